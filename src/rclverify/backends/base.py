@@ -1,0 +1,125 @@
+"""The backend plug-in interface (shared/DESIGN.md, steps 5 and 6).
+
+A backend turns one node's guarantees into :class:`Obligation` records
+(``export``) and produces one :class:`Evidence` record per obligation
+(``run``).  Backends are registered by name in :mod:`rclverify.backends`;
+the verification plan names them per node.
+
+Rules every backend keeps:
+
+* ``export`` is deterministic: same inputs, same obligations and byte-for-byte
+  the same rendered artifacts (no timestamps inside artifacts).
+* ``run`` never raises for a user-caused problem: a missing tool is
+  ``pending`` (with the reason and the command to run), a tool crash is
+  ``error``, a refutation is ``failed`` with a counterexample when there is one,
+  a timeout/unknown is ``inconclusive``.  Nothing unchecked is ``discharged``.
+* Every file the result depends on is listed in ``Obligation.inputs``
+  (workspace-relative); :func:`make_evidence` hashes them for staleness.
+"""
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+from datetime import datetime, timezone
+from pathlib import Path
+from typing import Any, Mapping, Protocol
+
+from ..evidence.records import Evidence, Obligation, hash_inputs
+from ..rcl import ast
+from ..rcl.types import Checked, CheckedNode
+
+
+@dataclass(frozen=True)
+class NodeTarget:
+    """Everything a backend needs to know about one node of the system.
+
+    ``root``            workspace root (absolute);
+    ``checked``         the whole type-checked system (environment + nodes);
+    ``node``            the node this target is about;
+    ``config``          the plan's evidence entry for this node and backend
+                        (the mapping under ``nodes.<Node>.evidence[k]``,
+                        including its ``backend`` key);
+    ``facts``           the plan's environment facts for this node, parsed;
+    ``contract_files``  workspace-relative RCL files of the system;
+    ``plan_file``       workspace-relative path of the plan;
+    ``artifacts``       absolute directory ``artifacts/<backend>/<node>/``
+                        where the backend renders its files;
+    ``index``           position of this entry among the node's evidence
+                        entries (distinguishes two entries of one backend).
+    """
+
+    root: Path
+    checked: Checked
+    node: CheckedNode
+    config: Mapping[str, Any]
+    facts: tuple[ast.Expr, ...] = ()
+    contract_files: tuple[str, ...] = ()
+    plan_file: str = "contracts/plan.yaml"
+    artifacts: Path = field(default_factory=Path)
+    index: int = 0
+
+    def rel(self, path: Path) -> str:
+        """``path`` relative to the workspace root, with forward slashes."""
+        return path.resolve().relative_to(self.root.resolve()).as_posix()
+
+
+class Backend(Protocol):
+    """A verification backend.  ``name`` is the plan's ``backend:`` value."""
+
+    name: str
+    kind: str
+
+    def export(self, target: NodeTarget) -> list[Obligation]:
+        """Render the node's obligations under ``target.artifacts`` and return them.
+
+        Raises :class:`rclverify.plan.errors.PlanError` for a configuration
+        the user got wrong (missing file, unmappable type ...).
+        """
+        ...
+
+    def run(self, obligation: Obligation, target: NodeTarget) -> Evidence:
+        """Check one exported obligation and return its evidence record."""
+        ...
+
+
+def utc_now() -> str:
+    """ISO-8601 UTC timestamp with second precision (evidence records only)."""
+    return datetime.now(timezone.utc).replace(microsecond=0).isoformat()
+
+
+class Stopwatch:
+    """Measures a run: ``started`` (ISO UTC) and ``elapsed()`` in seconds."""
+
+    def __init__(self) -> None:
+        self.started = utc_now()
+        self._t0 = time.perf_counter()
+
+    def elapsed(self) -> float:
+        return round(time.perf_counter() - self._t0, 4)
+
+
+def make_evidence(
+    target: NodeTarget,
+    obligation: Obligation,
+    status: str,
+    *,
+    tool: str,
+    tool_version: str,
+    clock: Stopwatch,
+    explanation: str = "",
+    log: str = "",
+    artifacts: tuple[str, ...] = (),
+    counterexample: Mapping[str, Any] | None = None,
+    details: Mapping[str, Any] | None = None,
+) -> Evidence:
+    """Build an :class:`Evidence` record for ``obligation``, hashing its inputs now.
+
+    ``status`` must be one of the statuses in :mod:`rclverify.evidence.records`.
+    """
+    return Evidence(
+        obligation=obligation.id, backend=obligation.backend, kind=obligation.kind, status=status,
+        tool=tool, tool_version=tool_version, started=clock.started, duration_s=clock.elapsed(),
+        input_hashes=hash_inputs(target.root, obligation.inputs), artifacts=artifacts,
+        log=log[-20000:], counterexample=dict(counterexample) if counterexample is not None else None,
+        explanation=explanation, details=dict(details or {}),
+    )

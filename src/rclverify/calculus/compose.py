@@ -1,0 +1,233 @@
+"""The composition calculus, applied automatically (paper lines 556-768).
+
+For each node ``n`` of the system model:
+
+* its assumption is split into top-level conjuncts; a conjunct that mentions
+  an internally produced input is *internal*, the rest are *environment
+  assumptions* left to the user;
+* each internal conjunct is a **side condition**: the guarantees of ``n``'s
+  producers must entail it (the premise after the turnstile in R1 and R3,
+  lines 564-590 and 664-690; R2, lines 612-640, when a producer feeds
+  several consumers).  Producers' outputs and ``n``'s inputs are the same Z3
+  symbol.  Each side condition is a recorded Z3 validity query;
+* the rules it instantiates: R1 (one producer), R3 (several producers), R2
+  (a producer of ``n`` branches to several consumers) and R4 (``n`` lies on
+  a loop, lines 717-768, with the extra assumption that rule rests on);
+* the rule instance's conclusion, ``A_p1 and ... and A_pk => <> G_n``
+  (for the Agent this is the paper's derivation D1, lines 1183-1250); and
+* the **derived property** of ``n`` over its whole upstream cone:
+  ``(environment assumptions of the cone) => <> G_n``.
+
+A side condition is ``discharged`` (Z3 proved it), ``failed`` (Z3 found a
+model of the producers' guarantees violating the conjunct; the model is
+shown in RCL names) or ``inconclusive`` (unknown/timeout; never proved).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any, Sequence
+
+from ..logic.encode import Encoder
+from ..logic.query import DEFAULT_TIMEOUT_MS, prove
+from ..rcl import ast
+from ..rcl.printer import expr_to_rcl
+from ..rcl.types import Checked
+from ..system.model import SystemModel
+
+STATUS = {"proved": "discharged", "refuted": "failed", "inconclusive": "inconclusive"}
+
+R4_ASSUMPTION = (
+    "Rule R4 (paper lines 717-768) is applied because {loop} form a loop. It rests on an extra assumption the "
+    "contracts cannot show: every node in the loop terminates and produces an output for each input that "
+    "satisfies its assumption, and outputs persist once produced (R3's simplifying assumption, line 660), so "
+    "the inputs that close the loop are available together. The paper assumes contracts are not circularly "
+    "dependent (line 712); this system's are."
+)
+
+
+def conjuncts(e: ast.Expr) -> list[ast.Expr]:
+    """Top-level conjuncts of a formula (``a and (b and c)`` -> ``[a, b, c]``)."""
+    if isinstance(e, ast.Binary) and e.op == "and":
+        return conjuncts(e.left) + conjuncts(e.right)
+    return [e]
+
+
+def free_io(e: ast.Expr, bound: frozenset[str] = frozenset()) -> set[tuple[str | None, str]]:
+    """The I/O names (prefix, name) a formula mentions, bound variables excluded."""
+    out: set[tuple[str | None, str]] = set()
+    if isinstance(e, ast.Var):
+        if e.prefix is not None or e.name not in bound:
+            out.add((e.prefix, e.name))
+    elif isinstance(e, ast.Apply):
+        out |= free_io(e.func, bound)
+        for a in e.args:
+            out |= free_io(a, bound)
+    elif isinstance(e, ast.Quant):
+        inner = bound | set(e.variables)
+        for b in e.bindings:
+            if not isinstance(b.domain, (ast.TBase, ast.TName, ast.TEnum, ast.TConstructors, ast.TFunc,
+                                         ast.TEmpty, ast.TSet, ast.TSeq, ast.TTuple)):
+                out |= free_io(b.domain, bound)
+        out |= free_io(e.body, frozenset(inner))
+    else:
+        for v in vars(e).values():
+            if isinstance(v, tuple):
+                for it in v:
+                    if isinstance(it, (ast.Var, ast.Apply, ast.Quant, ast.Binary, ast.Unary, ast.Compare,
+                                       ast.Member, ast.SetLit, ast.SeqLit, ast.TupleLit, ast.NumLit, ast.BoolLit)):
+                        out |= free_io(it, bound)
+            elif isinstance(v, (ast.Var, ast.Apply, ast.Quant, ast.Binary, ast.Unary, ast.Compare, ast.Member,
+                                ast.SetLit, ast.SeqLit, ast.TupleLit)):
+                out |= free_io(v, bound)
+    return out
+
+
+def _loc(l: ast.Loc) -> str:
+    return f"{l.file}:{l.line}:{l.col}"
+
+
+def contract_text(exprs: Sequence[ast.Expr]) -> str:
+    """Conjunction of formulas as RCL text (``TRUE`` when empty)."""
+    if not exprs:
+        return "TRUE"
+    if len(exprs) == 1:
+        return expr_to_rcl(exprs[0])
+    return " and ".join(f"({expr_to_rcl(e)})" for e in exprs)
+
+
+@dataclass(frozen=True)
+class SideCondition:
+    id: str
+    node: str
+    rule: str
+    conjunct: str
+    source: str
+    hypotheses: tuple[str, ...]
+    status: str
+    duration_s: float
+    smt2: str
+    model: dict[str, str] | None = None
+    explanation: str = ""
+
+    def to_json(self, smt2_path: str) -> dict[str, Any]:
+        return {"id": self.id, "node": self.node, "rule": self.rule, "conjunct": self.conjunct,
+                "source": self.source, "hypotheses": list(self.hypotheses), "status": self.status,
+                "duration_s": self.duration_s, "smt2": smt2_path, "model": self.model,
+                "explanation": self.explanation}
+
+
+@dataclass(frozen=True)
+class NodeComposition:
+    """Everything the calculus says about one node (JSON via :meth:`to_json`)."""
+
+    node: str
+    rules: tuple[str, ...]
+    producers: tuple[str, ...]
+    side_conditions: tuple[SideCondition, ...]
+    environment_assumptions: tuple[dict[str, str], ...]
+    instances: tuple[dict[str, Any], ...]
+    derived_property: str
+    cone: tuple[str, ...]
+    loop_assumption: str | None = None
+    extra: dict[str, Any] = field(default_factory=dict)
+
+
+def _rules(model: SystemModel, node: str) -> tuple[str, ...]:
+    producers = model.producers(node)
+    rules = []
+    if len(producers) == 1:
+        rules.append("R1")
+    elif len(producers) > 1:
+        rules.append("R3")
+    if any(len(model.consumers(p)) > 1 for p in producers):
+        rules.append("R2")
+    if model.loop_of(node):
+        rules.append("R4")
+    return tuple(rules)
+
+
+def split_assumption(checked: Checked, model: SystemModel, node: str) -> tuple[list[ast.Expr], list[ast.Expr]]:
+    """(internal conjuncts, environment conjuncts) of ``node``'s assumption."""
+    cn = checked.nodes[node]
+    internal_vars = model.internal_inputs(node)
+    internal, env = [], []
+    for cl in cn.node.assumes:
+        for c in conjuncts(cl.formula):
+            names = {n for p, n in free_io(c) if (p == "in" or (p is None and n in cn.inputs))}
+            (internal if names & internal_vars else env).append(c)
+    return internal, env
+
+
+def compose_node(checked: Checked, model: SystemModel, node: str, *,
+                 timeout_ms: int = DEFAULT_TIMEOUT_MS) -> NodeComposition:
+    """Apply the calculus to ``node``: discharge its side conditions with Z3.
+
+    Returns a :class:`NodeComposition`.  Never raises on solver trouble
+    (an unknown answer is an ``inconclusive`` side condition).
+    """
+    cn = checked.nodes[node]
+    producers = model.producers(node)
+    rules = _rules(model, node)
+    internal, env = split_assumption(checked, model, node)
+    enc = Encoder(checked.env, model.alias())
+    hyps, hyp_text = [], []
+    for p in producers:
+        pn = checked.nodes[p]
+        for k, g in enumerate(pn.node.guarantees, 1):
+            hyps.append(enc.formula(g.formula, pn))
+            hyp_text.append(f"{p} guarantee {k}: {expr_to_rcl(g.formula)}")
+    rule = "R3" if len(producers) > 1 else "R1"
+    scs = []
+    for k, c in enumerate(internal, 1):
+        goal = enc.formula(c, cn)
+        r = prove(goal, hyps, enc, timeout_ms=timeout_ms,
+                  comment=f"rclverify side condition {node}.sc{k} ({rule}): guarantees of {', '.join(producers)} "
+                          f"entail {expr_to_rcl(c)}\nsource {_loc(c.loc)}; unsat means discharged")
+        status = STATUS[r.status]
+        if status == "discharged":
+            expl = f"Z3 proved that the guarantees of {', '.join(producers)} entail this conjunct of {node}'s assumption."
+        elif status == "failed":
+            expl = (f"Z3 found values satisfying every guarantee of {', '.join(producers)} that violate this conjunct "
+                    f"of {node}'s assumption (model below); the nodes are not correctly linked.")
+        else:
+            expl = f"Z3 could not decide the side condition ({r.reason or 'unknown'}); it is not proved."
+        scs.append(SideCondition(f"{node}.sc{k}", node, rule, expr_to_rcl(c), _loc(c.loc), tuple(hyp_text),
+                                 status, r.duration_s, r.smt2, r.model, expl))
+    env_assumptions = tuple({"node": node, "text": expr_to_rcl(c), "source": _loc(c.loc)} for c in env)
+    g_text = contract_text([g.formula for g in cn.node.guarantees])
+    a_text = contract_text([a.formula for a in cn.node.assumes])
+    instances = []
+    if producers:
+        premises = []
+        prem_a = []
+        for p in producers:
+            pn = checked.nodes[p]
+            pa = contract_text([a.formula for a in pn.node.assumes])
+            premises.append(f"{p}: ({pa}) => <> ({contract_text([g.formula for g in pn.node.guarantees])})")
+            prem_a.append(pa)
+        premises.append(f"{node}: ({a_text}) => <> ({g_text})")
+        premises.append("side condition: " + " and ".join(f"G_{p}" for p in producers) + f" => A_{node}"
+                        + ("" if scs else " (no conjunct of the assumption ranges over produced inputs)"))
+        instances.append({"rule": rule, "premises": premises,
+                          "conclusion": " and ".join(f"({a})" for a in prem_a) + f" => <> G_{node}"})
+    cone = model.upstream(node)
+    cone_env = []
+    for m in cone:
+        _, env_m = split_assumption(checked, model, m)
+        cone_env.extend(f"{expr_to_rcl(c)}  [{m}]" for c in env_m)
+    derived = ("(" + " and ".join(c.split("  [")[0] for c in cone_env) + ")" if cone_env else "TRUE") + f" => <> G_{node}"
+    loop = model.loop_of(node)
+    return NodeComposition(node, rules, tuple(producers), tuple(scs), env_assumptions, tuple(instances), derived,
+                           tuple(cone), R4_ASSUMPTION.format(loop="{" + ", ".join(loop) + "}") if loop else None,
+                           {"cone_environment_assumptions": cone_env, "guarantee": g_text})
+
+
+def composition_json(c: NodeComposition, smt2_paths: Sequence[str]) -> dict[str, Any]:
+    """JSON form of a node's composition; ``smt2_paths`` parallel to its side conditions."""
+    return {
+        "node": c.node, "rules": list(c.rules), "producers": list(c.producers),
+        "side_conditions": [sc.to_json(p) for sc, p in zip(c.side_conditions, smt2_paths)],
+        "environment_assumptions": list(c.environment_assumptions), "instances": list(c.instances),
+        "derived_property": c.derived_property, "cone": list(c.cone), "loop_assumption": c.loop_assumption,
+        "cone_environment_assumptions": c.extra["cone_environment_assumptions"], "guarantee": c.extra["guarantee"],
+    }

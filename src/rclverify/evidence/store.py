@@ -1,0 +1,112 @@
+"""Atomic JSON storage of obligations and evidence under ``artifacts/``.
+
+Every write goes to a temporary file in the destination directory and is
+moved into place with :func:`os.replace`, so a crash or a failing stage never
+leaves a half-written record and never loses the record already there.
+"""
+from __future__ import annotations
+
+import json
+import os
+import tempfile
+from pathlib import Path
+from typing import Any, Iterable
+
+from .records import Evidence, Obligation, hash_inputs
+
+
+def atomic_write_text(path: Path, text: str) -> bool:
+    """Write ``text`` to ``path`` atomically; skip the write when the file
+    already holds exactly ``text``.
+
+    Returns ``True`` when the file changed.  Parent directories are created.
+    Raises ``OSError`` when the directory cannot be written.
+    """
+    path.parent.mkdir(parents=True, exist_ok=True)
+    try:
+        if path.read_text(encoding="utf-8") == text:
+            return False
+    except (FileNotFoundError, UnicodeDecodeError):
+        pass
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+    try:
+        with os.fdopen(fd, "w", encoding="utf-8") as fh:
+            fh.write(text)
+            fh.flush()
+            os.fsync(fh.fileno())
+        os.replace(tmp, path)
+    except BaseException:
+        try:
+            os.unlink(tmp)
+        except FileNotFoundError:
+            pass
+        raise
+    return True
+
+
+def dumps(value: Any) -> str:
+    """Deterministic JSON text: sorted keys, two-space indent, final newline."""
+    return json.dumps(value, sort_keys=True, indent=2, ensure_ascii=False) + "\n"
+
+
+def write_json(path: Path, value: Any) -> bool:
+    """Atomically write ``value`` as deterministic JSON (see :func:`dumps`)."""
+    return atomic_write_text(path, dumps(value))
+
+
+def read_json(path: Path) -> Any:
+    """Read a JSON file.  Raises ``FileNotFoundError`` / ``json.JSONDecodeError``."""
+    return json.loads(path.read_text(encoding="utf-8"))
+
+
+class EvidenceStore:
+    """Evidence records under ``<root>/artifacts/evidence/<obligation id>.json``.
+
+    ``root`` is the workspace directory.
+    """
+
+    def __init__(self, root: Path) -> None:
+        self.root = root
+        self.dir = root / "artifacts" / "evidence"
+
+    def path(self, obligation_id: str) -> Path:
+        return self.dir / f"{obligation_id}.json"
+
+    def put(self, ev: Evidence) -> Path:
+        """Store ``ev`` atomically, replacing the previous record for its obligation."""
+        p = self.path(ev.obligation)
+        write_json(p, ev.to_json())
+        return p
+
+    def get(self, obligation_id: str) -> Evidence | None:
+        """The stored record, or ``None`` when there is none (or it is unreadable)."""
+        try:
+            return Evidence.from_json(read_json(self.path(obligation_id)))
+        except (FileNotFoundError, ValueError, KeyError, TypeError):
+            return None
+
+    def all(self) -> list[Evidence]:
+        """Every readable record, sorted by obligation id."""
+        out = []
+        for p in sorted(self.dir.glob("*.json")):
+            ev = self.get(p.stem)
+            if ev is not None:
+                out.append(ev)
+        return out
+
+    def current_status(self, ev: Evidence) -> str:
+        """``ev.status``, or ``"stale"`` when any input's sha256 changed since."""
+        now = hash_inputs(self.root, list(ev.input_hashes))
+        if any(now[p] != h for p, h in ev.input_hashes.items()):
+            return "stale"
+        return ev.status
+
+
+def write_obligations(path: Path, obligations: Iterable[Obligation]) -> bool:
+    """Write a list of obligations (sorted by id) atomically as JSON."""
+    return write_json(path, [o.to_json() for o in sorted(obligations, key=lambda o: o.id)])
+
+
+def read_obligations(path: Path) -> list[Obligation]:
+    """Read obligations written by :func:`write_obligations`."""
+    return [Obligation.from_json(d) for d in read_json(path)]

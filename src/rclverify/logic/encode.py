@@ -1,0 +1,425 @@
+"""RCL formulas -> Z3 (shared/DESIGN.md "Semantics the tool commits to").
+
+Encoding
+--------
+* ``REAL`` -> Real, ``INTEGER`` -> Int, ``NATURAL`` -> Int with ``>= 0``
+  guards on every bound variable (``forall``: guard ``->`` body, ``exists``:
+  guard ``and`` body) and an axiom for every free symbol (:meth:`Encoder.axioms`),
+  ``BOOL`` -> Bool.
+* Enumerations -> Z3 enumeration sorts, constructor sets -> algebraic
+  datatypes (accessor ``<ctor>_<k>``, recogniser ``is_<ctor>``), both named
+  after their context type; function types -> uninterpreted functions;
+  ``set(T)`` -> Z3 sets, ``seq(T)`` -> Z3 sequences, tuples -> datatypes.
+* ``exists_unique(x, y in D | P)`` -> ``exists x, y. P and forall x2, y2.
+  P[x2, y2] -> x2 == x and y2 == y`` (uniqueness of the tuple).
+* Quantifying over the empty type ``{}``: ``forall`` is TRUE, ``exists``
+  FALSE; a formula that needs a value of the empty type is rejected.
+* Free I/O variables become symbols named ``<Node>.<in|out>.<name>``;
+  ``alias`` (the system model's connections) renames a consumer's input to
+  the producer's output symbol, so that "an output variable and the input
+  variable it feeds are the same symbol in the composed query".
+
+Sorts are cached per process, so two encoders (e.g. a contract's and a Hoare
+program's) agree on the sort ``RadStat``.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from fractions import Fraction
+from typing import Any, Callable, Mapping
+
+import z3
+
+from ..rcl import ast
+from ..rcl.types import (BOOL, NATURAL, Checked, CheckedNode, DataT, EmptyT, EnumT, Env, FuncT, Scalar, SeqT,
+                         SetT, TupleT, Type)
+from ..rcl.typecheck import domain_type
+
+_SORTS: dict[Type, Any] = {}
+_ENUM_CONSTS: dict[tuple[str, str], z3.ExprRef] = {}
+
+
+class EncodingError(Exception):
+    """A well-typed formula that the Z3 encoding does not support (located)."""
+
+    def __init__(self, loc: ast.Loc, message: str) -> None:
+        self.loc = loc
+        super().__init__(f"{loc}: error: {message}")
+
+
+def sort_of(t: Type) -> z3.SortRef:
+    """Z3 sort of a resolved RCL type (cached per process).
+
+    Raises :class:`ValueError` for the empty type and for function types,
+    which are not first-class values (they become uninterpreted functions).
+    """
+    if t in _SORTS:
+        return _SORTS[t]  # type: ignore[no-any-return]
+    s: Any
+    if isinstance(t, Scalar):
+        s = {"REAL": z3.RealSort(), "INTEGER": z3.IntSort(), "NATURAL": z3.IntSort(), "BOOL": z3.BoolSort()}[t.name]
+    elif isinstance(t, EnumT):
+        s, consts = z3.EnumSort(t.name, list(t.values))
+        for v, c in zip(t.values, consts):
+            _ENUM_CONSTS[(t.name, v)] = c
+    elif isinstance(t, DataT):
+        dt = z3.Datatype(t.name)
+        for cname, args in t.ctors:
+            dt.declare(cname, *[(f"{cname}_{k}", sort_of(a)) for k, a in enumerate(args)])
+        s = dt.create()
+    elif isinstance(t, TupleT):
+        name = "Tuple_" + "_".join(str(sort_of(e)) for e in t.elems)
+        dt = z3.Datatype(name)
+        dt.declare("mk_" + name, *[(f"{name}_{k}", sort_of(e)) for k, e in enumerate(t.elems)])
+        s = dt.create()
+    elif isinstance(t, SetT):
+        s = z3.SetSort(sort_of(t.elem))
+    elif isinstance(t, SeqT):
+        s = z3.SeqSort(sort_of(t.elem))
+    elif isinstance(t, EmptyT):
+        raise ValueError(f"the empty type {t} has no values")
+    else:
+        raise ValueError(f"function type {t} is not a first-class value")
+    _SORTS[t] = s
+    return s  # type: ignore[no-any-return]
+
+
+def enum_const(t: EnumT, value: str) -> z3.ExprRef:
+    """The Z3 constant for enumeration value ``value`` of ``t``."""
+    sort_of(t)
+    return _ENUM_CONSTS[(t.name, value)]
+
+
+def _ctor(t: DataT, name: str) -> z3.FuncDeclRef:
+    s: Any = sort_of(t)
+    for k in range(s.num_constructors()):
+        if s.constructor(k).name() == name:
+            return s.constructor(k)  # type: ignore[no-any-return]
+    raise KeyError(name)
+
+
+def _recogniser(t: DataT, name: str) -> z3.FuncDeclRef:
+    s: Any = sort_of(t)
+    for k in range(s.num_constructors()):
+        if s.constructor(k).name() == name:
+            return s.recognizer(k)  # type: ignore[no-any-return]
+    raise KeyError(name)
+
+
+@dataclass(frozen=True)
+class Symbol:
+    """A free symbol created by the encoder: its Z3 name, RCL display name and type."""
+
+    z3name: str
+    display: str
+    type: Type
+    decl: Any  # z3.ExprRef for constants, z3.FuncDeclRef for functions
+
+
+def _coerce(a: z3.ExprRef, b: z3.ExprRef) -> tuple[z3.ExprRef, z3.ExprRef]:
+    """Widen Int to Real when one side is Real."""
+    if z3.is_int(a) and z3.is_real(b):
+        return z3.ToReal(a), b
+    if z3.is_real(a) and z3.is_int(b):
+        return a, z3.ToReal(b)
+    return a, b
+
+
+def _to_sort(x: z3.ExprRef, s: z3.SortRef) -> z3.ExprRef:
+    if s == z3.RealSort() and z3.is_int(x):
+        return z3.ToReal(x)
+    return x
+
+
+class Encoder:
+    """Encodes RCL formulas of one system into Z3.
+
+    ``env``    the checked environment (context types, constants, values);
+    ``alias``  maps ``(node, "in"|"out", var)`` to the canonical symbol name
+               another I/O variable uses (consumer input -> producer output).
+    """
+
+    def __init__(self, env: Env, alias: Mapping[tuple[str, str, str], str] | None = None) -> None:
+        self.env = env
+        self.alias = dict(alias or {})
+        self.symbols: dict[str, Symbol] = {}
+
+    @staticmethod
+    def for_system(checked: Checked, alias: Mapping[tuple[str, str, str], str] | None = None) -> "Encoder":
+        return Encoder(checked.env, alias)
+
+    # -- sorts and values ------------------------------------------------------------
+    def sort(self, t: Type) -> z3.SortRef:
+        """See :func:`sort_of`."""
+        return sort_of(t)
+
+    def enum_value(self, name: str) -> z3.ExprRef:
+        """Z3 constant of an enumeration value (or argument-less constructor)."""
+        if name in self.env.enum_values:
+            return enum_const(self.env.enum_values[name], name)
+        return _ctor(self.env.ctors[name], name)()
+
+    def ctor(self, name: str) -> z3.FuncDeclRef:
+        """Z3 constructor of constructor-set alternative ``name``."""
+        return _ctor(self.env.ctors[name], name)
+
+    # -- symbols --------------------------------------------------------------------------
+    def symbol_name(self, node: str, prefix: str, var: str) -> str:
+        return self.alias.get((node, prefix, var), f"{node}.{prefix}.{var}")
+
+    def io_symbol(self, node: CheckedNode, prefix: str, var: str) -> Any:
+        """The Z3 constant (or function declaration) of ``node``'s ``prefix.var``."""
+        t = node.inputs[var] if prefix == "in" else node.outputs[var]
+        name = self.symbol_name(node.name, prefix, var)
+        if name in self.symbols:
+            return self.symbols[name].decl
+        display = name if name.count(".") >= 2 else f"{node.name}.{prefix}.{var}"
+        if isinstance(t, FuncT):
+            decl: Any = z3.Function(name, *[sort_of(a) for a in t.args], sort_of(t.result))
+        else:
+            decl = z3.Const(name, sort_of(t))
+        self.symbols[name] = Symbol(name, display, t, decl)
+        return decl
+
+    def axioms(self) -> list[z3.BoolRef]:
+        """Typing side constraints of every free symbol created so far.
+
+        NATURAL constants are ``>= 0``; functions with a NATURAL result are
+        ``>= 0`` everywhere; constructor-set constants have NATURAL fields
+        ``>= 0``.
+        """
+        out: list[z3.BoolRef] = []
+        for sym in self.symbols.values():
+            t = sym.type
+            if t == NATURAL:
+                out.append(sym.decl >= 0)
+            elif isinstance(t, FuncT) and t.result == NATURAL:
+                xs = [z3.Const(f"_a{k}", sort_of(a)) for k, a in enumerate(t.args)]
+                out.append(z3.ForAll(xs, sym.decl(*xs) >= 0) if xs else sym.decl() >= 0)
+            elif isinstance(t, DataT):
+                for cname, args in t.ctors:
+                    for k, a in enumerate(args):
+                        if a == NATURAL:
+                            acc = getattr(sort_of(t), f"{cname}_{k}")
+                            out.append(z3.Implies(_recogniser(t, cname)(sym.decl), acc(sym.decl) >= 0))
+        return out
+
+    # -- formulas ----------------------------------------------------------------------------
+    def formula(self, e: ast.Expr, node: CheckedNode, symbols: Mapping[str, Any] | None = None) -> z3.BoolRef:
+        """Encode a (type-checked) formula of ``node``.
+
+        ``symbols`` maps qualified I/O names (``"in.r"``, ``"out.x"``) to Z3
+        terms (or function declarations) used instead of the node's symbols.
+        Raises :class:`EncodingError` for unsupported constructs.
+        """
+        r = _Ctx(self, node, dict(symbols or {})).enc(e, {})
+        if not z3.is_bool(r):
+            raise EncodingError(e.loc, "expected a formula")
+        return r  # type: ignore[no-any-return]
+
+    def term(self, e: ast.Expr, node: CheckedNode, symbols: Mapping[str, Any] | None = None) -> z3.ExprRef:
+        """Encode a term (e.g. the left-hand side of a binding) of ``node``."""
+        return _Ctx(self, node, dict(symbols or {})).enc(e, {})
+
+
+class _Ctx:
+    def __init__(self, enc: Encoder, node: CheckedNode, symbols: dict[str, Any]) -> None:
+        self.e, self.node, self.symbols = enc, node, symbols
+
+    # -- names -------------------------------------------------------------------------
+    def io(self, v: ast.Var) -> Any:
+        prefix = v.prefix or ("in" if v.name in self.node.inputs else "out")
+        q = f"{prefix}.{v.name}"
+        if q in self.symbols:
+            return self.symbols[q]
+        if v.prefix is None and v.name in self.symbols:
+            return self.symbols[v.name]
+        t = self.node.inputs.get(v.name) if prefix == "in" else self.node.outputs.get(v.name)
+        if isinstance(t, EmptyT):
+            raise EncodingError(v.loc, f"{q} has the empty type {t}; no formula can use its value")
+        return self.e.io_symbol(self.node, prefix, v.name)
+
+    def var(self, v: ast.Var, bound: Mapping[str, z3.ExprRef]) -> Any:
+        if v.prefix is not None:
+            return self.io(v)
+        if v.name in bound:
+            return bound[v.name]
+        if v.name in self.node.inputs or v.name in self.node.outputs:
+            return self.io(v)
+        env = self.e.env
+        if v.name in env.constants:
+            return self.enc(env.constants[v.name][1], {})
+        if v.name in env.enum_values or v.name in env.ctors:
+            return self.e.enum_value(v.name)
+        raise EncodingError(v.loc, f"unknown name {v.name!r}")
+
+    # -- expressions ---------------------------------------------------------------------
+    def enc(self, x: ast.Expr, bound: Mapping[str, z3.ExprRef]) -> Any:
+        m: Callable[..., Any] = getattr(self, "e_" + type(x).__name__)
+        return m(x, bound)
+
+    def e_BoolLit(self, x: ast.BoolLit, b: Mapping[str, Any]) -> Any:
+        return z3.BoolVal(x.value)
+
+    def e_NumLit(self, x: ast.NumLit, b: Mapping[str, Any]) -> Any:
+        v = x.value
+        if x.is_integral:
+            return z3.IntVal(int(v))
+        return z3.RealVal(f"{v.numerator}/{v.denominator}")
+
+    def e_Var(self, x: ast.Var, b: Mapping[str, Any]) -> Any:
+        r = self.var(x, b)
+        if isinstance(r, z3.FuncDeclRef) and r.arity() > 0:
+            raise EncodingError(x.loc, f"{x.qualified} is a function; comparing whole functions is not supported, apply it")
+        return r() if isinstance(r, z3.FuncDeclRef) else r
+
+    def e_Apply(self, x: ast.Apply, b: Mapping[str, Any]) -> Any:
+        f = x.func
+        args = [self.enc(a, b) for a in x.args]
+        is_value = f.prefix is not None or f.name in b or f.name in self.node.inputs or f.name in self.node.outputs
+        if not is_value and f.name in self.e.env.ctors:
+            c = self.e.ctor(f.name)
+            return c(*[_to_sort(a, c.domain(k)) for k, a in enumerate(args)])
+        fn = self.var(f, b)
+        if isinstance(fn, z3.FuncDeclRef):
+            return fn(*[_to_sort(a, fn.domain(k)) for k, a in enumerate(args)])
+        raise EncodingError(x.loc, f"{f.qualified} cannot be applied")
+
+    def e_Unary(self, x: ast.Unary, b: Mapping[str, Any]) -> Any:
+        v = self.enc(x.operand, b)
+        return z3.Not(v) if x.op == "not" else -v
+
+    def e_Binary(self, x: ast.Binary, b: Mapping[str, Any]) -> Any:
+        lhs, rhs = self.enc(x.left, b), self.enc(x.right, b)
+        op = x.op
+        if op == "and":
+            return z3.And(lhs, rhs)
+        if op == "or":
+            return z3.Or(lhs, rhs)
+        if op == "->":
+            return z3.Implies(lhs, rhs)
+        if op == "<=>":
+            return lhs == rhs
+        if op == "/":
+            return z3.ToReal(lhs) / z3.ToReal(rhs) if not (z3.is_real(lhs) and z3.is_real(rhs)) else lhs / rhs
+        lhs, rhs = _coerce(lhs, rhs)
+        return {"+": lambda: lhs + rhs, "-": lambda: lhs - rhs, "*": lambda: lhs * rhs}[op]()
+
+    def e_Compare(self, x: ast.Compare, b: Mapping[str, Any]) -> Any:
+        vals = [self.enc(o, b) for o in x.operands]
+        parts = []
+        for op, a, c in zip(x.ops, vals, vals[1:]):
+            a, c = _coerce(a, c)
+            parts.append({"==": lambda: a == c, "!=": lambda: a != c, "<": lambda: a < c, "<=": lambda: a <= c,
+                          ">": lambda: a > c, ">=": lambda: a >= c}[op]())
+        return parts[0] if len(parts) == 1 else z3.And(*parts)
+
+    def member(self, elem: Any, coll: ast.Expr, b: Mapping[str, Any]) -> Any:
+        env = self.e.env
+        if isinstance(coll, ast.SetLit) or isinstance(coll, ast.SeqLit):
+            items = [self.enc(i, b) for i in coll.items]
+            eqs = [(lambda p: p[0] == p[1])(_coerce(elem, i)) for i in items]
+            return z3.Or(*eqs) if eqs else z3.BoolVal(False)
+        if isinstance(coll, ast.Var) and coll.prefix is None and coll.name not in b and coll.name in env.types \
+                and coll.name not in self.node.inputs and coll.name not in self.node.outputs:
+            t = env.types[coll.name]
+            return elem >= 0 if t == NATURAL else z3.BoolVal(True)
+        s = self.enc(coll, b)
+        if z3.is_seq(s):
+            return z3.Contains(s, z3.Unit(elem))
+        return z3.IsMember(elem, s)
+
+    def e_Member(self, x: ast.Member, b: Mapping[str, Any]) -> Any:
+        r = self.member(self.enc(x.elem, b), x.collection, b)
+        return z3.Not(r) if x.negated else r
+
+    def e_SetLit(self, x: ast.SetLit, b: Mapping[str, Any]) -> Any:
+        if not x.items:
+            raise EncodingError(x.loc, "an empty set literal is only supported on the right of 'in'")
+        items = [self.enc(i, b) for i in x.items]
+        s = z3.EmptySet(items[0].sort())
+        for i in items:
+            s = z3.SetAdd(s, i)
+        return s
+
+    def e_SeqLit(self, x: ast.SeqLit, b: Mapping[str, Any]) -> Any:
+        if not x.items:
+            raise EncodingError(x.loc, "an empty sequence literal is not supported here")
+        items = [z3.Unit(self.enc(i, b)) for i in x.items]
+        return items[0] if len(items) == 1 else z3.Concat(*items)
+
+    def e_TupleLit(self, x: ast.TupleLit, b: Mapping[str, Any]) -> Any:
+        raise EncodingError(x.loc, "tuple literals are not supported by the Z3 encoding yet")
+
+    def e_Quant(self, x: ast.Quant, b: Mapping[str, Any]) -> Any:
+        inner = dict(b)
+        xs: list[z3.ExprRef] = []
+        guards: list[Any] = []
+        for bd in x.bindings:
+            t = domain_type(bd, self.node, self.e.env, self._bound_types(b))
+            if isinstance(t, EmptyT):
+                return z3.BoolVal(x.kind == "forall")
+            if isinstance(t, FuncT):
+                raise EncodingError(bd.loc, "quantifying over functions is not supported")
+            for nm in bd.names:
+                v = z3.Const(nm, sort_of(t))
+                inner[nm] = v
+                xs.append(v)
+                if t == NATURAL:
+                    guards.append(v >= 0)
+                if not isinstance(bd.domain, (ast.TBase, ast.TName, ast.TEnum, ast.TConstructors, ast.TEmpty,
+                                              ast.TSet, ast.TSeq, ast.TTuple, ast.TFunc)) or (
+                        isinstance(bd.domain, ast.TName) and bd.domain.name not in self.e.env.types):
+                    coll = bd.domain if not isinstance(bd.domain, ast.TName) else ast.Var(bd.domain.name, None, bd.domain.loc)
+                    guards.append(self.member(v, coll, b))  # type: ignore[arg-type]
+        body = self.enc(x.body, inner)
+        guard = z3.And(*guards) if guards else None
+        if x.kind == "forall":
+            return z3.ForAll(xs, z3.Implies(guard, body) if guard is not None else body)
+        core = z3.And(guard, body) if guard is not None else body
+        if x.kind == "exists":
+            return z3.Exists(xs, core)
+        ys = [z3.Const(str(v) + "_u", v.sort()) for v in xs]
+        body_y = z3.substitute(core, *zip(xs, ys))
+        unique = z3.ForAll(ys, z3.Implies(body_y, z3.And(*[y == v for y, v in zip(ys, xs)])))
+        return z3.Exists(xs, z3.And(core, unique))
+
+    def _bound_types(self, b: Mapping[str, Any]) -> dict[str, Type]:
+        out: dict[str, Type] = {}
+        for nm, v in b.items():
+            s = v.sort()
+            if s == z3.RealSort():
+                out[nm] = Scalar("REAL")
+            elif s == z3.IntSort():
+                out[nm] = Scalar("INTEGER")
+            elif s == z3.BoolSort():
+                out[nm] = BOOL
+            else:
+                for t, st in _SORTS.items():
+                    if st == s:
+                        out[nm] = t
+                        break
+        return out
+
+
+def value_to_rcl(v: z3.ExprRef) -> str:
+    """Render a Z3 model value in RCL notation (``move(1.5, 0)``, ``green``, ``7/3``)."""
+    if z3.is_int_value(v):
+        return str(v.as_long())  # type: ignore[attr-defined]
+    if z3.is_rational_value(v):
+        fr = Fraction(v.numerator_as_long(), v.denominator_as_long())  # type: ignore[attr-defined]
+        if fr.denominator == 1:
+            return str(fr.numerator)
+        dec = float(fr)
+        return repr(dec) if Fraction(dec) == fr else f"{fr.numerator}/{fr.denominator}"
+    if z3.is_algebraic_value(v):
+        return v.as_decimal(6)  # type: ignore[attr-defined, no-any-return]
+    if z3.is_true(v):
+        return "TRUE"
+    if z3.is_false(v):
+        return "FALSE"
+    if z3.is_app(v) and v.num_args() > 0:
+        return f"{v.decl().name()}(" + ", ".join(value_to_rcl(a) for a in v.children()) + ")"
+    if z3.is_app(v):
+        return v.decl().name()
+    return str(v)

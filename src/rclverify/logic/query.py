@@ -1,0 +1,146 @@
+"""Validity and satisfiability queries with Z3, and their explanations.
+
+Every query:
+
+* runs with a per-query timeout (milliseconds);
+* maps Z3's answer to the tool's verdicts without ever upgrading an
+  ``unknown``: validity -> ``proved`` (negation unsat) / ``refuted`` (sat,
+  with a model) / ``inconclusive`` (unknown or timeout); satisfiability ->
+  ``sat`` (with a model) / ``unsat`` (with an unsat core of the labelled
+  formulas) / ``inconclusive``;
+* keeps its SMT-LIB2 text so a second solver can re-check it
+  (shared/DESIGN.md, "Calculus").
+
+Models are rendered in RCL terms by :func:`render_model`.
+"""
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+from typing import Any, Sequence
+
+import z3
+
+from .encode import Encoder, value_to_rcl
+
+DEFAULT_TIMEOUT_MS = 10_000
+
+
+@dataclass(frozen=True)
+class QueryResult:
+    """Outcome of one query.
+
+    ``status``    ``proved``/``refuted``/``inconclusive`` for validity,
+                  ``sat``/``unsat``/``inconclusive`` for satisfiability;
+    ``model``     RCL name -> RCL value text (refuted or sat), else ``None``;
+    ``core``      labels of the formulas in an unsat core (unsat), else ``None``;
+    ``smt2``      the query as an SMT-LIB2 script;
+    ``reason``    Z3's reason for ``unknown`` ('' otherwise);
+    ``duration_s`` wall time in seconds.
+    """
+
+    status: str
+    smt2: str
+    duration_s: float
+    model: dict[str, str] | None = None
+    core: list[str] | None = None
+    reason: str = ""
+    extra: dict[str, Any] = field(default_factory=dict)
+
+
+def _solver(timeout_ms: int) -> z3.Solver:
+    s = z3.Solver()
+    s.set("timeout", int(timeout_ms))
+    return s
+
+
+def _smt2(formulas: Sequence[z3.BoolRef], comment: str) -> str:
+    s = z3.Solver()
+    for f in formulas:
+        s.add(f)
+    header = "".join(f"; {line}\n" for line in comment.splitlines())
+    return header + s.to_smt2()
+
+
+def prove(goal: z3.BoolRef, hypotheses: Sequence[z3.BoolRef], enc: Encoder | None = None, *,
+          timeout_ms: int = DEFAULT_TIMEOUT_MS, comment: str = "") -> QueryResult:
+    """Is ``hypotheses => goal`` valid?  Checks ``hypotheses and not goal``.
+
+    ``enc`` (when given) renders a refuting model in RCL terms and adds its
+    typing axioms to the hypotheses.  Never raises on solver trouble:
+    an unknown answer is ``inconclusive`` with Z3's reason.
+    """
+    hyps = list(hypotheses) + (enc.axioms() if enc else [])
+    formulas = hyps + [z3.Not(goal)]
+    s = _solver(timeout_ms)
+    s.add(*formulas)
+    t0 = time.perf_counter()
+    r = s.check()
+    dt = round(time.perf_counter() - t0, 4)
+    text = _smt2(formulas, comment or "validity query: unsat means the goal follows from the hypotheses")
+    if r == z3.unsat:
+        return QueryResult("proved", text, dt)
+    if r == z3.sat:
+        return QueryResult("refuted", text, dt, model=render_model(s.model(), enc))
+    return QueryResult("inconclusive", text, dt, reason=s.reason_unknown())
+
+
+def satisfiable(labelled: Sequence[tuple[str, z3.BoolRef]], enc: Encoder | None = None, *,
+                timeout_ms: int = DEFAULT_TIMEOUT_MS, comment: str = "") -> QueryResult:
+    """Can all the labelled formulas hold together?
+
+    On ``unsat`` the result's ``core`` lists the labels of an unsat core
+    (the encoder's typing axioms are unlabelled background).
+    """
+    background = enc.axioms() if enc else []
+    s = _solver(timeout_ms)
+    s.set("unsat_core", True)
+    s.add(*background)
+    trackers = {}
+    for k, (label, f) in enumerate(labelled):
+        b = z3.Bool(f"__label_{k}")
+        trackers[str(b)] = label
+        s.assert_and_track(f, b)
+    t0 = time.perf_counter()
+    r = s.check()
+    dt = round(time.perf_counter() - t0, 4)
+    text = _smt2(background + [f for _, f in labelled], comment or "satisfiability query")
+    if r == z3.sat:
+        return QueryResult("sat", text, dt, model=render_model(s.model(), enc))
+    if r == z3.unsat:
+        core = sorted({trackers[str(c)] for c in s.unsat_core() if str(c) in trackers},
+                      key=[lbl for lbl, _ in labelled].index)
+        return QueryResult("unsat", text, dt, core=core)
+    return QueryResult("inconclusive", text, dt, reason=s.reason_unknown())
+
+
+def render_model(model: z3.ModelRef, enc: Encoder | None) -> dict[str, str]:
+    """The free symbols of ``enc`` (or every declaration of ``model``) in RCL terms.
+
+    Constants map to their value (``green``, ``move(0.5, 1)``); functions to a
+    finite table ``{(0, 0) -> 3, else -> 0}``.  Names are the RCL names of the
+    symbols (``Agent.in.wayP``).
+    """
+    out: dict[str, str] = {}
+    decls = {d.name(): d for d in model.decls()}
+    names = ({n: s.display for n, s in enc.symbols.items()} if enc else {n: n for n in decls})
+    for z3name, display in sorted(names.items(), key=lambda kv: kv[1]):
+        d = decls.get(z3name)
+        if d is None:
+            continue
+        if d.arity() == 0:
+            out[display] = value_to_rcl(model.eval(d(), model_completion=True))
+            continue
+        interp = model[d]
+        if not isinstance(interp, z3.FuncInterp):
+            out[display] = str(interp)
+            continue
+        rows = []
+        for k in range(interp.num_entries()):
+            e = interp.entry(k)
+            args = ", ".join(value_to_rcl(e.arg_value(j)) for j in range(e.num_args()))
+            rows.append(f"({args}) -> {value_to_rcl(e.value())}")
+        else_v = interp.else_value()
+        rows.append(f"else -> {value_to_rcl(else_v) if else_v is not None else '?'}")
+        out[display] = "{" + ", ".join(rows) + "}"
+    return out

@@ -1,0 +1,262 @@
+"""Load and validate the verification plan (``contracts/plan.yaml``).
+
+The plan is YAML read with PyYAML's safe loader (through ``yaml.compose`` so
+that every value keeps its line and column), validated against the JSON
+schema ``plan.schema.json``, and then resolved against the type-checked
+contracts (:func:`resolve`): node names, guarantee indices, connection
+variables and environment facts must all exist and type-check.  Every
+mistake is a :class:`~rclverify.plan.errors.PlanError` located in the plan
+file.  The format is documented in docs/plan.md.
+"""
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass, field
+from importlib import resources
+from pathlib import Path
+from typing import Any, Mapping
+
+import jsonschema
+import yaml
+
+from ..rcl import ast
+from ..rcl.errors import RclError
+from ..rcl.parser import parse_formula
+from ..rcl.typecheck import infer
+from ..rcl.types import BOOL, Checked
+from .errors import PlanError, plan_error
+
+Path_ = tuple[Any, ...]
+
+
+@dataclass(frozen=True)
+class Support:
+    """One ``supported_by`` row: a node and 1-based guarantee indices."""
+
+    node: str
+    guarantees: tuple[int, ...]
+    loc: ast.Loc
+
+
+@dataclass(frozen=True)
+class Requirement:
+    id: str
+    text: str
+    support: tuple[Support, ...]
+    loc: ast.Loc
+
+
+@dataclass(frozen=True)
+class Connection:
+    """An explicit connection ``from: Producer.var`` -> ``to: Consumer.var``."""
+
+    from_node: str
+    from_var: str
+    to_node: str
+    to_var: str
+    loc: ast.Loc
+
+
+@dataclass(frozen=True)
+class Fact:
+    """An environment fact: an RCL formula over one node's inputs/outputs."""
+
+    node: str
+    text: str
+    expr: ast.Expr
+    loc: ast.Loc
+
+
+@dataclass(frozen=True)
+class EvidenceEntry:
+    """``nodes.<Node>.evidence[index]``: a backend and its configuration."""
+
+    node: str
+    index: int
+    backend: str
+    config: Mapping[str, Any]
+    loc: ast.Loc
+
+
+@dataclass(frozen=True)
+class Plan:
+    """A loaded plan.  Paths are workspace-relative strings.
+
+    ``instances`` maps a node to the inclusive NATURAL range ``(lo, hi)``
+    used by the health checks to instantiate quantified formulas.
+    """
+
+    file: str
+    root: Path
+    contracts: tuple[str, ...]
+    requirements: tuple[Requirement, ...]
+    connections: tuple[Connection, ...]
+    facts: Mapping[str, tuple[Fact, ...]]
+    instances: Mapping[str, tuple[int, int]]
+    evidence: Mapping[str, tuple[EvidenceEntry, ...]]
+    replacements: Mapping[str, tuple[str, ast.Loc]] = field(default_factory=dict)
+    locs: Mapping[Path_, ast.Loc] = field(default_factory=dict)
+
+
+def _schema() -> dict[str, Any]:
+    return json.loads(resources.files("rclverify.plan").joinpath("plan.schema.json").read_text(encoding="utf-8"))  # type: ignore[no-any-return]
+
+
+def _to_py(node: yaml.Node, path: Path_, locs: dict[Path_, ast.Loc], file: str) -> Any:
+    mark = node.start_mark
+    quoted = isinstance(node, yaml.ScalarNode) and node.style in ("'", '"')
+    locs[path] = ast.Loc(file, mark.line + 1, mark.column + 1 + (1 if quoted else 0))
+    if isinstance(node, yaml.MappingNode):
+        out: dict[Any, Any] = {}
+        for k, v in node.value:
+            key = yaml.safe_load(yaml.serialize(k)) if not isinstance(k, yaml.ScalarNode) else k.value
+            out[key] = _to_py(v, path + (key,), locs, file)
+        return out
+    if isinstance(node, yaml.SequenceNode):
+        return [_to_py(v, path + (i,), locs, file) for i, v in enumerate(node.value)]
+    return yaml.safe_load(yaml.serialize(node))
+
+
+def read_plan_data(root: Path, plan_rel: str) -> tuple[dict[str, Any], dict[Path_, ast.Loc]]:
+    """Read ``root/plan_rel`` into plain data plus a location for every value path.
+
+    Raises :class:`PlanError` on a missing file, bad YAML or a schema violation.
+    """
+    p = root / plan_rel
+    try:
+        text = p.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as exc:
+        raise plan_error(plan_rel, 1, 1, f"cannot read the verification plan: {getattr(exc, 'strerror', None) or exc}", "E-io") from None
+    try:
+        node = yaml.compose(text, Loader=yaml.SafeLoader)
+    except yaml.YAMLError as exc:
+        mark = getattr(exc, "problem_mark", None)
+        line, col = (mark.line + 1, mark.column + 1) if mark else (1, 1)
+        raise plan_error(plan_rel, line, col, f"invalid YAML: {getattr(exc, 'problem', exc)}", "E-yaml") from None
+    locs: dict[Path_, ast.Loc] = {}
+    data = _to_py(node, (), locs, plan_rel) if node is not None else None
+    if not isinstance(data, dict):
+        raise plan_error(plan_rel, 1, 1, "the verification plan must be a mapping with a 'contracts' list")
+    errors = sorted(jsonschema.Draft202012Validator(_schema()).iter_errors(data), key=lambda e: list(map(str, e.absolute_path)))
+    if errors:
+        diags = []
+        for e in errors:
+            path = tuple(e.absolute_path)
+            while path and path not in locs:
+                path = path[:-1]
+            loc = locs.get(path, ast.Loc(plan_rel, 1, 1))
+            where = ".".join(map(str, e.absolute_path)) or "plan"
+            diags.extend(plan_error(loc.file, loc.line, loc.col, f"{where}: {e.message}").diagnostics)
+        raise PlanError(diags)
+    return data, locs
+
+
+def load_plan(root: Path, plan_rel: str = "contracts/plan.yaml") -> Plan:
+    """Read and schema-check the plan (contract-independent part).
+
+    Raises :class:`PlanError`.  Call :func:`resolve` once the contracts are
+    checked to validate the references into them.
+    """
+    data, locs = read_plan_data(root, plan_rel)
+
+    def loc(*path: Any) -> ast.Loc:
+        return locs.get(tuple(path), ast.Loc(plan_rel, 1, 1))
+
+    contracts = tuple(data["contracts"])
+    for i, c in enumerate(contracts):
+        if not (root / c).is_file():
+            l = loc("contracts", i)
+            raise plan_error(plan_rel, l.line, l.col, f"contract file {c!r} does not exist", "E-io")
+    reqs = []
+    for i, r in enumerate(data.get("requirements", [])):
+        sup = tuple(Support(s["node"], tuple(s["guarantees"]), loc("requirements", i, "supported_by", j))
+                    for j, s in enumerate(r.get("supported_by", [])))
+        reqs.append(Requirement(str(r["id"]), str(r["text"]).strip(), sup, loc("requirements", i)))
+    conns = []
+    for i, c in enumerate(data.get("connections", []) or []):
+        fn, fv = c["from"].split(".", 1)
+        tn, tv = c["to"].split(".", 1)
+        conns.append(Connection(fn, fv, tn, tv, loc("connections", i)))
+    facts: dict[str, tuple[Fact, ...]] = {}
+    instances: dict[str, tuple[int, int]] = {}
+    for node, spec in (data.get("environment") or {}).items():
+        if isinstance(spec, list):
+            spec = {"facts": spec}
+            base: Path_ = ("environment", node)
+        else:
+            base = ("environment", node, "facts")
+        out = []
+        for i, text in enumerate(spec.get("facts", [])):
+            l = loc(*base, i)
+            try:
+                expr = parse_formula(text, plan_rel, l.line, l.col)
+            except RclError as exc:
+                raise PlanError(exc.diagnostics) from None
+            out.append(Fact(node, text, expr, l))
+        facts[node] = tuple(out)
+        if "instances" in spec:
+            lo, hi = spec["instances"]
+            instances[node] = (int(lo), int(hi))
+    evidence: dict[str, tuple[EvidenceEntry, ...]] = {}
+    replacements: dict[str, tuple[str, ast.Loc]] = {}
+    for node, spec in (data.get("nodes") or {}).items():
+        evidence[node] = tuple(EvidenceEntry(node, i, e["backend"], e, loc("nodes", node, "evidence", i))
+                               for i, e in enumerate(spec.get("evidence", [])))
+        if "replacement" in spec:
+            replacements[node] = (spec["replacement"], loc("nodes", node, "replacement"))
+    return Plan(plan_rel, root, contracts, tuple(reqs), tuple(conns), facts, instances, evidence, replacements, locs)
+
+
+def resolve(plan: Plan, checked: Checked) -> None:
+    """Check the plan's references into the contracts.
+
+    Every node named must exist, guarantee indices must be in range,
+    connection endpoints must be an output and an input of equal type, and
+    environment facts must be well-typed formulas of their node.  Raises
+    :class:`PlanError` listing every problem.
+    """
+    diags = []
+    nodes = checked.nodes
+
+    def bad(l: ast.Loc, msg: str) -> None:
+        diags.extend(plan_error(l.file, l.line, l.col, msg).diagnostics)
+
+    def node_ok(name: str, l: ast.Loc) -> bool:
+        if name in nodes:
+            return True
+        bad(l, f"no node named {name!r} in the contracts; nodes are: {', '.join(nodes)}")
+        return False
+
+    for r in plan.requirements:
+        for s in r.support:
+            if node_ok(s.node, s.loc):
+                n = len(nodes[s.node].node.guarantees)
+                for g in s.guarantees:
+                    if not 1 <= g <= n:
+                        bad(s.loc, f"{r.id}: node {s.node} has {n} guarantee(s); there is no guarantee {g}")
+    for c in plan.connections:
+        if node_ok(c.from_node, c.loc) and node_ok(c.to_node, c.loc):
+            ot = nodes[c.from_node].outputs.get(c.from_var)
+            it = nodes[c.to_node].inputs.get(c.to_var)
+            if ot is None:
+                bad(c.loc, f"{c.from_node} has no output {c.from_var!r}")
+            if it is None:
+                bad(c.loc, f"{c.to_node} has no input {c.to_var!r}")
+            if ot is not None and it is not None and ot != it:
+                bad(c.loc, f"connection joins {c.from_node}.{c.from_var} : {ot} to {c.to_node}.{c.to_var} : {it}")
+    for node, facts in plan.facts.items():
+        for f in facts:
+            if not node_ok(node, f.loc):
+                break
+            try:
+                t = infer(f.expr, nodes[node], checked.env)
+            except RclError as exc:
+                diags.extend(exc.diagnostics)
+                continue
+            if t != BOOL:
+                bad(f.loc, f"an environment fact must be a formula, found {t}")
+    for node, entries in plan.evidence.items():
+        if entries:
+            node_ok(node, entries[0].loc)
+    if diags:
+        raise PlanError(diags)

@@ -1,0 +1,1 @@
+"""rcl stage of rclverify."""

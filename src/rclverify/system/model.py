@@ -1,0 +1,189 @@
+"""The system model: which node outputs feed which node inputs.
+
+Connections (shared/DESIGN.md "Semantics"; paper lines 437-461 on system
+models) are found, for each input of each node, in this order:
+
+1. the plan's explicit ``connections`` (``via = "plan"``);
+2. an output of another node with the same name and the same type
+   (``via = "name"``);
+3. an output of another node bound to the same ROS topic field
+   (``msg_type`` and ``field``; ``via = "topic"``).
+
+Anything unconnected is an *environment input*.  Inputs of the empty type
+``{}`` (hardware, e.g. ``SensorsType``) are always environment inputs.
+An input that two or more nodes could feed by name or topic is ambiguous and
+is an error asking for an explicit connection in the plan.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any, Iterable, Sequence
+
+from ..plan.load import Connection
+from ..rcl.errors import RclError, error
+from ..rcl.types import Checked, EmptyT
+
+
+@dataclass(frozen=True)
+class Link:
+    """``from_node.out.from_var`` feeds ``to_node.in.to_var``."""
+
+    from_node: str
+    from_var: str
+    to_node: str
+    to_var: str
+    via: str
+
+    def to_json(self) -> dict[str, str]:
+        return {"from_node": self.from_node, "from_var": self.from_var, "to_node": self.to_node,
+                "to_var": self.to_var, "via": self.via}
+
+
+@dataclass(frozen=True)
+class SystemModel:
+    """Nodes (source order), links, environment inputs and loops.
+
+    ``env_inputs`` are ``(node, var, type)`` triples; ``loops`` are the
+    strongly connected components with a cycle, each sorted by node name.
+    """
+
+    nodes: tuple[str, ...]
+    links: tuple[Link, ...]
+    env_inputs: tuple[tuple[str, str, str], ...]
+    loops: tuple[tuple[str, ...], ...]
+
+    def producers(self, node: str) -> list[str]:
+        """Nodes feeding ``node``, in source order, without repeats."""
+        ps = {l.from_node for l in self.links if l.to_node == node}
+        return [n for n in self.nodes if n in ps]
+
+    def consumers(self, node: str) -> list[str]:
+        cs = {l.to_node for l in self.links if l.from_node == node}
+        return [n for n in self.nodes if n in cs]
+
+    def internal_inputs(self, node: str) -> set[str]:
+        return {l.to_var for l in self.links if l.to_node == node}
+
+    def loop_of(self, node: str) -> tuple[str, ...] | None:
+        for loop in self.loops:
+            if node in loop:
+                return loop
+        return None
+
+    def upstream(self, node: str) -> list[str]:
+        """The upstream cone of ``node``: itself and every node that reaches it."""
+        seen, todo = {node}, [node]
+        while todo:
+            for p in self.producers(todo.pop()):
+                if p not in seen:
+                    seen.add(p)
+                    todo.append(p)
+        return [n for n in self.nodes if n in seen]
+
+    def alias(self) -> dict[tuple[str, str, str], str]:
+        """Encoder aliases: each connected input becomes its producer's output symbol."""
+        return {(l.to_node, "in", l.to_var): f"{l.from_node}.out.{l.from_var}" for l in self.links}
+
+    def to_json(self) -> dict[str, Any]:
+        return {
+            "nodes": list(self.nodes),
+            "connections": [l.to_json() for l in self.links],
+            "environment_inputs": [{"node": n, "var": v, "type": t} for n, v, t in self.env_inputs],
+            "loops": [list(l) for l in self.loops],
+        }
+
+    @staticmethod
+    def from_json(d: dict[str, Any]) -> "SystemModel":
+        return SystemModel(tuple(d["nodes"]), tuple(Link(**l) for l in d["connections"]),
+                           tuple((e["node"], e["var"], e["type"]) for e in d["environment_inputs"]),
+                           tuple(tuple(l) for l in d["loops"]))
+
+
+def build(checked: Checked, connections: Sequence[Connection] = ()) -> SystemModel:
+    """Build the system model of the checked contracts.
+
+    Raises :class:`RclError` (located at the input's declaration) when an
+    input could be fed by several nodes and the plan does not say which.
+    """
+    nodes = list(checked.nodes)
+    links: list[Link] = []
+    env: list[tuple[str, str, str]] = []
+    diags = []
+    explicit = {(c.to_node, c.to_var): c for c in connections}
+    for n, cn in checked.nodes.items():
+        for iv in cn.node.inputs:
+            t = cn.inputs[iv.name]
+            c = explicit.get((n, iv.name))
+            if c is not None:
+                links.append(Link(c.from_node, c.from_var, n, iv.name, "plan"))
+                continue
+            if isinstance(t, EmptyT):
+                env.append((n, iv.name, str(t)))
+                continue
+            by_name = [m for m, other in checked.nodes.items() if m != n and other.outputs.get(iv.name) == t]
+            via, cands = "name", [(m, iv.name) for m in by_name]
+            if not cands:
+                via, cands = "topic", _by_topic(checked, n, iv.name)
+            if len(cands) > 1:
+                diags.append(error(iv.loc, f"input {iv.name!r} of {n} could be fed by {', '.join(m for m, _ in cands)}; "
+                                           "name the producer under 'connections' in the plan", "E-connection"))
+            elif cands:
+                links.append(Link(cands[0][0], cands[0][1], n, iv.name, via))
+            else:
+                env.append((n, iv.name, str(t)))
+    if diags:
+        raise RclError(diags)
+    return SystemModel(tuple(nodes), tuple(links), tuple(env), _loops(nodes, links))
+
+
+def _by_topic(checked: Checked, node: str, var: str) -> list[tuple[str, str]]:
+    cn = checked.nodes[node]
+    keys = {(t.msg_type, t.field) for t in cn.node.topics
+            if t.match is not None and t.match.name == var and t.match.prefix in (None, "in")}
+    out = []
+    for m, other in checked.nodes.items():
+        if m == node:
+            continue
+        for t in other.node.topics:
+            if t.match is not None and (t.msg_type, t.field) in keys and t.match.prefix in (None, "out") \
+                    and t.match.name in other.outputs and other.outputs[t.match.name] == cn.inputs[var]:
+                out.append((m, t.match.name))
+    return out
+
+
+def _loops(nodes: Sequence[str], links: Iterable[Link]) -> tuple[tuple[str, ...], ...]:
+    """Strongly connected components with a cycle (Tarjan), sorted."""
+    succ: dict[str, set[str]] = {n: set() for n in nodes}
+    for l in links:
+        succ[l.from_node].add(l.to_node)
+    index: dict[str, int] = {}
+    low: dict[str, int] = {}
+    stack: list[str] = []
+    on: set[str] = set()
+    out: list[tuple[str, ...]] = []
+
+    def visit(v: str) -> None:
+        index[v] = low[v] = len(index)
+        stack.append(v)
+        on.add(v)
+        for w in sorted(succ[v]):
+            if w not in index:
+                visit(w)
+                low[v] = min(low[v], low[w])
+            elif w in on:
+                low[v] = min(low[v], index[w])
+        if low[v] == index[v]:
+            comp = []
+            while True:
+                w = stack.pop()
+                on.discard(w)
+                comp.append(w)
+                if w == v:
+                    break
+            if len(comp) > 1 or v in succ[v]:
+                out.append(tuple(sorted(comp)))
+
+    for n in nodes:
+        if n not in index:
+            visit(n)
+    return tuple(sorted(out))
