@@ -1,1 +1,34 @@
-"""backends stage of rclverify."""
+"""Verification backends, registered by the name a plan uses for them.
+
+Implemented: ``hoare`` (Z3), ``dafny`` (Dafny), ``ajpf`` (AJPF/MCAPL
+property instances).  Named but not implemented yet (their evidence is
+``pending`` with "backend not available"): ``review``, ``experiment``,
+``property_tests``, ``monitors``.
+"""
+from __future__ import annotations
+
+from importlib import import_module
+from typing import Any
+
+IMPLEMENTED = {
+    "hoare": ("rclverify.backends.hoare.backend", "HoareBackend"),
+    "dafny": ("rclverify.backends.dafny.backend", "DafnyBackend"),
+    "ajpf": ("rclverify.backends.ajpf.backend", "AjpfBackend"),
+}
+NOT_AVAILABLE = ("review", "experiment", "property_tests", "monitors")
+KNOWN = tuple(IMPLEMENTED) + NOT_AVAILABLE
+
+
+def get_backend(name: str) -> Any:
+    """The backend object for a plan's ``backend:`` value.
+
+    Raises ``KeyError`` for an unknown name (the plan loader reports it,
+    located, before this is ever called).
+    """
+    if name in IMPLEMENTED:
+        module, cls = IMPLEMENTED[name]
+        return getattr(import_module(module), cls)()
+    if name in NOT_AVAILABLE:
+        from .unavailable import UnavailableBackend
+        return UnavailableBackend(name)
+    raise KeyError(name)

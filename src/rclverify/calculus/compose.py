@@ -153,6 +153,8 @@ def split_assumption(checked: Checked, model: SystemModel, node: str) -> tuple[l
     internal, env = [], []
     for cl in cn.node.assumes:
         for c in conjuncts(cl.formula):
+            if isinstance(c, ast.BoolLit) and c.value:
+                continue
             names = {n for p, n in free_io(c) if (p == "in" or (p is None and n in cn.inputs))}
             (internal if names & internal_vars else env).append(c)
     return internal, env

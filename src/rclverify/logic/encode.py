@@ -181,6 +181,12 @@ class Encoder:
         self.symbols[name] = Symbol(name, display, t, decl)
         return decl
 
+    def fresh(self, z3name: str, display: str, t: Type) -> z3.ExprRef:
+        """A new free constant (e.g. a Skolem witness) shown as ``display`` in models."""
+        decl = z3.Const(z3name, sort_of(t))
+        self.symbols[z3name] = Symbol(z3name, display, t, decl)
+        return decl
+
     def axioms(self) -> list[z3.BoolRef]:
         """Typing side constraints of every free symbol created so far.
 
@@ -205,14 +211,17 @@ class Encoder:
         return out
 
     # -- formulas ----------------------------------------------------------------------------
-    def formula(self, e: ast.Expr, node: CheckedNode, symbols: Mapping[str, Any] | None = None) -> z3.BoolRef:
+    def formula(self, e: ast.Expr, node: CheckedNode, symbols: Mapping[str, Any] | None = None,
+                bound: Mapping[str, z3.ExprRef] | None = None) -> z3.BoolRef:
         """Encode a (type-checked) formula of ``node``.
 
         ``symbols`` maps qualified I/O names (``"in.r"``, ``"out.x"``) to Z3
-        terms (or function declarations) used instead of the node's symbols.
-        Raises :class:`EncodingError` for unsupported constructs.
+        terms (or function declarations) used instead of the node's symbols;
+        ``bound`` gives Z3 terms for variables bound outside ``e`` (used to
+        instantiate a quantifier's body).  Raises :class:`EncodingError` for
+        unsupported constructs.
         """
-        r = _Ctx(self, node, dict(symbols or {})).enc(e, {})
+        r = _Ctx(self, node, dict(symbols or {})).enc(e, dict(bound or {}))
         if not z3.is_bool(r):
             raise EncodingError(e.loc, "expected a formula")
         return r  # type: ignore[no-any-return]

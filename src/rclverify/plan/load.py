@@ -255,8 +255,13 @@ def resolve(plan: Plan, checked: Checked) -> None:
                 continue
             if t != BOOL:
                 bad(f.loc, f"an environment fact must be a formula, found {t}")
+    from ..backends import KNOWN
     for node, entries in plan.evidence.items():
         if entries:
             node_ok(node, entries[0].loc)
+        for e in entries:
+            if e.backend not in KNOWN:
+                bl = plan.locs.get(("nodes", node, "evidence", e.index, "backend"), e.loc)
+                bad(bl, f"unknown backend {e.backend!r}; known backends: {', '.join(KNOWN)}")
     if diags:
         raise PlanError(diags)

@@ -1,0 +1,265 @@
+"""Contract health: consistency and vacuity of each node's contract.
+
+The calculus is sound only for contracts that can be met (paper lines
+740-768: nodes "verified to preserve their guarantees").  Three checks per
+node, each a Z3 satisfiability query over the node's assumption ``A``, its
+guarantees ``G1..Gn`` and the plan's environment facts ``F``:
+
+``assumption-satisfiable``  can ``A`` hold at all?
+``contract-consistent``     can ``A and G1 and ... and Gn and F`` hold?
+``non-vacuous``             for each guarantee ``forall v | P -> Q``: can the
+                            premise ``P`` hold (for some witness values of
+                            ``v``) together with ``A``, every guarantee and
+                            ``F``?  If not, the guarantee can never fire: it
+                            is vacuous in every environment the plan allows.
+
+When the plan gives ``instances: [lo, hi]`` for the node, every universally
+quantified NATURAL variable of the guarantees and facts is also instantiated
+at ``lo..hi+1`` as *redundant lemmas* (implied by the formulas, so they change
+no answer but help Z3's quantifier instantiation), and a premise Z3 cannot
+decide is examined instance by instance.
+
+Findings: ``ok`` (with a witness model), ``problem`` (with an unsat core in
+RCL terms: which clauses contradict each other), ``inconclusive`` (Z3 could
+not decide within the timeout; never counted as ok).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any, Sequence
+
+import z3
+
+from ..logic.encode import Encoder
+from ..logic.query import QueryResult, satisfiable
+from ..rcl import ast
+from ..rcl.printer import expr_to_rcl
+from ..rcl.typecheck import domain_type
+from ..rcl.types import NATURAL, Checked, CheckedNode
+
+HEALTH_TIMEOUT_MS = 5_000
+#: Timeout of one per-instance premise query, and how many undecided
+#: instances in a row (with no vacuous one found) end the scan.
+INSTANCE_TIMEOUT_MS = 2_000
+GIVE_UP_AFTER = 3
+
+
+@dataclass(frozen=True)
+class Finding:
+    id: str
+    node: str
+    check: str
+    guarantee: int | None
+    status: str
+    message: str
+    explanation: str
+    model: dict[str, str] | None = None
+    core: list[str] | None = None
+    duration_s: float = 0.0
+    instances: dict[str, str] | None = None
+
+    def to_json(self) -> dict[str, Any]:
+        return {"id": self.id, "node": self.node, "check": self.check, "guarantee": self.guarantee,
+                "status": self.status, "message": self.message, "explanation": self.explanation,
+                "model": self.model, "core": self.core, "duration_s": self.duration_s,
+                "instances": self.instances}
+
+
+def _where(l: ast.Loc) -> str:
+    return f"{l.file}:{l.line}:{l.col}"
+
+
+def _peel(e: ast.Expr) -> tuple[list[ast.Binding], ast.Expr]:
+    """Outer ``forall`` bindings and the body under them."""
+    bindings: list[ast.Binding] = []
+    while isinstance(e, ast.Quant) and e.kind == "forall":
+        bindings.extend(e.bindings)
+        e = e.body
+    return bindings, e
+
+
+class _NodeHealth:
+    def __init__(self, checked: Checked, node: CheckedNode, facts: Sequence[tuple[ast.Expr, ast.Loc]],
+                 instances: tuple[int, int] | None, timeout_ms: int) -> None:
+        self.checked, self.node, self.instances, self.timeout = checked, node, instances, timeout_ms
+        self.enc = Encoder(checked.env)
+        n = node.node
+        self.assume = [(f"assumption {k} ({_where(a.loc)})", self.enc.formula(a.formula, node))
+                       for k, a in enumerate(n.assumes, 1)]
+        self.guars = [(f"guarantee {k} ({_where(g.loc)})", self.enc.formula(g.formula, node))
+                      for k, g in enumerate(n.guarantees, 1)]
+        self.facts = [(f"environment fact {k} ({_where(loc)})", self.enc.formula(f, node))
+                      for k, (f, loc) in enumerate(facts, 1)]
+        self.lemmas: list[tuple[str, z3.BoolRef]] = []
+        if instances:
+            for (label, _), g in zip(self.guars, n.guarantees):
+                self.lemmas += self._instances(label, g.formula)
+            for (label, _), (f, _) in zip(self.facts, facts):
+                self.lemmas += self._instances(label, f)
+
+    def _instances(self, label: str, e: ast.Expr) -> list[tuple[str, z3.BoolRef]]:
+        assert self.instances is not None
+        if not (isinstance(e, ast.Quant) and e.kind == "forall"):
+            return []
+        out = []
+        for b in e.bindings:
+            if domain_type(b, self.node, self.checked.env) != NATURAL:
+                continue
+            for v in b.names:
+                rest = tuple(ast.Binding(tuple(n for n in bb.names if n != v), bb.domain, bb.loc)
+                             for bb in e.bindings)
+                rest = tuple(bb for bb in rest if bb.names)
+                body = ast.Quant("forall", rest, e.body, e.loc) if rest else e.body
+                lo, hi = self.instances
+                for k in range(lo, hi + 2):
+                    out.append((f"{label} at {v}={k}", self.enc.formula(body, self.node, bound={v: z3.IntVal(k)})))
+        return out
+
+    def sat(self, extra: Sequence[tuple[str, z3.BoolRef]], *, guarantees: bool = True, comment: str = "",
+            timeout_ms: int | None = None) -> QueryResult:
+        labelled = list(self.assume) + (list(self.guars) + list(self.facts) + list(self.lemmas) if guarantees else [])
+        return satisfiable(labelled + list(extra), self.enc, timeout_ms=timeout_ms or self.timeout, comment=comment)
+
+    @staticmethod
+    def core_text(core: Sequence[str] | None) -> list[str]:
+        return list(core or [])
+
+    def premise(self, k: int, fixed: dict[str, int] | None = None) -> tuple[list[tuple[str, z3.BoolRef]], str] | None:
+        g = self.node.node.guarantees[k - 1]
+        bindings, body = _peel(g.formula)
+        if not (isinstance(body, ast.Binary) and body.op == "->"):
+            return None
+        bound: dict[str, z3.ExprRef] = {}
+        guards = []
+        for b in bindings:
+            t = domain_type(b, self.node, self.checked.env, {})
+            for v in b.names:
+                if fixed and v in fixed:
+                    bound[v] = z3.IntVal(fixed[v])
+                    continue
+                c = self.enc.fresh(f"{self.node.name}.g{k}.{v}", f"{v} (witness for guarantee {k})", t)
+                bound[v] = c
+                if t == NATURAL:
+                    guards.append(c >= 0)
+        p = self.enc.formula(body.left, self.node, bound=bound)
+        label = f"premise of guarantee {k}" + (" at " + ", ".join(f"{v}={x}" for v, x in fixed.items()) if fixed else "")
+        return [(label, z3.And(p, *guards) if guards else p)], expr_to_rcl(body.left)
+
+    def natural_vars(self, k: int) -> list[str]:
+        bindings, _ = _peel(self.node.node.guarantees[k - 1].formula)
+        return [v for b in bindings if domain_type(b, self.node, self.checked.env) == NATURAL for v in b.names]
+
+
+def check_node(checked: Checked, node: str, facts: Sequence[tuple[ast.Expr, ast.Loc]] = (),
+               instances: tuple[int, int] | None = None, *, timeout_ms: int = HEALTH_TIMEOUT_MS) -> list[Finding]:
+    """Run the three health checks on ``node``; returns its findings in order."""
+    h = _NodeHealth(checked, checked.nodes[node], facts, instances, timeout_ms)
+    out: list[Finding] = []
+    n = node
+
+    r = h.sat([], guarantees=False, comment=f"health {n}: is the assumption satisfiable?")
+    if r.status == "sat":
+        out.append(Finding(f"{n}.assumption-satisfiable", n, "assumption-satisfiable", None, "ok",
+                           f"The assumption of {n} can be met.", "Z3 found inputs satisfying it (witness below).", r.model,
+                           duration_s=r.duration_s))
+    elif r.status == "unsat":
+        out.append(Finding(f"{n}.assumption-satisfiable", n, "assumption-satisfiable", None, "problem",
+                           f"The assumption of {n} can never hold: the node's contract is vacuous.",
+                           "Unsat core: the clauses listed contradict each other.", None, h.core_text(r.core), r.duration_s))
+    else:
+        out.append(Finding(f"{n}.assumption-satisfiable", n, "assumption-satisfiable", None, "inconclusive",
+                           f"Z3 could not decide whether the assumption of {n} can hold.", r.reason, duration_s=r.duration_s))
+
+    r = h.sat([], comment=f"health {n}: can the assumption, every guarantee and the environment facts hold together?")
+    check = "contract-consistent"
+    if r.status == "sat":
+        out.append(Finding(f"{n}.{check}", n, check, None, "ok",
+                           f"The assumption and guarantees of {n} (with the environment facts) can hold together.",
+                           "Z3 found a witness (below).", r.model, duration_s=r.duration_s))
+    elif r.status == "unsat":
+        out.append(Finding(f"{n}.{check}", n, check, None, "problem",
+                           f"The contract of {n} contradicts itself: no output can satisfy its guarantees.",
+                           "Unsat core: the clauses listed contradict each other.", None, h.core_text(r.core), r.duration_s))
+    else:
+        out.append(Finding(f"{n}.{check}", n, check, None, "inconclusive",
+                           f"Z3 could not decide whether the contract of {n} is consistent ({r.reason}).",
+                           "The quantifier alternation in the guarantees is beyond Z3's decision procedures within the "
+                           "timeout; no conclusion is drawn.", duration_s=r.duration_s))
+
+    for k in range(1, len(checked.nodes[node].node.guarantees) + 1):
+        out.append(_non_vacuity(h, n, k))
+    return out
+
+
+def _non_vacuity(h: _NodeHealth, n: str, k: int) -> Finding:
+    fid, check = f"{n}.g{k}.non-vacuous", "non-vacuous"
+    prem = h.premise(k)
+    if prem is None:
+        return Finding(fid, n, check, k, "ok", f"Guarantee {k} of {n} is not an implication; nothing can make it vacuous.",
+                       "Not of the form forall ... (premise -> conclusion).")
+    extra, ptext = prem
+    r = h.sat(extra, comment=f"health {n}: can the premise of guarantee {k} hold? {ptext}")
+    if r.status == "sat":
+        return Finding(fid, n, check, k, "ok", f"The premise of guarantee {k} of {n} can hold: the guarantee can fire.",
+                       f"Premise: {ptext}. Z3 found a situation where it holds together with the assumption, every "
+                       "guarantee and the environment facts (witness below).", r.model, duration_s=r.duration_s)
+    if r.status == "unsat":
+        return Finding(fid, n, check, k, "problem",
+                       f"Guarantee {k} of {n} is vacuous: its premise can never hold together with the node's other "
+                       "guarantees and the environment facts, so it promises nothing.",
+                       f"Premise: {ptext}. The unsat core names the clauses that exclude it.", None, h.core_text(r.core),
+                       r.duration_s)
+    nat = h.natural_vars(k)
+    if not (h.instances and nat):
+        return Finding(fid, n, check, k, "inconclusive", f"Z3 could not decide whether guarantee {k} of {n} can fire ({r.reason}).",
+                       f"Premise: {ptext}. Give the plan an 'instances' range for {n} to examine it instance by instance.",
+                       duration_s=r.duration_s)
+    v = nat[0]
+    lo, hi = h.instances
+    per: dict[str, str] = {}
+    cores: dict[str, list[str]] = {}
+    total = r.duration_s
+    streak = 0
+    for x in range(lo, hi + 1):
+        pe = h.premise(k, {v: x})
+        assert pe is not None
+        ri = h.sat(pe[0], comment=f"health {n}: premise of guarantee {k} at {v}={x}",
+                   timeout_ms=min(h.timeout, INSTANCE_TIMEOUT_MS))
+        total += ri.duration_s
+        streak = streak + 1 if ri.status == "inconclusive" else 0
+        if streak >= GIVE_UP_AFTER and not any(s == "vacuous" for s in per.values()):
+            per[str(x)] = "inconclusive"
+            per.update({str(y): "not examined" for y in range(x + 1, hi + 1)})
+            break
+        per[str(x)] = {"sat": "can fire", "unsat": "vacuous", "inconclusive": "inconclusive"}[ri.status]
+        if ri.status == "unsat":
+            cores[str(x)] = h.core_text(ri.core)
+    vac = [x for x, s in per.items() if s == "vacuous"]
+    fires = [x for x, s in per.items() if s == "can fire"]
+    unk = [x for x, s in per.items() if s in ("inconclusive", "not examined")]
+    if vac:
+        sample = cores[vac[0]]
+        msg = (f"Guarantee {k} of {n} is vacuous for {v} in {_ranges(vac)}: its premise contradicts the node's other "
+               f"guarantees and the environment facts there" + (f"; it can fire only for {v} in {_ranges(fires)}" if fires else "")
+               + (f"; undecided for {v} in {_ranges(unk)}" if unk else "") + ".")
+        return Finding(fid, n, check, k, "problem", msg,
+                       f"Premise: {ptext}. Unsat core at {v}={vac[0]} below. Z3 could not decide the general case "
+                       f"({r.reason}), so each instance {v}={lo}..{hi} was checked.", None, sample, round(total, 4), per)
+    if fires and not unk:
+        return Finding(fid, n, check, k, "ok", f"Guarantee {k} of {n} can fire for every {v} in {lo}..{hi}.",
+                       f"Premise: {ptext}.", None, None, round(total, 4), per)
+    return Finding(fid, n, check, k, "inconclusive", f"Z3 could not decide whether guarantee {k} of {n} can fire"
+                   + (f" for {v} in {_ranges(unk)}" if unk else "") + ".",
+                   f"Premise: {ptext}.", None, None, round(total, 4), per)
+
+
+def _ranges(xs: Sequence[str]) -> str:
+    nums = sorted(int(x) for x in xs)
+    parts, start = [], None
+    for i, x in enumerate(nums):
+        if start is None:
+            start = x
+        if i + 1 == len(nums) or nums[i + 1] != x + 1:
+            parts.append(f"{start}" if start == x else f"{start}..{x}")
+            start = None
+    return "{" + ", ".join(parts) + "}"

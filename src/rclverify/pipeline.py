@@ -1,0 +1,202 @@
+"""The pipeline's stages as plain functions over a workspace's artifacts.
+
+Each stage reads its inputs (the RCL files, the plan, earlier stages' JSON
+under ``artifacts/``) and writes its own outputs atomically; no stage reaches
+into another's internals.  doit (:mod:`rclverify.tasks`) and the CLI
+(:mod:`rclverify.cli`) both call these functions.
+
+Artifact layout (workspace-relative)::
+
+    artifacts/check/diagnostics.json     lint warnings of the contracts
+    artifacts/contracts/<Node>.json      canonical snapshot of one node's contract,
+                                         the shared context, its facts and plan entries
+    artifacts/system/model.json|.dot     the system model
+    artifacts/calculus/<Node>.json       rule instances, side conditions, derived property
+    artifacts/calculus/<Node>.sc<k>.smt2 each side condition as SMT-LIB2
+    artifacts/health/<Node>.json         contract health findings
+    artifacts/obligations/<Node>.json    exported obligations of the node
+    artifacts/evidence/<obligation>.json one evidence record per obligation
+"""
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass
+from functools import cached_property
+from pathlib import Path
+from typing import Any
+
+from .backends import get_backend
+from .backends.base import NodeTarget
+from .calculus.compose import compose_node, composition_json
+from .evidence.records import Evidence
+from .evidence.store import EvidenceStore, atomic_write_text, read_json, read_obligations, write_json, write_obligations
+from .health.checks import check_node
+from .plan.load import Plan, load_plan, resolve
+from .rcl import ast
+from .rcl.lint import lint
+from .rcl.printer import to_rcl
+from .rcl.typecheck import load
+from .rcl.types import Checked
+from .system.model import SystemModel, build
+
+PLAN = "contracts/plan.yaml"
+
+
+@dataclass
+class Workspace:
+    """A workspace root plus its plan; loads and checks lazily (cached).
+
+    Raises :class:`~rclverify.rcl.errors.RclError` (or PlanError) from the
+    properties when the contracts or the plan are wrong.
+    """
+
+    root: Path
+    plan_file: str = PLAN
+
+    def path(self, rel: str) -> Path:
+        return self.root / rel
+
+    @cached_property
+    def plan(self) -> Plan:
+        return load_plan(self.root, self.plan_file)
+
+    @cached_property
+    def checked(self) -> Checked:
+        import os
+        cwd = os.getcwd()
+        os.chdir(self.root)  # locations in diagnostics and artifacts stay workspace-relative
+        try:
+            c = load(list(self.plan.contracts))
+        finally:
+            os.chdir(cwd)
+        resolve(self.plan, c)
+        return c
+
+    @cached_property
+    def model(self) -> SystemModel:
+        return build(self.checked, self.plan.connections)
+
+    def node_names(self) -> list[str]:
+        return list(self.checked.nodes)
+
+    # -- artifact paths ---------------------------------------------------------------
+    @staticmethod
+    def snapshot(node: str) -> str:
+        return f"artifacts/contracts/{node}.json"
+
+    @staticmethod
+    def calculus(node: str) -> str:
+        return f"artifacts/calculus/{node}.json"
+
+    @staticmethod
+    def health(node: str) -> str:
+        return f"artifacts/health/{node}.json"
+
+    @staticmethod
+    def obligations(node: str) -> str:
+        return f"artifacts/obligations/{node}.json"
+
+    @staticmethod
+    def entry_done(node: str, index: int) -> str:
+        return f"artifacts/runs/{node}.{index}.json"
+
+    MODEL = "artifacts/system/model.json"
+    DOT = "artifacts/system/model.dot"
+    DIAGNOSTICS = "artifacts/check/diagnostics.json"
+
+    def target(self, node: str, index: int) -> NodeTarget:
+        entry = self.plan.evidence[node][index]
+        return NodeTarget(
+            root=self.root.resolve(), checked=self.checked, node=self.checked.nodes[node], config=entry.config,
+            facts=tuple(f.expr for f in self.plan.facts.get(node, ())), contract_files=self.plan.contracts,
+            plan_file=self.plan.file, artifacts=(self.root / "artifacts" / entry.backend / node).resolve(), index=index)
+
+
+def stage_check(ws: Workspace) -> dict[str, Any]:
+    """Parse, type-check, resolve the plan, lint; write snapshots and the system model.
+
+    Returns the diagnostics JSON (lint warnings).  Raises RclError/PlanError.
+    """
+    checked, model = ws.checked, ws.model
+    warnings = [d.to_json() for s in checked.specs for d in lint(s)]
+    write_json(ws.path(ws.DIAGNOSTICS), {"warnings": warnings})
+    context_text = to_rcl(ast.Spec(tuple(c for s in checked.specs for c in s.contexts), ()))
+    for name, cn in checked.nodes.items():
+        snap = {
+            "node": name, "rcl": to_rcl(ast.Spec((), (cn.node,))), "context": context_text,
+            "facts": [f.text for f in ws.plan.facts.get(name, ())],
+            "instances": list(ws.plan.instances[name]) if name in ws.plan.instances else None,
+            "evidence": [dict(e.config) for e in ws.plan.evidence.get(name, ())],
+            "source": f"{cn.node.loc.file}:{cn.node.loc.line}",
+        }
+        write_json(ws.path(ws.snapshot(name)), snap)
+    write_json(ws.path(ws.MODEL), model.to_json())
+    from .report.diagram import system_dot
+    atomic_write_text(ws.path(ws.DOT), system_dot(_system_view(ws, model, {})))
+    return {"warnings": warnings}
+
+
+def _system_view(ws: Workspace, model: SystemModel, status: dict[str, str]) -> dict[str, Any]:
+    d = model.to_json()
+    return {"nodes": [{"name": n, "status": status.get(n, "pending")} for n in model.nodes],
+            "connections": d["connections"], "environment_inputs": d["environment_inputs"], "loops": d["loops"]}
+
+
+def stage_compose(ws: Workspace, node: str) -> dict[str, Any]:
+    """Apply the calculus to ``node``; writes its JSON and one .smt2 per side condition."""
+    comp = compose_node(ws.checked, ws.model, node)
+    paths = []
+    for sc in comp.side_conditions:
+        rel = f"artifacts/calculus/{sc.id}.smt2"
+        atomic_write_text(ws.path(rel), sc.smt2)
+        paths.append(rel)
+    out = composition_json(comp, paths)
+    write_json(ws.path(ws.calculus(node)), out)
+    return out
+
+
+def stage_health(ws: Workspace, node: str) -> list[dict[str, Any]]:
+    """Run the contract health checks of ``node``; writes its findings JSON."""
+    facts = [(f.expr, f.loc) for f in ws.plan.facts.get(node, ())]
+    findings = [f.to_json() for f in check_node(ws.checked, node, facts, ws.plan.instances.get(node))]
+    write_json(ws.path(ws.health(node)), findings)
+    return findings
+
+
+def stage_export(ws: Workspace, node: str) -> list[dict[str, Any]]:
+    """Export ``node``'s obligations for every evidence entry of the plan."""
+    obligations = []
+    for entry in ws.plan.evidence.get(node, ()):
+        backend = get_backend(entry.backend)
+        for o in backend.export(ws.target(node, entry.index)):
+            obligations.append(dataclasses.replace(o, data={**o.data, "entry": entry.index}))
+    write_obligations(ws.path(ws.obligations(node)), obligations)
+    return [o.to_json() for o in obligations]
+
+
+def stage_run(ws: Workspace, node: str, index: int) -> list[Evidence]:
+    """Run the backend of evidence entry ``index`` of ``node`` on its obligations.
+
+    Each evidence record is stored atomically as soon as it is produced.
+    """
+    entry = ws.plan.evidence[node][index]
+    backend = get_backend(entry.backend)
+    target = ws.target(node, index)
+    store = EvidenceStore(ws.root)
+    obligations = [o for o in read_obligations(ws.path(ws.obligations(node)))
+                   if o.data.get("entry", index) == index and o.backend == entry.backend]
+    out = []
+    for o in obligations:
+        ev = backend.run(o, target)
+        store.put(ev)
+        out.append(ev)
+    write_json(ws.path(ws.entry_done(node, index)), sorted(e.obligation for e in out))
+    return out
+
+
+def read_artifact(ws: Workspace, rel: str, default: Any = None) -> Any:
+    """JSON of an artifact, or ``default`` when it does not exist yet."""
+    try:
+        return read_json(ws.path(rel))
+    except FileNotFoundError:
+        return default

@@ -1,0 +1,165 @@
+"""Roll the pipeline's artifacts up into the assurance report (one dict).
+
+Traceability: requirement -> node -> guarantee -> obligation -> evidence.
+Roll-up takes the worst status of the children
+(:data:`rclverify.evidence.records.SEVERITY`); nothing is shown as verified
+while any of its evidence is failed, pending, stale or missing:
+
+* obligation: its evidence's *current* status (``stale`` when an input's
+  sha256 changed since the evidence was produced), ``pending`` when there is
+  no evidence record;
+* guarantee: worst of its obligations (``pending`` when it has none), and
+  ``failed`` when the health checks found it vacuous or the contract
+  contradictory (``inconclusive`` when they could not decide);
+* node: worst of its guarantees and its side conditions;
+* requirement: worst of the guarantees that support it and of the side
+  conditions of their nodes;
+* derived property: worst of the side conditions in the node's upstream cone.
+"""
+from __future__ import annotations
+
+from typing import Any
+
+import z3
+
+from .. import __version__
+from ..evidence.records import SEVERITY, Obligation, worst
+from ..evidence.store import EvidenceStore, read_obligations
+from ..pipeline import Workspace, read_artifact
+from ..rcl import ast
+from ..rcl.latex import to_latex
+from ..rcl.printer import expr_to_rcl, type_to_rcl
+
+_FINDING_AS = {"ok": "discharged", "problem": "failed", "inconclusive": "inconclusive"}
+
+
+def _src(l: ast.Loc) -> str:
+    return f"{l.file}:{l.line}:{l.col}"
+
+
+def build_report(ws: Workspace) -> dict[str, Any]:
+    """Read every artifact of ``ws`` and return the report dict (see render.py)."""
+    checked, model, plan = ws.checked, ws.model, ws.plan
+    store = EvidenceStore(ws.root)
+    obligations: list[Obligation] = []
+    for n in checked.nodes:
+        try:
+            obligations.extend(read_obligations(ws.path(ws.obligations(n))))
+        except FileNotFoundError:
+            pass
+    ev_rows, ob_rows, pending = [], [], []
+    ob_status: dict[str, str] = {}
+    for o in obligations:
+        ev = store.get(o.id)
+        status = store.current_status(ev) if ev else "pending"
+        ob_status[o.id] = status
+        ob_rows.append({"id": o.id, "node": o.node, "guarantee": o.guarantee, "backend": o.backend, "kind": o.kind,
+                        "instance": o.instance, "statement": o.statement, "source": str(o.source),
+                        "artifact": o.artifact, "status": status})
+        if ev is None:
+            pending.append({"obligation": o.id, "backend": o.backend, "reason": "no evidence record yet: run `doit verify`"})
+            continue
+        expl = ev.explanation
+        if status == "stale" and ev.status != "stale":
+            expl = f"STALE: an input changed since this evidence was produced (recorded status {ev.status}). " + expl
+        ev_rows.append({"obligation": ev.obligation, "backend": ev.backend, "kind": ev.kind, "status": status,
+                        "tool": ev.tool, "tool_version": ev.tool_version, "started": ev.started,
+                        "duration_s": ev.duration_s, "explanation": expl, "counterexample": ev.counterexample,
+                        "artifacts": list(ev.artifacts), "log_excerpt": ev.log[-2000:]})
+        if status == "pending":
+            pending.append({"obligation": o.id, "backend": o.backend, "reason": ev.explanation})
+
+    comps = {n: read_artifact(ws, ws.calculus(n), {}) for n in checked.nodes}
+    health = {n: read_artifact(ws, ws.health(n), []) for n in checked.nodes}
+    side_conditions = [sc for n in checked.nodes for sc in comps[n].get("side_conditions", [])]
+    sc_status = {n: worst([sc["status"] for sc in comps[n].get("side_conditions", [])], empty="discharged")
+                 for n in checked.nodes}
+
+    def g_status(node: str, k: int) -> str:
+        sts = [ob_status[o.id] for o in obligations if o.node == node and o.guarantee == k]
+        s = worst(sts) if sts else "pending"
+        for f in health[node]:
+            if f["guarantee"] in (None, k) and f["status"] != "ok":
+                s = worst([s, _FINDING_AS[f["status"]]])
+        return s
+
+    nodes = []
+    node_status: dict[str, str] = {}
+    for name, cn in checked.nodes.items():
+        internal = {l.to_var: f"{l.from_node}.{l.from_var}" for l in model.links if l.to_node == name}
+        consumers: dict[str, list[str]] = {}
+        for l in model.links:
+            if l.from_node == name:
+                consumers.setdefault(l.from_var, []).append(f"{l.to_node}.{l.to_var}")
+        env_texts = {e["text"] for e in comps[name].get("environment_assumptions", [])}
+        guarantees = [{"index": k, "text": expr_to_rcl(g.formula), "source": _src(g.loc), "status": g_status(name, k),
+                       "obligations": sorted(o.id for o in obligations if o.node == name and o.guarantee == k)}
+                      for k, g in enumerate(cn.node.guarantees, 1)]
+        status = worst([g["status"] for g in guarantees] + [sc_status[name]])
+        node_status[name] = status
+        nodes.append({
+            "name": name, "source": _src(cn.node.loc), "status": status,
+            "inputs": [{"name": v.name, "type": type_to_rcl(v.type), "producer": internal.get(v.name)} for v in cn.node.inputs],
+            "outputs": [{"name": v.name, "type": type_to_rcl(v.type), "consumers": consumers.get(v.name, [])}
+                        for v in cn.node.outputs],
+            "assumptions": [{"text": expr_to_rcl(a.formula), "source": _src(a.loc),
+                             "environment": expr_to_rcl(a.formula) in env_texts} for a in cn.node.assumes],
+            "guarantees": guarantees, "latex": to_latex(ast.Spec((), (cn.node,))),
+        })
+
+    requirements = []
+    for r in plan.requirements:
+        support = []
+        for s in r.support:
+            for k in s.guarantees:
+                g = checked.nodes[s.node].node.guarantees[k - 1]
+                support.append({"node": s.node, "guarantee": k, "text": expr_to_rcl(g.formula), "source": _src(g.loc),
+                                "status": g_status(s.node, k),
+                                "obligations": sorted(o.id for o in obligations if o.node == s.node and o.guarantee == k)})
+        st = worst([x["status"] for x in support] + [sc_status[x["node"]] for x in support]) if support else "pending"
+        requirements.append({"id": r.id, "text": r.text, "status": st, "support": support})
+
+    derived = []
+    for n in checked.nodes:
+        c = comps[n]
+        if not c:
+            continue
+        derived.append({"node": n, "rules": c["rules"], "instances": c["instances"],
+                        "environment_assumptions": c["cone_environment_assumptions"], "property": c["derived_property"],
+                        "status": worst([sc_status[m] for m in c["cone"]], empty="discharged"),
+                        "loop_assumption": c["loop_assumption"]})
+
+    findings = [f for n in checked.nodes for f in health[n]]
+    diagnostics = read_artifact(ws, ws.DIAGNOSTICS, {"warnings": []})
+    lint_rows = [{"severity": d["severity"], "location": f"{d['file']}:{d['line']}:{d['col']}", "message": d["message"]}
+                 for d in diagnostics["warnings"]]
+    env_assumptions = [e for n in checked.nodes for e in comps[n].get("environment_assumptions", [])]
+
+    problems = []
+    for f in findings:
+        if f["status"] == "problem":
+            problems.append(f"Contract health: {f['message']}")
+    for sc in side_conditions:
+        if sc["status"] != "discharged":
+            problems.append(f"Side condition {sc['id']} is {sc['status']}: {sc['conjunct']}")
+    for e in ev_rows:
+        if e["status"] in ("failed", "error", "stale"):
+            problems.append(f"Evidence {e['obligation']} is {e['status']}: {e['explanation'][:300]}")
+    counts: dict[str, int] = {}
+    for o in ob_rows:
+        counts[o["status"]] = counts.get(o["status"], 0) + 1
+    overall = worst([r["status"] for r in requirements] + list(node_status.values()) + [d["status"] for d in derived])
+    strict_ok = all(o["status"] == "discharged" for o in ob_rows)
+    headline = (f"{len(ob_rows)} obligations: " + ", ".join(f"{counts[s]} {s}" for s in sorted(counts, key=SEVERITY.__getitem__))
+                + f"; {sum(1 for sc in side_conditions if sc['status'] == 'discharged')}/{len(side_conditions)} side conditions "
+                f"discharged; {sum(1 for f in findings if f['status'] == 'problem')} contract health problem(s).")
+    system = {"nodes": [{"name": n, "status": node_status[n]} for n in model.nodes], **{
+        k: v for k, v in model.to_json().items() if k != "nodes"}}
+    return {
+        "meta": {"tool": "rclverify", "version": __version__, "workspace": ws.root.resolve().name, "plan": plan.file,
+                 "contracts": list(plan.contracts), "z3_version": z3.get_version_string(), "strict_ok": strict_ok},
+        "summary": {"status": overall, "counts": counts, "headline": headline, "problems": problems},
+        "system": system, "requirements": requirements, "nodes": nodes, "side_conditions": side_conditions,
+        "derived_properties": derived, "findings": findings, "obligations": ob_rows, "evidence": ev_rows,
+        "environment_assumptions": env_assumptions, "pending": pending, "lint": lint_rows,
+    }

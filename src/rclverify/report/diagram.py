@@ -1,0 +1,193 @@
+"""Graphviz diagram of the system model for the assurance report.
+
+The system model (paper section "System Model", lines 437-461) is a directed
+graph: each node of the contract set is a box, each connection from an output
+variable to an input variable is an edge labelled with the variable, and every
+input nobody produces is fed by an environment source.  Connections on a loop
+(handled by rule R4, paper lines 714-768) are drawn bold.
+
+:func:`system_dot` renders the graph as DOT text from the ``system`` part of
+the report dict (template ``templates/system.dot.j2``); :func:`dot_to_svg`
+lays it out with the Graphviz ``dot`` program when it is installed.
+"""
+from __future__ import annotations
+
+import shutil
+import subprocess
+from dataclasses import dataclass
+from functools import lru_cache
+from typing import Any, Mapping, Sequence
+
+import jinja2
+
+#: Fill and border colour of a node box, by (normalised) status.
+_NODE_COLOURS: Mapping[str, tuple[str, str]] = {
+    "discharged": ("#dafbe1", "#1a7f37"),
+    "pending": ("#eaeef2", "#6e7781"),
+    "inconclusive": ("#fff8c5", "#9a6700"),
+    "stale": ("#fbefff", "#8250df"),
+    "error": ("#ffebe9", "#82071e"),
+    "failed": ("#ffebe9", "#cf222e"),
+}
+_OTHER_COLOURS = ("#ffffff", "#24292f")
+
+#: Seconds the ``dot`` program may run before the diagram is given up.
+DOT_TIMEOUT_S = 30.0
+
+INSTALL_HINT = "install graphviz for the diagram (the `dot` program was not found)"
+
+
+@lru_cache(maxsize=1)
+def _environment() -> jinja2.Environment:
+    return jinja2.Environment(
+        loader=jinja2.PackageLoader("rclverify.report", "templates"),
+        autoescape=False,
+        undefined=jinja2.StrictUndefined,
+        trim_blocks=True,
+        lstrip_blocks=True,
+        keep_trailing_newline=True,
+    )
+
+
+def _escape(text: str) -> str:
+    """Escape ``text`` for the inside of a DOT double-quoted string."""
+    return (
+        text.replace("\\", "\\\\")
+        .replace('"', '\\"')
+        .replace("\r\n", "\n")
+        .replace("\n", " ")
+    )
+
+
+def dot_string(*lines: str) -> str:
+    """A DOT double-quoted string whose label shows ``lines`` one per line.
+
+    Backslashes and quotes are escaped, so user text (node names, variable
+    names, types) cannot end the string or inject Graphviz escapes.
+    """
+    return '"' + "\\n".join(_escape(line) for line in lines) + '"'
+
+
+def _loop_edges(loops: Sequence[Sequence[str]]) -> set[tuple[str, str]]:
+    """Consecutive node pairs of every loop, closing each cycle."""
+    pairs: set[tuple[str, str]] = set()
+    for loop in loops:
+        cycle = list(loop)
+        if len(cycle) > 1 and cycle[0] == cycle[-1]:
+            cycle = cycle[:-1]
+        for k, name in enumerate(cycle):
+            pairs.add((name, cycle[(k + 1) % len(cycle)]))
+    return pairs
+
+
+def system_dot(system: Mapping[str, Any], title: str = "system model") -> str:
+    """Graphviz DOT text of the system model.
+
+    ``system`` is ``report["system"]``: ``nodes`` (``[{"name", "status"}]``),
+    ``connections`` (``[{"from_node", "from_var", "to_node", "to_var",
+    "via"}]``), ``environment_inputs`` (``[{"node", "var", "type"}]``) and
+    ``loops`` (``[[node, ...]]``, each a cycle in order).  ``title`` names the
+    source in the header comment.
+
+    Nodes are boxes labelled with their name and overall status and coloured
+    by it; edges are labelled with the variable (``out -> in`` when the two
+    names differ); environment inputs are plain-text sources ``env: <var>``
+    with a dashed edge; connections on a loop (R4, paper lines 714-768) are
+    bold.  Everything is sorted, so equal inputs give byte-equal output.
+    Raises ``KeyError`` when a required key is missing.
+    """
+    loop_pairs = _loop_edges(system["loops"])
+    names = {n["name"] for n in system["nodes"]}
+    status = {n["name"]: n["status"] for n in system["nodes"]}
+    for c in system["connections"]:
+        names.update((c["from_node"], c["to_node"]))
+    for e in system["environment_inputs"]:
+        names.add(e["node"])
+
+    nodes = []
+    for name in sorted(names):
+        st = status.get(name)
+        fill, border = _NODE_COLOURS.get(st or "", _OTHER_COLOURS)
+        label = dot_string(name, st) if st else dot_string(name)
+        nodes.append({"id": dot_string(name), "label": label, "fill": fill, "border": border})
+
+    edges = []
+    conns = sorted(
+        system["connections"],
+        key=lambda c: (c["from_node"], c["from_var"], c["to_node"], c["to_var"], str(c.get("via") or "")),
+    )
+    for c in conns:
+        var = c["from_var"] if c["from_var"] == c["to_var"] else f"{c['from_var']} -> {c['to_var']}"
+        via = str(c.get("via") or "")
+        tip = f"{c['from_node']}.{c['from_var']} -> {c['to_node']}.{c['to_var']}" + (f" ({via})" if via else "")
+        edges.append({
+            "src": dot_string(c["from_node"]),
+            "dst": dot_string(c["to_node"]),
+            "label": dot_string(var),
+            "tooltip": dot_string(tip),
+            "loop": (c["from_node"], c["to_node"]) in loop_pairs,
+        })
+
+    sources = []
+    for e in sorted(system["environment_inputs"], key=lambda e: (e["node"], e["var"])):
+        typ = str(e.get("type") or "")
+        sources.append({
+            "id": dot_string(f"env:{e['node']}.{e['var']}"),
+            "label": dot_string(f"env: {e['var']}"),
+            "tooltip": dot_string(f"{e['node']}.{e['var']}" + (f" : {typ}" if typ else "")),
+            "dst": dot_string(e["node"]),
+        })
+
+    return _environment().get_template("system.dot.j2").render(
+        title=title.replace("\n", " "), nodes=nodes, edges=edges, sources=sources,
+    )
+
+
+@dataclass(frozen=True)
+class Rendering:
+    """Outcome of laying out a DOT graph.
+
+    ``svg`` is inline-ready SVG (no XML prolog) or ``None``; ``note`` says
+    why there is no SVG ('' when there is one).
+    """
+
+    svg: str | None
+    note: str
+
+
+def render_dot(dot: str, timeout_s: float = DOT_TIMEOUT_S) -> Rendering:
+    """Run ``dot -Tsvg`` on ``dot`` (no shell) and explain any failure.
+
+    ``timeout_s`` is in seconds.  Never raises for a missing, failing or
+    hanging ``dot``: the reason is in :attr:`Rendering.note`.
+    """
+    exe = shutil.which("dot")
+    if exe is None:
+        return Rendering(None, INSTALL_HINT)
+    try:
+        proc = subprocess.run(
+            [exe, "-Tsvg"], input=dot.encode("utf-8"), capture_output=True,
+            timeout=timeout_s, check=False,
+        )
+    except subprocess.TimeoutExpired:
+        return Rendering(None, f"graphviz `dot` did not finish within {timeout_s:g} s")
+    except OSError as exc:
+        return Rendering(None, f"graphviz `dot` could not be run: {exc.strerror or exc}")
+    out = proc.stdout.decode("utf-8", "replace")
+    start = out.find("<svg")
+    if proc.returncode != 0 or start < 0:
+        err = proc.stderr.decode("utf-8", "replace").strip().splitlines()
+        why = err[0] if err else "no SVG produced"
+        return Rendering(None, f"graphviz `dot` failed (exit code {proc.returncode}): {why}")
+    return Rendering(out[start:].rstrip() + "\n", "")
+
+
+def dot_to_svg(dot: str, timeout_s: float = DOT_TIMEOUT_S) -> str | None:
+    """SVG text of the DOT graph ``dot``, ready to inline in HTML.
+
+    Runs the Graphviz ``dot`` program (``dot -Tsvg``, no shell, at most
+    ``timeout_s`` seconds) and strips the XML prolog, doctype and comments
+    that precede the ``<svg`` element.  Returns ``None`` when ``dot`` is not
+    installed, fails, or times out (see :func:`render_dot` for the reason).
+    """
+    return render_dot(dot, timeout_s).svg

@@ -1,0 +1,439 @@
+"""Render the assurance report (HTML, Markdown, JSON) from the report dict.
+
+The report dict is the plain, JSON-serialisable roll-up of the pipeline
+(system model, calculus, contract health, obligations, evidence) that traces
+requirement -> node -> guarantee -> obligation -> evidence (shared design,
+"Evidence"; the paper's five steps, lines 368-437).  This module does no
+verification: it lays that dict out so that a genuine problem (a failed,
+erroneous, stale or inconclusive item, a refuted side condition, a contract
+health problem) comes first and cannot be missed.
+
+Templates: ``templates/assurance.html.j2`` (autoescaped) and
+``templates/assurance.md.j2`` (not autoescaped; the ``md``/``code`` filters
+escape Markdown).  Output is deterministic: nothing in it depends on the time
+of rendering; evidence records show their own start times.
+"""
+from __future__ import annotations
+
+import re
+from collections import defaultdict
+from functools import lru_cache
+from pathlib import Path
+from typing import Any, Callable, Mapping, Sequence
+from urllib.parse import quote
+
+import jinja2
+from markupsafe import Markup, escape
+
+from ..evidence.records import SEVERITY
+from ..evidence.store import atomic_write_text, dumps
+from . import diagram
+
+#: Top-level keys every report dict carries.
+REPORT_KEYS: tuple[str, ...] = (
+    "meta", "summary", "system", "requirements", "nodes", "side_conditions",
+    "derived_properties", "findings", "obligations", "evidence",
+    "environment_assumptions", "pending", "lint",
+)
+
+#: Status word -> badge style.  Evidence statuses map to themselves; contract
+#: health and solver words map to the evidence status they stand for.
+STATUS_STYLE: Mapping[str, str] = {
+    "discharged": "discharged",
+    "pending": "pending",
+    "inconclusive": "inconclusive",
+    "stale": "stale",
+    "error": "error",
+    "failed": "failed",
+    "ok": "discharged",
+    "problem": "failed",
+    "proved": "discharged",
+    "refuted": "failed",
+    "unknown": "inconclusive",
+}
+
+#: Severity of a status word for ordering the attention list (larger is
+#: worse).  A word outside the vocabulary ranks as an error: the report cannot
+#: vouch for what it does not understand.
+_RANK: Mapping[str, int] = {**SEVERITY, "ok": 0, "proved": 0, "problem": 5, "refuted": 5, "unknown": 2}
+_UNKNOWN_RANK = SEVERITY["error"]
+
+#: Marker shown in Markdown next to a status (no colours there).
+_MD_MARK: Mapping[str, str] = {
+    "discharged": "\u2705",
+    "pending": "\u23f3",
+    "inconclusive": "\u26a0\ufe0f",
+    "stale": "\U0001f7e3",
+    "error": "\u26d4",
+    "failed": "\u274c",
+}
+
+#: Order in which status counts are listed: worst first, then any other key.
+_COUNT_ORDER = sorted(SEVERITY, key=lambda s: -SEVERITY[s])
+
+
+def rank(status: str) -> int:
+    """Severity of ``status`` (0 = fine ... 5 = failed/problem)."""
+    return _RANK.get(status, _UNKNOWN_RANK)
+
+
+def style(status: str) -> str:
+    """CSS class suffix for ``status`` (``other`` for an unknown word)."""
+    return STATUS_STYLE.get(status, "other")
+
+
+# ---------------------------------------------------------------------------
+# filters
+
+
+_ANCHOR_BAD = re.compile(r"[^A-Za-z0-9_.\-]")
+
+
+def anchor(*parts: Any) -> str:
+    """A fragment id built from ``parts`` joined by ``-``.
+
+    Characters other than letters, digits, ``_ . -`` are hex-encoded as
+    ``_xx``, so any user text gives a valid, quote-free HTML id.
+    """
+    text = "-".join(str(p) for p in parts)
+    return _ANCHOR_BAD.sub(lambda m: "".join(f"_{b:02x}" for b in m.group(0).encode("utf-8")), text)
+
+
+def html_badge(status: Any) -> Markup:
+    """``<span class="badge st-...">status</span>`` (status text escaped)."""
+    s = str(status)
+    return Markup('<span class="badge st-%s">%s</span>') % (style(s), escape(s))
+
+
+_MD_SPECIAL = re.compile(r"([\\`*_\[\]<>|&#])")
+_WS = re.compile(r"\s*[\r\n]+\s*")
+
+
+def md_text(value: Any) -> str:
+    """Escape ``value`` for inline Markdown (also inside a table cell).
+
+    Markdown punctuation, ``<``, ``>``, ``&`` and ``|`` are backslash-escaped,
+    so no HTML or table structure can come from user text; line breaks
+    become spaces.
+    """
+    return _MD_SPECIAL.sub(r"\\\1", _WS.sub(" ", str(value)).strip())
+
+
+def md_code(value: Any, cell: bool = True) -> str:
+    """``value`` as an inline code span.
+
+    The fence is longer than any backtick run inside; with ``cell`` (the
+    default) ``|`` is escaped so the span can sit in a table cell.  An empty
+    value gives ``''``.
+    """
+    text = _WS.sub(" ", str(value)).strip()
+    if not text:
+        return ""
+    runs = [len(m) for m in re.findall(r"`+", text)]
+    fence = "`" * (max(runs, default=0) + 1)
+    if text.startswith("`") or text.endswith("`"):
+        text = f" {text} "
+    if cell:
+        text = text.replace("|", "\\|")
+    return f"{fence}{text}{fence}"
+
+
+def md_fence(value: Any, lang: str = "") -> str:
+    """``value`` as a fenced code block (fence longer than any backtick run)."""
+    text = str(value).rstrip("\n")
+    runs = [len(m) for m in re.findall(r"`{3,}", text)]
+    fence = "`" * max(3, max(runs, default=0) + 1)
+    return f"{fence}{lang}\n{text}\n{fence}"
+
+
+def md_badge(status: Any) -> str:
+    """A status for Markdown: a marker and the word, bold unless fine."""
+    s = str(status)
+    mark = _MD_MARK.get(style(s), "\u2753")
+    word = md_text(s)
+    return f"{mark} {word}" if rank(s) == 0 else f"{mark} **{word}**"
+
+
+def seconds(value: Any) -> str:
+    """A duration in seconds as ``'1.23 s'`` (``'-'`` when absent)."""
+    if value is None or value == "":
+        return "-"
+    return f"{float(value):.2f} s"
+
+
+def comment_safe(value: Any) -> str:
+    """Text safe inside an HTML comment (no ``--``, one line)."""
+    text = _WS.sub(" ", str(value))
+    while "--" in text:
+        text = text.replace("--", "- -")
+    return text
+
+
+def link_maker(prefix: str) -> Callable[[str], str]:
+    """Return a function mapping a workspace-relative path to an href.
+
+    ``prefix`` is the path from the report's directory to the workspace root
+    (``'../'`` for the standard ``reports/`` folder).  The path is
+    percent-encoded, so ``:`` cannot start a URL scheme.
+    """
+    def href(path: str) -> str:
+        return prefix + quote(str(path), safe="/._-~")
+    return href
+
+
+@lru_cache(maxsize=1)
+def environment() -> jinja2.Environment:
+    """The report's jinja2 environment.
+
+    ``*.html.j2`` templates are autoescaped, ``*.md.j2``/``*.dot.j2`` are
+    not; undefined names raise (``StrictUndefined``).
+    """
+    env = jinja2.Environment(
+        loader=jinja2.PackageLoader("rclverify.report", "templates"),
+        autoescape=jinja2.select_autoescape(
+            enabled_extensions=("html.j2", "html"),
+            disabled_extensions=("md.j2", "dot.j2"),
+            default_for_string=True,
+            default=True,
+        ),
+        undefined=jinja2.StrictUndefined,
+        trim_blocks=True,
+        lstrip_blocks=True,
+        keep_trailing_newline=True,
+    )
+    env.filters.update(
+        anchor=anchor, badge=html_badge, md=md_text, code=md_code, fence=md_fence,
+        mdbadge=md_badge, secs=seconds, comment_safe=comment_safe, style=style,
+    )
+    env.globals.update(anchor=anchor, rank=rank)
+    return env
+
+
+# ---------------------------------------------------------------------------
+# view model
+
+
+def validate(report: Mapping[str, Any]) -> None:
+    """Check the top-level shape of ``report``.
+
+    Raises ``ValueError`` naming every missing top-level key (the templates
+    themselves raise ``jinja2.UndefinedError`` for a missing inner key).
+    """
+    missing = [k for k in REPORT_KEYS if k not in report]
+    if missing:
+        raise ValueError("report dict lacks key(s): " + ", ".join(missing))
+
+
+def _by(items: Sequence[Mapping[str, Any]], key: str) -> dict[str, list[Mapping[str, Any]]]:
+    out: dict[str, list[Mapping[str, Any]]] = defaultdict(list)
+    for it in items:
+        out[str(it[key])].append(it)
+    return out
+
+
+def _attention(report: Mapping[str, Any], ev_anchor: Sequence[str]) -> tuple[list[dict[str, Any]], list[dict[str, Any]]]:
+    """Items needing attention: (problems, outstanding).
+
+    Problems are everything worse than pending (failed, error, stale,
+    inconclusive evidence; refuted or undecided side conditions; contract
+    health problems; derived properties that do not hold; lint errors);
+    outstanding are the pending items with their reason.  Each item is
+    ``{"status", "kind", "ref", "anchor", "where", "message", "formula"}``
+    (``formula`` is RCL text to show as code, or ''); both lists
+    are sorted worst first, then by kind and reference.
+    """
+    items: list[dict[str, Any]] = []
+
+    def add(status: str, kind: str, ref: str, anchor_id: str, where: str, message: str,
+            formula: str = "") -> None:
+        items.append({"status": status, "kind": kind, "ref": ref, "anchor": anchor_id,
+                      "where": where, "message": message, "formula": formula})
+
+    reasons: dict[str, list[str]] = defaultdict(list)
+    for p in report["pending"]:
+        reasons[str(p["obligation"])].append(str(p["reason"]))
+    evidenced: set[str] = set()
+    for ev, aid in zip(report["evidence"], ev_anchor):
+        ob = str(ev["obligation"])
+        evidenced.add(ob)
+        if rank(ev["status"]) == 0:
+            continue
+        msg = str(ev["explanation"])
+        if ev["status"] == "pending" and reasons.get(ob):
+            msg = " ".join(dict.fromkeys([*reasons[ob], msg] if msg else reasons[ob]))
+        add(ev["status"], "evidence", ob, aid, f"{ev['backend']} ({ev['kind']})", msg)
+    for p in report["pending"]:
+        ob = str(p["obligation"])
+        if ob not in evidenced:
+            add("pending", "obligation", ob, anchor("ob", ob), str(p["backend"]), str(p["reason"]))
+            evidenced.add(ob)
+    for o in report["obligations"]:
+        if o["id"] not in evidenced and rank(o["status"]) > 0:
+            add(o["status"], "obligation", o["id"], anchor("ob", o["id"]), str(o["backend"]),
+                "No evidence record for this obligation.")
+    for sc in report["side_conditions"]:
+        if rank(sc["status"]) > 0:
+            add(sc["status"], "side condition", sc["id"], anchor("sc", sc["id"]),
+                f"{sc['node']}, {sc['rule']}, {sc['source']}",
+                str(sc["explanation"]) or "Assumption conjunct not established:", str(sc["conjunct"]))
+    for f in report["findings"]:
+        if rank(f["status"]) > 0:
+            where = str(f["node"]) + (f", guarantee {f['guarantee']}" if f["guarantee"] is not None else "")
+            msg = str(f["message"]) + (f" {f['explanation']}" if f["explanation"] else "")
+            add(f["status"], f"contract health: {f['check']}", f["id"], anchor("finding", f["id"]), where, msg)
+    for d in report["derived_properties"]:
+        if rank(d["status"]) > SEVERITY["pending"]:
+            add(d["status"], "derived property", d["node"], anchor("derived", d["node"]),
+                ", ".join(d["rules"]), "Derived property not established:", str(d["property"]))
+    for k, lint in enumerate(report["lint"]):
+        if str(lint["severity"]).lower() == "error":
+            add("error", "lint", str(lint["location"]), anchor("lint", k + 1), str(lint["location"]),
+                str(lint["message"]))
+
+    kind_order = {"evidence": 0, "obligation": 1, "side condition": 2, "derived property": 4, "lint": 5}
+    items.sort(key=lambda it: (-rank(it["status"]), kind_order.get(it["kind"], 3), it["kind"], it["ref"]))
+    problems = [it for it in items if rank(it["status"]) > SEVERITY["pending"]]
+    outstanding = [it for it in items if rank(it["status"]) <= SEVERITY["pending"]]
+    return problems, outstanding
+
+
+def view(report: Mapping[str, Any]) -> dict[str, Any]:
+    """Derived lookups the templates need (pure function of ``report``).
+
+    Keys: ``counts`` (``[(status, n)]`` worst first), ``problems`` and
+    ``outstanding`` (see :func:`_attention`), ``unmet_requirements``,
+    ``ev_anchor`` (one fragment id per evidence record, in order),
+    ``evidence_of`` (obligation id -> ``[(anchor, record)]``), ``obligation``
+    (id -> obligation), ``trace`` (requirement rows with ``rowspan`` and the
+    evidence of each supporting obligation), ``sections`` (per node: the node,
+    its rule instances/derived property, side conditions and findings).
+    """
+    validate(report)
+    seen: dict[str, int] = defaultdict(int)
+    ev_anchor: list[str] = []
+    evidence_of: dict[str, list[tuple[str, Mapping[str, Any]]]] = defaultdict(list)
+    for ev in report["evidence"]:
+        ob = str(ev["obligation"])
+        seen[ob] += 1
+        aid = anchor("ev", ob) if seen[ob] == 1 else anchor("ev", ob, seen[ob])
+        ev_anchor.append(aid)
+        evidence_of[ob].append((aid, ev))
+    obligation = {str(o["id"]): o for o in report["obligations"]}
+
+    counts_in = report["summary"]["counts"]
+    counts = [(s, counts_in[s]) for s in _COUNT_ORDER if s in counts_in]
+    counts += [(s, counts_in[s]) for s in sorted(counts_in) if s not in SEVERITY]
+
+    trace = []
+    for req in report["requirements"]:
+        rows = []
+        for sup in req["support"]:
+            obs = []
+            for oid in sup["obligations"]:
+                o = obligation.get(str(oid))
+                obs.append({
+                    "id": oid,
+                    "known": o is not None,
+                    "status": o["status"] if o is not None else "pending",
+                    "backend": o["backend"] if o is not None else "",
+                    "evidence": evidence_of.get(str(oid), []),
+                })
+            rows.append({"support": sup, "obligations": obs})
+        trace.append({"req": req, "rows": rows, "rowspan": max(1, len(rows))})
+
+    derived = _by(report["derived_properties"], "node")
+    sides = _by(report["side_conditions"], "node")
+    findings = _by(report["findings"], "node")
+    sections = []
+    named = [str(n["name"]) for n in report["nodes"]]
+    for n in report["nodes"]:
+        name = str(n["name"])
+        sections.append({"name": name, "node": n, "derived": derived.get(name, []),
+                         "side": sides.get(name, []), "findings": findings.get(name, [])})
+    for name in sorted((set(derived) | set(sides)) - set(named)):
+        sections.append({"name": name, "node": None, "derived": derived.get(name, []),
+                         "side": sides.get(name, []), "findings": findings.get(name, [])})
+
+    problems, outstanding = _attention(report, ev_anchor)
+    unmet = [r for r in report["requirements"] if rank(r["status"]) > 0]
+    return {
+        "counts": counts, "problems": problems, "outstanding": outstanding,
+        "unmet_requirements": unmet, "ev_anchor": ev_anchor, "evidence_of": evidence_of,
+        "obligation": obligation, "trace": trace, "sections": sections,
+        "lint_errors": sum(1 for x in report["lint"] if str(x["severity"]).lower() == "error"),
+    }
+
+
+def _header(report: Mapping[str, Any]) -> str:
+    meta = report["meta"]
+    contracts = ", ".join(str(c) for c in meta["contracts"])
+    return (f"assurance report of {meta['workspace']} from {meta['plan']} ({contracts}), "
+            f"generated by {meta['tool']} {meta['version']}")
+
+
+def _context(report: Mapping[str, Any], link_prefix: str) -> dict[str, Any]:
+    return {"r": report, "v": view(report), "header": _header(report), "href": link_maker(link_prefix)}
+
+
+def render_html(report: Mapping[str, Any], link_prefix: str = "../",
+                rendering: diagram.Rendering | None = None) -> str:
+    """The assurance report as one self-contained HTML page.
+
+    ``report`` is the report dict (see :data:`REPORT_KEYS`); ``link_prefix``
+    the path from the report's directory to the workspace root, prepended to
+    the workspace-relative artifact paths it links to.  The system diagram is
+    laid out with Graphviz (:func:`diagram.render_dot`) unless ``rendering``
+    is given; without Graphviz the page says so and shows the DOT source.
+    Every value from the report is HTML-escaped; only the SVG produced by
+    ``dot`` is inlined as markup.  Raises ``ValueError`` for a missing
+    top-level key and ``jinja2.UndefinedError`` for a missing inner key.
+    """
+    dot = diagram.system_dot(report["system"], title=f"system model of {report['meta']['workspace']}")
+    drawn = rendering if rendering is not None else diagram.render_dot(dot)
+    return environment().get_template("assurance.html.j2").render(
+        **_context(report, link_prefix), dot=dot, svg=drawn.svg, diagram_note=drawn.note,
+    )
+
+
+def render_markdown(report: Mapping[str, Any], link_prefix: str = "../") -> str:
+    """The assurance report as Markdown (GitHub-flavoured tables).
+
+    Same sections and order as :func:`render_html`; the system diagram is
+    given as DOT source.  User text is Markdown-escaped (:func:`md_text`,
+    :func:`md_code`).  Raises like :func:`render_html`.
+    """
+    dot = diagram.system_dot(report["system"], title=f"system model of {report['meta']['workspace']}")
+    return environment().get_template("assurance.md.j2").render(**_context(report, link_prefix), dot=dot)
+
+
+def render_json(report: Mapping[str, Any]) -> str:
+    """The report dict as deterministic JSON (sorted keys, indent 2, final newline).
+
+    Raises ``ValueError`` for a missing top-level key and ``TypeError`` for a
+    value that is not JSON-serialisable.
+    """
+    validate(report)
+    return dumps(report)
+
+
+def render_all(report: Mapping[str, Any], out_dir: Path, link_prefix: str = "../") -> list[Path]:
+    """Write ``assurance.html``, ``assurance.md`` and ``assurance.json`` to ``out_dir``.
+
+    All three texts are rendered before anything is written, so a rendering
+    error leaves the previous report untouched; each file is then written
+    atomically (and left alone when unchanged).  ``link_prefix`` as in
+    :func:`render_html`.  Returns the three paths in that order.  Raises
+    ``ValueError``/``TypeError``/``jinja2.UndefinedError`` for a malformed
+    report and ``OSError`` when ``out_dir`` cannot be written.
+    """
+    texts = {
+        "assurance.html": render_html(report, link_prefix),
+        "assurance.md": render_markdown(report, link_prefix),
+        "assurance.json": render_json(report),
+    }
+    paths = []
+    for name, text in texts.items():
+        path = Path(out_dir) / name
+        atomic_write_text(path, text)
+        paths.append(path)
+    return paths

@@ -1,0 +1,228 @@
+"""doit task generators for a workspace (``dodo.py`` only calls :func:`build_tasks`).
+
+Stages and their real file dependencies, per node ``N``:
+
+``check``          contracts + plan -> artifacts/contracts/N.json (one snapshot per
+                   node, rewritten only when that node's text changes), model, lint
+``graph``          model.dot -> model.svg (when graphviz is installed)
+``compose:N``      snapshot of N and of N's producers + model -> calculus/N.json
+``health:N``       snapshot of N -> health/N.json
+``export:N``       snapshot of N + the backend input files -> obligations/N.json
+``evidence:N.k-B`` obligations/N.json + entry k's input files -> evidence records
+``report``         every artifact above -> reports/assurance.{html,md,json}
+``verify``         the whole pipeline; ``doit verify --strict`` fails unless every
+                   obligation is discharged
+
+doit compares file contents (md5), so editing one node's contract changes
+only that node's snapshot: its compose/health/export/run tasks, its
+consumers' compose tasks (their side conditions) and the report re-run.
+Actions are module-level functions with plain arguments, so ``doit -n 2``
+(parallel processes) behaves like a serial run.
+"""
+from __future__ import annotations
+
+import glob
+import json
+import os
+import shutil
+from pathlib import Path
+from typing import Any, Callable, Iterator
+
+from doit.exceptions import TaskFailed
+from doit.tools import config_changed
+
+from .pipeline import Workspace
+from .rcl.errors import RclError
+
+REPORTS = ["reports/assurance.html", "reports/assurance.md", "reports/assurance.json"]
+
+
+def _ws(root: str) -> Workspace:
+    return Workspace(Path(root))
+
+
+def _fail(exc: RclError) -> TaskFailed:
+    return TaskFailed("\n".join(str(d) for d in exc.diagnostics))
+
+
+def act_check(root: str) -> Any:
+    from .pipeline import stage_check
+    try:
+        out = stage_check(_ws(root))
+    except RclError as exc:
+        return _fail(exc)
+    for w in out["warnings"]:
+        print(f"{w['file']}:{w['line']}:{w['col']}: warning: {w['message']}")
+    return None
+
+
+def act_graph(root: str) -> Any:
+    from .evidence.store import atomic_write_text
+    from .report.diagram import dot_to_svg
+    ws = _ws(root)
+    svg = dot_to_svg(ws.path(ws.DOT).read_text(encoding="utf-8"))
+    if svg is None:
+        print("graphviz 'dot' not found: the report embeds the DOT source instead of a diagram")
+        return None
+    atomic_write_text(ws.path("artifacts/system/model.svg"), svg)
+    return None
+
+
+def act_node(root: str, stage: str, node: str) -> Any:
+    from . import pipeline
+    try:
+        getattr(pipeline, f"stage_{stage}")(_ws(root), node)
+    except RclError as exc:
+        return _fail(exc)
+    return None
+
+
+def act_run(root: str, node: str, index: int) -> Any:
+    from .pipeline import stage_run
+    try:
+        evs = stage_run(_ws(root), node, index)
+    except RclError as exc:
+        return _fail(exc)
+    for e in evs:
+        print(f"{e.obligation}: {e.status}")
+    return None
+
+
+def act_report(root: str) -> Any:
+    from .report.build import build_report
+    from .report.render import render_all
+    ws = _ws(root)
+    try:
+        report = build_report(ws)
+    except RclError as exc:
+        return _fail(exc)
+    render_all(report, ws.path("reports"))
+    print(f"report: reports/assurance.html  ({report['summary']['headline']})")
+    return None
+
+
+def act_verify(root: str, strict: bool) -> Any:
+    path = Path(root) / "reports" / "assurance.json"
+    report = json.loads(path.read_text(encoding="utf-8"))
+    s = report["summary"]
+    print(f"overall: {s['status']} -- {s['headline']}")
+    for p in s["problems"]:
+        print(f"  problem: {p}")
+    if strict and not report["meta"]["strict_ok"]:
+        return TaskFailed("--strict: some evidence is failed, inconclusive, pending, stale or error (see reports/assurance.html)")
+    return None
+
+
+def strict_uptodate(task: Any, values: Any) -> bool:
+    """``verify`` is up to date unless ``--strict`` asks for the check again."""
+    return not bool(task.options.get("strict"))
+
+
+def _inputs(config: Any, root: Path) -> list[str]:
+    """Workspace files named in a plan evidence entry (strings that are existing paths)."""
+    out: set[str] = set()
+
+    def walk(v: Any) -> None:
+        if isinstance(v, str) and "/" in v and (root / v).exists():
+            p = root / v
+            if p.is_dir():
+                out.update(os.path.relpath(f, root) for f in glob.glob(str(p / "**" / "*"), recursive=True)
+                           if os.path.isfile(f))
+            else:
+                out.add(v)
+        elif isinstance(v, dict):
+            for x in v.values():
+                walk(x)
+        elif isinstance(v, list):
+            for x in v:
+                walk(x)
+    walk(dict(config))
+    return sorted(out)
+
+
+def _tool_fingerprint() -> dict[str, Any]:
+    return {"dafny": shutil.which("dafny"), "mcapl": os.environ.get("MCAPL_HOME") or os.environ.get("AJPF_HOME"),
+            "dot": shutil.which("dot")}
+
+
+def build_tasks(root: str | Path, plan_file: str = "contracts/plan.yaml") -> dict[str, Callable[[], Any]]:
+    """The ``task_*`` functions for a dodo.py of the workspace at ``root``."""
+    rootp = Path(root).resolve()
+    r = str(rootp)
+    ws = Workspace(rootp, plan_file)
+    try:
+        nodes = ws.node_names()
+        model = ws.model
+        ok = True
+    except RclError:
+        nodes, model, ok = [], None, False
+    try:
+        contract_deps = [str(rootp / c) for c in ws.plan.contracts]
+    except RclError:
+        contract_deps = []
+    snap = {n: str(rootp / ws.snapshot(n)) for n in nodes}
+
+    def task_check() -> dict[str, Any]:
+        """Parse and type-check the contracts, check the plan, lint, build the system model."""
+        return {"actions": [(act_check, [r])], "file_dep": [str(rootp / plan_file)] + contract_deps,
+                "targets": list(snap.values()) + [str(rootp / p) for p in (ws.MODEL, ws.DOT, ws.DIAGNOSTICS)],
+                "verbosity": 2, "clean": True}
+
+    def task_graph() -> dict[str, Any]:
+        """Render the system model diagram (SVG) with graphviz."""
+        return {"actions": [(act_graph, [r])], "file_dep": [str(rootp / ws.DOT)], "task_dep": ["check"],
+                "uptodate": [config_changed(_tool_fingerprint()["dot"] or "")], "verbosity": 2}
+
+    def node_tasks(stage: str, doc: str, deps: Callable[[str], list[str]], target: Callable[[str], str]) -> Iterator[dict[str, Any]]:
+        yield {"basename": stage, "name": None, "doc": doc}
+        for n in nodes:
+            yield {"name": n, "actions": [(act_node, [r, stage, n])], "file_dep": deps(n),
+                   "targets": [str(rootp / target(n))], "verbosity": 2, "clean": True}
+
+    def task_compose() -> Iterator[dict[str, Any]]:
+        return node_tasks("compose", "Apply the calculus (R1-R4): discharge side conditions with Z3, derive properties.",
+                          lambda n: [snap[n]] + [snap[p] for p in model.producers(n)] + [str(rootp / ws.MODEL)],
+                          ws.calculus)
+
+    def task_health() -> Iterator[dict[str, Any]]:
+        return node_tasks("health", "Check contract health: satisfiable assumption, consistency, non-vacuity.",
+                          lambda n: [snap[n]], ws.health)
+
+    def task_export() -> Iterator[dict[str, Any]]:
+        return node_tasks("export", "Export each node's guarantees as obligations to the plan's backends.",
+                          lambda n: [snap[n]] + [str(rootp / f) for e in ws.plan.evidence.get(n, ()) for f in _inputs(e.config, rootp)],
+                          ws.obligations)
+
+    def task_evidence() -> Iterator[dict[str, Any]]:
+        yield {"basename": "evidence", "name": None, "doc": "Run each backend on its obligations and record evidence."}
+        for n in nodes:
+            for e in ws.plan.evidence.get(n, ()):
+                deps = [str(rootp / ws.obligations(n)), snap[n]] + [str(rootp / f) for f in _inputs(e.config, rootp)]
+                if e.backend == "ajpf":
+                    deps += sorted(glob.glob(str(rootp / "backends" / "ajpf" / "results" / "*")))
+                yield {"name": f"{n}.{e.index}-{e.backend}", "actions": [(act_run, [r, n, e.index])],
+                       "file_dep": sorted(set(deps)), "targets": [str(rootp / ws.entry_done(n, e.index))],
+                       "uptodate": [config_changed(_tool_fingerprint())], "verbosity": 2, "clean": True}
+
+    def task_report() -> dict[str, Any]:
+        """Roll everything up into reports/assurance.{html,md,json}."""
+        deps = [str(rootp / p) for p in (ws.MODEL, ws.DIAGNOSTICS)] + list(snap.values())
+        for n in nodes:
+            deps += [str(rootp / ws.calculus(n)), str(rootp / ws.health(n)), str(rootp / ws.obligations(n))]
+            deps += [str(rootp / ws.entry_done(n, e.index)) for e in ws.plan.evidence.get(n, ())]
+        return {"actions": [(act_report, [r])], "file_dep": deps, "task_dep": ["graph"] if ok else [],
+                "targets": [str(rootp / p) for p in REPORTS], "verbosity": 2, "clean": True}
+
+    def task_verify() -> dict[str, Any]:
+        """The whole pipeline: check, compose, health, export, run, report.  --strict fails on any open evidence."""
+        return {"actions": [(act_verify, [r])], "task_dep": ["check", "report"] if ok else ["check"],
+                "file_dep": [str(rootp / REPORTS[2])] if ok else [],
+                "params": [{"name": "strict", "long": "strict", "type": bool, "default": False,
+                            "help": "fail unless every obligation is discharged"}],
+                "uptodate": [strict_uptodate], "verbosity": 2}
+
+    creators: dict[str, Callable[[], Any]] = {"task_check": task_check, "task_verify": task_verify}
+    if ok:
+        creators.update({"task_graph": task_graph, "task_compose": task_compose, "task_health": task_health,
+                         "task_export": task_export, "task_evidence": task_evidence, "task_report": task_report})
+    return creators

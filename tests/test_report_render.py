@@ -1,0 +1,366 @@
+"""Tests of the assurance report renderers (HTML, Markdown, JSON, DOT/SVG)."""
+from __future__ import annotations
+
+import copy
+import json
+import re
+import shutil
+from html.parser import HTMLParser
+from pathlib import Path
+from typing import Any
+
+import jinja2
+import pytest
+
+from rclverify.report import diagram, render
+
+
+def _report() -> dict[str, Any]:
+    """A small report in the shape the pipeline produces: two nodes in a loop,
+    an environment input, one failed evidence (with a hostile explanation),
+    one pending, one refuted side condition and one health problem."""
+    return {
+        "meta": {
+            "tool": "rclverify", "version": "0.1.0", "workspace": "mini",
+            "plan": "contracts/plan.yaml", "contracts": ["contracts/mini.rcl"],
+            "z3_version": "4.12.2", "strict_ok": False,
+        },
+        "summary": {
+            "status": "failed",
+            "counts": {"discharged": 1, "failed": 1, "pending": 1},
+            "headline": "1 of 3 obligations discharged; 1 failed.",
+            "problems": ["Sensor guarantee 1 fails its Hoare proof."],
+        },
+        "system": {
+            "nodes": [{"name": "Sensor", "status": "failed"}, {"name": "Agent", "status": "pending"}],
+            "connections": [
+                {"from_node": "Sensor", "from_var": "status", "to_node": "Agent", "to_var": "status", "via": "name"},
+                {"from_node": "Agent", "from_var": "command", "to_node": "Sensor", "to_var": "cmd", "via": "plan"},
+            ],
+            "environment_inputs": [{"node": "Sensor", "var": "r", "type": "REAL"}],
+            "loops": [["Agent", "Sensor"]],
+        },
+        "requirements": [
+            {"id": "REQ1", "text": "Report high radiation as red.", "status": "failed",
+             "support": [
+                 {"node": "Sensor", "guarantee": 1, "text": "in.r >= 250 -> out.status == red",
+                  "source": "contracts/mini.rcl:12:3", "status": "failed",
+                  "obligations": ["Sensor.g1.hoare"]},
+                 {"node": "Agent", "guarantee": 1, "text": "in.status == red -> out.command == stop",
+                  "source": "contracts/mini.rcl:20:3", "status": "pending",
+                  "obligations": ["Agent.g1.ajpf"]},
+             ]},
+            {"id": "REQ2", "text": "Move when | safe & sound.", "status": "discharged",
+             "support": [
+                 {"node": "Agent", "guarantee": 2, "text": "forall(k in NATURAL | in.status == green -> out.command == go)",
+                  "source": "contracts/mini.rcl:21:3", "status": "discharged",
+                  "obligations": ["Agent.g2.dafny"]},
+             ]},
+        ],
+        "nodes": [
+            {"name": "Sensor", "source": "contracts/mini.rcl:8:1", "status": "failed",
+             "inputs": [{"name": "r", "type": "REAL", "producer": None},
+                        {"name": "cmd", "type": "Cmd", "producer": "Agent.command"}],
+             "outputs": [{"name": "status", "type": "RadStat", "consumers": ["Agent.status"]}],
+             "assumptions": [{"text": "in.r >= 0", "source": "contracts/mini.rcl:11:3", "environment": True}],
+             "guarantees": [{"index": 1, "text": "in.r >= 250 -> out.status == red",
+                             "source": "contracts/mini.rcl:12:3", "status": "failed",
+                             "obligations": ["Sensor.g1.hoare"]}],
+             "latex": "\\textbf{Sensor}: $r \\geq 250 \\Rightarrow status = red$"},
+            {"name": "Agent", "source": "contracts/mini.rcl:16:1", "status": "pending",
+             "inputs": [{"name": "status", "type": "RadStat", "producer": "Sensor.status"}],
+             "outputs": [{"name": "command", "type": "Cmd", "consumers": ["Sensor.cmd"]}],
+             "assumptions": [{"text": "in.status in {red, orange, green}",
+                              "source": "contracts/mini.rcl:19:3", "environment": False}],
+             "guarantees": [
+                 {"index": 1, "text": "in.status == red -> out.command == stop",
+                  "source": "contracts/mini.rcl:20:3", "status": "pending", "obligations": ["Agent.g1.ajpf"]},
+                 {"index": 2, "text": "in.status == green -> out.command == go",
+                  "source": "contracts/mini.rcl:21:3", "status": "discharged", "obligations": ["Agent.g2.dafny"]},
+             ],
+             "latex": "\\textbf{Agent}"},
+        ],
+        "side_conditions": [
+            {"id": "Agent.sc1", "node": "Agent", "rule": "R1", "conjunct": "in.status in {red, orange, green}",
+             "source": "contracts/mini.rcl:19:3", "hypotheses": ["in.r >= 250 -> out.status == red"],
+             "status": "discharged", "model": None, "smt2": "artifacts/calculus/Agent.sc1.smt2",
+             "duration_s": 0.012, "explanation": ""},
+            {"id": "Sensor.sc1", "node": "Sensor", "rule": "R4", "conjunct": "in.cmd != halt",
+             "source": "contracts/mini.rcl:11:9", "hypotheses": ["in.status == red -> out.command == stop"],
+             "status": "failed", "model": {"Agent.out.command": "halt"},
+             "smt2": "artifacts/calculus/Sensor.sc1.smt2", "duration_s": 0.02,
+             "explanation": "The producer's guarantee allows halt."},
+        ],
+        "derived_properties": [
+            {"node": "Agent", "rules": ["R1", "R4"],
+             "instances": [{"rule": "R1", "premises": ["A_S => <> G_S", "A_A => <> G_A"],
+                            "conclusion": "A_S => <> G_A"}],
+             "environment_assumptions": ["in.r >= 0"],
+             "property": "in.r >= 0 => <> (in.status == red -> out.command == stop)",
+             "status": "failed",
+             "loop_assumption": "Every node on the loop Agent -> Sensor terminates for each input."},
+        ],
+        "findings": [
+            {"id": "Agent.health.g2", "node": "Agent", "check": "vacuity", "guarantee": 2,
+             "status": "problem", "message": "Guarantee 2 can never fire.", "explanation": "Its premise is unsatisfiable.",
+             "model": None, "core": ["in.status == green", "in.status != green"]},
+            {"id": "Sensor.health.assume", "node": "Sensor", "check": "assumption satisfiable", "guarantee": None,
+             "status": "ok", "message": "The assumption is satisfiable.", "explanation": "",
+             "model": {"Sensor.in.r": "0.0"}, "core": None},
+        ],
+        "obligations": [
+            {"id": "Agent.g1.ajpf", "node": "Agent", "guarantee": 1, "backend": "ajpf", "kind": "model checking",
+             "instance": "", "statement": "[] (red -> <> stop)", "source": "contracts/mini.rcl:20:3",
+             "artifact": "artifacts/ajpf/Agent.g1.psl", "status": "pending"},
+            {"id": "Agent.g2.dafny", "node": "Agent", "guarantee": 2, "backend": "dafny", "kind": "proof",
+             "instance": "", "statement": "ensures status == green ==> command == go",
+             "source": "contracts/mini.rcl:21:3", "artifact": "artifacts/dafny/Agent.dfy", "status": "discharged"},
+            {"id": "Sensor.g1.hoare", "node": "Sensor", "guarantee": 1, "backend": "hoare", "kind": "proof",
+             "instance": "", "statement": "{r >= 250} P {status == red}", "source": "contracts/mini.rcl:12:3",
+             "artifact": "artifacts/hoare/Sensor.g1.smt2", "status": "failed"},
+        ],
+        "evidence": [
+            {"obligation": "Agent.g1.ajpf", "backend": "ajpf", "kind": "model checking", "status": "pending",
+             "tool": "ajpf", "tool_version": "unknown", "started": "2024-05-01T10:00:00Z", "duration_s": 0.0,
+             "explanation": "", "counterexample": None, "artifacts": ["artifacts/ajpf/Agent.g1.psl"],
+             "log_excerpt": ""},
+            {"obligation": "Agent.g2.dafny", "backend": "dafny", "kind": "proof", "status": "discharged",
+             "tool": "dafny", "tool_version": "2.3.0", "started": "2024-05-01T10:00:01Z", "duration_s": 6.5,
+             "explanation": "Dafny verified the refinement.", "counterexample": None,
+             "artifacts": ["artifacts/dafny/Agent.dfy"], "log_excerpt": "Dafny program verifier finished with 2 verified, 0 errors"},
+            {"obligation": "Sensor.g1.hoare", "backend": "hoare", "kind": "proof", "status": "failed",
+             "tool": "z3", "tool_version": "4.12.2", "started": "2024-05-01T10:00:02Z", "duration_s": 0.03,
+             "explanation": "Postcondition fails <script>alert(1)</script> at r = 250.",
+             "counterexample": {"r": "250.0"}, "artifacts": ["artifacts/hoare/Sensor.g1.smt2"],
+             "log_excerpt": "sat\n(model (define-fun r () Real 250.0))"},
+        ],
+        "environment_assumptions": [{"node": "Sensor", "text": "in.r >= 0", "source": "contracts/mini.rcl:11:3"}],
+        "pending": [{"obligation": "Agent.g1.ajpf", "backend": "ajpf",
+                     "reason": "AJPF is not installed; run: ajpf-run artifacts/ajpf/Agent.g1.jpf"}],
+        "lint": [{"severity": "warning", "location": "contracts/mini.rcl:20:3",
+                  "message": "'->' mixed with 'and' without parentheses."}],
+    }
+
+
+def _section(text: str, start: str, end: str) -> str:
+    i = text.index(start)
+    return text[i:text.index(end, i + len(start))]
+
+
+NO_DOT = diagram.Rendering(None, diagram.INSTALL_HINT)
+
+
+def test_html_autoescapes_report_text() -> None:
+    html = render.render_html(_report(), rendering=NO_DOT)
+    assert "<script>" not in html
+    assert "&lt;script&gt;alert(1)&lt;/script&gt;" in html
+    # The requirement text with '&' and '|' is escaped, not dropped.
+    assert "Move when | safe &amp; sound." in html
+
+
+def test_html_sections_in_order_and_anchors_resolve() -> None:
+    html = render.render_html(_report(), rendering=NO_DOT)
+    order = ["id=\"attention\"", "id=\"system\"", "id=\"traceability\"", "id=\"calculus\"",
+             "id=\"health\"", "id=\"evidence\"", "id=\"pending\"", "id=\"environment\"",
+             "id=\"lint\"", "id=\"appendix\""]
+    positions = [html.index(s) for s in order]
+    assert positions == sorted(positions)
+    ids = set(re.findall(r'\sid="([^"]+)"', html))
+    targets = set(re.findall(r'href="#([^"]+)"', html))
+    assert targets, "no internal links"
+    assert targets <= ids, f"dangling links: {sorted(targets - ids)}"
+    # Requirement rows link to node, guarantee and evidence sections.
+    trace = _section(html, 'id="traceability"', "</section>")
+    for frag in ("#node-Sensor", "#g-Sensor-1", "#ob-Sensor.g1.hoare", "#ev-Sensor.g1.hoare"):
+        assert f'href="{frag}"' in trace
+    assert 'rowspan="2"' in trace
+
+
+class _TagBalance(HTMLParser):
+    VOID = {"br", "meta", "link", "img", "hr", "input", "path", "polygon", "ellipse", "polyline"}
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.stack: list[str] = []
+        self.errors: list[str] = []
+
+    def handle_starttag(self, tag: str, attrs: Any) -> None:
+        if tag not in self.VOID:
+            self.stack.append(tag)
+
+    def handle_endtag(self, tag: str) -> None:
+        if tag in self.VOID:
+            return
+        if self.stack and self.stack[-1] == tag:
+            self.stack.pop()
+        else:
+            self.errors.append(f"</{tag}> at {self.getpos()} inside {self.stack[-3:]}")
+
+
+@pytest.mark.parametrize("with_svg", [False, True])
+def test_html_tags_balance(with_svg: bool) -> None:
+    if with_svg and shutil.which("dot") is None:
+        pytest.skip("graphviz `dot` not installed")
+    html = render.render_html(_report(), rendering=None if with_svg else NO_DOT)
+    parser = _TagBalance()
+    parser.feed(html)
+    assert parser.errors == [] and parser.stack == []
+
+
+def test_failed_evidence_is_first_in_attention() -> None:
+    html = render.render_html(_report(), rendering=NO_DOT)
+    attention = _section(html, 'id="attention"', "</section>")
+    assert "Sensor.g1.hoare" in attention
+    assert "Sensor guarantee 1 fails its Hoare proof." in attention
+    # Refuted side condition and health problem are problems too; pending is outstanding.
+    problems = _section(attention, "Problems (", "</table>")
+    assert "Sensor.sc1" in problems and "Agent.health.g2" in problems
+    assert problems.index("Sensor.g1.hoare") < problems.index("Agent.health.g2")
+    assert "Agent.g1.ajpf" not in problems
+    outstanding = _section(attention, "Outstanding (", "</table>")
+    assert "Agent.g1.ajpf" in outstanding and "AJPF is not installed" in outstanding
+    # A healthy finding is not flagged.
+    assert "Sensor.health.assume" not in attention
+
+    md = render.render_markdown(_report())
+    md_attention = _section(md, "## What needs attention", "## System model")
+    assert "Sensor.g1.hoare" in md_attention and "**failed**" in md_attention
+
+
+def test_all_clear_report_says_nothing_needs_attention() -> None:
+    rep = _report()
+    rep["summary"].update(status="discharged", problems=[], counts={"discharged": 1})
+    rep["requirements"] = []
+    rep["pending"] = []
+    for key in ("evidence", "obligations", "side_conditions", "derived_properties", "findings"):
+        rep[key] = [x for x in rep[key] if render.rank(x["status"]) == 0]
+    attention = _section(render.render_html(rep, rendering=NO_DOT), 'id="attention"', "</section>")
+    assert "Nothing needs attention" in attention and "Problems (" not in attention
+
+
+def test_markdown_traceability_table_and_escaping() -> None:
+    md = render.render_markdown(_report())
+    trace = _section(md, "## Requirements traceability", "## Calculus")
+    lines = [ln for ln in trace.splitlines() if ln.startswith("|")]
+    assert lines[0] == "| Requirement | Node | Guarantee | Obligations | Evidence |"
+    assert lines[1].count("---") == 5
+    rows = lines[2:]
+    assert len(rows) == 3  # REQ1 has two supporting guarantees, REQ2 one
+    assert "REQ1" in rows[0] and "Sensor.g1.hoare" in rows[0] and "#ev-Sensor.g1.hoare" in rows[0]
+    assert "REQ1" not in rows[1] and "Agent.g1.ajpf" in rows[1]
+    # Every row keeps the five columns: user '|' is escaped, never a cell break.
+    for row in rows:
+        assert len(re.findall(r"(?<!\\)\|", row)) == 6, row
+    assert "safe \\& sound" in rows[2]
+    assert "`forall(k in NATURAL \\| in.status == green -> out.command == go)`" in rows[2]
+    assert "<script>" not in md
+
+
+def test_markdown_shows_counterexamples_and_loop_assumption() -> None:
+    md = render.render_markdown(_report())
+    assert "`r` = `250.0`" in md
+    assert "`Agent.out.command` = `halt`" in md
+    assert "R4 extra assumption:" in md and "terminates for each input" in md
+    assert "```latex\n\\textbf{Sensor}" in md
+
+
+def test_json_is_deterministic_and_round_trips(tmp_path: Path) -> None:
+    rep = _report()
+    text = render.render_json(rep)
+    assert json.loads(text) == rep
+    shuffled = {k: rep[k] for k in reversed(list(rep))}
+    assert render.render_json(shuffled) == text
+    assert text.startswith('{\n  "derived_properties"')
+
+
+def test_missing_key_is_reported() -> None:
+    rep = _report()
+    del rep["lint"]
+    with pytest.raises(ValueError, match="lint"):
+        render.render_json(rep)
+    rep = _report()
+    del rep["evidence"][0]["started"]
+    with pytest.raises(jinja2.UndefinedError):
+        render.render_html(rep, rendering=NO_DOT)
+
+
+def test_dot_has_every_node_and_connection() -> None:
+    rep = _report()
+    dot = diagram.system_dot(rep["system"])
+    assert dot.startswith("// system model, generated by rclverify\ndigraph system {")
+    for n in rep["system"]["nodes"]:
+        assert re.search(rf'^\s*"{n["name"]}" \[label="{n["name"]}\\n{n["status"]}"', dot, re.M)
+    assert re.search(r'"Sensor" -> "Agent" \[label="status"', dot)
+    assert re.search(r'"Agent" -> "Sensor" \[label="command -> cmd"', dot)
+    assert '"env:Sensor.r" [label="env: r"' in dot
+    assert '"env:Sensor.r" -> "Sensor"' in dot
+    # Both connections lie on the loop and are drawn bold.
+    assert dot.count("penwidth=2.2") == 2
+    # Deterministic regardless of input order.
+    rev = copy.deepcopy(rep["system"])
+    for key in ("nodes", "connections", "environment_inputs"):
+        rev[key].reverse()
+    assert diagram.system_dot(rev) == dot
+
+
+def test_dot_quotes_hostile_names() -> None:
+    system = {"nodes": [{"name": 'A"] ; x -> y [label="', "status": "discharged"}],
+              "connections": [], "environment_inputs": [], "loops": []}
+    dot = diagram.system_dot(system)
+    assert '"A\\"] ; x -> y [label=\\""' in dot
+    assert "\n  x -> y" not in dot
+
+
+@pytest.mark.skipif(shutil.which("dot") is None, reason="graphviz `dot` not installed")
+def test_dot_to_svg_and_inline_html() -> None:
+    rep = _report()
+    svg = diagram.dot_to_svg(diagram.system_dot(rep["system"]))
+    assert svg is not None and svg.startswith("<svg ")
+    assert "<?xml" not in svg and "<!DOCTYPE" not in svg
+    assert svg.rstrip().endswith("</svg>")
+    assert ">Sensor</text>" in svg and ">env: r</text>" in svg
+    html = render.render_html(rep)
+    system = _section(html, 'id="system"', "</section>")
+    assert "<svg " in system and "install graphviz" not in system
+
+
+def test_without_dot_report_embeds_source(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setattr(diagram.shutil, "which", lambda name: None)
+    assert diagram.dot_to_svg("digraph { a -> b }") is None
+    html = render.render_html(_report())
+    system = _section(html, 'id="system"', "</section>")
+    assert "install graphviz for the diagram" in system
+    assert "<svg" not in system
+    assert "digraph system {" in system and "&#34;Sensor&#34; -&gt; &#34;Agent&#34;" in system
+
+
+@pytest.mark.skipif(shutil.which("dot") is None, reason="graphviz `dot` not installed")
+def test_dot_error_is_explained() -> None:
+    result = diagram.render_dot("digraph { this is not dot")
+    assert result.svg is None and "failed" in result.note
+
+
+def test_render_all_writes_three_files(tmp_path: Path) -> None:
+    out = tmp_path / "reports"
+    paths = render.render_all(_report(), out)
+    assert [p.name for p in paths] == ["assurance.html", "assurance.md", "assurance.json"]
+    assert all(p.is_file() and p.stat().st_size > 0 for p in paths)
+    assert json.loads(paths[2].read_text(encoding="utf-8")) == _report()
+    html = paths[0].read_text(encoding="utf-8")
+    assert html.startswith("<!-- assurance report of mini from contracts/plan.yaml")
+    assert 'href="../artifacts/calculus/Sensor.sc1.smt2"' in html
+    assert "<link" not in html and "<script" not in html and "http://" not in html.replace(
+        'xmlns="http://www.w3.org/2000/svg"', "").replace('xmlns:xlink="http://www.w3.org/1999/xlink"', "")
+    # Same report, same bytes.
+    before = [p.read_bytes() for p in paths]
+    render.render_all(_report(), out)
+    assert [p.read_bytes() for p in paths] == before
+    assert sorted(x.name for x in out.iterdir()) == ["assurance.html", "assurance.json", "assurance.md"]
+
+
+def test_artifact_links_cannot_become_urls() -> None:
+    rep = _report()
+    rep["obligations"][0]["artifact"] = "javascript:alert(1)"
+    html = render.render_html(rep, link_prefix="", rendering=NO_DOT)
+    assert 'href="javascript:' not in html
+    assert 'href="javascript%3Aalert%281%29"' in html
