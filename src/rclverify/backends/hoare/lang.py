@@ -1,0 +1,578 @@
+"""The hoare backend's imperative language: immutable AST, parser and printer.
+
+The paper models the Radiation Sensor node "as a simple program in a Hoare
+Logic-style language" (shared/reference, lines 1477-1491) and proves its
+guarantee by hand (appendix B, lines 1984-).  This module gives that language
+a concrete, checkable form (grammar: ``imp.lark``):
+
+* declarations: ``var x, y : T;`` where ``T`` is ``REAL``, ``INTEGER``,
+  ``NATURAL``, ``BOOL`` or a type name of the RCL context (``RadStat``), and
+  ``extern f : T1 x T2 --> T;`` for uninterpreted functions;
+* statements: ``x := e``, ``if c then S [elif c then S]* [else S] end``, the
+  paper's ``IF (c) THEN s [ELSE s]`` (one statement per branch),
+  ``while c invariant I do S end`` and ``skip``; ``;`` between statements is
+  optional;
+* expressions: ``-> or and not``, comparisons (``=`` is ``==``),
+  ``+ - * /``, unary ``-``, numbers, ``TRUE``/``FALSE``, names (variables and
+  the context's enumeration values), calls ``f(e, ...)`` and ``old(x)`` (the
+  value ``x`` had when the program started; meant for loop invariants).
+
+Locations are excluded from equality, so ``parse_program(to_text(p)) == p``.
+
+Public entry points
+-------------------
+``parse_program(text, file)`` / ``parse_program_file(path, display)`` -> :class:`Program`
+``parse_expression(text, file, line, col)`` -> :data:`Expr`
+``to_text(program)`` -> ``str``; ``expr_text(expr)`` -> ``str``; ``stmt_header(stmt)`` -> ``str``
+
+Every parse error is an :class:`~rclverify.rcl.errors.RclError` located in the
+program file (``file:line:col``).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from functools import lru_cache
+from importlib import resources
+from pathlib import Path
+from typing import Any, Literal, Union
+
+from lark import Lark, Token, Transformer, v_args
+from lark.exceptions import UnexpectedCharacters, UnexpectedEOF, UnexpectedInput, UnexpectedToken, VisitError
+
+from ...rcl import ast as rast
+from ...rcl.ast import Loc
+from ...rcl.errors import RclError, error
+
+NOLOC = Loc()
+
+
+def _loc() -> Loc:
+    return field(default=NOLOC, compare=False, repr=False)
+
+
+# --------------------------------------------------------------------------
+# Expressions
+# --------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class Num:
+    """A numeric literal; ``text`` as written (``120``, ``2.5``)."""
+
+    text: str
+    loc: Loc = _loc()
+
+    @property
+    def is_integral(self) -> bool:
+        return "." not in self.text
+
+
+@dataclass(frozen=True)
+class BoolConst:
+    """``TRUE`` / ``FALSE``."""
+
+    value: bool
+    loc: Loc = _loc()
+
+
+@dataclass(frozen=True)
+class Name:
+    """A variable or an enumeration value of the RCL context (``green``)."""
+
+    name: str
+    loc: Loc = _loc()
+
+
+@dataclass(frozen=True)
+class Old:
+    """``old(x)``: the value of variable ``x`` in the initial state."""
+
+    name: str
+    loc: Loc = _loc()
+
+
+@dataclass(frozen=True)
+class Call:
+    """``f(a, ...)``: an uninterpreted (``extern``) function or an RCL constructor."""
+
+    func: str
+    args: tuple["Expr", ...]
+    loc: Loc = _loc()
+
+
+UnOp = Literal["not", "-"]
+BinOp = Literal["->", "or", "and", "==", "!=", "<", "<=", ">", ">=", "+", "-", "*", "/"]
+COMPARISONS: frozenset[str] = frozenset({"==", "!=", "<", "<=", ">", ">="})
+ARITHMETIC: frozenset[str] = frozenset({"+", "-", "*", "/"})
+CONNECTIVES: frozenset[str] = frozenset({"->", "or", "and"})
+
+
+@dataclass(frozen=True)
+class Unary:
+    """``not e`` or ``- e``."""
+
+    op: UnOp
+    operand: "Expr"
+    loc: Loc = _loc()
+
+
+@dataclass(frozen=True)
+class Binary:
+    """A binary connective, comparison or arithmetic operator (``op`` in :data:`BinOp`)."""
+
+    op: BinOp
+    left: "Expr"
+    right: "Expr"
+    loc: Loc = _loc()
+
+
+Expr = Union[Num, BoolConst, Name, Old, Call, Unary, Binary]
+
+
+# --------------------------------------------------------------------------
+# Statements and programs
+# --------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class Assign:
+    """``target := value``."""
+
+    target: str
+    value: Expr
+    loc: Loc = _loc()
+
+
+@dataclass(frozen=True)
+class If:
+    """``if cond then then_ else else_ end``; a missing ``else`` is ``else_ == ()``.
+
+    ``elif`` chains and the paper's ``IF/THEN/ELSE`` spelling parse to nested
+    :class:`If` values.
+    """
+
+    cond: Expr
+    then_: tuple["Stmt", ...]
+    else_: tuple["Stmt", ...] = ()
+    loc: Loc = _loc()
+
+
+@dataclass(frozen=True)
+class While:
+    """``while cond invariant invariant do body end`` (several ``invariant``
+    clauses are conjoined)."""
+
+    cond: Expr
+    invariant: Expr
+    body: tuple["Stmt", ...]
+    loc: Loc = _loc()
+
+
+@dataclass(frozen=True)
+class Skip:
+    """``skip``."""
+
+    loc: Loc = _loc()
+
+
+Stmt = Union[Assign, If, While, Skip]
+
+
+@dataclass(frozen=True)
+class VarDecl:
+    """``var name : type;`` (``type`` is an RCL type expression)."""
+
+    name: str
+    type: rast.TypeExpr
+    loc: Loc = _loc()
+
+
+@dataclass(frozen=True)
+class ExternDecl:
+    """``extern name : T1 x ... --> T;``: an uninterpreted function."""
+
+    name: str
+    type: rast.TypeExpr
+    loc: Loc = _loc()
+
+
+@dataclass(frozen=True)
+class Program:
+    """A whole program: declarations in source order and the statement sequence."""
+
+    vars: tuple[VarDecl, ...]
+    externs: tuple[ExternDecl, ...]
+    body: tuple[Stmt, ...]
+    file: str = field(default="<string>", compare=False)
+
+
+# --------------------------------------------------------------------------
+# Parser
+# --------------------------------------------------------------------------
+
+_FRIENDLY = {"NAME": "a name", "NUMBER": "a number", "CMP_OP": "a comparison", "$END": "end of file"}
+
+
+@lru_cache(maxsize=1)
+def _lark() -> Lark:
+    grammar = resources.files("rclverify.backends.hoare").joinpath("imp.lark").read_text(encoding="utf-8")
+    return Lark(grammar, parser="lalr", start=["start", "expr"], propagate_positions=True,
+                maybe_placeholders=True)
+
+
+def _describe(term: str) -> str:
+    if term in _FRIENDLY:
+        return _FRIENDLY[term]
+    try:
+        pattern = _lark().get_terminal(term).pattern
+    except KeyError:
+        return term
+    return f"'{pattern.value}'" if pattern.type == "str" else term.lower()
+
+
+def _block(stmts: Any) -> tuple[Stmt, ...]:
+    if stmts is None:
+        return ()
+    if isinstance(stmts, tuple):
+        return stmts
+    return (stmts,)
+
+
+class _ToAst(Transformer[Token, Any]):
+    """Builds the immutable AST; ``dline``/``dcol`` shift locations."""
+
+    def __init__(self, file: str, dline: int = 0, dcol: int = 0) -> None:
+        super().__init__()
+        self.file, self.dline, self.dcol = file, dline, dcol
+
+    def _loc(self, m: Any) -> Loc:
+        if getattr(m, "empty", True) and not isinstance(m, Token):
+            return Loc(self.file)
+        line, col, end_line, end_col = m.line, m.column, m.end_line, m.end_column
+        if line == 1:
+            col += self.dcol
+        if end_line == 1:
+            end_col += self.dcol
+        return Loc(self.file, line + self.dline, col, end_line + self.dline, end_col)
+
+    # -- declarations ----------------------------------------------------------
+    def start(self, c: list[Any]) -> Program:
+        decls, body = c[:-1], c[-1]
+        vars_ = tuple(d for group in decls if group[0] == "var" for d in group[1])
+        externs = tuple(d for group in decls if group[0] == "extern" for d in group[1])
+        return Program(vars_, externs, body, self.file)
+
+    def _names(self, c: list[Any]) -> list[Token]:
+        return [t for t in c[:-1]]
+
+    def var_decl(self, c: list[Any]) -> tuple[str, tuple[VarDecl, ...]]:
+        return ("var", tuple(VarDecl(str(t), c[-1], self._loc(t)) for t in self._names(c)))
+
+    def extern_decl(self, c: list[Any]) -> tuple[str, tuple[ExternDecl, ...]]:
+        return ("extern", tuple(ExternDecl(str(t), c[-1], self._loc(t)) for t in self._names(c)))
+
+    @v_args(meta=True)
+    def real(self, meta: Any, c: list[Any]) -> rast.TBase:
+        return rast.TBase("REAL", self._loc(meta))
+
+    @v_args(meta=True)
+    def integer(self, meta: Any, c: list[Any]) -> rast.TBase:
+        return rast.TBase("INTEGER", self._loc(meta))
+
+    @v_args(meta=True)
+    def natural(self, meta: Any, c: list[Any]) -> rast.TBase:
+        return rast.TBase("NATURAL", self._loc(meta))
+
+    @v_args(meta=True)
+    def bool(self, meta: Any, c: list[Any]) -> rast.TBase:
+        return rast.TBase("BOOL", self._loc(meta))
+
+    @v_args(meta=True)
+    def named_type(self, meta: Any, c: list[Any]) -> rast.TName:
+        return rast.TName(str(c[0]), self._loc(meta))
+
+    @v_args(meta=True)
+    def func_type(self, meta: Any, c: list[Any]) -> rast.TFunc:
+        return rast.TFunc(tuple(c[:-1]), c[-1], self._loc(meta))
+
+    # -- statements --------------------------------------------------------------
+    def stmts(self, c: list[Any]) -> tuple[Stmt, ...]:
+        return tuple(s for s in c if s is not None)
+
+    @v_args(meta=True)
+    def assign(self, meta: Any, c: list[Any]) -> Assign:
+        return Assign(str(c[0]), c[1], self._loc(meta))
+
+    @v_args(meta=True)
+    def if_lower(self, meta: Any, c: list[Any]) -> If:
+        cond, then_, *elifs, else_ = c
+        tail: tuple[Stmt, ...] = _block(else_)
+        for e_cond, e_body, e_loc in reversed(elifs):
+            tail = (If(e_cond, e_body, tail, e_loc),)
+        return If(cond, then_, tail, self._loc(meta))
+
+    @v_args(meta=True)
+    def elif_clause(self, meta: Any, c: list[Any]) -> tuple[Expr, tuple[Stmt, ...], Loc]:
+        return (c[0], c[1], self._loc(meta))
+
+    @v_args(meta=True)
+    def if_upper(self, meta: Any, c: list[Any]) -> If:
+        return If(c[0], _block(c[1]), _block(c[2]), self._loc(meta))
+
+    @v_args(meta=True)
+    def while_stmt(self, meta: Any, c: list[Any]) -> While:
+        cond, *invs, body = c
+        inv = invs[0]
+        for more in invs[1:]:
+            inv = Binary("and", inv, more, inv.loc)
+        return While(cond, inv, body, self._loc(meta))
+
+    def invariant(self, c: list[Any]) -> Expr:
+        return c[0]  # type: ignore[no-any-return]
+
+    @v_args(meta=True)
+    def skip(self, meta: Any, c: list[Any]) -> Skip:
+        return Skip(self._loc(meta))
+
+    # -- expressions -----------------------------------------------------------------
+    def _bin(self, op: BinOp, meta: Any, c: list[Any]) -> Binary:
+        return Binary(op, c[0], c[-1], self._loc(meta))
+
+    @v_args(meta=True)
+    def implies(self, meta: Any, c: list[Any]) -> Binary:
+        return self._bin("->", meta, c)
+
+    @v_args(meta=True)
+    def or_(self, meta: Any, c: list[Any]) -> Binary:
+        return self._bin("or", meta, c)
+
+    @v_args(meta=True)
+    def and_(self, meta: Any, c: list[Any]) -> Binary:
+        return self._bin("and", meta, c)
+
+    @v_args(meta=True)
+    def not_(self, meta: Any, c: list[Any]) -> Unary:
+        return Unary("not", c[-1], self._loc(meta))
+
+    @v_args(meta=True)
+    def compare(self, meta: Any, c: list[Any]) -> Binary:
+        op = str(c[1])
+        return Binary("==" if op == "=" else op, c[0], c[2], self._loc(meta))  # type: ignore[arg-type]
+
+    @v_args(meta=True)
+    def add(self, meta: Any, c: list[Any]) -> Binary:
+        return self._bin("+", meta, c)
+
+    @v_args(meta=True)
+    def sub(self, meta: Any, c: list[Any]) -> Binary:
+        return self._bin("-", meta, c)
+
+    @v_args(meta=True)
+    def mul(self, meta: Any, c: list[Any]) -> Binary:
+        return self._bin("*", meta, c)
+
+    @v_args(meta=True)
+    def div(self, meta: Any, c: list[Any]) -> Binary:
+        return self._bin("/", meta, c)
+
+    @v_args(meta=True)
+    def minus(self, meta: Any, c: list[Any]) -> Unary:
+        return Unary("-", c[0], self._loc(meta))
+
+    @v_args(meta=True)
+    def number(self, meta: Any, c: list[Any]) -> Num:
+        return Num(str(c[0]), self._loc(meta))
+
+    @v_args(meta=True)
+    def true(self, meta: Any, c: list[Any]) -> BoolConst:
+        return BoolConst(True, self._loc(meta))
+
+    @v_args(meta=True)
+    def false(self, meta: Any, c: list[Any]) -> BoolConst:
+        return BoolConst(False, self._loc(meta))
+
+    @v_args(meta=True)
+    def name(self, meta: Any, c: list[Any]) -> Name:
+        return Name(str(c[0]), self._loc(meta))
+
+    @v_args(meta=True)
+    def call(self, meta: Any, c: list[Any]) -> Call:
+        return Call(str(c[0]), tuple(a for a in c[1:] if a is not None), self._loc(meta))
+
+    @v_args(meta=True)
+    def old(self, meta: Any, c: list[Any]) -> Old:
+        return Old(str(c[0]), self._loc(meta))
+
+
+def _syntax_error(exc: UnexpectedInput, file: str, text: str, dline: int, dcol: int) -> RclError:
+    line = getattr(exc, "line", 0) or 0
+    col = getattr(exc, "column", 0) or 0
+    expected: Any
+    if isinstance(exc, UnexpectedEOF) or (isinstance(exc, UnexpectedToken) and exc.token.type == "$END"):
+        lines = text.splitlines() or [""]
+        line, col = len(lines), len(lines[-1]) + 1
+        msg = "unexpected end of program"
+        expected = getattr(exc, "expected", None)
+    elif isinstance(exc, UnexpectedToken):
+        msg = f"unexpected {exc.token.value!r}"
+        expected = exc.expected
+    elif isinstance(exc, UnexpectedCharacters):
+        msg = f"unexpected character {exc.char!r}"
+        expected = exc.allowed
+    else:  # pragma: no cover - lark has no other subclasses today
+        msg, expected = str(exc).splitlines()[0], None
+    if expected:
+        names = sorted({_describe(t) for t in expected if not t.startswith("__")})
+        if names:
+            msg += "; expected " + (names[0] if len(names) == 1 else "one of " + ", ".join(names))
+    if line == 1:
+        col += dcol
+    return RclError([error(Loc(file, line + dline, col), msg, "E-syntax")])
+
+
+def _parse(text: str, file: str, start: str, dline: int, dcol: int) -> Any:
+    try:
+        tree = _lark().parse(text, start=start)
+    except UnexpectedInput as exc:
+        raise _syntax_error(exc, file, text, dline, dcol) from None
+    try:
+        return _ToAst(file, dline, dcol).transform(tree)
+    except VisitError as exc:  # pragma: no cover - transformer bugs are internal errors
+        raise exc.orig_exc from exc
+
+
+def parse_program(text: str, file: str = "<string>") -> Program:
+    """Parse a program's text; ``file`` names it in locations and errors.
+
+    Returns a :class:`Program`; raises :class:`RclError` (code ``E-syntax``)
+    located at the offending token.
+    """
+    return _parse(text, file, "start", 0, 0)  # type: ignore[no-any-return]
+
+
+def parse_program_file(path: str | Path, display: str | None = None) -> Program:
+    """Read and parse a program file.
+
+    ``display`` is the name used in locations (e.g. the workspace-relative
+    path); defaults to ``str(path)``.  An unreadable file is an
+    :class:`RclError` (code ``E-io``) located at line 1.
+    """
+    name = display if display is not None else str(path)
+    try:
+        text = Path(path).read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as exc:
+        reason = getattr(exc, "strerror", None) or str(exc)
+        raise RclError([error(Loc(name, 1, 1), f"cannot read program: {reason}", "E-io")]) from None
+    return parse_program(text, name)
+
+
+def parse_expression(text: str, file: str = "<string>", line: int = 1, col: int = 1) -> Expr:
+    """Parse one expression of the language (e.g. a plan binding ``radiation_at(i)``).
+
+    ``line``/``col`` say where ``text`` starts in ``file``; raises
+    :class:`RclError` located there.
+    """
+    return _parse(text, file, "expr", line - 1, col - 1)  # type: ignore[no-any-return]
+
+
+# --------------------------------------------------------------------------
+# Printer
+# --------------------------------------------------------------------------
+
+#: Binding strength, loosest first (the grammar's precedence).
+_PREC: dict[str, int] = {"->": 1, "or": 2, "and": 3, "not": 4, "==": 5, "!=": 5, "<": 5, "<=": 5, ">": 5,
+                         ">=": 5, "+": 6, "-": 6, "*": 7, "/": 7, "neg": 8}
+_ATOM = 9
+
+
+def _prec(e: Expr) -> int:
+    if isinstance(e, Binary):
+        return _PREC[e.op]
+    if isinstance(e, Unary):
+        return _PREC["not"] if e.op == "not" else _PREC["neg"]
+    return _ATOM
+
+
+def expr_text(e: Expr, context: int = 0) -> str:
+    """Render an expression in the language's concrete syntax with the fewest
+    parentheses that reparse to the same tree; ``context`` is the binding
+    strength of the enclosing operator (0 at top level)."""
+    p = _prec(e)
+    if isinstance(e, Num):
+        s = e.text
+    elif isinstance(e, BoolConst):
+        s = "TRUE" if e.value else "FALSE"
+    elif isinstance(e, Name):
+        s = e.name
+    elif isinstance(e, Old):
+        s = f"old({e.name})"
+    elif isinstance(e, Call):
+        s = f"{e.func}(" + ", ".join(expr_text(a) for a in e.args) + ")"
+    elif isinstance(e, Unary):
+        s = ("not " if e.op == "not" else "-") + expr_text(e.operand, p)
+    elif e.op == "->":
+        s = f"{expr_text(e.left, p + 1)} -> {expr_text(e.right, p)}"
+    elif e.op in COMPARISONS:
+        s = f"{expr_text(e.left, p + 1)} {e.op} {expr_text(e.right, p + 1)}"
+    else:
+        s = f"{expr_text(e.left, p)} {e.op} {expr_text(e.right, p + 1)}"
+    return f"({s})" if p < context else s
+
+
+def _type_text(t: rast.TypeExpr) -> str:
+    if isinstance(t, rast.TBase):
+        return t.name
+    if isinstance(t, rast.TName):
+        return t.name
+    if isinstance(t, rast.TFunc):
+        return " x ".join(_type_text(a) for a in t.args) + " --> " + _type_text(t.result)
+    raise ValueError(f"type {t!r} has no concrete syntax in this language")
+
+
+def stmt_header(s: Stmt) -> str:
+    """One-line rendering of a statement's head: ``x := e``, ``if c then``,
+    ``while c invariant I do`` or ``skip`` (used by proof outlines)."""
+    if isinstance(s, Assign):
+        return f"{s.target} := {expr_text(s.value)}"
+    if isinstance(s, If):
+        return f"if {expr_text(s.cond)} then"
+    if isinstance(s, While):
+        return f"while {expr_text(s.cond)} invariant {expr_text(s.invariant)} do"
+    return "skip"
+
+
+def _stmts_lines(stmts: tuple[Stmt, ...], depth: int) -> list[str]:
+    pad = "  " * depth
+    out: list[str] = []
+    for s in stmts:
+        if isinstance(s, If):
+            out.append(pad + stmt_header(s))
+            out.extend(_stmts_lines(s.then_, depth + 1))
+            tail = s.else_
+            while len(tail) == 1 and isinstance(tail[0], If):
+                out.append(pad + f"elif {expr_text(tail[0].cond)} then")
+                out.extend(_stmts_lines(tail[0].then_, depth + 1))
+                tail = tail[0].else_
+            if tail:
+                out.append(pad + "else")
+                out.extend(_stmts_lines(tail, depth + 1))
+            out.append(pad + "end")
+        elif isinstance(s, While):
+            out.append(pad + stmt_header(s))
+            out.extend(_stmts_lines(s.body, depth + 1))
+            out.append(pad + "end")
+        else:
+            out.append(pad + stmt_header(s))
+    return out
+
+
+def to_text(p: Program) -> str:
+    """Render a program in canonical concrete syntax (lowercase keywords,
+    one declaration per line, two-space indentation, trailing newline).
+    ``parse_program(to_text(p)) == p``."""
+    lines = [f"var {d.name} : {_type_text(d.type)};" for d in p.vars]
+    lines += [f"extern {d.name} : {_type_text(d.type)};" for d in p.externs]
+    if lines:
+        lines.append("")
+    lines += _stmts_lines(p.body, 0)
+    return "\n".join(lines) + "\n"

@@ -1,0 +1,503 @@
+"""From a node's RCL guarantee to Hoare triples over a program.
+
+The paper turns the Radiation Sensor's guarantee into four Hoare triples over
+its program (shared/reference, lines 1492-1508): the guarantee reads
+``forall i | command = inspect(i) -> (inspected(i) and (0 <= r < 120 -> status
+= green) and ...)`` and each consequence becomes ``{premise} P {consequence}``.
+This module does that for any guarantee:
+
+* a guarantee ``forall vars | H -> C`` (``H`` optional, the ``forall``
+  optional) is split into the conjuncts of ``C``;
+* a conjunct ``P -> Q`` gives the triple ``{A and H and P} program {Q}``, a
+  plain conjunct ``Q`` gives ``{A and H} program {Q}``, where ``A`` is the
+  node's assumption (all its ``assume`` clauses);
+* the plan's ``binding`` maps RCL inputs to program expressions over the
+  initial state (``in.r: radiation_at(i)``) and RCL outputs to program
+  variables read in the final state (``out.radiationStatus: output``); a
+  bound variable of the outer ``forall`` named like a program variable is
+  that variable's initial value (``i``), other bound variables are fixed but
+  arbitrary values;
+* in the postcondition an input means its value when the program started
+  (the program's ``old(x)`` constants); a part of ``A``/``H``/``P`` that
+  mentions a bound output is moved into the postcondition as a premise;
+* an I/O name in the conjunct that the binding does not cover makes the
+  triple *not checkable* by this backend: it is exported with a ``pending``
+  reason and never discharged.
+
+Encoding uses the system's :class:`rclverify.logic.encode.Encoder`, so the
+program's sorts and the contract's are the same Z3 sorts.
+"""
+from __future__ import annotations
+
+import inspect
+import re
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Mapping
+
+import z3
+
+from ...logic.encode import Encoder
+from ...plan.errors import PlanError, plan_error
+from ...rcl import ast
+from ...rcl.errors import RclError, error
+from ...rcl.printer import binding_to_rcl, expr_to_rcl
+from ...rcl.typecheck import domain_type
+from ...rcl.types import NATURAL, CheckedNode, FuncT, Type, assignable
+from ..base import NodeTarget
+from . import lang
+from .check import ProgramTypes, check_program, expr_type
+from .wp import ProgramModel
+
+
+DEFAULT_TIMEOUT_MS = 10_000
+CONFIG_KEYS = ("backend", "program", "binding", "timeout_ms")
+_IO_KEY = re.compile(r"^(in|out)\.([A-Za-z_][A-Za-z0-9_]*'*)$")
+
+
+def rcl_text(e: ast.Expr) -> str:
+    """RCL text of ``e`` (``and``/``or`` under ``->`` parenthesised)."""
+    return expr_to_rcl(e, explicit=True)
+
+
+# --------------------------------------------------------------------------
+# Plan entry
+# --------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class HoareConfig:
+    """A checked plan entry ``{backend: hoare, program, binding, timeout_ms}``.
+
+    ``program``      workspace-relative path of the program;
+    ``inputs``       ``in.x`` -> program expression (initial state) or extern name;
+    ``outputs``      ``out.x`` -> program variable (final state);
+    ``binding_text`` the binding as written, for display;
+    ``timeout_ms``   Z3 timeout per verification condition, milliseconds.
+    """
+
+    program: str
+    inputs: Mapping[str, lang.Expr]
+    outputs: Mapping[str, str]
+    binding_text: Mapping[str, str]
+    timeout_ms: int
+
+    @property
+    def stem(self) -> str:
+        return Path(self.program).stem
+
+
+class _PlanLocator:
+    """Finds the plan line of a value of this evidence entry (best effort)."""
+
+    def __init__(self, target: NodeTarget) -> None:
+        self.file = target.plan_file
+        try:
+            self.lines = (target.root / target.plan_file).read_text(encoding="utf-8").splitlines()
+        except OSError:
+            self.lines = []
+        prog = str(target.config.get("program", "") or "")
+        self.start = next((k for k, ln in enumerate(self.lines) if prog and prog in ln), 0)
+        if not prog:
+            node = target.node.name
+            self.start = next((k for k, ln in enumerate(self.lines) if ln.strip().startswith(f"{node}:")), 0)
+
+    def find(self, needle: str, after: str = "") -> tuple[int, int]:
+        """(line, col), 1-based, of ``needle`` on the line of this entry that
+        holds ``after`` (a key such as ``in.r:``), else of ``after`` itself,
+        else of ``needle`` within the entry, else the entry's first line."""
+        end = next((k for k in range(self.start + 1, len(self.lines))
+                    if self.lines[k].lstrip().startswith("- backend:")), len(self.lines))
+        window = range(self.start, end)
+        if after:
+            anchor = next((k for k in window if after in self.lines[k]), None)
+            if anchor is not None:
+                col = self.lines[anchor].find(needle) if needle else -1
+                return anchor + 1, (col if col >= 0 else self.lines[anchor].find(after)) + 1
+        if needle:
+            for k in window:
+                col = self.lines[k].find(needle)
+                if col >= 0:
+                    return k + 1, col + 1
+        return (self.start + 1, 1) if self.lines else (1, 1)
+
+    def error(self, message: str, needle: str = "", after: str = "") -> PlanError:
+        line, col = self.find(needle, after)
+        return plan_error(self.file, line, col, message, "E-plan-hoare")
+
+
+def load_program(target: NodeTarget) -> tuple[HoareConfig, lang.Program, ProgramTypes]:
+    """Read the plan entry in ``target.config``, parse and check its program.
+
+    Returns ``(config, program, types)``.  Raises :class:`PlanError` for a bad
+    entry (located in the plan) and :class:`RclError` for a bad program
+    (located in the program file).
+    """
+    cfg = target.config
+    loc = _PlanLocator(target)
+    unknown = sorted(k for k in cfg if k not in CONFIG_KEYS)
+    if unknown:
+        raise loc.error(f"unknown key {unknown[0]!r} in a hoare evidence entry; expected {', '.join(CONFIG_KEYS)}",
+                        f"{unknown[0]}:")
+    prog = cfg.get("program")
+    if not isinstance(prog, str) or not prog:
+        raise loc.error("a hoare evidence entry needs 'program: <path of the .imp file>'", "backend: hoare")
+    path = target.root / prog
+    if not path.is_file():
+        raise loc.error(f"program file {prog!r} does not exist", prog)
+    timeout = cfg.get("timeout_ms", DEFAULT_TIMEOUT_MS)
+    if not isinstance(timeout, int) or isinstance(timeout, bool) or timeout <= 0:
+        raise loc.error("timeout_ms must be a positive number of milliseconds", "timeout_ms")
+    program = lang.parse_program_file(path, prog)
+    types = check_program(program, target.checked.env)
+    raw = cfg.get("binding", {}) or {}
+    if not isinstance(raw, Mapping):
+        raise loc.error("binding must map RCL names (in.x, out.y) to program expressions", "binding")
+    node = target.node
+    inputs: dict[str, lang.Expr] = {}
+    outputs: dict[str, str] = {}
+    text: dict[str, str] = {}
+    for key, value in raw.items():
+        m = _IO_KEY.match(str(key))
+        if not m:
+            raise loc.error(f"binding key {key!r} must be an RCL input or output name, e.g. in.r or out.status",
+                            str(key), "binding")
+        prefix, name = m.group(1), m.group(2)
+        io_t = (node.inputs if prefix == "in" else node.outputs).get(name)
+        if io_t is None:
+            pool = [f"{prefix}.{n}" for n in (node.inputs if prefix == "in" else node.outputs)]
+            raise loc.error(f"{key} is not an {'input' if prefix == 'in' else 'output'} of {node.name}"
+                            + (f"; it has {', '.join(pool)}" if pool else ""), str(key), "binding")
+        if not isinstance(value, (str, int, float)) or isinstance(value, bool):
+            raise loc.error(f"the binding of {key} must be a program expression (a string)", str(key), "binding")
+        vtext = str(value)
+        line, col = loc.find(vtext, f"{key}:")
+        expr = lang.parse_expression(vtext, loc.file, line, col)
+        text[str(key)] = vtext
+        if prefix == "in":
+            _check_input_binding(str(key), io_t, expr, types, loc.file, line, col)
+            inputs[str(key)] = expr
+        else:
+            outputs[str(key)] = _check_output_binding(str(key), io_t, expr, types, loc.file, line, col)
+    return HoareConfig(prog, inputs, outputs, text, timeout), program, types
+
+
+def _located(file: str, line: int, col: int, msg: str) -> PlanError:
+    return PlanError([error(ast.Loc(file, line, col), msg, "E-plan-hoare")])
+
+
+def _check_input_binding(key: str, io_t: Type, expr: lang.Expr, types: ProgramTypes,
+                         file: str, line: int, col: int) -> None:
+    if isinstance(io_t, FuncT):
+        if isinstance(expr, lang.Name) and types.externs.get(expr.name) == io_t:
+            return
+        raise _located(file, line, col, f"{key} is a function ({io_t}); bind it to an extern of that type")
+    t = expr_type(expr, types)
+    if not assignable(t, io_t):
+        raise _located(file, line, col, f"{key} is {io_t} but the program expression is {t}")
+
+
+def _check_output_binding(key: str, io_t: Type, expr: lang.Expr, types: ProgramTypes,
+                          file: str, line: int, col: int) -> str:
+    if isinstance(io_t, FuncT):
+        raise _located(file, line, col, f"{key} is a function ({io_t}); a program variable cannot model it, "
+                       "leave it unbound or cover it with another backend")
+    if not isinstance(expr, lang.Name) or expr.name not in types.vars:
+        raise _located(file, line, col, f"{key} must be bound to a program variable (read in the final state)")
+    vt = types.vars[expr.name]
+    if not assignable(vt, io_t):
+        raise _located(file, line, col, f"{key} is {io_t} but variable {expr.name!r} is {vt}")
+    return expr.name
+
+
+# --------------------------------------------------------------------------
+# Conjuncts of a guarantee
+# --------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class Conjunct:
+    """One triple to prove, in RCL terms.
+
+    ``guarantee``/``index`` are 1-based (the guarantee clause, the conjunct in
+    it); ``bindings`` are the outer ``forall``'s; ``assumption`` the node's
+    assume formulas; ``hypothesis`` ``H`` and ``premise`` ``P`` (``None``
+    when absent); ``conclusion`` ``Q``; ``uncovered`` the I/O names of
+    ``P``/``Q`` the plan's binding does not cover (non-empty -> pending).
+    """
+
+    guarantee: int
+    index: int
+    clause: ast.Clause
+    bindings: tuple[ast.Binding, ...]
+    assumption: tuple[ast.Expr, ...]
+    hypothesis: ast.Expr | None
+    premise: ast.Expr | None
+    conclusion: ast.Expr
+    loc: ast.Loc
+    uncovered: tuple[str, ...] = ()
+
+    @property
+    def conjunct_text(self) -> str:
+        body = self.conclusion if self.premise is None else ast.Binary("->", self.premise, self.conclusion)
+        return rcl_text(body)
+
+    @property
+    def pending_reason(self) -> str:
+        if not self.uncovered:
+            return ""
+        return (f"the program does not model {', '.join(self.uncovered)}; "
+                "bind it in the plan or cover it with another backend")
+
+
+def _conjuncts(e: ast.Expr) -> list[ast.Expr]:
+    if isinstance(e, ast.Binary) and e.op == "and":
+        return _conjuncts(e.left) + _conjuncts(e.right)
+    return [e]
+
+
+def io_names(e: ast.Expr, node: CheckedNode, bound: frozenset[str] = frozenset()) -> list[str]:
+    """Qualified I/O names (``in.r``, ``out.inspected``) occurring in ``e``, in order."""
+    out: list[str] = []
+
+    def add(v: ast.Var, scope: frozenset[str]) -> None:
+        if v.prefix is None and v.name in scope:
+            return
+        if v.prefix is not None:
+            q = v.qualified
+        elif v.name in node.inputs:
+            q = f"in.{v.name}"
+        elif v.name in node.outputs:
+            q = f"out.{v.name}"
+        else:
+            return
+        if q not in out:
+            out.append(q)
+
+    def go(x: Any, scope: frozenset[str]) -> None:
+        if isinstance(x, ast.Var):
+            add(x, scope)
+        elif isinstance(x, ast.Apply):
+            add(x.func, scope)
+            for a in x.args:
+                go(a, scope)
+        elif isinstance(x, ast.Quant):
+            inner = scope | frozenset(x.variables)
+            for b in x.bindings:
+                if not _is_type_domain(b.domain):
+                    go(b.domain, scope)
+            go(x.body, inner)
+        elif isinstance(x, ast.Unary):
+            go(x.operand, scope)
+        elif isinstance(x, ast.Binary):
+            go(x.left, scope)
+            go(x.right, scope)
+        elif isinstance(x, ast.Compare):
+            for o in x.operands:
+                go(o, scope)
+        elif isinstance(x, ast.Member):
+            go(x.elem, scope)
+            go(x.collection, scope)
+        elif isinstance(x, (ast.SetLit, ast.SeqLit, ast.TupleLit)):
+            for i in x.items:
+                go(i, scope)
+
+    go(e, bound)
+    return out
+
+
+def _is_type_domain(d: Any) -> bool:
+    return isinstance(d, (ast.TBase, ast.TName, ast.TEnum, ast.TConstructors, ast.TFunc, ast.TEmpty, ast.TSet,
+                          ast.TSeq, ast.TTuple))
+
+
+def conjuncts(node: CheckedNode, covered: set[str] | frozenset[str]) -> list[Conjunct]:
+    """Split every guarantee of ``node`` into triples (see the module text).
+
+    ``covered`` are the qualified I/O names the plan binds.  Returns them in
+    guarantee order, conjuncts left to right.
+    """
+    n = node.node
+    assumption = tuple(c.formula for c in n.assumes)
+    out: list[Conjunct] = []
+    for g, clause in enumerate(n.guarantees, start=1):
+        f = clause.formula
+        bindings: tuple[ast.Binding, ...] = ()
+        if isinstance(f, ast.Quant) and f.kind == "forall":
+            bindings, f = f.bindings, f.body
+        bound = frozenset(nm for b in bindings for nm in b.names)
+        hyp: ast.Expr | None = None
+        if isinstance(f, ast.Binary) and f.op == "->":
+            hyp, f = f.left, f.right
+        for k, part in enumerate(_conjuncts(f), start=1):
+            premise: ast.Expr | None = None
+            concl = part
+            if isinstance(part, ast.Binary) and part.op == "->":
+                premise, concl = part.left, part.right
+            names = io_names(part, node, bound)
+            uncovered = tuple(q for q in names if q not in covered)
+            loc = part.loc if part.loc.line else clause.loc
+            out.append(Conjunct(g, k, clause, bindings, assumption, hyp, premise, concl, loc, uncovered))
+    return out
+
+
+def precondition_parts(c: Conjunct, outputs: Mapping[str, str], node: CheckedNode
+                       ) -> tuple[list[ast.Expr], list[ast.Expr]]:
+    """Split ``A``, ``H``, ``P`` into (pre-state parts, post-state premises):
+    a part mentioning a bound output can only be evaluated after the program."""
+    pre: list[ast.Expr] = []
+    post: list[ast.Expr] = []
+    bound = frozenset(nm for b in c.bindings for nm in b.names)
+    for part in [*c.assumption, *([c.hypothesis] if c.hypothesis is not None else []),
+                 *([c.premise] if c.premise is not None else [])]:
+        outs = [q for q in io_names(part, node, bound) if q.startswith("out.") and q in outputs]
+        (post if outs else pre).append(part)
+    return pre, post
+
+
+def _conj(parts: list[ast.Expr]) -> ast.Expr:
+    if not parts:
+        return ast.BoolLit(True)
+    e = parts[0]
+    for p in parts[1:]:
+        e = ast.Binary("and", e, p)
+    return e
+
+
+def statement(c: Conjunct, cfg: HoareConfig, node: CheckedNode, program_vars: frozenset[str] = frozenset()) -> str:
+    """The triple in readable RCL form, e.g.
+    ``forall i in NATURAL: {0 <= in.r and ...} radiation_sensor {out.radiationStatus == green}
+    where in.r = radiation_at(i), out.radiationStatus = output, i = program variable i``.
+    ``program_vars`` are the program's variables (bound variables named like
+    one are identified with it)."""
+    pre, post_prem = precondition_parts(c, cfg.outputs, node)
+    post: ast.Expr = c.conclusion
+    if post_prem:
+        post = ast.Binary("->", _conj(post_prem), post)
+    head = ""
+    if c.bindings:
+        head = "forall " + ", ".join(_binding_text(b) for b in c.bindings) + ": "
+    text = f"{head}{{{rcl_text(_conj(pre))}}} {cfg.stem} {{{rcl_text(post)}}}"
+    binds = [f"{k} = {v}" for k, v in sorted(cfg.binding_text.items())]
+    binds += [f"{nm} = program variable {nm}" for b in c.bindings for nm in b.names if nm in program_vars]
+    if binds:
+        text += " where " + ", ".join(binds)
+    return text
+
+
+def _binding_text(b: ast.Binding) -> str:
+    return binding_to_rcl(b)
+
+
+# --------------------------------------------------------------------------
+# Encoding a conjunct as Z3 pre/postconditions over the program
+# --------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class EncodedTriple:
+    """A triple over the program's Z3 vocabulary.
+
+    ``pre``            over the initial-state constants;
+    ``post``           over the final-state constants (inputs as ``old(x)``);
+    ``background``     facts true in every state (encoder typing axioms,
+                       ranges of fixed bound variables);
+    ``observe``        RCL input name -> its initial-state term, and each bound
+                       variable that is not a program variable -> its constant
+                       (shown in counterexamples);
+    ``observe_final``  RCL output name -> program variable;
+    ``names``          Z3 symbol name -> display name (``in.command``).
+    """
+
+    pre: z3.BoolRef
+    post: z3.BoolRef
+    background: tuple[z3.BoolRef, ...]
+    observe: Mapping[str, z3.ExprRef]
+    observe_final: Mapping[str, str]
+    names: Mapping[str, str] = field(default_factory=dict)
+
+
+def _encode(enc: Encoder, e: ast.Expr, node: CheckedNode, symbols: Mapping[str, Any],
+            bound: Mapping[str, z3.ExprRef]) -> z3.BoolRef:
+    """Encode ``e`` with its free bound-variable names given by ``bound``."""
+    params = inspect.signature(enc.formula).parameters
+    if "bound" in params:
+        return enc.formula(e, node, symbols, bound=bound)
+    # Encoder.formula has no way yet to give free (bound) variables; open a
+    # quantifier over them and instantiate it with our terms instead.
+    if not bound:
+        return enc.formula(e, node, symbols)
+    from ...logic.encode import _Ctx  # noqa: PLC0415 - see the comment above
+    r = _Ctx(enc, node, dict(symbols)).enc(e, dict(bound))
+    assert z3.is_bool(r)
+    return r
+
+
+def _to_old(m: ProgramModel, t: z3.ExprRef) -> z3.ExprRef:
+    return z3.substitute(t, *[(m.consts[n], m.olds[n]) for n in m.consts]) if m.consts else t
+
+
+def encode_triple(c: Conjunct, cfg: HoareConfig, m: ProgramModel, enc: Encoder, node: CheckedNode,
+                  program: lang.Program) -> EncodedTriple:
+    """Encode a (covered) conjunct as pre/postcondition over program ``m``.
+
+    Raises :class:`RclError` when a bound variable of the guarantee and the
+    program variable of the same name have different sorts (located at the
+    variable's declaration).
+    """
+    env = enc.env
+    pre_b: dict[str, z3.ExprRef] = {}
+    post_b: dict[str, z3.ExprRef] = {}
+    pre_guards: list[z3.BoolRef] = []
+    background: list[z3.BoolRef] = []
+    scope: dict[str, Type] = {}
+    fixed: dict[str, z3.ExprRef] = {}
+    taken = set(m.consts) | set(m.funcs) | {f"old({n})" for n in m.consts}
+    for b in c.bindings:
+        t = domain_type(b, node, env, scope)
+        sort = enc.sort(t)
+        for nm in b.names:
+            scope[nm] = t
+            if nm in m.consts:
+                if m.consts[nm].sort() != sort:
+                    msg = f"variable {nm!r} is {m.types.vars[nm]} but the guarantee at {c.clause.loc} binds it in {t}"
+                    raise RclError([error(m.types.var_loc(program, nm), msg, "E-type")])
+                pre_b[nm], post_b[nm] = m.consts[nm], m.olds[nm]
+                if t == NATURAL:
+                    pre_guards.append(m.consts[nm] >= 0)
+            else:
+                zname = nm
+                while zname in taken:
+                    zname += "'"
+                taken.add(zname)
+                v = z3.Const(zname, sort)
+                pre_b[nm] = post_b[nm] = v
+                fixed[nm] = v
+                if t == NATURAL:
+                    background.append(v >= 0)
+        if not _is_type_domain(b.domain):
+            for nm in b.names:
+                member = ast.Member(ast.Var(nm), b.domain)  # type: ignore[arg-type]
+                pre_guards.append(_encode(enc, member, node, {}, pre_b))
+    pre_syms: dict[str, Any] = {}
+    post_syms: dict[str, Any] = {}
+    observe: dict[str, z3.ExprRef] = dict(fixed)
+    for key, expr in cfg.inputs.items():
+        if isinstance(expr, lang.Name) and expr.name in m.funcs:
+            pre_syms[key] = post_syms[key] = m.funcs[expr.name]
+            continue
+        term = m.term(expr)
+        pre_syms[key], post_syms[key] = term, _to_old(m, term)
+        observe[key] = term
+    for key, var in cfg.outputs.items():
+        post_syms[key] = m.consts[var]
+    pre_parts, post_prem = precondition_parts(c, cfg.outputs, node)
+    pre = z3.And(*pre_guards, *[_encode(enc, p, node, pre_syms, pre_b) for p in pre_parts])
+    post = _encode(enc, c.conclusion, node, post_syms, post_b)
+    if post_prem:
+        post = z3.Implies(z3.And(*[_encode(enc, p, node, post_syms, post_b) for p in post_prem]), post)
+    background.extend(enc.axioms())
+    names = {s.z3name: s.display.split(".", 1)[1] if s.display.startswith(node.name + ".") else s.display
+             for s in enc.symbols.values()}
+    return EncodedTriple(pre, post, tuple(background), observe,
+                         {k: v for k, v in cfg.outputs.items()}, names)

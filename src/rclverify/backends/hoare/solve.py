@@ -1,0 +1,215 @@
+"""Discharging a Hoare triple's verification conditions with Z3.
+
+Each VC ``hyps => goal`` (:class:`rclverify.backends.hoare.wp.VC`) is
+checked by asking Z3 whether ``hyps and not goal`` is satisfiable, with a
+timeout (shared/DESIGN.md, "Solver answers"): unsat -> the VC is valid;
+sat -> it is refuted and the model is a counterexample; unknown (or timeout)
+-> nothing is concluded.  A triple is ``discharged`` only when every VC is
+valid, ``failed`` when one is refuted, ``inconclusive`` otherwise.
+
+A counterexample of the triple's own VC (``main``) names concrete values of
+the program's initial variables and of the uninterpreted function
+applications the VC mentions, and then *runs the program* on them (the model
+interprets the externs) to show the final values, e.g.
+``{"i": 0, "radiation_at(i)": 15, "output (final)": "orange"}``.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from fractions import Fraction
+from typing import Any, Mapping, Sequence
+
+import z3
+
+from . import lang
+from .outline import z3_text
+from .wp import VC, ProgramModel, iter_terms
+
+#: Statement executions allowed when replaying a counterexample (loops).
+MAX_STEPS = 100_000
+
+
+@dataclass(frozen=True)
+class VCResult:
+    """Z3's answer for one VC: ``status`` ``valid``/``invalid``/``unknown``;
+    ``model`` (invalid only); ``reason`` (unknown only); ``smt2`` the query."""
+
+    vc: VC
+    status: str
+    smt2: str
+    model: z3.ModelRef | None = None
+    reason: str = ""
+    hyps: tuple[z3.BoolRef, ...] = ()
+
+
+@dataclass(frozen=True)
+class TripleResult:
+    """All VCs of a triple checked.
+
+    ``status``          ``discharged``/``failed``/``inconclusive``;
+    ``results``         per VC, ``main`` first;
+    ``failed``          the first refuted VC's result (``failed`` only);
+    ``counterexample``  JSON-serialisable name -> value (``failed`` only).
+    """
+
+    status: str
+    results: tuple[VCResult, ...]
+    failed: VCResult | None = None
+    counterexample: dict[str, Any] | None = None
+    notes: tuple[str, ...] = field(default=())
+
+
+def json_value(v: z3.ExprRef) -> Any:
+    """A model value as JSON: int, float (exact decimals), ``"p/q"``, bool or RCL text."""
+    if z3.is_int_value(v):
+        return v.as_long()
+    if z3.is_rational_value(v):
+        fr = Fraction(v.numerator_as_long(), v.denominator_as_long())
+        if fr.denominator == 1:
+            return fr.numerator
+        dec = float(fr)
+        return dec if Fraction(dec) == fr else f"{fr.numerator}/{fr.denominator}"
+    if z3.is_algebraic_value(v):
+        return str(v.as_decimal(6))
+    if z3.is_true(v):
+        return True
+    if z3.is_false(v):
+        return False
+    return z3_text(v)
+
+
+def _smt2(formulas: Sequence[z3.BoolRef], title: str) -> str:
+    s = z3.Solver()
+    s.add(*formulas)
+    # Solver.sexpr() names shared subterms a!1, a!2 ... in order (to_smt2()
+    # uses internal ids, which differ between processes): deterministic text.
+    return f"; {title}\n" + str(s.sexpr()) + "(check-sat)\n"
+
+
+def check_vc(vc: VC, background: Sequence[z3.BoolRef], m: ProgramModel, timeout_ms: int) -> VCResult:
+    """Check one VC under ``background`` facts (typing axioms ...).
+
+    The program's own range facts (NATURAL variables, externs with a NATURAL
+    result) for the symbols the VC mentions are added.  ``timeout_ms`` in
+    milliseconds.  Never raises for an unknown answer.
+    """
+    core = [*vc.hyps, vc.goal]
+    hyps = (*vc.hyps, *background, *m.typing_facts(core))
+    formulas = [*hyps, z3.Not(vc.goal)]
+    s = z3.Solver()
+    s.set("timeout", int(timeout_ms))
+    s.add(*formulas)
+    r = s.check()
+    text = _smt2(formulas, f"{vc.id}: {vc.label}; unsat means the condition holds")
+    if r == z3.unsat:
+        return VCResult(vc, "valid", text, hyps=hyps)
+    if r == z3.sat:
+        return VCResult(vc, "invalid", text, model=s.model(), hyps=hyps)
+    return VCResult(vc, "unknown", text, reason=s.reason_unknown(), hyps=hyps)
+
+
+class _Replay:
+    """Runs the program concretely under a model (externs as the model interprets them)."""
+
+    def __init__(self, m: ProgramModel, model: z3.ModelRef) -> None:
+        self.m, self.model = m, model
+        self.init = {n: model.eval(c, model_completion=True) for n, c in m.consts.items()}
+        self.state = dict(self.init)
+        self.steps = 0
+
+    def eval(self, e: lang.Expr) -> z3.ExprRef:
+        t = self.m.term(e)
+        subs = [(self.m.consts[n], v) for n, v in self.state.items()]
+        subs += [(self.m.olds[n], v) for n, v in self.init.items()]
+        return self.model.eval(z3.substitute(t, *subs), model_completion=True)
+
+    def run(self, body: tuple[lang.Stmt, ...]) -> bool:
+        for s in body:
+            self.steps += 1
+            if self.steps > MAX_STEPS:
+                return False
+            if isinstance(s, lang.Assign):
+                self.state[s.target] = self.model.eval(self.m.value_for(s.target, self.eval(s.value)),
+                                                       model_completion=True)
+            elif isinstance(s, lang.If):
+                if not self.run(s.then_ if z3.is_true(self.eval(s.cond)) else s.else_):
+                    return False
+            elif isinstance(s, lang.While):
+                while z3.is_true(self.eval(s.cond)):
+                    if not self.run(s.body):
+                        return False
+                    self.steps += 1
+                    if self.steps > MAX_STEPS:
+                        return False
+        return True
+
+
+def _assigned(body: tuple[lang.Stmt, ...]) -> list[str]:
+    out: list[str] = []
+    for s in body:
+        names = ([s.target] if isinstance(s, lang.Assign) else
+                 _assigned(s.then_) + _assigned(s.else_) if isinstance(s, lang.If) else
+                 _assigned(s.body) if isinstance(s, lang.While) else [])
+        out.extend(n for n in names if n not in out)
+    return out
+
+
+def counterexample(res: VCResult, m: ProgramModel, observe: Mapping[str, z3.ExprRef] | None = None,
+                   observe_final: Mapping[str, str] | None = None,
+                   names: Mapping[str, str] | None = None) -> tuple[dict[str, Any], list[str]]:
+    """Concrete values behind a refuted VC.
+
+    Returns ``(values, notes)``: ``values`` maps the program variables the VC
+    mentions and the extern applications in it (``radiation_at(i)``) to their
+    values; ``observe`` adds named initial-state terms (``in.r``), and the
+    VC's other free symbols are added under their ``names`` (``in.command``);
+    for the
+    ``main`` VC the program is replayed and ``"<x> (final)"`` gives each
+    assigned variable's final value, ``observe_final`` names some of them
+    again (``out.radiationStatus`` -> ``output``).  ``notes`` explain what the
+    state is.
+    """
+    assert res.model is not None
+    model = res.model
+    formulas = [*res.vc.hyps, res.vc.goal]
+    out: dict[str, Any] = {}
+    for n in m.variables_in(formulas):
+        out[n] = json_value(model.eval(m.consts[n], model_completion=True))
+    for n in m.olds_in(formulas):
+        out[f"old({n})"] = json_value(model.eval(m.olds[n], model_completion=True))
+    for app in m.extern_applications(formulas):
+        out[z3_text(app, names)] = json_value(model.eval(app, model_completion=True))
+    for label, term in (observe or {}).items():
+        out[label] = json_value(model.eval(term, model_completion=True))
+    program_names = {c.decl().name() for c in (*m.consts.values(), *m.olds.values())}
+    for t in iter_terms(formulas):  # other free symbols, e.g. the contract's in.command
+        if z3.is_const(t) and t.decl().kind() == z3.Z3_OP_UNINTERPRETED and t.decl().name() not in program_names:
+            label = (names or {}).get(t.decl().name(), t.decl().name())
+            out.setdefault(label, json_value(model.eval(t, model_completion=True)))
+    notes: list[str] = []
+    if res.vc.state == "initial":
+        replay = _Replay(m, model)
+        if replay.run(m.program.body):
+            for n in _assigned(m.program.body):
+                out[f"{n} (final)"] = json_value(replay.state[n])
+            for label, var in (observe_final or {}).items():
+                out[label] = json_value(replay.state[var])
+        else:
+            notes.append(f"replaying the program on these values did not finish within {MAX_STEPS} steps")
+    else:
+        notes.append(f"the values are a state at the head of the loop at line {res.vc.loc.line}")
+    return out, notes
+
+
+def check_all(vcs: Sequence[VC], background: Sequence[z3.BoolRef], m: ProgramModel, timeout_ms: int,
+              observe: Mapping[str, z3.ExprRef] | None = None, observe_final: Mapping[str, str] | None = None,
+              names: Mapping[str, str] | None = None) -> TripleResult:
+    """Check every VC of a triple (``main`` first) and roll the answers up."""
+    results = tuple(check_vc(vc, background, m, timeout_ms) for vc in vcs)
+    bad = next((r for r in results if r.status == "invalid"), None)
+    if bad is not None:
+        cex, notes = counterexample(bad, m, observe, observe_final, names)
+        return TripleResult("failed", results, bad, cex, tuple(notes))
+    if any(r.status == "unknown" for r in results):
+        return TripleResult("inconclusive", results)
+    return TripleResult("discharged", results)

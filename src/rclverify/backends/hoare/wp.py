@@ -1,0 +1,334 @@
+"""Weakest preconditions of the hoare backend's language, as Z3 formulas.
+
+The paper proves the Radiation Sensor's triples by hand with the assignment
+axiom, the conditional rule and the rule of consequence (shared/reference,
+lines 1505-1541 and appendix B, 1984-).  This module mechanises the same
+calculus backwards from a postcondition (Dijkstra's weakest preconditions,
+partial correctness):
+
+* ``wp(x := e, Q)      = Q[e/x]``  (and ``e >= 0`` when ``x`` is NATURAL and
+  ``e`` is not syntactically NATURAL: the value must stay in the type);
+* ``wp(S1; S2, Q)      = wp(S1, wp(S2, Q))``;
+* ``wp(if c then S1 else S2 end, Q) = (c -> wp(S1, Q)) and (not c -> wp(S2, Q))``;
+* ``wp(skip, Q)        = Q``;
+* ``wp(while c invariant I do S end, Q) = I``, with two verification
+  conditions collected on the side: ``I and c => wp(S, I)`` (the body
+  preserves the invariant) and ``I and not c => Q`` (on exit the invariant
+  establishes what follows).  As in Hoare's while rule, the loop VCs hold in
+  an arbitrary state at the loop head: the invariant must state everything the
+  code after the loop relies on, including variables the loop leaves alone
+  (write ``n == old(n)``).
+
+Everything is a Z3 term: REAL -> Real, INTEGER/NATURAL -> Int, BOOL -> Bool,
+context enumerations and constructor sets -> the *same* Z3 sorts the RCL
+encoder uses (obtained through :class:`Sorts`, i.e.
+:class:`rclverify.logic.encode.Encoder`).  Variables are constants named after
+them; ``old(x)`` is a constant named ``old(x)``; externs are uninterpreted
+functions.  Alongside the precondition the computation records a proof
+outline: the assertion that holds before every statement, as in the paper's
+proof figures.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Iterator, Literal, Protocol
+
+import z3
+
+from ...rcl.ast import Loc
+from ...rcl.types import NATURAL, Type
+from . import lang
+from .check import ProgramTypes, expr_type
+
+
+class Sorts(Protocol):
+    """What the encoding needs from the RCL encoder (``Encoder`` satisfies it)."""
+
+    def sort(self, t: Type) -> z3.SortRef: ...
+
+    def enum_value(self, name: str) -> z3.ExprRef: ...
+
+    def ctor(self, name: str) -> z3.FuncDeclRef: ...
+
+
+def _widen(x: z3.ExprRef, s: z3.SortRef) -> z3.ExprRef:
+    if s == z3.RealSort() and z3.is_int(x):
+        return z3.ToReal(x)
+    return x
+
+
+def _coerce(a: z3.ExprRef, b: z3.ExprRef) -> tuple[z3.ExprRef, z3.ExprRef]:
+    if z3.is_int(a) and z3.is_real(b):
+        return z3.ToReal(a), b
+    if z3.is_real(a) and z3.is_int(b):
+        return a, z3.ToReal(b)
+    return a, b
+
+
+class ProgramModel:
+    """The Z3 vocabulary of one checked program.
+
+    ``consts[x]``  the constant of variable ``x`` (its value in the state the
+                   formula talks about); ``olds[x]`` the constant ``old(x)``
+                   (its value in the initial state); ``funcs[f]`` the
+                   uninterpreted function of extern ``f``.
+    """
+
+    def __init__(self, program: lang.Program, types: ProgramTypes, sorts: Sorts) -> None:
+        self.program, self.types, self.sorts = program, types, sorts
+        self.consts: dict[str, z3.ExprRef] = {}
+        self.olds: dict[str, z3.ExprRef] = {}
+        for name, t in types.vars.items():
+            s = sorts.sort(t)
+            self.consts[name] = z3.Const(name, s)
+            self.olds[name] = z3.Const(f"old({name})", s)
+        self.funcs: dict[str, z3.FuncDeclRef] = {
+            name: z3.Function(name, *[sorts.sort(a) for a in ft.args], sorts.sort(ft.result))
+            for name, ft in types.externs.items()}
+
+    def sort_of_var(self, name: str) -> z3.SortRef:
+        return self.consts[name].sort()
+
+    def term(self, e: lang.Expr) -> z3.ExprRef:
+        """Encode a (checked) expression over the current-state constants."""
+        if isinstance(e, lang.Num):
+            return z3.IntVal(int(e.text)) if e.is_integral else z3.RealVal(e.text)
+        if isinstance(e, lang.BoolConst):
+            return z3.BoolVal(e.value)
+        if isinstance(e, lang.Name):
+            if e.name in self.consts:
+                return self.consts[e.name]
+            return self.sorts.enum_value(e.name)
+        if isinstance(e, lang.Old):
+            return self.olds[e.name]
+        if isinstance(e, lang.Call):
+            f = self.funcs[e.func] if e.func in self.funcs else self.sorts.ctor(e.func)
+            return f(*[_widen(self.term(a), f.domain(k)) for k, a in enumerate(e.args)])
+        if isinstance(e, lang.Unary):
+            v = self.term(e.operand)
+            return z3.Not(v) if e.op == "not" else -v
+        a, b = self.term(e.left), self.term(e.right)
+        op = e.op
+        if op == "and":
+            return z3.And(a, b)
+        if op == "or":
+            return z3.Or(a, b)
+        if op == "->":
+            return z3.Implies(a, b)
+        if op == "/":
+            return _widen(a, z3.RealSort()) / _widen(b, z3.RealSort())
+        a, b = _coerce(a, b)
+        if op == "==":
+            return z3.ExprRef.__eq__(a, b)
+        if op == "!=":
+            return z3.ExprRef.__ne__(a, b)
+        # Call the left operand's method explicitly: for ``k >= 0`` Python would
+        # otherwise prefer the numeral's reflected method (IntNumRef subclasses
+        # ArithRef) and build ``0 <= k``, which outlines would then show.
+        method = {"<": "__lt__", "<=": "__le__", ">": "__gt__", ">=": "__ge__", "+": "__add__",
+                  "-": "__sub__", "*": "__mul__"}[op]
+        return getattr(z3.ArithRef, method)(a, b)
+
+    def formula(self, e: lang.Expr) -> z3.BoolRef:
+        """Encode a (checked) BOOL expression."""
+        r = self.term(e)
+        assert z3.is_bool(r)
+        return r
+
+    def value_for(self, name: str, value: z3.ExprRef) -> z3.ExprRef:
+        """``value`` widened to variable ``name``'s sort (Int -> Real)."""
+        return _widen(value, self.sort_of_var(name))
+
+    def typing_facts(self, formulas: list[z3.BoolRef]) -> list[z3.BoolRef]:
+        """Range facts for the symbols of ``formulas``: ``x >= 0`` for every
+        NATURAL variable (and ``old(x)``) occurring, and ``f(a) >= 0`` for every
+        application of an extern with a NATURAL result occurring outside
+        quantifiers.  Sorted by text for determinism."""
+        nat_consts = {self.consts[n].get_id(): self.consts[n] for n, t in self.types.vars.items() if t == NATURAL}
+        nat_consts.update({self.olds[n].get_id(): self.olds[n] for n, t in self.types.vars.items() if t == NATURAL})
+        nat_funcs = {n for n, ft in self.types.externs.items() if ft.result == NATURAL}
+        facts: dict[str, z3.BoolRef] = {}
+        for t in iter_terms(formulas):
+            if t.get_id() in nat_consts or (z3.is_app(t) and t.num_args() > 0 and t.decl().name() in nat_funcs
+                                            and t.decl() == self.funcs[t.decl().name()]):
+                facts[t.sexpr()] = t >= 0
+        return [facts[k] for k in sorted(facts)]
+
+    def extern_applications(self, formulas: list[z3.BoolRef]) -> list[z3.ExprRef]:
+        """Applications of externs in ``formulas`` (outside quantifiers), in first-seen order."""
+        out: dict[int, z3.ExprRef] = {}
+        for t in iter_terms(formulas):
+            if z3.is_app(t) and t.num_args() > 0 and t.decl().name() in self.funcs \
+                    and t.decl() == self.funcs[t.decl().name()]:
+                out.setdefault(t.get_id(), t)
+        return list(out.values())
+
+    def variables_in(self, formulas: list[z3.BoolRef]) -> list[str]:
+        """Program variables whose current-state constant occurs in ``formulas`` (declaration order)."""
+        ids = {t.get_id() for t in iter_terms(formulas)}
+        return [n for n in self.types.vars if self.consts[n].get_id() in ids]
+
+    def olds_in(self, formulas: list[z3.BoolRef]) -> list[str]:
+        """Program variables whose ``old(x)`` constant occurs in ``formulas``."""
+        ids = {t.get_id() for t in iter_terms(formulas)}
+        return [n for n in self.types.vars if self.olds[n].get_id() in ids]
+
+
+def iter_terms(formulas: list[z3.BoolRef]) -> Iterator[z3.ExprRef]:
+    """Every sub-term of ``formulas`` outside quantifier bodies, each once."""
+    seen: set[int] = set()
+    stack: list[z3.ExprRef] = list(reversed(formulas))
+    while stack:
+        t = stack.pop()
+        if t.get_id() in seen:
+            continue
+        seen.add(t.get_id())
+        if z3.is_quantifier(t) or z3.is_var(t):
+            continue
+        yield t
+        if z3.is_app(t):
+            stack.extend(reversed(t.children()))
+
+
+# --------------------------------------------------------------------------
+# Proof outline items and verification conditions
+# --------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class OutlineItem:
+    """One line of a proof outline.
+
+    ``kind`` ``"assert"``: ``formula`` holds at this point, ``note`` says which
+    rule produced it; ``kind`` ``"code"``: ``text`` is a line of the program
+    (``line`` its line in the program file).  ``depth`` is the nesting level.
+    """
+
+    depth: int
+    kind: Literal["assert", "code"]
+    text: str = ""
+    formula: z3.BoolRef | None = None
+    note: str = ""
+    line: int = 0
+
+
+@dataclass(frozen=True)
+class VC:
+    """A verification condition: ``hyps => goal`` must be valid.
+
+    ``id``      stable name (``main``, ``loop@7.preserve``, ``loop@7.exit``);
+    ``label``   one sentence for readers; ``loc`` where it comes from;
+    ``state``   ``"initial"`` (the variables are the program's initial state)
+                or ``"loop"`` (an arbitrary state at the loop head).
+    """
+
+    id: str
+    label: str
+    hyps: tuple[z3.BoolRef, ...]
+    goal: z3.BoolRef
+    loc: Loc
+    state: Literal["initial", "loop"]
+
+
+@dataclass(frozen=True)
+class WP:
+    """Result of :func:`wp`: the weakest precondition, the loop VCs collected
+    on the way (program order), and the proof outline (top to bottom)."""
+
+    pre: z3.BoolRef
+    vcs: tuple[VC, ...]
+    outline: tuple[OutlineItem, ...]
+
+
+def _rule(s: lang.Stmt, m: ProgramModel) -> str:
+    if isinstance(s, lang.Assign):
+        if _needs_range(s, m):
+            return f"assignment axiom, with {s.target} >= 0 (NATURAL)"
+        return "assignment axiom"
+    if isinstance(s, lang.If):
+        return "conditional rule"
+    if isinstance(s, lang.While):
+        return "loop invariant (while rule)"
+    return "skip axiom"
+
+
+def _needs_range(s: lang.Assign, m: ProgramModel) -> bool:
+    return m.types.vars[s.target] == NATURAL and expr_type(s.value, m.types) != NATURAL
+
+
+def _stmt(s: lang.Stmt, post: z3.BoolRef, m: ProgramModel, depth: int
+          ) -> tuple[z3.BoolRef, list[VC], list[OutlineItem]]:
+    """wp of one statement: (pre, VCs, outline lines of the statement itself)."""
+    line = s.loc.line
+    if isinstance(s, lang.Assign):
+        value = m.value_for(s.target, m.term(s.value))
+        pre = z3.substitute(post, (m.consts[s.target], value))
+        if _needs_range(s, m):
+            pre = z3.And(value >= 0, pre)
+        return pre, [], [OutlineItem(depth, "code", lang.stmt_header(s), line=line)]
+    if isinstance(s, lang.Skip):
+        return post, [], [OutlineItem(depth, "code", "skip", line=line)]
+    if isinstance(s, lang.If):
+        c = m.formula(s.cond)
+        w1, vcs1, items1 = _block(s.then_, post, m, depth + 1, "the if's postcondition")
+        w2, vcs2, items2 = _block(s.else_, post, m, depth + 1,
+                                  "the if's postcondition" if s.else_ else "the if's postcondition (no else: skip)")
+        pre = z3.And(z3.Implies(c, w1), z3.Implies(z3.Not(c), w2))
+        items = [OutlineItem(depth, "code", lang.stmt_header(s), line=line), *items1,
+                 OutlineItem(depth, "code", "else"), *items2, OutlineItem(depth, "code", "end")]
+        return pre, vcs1 + vcs2, items
+    assert isinstance(s, lang.While)
+    c, inv = m.formula(s.cond), m.formula(s.invariant)
+    wbody, vcs_body, items_body = _block(s.body, inv, m, depth + 1, "the invariant, re-established")
+    vid = f"loop@{line}"
+    preserve = VC(f"{vid}.preserve", f"the loop at line {line} preserves its invariant",
+                  (inv, c), wbody, s.loc, "loop")
+    exit_ = VC(f"{vid}.exit", f"on exit from the loop at line {line}, the invariant establishes what follows",
+               (inv, z3.Not(c)), post, s.loc, "loop")
+    items = [OutlineItem(depth, "code", lang.stmt_header(s), line=line),
+             OutlineItem(depth + 1, "assert", formula=z3.And(inv, c),
+                         note=f"invariant and loop condition; implies the next assertion ({preserve.id})"),
+             *items_body, OutlineItem(depth, "code", "end"),
+             OutlineItem(depth, "assert", formula=z3.And(inv, z3.Not(c)),
+                         note=f"invariant and negated condition; implies the next assertion ({exit_.id})")]
+    return inv, [preserve, *vcs_body, exit_], items
+
+
+def _block(stmts: tuple[lang.Stmt, ...], post: z3.BoolRef, m: ProgramModel, depth: int, post_note: str
+           ) -> tuple[z3.BoolRef, list[VC], list[OutlineItem]]:
+    segments: list[tuple[lang.Stmt, z3.BoolRef, list[VC], list[OutlineItem]]] = []
+    q = post
+    for s in reversed(stmts):
+        pre_s, vcs_s, items_s = _stmt(s, q, m, depth)
+        segments.append((s, pre_s, vcs_s, items_s))
+        q = pre_s
+    segments.reverse()
+    items: list[OutlineItem] = []
+    vcs: list[VC] = []
+    for s, pre_s, vcs_s, items_s in segments:
+        items.append(OutlineItem(depth, "assert", formula=pre_s, note=_rule(s, m)))
+        items.extend(items_s)
+        vcs.extend(vcs_s)
+    items.append(OutlineItem(depth, "assert", formula=post, note=post_note))
+    return q, vcs, items
+
+
+def wp(body: tuple[lang.Stmt, ...], post: z3.BoolRef, m: ProgramModel) -> WP:
+    """Weakest precondition of ``body`` for ``post`` (a Z3 formula over the
+    current-state constants of ``m``).
+
+    Returns :class:`WP`: ``pre`` over the initial-state constants, the loop
+    VCs (``state == "loop"``) and the proof outline.  Pure: no solver call.
+    """
+    pre, vcs, items = _block(body, post, m, 0, "postcondition")
+    return WP(pre, tuple(vcs), tuple(items))
+
+
+def main_vc(pre: z3.BoolRef, result: WP, m: ProgramModel, loc: Loc) -> VC:
+    """The triple's own VC: ``pre and old(x) == x (for every x) => wp(program, post)``."""
+    formulas = [pre, result.pre]
+    olds = m.olds_in(formulas)
+    links = tuple(m.olds[n] == m.consts[n] for n in olds)
+    return VC("main", "the precondition implies the weakest precondition of the program",
+              (pre, *links), result.pre, loc, "initial")
+
