@@ -1,0 +1,116 @@
+"""End to end: `doit verify` on a copy of the bundled workspace (the paper's case study)."""
+from __future__ import annotations
+
+import json
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def _doit(ws: Path, *args: str) -> subprocess.CompletedProcess[str]:
+    return subprocess.run([sys.executable, "-m", "doit", *args], cwd=ws, capture_output=True, text=True, timeout=600)
+
+
+@pytest.fixture(scope="module")
+def workspace(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    ws = tmp_path_factory.mktemp("ws")
+    for item in ("contracts", "backends", "dodo.py"):
+        src = ROOT / item
+        (shutil.copytree if src.is_dir() else shutil.copy)(src, ws / item)
+    r = _doit(ws, "verify")
+    assert r.returncode == 0, r.stdout + r.stderr
+    return ws
+
+
+@pytest.fixture(scope="module")
+def report(workspace: Path) -> dict:
+    return json.loads((workspace / "reports" / "assurance.json").read_text())
+
+
+def test_report_has_the_traceability_keys(report: dict) -> None:
+    for key in ("requirements", "nodes", "side_conditions", "derived_properties", "findings", "obligations", "evidence"):
+        assert isinstance(report[key], list) and report[key], key
+        assert all("status" in x for x in report[key]), key
+    assert [r["id"] for r in report["requirements"]] == ["REQ1", "REQ2", "REQ3", "REQ4"]
+    assert report["meta"]["plan"] == "contracts/plan.yaml"
+
+
+def test_calculus_reproduces_d1(report: dict) -> None:
+    sc = {s["id"]: s for s in report["side_conditions"]}
+    assert sc["Agent.sc1"]["status"] == "discharged"
+    assert sc["Navigation.sc1"]["status"] == "discharged"
+    agent = next(d for d in report["derived_properties"] if d["node"] == "Agent")
+    assert "R3" in agent["rules"]
+    assert agent["instances"][0]["conclusion"].endswith("and (0 <= in.r) => <> G_Agent")
+
+
+def test_genuine_problems_of_the_case_study_are_shown(report: dict) -> None:
+    findings = {f["id"]: f for f in report["findings"]}
+    assert findings["Agent.g2.non-vacuous"]["status"] == "problem"
+    ev = {e["obligation"]: e for e in report["evidence"]}
+    appendix_b = [e for k, e in ev.items() if "appendix_b" in k and e["status"] == "failed"]
+    assert appendix_b and all(e["counterexample"] for e in appendix_b)
+    listing = [e for k, e in ev.items() if ".hoare.radiation_sensor." in k]
+    assert sorted(e["status"] for e in listing) == ["discharged", "discharged", "discharged", "pending"]
+    problems = "\n".join(report["summary"]["problems"])
+    assert "Guarantee 2 of Agent is vacuous" in problems
+    # requirements resting on failed or open evidence are not shown as verified
+    assert all(r["status"] != "discharged" for r in report["requirements"])
+
+
+
+def test_unavailable_backends_are_pending_not_skipped(report: dict) -> None:
+    ev = [e for e in report["evidence"] if e["backend"] in ("review", "experiment")]
+    assert len(ev) == 2
+    assert all(e["status"] == "pending" and "backend not available" in e["explanation"] for e in ev)
+    ajpf = [e for e in report["evidence"] if e["backend"] == "ajpf"]
+    assert ajpf and all(e["status"] == "pending" for e in ajpf)
+
+
+def test_dafny_evidence_is_real_or_pending(report: dict) -> None:
+    [ev] = [e for e in report["evidence"] if e["backend"] == "dafny"]
+    if shutil.which("dafny"):
+        assert ev["status"] in ("failed", "discharged", "error") and ev["tool_version"] != "-"
+    else:
+        assert ev["status"] == "pending" and "dafny not installed" in ev["explanation"]
+
+
+def test_html_report_shows_the_problems_first(workspace: Path) -> None:
+    html = (workspace / "reports" / "assurance.html").read_text()
+    assert html.index("Guarantee 2 of Agent is vacuous") < html.index("Requirements traceability")
+    assert "<svg" in html or "install graphviz" in html
+
+
+def test_second_run_executes_no_task(workspace: Path) -> None:
+    r = _doit(workspace, "verify")
+    assert r.returncode == 0
+    executed = [l for l in r.stdout.splitlines() if l.startswith(".  ")]
+    assert executed == [], executed
+
+
+def test_strict_mode_fails_on_open_evidence(workspace: Path) -> None:
+    r = _doit(workspace, "verify", "--strict")
+    assert r.returncode != 0
+    assert "--strict" in r.stdout + r.stderr
+
+
+def test_bad_rcl_gives_located_error_and_keeps_evidence(workspace: Path) -> None:
+    rcl = workspace / "contracts" / "remote_inspection.rcl"
+    before = {p.name: p.read_bytes() for p in (workspace / "artifacts" / "evidence").glob("*.json")}
+    original = rcl.read_text()
+    try:
+        rcl.write_text(original.replace("assume( 0 <= in.r )", "assume( 0 <= in.rr )"))
+        r = _doit(workspace, "verify")
+        out = r.stdout + r.stderr
+        assert r.returncode != 0
+        assert "remote_inspection.rcl:" in out and "no input named 'rr'" in out
+        assert "Traceback" not in out
+        after = {p.name: p.read_bytes() for p in (workspace / "artifacts" / "evidence").glob("*.json")}
+        assert after == before
+    finally:
+        rcl.write_text(original)
