@@ -329,6 +329,8 @@ class _Ctx:
             items = [self.enc(i, b) for i in coll.items]
             eqs = [(lambda p: p[0] == p[1])(_coerce(elem, i)) for i in items]
             return z3.Or(*eqs) if eqs else z3.BoolVal(False)
+        if isinstance(coll, ast.Var) and coll.prefix is None and coll.name not in b and coll.name in ("REAL", "INTEGER", "NATURAL", "BOOL"):
+            return self.in_base(elem, coll.name)
         if isinstance(coll, ast.Var) and coll.prefix is None and coll.name not in b and coll.name in env.types \
                 and coll.name not in self.node.inputs and coll.name not in self.node.outputs:
             t = env.types[coll.name]
@@ -337,6 +339,14 @@ class _Ctx:
         if z3.is_seq(s):
             return z3.Contains(s, z3.Unit(elem))
         return z3.IsMember(elem, s)
+
+    @staticmethod
+    def in_base(elem: Any, base: str) -> Any:
+        """``elem in NATURAL`` and friends: integrality and sign constraints."""
+        if base in ("NATURAL", "INTEGER"):
+            integral = z3.IsInt(elem) if z3.is_real(elem) else z3.BoolVal(True)
+            return z3.And(integral, elem >= 0) if base == "NATURAL" else integral
+        return z3.BoolVal(True)
 
     def e_Member(self, x: ast.Member, b: Mapping[str, Any]) -> Any:
         r = self.member(self.enc(x.elem, b), x.collection, b)

@@ -38,6 +38,9 @@ from .types import (BOOL, INTEGER, NATURAL, REAL, Checked, CheckedNode, DataT, E
                     Scalar, SeqT, SetT, TupleT, Type, assignable, comparable, is_numeric, numeric_join)
 
 
+BASE_NAMES = ("REAL", "INTEGER", "NATURAL", "BOOL")
+
+
 class _Fail(Exception):
     """Internal: an expression could not be typed (a diagnostic was recorded)."""
 
@@ -315,6 +318,8 @@ class _Checker:
             raise _Fail
 
     def collection(self, c: ast.Expr, node: CheckedNode | None, bound: Mapping[str, Type]) -> SetT:
+        if isinstance(c, ast.Var) and c.prefix is None and c.name in BASE_NAMES and c.name not in bound:
+            return SetT(Scalar(c.name))  # type: ignore[arg-type]
         if isinstance(c, ast.Var) and c.prefix is None and c.name not in bound and c.name in self.types and not (
                 node and (c.name in node.inputs or c.name in node.outputs)):
             return SetT(self.types[c.name])

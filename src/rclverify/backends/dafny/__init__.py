@@ -1,0 +1,13 @@
+"""The ``dafny`` backend (paper lines 1667-1762: a node re-specified and
+verified in Dafny, showing implementations are interchangeable under the
+node's contract).
+
+Modules: :mod:`.types` (RCL type -> Dafny type), :mod:`.translate` (RCL
+formula -> Dafny expression), :mod:`.stubgen` (the ``abstract module``
+contract stub), :mod:`.runner` (find, identify, run Dafny and read its
+output), :mod:`.backend` (:class:`DafnyBackend`, name ``dafny``, kind
+``proof``).
+"""
+from .backend import DafnyBackend
+
+__all__ = ["DafnyBackend"]

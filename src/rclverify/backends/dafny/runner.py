@@ -1,0 +1,478 @@
+"""Find, identify and run Dafny; read its output; inspect implementations.
+
+Two command-line generations are supported (paper lines 1667-1762 used
+Dafny 3.x; Debian ships 2.3; current releases are 4.x):
+
+* **legacy** (2.x, 3.x): ``dafny /compile:0 /nologo /timeLimit:<s>
+  /errorLimit:<n> <files>``; its version is the banner ``Dafny 2.3.0.10506``
+  that ``dafny /version`` prints first;
+* **verify** (4.x and later): ``dafny verify --verification-time-limit <s>
+  <files>``; ``dafny --version`` prints the bare version ``4.9.1+...``.
+
+:func:`detect` tries ``--version`` first (a bare version number means the
+new CLI) and falls back to ``/version``.
+
+Dafny reports, in both generations, ``file(line,col): Error[ code]: message``,
+``file(line,col): Related location[: message]`` (for a failing
+postcondition: the ``ensures`` it concerns), ``file(line,col): Timed out on
+...``, ``file(line,col): Warning: ...`` and the summary ``Dafny program
+verifier finished with N verified, M errors[, K time outs]``; parse and
+resolution failures end in ``N parse errors detected`` / ``N
+resolution/type errors detected``.  :func:`parse_output` reads all of them.
+
+:func:`scan_implementation` reads a user's implementation without Dafny:
+which module refines the contract, whether the method is given a body, and
+constructs that would make a successful run prove nothing (``assume``,
+``expect``, ``{:axiom}``, ``{:verify false}``, ``{:extern}``, ``decreases *``).
+"""
+from __future__ import annotations
+
+import os
+import re
+import shutil
+import subprocess
+import time
+from dataclasses import dataclass, field
+from functools import lru_cache
+from pathlib import Path
+from typing import Mapping, Sequence
+
+
+# ---------------------------------------------------------------------------
+# Finding and identifying Dafny
+# ---------------------------------------------------------------------------
+
+@dataclass(frozen=True)
+class DafnyTool:
+    """An installed Dafny: ``exe`` path, ``version`` text (``2.3.0.10506``),
+    ``major`` version and whether it takes the legacy ``/option`` CLI."""
+
+    exe: str
+    version: str
+    major: int
+    legacy: bool
+
+
+def find_dafny(configured: str | None = None, path: str | None = None) -> str | None:
+    """Path of the Dafny executable, or ``None`` when there is none.
+
+    ``configured`` (the plan's ``dafny:`` key) is a command name or path;
+    default ``dafny``.  ``path`` is the search path (default: ``$PATH``).
+    """
+    return shutil.which(configured or "dafny", path=path if path is not None else os.environ.get("PATH", ""))
+
+
+_BARE_VERSION = re.compile(r"\A\s*(\d+)\.(\d+)\.(\d+)\S*")
+_BANNER = re.compile(r"Dafny\s+(?:version\s+)?((\d+)\.\d+\.\d+(?:\.\d+)?)")
+
+
+def _probe(exe: str, arg: str, timeout_s: float) -> str:
+    try:
+        p = subprocess.run([exe, arg], capture_output=True, text=True, timeout=timeout_s,
+                           stdin=subprocess.DEVNULL, errors="replace")
+    except (OSError, subprocess.TimeoutExpired):
+        return ""
+    return (p.stdout or "") + (p.stderr or "")
+
+
+@lru_cache(maxsize=8)
+def _detect_cached(exe: str, mtime: float, timeout_s: float) -> DafnyTool | None:
+    out = _probe(exe, "--version", timeout_s)
+    m = _BARE_VERSION.match(out)
+    if m:
+        return DafnyTool(exe, out.strip().split()[0], int(m.group(1)), int(m.group(1)) < 4)
+    out = _probe(exe, "/version", timeout_s)
+    b = _BANNER.search(out)
+    if b:
+        return DafnyTool(exe, b.group(1), int(b.group(2)), int(b.group(2)) < 4)
+    return None
+
+
+def detect(exe: str, timeout_s: float = 120.0) -> DafnyTool | None:
+    """Identify the Dafny at ``exe`` (cached per executable and modification time).
+
+    Returns ``None`` when ``exe`` does not run or does not say which Dafny
+    it is.  Takes about a second (two process starts at most).
+    """
+    try:
+        mtime = Path(exe).stat().st_mtime
+    except OSError:
+        return None
+    return _detect_cached(exe, mtime, timeout_s)
+
+
+def verify_argv(tool: DafnyTool | None, files: Sequence[str], time_limit_s: int, error_limit: int = 20,
+                options: Sequence[str] = ()) -> list[str]:
+    """The command line verifying ``files`` (workspace-relative) with Dafny.
+
+    ``time_limit_s`` bounds each verification condition (seconds);
+    ``error_limit`` the errors reported per procedure (legacy CLI);
+    ``options`` extra options passed verbatim before the files (they must
+    suit the CLI generation of ``tool``).  With ``tool=None`` the legacy
+    form of the Debian package is returned with the command name ``dafny``.
+    """
+    exe = tool.exe if tool else "dafny"
+    if tool is None or tool.legacy:
+        return [exe, "/compile:0", "/nologo", f"/timeLimit:{time_limit_s}", f"/errorLimit:{error_limit}",
+                *options, *files]
+    return [exe, "verify", "--verification-time-limit", str(time_limit_s), *options, *files]
+
+
+def user_commands(files: Sequence[str], time_limit_s: int, options: Sequence[str] = ()) -> tuple[str, str]:
+    """The commands a user runs by hand: ``(Dafny 2.x/3.x form, Dafny 4.x form)``.
+
+    ``options`` starting with ``/`` go to the first form, those starting
+    with ``-`` to the second.
+    """
+    legacy = " ".join(["dafny", "/compile:0", f"/timeLimit:{time_limit_s}",
+                       *[o for o in options if o.startswith("/")], *files])
+    new = " ".join(["dafny", "verify", "--verification-time-limit", str(time_limit_s),
+                    *[o for o in options if o.startswith("-")], *files])
+    return legacy, new
+
+
+def user_command(files: Sequence[str], time_limit_s: int, options: Sequence[str] = ()) -> str:
+    """Both forms of :func:`user_commands` on one line, for explanations."""
+    legacy, new = user_commands(files, time_limit_s, options)
+    return f"{legacy}  (Dafny 2.x/3.x), or {new}  (Dafny 4.x)"
+
+
+# ---------------------------------------------------------------------------
+# Running
+# ---------------------------------------------------------------------------
+
+@dataclass(frozen=True)
+class RunOutput:
+    """One Dafny process: ``argv``, ``returncode`` (``None`` when it was
+    killed at the process timeout), combined ``output``, ``duration_s``."""
+
+    argv: tuple[str, ...]
+    returncode: int | None
+    output: str
+    duration_s: float
+    timed_out: bool = False
+
+
+def run(argv: Sequence[str], cwd: Path, timeout_s: float, env: Mapping[str, str] | None = None) -> RunOutput:
+    """Run Dafny in ``cwd`` and capture stdout+stderr; kill it after ``timeout_s`` seconds.
+
+    Raises ``OSError`` when the executable cannot be started.
+    """
+    t0 = time.perf_counter()
+    try:
+        p = subprocess.run(list(argv), cwd=cwd, capture_output=True, text=True, timeout=timeout_s,
+                           stdin=subprocess.DEVNULL, env=dict(env) if env is not None else None, errors="replace")
+    except subprocess.TimeoutExpired as exc:
+        out = _text(exc.stdout) + _text(exc.stderr)
+        return RunOutput(tuple(argv), None, out, round(time.perf_counter() - t0, 3), True)
+    return RunOutput(tuple(argv), p.returncode, (p.stdout or "") + (p.stderr or ""), round(time.perf_counter() - t0, 3))
+
+
+def _text(b: bytes | str | None) -> str:
+    if b is None:
+        return ""
+    return b if isinstance(b, str) else b.decode("utf-8", "replace")
+
+
+# ---------------------------------------------------------------------------
+# Parsing the output
+# ---------------------------------------------------------------------------
+
+@dataclass(frozen=True)
+class Position:
+    """A location in a Dafny file as Dafny prints it (``file(line,col)``)."""
+
+    file: str
+    line: int
+    col: int
+
+    def __str__(self) -> str:
+        return f"{self.file}({self.line},{self.col})"
+
+
+@dataclass
+class Message:
+    """One diagnostic: ``severity`` is ``error``, ``timeout`` or ``warning``;
+    ``code`` e.g. ``BP5003``; ``related`` the related locations (with their
+    message, possibly '') that Dafny lists under it."""
+
+    severity: str
+    at: Position
+    message: str
+    code: str = ""
+    related: list[tuple[Position, str]] = field(default_factory=list)
+
+
+@dataclass
+class Output:
+    """What a Dafny run said.
+
+    ``summary``   whether the "verifier finished" line was printed;
+    ``verified``/``errors``/``timeouts``/``other`` its counts (``other``:
+    inconclusive, out of memory, out of resource);
+    ``parse_errors`` / ``resolution_errors``: counts of the lines "N parse
+    errors detected" / "N resolution/type errors detected";
+    ``prover_messages``: distinct "Prover error:" lines (solver complaints
+    that did not stop verification).
+    """
+
+    summary: bool = False
+    verified: int = 0
+    errors: int = 0
+    timeouts: int = 0
+    other: int = 0
+    parse_errors: int = 0
+    resolution_errors: int = 0
+    messages: list[Message] = field(default_factory=list)
+    prover_messages: list[str] = field(default_factory=list)
+
+
+_POS = r"(?P<file>[^\s()\[][^()\[]*?)(?:\[[^\]]*\])?\((?P<line>-?\d+),(?P<col>-?\d+)\)"
+_ERROR = re.compile(_POS + r":\s+Error(?:\s+(?P<code>[A-Z]+\d+))?:\s*(?P<msg>.*)$")
+_TIMEOUT_ON = re.compile(_POS + r":\s+Timed out on(?:\s+(?P<code>[A-Z]+\d+))?:\s*(?P<msg>.*)$")
+_TIMEOUT_PROC = re.compile(_POS + r":\s+(?:Error:\s+)?(?P<msg>Verification of .* timed out.*)$")
+_RELATED = re.compile(_POS + r":\s+Related location(?::\s*(?P<msg>.*))?$")
+_WARNING = re.compile(_POS + r":\s+Warning:\s*(?P<msg>.*)$")
+_SUMMARY = re.compile(r"Dafny program verifier finished with (?P<v>\d+) verified, (?P<e>\d+) errors?(?P<rest>.*)$")
+_DETECTED = re.compile(r"(?P<n>\d+) (?P<kind>parse|resolution/type) errors? detected in")
+
+
+def _pos(m: re.Match[str]) -> Position:
+    return Position(m.group("file").strip(), int(m.group("line")), int(m.group("col")))
+
+
+def parse_output(text: str) -> Output:
+    """Read Dafny's console output (any supported version) into an :class:`Output`."""
+    out = Output()
+    last: Message | None = None
+    for raw in text.splitlines():
+        line = raw.rstrip()
+        if m := _SUMMARY.search(line):
+            out.summary = True
+            out.verified, out.errors = int(m.group("v")), int(m.group("e"))
+            for n, what in re.findall(r"(\d+) ([a-z ]+?)(?=,|$)", m.group("rest")):
+                if what.startswith("time out"):
+                    out.timeouts += int(n)
+                else:
+                    out.other += int(n)
+            continue
+        if m := _DETECTED.search(line):
+            if m.group("kind") == "parse":
+                out.parse_errors += int(m.group("n"))
+            else:
+                out.resolution_errors += int(m.group("n"))
+            continue
+        if line.startswith("Prover error:"):
+            gist = re.sub(r"line \d+ column \d+: ", "", line)
+            if all(re.sub(r"line \d+ column \d+: ", "", p) != gist for p in out.prover_messages):
+                out.prover_messages.append(line)
+            continue
+        if m := _RELATED.match(line):
+            if last is not None:
+                last.related.append((_pos(m), (m.group("msg") or "").strip()))
+            continue
+        if m := _TIMEOUT_ON.match(line):
+            last = Message("timeout", _pos(m), m.group("msg").strip(), m.group("code") or "")
+            out.messages.append(last)
+            continue
+        if m := _TIMEOUT_PROC.match(line):
+            last = Message("timeout", _pos(m), m.group("msg").strip())
+            out.messages.append(last)
+            continue
+        if m := _ERROR.match(line):
+            last = Message("error", _pos(m), m.group("msg").strip(), m.group("code") or "")
+            out.messages.append(last)
+            continue
+        if m := _WARNING.match(line):
+            last = Message("warning", _pos(m), m.group("msg").strip())
+            out.messages.append(last)
+            continue
+    return out
+
+
+# ---------------------------------------------------------------------------
+# Reading an implementation
+# ---------------------------------------------------------------------------
+
+@dataclass(frozen=True)
+class Token:
+    text: str
+    line: int
+
+
+@dataclass
+class ImplementationScan:
+    """What :func:`scan_implementation` found.
+
+    ``refining``   ``(module name, line)`` of every module refining the contract;
+    ``body_line``  line of the method body's ``{`` in the first refining
+                   module, or ``None`` when the method is not given a body;
+    ``method_line`` line of the method declaration (``None`` when absent);
+    ``unsound``    ``(line, construct)`` of every construct that lets Dafny
+                   accept a claim it did not prove.
+    """
+
+    refining: list[tuple[str, int]] = field(default_factory=list)
+    method_line: int | None = None
+    body_line: int | None = None
+    unsound: list[tuple[int, str]] = field(default_factory=list)
+
+
+_TOKEN = re.compile(r"\{:|[A-Za-z_][A-Za-z0-9_'?]*|\d[\d._]*|:=|==>|<==>|==|!=|<=|>=|&&|\|\||::|\S")
+_DECL_KEYWORDS = {"method", "function", "predicate", "lemma", "datatype", "codatatype", "type", "const", "class",
+                  "module", "import", "iterator", "newtype", "trait", "constructor", "twostate", "inductive",
+                  "colemma", "copredicate", "greatest", "least"}
+_SPEC_KEYWORDS = {"requires", "ensures", "modifies", "reads", "decreases", "free"}
+
+
+def _tokens(text: str) -> list[Token]:
+    """Dafny tokens of ``text`` with comments, strings and char literals removed."""
+    out: list[Token] = []
+    i, line, n = 0, 1, len(text)
+    while i < n:
+        c = text[i]
+        if c == "\n":
+            line += 1
+            i += 1
+        elif text.startswith("//", i):
+            j = text.find("\n", i)
+            i = n if j < 0 else j
+        elif text.startswith("/*", i):
+            depth, i = 1, i + 2
+            while i < n and depth:
+                if text.startswith("/*", i):
+                    depth, i = depth + 1, i + 2
+                elif text.startswith("*/", i):
+                    depth, i = depth - 1, i + 2
+                else:
+                    line += text[i] == "\n"
+                    i += 1
+        elif c == '"':
+            i += 1
+            while i < n and text[i] != '"':
+                i += 2 if text[i] == "\\" else 1
+            i += 1
+        elif c == "'" and re.match(r"'(\\.|[^'\\])'", text[i:i + 4]):
+            i += len(re.match(r"'(\\.|[^'\\])'", text[i:i + 4]).group(0))  # type: ignore[union-attr]
+        elif c.isspace():
+            i += 1
+        else:
+            m = _TOKEN.match(text, i)
+            assert m is not None
+            out.append(Token(m.group(0), line))
+            i = m.end()
+    return out
+
+
+def _match_close(toks: list[Token], k: int) -> int:
+    """Index of the bracket closing the one at ``toks[k]`` (``len(toks)`` when unclosed).
+
+    ``{:`` (an attribute) closes with ``}``; ``<`` (type parameters) with ``>``.
+    """
+    if toks[k].text == "<":
+        opens, closes = {"<"}, {">"}
+    else:
+        opens, closes = {"(", "[", "{", "{:"}, {")", "]", "}"}
+    depth = 0
+    for j in range(k, len(toks)):
+        t = toks[j].text
+        if t in opens:
+            depth += 1
+        elif t in closes:
+            depth -= 1
+            if depth == 0:
+                return j
+    return len(toks)
+
+
+def _unsound(toks: list[Token]) -> list[tuple[int, str]]:
+    found: list[tuple[int, str]] = []
+    for k, t in enumerate(toks):
+        nxt = toks[k + 1].text if k + 1 < len(toks) else ""
+        nxt2 = toks[k + 2].text if k + 2 < len(toks) else ""
+        if t.text in ("assume", "expect"):
+            found.append((t.line, f"{t.text} statement"))
+        elif t.text == "{:" and nxt in ("axiom", "extern"):
+            found.append((t.line, f"{{:{nxt}}} attribute"))
+        elif t.text == "{:" and nxt == "verify" and nxt2 == "false":
+            found.append((t.line, "{:verify false} attribute"))
+        elif t.text == "decreases" and nxt == "*":
+            found.append((t.line, "decreases * (possibly non-terminating)"))
+    return found
+
+
+def _body_start(toks: list[Token], k: int, end: int) -> int | None:
+    """Given ``toks[k]`` just after a method's name, the index of its body's
+    ``{`` (``None`` when the declaration ends without a body)."""
+    j = k
+    if j < end and toks[j].text == "<":
+        j = _match_close(toks, j) + 1
+    if j < end and toks[j].text == "(":
+        j = _match_close(toks, j) + 1
+    if j < end and toks[j].text == "returns" and j + 1 < end and toks[j + 1].text == "(":
+        j = _match_close(toks, j + 1) + 1
+    while j < end:
+        t = toks[j].text
+        if t in _DECL_KEYWORDS or t in ("ghost", "static", "}"):
+            return None
+        if t == "{:":
+            j = _match_close(toks, j) + 1
+            continue
+        if t in ("(", "["):
+            j = _match_close(toks, j) + 1
+            continue
+        if t == "{":
+            prev = toks[j - 1].text
+            if re.fullmatch(r"[A-Za-z0-9_'?]+|\)|\]|\}", prev) and prev not in _SPEC_KEYWORDS and prev not in (
+                    "in", "then", "else", "set", "iset", "multiset", "seq", "map", "imap"):
+                return j
+            j = _match_close(toks, j) + 1
+            continue
+        j += 1
+    return None
+
+
+def scan_implementation(text: str, contract_module: str, method: str) -> ImplementationScan:
+    """Inspect an implementation's Dafny text (see :class:`ImplementationScan`).
+
+    ``contract_module`` is the abstract module it must refine
+    (``AgentContract``), ``method`` the method it must give a body.  A
+    lexical reading: comments and strings are skipped, set displays in
+    specification clauses are told from the body by the token before
+    ``{``.
+    """
+    toks = _tokens(text)
+    scan = ImplementationScan(unsound=_unsound(toks))
+    first_module: tuple[int, int] | None = None
+    for k, t in enumerate(toks):
+        if not (t.text == "module" and k + 3 < len(toks) and toks[k + 2].text == "refines"):
+            continue
+        j = k + 3
+        while j + 2 < len(toks) and toks[j + 1].text == ".":
+            j += 2
+        if toks[j].text == contract_module:
+            scan.refining.append((toks[k + 1].text, t.line))
+            if first_module is None:
+                brace = next((i for i in range(j + 1, len(toks)) if toks[i].text == "{"), None)
+                if brace is not None:
+                    first_module = (brace, _match_close(toks, brace))
+    if first_module is None:
+        return scan
+    start, end = first_module
+    depth = 0
+    for k in range(start + 1, end):
+        tx = toks[k].text
+        if tx in ("{", "{:"):
+            depth += 1
+        elif tx == "}":
+            depth -= 1
+        elif tx == "method" and depth == 0:
+            j = k + 1
+            while j < end and toks[j].text == "{:":
+                j = _match_close(toks, j) + 1
+            if j < end and toks[j].text == method:
+                scan.method_line = toks[k].line
+                b = _body_start(toks, j + 1, end)
+                scan.body_line = toks[b].line if b is not None else None
+                break
+    return scan

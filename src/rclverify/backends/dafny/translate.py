@@ -1,0 +1,432 @@
+"""RCL formulas -> Dafny expressions (for ``requires``/``ensures`` clauses).
+
+The translation keeps the meaning the Z3 encoding gives a formula
+(:mod:`rclverify.logic.encode`, shared/DESIGN.md "Semantics"):
+
+* connectives: ``not`` -> ``!``, ``and`` -> ``&&``, ``or`` -> ``||``,
+  ``->`` -> ``==>``, ``<=>`` -> ``<==>``; every compound sub-expression is
+  parenthesised, so Dafny's precedence never changes the reading;
+* chained comparisons ``a < b <= c`` -> ``(a < b) && (b <= c)``;
+* numbers: NATURAL <: INTEGER <: REAL widening is made explicit, because
+  Dafny does not mix ``int`` and ``real``: an integer literal in a real
+  context is written ``120.0``, any other integer term ``(t as real)``;
+  ``/`` is real division (both sides widened), as in the Z3 encoding;
+* ``x in T`` for a type name ``T``: true for the type itself, ``x >= 0`` for
+  ``NATURAL``, ``x.Floor as real == x`` for a real tested against
+  ``INTEGER``;
+* quantifiers: ``forall(x', y' in REAL, i in NATURAL | P)`` ->
+  ``(forall x': real, y': real, i: nat :: P)`` (Dafny's ``nat`` adds the
+  ``i >= 0`` guard the Z3 encoding adds); a binding over a set term adds
+  ``x in S`` as guard (``==>`` under ``forall``, ``&&`` under ``exists``);
+  a ``forall``/``exists`` all of whose bindings range over set or sequence
+  literals (``exists(w in {4, 5} | P)``) is expanded into the finite
+  conjunction/disjunction of its instances (up to 64), which is equivalent
+  and leaves Dafny no trigger to miss;
+  ``exists_unique(xs | P)`` -> ``(exists xs :: P && (forall ys :: P[ys] ==>
+  ys == xs))``; a binding over the empty type ``{}`` makes ``forall`` true
+  and ``exists`` false (as in the Z3 encoding).  Dafny picks the triggers
+  itself and may warn ("No terms found to trigger on"); the runner records
+  such warnings;
+* names: I/O variables, constants and bound variables get Dafny-safe names
+  (:func:`.types.dafny_ident`); a bound variable that would capture a
+  parameter, a constant or a datatype value is renamed; an enumeration
+  value or constructor whose name is shadowed is qualified (``RadStat.red``).
+
+Quantifying over functions is rejected with a located
+:class:`~rclverify.plan.errors.PlanError`.
+"""
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass, field
+from fractions import Fraction
+from typing import Mapping
+
+from ...plan.errors import PlanError
+from ...rcl import ast
+from ...rcl.errors import error
+from ...rcl.printer import is_type
+from ...rcl.typecheck import domain_type
+from ...rcl.types import (BOOL, INTEGER, NATURAL, REAL, CheckedNode, DataT, EmptyT, EnumT, Env, FuncT, SeqT, SetT,
+                          TupleT, Type, numeric_join)
+from .types import dafny_ident, dafny_type
+
+_BASE_NAMES = {"REAL": REAL, "INTEGER": INTEGER, "NATURAL": NATURAL, "BOOL": BOOL}
+_INT_LIT = re.compile(r"\A(\(?)(-?\d+)(\)?)\Z")
+_LOGIC = {"and": "&&", "or": "||", "->": "==>", "<=>": "<==>"}
+#: Largest number of instances a quantifier over literal collections is expanded into.
+_EXPANSION_LIMIT = 64
+
+
+def real_literal(value: Fraction) -> str:
+    """Exact Dafny ``real`` literal text of ``value`` (``120.0``, ``0.125``, ``-2.5``).
+
+    Values whose decimal expansion does not terminate are written as a
+    quotient ``(1.0 / 3.0)``.
+    """
+    sign = "-" if value < 0 else ""
+    v = abs(value)
+    d = v.denominator
+    twos = fives = 0
+    while d % 2 == 0:
+        d //= 2
+        twos += 1
+    while d % 5 == 0:
+        d //= 5
+        fives += 1
+    if d != 1:
+        return f"({sign}{v.numerator}.0 / {v.denominator}.0)"
+    k = max(twos, fives)
+    digits = str(v.numerator * 10 ** k // v.denominator).rjust(k + 1, "0")
+    whole, frac = (digits[:-k], digits[-k:]) if k else (digits, "0")
+    return f"{sign}{whole}.{frac}"
+
+
+@dataclass
+class _Bound:
+    dafny: str
+    type: Type
+
+
+@dataclass
+class Translator:
+    """Translates the formulas of one node into Dafny expressions.
+
+    ``env``     the checked environment (contexts);
+    ``node``    the node whose formulas are translated;
+    ``io``      ``"in.x"``/``"out.x"`` -> Dafny parameter name;
+    ``consts``  RCL constant name -> Dafny constant name;
+    ``taken``   further Dafny names in scope (datatype, type and method names).
+
+    :meth:`formula` returns the Dafny text of a BOOL formula; raises
+    :class:`PlanError` (located) for constructs Dafny cannot express.
+    """
+
+    env: Env
+    node: CheckedNode
+    io: Mapping[str, str]
+    consts: Mapping[str, str] = field(default_factory=dict)
+    taken: frozenset[str] = frozenset()
+    used_consts: set[str] = field(default_factory=set)
+    used_types: list[Type] = field(default_factory=list)
+
+    # -- entry points ---------------------------------------------------------------
+    def formula(self, e: ast.Expr) -> str:
+        """Dafny text of the formula ``e`` (type-checked RCL, BOOL)."""
+        text, t = self.tr(e, {})
+        if t != BOOL:
+            raise self._err(e.loc, f"expected a formula, found a term of type {t}")
+        return _strip(text)
+
+    def term(self, e: ast.Expr) -> tuple[str, Type]:
+        """Dafny text and RCL type of the term ``e``."""
+        return self.tr(e, {})
+
+    # -- internals ------------------------------------------------------------------------
+    @staticmethod
+    def _err(loc: ast.Loc, msg: str) -> PlanError:
+        return PlanError([error(loc, msg, "E-dafny")])
+
+    def _names_in_scope(self, scope: Mapping[str, _Bound]) -> set[str]:
+        return set(self.io.values()) | set(self.consts.values()) | set(self.taken) | {b.dafny for b in scope.values()}
+
+    def _value_names(self) -> set[str]:
+        return {dafny_ident(v) for v in self.env.enum_values} | {dafny_ident(c) for c in self.env.ctors}
+
+    def _io_name(self, v: ast.Var) -> str | None:
+        if v.prefix is not None:
+            return self.io.get(v.qualified)
+        if v.name in self.node.inputs:
+            return self.io.get(f"in.{v.name}")
+        if v.name in self.node.outputs:
+            return self.io.get(f"out.{v.name}")
+        return None
+
+    def _value(self, name: str, owner: EnumT | DataT, scope: Mapping[str, _Bound]) -> str:
+        d = dafny_ident(name)
+        shadowed = d in set(self.io.values()) | set(self.consts.values()) | {b.dafny for b in scope.values()}
+        return f"{dafny_ident(owner.name)}.{d}" if shadowed else d
+
+    @staticmethod
+    def conv(text: str, src: Type, dst: Type) -> str:
+        """Widen ``text`` (of type ``src``) to ``dst`` where Dafny needs it (int -> real)."""
+        if dst == REAL and src in (NATURAL, INTEGER):
+            m = _INT_LIT.match(text)
+            if m:
+                return f"{m.group(1)}{m.group(2)}.0{m.group(3)}"
+            return f"({text} as real)"
+        return text
+
+    def _join(self, items: list[tuple[str, Type]]) -> tuple[list[str], Type]:
+        t: Type | None = None
+        for _, it in items:
+            if t is None:
+                t = it
+            elif numeric_join(t, it) is not None:
+                t = numeric_join(t, it)
+        if t is None:
+            return [], EmptyT("{}")
+        return [self.conv(s, it, t) for s, it in items], t
+
+    # -- the translation --------------------------------------------------------------
+    def tr(self, e: ast.Expr, scope: Mapping[str, _Bound]) -> tuple[str, Type]:
+        """``(text, type)`` of ``e`` with bound variables ``scope``; records the
+        type in :attr:`used_types` (the stub declares the datatypes used)."""
+        text, t = self._tr(e, scope)
+        if t not in self.used_types:
+            self.used_types.append(t)
+        return text, t
+
+    def _tr(self, e: ast.Expr, scope: Mapping[str, _Bound]) -> tuple[str, Type]:
+        if isinstance(e, ast.BoolLit):
+            return ("true" if e.value else "false"), BOOL
+        if isinstance(e, ast.NumLit):
+            if e.is_integral:
+                return str(int(e.value)), NATURAL
+            return real_literal(e.value), REAL
+        if isinstance(e, ast.Var):
+            return self.var(e, scope)
+        if isinstance(e, ast.Apply):
+            return self.apply(e, scope)
+        if isinstance(e, ast.Unary):
+            s, t = self.tr(e.operand, scope)
+            if e.op == "not":
+                return f"!{_wrap(s)}", BOOL
+            return f"(-{_wrap(s)})", (REAL if t == REAL else INTEGER)
+        if isinstance(e, ast.Binary):
+            return self.binary(e, scope)
+        if isinstance(e, ast.Compare):
+            return self.compare(e, scope)
+        if isinstance(e, ast.Member):
+            s = self.member(self.tr(e.elem, scope), e.collection, scope)
+            return (f"!{_wrap(s)}" if e.negated else s), BOOL
+        if isinstance(e, (ast.SetLit, ast.SeqLit)):
+            texts, t = self._join([self.tr(i, scope) for i in e.items])
+            if isinstance(e, ast.SetLit):
+                return "{" + ", ".join(texts) + "}", SetT(t)
+            return "[" + ", ".join(texts) + "]", SeqT(t)
+        if isinstance(e, ast.TupleLit):
+            parts = [self.tr(i, scope) for i in e.items]
+            return "(" + ", ".join(s for s, _ in parts) + ")", TupleT(tuple(t for _, t in parts))
+        if isinstance(e, ast.Quant):
+            return self.quant(e, scope), BOOL
+        raise self._err(getattr(e, "loc", ast.NOLOC), f"unsupported expression {type(e).__name__}")  # pragma: no cover
+
+    def var(self, v: ast.Var, scope: Mapping[str, _Bound]) -> tuple[str, Type]:
+        if v.prefix is None and v.name in scope:
+            b = scope[v.name]
+            return b.dafny, b.type
+        io = self._io_name(v)
+        if io is not None:
+            t = self.node.io_type(v)
+            assert t is not None
+            return io, t
+        if v.prefix is None:
+            if v.name in self.env.constants:
+                t, value = self.env.constants[v.name]
+                if v.name in self.consts:
+                    self.used_consts.add(v.name)
+                    return self.consts[v.name], t
+                s, vt = self.tr(value, {})
+                return self.conv(s, vt, t), t
+            if v.name in self.env.enum_values:
+                enum = self.env.enum_values[v.name]
+                return self._value(v.name, enum, scope), enum
+            if v.name in self.env.ctors:
+                data = self.env.ctors[v.name]
+                return self._value(v.name, data, scope), data
+        raise self._err(v.loc, f"unknown name {v.qualified!r} in node {self.node.name}")
+
+    def apply(self, e: ast.Apply, scope: Mapping[str, _Bound]) -> tuple[str, Type]:
+        f = e.func
+        is_var = f.prefix is not None or f.name in scope or self._io_name(f) is not None or f.name in self.env.constants
+        args = [self.tr(a, scope) for a in e.args]
+        if not is_var and f.name in self.env.ctors:
+            data = self.env.ctors[f.name]
+            params = data.ctor(f.name) or ()
+            texts = [self.conv(s, t, p) for (s, t), p in zip(args, params)]
+            return f"{self._value(f.name, data, scope)}({', '.join(texts)})", data
+        fs, ft = self.var(f, scope)
+        if not isinstance(ft, FuncT):
+            raise self._err(f.loc, f"{f.qualified} has type {ft} and cannot be applied")
+        texts = [self.conv(s, t, p) for (s, t), p in zip(args, ft.args)]
+        return f"{fs}({', '.join(texts)})", ft.result
+
+    def binary(self, e: ast.Binary, scope: Mapping[str, _Bound]) -> tuple[str, Type]:
+        (ls, lt), (rs, rt) = self.tr(e.left, scope), self.tr(e.right, scope)
+        if e.op in _LOGIC:
+            return f"({ls} {_LOGIC[e.op]} {rs})", BOOL
+        if e.op == "/":
+            return f"({self.conv(ls, lt, REAL)} / {self.conv(rs, rt, REAL)})", REAL
+        j = numeric_join(lt, rt)
+        if j is None:
+            raise self._err(e.loc, f"'{e.op}' needs numbers, found {lt} and {rt}")
+        t: Type = INTEGER if (e.op == "-" and j == NATURAL) else j
+        return f"({self.conv(ls, lt, j)} {e.op} {self.conv(rs, rt, j)})", t
+
+    def compare(self, e: ast.Compare, scope: Mapping[str, _Bound]) -> tuple[str, Type]:
+        vals = [self.tr(o, scope) for o in e.operands]
+        parts = []
+        for op, (a, at), (b, bt) in zip(e.ops, vals, vals[1:]):
+            j = numeric_join(at, bt)
+            if j is not None:
+                a, b = self.conv(a, at, j), self.conv(b, bt, j)
+            parts.append(f"({a} {op} {b})")
+        return (parts[0] if len(parts) == 1 else "(" + " && ".join(parts) + ")"), BOOL
+
+    def _type_name(self, c: ast.Expr, scope: Mapping[str, _Bound]) -> Type | None:
+        """The type a bare name used as a collection denotes (``RadStat``, ``NATURAL``), if any."""
+        if not isinstance(c, ast.Var) or c.prefix is not None or c.name in scope or self._io_name(c) is not None:
+            return None
+        if c.name in _BASE_NAMES:
+            return _BASE_NAMES[c.name]
+        return self.env.types.get(c.name)
+
+    def member(self, elem: tuple[str, Type], coll: ast.Expr, scope: Mapping[str, _Bound]) -> str:
+        es, et = elem
+        tt = self._type_name(coll, scope)
+        if tt is not None:
+            if tt == NATURAL and et in (NATURAL, INTEGER):
+                return f"({es} >= 0)"
+            if tt == NATURAL and et == REAL:
+                return f"((({es}.Floor as real) == {es}) && ({es} >= 0.0))"
+            if tt == INTEGER and et == REAL:
+                return f"(({es}.Floor as real) == {es})"
+            if isinstance(tt, EmptyT):
+                return "false"
+            return "true"
+        cs, ct = self.tr(coll, scope)
+        if isinstance(ct, (SetT, SeqT)) and numeric_join(et, ct.elem) == REAL:
+            # Dafny keeps int and real apart (nat and int mix freely): widen the integer side
+            if ct.elem != REAL:
+                if not isinstance(coll, (ast.SetLit, ast.SeqLit)):
+                    raise self._err(coll.loc, f"membership of a {et} in a collection of {ct.elem} needs a "
+                                              "conversion Dafny cannot apply to a whole collection")
+                items = [self.conv(s, t, REAL) for s, t in (self.tr(i, scope) for i in coll.items)]
+                cs = ("{" if isinstance(coll, ast.SetLit) else "[") + ", ".join(items) + (
+                    "}" if isinstance(coll, ast.SetLit) else "]")
+            es = self.conv(es, et, REAL)
+        return f"({es} in {cs})"
+
+    def _expand_literal(self, e: ast.Quant, scope: Mapping[str, _Bound]) -> str | None:
+        """``forall``/``exists`` whose every binding ranges over a set or sequence
+        literal, as a finite conjunction/disjunction of instances (at most
+        :data:`_EXPANSION_LIMIT`).  Equivalent to the guarded quantifier, and
+        gives Dafny nothing to trigger on to get wrong.  ``None`` otherwise."""
+        if e.kind == "exists_unique" or not all(isinstance(b.domain, (ast.SetLit, ast.SeqLit)) for b in e.bindings):
+            return None
+        choices: list[list[tuple[str, str, Type]]] = []  # per bound name: (rcl name, text, type) options
+        for bd in e.bindings:
+            coll = bd.domain
+            assert isinstance(coll, (ast.SetLit, ast.SeqLit))
+            texts, t = self._join([self.tr(i, scope) for i in coll.items])
+            for nm in bd.names:
+                choices.append([(nm, _wrap(x), t) for x in texts])
+        total = 1
+        for c in choices:
+            total *= len(c)
+        if total > _EXPANSION_LIMIT:
+            return None
+        if total == 0:
+            return "true" if e.kind == "forall" else "false"
+        instances: list[str] = []
+
+        def walk(k: int, sc: dict[str, _Bound]) -> None:
+            if k == len(choices):
+                instances.append(self.tr(e.body, sc)[0])
+                return
+            for nm, text, t in choices[k]:
+                walk(k + 1, {**sc, nm: _Bound(text, t)})
+
+        walk(0, dict(scope))
+        joiner = " && " if e.kind == "forall" else " || "
+        return "(" + joiner.join(instances) + ")"
+
+    def quant(self, e: ast.Quant, scope: Mapping[str, _Bound]) -> str:
+        expanded = self._expand_literal(e, scope)
+        if expanded is not None:
+            return expanded
+        inner = dict(scope)
+        decls: list[str] = []
+        guards: list[str] = []
+        news: list[tuple[str, str, Type, str]] = []  # (rcl name, dafny name, type, dafny type)
+        rcl_bound = {k: b.type for k, b in scope.items()}
+        for bd in e.bindings:
+            t = domain_type(bd, self.node, self.env, rcl_bound)
+            if isinstance(t, EmptyT):
+                return "true" if e.kind == "forall" else "false"
+            if isinstance(t, FuncT):
+                raise self._err(bd.loc, f"quantifying over functions ({', '.join(bd.names)} in {t}) cannot be "
+                                        "expressed in the Dafny contract stub")
+            dt = dafny_type(t, bd.loc, f"the domain of {', '.join(bd.names)}")
+            if t not in self.used_types:
+                self.used_types.append(t)
+            coll: ast.Expr | None = None
+            if not is_type(bd.domain):
+                coll = bd.domain  # type: ignore[assignment]
+            elif isinstance(bd.domain, ast.TName) and bd.domain.name not in self.env.types:
+                coll = ast.Var(bd.domain.name, None, bd.domain.loc)
+            for nm in bd.names:
+                taken = self._names_in_scope(inner) | self._value_names()
+                d = dafny_ident(nm, taken)
+                decls.append(f"{d}: {dt}")
+                news.append((nm, d, t, dt))
+                inner[nm] = _Bound(d, t)
+                if coll is not None:
+                    guards.append(self.member((d, t), coll, scope))
+                rcl_bound[nm] = t
+        body, bt = self.tr(e.body, inner)
+        guard = " && ".join(guards)
+        binders = ", ".join(decls)
+        if e.kind == "forall":
+            return f"(forall {binders} :: {guard} ==> {body})" if guard else f"(forall {binders} :: {body})"
+        core = f"{guard} && {body}" if guard else body
+        if e.kind == "exists":
+            return f"(exists {binders} :: {core})"
+        # exists_unique: the tuple of bound values is unique
+        again = dict(scope)
+        ydecls, yguards, eqs = [], [], []
+        taken = self._names_in_scope(inner) | self._value_names()
+        for nm, d, t, dt in news:
+            y = dafny_ident(f"{d}_u", taken)
+            taken.add(y)
+            again[nm] = _Bound(y, t)
+            ydecls.append(f"{y}: {dt}")
+            eqs.append(f"({y} == {d})")
+        for bd in e.bindings:
+            coll = None
+            if not is_type(bd.domain):
+                coll = bd.domain  # type: ignore[assignment]
+            elif isinstance(bd.domain, ast.TName) and bd.domain.name not in self.env.types:
+                coll = ast.Var(bd.domain.name, None, bd.domain.loc)
+            if coll is not None:
+                for nm in bd.names:
+                    yguards.append(self.member((again[nm].dafny, again[nm].type), coll, scope))
+        ybody, _ = self.tr(e.body, again)
+        ycore = " && ".join(yguards + [ybody])
+        unique = f"(forall {', '.join(ydecls)} :: ({ycore}) ==> ({' && '.join(eqs)}))"
+        return f"(exists {binders} :: {core} && {unique})"
+
+
+def _wrap(s: str) -> str:
+    """Parenthesise ``s`` unless it is already atomic or parenthesised as a whole."""
+    if re.fullmatch(r"[A-Za-z0-9_'.]+", s) or _balanced_parens(s):
+        return s
+    return f"({s})"
+
+
+def _balanced_parens(s: str) -> bool:
+    if not (s.startswith("(") and s.endswith(")")):
+        return False
+    depth = 0
+    for k, ch in enumerate(s):
+        depth += ch == "("
+        depth -= ch == ")"
+        if depth == 0 and k < len(s) - 1:
+            return False
+    return True
+
+
+def _strip(s: str) -> str:
+    """Drop one pair of parentheses enclosing the whole of ``s``."""
+    return s[1:-1] if _balanced_parens(s) else s

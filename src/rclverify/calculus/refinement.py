@@ -1,0 +1,300 @@
+"""Contract refinement: may node contract B replace node contract A?
+
+Paper lines 1667-1700 ("Compositionality enables Interchangeability"): a
+node's implementation can be swapped for another "as long as the new
+implementation conforms to the FOL contract".  Lifted from implementations to
+contracts, B may replace A in any system where A was used when
+
+1. B has A's interface: the same input names and output names, each of the
+   same type (otherwise the question is ill-posed and a located error is
+   raised);
+2. B assumes no more than A:            ``A_A  =>  A_B``
+3. B guarantees at least what A does, wherever A's assumption holds:
+                                        ``A_A and G_B  =>  G_A``
+
+``A_X`` is the conjunction of node X's assume clauses (TRUE when it has
+none) and ``G_X`` the conjunction of its guarantee clauses.  Input and output
+variables of A and B are the same Z3 symbols.  Each side is decided by Z3
+(:func:`rclverify.logic.query.prove`): ``proved``, ``refuted`` with a model
+in RCL names, or ``inconclusive`` (unknown/timeout; never counted as proved).
+
+``refines_main`` implements the command ``rclverify refines A.rcl:Node
+B.rcl:Node``.
+"""
+from __future__ import annotations
+
+import sys
+from dataclasses import dataclass, field
+from typing import Any, Mapping, TextIO
+
+import z3  # type: ignore[import-untyped]
+
+from ..logic.encode import EncodingError, Encoder
+from ..logic.query import DEFAULT_TIMEOUT_MS, QueryResult, prove
+from ..rcl import ast
+from ..rcl.errors import Diagnostic, RclError, error
+from ..rcl.printer import expr_to_rcl
+from ..rcl.typecheck import load
+from ..rcl.types import Checked, CheckedNode, Env
+
+
+@dataclass(frozen=True)
+class SideResult:
+    """One refinement condition.
+
+    ``name``       ``"assumption"`` or ``"guarantee"``;
+    ``statement``  the implication checked, in RCL;
+    ``status``     ``proved`` / ``refuted`` / ``inconclusive``;
+    ``model``      RCL name (``in.r``, ``out.radiationStatus``) -> value text,
+                   for ``refuted``;
+    ``reason``     Z3's reason for ``inconclusive``;
+    ``smt2``       the query as SMT-LIB2; ``duration_s`` its wall time.
+    """
+
+    name: str
+    statement: str
+    status: str
+    model: Mapping[str, str] | None = None
+    reason: str = ""
+    smt2: str = ""
+    duration_s: float = 0.0
+
+
+@dataclass(frozen=True)
+class RefinementResult:
+    """The verdict on "B refines A".
+
+    ``verdict`` is ``refines`` (both sides proved), ``does not refine``
+    (a side refuted) or ``inconclusive``.
+    """
+
+    a: str
+    b: str
+    assumption: SideResult
+    guarantee: SideResult
+    a_loc: ast.Loc = field(default=ast.NOLOC)
+    b_loc: ast.Loc = field(default=ast.NOLOC)
+
+    @property
+    def verdict(self) -> str:
+        sides = (self.assumption.status, self.guarantee.status)
+        if all(s == "proved" for s in sides):
+            return "refines"
+        if "refuted" in sides:
+            return "does not refine"
+        return "inconclusive"
+
+    def to_json(self) -> dict[str, Any]:
+        def side(s: SideResult) -> dict[str, Any]:
+            return {"statement": s.statement, "status": s.status, "model": dict(s.model) if s.model else None,
+                    "reason": s.reason, "duration_s": s.duration_s}
+        return {"a": self.a, "b": self.b, "verdict": self.verdict,
+                "assumption": side(self.assumption), "guarantee": side(self.guarantee)}
+
+
+# ---------------------------------------------------------------------------
+# Interface and environments
+# ---------------------------------------------------------------------------
+
+def _io_loc(node: CheckedNode, prefix: str, name: str) -> ast.Loc:
+    group = node.node.inputs if prefix == "in" else node.node.outputs
+    return next((v.loc for v in group if v.name == name), node.node.loc)
+
+
+def check_interface(a: CheckedNode, b: CheckedNode) -> None:
+    """Raise :class:`RclError` (one diagnostic per difference, located in B,
+    or at B's node when B lacks a variable) unless A and B have the same
+    inputs and outputs with the same types."""
+    diags: list[Diagnostic] = []
+    for prefix, kind, ta, tb in (("in", "input", a.inputs, b.inputs), ("out", "output", a.outputs, b.outputs)):
+        for name, t in ta.items():
+            if name not in tb:
+                diags.append(error(b.node.loc, f"node {b.name} has no {kind} {name!r}, which {a.name} "
+                                               f"({_io_loc(a, prefix, name)}) has; a replacement needs the same "
+                                               f"interface", "E-refines-interface"))
+            elif tb[name] != t:
+                diags.append(error(_io_loc(b, prefix, name), f"{kind} {name!r} has type {tb[name]} here but "
+                                                             f"{t} in {a.name} ({_io_loc(a, prefix, name)})",
+                                   "E-refines-interface"))
+        for name in tb:
+            if name not in ta:
+                diags.append(error(_io_loc(b, prefix, name), f"{kind} {name!r} of {b.name} is not an {kind} of "
+                                                             f"{a.name} ({a.node.loc}); a replacement needs the "
+                                                             f"same interface", "E-refines-interface"))
+    if diags:
+        raise RclError(diags)
+
+
+def merge_envs(a: Checked, b: Checked) -> Env:
+    """One environment for two separately checked systems.
+
+    Context names both declare must mean the same (same type, same constant
+    value, same enumeration values and constructors); otherwise an
+    :class:`RclError` located at B's declaration is raised.
+    """
+    diags: list[Diagnostic] = []
+    types, consts = dict(a.env.types), dict(a.env.constants)
+    enums, ctors = dict(a.env.enum_values), dict(a.env.ctors)
+    locs = _decl_locs(b)
+    for name, t in b.env.types.items():
+        if name in types and types[name] != t:
+            diags.append(error(locs.get(name, ast.NOLOC), f"context type {name} is {t} here but "
+                                                          f"{types[name]} in the other contract", "E-refines-context"))
+        types.setdefault(name, t)
+    for name, (t, v) in b.env.constants.items():
+        if name in consts and (consts[name][0] != t or consts[name][1] != v):
+            diags.append(error(locs.get(name, ast.NOLOC), f"constant {name} differs from the other contract's",
+                               "E-refines-context"))
+        consts.setdefault(name, (t, v))
+    anywhere = next(iter(locs.values()), ast.NOLOC)
+    for value, enum in b.env.enum_values.items():
+        if value in enums and enums[value] != enum:
+            diags.append(error(locs.get(enum.name, anywhere), f"value {value} belongs to {enum} here but to "
+                                                              f"{enums[value]} in the other contract",
+                               "E-refines-context"))
+        enums.setdefault(value, enum)
+    for cname, data in b.env.ctors.items():
+        if cname in ctors and ctors[cname] != data:
+            diags.append(error(locs.get(data.name, anywhere), f"constructor {cname} belongs to {data} here but "
+                                                              f"to {ctors[cname]} in the other contract",
+                               "E-refines-context"))
+        ctors.setdefault(cname, data)
+    if diags:
+        raise RclError(diags)
+    return Env(types, consts, enums, ctors)
+
+
+def _decl_locs(c: Checked) -> dict[str, ast.Loc]:
+    return {d.name: d.loc for s in c.specs for ctx in s.contexts for d in ctx.decls}
+
+
+# ---------------------------------------------------------------------------
+# The check
+# ---------------------------------------------------------------------------
+
+def _conj(clauses: tuple[ast.Clause, ...]) -> str:
+    return " and ".join(f"({expr_to_rcl(c.formula)})" for c in clauses) or "TRUE"
+
+
+def _rename(model: Mapping[str, str] | None, node: str) -> dict[str, str] | None:
+    if model is None:
+        return None
+    prefix = f"{node}."
+    return {(k[len(prefix):] if k.startswith(prefix) else k): v for k, v in model.items()}
+
+
+def check_refinement(a: CheckedNode, b: CheckedNode, env: Env, *,
+                     timeout_ms: int = DEFAULT_TIMEOUT_MS) -> RefinementResult:
+    """Decide whether contract ``b`` may replace contract ``a`` (module docstring).
+
+    ``env`` must resolve both nodes' names (see :func:`merge_envs` for nodes
+    checked separately).  ``timeout_ms`` bounds each Z3 query.  Raises
+    :class:`RclError` for an interface mismatch and for formulas the Z3
+    encoding does not support (located).
+    """
+    check_interface(a, b)
+    enc = Encoder(env)
+    shared: dict[str, Any] = {}
+    for prefix, group in (("in", a.inputs), ("out", a.outputs)):
+        for name in group:
+            shared[f"{prefix}.{name}"] = enc.io_symbol(a, prefix, name)
+    try:
+        def conj(node: CheckedNode, clauses: tuple[ast.Clause, ...]) -> z3.BoolRef:
+            fs = [enc.formula(c.formula, node, shared) for c in clauses]
+            return z3.And(*fs) if fs else z3.BoolVal(True)
+
+        aa, ga = conj(a, a.node.assumes), conj(a, a.node.guarantees)
+        ab, gb = conj(b, b.node.assumes), conj(b, b.node.guarantees)
+    except EncodingError as exc:
+        raise RclError([error(exc.loc, str(exc).split(": error: ", 1)[-1], "E-encoding")]) from None
+    s_assume = f"{_conj(a.node.assumes)} -> {_conj(b.node.assumes)}"
+    s_guar = f"{_conj(a.node.assumes)} and {_conj(b.node.guarantees)} -> {_conj(a.node.guarantees)}"
+    q1 = prove(ab, [aa], enc, timeout_ms=timeout_ms,
+               comment=f"refinement, assumption side: A_{a.name} => A_{b.name}\nunsat: B assumes no more than A")
+    q2 = prove(ga, [aa, gb], enc, timeout_ms=timeout_ms,
+               comment=f"refinement, guarantee side: A_{a.name} and G_{b.name} => G_{a.name}\n"
+                       "unsat: B guarantees at least what A does")
+
+    def side(name: str, stmt: str, q: QueryResult) -> SideResult:
+        return SideResult(name, stmt, q.status, _rename(q.model, a.name), q.reason, q.smt2, q.duration_s)
+
+    return RefinementResult(a.name, b.name, side("assumption", s_assume, q1), side("guarantee", s_guar, q2),
+                            a.node.loc, b.node.loc)
+
+
+# ---------------------------------------------------------------------------
+# Command line
+# ---------------------------------------------------------------------------
+
+def _split_spec(spec: str) -> tuple[str, str | None]:
+    """``path.rcl:Node`` -> ``(path, Node)``; ``path.rcl`` -> ``(path, None)``."""
+    head, sep, tail = spec.rpartition(":")
+    if sep and tail and head and "/" not in tail and "\\" not in tail and not tail.endswith(".rcl"):
+        return head, tail
+    return spec, None
+
+
+def load_node(spec: str) -> tuple[Checked, CheckedNode]:
+    """Parse and type-check the RCL file of ``path[:Node]`` and pick the node.
+
+    Without ``:Node`` the file must hold exactly one node.  Raises
+    :class:`RclError` (located) for a missing file, a syntax or type error,
+    or an unknown node (listing the nodes there are).
+    """
+    path, name = _split_spec(spec)
+    checked = load([path])
+    if name is None:
+        if len(checked.nodes) != 1:
+            raise RclError([error(ast.Loc(path, 1, 1), f"{path} has {len(checked.nodes)} nodes "
+                                                       f"({', '.join(checked.nodes) or 'none'}); "
+                                                       f"write {path}:<node>", "E-refines-node")])
+        name = next(iter(checked.nodes))
+    if name not in checked.nodes:
+        raise RclError([error(ast.Loc(path, 1, 1), f"{path} has no node {name!r}; its nodes are: "
+                                                   f"{', '.join(checked.nodes) or 'none'}", "E-refines-node")])
+    return checked, checked.nodes[name]
+
+
+def render(result: RefinementResult, spec_a: str, spec_b: str) -> str:
+    """The verdict as text (what ``rclverify refines`` prints)."""
+    lines = [f"Does {spec_b} refine {spec_a}?  (may {result.b} replace {result.a})"]
+    for s, label in ((result.assumption, "assumption (A_A -> A_B)"),
+                     (result.guarantee, "guarantee  (A_A and G_B -> G_A)")):
+        lines.append(f"  {label}: {s.status}")
+        lines.append(f"      {s.statement}")
+        if s.status == "refuted" and s.model is not None:
+            lines.append("      counterexample:")
+            lines += [f"        {k} = {v}" for k, v in sorted(s.model.items())]
+        if s.status == "inconclusive" and s.reason:
+            lines.append(f"      solver: {s.reason}")
+    verdict = {"refines": f"yes: {result.b} ({spec_b}) refines {result.a} ({spec_a})",
+               "does not refine": f"no: {result.b} ({spec_b}) does not refine {result.a} ({spec_a})",
+               "inconclusive": "inconclusive: the solver could not decide every side"}[result.verdict]
+    lines.append(f"verdict: {verdict}")
+    return "\n".join(lines) + "\n"
+
+
+def refines_main(spec_a: str, spec_b: str, *, out: TextIO | None = None, err: TextIO | None = None) -> int:
+    """``rclverify refines A.rcl:Node B.rcl:Node``: print whether B refines A.
+
+    Returns the exit code: 0 when B refines A, 1 when it does not or the
+    solver could not decide (the output says which), 2 on a user error
+    (printed as ``file:line:col: error: message``).
+    """
+    out = out or sys.stdout
+    err = err or sys.stderr
+    try:
+        ca, na = load_node(spec_a)
+        cb, nb = load_node(spec_b)
+        env = merge_envs(ca, cb)
+        result = check_refinement(na, nb, env)
+    except RclError as exc:
+        for d in exc.diagnostics:
+            print(d, file=err)
+        return 2
+    out.write(render(result, spec_a, spec_b))
+    return 0 if result.verdict == "refines" else 1
+
+
+__all__ = ["RefinementResult", "SideResult", "check_interface", "check_refinement", "load_node", "merge_envs",
+           "refines_main", "render"]
