@@ -96,6 +96,7 @@ class Plan:
     evidence: Mapping[str, tuple[EvidenceEntry, ...]]
     replacements: Mapping[str, tuple[str, ast.Loc]] = field(default_factory=dict)
     locs: Mapping[Path_, ast.Loc] = field(default_factory=dict)
+    name: str = ""
 
 
 def _schema() -> dict[str, Any]:
@@ -204,7 +205,8 @@ def load_plan(root: Path, plan_rel: str = "contracts/plan.yaml") -> Plan:
                                for i, e in enumerate(spec.get("evidence", [])))
         if "replacement" in spec:
             replacements[node] = (spec["replacement"], loc("nodes", node, "replacement"))
-    return Plan(plan_rel, root, contracts, tuple(reqs), tuple(conns), facts, instances, evidence, replacements, locs)
+    return Plan(plan_rel, root, contracts, tuple(reqs), tuple(conns), facts, instances, evidence, replacements, locs,
+                str(data.get("name", "")))
 
 
 def resolve(plan: Plan, checked: Checked) -> None:

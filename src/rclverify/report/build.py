@@ -75,8 +75,12 @@ def build_report(ws: Workspace) -> dict[str, Any]:
     sc_status = {n: worst([sc["status"] for sc in comps[n].get("side_conditions", [])], empty="discharged")
                  for n in checked.nodes}
 
+    def applies(o: Obligation, node: str, k: int) -> bool:
+        """Obligation ``o`` bears on guarantee ``k`` of ``node`` (guarantee 0: the whole contract)."""
+        return o.node == node and o.guarantee in (k, 0)
+
     def g_status(node: str, k: int) -> str:
-        sts = [ob_status[o.id] for o in obligations if o.node == node and o.guarantee == k]
+        sts = [ob_status[o.id] for o in obligations if applies(o, node, k)]
         s = worst(sts) if sts else "pending"
         for f in health[node]:
             if f["guarantee"] in (None, k) and f["status"] != "ok":
@@ -93,7 +97,7 @@ def build_report(ws: Workspace) -> dict[str, Any]:
                 consumers.setdefault(l.from_var, []).append(f"{l.to_node}.{l.to_var}")
         env_texts = {e["text"] for e in comps[name].get("environment_assumptions", [])}
         guarantees = [{"index": k, "text": expr_to_rcl(g.formula), "source": _src(g.loc), "status": g_status(name, k),
-                       "obligations": sorted(o.id for o in obligations if o.node == name and o.guarantee == k)}
+                       "obligations": sorted(o.id for o in obligations if applies(o, name, k))}
                       for k, g in enumerate(cn.node.guarantees, 1)]
         status = worst([g["status"] for g in guarantees] + [sc_status[name]])
         node_status[name] = status
@@ -115,7 +119,7 @@ def build_report(ws: Workspace) -> dict[str, Any]:
                 g = checked.nodes[s.node].node.guarantees[k - 1]
                 support.append({"node": s.node, "guarantee": k, "text": expr_to_rcl(g.formula), "source": _src(g.loc),
                                 "status": g_status(s.node, k),
-                                "obligations": sorted(o.id for o in obligations if o.node == s.node and o.guarantee == k)})
+                                "obligations": sorted(o.id for o in obligations if applies(o, s.node, k))})
         st = worst([x["status"] for x in support] + [sc_status[x["node"]] for x in support]) if support else "pending"
         requirements.append({"id": r.id, "text": r.text, "status": st, "support": support})
 
@@ -156,7 +160,7 @@ def build_report(ws: Workspace) -> dict[str, Any]:
     system = {"nodes": [{"name": n, "status": node_status[n]} for n in model.nodes], **{
         k: v for k, v in model.to_json().items() if k != "nodes"}}
     return {
-        "meta": {"tool": "rclverify", "version": __version__, "workspace": ws.root.resolve().name, "plan": plan.file,
+        "meta": {"tool": "rclverify", "version": __version__, "workspace": plan.name or ws.root.resolve().name, "plan": plan.file,
                  "contracts": list(plan.contracts), "z3_version": z3.get_version_string(), "strict_ok": strict_ok},
         "summary": {"status": overall, "counts": counts, "headline": headline, "problems": problems},
         "system": system, "requirements": requirements, "nodes": nodes, "side_conditions": side_conditions,
