@@ -82,7 +82,7 @@ def test_dafny_evidence_is_real_or_pending(report: dict) -> None:
 
 def test_html_report_shows_the_problems_first(workspace: Path) -> None:
     html = (workspace / "reports" / "assurance.html").read_text()
-    assert html.index("Guarantee 2 of Agent is vacuous") < html.index("Requirements traceability")
+    assert html.index("Guarantee 2 of Agent is vacuous") < html.index('id="traceability"')
     assert "<svg" in html or "install graphviz" in html
 
 

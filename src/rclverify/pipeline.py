@@ -35,7 +35,9 @@ from .plan.load import Plan, load_plan, resolve
 from .rcl import ast
 from .rcl.lint import lint
 from .rcl.printer import to_rcl
-from .rcl.typecheck import load
+from .rcl.errors import RclError
+from .rcl.parser import parse_text
+from .rcl.typecheck import check
 from .rcl.types import Checked
 from .system.model import SystemModel, build
 
@@ -62,13 +64,17 @@ class Workspace:
 
     @cached_property
     def checked(self) -> Checked:
-        import os
-        cwd = os.getcwd()
-        os.chdir(self.root)  # locations in diagnostics and artifacts stay workspace-relative
-        try:
-            c = load(list(self.plan.contracts))
-        finally:
-            os.chdir(cwd)
+        plan = self.plan
+        specs = []
+        diags = []
+        for rel in plan.contracts:  # parsed under their workspace-relative names
+            try:
+                specs.append(parse_text((self.root / rel).read_text(encoding="utf-8"), rel))
+            except RclError as exc:
+                diags.extend(exc.diagnostics)
+        if diags:
+            raise RclError(diags)
+        c = check(specs)
         resolve(self.plan, c)
         return c
 

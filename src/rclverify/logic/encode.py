@@ -36,6 +36,18 @@ from ..rcl.types import (BOOL, NATURAL, Checked, CheckedNode, DataT, EmptyT, Enu
 from ..rcl.typecheck import domain_type
 
 _SORTS: dict[Type, Any] = {}
+_SORT_NAMES: dict[str, Type] = {}
+
+
+def _sort_name(t: Type, name: str) -> str:
+    """A Z3 sort name for ``t``: its own name unless another type already took it
+    (Z3's datatype names are global to the process)."""
+    k, candidate = 1, name
+    while candidate in _SORT_NAMES and _SORT_NAMES[candidate] != t:
+        k += 1
+        candidate = f"{name}_{k}"
+    _SORT_NAMES[candidate] = t
+    return candidate
 _ENUM_CONSTS: dict[tuple[str, str], z3.ExprRef] = {}
 
 
@@ -59,11 +71,11 @@ def sort_of(t: Type) -> z3.SortRef:
     if isinstance(t, Scalar):
         s = {"REAL": z3.RealSort(), "INTEGER": z3.IntSort(), "NATURAL": z3.IntSort(), "BOOL": z3.BoolSort()}[t.name]
     elif isinstance(t, EnumT):
-        s, consts = z3.EnumSort(t.name, list(t.values))
+        s, consts = z3.EnumSort(_sort_name(t, t.name), list(t.values))
         for v, c in zip(t.values, consts):
             _ENUM_CONSTS[(t.name, v)] = c
     elif isinstance(t, DataT):
-        dt = z3.Datatype(t.name)
+        dt = z3.Datatype(_sort_name(t, t.name))
         for cname, args in t.ctors:
             dt.declare(cname, *[(f"{cname}_{k}", sort_of(a)) for k, a in enumerate(args)])
         s = dt.create()
@@ -442,3 +454,33 @@ def value_to_rcl(v: z3.ExprRef) -> str:
     if z3.is_app(v):
         return v.decl().name()
     return str(v)
+
+
+_OPS = {z3.Z3_OP_AND: " and ", z3.Z3_OP_OR: " or ", z3.Z3_OP_EQ: " == ", z3.Z3_OP_LE: " <= ", z3.Z3_OP_LT: " < ",
+        z3.Z3_OP_GE: " >= ", z3.Z3_OP_GT: " > ", z3.Z3_OP_ADD: " + ", z3.Z3_OP_SUB: " - ", z3.Z3_OP_MUL: " * ",
+        z3.Z3_OP_IMPLIES: " -> ", z3.Z3_OP_DIV: " / "}
+
+
+def term_to_rcl(e: z3.ExprRef) -> str:
+    """Render a (small) Z3 term from a model in RCL notation, e.g. a function
+    table's symbolic ``else`` branch: ``p1 == 2 and p2 == 3``."""
+    if z3.is_int_value(e) or z3.is_rational_value(e) or z3.is_true(e) or z3.is_false(e):
+        return value_to_rcl(e)
+    if not z3.is_app(e):
+        return str(e)
+    k = e.decl().kind()
+    kids = e.children()
+    if k in _OPS and kids:
+        return "(" + _OPS[k].join(term_to_rcl(c) for c in kids) + ")"
+    if k == z3.Z3_OP_NOT:
+        return f"not {term_to_rcl(kids[0])}"
+    if k == z3.Z3_OP_ITE:
+        c, a, b = (term_to_rcl(x) for x in kids)
+        return f"(if {c} then {a} else {b})"
+    if k == z3.Z3_OP_DISTINCT:
+        return "(" + " != ".join(term_to_rcl(c) for c in kids) + ")"
+    if k == z3.Z3_OP_TO_REAL and kids:
+        return term_to_rcl(kids[0])
+    if kids:
+        return f"{e.decl().name()}(" + ", ".join(term_to_rcl(c) for c in kids) + ")"
+    return value_to_rcl(e)

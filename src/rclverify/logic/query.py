@@ -21,7 +21,7 @@ from typing import Any, Sequence
 
 import z3
 
-from .encode import Encoder, value_to_rcl
+from .encode import Encoder, term_to_rcl, value_to_rcl
 
 DEFAULT_TIMEOUT_MS = 10_000
 
@@ -141,6 +141,13 @@ def render_model(model: z3.ModelRef, enc: Encoder | None) -> dict[str, str]:
             args = ", ".join(value_to_rcl(e.arg_value(j)) for j in range(e.num_args()))
             rows.append(f"({args}) -> {value_to_rcl(e.value())}")
         else_v = interp.else_value()
-        rows.append(f"else -> {value_to_rcl(else_v) if else_v is not None else '?'}")
+        params = [z3.Const(f"p{j + 1}", d.domain(j)) for j in range(d.arity())]
+        if else_v is None:
+            rows.append("else -> ?")
+        elif z3.is_app(else_v) and else_v.num_args() == 0 or z3.is_rational_value(else_v) or z3.is_int_value(else_v):
+            rows.append(f"else -> {value_to_rcl(else_v)}")
+        else:
+            body = z3.substitute_vars(else_v, *reversed(params)) if params else else_v
+            rows.append(f"({', '.join(map(str, params))}) -> {term_to_rcl(body)}")
         out[display] = "{" + ", ".join(rows) + "}"
     return out

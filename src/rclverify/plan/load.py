@@ -27,6 +27,8 @@ from ..rcl.types import BOOL, Checked
 from .errors import PlanError, plan_error
 
 Path_ = tuple[Any, ...]
+#: Marker in a location path: ``path + (key, KEY)`` is where the key itself is written.
+KEY = "\0key"
 
 
 @dataclass(frozen=True)
@@ -112,6 +114,7 @@ def _to_py(node: yaml.Node, path: Path_, locs: dict[Path_, ast.Loc], file: str) 
         for k, v in node.value:
             key = yaml.safe_load(yaml.serialize(k)) if not isinstance(k, yaml.ScalarNode) else k.value
             out[key] = _to_py(v, path + (key,), locs, file)
+            locs[path + (key, KEY)] = ast.Loc(file, k.start_mark.line + 1, k.start_mark.column + 1)
         return out
     if isinstance(node, yaml.SequenceNode):
         return [_to_py(v, path + (i,), locs, file) for i, v in enumerate(node.value)]
@@ -143,6 +146,11 @@ def read_plan_data(root: Path, plan_rel: str) -> tuple[dict[str, Any], dict[Path
         diags = []
         for e in errors:
             path = tuple(e.absolute_path)
+            if e.validator == "additionalProperties" and isinstance(e.instance, dict):
+                allowed = set(e.schema.get("properties", {})) if isinstance(e.schema, dict) else set()
+                extra = [k for k in e.instance if k not in allowed]
+                if extra and path + (extra[0], KEY) in locs:
+                    path = path + (extra[0], KEY)
             while path and path not in locs:
                 path = path[:-1]
             loc = locs.get(path, ast.Loc(plan_rel, 1, 1))

@@ -89,6 +89,7 @@ class _Checker:
             for v in t.values:
                 if v in seen:
                     self.err(t.loc, f"enumeration value {v!r} appears twice in {name}", "E-duplicate")
+                    continue
                 seen.add(v)
                 self._claim_value(v, t.loc)
                 self.enum_values[v] = enum
@@ -204,6 +205,12 @@ class _Checker:
             kind = "input" if v.prefix == "in" else "output"
             where = f"node {node.name}" if node else "a context constant"
             pool = list(table)
+            other = "out" if v.prefix == "in" else "in"
+            if node is not None and v.name in (node.outputs if v.prefix == "in" else node.inputs):
+                self.err(v.loc, f"{where} has no {kind} named {v.name!r}, but it has an "
+                                f"{'output' if other == 'out' else 'input'} of that name; did you mean {other}.{v.name}? "
+                                f"(its {kind}s are: {', '.join(pool) or 'none'})", "E-name")
+                raise _Fail
             self.err(v.loc, f"{where} has no {kind} named {v.name!r} (in {v.qualified})"
                      + (_candidates(v.name, pool) if _candidates(v.name, pool) else f"; its {kind}s are: {', '.join(pool) or 'none'}"), "E-name")
             raise _Fail
@@ -332,6 +339,12 @@ class _Checker:
     def domain(self, b: ast.Binding, node: CheckedNode | None, bound: Mapping[str, Type]) -> Type:
         d = b.domain
         if isinstance(d, ast.TName) and d.name not in self.types and d.name not in self.type_decls:
+            known = d.name in bound or d.name in self.constants or (
+                node is not None and (d.name in node.inputs or d.name in node.outputs))
+            if not known:
+                self.err(d.loc, f"unknown type or set {d.name!r}"
+                         + _candidates(d.name, list(self.types) + list(self.type_decls) + list(BASE_NAMES)), "E-name")
+                raise _Fail
             return self.collection(ast.Var(d.name, None, d.loc), node, bound).elem
         if isinstance(d, (ast.TBase, ast.TName, ast.TEnum, ast.TConstructors, ast.TFunc, ast.TEmpty,
                           ast.TSet, ast.TSeq, ast.TTuple)):
@@ -386,7 +399,8 @@ def check(specs: Sequence[ast.Spec]) -> Checked:
             if cn is not None:
                 nodes[n.name] = cn
     if c.diags:
-        raise RclError(sorted(c.diags, key=lambda d: (d.loc.file, d.loc.line, d.loc.col)))
+        unique = list(dict.fromkeys(c.diags))
+        raise RclError(sorted(unique, key=lambda d: (d.loc.file, d.loc.line, d.loc.col)))
     return Checked(c.env, nodes, tuple(specs))
 
 
