@@ -1,0 +1,247 @@
+"""LaTeX rendering of RCL contracts in the style of the paper's tables.
+
+``to_latex(spec)`` renders a whole file: the context clauses and one block
+per node (inputs, outputs, topics, assumptions, guarantees), using the
+notation of the paper's contract tables and appendix A (shared/reference
+lines 1102-1304, 1890-1983): ``\\forall``, ``\\exists``, ``\\exists!``,
+``\\land``, ``\\lor``, ``\\lnot``, ``\\Rightarrow``, ``\\iff``, ``\\in``,
+``\\notin``, ``\\leq``, ``\\geq``, ``\\neq``, ``\\mathbb{R}``/``\\mathbb{Z}``/
+``\\mathbb{N}``/``\\mathbb{B}`` for the base types, ``\\times`` and
+``\\rightarrow`` in function types, ``\\emptyset`` for ``{}``.  ``in.``/``out.``
+prefixes are kept as in the tables, primes stay ``'``, underscores are
+escaped.  The quantifier separator is ``\\bullet`` (as in the tables).
+
+Parentheses follow the RCL precedence table of :mod:`rclverify.rcl.printer`;
+in addition a quantifier, whose scope extends as far right as possible in
+mathematical notation, is parenthesised whenever something follows it.
+
+The document structure comes from the jinja2 template
+``templates/contracts.tex.j2`` of this package.
+"""
+from __future__ import annotations
+
+from functools import lru_cache
+from pathlib import PurePath
+from typing import Union
+
+import jinja2
+
+from . import ast
+from .printer import MINUS_LEVEL, NOT_LEVEL, SUM_LEVEL, clarifying_parens, is_type, level, operand_levels
+
+_TEX_SPECIALS = {
+    "\\": r"\textbackslash{}", "_": r"\_", "{": r"\{", "}": r"\}", "$": r"\$", "&": r"\&",
+    "#": r"\#", "%": r"\%", "^": r"\^{}", "~": r"\~{}",
+}
+_BASE = {"REAL": r"\mathbb{R}", "INTEGER": r"\mathbb{Z}", "NATURAL": r"\mathbb{N}", "BOOL": r"\mathbb{B}"}
+_BINARY = {
+    "<=>": r"\iff", "->": r"\Rightarrow", "or": r"\lor", "and": r"\land",
+    "+": "+", "-": "-", "*": r"\cdot", "/": "/",
+}
+_COMPARE = {"==": "=", "!=": r"\neq", "<": "<", "<=": r"\leq", ">": ">", ">=": r"\geq"}
+_QUANT = {"forall": r"\forall", "exists": r"\exists", "exists_unique": r"\exists!\,"}
+
+
+def escape(text: str) -> str:
+    """``text`` with LaTeX's special characters escaped (``_`` -> ``\\_``)."""
+    return "".join(_TEX_SPECIALS.get(ch, ch) for ch in text)
+
+
+def name_to_latex(name: str) -> str:
+    """A name in math mode: one letter stays as is (``x``), longer names are
+    ``\\mathit{...}``; trailing primes stay ``'`` (``x''``, ``\\mathit{in.at}``)."""
+    base = name.rstrip("'")
+    primes = name[len(base):]
+    if len(base) == 1:
+        return base + primes
+    return r"\mathit{" + escape(base) + "}" + primes
+
+
+def _var(v: ast.Var) -> str:
+    return name_to_latex(v.qualified)
+
+
+def _number(text: str) -> str:
+    low = text.lower()
+    if "e" in low:
+        mantissa, exponent = low.split("e", 1)
+        return f"{mantissa} \\times 10^{{{exponent.lstrip('+')}}}"
+    return text
+
+
+# ---------------------------------------------------------------------------
+# Types
+# ---------------------------------------------------------------------------
+
+def type_to_latex(t: ast.TypeExpr) -> str:
+    """Math-mode LaTeX of a type, e.g. ``\\mathbb{R} \\times \\mathbb{R}
+    \\rightarrow \\mathbb{N}`` for ``REAL x REAL --> NATURAL``.  Raises
+    ``TypeError`` for a value that is not a type."""
+    if isinstance(t, ast.TBase):
+        return _BASE[t.name]
+    if isinstance(t, ast.TName):
+        return name_to_latex(t.name)
+    if isinstance(t, ast.TEnum):
+        return r"\{" + ", ".join(name_to_latex(v) for v in t.values) + r"\}"
+    if isinstance(t, ast.TConstructors):
+        return r"\{" + ", ".join(_ctor(c) for c in t.ctors) + r"\}"
+    if isinstance(t, ast.TFunc):
+        def factor(a: ast.TypeExpr) -> str:
+            s = type_to_latex(a)
+            return f"({s})" if isinstance(a, ast.TFunc) else s
+        return r" \times ".join(factor(a) for a in t.args) + r" \rightarrow " + factor(t.result)
+    if isinstance(t, ast.TEmpty):
+        return r"\emptyset"
+    if isinstance(t, ast.TSet):
+        return r"\mathcal{P}(" + type_to_latex(t.elem) + ")"
+    if isinstance(t, ast.TSeq):
+        return r"\mathrm{seq}(" + type_to_latex(t.elem) + ")"
+    if isinstance(t, ast.TTuple):
+        return "(" + ", ".join(type_to_latex(e) for e in t.elems) + ")"
+    raise TypeError(f"not an RCL type: {t!r}")
+
+
+def _ctor(c: ast.Constructor) -> str:
+    if not c.args:
+        return name_to_latex(c.name)
+    return name_to_latex(c.name) + "(" + ", ".join(type_to_latex(a) for a in c.args) + ")"
+
+
+# ---------------------------------------------------------------------------
+# Expressions
+# ---------------------------------------------------------------------------
+
+def expr_to_latex(e: ast.Expr, explicit: bool = False) -> str:
+    """Math-mode LaTeX of a formula or term (no surrounding ``$``).
+
+    ``explicit=True`` also parenthesises an ``and``/``or`` operand of
+    ``->``/``<=>``.  Raises ``TypeError`` for a value that is not an
+    expression."""
+    return _Tex(explicit).expr(e, 0, True)
+
+
+class _Tex:
+    def __init__(self, explicit: bool) -> None:
+        self.explicit = explicit
+
+    def expr(self, e: ast.Expr, min_level: int, open_right: bool, force: bool = False) -> str:
+        """``open_right``: nothing follows ``e`` inside its enclosing
+        delimiters, so a quantifier there needs no parentheses."""
+        wrap = force or level(e) < min_level
+        s = self.bare(e, True if wrap else open_right)
+        return f"({s})" if wrap else s
+
+    def items(self, items: tuple[ast.Expr, ...]) -> str:
+        return ", ".join(self.expr(i, 0, True) for i in items)
+
+    def bare(self, e: ast.Expr, open_right: bool) -> str:
+        if isinstance(e, ast.Var):
+            return _var(e)
+        if isinstance(e, ast.BoolLit):
+            return r"\mathit{TRUE}" if e.value else r"\mathit{FALSE}"
+        if isinstance(e, ast.NumLit):
+            return _number(e.text)
+        if isinstance(e, ast.Apply):
+            return f"{_var(e.func)}({self.items(e.args)})"
+        if isinstance(e, ast.Unary):
+            if e.op == "not":
+                return r"\lnot " + self.expr(e.operand, NOT_LEVEL, open_right)
+            return "-" + self.expr(e.operand, MINUS_LEVEL, open_right)
+        if isinstance(e, ast.Binary):
+            lmin, rmin = operand_levels(e)
+            lf = self.explicit and clarifying_parens(e, e.left)
+            rf = self.explicit and clarifying_parens(e, e.right)
+            left = self.expr(e.left, lmin, False, lf)
+            right = self.expr(e.right, rmin, open_right, rf)
+            return f"{left} {_BINARY[e.op]} {right}"
+        if isinstance(e, ast.Compare):
+            last = len(e.operands) - 1
+            parts = [self.expr(e.operands[0], SUM_LEVEL, False)]
+            for k, (op, operand) in enumerate(zip(e.ops, e.operands[1:]), 1):
+                parts += [_COMPARE[op], self.expr(operand, SUM_LEVEL, open_right and k == last)]
+            return " ".join(parts)
+        if isinstance(e, ast.Member):
+            kw = r"\notin" if e.negated else r"\in"
+            return (f"{self.expr(e.elem, SUM_LEVEL, False)} {kw} "
+                    f"{self.expr(e.collection, SUM_LEVEL, open_right)}")
+        if isinstance(e, ast.SetLit):
+            return r"\{" + self.items(e.items) + r"\}" if e.items else r"\emptyset"
+        if isinstance(e, ast.SeqLit):
+            return r"\langle " + self.items(e.items) + r" \rangle"
+        if isinstance(e, ast.TupleLit):
+            return "(" + self.items(e.items) + ")"
+        if isinstance(e, ast.Quant):
+            binds = ", ".join(self.binding(b) for b in e.bindings)
+            s = f"{_QUANT[e.kind]} {binds} \\bullet {self.expr(e.body, 0, True)}"
+            return s if open_right else f"({s})"
+        raise TypeError(f"not an RCL expression: {e!r}")
+
+    def binding(self, b: ast.Binding) -> str:
+        d = b.domain
+        dom = type_to_latex(d) if is_type(d) else self.expr(d, SUM_LEVEL, False)  # type: ignore[arg-type]
+        return ", ".join(name_to_latex(n) for n in b.names) + r" \in " + dom
+
+
+# ---------------------------------------------------------------------------
+# Document
+# ---------------------------------------------------------------------------
+
+@lru_cache(maxsize=1)
+def _env() -> jinja2.Environment:
+    return jinja2.Environment(
+        loader=jinja2.PackageLoader("rclverify.rcl", "templates"),
+        undefined=jinja2.StrictUndefined, autoescape=False, keep_trailing_newline=True,
+        trim_blocks=True, lstrip_blocks=True,
+        block_start_string="<%", block_end_string="%>",
+        variable_start_string="<<", variable_end_string=">>",
+        comment_start_string="<#", comment_end_string="#>",
+    )
+
+
+def _source_name(file: str) -> str:
+    """The file as the user gave it, or only its name when absolute (no
+    machine paths inside generated artifacts)."""
+    p = PurePath(file)
+    return p.name if p.is_absolute() else p.as_posix()
+
+
+def _io(vs: tuple[ast.IOVar, ...]) -> str:
+    return "(" + ", ".join(f"{name_to_latex(v.name)} : {type_to_latex(v.type)}" for v in vs) + ")"
+
+
+def _topic(t: ast.Topic) -> str:
+    s = r"\texttt{" + escape(t.msg_type) + r"}~\texttt{" + escape(t.field) + "}"
+    if t.match is not None:
+        s += r" matches: $" + _var(t.match) + "$"
+    return s
+
+
+def _decl(d: Union[ast.TypeDecl, ast.ConstDecl], explicit: bool) -> dict[str, str]:
+    if isinstance(d, ast.TypeDecl):
+        return {"name": name_to_latex(d.name), "sep": ":", "body": type_to_latex(d.type), "line": str(d.loc.line)}
+    typed = f" : {type_to_latex(d.type)}" if d.type is not None else ""
+    return {"name": name_to_latex(d.name) + typed, "sep": "=",
+            "body": expr_to_latex(d.value, explicit), "line": str(d.loc.line)}
+
+
+def to_latex(spec: ast.Spec, document: bool = True, explicit: bool = False) -> str:
+    """LaTeX of a parsed RCL file, paper style.
+
+    ``document=True`` gives a complete ``article`` (packages amssymb and
+    tabularx); ``False`` only the blocks, for inclusion in another document.
+    ``explicit``: see :func:`expr_to_latex`.  The first line is a comment
+    naming the source file and "generated by rclverify"; the output holds no
+    timestamps and no absolute paths."""
+    source = _source_name(spec.file)
+    contexts = [[_decl(d, explicit) for d in c.decls] for c in spec.contexts]
+    nodes = [{
+        "name": escape(n.name),
+        "line": n.loc.line,
+        "inputs": _io(n.inputs),
+        "outputs": _io(n.outputs),
+        "topics": [_topic(t) for t in n.topics],
+        "assumes": [expr_to_latex(c.formula, explicit) for c in n.assumes],
+        "guarantees": [expr_to_latex(c.formula, explicit) for c in n.guarantees],
+    } for n in spec.nodes]
+    return _env().get_template("contracts.tex.j2").render(
+        source=source, source_tex=escape(source), document=document, contexts=contexts, nodes=nodes)

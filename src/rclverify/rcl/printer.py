@@ -1,0 +1,256 @@
+"""Pretty-printer from the RCL AST back to RCL text.
+
+``to_rcl(spec)`` prints a whole file, ``expr_to_rcl(e)`` one formula or
+term, ``type_to_rcl(t)`` one type.  Parentheses are written only where the
+fixed precedence of RCL requires them, so that
+
+    parse_text(to_rcl(parse_text(src))) == parse_text(src)
+
+for every file (AST equality ignores locations and the ``parenthesised``
+flag).  Precedence, loosest first (the grammar in ``rcl.lark``, written from
+the paper's EBNF table and listings, shared/reference lines 499-555 and
+1131-1171):
+
+====  ======================================  =============
+level operators                               associativity
+====  ======================================  =============
+1     ``<=>``                                 left
+2     ``->``                                  right
+3     ``or``                                  left
+4     ``and``                                 left
+5     ``not``                                 prefix
+6     comparisons ``== != < <= > >=``,        chained /
+      membership ``in !in``                   none
+7     ``+ -``                                 left
+8     ``* /``                                 left
+9     unary ``-``                             prefix
+10    atoms: names, literals, applications,
+      quantifiers, set/sequence/tuple literals
+====  ======================================  =============
+
+The level table is shared with :mod:`rclverify.rcl.latex` through
+:func:`level` and :func:`operand_levels`.
+"""
+from __future__ import annotations
+
+from typing import Union
+
+from . import ast
+
+#: Precedence level of each binary operator (higher binds tighter).
+BINARY_LEVEL: dict[str, int] = {
+    "<=>": 1, "->": 2, "or": 3, "and": 4, "+": 7, "-": 7, "*": 8, "/": 8,
+}
+NOT_LEVEL = 5
+COMPARE_LEVEL = 6
+SUM_LEVEL = 7
+MINUS_LEVEL = 9
+ATOM_LEVEL = 10
+#: Right-associative binary operators.
+RIGHT_ASSOC = frozenset({"->"})
+
+
+def level(e: ast.Expr) -> int:
+    """The precedence level (1 = loosest, 10 = atom) of the operator at the
+    root of ``e``; see the module table."""
+    if isinstance(e, ast.Binary):
+        return BINARY_LEVEL[e.op]
+    if isinstance(e, ast.Unary):
+        return NOT_LEVEL if e.op == "not" else MINUS_LEVEL
+    if isinstance(e, (ast.Compare, ast.Member)):
+        return COMPARE_LEVEL
+    return ATOM_LEVEL
+
+
+def operand_levels(e: ast.Binary) -> tuple[int, int]:
+    """Minimum levels the (left, right) operands of ``e`` must have to be
+    printed without parentheses; an operand below its minimum is wrapped."""
+    lv = BINARY_LEVEL[e.op]
+    if e.op in RIGHT_ASSOC:
+        return lv + 1, lv
+    return lv, lv + 1
+
+
+# ---------------------------------------------------------------------------
+# Types
+# ---------------------------------------------------------------------------
+
+def _type_atom(t: ast.TypeExpr) -> str:
+    """A type in a position that admits only a type atom (function factors)."""
+    s = type_to_rcl(t)
+    return f"({s})" if isinstance(t, ast.TFunc) else s
+
+
+def type_to_rcl(t: ast.TypeExpr) -> str:
+    """RCL text of a type: ``REAL``, ``RadStat``, ``{red, orange, green}``,
+    ``{move(REAL, REAL), inspect(NATURAL)}``, ``REAL x REAL --> BOOL``, ``{}``,
+    ``set(T)``, ``seq(T)``, ``(T1, T2)``.  Raises ``TypeError`` for a value
+    that is not a type."""
+    if isinstance(t, (ast.TBase, ast.TName)):
+        return t.name
+    if isinstance(t, ast.TEnum):
+        return "{" + ", ".join(t.values) + "}"
+    if isinstance(t, ast.TConstructors):
+        return "{" + ", ".join(_ctor(c) for c in t.ctors) + "}"
+    if isinstance(t, ast.TFunc):
+        return " x ".join(_type_atom(a) for a in t.args) + " --> " + _type_atom(t.result)
+    if isinstance(t, ast.TEmpty):
+        return "{}"
+    if isinstance(t, ast.TSet):
+        return f"set({type_to_rcl(t.elem)})"
+    if isinstance(t, ast.TSeq):
+        return f"seq({type_to_rcl(t.elem)})"
+    if isinstance(t, ast.TTuple):
+        return "(" + ", ".join(type_to_rcl(e) for e in t.elems) + ")"
+    raise TypeError(f"not an RCL type: {t!r}")
+
+
+def _ctor(c: ast.Constructor) -> str:
+    if not c.args:
+        return c.name
+    return f"{c.name}(" + ", ".join(type_to_rcl(a) for a in c.args) + ")"
+
+
+# ---------------------------------------------------------------------------
+# Expressions
+# ---------------------------------------------------------------------------
+
+_TYPE_CLASSES = (ast.TBase, ast.TName, ast.TEnum, ast.TConstructors, ast.TFunc, ast.TEmpty,
+                 ast.TSet, ast.TSeq, ast.TTuple)
+
+
+def is_type(d: object) -> bool:
+    """Whether ``d`` is a type (a quantifier domain is a type or a term)."""
+    return isinstance(d, _TYPE_CLASSES)
+
+
+def clarifying_parens(e: ast.Binary, operand: ast.Expr) -> bool:
+    """Whether ``operand`` of ``e`` is an ``and``/``or`` directly under
+    ``->``/``<=>``: parentheses there are not required by precedence but
+    state the reading explicitly (the case the lint rule
+    ``W-implication-precedence`` warns about)."""
+    return e.op in ("->", "<=>") and isinstance(operand, ast.Binary) and operand.op in ("and", "or")
+
+
+def expr_to_rcl(e: ast.Expr, explicit: bool = False) -> str:
+    """RCL text of a formula or term, parenthesised only where the
+    precedence table requires.  With ``explicit=True`` an ``and``/``or``
+    operand of ``->``/``<=>`` is parenthesised too (same AST, lint-clean
+    text).  Quantifiers print as ``forall(x, y in REAL | body)``
+    (``exists_unique`` for the unique existential).  Raises ``TypeError``
+    for a value that is not an expression."""
+    return _Printer(explicit).expr(e)
+
+
+def binding_to_rcl(b: ast.Binding, explicit: bool = False) -> str:
+    """``x', y' in REAL``: one binding of a quantifier."""
+    return _Printer(explicit).binding(b)
+
+
+class _Printer:
+    def __init__(self, explicit: bool) -> None:
+        self.explicit = explicit
+
+    def wrap(self, e: ast.Expr, min_level: int, force: bool = False) -> str:
+        s = self.expr(e)
+        return f"({s})" if force or level(e) < min_level else s
+
+    def items(self, items: tuple[ast.Expr, ...]) -> str:
+        return ", ".join(self.expr(i) for i in items)
+
+    def binding(self, b: ast.Binding) -> str:
+        d = b.domain
+        dom = type_to_rcl(d) if is_type(d) else self.wrap(d, SUM_LEVEL)  # type: ignore[arg-type]
+        return ", ".join(b.names) + " in " + dom
+
+    def expr(self, e: ast.Expr) -> str:
+        return _expr(self, e)
+
+
+def _expr(p: _Printer, e: ast.Expr) -> str:
+    if isinstance(e, ast.Var):
+        return e.qualified
+    if isinstance(e, ast.BoolLit):
+        return "TRUE" if e.value else "FALSE"
+    if isinstance(e, ast.NumLit):
+        return e.text
+    if isinstance(e, ast.Apply):
+        return f"{e.func.qualified}({p.items(e.args)})"
+    if isinstance(e, ast.Unary):
+        if e.op == "not":
+            return "not " + p.wrap(e.operand, NOT_LEVEL)
+        inner = p.wrap(e.operand, MINUS_LEVEL)
+        return "-" + inner if not inner.startswith("-") else "- " + inner
+    if isinstance(e, ast.Binary):
+        lmin, rmin = operand_levels(e)
+        lf = p.explicit and clarifying_parens(e, e.left)
+        rf = p.explicit and clarifying_parens(e, e.right)
+        return f"{p.wrap(e.left, lmin, lf)} {e.op} {p.wrap(e.right, rmin, rf)}"
+    if isinstance(e, ast.Compare):
+        parts = [p.wrap(e.operands[0], SUM_LEVEL)]
+        for op, operand in zip(e.ops, e.operands[1:]):
+            parts += [op, p.wrap(operand, SUM_LEVEL)]
+        return " ".join(parts)
+    if isinstance(e, ast.Member):
+        kw = "!in" if e.negated else "in"
+        return f"{p.wrap(e.elem, SUM_LEVEL)} {kw} {p.wrap(e.collection, SUM_LEVEL)}"
+    if isinstance(e, ast.SetLit):
+        return "{" + p.items(e.items) + "}"
+    if isinstance(e, ast.SeqLit):
+        return "[" + p.items(e.items) + "]"
+    if isinstance(e, ast.TupleLit):
+        return "(" + p.items(e.items) + ")"
+    if isinstance(e, ast.Quant):
+        binds = ", ".join(p.binding(b) for b in e.bindings)
+        return f"{e.kind}({binds} | {p.expr(e.body)})"
+    raise TypeError(f"not an RCL expression: {e!r}")
+
+
+# ---------------------------------------------------------------------------
+# Declarations
+# ---------------------------------------------------------------------------
+
+def _decl(d: Union[ast.TypeDecl, ast.ConstDecl], explicit: bool) -> str:
+    if isinstance(d, ast.TypeDecl):
+        return f"{d.name} : {type_to_rcl(d.type)} ;"
+    typed = f" : {type_to_rcl(d.type)}" if d.type is not None else ""
+    return f"{d.name}{typed} = {expr_to_rcl(d.value, explicit)} ;"
+
+
+def context_to_rcl(c: ast.Context, explicit: bool = False) -> str:
+    """``context { ... }`` with one declaration per line."""
+    body = "".join(f"  {_decl(d, explicit)}\n" for d in c.decls)
+    return "context {\n" + body + "}\n"
+
+
+def _topic(t: ast.Topic) -> str:
+    match = f" matches({t.match.qualified})" if t.match is not None else ""
+    return f"{t.msg_type} {t.field}{match}"
+
+
+def _io(vs: tuple[ast.IOVar, ...]) -> str:
+    return ", ".join(f"{v.name} : {type_to_rcl(v.type)}" for v in vs)
+
+
+def node_to_rcl(n: ast.Node, explicit: bool = False) -> str:
+    """``node Name { inputs(...) outputs(...) topics(...) assume(...)* guarantee(...)* }``.
+
+    Assumptions are printed before guarantees (the AST keeps them apart);
+    ``topics(...)`` is omitted when the node has none."""
+    lines = [f"node {n.name} {{", f"  inputs( {_io(n.inputs)} )", f"  outputs( {_io(n.outputs)} )"]
+    if n.topics:
+        sep = ",\n          "
+        lines.append(f"  topics( {sep.join(_topic(t) for t in n.topics)} )")
+    lines += [f"  assume( {expr_to_rcl(c.formula, explicit)} )" for c in n.assumes]
+    lines += [f"  guarantee( {expr_to_rcl(c.formula, explicit)} )" for c in n.guarantees]
+    return "\n".join(lines) + "\n}\n"
+
+
+def to_rcl(spec: ast.Spec, explicit: bool = False) -> str:
+    """RCL text of a whole file: its context clauses, then its nodes,
+    separated by blank lines.  Comments and layout of the source are not
+    kept; everything the AST holds is.  ``explicit``: see
+    :func:`expr_to_rcl`."""
+    parts = [context_to_rcl(c, explicit) for c in spec.contexts]
+    parts += [node_to_rcl(n, explicit) for n in spec.nodes]
+    return "\n".join(parts)
