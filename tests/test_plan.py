@@ -221,8 +221,6 @@ def test_fact_syntax_error_in_an_unquoted_scalar(tmp_path: Path) -> None:
     assert d.code == "E-syntax" and at(d) == where(text, "* 3")
 
 
-@pytest.mark.xfail(strict=True, reason="facts written as YAML block scalars (>- or |) are located from the "
-                                       "block indicator: line off by one and the indentation not added")
 def test_fact_syntax_error_in_a_block_scalar(tmp_path: Path) -> None:
     text = BASE.replace('    - "in.r <= 1000"', "    - >-\n      in.r <=\n        )")
     (d,) = load_errors(tmp_path, text)

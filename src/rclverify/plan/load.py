@@ -105,19 +105,30 @@ def _schema() -> dict[str, Any]:
     return json.loads(resources.files("rclverify.plan").joinpath("plan.schema.json").read_text(encoding="utf-8"))  # type: ignore[no-any-return]
 
 
-def _to_py(node: yaml.Node, path: Path_, locs: dict[Path_, ast.Loc], file: str) -> Any:
+#: Block scalars (``|``/``>``) by value path: (first content line, the content's
+#: source lines with their indentation), so a formula in one is parsed from its
+#: source text and every diagnostic maps exactly onto the plan file.
+Blocks = dict[Path_, tuple[int, str]]
+
+
+def _to_py(node: yaml.Node, path: Path_, locs: dict[Path_, ast.Loc], file: str, lines: list[str],
+           blocks: Blocks) -> Any:
     mark = node.start_mark
     quoted = isinstance(node, yaml.ScalarNode) and node.style in ("'", '"')
     locs[path] = ast.Loc(file, mark.line + 1, mark.column + 1 + (1 if quoted else 0))
+    if isinstance(node, yaml.ScalarNode) and node.style in ("|", ">"):
+        first, last = mark.line + 1, node.end_mark.line
+        raw = lines[first:last + 1] if node.end_mark.column else lines[first:last]
+        blocks[path] = (first + 1, "\n".join(raw))
     if isinstance(node, yaml.MappingNode):
         out: dict[Any, Any] = {}
         for k, v in node.value:
             key = yaml.safe_load(yaml.serialize(k)) if not isinstance(k, yaml.ScalarNode) else k.value
-            out[key] = _to_py(v, path + (key,), locs, file)
+            out[key] = _to_py(v, path + (key,), locs, file, lines, blocks)
             locs[path + (key, KEY)] = ast.Loc(file, k.start_mark.line + 1, k.start_mark.column + 1)
         return out
     if isinstance(node, yaml.SequenceNode):
-        return [_to_py(v, path + (i,), locs, file) for i, v in enumerate(node.value)]
+        return [_to_py(v, path + (i,), locs, file, lines, blocks) for i, v in enumerate(node.value)]
     return yaml.safe_load(yaml.serialize(node))
 
 
@@ -126,6 +137,11 @@ def read_plan_data(root: Path, plan_rel: str) -> tuple[dict[str, Any], dict[Path
 
     Raises :class:`PlanError` on a missing file, bad YAML or a schema violation.
     """
+    data, locs, _ = _read_plan_source(root, plan_rel)
+    return data, locs
+
+
+def _read_plan_source(root: Path, plan_rel: str) -> tuple[dict[str, Any], dict[Path_, ast.Loc], Blocks]:
     p = root / plan_rel
     try:
         text = p.read_text(encoding="utf-8")
@@ -138,7 +154,8 @@ def read_plan_data(root: Path, plan_rel: str) -> tuple[dict[str, Any], dict[Path
         line, col = (mark.line + 1, mark.column + 1) if mark else (1, 1)
         raise plan_error(plan_rel, line, col, f"invalid YAML: {getattr(exc, 'problem', exc)}", "E-yaml") from None
     locs: dict[Path_, ast.Loc] = {}
-    data = _to_py(node, (), locs, plan_rel) if node is not None else None
+    blocks: Blocks = {}
+    data = _to_py(node, (), locs, plan_rel, text.splitlines(), blocks) if node is not None else None
     if not isinstance(data, dict):
         raise plan_error(plan_rel, 1, 1, "the verification plan must be a mapping with a 'contracts' list")
     errors = sorted(jsonschema.Draft202012Validator(_schema()).iter_errors(data), key=lambda e: list(map(str, e.absolute_path)))
@@ -157,7 +174,7 @@ def read_plan_data(root: Path, plan_rel: str) -> tuple[dict[str, Any], dict[Path
             where = ".".join(map(str, e.absolute_path)) or "plan"
             diags.extend(plan_error(loc.file, loc.line, loc.col, f"{where}: {e.message}").diagnostics)
         raise PlanError(diags)
-    return data, locs
+    return data, locs, blocks
 
 
 def load_plan(root: Path, plan_rel: str = "contracts/plan.yaml") -> Plan:
@@ -166,7 +183,7 @@ def load_plan(root: Path, plan_rel: str = "contracts/plan.yaml") -> Plan:
     Raises :class:`PlanError`.  Call :func:`resolve` once the contracts are
     checked to validate the references into them.
     """
-    data, locs = read_plan_data(root, plan_rel)
+    data, locs, blocks = _read_plan_source(root, plan_rel)
 
     def loc(*path: Any) -> ast.Loc:
         return locs.get(tuple(path), ast.Loc(plan_rel, 1, 1))
@@ -197,8 +214,13 @@ def load_plan(root: Path, plan_rel: str = "contracts/plan.yaml") -> Plan:
         out = []
         for i, text in enumerate(spec.get("facts", [])):
             l = loc(*base, i)
+            block = blocks.get(tuple(base) + (i,))
             try:
-                expr = parse_formula(text, plan_rel, l.line, l.col)
+                if block is not None:
+                    expr = parse_formula(block[1], plan_rel, block[0], 1)
+                    l = ast.Loc(plan_rel, block[0], len(block[1]) - len(block[1].lstrip()) + 1)
+                else:
+                    expr = parse_formula(text, plan_rel, l.line, l.col)
             except RclError as exc:
                 raise PlanError(exc.diagnostics) from None
             out.append(Fact(node, text, expr, l))
