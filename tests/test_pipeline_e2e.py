@@ -114,3 +114,31 @@ def test_bad_rcl_gives_located_error_and_keeps_evidence(workspace: Path) -> None
         assert after == before
     finally:
         rcl.write_text(original)
+
+
+def test_staleness_follows_the_inputs_of_each_obligation(workspace: Path) -> None:
+    plan = workspace / "contracts" / "plan.yaml"
+    program = workspace / "backends" / "hoare" / "radiation_sensor.imp"
+    plan_text, program_text = plan.read_text(), program.read_text()
+    try:
+        # a change that concerns no node's evidence keeps every record fresh
+        plan.write_text(plan_text.replace("Each waypoint only needs", "Each waypoint needs"))
+        assert _doit(workspace, "verify").returncode == 0
+        report = json.loads((workspace / "reports" / "assurance.json").read_text())
+        assert not [e for e in report["evidence"] if e["status"] == "stale"]
+        # a changed backend input makes its evidence stale until it is re-run
+        program.write_text(program_text + "\n// reviewed\n")
+        r = subprocess.run([sys.executable, "-m", "rclverify.cli", "report", "-w", str(workspace)],
+                           capture_output=True, text=True, timeout=300)
+        assert r.returncode == 0, r.stderr
+        report = json.loads((workspace / "reports" / "assurance.json").read_text())
+        stale = {e["obligation"] for e in report["evidence"] if e["status"] == "stale"}
+        assert stale and all(".hoare.radiation_sensor.c" in s for s in stale)
+        r = _doit(workspace, "verify")
+        assert ".  evidence:RadiationSensor.0-hoare" in r.stdout
+        assert ".  evidence:RadiationSensor.1-hoare" not in r.stdout
+        report = json.loads((workspace / "reports" / "assurance.json").read_text())
+        assert not [e for e in report["evidence"] if e["status"] == "stale"]
+    finally:
+        plan.write_text(plan_text)
+        program.write_text(program_text)

@@ -172,10 +172,16 @@ def stage_health(ws: Workspace, node: str) -> list[dict[str, Any]]:
 def stage_export(ws: Workspace, node: str) -> list[dict[str, Any]]:
     """Export ``node``'s obligations for every evidence entry of the plan."""
     obligations = []
+    shared = set(ws.plan.contracts) | {ws.plan.file}
+    snapshot = ws.snapshot(node)
     for entry in ws.plan.evidence.get(node, ()):
         backend = get_backend(entry.backend)
         for o in backend.export(ws.target(node, entry.index)):
-            obligations.append(dataclasses.replace(o, data={**o.data, "entry": entry.index}))
+            # Evidence about a node depends on that node's contract, the shared
+            # context and its plan entries -- exactly its snapshot -- not on the
+            # whole contract and plan files, which other nodes share.
+            inputs = tuple(sorted({snapshot, *(i for i in o.inputs if i not in shared)}))
+            obligations.append(dataclasses.replace(o, inputs=inputs, data={**o.data, "entry": entry.index}))
     write_obligations(ws.path(ws.obligations(node)), obligations)
     return [o.to_json() for o in obligations]
 
@@ -196,7 +202,10 @@ def stage_run(ws: Workspace, node: str, index: int) -> list[Evidence]:
         ev = backend.run(o, target)
         store.put(ev)
         out.append(ev)
-    write_json(ws.path(ws.entry_done(node, index)), sorted(e.obligation for e in out))
+    # The report depends on this record: it changes whenever any evidence is re-produced.
+    write_json(ws.path(ws.entry_done(node, index)),
+               [{"obligation": e.obligation, "status": e.status, "started": e.started}
+                for e in sorted(out, key=lambda e: e.obligation)])
     return out
 
 

@@ -141,7 +141,8 @@ def _inputs(config: Any, root: Path) -> list[str]:
 
 
 def _tool_fingerprint() -> dict[str, Any]:
-    return {"dafny": shutil.which("dafny"), "mcapl": os.environ.get("MCAPL_HOME") or os.environ.get("AJPF_HOME"),
+    from . import __version__
+    return {"rclverify": __version__, "dafny": shutil.which("dafny"), "mcapl": os.environ.get("MCAPL_HOME") or os.environ.get("AJPF_HOME"),
             "dot": shutil.which("dot")}
 
 
