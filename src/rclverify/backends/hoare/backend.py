@@ -231,8 +231,9 @@ class HoareBackend:
             details["failed_vc"] = res.failed.vc.id
             if res.notes:
                 details["notes"] = list(res.notes)
-            return evidence("failed", f"Z3 refuted {res.failed.vc.id} ({res.failed.vc.label}) for "
-                            f"{p.config.program}: {_cex_text(res.counterexample or {})}", log=log,
+            return evidence("failed", f"{p.config.program} does not meet the triple: the postcondition "
+                            f"{details['triple']['post']} fails on this run (verification condition "
+                            f"{res.failed.vc.id}: {res.failed.vc.label}): {_cex_text(res.counterexample or {})}", log=log,
                             artifacts=tuple(artifacts), counterexample=res.counterexample, details=details)
         reasons = sorted({r.reason for r in res.results if r.status == "unknown"})
         return evidence("inconclusive", f"Z3 answered unknown ({', '.join(reasons) or 'no reason given'}) "
