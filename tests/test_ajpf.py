@@ -8,7 +8,7 @@ from pathlib import Path
 from typing import Iterator
 
 import pytest
-import yaml
+from rclverify.pipeline import Workspace
 
 from rclverify.backends.ajpf import AjpfBackend, psl
 from rclverify.backends.ajpf.instantiate import Translator
@@ -19,7 +19,6 @@ from rclverify.evidence.records import Obligation
 from rclverify.evidence.store import EvidenceStore
 from rclverify.plan.errors import PlanError
 from rclverify.rcl.parser import parse_formula
-from rclverify.rcl.typecheck import load
 
 REPO = Path(__file__).resolve().parents[1]
 
@@ -75,11 +74,7 @@ def make_target(root: Path, rows: str = ROWS_YAML, monkeypatch: pytest.MonkeyPat
     shutil.copy(REPO / "backends" / "ajpf" / "jackal.gwen", root / "backends" / "ajpf" / "jackal.gwen")
     plan_text = PLAN_TEMPLATE.format(rows=rows)
     (root / "contracts" / "plan.yaml").write_text(plan_text, encoding="utf-8")
-    entry = yaml.safe_load(plan_text)["nodes"]["Agent"]["evidence"][0]
-    checked = load([root / "contracts" / "remote_inspection.rcl"])
-    return NodeTarget(root=root, checked=checked, node=checked.nodes["Agent"], config=entry,
-                      contract_files=("contracts/remote_inspection.rcl",), plan_file="contracts/plan.yaml",
-                      artifacts=root / "artifacts" / "ajpf" / "Agent")
+    return Workspace(root).target("Agent", 0)  # as the pipeline builds it, with the plan's locations
 
 
 @pytest.fixture

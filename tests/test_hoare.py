@@ -8,7 +8,6 @@ from pathlib import Path
 from typing import Any
 
 import pytest
-import yaml
 import z3
 
 from rclverify.backends.base import NodeTarget
@@ -428,3 +427,22 @@ def test_premise_over_an_output_moves_to_the_postcondition(workspace: Path, prog
     if refuted:
         cex = second.counterexample
         assert 20 <= cex["radiation_at(i)"] < cex["k"] <= 250 and cex["output (final)"] == "red"
+
+
+def test_bad_binding_is_located_at_its_key_in_the_plan(tmp_path: Path) -> None:
+    import shutil
+    from rclverify.pipeline import Workspace
+    from rclverify.plan.errors import PlanError
+    for item in ("contracts", "backends"):
+        shutil.copytree(REPO / item, tmp_path / item)
+    plan = tmp_path / "contracts" / "plan.yaml"
+    text = plan.read_text().replace("in.r: radiation_at(i)", "in.rr: radiation_at(i)", 1)
+    plan.write_text(text)
+    ws = Workspace(tmp_path)
+    index = next(e.index for e in ws.plan.evidence["RadiationSensor"] if e.backend == "hoare")
+    with pytest.raises(PlanError) as exc:
+        HoareBackend().export(ws.target("RadiationSensor", index))
+    d = exc.value.diagnostics[0]
+    line = text.splitlines()[d.loc.line - 1]
+    assert d.loc.file == "contracts/plan.yaml" and line[d.loc.col - 1:].startswith("in.rr:")
+    assert "in.rr is not an input of RadiationSensor" in d.message

@@ -115,7 +115,8 @@ class Workspace:
         return NodeTarget(
             root=self.root.resolve(), checked=self.checked, node=self.checked.nodes[node], config=entry.config,
             facts=tuple(f.expr for f in self.plan.facts.get(node, ())), contract_files=self.plan.contracts,
-            plan_file=self.plan.file, artifacts=(self.root / "artifacts" / entry.backend / node).resolve(), index=index)
+            plan_file=self.plan.file, artifacts=(self.root / "artifacts" / entry.backend / node).resolve(), index=index,
+            plan_locs=self.plan.locs)
 
 
 def stage_check(ws: Workspace) -> dict[str, Any]:

@@ -25,6 +25,8 @@ from pathlib import Path
 from typing import Any, Mapping, Protocol
 
 from ..evidence.records import Evidence, Obligation, hash_inputs
+from ..plan.errors import PlanError, plan_error
+from ..plan.load import KEY
 from ..rcl import ast
 from ..rcl.types import Checked, CheckedNode
 
@@ -45,7 +47,8 @@ class NodeTarget:
     ``artifacts``       absolute directory ``artifacts/<backend>/<node>/``
                         where the backend renders its files;
     ``index``           position of this entry among the node's evidence
-                        entries (distinguishes two entries of one backend).
+                        entries (distinguishes two entries of one backend);
+    ``plan_locs``       the plan's value locations (see :meth:`config_loc`).
     """
 
     root: Path
@@ -57,6 +60,29 @@ class NodeTarget:
     plan_file: str = "contracts/plan.yaml"
     artifacts: Path = field(default_factory=Path)
     index: int = 0
+    plan_locs: Mapping[tuple[Any, ...], ast.Loc] = field(default_factory=dict)
+
+    def config_loc(self, *path: Any, key: bool = False) -> ast.Loc:
+        """Where ``nodes.<Node>.evidence[index].<path...>`` is written in the plan.
+
+        ``key=True`` gives the position of the last key itself rather than its
+        value.  Falls back to the deepest part of the path the plan has, then
+        to the plan's first line.
+        """
+        full = ("nodes", self.node.name, "evidence", self.index) + tuple(path)
+        if key and full + (KEY,) in self.plan_locs:
+            return self.plan_locs[full + (KEY,)]
+        while full:
+            if full in self.plan_locs:
+                return self.plan_locs[full]
+            full = full[:-1]
+        return ast.Loc(self.plan_file, 1, 1)
+
+    def config_error(self, message: str, *path: Any, key: bool = False, code: str = "E-plan",
+                     col_offset: int = 0) -> PlanError:
+        """A :class:`PlanError` located at :meth:`config_loc` (plus ``col_offset`` columns)."""
+        loc = self.config_loc(*path, key=key)
+        return plan_error(loc.file, loc.line, loc.col + col_offset, message, code)
 
     def rel(self, path: Path) -> str:
         """``path`` relative to the workspace root, with forward slashes."""

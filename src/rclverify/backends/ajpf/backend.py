@@ -44,7 +44,7 @@ from jinja2 import Environment, PackageLoader, StrictUndefined
 
 from ...evidence.records import Evidence, Obligation, SourceRef, make_obligation_id
 from ...evidence.store import atomic_write_text
-from ...plan.errors import PlanError, plan_error
+from ...plan.errors import PlanError
 from ...rcl import ast
 from ...rcl.errors import RclError
 from ..base import NodeTarget, Stopwatch, make_evidence
@@ -93,38 +93,6 @@ def _templates() -> Environment:
 # ---------------------------------------------------------------------------
 
 
-class _Locator:
-    """Finds where a key or text of this node's ``ajpf`` entry is in the plan file."""
-
-    def __init__(self, target: NodeTarget) -> None:
-        self.file = target.plan_file
-        try:
-            self.lines = (target.root / target.plan_file).read_text(encoding="utf-8").splitlines()
-        except OSError:
-            self.lines = []
-        self.start = self._entry_start(target.node.name)
-
-    def _entry_start(self, node: str) -> int:
-        node_line = next((k for k, l in enumerate(self.lines) if re.match(rf"^\s+{re.escape(node)}\s*:\s*$", l)), 0)
-        for k in range(node_line, len(self.lines)):
-            if re.search(r"backend\s*:\s*ajpf\b", self.lines[k]):
-                return k
-        return node_line
-
-    def find(self, needle: str) -> tuple[int, int]:
-        """1-based ``(line, col)`` of the first occurrence of ``needle`` at or
-        after the entry (the entry's line when it is not found)."""
-        for k in range(self.start, len(self.lines)):
-            col = self.lines[k].find(needle)
-            if col >= 0:
-                return k + 1, col + 1
-        return self.start + 1, 1
-
-    def error(self, needle: str, message: str) -> PlanError:
-        line, col = self.find(needle)
-        return plan_error(self.file, line, col, message)
-
-
 def read_config(target: NodeTarget) -> AjpfConfig:
     """Check the plan entry ``target.config`` and the mapping rows in it.
 
@@ -133,57 +101,56 @@ def read_config(target: NodeTarget) -> AjpfConfig:
     invalid domain, or a mapping row that does not parse or check.
     """
     cfg = target.config
-    loc = _Locator(target)
     for key in cfg:
         if key not in _KEYS:
-            raise loc.error(f"{key}", f"unknown key {key!r} in the ajpf entry of {target.node.name} "
-                                      f"(allowed: {', '.join(_KEYS)})")
+            raise target.config_error(f"unknown key {key!r} in the ajpf entry of {target.node.name} "
+                                      f"(allowed: {', '.join(_KEYS)})", key, key=True)
     agent = cfg.get("agent")
     if not isinstance(agent, str) or not _AGENT.match(agent):
-        raise loc.error("agent", "'agent' must name the Gwendolen agent (a lower-case name, e.g. jackal)")
+        raise target.config_error("'agent' must name the Gwendolen agent (a lower-case name, e.g. jackal)", "agent")
     model = cfg.get("model")
     if not isinstance(model, str) or not model:
-        raise loc.error("model", "'model' must be the workspace-relative path of the Gwendolen program")
+        raise target.config_error("'model' must be the workspace-relative path of the Gwendolen program", "model")
     if not (target.root / model).is_file():
-        raise loc.error(model, f"model file {model!r} does not exist")
-    domains = _domains(cfg.get("domains", {}), loc)
+        raise target.config_error(f"model file {model!r} does not exist", "model")
+    domains = _domains(cfg.get("domains", {}), target)
     env_class = cfg.get("environment_class", DEFAULT_ENV)
     if not isinstance(env_class, str) or not _JAVA_CLASS.match(env_class):
-        raise loc.error("environment_class", "'environment_class' must be a Java class name")
+        raise target.config_error("'environment_class' must be a Java class name", "environment_class")
     home = cfg.get("mcapl_home")
     if home is not None and not isinstance(home, str):
-        raise loc.error("mcapl_home", "'mcapl_home' must be a directory path")
+        raise target.config_error("'mcapl_home' must be a directory path", "mcapl_home")
     timeout = cfg.get("timeout_s", DEFAULT_TIMEOUT_S)
     if isinstance(timeout, bool) or not isinstance(timeout, (int, float)) or timeout <= 0:
-        raise loc.error("timeout_s", "'timeout_s' must be a positive number of seconds")
+        raise target.config_error("'timeout_s' must be a positive number of seconds", "timeout_s")
     results = cfg.get("results", DEFAULT_RESULTS)
     if not isinstance(results, str) or not results:
-        raise loc.error("results", "'results' must be a workspace-relative directory")
+        raise target.config_error("'results' must be a workspace-relative directory", "results")
     log_info = cfg.get("log_info", list(DEFAULT_LOG_INFO))
     if not isinstance(log_info, list) or not all(isinstance(x, str) and _JAVA_CLASS.match(x) for x in log_info):
-        raise loc.error("log_info", "'log_info' must be a list of logger (class) names")
-    rows = _rows(cfg.get("mapping", []), target, agent, domains, loc)
+        raise target.config_error("'log_info' must be a list of logger (class) names", "log_info")
+    rows = _rows(cfg.get("mapping", []), target, agent, domains)
     return AjpfConfig(agent, model, domains, rows, env_class, home, float(timeout), results.rstrip("/"),
                       tuple(log_info))
 
 
-def _domains(raw: Any, loc: _Locator) -> dict[str, tuple[int, int]]:
+def _domains(raw: Any, target: NodeTarget) -> dict[str, tuple[int, int]]:
     if not isinstance(raw, Mapping):
-        raise loc.error("domains", "'domains' must map variable names to [low, high] (inclusive)")
+        raise target.config_error("'domains' must map variable names to [low, high] (inclusive)", "domains")
     out: dict[str, tuple[int, int]] = {}
     size = 1
     for name, bounds in raw.items():
         ok = (isinstance(bounds, (list, tuple)) and len(bounds) == 2
               and all(isinstance(b, int) and not isinstance(b, bool) for b in bounds))
         if not isinstance(name, str) or not ok:
-            raise loc.error("domains", f"domain of {name!r} must be [low, high] with integer bounds")
+            raise target.config_error(f"domain of {name!r} must be [low, high] with integer bounds", "domains", name)
         lo, hi = bounds
         if lo > hi:
-            raise loc.error("domains", f"domain of {name!r} is empty: {lo} > {hi}")
+            raise target.config_error(f"domain of {name!r} is empty: {lo} > {hi}", "domains", name)
         size *= hi - lo + 1
         out[name] = (lo, hi)
     if size > MAX_INSTANCES:
-        raise loc.error("domains", f"the domains give {size} instances per guarantee (limit {MAX_INSTANCES})")
+        raise target.config_error(f"the domains give {size} instances per guarantee (limit {MAX_INSTANCES})", "domains")
     return out
 
 
@@ -201,27 +168,20 @@ def _io(target: NodeTarget) -> dict[str, str]:
 
 
 def _rows(raw: Any, target: NodeTarget, agent: str, domains: Mapping[str, tuple[int, int]],
-          loc: _Locator) -> tuple[Row, ...]:
+          ) -> tuple[Row, ...]:
     if not isinstance(raw, list):
-        raise loc.error("mapping", "'mapping' must be a list of rows {rcl: ..., ajpf: ...}")
+        raise target.config_error("'mapping' must be a list of rows {rcl: ..., ajpf: ...}", "mapping")
     rows = []
     fixed = _fixed_names(target)
     io = _io(target)
     for k, item in enumerate(raw):
-        rcl_text = item.get("rcl") if isinstance(item, Mapping) else None
-        if isinstance(rcl_text, str):
-            line, col = loc.find(rcl_text)
-        else:
-            line, col = loc.find("mapping")
         try:
             rows.append(build_row(k, item, dom_names=domains, fixed=fixed, io=io, agent=agent,
-                                  loc=ast.Loc(loc.file, line, col)))
+                                  loc=target.config_loc("mapping", k, "rcl")))
         except RowError as exc:
             text = item.get(exc.key) if isinstance(item, Mapping) and isinstance(item.get(exc.key), str) else None
-            if text is not None:
-                line, col = loc.find(text)
-                col += max(exc.col - 1, 0)
-            raise plan_error(loc.file, line, col, f"mapping row {k + 1}: {exc}") from None
+            raise target.config_error(f"mapping row {k + 1}: {exc}", "mapping", k, *((exc.key,) if text else ()),
+                                      col_offset=max(exc.col - 1, 0) if text else 0) from None
         except RclError as exc:
             raise PlanError(exc.diagnostics) from None
     return tuple(rows)

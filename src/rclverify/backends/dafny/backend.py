@@ -45,7 +45,7 @@ import jinja2
 
 from ...evidence.records import Evidence, Obligation, SourceRef, make_obligation_id
 from ...evidence.store import atomic_write_text
-from ...plan.errors import plan_error
+
 from ...rcl.errors import RclError
 from ...rcl.printer import expr_to_rcl
 from ..base import NodeTarget, Stopwatch, make_evidence
@@ -70,8 +70,8 @@ class _Config:
         where = f"nodes.{target.node.name}.evidence[{target.index}]"
 
         def bad(key: str, what: str) -> RclError:
-            return plan_error(target.plan_file, 1, 1, f"{where}.{key} must be {what}, found {cfg.get(key)!r}",
-                              "E-plan-dafny")
+            return target.config_error(f"{where}.{key} must be {what}, found {cfg.get(key)!r}", key,
+                                       code="E-plan-dafny")
 
         impl = cfg.get("implementation", f"backends/dafny/{snake(target.node.name)}.dfy")
         if not isinstance(impl, str) or not impl.endswith(".dfy"):

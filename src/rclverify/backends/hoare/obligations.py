@@ -38,7 +38,7 @@ from typing import Any, Mapping
 import z3
 
 from ...logic.encode import Encoder
-from ...plan.errors import PlanError, plan_error
+from ...plan.errors import PlanError
 from ...rcl import ast
 from ...rcl.errors import RclError, error
 from ...rcl.printer import binding_to_rcl, expr_to_rcl
@@ -87,43 +87,7 @@ class HoareConfig:
         return Path(self.program).stem
 
 
-class _PlanLocator:
-    """Finds the plan line of a value of this evidence entry (best effort)."""
-
-    def __init__(self, target: NodeTarget) -> None:
-        self.file = target.plan_file
-        try:
-            self.lines = (target.root / target.plan_file).read_text(encoding="utf-8").splitlines()
-        except OSError:
-            self.lines = []
-        prog = str(target.config.get("program", "") or "")
-        self.start = next((k for k, ln in enumerate(self.lines) if prog and prog in ln), 0)
-        if not prog:
-            node = target.node.name
-            self.start = next((k for k, ln in enumerate(self.lines) if ln.strip().startswith(f"{node}:")), 0)
-
-    def find(self, needle: str, after: str = "") -> tuple[int, int]:
-        """(line, col), 1-based, of ``needle`` on the line of this entry that
-        holds ``after`` (a key such as ``in.r:``), else of ``after`` itself,
-        else of ``needle`` within the entry, else the entry's first line."""
-        end = next((k for k in range(self.start + 1, len(self.lines))
-                    if self.lines[k].lstrip().startswith("- backend:")), len(self.lines))
-        window = range(self.start, end)
-        if after:
-            anchor = next((k for k in window if after in self.lines[k]), None)
-            if anchor is not None:
-                col = self.lines[anchor].find(needle) if needle else -1
-                return anchor + 1, (col if col >= 0 else self.lines[anchor].find(after)) + 1
-        if needle:
-            for k in window:
-                col = self.lines[k].find(needle)
-                if col >= 0:
-                    return k + 1, col + 1
-        return (self.start + 1, 1) if self.lines else (1, 1)
-
-    def error(self, message: str, needle: str = "", after: str = "") -> PlanError:
-        line, col = self.find(needle, after)
-        return plan_error(self.file, line, col, message, "E-plan-hoare")
+CODE = "E-plan-hoare"
 
 
 def load_program(target: NodeTarget) -> tuple[HoareConfig, lang.Program, ProgramTypes]:
@@ -134,25 +98,25 @@ def load_program(target: NodeTarget) -> tuple[HoareConfig, lang.Program, Program
     (located in the program file).
     """
     cfg = target.config
-    loc = _PlanLocator(target)
     unknown = sorted(k for k in cfg if k not in CONFIG_KEYS)
     if unknown:
-        raise loc.error(f"unknown key {unknown[0]!r} in a hoare evidence entry; expected {', '.join(CONFIG_KEYS)}",
-                        f"{unknown[0]}:")
+        raise target.config_error(f"unknown key {unknown[0]!r} in a hoare evidence entry; expected "
+                                  f"{', '.join(CONFIG_KEYS)}", unknown[0], key=True, code=CODE)
     prog = cfg.get("program")
     if not isinstance(prog, str) or not prog:
-        raise loc.error("a hoare evidence entry needs 'program: <path of the .imp file>'", "backend: hoare")
+        raise target.config_error("a hoare evidence entry needs 'program: <path of the .imp file>'", code=CODE)
     path = target.root / prog
     if not path.is_file():
-        raise loc.error(f"program file {prog!r} does not exist", prog)
+        raise target.config_error(f"program file {prog!r} does not exist", "program", code=CODE)
     timeout = cfg.get("timeout_ms", DEFAULT_TIMEOUT_MS)
     if not isinstance(timeout, int) or isinstance(timeout, bool) or timeout <= 0:
-        raise loc.error("timeout_ms must be a positive number of milliseconds", "timeout_ms")
+        raise target.config_error("timeout_ms must be a positive number of milliseconds", "timeout_ms", code=CODE)
     program = lang.parse_program_file(path, prog)
     types = check_program(program, target.checked.env)
     raw = cfg.get("binding", {}) or {}
     if not isinstance(raw, Mapping):
-        raise loc.error("binding must map RCL names (in.x, out.y) to program expressions", "binding")
+        raise target.config_error("binding must map RCL names (in.x, out.y) to program expressions", "binding",
+                                  code=CODE)
     node = target.node
     inputs: dict[str, lang.Expr] = {}
     outputs: dict[str, str] = {}
@@ -160,25 +124,27 @@ def load_program(target: NodeTarget) -> tuple[HoareConfig, lang.Program, Program
     for key, value in raw.items():
         m = _IO_KEY.match(str(key))
         if not m:
-            raise loc.error(f"binding key {key!r} must be an RCL input or output name, e.g. in.r or out.status",
-                            str(key), "binding")
+            raise target.config_error(f"binding key {key!r} must be an RCL input or output name, e.g. in.r or "
+                                      "out.status", "binding", key, key=True, code=CODE)
         prefix, name = m.group(1), m.group(2)
         io_t = (node.inputs if prefix == "in" else node.outputs).get(name)
         if io_t is None:
             pool = [f"{prefix}.{n}" for n in (node.inputs if prefix == "in" else node.outputs)]
-            raise loc.error(f"{key} is not an {'input' if prefix == 'in' else 'output'} of {node.name}"
-                            + (f"; it has {', '.join(pool)}" if pool else ""), str(key), "binding")
+            raise target.config_error(f"{key} is not an {'input' if prefix == 'in' else 'output'} of {node.name}"
+                            + (f"; it has {', '.join(pool)}" if pool else ""), "binding", key, key=True, code=CODE)
         if not isinstance(value, (str, int, float)) or isinstance(value, bool):
-            raise loc.error(f"the binding of {key} must be a program expression (a string)", str(key), "binding")
+            raise target.config_error(f"the binding of {key} must be a program expression (a string)", "binding", key,
+                                      code=CODE)
         vtext = str(value)
-        line, col = loc.find(vtext, f"{key}:")
-        expr = lang.parse_expression(vtext, loc.file, line, col)
+        at = target.config_loc("binding", key)
+        line, col, file = at.line, at.col, at.file
+        expr = lang.parse_expression(vtext, file, line, col)
         text[str(key)] = vtext
         if prefix == "in":
-            _check_input_binding(str(key), io_t, expr, types, loc.file, line, col)
+            _check_input_binding(str(key), io_t, expr, types, file, line, col)
             inputs[str(key)] = expr
         else:
-            outputs[str(key)] = _check_output_binding(str(key), io_t, expr, types, loc.file, line, col)
+            outputs[str(key)] = _check_output_binding(str(key), io_t, expr, types, file, line, col)
     return HoareConfig(prog, inputs, outputs, text, timeout), program, types
 
 
