@@ -64,6 +64,15 @@ def test_genuine_problems_of_the_case_study_are_shown(report: dict) -> None:
 
 
 
+def test_replacement_contract_is_checked_by_refinement(report: dict, workspace: Path) -> None:
+    [f] = [f for f in report["findings"] if f["check"] == "replacement-refines"]
+    assert f["node"] == "Agent" and f["status"] == "problem"
+    assert "guarantee side fails" in f["message"]
+    assert f["model"]["in.radiationStatus"] in ("red", "orange")
+    assert (workspace / f["smt2"]).is_file()
+    assert all((workspace / x["smt2"]).is_file() for x in report["findings"] if x.get("smt2"))
+
+
 def test_unavailable_backends_are_pending_not_skipped(report: dict) -> None:
     ev = [e for e in report["evidence"] if e["backend"] in ("review", "experiment")]
     assert len(ev) == 2

@@ -186,8 +186,12 @@ def build_tasks(root: str | Path, plan_file: str = "contracts/plan.yaml") -> dic
                           ws.calculus)
 
     def task_health() -> Iterator[dict[str, Any]]:
-        return node_tasks("health", "Check contract health: satisfiable assumption, consistency, non-vacuity.",
-                          lambda n: [snap[n]], ws.health)
+        def deps(n: str) -> list[str]:
+            repl = ws.plan.replacements.get(n)
+            extra = [str(rootp / repl[0].rpartition(":")[0])] if repl and (rootp / repl[0].rpartition(":")[0]).is_file() else []
+            return [snap[n]] + extra
+        return node_tasks("health", "Check contract health: satisfiable assumption, consistency, non-vacuity, "
+                          "and that a replacement contract refines the node's.", deps, ws.health)
 
     def task_export() -> Iterator[dict[str, Any]]:
         return node_tasks("export", "Export each node's guarantees as obligations to the plan's backends.",

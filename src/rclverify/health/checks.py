@@ -25,7 +25,7 @@ not decide within the timeout; never counted as ok).
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field, replace
 from typing import Any, Sequence
 
 import z3
@@ -57,6 +57,7 @@ class Finding:
     core: list[str] | None = None
     duration_s: float = 0.0
     instances: dict[str, str] | None = None
+    smt2: str = field(default="", compare=False)
 
     def to_json(self) -> dict[str, Any]:
         return {"id": self.id, "node": self.node, "check": self.check, "guarantee": self.guarantee,
@@ -158,6 +159,7 @@ def check_node(checked: Checked, node: str, facts: Sequence[tuple[ast.Expr, ast.
     n = node
 
     r = h.sat([], guarantees=False, comment=f"health {n}: is the assumption satisfiable?")
+    mark = len(out)
     if r.status == "sat":
         out.append(Finding(f"{n}.assumption-satisfiable", n, "assumption-satisfiable", None, "ok",
                            f"The assumption of {n} can be met.", "Z3 found inputs satisfying it (witness below).", r.model,
@@ -170,7 +172,9 @@ def check_node(checked: Checked, node: str, facts: Sequence[tuple[ast.Expr, ast.
         out.append(Finding(f"{n}.assumption-satisfiable", n, "assumption-satisfiable", None, "inconclusive",
                            f"Z3 could not decide whether the assumption of {n} can hold.", r.reason, duration_s=r.duration_s))
 
+    out[mark] = replace(out[mark], smt2=r.smt2)
     r = h.sat([], comment=f"health {n}: can the assumption, every guarantee and the environment facts hold together?")
+    mark = len(out)
     check = "contract-consistent"
     if r.status == "sat":
         out.append(Finding(f"{n}.{check}", n, check, None, "ok",
@@ -186,6 +190,7 @@ def check_node(checked: Checked, node: str, facts: Sequence[tuple[ast.Expr, ast.
                            "The quantifier alternation in the guarantees is beyond Z3's decision procedures within the "
                            "timeout; no conclusion is drawn.", duration_s=r.duration_s))
 
+    out[mark] = replace(out[mark], smt2=r.smt2)
     for k in range(1, len(checked.nodes[node].node.guarantees) + 1):
         out.append(_non_vacuity(h, n, k))
     return out
@@ -199,6 +204,11 @@ def _non_vacuity(h: _NodeHealth, n: str, k: int) -> Finding:
                        "Not of the form forall ... (premise -> conclusion).")
     extra, ptext = prem
     r = h.sat(extra, comment=f"health {n}: can the premise of guarantee {k} hold? {ptext}")
+    return replace(_premise_finding(h, n, k, r, ptext), smt2=r.smt2)
+
+
+def _premise_finding(h: _NodeHealth, n: str, k: int, r: QueryResult, ptext: str) -> Finding:
+    fid, check = f"{n}.g{k}.non-vacuous", "non-vacuous"
     if r.status == "sat":
         return Finding(fid, n, check, k, "ok", f"The premise of guarantee {k} of {n} can hold: the guarantee can fire.",
                        f"Premise: {ptext}. Z3 found a situation where it holds together with the assumption, every "
