@@ -35,7 +35,7 @@ from .plan.load import Plan, load_plan, resolve
 from .rcl import ast
 from .rcl.lint import lint
 from .rcl.printer import to_rcl
-from .rcl.errors import RclError, error
+from .rcl.errors import Diagnostic, RclError, error
 from .rcl.parser import parse_text
 from .rcl.typecheck import check
 from .rcl.types import Checked
@@ -66,7 +66,7 @@ class Workspace:
     def checked(self) -> Checked:
         plan = self.plan
         specs = []
-        diags = []
+        diags: list[Diagnostic] = []
         for rel in plan.contracts:  # parsed under their workspace-relative names
             try:
                 specs.append(parse_text((self.root / rel).read_text(encoding="utf-8"), rel))

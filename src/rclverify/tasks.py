@@ -33,6 +33,7 @@ from doit.tools import config_changed
 
 from .pipeline import Workspace
 from .rcl.errors import RclError
+from .system.model import SystemModel
 
 REPORTS = ["reports/assurance.html", "reports/assurance.md", "reports/assurance.json"]
 
@@ -181,8 +182,10 @@ def build_tasks(root: str | Path, plan_file: str = "contracts/plan.yaml") -> dic
                    "targets": [str(rootp / target(n))], "verbosity": 2, "clean": True}
 
     def task_compose() -> Iterator[dict[str, Any]]:
+        assert model is not None  # task_compose is registered only when ok, i.e. the model was built
+        sysmodel: SystemModel = model
         return node_tasks("compose", "Apply the calculus (R1-R4): discharge side conditions with Z3, derive properties.",
-                          lambda n: [snap[n]] + [snap[p] for p in model.producers(n)] + [str(rootp / ws.MODEL)],
+                          lambda n: [snap[n]] + [snap[p] for p in sysmodel.producers(n)] + [str(rootp / ws.MODEL)],
                           ws.calculus)
 
     def task_health() -> Iterator[dict[str, Any]]:

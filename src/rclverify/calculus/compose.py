@@ -150,7 +150,8 @@ def split_assumption(checked: Checked, model: SystemModel, node: str) -> tuple[l
     """(internal conjuncts, environment conjuncts) of ``node``'s assumption."""
     cn = checked.nodes[node]
     internal_vars = model.internal_inputs(node)
-    internal, env = [], []
+    internal: list[ast.Expr] = []
+    env: list[ast.Expr] = []
     for cl in cn.node.assumes:
         for c in conjuncts(cl.formula):
             if isinstance(c, ast.BoolLit) and c.value:
@@ -213,7 +214,7 @@ def compose_node(checked: Checked, model: SystemModel, node: str, *,
         instances.append({"rule": rule, "premises": premises,
                           "conclusion": " and ".join(f"({a})" for a in prem_a) + f" => <> G_{node}"})
     cone = model.upstream(node)
-    cone_env = []
+    cone_env: list[str] = []
     for m in cone:
         _, env_m = split_assumption(checked, model, m)
         cone_env.extend(f"{expr_to_rcl(c)}  [{m}]" for c in env_m)

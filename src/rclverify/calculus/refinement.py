@@ -27,7 +27,7 @@ import sys
 from dataclasses import dataclass, field
 from typing import Any, Mapping, TextIO
 
-import z3  # type: ignore[import-untyped]
+import z3
 
 from ..logic.encode import EncodingError, Encoder
 from ..logic.query import DEFAULT_TIMEOUT_MS, QueryResult, prove

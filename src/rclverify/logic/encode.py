@@ -66,7 +66,7 @@ def sort_of(t: Type) -> z3.SortRef:
     which are not first-class values (they become uninterpreted functions).
     """
     if t in _SORTS:
-        return _SORTS[t]  # type: ignore[no-any-return]
+        return _SORTS[t]
     s: Any
     if isinstance(t, Scalar):
         s = {"REAL": z3.RealSort(), "INTEGER": z3.IntSort(), "NATURAL": z3.IntSort(), "BOOL": z3.BoolSort()}[t.name]
@@ -93,7 +93,7 @@ def sort_of(t: Type) -> z3.SortRef:
     else:
         raise ValueError(f"function type {t} is not a first-class value")
     _SORTS[t] = s
-    return s  # type: ignore[no-any-return]
+    return s
 
 
 def enum_const(t: EnumT, value: str) -> z3.ExprRef:
@@ -106,7 +106,7 @@ def _ctor(t: DataT, name: str) -> z3.FuncDeclRef:
     s: Any = sort_of(t)
     for k in range(s.num_constructors()):
         if s.constructor(k).name() == name:
-            return s.constructor(k)  # type: ignore[no-any-return]
+            return s.constructor(k)
     raise KeyError(name)
 
 
@@ -114,7 +114,7 @@ def _recogniser(t: DataT, name: str) -> z3.FuncDeclRef:
     s: Any = sort_of(t)
     for k in range(s.num_constructors()):
         if s.constructor(k).name() == name:
-            return s.recognizer(k)  # type: ignore[no-any-return]
+            return s.recognizer(k)
     raise KeyError(name)
 
 
@@ -236,7 +236,7 @@ class Encoder:
         r = _Ctx(self, node, dict(symbols or {})).enc(e, dict(bound or {}))
         if not z3.is_bool(r):
             raise EncodingError(e.loc, "expected a formula")
-        return r  # type: ignore[no-any-return]
+        return r
 
     def term(self, e: ast.Expr, node: CheckedNode, symbols: Mapping[str, Any] | None = None) -> z3.ExprRef:
         """Encode a term (e.g. the left-hand side of a binding) of ``node``."""
@@ -402,7 +402,7 @@ class _Ctx:
                                               ast.TSet, ast.TSeq, ast.TTuple, ast.TFunc)) or (
                         isinstance(bd.domain, ast.TName) and bd.domain.name not in self.e.env.types):
                     coll = bd.domain if not isinstance(bd.domain, ast.TName) else ast.Var(bd.domain.name, None, bd.domain.loc)
-                    guards.append(self.member(v, coll, b))  # type: ignore[arg-type]
+                    guards.append(self.member(v, coll, b))
         body = self.enc(x.body, inner)
         guard = z3.And(*guards) if guards else None
         if x.kind == "forall":
@@ -436,15 +436,15 @@ class _Ctx:
 def value_to_rcl(v: z3.ExprRef) -> str:
     """Render a Z3 model value in RCL notation (``move(1.5, 0)``, ``green``, ``7/3``)."""
     if z3.is_int_value(v):
-        return str(v.as_long())  # type: ignore[attr-defined]
+        return str(v.as_long())
     if z3.is_rational_value(v):
-        fr = Fraction(v.numerator_as_long(), v.denominator_as_long())  # type: ignore[attr-defined]
+        fr = Fraction(v.numerator_as_long(), v.denominator_as_long())
         if fr.denominator == 1:
             return str(fr.numerator)
         dec = float(fr)
         return repr(dec) if Fraction(dec) == fr else f"{fr.numerator}/{fr.denominator}"
     if z3.is_algebraic_value(v):
-        return v.as_decimal(6)  # type: ignore[attr-defined, no-any-return]
+        return str(v.as_decimal(6))
     if z3.is_true(v):
         return "TRUE"
     if z3.is_false(v):
@@ -452,7 +452,7 @@ def value_to_rcl(v: z3.ExprRef) -> str:
     if z3.is_app(v) and v.num_args() > 0:
         return f"{v.decl().name()}(" + ", ".join(value_to_rcl(a) for a in v.children()) + ")"
     if z3.is_app(v):
-        return v.decl().name()
+        return str(v.decl().name())
     return str(v)
 
 

@@ -59,7 +59,7 @@ def _smt2(formulas: Sequence[z3.BoolRef], comment: str) -> str:
     for f in formulas:
         s.add(f)
     header = "".join(f"; {line}\n" for line in comment.splitlines())
-    return header + s.to_smt2()
+    return header + str(s.to_smt2())
 
 
 def prove(goal: z3.BoolRef, hypotheses: Sequence[z3.BoolRef], enc: Encoder | None = None, *,

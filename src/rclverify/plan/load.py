@@ -20,7 +20,7 @@ import jsonschema
 import yaml
 
 from ..rcl import ast
-from ..rcl.errors import RclError
+from ..rcl.errors import Diagnostic, RclError
 from ..rcl.parser import parse_formula
 from ..rcl.typecheck import infer
 from ..rcl.types import BOOL, Checked
@@ -160,7 +160,7 @@ def _read_plan_source(root: Path, plan_rel: str) -> tuple[dict[str, Any], dict[P
         raise plan_error(plan_rel, 1, 1, "the verification plan must be a mapping with a 'contracts' list")
     errors = sorted(jsonschema.Draft202012Validator(_schema()).iter_errors(data), key=lambda e: list(map(str, e.absolute_path)))
     if errors:
-        diags = []
+        diags: list[Diagnostic] = []
         for e in errors:
             path = tuple(e.absolute_path)
             if e.validator == "additionalProperties" and isinstance(e.instance, dict):
@@ -247,7 +247,7 @@ def resolve(plan: Plan, checked: Checked) -> None:
     environment facts must be well-typed formulas of their node.  Raises
     :class:`PlanError` listing every problem.
     """
-    diags = []
+    diags: list[Diagnostic] = []
     nodes = checked.nodes
 
     def bad(l: ast.Loc, msg: str) -> None:

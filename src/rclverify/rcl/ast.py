@@ -43,7 +43,7 @@ NOLOC = Loc()
 
 
 def _loc() -> Loc:
-    return field(default=NOLOC, compare=False, repr=False)  # type: ignore[return-value]
+    return field(default=NOLOC, compare=False, repr=False)
 
 
 # --------------------------------------------------------------------------

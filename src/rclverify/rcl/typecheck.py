@@ -188,9 +188,9 @@ class _Checker:
             ok = False
         for cl in n.assumes + n.guarantees:
             try:
-                t = self.infer(cl.formula, cn, {})
-                if t != BOOL:
-                    self.err(cl.formula.loc, f"a contract clause must be a formula (BOOL), found {t}")
+                ft = self.infer(cl.formula, cn, {})
+                if ft != BOOL:
+                    self.err(cl.formula.loc, f"a contract clause must be a formula (BOOL), found {ft}")
                     ok = False
             except _Fail:
                 ok = False
@@ -311,9 +311,9 @@ class _Checker:
             return TupleT(tuple(self.infer(i, node, bound) for i in e.items))
         if isinstance(e, ast.Quant):
             inner = dict(bound)
-            for b in e.bindings:
-                dt = self.domain(b, node, bound)
-                for nm in b.names:
+            for bd in e.bindings:
+                dt = self.domain(bd, node, bound)
+                for nm in bd.names:
                     inner[nm] = dt
             self.expect_bool(e.body, self.infer(e.body, node, inner), e.kind)
             return BOOL

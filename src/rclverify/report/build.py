@@ -47,7 +47,9 @@ def build_report(ws: Workspace) -> dict[str, Any]:
             obligations.extend(read_obligations(ws.path(ws.obligations(n))))
         except FileNotFoundError:
             pass
-    ev_rows, ob_rows, pending = [], [], []
+    ev_rows: list[dict[str, Any]] = []
+    ob_rows: list[dict[str, Any]] = []
+    pending: list[dict[str, Any]] = []
     ob_status: dict[str, str] = {}
     for o in obligations:
         ev = store.get(o.id)
@@ -96,9 +98,10 @@ def build_report(ws: Workspace) -> dict[str, Any]:
             if l.from_node == name:
                 consumers.setdefault(l.from_var, []).append(f"{l.to_node}.{l.to_var}")
         env_texts = {e["text"] for e in comps[name].get("environment_assumptions", [])}
-        guarantees = [{"index": k, "text": expr_to_rcl(g.formula), "source": _src(g.loc), "status": g_status(name, k),
-                       "obligations": sorted(o.id for o in obligations if applies(o, name, k))}
-                      for k, g in enumerate(cn.node.guarantees, 1)]
+        guarantees: list[dict[str, Any]] = [
+            {"index": k, "text": expr_to_rcl(g.formula), "source": _src(g.loc), "status": g_status(name, k),
+             "obligations": sorted(o.id for o in obligations if applies(o, name, k))}
+            for k, g in enumerate(cn.node.guarantees, 1)]
         status = worst([g["status"] for g in guarantees] + [sc_status[name]])
         node_status[name] = status
         nodes.append({
@@ -111,9 +114,9 @@ def build_report(ws: Workspace) -> dict[str, Any]:
             "guarantees": guarantees, "latex": to_latex(ast.Spec((), (cn.node,))),
         })
 
-    requirements = []
+    requirements: list[dict[str, Any]] = []
     for r in plan.requirements:
-        support = []
+        support: list[dict[str, Any]] = []
         for s in r.support:
             for k in s.guarantees:
                 g = checked.nodes[s.node].node.guarantees[k - 1]
@@ -150,8 +153,8 @@ def build_report(ws: Workspace) -> dict[str, Any]:
         if e["status"] in ("failed", "error", "stale"):
             problems.append(f"Evidence {e['obligation']} is {e['status']}: {e['explanation'][:300]}")
     counts: dict[str, int] = {}
-    for o in ob_rows:
-        counts[o["status"]] = counts.get(o["status"], 0) + 1
+    for row in ob_rows:
+        counts[row["status"]] = counts.get(row["status"], 0) + 1
     overall = worst([r["status"] for r in requirements] + list(node_status.values()) + [d["status"] for d in derived])
     strict_ok = all(o["status"] == "discharged" for o in ob_rows)
     headline = (f"{len(ob_rows)} obligations: " + ", ".join(f"{counts[s]} {s}" for s in sorted(counts, key=SEVERITY.__getitem__))
