@@ -128,8 +128,8 @@ class Symbol:
     decl: Any  # z3.ExprRef for constants, z3.FuncDeclRef for functions
 
 
-def _coerce(a: z3.ExprRef, b: z3.ExprRef) -> tuple[z3.ExprRef, z3.ExprRef]:
-    """Widen Int to Real when one side is Real."""
+def coerce(a: z3.ExprRef, b: z3.ExprRef) -> tuple[z3.ExprRef, z3.ExprRef]:
+    """Widen Int to Real when one side is Real (NATURAL <: INTEGER <: REAL)."""
     if z3.is_int(a) and z3.is_real(b):
         return z3.ToReal(a), b
     if z3.is_real(a) and z3.is_int(b):
@@ -137,10 +137,42 @@ def _coerce(a: z3.ExprRef, b: z3.ExprRef) -> tuple[z3.ExprRef, z3.ExprRef]:
     return a, b
 
 
-def _to_sort(x: z3.ExprRef, s: z3.SortRef) -> z3.ExprRef:
+def widen(x: z3.ExprRef, s: z3.SortRef) -> z3.ExprRef:
+    """``x`` as a value of sort ``s`` (an Int widened to Real when ``s`` is Real)."""
     if s == z3.RealSort() and z3.is_int(x):
         return z3.ToReal(x)
     return x
+
+
+_ARITH = {"<": "__lt__", "<=": "__le__", ">": "__gt__", ">=": "__ge__", "+": "__add__", "-": "__sub__",
+          "*": "__mul__"}
+
+
+def apply_operator(op: str, a: Any, b: Any) -> Any:
+    """``a op b`` in Z3 for a binary connective, comparison or arithmetic operator
+    of RCL (or the Hoare language): ``and or -> <=> == != < <= > >= + - * /``.
+
+    Numeric operands are widened as :func:`coerce` does; ``/`` is real
+    division.  The left operand's method is called explicitly so that
+    ``k >= 0`` stays ``k >= 0`` (Python would otherwise prefer the numeral's
+    reflected method and build ``0 <= k``).  Raises ``KeyError`` for an
+    unknown operator.
+    """
+    if op == "and":
+        return z3.And(a, b)
+    if op == "or":
+        return z3.Or(a, b)
+    if op == "->":
+        return z3.Implies(a, b)
+    if op == "/":
+        return widen(a, z3.RealSort()) / widen(b, z3.RealSort())
+    if op in ("<=>", "=="):
+        a, b = coerce(a, b)
+        return z3.ExprRef.__eq__(a, b)
+    a, b = coerce(a, b)
+    if op == "!=":
+        return z3.ExprRef.__ne__(a, b)
+    return getattr(z3.ArithRef, _ARITH[op])(a, b)
 
 
 class Encoder:
@@ -300,10 +332,10 @@ class _Ctx:
         is_value = f.prefix is not None or f.name in b or f.name in self.node.inputs or f.name in self.node.outputs
         if not is_value and f.name in self.e.env.ctors:
             c = self.e.ctor(f.name)
-            return c(*[_to_sort(a, c.domain(k)) for k, a in enumerate(args)])
+            return c(*[widen(a, c.domain(k)) for k, a in enumerate(args)])
         fn = self.var(f, b)
         if isinstance(fn, z3.FuncDeclRef):
-            return fn(*[_to_sort(a, fn.domain(k)) for k, a in enumerate(args)])
+            return fn(*[widen(a, fn.domain(k)) for k, a in enumerate(args)])
         raise EncodingError(x.loc, f"{f.qualified} cannot be applied")
 
     def e_Unary(self, x: ast.Unary, b: Mapping[str, Any]) -> Any:
@@ -311,35 +343,18 @@ class _Ctx:
         return z3.Not(v) if x.op == "not" else -v
 
     def e_Binary(self, x: ast.Binary, b: Mapping[str, Any]) -> Any:
-        lhs, rhs = self.enc(x.left, b), self.enc(x.right, b)
-        op = x.op
-        if op == "and":
-            return z3.And(lhs, rhs)
-        if op == "or":
-            return z3.Or(lhs, rhs)
-        if op == "->":
-            return z3.Implies(lhs, rhs)
-        if op == "<=>":
-            return lhs == rhs
-        if op == "/":
-            return z3.ToReal(lhs) / z3.ToReal(rhs) if not (z3.is_real(lhs) and z3.is_real(rhs)) else lhs / rhs
-        lhs, rhs = _coerce(lhs, rhs)
-        return {"+": lambda: lhs + rhs, "-": lambda: lhs - rhs, "*": lambda: lhs * rhs}[op]()
+        return apply_operator(x.op, self.enc(x.left, b), self.enc(x.right, b))
 
     def e_Compare(self, x: ast.Compare, b: Mapping[str, Any]) -> Any:
         vals = [self.enc(o, b) for o in x.operands]
-        parts = []
-        for op, a, c in zip(x.ops, vals, vals[1:]):
-            a, c = _coerce(a, c)
-            parts.append({"==": lambda: a == c, "!=": lambda: a != c, "<": lambda: a < c, "<=": lambda: a <= c,
-                          ">": lambda: a > c, ">=": lambda: a >= c}[op]())
+        parts = [apply_operator(op, l, r) for op, l, r in zip(x.ops, vals, vals[1:])]
         return parts[0] if len(parts) == 1 else z3.And(*parts)
 
     def member(self, elem: Any, coll: ast.Expr, b: Mapping[str, Any]) -> Any:
         env = self.e.env
         if isinstance(coll, ast.SetLit) or isinstance(coll, ast.SeqLit):
             items = [self.enc(i, b) for i in coll.items]
-            eqs = [(lambda p: p[0] == p[1])(_coerce(elem, i)) for i in items]
+            eqs = [(lambda p: p[0] == p[1])(coerce(elem, i)) for i in items]
             return z3.Or(*eqs) if eqs else z3.BoolVal(False)
         if isinstance(coll, ast.Var) and coll.prefix is None and coll.name not in b and coll.name in ("REAL", "INTEGER", "NATURAL", "BOOL"):
             return self.in_base(elem, coll.name)

@@ -31,7 +31,7 @@ from contextlib import contextmanager
 from functools import lru_cache
 from importlib import resources
 from pathlib import Path
-from typing import Any, Iterable, Iterator, cast
+from typing import Any, Iterable, Iterator, Mapping, cast
 
 from lark import Lark, Token, Transformer
 from lark.parsers.lalr_analysis import Shift
@@ -68,14 +68,22 @@ def _lark() -> Lark:
                 maybe_placeholders=True, transformer=_BUILDER)
 
 
-def _describe(term: str) -> str:
-    if term in _FRIENDLY:
-        return _FRIENDLY[term]
+def describe_terminal(parser: Lark, term: str, friendly: Mapping[str, str]) -> str:
+    """How a syntax error names the terminal ``term`` of ``parser``: the
+    ``friendly`` wording when there is one, the literal text of a keyword or
+    punctuation terminal in quotes, else the terminal's name in lower case.
+    Shared by every Lark grammar of the project (RCL, the Hoare language)."""
+    if term in friendly:
+        return friendly[term]
     try:
-        pattern = _lark().get_terminal(term).pattern
+        pattern = parser.get_terminal(term).pattern
     except KeyError:
         return term
     return f"'{pattern.value}'" if pattern.type == "str" else term.lower()
+
+
+def _describe(term: str) -> str:
+    return describe_terminal(_lark(), term, _FRIENDLY)
 
 
 class _Spanned:

@@ -41,6 +41,7 @@ from lark.exceptions import UnexpectedCharacters, UnexpectedEOF, UnexpectedInput
 
 from ...rcl import ast as rast
 from ...rcl.ast import Loc
+from ...rcl.parser import describe_terminal
 from ...rcl.errors import RclError, error
 
 NOLOC = Loc()
@@ -221,13 +222,7 @@ def _lark() -> Lark:
 
 
 def _describe(term: str) -> str:
-    if term in _FRIENDLY:
-        return _FRIENDLY[term]
-    try:
-        pattern = _lark().get_terminal(term).pattern
-    except KeyError:
-        return term
-    return f"'{pattern.value}'" if pattern.type == "str" else term.lower()
+    return describe_terminal(_lark(), term, _FRIENDLY)
 
 
 def _block(stmts: Any) -> tuple[Stmt, ...]:

@@ -35,6 +35,7 @@ from typing import Iterator, Literal, Protocol
 
 import z3
 
+from ...logic.encode import apply_operator, widen
 from ...rcl.ast import Loc
 from ...rcl.types import NATURAL, Type
 from . import lang
@@ -49,20 +50,6 @@ class Sorts(Protocol):
     def enum_value(self, name: str) -> z3.ExprRef: ...
 
     def ctor(self, name: str) -> z3.FuncDeclRef: ...
-
-
-def _widen(x: z3.ExprRef, s: z3.SortRef) -> z3.ExprRef:
-    if s == z3.RealSort() and z3.is_int(x):
-        return z3.ToReal(x)
-    return x
-
-
-def _coerce(a: z3.ExprRef, b: z3.ExprRef) -> tuple[z3.ExprRef, z3.ExprRef]:
-    if z3.is_int(a) and z3.is_real(b):
-        return z3.ToReal(a), b
-    if z3.is_real(a) and z3.is_int(b):
-        return a, z3.ToReal(b)
-    return a, b
 
 
 class ProgramModel:
@@ -103,31 +90,11 @@ class ProgramModel:
             return self.olds[e.name]
         if isinstance(e, lang.Call):
             f = self.funcs[e.func] if e.func in self.funcs else self.sorts.ctor(e.func)
-            return f(*[_widen(self.term(a), f.domain(k)) for k, a in enumerate(e.args)])
+            return f(*[widen(self.term(a), f.domain(k)) for k, a in enumerate(e.args)])
         if isinstance(e, lang.Unary):
             v = self.term(e.operand)
             return z3.Not(v) if e.op == "not" else -v
-        a, b = self.term(e.left), self.term(e.right)
-        op = e.op
-        if op == "and":
-            return z3.And(a, b)
-        if op == "or":
-            return z3.Or(a, b)
-        if op == "->":
-            return z3.Implies(a, b)
-        if op == "/":
-            return _widen(a, z3.RealSort()) / _widen(b, z3.RealSort())
-        a, b = _coerce(a, b)
-        if op == "==":
-            return z3.ExprRef.__eq__(a, b)
-        if op == "!=":
-            return z3.ExprRef.__ne__(a, b)
-        # Call the left operand's method explicitly: for ``k >= 0`` Python would
-        # otherwise prefer the numeral's reflected method (IntNumRef subclasses
-        # ArithRef) and build ``0 <= k``, which outlines would then show.
-        method = {"<": "__lt__", "<=": "__le__", ">": "__gt__", ">=": "__ge__", "+": "__add__",
-                  "-": "__sub__", "*": "__mul__"}[op]
-        return getattr(z3.ArithRef, method)(a, b)
+        return apply_operator(e.op, self.term(e.left), self.term(e.right))
 
     def formula(self, e: lang.Expr) -> z3.BoolRef:
         """Encode a (checked) BOOL expression."""
@@ -137,7 +104,7 @@ class ProgramModel:
 
     def value_for(self, name: str, value: z3.ExprRef) -> z3.ExprRef:
         """``value`` widened to variable ``name``'s sort (Int -> Real)."""
-        return _widen(value, self.sort_of_var(name))
+        return widen(value, self.sort_of_var(name))
 
     def typing_facts(self, formulas: list[z3.BoolRef]) -> list[z3.BoolRef]:
         """Range facts for the symbols of ``formulas``: ``x >= 0`` for every
