@@ -28,8 +28,8 @@ from typing import Any
 from .backends import get_backend
 from .backends.base import NodeTarget
 from .calculus.compose import compose_node, composition_json
-from .evidence.records import Evidence
-from .evidence.store import EvidenceStore, atomic_write_text, read_json, read_obligations, write_json, write_obligations
+from .evidence.records import Evidence, Obligation
+from .evidence.store import EvidenceStore, atomic_write_text, read_json, write_json, write_obligations
 from .health.checks import check_node
 from .plan.load import Plan, load_plan, resolve
 from .rcl import ast
@@ -103,8 +103,13 @@ class Workspace:
         return f"artifacts/obligations/{node}.json"
 
     @staticmethod
-    def entry_done(node: str, index: int) -> str:
-        return f"artifacts/runs/{node}.{index}.json"
+    def obligation(node: str, obligation_id: str) -> str:
+        """One obligation's own record: the input of its evidence task."""
+        return f"artifacts/obligations/{node}/{obligation_id}.json"
+
+    @staticmethod
+    def evidence(obligation_id: str) -> str:
+        return f"artifacts/evidence/{obligation_id}.json"
 
     MODEL = "artifacts/system/model.json"
     DOT = "artifacts/system/model.dot"
@@ -231,30 +236,23 @@ def stage_export(ws: Workspace, node: str) -> list[dict[str, Any]]:
             inputs = tuple(sorted({snapshot, *(i for i in o.inputs if i not in shared)}))
             obligations.append(dataclasses.replace(o, inputs=inputs, data={**o.data, "entry": entry.index}))
     write_obligations(ws.path(ws.obligations(node)), obligations)
+    keep = set()
+    for o in obligations:  # rewritten only when changed, so only changed obligations re-run
+        write_json(ws.path(ws.obligation(node, o.id)), o.to_json())
+        keep.add(f"{o.id}.json")
+    for old in ws.path(f"artifacts/obligations/{node}").glob("*.json"):
+        if old.name not in keep:
+            old.unlink()
     return [o.to_json() for o in obligations]
 
 
-def stage_run(ws: Workspace, node: str, index: int) -> list[Evidence]:
-    """Run the backend of evidence entry ``index`` of ``node`` on its obligations.
-
-    Each evidence record is stored atomically as soon as it is produced.
-    """
-    entry = ws.plan.evidence[node][index]
-    backend = get_backend(entry.backend)
-    target = ws.target(node, index)
-    store = EvidenceStore(ws.root)
-    obligations = [o for o in read_obligations(ws.path(ws.obligations(node)))
-                   if o.data.get("entry", index) == index and o.backend == entry.backend]
-    out = []
-    for o in obligations:
-        ev = backend.run(o, target)
-        store.put(ev)
-        out.append(ev)
-    # The report depends on this record: it changes whenever any evidence is re-produced.
-    write_json(ws.path(ws.entry_done(node, index)),
-               [{"obligation": e.obligation, "status": e.status, "started": e.started}
-                for e in sorted(out, key=lambda e: e.obligation)])
-    return out
+def stage_run(ws: Workspace, node: str, obligation_id: str) -> Evidence:
+    """Run the backend of one exported obligation and store its evidence record
+    atomically (an earlier record is replaced only by a complete new one)."""
+    o = Obligation.from_json(read_json(ws.path(ws.obligation(node, obligation_id))))
+    ev = get_backend(o.backend).run(o, ws.target(node, int(o.data.get("entry", 0))))
+    EvidenceStore(ws.root).put(ev)
+    return ev
 
 
 def read_artifact(ws: Workspace, rel: str, default: Any = None) -> Any:

@@ -8,7 +8,8 @@ Stages and their real file dependencies, per node ``N``:
 ``compose:N``      snapshot of N and of N's producers + model -> calculus/N.json
 ``health:N``       snapshot of N -> health/N.json
 ``export:N``       snapshot of N + the backend input files -> obligations/N.json
-``evidence:N.k-B`` obligations/N.json + entry k's input files -> evidence records
+``evidence:ID``     one obligation's record + the files it reads -> its evidence record
+                   (created after ``export`` ran, when the obligations are known)
 ``report``         every artifact above -> reports/assurance.{html,md,json}
 ``verify``         the whole pipeline; ``doit verify --strict`` fails unless every
                    obligation is discharged
@@ -28,6 +29,7 @@ import shutil
 from pathlib import Path
 from typing import Any, Callable, Iterator
 
+from doit import create_after
 from doit.exceptions import TaskFailed
 from doit.tools import config_changed
 
@@ -78,14 +80,13 @@ def act_node(root: str, stage: str, node: str) -> Any:
     return None
 
 
-def act_run(root: str, node: str, index: int) -> Any:
+def act_run(root: str, node: str, obligation_id: str) -> Any:
     from .pipeline import stage_run
     try:
-        evs = stage_run(_ws(root), node, index)
+        ev = stage_run(_ws(root), node, obligation_id)
     except RclError as exc:
         return _fail(exc)
-    for e in evs:
-        print(f"{e.obligation}: {e.status}")
+    print(f"{ev.obligation}: {ev.status}")
     return None
 
 
@@ -201,23 +202,34 @@ def build_tasks(root: str | Path, plan_file: str = "contracts/plan.yaml") -> dic
                           lambda n: [snap[n]] + [str(rootp / f) for e in ws.plan.evidence.get(n, ()) for f in _inputs(e.config, rootp)],
                           ws.obligations)
 
-    def task_evidence() -> Iterator[dict[str, Any]]:
-        yield {"basename": "evidence", "name": None, "doc": "Run each backend on its obligations and record evidence."}
+    def exported() -> list[tuple[str, dict[str, Any]]]:
+        """(node, obligation JSON) of every exported obligation (read after export ran)."""
+        out = []
         for n in nodes:
-            for e in ws.plan.evidence.get(n, ()):
-                deps = [str(rootp / ws.obligations(n)), snap[n]] + [str(rootp / f) for f in _inputs(e.config, rootp)]
-                if e.backend == "ajpf":
-                    deps += sorted(glob.glob(str(rootp / "backends" / "ajpf" / "results" / "*")))
-                yield {"name": f"{n}.{e.index}-{e.backend}", "actions": [(act_run, [r, n, e.index])],
-                       "file_dep": sorted(set(deps)), "targets": [str(rootp / ws.entry_done(n, e.index))],
-                       "uptodate": [config_changed(_tool_fingerprint())], "verbosity": 2, "clean": True}
+            try:
+                out.extend((n, o) for o in json.loads((rootp / ws.obligations(n)).read_text(encoding="utf-8")))
+            except (OSError, ValueError):
+                continue
+        return out
 
+    @create_after(executed="export")
+    def task_evidence() -> Iterator[dict[str, Any]]:
+        """Run the backends: one task per obligation, one evidence record each."""
+        yield {"basename": "evidence", "name": None, "doc": "Run each backend on its obligations and record evidence."}
+        for n, o in exported():
+            deps = [str(rootp / ws.obligation(n, o["id"]))]
+            deps += [str(rootp / i) for i in o["inputs"] if (rootp / i).is_file()]
+            yield {"name": o["id"], "actions": [(act_run, [r, n, o["id"]])], "file_dep": sorted(set(deps)),
+                   "targets": [str(rootp / ws.evidence(o["id"]))], "uptodate": [config_changed(_tool_fingerprint())],
+                   "verbosity": 2, "clean": True}
+
+    @create_after(executed="evidence")
     def task_report() -> dict[str, Any]:
         """Roll everything up into reports/assurance.{html,md,json}."""
         deps = [str(rootp / p) for p in (ws.MODEL, ws.DIAGNOSTICS)] + list(snap.values())
         for n in nodes:
             deps += [str(rootp / ws.calculus(n)), str(rootp / ws.health(n)), str(rootp / ws.obligations(n))]
-            deps += [str(rootp / ws.entry_done(n, e.index)) for e in ws.plan.evidence.get(n, ())]
+        deps += [str(rootp / ws.evidence(o["id"])) for _, o in exported()]
         return {"actions": [(act_report, [r])], "file_dep": deps, "task_dep": ["graph"] if ok else [],
                 "targets": [str(rootp / p) for p in REPORTS], "verbosity": 2, "clean": True}
 
