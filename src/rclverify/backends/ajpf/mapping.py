@@ -46,6 +46,7 @@ from dataclasses import dataclass, field, replace
 from typing import Any, Iterable, Iterator, Mapping, Sequence, Union, cast
 
 from ...rcl import ast
+from ...rcl.printer import expr_to_rcl
 from ...rcl.errors import RclError
 from ...rcl.parser import parse_formula
 from . import psl
@@ -766,9 +767,6 @@ def _dnf(f: Form, limit: int) -> list[tuple[tuple[Item, ...], frozenset[str]]]:
 # Showing RCL (for reports of unmapped atoms)
 # ---------------------------------------------------------------------------
 
-_PREC = {"<=>": 1, "->": 2, "or": 3, "and": 4, "+": 7, "-": 7, "*": 8, "/": 8}
-
-
 def show(e: Any) -> str:
     """RCL text of an expression or canonical item (for messages, not for re-parsing
     guarantees; parenthesised where precedence needs it)."""
@@ -817,39 +815,9 @@ def _show_domain(d: Any) -> str:
 
 
 def _show(e: Any, prec: int) -> str:
-    if isinstance(e, ast.Var):
-        return e.qualified
-    if isinstance(e, ast.BoolLit):
-        return "TRUE" if e.value else "FALSE"
-    if isinstance(e, ast.NumLit):
-        return e.text
-    if isinstance(e, ast.Apply):
-        return f"{e.func.qualified}({', '.join(_show(a, 0) for a in e.args)})"
-    if isinstance(e, ast.Unary):
-        inner = _show(e.operand, 6 if e.op == "not" else 9)
-        text = f"not {inner}" if e.op == "not" else f"-{inner}"
-        return text if prec <= 6 else f"({text})"
-    if isinstance(e, ast.Binary):
-        p = _PREC[e.op]
-        text = f"{_show(e.left, p)} {e.op} {_show(e.right, p + 1)}"
-        return text if prec <= p else f"({text})"
-    if isinstance(e, ast.Compare):
-        parts = [_show(e.operands[0], 7)]
-        for op, o in zip(e.ops, e.operands[1:]):
-            parts.append(f"{op} {_show(o, 7)}")
-        text = " ".join(parts)
-        return text if prec <= 5 else f"({text})"
-    if isinstance(e, ast.Member):
-        text = f"{_show(e.elem, 7)} {'!in' if e.negated else 'in'} {_show(e.collection, 7)}"
-        return text if prec <= 5 else f"({text})"
-    if isinstance(e, ast.SetLit):
-        return "{" + ", ".join(_show(i, 0) for i in e.items) + "}"
-    if isinstance(e, ast.TupleLit):
-        return "(" + ", ".join(_show(i, 0) for i in e.items) + ")"
-    if isinstance(e, ast.SeqLit):
-        return "[" + ", ".join(_show(i, 0) for i in e.items) + "]"
-    if isinstance(e, ast.Quant):
-        kind = "exists!" if e.kind == "exists_unique" else e.kind
-        binds = ", ".join(f"{', '.join(b.names)} in {_show_domain(b.domain)}" for b in e.bindings)
-        return f"{kind}({binds} | {_show(e.body, 0)})"
-    return repr(e)
+    """RCL text of a plain AST expression (the shared printer); ``prec`` 7 asks
+    for parentheses around anything looser than arithmetic (a comparison operand)."""
+    text = expr_to_rcl(e)
+    tight = isinstance(e, (ast.Var, ast.BoolLit, ast.NumLit, ast.Apply, ast.SetLit, ast.TupleLit, ast.SeqLit,
+                           ast.Quant)) or (isinstance(e, ast.Binary) and e.op in ("+", "-", "*", "/"))
+    return text if prec < 7 or tight else f"({text})"
