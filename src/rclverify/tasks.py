@@ -27,15 +27,23 @@ import json
 import os
 import shutil
 from pathlib import Path
-from typing import Any, Callable, Iterator
+from typing import Any, Callable, Iterator, TypeVar, cast
 
-from doit import create_after
+from doit import create_after as _create_after
 from doit.exceptions import TaskFailed
 from doit.tools import config_changed
 
 from .pipeline import Workspace
 from .rcl.errors import RclError
 from .system.model import SystemModel
+
+_F = TypeVar("_F", bound=Callable[..., Any])
+
+
+def create_after(executed: str) -> Callable[[_F], _F]:
+    """doit's ``create_after`` (delayed task creation), typed."""
+    return cast(Callable[[_F], _F], _create_after(executed=executed))
+
 
 REPORTS = ["reports/assurance.html", "reports/assurance.md", "reports/assurance.json"]
 
@@ -204,7 +212,7 @@ def build_tasks(root: str | Path, plan_file: str = "contracts/plan.yaml") -> dic
 
     def exported() -> list[tuple[str, dict[str, Any]]]:
         """(node, obligation JSON) of every exported obligation (read after export ran)."""
-        out = []
+        out: list[tuple[str, dict[str, Any]]] = []
         for n in nodes:
             try:
                 out.extend((n, o) for o in json.loads((rootp / ws.obligations(n)).read_text(encoding="utf-8")))

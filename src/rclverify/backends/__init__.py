@@ -8,7 +8,10 @@ property instances).  Named but not implemented yet (their evidence is
 from __future__ import annotations
 
 from importlib import import_module
-from typing import Any
+from typing import TYPE_CHECKING, cast
+
+if TYPE_CHECKING:
+    from .base import Backend
 
 IMPLEMENTED = {
     "hoare": ("rclverify.backends.hoare.backend", "HoareBackend"),
@@ -19,7 +22,7 @@ NOT_AVAILABLE = ("review", "experiment", "property_tests", "monitors")
 KNOWN = tuple(IMPLEMENTED) + NOT_AVAILABLE
 
 
-def get_backend(name: str) -> Any:
+def get_backend(name: str) -> "Backend":
     """The backend object for a plan's ``backend:`` value.
 
     Raises ``KeyError`` for an unknown name (the plan loader reports it,
@@ -27,7 +30,7 @@ def get_backend(name: str) -> Any:
     """
     if name in IMPLEMENTED:
         module, cls = IMPLEMENTED[name]
-        return getattr(import_module(module), cls)()
+        return cast("Backend", getattr(import_module(module), cls)())
     if name in NOT_AVAILABLE:
         from .unavailable import UnavailableBackend
         return UnavailableBackend(name)

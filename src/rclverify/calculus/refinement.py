@@ -24,7 +24,7 @@ B.rcl:Node``.
 from __future__ import annotations
 
 import sys
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Any, Mapping, TextIO
 
 import z3
@@ -72,8 +72,6 @@ class RefinementResult:
     b: str
     assumption: SideResult
     guarantee: SideResult
-    a_loc: ast.Loc = field(default=ast.NOLOC)
-    b_loc: ast.Loc = field(default=ast.NOLOC)
 
     @property
     def verdict(self) -> str:
@@ -218,8 +216,7 @@ def check_refinement(a: CheckedNode, b: CheckedNode, env: Env, *,
     def side(name: str, stmt: str, q: QueryResult) -> SideResult:
         return SideResult(name, stmt, q.status, _rename(q.model, a.name), q.reason, q.smt2, q.duration_s)
 
-    return RefinementResult(a.name, b.name, side("assumption", s_assume, q1), side("guarantee", s_guar, q2),
-                            a.node.loc, b.node.loc)
+    return RefinementResult(a.name, b.name, side("assumption", s_assume, q1), side("guarantee", s_guar, q2))
 
 
 # ---------------------------------------------------------------------------

@@ -14,6 +14,9 @@ Statuses, from best to worst (roll-up takes the worst child):
 ``error``       the tool itself broke;
 ``failed``      the tool found the obligation does not hold
                 (``counterexample`` when there is one).
+
+Kinds of evidence: ``proof``, ``model checking``, ``testing``,
+``experiment``, ``review``, ``monitoring``.
 """
 from __future__ import annotations
 
@@ -21,10 +24,8 @@ import hashlib
 import re
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
-from typing import Any, Literal, Mapping, Sequence
+from typing import Any, Mapping, Sequence
 
-Status = Literal["discharged", "pending", "inconclusive", "stale", "error", "failed"]
-Kind = Literal["proof", "model checking", "testing", "experiment", "review", "monitoring"]
 
 #: Severity order used by every roll-up; larger is worse.
 SEVERITY: Mapping[str, int] = {

@@ -121,10 +121,6 @@ class _NodeHealth:
         labelled = list(self.assume) + (list(self.guars) + list(self.facts) + list(self.lemmas) if guarantees else [])
         return satisfiable(labelled + list(extra), self.enc, timeout_ms=timeout_ms or self.timeout, comment=comment)
 
-    @staticmethod
-    def core_text(core: Sequence[str] | None) -> list[str]:
-        return list(core or [])
-
     def premise(self, k: int, fixed: dict[str, int] | None = None) -> tuple[list[tuple[str, z3.BoolRef]], str] | None:
         g = self.node.node.guarantees[k - 1]
         bindings, body = _peel(g.formula)
@@ -167,7 +163,7 @@ def check_node(checked: Checked, node: str, facts: Sequence[tuple[ast.Expr, ast.
     elif r.status == "unsat":
         out.append(Finding(f"{n}.assumption-satisfiable", n, "assumption-satisfiable", None, "problem",
                            f"The assumption of {n} can never hold: the node's contract is vacuous.",
-                           "Unsat core: the clauses listed contradict each other.", None, h.core_text(r.core), r.duration_s))
+                           "Unsat core: the clauses listed contradict each other.", None, list(r.core or []), r.duration_s))
     else:
         out.append(Finding(f"{n}.assumption-satisfiable", n, "assumption-satisfiable", None, "inconclusive",
                            f"Z3 could not decide whether the assumption of {n} can hold.", r.reason, duration_s=r.duration_s))
@@ -183,7 +179,7 @@ def check_node(checked: Checked, node: str, facts: Sequence[tuple[ast.Expr, ast.
     elif r.status == "unsat":
         out.append(Finding(f"{n}.{check}", n, check, None, "problem",
                            f"The contract of {n} contradicts itself: no output can satisfy its guarantees.",
-                           "Unsat core: the clauses listed contradict each other.", None, h.core_text(r.core), r.duration_s))
+                           "Unsat core: the clauses listed contradict each other.", None, list(r.core or []), r.duration_s))
     else:
         out.append(Finding(f"{n}.{check}", n, check, None, "inconclusive",
                            f"Z3 could not decide whether the contract of {n} is consistent ({r.reason}).",
@@ -217,7 +213,7 @@ def _premise_finding(h: _NodeHealth, n: str, k: int, r: QueryResult, ptext: str)
         return Finding(fid, n, check, k, "problem",
                        f"Guarantee {k} of {n} is vacuous: its premise can never hold together with the node's other "
                        "guarantees and the environment facts, so it promises nothing.",
-                       f"Premise: {ptext}. The unsat core names the clauses that exclude it.", None, h.core_text(r.core),
+                       f"Premise: {ptext}. The unsat core names the clauses that exclude it.", None, list(r.core or []),
                        r.duration_s)
     nat = h.natural_vars(k)
     if not (h.instances and nat):
@@ -243,7 +239,7 @@ def _premise_finding(h: _NodeHealth, n: str, k: int, r: QueryResult, ptext: str)
             break
         per[str(x)] = {"sat": "can fire", "unsat": "vacuous", "inconclusive": "inconclusive"}[ri.status]
         if ri.status == "unsat":
-            cores[str(x)] = h.core_text(ri.core)
+            cores[str(x)] = list(ri.core or [])
     vac = [x for x, s in per.items() if s == "vacuous"]
     fires = [x for x, s in per.items() if s == "can fire"]
     unk = [x for x, s in per.items() if s in ("inconclusive", "not examined")]

@@ -31,7 +31,7 @@ from typing import Any, Callable, Mapping
 import z3
 
 from ..rcl import ast
-from ..rcl.types import (BOOL, NATURAL, Checked, CheckedNode, DataT, EmptyT, EnumT, Env, FuncT, Scalar, SeqT,
+from ..rcl.types import (BOOL, NATURAL, CheckedNode, DataT, EmptyT, EnumT, Env, FuncT, Scalar, SeqT,
                          SetT, TupleT, Type)
 from ..rcl.typecheck import domain_type
 
@@ -187,10 +187,6 @@ class Encoder:
         self.env = env
         self.alias = dict(alias or {})
         self.symbols: dict[str, Symbol] = {}
-
-    @staticmethod
-    def for_system(checked: Checked, alias: Mapping[tuple[str, str, str], str] | None = None) -> "Encoder":
-        return Encoder(checked.env, alias)
 
     # -- sorts and values ------------------------------------------------------------
     def sort(self, t: Type) -> z3.SortRef:

@@ -16,8 +16,8 @@ Models are rendered in RCL terms by :func:`render_model`.
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field
-from typing import Any, Sequence
+from dataclasses import dataclass
+from typing import Sequence
 
 import z3
 
@@ -45,7 +45,6 @@ class QueryResult:
     model: dict[str, str] | None = None
     core: list[str] | None = None
     reason: str = ""
-    extra: dict[str, Any] = field(default_factory=dict)
 
 
 def _solver(timeout_ms: int) -> z3.Solver:

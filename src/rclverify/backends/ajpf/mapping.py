@@ -628,17 +628,6 @@ def substitute(text: str, values: Mapping[str, int]) -> str:
     return _PLACEHOLDER.sub(one, text)
 
 
-def placeholder_vars(text: str) -> set[str]:
-    """Variables used in the ``{...}`` placeholders of ``text`` (unparsable ones skipped)."""
-    out: set[str] = set()
-    for m in _PLACEHOLDER.finditer(text):
-        try:
-            out |= expr_vars(parse_formula(m.group(1)))
-        except RclError:
-            continue
-    return out
-
-
 class RowError(ValueError):
     """A mapping row the user got wrong; ``col`` is 1-based within the offending text
     (0 when unknown) and ``key`` names the row key (``rcl``, ``ajpf``, ``when``)."""

@@ -104,7 +104,6 @@ class Call:
 UnOp = Literal["not", "-"]
 BinOp = Literal["->", "or", "and", "==", "!=", "<", "<=", ">", ">=", "+", "-", "*", "/"]
 COMPARISONS: frozenset[str] = frozenset({"==", "!=", "<", "<=", ">", ">="})
-ARITHMETIC: frozenset[str] = frozenset({"+", "-", "*", "/"})
 CONNECTIVES: frozenset[str] = frozenset({"->", "or", "and"})
 
 
