@@ -5,7 +5,8 @@ import re
 from collections import Counter
 from pathlib import Path
 
-from rclverify.rcl.lint import free_names, lint
+from rclverify.rcl.lint import lint
+from rclverify.rcl.walk import free_names
 from rclverify.rcl.parser import parse_file, parse_formula, parse_text
 
 ROOT = Path(__file__).resolve().parents[1]

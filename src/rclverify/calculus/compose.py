@@ -31,6 +31,7 @@ from ..logic.encode import Encoder
 from ..logic.query import DEFAULT_TIMEOUT_MS, prove
 from ..rcl import ast
 from ..rcl.printer import expr_to_rcl
+from ..rcl.walk import free_names, subexpressions
 from ..rcl.types import Checked
 from ..system.model import SystemModel
 
@@ -52,34 +53,12 @@ def conjuncts(e: ast.Expr) -> list[ast.Expr]:
     return [e]
 
 
-def free_io(e: ast.Expr, bound: frozenset[str] = frozenset()) -> set[tuple[str | None, str]]:
-    """The I/O names (prefix, name) a formula mentions, bound variables excluded."""
-    out: set[tuple[str | None, str]] = set()
-    if isinstance(e, ast.Var):
-        if e.prefix is not None or e.name not in bound:
-            out.add((e.prefix, e.name))
-    elif isinstance(e, ast.Apply):
-        out |= free_io(e.func, bound)
-        for a in e.args:
-            out |= free_io(a, bound)
-    elif isinstance(e, ast.Quant):
-        inner = bound | set(e.variables)
-        for b in e.bindings:
-            if not isinstance(b.domain, (ast.TBase, ast.TName, ast.TEnum, ast.TConstructors, ast.TFunc,
-                                         ast.TEmpty, ast.TSet, ast.TSeq, ast.TTuple)):
-                out |= free_io(b.domain, bound)
-        out |= free_io(e.body, frozenset(inner))
-    else:
-        for v in vars(e).values():
-            if isinstance(v, tuple):
-                for it in v:
-                    if isinstance(it, (ast.Var, ast.Apply, ast.Quant, ast.Binary, ast.Unary, ast.Compare,
-                                       ast.Member, ast.SetLit, ast.SeqLit, ast.TupleLit, ast.NumLit, ast.BoolLit)):
-                        out |= free_io(it, bound)
-            elif isinstance(v, (ast.Var, ast.Apply, ast.Quant, ast.Binary, ast.Unary, ast.Compare, ast.Member,
-                                ast.SetLit, ast.SeqLit, ast.TupleLit)):
-                out |= free_io(v, bound)
-    return out
+def free_io(e: ast.Expr) -> set[tuple[str | None, str]]:
+    """The I/O names ``(prefix, name)`` a formula mentions: every ``in.``/``out.``
+    name, and the unprefixed names not bound inside it (a bare ``r`` may be an
+    input; the caller decides which names are I/O)."""
+    prefixed = {(v.prefix, v.name) for v in subexpressions(e) if isinstance(v, ast.Var) and v.prefix is not None}
+    return prefixed | {(None, n) for n in free_names(e)}
 
 
 def _loc(l: ast.Loc) -> str:

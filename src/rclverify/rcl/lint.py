@@ -25,11 +25,9 @@ may be passed through or consumed only by the implementation.
 """
 from __future__ import annotations
 
-from typing import Iterator, Union
-
 from . import ast
 from .errors import Diagnostic, warning
-from .printer import is_type
+from .walk import free_names, subexpressions
 
 _IMPLICATIONS = ("->", "<=>")
 _JUNCTIONS = ("and", "or")
@@ -62,63 +60,6 @@ def lint(spec: ast.Spec) -> list[Diagnostic]:
 # ---------------------------------------------------------------------------
 # Traversal
 # ---------------------------------------------------------------------------
-
-def subexpressions(e: ast.Expr) -> Iterator[ast.Expr]:
-    """``e`` and every expression inside it, pre-order (including
-    quantifier domains that are terms and applied function names)."""
-    stack: list[ast.Expr] = [e]
-    while stack:
-        cur = stack.pop()
-        yield cur
-        stack.extend(reversed(list(_children(cur))))
-
-
-def _children(e: ast.Expr) -> Iterator[ast.Expr]:
-    if isinstance(e, ast.Apply):
-        yield e.func
-        yield from e.args
-    elif isinstance(e, ast.Unary):
-        yield e.operand
-    elif isinstance(e, ast.Binary):
-        yield e.left
-        yield e.right
-    elif isinstance(e, ast.Compare):
-        yield from e.operands
-    elif isinstance(e, ast.Member):
-        yield e.elem
-        yield e.collection
-    elif isinstance(e, (ast.SetLit, ast.SeqLit, ast.TupleLit)):
-        yield from e.items
-    elif isinstance(e, ast.Quant):
-        for b in e.bindings:
-            if not is_type(b.domain):
-                yield b.domain  # type: ignore[misc]
-        yield e.body
-
-
-def free_names(e: Union[ast.Expr, ast.TypeExpr]) -> set[str]:
-    """Unprefixed names occurring free in ``e`` (bound variables of inner
-    quantifiers excluded, shadowing respected).  A type name counts (as a
-    quantifier domain ``x in s`` it may name an earlier bound variable);
-    other types have none."""
-    if isinstance(e, ast.TName):
-        return {e.name}
-    if is_type(e):
-        return set()
-    if isinstance(e, ast.Var):
-        return {e.name} if e.prefix is None else set()
-    if isinstance(e, ast.Quant):
-        free: set[str] = set()
-        bound: set[str] = set()
-        for b in e.bindings:
-            free |= free_names(b.domain) - bound
-            bound |= set(b.names)
-        return free | (free_names(e.body) - bound)
-    out: set[str] = set()
-    for c in _children(e):  # type: ignore[arg-type]
-        out |= free_names(c)
-    return out
-
 
 # ---------------------------------------------------------------------------
 # Rules

@@ -47,6 +47,7 @@ from typing import Any, Iterable, Iterator, Mapping, Sequence, Union, cast
 
 from ...rcl import ast
 from ...rcl.printer import expr_to_rcl
+from ...rcl.walk import free_names
 from ...rcl.errors import RclError
 from ...rcl.parser import parse_formula
 from . import psl
@@ -97,34 +98,10 @@ Form = Union[FConst, FLit, FAnd, FOr, FQuant]
 Item = Union[FLit, FQuant]
 
 
-def expr_vars(e: Any, bound: frozenset[str] = frozenset()) -> set[str]:
-    """Names of the unprefixed variables occurring free in an RCL expression."""
-    out: set[str] = set()
-    if isinstance(e, ast.Var):
-        if e.prefix is None and e.name not in bound:
-            out.add(e.name)
-    elif isinstance(e, ast.Apply):
-        for a in e.args:
-            out |= expr_vars(a, bound)
-    elif isinstance(e, ast.Unary):
-        out |= expr_vars(e.operand, bound)
-    elif isinstance(e, ast.Binary):
-        out |= expr_vars(e.left, bound) | expr_vars(e.right, bound)
-    elif isinstance(e, (ast.Compare,)):
-        for o in e.operands:
-            out |= expr_vars(o, bound)
-    elif isinstance(e, ast.Member):
-        out |= expr_vars(e.elem, bound) | expr_vars(e.collection, bound)
-    elif isinstance(e, (ast.SetLit, ast.TupleLit, ast.SeqLit)):
-        for o in e.items:
-            out |= expr_vars(o, bound)
-    elif isinstance(e, ast.Quant):
-        inner = bound | frozenset(e.variables)
-        for b in e.bindings:
-            if not _is_type(b.domain):
-                out |= expr_vars(b.domain, bound)
-        out |= expr_vars(e.body, inner)
-    return out
+def expr_vars(e: Any) -> set[str]:
+    """Names of the unprefixed variables occurring free in an RCL expression
+    (applied function and constructor names and type-named domains excluded)."""
+    return free_names(e, heads=False, type_names=False)
 
 
 def form_vars(f: Form) -> set[str]:
