@@ -24,7 +24,7 @@ shown in RCL names) or ``inconclusive`` (unknown/timeout; never proved).
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Any, Sequence
 
 from ..logic.encode import Encoder
@@ -108,7 +108,8 @@ class NodeComposition:
     derived_property: str
     cone: tuple[str, ...]
     loop_assumption: str | None = None
-    extra: dict[str, Any] = field(default_factory=dict)
+    cone_environment: tuple[tuple[str, str], ...] = ()
+    guarantee: str = ""
 
 
 def _rules(model: SystemModel, node: str) -> tuple[str, ...]:
@@ -193,15 +194,12 @@ def compose_node(checked: Checked, model: SystemModel, node: str, *,
         instances.append({"rule": rule, "premises": premises,
                           "conclusion": " and ".join(f"({a})" for a in prem_a) + f" => <> G_{node}"})
     cone = model.upstream(node)
-    cone_env: list[str] = []
-    for m in cone:
-        _, env_m = split_assumption(checked, model, m)
-        cone_env.extend(f"{expr_to_rcl(c)}  [{m}]" for c in env_m)
-    derived = ("(" + " and ".join(c.split("  [")[0] for c in cone_env) + ")" if cone_env else "TRUE") + f" => <> G_{node}"
+    cone_env = tuple((m, expr_to_rcl(c)) for m in cone for c in split_assumption(checked, model, m)[1])
+    derived = ("(" + " and ".join(t for _, t in cone_env) + ")" if cone_env else "TRUE") + f" => <> G_{node}"
     loop = model.loop_of(node)
     return NodeComposition(node, rules, tuple(producers), tuple(scs), env_assumptions, tuple(instances), derived,
                            tuple(cone), R4_ASSUMPTION.format(loop="{" + ", ".join(loop) + "}") if loop else None,
-                           {"cone_environment_assumptions": cone_env, "guarantee": g_text})
+                           cone_env, g_text)
 
 
 def composition_json(c: NodeComposition, smt2_paths: Sequence[str]) -> dict[str, Any]:
@@ -211,5 +209,6 @@ def composition_json(c: NodeComposition, smt2_paths: Sequence[str]) -> dict[str,
         "side_conditions": [sc.to_json(p) for sc, p in zip(c.side_conditions, smt2_paths)],
         "environment_assumptions": list(c.environment_assumptions), "instances": list(c.instances),
         "derived_property": c.derived_property, "cone": list(c.cone), "loop_assumption": c.loop_assumption,
-        "cone_environment_assumptions": c.extra["cone_environment_assumptions"], "guarantee": c.extra["guarantee"],
+        "cone_environment_assumptions": [f"{text}  [{node}]" for node, text in c.cone_environment],
+        "guarantee": c.guarantee,
     }
