@@ -30,7 +30,8 @@ from .backends.base import NodeTarget
 from .calculus.compose import compose_node, composition_json
 from .evidence.records import Evidence, Obligation
 from .evidence.store import EvidenceStore, atomic_write_text, read_json, write_json, write_obligations
-from .health.checks import check_node
+from .calculus.refinement import check_refinement, merge_envs, split_spec
+from .health.checks import Finding, check_node, refinement_finding
 from .plan.load import Plan, load_plan, resolve
 from .rcl import ast
 from .rcl.lint import lint
@@ -171,55 +172,41 @@ def stage_compose(ws: Workspace, node: str) -> dict[str, Any]:
 def stage_health(ws: Workspace, node: str) -> list[dict[str, Any]]:
     """Run the contract health checks of ``node``; writes its findings JSON."""
     facts = [(f.expr, f.loc) for f in ws.plan.facts.get(node, ())]
+    checked = check_node(ws.checked, node, facts, ws.plan.instances.get(node))
+    if node in ws.plan.replacements:
+        checked.append(replacement_finding(ws, node))
     findings = []
-    for f in check_node(ws.checked, node, facts, ws.plan.instances.get(node)):
+    for f in checked:
         j = f.to_json()
         if f.smt2:
             j["smt2"] = f"artifacts/health/{f.id}.smt2"
             atomic_write_text(ws.path(j["smt2"]), f.smt2)
         findings.append(j)
-    if node in ws.plan.replacements:
-        findings.append(replacement_finding(ws, node))
     write_json(ws.path(ws.health(node)), findings)
     return findings
 
 
-def replacement_finding(ws: Workspace, node: str) -> dict[str, Any]:
+def replacement_finding(ws: Workspace, node: str) -> Finding:
     """Check that the plan's replacement contract for ``node`` refines it
-    (paper lines 1667-1700, interchangeability) and say so as a finding.
+    (paper lines 1667-1700, interchangeability).
 
-    Raises :class:`RclError` (located) when the replacement cannot be read or
-    does not check, or when its interface differs.
+    Raises :class:`RclError` (located at the plan's ``replacement`` entry, or
+    in the replacement file) when it cannot be read, does not check, lacks the
+    node, or has a different interface.
     """
-    from .calculus.refinement import check_refinement, merge_envs
     spec, loc = ws.plan.replacements[node]
-    rel, _, name = spec.rpartition(":")
+    rel, name = split_spec(spec)
     try:
         text = (ws.root / rel).read_text(encoding="utf-8")
     except OSError as exc:
         raise RclError([error(loc, f"cannot read replacement contract {rel!r}: {exc.strerror or exc}", "E-io")]) from None
     other = check([parse_text(text, rel)])
-    if name not in other.nodes:
+    if name is None and len(other.nodes) == 1:
+        name = next(iter(other.nodes))
+    if name is None or name not in other.nodes:
         raise RclError([error(loc, f"{rel} has no node {name!r}; it has {', '.join(other.nodes) or 'none'}", "E-plan")])
-    r = check_refinement(ws.checked.nodes[node], other.nodes[name], merge_envs(ws.checked, other))
-    fid = f"{node}.replacement-refines"
-    for side in (r.assumption, r.guarantee):
-        atomic_write_text(ws.path(f"artifacts/health/{fid}.{side.name}.smt2"), side.smt2)
-    sides = {"proved": "holds", "refuted": "fails", "inconclusive": "is undecided"}
-    detail = (f"Assumption side (A_{node} -> A_replacement) {sides[r.assumption.status]}; guarantee side "
-              f"(A_{node} and G_replacement -> G_{node}) {sides[r.guarantee.status]}.")
-    failed = next((s for s in (r.assumption, r.guarantee) if s.status == "refuted"), None)
-    if r.verdict == "refines":
-        status, msg = "ok", f"The replacement contract {spec} refines {node}: it may replace it."
-    elif failed is not None:
-        status, msg = "problem", f"The replacement contract {spec} does not refine {node}: its {failed.name} side fails."
-    else:
-        status, msg = "inconclusive", f"Z3 could not decide whether {spec} refines {node}."
-    return {"id": fid, "node": node, "check": "replacement-refines", "guarantee": None, "status": status,
-            "message": msg, "explanation": detail + (f" Statement: {failed.statement}" if failed else ""),
-            "model": failed.model if failed else None, "core": None,
-            "duration_s": round(r.assumption.duration_s + r.guarantee.duration_s, 4), "instances": None,
-            "smt2": f"artifacts/health/{fid}.guarantee.smt2"}
+    return refinement_finding(node, spec, check_refinement(ws.checked.nodes[node], other.nodes[name],
+                                                           merge_envs(ws.checked, other)))
 
 
 def stage_export(ws: Workspace, node: str) -> list[dict[str, Any]]:

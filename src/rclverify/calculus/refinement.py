@@ -223,7 +223,7 @@ def check_refinement(a: CheckedNode, b: CheckedNode, env: Env, *,
 # Command line
 # ---------------------------------------------------------------------------
 
-def _split_spec(spec: str) -> tuple[str, str | None]:
+def split_spec(spec: str) -> tuple[str, str | None]:
     """``path.rcl:Node`` -> ``(path, Node)``; ``path.rcl`` -> ``(path, None)``."""
     head, sep, tail = spec.rpartition(":")
     if sep and tail and head and "/" not in tail and "\\" not in tail and not tail.endswith(".rcl"):
@@ -238,7 +238,7 @@ def load_node(spec: str) -> tuple[Checked, CheckedNode]:
     :class:`RclError` (located) for a missing file, a syntax or type error,
     or an unknown node (listing the nodes there are).
     """
-    path, name = _split_spec(spec)
+    path, name = split_spec(spec)
     checked = load([path])
     if name is None:
         if len(checked.nodes) != 1:

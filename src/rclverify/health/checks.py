@@ -30,6 +30,7 @@ from typing import Any, Sequence
 
 import z3
 
+from ..calculus.refinement import RefinementResult
 from ..logic.encode import Encoder
 from ..logic.query import QueryResult, satisfiable
 from ..rcl import ast
@@ -257,6 +258,26 @@ def _premise_finding(h: _NodeHealth, n: str, k: int, r: QueryResult, ptext: str)
     return Finding(fid, n, check, k, "inconclusive", f"Z3 could not decide whether guarantee {k} of {n} can fire"
                    + (f" for {v} in {_ranges(unk)}" if unk else "") + ".",
                    f"Premise: {ptext}.", None, None, round(total, 4), per)
+
+
+def refinement_finding(node: str, spec: str, r: RefinementResult) -> Finding:
+    """The verdict of "may ``spec`` replace ``node``'s contract" as a finding
+    (check ``replacement-refines``; paper lines 1667-1700).  Its SMT-LIB2 holds
+    both refinement queries, separated by ``(reset)``."""
+    sides = {"proved": "holds", "refuted": "fails", "inconclusive": "is undecided"}
+    detail = (f"Assumption side (A_{node} -> A_replacement) {sides[r.assumption.status]}; guarantee side "
+              f"(A_{node} and G_replacement -> G_{node}) {sides[r.guarantee.status]}.")
+    failed = next((s for s in (r.assumption, r.guarantee) if s.status == "refuted"), None)
+    if r.verdict == "refines":
+        status, msg = "ok", f"The replacement contract {spec} refines {node}: it may replace it."
+    elif failed is not None:
+        status, msg = "problem", f"The replacement contract {spec} does not refine {node}: its {failed.name} side fails."
+    else:
+        status, msg = "inconclusive", f"Z3 could not decide whether {spec} refines {node}."
+    return Finding(f"{node}.replacement-refines", node, "replacement-refines", None, status, msg,
+                   detail + (f" Statement: {failed.statement}" if failed else ""), dict(failed.model) if failed and failed.model is not None else None,
+                   None, round(r.assumption.duration_s + r.guarantee.duration_s, 4),
+                   smt2=r.assumption.smt2 + "\n(reset)\n" + r.guarantee.smt2)
 
 
 def _ranges(xs: Sequence[str]) -> str:
