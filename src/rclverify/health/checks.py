@@ -274,8 +274,9 @@ def refinement_finding(node: str, spec: str, r: RefinementResult) -> Finding:
         status, msg = "problem", f"The replacement contract {spec} does not refine {node}: its {failed.name} side fails."
     else:
         status, msg = "inconclusive", f"Z3 could not decide whether {spec} refines {node}."
+    model = dict(failed.model) if failed is not None and failed.model is not None else None
     return Finding(f"{node}.replacement-refines", node, "replacement-refines", None, status, msg,
-                   detail + (f" Statement: {failed.statement}" if failed else ""), dict(failed.model) if failed and failed.model is not None else None,
+                   detail + (f" Statement: {failed.statement}" if failed else ""), model,
                    None, round(r.assumption.duration_s + r.guarantee.duration_s, 4),
                    smt2=r.assumption.smt2 + "\n(reset)\n" + r.guarantee.smt2)
 
