@@ -26,13 +26,14 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from fractions import Fraction
-from typing import Any, Callable, Mapping
+from typing import Any, Callable, Mapping, cast
 
 import z3
 
 from ..rcl import ast
 from ..rcl.types import (BOOL, NATURAL, CheckedNode, DataT, EmptyT, EnumT, Env, FuncT, Scalar, SeqT,
                          SetT, TupleT, Type)
+from ..rcl.printer import is_type
 from ..rcl.typecheck import domain_type
 
 _SORTS: dict[Type, Any] = {}
@@ -274,6 +275,7 @@ class Encoder:
 class _Ctx:
     def __init__(self, enc: Encoder, node: CheckedNode, symbols: dict[str, Any]) -> None:
         self.e, self.node, self.symbols = enc, node, symbols
+        self.var_types: dict[int, Type] = {}  # RCL type of each bound variable made here, by Z3 id
 
     # -- names -------------------------------------------------------------------------
     def io(self, v: ast.Var) -> Any:
@@ -405,14 +407,15 @@ class _Ctx:
                 raise EncodingError(bd.loc, "quantifying over functions is not supported")
             for nm in bd.names:
                 v = z3.Const(nm, sort_of(t))
+                self.var_types[v.get_id()] = t
                 inner[nm] = v
                 xs.append(v)
                 if t == NATURAL:
                     guards.append(v >= 0)
-                if not isinstance(bd.domain, (ast.TBase, ast.TName, ast.TEnum, ast.TConstructors, ast.TEmpty,
-                                              ast.TSet, ast.TSeq, ast.TTuple, ast.TFunc)) or (
-                        isinstance(bd.domain, ast.TName) and bd.domain.name not in self.e.env.types):
-                    coll = bd.domain if not isinstance(bd.domain, ast.TName) else ast.Var(bd.domain.name, None, bd.domain.loc)
+                if not is_type(bd.domain) or (isinstance(bd.domain, ast.TName)
+                                              and bd.domain.name not in self.e.env.types):
+                    coll = (ast.Var(bd.domain.name, None, bd.domain.loc) if isinstance(bd.domain, ast.TName)
+                            else cast(ast.Expr, bd.domain))  # a term domain: is_type said so
                     guards.append(self.member(v, coll, b))
         body = self.enc(x.body, inner)
         guard = z3.And(*guards) if guards else None
@@ -427,20 +430,14 @@ class _Ctx:
         return z3.Exists(xs, z3.And(core, unique))
 
     def _bound_types(self, b: Mapping[str, Any]) -> dict[str, Type]:
+        """RCL types of the bound names in scope: recorded for variables this
+        encoder bound; read off the sort for scalars bound by the caller."""
+        scalars = {z3.RealSort(): Scalar("REAL"), z3.IntSort(): Scalar("INTEGER"), z3.BoolSort(): BOOL}
         out: dict[str, Type] = {}
         for nm, v in b.items():
-            s = v.sort()
-            if s == z3.RealSort():
-                out[nm] = Scalar("REAL")
-            elif s == z3.IntSort():
-                out[nm] = Scalar("INTEGER")
-            elif s == z3.BoolSort():
-                out[nm] = BOOL
-            else:
-                for t, st in _SORTS.items():
-                    if st == s:
-                        out[nm] = t
-                        break
+            t = self.var_types.get(v.get_id()) or scalars.get(v.sort())
+            if t is not None:
+                out[nm] = t
         return out
 
 
