@@ -48,8 +48,32 @@ def create_after(executed: str) -> Callable[[_F], _F]:
 REPORTS = ["reports/assurance.html", "reports/assurance.md", "reports/assurance.json"]
 
 
+_WORKSPACES: dict[str, tuple[tuple[tuple[str, int, int], ...], Workspace]] = {}
+
+
+def _stamp(ws: Workspace) -> tuple[tuple[str, int, int], ...]:
+    files = [ws.plan_file] + (list(ws.plan.contracts) if "plan" in vars(ws) else [])
+    out = []
+    for f in files:
+        try:
+            st = (ws.root / f).stat()
+            out.append((f, st.st_mtime_ns, st.st_size))
+        except OSError:
+            out.append((f, -1, -1))
+    return tuple(out)
+
+
 def _ws(root: str) -> Workspace:
-    return Workspace(Path(root))
+    """The workspace at ``root``, loaded once per process: every action of a
+    doit run would otherwise parse and check the contracts again.  Reloaded
+    when the plan or a contract file changed on disk (stat-based)."""
+    cached = _WORKSPACES.get(root)
+    if cached is not None and _stamp(cached[1]) == cached[0]:
+        return cached[1]
+    ws = Workspace(Path(root))
+    ws.model  # load now (raises RclError for bad input) so the stamp covers the contracts read
+    _WORKSPACES[root] = (_stamp(ws), ws)
+    return ws
 
 
 def _fail(exc: RclError) -> TaskFailed:
@@ -70,12 +94,11 @@ def act_check(root: str) -> Any:
 def act_graph(root: str) -> Any:
     from .evidence.store import atomic_write_text
     from .report.diagram import dot_to_svg
-    ws = _ws(root)
-    svg = dot_to_svg(ws.path(ws.DOT).read_text(encoding="utf-8"))
+    svg = dot_to_svg((Path(root) / Workspace.DOT).read_text(encoding="utf-8"))
     if svg is None:
         print("graphviz 'dot' not found: the report embeds the DOT source instead of a diagram")
         return None
-    atomic_write_text(ws.path("artifacts/system/model.svg"), svg)
+    atomic_write_text(Path(root) / "artifacts/system/model.svg", svg)
     return None
 
 
@@ -101,8 +124,8 @@ def act_run(root: str, node: str, obligation_id: str) -> Any:
 def act_report(root: str) -> Any:
     from .report.build import build_report
     from .report.render import render_all
-    ws = _ws(root)
     try:
+        ws = _ws(root)
         report = build_report(ws)
     except RclError as exc:
         return _fail(exc)
