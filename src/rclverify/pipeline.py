@@ -146,14 +146,8 @@ def stage_check(ws: Workspace) -> dict[str, Any]:
         write_json(ws.path(ws.snapshot(name)), snap)
     write_json(ws.path(ws.MODEL), model.to_json())
     from .report.diagram import system_dot
-    atomic_write_text(ws.path(ws.DOT), system_dot(_system_view(ws, model, {})))
+    atomic_write_text(ws.path(ws.DOT), system_dot(model.view({})))
     return {"warnings": warnings}
-
-
-def _system_view(ws: Workspace, model: SystemModel, status: dict[str, str]) -> dict[str, Any]:
-    d = model.to_json()
-    return {"nodes": [{"name": n, "status": status.get(n, "pending")} for n in model.nodes],
-            "connections": d["connections"], "environment_inputs": d["environment_inputs"], "loops": d["loops"]}
 
 
 def stage_compose(ws: Workspace, node: str) -> dict[str, Any]:

@@ -160,8 +160,7 @@ def build_report(ws: Workspace) -> dict[str, Any]:
     headline = (f"{len(ob_rows)} obligations: " + ", ".join(f"{counts[s]} {s}" for s in sorted(counts, key=SEVERITY.__getitem__))
                 + f"; {sum(1 for sc in side_conditions if sc['status'] == 'discharged')}/{len(side_conditions)} side conditions "
                 f"discharged; {sum(1 for f in findings if f['status'] == 'problem')} contract health problem(s).")
-    system = {"nodes": [{"name": n, "status": node_status[n]} for n in model.nodes], **{
-        k: v for k, v in model.to_json().items() if k != "nodes"}}
+    system = model.view(node_status)
     return {
         "meta": {"tool": "rclverify", "version": __version__, "workspace": plan.name or ws.root.resolve().name, "plan": plan.file,
                  "contracts": list(plan.contracts), "z3_version": z3.get_version_string(), "strict_ok": strict_ok},

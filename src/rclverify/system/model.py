@@ -92,6 +92,13 @@ class SystemModel:
             "loops": [list(l) for l in self.loops],
         }
 
+    def view(self, status: dict[str, str]) -> dict[str, Any]:
+        """:meth:`to_json` with each node's roll-up status (``pending`` when
+        unknown): what the diagram and the report's system section show."""
+        d = self.to_json()
+        d["nodes"] = [{"name": n, "status": status.get(n, "pending")} for n in self.nodes]
+        return d
+
     @staticmethod
     def from_json(d: dict[str, Any]) -> "SystemModel":
         return SystemModel(tuple(d["nodes"]), tuple(Link(**l) for l in d["connections"]),
