@@ -168,3 +168,29 @@ def test_parallel_run_gives_the_serial_results(report: dict, tmp_path: Path) -> 
     assert r.returncode == 0, r.stdout + r.stderr
     parallel = json.loads((tmp_path / "reports" / "assurance.json").read_text())
     assert _statuses(parallel) == _statuses(report)
+
+
+def test_side_conditions_are_written_for_a_second_solver(report: dict, workspace: Path) -> None:
+    import z3
+    for sc in report["side_conditions"]:
+        s = z3.Solver(ctx=z3.Context())  # a fresh solver instance, as a second solver would be
+        s.from_file(str(workspace / sc["smt2"]))  # the negated side condition: unsat means it holds
+        assert s.check() == z3.unsat, sc["id"]
+
+
+def test_editing_one_contract_reruns_that_node_its_consumers_and_the_report(workspace: Path) -> None:
+    rcl = workspace / "contracts" / "remote_inspection.rcl"
+    original = rcl.read_text()
+    try:
+        rcl.write_text(original.replace("and (250 <= in.r -> out.radiationStatus == red)",
+                                        "and (251 <= in.r -> out.radiationStatus == red)"))
+        r = _doit(workspace, "verify")
+        assert r.returncode == 0, r.stdout + r.stderr
+        ran = {l[3:] for l in r.stdout.splitlines() if l.startswith(".  ")}
+        evidence = {t for t in ran if t.startswith("evidence:")}
+        assert evidence and all(t.startswith("evidence:RadiationSensor.") for t in evidence)
+        assert ran - evidence == {"check", "compose:RadiationSensor", "compose:Agent", "health:RadiationSensor",
+                                  "export:RadiationSensor", "report", "verify"}
+    finally:
+        rcl.write_text(original)
+        assert _doit(workspace, "verify").returncode == 0

@@ -60,6 +60,13 @@ class EncodingError(Exception):
         super().__init__(f"{loc}: error: {message}")
 
 
+def smt_symbol(name: str) -> str:
+    """A Z3/SMT-LIB2 symbol for an RCL name: primes (``x'``), which SMT-LIB
+    simple symbols do not allow, become ``_prime`` (``x_prime``), so that the
+    written queries can be re-checked by a second solver."""
+    return name.replace("'", "_prime")
+
+
 def sort_of(t: Type) -> z3.SortRef:
     """Z3 sort of a resolved RCL type (cached per process).
 
@@ -224,6 +231,7 @@ class Encoder:
 
     def fresh(self, z3name: str, display: str, t: Type) -> z3.ExprRef:
         """A new free constant (e.g. a Skolem witness) shown as ``display`` in models."""
+        z3name = smt_symbol(z3name)
         decl = z3.Const(z3name, sort_of(t))
         self.symbols[z3name] = Symbol(z3name, display, t, decl)
         return decl
@@ -406,7 +414,7 @@ class _Ctx:
             if isinstance(t, FuncT):
                 raise EncodingError(bd.loc, "quantifying over functions is not supported")
             for nm in bd.names:
-                v = z3.Const(nm, sort_of(t))
+                v = z3.Const(smt_symbol(nm), sort_of(t))
                 self.var_types[v.get_id()] = t
                 inner[nm] = v
                 xs.append(v)
