@@ -155,3 +155,16 @@ def test_console_script_prints_no_traceback() -> None:
     assert "Traceback" not in proc.stderr and proc.stdout == ""
     errs = located_errors(proc.stderr)
     assert [(l, c) for _, l, c, _ in errs] == [(9, 16), (10, 14)]
+
+
+def test_graph_writes_dot_and_svg(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    import shutil as sh
+    ws = tmp_path / "ws"
+    sh.copytree(ROOT / "contracts", ws / "contracts")
+    sh.copytree(ROOT / "backends", ws / "backends")
+    out = tmp_path / "model.dot"
+    assert main(["graph", "-w", str(ws), "-o", str(out)]) == 0
+    dot = out.read_text()
+    assert dot.lstrip().startswith(("digraph", "//", "/*")) and "Localisation" in dot and "RadiationSensor" in dot
+    if sh.which("dot"):
+        assert "<svg" in out.with_suffix(".svg").read_text()

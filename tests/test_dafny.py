@@ -376,3 +376,23 @@ def test_workspace_agent_implementation_is_bundled() -> None:
     text = (REPO / "backends" / "dafny" / "agent.dfy").read_text(encoding="utf-8")
     scan = scan_implementation(text, "AgentContract", "Agent")
     assert scan.refining and scan.body_line is not None and scan.unsound == []
+
+
+def _fake_dafny(tmp_path: Path, name: str, script: str) -> str:
+    exe = tmp_path / name
+    exe.write_text("#!/bin/sh\n" + script)
+    exe.chmod(0o755)
+    return str(exe)
+
+
+def test_version_detection_picks_the_command_line_generation(tmp_path: Path) -> None:
+    from rclverify.backends.dafny.runner import detect, verify_argv
+    new = _fake_dafny(tmp_path, "dafny4", 'if [ "$1" = "--version" ]; then echo "4.9.1"; fi\n')
+    old = _fake_dafny(tmp_path, "dafny2", 'if [ "$1" = "/version" ]; then echo "Dafny 2.3.0.10506"; '
+                                           'else echo "*** Error: unknown"; fi\n')
+    t4, t2 = detect(new), detect(old)
+    assert t4 is not None and (t4.major, t4.legacy, t4.version) == (4, False, "4.9.1")
+    assert t2 is not None and (t2.major, t2.legacy, t2.version) == (2, True, "2.3.0.10506")
+    assert verify_argv(t4, ["a.dfy"], 30)[:4] == [new, "verify", "--verification-time-limit", "30"]
+    assert verify_argv(t2, ["a.dfy"], 30)[:4] == [old, "/compile:0", "/nologo", "/timeLimit:30"]
+    assert detect(_fake_dafny(tmp_path, "other", "echo hello\n")) is None

@@ -1,0 +1,87 @@
+"""Evidence records, roll-up order, atomic storage and staleness (shared/DESIGN.md "Evidence")."""
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+
+from rclverify.evidence.records import SEVERITY, Evidence, Obligation, SourceRef, hash_inputs, \
+    make_obligation_id, worst
+from rclverify.evidence.store import EvidenceStore, atomic_write_text, read_obligations, write_obligations
+
+
+def _obligation(**kw: object) -> Obligation:
+    base = dict(id="N.g1.hoare.p", node="N", guarantee=1, backend="hoare", kind="proof", statement="{A} P {Q}",
+                source=SourceRef("c.rcl", 3, 5), inputs=("prog.imp",), data={"entry": 0})
+    base.update(kw)
+    return Obligation(**base)  # type: ignore[arg-type]
+
+
+def _evidence(root: Path, status: str = "discharged") -> Evidence:
+    return Evidence(obligation="N.g1.hoare.p", backend="hoare", kind="proof", status=status, tool="z3",
+                    tool_version="4", started="2026-01-01T00:00:00+00:00", duration_s=0.5,
+                    input_hashes=hash_inputs(root, ["prog.imp"]), counterexample={"x": "1"})
+
+
+def test_roll_up_takes_the_worst_and_missing_is_pending() -> None:
+    assert worst(["discharged", "pending", "failed", "stale"]) == "failed"
+    assert worst(["discharged", "inconclusive"]) == "inconclusive"
+    assert worst([]) == "pending"
+    assert [s for s, _ in sorted(SEVERITY.items(), key=lambda kv: kv[1])] == \
+        ["discharged", "pending", "inconclusive", "stale", "error", "failed"]
+    with pytest.raises(KeyError):
+        worst(["proved"])
+
+
+def test_obligation_ids_are_stable_and_file_safe() -> None:
+    assert make_obligation_id("Agent", 2, "ajpf", "p3 i=4") == "Agent.g2.ajpf.p3_i_4"
+    assert make_obligation_id("Agent", 1, "dafny") == "Agent.g1.dafny"
+
+
+def test_records_round_trip_through_json(tmp_path: Path) -> None:
+    o = _obligation()
+    assert Obligation.from_json(json.loads(json.dumps(o.to_json()))) == o
+    (tmp_path / "prog.imp").write_text("skip")
+    e = _evidence(tmp_path)
+    assert Evidence.from_json(json.loads(json.dumps(e.to_json()))) == e
+    with pytest.raises(ValueError):
+        Evidence.from_json({**e.to_json(), "status": "passed"})
+    write_obligations(tmp_path / "o.json", [o])
+    assert read_obligations(tmp_path / "o.json") == [o]
+
+
+def test_atomic_write_replaces_whole_and_skips_identical_content(tmp_path: Path) -> None:
+    p = tmp_path / "d" / "f.json"
+    assert atomic_write_text(p, "one") is True
+    assert atomic_write_text(p, "one") is False
+    assert atomic_write_text(p, "two") is True and p.read_text() == "two"
+    assert [f.name for f in p.parent.iterdir()] == ["f.json"]  # no temporary file left behind
+
+
+def test_a_failing_write_keeps_the_record_already_there(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    (tmp_path / "prog.imp").write_text("skip")
+    store = EvidenceStore(tmp_path)
+    store.put(_evidence(tmp_path))
+    before = store.path("N.g1.hoare.p").read_bytes()
+
+    def broken(*a: object, **k: object) -> None:
+        raise OSError("disk full")
+    monkeypatch.setattr("os.replace", broken)
+    with pytest.raises(OSError):
+        store.put(_evidence(tmp_path, "failed"))
+    assert store.path("N.g1.hoare.p").read_bytes() == before
+    assert [f.name for f in store.dir.iterdir()] == ["N.g1.hoare.p.json"]
+
+
+def test_evidence_is_stale_once_an_input_changes(tmp_path: Path) -> None:
+    (tmp_path / "prog.imp").write_text("skip")
+    store = EvidenceStore(tmp_path)
+    store.put(_evidence(tmp_path, "failed"))
+    ev = store.get("N.g1.hoare.p")
+    assert ev is not None and store.current_status(ev) == "failed"
+    (tmp_path / "prog.imp").write_text("skip; skip")
+    assert store.current_status(ev) == "stale"
+    (tmp_path / "prog.imp").unlink()
+    assert store.current_status(ev) == "stale"
+    assert store.get("missing") is None
