@@ -34,6 +34,11 @@ def test_self_contradictory_contract():
     assert sorted(c.core) == ["guarantee 1 (t.rcl:2:7)", "guarantee 2 (t.rcl:2:28)"]
 
 
+def test_a_guarantee_without_premise_gets_no_vacuity_verdict():
+    f = _findings("""node n { inputs(x : REAL) outputs(y : REAL) guarantee(out.y == in.x) }""", "n")
+    assert set(f) == {"n.assumption-satisfiable", "n.contract-consistent"}
+
+
 def test_vacuous_and_firing_guarantees():
     f = _findings("""context { S : {on, off}; }
       node n { inputs(x : REAL) outputs(s : S)

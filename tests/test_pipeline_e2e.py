@@ -47,6 +47,10 @@ def test_calculus_reproduces_d1(report: dict) -> None:
     agent = next(d for d in report["derived_properties"] if d["node"] == "Agent")
     assert "R3" in agent["rules"]
     assert agent["instances"][0]["conclusion"].endswith("and (0 <= in.r) => <> G_Agent")
+    # a derived property rests on the cone's contracts too: with their evidence open it is not verified
+    loc = next(d for d in report["derived_properties"] if d["node"] == "Localisation")
+    assert loc["property"] == "TRUE => <> G_Localisation" and loc["status"] == "pending"
+    assert all(d["status"] != "discharged" for d in report["derived_properties"])
 
 
 def test_genuine_problems_of_the_case_study_are_shown(report: dict) -> None:

@@ -14,7 +14,9 @@ while any of its evidence is failed, pending, stale or missing:
 * node: worst of its guarantees and its side conditions;
 * requirement: worst of the guarantees that support it and of the side
   conditions of their nodes;
-* derived property: worst of the side conditions in the node's upstream cone.
+* derived property: worst of the nodes in the node's upstream cone (their
+  side conditions and their evidence: the rules' premises are the nodes'
+  contracts, which only the evidence establishes).
 """
 from __future__ import annotations
 
@@ -133,7 +135,9 @@ def build_report(ws: Workspace) -> dict[str, Any]:
             continue
         derived.append({"node": n, "rules": c["rules"], "instances": c["instances"],
                         "environment_assumptions": c["cone_environment_assumptions"], "property": c["derived_property"],
-                        "status": worst([sc_status[m] for m in c["cone"]], empty="discharged"),
+                        # holds once its side conditions do AND every node of the cone
+                        # meets its contract (the rules' premises): their evidence counts
+                        "status": worst([node_status[m] for m in c["cone"]]),
                         "loop_assumption": c["loop_assumption"]})
 
     findings = [f for n in checked.nodes for f in health[n]]
