@@ -168,3 +168,16 @@ def test_graph_writes_dot_and_svg(tmp_path: Path, capsys: pytest.CaptureFixture[
     assert dot.lstrip().startswith(("digraph", "//", "/*")) and "Localisation" in dot and "RadiationSensor" in dot
     if sh.which("dot"):
         assert "<svg" in out.with_suffix(".svg").read_text()
+
+
+def test_strict_gate_counts_side_conditions_not_only_evidence(tmp_path: Path) -> None:
+    """No obligation at all, but a refuted side condition: the report must not pass --strict."""
+    import json
+    (tmp_path / "contracts").mkdir()
+    rover = (ROOT / "tests" / "data" / "rover_navigation.rcl").read_text()
+    (tmp_path / "contracts" / "rover.rcl").write_text(rover.replace("out.dest_plan <= 20", "out.dest_plan <= 25"))
+    (tmp_path / "contracts" / "plan.yaml").write_text("contracts: [contracts/rover.rcl]\n")
+    assert main(["compose", "-w", str(tmp_path)]) == 1  # Interface.sc1 is refuted
+    assert main(["report", "-w", str(tmp_path)]) == 0
+    report = json.loads((tmp_path / "reports" / "assurance.json").read_text())
+    assert report["obligations"] == [] and report["meta"]["strict_ok"] is False

@@ -187,7 +187,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     add("export", cmd_export, "export obligations to the plan's backends", True)
     add("report", cmd_report, "rebuild the assurance report from the artifacts", True)
     v = add("verify", cmd_verify, "run the whole pipeline with doit", True)
-    v.add_argument("--strict", action="store_true", help="exit 1 unless every obligation is discharged")
+    v.add_argument("--strict", action="store_true",
+                   help="exit 1 unless every obligation, side condition and health check holds")
     v.add_argument("-n", "--jobs", type=int, default=1, help="parallel doit processes")
     r = add("refines", cmd_refines, "check with Z3 that contract B may replace contract A")
     r.add_argument("original", help="FILE.rcl:Node of the contract to replace")

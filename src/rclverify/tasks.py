@@ -142,7 +142,8 @@ def act_verify(root: str, strict: bool) -> Any:
     for p in s["problems"]:
         print(f"  problem: {p}")
     if strict and not report["meta"]["strict_ok"]:
-        return TaskFailed("--strict: some evidence is failed, inconclusive, pending, stale or error (see reports/assurance.html)")
+        return TaskFailed("--strict: some evidence is failed, inconclusive, pending, stale or error, or a side condition "
+                          "or contract health check is not proved (see reports/assurance.html)")
     return None
 
 
@@ -269,7 +270,7 @@ def build_tasks(root: str | Path, plan_file: str = "contracts/plan.yaml") -> dic
         return {"actions": [(act_verify, [r])], "task_dep": ["check", "report"] if ok else ["check"],
                 "file_dep": [str(rootp / REPORTS[2])] if ok else [],
                 "params": [{"name": "strict", "long": "strict", "type": bool, "default": False,
-                            "help": "fail unless every obligation is discharged"}],
+                            "help": "fail unless every obligation, side condition and health check holds"}],
                 "uptodate": [strict_uptodate], "verbosity": 2}
 
     creators: dict[str, Callable[[], Any]] = {"task_check": task_check, "task_verify": task_verify}

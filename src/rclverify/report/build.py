@@ -160,7 +160,11 @@ def build_report(ws: Workspace) -> dict[str, Any]:
     for row in ob_rows:
         counts[row["status"]] = counts.get(row["status"], 0) + 1
     overall = worst([r["status"] for r in requirements] + list(node_status.values()) + [d["status"] for d in derived])
-    strict_ok = all(o["status"] == "discharged" for o in ob_rows)
+    # the --strict gate: every obligation discharged, every side condition proved,
+    # and no health check that found a problem or could not decide
+    strict_ok = (all(o["status"] == "discharged" for o in ob_rows)
+                 and all(sc["status"] == "discharged" for sc in side_conditions)
+                 and all(f["status"] == "ok" for f in findings))
     headline = (f"{len(ob_rows)} obligations: " + ", ".join(f"{counts[s]} {s}" for s in sorted(counts, key=SEVERITY.__getitem__))
                 + f"; {sum(1 for sc in side_conditions if sc['status'] == 'discharged')}/{len(side_conditions)} side conditions "
                 f"discharged; {sum(1 for f in findings if f['status'] == 'problem')} contract health problem(s).")
