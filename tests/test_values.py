@@ -19,7 +19,7 @@ def test_finite_function_call_index_and_default() -> None:
     with pytest.raises(TypeError):
         f(1.0)
     with pytest.raises(TypeError):
-        FiniteFunction({(1, 2): 0}, 0, arity=1)
+        FiniteFunction({(1, 2, 3): 0}, 0, arity=2)
 
 
 @pytest.mark.parametrize("value, typ, fragment", [
