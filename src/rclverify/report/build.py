@@ -142,7 +142,8 @@ def build_report(ws: Workspace) -> dict[str, Any]:
 
     findings = [f for n in checked.nodes for f in health[n]]
     diagnostics = read_artifact(ws, ws.DIAGNOSTICS, {"warnings": []})
-    lint_rows = [{"severity": d["severity"], "location": f"{d['file']}:{d['line']}:{d['col']}", "message": d["message"]}
+    lint_rows = [{"severity": d["severity"], "location": f"{d['file']}:{d['line']}:{d['col']}", "message": d["message"],
+                  "code": d.get("code", "")}
                  for d in diagnostics["warnings"]]
     env_assumptions = [e for n in checked.nodes for e in comps[n].get("environment_assumptions", [])]
 
