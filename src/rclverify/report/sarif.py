@@ -201,7 +201,8 @@ def _finding_results(report: Mapping[str, Any]) -> list[dict[str, Any]]:
 
 
 def _lint_results(report: Mapping[str, Any]) -> tuple[list[dict[str, Any]], list[Rule]]:
-    out, rules = [], {}
+    out: list[dict[str, Any]] = []
+    rules: dict[str, Rule] = {}
     for k, d in enumerate(report["lint"]):
         rid = lint_rule_id(str(d.get("code", "")))
         level = _LINT_LEVEL.get(str(d["severity"]).lower(), "note")
