@@ -146,6 +146,8 @@ def act_verify(root: str, strict: bool) -> Any:
     print(f"overall: {s['status']} -- {s['headline']}")
     for p in s["problems"]:
         print(f"  problem: {p}")
+    from .report.summary import print_summary
+    print_summary(report, "reports/assurance.html")
     if strict and not report["meta"]["strict_ok"]:
         return TaskFailed("--strict: some evidence is failed, inconclusive, pending, stale or error, or a side condition "
                           "or contract health check is not proved (see reports/assurance.html)")
