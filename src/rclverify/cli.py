@@ -159,7 +159,7 @@ def cmd_verify(args: argparse.Namespace) -> int:
     module.__dict__.update(tasks)
     module.DOIT_CONFIG = {"verbosity": 2, "dep_file": str(Path(args.workspace) / ".doit.db")}  # type: ignore[attr-defined]
     from .progress import ProgressReporter
-    module.DOIT_CONFIG["reporter"] = ProgressReporter  # type: ignore[attr-defined]
+    module.DOIT_CONFIG["reporter"] = ProgressReporter
     argv = ["verify"] + (["--strict"] if args.strict else [])
     if args.jobs > 1:
         argv = ["-n", str(args.jobs)] + argv

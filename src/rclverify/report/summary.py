@@ -94,7 +94,7 @@ def summary_table(report: Mapping[str, Any], colour: bool) -> Table:
     cols = [("node", total["node"]), ("status", total["status"]), ("obligations", _counts(total["obligations"], colour)),
             ("side conditions", f"{total['sc_proved']}/{total['sc_total']} proved"), ("health", _health(total))]
     for head, foot in cols:
-        table.add_column(head, footer=foot, overflow="fold")
+        table.add_column(head, footer=foot, overflow="fold", no_wrap=head in ("node", "status"))
     for r in shown:
         st = f"[{_COLOUR.get(r['status'], 'red')}]{r['status']}[/]" if colour else r["status"]
         table.add_row(r["node"], st, _counts(r["obligations"], colour),
