@@ -44,6 +44,8 @@ def test_init_then_doit_verify_works_in_a_fresh_directory(tmp_path: Path) -> Non
     # without evidence entries nothing reads as verified
     assert all(g["status"] == "pending" for n in report["nodes"] for g in n["guarantees"])
     assert (ws / "reports" / "assurance.sarif").is_file() and (ws / "reports" / "assurance.junit.xml").is_file()
+    # --strict does not pass a system whose guarantees have no evidence yet
+    assert report["meta"]["strict_ok"] is False
 
 
 def test_init_defaults_and_refuses_to_overwrite(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
