@@ -15,6 +15,8 @@ created after the export stage ran (docs/architecture.md, "doit tasks").
 """
 from __future__ import annotations
 
+import io
+import os
 import sys
 import time
 from typing import Any, Mapping
@@ -25,6 +27,53 @@ from rich.live import Live
 from rich.text import Text
 
 from .report.summary import is_terminal
+
+
+class _ChildLineWriter(io.TextIOBase):
+    """Standard output of a ``doit -n N`` worker process forked while the live
+    line is shown.  It writes whole lines only, each batch starting by
+    clearing the terminal line (``\\r`` + erase line), in one ``os.write``:
+    the parent's one-line live display is then redrawn below it at its next
+    refresh instead of being overwritten mid-line."""
+
+    def __init__(self, fd: int) -> None:
+        super().__init__()
+        self._fd = fd
+        self._buf = ""
+
+    def writable(self) -> bool:
+        return True
+
+    def isatty(self) -> bool:
+        return True
+
+    def fileno(self) -> int:
+        return self._fd
+
+    def write(self, text: str) -> int:
+        self._buf += text
+        if "\n" in self._buf:
+            lines, _, self._buf = self._buf.rpartition("\n")
+            os.write(self._fd, ("\r\x1b[2K" + lines + "\n").encode("utf-8", "replace"))
+        return len(text)
+
+    def flush(self) -> None:
+        if self._buf:
+            text, self._buf = self._buf, ""
+            os.write(self._fd, ("\r\x1b[2K" + text + "\n").encode("utf-8", "replace"))
+
+
+_LIVE_ACTIVE = False
+
+
+def _after_fork_in_child() -> None:
+    if _LIVE_ACTIVE and sys.__stdout__ is not None and sys.__stderr__ is not None:
+        sys.stdout = _ChildLineWriter(sys.__stdout__.fileno())
+        sys.stderr = _ChildLineWriter(sys.__stderr__.fileno())
+
+
+if hasattr(os, "register_at_fork"):
+    os.register_at_fork(after_in_child=_after_fork_in_child)
 
 
 def backend_of(obligation_id: str) -> str:
@@ -65,6 +114,8 @@ class ProgressReporter(ConsoleReporter):  # type: ignore[misc]
             self.live = Live(self._line(), console=console, transient=True, refresh_per_second=4,
                              redirect_stdout=True, redirect_stderr=True, get_renderable=self._line)
             self.live.start()
+            global _LIVE_ACTIVE
+            _LIVE_ACTIVE = True
 
     def execute_task(self, task: Any) -> None:
         if not self.live_mode:
@@ -97,6 +148,8 @@ class ProgressReporter(ConsoleReporter):  # type: ignore[misc]
     def complete_run(self) -> None:
         """Stop the live line, then let doit report failures as usual."""
         if self.live is not None:
+            global _LIVE_ACTIVE
+            _LIVE_ACTIVE = False
             self.live.stop()
             self.live = None
         super().complete_run()
@@ -122,4 +175,6 @@ class ProgressReporter(ConsoleReporter):  # type: ignore[misc]
                 line.append(f" +{len(running) - 1}")
         secs = int(time.monotonic() - self.started)
         line.append(f"  {secs // 60}:{secs % 60:02d}", style="dim")
+        # one terminal line at most: worker processes rely on it (see _ChildLineWriter)
+        line.no_wrap, line.overflow = True, "ellipsis"
         return line
