@@ -167,7 +167,8 @@ def build_report(ws: Workspace) -> dict[str, Any]:
                  and all(sc["status"] == "discharged" for sc in side_conditions)
                  and all(f["status"] == "ok" for f in findings)
                  # and no guarantee left without evidence (no obligation exported for it)
-                 and all(g["status"] == "discharged" for n in nodes for g in n["guarantees"]))
+                 and all(g_status(name, k) == "discharged" for name, cn in checked.nodes.items()
+                         for k in range(1, len(cn.node.guarantees) + 1)))
     headline = (f"{len(ob_rows)} obligations: " + ", ".join(f"{counts[s]} {s}" for s in sorted(counts, key=SEVERITY.__getitem__))
                 + f"; {sum(1 for sc in side_conditions if sc['status'] == 'discharged')}/{len(side_conditions)} side conditions "
                 f"discharged; {sum(1 for f in findings if f['status'] == 'problem')} contract health problem(s).")
