@@ -3,8 +3,9 @@
 obligation is discharged.  All logic lives in rclverify.tasks."""
 from pathlib import Path
 
+from rclverify.progress import ProgressReporter
 from rclverify.tasks import build_tasks
 
-DOIT_CONFIG = {"default_tasks": ["verify"], "verbosity": 2, "dep_file": ".doit.db"}
+DOIT_CONFIG = {"default_tasks": ["verify"], "verbosity": 2, "dep_file": ".doit.db", "reporter": ProgressReporter}
 
 globals().update(build_tasks(Path(__file__).parent))

@@ -100,6 +100,39 @@ def test_html_report_shows_the_problems_first(workspace: Path) -> None:
     assert "<svg" in html or "install graphviz" in html
 
 
+def test_ci_formats_carry_the_case_study_findings_at_their_rcl_locations(workspace: Path) -> None:
+    import jsonschema
+    import junitparser
+    from sarif import loader
+    reports = workspace / "reports"
+    log = json.loads((reports / "assurance.sarif").read_text())
+    schema = json.loads((ROOT / "tests" / "data" / "sarif-schema-2.1.0.json").read_text())
+    jsonschema.Draft4Validator(schema).validate(log)
+    records = loader.load_sarif_file(str(reports / "assurance.sarif")).get_records()
+    at = {(r["Code"], r["Location"], r["Line"]) for r in records}
+    rcl = "contracts/remote_inspection.rcl"
+    assert ("RCL-HEALTH-VACUOUS", rcl, 69) in at  # Agent guarantee 2
+    assert ("RCL-HEALTH-REPLACEMENT", rcl, 53) in at  # the Agent node
+    assert ("RCL-LINT-UNUSED-BOUND", rcl, 72) in at  # x', y' of Agent guarantee 3
+    refuted = [r for r in records if r["Code"] == "RCL-OBL-FAILED" and "appendix_b" in r["Description"]]
+    assert refuted and all(r["Severity"] == "error" and r["Location"] == rcl and "Counterexample: " in r["Description"]
+                           for r in refuted)
+    assert any("radiation_at(i) = 10" in r["Description"] for r in refuted)
+    assert {r["Severity"] for r in records if r["Code"] == "RCL-OBL-PENDING"} == {"note"}
+    xml = junitparser.JUnitXml.fromfile(str(reports / "assurance.junit.xml"))
+    suites = {s.name: s for s in xml}
+    assert set(suites) == {"Localisation", "Navigation", "Agent", "RadiationSensor"}
+    cases = {c.name: c for s in xml for c in s}
+    report = json.loads((reports / "assurance.json").read_text())
+    assert {o["id"] for o in report["obligations"]} | {sc["id"] for sc in report["side_conditions"]} <= set(cases)
+    failed = [c for n, c in cases.items() if "appendix_b" in n and c.result and isinstance(c.result[0], junitparser.Failure)]
+    assert failed and all("counterexample: " in c.result[0].text for c in failed)
+    assert failed[0].classname == "RadiationSensor.obligation" and failed[0]._elem.get("file") == rcl
+    review = cases["Localisation.g1.review.e0"]
+    assert isinstance(review.result[0], junitparser.Skipped) and "review" in review.result[0].message
+    assert not cases["Agent.sc1"].result  # the side condition of D1 is proved: the test case passes
+
+
 def test_second_run_executes_no_task(workspace: Path) -> None:
     r = _doit(workspace, "verify")
     assert r.returncode == 0

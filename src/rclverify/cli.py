@@ -10,6 +10,7 @@
 ``rclverify report``               rebuild reports/ from the artifacts
 ``rclverify verify [--strict]``    the whole pipeline through doit
 ``rclverify refines A.rcl:N B.rcl:M``  may contract M replace contract N?
+``rclverify init DIR [--nodes A,B]``  write a new workspace that verifies at once
 
 Exit codes: 0 success, 1 errors in the input (or, for ``compose``/``verify
 --strict``, an obligation that does not hold), 2 usage errors.  A user's
@@ -142,6 +143,9 @@ def cmd_report(args: argparse.Namespace) -> int:
     report = build_report(ws)
     for p in render_all(report, ws.path("reports")):
         print(p)
+    from .report.ci import write_ci_reports
+    for p in write_ci_reports(report, ws.path("reports")):
+        print(p)
     print(report["summary"]["headline"])
     return 0
 
@@ -154,10 +158,29 @@ def cmd_verify(args: argparse.Namespace) -> int:
     module = type(sys)("rclverify_dodo")
     module.__dict__.update(tasks)
     module.DOIT_CONFIG = {"verbosity": 2, "dep_file": str(Path(args.workspace) / ".doit.db")}  # type: ignore[attr-defined]
+    from .progress import ProgressReporter
+    module.DOIT_CONFIG["reporter"] = ProgressReporter
     argv = ["verify"] + (["--strict"] if args.strict else [])
     if args.jobs > 1:
         argv = ["-n", str(args.jobs)] + argv
     return int(DoitMain(ModuleTaskLoader(module)).run(argv))
+
+
+def cmd_init(args: argparse.Namespace) -> int:
+    from .scaffold import InitError, init_workspace
+    names = [n.strip() for n in args.nodes.split(",")] if args.nodes is not None else None
+    try:
+        written = init_workspace(Path(args.dir), names)
+    except InitError as exc:
+        print(f"{args.dir}: error: {exc}", file=sys.stderr)
+        return exc.exit_code
+    except OSError as exc:
+        print(f"{args.dir}: error: cannot write the workspace: {exc.strerror or exc}", file=sys.stderr)
+        return 1
+    for p in written:
+        print(p)
+    print(f"workspace written; run `doit verify` in {args.dir}")
+    return 0
 
 
 def cmd_refines(args: argparse.Namespace) -> int:
@@ -190,6 +213,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     v.add_argument("--strict", action="store_true",
                    help="exit 1 unless every obligation, side condition and health check holds")
     v.add_argument("-n", "--jobs", type=int, default=1, help="parallel doit processes")
+    i = add("init", cmd_init, "write a new workspace (dodo.py, example contracts, plan) that verifies at once")
+    i.add_argument("dir", help="directory to create (must be new or empty)")
+    i.add_argument("--nodes", help="comma-separated node names, in chain order (default: Sensor,Controller,Actuator)")
     r = add("refines", cmd_refines, "check with Z3 that contract B may replace contract A")
     r.add_argument("original", help="FILE.rcl:Node of the contract to replace")
     r.add_argument("replacement", help="FILE.rcl:Node of the replacement contract")

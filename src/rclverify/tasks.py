@@ -11,6 +11,7 @@ Stages and their real file dependencies, per node ``N``:
 ``evidence:ID``     one obligation's record + the files it reads -> its evidence record
                    (created after ``export`` ran, when the obligations are known)
 ``report``         every artifact above -> reports/assurance.{html,md,json}
+                   and the CI formats reports/assurance.sarif, assurance.junit.xml
 ``verify``         the whole pipeline; ``doit verify --strict`` fails unless every
                    obligation is discharged
 
@@ -46,6 +47,8 @@ def create_after(executed: str) -> Callable[[_F], _F]:
 
 
 REPORTS = ["reports/assurance.html", "reports/assurance.md", "reports/assurance.json"]
+#: The CI formats the ``report`` task also writes (SARIF 2.1.0, JUnit XML; see report/ci.py).
+CI_REPORTS = ["reports/assurance.sarif", "reports/assurance.junit.xml"]
 
 
 _WORKSPACES: dict[str, tuple[tuple[tuple[str, int, int], ...], Workspace]] = {}
@@ -130,6 +133,8 @@ def act_report(root: str) -> Any:
     except RclError as exc:
         return _fail(exc)
     render_all(report, ws.path("reports"))
+    from .report.ci import write_ci_reports
+    write_ci_reports(report, ws.path("reports"))
     print(f"report: reports/assurance.html  ({report['summary']['headline']})")
     return None
 
@@ -141,6 +146,8 @@ def act_verify(root: str, strict: bool) -> Any:
     print(f"overall: {s['status']} -- {s['headline']}")
     for p in s["problems"]:
         print(f"  problem: {p}")
+    from .report.summary import print_summary
+    print_summary(report, "reports/assurance.html")
     if strict and not report["meta"]["strict_ok"]:
         return TaskFailed("--strict: some evidence is failed, inconclusive, pending, stale or error, or a side condition "
                           "or contract health check is not proved (see reports/assurance.html)")
@@ -263,7 +270,7 @@ def build_tasks(root: str | Path, plan_file: str = "contracts/plan.yaml") -> dic
             deps += [str(rootp / ws.calculus(n)), str(rootp / ws.health(n)), str(rootp / ws.obligations(n))]
         deps += [str(rootp / ws.evidence(o["id"])) for _, o in exported()]
         return {"actions": [(act_report, [r])], "file_dep": deps, "task_dep": ["graph"] if ok else [],
-                "targets": [str(rootp / p) for p in REPORTS], "verbosity": 2, "clean": True}
+                "targets": [str(rootp / p) for p in REPORTS + CI_REPORTS], "verbosity": 2, "clean": True}
 
     def task_verify() -> dict[str, Any]:
         """The whole pipeline: check, compose, health, export, run, report.  --strict fails on any open evidence."""

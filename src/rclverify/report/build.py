@@ -142,7 +142,8 @@ def build_report(ws: Workspace) -> dict[str, Any]:
 
     findings = [f for n in checked.nodes for f in health[n]]
     diagnostics = read_artifact(ws, ws.DIAGNOSTICS, {"warnings": []})
-    lint_rows = [{"severity": d["severity"], "location": f"{d['file']}:{d['line']}:{d['col']}", "message": d["message"]}
+    lint_rows = [{"severity": d["severity"], "location": f"{d['file']}:{d['line']}:{d['col']}", "message": d["message"],
+                  "code": d.get("code", "")}
                  for d in diagnostics["warnings"]]
     env_assumptions = [e for n in checked.nodes for e in comps[n].get("environment_assumptions", [])]
 
@@ -164,7 +165,10 @@ def build_report(ws: Workspace) -> dict[str, Any]:
     # and no health check that found a problem or could not decide
     strict_ok = (all(o["status"] == "discharged" for o in ob_rows)
                  and all(sc["status"] == "discharged" for sc in side_conditions)
-                 and all(f["status"] == "ok" for f in findings))
+                 and all(f["status"] == "ok" for f in findings)
+                 # and no guarantee left without evidence (no obligation exported for it)
+                 and all(g_status(name, k) == "discharged" for name, cn in checked.nodes.items()
+                         for k in range(1, len(cn.node.guarantees) + 1)))
     headline = (f"{len(ob_rows)} obligations: " + ", ".join(f"{counts[s]} {s}" for s in sorted(counts, key=SEVERITY.__getitem__))
                 + f"; {sum(1 for sc in side_conditions if sc['status'] == 'discharged')}/{len(side_conditions)} side conditions "
                 f"discharged; {sum(1 for f in findings if f['status'] == 'problem')} contract health problem(s).")

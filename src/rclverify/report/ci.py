@@ -1,0 +1,35 @@
+"""Write the report's CI formats: ``assurance.sarif`` and ``assurance.junit.xml``.
+
+Called next to :func:`rclverify.report.render.render_all` by ``rclverify
+report`` and the doit ``report`` task.
+"""
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any, Mapping
+
+from ..evidence.store import atomic_write_text
+from .junit import render_junit
+from .sarif import render_sarif
+
+#: File names written under ``reports/``, in the order :func:`write_ci_reports` returns them.
+CI_FILES: tuple[str, ...] = ("assurance.sarif", "assurance.junit.xml")
+
+
+def write_ci_reports(report: Mapping[str, Any], out_dir: Path) -> list[Path]:
+    """Render ``report`` (the dict of ``build_report``) as SARIF 2.1.0 and JUnit
+    XML and write both to ``out_dir``.
+
+    Both texts are rendered before anything is written, so an error leaves the
+    previous files untouched; each write is atomic (and skipped when the text
+    is unchanged).  Returns the two paths (see :data:`CI_FILES`).  Raises
+    ``KeyError`` for a malformed report and ``OSError`` when ``out_dir``
+    cannot be written.
+    """
+    texts = dict(zip(CI_FILES, (render_sarif(report), render_junit(report))))
+    paths = []
+    for name, text in texts.items():
+        path = Path(out_dir) / name
+        atomic_write_text(path, text)
+        paths.append(path)
+    return paths

@@ -1,0 +1,252 @@
+"""The assurance report as a SARIF 2.1.0 log (``reports/assurance.sarif``).
+
+SARIF (OASIS Static Analysis Results Interchange Format 2.1.0) is what code
+scanning views read.  This module only lays out the report dict of
+:func:`rclverify.report.build.build_report`; it verifies nothing itself.
+
+One ``result`` per item that needs attention:
+
+* an obligation whose status is ``failed``, ``error``, ``stale``,
+  ``inconclusive`` or ``pending`` (a discharged one gives none);
+* a side condition of the calculus that is not ``discharged``;
+* a contract health finding whose status is ``problem`` or ``inconclusive``;
+* a lint warning.
+
+Each result names a stable rule id per kind of finding (:data:`RULES`,
+:func:`lint_rule_id`), a level (``error``/``warning``/``note``), the RCL
+file, line and column of the contract clause it is about (the records'
+``source``/``location``, 1-based, columns in Unicode code points), and, when
+there is one, the counterexample in the message.  Paths are relative to the
+workspace root (``uriBaseId`` ``%SRCROOT%``).  The log is deterministic for
+a given report dict: no timestamps, keys sorted, results in report order.
+The decisions behind the mapping are in ``docs/ci.md``.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any, Mapping, Sequence
+
+from ..evidence.store import dumps
+
+#: The SARIF version written and the schema it validates against.
+SARIF_VERSION = "2.1.0"
+SARIF_SCHEMA = "https://docs.oasis-open.org/sarif/sarif/v2.1.0/errata01/os/schemas/sarif-schema-2.1.0.json"
+#: Base id of every artifact location: the workspace root.
+SRCROOT = "%SRCROOT%"
+
+
+@dataclass(frozen=True)
+class Rule:
+    """One kind of finding: a stable SARIF ``reportingDescriptor``."""
+
+    id: str
+    name: str
+    level: str
+    text: str
+
+
+#: The fixed rules, keyed by id.  Lint rules are derived from the lint codes
+#: (:func:`lint_rule_id`).
+RULES: Mapping[str, Rule] = {r.id: r for r in (
+    Rule("RCL-OBL-FAILED", "ObligationFailed", "error",
+         "A backend refuted a proof obligation of a node's guarantee (the evidence is failed)."),
+    Rule("RCL-OBL-ERROR", "ObligationError", "error",
+         "A backend could not check a proof obligation (the evidence is error)."),
+    Rule("RCL-OBL-STALE", "ObligationStale", "warning",
+         "An input of the obligation changed after its evidence was produced; the evidence no longer vouches for it."),
+    Rule("RCL-OBL-INCONCLUSIVE", "ObligationInconclusive", "warning",
+         "The backend could not decide the obligation (unknown, timeout or bounded search)."),
+    Rule("RCL-OBL-PENDING", "ObligationPending", "note",
+         "The obligation has no evidence yet (the backend cannot run here or is not implemented)."),
+    Rule("RCL-SC-REFUTED", "SideConditionRefuted", "error",
+         "Z3 refuted a side condition of the composition calculus: the producers' guarantees do not entail "
+         "this conjunct of the consumer's assumption."),
+    Rule("RCL-SC-INCONCLUSIVE", "SideConditionInconclusive", "warning",
+         "Z3 could not decide a side condition of the composition calculus."),
+    Rule("RCL-HEALTH-UNSATISFIABLE-ASSUMPTION", "AssumptionUnsatisfiable", "error",
+         "The node's assumption can never hold: its contract promises nothing."),
+    Rule("RCL-HEALTH-INCONSISTENT", "ContractInconsistent", "error",
+         "The node's guarantees contradict each other (or the environment facts) under its assumption."),
+    Rule("RCL-HEALTH-VACUOUS", "GuaranteeVacuous", "error",
+         "The premise of a guarantee can never hold together with the other guarantees and the facts: "
+         "it promises nothing."),
+    Rule("RCL-HEALTH-REPLACEMENT", "ReplacementDoesNotRefine", "error",
+         "The replacement contract offered for the node does not refine the node's contract."),
+    Rule("RCL-HEALTH-OTHER", "HealthProblem", "error", "A contract health check found a problem."),
+    Rule("RCL-HEALTH-INCONCLUSIVE", "HealthInconclusive", "warning",
+         "Z3 could not decide a contract health check."),
+)}
+
+_HEALTH_RULE = {"assumption-satisfiable": "RCL-HEALTH-UNSATISFIABLE-ASSUMPTION",
+                "contract-consistent": "RCL-HEALTH-INCONSISTENT",
+                "non-vacuous": "RCL-HEALTH-VACUOUS",
+                "replacement-refines": "RCL-HEALTH-REPLACEMENT"}
+_OBLIGATION_RULE = {"failed": "RCL-OBL-FAILED", "error": "RCL-OBL-ERROR", "stale": "RCL-OBL-STALE",
+                    "inconclusive": "RCL-OBL-INCONCLUSIVE", "pending": "RCL-OBL-PENDING"}
+_LINT_LEVEL = {"error": "error", "warning": "warning"}
+
+
+def lint_rule_id(code: str) -> str:
+    """Rule id of a lint code: ``W-unused-bound`` -> ``RCL-LINT-UNUSED-BOUND``
+    (``RCL-LINT`` when the code is empty)."""
+    tail = code.split("-", 1)[1] if code[:2] in ("W-", "E-") else code
+    return f"RCL-LINT-{tail.upper()}" if tail else "RCL-LINT"
+
+
+def split_location(text: str) -> tuple[str, int, int] | None:
+    """``'contracts/x.rcl:12:5'`` -> ``('contracts/x.rcl', 12, 5)``; ``None``
+    when ``text`` is not of that shape (or names no file)."""
+    parts = str(text).rsplit(":", 2)
+    if len(parts) != 3 or not parts[0] or not parts[1].isdigit() or not parts[2].isdigit():
+        return None
+    return parts[0], int(parts[1]), int(parts[2])
+
+
+def _location(text: str) -> list[dict[str, Any]]:
+    loc = split_location(text)
+    if loc is None or loc[0].startswith("<"):
+        return []
+    file, line, col = loc
+    region: dict[str, Any] = {"startLine": max(1, line)}
+    if col >= 1:
+        region["startColumn"] = col
+    return [{"physicalLocation": {"artifactLocation": {"uri": file, "uriBaseId": SRCROOT}, "region": region}}]
+
+
+def _values(mapping: Mapping[str, Any] | None) -> str:
+    if not mapping:
+        return ""
+    return ", ".join(f"{k} = {v}" for k, v in sorted(mapping.items()))
+
+
+def _result(rule: str, level: str, text: str, where: str, key: str, props: Mapping[str, Any]) -> dict[str, Any]:
+    return {"ruleId": rule, "level": level, "message": {"text": text}, "locations": _location(where),
+            "partialFingerprints": {"rclverifyItem/v1": key}, "properties": dict(props)}
+
+
+def _obligation_results(report: Mapping[str, Any]) -> list[dict[str, Any]]:
+    evidence: dict[str, Mapping[str, Any]] = {}
+    for ev in report["evidence"]:
+        evidence[str(ev["obligation"])] = ev
+    reasons: dict[str, str] = {}
+    for p in report["pending"]:
+        reasons.setdefault(str(p["obligation"]), str(p["reason"]))
+    out = []
+    for o in report["obligations"]:
+        rule = _OBLIGATION_RULE.get(str(o["status"]))
+        if rule is None:
+            continue
+        ev = evidence.get(str(o["id"]))
+        words = [f"Obligation {o['id']} ({o['backend']}, {o['kind']}) of {o['node']} guarantee {o['guarantee']} "
+                 f"is {o['status']}: {o['statement']}."]
+        expl = str(ev["explanation"]) if ev is not None else reasons.get(str(o["id"]), "no evidence record yet")
+        if expl:
+            words.append(expl)
+        if ev is not None and ev.get("counterexample"):
+            words.append(f"Counterexample: {_values(ev['counterexample'])}.")
+        props = {"obligation": o["id"], "node": o["node"], "guarantee": o["guarantee"], "backend": o["backend"],
+                 "status": o["status"]}
+        if ev is not None and ev.get("counterexample"):
+            props["counterexample"] = dict(ev["counterexample"])
+        out.append(_result(rule, RULES[rule].level, " ".join(words), str(o["source"]), f"obligation:{o['id']}", props))
+    return out
+
+
+def _side_condition_results(report: Mapping[str, Any]) -> list[dict[str, Any]]:
+    out = []
+    for sc in report["side_conditions"]:
+        status = str(sc["status"])
+        if status == "discharged":
+            continue
+        rule = "RCL-SC-REFUTED" if status == "failed" else "RCL-SC-INCONCLUSIVE"
+        words = [f"Side condition {sc['id']} ({sc['rule']}) of {sc['node']} is {status}: {sc['conjunct']}."]
+        if sc.get("explanation"):
+            words.append(str(sc["explanation"]))
+        if sc.get("model"):
+            words.append(f"Counterexample: {_values(sc['model'])}.")
+        props = {"sideCondition": sc["id"], "node": sc["node"], "rule": sc["rule"], "status": status}
+        out.append(_result(rule, RULES[rule].level, " ".join(words), str(sc["source"]), f"side-condition:{sc['id']}",
+                           props))
+    return out
+
+
+def _finding_location(report: Mapping[str, Any], f: Mapping[str, Any]) -> str:
+    for n in report["nodes"]:
+        if n["name"] == f["node"]:
+            for g in n["guarantees"]:
+                if f["guarantee"] is not None and g["index"] == f["guarantee"]:
+                    return str(g["source"])
+            return str(n["source"])
+    return ""
+
+
+def _finding_results(report: Mapping[str, Any]) -> list[dict[str, Any]]:
+    out = []
+    for f in report["findings"]:
+        if f["status"] == "ok":
+            continue
+        rule = ("RCL-HEALTH-INCONCLUSIVE" if f["status"] == "inconclusive"
+                else _HEALTH_RULE.get(str(f["check"]), "RCL-HEALTH-OTHER"))
+        words = [str(f["message"])]
+        if f.get("explanation"):
+            words.append(str(f["explanation"]))
+        if f.get("core"):
+            words.append("Unsat core: " + "; ".join(str(c) for c in f["core"]) + ".")
+        if f.get("model"):
+            words.append(f"Counterexample: {_values(f['model'])}.")
+        props = {"finding": f["id"], "node": f["node"], "check": f["check"], "status": f["status"]}
+        out.append(_result(rule, RULES[rule].level, " ".join(words), _finding_location(report, f),
+                           f"health:{f['id']}", props))
+    return out
+
+
+def _lint_results(report: Mapping[str, Any]) -> tuple[list[dict[str, Any]], list[Rule]]:
+    out: list[dict[str, Any]] = []
+    rules: dict[str, Rule] = {}
+    for k, d in enumerate(report["lint"]):
+        rid = lint_rule_id(str(d.get("code", "")))
+        level = _LINT_LEVEL.get(str(d["severity"]).lower(), "note")
+        rules.setdefault(rid, Rule(rid, "Lint" + "".join(w.capitalize() for w in rid.split("-")[2:]), level,
+                                   "RCL lint: a contract clause that is legal but probably not what was meant."))
+        out.append(_result(rid, level, str(d["message"]), str(d["location"]),
+                           f"lint:{d['location']}:{d.get('code', '')}:{k}", {"severity": d["severity"]}))
+    return out, sorted(rules.values(), key=lambda r: r.id)
+
+
+def _descriptor(r: Rule) -> dict[str, Any]:
+    return {"id": r.id, "name": r.name, "shortDescription": {"text": r.text},
+            "defaultConfiguration": {"level": r.level}}
+
+
+def sarif_log(report: Mapping[str, Any]) -> dict[str, Any]:
+    """The SARIF 2.1.0 log (a JSON-serialisable dict) of ``report``.
+
+    ``report`` is the dict of :func:`~rclverify.report.build.build_report`
+    (keys ``meta``, ``obligations``, ``evidence``, ``pending``,
+    ``side_conditions``, ``findings``, ``nodes``, ``lint``).  Every rule of
+    :data:`RULES` is listed in the driver (so ids stay stable whether or not
+    they fire), results refer to their rule by ``ruleIndex`` too.  Raises
+    ``KeyError`` for a report dict without those keys.
+    """
+    lint, lint_rules = _lint_results(report)
+    results = _obligation_results(report) + _side_condition_results(report) + _finding_results(report) + lint
+    rules: Sequence[Rule] = list(RULES.values()) + lint_rules
+    index = {r.id: i for i, r in enumerate(rules)}
+    for res in results:
+        res["ruleIndex"] = index[res["ruleId"]]
+    meta = report["meta"]
+    run = {
+        "tool": {"driver": {"name": "rclverify", "version": str(meta["version"]),
+                            "rules": [_descriptor(r) for r in rules]}},
+        "originalUriBaseIds": {SRCROOT: {"description": {"text": "the root of the rclverify workspace"}}},
+        "columnKind": "unicodeCodePoints",
+        "results": results,
+        "properties": {"workspace": meta["workspace"], "plan": meta["plan"], "status": report["summary"]["status"],
+                       "strictOk": bool(meta["strict_ok"])},
+    }
+    return {"$schema": SARIF_SCHEMA, "version": SARIF_VERSION, "runs": [run]}
+
+
+def render_sarif(report: Mapping[str, Any]) -> str:
+    """:func:`sarif_log` as deterministic JSON text (sorted keys, final newline)."""
+    return dumps(sarif_log(report))

@@ -1,0 +1,121 @@
+"""The one-screen summary that ends ``doit verify`` and ``rclverify verify``.
+
+Per node: obligations by status, side conditions proved, contract health,
+the node's rolled-up status; a total row; the path of the report.  Built from
+the report dict of :func:`rclverify.report.build.build_report` with ``rich``
+tables.  On a terminal the table has colours; otherwise it is plain ASCII
+(no escape codes), so CI logs stay readable.
+"""
+from __future__ import annotations
+
+import sys
+from typing import IO, Any, Mapping
+
+from rich import box
+from rich.console import Console
+from rich.markup import escape
+from rich.table import Table
+
+from ..evidence.records import SEVERITY
+
+#: At most this many node rows (worst first); the rest are summed in one row.
+MAX_ROWS = 15
+
+_COLOUR = {"discharged": "green", "pending": "yellow", "inconclusive": "yellow", "stale": "magenta",
+           "error": "red", "failed": "red"}
+
+
+def _rank(status: str) -> int:
+    return SEVERITY.get(status, SEVERITY["error"])
+
+
+def node_rows(report: Mapping[str, Any]) -> list[dict[str, Any]]:
+    """One row per node of ``report``: ``{"node", "status", "obligations"
+    (status -> count), "sc_proved", "sc_total", "health_problems",
+    "health_open", "health_total"}``, worst status first, then report order."""
+    rows = []
+    for k, n in enumerate(report["nodes"]):
+        name = n["name"]
+        obs: dict[str, int] = {}
+        for o in report["obligations"]:
+            if o["node"] == name:
+                obs[o["status"]] = obs.get(o["status"], 0) + 1
+        scs = [sc for sc in report["side_conditions"] if sc["node"] == name]
+        fs = [f for f in report["findings"] if f["node"] == name]
+        rows.append({"node": name, "status": n["status"], "obligations": obs, "order": k,
+                     "sc_proved": sum(sc["status"] == "discharged" for sc in scs), "sc_total": len(scs),
+                     "health_problems": sum(f["status"] == "problem" for f in fs),
+                     "health_open": sum(f["status"] == "inconclusive" for f in fs), "health_total": len(fs)})
+    rows.sort(key=lambda r: (-_rank(r["status"]), r["order"]))
+    return rows
+
+
+def _counts(obs: Mapping[str, int], colour: bool) -> str:
+    if not obs:
+        return "none"
+    parts = []
+    for s in sorted(obs, key=lambda s: -_rank(s)):
+        text = f"{obs[s]} {s}"
+        parts.append(f"[{_COLOUR.get(s, 'red')}]{text}[/]" if colour else text)
+    return ", ".join(parts)
+
+
+def _health(r: Mapping[str, Any]) -> str:
+    if not r["health_total"]:
+        return "-"
+    words = []
+    if r["health_problems"]:
+        words.append(f"{r['health_problems']} problem")
+    if r["health_open"]:
+        words.append(f"{r['health_open']} undecided")
+    return ", ".join(words) or f"{r['health_total']} ok"
+
+
+def _merge(rows: list[dict[str, Any]], label: str) -> dict[str, Any]:
+    out: dict[str, Any] = {"node": label, "status": max((r["status"] for r in rows), key=_rank, default="discharged"),
+                           "obligations": {}}
+    for key in ("sc_proved", "sc_total", "health_problems", "health_open", "health_total"):
+        out[key] = sum(r[key] for r in rows)
+    for r in rows:
+        for s, c in r["obligations"].items():
+            out["obligations"][s] = out["obligations"].get(s, 0) + c
+    return out
+
+
+def summary_table(report: Mapping[str, Any], colour: bool) -> Table:
+    """The summary table of ``report`` (at most :data:`MAX_ROWS` node rows + total)."""
+    rows = node_rows(report)
+    shown, rest = rows[:MAX_ROWS], rows[MAX_ROWS:]
+    if rest:
+        shown = shown + [_merge(rest, f"(+{len(rest)} more nodes)")]
+    table = Table(title=escape(f"rclverify: {report['meta']['workspace']}"), box=box.SIMPLE_HEAD if colour else box.ASCII,
+                  show_footer=True, title_justify="left")
+    total = _merge(rows, "total")
+    cols = [("node", total["node"]), ("status", total["status"]), ("obligations", _counts(total["obligations"], colour)),
+            ("side conditions", f"{total['sc_proved']}/{total['sc_total']} proved"), ("health", _health(total))]
+    for head, foot in cols:
+        table.add_column(head, footer=foot, overflow="fold", no_wrap=head in ("node", "status"))
+    for r in shown:
+        st = f"[{_COLOUR.get(r['status'], 'red')}]{r['status']}[/]" if colour else r["status"]
+        table.add_row(r["node"], st, _counts(r["obligations"], colour),
+                      f"{r['sc_proved']}/{r['sc_total']} proved" if r["sc_total"] else "-", _health(r))
+    return table
+
+
+def is_terminal() -> bool:
+    """Is the process's standard output a terminal?"""
+    out = sys.__stdout__
+    return bool(out is not None and out.isatty())
+
+
+def print_summary(report: Mapping[str, Any], report_path: str, file: IO[str] | None = None,
+                  terminal: bool | None = None) -> None:
+    """Print the summary table of ``report`` and the report's path to ``file``
+    (default: the current ``sys.stdout``).  ``terminal`` (default
+    :func:`is_terminal`) selects colours and box drawing; otherwise plain
+    ASCII, at most 120 columns wide."""
+    tty = is_terminal() if terminal is None else terminal
+    console = Console(file=file or sys.stdout, force_terminal=tty, no_color=not tty, highlight=False,
+                      width=None if tty else 120, soft_wrap=False)
+    console.print(summary_table(report, tty))
+    console.print(f"report: {report_path}", markup=False)

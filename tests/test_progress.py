@@ -1,0 +1,66 @@
+"""Terminal output of verify: the live progress line and the summary table."""
+from __future__ import annotations
+
+import io
+from types import SimpleNamespace
+from typing import Any
+
+from rclverify.progress import ProgressReporter, backend_of
+from rclverify.report.summary import MAX_ROWS, node_rows, print_summary
+
+
+def _report(n_nodes: int) -> dict[str, Any]:
+    nodes = [{"name": f"N{k}", "status": "failed" if k == 7 else "discharged"} for k in range(n_nodes)]
+    obligations = [{"node": f"N{k}", "status": "failed" if k == 7 else "discharged"} for k in range(n_nodes)]
+    obligations.append({"node": "N0", "status": "pending"})
+    scs = [{"node": f"N{k}", "status": "discharged"} for k in range(1, n_nodes)]
+    findings = [{"node": "N7", "status": "problem"}, {"node": "N3", "status": "inconclusive"}, {"node": "N1", "status": "ok"}]
+    return {"meta": {"workspace": "w [x]"}, "nodes": nodes, "obligations": obligations, "side_conditions": scs,
+            "findings": findings}
+
+
+def test_summary_rows_put_the_worst_node_first() -> None:
+    rows = node_rows(_report(4))
+    assert [r["node"] for r in rows] == ["N0", "N1", "N2", "N3"]  # N0 pending ranks above discharged
+    rows = node_rows(_report(9))
+    assert rows[0]["node"] == "N7" and rows[0]["obligations"] == {"failed": 1} and rows[0]["health_problems"] == 1
+
+
+def test_plain_summary_fits_one_screen_and_has_no_escape_codes() -> None:
+    out = io.StringIO()
+    print_summary(_report(40), "reports/assurance.html", file=out, terminal=False)
+    text = out.getvalue()
+    assert "\x1b[" not in text and "w [x]" in text
+    lines = text.splitlines()
+    assert len(lines) <= MAX_ROWS + 12
+    assert any(l.startswith("| N7 ") and "failed" in l and "1 problem" in l for l in lines)
+    assert any("(+25 more nodes)" in l for l in lines)
+    total = next(l for l in lines if l.startswith("| total"))
+    assert "1 failed, 1 pending, 39 discharged" in total and "39/39 proved" in total
+    assert lines[-1] == "report: reports/assurance.html"
+
+
+def test_progress_line_shows_stage_count_and_running_backend() -> None:
+    rep = ProgressReporter(io.StringIO(), {})
+    rep.live_mode = True  # as on a terminal, without starting the live display
+    rep.tasks = {"check": 0, "evidence": 0, "evidence:A.g1.hoare.c1": 0, "evidence:A.g1.dafny.contract": 0}
+    first = SimpleNamespace(name="evidence:A.g1.hoare.c1", actions=[object()])
+    second = SimpleNamespace(name="evidence:A.g1.dafny.contract", actions=[object()])
+    rep.execute_task(first)
+    line = rep._line().plain
+    assert line.startswith("evidence") and "0/2 obligations" in line and "running: hoare (A.g1.hoare.c1)" in line
+    rep.add_success(first)
+    rep.skip_uptodate(second)
+    line = rep._line().plain
+    assert "2/2 obligations" in line and "running" not in line
+    assert rep.outstream.getvalue() == ""  # no per-task lines on a terminal
+    assert backend_of("Agent.g0.dafny.contract") == "dafny" and backend_of("odd") == ""
+
+
+def test_progress_is_doit_console_output_when_not_a_terminal() -> None:
+    out = io.StringIO()
+    rep = ProgressReporter(out, {})
+    rep.live_mode = False
+    rep.execute_task(SimpleNamespace(name="report", actions=[object()], title=lambda: "report"))
+    rep.skip_uptodate(SimpleNamespace(name="check", actions=[object()], title=lambda: "check"))
+    assert out.getvalue() == ".  report\n-- check\n"
