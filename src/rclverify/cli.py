@@ -142,6 +142,9 @@ def cmd_report(args: argparse.Namespace) -> int:
     report = build_report(ws)
     for p in render_all(report, ws.path("reports")):
         print(p)
+    from .argument.export import write_argument
+    for p in write_argument(report, ws.path("reports")):
+        print(p)
     print(report["summary"]["headline"])
     return 0
 
