@@ -181,6 +181,7 @@ def test_gsn2x_yaml_has_the_documented_shape() -> None:
         for x in body.get("inContextOf", []):
             assert arg.elements[x].type in ("context", "assumption", "justification")
     assert data["G-ob.Sensor.g2.review"]["undeveloped"] is True
+    assert data["Sn-ev.Sensor.g1.hoare"]["url"] == "../artifacts/evidence/Sensor.g1.hoare.json"
     assert data["G-system"]["text"].endswith("[pending]")
 
 

@@ -64,10 +64,14 @@ def to_json_text(arg: Argument) -> str:
     return dumps(arg.to_json())
 
 
-def to_gsn_yaml(arg: Argument, title: str = "assurance argument") -> str:
-    """The argument in gsn2x's YAML input format (see the module docstring)."""
+def to_gsn_yaml(arg: Argument, title: str = "assurance argument", link_prefix: str = "../") -> str:
+    """The argument in gsn2x's YAML input format (see the module docstring).
+
+    ``link_prefix`` (the path from the YAML file's directory to the
+    workspace root) is prepended to each element's ``url``."""
     elements = [{"id": e.id, "text": _with_status(e), "supported_by": e.supported_by,
-                 "in_context_of": e.in_context_of, "undeveloped": e.undeveloped, "url": e.url}
+                 "in_context_of": e.in_context_of, "undeveloped": e.undeveloped,
+                 "url": link_prefix + e.url if e.url else ""}
                 for e in arg.elements.values()]
     return _environment().get_template("argument.gsn.yaml.j2").render(title=title.replace("\n", " "), elements=elements)
 
