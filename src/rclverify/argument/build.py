@@ -95,16 +95,15 @@ def build_argument(report: Mapping[str, Any]) -> Argument:
                            f"Verification plan {meta['plan']} and contracts {', '.join(map(str, meta['contracts']))} "
                            f"of {meta['workspace']}", url=str(meta["plan"])))
     a_persist = b.add(Element(ident("A", "persist"), "assumption", PERSIST))
-    loops: list[str] = []
+    loop_ids: dict[str, str] = {}  # R4's assumption text -> its element (one per loop)
     loop_of: dict[str, str] = {}
     for d in report["derived_properties"]:
         text = d.get("loop_assumption")
         if text:
-            aid = ident("A", "loop", len(loops) + 1) if text not in {b.els[x].text for x in loops} else \
-                next(x for x in loops if b.els[x].text == text)
-            if aid not in loops:
-                loops.append(b.add(Element(aid, "assumption", str(text))))
-            loop_of[str(d["node"])] = aid
+            if text not in loop_ids:
+                loop_ids[text] = b.add(Element(ident("A", "loop", len(loop_ids) + 1), "assumption", str(text)))
+            loop_of[str(d["node"])] = loop_ids[text]
+    loops = list(loop_ids.values())
     j_calc = b.add(Element(ident("J", "calculus"), "justification", CALCULUS))
 
     def evidence_goals(node: str, k: int) -> list[str]:
