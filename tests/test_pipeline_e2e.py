@@ -131,6 +131,37 @@ def test_ci_formats_carry_the_case_study_findings_at_their_rcl_locations(workspa
     review = cases["Localisation.g1.review.e0"]
     assert isinstance(review.result[0], junitparser.Skipped) and "review" in review.result[0].message
     assert not cases["Agent.sc1"].result  # the side condition of D1 is proved: the test case passes
+def test_the_argument_is_written_and_agrees_with_the_report(report: dict, workspace: Path) -> None:
+    arg = json.loads((workspace / "reports" / "argument.json").read_text())
+    status = {e["id"]: e["status"] for e in arg["elements"]}
+    assert status[arg["top"]] == report["summary"]["status"]
+    for r in report["requirements"]:
+        assert status[f"G-{r['id']}"] == r["status"], r["id"]
+    for n in report["nodes"]:
+        assert status[f"G-{n['name']}"] == n["status"], n["name"]
+        for g in n["guarantees"]:
+            assert status[f"G-{n['name']}.g{g['index']}"] == g["status"]
+    solutions = {e["ref"] for e in arg["elements"] if e["type"] == "solution"}
+    assert {e["obligation"] for e in report["evidence"]} <= solutions
+    assert (workspace / "reports" / "argument.gsn.yaml").read_text().startswith("# assurance argument of")
+    html = (workspace / "reports" / "assurance.html").read_text()
+    assert '<section id="argument">' in html
+    if shutil.which("dot"):
+        assert (workspace / "reports" / "argument.svg").read_text().startswith("<svg")
+
+
+def test_bundle_of_the_case_study_verifies(workspace: Path, tmp_path: Path) -> None:
+    from rclverify.bundle.archive import verify_bundle
+    out = tmp_path / "case-study.tar.gz"
+    r = subprocess.run([sys.executable, "-m", "rclverify.cli", "bundle", "-w", str(workspace), "-o", str(out)],
+                       capture_output=True, text=True, timeout=300)
+    assert r.returncode == 0, r.stderr
+    manifest = verify_bundle(out)
+    for f in ("contracts/plan.yaml", "contracts/remote_inspection.rcl", "reports/assurance.html",
+              "reports/argument.json", "backends/dafny/agent.dfy"):
+        assert f in manifest["files"], f
+    assert set(manifest["tools"]) >= {"rclverify", "z3", "dafny", "hypothesis", "python"}
+    assert any(f.startswith("artifacts/evidence/") for f in manifest["files"])
 
 
 def test_second_run_executes_no_task(workspace: Path) -> None:

@@ -11,6 +11,7 @@
 ``rclverify verify [--strict]``    the whole pipeline through doit
 ``rclverify refines A.rcl:N B.rcl:M``  may contract M replace contract N?
 ``rclverify init DIR [--nodes A,B]``  write a new workspace that verifies at once
+``rclverify bundle [-o FILE]``     the assessor's bundle; ``--verify FILE`` checks one
 
 Exit codes: 0 success, 1 errors in the input (or, for ``compose``/``verify
 --strict``, an obligation that does not hold), 2 usage errors.  A user's
@@ -146,6 +147,9 @@ def cmd_report(args: argparse.Namespace) -> int:
     from .report.ci import write_ci_reports
     for p in write_ci_reports(report, ws.path("reports")):
         print(p)
+    from .argument.export import write_argument
+    for p in write_argument(report, ws.path("reports")):
+        print(p)
     print(report["summary"]["headline"])
     return 0
 
@@ -183,6 +187,34 @@ def cmd_init(args: argparse.Namespace) -> int:
     return 0
 
 
+def cmd_bundle(args: argparse.Namespace) -> int:
+    """Write the assessor's bundle, or (``--verify FILE``) check one against its manifest."""
+    from .bundle.archive import verify_bundle, write_bundle
+    from .bundle.manifest import BundleError
+    if args.verify:
+        try:
+            manifest = verify_bundle(Path(args.verify))
+        except BundleError as exc:
+            for problem in exc.problems:
+                print(f"{args.verify}: error: {problem}", file=sys.stderr)
+            return 1
+        print(f"{args.verify}: {len(manifest['files'])} file(s) match MANIFEST.json")
+        return 0
+    ws = _ws(args)
+    name = "".join(c if c.isalnum() or c in "-_." else "-" for c in (ws.plan.name or ws.root.resolve().name)).strip("-")
+    out = Path(args.output) if args.output else Path(f"{name or 'workspace'}-bundle.tar.gz")
+    try:
+        manifest = write_bundle(ws.root, ws.plan, out)
+    except BundleError as exc:
+        for problem in exc.problems:
+            print(f"{args.workspace}: error: {problem}", file=sys.stderr)
+        return 1
+    for m in manifest["missing"]:
+        print(f"warning: {m}: named by the plan but does not exist; not in the bundle", file=sys.stderr)
+    print(f"{out}: {len(manifest['files'])} file(s) and MANIFEST.json; check with: rclverify bundle --verify {out}")
+    return 0
+
+
 def cmd_refines(args: argparse.Namespace) -> int:
     from .calculus.refinement import refines_main
     return refines_main(args.original, args.replacement)
@@ -216,6 +248,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     i = add("init", cmd_init, "write a new workspace (dodo.py, example contracts, plan) that verifies at once")
     i.add_argument("dir", help="directory to create (must be new or empty)")
     i.add_argument("--nodes", help="comma-separated node names, in chain order (default: Sensor,Controller,Actuator)")
+    bnd = add("bundle", cmd_bundle, "write the assessor's bundle (reports, artifacts, plan, contracts, manifest)", True)
+    bnd.add_argument("-o", "--output", help="archive to write (.tar.gz or .zip; default: <workspace name>-bundle.tar.gz)")
+    bnd.add_argument("--verify", metavar="FILE", help="check the archive FILE against its manifest instead")
     r = add("refines", cmd_refines, "check with Z3 that contract B may replace contract A")
     r.add_argument("original", help="FILE.rcl:Node of the contract to replace")
     r.add_argument("replacement", help="FILE.rcl:Node of the replacement contract")

@@ -49,6 +49,8 @@ def create_after(executed: str) -> Callable[[_F], _F]:
 REPORTS = ["reports/assurance.html", "reports/assurance.md", "reports/assurance.json"]
 #: The CI formats the ``report`` task also writes (SARIF 2.1.0, JUnit XML; see report/ci.py).
 CI_REPORTS = ["reports/assurance.sarif", "reports/assurance.junit.xml"]
+#: The assurance argument written next to the report (argument.svg only with graphviz).
+ARGUMENT_REPORTS = ["reports/argument.json", "reports/argument.gsn.yaml", "reports/argument.dot"]
 
 
 _WORKSPACES: dict[str, tuple[tuple[tuple[str, int, int], ...], Workspace]] = {}
@@ -135,6 +137,8 @@ def act_report(root: str) -> Any:
     render_all(report, ws.path("reports"))
     from .report.ci import write_ci_reports
     write_ci_reports(report, ws.path("reports"))
+    from .argument.export import write_argument
+    write_argument(report, ws.path("reports"))
     print(f"report: reports/assurance.html  ({report['summary']['headline']})")
     return None
 
@@ -270,7 +274,7 @@ def build_tasks(root: str | Path, plan_file: str = "contracts/plan.yaml") -> dic
             deps += [str(rootp / ws.calculus(n)), str(rootp / ws.health(n)), str(rootp / ws.obligations(n))]
         deps += [str(rootp / ws.evidence(o["id"])) for _, o in exported()]
         return {"actions": [(act_report, [r])], "file_dep": deps, "task_dep": ["graph"] if ok else [],
-                "targets": [str(rootp / p) for p in REPORTS + CI_REPORTS], "verbosity": 2, "clean": True}
+                "targets": [str(rootp / p) for p in REPORTS + CI_REPORTS + ARGUMENT_REPORTS], "verbosity": 2, "clean": True}
 
     def task_verify() -> dict[str, Any]:
         """The whole pipeline: check, compose, health, export, run, report.  --strict fails on any open evidence."""

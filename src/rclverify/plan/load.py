@@ -188,6 +188,8 @@ def load_plan(root: Path, plan_rel: str = "contracts/plan.yaml") -> Plan:
     def loc(*path: Any) -> ast.Loc:
         return locs.get(tuple(path), ast.Loc(plan_rel, 1, 1))
 
+    from .paths import check_plan_paths
+    check_plan_paths(root, plan_rel, data, locs)
     contracts = tuple(data["contracts"])
     for i, c in enumerate(contracts):
         if not (root / c).is_file():

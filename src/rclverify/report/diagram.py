@@ -30,6 +30,9 @@ _NODE_COLOURS: Mapping[str, tuple[str, str]] = {
     "failed": ("#ffebe9", "#cf222e"),
 }
 _OTHER_COLOURS = ("#ffffff", "#24292f")
+#: Public name of the status colours, shared with the argument diagram.
+NODE_COLOURS = _NODE_COLOURS
+OTHER_COLOURS = _OTHER_COLOURS
 
 #: Seconds the ``dot`` program may run before the diagram is given up.
 DOT_TIMEOUT_S = 30.0

@@ -375,6 +375,18 @@ def _context(report: Mapping[str, Any], link_prefix: str) -> dict[str, Any]:
     return {"r": report, "v": view(report), "header": _header(report), "href": link_maker(link_prefix)}
 
 
+#: Stand-in layout where only the argument's DOT source is shown (Markdown).
+_NO_LAYOUT = diagram.Rendering(None, "the Markdown report gives the argument as DOT source")
+
+
+def _argument(report: Mapping[str, Any], rendering: diagram.Rendering | None) -> dict[str, Any]:
+    """The assurance argument's view for the templates (GSN goal structure
+    built from ``report``, see :mod:`rclverify.argument`); ``rendering`` of
+    the system diagram, when given, stands in for its layout too."""
+    from ..argument.export import argument_view
+    return argument_view(report, rendering)
+
+
 def render_html(report: Mapping[str, Any], link_prefix: str = "../",
                 rendering: diagram.Rendering | None = None) -> str:
     """The assurance report as one self-contained HTML page.
@@ -392,6 +404,7 @@ def render_html(report: Mapping[str, Any], link_prefix: str = "../",
     drawn = rendering if rendering is not None else diagram.render_dot(dot)
     return environment().get_template("assurance.html.j2").render(
         **_context(report, link_prefix), dot=dot, svg=drawn.svg, diagram_note=drawn.note,
+        argument=_argument(report, rendering),
     )
 
 
@@ -403,7 +416,8 @@ def render_markdown(report: Mapping[str, Any], link_prefix: str = "../") -> str:
     :func:`md_code`).  Raises like :func:`render_html`.
     """
     dot = diagram.system_dot(report["system"], title=f"system model of {report['meta']['workspace']}")
-    return environment().get_template("assurance.md.j2").render(**_context(report, link_prefix), dot=dot)
+    return environment().get_template("assurance.md.j2").render(**_context(report, link_prefix), dot=dot,
+                                                                 argument=_argument(report, _NO_LAYOUT))
 
 
 def render_json(report: Mapping[str, Any]) -> str:

@@ -1,0 +1,204 @@
+"""Build the GSN goal structure from the assurance report dict.
+
+The argument is built from the report dict of :func:`rclverify.report.build.build_report`
+(the same data the report shows), so it needs no other artifact and works
+with any backend and any evidence kind: a solution is one evidence record,
+whatever produced it.  Structure (docs/argument.md)::
+
+    G-system  the system meets REQ1..REQn            in context of C-plan
+      S-requirements  argument over each requirement
+        G-<REQ>  the requirement's text
+          S-<REQ>  argument over the composition calculus (rules R1-R4,
+                   paper lines 556-768)              in context of A-persist,
+                   the loop rule's assumption, J-calculus
+            G-<Node>.g<k>   each supporting guarantee
+            G-<Node>.sc<k>  each side condition of a supporting node
+      S-contracts  argument over the node contracts (the rules' premises)
+        G-<Node>  the node meets its contract        in context of C-<Node>,
+                                                     its environment assumptions
+          G-<Node>.g<k>, G-<Node>.sc<k>
+    G-<Node>.g<k>   supported by one solution per evidence record of an
+                    obligation on it (guarantee k, or 0 = the whole contract),
+                    one per contract health finding on it, and an undeveloped
+                    goal per obligation without a record, or when no
+                    obligation was exported at all
+    G-<Node>.sc<k>  supported by the Z3 query's solution
+
+Statuses then propagate upward (:func:`.model.propagate`): with the
+report's own roll-up rules this gives every requirement, guarantee and node
+goal the status the report shows for it.
+"""
+from __future__ import annotations
+
+import re
+from typing import Any, Mapping
+
+from .model import Argument, Element, propagate
+
+_FINDING_AS = {"ok": "discharged", "problem": "failed", "inconclusive": "inconclusive"}
+_ID_BAD = re.compile(r"[^A-Za-z0-9_.\-]+")
+
+PERSIST = ("Outputs persist once produced, so the inputs a node receives from several producers are "
+           "available together (the calculus's simplifying assumption for R3, paper lines 658-660; "
+           "the user must ensure it).")
+CALCULUS = ("Rules R1 (sequence), R2 (branch), R3 (join) and R4 (loop) of the composition calculus "
+            "(paper lines 556-768): when each node meets its contract and every side condition is "
+            "discharged, each node's guarantee eventually holds in the composed system.")
+
+
+def ident(prefix: str, *parts: Any) -> str:
+    """A GSN id ``<prefix>-<parts joined by '.'>`` with unsafe characters replaced by ``_``."""
+    return prefix + "-" + _ID_BAD.sub("_", ".".join(str(p) for p in parts))
+
+
+def _clip(text: str, n: int = 400) -> str:
+    text = " ".join(str(text).split())
+    return text if len(text) <= n else text[: n - 3] + "..."
+
+
+class _Builder:
+    def __init__(self) -> None:
+        self.els: dict[str, Element] = {}
+
+    def add(self, e: Element) -> str:
+        if e.id not in self.els:
+            self.els[e.id] = e
+        return e.id
+
+
+def build_argument(report: Mapping[str, Any]) -> Argument:
+    """The goal structure of ``report`` (a report dict, see
+    :data:`rclverify.report.render.REPORT_KEYS`), statuses propagated.
+
+    Returns an :class:`Argument` whose element order is deterministic
+    (requirements and nodes in report order, obligations sorted by id).
+    Raises ``KeyError`` for a missing report key and
+    :class:`.model.ArgumentError` if the result were malformed.
+    """
+    b = _Builder()
+    meta = report["meta"]
+    reqs = report["requirements"]
+    ev_of = {str(e["obligation"]): e for e in report["evidence"]}
+    obligations = sorted(report["obligations"], key=lambda o: str(o["id"]))
+    sides: dict[str, list[Mapping[str, Any]]] = {}
+    for sc in report["side_conditions"]:
+        sides.setdefault(str(sc["node"]), []).append(sc)
+    findings: dict[str, list[Mapping[str, Any]]] = {}
+    for f in report["findings"]:
+        findings.setdefault(str(f["node"]), []).append(f)
+    env: dict[str, list[Mapping[str, Any]]] = {}
+    for a in report["environment_assumptions"]:
+        env.setdefault(str(a["node"]), []).append(a)
+
+    top = ident("G", "system")
+    c_plan = b.add(Element(ident("C", "plan"), "context",
+                           f"Verification plan {meta['plan']} and contracts {', '.join(map(str, meta['contracts']))} "
+                           f"of {meta['workspace']}", url=str(meta["plan"])))
+    a_persist = b.add(Element(ident("A", "persist"), "assumption", PERSIST))
+    loop_ids: dict[str, str] = {}  # R4's assumption text -> its element (one per loop)
+    loop_of: dict[str, str] = {}
+    for d in report["derived_properties"]:
+        text = d.get("loop_assumption")
+        if text:
+            if text not in loop_ids:
+                loop_ids[text] = b.add(Element(ident("A", "loop", len(loop_ids) + 1), "assumption", str(text)))
+            loop_of[str(d["node"])] = loop_ids[text]
+    loops = list(loop_ids.values())
+    j_calc = b.add(Element(ident("J", "calculus"), "justification", CALCULUS))
+
+    def evidence_goals(node: str, k: int) -> list[str]:
+        """Solutions and undeveloped goals under guarantee ``k`` of ``node``."""
+        kids: list[str] = []
+        mine = [o for o in obligations if o["node"] == node and int(o["guarantee"]) in (k, 0)]
+        for o in mine:
+            oid = str(o["id"])
+            ev = ev_of.get(oid)
+            if ev is None:
+                kids.append(b.add(Element(ident("G", "ob", oid), "goal",
+                                          f"Obligation {oid} ({o['backend']}) is discharged: no evidence record yet",
+                                          undeveloped=True, ref=oid)))
+                continue
+            tool = f"{ev['tool']} {ev['tool_version']}".strip()
+            kids.append(b.add(Element(
+                ident("Sn", "ev", oid), "solution",
+                _clip(f"{ev['kind']} evidence ({ev['backend']}, {tool}) for {oid}: {ev['status']}. {ev['explanation']}"),
+                status=str(ev["status"]), ref=oid, url=f"artifacts/evidence/{oid}.json")))
+        if not mine:
+            kids.append(b.add(Element(ident("G", node, f"g{k}", "evidence"), "goal",
+                                      f"Evidence that {node} guarantee {k} holds: no obligation was exported for it",
+                                      undeveloped=True, ref=f"{node}.g{k}")))
+        for f in findings.get(node, []):
+            if f["guarantee"] in (None, k):
+                kids.append(b.add(Element(
+                    ident("Sn", "health", f["id"]), "solution",
+                    _clip(f"Contract health check {f['check']} (Z3): {f['status']}. {f['message']}"),
+                    status=_FINDING_AS.get(str(f["status"]), "error"), ref=str(f["id"]),
+                    url=str(f.get("smt2") or ""))))
+        return kids
+
+    def side_goal(sc: Mapping[str, Any]) -> str:
+        sid = str(sc["id"])
+        sn = b.add(Element(ident("Sn", "sc", sid), "solution",
+                           _clip(f"Z3 query {sc['smt2']}: {sc['status']}. {sc['explanation']}"),
+                           status=str(sc["status"]), ref=sid, url=str(sc["smt2"])))
+        return b.add(Element(ident("G", "sc", sid), "goal",
+                             _clip(f"Side condition {sid} ({sc['rule']}, {sc['source']}): the conjunct "
+                                   f"{sc['conjunct']} of {sc['node']}'s assumption follows from its producers' guarantees"),
+                             supported_by=(sn,), ref=sid))
+
+    guarantee_goal: dict[tuple[str, int], str] = {}
+    contract_goals: list[str] = []
+    for n in report["nodes"]:
+        name = str(n["name"])
+        g_ids = []
+        for g in n["guarantees"]:
+            k = int(g["index"])
+            gid = b.add(Element(ident("G", name, f"g{k}"), "goal",
+                                _clip(f"{name} guarantee {k} holds ({g['source']}): {g['text']}"),
+                                supported_by=tuple(evidence_goals(name, k)), ref=f"{name}.g{k}"))
+            guarantee_goal[(name, k)] = gid
+            g_ids.append(gid)
+        sc_ids = [side_goal(sc) for sc in sides.get(name, [])]
+        c_node = b.add(Element(ident("C", name), "context", f"Contract of {name} ({n['source']})", ref=name))
+        ctx = [c_node] + [b.add(Element(ident("A", "env", name, i), "assumption",
+                                        _clip(f"Environment assumption of {name} ({a['source']}): {a['text']}"), ref=name))
+                          for i, a in enumerate(env.get(name, []), 1)]
+        contract_goals.append(b.add(Element(
+            ident("G", name), "goal",
+            f"{name} meets its contract in the composed system: for every input satisfying its assumption, "
+            f"eventually an output satisfying its guarantees (paper lines 462-495)",
+            supported_by=tuple(g_ids + sc_ids), in_context_of=tuple(ctx), ref=name)))
+
+    req_goals = []
+    for r in reqs:
+        rid = str(r["id"])
+        kids: list[str] = []
+        nodes_used: list[str] = []
+        for s in r["support"]:
+            kids.append(guarantee_goal[(str(s["node"]), int(s["guarantee"]))])
+            if s["node"] not in nodes_used:
+                nodes_used.append(str(s["node"]))
+        for name in nodes_used:
+            kids += [ident("G", "sc", sc["id"]) for sc in sides.get(name, [])]
+        ctx = [a_persist] + sorted({loop_of[x] for x in nodes_used if x in loop_of}) + [j_calc]
+        strategy = b.add(Element(
+            ident("S", rid), "strategy",
+            f"Argument over the composition calculus: {rid} follows from the guarantees of "
+            f"{', '.join(nodes_used) or 'no node'} once the side conditions of their assumptions are discharged",
+            supported_by=tuple(dict.fromkeys(kids)), in_context_of=tuple(ctx), ref=rid))
+        if kids:
+            req_goals.append(b.add(Element(ident("G", rid), "goal", _clip(f"{rid}: {r['text']}"),
+                                           supported_by=(strategy,), ref=rid)))
+        else:  # no supporting guarantee listed: nothing argues for it
+            del b.els[strategy]
+            req_goals.append(b.add(Element(ident("G", rid), "goal", _clip(f"{rid}: {r['text']} (no supporting guarantee listed)"),
+                                           undeveloped=True, ref=rid)))
+    s_reqs = b.add(Element(ident("S", "requirements"), "strategy", "Argument over each requirement of the plan",
+                           supported_by=tuple(req_goals), undeveloped=not req_goals))
+    s_contracts = b.add(Element(ident("S", "contracts"), "strategy",
+                                "Argument over the node contracts: every node meets its contract (the premises of rules R1-R4)",
+                                supported_by=tuple(contract_goals), in_context_of=(a_persist, *loops)))
+    ids = ", ".join(str(r["id"]) for r in reqs) or "no requirement listed"
+    b.els = {top: Element(top, "goal", f"The system {meta['workspace']} meets its requirements ({ids})",
+                          supported_by=(s_reqs, s_contracts), in_context_of=(c_plan,)), **b.els}
+    return propagate(Argument(top, b.els))

@@ -1,0 +1,146 @@
+"""Write the assurance argument: JSON, gsn2x YAML, Graphviz DOT and SVG.
+
+* JSON (:func:`to_json_text`): :meth:`Argument.to_json`, sorted keys.
+* YAML (:func:`to_gsn_yaml`): the input format of gsn2x (jonasthewolf/gsn2x,
+  "Syntax in YAML"): one top-level key per element whose prefix gives its
+  type (``G``, ``S``, ``Sn``, ``C``, ``A``, ``J``), with ``text``, and
+  optionally ``supportedBy``, ``inContextOf`` (lists of ids),
+  ``undeveloped: true`` and ``url``.  The status is appended to the text of
+  goals, strategies and solutions (gsn2x has no status attribute).
+* DOT (:func:`to_dot`): GSN shapes (goal box, strategy parallelogram,
+  solution ellipse, context rounded box, assumption and justification ovals
+  marked A/J, undeveloped goals marked with a diamond), supportedBy as solid
+  arrows, inContextOf as dashed arrows with hollow heads, coloured by status
+  like the system diagram; laid out left to right so the many solutions
+  stack vertically.
+* SVG with Graphviz ``dot`` (:func:`rclverify.report.diagram.render_dot`);
+  without it the DOT source stands in, as for the system diagram.
+
+Everything is deterministic: the element order is the builder's, nothing
+depends on the time.
+"""
+from __future__ import annotations
+
+import json
+import textwrap
+from functools import lru_cache
+from pathlib import Path
+from typing import Any, Mapping
+
+import jinja2
+
+from ..evidence.store import atomic_write_text, dumps
+from ..report import diagram
+from .build import build_argument
+from .model import Argument, Element
+
+#: File names written by :func:`write_argument` (in this order).
+FILES = ("argument.json", "argument.gsn.yaml", "argument.dot", "argument.svg")
+
+_SHAPES = {"goal": ("box", ""), "strategy": ("parallelogram", ""), "solution": ("ellipse", ""),
+           "context": ("box", "rounded,filled"), "assumption": ("oval", ""), "justification": ("oval", "")}
+
+
+def _yq(value: Any) -> str:
+    """A YAML double-quoted scalar (JSON string syntax, which YAML reads)."""
+    return json.dumps(str(value), ensure_ascii=False)
+
+
+@lru_cache(maxsize=1)
+def _environment() -> jinja2.Environment:
+    env = jinja2.Environment(loader=jinja2.PackageLoader("rclverify.argument", "templates"), autoescape=False,
+                             undefined=jinja2.StrictUndefined, trim_blocks=True, lstrip_blocks=True,
+                             keep_trailing_newline=True)
+    env.filters["yq"] = _yq
+    return env
+
+
+def _with_status(e: Element) -> str:
+    return f"{e.text} [{e.status}]" if e.status is not None else e.text
+
+
+def to_json_text(arg: Argument) -> str:
+    """The argument as deterministic JSON text (sorted keys, final newline)."""
+    return dumps(arg.to_json())
+
+
+def to_gsn_yaml(arg: Argument, title: str = "assurance argument", link_prefix: str = "../") -> str:
+    """The argument in gsn2x's YAML input format (see the module docstring).
+
+    ``link_prefix`` (the path from the YAML file's directory to the
+    workspace root) is prepended to each element's ``url``."""
+    elements = [{"id": e.id, "text": _with_status(e), "supported_by": e.supported_by,
+                 "in_context_of": e.in_context_of, "undeveloped": e.undeveloped,
+                 "url": link_prefix + e.url if e.url else ""}
+                for e in arg.elements.values()]
+    return _environment().get_template("argument.gsn.yaml.j2").render(title=title.replace("\n", " "), elements=elements)
+
+
+def _label(e: Element) -> str:
+    head = e.id if e.type != "solution" else e.ref or e.id
+    width = 28 if e.type == "solution" else 44
+    body = e.text if len(e.text) <= 180 else e.text[:177] + "..."
+    lines = [head] + (textwrap.wrap(body, width) if e.type != "solution" else [])
+    if e.type in ("assumption", "justification"):
+        lines.append("A" if e.type == "assumption" else "J")
+    if e.status is not None:
+        lines.append(e.status)
+    if e.undeveloped:
+        lines.append("\u25c7 undeveloped")
+    return diagram.dot_string(*lines)
+
+
+def to_dot(arg: Argument, title: str = "assurance argument", link_prefix: str = "../") -> str:
+    """Graphviz DOT text of the argument; ``link_prefix`` is prepended to the
+    workspace-relative ``url`` of an element (its record) to make a link."""
+    nodes, edges = [], []
+    for e in arg.elements.values():
+        shape, style = _SHAPES[e.type]
+        fill, border = diagram.NODE_COLOURS.get(e.status or "", diagram.OTHER_COLOURS)
+        nodes.append({"id": diagram.dot_string(e.id), "label": _label(e), "tooltip": diagram.dot_string(e.text),
+                      "shape": shape, "style": style, "fill": fill, "border": border,
+                      "url": diagram.dot_string(link_prefix + e.url) if e.url else ""})
+        edges += [{"src": diagram.dot_string(e.id), "dst": diagram.dot_string(x), "context": False} for x in e.supported_by]
+        edges += [{"src": diagram.dot_string(e.id), "dst": diagram.dot_string(x), "context": True} for x in e.in_context_of]
+    return _environment().get_template("argument.dot.j2").render(title=title.replace("\n", " "), nodes=nodes, edges=edges)
+
+
+def argument_view(report: Mapping[str, Any], rendering: diagram.Rendering | None = None) -> dict[str, Any]:
+    """What the report templates show of the argument: ``argument`` (the
+    JSON form), ``dot``, ``svg`` (``None`` without Graphviz), ``note`` (why
+    there is no SVG) and ``goals`` (the requirement and contract goals with
+    their statuses, for the tables).  ``rendering`` replaces running ``dot``."""
+    arg = build_argument(report)
+    dot = to_dot(arg, f"assurance argument of {report['meta']['workspace']}")
+    drawn = rendering if rendering is not None else diagram.render_dot(dot)
+    top = arg.elements[arg.top]
+    goals = [top] + [arg.elements[g] for s in top.supported_by for g in arg.elements[s].supported_by]
+    return {"argument": arg.to_json(), "dot": dot, "svg": drawn.svg, "note": drawn.note,
+            "goals": [{"id": g.id, "text": g.text, "status": g.status, "undeveloped": g.undeveloped} for g in goals]}
+
+
+def write_argument(report: Mapping[str, Any], out_dir: Path) -> list[Path]:
+    """Write :data:`FILES` for ``report`` into ``out_dir`` (``reports/``).
+
+    Everything is rendered before anything is written; each file is written
+    atomically and only when changed.  Without Graphviz, ``argument.svg`` is
+    removed (so no stale diagram remains) and not returned.  Returns the
+    paths written.  Raises ``KeyError`` for a malformed report and ``OSError``
+    when ``out_dir`` cannot be written.
+    """
+    arg = build_argument(report)
+    title = f"assurance argument of {report['meta']['workspace']}"
+    dot = to_dot(arg, title)
+    texts = {FILES[0]: to_json_text(arg), FILES[1]: to_gsn_yaml(arg, title), FILES[2]: dot}
+    svg = diagram.render_dot(dot).svg
+    paths = []
+    for name, text in texts.items():
+        atomic_write_text(out_dir / name, text)
+        paths.append(out_dir / name)
+    svg_path = out_dir / FILES[3]
+    if svg is None:
+        svg_path.unlink(missing_ok=True)
+    else:
+        atomic_write_text(svg_path, svg)
+        paths.append(svg_path)
+    return paths

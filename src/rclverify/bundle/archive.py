@@ -1,0 +1,164 @@
+"""Write an assessor's bundle as one archive and check an archive against
+its manifest.
+
+Formats: gzip-compressed tar (``.tar.gz``/``.tgz``, the default) or zip
+(``.zip``), both with the standard library.  Archives are deterministic:
+members in sorted path order, ``MANIFEST.json`` first, every mtime fixed
+(1980-01-01 for zip, the epoch for tar and the gzip header), owner 0, mode
+0644, so the same workspace gives the same bytes.  The archive is written to
+a temporary file beside the destination and moved into place, so a failure
+never leaves a half-written archive or destroys an earlier one.
+"""
+from __future__ import annotations
+
+import gzip
+import io
+import json
+import os
+import tarfile
+import tempfile
+import zipfile
+from pathlib import Path, PurePosixPath
+from typing import Any, Mapping
+
+from ..evidence.store import dumps
+from ..plan.load import Plan
+from .manifest import MANIFEST, BundleError, build_manifest, collect, sha256_bytes, tool_versions
+
+_ZIP_TIME = (1980, 1, 1, 0, 0, 0)
+
+
+def is_zip(path: Path) -> bool:
+    """``path`` is to be a zip archive (by its suffix)."""
+    return path.suffix.lower() == ".zip"
+
+
+def _tar_bytes(members: Mapping[str, bytes]) -> bytes:
+    raw = io.BytesIO()
+    with gzip.GzipFile(filename="", mode="wb", fileobj=raw, mtime=0) as gz:
+        with tarfile.open(fileobj=gz, mode="w", format=tarfile.GNU_FORMAT) as tar:
+            for name, data in members.items():
+                info = tarfile.TarInfo(name)
+                info.size, info.mtime, info.mode = len(data), 0, 0o644
+                info.uid = info.gid = 0
+                info.uname = info.gname = ""
+                tar.addfile(info, io.BytesIO(data))
+    return raw.getvalue()
+
+
+def _zip_bytes(members: Mapping[str, bytes]) -> bytes:
+    raw = io.BytesIO()
+    with zipfile.ZipFile(raw, "w") as zf:
+        for name, data in members.items():
+            info = zipfile.ZipInfo(name, date_time=_ZIP_TIME)
+            info.compress_type = zipfile.ZIP_DEFLATED
+            info.external_attr = 0o644 << 16
+            zf.writestr(info, data)
+    return raw.getvalue()
+
+
+def _atomic_write_bytes(path: Path, data: bytes) -> None:
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+    try:
+        os.chmod(tmp, 0o644)  # mkstemp creates 0600; an archive is for others to read
+        with os.fdopen(fd, "wb") as fh:
+            fh.write(data)
+            fh.flush()
+            os.fsync(fh.fileno())
+        os.replace(tmp, path)
+    except BaseException:
+        try:
+            os.unlink(tmp)
+        except FileNotFoundError:
+            pass
+        raise
+
+
+def write_bundle(root: Path, plan: Plan, out: Path, tools: Mapping[str, str] | None = None) -> dict[str, Any]:
+    """Pack the workspace ``root`` (plan ``plan``) into the archive ``out``.
+
+    ``tools`` overrides :func:`.manifest.tool_versions` (tests).  Returns the
+    manifest.  Raises :class:`BundleError` when the report has not been
+    written yet or a file comes from outside the workspace, ``OSError`` when
+    a file cannot be read or ``out`` cannot be written.
+    """
+    if not (root / "reports" / "assurance.json").is_file():
+        raise BundleError(["reports/assurance.json: no assurance report yet; run `doit verify` first"])
+    files, missing = collect(root, plan)
+    out_res = out.resolve()
+    files = [f for f in files if (root / f).resolve() != out_res]
+    contents = {f: (root / f).read_bytes() for f in files}
+    manifest = build_manifest(root, plan, files, missing, contents, tools if tools is not None else tool_versions())
+    members = {MANIFEST: dumps(manifest).encode("utf-8"), **contents}
+    _atomic_write_bytes(out, _zip_bytes(members) if is_zip(out) else _tar_bytes(members))
+    return manifest
+
+
+def _unsafe(name: str) -> bool:
+    p = PurePosixPath(name)
+    return p.is_absolute() or ".." in p.parts or "\\" in name
+
+
+def read_members(path: Path) -> dict[str, bytes]:
+    """The regular-file members of the archive at ``path`` (tar.gz or zip).
+
+    Raises :class:`BundleError` for an unreadable or corrupt archive, and for
+    members that are links, devices, absolute or ``..`` paths, or repeated.
+    Nothing is extracted to disk.
+    """
+    out: dict[str, bytes] = {}
+    problems: list[str] = []
+    try:
+        if zipfile.is_zipfile(path):
+            with zipfile.ZipFile(path) as zf:
+                for info in zf.infolist():
+                    if info.is_dir():
+                        continue
+                    if _unsafe(info.filename) or info.filename in out:
+                        problems.append(f"{info.filename}: unsafe or repeated member")
+                        continue
+                    out[info.filename] = zf.read(info)
+        else:
+            with tarfile.open(path, "r:*") as tar:
+                for m in tar.getmembers():
+                    if m.isdir():
+                        continue
+                    if not m.isfile() or _unsafe(m.name) or m.name in out:
+                        problems.append(f"{m.name}: unsafe, repeated or not a regular file")
+                        continue
+                    f = tar.extractfile(m)
+                    out[m.name] = f.read() if f is not None else b""
+    except (OSError, tarfile.TarError, zipfile.BadZipFile, EOFError) as exc:
+        raise BundleError([f"cannot read the archive: {exc}"]) from None
+    if problems:
+        raise BundleError(problems)
+    return out
+
+
+def verify_bundle(path: Path) -> dict[str, Any]:
+    """Check the archive at ``path`` against its ``MANIFEST.json``.
+
+    Returns the manifest when every listed file is present with its sha256
+    and nothing else is in the archive.  Raises :class:`BundleError` listing
+    each changed, missing or extra file by name (and a missing or malformed
+    manifest).
+    """
+    members = read_members(path)
+    if MANIFEST not in members:
+        raise BundleError([f"{MANIFEST}: missing from the archive"])
+    try:
+        manifest = json.loads(members.pop(MANIFEST).decode("utf-8"))
+        listed = {str(k): str(v["sha256"]) for k, v in manifest["files"].items()}
+    except (ValueError, KeyError, TypeError, AttributeError) as exc:
+        raise BundleError([f"{MANIFEST}: malformed manifest ({exc})"]) from None
+    problems = []
+    for name in sorted(listed):
+        if name not in members:
+            problems.append(f"{name}: missing from the archive")
+        elif (h := sha256_bytes(members[name])) != listed[name]:
+            problems.append(f"{name}: changed (sha256 {h}, manifest says {listed[name]})")
+    problems += [f"{name}: in the archive but not in the manifest" for name in sorted(set(members) - set(listed))]
+    if problems:
+        raise BundleError(problems)
+    return dict(manifest)

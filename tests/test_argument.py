@@ -1,0 +1,217 @@
+"""The assurance argument: GSN structure, status propagation, exports."""
+from __future__ import annotations
+
+import copy
+import json
+import shutil
+from typing import Any
+
+import pytest
+import yaml
+
+from rclverify.argument.build import build_argument
+from rclverify.argument.export import argument_view, to_dot, to_gsn_yaml, to_json_text, write_argument
+from rclverify.argument.model import Argument, ArgumentError, Element, propagate
+from rclverify.report import render
+from rclverify.report.diagram import Rendering
+
+NO_DOT = Rendering(None, "no graphviz in this test")
+
+
+def _ev(ob: str, status: str, kind: str = "proof", backend: str = "hoare") -> dict[str, Any]:
+    return {"obligation": ob, "backend": backend, "kind": kind, "status": status, "tool": "z3", "tool_version": "4",
+            "started": "2026-01-01T00:00:00Z", "duration_s": 0.1, "explanation": f"{ob} is {status}",
+            "counterexample": None, "artifacts": [], "log_excerpt": ""}
+
+
+def _ob(oid: str, node: str, k: int, backend: str = "hoare", status: str = "discharged") -> dict[str, Any]:
+    return {"id": oid, "node": node, "guarantee": k, "backend": backend, "kind": "proof", "instance": "",
+            "statement": "s", "source": "c.rcl:1:1", "artifact": "", "status": status}
+
+
+def _report() -> dict[str, Any]:
+    """Sensor (2 guarantees) feeds Planner (1 guarantee, one side condition);
+    every piece of evidence is discharged except where a test changes it."""
+    g = lambda k, text: {"index": k, "text": text, "source": f"c.rcl:{k}:3", "status": "discharged", "obligations": []}
+    return {
+        "meta": {"tool": "rclverify", "version": "0", "workspace": "mini", "plan": "contracts/plan.yaml",
+                 "contracts": ["contracts/c.rcl"], "z3_version": "4", "strict_ok": True},
+        "summary": {"status": "discharged", "counts": {}, "headline": "", "problems": []},
+        "system": {"nodes": [], "connections": [], "environment_inputs": [], "loops": []},
+        "requirements": [
+            {"id": "REQ1", "text": "Report radiation.", "status": "discharged",
+             "support": [{"node": "Sensor", "guarantee": 1, "text": "a", "source": "c.rcl:1:3", "status": "discharged", "obligations": []},
+                         {"node": "Planner", "guarantee": 1, "text": "b", "source": "c.rcl:1:3", "status": "discharged", "obligations": []}]},
+            {"id": "REQ2", "text": "Second.", "status": "discharged",
+             "support": [{"node": "Sensor", "guarantee": 2, "text": "c", "source": "c.rcl:2:3", "status": "discharged", "obligations": []}]},
+        ],
+        "nodes": [{"name": "Sensor", "source": "c.rcl:1:1", "status": "discharged", "guarantees": [g(1, "a"), g(2, "c")],
+                   "inputs": [], "outputs": [], "assumptions": [], "latex": ""},
+                  {"name": "Planner", "source": "c.rcl:9:1", "status": "discharged", "guarantees": [g(1, "b")],
+                   "inputs": [], "outputs": [], "assumptions": [], "latex": ""}],
+        "side_conditions": [{"id": "Planner.sc1", "node": "Planner", "rule": "R1", "conjunct": "in.x > 0",
+                             "source": "c.rcl:10:3", "status": "discharged", "smt2": "artifacts/calculus/Planner.sc1.smt2",
+                             "explanation": "proved", "model": None, "hypotheses": [], "duration_s": 0.0}],
+        "derived_properties": [{"node": "Planner", "rules": ["R1"], "instances": [], "environment_assumptions": [],
+                                "property": "p", "status": "discharged", "loop_assumption": None}],
+        "findings": [{"id": "Sensor.assumption-satisfiable", "node": "Sensor", "check": "assumption-satisfiable",
+                      "guarantee": None, "status": "ok", "message": "ok", "explanation": "", "smt2": "",
+                      "model": None, "core": None, "duration_s": 0.0, "instances": None}],
+        "obligations": [_ob("Sensor.g1.hoare", "Sensor", 1), _ob("Sensor.g2.review", "Sensor", 2, "review"),
+                        _ob("Planner.g0.dafny", "Planner", 0, "dafny")],
+        "evidence": [_ev("Sensor.g1.hoare", "discharged"), _ev("Sensor.g2.review", "discharged", "review", "review"),
+                     _ev("Planner.g0.dafny", "discharged")],
+        "environment_assumptions": [{"node": "Sensor", "source": "c.rcl:2:5", "text": "0 <= in.r"}],
+        "pending": [], "lint": [],
+    }
+
+
+def _status(arg: Argument, eid: str) -> str | None:
+    return arg.elements[eid].status
+
+
+def test_structure_has_the_gsn_elements_of_the_method() -> None:
+    arg = build_argument(_report())
+    els = arg.elements
+    top = els[arg.top]
+    assert arg.top == "G-system" and "REQ1, REQ2" in top.text and top.in_context_of == ("C-plan",)
+    assert {"G-REQ1", "G-REQ2", "S-REQ1", "G-Sensor", "G-Planner", "G-Sensor.g1", "G-Sensor.g2", "G-Planner.g1",
+            "G-sc.Planner.sc1", "Sn-sc.Planner.sc1", "A-persist", "J-calculus", "A-env.Sensor.1"} <= set(els)
+    assert "composition calculus" in els["S-REQ1"].text
+    assert els["S-REQ1"].supported_by == ("G-Sensor.g1", "G-Planner.g1", "G-sc.Planner.sc1")
+    assert "A-persist" in els["S-REQ1"].in_context_of and "J-calculus" in els["S-REQ1"].in_context_of
+    # the whole-contract obligation (guarantee 0) supports every guarantee of its node
+    assert "Sn-ev.Planner.g0.dafny" in els["G-Planner.g1"].supported_by
+    # node-level health findings support every guarantee of the node
+    assert "Sn-health.Sensor.assumption-satisfiable" in els["G-Sensor.g2"].supported_by
+    assert all(e.status == "discharged" for e in els.values() if e.type in ("goal", "strategy", "solution"))
+    assert all(e.status is None for e in els.values() if e.type in ("context", "assumption", "justification"))
+
+
+def test_one_failed_solution_fails_every_goal_above_it() -> None:
+    rep = _report()
+    rep["evidence"][0]["status"] = "failed"  # Sensor.g1.hoare
+    arg = build_argument(rep)
+    for eid in ("Sn-ev.Sensor.g1.hoare", "G-Sensor.g1", "S-REQ1", "G-REQ1", "S-requirements", "G-Sensor",
+                "S-contracts", "G-system"):
+        assert _status(arg, eid) == "failed", eid
+    # what it does not support is unaffected
+    for eid in ("G-Sensor.g2", "G-REQ2", "G-Planner", "G-Planner.g1"):
+        assert _status(arg, eid) == "discharged", eid
+
+
+def test_a_loop_assumption_is_an_explicit_gsn_assumption() -> None:
+    rep = _report()
+    rep["derived_properties"][0]["loop_assumption"] = "Rule R4 ... every node in the loop terminates"
+    arg = build_argument(rep)
+    loops = [e for e in arg.elements.values() if e.id.startswith("A-loop")]
+    assert len(loops) == 1 and "terminates" in loops[0].text
+    assert loops[0].id in arg.elements["S-REQ1"].in_context_of and loops[0].id in arg.elements["S-contracts"].in_context_of
+
+
+def test_missing_evidence_is_an_undeveloped_goal_counted_as_pending() -> None:
+    rep = _report()
+    del rep["evidence"][1]  # Sensor.g2.review has no record
+    rep["obligations"] = [o for o in rep["obligations"] if o["id"] != "Planner.g0.dafny"]
+    del rep["evidence"][-1]  # Planner guarantee 1: no obligation at all
+    arg = build_argument(rep)
+    ob = arg.elements["G-ob.Sensor.g2.review"]
+    assert ob.undeveloped and ob.status == "pending" and not ob.supported_by
+    none = arg.elements["G-Planner.g1.evidence"]
+    assert none.undeveloped and none.status == "pending"
+    assert _status(arg, "G-REQ2") == "pending" and _status(arg, "G-REQ1") == "pending"
+    assert _status(arg, "G-system") == "pending"
+
+
+def test_any_evidence_kind_is_a_solution_with_its_own_status() -> None:
+    rep = _report()
+    rep["obligations"].append(_ob("Sensor.g1.experiment.e0", "Sensor", 1, "experiment"))
+    rep["evidence"].append(_ev("Sensor.g1.experiment.e0", "inconclusive", "experiment", "experiment"))
+    arg = build_argument(rep)
+    sn = arg.elements["Sn-ev.Sensor.g1.experiment.e0"]
+    assert sn.type == "solution" and sn.status == "inconclusive" and sn.text.startswith("experiment evidence")
+    assert sn.url == "artifacts/evidence/Sensor.g1.experiment.e0.json"
+    assert _status(arg, "G-REQ1") == "inconclusive" and _status(arg, "G-REQ2") == "discharged"
+
+
+def test_propagation_takes_the_worst_child_and_rejects_malformed_structures() -> None:
+    els = {e.id: e for e in [
+        Element("G1", "goal", "top", supported_by=("S1",), in_context_of=("C1",)),
+        Element("S1", "strategy", "s", supported_by=("G2", "G3", "Sn1")),
+        Element("G2", "goal", "no evidence", undeveloped=True),
+        Element("G3", "goal", "stale", supported_by=("Sn2",)),
+        Element("Sn1", "solution", "ok", status="discharged"),
+        Element("Sn2", "solution", "old", status="stale"),
+        Element("C1", "context", "c"),
+    ]}
+    arg = propagate(Argument("G1", els))
+    assert [arg.status(i) for i in ("G1", "S1", "G2", "G3", "C1")] == ["stale", "stale", "pending", "stale", None]
+    with pytest.raises(ArgumentError, match="cycle"):
+        propagate(Argument("G1", {**els, "G3": Element("G3", "goal", "x", supported_by=("G1",))}))
+    with pytest.raises(ArgumentError, match="cannot link"):
+        propagate(Argument("G1", {**els, "G3": Element("G3", "goal", "x", supported_by=("C1",))}))
+    with pytest.raises(ArgumentError, match="must start with"):
+        propagate(Argument("G1", {**els, "Sn3": Element("Sn3", "strategy", "x")}))
+    with pytest.raises(ArgumentError, match="not an evidence status"):
+        propagate(Argument("G1", {**els, "Sn1": Element("Sn1", "solution", "x", status="proved")}))
+
+
+def test_json_round_trips_and_is_deterministic() -> None:
+    arg = build_argument(_report())
+    text = to_json_text(arg)
+    assert Argument.from_json(json.loads(text)) == arg
+    assert to_json_text(build_argument(copy.deepcopy(_report()))) == text
+
+
+def test_gsn2x_yaml_has_the_documented_shape() -> None:
+    rep = _report()
+    del rep["evidence"][1]
+    arg = build_argument(rep)
+    text = to_gsn_yaml(arg, "mini")
+    assert text.startswith("# mini, generated by rclverify")
+    data = yaml.safe_load(text)
+    assert list(data) == list(arg.elements)
+    prefix = {"goal": "G", "strategy": "S", "solution": "Sn", "context": "C", "assumption": "A", "justification": "J"}
+    for eid, body in data.items():
+        e = arg.elements[eid]
+        assert eid.startswith(prefix[e.type]) and isinstance(body["text"], str)
+        assert set(body) <= {"text", "supportedBy", "inContextOf", "undeveloped", "url"}
+        for x in body.get("supportedBy", []):
+            assert data[x] is not None and arg.elements[x].type in ("goal", "strategy", "solution")
+        for x in body.get("inContextOf", []):
+            assert arg.elements[x].type in ("context", "assumption", "justification")
+    assert data["G-ob.Sensor.g2.review"]["undeveloped"] is True
+    assert data["Sn-ev.Sensor.g1.hoare"]["url"] == "../artifacts/evidence/Sensor.g1.hoare.json"
+    assert data["G-system"]["text"].endswith("[pending]")
+
+
+def test_hostile_text_cannot_break_the_yaml_or_the_dot() -> None:
+    rep = _report()
+    rep["requirements"][0]["text"] = 'x"\n  supportedBy: [G-evil]\n}; "a" -> "b'
+    arg = build_argument(rep)
+    data = yaml.safe_load(to_gsn_yaml(arg))
+    assert "G-evil" not in data and data["G-REQ1"]["text"].startswith('REQ1: x"')
+    dot = to_dot(arg)
+    assert '"G-REQ1" [label="G-REQ1\\nREQ1: x\\"' in dot
+
+
+@pytest.mark.skipif(shutil.which("dot") is None, reason="graphviz not installed")
+def test_the_html_report_embeds_the_argument_diagram(tmp_path: Any) -> None:
+    html = render.render_html(_report())
+    section = html[html.index('<section id="argument">'):]
+    section = section[:section.index("</section>")]
+    assert "<svg" in section and "G-system" in section and 'href="#argument"' in html
+    paths = write_argument(_report(), tmp_path)
+    assert [p.name for p in paths] == ["argument.json", "argument.gsn.yaml", "argument.dot", "argument.svg"]
+    before = [p.read_bytes() for p in paths]
+    write_argument(_report(), tmp_path)
+    assert [p.read_bytes() for p in paths] == before
+
+
+def test_without_graphviz_the_report_shows_the_dot_source() -> None:
+    view = argument_view(_report(), NO_DOT)
+    assert view["svg"] is None and view["dot"].startswith("// assurance argument of mini")
+    html = render.render_html(_report(), rendering=NO_DOT)
+    assert "The argument's Graphviz source" in html and "no graphviz in this test" in html
+    md = render.render_markdown(_report())
+    assert "## Assurance argument (GSN)" in md and "`G-REQ1`" in md
