@@ -90,6 +90,26 @@ def _io_type(node: CheckedNode, qualified: str) -> Type:
     return table[name]
 
 
+_ENCODED: dict[tuple[int, str], tuple[ast.Expr, z3.BoolRef, dict[str, Any]]] = {}
+
+
+def _encoded(formula: ast.Expr, checked: Checked, node: CheckedNode) -> tuple[z3.BoolRef, dict[str, Any]]:
+    """``formula`` encoded once over free I/O symbols (cached per formula object:
+    encoding costs more than the check), with those symbols by qualified name."""
+    key = (id(formula), node.name)
+    hit = _ENCODED.get(key)
+    if hit is not None and hit[0] is formula:
+        return hit[1], hit[2]
+    enc = Encoder(checked.env)
+    phi = enc.formula(formula, node)
+    free: dict[str, Any] = {}
+    for sym in enc.symbols.values():
+        q = sym.z3name.split(".", 1)[1]  # "<Node>.in.x" -> "in.x"
+        free[q] = sym.decl
+    _ENCODED[key] = (formula, phi, free)
+    return phi, free
+
+
 def check_concrete(formula: ast.Expr, checked: Checked, node: CheckedNode, values: Mapping[str, Any], *,
                    timeout_ms: int = 2000) -> tuple[bool | None, str]:
     """Does ``formula`` (an RCL formula of ``node``) hold on these concrete values?
@@ -107,25 +127,24 @@ def check_concrete(formula: ast.Expr, checked: Checked, node: CheckedNode, value
     Semantics: shared/DESIGN.md ("Semantics the tool commits to"); a node's
     contract is checked per input/output pair as in the paper, lines 462-495.
     """
-    enc = Encoder(checked.env)
-    symbols: dict[str, Any] = {}
+    phi, free = _encoded(formula, checked, node)
+    consts: list[tuple[z3.ExprRef, z3.ExprRef]] = []
     funcs: list[tuple[z3.FuncDeclRef, z3.ExprRef]] = []
-    for q, v in values.items():
-        t = _io_type(node, q)
+    enc = Encoder(checked.env)
+    for q, decl in free.items():
+        if q not in values:
+            raise KeyError(f"no value given for {node.name}.{q}")
+        t, v = _io_type(node, q), values[q]
         if isinstance(t, FuncT):
             if not isinstance(v, FiniteFunction):
                 raise ConcreteValueError(f"{q}: {v!r} is not a finite function ({t})")
-            f = z3.Function(f"{node.name}.{q}", *[sort_of(a) for a in t.args], sort_of(t.result))
-            symbols[q] = f
-            funcs.append((f, finite_interpretation(v, t, enc)))
+            funcs.append((decl, finite_interpretation(v, t, enc)))
         else:
-            symbols[q] = to_z3(v, t, enc)
-    phi = enc.formula(formula, node, symbols)
+            consts.append((decl, to_z3(v, t, enc)))
+    if consts:
+        phi = z3.substitute(phi, *consts)
     if funcs:
         phi = z3.substitute_funs(phi, *funcs)
-    if enc.symbols:  # an I/O variable the values did not give
-        missing = sorted(s.display for s in enc.symbols.values())
-        raise KeyError(f"no value given for {', '.join(missing)}")
     simple = z3.simplify(phi)
     if z3.is_true(simple):
         return True, ""

@@ -26,7 +26,7 @@ from typing import Any, Callable, Mapping
 
 import hypothesis
 import z3
-from hypothesis import HealthCheck, Verbosity, given, settings
+from hypothesis import HealthCheck, Phase, Verbosity, given, settings
 from hypothesis import strategies as st
 from hypothesis.errors import FailedHealthCheck, Unsatisfiable
 
@@ -183,6 +183,7 @@ class GuaranteeRun:
     guarantee: int
     cfg: Config
     impl: Any
+    stop_at_failure: bool = True  # False: count violations and go on (benchmarks); no shrinking then
     counts: Counts = field(default_factory=Counts)
     last_failure: dict[str, str] | None = None
     unknown: set[str] = field(default_factory=set)
@@ -224,7 +225,8 @@ class GuaranteeRun:
             cex["step"] = str(step)
         cex["reason"] = reason
         self.last_failure = cex
-        raise _Violation(reason)
+        if self.stop_at_failure:
+            raise _Violation(reason)
 
     def check_step(self, impl: Callable[..., Any], inputs: Mapping[str, Any], step: int | None) -> None:
         """Call the implementation on one input and check its outputs (raises on a violation)."""
@@ -233,23 +235,22 @@ class GuaranteeRun:
         try:
             result = impl(**kwargs)
         except Exception as exc:  # the implementation's own failure
-            self._fail(inputs, None, f"the implementation raised {type(exc).__name__}: {exc}", None, step)
+            return self._fail(inputs, None, f"the implementation raised {type(exc).__name__}: {exc}", None, step)
         if not isinstance(result, Mapping):
-            self._fail(inputs, None, f"the implementation returned {result!r}, not a mapping of output name to "
-                       f"value", None, step)
+            return self._fail(inputs, None, f"the implementation returned {result!r}, not a mapping of output "
+                              f"name to value", None, step)
         outputs = dict(result)
         names = set(self.node.outputs)
         if set(outputs) != names:
             missing, extra = sorted(names - set(outputs)), sorted(set(outputs) - names)
-            self._fail(inputs, None, "the implementation's outputs do not match the node's: "
+            return self._fail(inputs, None, "the implementation's outputs do not match the node's: "
                        + "; ".join(p for p in (f"missing {', '.join(missing)}" if missing else "",
                                               f"unexpected {', '.join(map(str, extra))}" if extra else "") if p),
                        None, step)
         for name, t in self.node.outputs.items():
             why = conforms(outputs[name], t)
             if why:
-                self.last_failure = None
-                self._fail(inputs, None, f"output out.{name} is not a value of its type {t}: {why}", None, step)
+                return self._fail(inputs, None, f"output out.{name} is not a value of its type {t}: {why}", None, step)
         values = {**inputs, **{f"out.{k}": v for k, v in outputs.items()}}
         g = self.node.node.guarantees[self.guarantee - 1]
         for c in conjuncts(g.formula):
@@ -259,7 +260,7 @@ class GuaranteeRun:
                 self.unknown.add(why)
                 return
             if not ok:
-                self._fail(inputs, outputs, f"the outputs violate guarantee {self.guarantee} "
+                return self._fail(inputs, outputs, f"the outputs violate guarantee {self.guarantee} "
                            f"({expr_to_rcl(c)})", c, step)
 
     def body(self, example: Any) -> None:
@@ -274,7 +275,10 @@ class GuaranteeRun:
     def settings(self, verbosity: Verbosity = Verbosity.quiet) -> settings:
         return settings(max_examples=self.cfg.max_examples, database=None, derandomize=False,
                         deadline=self.cfg.deadline_ms, report_multiple_bugs=False, print_blob=False,
-                        verbosity=verbosity, suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
+                        verbosity=verbosity, suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large],
+                        # no "explain" phase: it re-runs the shrunk example many times and adds nothing
+                        # the counterexample does not already say
+                        phases=[Phase.explicit, Phase.reuse, Phase.generate, Phase.target, Phase.shrink])
 
     def run(self) -> Outcome:
         """Run Hypothesis; never raises for a failing, inconclusive or starved run."""

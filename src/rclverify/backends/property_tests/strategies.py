@@ -31,6 +31,8 @@ from ...values import FiniteFunction, Term
 
 SMALL_NAT = 5
 POOL_SIZE = 4
+_POOL_COUNT = st.integers(min_value=1, max_value=POOL_SIZE)
+_BOOLS = st.booleans()
 
 
 @dataclass
@@ -130,6 +132,7 @@ class InputSpace:
     bounds: dict[str, Bound]
     constants: list[Fraction]
     pools: dict[tuple[Type, ...], list[tuple[Any, ...]]] = field(default_factory=dict)
+    cache: dict[tuple[Type, int, bool], st.SearchStrategy[Any]] = field(default_factory=dict)
 
     def real(self, bd: Bound | None, small: bool = False) -> st.SearchStrategy[Any]:
         lo = float(bd.lo) if bd and bd.lo is not None else (-1000.0 if small else None)
@@ -162,7 +165,17 @@ class InputSpace:
         return st.one_of(st.sampled_from(edges), ints) if edges and not small else ints
 
     def value(self, t: Type, bd: Bound | None = None, small: bool = False) -> st.SearchStrategy[Any]:
-        """A strategy for values of RCL type ``t`` (``small``: inside a table or term)."""
+        """A strategy for values of RCL type ``t`` (``small``: inside a table or term).
+
+        Built once per (type, bound, size) and reused: Hypothesis inspects a
+        strategy's source when it is built, which would dominate the run time.
+        """
+        key = (t, id(bd), small)
+        if key not in self.cache:
+            self.cache[key] = self._value(t, bd, small)
+        return self.cache[key]
+
+    def _value(self, t: Type, bd: Bound | None, small: bool) -> st.SearchStrategy[Any]:
         if isinstance(t, Scalar):
             if t.name == "BOOL":
                 return st.booleans()
@@ -189,14 +202,19 @@ class InputSpace:
         raise ValueError(f"no strategy for {t}")
 
     def function(self, t: FuncT) -> st.SearchStrategy[FiniteFunction]:
+        points = st.tuples(*[self.value(a, small=True) for a in t.args])
+
         @st.composite
         def draw_fn(draw: Callable[..., Any]) -> FiniteFunction:
             pool = self.pools.get(t.args)
             if pool is None:
-                pool = draw(st.lists(st.tuples(*[self.value(a, small=True) for a in t.args]),
-                                     min_size=1, max_size=POOL_SIZE, unique=True))
+                pool = []
+                for _ in range(draw(_POOL_COUNT)):
+                    point = draw(points)
+                    if point not in pool:
+                        pool.append(point)
                 self.pools[t.args] = pool
-            keys = draw(st.lists(st.sampled_from(pool), unique=True, max_size=len(pool)))
+            keys = [k for k in pool if draw(_BOOLS)]
             table = {k: draw(self.value(t.result, small=True)) for k in keys}
             return FiniteFunction(table, draw(self.value(t.result, small=True)), len(t.args))
         return draw_fn()
