@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import re
 from pathlib import Path
-from typing import Any
+from typing import Any, Callable
 
 import jinja2
 
@@ -141,7 +141,7 @@ class PropertyTestsBackend:
         return self._evidence(evidence, outcome, cfg, target, path, k)
 
     @staticmethod
-    def _evidence(evidence: Any, outcome: Outcome, cfg: Config, target: NodeTarget, path: Path, k: int) -> Evidence:
+    def _evidence(evidence: Callable[..., Evidence], outcome: Outcome, cfg: Config, target: NodeTarget, path: Path, k: int) -> Evidence:
         replay = f"python3 -m pytest {target.rel(path)}::test_guarantee_{k}"
         details: dict[str, Any] = {
             "examples": outcome.counts.as_dict(), "seed": cfg.seed, "max_examples": cfg.max_examples,

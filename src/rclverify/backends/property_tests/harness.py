@@ -297,6 +297,11 @@ class GuaranteeRun:
             return Outcome("error", msg, self.counts, None, sorted(self.unknown), health=kind)
         except EncodingError as exc:
             return Outcome("error", f"Z3 cannot express the formula: {exc}", self.counts, None, sorted(self.unknown))
+        if self.counts.failures:  # only without stop_at_failure: the last violation, not shrunk
+            assert self.last_failure is not None
+            return Outcome("failed", f"{self.counts.failures} example(s) violate guarantee {self.guarantee}, e.g. "
+                           f"{_example_text(self.last_failure)} (not shrunk)", self.counts, self.last_failure,
+                           sorted(self.unknown))
         if self.counts.inconclusive:
             return Outcome("inconclusive", f"no violation, but Z3 answered unknown on {self.counts.inconclusive} "
                            f"example(s) ({', '.join(sorted(self.unknown))})", self.counts, None, sorted(self.unknown))

@@ -19,6 +19,7 @@ constrained by the node's assumption (docs/property-tests.md, "Strategies").
 from __future__ import annotations
 
 import math
+from functools import partial
 from dataclasses import dataclass, field
 from fractions import Fraction
 from typing import Any, Callable, Mapping
@@ -68,6 +69,10 @@ def _input(e: ast.Expr, node: CheckedNode) -> str | None:
     return None
 
 
+def _term(name: str, args: tuple[Any, ...]) -> Term:
+    return Term(name, tuple(args))
+
+
 def conjuncts(e: ast.Expr) -> list[ast.Expr]:
     """Top-level ``and`` conjuncts of a formula."""
     if isinstance(e, ast.Binary) and e.op == "and":
@@ -84,10 +89,11 @@ def assumption_bounds(node: CheckedNode) -> dict[str, Bound]:
     for clause in node.node.assumes:
         for c in conjuncts(clause.formula):
             if isinstance(c, ast.Compare):
-                for op, a, b in zip(c.ops, c.operands, c.operands[1:]):
+                for cop, a, b in zip(c.ops, c.operands, c.operands[1:]):
+                    op: str = cop
                     name, v = _input(a, node), _num(b)
                     if name is None:
-                        name, v, op = _input(b, node), _num(a), _FLIP[op]
+                        name, v, op = _input(b, node), _num(a), _FLIP[cop]
                     if name is None or v is None:
                         continue
                     bd = out.setdefault(name, Bound())
@@ -149,9 +155,9 @@ class InputSpace:
     def integer(self, bd: Bound | None, natural: bool, small: bool = False) -> st.SearchStrategy[int]:
         lo = math.ceil(bd.lo) if bd and bd.lo is not None else None
         hi = math.floor(bd.hi) if bd and bd.hi is not None else None
-        if bd and bd.lo is not None and bd.lo_strict and bd.lo == lo:
+        if lo is not None and bd is not None and bd.lo_strict and bd.lo == lo:
             lo += 1
-        if bd and bd.hi is not None and bd.hi_strict and bd.hi == hi:
+        if hi is not None and bd is not None and bd.hi_strict and bd.hi == hi:
             hi -= 1
         if natural:
             lo = 0 if lo is None else max(lo, 0)
@@ -186,7 +192,7 @@ class InputSpace:
             allowed = [v for v in t.values if bd is None or bd.enum is None or v in bd.enum]
             return st.sampled_from(allowed or list(t.values))
         if isinstance(t, DataT):
-            alts = [st.tuples(*[self.value(a, small=True) for a in args]).map(lambda xs, n=name: Term(n, tuple(xs)))
+            alts = [st.tuples(*[self.value(a, small=True) for a in args]).map(partial(_term, name))
                     for name, args in t.ctors]
             return st.one_of(*alts)
         if isinstance(t, TupleT):
