@@ -187,3 +187,9 @@ def test_written_pytest_file_agrees_with_backend(tmp_path: Path, impl: str, stat
     assert proc.returncode == rc, proc.stdout + proc.stderr
     if rc:
         assert "in.r = 120" in proc.stdout
+
+
+def test_check_concrete_rejects_unknown_name(checked: Any) -> None:
+    node = checked.nodes["RadiationSensor"]
+    with pytest.raises(KeyError, match="no out.nope"):
+        check_concrete(node.node.guarantees[0].formula, checked, node, {"out.nope": 1})

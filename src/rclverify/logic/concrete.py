@@ -127,6 +127,8 @@ def check_concrete(formula: ast.Expr, checked: Checked, node: CheckedNode, value
     Semantics: shared/DESIGN.md ("Semantics the tool commits to"); a node's
     contract is checked per input/output pair as in the paper, lines 462-495.
     """
+    for q in values:
+        _io_type(node, q)  # KeyError for a name that is not an I/O variable of the node
     phi, free = _encoded(formula, checked, node)
     consts: list[tuple[z3.ExprRef, z3.ExprRef]] = []
     funcs: list[tuple[z3.FuncDeclRef, z3.ExprRef]] = []
