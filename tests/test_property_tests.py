@@ -193,3 +193,19 @@ def test_check_concrete_rejects_unknown_name(checked: Any) -> None:
     node = checked.nodes["RadiationSensor"]
     with pytest.raises(KeyError, match="no out.nope"):
         check_concrete(node.node.guarantees[0].formula, checked, node, {"out.nope": 1})
+
+
+def test_z3_unknown_is_inconclusive_never_passed(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    from rclverify.backends.property_tests import harness
+    real = harness.check_concrete
+
+    def unknown_on_guarantee(formula: Any, checked: Any, node: Any, values: Any, **kw: Any) -> Any:
+        if any(k.startswith("out.") for k in values):  # the guarantee check, not the assumption's
+            return None, "timeout"
+        return real(formula, checked, node, values, **kw)
+
+    monkeypatch.setattr(harness, "check_concrete", unknown_on_guarantee)
+    ev = run(workspace(tmp_path, GOOD))
+    assert ev.status == "inconclusive"
+    assert ev.details["examples"]["inconclusive"] == 100 and ev.details["unknown_reasons"] == ["timeout"]
+    assert "Z3 answered unknown on 100 example(s)" in ev.explanation
