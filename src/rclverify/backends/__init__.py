@@ -17,8 +17,9 @@ IMPLEMENTED = {
     "hoare": ("rclverify.backends.hoare.backend", "HoareBackend"),
     "dafny": ("rclverify.backends.dafny.backend", "DafnyBackend"),
     "ajpf": ("rclverify.backends.ajpf.backend", "AjpfBackend"),
+    "property_tests": ("rclverify.backends.property_tests.backend", "PropertyTestsBackend"),
 }
-NOT_AVAILABLE = ("review", "experiment", "property_tests", "monitors")
+NOT_AVAILABLE = ("review", "experiment", "monitors")
 KNOWN = tuple(IMPLEMENTED) + NOT_AVAILABLE
 
 

@@ -70,6 +70,9 @@ def build_report(ws: Workspace) -> dict[str, Any]:
                         "tool": ev.tool, "tool_version": ev.tool_version, "started": ev.started,
                         "duration_s": ev.duration_s, "explanation": expl, "counterexample": ev.counterexample,
                         "artifacts": list(ev.artifacts), "log_excerpt": ev.log[-2000:]})
+        if isinstance(ev.details.get("examples"), dict):  # property tests: example counts and seed
+            ev_rows[-1]["examples"] = {**ev.details["examples"], "seed": ev.details.get("seed"),
+                                       "replay": ev.details.get("replay", "")}
         if status == "pending":
             pending.append({"obligation": o.id, "backend": o.backend, "reason": ev.explanation})
 

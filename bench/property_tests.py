@@ -1,0 +1,67 @@
+"""Throughput of the property_tests backend on the bundled workspace.
+
+For the Radiation Sensor and the Agent (their implementations under
+``backends/property_tests/``), it runs Hypothesis on every guarantee in two
+ways and prints wall-clock figures:
+
+* ``backend``: the run exactly as ``doit verify`` does it (stops at the
+  first violation and shrinks it); checked examples per second counts every
+  example whose outputs were checked, shrinking included;
+* ``all-N``: N examples (``--examples``, default 200) drawn with the same
+  seed and checked against the guarantee without stopping at a violation
+  (no shrinking), so the time for the full N examples is measured even when
+  the contract cannot be met (the Agent's).
+
+Aims (issue 7): at least 100 checked examples per second for the Radiation
+Sensor; the Agent's 200 examples in under 30 s on 2 cores.  The figures
+are printed, not asserted.
+
+Usage::
+
+    python bench/property_tests.py [--examples 200] [--root .]
+"""
+from __future__ import annotations
+
+import argparse
+import time
+from pathlib import Path
+
+from rclverify.backends.property_tests.harness import GuaranteeRun, load_implementation, read_config
+from rclverify.pipeline import Workspace
+
+NODES = ("RadiationSensor", "Agent")
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--examples", type=int, default=200)
+    ap.add_argument("--root", type=Path, default=Path(__file__).resolve().parents[1])
+    args = ap.parse_args()
+    ws = Workspace(args.root)
+    print(f"{'node':<16} {'guarantee':>9} {'mode':>8} {'status':>12} {'checked':>8} {'failing':>8} "
+          f"{'seconds':>8} {'ex/s':>8}")
+    for name in NODES:
+        entries = [e for e in ws.plan.evidence.get(name, ()) if e.backend == "property_tests"]
+        if not entries:
+            print(f"{name}: no property_tests entry in the plan")
+            continue
+        target = ws.target(name, entries[0].index)
+        for mode in ("backend", f"all-{args.examples}"):
+            cfg = read_config({**target.config, "max_examples": args.examples}, target.node, target.root)
+            impl = load_implementation(target.root, cfg)
+            total_n, total_t = 0, 0.0
+            for k in range(1, len(target.node.node.guarantees) + 1):
+                run = GuaranteeRun(target.checked, target.node, k, cfg, impl, stop_at_failure=mode == "backend")
+                t0 = time.perf_counter()
+                out = run.run()
+                dt = time.perf_counter() - t0
+                n = out.counts.steps
+                total_n, total_t = total_n + n, total_t + dt
+                print(f"{name:<16} {k:>9} {mode:>8} {out.status:>12} {n:>8} {out.counts.failures:>8} "
+                      f"{dt:>8.2f} {n / dt:>8.1f}")
+            print(f"{name:<16} {'all':>9} {mode:>8} {'':>12} {total_n:>8} {'':>8} {total_t:>8.2f} "
+                  f"{total_n / total_t:>8.1f}")
+
+
+if __name__ == "__main__":
+    main()

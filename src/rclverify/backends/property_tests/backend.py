@@ -1,0 +1,159 @@
+"""The ``property_tests`` backend: a Python implementation of a node tested
+with Hypothesis against the node's contract, every example checked by Z3.
+
+* ``export`` reads the plan entry ``{backend: property_tests, implementation:
+  <file.py>:<callable>, max_examples, seed, deadline_ms, steps, bounds}``,
+  makes one obligation per guarantee of the node (all guarantees are tested
+  on the same examples: same seed, same strategy) and renders one readable
+  pytest file, ``artifacts/property_tests/<Node>/test_<node>_e<entry>.py``;
+* ``run`` runs Hypothesis for one guarantee (:mod:`.harness`): every valid
+  example passed -> ``discharged`` (kind ``testing``: evidence from tests,
+  not a proof); a violation -> ``failed`` with the shrunk counterexample;
+  Z3 unknown on some example -> ``inconclusive``; an assumption filtering
+  cannot satisfy or an implementation that cannot be loaded -> ``error``.
+
+Calling convention and decisions: docs/property-tests.md.  The paper
+verifies the case study's nodes by other means (Agent: AJPF, lines
+1338-1475; Radiation Sensor: Hoare logic, lines 1476-1541); this backend adds
+testing of executable models of the same nodes against the same contracts.
+"""
+from __future__ import annotations
+
+import re
+from pathlib import Path
+from typing import Any, Callable
+
+import jinja2
+
+from ...evidence.records import Evidence, Obligation, SourceRef, make_obligation_id
+from ...evidence.store import atomic_write_text
+from ...plan.errors import PlanError
+from ...rcl.printer import expr_to_rcl
+from ..base import NodeTarget, Stopwatch, make_evidence
+from .harness import Config, ConfigError, Outcome, load_implementation, read_config, run_guarantee, versions
+
+NAME = "property_tests"
+KIND = "testing"
+
+
+def _templates() -> jinja2.Environment:
+    return jinja2.Environment(loader=jinja2.PackageLoader("rclverify.backends.property_tests", "templates"),
+                              undefined=jinja2.StrictUndefined, autoescape=False, keep_trailing_newline=True)
+
+
+def _config(target: NodeTarget) -> Config:
+    try:
+        return read_config(target.config, target.node, target.root)
+    except ConfigError as exc:
+        raise target.config_error(str(exc), *exc.path) from None
+
+
+def _source(target: NodeTarget, loc: Any) -> SourceRef:
+    file = Path(str(loc.file))
+    text = str(loc.file)
+    if file.is_absolute():
+        try:
+            text = file.resolve().relative_to(target.root.resolve()).as_posix()
+        except ValueError:
+            pass
+    return SourceRef(text, loc.line, loc.col)
+
+
+def test_file(target: NodeTarget) -> Path:
+    """Path of the pytest file rendered for ``target``."""
+    stem = re.sub(r"[^0-9a-zA-Z_]", "_", target.node.name).lower()
+    return target.artifacts / f"test_{stem}_e{target.index}.py"
+
+
+def render_tests(target: NodeTarget, cfg: Config, stateful: bool) -> str:
+    """Text of the generated pytest file (deterministic: no timestamps)."""
+    node = target.node
+    guarantees = [dict(index=k, source=str(_source(target, g.loc)), text=expr_to_rcl(g.formula))
+                  for k, g in enumerate(node.node.guarantees, 1)]
+    assumes = [dict(text=expr_to_rcl(a.formula), source=str(_source(target, a.loc))) for a in node.node.assumes]
+    return _templates().get_template("test_node.py.j2").render(
+        node=node.name, implementation=cfg.implementation, plan_file=target.plan_file, entry=target.index,
+        seed=cfg.seed, max_examples=cfg.max_examples, steps=cfg.steps, stateful=stateful,
+        inputs=[(n, str(t)) for n, t in node.inputs.items()], outputs=[(n, str(t)) for n, t in node.outputs.items()],
+        assumes=assumes, guarantees=guarantees, artifact=target.rel(test_file(target)))
+
+
+def _is_class(target: NodeTarget, cfg: Config) -> bool:
+    import inspect
+    try:
+        return inspect.isclass(load_implementation(target.root, cfg))
+    except ConfigError as exc:
+        raise target.config_error(str(exc), *exc.path) from None
+
+
+class PropertyTestsBackend:
+    """Hypothesis property tests of a Python implementation, outputs checked by Z3.
+
+    ``name`` ``"property_tests"``, ``kind`` ``"testing"``.
+    """
+
+    name = NAME
+    kind = KIND
+
+    def export(self, target: NodeTarget) -> list[Obligation]:
+        """Render the pytest file; return one obligation per guarantee.
+
+        Raises :class:`~rclverify.plan.errors.PlanError` (located in the plan)
+        for a bad entry or an implementation that does not import.
+        """
+        cfg = _config(target)
+        path = test_file(target)
+        atomic_write_text(path, render_tests(target, cfg, _is_class(target, cfg)))
+        inputs = tuple(sorted({cfg.file, *target.contract_files, target.plan_file}))
+        out = []
+        for k, g in enumerate(target.node.node.guarantees, 1):
+            out.append(Obligation(
+                id=make_obligation_id(target.node.name, k, NAME, f"e{target.index}"), node=target.node.name,
+                guarantee=k, backend=NAME, kind=KIND,
+                statement=f"{cfg.implementation} meets guarantee {k} of {target.node.name} on every tested input "
+                          f"satisfying the assumption: {expr_to_rcl(g.formula)}",
+                source=_source(target, g.loc), instance=f"e{target.index}", artifact=target.rel(path),
+                inputs=inputs, data={"implementation": cfg.implementation, "max_examples": cfg.max_examples,
+                                     "seed": cfg.seed, "guarantee": k}))
+        return out
+
+    def run(self, obligation: Obligation, target: NodeTarget) -> Evidence:
+        """Run Hypothesis for the obligation's guarantee; return its evidence (never raises
+        for a user-caused problem)."""
+        clock = Stopwatch()
+
+        def evidence(status: str, explanation: str, **kw: Any) -> Evidence:
+            return make_evidence(target, obligation, status, tool="hypothesis", tool_version=versions(),
+                                 clock=clock, explanation=explanation, **kw)
+
+        try:
+            cfg = read_config(target.config, target.node, target.root)
+            k = int(obligation.data.get("guarantee", obligation.guarantee))
+            if not 1 <= k <= len(target.node.node.guarantees):
+                return evidence("error", "the contract no longer has this guarantee; export again")
+            path = test_file(target)
+            atomic_write_text(path, render_tests(target, cfg, _is_class(target, cfg)))
+            outcome = run_guarantee(target.checked, target.node, k, cfg, target.root)
+        except ConfigError as exc:
+            return evidence("error", f"{target.config_loc(*exc.path)}: error: {exc}")
+        except PlanError as exc:  # the implementation no longer imports
+            return evidence("error", str(exc))
+        return self._evidence(evidence, outcome, cfg, target, path, k)
+
+    @staticmethod
+    def _evidence(evidence: Callable[..., Evidence], outcome: Outcome, cfg: Config, target: NodeTarget, path: Path, k: int) -> Evidence:
+        replay = f"python3 -m pytest {target.rel(path)}::test_guarantee_{k}"
+        details: dict[str, Any] = {
+            "examples": outcome.counts.as_dict(), "seed": cfg.seed, "max_examples": cfg.max_examples,
+            "implementation": cfg.implementation, "deadline_ms": cfg.deadline_ms, "replay": replay,
+        }
+        if outcome.unknown_reasons:
+            details["unknown_reasons"] = outcome.unknown_reasons
+        if outcome.health:
+            details["health_check"] = outcome.health
+        log = "; ".join(f"{a} {b}" for a, b in outcome.counts.as_dict().items())
+        cex = outcome.counterexample
+        if cex is not None:
+            cex = {**cex, "replay": replay}
+        return evidence(outcome.status, outcome.message, log=log, artifacts=(target.rel(path),),
+                        counterexample=cex, details=details)

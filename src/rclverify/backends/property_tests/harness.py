@@ -1,0 +1,337 @@
+"""The Hypothesis run of one guarantee of a node against a Python implementation.
+
+Shared by the backend (:mod:`.backend`) and the pytest files it writes under
+``artifacts/property_tests/<Node>/``, so that both check exactly the same
+thing (docs/property-tests.md).
+
+Per example: inputs are drawn (:mod:`.strategies`) and kept only when Z3
+says the node's assumption holds on them (a filter, so Hypothesis's
+``filter_too_much`` health check watches the rejection rate); the
+implementation is called with one keyword argument per input; its outputs
+must be a mapping with exactly the node's output names, each value of its
+RCL type (:func:`rclverify.values.conforms`); then every top-level conjunct
+of the guarantee is checked on the inputs and outputs by Z3
+(:func:`rclverify.logic.concrete.check_concrete`).  A violation is shrunk by
+Hypothesis; Z3's ``unknown`` counts as inconclusive, never as passed.
+"""
+from __future__ import annotations
+
+import importlib.util
+import inspect
+import sys
+from dataclasses import dataclass, field
+from fractions import Fraction
+from pathlib import Path
+from typing import Any, Callable, Mapping
+
+import hypothesis
+import z3
+from hypothesis import HealthCheck, Phase, Verbosity, given, settings
+from hypothesis import strategies as st
+from hypothesis.errors import FailedHealthCheck, Unsatisfiable
+
+from ...logic.concrete import check_concrete
+from ...logic.encode import EncodingError
+from ...rcl import ast
+from ...rcl.printer import expr_to_rcl
+from ...rcl.types import Checked, CheckedNode
+from ...values import conforms, render
+from .strategies import conjuncts, input_space
+
+DEFAULT_MAX_EXAMPLES = 200
+DEFAULT_SEED = 20260
+DEFAULT_STEPS = 4
+Z3_TIMEOUT_MS = 2000
+
+
+class ConfigError(Exception):
+    """A plan entry the harness cannot use; ``path`` is the key path inside the entry."""
+
+    def __init__(self, message: str, *path: Any) -> None:
+        super().__init__(message)
+        self.path = path
+
+
+@dataclass(frozen=True)
+class Config:
+    """A plan entry ``{backend: property_tests, implementation: file.py:callable, ...}``."""
+
+    implementation: str
+    file: str
+    attr: str
+    max_examples: int = DEFAULT_MAX_EXAMPLES
+    seed: int = DEFAULT_SEED
+    deadline_ms: int | None = None
+    steps: int = DEFAULT_STEPS
+    bounds: Mapping[str, tuple[Fraction | None, Fraction | None]] = field(default_factory=dict)
+
+
+def _positive(raw: Mapping[str, Any], key: str, default: int) -> int:
+    v = raw.get(key, default)
+    if isinstance(v, bool) or not isinstance(v, int) or v < 1:
+        raise ConfigError(f"{key} must be a positive integer", key)
+    return v
+
+
+def read_config(raw: Mapping[str, Any], node: CheckedNode, root: Path) -> Config:
+    """Validate a plan entry.  Raises :class:`ConfigError` (with the key path)."""
+    impl = raw.get("implementation")
+    if not isinstance(impl, str) or ":" not in impl:
+        raise ConfigError("implementation must be '<file.py>:<callable>' (workspace-relative)", "implementation")
+    file, _, attr = impl.rpartition(":")
+    if not (root / file).is_file():
+        raise ConfigError(f"implementation file {file!r} does not exist", "implementation")
+    seed = raw.get("seed", DEFAULT_SEED)
+    if isinstance(seed, bool) or not isinstance(seed, int):
+        raise ConfigError("seed must be an integer", "seed")
+    deadline = raw.get("deadline_ms")
+    if deadline is not None and (isinstance(deadline, bool) or not isinstance(deadline, int) or deadline < 1):
+        raise ConfigError("deadline_ms must be a positive integer (milliseconds)", "deadline_ms")
+    bounds: dict[str, tuple[Fraction | None, Fraction | None]] = {}
+    raw_bounds = raw.get("bounds") or {}
+    if not isinstance(raw_bounds, Mapping):
+        raise ConfigError("bounds must map in.<input> to [lo, hi]", "bounds")
+    for k, v in raw_bounds.items():
+        name = str(k).removeprefix("in.")
+        if name not in node.inputs:
+            raise ConfigError(f"{k!r} is not an input of {node.name} ({', '.join(node.inputs)})", "bounds", k)
+        if (not isinstance(v, list) or len(v) != 2
+                or any(x is not None and (isinstance(x, bool) or not isinstance(x, (int, float))) for x in v)):
+            raise ConfigError(f"bounds of {k} must be [lo, hi] (numbers or null)", "bounds", k)
+        bounds[name] = (None if v[0] is None else Fraction(v[0]), None if v[1] is None else Fraction(v[1]))
+    return Config(impl, file, attr, _positive(raw, "max_examples", DEFAULT_MAX_EXAMPLES), seed, deadline,
+                  _positive(raw, "steps", DEFAULT_STEPS), bounds)
+
+
+def load_implementation(root: Path, cfg: Config) -> Any:
+    """Import the implementation's file afresh and return the named callable or class.
+
+    Raises :class:`ConfigError` when the file does not import or lacks the name.
+    """
+    path = (root / cfg.file).resolve()
+    modname = f"rclverify_impl_{abs(hash(str(path)))}"
+    spec = importlib.util.spec_from_file_location(modname, path)
+    if spec is None or spec.loader is None:
+        raise ConfigError(f"cannot import {cfg.file}", "implementation")
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[modname] = module
+    try:
+        spec.loader.exec_module(module)
+    except Exception as exc:  # the user's file: any error is theirs
+        raise ConfigError(f"importing {cfg.file} failed: {type(exc).__name__}: {exc}", "implementation") from None
+    obj = getattr(module, cfg.attr, None)
+    if obj is None or not callable(obj):
+        raise ConfigError(f"{cfg.file} has no callable {cfg.attr!r}", "implementation")
+    return obj
+
+
+@dataclass
+class Counts:
+    """Example counts of one run (shrinking steps included in ``valid``)."""
+
+    drawn: int = 0
+    valid: int = 0
+    rejected: int = 0
+    assumption_unknown: int = 0
+    failures: int = 0
+    inconclusive: int = 0
+    steps: int = 0
+
+    def as_dict(self) -> dict[str, int]:
+        return {"run": self.drawn, "valid": self.valid, "rejected": self.rejected,
+                "assumption_unknown": self.assumption_unknown, "failures": self.failures,
+                "inconclusive": self.inconclusive, "steps_checked": self.steps}
+
+
+@dataclass
+class Outcome:
+    """Result of :func:`run_guarantee`.
+
+    ``status``: ``discharged`` (every valid example passed, none
+    inconclusive), ``failed`` (a counterexample, shrunk), ``inconclusive``
+    (no failure, but Z3 answered unknown on some example), ``error``
+    (health check or configuration).  ``counterexample`` maps ``in.x`` /
+    ``out.y`` / ``guarantee`` / ``source`` / ``reason`` to RCL text.
+    """
+
+    status: str
+    message: str
+    counts: Counts
+    counterexample: dict[str, str] | None = None
+    unknown_reasons: list[str] = field(default_factory=list)
+    health: str = ""
+
+
+class _Violation(AssertionError):
+    pass
+
+
+def _source(loc: ast.Loc) -> str:
+    return f"{loc.file}:{loc.line}:{loc.col}"
+
+
+def _assumption_text(node: CheckedNode) -> str:
+    return " and ".join(f"{expr_to_rcl(c.formula)} ({_source(c.loc)})" for c in node.node.assumes) or "TRUE"
+
+
+@dataclass
+class GuaranteeRun:
+    """Everything needed to check guarantee ``guarantee`` (1-based) of ``node``."""
+
+    checked: Checked
+    node: CheckedNode
+    guarantee: int
+    cfg: Config
+    impl: Any
+    stop_at_failure: bool = True  # False: count violations and go on (benchmarks); no shrinking then
+    counts: Counts = field(default_factory=Counts)
+    last_failure: dict[str, str] | None = None
+    unknown: set[str] = field(default_factory=set)
+
+    @property
+    def stateful(self) -> bool:
+        return inspect.isclass(self.impl)
+
+    def assumption_holds(self, values: Mapping[str, Any]) -> bool:
+        self.counts.drawn += 1
+        for clause in self.node.node.assumes:
+            ok, why = check_concrete(clause.formula, self.checked, self.node, values, timeout_ms=Z3_TIMEOUT_MS)
+            if ok is None:
+                self.counts.assumption_unknown += 1
+                self.unknown.add(f"assumption: {why}")
+            if ok is not True:
+                self.counts.rejected += 1
+                return False
+        return True
+
+    def strategy(self) -> st.SearchStrategy[Any]:
+        one = input_space(self.node, self.cfg.bounds).inputs().filter(self.assumption_holds)
+        if self.stateful:
+            return st.lists(one, min_size=1, max_size=self.cfg.steps)
+        return one
+
+    def _fail(self, inputs: Mapping[str, Any], outputs: Mapping[str, Any] | None, reason: str,
+              conjunct: ast.Expr | None, step: int | None) -> None:
+        self.counts.failures += 1
+        g = self.node.node.guarantees[self.guarantee - 1]
+        cex = {k: render(v) for k, v in sorted(inputs.items())}
+        if outputs is not None:
+            cex.update({f"out.{k}": render(v) for k, v in sorted(outputs.items())})
+        cex["guarantee"] = f"{self.node.name} guarantee {self.guarantee}"
+        cex["source"] = _source(conjunct.loc if conjunct is not None else g.loc)
+        if conjunct is not None:
+            cex["conjunct"] = expr_to_rcl(conjunct)
+        if step is not None:
+            cex["step"] = str(step)
+        cex["reason"] = reason
+        self.last_failure = cex
+        if self.stop_at_failure:
+            raise _Violation(reason)
+
+    def check_step(self, impl: Callable[..., Any], inputs: Mapping[str, Any], step: int | None) -> None:
+        """Call the implementation on one input and check its outputs (raises on a violation)."""
+        self.counts.steps += 1
+        kwargs = {k.removeprefix("in."): v for k, v in inputs.items()}
+        try:
+            result = impl(**kwargs)
+        except Exception as exc:  # the implementation's own failure
+            return self._fail(inputs, None, f"the implementation raised {type(exc).__name__}: {exc}", None, step)
+        if not isinstance(result, Mapping):
+            return self._fail(inputs, None, f"the implementation returned {result!r}, not a mapping of output "
+                              f"name to value", None, step)
+        outputs = dict(result)
+        names = set(self.node.outputs)
+        if set(outputs) != names:
+            missing, extra = sorted(names - set(outputs)), sorted(set(outputs) - names)
+            return self._fail(inputs, None, "the implementation's outputs do not match the node's: "
+                       + "; ".join(p for p in (f"missing {', '.join(missing)}" if missing else "",
+                                              f"unexpected {', '.join(map(str, extra))}" if extra else "") if p),
+                       None, step)
+        for name, t in self.node.outputs.items():
+            why = conforms(outputs[name], t)
+            if why:
+                return self._fail(inputs, None, f"output out.{name} is not a value of its type {t}: {why}", None, step)
+        values = {**inputs, **{f"out.{k}": v for k, v in outputs.items()}}
+        g = self.node.node.guarantees[self.guarantee - 1]
+        for c in conjuncts(g.formula):
+            ok, why = check_concrete(c, self.checked, self.node, values, timeout_ms=Z3_TIMEOUT_MS)
+            if ok is None:
+                self.counts.inconclusive += 1
+                self.unknown.add(why)
+                return
+            if not ok:
+                return self._fail(inputs, outputs, f"the outputs violate guarantee {self.guarantee} "
+                           f"({expr_to_rcl(c)})", c, step)
+
+    def body(self, example: Any) -> None:
+        self.counts.valid += 1
+        if self.stateful:
+            machine = self.impl()
+            for k, inputs in enumerate(example, 1):
+                self.check_step(machine.step, inputs, k)
+        else:
+            self.check_step(self.impl, example, None)
+
+    def settings(self, verbosity: Verbosity = Verbosity.quiet) -> settings:
+        return settings(max_examples=self.cfg.max_examples, database=None, derandomize=False,
+                        deadline=self.cfg.deadline_ms, report_multiple_bugs=False, print_blob=False,
+                        verbosity=verbosity, suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large],
+                        # no "explain" phase: it re-runs the shrunk example many times and adds nothing
+                        # the counterexample does not already say
+                        phases=[Phase.explicit, Phase.reuse, Phase.generate, Phase.target, Phase.shrink])
+
+    def run(self) -> Outcome:
+        """Run Hypothesis; never raises for a failing, inconclusive or starved run."""
+        test = hypothesis.seed(self.cfg.seed)(self.settings()(given(self.strategy())(self.body)))
+        try:
+            test()
+        except _Violation as exc:
+            assert self.last_failure is not None
+            return Outcome("failed", f"{exc} on the shrunk example {_example_text(self.last_failure)}",
+                           self.counts, self.last_failure, sorted(self.unknown))
+        except (FailedHealthCheck, Unsatisfiable) as exc:
+            kind = "filter_too_much" if isinstance(exc, FailedHealthCheck) else "unsatisfiable"
+            msg = (f"the assumption of {self.node.name}, {_assumption_text(self.node)}, rejected "
+                   f"{self.counts.rejected} of {self.counts.drawn} drawn inputs ({kind}): filtering cannot find "
+                   f"inputs that satisfy it; give bounds for its inputs in the plan (bounds: {{in.x: [lo, hi]}})")
+            return Outcome("error", msg, self.counts, None, sorted(self.unknown), health=kind)
+        except EncodingError as exc:
+            return Outcome("error", f"Z3 cannot express the formula: {exc}", self.counts, None, sorted(self.unknown))
+        if self.counts.failures:  # only without stop_at_failure: the last violation, not shrunk
+            assert self.last_failure is not None
+            return Outcome("failed", f"{self.counts.failures} example(s) violate guarantee {self.guarantee}, e.g. "
+                           f"{_example_text(self.last_failure)} (not shrunk)", self.counts, self.last_failure,
+                           sorted(self.unknown))
+        if self.counts.inconclusive:
+            return Outcome("inconclusive", f"no violation, but Z3 answered unknown on {self.counts.inconclusive} "
+                           f"example(s) ({', '.join(sorted(self.unknown))})", self.counts, None, sorted(self.unknown))
+        return Outcome("discharged", f"all {self.counts.valid} valid example(s) met guarantee {self.guarantee}",
+                       self.counts, None, [])
+
+
+def _example_text(cex: Mapping[str, str]) -> str:
+    return ", ".join(f"{k} = {v}" for k, v in cex.items() if k.startswith(("in.", "out.", "step")))
+
+
+def run_guarantee(checked: Checked, node: CheckedNode, guarantee: int, cfg: Config, root: Path) -> Outcome:
+    """Load the implementation and run guarantee ``guarantee`` (1-based) of ``node``.
+
+    Raises :class:`ConfigError` for an implementation that cannot be loaded.
+    """
+    impl = load_implementation(root, cfg)
+    return GuaranteeRun(checked, node, guarantee, cfg, impl).run()
+
+
+def versions() -> str:
+    """``hypothesis <v>; z3 <v>`` of this process."""
+    return f"hypothesis {hypothesis.__version__}; z3 {z3.get_version_string()}"
+
+
+def check_from_workspace(root: Path, plan_file: str, node: str, entry: int, guarantee: int) -> Outcome:
+    """What a generated pytest file calls: rebuild the node's target from the
+    workspace at ``root`` and run one guarantee, exactly as the backend does."""
+    from ...pipeline import Workspace
+    ws = Workspace(root, plan_file)
+    target = ws.target(node, entry)
+    cfg = read_config(target.config, target.node, target.root)
+    return run_guarantee(target.checked, target.node, guarantee, cfg, target.root)

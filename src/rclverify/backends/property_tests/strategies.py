@@ -1,0 +1,247 @@
+"""Hypothesis strategies for a node's inputs, derived from their RCL types and
+constrained by the node's assumption (docs/property-tests.md, "Strategies").
+
+* Bounds by construction: every top-level conjunct of the assumption of the
+  form ``c <= in.x``, ``in.x < c``, ``a <= in.x < b`` (numeric literals) bounds
+  a numeric input; ``in.e in {v1, v2}`` restricts an enumeration input.  The
+  plan's ``bounds: {in.x: [lo, hi]}`` narrows further (either end may be null).
+* Boundary values: the numeric literals of the node's contract (and, for
+  REAL, their float neighbours) are drawn alongside arbitrary values, so a
+  threshold that is off by one is hit.
+* Function-typed inputs are finite tables with a default
+  (:class:`~rclverify.values.FiniteFunction`).  Their keys come from one pool
+  of argument tuples per argument type, drawn once per example, so two
+  functions over the same domain (the Agent's ``at`` and ``wayP``) share
+  their points; values inside tables are small (NATURAL 0..5, INTEGER -5..5).
+* What the bounds do not capture is enforced by filtering with the whole
+  assumption, checked by Z3 (:func:`~rclverify.logic.concrete.check_concrete`).
+"""
+from __future__ import annotations
+
+import math
+from functools import partial
+from dataclasses import dataclass, field
+from fractions import Fraction
+from typing import Any, Callable, Mapping
+
+from hypothesis import strategies as st
+
+from ...rcl import ast
+from ...rcl.types import CheckedNode, DataT, EmptyT, EnumT, FuncT, Scalar, SeqT, SetT, TupleT, Type
+from ...values import FiniteFunction, Term
+
+SMALL_NAT = 5
+POOL_SIZE = 4
+_POOL_COUNT = st.integers(min_value=1, max_value=POOL_SIZE)
+_BOOLS = st.booleans()
+
+
+@dataclass
+class Bound:
+    """Closed/open numeric bounds of one input (``None``: unbounded)."""
+
+    lo: Fraction | None = None
+    hi: Fraction | None = None
+    lo_strict: bool = False
+    hi_strict: bool = False
+    enum: frozenset[str] | None = None
+
+    def lower(self, v: Fraction, strict: bool) -> None:
+        if self.lo is None or v > self.lo or (v == self.lo and strict):
+            self.lo, self.lo_strict = v, strict
+
+    def upper(self, v: Fraction, strict: bool) -> None:
+        if self.hi is None or v < self.hi or (v == self.hi and strict):
+            self.hi, self.hi_strict = v, strict
+
+
+def _num(e: ast.Expr) -> Fraction | None:
+    if isinstance(e, ast.NumLit):
+        return e.value
+    if isinstance(e, ast.Unary) and e.op == "-" and isinstance(e.operand, ast.NumLit):
+        return -e.operand.value
+    return None
+
+
+def _input(e: ast.Expr, node: CheckedNode) -> str | None:
+    if isinstance(e, ast.Var) and e.prefix in (None, "in") and e.name in node.inputs:
+        return e.name
+    return None
+
+
+def _term(name: str, args: tuple[Any, ...]) -> Term:
+    return Term(name, tuple(args))
+
+
+def conjuncts(e: ast.Expr) -> list[ast.Expr]:
+    """Top-level ``and`` conjuncts of a formula."""
+    if isinstance(e, ast.Binary) and e.op == "and":
+        return conjuncts(e.left) + conjuncts(e.right)
+    return [e]
+
+
+_FLIP = {"<": ">", "<=": ">=", ">": "<", ">=": "<=", "==": "==", "!=": "!="}
+
+
+def assumption_bounds(node: CheckedNode) -> dict[str, Bound]:
+    """Bounds per input name found in the assumption's top-level conjuncts."""
+    out: dict[str, Bound] = {}
+    for clause in node.node.assumes:
+        for c in conjuncts(clause.formula):
+            if isinstance(c, ast.Compare):
+                for cop, a, b in zip(c.ops, c.operands, c.operands[1:]):
+                    op: str = cop
+                    name, v = _input(a, node), _num(b)
+                    if name is None:
+                        name, v, op = _input(b, node), _num(a), _FLIP[cop]
+                    if name is None or v is None:
+                        continue
+                    bd = out.setdefault(name, Bound())
+                    if op in (">", ">=", "=="):
+                        bd.lower(v, op == ">")
+                    if op in ("<", "<=", "=="):
+                        bd.upper(v, op == "<")
+            elif isinstance(c, ast.Member) and not c.negated and isinstance(c.collection, ast.SetLit):
+                name = _input(c.elem, node)
+                if name is not None and isinstance(node.inputs[name], EnumT):
+                    vals = frozenset(i.name for i in c.collection.items if isinstance(i, ast.Var))
+                    bd = out.setdefault(name, Bound())
+                    bd.enum = vals if bd.enum is None else bd.enum & vals
+    return out
+
+
+def contract_constants(node: CheckedNode) -> list[Fraction]:
+    """Every numeric literal of the node's contract (sorted, unique)."""
+    found: set[Fraction] = set()
+
+    def walk(x: Any) -> None:
+        if isinstance(x, ast.NumLit):
+            found.add(x.value)
+        elif isinstance(x, tuple):
+            for y in x:
+                walk(y)
+        elif hasattr(x, "__dataclass_fields__"):
+            for f in x.__dataclass_fields__:
+                if f != "loc":
+                    walk(getattr(x, f))
+
+    for clause in (*node.node.assumes, *node.node.guarantees):
+        walk(clause.formula)
+    return sorted(found)
+
+
+@dataclass
+class InputSpace:
+    """How one node's inputs are drawn (see the module docstring)."""
+
+    node: CheckedNode
+    bounds: dict[str, Bound]
+    constants: list[Fraction]
+    pools: dict[tuple[Type, ...], list[tuple[Any, ...]]] = field(default_factory=dict)
+    cache: dict[tuple[Type, int, bool], st.SearchStrategy[Any]] = field(default_factory=dict)
+
+    def real(self, bd: Bound | None, small: bool = False) -> st.SearchStrategy[Any]:
+        lo = float(bd.lo) if bd and bd.lo is not None else (-1000.0 if small else None)
+        hi = float(bd.hi) if bd and bd.hi is not None else (1000.0 if small else None)
+        edges: set[float] = set()
+        for c in self.constants:
+            f = float(c)
+            edges.update((f, math.nextafter(f, -math.inf), math.nextafter(f, math.inf)))
+        edges_in = sorted(e for e in edges if (lo is None or e >= lo) and (hi is None or e <= hi))
+        floats = st.floats(min_value=lo, max_value=hi, allow_nan=False, allow_infinity=False,
+                           exclude_min=bool(bd and bd.lo_strict), exclude_max=bool(bd and bd.hi_strict))
+        return st.one_of(st.sampled_from(edges_in), floats) if edges_in else floats
+
+    def integer(self, bd: Bound | None, natural: bool, small: bool = False) -> st.SearchStrategy[int]:
+        lo = math.ceil(bd.lo) if bd and bd.lo is not None else None
+        hi = math.floor(bd.hi) if bd and bd.hi is not None else None
+        if lo is not None and bd is not None and bd.lo_strict and bd.lo == lo:
+            lo += 1
+        if hi is not None and bd is not None and bd.hi_strict and bd.hi == hi:
+            hi -= 1
+        if natural:
+            lo = 0 if lo is None else max(lo, 0)
+        if small:
+            lo = -SMALL_NAT if lo is None else lo
+            hi = lo + 2 * SMALL_NAT if hi is None else hi
+            hi = min(hi, SMALL_NAT) if lo <= SMALL_NAT else hi
+        edges = sorted({int(c) + d for c in self.constants if c.denominator == 1 for d in (-1, 0, 1)
+                        if (lo is None or int(c) + d >= lo) and (hi is None or int(c) + d <= hi)})
+        ints = st.integers(min_value=lo, max_value=hi)
+        return st.one_of(st.sampled_from(edges), ints) if edges and not small else ints
+
+    def value(self, t: Type, bd: Bound | None = None, small: bool = False) -> st.SearchStrategy[Any]:
+        """A strategy for values of RCL type ``t`` (``small``: inside a table or term).
+
+        Built once per (type, bound, size) and reused: Hypothesis inspects a
+        strategy's source when it is built, which would dominate the run time.
+        """
+        key = (t, id(bd), small)
+        if key not in self.cache:
+            self.cache[key] = self._value(t, bd, small)
+        return self.cache[key]
+
+    def _value(self, t: Type, bd: Bound | None, small: bool) -> st.SearchStrategy[Any]:
+        if isinstance(t, Scalar):
+            if t.name == "BOOL":
+                return st.booleans()
+            if t.name == "REAL":
+                return self.real(bd, small)
+            return self.integer(bd, t.name == "NATURAL", small)
+        if isinstance(t, EnumT):
+            allowed = [v for v in t.values if bd is None or bd.enum is None or v in bd.enum]
+            return st.sampled_from(allowed or list(t.values))
+        if isinstance(t, DataT):
+            alts = [st.tuples(*[self.value(a, small=True) for a in args]).map(partial(_term, name))
+                    for name, args in t.ctors]
+            return st.one_of(*alts)
+        if isinstance(t, TupleT):
+            return st.tuples(*[self.value(e, small=True) for e in t.elems])
+        if isinstance(t, SetT):
+            return st.frozensets(self.value(t.elem, small=True), max_size=POOL_SIZE)
+        if isinstance(t, SeqT):
+            return st.lists(self.value(t.elem, small=True), max_size=POOL_SIZE).map(tuple)
+        if isinstance(t, FuncT):
+            return self.function(t)
+        if isinstance(t, EmptyT):
+            return st.nothing()
+        raise ValueError(f"no strategy for {t}")
+
+    def function(self, t: FuncT) -> st.SearchStrategy[FiniteFunction]:
+        points = st.tuples(*[self.value(a, small=True) for a in t.args])
+
+        @st.composite
+        def draw_fn(draw: Callable[..., Any]) -> FiniteFunction:
+            pool = self.pools.get(t.args)
+            if pool is None:
+                pool = []
+                for _ in range(draw(_POOL_COUNT)):
+                    point = draw(points)
+                    if point not in pool:
+                        pool.append(point)
+                self.pools[t.args] = pool
+            keys = [k for k in pool if draw(_BOOLS)]
+            table = {k: draw(self.value(t.result, small=True)) for k in keys}
+            return FiniteFunction(table, draw(self.value(t.result, small=True)), len(t.args))
+        return draw_fn()
+
+    def inputs(self) -> st.SearchStrategy[dict[str, Any]]:
+        """One example: qualified input name -> value."""
+        @st.composite
+        def draw_inputs(draw: Callable[..., Any]) -> dict[str, Any]:
+            self.pools = {}
+            return {f"in.{n}": draw(self.value(t, self.bounds.get(n))) for n, t in self.node.inputs.items()}
+        return draw_inputs()
+
+
+def input_space(node: CheckedNode, plan_bounds: Mapping[str, tuple[Fraction | None, Fraction | None]]) -> InputSpace:
+    """The :class:`InputSpace` of ``node``; ``plan_bounds`` maps input names
+    (without ``in.``) to the plan's ``[lo, hi]`` (closed)."""
+    bounds = assumption_bounds(node)
+    for name, (lo, hi) in plan_bounds.items():
+        bd = bounds.setdefault(name, Bound())
+        if lo is not None:
+            bd.lower(lo, False)
+        if hi is not None:
+            bd.upper(hi, False)
+    return InputSpace(node, bounds, contract_constants(node))

@@ -1,0 +1,211 @@
+"""Tests of the property_tests backend and of the Z3 check on concrete values
+(rclverify.logic.concrete): real Hypothesis runs on small workspaces."""
+from __future__ import annotations
+
+import os
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from rclverify.backends import get_backend
+from rclverify.backends.property_tests.backend import PropertyTestsBackend
+from rclverify.evidence.records import Evidence
+from rclverify.logic.concrete import check_concrete
+from rclverify.pipeline import Workspace
+from rclverify.plan.errors import PlanError
+from rclverify.rcl.typecheck import load
+from rclverify.values import FiniteFunction, Term
+
+REPO = Path(__file__).resolve().parents[1]
+RCL = "contracts/remote_inspection.rcl"
+
+GOOD = '''
+from rclverify.values import FiniteFunction
+
+def sensor(r, command):
+    status = "green" if r < 120 else "orange" if r < 250 else "red"
+    table = {(command.args[0],): True} if command.name == "inspect" else {}
+    return {"radiationStatus": status, "inspected": FiniteFunction(table, False, 1)}
+'''
+OFF_BY_ONE = GOOD.replace("r < 120", "r <= 120")
+OUT_OF_TYPE = GOOD.replace('"red"', '"yellow"')
+RAISES = GOOD.replace("    status =", "    if r > 1000: raise ValueError('too hot')\n    status =")
+STATEFUL = '''
+from rclverify.values import FiniteFunction
+
+class Sensor:
+    """Remembers every inspected waypoint."""
+    def __init__(self):
+        self.done = {}
+
+    def step(self, r, command):
+        if command.name == "inspect":
+            self.done[(command.args[0],)] = True
+        status = "green" if r < 120 else "orange" if r < 250 else "red"
+        return {"radiationStatus": status, "inspected": FiniteFunction(dict(self.done), False, 1)}
+'''
+
+
+def workspace(tmp: Path, impl: str, extra: str = "", rcl: str | None = None, node: str = "RadiationSensor") -> Path:
+    (tmp / "contracts").mkdir(parents=True)
+    if rcl is None:
+        shutil.copy(REPO / RCL, tmp / RCL)
+    else:
+        (tmp / RCL).write_text(rcl)
+    (tmp / "impl.py").write_text(impl)
+    attr = "Sensor" if "class Sensor" in impl else "sensor"
+    (tmp / "contracts/plan.yaml").write_text(
+        f"contracts: [{RCL}]\nnodes:\n  {node}:\n    evidence:\n      - backend: property_tests\n"
+        f"        implementation: impl.py:{attr}\n        max_examples: 100\n{extra}")
+    return tmp
+
+
+def run(root: Path, node: str = "RadiationSensor", guarantee: int = 1) -> Evidence:
+    ws = Workspace(root)
+    target = ws.target(node, 0)
+    backend = PropertyTestsBackend()
+    obligations = backend.export(target)
+    return backend.run(obligations[guarantee - 1], target)
+
+
+# -- the Z3 check on concrete values ------------------------------------------------------------
+
+@pytest.fixture(scope="module")
+def checked() -> Any:
+    return load([REPO / RCL])
+
+
+def test_check_concrete_radiation_sensor(checked: Any) -> None:
+    node = checked.nodes["RadiationSensor"]
+    g = node.node.guarantees[0].formula
+    values = {"in.r": 130.0, "in.command": Term("inspect", (3,)), "out.radiationStatus": "orange",
+              "out.inspected": FiniteFunction({(3,): True}, False, 1)}
+    assert check_concrete(g, checked, node, values) == (True, "")
+    assert check_concrete(g, checked, node, {**values, "out.radiationStatus": "green"}) == (False, "")
+    assert check_concrete(g, checked, node, {**values, "out.inspected": FiniteFunction({}, False, 1)}) == (False, "")
+    with pytest.raises(KeyError, match="out.radiationStatus"):
+        check_concrete(g, checked, node, {k: v for k, v in values.items() if k != "out.radiationStatus"})
+
+
+def test_check_concrete_quantifies_over_function_tables(checked: Any) -> None:
+    node = checked.nodes["Agent"]
+    wayp = FiniteFunction({(0.0, 0.0): 0, (1.0, 2.0): 1}, 5, 2)
+    values = {"in.wayP": wayp, "in.at": FiniteFunction({(1.0, 2.0): True}, False, 2), "in.radiationStatus": "green",
+              "in.inspected": FiniteFunction({(1,): True}, False, 1)}
+    g1 = node.node.guarantees[0].formula
+    # at waypoint 1, inspected, no waypoint 2: guarantee 1 asks for a move to waypoint 0 at (0, 0)
+    assert check_concrete(g1, checked, node, {**values, "out.command": Term("move", (0.0, 0.0))})[0] is True
+    assert check_concrete(g1, checked, node, {**values, "out.command": Term("move", (1.0, 2.0))})[0] is False
+
+
+# -- the backend ---------------------------------------------------------------------------------
+
+def test_registered() -> None:
+    assert isinstance(get_backend("property_tests"), PropertyTestsBackend)
+
+
+def test_correct_implementation_discharged(tmp_path: Path) -> None:
+    ev = run(workspace(tmp_path, GOOD))
+    assert ev.status == "discharged", ev.explanation
+    assert ev.kind == "testing" and ev.tool == "hypothesis" and "z3" in ev.tool_version
+    ex = ev.details["examples"]
+    assert ex["valid"] == 100 and ex["failures"] == 0 and ex["inconclusive"] == 0
+    assert "impl.py" in ev.input_hashes
+
+
+def test_off_by_one_threshold_caught_with_shrunk_counterexample(tmp_path: Path) -> None:
+    ev = run(workspace(tmp_path, OFF_BY_ONE))
+    assert ev.status == "failed"
+    cex = ev.counterexample or {}
+    assert cex["in.r"] == "120" or cex["in.r"] == "120.0"
+    assert cex["out.radiationStatus"] == "green"
+    assert cex["guarantee"] == "RadiationSensor guarantee 1"
+    assert cex["source"].startswith("contracts/remote_inspection.rcl:")
+    assert "test_guarantee_1" in cex["replay"]
+
+
+def test_out_of_type_output_named(tmp_path: Path) -> None:
+    ev = run(workspace(tmp_path, OUT_OF_TYPE, extra="        bounds: {in.r: [0, 100000]}\n"))
+    assert ev.status == "failed"
+    assert "output out.radiationStatus is not a value of its type" in ev.explanation
+    assert "'yellow'" in ev.explanation
+
+
+def test_raising_implementation_fails(tmp_path: Path) -> None:
+    ev = run(workspace(tmp_path, RAISES))
+    assert ev.status == "failed"
+    assert "raised ValueError: too hot" in ev.explanation
+
+
+def test_stateful_implementation_checked_step_by_step(tmp_path: Path) -> None:
+    ev = run(workspace(tmp_path, STATEFUL))
+    assert ev.status == "discharged", ev.explanation
+    assert ev.details["examples"]["steps_checked"] > ev.details["examples"]["valid"]
+
+
+def test_starved_filter_gives_health_message(tmp_path: Path) -> None:
+    rcl = ("context { K : {a} ; }\nnode Sq {\n  inputs( x : REAL )\n  outputs( y : REAL )\n"
+           "  assume( in.x * in.x == 2 )\n  guarantee( out.y == in.x )\n}\n")
+    impl = "def sensor(x):\n    return {'y': x}\n"
+    ev = run(workspace(tmp_path, impl, rcl=rcl, node="Sq"), node="Sq")
+    assert ev.status == "error"
+    assert "in.x * in.x == 2" in ev.explanation and "contracts/remote_inspection.rcl:5:" in ev.explanation
+    assert "filtering cannot find inputs" in ev.explanation
+    assert ev.details["examples"]["rejected"] > 0 and ev.details["examples"]["valid"] == 0
+
+
+def test_same_seed_same_evidence(tmp_path: Path) -> None:
+    root = workspace(tmp_path, OFF_BY_ONE)
+    a, b = run(root).to_json(), run(root).to_json()
+    for k in ("started", "duration_s"):
+        a.pop(k), b.pop(k)
+    assert a == b
+
+
+def test_bad_entry_is_a_located_plan_error(tmp_path: Path) -> None:
+    root = workspace(tmp_path, GOOD)
+    plan = (root / "contracts/plan.yaml").read_text().replace("impl.py:sensor", "impl.py:nosuch")
+    (root / "contracts/plan.yaml").write_text(plan)
+    with pytest.raises(PlanError, match=r"contracts/plan.yaml:\d+:\d+: error: impl.py has no callable 'nosuch'"):
+        PropertyTestsBackend().export(Workspace(root).target("RadiationSensor", 0))
+
+
+@pytest.mark.parametrize("impl,status,rc", [(GOOD, "discharged", 0), (OFF_BY_ONE, "failed", 1)],
+                         ids=["correct", "off_by_one"])
+def test_written_pytest_file_agrees_with_backend(tmp_path: Path, impl: str, status: str, rc: int) -> None:
+    root = workspace(tmp_path, impl)
+    ev = run(root)
+    assert ev.status == status
+    (artifact,) = ev.artifacts
+    env = {**os.environ, "PYTHONPATH": str(REPO / "src")}
+    proc = subprocess.run([sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", artifact],
+                          cwd=root, env=env, capture_output=True, text=True, timeout=300)
+    assert proc.returncode == rc, proc.stdout + proc.stderr
+    if rc:
+        assert "in.r = 120" in proc.stdout
+
+
+def test_check_concrete_rejects_unknown_name(checked: Any) -> None:
+    node = checked.nodes["RadiationSensor"]
+    with pytest.raises(KeyError, match="no out.nope"):
+        check_concrete(node.node.guarantees[0].formula, checked, node, {"out.nope": 1})
+
+
+def test_z3_unknown_is_inconclusive_never_passed(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    from rclverify.backends.property_tests import harness
+    real = harness.check_concrete
+
+    def unknown_on_guarantee(formula: Any, checked: Any, node: Any, values: Any, **kw: Any) -> Any:
+        if any(k.startswith("out.") for k in values):  # the guarantee check, not the assumption's
+            return None, "timeout"
+        return real(formula, checked, node, values, **kw)
+
+    monkeypatch.setattr(harness, "check_concrete", unknown_on_guarantee)
+    ev = run(workspace(tmp_path, GOOD))
+    assert ev.status == "inconclusive"
+    assert ev.details["examples"]["inconclusive"] == 100 and ev.details["unknown_reasons"] == ["timeout"]
+    assert "Z3 answered unknown on 100 example(s)" in ev.explanation
