@@ -1,9 +1,10 @@
 """Verification backends, registered by the name a plan uses for them.
 
 Implemented: ``hoare`` (Z3), ``dafny`` (Dafny), ``ajpf`` (AJPF/MCAPL
-property instances).  Named but not implemented yet (their evidence is
-``pending`` with "backend not available"): ``review``, ``experiment``,
-``property_tests``, ``monitors``.
+property instances), ``experiment`` (experiment figures against an
+acceptance criterion), ``review`` (code review records).  Named but not
+implemented yet (their evidence is ``pending`` with "backend not
+available"): ``property_tests``, ``monitors``.
 """
 from __future__ import annotations
 
@@ -17,8 +18,10 @@ IMPLEMENTED = {
     "hoare": ("rclverify.backends.hoare.backend", "HoareBackend"),
     "dafny": ("rclverify.backends.dafny.backend", "DafnyBackend"),
     "ajpf": ("rclverify.backends.ajpf.backend", "AjpfBackend"),
+    "experiment": ("rclverify.backends.experiment.backend", "ExperimentBackend"),
+    "review": ("rclverify.backends.review.backend", "ReviewBackend"),
 }
-NOT_AVAILABLE = ("review", "experiment", "property_tests", "monitors")
+NOT_AVAILABLE = ("property_tests", "monitors")
 KNOWN = tuple(IMPLEMENTED) + NOT_AVAILABLE
 
 
