@@ -10,6 +10,7 @@
 ``rclverify report``               rebuild reports/ from the artifacts
 ``rclverify verify [--strict]``    the whole pipeline through doit
 ``rclverify refines A.rcl:N B.rcl:M``  may contract M replace contract N?
+``rclverify review NODE [-o FILE]``  write a review record to fill in
 
 Exit codes: 0 success, 1 errors in the input (or, for ``compose``/``verify
 --strict``, an obligation that does not hold), 2 usage errors.  A user's
@@ -160,6 +161,26 @@ def cmd_verify(args: argparse.Namespace) -> int:
     return int(DoitMain(ModuleTaskLoader(module)).run(argv))
 
 
+def cmd_review(args: argparse.Namespace) -> int:
+    from .backends.review.blank import blank_record
+    from .evidence.store import atomic_write_text
+    ws = _ws(args)
+    if args.node not in ws.checked.nodes:
+        print(f"error: no node named {args.node!r}; nodes: {', '.join(ws.node_names())}", file=sys.stderr)
+        return 2
+    try:
+        text = blank_record(ws.checked.nodes[args.node], ws.root, args.files)
+    except FileNotFoundError as exc:
+        print(f"error: cannot read reviewed file {exc}", file=sys.stderr)
+        return 1
+    if args.output:
+        atomic_write_text(Path(args.output), text)
+        print(f"review record to fill in: {args.output}")
+    else:
+        print(text, end="")
+    return 0
+
+
 def cmd_refines(args: argparse.Namespace) -> int:
     from .calculus.refinement import refines_main
     return refines_main(args.original, args.replacement)
@@ -190,6 +211,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     v.add_argument("--strict", action="store_true",
                    help="exit 1 unless every obligation, side condition and health check holds")
     v.add_argument("-n", "--jobs", type=int, default=1, help="parallel doit processes")
+    rv = add("review", cmd_review, "write a review record to fill in for NODE (checklist from its guarantees)", True)
+    rv.add_argument("node")
+    rv.add_argument("-o", "--output", help="write the record to this file instead of standard output")
+    rv.add_argument("-f", "--files", nargs="*", default=[], help="reviewed files (workspace-relative), listed with their sha256")
     r = add("refines", cmd_refines, "check with Z3 that contract B may replace contract A")
     r.add_argument("original", help="FILE.rcl:Node of the contract to replace")
     r.add_argument("replacement", help="FILE.rcl:Node of the replacement contract")
