@@ -66,8 +66,8 @@ def test_paper_mean_argument_holds_but_is_not_discharged(ws: Workspace) -> None:
 def test_paper_statistics_are_flagged_with_the_bound_in_words() -> None:
     flags = check(load_summary(PAPER, "nav.yaml"))
     spread = next(f for f in flags if f["bound"] == "spread of best and worst")["explanation"]
-    assert "47 trials with smallest 0.08 m, largest 0.43 m and mean 21.4 cm" in spread
-    assert "at least 0.03712 m (population; 0.03752 m as a sample deviation)" in spread
+    assert "47 trials with smallest 8 cm, largest 43 cm and mean 21.4 cm" in spread
+    assert "at least 3.712 cm (population; 3.752 cm as a sample deviation)" in spread
     assert spread.endswith("the reported deviation is 4 mm")
 
 

@@ -24,11 +24,16 @@ from __future__ import annotations
 from fractions import Fraction
 from typing import Any
 
-from .figures import Figures, format_value
+from .figures import Figures
 
 
-def _f(v: Fraction, dim: str) -> str:
-    return format_value(v, dim)
+def _display_unit(text: str, dim: str) -> tuple[str, Fraction]:
+    """The unit ``text`` is written in (``"21.4 cm"`` -> cm), else the base unit."""
+    from .figures import BASE, UNITS
+    word = text.split()[-1] if len(text.split()) == 2 else ""
+    if word in UNITS and UNITS[word][0] == dim:
+        return word, UNITS[word][1]
+    return BASE.get(dim, ""), Fraction(1)
 
 
 def check(fig: Figures) -> list[dict[str, str]]:
@@ -45,6 +50,10 @@ def check(fig: Figures) -> list[dict[str, str]]:
     lo_name, hi_name = ("best", "worst") if fig.better == "lower" else ("worst", "best")
     a, b = st[lo_name].value, st[hi_name].value
     d = fig.dim
+    unit, factor = _display_unit(st["mean"].text, d)
+
+    def show(v: Fraction | float) -> str:
+        return f"{float(v) / float(factor):.4g}" + (f" {unit}" if unit else "")
     shown = {k: st[k].show() for k in st}
     flags: list[dict[str, str]] = []
 
@@ -58,8 +67,8 @@ def check(fig: Figures) -> list[dict[str, str]]:
              f"although {'lower' if fig.better == 'lower' else 'higher'} is better")
         return flags
     if not a <= m <= b:
-        flag("mean between extremes", f"the mean {shown['mean']} is not between the smallest trial {_f(a, d)} and the "
-             f"largest {_f(b, d)}")
+        flag("mean between extremes", f"the mean {shown['mean']} is not between the smallest trial {show(a)} and the "
+             f"largest {show(b)}")
         return flags
     if n == 1:
         if a != b or s != 0:
@@ -69,14 +78,14 @@ def check(fig: Figures) -> list[dict[str, str]]:
     lo_mean, hi_mean = ((n - 1) * a + b) / n, (a + (n - 1) * b) / n
     if not lo_mean <= m <= hi_mean:
         flag("mean with one trial at each extreme",
-             f"with {n} trials, one at {_f(a, d)} and one at {_f(b, d)}, the mean lies between {_f(lo_mean, d)} and "
-             f"{_f(hi_mean, d)}; the reported mean is {shown['mean']}")
+             f"with {n} trials, one at {show(a)} and one at {show(b)}, the mean lies between {show(lo_mean)} and "
+             f"{show(hi_mean)}; the reported mean is {shown['mean']}")
         return flags
     far = max(b - m, m - a)
     if far * far > s * s * (n - 1):
         flag("Samuelson's inequality",
-             f"a trial {_f(far, d)} from the mean ({'worst' if (b - m) >= (m - a) else 'best'} trial) needs a standard "
-             f"deviation of at least {_f(far, d)} / sqrt({n - 1}) = {float(far) / float(n - 1) ** 0.5:.4g} {_unit(d)}"
+             f"a trial {show(far)} from the mean ({'worst' if (b - m) >= (m - a) else 'best'} trial) needs a standard "
+             f"deviation of at least {show(far)} / sqrt({n - 1}) = {show(float(far) / float(n - 1) ** 0.5)}"
              f" with {n} trials; the reported deviation is {shown['std']}")
     ss_min = (a - m) ** 2 + (b - m) ** 2
     if n > 2:
@@ -84,21 +93,16 @@ def check(fig: Figures) -> list[dict[str, str]]:
         ss_min += (n - 2) * (c - m) ** 2
     if s * s * n < ss_min:
         flag("spread of best and worst",
-             f"{n} trials with smallest {_f(a, d)}, largest {_f(b, d)} and mean {shown['mean']} have a standard deviation "
-             f"of at least {float(ss_min / n) ** 0.5:.4g} {_unit(d)} (population; "
-             f"{float(ss_min / (n - 1)) ** 0.5:.4g} {_unit(d)} as a sample deviation); the reported deviation is "
+             f"{n} trials with smallest {show(a)}, largest {show(b)} and mean {shown['mean']} have a standard deviation "
+             f"of at least {show(float(ss_min / n) ** 0.5)} (population; "
+             f"{show(float(ss_min / (n - 1)) ** 0.5)} as a sample deviation); the reported deviation is "
              f"{shown['std']}")
     if s * s * (n - 1) > n * (b - m) * (m - a):
         top = n * (b - m) * (m - a) / (n - 1)
         flag("Bhatia-Davis inequality",
-             f"trials between {_f(a, d)} and {_f(b, d)} with mean {shown['mean']} have a standard deviation of at most "
-             f"{float(top) ** 0.5:.4g} {_unit(d)} (sample deviation, {n} trials); the reported deviation is {shown['std']}")
+             f"trials between {show(a)} and {show(b)} with mean {shown['mean']} have a standard deviation of at most "
+             f"{show(float(top) ** 0.5)} (sample deviation, {n} trials); the reported deviation is {shown['std']}")
     return flags
-
-
-def _unit(dim: str) -> str:
-    from .figures import BASE
-    return BASE.get(dim, "")
 
 
 def figures_json(fig: Figures) -> dict[str, Any]:

@@ -6,6 +6,7 @@ same figures always give the same bytes for one matplotlib version.
 from __future__ import annotations
 
 import io
+import textwrap
 from typing import Mapping
 
 from .figures import BASE, Figures, Quantity
@@ -19,7 +20,7 @@ def render_svg(fig: Figures, constants: Mapping[str, Quantity], title: str) -> s
     import matplotlib.pyplot as plt
     unit = BASE.get(fig.dim, "")
     with matplotlib.rc_context({"svg.hashsalt": "rclverify", "svg.fonttype": "none", "font.size": 9}):
-        f, ax = plt.subplots(figsize=(6.4, 3.2))
+        f, ax = plt.subplots(figsize=(6.4, 3.6))
         try:
             if fig.trials:
                 xs = list(range(1, len(fig.trials) + 1))
@@ -37,7 +38,8 @@ def render_svg(fig: Figures, constants: Mapping[str, Quantity], title: str) -> s
             for k, (name, q) in enumerate(sorted(constants.items())):
                 if q.dim == fig.dim:
                     ax.axhline(float(q.value), color=f"C{3 + k}", linestyle="--", label=f"{name} ({q.show()})")
-            ax.set_ylabel(f"{fig.measure or fig.column or 'measure'}" + (f" [{unit}]" if unit else ""))
+            label = f"{fig.measure or fig.column or 'measure'}" + (f" [{unit}]" if unit else "")
+            ax.set_ylabel(textwrap.fill(label, 32))
             ax.set_title(title)
             ax.legend(loc="best", fontsize=7)
             f.tight_layout()
