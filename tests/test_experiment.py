@@ -165,3 +165,9 @@ def test_criterion_comparing_a_length_with_a_number_is_refused(ws: Workspace) ->
 
 def test_bundled_plan_checks(ws: Workspace) -> None:
     assert act_check(str(ws.root)) is None
+
+
+def test_division_by_a_zero_figure_is_undecided_not_failed() -> None:
+    fig = load_summary("count: 3\nmean: 0 cm\nstd: 0 cm\nbest: 0 cm\nworst: 0 cm\n", "z.yaml")
+    v = evaluate(_crit("worst / mean <= 2"), fig, {})  # type: ignore[arg-type]
+    assert v.holds is None

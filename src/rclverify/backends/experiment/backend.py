@@ -114,8 +114,9 @@ class ExperimentBackend:
             return evidence("failed", f"the data in {cfg.file} misses the criterion {cfg.criterion_text}{where}: "
                             f"{figures}{flag_text}", counterexample=dict(_figure_rows(cfg)), **kw)
         if verdict.holds is None:
-            return evidence("inconclusive", f"Z3 could not decide the criterion {cfg.criterion_text} within "
-                            f"{cfg.timeout_ms} ms on {figures}{flag_text}", **kw)
+            return evidence("inconclusive", f"Z3 could not decide the criterion {cfg.criterion_text} on "
+                            f"{figures} (timeout of {cfg.timeout_ms} ms, or a division by a figure that is zero)"
+                            f"{flag_text}", **kw)
         if flags:
             return evidence("inconclusive", f"the criterion {cfg.criterion_text} holds on the reported figures "
                             f"({figures}), but they establish nothing{flag_text}", **kw)

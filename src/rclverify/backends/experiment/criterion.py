@@ -165,21 +165,27 @@ def _decide(formula: z3.ExprRef, background: list[z3.ExprRef], timeout_ms: int) 
     s = z3.Solver()
     s.set("timeout", timeout_ms)
     s.add(*background)
+    s.push()
     s.add(z3.Not(formula))
     r = s.check()
+    s.pop()
     if r == z3.unsat:
         return True
-    if r == z3.sat:
-        return False
-    return None
+    if r != z3.sat:
+        return None
+    # the figures fix every value, so the criterion itself must then be
+    # unsatisfiable; when it is not (a division by a zero figure leaves the
+    # quotient unspecified) the answer is undecided, never "fails"
+    s.add(formula)
+    return False if s.check() == z3.unsat else None
 
 
 def evaluate(expr: ast.Expr, figures: Figures, constants: Mapping[str, Quantity], timeout_ms: int = 10000) -> Verdict:
     """Decide the (dimension-checked) criterion on ``figures`` exactly with Z3.
 
     A criterion naming the per-trial column must hold on every trial.
-    Division by zero is Z3's (unspecified) division; write criteria that do
-    not divide by a figure that may be zero.
+    A division by a figure that is zero leaves the quotient unspecified
+    (Z3's semantics): the verdict is then undecided (``holds`` ``None``).
     """
     env: dict[str, z3.ArithRef] = {k: _val(q.value) for k, q in figures.stats.items()}
     env.update({k: _val(q.value) for k, q in constants.items()})
