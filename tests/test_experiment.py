@@ -135,6 +135,7 @@ def test_per_trial_data_end_to_end_with_plot(ws: Workspace) -> None:
     assert EvidenceStore(root).current_status(ev) == "stale"  # type: ignore[arg-type]
     ev2 = stage_run(Workspace(root), "Navigation", E0)
     assert ev2.status == "failed" and "on 1 of 3 trials (trials 2)" in ev2.explanation
+    assert ev2.counterexample == {"trial 2": "0.31 m"}
 
 
 def test_svg_has_no_date() -> None:

@@ -33,6 +33,7 @@ from ..base import NodeTarget, Stopwatch, make_evidence
 from .config import ExperimentConfig, read_config
 from .consistency import check, figures_json
 from .criterion import evaluate
+from .figures import format_value
 from .plot import render_svg
 
 NAME = "experiment"
@@ -50,6 +51,13 @@ def _figure_rows(cfg: ExperimentConfig) -> list[list[str]]:
     rows = [[k, q.show()] for k, q in cfg.figures.stats.items()]
     rows += [[f"{k} (constant)", q.show()] for k, q in sorted(cfg.constants.items())]
     return rows
+
+
+def _failing_trials(cfg: ExperimentConfig, failing: tuple[int, ...]) -> dict[str, str] | None:
+    """The trials that miss a per-trial criterion (at most 20), value in base units."""
+    if not failing:
+        return None
+    return {f"trial {i}": format_value(cfg.figures.trials[i - 1], cfg.figures.dim) for i in failing[:20]}
 
 
 class ExperimentBackend:
@@ -99,7 +107,8 @@ class ExperimentBackend:
             "criterion": cfg.criterion_text, "file": cfg.file, "figures": figures_json(cfg.figures),
             "constants": {k: q.show() for k, q in sorted(cfg.constants.items())},
             "criterion_holds": verdict.holds, "flags": flags, "per_trial": verdict.per_trial,
-            "failing_trials": list(verdict.failing), "figures_table": _figure_rows(cfg),
+            "failing_trials": list(verdict.failing),
+            "figures_table": _figure_rows(cfg) + [[f"flag: {f['bound']}", f["explanation"]] for f in flags],
             "plot": target.rel(svg_path),
         }
         log = "\n".join([f"criterion: {cfg.criterion_text}", f"figures: {figures}",
@@ -112,7 +121,7 @@ class ExperimentBackend:
                      f"(trials {', '.join(map(str, verdict.failing[:20]))}{' ...' if len(verdict.failing) > 20 else ''})"
                      if verdict.per_trial else "")
             return evidence("failed", f"the data in {cfg.file} misses the criterion {cfg.criterion_text}{where}: "
-                            f"{figures}{flag_text}", counterexample=dict(_figure_rows(cfg)), **kw)
+                            f"{figures}{flag_text}", counterexample=_failing_trials(cfg, verdict.failing), **kw)
         if verdict.holds is None:
             return evidence("inconclusive", f"Z3 could not decide the criterion {cfg.criterion_text} on "
                             f"{figures} (timeout of {cfg.timeout_ms} ms, or a division by a figure that is zero)"
