@@ -30,6 +30,9 @@ def located_errors(stderr: str) -> list[tuple[str, int, int, str]]:
 def copy_workspace(tmp_path: Path) -> Path:
     ws = tmp_path / "ws"
     shutil.copytree(ROOT / "contracts", ws / "contracts")
+    # the plan's experiment and review entries are checked with the plan
+    for rel in ("backends/experiment", "backends/review"):
+        shutil.copytree(ROOT / rel, ws / rel)
     return ws
 
 

@@ -12,6 +12,7 @@
 ``rclverify refines A.rcl:N B.rcl:M``  may contract M replace contract N?
 ``rclverify init DIR [--nodes A,B]``  write a new workspace that verifies at once
 ``rclverify bundle [-o FILE]``     the assessor's bundle; ``--verify FILE`` checks one
+``rclverify review NODE [-o FILE]``  write a review record to fill in
 
 Exit codes: 0 success, 1 errors in the input (or, for ``compose``/``verify
 --strict``, an obligation that does not hold), 2 usage errors.  A user's
@@ -215,6 +216,26 @@ def cmd_bundle(args: argparse.Namespace) -> int:
     return 0
 
 
+def cmd_review(args: argparse.Namespace) -> int:
+    from .backends.review.blank import blank_record
+    from .evidence.store import atomic_write_text
+    ws = _ws(args)
+    if args.node not in ws.checked.nodes:
+        print(f"error: no node named {args.node!r}; nodes: {', '.join(ws.node_names())}", file=sys.stderr)
+        return 2
+    try:
+        text = blank_record(ws.checked.nodes[args.node], ws.root, args.files)
+    except FileNotFoundError as exc:
+        print(f"error: cannot read reviewed file {exc}", file=sys.stderr)
+        return 1
+    if args.output:
+        atomic_write_text(Path(args.output), text)
+        print(f"review record to fill in: {args.output}")
+    else:
+        print(text, end="")
+    return 0
+
+
 def cmd_refines(args: argparse.Namespace) -> int:
     from .calculus.refinement import refines_main
     return refines_main(args.original, args.replacement)
@@ -251,6 +272,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     bnd = add("bundle", cmd_bundle, "write the assessor's bundle (reports, artifacts, plan, contracts, manifest)", True)
     bnd.add_argument("-o", "--output", help="archive to write (.tar.gz or .zip; default: <workspace name>-bundle.tar.gz)")
     bnd.add_argument("--verify", metavar="FILE", help="check the archive FILE against its manifest instead")
+    rv = add("review", cmd_review, "write a review record to fill in for NODE (checklist from its guarantees)", True)
+    rv.add_argument("node")
+    rv.add_argument("-o", "--output", help="write the record to this file instead of standard output")
+    rv.add_argument("-f", "--files", nargs="*", default=[], help="reviewed files (workspace-relative), listed with their sha256")
     r = add("refines", cmd_refines, "check with Z3 that contract B may replace contract A")
     r.add_argument("original", help="FILE.rcl:Node of the contract to replace")
     r.add_argument("replacement", help="FILE.rcl:Node of the replacement contract")

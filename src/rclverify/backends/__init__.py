@@ -1,9 +1,11 @@
 """Verification backends, registered by the name a plan uses for them.
 
 Implemented: ``hoare`` (Z3), ``dafny`` (Dafny), ``ajpf`` (AJPF/MCAPL
-property instances).  Named but not implemented yet (their evidence is
-``pending`` with "backend not available"): ``review``, ``experiment``,
-``property_tests``, ``monitors``.
+property instances), ``property_tests`` (Hypothesis, every example checked
+by Z3), ``experiment`` (experiment figures against an acceptance
+criterion), ``review`` (code review records).  Named but not implemented
+yet (their evidence is ``pending`` with "backend not available"):
+``monitors``.
 """
 from __future__ import annotations
 
@@ -18,8 +20,10 @@ IMPLEMENTED = {
     "dafny": ("rclverify.backends.dafny.backend", "DafnyBackend"),
     "ajpf": ("rclverify.backends.ajpf.backend", "AjpfBackend"),
     "property_tests": ("rclverify.backends.property_tests.backend", "PropertyTestsBackend"),
+    "experiment": ("rclverify.backends.experiment.backend", "ExperimentBackend"),
+    "review": ("rclverify.backends.review.backend", "ReviewBackend"),
 }
-NOT_AVAILABLE = ("review", "experiment", "monitors")
+NOT_AVAILABLE = ("monitors",)
 KNOWN = tuple(IMPLEMENTED) + NOT_AVAILABLE
 
 

@@ -297,5 +297,8 @@ def resolve(plan: Plan, checked: Checked) -> None:
             if e.backend not in KNOWN:
                 bl = plan.locs.get(("nodes", node, "evidence", e.index, "backend"), e.loc)
                 bad(bl, f"unknown backend {e.backend!r}; known backends: {', '.join(KNOWN)}")
+    # experiment and review entries name data files and criteria: check them now
+    from ..backends.entry_checks import check_entries
+    diags.extend(check_entries(plan, checked))
     if diags:
         raise PlanError(diags)

@@ -39,6 +39,24 @@ def _src(l: ast.Loc) -> str:
     return f"{l.file}:{l.line}:{l.col}"
 
 
+def _evidence_extras(ws: Workspace, details: Any) -> dict[str, Any]:
+    """Rows a backend asks the report to show (``details.figures_table``: the
+    experiment figures, the review record) and the inline SVG of its plot
+    (``details.plot``, an SVG artifact the backend drew with matplotlib)."""
+    out: dict[str, Any] = {}
+    rows = details.get("figures_table") if isinstance(details, dict) else None
+    if rows:
+        out["figures"] = [[str(a), str(b)] for a, b in rows]
+    plot = details.get("plot") if isinstance(details, dict) else None
+    if isinstance(plot, str) and plot.endswith(".svg"):
+        try:
+            text = ws.path(plot).read_text(encoding="utf-8")
+            out["plot_svg"] = text[text.index("<svg"):]
+        except (OSError, ValueError):
+            pass
+    return out
+
+
 def build_report(ws: Workspace) -> dict[str, Any]:
     """Read every artifact of ``ws`` and return the report dict (see render.py)."""
     checked, model, plan = ws.checked, ws.model, ws.plan
@@ -69,7 +87,8 @@ def build_report(ws: Workspace) -> dict[str, Any]:
         ev_rows.append({"obligation": ev.obligation, "backend": ev.backend, "kind": ev.kind, "status": status,
                         "tool": ev.tool, "tool_version": ev.tool_version, "started": ev.started,
                         "duration_s": ev.duration_s, "explanation": expl, "counterexample": ev.counterexample,
-                        "artifacts": list(ev.artifacts), "log_excerpt": ev.log[-2000:]})
+                        "artifacts": list(ev.artifacts), "log_excerpt": ev.log[-2000:],
+                        **_evidence_extras(ws, ev.details)})
         if isinstance(ev.details.get("examples"), dict):  # property tests: example counts and seed
             ev_rows[-1]["examples"] = {**ev.details["examples"], "seed": ev.details.get("seed"),
                                        "replay": ev.details.get("replay", "")}

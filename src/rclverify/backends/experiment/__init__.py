@@ -1,0 +1,14 @@
+"""The ``experiment`` backend: a node guarantee supported by experiments
+(simulation or field trials) judged against an acceptance criterion (paper:
+Navigation node, shared/reference lines 1318-1329).
+
+Modules: :mod:`.figures` (data: per-trial CSV or summary statistics, with
+units), :mod:`.criterion` (the criterion: an RCL expression over the
+figures, checked and evaluated exactly with Z3), :mod:`.consistency` (bounds
+every sample's summary statistics obey), :mod:`.plot` (SVG plot with
+matplotlib), :mod:`.config` (the plan entry), :mod:`.backend`
+(:class:`ExperimentBackend`).
+"""
+from .backend import ExperimentBackend
+
+__all__ = ["ExperimentBackend"]

@@ -1,0 +1,95 @@
+"""The ``review`` backend: a node's guarantees checked by a recorded code review.
+
+The paper verifies the Localisation node by code review: the message type
+the node publishes can carry only one position at a time (shared/reference
+lines 1307-1317).  This backend records such a review as evidence:
+
+* ``export`` reads the plan entry ``{backend: review, record: <yaml>}``,
+  validates the record (:mod:`.record`) and exports one obligation per
+  guarantee, whose inputs are the record and every reviewed file (so editing
+  a reviewed file makes the evidence ``stale``);
+* ``run`` judges the record against the checklist generated from the
+  guarantee (:func:`.record.judge`): all yes and verdict pass with the
+  reviewed files unchanged -> ``discharged``; a no or a fail -> ``failed``
+  with the question; unanswered -> ``pending``; a changed file -> ``stale``.
+"""
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+from ...evidence.records import Evidence, Obligation, SourceRef, make_obligation_id
+from ...plan.errors import PlanError, plan_error
+from ..base import NodeTarget, Stopwatch, make_evidence
+from .record import Question, RecordError, ReviewRecord, checklist, judge, parse_record
+
+NAME = "review"
+KIND = "review"
+
+
+def read_record(root: Path, config: Any, loc: Any) -> tuple[str, ReviewRecord]:
+    """(workspace-relative path, record) of a plan entry; ``loc(*path)`` locates
+    its values.  Raises :class:`PlanError` for a missing or malformed record."""
+    rel = config.get("record")
+    if not isinstance(rel, str):
+        l = loc()
+        raise plan_error(l.file, l.line, l.col, "review: name the review record (record: <file>.yaml)")
+    l = loc("record")
+    if not (root / rel).is_file():
+        raise plan_error(l.file, l.line, l.col, f"review record {rel!r} does not exist "
+                         "(write a blank one with `rclverify review NODE -o FILE`)", "E-io")
+    try:
+        return rel, parse_record((root / rel).read_text(encoding="utf-8"), rel)
+    except (RecordError, OSError, UnicodeDecodeError) as exc:
+        raise plan_error(l.file, l.line, l.col, f"review record: {exc}") from None
+
+
+def _load(target: NodeTarget) -> tuple[str, ReviewRecord]:
+    rel, rec = read_record(target.root, target.config, lambda *p: target.config_loc(*p))
+    if rec.node != target.node.name:
+        l = target.config_loc("record")
+        raise plan_error(l.file, l.line, l.col, f"review record {rel} is about node {rec.node!r}, not {target.node.name!r}")
+    return rel, rec
+
+
+class ReviewBackend:
+    """Code review evidence (``kind`` ``review``).  Paper: lines 1307-1317."""
+
+    name = NAME
+    kind = KIND
+
+    def export(self, target: NodeTarget) -> list[Obligation]:
+        """One obligation per guarantee.  Raises :class:`PlanError` (located)."""
+        rel, rec = _load(target)
+        questions = checklist(target.node)
+        files = {p for p, _ in rec.files}
+        out = []
+        for k, g in enumerate(target.node.node.guarantees, 1):
+            qs = [q for q in questions if q.guarantee == k]
+            out.append(Obligation(
+                id=make_obligation_id(target.node.name, k, NAME, f"e{target.index}"), node=target.node.name,
+                guarantee=k, backend=NAME, kind=KIND, statement=" ".join(f"[{q.id}] {q.question}" for q in qs),
+                source=SourceRef(g.loc.file, g.loc.line, g.loc.col), instance=f"e{target.index}",
+                inputs=tuple(sorted({rel, *files, *target.contract_files, target.plan_file})),
+                data={"record": rel, "questions": [q.id for q in qs]}))
+        return out
+
+    def run(self, obligation: Obligation, target: NodeTarget) -> Evidence:
+        """Judge the record for the obligation's guarantee (never raises for a user problem)."""
+        clock = Stopwatch()
+        try:
+            rel, rec = _load(target)
+        except PlanError as exc:
+            return make_evidence(target, obligation, "error", tool="review record", tool_version="-", clock=clock,
+                                 explanation=f"the review record no longer checks: {exc}", log=str(exc))
+        qs: list[Question] = [q for q in checklist(target.node) if q.guarantee == obligation.guarantee]
+        status, explanation, details = judge(rec, qs, target.root)
+        details["record"] = rel
+        details["figures_table"] = ([["reviewer", rec.reviewer], ["date", rec.date], ["scope", rec.scope],
+                                     ["verdict", rec.verdict or "(none)"]]
+                                    + [[f"{q['id']} ({q['location']})", f"{q['answer'] or 'unanswered'}: {q['question']}"
+                                        + (f" -- {q['note']}" if q["note"] else "")] for q in details["checklist"]]
+                                    + [["file", f"{p} sha256 {h}"] for p, h in rec.files])
+        return make_evidence(target, obligation, status, tool="review record", tool_version=rel, clock=clock,
+                             explanation=explanation, details=details,
+                             log="\n".join(f"{q['id']}: {q['answer']}" for q in details["checklist"]))

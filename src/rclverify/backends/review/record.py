@@ -1,0 +1,174 @@
+"""Review records: the checklist a node's guarantees call for, and the filled-in record.
+
+Record (YAML)::
+
+    node: Localisation
+    reviewer: <who reviewed; say so when unknown>
+    date: <YYYY-MM-DD, or text saying it is unknown>
+    scope: <what was reviewed, against what>
+    files:                              # the reviewed files, workspace-relative
+      - {path: src/localisation.py, sha256: <hex>}
+    checklist:                          # one answer per generated question
+      - {id: g1.c1, answer: yes, note: <why>}   # yes | no | (empty: unanswered)
+    verdict: pass                       # pass | fail | (empty: not decided)
+
+The checklist has one question per conjunct of each guarantee (top-level
+``and`` split), with the conjunct's RCL location, so a reviewer knows what
+to check and the record says what was checked.
+"""
+from __future__ import annotations
+
+import hashlib
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, Mapping
+
+import yaml
+
+from ...rcl import ast
+from ...rcl.printer import expr_to_rcl
+from ...rcl.types import CheckedNode
+
+
+class RecordError(ValueError):
+    """A malformed review record (message names the field)."""
+
+
+@dataclass(frozen=True)
+class Question:
+    """One checklist question: ``id`` ``g<k>.c<j>``, the guarantee index, the
+    conjunct as RCL, the question text and the conjunct's location."""
+
+    id: str
+    guarantee: int
+    conjunct: str
+    question: str
+    location: str
+
+
+def _conjuncts(e: ast.Expr) -> list[ast.Expr]:
+    if isinstance(e, ast.Binary) and e.op == "and":
+        return _conjuncts(e.left) + _conjuncts(e.right)
+    return [e]
+
+
+def checklist(node: CheckedNode) -> list[Question]:
+    """The questions a review of ``node`` answers, guarantee by guarantee."""
+    out = []
+    assume = " and ".join(expr_to_rcl(a.formula) for a in node.node.assumes) or "TRUE"
+    for k, g in enumerate(node.node.guarantees, 1):
+        for j, c in enumerate(_conjuncts(g.formula), 1):
+            text = expr_to_rcl(c)
+            loc = c.loc if c.loc.line else g.loc
+            out.append(Question(
+                f"g{k}.c{j}", k, text,
+                f"For every input satisfying the assumption ({assume}), does the reviewed code eventually produce "
+                f"outputs satisfying {text}?", f"{loc.file}:{loc.line}:{loc.col}"))
+    return out
+
+
+@dataclass(frozen=True)
+class ReviewRecord:
+    """A parsed record.  ``answers`` maps question id to ``"yes"``/``"no"``/``None``;
+    ``notes`` question id to the reviewer's note; ``verdict`` ``"pass"``/``"fail"``/``None``."""
+
+    node: str
+    reviewer: str
+    date: str
+    scope: str
+    files: tuple[tuple[str, str], ...]
+    answers: Mapping[str, str | None]
+    notes: Mapping[str, str]
+    verdict: str | None
+
+
+def _answer(v: Any, where: str) -> str | None:
+    if v is None or v == "":
+        return None
+    if v is True or str(v).lower() == "yes":
+        return "yes"
+    if v is False or str(v).lower() == "no":
+        return "no"
+    raise RecordError(f"{where}: answer must be yes, no or empty, found {v!r}")
+
+
+def parse_record(text: str, file: str) -> ReviewRecord:
+    """Parse and validate a record's text.  Raises :class:`RecordError`."""
+    try:
+        data = yaml.safe_load(text)
+    except yaml.YAMLError as exc:
+        raise RecordError(f"{file}: invalid YAML: {getattr(exc, 'problem', exc)}") from None
+    if not isinstance(data, dict):
+        raise RecordError(f"{file}: a review record is a mapping (node, reviewer, date, scope, files, checklist, verdict)")
+    missing = [k for k in ("node", "reviewer", "date", "scope", "files", "checklist", "verdict") if k not in data]
+    if missing:
+        raise RecordError(f"{file}: missing field(s) {', '.join(missing)}")
+    files = []
+    for i, f in enumerate(data["files"] or []):
+        if not isinstance(f, dict) or not isinstance(f.get("path"), str) or not isinstance(f.get("sha256"), str):
+            raise RecordError(f"{file}: files[{i}] needs path and sha256")
+        files.append((f["path"], f["sha256"].strip().lower()))
+    answers: dict[str, str | None] = {}
+    notes: dict[str, str] = {}
+    for i, q in enumerate(data["checklist"] or []):
+        if not isinstance(q, dict) or "id" not in q:
+            raise RecordError(f"{file}: checklist[{i}] needs an id")
+        answers[str(q["id"])] = _answer(q.get("answer"), f"{file}: checklist {q['id']}")
+        notes[str(q["id"])] = str(q.get("note") or "").strip()
+    verdict = data["verdict"]
+    if verdict not in (None, "", "pass", "fail"):
+        raise RecordError(f"{file}: verdict must be pass, fail or empty, found {verdict!r}")
+    return ReviewRecord(str(data["node"]), str(data["reviewer"] or "").strip(), str(data["date"] or "").strip(),
+                        str(data["scope"] or "").strip(), tuple(files), answers, notes, verdict or None)
+
+
+def sha256_of(path: Path) -> str | None:
+    """Hex sha256 of a file, ``None`` when it cannot be read."""
+    try:
+        return hashlib.sha256(path.read_bytes()).hexdigest()
+    except OSError:
+        return None
+
+
+def judge(record: ReviewRecord, questions: list[Question], root: Path) -> tuple[str, str, dict[str, Any]]:
+    """(status, explanation, details) of ``record`` for the ``questions`` of one guarantee.
+
+    * a listed file missing or with another sha256 -> ``stale``;
+    * a question the record does not answer (the contract's checklist
+      changed) -> ``stale`` (regenerate with ``rclverify review``);
+    * an answer ``no`` or verdict ``fail`` -> ``failed`` naming the question;
+    * an unanswered question, no verdict, or no reviewed file -> ``pending``;
+    * otherwise ``discharged``.
+    """
+    details: dict[str, Any] = {"reviewer": record.reviewer, "date": record.date, "scope": record.scope,
+                               "files": [{"path": p, "sha256": h} for p, h in record.files], "verdict": record.verdict,
+                               "checklist": [{"id": q.id, "question": q.question, "location": q.location,
+                                              "answer": record.answers.get(q.id), "note": record.notes.get(q.id, "")}
+                                             for q in questions]}
+    for p, h in record.files:
+        now = sha256_of(root / p)
+        if now != h:
+            what = "is missing" if now is None else f"has sha256 {now[:12]}..., the record lists {h[:12]}..."
+            return "stale", f"reviewed file {p} changed since the review: it {what}; review it again", details
+    missing = [q for q in questions if q.id not in record.answers]
+    if missing:
+        return "stale", (f"the record does not answer {', '.join(q.id for q in missing)} ({missing[0].location}: "
+                         f"{missing[0].conjunct}); the contract's checklist changed: regenerate it with "
+                         f"`rclverify review {record.node}`"), details
+    for q in questions:
+        if record.answers.get(q.id) == "no":
+            return "failed", (f"the reviewer answered no to {q.id} ({q.location}): {q.question}"
+                              + (f" Note: {record.notes[q.id]}" if record.notes.get(q.id) else "")), details
+    if record.verdict == "fail":
+        return "failed", f"the review's verdict is fail (reviewer: {record.reviewer or 'not named'})", details
+    open_q = [q.id for q in questions if record.answers.get(q.id) is None]
+    if open_q:
+        return "pending", f"checklist question(s) {', '.join(open_q)} not answered yet", details
+    if record.verdict is None:
+        return "pending", "the review has no verdict yet", details
+    if not record.files:
+        return "pending", ("the record lists no reviewed file, so the verdict cannot be tied to code in this workspace "
+                           "(and no change to that code can make it stale); add the reviewed files with their sha256"), details
+    return "discharged", (f"reviewed by {record.reviewer} on {record.date}: every checklist question of the guarantee "
+                          f"answered yes, verdict pass, {len(record.files)} file(s) unchanged since"), details
+
