@@ -1,9 +1,9 @@
 """Verification backends, registered by the name a plan uses for them.
 
 Implemented: ``hoare`` (Z3), ``dafny`` (Dafny), ``ajpf`` (AJPF/MCAPL
-property instances).  Named but not implemented yet (their evidence is
+property instances), ``monitors`` (RML/ROSMonitoring, offline trace checking).  Named but not implemented yet (their evidence is
 ``pending`` with "backend not available"): ``review``, ``experiment``,
-``property_tests``, ``monitors``.
+``property_tests``.
 """
 from __future__ import annotations
 
@@ -17,8 +17,9 @@ IMPLEMENTED = {
     "hoare": ("rclverify.backends.hoare.backend", "HoareBackend"),
     "dafny": ("rclverify.backends.dafny.backend", "DafnyBackend"),
     "ajpf": ("rclverify.backends.ajpf.backend", "AjpfBackend"),
+    "monitors": ("rclverify.backends.monitors.backend", "MonitorsBackend"),
 }
-NOT_AVAILABLE = ("review", "experiment", "property_tests", "monitors")
+NOT_AVAILABLE = ("review", "experiment", "property_tests")
 KNOWN = tuple(IMPLEMENTED) + NOT_AVAILABLE
 
 
