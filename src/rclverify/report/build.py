@@ -70,6 +70,8 @@ def build_report(ws: Workspace) -> dict[str, Any]:
                         "tool": ev.tool, "tool_version": ev.tool_version, "started": ev.started,
                         "duration_s": ev.duration_s, "explanation": expl, "counterexample": ev.counterexample,
                         "artifacts": list(ev.artifacts), "log_excerpt": ev.log[-2000:]})
+        if isinstance(ev.details, dict) and ev.details.get("monitoring"):
+            ev_rows[-1]["monitoring"] = ev.details["monitoring"]
         if status == "pending":
             pending.append({"obligation": o.id, "backend": o.backend, "reason": ev.explanation})
 

@@ -11,12 +11,15 @@ Every message on an input topic is an *input event*:
   node producing the input); true -> the event opens an obligation on the
   inputs as they are now;
 * the guarantees are evaluated at once on the outputs as they stand (outputs
-  persist until changed), and every later message on an output topic them on the
-  obligation's inputs and the current outputs; all true -> ``satisfied``;
+  persist until changed), and again at every later message on an output
+  topic, on the obligation's inputs and the current outputs; all true ->
+  ``satisfied``;
 * an obligation not satisfied within ``horizon`` seconds of its event is
-  ``violated`` (with the last output event evaluated against it and the
-  guarantee that failed there, or "no output" when none came), or
-  ``inconclusive`` when the last evaluation could not be decided;
+  ``violated`` (``inconclusive`` when its last evaluation could not be
+  decided).  The violating event reported is the last output event that
+  failed the obligation before the node's next input event (the node's
+  answer to it), with the guarantee that failed there, or "no output"
+  when none came;
 * at the end of the trace, obligations still within their horizon are
   ``open``.
 
@@ -71,6 +74,7 @@ class _Group:
     events: deque[Event] = field(default_factory=deque)
     last: tuple[Event, int, dict[str, Any]] | None = None  # (output event, failing guarantee, outputs)
     undecided: str = ""
+    answered: bool = False  # a later input event arrived: the node's answer to these events is complete
 
 
 @dataclass
@@ -196,6 +200,8 @@ class NodeMonitor:
             self._output(ev)
 
     def _input(self, ev: Event) -> None:
+        for g in self.pending.values():
+            g.answered = True
         inputs = {k: v for k, v in self.values.items() if k.startswith("in.")}
         if any(inputs.get(k) is None for k in self.needed_inputs):
             self.result.counts["incomplete input"] += 1
@@ -244,7 +250,7 @@ class NodeMonitor:
             if failed is None and not undecided:
                 self.result.counts["satisfied"] += len(g.events)
                 done.append(key)
-            elif failed is not None:
+            elif failed is not None and (g.last is None or not g.answered):
                 g.last, g.undecided = (ev, failed[0], {k: v for k, v in values.items() if k.startswith("out.")}), ""
             else:
                 g.undecided = undecided
