@@ -175,7 +175,7 @@ def test_agent_rml_has_one_term_per_guarantee_and_parses(exported: Path) -> None
     assert "Main = G1 /\\ G2 /\\ G3;" in text
     # event type names start lower-case; the topic is the topic name, fields flattened
     assert "inspected(x1) matches {topic: 'inspected', id: x1};" in text
-    g2 = text.split("G2 = ")[1].split(";")[0]
+    g2 = terms[1][len("G2 = "):-1]
     # the paper's t2 (lines 1611-1640): not at, or not at waypoint i, or inspected(i), or inspect(i)
     assert g2 == "{let xp, yp, i; (((not_at(xp, yp) \\/ not_wayP(xp, yp, i)) \\/ inspected(i)) \\/ " \
                  "command_inspect(i))}*"
