@@ -243,7 +243,7 @@ class Translator:
         side, other = self._observed(lhs), rhs
         if side is None:
             side, other = self._observed(rhs), lhs
-            op = {"<": ">", "<=": ">=", ">": "<", ">=": "<="}.get(op, op)
+            op = {"<": ">", "<=": ">=", ">": "<", ">=": "<="}.get(op, op)  # type: ignore[assignment]
         if side is None:
             raise Inexpressible(e, "the comparison mentions no input or output of the node")
         if self._observed(other) is not None:
