@@ -96,6 +96,25 @@ def write_bag(path: Path, run: str, msg_dir: Path, mcap: bool = False) -> None:
             writer.write(conns[topic], int(round(t * 1000)) * 1_000_000, data)
 
 
+def write_bag1(path: Path, run: str, msg_dir: Path) -> None:
+    """The run as a ROS 1 ``.bag`` (rosbags' rosbag1 writer)."""
+    from rosbags.rosbag1 import Writer
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "src"))
+    from rclverify.traces.bag import typestore
+    store = typestore([msg_dir])
+    Snapshot = store.types["gazebo_radiation_plugin/msg/Snapshot"]
+    if path.exists():
+        path.unlink()
+    with Writer(path) as writer:
+        conns: dict[str, Any] = {}
+        for t, topic, fields in events(run):
+            if topic not in conns:
+                conns[topic] = writer.add_connection("/" + topic, "gazebo_radiation_plugin/msg/Snapshot",
+                                                     typestore=store)
+            data = store.serialize_ros1(Snapshot(**fields), "gazebo_radiation_plugin/msg/Snapshot")
+            writer.write(conns[topic], int(round(t * 1000)) * 1_000_000 + 1_000_000_000, data)
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("workspace", nargs="?", default=str(Path(__file__).resolve().parents[1]))

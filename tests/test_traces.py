@@ -104,3 +104,23 @@ def test_constructor_rule_names_the_constructor_then_takes_arguments_by_type() -
     assert map_value(CMD, {**MSGF, "command": "move"}, rule, None) == Term("move", (1.5, 2.0))
     with pytest.raises(MappingError, match="not a constructor"):
         map_value(CMD, {**MSGF, "command": "fly"}, rule, None)
+
+
+@pytest.mark.parametrize("form", ["mcap", "ros1"])
+def test_mcap_and_ros1_bags_carry_the_same_events(tmp_path: Path, form: str) -> None:
+    import importlib.util
+    spec = importlib.util.spec_from_file_location("make_traces", REPO / "scripts" / "make_traces.py")
+    assert spec is not None and spec.loader is not None
+    mt = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mt)
+    if form == "mcap":
+        path = tmp_path / "run_mcap"
+        mt.write_bag(path, "sensor_fault", MSG[0], mcap=True)
+        assert list(path.glob("*.mcap"))
+    else:
+        path = tmp_path / "run.bag"
+        mt.write_bag1(path, "sensor_fault", MSG[0])
+    log = list(read_trace(TRACES / "sensor_fault.jsonl"))
+    bag = list(read_trace(path, MSG))
+    assert [(e.topic, dict(e.fields)) for e in bag] == [(e.topic, dict(e.fields)) for e in log]
+    assert [e.time - bag[0].time for e in bag] == pytest.approx([e.time for e in log])
