@@ -147,6 +147,7 @@ class NodeMonitor:
             _names(f, needed)
         self.needed_inputs = sorted(k for k in self.values if k.startswith("in.") and
                                     (k in needed or k[3:] in needed))
+        self._outputs = sorted(k for k in self.values if k.startswith("out."))
         self.pending: dict[Any, _Group] = {}
         self.fallback = concrete_fallback()
         self._cache: dict[tuple[int, Any, Any], tuple[bool | None, str]] = {}
@@ -168,9 +169,6 @@ class NodeMonitor:
         self._cache[ck] = (v, reason)
         return v, reason
 
-    @property
-    def _outputs(self) -> list[str]:
-        return sorted(k for k in self.values if k.startswith("out."))
 
     def _rendered(self, values: Mapping[str, Any]) -> dict[str, str]:
         return {k: render(v) for k, v in sorted(values.items()) if v is not None}
