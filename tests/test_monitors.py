@@ -251,3 +251,9 @@ def test_cli_reports_verdicts_then_a_located_error(exported: Path, capsys: pytes
     out, _ = capsys.readouterr()
     assert "RadiationSensor: 16 satisfied" in out
     assert rc == 1  # the published Agent and Navigation contracts are violated by any run
+
+
+def test_evaluate_answers_none_on_values_of_the_wrong_form(checked: Any) -> None:
+    wayp = FiniteFunction({(0.0, 0.0): 0}, None, 2)  # partial: no result outside the table
+    assert ev(checked, "Agent", "exists(x, y in REAL | in.wayP(x, y) + 1 == 1)", {"in.wayP": wayp}) is True
+    assert ev(checked, "Agent", "forall(x, y in REAL | in.wayP(x, y) + 1 >= 1)", {"in.wayP": wayp}) is None

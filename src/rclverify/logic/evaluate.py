@@ -56,7 +56,7 @@ def evaluate(formula: ast.Expr, checked: Checked, node: CheckedNode,
     """
     try:
         return bool(Evaluator(checked, node, values).eval(formula, {}))
-    except Undecided:
+    except (Undecided, TypeError, ZeroDivisionError):
         return None
 
 
@@ -67,6 +67,8 @@ def why_undecided(formula: ast.Expr, checked: Checked, node: CheckedNode, values
         return ""
     except Undecided as exc:
         return str(exc)
+    except (TypeError, ZeroDivisionError) as exc:
+        return f"a value has the wrong form for the formula: {exc}"
 
 
 def _children(e: Any) -> Iterable[Any]:

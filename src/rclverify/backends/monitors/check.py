@@ -163,7 +163,10 @@ class NodeMonitor:
         if v is None:
             reason = why_undecided(formula, self.checked, self.node, values)
             if self.fallback is not None and "no value for" not in reason:
-                v, reason = self.fallback(formula, self.checked, self.node, values)
+                try:
+                    v, reason = self.fallback(formula, self.checked, self.node, values)
+                except Exception as exc:  # the Z3 checker's own failure: undecided, with its reason
+                    v, reason = None, f"{reason}; Z3 on concrete values failed: {exc}"
         if len(self._cache) > 4096:
             self._cache.clear()
         self._cache[ck] = (v, reason)
