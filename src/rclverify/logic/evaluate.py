@@ -150,13 +150,14 @@ def _free(e: Any, names: set[str], out: set[str]) -> None:
         _free(c, names, out)
 
 
-def _stage(guards: list[Any], names: list[str]) -> list[list[Any]]:
-    """Guards grouped by the depth at which their last bound variable is bound."""
-    staged: list[list[Any]] = [[] for _ in names]
+def _stage(guards: list[Any], slots: list[tuple[str, ...]]) -> list[list[Any]]:
+    """Guards grouped by the slot at which their last bound variable is bound."""
+    where = {n: k for k, names in enumerate(slots) for n in names}
+    staged: list[list[Any]] = [[] for _ in slots]
     for g in guards:
         used: set[str] = set()
-        _free(g, set(names), used)
-        depth = max((names.index(n) for n in used), default=0)
+        _free(g, set(where), used)
+        depth = max((where[n] for n in used), default=0)
         staged[depth].append(g)
     return staged
 
@@ -195,7 +196,7 @@ class Evaluator:
         self.node = node
         self.values = values
         self._numbers: set[Any] | None = None
-        self._domains: dict[tuple[int, str], list[Any]] = {}
+        self._slots: dict[int, tuple[list[tuple[str, ...]], list[list[tuple[Any, ...]]]]] = {}
 
     def numbers(self) -> set[Any]:
         if self._numbers is None:
@@ -346,9 +347,8 @@ class Evaluator:
                 if scalar == "NATURAL" and c < 0:
                     continue
             cands.add(c)
-        top = max((Fraction(v) for v in base | cands), default=Fraction(0))
-        fresh = top + 2 * max((abs(k) for k in shifts), default=Fraction(0)) + 1
-        fresh_value: Any = int(fresh) if scalar != "REAL" or fresh.denominator == 1 else fresh
+        top = max(base | cands, default=0)
+        fresh_value: Any = int(top + 2 * max((abs(k) for k in shifts), default=0)) + 1
         return sorted(cands) + [_Fresh(fresh_value)]
 
     def _terms(self, ctor: str) -> list[Term]:
@@ -419,18 +419,12 @@ class Evaluator:
         return all(self._positional(c, name, b, vals) for c in _children(e))
 
     def quant(self, e: ast.Quant, b: Mapping[str, Any]) -> bool:
-        names: list[str] = []
-        doms: list[list[Any]] = []
-        for binding in e.bindings:
-            for n in binding.names:
-                names.append(n)
-                ck = (id(e), n)
-                dom = self._domains.get(ck)
-                if dom is None:
-                    dom = self.domain(binding, n, e.body, b)
-                    if not isinstance(binding.domain, (ast.SetLit, ast.Var)):
-                        self._domains[ck] = dom
-                doms.append(dom)
+        cached = self._slots.get(id(e))
+        if cached is None:
+            cached = self.slots(e, b)
+            if not any(isinstance(bd.domain, (ast.SetLit, ast.Var)) for bd in e.bindings):
+                self._slots[id(e)] = cached
+        slots, doms = cached
         if e.kind in ("forall", "exists"):
             if e.kind == "forall" and isinstance(e.body, ast.Binary) and e.body.op == "->":
                 guards = _conjuncts(e.body.left)
@@ -438,41 +432,136 @@ class Evaluator:
                 guards = _conjuncts(e.body)
             else:
                 guards = []
-            staged = _stage(guards, names)
-            found = self._search(e, b, names, doms, staged, 0, dict(b))
+            staged = _stage(guards, slots)
+            found = self._search(e, slots, doms, staged, 0, dict(b))
             return (not found) if e.kind == "forall" else found
         count = 0
-        for vs in itertools.product(*doms):
-            if self.eval(e.body, self.bind(b, names, vs)):
-                if any(isinstance(v, _Fresh) for v in vs):
+        for combo in itertools.product(*doms):
+            cur = dict(b)
+            fresh = False
+            for names, values in zip(slots, combo):
+                for n, v in zip(names, values):
+                    fresh = fresh or isinstance(v, _Fresh)
+                    cur[n] = v.value if isinstance(v, _Fresh) else v
+            if self.eval(e.body, cur):
+                if fresh:
                     return False
                 count += 1
                 if count > 1:
                     return False
         return count == 1
 
-    def _search(self, e: ast.Quant, b: Mapping[str, Any], names: list[str], doms: list[list[Any]],
+    def slots(self, e: ast.Quant, b: Mapping[str, Any]) -> tuple[list[tuple[str, ...]], list[list[tuple[Any, ...]]]]:
+        """The quantifier's variables in enumeration slots and each slot's candidate tuples.
+
+        Variables that occur only together, as the whole argument list of
+        function applications and constructor terms (``at(x, y)``,
+        ``move(x, y)``), form one slot whose candidates are the table keys and
+        term arguments plus one fresh tuple; every other variable is a slot
+        of its own (:meth:`domain`).
+        """
+        bindings = {n: bd for bd in e.bindings for n in bd.names}
+        group = self._joint(e, b, bindings)
+        slots: list[tuple[str, ...]] = []
+        doms: list[list[tuple[Any, ...]]] = []
+        for n in e.variables:
+            if group and n in group[0]:
+                if n == group[0][0]:
+                    slots.append(group[0])
+                    doms.append(group[1])
+                continue
+            slots.append((n,))
+            doms.append([(v,) for v in self.domain(bindings[n], n, e.body, b)])
+        return slots, doms
+
+    def _joint(self, e: ast.Quant, b: Mapping[str, Any],
+               bindings: Mapping[str, ast.Binding]) -> tuple[tuple[str, ...], list[tuple[Any, ...]]] | None:
+        names = set(e.variables)
+        apps: list[ast.Apply] = []
+        _tuple_apps(e.body, names, apps)
+        for first in apps:
+            group = tuple(a.name for a in first.args if isinstance(a, ast.Var))
+            if len(group) < 2 or len(set(group)) != len(group):
+                continue
+            kinds = []
+            for n in group:
+                dom = bindings[n].domain
+                if not (isinstance(dom, ast.TBase) and dom.name in _INFINITE):
+                    break
+                kinds.append(dom.name)
+            else:
+                uses: list[ast.Apply] = []
+                if not _only_as(e.body, group, uses):
+                    continue
+                keys: set[tuple[Any, ...]] = set()
+                for app in uses:
+                    if app.func.prefix is None and app.func.name in self.env.ctors and app.func.name not in b:
+                        keys.update(tuple(t.args) for t in self._terms(app.func.name) if len(t.args) == len(group))
+                        continue
+                    f = self.var(app.func, b)
+                    if not isinstance(f, FiniteFunction):
+                        break
+                    keys.update(f.table)
+                else:
+                    ok = [k for k in keys if all(_fits(v, kind) for v, kind in zip(k, kinds))]
+                    top: set[Any] = set(self.numbers())
+                    _literals(e.body, top)
+                    fresh = int(max((abs(v) for v in top), default=0)) + 1
+                    cands: list[tuple[Any, ...]] = sorted(ok, key=repr)
+                    cands.append(tuple(_Fresh(fresh) for _ in group))
+                    return group, cands
+        return None
+
+    def _search(self, e: ast.Quant, slots: list[tuple[str, ...]], doms: list[list[tuple[Any, ...]]],
                 staged: list[list[ast.Expr]], depth: int, cur: dict[str, Any]) -> bool:
         """True when some assignment is a counterexample (forall) or a witness (exists);
         guards whose variables are all bound are checked as soon as possible."""
-        if depth == len(names):
+        if depth == len(slots):
             v = bool(self.eval(e.body, cur))
             return (not v) if e.kind == "forall" else v
-        n = names[depth]
-        for value in doms[depth]:
-            cur[n] = value.value if isinstance(value, _Fresh) else value
+        names = slots[depth]
+        for values in doms[depth]:
+            for n, value in zip(names, values):
+                cur[n] = value.value if isinstance(value, _Fresh) else value
             if all(self.eval(g, cur) for g in staged[depth]):
-                if self._search(e, b, names, doms, staged, depth + 1, cur):
+                if self._search(e, slots, doms, staged, depth + 1, cur):
                     return True
-        del cur[n]
+        for n in names:
+            cur.pop(n, None)
         return False
 
-    @staticmethod
-    def bind(b: Mapping[str, Any], names: list[str], vs: tuple[Any, ...]) -> dict[str, Any]:
-        out = dict(b)
-        for n, v in zip(names, vs):
-            out[n] = v.value if isinstance(v, _Fresh) else v
-        return out
+
+def _fits(v: Any, kind: str) -> bool:
+    if isinstance(v, bool) or not isinstance(v, (int, float, Fraction)):
+        return False
+    if kind == "REAL":
+        return True
+    return isinstance(v, int) and (kind == "INTEGER" or v >= 0)
+
+
+def _tuple_apps(e: Any, names: set[str], out: list[ast.Apply]) -> None:
+    """Applications whose arguments are all variables of ``names``."""
+    if isinstance(e, ast.Quant):
+        names = names - set(e.variables)
+    if isinstance(e, ast.Apply) and e.args and all(
+            isinstance(a, ast.Var) and a.prefix is None and a.name in names for a in e.args):
+        out.append(e)
+    for c in _children(e):
+        _tuple_apps(c, names, out)
+
+
+def _only_as(e: Any, group: tuple[str, ...], uses: list[ast.Apply]) -> bool:
+    """True when every occurrence of a ``group`` variable in ``e`` is inside an
+    application whose whole argument list is ``group`` (collected in ``uses``)."""
+    if isinstance(e, ast.Quant) and set(group) & set(e.variables):
+        return False  # a nested binder shadows a group variable: no joint slot
+    if isinstance(e, ast.Apply) and len(e.args) == len(group) and all(
+            isinstance(a, ast.Var) and a.prefix is None and a.name == g for a, g in zip(e.args, group)):
+        uses.append(e)
+        return True
+    if isinstance(e, ast.Var):
+        return not (e.prefix is None and e.name in group)
+    return all(_only_as(c, group, uses) for c in _children(e))
 
 
 class _Fresh:
