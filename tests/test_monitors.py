@@ -257,3 +257,21 @@ def test_evaluate_answers_none_on_values_of_the_wrong_form(checked: Any) -> None
     wayp = FiniteFunction({(0.0, 0.0): 0}, None, 2)  # partial: no result outside the table
     assert ev(checked, "Agent", "exists(x, y in REAL | in.wayP(x, y) + 1 == 1)", {"in.wayP": wayp}) is True
     assert ev(checked, "Agent", "forall(x, y in REAL | in.wayP(x, y) + 1 >= 1)", {"in.wayP": wayp}) is None
+
+
+def test_joint_enumeration_of_argument_tuples_matches_brute_force(checked: Any) -> None:
+    """x, y used only as the argument tuple of wayP and move: enumerated jointly over the
+    table keys and the command's arguments; compared with a search over a grid."""
+    grid = [0.0, 1.0, 2.0, 5.0]
+    wayp = FiniteFunction({(0.0, 0.0): 0, (1.0, 2.0): 1, (2.0, 1.0): 2}, None, 2)
+    for cmd in (Term("move", (1.0, 2.0)), Term("move", (2.0, 1.0)), Term("move", (5.0, 5.0)), Term("inspect", (1,))):
+        vals = {"in.wayP": wayp, "out.command": cmd}
+        for k in (0, 1, 2, 3):
+            want = any(wayp(x, y) == k and cmd == Term("move", (x, y)) for x in grid for y in grid)
+            got = ev(checked, "Agent", f"exists(x, y in REAL | in.wayP(x, y) == {k} and out.command == move(x, y))",
+                     vals)
+            assert got is want, (cmd, k)
+            want_all = all(not (wayp(x, y) == k) or cmd == Term("move", (x, y)) for x in grid for y in grid)
+            got_all = ev(checked, "Agent", f"forall(x, y in REAL | in.wayP(x, y) == {k} -> out.command == move(x, y))",
+                         vals)
+            assert got_all is want_all, (cmd, k)
