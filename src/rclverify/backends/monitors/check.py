@@ -120,6 +120,9 @@ class NodeMonitor:
     ``rules`` maps topic names to :class:`TopicRule`; ``horizon`` is in seconds.
     """
 
+    #: Evaluations remembered per (formula, inputs, outputs); 0 turns the cache off.
+    cache_size = 4096
+
     def __init__(self, checked: Checked, node: CheckedNode, rules: Mapping[str, TopicRule],
                  horizon: float) -> None:
         self.checked, self.node, self.horizon = checked, node, horizon
@@ -167,9 +170,10 @@ class NodeMonitor:
                     v, reason = self.fallback(formula, self.checked, self.node, values)
                 except Exception as exc:  # the Z3 checker's own failure: undecided, with its reason
                     v, reason = None, f"{reason}; Z3 on concrete values failed: {exc}"
-        if len(self._cache) > 4096:
-            self._cache.clear()
-        self._cache[ck] = (v, reason)
+        if self.cache_size:
+            if len(self._cache) >= self.cache_size:
+                self._cache.clear()
+            self._cache[ck] = (v, reason)
         return v, reason
 
 
