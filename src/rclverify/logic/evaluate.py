@@ -132,6 +132,36 @@ def _offsets(e: Any, name: str, out: set[Fraction]) -> bool:
     return all(_offsets(c, name, out) for c in _children(e))
 
 
+_STATIC: dict[tuple[int, str, str], tuple[Any, Any]] = {}
+
+
+def _static_shifts(body: Any, name: str) -> set[Fraction] | None:
+    """:func:`_offsets` of ``body`` for ``name`` plus 0, memoised per AST node
+    (the node is kept in the memo, so its id stays its own); None when ``name``
+    has a use that is not an argument or an equality operand."""
+    key = (id(body), name, "shifts")
+    hit = _STATIC.get(key)
+    if hit is not None and hit[0] is body:
+        return set(hit[1]) if hit[1] is not None else None
+    shifts: set[Fraction] = set()
+    ok = _offsets(body, name, shifts)
+    result = frozenset(shifts | {Fraction(0)}) if ok else None
+    _STATIC[key] = (body, result)
+    return set(result) if result is not None else None
+
+
+def _static_literals(body: Any) -> set[Any]:
+    """The numeric literals of ``body`` (memoised per AST node)."""
+    key = (id(body), "", "literals")
+    hit = _STATIC.get(key)
+    if hit is not None and hit[0] is body:
+        return set(hit[1])
+    out: set[Any] = set()
+    _literals(body, out)
+    _STATIC[key] = (body, frozenset(out))
+    return out
+
+
 def _conjuncts(e: Any) -> list[Any]:
     if isinstance(e, ast.Binary) and e.op == "and":
         return _conjuncts(e.left) + _conjuncts(e.right)
@@ -321,16 +351,14 @@ class Evaluator:
         raise Undecided(f"quantifier over {dom} is not finite")
 
     def candidates(self, name: str, scalar: str, body: ast.Expr, b: Mapping[str, Any]) -> list[Any]:
-        shifts: set[Fraction] = set()
-        if not _offsets(body, name, shifts):
+        shifts = _static_shifts(body, name)
+        if shifts is None:
             raise Undecided(f"{name} ranges over {scalar} and is used outside equalities and arguments")
         shifts.add(Fraction(0))
-        base: set[Any] = set(self.numbers())
-        _literals(body, base)
+        base: set[Any] = set(self.numbers()) | _static_literals(body)
         local: set[Any] = set()
         if self._positional(body, name, b, local):
-            found: set[Any] = set()
-            _literals(body, found)
+            found = _static_literals(body)
             raw = {v for v in local if not isinstance(v, bool) and isinstance(v, (int, float, Fraction))}
             raw |= {v - k for v in found for k in shifts}
         else:
@@ -504,8 +532,7 @@ class Evaluator:
                     keys.update(f.table)
                 else:
                     ok = [k for k in keys if all(_fits(v, kind) for v, kind in zip(k, kinds))]
-                    top: set[Any] = set(self.numbers())
-                    _literals(e.body, top)
+                    top: set[Any] = set(self.numbers()) | _static_literals(e.body)
                     fresh = int(max((abs(v) for v in top), default=0)) + 1
                     cands: list[tuple[Any, ...]] = sorted(ok, key=repr)
                     cands.append(tuple(_Fresh(fresh) for _ in group))
