@@ -90,7 +90,7 @@ def test_experiment_and_review_evidence_are_in_the_report(report: dict, workspac
     assert '<figure class="plot"><svg' in html and "Samuelson" in html
 
 
-def test_unavailable_backends_are_pending_not_skipped(report: dict) -> None:
+def test_ajpf_without_mcapl_is_pending_not_skipped(report: dict) -> None:
     ajpf = [e for e in report["evidence"] if e["backend"] == "ajpf"]
     assert ajpf and all(e["status"] == "pending" for e in ajpf)
 

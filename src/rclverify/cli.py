@@ -241,6 +241,11 @@ def cmd_refines(args: argparse.Namespace) -> int:
     return refines_main(args.original, args.replacement)
 
 
+def cmd_monitor(args: argparse.Namespace) -> int:
+    from .backends.monitors.cli import monitor_command
+    return monitor_command(args)
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``rclverify`` console script; returns the exit code."""
     p = argparse.ArgumentParser(prog="rclverify", description="Compositional verification from RCL contracts.")
@@ -280,6 +285,12 @@ def main(argv: Sequence[str] | None = None) -> int:
     r.add_argument("original", help="FILE.rcl:Node of the contract to replace")
     r.add_argument("replacement", help="FILE.rcl:Node of the replacement contract")
 
+    m = add("monitor", cmd_monitor, "check recorded runs (ROSMonitoring logs, ROS bags) against every "
+            "node's contract", True)
+    m.add_argument("traces", nargs="+", metavar="TRACE", help="a .jsonl log, a .bag, a ROS 2 bag directory or .mcap")
+    m.add_argument("--mapping", help="mapping file (default: backends/monitors/mapping.yaml if present)")
+    m.add_argument("--horizon", type=float, help="seconds an input event may wait for its answer (default 5.0)")
+    m.add_argument("--json", action="store_true", help="print the verdicts as JSON")
     args = p.parse_args(argv)
     try:
         return int(args.fn(args))

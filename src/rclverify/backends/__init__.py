@@ -3,9 +3,8 @@
 Implemented: ``hoare`` (Z3), ``dafny`` (Dafny), ``ajpf`` (AJPF/MCAPL
 property instances), ``property_tests`` (Hypothesis, every example checked
 by Z3), ``experiment`` (experiment figures against an acceptance
-criterion), ``review`` (code review records).  Named but not implemented
-yet (their evidence is ``pending`` with "backend not available"):
-``monitors``.
+criterion), ``review`` (code review records), ``monitors``
+(RML/ROSMonitoring, offline trace checking).
 """
 from __future__ import annotations
 
@@ -22,9 +21,9 @@ IMPLEMENTED = {
     "property_tests": ("rclverify.backends.property_tests.backend", "PropertyTestsBackend"),
     "experiment": ("rclverify.backends.experiment.backend", "ExperimentBackend"),
     "review": ("rclverify.backends.review.backend", "ReviewBackend"),
+    "monitors": ("rclverify.backends.monitors.backend", "MonitorsBackend"),
 }
-NOT_AVAILABLE = ("monitors",)
-KNOWN = tuple(IMPLEMENTED) + NOT_AVAILABLE
+KNOWN = tuple(IMPLEMENTED)
 
 
 def get_backend(name: str) -> "Backend":
@@ -36,7 +35,4 @@ def get_backend(name: str) -> "Backend":
     if name in IMPLEMENTED:
         module, cls = IMPLEMENTED[name]
         return cast("Backend", getattr(import_module(module), cls)())
-    if name in NOT_AVAILABLE:
-        from .unavailable import UnavailableBackend
-        return UnavailableBackend(name)
     raise KeyError(name)

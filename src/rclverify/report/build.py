@@ -92,6 +92,8 @@ def build_report(ws: Workspace) -> dict[str, Any]:
         if isinstance(ev.details.get("examples"), dict):  # property tests: example counts and seed
             ev_rows[-1]["examples"] = {**ev.details["examples"], "seed": ev.details.get("seed"),
                                        "replay": ev.details.get("replay", "")}
+        if isinstance(ev.details, dict) and ev.details.get("monitoring"):
+            ev_rows[-1]["monitoring"] = ev.details["monitoring"]
         if status == "pending":
             pending.append({"obligation": o.id, "backend": o.backend, "reason": ev.explanation})
 

@@ -1,0 +1,332 @@
+"""Offline checking of one node's contract on a recorded trace.
+
+Semantics (docs/monitors.md; paper lines 462-495 for the contract, 791-980
+for the monitors): the node's state is the latest value of each input and
+output, mapped from the messages on its topics (:mod:`rclverify.traces.mapping`).
+Every message on an input topic is an *input event*:
+
+* once every input the contract mentions has been observed, the assumption
+  is evaluated on the inputs: false -> the event's verdict is
+  ``assumption violated`` (blamed on the environment or on the upstream
+  node producing the input); true -> the event opens an obligation on the
+  inputs as they are now;
+* the guarantees are evaluated at once on the outputs as they stand (outputs
+  persist until changed), and again at every later message on an output
+  topic, on the obligation's inputs and the current outputs; all true ->
+  ``satisfied``;
+* an obligation not satisfied within ``horizon`` seconds of its event is
+  ``violated`` (``inconclusive`` when its last evaluation could not be
+  decided).  The violating event reported is the last output event that
+  failed the obligation before the node's next input event (the node's
+  answer to it), with the guarantee that failed there, or "no output"
+  when none came;
+* at the end of the trace, obligations still within their horizon are
+  ``open``.
+
+A node with no input topics checks its guarantees on every output event.
+Memory holds only the state and the pending obligations (grouped by equal
+inputs), never the trace.
+"""
+from __future__ import annotations
+
+from collections import deque
+from dataclasses import dataclass, field
+from typing import Any, Callable, Iterable, Mapping
+
+from ...logic.evaluate import evaluate, why_undecided
+from ...rcl import ast
+from ...rcl.printer import expr_to_rcl
+from ...rcl.types import Checked, CheckedNode
+from ...traces.events import Event
+from ...traces.mapping import MappingError, TopicRule, initial_value, map_value
+from ...values import render
+
+VERDICTS = ("satisfied", "violated", "open", "assumption violated", "inconclusive", "incomplete input")
+
+
+def _names(e: Any, out: set[str]) -> None:
+    if isinstance(e, ast.Var):
+        out.add(e.qualified)
+    for name in ("args", "operand", "left", "right", "operands", "elem", "collection", "items", "body", "func"):
+        c = getattr(e, name, None)
+        if c is None:
+            continue
+        for x in (c if isinstance(c, tuple) else (c,)):
+            _names(x, out)
+
+
+def concrete_fallback() -> Callable[..., tuple[bool | None, str]] | None:
+    """``rclverify.logic.concrete.check_concrete`` when that module exists (Z3 on
+    concrete values), else ``None``."""
+    try:
+        from ...logic import concrete  # type: ignore[attr-defined]
+    except ImportError:
+        return None
+    fn: Callable[..., tuple[bool | None, str]] = getattr(concrete, "check_concrete")
+    return fn
+
+
+@dataclass
+class _Group:
+    """Pending input events with equal inputs: their events, deadlines and last outcome."""
+
+    inputs: dict[str, Any]
+    events: deque[Event] = field(default_factory=deque)
+    last: tuple[Event, int, dict[str, Any]] | None = None  # (output event, failing guarantee, outputs)
+    undecided: str = ""
+    answered: bool = False  # a later input event arrived: the node's answer to these events is complete
+
+
+@dataclass
+class NodeResult:
+    """Verdicts of one node on one trace.
+
+    ``counts`` verdict -> number of input events; ``first_violation`` and
+    ``first_assumption_violation`` are dicts (event index, time, where,
+    guarantee, formula, values, reason) or ``None``; ``events`` is the
+    number of events on the node's topics.
+    """
+
+    node: str
+    counts: dict[str, int] = field(default_factory=lambda: {v: 0 for v in VERDICTS})
+    events: int = 0
+    first_violation: dict[str, Any] | None = None
+    first_assumption_violation: dict[str, Any] | None = None
+    first_inconclusive: dict[str, Any] | None = None
+
+    def to_json(self) -> dict[str, Any]:
+        return {"node": self.node, "counts": dict(self.counts), "events": self.events,
+                "first_violation": self.first_violation,
+                "first_assumption_violation": self.first_assumption_violation,
+                "first_inconclusive": self.first_inconclusive}
+
+
+def producers(checked: Checked, node: CheckedNode, var: str) -> list[str]:
+    """Other nodes whose output has the input's name or is matched to the input's topic."""
+    topics = {t.field for t in node.node.topics if t.match is not None and t.match.name == var}
+    out = []
+    for other in checked.nodes.values():
+        if other.name == node.name:
+            continue
+        if var in other.outputs or any(t.field in topics and t.match is not None and t.match.name in other.outputs
+                                       for t in other.node.topics):
+            out.append(other.name)
+    return sorted(out)
+
+
+class NodeMonitor:
+    """Streams events through one node's contract; :meth:`finish` gives the result.
+
+    ``rules`` maps topic names to :class:`TopicRule`; ``horizon`` is in seconds.
+    """
+
+    #: Evaluations remembered per (formula, inputs, outputs); 0 turns the cache off.
+    cache_size = 4096
+
+    def __init__(self, checked: Checked, node: CheckedNode, rules: Mapping[str, TopicRule],
+                 horizon: float) -> None:
+        self.checked, self.node, self.horizon = checked, node, horizon
+        self.rules = rules
+        self.result = NodeResult(node.name)
+        self.topics: dict[str, list[tuple[str, Any, bool]]] = {}
+        for t in node.node.topics:
+            if t.match is None:
+                continue
+            typ = node.io_type(t.match)
+            if typ is None:
+                continue
+            is_input = t.match.prefix == "in" or (t.match.prefix is None and t.match.name in node.inputs)
+            key = ("in." if is_input else "out.") + t.match.name
+            self.topics.setdefault(t.field.lstrip("/"), []).append((key, typ, is_input))
+        self.has_inputs = any(i for vs in self.topics.values() for _, _, i in vs)
+        self.values: dict[str, Any] = {}
+        for topic, vs in self.topics.items():
+            for key, typ, _ in vs:
+                self.values[key] = initial_value(typ, rules.get(topic, TopicRule()))
+        self.assumption = tuple(c.formula for c in node.node.assumes)
+        self.guarantees = tuple(c.formula for c in node.node.guarantees)
+        needed: set[str] = set()
+        for f in self.assumption + self.guarantees:
+            _names(f, needed)
+        self.needed_inputs = sorted(k for k in self.values if k.startswith("in.") and
+                                    (k in needed or k[3:] in needed))
+        self._outputs = sorted(k for k in self.values if k.startswith("out."))
+        self.pending: dict[Any, _Group] = {}
+        self.fallback = concrete_fallback()
+        self._cache: dict[tuple[int, Any, Any], tuple[bool | None, str]] = {}
+
+    # -- evaluation --------------------------------------------------------------
+    def _truth(self, k: int, formula: ast.Expr, values: Mapping[str, Any], key: Any) -> tuple[bool | None, str]:
+        ck = (k, key, tuple(self.values[o] for o in self._outputs))
+        hit = self._cache.get(ck)
+        if hit is not None:
+            return hit
+        v = evaluate(formula, self.checked, self.node, values)
+        reason = ""
+        if v is None:
+            reason = why_undecided(formula, self.checked, self.node, values)
+            if self.fallback is not None and "no value for" not in reason:
+                try:
+                    v, reason = self.fallback(formula, self.checked, self.node, values)
+                except Exception as exc:  # the Z3 checker's own failure: undecided, with its reason
+                    v, reason = None, f"{reason}; Z3 on concrete values failed: {exc}"
+        if self.cache_size:
+            if len(self._cache) >= self.cache_size:
+                self._cache.clear()
+            self._cache[ck] = (v, reason)
+        return v, reason
+
+
+    def _rendered(self, values: Mapping[str, Any]) -> dict[str, str]:
+        return {k: render(v) for k, v in sorted(values.items()) if v is not None}
+
+    # -- streaming ---------------------------------------------------------------
+    def feed(self, ev: Event) -> None:
+        """Process one event (ignored unless on one of the node's topics)."""
+        vs = self.topics.get(ev.topic)
+        if vs is None:
+            return
+        self.result.events += 1
+        self._expire(ev.time)
+        is_input = False
+        for key, typ, inp in vs:
+            try:
+                self.values[key] = map_value(typ, ev.fields, self.rules.get(ev.topic, TopicRule()),
+                                             self.values.get(key))
+            except MappingError as exc:
+                self._note_inconclusive(ev, 0, f"{key}: {exc}")
+                return
+            is_input = is_input or inp
+        if is_input:
+            self._input(ev)
+        if any(not inp for _, _, inp in vs):
+            if not self.has_inputs:
+                self._input(ev)
+            self._output(ev)
+
+    def _input(self, ev: Event) -> None:
+        for g in self.pending.values():
+            g.answered = True
+        inputs = {k: v for k, v in self.values.items() if k.startswith("in.")}
+        if any(inputs.get(k) is None for k in self.needed_inputs):
+            self.result.counts["incomplete input"] += 1
+            return
+        for formula in self.assumption:
+            ok, reason = self._truth(-1, formula, inputs, ("A", id(formula), tuple(inputs.items())))
+            if ok is False:
+                self.result.counts["assumption violated"] += 1
+                if self.result.first_assumption_violation is None:
+                    mentioned: set[str] = set()
+                    _names(formula, mentioned)
+                    blamed = sorted({p for k in inputs if k in mentioned or k[3:] in mentioned
+                                     for p in producers(self.checked, self.node, k[3:])})
+                    self.result.first_assumption_violation = {
+                        "event": ev.index, "time": ev.time, "where": ev.where, "assumption": expr_to_rcl(formula),
+                        "values": self._rendered(inputs),
+                        "blame": ("upstream node(s) " + ", ".join(blamed)) if blamed else "environment"}
+                return
+            if ok is None:
+                self._note_inconclusive(ev, 0, f"assumption undecided: {reason}")
+                return
+        key = tuple(inputs.items())
+        group = self.pending.get(key)
+        if group is None:
+            group = self.pending[key] = _Group(inputs)
+        group.events.append(ev)
+        if len(group.events) == 1:
+            self._output(ev, only=key)
+
+    def _output(self, ev: Event, only: Any = None) -> None:
+        done = []
+        groups = self.pending.items() if only is None else [(only, self.pending[only])]
+        for key, g in groups:
+            values = dict(g.inputs)
+            values.update((k, v) for k, v in self.values.items() if k.startswith("out."))
+            failed: tuple[int, str] | None = None
+            undecided = ""
+            for k, formula in enumerate(self.guarantees, 1):
+                ok, reason = self._truth(k, formula, values, key)
+                if ok is False:
+                    failed = (k, "")
+                    break
+                if ok is None:
+                    undecided = f"guarantee {k}: {reason}"
+                    break
+            if failed is None and not undecided:
+                self.result.counts["satisfied"] += len(g.events)
+                done.append(key)
+            elif failed is not None and (g.last is None or not g.answered):
+                g.last, g.undecided = (ev, failed[0], {k: v for k, v in values.items() if k.startswith("out.")}), ""
+            else:
+                g.undecided = undecided
+        for key in done:
+            del self.pending[key]
+
+    def _expire(self, now: float) -> None:
+        empty = []
+        for key, g in self.pending.items():
+            while g.events and g.events[0].time + self.horizon < now:
+                self._close(g, g.events.popleft())
+            if not g.events:
+                empty.append(key)
+        for key in empty:
+            del self.pending[key]
+
+    def _close(self, g: _Group, trigger: Event) -> None:
+        if g.undecided and g.last is None:
+            self.result.counts["inconclusive"] += 1
+            self._first_inconclusive(trigger, g.undecided)
+            return
+        self.result.counts["violated"] += 1
+        if self.result.first_violation is not None:
+            return
+        if g.last is None:
+            self.result.first_violation = {
+                "event": trigger.index, "time": trigger.time, "where": trigger.where, "guarantee": None,
+                "formula": "", "values": self._rendered(g.inputs),
+                "reason": f"no output satisfying the guarantees within {self.horizon} s of the input event"}
+            return
+        out, k, outputs = g.last
+        self.result.first_violation = {
+            "event": out.index, "time": out.time, "where": out.where, "guarantee": k,
+            "formula": expr_to_rcl(self.guarantees[k - 1]), "trigger": trigger.index,
+            "trigger_time": trigger.time, "trigger_where": trigger.where,
+            "values": self._rendered({**g.inputs, **outputs}),
+            "reason": f"guarantee {k} is false on the output at {out.where} answering the input at "
+                      f"{trigger.where}, and no output within {self.horizon} s satisfied it"}
+
+    def _note_inconclusive(self, ev: Event, k: int, reason: str) -> None:
+        self.result.counts["inconclusive"] += 1
+        self._first_inconclusive(ev, reason)
+
+    def _first_inconclusive(self, ev: Event, reason: str) -> None:
+        if self.result.first_inconclusive is None:
+            self.result.first_inconclusive = {"event": ev.index, "time": ev.time, "where": ev.where,
+                                              "reason": reason}
+
+    def finish(self) -> NodeResult:
+        """Close the run: obligations past their horizon are violated, the rest open."""
+        for g in self.pending.values():
+            self.result.counts["open"] += len(g.events)
+        self.pending.clear()
+        return self.result
+
+
+def check_trace(checked: Checked, nodes: Iterable[CheckedNode], events: Iterable[Event],
+                rules: Mapping[str, TopicRule], horizon: float) -> tuple[int, list[NodeResult]]:
+    """Stream ``events`` through a monitor per node; returns (events read, results).
+
+    Raises whatever the event source raises (:class:`TraceError`) after the
+    events before it were processed.
+    """
+    monitors = [NodeMonitor(checked, n, rules, horizon) for n in nodes]
+    count = 0
+    last_time = 0.0
+    for ev in events:
+        count += 1
+        last_time = ev.time
+        for m in monitors:
+            m.feed(ev)
+    for m in monitors:
+        m._expire(last_time)
+    return count, [m.finish() for m in monitors]

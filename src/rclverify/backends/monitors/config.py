@@ -1,0 +1,87 @@
+"""The monitors plan entry and the workspace's mapping file.
+
+Plan entry (``nodes.<Node>.evidence[k]``)::
+
+    - backend: monitors
+      mapping: backends/monitors/mapping.yaml   # topic rules, .msg dirs
+      horizon: 2.0                              # seconds (default 5.0)
+      traces: [backends/monitors/traces/nominal.jsonl, ...]
+
+Mapping file: ``msg_dirs`` (directories holding ``<pkg>/msg/<Type>.msg``),
+``topics`` (:func:`rclverify.traces.mapping.load_rules`), optional
+``ros_version`` (``ros1``/``ros2``, default ``ros2``) and ``horizon``.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, Mapping
+
+import yaml
+
+from ...traces.mapping import TopicRule, load_rules
+
+DEFAULT_MAPPING = "backends/monitors/mapping.yaml"
+DEFAULT_HORIZON = 5.0
+
+
+class ConfigError(Exception):
+    """A bad mapping file or plan entry: ``(message, path)`` where ``path`` is
+    the plan key at fault (``()`` for the mapping file itself)."""
+
+    def __init__(self, message: str, *path: Any) -> None:
+        super().__init__(message)
+        self.path = path
+
+
+@dataclass(frozen=True)
+class MonitorConfig:
+    """Resolved options: workspace-relative ``mapping`` file, ``rules`` per topic,
+    ``msg_dirs`` (relative), ``horizon`` in seconds, ``ros_version``, ``traces``."""
+
+    mapping: str
+    rules: Mapping[str, TopicRule]
+    msg_dirs: tuple[str, ...]
+    horizon: float
+    ros_version: str
+    traces: tuple[str, ...] = ()
+
+    def msg_files(self, root: Path) -> list[str]:
+        """Workspace-relative ``.msg`` files under the message directories, sorted."""
+        return sorted(p.relative_to(root).as_posix() for d in self.msg_dirs for p in (root / d).rglob("*.msg"))
+
+
+def load_mapping(root: Path, rel: str | None, horizon: Any = None, traces: Any = ()) -> MonitorConfig:
+    """Read the mapping file (``rel`` or the default; absent default -> no rules).
+
+    Raises :class:`ConfigError` for an unreadable file or malformed options.
+    """
+    path = root / (rel or DEFAULT_MAPPING)
+    raw: Any = {}
+    if path.is_file():
+        try:
+            raw = yaml.safe_load(path.read_text(encoding="utf-8")) or {}
+        except yaml.YAMLError as exc:
+            mark = getattr(exc, "problem_mark", None)
+            line = f"{mark.line + 1}:{mark.column + 1}" if mark is not None else "1:1"
+            raise ConfigError(f"{rel or DEFAULT_MAPPING}:{line}: error: not valid YAML: {exc}") from None
+    elif rel:
+        raise ConfigError(f"no such mapping file: {rel}", "mapping")
+    if not isinstance(raw, Mapping):
+        raise ConfigError(f"{rel or DEFAULT_MAPPING}:1:1: error: expected a mapping")
+    try:
+        rules = load_rules(raw.get("topics"))
+    except ValueError as exc:
+        raise ConfigError(f"{rel or DEFAULT_MAPPING}:1:1: error: {exc}") from None
+    h = horizon if horizon is not None else raw.get("horizon", DEFAULT_HORIZON)
+    if isinstance(h, bool) or not isinstance(h, (int, float)) or h < 0:
+        raise ConfigError(f"horizon must be a number of seconds >= 0, not {h!r}", "horizon")
+    if isinstance(traces, str) or not isinstance(traces, (list, tuple)):
+        raise ConfigError("traces must be a list of files", "traces")
+    for k, t in enumerate(traces):
+        if not (root / str(t)).exists():
+            raise ConfigError(f"no such trace: {t}", "traces", k)
+    ros = str(raw.get("ros_version", "ros2"))
+    return MonitorConfig(rel or DEFAULT_MAPPING if path.is_file() else "", rules,
+                         tuple(str(d) for d in raw.get("msg_dirs", ()) or ()), float(h), ros,
+                         tuple(str(t) for t in traces))

@@ -1,0 +1,600 @@
+"""Direct evaluation of an RCL formula on a node's concrete values (no solver).
+
+Used by the offline trace checker (:mod:`rclverify.backends.monitors`) on
+every event, so it must be fast.  Values follow :mod:`rclverify.values`;
+the environment is keyed by qualified names (``"in.r"``,
+``"out.radiationStatus"``), a bare name resolving inputs first, like
+:meth:`CheckedNode.io_type`.
+
+Quantifiers are decided by enumeration:
+
+* over ``BOOL``, an enumeration, a set literal or a finite set value: every
+  element;
+* over ``REAL``/``INTEGER``/``NATURAL``: exactly, when the bound variable
+  occurs only as an argument of a function-typed input or of a constructor,
+  or as an operand of ``==``/``!=`` (possibly shifted by a literal,
+  ``i + 1``).  Then only the values the environment and the formula mention
+  (shifted back by those literals) can make an atom true; every other value
+  behaves like one fresh value, which is enumerated once.  For
+  ``exists_unique`` a fresh value satisfying the body stands for infinitely
+  many, so uniqueness fails.  Any other use (``x < 3``, ``x * y``) makes the
+  quantifier undecidable here and :func:`evaluate` answers ``None``.
+"""
+from __future__ import annotations
+
+import itertools
+from fractions import Fraction
+from typing import Any, Callable, Iterable, Mapping
+
+from ..rcl import ast
+from ..rcl import types as T
+from ..rcl.types import Checked, CheckedNode
+from ..values import FiniteFunction, Term
+
+
+class Undecided(Exception):
+    """The formula cannot be decided by direct evaluation (reason in ``str``)."""
+
+
+_CMP: Mapping[str, Callable[[Any, Any], bool]] = {
+    "==": lambda a, b: a == b, "!=": lambda a, b: a != b, "<": lambda a, b: a < b,
+    "<=": lambda a, b: a <= b, ">": lambda a, b: a > b, ">=": lambda a, b: a >= b,
+}
+_INFINITE = ("REAL", "INTEGER", "NATURAL")
+_LIT: dict[str, Any] = {}
+
+
+def evaluate(formula: ast.Expr, checked: Checked, node: CheckedNode,
+             values: Mapping[str, Any]) -> bool | None:
+    """Truth value of ``formula`` for ``node`` on ``values``.
+
+    ``values`` maps qualified names (``"in.r"``) to values in the
+    :mod:`rclverify.values` convention.  Returns ``True``/``False``, or
+    ``None`` when the formula cannot be decided directly (a quantifier over
+    an infinite domain that does not reduce to finitely many candidates, or
+    a value the formula needs is missing).  Never raises for such cases.
+    """
+    try:
+        return bool(Evaluator(checked, node, values).eval(formula, {}))
+    except (Undecided, TypeError, ZeroDivisionError):
+        return None
+
+
+def why_undecided(formula: ast.Expr, checked: Checked, node: CheckedNode, values: Mapping[str, Any]) -> str:
+    """The reason :func:`evaluate` answers ``None`` ('' when it decides)."""
+    try:
+        Evaluator(checked, node, values).eval(formula, {})
+        return ""
+    except Undecided as exc:
+        return str(exc)
+    except (TypeError, ZeroDivisionError) as exc:
+        return f"a value has the wrong form for the formula: {exc}"
+
+
+def _children(e: Any) -> Iterable[Any]:
+    if isinstance(e, ast.Apply):
+        return e.args
+    if isinstance(e, ast.Unary):
+        return (e.operand,)
+    if isinstance(e, ast.Binary):
+        return (e.left, e.right)
+    if isinstance(e, ast.Compare):
+        return e.operands
+    if isinstance(e, ast.Member):
+        return (e.elem, e.collection)
+    if isinstance(e, (ast.SetLit, ast.TupleLit, ast.SeqLit)):
+        return e.items
+    if isinstance(e, ast.Quant):
+        return (e.body,)
+    return ()
+
+
+def _shift(e: Any, name: str) -> Fraction | None:
+    """``k`` when ``e`` is ``name``, ``name + k`` or ``name - k`` (literal k); else None."""
+    if isinstance(e, ast.Var) and e.prefix is None and e.name == name:
+        return Fraction(0)
+    if isinstance(e, ast.Binary) and e.op in ("+", "-"):
+        if isinstance(e.right, ast.NumLit) and isinstance(e.left, ast.Var) and e.left.prefix is None \
+                and e.left.name == name:
+            return e.right.value if e.op == "+" else -e.right.value
+        if e.op == "+" and isinstance(e.left, ast.NumLit) and isinstance(e.right, ast.Var) \
+                and e.right.prefix is None and e.right.name == name:
+            return e.left.value
+    return None
+
+
+def _offsets(e: Any, name: str, out: set[Fraction]) -> bool:
+    """Collect the shifts under which ``name`` occurs in ``e``; False on a use
+    that is not an argument or an ``==``/``!=`` operand."""
+    if isinstance(e, ast.Quant) and name in e.variables:
+        return True
+    if isinstance(e, ast.Apply):
+        for a in e.args:
+            k = _shift(a, name)
+            if k is not None:
+                out.add(k)
+            elif not _offsets(a, name, out):
+                return False
+        return True
+    if isinstance(e, ast.Compare):
+        for op, (a, b) in zip(e.ops, zip(e.operands, e.operands[1:])):
+            for side in (a, b):
+                k = _shift(side, name)
+                if k is not None:
+                    if op not in ("==", "!="):
+                        return False
+                    out.add(k)
+                elif not _offsets(side, name, out):
+                    return False
+        return True
+    if isinstance(e, ast.Var):
+        return not (e.prefix is None and e.name == name)
+    return all(_offsets(c, name, out) for c in _children(e))
+
+
+_STATIC: dict[tuple[int, str, str], tuple[Any, Any]] = {}
+
+
+def _static_shifts(body: Any, name: str) -> set[Fraction] | None:
+    """:func:`_offsets` of ``body`` for ``name`` plus 0, memoised per AST node
+    (the node is kept in the memo, so its id stays its own); None when ``name``
+    has a use that is not an argument or an equality operand."""
+    key = (id(body), name, "shifts")
+    hit = _STATIC.get(key)
+    if hit is not None and hit[0] is body:
+        return set(hit[1]) if hit[1] is not None else None
+    shifts: set[Fraction] = set()
+    ok = _offsets(body, name, shifts)
+    result = frozenset(shifts | {Fraction(0)}) if ok else None
+    _STATIC[key] = (body, result)
+    return set(result) if result is not None else None
+
+
+def _static_literals(body: Any) -> set[Any]:
+    """The numeric literals of ``body`` (memoised per AST node)."""
+    key = (id(body), "", "literals")
+    hit = _STATIC.get(key)
+    if hit is not None and hit[0] is body:
+        return set(hit[1])
+    out: set[Any] = set()
+    _literals(body, out)
+    _STATIC[key] = (body, frozenset(out))
+    return out
+
+
+def _conjuncts(e: Any) -> list[Any]:
+    if isinstance(e, ast.Binary) and e.op == "and":
+        return _conjuncts(e.left) + _conjuncts(e.right)
+    return [e]
+
+
+def _free(e: Any, names: set[str], out: set[str]) -> None:
+    if isinstance(e, ast.Var) and e.prefix is None and e.name in names:
+        out.add(e.name)
+    if isinstance(e, ast.Quant):
+        inner = names - set(e.variables)
+        for c in _children(e):
+            _free(c, inner, out)
+        return
+    for c in _children(e):
+        _free(c, names, out)
+
+
+def _stage(guards: list[Any], slots: list[tuple[str, ...]]) -> list[list[Any]]:
+    """Guards grouped by the slot at which their last bound variable is bound."""
+    where = {n: k for k, names in enumerate(slots) for n in names}
+    staged: list[list[Any]] = [[] for _ in slots]
+    for g in guards:
+        used: set[str] = set()
+        _free(g, set(where), used)
+        depth = max((where[n] for n in used), default=0)
+        staged[depth].append(g)
+    return staged
+
+
+def _numbers(v: Any, out: set[Any]) -> None:
+    if isinstance(v, bool) or v is None:
+        return
+    if isinstance(v, (int, float, Fraction)):
+        out.add(v)
+    elif isinstance(v, Term):
+        for a in v.args:
+            _numbers(a, out)
+    elif isinstance(v, FiniteFunction):
+        for key, res in v.table.items():
+            for a in key:
+                _numbers(a, out)
+            _numbers(res, out)
+        _numbers(v.default, out)
+    elif isinstance(v, (tuple, frozenset)):
+        for a in v:
+            _numbers(a, out)
+
+
+def _literals(e: Any, out: set[Any]) -> None:
+    if isinstance(e, ast.NumLit):
+        out.add(e.value)
+    for c in _children(e):
+        _literals(c, out)
+
+
+class Evaluator:
+    """One evaluation context: the node, its values and the candidate numbers."""
+
+    def __init__(self, checked: Checked, node: CheckedNode, values: Mapping[str, Any]) -> None:
+        self.env = checked.env
+        self.node = node
+        self.values = values
+        self._numbers: set[Any] | None = None
+        self._slots: dict[int, tuple[list[tuple[str, ...]], list[list[tuple[Any, ...]]]]] = {}
+
+    def numbers(self) -> set[Any]:
+        if self._numbers is None:
+            found: set[Any] = set()
+            for v in self.values.values():
+                _numbers(v, found)
+            self._numbers = found
+        return self._numbers
+
+    # -- names ---------------------------------------------------------------
+    def io(self, v: ast.Var) -> Any:
+        if v.prefix is not None:
+            key = v.qualified
+        elif v.name in self.node.inputs:
+            key = "in." + v.name
+        else:
+            key = "out." + v.name
+        if key not in self.values:
+            raise Undecided(f"no value for {key}")
+        return self.values[key]
+
+    def var(self, v: ast.Var, bound: Mapping[str, Any]) -> Any:
+        if v.prefix is None and v.name in bound:
+            return bound[v.name]
+        if v.prefix is None and v.name in self.env.enum_values:
+            return v.name
+        if v.prefix is None and v.name in self.env.constants:
+            return self.eval(self.env.constants[v.name][1], {})
+        if v.prefix is None and v.name in self.env.ctors:
+            return Term(v.name, ())
+        return self.io(v)
+
+    # -- expressions -----------------------------------------------------------
+    def eval(self, e: ast.Expr, b: Mapping[str, Any]) -> Any:
+        if isinstance(e, ast.BoolLit):
+            return e.value
+        if isinstance(e, ast.NumLit):
+            lit = _LIT.get(e.text)
+            if lit is None:
+                v = e.value
+                lit = _LIT[e.text] = int(v) if v.denominator == 1 else v
+            return lit
+        if isinstance(e, ast.Var):
+            return self.var(e, b)
+        if isinstance(e, ast.Apply):
+            args = tuple(self.eval(a, b) for a in e.args)
+            if e.func.prefix is None and e.func.name in self.env.ctors and e.func.name not in b:
+                return Term(e.func.name, args)
+            f = self.var(e.func, b)
+            if not callable(f):
+                raise Undecided(f"{e.func.qualified} is not a function value")
+            return f(*args)
+        if isinstance(e, ast.Unary):
+            x = self.eval(e.operand, b)
+            return (not x) if e.op == "not" else -x
+        if isinstance(e, ast.Binary):
+            return self.binary(e, b)
+        if isinstance(e, ast.Compare):
+            vals = [self.eval(o, b) for o in e.operands]
+            return all(_CMP[op](x, y) for op, x, y in zip(e.ops, vals, vals[1:]))
+        if isinstance(e, ast.Member):
+            x = self.eval(e.elem, b)
+            coll = self.collection(e.collection, b)
+            return (x not in coll) if e.negated else (x in coll)
+        if isinstance(e, ast.SetLit):
+            return frozenset(self.eval(i, b) for i in e.items)
+        if isinstance(e, (ast.TupleLit, ast.SeqLit)):
+            return tuple(self.eval(i, b) for i in e.items)
+        if isinstance(e, ast.Quant):
+            return self.quant(e, b)
+        raise Undecided(f"cannot evaluate {type(e).__name__}")
+
+    def collection(self, e: Any, b: Mapping[str, Any]) -> Any:
+        if isinstance(e, ast.SetLit):
+            return {self.eval(i, b) for i in e.items}
+        v = self.eval(e, b)
+        if isinstance(v, (frozenset, tuple, set)):
+            return v
+        raise Undecided("membership in a value that is not a set")
+
+    def binary(self, e: ast.Binary, b: Mapping[str, Any]) -> Any:
+        op = e.op
+        if op == "and":
+            return bool(self.eval(e.left, b)) and bool(self.eval(e.right, b))
+        if op == "or":
+            return bool(self.eval(e.left, b)) or bool(self.eval(e.right, b))
+        if op == "->":
+            return (not self.eval(e.left, b)) or bool(self.eval(e.right, b))
+        if op == "<=>":
+            return bool(self.eval(e.left, b)) == bool(self.eval(e.right, b))
+        x, y = self.eval(e.left, b), self.eval(e.right, b)
+        if op == "+":
+            return x + y
+        if op == "-":
+            return x - y
+        if op == "*":
+            return x * y
+        if y == 0:
+            raise Undecided("division by zero")
+        return Fraction(x) / Fraction(y)
+
+    # -- quantifiers -------------------------------------------------------------
+    def domain(self, binding: ast.Binding, name: str, body: ast.Expr, b: Mapping[str, Any]) -> list[Any]:
+        dom = binding.domain
+        if isinstance(dom, ast.TBase):
+            base = dom.name
+            typ: Any = T.Scalar(base) if base in _INFINITE or base == "BOOL" else None
+        elif isinstance(dom, ast.TName):
+            typ = self.env.types.get(dom.name)
+        elif isinstance(dom, ast.TEnum):
+            return list(dom.values)
+        elif isinstance(dom, ast.TypeExpr.__args__):  # type: ignore[attr-defined]
+            raise Undecided(f"quantifier over a {type(dom).__name__} domain")
+        else:
+            return list(self.collection(dom, b))
+        if isinstance(typ, T.EnumT):
+            return list(typ.values)
+        if isinstance(typ, T.Scalar) and typ.name == "BOOL":
+            return [False, True]
+        if isinstance(typ, T.Scalar):
+            return self.candidates(name, typ.name, body, b)
+        raise Undecided(f"quantifier over {dom} is not finite")
+
+    def candidates(self, name: str, scalar: str, body: ast.Expr, b: Mapping[str, Any]) -> list[Any]:
+        shifts = _static_shifts(body, name)
+        if shifts is None:
+            raise Undecided(f"{name} ranges over {scalar} and is used outside equalities and arguments")
+        shifts.add(Fraction(0))
+        base: set[Any] = set(self.numbers()) | _static_literals(body)
+        local: set[Any] = set()
+        if self._positional(body, name, b, local):
+            found = _static_literals(body)
+            raw = {v for v in local if not isinstance(v, bool) and isinstance(v, (int, float, Fraction))}
+            raw |= {v - k for v in found for k in shifts}
+        else:
+            raw = {v - k for v in base for k in shifts}
+        cands: set[Any] = set()
+        for c in raw:
+            if scalar != "REAL":
+                if isinstance(c, float):
+                    if not c.is_integer():
+                        continue
+                elif not isinstance(c, int) and Fraction(c).denominator != 1:
+                    continue
+                c = int(c)
+                if scalar == "NATURAL" and c < 0:
+                    continue
+            cands.add(c)
+        top = max(base | cands, default=0)
+        fresh_value: Any = int(top + 2 * max((abs(k) for k in shifts), default=0)) + 1
+        return sorted(cands) + [_Fresh(fresh_value)]
+
+    def _terms(self, ctor: str) -> list[Term]:
+        out: list[Term] = []
+
+        def walk(v: Any) -> None:
+            if isinstance(v, Term):
+                if v.name == ctor:
+                    out.append(v)
+                for a in v.args:
+                    walk(a)
+            elif isinstance(v, FiniteFunction):
+                for res in v.table.values():
+                    walk(res)
+            elif isinstance(v, (tuple, frozenset)):
+                for a in v:
+                    walk(a)
+        for v in self.values.values():
+            walk(v)
+        return out
+
+    def _results(self, e: Any, b: Mapping[str, Any]) -> set[Any] | None:
+        """Every value ``e`` can take whatever the bound variables are, when known."""
+        if isinstance(e, ast.NumLit):
+            return {e.value}
+        if isinstance(e, ast.Var) and (e.prefix is not None or e.name in self.node.inputs
+                                       or e.name in self.node.outputs) and e.name not in b:
+            v = self.io(e)
+            return {v} if not isinstance(v, FiniteFunction) else None
+        if isinstance(e, ast.Apply) and e.func.name not in self.env.ctors:
+            f = self.var(e.func, b)
+            if isinstance(f, FiniteFunction):
+                return set(f.table.values()) | {f.default}
+        return None
+
+    def _positional(self, e: Any, name: str, b: Mapping[str, Any], vals: set[Any]) -> bool:
+        """Collect the only values ``name`` can take to make an atom differ from a
+        fresh value; False when some occurrence gives no such bound."""
+        if isinstance(e, ast.Quant) and name in e.variables:
+            return True
+        if isinstance(e, ast.Apply):
+            for p, a in enumerate(e.args):
+                k = _shift(a, name)
+                if k is None:
+                    if not self._positional(a, name, b, vals):
+                        return False
+                    continue
+                if e.func.prefix is None and e.func.name in self.env.ctors and e.func.name not in b:
+                    vals.update(t.args[p] - k for t in self._terms(e.func.name)
+                                if p < len(t.args) and isinstance(t.args[p], (int, float, Fraction)))
+                    continue
+                f = self.var(e.func, b)
+                if not isinstance(f, FiniteFunction):
+                    return False
+                vals.update(key[p] - k for key in f.table if isinstance(key[p], (int, float, Fraction)))
+            return True
+        if isinstance(e, ast.Compare):
+            for a, c in zip(e.operands, e.operands[1:]):
+                for side, other in ((a, c), (c, a)):
+                    k = _shift(side, name)
+                    if k is None:
+                        continue
+                    res = self._results(other, b)
+                    if res is None:
+                        return False
+                    vals.update(v - k for v in res if isinstance(v, (int, float, Fraction)) and not isinstance(v, bool))
+            return all(self._positional(o, name, b, vals) for o in e.operands if _shift(o, name) is None)
+        return all(self._positional(c, name, b, vals) for c in _children(e))
+
+    def quant(self, e: ast.Quant, b: Mapping[str, Any]) -> bool:
+        cached = self._slots.get(id(e))
+        if cached is None:
+            cached = self.slots(e, b)
+            if not any(isinstance(bd.domain, (ast.SetLit, ast.Var)) for bd in e.bindings):
+                self._slots[id(e)] = cached
+        slots, doms = cached
+        if e.kind in ("forall", "exists"):
+            if e.kind == "forall" and isinstance(e.body, ast.Binary) and e.body.op == "->":
+                guards = _conjuncts(e.body.left)
+            elif e.kind == "exists":
+                guards = _conjuncts(e.body)
+            else:
+                guards = []
+            staged = _stage(guards, slots)
+            found = self._search(e, slots, doms, staged, 0, dict(b))
+            return (not found) if e.kind == "forall" else found
+        count = 0
+        for combo in itertools.product(*doms):
+            cur = dict(b)
+            fresh = False
+            for names, values in zip(slots, combo):
+                for n, v in zip(names, values):
+                    fresh = fresh or isinstance(v, _Fresh)
+                    cur[n] = v.value if isinstance(v, _Fresh) else v
+            if self.eval(e.body, cur):
+                if fresh:
+                    return False
+                count += 1
+                if count > 1:
+                    return False
+        return count == 1
+
+    def slots(self, e: ast.Quant, b: Mapping[str, Any]) -> tuple[list[tuple[str, ...]], list[list[tuple[Any, ...]]]]:
+        """The quantifier's variables in enumeration slots and each slot's candidate tuples.
+
+        Variables that occur only together, as the whole argument list of
+        function applications and constructor terms (``at(x, y)``,
+        ``move(x, y)``), form one slot whose candidates are the table keys and
+        term arguments plus one fresh tuple; every other variable is a slot
+        of its own (:meth:`domain`).
+        """
+        bindings = {n: bd for bd in e.bindings for n in bd.names}
+        group = self._joint(e, b, bindings)
+        slots: list[tuple[str, ...]] = []
+        doms: list[list[tuple[Any, ...]]] = []
+        for n in e.variables:
+            if group and n in group[0]:
+                if n == group[0][0]:
+                    slots.append(group[0])
+                    doms.append(group[1])
+                continue
+            slots.append((n,))
+            doms.append([(v,) for v in self.domain(bindings[n], n, e.body, b)])
+        return slots, doms
+
+    def _joint(self, e: ast.Quant, b: Mapping[str, Any],
+               bindings: Mapping[str, ast.Binding]) -> tuple[tuple[str, ...], list[tuple[Any, ...]]] | None:
+        names = set(e.variables)
+        apps: list[ast.Apply] = []
+        _tuple_apps(e.body, names, apps)
+        for first in apps:
+            group = tuple(a.name for a in first.args if isinstance(a, ast.Var))
+            if len(group) < 2 or len(set(group)) != len(group):
+                continue
+            kinds = []
+            for n in group:
+                dom = bindings[n].domain
+                if not (isinstance(dom, ast.TBase) and dom.name in _INFINITE):
+                    break
+                kinds.append(dom.name)
+            else:
+                uses: list[ast.Apply] = []
+                if not _only_as(e.body, group, uses):
+                    continue
+                keys: set[tuple[Any, ...]] = set()
+                for app in uses:
+                    if app.func.prefix is None and app.func.name in self.env.ctors and app.func.name not in b:
+                        keys.update(tuple(t.args) for t in self._terms(app.func.name) if len(t.args) == len(group))
+                        continue
+                    f = self.var(app.func, b)
+                    if not isinstance(f, FiniteFunction):
+                        break
+                    keys.update(f.table)
+                else:
+                    ok = [k for k in keys if all(_fits(v, kind) for v, kind in zip(k, kinds))]
+                    top: set[Any] = set(self.numbers()) | _static_literals(e.body)
+                    fresh = int(max((abs(v) for v in top), default=0)) + 1
+                    cands: list[tuple[Any, ...]] = sorted(ok, key=repr)
+                    cands.append(tuple(_Fresh(fresh) for _ in group))
+                    return group, cands
+        return None
+
+    def _search(self, e: ast.Quant, slots: list[tuple[str, ...]], doms: list[list[tuple[Any, ...]]],
+                staged: list[list[ast.Expr]], depth: int, cur: dict[str, Any]) -> bool:
+        """True when some assignment is a counterexample (forall) or a witness (exists);
+        guards whose variables are all bound are checked as soon as possible."""
+        if depth == len(slots):
+            v = bool(self.eval(e.body, cur))
+            return (not v) if e.kind == "forall" else v
+        names = slots[depth]
+        for values in doms[depth]:
+            for n, value in zip(names, values):
+                cur[n] = value.value if isinstance(value, _Fresh) else value
+            if all(self.eval(g, cur) for g in staged[depth]):
+                if self._search(e, slots, doms, staged, depth + 1, cur):
+                    return True
+        for n in names:
+            cur.pop(n, None)
+        return False
+
+
+def _fits(v: Any, kind: str) -> bool:
+    if isinstance(v, bool) or not isinstance(v, (int, float, Fraction)):
+        return False
+    if kind == "REAL":
+        return True
+    return isinstance(v, int) and (kind == "INTEGER" or v >= 0)
+
+
+def _tuple_apps(e: Any, names: set[str], out: list[ast.Apply]) -> None:
+    """Applications whose arguments are all variables of ``names``."""
+    if isinstance(e, ast.Quant):
+        names = names - set(e.variables)
+    if isinstance(e, ast.Apply) and e.args and all(
+            isinstance(a, ast.Var) and a.prefix is None and a.name in names for a in e.args):
+        out.append(e)
+    for c in _children(e):
+        _tuple_apps(c, names, out)
+
+
+def _only_as(e: Any, group: tuple[str, ...], uses: list[ast.Apply]) -> bool:
+    """True when every occurrence of a ``group`` variable in ``e`` is inside an
+    application whose whole argument list is ``group`` (collected in ``uses``)."""
+    if isinstance(e, ast.Quant) and set(group) & set(e.variables):
+        return False  # a nested binder shadows a group variable: no joint slot
+    if isinstance(e, ast.Apply) and len(e.args) == len(group) and all(
+            isinstance(a, ast.Var) and a.prefix is None and a.name == g for a, g in zip(e.args, group)):
+        uses.append(e)
+        return True
+    if isinstance(e, ast.Var):
+        return not (e.prefix is None and e.name in group)
+    return all(_only_as(c, group, uses) for c in _children(e))
+
+
+class _Fresh:
+    """A value no atom of the body can tell apart from infinitely many others."""
+
+    __slots__ = ("value",)
+
+    def __init__(self, value: Any) -> None:
+        self.value = value

@@ -1,0 +1,29 @@
+"""One observed message and the error a bad trace raises."""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any, Mapping
+
+
+class TraceError(Exception):
+    """A trace that cannot be read; ``str`` is ``file:line: error: ...`` for a
+    log, ``file: message N (offset B): error: ...`` for a bag."""
+
+
+@dataclass(frozen=True)
+class Event:
+    """A message as a monitor sees it.
+
+    ``index``  0-based position in the trace;
+    ``time``   seconds (float) since the epoch or the recording's start;
+    ``topic``  topic name without leading ``/``;
+    ``fields`` the message's fields flattened beside the topic, as
+               ROSMonitoring sends them (``{"posx": 1.0, "id": 3, ...}``);
+    ``where``  where it was read (``log.jsonl:12`` or ``run_bag: message 4``).
+    """
+
+    index: int
+    time: float
+    topic: str
+    fields: Mapping[str, Any]
+    where: str
