@@ -30,6 +30,7 @@ from ...evidence.store import atomic_write_text
 from ...plan.errors import PlanError
 from ...rcl.printer import expr_to_rcl
 from ..base import NodeTarget, Stopwatch, make_evidence
+from .seeding import split_facts
 from .harness import Config, ConfigError, Outcome, load_implementation, read_config, run_guarantee, versions
 
 NAME = "property_tests"
@@ -133,7 +134,7 @@ class PropertyTestsBackend:
                 return evidence("error", "the contract no longer has this guarantee; export again")
             path = test_file(target)
             atomic_write_text(path, render_tests(target, cfg, _is_class(target, cfg)))
-            outcome = run_guarantee(target.checked, target.node, k, cfg, target.root)
+            outcome = run_guarantee(target.checked, target.node, k, cfg, target.root, target.facts)
         except ConfigError as exc:
             return evidence("error", f"{target.config_loc(*exc.path)}: error: {exc}")
         except PlanError as exc:  # the implementation no longer imports
@@ -147,6 +148,12 @@ class PropertyTestsBackend:
             "examples": outcome.counts.as_dict(), "seed": cfg.seed, "max_examples": cfg.max_examples,
             "implementation": cfg.implementation, "deadline_ms": cfg.deadline_ms, "replay": replay,
         }
+        used, unused = split_facts(target.facts, target.node)
+        if used:
+            details["facts"] = [f"{expr_to_rcl(f)} ({_source(target, f.loc)})" for f in used]
+        if unused:
+            details["facts_not_used"] = [f"{expr_to_rcl(f)} ({_source(target, f.loc)}): names an output"
+                                         for f in unused]
         if outcome.unknown_reasons:
             details["unknown_reasons"] = outcome.unknown_reasons
         if outcome.health:

@@ -139,6 +139,7 @@ class InputSpace:
     constants: list[Fraction]
     pools: dict[tuple[Type, ...], list[tuple[Any, ...]]] = field(default_factory=dict)
     cache: dict[tuple[Type, int, bool], st.SearchStrategy[Any]] = field(default_factory=dict)
+    seed: Mapping[str, Any] | None = None  # a Z3 model of the assumption and facts (.seeding)
 
     def real(self, bd: Bound | None, small: bool = False) -> st.SearchStrategy[Any]:
         lo = float(bd.lo) if bd and bd.lo is not None else (-1000.0 if small else None)
@@ -230,13 +231,40 @@ class InputSpace:
         @st.composite
         def draw_inputs(draw: Callable[..., Any]) -> dict[str, Any]:
             self.pools = {}
-            return {f"in.{n}": draw(self.value(t, self.bounds.get(n))) for n, t in self.node.inputs.items()}
+            drawn = {f"in.{n}": draw(self.value(t, self.bounds.get(n))) for n, t in self.node.inputs.items()}
+            if self.seed:
+                for q, base in self.seed.items():
+                    if isinstance(base, FiniteFunction):
+                        drawn[q] = self.vary(draw, base, drawn[q], self.pools.get(self.node.inputs[q[3:]].args, []))  # type: ignore[union-attr]
+            return drawn
         return draw_inputs()
 
+    def vary(self, draw: Callable[..., Any], base: FiniteFunction, drawn: FiniteFunction,
+             pool: list[tuple[Any, ...]]) -> FiniteFunction:
+        """``base`` (a table from a Z3 model of the facts) varied by Hypothesis: each
+        of its keys may move to a point of this example's pool (so other
+        functions over the same domain meet it); the drawn table's entries at
+        other keys are added.  The results, hence the values the table takes,
+        are the model's; the harness's filter checks the facts again."""
+        arity = base.arity
+        table: dict[tuple[Any, ...], Any] = {}
+        for key, res in base.table.items():
+            if pool and draw(_BOOLS):
+                moved = draw(st.sampled_from(pool))
+                if moved not in table and moved not in base.table:
+                    key = moved
+            table[key] = res
+        for key, res in drawn.table.items():
+            table.setdefault(key, res)
+        return FiniteFunction(table, base.default, arity)
 
-def input_space(node: CheckedNode, plan_bounds: Mapping[str, tuple[Fraction | None, Fraction | None]]) -> InputSpace:
+
+def input_space(node: CheckedNode, plan_bounds: Mapping[str, tuple[Fraction | None, Fraction | None]],
+                seed: Mapping[str, Any] | None = None) -> InputSpace:
     """The :class:`InputSpace` of ``node``; ``plan_bounds`` maps input names
-    (without ``in.``) to the plan's ``[lo, hi]`` (closed)."""
+    (without ``in.``) to the plan's ``[lo, hi]`` (closed); ``seed`` maps
+    qualified input names to a Z3 model's values (function-typed ones are
+    varied per example, see :meth:`InputSpace.vary`)."""
     bounds = assumption_bounds(node)
     for name, (lo, hi) in plan_bounds.items():
         bd = bounds.setdefault(name, Bound())
@@ -244,4 +272,4 @@ def input_space(node: CheckedNode, plan_bounds: Mapping[str, tuple[Fraction | No
             bd.lower(lo, False)
         if hi is not None:
             bd.upper(hi, False)
-    return InputSpace(node, bounds, contract_constants(node))
+    return InputSpace(node, bounds, contract_constants(node), seed=seed)
