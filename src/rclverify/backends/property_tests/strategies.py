@@ -34,6 +34,7 @@ SMALL_NAT = 5
 POOL_SIZE = 4
 _POOL_COUNT = st.integers(min_value=1, max_value=POOL_SIZE)
 _BOOLS = st.booleans()
+_MOVE = st.integers(min_value=0, max_value=2)  # keep a seeded key, move it to a pool point, to a new point
 
 
 @dataclass
@@ -140,6 +141,7 @@ class InputSpace:
     pools: dict[tuple[Type, ...], list[tuple[Any, ...]]] = field(default_factory=dict)
     cache: dict[tuple[Type, int, bool], st.SearchStrategy[Any]] = field(default_factory=dict)
     seed: Mapping[str, Any] | None = None  # a Z3 model of the assumption and facts (.seeding)
+    node_arg_types: dict[int, tuple[Type, ...]] = field(default_factory=dict)
 
     def real(self, bd: Bound | None, small: bool = False) -> st.SearchStrategy[Any]:
         lo = float(bd.lo) if bd and bd.lo is not None else (-1000.0 if small else None)
@@ -235,7 +237,10 @@ class InputSpace:
             if self.seed:
                 for q, base in self.seed.items():
                     if isinstance(base, FiniteFunction):
-                        drawn[q] = self.vary(draw, base, drawn[q], self.pools.get(self.node.inputs[q[3:]].args, []))  # type: ignore[union-attr]
+                        t = self.node.inputs[q[3:]]
+                        assert isinstance(t, FuncT)
+                        self.node_arg_types[base.arity] = t.args
+                        drawn[q] = self.vary(draw, base, drawn[q], self.pools.get(t.args, []))
             return drawn
         return draw_inputs()
 
@@ -243,19 +248,23 @@ class InputSpace:
              pool: list[tuple[Any, ...]]) -> FiniteFunction:
         """``base`` (a table from a Z3 model of the facts) varied by Hypothesis: each
         of its keys may move to a point of this example's pool (so other
-        functions over the same domain meet it); the drawn table's entries at
-        other keys are added.  The results, hence the values the table takes,
-        are the model's; the harness's filter checks the facts again."""
+        functions over the same domain meet it) or to a new point; the drawn
+        table's entries are added, each at a seeded key possibly overriding
+        the model's result.  The harness's filter checks the facts again."""
         arity = base.arity
+        args = self.node_arg_types.get(arity)
         table: dict[tuple[Any, ...], Any] = {}
         for key, res in base.table.items():
-            if pool and draw(_BOOLS):
+            choice = draw(_MOVE)
+            moved = key
+            if choice == 1 and pool:
                 moved = draw(st.sampled_from(pool))
-                if moved not in table and moved not in base.table:
-                    key = moved
-            table[key] = res
+            elif choice == 2 and args is not None:
+                moved = draw(st.tuples(*[self.value(a) for a in args]))
+            table[moved if moved not in table and moved not in base.table else key] = res
         for key, res in drawn.table.items():
-            table.setdefault(key, res)
+            if key not in table or draw(_BOOLS):
+                table[key] = res
         return FiniteFunction(table, base.default, arity)
 
 
