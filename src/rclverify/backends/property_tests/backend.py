@@ -72,11 +72,14 @@ def render_tests(target: NodeTarget, cfg: Config, stateful: bool) -> str:
     guarantees = [dict(index=k, source=str(_source(target, g.loc)), text=expr_to_rcl(g.formula))
                   for k, g in enumerate(node.node.guarantees, 1)]
     assumes = [dict(text=expr_to_rcl(a.formula), source=str(_source(target, a.loc))) for a in node.node.assumes]
+    used, unused = split_facts(target.facts, node)
     return _templates().get_template("test_node.py.j2").render(
         node=node.name, implementation=cfg.implementation, plan_file=target.plan_file, entry=target.index,
         seed=cfg.seed, max_examples=cfg.max_examples, steps=cfg.steps, stateful=stateful,
         inputs=[(n, str(t)) for n, t in node.inputs.items()], outputs=[(n, str(t)) for n, t in node.outputs.items()],
-        assumes=assumes, guarantees=guarantees, artifact=target.rel(test_file(target)))
+        assumes=assumes, guarantees=guarantees, artifact=target.rel(test_file(target)),
+        facts=[dict(text=expr_to_rcl(f), source=str(_source(target, f.loc))) for f in used],
+        facts_not_used=[dict(text=expr_to_rcl(f), source=str(_source(target, f.loc))) for f in unused])
 
 
 def _is_class(target: NodeTarget, cfg: Config) -> bool:
