@@ -133,3 +133,17 @@ def test_same_seed_same_examples_under_facts(tmp_path: Path) -> None:
         run.run()
         runs.append(seen)
     assert [repr(sorted(x.items())) for x in runs[0]] == [repr(sorted(x.items())) for x in runs[1]]
+
+
+def test_z3_model_does_not_depend_on_earlier_z3_work(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    import z3
+    target = Workspace(workspace(tmp_path)).target("Lookup", 0)
+    formulas = tuple(seeding.split_facts(target.facts, target.node)[0])
+    monkeypatch.setattr(seeding, "_BASE", {})
+    first = seeding.Seeder(target.checked, target.node, formulas).base()
+    s = z3.Solver()
+    k = z3.Int("k")
+    s.add(k * k > 17, k < 100)
+    assert s.check() == z3.sat
+    monkeypatch.setattr(seeding, "_BASE", {})
+    assert first is not None and seeding.Seeder(target.checked, target.node, formulas).base() == first

@@ -6,42 +6,41 @@ The plan's environment facts (``environment: <Node>: facts:``) say what the
 environment is known to satisfy, e.g. for the Agent that the scenario has
 the waypoints 0..12 (paper lines 990, 1420-1445).  Filtering draws by such a
 fact starves: an existence fact ("every k <= 12 has a waypoint") almost never
-holds on a random finite table.  So a drawn example that breaks the
-assumption or a fact is *repaired*:
+holds on a random finite table.  So inputs are built from a Z3 model:
 
-* every function-typed input becomes a finite table skeleton: the drawn
-  table's keys (fixed) plus ``extra`` further keys whose argument values are
-  Z3 unknowns, each with an unknown result, plus an unknown default; the
-  skeleton (``ite`` over the keys) replaces the function symbol in the
-  assumption and the facts, as :func:`rclverify.logic.concrete.finite_interpretation`
-  does for a concrete table;
-* the draw becomes *hints*: every drawn scalar value, every drawn table
-  result and default, and Hypothesis-drawn values for the extra keys, each a
-  tracked Z3 assumption; hints in an unsat core are dropped until the rest
-  is satisfiable (so the model keeps as much of the draw as the formulas
-  allow, and Hypothesis still varies and shrinks the example);
-* the model becomes the example's values.  ``extra`` is the smallest of
-  0, 1, 2, 4, ..., 64 for which the formulas are satisfiable at all, found
-  once per node.
+* :meth:`Seeder.base`: every function-typed input the formulas (assumption
+  plus usable facts) mention becomes a table of ``n`` entries at fixed
+  distinct keys ``(0, 0), (1, 1), ...`` with unknown results and an unknown
+  default; the table (``ite`` over the keys, as
+  :func:`rclverify.logic.concrete.finite_interpretation` builds for a
+  concrete table) replaces the function symbol; Z3 (tactics ``simplify``,
+  ``qe``, ``smt``) finds the results.  ``n`` is the first of
+  :data:`EXTRA_SIZES` with a model.  Computed once per node and process, in
+  a fresh Z3 context fed the formulas' SMT-LIB text, so the model does not
+  depend on what the process asked Z3 before (same seed, same evidence, also
+  in the generated pytest file run alone);
+* :meth:`rclverify.backends.property_tests.strategies.InputSpace.vary`: per
+  example, Hypothesis varies the model's tables (keys moved, drawn entries
+  added or overriding).
 
-Every repaired example is then checked again by
+Every example is then checked by
 :func:`~rclverify.logic.concrete.check_concrete` (the harness's filter), so
 the encoding here never decides validity on its own.  Facts that name an
 output cannot constrain inputs and are not used for drawing (reported).
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from fractions import Fraction
-from typing import Any, Mapping
+from typing import Any
 
 import z3
 
 from ...logic.concrete import to_z3
-from ...logic.encode import Encoder, EncodingError, sort_of, widen
+from ...logic.encode import Encoder, EncodingError, sort_of
 from ...rcl import ast
 from ...rcl.types import Checked, CheckedNode, DataT, EnumT, FuncT, Scalar, Type
-from ...values import FiniteFunction, Term, conforms
+from ...values import FiniteFunction, Term
 
 EXTRA_SIZES = (0, 1, 2, 4, 8, 16, 32, 64)
 SOLVER_TIMEOUT_MS = 2000
@@ -145,25 +144,39 @@ class Seeder:
                 readback[q] = (t, None, decl, None)
         if funcs:
             phi = z3.substitute_funs(phi, *funcs)
-        s = z3.Then("simplify", "qe", "smt").solver()
+        # A fresh Z3 context: the model depends only on these formulas, not on
+        # what else this process asked Z3 before (the generated pytest file
+        # runs alone and must see the same examples as the backend).
+        ctx = z3.Context()
+        s = z3.Then("simplify", "qe", "smt", ctx=ctx).solver()
         s.set("timeout", SOLVER_TIMEOUT_MS)
-        s.add(phi, *side)
+        text = z3.Solver()
+        text.add(phi, *side)
+        s.add(z3.parse_smt2_string(text.to_smt2(), ctx=ctx))  # by its text: no state carried over
         if s.check() != z3.sat:
             return None
         m = s.model()
+        by_name = {d.name(): d for d in m.decls()}
+
+        def value(x: z3.ExprRef, t: Type) -> Any:
+            d = by_name.get(x.decl().name())
+            v = m[d] if d is not None else None
+            if v is None:  # not in the model: any value will do; take the sort's first
+                v = m.eval(z3.FreshConst(x.sort().translate(ctx)), model_completion=True)
+            return _from_z3(v, t)
         out: dict[str, Any] = {}
         for q, (t, keys, vals, d) in readback.items():
             if keys is None:
-                out[q] = _from_z3(m.eval(vals, model_completion=True), t)
+                out[q] = value(vals, t)
             else:
-                table = {k: _from_z3(m.eval(v, model_completion=True), t.result) for k, v in zip(keys, vals)}
-                out[q] = FiniteFunction(table, _from_z3(m.eval(d, model_completion=True), t.result), len(t.args))
+                table = {k: value(v, t.result) for k, v in zip(keys, vals)}
+                out[q] = FiniteFunction(table, value(d, t.result), len(t.args))
         return out
 
     def base(self) -> dict[str, Any] | None:
         """A model of the formulas with the fewest table entries in :data:`EXTRA_SIZES`
         (cached per node and formulas; ``None``: none found)."""
-        key = (self.node.name, tuple(id(f) for f in self.formulas), tuple(map(str, self.formulas)))
+        key = (self.node.name, tuple(map(str, self.formulas)))
         if key not in _BASE:
             found = None
             for n in EXTRA_SIZES:
