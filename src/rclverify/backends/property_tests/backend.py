@@ -30,6 +30,7 @@ from ...evidence.store import atomic_write_text
 from ...plan.errors import PlanError
 from ...rcl.printer import expr_to_rcl
 from ..base import NodeTarget, Stopwatch, make_evidence
+from .seeding import split_facts
 from .harness import Config, ConfigError, Outcome, load_implementation, read_config, run_guarantee, versions
 
 NAME = "property_tests"
@@ -71,11 +72,14 @@ def render_tests(target: NodeTarget, cfg: Config, stateful: bool) -> str:
     guarantees = [dict(index=k, source=str(_source(target, g.loc)), text=expr_to_rcl(g.formula))
                   for k, g in enumerate(node.node.guarantees, 1)]
     assumes = [dict(text=expr_to_rcl(a.formula), source=str(_source(target, a.loc))) for a in node.node.assumes]
+    used, unused = split_facts(target.facts, node)
     return _templates().get_template("test_node.py.j2").render(
         node=node.name, implementation=cfg.implementation, plan_file=target.plan_file, entry=target.index,
         seed=cfg.seed, max_examples=cfg.max_examples, steps=cfg.steps, stateful=stateful,
         inputs=[(n, str(t)) for n, t in node.inputs.items()], outputs=[(n, str(t)) for n, t in node.outputs.items()],
-        assumes=assumes, guarantees=guarantees, artifact=target.rel(test_file(target)))
+        assumes=assumes, guarantees=guarantees, artifact=target.rel(test_file(target)),
+        facts=[dict(text=expr_to_rcl(f), source=str(_source(target, f.loc))) for f in used],
+        facts_not_used=[dict(text=expr_to_rcl(f), source=str(_source(target, f.loc))) for f in unused])
 
 
 def _is_class(target: NodeTarget, cfg: Config) -> bool:
@@ -133,7 +137,7 @@ class PropertyTestsBackend:
                 return evidence("error", "the contract no longer has this guarantee; export again")
             path = test_file(target)
             atomic_write_text(path, render_tests(target, cfg, _is_class(target, cfg)))
-            outcome = run_guarantee(target.checked, target.node, k, cfg, target.root)
+            outcome = run_guarantee(target.checked, target.node, k, cfg, target.root, target.facts)
         except ConfigError as exc:
             return evidence("error", f"{target.config_loc(*exc.path)}: error: {exc}")
         except PlanError as exc:  # the implementation no longer imports
@@ -147,6 +151,12 @@ class PropertyTestsBackend:
             "examples": outcome.counts.as_dict(), "seed": cfg.seed, "max_examples": cfg.max_examples,
             "implementation": cfg.implementation, "deadline_ms": cfg.deadline_ms, "replay": replay,
         }
+        used, unused = split_facts(target.facts, target.node)
+        if used:
+            details["facts"] = [f"{expr_to_rcl(f)} ({_source(target, f.loc)})" for f in used]
+        if unused:
+            details["facts_not_used"] = [f"{expr_to_rcl(f)} ({_source(target, f.loc)}): names an output"
+                                         for f in unused]
         if outcome.unknown_reasons:
             details["unknown_reasons"] = outcome.unknown_reasons
         if outcome.health:

@@ -36,6 +36,7 @@ from ...rcl import ast
 from ...rcl.printer import expr_to_rcl
 from ...rcl.types import Checked, CheckedNode
 from ...values import conforms, render
+from .seeding import Seeder, split_facts
 from .strategies import conjuncts, input_space
 
 DEFAULT_MAX_EXAMPLES = 200
@@ -132,6 +133,7 @@ class Counts:
     drawn: int = 0
     valid: int = 0
     rejected: int = 0
+    rejected_by_facts: int = 0
     assumption_unknown: int = 0
     failures: int = 0
     inconclusive: int = 0
@@ -139,6 +141,7 @@ class Counts:
 
     def as_dict(self) -> dict[str, int]:
         return {"run": self.drawn, "valid": self.valid, "rejected": self.rejected,
+                "rejected_by_facts": self.rejected_by_facts,
                 "assumption_unknown": self.assumption_unknown, "failures": self.failures,
                 "inconclusive": self.inconclusive, "steps_checked": self.steps}
 
@@ -183,6 +186,7 @@ class GuaranteeRun:
     guarantee: int
     cfg: Config
     impl: Any
+    facts: tuple[ast.Expr, ...] = ()  # the plan's environment facts of the node (docs/property-tests.md)
     stop_at_failure: bool = True  # False: count violations and go on (benchmarks); no shrinking then
     counts: Counts = field(default_factory=Counts)
     last_failure: dict[str, str] | None = None
@@ -202,10 +206,32 @@ class GuaranteeRun:
             if ok is not True:
                 self.counts.rejected += 1
                 return False
+        for fact in self.used_facts:
+            ok, why = check_concrete(fact, self.checked, self.node, values, timeout_ms=Z3_TIMEOUT_MS)
+            if ok is None:
+                self.counts.assumption_unknown += 1
+                self.unknown.add(f"fact: {why}")
+            if ok is not True:
+                self.counts.rejected += 1
+                self.counts.rejected_by_facts += 1
+                return False
         return True
 
+    @property
+    def used_facts(self) -> tuple[ast.Expr, ...]:
+        """The facts inputs are drawn under: those naming no output."""
+        return split_facts(self.facts, self.node)[0]
+
+    def facts_text(self) -> str:
+        """The facts as RCL text with their plan locations ("" when there are none)."""
+        return "; ".join(f"{expr_to_rcl(f)} ({_source(f.loc)})" for f in self.used_facts)
+
     def strategy(self) -> st.SearchStrategy[Any]:
-        one = input_space(self.node, self.cfg.bounds).inputs().filter(self.assumption_holds)
+        seed = None
+        if self.used_facts:
+            formulas = tuple(c.formula for c in self.node.node.assumes) + self.used_facts
+            seed = Seeder(self.checked, self.node, formulas).base()
+        one = input_space(self.node, self.cfg.bounds, seed).inputs().filter(self.assumption_holds)
         if self.stateful:
             return st.lists(one, min_size=1, max_size=self.cfg.steps)
         return one
@@ -223,6 +249,8 @@ class GuaranteeRun:
             cex["conjunct"] = expr_to_rcl(conjunct)
         if step is not None:
             cex["step"] = str(step)
+        if self.used_facts:
+            cex["facts"] = f"{self.facts_text()}: all hold on these inputs (checked by Z3)"
         cex["reason"] = reason
         self.last_failure = cex
         if self.stop_at_failure:
@@ -291,7 +319,8 @@ class GuaranteeRun:
                            self.counts, self.last_failure, sorted(self.unknown))
         except (FailedHealthCheck, Unsatisfiable) as exc:
             kind = "filter_too_much" if isinstance(exc, FailedHealthCheck) else "unsatisfiable"
-            msg = (f"the assumption of {self.node.name}, {_assumption_text(self.node)}, rejected "
+            facts = f" with the environment facts {self.facts_text()}" if self.used_facts else ""
+            msg = (f"the assumption of {self.node.name}, {_assumption_text(self.node)}{facts}, rejected "
                    f"{self.counts.rejected} of {self.counts.drawn} drawn inputs ({kind}): filtering cannot find "
                    f"inputs that satisfy it; give bounds for its inputs in the plan (bounds: {{in.x: [lo, hi]}})")
             return Outcome("error", msg, self.counts, None, sorted(self.unknown), health=kind)
@@ -313,13 +342,15 @@ def _example_text(cex: Mapping[str, str]) -> str:
     return ", ".join(f"{k} = {v}" for k, v in cex.items() if k.startswith(("in.", "out.", "step")))
 
 
-def run_guarantee(checked: Checked, node: CheckedNode, guarantee: int, cfg: Config, root: Path) -> Outcome:
-    """Load the implementation and run guarantee ``guarantee`` (1-based) of ``node``.
+def run_guarantee(checked: Checked, node: CheckedNode, guarantee: int, cfg: Config, root: Path,
+                  facts: tuple[ast.Expr, ...] = ()) -> Outcome:
+    """Load the implementation and run guarantee ``guarantee`` (1-based) of ``node``,
+    inputs drawn under the assumption and the environment ``facts`` (parsed plan facts).
 
     Raises :class:`ConfigError` for an implementation that cannot be loaded.
     """
     impl = load_implementation(root, cfg)
-    return GuaranteeRun(checked, node, guarantee, cfg, impl).run()
+    return GuaranteeRun(checked, node, guarantee, cfg, impl, facts).run()
 
 
 def versions() -> str:
@@ -334,4 +365,4 @@ def check_from_workspace(root: Path, plan_file: str, node: str, entry: int, guar
     ws = Workspace(root, plan_file)
     target = ws.target(node, entry)
     cfg = read_config(target.config, target.node, target.root)
-    return run_guarantee(target.checked, target.node, guarantee, cfg, target.root)
+    return run_guarantee(target.checked, target.node, guarantee, cfg, target.root, target.facts)

@@ -34,6 +34,7 @@ SMALL_NAT = 5
 POOL_SIZE = 4
 _POOL_COUNT = st.integers(min_value=1, max_value=POOL_SIZE)
 _BOOLS = st.booleans()
+_MOVE = st.integers(min_value=0, max_value=2)  # keep a seeded key, move it to a pool point, to a new point
 
 
 @dataclass
@@ -139,6 +140,8 @@ class InputSpace:
     constants: list[Fraction]
     pools: dict[tuple[Type, ...], list[tuple[Any, ...]]] = field(default_factory=dict)
     cache: dict[tuple[Type, int, bool], st.SearchStrategy[Any]] = field(default_factory=dict)
+    seed: Mapping[str, Any] | None = None  # a Z3 model of the assumption and facts (.seeding)
+    node_arg_types: dict[int, tuple[Type, ...]] = field(default_factory=dict)
 
     def real(self, bd: Bound | None, small: bool = False) -> st.SearchStrategy[Any]:
         lo = float(bd.lo) if bd and bd.lo is not None else (-1000.0 if small else None)
@@ -230,13 +233,47 @@ class InputSpace:
         @st.composite
         def draw_inputs(draw: Callable[..., Any]) -> dict[str, Any]:
             self.pools = {}
-            return {f"in.{n}": draw(self.value(t, self.bounds.get(n))) for n, t in self.node.inputs.items()}
+            drawn = {f"in.{n}": draw(self.value(t, self.bounds.get(n))) for n, t in self.node.inputs.items()}
+            if self.seed:
+                for q, base in self.seed.items():
+                    if isinstance(base, FiniteFunction):
+                        t = self.node.inputs[q[3:]]
+                        assert isinstance(t, FuncT)
+                        self.node_arg_types[base.arity] = t.args
+                        drawn[q] = self.vary(draw, base, drawn[q], self.pools.get(t.args, []))
+            return drawn
         return draw_inputs()
 
+    def vary(self, draw: Callable[..., Any], base: FiniteFunction, drawn: FiniteFunction,
+             pool: list[tuple[Any, ...]]) -> FiniteFunction:
+        """``base`` (a table from a Z3 model of the facts) varied by Hypothesis: each
+        of its keys may move to a point of this example's pool (so other
+        functions over the same domain meet it) or to a new point; the drawn
+        table's entries are added, each at a seeded key possibly overriding
+        the model's result.  The harness's filter checks the facts again."""
+        arity = base.arity
+        args = self.node_arg_types.get(arity)
+        table: dict[tuple[Any, ...], Any] = {}
+        for key, res in base.table.items():
+            choice = draw(_MOVE)
+            moved = key
+            if choice == 1 and pool:
+                moved = draw(st.sampled_from(pool))
+            elif choice == 2 and args is not None:
+                moved = draw(st.tuples(*[self.value(a) for a in args]))
+            table[moved if moved not in table and moved not in base.table else key] = res
+        for key, res in drawn.table.items():
+            if key not in table or draw(_BOOLS):
+                table[key] = res
+        return FiniteFunction(table, base.default, arity)
 
-def input_space(node: CheckedNode, plan_bounds: Mapping[str, tuple[Fraction | None, Fraction | None]]) -> InputSpace:
+
+def input_space(node: CheckedNode, plan_bounds: Mapping[str, tuple[Fraction | None, Fraction | None]],
+                seed: Mapping[str, Any] | None = None) -> InputSpace:
     """The :class:`InputSpace` of ``node``; ``plan_bounds`` maps input names
-    (without ``in.``) to the plan's ``[lo, hi]`` (closed)."""
+    (without ``in.``) to the plan's ``[lo, hi]`` (closed); ``seed`` maps
+    qualified input names to a Z3 model's values (function-typed ones are
+    varied per example, see :meth:`InputSpace.vary`)."""
     bounds = assumption_bounds(node)
     for name, (lo, hi) in plan_bounds.items():
         bd = bounds.setdefault(name, Bound())
@@ -244,4 +281,4 @@ def input_space(node: CheckedNode, plan_bounds: Mapping[str, tuple[Fraction | No
             bd.lower(lo, False)
         if hi is not None:
             bd.upper(hi, False)
-    return InputSpace(node, bounds, contract_constants(node))
+    return InputSpace(node, bounds, contract_constants(node), seed=seed)
