@@ -17,6 +17,7 @@ is an error asking for an explicit connection in the plan.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 from typing import Any, Iterable, Sequence
 
 from ..plan.load import Connection
@@ -52,17 +53,33 @@ class SystemModel:
     env_inputs: tuple[tuple[str, str, str], ...]
     loops: tuple[tuple[str, ...], ...]
 
+    @cached_property
+    def _index(self) -> dict[str, tuple[list[str], list[str], set[str]]]:
+        """Per node: (producers, consumers, internal inputs), built once in
+        O(links) so that the per-node queries below do not scan every link
+        (with them a 1000-node system's calculus was quadratic in the links)."""
+        order = {n: k for k, n in enumerate(self.nodes)}
+        prod: dict[str, set[str]] = {n: set() for n in self.nodes}
+        cons: dict[str, set[str]] = {n: set() for n in self.nodes}
+        ins: dict[str, set[str]] = {n: set() for n in self.nodes}
+        for l in self.links:
+            prod.setdefault(l.to_node, set()).add(l.from_node)
+            cons.setdefault(l.from_node, set()).add(l.to_node)
+            ins.setdefault(l.to_node, set()).add(l.to_var)
+
+        def ordered(names: set[str]) -> list[str]:
+            return sorted((n for n in names if n in order), key=order.__getitem__)
+        return {n: (ordered(prod[n]), ordered(cons.get(n, set())), ins[n]) for n in prod}
+
     def producers(self, node: str) -> list[str]:
         """Nodes feeding ``node``, in source order, without repeats."""
-        ps = {l.from_node for l in self.links if l.to_node == node}
-        return [n for n in self.nodes if n in ps]
+        return list(self._index[node][0]) if node in self._index else []
 
     def consumers(self, node: str) -> list[str]:
-        cs = {l.to_node for l in self.links if l.from_node == node}
-        return [n for n in self.nodes if n in cs]
+        return list(self._index[node][1]) if node in self._index else []
 
     def internal_inputs(self, node: str) -> set[str]:
-        return {l.to_var for l in self.links if l.to_node == node}
+        return set(self._index[node][2]) if node in self._index else set()
 
     def loop_of(self, node: str) -> tuple[str, ...] | None:
         for loop in self.loops:
