@@ -10,7 +10,8 @@ fresh ``python -m doit`` process:
 
 plus the peak resident memory of each run (the largest ``ru_maxrss`` of the
 doit process and its children, from ``resource.getrusage(RUSAGE_CHILDREN)``
-in an intermediate process) and the numbers of nodes, obligations and side
+in an intermediate process), the CPU seconds (user + system) of the run
+and the numbers of nodes, obligations and side
 conditions.  Wall-clock seconds; on a shared machine expect +-25%.
 
 The synthetic system (see :func:`topology`): node ``N<k>`` produces ``v<k>``
@@ -133,6 +134,7 @@ def generate(root: Path, n: int, property_tests: bool) -> None:
 @dataclass
 class Run:
     seconds: float
+    cpu: float
     peak_mb: float
     ran: list[str]
     rc: int
@@ -142,7 +144,9 @@ class Run:
 PROBE = ("import resource, subprocess, sys, json\n"
          "r = subprocess.run(sys.argv[1:], capture_output=True, text=True)\n"
          "print(json.dumps({'rc': r.returncode, 'out': r.stdout + r.stderr,"
-         " 'maxrss_kb': resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss}))\n")
+          'maxrss_kb': resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss,"
+         " 'cpu': resource.getrusage(resource.RUSAGE_CHILDREN).ru_utime"
+         " + resource.getrusage(resource.RUSAGE_CHILDREN).ru_stime}))\n")
 
 
 def doit_verify(root: Path, jobs: int) -> Run:
@@ -153,7 +157,7 @@ def doit_verify(root: Path, jobs: int) -> Run:
     seconds = time.perf_counter() - t0
     res = json.loads(p.stdout)
     ran = [line[3:] for line in res["out"].splitlines() if line.startswith(".  ")]
-    return Run(seconds, res["maxrss_kb"] / 1024, ran, res["rc"], res["out"])
+    return Run(seconds, res["cpu"], res["maxrss_kb"] / 1024, ran, res["rc"], res["out"])
 
 
 def summarise(ran: list[str]) -> str:
@@ -210,8 +214,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     print(f"pipeline scale: doit{' -n ' + str(args.jobs) if args.jobs > 1 else ''} verify, "
           f"{os.cpu_count()} CPU(s); obligations: hoare"
           + (", property_tests" if pt else " (property_tests skipped: backend not implemented in this tree)"))
-    header = (f"{'nodes':>6} {'oblig.':>7} {'side c.':>7} {'cold s':>8} {'MB':>6} {'no-op s':>8} {'ran':>4} "
-              f"{'edit s':>7} {'MB':>6}  tasks run after the edit")
+    header = (f"{'nodes':>6} {'oblig.':>7} {'side c.':>7} {'cold s':>7} {'(cpu)':>7} {'MB':>5} {'no-op s':>7} "
+              f"{'(cpu)':>6} {'ran':>3} {'edit s':>6} {'(cpu)':>6} {'MB':>5}  tasks run after the edit")
     print(header)
     print("-" * len(header))
     try:
@@ -229,13 +233,14 @@ def main(argv: Sequence[str] | None = None) -> int:
             edited = edit_one(root, n)
             edit = doit_verify(root, args.jobs)
             ran = summarise([t for t in edit.ran if t != "verify"])
-            print(f"{n:>6} {nob:>7} {nsc:>7} {cold.seconds:>8.1f} {cold.peak_mb:>6.0f} {noop.seconds:>8.2f} "
-                  f"{len(noop.ran):>4} {edit.seconds:>7.2f} {edit.peak_mb:>6.0f}  ({edited}) {ran}", flush=True)
+            print(f"{n:>6} {nob:>7} {nsc:>7} {cold.seconds:>7.1f} {cold.cpu:>7.1f} {cold.peak_mb:>5.0f} "
+                  f"{noop.seconds:>7.2f} {noop.cpu:>6.2f} {len(noop.ran):>3} {edit.seconds:>6.2f} {edit.cpu:>6.2f} "
+                  f"{edit.peak_mb:>5.0f}  ({edited}) {ran}", flush=True)
     finally:
         if not args.keep:
             shutil.rmtree(base, ignore_errors=True)
-    print("cold/no-op/edit: wall-clock seconds of one `doit verify`; MB: peak RSS of the largest process; "
-          "ran: tasks the no-op run executed (0 expected).")
+    print("cold/no-op/edit: wall-clock seconds of one `doit verify`; (cpu): CPU seconds (user+sys) of doit and its "
+          "children; MB: peak RSS of the largest process; ran: tasks the no-op run executed (0 expected).")
     return 0
 
 

@@ -33,6 +33,7 @@ from doit import create_after as _create_after
 from doit.exceptions import TaskFailed
 from doit.tools import config_changed
 
+from . import wscache
 from .pipeline import Workspace
 from .rcl.errors import RclError
 from .system.model import SystemModel
@@ -180,6 +181,7 @@ def build_tasks(root: str | Path, plan_file: str = "contracts/plan.yaml") -> dic
     rootp = Path(root).resolve()
     r = str(rootp)
     ws = Workspace(rootp, plan_file)
+    restored = wscache.restore(ws)  # the loaded workspace of an earlier run, when no input changed
     try:
         nodes = ws.node_names()
         model = ws.model
@@ -188,6 +190,8 @@ def build_tasks(root: str | Path, plan_file: str = "contracts/plan.yaml") -> dic
         nodes, model, ok = [], None, False
     if ok:
         _WORKSPACES[r] = ws
+        if not restored:
+            wscache.save(ws)
     else:
         _WORKSPACES.pop(r, None)
     try:

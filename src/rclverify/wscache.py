@@ -1,0 +1,92 @@
+"""A cache of a workspace's loaded plan, checked contracts and system model.
+
+Every ``doit`` run starts by loading the workspace (:func:`rclverify.tasks.build_tasks`
+needs the node names, the plan's evidence entries and the system model to
+define the tasks).  For a system of 1000 nodes that is about 3 s of YAML
+reading, parsing and type checking -- the whole budget of a no-op run.  The
+result is therefore kept in ``artifacts/cache/workspace.pickle`` and reused
+when nothing it was computed from changed:
+
+* the sha256 of the plan file and of every contract file it lists,
+* the workspace's absolute path and the plan's path,
+* the rclverify code (name, size and modification time of every file of the
+  package) and the Python version.
+
+Anything else (a changed file, a damaged or missing cache, another version)
+means a normal load.  Only workspaces that load without error are cached, so
+an error is always reported from the files themselves.  The cache is written
+atomically and is a pure speed-up: deleting ``artifacts/cache`` is always
+safe.  Like ``dodo.py`` it is trusted code of the workspace (pickle).
+"""
+from __future__ import annotations
+
+import hashlib
+import os
+import pickle
+import sys
+import tempfile
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    from .pipeline import Workspace
+
+CACHE = "artifacts/cache/workspace.pickle"
+_FORMAT = 1
+
+
+def _sha(path: Path) -> str:
+    try:
+        return hashlib.sha256(path.read_bytes()).hexdigest()
+    except OSError:
+        return "-"
+
+
+def _code_stamp() -> str:
+    """Changes whenever a file of the installed rclverify package changes."""
+    pkg = Path(__file__).resolve().parent
+    h = hashlib.sha256(f"{_FORMAT} {sys.version}".encode())
+    for p in sorted(pkg.rglob("*")):
+        if p.suffix in (".py", ".lark", ".json", ".j2"):
+            st = p.stat()
+            h.update(f"{p.relative_to(pkg)} {st.st_size} {st.st_mtime_ns}\n".encode())
+    return h.hexdigest()
+
+
+def _header(ws: "Workspace", contracts: tuple[str, ...]) -> dict[str, Any]:
+    return {"root": str(ws.root.resolve()), "plan_file": ws.plan_file, "code": _code_stamp(),
+            "plan": _sha(ws.root / ws.plan_file), "contracts": {c: _sha(ws.root / c) for c in contracts}}
+
+
+def restore(ws: "Workspace") -> bool:
+    """Fill ``ws``'s plan, checked contracts and model from the cache when it
+    is valid for the files on disk.  Returns whether it did; never raises."""
+    try:
+        with open(ws.root / CACHE, "rb") as fh:
+            header = pickle.load(fh)
+            if not isinstance(header, dict) or header != _header(ws, tuple(header.get("contracts", ()))):
+                return False
+            plan, checked, model = pickle.load(fh)
+    except Exception:  # a missing, damaged or foreign cache is simply not used
+        return False
+    ws.__dict__.update(plan=plan, checked=checked, model=model)  # the cached_property slots
+    return True
+
+
+def save(ws: "Workspace") -> None:
+    """Write the cache for a workspace whose model loaded without error.
+    Never raises (a cache that cannot be written is not written)."""
+    path = ws.root / CACHE
+    try:
+        header = _header(ws, tuple(ws.plan.contracts))
+        path.parent.mkdir(parents=True, exist_ok=True)
+        fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=".workspace.", suffix=".tmp")
+        with os.fdopen(fd, "wb") as fh:
+            pickle.dump(header, fh, protocol=pickle.HIGHEST_PROTOCOL)
+            pickle.dump((ws.plan, ws.checked, ws.model), fh, protocol=pickle.HIGHEST_PROTOCOL)
+        os.replace(tmp, path)
+    except Exception:
+        try:
+            os.unlink(tmp)
+        except (OSError, UnboundLocalError):
+            pass
