@@ -143,10 +143,9 @@ class Run:
 
 PROBE = ("import resource, subprocess, sys, json\n"
          "r = subprocess.run(sys.argv[1:], capture_output=True, text=True)\n"
+         "u = resource.getrusage(resource.RUSAGE_CHILDREN)\n"
          "print(json.dumps({'rc': r.returncode, 'out': r.stdout + r.stderr,"
-          'maxrss_kb': resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss,"
-         " 'cpu': resource.getrusage(resource.RUSAGE_CHILDREN).ru_utime"
-         " + resource.getrusage(resource.RUSAGE_CHILDREN).ru_stime}))\n")
+         " 'maxrss_kb': u.ru_maxrss, 'cpu': u.ru_utime + u.ru_stime}))\n")
 
 
 def doit_verify(root: Path, jobs: int) -> Run:
