@@ -18,6 +18,7 @@ mistake prints ``file:line:col: error: message`` lines, never a traceback.
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 from pathlib import Path
 from typing import Callable, Sequence
@@ -157,7 +158,18 @@ def cmd_verify(args: argparse.Namespace) -> int:
     argv = ["verify"] + (["--strict"] if args.strict else [])
     if args.jobs > 1:
         argv = ["-n", str(args.jobs)] + argv
-    return int(DoitMain(ModuleTaskLoader(module)).run(argv))
+    if not args.cluster:
+        return int(DoitMain(ModuleTaskLoader(module)).run(argv))
+    from .cluster import CLUSTER_ENV  # read by the evidence tasks, also in doit's worker processes
+    before = os.environ.get(CLUSTER_ENV)
+    os.environ[CLUSTER_ENV] = args.cluster
+    try:
+        return int(DoitMain(ModuleTaskLoader(module)).run(argv))
+    finally:
+        if before is None:
+            del os.environ[CLUSTER_ENV]
+        else:
+            os.environ[CLUSTER_ENV] = before
 
 
 def cmd_refines(args: argparse.Namespace) -> int:
@@ -190,6 +202,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     v.add_argument("--strict", action="store_true",
                    help="exit 1 unless every obligation, side condition and health check holds")
     v.add_argument("-n", "--jobs", type=int, default=1, help="parallel doit processes")
+    v.add_argument("--cluster", metavar="ADDRESS",
+                   help="send backend jobs to the Dask scheduler at ADDRESS (e.g. tcp://127.0.0.1:8786); "
+                        "default: run them locally")
     r = add("refines", cmd_refines, "check with Z3 that contract B may replace contract A")
     r.add_argument("original", help="FILE.rcl:Node of the contract to replace")
     r.add_argument("replacement", help="FILE.rcl:Node of the replacement contract")

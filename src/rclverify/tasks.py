@@ -108,11 +108,18 @@ def act_node(root: str, stage: str, node: str) -> Any:
 
 
 def act_run(root: str, node: str, obligation_id: str) -> Any:
+    from . import cluster
     from .pipeline import stage_run
+    addr = cluster.address()  # RCLVERIFY_CLUSTER: the backend job runs on that Dask cluster
     try:
-        ev = stage_run(_ws(root), node, obligation_id)
+        if addr is None:
+            ev = stage_run(_ws(root), node, obligation_id)
+        else:
+            ev = cluster.run_on_cluster(addr, _ws(root), node, obligation_id)
     except RclError as exc:
         return _fail(exc)
+    except cluster.ClusterError as exc:
+        return TaskFailed(f"error: {exc}")
     print(f"{ev.obligation}: {ev.status}")
     return None
 
