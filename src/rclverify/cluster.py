@@ -90,7 +90,7 @@ def _client(addr: str) -> Any:
     if client is None:
         from dask.distributed import Client
         try:
-            client = Client(addr, timeout=CONNECT_TIMEOUT_S, set_as_default=False)
+            client = Client(addr, timeout=CONNECT_TIMEOUT_S, set_as_default=False)  # type: ignore[no-untyped-call]
         except (OSError, TimeoutError, ValueError) as exc:
             raise ClusterError(f"cannot reach the Dask scheduler at {addr}: {exc}") from None
         _CLIENTS[addr] = client

@@ -18,7 +18,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from functools import cached_property
-from typing import Any, Iterable, Sequence
+from typing import Any, Iterable, Iterator, Sequence
 
 from ..plan.load import Connection
 from ..rcl.errors import RclError, error
@@ -186,26 +186,40 @@ def _loops(nodes: Sequence[str], links: Iterable[Link]) -> tuple[tuple[str, ...]
     on: set[str] = set()
     out: list[tuple[str, ...]] = []
 
-    def visit(v: str) -> None:
-        index[v] = low[v] = len(index)
-        stack.append(v)
-        on.add(v)
-        for w in sorted(succ[v]):
-            if w not in index:
-                visit(w)
-                low[v] = min(low[v], low[w])
-            elif w in on:
-                low[v] = min(low[v], index[w])
-        if low[v] == index[v]:
-            comp = []
-            while True:
-                w = stack.pop()
-                on.discard(w)
-                comp.append(w)
-                if w == v:
+    def visit(root: str) -> None:
+        # Tarjan's algorithm with an explicit stack of (node, its remaining
+        # successors): a chain of a thousand nodes would exceed Python's
+        # recursion limit with the recursive formulation.
+        index[root] = low[root] = len(index)
+        stack.append(root)
+        on.add(root)
+        work: list[tuple[str, Iterator[str]]] = [(root, iter(sorted(succ[root])))]
+        while work:
+            v, successors = work[-1]
+            for w in successors:
+                if w not in index:
+                    index[w] = low[w] = len(index)
+                    stack.append(w)
+                    on.add(w)
+                    work.append((w, iter(sorted(succ[w]))))
                     break
-            if len(comp) > 1 or v in succ[v]:
-                out.append(tuple(sorted(comp)))
+                if w in on:
+                    low[v] = min(low[v], index[w])
+            else:
+                work.pop()
+                if work:
+                    parent = work[-1][0]
+                    low[parent] = min(low[parent], low[v])
+                if low[v] == index[v]:
+                    comp = []
+                    while True:
+                        w = stack.pop()
+                        on.discard(w)
+                        comp.append(w)
+                        if w == v:
+                            break
+                    if len(comp) > 1 or v in succ[v]:
+                        out.append(tuple(sorted(comp)))
 
     for n in nodes:
         if n not in index:
