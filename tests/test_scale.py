@@ -80,7 +80,10 @@ def test_workspace_cache_is_used_only_while_the_inputs_are_unchanged(tmp_path: P
     assert wscache.restore(again)
     assert again.node_names() == ["A"] and again.model == ws.model
     (tmp_path / "contracts" / "a.rcl").write_text(RCL.replace("0 <= out.v", "1 <= out.v"))
-    assert not wscache.restore(Workspace(tmp_path))
+    edited = Workspace(tmp_path)
+    assert not wscache.restore(edited)
+    from rclverify.rcl.printer import expr_to_rcl
+    assert expr_to_rcl(edited.checked.nodes["A"].node.guarantees[0].formula) == "1 <= out.v"  # parsed again
     (tmp_path / "contracts" / "a.rcl").write_text(RCL)
     (tmp_path / "contracts" / "plan.yaml").write_text("contracts: [contracts/a.rcl]\nname: x\n")
     assert not wscache.restore(Workspace(tmp_path))
@@ -92,3 +95,16 @@ def test_a_damaged_cache_is_ignored(tmp_path: Path) -> None:
     (tmp_path / wscache.CACHE).write_bytes(b"not a pickle")
     assert not wscache.restore(ws)
     assert ws.node_names() == ["A"]
+
+
+def test_a_missing_contract_is_reported_even_with_a_cached_plan(tmp_path: Path) -> None:
+    import pytest
+    from rclverify.plan.errors import PlanError
+    ws = _ws(tmp_path)
+    ws.model
+    wscache.save(ws)
+    (tmp_path / "contracts" / "a.rcl").unlink()
+    again = Workspace(tmp_path)
+    assert not wscache.restore(again)
+    with pytest.raises(PlanError):
+        again.model

@@ -12,8 +12,9 @@ when nothing it was computed from changed:
 * the rclverify code (name, size and modification time of every file of the
   package) and the Python version.
 
-Anything else (a changed file, a damaged or missing cache, another version)
-means a normal load.  Only workspaces that load without error are cached, so
+When a file changed, the parsed contract files whose text is unchanged and
+an unchanged plan are still reused (see :func:`restore`); a damaged or
+missing cache, another code version or another path means a normal load.  Only workspaces that load without error are cached, so
 an error is always reported from the files themselves.  The cache is written
 atomically and is a pure speed-up: deleting ``artifacts/cache`` is always
 safe.  Like ``dodo.py`` it is trusted code of the workspace (pickle).
@@ -60,17 +61,35 @@ def _header(ws: "Workspace", contracts: tuple[str, ...]) -> dict[str, Any]:
 
 def restore(ws: "Workspace") -> bool:
     """Fill ``ws``'s plan, checked contracts and model from the cache when it
-    is valid for the files on disk.  Returns whether it did; never raises."""
+    is valid for the files on disk.  Returns whether it did; never raises.
+
+    When some input changed, what is still valid is reused: the parsed
+    contract files whose text is unchanged (``ws.parsed``, checked against
+    their sha256 when the workspace loads) and the plan when its own text is
+    unchanged and every contract file it lists exists (it is resolved
+    against the contracts again).  Editing one contract of a large system
+    then re-parses one file.
+    """
     try:
         with open(ws.root / CACHE, "rb") as fh:
             header = pickle.load(fh)
-            if not isinstance(header, dict) or header != _header(ws, tuple(header.get("contracts", ()))):
+            if not isinstance(header, dict):
                 return False
-            plan, checked, model = pickle.load(fh)
+            now = _header(ws, tuple(header.get("contracts", ())))
+            if any(header.get(k) != now[k] for k in ("root", "plan_file", "code")):
+                return False
+            plan, parsed = pickle.load(fh)
+            if header == now:
+                checked, model = pickle.load(fh)
+                ws.__dict__.update(plan=plan, checked=checked, model=model)  # the cached_property slots
+                ws.parsed.update(parsed)
+                return True
     except Exception:  # a missing, damaged or foreign cache is simply not used
         return False
-    ws.__dict__.update(plan=plan, checked=checked, model=model)  # the cached_property slots
-    return True
+    ws.parsed.update(parsed)  # re-validated per file by Workspace.checked
+    if header.get("plan") == now["plan"] and all((ws.root / c).is_file() for c in plan.contracts):
+        ws.__dict__["plan"] = plan
+    return False
 
 
 def save(ws: "Workspace") -> None:
@@ -83,7 +102,8 @@ def save(ws: "Workspace") -> None:
         fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=".workspace.", suffix=".tmp")
         with os.fdopen(fd, "wb") as fh:
             pickle.dump(header, fh, protocol=pickle.HIGHEST_PROTOCOL)
-            pickle.dump((ws.plan, ws.checked, ws.model), fh, protocol=pickle.HIGHEST_PROTOCOL)
+            pickle.dump((ws.plan, ws.parsed), fh, protocol=pickle.HIGHEST_PROTOCOL)
+            pickle.dump((ws.checked, ws.model), fh, protocol=pickle.HIGHEST_PROTOCOL)
         os.replace(tmp, path)
     except Exception:
         try:
