@@ -134,6 +134,10 @@ def build(checked: Checked, connections: Sequence[Connection] = ()) -> SystemMod
     env: list[tuple[str, str, str]] = []
     diags = []
     explicit = {(c.to_node, c.to_var): c for c in connections}
+    outputs: dict[str, list[tuple[str, Any]]] = {}  # output name -> (node, type), in node order
+    for m, other in checked.nodes.items():
+        for name, ot in other.outputs.items():
+            outputs.setdefault(name, []).append((m, ot))
     for n, cn in checked.nodes.items():
         for iv in cn.node.inputs:
             t = cn.inputs[iv.name]
@@ -144,7 +148,7 @@ def build(checked: Checked, connections: Sequence[Connection] = ()) -> SystemMod
             if isinstance(t, EmptyT):
                 env.append((n, iv.name, str(t)))
                 continue
-            by_name = [m for m, other in checked.nodes.items() if m != n and other.outputs.get(iv.name) == t]
+            by_name = [m for m, ot in outputs.get(iv.name, []) if m != n and ot == t]
             via, cands = "name", [(m, iv.name) for m in by_name]
             if not cands:
                 via, cands = "topic", _by_topic(checked, n, iv.name)
