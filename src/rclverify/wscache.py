@@ -21,6 +21,7 @@ safe.  Like ``dodo.py`` it is trusted code of the workspace (pickle).
 """
 from __future__ import annotations
 
+import gc
 import hashlib
 import os
 import pickle
@@ -33,7 +34,7 @@ if TYPE_CHECKING:
     from .pipeline import Workspace
 
 CACHE = "artifacts/cache/workspace.pickle"
-_FORMAT = 1
+_FORMAT = 2
 
 
 def _sha(path: Path) -> str:
@@ -78,9 +79,14 @@ def restore(ws: "Workspace") -> bool:
             now = _header(ws, tuple(header.get("contracts", ())))
             if any(header.get(k) != now[k] for k in ("root", "plan_file", "code")):
                 return False
-            plan, parsed = pickle.load(fh)
+            gc_was_enabled = gc.isenabled()
+            gc.disable()  # the loaded objects are all live: collecting during the load only costs time
+            try:
+                plan, parsed, checked, model = pickle.load(fh)
+            finally:
+                if gc_was_enabled:
+                    gc.enable()
             if header == now:
-                checked, model = pickle.load(fh)
                 ws.__dict__.update(plan=plan, checked=checked, model=model)  # the cached_property slots
                 ws.parsed.update(parsed)
                 return True
@@ -102,8 +108,7 @@ def save(ws: "Workspace") -> None:
         fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=".workspace.", suffix=".tmp")
         with os.fdopen(fd, "wb") as fh:
             pickle.dump(header, fh, protocol=pickle.HIGHEST_PROTOCOL)
-            pickle.dump((ws.plan, ws.parsed), fh, protocol=pickle.HIGHEST_PROTOCOL)
-            pickle.dump((ws.checked, ws.model), fh, protocol=pickle.HIGHEST_PROTOCOL)
+            pickle.dump((ws.plan, ws.parsed, ws.checked, ws.model), fh, protocol=pickle.HIGHEST_PROTOCOL)
         os.replace(tmp, path)
     except Exception:
         try:
