@@ -19,6 +19,10 @@ only that node's snapshot: its compose/health/export/run tasks, its
 consumers' compose tasks (their side conditions) and the report re-run.
 Actions are module-level functions with plain arguments, so ``doit -n 2``
 (parallel processes) behaves like a serial run.
+
+With the environment variable ``RCLVERIFY_CLUSTER=ADDRESS`` the ``evidence``
+tasks send their backend jobs to that Dask scheduler (:mod:`rclverify.cluster`);
+the records are stored locally as in a local run.
 """
 from __future__ import annotations
 
