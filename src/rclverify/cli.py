@@ -21,6 +21,7 @@ mistake prints ``file:line:col: error: message`` lines, never a traceback.
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 from pathlib import Path
 from typing import Callable, Sequence
@@ -168,7 +169,18 @@ def cmd_verify(args: argparse.Namespace) -> int:
     argv = ["verify"] + (["--strict"] if args.strict else [])
     if args.jobs > 1:
         argv = ["-n", str(args.jobs)] + argv
-    return int(DoitMain(ModuleTaskLoader(module)).run(argv))
+    if not args.cluster:
+        return int(DoitMain(ModuleTaskLoader(module)).run(argv))
+    from .cluster import CLUSTER_ENV  # read by the evidence tasks, also in doit's worker processes
+    before = os.environ.get(CLUSTER_ENV)
+    os.environ[CLUSTER_ENV] = args.cluster
+    try:
+        return int(DoitMain(ModuleTaskLoader(module)).run(argv))
+    finally:
+        if before is None:
+            del os.environ[CLUSTER_ENV]
+        else:
+            os.environ[CLUSTER_ENV] = before
 
 
 def cmd_init(args: argparse.Namespace) -> int:
@@ -271,6 +283,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     v.add_argument("--strict", action="store_true",
                    help="exit 1 unless every obligation, side condition and health check holds")
     v.add_argument("-n", "--jobs", type=int, default=1, help="parallel doit processes")
+    v.add_argument("--cluster", metavar="ADDRESS",
+                   help="send backend jobs to the Dask scheduler at ADDRESS (e.g. tcp://127.0.0.1:8786); "
+                        "default: run them locally")
     i = add("init", cmd_init, "write a new workspace (dodo.py, example contracts, plan) that verifies at once")
     i.add_argument("dir", help="directory to create (must be new or empty)")
     i.add_argument("--nodes", help="comma-separated node names, in chain order (default: Sensor,Controller,Actuator)")

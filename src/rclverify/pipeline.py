@@ -20,6 +20,7 @@ Artifact layout (workspace-relative)::
 from __future__ import annotations
 
 import dataclasses
+import hashlib
 from dataclasses import dataclass
 from functools import cached_property
 from pathlib import Path
@@ -55,6 +56,9 @@ class Workspace:
 
     root: Path
     plan_file: str = PLAN
+    #: Parsed contract files of an earlier load, ``rel -> (sha256 of the text, Spec)``;
+    #: a file whose text has the same hash is not parsed again (see :mod:`rclverify.wscache`).
+    parsed: dict[str, tuple[str, ast.Spec]] = dataclasses.field(default_factory=dict, repr=False, compare=False)
 
     def path(self, rel: str) -> Path:
         return self.root / rel
@@ -69,10 +73,18 @@ class Workspace:
         specs = []
         diags: list[Diagnostic] = []
         for rel in plan.contracts:  # parsed under their workspace-relative names
+            text = (self.root / rel).read_text(encoding="utf-8")
+            sha = hashlib.sha256(text.encode("utf-8")).hexdigest()
+            if rel in self.parsed and self.parsed[rel][0] == sha:
+                specs.append(self.parsed[rel][1])
+                continue
             try:
-                specs.append(parse_text((self.root / rel).read_text(encoding="utf-8"), rel))
+                spec = parse_text(text, rel)
             except RclError as exc:
                 diags.extend(exc.diagnostics)
+                continue
+            self.parsed[rel] = (sha, spec)
+            specs.append(spec)
         if diags:
             raise RclError(diags)
         c = check(specs)

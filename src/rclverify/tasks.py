@@ -20,6 +20,10 @@ only that node's snapshot: its compose/health/export/run tasks, its
 consumers' compose tasks (their side conditions) and the report re-run.
 Actions are module-level functions with plain arguments, so ``doit -n 2``
 (parallel processes) behaves like a serial run.
+
+With the environment variable ``RCLVERIFY_CLUSTER=ADDRESS`` the ``evidence``
+tasks send their backend jobs to that Dask scheduler (:mod:`rclverify.cluster`);
+the records are stored locally as in a local run.
 """
 from __future__ import annotations
 
@@ -34,6 +38,7 @@ from doit import create_after as _create_after
 from doit.exceptions import TaskFailed
 from doit.tools import config_changed
 
+from . import wscache
 from .pipeline import Workspace
 from .rcl.errors import RclError
 from .system.model import SystemModel
@@ -53,31 +58,26 @@ CI_REPORTS = ["reports/assurance.sarif", "reports/assurance.junit.xml"]
 ARGUMENT_REPORTS = ["reports/argument.json", "reports/argument.gsn.yaml", "reports/argument.dot"]
 
 
-_WORKSPACES: dict[str, tuple[tuple[tuple[str, int, int], ...], Workspace]] = {}
-
-
-def _stamp(ws: Workspace) -> tuple[tuple[str, int, int], ...]:
-    files = [ws.plan_file] + (list(ws.plan.contracts) if "plan" in vars(ws) else [])
-    out = []
-    for f in files:
-        try:
-            st = (ws.root / f).stat()
-            out.append((f, st.st_mtime_ns, st.st_size))
-        except OSError:
-            out.append((f, -1, -1))
-    return tuple(out)
+_WORKSPACES: dict[str, Workspace] = {}
 
 
 def _ws(root: str) -> Workspace:
-    """The workspace at ``root``, loaded once per process: every action of a
-    doit run would otherwise parse and check the contracts again.  Reloaded
-    when the plan or a contract file changed on disk (stat-based)."""
-    cached = _WORKSPACES.get(root)
-    if cached is not None and _stamp(cached[1]) == cached[0]:
-        return cached[1]
-    ws = Workspace(Path(root))
-    ws.model  # load now (raises RclError for bad input) so the stamp covers the contracts read
-    _WORKSPACES[root] = (_stamp(ws), ws)
+    """The workspace at ``root``, loaded once per doit run: every action would
+    otherwise parse and check the contracts again.
+
+    :func:`build_tasks` (called at the start of every run, also by
+    ``rclverify verify``) puts the workspace it loaded here, so the actions of
+    a run see the contracts and plan as they were when the run started -- the
+    state its ``check`` task snapshots and every later task depends on.  A
+    contract edited while a run is under way is therefore picked up by the
+    next run, whose ``check`` sees the changed file.  Without a seeded entry
+    (a worker process that did not inherit it) the workspace is loaded here.
+    """
+    ws = _WORKSPACES.get(root)
+    if ws is None:
+        ws = Workspace(Path(root))
+        ws.model  # load now: raises RclError for bad input and then caches nothing
+        _WORKSPACES[root] = ws
     return ws
 
 
@@ -117,11 +117,18 @@ def act_node(root: str, stage: str, node: str) -> Any:
 
 
 def act_run(root: str, node: str, obligation_id: str) -> Any:
+    from . import cluster
     from .pipeline import stage_run
+    addr = cluster.address()  # RCLVERIFY_CLUSTER: the backend job runs on that Dask cluster
     try:
-        ev = stage_run(_ws(root), node, obligation_id)
+        if addr is None:
+            ev = stage_run(_ws(root), node, obligation_id)
+        else:
+            ev = cluster.run_on_cluster(addr, _ws(root), node, obligation_id)
     except RclError as exc:
         return _fail(exc)
+    except cluster.ClusterError as exc:
+        return TaskFailed(f"error: {exc}")
     print(f"{ev.obligation}: {ev.status}")
     return None
 
@@ -196,12 +203,19 @@ def build_tasks(root: str | Path, plan_file: str = "contracts/plan.yaml") -> dic
     rootp = Path(root).resolve()
     r = str(rootp)
     ws = Workspace(rootp, plan_file)
+    restored = wscache.restore(ws)  # the loaded workspace of an earlier run, when no input changed
     try:
         nodes = ws.node_names()
         model = ws.model
         ok = True
     except RclError:
         nodes, model, ok = [], None, False
+    if ok:
+        _WORKSPACES[r] = ws
+        if not restored:
+            wscache.save(ws)
+    else:
+        _WORKSPACES.pop(r, None)
     try:
         contract_deps = [str(rootp / c) for c in ws.plan.contracts]
     except RclError:
@@ -259,11 +273,12 @@ def build_tasks(root: str | Path, plan_file: str = "contracts/plan.yaml") -> dic
     def task_evidence() -> Iterator[dict[str, Any]]:
         """Run the backends: one task per obligation, one evidence record each."""
         yield {"basename": "evidence", "name": None, "doc": "Run each backend on its obligations and record evidence."}
+        fingerprint = _tool_fingerprint()  # once, not a PATH search per obligation
         for n, o in exported():
             deps = [str(rootp / ws.obligation(n, o["id"]))]
             deps += [str(rootp / i) for i in o["inputs"] if (rootp / i).is_file()]
             yield {"name": o["id"], "actions": [(act_run, [r, n, o["id"]])], "file_dep": sorted(set(deps)),
-                   "targets": [str(rootp / ws.evidence(o["id"]))], "uptodate": [config_changed(_tool_fingerprint())],
+                   "targets": [str(rootp / ws.evidence(o["id"]))], "uptodate": [config_changed(fingerprint)],
                    "verbosity": 2, "clean": True}
 
     @create_after(executed="evidence")

@@ -141,6 +141,22 @@ def split_assumption(checked: Checked, model: SystemModel, node: str) -> tuple[l
     return internal, env
 
 
+_ENV_TEXTS: dict[str, Any] = {"key": None, "texts": {}}
+
+
+def _environment_texts(checked: Checked, model: SystemModel, node: str) -> tuple[str, ...]:
+    """The environment conjuncts of ``node``'s assumption as RCL text,
+    remembered for the last (checked, model) pair: every node of an upstream
+    cone needs them, and in one process (a doit run) the cones of a chain of
+    N nodes would otherwise split N*N/2 assumptions."""
+    if _ENV_TEXTS["key"] is None or _ENV_TEXTS["key"][0] is not checked or _ENV_TEXTS["key"][1] is not model:
+        _ENV_TEXTS["key"], _ENV_TEXTS["texts"] = (checked, model), {}
+    texts: dict[str, tuple[str, ...]] = _ENV_TEXTS["texts"]
+    if node not in texts:
+        texts[node] = tuple(expr_to_rcl(c) for c in split_assumption(checked, model, node)[1])
+    return texts[node]
+
+
 def compose_node(checked: Checked, model: SystemModel, node: str, *,
                  timeout_ms: int = DEFAULT_TIMEOUT_MS) -> NodeComposition:
     """Apply the calculus to ``node``: discharge its side conditions with Z3.
@@ -194,7 +210,7 @@ def compose_node(checked: Checked, model: SystemModel, node: str, *,
         instances.append({"rule": rule, "premises": premises,
                           "conclusion": " and ".join(f"({a})" for a in prem_a) + f" => <> G_{node}"})
     cone = model.upstream(node)
-    cone_env = tuple((m, expr_to_rcl(c)) for m in cone for c in split_assumption(checked, model, m)[1])
+    cone_env = tuple((m, t) for m in cone for t in _environment_texts(checked, model, m))
     derived = ("(" + " and ".join(t for _, t in cone_env) + ")" if cone_env else "TRUE") + f" => <> G_{node}"
     loop = model.loop_of(node)
     return NodeComposition(node, rules, tuple(producers), tuple(scs), env_assumptions, tuple(instances), derived,

@@ -108,8 +108,17 @@ def build_report(ws: Workspace) -> dict[str, Any]:
         """Obligation ``o`` bears on guarantee ``k`` of ``node`` (guarantee 0: the whole contract)."""
         return o.node == node and o.guarantee in (k, 0)
 
+    by_node: dict[str, list[Obligation]] = {}  # one pass; a scan per guarantee was quadratic in the system size
+    for o in obligations:
+        by_node.setdefault(o.node, []).append(o)
+    links_to: dict[str, list[Any]] = {}
+    links_from: dict[str, list[Any]] = {}
+    for l in model.links:
+        links_to.setdefault(l.to_node, []).append(l)
+        links_from.setdefault(l.from_node, []).append(l)
+
     def g_status(node: str, k: int) -> str:
-        sts = [ob_status[o.id] for o in obligations if applies(o, node, k)]
+        sts = [ob_status[o.id] for o in by_node.get(node, []) if applies(o, node, k)]
         s = worst(sts) if sts else "pending"
         for f in health[node]:
             if f["guarantee"] in (None, k) and f["status"] != "ok":
@@ -119,15 +128,15 @@ def build_report(ws: Workspace) -> dict[str, Any]:
     nodes = []
     node_status: dict[str, str] = {}
     for name, cn in checked.nodes.items():
-        internal = {l.to_var: f"{l.from_node}.{l.from_var}" for l in model.links if l.to_node == name}
+        internal = {l.to_var: f"{l.from_node}.{l.from_var}" for l in links_to.get(name, [])}
         consumers: dict[str, list[str]] = {}
-        for l in model.links:
+        for l in links_from.get(name, []):
             if l.from_node == name:
                 consumers.setdefault(l.from_var, []).append(f"{l.to_node}.{l.to_var}")
         env_texts = {e["text"] for e in comps[name].get("environment_assumptions", [])}
         guarantees: list[dict[str, Any]] = [
             {"index": k, "text": expr_to_rcl(g.formula), "source": _src(g.loc), "status": g_status(name, k),
-             "obligations": sorted(o.id for o in obligations if applies(o, name, k))}
+             "obligations": sorted(o.id for o in by_node.get(name, []) if applies(o, name, k))}
             for k, g in enumerate(cn.node.guarantees, 1)]
         status = worst([g["status"] for g in guarantees] + [sc_status[name]])
         node_status[name] = status

@@ -17,7 +17,8 @@ is an error asking for an explicit connection in the plan.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any, Iterable, Sequence
+from functools import cached_property
+from typing import Any, Iterable, Iterator, Sequence
 
 from ..plan.load import Connection
 from ..rcl.errors import RclError, error
@@ -52,17 +53,33 @@ class SystemModel:
     env_inputs: tuple[tuple[str, str, str], ...]
     loops: tuple[tuple[str, ...], ...]
 
+    @cached_property
+    def _index(self) -> dict[str, tuple[list[str], list[str], set[str]]]:
+        """Per node: (producers, consumers, internal inputs), built once in
+        O(links) so that the per-node queries below do not scan every link
+        (with them a 1000-node system's calculus was quadratic in the links)."""
+        order = {n: k for k, n in enumerate(self.nodes)}
+        prod: dict[str, set[str]] = {n: set() for n in self.nodes}
+        cons: dict[str, set[str]] = {n: set() for n in self.nodes}
+        ins: dict[str, set[str]] = {n: set() for n in self.nodes}
+        for l in self.links:
+            prod.setdefault(l.to_node, set()).add(l.from_node)
+            cons.setdefault(l.from_node, set()).add(l.to_node)
+            ins.setdefault(l.to_node, set()).add(l.to_var)
+
+        def ordered(names: set[str]) -> list[str]:
+            return sorted((n for n in names if n in order), key=order.__getitem__)
+        return {n: (ordered(prod[n]), ordered(cons.get(n, set())), ins[n]) for n in prod}
+
     def producers(self, node: str) -> list[str]:
         """Nodes feeding ``node``, in source order, without repeats."""
-        ps = {l.from_node for l in self.links if l.to_node == node}
-        return [n for n in self.nodes if n in ps]
+        return list(self._index[node][0]) if node in self._index else []
 
     def consumers(self, node: str) -> list[str]:
-        cs = {l.to_node for l in self.links if l.from_node == node}
-        return [n for n in self.nodes if n in cs]
+        return list(self._index[node][1]) if node in self._index else []
 
     def internal_inputs(self, node: str) -> set[str]:
-        return {l.to_var for l in self.links if l.to_node == node}
+        return set(self._index[node][2]) if node in self._index else set()
 
     def loop_of(self, node: str) -> tuple[str, ...] | None:
         for loop in self.loops:
@@ -117,6 +134,10 @@ def build(checked: Checked, connections: Sequence[Connection] = ()) -> SystemMod
     env: list[tuple[str, str, str]] = []
     diags = []
     explicit = {(c.to_node, c.to_var): c for c in connections}
+    outputs: dict[str, list[tuple[str, Any]]] = {}  # output name -> (node, type), in node order
+    for m, other in checked.nodes.items():
+        for name, ot in other.outputs.items():
+            outputs.setdefault(name, []).append((m, ot))
     for n, cn in checked.nodes.items():
         for iv in cn.node.inputs:
             t = cn.inputs[iv.name]
@@ -127,7 +148,7 @@ def build(checked: Checked, connections: Sequence[Connection] = ()) -> SystemMod
             if isinstance(t, EmptyT):
                 env.append((n, iv.name, str(t)))
                 continue
-            by_name = [m for m, other in checked.nodes.items() if m != n and other.outputs.get(iv.name) == t]
+            by_name = [m for m, ot in outputs.get(iv.name, []) if m != n and ot == t]
             via, cands = "name", [(m, iv.name) for m in by_name]
             if not cands:
                 via, cands = "topic", _by_topic(checked, n, iv.name)
@@ -169,26 +190,40 @@ def _loops(nodes: Sequence[str], links: Iterable[Link]) -> tuple[tuple[str, ...]
     on: set[str] = set()
     out: list[tuple[str, ...]] = []
 
-    def visit(v: str) -> None:
-        index[v] = low[v] = len(index)
-        stack.append(v)
-        on.add(v)
-        for w in sorted(succ[v]):
-            if w not in index:
-                visit(w)
-                low[v] = min(low[v], low[w])
-            elif w in on:
-                low[v] = min(low[v], index[w])
-        if low[v] == index[v]:
-            comp = []
-            while True:
-                w = stack.pop()
-                on.discard(w)
-                comp.append(w)
-                if w == v:
+    def visit(root: str) -> None:
+        # Tarjan's algorithm with an explicit stack of (node, its remaining
+        # successors): a chain of a thousand nodes would exceed Python's
+        # recursion limit with the recursive formulation.
+        index[root] = low[root] = len(index)
+        stack.append(root)
+        on.add(root)
+        work: list[tuple[str, Iterator[str]]] = [(root, iter(sorted(succ[root])))]
+        while work:
+            v, successors = work[-1]
+            for w in successors:
+                if w not in index:
+                    index[w] = low[w] = len(index)
+                    stack.append(w)
+                    on.add(w)
+                    work.append((w, iter(sorted(succ[w]))))
                     break
-            if len(comp) > 1 or v in succ[v]:
-                out.append(tuple(sorted(comp)))
+                if w in on:
+                    low[v] = min(low[v], index[w])
+            else:
+                work.pop()
+                if work:
+                    parent = work[-1][0]
+                    low[parent] = min(low[parent], low[v])
+                if low[v] == index[v]:
+                    comp = []
+                    while True:
+                        w = stack.pop()
+                        on.discard(w)
+                        comp.append(w)
+                        if w == v:
+                            break
+                    if len(comp) > 1 or v in succ[v]:
+                        out.append(tuple(sorted(comp)))
 
     for n in nodes:
         if n not in index:

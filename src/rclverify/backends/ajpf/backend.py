@@ -37,6 +37,7 @@ from __future__ import annotations
 import hashlib
 import re
 from dataclasses import dataclass, field
+from functools import lru_cache
 from pathlib import Path
 from typing import Any, Mapping, Sequence
 
@@ -83,6 +84,7 @@ class AjpfConfig:
     log_info: tuple[str, ...] = DEFAULT_LOG_INFO
 
 
+@lru_cache(maxsize=1)  # one environment per process: jinja2 then compiles each template once
 def _templates() -> Environment:
     return Environment(loader=PackageLoader("rclverify.backends.ajpf", "templates"), undefined=StrictUndefined,
                        keep_trailing_newline=True, trim_blocks=True, lstrip_blocks=True, autoescape=False)

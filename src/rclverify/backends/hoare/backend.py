@@ -19,6 +19,7 @@ backend mechanises that step:
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import lru_cache
 from pathlib import Path
 from typing import Any
 
@@ -39,6 +40,7 @@ NAME = "hoare"
 KIND = "proof"
 
 
+@lru_cache(maxsize=1)  # one environment per process: jinja2 then compiles each template once
 def _templates() -> jinja2.Environment:
     return jinja2.Environment(loader=jinja2.PackageLoader("rclverify.backends.hoare", "templates"),
                               undefined=jinja2.StrictUndefined, autoescape=False, keep_trailing_newline=True,
@@ -82,8 +84,10 @@ def _source(target: NodeTarget, loc: Any) -> SourceRef:
     return SourceRef(file, loc.line, loc.col)
 
 
-def prepare(target: NodeTarget) -> list[Prepared]:
-    """Derive every triple of ``target``'s node for its plan entry.
+def prepare(target: NodeTarget, only: str | None = None) -> list[Prepared]:
+    """Derive every triple of ``target``'s node for its plan entry (only the
+    one with obligation id ``only`` when given: a run checks one triple and
+    need not encode the others).
 
     Raises :class:`~rclverify.plan.errors.PlanError` (bad entry) or
     :class:`~rclverify.rcl.errors.RclError` (bad program, or a guarantee the
@@ -98,6 +102,8 @@ def prepare(target: NodeTarget) -> list[Prepared]:
     for c in conjuncts(node, covered):
         instance = f"{cfg.stem}.c{c.index}"
         oid = make_obligation_id(node.name, c.guarantee, NAME, instance)
+        if only is not None and oid != only:
+            continue
         identified = tuple(nm for b in c.bindings for nm in b.names if nm in types.vars)
         triple: EncodedTriple | None = None
         result: WP | None = None
@@ -129,8 +135,9 @@ def outline_lines(p: Prepared) -> list[OutlineLine]:
                           "precondition of the triple; implies the next assertion (main)")
 
 
-def render_obligation(target: NodeTarget, p: Prepared) -> str:
-    """Text of the obligation artifact: the triple, binding, VCs and proof outline."""
+def render_obligation(target: NodeTarget, p: Prepared, lines: list[OutlineLine] | None = None) -> str:
+    """Text of the obligation artifact: the triple, binding, VCs and proof outline
+    (``lines``: the outline when the caller already rendered it)."""
     ctx: dict[str, Any] = dict(
         header=_header(target, p), id=p.id, node=target.node.name, guarantee=p.conjunct.guarantee,
         conjunct=p.conjunct.index, source=str(p.source), conjunct_text=p.conjunct.conjunct_text,
@@ -140,7 +147,7 @@ def render_obligation(target: NodeTarget, p: Prepared) -> str:
     if p.triple is not None:
         ctx.update(pre=z3_text(p.triple.pre, p.triple.names), post=z3_text(p.triple.post, p.triple.names),
                    vcs=p.vcs, outline=[dict(pad=" " * ln.indent, text=ln.text, note=ln.note)
-                                       for ln in outline_lines(p)])
+                                       for ln in (outline_lines(p) if lines is None else lines)])
     return _templates().get_template("obligation.txt.j2").render(**ctx)
 
 
@@ -196,14 +203,15 @@ class HoareBackend:
                                  explanation=explanation, **kw)
 
         try:
-            prepared = {p.id: p for p in prepare(target)}
+            prepared = {p.id: p for p in prepare(target, only=obligation.id)}
         except RclError as exc:
             return evidence("error", f"the obligation could not be rebuilt: {exc}", log=str(exc))
         p = prepared.get(obligation.id)
         if p is None:
             return evidence("error", "the plan entry, program or contract no longer yields this obligation; "
                             "export again")
-        atomic_write_text(p.artifact, render_obligation(target, p))
+        lines = outline_lines(p) if p.triple is not None and p.result is not None else None
+        atomic_write_text(p.artifact, render_obligation(target, p, lines))
         artifacts = [target.rel(p.artifact)]
         if p.pending or p.triple is None:
             return evidence("pending", p.pending, artifacts=tuple(artifacts),
@@ -215,7 +223,7 @@ class HoareBackend:
             return evidence("error", f"Z3 failed: {exc}", log=str(exc), artifacts=tuple(artifacts))
         atomic_write_text(p.smt2, render_queries(target, p, res))
         artifacts.append(target.rel(p.smt2))
-        outline = outline_text(outline_lines(p))
+        outline = outline_text(lines if lines is not None else outline_lines(p))
         details: dict[str, Any] = {
             "outline": outline if len(outline) <= 8000 else outline[:8000] + "...\n",
             "vcs": {r.vc.id: r.status for r in res.results},

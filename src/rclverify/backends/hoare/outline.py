@@ -43,6 +43,18 @@ class _Printer:
     def __init__(self, names: Mapping[str, str]) -> None:
         self.names = names
         self.bound: list[str] = []  # innermost last
+        # (Z3 ast id, context, bound names) -> (the term, kept alive so its id is not reused; its text).
+        # The assertions of one outline share most of their subterms, and walking
+        # a term through Z3's Python API is the costly part of rendering it.
+        self.memo: dict[tuple[int, int, tuple[str, ...]], tuple[z3.ExprRef, str]] = {}
+
+    def go(self, t: z3.ExprRef, context: int = 0) -> str:
+        key = (t.get_id(), context, tuple(self.bound))
+        hit = self.memo.get(key)
+        if hit is None:
+            hit = (t, self._go(t, context))
+            self.memo[key] = hit
+        return hit[1]
 
     def name(self, n: str) -> str:
         return self.names.get(n, n)
@@ -50,7 +62,7 @@ class _Printer:
     def wrap(self, s: str, p: int, context: int) -> str:
         return f"({s})" if p < context else s
 
-    def go(self, t: z3.ExprRef, context: int = 0) -> str:
+    def _go(self, t: z3.ExprRef, context: int = 0) -> str:
         if z3.is_var(t):
             idx = z3.get_var_index(t)
             return self.bound[-1 - idx] if idx < len(self.bound) else f"?{idx}"
@@ -131,12 +143,13 @@ def render_outline(items: Sequence[OutlineItem], names: Mapping[str, str] | None
     """Turn outline items into lines; a ``precondition`` (the triple's) is
     put first, with ``pre_note`` (e.g. which VC shows it implies the next)."""
     out: list[OutlineLine] = []
+    printer = _Printer(names or {})  # one for all lines: they share subterms (see _Printer.memo)
     if precondition is not None:
-        out.append(OutlineLine(0, "{ " + z3_text(precondition, names) + " }", pre_note))
+        out.append(OutlineLine(0, "{ " + printer.go(precondition) + " }", pre_note))
     for it in items:
         if it.kind == "assert":
             assert it.formula is not None
-            out.append(OutlineLine(2 * it.depth, "{ " + z3_text(it.formula, names) + " }", it.note))
+            out.append(OutlineLine(2 * it.depth, "{ " + printer.go(it.formula) + " }", it.note))
         else:
             out.append(OutlineLine(2 * it.depth, it.text))
     return out

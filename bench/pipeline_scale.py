@@ -1,0 +1,247 @@
+"""How the whole pipeline (``doit verify``) scales with the number of nodes.
+
+Writes a synthetic workspace of N nodes for each N and measures, each in a
+fresh ``python -m doit`` process:
+
+* **cold**: ``doit verify`` on the fresh workspace (no artifacts, no .doit.db),
+* **no-op**: a second ``doit verify`` with nothing changed (must execute no task),
+* **edit**: ``doit verify`` after editing one contract (the middle node's
+  second guarantee), with the tasks that ran,
+
+plus the peak resident memory of each run (the largest ``ru_maxrss`` of the
+doit process and its children, from ``resource.getrusage(RUSAGE_CHILDREN)``
+in an intermediate process), the CPU seconds (user + system) of the run
+and the numbers of nodes, obligations and side
+conditions.  Wall-clock seconds; on a shared machine expect +-25%.
+
+The synthetic system (see :func:`topology`): node ``N<k>`` produces ``v<k>``
+and reads ``v<k-1>`` (a chain); every third node also reads ``v<k-3>`` (a
+join, rule R3; node ``k-3`` then feeds two consumers, a branch, R2); every
+tenth node closes a loop by reading the output of the node four places
+downstream (R4).  Node ``N0`` reads the environment input ``e0``.  Every node
+has two guarantees and a ``hoare`` evidence entry over one shared clamp
+program (``backends/hoare/clamp.imp``), so each node gives Hoare obligations
+checked by Z3, and the calculus and health checks run as usual.
+Property-test obligations (``property_tests`` evidence entries) are added
+only when this tree's ``rclverify.backends`` implements that backend; the
+table says whether they were.
+
+Usage::
+
+    python bench/pipeline_scale.py                     # N = 10 100 500 1000
+    python bench/pipeline_scale.py --sizes 10,100 -n 2 # quick run, doit -n 2
+    python bench/pipeline_scale.py --keep DIR          # keep the workspaces under DIR
+
+The figures are printed, not asserted.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import re
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Sequence
+
+import yaml
+
+CLAMP = """\
+// A clamp: y is x when x is not negative, else 0.  The synthetic nodes of
+// bench/pipeline_scale.py are bound to it (in.<first input> -> x).
+var x, z : REAL;
+var y : REAL;
+
+IF (x < 0) THEN
+   y := 0
+ELSE
+   y := x
+"""
+
+DODO = """\
+from pathlib import Path
+
+from rclverify.tasks import build_tasks
+
+DOIT_CONFIG = {"default_tasks": ["verify"], "verbosity": 2, "dep_file": ".doit.db"}
+
+globals().update(build_tasks(Path(__file__).parent))
+"""
+
+
+def topology(n: int) -> dict[int, list[int]]:
+    """Producers of each node ``0..n-1``: chain, joins every third node, a
+    loop back from every tenth node (see the module docstring)."""
+    prod: dict[int, list[int]] = {k: ([k - 1] if k else []) for k in range(n)}
+    for k in range(3, n, 3):
+        prod[k].append(k - 3)
+    for k in range(10, n, 10):
+        if k + 4 < n:
+            prod[k].append(k + 4)
+    return prod
+
+
+def contract(k: int, producers: list[int]) -> str:
+    """RCL text of node ``N<k>``."""
+    ins = [f"v{p}" for p in producers] or ["e0"]
+    first = ins[0]
+    assume = " and ".join(f"0 <= in.{i}" for i in ins)
+    return (
+        f"// Synthetic node {k}.\n"
+        f"node N{k} {{\n"
+        f"  inputs( {', '.join(f'{i} : REAL' for i in ins)} )\n"
+        f"  outputs( v{k} : REAL )\n"
+        f"  assume( {assume} )\n"
+        f"  guarantee( 0 <= out.v{k} )\n"
+        f"  guarantee( in.{first} <= 100 -> out.v{k} <= in.{first} + 1 )\n"
+        f"}}\n"
+    )
+
+
+def has_property_tests() -> bool:
+    """Whether this tree implements the ``property_tests`` backend."""
+    from rclverify import backends
+    return "property_tests" in getattr(backends, "IMPLEMENTED", {})
+
+
+def generate(root: Path, n: int, property_tests: bool) -> None:
+    """Write an ``n``-node workspace under ``root`` (which must not exist)."""
+    (root / "contracts").mkdir(parents=True)
+    (root / "backends" / "hoare").mkdir(parents=True)
+    (root / "backends" / "hoare" / "clamp.imp").write_text(CLAMP)
+    (root / "dodo.py").write_text(DODO)
+    prod = topology(n)
+    nodes: dict[str, object] = {}
+    for k in range(n):
+        (root / "contracts" / f"n{k}.rcl").write_text(contract(k, prod[k]))
+        ins = [f"v{p}" for p in prod[k]] or ["e0"]
+        binding = {f"in.{ins[0]}": "x", f"out.v{k}": "y"}
+        binding.update({f"in.{i}": "z" for i in ins[1:]})
+        entries: list[dict[str, object]] = [{"backend": "hoare", "program": "backends/hoare/clamp.imp", "binding": binding}]
+        if property_tests:
+            entries.append({"backend": "property_tests"})
+        nodes[f"N{k}"] = {"evidence": entries}
+    plan = {"name": f"synthetic system of {n} nodes", "contracts": [f"contracts/n{k}.rcl" for k in range(n)],
+            "nodes": nodes}
+    (root / "contracts" / "plan.yaml").write_text(yaml.safe_dump(plan, sort_keys=False))
+
+
+@dataclass
+class Run:
+    seconds: float
+    cpu: float
+    peak_mb: float
+    ran: list[str]
+    rc: int
+    output: str
+
+
+PROBE = ("import resource, subprocess, sys, json\n"
+         "r = subprocess.run(sys.argv[1:], capture_output=True, text=True)\n"
+         "u = resource.getrusage(resource.RUSAGE_CHILDREN)\n"
+         "print(json.dumps({'rc': r.returncode, 'out': r.stdout + r.stderr,"
+         " 'maxrss_kb': u.ru_maxrss, 'cpu': u.ru_utime + u.ru_stime}))\n")
+
+
+def doit_verify(root: Path, jobs: int) -> Run:
+    """Run ``python -m doit [-n jobs] verify`` in ``root``; time, peak memory, executed tasks."""
+    cmd = [sys.executable, "-m", "doit"] + (["-n", str(jobs)] if jobs > 1 else []) + ["verify"]
+    t0 = time.perf_counter()
+    p = subprocess.run([sys.executable, "-c", PROBE, *cmd], cwd=root, capture_output=True, text=True)
+    seconds = time.perf_counter() - t0
+    res = json.loads(p.stdout)
+    ran = [line[3:] for line in res["out"].splitlines() if line.startswith(".  ")]
+    return Run(seconds, res["cpu"], res["maxrss_kb"] / 1024, ran, res["rc"], res["out"])
+
+
+def summarise(ran: list[str]) -> str:
+    """Tasks that ran, grouped by stage: ``check, compose x3 (N4, N5, N7), ...``."""
+    groups: dict[str, list[str]] = {}
+    for t in ran:
+        stage, _, name = t.partition(":")
+        groups.setdefault(stage, []).append(name)
+    parts = []
+    for stage, names in groups.items():
+        names = [x for x in names if x]
+        if not names:
+            parts.append(stage)
+        elif stage == "evidence":
+            parts.append(f"evidence x{len(names)}")
+        else:
+            parts.append(f"{stage} {'/'.join(names)}")
+    return ", ".join(parts)
+
+
+def edit_one(root: Path, n: int) -> str:
+    """Change the middle node's second guarantee (100 -> 99, still provable); its name."""
+    k = n // 2
+    p = root / "contracts" / f"n{k}.rcl"
+    p.write_text(p.read_text().replace("<= 100 ->", "<= 99 ->"))
+    return f"N{k}"
+
+
+def counts(root: Path) -> tuple[int, int]:
+    """(obligations, side conditions) in the written report."""
+    rep = json.loads((root / "reports" / "assurance.json").read_text())
+    return len(rep["obligations"]), len(rep["side_conditions"])
+
+
+def _sizes(values: Sequence[str]) -> list[int]:
+    out = []
+    for v in values:
+        out += [int(p) for p in v.split(",") if p.strip()]
+    if not out or min(out) < 1:
+        raise SystemExit("sizes must be positive integers")
+    return out
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--sizes", nargs="+", default=["10", "100", "500", "1000"],
+                    help="numbers of nodes (space or comma separated)")
+    ap.add_argument("-n", "--jobs", type=int, default=1, help="doit parallel processes (doit -n)")
+    ap.add_argument("--keep", help="write the workspaces under this directory and keep them")
+    args = ap.parse_args(argv)
+    sizes = _sizes(args.sizes)
+    pt = has_property_tests()
+    base = Path(args.keep) if args.keep else Path(tempfile.mkdtemp(prefix="rclverify-bench-"))
+    print(f"pipeline scale: doit{' -n ' + str(args.jobs) if args.jobs > 1 else ''} verify, "
+          f"{os.cpu_count()} CPU(s); obligations: hoare"
+          + (", property_tests" if pt else " (property_tests skipped: backend not implemented in this tree)"))
+    header = (f"{'nodes':>6} {'oblig.':>7} {'side c.':>7} {'cold s':>7} {'(cpu)':>7} {'MB':>5} {'no-op s':>7} "
+              f"{'(cpu)':>6} {'ran':>3} {'edit s':>6} {'(cpu)':>6} {'MB':>5}  tasks run after the edit")
+    print(header)
+    print("-" * len(header))
+    try:
+        for n in sizes:
+            root = base / f"n{n}"
+            if root.exists():
+                shutil.rmtree(root)
+            generate(root, n, pt)
+            cold = doit_verify(root, args.jobs)
+            if cold.rc != 0:
+                print(f"{n:>6}  cold run failed (exit {cold.rc}):\n{cold.output[-3000:]}")
+                return 1
+            nob, nsc = counts(root)
+            noop = doit_verify(root, args.jobs)
+            edited = edit_one(root, n)
+            edit = doit_verify(root, args.jobs)
+            ran = summarise([t for t in edit.ran if t != "verify"])
+            print(f"{n:>6} {nob:>7} {nsc:>7} {cold.seconds:>7.1f} {cold.cpu:>7.1f} {cold.peak_mb:>5.0f} "
+                  f"{noop.seconds:>7.2f} {noop.cpu:>6.2f} {len(noop.ran):>3} {edit.seconds:>6.2f} {edit.cpu:>6.2f} "
+                  f"{edit.peak_mb:>5.0f}  ({edited}) {ran}", flush=True)
+    finally:
+        if not args.keep:
+            shutil.rmtree(base, ignore_errors=True)
+    print("cold/no-op/edit: wall-clock seconds of one `doit verify`; (cpu): CPU seconds (user+sys) of doit and its "
+          "children; MB: peak RSS of the largest process; ran: tasks the no-op run executed (0 expected).")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

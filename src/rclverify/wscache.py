@@ -1,0 +1,117 @@
+"""A cache of a workspace's loaded plan, checked contracts and system model.
+
+Every ``doit`` run starts by loading the workspace (:func:`rclverify.tasks.build_tasks`
+needs the node names, the plan's evidence entries and the system model to
+define the tasks).  For a system of 1000 nodes that is about 3 s of YAML
+reading, parsing and type checking -- the whole budget of a no-op run.  The
+result is therefore kept in ``artifacts/cache/workspace.pickle`` and reused
+when nothing it was computed from changed:
+
+* the sha256 of the plan file and of every contract file it lists,
+* the workspace's absolute path and the plan's path,
+* the rclverify code (name, size and modification time of every file of the
+  package) and the Python version.
+
+When a file changed, the parsed contract files whose text is unchanged and
+an unchanged plan are still reused (see :func:`restore`); a damaged or
+missing cache, another code version or another path means a normal load.  Only workspaces that load without error are cached, so
+an error is always reported from the files themselves.  The cache is written
+atomically and is a pure speed-up: deleting ``artifacts/cache`` is always
+safe.  Like ``dodo.py`` it is trusted code of the workspace (pickle).
+"""
+from __future__ import annotations
+
+import gc
+import hashlib
+import os
+import pickle
+import sys
+import tempfile
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    from .pipeline import Workspace
+
+CACHE = "artifacts/cache/workspace.pickle"
+_FORMAT = 2
+
+
+def _sha(path: Path) -> str:
+    try:
+        return hashlib.sha256(path.read_bytes()).hexdigest()
+    except OSError:
+        return "-"
+
+
+def _code_stamp() -> str:
+    """Changes whenever a file of the installed rclverify package changes."""
+    pkg = Path(__file__).resolve().parent
+    h = hashlib.sha256(f"{_FORMAT} {sys.version}".encode())
+    for p in sorted(pkg.rglob("*")):
+        if p.suffix in (".py", ".lark", ".json", ".j2"):
+            st = p.stat()
+            h.update(f"{p.relative_to(pkg)} {st.st_size} {st.st_mtime_ns}\n".encode())
+    return h.hexdigest()
+
+
+def _header(ws: "Workspace", contracts: tuple[str, ...]) -> dict[str, Any]:
+    return {"root": str(ws.root.resolve()), "plan_file": ws.plan_file, "code": _code_stamp(),
+            "plan": _sha(ws.root / ws.plan_file), "contracts": {c: _sha(ws.root / c) for c in contracts}}
+
+
+def restore(ws: "Workspace") -> bool:
+    """Fill ``ws``'s plan, checked contracts and model from the cache when it
+    is valid for the files on disk.  Returns whether it did; never raises.
+
+    When some input changed, what is still valid is reused: the parsed
+    contract files whose text is unchanged (``ws.parsed``, checked against
+    their sha256 when the workspace loads) and the plan when its own text is
+    unchanged and every contract file it lists exists (it is resolved
+    against the contracts again).  Editing one contract of a large system
+    then re-parses one file.
+    """
+    try:
+        with open(ws.root / CACHE, "rb") as fh:
+            header = pickle.load(fh)
+            if not isinstance(header, dict):
+                return False
+            now = _header(ws, tuple(header.get("contracts", ())))
+            if any(header.get(k) != now[k] for k in ("root", "plan_file", "code")):
+                return False
+            gc_was_enabled = gc.isenabled()
+            gc.disable()  # the loaded objects are all live: collecting during the load only costs time
+            try:
+                plan, parsed, checked, model = pickle.load(fh)
+            finally:
+                if gc_was_enabled:
+                    gc.enable()
+            if header == now:
+                ws.__dict__.update(plan=plan, checked=checked, model=model)  # the cached_property slots
+                ws.parsed.update(parsed)
+                return True
+    except Exception:  # a missing, damaged or foreign cache is simply not used
+        return False
+    ws.parsed.update(parsed)  # re-validated per file by Workspace.checked
+    if header.get("plan") == now["plan"] and all((ws.root / c).is_file() for c in plan.contracts):
+        ws.__dict__["plan"] = plan
+    return False
+
+
+def save(ws: "Workspace") -> None:
+    """Write the cache for a workspace whose model loaded without error.
+    Never raises (a cache that cannot be written is not written)."""
+    path = ws.root / CACHE
+    try:
+        header = _header(ws, tuple(ws.plan.contracts))
+        path.parent.mkdir(parents=True, exist_ok=True)
+        fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=".workspace.", suffix=".tmp")
+        with os.fdopen(fd, "wb") as fh:
+            pickle.dump(header, fh, protocol=pickle.HIGHEST_PROTOCOL)
+            pickle.dump((ws.plan, ws.parsed, ws.checked, ws.model), fh, protocol=pickle.HIGHEST_PROTOCOL)
+        os.replace(tmp, path)
+    except Exception:
+        try:
+            os.unlink(tmp)
+        except (OSError, UnboundLocalError):
+            pass

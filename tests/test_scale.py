@@ -1,0 +1,110 @@
+"""What the pipeline needs to scale: no recursion limit on long chains, the
+system model's per-node index, and the cached workspace of a doit run."""
+from __future__ import annotations
+
+import random
+from pathlib import Path
+
+from rclverify import wscache
+from rclverify.pipeline import Workspace
+from rclverify.system.model import Link, SystemModel, _loops
+
+
+def _sccs_by_reachability(nodes: list[str], links: list[Link]) -> tuple[tuple[str, ...], ...]:
+    succ: dict[str, set[str]] = {n: set() for n in nodes}
+    for l in links:
+        succ[l.from_node].add(l.to_node)
+    reach = {}
+    for n in nodes:
+        seen, todo = {n}, [n]
+        while todo:
+            for w in succ[todo.pop()]:
+                if w not in seen:
+                    seen.add(w)
+                    todo.append(w)
+        reach[n] = seen
+    comps = {tuple(sorted(m for m in nodes if m in reach[n] and n in reach[m])) for n in nodes}
+    return tuple(sorted(c for c in comps if len(c) > 1 or c[0] in succ[c[0]]))
+
+
+def test_loops_of_a_long_chain_closed_into_a_ring() -> None:
+    nodes = [f"N{k}" for k in range(3000)]
+    links = [Link(nodes[k], "o", nodes[(k + 1) % 3000], "i", "name") for k in range(3000)]
+    assert _loops(nodes, links) == (tuple(sorted(nodes)),)
+
+
+def test_loops_agree_with_reachability_on_random_graphs() -> None:
+    rnd = random.Random(12)
+    for _ in range(200):
+        nodes = [f"n{k}" for k in range(rnd.randint(1, 10))]
+        links = [Link(rnd.choice(nodes), "o", rnd.choice(nodes), "i", "name") for _ in range(rnd.randint(0, 18))]
+        assert _loops(nodes, links) == _sccs_by_reachability(nodes, links)
+
+
+def test_model_index_answers_like_a_scan_of_the_links() -> None:
+    rnd = random.Random(3)
+    nodes = tuple(f"n{k}" for k in range(30))
+    links = tuple(Link(rnd.choice(nodes), f"o{k}", rnd.choice(nodes), f"i{k}", "name") for k in range(60))
+    m = SystemModel(nodes, links, (), ())
+    for n in nodes:
+        ps = {l.from_node for l in links if l.to_node == n}
+        cs = {l.to_node for l in links if l.from_node == n}
+        assert m.producers(n) == [x for x in nodes if x in ps]
+        assert m.consumers(n) == [x for x in nodes if x in cs]
+        assert m.internal_inputs(n) == {l.to_var for l in links if l.to_node == n}
+
+
+RCL = """\
+node A {
+  inputs( e : REAL )
+  outputs( v : REAL )
+  assume( 0 <= in.e )
+  guarantee( 0 <= out.v )
+}
+"""
+
+
+def _ws(root: Path) -> Workspace:
+    (root / "contracts").mkdir(parents=True, exist_ok=True)
+    (root / "contracts" / "a.rcl").write_text(RCL)
+    (root / "contracts" / "plan.yaml").write_text("contracts: [contracts/a.rcl]\n")
+    return Workspace(root)
+
+
+def test_workspace_cache_is_used_only_while_the_inputs_are_unchanged(tmp_path: Path) -> None:
+    ws = _ws(tmp_path)
+    assert not wscache.restore(ws)  # nothing cached yet
+    ws.model
+    wscache.save(ws)
+    again = Workspace(tmp_path)
+    assert wscache.restore(again)
+    assert again.node_names() == ["A"] and again.model == ws.model
+    (tmp_path / "contracts" / "a.rcl").write_text(RCL.replace("0 <= out.v", "1 <= out.v"))
+    edited = Workspace(tmp_path)
+    assert not wscache.restore(edited)
+    from rclverify.rcl.printer import expr_to_rcl
+    assert expr_to_rcl(edited.checked.nodes["A"].node.guarantees[0].formula) == "1 <= out.v"  # parsed again
+    (tmp_path / "contracts" / "a.rcl").write_text(RCL)
+    (tmp_path / "contracts" / "plan.yaml").write_text("contracts: [contracts/a.rcl]\nname: x\n")
+    assert not wscache.restore(Workspace(tmp_path))
+
+
+def test_a_damaged_cache_is_ignored(tmp_path: Path) -> None:
+    ws = _ws(tmp_path)
+    (tmp_path / wscache.CACHE).parent.mkdir(parents=True)
+    (tmp_path / wscache.CACHE).write_bytes(b"not a pickle")
+    assert not wscache.restore(ws)
+    assert ws.node_names() == ["A"]
+
+
+def test_a_missing_contract_is_reported_even_with_a_cached_plan(tmp_path: Path) -> None:
+    import pytest
+    from rclverify.plan.errors import PlanError
+    ws = _ws(tmp_path)
+    ws.model
+    wscache.save(ws)
+    (tmp_path / "contracts" / "a.rcl").unlink()
+    again = Workspace(tmp_path)
+    assert not wscache.restore(again)
+    with pytest.raises(PlanError):
+        again.model
