@@ -43,6 +43,7 @@ def _workspace(root: Path, plan: str = PLAN) -> Path:
         "artifacts/evidence/Sensor.g1.hoare.json": json.dumps(
             {"input_hashes": {"backends/hoare/sensor.imp": "x", "backends/ajpf/never.log": "missing"}}),
         "artifacts/.evidence.tmp": "half-written",
+        "artifacts/cache/workspace.pickle": "machine-local pickled cache: never bundled",
         "dodo.py": "# tasks\n",
     }
     for rel, text in files.items():

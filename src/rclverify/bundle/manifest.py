@@ -3,7 +3,9 @@
 Collected (workspace-relative POSIX paths, sorted):
 
 * every regular file under ``reports/`` and ``artifacts/`` (hidden files,
-  such as the temporary files of atomic writes, are left out);
+  such as the temporary files of atomic writes, are left out, and so is
+  ``artifacts/cache/``: a machine-local speed-up holding pickled data, which
+  an assessor must never be handed to load);
 * the plan, its contract files and replacement contracts;
 * every file the plan's evidence entries name (a directory contributes the
   files under it; the same paths :mod:`rclverify.plan.paths` checks), and
@@ -35,6 +37,8 @@ FORMAT = "rclverify-bundle/1"
 MANIFEST = "MANIFEST.json"
 #: Workspace folders packed whole.
 TREES = ("reports", "artifacts")
+#: Left out of the trees: the workspace cache (rclverify.wscache), pickled.
+EXCLUDED = ("artifacts/cache/",)
 
 
 class BundleError(Exception):
@@ -90,7 +94,8 @@ def _files_under(root: Path, rel: str) -> list[str]:
     out = []
     for p in base.rglob("*"):
         r = p.relative_to(root)
-        if any(part.startswith(".") for part in r.parts) or not p.is_file():
+        if any(part.startswith(".") for part in r.parts) or not p.is_file() \
+                or r.as_posix().startswith(EXCLUDED):
             continue
         out.append(r.as_posix())
     return out
