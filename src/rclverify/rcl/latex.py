@@ -27,7 +27,8 @@ from typing import Union
 import jinja2
 
 from . import ast
-from .printer import MINUS_LEVEL, NOT_LEVEL, SUM_LEVEL, clarifying_parens, is_type, level, operand_levels
+from .printer import (BINARY_LEVEL, FLAT_CHAINS, MINUS_LEVEL, NOT_LEVEL, SUM_LEVEL, chain_operands, clarifying_parens,
+                      is_type, level, operand_levels)
 
 _TEX_SPECIALS = {
     "\\": r"\textbackslash{}", "_": r"\_", "{": r"\{", "}": r"\}", "$": r"\$", "&": r"\&",
@@ -147,6 +148,11 @@ class _Tex:
             if e.op == "not":
                 return r"\lnot " + self.expr(e.operand, NOT_LEVEL, open_right)
             return "-" + self.expr(e.operand, MINUS_LEVEL, open_right)
+        if isinstance(e, ast.Binary) and e.op in FLAT_CHAINS:
+            ops = chain_operands(e)
+            lv = BINARY_LEVEL[e.op]
+            return f" {_BINARY[e.op]} ".join(self.expr(o, lv + 1, open_right and k == len(ops) - 1)
+                                             for k, o in enumerate(ops))
         if isinstance(e, ast.Binary):
             lmin, rmin = operand_levels(e)
             lf = self.explicit and clarifying_parens(e, e.left)

@@ -31,7 +31,7 @@ from contextlib import contextmanager
 from functools import lru_cache
 from importlib import resources
 from pathlib import Path
-from typing import Any, Iterable, Iterator, Mapping, cast
+from typing import Any, Callable, Iterable, Iterator, Mapping, cast
 
 from lark import Lark, Token, Transformer
 from lark.parsers.lalr_analysis import Shift
@@ -124,6 +124,31 @@ class _ToAst(Transformer[Token, Any]):
         # operand's own location is the text inside them.  The node is held
         # so that its id stays unique for the whole parse.
         self.wrapped: dict[int, tuple[Any, ast.Loc]] = {}
+        # id(node) -> (node, nesting depth) for nodes deeper than a leaf.
+        self.depths: dict[int, tuple[Any, int]] = {}
+
+    def depth_of(self, x: Any) -> int:
+        """Nesting depth of a built value: 1 for a leaf, 0 for a token."""
+        if isinstance(x, tuple):
+            return max((self.depth_of(i) for i in x), default=0)
+        if isinstance(x, Token) or x is None:
+            return 0
+        got = self.depths.get(id(x))
+        return got[1] if got is not None else 1
+
+    def _track_chain(self, node: Any, operands: list[Any]) -> None:
+        """Record depths of a balanced chain's inner nodes and check the limit."""
+        leaves = {id(o) for o in operands}
+
+        def walk(n: Any) -> int:
+            if isinstance(n, ast.Binary) and id(n) not in leaves:
+                d = 1 + max(walk(n.left), walk(n.right))
+                self.depths[id(n)] = (n, d)
+                return d
+            return self.depth_of(n)
+        d = walk(node)
+        if d > NESTING_LIMIT:
+            raise RclError([error(node.loc, f"too deeply nested (limit {NESTING_LIMIT})", "E-depth")])
 
     # -- locations -------------------------------------------------------
     def _start(self, x: Any) -> tuple[int, int]:
@@ -259,10 +284,19 @@ class _ToAst(Transformer[Token, Any]):
         return self._bin("->", c)
 
     def disj(self, c: list[Any]) -> ast.Binary:
-        return self._bin("or", c)
+        return self._chain("or", c)
 
     def conj(self, c: list[Any]) -> ast.Binary:
-        return self._bin("and", c)
+        return self._chain("and", c)
+
+    def _chain(self, op: ast.BinaryOp, c: list[Any]) -> ast.Binary:
+        """A flat ``a op b op c ...`` chain as a balanced tree (see
+        :func:`balanced`): depth log2(n), so every recursive consumer copes
+        with chains of any length."""
+        operands = c[0::2]
+        node = balanced(op, operands, lambda a, b: self._span([a, b]))
+        self._track_chain(node, operands)
+        return node
 
     def add(self, c: list[Any]) -> ast.Binary:
         return self._bin("+", c)
@@ -360,6 +394,61 @@ class _ToAst(Transformer[Token, Any]):
             e = dataclasses.replace(e, parenthesised=True)
         self.wrapped[id(e)] = (e, self._span(c))
         return e
+
+
+#: Deepest nesting of expressions and types the parser accepts (AST depth;
+#: parentheses alone do not count, a balanced ``and``/``or`` chain of n
+#: operands counts log2(n)).  Deeper input is a located ``E-depth`` error
+#: instead of a ``RecursionError`` in a later stage (docs/rcl-language.md).
+NESTING_LIMIT = 200
+
+
+def balanced(op: ast.BinaryOp, operands: list[Any], span: Callable[[Any, Any], ast.Loc]) -> Any:
+    """The balanced tree of ``op`` over ``operands`` (n >= 1): the first
+    ceil(n/2) operands form the left subtree, the rest the right one, so two
+    and three operands give the left-nested tree a left-associative grammar
+    gives.  ``span(first, last)`` is the location of a subtree.  Also used by
+    the printer's round-trip check (printer.py); iterative (no recursion)."""
+    if len(operands) == 1:
+        return operands[0]
+    # Build bottom-up over (lo, hi) ranges with an explicit post-order stack.
+    result: dict[tuple[int, int], Any] = {}
+    stack: list[tuple[int, int, bool]] = [(0, len(operands), False)]
+    while stack:
+        lo, hi, ready = stack.pop()
+        if hi - lo == 1:
+            result[(lo, hi)] = operands[lo]
+            continue
+        mid = lo + (hi - lo + 1) // 2
+        if not ready:
+            stack += [(lo, hi, True), (mid, hi, False), (lo, mid, False)]
+            continue
+        left, right = result.pop((lo, mid)), result.pop((mid, hi))
+        result[(lo, hi)] = ast.Binary(op, left, right, span(operands[lo], operands[hi - 1]))
+    return result[(0, len(operands))]
+
+
+def _depth_tracked(fn: Callable[..., Any], inc: int = 1) -> Callable[..., Any]:
+    """Wrap a builder method so that the depth of what it builds is recorded
+    and checked against :data:`NESTING_LIMIT`."""
+    def wrapper(self: "_ToAst", c: list[Any]) -> Any:
+        d = inc + max((self.depth_of(x) for x in c), default=0)
+        if d > NESTING_LIMIT:
+            raise RclError([error(self._span(c), f"too deeply nested (limit {NESTING_LIMIT})", "E-depth")])
+        node = fn(self, c)
+        self.depths[id(node)] = (node, d)
+        return node
+    wrapper.__name__ = fn.__name__
+    return wrapper
+
+
+for _name in ("iff", "implies", "add", "sub", "mul", "div", "neg", "minus", "compare", "member", "not_member",
+              "apply", "quant", "bindings", "binding", "set_lit", "seq_lit", "tuple_lit",
+              "func_type", "set_type", "seq_type", "tuple_type", "alt", "alt_type", "io_var", "type_decl",
+              "const_decl"):
+    setattr(_ToAst, _name, _depth_tracked(getattr(_ToAst, _name)))
+for _name in ("paren", "type_atom"):
+    setattr(_ToAst, _name, _depth_tracked(getattr(_ToAst, _name), inc=0))
 
 
 _BUILDER = _ToAst()

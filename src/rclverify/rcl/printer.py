@@ -124,6 +124,28 @@ def is_type(d: object) -> bool:
     return isinstance(d, _TYPE_CLASSES)
 
 
+#: Associative connectives whose chains print flat (the parser reads a flat
+#: chain as a balanced tree, parser.balanced).
+FLAT_CHAINS = frozenset({"and", "or"})
+
+
+def chain_operands(e: ast.Binary) -> list[ast.Expr]:
+    """The operands of the maximal ``and``/``or`` chain rooted at ``e``, left
+    to right: nested nodes of the same operator are opened unless the source
+    parenthesised them (``Binary.parenthesised``).  Iterative, so a chain of
+    any length or shape (balanced from the parser, left-nested when built by
+    a program) prints flat without recursion."""
+    out: list[ast.Expr] = []
+    stack: list[ast.Expr] = [e.right, e.left]
+    while stack:
+        cur = stack.pop()
+        if isinstance(cur, ast.Binary) and cur.op == e.op and not cur.parenthesised:
+            stack += [cur.right, cur.left]
+        else:
+            out.append(cur)
+    return out
+
+
 def clarifying_parens(e: ast.Binary, operand: ast.Expr) -> bool:
     """Whether ``operand`` of ``e`` is an ``and``/``or`` directly under
     ``->``/``<=>``: parentheses there are not required by precedence but
@@ -181,6 +203,11 @@ def _expr(p: _Printer, e: ast.Expr) -> str:
             return "not " + p.wrap(e.operand, NOT_LEVEL)
         inner = p.wrap(e.operand, MINUS_LEVEL)
         return "-" + inner if not inner.startswith("-") else "- " + inner
+    if isinstance(e, ast.Binary) and e.op in FLAT_CHAINS:
+        # A parenthesised operand of the same operator keeps its parentheses
+        # (level + 1 forces them), so re-parsing gives the same tree.
+        lv = BINARY_LEVEL[e.op]
+        return f" {e.op} ".join(p.wrap(o, lv + 1) for o in chain_operands(e))
     if isinstance(e, ast.Binary):
         lmin, rmin = operand_levels(e)
         lf = p.explicit and clarifying_parens(e, e.left)
