@@ -25,6 +25,7 @@ from ..rcl.parser import parse_formula
 from ..rcl.typecheck import infer
 from ..rcl.types import BOOL, Checked
 from .errors import PlanError, plan_error
+from .yamlguard import check_size, compose_guarded
 
 Path_ = tuple[Any, ...]
 #: Marker in a location path: ``path + (key, KEY)`` is where the key itself is written.
@@ -143,12 +144,13 @@ def read_plan_data(root: Path, plan_rel: str) -> tuple[dict[str, Any], dict[Path
 
 def _read_plan_source(root: Path, plan_rel: str) -> tuple[dict[str, Any], dict[Path_, ast.Loc], Blocks]:
     p = root / plan_rel
+    check_size(p, plan_rel)
     try:
         text = p.read_text(encoding="utf-8")
     except (OSError, UnicodeDecodeError) as exc:
         raise plan_error(plan_rel, 1, 1, f"cannot read the verification plan: {getattr(exc, 'strerror', None) or exc}", "E-io") from None
     try:
-        node = yaml.compose(text, Loader=yaml.SafeLoader)
+        node = compose_guarded(text, plan_rel)
     except yaml.YAMLError as exc:
         mark = getattr(exc, "problem_mark", None)
         line, col = (mark.line + 1, mark.column + 1) if mark else (1, 1)
