@@ -34,7 +34,8 @@ _TEX_SPECIALS = {
     "\\": r"\textbackslash{}", "_": r"\_", "{": r"\{", "}": r"\}", "$": r"\$", "&": r"\&",
     "#": r"\#", "%": r"\%", "^": r"\^{}", "~": r"\~{}",
 }
-_BASE = {"REAL": r"\mathbb{R}", "INTEGER": r"\mathbb{Z}", "NATURAL": r"\mathbb{N}", "BOOL": r"\mathbb{B}"}
+_BASE = {"REAL": r"\mathbb{R}", "INTEGER": r"\mathbb{Z}", "NATURAL": r"\mathbb{N}", "BOOL": r"\mathbb{B}",
+         "STRING": r"\mathsf{STRING}"}
 _BINARY = {
     "<=>": r"\iff", "->": r"\Rightarrow", "or": r"\lor", "and": r"\land",
     "+": "+", "-": "-", "*": r"\cdot", "/": "/",
@@ -180,6 +181,17 @@ class _Tex:
             binds = ", ".join(self.binding(b) for b in e.bindings)
             s = f"{_QUANT[e.kind]} {binds} \\bullet {self.expr(e.body, 0, True)}"
             return s if open_right else f"({s})"
+        if isinstance(e, ast.StrLit):
+            return r"\texttt{``" + _tex_escape(e.value) + "''}"
+        if isinstance(e, ast.SeqRange):
+            return (r"\langle " + self.expr(e.lo, SUM_LEVEL, False) + r" \ldots "
+                    + self.expr(e.hi, SUM_LEVEL, False) + r" \rangle")
+        if isinstance(e, ast.TupleQuant):
+            d = e.domain
+            dom = type_to_latex(d) if is_type(d) else self.expr(d, SUM_LEVEL, False)  # type: ignore[arg-type]
+            names = ", ".join(name_to_latex(n) for n in e.names)
+            s = f"{_QUANT[e.kind]} ({names}) \\in {dom} \\bullet {self.expr(e.body, 0, True)}"
+            return s if open_right else f"({s})"
         raise TypeError(f"not an RCL expression: {e!r}")
 
     def binding(self, b: ast.Binding) -> str:
@@ -251,3 +263,12 @@ def to_latex(spec: ast.Spec, document: bool = True, explicit: bool = False) -> s
     } for n in spec.nodes]
     return _env().get_template("contracts.tex.j2").render(
         source=source, source_tex=escape(source), document=document, contexts=contexts, nodes=nodes)
+
+
+_TEX_SPECIAL = {"\\": r"\textbackslash{}", "{": r"\{", "}": r"\}", "$": r"\$", "&": r"\&", "#": r"\#",
+                "_": r"\_", "%": r"\%", "~": r"\textasciitilde{}", "^": r"\textasciicircum{}"}
+
+
+def _tex_escape(text: str) -> str:
+    """``text`` with LaTeX's special characters escaped (string literals)."""
+    return "".join(_TEX_SPECIAL.get(ch, ch) for ch in text)

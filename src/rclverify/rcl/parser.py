@@ -43,14 +43,14 @@ from .errors import Diagnostic, RclError, error
 _FRIENDLY = {
     "NAME": "a name", "IO_NAME": "an in./out. name", "NUMBER": "a number", "ROS_TYPE": "a ROS type",
     "CMP_OP": "a comparison", "EXISTS_BANG": "'exists!'", "$END": "end of file",
-    "BASE_TYPE": "REAL/INTEGER/NATURAL/BOOL",
+    "BASE_TYPE": "REAL/INTEGER/NATURAL/BOOL/STRING", "STRING_LIT": "a string", "LT": "'<'", "GT": "'>'",
 }
 
 # Terminals whose text is data; every other token (keywords, punctuation) is
 # syntax, kept in the children only for its position.  "QUANT" is the
 # quantifier-kind token the transformer itself makes.
 _VALUE_TERMINALS = frozenset({"NAME", "IO_NAME", "NUMBER", "ROS_TYPE", "CMP_OP", "BASE_TYPE", "EXISTS_BANG",
-                              "QUANT"})
+                              "QUANT", "STRING_LIT"})
 
 
 def grammar_text() -> str:
@@ -256,8 +256,10 @@ class _ToAst(Transformer[Token, Any]):
         return ast.TConstructors(tuple(alts), self._span(c))
 
     def func_type(self, c: list[Any]) -> ast.TFunc:
-        v = _vals(c)
-        return ast.TFunc(tuple(v[:-1]), v[-1], self._span(c))
+        arrow = next(k for k, x in enumerate(c) if isinstance(x, Token) and x.value == "-->")
+        args, res = _vals(c[:arrow]), _vals(c[arrow + 1:])
+        result = res[0] if len(res) == 1 else ast.TTuple(tuple(res), self._span(c[arrow + 1:]))
+        return ast.TFunc(tuple(args), result, self._span(c))
 
     def set_type(self, c: list[Any]) -> ast.TSet:
         return ast.TSet(_vals(c)[0], self._span(c))
@@ -385,6 +387,24 @@ class _ToAst(Transformer[Token, Any]):
     def seq_lit(self, c: list[Any]) -> ast.SeqLit:
         return ast.SeqLit(tuple(x for x in _vals(c) if x is not None), self._span(c))
 
+    def seq_range(self, c: list[Any]) -> ast.SeqRange:
+        v = _vals(c)
+        return ast.SeqRange(v[0], v[1], self._span(c))
+
+    def string(self, c: list[Any]) -> ast.StrLit:
+        return ast.StrLit(_unquote(str(c[0])), self._span(c))
+
+    def tuple_binder(self, c: list[Any]) -> list[Token]:
+        return [t for t in _vals(c)]
+
+    def tuple_quant(self, c: list[Any]) -> ast.TupleQuant:
+        v = _vals(c)
+        kind, names, domain, body = v[0], v[1], v[2], v[3]
+        if isinstance(domain, ast.Var) and domain.prefix is None:
+            domain = ast.TName(domain.name, domain.loc)
+        return ast.TupleQuant(str(kind), tuple(str(n) for n in names), domain, body,  # type: ignore[arg-type]
+                              self._span(c), tuple(self._span([n]) for n in names))
+
     def tuple_lit(self, c: list[Any]) -> ast.TupleLit:
         return ast.TupleLit(tuple(_vals(c)), self._span(c))
 
@@ -428,6 +448,11 @@ def balanced(op: ast.BinaryOp, operands: list[Any], span: Callable[[Any, Any], a
     return result[(0, len(operands))]
 
 
+def _unquote(text: str) -> str:
+    """The value of a ``STRING_LIT`` token: quotes removed, ``\\x`` -> ``x``."""
+    return re.sub(r"\\(.)", r"\1", text[1:-1])
+
+
 def _depth_tracked(fn: Callable[..., Any], inc: int = 1) -> Callable[..., Any]:
     """Wrap a builder method so that the depth of what it builds is recorded
     and checked against :data:`NESTING_LIMIT`."""
@@ -443,7 +468,7 @@ def _depth_tracked(fn: Callable[..., Any], inc: int = 1) -> Callable[..., Any]:
 
 
 for _name in ("iff", "implies", "add", "sub", "mul", "div", "neg", "minus", "compare", "member", "not_member",
-              "apply", "quant", "bindings", "binding", "set_lit", "seq_lit", "tuple_lit",
+              "apply", "quant", "tuple_quant", "seq_range", "bindings", "binding", "set_lit", "seq_lit", "tuple_lit",
               "func_type", "set_type", "seq_type", "tuple_type", "alt", "alt_type", "io_var", "type_decl",
               "const_decl"):
     setattr(_ToAst, _name, _depth_tracked(getattr(_ToAst, _name)))

@@ -224,7 +224,17 @@ def _expr(p: _Printer, e: ast.Expr) -> str:
     if isinstance(e, ast.SetLit):
         return "{" + p.items(e.items) + "}"
     if isinstance(e, ast.SeqLit):
-        return "[" + p.items(e.items) + "]"
+        # The paper's angle brackets; items at sum level (a comparison inside
+        # would read as the closing '>'), so anything looser is parenthesised.
+        return "<" + ", ".join(p.wrap(i, SUM_LEVEL) for i in e.items) + ">"
+    if isinstance(e, ast.SeqRange):
+        return f"<{p.wrap(e.lo, SUM_LEVEL)} upto {p.wrap(e.hi, SUM_LEVEL)}>"
+    if isinstance(e, ast.StrLit):
+        return '"' + e.value.replace("\\", "\\\\").replace('"', '\\"') + '"'
+    if isinstance(e, ast.TupleQuant):
+        d = e.domain
+        dom = type_to_rcl(d) if is_type(d) else p.wrap(d, SUM_LEVEL)  # type: ignore[arg-type]
+        return f"{e.kind}(({', '.join(e.names)}) in {dom} | {p.expr(e.body)})"
     if isinstance(e, ast.TupleLit):
         return "(" + p.items(e.items) + ")"
     if isinstance(e, ast.Quant):
