@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import dataclasses
 import gc
+from itertools import accumulate
 import re
 import threading
 from contextlib import contextmanager
@@ -124,31 +125,6 @@ class _ToAst(Transformer[Token, Any]):
         # operand's own location is the text inside them.  The node is held
         # so that its id stays unique for the whole parse.
         self.wrapped: dict[int, tuple[Any, ast.Loc]] = {}
-        # id(node) -> (node, nesting depth) for nodes deeper than a leaf.
-        self.depths: dict[int, tuple[Any, int]] = {}
-
-    def depth_of(self, x: Any) -> int:
-        """Nesting depth of a built value: 1 for a leaf, 0 for a token."""
-        if isinstance(x, tuple):
-            return max((self.depth_of(i) for i in x), default=0)
-        if isinstance(x, Token) or x is None:
-            return 0
-        got = self.depths.get(id(x))
-        return got[1] if got is not None else 1
-
-    def _track_chain(self, node: Any, operands: list[Any]) -> None:
-        """Record depths of a balanced chain's inner nodes and check the limit."""
-        leaves = {id(o) for o in operands}
-
-        def walk(n: Any) -> int:
-            if isinstance(n, ast.Binary) and id(n) not in leaves:
-                d = 1 + max(walk(n.left), walk(n.right))
-                self.depths[id(n)] = (n, d)
-                return d
-            return self.depth_of(n)
-        d = walk(node)
-        if d > NESTING_LIMIT:
-            raise RclError([error(node.loc, f"too deeply nested (limit {NESTING_LIMIT})", "E-depth")])
 
     # -- locations -------------------------------------------------------
     def _start(self, x: Any) -> tuple[int, int]:
@@ -173,7 +149,25 @@ class _ToAst(Transformer[Token, Any]):
                 return ast.Loc(self.file)
         if last is None or not (isinstance(last, Token) or hasattr(last, "loc")):
             last = next(x for x in reversed(c) if isinstance(x, Token) or hasattr(x, "loc"))
-        return ast.Loc(self.file, *self._start(first), *self._end(last))
+        # _start/_end inlined: this runs once per AST node (hot in parsing).
+        wrapped = self.wrapped
+        if isinstance(first, Token):
+            sl = first.line or 0
+            sc = (first.column or 0) + (self.dcol if sl == 1 else 0)
+            sl += self.dline
+        else:
+            w = wrapped.get(id(first)) if wrapped else None
+            loc = w[1] if w is not None else first.loc
+            sl, sc = loc.line, loc.col
+        if isinstance(last, Token):
+            el = last.end_line or 0
+            ec = (last.end_column or 0) + (self.dcol if el == 1 else 0)
+            el += self.dline
+        else:
+            w = wrapped.get(id(last)) if wrapped else None
+            loc = w[1] if w is not None else last.loc
+            el, ec = loc.end_line, loc.end_col
+        return ast.Loc(self.file, sl, sc, el, ec)
 
     # -- top level -----------------------------------------------------------
     def start(self, c: list[Any]) -> ast.Spec:
@@ -295,10 +289,9 @@ class _ToAst(Transformer[Token, Any]):
         """A flat ``a op b op c ...`` chain as a balanced tree (see
         :func:`balanced`): depth log2(n), so every recursive consumer copes
         with chains of any length."""
-        operands = c[0::2]
-        node = balanced(op, operands, lambda a, b: self._span([a, b]))
-        self._track_chain(node, operands)
-        return node
+        if len(c) == 3:
+            return ast.Binary(op, c[0], c[2], self._span(c))
+        return balanced(op, c[0::2], lambda a, b: self._span([a, b]))  # type: ignore[no-any-return]
 
     def add(self, c: list[Any]) -> ast.Binary:
         return self._bin("+", c)
@@ -453,29 +446,6 @@ def _unquote(text: str) -> str:
     return re.sub(r"\\(.)", r"\1", text[1:-1])
 
 
-def _depth_tracked(fn: Callable[..., Any], inc: int = 1) -> Callable[..., Any]:
-    """Wrap a builder method so that the depth of what it builds is recorded
-    and checked against :data:`NESTING_LIMIT`."""
-    def wrapper(self: "_ToAst", c: list[Any]) -> Any:
-        d = inc + max((self.depth_of(x) for x in c), default=0)
-        if d > NESTING_LIMIT:
-            raise RclError([error(self._span(c), f"too deeply nested (limit {NESTING_LIMIT})", "E-depth")])
-        node = fn(self, c)
-        self.depths[id(node)] = (node, d)
-        return node
-    wrapper.__name__ = fn.__name__
-    return wrapper
-
-
-for _name in ("iff", "implies", "add", "sub", "mul", "div", "neg", "minus", "compare", "member", "not_member",
-              "apply", "quant", "tuple_quant", "seq_range", "bindings", "binding", "set_lit", "seq_lit", "tuple_lit",
-              "func_type", "set_type", "seq_type", "tuple_type", "alt", "alt_type", "io_var", "type_decl",
-              "const_decl"):
-    setattr(_ToAst, _name, _depth_tracked(getattr(_ToAst, _name)))
-for _name in ("paren", "type_atom"):
-    setattr(_ToAst, _name, _depth_tracked(getattr(_ToAst, _name), inc=0))
-
-
 _BUILDER = _ToAst()
 _LOCK = threading.Lock()
 
@@ -585,11 +555,78 @@ def _parse(text: str, file: str, start: str, dline: int, dcol: int) -> Any:
     with _LOCK, _gc_paused():
         _BUILDER.reset(file, dline, dcol)
         try:
-            return parser.parse(text, start=start)
+            result = parser.parse(text, start=start)
         except UnexpectedInput as exc:
             raise _syntax_error(exc, file, text, dline, dcol) from None
         finally:
             _BUILDER.reset("<string>", 0, 0)
+    check_nesting(result, text, dline)
+    return result
+
+
+#: Fields that hold subtrees, per AST class (leaves are absent).
+_CHILD_FIELDS: dict[type, tuple[str, ...]] = {
+    ast.Binary: ("left", "right"), ast.Unary: ("operand",), ast.Compare: ("operands",),
+    ast.Member: ("elem", "collection"), ast.Apply: ("args",), ast.SetLit: ("items",), ast.SeqLit: ("items",),
+    ast.TupleLit: ("items",), ast.Quant: ("bindings", "body"), ast.Binding: ("domain",),
+    ast.TupleQuant: ("domain", "body"), ast.SeqRange: ("lo", "hi"), ast.ConstDecl: ("value", "type"),
+    ast.TypeDecl: ("type",), ast.IOVar: ("type",), ast.TFunc: ("args", "result"), ast.TSet: ("elem",),
+    ast.TSeq: ("elem",), ast.TTuple: ("elems",), ast.TConstructors: ("ctors",), ast.Constructor: ("args",),
+}
+
+
+def _too_deep(root: Any) -> Any | None:
+    """The first node (pre-order) at depth NESTING_LIMIT + 1 under ``root``,
+    or ``None``.  Iterative."""
+    stack: list[tuple[Any, int]] = [(root, 1)]
+    fields = _CHILD_FIELDS
+    while stack:
+        node, d = stack.pop()
+        if d > NESTING_LIMIT:
+            return node
+        for f in fields.get(type(node), ()):
+            v = getattr(node, f)
+            if isinstance(v, tuple):
+                stack.extend((x, d + 1) for x in v)
+            elif v is not None:
+                stack.append((v, d + 1))
+    return None
+
+
+def check_nesting(tree: Any, text: str, dline: int = 0) -> None:
+    """Raise a located ``E-depth`` :class:`RclError` when a formula or type
+    in ``tree`` (a :class:`~rclverify.rcl.ast.Spec` or an expression parsed
+    from ``text``, its lines shifted by ``dline``) nests deeper than
+    :data:`NESTING_LIMIT` (AST depth: parentheses alone do not count, a
+    balanced ``and``/``or`` chain of n operands counts log2(n)).
+
+    Every level of nesting takes at least one character, so only the
+    declarations and clauses whose text is longer than the limit are
+    walked: the check costs next to nothing on ordinary contracts."""
+    roots: list[Any] = []
+    if isinstance(tree, ast.Spec):
+        for c in tree.contexts:
+            roots += c.decls
+        for n in tree.nodes:
+            roots += n.inputs + n.outputs
+            roots += [cl.formula for cl in n.assumes + n.guarantees]
+    else:
+        roots.append(tree)
+    starts: list[int] | None = None
+    for r in roots:
+        loc = r.loc
+        if loc.end_line == loc.line:
+            if loc.end_col - loc.col <= NESTING_LIMIT:
+                continue
+        else:
+            if starts is None:
+                starts = [0, *accumulate(len(line) + 1 for line in text.split("\n"))]
+            a, b = loc.line - dline - 1, loc.end_line - dline - 1
+            if 0 <= a < b < len(starts) and starts[b] + loc.end_col - starts[a] - loc.col <= NESTING_LIMIT:
+                continue
+        bad = _too_deep(r)
+        if bad is not None:
+            raise RclError([error(bad.loc, f"too deeply nested (limit {NESTING_LIMIT})", "E-depth")])
 
 
 def ast_from_tree(tree: Any, file: str = "<string>") -> Any:
