@@ -8,7 +8,7 @@ arithmetic and topics.  For each N it prints:
 
 * the file size,
 * the LALR(1) parse time, text to AST (``rclverify.rcl.parser.parse_text``;
-  best of ``--repeat`` runs for N <= 160) and the time per node,
+  best of ``--repeat`` runs for N <= 1000) and the time per node,
 * the type-check time (``rclverify.rcl.typecheck.check``; the column is
   skipped with a note when the checker cannot be imported),
 * the peak Python memory of parse + check (tracemalloc, in a separate run so
