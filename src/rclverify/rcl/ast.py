@@ -16,13 +16,12 @@ Shapes
 """
 from __future__ import annotations
 
-import dataclasses
 from dataclasses import dataclass, field
 from fractions import Fraction
 from typing import Literal, Union
 
 
-@dataclass(frozen=True, init=False)
+@dataclass(frozen=True)
 class Loc:
     """A source location: 1-based line and column of the first character.
 
@@ -35,13 +34,6 @@ class Loc:
     col: int = 0
     end_line: int = 0
     end_col: int = 0
-
-    def __init__(self, file: str = "<string>", line: int = 0, col: int = 0, end_line: int = 0,
-                 end_col: int = 0) -> None:
-        # One dict update instead of the five object.__setattr__ calls of a
-        # generated frozen __init__: the parser makes one Loc per AST node,
-        # and this keeps parsing as fast as before the grammar grew.
-        self.__dict__.update(file=file, line=line, col=col, end_line=end_line, end_col=end_col)
 
     def __str__(self) -> str:
         return f"{self.file}:{self.line}:{self.col}"
@@ -454,30 +446,3 @@ class Spec:
     nodes: tuple[Node, ...]
     file: str = field(default="<string>", compare=False)
 
-
-def _fast_frozen_init(cls: type) -> None:
-    """Give the frozen dataclass ``cls`` an ``__init__`` that fills the
-    instance dict in one update instead of one ``object.__setattr__`` call
-    per field (what the generated frozen ``__init__`` does).  Same
-    signature, defaults and resulting object; the parser builds one node per
-    piece of syntax, so this keeps parsing as fast as before the grammar
-    grew (bench/parse_scale.py)."""
-    flds = dataclasses.fields(cls)
-    params, env = [], {}
-    for f in flds:
-        if f.default is not dataclasses.MISSING:
-            env[f"_d_{f.name}"] = f.default
-            params.append(f"{f.name}=_d_{f.name}")
-        else:
-            params.append(f.name)
-    body = ", ".join(f"{f.name}={f.name}" for f in flds)
-    src = f"def __init__(self, {', '.join(params)}):\n    self.__dict__.update({body})\n"
-    exec(src, env)  # noqa: S102 - generated from the class's own field list
-    init = env["__init__"]
-    init.__qualname__ = f"{cls.__qualname__}.__init__"
-    cls.__init__ = init  # type: ignore[misc]
-
-
-for _cls in list(globals().values()):
-    if isinstance(_cls, type) and dataclasses.is_dataclass(_cls) and _cls.__module__ == __name__ and _cls is not Loc:
-        _fast_frozen_init(_cls)

@@ -215,7 +215,7 @@ class _Checker:
 
     # -- expressions ----------------------------------------------------------------
     def var(self, v: ast.Var, node: CheckedNode | None, bound: Mapping[str, Type]) -> Type:
-        if v.name not in bound and ((v.prefix, v.name) in self.failed_io or (
+        if (self.failed_io or self.failed_consts) and v.name not in bound and ((v.prefix, v.name) in self.failed_io or (
                 v.prefix is None and (("in", v.name) in self.failed_io or ("out", v.name) in self.failed_io
                                       or v.name in self.failed_consts))):
             raise _Fail  # its declaration already has an error; no knock-on message
