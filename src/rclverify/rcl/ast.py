@@ -21,7 +21,7 @@ from fractions import Fraction
 from typing import Literal, Union
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, slots=True)
 class Loc:
     """A source location: 1-based line and column of the first character.
 
