@@ -102,7 +102,7 @@ def _is_syntax(x: Any) -> bool:
 
 def _vals(c: list[Any]) -> list[Any]:
     """The data children of a rule (syntax tokens dropped, placeholders kept)."""
-    return [x for x in c if not _is_syntax(x)]
+    return [x for x in c if not (isinstance(x, Token) and x.type not in _VALUE_TERMINALS)]  # _is_syntax, inlined
 
 
 class _ToAst(Transformer[Token, Any]):
