@@ -8,7 +8,7 @@ arithmetic and topics.  For each N it prints:
 
 * the file size,
 * the LALR(1) parse time, text to AST (``rclverify.rcl.parser.parse_text``;
-  best of ``--repeat`` runs for N <= 160) and the time per node,
+  best of ``--repeat`` runs for N <= 1000) and the time per node,
 * the type-check time (``rclverify.rcl.typecheck.check``; the column is
   skipped with a note when the checker cannot be imported),
 * the peak Python memory of parse + check (tracemalloc, in a separate run so
@@ -20,6 +20,11 @@ arithmetic and topics.  For each N it prints:
   is lark's default for Earley (``dynamic``); ``--earley-lexer basic``
   measures the faster basic-lexer Earley, a lower bound on the speed-up.
 
+* the same parse and type-check with the front end as it was before the
+  full-language work (bench/before_issue11/: the old grammar, AST builder
+  and checker, loaded as modules), and the ratio new / old of each
+  (1.00 = same speed; below 1 = faster now).
+
 Times are CPU seconds of the benchmark process (less disturbed by other
 work on a shared machine than wall-clock time; still expect +-25%).
 Finally it prints the log-log slope of the LALR parse time against N
@@ -29,17 +34,19 @@ the basic Earley lexer cannot tell from the keyword.
 
 Usage::
 
-    python bench/parse_scale.py                 # N = 10 40 160 640 1000
+    python bench/parse_scale.py                 # N = 10 40 160 640 1000 5000
     python bench/parse_scale.py --sizes 10 100  # or --sizes 10,100
 """
 from __future__ import annotations
 
 import argparse
+import importlib
 import math
 import sys
 import time
 import tracemalloc
-from typing import Callable, Sequence, TypeVar
+from pathlib import Path
+from typing import Any, Callable, Sequence, TypeVar
 
 from lark import Lark
 
@@ -83,6 +90,25 @@ node Stage{k} {{
 """
 
 
+BEFORE = Path(__file__).resolve().parent / "before_issue11"
+
+
+def before_front_end() -> tuple[Callable[[str, str], Any], Callable[[list[Any]], Any]]:
+    """``(parse_text, check)`` of the front end before the full-language
+    work: bench/before_issue11/ imported as a package of its own (old AST,
+    parser, checker and types), its parser reading the old grammar file."""
+    sys.path.insert(0, str(BEFORE.parent))
+    try:
+        parser = importlib.import_module("before_issue11.parser")
+        checker = importlib.import_module("before_issue11.typecheck")
+    finally:
+        sys.path.remove(str(BEFORE.parent))
+    grammar = (BEFORE / "rcl.lark").read_text(encoding="utf-8")
+    parser.grammar_text = lambda: grammar
+    parser._lark.cache_clear()
+    return parser.parse_text, checker.check
+
+
 def generate(n: int) -> str:
     """RCL text of an ``n``-node chain: one context clause and nodes
     ``Stage1`` .. ``Stage<n>``; node k's inputs are node k-1's outputs
@@ -121,14 +147,14 @@ def _sizes(values: Sequence[str]) -> list[int]:
 
 def main(argv: Sequence[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--sizes", nargs="+", default=["10", "40", "160", "640", "1000"],
+    ap.add_argument("--sizes", nargs="+", default=["10", "40", "160", "640", "1000", "5000"],
                     help="numbers of nodes (space or comma separated)")
     ap.add_argument("--earley-max", type=int, default=160, help="largest N also parsed with Earley")
     ap.add_argument("--earley-lexer", choices=["dynamic", "basic"], default="dynamic",
                     help="Earley lexer: 'dynamic' (lark's default for Earley; default) or 'basic' "
                          "(the faster Earley, hence a smaller, conservative speed-up)")
     ap.add_argument("--repeat", type=int, default=3,
-                    help="timing runs of the LALR parse and the check for N <= 160, the best is kept "
+                    help="timing runs of the parses and checks for N <= 1000, the best is kept "
                          "(larger N, and Earley: one run)")
     args = ap.parse_args(argv)
     sizes = _sizes(args.sizes)
@@ -143,8 +169,11 @@ def main(argv: Sequence[str] | None = None) -> int:
     earley = Lark(grammar_text(), parser="earley", lexer=args.earley_lexer, keep_all_tokens=True,
                   maybe_placeholders=True)
     parse_text("context { }")  # build the LALR tables outside the measurements
+    old_parse, old_check = before_front_end()
+    old_parse("context { }", "warm-up")
 
     header = (f"{'N':>5} {'size KB':>8} {'parse s':>8} {'ms/node':>8} {'check s':>8} {'peak MB':>8} "
+              f"{'old parse':>9} {'old check':>9} {'parse new/old':>13} {'check new/old':>13} "
               f"{'Earley s':>9} {'speed-up':>9}  same AST")
     print(f"CPU seconds. parse = LALR(1), text -> AST; Earley = {args.earley_lexer}-lexer Earley, "
           "text -> parse tree only")
@@ -154,9 +183,15 @@ def main(argv: Sequence[str] | None = None) -> int:
     for n in sizes:
         text = generate(n)
         name = f"stage{n}.rcl"
-        repeat = args.repeat if n <= 160 else 1
+        repeat = args.repeat if n <= 1000 else 1
         t_parse, spec = best_of(repeat, lambda: parse_text(text, name))
-        t_check = best_of(repeat, lambda: check([spec]))[0] if check is not None else None
+        t_old_parse, old_spec = best_of(repeat, lambda: old_parse(text, name))
+        # The checks run with the cyclic GC paused (both alike): otherwise a
+        # collection of the large heap lands in one or the other at random.
+        with gc_paused():
+            t_check = best_of(repeat, lambda: check([spec]))[0] if check is not None else None
+            t_old_check = best_of(repeat, lambda: old_check([old_spec]))[0]
+        del old_spec
 
         tracemalloc.start()
         spec2 = parse_text(text, name)
@@ -174,8 +209,10 @@ def main(argv: Sequence[str] | None = None) -> int:
             same = "yes" if ast_from_tree(tree, name) == spec else "NO"
             del tree
         check_col = f"{t_check:8.3f}" if t_check is not None else f"{'n/a':>8}"
+        check_ratio = f"{t_check / t_old_check:13.2f}" if t_check is not None else f"{'n/a':>13}"
         print(f"{n:5d} {len(text.encode()) / 1024:8.1f} {t_parse:8.3f} {1000 * t_parse / n:8.2f} "
-              f"{check_col} {peak:8.1f} {earley_col} {speed_col}  {same}", flush=True)
+              f"{check_col} {peak:8.1f} {t_old_parse:9.3f} {t_old_check:9.3f} {t_parse / t_old_parse:13.2f} "
+              f"{check_ratio} {earley_col} {speed_col}  {same}", flush=True)
         ns.append(n)
         times.append(t_parse)
     if len(ns) >= 2:

@@ -36,12 +36,14 @@ def _print_diags(exc: RclError) -> int:
 
 
 def cmd_check(args: argparse.Namespace) -> int:
+    from .rcl.filewarn import file_warnings
     from .rcl.lint import lint
     from .rcl.parser import parse_files
     from .rcl.typecheck import check
     specs = parse_files(args.files)
     check(specs)
-    warnings = [d for s in specs for d in lint(s)]
+    warnings = [d for s in specs for d in file_warnings(s)]
+    warnings += [d for s in specs for d in lint(s)]
     for d in warnings:
         print(d)
     print(f"{len(args.files)} file(s): 0 errors, {len(warnings)} warning(s)")
@@ -54,14 +56,23 @@ def cmd_latex(args: argparse.Namespace) -> int:
     from .rcl.typecheck import check
     spec = parse_file(args.file)
     check([spec])
-    print(to_latex(spec), end="")
-    return 0
+    return _emit(to_latex(spec), args.output)
 
 
 def cmd_fmt(args: argparse.Namespace) -> int:
     from .rcl.parser import parse_file
     from .rcl.printer import to_rcl
-    print(to_rcl(parse_file(args.file)), end="")
+    return _emit(to_rcl(parse_file(args.file)), args.output)
+
+
+def _emit(text: str, output: str | None) -> int:
+    """Write ``text`` to stdout, or atomically to the file ``output``
+    (``-o FILE``; a write error is a located ``E-io`` error, exit 1)."""
+    if output is None:
+        print(text, end="")
+        return 0
+    from .rcl.output import write_atomic
+    write_atomic(Path(output), text)
     return 0
 
 
@@ -261,6 +272,8 @@ def cmd_monitor(args: argparse.Namespace) -> int:
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``rclverify`` console script; returns the exit code."""
     p = argparse.ArgumentParser(prog="rclverify", description="Compositional verification from RCL contracts.")
+    from . import __version__
+    p.add_argument("--version", action="version", version=f"rclverify {__version__}")
     sub = p.add_subparsers(dest="command", required=True)
 
     def add(name: str, fn: Callable[[argparse.Namespace], int], help: str, workspace: bool = False) -> argparse.ArgumentParser:
@@ -272,8 +285,11 @@ def main(argv: Sequence[str] | None = None) -> int:
         return sp
 
     add("check", cmd_check, "parse, type-check and lint RCL files").add_argument("files", nargs="+")
-    add("latex", cmd_latex, "print RCL contracts as LaTeX").add_argument("file")
-    add("fmt", cmd_fmt, "print RCL contracts in canonical form").add_argument("file")
+    for name, fn, what in (("latex", cmd_latex, "print RCL contracts as LaTeX"),
+                           ("fmt", cmd_fmt, "print RCL contracts in canonical form")):
+        sp = add(name, fn, what)
+        sp.add_argument("file")
+        sp.add_argument("-o", "--output", metavar="FILE", help="write to FILE instead of standard output")
     add("graph", cmd_graph, "write the system model as Graphviz DOT (and SVG)", True).add_argument("-o", "--output")
     add("compose", cmd_compose, "apply the calculus: side conditions and derived properties", True)
     add("health", cmd_health, "contract consistency and vacuity checks", True).add_argument("nodes", nargs="*")
@@ -313,6 +329,11 @@ def main(argv: Sequence[str] | None = None) -> int:
         return _print_diags(exc)
     except KeyboardInterrupt:
         return 130
+    except RecursionError:
+        # Last line of defence: the parser bounds nesting (rcl/parser.py
+        # NESTING_LIMIT), so this means a stage built a deeper formula itself.
+        print(f"error: {args.command}: input too deeply nested for this stage", file=sys.stderr)
+        return 1
 
 
 if __name__ == "__main__":  # pragma: no cover

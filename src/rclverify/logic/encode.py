@@ -33,7 +33,7 @@ import z3
 from ..rcl import ast
 from ..rcl.types import (BOOL, NATURAL, CheckedNode, DataT, EmptyT, EnumT, Env, FuncT, Scalar, SeqT,
                          SetT, TupleT, Type)
-from ..rcl.printer import is_type
+from ..rcl.printer import FLAT_CHAINS, chain_operands, is_type
 from ..rcl.typecheck import domain_type
 
 _SORTS: dict[Type, Any] = {}
@@ -77,7 +77,8 @@ def sort_of(t: Type) -> z3.SortRef:
         return _SORTS[t]
     s: Any
     if isinstance(t, Scalar):
-        s = {"REAL": z3.RealSort(), "INTEGER": z3.IntSort(), "NATURAL": z3.IntSort(), "BOOL": z3.BoolSort()}[t.name]
+        s = {"REAL": z3.RealSort(), "INTEGER": z3.IntSort(), "NATURAL": z3.IntSort(), "BOOL": z3.BoolSort(),
+             "STRING": z3.StringSort()}[t.name]
     elif isinstance(t, EnumT):
         s, consts = z3.EnumSort(_sort_name(t, t.name), list(t.values))
         for v, c in zip(t.values, consts):
@@ -349,7 +350,57 @@ class _Ctx:
         return z3.Not(v) if x.op == "not" else -v
 
     def e_Binary(self, x: ast.Binary, b: Mapping[str, Any]) -> Any:
+        if x.op in FLAT_CHAINS:
+            # One n-ary And/Or over the whole chain, opened iteratively, so a
+            # chain of any length or shape (also one built by a program,
+            # left-nested) encodes without deep recursion.
+            parts = [self.enc(o, b) for o in chain_operands(x)]
+            return z3.And(*parts) if x.op == "and" else z3.Or(*parts)
         return apply_operator(x.op, self.enc(x.left, b), self.enc(x.right, b))
+
+    def e_StrLit(self, x: ast.StrLit, b: Mapping[str, Any]) -> Any:
+        return z3.StringVal(x.value)
+
+    def e_SeqRange(self, x: ast.SeqRange, b: Mapping[str, Any]) -> Any:
+        lo, hi = x.lo, x.hi
+        if isinstance(lo, ast.NumLit) and isinstance(hi, ast.NumLit) and lo.is_integral and hi.is_integral:
+            a, z = int(lo.value), int(hi.value)
+            if z - a + 1 > MAX_RANGE_ITEMS:
+                raise EncodingError(x.loc, f"a range of {z - a + 1} items is above the Z3 encoding's limit of "
+                                           f"{MAX_RANGE_ITEMS}; not supported by backend z3")
+            if z < a:
+                return z3.Empty(z3.SeqSort(z3.IntSort()))
+            units = [z3.Unit(z3.IntVal(k)) for k in range(a, z + 1)]
+            return units[0] if len(units) == 1 else z3.Concat(*units)
+        raise EncodingError(x.loc, "a range with non-literal bounds is only supported on the right of 'in' "
+                                   "by backend z3")
+
+    def e_TupleQuant(self, x: ast.TupleQuant, b: Mapping[str, Any]) -> Any:
+        """``Q((u, v) in S | body)``: one bound variable per component, and
+        the tuple they form must be an element of ``S`` (no guard when ``S``
+        is a tuple type)."""
+        probe = ast.Binding(("_tuple",), x.domain, x.loc)
+        t = domain_type(probe, self.node, self.e.env, self._bound_types(b))
+        if not isinstance(t, TupleT) or len(t.elems) != len(x.names):
+            raise EncodingError(x.loc, f"{len(x.names)} names cannot take apart an element of type {t}")
+        inner = dict(b)
+        xs: list[z3.ExprRef] = []
+        guards: list[Any] = []
+        for nm, ct in zip(x.names, t.elems):
+            if isinstance(ct, (FuncT, EmptyT)):
+                raise EncodingError(x.loc, f"quantifying over {ct} is not supported by backend z3")
+            v = z3.Const(smt_symbol(nm), sort_of(ct))
+            self.var_types[v.get_id()] = ct
+            inner[nm] = v
+            xs.append(v)
+            if ct == NATURAL:
+                guards.append(v >= 0)
+        d = x.domain
+        if not is_type(d) or (isinstance(d, ast.TName) and d.name not in self.e.env.types):
+            coll = ast.Var(d.name, None, d.loc) if isinstance(d, ast.TName) else cast(ast.Expr, d)
+            tup = cast(z3.DatatypeSortRef, sort_of(t)).constructor(0)(*xs)
+            guards.append(self.member(tup, coll, b))
+        return self._close(x.kind, xs, guards, self.enc(x.body, inner))
 
     def e_Compare(self, x: ast.Compare, b: Mapping[str, Any]) -> Any:
         vals = [self.enc(o, b) for o in x.operands]
@@ -358,6 +409,10 @@ class _Ctx:
 
     def member(self, elem: Any, coll: ast.Expr, b: Mapping[str, Any]) -> Any:
         env = self.e.env
+        if isinstance(coll, ast.SeqRange):
+            lo, hi = self.enc(coll.lo, b), self.enc(coll.hi, b)
+            integral = z3.IsInt(elem) if z3.is_real(elem) else z3.BoolVal(True)
+            return z3.And(integral, lo <= elem, elem <= hi)
         if isinstance(coll, ast.SetLit) or isinstance(coll, ast.SeqLit):
             items = [self.enc(i, b) for i in coll.items]
             eqs = [(lambda p: p[0] == p[1])(coerce(elem, i)) for i in items]
@@ -425,12 +480,16 @@ class _Ctx:
                     coll = (ast.Var(bd.domain.name, None, bd.domain.loc) if isinstance(bd.domain, ast.TName)
                             else cast(ast.Expr, bd.domain))  # a term domain: is_type said so
                     guards.append(self.member(v, coll, b))
-        body = self.enc(x.body, inner)
+        return self._close(x.kind, xs, guards, self.enc(x.body, inner))
+
+    @staticmethod
+    def _close(kind: str, xs: list[z3.ExprRef], guards: list[Any], body: Any) -> Any:
+        """The Z3 quantifier ``kind`` over ``xs`` with ``guards`` on them."""
         guard = z3.And(*guards) if guards else None
-        if x.kind == "forall":
+        if kind == "forall":
             return z3.ForAll(xs, z3.Implies(guard, body) if guard is not None else body)
         core = z3.And(guard, body) if guard is not None else body
-        if x.kind == "exists":
+        if kind == "exists":
             return z3.Exists(xs, core)
         ys = [z3.Const(str(v) + "_u", v.sort()) for v in xs]
         body_y = z3.substitute(core, *zip(xs, ys))
@@ -447,6 +506,10 @@ class _Ctx:
             if t is not None:
                 out[nm] = t
         return out
+
+
+#: Largest ``<a upto b>`` with literal bounds the Z3 encoding spells out.
+MAX_RANGE_ITEMS = 10_000
 
 
 def value_to_rcl(v: z3.ExprRef) -> str:

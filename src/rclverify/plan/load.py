@@ -25,6 +25,7 @@ from ..rcl.parser import parse_formula
 from ..rcl.typecheck import infer
 from ..rcl.types import BOOL, Checked
 from .errors import PlanError, plan_error
+from .yamlguard import check_size, compose_guarded
 
 Path_ = tuple[Any, ...]
 #: Marker in a location path: ``path + (key, KEY)`` is where the key itself is written.
@@ -123,13 +124,26 @@ def _to_py(node: yaml.Node, path: Path_, locs: dict[Path_, ast.Loc], file: str, 
     if isinstance(node, yaml.MappingNode):
         out: dict[Any, Any] = {}
         for k, v in node.value:
-            key = yaml.safe_load(yaml.serialize(k)) if not isinstance(k, yaml.ScalarNode) else k.value
+            if not isinstance(k, yaml.ScalarNode):
+                raise plan_error(file, k.start_mark.line + 1, k.start_mark.column + 1,
+                                 "a mapping key must be a plain value, not a list or a mapping", "E-yaml")
+            key = k.value
             out[key] = _to_py(v, path + (key,), locs, file, lines, blocks)
             locs[path + (key, KEY)] = ast.Loc(file, k.start_mark.line + 1, k.start_mark.column + 1)
         return out
     if isinstance(node, yaml.SequenceNode):
         return [_to_py(v, path + (i,), locs, file, lines, blocks) for i, v in enumerate(node.value)]
-    return yaml.safe_load(yaml.serialize(node))
+    return _construct(node)
+
+
+def _construct(node: yaml.Node) -> Any:
+    """The plain value of ``node`` by PyYAML's safe constructor (an unknown
+    tag raises ``yaml.YAMLError`` with the node's mark)."""
+    loader = yaml.SafeLoader("")
+    try:
+        return loader.construct_object(node, deep=True)
+    finally:
+        loader.dispose()
 
 
 def read_plan_data(root: Path, plan_rel: str) -> tuple[dict[str, Any], dict[Path_, ast.Loc]]:
@@ -143,19 +157,25 @@ def read_plan_data(root: Path, plan_rel: str) -> tuple[dict[str, Any], dict[Path
 
 def _read_plan_source(root: Path, plan_rel: str) -> tuple[dict[str, Any], dict[Path_, ast.Loc], Blocks]:
     p = root / plan_rel
+    check_size(p, plan_rel)
     try:
         text = p.read_text(encoding="utf-8")
     except (OSError, UnicodeDecodeError) as exc:
         raise plan_error(plan_rel, 1, 1, f"cannot read the verification plan: {getattr(exc, 'strerror', None) or exc}", "E-io") from None
     try:
-        node = yaml.compose(text, Loader=yaml.SafeLoader)
+        node = compose_guarded(text, plan_rel)
     except yaml.YAMLError as exc:
         mark = getattr(exc, "problem_mark", None)
         line, col = (mark.line + 1, mark.column + 1) if mark else (1, 1)
         raise plan_error(plan_rel, line, col, f"invalid YAML: {getattr(exc, 'problem', exc)}", "E-yaml") from None
     locs: dict[Path_, ast.Loc] = {}
     blocks: Blocks = {}
-    data = _to_py(node, (), locs, plan_rel, text.splitlines(), blocks) if node is not None else None
+    try:
+        data = _to_py(node, (), locs, plan_rel, text.splitlines(), blocks) if node is not None else None
+    except yaml.YAMLError as exc:  # e.g. a tag the safe loader does not construct
+        mark = getattr(exc, "problem_mark", None) or getattr(exc, "context_mark", None)
+        line, col = (mark.line + 1, mark.column + 1) if mark else (1, 1)
+        raise plan_error(plan_rel, line, col, f"invalid YAML: {getattr(exc, 'problem', exc)}", "E-yaml") from None
     if not isinstance(data, dict):
         raise plan_error(plan_rel, 1, 1, "the verification plan must be a mapping with a 'contracts' list")
     errors = sorted(jsonschema.Draft202012Validator(_schema()).iter_errors(data), key=lambda e: list(map(str, e.absolute_path)))

@@ -21,7 +21,7 @@ from fractions import Fraction
 from typing import Literal, Union
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, slots=True)
 class Loc:
     """A source location: 1-based line and column of the first character.
 
@@ -50,12 +50,14 @@ def _loc() -> Loc:
 # Types
 # --------------------------------------------------------------------------
 
-BaseName = Literal["REAL", "INTEGER", "NATURAL", "BOOL"]
+BaseName = Literal["REAL", "INTEGER", "NATURAL", "BOOL", "STRING"]
 
 
 @dataclass(frozen=True)
 class TBase:
-    """A built-in scalar type: ``REAL``, ``INTEGER``, ``NATURAL`` or ``BOOL``."""
+    """A built-in scalar type: ``REAL``, ``INTEGER``, ``NATURAL``, ``BOOL``,
+    or ``STRING`` (character strings, e.g. values read from ROS ``string``
+    topics)."""
 
     name: BaseName
     loc: Loc = _loc()
@@ -310,7 +312,49 @@ class Quant:
         return tuple(n for b in self.bindings for n in b.names)
 
 
-Expr = Union[Var, BoolLit, NumLit, Apply, Unary, Binary, Compare, Member, SetLit, TupleLit, SeqLit, Quant]
+@dataclass(frozen=True)
+class StrLit:
+    """A string literal ``"hello"``; ``value`` is the text between the quotes
+    with the escapes ``\\"`` and ``\\\\`` resolved.  Type ``STRING``."""
+
+    value: str
+    loc: Loc = _loc()
+
+
+@dataclass(frozen=True)
+class SeqRange:
+    """``<lo upto hi>``: the sequence of the integers ``lo, lo+1, ..., hi``
+    (empty when ``hi < lo``).  Type ``seq(INTEGER)`` (``seq(NATURAL)`` when
+    both bounds are natural numbers)."""
+
+    lo: "Expr"
+    hi: "Expr"
+    loc: Loc = _loc()
+
+
+@dataclass(frozen=True)
+class TupleQuant:
+    """A quantifier over the tuples of a collection, destructured:
+    ``forall((u, v) in S | body)`` binds ``u`` and ``v`` to the components
+    of each element of ``S`` (a set or sequence of tuples, or a tuple type).
+    ``exists`` and ``exists_unique`` likewise (unique: exactly one element).
+    A separate node class so that consumers which only know :class:`Quant`
+    reject it rather than misread it."""
+
+    kind: QuantKind
+    names: tuple[str, ...]
+    domain: Union[TypeExpr, "Expr"]
+    body: "Expr"
+    loc: Loc = _loc()
+    name_locs: tuple[Loc, ...] = field(default=(), compare=False, repr=False)
+
+    @property
+    def variables(self) -> tuple[str, ...]:
+        return self.names
+
+
+Expr = Union[Var, BoolLit, NumLit, Apply, Unary, Binary, Compare, Member, SetLit, TupleLit, SeqLit, Quant,
+             StrLit, SeqRange, TupleQuant]
 
 
 # --------------------------------------------------------------------------
@@ -401,3 +445,4 @@ class Spec:
     contexts: tuple[Context, ...]
     nodes: tuple[Node, ...]
     file: str = field(default="<string>", compare=False)
+

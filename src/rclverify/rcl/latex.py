@@ -27,13 +27,15 @@ from typing import Union
 import jinja2
 
 from . import ast
-from .printer import MINUS_LEVEL, NOT_LEVEL, SUM_LEVEL, clarifying_parens, is_type, level, operand_levels
+from .printer import (BINARY_LEVEL, FLAT_CHAINS, MINUS_LEVEL, NOT_LEVEL, SUM_LEVEL, chain_operands, clarifying_parens,
+                      is_type, level, operand_levels)
 
 _TEX_SPECIALS = {
     "\\": r"\textbackslash{}", "_": r"\_", "{": r"\{", "}": r"\}", "$": r"\$", "&": r"\&",
     "#": r"\#", "%": r"\%", "^": r"\^{}", "~": r"\~{}",
 }
-_BASE = {"REAL": r"\mathbb{R}", "INTEGER": r"\mathbb{Z}", "NATURAL": r"\mathbb{N}", "BOOL": r"\mathbb{B}"}
+_BASE = {"REAL": r"\mathbb{R}", "INTEGER": r"\mathbb{Z}", "NATURAL": r"\mathbb{N}", "BOOL": r"\mathbb{B}",
+         "STRING": r"\mathsf{STRING}"}
 _BINARY = {
     "<=>": r"\iff", "->": r"\Rightarrow", "or": r"\lor", "and": r"\land",
     "+": "+", "-": "-", "*": r"\cdot", "/": "/",
@@ -147,6 +149,11 @@ class _Tex:
             if e.op == "not":
                 return r"\lnot " + self.expr(e.operand, NOT_LEVEL, open_right)
             return "-" + self.expr(e.operand, MINUS_LEVEL, open_right)
+        if isinstance(e, ast.Binary) and e.op in FLAT_CHAINS:
+            ops = chain_operands(e)
+            lv = BINARY_LEVEL[e.op]
+            return f" {_BINARY[e.op]} ".join(self.expr(o, lv + 1, open_right and k == len(ops) - 1)
+                                             for k, o in enumerate(ops))
         if isinstance(e, ast.Binary):
             lmin, rmin = operand_levels(e)
             lf = self.explicit and clarifying_parens(e, e.left)
@@ -173,6 +180,17 @@ class _Tex:
         if isinstance(e, ast.Quant):
             binds = ", ".join(self.binding(b) for b in e.bindings)
             s = f"{_QUANT[e.kind]} {binds} \\bullet {self.expr(e.body, 0, True)}"
+            return s if open_right else f"({s})"
+        if isinstance(e, ast.StrLit):
+            return r"\texttt{``" + _tex_escape(e.value) + "''}"
+        if isinstance(e, ast.SeqRange):
+            return (r"\langle " + self.expr(e.lo, SUM_LEVEL, False) + r" \ldots "
+                    + self.expr(e.hi, SUM_LEVEL, False) + r" \rangle")
+        if isinstance(e, ast.TupleQuant):
+            d = e.domain
+            dom = type_to_latex(d) if is_type(d) else self.expr(d, SUM_LEVEL, False)  # type: ignore[arg-type]
+            names = ", ".join(name_to_latex(n) for n in e.names)
+            s = f"{_QUANT[e.kind]} ({names}) \\in {dom} \\bullet {self.expr(e.body, 0, True)}"
             return s if open_right else f"({s})"
         raise TypeError(f"not an RCL expression: {e!r}")
 
@@ -245,3 +263,12 @@ def to_latex(spec: ast.Spec, document: bool = True, explicit: bool = False) -> s
     } for n in spec.nodes]
     return _env().get_template("contracts.tex.j2").render(
         source=source, source_tex=escape(source), document=document, contexts=contexts, nodes=nodes)
+
+
+_TEX_SPECIAL = {"\\": r"\textbackslash{}", "{": r"\{", "}": r"\}", "$": r"\$", "&": r"\&", "#": r"\#",
+                "_": r"\_", "%": r"\%", "~": r"\textasciitilde{}", "^": r"\textasciicircum{}"}
+
+
+def _tex_escape(text: str) -> str:
+    """``text`` with LaTeX's special characters escaped (string literals)."""
+    return "".join(_TEX_SPECIAL.get(ch, ch) for ch in text)

@@ -25,13 +25,14 @@ from __future__ import annotations
 
 import dataclasses
 import gc
+from itertools import accumulate
 import re
 import threading
 from contextlib import contextmanager
 from functools import lru_cache
 from importlib import resources
 from pathlib import Path
-from typing import Any, Iterable, Iterator, Mapping, cast
+from typing import Any, Callable, Iterable, Iterator, Mapping, cast
 
 from lark import Lark, Token, Transformer
 from lark.parsers.lalr_analysis import Shift
@@ -43,14 +44,14 @@ from .errors import Diagnostic, RclError, error
 _FRIENDLY = {
     "NAME": "a name", "IO_NAME": "an in./out. name", "NUMBER": "a number", "ROS_TYPE": "a ROS type",
     "CMP_OP": "a comparison", "EXISTS_BANG": "'exists!'", "$END": "end of file",
-    "BASE_TYPE": "REAL/INTEGER/NATURAL/BOOL",
+    "BASE_TYPE": "REAL/INTEGER/NATURAL/BOOL/STRING", "STRING_LIT": "a string", "LT": "'<'", "GT": "'>'",
 }
 
 # Terminals whose text is data; every other token (keywords, punctuation) is
 # syntax, kept in the children only for its position.  "QUANT" is the
 # quantifier-kind token the transformer itself makes.
 _VALUE_TERMINALS = frozenset({"NAME", "IO_NAME", "NUMBER", "ROS_TYPE", "CMP_OP", "BASE_TYPE", "EXISTS_BANG",
-                              "QUANT"})
+                              "QUANT", "STRING_LIT"})
 
 
 def grammar_text() -> str:
@@ -101,7 +102,7 @@ def _is_syntax(x: Any) -> bool:
 
 def _vals(c: list[Any]) -> list[Any]:
     """The data children of a rule (syntax tokens dropped, placeholders kept)."""
-    return [x for x in c if not _is_syntax(x)]
+    return [x for x in c if not (isinstance(x, Token) and x.type not in _VALUE_TERMINALS)]  # _is_syntax, inlined
 
 
 class _ToAst(Transformer[Token, Any]):
@@ -148,7 +149,25 @@ class _ToAst(Transformer[Token, Any]):
                 return ast.Loc(self.file)
         if last is None or not (isinstance(last, Token) or hasattr(last, "loc")):
             last = next(x for x in reversed(c) if isinstance(x, Token) or hasattr(x, "loc"))
-        return ast.Loc(self.file, *self._start(first), *self._end(last))
+        # _start/_end inlined: this runs once per AST node (hot in parsing).
+        wrapped = self.wrapped
+        if isinstance(first, Token):
+            sl = first.line or 0
+            sc = (first.column or 0) + (self.dcol if sl == 1 else 0)
+            sl += self.dline
+        else:
+            w = wrapped.get(id(first)) if wrapped else None
+            loc = w[1] if w is not None else first.loc
+            sl, sc = loc.line, loc.col
+        if isinstance(last, Token):
+            el = last.end_line or 0
+            ec = (last.end_column or 0) + (self.dcol if el == 1 else 0)
+            el += self.dline
+        else:
+            w = wrapped.get(id(last)) if wrapped else None
+            loc = w[1] if w is not None else last.loc
+            el, ec = loc.end_line, loc.end_col
+        return ast.Loc(self.file, sl, sc, el, ec)
 
     # -- top level -----------------------------------------------------------
     def start(self, c: list[Any]) -> ast.Spec:
@@ -231,8 +250,10 @@ class _ToAst(Transformer[Token, Any]):
         return ast.TConstructors(tuple(alts), self._span(c))
 
     def func_type(self, c: list[Any]) -> ast.TFunc:
-        v = _vals(c)
-        return ast.TFunc(tuple(v[:-1]), v[-1], self._span(c))
+        arrow = next(k for k, x in enumerate(c) if isinstance(x, Token) and x.value == "-->")
+        args, res = _vals(c[:arrow]), _vals(c[arrow + 1:])
+        result = res[0] if len(res) == 1 else ast.TTuple(tuple(res), self._span(c[arrow + 1:]))
+        return ast.TFunc(tuple(args), result, self._span(c))
 
     def set_type(self, c: list[Any]) -> ast.TSet:
         return ast.TSet(_vals(c)[0], self._span(c))
@@ -259,10 +280,18 @@ class _ToAst(Transformer[Token, Any]):
         return self._bin("->", c)
 
     def disj(self, c: list[Any]) -> ast.Binary:
-        return self._bin("or", c)
+        return self._chain("or", c)
 
     def conj(self, c: list[Any]) -> ast.Binary:
-        return self._bin("and", c)
+        return self._chain("and", c)
+
+    def _chain(self, op: ast.BinaryOp, c: list[Any]) -> ast.Binary:
+        """A flat ``a op b op c ...`` chain as a balanced tree (see
+        :func:`balanced`): depth log2(n), so every recursive consumer copes
+        with chains of any length."""
+        if len(c) == 3:
+            return ast.Binary(op, c[0], c[2], self._span(c))
+        return balanced(op, c[0::2], lambda a, b: self._span([a, b]))  # type: ignore[no-any-return]
 
     def add(self, c: list[Any]) -> ast.Binary:
         return self._bin("+", c)
@@ -351,6 +380,24 @@ class _ToAst(Transformer[Token, Any]):
     def seq_lit(self, c: list[Any]) -> ast.SeqLit:
         return ast.SeqLit(tuple(x for x in _vals(c) if x is not None), self._span(c))
 
+    def seq_range(self, c: list[Any]) -> ast.SeqRange:
+        v = _vals(c)
+        return ast.SeqRange(v[0], v[1], self._span(c))
+
+    def string(self, c: list[Any]) -> ast.StrLit:
+        return ast.StrLit(_unquote(str(c[0])), self._span(c))
+
+    def tuple_binder(self, c: list[Any]) -> list[Token]:
+        return [t for t in _vals(c)]
+
+    def tuple_quant(self, c: list[Any]) -> ast.TupleQuant:
+        v = _vals(c)
+        kind, names, domain, body = v[0], v[1], v[2], v[3]
+        if isinstance(domain, ast.Var) and domain.prefix is None:
+            domain = ast.TName(domain.name, domain.loc)
+        return ast.TupleQuant(str(kind), tuple(str(n) for n in names), domain, body,  # type: ignore[arg-type]
+                              self._span(c), tuple(self._span([n]) for n in names))
+
     def tuple_lit(self, c: list[Any]) -> ast.TupleLit:
         return ast.TupleLit(tuple(_vals(c)), self._span(c))
 
@@ -360,6 +407,43 @@ class _ToAst(Transformer[Token, Any]):
             e = dataclasses.replace(e, parenthesised=True)
         self.wrapped[id(e)] = (e, self._span(c))
         return e
+
+
+#: Deepest nesting of expressions and types the parser accepts (AST depth;
+#: parentheses alone do not count, a balanced ``and``/``or`` chain of n
+#: operands counts log2(n)).  Deeper input is a located ``E-depth`` error
+#: instead of a ``RecursionError`` in a later stage (docs/rcl-language.md).
+NESTING_LIMIT = 200
+
+
+def balanced(op: ast.BinaryOp, operands: list[Any], span: Callable[[Any, Any], ast.Loc]) -> Any:
+    """The balanced tree of ``op`` over ``operands`` (n >= 1): the first
+    ceil(n/2) operands form the left subtree, the rest the right one, so two
+    and three operands give the left-nested tree a left-associative grammar
+    gives.  ``span(first, last)`` is the location of a subtree.  Also used by
+    the printer's round-trip check (printer.py); iterative (no recursion)."""
+    if len(operands) == 1:
+        return operands[0]
+    # Build bottom-up over (lo, hi) ranges with an explicit post-order stack.
+    result: dict[tuple[int, int], Any] = {}
+    stack: list[tuple[int, int, bool]] = [(0, len(operands), False)]
+    while stack:
+        lo, hi, ready = stack.pop()
+        if hi - lo == 1:
+            result[(lo, hi)] = operands[lo]
+            continue
+        mid = lo + (hi - lo + 1) // 2
+        if not ready:
+            stack += [(lo, hi, True), (mid, hi, False), (lo, mid, False)]
+            continue
+        left, right = result.pop((lo, mid)), result.pop((mid, hi))
+        result[(lo, hi)] = ast.Binary(op, left, right, span(operands[lo], operands[hi - 1]))
+    return result[(0, len(operands))]
+
+
+def _unquote(text: str) -> str:
+    """The value of a ``STRING_LIT`` token: quotes removed, ``\\x`` -> ``x``."""
+    return re.sub(r"\\(.)", r"\1", text[1:-1])
 
 
 _BUILDER = _ToAst()
@@ -471,11 +555,78 @@ def _parse(text: str, file: str, start: str, dline: int, dcol: int) -> Any:
     with _LOCK, _gc_paused():
         _BUILDER.reset(file, dline, dcol)
         try:
-            return parser.parse(text, start=start)
+            result = parser.parse(text, start=start)
         except UnexpectedInput as exc:
             raise _syntax_error(exc, file, text, dline, dcol) from None
         finally:
             _BUILDER.reset("<string>", 0, 0)
+    check_nesting(result, text, dline)
+    return result
+
+
+#: Fields that hold subtrees, per AST class (leaves are absent).
+_CHILD_FIELDS: dict[type, tuple[str, ...]] = {
+    ast.Binary: ("left", "right"), ast.Unary: ("operand",), ast.Compare: ("operands",),
+    ast.Member: ("elem", "collection"), ast.Apply: ("args",), ast.SetLit: ("items",), ast.SeqLit: ("items",),
+    ast.TupleLit: ("items",), ast.Quant: ("bindings", "body"), ast.Binding: ("domain",),
+    ast.TupleQuant: ("domain", "body"), ast.SeqRange: ("lo", "hi"), ast.ConstDecl: ("value", "type"),
+    ast.TypeDecl: ("type",), ast.IOVar: ("type",), ast.TFunc: ("args", "result"), ast.TSet: ("elem",),
+    ast.TSeq: ("elem",), ast.TTuple: ("elems",), ast.TConstructors: ("ctors",), ast.Constructor: ("args",),
+}
+
+
+def _too_deep(root: Any) -> Any | None:
+    """The first node (pre-order) at depth NESTING_LIMIT + 1 under ``root``,
+    or ``None``.  Iterative."""
+    stack: list[tuple[Any, int]] = [(root, 1)]
+    fields = _CHILD_FIELDS
+    while stack:
+        node, d = stack.pop()
+        if d > NESTING_LIMIT:
+            return node
+        for f in fields.get(type(node), ()):
+            v = getattr(node, f)
+            if isinstance(v, tuple):
+                stack.extend((x, d + 1) for x in v)
+            elif v is not None:
+                stack.append((v, d + 1))
+    return None
+
+
+def check_nesting(tree: Any, text: str, dline: int = 0) -> None:
+    """Raise a located ``E-depth`` :class:`RclError` when a formula or type
+    in ``tree`` (a :class:`~rclverify.rcl.ast.Spec` or an expression parsed
+    from ``text``, its lines shifted by ``dline``) nests deeper than
+    :data:`NESTING_LIMIT` (AST depth: parentheses alone do not count, a
+    balanced ``and``/``or`` chain of n operands counts log2(n)).
+
+    Every level of nesting takes at least one character, so only the
+    declarations and clauses whose text is longer than the limit are
+    walked: the check costs next to nothing on ordinary contracts."""
+    roots: list[Any] = []
+    if isinstance(tree, ast.Spec):
+        for c in tree.contexts:
+            roots += c.decls
+        for n in tree.nodes:
+            roots += n.inputs + n.outputs
+            roots += [cl.formula for cl in n.assumes + n.guarantees]
+    else:
+        roots.append(tree)
+    starts: list[int] | None = None
+    for r in roots:
+        loc = r.loc
+        if loc.end_line == loc.line:
+            if loc.end_col - loc.col <= NESTING_LIMIT:
+                continue
+        else:
+            if starts is None:
+                starts = [0, *accumulate(len(line) + 1 for line in text.split("\n"))]
+            a, b = loc.line - dline - 1, loc.end_line - dline - 1
+            if 0 <= a < b < len(starts) and starts[b] + loc.end_col - starts[a] - loc.col <= NESTING_LIMIT:
+                continue
+        bad = _too_deep(r)
+        if bad is not None:
+            raise RclError([error(bad.loc, f"too deeply nested (limit {NESTING_LIMIT})", "E-depth")])
 
 
 def ast_from_tree(tree: Any, file: str = "<string>") -> Any:

@@ -124,6 +124,59 @@ def is_type(d: object) -> bool:
     return isinstance(d, _TYPE_CLASSES)
 
 
+#: Associative connectives whose chains print flat (the parser reads a flat
+#: chain as a balanced tree, parser.balanced).
+FLAT_CHAINS = frozenset({"and", "or"})
+
+
+def chain_operands(e: ast.Binary) -> list[ast.Expr]:
+    """The operands of the maximal ``and``/``or`` chain rooted at ``e``, left
+    to right: nested nodes of the same operator are opened unless the source
+    parenthesised them (``Binary.parenthesised``).  Iterative, so a chain of
+    any length or shape (balanced from the parser, left-nested when built by
+    a program) prints flat without recursion."""
+    out: list[ast.Expr] = []
+    stack: list[ast.Expr] = [e.right, e.left]
+    while stack:
+        cur = stack.pop()
+        if isinstance(cur, ast.Binary) and cur.op == e.op and not cur.parenthesised:
+            stack += [cur.right, cur.left]
+        else:
+            out.append(cur)
+    return out
+
+
+#: Longest chain that is printed with inner parentheses when its tree is not
+#: the balanced one the parser builds (a tree made by a program); a longer one
+#: prints flat, which means the same by associativity.
+EXACT_CHAIN_MAX = 64
+
+
+def _opens(x: ast.Expr, op: str) -> bool:
+    return isinstance(x, ast.Binary) and x.op == op and not x.parenthesised
+
+
+def is_balanced_chain(e: ast.Binary, n: int) -> bool:
+    """Whether ``e`` is exactly the tree the parser builds for a flat chain
+    of its ``n`` operands (parser.balanced: the first ceil(k/2) operands on
+    the left at every level).  Iterative."""
+    if n < 2:
+        return False
+    stack: list[tuple[ast.Expr, int]] = [(e.left, (n + 1) // 2), (e.right, n - (n + 1) // 2)]
+    while stack:
+        x, k = stack.pop()
+        if k == 1:
+            if _opens(x, e.op):
+                return False
+            continue
+        if not _opens(x, e.op):
+            return False
+        assert isinstance(x, ast.Binary)
+        half = (k + 1) // 2
+        stack += [(x.left, half), (x.right, k - half)]
+    return True
+
+
 def clarifying_parens(e: ast.Binary, operand: ast.Expr) -> bool:
     """Whether ``operand`` of ``e`` is an ``and``/``or`` directly under
     ``->``/``<=>``: parentheses there are not required by precedence but
@@ -181,6 +234,20 @@ def _expr(p: _Printer, e: ast.Expr) -> str:
             return "not " + p.wrap(e.operand, NOT_LEVEL)
         inner = p.wrap(e.operand, MINUS_LEVEL)
         return "-" + inner if not inner.startswith("-") else "- " + inner
+    if isinstance(e, ast.Binary) and e.op in FLAT_CHAINS:
+        ops = chain_operands(e)
+        if len(ops) > EXACT_CHAIN_MAX or is_balanced_chain(e, len(ops)):
+            # A parenthesised operand of the same operator keeps its
+            # parentheses (level + 1 forces them), so re-parsing gives the
+            # same tree.
+            lv = BINARY_LEVEL[e.op]
+            return f" {e.op} ".join(p.wrap(o, lv + 1) for o in ops)
+        # Another shape (built by a program): same-operator operands in
+        # parentheses, so that re-parsing rebuilds exactly this tree.
+        lf = _opens(e.left, e.op) or (p.explicit and clarifying_parens(e, e.left))
+        rf = _opens(e.right, e.op) or (p.explicit and clarifying_parens(e, e.right))
+        lmin, rmin = operand_levels(e)
+        return f"{p.wrap(e.left, lmin, lf)} {e.op} {p.wrap(e.right, rmin, rf)}"
     if isinstance(e, ast.Binary):
         lmin, rmin = operand_levels(e)
         lf = p.explicit and clarifying_parens(e, e.left)
@@ -197,7 +264,17 @@ def _expr(p: _Printer, e: ast.Expr) -> str:
     if isinstance(e, ast.SetLit):
         return "{" + p.items(e.items) + "}"
     if isinstance(e, ast.SeqLit):
-        return "[" + p.items(e.items) + "]"
+        # The paper's angle brackets; items at sum level (a comparison inside
+        # would read as the closing '>'), so anything looser is parenthesised.
+        return "<" + ", ".join(p.wrap(i, SUM_LEVEL) for i in e.items) + ">"
+    if isinstance(e, ast.SeqRange):
+        return f"<{p.wrap(e.lo, SUM_LEVEL)} upto {p.wrap(e.hi, SUM_LEVEL)}>"
+    if isinstance(e, ast.StrLit):
+        return '"' + e.value.replace("\\", "\\\\").replace('"', '\\"') + '"'
+    if isinstance(e, ast.TupleQuant):
+        d = e.domain
+        dom = type_to_rcl(d) if is_type(d) else p.wrap(d, SUM_LEVEL)  # type: ignore[arg-type]
+        return f"{e.kind}(({', '.join(e.names)}) in {dom} | {p.expr(e.body)})"
     if isinstance(e, ast.TupleLit):
         return "(" + p.items(e.items) + ")"
     if isinstance(e, ast.Quant):

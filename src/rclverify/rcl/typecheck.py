@@ -34,11 +34,11 @@ from typing import Iterable, Mapping, Sequence
 from . import ast
 from .errors import Diagnostic, RclError, error
 from .parser import parse_files
-from .types import (BOOL, INTEGER, NATURAL, REAL, Checked, CheckedNode, DataT, EmptyT, EnumT, Env, FuncT,
+from .types import (BOOL, INTEGER, NATURAL, REAL, STRING, Checked, CheckedNode, DataT, EmptyT, EnumT, Env, FuncT,
                     Scalar, SeqT, SetT, TupleT, Type, assignable, comparable, is_numeric, numeric_join)
 
 
-BASE_NAMES = ("REAL", "INTEGER", "NATURAL", "BOOL")
+BASE_NAMES = ("REAL", "INTEGER", "NATURAL", "BOOL", "STRING")
 
 
 class _Fail(Exception):
@@ -59,6 +59,12 @@ class _Checker:
         self.enum_values: dict[str, EnumT] = {}
         self.ctors: dict[str, DataT] = {}
         self._resolving: set[str] = set()
+        # Names whose declaration already failed (an unknown type was
+        # reported there): later uses fail silently instead of adding
+        # knock-on messages.  ``unknown_types``: reported once per name.
+        self.unknown_types: set[str] = set()
+        self.failed_io: set[tuple[str, str]] = set()
+        self.failed_consts: set[str] = set()
 
     # -- diagnostics -------------------------------------------------------------
     def err(self, loc: ast.Loc, msg: str, code: str = "E-type") -> None:
@@ -81,7 +87,9 @@ class _Checker:
                     self.err(t.loc, f"type {t.name!r} is defined in terms of itself", "E-type-cycle")
                     raise _Fail
                 return self.declare_type(self.type_decls[t.name])
-            self.err(t.loc, f"unknown type {t.name!r}" + _candidates(t.name, list(self.type_decls) + ["REAL", "INTEGER", "NATURAL", "BOOL"]), "E-name")
+            if t.name not in self.unknown_types:
+                self.unknown_types.add(t.name)
+                self.err(t.loc, f"unknown type {t.name!r}" + _candidates(t.name, list(self.type_decls) + list(BASE_NAMES)), "E-name")
             raise _Fail
         if isinstance(t, ast.TEnum):
             enum = EnumT(name, t.values)
@@ -142,6 +150,13 @@ class _Checker:
             seen[d.name] = d.loc
             if isinstance(d, ast.TypeDecl):
                 self.type_decls[d.name] = d
+            elif _is_enum_constant(d, decls):
+                # `Wayp = {wayA, wayB, wayC} ;`: a set of fresh names declared
+                # as a constant is an enumeration usable as a type (`w : Wayp`)
+                # and as a set (`w in Wayp`), as in the original tool
+                # (docs/rcl-language.md).
+                items = tuple(i.name for i in d.value.items)  # type: ignore[union-attr]
+                self.type_decls[d.name] = ast.TypeDecl(d.name, ast.TEnum(items, d.value.loc), d.loc)
         for d in decls:
             if isinstance(d, ast.TypeDecl) and self.type_decls.get(d.name) is d:
                 try:
@@ -149,7 +164,7 @@ class _Checker:
                 except _Fail:
                     pass
         for d in decls:
-            if isinstance(d, ast.ConstDecl) and d.name not in self.constants:
+            if isinstance(d, ast.ConstDecl) and d.name not in self.constants and d.name not in self.type_decls:
                 try:
                     vt = self.infer(d.value, None, {})
                     if d.type is not None:
@@ -159,14 +174,15 @@ class _Checker:
                         vt = dt
                     self.constants[d.name] = (vt, d.value)
                 except _Fail:
-                    pass
+                    self.failed_consts.add(d.name)
 
     # -- nodes --------------------------------------------------------------------------
     def node(self, n: ast.Node) -> CheckedNode | None:
         inputs: dict[str, Type] = {}
         outputs: dict[str, Type] = {}
         ok = True
-        for group, table in ((n.inputs, inputs), (n.outputs, outputs)):
+        self.failed_io = set()
+        for group, table, prefix in ((n.inputs, inputs, "in"), (n.outputs, outputs, "out")):
             for v in group:
                 if v.name in table:
                     self.err(v.loc, f"{v.name!r} is declared twice in node {n.name}", "E-duplicate")
@@ -175,6 +191,7 @@ class _Checker:
                 try:
                     table[v.name] = self.resolve(v.type, f"{n.name}_{v.name}")
                 except _Fail:
+                    self.failed_io.add((prefix, v.name))
                     ok = False
         cn = CheckedNode(n, inputs, outputs)
         for t in n.topics:
@@ -198,6 +215,10 @@ class _Checker:
 
     # -- expressions ----------------------------------------------------------------
     def var(self, v: ast.Var, node: CheckedNode | None, bound: Mapping[str, Type]) -> Type:
+        if (self.failed_io or self.failed_consts) and v.name not in bound and ((v.prefix, v.name) in self.failed_io or (
+                v.prefix is None and (("in", v.name) in self.failed_io or ("out", v.name) in self.failed_io
+                                      or v.name in self.failed_consts))):
+            raise _Fail  # its declaration already has an error; no knock-on message
         if v.prefix is not None:
             table = (node.inputs if v.prefix == "in" else node.outputs) if node else {}
             if v.name in table:
@@ -309,6 +330,25 @@ class _Checker:
             return SetT(elem) if isinstance(e, ast.SetLit) else SeqT(elem)
         if isinstance(e, ast.TupleLit):
             return TupleT(tuple(self.infer(i, node, bound) for i in e.items))
+        if isinstance(e, ast.StrLit):
+            return STRING
+        if isinstance(e, ast.SeqRange):
+            ts = [self.infer(x, node, bound) for x in (e.lo, e.hi)]
+            for x, t in zip((e.lo, e.hi), ts):
+                if t not in (NATURAL, INTEGER):
+                    self.err(x.loc, f"a bound of '<a upto b>' must be an integer (NATURAL or INTEGER), found {t}")
+                    raise _Fail
+            return SeqT(NATURAL if ts == [NATURAL, NATURAL] else INTEGER)
+        if isinstance(e, ast.TupleQuant):
+            et = self.domain(ast.Binding(e.names, e.domain, e.loc), node, bound)
+            if not isinstance(et, TupleT) or len(et.elems) != len(e.names):
+                self.err(e.domain.loc, f"({', '.join(e.names)}) takes apart tuples of {len(e.names)} components, "
+                                       f"but the elements here have type {et}")
+                raise _Fail
+            inner = dict(bound)
+            inner.update(zip(e.names, et.elems))
+            self.expect_bool(e.body, self.infer(e.body, node, inner), e.kind)
+            return BOOL
         if isinstance(e, ast.Quant):
             inner = dict(bound)
             for bd in e.bindings:
@@ -377,6 +417,23 @@ class _Checker:
             if not assignable(at, p):
                 self.err(a.loc, f"argument of {what} must be {p}, found {at}")
                 raise _Fail
+
+
+def _is_enum_constant(d: ast.TypeDecl | ast.ConstDecl, decls: Sequence[ast.TypeDecl | ast.ConstDecl]) -> bool:
+    """Whether ``d`` is ``Name = {a, b, c} ;`` (no declared type) whose items
+    are all bare names not declared anywhere in the contexts: then the names
+    are new enumeration values and ``Name`` is their type."""
+    if not (isinstance(d, ast.ConstDecl) and d.type is None and isinstance(d.value, ast.SetLit) and d.value.items):
+        return False
+    if not all(isinstance(i, ast.Var) and i.prefix is None for i in d.value.items):
+        return False
+    declared = {x.name for x in decls}
+    for x in decls:
+        if isinstance(x, ast.TypeDecl) and isinstance(x.type, ast.TEnum):
+            declared.update(x.type.values)
+        elif isinstance(x, ast.TypeDecl) and isinstance(x.type, ast.TConstructors):
+            declared.update(c.name for c in x.type.ctors)
+    return not any(i.name in declared for i in d.value.items)  # type: ignore[union-attr]
 
 
 def check(specs: Sequence[ast.Spec]) -> Checked:

@@ -15,7 +15,7 @@ from typing import Literal, Mapping, Union
 
 from . import ast
 
-ScalarName = Literal["REAL", "INTEGER", "NATURAL", "BOOL"]
+ScalarName = Literal["REAL", "INTEGER", "NATURAL", "BOOL", "STRING"]
 
 
 @dataclass(frozen=True)
@@ -103,6 +103,7 @@ REAL = Scalar("REAL")
 INTEGER = Scalar("INTEGER")
 NATURAL = Scalar("NATURAL")
 BOOL = Scalar("BOOL")
+STRING = Scalar("STRING")
 NUMERIC_RANK = {"NATURAL": 0, "INTEGER": 1, "REAL": 2}
 
 
@@ -124,10 +125,10 @@ def assignable(src: Type, dst: Type) -> bool:
     if is_numeric(src) and is_numeric(dst):
         assert isinstance(src, Scalar) and isinstance(dst, Scalar)
         return NUMERIC_RANK[src.name] <= NUMERIC_RANK[dst.name]
-    if isinstance(src, SetT) and isinstance(dst, SetT):
-        return assignable(src.elem, dst.elem)
-    if isinstance(src, SeqT) and isinstance(dst, SeqT):
-        return assignable(src.elem, dst.elem)
+    if isinstance(src, SetT) and isinstance(dst, SetT) or isinstance(src, SeqT) and isinstance(dst, SeqT):
+        # A collection of the empty type (the literals {} and <>) is empty,
+        # so it belongs to every set/sequence type.
+        return isinstance(src.elem, EmptyT) or assignable(src.elem, dst.elem)
     if isinstance(src, TupleT) and isinstance(dst, TupleT):
         return len(src.elems) == len(dst.elems) and all(map(assignable, src.elems, dst.elems))
     return False

@@ -37,6 +37,13 @@ def children(e: ast.Expr) -> Iterator[ast.Expr]:
             if not is_type(b.domain):
                 yield b.domain  # type: ignore[misc]
         yield e.body
+    elif isinstance(e, ast.SeqRange):
+        yield e.lo
+        yield e.hi
+    elif isinstance(e, ast.TupleQuant):
+        if not is_type(e.domain):
+            yield e.domain  # type: ignore[misc]
+        yield e.body
 
 
 def subexpressions(e: ast.Expr) -> Iterator[ast.Expr]:
@@ -77,6 +84,9 @@ def free_names(e: Union[ast.Expr, ast.TypeExpr], *, heads: bool = True, type_nam
             free |= free_names(b.domain, heads=heads, type_names=type_names) - bound
             bound |= set(b.names)
         return free | (free_names(e.body, heads=heads, type_names=type_names) - bound)
+    if isinstance(e, ast.TupleQuant):
+        dom = free_names(e.domain, heads=heads, type_names=type_names)
+        return dom | (free_names(e.body, heads=heads, type_names=type_names) - set(e.names))
     found: set[str] = set()
     for c in children(e):  # type: ignore[arg-type]
         found |= free_names(c, heads=heads, type_names=type_names)

@@ -51,7 +51,7 @@ refines requires return returns reveal reveals seq set static string then this t
 twostate type unchanged var while witness yield yields
 """.split())
 
-_SCALARS = {"REAL": "real", "INTEGER": "int", "NATURAL": "nat", "BOOL": "bool"}
+_SCALARS = {"REAL": "real", "INTEGER": "int", "NATURAL": "nat", "BOOL": "bool", "STRING": "string"}
 _IDENT = re.compile(r"[A-Za-z][A-Za-z0-9_']*\Z")
 
 

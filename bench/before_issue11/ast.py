@@ -1,0 +1,403 @@
+"""Immutable abstract syntax of RCL, the ROS Contract Language.
+
+Every node carries a :class:`Loc`.  Locations are excluded from equality
+(``compare=False``) so that a printed-and-reparsed file compares equal to the
+original (the round-trip property of the printer).
+
+Source of the syntax: the EBNF table and the listings of the paper
+(shared/reference, lines 499-555, 1131-1171 and appendix A, 1890-1983).
+
+Shapes
+------
+* A :class:`Spec` is one RCL file: a tuple of :class:`Context` clauses and a
+  tuple of :class:`Node` clauses, in source order.
+* Types are :data:`TypeExpr` values; formulas and terms are :data:`Expr`
+  values (one syntactic category, told apart by the type checker).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from fractions import Fraction
+from typing import Literal, Union
+
+
+@dataclass(frozen=True)
+class Loc:
+    """A source location: 1-based line and column of the first character.
+
+    ``end_line``/``end_col`` point one past the last character (0 when
+    unknown).  ``file`` is the path as given by the user.
+    """
+
+    file: str = "<string>"
+    line: int = 0
+    col: int = 0
+    end_line: int = 0
+    end_col: int = 0
+
+    def __str__(self) -> str:
+        return f"{self.file}:{self.line}:{self.col}"
+
+
+NOLOC = Loc()
+
+
+def _loc() -> Loc:
+    return field(default=NOLOC, compare=False, repr=False)
+
+
+# --------------------------------------------------------------------------
+# Types
+# --------------------------------------------------------------------------
+
+BaseName = Literal["REAL", "INTEGER", "NATURAL", "BOOL"]
+
+
+@dataclass(frozen=True)
+class TBase:
+    """A built-in scalar type: ``REAL``, ``INTEGER``, ``NATURAL`` or ``BOOL``."""
+
+    name: BaseName
+    loc: Loc = _loc()
+
+
+@dataclass(frozen=True)
+class TName:
+    """A reference to a type declared in a ``context`` clause (e.g. ``RadStat``)."""
+
+    name: str
+    loc: Loc = _loc()
+
+
+@dataclass(frozen=True)
+class TEnum:
+    """An enumeration ``{red, orange, green}``; ``values`` in source order."""
+
+    values: tuple[str, ...]
+    loc: Loc = _loc()
+
+
+@dataclass(frozen=True)
+class Constructor:
+    """One alternative ``move(REAL, REAL)`` of a constructor set."""
+
+    name: str
+    args: tuple["TypeExpr", ...]
+    loc: Loc = _loc()
+
+
+@dataclass(frozen=True)
+class TConstructors:
+    """A constructor set ``{ move(REAL, REAL), inspect(NATURAL) }``.
+
+    Alternatives without arguments (``stop``) have ``args == ()``; a set of
+    only argument-less alternatives is written and parsed as a :class:`TEnum`.
+    """
+
+    ctors: tuple[Constructor, ...]
+    loc: Loc = _loc()
+
+
+@dataclass(frozen=True)
+class TFunc:
+    """A function type ``REAL x REAL --> BOOL`` (``args`` are the domain factors)."""
+
+    args: tuple["TypeExpr", ...]
+    result: "TypeExpr"
+    loc: Loc = _loc()
+
+
+@dataclass(frozen=True)
+class TEmpty:
+    """The empty type ``{}`` (used for hardware inputs, e.g. ``SensorsType``)."""
+
+    loc: Loc = _loc()
+
+
+@dataclass(frozen=True)
+class TSet:
+    """``set(T)``: finite sets of ``T`` (also written ``P(T)``)."""
+
+    elem: "TypeExpr"
+    loc: Loc = _loc()
+
+
+@dataclass(frozen=True)
+class TSeq:
+    """``seq(T)``: finite sequences of ``T``."""
+
+    elem: "TypeExpr"
+    loc: Loc = _loc()
+
+
+@dataclass(frozen=True)
+class TTuple:
+    """``(T1, T2, ...)``: tuples (at least two components)."""
+
+    elems: tuple["TypeExpr", ...]
+    loc: Loc = _loc()
+
+
+TypeExpr = Union[TBase, TName, TEnum, TConstructors, TFunc, TEmpty, TSet, TSeq, TTuple]
+
+
+# --------------------------------------------------------------------------
+# Expressions (terms and formulas)
+# --------------------------------------------------------------------------
+
+Prefix = Literal["in", "out"]
+
+
+@dataclass(frozen=True)
+class Var:
+    """A name: an input/output (``in.at``/``out.command``, or bare ``r``),
+    a bound variable (``x'``), a context constant, or an enumeration value
+    (``green``).  ``prefix`` is ``"in"``, ``"out"`` or ``None``; primes are
+    part of ``name`` (``"x''"``)."""
+
+    name: str
+    prefix: Prefix | None = None
+    loc: Loc = _loc()
+
+    @property
+    def qualified(self) -> str:
+        """``in.at`` / ``out.command`` / ``r``: the name as written."""
+        return f"{self.prefix}.{self.name}" if self.prefix else self.name
+
+
+@dataclass(frozen=True)
+class BoolLit:
+    """``TRUE`` / ``FALSE``."""
+
+    value: bool
+    loc: Loc = _loc()
+
+
+@dataclass(frozen=True)
+class NumLit:
+    """A numeric literal; ``text`` is kept for printing, ``value`` is exact."""
+
+    text: str
+    loc: Loc = _loc()
+
+    @property
+    def value(self) -> Fraction:
+        return Fraction(self.text)
+
+    @property
+    def is_integral(self) -> bool:
+        return "." not in self.text and "e" not in self.text.lower()
+
+
+@dataclass(frozen=True)
+class Apply:
+    """``f(a, b)``: a function-typed input applied to arguments, or a
+    constructor term ``move(x, y)``; the checker tells which."""
+
+    func: Var
+    args: tuple["Expr", ...]
+    loc: Loc = _loc()
+
+
+UnaryOp = Literal["not", "-"]
+
+
+@dataclass(frozen=True)
+class Unary:
+    """``not f`` or ``- t``."""
+
+    op: UnaryOp
+    operand: "Expr"
+    loc: Loc = _loc()
+
+
+BinaryOp = Literal["<=>", "->", "or", "and", "+", "-", "*", "/"]
+
+
+@dataclass(frozen=True)
+class Binary:
+    """A binary connective or arithmetic operator.
+
+    Precedence, loosest first: ``<=>``, ``->`` (right-assoc), ``or``,
+    ``and``, ``not``, comparison, ``+ -``, ``* /``.
+    ``parenthesised`` records whether the source wrapped this node in
+    parentheses (used only by lint; excluded from equality).
+    """
+
+    op: BinaryOp
+    left: "Expr"
+    right: "Expr"
+    loc: Loc = _loc()
+    parenthesised: bool = field(default=False, compare=False)
+
+
+CompareOp = Literal["==", "!=", "<", "<=", ">", ">="]
+
+
+@dataclass(frozen=True)
+class Compare:
+    """A (possibly chained) comparison ``a < b <= c``: ``operands`` has one
+    more element than ``ops``; it means ``a < b and b <= c``."""
+
+    ops: tuple[CompareOp, ...]
+    operands: tuple["Expr", ...]
+    loc: Loc = _loc()
+
+
+@dataclass(frozen=True)
+class Member:
+    """``e in S`` (``negated`` for ``e !in S``); ``S`` is a set literal,
+    a type name, or a set-typed term."""
+
+    elem: "Expr"
+    collection: "Expr"
+    negated: bool = False
+    loc: Loc = _loc()
+
+
+@dataclass(frozen=True)
+class SetLit:
+    """``{a, b, c}``."""
+
+    items: tuple["Expr", ...]
+    loc: Loc = _loc()
+
+
+@dataclass(frozen=True)
+class TupleLit:
+    """``(a, b)`` with at least two items."""
+
+    items: tuple["Expr", ...]
+    loc: Loc = _loc()
+
+
+@dataclass(frozen=True)
+class SeqLit:
+    """``[a, b, c]``."""
+
+    items: tuple["Expr", ...]
+    loc: Loc = _loc()
+
+
+@dataclass(frozen=True)
+class Binding:
+    """``x', y' in REAL``: the names bound and their domain.
+
+    ``domain`` is a :data:`TypeExpr` (``REAL``, ``RadStat``) or, for a
+    bounded quantifier over a finite set, an :data:`Expr` (``{1, 2, 3}``).
+    """
+
+    names: tuple[str, ...]
+    domain: Union[TypeExpr, "Expr"]
+    loc: Loc = _loc()
+    name_locs: tuple[Loc, ...] = field(default=(), compare=False, repr=False)
+
+
+QuantKind = Literal["forall", "exists", "exists_unique"]
+
+
+@dataclass(frozen=True)
+class Quant:
+    """``forall (x in REAL, i in NATURAL | body)``; ``exists_unique`` is ``∃!``."""
+
+    kind: QuantKind
+    bindings: tuple[Binding, ...]
+    body: "Expr"
+    loc: Loc = _loc()
+
+    @property
+    def variables(self) -> tuple[str, ...]:
+        return tuple(n for b in self.bindings for n in b.names)
+
+
+Expr = Union[Var, BoolLit, NumLit, Apply, Unary, Binary, Compare, Member, SetLit, TupleLit, SeqLit, Quant]
+
+
+# --------------------------------------------------------------------------
+# Declarations
+# --------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class TypeDecl:
+    """``Name : type ;`` in a context clause."""
+
+    name: str
+    type: TypeExpr
+    loc: Loc = _loc()
+
+
+@dataclass(frozen=True)
+class ConstDecl:
+    """``Name = value ;`` in a context clause (a named constant).
+
+    ``type`` is optional: ``MaxLevel : REAL = 250 ;`` declares it, plain
+    ``MaxLevel = 250 ;`` lets the checker infer it from ``value``.
+    """
+
+    name: str
+    value: Expr
+    type: TypeExpr | None = None
+    loc: Loc = _loc()
+
+
+@dataclass(frozen=True)
+class Context:
+    """``context { ... }``: type and constant declarations in source order."""
+
+    decls: tuple[Union[TypeDecl, ConstDecl], ...]
+    loc: Loc = _loc()
+
+
+@dataclass(frozen=True)
+class IOVar:
+    """``name : TypeName`` in ``inputs(...)``/``outputs(...)``."""
+
+    name: str
+    type: TypeExpr
+    loc: Loc = _loc()
+
+
+@dataclass(frozen=True)
+class Topic:
+    """``ros_pkg/Type field matches(in.x)``.
+
+    ``msg_type`` is the ROS message type (``gazebo_radiation_plugin/Snapshot``),
+    ``field`` the message field, ``match`` the contract variable it populates
+    (``None`` when there is no ``matches`` clause).
+    """
+
+    msg_type: str
+    field: str
+    match: Var | None = None
+    loc: Loc = _loc()
+
+
+@dataclass(frozen=True)
+class Clause:
+    """One ``assume(...)`` or ``guarantee(...)`` clause."""
+
+    formula: Expr
+    loc: Loc = _loc()
+
+
+@dataclass(frozen=True)
+class Node:
+    """``node name { inputs(...) outputs(...) topics(...) assume(...)* guarantee(...)+ }``."""
+
+    name: str
+    inputs: tuple[IOVar, ...]
+    outputs: tuple[IOVar, ...]
+    topics: tuple[Topic, ...]
+    assumes: tuple[Clause, ...]
+    guarantees: tuple[Clause, ...]
+    loc: Loc = _loc()
+
+
+@dataclass(frozen=True)
+class Spec:
+    """One RCL file."""
+
+    contexts: tuple[Context, ...]
+    nodes: tuple[Node, ...]
+    file: str = field(default="<string>", compare=False)

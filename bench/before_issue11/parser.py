@@ -1,0 +1,531 @@
+"""RCL parser: Lark LALR(1) over ``rcl.lark``, building the AST as it reduces.
+
+Public entry points
+-------------------
+``parse_text(text, file)``  -> :class:`~rclverify.rcl.ast.Spec`
+``parse_file(path)``        -> :class:`~rclverify.rcl.ast.Spec`
+``parse_files(paths)``      -> list of :class:`~rclverify.rcl.ast.Spec`
+``parse_formula(text, file, line, col)`` -> :data:`~rclverify.rcl.ast.Expr`
+  (a single formula, e.g. an environment fact in the plan; ``line``/``col``
+  say where ``text`` starts in ``file`` so diagnostics point into it).
+
+All raise :class:`~rclverify.rcl.errors.RclError` with a located diagnostic
+on malformed input: ``file:line:col: error: unexpected X; expected one of
+A, B, ...`` (code ``E-syntax``), where the expected set is what the LALR
+automaton would accept at that point, keywords included.  The grammar
+follows the paper's EBNF table (shared/reference lines 499-555), its
+listings (1131-1171) and appendix A (1890-1983); see ``rcl.lark`` for the
+precedence table and the reserved words.
+
+The AST is built by lark's inline transformer (no intermediate parse tree)
+with the cyclic garbage collector paused, which keeps parsing linear in the
+size of the system (bench/parse_scale.py).
+"""
+from __future__ import annotations
+
+import dataclasses
+import gc
+import re
+import threading
+from contextlib import contextmanager
+from functools import lru_cache
+from importlib import resources
+from pathlib import Path
+from typing import Any, Iterable, Iterator, Mapping, cast
+
+from lark import Lark, Token, Transformer
+from lark.parsers.lalr_analysis import Shift
+from lark.exceptions import UnexpectedCharacters, UnexpectedEOF, UnexpectedInput, UnexpectedToken
+
+from . import ast
+from .errors import Diagnostic, RclError, error
+
+_FRIENDLY = {
+    "NAME": "a name", "IO_NAME": "an in./out. name", "NUMBER": "a number", "ROS_TYPE": "a ROS type",
+    "CMP_OP": "a comparison", "EXISTS_BANG": "'exists!'", "$END": "end of file",
+    "BASE_TYPE": "REAL/INTEGER/NATURAL/BOOL",
+}
+
+# Terminals whose text is data; every other token (keywords, punctuation) is
+# syntax, kept in the children only for its position.  "QUANT" is the
+# quantifier-kind token the transformer itself makes.
+_VALUE_TERMINALS = frozenset({"NAME", "IO_NAME", "NUMBER", "ROS_TYPE", "CMP_OP", "BASE_TYPE", "EXISTS_BANG",
+                              "QUANT"})
+
+
+def grammar_text() -> str:
+    """The text of ``rcl.lark`` (for tools that build other lark parsers
+    over the same grammar, e.g. the parse benchmark)."""
+    return resources.files("rclverify.rcl").joinpath("rcl.lark").read_text(encoding="utf-8")
+
+
+@lru_cache(maxsize=1)
+def _lark() -> Lark:
+    """The LALR(1) parser with the AST builder applied during parsing
+    (no intermediate parse tree).  ``keep_all_tokens`` keeps keywords and
+    punctuation in the children so every AST node spans its full text."""
+    return Lark(grammar_text(), parser="lalr", start=["start", "expr"], keep_all_tokens=True,
+                maybe_placeholders=True, transformer=_BUILDER)
+
+
+def describe_terminal(parser: Lark, term: str, friendly: Mapping[str, str]) -> str:
+    """How a syntax error names the terminal ``term`` of ``parser``: the
+    ``friendly`` wording when there is one, the literal text of a keyword or
+    punctuation terminal in quotes, else the terminal's name in lower case.
+    Shared by every Lark grammar of the project (RCL, the Hoare language)."""
+    if term in friendly:
+        return friendly[term]
+    try:
+        pattern = parser.get_terminal(term).pattern
+    except KeyError:
+        return term
+    return f"'{pattern.value}'" if pattern.type == "str" else term.lower()
+
+
+def _describe(term: str) -> str:
+    return describe_terminal(_lark(), term, _FRIENDLY)
+
+
+class _Spanned:
+    """An intermediate value with the location of the text it came from."""
+
+    __slots__ = ("value", "loc")
+
+    def __init__(self, value: Any, loc: ast.Loc) -> None:
+        self.value, self.loc = value, loc
+
+
+def _is_syntax(x: Any) -> bool:
+    return isinstance(x, Token) and x.type not in _VALUE_TERMINALS
+
+
+def _vals(c: list[Any]) -> list[Any]:
+    """The data children of a rule (syntax tokens dropped, placeholders kept)."""
+    return [x for x in c if not _is_syntax(x)]
+
+
+class _ToAst(Transformer[Token, Any]):
+    """Builds the immutable AST while the LALR parser reduces.
+
+    Children arrive with all tokens kept; a node's location runs from the
+    start of its first child to the end of its last one.  ``file``, ``dline``
+    and ``dcol`` (set by :func:`_parse` for each run) offset locations for a
+    formula embedded in another file (first line shifted by ``dcol``)."""
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.reset("<string>", 0, 0)
+
+    def reset(self, file: str, dline: int, dcol: int) -> None:
+        """Prepare for one parse of ``file`` (offsets as in :func:`parse_formula`)."""
+        self.file, self.dline, self.dcol = file, dline, dcol
+        # id(node) -> (node, span with the parentheses) for parenthesised
+        # expressions: a parent spans its operand's parentheses, while the
+        # operand's own location is the text inside them.  The node is held
+        # so that its id stays unique for the whole parse.
+        self.wrapped: dict[int, tuple[Any, ast.Loc]] = {}
+
+    # -- locations -------------------------------------------------------
+    def _start(self, x: Any) -> tuple[int, int]:
+        if isinstance(x, Token):
+            line = x.line or 0
+            return line + self.dline, (x.column or 0) + (self.dcol if line == 1 else 0)
+        loc = self.wrapped[id(x)][1] if id(x) in self.wrapped else x.loc
+        return loc.line, loc.col
+
+    def _end(self, x: Any) -> tuple[int, int]:
+        if isinstance(x, Token):
+            end_line = x.end_line or 0
+            return end_line + self.dline, (x.end_column or 0) + (self.dcol if end_line == 1 else 0)
+        loc = self.wrapped[id(x)][1] if id(x) in self.wrapped else x.loc
+        return loc.end_line, loc.end_col
+
+    def _span(self, c: list[Any]) -> ast.Loc:
+        first, last = c[0], c[-1]  # usually positioned; else skip placeholders
+        if first is None or not (isinstance(first, Token) or hasattr(first, "loc")):
+            first = next((x for x in c if isinstance(x, Token) or hasattr(x, "loc")), None)
+            if first is None:
+                return ast.Loc(self.file)
+        if last is None or not (isinstance(last, Token) or hasattr(last, "loc")):
+            last = next(x for x in reversed(c) if isinstance(x, Token) or hasattr(x, "loc"))
+        return ast.Loc(self.file, *self._start(first), *self._end(last))
+
+    # -- top level -----------------------------------------------------------
+    def start(self, c: list[Any]) -> ast.Spec:
+        ctx = tuple(i for i in c if isinstance(i, ast.Context))
+        nodes = tuple(i for i in c if isinstance(i, ast.Node))
+        return ast.Spec(ctx, nodes, file=self.file)
+
+    def context_clause(self, c: list[Any]) -> ast.Context:
+        return ast.Context(tuple(_vals(c)), self._span(c))
+
+    def type_decl(self, c: list[Any]) -> ast.TypeDecl:
+        v = _vals(c)
+        return ast.TypeDecl(str(v[0]), v[1], self._span(c))
+
+    def const_decl(self, c: list[Any]) -> ast.ConstDecl:
+        v = _vals(c)
+        if len(v) == 3:
+            return ast.ConstDecl(str(v[0]), v[2], v[1], self._span(c))
+        return ast.ConstDecl(str(v[0]), v[1], None, self._span(c))
+
+    def node_clause(self, c: list[Any]) -> ast.Node:
+        v = _vals(c)
+        name, inputs, outputs = str(v[0]), v[1], v[2]
+        rest = v[3:]
+        topics: tuple[ast.Topic, ...] = ()
+        if rest and rest[0][0] == "topics":
+            topics = rest[0][1]
+            rest = rest[1:]
+        assumes = tuple(cl for kind, cl in rest if kind == "assume")
+        guarantees = tuple(cl for kind, cl in rest if kind == "guarantee")
+        return ast.Node(name, inputs, outputs, topics, assumes, guarantees, self._span(c))
+
+    def inputs(self, c: list[Any]) -> tuple[ast.IOVar, ...]:
+        return tuple(x for x in _vals(c) if x is not None)
+
+    outputs = inputs
+
+    def io_var(self, c: list[Any]) -> ast.IOVar:
+        v = _vals(c)
+        return ast.IOVar(str(v[0]), v[1], self._span(c))
+
+    def topics(self, c: list[Any]) -> tuple[str, tuple[ast.Topic, ...]]:
+        return ("topics", tuple(x for x in _vals(c) if x is not None))
+
+    def topic(self, c: list[Any]) -> ast.Topic:
+        v = _vals(c)
+        match = v[2].value if v[2] is not None else None
+        return ast.Topic(str(v[0]), str(v[1]), match, self._span(c))
+
+    def topic_match(self, c: list[Any]) -> _Spanned:
+        return _Spanned(_vals(c)[0], self._span(c))
+
+    def assume(self, c: list[Any]) -> tuple[str, ast.Clause]:
+        return ("assume", ast.Clause(_vals(c)[0], self._span(c)))
+
+    def guarantee(self, c: list[Any]) -> tuple[str, ast.Clause]:
+        return ("guarantee", ast.Clause(_vals(c)[0], self._span(c)))
+
+    # -- types ---------------------------------------------------------------
+    def base_name(self, c: list[Token]) -> Token:
+        return c[0]  # the BASE_TYPE token: its text and its position
+
+    def base_type(self, c: list[Any]) -> ast.TBase:
+        return ast.TBase(str(c[0]), self._span(c))  # type: ignore[arg-type]
+
+    def named_type(self, c: list[Any]) -> ast.TName:
+        return ast.TName(str(c[0]), self._span(c))
+
+    def empty_type(self, c: list[Any]) -> ast.TEmpty:
+        return ast.TEmpty(self._span(c))
+
+    def alt(self, c: list[Any]) -> ast.Constructor:
+        v = _vals(c)
+        return ast.Constructor(str(v[0]), tuple(t for t in v[1:] if t is not None), self._span(c))
+
+    def alt_type(self, c: list[Any]) -> ast.TypeExpr:
+        alts: list[ast.Constructor] = _vals(c)
+        if all(not a.args for a in alts):
+            return ast.TEnum(tuple(a.name for a in alts), self._span(c))
+        return ast.TConstructors(tuple(alts), self._span(c))
+
+    def func_type(self, c: list[Any]) -> ast.TFunc:
+        v = _vals(c)
+        return ast.TFunc(tuple(v[:-1]), v[-1], self._span(c))
+
+    def set_type(self, c: list[Any]) -> ast.TSet:
+        return ast.TSet(_vals(c)[0], self._span(c))
+
+    def seq_type(self, c: list[Any]) -> ast.TSeq:
+        return ast.TSeq(_vals(c)[0], self._span(c))
+
+    def tuple_type(self, c: list[Any]) -> ast.TTuple:
+        return ast.TTuple(tuple(_vals(c)), self._span(c))
+
+    def type_atom(self, c: list[Any]) -> Any:
+        t = c[1]  # "(" type ")": the type itself, spanning its parentheses for its parent
+        self.wrapped[id(t)] = (t, self._span(c))
+        return t
+
+    # -- expressions -----------------------------------------------------------
+    def _bin(self, op: ast.BinaryOp, c: list[Any]) -> ast.Binary:
+        return ast.Binary(op, c[0], c[2], self._span(c))
+
+    def iff(self, c: list[Any]) -> ast.Binary:
+        return self._bin("<=>", c)
+
+    def implies(self, c: list[Any]) -> ast.Binary:
+        return self._bin("->", c)
+
+    def disj(self, c: list[Any]) -> ast.Binary:
+        return self._bin("or", c)
+
+    def conj(self, c: list[Any]) -> ast.Binary:
+        return self._bin("and", c)
+
+    def add(self, c: list[Any]) -> ast.Binary:
+        return self._bin("+", c)
+
+    def sub(self, c: list[Any]) -> ast.Binary:
+        return self._bin("-", c)
+
+    def mul(self, c: list[Any]) -> ast.Binary:
+        return self._bin("*", c)
+
+    def div(self, c: list[Any]) -> ast.Binary:
+        return self._bin("/", c)
+
+    def neg(self, c: list[Any]) -> ast.Unary:
+        return ast.Unary("not", c[1], self._span(c))
+
+    def minus(self, c: list[Any]) -> ast.Unary:
+        return ast.Unary("-", c[1], self._span(c))
+
+    def compare(self, c: list[Any]) -> ast.Compare:
+        ops = cast("tuple[ast.CompareOp, ...]", tuple(str(t) for t in c[1::2]))
+        return ast.Compare(ops, tuple(c[0::2]), self._span(c))
+
+    def member(self, c: list[Any]) -> ast.Member:
+        return ast.Member(c[0], c[2], False, self._span(c))
+
+    def not_member(self, c: list[Any]) -> ast.Member:
+        return ast.Member(c[0], c[2], True, self._span(c))
+
+    def number(self, c: list[Any]) -> ast.NumLit:
+        return ast.NumLit(str(c[0]), self._span(c))
+
+    def true(self, c: list[Any]) -> ast.BoolLit:
+        return ast.BoolLit(True, self._span(c))
+
+    def false(self, c: list[Any]) -> ast.BoolLit:
+        return ast.BoolLit(False, self._span(c))
+
+    def io_name(self, c: list[Any]) -> ast.Var:
+        prefix, name = str(c[0]).split(".", 1)
+        return ast.Var(name, prefix, self._span(c))  # type: ignore[arg-type]
+
+    def plain_name(self, c: list[Any]) -> ast.Var:
+        return ast.Var(str(c[0]), None, self._span(c))
+
+    base_type_name = plain_name
+
+    def apply(self, c: list[Any]) -> ast.Apply:
+        v = _vals(c)
+        return ast.Apply(v[0], tuple(a for a in v[1:] if a is not None), self._span(c))
+
+    def _kind(self, kind: str, c: list[Token]) -> Token:
+        return Token.new_borrow_pos("QUANT", kind, c[0])
+
+    def forall(self, c: list[Token]) -> Token:
+        return self._kind("forall", c)
+
+    def exists(self, c: list[Token]) -> Token:
+        return self._kind("exists", c)
+
+    def exists_unique(self, c: list[Token]) -> Token:
+        return self._kind("exists_unique", c)
+
+    def quant(self, c: list[Any]) -> ast.Quant:
+        v = _vals(c)
+        return ast.Quant(str(v[0]), v[1], v[2], self._span(c))  # type: ignore[arg-type]
+
+    def bindings(self, c: list[Any]) -> tuple[ast.Binding, ...]:
+        return tuple(_vals(c))
+
+    def binding(self, c: list[Any]) -> ast.Binding:
+        v = _vals(c)
+        names = tuple(str(n) for n in v[:-1])
+        locs = tuple(self._span([n]) for n in v[:-1])
+        domain = v[-1]
+        if isinstance(domain, ast.Var) and domain.prefix is None:
+            domain = ast.TName(domain.name, domain.loc)
+        return ast.Binding(names, domain, self._span(c), locs)
+
+    def bound_name(self, c: list[Token]) -> Token:
+        return c[0]  # the NAME token: its text and its position
+
+    def set_lit(self, c: list[Any]) -> ast.SetLit:
+        return ast.SetLit(tuple(x for x in _vals(c) if x is not None), self._span(c))
+
+    def seq_lit(self, c: list[Any]) -> ast.SeqLit:
+        return ast.SeqLit(tuple(x for x in _vals(c) if x is not None), self._span(c))
+
+    def tuple_lit(self, c: list[Any]) -> ast.TupleLit:
+        return ast.TupleLit(tuple(_vals(c)), self._span(c))
+
+    def paren(self, c: list[Any]) -> Any:
+        e = c[1]
+        if isinstance(e, ast.Binary):
+            e = dataclasses.replace(e, parenthesised=True)
+        self.wrapped[id(e)] = (e, self._span(c))
+        return e
+
+
+_BUILDER = _ToAst()
+_LOCK = threading.Lock()
+
+
+def _accepts(state: Any) -> set[str] | None:
+    """Terminals the LALR automaton accepts in parser state ``state``.
+
+    The expected set lark attaches to an error is either the contextual
+    lexer's terminal set (which omits keywords the NAME pattern absorbs, and
+    may include follow tokens of merged states) or the raw action-table row.
+    Simulating the reductions for each candidate terminal, without touching the
+    value stack, gives exactly the tokens that would let the parse continue.
+    Returns ``None`` when ``state`` is not a lark ``ParserState``.
+    """
+    try:
+        states = state.parse_conf.states
+        end_state = state.parse_conf.end_state
+        base_stack = list(state.state_stack)
+    except AttributeError:
+        return None
+    accepted: set[str] = set()
+    for term in states[base_stack[-1]]:
+        if not term.isupper():
+            continue
+        stack = list(base_stack)
+        while True:
+            entry = states[stack[-1]].get(term)
+            if entry is None:
+                break
+            action, arg = entry
+            if action is Shift:
+                accepted.add(term)
+                break
+            size = len(arg.expansion)
+            if size:
+                del stack[-size:]
+            stack.append(states[stack[-1]][arg.origin.name][1])
+            if term == "$END" and stack[-1] == end_state:
+                accepted.add(term)
+                break
+    return accepted
+
+
+def _unterminated_comment(text: str) -> int | None:
+    """Offset of a ``/*`` that is never closed, or ``None``."""
+    for m in _COMMENT_SCAN.finditer(text):
+        if m.group(0) == "/*":
+            return m.start()
+    return None
+
+
+_COMMENT_SCAN = re.compile(r"//[^\n]*|/\*.*?\*/|/\*", re.S)
+
+
+def _line_col(text: str, offset: int) -> tuple[int, int]:
+    line = text.count("\n", 0, offset) + 1
+    return line, offset - (text.rfind("\n", 0, offset) + 1) + 1
+
+
+def _syntax_error(exc: UnexpectedInput, file: str, text: str, dline: int, dcol: int) -> RclError:
+    """Turn a lark exception into a located ``E-syntax`` diagnostic:
+    ``unexpected X; expected one of A, B, ...`` at the offending token."""
+    line = getattr(exc, "line", 0) or 0
+    col = getattr(exc, "column", 0) or 0
+    expected: Iterable[str] | None = _accepts(getattr(exc, "state", None))
+    if expected is None:
+        expected = getattr(exc, "expected", None) or getattr(exc, "allowed", None)
+    hint = ""
+    open_comment = _unterminated_comment(text)
+    pos = getattr(exc, "pos_in_stream", None)
+    if open_comment is not None and (pos is None or pos >= open_comment):
+        line, col = _line_col(text, open_comment)
+        msg, expected = "unterminated /* comment (no closing */)", None
+    elif isinstance(exc, UnexpectedEOF) or (isinstance(exc, UnexpectedToken) and exc.token.type == "$END"):
+        line, col = _line_col(text, len(text.rstrip()))
+        msg = "unexpected end of input"
+    elif isinstance(exc, UnexpectedToken):
+        msg = f"unexpected {exc.token.value!r}"
+        if exc.token.value == "=" and expected and "CMP_OP" in expected:
+            hint = " (equality is written '==')"
+    elif isinstance(exc, UnexpectedCharacters):
+        msg = f"unexpected character {exc.char!r}"
+    else:  # pragma: no cover - lark has no other subclasses today
+        msg, expected = str(exc).splitlines()[0], None
+    if expected:
+        names = sorted({_describe(t) for t in expected})
+        if names:
+            msg += "; expected " + (names[0] if len(names) == 1 else "one of " + ", ".join(names))
+    msg += hint
+    if line == 1:
+        col += dcol
+    return RclError([error(ast.Loc(file, line + dline, col), msg, "E-syntax")])
+
+
+def parse_text(text: str, file: str = "<string>") -> ast.Spec:
+    """Parse a whole RCL file's text.  Raises :class:`RclError` on a syntax error."""
+    return _parse(text, file, "start", 0, 0)  # type: ignore[no-any-return]
+
+
+def parse_formula(text: str, file: str = "<string>", line: int = 1, col: int = 1) -> ast.Expr:
+    """Parse one RCL formula (or term) starting at ``file:line:col``."""
+    return _parse(text, file, "expr", line - 1, col - 1)  # type: ignore[no-any-return]
+
+
+def _parse(text: str, file: str, start: str, dline: int, dcol: int) -> Any:
+    parser = _lark()
+    with _LOCK, _gc_paused():
+        _BUILDER.reset(file, dline, dcol)
+        try:
+            return parser.parse(text, start=start)
+        except UnexpectedInput as exc:
+            raise _syntax_error(exc, file, text, dline, dcol) from None
+        finally:
+            _BUILDER.reset("<string>", 0, 0)
+
+
+def ast_from_tree(tree: Any, file: str = "<string>") -> Any:
+    """The AST of a lark parse tree of ``rcl.lark`` built by another lark
+    parser with ``keep_all_tokens=True`` and ``maybe_placeholders=True``
+    (e.g. an Earley parser over the same grammar, in the parse benchmark)."""
+    with _LOCK:
+        _BUILDER.reset(file, 0, 0)
+        try:
+            return _BUILDER.transform(tree)
+        finally:
+            _BUILDER.reset("<string>", 0, 0)
+
+
+@contextmanager
+def _gc_paused() -> Iterator[None]:
+    """Pause the cyclic garbage collector while parsing.
+
+    Parse trees and AST nodes hold no reference cycles, so reference counting
+    frees them; without the pause the collector repeatedly scans the growing
+    heap and parsing a large system becomes superlinear (about 2x slower at a
+    thousand nodes, see bench/parse_scale.py)."""
+    was_enabled = gc.isenabled()
+    gc.disable()
+    try:
+        yield
+    finally:
+        if was_enabled:
+            gc.enable()
+
+
+def parse_file(path: str | Path) -> ast.Spec:
+    """Read and parse an RCL file.  A missing/unreadable file is an RclError."""
+    p = Path(path)
+    try:
+        text = p.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as exc:
+        raise RclError([error(ast.Loc(str(path), 1, 1), f"cannot read RCL file: {getattr(exc, 'strerror', None) or exc}", "E-io")]) from None
+    return parse_text(text, str(path))
+
+
+def parse_files(paths: Iterable[str | Path]) -> list[ast.Spec]:
+    """Parse several files; collects the syntax errors of all of them."""
+    specs: list[ast.Spec] = []
+    diags: list[Diagnostic] = []
+    for p in paths:
+        try:
+            specs.append(parse_file(p))
+        except RclError as e:
+            diags.extend(e.diagnostics)
+    if diags:
+        raise RclError(diags)
+    return specs

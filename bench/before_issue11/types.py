@@ -1,0 +1,184 @@
+"""Semantic (resolved) RCL types and the typing environment.
+
+The type checker (:mod:`rclverify.rcl.typecheck`) resolves every
+:data:`rclverify.rcl.ast.TypeExpr` into a :data:`Type` below: context names
+are expanded, enumerations and constructor sets keep the context name they
+were declared under (it names the Z3 sort and the Dafny datatype).
+
+Numeric subtyping: ``NATURAL <: INTEGER <: REAL`` (paper section 3.2 uses
+the three as the usual number sets).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Literal, Mapping, Union
+
+from . import ast
+
+ScalarName = Literal["REAL", "INTEGER", "NATURAL", "BOOL"]
+
+
+@dataclass(frozen=True)
+class Scalar:
+    name: ScalarName
+
+    def __str__(self) -> str:
+        return self.name
+
+
+@dataclass(frozen=True)
+class EnumT:
+    """Enumeration; ``name`` is the context name (or a synthetic one)."""
+
+    name: str
+    values: tuple[str, ...]
+
+    def __str__(self) -> str:
+        return self.name
+
+
+@dataclass(frozen=True)
+class DataT:
+    """Constructor set; ``ctors`` is ``((ctor name, (arg types...)), ...)``."""
+
+    name: str
+    ctors: tuple[tuple[str, tuple["Type", ...]], ...]
+
+    def __str__(self) -> str:
+        return self.name
+
+    def ctor(self, name: str) -> tuple["Type", ...] | None:
+        for n, args in self.ctors:
+            if n == name:
+                return args
+        return None
+
+
+@dataclass(frozen=True)
+class FuncT:
+    args: tuple["Type", ...]
+    result: "Type"
+
+    def __str__(self) -> str:
+        return " x ".join(map(str, self.args)) + " --> " + str(self.result)
+
+
+@dataclass(frozen=True)
+class EmptyT:
+    """The empty type ``{}``; no value inhabits it."""
+
+    name: str = "{}"
+
+    def __str__(self) -> str:
+        return self.name
+
+
+@dataclass(frozen=True)
+class SetT:
+    elem: "Type"
+
+    def __str__(self) -> str:
+        return f"set({self.elem})"
+
+
+@dataclass(frozen=True)
+class SeqT:
+    elem: "Type"
+
+    def __str__(self) -> str:
+        return f"seq({self.elem})"
+
+
+@dataclass(frozen=True)
+class TupleT:
+    elems: tuple["Type", ...]
+
+    def __str__(self) -> str:
+        return "(" + ", ".join(map(str, self.elems)) + ")"
+
+
+Type = Union[Scalar, EnumT, DataT, FuncT, EmptyT, SetT, SeqT, TupleT]
+
+REAL = Scalar("REAL")
+INTEGER = Scalar("INTEGER")
+NATURAL = Scalar("NATURAL")
+BOOL = Scalar("BOOL")
+NUMERIC_RANK = {"NATURAL": 0, "INTEGER": 1, "REAL": 2}
+
+
+def is_numeric(t: Type) -> bool:
+    return isinstance(t, Scalar) and t.name in NUMERIC_RANK
+
+
+def numeric_join(a: Type, b: Type) -> Scalar | None:
+    """The least numeric supertype of ``a`` and ``b`` (``None`` if either is not numeric)."""
+    if not (isinstance(a, Scalar) and isinstance(b, Scalar) and is_numeric(a) and is_numeric(b)):
+        return None
+    return a if NUMERIC_RANK[a.name] >= NUMERIC_RANK[b.name] else b
+
+
+def assignable(src: Type, dst: Type) -> bool:
+    """``src`` may be used where ``dst`` is expected (numeric widening allowed)."""
+    if src == dst:
+        return True
+    if is_numeric(src) and is_numeric(dst):
+        assert isinstance(src, Scalar) and isinstance(dst, Scalar)
+        return NUMERIC_RANK[src.name] <= NUMERIC_RANK[dst.name]
+    if isinstance(src, SetT) and isinstance(dst, SetT):
+        return assignable(src.elem, dst.elem)
+    if isinstance(src, SeqT) and isinstance(dst, SeqT):
+        return assignable(src.elem, dst.elem)
+    if isinstance(src, TupleT) and isinstance(dst, TupleT):
+        return len(src.elems) == len(dst.elems) and all(map(assignable, src.elems, dst.elems))
+    return False
+
+
+def comparable(a: Type, b: Type) -> bool:
+    """``a == b`` is well-typed."""
+    return assignable(a, b) or assignable(b, a)
+
+
+@dataclass(frozen=True)
+class Env:
+    """The resolved global environment of a set of RCL files (their contexts).
+
+    ``types``        context type name -> resolved type;
+    ``constants``    constant name -> (type, defining expression);
+    ``enum_values``  enumeration value -> its enumeration type;
+    ``ctors``        constructor name -> its constructor-set type.
+    """
+
+    types: Mapping[str, Type] = field(default_factory=dict)
+    constants: Mapping[str, tuple[Type, ast.Expr]] = field(default_factory=dict)
+    enum_values: Mapping[str, EnumT] = field(default_factory=dict)
+    ctors: Mapping[str, DataT] = field(default_factory=dict)
+
+
+@dataclass(frozen=True)
+class CheckedNode:
+    """A node whose contract type-checked: its AST and resolved I/O types."""
+
+    node: ast.Node
+    inputs: Mapping[str, Type]
+    outputs: Mapping[str, Type]
+
+    @property
+    def name(self) -> str:
+        return self.node.name
+
+    def io_type(self, var: ast.Var) -> Type | None:
+        """Type of ``in.x``/``out.x``/bare ``x`` (inputs first for bare names)."""
+        if var.prefix == "in":
+            return self.inputs.get(var.name)
+        if var.prefix == "out":
+            return self.outputs.get(var.name)
+        return self.inputs.get(var.name) or self.outputs.get(var.name)
+
+
+@dataclass(frozen=True)
+class Checked:
+    """The result of type checking: environment plus nodes by name (source order)."""
+
+    env: Env
+    nodes: Mapping[str, CheckedNode]
+    specs: tuple[ast.Spec, ...] = ()
