@@ -50,7 +50,7 @@ nodes:
   N1:
     evidence:
       - {backend: hoare, program: backends/hoare/clamp.imp, binding: {in.v0: x, out.v1: y}}
-      - {backend: review}
+      - {backend: review, record: backends/review/n1.yaml}
 """
 
 TIMING = ("started", "duration_s")
@@ -62,6 +62,12 @@ def _workspace(path: Path) -> Path:
     (path / "contracts" / "system.rcl").write_text(RCL)
     (path / "contracts" / "plan.yaml").write_text(PLAN)
     (path / "backends" / "hoare" / "clamp.imp").write_text(CLAMP)
+    # a review record not filled in yet: its two obligations are pending
+    from rclverify.backends.review.blank import blank_record
+    from rclverify.rcl.typecheck import load
+    (path / "backends" / "review").mkdir(parents=True)
+    node = load([path / "contracts" / "system.rcl"]).nodes["N1"]
+    (path / "backends" / "review" / "n1.yaml").write_text(blank_record(node, path))
     return path
 
 
