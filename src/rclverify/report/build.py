@@ -14,9 +14,13 @@ while any of its evidence is failed, pending, stale or missing:
 * node: worst of its guarantees and its side conditions;
 * requirement: worst of the guarantees that support it and of the side
   conditions of their nodes;
-* derived property: worst of the nodes in the node's upstream cone (their
-  side conditions and their evidence: the rules' premises are the nodes'
-  contracts, which only the evidence establishes).
+* derived property: two separate statuses.  Its *derivation* (``status``,
+  shown as ``derived`` / ``not derived`` / ``undecided``) is the worst of the
+  side conditions of the nodes in its upstream cone: the calculus derived it
+  when all of them are discharged.  Its *evidence* (``evidence_status`` with
+  ``evidence_note``, e.g. "rests on 1 failed node contract:
+  RadiationSensor") is the worst status of those nodes' guarantees: the
+  rules' premises are the node contracts, which only evidence establishes.
 """
 from __future__ import annotations
 
@@ -37,6 +41,28 @@ _FINDING_AS = {"ok": "discharged", "problem": "failed", "inconclusive": "inconcl
 
 def _src(l: ast.Loc) -> str:
     return f"{l.file}:{l.line}:{l.col}"
+
+
+_DERIVATION = {"discharged": "derived", "failed": "not derived"}
+
+
+def _evidence_of_cone(cone: list[str], node_evidence: dict[str, str]) -> tuple[str, str]:
+    """(worst evidence status of the nodes of ``cone``, the sentence saying
+    which node contracts a derived property rests on that are not yet
+    established: "derived; rests on 1 failed node contract: RadiationSensor")."""
+    if not cone:
+        return "discharged", "derived; rests on no node contract"
+    by: dict[str, list[str]] = {}
+    for m in cone:
+        by.setdefault(node_evidence.get(m, "pending"), []).append(m)
+    parts = []
+    for st in sorted(by, key=lambda x: -SEVERITY.get(x, 0)):
+        if st == "discharged":
+            continue
+        ns = by[st]
+        parts.append(f"{len(ns)} {st} node contract{'s' if len(ns) != 1 else ''}: {', '.join(ns)}")
+    note = "rests on " + "; ".join(parts) if parts else "every node contract it rests on is discharged"
+    return worst(list(by)), note
 
 
 def build_report(ws: Workspace) -> dict[str, Any]:
@@ -93,6 +119,7 @@ def build_report(ws: Workspace) -> dict[str, Any]:
 
     nodes = []
     node_status: dict[str, str] = {}
+    node_evidence: dict[str, str] = {}
     for name, cn in checked.nodes.items():
         internal = {l.to_var: f"{l.from_node}.{l.from_var}" for l in model.links if l.to_node == name}
         consumers: dict[str, list[str]] = {}
@@ -106,6 +133,7 @@ def build_report(ws: Workspace) -> dict[str, Any]:
             for k, g in enumerate(cn.node.guarantees, 1)]
         status = worst([g["status"] for g in guarantees] + [sc_status[name]])
         node_status[name] = status
+        node_evidence[name] = worst([g["status"] for g in guarantees], empty="pending")
         nodes.append({
             "name": name, "source": _src(cn.node.loc), "status": status,
             "inputs": [{"name": v.name, "type": type_to_rcl(v.type), "producer": internal.get(v.name)} for v in cn.node.inputs],
@@ -133,11 +161,14 @@ def build_report(ws: Workspace) -> dict[str, Any]:
         c = comps[n]
         if not c:
             continue
+        derivation = worst([sc_status[m] for m in c["cone"]], empty="discharged")
+        ev_status, ev_note = _evidence_of_cone(c["cone"], node_evidence)
         derived.append({"node": n, "rules": c["rules"], "instances": c["instances"],
                         "environment_assumptions": c["cone_environment_assumptions"], "property": c["derived_property"],
-                        # holds once its side conditions do AND every node of the cone
-                        # meets its contract (the rules' premises): their evidence counts
-                        "status": worst([node_status[m] for m in c["cone"]]),
+                        # the derivation: every side condition of the cone discharged
+                        "status": derivation, "derivation": _DERIVATION.get(derivation, "undecided"),
+                        # what the rules' premises (the node contracts) rest on
+                        "evidence_status": ev_status, "evidence_note": ev_note,
                         "loop_assumption": c["loop_assumption"]})
 
     findings = [f for n in checked.nodes for f in health[n]]
@@ -165,9 +196,7 @@ def build_report(ws: Workspace) -> dict[str, Any]:
     strict_ok = (all(o["status"] == "discharged" for o in ob_rows)
                  and all(sc["status"] == "discharged" for sc in side_conditions)
                  and all(f["status"] == "ok" for f in findings))
-    headline = (f"{len(ob_rows)} obligations: " + ", ".join(f"{counts[s]} {s}" for s in sorted(counts, key=SEVERITY.__getitem__))
-                + f"; {sum(1 for sc in side_conditions if sc['status'] == 'discharged')}/{len(side_conditions)} side conditions "
-                f"discharged; {sum(1 for f in findings if f['status'] == 'problem')} contract health problem(s).")
+    headline = _headline(ob_rows, counts, side_conditions, findings)
     system = model.view(node_status)
     return {
         "meta": {"tool": "rclverify", "version": __version__, "workspace": plan.name or ws.root.resolve().name, "plan": plan.file,
@@ -177,3 +206,24 @@ def build_report(ws: Workspace) -> dict[str, Any]:
         "derived_properties": derived, "findings": findings, "obligations": ob_rows, "evidence": ev_rows,
         "environment_assumptions": env_assumptions, "pending": pending, "lint": lint_rows,
     }
+
+
+def _headline(ob_rows: list[dict[str, Any]], counts: dict[str, int], side_conditions: list[dict[str, Any]],
+              findings: list[dict[str, Any]]) -> str:
+    """The one-line summary, without empty fragments: a kind with nothing
+    in it is said in words ("no obligations"), never as "0 obligations: ;"."""
+    parts = []
+    if ob_rows:
+        parts.append(f"{len(ob_rows)} obligation{'s' if len(ob_rows) != 1 else ''}: "
+                     + ", ".join(f"{counts[s]} {s}" for s in sorted(counts, key=lambda x: SEVERITY.get(x, 99))))
+    else:
+        parts.append("no obligations")
+    if side_conditions:
+        parts.append(f"{sum(1 for sc in side_conditions if sc['status'] == 'discharged')}/{len(side_conditions)} "
+                     "side conditions discharged")
+    else:
+        parts.append("no side conditions")
+    problems = sum(1 for f in findings if f["status"] == "problem")
+    parts.append(f"{problems} contract health problem{'s' if problems != 1 else ''}" if problems
+                 else "no contract health problem")
+    return "; ".join(parts) + "."
