@@ -286,7 +286,7 @@ def compose_node(checked: Checked, model: SystemModel, node: str, *,
 def _shape(rule: str, producers: Sequence[str], node: str, siblings: Sequence[str]) -> str:
     """The graph shape that selects ``rule``, in words."""
     if rule == "R3":
-        return f"join: {', '.join(producers)} all feed {node}"
+        return f"join: {', '.join(producers)} feed {node}"
     if rule == "R2":
         return f"branch: the output of {producers[0]} that {node} reads is also read by {', '.join(siblings)}"
     return f"sequence: {producers[0]} feeds {node} only"

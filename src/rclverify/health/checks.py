@@ -150,7 +150,10 @@ class _NodeHealth:
 
 def check_node(checked: Checked, node: str, facts: Sequence[tuple[ast.Expr, ast.Loc]] = (),
                instances: tuple[int, int] | None = None, *, timeout_ms: int = HEALTH_TIMEOUT_MS) -> list[Finding]:
-    """Run the three health checks on ``node``; returns its findings in order."""
+    """Run the three health checks on ``node``, then the checks of
+    :mod:`rclverify.health.shape` (tautologies, guarantees constraining no
+    output, unconstrained outputs, redundant conjuncts); returns its findings
+    in order."""
     h = _NodeHealth(checked, checked.nodes[node], facts, instances, timeout_ms)
     out: list[Finding] = []
     n = node
@@ -192,6 +195,8 @@ def check_node(checked: Checked, node: str, facts: Sequence[tuple[ast.Expr, ast.
         f = _non_vacuity(h, n, k)
         if f is not None:  # only implications have a premise that can be vacuous
             out.append(f)
+    from .shape import shape_findings  # shape builds on Finding: imported here to avoid a cycle
+    out += shape_findings(checked, node)
     return out
 
 

@@ -54,13 +54,14 @@ STATUS_STYLE: Mapping[str, str] = {
     "derived": "discharged",
     "not derived": "failed",
     "undecided": "inconclusive",
+    "warning": "pending",
 }
 
 #: Severity of a status word for ordering the attention list (larger is
 #: worse).  A word outside the vocabulary ranks as an error: the report cannot
 #: vouch for what it does not understand.
 _RANK: Mapping[str, int] = {**SEVERITY, "ok": 0, "proved": 0, "problem": 5, "refuted": 5, "unknown": 2,
-                            "derived": 0, "not derived": 5, "undecided": 2}
+                            "derived": 0, "not derived": 5, "undecided": 2, "warning": 1}
 _UNKNOWN_RANK = SEVERITY["error"]
 
 #: Marker shown in Markdown next to a status (no colours there).
