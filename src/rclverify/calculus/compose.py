@@ -250,6 +250,8 @@ def compose_node(checked: Checked, model: SystemModel, node: str, *,
             if first.status == "refuted":
                 expl += (" As written it is refuted, but that model violates the producers' assumptions, so it "
                          "is not shown.")
+        if r.strategy:
+            expl += f" Z3's default strategy gave up; answered with {r.strategy}."
         scs.append(SideCondition(f"{node}.sc{k}", node, rule, expr_to_rcl(c), _loc(c.loc), used_text,
                                  status, round(first.duration_s + (r.duration_s if r is not first else 0.0), 4),
                                  r.smt2, r.model, expl, variant, tuple(links)))

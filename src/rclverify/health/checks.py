@@ -120,7 +120,9 @@ class _NodeHealth:
     def sat(self, extra: Sequence[tuple[str, z3.BoolRef]], *, guarantees: bool = True, comment: str = "",
             timeout_ms: int | None = None) -> QueryResult:
         labelled = list(self.assume) + (list(self.guars) + list(self.facts) + list(self.lemmas) if guarantees else [])
-        return satisfiable(labelled + list(extra), self.enc, timeout_ms=timeout_ms or self.timeout, comment=comment)
+        # per-instance queries (own timeout) are not retried: the instance scan is their fallback
+        return satisfiable(labelled + list(extra), self.enc, timeout_ms=timeout_ms or self.timeout, comment=comment,
+                           retry=timeout_ms is None)
 
     def premise(self, k: int, fixed: dict[str, int] | None = None) -> tuple[list[tuple[str, z3.BoolRef]], str] | None:
         g = self.node.node.guarantees[k - 1]
@@ -172,7 +174,7 @@ def check_node(checked: Checked, node: str, facts: Sequence[tuple[ast.Expr, ast.
         out.append(Finding(f"{n}.assumption-satisfiable", n, "assumption-satisfiable", None, "inconclusive",
                            f"Z3 could not decide whether the assumption of {n} can hold.", r.reason, duration_s=r.duration_s))
 
-    out[mark] = replace(out[mark], smt2=r.smt2)
+    out[mark] = _noted(replace(out[mark], smt2=r.smt2), r)
     r = h.sat([], comment=f"health {n}: can the assumption, every guarantee and the environment facts hold together?")
     mark = len(out)
     check = "contract-consistent"
@@ -190,7 +192,7 @@ def check_node(checked: Checked, node: str, facts: Sequence[tuple[ast.Expr, ast.
                            "The quantifier alternation in the guarantees is beyond Z3's decision procedures within the "
                            "timeout; no conclusion is drawn.", duration_s=r.duration_s))
 
-    out[mark] = replace(out[mark], smt2=r.smt2)
+    out[mark] = _noted(replace(out[mark], smt2=r.smt2), r)
     for k in range(1, len(checked.nodes[node].node.guarantees) + 1):
         f = _non_vacuity(h, n, k)
         if f is not None:  # only implications have a premise that can be vacuous
@@ -200,13 +202,20 @@ def check_node(checked: Checked, node: str, facts: Sequence[tuple[ast.Expr, ast.
     return out
 
 
+def _noted(f: Finding, r: QueryResult) -> Finding:
+    """``f`` with the retry strategy that answered its query (logic/retry.py) stated."""
+    if not r.strategy:
+        return f
+    return replace(f, explanation=f"{f.explanation} Z3's default strategy gave up; answered with {r.strategy}.")
+
+
 def _non_vacuity(h: _NodeHealth, n: str, k: int) -> Finding | None:
     prem = h.premise(k)
     if prem is None:
         return None  # not forall ... (premise -> conclusion): no premise to examine
     extra, ptext = prem
     r = h.sat(extra, comment=f"health {n}: can the premise of guarantee {k} hold? {ptext}")
-    return replace(_premise_finding(h, n, k, r, ptext), smt2=r.smt2)
+    return _noted(replace(_premise_finding(h, n, k, r, ptext), smt2=r.smt2), r)
 
 
 def _premise_finding(h: _NodeHealth, n: str, k: int, r: QueryResult, ptext: str) -> Finding:
