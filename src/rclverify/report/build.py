@@ -35,6 +35,7 @@ from ..pipeline import Workspace, read_artifact
 from ..rcl import ast
 from ..rcl.latex import to_latex
 from ..rcl.printer import expr_to_rcl, type_to_rcl
+from .expected import expected_rows
 
 _FINDING_AS = {"ok": "discharged", "problem": "failed", "inconclusive": "inconclusive",
                # a health warning (health/shape.py) is shown but changes no status
@@ -101,6 +102,7 @@ def build_report(ws: Workspace) -> dict[str, Any]:
         if status == "pending":
             pending.append({"obligation": o.id, "backend": o.backend, "reason": ev.explanation})
 
+    expected = expected_rows(plan, ob_rows)
     comps = {n: read_artifact(ws, ws.calculus(n), {}) for n in checked.nodes}
     health = {n: read_artifact(ws, ws.health(n), []) for n in checked.nodes}
     side_conditions = [sc for n in checked.nodes for sc in comps[n].get("side_conditions", [])]
@@ -189,6 +191,10 @@ def build_report(ws: Workspace) -> dict[str, Any]:
     for e in ev_rows:
         if e["status"] in ("failed", "error", "stale"):
             problems.append(f"Evidence {e['obligation']} is {e['status']}: {e['explanation'][:300]}")
+    for x in expected:
+        if x["outcome"] == "MISMATCH":
+            problems.append(f"Expected verdict mismatch: {x['obligation']} is {x['actual']}, the plan expects "
+                            f"{x['expected']} ({x['source']})" + (f": {x['reason']}" if x["reason"] else ""))
     counts: dict[str, int] = {}
     for row in ob_rows:
         counts[row["status"]] = counts.get(row["status"], 0) + 1
@@ -207,6 +213,7 @@ def build_report(ws: Workspace) -> dict[str, Any]:
         "system": system, "requirements": requirements, "nodes": nodes, "side_conditions": side_conditions,
         "derived_properties": derived, "findings": findings, "obligations": ob_rows, "evidence": ev_rows,
         "environment_assumptions": env_assumptions, "pending": pending, "lint": lint_rows,
+        "expected_verdicts": expected,
     }
 
 
