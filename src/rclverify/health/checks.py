@@ -281,6 +281,8 @@ def refinement_finding(node: str, spec: str, r: RefinementResult) -> Finding:
     sides = {"proved": "holds", "refuted": "fails", "inconclusive": "is undecided"}
     detail = (f"Assumption side (A_{node} -> A_replacement) {sides[r.assumption.status]}; guarantee side "
               f"(A_{node} and G_replacement -> G_{node}) {sides[r.guarantee.status]}.")
+    if r.conditions:
+        detail += " Checked under the plan's environment facts and conditions: " + "; ".join(r.conditions) + "."
     failed = next((s for s in (r.assumption, r.guarantee) if s.status == "refuted"), None)
     if r.verdict == "refines":
         status, msg = "ok", f"The replacement contract {spec} refines {node}: it may replace it."
