@@ -47,10 +47,20 @@ def test_calculus_reproduces_d1(report: dict) -> None:
     agent = next(d for d in report["derived_properties"] if d["node"] == "Agent")
     assert "R3" in agent["rules"]
     assert agent["instances"][0]["conclusion"].endswith("and (0 <= in.r) => <> G_Agent")
-    # a derived property rests on the cone's contracts too: with their evidence open it is not verified
+    # derivation and evidence are separate: every side condition is discharged, so every
+    # derived property reads "derived", with the evidence it rests on beside it
     loc = next(d for d in report["derived_properties"] if d["node"] == "Localisation")
-    assert loc["property"] == "TRUE => <> G_Localisation" and loc["status"] == "pending"
-    assert all(d["status"] != "discharged" for d in report["derived_properties"])
+    assert loc["property"] == "TRUE => <> G_Localisation" and loc["derivation"] == "derived"
+    assert loc["evidence_status"] == "pending" and "1 pending node contract: Localisation" in loc["evidence_note"]
+    assert all(d["derivation"] == "derived" for d in report["derived_properties"])
+    assert "2 failed node contracts: Agent, RadiationSensor" in agent["evidence_note"]
+    # the loop section lists the real cycles only
+    assert report["system"]["loops"] == [["Navigation", "Agent"], ["Agent", "RadiationSensor"]]
+    edges = {(c["from_node"], c["to_node"]) for c in report["system"]["connections"]}
+    for cycle in report["system"]["loops"]:
+        assert all((cycle[k], cycle[(k + 1) % len(cycle)]) in edges for k in range(len(cycle)))
+    # lint: no warning on the conventional (A and B) -> C form
+    assert not any("precedence decides" in x["message"] for x in report["lint"])
 
 
 def test_genuine_problems_of_the_case_study_are_shown(report: dict) -> None:
