@@ -80,10 +80,18 @@ def test_genuine_problems_of_the_case_study_are_shown(report: dict) -> None:
 
 def test_replacement_contract_is_checked_by_refinement(report: dict, workspace: Path) -> None:
     [f] = [f for f in report["findings"] if f["check"] == "replacement-refines"]
-    assert f["node"] == "Agent" and f["status"] == "problem"
-    assert "guarantee side fails" in f["message"]
-    # any counterexample must say how waypoints and radiation look (Z3 picks one)
-    assert {"in.wayP", "in.radiationStatus", "out.command"} <= set(f["model"])
+    # checked under the plan's 13-waypoint facts (the same facts the health checks use)
+    assert "[environment fact]" in f["explanation"]
+    # without the facts Z3 refutes it at once; with them the guarantee side needs
+    # a model of nested quantifiers over wayP, which Z3 finds or not within its
+    # timeout depending on load: never "ok"
+    assert f["node"] == "Agent" and f["status"] in ("problem", "inconclusive")
+    if f["status"] == "problem":
+        assert "guarantee side fails" in f["message"]
+        # any counterexample must say how waypoints and radiation look (Z3 picks one)
+        assert {"in.wayP", "in.radiationStatus", "out.command"} <= set(f["model"])
+    else:
+        assert "guarantee side:" in f["message"]
     assert (workspace / f["smt2"]).is_file()
     assert all((workspace / x["smt2"]).is_file() for x in report["findings"] if x.get("smt2"))
 

@@ -289,7 +289,9 @@ def refinement_finding(node: str, spec: str, r: RefinementResult) -> Finding:
     elif failed is not None:
         status, msg = "problem", f"The replacement contract {spec} does not refine {node}: its {failed.name} side fails."
     else:
-        status, msg = "inconclusive", f"Z3 could not decide whether {spec} refines {node}."
+        why = "; ".join(f"{x.name} side: {x.reason}" for x in (r.assumption, r.guarantee)
+                        if x.status == "inconclusive" and x.reason)
+        status, msg = "inconclusive", f"Z3 could not decide whether {spec} refines {node}" + (f" ({why})." if why else ".")
     model = dict(failed.model) if failed is not None and failed.model is not None else None
     return Finding(f"{node}.replacement-refines", node, "replacement-refines", None, status, msg,
                    detail + (f" Statement: {failed.statement}" if failed else ""), model,
