@@ -132,7 +132,7 @@ def satisfiable(labelled: Sequence[tuple[str, z3.BoolRef]], enc: Encoder | None 
         s2.set("unsat_core", True)
         s2.add(*[rewrite(f) for f in background])
         for k, (label, f) in enumerate(labelled):
-            s2.assert_and_track(rewrite(f), z3.Bool(f"__label_{k}"))
+            s2.assert_and_track(rewrite(f), z3.Bool(f"__label_{k}", s2.ctx))
         r = s2.check()
         dt = round(time.perf_counter() - t0, 4)
         if r == z3.sat:

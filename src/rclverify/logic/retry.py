@@ -2,7 +2,7 @@
 
 Quantified formulas are where Z3 gives up.  Before a query is reported
 ``inconclusive`` (logic/query.py), it is retried, in this order, each with
-the query's own timeout:
+a deterministic resource limit (:data:`RETRY_RLIMIT`):
 
 ``finite instantiation``
     every quantifier whose bound variables all range over finite sorts
@@ -26,6 +26,13 @@ import itertools
 from typing import Callable, Sequence
 
 import z3
+
+#: Each retry is bounded by Z3's deterministic resource counter (``rlimit``),
+#: not by wall-clock time, so its answer does not depend on the machine's load
+#: (a serial and a parallel run agree).  About 2-5 s on one idle core; the
+#: wall-clock timeout is only a safety net far above it.
+RETRY_RLIMIT = 6_000_000
+SAFETY_TIMEOUT_MS = 120_000
 
 FINITE = "finite instantiation"
 MBQI = "model-based quantifier instantiation"
@@ -85,20 +92,29 @@ def _has_quantifier(e: z3.ExprRef) -> bool:
     return False
 
 
+def _bounded() -> z3.Solver:
+    """A solver in a fresh Z3 context (so the answer does not depend on what
+    the process encoded before) bounded by :data:`RETRY_RLIMIT`."""
+    s = z3.Solver(ctx=z3.Context())
+    s.set("rlimit", RETRY_RLIMIT)
+    s.set("timeout", SAFETY_TIMEOUT_MS)
+    return s
+
+
 def attempts(formulas: Sequence[z3.BoolRef], timeout_ms: int
              ) -> list[tuple[str, z3.Solver, Callable[[z3.BoolRef], z3.BoolRef]]]:
     """The retries that apply to ``formulas`` (none without a quantifier):
-    ``(strategy name, configured solver, rewrite of each formula)``."""
+    ``(strategy name, configured solver, rewrite of each formula)``.
+    ``timeout_ms`` (the first attempt's) is not used: retries are bounded by
+    :data:`RETRY_RLIMIT` so that their answers are reproducible."""
     if not any(_has_quantifier(f) for f in formulas):
         return []
     out: list[tuple[str, z3.Solver, Callable[[z3.BoolRef], z3.BoolRef]]] = []
     changed = [expand_finite(f) for f in formulas]
     if any(not a.eq(b) for a, b in zip(changed, formulas)):
-        s = z3.Solver()
-        s.set("timeout", int(timeout_ms))
-        out.append((FINITE, s, expand_finite))
-    s = z3.Solver()
-    s.set("timeout", int(timeout_ms))
+        s = _bounded()
+        out.append((FINITE, s, lambda f, c=s.ctx: expand_finite(f).translate(c)))
+    s = _bounded()
     s.set("smt.ematching", False)
-    out.append((MBQI, s, lambda f: f))
+    out.append((MBQI, s, lambda f, c=s.ctx: f.translate(c)))
     return out
