@@ -238,9 +238,9 @@ def check_refinement(a: CheckedNode, b: CheckedNode, env: Env, *,
         raise RclError([error(_io_loc(b, "in", extra[0]), f"input {extra[0]!r} of {b.name} is not an input of {a.name} "
                                                           "and no condition mentions it; give one with --assume",
                               "E-refines-interface")])
-    q1 = prove(ab, [aa, *hyps], enc, timeout_ms=timeout_ms,
+    q1 = prove(ab, [aa, *hyps], enc, timeout_ms=timeout_ms, deterministic=True,
                comment=f"refinement, assumption side: A_{a.name} => A_{b.name}\nunsat: B assumes no more than A")
-    q2 = prove(ga, [aa, gb, *hyps], enc, timeout_ms=timeout_ms,
+    q2 = prove(ga, [aa, gb, *hyps], enc, timeout_ms=timeout_ms, deterministic=True,
                comment=f"refinement, guarantee side: A_{a.name} and G_{b.name} => G_{a.name}\n"
                        "unsat: B guarantees at least what A does")
 

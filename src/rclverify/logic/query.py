@@ -22,7 +22,7 @@ from typing import Sequence
 import z3
 
 from .encode import Encoder, term_to_rcl, value_to_rcl
-from .retry import attempts
+from .retry import attempts, bounded_solver
 
 DEFAULT_TIMEOUT_MS = 10_000
 
@@ -66,17 +66,24 @@ def _smt2(formulas: Sequence[z3.BoolRef], comment: str) -> str:
 
 
 def prove(goal: z3.BoolRef, hypotheses: Sequence[z3.BoolRef], enc: Encoder | None = None, *,
-          timeout_ms: int = DEFAULT_TIMEOUT_MS, comment: str = "") -> QueryResult:
+          timeout_ms: int = DEFAULT_TIMEOUT_MS, comment: str = "", deterministic: bool = False) -> QueryResult:
     """Is ``hypotheses => goal`` valid?  Checks ``hypotheses and not goal``.
 
     ``enc`` (when given) renders a refuting model in RCL terms and adds its
-    typing axioms to the hypotheses.  Never raises on solver trouble:
+    typing axioms to the hypotheses.  ``deterministic``: run the first
+    attempt too in a fresh Z3 context bounded by a resource limit
+    (:func:`.retry.bounded_solver`) instead of ``timeout_ms``, so the answer
+    does not depend on load or history.  Never raises on solver trouble:
     an unknown answer is ``inconclusive`` with Z3's reason.
     """
     hyps = list(hypotheses) + (enc.axioms() if enc else [])
     formulas = hyps + [z3.Not(goal)]
-    s = _solver(timeout_ms)
-    s.add(*formulas)
+    if deterministic:
+        s = bounded_solver()
+        s.add(*[f.translate(s.ctx) for f in formulas])
+    else:
+        s = _solver(timeout_ms)
+        s.add(*formulas)
     t0 = time.perf_counter()
     r = s.check()
     dt = round(time.perf_counter() - t0, 4)

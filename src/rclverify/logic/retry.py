@@ -92,7 +92,7 @@ def _has_quantifier(e: z3.ExprRef) -> bool:
     return False
 
 
-def _bounded() -> z3.Solver:
+def bounded_solver() -> z3.Solver:
     """A solver in a fresh Z3 context (so the answer does not depend on what
     the process encoded before) bounded by :data:`RETRY_RLIMIT`."""
     s = z3.Solver(ctx=z3.Context())
@@ -112,9 +112,9 @@ def attempts(formulas: Sequence[z3.BoolRef], timeout_ms: int
     out: list[tuple[str, z3.Solver, Callable[[z3.BoolRef], z3.BoolRef]]] = []
     changed = [expand_finite(f) for f in formulas]
     if any(not a.eq(b) for a, b in zip(changed, formulas)):
-        s = _bounded()
+        s = bounded_solver()
         out.append((FINITE, s, lambda f, c=s.ctx: expand_finite(f).translate(c)))
-    s = _bounded()
+    s = bounded_solver()
     s.set("smt.ematching", False)
     out.append((MBQI, s, lambda f, c=s.ctx: f.translate(c)))
     return out
