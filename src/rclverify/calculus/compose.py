@@ -21,6 +21,25 @@ For each node ``n`` of the system model:
 A side condition is ``discharged`` (Z3 proved it), ``failed`` (Z3 found a
 model of the producers' guarantees violating the conjunct; the model is
 shown in RCL names) or ``inconclusive`` (unknown/timeout; never proved).
+
+Two variants, tried in order (docs/architecture.md, "Side conditions"):
+
+``as written``
+    the producers' guarantees alone entail the conjunct (the premise of
+    R1/R2/R3 exactly as printed);
+``with producers' assumptions``
+    the producers' guarantees *and their assumptions* entail it.  A consumer
+    only ever reads outputs produced while the producer's assumption held
+    (a contract promises nothing otherwise, lines 462-495), so this is sound
+    for the composed system; the record says which variant was discharged.
+
+A counterexample is only ever shown from the second variant, so it
+satisfies the producers' assumptions as well as their guarantees.
+
+Each rule instance is labelled with the rule actually applied, from the
+graph's shape: R3 (join) when several nodes feed the node, R2 (branch) when
+its single producer's output is also read by another node, R1 (sequence)
+otherwise; R4 is added for a node on a cycle.
 """
 from __future__ import annotations
 
@@ -87,12 +106,14 @@ class SideCondition:
     smt2: str
     model: dict[str, str] | None = None
     explanation: str = ""
+    variant: str = ""
+    links: tuple[str, ...] = ()
 
     def to_json(self, smt2_path: str) -> dict[str, Any]:
         return {"id": self.id, "node": self.node, "rule": self.rule, "conjunct": self.conjunct,
                 "source": self.source, "hypotheses": list(self.hypotheses), "status": self.status,
                 "duration_s": self.duration_s, "smt2": smt2_path, "model": self.model,
-                "explanation": self.explanation}
+                "explanation": self.explanation, "variant": self.variant, "links": list(self.links)}
 
 
 @dataclass(frozen=True)
@@ -112,14 +133,40 @@ class NodeComposition:
     guarantee: str = ""
 
 
-def _rules(model: SystemModel, node: str) -> tuple[str, ...]:
+VARIANT_AS_WRITTEN = "as written"
+VARIANT_WITH_ASSUMPTIONS = "with producers' assumptions"
+
+
+def branch_siblings(model: SystemModel, node: str) -> list[str]:
+    """Other readers of the outputs that feed ``node`` (an output read by
+    several nodes is a branch, rule R2, paper lines 612-640), source order."""
+    feeding = {(l.from_node, l.from_var) for l in model.links if l.to_node == node}
+    others = {l.to_node for l in model.links if (l.from_node, l.from_var) in feeding and l.to_node != node}
+    return [n for n in model.nodes if n in others]
+
+
+def instance_rule(model: SystemModel, node: str) -> str | None:
+    """The rule whose instance derives ``node``'s contract from its producers:
+    ``R3`` (several producers: a join, lines 664-690), ``R2`` (one producer
+    whose output another node also reads: a branch, lines 612-640), ``R1``
+    (one producer feeding only ``node``: a sequence, lines 564-590), ``None``
+    (no producer)."""
     producers = model.producers(node)
-    rules = []
-    if len(producers) == 1:
-        rules.append("R1")
-    elif len(producers) > 1:
-        rules.append("R3")
-    if any(len(model.consumers(p)) > 1 for p in producers):
+    if len(producers) > 1:
+        return "R3"
+    if not producers:
+        return None
+    return "R2" if branch_siblings(model, node) else "R1"
+
+
+def _rules(model: SystemModel, node: str) -> tuple[str, ...]:
+    """Rules applied at ``node``: its instance's rule, ``R2`` as well when a
+    join's input comes from a branching output, ``R4`` on a cycle."""
+    rules: list[str] = []
+    r = instance_rule(model, node)
+    if r is not None:
+        rules.append(r)
+    if r == "R3" and branch_siblings(model, node):
         rules.append("R2")
     if model.loop_of(node):
         rules.append("R4")
@@ -170,28 +217,60 @@ def compose_node(checked: Checked, model: SystemModel, node: str, *,
     internal, env = split_assumption(checked, model, node)
     enc = Encoder(checked.env, model.alias())
     hyps, hyp_text = [], []
+    prod_assumptions, prod_a_text = [], []
     for p in producers:
         pn = checked.nodes[p]
         for k, g in enumerate(pn.node.guarantees, 1):
             hyps.append(enc.formula(g.formula, pn))
             hyp_text.append(f"{p} guarantee {k}: {expr_to_rcl(g.formula)}")
-    rule = "R3" if len(producers) > 1 else "R1"
+        for k, a in enumerate(pn.node.assumes, 1):
+            if isinstance(a.formula, ast.BoolLit) and a.formula.value:
+                continue
+            prod_assumptions.append(enc.formula(a.formula, pn))
+            prod_a_text.append(f"{p} assumption {k}: {expr_to_rcl(a.formula)}")
+    rule = instance_rule(model, node) or "R1"
+    who = ", ".join(producers)
     scs = []
     for k, c in enumerate(internal, 1):
         goal = enc.formula(c, cn)
-        r = prove(goal, hyps, enc, timeout_ms=timeout_ms,
-                  comment=f"rclverify side condition {node}.sc{k} ({rule}): guarantees of {', '.join(producers)} "
-                          f"entail {expr_to_rcl(c)}\nsource {_loc(c.loc)}; unsat means discharged")
+        links = _links_of(model, cn, node, c)
+        head = (f"rclverify side condition {node}.sc{k} ({rule}): guarantees of {who} "
+                f"entail {expr_to_rcl(c)}\nsource {_loc(c.loc)}; unsat means discharged")
+        r = prove(goal, hyps, enc, timeout_ms=timeout_ms, comment=head + "\nvariant: " + VARIANT_AS_WRITTEN)
+        variant, used_text = VARIANT_AS_WRITTEN, tuple(hyp_text)
+        first = r
+        if r.status != "proved" and prod_assumptions:
+            r = prove(goal, hyps + prod_assumptions, enc, timeout_ms=timeout_ms,
+                      comment=head + "\nvariant: " + VARIANT_WITH_ASSUMPTIONS)
+            variant, used_text = VARIANT_WITH_ASSUMPTIONS, tuple(hyp_text) + tuple(prod_a_text)
         status = STATUS[r.status]
-        if status == "discharged":
-            expl = f"Z3 proved that the guarantees of {', '.join(producers)} entail this conjunct of {node}'s assumption."
+        link_text = "; ".join(links) or "no link"
+        if status == "discharged" and variant == VARIANT_AS_WRITTEN:
+            expl = (f"Discharged as written: Z3 proved that the guarantees of {who} entail this conjunct of "
+                    f"{node}'s assumption.")
+        elif status == "discharged":
+            expl = (f"Discharged with the producers' assumptions: the guarantees of {who} alone do not entail "
+                    f"this conjunct of {node}'s assumption ({first.status}), but together with the assumptions "
+                    f"of {who} they do. {node} only reads outputs produced while those assumptions held, so the "
+                    "link is sound; the environment must meet the producers' assumptions.")
         elif status == "failed":
-            expl = (f"Z3 found values satisfying every guarantee of {', '.join(producers)} that violate this conjunct "
-                    f"of {node}'s assumption (model below); the nodes are not correctly linked.")
+            feeders = sorted({x.split(".", 1)[0] for x in links}, key=producers.index) or producers
+            expl = (f"{' and '.join(feeders)} and {node} are not correctly linked on {link_text}: Z3 found values "
+                    f"satisfying every guarantee{' and assumption' if prod_assumptions else ''} of {who} that "
+                    f"violate this conjunct of {node}'s assumption (model below). What "
+                    f"{' and '.join(feeders)} guarantee{'s' if len(feeders) == 1 else ''} about "
+                    f"{'these outputs' if len(links) > 1 else 'this output'} is weaker than what {node} assumes.")
         else:
-            expl = f"Z3 could not decide the side condition ({r.reason or 'unknown'}); it is not proved."
-        scs.append(SideCondition(f"{node}.sc{k}", node, rule, expr_to_rcl(c), _loc(c.loc), tuple(hyp_text),
-                                 status, r.duration_s, r.smt2, r.model, expl))
+            expl = (f"Z3 could not decide the side condition (reason given by Z3: {r.reason or 'unknown'}); "
+                    "it is not proved.")
+            if first.status == "refuted":
+                expl += (" As written it is refuted, but that model violates the producers' assumptions, so it "
+                         "is not shown.")
+        if r.strategy:
+            expl += f" Z3's default strategy gave up; answered with {r.strategy}."
+        scs.append(SideCondition(f"{node}.sc{k}", node, rule, expr_to_rcl(c), _loc(c.loc), used_text,
+                                 status, round(first.duration_s + (r.duration_s if r is not first else 0.0), 4),
+                                 r.smt2, r.model, expl, variant, tuple(links)))
     env_assumptions = tuple({"node": node, "text": expr_to_rcl(c), "source": _loc(c.loc)} for c in env)
     g_text = contract_text([g.formula for g in cn.node.guarantees])
     a_text = contract_text([a.formula for a in cn.node.assumes])
@@ -199,16 +278,20 @@ def compose_node(checked: Checked, model: SystemModel, node: str, *,
     if producers:
         premises = []
         prem_a = []
+        siblings = branch_siblings(model, node) if rule == "R2" else []
         for p in producers:
             pn = checked.nodes[p]
             pa = contract_text([a.formula for a in pn.node.assumes])
             premises.append(f"{p}: ({pa}) => <> ({contract_text([g.formula for g in pn.node.guarantees])})")
             prem_a.append(pa)
         premises.append(f"{node}: ({a_text}) => <> ({g_text})")
+        for sib in siblings:
+            premises.append(f"{sib} (the other reader of the branch; its own side condition is checked at {sib})")
         premises.append("side condition: " + " and ".join(f"G_{p}" for p in producers) + f" => A_{node}"
                         + ("" if scs else " (no conjunct of the assumption ranges over produced inputs)"))
         instances.append({"rule": rule, "premises": premises,
-                          "conclusion": " and ".join(f"({a})" for a in prem_a) + f" => <> G_{node}"})
+                          "conclusion": " and ".join(f"({a})" for a in prem_a) + f" => <> G_{node}",
+                          "shape": _shape(rule, producers, node, siblings)})
     cone = model.upstream(node)
     cone_env = tuple((m, t) for m in cone for t in _environment_texts(checked, model, m))
     derived = ("(" + " and ".join(t for _, t in cone_env) + ")" if cone_env else "TRUE") + f" => <> G_{node}"
@@ -216,6 +299,26 @@ def compose_node(checked: Checked, model: SystemModel, node: str, *,
     return NodeComposition(node, rules, tuple(producers), tuple(scs), env_assumptions, tuple(instances), derived,
                            tuple(cone), R4_ASSUMPTION.format(loop="{" + ", ".join(loop) + "}") if loop else None,
                            cone_env, g_text)
+
+
+def _shape(rule: str, producers: Sequence[str], node: str, siblings: Sequence[str]) -> str:
+    """The graph shape that selects ``rule``, in words."""
+    if rule == "R3":
+        return f"join: {', '.join(producers)} feed {node}"
+    if rule == "R2":
+        return f"branch: the output of {producers[0]} that {node} reads is also read by {', '.join(siblings)}"
+    return f"sequence: {producers[0]} feeds {node} only"
+
+
+def _links_of(model: SystemModel, cn: Any, node: str, c: ast.Expr) -> list[str]:
+    """The connections carrying the inputs a conjunct mentions, as
+    ``Producer.out.x -> Node.in.y (via name/topic/plan)``."""
+    names = {n for p, n in free_io(c) if (p == "in" or (p is None and n in cn.inputs))}
+    topics = {t.match.name: f"{t.msg_type} {t.field}" for t in cn.node.topics
+              if t.match is not None and t.match.prefix in (None, "in")}
+    return [f"{l.from_node}.out.{l.from_var} -> {node}.in.{l.to_var} (via {l.via}"
+            + (f", topic {topics[l.to_var]})" if l.to_var in topics else ")")
+            for l in model.links if l.to_node == node and l.to_var in names]
 
 
 def composition_json(c: NodeComposition, smt2_paths: Sequence[str]) -> dict[str, Any]:

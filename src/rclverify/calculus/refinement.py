@@ -18,14 +18,26 @@ variables of A and B are the same Z3 symbols.  Each side is decided by Z3
 (:func:`rclverify.logic.query.prove`): ``proved``, ``refuted`` with a model
 in RCL names, or ``inconclusive`` (unknown/timeout; never counted as proved).
 
+Conditions (docs/architecture.md, "Refinement"):
+
+* the *environment facts* the plan states for the node (the same facts the
+  health checks and side conditions use) are hypotheses of both sides: B
+  must replace A only in the environment the plan describes;
+* B may read inputs A does not have when the plan or the user gives a
+  condition on them (``rclverify refines A B --assume "in.extra >= 0"``):
+  each condition, over B's inputs, is a hypothesis of both sides.  The result
+  then states the condition under which B refines A
+  (``RefinementResult.conditions``).  Without a condition an extra input is
+  still an interface error.
+
 ``refines_main`` implements the command ``rclverify refines A.rcl:Node
-B.rcl:Node``.
+B.rcl:Node [--assume FORMULA ...]``.
 """
 from __future__ import annotations
 
 import sys
 from dataclasses import dataclass
-from typing import Any, Mapping, TextIO
+from typing import Any, Mapping, Sequence, TextIO
 
 import z3
 
@@ -33,6 +45,8 @@ from ..logic.encode import EncodingError, Encoder
 from ..logic.query import DEFAULT_TIMEOUT_MS, QueryResult, prove
 from ..rcl import ast
 from ..rcl.errors import Diagnostic, RclError, error
+from ..rcl.parser import parse_formula
+from .compose import free_io
 from ..rcl.printer import expr_to_rcl
 from ..rcl.typecheck import load
 from ..rcl.types import Checked, CheckedNode, Env
@@ -72,6 +86,7 @@ class RefinementResult:
     b: str
     assumption: SideResult
     guarantee: SideResult
+    conditions: tuple[str, ...] = ()
 
     @property
     def verdict(self) -> str:
@@ -87,7 +102,8 @@ class RefinementResult:
             return {"statement": s.statement, "status": s.status, "model": dict(s.model) if s.model else None,
                     "reason": s.reason, "duration_s": s.duration_s}
         return {"a": self.a, "b": self.b, "verdict": self.verdict,
-                "assumption": side(self.assumption), "guarantee": side(self.guarantee)}
+                "assumption": side(self.assumption), "guarantee": side(self.guarantee),
+                "conditions": list(self.conditions)}
 
 
 # ---------------------------------------------------------------------------
@@ -99,10 +115,11 @@ def _io_loc(node: CheckedNode, prefix: str, name: str) -> ast.Loc:
     return next((v.loc for v in group if v.name == name), node.node.loc)
 
 
-def check_interface(a: CheckedNode, b: CheckedNode) -> None:
+def check_interface(a: CheckedNode, b: CheckedNode, extra_inputs_ok: bool = False) -> None:
     """Raise :class:`RclError` (one diagnostic per difference, located in B,
     or at B's node when B lacks a variable) unless A and B have the same
-    inputs and outputs with the same types."""
+    inputs and outputs with the same types.  ``extra_inputs_ok``: B may have
+    inputs A lacks (their values are constrained by given conditions)."""
     diags: list[Diagnostic] = []
     for prefix, kind, ta, tb in (("in", "input", a.inputs, b.inputs), ("out", "output", a.outputs, b.outputs)):
         for name, t in ta.items():
@@ -115,10 +132,13 @@ def check_interface(a: CheckedNode, b: CheckedNode) -> None:
                                                              f"{t} in {a.name} ({_io_loc(a, prefix, name)})",
                                    "E-refines-interface"))
         for name in tb:
-            if name not in ta:
+            if name not in ta and not (prefix == "in" and extra_inputs_ok):
                 diags.append(error(_io_loc(b, prefix, name), f"{kind} {name!r} of {b.name} is not an {kind} of "
                                                              f"{a.name} ({a.node.loc}); a replacement needs the "
-                                                             f"same interface", "E-refines-interface"))
+                                                             f"same interface" + ("" if prefix == "out" else
+                                                             ", or a condition on the extra input (--assume, or "
+                                                             "the plan's environment facts)"),
+                                   "E-refines-interface"))
     if diags:
         raise RclError(diags)
 
@@ -182,15 +202,21 @@ def _rename(model: Mapping[str, str] | None, node: str) -> dict[str, str] | None
 
 
 def check_refinement(a: CheckedNode, b: CheckedNode, env: Env, *,
-                     timeout_ms: int = DEFAULT_TIMEOUT_MS) -> RefinementResult:
+                     timeout_ms: int = DEFAULT_TIMEOUT_MS, facts: Sequence[ast.Expr] = (),
+                     conditions: Sequence[ast.Expr] = ()) -> RefinementResult:
     """Decide whether contract ``b`` may replace contract ``a`` (module docstring).
 
     ``env`` must resolve both nodes' names (see :func:`merge_envs` for nodes
-    checked separately).  ``timeout_ms`` bounds each Z3 query.  Raises
+    checked separately).  ``timeout_ms`` bounds each Z3 query.  ``facts``:
+    the plan's environment facts of ``a``'s node (formulas over ``a``'s
+    inputs and outputs); ``conditions``: formulas over ``b``'s inputs (those
+    ``a`` lacks included), which allow ``b`` extra inputs.  Both are
+    hypotheses of both sides and are listed in the result.  Raises
     :class:`RclError` for an interface mismatch and for formulas the Z3
     encoding does not support (located).
     """
-    check_interface(a, b)
+    extra = [n for n in b.inputs if n not in a.inputs]
+    check_interface(a, b, extra_inputs_ok=bool(conditions) or bool(facts))
     enc = Encoder(env)
     shared: dict[str, Any] = {}
     for prefix, group in (("in", a.inputs), ("out", a.outputs)):
@@ -203,20 +229,31 @@ def check_refinement(a: CheckedNode, b: CheckedNode, env: Env, *,
 
         aa, ga = conj(a, a.node.assumes), conj(a, a.node.guarantees)
         ab, gb = conj(b, b.node.assumes), conj(b, b.node.guarantees)
+        hyps = [enc.formula(f, a, shared) for f in facts] + [enc.formula(c, b, shared) for c in conditions]
     except EncodingError as exc:
         raise RclError([error(exc.loc, str(exc).split(": error: ", 1)[-1], "E-encoding")]) from None
     s_assume = f"{_conj(a.node.assumes)} -> {_conj(b.node.assumes)}"
     s_guar = f"{_conj(a.node.assumes)} and {_conj(b.node.guarantees)} -> {_conj(a.node.guarantees)}"
-    q1 = prove(ab, [aa], enc, timeout_ms=timeout_ms,
+    if extra and not any(n in {v for _, v in _io_names(f)} for f in list(conditions) + list(facts) for n in extra):
+        raise RclError([error(_io_loc(b, "in", extra[0]), f"input {extra[0]!r} of {b.name} is not an input of {a.name} "
+                                                          "and no condition mentions it; give one with --assume",
+                              "E-refines-interface")])
+    q1 = prove(ab, [aa, *hyps], enc, timeout_ms=timeout_ms, deterministic=True,
                comment=f"refinement, assumption side: A_{a.name} => A_{b.name}\nunsat: B assumes no more than A")
-    q2 = prove(ga, [aa, gb], enc, timeout_ms=timeout_ms,
+    q2 = prove(ga, [aa, gb, *hyps], enc, timeout_ms=timeout_ms, deterministic=True,
                comment=f"refinement, guarantee side: A_{a.name} and G_{b.name} => G_{a.name}\n"
                        "unsat: B guarantees at least what A does")
 
     def side(name: str, stmt: str, q: QueryResult) -> SideResult:
         return SideResult(name, stmt, q.status, _rename(q.model, a.name), q.reason, q.smt2, q.duration_s)
 
-    return RefinementResult(a.name, b.name, side("assumption", s_assume, q1), side("guarantee", s_guar, q2))
+    conds = tuple(f"{expr_to_rcl(f)}  [environment fact]" for f in facts) + tuple(
+        f"{expr_to_rcl(c)}  [condition]" for c in conditions)
+    return RefinementResult(a.name, b.name, side("assumption", s_assume, q1), side("guarantee", s_guar, q2), conds)
+
+
+def _io_names(e: ast.Expr) -> set[tuple[str | None, str]]:
+    return free_io(e)
 
 
 # ---------------------------------------------------------------------------
@@ -267,12 +304,21 @@ def render(result: RefinementResult, spec_a: str, spec_b: str) -> str:
     verdict = {"refines": f"yes: {result.b} ({spec_b}) refines {result.a} ({spec_a})",
                "does not refine": f"no: {result.b} ({spec_b}) does not refine {result.a} ({spec_a})",
                "inconclusive": "inconclusive: the solver could not decide every side"}[result.verdict]
+    if result.conditions:
+        lines.append("  under the conditions:")
+        lines += [f"      {c}" for c in result.conditions]
+        if result.verdict == "refines":
+            verdict += " wherever these conditions hold"
     lines.append(f"verdict: {verdict}")
     return "\n".join(lines) + "\n"
 
 
-def refines_main(spec_a: str, spec_b: str, *, out: TextIO | None = None, err: TextIO | None = None) -> int:
+def refines_main(spec_a: str, spec_b: str, *, out: TextIO | None = None, err: TextIO | None = None,
+                 assumes: Sequence[str] = ()) -> int:
     """``rclverify refines A.rcl:Node B.rcl:Node``: print whether B refines A.
+
+    ``assumes``: RCL formulas over B's inputs (``--assume``), conditions
+    under which the replacement is checked (they let B read extra inputs).
 
     Returns the exit code: 0 when B refines A, 1 when it does not or the
     solver could not decide (the output says which), 2 on a user error
@@ -284,7 +330,8 @@ def refines_main(spec_a: str, spec_b: str, *, out: TextIO | None = None, err: Te
         ca, na = load_node(spec_a)
         cb, nb = load_node(spec_b)
         env = merge_envs(ca, cb)
-        result = check_refinement(na, nb, env)
+        conds = [parse_formula(t) for t in assumes]
+        result = check_refinement(na, nb, env, conditions=conds)
     except RclError as exc:
         for d in exc.diagnostics:
             print(d, file=err)

@@ -120,7 +120,9 @@ class _NodeHealth:
     def sat(self, extra: Sequence[tuple[str, z3.BoolRef]], *, guarantees: bool = True, comment: str = "",
             timeout_ms: int | None = None) -> QueryResult:
         labelled = list(self.assume) + (list(self.guars) + list(self.facts) + list(self.lemmas) if guarantees else [])
-        return satisfiable(labelled + list(extra), self.enc, timeout_ms=timeout_ms or self.timeout, comment=comment)
+        # per-instance queries (own timeout) are not retried: the instance scan is their fallback
+        return satisfiable(labelled + list(extra), self.enc, timeout_ms=timeout_ms or self.timeout, comment=comment,
+                           retry=timeout_ms is None)
 
     def premise(self, k: int, fixed: dict[str, int] | None = None) -> tuple[list[tuple[str, z3.BoolRef]], str] | None:
         g = self.node.node.guarantees[k - 1]
@@ -150,7 +152,10 @@ class _NodeHealth:
 
 def check_node(checked: Checked, node: str, facts: Sequence[tuple[ast.Expr, ast.Loc]] = (),
                instances: tuple[int, int] | None = None, *, timeout_ms: int = HEALTH_TIMEOUT_MS) -> list[Finding]:
-    """Run the three health checks on ``node``; returns its findings in order."""
+    """Run the three health checks on ``node``, then the checks of
+    :mod:`rclverify.health.shape` (tautologies, guarantees constraining no
+    output, unconstrained outputs, redundant conjuncts); returns its findings
+    in order."""
     h = _NodeHealth(checked, checked.nodes[node], facts, instances, timeout_ms)
     out: list[Finding] = []
     n = node
@@ -169,7 +174,7 @@ def check_node(checked: Checked, node: str, facts: Sequence[tuple[ast.Expr, ast.
         out.append(Finding(f"{n}.assumption-satisfiable", n, "assumption-satisfiable", None, "inconclusive",
                            f"Z3 could not decide whether the assumption of {n} can hold.", r.reason, duration_s=r.duration_s))
 
-    out[mark] = replace(out[mark], smt2=r.smt2)
+    out[mark] = _noted(replace(out[mark], smt2=r.smt2), r)
     r = h.sat([], comment=f"health {n}: can the assumption, every guarantee and the environment facts hold together?")
     mark = len(out)
     check = "contract-consistent"
@@ -187,12 +192,21 @@ def check_node(checked: Checked, node: str, facts: Sequence[tuple[ast.Expr, ast.
                            "The quantifier alternation in the guarantees is beyond Z3's decision procedures within the "
                            "timeout; no conclusion is drawn.", duration_s=r.duration_s))
 
-    out[mark] = replace(out[mark], smt2=r.smt2)
+    out[mark] = _noted(replace(out[mark], smt2=r.smt2), r)
     for k in range(1, len(checked.nodes[node].node.guarantees) + 1):
         f = _non_vacuity(h, n, k)
         if f is not None:  # only implications have a premise that can be vacuous
             out.append(f)
+    from .shape import shape_findings  # shape builds on Finding: imported here to avoid a cycle
+    out += shape_findings(checked, node)
     return out
+
+
+def _noted(f: Finding, r: QueryResult) -> Finding:
+    """``f`` with the retry strategy that answered its query (logic/retry.py) stated."""
+    if not r.strategy:
+        return f
+    return replace(f, explanation=f"{f.explanation} Z3's default strategy gave up; answered with {r.strategy}.")
 
 
 def _non_vacuity(h: _NodeHealth, n: str, k: int) -> Finding | None:
@@ -201,7 +215,7 @@ def _non_vacuity(h: _NodeHealth, n: str, k: int) -> Finding | None:
         return None  # not forall ... (premise -> conclusion): no premise to examine
     extra, ptext = prem
     r = h.sat(extra, comment=f"health {n}: can the premise of guarantee {k} hold? {ptext}")
-    return replace(_premise_finding(h, n, k, r, ptext), smt2=r.smt2)
+    return _noted(replace(_premise_finding(h, n, k, r, ptext), smt2=r.smt2), r)
 
 
 def _premise_finding(h: _NodeHealth, n: str, k: int, r: QueryResult, ptext: str) -> Finding:
@@ -267,13 +281,17 @@ def refinement_finding(node: str, spec: str, r: RefinementResult) -> Finding:
     sides = {"proved": "holds", "refuted": "fails", "inconclusive": "is undecided"}
     detail = (f"Assumption side (A_{node} -> A_replacement) {sides[r.assumption.status]}; guarantee side "
               f"(A_{node} and G_replacement -> G_{node}) {sides[r.guarantee.status]}.")
+    if r.conditions:
+        detail += " Checked under the plan's environment facts and conditions: " + "; ".join(r.conditions) + "."
     failed = next((s for s in (r.assumption, r.guarantee) if s.status == "refuted"), None)
     if r.verdict == "refines":
         status, msg = "ok", f"The replacement contract {spec} refines {node}: it may replace it."
     elif failed is not None:
         status, msg = "problem", f"The replacement contract {spec} does not refine {node}: its {failed.name} side fails."
     else:
-        status, msg = "inconclusive", f"Z3 could not decide whether {spec} refines {node}."
+        why = "; ".join(f"{x.name} side: {x.reason}" for x in (r.assumption, r.guarantee)
+                        if x.status == "inconclusive" and x.reason)
+        status, msg = "inconclusive", f"Z3 could not decide whether {spec} refines {node}" + (f" ({why})." if why else ".")
     model = dict(failed.model) if failed is not None and failed.model is not None else None
     return Finding(f"{node}.replacement-refines", node, "replacement-refines", None, status, msg,
                    detail + (f" Statement: {failed.statement}" if failed else ""), model,

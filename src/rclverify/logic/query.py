@@ -22,6 +22,7 @@ from typing import Sequence
 import z3
 
 from .encode import Encoder, term_to_rcl, value_to_rcl
+from .retry import attempts, bounded_solver
 
 DEFAULT_TIMEOUT_MS = 10_000
 
@@ -36,7 +37,9 @@ class QueryResult:
     ``core``      labels of the formulas in an unsat core (unsat), else ``None``;
     ``smt2``      the query as an SMT-LIB2 script;
     ``reason``    Z3's reason for ``unknown`` ('' otherwise);
-    ``duration_s`` wall time in seconds.
+    ``duration_s`` wall time in seconds;
+    ``strategy``  the retry of :mod:`.retry` that answered ('' when the
+                  first attempt did, or when every attempt was unknown).
     """
 
     status: str
@@ -45,6 +48,7 @@ class QueryResult:
     model: dict[str, str] | None = None
     core: list[str] | None = None
     reason: str = ""
+    strategy: str = ""
 
 
 def _solver(timeout_ms: int) -> z3.Solver:
@@ -62,17 +66,24 @@ def _smt2(formulas: Sequence[z3.BoolRef], comment: str) -> str:
 
 
 def prove(goal: z3.BoolRef, hypotheses: Sequence[z3.BoolRef], enc: Encoder | None = None, *,
-          timeout_ms: int = DEFAULT_TIMEOUT_MS, comment: str = "") -> QueryResult:
+          timeout_ms: int = DEFAULT_TIMEOUT_MS, comment: str = "", deterministic: bool = False) -> QueryResult:
     """Is ``hypotheses => goal`` valid?  Checks ``hypotheses and not goal``.
 
     ``enc`` (when given) renders a refuting model in RCL terms and adds its
-    typing axioms to the hypotheses.  Never raises on solver trouble:
+    typing axioms to the hypotheses.  ``deterministic``: run the first
+    attempt too in a fresh Z3 context bounded by a resource limit
+    (:func:`.retry.bounded_solver`) instead of ``timeout_ms``, so the answer
+    does not depend on load or history.  Never raises on solver trouble:
     an unknown answer is ``inconclusive`` with Z3's reason.
     """
     hyps = list(hypotheses) + (enc.axioms() if enc else [])
     formulas = hyps + [z3.Not(goal)]
-    s = _solver(timeout_ms)
-    s.add(*formulas)
+    if deterministic:
+        s = bounded_solver()
+        s.add(*[f.translate(s.ctx) for f in formulas])
+    else:
+        s = _solver(timeout_ms)
+        s.add(*formulas)
     t0 = time.perf_counter()
     r = s.check()
     dt = round(time.perf_counter() - t0, 4)
@@ -81,12 +92,25 @@ def prove(goal: z3.BoolRef, hypotheses: Sequence[z3.BoolRef], enc: Encoder | Non
         return QueryResult("proved", text, dt)
     if r == z3.sat:
         return QueryResult("refuted", text, dt, model=render_model(s.model(), enc))
-    return QueryResult("inconclusive", text, dt, reason=s.reason_unknown())
+    reasons = [f"default: {s.reason_unknown()}"]
+    for name, s2, rewrite in attempts(formulas, timeout_ms):
+        s2.add(*[rewrite(f) for f in formulas])
+        r = s2.check()
+        dt = round(time.perf_counter() - t0, 4)
+        if r == z3.unsat:
+            return QueryResult("proved", text, dt, strategy=name)
+        if r == z3.sat:
+            return QueryResult("refuted", text, dt, model=render_model(s2.model(), enc), strategy=name)
+        reasons.append(f"{name}: {s2.reason_unknown()}")
+    return QueryResult("inconclusive", text, dt, reason="; ".join(reasons) if len(reasons) > 1 else s.reason_unknown())
 
 
 def satisfiable(labelled: Sequence[tuple[str, z3.BoolRef]], enc: Encoder | None = None, *,
-                timeout_ms: int = DEFAULT_TIMEOUT_MS, comment: str = "") -> QueryResult:
+                timeout_ms: int = DEFAULT_TIMEOUT_MS, comment: str = "", retry: bool = True) -> QueryResult:
     """Can all the labelled formulas hold together?
+
+    ``retry``: on ``unknown``, try the strategies of :mod:`.retry` (off for
+    the many small per-instance queries whose caller has its own fallback).
 
     On ``unsat`` the result's ``core`` lists the labels of an unsat core
     (the encoder's typing axioms are unlabelled background).
@@ -110,7 +134,22 @@ def satisfiable(labelled: Sequence[tuple[str, z3.BoolRef]], enc: Encoder | None 
         core = sorted({trackers[str(c)] for c in s.unsat_core() if str(c) in trackers},
                       key=[lbl for lbl, _ in labelled].index)
         return QueryResult("unsat", text, dt, core=core)
-    return QueryResult("inconclusive", text, dt, reason=s.reason_unknown())
+    reasons = [f"default: {s.reason_unknown()}"]
+    for name, s2, rewrite in attempts(background + [f for _, f in labelled], timeout_ms) if retry else []:
+        s2.set("unsat_core", True)
+        s2.add(*[rewrite(f) for f in background])
+        for k, (label, f) in enumerate(labelled):
+            s2.assert_and_track(rewrite(f), z3.Bool(f"__label_{k}", s2.ctx))
+        r = s2.check()
+        dt = round(time.perf_counter() - t0, 4)
+        if r == z3.sat:
+            return QueryResult("sat", text, dt, model=render_model(s2.model(), enc), strategy=name)
+        if r == z3.unsat:
+            core = sorted({trackers[str(c)] for c in s2.unsat_core() if str(c) in trackers},
+                          key=[lbl for lbl, _ in labelled].index)
+            return QueryResult("unsat", text, dt, core=core, strategy=name)
+        reasons.append(f"{name}: {s2.reason_unknown()}")
+    return QueryResult("inconclusive", text, dt, reason="; ".join(reasons) if len(reasons) > 1 else s.reason_unknown())
 
 
 def render_model(model: z3.ModelRef, enc: Encoder | None) -> dict[str, str]:

@@ -4,14 +4,18 @@
 raises and never changes what a contract means.  The rules:
 
 ``W-implication-precedence``
-    An operand of ``->`` (or ``<=>``) that is an ``and``/``or`` written
-    without parentheses.  RCL's fixed precedence (``<=>``, ``->``, ``or``,
-    ``and``, ... loosest first; see ``rcl.lark``) reads ``A and B -> C`` as
-    ``(A and B) -> C`` and ``A -> B and C`` as ``A -> (B and C)``.  The paper's
-    own contracts show why this deserves a warning: the Radiation Sensor
-    guarantee of appendix A (shared/reference lines 1966-1983) reads, as
-    printed, as one chain of implications, while its table and prose
-    (lines 1290-1304, 1485-1492) mean separate conjuncts.
+    A *chain* whose meaning precedence decides: two or more ``->``/``<=>``
+    in one unparenthesised run of connectives (``A -> B and C -> D`` reads
+    as ``A -> ((B and C) -> D)``), or ``and`` and ``or`` mixed without
+    parentheses (``A and B or C``).  One warning per chain, at its start,
+    printing the parse with full parentheses.  The conventional forms
+    ``(A and B) -> C`` written ``A and B -> C``, ``A or B -> C`` and
+    ``A -> B and C`` are not warned about: every reader takes ``and``/``or``
+    to bind tighter than ``->``.  The paper's own contracts show why chains
+    deserve a warning: the Radiation Sensor guarantee of appendix A
+    (shared/reference lines 1966-1983) reads, as printed, as one chain of
+    implications, while its table and prose (lines 1290-1304, 1485-1492)
+    mean separate conjuncts.
 ``W-unused-bound``
     A quantified variable that neither the quantifier's body nor a later
     binding's domain mentions (e.g. the ``x', y'`` of the Agent's third
@@ -27,6 +31,7 @@ from __future__ import annotations
 
 from . import ast
 from .errors import Diagnostic, warning
+from .printer import expr_to_rcl
 from .walk import free_names, subexpressions
 
 _IMPLICATIONS = ("->", "<=>")
@@ -67,19 +72,62 @@ def lint(spec: ast.Spec) -> list[Diagnostic]:
 
 def _implication_precedence(formula: ast.Expr, where: str) -> list[Diagnostic]:
     diags = []
+    inner: set[int] = set()  # ids of connective nodes that belong to a run started above them
     for e in subexpressions(formula):
-        if not (isinstance(e, ast.Binary) and e.op in _IMPLICATIONS):
+        if not _is_connective(e) or id(e) in inner:
             continue
-        for side, operand in (("left", e.left), ("right", e.right)):
-            if isinstance(operand, ast.Binary) and operand.op in _JUNCTIONS and not operand.parenthesised:
-                j, imp = operand.op, e.op
-                reading = f"(A {j} B) {imp} C" if side == "left" else f"A {imp} (B {j} C)"
-                diags.append(warning(
-                    operand.loc,
-                    f"{where}: '{imp}' has an unparenthesised '{j}' as its {side} operand; "
-                    f"read as {reading}; add parentheses to make it explicit",
-                    "W-implication-precedence"))
+        run = _run(e)
+        inner.update(id(x) for x in run[1:])
+        ops = [x.op for x in run if isinstance(x, ast.Binary)]
+        chain = sum(1 for o in ops if o in _IMPLICATIONS) >= 2
+        mixed = any(isinstance(x, ast.Binary) and x.op in _JUNCTIONS and _mixes(x) for x in run)
+        if chain or mixed:
+            what = ("a chain of '->'/'<=>'" if chain else "'and' and 'or' mixed") + " without parentheses"
+            diags.append(warning(
+                e.loc,
+                f"{where}: {what}; precedence decides its meaning, which is {full_parens(e)}; "
+                "add parentheses to say which is meant",
+                "W-implication-precedence"))
     return diags
+
+
+def _is_connective(e: ast.Expr) -> bool:
+    return isinstance(e, ast.Binary) and e.op in _IMPLICATIONS + _JUNCTIONS
+
+
+def _run(e: ast.Expr) -> list[ast.Expr]:
+    """``e`` and the connectives below it reached without crossing
+    parentheses (an unparenthesised run of ``and``/``or``/``->``/``<=>``)."""
+    out, todo = [], [e]
+    while todo:
+        x = todo.pop()
+        out.append(x)
+        if isinstance(x, ast.Binary):
+            for c in (x.left, x.right):
+                if _is_connective(c) and not getattr(c, "parenthesised", False):
+                    todo.append(c)
+    return out
+
+
+def _mixes(x: ast.Binary) -> bool:
+    """An ``and`` directly under an ``or`` (or the reverse), unparenthesised."""
+    other = "or" if x.op == "and" else "and"
+    return any(isinstance(c, ast.Binary) and c.op == other and not c.parenthesised for c in (x.left, x.right))
+
+
+def full_parens(e: ast.Expr) -> str:
+    """``e`` with every connective of its unparenthesised run wrapped in
+    parentheses (operands outside the run printed canonically)."""
+    if _is_connective(e) and isinstance(e, ast.Binary):
+        return f"({_operand(e.left)} {e.op} {_operand(e.right)})"
+    return expr_to_rcl(e)
+
+
+def _operand(c: ast.Expr) -> str:
+    if _is_connective(c) and not getattr(c, "parenthesised", False):
+        return full_parens(c)
+    text = expr_to_rcl(c)
+    return text if not _is_connective(c) or text.startswith("(") else f"({text})"
 
 
 def _unused_bound(formula: ast.Expr, where: str) -> list[Diagnostic]:

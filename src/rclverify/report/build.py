@@ -14,9 +14,13 @@ while any of its evidence is failed, pending, stale or missing:
 * node: worst of its guarantees and its side conditions;
 * requirement: worst of the guarantees that support it and of the side
   conditions of their nodes;
-* derived property: worst of the nodes in the node's upstream cone (their
-  side conditions and their evidence: the rules' premises are the nodes'
-  contracts, which only the evidence establishes).
+* derived property: two separate statuses.  Its *derivation* (``status``,
+  shown as ``derived`` / ``not derived`` / ``undecided``) is the worst of the
+  side conditions of the nodes in its upstream cone: the calculus derived it
+  when all of them are discharged.  Its *evidence* (``evidence_status`` with
+  ``evidence_note``, e.g. "rests on 1 failed node contract:
+  RadiationSensor") is the worst status of those nodes' guarantees: the
+  rules' premises are the node contracts, which only evidence establishes.
 """
 from __future__ import annotations
 
@@ -31,8 +35,11 @@ from ..pipeline import Workspace, read_artifact
 from ..rcl import ast
 from ..rcl.latex import to_latex
 from ..rcl.printer import expr_to_rcl, type_to_rcl
+from .expected import expected_rows
 
-_FINDING_AS = {"ok": "discharged", "problem": "failed", "inconclusive": "inconclusive"}
+_FINDING_AS = {"ok": "discharged", "problem": "failed", "inconclusive": "inconclusive",
+               # a health warning (health/shape.py) is shown but changes no status
+               "warning": "discharged"}
 
 
 def _src(l: ast.Loc) -> str:
@@ -55,6 +62,28 @@ def _evidence_extras(ws: Workspace, details: Any) -> dict[str, Any]:
         except (OSError, ValueError):
             pass
     return out
+
+
+_DERIVATION = {"discharged": "derived", "failed": "not derived"}
+
+
+def _evidence_of_cone(cone: list[str], node_evidence: dict[str, str]) -> tuple[str, str]:
+    """(worst evidence status of the nodes of ``cone``, the sentence saying
+    which node contracts a derived property rests on that are not yet
+    established: "derived; rests on 1 failed node contract: RadiationSensor")."""
+    if not cone:
+        return "discharged", "derived; rests on no node contract"
+    by: dict[str, list[str]] = {}
+    for m in cone:
+        by.setdefault(node_evidence.get(m, "pending"), []).append(m)
+    parts = []
+    for st in sorted(by, key=lambda x: -SEVERITY.get(x, 0)):
+        if st == "discharged":
+            continue
+        ns = by[st]
+        parts.append(f"{len(ns)} {st} node contract{'s' if len(ns) != 1 else ''}: {', '.join(ns)}")
+    note = "rests on " + "; ".join(parts) if parts else "every node contract it rests on is discharged"
+    return worst(list(by)), note
 
 
 def build_report(ws: Workspace) -> dict[str, Any]:
@@ -98,6 +127,7 @@ def build_report(ws: Workspace) -> dict[str, Any]:
         if status == "pending":
             pending.append({"obligation": o.id, "backend": o.backend, "reason": ev.explanation})
 
+    expected = expected_rows(plan, ob_rows)
     comps = {n: read_artifact(ws, ws.calculus(n), {}) for n in checked.nodes}
     health = {n: read_artifact(ws, ws.health(n), []) for n in checked.nodes}
     side_conditions = [sc for n in checked.nodes for sc in comps[n].get("side_conditions", [])]
@@ -127,6 +157,7 @@ def build_report(ws: Workspace) -> dict[str, Any]:
 
     nodes = []
     node_status: dict[str, str] = {}
+    node_evidence: dict[str, str] = {}
     for name, cn in checked.nodes.items():
         internal = {l.to_var: f"{l.from_node}.{l.from_var}" for l in links_to.get(name, [])}
         consumers: dict[str, list[str]] = {}
@@ -140,6 +171,7 @@ def build_report(ws: Workspace) -> dict[str, Any]:
             for k, g in enumerate(cn.node.guarantees, 1)]
         status = worst([g["status"] for g in guarantees] + [sc_status[name]])
         node_status[name] = status
+        node_evidence[name] = worst([g["status"] for g in guarantees], empty="pending")
         nodes.append({
             "name": name, "source": _src(cn.node.loc), "status": status,
             "inputs": [{"name": v.name, "type": type_to_rcl(v.type), "producer": internal.get(v.name)} for v in cn.node.inputs],
@@ -167,11 +199,14 @@ def build_report(ws: Workspace) -> dict[str, Any]:
         c = comps[n]
         if not c:
             continue
+        derivation = worst([sc_status[m] for m in c["cone"]], empty="discharged")
+        ev_status, ev_note = _evidence_of_cone(c["cone"], node_evidence)
         derived.append({"node": n, "rules": c["rules"], "instances": c["instances"],
                         "environment_assumptions": c["cone_environment_assumptions"], "property": c["derived_property"],
-                        # holds once its side conditions do AND every node of the cone
-                        # meets its contract (the rules' premises): their evidence counts
-                        "status": worst([node_status[m] for m in c["cone"]]),
+                        # the derivation: every side condition of the cone discharged
+                        "status": derivation, "derivation": _DERIVATION.get(derivation, "undecided"),
+                        # what the rules' premises (the node contracts) rest on
+                        "evidence_status": ev_status, "evidence_note": ev_note,
                         "loop_assumption": c["loop_assumption"]})
 
     findings = [f for n in checked.nodes for f in health[n]]
@@ -191,6 +226,10 @@ def build_report(ws: Workspace) -> dict[str, Any]:
     for e in ev_rows:
         if e["status"] in ("failed", "error", "stale"):
             problems.append(f"Evidence {e['obligation']} is {e['status']}: {e['explanation'][:300]}")
+    for x in expected:
+        if x["outcome"] == "MISMATCH":
+            problems.append(f"Expected verdict mismatch: {x['obligation']} is {x['actual']}, the plan expects "
+                            f"{x['expected']} ({x['source']})" + (f": {x['reason']}" if x["reason"] else ""))
     counts: dict[str, int] = {}
     for row in ob_rows:
         counts[row["status"]] = counts.get(row["status"], 0) + 1
@@ -199,13 +238,11 @@ def build_report(ws: Workspace) -> dict[str, Any]:
     # and no health check that found a problem or could not decide
     strict_ok = (all(o["status"] == "discharged" for o in ob_rows)
                  and all(sc["status"] == "discharged" for sc in side_conditions)
-                 and all(f["status"] == "ok" for f in findings)
+                 and all(f["status"] in ("ok", "warning") for f in findings)
                  # and no guarantee left without evidence (no obligation exported for it)
                  and all(g_status(name, k) == "discharged" for name, cn in checked.nodes.items()
                          for k in range(1, len(cn.node.guarantees) + 1)))
-    headline = (f"{len(ob_rows)} obligations: " + ", ".join(f"{counts[s]} {s}" for s in sorted(counts, key=SEVERITY.__getitem__))
-                + f"; {sum(1 for sc in side_conditions if sc['status'] == 'discharged')}/{len(side_conditions)} side conditions "
-                f"discharged; {sum(1 for f in findings if f['status'] == 'problem')} contract health problem(s).")
+    headline = _headline(ob_rows, counts, side_conditions, findings)
     system = model.view(node_status)
     return {
         "meta": {"tool": "rclverify", "version": __version__, "workspace": plan.name or ws.root.resolve().name, "plan": plan.file,
@@ -214,4 +251,26 @@ def build_report(ws: Workspace) -> dict[str, Any]:
         "system": system, "requirements": requirements, "nodes": nodes, "side_conditions": side_conditions,
         "derived_properties": derived, "findings": findings, "obligations": ob_rows, "evidence": ev_rows,
         "environment_assumptions": env_assumptions, "pending": pending, "lint": lint_rows,
+        "expected_verdicts": expected,
     }
+
+
+def _headline(ob_rows: list[dict[str, Any]], counts: dict[str, int], side_conditions: list[dict[str, Any]],
+              findings: list[dict[str, Any]]) -> str:
+    """The one-line summary, without empty fragments: a kind with nothing
+    in it is said in words ("no obligations"), never as "0 obligations: ;"."""
+    parts = []
+    if ob_rows:
+        parts.append(f"{len(ob_rows)} obligation{'s' if len(ob_rows) != 1 else ''}: "
+                     + ", ".join(f"{counts[s]} {s}" for s in sorted(counts, key=lambda x: SEVERITY.get(x, 99))))
+    else:
+        parts.append("no obligations")
+    if side_conditions:
+        parts.append(f"{sum(1 for sc in side_conditions if sc['status'] == 'discharged')}/{len(side_conditions)} "
+                     "side conditions discharged")
+    else:
+        parts.append("no side conditions")
+    problems = sum(1 for f in findings if f["status"] == "problem")
+    parts.append(f"{problems} contract health problem{'s' if problems != 1 else ''}" if problems
+                 else "no contract health problem")
+    return "; ".join(parts) + "."

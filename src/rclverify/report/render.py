@@ -50,12 +50,18 @@ STATUS_STYLE: Mapping[str, str] = {
     "proved": "discharged",
     "refuted": "failed",
     "unknown": "inconclusive",
+    # derivation status of a derived property (report/build.py)
+    "derived": "discharged",
+    "not derived": "failed",
+    "undecided": "inconclusive",
+    "warning": "pending",
 }
 
 #: Severity of a status word for ordering the attention list (larger is
 #: worse).  A word outside the vocabulary ranks as an error: the report cannot
 #: vouch for what it does not understand.
-_RANK: Mapping[str, int] = {**SEVERITY, "ok": 0, "proved": 0, "problem": 5, "refuted": 5, "unknown": 2}
+_RANK: Mapping[str, int] = {**SEVERITY, "ok": 0, "proved": 0, "problem": 5, "refuted": 5, "unknown": 2,
+                            "derived": 0, "not derived": 5, "undecided": 2, "warning": 1}
 _UNKNOWN_RANK = SEVERITY["error"]
 
 #: Marker shown in Markdown next to a status (no colours there).
@@ -284,7 +290,8 @@ def _attention(report: Mapping[str, Any], ev_anchor: Sequence[str]) -> tuple[lis
     for d in report["derived_properties"]:
         if rank(d["status"]) > SEVERITY["pending"]:
             add(d["status"], "derived property", d["node"], anchor("derived", d["node"]),
-                ", ".join(d["rules"]), "Derived property not established:", str(d["property"]))
+                ", ".join(d["rules"]), f"Derived property {d.get('derivation', 'not established')} "
+                "(a side condition of its cone is not discharged):", str(d["property"]))
     for k, lint in enumerate(report["lint"]):
         if str(lint["severity"]).lower() == "error":
             add("error", "lint", str(lint["location"]), anchor("lint", k + 1), str(lint["location"]),

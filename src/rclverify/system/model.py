@@ -20,6 +20,8 @@ from dataclasses import dataclass
 from functools import cached_property
 from typing import Any, Iterable, Iterator, Sequence
 
+import networkx as nx  # type: ignore[import-untyped]
+
 from ..plan.load import Connection
 from ..rcl.errors import RclError, error
 from ..rcl.types import Checked, EmptyT
@@ -109,11 +111,33 @@ class SystemModel:
             "loops": [list(l) for l in self.loops],
         }
 
+    def cycles(self) -> list[list[str]]:
+        """The elementary cycles of the node graph (an edge per connection),
+        each as its node sequence starting at its first node in source order
+        and following existing connections only; the closing edge goes from
+        the last node back to the first.  Sorted by length, then by sequence.
+        Found with networkx's ``simple_cycles`` (Johnson's algorithm)."""
+        g = nx.DiGraph()
+        g.add_nodes_from(self.nodes)
+        g.add_edges_from((l.from_node, l.to_node) for l in self.links)
+        order = {n: k for k, n in enumerate(self.nodes)}
+        out = []
+        for c in nx.simple_cycles(g):
+            k = min(range(len(c)), key=lambda j: order[c[j]])
+            out.append(c[k:] + c[:k])
+        return sorted(out, key=lambda c: (len(c), [order[n] for n in c]))
+
     def view(self, status: dict[str, str]) -> dict[str, Any]:
         """:meth:`to_json` with each node's roll-up status (``pending`` when
-        unknown): what the diagram and the report's system section show."""
+        unknown): what the diagram and the report's system section show.
+        There ``loops`` are the graph's real cycles (:meth:`cycles`), each a
+        node sequence whose consecutive pairs (and last -> first) are
+        connections; the strongly connected components R4 is applied to are
+        under ``loop_components``."""
         d = self.to_json()
         d["nodes"] = [{"name": n, "status": status.get(n, "pending")} for n in self.nodes]
+        d["loop_components"] = d["loops"]
+        d["loops"] = self.cycles()
         return d
 
     @staticmethod

@@ -36,7 +36,7 @@ from __future__ import annotations
 
 import hashlib
 import re
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from functools import lru_cache
 from pathlib import Path
 from typing import Any, Mapping, Sequence
@@ -49,6 +49,7 @@ from ...plan.errors import PlanError
 from ...rcl import ast
 from ...rcl.errors import RclError
 from ..base import NodeTarget, Stopwatch, make_evidence
+from .coverage import coverage_notes
 from . import psl, runner
 from .instantiate import Instance, Translator
 from .mapping import Row, RowError, build_row
@@ -263,16 +264,20 @@ class AjpfBackend:
             if old.name not in current:
                 old.unlink()
 
+        texts = {(g, inst.label): psl.to_text(inst.formula) for g, _, inst in planned if inst.formula is not None}
+        coverage = coverage_notes(cfg.rows, [(g, inst) for g, _, inst in planned], texts)
         per_guarantee: dict[int, list[str]] = {}
         for g, _, inst in planned:
             for u in inst.unmapped:
                 if u not in per_guarantee.setdefault(g, []):
                     per_guarantee[g].append(u)
-        return [self._obligation(target, cfg, g, clause, inst, numbers, psl_rel, ail_rel, per_guarantee.get(g, []))
+        return [self._obligation(target, cfg, g, clause, inst, numbers, psl_rel, ail_rel, per_guarantee.get(g, []),
+                                 coverage.get((g, inst.label), []))
                 for g, clause, inst in planned]
 
     def _obligation(self, target: NodeTarget, cfg: AjpfConfig, g: int, clause: ast.Clause, inst: Instance,
-                    numbers: Mapping[str, int], psl_rel: str, ail_rel: str, g_unmapped: Sequence[str]) -> Obligation:
+                    numbers: Mapping[str, int], psl_rel: str, ail_rel: str, g_unmapped: Sequence[str],
+                    partial: Sequence[str] = ()) -> Obligation:
         node = target.node.name
         values = "_".join(f"{k}{v}" for k, v in inst.values)
         file, line, col = self._src_parts(target, clause.loc)
@@ -295,6 +300,8 @@ class AjpfBackend:
         log_rel = self._log_rel(cfg, target, n)
         data.update({"property": n, "psl": text, "trivial": inst.trivial, "jpf": jpf_rel, "ail": ail_rel,
                      "log": log_rel, "command": runner.user_command(jpf_rel, log_rel)})
+        if partial:
+            data.update({"coverage": "partial", "coverage_notes": list(partial)})
         return Obligation(
             id=make_obligation_id(node, g, self.name, f"p{n}_{values}" if values else f"p{n}"),
             node=node, guarantee=g, backend=self.name, kind=self.kind, statement=f"{n}: {text}",
@@ -303,6 +310,21 @@ class AjpfBackend:
 
     # -- run ---------------------------------------------------------------
     def run(self, obligation: Obligation, target: NodeTarget) -> Evidence:
+        """Evidence for one exported obligation (:meth:`_run_one`), with the
+        obligation's partial coverage (see :mod:`.coverage`) stated first in
+        its explanation; a verified property that covers its guarantee only
+        partially is ``inconclusive``, not ``discharged``."""
+        ev = self._run_one(obligation, target)
+        notes = obligation.data.get("coverage_notes") or []
+        if not notes:
+            return ev
+        status = "inconclusive" if ev.status == "discharged" else ev.status
+        prefix = "PARTIAL COVERAGE of guarantee " + str(obligation.guarantee) + ": " + "; ".join(notes) + ". "
+        if ev.status == "discharged":
+            prefix += "AJPF verified the property, but it does not check the whole guarantee. "
+        return replace(ev, status=status, explanation=prefix + ev.explanation)
+
+    def _run_one(self, obligation: Obligation, target: NodeTarget) -> Evidence:
         """Evidence for one exported obligation.
 
         Order: an obligation with unmapped atoms is ``pending``; a log at

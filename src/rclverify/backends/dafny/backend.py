@@ -209,10 +209,11 @@ class DafnyBackend:
         except OSError as exc:
             return ev("error", f"could not start {exe}: {exc}", tool.version, details={"command": shown})
         log_path = target.artifacts / f"{snake(target.node.name)}_dafny.log"
+        shown_log, log_notes = runner.filter_log(res.output)
         atomic_write_text(log_path, _jinja().get_template("log.txt.j2").render(
             node=target.node.name, obligation=obligation.id, command=shown,
             exit_code="killed at the process timeout" if res.timed_out else res.returncode,
-            output=res.output.rstrip("\n")))
+            output=shown_log.rstrip("\n"), notes=log_notes))
         artifacts = (stub_rel, target.rel(log_path))
         out = runner.parse_output(res.output)
         clauses = clause_lines(stub.text)
@@ -220,7 +221,9 @@ class DafnyBackend:
                                               len(target.node.node.guarantees), target)
         details.update(scan_details)
         details["command"] = shown
-        return ev(status, explanation, tool.version, log=res.output, artifacts=artifacts, details=details)
+        if log_notes:
+            details["log_filtered"] = log_notes
+        return ev(status, explanation, tool.version, log=shown_log, artifacts=artifacts, details=details)
 
 
 def _same_file(printed: str, rel: str, root: Path) -> bool:

@@ -476,3 +476,43 @@ def scan_implementation(text: str, contract_module: str, method: str) -> Impleme
                 scan.body_line = toks[b].line if b is not None else None
                 break
     return scan
+
+
+_PROVER_OPTION = re.compile(r"^Prover error: line \d+ column \d+: unknown parameter '([A-Za-z0-9_.]+)'\s*$")
+_LEGAL_HEADER = re.compile(r"^Legal parameters are:\s*$")
+_LEGAL_ROW = re.compile(r"^\s+\S.*$")
+
+
+def filter_log(text: str) -> tuple[str, list[str]]:
+    """Dafny's output without the known harmless prover messages.
+
+    Dafny 2.3 (Boogie) sets Z3 options that newer Z3 releases dropped
+    (``model_compress``); Z3 then prints, for every verification condition,
+    "Prover error: ... unknown parameter 'model_compress'" and its whole
+    table of legal parameters.  The option only shapes how counterexample
+    models are printed; the verification result is unaffected (Dafny still
+    reports each postcondition it cannot prove).  Returns ``(filtered text,
+    notes)``; each note says which message was removed and how often, so the
+    record says what was filtered.  The verdict is always computed from the
+    unfiltered output.
+    """
+    out: list[str] = []
+    removed: dict[str, int] = {}
+    lines = text.splitlines()
+    k = 0
+    while k < len(lines):
+        m = _PROVER_OPTION.match(lines[k])
+        if m:
+            removed[m.group(1)] = removed.get(m.group(1), 0) + 1
+            k += 1
+            if k < len(lines) and _LEGAL_HEADER.match(lines[k]):
+                k += 1
+                while k < len(lines) and _LEGAL_ROW.match(lines[k]):
+                    k += 1
+            continue
+        out.append(lines[k])
+        k += 1
+    notes = [f"removed {n} \"Prover error: unknown parameter '{opt}'\" message(s) with Z3's table of legal "
+             f"parameters: this Dafny sets the Z3 option {opt}, which the installed Z3 no longer has; it only "
+             "affects how models are printed" for opt, n in sorted(removed.items())]
+    return "\n".join(out) + ("\n" if text.endswith("\n") else ""), notes

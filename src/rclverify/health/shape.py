@@ -1,0 +1,106 @@
+"""Contract health, part two: what a guarantee actually constrains.
+
+Four checks per node, each reported only when it finds something (a clean
+contract adds no rows to the report):
+
+``tautology`` (``problem``)
+    a top-level conjunct of a guarantee that Z3 proves valid on its own:
+    it holds whatever the inputs and outputs, so it promises nothing.
+``constrains-no-output`` (``problem``)
+    a guarantee that mentions no output of the node: it can only restate
+    facts about the inputs, never what the node produces (a guarantee is
+    about the node's outputs, paper lines 462-495).
+``unconstrained-output`` (``warning``)
+    an output that no guarantee mentions: nothing the node produces there is
+    promised, so no obligation covers it and consumers may assume nothing.
+``redundant`` (``warning``)
+    a conjunct that Z3 proves from the node's assumption and the node's other
+    guarantee conjuncts: it adds nothing (often a sign of a copy-paste slip).
+
+Conjuncts are the top-level ``and`` operands of each guarantee (a guarantee
+``forall(v | P -> Q1 and Q2)`` is one conjunct).  The validity queries run
+with a short timeout; an undecided one reports nothing (these checks look
+for defects, and never count as evidence that a contract is healthy).
+``warning`` findings do not change any status; ``problem`` ones do, like the
+other health problems (report/build.py).
+"""
+from __future__ import annotations
+
+from ..calculus.compose import conjuncts, free_io
+from ..logic.encode import Encoder
+from ..logic.query import prove
+from ..rcl import ast
+from ..rcl.printer import expr_to_rcl
+from ..rcl.types import Checked, CheckedNode
+from .checks import Finding
+
+SHAPE_TIMEOUT_MS = 2_000
+
+
+def _where(l: ast.Loc) -> str:
+    return f"{l.file}:{l.line}:{l.col}"
+
+
+def outputs_mentioned(e: ast.Expr, cn: CheckedNode) -> set[str]:
+    """Outputs of ``cn`` that ``e`` mentions (``out.x``, or a bare free ``x``
+    that is an output and not an input of the node)."""
+    return {n for p, n in free_io(e)
+            if (p == "out" and n in cn.outputs) or (p is None and n in cn.outputs and n not in cn.inputs)}
+
+
+def shape_findings(checked: Checked, node: str, *, timeout_ms: int = SHAPE_TIMEOUT_MS) -> list[Finding]:
+    """The four checks above on ``node``; returns only the findings that
+    found something, in guarantee order then output order.  Never raises on
+    solver trouble."""
+    cn = checked.nodes[node]
+    n = cn.node
+    out: list[Finding] = []
+    enc = Encoder(checked.env)
+    parts: list[tuple[int, int, ast.Expr]] = [(k, j, c) for k, g in enumerate(n.guarantees, 1)
+                                             for j, c in enumerate(conjuncts(g.formula), 1)]
+    mentioned: set[str] = set()
+    for k, g in enumerate(n.guarantees, 1):
+        outs = outputs_mentioned(g.formula, cn)
+        mentioned |= outs
+        if not outs and n.outputs:
+            out.append(Finding(f"{node}.g{k}.constrains-no-output", node, "constrains-no-output", k, "problem",
+                               f"Guarantee {k} of {node} ({_where(g.loc)}) constrains no output: it mentions none of "
+                               f"{', '.join(o.name for o in n.outputs)}.",
+                               "A guarantee states what the node produces; this one only speaks about inputs (or "
+                               "nothing), so an implementation meets it whatever it outputs."))
+    valid: set[tuple[int, int]] = set()
+    for k, j, c in parts:
+        if isinstance(c, ast.BoolLit):
+            continue
+        r = prove(enc.formula(c, cn), [], enc, timeout_ms=timeout_ms,
+                  comment=f"health {node}: is conjunct {j} of guarantee {k} valid on its own?")
+        if r.status == "proved":
+            valid.add((k, j))
+            out.append(Finding(f"{node}.g{k}.c{j}.tautology", node, "tautology", k, "problem",
+                               f"Conjunct {j} of guarantee {k} of {node} ({_where(c.loc)}) is always true: "
+                               f"`{expr_to_rcl(c)}` holds whatever the inputs and outputs.",
+                               "Z3 proved it valid with no hypothesis: it promises nothing. Check it says what was "
+                               "meant (a comparison of a value with itself, a premise that is always false, ...).",
+                               duration_s=r.duration_s, smt2=r.smt2))
+    for o in n.outputs:
+        if o.name not in mentioned:
+            out.append(Finding(f"{node}.out.{o.name}.unconstrained-output", node, "unconstrained-output", None,
+                               "warning",
+                               f"Output {o.name} of {node} ({_where(o.loc)}) is constrained by no guarantee.",
+                               "The contract promises nothing about it: no obligation covers it and a consumer of it "
+                               "may assume nothing."))
+    if len(parts) > 1:
+        assume = [enc.formula(a.formula, cn) for a in n.assumes]
+        for k, j, c in parts:
+            if isinstance(c, ast.BoolLit) or (k, j) in valid:
+                continue
+            others = [enc.formula(x, cn) for kk, jj, x in parts if (kk, jj) != (k, j)]
+            r = prove(enc.formula(c, cn), assume + others, enc, timeout_ms=timeout_ms,
+                      comment=f"health {node}: is conjunct {j} of guarantee {k} implied by the others?")
+            if r.status == "proved":
+                out.append(Finding(f"{node}.g{k}.c{j}.redundant", node, "redundant", k, "warning",
+                                   f"Conjunct {j} of guarantee {k} of {node} ({_where(c.loc)}) is redundant: the "
+                                   "assumption and the other guarantee conjuncts imply it.",
+                                   f"`{expr_to_rcl(c)}` adds nothing to the contract; Z3 proved it from the rest.",
+                                   duration_s=r.duration_s, smt2=r.smt2))
+    return out

@@ -1,0 +1,68 @@
+"""Health findings about what guarantees constrain (health/shape.py)."""
+from __future__ import annotations
+
+from pathlib import Path
+
+from rclverify.health.checks import check_node
+from rclverify.health.shape import shape_findings
+from rclverify.rcl.parser import parse_text
+from rclverify.rcl.typecheck import check, load
+
+TEXT = """
+node N {
+  inputs( a : REAL )
+  outputs( o : REAL, spare : REAL )
+  assume( 0 <= in.a )
+  guarantee( out.o >= in.a and (out.o == out.o or in.a > 3) )
+  guarantee( in.a >= 0 )
+  guarantee( out.o >= 0 )
+}
+"""
+
+
+def _findings(text: str = TEXT):
+    checked = check([parse_text(text, "n.rcl")])
+    return {f.id: f for f in shape_findings(checked, "N")}
+
+
+def test_a_tautological_guarantee_conjunct_is_a_problem_with_its_location():
+    fs = _findings()
+    f = fs["N.g1.c2.tautology"]
+    assert f.status == "problem" and f.guarantee == 1
+    assert "n.rcl:6:" in f.message and "always true" in f.message
+    assert "N.g1.c1.tautology" not in fs  # out.o >= in.a is a real constraint
+
+
+def test_an_output_no_guarantee_constrains_is_reported():
+    fs = _findings()
+    f = fs["N.out.spare.unconstrained-output"]
+    assert f.status == "warning" and "spare" in f.message and "n.rcl:4:" in f.message
+    assert "N.out.o.unconstrained-output" not in fs
+
+
+def test_a_guarantee_about_inputs_only_constrains_no_output():
+    fs = _findings()
+    f = fs["N.g2.constrains-no-output"]
+    assert f.status == "problem" and f.guarantee == 2
+    assert [k for k in fs if k.endswith("constrains-no-output")] == ["N.g2.constrains-no-output"]
+
+
+def test_a_conjunct_implied_by_the_others_is_redundant():
+    fs = _findings()
+    # out.o >= 0 follows from out.o >= in.a and the assumption 0 <= in.a
+    assert fs["N.g3.c1.redundant"].status == "warning"
+    # the tautology is reported as such, not again as redundant
+    assert "N.g1.c2.redundant" not in fs
+    assert "N.g1.c1.redundant" not in fs
+
+
+def test_check_node_includes_the_shape_findings():
+    checked = check([parse_text(TEXT, "n.rcl")])
+    ids = [f.id for f in check_node(checked, "N")]
+    assert "N.g1.c2.tautology" in ids and "N.out.spare.unconstrained-output" in ids
+
+
+def test_the_case_study_has_no_such_finding():
+    checked = load([Path(__file__).resolve().parents[1] / "contracts" / "remote_inspection.rcl"])
+    for n in ("Localisation", "Navigation", "RadiationSensor"):
+        assert shape_findings(checked, n) == [], n
