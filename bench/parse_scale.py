@@ -21,8 +21,8 @@ arithmetic and topics.  For each N it prints:
   measures the faster basic-lexer Earley, a lower bound on the speed-up.
 
 * the same parse and type-check with the front end as it was before the
-  full-language work (bench/before_issue11/: the old grammar, AST builder
-  and checker, loaded as modules), and the ratio new / old of each
+  full-language work (the old grammar, AST builder and checker, read from
+  the git history at commit b59aa9d and loaded as modules), and the ratio new / old of each
   (1.00 = same speed; below 1 = faster now).
 
 Times are CPU seconds of the benchmark process (less disturbed by other
@@ -42,7 +42,9 @@ from __future__ import annotations
 import argparse
 import importlib
 import math
+import subprocess
 import sys
+import tempfile
 import time
 import tracemalloc
 from pathlib import Path
@@ -90,20 +92,38 @@ node Stage{k} {{
 """
 
 
-BEFORE = Path(__file__).resolve().parent / "before_issue11"
+#: The last commit before the full-language work; its front end is read from
+#: the repository's history at run time rather than kept as a second copy.
+BEFORE_COMMIT = "b59aa9d"
+BEFORE_FILES = ("__init__.py", "ast.py", "errors.py", "parser.py", "rcl.lark", "typecheck.py", "types.py", "walk.py")
 
 
 def before_front_end() -> tuple[Callable[[str, str], Any], Callable[[list[Any]], Any]]:
     """``(parse_text, check)`` of the front end before the full-language
-    work: bench/before_issue11/ imported as a package of its own (old AST,
-    parser, checker and types), its parser reading the old grammar file."""
-    sys.path.insert(0, str(BEFORE.parent))
+    work: ``src/rclverify/rcl/`` at commit ``BEFORE_COMMIT``, written by
+    ``git show`` into a temporary package ``before_issue11`` and imported
+    (old AST, parser, checker and types), its parser reading the old grammar.
+
+    Raises ``SystemExit`` with a message when the git history is not there.
+    """
+    repo = Path(__file__).resolve().parent.parent
+    pkg = Path(tempfile.mkdtemp(prefix="rcl-before-")) / "before_issue11"
+    pkg.mkdir()
+    for name in BEFORE_FILES:
+        try:
+            text = subprocess.run(["git", "-C", str(repo), "show", f"{BEFORE_COMMIT}:src/rclverify/rcl/{name}"],
+                                  check=True, capture_output=True, text=True).stdout
+        except (OSError, subprocess.CalledProcessError) as exc:
+            raise SystemExit(f"parse_scale: the old front end is read from the git history (commit "
+                             f"{BEFORE_COMMIT}); run this in a clone of the repository ({exc})")
+        (pkg / name).write_text(text, encoding="utf-8")
+    sys.path.insert(0, str(pkg.parent))
     try:
         parser = importlib.import_module("before_issue11.parser")
         checker = importlib.import_module("before_issue11.typecheck")
     finally:
-        sys.path.remove(str(BEFORE.parent))
-    grammar = (BEFORE / "rcl.lark").read_text(encoding="utf-8")
+        sys.path.remove(str(pkg.parent))
+    grammar = (pkg / "rcl.lark").read_text(encoding="utf-8")
     parser.grammar_text = lambda: grammar
     parser._lark.cache_clear()
     return parser.parse_text, checker.check
