@@ -14,14 +14,12 @@ from __future__ import annotations
 import gzip
 import io
 import json
-import os
 import tarfile
-import tempfile
 import zipfile
 from pathlib import Path, PurePosixPath
 from typing import Any, Mapping
 
-from ..evidence.store import dumps
+from ..evidence.store import atomic_write_bytes, dumps
 from ..plan.load import Plan
 from .manifest import MANIFEST, BundleError, build_manifest, collect, sha256_bytes, tool_versions
 
@@ -57,24 +55,6 @@ def _zip_bytes(members: Mapping[str, bytes]) -> bytes:
     return raw.getvalue()
 
 
-def _atomic_write_bytes(path: Path, data: bytes) -> None:
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
-    try:
-        os.chmod(tmp, 0o644)  # mkstemp creates 0600; an archive is for others to read
-        with os.fdopen(fd, "wb") as fh:
-            fh.write(data)
-            fh.flush()
-            os.fsync(fh.fileno())
-        os.replace(tmp, path)
-    except BaseException:
-        try:
-            os.unlink(tmp)
-        except FileNotFoundError:
-            pass
-        raise
-
-
 def write_bundle(root: Path, plan: Plan, out: Path, tools: Mapping[str, str] | None = None) -> dict[str, Any]:
     """Pack the workspace ``root`` (plan ``plan``) into the archive ``out``.
 
@@ -91,7 +71,9 @@ def write_bundle(root: Path, plan: Plan, out: Path, tools: Mapping[str, str] | N
     contents = {f: (root / f).read_bytes() for f in files}
     manifest = build_manifest(root, plan, files, missing, contents, tools if tools is not None else tool_versions())
     members = {MANIFEST: dumps(manifest).encode("utf-8"), **contents}
-    _atomic_write_bytes(out, _zip_bytes(members) if is_zip(out) else _tar_bytes(members))
+    out.parent.mkdir(parents=True, exist_ok=True)
+    # durable, and 0644: an archive is for others to read
+    atomic_write_bytes(out, _zip_bytes(members) if is_zip(out) else _tar_bytes(members), durable=True, mode=0o644)
     return manifest
 
 

@@ -35,10 +35,25 @@ def atomic_write_text(path: Path, text: str, *, durable: bool = False) -> bool:
             return False
     except (FileNotFoundError, UnicodeDecodeError):
         pass
+    atomic_write_bytes(path, text.encode("utf-8"), durable=durable)
+    return True
+
+
+def atomic_write_bytes(path: Path, data: bytes, *, durable: bool = False, mode: int | None = None) -> None:
+    """Write ``data`` to ``path`` through a temporary file in the same
+    directory renamed into place (:func:`os.replace`): readers see the old
+    content or the new, never a part.  ``durable=True`` fsyncs before the
+    rename; ``mode`` sets the permission bits (``mkstemp`` creates 0600).
+
+    The parent directory must exist.  Raises ``OSError`` when it cannot be
+    written; the temporary file is removed and ``path`` is left as it was.
+    """
     fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
     try:
-        with os.fdopen(fd, "w", encoding="utf-8") as fh:
-            fh.write(text)
+        if mode is not None:
+            os.chmod(tmp, mode)
+        with os.fdopen(fd, "wb") as fh:
+            fh.write(data)
             if durable:
                 fh.flush()
                 os.fsync(fh.fileno())
@@ -49,7 +64,6 @@ def atomic_write_text(path: Path, text: str, *, durable: bool = False) -> bool:
         except FileNotFoundError:
             pass
         raise
-    return True
 
 
 def dumps(value: Any) -> str:

@@ -113,8 +113,16 @@ def attempts(formulas: Sequence[z3.BoolRef], timeout_ms: int
     changed = [expand_finite(f) for f in formulas]
     if any(not a.eq(b) for a, b in zip(changed, formulas)):
         s = bounded_solver()
-        out.append((FINITE, s, lambda f, c=s.ctx: expand_finite(f).translate(c)))
+        out.append((FINITE, s, _translating(s.ctx, expand_finite)))
     s = bounded_solver()
     s.set("smt.ematching", False)
-    out.append((MBQI, s, lambda f, c=s.ctx: f.translate(c)))
+    out.append((MBQI, s, _translating(s.ctx, lambda f: f)))
     return out
+
+
+def _translating(ctx: z3.Context, rewrite: Callable[[z3.BoolRef], z3.BoolRef]
+                 ) -> Callable[[z3.BoolRef], z3.BoolRef]:
+    """``rewrite`` followed by translation into the solver's context ``ctx``."""
+    def apply(f: z3.BoolRef) -> z3.BoolRef:
+        return rewrite(f).translate(ctx)
+    return apply

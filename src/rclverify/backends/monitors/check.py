@@ -31,8 +31,9 @@ from __future__ import annotations
 
 from collections import deque
 from dataclasses import dataclass, field
-from typing import Any, Callable, Iterable, Mapping
+from typing import Any, Iterable, Mapping
 
+from ...logic.concrete import check_concrete
 from ...logic.evaluate import evaluate, why_undecided
 from ...rcl import ast
 from ...rcl.printer import expr_to_rcl
@@ -53,17 +54,6 @@ def _names(e: Any, out: set[str]) -> None:
             continue
         for x in (c if isinstance(c, tuple) else (c,)):
             _names(x, out)
-
-
-def concrete_fallback() -> Callable[..., tuple[bool | None, str]] | None:
-    """``rclverify.logic.concrete.check_concrete`` when that module exists (Z3 on
-    concrete values), else ``None``."""
-    try:
-        from ...logic import concrete  # type: ignore[attr-defined]
-    except ImportError:
-        return None
-    fn: Callable[..., tuple[bool | None, str]] = getattr(concrete, "check_concrete")
-    return fn
 
 
 @dataclass
@@ -152,7 +142,6 @@ class NodeMonitor:
                                     (k in needed or k[3:] in needed))
         self._outputs = sorted(k for k in self.values if k.startswith("out."))
         self.pending: dict[Any, _Group] = {}
-        self.fallback = concrete_fallback()
         self._cache: dict[tuple[int, Any, Any], tuple[bool | None, str]] = {}
 
     # -- evaluation --------------------------------------------------------------
@@ -165,9 +154,9 @@ class NodeMonitor:
         reason = ""
         if v is None:
             reason = why_undecided(formula, self.checked, self.node, values)
-            if self.fallback is not None and "no value for" not in reason:
+            if "no value for" not in reason:  # undecided directly: Z3 on the concrete values
                 try:
-                    v, reason = self.fallback(formula, self.checked, self.node, values)
+                    v, reason = check_concrete(formula, self.checked, self.node, values)
                 except Exception as exc:  # the Z3 checker's own failure: undecided, with its reason
                     v, reason = None, f"{reason}; Z3 on concrete values failed: {exc}"
         if self.cache_size:
