@@ -46,6 +46,15 @@ def _src(l: ast.Loc) -> str:
     return f"{l.file}:{l.line}:{l.col}"
 
 
+def _brief(text: str, limit: int = 300) -> str:
+    """``text`` cut to at most ``limit`` characters at a word boundary, with
+    an ellipsis and a pointer to the full record when it was cut."""
+    if len(text) <= limit:
+        return text
+    cut = text[:limit].rsplit(" ", 1)[0].rstrip(" ,;:")
+    return cut + " ... (in full in the evidence record)"
+
+
 def _evidence_extras(ws: Workspace, details: Any) -> dict[str, Any]:
     """Rows a backend asks the report to show (``details.figures_table``: the
     experiment figures, the review record) and the inline SVG of its plot
@@ -225,7 +234,7 @@ def build_report(ws: Workspace) -> dict[str, Any]:
             problems.append(f"Side condition {sc['id']} is {sc['status']}: {sc['conjunct']}")
     for e in ev_rows:
         if e["status"] in ("failed", "error", "stale"):
-            problems.append(f"Evidence {e['obligation']} is {e['status']}: {e['explanation'][:300]}")
+            problems.append(f"Evidence {e['obligation']} is {e['status']}: {_brief(e['explanation'])}")
     for x in expected:
         if x["outcome"] == "MISMATCH":
             problems.append(f"Expected verdict mismatch: {x['obligation']} is {x['actual']}, the plan expects "
