@@ -141,6 +141,8 @@ def act_report(root: str) -> Any:
         report = build_report(ws)
     except RclError as exc:
         return _fail(exc)
+    from .report import layoutcache
+    layoutcache.use_directory(ws.path("artifacts/cache/layout"))
     render_all(report, ws.path("reports"))
     from .report.ci import write_ci_reports
     write_ci_reports(report, ws.path("reports"))
