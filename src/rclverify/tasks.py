@@ -261,8 +261,16 @@ def build_tasks(root: str | Path, plan_file: str = "contracts/plan.yaml") -> dic
                           lambda n: [snap[n]] + [str(rootp / f) for e in ws.plan.evidence.get(n, ()) for f in _inputs(e.config, rootp)],
                           ws.obligations)
 
+    exported_memo: list[list[tuple[str, dict[str, Any]]]] = []
+
     def exported() -> list[tuple[str, dict[str, Any]]]:
-        """(node, obligation JSON) of every exported obligation (read after export ran)."""
+        """(node, obligation JSON) of every exported obligation (read after export ran;
+        once per run: the evidence and report tasks are both created after it)."""
+        if not exported_memo:
+            exported_memo.append(read_exported())
+        return exported_memo[0]
+
+    def read_exported() -> list[tuple[str, dict[str, Any]]]:
         out: list[tuple[str, dict[str, Any]]] = []
         for n in nodes:
             try:
