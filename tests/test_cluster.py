@@ -50,7 +50,21 @@ nodes:
   N1:
     evidence:
       - {backend: hoare, program: backends/hoare/clamp.imp, binding: {in.v0: x, out.v1: y}}
-      - {backend: review}
+      - {backend: review, record: backends/review/n1.yaml}
+"""
+
+#: A review record not filled in yet: its obligations are pending (the review
+#: backend needs a record file since it was changed to check answered records).
+REVIEW = """\
+node: N1
+reviewer: ""
+date: ""
+scope: ""
+files: []
+checklist:
+  - {id: g1.c1, answer: ""}
+  - {id: g2.c1, answer: ""}
+verdict: ""
 """
 
 TIMING = ("started", "duration_s")
@@ -62,6 +76,8 @@ def _workspace(path: Path) -> Path:
     (path / "contracts" / "system.rcl").write_text(RCL)
     (path / "contracts" / "plan.yaml").write_text(PLAN)
     (path / "backends" / "hoare" / "clamp.imp").write_text(CLAMP)
+    (path / "backends" / "review").mkdir(parents=True)
+    (path / "backends" / "review" / "n1.yaml").write_text(REVIEW)
     return path
 
 
