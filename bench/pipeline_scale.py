@@ -22,9 +22,9 @@ downstream (R4).  Node ``N0`` reads the environment input ``e0``.  Every node
 has two guarantees and a ``hoare`` evidence entry over one shared clamp
 program (``backends/hoare/clamp.imp``), so each node gives Hoare obligations
 checked by Z3, and the calculus and health checks run as usual.
-Property-test obligations (``property_tests`` evidence entries) are added
-only when this tree's ``rclverify.backends`` implements that backend; the
-table says whether they were.
+Every tenth node (``--property-tests EVERY``; 0 for none) also has a
+``property_tests`` entry, 25 Hypothesis examples against the same clamp
+written in Python (``backends/property_tests/clamp.py``).
 
 Usage::
 
@@ -109,23 +109,39 @@ def has_property_tests() -> bool:
     return "property_tests" in getattr(backends, "IMPLEMENTED", {})
 
 
-def generate(root: Path, n: int, property_tests: bool) -> None:
-    """Write an ``n``-node workspace under ``root`` (which must not exist)."""
+def implementation(k: int, producers: list[int]) -> str:
+    """Python text of node ``N<k>``'s clamp, the callable ``n<k>`` that the
+    ``property_tests`` backend calls with one keyword argument per input."""
+    ins = [f"v{p}" for p in producers] or ["e0"]
+    return (f"def n{k}({', '.join(ins)}):\n"
+            f"    return {{'v{k}': {ins[0]} if {ins[0]} >= 0 else 0}}\n\n\n")
+
+
+def generate(root: Path, n: int, property_tests: bool, pt_every: int = 10) -> None:
+    """Write an ``n``-node workspace under ``root`` (which must not exist);
+    with ``property_tests``, every ``pt_every``-th node also gets a
+    ``property_tests`` entry (25 examples) over its clamp in Python."""
     (root / "contracts").mkdir(parents=True)
     (root / "backends" / "hoare").mkdir(parents=True)
     (root / "backends" / "hoare" / "clamp.imp").write_text(CLAMP)
     (root / "dodo.py").write_text(DODO)
     prod = topology(n)
     nodes: dict[str, object] = {}
+    impls: list[str] = []
     for k in range(n):
         (root / "contracts" / f"n{k}.rcl").write_text(contract(k, prod[k]))
         ins = [f"v{p}" for p in prod[k]] or ["e0"]
         binding = {f"in.{ins[0]}": "x", f"out.v{k}": "y"}
         binding.update({f"in.{i}": "z" for i in ins[1:]})
         entries: list[dict[str, object]] = [{"backend": "hoare", "program": "backends/hoare/clamp.imp", "binding": binding}]
-        if property_tests:
-            entries.append({"backend": "property_tests"})
+        if property_tests and k % pt_every == 0:
+            impls.append(implementation(k, prod[k]))
+            entries.append({"backend": "property_tests", "implementation": f"backends/property_tests/clamp.py:n{k}",
+                            "max_examples": 25})
         nodes[f"N{k}"] = {"evidence": entries}
+    if impls:
+        (root / "backends" / "property_tests").mkdir(parents=True)
+        (root / "backends" / "property_tests" / "clamp.py").write_text("".join(impls))
     plan = {"name": f"synthetic system of {n} nodes", "contracts": [f"contracts/n{k}.rcl" for k in range(n)],
             "nodes": nodes}
     (root / "contracts" / "plan.yaml").write_text(yaml.safe_dump(plan, sort_keys=False))
@@ -206,13 +222,15 @@ def main(argv: Sequence[str] | None = None) -> int:
                     help="numbers of nodes (space or comma separated)")
     ap.add_argument("-n", "--jobs", type=int, default=1, help="doit parallel processes (doit -n)")
     ap.add_argument("--keep", help="write the workspaces under this directory and keep them")
+    ap.add_argument("--property-tests", type=int, default=10, metavar="EVERY",
+                    help="give every EVERY-th node a property_tests entry (default 10; 0: none)")
     args = ap.parse_args(argv)
     sizes = _sizes(args.sizes)
-    pt = has_property_tests()
+    pt = has_property_tests() and args.property_tests > 0
     base = Path(args.keep) if args.keep else Path(tempfile.mkdtemp(prefix="rclverify-bench-"))
     print(f"pipeline scale: doit{' -n ' + str(args.jobs) if args.jobs > 1 else ''} verify, "
           f"{os.cpu_count()} CPU(s); obligations: hoare"
-          + (", property_tests" if pt else " (property_tests skipped: backend not implemented in this tree)"))
+          + (f", property_tests on every {args.property_tests}th node" if pt else " (no property_tests)"))
     header = (f"{'nodes':>6} {'oblig.':>7} {'side c.':>7} {'cold s':>7} {'(cpu)':>7} {'MB':>5} {'no-op s':>7} "
               f"{'(cpu)':>6} {'ran':>3} {'edit s':>6} {'(cpu)':>6} {'MB':>5}  tasks run after the edit")
     print(header)
@@ -222,7 +240,7 @@ def main(argv: Sequence[str] | None = None) -> int:
             root = base / f"n{n}"
             if root.exists():
                 shutil.rmtree(root)
-            generate(root, n, pt)
+            generate(root, n, pt, args.property_tests)
             cold = doit_verify(root, args.jobs)
             if cold.rc != 0:
                 print(f"{n:>6}  cold run failed (exit {cold.rc}):\n{cold.output[-3000:]}")

@@ -141,6 +141,8 @@ def act_report(root: str) -> Any:
         report = build_report(ws)
     except RclError as exc:
         return _fail(exc)
+    from .report import layoutcache
+    layoutcache.use_directory(ws.path("artifacts/cache/layout"))
     render_all(report, ws.path("reports"))
     from .report.ci import write_ci_reports
     write_ci_reports(report, ws.path("reports"))
@@ -259,8 +261,16 @@ def build_tasks(root: str | Path, plan_file: str = "contracts/plan.yaml") -> dic
                           lambda n: [snap[n]] + [str(rootp / f) for e in ws.plan.evidence.get(n, ()) for f in _inputs(e.config, rootp)],
                           ws.obligations)
 
+    exported_memo: list[list[tuple[str, dict[str, Any]]]] = []
+
     def exported() -> list[tuple[str, dict[str, Any]]]:
-        """(node, obligation JSON) of every exported obligation (read after export ran)."""
+        """(node, obligation JSON) of every exported obligation (read after export ran;
+        once per run: the evidence and report tasks are both created after it)."""
+        if not exported_memo:
+            exported_memo.append(read_exported())
+        return exported_memo[0]
+
+    def read_exported() -> list[tuple[str, dict[str, Any]]]:
         out: list[tuple[str, dict[str, Any]]] = []
         for n in nodes:
             try:

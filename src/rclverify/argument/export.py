@@ -105,13 +105,28 @@ def to_dot(arg: Argument, title: str = "assurance argument", link_prefix: str = 
     return _environment().get_template("argument.dot.j2").render(title=title.replace("\n", " "), nodes=nodes, edges=edges)
 
 
+#: The last report built (kept, so its ``id`` is not reused) and its argument and DOT text.
+_last: list[tuple[Mapping[str, Any], Argument, str]] = []
+
+
+def _built(report: Mapping[str, Any]) -> tuple[Argument, str]:
+    """``(argument, dot)`` of ``report``.  One report run shows the argument
+    three times (HTML, Markdown, ``reports/argument.*``) from the same report
+    dict, which no renderer changes; it is built once for that dict."""
+    if _last and _last[0][0] is report:
+        return _last[0][1], _last[0][2]
+    arg = build_argument(report)
+    dot = to_dot(arg, f"assurance argument of {report['meta']['workspace']}")
+    _last[:] = [(report, arg, dot)]
+    return arg, dot
+
+
 def argument_view(report: Mapping[str, Any], rendering: diagram.Rendering | None = None) -> dict[str, Any]:
     """What the report templates show of the argument: ``argument`` (the
     JSON form), ``dot``, ``svg`` (``None`` without Graphviz), ``note`` (why
     there is no SVG) and ``goals`` (the requirement and contract goals with
     their statuses, for the tables).  ``rendering`` replaces running ``dot``."""
-    arg = build_argument(report)
-    dot = to_dot(arg, f"assurance argument of {report['meta']['workspace']}")
+    arg, dot = _built(report)
     drawn = rendering if rendering is not None else diagram.render_dot(dot)
     top = arg.elements[arg.top]
     goals = [top] + [arg.elements[g] for s in top.supported_by for g in arg.elements[s].supported_by]
@@ -128,9 +143,8 @@ def write_argument(report: Mapping[str, Any], out_dir: Path) -> list[Path]:
     paths written.  Raises ``KeyError`` for a malformed report and ``OSError``
     when ``out_dir`` cannot be written.
     """
-    arg = build_argument(report)
+    arg, dot = _built(report)
     title = f"assurance argument of {report['meta']['workspace']}"
-    dot = to_dot(arg, title)
     texts = {FILES[0]: to_json_text(arg), FILES[1]: to_gsn_yaml(arg, title), FILES[2]: dot}
     svg = diagram.render_dot(dot).svg
     paths = []

@@ -20,6 +20,8 @@ from typing import Any, Mapping, Sequence
 
 import jinja2
 
+from . import layoutcache
+
 #: Fill and border colour of a node box, by (normalised) status.
 _NODE_COLOURS: Mapping[str, tuple[str, str]] = {
     "discharged": ("#dafbe1", "#1a7f37"),
@@ -162,11 +164,27 @@ def render_dot(dot: str, timeout_s: float = DOT_TIMEOUT_S) -> Rendering:
     """Run ``dot -Tsvg`` on ``dot`` (no shell) and explain any failure.
 
     ``timeout_s`` is in seconds.  Never raises for a missing, failing or
-    hanging ``dot``: the reason is in :attr:`Rendering.note`.
+    hanging ``dot``: the reason is in :attr:`Rendering.note`.  A layout
+    already made for the same text by the same ``dot`` is reused
+    (:mod:`.layoutcache`; the SVG is the same byte for byte).
     """
     exe = shutil.which("dot")
     if exe is None:
         return Rendering(None, INSTALL_HINT)
+    failures: list[Rendering] = []
+
+    def compute() -> str | None:
+        drawn = _run_dot(exe, dot, timeout_s)
+        if drawn.svg is None:
+            failures.append(drawn)
+        return drawn.svg
+
+    svg = layoutcache.lookup(dot, exe, compute)
+    return Rendering(svg, "") if svg is not None else failures[0]
+
+
+def _run_dot(exe: str, dot: str, timeout_s: float) -> Rendering:
+    """Run the ``dot`` program at ``exe`` on ``dot`` (see :func:`render_dot`)."""
     try:
         proc = subprocess.run(
             [exe, "-Tsvg"], input=dot.encode("utf-8"), capture_output=True,

@@ -72,6 +72,10 @@ def junit_tree(report: Mapping[str, Any]) -> ET.Element:
     reasons: dict[str, str] = {}
     for p in report["pending"]:
         reasons.setdefault(str(p["obligation"]), str(p["reason"]))
+    by_node: dict[Any, dict[str, list[Mapping[str, Any]]]] = {}  # node -> kind -> items, in report order
+    for kind in ("obligations", "side_conditions", "findings"):
+        for item in report[kind]:
+            by_node.setdefault(item["node"], {}).setdefault(kind, []).append(item)
     root = ET.Element("testsuites", {"name": f"rclverify: {report['meta']['workspace']}"})
     totals = {"tests": 0, "failures": 0, "errors": 0, "skipped": 0}
     total_time = 0.0
@@ -89,7 +93,7 @@ def junit_tree(report: Mapping[str, Any]) -> ET.Element:
             if bumped:
                 counts[bumped] += 1
 
-        for o in (o for o in report["obligations"] if o["node"] == name):
+        for o in by_node.get(name, {}).get("obligations", ()):
             ev = evidence.get(str(o["id"]))
             secs = ev["duration_s"] if ev is not None else 0.0
             case = _case(suite, f"{name}.obligation", str(o["id"]), str(o["source"]), secs)
@@ -98,14 +102,14 @@ def junit_tree(report: Mapping[str, Any]) -> ET.Element:
             tally(case, str(o["status"]), expl.splitlines()[0] if expl else str(o["status"]),
                   _lines(f"obligation ({o['backend']}, {o['kind']}) of guarantee {o['guarantee']}: {o['statement']}",
                          f"source: {o['source']}", expl, f"counterexample: {cex}" if cex else ""), secs)
-        for sc in (s for s in report["side_conditions"] if s["node"] == name):
+        for sc in by_node.get(name, {}).get("side_conditions", ()):
             case = _case(suite, f"{name}.side_condition", str(sc["id"]), str(sc["source"]), sc.get("duration_s"))
             model = _values(sc.get("model"))
             tally(case, str(sc["status"]), str(sc.get("explanation") or sc["status"]),
                   _lines(f"side condition ({sc['rule']}): {sc['conjunct']}", f"source: {sc['source']}",
                          str(sc.get("explanation") or ""), f"counterexample: {model}" if model else ""),
                   sc.get("duration_s"))
-        for f in (f for f in report["findings"] if f["node"] == name):
+        for f in by_node.get(name, {}).get("findings", ()):
             case = _case(suite, f"{name}.health", str(f["id"]), _source_of(node, f), f.get("duration_s"))
             core = "; ".join(str(c) for c in f.get("core") or [])
             model = _values(f.get("model"))

@@ -424,7 +424,10 @@ def _syntax_error(exc: UnexpectedInput, file: str, text: str, dline: int, dcol: 
     return RclError([error(Loc(file, line + dline, col), msg, "E-syntax")])
 
 
+@lru_cache(maxsize=512)
 def _parse(text: str, file: str, start: str, dline: int, dcol: int) -> Any:
+    # Memoised: the AST is immutable (frozen dataclasses and tuples), and one
+    # process checks many triples over the same program file and bindings.
     try:
         tree = _lark().parse(text, start=start)
     except UnexpectedInput as exc:

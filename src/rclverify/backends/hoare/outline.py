@@ -26,6 +26,15 @@ _P_IMP, _P_OR, _P_AND, _P_NOT, _P_CMP, _P_SUM, _P_PROD, _P_NEG, _P_ATOM = range(
 
 _CMP = {z3.Z3_OP_LE: "<=", z3.Z3_OP_LT: "<", z3.Z3_OP_GE: ">=", z3.Z3_OP_GT: ">"}
 _SORT_NAMES = {"Real": "REAL", "Int": "INTEGER", "Bool": "BOOL"}
+_ARITH = {z3.Z3_OP_ADD: "+", z3.Z3_OP_SUB: "-", z3.Z3_OP_MUL: "*", z3.Z3_OP_DIV: "/", z3.Z3_OP_IDIV: "div"}
+
+
+def _kind(t: z3.ExprRef) -> int:
+    """Z3 declaration kind of an application (``-1`` for a variable or quantifier)."""
+    ctx, a = t.ctx_ref(), t.as_ast()
+    if z3.Z3_get_ast_kind(ctx, a) not in (z3.Z3_APP_AST, z3.Z3_NUMERAL_AST):
+        return -1
+    return int(z3.Z3_get_decl_kind(ctx, z3.Z3_get_app_decl(ctx, a)))
 
 
 def number_text(v: z3.ExprRef) -> str:
@@ -63,26 +72,36 @@ class _Printer:
         return f"({s})" if p < context else s
 
     def _go(self, t: z3.ExprRef, context: int = 0) -> str:
-        if z3.is_var(t):
-            idx = z3.get_var_index(t)
+        # Z3's low-level API directly: the typed Python wrappers (is_true,
+        # children(), ...) re-check every term's kind and sort many times and
+        # were most of the time spent rendering outlines.  Same cases, same text.
+        ctx, a = t.ctx_ref(), t.as_ast()
+        ak = z3.Z3_get_ast_kind(ctx, a)
+        if ak == z3.Z3_VAR_AST:
+            idx = z3.Z3_get_index_value(ctx, a)
             return self.bound[-1 - idx] if idx < len(self.bound) else f"?{idx}"
-        if z3.is_quantifier(t):
-            return self.quantifier(t, context)
-        if z3.is_true(t):
-            return "TRUE"
-        if z3.is_false(t):
-            return "FALSE"
-        if z3.is_int_value(t) or z3.is_rational_value(t):
-            s = number_text(t)
-            return self.wrap(s, _P_PROD if "/" in s else _P_ATOM, context)
-        if not z3.is_app(t):
+        if ak == z3.Z3_QUANTIFIER_AST:
+            return self.quantifier(z3.QuantifierRef(a, t.ctx), context)
+        if ak != z3.Z3_APP_AST and ak != z3.Z3_NUMERAL_AST:
             return str(t)
-        k = t.decl().kind()
-        ch = t.children()
+        decl = z3.Z3_get_app_decl(ctx, a)
+        k = z3.Z3_get_decl_kind(ctx, decl)
+        if k == z3.Z3_OP_TRUE:
+            return "TRUE"
+        if k == z3.Z3_OP_FALSE:
+            return "FALSE"
+        if k == z3.Z3_OP_ANUM:
+            sk = z3.Z3_get_sort_kind(ctx, z3.Z3_get_sort(ctx, a))
+            num = z3.IntNumRef(a, t.ctx) if sk == z3.Z3_INT_SORT else z3.RatNumRef(a, t.ctx)
+            s = number_text(num)
+            return self.wrap(s, _P_PROD if "/" in s else _P_ATOM, context)
+        ch = [z3.ExprRef(z3.Z3_get_app_arg(ctx, a, i), t.ctx) for i in range(z3.Z3_get_app_num_args(ctx, a))]
         if k == z3.Z3_OP_AND:
-            return self.wrap(" and ".join(self.go(c, _P_AND + (1 if z3.is_and(c) else 0)) for c in ch), _P_AND, context)
+            return self.wrap(" and ".join(self.go(c, _P_AND + (1 if _kind(c) == z3.Z3_OP_AND else 0)) for c in ch),
+                             _P_AND, context)
         if k == z3.Z3_OP_OR:
-            return self.wrap(" or ".join(self.go(c, _P_OR + (1 if z3.is_or(c) else 0)) for c in ch), _P_OR, context)
+            return self.wrap(" or ".join(self.go(c, _P_OR + (1 if _kind(c) == z3.Z3_OP_OR else 0)) for c in ch),
+                             _P_OR, context)
         if k == z3.Z3_OP_IMPLIES:
             return self.wrap(f"{self.go(ch[0], _P_IMP + 1)} -> {self.go(ch[1], _P_IMP)}", _P_IMP, context)
         if k == z3.Z3_OP_NOT:
@@ -93,9 +112,8 @@ class _Printer:
             return self.wrap(f"{self.go(ch[0], _P_CMP + 1)} != {self.go(ch[1], _P_CMP + 1)}", _P_CMP, context)
         if k in _CMP:
             return self.wrap(f"{self.go(ch[0], _P_CMP + 1)} {_CMP[k]} {self.go(ch[1], _P_CMP + 1)}", _P_CMP, context)
-        if k in (z3.Z3_OP_ADD, z3.Z3_OP_SUB, z3.Z3_OP_MUL, z3.Z3_OP_DIV, z3.Z3_OP_IDIV):
-            op = {z3.Z3_OP_ADD: "+", z3.Z3_OP_SUB: "-", z3.Z3_OP_MUL: "*", z3.Z3_OP_DIV: "/",
-                  z3.Z3_OP_IDIV: "div"}[k]
+        if k in _ARITH:
+            op = _ARITH[k]
             p = _P_SUM if op in "+-" else _P_PROD
             parts = [self.go(ch[0], p)] + [self.go(c, p + 1) for c in ch[1:]]
             return self.wrap(f" {op} ".join(parts), p, context)
@@ -103,7 +121,7 @@ class _Printer:
             return self.wrap("-" + self.go(ch[0], _P_NEG), _P_NEG, context)
         if k == z3.Z3_OP_TO_REAL:
             return self.go(ch[0], context)
-        name = self.name(t.decl().name())
+        name = self.name(z3.FuncDeclRef(decl, t.ctx).name())
         if not ch:
             return name
         return f"{name}(" + ", ".join(self.go(c) for c in ch) + ")"
