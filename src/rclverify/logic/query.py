@@ -22,7 +22,7 @@ from typing import Sequence
 import z3
 
 from .encode import Encoder, term_to_rcl, value_to_rcl
-from .retry import attempts, bounded_solver
+from .retry import attempts, bounded_solver, load_canonical
 
 DEFAULT_TIMEOUT_MS = 10_000
 
@@ -73,14 +73,17 @@ def prove(goal: z3.BoolRef, hypotheses: Sequence[z3.BoolRef], enc: Encoder | Non
     typing axioms to the hypotheses.  ``deterministic``: run the first
     attempt too in a fresh Z3 context bounded by a resource limit
     (:func:`.retry.bounded_solver`) instead of ``timeout_ms``, so the answer
-    does not depend on load or history.  Never raises on solver trouble:
+    does not depend on load or history: the query is loaded from its
+    canonical SMT-LIB2 text (:func:`.retry.load_canonical`), so not even
+    Z3's term ids or quantifier identifiers of the calling process reach
+    the solver; the model is read back through ``enc``'s names.  Never raises on solver trouble:
     an unknown answer is ``inconclusive`` with Z3's reason.
     """
     hyps = list(hypotheses) + (enc.axioms() if enc else [])
     formulas = hyps + [z3.Not(goal)]
     if deterministic:
         s = bounded_solver()
-        s.add(*[f.translate(s.ctx) for f in formulas])
+        load_canonical(s, formulas)
     else:
         s = _solver(timeout_ms)
         s.add(*formulas)
@@ -94,7 +97,7 @@ def prove(goal: z3.BoolRef, hypotheses: Sequence[z3.BoolRef], enc: Encoder | Non
         return QueryResult("refuted", text, dt, model=render_model(s.model(), enc))
     reasons = [f"default: {s.reason_unknown()}"]
     for name, s2, rewrite in attempts(formulas, timeout_ms):
-        s2.add(*[rewrite(f) for f in formulas])
+        load_canonical(s2, [rewrite(f) for f in formulas])
         r = s2.check()
         dt = round(time.perf_counter() - t0, 4)
         if r == z3.unsat:
@@ -136,11 +139,12 @@ def satisfiable(labelled: Sequence[tuple[str, z3.BoolRef]], enc: Encoder | None 
         return QueryResult("unsat", text, dt, core=core)
     reasons = [f"default: {s.reason_unknown()}"]
     for name, s2, rewrite in attempts(background + [f for _, f in labelled], timeout_ms) if retry else []:
+        # tracked formulas as ``label -> formula`` checked under the labels
+        # (what assert_and_track does), so they load as canonical text
         s2.set("unsat_core", True)
-        s2.add(*[rewrite(f) for f in background])
-        for k, (label, f) in enumerate(labelled):
-            s2.assert_and_track(rewrite(f), z3.Bool(f"__label_{k}", s2.ctx))
-        r = s2.check()
+        load_canonical(s2, [rewrite(f) for f in background]
+                       + [z3.Implies(z3.Bool(f"__label_{k}", f.ctx), rewrite(f)) for k, (_, f) in enumerate(labelled)])
+        r = s2.check(*[z3.Bool(f"__label_{k}", s2.ctx) for k in range(len(labelled))])
         dt = round(time.perf_counter() - t0, 4)
         if r == z3.sat:
             return QueryResult("sat", text, dt, model=render_model(s2.model(), enc), strategy=name)

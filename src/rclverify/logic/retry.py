@@ -11,6 +11,9 @@ a deterministic resource limit (:data:`RETRY_RLIMIT`):
     the answer means the same.
 ``model-based quantifier instantiation``
     the same formulas with e-matching switched off (``smt.ematching=false``),
+    after Z3's ``simplify`` tactic on the whole query (which flattens and
+    normalises it; on the case study's replacement check this is what lets
+    MBQI find the refuting model within the limit),
     so Z3 instantiates quantifiers only from candidate models (MBQI; de
     Moura and Bjorner, "Efficient E-matching for SMT solvers" and the Z3
     guide's section on quantifiers).  Often finds models for satisfiable
@@ -23,7 +26,7 @@ comes with a model.  The strategy that answered is recorded on the result
 from __future__ import annotations
 
 import itertools
-from typing import Callable, Sequence
+from typing import Callable, Sequence, cast
 
 import z3
 
@@ -50,30 +53,38 @@ def _finite_values(s: z3.SortRef) -> list[z3.ExprRef] | None:
     return None
 
 
-def expand_finite(e: z3.ExprRef) -> z3.ExprRef:
-    """``e`` with every quantifier over finite sorts only written out
-    (innermost first); other quantifiers are kept, with their bodies
-    expanded.  Equivalent to ``e``."""
+def expand_finite(e: z3.ExprRef, depth: int = 0) -> z3.ExprRef:
+    """``e`` (a closed formula) with every quantifier over finite sorts only
+    written out; other quantifiers are kept, with their bodies expanded.
+    Equivalent to ``e``.
+
+    Each quantifier is opened top-down: its bound variables become constants
+    named ``<name>!q<depth>_<k>`` (``!`` never occurs in an encoder's name, and
+    the depth keeps nested binders apart), so a body never holds a loose de
+    Bruijn index, and the names depend on the formula only (``FreshConst``'s
+    counter would carry the process's history into the query).  ``depth`` is
+    the number of enclosing binders (internal).
+    """
     if z3.is_quantifier(e):
         q = e
-        body = expand_finite(q.body())
         if q.is_lambda():
             return e
+        names = [z3.Const(f"{q.var_name(k)}!q{depth}_{k}", q.var_sort(k)) for k in range(q.num_vars())]
+        # de Bruijn: variable 0 is the last bound one
+        opened = z3.substitute_vars(q.body(), *reversed(names))
+        body = expand_finite(opened, depth + 1)
         domains = [_finite_values(q.var_sort(k)) for k in range(q.num_vars())]
         if all(d is not None for d in domains):
             combos = list(itertools.islice(itertools.product(*[d for d in domains if d is not None]),
                                            MAX_INSTANCES + 1))
             if len(combos) <= MAX_INSTANCES:
-                # de Bruijn: variable 0 is the last bound one
-                insts = [z3.substitute_vars(body, *reversed(c)) for c in combos]
+                insts = [z3.substitute(body, *zip(names, c)) for c in combos]
                 return z3.And(*insts) if q.is_forall() else z3.Or(*insts)
-        if body.eq(q.body()):
+        if body.eq(opened):
             return e
-        names = [z3.FreshConst(q.var_sort(k), q.var_name(k)) for k in range(q.num_vars())]
-        inner = z3.substitute_vars(body, *reversed(names))
-        return z3.ForAll(names, inner) if q.is_forall() else z3.Exists(names, inner)
+        return z3.ForAll(names, body) if q.is_forall() else z3.Exists(names, body)
     if z3.is_app(e) and e.num_args() > 0:
-        kids = [expand_finite(c) for c in e.children()]
+        kids = [expand_finite(c, depth) for c in e.children()]
         return e.decl()(*kids)
     return e
 
@@ -92,19 +103,46 @@ def _has_quantifier(e: z3.ExprRef) -> bool:
     return False
 
 
-def bounded_solver() -> z3.Solver:
+def bounded_solver(*tactics: str) -> z3.Solver:
     """A solver in a fresh Z3 context (so the answer does not depend on what
-    the process encoded before) bounded by :data:`RETRY_RLIMIT`."""
-    s = z3.Solver(ctx=z3.Context())
+    the process encoded before) bounded by :data:`RETRY_RLIMIT`; with
+    ``tactics`` (Z3 tactic names, e.g. ``"simplify", "smt"``), the solver
+    runs them in sequence (models are mapped back to the query's symbols)."""
+    ctx = z3.Context()
+    s = z3.Then(*tactics, ctx=ctx).solver() if len(tactics) > 1 else z3.Solver(ctx=ctx)
     s.set("rlimit", RETRY_RLIMIT)
     s.set("timeout", SAFETY_TIMEOUT_MS)
     return s
 
 
+def canonical_smt2(formulas: Sequence[z3.BoolRef]) -> str:
+    """``formulas`` as SMT-LIB2 text that depends only on their structure.
+
+    Z3's printer names shared subterms and orders declarations by term id,
+    and a quantifier keeps a default identifier drawn from its context's
+    counter: both are history of the process (what it encoded before).  The
+    formulas are first copied into a fresh context, where ids follow the
+    formulas' structure alone, and printed there.
+    """
+    ctx = z3.Context()
+    s = z3.Solver(ctx=ctx)
+    s.add(*[f.translate(ctx) for f in formulas])
+    return str(s.to_smt2())
+
+
+def load_canonical(s: z3.Solver, formulas: Sequence[z3.BoolRef]) -> None:
+    """Assert ``formulas`` in ``s`` (a solver of its own fresh context) by
+    parsing :func:`canonical_smt2`, so the solver's state, and hence its
+    answer under a resource limit, is a function of the query alone."""
+    s.from_string(canonical_smt2(formulas))
+
+
 def attempts(formulas: Sequence[z3.BoolRef], timeout_ms: int
              ) -> list[tuple[str, z3.Solver, Callable[[z3.BoolRef], z3.BoolRef]]]:
     """The retries that apply to ``formulas`` (none without a quantifier):
-    ``(strategy name, configured solver, rewrite of each formula)``.
+    ``(strategy name, configured solver, rewrite of each formula)``.  The
+    rewrite stays in the formulas' context; load its results into the
+    solver with :func:`load_canonical`.
     ``timeout_ms`` (the first attempt's) is not used: retries are bounded by
     :data:`RETRY_RLIMIT` so that their answers are reproducible."""
     if not any(_has_quantifier(f) for f in formulas):
@@ -113,8 +151,8 @@ def attempts(formulas: Sequence[z3.BoolRef], timeout_ms: int
     changed = [expand_finite(f) for f in formulas]
     if any(not a.eq(b) for a, b in zip(changed, formulas)):
         s = bounded_solver()
-        out.append((FINITE, s, lambda f, c=s.ctx: expand_finite(f).translate(c)))
-    s = bounded_solver()
+        out.append((FINITE, s, lambda f: cast(z3.BoolRef, expand_finite(f))))
+    s = bounded_solver("simplify", "smt")
     s.set("smt.ematching", False)
-    out.append((MBQI, s, lambda f, c=s.ctx: f.translate(c)))
+    out.append((MBQI, s, lambda f: f))
     return out
