@@ -17,12 +17,12 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass
-from typing import Sequence
+from typing import Callable, Sequence
 
 import z3
 
 from .encode import Encoder, term_to_rcl, value_to_rcl
-from .retry import attempts, bounded_solver, load_canonical
+from .retry import attempts, bounded_solver, load_canonical, variants
 
 DEFAULT_TIMEOUT_MS = 10_000
 
@@ -96,15 +96,16 @@ def prove(goal: z3.BoolRef, hypotheses: Sequence[z3.BoolRef], enc: Encoder | Non
     if r == z3.sat:
         return QueryResult("refuted", text, dt, model=render_model(s.model(), enc))
     reasons = [f"default: {s.reason_unknown()}"]
-    for name, s2, rewrite in attempts(formulas, timeout_ms):
-        load_canonical(s2, [rewrite(f) for f in formulas])
-        r = s2.check()
-        dt = round(time.perf_counter() - t0, 4)
-        if r == z3.unsat:
-            return QueryResult("proved", text, dt, strategy=name)
-        if r == z3.sat:
-            return QueryResult("refuted", text, dt, model=render_model(s2.model(), enc), strategy=name)
-        reasons.append(f"{name}: {s2.reason_unknown()}")
+    for name0, s0, rewrite in attempts(formulas, timeout_ms):
+        for name, s2 in variants(name0, s0):
+            load_canonical(s2, [rewrite(f) for f in formulas])
+            r = s2.check()
+            dt = round(time.perf_counter() - t0, 4)
+            if r == z3.unsat:
+                return QueryResult("proved", text, dt, strategy=name)
+            if r == z3.sat:
+                return QueryResult("refuted", text, dt, model=render_model(s2.model(), enc), strategy=name)
+            reasons.append(f"{name}: {s2.reason_unknown()}")
     return QueryResult("inconclusive", text, dt, reason="; ".join(reasons) if len(reasons) > 1 else s.reason_unknown())
 
 
@@ -138,22 +139,37 @@ def satisfiable(labelled: Sequence[tuple[str, z3.BoolRef]], enc: Encoder | None 
                       key=[lbl for lbl, _ in labelled].index)
         return QueryResult("unsat", text, dt, core=core)
     reasons = [f"default: {s.reason_unknown()}"]
-    for name, s2, rewrite in attempts(background + [f for _, f in labelled], timeout_ms) if retry else []:
-        # tracked formulas as ``label -> formula`` checked under the labels
-        # (what assert_and_track does), so they load as canonical text
-        s2.set("unsat_core", True)
-        load_canonical(s2, [rewrite(f) for f in background]
-                       + [z3.Implies(z3.Bool(f"__label_{k}", f.ctx), rewrite(f)) for k, (_, f) in enumerate(labelled)])
-        r = s2.check(*[z3.Bool(f"__label_{k}", s2.ctx) for k in range(len(labelled))])
-        dt = round(time.perf_counter() - t0, 4)
-        if r == z3.sat:
-            return QueryResult("sat", text, dt, model=render_model(s2.model(), enc), strategy=name)
-        if r == z3.unsat:
-            core = sorted({trackers[str(c)] for c in s2.unsat_core() if str(c) in trackers},
-                          key=[lbl for lbl, _ in labelled].index)
-            return QueryResult("unsat", text, dt, core=core, strategy=name)
-        reasons.append(f"{name}: {s2.reason_unknown()}")
+    labels = [lbl for lbl, _ in labelled]
+    for name0, s0, rewrite in attempts(background + [f for _, f in labelled], timeout_ms) if retry else []:
+        for name, s2 in variants(name0, s0):
+            # loaded untracked from canonical text (tracking changes Z3's search)
+            load_canonical(s2, [rewrite(f) for f in background + [f for _, f in labelled]])
+            r = s2.check()
+            dt = round(time.perf_counter() - t0, 4)
+            if r == z3.sat:
+                return QueryResult("sat", text, dt, model=render_model(s2.model(), enc), strategy=name)
+            if r == z3.unsat:
+                core = _retry_core(background, labelled, rewrite) or labels
+                return QueryResult("unsat", text, round(time.perf_counter() - t0, 4), core=core, strategy=name)
+            reasons.append(f"{name}: {s2.reason_unknown()}")
     return QueryResult("inconclusive", text, dt, reason="; ".join(reasons) if len(reasons) > 1 else s.reason_unknown())
+
+
+def _retry_core(background: Sequence[z3.BoolRef], labelled: Sequence[tuple[str, z3.BoolRef]],
+                rewrite: Callable[[z3.BoolRef], z3.BoolRef]) -> list[str] | None:
+    """Labels of an unsat core of a query a retry found unsat: the formulas
+    tracked as ``label -> formula`` and checked under the labels, in a fresh
+    bounded context; ``None`` when that check is not ``unsat`` (the caller
+    then names every label, which is a core too)."""
+    s = bounded_solver()
+    s.set("smt.ematching", False)
+    s.set("unsat_core", True)
+    load_canonical(s, [rewrite(f) for f in background]
+                   + [z3.Implies(z3.Bool(f"__label_{k}", f.ctx), rewrite(f)) for k, (_, f) in enumerate(labelled)])
+    if s.check(*[z3.Bool(f"__label_{k}", s.ctx) for k in range(len(labelled))]) != z3.unsat:
+        return None
+    found = {str(c) for c in s.unsat_core()}
+    return [lbl for k, (lbl, _) in enumerate(labelled) if f"__label_{k}" in found]
 
 
 def render_model(model: z3.ModelRef, enc: Encoder | None) -> dict[str, str]:
