@@ -21,7 +21,8 @@ import json, sys
 from pathlib import Path
 from rclverify.pipeline import Workspace, replacement_finding
 f = replacement_finding(Workspace(Path(sys.argv[1])), "Agent")
-print(json.dumps({"status": f.status, "message": f.message, "model": f.model}, sort_keys=True))
+print(json.dumps({"status": f.status, "message": f.message, "model": f.model, "explanation": f.explanation},
+                 sort_keys=True))
 """
 
 
@@ -42,7 +43,7 @@ def _unrelated_z3_work() -> None:
 def _replacement_here() -> dict[str, object]:
     from rclverify.pipeline import Workspace, replacement_finding
     f = replacement_finding(Workspace(ROOT), "Agent")
-    return {"status": f.status, "message": f.message, "model": f.model}
+    return {"status": f.status, "message": f.message, "model": f.model, "explanation": f.explanation}
 
 
 def test_replacement_verdict_is_the_same_in_a_fresh_process_and_after_other_z3_work() -> None:
@@ -56,6 +57,7 @@ def test_replacement_verdict_is_the_same_in_a_fresh_process_and_after_other_z3_w
     here = _replacement_here()
     assert json.loads(fresh.stdout) == here
     assert here["status"] == "problem" and "guarantee side fails" in str(here["message"])
+    assert "answered with model-based quantifier instantiation after simplification" in str(here["explanation"])
 
 
 def test_canonical_text_does_not_depend_on_term_ids() -> None:
