@@ -120,3 +120,52 @@ def test_finite_expansion_under_a_kept_quantifier_is_an_equivalence() -> None:
     s = z3.Solver()
     s.add(expand_finite(z3.ForAll([r], z3.ForAll([c], f(c, r)))), z3.Not(f(green, z3.RealVal(3))))
     assert s.check() == z3.unsat
+
+
+def _cmd_sort() -> tuple[z3.DatatypeSortRef, z3.DatatypeSortRef]:
+    global _CMD
+    if _CMD is None:
+        c = z3.Datatype("CaseCmd")
+        c.declare("case_move", ("case_move_0", z3.RealSort()), ("case_move_1", z3.BoolSort()))
+        c.declare("case_inspect", ("case_inspect_0", z3.IntSort()))
+        c.declare("case_stop")
+        lst = z3.Datatype("CaseList")
+        lst.declare("case_nil")
+        lst.declare("case_cons", ("case_head", z3.IntSort()), ("case_tail", lst))
+        _CMD = (c.create(), lst.create())
+    return _CMD
+
+
+_CMD: tuple[z3.DatatypeSortRef, z3.DatatypeSortRef] | None = None
+
+
+def test_constructor_arguments_are_split_by_constructor() -> None:
+    # finite instantiation of constructor arguments (issue 10): a bound
+    # constructor-set variable becomes one case per constructor, its Bool
+    # argument is written out, its REAL/INTEGER arguments stay bound
+    Cmd, _ = _cmd_sort()
+    c, r = z3.Const("sc", Cmd), z3.Real("sr")
+    p = z3.Function("sp", Cmd, z3.RealSort(), z3.BoolSort())
+    for q in (z3.ForAll([c], p(c, 1)), z3.Exists([c], z3.Not(p(c, 0))),
+              z3.ForAll([r], z3.Exists([c], z3.And(p(c, r), Cmd.is_case_move(c))))):
+        e = expand_finite(q)
+        s = z3.Solver()
+        s.add(e != q)
+        assert s.check() == z3.unsat, e
+    e = expand_finite(z3.ForAll([c], p(c, 1)))
+    text = canonical_smt2([e])
+    assert "case_stop" in text and "case_move" in text and "case_inspect" in text
+    assert "(case_move sc!q0_0_case_move_0!q1_0 true)" in text  # the Bool argument written out
+    # a goal about every command: decided without any quantifier over commands left
+    s = z3.Solver()
+    s.add(z3.Not(expand_finite(z3.ForAll([c], z3.Or(Cmd.is_case_move(c), Cmd.is_case_inspect(c),
+                                                        Cmd.is_case_stop(c))))))
+    assert s.check() == z3.unsat and not z3.is_quantifier(s.assertions()[0].arg(0))
+
+
+def test_recursive_constructor_sets_are_not_split() -> None:
+    _, Lst = _cmd_sort()
+    x = z3.Const("lx", Lst)
+    f = z3.Function("lf", Lst, z3.BoolSort())
+    q = z3.ForAll([x], f(x))
+    assert expand_finite(q).eq(q)

@@ -5,9 +5,11 @@ Quantified formulas are where Z3 gives up.  Before a query is reported
 a deterministic resource limit (:data:`RETRY_RLIMIT`):
 
 ``finite instantiation``
-    every quantifier whose bound variables all range over finite sorts
-    (enumerations, BOOL) is replaced by the conjunction (``forall``) or
-    disjunction (``exists``) of its instances.  This is an equivalence, so
+    every quantifier's bound variables of finite sorts (enumerations, BOOL)
+    are replaced by the conjunction (``forall``) or disjunction (``exists``)
+    of its instances, and those of a non-recursive constructor set by one
+    case per constructor with its arguments bound instead (written out in
+    turn when finite; :func:`expand_finite`).  This is an equivalence, so
     the answer means the same.
 ``model-based quantifier instantiation``
     the same formulas with e-matching switched off (``smt.ematching=false``),
@@ -57,17 +59,43 @@ def _finite_values(s: z3.SortRef) -> list[z3.ExprRef] | None:
     return None
 
 
+def _cases(v: z3.ExprRef, tag: str) -> list[tuple[z3.ExprRef, list[z3.ExprRef]]] | None:
+    """The cases a bound variable ``v`` splits into: ``(value, new bound
+    variables in it)``.  A finite sort gives its values; a constructor set
+    that is not recursive gives one case per constructor, applied to new
+    variables for its arguments (every value of a datatype is some
+    constructor applied to arguments); other sorts give ``None``."""
+    s = v.sort()
+    values = _finite_values(s)
+    if values is not None:
+        return [(x, []) for x in values]
+    if isinstance(s, z3.DatatypeSortRef) and s.num_constructors() > 0:
+        ctors = [s.constructor(k) for k in range(s.num_constructors())]
+        if any(c.domain(j) == s for c in ctors for j in range(c.arity())):
+            return None  # recursive: splitting would not end
+        out: list[tuple[z3.ExprRef, list[z3.ExprRef]]] = []
+        for c in ctors:
+            args = [z3.Const(f"{tag}_{c.name()}_{j}", c.domain(j)) for j in range(c.arity())]
+            out.append((c(*args), args))
+        return out
+    return None
+
+
 def expand_finite(e: z3.ExprRef, depth: int = 0) -> z3.ExprRef:
-    """``e`` (a closed formula) with every quantifier over finite sorts only
-    written out; other quantifiers are kept, with their bodies expanded.
-    Equivalent to ``e``.
+    """``e`` (a closed formula) with every quantifier over finite sorts
+    written out, and every bound variable of a (non-recursive) constructor
+    set split into one case per constructor, whose arguments are bound
+    instead (and written out in turn when their sorts are finite); other
+    bound variables stay quantified.  Equivalent to ``e``.
 
     Each quantifier is opened top-down: its bound variables become constants
     named ``<name>!q<depth>_<k>`` (``!`` never occurs in an encoder's name, and
     the depth keeps nested binders apart), so a body never holds a loose de
     Bruijn index, and the names depend on the formula only (``FreshConst``'s
     counter would carry the process's history into the query).  ``depth`` is
-    the number of enclosing binders (internal).
+    the number of enclosing binders (internal).  At most
+    :data:`MAX_INSTANCES` instances are written per quantifier; beyond that
+    it is kept.
     """
     if z3.is_quantifier(e):
         q = e
@@ -77,12 +105,21 @@ def expand_finite(e: z3.ExprRef, depth: int = 0) -> z3.ExprRef:
         # de Bruijn: variable 0 is the last bound one
         opened = z3.substitute_vars(q.body(), *reversed(names))
         body = expand_finite(opened, depth + 1)
-        domains = [_finite_values(q.var_sort(k)) for k in range(q.num_vars())]
-        if all(d is not None for d in domains):
-            combos = list(itertools.islice(itertools.product(*[d for d in domains if d is not None]),
-                                           MAX_INSTANCES + 1))
+        cases = [_cases(v, f"{v}") for v in names]
+        split = [k for k, c in enumerate(cases) if c is not None]
+        if split:
+            combos = list(itertools.islice(itertools.product(*[cases[k] or [] for k in split]), MAX_INSTANCES + 1))
             if len(combos) <= MAX_INSTANCES:
-                insts = [z3.substitute(body, *zip(names, c)) for c in combos]
+                kept = [v for k, v in enumerate(names) if cases[k] is None]
+                insts = []
+                for combo in combos:
+                    inst = z3.substitute(body, *[(names[k], val) for k, (val, _) in zip(split, combo)])
+                    bound = kept + [a for _, args in combo for a in args]
+                    if not bound:
+                        insts.append(inst)
+                        continue
+                    inner = z3.ForAll(bound, inst) if q.is_forall() else z3.Exists(bound, inst)
+                    insts.append(expand_finite(inner, depth + 1) if any(args for _, args in combo) else inner)
                 return z3.And(*insts) if q.is_forall() else z3.Or(*insts)
         if body.eq(opened):
             return e
