@@ -75,9 +75,9 @@ def prove(goal: z3.BoolRef, hypotheses: Sequence[z3.BoolRef], enc: Encoder | Non
     (:func:`.retry.bounded_solver`) instead of ``timeout_ms``, so the answer
     does not depend on load or history: the query is loaded from its
     canonical SMT-LIB2 text (:func:`.retry.load_canonical`), so not even
-    Z3's term ids or quantifier identifiers of the calling process reach
-    the solver; the model is read back through ``enc``'s names.  Never raises on solver trouble:
-    an unknown answer is ``inconclusive`` with Z3's reason.
+    the calling process's Z3 term ids reach the solver; the model is read
+    back through ``enc``'s symbol names, which the text keeps.  Never raises
+    on solver trouble: an unknown answer is ``inconclusive`` with Z3's reason.
     """
     hyps = list(hypotheses) + (enc.axioms() if enc else [])
     formulas = hyps + [z3.Not(goal)]
@@ -143,13 +143,14 @@ def satisfiable(labelled: Sequence[tuple[str, z3.BoolRef]], enc: Encoder | None 
     for name0, s0, rewrite in attempts(background + [f for _, f in labelled], timeout_ms) if retry else []:
         for name, s2 in variants(name0, s0):
             # loaded untracked from canonical text (tracking changes Z3's search)
-            load_canonical(s2, [rewrite(f) for f in background + [f for _, f in labelled]])
+            load_canonical(s2, [rewrite(g) for g in background + [f for _, f in labelled]])
             r = s2.check()
             dt = round(time.perf_counter() - t0, 4)
             if r == z3.sat:
                 return QueryResult("sat", text, dt, model=render_model(s2.model(), enc), strategy=name)
             if r == z3.unsat:
-                core = _retry_core(background, labelled, rewrite) or labels
+                tracked = _retry_core(background, labelled, rewrite)
+                core = tracked if tracked is not None else labels
                 return QueryResult("unsat", text, round(time.perf_counter() - t0, 4), core=core, strategy=name)
             reasons.append(f"{name}: {s2.reason_unknown()}")
     return QueryResult("inconclusive", text, dt, reason="; ".join(reasons) if len(reasons) > 1 else s.reason_unknown())

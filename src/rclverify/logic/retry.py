@@ -159,11 +159,11 @@ def bounded_solver(*tactics: str) -> z3.Solver:
 def canonical_smt2(formulas: Sequence[z3.BoolRef]) -> str:
     """``formulas`` as SMT-LIB2 text that depends only on their structure.
 
-    Z3's printer names shared subterms and orders declarations by term id,
-    and a quantifier keeps a default identifier drawn from its context's
-    counter: both are history of the process (what it encoded before).  The
-    formulas are first copied into a fresh context, where ids follow the
-    formulas' structure alone, and printed there.
+    Z3's printer names and orders shared subterms by term id, and ids are
+    history of the process (what it encoded before); so, measurably, is the
+    search of a solver whose context was filled by ``translate`` from the
+    process's context.  The formulas are first copied into a fresh context,
+    where ids follow the formulas' structure alone, and printed there.
     """
     ctx = z3.Context()
     s = z3.Solver(ctx=ctx)
