@@ -62,7 +62,9 @@ class SideResult:
     ``model``      RCL name (``in.r``, ``out.radiationStatus``) -> value text,
                    for ``refuted``;
     ``reason``     Z3's reason for ``inconclusive``;
-    ``smt2``       the query as SMT-LIB2; ``duration_s`` its wall time.
+    ``smt2``       the query as SMT-LIB2; ``duration_s`` its wall time;
+    ``strategy``   the retry that decided it (logic/retry.py), '' when Z3's
+                   first attempt did or nothing did.
     """
 
     name: str
@@ -72,6 +74,7 @@ class SideResult:
     reason: str = ""
     smt2: str = ""
     duration_s: float = 0.0
+    strategy: str = ""
 
 
 @dataclass(frozen=True)
@@ -245,7 +248,7 @@ def check_refinement(a: CheckedNode, b: CheckedNode, env: Env, *,
                        "unsat: B guarantees at least what A does")
 
     def side(name: str, stmt: str, q: QueryResult) -> SideResult:
-        return SideResult(name, stmt, q.status, _rename(q.model, a.name), q.reason, q.smt2, q.duration_s)
+        return SideResult(name, stmt, q.status, _rename(q.model, a.name), q.reason, q.smt2, q.duration_s, q.strategy)
 
     conds = tuple(f"{expr_to_rcl(f)}  [environment fact]" for f in facts) + tuple(
         f"{expr_to_rcl(c)}  [condition]" for c in conditions)
@@ -294,7 +297,7 @@ def render(result: RefinementResult, spec_a: str, spec_b: str) -> str:
     lines = [f"Does {spec_b} refine {spec_a}?  (may {result.b} replace {result.a})"]
     for s, label in ((result.assumption, "assumption (A_A -> A_B)"),
                      (result.guarantee, "guarantee  (A_A and G_B -> G_A)")):
-        lines.append(f"  {label}: {s.status}")
+        lines.append(f"  {label}: {s.status}" + (f" (by {s.strategy})" if s.strategy else ""))
         lines.append(f"      {s.statement}")
         if s.status == "refuted" and s.model is not None:
             lines.append("      counterexample:")

@@ -283,6 +283,9 @@ def refinement_finding(node: str, spec: str, r: RefinementResult) -> Finding:
               f"(A_{node} and G_replacement -> G_{node}) {sides[r.guarantee.status]}.")
     if r.conditions:
         detail += " Checked under the plan's environment facts and conditions: " + "; ".join(r.conditions) + "."
+    for x in (r.assumption, r.guarantee):
+        if x.strategy:
+            detail += f" Z3's default strategy gave up on the {x.name} side; answered with {x.strategy}."
     failed = next((s for s in (r.assumption, r.guarantee) if s.status == "refuted"), None)
     if r.verdict == "refines":
         status, msg = "ok", f"The replacement contract {spec} refines {node}: it may replace it."

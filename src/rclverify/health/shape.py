@@ -1,6 +1,6 @@
 """Contract health, part two: what a guarantee actually constrains.
 
-Four checks per node, each reported only when it finds something (a clean
+Three checks per node, each reported only when it finds something (a clean
 contract adds no rows to the report):
 
 ``tautology`` (``problem``)
@@ -10,12 +10,14 @@ contract adds no rows to the report):
     a guarantee that mentions no output of the node: it can only restate
     facts about the inputs, never what the node produces (a guarantee is
     about the node's outputs, paper lines 462-495).
-``unconstrained-output`` (``warning``)
-    an output that no guarantee mentions: nothing the node produces there is
-    promised, so no obligation covers it and consumers may assume nothing.
 ``redundant`` (``warning``)
     a conjunct that Z3 proves from the node's assumption and the node's other
     guarantee conjuncts: it adds nothing (often a sign of a copy-paste slip).
+
+An output that no guarantee mentions is not reported here: the lint's
+``W-unconstrained-output`` (rcl/lint.py) is the one place that says it, so
+the report does not say it twice (docs/architecture.md, "One finding, one
+place").
 
 Conjuncts are the top-level ``and`` operands of each guarantee (a guarantee
 ``forall(v | P -> Q1 and Q2)`` is one conjunct).  The validity queries run
@@ -49,8 +51,8 @@ def outputs_mentioned(e: ast.Expr, cn: CheckedNode) -> set[str]:
 
 
 def shape_findings(checked: Checked, node: str, *, timeout_ms: int = SHAPE_TIMEOUT_MS) -> list[Finding]:
-    """The four checks above on ``node``; returns only the findings that
-    found something, in guarantee order then output order.  Never raises on
+    """The three checks above on ``node``; returns only the findings that
+    found something, in guarantee order.  Never raises on
     solver trouble."""
     cn = checked.nodes[node]
     n = cn.node
@@ -58,10 +60,8 @@ def shape_findings(checked: Checked, node: str, *, timeout_ms: int = SHAPE_TIMEO
     enc = Encoder(checked.env)
     parts: list[tuple[int, int, ast.Expr]] = [(k, j, c) for k, g in enumerate(n.guarantees, 1)
                                              for j, c in enumerate(conjuncts(g.formula), 1)]
-    mentioned: set[str] = set()
     for k, g in enumerate(n.guarantees, 1):
         outs = outputs_mentioned(g.formula, cn)
-        mentioned |= outs
         if not outs and n.outputs:
             out.append(Finding(f"{node}.g{k}.constrains-no-output", node, "constrains-no-output", k, "problem",
                                f"Guarantee {k} of {node} ({_where(g.loc)}) constrains no output: it mentions none of "
@@ -82,13 +82,6 @@ def shape_findings(checked: Checked, node: str, *, timeout_ms: int = SHAPE_TIMEO
                                "Z3 proved it valid with no hypothesis: it promises nothing. Check it says what was "
                                "meant (a comparison of a value with itself, a premise that is always false, ...).",
                                duration_s=r.duration_s, smt2=r.smt2))
-    for o in n.outputs:
-        if o.name not in mentioned:
-            out.append(Finding(f"{node}.out.{o.name}.unconstrained-output", node, "unconstrained-output", None,
-                               "warning",
-                               f"Output {o.name} of {node} ({_where(o.loc)}) is constrained by no guarantee.",
-                               "The contract promises nothing about it: no obligation covers it and a consumer of it "
-                               "may assume nothing."))
     if len(parts) > 1:
         assume = [enc.formula(a.formula, cn) for a in n.assumes]
         for k, j, c in parts:

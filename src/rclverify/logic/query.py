@@ -17,12 +17,12 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass
-from typing import Sequence
+from typing import Callable, Sequence
 
 import z3
 
 from .encode import Encoder, term_to_rcl, value_to_rcl
-from .retry import attempts, bounded_solver
+from .retry import attempts, bounded_solver, load_canonical, variants
 
 DEFAULT_TIMEOUT_MS = 10_000
 
@@ -73,14 +73,17 @@ def prove(goal: z3.BoolRef, hypotheses: Sequence[z3.BoolRef], enc: Encoder | Non
     typing axioms to the hypotheses.  ``deterministic``: run the first
     attempt too in a fresh Z3 context bounded by a resource limit
     (:func:`.retry.bounded_solver`) instead of ``timeout_ms``, so the answer
-    does not depend on load or history.  Never raises on solver trouble:
-    an unknown answer is ``inconclusive`` with Z3's reason.
+    does not depend on load or history: the query is loaded from its
+    canonical SMT-LIB2 text (:func:`.retry.load_canonical`), so not even
+    the calling process's Z3 term ids reach the solver; the model is read
+    back through ``enc``'s symbol names, which the text keeps.  Never raises
+    on solver trouble: an unknown answer is ``inconclusive`` with Z3's reason.
     """
     hyps = list(hypotheses) + (enc.axioms() if enc else [])
     formulas = hyps + [z3.Not(goal)]
     if deterministic:
         s = bounded_solver()
-        s.add(*[f.translate(s.ctx) for f in formulas])
+        load_canonical(s, formulas)
     else:
         s = _solver(timeout_ms)
         s.add(*formulas)
@@ -93,15 +96,16 @@ def prove(goal: z3.BoolRef, hypotheses: Sequence[z3.BoolRef], enc: Encoder | Non
     if r == z3.sat:
         return QueryResult("refuted", text, dt, model=render_model(s.model(), enc))
     reasons = [f"default: {s.reason_unknown()}"]
-    for name, s2, rewrite in attempts(formulas, timeout_ms):
-        s2.add(*[rewrite(f) for f in formulas])
-        r = s2.check()
-        dt = round(time.perf_counter() - t0, 4)
-        if r == z3.unsat:
-            return QueryResult("proved", text, dt, strategy=name)
-        if r == z3.sat:
-            return QueryResult("refuted", text, dt, model=render_model(s2.model(), enc), strategy=name)
-        reasons.append(f"{name}: {s2.reason_unknown()}")
+    for name0, s0, rewrite in attempts(formulas, timeout_ms):
+        for name, s2 in variants(name0, s0):
+            load_canonical(s2, [rewrite(f) for f in formulas])
+            r = s2.check()
+            dt = round(time.perf_counter() - t0, 4)
+            if r == z3.unsat:
+                return QueryResult("proved", text, dt, strategy=name)
+            if r == z3.sat:
+                return QueryResult("refuted", text, dt, model=render_model(s2.model(), enc), strategy=name)
+            reasons.append(f"{name}: {s2.reason_unknown()}")
     return QueryResult("inconclusive", text, dt, reason="; ".join(reasons) if len(reasons) > 1 else s.reason_unknown())
 
 
@@ -135,21 +139,38 @@ def satisfiable(labelled: Sequence[tuple[str, z3.BoolRef]], enc: Encoder | None 
                       key=[lbl for lbl, _ in labelled].index)
         return QueryResult("unsat", text, dt, core=core)
     reasons = [f"default: {s.reason_unknown()}"]
-    for name, s2, rewrite in attempts(background + [f for _, f in labelled], timeout_ms) if retry else []:
-        s2.set("unsat_core", True)
-        s2.add(*[rewrite(f) for f in background])
-        for k, (label, f) in enumerate(labelled):
-            s2.assert_and_track(rewrite(f), z3.Bool(f"__label_{k}", s2.ctx))
-        r = s2.check()
-        dt = round(time.perf_counter() - t0, 4)
-        if r == z3.sat:
-            return QueryResult("sat", text, dt, model=render_model(s2.model(), enc), strategy=name)
-        if r == z3.unsat:
-            core = sorted({trackers[str(c)] for c in s2.unsat_core() if str(c) in trackers},
-                          key=[lbl for lbl, _ in labelled].index)
-            return QueryResult("unsat", text, dt, core=core, strategy=name)
-        reasons.append(f"{name}: {s2.reason_unknown()}")
+    labels = [lbl for lbl, _ in labelled]
+    for name0, s0, rewrite in attempts(background + [f for _, f in labelled], timeout_ms) if retry else []:
+        for name, s2 in variants(name0, s0):
+            # loaded untracked from canonical text (tracking changes Z3's search)
+            load_canonical(s2, [rewrite(g) for g in background + [f for _, f in labelled]])
+            r = s2.check()
+            dt = round(time.perf_counter() - t0, 4)
+            if r == z3.sat:
+                return QueryResult("sat", text, dt, model=render_model(s2.model(), enc), strategy=name)
+            if r == z3.unsat:
+                tracked = _retry_core(background, labelled, rewrite)
+                core = tracked if tracked is not None else labels
+                return QueryResult("unsat", text, round(time.perf_counter() - t0, 4), core=core, strategy=name)
+            reasons.append(f"{name}: {s2.reason_unknown()}")
     return QueryResult("inconclusive", text, dt, reason="; ".join(reasons) if len(reasons) > 1 else s.reason_unknown())
+
+
+def _retry_core(background: Sequence[z3.BoolRef], labelled: Sequence[tuple[str, z3.BoolRef]],
+                rewrite: Callable[[z3.BoolRef], z3.BoolRef]) -> list[str] | None:
+    """Labels of an unsat core of a query a retry found unsat: the formulas
+    tracked as ``label -> formula`` and checked under the labels, in a fresh
+    bounded context; ``None`` when that check is not ``unsat`` (the caller
+    then names every label, which is a core too)."""
+    s = bounded_solver()
+    s.set("smt.ematching", False)
+    s.set("unsat_core", True)
+    load_canonical(s, [rewrite(f) for f in background]
+                   + [z3.Implies(z3.Bool(f"__label_{k}", f.ctx), rewrite(f)) for k, (_, f) in enumerate(labelled)])
+    if s.check(*[z3.Bool(f"__label_{k}", s.ctx) for k in range(len(labelled))]) != z3.unsat:
+        return None
+    found = {str(c) for c in s.unsat_core()}
+    return [lbl for k, (lbl, _) in enumerate(labelled) if f"__label_{k}" in found]
 
 
 def render_model(model: z3.ModelRef, enc: Encoder | None) -> dict[str, str]:

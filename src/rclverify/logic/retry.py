@@ -5,9 +5,11 @@ Quantified formulas are where Z3 gives up.  Before a query is reported
 a deterministic resource limit (:data:`RETRY_RLIMIT`):
 
 ``finite instantiation``
-    every quantifier whose bound variables all range over finite sorts
-    (enumerations, BOOL) is replaced by the conjunction (``forall``) or
-    disjunction (``exists``) of its instances.  This is an equivalence, so
+    every quantifier's bound variables of finite sorts (enumerations, BOOL)
+    are replaced by the conjunction (``forall``) or disjunction (``exists``)
+    of its instances, and those of a non-recursive constructor set by one
+    case per constructor with its arguments bound instead (written out in
+    turn when finite; :func:`expand_finite`).  This is an equivalence, so
     the answer means the same.
 ``model-based quantifier instantiation``
     the same formulas with e-matching switched off (``smt.ematching=false``),
@@ -16,6 +18,12 @@ a deterministic resource limit (:data:`RETRY_RLIMIT`):
     guide's section on quantifiers).  Often finds models for satisfiable
     quantified formulas that the default strategy times out on.
 
+    When that runs out too, the same once more after Z3's ``simplify``
+    tactic on the whole query (:func:`variants`; strategy name
+    :data:`MBQI_SIMPLIFIED`): which of the two finds a model within the
+    limit varies from query to query (on the case study the contract
+    consistency check needs the first, the replacement check the second).
+
 A retry never changes what an answer means: unsat is still unsat, sat still
 comes with a model.  The strategy that answered is recorded on the result
 (``QueryResult.strategy``) and shown in the report.
@@ -23,7 +31,7 @@ comes with a model.  The strategy that answered is recorded on the result
 from __future__ import annotations
 
 import itertools
-from typing import Callable, Sequence
+from typing import Callable, Sequence, cast
 
 import z3
 
@@ -36,6 +44,7 @@ SAFETY_TIMEOUT_MS = 120_000
 
 FINITE = "finite instantiation"
 MBQI = "model-based quantifier instantiation"
+MBQI_SIMPLIFIED = "model-based quantifier instantiation after simplification"
 #: At most this many instances per quantifier are written out.
 MAX_INSTANCES = 256
 
@@ -50,30 +59,73 @@ def _finite_values(s: z3.SortRef) -> list[z3.ExprRef] | None:
     return None
 
 
-def expand_finite(e: z3.ExprRef) -> z3.ExprRef:
-    """``e`` with every quantifier over finite sorts only written out
-    (innermost first); other quantifiers are kept, with their bodies
-    expanded.  Equivalent to ``e``."""
+def _cases(v: z3.ExprRef, tag: str) -> list[tuple[z3.ExprRef, list[z3.ExprRef]]] | None:
+    """The cases a bound variable ``v`` splits into: ``(value, new bound
+    variables in it)``.  A finite sort gives its values; a constructor set
+    that is not recursive gives one case per constructor, applied to new
+    variables for its arguments (every value of a datatype is some
+    constructor applied to arguments); other sorts give ``None``."""
+    s = v.sort()
+    values = _finite_values(s)
+    if values is not None:
+        return [(x, []) for x in values]
+    if isinstance(s, z3.DatatypeSortRef) and s.num_constructors() > 0:
+        ctors = [s.constructor(k) for k in range(s.num_constructors())]
+        if any(c.domain(j) == s for c in ctors for j in range(c.arity())):
+            return None  # recursive: splitting would not end
+        out: list[tuple[z3.ExprRef, list[z3.ExprRef]]] = []
+        for c in ctors:
+            args = [z3.Const(f"{tag}_{c.name()}_{j}", c.domain(j)) for j in range(c.arity())]
+            out.append((c(*args), args))
+        return out
+    return None
+
+
+def expand_finite(e: z3.ExprRef, depth: int = 0) -> z3.ExprRef:
+    """``e`` (a closed formula) with every quantifier over finite sorts
+    written out, and every bound variable of a (non-recursive) constructor
+    set split into one case per constructor, whose arguments are bound
+    instead (and written out in turn when their sorts are finite); other
+    bound variables stay quantified.  Equivalent to ``e``.
+
+    Each quantifier is opened top-down: its bound variables become constants
+    named ``<name>!q<depth>_<k>`` (``!`` never occurs in an encoder's name, and
+    the depth keeps nested binders apart), so a body never holds a loose de
+    Bruijn index, and the names depend on the formula only (``FreshConst``'s
+    counter would carry the process's history into the query).  ``depth`` is
+    the number of enclosing binders (internal).  At most
+    :data:`MAX_INSTANCES` instances are written per quantifier; beyond that
+    it is kept.
+    """
     if z3.is_quantifier(e):
         q = e
-        body = expand_finite(q.body())
         if q.is_lambda():
             return e
-        domains = [_finite_values(q.var_sort(k)) for k in range(q.num_vars())]
-        if all(d is not None for d in domains):
-            combos = list(itertools.islice(itertools.product(*[d for d in domains if d is not None]),
-                                           MAX_INSTANCES + 1))
+        names = [z3.Const(f"{q.var_name(k)}!q{depth}_{k}", q.var_sort(k)) for k in range(q.num_vars())]
+        # de Bruijn: variable 0 is the last bound one
+        opened = z3.substitute_vars(q.body(), *reversed(names))
+        body = expand_finite(opened, depth + 1)
+        cases = [_cases(v, f"{v}") for v in names]
+        split = [k for k, c in enumerate(cases) if c is not None]
+        if split:
+            combos = list(itertools.islice(itertools.product(*[cases[k] or [] for k in split]), MAX_INSTANCES + 1))
             if len(combos) <= MAX_INSTANCES:
-                # de Bruijn: variable 0 is the last bound one
-                insts = [z3.substitute_vars(body, *reversed(c)) for c in combos]
+                kept = [v for k, v in enumerate(names) if cases[k] is None]
+                insts = []
+                for combo in combos:
+                    inst = z3.substitute(body, *[(names[k], val) for k, (val, _) in zip(split, combo)])
+                    bound = kept + [a for _, args in combo for a in args]
+                    if not bound:
+                        insts.append(inst)
+                        continue
+                    inner = z3.ForAll(bound, inst) if q.is_forall() else z3.Exists(bound, inst)
+                    insts.append(expand_finite(inner, depth + 1) if any(args for _, args in combo) else inner)
                 return z3.And(*insts) if q.is_forall() else z3.Or(*insts)
-        if body.eq(q.body()):
+        if body.eq(opened):
             return e
-        names = [z3.FreshConst(q.var_sort(k), q.var_name(k)) for k in range(q.num_vars())]
-        inner = z3.substitute_vars(body, *reversed(names))
-        return z3.ForAll(names, inner) if q.is_forall() else z3.Exists(names, inner)
+        return z3.ForAll(names, body) if q.is_forall() else z3.Exists(names, body)
     if z3.is_app(e) and e.num_args() > 0:
-        kids = [expand_finite(c) for c in e.children()]
+        kids = [expand_finite(c, depth) for c in e.children()]
         return e.decl()(*kids)
     return e
 
@@ -92,19 +144,46 @@ def _has_quantifier(e: z3.ExprRef) -> bool:
     return False
 
 
-def bounded_solver() -> z3.Solver:
+def bounded_solver(*tactics: str) -> z3.Solver:
     """A solver in a fresh Z3 context (so the answer does not depend on what
-    the process encoded before) bounded by :data:`RETRY_RLIMIT`."""
-    s = z3.Solver(ctx=z3.Context())
+    the process encoded before) bounded by :data:`RETRY_RLIMIT`; with
+    ``tactics`` (Z3 tactic names, e.g. ``"simplify", "smt"``), the solver
+    runs them in sequence (models are mapped back to the query's symbols)."""
+    ctx = z3.Context()
+    s = z3.Then(*tactics, ctx=ctx).solver() if len(tactics) > 1 else z3.Solver(ctx=ctx)
     s.set("rlimit", RETRY_RLIMIT)
     s.set("timeout", SAFETY_TIMEOUT_MS)
     return s
 
 
+def canonical_smt2(formulas: Sequence[z3.BoolRef]) -> str:
+    """``formulas`` as SMT-LIB2 text that depends only on their structure.
+
+    Z3's printer names and orders shared subterms by term id, and ids are
+    history of the process (what it encoded before); so, measurably, is the
+    search of a solver whose context was filled by ``translate`` from the
+    process's context.  The formulas are first copied into a fresh context,
+    where ids follow the formulas' structure alone, and printed there.
+    """
+    ctx = z3.Context()
+    s = z3.Solver(ctx=ctx)
+    s.add(*[f.translate(ctx) for f in formulas])
+    return str(s.to_smt2())
+
+
+def load_canonical(s: z3.Solver, formulas: Sequence[z3.BoolRef]) -> None:
+    """Assert ``formulas`` in ``s`` (a solver of its own fresh context) by
+    parsing :func:`canonical_smt2`, so the solver's state, and hence its
+    answer under a resource limit, is a function of the query alone."""
+    s.from_string(canonical_smt2(formulas))
+
+
 def attempts(formulas: Sequence[z3.BoolRef], timeout_ms: int
              ) -> list[tuple[str, z3.Solver, Callable[[z3.BoolRef], z3.BoolRef]]]:
     """The retries that apply to ``formulas`` (none without a quantifier):
-    ``(strategy name, configured solver, rewrite of each formula)``.
+    ``(strategy name, configured solver, rewrite of each formula)``.  The
+    rewrite stays in the formulas' context; load its results into the
+    solver with :func:`load_canonical`.
     ``timeout_ms`` (the first attempt's) is not used: retries are bounded by
     :data:`RETRY_RLIMIT` so that their answers are reproducible."""
     if not any(_has_quantifier(f) for f in formulas):
@@ -113,16 +192,21 @@ def attempts(formulas: Sequence[z3.BoolRef], timeout_ms: int
     changed = [expand_finite(f) for f in formulas]
     if any(not a.eq(b) for a, b in zip(changed, formulas)):
         s = bounded_solver()
-        out.append((FINITE, s, _translating(s.ctx, expand_finite)))
+        out.append((FINITE, s, lambda f: cast(z3.BoolRef, expand_finite(f))))
     s = bounded_solver()
     s.set("smt.ematching", False)
-    out.append((MBQI, s, _translating(s.ctx, lambda f: f)))
+    out.append((MBQI, s, lambda f: f))
     return out
 
 
-def _translating(ctx: z3.Context, rewrite: Callable[[z3.BoolRef], z3.BoolRef]
-                 ) -> Callable[[z3.BoolRef], z3.BoolRef]:
-    """``rewrite`` followed by translation into the solver's context ``ctx``."""
-    def apply(f: z3.BoolRef) -> z3.BoolRef:
-        return rewrite(f).translate(ctx)
-    return apply
+def variants(name: str, s: z3.Solver) -> list[tuple[str, z3.Solver]]:
+    """The solvers to try, in order, for the retry ``name`` whose configured
+    solver is ``s``: ``s`` itself, and for MBQI also MBQI after Z3's
+    ``simplify`` tactic (:data:`MBQI_SIMPLIFIED`), each in its own fresh,
+    resource-bounded context."""
+    out = [(name, s)]
+    if name == MBQI:
+        s2 = bounded_solver("simplify", "smt")
+        s2.set("smt.ematching", False)
+        out.append((MBQI_SIMPLIFIED, s2))
+    return out

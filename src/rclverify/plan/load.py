@@ -320,5 +320,8 @@ def resolve(plan: Plan, checked: Checked) -> None:
     # experiment and review entries name data files and criteria: check them now
     from ..backends.entry_checks import check_entries
     diags.extend(check_entries(plan, checked))
+    # expected verdicts: a malformed entry is an error here, not a report row
+    from .expected import check_expected
+    diags.extend(check_expected(plan, checked))
     if diags:
         raise PlanError(diags)
