@@ -364,3 +364,12 @@ def test_artifact_links_cannot_become_urls() -> None:
     html = render.render_html(rep, link_prefix="", rendering=NO_DOT)
     assert 'href="javascript:' not in html
     assert 'href="javascript%3Aalert%281%29"' in html
+
+
+def test_huge_model_values_are_clipped_in_html_and_markdown_but_kept_in_json() -> None:
+    from rclverify.report.render import CLIP_CHARS, clip
+    value = "ite(" * 5000
+    shown = clip(value)
+    assert shown.startswith(value[:CLIP_CHARS]) and len(shown) < CLIP_CHARS + 80
+    assert f"{len(value) - CLIP_CHARS} more characters in the JSON report" in shown
+    assert clip("short") == "short"

@@ -187,6 +187,21 @@ def link_maker(prefix: str) -> Callable[[str], str]:
     return href
 
 
+#: Longest model value shown in the reports (characters); the JSON report and
+#: the artifacts keep every value whole.
+CLIP_CHARS = 2000
+
+
+def clip(value: Any, limit: int = CLIP_CHARS) -> str:
+    """``str(value)``, cut to ``limit`` characters with a note of how much
+    was left out: a function-table model of a nested quantifier can run to
+    hundreds of thousands of characters, which no reader scrolls through."""
+    text = str(value)
+    if len(text) <= limit:
+        return text
+    return f"{text[:limit]} ... ({len(text) - limit} more characters in the JSON report)"
+
+
 @lru_cache(maxsize=1)
 def environment() -> jinja2.Environment:
     """The report's jinja2 environment.
@@ -209,7 +224,7 @@ def environment() -> jinja2.Environment:
     )
     env.filters.update(
         anchor=anchor, badge=html_badge, md=md_text, code=md_code, fence=md_fence,
-        mdbadge=md_badge, secs=seconds, comment_safe=comment_safe, style=style,
+        mdbadge=md_badge, secs=seconds, comment_safe=comment_safe, style=style, clip=clip,
     )
     env.globals.update(anchor=anchor, rank=rank)
     return env
