@@ -27,10 +27,7 @@ import xml.etree.ElementTree as ET
 from typing import Any, Mapping
 
 from .sarif import split_location
-
-
-def _values(mapping: Mapping[str, Any] | None) -> str:
-    return ", ".join(f"{k} = {v}" for k, v in sorted((mapping or {}).items()))
+from .render import model_text
 
 
 def _case(suite: ET.Element, classname: str, name: str, where: str, seconds: Any) -> ET.Element:
@@ -98,13 +95,13 @@ def junit_tree(report: Mapping[str, Any]) -> ET.Element:
             secs = ev["duration_s"] if ev is not None else 0.0
             case = _case(suite, f"{name}.obligation", str(o["id"]), str(o["source"]), secs)
             expl = str(ev["explanation"]) if ev is not None else reasons.get(str(o["id"]), "no evidence record yet")
-            cex = _values(ev.get("counterexample")) if ev is not None else ""
+            cex = model_text(ev.get("counterexample")) if ev is not None else ""
             tally(case, str(o["status"]), expl.splitlines()[0] if expl else str(o["status"]),
                   _lines(f"obligation ({o['backend']}, {o['kind']}) of guarantee {o['guarantee']}: {o['statement']}",
                          f"source: {o['source']}", expl, f"counterexample: {cex}" if cex else ""), secs)
         for sc in by_node.get(name, {}).get("side_conditions", ()):
             case = _case(suite, f"{name}.side_condition", str(sc["id"]), str(sc["source"]), sc.get("duration_s"))
-            model = _values(sc.get("model"))
+            model = model_text(sc.get("model"))
             tally(case, str(sc["status"]), str(sc.get("explanation") or sc["status"]),
                   _lines(f"side condition ({sc['rule']}): {sc['conjunct']}", f"source: {sc['source']}",
                          str(sc.get("explanation") or ""), f"counterexample: {model}" if model else ""),
@@ -112,7 +109,7 @@ def junit_tree(report: Mapping[str, Any]) -> ET.Element:
         for f in by_node.get(name, {}).get("findings", ()):
             case = _case(suite, f"{name}.health", str(f["id"]), _source_of(node, f), f.get("duration_s"))
             core = "; ".join(str(c) for c in f.get("core") or [])
-            model = _values(f.get("model"))
+            model = model_text(f.get("model"))
             tally(case, str(f["status"]), str(f["message"]),
                   _lines(str(f["message"]), str(f.get("explanation") or ""), f"unsat core: {core}" if core else "",
                          f"counterexample: {model}" if model else ""), f.get("duration_s"))

@@ -202,6 +202,13 @@ def clip(value: Any, limit: int = CLIP_CHARS) -> str:
     return f"{text[:limit]} ... ({len(text) - limit} more characters in the JSON report)"
 
 
+def model_text(model: Mapping[str, Any] | None) -> str:
+    """``name = value, ...`` of a model or counterexample, sorted by name,
+    each value clipped (:func:`clip`); ``""`` for none.  For the one-line
+    messages of SARIF and JUnit."""
+    return ", ".join(f"{k} = {clip(v)}" for k, v in sorted((model or {}).items()))
+
+
 @lru_cache(maxsize=1)
 def environment() -> jinja2.Environment:
     """The report's jinja2 environment.

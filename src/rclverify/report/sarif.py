@@ -27,6 +27,7 @@ from dataclasses import dataclass
 from typing import Any, Mapping, Sequence
 
 from ..evidence.store import dumps
+from .render import model_text
 
 #: The SARIF version written and the schema it validates against.
 SARIF_VERSION = "2.1.0"
@@ -113,12 +114,6 @@ def _location(text: str) -> list[dict[str, Any]]:
     return [{"physicalLocation": {"artifactLocation": {"uri": file, "uriBaseId": SRCROOT}, "region": region}}]
 
 
-def _values(mapping: Mapping[str, Any] | None) -> str:
-    if not mapping:
-        return ""
-    return ", ".join(f"{k} = {v}" for k, v in sorted(mapping.items()))
-
-
 def _result(rule: str, level: str, text: str, where: str, key: str, props: Mapping[str, Any]) -> dict[str, Any]:
     return {"ruleId": rule, "level": level, "message": {"text": text}, "locations": _location(where),
             "partialFingerprints": {"rclverifyItem/v1": key}, "properties": dict(props)}
@@ -143,7 +138,7 @@ def _obligation_results(report: Mapping[str, Any]) -> list[dict[str, Any]]:
         if expl:
             words.append(expl)
         if ev is not None and ev.get("counterexample"):
-            words.append(f"Counterexample: {_values(ev['counterexample'])}.")
+            words.append(f"Counterexample: {model_text(ev['counterexample'])}.")
         props = {"obligation": o["id"], "node": o["node"], "guarantee": o["guarantee"], "backend": o["backend"],
                  "status": o["status"]}
         if ev is not None and ev.get("counterexample"):
@@ -163,7 +158,7 @@ def _side_condition_results(report: Mapping[str, Any]) -> list[dict[str, Any]]:
         if sc.get("explanation"):
             words.append(str(sc["explanation"]))
         if sc.get("model"):
-            words.append(f"Counterexample: {_values(sc['model'])}.")
+            words.append(f"Counterexample: {model_text(sc['model'])}.")
         props = {"sideCondition": sc["id"], "node": sc["node"], "rule": sc["rule"], "status": status}
         out.append(_result(rule, RULES[rule].level, " ".join(words), str(sc["source"]), f"side-condition:{sc['id']}",
                            props))
@@ -193,7 +188,7 @@ def _finding_results(report: Mapping[str, Any]) -> list[dict[str, Any]]:
         if f.get("core"):
             words.append("Unsat core: " + "; ".join(str(c) for c in f["core"]) + ".")
         if f.get("model"):
-            words.append(f"Counterexample: {_values(f['model'])}.")
+            words.append(f"Counterexample: {model_text(f['model'])}.")
         props = {"finding": f["id"], "node": f["node"], "check": f["check"], "status": f["status"]}
         out.append(_result(rule, RULES[rule].level, " ".join(words), _finding_location(report, f),
                            f"health:{f['id']}", props))
