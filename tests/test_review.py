@@ -131,3 +131,14 @@ def test_conjuncts_split_at_top_level_and_only() -> None:
     f = parse_formula("out.a == 1 and (out.b == 2 and out.c == 3) and (out.d == 1 or out.e == 2)", "x.rcl", 1, 1)
     parts = _conjuncts(f)
     assert len(parts) == 4 and [p.loc.col for p in parts][:2] == [1, 17]
+
+
+def test_an_alias_bomb_in_a_review_record_is_refused_before_expansion() -> None:
+    from rclverify.backends.review.record import parse_record
+    from rclverify.plan.errors import PlanError
+    bomb = "a: &a [x, x, x, x, x, x, x, x, x, x]\n" + "".join(
+        f"{chr(98 + k)}: &{chr(98 + k)} [*{chr(97 + k)}, *{chr(97 + k)}, *{chr(97 + k)}, *{chr(97 + k)}, "
+        f"*{chr(97 + k)}, *{chr(97 + k)}, *{chr(97 + k)}, *{chr(97 + k)}, *{chr(97 + k)}, *{chr(97 + k)}]\n"
+        for k in range(8))
+    with pytest.raises(PlanError, match="alias bomb"):
+        parse_record(bomb, "backends/review/bomb.yaml")

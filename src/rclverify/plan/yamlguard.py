@@ -1,4 +1,4 @@
-"""Bounds on the YAML the tool reads (the verification plan).
+"""Bounds on the YAML the tool reads (the plan and the files it names).
 
 PyYAML's composer keeps an alias as a second reference to the anchored node,
 so a small file can describe an exponentially large document (the "billion
@@ -15,6 +15,10 @@ alias.  This module refuses such input before that happens:
                                 linear in the file) and refuses more than
                                 :data:`MAX_YAML_NODES`, an alias cycle, or
                                 nesting deeper than :data:`MAX_YAML_DEPTH`.
+
+``safe_load_guarded(text, file)``  ``yaml.safe_load`` after the same checks: for
+                                every other YAML file the plan names (review
+                                records, summary statistics, trace mappings).
 
 Every refusal is a :class:`~rclverify.plan.errors.PlanError` located in the
 file (``E-yaml-limit``); memory stays bounded by the file size.  The limits
@@ -106,3 +110,13 @@ def compose_guarded(text: str, file: str) -> yaml.Node | None:
             if id(c) not in size:
                 stack.append((c, depth + 1, False))
     return root
+
+
+def safe_load_guarded(text: str, file: str) -> object:
+    """``yaml.safe_load(text)`` once :func:`compose_guarded` has accepted it.
+
+    Raises ``yaml.YAMLError`` for malformed YAML and ``PlanError`` (located in
+    ``file``) for input over a limit, before any alias is expanded."""
+    if compose_guarded(text, file) is None:
+        return None
+    return yaml.safe_load(text)

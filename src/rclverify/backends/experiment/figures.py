@@ -27,6 +27,8 @@ from dataclasses import dataclass
 from fractions import Fraction
 from typing import Any, Mapping
 
+from ...plan.yamlguard import safe_load_guarded
+
 #: unit -> (dimension, factor to the base unit).  Base units: m, s.
 UNITS: Mapping[str, tuple[str, Fraction]] = {
     "": ("1", Fraction(1)),
@@ -108,7 +110,7 @@ def load_summary(text: str, file: str) -> Figures:
     """Read a summary-statistics YAML text.  Raises :class:`DataError`."""
     import yaml
     try:
-        data = yaml.safe_load(text)
+        data = safe_load_guarded(text, file)
     except yaml.YAMLError as exc:
         raise DataError(f"{file}: invalid YAML: {getattr(exc, 'problem', exc)}") from None
     if not isinstance(data, dict):

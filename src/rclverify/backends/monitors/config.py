@@ -20,6 +20,7 @@ from typing import Any, Mapping
 import yaml
 
 from ...traces.mapping import TopicRule, load_rules
+from ...plan.yamlguard import safe_load_guarded
 
 DEFAULT_MAPPING = "backends/monitors/mapping.yaml"
 DEFAULT_HORIZON = 5.0
@@ -60,7 +61,7 @@ def load_mapping(root: Path, rel: str | None, horizon: Any = None, traces: Any =
     raw: Any = {}
     if path.is_file():
         try:
-            raw = yaml.safe_load(path.read_text(encoding="utf-8")) or {}
+            raw = safe_load_guarded(path.read_text(encoding="utf-8"), rel or DEFAULT_MAPPING) or {}
         except yaml.YAMLError as exc:
             mark = getattr(exc, "problem_mark", None)
             line = f"{mark.line + 1}:{mark.column + 1}" if mark is not None else "1:1"

@@ -28,6 +28,7 @@ import yaml
 from ...rcl import ast
 from ...rcl.printer import expr_to_rcl
 from ...rcl.types import CheckedNode
+from ...plan.yamlguard import safe_load_guarded
 
 
 class RecordError(ValueError):
@@ -95,7 +96,7 @@ def _answer(v: Any, where: str) -> str | None:
 def parse_record(text: str, file: str) -> ReviewRecord:
     """Parse and validate a record's text.  Raises :class:`RecordError`."""
     try:
-        data = yaml.safe_load(text)
+        data = safe_load_guarded(text, file)
     except yaml.YAMLError as exc:
         raise RecordError(f"{file}: invalid YAML: {getattr(exc, 'problem', exc)}") from None
     if not isinstance(data, dict):
