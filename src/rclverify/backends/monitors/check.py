@@ -33,6 +33,8 @@ from collections import deque
 from dataclasses import dataclass, field
 from typing import Any, Iterable, Mapping
 
+import z3
+
 from ...logic.concrete import check_concrete
 from ...logic.evaluate import evaluate, why_undecided
 from ...rcl import ast
@@ -157,7 +159,7 @@ class NodeMonitor:
             if "no value for" not in reason:  # undecided directly: Z3 on the concrete values
                 try:
                     v, reason = check_concrete(formula, self.checked, self.node, values)
-                except Exception as exc:  # the Z3 checker's own failure: undecided, with its reason
+                except (ValueError, KeyError, z3.Z3Exception) as exc:  # a value Z3 cannot take: undecided, with the reason
                     v, reason = None, f"{reason}; Z3 on concrete values failed: {exc}"
         if self.cache_size:
             if len(self._cache) >= self.cache_size:
