@@ -396,3 +396,35 @@ def test_version_detection_picks_the_command_line_generation(tmp_path: Path) -> 
     assert verify_argv(t4, ["a.dfy"], 30)[:4] == [new, "verify", "--verification-time-limit", "30"]
     assert verify_argv(t2, ["a.dfy"], 30)[:4] == [old, "/compile:0", "/nologo", "/timeLimit:30"]
     assert detect(_fake_dafny(tmp_path, "other", "echo hello\n")) is None
+
+
+TUPLES = """\
+node n { inputs(a : INTEGER, p : (REAL, REAL)) outputs(o : <NATURAL>)
+  guarantee((in.a, in.a) in NATURAL.INTEGER and in.p in REAL.INTEGER)
+  guarantee(in.p == (1, 2) -> out.o == <>)
+}
+"""
+
+
+def test_qualified_builtins_and_tuple_literals_translate_to_dafny_that_resolves(tmp_path: Path) -> None:
+    import subprocess
+
+    from rclverify.rcl.parser import parse_text
+    from rclverify.rcl.typecheck import check
+    spec = parse_text(TUPLES)
+    c = check([spec])
+    tr = Translator(c.env, c.nodes["n"], {"in.a": "a", "in.p": "p", "out.o": "o"})
+    g1, g2 = (tr.formula(g.formula) for g in spec.nodes[0].guarantees)
+    # `(x, y) in NATURAL.INTEGER`: the first component is a natural, the second any integer.
+    assert "(a, a).0 >= 0" in g1 and "p.1.Floor as real) == p.1" in g1
+    # the integer tuple literal is widened component by component to (real, real)
+    assert "(1, 2).0 as real" in g2 and "o == []" in g2
+    if not HAVE_DAFNY:
+        pytest.skip("dafny is not installed")
+    src = tmp_path / "t.dfy"
+    src.write_text(f"method M(a: int, p: (real, real), o: seq<nat>)\n  requires {g1}\n  requires {g2}\n{{\n}}\n")
+    from rclverify.backends.dafny.runner import detect, verify_argv
+    tool = detect(str(find_dafny()))
+    assert tool is not None
+    out = subprocess.run(verify_argv(tool, [str(src)], 60), capture_output=True, text=True, timeout=300)
+    assert "0 errors" in out.stdout, out.stdout

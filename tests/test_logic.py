@@ -98,10 +98,12 @@ def test_the_case_study_encodes() -> None:
     assert "Agent.out.command" in enc.symbols and "RadiationSensor.in.r" in enc.symbols
 
 
-def test_tuple_literals_are_a_located_encoding_error(checked: Checked) -> None:
+def test_tuple_literals_encode_and_an_unsorted_empty_literal_is_a_located_error(checked: Checked) -> None:
     enc = Encoder(checked.env)
+    pair = enc.term(parse_formula("(1, 2)", "f.rcl", 3, 7), checked.nodes["N"])
+    assert pair.sort().name() == "Tuple_Int_Int"
     with pytest.raises(EncodingError) as info:
-        enc.term(parse_formula("(1, 2)", "f.rcl", 3, 7), checked.nodes["N"])
+        enc.term(parse_formula("<>", "f.rcl", 3, 7), checked.nodes["N"])
     assert str(info.value).startswith("f.rcl:3:7: error:")
 
 

@@ -19,6 +19,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
+from rclverify.logic.encode import Encoder, EncodingError
 from rclverify.plan.load import read_plan_data
 from rclverify.rcl.errors import RclError
 from rclverify.rcl.filewarn import file_warnings
@@ -37,7 +38,7 @@ VOCAB = ["(", ")", "{", "}", "<", ">", "<>", ",", ";", ":", "|", "=", "==", "!="
          "exists!(", "A(", "G(", "assume(", "guarantee(", "node", "context", "inputs(", "outputs(", "topics(",
          "matches", "set(", "seq(", "REAL", "INTEGER", "NATURAL", "BOOL", "STRING", "TRUE", "FALSE", "0", "1",
          "2.5", "1e400", '"s"', '"', "'", "in.a", "out.o", "a", "o", "u", "v", "(u, v)", "[", "]", "/*", "*/",
-         "//", "\n", "\t", "é", "\x00", "pkg/Msg"]
+         "//", "\n", "\t", "é", "\x00", "pkg/Msg", ".", "REAL.REAL", "NATURAL.INTEGER", "(1, 2)", "(in.a, 1)"]
 
 FUZZ = settings(derandomize=True, deadline=None, database=None, max_examples=800,
                 suppress_health_check=list(HealthCheck))
@@ -55,11 +56,20 @@ def run_front_end(text: str) -> None:
     file_warnings(spec)
     lint(spec)
     try:
-        check([spec])
+        checked = check([spec])
     except RclError as e:
         assert e.diagnostics and all(d.loc.line >= 1 for d in e.diagnostics), e
         return
     to_latex(spec)
+    # The Z3 encoding the calculus and health checks use: a located
+    # EncodingError for what it does not support, never anything else.
+    enc = Encoder(checked.env)
+    for n in spec.nodes:
+        for clause in n.assumes + n.guarantees:
+            try:
+                enc.formula(clause.formula, checked.nodes[n.name])
+            except EncodingError as e:
+                assert ":" in str(e), e
 
 
 mutation = st.tuples(st.sampled_from(["insert", "delete", "replace", "duplicate"]),

@@ -15,6 +15,7 @@ import z3
 from rclverify import __version__
 from rclverify.cli import main
 from rclverify.logic.encode import Encoder, EncodingError
+from rclverify.logic.evaluate import evaluate
 from rclverify.plan.errors import PlanError
 from rclverify.plan.load import load_plan
 from rclverify.rcl import ast
@@ -158,6 +159,55 @@ def test_z3_meaning_of_strings_ranges_and_tuple_binders() -> None:
     assert _z3(node("guarantee(forall((u, v) in Pair | u == v or u != v))", ctx=ctx, io=io)) == z3.unsat
     # Not valid: a set of pairs may hold a pair with distinct components.
     assert _z3(node("guarantee(forall((u, v) in in.p | u == v))", ctx=ctx, io=io)) == z3.sat
+
+
+def test_qualified_builtin_terms_are_products_of_base_types() -> None:
+    # The original tool's localisation contract: `(x, y) in REAL.REAL` is the
+    # pair (x, y) ranging over REAL x REAL.
+    ctx = "Pos : REAL x REAL --> BOOL ;"
+    io = "inputs() outputs(position : Pos)"
+    src = node("guarantee(exists_unique((x, y) in REAL.REAL | out.position(x, y) == TRUE))\n"
+               "guarantee(forall(p in NATURAL.INTEGER | p in INTEGER.INTEGER))\n"
+               "guarantee(forall(a, b in REAL | (a, b) in REAL.REAL and (1, -1) !in NATURAL.NATURAL))",
+               ctx=ctx, io=io)
+    spec, c = checked(src)
+    assert "REAL.REAL" in to_rcl(spec) and "NATURAL.INTEGER" in to_rcl(spec)
+    assert r"\mathbb{N} \times \mathbb{Z}" in to_latex(spec)
+    assert _z3(src, 1) == z3.unsat  # every (NATURAL, INTEGER) pair is a pair of integers
+    assert _z3(src, 2) == z3.unsat  # (1, -1) has a negative component
+    # Not valid the other way round: (0, -1) is an integer pair, not a natural one.
+    assert _z3(node("guarantee(forall(p in INTEGER.INTEGER | p in NATURAL.NATURAL))")) == z3.sat
+    assert _z3(node("guarantee(forall((u, v) in NATURAL.REAL | u >= 0))")) == z3.unsat
+
+
+def test_qualified_builtin_terms_must_name_base_types_and_fit_the_element() -> None:
+    with pytest.raises(RclError, match=r"<string>:2:28: error: unexpected character '\.'"):
+        parse_text(node("guarantee(forall(p in REAL.FOO | TRUE))"))
+    with pytest.raises(RclError, match=r"2:25: error: membership of a \(NATURAL, NATURAL, NATURAL\) in a collection of \(REAL, REAL\)"):
+        check([parse_text(node("guarantee((1, 2, 3) in REAL.REAL)"))])
+
+
+def test_monitor_evaluates_builtin_terms_on_the_right_of_in() -> None:
+    src = node("guarantee((in.a, in.a) in NATURAL.INTEGER and in.a in NATURAL)")
+    spec, c = checked(src)
+    f = spec.nodes[0].guarantees[0].formula
+    assert evaluate(f, c, c.nodes["n"], {"in.a": 3, "out.o": 0}) is True
+    assert evaluate(f, c, c.nodes["n"], {"in.a": -3, "out.o": 0}) is False
+    assert evaluate(f, c, c.nodes["n"], {"in.a": 0.5, "out.o": 0}) is False
+
+
+def test_z3_meaning_of_tuple_literals_and_empty_literals() -> None:
+    io = "inputs(p : (REAL, REAL), s : set((NATURAL, NATURAL)), q : <NATURAL>) outputs(o : <NATURAL>)"
+    assert _z3(node("guarantee((1, 2) == (1, 2) and (1, 2) != (2, 1))", io=io)) == z3.unsat
+    # Tuple literals of integers compare with tuples of reals component by component.
+    assert _z3(node("guarantee(in.p == (1, 2) -> in.p != (1.5, 2))", io=io)) == z3.unsat
+    assert _z3(node("guarantee(in.p == (1, 2) -> in.p == (1.5, 2))", io=io)) == z3.sat
+    assert _z3(node("guarantee((1, 2) in {(1, 2), (3, 4)} and (2, 1) !in {(1, 2), (3, 4)})", io=io)) == z3.unsat
+    assert _z3(node("guarantee(in.s == {(0, 0)} -> (0, 0) in in.s)", io=io)) == z3.unsat
+    # The empty literal takes the sort of the other side of the comparison.
+    assert _z3(node("guarantee(out.o == <> -> not (3 in out.o))", io=io)) == z3.unsat
+    assert _z3(node("guarantee(in.q != <> or in.s == {})", io=io)) == z3.sat
+    assert _z3(node("guarantee(<> == <> and {} == {})", io=io)) == z3.unsat
 
 
 def test_unsupported_encodings_are_located_errors() -> None:

@@ -32,7 +32,7 @@ import z3
 
 from ..rcl import ast
 from ..rcl.types import (BOOL, NATURAL, CheckedNode, DataT, EmptyT, EnumT, Env, FuncT, Scalar, SeqT,
-                         SetT, TupleT, Type)
+                         SetT, TupleT, Type, qualified_base)
 from ..rcl.printer import FLAT_CHAINS, chain_operands, is_type
 from ..rcl.typecheck import domain_type
 
@@ -89,10 +89,7 @@ def sort_of(t: Type) -> z3.SortRef:
             dt.declare(cname, *[(f"{cname}_{k}", sort_of(a)) for k, a in enumerate(args)])
         s = dt.create()
     elif isinstance(t, TupleT):
-        name = "Tuple_" + "_".join(str(sort_of(e)) for e in t.elems)
-        dt = z3.Datatype(name)
-        dt.declare("mk_" + name, *[(f"{name}_{k}", sort_of(e)) for k, e in enumerate(t.elems)])
-        s = dt.create()
+        s = tuple_sort([sort_of(e) for e in t.elems])
     elif isinstance(t, SetT):
         s = z3.SetSort(sort_of(t.elem))
     elif isinstance(t, SeqT):
@@ -137,19 +134,69 @@ class Symbol:
     decl: Any  # z3.ExprRef for constants, z3.FuncDeclRef for functions
 
 
+def tuple_sort(fields: list[z3.SortRef]) -> z3.SortRef:
+    """The Z3 datatype for tuples whose components have sorts ``fields``.
+
+    One sort per list of component sorts (named ``Tuple_<sorts>``, with the
+    constructor ``mk_Tuple_<sorts>`` and accessors ``Tuple_<sorts>_<k>``), so
+    a tuple literal ``(1, 2)`` and a variable of type ``(NATURAL, INTEGER)``
+    share a sort (both components are Z3 ``Int``).
+    """
+    name = "Tuple_" + "_".join(str(f) for f in fields)
+    if name not in _TUPLE_SORTS:
+        dt = z3.Datatype(name)
+        dt.declare("mk_" + name, *[(f"{name}_{k}", f) for k, f in enumerate(fields)])
+        _TUPLE_SORTS[name] = dt.create()
+    return _TUPLE_SORTS[name]
+
+
+_TUPLE_SORTS: dict[str, z3.SortRef] = {}
+
+
+def _tuple_fields(s: z3.SortRef) -> list[z3.SortRef] | None:
+    """The component sorts of a tuple sort made by :func:`tuple_sort`, else ``None``."""
+    if s.kind() != z3.Z3_DATATYPE_SORT or not s.name().startswith("Tuple_"):
+        return None
+    c = cast(z3.DatatypeSortRef, s).constructor(0)
+    return [c.domain(k) for k in range(c.arity())]
+
+
+def _is_empty_literal(x: ast.Expr) -> bool:
+    return isinstance(x, (ast.SetLit, ast.SeqLit)) and not x.items
+
+
+def _join_sort(a: z3.SortRef, b: z3.SortRef) -> z3.SortRef:
+    """The sort both ``a`` and ``b`` widen to: Real over Int, componentwise
+    for tuples of equal length; ``a`` when there is none (Z3 then reports the
+    mismatch, which the type checker has already ruled out)."""
+    if a == b:
+        return a
+    if {a, b} == {z3.IntSort(), z3.RealSort()}:
+        return z3.RealSort()
+    fa, fb = _tuple_fields(a), _tuple_fields(b)
+    if fa is not None and fb is not None and len(fa) == len(fb):
+        return tuple_sort([_join_sort(x, y) for x, y in zip(fa, fb)])
+    return a
+
+
 def coerce(a: z3.ExprRef, b: z3.ExprRef) -> tuple[z3.ExprRef, z3.ExprRef]:
-    """Widen Int to Real when one side is Real (NATURAL <: INTEGER <: REAL)."""
-    if z3.is_int(a) and z3.is_real(b):
-        return z3.ToReal(a), b
-    if z3.is_real(a) and z3.is_int(b):
-        return a, z3.ToReal(b)
-    return a, b
+    """Widen Int to Real when one side is Real (NATURAL <: INTEGER <: REAL),
+    componentwise for tuples (``(1, 2) == p`` with ``p : (REAL, REAL)``)."""
+    s = _join_sort(a.sort(), b.sort())
+    return widen(a, s), widen(b, s)
 
 
 def widen(x: z3.ExprRef, s: z3.SortRef) -> z3.ExprRef:
-    """``x`` as a value of sort ``s`` (an Int widened to Real when ``s`` is Real)."""
+    """``x`` as a value of sort ``s`` (an Int widened to Real when ``s`` is
+    Real; a tuple rebuilt component by component when ``s`` is a wider tuple
+    sort); ``x`` itself otherwise."""
     if s == z3.RealSort() and z3.is_int(x):
         return z3.ToReal(x)
+    fs, fx = _tuple_fields(s), _tuple_fields(x.sort())
+    if fs is not None and fx is not None and len(fs) == len(fx) and x.sort() != s:
+        xs = cast(z3.DatatypeSortRef, x.sort())
+        return cast(z3.DatatypeSortRef, s).constructor(0)(
+            *[widen(xs.accessor(0, k)(x), f) for k, f in enumerate(fs)])
     return x
 
 
@@ -403,7 +450,12 @@ class _Ctx:
         return self._close(x.kind, xs, guards, self.enc(x.body, inner))
 
     def e_Compare(self, x: ast.Compare, b: Mapping[str, Any]) -> Any:
-        vals = [self.enc(o, b) for o in x.operands]
+        vals = [None if _is_empty_literal(o) else self.enc(o, b) for o in x.operands]
+        for k, o in enumerate(x.operands):
+            if vals[k] is None:
+                # `out.route == <>`: the empty literal takes its neighbour's sort.
+                near = [v for v in vals[max(k - 1, 0):k + 2] if v is not None]
+                vals[k] = self.empty_literal(cast(ast.SetLit | ast.SeqLit, o), near[0].sort() if near else None)
         parts = [apply_operator(op, l, r) for op, l, r in zip(x.ops, vals, vals[1:])]
         return parts[0] if len(parts) == 1 else z3.And(*parts)
 
@@ -423,10 +475,21 @@ class _Ctx:
                 and coll.name not in self.node.inputs and coll.name not in self.node.outputs:
             t = env.types[coll.name]
             return elem >= 0 if t == NATURAL else z3.BoolVal(True)
+        if isinstance(coll, ast.Var) and coll.prefix is None and coll.name not in b \
+                and (product := qualified_base(coll.name)) is not None:
+            return self.in_product(elem, product, coll.loc)
         s = self.enc(coll, b)
         if z3.is_seq(s):
-            return z3.Contains(s, z3.Unit(elem))
-        return z3.IsMember(elem, s)
+            return z3.Contains(s, z3.Unit(widen(elem, cast(z3.SeqSortRef, s.sort()).basis())))
+        return z3.IsMember(widen(elem, cast(z3.ArraySortRef, s.sort()).domain()), s)
+
+    def in_product(self, elem: Any, product: TupleT, loc: ast.Loc) -> Any:
+        """``(x, y) in REAL.REAL``: each component in its base type."""
+        fields = _tuple_fields(elem.sort())
+        if fields is None or len(fields) != len(product.elems):
+            raise EncodingError(loc, f"membership in {product} needs a tuple of {len(product.elems)} components")
+        acc = cast(z3.DatatypeSortRef, elem.sort()).accessor
+        return z3.And(*[self.in_base(acc(0, k)(elem), cast(Scalar, t).name) for k, t in enumerate(product.elems)])
 
     @staticmethod
     def in_base(elem: Any, base: str) -> Any:
@@ -442,21 +505,48 @@ class _Ctx:
 
     def e_SetLit(self, x: ast.SetLit, b: Mapping[str, Any]) -> Any:
         if not x.items:
-            raise EncodingError(x.loc, "an empty set literal is only supported on the right of 'in'")
+            raise EncodingError(x.loc, "an empty set literal is only supported where its element type is known "
+                                       "(compared with a set, or on the right of 'in')")
         items = [self.enc(i, b) for i in x.items]
-        s = z3.EmptySet(items[0].sort())
+        elem = items[0].sort()
+        for i in items[1:]:
+            elem = _join_sort(elem, i.sort())
+        s = z3.EmptySet(elem)
         for i in items:
-            s = z3.SetAdd(s, i)
+            s = z3.SetAdd(s, widen(i, elem))
         return s
 
     def e_SeqLit(self, x: ast.SeqLit, b: Mapping[str, Any]) -> Any:
         if not x.items:
-            raise EncodingError(x.loc, "an empty sequence literal is not supported here")
-        items = [z3.Unit(self.enc(i, b)) for i in x.items]
-        return items[0] if len(items) == 1 else z3.Concat(*items)
+            raise EncodingError(x.loc, "an empty sequence literal is only supported where its element type is "
+                                       "known (compared with a sequence, or on the right of 'in')")
+        items = [self.enc(i, b) for i in x.items]
+        elem = items[0].sort()
+        for i in items[1:]:
+            elem = _join_sort(elem, i.sort())
+        units = [z3.Unit(widen(i, elem)) for i in items]
+        return units[0] if len(units) == 1 else z3.Concat(*units)
+
+    def empty_literal(self, x: ast.SetLit | ast.SeqLit, like: z3.SortRef | None) -> Any:
+        """``{}`` or ``<>`` as a value of sort ``like`` (the other side of a
+        comparison); of integers when both sides are empty literals, where
+        the element type does not matter.  Raises :class:`EncodingError`
+        when ``like`` is not a set (sequence) sort."""
+        if isinstance(x, ast.SeqLit):
+            if like is None:
+                return z3.Empty(z3.SeqSort(z3.IntSort()))
+            if isinstance(like, z3.SeqSortRef):
+                return z3.Empty(like)
+        else:
+            if like is None:
+                return z3.EmptySet(z3.IntSort())
+            if isinstance(like, z3.ArraySortRef) and like.range() == z3.BoolSort():
+                return z3.EmptySet(like.domain())
+        raise EncodingError(x.loc, f"an empty literal compared with a value of Z3 sort {like}")
 
     def e_TupleLit(self, x: ast.TupleLit, b: Mapping[str, Any]) -> Any:
-        raise EncodingError(x.loc, "tuple literals are not supported by the Z3 encoding yet")
+        items = [self.enc(i, b) for i in x.items]
+        return cast(z3.DatatypeSortRef, tuple_sort([i.sort() for i in items])).constructor(0)(*items)
 
     def e_Quant(self, x: ast.Quant, b: Mapping[str, Any]) -> Any:
         inner = dict(b)

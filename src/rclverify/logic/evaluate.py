@@ -29,7 +29,7 @@ from typing import Any, Callable, Iterable, Mapping
 from ..rcl import ast
 from ..rcl import types as T
 from ..rcl.types import Checked, CheckedNode
-from ..values import FiniteFunction, Term
+from ..values import FiniteFunction, Term, conforms
 
 
 class Undecided(Exception):
@@ -289,6 +289,10 @@ class Evaluator:
             return all(_CMP[op](x, y) for op, x, y in zip(e.ops, vals, vals[1:]))
         if isinstance(e, ast.Member):
             x = self.eval(e.elem, b)
+            carrier = self.carrier(e.collection, b)
+            if carrier is not None:  # `x in NATURAL`, `(x, y) in REAL.REAL`
+                inside = conforms(x, carrier) is None
+                return (not inside) if e.negated else inside
             coll = self.collection(e.collection, b)
             return (x not in coll) if e.negated else (x in coll)
         if isinstance(e, ast.SetLit):
@@ -298,6 +302,15 @@ class Evaluator:
         if isinstance(e, ast.Quant):
             return self.quant(e, b)
         raise Undecided(f"cannot evaluate {type(e).__name__}")
+
+    def carrier(self, e: Any, b: Mapping[str, Any]) -> T.Type | None:
+        """The type a built-in term on the right of ``in`` stands for
+        (``NATURAL``, or the product ``REAL.REAL``), else ``None``."""
+        if not isinstance(e, ast.Var) or e.prefix is not None or e.name in b:
+            return None
+        if e.name in T.BASE_NAMES:
+            return T.Scalar(e.name)
+        return T.qualified_base(e.name)
 
     def collection(self, e: Any, b: Mapping[str, Any]) -> Any:
         if isinstance(e, ast.SetLit):

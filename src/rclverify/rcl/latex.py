@@ -27,6 +27,7 @@ from typing import Union
 import jinja2
 
 from . import ast
+from .types import qualified_base
 from .printer import (BINARY_LEVEL, FLAT_CHAINS, MINUS_LEVEL, NOT_LEVEL, SUM_LEVEL, chain_operands, clarifying_parens,
                       is_type, level, operand_levels)
 
@@ -60,6 +61,11 @@ def name_to_latex(name: str) -> str:
 
 
 def _var(v: ast.Var) -> str:
+    """A variable; a base type used as a set (``x in NATURAL``) is its
+    blackboard letter, a qualified built-in term (``REAL.REAL``) the product
+    of the letters (``\\mathbb{R} \\times \\mathbb{R}``)."""
+    if v.prefix is None and (v.name in _BASE or qualified_base(v.name) is not None):
+        return r" \times ".join(_BASE[p] for p in v.name.split("."))
     return name_to_latex(v.qualified)
 
 
@@ -82,7 +88,7 @@ def type_to_latex(t: ast.TypeExpr) -> str:
     if isinstance(t, ast.TBase):
         return _BASE[t.name]
     if isinstance(t, ast.TName):
-        return name_to_latex(t.name)
+        return _var(ast.Var(t.name, None, t.loc))
     if isinstance(t, ast.TEnum):
         return r"\{" + ", ".join(name_to_latex(v) for v in t.values) + r"\}"
     if isinstance(t, ast.TConstructors):

@@ -44,14 +44,15 @@ from .errors import Diagnostic, RclError, error
 _FRIENDLY = {
     "NAME": "a name", "IO_NAME": "an in./out. name", "NUMBER": "a number", "ROS_TYPE": "a ROS type",
     "CMP_OP": "a comparison", "EXISTS_BANG": "'exists!'", "$END": "end of file",
-    "BASE_TYPE": "REAL/INTEGER/NATURAL/BOOL/STRING", "STRING_LIT": "a string", "LT": "'<'", "GT": "'>'",
+    "BASE_TYPE": "REAL/INTEGER/NATURAL/BOOL/STRING",
+    "QUALIFIED_BASE": "a qualified built-in such as REAL.REAL", "STRING_LIT": "a string", "LT": "'<'", "GT": "'>'",
 }
 
 # Terminals whose text is data; every other token (keywords, punctuation) is
 # syntax, kept in the children only for its position.  "QUANT" is the
 # quantifier-kind token the transformer itself makes.
 _VALUE_TERMINALS = frozenset({"NAME", "IO_NAME", "NUMBER", "ROS_TYPE", "CMP_OP", "BASE_TYPE", "EXISTS_BANG",
-                              "QUANT", "STRING_LIT"})
+                              "QUANT", "STRING_LIT", "QUALIFIED_BASE"})
 
 
 def grammar_text() -> str:
@@ -338,6 +339,7 @@ class _ToAst(Transformer[Token, Any]):
         return ast.Var(str(c[0]), None, self._span(c))
 
     base_type_name = plain_name
+    qualified_base = plain_name
 
     def apply(self, c: list[Any]) -> ast.Apply:
         v = _vals(c)

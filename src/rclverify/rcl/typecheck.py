@@ -34,11 +34,9 @@ from typing import Iterable, Mapping, Sequence
 from . import ast
 from .errors import Diagnostic, RclError, error
 from .parser import parse_files
-from .types import (BOOL, INTEGER, NATURAL, REAL, STRING, Checked, CheckedNode, DataT, EmptyT, EnumT, Env, FuncT,
+from .types import (BASE_NAMES, BOOL, INTEGER, NATURAL, REAL, STRING, Checked, qualified_base, CheckedNode, DataT, EmptyT, EnumT, Env, FuncT,
                     Scalar, SeqT, SetT, TupleT, Type, assignable, comparable, is_numeric, numeric_join)
 
-
-BASE_NAMES = ("REAL", "INTEGER", "NATURAL", "BOOL", "STRING")
 
 
 class _Fail(Exception):
@@ -366,7 +364,9 @@ class _Checker:
 
     def collection(self, c: ast.Expr, node: CheckedNode | None, bound: Mapping[str, Type]) -> SetT:
         if isinstance(c, ast.Var) and c.prefix is None and c.name in BASE_NAMES and c.name not in bound:
-            return SetT(Scalar(c.name))  # type: ignore[arg-type]
+            return SetT(Scalar(c.name))
+        if isinstance(c, ast.Var) and c.prefix is None and (product := qualified_base(c.name)) is not None:
+            return SetT(product)
         if isinstance(c, ast.Var) and c.prefix is None and c.name not in bound and c.name in self.types and not (
                 node and (c.name in node.inputs or c.name in node.outputs)):
             return SetT(self.types[c.name])
@@ -378,6 +378,8 @@ class _Checker:
 
     def domain(self, b: ast.Binding, node: CheckedNode | None, bound: Mapping[str, Type]) -> Type:
         d = b.domain
+        if isinstance(d, ast.TName) and (product := qualified_base(d.name)) is not None:
+            return product
         if isinstance(d, ast.TName) and d.name not in self.types and d.name not in self.type_decls:
             known = d.name in bound or d.name in self.constants or (
                 node is not None and (d.name in node.inputs or d.name in node.outputs))

@@ -105,6 +105,22 @@ NATURAL = Scalar("NATURAL")
 BOOL = Scalar("BOOL")
 STRING = Scalar("STRING")
 NUMERIC_RANK = {"NATURAL": 0, "INTEGER": 1, "REAL": 2}
+BASE_NAMES: tuple[ScalarName, ...] = ("REAL", "INTEGER", "NATURAL", "BOOL", "STRING")
+
+
+def qualified_base(name: str) -> TupleT | None:
+    """The product type a qualified built-in term denotes, else ``None``.
+
+    ``"REAL.REAL"`` -> ``(REAL, REAL)``; ``"NATURAL.INTEGER"`` -> ``(NATURAL,
+    INTEGER)``.  The original RCL tool's grammar lets built-in type names be
+    joined by ``.`` as a term, and its contracts use it as the set of pairs a
+    tuple ranges over: ``(x, y) in REAL.REAL`` (docs/rcl-language.md).  A
+    plain name or a single base type gives ``None``.
+    """
+    parts = name.split(".")
+    if len(parts) < 2 or not all(p in BASE_NAMES for p in parts):
+        return None
+    return TupleT(tuple(Scalar(p) for p in parts))  # type: ignore[arg-type]
 
 
 def is_numeric(t: Type) -> bool:

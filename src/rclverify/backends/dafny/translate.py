@@ -48,7 +48,7 @@ from ...rcl.errors import error
 from ...rcl.printer import is_type
 from ...rcl.typecheck import domain_type
 from ...rcl.types import (BOOL, INTEGER, NATURAL, REAL, CheckedNode, DataT, EmptyT, EnumT, Env, FuncT, SeqT, SetT,
-                          TupleT, Type, numeric_join)
+                          TupleT, Type, numeric_join, qualified_base)
 from .types import dafny_ident, dafny_type
 
 _BASE_NAMES = {"REAL": REAL, "INTEGER": INTEGER, "NATURAL": NATURAL, "BOOL": BOOL}
@@ -155,6 +155,10 @@ class Translator:
             if m:
                 return f"{m.group(1)}{m.group(2)}.0{m.group(3)}"
             return f"({text} as real)"
+        if isinstance(src, TupleT) and isinstance(dst, TupleT) and src != dst and len(src.elems) == len(dst.elems):
+            # component by component: `(1, 2)` where `(real, real)` is expected
+            return "(" + ", ".join(Translator.conv(f"{_wrap(text)}.{k}", a, b)
+                                   for k, (a, b) in enumerate(zip(src.elems, dst.elems))) + ")"
         return text
 
     def _join(self, items: list[tuple[str, Type]]) -> tuple[list[str], Type]:
@@ -268,7 +272,7 @@ class Translator:
         vals = [self.tr(o, scope) for o in e.operands]
         parts = []
         for op, (a, at), (b, bt) in zip(e.ops, vals, vals[1:]):
-            j = numeric_join(at, bt)
+            j = _value_join(at, bt)
             if j is not None:
                 a, b = self.conv(a, at, j), self.conv(b, bt, j)
             parts.append(f"({a} {op} {b})")
@@ -280,21 +284,15 @@ class Translator:
             return None
         if c.name in _BASE_NAMES:
             return _BASE_NAMES[c.name]
+        if (product := qualified_base(c.name)) is not None:
+            return product  # `REAL.REAL`: the pairs of reals
         return self.env.types.get(c.name)
 
     def member(self, elem: tuple[str, Type], coll: ast.Expr, scope: Mapping[str, _Bound]) -> str:
         es, et = elem
         tt = self._type_name(coll, scope)
         if tt is not None:
-            if tt == NATURAL and et in (NATURAL, INTEGER):
-                return f"({es} >= 0)"
-            if tt == NATURAL and et == REAL:
-                return f"((({es}.Floor as real) == {es}) && ({es} >= 0.0))"
-            if tt == INTEGER and et == REAL:
-                return f"(({es}.Floor as real) == {es})"
-            if isinstance(tt, EmptyT):
-                return "false"
-            return "true"
+            return self._in_carrier(es, et, tt)
         cs, ct = self.tr(coll, scope)
         if isinstance(ct, (SetT, SeqT)) and numeric_join(et, ct.elem) == REAL:
             # Dafny keeps int and real apart (nat and int mix freely): widen the integer side
@@ -307,6 +305,23 @@ class Translator:
                     "}" if isinstance(coll, ast.SetLit) else "]")
             es = self.conv(es, et, REAL)
         return f"({es} in {cs})"
+
+    def _in_carrier(self, es: str, et: Type, tt: Type) -> str:
+        """``es in T`` for a type ``T`` used as a set: the integrality and
+        sign a value of type ``et`` must have to be a ``T``, component by
+        component for a product such as ``REAL.REAL`` (``es.0``, ``es.1``)."""
+        if isinstance(tt, TupleT) and isinstance(et, TupleT) and len(tt.elems) == len(et.elems):
+            parts = [self._in_carrier(f"{es}.{k}", e, t) for k, (e, t) in enumerate(zip(et.elems, tt.elems))]
+            return "(" + " && ".join(parts) + ")"
+        if tt == NATURAL and et in (NATURAL, INTEGER):
+            return f"({es} >= 0)"
+        if tt == NATURAL and et == REAL:
+            return f"((({es}.Floor as real) == {es}) && ({es} >= 0.0))"
+        if tt == INTEGER and et == REAL:
+            return f"(({es}.Floor as real) == {es})"
+        if isinstance(tt, EmptyT):
+            return "false"
+        return "true"
 
     def _expand_literal(self, e: ast.Quant, scope: Mapping[str, _Bound]) -> str | None:
         """``forall``/``exists`` whose every binding ranges over a set or sequence
@@ -406,6 +421,15 @@ class Translator:
         ycore = " && ".join(yguards + [ybody])
         unique = f"(forall {', '.join(ydecls)} :: ({ycore}) ==> ({' && '.join(eqs)}))"
         return f"(exists {binders} :: {core} && {unique})"
+
+
+def _value_join(a: Type, b: Type) -> Type | None:
+    """The type both sides of ``==`` widen to: the numeric join, taken
+    component by component for tuples; ``None`` when no widening applies."""
+    if isinstance(a, TupleT) and isinstance(b, TupleT) and len(a.elems) == len(b.elems):
+        parts = [x if x == y else _value_join(x, y) for x, y in zip(a.elems, b.elems)]
+        return None if any(p is None for p in parts) else TupleT(tuple(p for p in parts if p is not None))
+    return numeric_join(a, b)
 
 
 def _wrap(s: str) -> str:
