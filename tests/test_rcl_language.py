@@ -230,6 +230,17 @@ def test_unknown_type_reported_once_without_knock_on_messages() -> None:
     assert (e.value.diagnostics[0].loc.line, e.value.diagnostics[0].loc.col) == (1, 21)
 
 
+def test_unknown_type_used_as_a_domain_too_is_reported_once_with_the_case_hint() -> None:
+    # A contract in the style of the original tool's examples: `String` for a string topic.
+    src = node("guarantee(not forall(x in String | in.c == x and out.n != 10))",
+               io="inputs(c : String) outputs(n : INTEGER)")
+    with pytest.raises(RclError) as e:
+        check([parse_text(src)])
+    msgs = [str(d) for d in e.value.diagnostics]
+    assert len(msgs) == 1, msgs
+    assert "1:21: error: unknown type 'String'; did you mean 'STRING'?" in msgs[0]
+
+
 def test_empty_file_warns(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     f = tmp_path / "empty.rcl"
     f.write_text("// nothing here\n")

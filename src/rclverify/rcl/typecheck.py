@@ -44,8 +44,14 @@ class _Fail(Exception):
 
 
 def _candidates(name: str, pool: Iterable[str]) -> str:
-    close = difflib.get_close_matches(name, sorted(set(pool)), n=4, cutoff=0.5)
-    return f"; did you mean {', '.join(repr(c) for c in close)}?" if close else ""
+    """``"; did you mean 'STRING'?"``: close names from ``pool``, a name that
+    differs only in case first (``String`` -> ``STRING``); ``""`` if none."""
+    names = sorted(set(pool))
+    same = [c for c in names if c.lower() == name.lower() and c != name]
+    lower = {c.lower(): c for c in names}
+    close = same + [lower[c] for c in difflib.get_close_matches(name.lower(), sorted(lower), n=4, cutoff=0.5)
+                    if lower[c] not in same]
+    return f"; did you mean {', '.join(repr(c) for c in close[:4])}?" if close else ""
 
 
 class _Checker:
@@ -384,8 +390,13 @@ class _Checker:
             known = d.name in bound or d.name in self.constants or (
                 node is not None and (d.name in node.inputs or d.name in node.outputs))
             if not known:
-                self.err(d.loc, f"unknown type or set {d.name!r}"
-                         + _candidates(d.name, list(self.types) + list(self.type_decls) + list(BASE_NAMES)), "E-name")
+                # An unknown type is reported once, where it is first used
+                # (`inputs(c : String)` then `forall(x in String | ...)`).
+                if d.name not in self.unknown_types:
+                    self.unknown_types.add(d.name)
+                    self.err(d.loc, f"unknown type or set {d.name!r}"
+                             + _candidates(d.name, list(self.types) + list(self.type_decls) + list(BASE_NAMES)),
+                             "E-name")
                 raise _Fail
             return self.collection(ast.Var(d.name, None, d.loc), node, bound).elem
         if isinstance(d, (ast.TBase, ast.TName, ast.TEnum, ast.TConstructors, ast.TFunc, ast.TEmpty,
