@@ -270,6 +270,23 @@ def test_unknown_backend_lists_the_known_ones(tmp_path: Path) -> None:
     assert all(k in d.message for k in KNOWN)
 
 
+def test_misspelt_entry_key_is_located_with_the_closest_key(tmp_path: Path) -> None:
+    text = BASE.replace("        implementation: backends/dafny/agent.dfy",
+                        "        implementation: backends/dafny/agent.dfy\n        time_limt: 5")
+    (d,) = resolve_errors(tmp_path, text)
+    assert at(d) == where(text, "time_limt")
+    assert d.message == "unknown key 'time_limt' in a dafny evidence entry; did you mean 'time_limit'?"
+
+
+@pytest.mark.parametrize("backend", sorted(KNOWN))
+def test_every_backend_rejects_an_unknown_key_and_accepts_expected(backend: str) -> None:
+    from rclverify.backends.keys import allowed_keys, unknown_key_messages
+    assert "expected" in allowed_keys(backend)
+    assert unknown_key_messages(backend, {"backend": backend, "expected": []}) == []
+    ((key, msg),) = unknown_key_messages(backend, {"backend": backend, "frobnicate": 1})
+    assert key == "frobnicate" and msg.startswith(f"unknown key 'frobnicate' in a {backend} evidence entry; ")
+
+
 def test_evidence_for_an_unknown_node(tmp_path: Path) -> None:
     text = BASE.replace("  RadiationSensor:\n    evidence:", "  RadiationSensr:\n    evidence:")
     (d,) = resolve_errors(tmp_path, text)

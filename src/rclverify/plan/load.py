@@ -310,6 +310,7 @@ def resolve(plan: Plan, checked: Checked) -> None:
             if t != BOOL:
                 bad(f.loc, f"an environment fact must be a formula, found {t}")
     from ..backends import KNOWN
+    from ..backends.keys import unknown_key_messages
     for node, entries in plan.evidence.items():
         if entries:
             node_ok(node, entries[0].loc)
@@ -317,6 +318,9 @@ def resolve(plan: Plan, checked: Checked) -> None:
             if e.backend not in KNOWN:
                 bl = plan.locs.get(("nodes", node, "evidence", e.index, "backend"), e.loc)
                 bad(bl, f"unknown backend {e.backend!r}; known backends: {', '.join(KNOWN)}")
+            for key, msg in unknown_key_messages(e.backend, e.config):
+                path = ("nodes", node, "evidence", e.index, key)
+                bad(plan.locs.get(path + (KEY,), plan.locs.get(path, e.loc)), msg)
     # experiment and review entries name data files and criteria: check them now
     from ..backends.entry_checks import check_entries
     diags.extend(check_entries(plan, checked))

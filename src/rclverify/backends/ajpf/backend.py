@@ -49,6 +49,7 @@ from ...plan.errors import PlanError
 from ...rcl import ast
 from ...rcl.errors import RclError
 from ..base import NodeTarget, Stopwatch, make_evidence
+from ..keys import allowed_keys
 from .coverage import coverage_notes
 from . import psl, runner
 from .instantiate import Instance, Translator
@@ -64,8 +65,7 @@ DEFAULT_TIMEOUT_S = 3600.0
 DEFAULT_LOG_INFO = ("ail.util.AJPF_w_AIL", "ail.mas.DefaultEnvironment", "ajpf.product.Product")
 #: Upper bound on the number of instances of one guarantee.
 MAX_INSTANCES = 10000
-_KEYS = ("backend", "agent", "model", "domains", "mapping", "environment_class", "mcapl_home", "timeout_s",
-         "results", "log_info")
+_KEYS = allowed_keys("ajpf")
 _JAVA_CLASS = re.compile(r"^[A-Za-z_$][\w$]*(\.[A-Za-z_$][\w$]*)*$")
 _AGENT = re.compile(r"^[a-z][A-Za-z0-9_]*$")
 

@@ -44,6 +44,7 @@ from ...rcl.errors import RclError, error
 from ...rcl.printer import binding_to_rcl, expr_to_rcl
 from ...rcl.typecheck import domain_type
 from ...rcl.types import NATURAL, CheckedNode, FuncT, Type, assignable
+from ..keys import allowed_keys
 from ..base import NodeTarget
 from . import lang
 from .check import ProgramTypes, check_program, expr_type
@@ -51,7 +52,7 @@ from .wp import ProgramModel
 
 
 DEFAULT_TIMEOUT_MS = 10_000
-CONFIG_KEYS = ("backend", "program", "binding", "timeout_ms")
+CONFIG_KEYS = allowed_keys("hoare")
 _IO_KEY = re.compile(r"^(in|out)\.([A-Za-z_][A-Za-z0-9_]*'*)$")
 
 
