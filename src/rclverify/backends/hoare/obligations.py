@@ -44,8 +44,8 @@ from ...rcl.errors import RclError, error
 from ...rcl.printer import binding_to_rcl, expr_to_rcl
 from ...rcl.typecheck import domain_type
 from ...rcl.types import NATURAL, CheckedNode, FuncT, Type, assignable
-from ..keys import allowed_keys
 from ..base import NodeTarget
+from ..keys import allowed_keys
 from . import lang
 from .check import ProgramTypes, check_program, expr_type
 from .wp import ProgramModel
