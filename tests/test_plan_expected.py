@@ -102,3 +102,27 @@ def test_the_command_line_reports_it_with_a_non_zero_exit(tmp_path: Path, capsys
     assert re.search(rf"^contracts/plan\.yaml:{line}:{col}: error: hoare evidence of RadiationSensor: "
                      r"unknown verdict 'passed'", err, re.M), err
     assert "Traceback" not in err
+
+
+def test_whole_contract_backends_expect_guarantee_0(tmp_path: Path) -> None:
+    from rclverify.report.expected import expected_rows
+    head = HEAD.replace("      - backend: hoare\n        program: backends/hoare/radiation_sensor.imp\n",
+                        "      - backend: monitors\n        traces: []\n")
+    shutil.copytree(ROOT / "contracts", tmp_path / "contracts")
+    text = head + "          - {guarantee: 1, verdict: failed}\n"
+    (tmp_path / PLAN).write_text(text, encoding="utf-8")
+    plan = load_plan(tmp_path)
+    with pytest.raises(PlanError) as info:
+        resolve(plan, load([tmp_path / c for c in plan.contracts]))
+    (d,) = info.value.diagnostics
+    assert (d.loc.line, d.loc.col) == _at(text, "1, verdict")
+    assert "monitors obligations cover the whole contract of RadiationSensor" in d.message
+    assert "write 'guarantee: 0'" in d.message
+    # guarantee 0 resolves, and matches the whole-contract obligation in the report
+    (tmp_path / PLAN).write_text(head + "          - {guarantee: 0, verdict: failed}\n", encoding="utf-8")
+    plan = load_plan(tmp_path)
+    resolve(plan, load([tmp_path / c for c in plan.contracts]))
+    ob = {"node": "RadiationSensor", "backend": "monitors", "guarantee": 0, "instance": None, "status": "failed",
+          "id": "RadiationSensor.g0.monitors.run"}
+    (row,) = expected_rows(plan, [ob])
+    assert row["outcome"] == "as expected" and row["obligation"] == "RadiationSensor.g0.monitors.run"

@@ -27,7 +27,14 @@ VERDICTS = ("discharged", "failed")
 KEYS = ("guarantee", "instance", "verdict", "reason")
 
 
-def _item_problems(item: Any, n_guarantees: int, node: str) -> list[tuple[tuple[Any, ...], bool, str]]:
+#: Backends whose obligations cover a node's whole contract (guarantee 0 in
+#: the obligation id, ``<Node>.g0.dafny.contract``): their expectations say
+#: ``guarantee: 0``.
+WHOLE_CONTRACT_BACKENDS = ("dafny", "monitors")
+
+
+def _item_problems(item: Any, n_guarantees: int, node: str,
+                   backend: str = "") -> list[tuple[tuple[Any, ...], bool, str]]:
     """``(path below the item, at the key?, message)`` for each problem of one expectation."""
     if not isinstance(item, Mapping):
         return [((), False, "an expectation must be a mapping {guarantee: N, verdict: discharged|failed, "
@@ -41,7 +48,10 @@ def _item_problems(item: Any, n_guarantees: int, node: str) -> list[tuple[tuple[
         out.append(((), False, "an expectation needs 'guarantee' (the guarantee's number, from 1)"))
     elif isinstance(g, bool) or not isinstance(g, int):
         out.append((("guarantee",), False, f"'guarantee' must be a guarantee number, found {g!r}"))
-    elif not 1 <= g <= n_guarantees:
+    elif backend in WHOLE_CONTRACT_BACKENDS and g != 0:
+        out.append((("guarantee",), False, f"{backend} obligations cover the whole contract of {node}, not one "
+                                           "guarantee: write 'guarantee: 0'"))
+    elif backend not in WHOLE_CONTRACT_BACKENDS and not 1 <= g <= n_guarantees:
         out.append((("guarantee",), False, f"node {node} has {n_guarantees} guarantee(s); there is no guarantee {g}"))
     v = item.get("verdict")
     if "verdict" not in item:
@@ -86,10 +96,10 @@ def check_expected(plan: Plan, checked: Checked) -> list[Diagnostic]:
                                                    "{guarantee: N, verdict: discharged|failed}", "E-plan-expected"))
                 continue
             for prefix, item in items:
-                for path, key, msg in _item_problems(item, n, node):
+                for path, key, msg in _item_problems(item, n, node, e.backend):
                     diags.append(error(loc(prefix + path, key), f"{e.backend} evidence of {node}: {msg}",
                                        "E-plan-expected"))
     return diags
 
 
-__all__ = ["KEYS", "VERDICTS", "check_expected"]
+__all__ = ["KEYS", "VERDICTS", "WHOLE_CONTRACT_BACKENDS", "check_expected"]
