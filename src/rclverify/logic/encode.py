@@ -503,28 +503,26 @@ class _Ctx:
         r = self.member(self.enc(x.elem, b), x.collection, b)
         return z3.Not(r) if x.negated else r
 
-    def e_SetLit(self, x: ast.SetLit, b: Mapping[str, Any]) -> Any:
+    def _items(self, x: ast.SetLit | ast.SeqLit, b: Mapping[str, Any], what: str) -> list[Any]:
+        """The items of a set or sequence literal, widened to one sort."""
         if not x.items:
-            raise EncodingError(x.loc, "an empty set literal is only supported where its element type is known "
-                                       "(compared with a set, or on the right of 'in')")
+            raise EncodingError(x.loc, f"an empty {what} literal is only supported where its element type is "
+                                       f"known (compared with a {what}, or on the right of 'in')")
         items = [self.enc(i, b) for i in x.items]
         elem = items[0].sort()
         for i in items[1:]:
             elem = _join_sort(elem, i.sort())
-        s = z3.EmptySet(elem)
+        return [widen(i, elem) for i in items]
+
+    def e_SetLit(self, x: ast.SetLit, b: Mapping[str, Any]) -> Any:
+        items = self._items(x, b, "set")
+        s = z3.EmptySet(items[0].sort())
         for i in items:
-            s = z3.SetAdd(s, widen(i, elem))
+            s = z3.SetAdd(s, i)
         return s
 
     def e_SeqLit(self, x: ast.SeqLit, b: Mapping[str, Any]) -> Any:
-        if not x.items:
-            raise EncodingError(x.loc, "an empty sequence literal is only supported where its element type is "
-                                       "known (compared with a sequence, or on the right of 'in')")
-        items = [self.enc(i, b) for i in x.items]
-        elem = items[0].sort()
-        for i in items[1:]:
-            elem = _join_sort(elem, i.sort())
-        units = [z3.Unit(widen(i, elem)) for i in items]
+        units = [z3.Unit(i) for i in self._items(x, b, "sequence")]
         return units[0] if len(units) == 1 else z3.Concat(*units)
 
     def empty_literal(self, x: ast.SetLit | ast.SeqLit, like: z3.SortRef | None) -> Any:
