@@ -40,14 +40,14 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass, field
 from fractions import Fraction
-from typing import Mapping
+from typing import Any, Mapping, cast
 
 from ...plan.errors import PlanError
 from ...rcl import ast
 from ...rcl.errors import error
 from ...rcl.printer import is_type
 from ...rcl.typecheck import domain_type
-from ...rcl.types import (BOOL, INTEGER, NATURAL, REAL, CheckedNode, DataT, EmptyT, EnumT, Env, FuncT, SeqT, SetT,
+from ...rcl.types import (BOOL, INTEGER, NATURAL, REAL, STRING, CheckedNode, DataT, EmptyT, EnumT, Env, FuncT, SeqT, SetT,
                           TupleT, Type, numeric_join, qualified_base)
 from .types import dafny_ident, dafny_type
 
@@ -56,6 +56,8 @@ _INT_LIT = re.compile(r"\A(\(?)(-?\d+)(\)?)\Z")
 _LOGIC = {"and": "&&", "or": "||", "->": "==>", "<=>": "<==>"}
 #: Largest number of instances a quantifier over literal collections is expanded into.
 _EXPANSION_LIMIT = 64
+#: Most items a literal range `<a upto b>` is spelled out to.
+_RANGE_LIMIT = 1000
 
 
 def real_literal(value: Fraction) -> str:
@@ -214,7 +216,69 @@ class Translator:
             return "(" + ", ".join(s for s, _ in parts) + ")", TupleT(tuple(t for _, t in parts))
         if isinstance(e, ast.Quant):
             return self.quant(e, scope), BOOL
+        if isinstance(e, ast.TupleQuant):
+            return self.tuple_quant(e, scope), BOOL
+        if isinstance(e, ast.StrLit):
+            return dafny_string(e.value, e.loc), STRING
+        if isinstance(e, ast.SeqRange):
+            return self.seq_range(e, scope)
         raise self._err(getattr(e, "loc", ast.NOLOC), f"unsupported expression {type(e).__name__}")  # pragma: no cover
+
+    def seq_range(self, e: ast.SeqRange, scope: Mapping[str, _Bound]) -> tuple[str, Type]:
+        """``<a upto b>`` with literal bounds, as the sequence it stands for
+        (at most :data:`_RANGE_LIMIT` items; Dafny 2 has no sequence
+        constructor).  With other bounds it is expressible only on the right
+        of ``in`` (:meth:`member`); here it is a located error."""
+        lo, hi = e.lo, e.hi
+        if isinstance(lo, ast.NumLit) and isinstance(hi, ast.NumLit) and lo.is_integral and hi.is_integral:
+            a, z = int(lo.value), int(hi.value)
+            if z - a + 1 <= _RANGE_LIMIT:
+                return "[" + ", ".join(str(k) for k in range(a, z + 1)) + "]", SeqT(NATURAL if a >= 0 else INTEGER)
+        raise self._err(e.loc, f"a range is expressible in the Dafny contract stub only on the right of 'in' or "
+                               f"with literal bounds at most {_RANGE_LIMIT} apart")
+
+    def tuple_quant(self, e: ast.TupleQuant, scope: Mapping[str, _Bound]) -> str:
+        """``Q((u, v) in S | body)``: one Dafny variable ``u_v`` of the tuple
+        type, ``u`` and ``v`` read as ``u_v.0`` and ``u_v.1``, guarded by
+        ``u_v in S`` unless ``S`` is a tuple type."""
+        rcl_bound = {k: b.type for k, b in scope.items()}
+        t = domain_type(ast.Binding(("_tuple",), e.domain, e.loc), self.node, self.env, rcl_bound)
+        if isinstance(t, EmptyT):
+            return "true" if e.kind == "forall" else "false"
+        if not isinstance(t, TupleT) or len(t.elems) != len(e.names):
+            raise self._err(e.loc, f"{len(e.names)} names cannot take apart an element of type {t}")
+        dt = dafny_type(t, e.loc, f"the domain of ({', '.join(e.names)})")
+        if t not in self.used_types:
+            self.used_types.append(t)
+        coll = self._domain_collection(e.domain)
+        taken = self._names_in_scope(scope) | self._value_names()
+
+        def parts(var: str) -> tuple[str, str]:
+            inner = dict(scope)
+            inner.update({nm: _Bound(f"{var}.{k}", ct) for k, (nm, ct) in enumerate(zip(e.names, t.elems))})
+            guard = self.member((var, t), coll, scope) if coll is not None else ""
+            body = self.tr(e.body, inner)[0]
+            return guard, body
+
+        d = dafny_ident("_".join(e.names), taken)
+        guard, body = parts(d)
+        if e.kind == "forall":
+            return f"(forall {d}: {dt} :: {guard} ==> {body})" if guard else f"(forall {d}: {dt} :: {body})"
+        core = f"{guard} && {body}" if guard else body
+        if e.kind == "exists":
+            return f"(exists {d}: {dt} :: {core})"
+        y = dafny_ident(f"{d}_u", taken | {d})
+        yguard, ybody = parts(y)
+        ycore = f"{yguard} && {ybody}" if yguard else ybody
+        return f"(exists {d}: {dt} :: {core} && (forall {y}: {dt} :: ({ycore}) ==> ({y} == {d})))"
+
+    def _domain_collection(self, domain: Any) -> ast.Expr | None:
+        """The collection a quantifier domain stands for, or ``None`` for a type."""
+        if not is_type(domain):
+            return cast(ast.Expr, domain)
+        if isinstance(domain, ast.TName) and domain.name not in self.env.types:
+            return ast.Var(domain.name, None, domain.loc)
+        return None
 
     def var(self, v: ast.Var, scope: Mapping[str, _Bound]) -> tuple[str, Type]:
         if v.prefix is None and v.name in scope:
@@ -290,6 +354,13 @@ class Translator:
 
     def member(self, elem: tuple[str, Type], coll: ast.Expr, scope: Mapping[str, _Bound]) -> str:
         es, et = elem
+        if isinstance(coll, ast.SeqRange):
+            # `e in <lo upto hi>`: an integer between the bounds
+            (ls, lt), (hs, ht) = self.tr(coll.lo, scope), self.tr(coll.hi, scope)
+            j = numeric_join(numeric_join(et, lt) or et, ht) or et
+            integral = self._in_carrier(es, et, INTEGER)
+            bounds = f"({self.conv(ls, lt, j)} <= {self.conv(es, et, j)} <= {self.conv(hs, ht, j)})"
+            return bounds if integral == "true" else f"({integral} && {bounds})"
         tt = self._type_name(coll, scope)
         if tt is not None:
             return self._in_carrier(es, et, tt)
@@ -376,11 +447,7 @@ class Translator:
             dt = dafny_type(t, bd.loc, f"the domain of {', '.join(bd.names)}")
             if t not in self.used_types:
                 self.used_types.append(t)
-            coll: ast.Expr | None = None
-            if not is_type(bd.domain):
-                coll = bd.domain  # type: ignore[assignment]
-            elif isinstance(bd.domain, ast.TName) and bd.domain.name not in self.env.types:
-                coll = ast.Var(bd.domain.name, None, bd.domain.loc)
+            coll = self._domain_collection(bd.domain)
             for nm in bd.names:
                 taken = self._names_in_scope(inner) | self._value_names()
                 d = dafny_ident(nm, taken)
@@ -409,11 +476,7 @@ class Translator:
             ydecls.append(f"{y}: {dt}")
             eqs.append(f"({y} == {d})")
         for bd in e.bindings:
-            coll = None
-            if not is_type(bd.domain):
-                coll = bd.domain  # type: ignore[assignment]
-            elif isinstance(bd.domain, ast.TName) and bd.domain.name not in self.env.types:
-                coll = ast.Var(bd.domain.name, None, bd.domain.loc)
+            coll = self._domain_collection(bd.domain)
             if coll is not None:
                 for nm in bd.names:
                     yguards.append(self.member((again[nm].dafny, again[nm].type), coll, scope))
@@ -421,6 +484,25 @@ class Translator:
         ycore = " && ".join(yguards + [ybody])
         unique = f"(forall {', '.join(ydecls)} :: ({ycore}) ==> ({' && '.join(eqs)}))"
         return f"(exists {binders} :: {core} && {unique})"
+
+
+def dafny_string(value: str, loc: ast.Loc) -> str:
+    """A Dafny string literal for ``value``: ``"`` and ``\\`` escaped,
+    other characters outside printable ASCII as ``\\uXXXX``.  Raises
+    :class:`PlanError` (located) for characters beyond U+FFFF, which Dafny 2
+    string literals cannot spell."""
+    out = []
+    for ch in value:
+        if ch in ('"', "\\"):
+            out.append("\\" + ch)
+        elif " " <= ch <= "~":
+            out.append(ch)
+        elif ord(ch) <= 0xFFFF:
+            out.append(f"\\u{ord(ch):04x}")
+        else:
+            raise PlanError([error(loc, f"the string literal holds {ch!r}, beyond U+FFFF, which a Dafny string "
+                                        "literal cannot spell", "E-dafny")])
+    return '"' + "".join(out) + '"'
 
 
 def _value_join(a: Type, b: Type) -> Type | None:
