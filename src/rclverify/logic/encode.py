@@ -181,19 +181,31 @@ def _join_sort(a: z3.SortRef, b: z3.SortRef) -> z3.SortRef:
 
 def coerce(a: z3.ExprRef, b: z3.ExprRef) -> tuple[z3.ExprRef, z3.ExprRef]:
     """Widen Int to Real when one side is Real (NATURAL <: INTEGER <: REAL),
-    componentwise for tuples (``(1, 2) == p`` with ``p : (REAL, REAL)``)."""
-    s = _join_sort(a.sort(), b.sort())
-    return widen(a, s), widen(b, s)
+    componentwise for tuples (``(1, 2) == p`` with ``p : (REAL, REAL)``).
+    Sort kinds are compared first: this runs for every comparison encoded."""
+    sa, sb = a.sort(), b.sort()
+    ka, kb = sa.kind(), sb.kind()
+    if ka == z3.Z3_INT_SORT and kb == z3.Z3_REAL_SORT:
+        return z3.ToReal(a), b
+    if ka == z3.Z3_REAL_SORT and kb == z3.Z3_INT_SORT:
+        return a, z3.ToReal(b)
+    if ka == kb == z3.Z3_DATATYPE_SORT and not sa.eq(sb):
+        s = _join_sort(sa, sb)
+        return widen(a, s), widen(b, s)
+    return a, b
 
 
 def widen(x: z3.ExprRef, s: z3.SortRef) -> z3.ExprRef:
     """``x`` as a value of sort ``s`` (an Int widened to Real when ``s`` is
     Real; a tuple rebuilt component by component when ``s`` is a wider tuple
     sort); ``x`` itself otherwise."""
-    if s == z3.RealSort() and z3.is_int(x):
-        return z3.ToReal(x)
+    ks = s.kind()
+    if ks == z3.Z3_REAL_SORT:
+        return z3.ToReal(x) if x.sort().kind() == z3.Z3_INT_SORT else x
+    if ks != z3.Z3_DATATYPE_SORT or x.sort().eq(s):
+        return x
     fs, fx = _tuple_fields(s), _tuple_fields(x.sort())
-    if fs is not None and fx is not None and len(fs) == len(fx) and x.sort() != s:
+    if fs is not None and fx is not None and len(fs) == len(fx):
         xs = cast(z3.DatatypeSortRef, x.sort())
         return cast(z3.DatatypeSortRef, s).constructor(0)(
             *[widen(xs.accessor(0, k)(x), f) for k, f in enumerate(fs)])
