@@ -16,7 +16,8 @@ Models are rendered in RCL terms by :func:`render_model`.
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, field
+from functools import cached_property
 from typing import Callable, Sequence
 
 import z3
@@ -35,7 +36,7 @@ class QueryResult:
                   ``sat``/``unsat``/``inconclusive`` for satisfiability;
     ``model``     RCL name -> RCL value text (refuted or sat), else ``None``;
     ``core``      labels of the formulas in an unsat core (unsat), else ``None``;
-    ``smt2``      the query as an SMT-LIB2 script;
+    ``script``    makes the query's SMT-LIB2 script (read it as ``smt2``);
     ``reason``    Z3's reason for ``unknown`` ('' otherwise);
     ``duration_s`` wall time in seconds;
     ``strategy``  the retry of :mod:`.retry` that answered ('' when the
@@ -43,12 +44,18 @@ class QueryResult:
     """
 
     status: str
-    smt2: str
+    script: Callable[[], str] = field(repr=False, compare=False)
     duration_s: float
     model: dict[str, str] | None = None
     core: list[str] | None = None
     reason: str = ""
     strategy: str = ""
+
+    @cached_property
+    def smt2(self) -> str:
+        """The query as an SMT-LIB2 script, written when first asked for:
+        most health queries find nothing and their text is never kept."""
+        return self.script()
 
 
 def _solver(timeout_ms: int) -> z3.Solver:
@@ -57,7 +64,11 @@ def _solver(timeout_ms: int) -> z3.Solver:
     return s
 
 
-def _smt2(formulas: Sequence[z3.BoolRef], comment: str) -> str:
+def _smt2(formulas: Sequence[z3.BoolRef], comment: str) -> Callable[[], str]:
+    return lambda: _script(formulas, comment)
+
+
+def _script(formulas: Sequence[z3.BoolRef], comment: str) -> str:
     s = z3.Solver()
     for f in formulas:
         s.add(f)
