@@ -249,6 +249,30 @@ def stage_run(ws: Workspace, node: str, obligation_id: str) -> Evidence:
     return ev
 
 
+def stage_report(ws: Workspace) -> tuple[dict[str, Any], list[Path]]:
+    """Build the report dict of ``ws`` and write every report file under
+    ``reports/``: ``assurance.{html,md,json}``, the CI formats and the
+    assurance argument.  Graphviz layouts and rendered pieces of the report
+    are kept under ``artifacts/cache/`` for the next run (a pure speed-up:
+    the files are the same without them, docs/scale.md).  Returns the report
+    dict and the paths written; raises ``RclError`` for contracts or a plan
+    that do not check and ``OSError`` when a file cannot be written."""
+    from .argument.export import write_argument
+    from .report import layoutcache
+    from .report.build import build_report
+    from .report.ci import write_ci_reports
+    from .report.fragments import FragmentCache
+    from .report.render import render_all
+    report = build_report(ws)
+    layoutcache.use_directory(ws.path("artifacts/cache/layout"))
+    fragments = FragmentCache(ws.path(FragmentCache.IN_WORKSPACE))
+    out = ws.path("reports")
+    paths = render_all(report, out, fragments=fragments) + write_ci_reports(report, out)
+    paths += write_argument(report, out, fragments)
+    fragments.save()
+    return report, paths
+
+
 def read_artifact(ws: Workspace, rel: str, default: Any = None) -> Any:
     """JSON of an artifact, or ``default`` when it does not exist yet."""
     try:
