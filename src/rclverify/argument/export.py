@@ -31,7 +31,7 @@ import jinja2
 
 from ..evidence.store import atomic_write_text, dumps
 from ..report import diagram
-from ..report.fragments import FragmentCache, cached_dumps
+from ..report.fragments import FragmentCache, cached_dumps, canonical
 from .build import build_argument
 from .model import Argument, Element
 
@@ -66,13 +66,22 @@ def to_json_text(arg: Argument, fragments: FragmentCache | None = None) -> str:
     return dumps(arg.to_json()) if fragments is None else cached_dumps(arg.to_json(), fragments)
 
 
+#: The last argument whose elements were keyed, the link prefix and the keys' canonical JSON.
+_keyed: list[tuple[Argument, str, list[str]]] = []
+
+
 def _pieces(arg: Argument, fragments: FragmentCache | None, kind: str, link_prefix: str,
             render: Callable[[Element], str]) -> list[str]:
     """``render(e)`` of every element in order, from ``fragments`` when the
-    element (its JSON form) and ``link_prefix`` were rendered before."""
+    element (its JSON form) and ``link_prefix`` were rendered before.  The
+    canonical JSON of each element is computed once per argument for the
+    three kinds of piece (DOT node, DOT edges, YAML)."""
     cache = fragments if fragments is not None else FragmentCache()
-    return [cache.text(kind, {"e": e.to_json(), "link_prefix": link_prefix}, lambda e=e: render(e))  # type: ignore[misc]
-            for e in arg.elements.values()]
+    if not (_keyed and _keyed[0][0] is arg and _keyed[0][1] == link_prefix):
+        _keyed[:] = [(arg, link_prefix, [canonical({"e": e.to_json(), "link_prefix": link_prefix})
+                                         for e in arg.elements.values()])]
+    return [cache.text_of_canonical(kind, data, lambda e=e: render(e))  # type: ignore[misc]
+            for e, data in zip(arg.elements.values(), _keyed[0][2])]
 
 
 def to_gsn_yaml(arg: Argument, title: str = "assurance argument", link_prefix: str = "../",

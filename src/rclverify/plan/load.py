@@ -16,7 +16,6 @@ from importlib import resources
 from pathlib import Path
 from typing import Any, Mapping
 
-import jsonschema
 import yaml
 
 from ..rcl import ast
@@ -178,6 +177,7 @@ def _read_plan_source(root: Path, plan_rel: str) -> tuple[dict[str, Any], dict[P
         raise plan_error(plan_rel, line, col, f"invalid YAML: {getattr(exc, 'problem', exc)}", "E-yaml") from None
     if not isinstance(data, dict):
         raise plan_error(plan_rel, 1, 1, "the verification plan must be a mapping with a 'contracts' list")
+    import jsonschema  # here, not at module level: a doit run that reuses the cached workspace never validates
     errors = sorted(jsonschema.Draft202012Validator(_schema()).iter_errors(data), key=lambda e: list(map(str, e.absolute_path)))
     if errors:
         diags: list[Diagnostic] = []

@@ -110,14 +110,22 @@ class FragmentCache:
 
     def key(self, kind: str, data: Any) -> str:
         """Hex sha256 of the salt, ``kind`` and the canonical JSON of ``data``."""
+        return self._key(kind, canonical(data))
+
+    def _key(self, kind: str, canonical_data: str) -> str:
         h = hashlib.sha256(f"{self._salt}\0{kind}\0".encode())
-        h.update(canonical(data).encode("utf-8", "surrogatepass"))
+        h.update(canonical_data.encode("utf-8", "surrogatepass"))
         return h.hexdigest()
 
     def text(self, kind: str, data: Any, render: Callable[[], str]) -> str:
         """The text of the piece ``kind`` rendered from ``data``: the cached
         one, or ``render()`` (which must depend on ``data`` only)."""
-        k = self.key(kind, data)
+        return self.text_of_canonical(kind, canonical(data), render)
+
+    def text_of_canonical(self, kind: str, canonical_data: str, render: Callable[[], str]) -> str:
+        """:meth:`text` for data already in canonical JSON (:func:`canonical`),
+        for data that keys several kinds of piece."""
+        k = self._key(kind, canonical_data)
         got = self._used.get(k)
         if got is None:
             got = self._old.get(k)
