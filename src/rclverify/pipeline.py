@@ -252,8 +252,8 @@ def stage_run(ws: Workspace, node: str, obligation_id: str) -> Evidence:
 def stage_report(ws: Workspace) -> tuple[dict[str, Any], list[Path]]:
     """Build the report dict of ``ws`` and write every report file under
     ``reports/``: ``assurance.{html,md,json}``, the CI formats and the
-    assurance argument.  Graphviz layouts and rendered pieces of the report
-    are kept under ``artifacts/cache/`` for the next run (a pure speed-up:
+    assurance argument.  Graphviz layouts, compiled templates and rendered
+    pieces of the report are kept under ``artifacts/cache/`` for the next run (a pure speed-up:
     the files are the same without them, docs/scale.md).  Returns the report
     dict and the paths written; raises ``RclError`` for contracts or a plan
     that do not check and ``OSError`` when a file cannot be written."""
@@ -262,9 +262,10 @@ def stage_report(ws: Workspace) -> tuple[dict[str, Any], list[Path]]:
     from .report.build import build_report
     from .report.ci import write_ci_reports
     from .report.fragments import FragmentCache
-    from .report.render import render_all
+    from .report.render import render_all, use_bytecode_cache
     report = build_report(ws)
     layoutcache.use_directory(ws.path("artifacts/cache/layout"))
+    use_bytecode_cache(ws.path("artifacts/cache/templates"))
     fragments = FragmentCache(ws.path(FragmentCache.IN_WORKSPACE))
     out = ws.path("reports")
     paths = render_all(report, out, fragments=fragments) + write_ci_reports(report, out)

@@ -240,6 +240,19 @@ def environment() -> jinja2.Environment:
     return env
 
 
+def use_bytecode_cache(directory: Path | None) -> None:
+    """Keep the report's compiled templates in ``directory`` (jinja2's
+    ``FileSystemBytecodeCache``, keyed by template name and source checksum;
+    ``None``: compile in memory only).  Compiling the report's templates is
+    about 0.3 s of every report run.  Raises ``OSError`` when ``directory``
+    cannot be created."""
+    if directory is None:
+        environment().bytecode_cache = None
+        return
+    Path(directory).mkdir(parents=True, exist_ok=True)
+    environment().bytecode_cache = jinja2.FileSystemBytecodeCache(str(directory))
+
+
 # ---------------------------------------------------------------------------
 # view model
 
