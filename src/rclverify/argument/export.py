@@ -68,20 +68,35 @@ def to_json_text(arg: Argument, fragments: FragmentCache | None = None) -> str:
 
 #: The last argument whose elements were keyed, the link prefix and the keys' canonical JSON.
 _keyed: list[tuple[Argument, str, list[str]]] = []
+#: Ends each element's text in a batch render (JSON-quoted YAML and DOT strings escape control characters).
+_SEP = "\x00"
 
 
-def _pieces(arg: Argument, fragments: FragmentCache | None, kind: str, link_prefix: str,
-            render: Callable[[Element], str]) -> list[str]:
-    """``render(e)`` of every element in order, from ``fragments`` when the
-    element (its JSON form) and ``link_prefix`` were rendered before.  The
-    canonical JSON of each element is computed once per argument for the
-    three kinds of piece (DOT node, DOT edges, YAML)."""
+def _pieces(arg: Argument, fragments: FragmentCache | None, template: str, link_prefix: str,
+            data: Callable[[Element], Any]) -> list[str]:
+    """The text of every element in order by ``template`` (which renders
+    ``items``, each followed by ``sep``), from ``fragments`` when the element
+    (its JSON form) and ``link_prefix`` were rendered before.  The elements
+    not kept are rendered in one call (a template call per element cost more
+    than the rendering); the canonical JSON of each element is computed once
+    per argument for the three kinds of piece (DOT node, DOT edges, YAML)."""
     cache = fragments if fragments is not None else FragmentCache()
     if not (_keyed and _keyed[0][0] is arg and _keyed[0][1] == link_prefix):
         _keyed[:] = [(arg, link_prefix, [canonical({"e": e.to_json(), "link_prefix": link_prefix})
                                          for e in arg.elements.values()])]
-    return [cache.text_of_canonical(kind, data, lambda e=e: render(e))  # type: ignore[misc]
-            for e, data in zip(arg.elements.values(), _keyed[0][2])]
+    keys = _keyed[0][2]
+    texts = [cache.lookup(template, k) for k in keys]
+    missing = [i for i, t in enumerate(texts) if t is None]
+    if missing:
+        elements = list(arg.elements.values())
+        rendered = _environment().get_template(template).render(items=[data(elements[i]) for i in missing], sep=_SEP)
+        parts = rendered.split(_SEP)
+        if len(parts) != len(missing) + 1 or parts[-1]:
+            raise ValueError(f"{template}: an element's text contains the separator")  # not from escaped text
+        for i, text in zip(missing, parts):
+            cache.store(template, keys[i], text)
+            texts[i] = text
+    return [t for t in texts if t is not None]
 
 
 def to_gsn_yaml(arg: Argument, title: str = "assurance argument", link_prefix: str = "../",
@@ -91,13 +106,11 @@ def to_gsn_yaml(arg: Argument, title: str = "assurance argument", link_prefix: s
     ``link_prefix`` (the path from the YAML file's directory to the
     workspace root) is prepended to each element's ``url``; ``fragments``
     keeps each element's text between runs (same text)."""
-    template = _environment().get_template("argument.gsn-element.yaml.j2")
-
-    def element(e: Element) -> str:
-        return template.render(e={"id": e.id, "text": _with_status(e), "supported_by": e.supported_by,
-                                  "in_context_of": e.in_context_of, "undeveloped": e.undeveloped,
-                                  "url": link_prefix + e.url if e.url else ""})
-    elements = _pieces(arg, fragments, "argument.gsn-element.yaml.j2", link_prefix, element)
+    def element(e: Element) -> dict[str, Any]:
+        return {"id": e.id, "text": _with_status(e), "supported_by": e.supported_by,
+                "in_context_of": e.in_context_of, "undeveloped": e.undeveloped,
+                "url": link_prefix + e.url if e.url else ""}
+    elements = _pieces(arg, fragments, "argument.gsn-elements.yaml.j2", link_prefix, element)
     return _environment().get_template("argument.gsn.yaml.j2").render(title=title.replace("\n", " "), elements=elements)
 
 
@@ -121,22 +134,19 @@ def to_dot(arg: Argument, title: str = "assurance argument", link_prefix: str = 
     workspace-relative ``url`` of an element (its record) to make a link.
     ``fragments`` keeps each element's node and edge lines between runs
     (same text)."""
-    env = _environment()
-
-    def node(e: Element) -> str:
+    def node(e: Element) -> dict[str, Any]:
         shape, style = _SHAPES[e.type]
         fill, border = diagram.NODE_COLOURS.get(e.status or "", diagram.OTHER_COLOURS)
-        return env.get_template("argument.dot-element.j2").render(n={
-            "id": diagram.dot_string(e.id), "label": _label(e), "tooltip": diagram.dot_string(e.text),
-            "shape": shape, "style": style, "fill": fill, "border": border,
-            "url": diagram.dot_string(link_prefix + e.url) if e.url else ""})
+        return {"id": diagram.dot_string(e.id), "label": _label(e), "tooltip": diagram.dot_string(e.text),
+                "shape": shape, "style": style, "fill": fill, "border": border,
+                "url": diagram.dot_string(link_prefix + e.url) if e.url else ""}
 
-    def edges(e: Element) -> str:
+    def edges(e: Element) -> list[dict[str, Any]]:
         out = [{"src": diagram.dot_string(e.id), "dst": diagram.dot_string(x), "context": False} for x in e.supported_by]
         out += [{"src": diagram.dot_string(e.id), "dst": diagram.dot_string(x), "context": True} for x in e.in_context_of]
-        return env.get_template("argument.dot-edges.j2").render(edges=out)
-    return env.get_template("argument.dot.j2").render(
-        title=title.replace("\n", " "), nodes=_pieces(arg, fragments, "argument.dot-element.j2", link_prefix, node),
+        return out
+    return _environment().get_template("argument.dot.j2").render(
+        title=title.replace("\n", " "), nodes=_pieces(arg, fragments, "argument.dot-nodes.j2", link_prefix, node),
         edges=_pieces(arg, fragments, "argument.dot-edges.j2", link_prefix, edges))
 
 

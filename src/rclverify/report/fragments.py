@@ -125,19 +125,29 @@ class FragmentCache:
     def text_of_canonical(self, kind: str, canonical_data: str, render: Callable[[], str]) -> str:
         """:meth:`text` for data already in canonical JSON (:func:`canonical`),
         for data that keys several kinds of piece."""
+        got = self.lookup(kind, canonical_data)
+        if got is None:
+            got = render()
+            self.store(kind, canonical_data, got)
+        return got
+
+    def lookup(self, kind: str, canonical_data: str) -> str | None:
+        """The kept text of the piece ``kind`` of ``canonical_data``, or
+        ``None`` (then :meth:`store` it: the caller renders many misses at once)."""
         k = self._key(kind, canonical_data)
         got = self._used.get(k)
         if got is None:
             got = self._old.get(k)
             if got is None:
-                got = render()
-                self.misses += 1
-            else:
-                self.hits += 1
+                return None
             self._used[k] = got
-        else:
-            self.hits += 1
+        self.hits += 1
         return got
+
+    def store(self, kind: str, canonical_data: str, text: str) -> None:
+        """Keep ``text`` as the piece ``kind`` of ``canonical_data``."""
+        self._used[self._key(kind, canonical_data)] = text
+        self.misses += 1
 
     def save(self) -> bool:
         """Write the pieces used since this cache was made to :attr:`path`
