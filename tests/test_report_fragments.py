@@ -3,38 +3,20 @@ warm cache is byte for byte the one rendered without any."""
 from __future__ import annotations
 
 import json
-import shutil
-import subprocess
-import sys
 from pathlib import Path
 
 import pytest
+# the case study after one `doit verify` (whose report task filled the cache), as the end-to-end tests use it
+from test_pipeline_e2e import _doit, workspace  # noqa: F401
 
 from rclverify.evidence.store import dumps
 from rclverify.pipeline import Workspace
 from rclverify.report.build import build_report
 from rclverify.report.fragments import FragmentCache, cached_dumps
 
-ROOT = Path(__file__).resolve().parents[1]
 #: Every file the report task writes (argument.svg only with Graphviz).
 FILES = ("assurance.html", "assurance.md", "assurance.json", "assurance.sarif", "assurance.junit.xml",
          "argument.json", "argument.gsn.yaml", "argument.dot", "argument.svg")
-
-
-def _doit(ws: Path, *args: str) -> subprocess.CompletedProcess[str]:
-    return subprocess.run([sys.executable, "-m", "doit", *args], cwd=ws, capture_output=True, text=True, timeout=600)
-
-
-@pytest.fixture(scope="module")
-def workspace(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    """The case study after one `doit verify` (whose report task filled the cache)."""
-    ws = tmp_path_factory.mktemp("ws")
-    for item in ("contracts", "backends", "dodo.py"):
-        src = ROOT / item
-        (shutil.copytree if src.is_dir() else shutil.copy)(src, ws / item)
-    r = _doit(ws, "verify")
-    assert r.returncode == 0, r.stdout + r.stderr
-    return ws
 
 
 def _render(ws: Path, out: Path, fragments: FragmentCache | None) -> dict[str, bytes]:
