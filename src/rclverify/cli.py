@@ -151,17 +151,9 @@ def cmd_export(args: argparse.Namespace) -> int:
 
 
 def cmd_report(args: argparse.Namespace) -> int:
-    from .report.build import build_report
-    from .report.render import render_all
-    ws = _ws(args)
-    report = build_report(ws)
-    for p in render_all(report, ws.path("reports")):
-        print(p)
-    from .report.ci import write_ci_reports
-    for p in write_ci_reports(report, ws.path("reports")):
-        print(p)
-    from .argument.export import write_argument
-    for p in write_argument(report, ws.path("reports")):
+    from .pipeline import stage_report
+    report, paths = stage_report(_ws(args))
+    for p in paths:
         print(p)
     print(report["summary"]["headline"])
     return 0

@@ -24,24 +24,23 @@ import hashlib
 from dataclasses import dataclass
 from functools import cached_property
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-from .backends import get_backend
-from .backends.base import NodeTarget
-from .calculus.compose import compose_node, composition_json
 from .evidence.records import Evidence, Obligation
 from .evidence.store import EvidenceStore, atomic_write_text, read_json, write_json, write_obligations
-from .calculus.refinement import check_refinement, merge_envs, split_spec
-from .health.checks import Finding, check_node, refinement_finding
 from .plan.load import Plan, load_plan, resolve
 from .rcl import ast
-from .rcl.lint import lint
-from .rcl.printer import to_rcl
 from .rcl.errors import Diagnostic, RclError, error
-from .rcl.parser import parse_text
-from .rcl.typecheck import check
 from .rcl.types import Checked
 from .system.model import SystemModel, build
+
+if TYPE_CHECKING:
+    from .backends.base import NodeTarget
+    from .health.checks import Finding
+
+# The parser, type checker, calculus, health checks, lint and backends are
+# imported where a stage uses them: a doit run that reuses the cached
+# workspace and runs no such stage (a no-op) never needs them (docs/scale.md).
 
 PLAN = "contracts/plan.yaml"
 
@@ -69,6 +68,8 @@ class Workspace:
 
     @cached_property
     def checked(self) -> Checked:
+        from .rcl.parser import parse_text
+        from .rcl.typecheck import check
         plan = self.plan
         specs = []
         diags: list[Diagnostic] = []
@@ -129,6 +130,7 @@ class Workspace:
     DIAGNOSTICS = "artifacts/check/diagnostics.json"
 
     def target(self, node: str, index: int) -> NodeTarget:
+        from .backends.base import NodeTarget
         entry = self.plan.evidence[node][index]
         return NodeTarget(
             root=self.root.resolve(), checked=self.checked, node=self.checked.nodes[node], config=entry.config,
@@ -142,6 +144,8 @@ def stage_check(ws: Workspace) -> dict[str, Any]:
 
     Returns the diagnostics JSON (lint warnings).  Raises RclError/PlanError.
     """
+    from .rcl.lint import lint
+    from .rcl.printer import to_rcl
     checked, model = ws.checked, ws.model
     warnings = [d.to_json() for s in checked.specs for d in lint(s)]
     write_json(ws.path(ws.DIAGNOSTICS), {"warnings": warnings})
@@ -164,6 +168,7 @@ def stage_check(ws: Workspace) -> dict[str, Any]:
 
 def stage_compose(ws: Workspace, node: str) -> dict[str, Any]:
     """Apply the calculus to ``node``; writes its JSON and one .smt2 per side condition."""
+    from .calculus.compose import compose_node, composition_json
     comp = compose_node(ws.checked, ws.model, node)
     paths = []
     for sc in comp.side_conditions:
@@ -177,6 +182,7 @@ def stage_compose(ws: Workspace, node: str) -> dict[str, Any]:
 
 def stage_health(ws: Workspace, node: str) -> list[dict[str, Any]]:
     """Run the contract health checks of ``node``; writes its findings JSON."""
+    from .health.checks import check_node
     facts = [(f.expr, f.loc) for f in ws.plan.facts.get(node, ())]
     checked = check_node(ws.checked, node, facts, ws.plan.instances.get(node))
     if node in ws.plan.replacements:
@@ -200,6 +206,10 @@ def replacement_finding(ws: Workspace, node: str) -> Finding:
     in the replacement file) when it cannot be read, does not check, lacks the
     node, or has a different interface.
     """
+    from .calculus.refinement import check_refinement, merge_envs, split_spec
+    from .health.checks import refinement_finding
+    from .rcl.parser import parse_text
+    from .rcl.typecheck import check
     spec, loc = ws.plan.replacements[node]
     rel, name = split_spec(spec)
     try:
@@ -218,6 +228,7 @@ def replacement_finding(ws: Workspace, node: str) -> Finding:
 
 def stage_export(ws: Workspace, node: str) -> list[dict[str, Any]]:
     """Export ``node``'s obligations for every evidence entry of the plan."""
+    from .backends import get_backend
     obligations = []
     shared = set(ws.plan.contracts) | {ws.plan.file}
     snapshot = ws.snapshot(node)
@@ -243,10 +254,36 @@ def stage_export(ws: Workspace, node: str) -> list[dict[str, Any]]:
 def stage_run(ws: Workspace, node: str, obligation_id: str) -> Evidence:
     """Run the backend of one exported obligation and store its evidence record
     atomically (an earlier record is replaced only by a complete new one)."""
+    from .backends import get_backend
     o = Obligation.from_json(read_json(ws.path(ws.obligation(node, obligation_id))))
     ev = get_backend(o.backend).run(o, ws.target(node, int(o.data.get("entry", 0))))
     EvidenceStore(ws.root).put(ev)
     return ev
+
+
+def stage_report(ws: Workspace) -> tuple[dict[str, Any], list[Path]]:
+    """Build the report dict of ``ws`` and write every report file under
+    ``reports/``: ``assurance.{html,md,json}``, the CI formats and the
+    assurance argument.  Graphviz layouts, compiled templates and rendered
+    pieces of the report are kept under ``artifacts/cache/`` for the next run (a pure speed-up:
+    the files are the same without them, docs/scale.md).  Returns the report
+    dict and the paths written; raises ``RclError`` for contracts or a plan
+    that do not check and ``OSError`` when a file cannot be written."""
+    from .argument.export import write_argument
+    from .report import layoutcache
+    from .report.build import build_report
+    from .report.ci import write_ci_reports
+    from .report.fragments import FragmentCache
+    from .report.render import render_all, use_bytecode_cache
+    report = build_report(ws)
+    layoutcache.use_directory(ws.path("artifacts/cache/layout"))
+    use_bytecode_cache(ws.path("artifacts/cache/templates"))
+    fragments = FragmentCache(ws.path(FragmentCache.IN_WORKSPACE))
+    out = ws.path("reports")
+    paths = render_all(report, out, fragments=fragments) + write_ci_reports(report, out)
+    paths += write_argument(report, out, fragments)
+    fragments.save()
+    return report, paths
 
 
 def read_artifact(ws: Workspace, rel: str, default: Any = None) -> Any:

@@ -134,20 +134,11 @@ def act_run(root: str, node: str, obligation_id: str) -> Any:
 
 
 def act_report(root: str) -> Any:
-    from .report.build import build_report
-    from .report.render import render_all
+    from .pipeline import stage_report
     try:
-        ws = _ws(root)
-        report = build_report(ws)
+        report, _ = stage_report(_ws(root))
     except RclError as exc:
         return _fail(exc)
-    from .report import layoutcache
-    layoutcache.use_directory(ws.path("artifacts/cache/layout"))
-    render_all(report, ws.path("reports"))
-    from .report.ci import write_ci_reports
-    write_ci_reports(report, ws.path("reports"))
-    from .argument.export import write_argument
-    write_argument(report, ws.path("reports"))
     print(f"report: reports/assurance.html  ({report['summary']['headline']})")
     return None
 

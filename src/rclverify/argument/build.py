@@ -80,6 +80,9 @@ def build_argument(report: Mapping[str, Any]) -> Argument:
     reqs = report["requirements"]
     ev_of = {str(e["obligation"]): e for e in report["evidence"]}
     obligations = sorted(report["obligations"], key=lambda o: str(o["id"]))
+    obligations_of: dict[str, list[Mapping[str, Any]]] = {}  # by node, still sorted by id
+    for o in obligations:
+        obligations_of.setdefault(str(o["node"]), []).append(o)
     sides: dict[str, list[Mapping[str, Any]]] = {}
     for sc in report["side_conditions"]:
         sides.setdefault(str(sc["node"]), []).append(sc)
@@ -109,7 +112,7 @@ def build_argument(report: Mapping[str, Any]) -> Argument:
     def evidence_goals(node: str, k: int) -> list[str]:
         """Solutions and undeveloped goals under guarantee ``k`` of ``node``."""
         kids: list[str] = []
-        mine = [o for o in obligations if o["node"] == node and int(o["guarantee"]) in (k, 0)]
+        mine = [o for o in obligations_of.get(node, []) if o["node"] == node and int(o["guarantee"]) in (k, 0)]
         for o in mine:
             oid = str(o["id"])
             ev = ev_of.get(oid)

@@ -25,12 +25,13 @@ import json
 import textwrap
 from functools import lru_cache
 from pathlib import Path
-from typing import Any, Mapping
+from typing import Any, Callable, Mapping
 
 import jinja2
 
 from ..evidence.store import atomic_write_text, dumps
 from ..report import diagram
+from ..report.fragments import FragmentCache, cached_dumps, canonical
 from .build import build_argument
 from .model import Argument, Element
 
@@ -59,20 +60,57 @@ def _with_status(e: Element) -> str:
     return f"{e.text} [{e.status}]" if e.status is not None else e.text
 
 
-def to_json_text(arg: Argument) -> str:
-    """The argument as deterministic JSON text (sorted keys, final newline)."""
-    return dumps(arg.to_json())
+def to_json_text(arg: Argument, fragments: FragmentCache | None = None) -> str:
+    """The argument as deterministic JSON text (sorted keys, final newline);
+    ``fragments`` keeps each element's text between runs (same text)."""
+    return dumps(arg.to_json()) if fragments is None else cached_dumps(arg.to_json(), fragments)
 
 
-def to_gsn_yaml(arg: Argument, title: str = "assurance argument", link_prefix: str = "../") -> str:
+#: The last argument whose elements were keyed, the link prefix and the keys' canonical JSON.
+_keyed: list[tuple[Argument, str, list[str]]] = []
+#: Ends each element's text in a batch render (JSON-quoted YAML and DOT strings escape control characters).
+_SEP = "\x00"
+
+
+def _pieces(arg: Argument, fragments: FragmentCache | None, template: str, link_prefix: str,
+            data: Callable[[Element], Any]) -> list[str]:
+    """The text of every element in order by ``template`` (which renders
+    ``items``, each followed by ``sep``), from ``fragments`` when the element
+    (its JSON form) and ``link_prefix`` were rendered before.  The elements
+    not kept are rendered in one call (a template call per element cost more
+    than the rendering); the canonical JSON of each element is computed once
+    per argument for the three kinds of piece (DOT node, DOT edges, YAML)."""
+    cache = fragments if fragments is not None else FragmentCache()
+    if not (_keyed and _keyed[0][0] is arg and _keyed[0][1] == link_prefix):
+        _keyed[:] = [(arg, link_prefix, [canonical({"e": e.to_json(), "link_prefix": link_prefix})
+                                         for e in arg.elements.values()])]
+    keys = _keyed[0][2]
+    texts = [cache.lookup(template, k) for k in keys]
+    missing = [i for i, t in enumerate(texts) if t is None]
+    if missing:
+        elements = list(arg.elements.values())
+        rendered = _environment().get_template(template).render(items=[data(elements[i]) for i in missing], sep=_SEP)
+        parts = rendered.split(_SEP)
+        if len(parts) != len(missing) + 1 or parts[-1]:
+            raise ValueError(f"{template}: an element's text contains the separator")  # not from escaped text
+        for i, text in zip(missing, parts):
+            cache.store(template, keys[i], text)
+            texts[i] = text
+    return [t for t in texts if t is not None]
+
+
+def to_gsn_yaml(arg: Argument, title: str = "assurance argument", link_prefix: str = "../",
+                fragments: FragmentCache | None = None) -> str:
     """The argument in gsn2x's YAML input format (see the module docstring).
 
     ``link_prefix`` (the path from the YAML file's directory to the
-    workspace root) is prepended to each element's ``url``."""
-    elements = [{"id": e.id, "text": _with_status(e), "supported_by": e.supported_by,
-                 "in_context_of": e.in_context_of, "undeveloped": e.undeveloped,
-                 "url": link_prefix + e.url if e.url else ""}
-                for e in arg.elements.values()]
+    workspace root) is prepended to each element's ``url``; ``fragments``
+    keeps each element's text between runs (same text)."""
+    def element(e: Element) -> dict[str, Any]:
+        return {"id": e.id, "text": _with_status(e), "supported_by": e.supported_by,
+                "in_context_of": e.in_context_of, "undeveloped": e.undeveloped,
+                "url": link_prefix + e.url if e.url else ""}
+    elements = _pieces(arg, fragments, "argument.gsn-elements.yaml.j2", link_prefix, element)
     return _environment().get_template("argument.gsn.yaml.j2").render(title=title.replace("\n", " "), elements=elements)
 
 
@@ -90,62 +128,75 @@ def _label(e: Element) -> str:
     return diagram.dot_string(*lines)
 
 
-def to_dot(arg: Argument, title: str = "assurance argument", link_prefix: str = "../") -> str:
+def to_dot(arg: Argument, title: str = "assurance argument", link_prefix: str = "../",
+           fragments: FragmentCache | None = None) -> str:
     """Graphviz DOT text of the argument; ``link_prefix`` is prepended to the
-    workspace-relative ``url`` of an element (its record) to make a link."""
-    nodes, edges = [], []
-    for e in arg.elements.values():
+    workspace-relative ``url`` of an element (its record) to make a link.
+    ``fragments`` keeps each element's node and edge lines between runs
+    (same text)."""
+    def node(e: Element) -> dict[str, Any]:
         shape, style = _SHAPES[e.type]
         fill, border = diagram.NODE_COLOURS.get(e.status or "", diagram.OTHER_COLOURS)
-        nodes.append({"id": diagram.dot_string(e.id), "label": _label(e), "tooltip": diagram.dot_string(e.text),
-                      "shape": shape, "style": style, "fill": fill, "border": border,
-                      "url": diagram.dot_string(link_prefix + e.url) if e.url else ""})
-        edges += [{"src": diagram.dot_string(e.id), "dst": diagram.dot_string(x), "context": False} for x in e.supported_by]
-        edges += [{"src": diagram.dot_string(e.id), "dst": diagram.dot_string(x), "context": True} for x in e.in_context_of]
-    return _environment().get_template("argument.dot.j2").render(title=title.replace("\n", " "), nodes=nodes, edges=edges)
+        return {"id": diagram.dot_string(e.id), "label": _label(e), "tooltip": diagram.dot_string(e.text),
+                "shape": shape, "style": style, "fill": fill, "border": border,
+                "url": diagram.dot_string(link_prefix + e.url) if e.url else ""}
+
+    def edges(e: Element) -> list[dict[str, Any]]:
+        out = [{"src": diagram.dot_string(e.id), "dst": diagram.dot_string(x), "context": False} for x in e.supported_by]
+        out += [{"src": diagram.dot_string(e.id), "dst": diagram.dot_string(x), "context": True} for x in e.in_context_of]
+        return out
+    return _environment().get_template("argument.dot.j2").render(
+        title=title.replace("\n", " "), nodes=_pieces(arg, fragments, "argument.dot-nodes.j2", link_prefix, node),
+        edges=_pieces(arg, fragments, "argument.dot-edges.j2", link_prefix, edges))
 
 
-#: The last report built (kept, so its ``id`` is not reused) and its argument and DOT text.
-_last: list[tuple[Mapping[str, Any], Argument, str]] = []
+#: The last report built (kept, so its ``id`` is not reused), its argument, DOT text and JSON form.
+_last: list[tuple[Mapping[str, Any], Argument, str, dict[str, Any]]] = []
 
 
-def _built(report: Mapping[str, Any]) -> tuple[Argument, str]:
-    """``(argument, dot)`` of ``report``.  One report run shows the argument
-    three times (HTML, Markdown, ``reports/argument.*``) from the same report
-    dict, which no renderer changes; it is built once for that dict."""
+def _built(report: Mapping[str, Any], fragments: FragmentCache | None = None) -> tuple[Argument, str, dict[str, Any]]:
+    """``(argument, dot, argument JSON)`` of ``report``.  One report run
+    shows the argument three times (HTML, Markdown, ``reports/argument.*``)
+    from the same report dict, which no renderer changes; it is built once
+    for that dict (``fragments`` as for :func:`to_dot`)."""
     if _last and _last[0][0] is report:
-        return _last[0][1], _last[0][2]
+        return _last[0][1], _last[0][2], _last[0][3]
     arg = build_argument(report)
-    dot = to_dot(arg, f"assurance argument of {report['meta']['workspace']}")
-    _last[:] = [(report, arg, dot)]
-    return arg, dot
+    dot = to_dot(arg, f"assurance argument of {report['meta']['workspace']}", fragments=fragments)
+    _last[:] = [(report, arg, dot, arg.to_json())]
+    return arg, dot, _last[0][3]
 
 
-def argument_view(report: Mapping[str, Any], rendering: diagram.Rendering | None = None) -> dict[str, Any]:
+def argument_view(report: Mapping[str, Any], rendering: diagram.Rendering | None = None,
+                  fragments: FragmentCache | None = None) -> dict[str, Any]:
     """What the report templates show of the argument: ``argument`` (the
     JSON form), ``dot``, ``svg`` (``None`` without Graphviz), ``note`` (why
     there is no SVG) and ``goals`` (the requirement and contract goals with
-    their statuses, for the tables).  ``rendering`` replaces running ``dot``."""
-    arg, dot = _built(report)
+    their statuses, for the tables).  ``rendering`` replaces running ``dot``;
+    ``fragments`` as for :func:`to_dot`."""
+    arg, dot, as_json = _built(report, fragments)
     drawn = rendering if rendering is not None else diagram.render_dot(dot)
     top = arg.elements[arg.top]
     goals = [top] + [arg.elements[g] for s in top.supported_by for g in arg.elements[s].supported_by]
-    return {"argument": arg.to_json(), "dot": dot, "svg": drawn.svg, "note": drawn.note,
+    return {"argument": as_json, "dot": dot, "svg": drawn.svg, "note": drawn.note,
             "goals": [{"id": g.id, "text": g.text, "status": g.status, "undeveloped": g.undeveloped} for g in goals]}
 
 
-def write_argument(report: Mapping[str, Any], out_dir: Path) -> list[Path]:
+def write_argument(report: Mapping[str, Any], out_dir: Path, fragments: FragmentCache | None = None) -> list[Path]:
     """Write :data:`FILES` for ``report`` into ``out_dir`` (``reports/``).
 
     Everything is rendered before anything is written; each file is written
     atomically and only when changed.  Without Graphviz, ``argument.svg`` is
-    removed (so no stale diagram remains) and not returned.  Returns the
-    paths written.  Raises ``KeyError`` for a malformed report and ``OSError``
-    when ``out_dir`` cannot be written.
+    removed (so no stale diagram remains) and not returned.  ``fragments``
+    keeps rendered pieces between runs (:mod:`rclverify.report.fragments`;
+    the files are the same without it).  Returns the paths written.  Raises
+    ``KeyError`` for a malformed report and ``OSError`` when ``out_dir``
+    cannot be written.
     """
-    arg, dot = _built(report)
+    arg, dot, as_json = _built(report, fragments)
     title = f"assurance argument of {report['meta']['workspace']}"
-    texts = {FILES[0]: to_json_text(arg), FILES[1]: to_gsn_yaml(arg, title), FILES[2]: dot}
+    json_text = dumps(as_json) if fragments is None else cached_dumps(as_json, fragments)
+    texts = {FILES[0]: json_text, FILES[1]: to_gsn_yaml(arg, title, fragments=fragments), FILES[2]: dot}
     svg = diagram.render_dot(dot).svg
     paths = []
     for name, text in texts.items():

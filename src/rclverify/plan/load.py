@@ -16,13 +16,10 @@ from importlib import resources
 from pathlib import Path
 from typing import Any, Mapping
 
-import jsonschema
 import yaml
 
 from ..rcl import ast
 from ..rcl.errors import Diagnostic, RclError
-from ..rcl.parser import parse_formula
-from ..rcl.typecheck import infer
 from ..rcl.types import BOOL, Checked
 from .errors import PlanError, plan_error
 from .yamlguard import check_size, compose_guarded
@@ -178,6 +175,7 @@ def _read_plan_source(root: Path, plan_rel: str) -> tuple[dict[str, Any], dict[P
         raise plan_error(plan_rel, line, col, f"invalid YAML: {getattr(exc, 'problem', exc)}", "E-yaml") from None
     if not isinstance(data, dict):
         raise plan_error(plan_rel, 1, 1, "the verification plan must be a mapping with a 'contracts' list")
+    import jsonschema  # here, not at module level: a doit run that reuses the cached workspace never validates
     errors = sorted(jsonschema.Draft202012Validator(_schema()).iter_errors(data), key=lambda e: list(map(str, e.absolute_path)))
     if errors:
         diags: list[Diagnostic] = []
@@ -203,6 +201,7 @@ def load_plan(root: Path, plan_rel: str = "contracts/plan.yaml") -> Plan:
     Raises :class:`PlanError`.  Call :func:`resolve` once the contracts are
     checked to validate the references into them.
     """
+    from ..rcl.parser import parse_formula  # here: a run that reuses the cached workspace loads no plan
     data, locs, blocks = _read_plan_source(root, plan_rel)
 
     def loc(*path: Any) -> ast.Loc:
@@ -269,6 +268,7 @@ def resolve(plan: Plan, checked: Checked) -> None:
     environment facts must be well-typed formulas of their node.  Raises
     :class:`PlanError` listing every problem.
     """
+    from ..rcl.typecheck import infer
     diags: list[Diagnostic] = []
     nodes = checked.nodes
 

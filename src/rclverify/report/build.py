@@ -82,6 +82,9 @@ def _evidence_of_cone(cone: list[str], node_evidence: dict[str, str]) -> tuple[s
     established: "derived; rests on 1 failed node contract: RadiationSensor")."""
     if not cone:
         return "discharged", "derived; rests on no node contract"
+    if {node_evidence.get(m, "pending") for m in cone} == {"discharged"}:
+        # the usual case, without building the per-status lists (cones of a long chain are long)
+        return "discharged", "every node contract it rests on is discharged"
     by: dict[str, list[str]] = {}
     for m in cone:
         by.setdefault(node_evidence.get(m, "pending"), []).append(m)

@@ -33,15 +33,21 @@ def node_rows(report: Mapping[str, Any]) -> list[dict[str, Any]]:
     """One row per node of ``report``: ``{"node", "status", "obligations"
     (status -> count), "sc_proved", "sc_total", "health_problems",
     "health_open", "health_total"}``, worst status first, then report order."""
+    def by_node(items: list[Mapping[str, Any]]) -> dict[Any, list[Mapping[str, Any]]]:
+        # one pass per kind: a scan of every item per node was quadratic in the system size
+        out: dict[Any, list[Mapping[str, Any]]] = {}
+        for it in items:
+            out.setdefault(it["node"], []).append(it)
+        return out
+    obligations, sides, findings = (by_node(report[k]) for k in ("obligations", "side_conditions", "findings"))
     rows = []
     for k, n in enumerate(report["nodes"]):
         name = n["name"]
         obs: dict[str, int] = {}
-        for o in report["obligations"]:
-            if o["node"] == name:
-                obs[o["status"]] = obs.get(o["status"], 0) + 1
-        scs = [sc for sc in report["side_conditions"] if sc["node"] == name]
-        fs = [f for f in report["findings"] if f["node"] == name]
+        for o in obligations.get(name, []):
+            obs[o["status"]] = obs.get(o["status"], 0) + 1
+        scs = sides.get(name, [])
+        fs = findings.get(name, [])
         rows.append({"node": name, "status": n["status"], "obligations": obs, "order": k,
                      "sc_proved": sum(sc["status"] == "discharged" for sc in scs), "sc_total": len(scs),
                      "health_problems": sum(f["status"] == "problem" for f in fs),

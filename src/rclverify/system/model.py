@@ -20,8 +20,6 @@ from dataclasses import dataclass
 from functools import cached_property
 from typing import Any, Iterable, Iterator, Sequence
 
-import networkx as nx  # type: ignore[import-untyped]
-
 from ..plan.load import Connection
 from ..rcl.errors import RclError, error
 from ..rcl.types import Checked, EmptyT
@@ -116,7 +114,13 @@ class SystemModel:
         each as its node sequence starting at its first node in source order
         and following existing connections only; the closing edge goes from
         the last node back to the first.  Sorted by length, then by sequence.
-        Found with networkx's ``simple_cycles`` (Johnson's algorithm)."""
+        Found with networkx's ``simple_cycles`` (Johnson's algorithm), once
+        per model: the check stage and the report both show them."""
+        return [list(c) for c in self._cycles]
+
+    @cached_property
+    def _cycles(self) -> tuple[tuple[str, ...], ...]:
+        import networkx as nx  # type: ignore[import-untyped]  # here: importing it is 0.15 s of every doit run
         g = nx.DiGraph()
         g.add_nodes_from(self.nodes)
         g.add_edges_from((l.from_node, l.to_node) for l in self.links)
@@ -125,7 +129,7 @@ class SystemModel:
         for c in nx.simple_cycles(g):
             k = min(range(len(c)), key=lambda j: order[c[j]])
             out.append(c[k:] + c[:k])
-        return sorted(out, key=lambda c: (len(c), [order[n] for n in c]))
+        return tuple(tuple(c) for c in sorted(out, key=lambda c: (len(c), [order[n] for n in c])))
 
     def view(self, status: dict[str, str]) -> dict[str, Any]:
         """:meth:`to_json` with each node's roll-up status (``pending`` when
