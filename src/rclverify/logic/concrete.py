@@ -110,16 +110,26 @@ def _encoded(formula: ast.Expr, checked: Checked, node: CheckedNode) -> tuple[z3
     return phi, free
 
 
+#: Z3's resource budget per check (its ``rlimit``, counted in Z3's own
+#: steps, about 2 s on an idle core): a budget of work, not of wall-clock
+#: time, so a check gives the same answer on a loaded machine, in a parallel
+#: run and on CI.
+CHECK_RLIMIT = 8_000_000
+#: Wall-clock safety net far above :data:`CHECK_RLIMIT`, in milliseconds.
+SAFETY_TIMEOUT_MS = 60_000
+
+
 def check_concrete(formula: ast.Expr, checked: Checked, node: CheckedNode, values: Mapping[str, Any], *,
-                   timeout_ms: int = 2000) -> tuple[bool | None, str]:
+                   timeout_ms: int = SAFETY_TIMEOUT_MS, rlimit: int = CHECK_RLIMIT) -> tuple[bool | None, str]:
     """Does ``formula`` (an RCL formula of ``node``) hold on these concrete values?
 
     ``values`` maps qualified names (``"in.r"``) to values of
     :mod:`rclverify.values`; every I/O variable the formula uses must be
     there.  Returns ``(True, "")`` when Z3 proves the formula holds,
     ``(False, "")`` when it is violated, ``(None, reason)`` when Z3 answers
-    unknown (``reason`` is Z3's, e.g. ``"timeout"``) within ``timeout_ms``
-    milliseconds.  Raises ``KeyError`` for a name that is not an I/O
+    unknown (``reason`` is Z3's, e.g. ``"max. resource limit exceeded"``)
+    within the resource budget ``rlimit`` (Z3 steps; ``timeout_ms``
+    milliseconds of wall-clock time are only a safety net).  Raises ``KeyError`` for a name that is not an I/O
     variable of ``node``, :class:`ConcreteValueError` for a value of the
     wrong shape, :class:`~rclverify.logic.encode.EncodingError` for a formula
     Z3 cannot express.
@@ -153,6 +163,7 @@ def check_concrete(formula: ast.Expr, checked: Checked, node: CheckedNode, value
     if z3.is_false(simple):
         return False, ""
     s = z3.Solver()
+    s.set("rlimit", int(rlimit))
     s.set("timeout", int(timeout_ms))
     s.add(z3.Not(phi))
     r = s.check()

@@ -42,7 +42,6 @@ from .strategies import conjuncts, input_space
 DEFAULT_MAX_EXAMPLES = 200
 DEFAULT_SEED = 20260
 DEFAULT_STEPS = 4
-Z3_TIMEOUT_MS = 2000
 
 
 class ConfigError(Exception):
@@ -199,7 +198,7 @@ class GuaranteeRun:
     def assumption_holds(self, values: Mapping[str, Any]) -> bool:
         self.counts.drawn += 1
         for clause in self.node.node.assumes:
-            ok, why = check_concrete(clause.formula, self.checked, self.node, values, timeout_ms=Z3_TIMEOUT_MS)
+            ok, why = check_concrete(clause.formula, self.checked, self.node, values)
             if ok is None:
                 self.counts.assumption_unknown += 1
                 self.unknown.add(f"assumption: {why}")
@@ -207,7 +206,7 @@ class GuaranteeRun:
                 self.counts.rejected += 1
                 return False
         for fact in self.used_facts:
-            ok, why = check_concrete(fact, self.checked, self.node, values, timeout_ms=Z3_TIMEOUT_MS)
+            ok, why = check_concrete(fact, self.checked, self.node, values)
             if ok is None:
                 self.counts.assumption_unknown += 1
                 self.unknown.add(f"fact: {why}")
@@ -282,7 +281,7 @@ class GuaranteeRun:
         values = {**inputs, **{f"out.{k}": v for k, v in outputs.items()}}
         g = self.node.node.guarantees[self.guarantee - 1]
         for c in conjuncts(g.formula):
-            ok, why = check_concrete(c, self.checked, self.node, values, timeout_ms=Z3_TIMEOUT_MS)
+            ok, why = check_concrete(c, self.checked, self.node, values)
             if ok is None:
                 self.counts.inconclusive += 1
                 self.unknown.add(why)

@@ -36,14 +36,18 @@ from typing import Any
 
 import z3
 
-from ...logic.concrete import to_z3
+from ...logic.concrete import SAFETY_TIMEOUT_MS, to_z3
 from ...logic.encode import Encoder, EncodingError, sort_of
 from ...rcl import ast
 from ...rcl.types import Checked, CheckedNode, DataT, EnumT, FuncT, Scalar, Type
 from ...values import FiniteFunction, Term
 
 EXTRA_SIZES = (0, 1, 2, 4, 8, 16, 32, 64)
-SOLVER_TIMEOUT_MS = 2000
+#: Z3's resource budget for one table size (its ``rlimit``, about 2 s on an
+#: idle core): a budget of work, not of wall-clock time, so the same tables
+#: are found on a loaded machine, in a parallel run and on CI (a wall-clock
+#: limit let a busy machine miss the size that works and starve the draw).
+SEED_RLIMIT = 8_000_000
 
 
 def names_output(e: Any, node: CheckedNode) -> bool:
@@ -149,7 +153,8 @@ class Seeder:
         # runs alone and must see the same examples as the backend).
         ctx = z3.Context()
         s = z3.Then("simplify", "qe", "smt", ctx=ctx).solver()
-        s.set("timeout", SOLVER_TIMEOUT_MS)
+        s.set("rlimit", SEED_RLIMIT)
+        s.set("timeout", SAFETY_TIMEOUT_MS)  # a safety net only
         text = z3.Solver()
         text.add(phi, *side)
         s.add(z3.parse_smt2_string(text.to_smt2(), ctx=ctx))  # by its text: no state carried over
