@@ -275,3 +275,16 @@ def test_alias_makes_the_producer_guarantee_entail_the_consumer_assumption() -> 
     r = prove(a2, [g2], plain)
     assert r.status == "refuted" and r.model is not None
     assert Fraction(r.model["Consumer.in.v"]) <= 0 and Fraction(r.model["Producer.out.v"]) > 5
+
+
+def test_query_budgets_are_resource_steps_not_wall_clock() -> None:
+    from rclverify.logic.query import budgeted_solver
+    s = budgeted_solver(5)
+    x, y = z3.Ints("x y")
+    s.add(x * x * x + y * y * y == 1729, x > 1, y > x)  # needs far more than 10,000 steps
+    assert s.check() == z3.unknown
+    assert "resource limit" in s.reason_unknown() or s.reason_unknown() == "canceled"
+    # a budget of work: the same query with the same budget stops at the same point
+    r1 = prove(x * x * x + y * y * y != 1729, [x > 1, y > x], timeout_ms=5)
+    r2 = prove(x * x * x + y * y * y != 1729, [x > 1, y > x], timeout_ms=5)
+    assert r1.status == r2.status == "inconclusive"

@@ -2,7 +2,9 @@
 
 Every query:
 
-* runs with a per-query timeout (milliseconds);
+* runs with a per-query budget, given in milliseconds and enforced as Z3
+  resource steps (:data:`STEPS_PER_MS`), so the answer does not depend on
+  the machine's load;
 * maps Z3's answer to the tool's verdicts without ever upgrading an
   ``unknown``: validity -> ``proved`` (negation unsat) / ``refuted`` (sat,
   with a model) / ``inconclusive`` (unknown or timeout); satisfiability ->
@@ -58,9 +60,25 @@ class QueryResult:
         return self.script()
 
 
-def _solver(timeout_ms: int) -> z3.Solver:
+#: Z3 resource steps per millisecond of a query's budget: a ``timeout_ms``
+#: budget is enforced as Z3's ``rlimit`` of ``timeout_ms * STEPS_PER_MS``
+#: steps (Z3 does some 2,000 steps per millisecond on the heavy quantified
+#: queries of the case study on one idle core, up to 4,000 on light ones,
+#: which finish well inside their budget), so an answer does not
+#: depend on the machine's load: a serial run, ``doit -n 2`` and a busy CI
+#: machine decide the same queries.
+STEPS_PER_MS = 2_000
+#: The wall-clock safety net, a multiple of the budget.
+SAFETY_FACTOR = 10
+
+
+def budgeted_solver(timeout_ms: int) -> z3.Solver:
+    """A solver in the process's context whose budget is ``timeout_ms``
+    milliseconds' worth of Z3 resource steps (:data:`STEPS_PER_MS`), with a
+    wall-clock safety net :data:`SAFETY_FACTOR` times longer."""
     s = z3.Solver()
-    s.set("timeout", int(timeout_ms))
+    s.set("rlimit", int(timeout_ms) * STEPS_PER_MS)
+    s.set("timeout", int(timeout_ms) * SAFETY_FACTOR)
     return s
 
 
@@ -96,7 +114,7 @@ def prove(goal: z3.BoolRef, hypotheses: Sequence[z3.BoolRef], enc: Encoder | Non
         s = bounded_solver()
         load_canonical(s, formulas)
     else:
-        s = _solver(timeout_ms)
+        s = budgeted_solver(timeout_ms)
         s.add(*formulas)
     t0 = time.perf_counter()
     r = s.check()
@@ -131,7 +149,7 @@ def satisfiable(labelled: Sequence[tuple[str, z3.BoolRef]], enc: Encoder | None 
     (the encoder's typing axioms are unlabelled background).
     """
     background = enc.axioms() if enc else []
-    s = _solver(timeout_ms)
+    s = budgeted_solver(timeout_ms)
     s.set("unsat_core", True)
     s.add(*background)
     trackers = {}

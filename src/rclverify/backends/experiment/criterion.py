@@ -21,6 +21,7 @@ from typing import Mapping
 
 import z3
 
+from ...logic.query import budgeted_solver
 from ...rcl import ast
 from .figures import Figures, Quantity
 
@@ -162,8 +163,7 @@ def _val(v: Fraction) -> z3.ArithRef:
 
 
 def _decide(formula: z3.ExprRef, background: list[z3.ExprRef], timeout_ms: int) -> bool | None:
-    s = z3.Solver()
-    s.set("timeout", timeout_ms)
+    s = budgeted_solver(timeout_ms)
     s.add(*background)
     s.push()
     s.add(z3.Not(formula))

@@ -21,6 +21,7 @@ from typing import Any, Mapping, Sequence
 
 import z3
 
+from ...logic.query import budgeted_solver
 from . import lang
 from .outline import z3_text
 from .wp import VC, ProgramModel, iter_terms
@@ -96,8 +97,7 @@ def check_vc(vc: VC, background: Sequence[z3.BoolRef], m: ProgramModel, timeout_
     core = [*vc.hyps, vc.goal]
     hyps = (*vc.hyps, *background, *m.typing_facts(core))
     formulas = [*hyps, z3.Not(vc.goal)]
-    s = z3.Solver()
-    s.set("timeout", int(timeout_ms))
+    s = budgeted_solver(timeout_ms)
     s.add(*formulas)
     r = s.check()
     text = _smt2(formulas, f"{vc.id}: {vc.label}; unsat means the condition holds")
