@@ -488,7 +488,8 @@ class Translator:
 
 def dafny_string(value: str, loc: ast.Loc) -> str:
     """A Dafny string literal for ``value``: ``"`` and ``\\`` escaped,
-    other characters outside printable ASCII as ``\\uXXXX``.  Raises
+    other characters outside printable ASCII as ``\\u`` and four hex
+    digits (``\\u00e9``).  Raises
     :class:`PlanError` (located) for characters beyond U+FFFF, which Dafny 2
     string literals cannot spell."""
     out = []
