@@ -24,6 +24,7 @@ from ..rcl import ast
 from ..rcl.types import Checked, CheckedNode, DataT, EnumT, FuncT, Scalar, SeqT, SetT, TupleT, Type
 from ..values import FiniteFunction, Term, exact
 from .encode import Encoder, sort_of, widen
+from .retry import SAFETY_TIMEOUT_MS
 
 
 class ConcreteValueError(ValueError):
@@ -115,8 +116,6 @@ def _encoded(formula: ast.Expr, checked: Checked, node: CheckedNode) -> tuple[z3
 #: time, so a check gives the same answer on a loaded machine, in a parallel
 #: run and on CI.
 CHECK_RLIMIT = 8_000_000
-#: Wall-clock safety net far above :data:`CHECK_RLIMIT`, in milliseconds.
-SAFETY_TIMEOUT_MS = 60_000
 
 
 def check_concrete(formula: ast.Expr, checked: Checked, node: CheckedNode, values: Mapping[str, Any], *,

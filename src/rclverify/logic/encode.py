@@ -448,18 +448,30 @@ class _Ctx:
         for nm, ct in zip(x.names, t.elems):
             if isinstance(ct, (FuncT, EmptyT)):
                 raise EncodingError(x.loc, f"quantifying over {ct} is not supported by backend z3")
-            v = z3.Const(smt_symbol(nm), sort_of(ct))
-            self.var_types[v.get_id()] = ct
-            inner[nm] = v
-            xs.append(v)
-            if ct == NATURAL:
-                guards.append(v >= 0)
-        d = x.domain
-        if not is_type(d) or (isinstance(d, ast.TName) and d.name not in self.e.env.types):
-            coll = ast.Var(d.name, None, d.loc) if isinstance(d, ast.TName) else cast(ast.Expr, d)
+            self._bind(nm, ct, inner, xs, guards)
+        coll = self._domain_collection(x.domain)
+        if coll is not None:
             tup = cast(z3.DatatypeSortRef, sort_of(t)).constructor(0)(*xs)
             guards.append(self.member(tup, coll, b))
         return self._close(x.kind, xs, guards, self.enc(x.body, inner))
+
+    def _bind(self, name: str, t: Type, inner: dict[str, Any], xs: list[z3.ExprRef], guards: list[Any]) -> z3.ExprRef:
+        """A bound variable ``name`` of type ``t``: put in scope (``inner``) and in
+        the quantifier's variables (``xs``), with ``>= 0`` for a NATURAL (``guards``)."""
+        v = z3.Const(smt_symbol(name), sort_of(t))
+        self.var_types[v.get_id()] = t
+        inner[name] = v
+        xs.append(v)
+        if t == NATURAL:
+            guards.append(v >= 0)
+        return v
+
+    def _domain_collection(self, d: Any) -> ast.Expr | None:
+        """The collection a quantifier domain stands for (a term, or a name
+        that is not a declared type), else ``None``: a type needs no guard."""
+        if is_type(d) and not (isinstance(d, ast.TName) and d.name not in self.e.env.types):
+            return None
+        return ast.Var(d.name, None, d.loc) if isinstance(d, ast.TName) else cast(ast.Expr, d)
 
     def e_Compare(self, x: ast.Compare, b: Mapping[str, Any]) -> Any:
         vals = [None if _is_empty_literal(o) else self.enc(o, b) for o in x.operands]
@@ -568,17 +580,10 @@ class _Ctx:
                 return z3.BoolVal(x.kind == "forall")
             if isinstance(t, FuncT):
                 raise EncodingError(bd.loc, "quantifying over functions is not supported")
+            coll = self._domain_collection(bd.domain)
             for nm in bd.names:
-                v = z3.Const(smt_symbol(nm), sort_of(t))
-                self.var_types[v.get_id()] = t
-                inner[nm] = v
-                xs.append(v)
-                if t == NATURAL:
-                    guards.append(v >= 0)
-                if not is_type(bd.domain) or (isinstance(bd.domain, ast.TName)
-                                              and bd.domain.name not in self.e.env.types):
-                    coll = (ast.Var(bd.domain.name, None, bd.domain.loc) if isinstance(bd.domain, ast.TName)
-                            else cast(ast.Expr, bd.domain))  # a term domain: is_type said so
+                v = self._bind(nm, t, inner, xs, guards)
+                if coll is not None:
                     guards.append(self.member(v, coll, b))
         return self._close(x.kind, xs, guards, self.enc(x.body, inner))
 

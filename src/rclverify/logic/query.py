@@ -119,11 +119,11 @@ def prove(goal: z3.BoolRef, hypotheses: Sequence[z3.BoolRef], enc: Encoder | Non
     t0 = time.perf_counter()
     r = s.check()
     dt = round(time.perf_counter() - t0, 4)
-    text = _smt2(formulas, comment or "validity query: unsat means the goal follows from the hypotheses")
+    script = _smt2(formulas, comment or "validity query: unsat means the goal follows from the hypotheses")
     if r == z3.unsat:
-        return QueryResult("proved", text, dt)
+        return QueryResult("proved", script, dt)
     if r == z3.sat:
-        return QueryResult("refuted", text, dt, model=render_model(s.model(), enc))
+        return QueryResult("refuted", script, dt, model=render_model(s.model(), enc))
     reasons = [f"default: {s.reason_unknown()}"]
     for name0, s0, rewrite in attempts(formulas, timeout_ms):
         for name, s2 in variants(name0, s0):
@@ -131,11 +131,11 @@ def prove(goal: z3.BoolRef, hypotheses: Sequence[z3.BoolRef], enc: Encoder | Non
             r = s2.check()
             dt = round(time.perf_counter() - t0, 4)
             if r == z3.unsat:
-                return QueryResult("proved", text, dt, strategy=name)
+                return QueryResult("proved", script, dt, strategy=name)
             if r == z3.sat:
-                return QueryResult("refuted", text, dt, model=render_model(s2.model(), enc), strategy=name)
+                return QueryResult("refuted", script, dt, model=render_model(s2.model(), enc), strategy=name)
             reasons.append(f"{name}: {s2.reason_unknown()}")
-    return QueryResult("inconclusive", text, dt, reason="; ".join(reasons) if len(reasons) > 1 else s.reason_unknown())
+    return QueryResult("inconclusive", script, dt, reason="; ".join(reasons) if len(reasons) > 1 else s.reason_unknown())
 
 
 def satisfiable(labelled: Sequence[tuple[str, z3.BoolRef]], enc: Encoder | None = None, *,
@@ -160,13 +160,13 @@ def satisfiable(labelled: Sequence[tuple[str, z3.BoolRef]], enc: Encoder | None 
     t0 = time.perf_counter()
     r = s.check()
     dt = round(time.perf_counter() - t0, 4)
-    text = _smt2(background + [f for _, f in labelled], comment or "satisfiability query")
+    script = _smt2(background + [f for _, f in labelled], comment or "satisfiability query")
     if r == z3.sat:
-        return QueryResult("sat", text, dt, model=render_model(s.model(), enc))
+        return QueryResult("sat", script, dt, model=render_model(s.model(), enc))
     if r == z3.unsat:
         core = sorted({trackers[str(c)] for c in s.unsat_core() if str(c) in trackers},
                       key=[lbl for lbl, _ in labelled].index)
-        return QueryResult("unsat", text, dt, core=core)
+        return QueryResult("unsat", script, dt, core=core)
     reasons = [f"default: {s.reason_unknown()}"]
     labels = [lbl for lbl, _ in labelled]
     for name0, s0, rewrite in attempts(background + [f for _, f in labelled], timeout_ms) if retry else []:
@@ -176,13 +176,13 @@ def satisfiable(labelled: Sequence[tuple[str, z3.BoolRef]], enc: Encoder | None 
             r = s2.check()
             dt = round(time.perf_counter() - t0, 4)
             if r == z3.sat:
-                return QueryResult("sat", text, dt, model=render_model(s2.model(), enc), strategy=name)
+                return QueryResult("sat", script, dt, model=render_model(s2.model(), enc), strategy=name)
             if r == z3.unsat:
                 tracked = _retry_core(background, labelled, rewrite)
                 core = tracked if tracked is not None else labels
-                return QueryResult("unsat", text, round(time.perf_counter() - t0, 4), core=core, strategy=name)
+                return QueryResult("unsat", script, round(time.perf_counter() - t0, 4), core=core, strategy=name)
             reasons.append(f"{name}: {s2.reason_unknown()}")
-    return QueryResult("inconclusive", text, dt, reason="; ".join(reasons) if len(reasons) > 1 else s.reason_unknown())
+    return QueryResult("inconclusive", script, dt, reason="; ".join(reasons) if len(reasons) > 1 else s.reason_unknown())
 
 
 def _retry_core(background: Sequence[z3.BoolRef], labelled: Sequence[tuple[str, z3.BoolRef]],

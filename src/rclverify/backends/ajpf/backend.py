@@ -49,7 +49,6 @@ from ...plan.errors import PlanError
 from ...rcl import ast
 from ...rcl.errors import RclError
 from ..base import NodeTarget, Stopwatch, make_evidence
-from ..keys import allowed_keys
 from .coverage import coverage_notes
 from . import psl, runner
 from .instantiate import Instance, Translator
@@ -65,7 +64,6 @@ DEFAULT_TIMEOUT_S = 3600.0
 DEFAULT_LOG_INFO = ("ail.util.AJPF_w_AIL", "ail.mas.DefaultEnvironment", "ajpf.product.Product")
 #: Upper bound on the number of instances of one guarantee.
 MAX_INSTANCES = 10000
-_KEYS = allowed_keys("ajpf")
 _JAVA_CLASS = re.compile(r"^[A-Za-z_$][\w$]*(\.[A-Za-z_$][\w$]*)*$")
 _AGENT = re.compile(r"^[a-z][A-Za-z0-9_]*$")
 
@@ -99,15 +97,11 @@ def _templates() -> Environment:
 def read_config(target: NodeTarget) -> AjpfConfig:
     """Check the plan entry ``target.config`` and the mapping rows in it.
 
-    Raises :class:`PlanError` (located in the plan file) for an unknown key,
+    Raises :class:`PlanError` (located in the plan file) for
     a missing or ill-typed value, a model file that does not exist, an
     invalid domain, or a mapping row that does not parse or check.
     """
-    cfg = target.config
-    for key in cfg:
-        if key not in _KEYS:
-            raise target.config_error(f"unknown key {key!r} in the ajpf entry of {target.node.name} "
-                                      f"(allowed: {', '.join(_KEYS)})", key, key=True)
+    cfg = target.config  # its keys were checked when the plan was resolved (backends/keys.py)
     agent = cfg.get("agent")
     if not isinstance(agent, str) or not _AGENT.match(agent):
         raise target.config_error("'agent' must name the Gwendolen agent (a lower-case name, e.g. jackal)", "agent")

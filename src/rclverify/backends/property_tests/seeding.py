@@ -36,8 +36,9 @@ from typing import Any
 
 import z3
 
-from ...logic.concrete import SAFETY_TIMEOUT_MS, to_z3
+from ...logic.concrete import to_z3
 from ...logic.encode import Encoder, EncodingError, sort_of
+from ...logic.retry import SAFETY_TIMEOUT_MS
 from ...rcl import ast
 from ...rcl.types import Checked, CheckedNode, DataT, EnumT, FuncT, Scalar, Type
 from ...values import FiniteFunction, Term
