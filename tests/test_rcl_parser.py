@@ -416,3 +416,21 @@ def test_grammar_is_unambiguous_on_the_case_study() -> None:
     tree = earley.parse(text)
     assert not list(tree.find_data("_ambig"))
     assert ast_from_tree(tree, "case.rcl") == parse_text(text, "case.rcl")
+
+
+def test_the_lalr_tables_are_cached_per_user_and_rebuilt_from_the_cache(tmp_path: Path,
+                                                                        monkeypatch: pytest.MonkeyPatch) -> None:
+    from rclverify.rcl.parser import _BUILDER, lark_cache_file
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "cache"))
+    where = lark_cache_file("rcl")
+    assert isinstance(where, str) and where.startswith(str(tmp_path / "cache" / "rclverify"))
+    options = dict(parser="lalr", start=["start", "expr"], keep_all_tokens=True, maybe_placeholders=True,
+                   transformer=_BUILDER, cache=where)
+    built = Lark(grammar_text(), **options)
+    assert Path(where).is_file()
+    loaded = Lark(grammar_text(), **options)  # from the file
+    text = "node A { inputs(x : REAL) outputs(y : REAL) guarantee(out.y >= in.x) }"
+    assert loaded.parse(text, start="start") == built.parse(text, start="start")
+    (tmp_path / "blocked").write_text("a file, not a directory")
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "blocked"))
+    assert lark_cache_file("rcl") is False  # no cache rather than an error

@@ -5,6 +5,8 @@ from __future__ import annotations
 import random
 from pathlib import Path
 
+import pytest
+
 from rclverify import wscache
 from rclverify.pipeline import Workspace
 from rclverify.system.model import Link, SystemModel, _loops
@@ -98,7 +100,6 @@ def test_a_damaged_cache_is_ignored(tmp_path: Path) -> None:
 
 
 def test_a_missing_contract_is_reported_even_with_a_cached_plan(tmp_path: Path) -> None:
-    import pytest
     from rclverify.plan.errors import PlanError
     ws = _ws(tmp_path)
     ws.model
@@ -108,3 +109,32 @@ def test_a_missing_contract_is_reported_even_with_a_cached_plan(tmp_path: Path) 
     assert not wscache.restore(again)
     with pytest.raises(PlanError):
         again.model
+
+
+def test_a_valid_cache_defers_the_checked_contracts_until_a_task_needs_them(tmp_path: Path,
+                                                                           monkeypatch: pytest.MonkeyPatch) -> None:
+    ws = _ws(tmp_path)
+    ws.model
+    wscache.save(ws)
+    again = Workspace(tmp_path)
+    assert wscache.restore(again)
+    # the task index is there at once; plan, contracts and model are not unpickled yet
+    assert again.index.nodes == ("A",) and again.index.contracts == ("contracts/a.rcl",)
+    assert {"plan", "checked", "model"}.isdisjoint(again.__dict__) and again.deferred is not None
+    import rclverify.rcl.parser as parser
+
+    def no_parse(*args: object, **kwargs: object) -> None:
+        raise AssertionError("parsed although the cache holds the checked contracts")
+    monkeypatch.setattr(parser, "parse_text", no_parse)
+    assert again.model == ws.model and again.deferred is None  # served from the cache, not parsed
+
+
+def test_a_contract_edited_after_the_cache_was_read_is_loaded_from_the_file(tmp_path: Path) -> None:
+    ws = _ws(tmp_path)
+    ws.model
+    wscache.save(ws)
+    again = Workspace(tmp_path)
+    assert wscache.restore(again)
+    (tmp_path / "contracts" / "a.rcl").write_text(RCL.replace("0 <= out.v", "2 <= out.v"))
+    from rclverify.rcl.printer import expr_to_rcl
+    assert expr_to_rcl(again.checked.nodes["A"].node.guarantees[0].formula) == "2 <= out.v"

@@ -24,7 +24,7 @@ import hashlib
 from dataclasses import dataclass
 from functools import cached_property
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, Callable, cast
 
 from .evidence.records import Evidence, Obligation
 from .evidence.store import EvidenceStore, atomic_write_text, read_json, write_json, write_obligations
@@ -45,6 +45,28 @@ if TYPE_CHECKING:
 PLAN = "contracts/plan.yaml"
 
 
+@dataclass(frozen=True)
+class TaskIndex:
+    """What defining a workspace's doit tasks needs of its loaded plan and
+    model (:func:`rclverify.tasks.build_tasks`), small enough to be read on
+    every run: a no-op run of a large system reads this and not the checked
+    contracts (:mod:`rclverify.wscache`, docs/scale.md).
+
+    ``nodes`` in source order; ``producers[n]`` the nodes feeding ``n`` (system
+    model, rule R3's premises); ``contracts`` the plan's contract files;
+    ``replacement[n]`` the file of ``n``'s replacement contract (plan
+    ``replacements``); ``entries[n]`` the config mappings of ``n``'s plan
+    evidence entries, in plan order (the files they name are dependencies of
+    ``export:n``).  Paths are workspace-relative strings.
+    """
+
+    nodes: tuple[str, ...]
+    producers: dict[str, tuple[str, ...]]
+    contracts: tuple[str, ...]
+    replacement: dict[str, str]
+    entries: dict[str, tuple[Any, ...]]
+
+
 @dataclass
 class Workspace:
     """A workspace root plus its plan; loads and checks lazily (cached).
@@ -58,16 +80,39 @@ class Workspace:
     #: Parsed contract files of an earlier load, ``rel -> (sha256 of the text, Spec)``;
     #: a file whose text has the same hash is not parsed again (see :mod:`rclverify.wscache`).
     parsed: dict[str, tuple[str, ast.Spec]] = dataclasses.field(default_factory=dict, repr=False, compare=False)
+    #: Set by :func:`rclverify.wscache.restore`: fills ``plan``, ``checked`` and
+    #: ``model`` from the cache the first time one of them is needed.
+    deferred: Callable[["Workspace"], None] | None = dataclasses.field(default=None, repr=False, compare=False)
 
     def path(self, rel: str) -> Path:
         return self.root / rel
 
+    def _cached(self, name: str) -> Any:
+        """Run the deferred cache load once; then ``name``'s value if it filled it, else None."""
+        if self.deferred is not None:
+            load, self.deferred = self.deferred, None
+            load(self)
+        return self.__dict__.get(name)
+
     @cached_property
     def plan(self) -> Plan:
-        return load_plan(self.root, self.plan_file)
+        cached = self._cached("plan")
+        return cached if cached is not None else load_plan(self.root, self.plan_file)
+
+    @cached_property
+    def index(self) -> TaskIndex:
+        """The :class:`TaskIndex` of the loaded workspace (raises like :attr:`model`)."""
+        plan, model = self.plan, self.model
+        return TaskIndex(
+            nodes=tuple(self.checked.nodes), producers={n: tuple(model.producers(n)) for n in self.checked.nodes},
+            contracts=tuple(plan.contracts), replacement={n: r[0].rpartition(":")[0] for n, r in plan.replacements.items()},
+            entries={n: tuple(e.config for e in es) for n, es in plan.evidence.items()})
 
     @cached_property
     def checked(self) -> Checked:
+        cached = self._cached("checked")
+        if cached is not None:
+            return cast(Checked, cached)
         from .rcl.parser import parse_text
         from .rcl.typecheck import check
         plan = self.plan
@@ -94,9 +139,12 @@ class Workspace:
 
     @cached_property
     def model(self) -> SystemModel:
-        return build(self.checked, self.plan.connections)
+        cached = self._cached("model")
+        return cast(SystemModel, cached) if cached is not None else build(self.checked, self.plan.connections)
 
     def node_names(self) -> list[str]:
+        if "index" in self.__dict__:
+            return list(self.index.nodes)
         return list(self.checked.nodes)
 
     # -- artifact paths ---------------------------------------------------------------

@@ -18,6 +18,10 @@ missing cache, another code version or another path means a normal load.  Only w
 an error is always reported from the files themselves.  The cache is written
 atomically and is a pure speed-up: deleting ``artifacts/cache`` is always
 safe.  Like ``dodo.py`` it is trusted code of the workspace (pickle).
+
+A no-op run needs only the :class:`~rclverify.pipeline.TaskIndex` (node
+names, producers, plan entries) to define its tasks; the checked contracts
+are unpickled only when a task first needs them (``Workspace.deferred``).
 """
 from __future__ import annotations
 
@@ -34,7 +38,7 @@ if TYPE_CHECKING:
     from .pipeline import Workspace
 
 CACHE = "artifacts/cache/workspace.pickle"
-_FORMAT = 2
+_FORMAT = 3
 
 
 def _sha(path: Path) -> str:
@@ -61,8 +65,16 @@ def _header(ws: "Workspace", contracts: tuple[str, ...]) -> dict[str, Any]:
 
 
 def restore(ws: "Workspace") -> bool:
-    """Fill ``ws``'s plan, checked contracts and model from the cache when it
-    is valid for the files on disk.  Returns whether it did; never raises.
+    """Fill ``ws``'s task index now, and its plan, checked contracts and
+    model on first use, from the cache when it is valid for the files on
+    disk.  Returns whether it did; never raises.
+
+    The cache holds the header, then the small :class:`~rclverify.pipeline.TaskIndex`,
+    then the large part: plan and parsed contracts, then checked contracts
+    and model.
+    A valid cache sets ``ws.index`` at once and leaves the large part for
+    ``ws.deferred`` (:func:`_load_deferred`): a no-op doit run defines its
+    tasks from the index alone and never unpickles the contracts.
 
     When some input changed, what is still valid is reused: the parsed
     contract files whose text is unchanged (``ws.parsed``, checked against
@@ -79,23 +91,47 @@ def restore(ws: "Workspace") -> bool:
             now = _header(ws, tuple(header.get("contracts", ())))
             if any(header.get(k) != now[k] for k in ("root", "plan_file", "code")):
                 return False
-            gc_was_enabled = gc.isenabled()
-            gc.disable()  # the loaded objects are all live: collecting during the load only costs time
-            try:
-                plan, parsed, checked, model = pickle.load(fh)
-            finally:
-                if gc_was_enabled:
-                    gc.enable()
+            index = pickle.load(fh)
             if header == now:
-                ws.__dict__.update(plan=plan, checked=checked, model=model)  # the cached_property slots
-                ws.parsed.update(parsed)
+                offset = fh.tell()
+                ws.__dict__["index"] = index
+                ws.deferred = lambda w: _load_deferred(w, header, offset)
                 return True
+            plan, parsed = _load_large(fh)  # not the checked contracts and model: they are rebuilt
     except Exception:  # a missing, damaged or foreign cache is simply not used
         return False
     ws.parsed.update(parsed)  # re-validated per file by Workspace.checked
     if header.get("plan") == now["plan"] and all((ws.root / c).is_file() for c in plan.contracts):
         ws.__dict__["plan"] = plan
     return False
+
+
+def _load_large(fh: Any) -> Any:
+    gc_was_enabled = gc.isenabled()
+    gc.disable()  # the loaded objects are all live: collecting during the load only costs time
+    try:
+        return pickle.load(fh)
+    finally:
+        if gc_was_enabled:
+            gc.enable()
+
+
+def _load_deferred(ws: "Workspace", header: dict[str, Any], offset: int) -> None:
+    """Fill ``ws``'s plan, parsed and checked contracts and model from the
+    cache that :func:`restore` validated, if the cache file and the inputs
+    are still those of ``header``; else fill nothing (``ws`` then loads from
+    the files, reusing nothing).  Never raises."""
+    try:
+        with open(ws.root / CACHE, "rb") as fh:
+            if pickle.load(fh) != header or _header(ws, tuple(header["contracts"])) != header:
+                return  # the cache was rewritten or an input changed since the run started
+            fh.seek(offset)
+            plan, parsed = _load_large(fh)
+            checked, model = _load_large(fh)
+    except Exception:
+        return
+    ws.__dict__.update(plan=plan, checked=checked, model=model)  # the cached_property slots
+    ws.parsed.update(parsed)
 
 
 def save(ws: "Workspace") -> None:
@@ -108,7 +144,9 @@ def save(ws: "Workspace") -> None:
         fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=".workspace.", suffix=".tmp")
         with os.fdopen(fd, "wb") as fh:
             pickle.dump(header, fh, protocol=pickle.HIGHEST_PROTOCOL)
-            pickle.dump((ws.plan, ws.parsed, ws.checked, ws.model), fh, protocol=pickle.HIGHEST_PROTOCOL)
+            pickle.dump(ws.index, fh, protocol=pickle.HIGHEST_PROTOCOL)
+            pickle.dump((ws.plan, ws.parsed), fh, protocol=pickle.HIGHEST_PROTOCOL)
+            pickle.dump((ws.checked, ws.model), fh, protocol=pickle.HIGHEST_PROTOCOL)
         os.replace(tmp, path)
     except Exception:
         try:

@@ -26,7 +26,9 @@ from __future__ import annotations
 import dataclasses
 import gc
 from itertools import accumulate
+import os
 import re
+import sys
 import threading
 from contextlib import contextmanager
 from functools import lru_cache
@@ -34,6 +36,7 @@ from importlib import resources
 from pathlib import Path
 from typing import Any, Callable, Iterable, Iterator, Mapping, cast
 
+import lark
 from lark import Lark, Token, Transformer
 from lark.parsers.lalr_analysis import Shift
 from lark.exceptions import UnexpectedCharacters, UnexpectedEOF, UnexpectedInput, UnexpectedToken
@@ -61,13 +64,31 @@ def grammar_text() -> str:
     return resources.files("rclverify.rcl").joinpath("rcl.lark").read_text(encoding="utf-8")
 
 
+def lark_cache_file(name: str) -> str | bool:
+    """Where lark keeps the analysed LALR tables of the grammar ``name``
+    (lark's own ``cache`` option): ``$XDG_CACHE_HOME/rclverify`` or
+    ``~/.cache/rclverify``.  Building the RCL tables costs about 0.25 s, a
+    tenth of a doit run that re-parses one edited contract; loading them
+    costs 0.02 s (docs/scale.md).  lark stores the sha256 of the grammar and
+    options in the file and rebuilds (and rewrites) the tables when they
+    differ, and falls back to building them when the file cannot be read or
+    written.  Returns ``False`` (no cache) when the directory cannot be made."""
+    base = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
+    folder = os.path.join(base, "rclverify")
+    try:
+        os.makedirs(folder, exist_ok=True)
+    except OSError:
+        return False
+    return os.path.join(folder, f"{name}-lark{lark.__version__}-py{sys.version_info[0]}{sys.version_info[1]}.cache")
+
+
 @lru_cache(maxsize=1)
 def _lark() -> Lark:
     """The LALR(1) parser with the AST builder applied during parsing
     (no intermediate parse tree).  ``keep_all_tokens`` keeps keywords and
     punctuation in the children so every AST node spans its full text."""
     return Lark(grammar_text(), parser="lalr", start=["start", "expr"], keep_all_tokens=True,
-                maybe_placeholders=True, transformer=_BUILDER)
+                maybe_placeholders=True, transformer=_BUILDER, cache=lark_cache_file("rcl"))
 
 
 def describe_terminal(parser: Lark, term: str, friendly: Mapping[str, str]) -> str:
