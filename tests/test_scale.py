@@ -118,7 +118,7 @@ def test_a_valid_cache_defers_the_checked_contracts_until_a_task_needs_them(tmp_
     wscache.save(ws)
     again = Workspace(tmp_path)
     assert wscache.restore(again)
-    # the task index is there at once; plan, contracts and model are not unpickled yet
+    # the task index is there at once; the plan and the parsed contracts are not unpickled yet
     assert again.index.nodes == ("A",) and again.index.contracts == ("contracts/a.rcl",)
     assert {"plan", "checked", "model"}.isdisjoint(again.__dict__) and again.deferred is not None
     import rclverify.rcl.parser as parser
@@ -126,7 +126,7 @@ def test_a_valid_cache_defers_the_checked_contracts_until_a_task_needs_them(tmp_
     def no_parse(*args: object, **kwargs: object) -> None:
         raise AssertionError("parsed although the cache holds the checked contracts")
     monkeypatch.setattr(parser, "parse_text", no_parse)
-    assert again.model == ws.model and again.deferred is None  # served from the cache, not parsed
+    assert again.model == ws.model and again.deferred is None  # type-checked from the cached parse
 
 
 def test_a_contract_edited_after_the_cache_was_read_is_loaded_from_the_file(tmp_path: Path) -> None:

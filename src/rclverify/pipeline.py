@@ -80,24 +80,24 @@ class Workspace:
     #: Parsed contract files of an earlier load, ``rel -> (sha256 of the text, Spec)``;
     #: a file whose text has the same hash is not parsed again (see :mod:`rclverify.wscache`).
     parsed: dict[str, tuple[str, ast.Spec]] = dataclasses.field(default_factory=dict, repr=False, compare=False)
-    #: Set by :func:`rclverify.wscache.restore`: fills ``plan``, ``checked`` and
-    #: ``model`` from the cache the first time one of them is needed.
+    #: Set by :func:`rclverify.wscache.restore`: fills ``plan`` and ``parsed``
+    #: from the cache the first time the plan or the checked contracts are needed.
     deferred: Callable[["Workspace"], None] | None = dataclasses.field(default=None, repr=False, compare=False)
 
     def path(self, rel: str) -> Path:
         return self.root / rel
 
-    def _cached(self, name: str) -> Any:
-        """Run the deferred cache load once; then ``name``'s value if it filled it, else None."""
+    def _run_deferred(self) -> None:
+        """Run the deferred cache load (once): it may fill ``plan`` and ``parsed``."""
         if self.deferred is not None:
             load, self.deferred = self.deferred, None
             load(self)
-        return self.__dict__.get(name)
 
     @cached_property
     def plan(self) -> Plan:
-        cached = self._cached("plan")
-        return cached if cached is not None else load_plan(self.root, self.plan_file)
+        self._run_deferred()
+        cached = self.__dict__.get("plan")
+        return cast(Plan, cached) if cached is not None else load_plan(self.root, self.plan_file)
 
     @cached_property
     def index(self) -> TaskIndex:
@@ -110,9 +110,7 @@ class Workspace:
 
     @cached_property
     def checked(self) -> Checked:
-        cached = self._cached("checked")
-        if cached is not None:
-            return cast(Checked, cached)
+        self._run_deferred()
         from .rcl.parser import parse_text
         from .rcl.typecheck import check
         plan = self.plan
@@ -139,8 +137,7 @@ class Workspace:
 
     @cached_property
     def model(self) -> SystemModel:
-        cached = self._cached("model")
-        return cast(SystemModel, cached) if cached is not None else build(self.checked, self.plan.connections)
+        return build(self.checked, self.plan.connections)
 
     def node_names(self) -> list[str]:
         if "index" in self.__dict__:
