@@ -3,9 +3,8 @@
 obligation is discharged.  All logic lives in rclverify.tasks."""
 from pathlib import Path
 
-from rclverify.progress import ProgressReporter
-from rclverify.tasks import build_tasks
+from rclverify.tasks import build_tasks, doit_config
 
-DOIT_CONFIG = {"default_tasks": ["verify"], "verbosity": 2, "dep_file": ".doit.db", "reporter": ProgressReporter}
+DOIT_CONFIG = doit_config()
 
 globals().update(build_tasks(Path(__file__).parent))

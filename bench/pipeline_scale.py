@@ -3,7 +3,7 @@
 Writes a synthetic workspace of N nodes for each N and measures, each in a
 fresh ``python -m doit`` process:
 
-* **cold**: ``doit verify`` on the fresh workspace (no artifacts, no .doit.db),
+* **cold**: ``doit verify`` on the fresh workspace (no artifacts, no doit state),
 * **no-op**: a second ``doit verify`` with nothing changed (must execute no task),
 * **edit**: ``doit verify`` after editing one contract (the middle node's
   second guarantee), with the tasks that ran,
@@ -66,9 +66,9 @@ ELSE
 DODO = """\
 from pathlib import Path
 
-from rclverify.tasks import build_tasks
+from rclverify.tasks import build_tasks, doit_config
 
-DOIT_CONFIG = {"default_tasks": ["verify"], "verbosity": 2, "dep_file": ".doit.db"}
+DOIT_CONFIG = doit_config()
 
 globals().update(build_tasks(Path(__file__).parent))
 """

@@ -94,7 +94,7 @@ def test_evidence_from_a_local_cluster_equals_the_local_run(tmp_path: Path) -> N
     r = _verify(local)
     assert r.returncode == 0, r.stdout + r.stderr
     remote = tmp_path / "remote"
-    shutil.copytree(tmp_path / "local", remote, ignore=shutil.ignore_patterns("artifacts", "reports", ".doit.db*"))
+    shutil.copytree(tmp_path / "local", remote, ignore=shutil.ignore_patterns("artifacts", "reports", ".doit.db*", ".doit.sqlite*"))
     with distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=False, dashboard_address=None, protocol="tcp://",
                                   host="127.0.0.1") as cluster:
         r = _verify(remote, "--cluster", cluster.scheduler_address)

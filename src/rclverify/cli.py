@@ -162,13 +162,11 @@ def cmd_report(args: argparse.Namespace) -> int:
 def cmd_verify(args: argparse.Namespace) -> int:
     from doit.cmd_base import ModuleTaskLoader
     from doit.doit_cmd import DoitMain
-    from .tasks import build_tasks
+    from .tasks import DEP_FILE, build_tasks, doit_config
     tasks = build_tasks(Path(args.workspace), args.plan)
     module = type(sys)("rclverify_dodo")
     module.__dict__.update(tasks)
-    module.DOIT_CONFIG = {"verbosity": 2, "dep_file": str(Path(args.workspace) / ".doit.db")}  # type: ignore[attr-defined]
-    from .progress import ProgressReporter
-    module.DOIT_CONFIG["reporter"] = ProgressReporter
+    module.DOIT_CONFIG = doit_config(str(Path(args.workspace) / DEP_FILE))  # type: ignore[attr-defined]
     argv = ["verify"] + (["--strict"] if args.strict else [])
     if args.jobs > 1:
         argv = ["-n", str(args.jobs)] + argv
