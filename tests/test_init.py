@@ -32,7 +32,7 @@ def test_init_then_doit_verify_works_in_a_fresh_directory(tmp_path: Path) -> Non
                        timeout=300)
     assert r.returncode == 0, r.stdout + r.stderr
     # not a terminal: doit's task lines, no progress line, the summary table in plain ASCII
-    assert ".  compose:Planner" in r.stdout and "\x1b[" not in r.stdout and "obligations  running" not in r.stdout
+    assert ".  node:Planner" in r.stdout and "\x1b[" not in r.stdout and "obligations  running" not in r.stdout
     assert "| total " in r.stdout and r.stdout.rstrip().endswith("report: reports/assurance.html")
     report = json.loads((ws / "reports" / "assurance.json").read_text())
     assert report["meta"]["workspace"] == "rover" and not report["lint"]

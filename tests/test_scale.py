@@ -138,3 +138,14 @@ def test_a_contract_edited_after_the_cache_was_read_is_loaded_from_the_file(tmp_
     (tmp_path / "contracts" / "a.rcl").write_text(RCL.replace("0 <= out.v", "2 <= out.v"))
     from rclverify.rcl.printer import expr_to_rcl
     assert expr_to_rcl(again.checked.nodes["A"].node.guarantees[0].formula) == "2 <= out.v"
+
+
+def test_a_node_task_runs_only_the_stages_whose_inputs_changed() -> None:
+    from rclverify.tasks import NODE_STAGES, stages_to_run
+    deps = {"compose": ["/w/a/snap/N.json", "/w/a/snap/P.json", "/w/a/model.json"],
+            "health": ["/w/a/snap/N.json"], "export": ["/w/a/snap/N.json", "/w/backends/prog.imp"]}
+    assert stages_to_run(deps, ["/w/a/snap/N.json"]) == ["compose", "health", "export"]
+    assert stages_to_run(deps, ["/w/a/snap/P.json"]) == ["compose"]  # a producer changed: side conditions only
+    assert stages_to_run(deps, ["/w/backends/prog.imp"]) == ["export"]
+    assert stages_to_run(deps, ["/w/a/model.json", "/w/backends/prog.imp"]) == ["compose", "export"]
+    assert stages_to_run(deps, []) == list(NODE_STAGES)  # no reason by file (forced run): everything

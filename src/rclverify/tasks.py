@@ -5,19 +5,25 @@ Stages and their real file dependencies, per node ``N``:
 ``check``          contracts + plan -> artifacts/contracts/N.json (one snapshot per
                    node, rewritten only when that node's text changes), model, lint
 ``graph``          model.dot -> model.svg (when graphviz is installed)
-``compose:N``      snapshot of N and of N's producers + model -> calculus/N.json
-``health:N``       snapshot of N -> health/N.json
-``export:N``       snapshot of N + the backend input files -> obligations/N.json
+``node:N``         three stages, each run only when one of its own inputs changed:
+                   compose  snapshot of N and of N's producers + model -> calculus/N.json
+                   health   snapshot of N (+ replacement contract) -> health/N.json
+                   export   snapshot of N + the backend input files -> obligations/N.json
 ``evidence:ID``     one obligation's record + the files it reads -> its evidence record
-                   (created after ``export`` ran, when the obligations are known)
+                   (created after ``node`` ran, when the obligations are known)
 ``report``         every artifact above -> reports/assurance.{html,md,json}
                    and the CI formats reports/assurance.sarif, assurance.junit.xml
 ``verify``         the whole pipeline; ``doit verify --strict`` fails unless every
                    obligation is discharged
 
 doit compares file contents (md5), so editing one node's contract changes
-only that node's snapshot: its compose/health/export/run tasks, its
-consumers' compose tasks (their side conditions) and the report re-run.
+only that node's snapshot: its node task (all three stages) and run tasks,
+its consumers' node tasks (the compose stage only: their side conditions)
+and the report re-run.  The three stages share one doit task per node
+because doit's own cost per task (defining it, checking its dependencies)
+was most of a no-op run of a large system (docs/scale.md); the task's
+action gets doit's list of changed dependencies and runs the stages that
+read one of them (:func:`stages_to_run`).
 Actions are module-level functions with plain arguments, so ``doit -n 2``
 (parallel processes) behaves like a serial run.
 
@@ -32,7 +38,7 @@ import json
 import os
 import shutil
 from pathlib import Path
-from typing import Any, Callable, Iterator, TypeVar, cast
+from typing import Any, Callable, Iterator, Mapping, Sequence, TypeVar, cast
 
 from doit import create_after as _create_after
 from doit.exceptions import TaskFailed
@@ -106,12 +112,38 @@ def act_graph(root: str) -> Any:
     return None
 
 
-def act_node(root: str, stage: str, node: str) -> Any:
+#: The stages of a ``node:<Node>`` task, in the order they run.
+NODE_STAGES = ("compose", "health", "export")
+
+
+def stages_to_run(deps: Mapping[str, Sequence[str]], changed: Sequence[str]) -> list[str]:
+    """The stages of a node task whose own file dependencies are among
+    ``changed`` (doit's ``dep_changed``), in :data:`NODE_STAGES` order.
+
+    ``deps`` maps each stage to its file dependencies.  An empty ``changed``
+    means doit gave no reason by file (a forced run, ``doit -a``, a changed
+    ``uptodate`` check): every stage runs.  A missing target makes doit list
+    every dependency as changed, so every stage runs then too.
+    """
+    if not changed:
+        return list(NODE_STAGES)
+    hit = set(changed)
+    return [stage for stage in NODE_STAGES if hit.intersection(deps[stage])]
+
+
+def act_node(root: str, node: str, deps: dict[str, list[str]], changed: list[str]) -> Any:
+    """Run the stages of ``node`` whose inputs changed (:func:`stages_to_run`).
+
+    ``changed`` is filled by doit (the task's file dependencies that changed
+    since its last successful run)."""
     from . import pipeline
+    stages = stages_to_run(deps, changed)
     try:
-        getattr(pipeline, f"stage_{stage}")(_ws(root), node)
+        for stage in stages:
+            getattr(pipeline, f"stage_{stage}")(_ws(root), node)
     except RclError as exc:
         return _fail(exc)
+    print(f"{node}: {', '.join(stages)}")
     return None
 
 
@@ -262,36 +294,24 @@ def build_tasks(root: str | Path, plan_file: str = "contracts/plan.yaml") -> dic
         return {"actions": [(act_graph, [r])], "file_dep": [str(rootp / ws.DOT)], "task_dep": ["check"],
                 "uptodate": [config_changed(_tool_fingerprint()["dot"] or "")], "verbosity": 2}
 
-    def node_tasks(stage: str, doc: str, deps: Callable[[str], list[str]], target: Callable[[str], str]) -> Iterator[dict[str, Any]]:
-        yield {"basename": stage, "name": None, "doc": doc}
+    def task_node() -> Iterator[dict[str, Any]]:
+        """One task per node: its calculus, health checks and exported obligations."""
+        assert index is not None  # registered only when ok, i.e. the model was built
+        model_json, seen = at(ws.MODEL), dict[str, tuple[str, ...]]()
+        yield {"basename": "node", "name": None,
+               "doc": "Per node, each when its own inputs changed: apply the calculus (R1-R4, side conditions "
+                      "discharged with Z3), check contract health, export the guarantees as obligations."}
         for n in nodes:
-            yield {"name": n, "actions": [(act_node, [r, stage, n])], "file_dep": deps(n),
-                   "targets": [at(target(n))], "verbosity": 2, "clean": True}
-
-    def task_compose() -> Iterator[dict[str, Any]]:
-        assert index is not None  # task_compose is registered only when ok, i.e. the model was built
-        producers = index.producers
-        return node_tasks("compose", "Apply the calculus (R1-R4): discharge side conditions with Z3, derive properties.",
-                          lambda n: [snap[n]] + [snap[p] for p in producers[n]] + [at(ws.MODEL)],
-                          ws.calculus)
-
-    def task_health() -> Iterator[dict[str, Any]]:
-        assert index is not None
-        replacement = index.replacement
-
-        def deps(n: str) -> list[str]:
-            repl = replacement.get(n)
-            extra = [str(rootp / repl)] if repl and (rootp / repl).is_file() else []
-            return [snap[n]] + extra
-        return node_tasks("health", "Check contract health: satisfiable assumption, consistency, non-vacuity, "
-                          "and that a replacement contract refines the node's.", deps, ws.health)
-
-    def task_export() -> Iterator[dict[str, Any]]:
-        assert index is not None
-        entries, seen = index.entries, dict[str, tuple[str, ...]]()
-        return node_tasks("export", "Export each node's guarantees as obligations to the plan's backends.",
-                          lambda n: [snap[n]] + [at(f) for config in entries.get(n, ()) for f in _inputs(config, rootp, seen)],
-                          ws.obligations)
+            repl = index.replacement.get(n)
+            deps = {
+                "compose": [snap[n], *(snap[p] for p in index.producers[n]), model_json],
+                "health": [snap[n]] + ([str(rootp / repl)] if repl and (rootp / repl).is_file() else []),
+                "export": [snap[n]] + [at(f) for config in index.entries.get(n, ()) for f in _inputs(config, rootp, seen)],
+            }
+            yield {"name": n, "actions": [(act_node, [r, n, deps])],
+                   "file_dep": sorted({d for ds in deps.values() for d in ds}),
+                   "targets": [at(ws.calculus(n)), at(ws.health(n)), at(ws.obligations(n))],
+                   "verbosity": 2, "clean": True}
 
     exported_memo: list[list[tuple[str, dict[str, Any]]]] = []
 
@@ -312,7 +332,7 @@ def build_tasks(root: str | Path, plan_file: str = "contracts/plan.yaml") -> dic
                 continue
         return out
 
-    @create_after(executed="export")
+    @create_after(executed="node")
     def task_evidence() -> Iterator[dict[str, Any]]:
         """Run the backends: one task per obligation, one evidence record each."""
         yield {"basename": "evidence", "name": None, "doc": "Run each backend on its obligations and record evidence."}
@@ -351,6 +371,6 @@ def build_tasks(root: str | Path, plan_file: str = "contracts/plan.yaml") -> dic
 
     creators: dict[str, Callable[[], Any]] = {"task_check": task_check, "task_verify": task_verify}
     if ok:
-        creators.update({"task_graph": task_graph, "task_compose": task_compose, "task_health": task_health,
-                         "task_export": task_export, "task_evidence": task_evidence, "task_report": task_report})
+        creators.update({"task_graph": task_graph, "task_node": task_node, "task_evidence": task_evidence,
+                         "task_report": task_report})
     return creators
