@@ -28,15 +28,16 @@ from typing import TYPE_CHECKING, Any, Callable, cast
 
 from .evidence.records import Evidence, Obligation
 from .evidence.store import EvidenceStore, atomic_write_text, read_json, write_json, write_obligations
-from .plan.load import Plan, load_plan, resolve
-from .rcl import ast
-from .rcl.errors import Diagnostic, RclError, error
-from .rcl.types import Checked
-from .system.model import SystemModel, build
+from .rcl.errors import RclError, error
 
 if TYPE_CHECKING:
     from .backends.base import NodeTarget
     from .health.checks import Finding
+    from .plan.load import Plan
+    from .rcl import ast
+    from .rcl.errors import Diagnostic
+    from .rcl.types import Checked
+    from .system.model import SystemModel
 
 # The parser, type checker, calculus, health checks, lint and backends are
 # imported where a stage uses them: a doit run that reuses the cached
@@ -97,7 +98,10 @@ class Workspace:
     def plan(self) -> Plan:
         self._run_deferred()
         cached = self.__dict__.get("plan")
-        return cast(Plan, cached) if cached is not None else load_plan(self.root, self.plan_file)
+        if cached is not None:
+            return cast("Plan", cached)
+        from .plan.load import load_plan
+        return load_plan(self.root, self.plan_file)
 
     @cached_property
     def index(self) -> TaskIndex:
@@ -111,6 +115,7 @@ class Workspace:
     @cached_property
     def checked(self) -> Checked:
         self._run_deferred()
+        from .plan.load import resolve
         from .rcl.parser import parse_text
         from .rcl.typecheck import check
         plan = self.plan
@@ -137,6 +142,7 @@ class Workspace:
 
     @cached_property
     def model(self) -> SystemModel:
+        from .system.model import build
         return build(self.checked, self.plan.connections)
 
     def node_names(self) -> list[str]:
@@ -189,6 +195,7 @@ def stage_check(ws: Workspace) -> dict[str, Any]:
 
     Returns the diagnostics JSON (lint warnings).  Raises RclError/PlanError.
     """
+    from .rcl import ast
     from .rcl.lint import lint
     from .rcl.printer import to_rcl
     checked, model = ws.checked, ws.model

@@ -21,12 +21,15 @@ import sys
 import time
 from typing import Any, Mapping
 
+from typing import TYPE_CHECKING
+
 from doit.reporter import ConsoleReporter
-from rich.console import Console
-from rich.live import Live
-from rich.text import Text
 
 from .report.summary import is_terminal
+
+if TYPE_CHECKING:  # rich is imported when the live line starts (a terminal): doit imports this on every run
+    from rich.live import Live
+    from rich.text import Text
 
 
 class _ChildLineWriter(io.TextIOBase):
@@ -110,6 +113,8 @@ class ProgressReporter(ConsoleReporter):  # type: ignore[misc]
         """Remember doit's task table (it grows when delayed tasks are created)."""
         self.tasks = tasks
         if self.live_mode:
+            from rich.console import Console
+            from rich.live import Live
             console = Console(file=sys.stdout, force_terminal=True)
             self.live = Live(self._line(), console=console, transient=True, refresh_per_second=4,
                              redirect_stdout=True, redirect_stderr=True, get_renderable=self._line)
@@ -163,6 +168,7 @@ class ProgressReporter(ConsoleReporter):  # type: ignore[misc]
             names, running = [], []
         total = sum(1 for name in names if name.startswith("evidence:"))
         obligations = f"{len(self.done)}/{total}" if total else "0/?"
+        from rich.text import Text
         line = Text()
         line.append(f"{self.stage:<9}", style="bold cyan")
         line.append(f" {obligations} obligations")

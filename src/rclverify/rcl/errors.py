@@ -8,9 +8,10 @@ traceback.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Iterable, Literal
+from typing import TYPE_CHECKING, Iterable, Literal
 
-from .ast import Loc
+if TYPE_CHECKING:  # annotations only: a no-op doit run imports this module but no AST
+    from .ast import Loc
 
 Severity = Literal["error", "warning"]
 

@@ -9,13 +9,10 @@ tables.  On a terminal the table has colours; otherwise it is plain ASCII
 from __future__ import annotations
 
 import sys
-from typing import IO, Any, Mapping
+from typing import IO, TYPE_CHECKING, Any, Mapping
 
-from rich import box
-from rich.console import Console
-from rich.markup import escape
-from rich.table import Table
-
+if TYPE_CHECKING:  # rich is imported where a table is drawn: doit imports this module on every run
+    from rich.table import Table
 from ..evidence.records import SEVERITY
 
 #: At most this many node rows (worst first); the rest are summed in one row.
@@ -90,6 +87,9 @@ def _merge(rows: list[dict[str, Any]], label: str) -> dict[str, Any]:
 
 def summary_table(report: Mapping[str, Any], colour: bool) -> Table:
     """The summary table of ``report`` (at most :data:`MAX_ROWS` node rows + total)."""
+    from rich import box
+    from rich.markup import escape
+    from rich.table import Table
     rows = node_rows(report)
     shown, rest = rows[:MAX_ROWS], rows[MAX_ROWS:]
     if rest:
@@ -120,6 +120,7 @@ def print_summary(report: Mapping[str, Any], report_path: str, file: IO[str] | N
     (default: the current ``sys.stdout``).  ``terminal`` (default
     :func:`is_terminal`) selects colours and box drawing; otherwise plain
     ASCII, at most 120 columns wide."""
+    from rich.console import Console
     tty = is_terminal() if terminal is None else terminal
     console = Console(file=file or sys.stdout, force_terminal=tty, no_color=not tty, highlight=False,
                       width=None if tty else 120, soft_wrap=False)
