@@ -276,6 +276,7 @@ def build_tasks(root: str | Path, plan_file: str = "contracts/plan.yaml") -> dic
         contract_deps = [str(rootp / c) for c in (index.contracts if index is not None else ws.plan.contracts)]
     except RclError:
         contract_deps = []
+
     def at(rel: str) -> str:
         """The absolute path of a workspace-relative artifact path (string
         joining: ``pathlib`` cost 0.3 s of a 1000-node no-op run)."""
