@@ -1,0 +1,144 @@
+"""The hoare backend's export -> run memo (backends/hoare/memo.py): a run in the
+process of the export reuses what the export built, only for unchanged inputs,
+and produces exactly what a run without it produces."""
+from __future__ import annotations
+
+import dataclasses
+import shutil
+from pathlib import Path
+from typing import Any, Iterator
+
+import pytest
+
+from rclverify.backends.base import NodeTarget
+from rclverify.backends.hoare import HoareBackend, backend, memo
+from rclverify.evidence.records import Evidence
+from rclverify.rcl.typecheck import load
+
+REPO = Path(__file__).resolve().parents[1]
+RCL = "contracts/remote_inspection.rcl"
+PLAN = "contracts/plan.yaml"
+PROGRAM = "backends/hoare/radiation_sensor.imp"
+APPENDIX_B = "backends/hoare/radiation_sensor_appendix_b.imp"
+BINDING = {"in.r": "radiation_at(i)", "out.radiationStatus": "output"}
+C3 = "RadiationSensor.g1.hoare.radiation_sensor.c3"
+
+
+@pytest.fixture()
+def workspace(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Iterator[Path]:
+    """A copy of the case-study workspace; the memo starts and ends empty."""
+    for rel in (RCL, PLAN, PROGRAM, APPENDIX_B):
+        (tmp_path / rel).parent.mkdir(parents=True, exist_ok=True)
+        shutil.copy(REPO / rel, tmp_path / rel)
+    monkeypatch.chdir(tmp_path)
+    memo.clear()
+    yield tmp_path
+    memo.clear()
+
+
+@pytest.fixture()
+def rebuilds(monkeypatch: pytest.MonkeyPatch) -> list[str | None]:
+    """The ``only`` argument of every ``prepare`` call a run makes (a rebuild)."""
+    calls: list[str | None] = []
+    real = backend.prepare
+
+    def counting(target: NodeTarget, only: str | None = None) -> Any:
+        calls.append(only)
+        return real(target, only)
+
+    monkeypatch.setattr(backend, "prepare", counting)
+    return calls
+
+
+def target(root: Path, program: str = PROGRAM, **extra: Any) -> NodeTarget:
+    checked = load([RCL])  # a fresh load: new objects, as a workspace loaded again
+    return NodeTarget(root=root, checked=checked, node=checked.nodes["RadiationSensor"],
+                      config={"backend": "hoare", "program": program, "binding": dict(BINDING), **extra},
+                      contract_files=(RCL,), plan_file=PLAN, artifacts=root / "artifacts" / "hoare" / "RadiationSensor")
+
+
+def comparable(ev: Evidence) -> dict[str, Any]:
+    j = ev.to_json()
+    j.pop("started", None)
+    j.pop("duration_s", None)
+    return j
+
+
+def files(root: Path) -> dict[str, bytes]:
+    return {p.relative_to(root).as_posix(): p.read_bytes() for p in sorted((root / "artifacts").rglob("*"))
+            if p.is_file()}
+
+
+@pytest.mark.parametrize("program", [PROGRAM, APPENDIX_B])  # all discharged/pending; two refuted
+def test_run_after_export_reuses_it_and_gives_the_same_evidence_and_files(
+        workspace: Path, rebuilds: list[str | None], program: str) -> None:
+    t = target(workspace, program)
+    b = HoareBackend()
+    obligations = b.export(t)
+    served = {o.id: comparable(b.run(o, t)) for o in obligations}
+    assert rebuilds == [None]  # the export's own prepare; no run rebuilt its triple
+    served_files = files(workspace)
+    shutil.rmtree(workspace / "artifacts")
+    memo.clear()
+    again = b.export(t)
+    memo.clear()  # as in a process that did not export
+    rebuilt = {o.id: comparable(b.run(o, t)) for o in again}
+    assert len(rebuilds) == 1 + 1 + len(obligations)  # export, export, one rebuild per run
+    assert rebuilt == served
+    assert files(workspace) == served_files
+
+
+def test_a_triple_is_served_once(workspace: Path, rebuilds: list[str | None]) -> None:
+    t = target(workspace)
+    b = HoareBackend()
+    o = next(o for o in b.export(t) if o.id == C3)
+    first, second = b.run(o, t), b.run(o, t)
+    assert rebuilds == [None, C3]  # the second run rebuilt
+    assert comparable(first) == comparable(second)
+
+
+def test_an_edited_program_is_not_served_from_the_memo(workspace: Path, rebuilds: list[str | None]) -> None:
+    t = target(workspace)
+    b = HoareBackend()
+    obligations = {o.id: o for o in b.export(t)}
+    path = workspace / PROGRAM
+    path.write_text(path.read_text().replace("input < 250", "input < 200"))
+    ev = b.run(obligations[C3], t)
+    assert rebuilds == [None, C3]
+    assert ev.status == "failed" and 200 <= ev.counterexample["radiation_at(i)"] < 250
+    assert "input < 200" in (workspace / obligations[C3].artifact).read_text()  # the stale artifact replaced
+
+
+def test_a_reloaded_contract_is_not_served_from_the_memo(workspace: Path, rebuilds: list[str | None]) -> None:
+    b = HoareBackend()
+    obligations = {o.id: o for o in b.export(target(workspace))}
+    path = workspace / RCL
+    path.write_text(path.read_text().replace("in.r < 250 ->", "in.r < 260 ->").replace("(250 <= in.r", "(260 <= in.r"))
+    ev = b.run(obligations[C3], target(workspace))  # the workspace loaded again
+    assert rebuilds == [None, C3]
+    assert ev.status == "failed" and 250 <= ev.counterexample["radiation_at(i)"] < 260
+
+
+def test_a_changed_plan_entry_is_not_served_from_the_memo(workspace: Path, rebuilds: list[str | None]) -> None:
+    t = target(workspace)
+    b = HoareBackend()
+    obligations = {o.id: o for o in b.export(t)}
+    changed = dataclasses.replace(t, config={**t.config, "timeout_ms": 5000})
+    assert b.run(obligations[C3], changed).status == "discharged"
+    assert rebuilds == [None, C3]
+
+
+def test_export_prepares_each_triple_as_a_run_alone_does(workspace: Path) -> None:
+    """What makes the memo exact: a triple prepared among all of them has the
+    same Z3 terms (background axioms included) as prepared on its own."""
+    t = target(workspace)
+    for p in backend.prepare(t):
+        (alone,) = backend.prepare(t, only=p.id)
+        if p.triple is None:
+            assert alone.triple is None
+            continue
+        assert alone.triple is not None
+        assert [f.sexpr() for f in p.triple.background] == [f.sexpr() for f in alone.triple.background]
+        assert [(v.id, v.goal.sexpr(), [h.sexpr() for h in v.hyps]) for v in p.vcs] == \
+            [(v.id, v.goal.sexpr(), [h.sexpr() for h in v.hyps]) for v in alone.vcs]
+        assert dict(p.triple.names) == dict(alone.triple.names)
