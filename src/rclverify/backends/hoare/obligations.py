@@ -32,6 +32,7 @@ from __future__ import annotations
 import inspect
 import re
 from dataclasses import dataclass, field
+from functools import lru_cache
 from pathlib import Path
 from typing import Any, Mapping
 
@@ -378,11 +379,16 @@ class EncodedTriple:
     names: Mapping[str, str] = field(default_factory=dict)
 
 
+@lru_cache(maxsize=None)
+def _takes_bound(cls: type) -> bool:
+    """Whether ``cls.formula`` (an encoder's) has a ``bound`` parameter (asked once per class)."""
+    return "bound" in inspect.signature(cls.formula).parameters
+
+
 def _encode(enc: Encoder, e: ast.Expr, node: CheckedNode, symbols: Mapping[str, Any],
             bound: Mapping[str, z3.ExprRef]) -> z3.BoolRef:
     """Encode ``e`` with its free bound-variable names given by ``bound``."""
-    params = inspect.signature(enc.formula).parameters
-    if "bound" in params:
+    if _takes_bound(type(enc)):
         return enc.formula(e, node, symbols, bound=bound)
     # Encoder.formula has no way yet to give free (bound) variables; open a
     # quantifier over them and instantiate it with our terms instead.
