@@ -11,7 +11,7 @@ artifacts are overwritten).
 
 Prints, per stage, the CPU seconds of this process (``time.process_time``,
 less disturbed by other work on a shared machine than wall-clock time) and the
-wall-clock seconds.  The contracts are loaded and type-checked before the
+wall-clock seconds, and the process's peak resident memory.  The contracts are loaded and type-checked before the
 clock starts (doit does that once per process too).  ``--profile FILE`` writes
 a cProfile of both stages (profiling inflates the times).  The figures are
 printed, not asserted.
@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import argparse
 import cProfile
+import resource
 import shutil
 import sys
 import tempfile
@@ -87,6 +88,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         print(f"{'export':<8} {n_nodes:>6} {cpu_e:>7.2f} {wall_e:>7.2f}")
         print(f"{'run':<8} {n_runs:>6} {cpu_r:>7.2f} {wall_r:>7.2f}")
         print(f"{'total':<8} {'':>6} {cpu_e + cpu_r:>7.2f} {wall_e + wall_r:>7.2f}")
+        print(f"peak resident memory of this process: {resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024:.0f} MB")
     finally:
         if tmp is not None:
             shutil.rmtree(tmp, ignore_errors=True)

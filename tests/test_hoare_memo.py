@@ -142,3 +142,45 @@ def test_export_prepares_each_triple_as_a_run_alone_does(workspace: Path) -> Non
         assert [(v.id, v.goal.sexpr(), [h.sexpr() for h in v.hyps]) for v in p.vcs] == \
             [(v.id, v.goal.sexpr(), [h.sexpr() for h in v.hyps]) for v in alone.vcs]
         assert dict(p.triple.names) == dict(alone.triple.names)
+
+
+# ---------------------------------------------------------------------------
+# the low-level term walks of wp.py find what the typed API finds
+# ---------------------------------------------------------------------------
+
+def reference_terms(formulas: list[Any]) -> list[Any]:
+    """Sub-terms outside quantifiers, each once, through the typed API (children())."""
+    import z3
+    seen: set[int] = set()
+    out = []
+    stack = list(reversed(formulas))
+    while stack:
+        t = stack.pop()
+        if t.get_id() in seen:
+            continue
+        seen.add(t.get_id())
+        if z3.is_quantifier(t) or z3.is_var(t):
+            continue
+        out.append(t)
+        if z3.is_app(t):
+            stack.extend(reversed(t.children()))
+    return out
+
+
+def test_term_walks_match_the_typed_api(workspace: Path) -> None:
+    import z3
+    from rclverify.backends.hoare.wp import iter_terms, term_ids
+    t = target(workspace)
+    p = next(p for p in backend.prepare(t) if p.triple is not None)
+    m = p.model
+    i, out = m.consts["i"], m.consts["output"]
+    f = m.funcs["radiation_at"]
+    k = z3.Int("k")
+    extra = z3.And(f(i) >= z3.RealVal("1/3"), z3.ForAll([k], f(k) > 0), m.olds["i"] == i + 1, out == out)
+    formulas = [*p.vcs[0].hyps, p.vcs[0].goal, extra, extra]
+    ref = reference_terms(formulas)
+    assert [x.sexpr() for x in iter_terms(formulas)] == [x.sexpr() for x in ref]
+    assert term_ids(formulas) == {x.get_id() for x in ref}
+    assert [x.sexpr() for x in m.extern_applications(formulas)] == ["(radiation_at i)"]  # f(k): under a quantifier
+    assert [x.sexpr() for x in m.typing_facts(formulas)] == ["(>= i 0)", "(>= |old(i)| 0)"]
+    assert m.olds_in(formulas) == ["i"] and m.variables_in(formulas) == ["i", "output"]

@@ -33,8 +33,8 @@ from typing import Any
 
 from ..base import NodeTarget
 
-#: Most triples kept at once (each holds its Z3 terms and rendered text, a few kB).
-MAX_TRIPLES = 20_000
+#: Most triples kept at once (each holds its Z3 terms and rendered texts, some 10 kB).
+MAX_TRIPLES = 10_000
 
 
 @dataclass(frozen=True)
