@@ -13,26 +13,17 @@ import pytest
 from rclverify.backends.base import NodeTarget
 from rclverify.backends.hoare import HoareBackend, backend, memo
 from rclverify.evidence.records import Evidence
-from rclverify.rcl.typecheck import load
 
-REPO = Path(__file__).resolve().parents[1]
-RCL = "contracts/remote_inspection.rcl"
-PLAN = "contracts/plan.yaml"
-PROGRAM = "backends/hoare/radiation_sensor.imp"
-APPENDIX_B = "backends/hoare/radiation_sensor_appendix_b.imp"
-BINDING = {"in.r": "radiation_at(i)", "out.radiationStatus": "output"}
+import test_hoare
+from test_hoare import APPENDIX_B, PROGRAM, RCL, entry, workspace  # noqa: F401 - workspace: a fixture
+
 C3 = "RadiationSensor.g1.hoare.radiation_sensor.c3"
 
 
-@pytest.fixture()
-def workspace(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Iterator[Path]:
-    """A copy of the case-study workspace; the memo starts and ends empty."""
-    for rel in (RCL, PLAN, PROGRAM, APPENDIX_B):
-        (tmp_path / rel).parent.mkdir(parents=True, exist_ok=True)
-        shutil.copy(REPO / rel, tmp_path / rel)
-    monkeypatch.chdir(tmp_path)
+@pytest.fixture(autouse=True)
+def empty_memo() -> Iterator[None]:
     memo.clear()
-    yield tmp_path
+    yield
     memo.clear()
 
 
@@ -51,10 +42,9 @@ def rebuilds(monkeypatch: pytest.MonkeyPatch) -> list[str | None]:
 
 
 def target(root: Path, program: str = PROGRAM, **extra: Any) -> NodeTarget:
-    checked = load([RCL])  # a fresh load: new objects, as a workspace loaded again
-    return NodeTarget(root=root, checked=checked, node=checked.nodes["RadiationSensor"],
-                      config={"backend": "hoare", "program": program, "binding": dict(BINDING), **extra},
-                      contract_files=(RCL,), plan_file=PLAN, artifacts=root / "artifacts" / "hoare" / "RadiationSensor")
+    """The case study's target, from a fresh load of the contracts (new objects,
+    as a workspace loaded again)."""
+    return test_hoare.target(root, entry(program, **extra))
 
 
 def comparable(ev: Evidence) -> dict[str, Any]:
