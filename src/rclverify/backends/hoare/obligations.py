@@ -32,7 +32,6 @@ from __future__ import annotations
 import inspect
 import re
 from dataclasses import dataclass, field
-from functools import lru_cache
 from pathlib import Path
 from typing import Any, Mapping
 
@@ -379,16 +378,21 @@ class EncodedTriple:
     names: Mapping[str, str] = field(default_factory=dict)
 
 
-@lru_cache(maxsize=None)
-def _takes_bound(cls: type) -> bool:
-    """Whether ``cls.formula`` (an encoder's) has a ``bound`` parameter (asked once per class)."""
-    return "bound" in inspect.signature(cls.formula).parameters
+_TAKES_BOUND: dict[type, bool] = {}
+
+
+def _takes_bound(enc: Encoder) -> bool:
+    """Whether ``enc.formula`` has a ``bound`` parameter (asked once per encoder class)."""
+    cls = type(enc)
+    if cls not in _TAKES_BOUND:
+        _TAKES_BOUND[cls] = "bound" in inspect.signature(cls.formula).parameters
+    return _TAKES_BOUND[cls]
 
 
 def _encode(enc: Encoder, e: ast.Expr, node: CheckedNode, symbols: Mapping[str, Any],
             bound: Mapping[str, z3.ExprRef]) -> z3.BoolRef:
     """Encode ``e`` with its free bound-variable names given by ``bound``."""
-    if _takes_bound(type(enc)):
+    if _takes_bound(enc):
         return enc.formula(e, node, symbols, bound=bound)
     # Encoder.formula has no way yet to give free (bound) variables; open a
     # quantifier over them and instantiate it with our terms instead.
