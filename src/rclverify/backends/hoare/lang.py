@@ -425,11 +425,19 @@ def _syntax_error(exc: UnexpectedInput, file: str, text: str, dline: int, dcol: 
 
 
 @lru_cache(maxsize=512)
+def _tree(text: str, start: str) -> Any:
+    # Memoised apart from the locations: the same binding text (``x``) is
+    # written at a different place of the plan for every node, and lark's
+    # parse is most of the cost; the transformer below does not change the tree.
+    return _lark().parse(text, start=start)
+
+
+@lru_cache(maxsize=512)
 def _parse(text: str, file: str, start: str, dline: int, dcol: int) -> Any:
     # Memoised: the AST is immutable (frozen dataclasses and tuples), and one
     # process checks many triples over the same program file and bindings.
     try:
-        tree = _lark().parse(text, start=start)
+        tree = _tree(text, start)
     except UnexpectedInput as exc:
         raise _syntax_error(exc, file, text, dline, dcol) from None
     try:

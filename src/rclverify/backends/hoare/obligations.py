@@ -378,11 +378,21 @@ class EncodedTriple:
     names: Mapping[str, str] = field(default_factory=dict)
 
 
+_TAKES_BOUND: dict[type, bool] = {}
+
+
+def _takes_bound(enc: Encoder) -> bool:
+    """Whether ``enc.formula`` has a ``bound`` parameter (asked once per encoder class)."""
+    cls = type(enc)
+    if cls not in _TAKES_BOUND:
+        _TAKES_BOUND[cls] = "bound" in inspect.signature(cls.formula).parameters
+    return _TAKES_BOUND[cls]
+
+
 def _encode(enc: Encoder, e: ast.Expr, node: CheckedNode, symbols: Mapping[str, Any],
             bound: Mapping[str, z3.ExprRef]) -> z3.BoolRef:
     """Encode ``e`` with its free bound-variable names given by ``bound``."""
-    params = inspect.signature(enc.formula).parameters
-    if "bound" in params:
+    if _takes_bound(enc):
         return enc.formula(e, node, symbols, bound=bound)
     # Encoder.formula has no way yet to give free (bound) variables; open a
     # quantifier over them and instantiate it with our terms instead.

@@ -16,7 +16,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from fractions import Fraction
-from typing import Mapping, Sequence
+from typing import Callable, Mapping, Sequence
 
 import z3
 
@@ -147,6 +147,13 @@ def z3_text(t: z3.ExprRef, names: Mapping[str, str] | None = None) -> str:
     return _Printer(names or {}).go(t)
 
 
+def term_printer(names: Mapping[str, str] | None = None) -> Callable[[z3.ExprRef], str]:
+    """:func:`z3_text` with ``names`` for many terms: the text of each term is
+    the same, and subterms the terms share are rendered once (the precondition
+    and postcondition of a triple are also lines of its proof outline)."""
+    return _Printer(names or {}).go
+
+
 @dataclass(frozen=True)
 class OutlineLine:
     """A rendered line: ``indent`` (spaces), ``text`` (``{ P }`` or code) and ``note``."""
@@ -157,17 +164,19 @@ class OutlineLine:
 
 
 def render_outline(items: Sequence[OutlineItem], names: Mapping[str, str] | None = None,
-                   precondition: z3.BoolRef | None = None, pre_note: str = "") -> list[OutlineLine]:
+                   precondition: z3.BoolRef | None = None, pre_note: str = "",
+                   show: Callable[[z3.ExprRef], str] | None = None) -> list[OutlineLine]:
     """Turn outline items into lines; a ``precondition`` (the triple's) is
-    put first, with ``pre_note`` (e.g. which VC shows it implies the next)."""
+    put first, with ``pre_note`` (e.g. which VC shows it implies the next).
+    ``show`` renders the assertions (default: a :func:`term_printer` of ``names``)."""
     out: list[OutlineLine] = []
-    printer = _Printer(names or {})  # one for all lines: they share subterms (see _Printer.memo)
+    go = show or term_printer(names)  # one for all lines: they share subterms (see _Printer.memo)
     if precondition is not None:
-        out.append(OutlineLine(0, "{ " + printer.go(precondition) + " }", pre_note))
+        out.append(OutlineLine(0, "{ " + go(precondition) + " }", pre_note))
     for it in items:
         if it.kind == "assert":
             assert it.formula is not None
-            out.append(OutlineLine(2 * it.depth, "{ " + printer.go(it.formula) + " }", it.note))
+            out.append(OutlineLine(2 * it.depth, "{ " + go(it.formula) + " }", it.note))
         else:
             out.append(OutlineLine(2 * it.depth, it.text))
     return out

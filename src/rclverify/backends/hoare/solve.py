@@ -79,9 +79,9 @@ def json_value(v: z3.ExprRef) -> Any:
     return z3_text(v)
 
 
-def _smt2(formulas: Sequence[z3.BoolRef], title: str) -> str:
-    s = z3.Solver()
-    s.add(*formulas)
+def _smt2(s: z3.Solver, title: str) -> str:
+    """The query text of solver ``s``, which holds the query's formulas and has
+    not been checked yet (its options, e.g. the budget, are not part of the text)."""
     # Solver.sexpr() names shared subterms a!1, a!2 ... in order (to_smt2()
     # uses internal ids, which differ between processes): deterministic text.
     return f"; {title}\n" + str(s.sexpr()) + "(check-sat)\n"
@@ -99,8 +99,8 @@ def check_vc(vc: VC, background: Sequence[z3.BoolRef], m: ProgramModel, timeout_
     formulas = [*hyps, z3.Not(vc.goal)]
     s = budgeted_solver(timeout_ms)
     s.add(*formulas)
+    text = _smt2(s, f"{vc.id}: {vc.label}; unsat means the condition holds")
     r = s.check()
-    text = _smt2(formulas, f"{vc.id}: {vc.label}; unsat means the condition holds")
     if r == z3.unsat:
         return VCResult(vc, "valid", text, hyps=hyps)
     if r == z3.sat:

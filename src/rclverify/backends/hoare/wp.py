@@ -31,9 +31,10 @@ proof figures.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Iterator, Literal, Protocol
+from typing import Any, Iterator, Literal, Protocol
 
 import z3
+from z3.z3 import _to_expr_ref  # the typed wrapper of a raw term (ArithRef, BoolRef ...)
 
 from ...logic.encode import apply_operator, widen
 from ...rcl.ast import Loc
@@ -111,50 +112,85 @@ class ProgramModel:
         NATURAL variable (and ``old(x)``) occurring, and ``f(a) >= 0`` for every
         application of an extern with a NATURAL result occurring outside
         quantifiers.  Sorted by text for determinism."""
-        nat_consts = {self.consts[n].get_id(): self.consts[n] for n, t in self.types.vars.items() if t == NATURAL}
-        nat_consts.update({self.olds[n].get_id(): self.olds[n] for n, t in self.types.vars.items() if t == NATURAL})
-        nat_funcs = {n for n, ft in self.types.externs.items() if ft.result == NATURAL}
+        nat_consts = {self.consts[n].get_id() for n, t in self.types.vars.items() if t == NATURAL}
+        nat_consts.update(self.olds[n].get_id() for n, t in self.types.vars.items() if t == NATURAL)
+        nat_funcs = {self.funcs[n].get_id() for n, ft in self.types.externs.items() if ft.result == NATURAL}
         facts: dict[str, z3.BoolRef] = {}
-        for t in iter_terms(formulas):
-            if t.get_id() in nat_consts or (z3.is_app(t) and t.num_args() > 0 and t.decl().name() in nat_funcs
-                                            and t.decl() == self.funcs[t.decl().name()]):
-                facts[t.sexpr()] = t >= 0
+        for t in _matching_terms(formulas, nat_consts, nat_funcs):
+            facts[t.sexpr()] = t >= 0
         return [facts[k] for k in sorted(facts)]
 
     def extern_applications(self, formulas: list[z3.BoolRef]) -> list[z3.ExprRef]:
         """Applications of externs in ``formulas`` (outside quantifiers), in first-seen order."""
-        out: dict[int, z3.ExprRef] = {}
-        for t in iter_terms(formulas):
-            if z3.is_app(t) and t.num_args() > 0 and t.decl().name() in self.funcs \
-                    and t.decl() == self.funcs[t.decl().name()]:
-                out.setdefault(t.get_id(), t)
-        return list(out.values())
+        return list(_matching_terms(formulas, set(), {f.get_id() for f in self.funcs.values()}))
 
     def variables_in(self, formulas: list[z3.BoolRef]) -> list[str]:
         """Program variables whose current-state constant occurs in ``formulas`` (declaration order)."""
-        ids = {t.get_id() for t in iter_terms(formulas)}
+        ids = term_ids(formulas)
         return [n for n in self.types.vars if self.consts[n].get_id() in ids]
 
     def olds_in(self, formulas: list[z3.BoolRef]) -> list[str]:
         """Program variables whose ``old(x)`` constant occurs in ``formulas``."""
-        ids = {t.get_id() for t in iter_terms(formulas)}
+        ids = term_ids(formulas)
         return [n for n in self.types.vars if self.olds[n].get_id() in ids]
+
+
+# Walking terms: Z3's low-level API directly.  The typed Python wrappers
+# (children(), is_app(), decl()) build and re-check an object per sub-term and
+# were most of the time spent in these walks (docs/scale.md); the order of the
+# walk and the terms found are the same.
+
+
+def _walk(formulas: list[z3.BoolRef]) -> Iterator[tuple[int, Any, int]]:
+    """``(ast id, ast, ast kind)`` of every sub-term of ``formulas`` outside
+    quantifier bodies, each once, in :func:`iter_terms` order."""
+    if not formulas:
+        return
+    ctx = formulas[0].ctx_ref()
+    seen: set[int] = set()
+    stack = [f.as_ast() for f in reversed(formulas)]
+    while stack:
+        a = stack.pop()
+        i = z3.Z3_get_ast_id(ctx, a)
+        if i in seen:
+            continue
+        seen.add(i)
+        k = z3.Z3_get_ast_kind(ctx, a)
+        if k != z3.Z3_APP_AST and k != z3.Z3_NUMERAL_AST:  # quantifiers and bound variables: not entered
+            continue
+        yield i, a, k
+        if k == z3.Z3_APP_AST:
+            n = z3.Z3_get_app_num_args(ctx, a)
+            stack.extend(z3.Z3_get_app_arg(ctx, a, j) for j in range(n - 1, -1, -1))
+
+
+def term_ids(formulas: list[z3.BoolRef]) -> set[int]:
+    """Z3 ids of every sub-term of ``formulas`` outside quantifier bodies."""
+    return {i for i, _, _ in _walk(formulas)}
+
+
+def _matching_terms(formulas: list[z3.BoolRef], const_ids: set[int], func_ids: set[int]) -> Iterator[z3.ExprRef]:
+    """Sub-terms of ``formulas`` (outside quantifiers, first-seen order) whose
+    id is in ``const_ids`` or that apply, to one or more arguments, a function
+    whose declaration's id is in ``func_ids``."""
+    if not formulas:
+        return
+    ctx, c = formulas[0].ctx_ref(), formulas[0].ctx
+    for i, a, k in _walk(formulas):
+        hit = i in const_ids
+        if not hit and func_ids and k == z3.Z3_APP_AST and z3.Z3_get_app_num_args(ctx, a) > 0:
+            hit = z3.Z3_get_func_decl_id(ctx, z3.Z3_get_app_decl(ctx, a)) in func_ids
+        if hit:
+            yield _to_expr_ref(a, c)
 
 
 def iter_terms(formulas: list[z3.BoolRef]) -> Iterator[z3.ExprRef]:
     """Every sub-term of ``formulas`` outside quantifier bodies, each once."""
-    seen: set[int] = set()
-    stack: list[z3.ExprRef] = list(reversed(formulas))
-    while stack:
-        t = stack.pop()
-        if t.get_id() in seen:
-            continue
-        seen.add(t.get_id())
-        if z3.is_quantifier(t) or z3.is_var(t):
-            continue
-        yield t
-        if z3.is_app(t):
-            stack.extend(reversed(t.children()))
+    if not formulas:
+        return
+    c = formulas[0].ctx
+    for _, a, _ in _walk(formulas):
+        yield _to_expr_ref(a, c)
 
 
 # --------------------------------------------------------------------------
