@@ -163,11 +163,6 @@ def render(target: NodeTarget, p: Prepared) -> Rendered:
     return Rendered(text, lines, ctx["pre"], ctx["post"])
 
 
-def render_obligation(target: NodeTarget, p: Prepared) -> str:
-    """Text of the obligation artifact: the triple, binding, VCs and proof outline."""
-    return render(target, p).text
-
-
 def render_queries(target: NodeTarget, p: Prepared, res: TripleResult) -> str:
     """SMT-LIB2 text of every VC query of a checked triple."""
     queries = [dict(id=r.vc.id, status=r.status, text=r.smt2 if r.smt2.endswith("\n") else r.smt2 + "\n")

@@ -20,6 +20,7 @@ testing of executable models of the same nodes against the same contracts.
 from __future__ import annotations
 
 import re
+from functools import lru_cache
 from pathlib import Path
 from typing import Any, Callable
 
@@ -37,7 +38,9 @@ NAME = "property_tests"
 KIND = "testing"
 
 
+@lru_cache(maxsize=1)
 def _templates() -> jinja2.Environment:
+    """One environment per process, so each template is compiled once (as in the other backends)."""
     return jinja2.Environment(loader=jinja2.PackageLoader("rclverify.backends.property_tests", "templates"),
                               undefined=jinja2.StrictUndefined, autoescape=False, keep_trailing_newline=True)
 
