@@ -149,3 +149,13 @@ def test_a_node_task_runs_only_the_stages_whose_inputs_changed() -> None:
     assert stages_to_run(deps, ["/w/backends/prog.imp"]) == ["export"]
     assert stages_to_run(deps, ["/w/a/model.json", "/w/backends/prog.imp"]) == ["compose", "export"]
     assert stages_to_run(deps, []) == list(NODE_STAGES)  # no reason by file (forced run): everything
+
+
+def test_a_plan_edited_after_the_cache_was_read_is_loaded_from_the_file(tmp_path: Path) -> None:
+    ws = _ws(tmp_path)
+    ws.model
+    wscache.save(ws)
+    again = Workspace(tmp_path)
+    assert wscache.restore(again)
+    (tmp_path / "contracts" / "plan.yaml").write_text("contracts: [contracts/a.rcl]\nname: edited\n")
+    assert again.plan.name == "edited"

@@ -58,7 +58,7 @@ class TaskIndex:
     ``replacement[n]`` the file of ``n``'s replacement contract (plan
     ``replacements``); ``entries[n]`` the config mappings of ``n``'s plan
     evidence entries, in plan order (the files they name are dependencies of
-    ``export:n``).  Paths are workspace-relative strings.
+    the export stage of ``node:n``).  Paths are workspace-relative strings.
     """
 
     nodes: tuple[str, ...]

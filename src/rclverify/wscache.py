@@ -20,8 +20,9 @@ atomically and is a pure speed-up: deleting ``artifacts/cache`` is always
 safe.  Like ``dodo.py`` it is trusted code of the workspace (pickle).
 
 A no-op run needs only the :class:`~rclverify.pipeline.TaskIndex` (node
-names, producers, plan entries) to define its tasks; the checked contracts
-are unpickled only when a task first needs them (``Workspace.deferred``).
+names, producers, plan entries) to define its tasks; the plan and the
+parsed contracts are unpickled only when a task first needs them
+(``Workspace.deferred``).
 """
 from __future__ import annotations
 
@@ -65,9 +66,9 @@ def _header(ws: "Workspace", contracts: tuple[str, ...]) -> dict[str, Any]:
 
 
 def restore(ws: "Workspace") -> bool:
-    """Fill ``ws``'s task index now, and its plan, checked contracts and
-    model on first use, from the cache when it is valid for the files on
-    disk.  Returns whether it did; never raises.
+    """Fill ``ws``'s task index now, and its plan and parsed contracts on
+    first use, from the cache when it is valid for the files on disk.
+    Returns whether it did; never raises.
 
     The cache holds the header, then the small :class:`~rclverify.pipeline.TaskIndex`,
     then the large part: the plan and the parsed contract files.  The
@@ -119,14 +120,16 @@ def _load_large(fh: Any) -> Any:
 
 
 def _load_deferred(ws: "Workspace", header: dict[str, Any], offset: int) -> None:
-    """Fill ``ws``'s plan, parsed and checked contracts and model from the
-    cache that :func:`restore` validated, if the cache file and the inputs
-    are still those of ``header``; else fill nothing (``ws`` then loads from
-    the files, reusing nothing).  Never raises."""
+    """Fill ``ws``'s plan and parsed contracts from the cache that
+    :func:`restore` validated, if the cache file is still the one read then
+    and the plan file is unchanged; else fill nothing (``ws`` then loads from
+    the files, reusing nothing).  A contract file edited since is parsed
+    again: ``Workspace.checked`` compares each parsed file's sha256 with the
+    file.  Never raises."""
     try:
         with open(ws.root / CACHE, "rb") as fh:
-            if pickle.load(fh) != header or _header(ws, tuple(header["contracts"])) != header:
-                return  # the cache was rewritten or an input changed since the run started
+            if pickle.load(fh) != header or _sha(ws.root / ws.plan_file) != header["plan"]:
+                return  # the cache was rewritten or the plan changed since the run started
             fh.seek(offset)
             plan, parsed = _load_large(fh)
     except Exception:
