@@ -194,14 +194,14 @@ def strict_uptodate(task: Any, values: Any) -> bool:
     return not bool(task.options.get("strict"))
 
 
-def _inputs(config: Any, root: Path, seen: dict[str, tuple[str, ...]] | None = None) -> list[str]:
+def _inputs(config: Any, root: Path, seen: dict[str, tuple[str, ...]]) -> list[str]:
     """Workspace files named in a plan evidence entry (strings that are existing paths).
 
     ``seen`` memoises the files of each path string across calls (the
     entries of many nodes name the same program or directory: one stat or
     directory walk per distinct string)."""
     out: set[str] = set()
-    memo: dict[str, tuple[str, ...]] = {} if seen is None else seen
+    memo = seen
 
     def files(v: str) -> tuple[str, ...]:
         if v not in memo:
@@ -246,7 +246,7 @@ def doit_config(dep_file: str = DEP_FILE) -> dict[str, Any]:
     SQLite rather than doit's default ``dbm`` store: with Python's fallback
     ``dbm.dumb`` (no gdbm on many systems) opening the store parses one line
     per task with ``ast.literal_eval``, about 0.3 CPU s of a 1000-node no-op
-    run (5000 tasks; docs/scale.md).  A workspace that switches store runs
+    run when it had 5000 tasks (docs/scale.md).  A workspace that switches store runs
     every task once, as doit knows no earlier state in the new file."""
     from .progress import ProgressReporter
     return {"default_tasks": ["verify"], "verbosity": 2, "dep_file": dep_file, "backend": "sqlite3",
