@@ -111,30 +111,32 @@ def test_a_missing_contract_is_reported_even_with_a_cached_plan(tmp_path: Path) 
         again.model
 
 
-def test_a_valid_cache_defers_the_checked_contracts_until_a_task_needs_them(tmp_path: Path,
-                                                                           monkeypatch: pytest.MonkeyPatch) -> None:
-    ws = _ws(tmp_path)
+def _cached_and_restored(root: Path) -> tuple[Workspace, Workspace]:
+    """A workspace loaded and cached, and a second one restored from that cache."""
+    ws = _ws(root)
     ws.model
     wscache.save(ws)
-    again = Workspace(tmp_path)
+    again = Workspace(root)
     assert wscache.restore(again)
+    return ws, again
+
+
+def test_a_valid_cache_defers_the_checked_contracts_until_a_task_needs_them(tmp_path: Path,
+                                                                           monkeypatch: pytest.MonkeyPatch) -> None:
+    ws, again = _cached_and_restored(tmp_path)
     # the task index is there at once; the plan and the parsed contracts are not unpickled yet
     assert again.index.nodes == ("A",) and again.index.contracts == ("contracts/a.rcl",)
     assert {"plan", "checked", "model"}.isdisjoint(again.__dict__) and again.deferred is not None
     import rclverify.rcl.parser as parser
 
     def no_parse(*args: object, **kwargs: object) -> None:
-        raise AssertionError("parsed although the cache holds the checked contracts")
+        raise AssertionError("parsed although the cache holds the parsed contracts")
     monkeypatch.setattr(parser, "parse_text", no_parse)
     assert again.model == ws.model and again.deferred is None  # type-checked from the cached parse
 
 
 def test_a_contract_edited_after_the_cache_was_read_is_loaded_from_the_file(tmp_path: Path) -> None:
-    ws = _ws(tmp_path)
-    ws.model
-    wscache.save(ws)
-    again = Workspace(tmp_path)
-    assert wscache.restore(again)
+    _, again = _cached_and_restored(tmp_path)
     (tmp_path / "contracts" / "a.rcl").write_text(RCL.replace("0 <= out.v", "2 <= out.v"))
     from rclverify.rcl.printer import expr_to_rcl
     assert expr_to_rcl(again.checked.nodes["A"].node.guarantees[0].formula) == "2 <= out.v"
@@ -152,10 +154,6 @@ def test_a_node_task_runs_only_the_stages_whose_inputs_changed() -> None:
 
 
 def test_a_plan_edited_after_the_cache_was_read_is_loaded_from_the_file(tmp_path: Path) -> None:
-    ws = _ws(tmp_path)
-    ws.model
-    wscache.save(ws)
-    again = Workspace(tmp_path)
-    assert wscache.restore(again)
+    _, again = _cached_and_restored(tmp_path)
     (tmp_path / "contracts" / "plan.yaml").write_text("contracts: [contracts/a.rcl]\nname: edited\n")
     assert again.plan.name == "edited"

@@ -29,7 +29,6 @@ program's sorts and the contract's are the same Z3 sorts.
 """
 from __future__ import annotations
 
-import inspect
 import re
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -378,30 +377,10 @@ class EncodedTriple:
     names: Mapping[str, str] = field(default_factory=dict)
 
 
-_TAKES_BOUND: dict[type, bool] = {}
-
-
-def _takes_bound(enc: Encoder) -> bool:
-    """Whether ``enc.formula`` has a ``bound`` parameter (asked once per encoder class)."""
-    cls = type(enc)
-    if cls not in _TAKES_BOUND:
-        _TAKES_BOUND[cls] = "bound" in inspect.signature(cls.formula).parameters
-    return _TAKES_BOUND[cls]
-
-
 def _encode(enc: Encoder, e: ast.Expr, node: CheckedNode, symbols: Mapping[str, Any],
             bound: Mapping[str, z3.ExprRef]) -> z3.BoolRef:
     """Encode ``e`` with its free bound-variable names given by ``bound``."""
-    if _takes_bound(enc):
-        return enc.formula(e, node, symbols, bound=bound)
-    # Encoder.formula has no way yet to give free (bound) variables; open a
-    # quantifier over them and instantiate it with our terms instead.
-    if not bound:
-        return enc.formula(e, node, symbols)
-    from ...logic.encode import _Ctx  # noqa: PLC0415 - see the comment above
-    r = _Ctx(enc, node, dict(symbols)).enc(e, dict(bound))
-    assert z3.is_bool(r)
-    return r
+    return enc.formula(e, node, symbols, bound=bound)
 
 
 def _to_old(m: ProgramModel, t: z3.ExprRef) -> z3.ExprRef:
