@@ -215,3 +215,33 @@ def test_without_graphviz_the_report_shows_the_dot_source() -> None:
     assert "The argument's Graphviz source" in html and "no graphviz in this test" in html
     md = render.render_markdown(_report())
     assert "## Assurance argument (GSN)" in md and "`G-REQ1`" in md
+
+
+@pytest.mark.skipif(shutil.which("dot") is None, reason="graphviz not installed")
+def test_a_long_element_text_is_clipped_in_the_tooltip_so_dot_accepts_it(tmp_path: Any) -> None:
+    # a 1000-node plan's context element names every contract file: Graphviz rejects
+    # a quoted string over 16,384 characters, and the argument diagram was lost
+    rep = _report()
+    rep["meta"]["contracts"] = [f"contracts/n{k}.rcl" for k in range(2000)]
+    arg = build_argument(rep)
+    assert max(len(e.text) for e in arg.elements.values()) > 16_384
+    assert all(len(line) < 16_384 for line in to_dot(arg).splitlines())
+    assert "argument.svg" in [p.name for p in write_argument(rep, tmp_path)]
+
+
+def test_an_argument_too_large_to_draw_is_not_laid_out(tmp_path: Any, monkeypatch: pytest.MonkeyPatch) -> None:
+    from rclverify.argument import export
+    from rclverify.report import diagram
+    n = len(build_argument(_report()).elements)
+    monkeypatch.setattr(export, "MAX_LAYOUT_ELEMENTS", n - 1)
+    monkeypatch.setattr(diagram, "render_dot", lambda *a, **k: pytest.fail("dot must not run"))
+    view = argument_view(_report())
+    assert view["too_large"] and view["svg"] is None and f"the argument has {n} elements" in view["note"]
+    (tmp_path / "argument.svg").write_text("<svg/>")  # a diagram of an earlier, smaller argument
+    names = [p.name for p in write_argument(_report(), tmp_path)]
+    assert names == ["argument.json", "argument.gsn.yaml", "argument.dot"] and not (tmp_path / "argument.svg").exists()
+    html = render.render_html(_report(), rendering=NO_DOT)
+    section = html[html.index('<section id="argument">'):html.index("</section>", html.index('<section id="argument">'))]
+    assert f"the argument has {n} elements" in section and '<a href="argument.dot">' in section
+    assert "<pre>" not in section and 'href="argument.svg"' not in section
+    assert "No diagram: the argument has" in render.render_markdown(_report())

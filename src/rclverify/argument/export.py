@@ -14,7 +14,10 @@
   like the system diagram; laid out left to right so the many solutions
   stack vertically.
 * SVG with Graphviz ``dot`` (:func:`rclverify.report.diagram.render_dot`);
-  without it the DOT source stands in, as for the system diagram.
+  without it the DOT source stands in, as for the system diagram.  An
+  argument of more than :data:`MAX_LAYOUT_ELEMENTS` elements is not laid
+  out (:func:`layout`), and its tooltips are clipped to
+  :data:`MAX_TOOLTIP_CHARS` so that ``dot`` accepts the file.
 
 Everything is deterministic: the element order is the builder's, nothing
 depends on the time.
@@ -114,6 +117,32 @@ def to_gsn_yaml(arg: Argument, title: str = "assurance argument", link_prefix: s
     return _environment().get_template("argument.gsn.yaml.j2").render(title=title.replace("\n", " "), elements=elements)
 
 
+#: The largest argument (in elements) laid out with Graphviz.  ``dot``'s time grows faster than
+#: the size: 1,218 elements (a 100-node system) take 0.6 s, 11,968 (1000 nodes) nearly two minutes,
+#: and a diagram of thousands of boxes is not legible anyway (docs/scale.md).
+MAX_LAYOUT_ELEMENTS = 2500
+#: Longest tooltip kept in the DOT text: Graphviz rejects a quoted string over 16,384 characters
+#: (the plan's context element lists every contract file).
+MAX_TOOLTIP_CHARS = 1000
+
+
+def layout(arg: Argument, dot: str) -> diagram.Rendering:
+    """The SVG of the argument's DOT text ``dot`` (:func:`rclverify.report.diagram.render_dot`),
+    or, for an argument of more than :data:`MAX_LAYOUT_ELEMENTS` elements, no SVG and a
+    note saying how to lay it out.  Never raises."""
+    n = len(arg.elements)
+    if n > MAX_LAYOUT_ELEMENTS:
+        return diagram.Rendering(None, f"the argument has {n} elements, more than the {MAX_LAYOUT_ELEMENTS} the report "
+                                       "lays out (Graphviz needs minutes for it, and a diagram of that size is not "
+                                       "legible); its structure is in the tables above and in argument.json; "
+                                       "to draw it anyway, run: dot -Tsvg reports/argument.dot")
+    return diagram.render_dot(dot)
+
+
+def _clip(text: str, limit: int) -> str:
+    return text if len(text) <= limit else text[:limit - 3] + "..."
+
+
 def _label(e: Element) -> str:
     head = e.id if e.type != "solution" else e.ref or e.id
     width = 28 if e.type == "solution" else 44
@@ -137,7 +166,7 @@ def to_dot(arg: Argument, title: str = "assurance argument", link_prefix: str = 
     def node(e: Element) -> dict[str, Any]:
         shape, style = _SHAPES[e.type]
         fill, border = diagram.NODE_COLOURS.get(e.status or "", diagram.OTHER_COLOURS)
-        return {"id": diagram.dot_string(e.id), "label": _label(e), "tooltip": diagram.dot_string(e.text),
+        return {"id": diagram.dot_string(e.id), "label": _label(e), "tooltip": diagram.dot_string(_clip(e.text, MAX_TOOLTIP_CHARS)),
                 "shape": shape, "style": style, "fill": fill, "border": border,
                 "url": diagram.dot_string(link_prefix + e.url) if e.url else ""}
 
@@ -171,14 +200,17 @@ def argument_view(report: Mapping[str, Any], rendering: diagram.Rendering | None
                   fragments: FragmentCache | None = None) -> dict[str, Any]:
     """What the report templates show of the argument: ``argument`` (the
     JSON form), ``dot``, ``svg`` (``None`` without Graphviz), ``note`` (why
-    there is no SVG) and ``goals`` (the requirement and contract goals with
+    there is no SVG), ``too_large`` (more than :data:`MAX_LAYOUT_ELEMENTS`
+    elements: not laid out, and the report links to the DOT file instead
+    of inlining it) and ``goals`` (the requirement and contract goals with
     their statuses, for the tables).  ``rendering`` replaces running ``dot``;
     ``fragments`` as for :func:`to_dot`."""
     arg, dot, as_json = _built(report, fragments)
-    drawn = rendering if rendering is not None else diagram.render_dot(dot)
+    too_large = len(arg.elements) > MAX_LAYOUT_ELEMENTS
+    drawn = layout(arg, dot) if rendering is None or too_large else rendering
     top = arg.elements[arg.top]
     goals = [top] + [arg.elements[g] for s in top.supported_by for g in arg.elements[s].supported_by]
-    return {"argument": as_json, "dot": dot, "svg": drawn.svg, "note": drawn.note,
+    return {"argument": as_json, "dot": dot, "svg": drawn.svg, "note": drawn.note, "too_large": too_large,
             "goals": [{"id": g.id, "text": g.text, "status": g.status, "undeveloped": g.undeveloped} for g in goals]}
 
 
@@ -197,7 +229,7 @@ def write_argument(report: Mapping[str, Any], out_dir: Path, fragments: Fragment
     title = f"assurance argument of {report['meta']['workspace']}"
     json_text = dumps(as_json) if fragments is None else cached_dumps(as_json, fragments)
     texts = {FILES[0]: json_text, FILES[1]: to_gsn_yaml(arg, title, fragments=fragments), FILES[2]: dot}
-    svg = diagram.render_dot(dot).svg
+    svg = layout(arg, dot).svg
     paths = []
     for name, text in texts.items():
         atomic_write_text(out_dir / name, text)
