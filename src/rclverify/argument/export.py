@@ -196,6 +196,14 @@ def _built(report: Mapping[str, Any], fragments: FragmentCache | None = None) ->
     return arg, dot, _last[0][3]
 
 
+def argument_dot(report: Mapping[str, Any], fragments: FragmentCache | None = None) -> tuple[Argument, str]:
+    """``(argument, DOT text)`` of ``report`` (built once per report dict, like
+    :func:`argument_view`; ``fragments`` as for :func:`to_dot`): what
+    :func:`layout` needs to lay the argument out ahead of the rendering."""
+    arg, dot, _ = _built(report, fragments)
+    return arg, dot
+
+
 def argument_view(report: Mapping[str, Any], rendering: diagram.Rendering | None = None,
                   fragments: FragmentCache | None = None) -> dict[str, Any]:
     """What the report templates show of the argument: ``argument`` (the

@@ -485,8 +485,13 @@ def _argument(report: Mapping[str, Any], rendering: diagram.Rendering | None,
     return argument_view(report, rendering, fragments)
 
 
+def _system_dot(report: Mapping[str, Any]) -> str:
+    return diagram.system_dot(report["system"], title=f"system model of {report['meta']['workspace']}")
+
+
 def render_html(report: Mapping[str, Any], link_prefix: str = "../",
-                rendering: diagram.Rendering | None = None, fragments: FragmentCache | None = None) -> str:
+                rendering: diagram.Rendering | None = None, fragments: FragmentCache | None = None,
+                system: diagram.Rendering | None = None) -> str:
     """The assurance report as one self-contained HTML page.
 
     ``report`` is the report dict (see :data:`REPORT_KEYS`); ``link_prefix``
@@ -497,11 +502,13 @@ def render_html(report: Mapping[str, Any], link_prefix: str = "../",
     Every value from the report is HTML-escaped; only the SVG produced by
     ``dot`` is inlined as markup.  ``fragments`` keeps rendered pieces
     between runs (:mod:`rclverify.report.fragments`; the text is the same
-    with or without it).  Raises ``ValueError`` for a missing top-level key
-    and ``jinja2.UndefinedError`` for a missing inner key.
+    with or without it).  ``system``, when given, is the system diagram's
+    layout already made (the argument's is still made here).  Raises
+    ``ValueError`` for a missing top-level key and ``jinja2.UndefinedError``
+    for a missing inner key.
     """
-    dot = diagram.system_dot(report["system"], title=f"system model of {report['meta']['workspace']}")
-    drawn = rendering if rendering is not None else diagram.render_dot(dot)
+    dot = _system_dot(report)
+    drawn = rendering if rendering is not None else system if system is not None else diagram.render_dot(dot)
     return environment().get_template("assurance.html.j2").render(
         **_context(report, link_prefix, fragments), dot=dot, svg=drawn.svg, diagram_note=drawn.note,
         argument=_argument(report, rendering, fragments),
@@ -515,7 +522,7 @@ def render_markdown(report: Mapping[str, Any], link_prefix: str = "../", fragmen
     given as DOT source.  User text is Markdown-escaped (:func:`md_text`,
     :func:`md_code`).  ``fragments`` and errors as for :func:`render_html`.
     """
-    dot = diagram.system_dot(report["system"], title=f"system model of {report['meta']['workspace']}")
+    dot = _system_dot(report)
     return environment().get_template("assurance.md.j2").render(**_context(report, link_prefix, fragments), dot=dot,
                                                                  argument=_argument(report, _NO_LAYOUT, fragments))
 
@@ -537,7 +544,9 @@ def render_all(report: Mapping[str, Any], out_dir: Path, link_prefix: str = "../
     """Write ``assurance.html``, ``assurance.md`` and ``assurance.json`` to ``out_dir``.
 
     All three texts are rendered before anything is written, so a rendering
-    error leaves the previous report untouched; each file is then written
+    error leaves the previous report untouched; the system diagram and the
+    argument are laid out by Graphviz in two threads while the Markdown and
+    JSON texts are rendered (the layouts are subprocesses); each file is then written
     atomically (and left alone when unchanged).  ``link_prefix`` as in
     :func:`render_html`.  ``fragments`` keeps the rendered pieces between
     runs (:mod:`rclverify.report.fragments`; the caller saves it); the files
@@ -545,11 +554,20 @@ def render_all(report: Mapping[str, Any], out_dir: Path, link_prefix: str = "../
     ``ValueError``/``TypeError``/``jinja2.UndefinedError`` for a malformed
     report and ``OSError`` when ``out_dir`` cannot be written.
     """
-    texts = {
-        "assurance.html": render_html(report, link_prefix, fragments=fragments),
-        "assurance.md": render_markdown(report, link_prefix, fragments=fragments),
-        "assurance.json": render_json(report, fragments),
-    }
+    from concurrent.futures import ThreadPoolExecutor
+
+    from ..argument.export import argument_dot, layout
+    texts = {}
+    # The two Graphviz layouts (seconds each on a large system) run as subprocesses beside the
+    # Markdown and JSON rendering; a thread only waits for its `dot`, so the GIL is not in the way.
+    with ThreadPoolExecutor(max_workers=2, thread_name_prefix="rclverify-dot") as pool:
+        system = pool.submit(diagram.render_dot, _system_dot(report))
+        argument = pool.submit(layout, *argument_dot(report, fragments))  # kept in the layout cache
+        texts["assurance.md"] = render_markdown(report, link_prefix, fragments=fragments)
+        texts["assurance.json"] = render_json(report, fragments)
+        argument.result()
+        texts["assurance.html"] = render_html(report, link_prefix, fragments=fragments, system=system.result())
+    texts = {name: texts[name] for name in ("assurance.html", "assurance.md", "assurance.json")}
     paths = []
     for name, text in texts.items():
         path = Path(out_dir) / name
