@@ -87,11 +87,25 @@ def _smt2(formulas: Sequence[z3.BoolRef], comment: str) -> Callable[[], str]:
 
 
 def _script(formulas: Sequence[z3.BoolRef], comment: str) -> str:
-    s = z3.Solver()
-    for f in formulas:
-        s.add(f)
     header = "".join(f"; {line}\n" for line in comment.splitlines())
-    return header + str(s.to_smt2())
+    return header + smtlib_benchmark(formulas)
+
+
+def smtlib_benchmark(formulas: Sequence[z3.BoolRef], ctx: z3.Context | None = None) -> str:
+    """``formulas`` as an SMT-LIB2 script, printed by the Z3 call
+    ``z3.Solver.to_smt2()`` makes (``Z3_benchmark_to_smtlib_string``)
+    without making a solver: a fresh solver costs about a millisecond, and
+    the text of every health query is kept.  The same script as a solver's,
+    up to which shared subterms the printer names with ``let`` (it decides
+    by reference counts, which a solver holding the formulas raises).
+    :func:`.retry.canonical_smt2`, whose text is parsed back and solved,
+    keeps printing through a solver.  ``ctx`` is the formulas' context
+    (default: the first formula's, else the main context)."""
+    c = ctx if ctx is not None else formulas[0].ctx if formulas else z3.main_ctx()
+    *init, last = list(formulas) or [z3.BoolVal(True, c)]
+    v = (z3.Ast * len(init))(*[f.as_ast() for f in init])
+    return str(z3.Z3_benchmark_to_smtlib_string(c.ref(), "benchmark generated from python API", "", "unknown", "",
+                                                len(init), v, last.as_ast()))
 
 
 def prove(goal: z3.BoolRef, hypotheses: Sequence[z3.BoolRef], enc: Encoder | None = None, *,
