@@ -71,3 +71,30 @@ def test_the_case_study_has_no_such_finding():
     checked = load([Path(__file__).resolve().parents[1] / "contracts" / "remote_inspection.rcl"])
     for n in ("Localisation", "Navigation", "RadiationSensor"):
         assert shape_findings(checked, n) == [], n
+
+
+def test_a_lone_tautological_conjunct_is_found():
+    text = "node N {\n  inputs( a : REAL )\n  outputs( o : REAL )\n  guarantee( out.o == out.o )\n}\n"
+    assert _findings(text)["N.g1.c1.tautology"].status == "problem"
+
+
+def test_validity_is_asked_only_of_a_conjunct_the_others_imply(monkeypatch):
+    # a counterexample to "implied by the others" falsifies the conjunct alone too, so the
+    # tautology query runs only for the conjuncts that are implied (or undecided)
+    from rclverify.health import shape
+    asked: list[str] = []
+    real = shape.prove
+
+    def spy(goal, hyps, enc, **kw):
+        asked.append(kw["comment"].split(": ", 1)[1])
+        return real(goal, hyps, enc, **kw)
+    monkeypatch.setattr(shape, "prove", spy)
+    fs = _findings()
+    valid_asked = sorted(q for q in asked if "valid on its own" in q)
+    # of the four conjuncts g1.c1 is the one the rest do not imply (g1.c2 is a tautology,
+    # g2.c1 restates the assumption, g3.c1 follows from g1.c1 and the assumption)
+    assert valid_asked == [f"is conjunct {j} of guarantee {k} valid on its own?" for k, j in ((2, 1), (3, 1))] + [
+        "is conjunct 2 of guarantee 1 valid on its own?"]
+    assert len(asked) == 4 + 3
+    assert {k for k in fs if k.endswith((".tautology", ".redundant"))} == {
+        "N.g1.c2.tautology", "N.g2.c1.redundant", "N.g3.c1.redundant"}
