@@ -197,6 +197,17 @@ def test_second_run_executes_no_task(workspace: Path) -> None:
     assert executed == [], executed
 
 
+def test_the_model_diagram_is_drawn_by_doit_graph_not_by_verify(workspace: Path) -> None:
+    system = workspace / "artifacts" / "system"
+    assert not (system / "model.dot").exists() and not (system / "model.svg").exists()  # verify ran before
+    r = _doit(workspace, "graph")
+    assert r.returncode == 0, r.stdout + r.stderr
+    dot = (system / "model.dot").read_text()
+    assert dot.lstrip().startswith(("digraph", "//")) and "Agent" in dot
+    if shutil.which("dot"):
+        assert "<svg" in (system / "model.svg").read_text()
+
+
 def test_strict_mode_fails_on_open_evidence(workspace: Path) -> None:
     r = _doit(workspace, "verify", "--strict")
     assert r.returncode != 0

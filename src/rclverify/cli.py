@@ -82,11 +82,11 @@ def _ws(args: argparse.Namespace):  # type: ignore[no-untyped-def]
 
 
 def cmd_graph(args: argparse.Namespace) -> int:
-    from .pipeline import stage_check
+    from .pipeline import stage_check, stage_graph
     from .report.diagram import dot_to_svg
     ws = _ws(args)
     stage_check(ws)
-    dot = ws.path(ws.DOT).read_text(encoding="utf-8")
+    dot = stage_graph(ws)
     out = Path(args.output) if args.output else ws.path(ws.DOT)
     if args.output:
         out.write_text(dot, encoding="utf-8")

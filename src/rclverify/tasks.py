@@ -4,7 +4,7 @@ Stages and their real file dependencies, per node ``N``:
 
 ``check``          contracts + plan -> artifacts/contracts/N.json (one snapshot per
                    node, rewritten only when that node's text changes), model, lint
-``graph``          model.dot -> model.svg (when graphviz is installed); not part of
+``graph``          model -> model.dot, model.svg (when graphviz is installed); not part of
                    ``verify`` (the report lays out its own diagram, with statuses):
                    ``doit graph`` runs it
 ``node:N``         three stages, each run only when one of its own inputs changed:
@@ -105,8 +105,13 @@ def act_check(root: str) -> Any:
 
 def act_graph(root: str) -> Any:
     from .evidence.store import atomic_write_text
+    from .pipeline import stage_graph
     from .report.diagram import dot_to_svg
-    svg = dot_to_svg((Path(root) / Workspace.DOT).read_text(encoding="utf-8"))
+    try:
+        dot = stage_graph(_ws(root))
+    except RclError as exc:
+        return _fail(exc)
+    svg = dot_to_svg(dot)
     if svg is None:
         print("graphviz 'dot' not found: the report embeds the DOT source instead of a diagram")
         return None
@@ -289,12 +294,12 @@ def build_tasks(root: str | Path, plan_file: str = "contracts/plan.yaml") -> dic
     def task_check() -> dict[str, Any]:
         """Parse and type-check the contracts, check the plan, lint, build the system model."""
         return {"actions": [(act_check, [r])], "file_dep": [str(rootp / plan_file)] + contract_deps,
-                "targets": list(snap.values()) + [str(rootp / p) for p in (ws.MODEL, ws.DOT, ws.DIAGNOSTICS)],
+                "targets": list(snap.values()) + [str(rootp / p) for p in (ws.MODEL, ws.DIAGNOSTICS)],
                 "verbosity": 2, "clean": True}
 
     def task_graph() -> dict[str, Any]:
         """Render the system model diagram (SVG) with graphviz."""
-        return {"actions": [(act_graph, [r])], "file_dep": [str(rootp / ws.DOT)], "task_dep": ["check"],
+        return {"actions": [(act_graph, [r])], "file_dep": [str(rootp / ws.MODEL)], "targets": [str(rootp / ws.DOT)], "task_dep": ["check"],
                 "uptodate": [config_changed(_tool_fingerprint()["dot"] or "")], "verbosity": 2}
 
     def task_node() -> Iterator[dict[str, Any]]:
