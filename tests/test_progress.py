@@ -64,3 +64,21 @@ def test_progress_is_doit_console_output_when_not_a_terminal() -> None:
     rep.execute_task(SimpleNamespace(name="report", actions=[object()], title=lambda: "report"))
     rep.skip_uptodate(SimpleNamespace(name="check", actions=[object()], title=lambda: "check"))
     assert out.getvalue() == ".  report\n-- check\n"
+
+
+def test_a_completed_run_freezes_the_heap_only_at_exit(monkeypatch: Any) -> None:
+    # the final garbage collection of a large run's heap took most of a second after the work
+    import atexit
+    import gc
+
+    from rclverify import progress
+    registered: list[Any] = []
+    monkeypatch.setattr(atexit, "register", registered.append)
+    monkeypatch.setattr(progress, "_FREEZE_REGISTERED", False)
+    frozen_before = gc.get_freeze_count()
+    for _ in range(2):
+        rep = ProgressReporter(io.StringIO(), {})
+        rep.live_mode = False
+        rep.complete_run()
+    assert registered == [gc.freeze]  # once per process, and nothing frozen while it still runs
+    assert gc.get_freeze_count() == frozen_before
