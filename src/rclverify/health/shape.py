@@ -76,27 +76,23 @@ def shape_findings(checked: Checked, node: str, *, timeout_ms: int = SHAPE_TIMEO
     assume = [enc.formula(a.formula, cn) for a in n.assumes] if len(parts) > 1 else []
     implied: dict[tuple[int, int], Finding] = {}
     for k, j, c in parts:
-        if isinstance(c, ast.BoolLit) or len(parts) == 1:
+        if isinstance(c, ast.BoolLit):
             continue
-        others = [enc.formula(x, cn) for kk, jj, x in parts if (kk, jj) != (k, j)]
-        r = prove(enc.formula(c, cn), assume + others, enc, timeout_ms=timeout_ms,
-                  comment=f"health {node}: is conjunct {j} of guarantee {k} implied by the others?")
-        if r.status == "refuted":
-            continue  # not valid on its own either: its counterexample falsifies the conjunct
-        if r.status == "proved":
-            implied[(k, j)] = Finding(f"{node}.g{k}.c{j}.redundant", node, "redundant", k, "warning",
-                                      f"Conjunct {j} of guarantee {k} of {node} ({_where(c.loc)}) is redundant: the "
-                                      "assumption and the other guarantee conjuncts imply it.",
-                                      f"`{expr_to_rcl(c)}` adds nothing to the contract; Z3 proved it from the rest.",
-                                      duration_s=r.duration_s, smt2=r.smt2)
+        if len(parts) > 1:
+            others = [enc.formula(x, cn) for kk, jj, x in parts if (kk, jj) != (k, j)]
+            r = prove(enc.formula(c, cn), assume + others, enc, timeout_ms=timeout_ms,
+                      comment=f"health {node}: is conjunct {j} of guarantee {k} implied by the others?")
+            if r.status == "refuted":
+                continue  # not valid on its own either: its counterexample falsifies the conjunct
+            if r.status == "proved":
+                implied[(k, j)] = Finding(f"{node}.g{k}.c{j}.redundant", node, "redundant", k, "warning",
+                                          f"Conjunct {j} of guarantee {k} of {node} ({_where(c.loc)}) is redundant: "
+                                          "the assumption and the other guarantee conjuncts imply it.",
+                                          f"`{expr_to_rcl(c)}` adds nothing to the contract; Z3 proved it from the "
+                                          "rest.", duration_s=r.duration_s, smt2=r.smt2)
         valid = _tautology(enc, cn, node, k, j, c, timeout_ms)
         if valid is not None:
             implied.pop((k, j), None)  # a tautology is reported as that, not also as redundant
-            out.append(valid)
-    if len(parts) == 1 and not isinstance(parts[0][2], ast.BoolLit):
-        k, j, c = parts[0]
-        valid = _tautology(enc, cn, node, k, j, c, timeout_ms)
-        if valid is not None:
             out.append(valid)
     out += implied.values()
     return out

@@ -491,7 +491,7 @@ def _system_dot(report: Mapping[str, Any]) -> str:
 
 def render_html(report: Mapping[str, Any], link_prefix: str = "../",
                 rendering: diagram.Rendering | None = None, fragments: FragmentCache | None = None,
-                system: diagram.Rendering | None = None) -> str:
+                system: diagram.Rendering | None = None, argument: diagram.Rendering | None = None) -> str:
     """The assurance report as one self-contained HTML page.
 
     ``report`` is the report dict (see :data:`REPORT_KEYS`); ``link_prefix``
@@ -502,8 +502,9 @@ def render_html(report: Mapping[str, Any], link_prefix: str = "../",
     Every value from the report is HTML-escaped; only the SVG produced by
     ``dot`` is inlined as markup.  ``fragments`` keeps rendered pieces
     between runs (:mod:`rclverify.report.fragments`; the text is the same
-    with or without it).  ``system``, when given, is the system diagram's
-    layout already made (the argument's is still made here).  Raises
+    with or without it).  ``system`` and ``argument``, when given, are the
+    two layouts already made (:func:`render_all` makes them in threads);
+    ``rendering`` stands in for both.  Raises
     ``ValueError`` for a missing top-level key and ``jinja2.UndefinedError``
     for a missing inner key.
     """
@@ -511,7 +512,7 @@ def render_html(report: Mapping[str, Any], link_prefix: str = "../",
     drawn = rendering if rendering is not None else system if system is not None else diagram.render_dot(dot)
     return environment().get_template("assurance.html.j2").render(
         **_context(report, link_prefix, fragments), dot=dot, svg=drawn.svg, diagram_note=drawn.note,
-        argument=_argument(report, rendering, fragments),
+        argument=_argument(report, rendering if rendering is not None else argument, fragments),
     )
 
 
@@ -562,11 +563,11 @@ def render_all(report: Mapping[str, Any], out_dir: Path, link_prefix: str = "../
     # Markdown and JSON rendering; a thread only waits for its `dot`, so the GIL is not in the way.
     with ThreadPoolExecutor(max_workers=2, thread_name_prefix="rclverify-dot") as pool:
         system = pool.submit(diagram.render_dot, _system_dot(report))
-        argument = pool.submit(layout, *argument_dot(report, fragments))  # kept in the layout cache
+        argument = pool.submit(layout, *argument_dot(report, fragments))
         texts["assurance.md"] = render_markdown(report, link_prefix, fragments=fragments)
         texts["assurance.json"] = render_json(report, fragments)
-        argument.result()
-        texts["assurance.html"] = render_html(report, link_prefix, fragments=fragments, system=system.result())
+        texts["assurance.html"] = render_html(report, link_prefix, fragments=fragments, system=system.result(),
+                                              argument=argument.result())
     texts = {name: texts[name] for name in ("assurance.html", "assurance.md", "assurance.json")}
     paths = []
     for name, text in texts.items():
