@@ -114,7 +114,7 @@ def act_graph(root: str) -> Any:
         return _fail(exc)
     svg = dot_to_svg(dot)
     if svg is None:
-        print("graphviz 'dot' not found: the report embeds the DOT source instead of a diagram")
+        print(f"graphviz 'dot' not found: {Workspace.DOT} written, model.svg not drawn")
         return None
     atomic_write_text(Path(root) / "artifacts/system/model.svg", svg)
     return None
@@ -209,19 +209,18 @@ def _inputs(config: Any, root: Path, seen: dict[str, tuple[str, ...]]) -> list[s
     entries of many nodes name the same program or directory: one stat or
     directory walk per distinct string)."""
     out: set[str] = set()
-    memo = seen
 
     def files(v: str) -> tuple[str, ...]:
-        if v not in memo:
+        if v not in seen:
             p = root / v
             if not p.exists():
-                memo[v] = ()
+                seen[v] = ()
             elif p.is_dir():
-                memo[v] = tuple(os.path.relpath(f, root) for f in glob.glob(str(p / "**" / "*"), recursive=True)
+                seen[v] = tuple(os.path.relpath(f, root) for f in glob.glob(str(p / "**" / "*"), recursive=True)
                                 if os.path.isfile(f))
             else:
-                memo[v] = (v,)
-        return memo[v]
+                seen[v] = (v,)
+        return seen[v]
 
     def walk(v: Any) -> None:
         if isinstance(v, str) and "/" in v:
@@ -299,9 +298,9 @@ def build_tasks(root: str | Path, plan_file: str = "contracts/plan.yaml") -> dic
                 "verbosity": 2, "clean": True}
 
     def task_graph() -> dict[str, Any]:
-        """Render the system model diagram (SVG) with graphviz."""
-        return {"actions": [(act_graph, [r])], "file_dep": [str(rootp / ws.MODEL)], "targets": [str(rootp / ws.DOT)], "task_dep": ["check"],
-                "uptodate": [config_changed(_tool_fingerprint()["dot"] or "")], "verbosity": 2}
+        """Write the system model as DOT and, with graphviz, draw it as SVG (doit graph)."""
+        return {"actions": [(act_graph, [r])], "file_dep": [str(rootp / ws.MODEL)], "targets": [str(rootp / ws.DOT)],
+                "task_dep": ["check"], "uptodate": [config_changed(shutil.which("dot") or "")], "verbosity": 2}
 
     def task_node() -> Iterator[dict[str, Any]]:
         """One task per node: its calculus, health checks and exported obligations."""
