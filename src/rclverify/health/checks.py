@@ -32,7 +32,7 @@ import z3
 
 from ..calculus.refinement import RefinementResult
 from ..logic.encode import Encoder
-from ..logic.query import QueryResult, satisfiable
+from ..logic.query import QueryResult, satisfiable, solver_session
 from ..rcl import ast
 from ..rcl.printer import expr_to_rcl
 from ..rcl.typecheck import domain_type
@@ -150,12 +150,15 @@ class _NodeHealth:
         return [v for b in bindings if domain_type(b, self.node, self.checked.env) == NATURAL for v in b.names]
 
 
+@solver_session()
 def check_node(checked: Checked, node: str, facts: Sequence[tuple[ast.Expr, ast.Loc]] = (),
                instances: tuple[int, int] | None = None, *, timeout_ms: int = HEALTH_TIMEOUT_MS) -> list[Finding]:
     """Run the three health checks on ``node``, then the checks of
     :mod:`rclverify.health.shape` (tautologies, guarantees constraining no
     output, unconstrained outputs, redundant conjuncts); returns its findings
-    in order."""
+    in order.  The queries share one solver session
+    (:func:`~rclverify.logic.query.solver_session`): they depend on the
+    node's contract, facts and instances alone, and run in a fixed order."""
     h = _NodeHealth(checked, checked.nodes[node], facts, instances, timeout_ms)
     out: list[Finding] = []
     n = node

@@ -18,9 +18,10 @@ Models are rendered in RCL terms by :func:`render_model`.
 from __future__ import annotations
 
 import time
+from contextlib import ExitStack, contextmanager
 from dataclasses import dataclass, field
 from functools import cached_property
-from typing import Callable, Sequence
+from typing import Callable, Iterator, Sequence
 
 import z3
 
@@ -82,6 +83,78 @@ def budgeted_solver(timeout_ms: int) -> z3.Solver:
     return s
 
 
+class _Session:
+    """The shared solver of one :func:`solver_session` block and the query
+    budget its parameters are set to (set again only when a query asks for
+    another: setting a parameter of a solver in use costs about as much as
+    a small query)."""
+
+    def __init__(self) -> None:
+        self.solver = z3.SimpleSolver()
+        self.solver.set("unsat_core", True)
+        self.budget_ms: int | None = None
+
+    def scope(self, timeout_ms: int) -> z3.Solver:
+        if self.budget_ms != timeout_ms:
+            self.solver.set("rlimit", int(timeout_ms) * STEPS_PER_MS)
+            self.solver.set("timeout", int(timeout_ms) * SAFETY_FACTOR)
+            self.budget_ms = timeout_ms
+        self.solver.push()
+        return self.solver
+
+
+#: The :func:`solver_session` blocks under way, innermost last.
+_SESSIONS: list[_Session] = []
+
+
+@contextmanager
+def solver_session() -> Iterator[None]:
+    """Within the block, every query of this module (and every
+    :func:`query_solver`) runs in one shared incremental Z3 solver, each in
+    its own ``push``/``pop`` scope, instead of a fresh solver each.
+
+    A fresh ``z3.Solver()`` costs about 1.5 ms of set-up and tear-down,
+    more than most queries of a contract take to solve; a scope of an
+    incremental solver costs about 0.25 ms (docs/scale.md, sixth round).
+    The solver is Z3's incremental SMT core (``z3.SimpleSolver``, the
+    engine ``z3.Solver()`` itself switches to once a scope is pushed) with
+    unsat cores enabled.  The answers are Z3's answers to the same
+    formulas (a popped scope leaves no assertion behind), but a model or
+    core may depend on the queries the solver answered before in the same
+    block, so a block must always ask the same queries in the same order:
+    each covers one unit of work whose queries follow from its inputs alone
+    (one node's calculus, one node's health checks, one Hoare triple),
+    never queries whose order depends on scheduling.  Blocks nest (the
+    innermost is used).  The retries of :mod:`.retry` keep their own fresh
+    solvers.  Usable as a decorator (``@solver_session()``).
+    """
+    _SESSIONS.append(_Session())
+    try:
+        yield
+    finally:
+        _SESSIONS.pop()
+
+
+@contextmanager
+def query_solver(timeout_ms: int, *, cores: bool = False) -> Iterator[z3.Solver]:
+    """A solver for one query, budgeted like :func:`budgeted_solver`: a new
+    scope of the innermost :func:`solver_session` (popped when the block
+    ends), or a fresh solver outside any session.  ``cores``: the query
+    needs unsat cores (always on in a session's solver, since Z3 takes that
+    option only before the first assertion)."""
+    if not _SESSIONS:
+        fresh = budgeted_solver(timeout_ms)
+        if cores:
+            fresh.set("unsat_core", True)
+        yield fresh
+        return
+    s = _SESSIONS[-1].scope(timeout_ms)
+    try:
+        yield s
+    finally:
+        s.pop()
+
+
 def _smt2(formulas: Sequence[z3.BoolRef], comment: str) -> Callable[[], str]:
     return lambda: _script(formulas, comment)
 
@@ -124,32 +197,33 @@ def prove(goal: z3.BoolRef, hypotheses: Sequence[z3.BoolRef], enc: Encoder | Non
     """
     hyps = list(hypotheses) + (enc.axioms() if enc else [])
     formulas = hyps + [z3.Not(goal)]
-    if deterministic:
-        s = bounded_solver()
-        load_canonical(s, formulas)
-    else:
-        s = budgeted_solver(timeout_ms)
-        s.add(*formulas)
-    t0 = time.perf_counter()
-    r = s.check()
-    dt = round(time.perf_counter() - t0, 4)
-    script = _smt2(formulas, comment or "validity query: unsat means the goal follows from the hypotheses")
-    if r == z3.unsat:
-        return QueryResult("proved", script, dt)
-    if r == z3.sat:
-        return QueryResult("refuted", script, dt, model=render_model(s.model(), enc))
-    reasons = [f"default: {s.reason_unknown()}"]
-    for name0, s0, rewrite in attempts(formulas, timeout_ms):
-        for name, s2 in variants(name0, s0):
-            load_canonical(s2, [rewrite(f) for f in formulas])
-            r = s2.check()
-            dt = round(time.perf_counter() - t0, 4)
-            if r == z3.unsat:
-                return QueryResult("proved", script, dt, strategy=name)
-            if r == z3.sat:
-                return QueryResult("refuted", script, dt, model=render_model(s2.model(), enc), strategy=name)
-            reasons.append(f"{name}: {s2.reason_unknown()}")
-    return QueryResult("inconclusive", script, dt, reason="; ".join(reasons) if len(reasons) > 1 else s.reason_unknown())
+    with ExitStack() as scope:
+        if deterministic:
+            s = bounded_solver()
+            load_canonical(s, formulas)
+        else:
+            s = scope.enter_context(query_solver(timeout_ms))
+            s.add(*formulas)
+        t0 = time.perf_counter()
+        r = s.check()
+        dt = round(time.perf_counter() - t0, 4)
+        script = _smt2(formulas, comment or "validity query: unsat means the goal follows from the hypotheses")
+        if r == z3.unsat:
+            return QueryResult("proved", script, dt)
+        if r == z3.sat:
+            return QueryResult("refuted", script, dt, model=render_model(s.model(), enc))
+        reasons = [f"default: {s.reason_unknown()}"]
+        for name0, s0, rewrite in attempts(formulas, timeout_ms):
+            for name, s2 in variants(name0, s0):
+                load_canonical(s2, [rewrite(f) for f in formulas])
+                r = s2.check()
+                dt = round(time.perf_counter() - t0, 4)
+                if r == z3.unsat:
+                    return QueryResult("proved", script, dt, strategy=name)
+                if r == z3.sat:
+                    return QueryResult("refuted", script, dt, model=render_model(s2.model(), enc), strategy=name)
+                reasons.append(f"{name}: {s2.reason_unknown()}")
+        return QueryResult("inconclusive", script, dt, reason="; ".join(reasons) if len(reasons) > 1 else s.reason_unknown())
 
 
 def satisfiable(labelled: Sequence[tuple[str, z3.BoolRef]], enc: Encoder | None = None, *,
@@ -163,40 +237,39 @@ def satisfiable(labelled: Sequence[tuple[str, z3.BoolRef]], enc: Encoder | None 
     (the encoder's typing axioms are unlabelled background).
     """
     background = enc.axioms() if enc else []
-    s = budgeted_solver(timeout_ms)
-    s.set("unsat_core", True)
-    s.add(*background)
-    trackers = {}
-    for k, (label, f) in enumerate(labelled):
-        b = z3.Bool(f"__label_{k}")
-        trackers[str(b)] = label
-        s.assert_and_track(f, b)
-    t0 = time.perf_counter()
-    r = s.check()
-    dt = round(time.perf_counter() - t0, 4)
-    script = _smt2(background + [f for _, f in labelled], comment or "satisfiability query")
-    if r == z3.sat:
-        return QueryResult("sat", script, dt, model=render_model(s.model(), enc))
-    if r == z3.unsat:
-        core = sorted({trackers[str(c)] for c in s.unsat_core() if str(c) in trackers},
-                      key=[lbl for lbl, _ in labelled].index)
-        return QueryResult("unsat", script, dt, core=core)
-    reasons = [f"default: {s.reason_unknown()}"]
-    labels = [lbl for lbl, _ in labelled]
-    for name0, s0, rewrite in attempts(background + [f for _, f in labelled], timeout_ms) if retry else []:
-        for name, s2 in variants(name0, s0):
-            # loaded untracked from canonical text (tracking changes Z3's search)
-            load_canonical(s2, [rewrite(g) for g in background + [f for _, f in labelled]])
-            r = s2.check()
-            dt = round(time.perf_counter() - t0, 4)
-            if r == z3.sat:
-                return QueryResult("sat", script, dt, model=render_model(s2.model(), enc), strategy=name)
-            if r == z3.unsat:
-                tracked = _retry_core(background, labelled, rewrite)
-                core = tracked if tracked is not None else labels
-                return QueryResult("unsat", script, round(time.perf_counter() - t0, 4), core=core, strategy=name)
-            reasons.append(f"{name}: {s2.reason_unknown()}")
-    return QueryResult("inconclusive", script, dt, reason="; ".join(reasons) if len(reasons) > 1 else s.reason_unknown())
+    with query_solver(timeout_ms, cores=True) as s:
+        s.add(*background)
+        trackers = {}
+        for k, (label, f) in enumerate(labelled):
+            b = z3.Bool(f"__label_{k}")
+            trackers[str(b)] = label
+            s.assert_and_track(f, b)
+        t0 = time.perf_counter()
+        r = s.check()
+        dt = round(time.perf_counter() - t0, 4)
+        script = _smt2(background + [f for _, f in labelled], comment or "satisfiability query")
+        if r == z3.sat:
+            return QueryResult("sat", script, dt, model=render_model(s.model(), enc))
+        if r == z3.unsat:
+            core = sorted({trackers[str(c)] for c in s.unsat_core() if str(c) in trackers},
+                          key=[lbl for lbl, _ in labelled].index)
+            return QueryResult("unsat", script, dt, core=core)
+        reasons = [f"default: {s.reason_unknown()}"]
+        labels = [lbl for lbl, _ in labelled]
+        for name0, s0, rewrite in attempts(background + [f for _, f in labelled], timeout_ms) if retry else []:
+            for name, s2 in variants(name0, s0):
+                # loaded untracked from canonical text (tracking changes Z3's search)
+                load_canonical(s2, [rewrite(g) for g in background + [f for _, f in labelled]])
+                r = s2.check()
+                dt = round(time.perf_counter() - t0, 4)
+                if r == z3.sat:
+                    return QueryResult("sat", script, dt, model=render_model(s2.model(), enc), strategy=name)
+                if r == z3.unsat:
+                    tracked = _retry_core(background, labelled, rewrite)
+                    core = tracked if tracked is not None else labels
+                    return QueryResult("unsat", script, round(time.perf_counter() - t0, 4), core=core, strategy=name)
+                reasons.append(f"{name}: {s2.reason_unknown()}")
+        return QueryResult("inconclusive", script, dt, reason="; ".join(reasons) if len(reasons) > 1 else s.reason_unknown())
 
 
 def _retry_core(background: Sequence[z3.BoolRef], labelled: Sequence[tuple[str, z3.BoolRef]],

@@ -21,7 +21,7 @@ from typing import Any, Mapping, Sequence
 
 import z3
 
-from ...logic.query import budgeted_solver
+from ...logic.query import query_solver, solver_session
 from . import lang
 from .outline import z3_text
 from .wp import VC, ProgramModel, iter_terms
@@ -97,15 +97,15 @@ def check_vc(vc: VC, background: Sequence[z3.BoolRef], m: ProgramModel, timeout_
     core = [*vc.hyps, vc.goal]
     hyps = (*vc.hyps, *background, *m.typing_facts(core))
     formulas = [*hyps, z3.Not(vc.goal)]
-    s = budgeted_solver(timeout_ms)
-    s.add(*formulas)
-    text = _smt2(s, f"{vc.id}: {vc.label}; unsat means the condition holds")
-    r = s.check()
-    if r == z3.unsat:
-        return VCResult(vc, "valid", text, hyps=hyps)
-    if r == z3.sat:
-        return VCResult(vc, "invalid", text, model=s.model(), hyps=hyps)
-    return VCResult(vc, "unknown", text, reason=s.reason_unknown(), hyps=hyps)
+    with query_solver(timeout_ms) as s:
+        s.add(*formulas)
+        text = _smt2(s, f"{vc.id}: {vc.label}; unsat means the condition holds")
+        r = s.check()
+        if r == z3.unsat:
+            return VCResult(vc, "valid", text, hyps=hyps)
+        if r == z3.sat:
+            return VCResult(vc, "invalid", text, model=s.model(), hyps=hyps)
+        return VCResult(vc, "unknown", text, reason=s.reason_unknown(), hyps=hyps)
 
 
 class _Replay:
@@ -204,8 +204,13 @@ def counterexample(res: VCResult, m: ProgramModel, observe: Mapping[str, z3.Expr
 def check_all(vcs: Sequence[VC], background: Sequence[z3.BoolRef], m: ProgramModel, timeout_ms: int,
               observe: Mapping[str, z3.ExprRef] | None = None, observe_final: Mapping[str, str] | None = None,
               names: Mapping[str, str] | None = None) -> TripleResult:
-    """Check every VC of a triple (``main`` first) and roll the answers up."""
-    results = tuple(check_vc(vc, background, m, timeout_ms) for vc in vcs)
+    """Check every VC of a triple (``main`` first) and roll the answers up.
+
+    The VCs share one solver session (:func:`~rclverify.logic.query.solver_session`):
+    the same VCs in the same order wherever the triple is checked (a local
+    run, a cluster worker), so the answers and counterexamples are too."""
+    with solver_session():
+        results = tuple(check_vc(vc, background, m, timeout_ms) for vc in vcs)
     bad = next((r for r in results if r.status == "invalid"), None)
     if bad is not None:
         cex, notes = counterexample(bad, m, observe, observe_final, names)
