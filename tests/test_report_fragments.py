@@ -13,6 +13,7 @@ from rclverify.evidence.store import dumps
 from rclverify.pipeline import Workspace
 from rclverify.report.build import build_report
 from rclverify.report.fragments import FragmentCache, cached_dumps
+from rclverify.report.parts import FRAGMENTS, PARTS, write_part
 
 #: Every file the report task writes (argument.svg only with Graphviz).
 FILES = ("assurance.html", "assurance.md", "assurance.json", "assurance.sarif", "assurance.junit.xml",
@@ -31,8 +32,8 @@ def _render(ws: Path, out: Path, fragments: FragmentCache | None) -> dict[str, b
     return {name: (out / name).read_bytes() for name in FILES if (out / name).exists()}
 
 
-def _reports(ws: Path) -> dict[str, bytes]:
-    return {name: (ws / "reports" / name).read_bytes() for name in FILES if (ws / "reports" / name).exists()}
+def _reports(ws: Path, sub: str = "reports") -> dict[str, bytes]:
+    return {name: (ws / sub / name).read_bytes() for name in FILES if (ws / sub / name).exists()}
 
 
 def test_empty_and_warm_cache_give_the_uncached_report(workspace: Path, tmp_path: Path) -> None:
@@ -57,12 +58,28 @@ def test_after_an_edit_the_warm_cache_gives_the_uncached_report(workspace: Path,
         r = _doit(workspace, "verify")  # its report task renders with the previous run's pieces
         assert r.returncode == 0, r.stdout + r.stderr
         assert _reports(workspace) == _render(workspace, tmp_path / "plain", None)
-        kept = FragmentCache(workspace / FragmentCache.IN_WORKSPACE)
-        assert _render(workspace, tmp_path / "warm", kept) == _reports(workspace)
-        assert kept.misses == 0  # the run kept exactly the pieces of the edited report
+        report = build_report(Workspace(workspace))
+        for part, rel in FRAGMENTS.items():  # each report task keeps the pieces of its own files
+            kept = FragmentCache(workspace / rel)
+            write_part(report, tmp_path / "warm", part, kept)
+            assert kept.misses == 0, part  # the run kept exactly the pieces of the edited report
+        assert _reports(tmp_path / "warm", "") == _reports(workspace)
     finally:
         rcl.write_text(original)
         assert _doit(workspace, "verify").returncode == 0
+
+
+def test_the_report_parts_write_disjoint_files_that_together_are_the_whole_report(workspace: Path,
+                                                                                 tmp_path: Path) -> None:
+    plain = _render(workspace, tmp_path / "plain", None)
+    report = build_report(Workspace(workspace))
+    for part in reversed(PARTS):  # the order the two report tasks finish in does not matter
+        written = [p.name for p in write_part(report, tmp_path / part, part)]
+        assert set(written) <= set(PARTS[part]) and set(PARTS[part]) - set(written) <= {"argument.svg"}
+        assert sorted(p.name for p in (tmp_path / part).iterdir()) == sorted(written)
+    assert not set(PARTS["html"]) & set(PARTS["text"])
+    both = {**_reports(tmp_path, "html"), **_reports(tmp_path, "text")}
+    assert both == plain
 
 
 def test_a_damaged_or_foreign_cache_file_is_an_empty_cache(tmp_path: Path) -> None:

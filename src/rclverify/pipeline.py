@@ -24,7 +24,7 @@ import hashlib
 from dataclasses import dataclass
 from functools import cached_property
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, Callable, cast
+from typing import TYPE_CHECKING, Any, Callable, Sequence, cast
 
 from .evidence.records import Evidence, Obligation
 from .evidence.store import EvidenceStore, atomic_write_text, read_json, write_json, write_obligations
@@ -323,28 +323,37 @@ def stage_run(ws: Workspace, node: str, obligation_id: str) -> Evidence:
     return ev
 
 
-def stage_report(ws: Workspace) -> tuple[dict[str, Any], list[Path]]:
-    """Build the report dict of ``ws`` and write every report file under
-    ``reports/``: ``assurance.{html,md,json}``, the CI formats and the
-    assurance argument.  Graphviz layouts, compiled templates and rendered
-    pieces of the report are kept under ``artifacts/cache/`` for the next run (a pure speed-up:
-    the files are the same without them, docs/scale.md).  Returns the report
-    dict and the paths written; raises ``RclError`` for contracts or a plan
-    that do not check and ``OSError`` when a file cannot be written."""
-    from .argument.export import write_argument
+#: The parts of the report (:data:`rclverify.report.parts.PARTS`), each a doit task of its own.
+REPORT_PARTS = ("html", "text")
+
+
+def stage_report(ws: Workspace, parts: Sequence[str] = REPORT_PARTS,
+                 report: dict[str, Any] | None = None) -> tuple[dict[str, Any], list[Path]]:
+    """Build the report dict of ``ws`` (unless ``report`` gives it) and write
+    the files of ``parts`` under ``reports/`` (:mod:`rclverify.report.parts`:
+    ``html`` is ``assurance.{html,json}``, the CI formats and the argument's
+    SVG; ``text`` is ``assurance.md`` and the rest of the argument).  Graphviz
+    layouts, compiled templates and rendered pieces of the report are kept
+    under ``artifacts/cache/`` for the next run (a pure speed-up: the files
+    are the same without them, docs/scale.md).  Returns the report dict and
+    the paths written; raises ``RclError`` for contracts or a plan that do
+    not check, ``KeyError`` for an unknown part and ``OSError`` when a file
+    cannot be written."""
     from .report import layoutcache
     from .report.build import build_report
-    from .report.ci import write_ci_reports
     from .report.fragments import FragmentCache
-    from .report.render import render_all, use_bytecode_cache
-    report = build_report(ws)
+    from .report.parts import FRAGMENTS, write_part
+    from .report.render import use_bytecode_cache
+    if report is None:
+        report = build_report(ws)
     layoutcache.use_directory(ws.path("artifacts/cache/layout"))
     use_bytecode_cache(ws.path("artifacts/cache/templates"))
-    fragments = FragmentCache(ws.path(FragmentCache.IN_WORKSPACE))
     out = ws.path("reports")
-    paths = render_all(report, out, fragments=fragments) + write_ci_reports(report, out)
-    paths += write_argument(report, out, fragments)
-    fragments.save()
+    paths: list[Path] = []
+    for part in parts:
+        fragments = FragmentCache(ws.path(FRAGMENTS[part]))
+        paths += write_part(report, out, part, fragments)
+        fragments.save()
     return report, paths
 
 

@@ -13,8 +13,10 @@ Stages and their real file dependencies, per node ``N``:
                    export   snapshot of N + the backend input files -> obligations/N.json
 ``evidence:ID``     one obligation's record + the files it reads -> its evidence record
                    (created after ``node`` ran, when the obligations are known)
-``report``         every artifact above -> reports/assurance.{html,md,json}
-                   and the CI formats reports/assurance.sarif, assurance.junit.xml
+``report:html``    every artifact above -> reports/assurance.{html,json}, the CI formats
+                   reports/assurance.sarif, assurance.junit.xml, argument.svg
+``report:text``    every artifact above -> reports/assurance.md, argument.{json,gsn.yaml,dot}
+                   (two tasks rendered at once by ``doit -n 2``: report/parts.py)
 ``verify``         the whole pipeline; ``doit verify --strict`` fails unless every
                    obligation is discharged
 
@@ -48,7 +50,7 @@ from doit.exceptions import TaskFailed
 from doit.tools import config_changed
 
 from . import wscache
-from .pipeline import TaskIndex, Workspace
+from .pipeline import REPORT_PARTS, TaskIndex, Workspace
 from .rcl.errors import RclError
 
 _F = TypeVar("_F", bound=Callable[..., Any])
@@ -60,10 +62,6 @@ def create_after(executed: str) -> Callable[[_F], _F]:
 
 
 REPORTS = ["reports/assurance.html", "reports/assurance.md", "reports/assurance.json"]
-#: The CI formats the ``report`` task also writes (SARIF 2.1.0, JUnit XML; see report/ci.py).
-CI_REPORTS = ["reports/assurance.sarif", "reports/assurance.junit.xml"]
-#: The assurance argument written next to the report (argument.svg only with graphviz).
-ARGUMENT_REPORTS = ["reports/argument.json", "reports/argument.gsn.yaml", "reports/argument.dot"]
 
 
 _WORKSPACES: dict[str, Workspace] = {}
@@ -172,13 +170,29 @@ def act_run(root: str, node: str, obligation_id: str) -> Any:
     return None
 
 
-def act_report(root: str) -> Any:
+#: The report dict built by the first report part of a run, for the other parts the same process
+#: runs (a serial run): keyed by workspace root, valid for the workspace object of that run.
+_REPORTS: dict[str, tuple[Workspace, dict[str, Any]]] = {}
+
+
+def act_report(root: str, part: str) -> Any:
+    """Write one part of the report (:mod:`rclverify.report.parts`).  The
+    parts run after every backend, from the same artifacts, so a process
+    that runs both (``doit`` without ``-n``) builds the report dict once:
+    it is kept for the workspace object of this run (:func:`_ws`), which
+    a later run (a new :func:`build_tasks`) replaces."""
     from .pipeline import stage_report
     try:
-        report, _ = stage_report(_ws(root))
+        ws = _ws(root)
+        kept = _REPORTS.get(root)
+        report, _ = stage_report(ws, (part,), kept[1] if kept is not None and kept[0] is ws else None)
     except RclError as exc:
         return _fail(exc)
-    print(f"report: reports/assurance.html  ({report['summary']['headline']})")
+    _REPORTS[root] = (ws, report)
+    if part == "html":
+        print(f"report: reports/assurance.html  ({report['summary']['headline']})")
+    else:
+        print(f"report: reports/assurance.md and the argument ({part})")
     return None
 
 
@@ -365,14 +379,19 @@ def build_tasks(root: str | Path, plan_file: str = "contracts/plan.yaml") -> dic
                    "verbosity": 2, "clean": True}
 
     @create_after(executed="evidence")
-    def task_report() -> dict[str, Any]:
-        """Roll everything up into reports/assurance.{html,md,json}."""
+    def task_report() -> Iterator[dict[str, Any]]:
+        """Roll everything up into the report files: two parts, rendered at once by doit -n 2."""
+        from .report.parts import PARTS
+        yield {"basename": "report", "name": None,
+               "doc": "Roll everything up into reports/ (assurance.{html,md,json}, the CI formats, the argument)."}
         deps = [at(p) for p in (ws.MODEL, ws.DIAGNOSTICS)] + list(snap.values())
         for n in nodes:
             deps += [at(ws.calculus(n)), at(ws.health(n)), at(ws.obligations(n))]
         deps += [at(ws.evidence(o["id"])) for _, o in exported()]
-        return {"actions": [(act_report, [r])], "file_dep": deps,
-                "targets": [str(rootp / p) for p in REPORTS + CI_REPORTS + ARGUMENT_REPORTS], "verbosity": 2, "clean": True}
+        for part in REPORT_PARTS:
+            yield {"name": part, "actions": [(act_report, [r, part])], "file_dep": deps,
+                   "targets": [at(f"reports/{f}") for f in PARTS[part] if f != "argument.svg"],
+                   "verbosity": 2, "clean": True}
 
     def task_verify() -> dict[str, Any]:
         """The whole pipeline: check, compose, health, export, run, report.  --strict fails on any open evidence."""

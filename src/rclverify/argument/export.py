@@ -179,69 +179,101 @@ def to_dot(arg: Argument, title: str = "assurance argument", link_prefix: str = 
         edges=_pieces(arg, fragments, "argument.dot-edges.j2", link_prefix, edges))
 
 
-#: The last report built (kept, so its ``id`` is not reused), its argument, DOT text and JSON form.
-_last: list[tuple[Mapping[str, Any], Argument, str, dict[str, Any]]] = []
+#: The last report built (kept, so its ``id`` is not reused), its argument and JSON form, and
+#: its DOT text once made (``[]`` until then).
+_last: list[tuple[Mapping[str, Any], Argument, dict[str, Any], list[str]]] = []
 
 
-def _built(report: Mapping[str, Any], fragments: FragmentCache | None = None) -> tuple[Argument, str, dict[str, Any]]:
-    """``(argument, dot, argument JSON)`` of ``report``.  One report run
-    shows the argument three times (HTML, Markdown, ``reports/argument.*``)
-    from the same report dict, which no renderer changes; it is built once
-    for that dict (``fragments`` as for :func:`to_dot`)."""
-    if _last and _last[0][0] is report:
-        return _last[0][1], _last[0][2], _last[0][3]
-    arg = build_argument(report)
-    dot = to_dot(arg, f"assurance argument of {report['meta']['workspace']}", fragments=fragments)
-    _last[:] = [(report, arg, dot, arg.to_json())]
-    return arg, dot, _last[0][3]
+def _built(report: Mapping[str, Any]) -> tuple[Argument, dict[str, Any], list[str]]:
+    """``(argument, argument JSON, [DOT text] or [])`` of ``report``.  One
+    report run shows the argument several times (HTML, Markdown,
+    ``reports/argument.*``) from the same report dict, which no renderer
+    changes; it is built once for that dict."""
+    if not (_last and _last[0][0] is report):
+        arg = build_argument(report)
+        _last[:] = [(report, arg, arg.to_json(), [])]
+    return _last[0][1], _last[0][2], _last[0][3]
+
+
+def too_large(arg: Argument) -> bool:
+    """More than :data:`MAX_LAYOUT_ELEMENTS` elements: the argument is not laid out."""
+    return len(arg.elements) > MAX_LAYOUT_ELEMENTS
 
 
 def argument_dot(report: Mapping[str, Any], fragments: FragmentCache | None = None) -> tuple[Argument, str]:
-    """``(argument, DOT text)`` of ``report`` (built once per report dict, like
-    :func:`argument_view`; ``fragments`` as for :func:`to_dot`): what
-    :func:`layout` needs to lay the argument out ahead of the rendering."""
-    arg, dot, _ = _built(report, fragments)
-    return arg, dot
+    """``(argument, DOT text)`` of ``report``, each made once per report dict
+    (``fragments`` as for :func:`to_dot`)."""
+    arg, _, dot = _built(report)
+    if not dot:
+        dot.append(to_dot(arg, f"assurance argument of {report['meta']['workspace']}", fragments=fragments))
+    return arg, dot[0]
+
+
+def argument_layout(report: Mapping[str, Any], fragments: FragmentCache | None = None) -> Callable[[], diagram.Rendering]:
+    """What lays the argument of ``report`` out: a call that returns
+    :func:`layout`'s rendering.  The DOT text is made now, by the caller
+    (the fragment cache is not shared between threads), and only when the
+    argument is laid out at all; the call itself only waits for Graphviz,
+    so it can run in a thread (``fragments`` as for :func:`to_dot`)."""
+    arg = _built(report)[0]
+    if too_large(arg):
+        return lambda: layout(arg, "")
+    dot = argument_dot(report, fragments)[1]
+    return lambda: layout(arg, dot)
 
 
 def argument_view(report: Mapping[str, Any], rendering: diagram.Rendering | None = None,
                   fragments: FragmentCache | None = None) -> dict[str, Any]:
     """What the report templates show of the argument: ``argument`` (the
-    JSON form), ``dot``, ``svg`` (``None`` without Graphviz), ``note`` (why
+    JSON form), ``dot`` (``None`` when the argument is too large to lay out:
+    no report shows it then), ``svg`` (``None`` without Graphviz), ``note`` (why
     there is no SVG), ``too_large`` (more than :data:`MAX_LAYOUT_ELEMENTS`
     elements: not laid out, and the report links to the DOT file instead
     of inlining it) and ``goals`` (the requirement and contract goals with
     their statuses, for the tables).  ``rendering`` replaces running ``dot``;
     ``fragments`` as for :func:`to_dot`."""
-    arg, dot, as_json = _built(report, fragments)
-    too_large = len(arg.elements) > MAX_LAYOUT_ELEMENTS
-    drawn = layout(arg, dot) if rendering is None or too_large else rendering
+    arg, as_json, _ = _built(report)
+    large = too_large(arg)
+    dot = None if large else argument_dot(report, fragments)[1]
+    drawn = layout(arg, dot or "") if rendering is None or large else rendering
     top = arg.elements[arg.top]
     goals = [top] + [arg.elements[g] for s in top.supported_by for g in arg.elements[s].supported_by]
-    return {"argument": as_json, "dot": dot, "svg": drawn.svg, "note": drawn.note, "too_large": too_large,
+    return {"argument": as_json, "dot": dot, "svg": drawn.svg, "note": drawn.note, "too_large": large,
             "goals": [{"id": g.id, "text": g.text, "status": g.status, "undeveloped": g.undeveloped} for g in goals]}
 
 
-def write_argument(report: Mapping[str, Any], out_dir: Path, fragments: FragmentCache | None = None) -> list[Path]:
-    """Write :data:`FILES` for ``report`` into ``out_dir`` (``reports/``).
+def write_argument(report: Mapping[str, Any], out_dir: Path, fragments: FragmentCache | None = None,
+                   files: tuple[str, ...] = FILES, rendering: diagram.Rendering | None = None) -> list[Path]:
+    """Write the :data:`FILES` named in ``files`` for ``report`` into ``out_dir`` (``reports/``).
 
     Everything is rendered before anything is written; each file is written
-    atomically and only when changed.  Without Graphviz, ``argument.svg`` is
-    removed (so no stale diagram remains) and not returned.  ``fragments``
-    keeps rendered pieces between runs (:mod:`rclverify.report.fragments`;
-    the files are the same without it).  Returns the paths written.  Raises
-    ``KeyError`` for a malformed report and ``OSError`` when ``out_dir``
-    cannot be written.
+    atomically and only when changed.  When the argument is not laid out
+    (no Graphviz, or too large), ``argument.svg`` is removed (so no stale
+    diagram remains) and not returned.  ``fragments`` keeps rendered pieces
+    between runs (:mod:`rclverify.report.fragments`; the files are the same
+    without it); ``rendering`` is the argument's layout when already made
+    (:func:`argument_layout`).  Returns the paths written, in
+    :data:`FILES` order.  Raises ``KeyError`` for a malformed report and
+    ``OSError`` when ``out_dir`` cannot be written.
     """
-    arg, dot, as_json = _built(report, fragments)
+    arg, as_json, _ = _built(report)
     title = f"assurance argument of {report['meta']['workspace']}"
-    json_text = dumps(as_json) if fragments is None else cached_dumps(as_json, fragments)
-    texts = {FILES[0]: json_text, FILES[1]: to_gsn_yaml(arg, title, fragments=fragments), FILES[2]: dot}
-    svg = layout(arg, dot).svg
+    texts: dict[str, str] = {}
+    if FILES[0] in files:
+        texts[FILES[0]] = dumps(as_json) if fragments is None else cached_dumps(as_json, fragments)
+    if FILES[1] in files:
+        texts[FILES[1]] = to_gsn_yaml(arg, title, fragments=fragments)
+    if FILES[2] in files:
+        texts[FILES[2]] = argument_dot(report, fragments)[1]
+    svg = None
+    if FILES[3] in files:
+        svg = (rendering if rendering is not None else argument_layout(report, fragments)()).svg
     paths = []
     for name, text in texts.items():
         atomic_write_text(out_dir / name, text)
         paths.append(out_dir / name)
+    if FILES[3] not in files:
+        return paths
     svg_path = out_dir / FILES[3]
     if svg is None:
         svg_path.unlink(missing_ok=True)

@@ -1,7 +1,7 @@
 """Write the report's CI formats: ``assurance.sarif`` and ``assurance.junit.xml``.
 
-Called next to :func:`rclverify.report.render.render_all` by ``rclverify
-report`` and the doit ``report`` task.
+Written with the HTML report (:mod:`rclverify.report.parts`, part ``html``)
+by ``rclverify report`` and the doit ``report:html`` task.
 """
 from __future__ import annotations
 

@@ -16,9 +16,10 @@ it is rendered from, so its text can be reused when that data is equal:
   (the callable gets nothing else: whatever the piece shows must be in the
   data the key is computed from);
 * :meth:`FragmentCache.save` writes the pieces used in this run (and only
-  those: pieces of an old version of a node are dropped) to
-  ``artifacts/cache/report-fragments.pickle`` atomically, when they differ
-  from what was loaded.
+  those: pieces of an old version of a node are dropped) to its file
+  atomically, when they differ from what was loaded (each part of the report
+  has its own file, ``artifacts/cache/report-fragments.<part>.pickle``:
+  :mod:`rclverify.report.parts`).
 
 A damaged or missing file, or one from another salt, is an empty cache.
 The cache is machine-local and a pure speed-up: deleting ``artifacts/cache``
@@ -82,9 +83,6 @@ class FragmentCache:
     ``path`` is the pickle file (``None``: keep pieces in memory only, for
     this object's life -- what a render without a workspace uses).
     """
-
-    #: Where a workspace keeps its pieces (relative to the workspace root).
-    IN_WORKSPACE = "artifacts/cache/report-fragments.pickle"
 
     def __init__(self, path: Path | None = None) -> None:
         self.path = path

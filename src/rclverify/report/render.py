@@ -540,38 +540,59 @@ def render_json(report: Mapping[str, Any], fragments: FragmentCache | None = Non
     return dumps(report) if fragments is None else cached_dumps(report, fragments)
 
 
+#: The report files :func:`render_files` writes, in this order.
+REPORT_FILES = ("assurance.html", "assurance.md", "assurance.json")
+
+
 def render_all(report: Mapping[str, Any], out_dir: Path, link_prefix: str = "../",
                fragments: FragmentCache | None = None) -> list[Path]:
-    """Write ``assurance.html``, ``assurance.md`` and ``assurance.json`` to ``out_dir``.
+    """Write ``assurance.html``, ``assurance.md`` and ``assurance.json`` to
+    ``out_dir`` (:func:`render_files` with every file; same arguments,
+    errors and return value)."""
+    return render_files(report, out_dir, REPORT_FILES, link_prefix, fragments)
 
-    All three texts are rendered before anything is written, so a rendering
-    error leaves the previous report untouched; the system diagram and the
-    argument are laid out by Graphviz in two threads while the Markdown and
-    JSON texts are rendered (the layouts are subprocesses); each file is then written
-    atomically (and left alone when unchanged).  ``link_prefix`` as in
-    :func:`render_html`.  ``fragments`` keeps the rendered pieces between
-    runs (:mod:`rclverify.report.fragments`; the caller saves it); the files
-    are the same with or without it.  Returns the three paths in that order.  Raises
+
+def render_files(report: Mapping[str, Any], out_dir: Path, names: Sequence[str] = REPORT_FILES,
+                 link_prefix: str = "../", fragments: FragmentCache | None = None,
+                 argument: Callable[[], diagram.Rendering] | None = None) -> list[Path]:
+    """Write the report files of :data:`REPORT_FILES` named in ``names`` to ``out_dir``.
+
+    All the texts are rendered before anything is written, so a rendering
+    error leaves the previous files untouched; for the HTML, the system
+    diagram and the argument are laid out by Graphviz in two threads while
+    the other texts are rendered (the layouts are subprocesses); each file
+    is then written atomically (and left alone when unchanged).
+    ``link_prefix`` as in :func:`render_html`.  ``fragments`` keeps the
+    rendered pieces between runs (:mod:`rclverify.report.fragments`; the
+    caller saves it); the files are the same with or without it.
+    ``argument`` lays the argument out (default
+    :func:`rclverify.argument.export.argument_layout`).  Returns the paths
+    in :data:`REPORT_FILES` order.  Raises
     ``ValueError``/``TypeError``/``jinja2.UndefinedError`` for a malformed
     report and ``OSError`` when ``out_dir`` cannot be written.
     """
-    from concurrent.futures import ThreadPoolExecutor
+    from concurrent.futures import Future, ThreadPoolExecutor
 
-    from ..argument.export import argument_dot, layout
+    from ..argument.export import argument_layout
     texts = {}
     # The two Graphviz layouts (seconds each on a large system) run as subprocesses beside the
-    # Markdown and JSON rendering; a thread only waits for its `dot`, so the GIL is not in the way.
+    # other rendering; a thread only waits for its `dot`, so the GIL is not in the way.
     with ThreadPoolExecutor(max_workers=2, thread_name_prefix="rclverify-dot") as pool:
-        system = pool.submit(diagram.render_dot, _system_dot(report))
-        argument = pool.submit(layout, *argument_dot(report, fragments))
-        texts["assurance.md"] = render_markdown(report, link_prefix, fragments=fragments)
-        texts["assurance.json"] = render_json(report, fragments)
-        texts["assurance.html"] = render_html(report, link_prefix, fragments=fragments, system=system.result(),
-                                              argument=argument.result())
-    texts = {name: texts[name] for name in ("assurance.html", "assurance.md", "assurance.json")}
+        layouts: tuple[Future[diagram.Rendering], Future[diagram.Rendering]] | None = None
+        if "assurance.html" in names:
+            layouts = (pool.submit(diagram.render_dot, _system_dot(report)),
+                       pool.submit(argument if argument is not None else argument_layout(report, fragments)))
+        if "assurance.md" in names:
+            texts["assurance.md"] = render_markdown(report, link_prefix, fragments=fragments)
+        if "assurance.json" in names:
+            texts["assurance.json"] = render_json(report, fragments)
+        if layouts is not None:
+            texts["assurance.html"] = render_html(report, link_prefix, fragments=fragments,
+                                                  system=layouts[0].result(), argument=layouts[1].result())
     paths = []
-    for name, text in texts.items():
-        path = Path(out_dir) / name
-        atomic_write_text(path, text)
-        paths.append(path)
+    for name in REPORT_FILES:
+        if name in texts:
+            path = Path(out_dir) / name
+            atomic_write_text(path, texts[name])
+            paths.append(path)
     return paths
