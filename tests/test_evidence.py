@@ -85,3 +85,28 @@ def test_evidence_is_stale_once_an_input_changes(tmp_path: Path) -> None:
     (tmp_path / "prog.imp").unlink()
     assert store.current_status(ev) == "stale"
     assert store.get("missing") is None
+
+
+def test_kept_input_hashes_are_taken_once_per_file(tmp_path: Path) -> None:
+    (tmp_path / "prog.imp").write_text("skip")
+    store = EvidenceStore(tmp_path)
+    ev = _evidence(tmp_path, "failed")
+    hashes: dict[str, str] = {}
+    assert store.current_status(ev, hashes) == "failed" and set(hashes) == {"prog.imp"}
+    (tmp_path / "prog.imp").write_text("skip; skip")
+    # the caller promised no change while it keeps the hashes: the kept one answers
+    assert store.current_status(ev, hashes) == "failed"
+    assert store.current_status(ev, {}) == store.current_status(ev) == "stale"
+
+
+def test_a_target_relates_artifact_paths_to_the_workspace_root(tmp_path: Path) -> None:
+    from rclverify.backends.base import NodeTarget
+    art = tmp_path / "artifacts" / "hoare" / "N"
+    t = NodeTarget(root=tmp_path, checked=None, node=None, config={}, artifacts=art)  # type: ignore[arg-type]
+    assert t.rel(art / "g1.txt") == "artifacts/hoare/N/g1.txt"
+    assert t.rel(art / "sub" / ".." / "g2.txt") == "artifacts/hoare/N/g2.txt"  # resolved
+    assert t.rel(tmp_path / "backends" / "p.imp") == "backends/p.imp"
+    link = tmp_path / "ws-link"
+    link.symlink_to(tmp_path)
+    t2 = NodeTarget(root=link, checked=None, node=None, config={}, artifacts=link / "artifacts" / "x")  # type: ignore[arg-type]
+    assert t2.rel(link / "artifacts" / "x" / "f.txt") == "artifacts/x/f.txt"

@@ -2,6 +2,7 @@
 system model's per-node index, and the cached workspace of a doit run."""
 from __future__ import annotations
 
+import json
 import random
 from pathlib import Path
 
@@ -9,7 +10,7 @@ import pytest
 
 from rclverify import wscache
 from rclverify.pipeline import Workspace
-from rclverify.system.model import Link, SystemModel, _loops
+from rclverify.system.model import Link, SystemModel, _loops, cycles_kept
 
 
 def _sccs_by_reachability(nodes: list[str], links: list[Link]) -> tuple[tuple[str, ...], ...]:
@@ -54,6 +55,31 @@ def test_model_index_answers_like_a_scan_of_the_links() -> None:
         assert m.producers(n) == [x for x in nodes if x in ps]
         assert m.consumers(n) == [x for x in nodes if x in cs]
         assert m.internal_inputs(n) == {l.to_var for l in links if l.to_node == n}
+        assert m.links_into(n) == tuple(l for l in links if l.to_node == n)
+    for l in links:
+        assert m.readers(l.from_node, l.from_var) == tuple(x.to_node for x in links
+                                                            if (x.from_node, x.from_var) == (l.from_node, l.from_var))
+    assert m.readers("n0", "no such output") == () and m.links_into("no such node") == ()
+    assert dict(m.alias()) == {(l.to_node, "in", l.to_var): f"{l.from_node}.out.{l.from_var}" for l in links}
+    loops = _loops(list(nodes), list(links))
+    m2 = SystemModel(nodes, links, (), loops)
+    for n in nodes:
+        assert m2.loop_of(n) == next((loop for loop in loops if n in loop), None)
+
+
+def test_cycles_are_kept_for_the_same_connections_and_found_again_for_others(tmp_path: Path) -> None:
+    ring = SystemModel(("A", "B", "C"), (Link("A", "o", "B", "i", "name"), Link("B", "o", "C", "i", "name"),
+                                         Link("C", "o", "A", "i", "name")), (), (("A", "B", "C"),))
+    path = tmp_path / "cache" / "cycles.json"
+    assert cycles_kept(ring, path) == [["A", "B", "C"]] == ring.cycles()
+    kept = json.loads(path.read_text())
+    path.write_text(json.dumps({"key": kept["key"], "cycles": [["from", "the", "file"]]}))
+    assert cycles_kept(ring, path) == [["from", "the", "file"]]  # served from the file: same connections
+    chain = SystemModel(ring.nodes, ring.links[:2], (), ())
+    assert cycles_kept(chain, path) == []  # other connections: found again, and the file replaced
+    assert json.loads(path.read_text())["cycles"] == []
+    path.write_text("{damaged")
+    assert cycles_kept(ring, path) == [["A", "B", "C"]]
 
 
 RCL = """\

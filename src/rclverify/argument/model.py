@@ -161,4 +161,8 @@ def propagate(arg: Argument) -> Argument:
             s = worst([k for k in kids if k is not None], empty=UNDEVELOPED_STATUS)
         memo[i] = s
         return s
-    return Argument(arg.top, {i: replace(e, status=status(i)) for i, e in els.items()})
+    out = {}
+    for i, e in els.items():
+        s = status(i)
+        out[i] = e if s == e.status else replace(e, status=s)  # most elements keep theirs (solutions)
+    return Argument(arg.top, out)

@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass, field
+from functools import cached_property
 from datetime import datetime, timezone
 from pathlib import Path
 from typing import Any, Mapping, Protocol
@@ -85,8 +86,19 @@ class NodeTarget:
         return plan_error(loc.file, loc.line, loc.col + col_offset, message, code)
 
     def rel(self, path: Path) -> str:
-        """``path`` relative to the workspace root, with forward slashes."""
+        """``path`` relative to the workspace root, with forward slashes.  A
+        path under :attr:`artifacts` (what the backends pass) is related by
+        its text when neither it nor the artifact directory names ``..``;
+        anything else is resolved first (symbolic links, ``..``)."""
+        a = str(self.artifacts)
+        p = str(path)
+        if p.startswith(a + "/") and ".." not in path.parts and ".." not in self.artifacts.parts:
+            return f"{self._artifacts_rel}/{p[len(a) + 1:]}"
         return path.resolve().relative_to(self.root.resolve()).as_posix()
+
+    @cached_property
+    def _artifacts_rel(self) -> str:
+        return self.artifacts.resolve().relative_to(self.root.resolve()).as_posix()
 
 
 class Backend(Protocol):

@@ -47,7 +47,7 @@ from dataclasses import dataclass
 from typing import Any, Sequence
 
 from ..logic.encode import Encoder
-from ..logic.query import DEFAULT_TIMEOUT_MS, prove
+from ..logic.query import DEFAULT_TIMEOUT_MS, prove, solver_session
 from ..rcl import ast
 from ..rcl.printer import expr_to_rcl
 from ..rcl.walk import free_names, subexpressions
@@ -140,9 +140,8 @@ VARIANT_WITH_ASSUMPTIONS = "with producers' assumptions"
 def branch_siblings(model: SystemModel, node: str) -> list[str]:
     """Other readers of the outputs that feed ``node`` (an output read by
     several nodes is a branch, rule R2, paper lines 612-640), source order."""
-    feeding = {(l.from_node, l.from_var) for l in model.links if l.to_node == node}
-    others = {l.to_node for l in model.links if (l.from_node, l.from_var) in feeding and l.to_node != node}
-    return [n for n in model.nodes if n in others]
+    others = {r for l in model.links_into(node) for r in model.readers(l.from_node, l.from_var) if r != node}
+    return [n for n in model.nodes if n in others] if others else []
 
 
 def instance_rule(model: SystemModel, node: str) -> str | None:
@@ -204,12 +203,15 @@ def _environment_texts(checked: Checked, model: SystemModel, node: str) -> tuple
     return texts[node]
 
 
+@solver_session()
 def compose_node(checked: Checked, model: SystemModel, node: str, *,
                  timeout_ms: int = DEFAULT_TIMEOUT_MS) -> NodeComposition:
     """Apply the calculus to ``node``: discharge its side conditions with Z3.
 
     Returns a :class:`NodeComposition`.  Never raises on solver trouble
-    (an unknown answer is an ``inconclusive`` side condition).
+    (an unknown answer is an ``inconclusive`` side condition).  The side
+    conditions share one solver session
+    (:func:`~rclverify.logic.query.solver_session`), asked in a fixed order.
     """
     cn = checked.nodes[node]
     producers = model.producers(node)
@@ -318,7 +320,7 @@ def _links_of(model: SystemModel, cn: Any, node: str, c: ast.Expr) -> list[str]:
               if t.match is not None and t.match.prefix in (None, "in")}
     return [f"{l.from_node}.out.{l.from_var} -> {node}.in.{l.to_var} (via {l.via}"
             + (f", topic {topics[l.to_var]})" if l.to_var in topics else ")")
-            for l in model.links if l.to_node == node and l.to_var in names]
+            for l in model.links_into(node) if l.to_var in names]
 
 
 def composition_json(c: NodeComposition, smt2_paths: Sequence[str]) -> dict[str, Any]:

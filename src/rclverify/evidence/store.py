@@ -123,9 +123,20 @@ class EvidenceStore:
                 out.append(ev)
         return out
 
-    def current_status(self, ev: Evidence) -> str:
-        """``ev.status``, or ``"stale"`` when any input's sha256 changed since."""
-        now = hash_inputs(self.root, list(ev.input_hashes))
+    def current_status(self, ev: Evidence, hashes: dict[str, str] | None = None) -> str:
+        """``ev.status``, or ``"stale"`` when any input's sha256 changed since.
+
+        ``hashes`` (workspace-relative path -> sha256), when given, keeps
+        the hashes taken across calls: the caller promises the files do not
+        change meanwhile (the report reads 2,000 evidence records of a
+        1000-node system, most naming the same program file)."""
+        if hashes is None:
+            now = hash_inputs(self.root, list(ev.input_hashes))
+        else:
+            missing = [p for p in ev.input_hashes if p not in hashes]
+            if missing:
+                hashes.update(hash_inputs(self.root, missing))
+            now = hashes
         if any(now[p] != h for p, h in ev.input_hashes.items()):
             return "stale"
         return ev.status

@@ -253,7 +253,7 @@ class Encoder:
 
     def __init__(self, env: Env, alias: Mapping[tuple[str, str, str], str] | None = None) -> None:
         self.env = env
-        self.alias = dict(alias or {})
+        self.alias: Mapping[tuple[str, str, str], str] = alias if alias is not None else {}
         self.symbols: dict[str, Symbol] = {}
 
     # -- sorts and values ------------------------------------------------------------

@@ -35,6 +35,7 @@ from ..pipeline import Workspace, read_artifact
 from ..rcl import ast
 from ..rcl.latex import to_latex
 from ..rcl.printer import expr_to_rcl, type_to_rcl
+from ..system.model import cycles_kept
 from .expected import expected_rows
 
 _FINDING_AS = {"ok": "discharged", "problem": "failed", "inconclusive": "inconclusive",
@@ -112,9 +113,10 @@ def build_report(ws: Workspace) -> dict[str, Any]:
     ob_rows: list[dict[str, Any]] = []
     pending: list[dict[str, Any]] = []
     ob_status: dict[str, str] = {}
+    hashes: dict[str, str] = {}  # input sha256s, taken once per file: nothing changes while the report is built
     for o in obligations:
         ev = store.get(o.id)
-        status = store.current_status(ev) if ev else "pending"
+        status = store.current_status(ev, hashes) if ev else "pending"
         ob_status[o.id] = status
         ob_rows.append({"id": o.id, "node": o.node, "guarantee": o.guarantee, "backend": o.backend, "kind": o.kind,
                         "instance": o.instance, "statement": o.statement, "source": str(o.source),
@@ -255,7 +257,7 @@ def build_report(ws: Workspace) -> dict[str, Any]:
                  and all(g_status(name, k) == "discharged" for name, cn in checked.nodes.items()
                          for k in range(1, len(cn.node.guarantees) + 1)))
     headline = _headline(ob_rows, counts, side_conditions, findings)
-    system = model.view(node_status)
+    system = model.view(node_status, cycles_kept(model, ws.path("artifacts/cache/system-cycles.json")))
     return {
         "meta": {"tool": "rclverify", "version": __version__, "workspace": plan.name or ws.root.resolve().name, "plan": plan.file,
                  "contracts": list(plan.contracts), "z3_version": z3.get_version_string(), "strict_ok": strict_ok},

@@ -16,10 +16,15 @@ is an error asking for an explicit connection in the plan.
 """
 from __future__ import annotations
 
+import hashlib
+import json
 from dataclasses import dataclass
 from functools import cached_property
-from typing import Any, Iterable, Iterator, Sequence
+from pathlib import Path
+from types import MappingProxyType
+from typing import Any, Iterable, Iterator, Mapping, Sequence
 
+from ..evidence.store import atomic_write_text
 from ..plan.load import Connection
 from ..rcl.errors import RclError, error
 from ..rcl.types import Checked, EmptyT
@@ -82,10 +87,16 @@ class SystemModel:
         return set(self._index[node][2]) if node in self._index else set()
 
     def loop_of(self, node: str) -> tuple[str, ...] | None:
+        """The loop (strongly connected component) ``node`` is on, if any."""
+        return self._loop_index.get(node)
+
+    @cached_property
+    def _loop_index(self) -> dict[str, tuple[str, ...]]:
+        out: dict[str, tuple[str, ...]] = {}
         for loop in self.loops:
-            if node in loop:
-                return loop
-        return None
+            for n in loop:
+                out.setdefault(n, loop)
+        return out
 
     def upstream(self, node: str) -> list[str]:
         """The upstream cone of ``node``: itself and every node that reaches it."""
@@ -97,9 +108,32 @@ class SystemModel:
                     todo.append(p)
         return [n for n in self.nodes if n in seen]
 
-    def alias(self) -> dict[tuple[str, str, str], str]:
-        """Encoder aliases: each connected input becomes its producer's output symbol."""
-        return {(l.to_node, "in", l.to_var): f"{l.from_node}.out.{l.from_var}" for l in self.links}
+    def alias(self) -> Mapping[tuple[str, str, str], str]:
+        """Encoder aliases: each connected input becomes its producer's output
+        symbol.  Built once per model (the calculus asks for it per node);
+        read-only."""
+        return self._alias
+
+    @cached_property
+    def _alias(self) -> Mapping[tuple[str, str, str], str]:
+        return MappingProxyType({(l.to_node, "in", l.to_var): f"{l.from_node}.out.{l.from_var}" for l in self.links})
+
+    def links_into(self, node: str) -> tuple[Link, ...]:
+        """The links feeding ``node``, in link order (indexed once per model)."""
+        return self._links_by_end[0].get(node, ())
+
+    def readers(self, from_node: str, from_var: str) -> tuple[str, ...]:
+        """The nodes reading output ``from_var`` of ``from_node``, in link order."""
+        return self._links_by_end[1].get((from_node, from_var), ())
+
+    @cached_property
+    def _links_by_end(self) -> tuple[dict[str, tuple[Link, ...]], dict[tuple[str, str], tuple[str, ...]]]:
+        into: dict[str, list[Link]] = {}
+        read: dict[tuple[str, str], list[str]] = {}
+        for l in self.links:
+            into.setdefault(l.to_node, []).append(l)
+            read.setdefault((l.from_node, l.from_var), []).append(l.to_node)
+        return ({n: tuple(ls) for n, ls in into.items()}, {k: tuple(ns) for k, ns in read.items()})
 
     def to_json(self) -> dict[str, Any]:
         return {
@@ -131,17 +165,18 @@ class SystemModel:
             out.append(c[k:] + c[:k])
         return tuple(tuple(c) for c in sorted(out, key=lambda c: (len(c), [order[n] for n in c])))
 
-    def view(self, status: dict[str, str]) -> dict[str, Any]:
+    def view(self, status: dict[str, str], cycles: list[list[str]] | None = None) -> dict[str, Any]:
         """:meth:`to_json` with each node's roll-up status (``pending`` when
         unknown): what the diagram and the report's system section show.
-        There ``loops`` are the graph's real cycles (:meth:`cycles`), each a
+        There ``loops`` are the graph's real cycles (:meth:`cycles`, or
+        ``cycles`` when the caller has them: :func:`cycles_kept`), each a
         node sequence whose consecutive pairs (and last -> first) are
         connections; the strongly connected components R4 is applied to are
         under ``loop_components``."""
         d = self.to_json()
         d["nodes"] = [{"name": n, "status": status.get(n, "pending")} for n in self.nodes]
         d["loop_components"] = d["loops"]
-        d["loops"] = self.cycles()
+        d["loops"] = self.cycles() if cycles is None else cycles
         return d
 
     @staticmethod
@@ -257,3 +292,28 @@ def _loops(nodes: Sequence[str], links: Iterable[Link]) -> tuple[tuple[str, ...]
         if n not in index:
             visit(n)
     return tuple(sorted(out))
+
+
+def cycles_kept(model: SystemModel, path: Path) -> list[list[str]]:
+    """``model.cycles()``, kept in the JSON file ``path`` for the next run
+    with the same nodes and connections (the key is the sha256 of the
+    model's nodes and links).  Finding the cycles of a 1000-node system
+    takes half a second, in each report task after every edit, while an
+    edit seldom changes a connection (docs/scale.md, sixth round).  A
+    missing, damaged or foreign file is recomputed and replaced
+    atomically; raises nothing for an unwritable cache (the cycles are
+    returned anyway)."""
+    key = hashlib.sha256(json.dumps([list(model.nodes), [l.to_json() for l in model.links]],
+                                    sort_keys=True).encode()).hexdigest()
+    try:
+        kept = json.loads(path.read_text(encoding="utf-8"))
+        if isinstance(kept, dict) and kept.get("key") == key and isinstance(kept.get("cycles"), list):
+            return [list(c) for c in kept["cycles"]]
+    except (OSError, ValueError):
+        pass
+    cycles = model.cycles()
+    try:
+        atomic_write_text(path, json.dumps({"key": key, "cycles": cycles}) + "\n")
+    except OSError:
+        pass
+    return cycles
