@@ -21,7 +21,10 @@ tenth node closes a loop by reading the output of the node four places
 downstream (R4).  Node ``N0`` reads the environment input ``e0``.  Every node
 has two guarantees and a ``hoare`` evidence entry over one shared clamp
 program (``backends/hoare/clamp.imp``), so each node gives Hoare obligations
-checked by Z3, and the calculus and health checks run as usual.
+checked by Z3, and the calculus and health checks run as usual
+(``--hoare EVERY``: only every EVERY-th node; 0 for none, which leaves the
+calculus and health checks alone, the workload the issue's speed aims were
+first measured on).
 Every tenth node (``--property-tests EVERY``; 0 for none) also has a
 ``property_tests`` entry, 25 Hypothesis examples against the same clamp
 written in Python (``backends/property_tests/clamp.py``).
@@ -31,6 +34,7 @@ Usage::
     python bench/pipeline_scale.py                     # N = 10 100 500 1000
     python bench/pipeline_scale.py --sizes 10,100 -n 2 # quick run, doit -n 2
     python bench/pipeline_scale.py --keep DIR          # keep the workspaces under DIR
+    python bench/pipeline_scale.py --hoare 0 --property-tests 0   # calculus and health only
 
 The figures are printed, not asserted.
 """
@@ -117,10 +121,11 @@ def implementation(k: int, producers: list[int]) -> str:
             f"    return {{'v{k}': {ins[0]} if {ins[0]} >= 0 else 0}}\n\n\n")
 
 
-def generate(root: Path, n: int, property_tests: bool, pt_every: int = 10) -> None:
+def generate(root: Path, n: int, property_tests: bool, pt_every: int = 10, hoare_every: int = 1) -> None:
     """Write an ``n``-node workspace under ``root`` (which must not exist);
-    with ``property_tests``, every ``pt_every``-th node also gets a
-    ``property_tests`` entry (25 examples) over its clamp in Python."""
+    every ``hoare_every``-th node (0: none) gets a ``hoare`` entry over the
+    clamp program; with ``property_tests``, every ``pt_every``-th node also
+    gets a ``property_tests`` entry (25 examples) over its clamp in Python."""
     (root / "contracts").mkdir(parents=True)
     (root / "backends" / "hoare").mkdir(parents=True)
     (root / "backends" / "hoare" / "clamp.imp").write_text(CLAMP)
@@ -133,12 +138,15 @@ def generate(root: Path, n: int, property_tests: bool, pt_every: int = 10) -> No
         ins = [f"v{p}" for p in prod[k]] or ["e0"]
         binding = {f"in.{ins[0]}": "x", f"out.v{k}": "y"}
         binding.update({f"in.{i}": "z" for i in ins[1:]})
-        entries: list[dict[str, object]] = [{"backend": "hoare", "program": "backends/hoare/clamp.imp", "binding": binding}]
+        entries: list[dict[str, object]] = []
+        if hoare_every and k % hoare_every == 0:
+            entries.append({"backend": "hoare", "program": "backends/hoare/clamp.imp", "binding": binding})
         if property_tests and k % pt_every == 0:
             impls.append(implementation(k, prod[k]))
             entries.append({"backend": "property_tests", "implementation": f"backends/property_tests/clamp.py:n{k}",
                             "max_examples": 25})
-        nodes[f"N{k}"] = {"evidence": entries}
+        if entries:
+            nodes[f"N{k}"] = {"evidence": entries}
     if impls:
         (root / "backends" / "property_tests").mkdir(parents=True)
         (root / "backends" / "property_tests" / "clamp.py").write_text("".join(impls))
@@ -224,12 +232,16 @@ def main(argv: Sequence[str] | None = None) -> int:
     ap.add_argument("--keep", help="write the workspaces under this directory and keep them")
     ap.add_argument("--property-tests", type=int, default=10, metavar="EVERY",
                     help="give every EVERY-th node a property_tests entry (default 10; 0: none)")
+    ap.add_argument("--hoare", type=int, default=1, metavar="EVERY",
+                    help="give every EVERY-th node a hoare entry (default 1: every node; 0: none, the calculus "
+                         "and health checks alone, the workload the issue's aims were measured on)")
     args = ap.parse_args(argv)
     sizes = _sizes(args.sizes)
     pt = has_property_tests() and args.property_tests > 0
     base = Path(args.keep) if args.keep else Path(tempfile.mkdtemp(prefix="rclverify-bench-"))
     print(f"pipeline scale: doit{' -n ' + str(args.jobs) if args.jobs > 1 else ''} verify, "
-          f"{os.cpu_count()} CPU(s); obligations: hoare"
+          f"{os.cpu_count()} CPU(s); obligations: "
+          + ("hoare" + (f" on every {args.hoare}th node" if args.hoare > 1 else "") if args.hoare > 0 else "none")
           + (f", property_tests on every {args.property_tests}th node" if pt else " (no property_tests)"))
     header = (f"{'nodes':>6} {'oblig.':>7} {'side c.':>7} {'cold s':>7} {'(cpu)':>7} {'MB':>5} {'no-op s':>7} "
               f"{'(cpu)':>6} {'ran':>3} {'edit s':>6} {'(cpu)':>6} {'MB':>5}  tasks run after the edit")
@@ -240,7 +252,7 @@ def main(argv: Sequence[str] | None = None) -> int:
             root = base / f"n{n}"
             if root.exists():
                 shutil.rmtree(root)
-            generate(root, n, pt, args.property_tests)
+            generate(root, n, pt, args.property_tests, args.hoare)
             cold = doit_verify(root, args.jobs)
             if cold.rc != 0:
                 print(f"{n:>6}  cold run failed (exit {cold.rc}):\n{cold.output[-3000:]}")

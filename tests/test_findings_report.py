@@ -20,6 +20,14 @@ def test_evidence_note_names_the_node_contracts_a_derivation_rests_on():
     assert note == "rests on 1 failed node contract: B; 1 pending node contract: C"
 
 
+def test_a_long_cone_names_ten_contracts_per_status_and_counts_the_rest():
+    cone = [f"N{k}" for k in range(25)]
+    st, note = _evidence_of_cone(cone, {"N3": "failed"})
+    assert st == "failed"
+    assert note == ("rests on 1 failed node contract: N3; 24 pending node contracts: "
+                    + ", ".join(f"N{k}" for k in range(11) if k != 3) + " and 14 more")
+
+
 def test_cycles_follow_existing_connections_only():
     # A -> B -> C -> A and A -> C: one SCC, two elementary cycles; no B -> A edge
     links = (Link("A", "x", "B", "x", "name"), Link("B", "y", "C", "y", "name"),

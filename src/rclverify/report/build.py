@@ -75,6 +75,11 @@ def _evidence_extras(ws: Workspace, details: Any) -> dict[str, Any]:
 
 
 _DERIVATION = {"discharged": "derived", "failed": "not derived"}
+#: Most node names a derived property's note lists per status ("3 pending node contracts: A, B, C");
+#: the rest are counted.  A property at the end of a 1000-node chain rests on 999 contracts: its
+#: note named them all, a quadratic amount of report text nobody reads (the cone itself is in the
+#: calculus artifact and the report's JSON).
+CONE_NAMES = 10
 
 
 def _evidence_of_cone(cone: list[str], node_evidence: dict[str, str]) -> tuple[str, str]:
@@ -94,7 +99,8 @@ def _evidence_of_cone(cone: list[str], node_evidence: dict[str, str]) -> tuple[s
         if st == "discharged":
             continue
         ns = by[st]
-        parts.append(f"{len(ns)} {st} node contract{'s' if len(ns) != 1 else ''}: {', '.join(ns)}")
+        named = ", ".join(ns[:CONE_NAMES]) + (f" and {len(ns) - CONE_NAMES} more" if len(ns) > CONE_NAMES else "")
+        parts.append(f"{len(ns)} {st} node contract{'s' if len(ns) != 1 else ''}: {named}")
     note = "rests on " + "; ".join(parts) if parts else "every node contract it rests on is discharged"
     return worst(list(by)), note
 
