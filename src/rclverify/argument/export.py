@@ -179,20 +179,19 @@ def to_dot(arg: Argument, title: str = "assurance argument", link_prefix: str = 
         edges=_pieces(arg, fragments, "argument.dot-edges.j2", link_prefix, edges))
 
 
-#: The last report built (kept, so its ``id`` is not reused), its argument and JSON form, and
-#: its DOT text once made (``[]`` until then).
-_last: list[tuple[Mapping[str, Any], Argument, dict[str, Any], list[str]]] = []
+#: The last report built (kept, so its ``id`` is not reused), its argument, and its DOT text once
+#: made (``[]`` until then).
+_last: list[tuple[Mapping[str, Any], Argument, list[str]]] = []
 
 
-def _built(report: Mapping[str, Any]) -> tuple[Argument, dict[str, Any], list[str]]:
-    """``(argument, argument JSON, [DOT text] or [])`` of ``report``.  One
-    report run shows the argument several times (HTML, Markdown,
-    ``reports/argument.*``) from the same report dict, which no renderer
-    changes; it is built once for that dict."""
+def _built(report: Mapping[str, Any]) -> tuple[Argument, list[str]]:
+    """``(argument, [DOT text] or [])`` of ``report``.  One report run shows
+    the argument several times (HTML, Markdown, ``reports/argument.*``) from
+    the same report dict, which no renderer changes; it is built once for
+    that dict."""
     if not (_last and _last[0][0] is report):
-        arg = build_argument(report)
-        _last[:] = [(report, arg, arg.to_json(), [])]
-    return _last[0][1], _last[0][2], _last[0][3]
+        _last[:] = [(report, build_argument(report), [])]
+    return _last[0][1], _last[0][2]
 
 
 def too_large(arg: Argument) -> bool:
@@ -203,7 +202,7 @@ def too_large(arg: Argument) -> bool:
 def argument_dot(report: Mapping[str, Any], fragments: FragmentCache | None = None) -> tuple[Argument, str]:
     """``(argument, DOT text)`` of ``report``, each made once per report dict
     (``fragments`` as for :func:`to_dot`)."""
-    arg, _, dot = _built(report)
+    arg, dot = _built(report)
     if not dot:
         dot.append(to_dot(arg, f"assurance argument of {report['meta']['workspace']}", fragments=fragments))
     return arg, dot[0]
@@ -224,21 +223,20 @@ def argument_layout(report: Mapping[str, Any], fragments: FragmentCache | None =
 
 def argument_view(report: Mapping[str, Any], rendering: diagram.Rendering | None = None,
                   fragments: FragmentCache | None = None) -> dict[str, Any]:
-    """What the report templates show of the argument: ``argument`` (the
-    JSON form), ``dot`` (``None`` when the argument is too large to lay out:
+    """What the report templates show of the argument: ``dot`` (``None`` when the argument is too large to lay out:
     no report shows it then), ``svg`` (``None`` without Graphviz), ``note`` (why
     there is no SVG), ``too_large`` (more than :data:`MAX_LAYOUT_ELEMENTS`
     elements: not laid out, and the report links to the DOT file instead
     of inlining it) and ``goals`` (the requirement and contract goals with
     their statuses, for the tables).  ``rendering`` replaces running ``dot``;
     ``fragments`` as for :func:`to_dot`."""
-    arg, as_json, _ = _built(report)
+    arg = _built(report)[0]
     large = too_large(arg)
     dot = None if large else argument_dot(report, fragments)[1]
     drawn = layout(arg, dot or "") if rendering is None or large else rendering
     top = arg.elements[arg.top]
     goals = [top] + [arg.elements[g] for s in top.supported_by for g in arg.elements[s].supported_by]
-    return {"argument": as_json, "dot": dot, "svg": drawn.svg, "note": drawn.note, "too_large": large,
+    return {"dot": dot, "svg": drawn.svg, "note": drawn.note, "too_large": large,
             "goals": [{"id": g.id, "text": g.text, "status": g.status, "undeveloped": g.undeveloped} for g in goals]}
 
 
@@ -256,10 +254,11 @@ def write_argument(report: Mapping[str, Any], out_dir: Path, fragments: Fragment
     :data:`FILES` order.  Raises ``KeyError`` for a malformed report and
     ``OSError`` when ``out_dir`` cannot be written.
     """
-    arg, as_json, _ = _built(report)
+    arg = _built(report)[0]
     title = f"assurance argument of {report['meta']['workspace']}"
     texts: dict[str, str] = {}
     if FILES[0] in files:
+        as_json = arg.to_json()
         texts[FILES[0]] = dumps(as_json) if fragments is None else cached_dumps(as_json, fragments)
     if FILES[1] in files:
         texts[FILES[1]] = to_gsn_yaml(arg, title, fragments=fragments)
