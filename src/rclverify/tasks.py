@@ -192,7 +192,7 @@ def act_report(root: str, part: str) -> Any:
     if part == "html":
         print(f"report: reports/assurance.html  ({report['summary']['headline']})")
     else:
-        print(f"report: reports/assurance.md and the argument ({part})")
+        print("report: reports/assurance.md, reports/argument.{json,gsn.yaml,dot}")
     return None
 
 

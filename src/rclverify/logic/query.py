@@ -118,10 +118,12 @@ def solver_session() -> Iterator[None]:
     incremental solver costs about 0.25 ms (docs/scale.md, sixth round).
     The solver is Z3's incremental SMT core (``z3.SimpleSolver``, the
     engine ``z3.Solver()`` itself switches to once a scope is pushed) with
-    unsat cores enabled.  The answers are Z3's answers to the same
-    formulas (a popped scope leaves no assertion behind), but a model or
-    core may depend on the queries the solver answered before in the same
-    block, so a block must always ask the same queries in the same order:
+    unsat cores enabled.  A popped scope leaves no assertion behind, so
+    each query is decided on its own formulas; but a model, a core (and, on
+    a query near its budget, whether Z3 gives up: the retries of
+    :mod:`.retry`, in fresh solvers, then take over) may depend on the
+    queries the solver answered before in the same block, so a block must
+    always ask the same queries in the same order:
     each covers one unit of work whose queries follow from its inputs alone
     (one node's calculus, one node's health checks, one Hoare triple),
     never queries whose order depends on scheduling.  Blocks nest (the
