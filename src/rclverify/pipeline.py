@@ -354,6 +354,8 @@ def stage_report(ws: Workspace, parts: Sequence[str] = REPORT_PARTS,
         fragments = FragmentCache(ws.path(FRAGMENTS[part]))
         paths += write_part(report, out, part, fragments)
         fragments.save()
+    # the one fragment cache of the single report task of earlier versions (38 MB at 1000 nodes)
+    ws.path("artifacts/cache/report-fragments.pickle").unlink(missing_ok=True)
     return report, paths
 
 

@@ -126,16 +126,20 @@ MAX_LAYOUT_ELEMENTS = 2500
 MAX_TOOLTIP_CHARS = 1000
 
 
-def layout(arg: Argument, dot: str) -> diagram.Rendering:
+def layout(arg: Argument, dot: str | None) -> diagram.Rendering:
     """The SVG of the argument's DOT text ``dot`` (:func:`rclverify.report.diagram.render_dot`),
     or, for an argument of more than :data:`MAX_LAYOUT_ELEMENTS` elements, no SVG and a
-    note saying how to lay it out.  Never raises."""
+    note saying how to lay it out (``dot`` may then be ``None``: it is not read).  Raises
+    ``ValueError`` for a ``None`` ``dot`` of an argument that is laid out (a caller's
+    mistake); never for Graphviz trouble."""
     n = len(arg.elements)
     if n > MAX_LAYOUT_ELEMENTS:
         return diagram.Rendering(None, f"the argument has {n} elements, more than the {MAX_LAYOUT_ELEMENTS} the report "
                                        "lays out (Graphviz needs minutes for it, and a diagram of that size is not "
                                        "legible); its structure is in the tables above and in argument.json; "
                                        "to draw it anyway, run: dot -Tsvg reports/argument.dot")
+    if dot is None:
+        raise ValueError("layout: the DOT text of an argument that is laid out is needed")
     return diagram.render_dot(dot)
 
 
@@ -215,16 +219,15 @@ def argument_layout(report: Mapping[str, Any], fragments: FragmentCache | None =
     argument is laid out at all; the call itself only waits for Graphviz,
     so it can run in a thread (``fragments`` as for :func:`to_dot`)."""
     arg = _built(report)[0]
-    if too_large(arg):
-        return lambda: layout(arg, "")
-    dot = argument_dot(report, fragments)[1]
+    dot = None if too_large(arg) else argument_dot(report, fragments)[1]
     return lambda: layout(arg, dot)
 
 
 def argument_view(report: Mapping[str, Any], rendering: diagram.Rendering | None = None,
                   fragments: FragmentCache | None = None) -> dict[str, Any]:
-    """What the report templates show of the argument: ``dot`` (``None`` when the argument is too large to lay out:
-    no report shows it then), ``svg`` (``None`` without Graphviz), ``note`` (why
+    """What the report templates show of the argument: ``dot`` (``None``
+    when the argument is too large to lay out: no report shows it then),
+    ``svg`` (``None`` without Graphviz), ``note`` (why
     there is no SVG), ``too_large`` (more than :data:`MAX_LAYOUT_ELEMENTS`
     elements: not laid out, and the report links to the DOT file instead
     of inlining it) and ``goals`` (the requirement and contract goals with
@@ -233,7 +236,7 @@ def argument_view(report: Mapping[str, Any], rendering: diagram.Rendering | None
     arg = _built(report)[0]
     large = too_large(arg)
     dot = None if large else argument_dot(report, fragments)[1]
-    drawn = layout(arg, dot or "") if rendering is None or large else rendering
+    drawn = layout(arg, dot) if rendering is None or large else rendering
     top = arg.elements[arg.top]
     goals = [top] + [arg.elements[g] for s in top.supported_by for g in arg.elements[s].supported_by]
     return {"dot": dot, "svg": drawn.svg, "note": drawn.note, "too_large": large,
