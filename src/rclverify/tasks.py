@@ -423,7 +423,8 @@ def build_tasks(root: str | Path, plan_file: str = "contracts/plan.yaml") -> dic
             deps += [at(ws.calculus(n)), at(ws.health(n)), at(ws.obligations(n))]
         deps += [at(ws.evidence(o["id"])) for _, o in exported()]
         for part in REPORT_PARTS:
-            yield {"name": part, "actions": [(act_report, [r, part])], "file_dep": deps,
+            yield {"name": part, "doc": "reports/" + ", ".join(PARTS[part]), "actions": [(act_report, [r, part])],
+                   "file_dep": deps,
                    "targets": [at(f"reports/{f}") for f in PARTS[part] if f != "argument.svg"],
                    "verbosity": 2, "clean": True}
 
