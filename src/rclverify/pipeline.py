@@ -323,11 +323,16 @@ def stage_run(ws: Workspace, node: str, obligation_id: str) -> Evidence:
     return ev
 
 
-#: The parts of the report (:data:`rclverify.report.parts.PARTS`), each a doit task of its own.
-REPORT_PARTS = ("html", "text")
+#: The report's files under ``reports/`` in two parts, each written by a doit task of its own
+#: (:mod:`rclverify.report.parts`; ``argument.svg`` only when the argument is laid out).  Here, not
+#: there: the task definitions of every run name these files, and the report modules import jinja2.
+REPORT_PARTS: dict[str, tuple[str, ...]] = {
+    "html": ("assurance.html", "assurance.json", "assurance.sarif", "assurance.junit.xml", "argument.svg"),
+    "text": ("assurance.md", "argument.json", "argument.gsn.yaml", "argument.dot"),
+}
 
 
-def stage_report(ws: Workspace, parts: Sequence[str] = REPORT_PARTS,
+def stage_report(ws: Workspace, parts: Sequence[str] = tuple(REPORT_PARTS),
                  report: dict[str, Any] | None = None) -> tuple[dict[str, Any], list[Path]]:
     """Build the report dict of ``ws`` (unless ``report`` gives it) and write
     the files of ``parts`` under ``reports/`` (:mod:`rclverify.report.parts`:

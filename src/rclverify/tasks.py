@@ -415,17 +415,16 @@ def build_tasks(root: str | Path, plan_file: str = "contracts/plan.yaml") -> dic
     @create_after(executed="evidence")
     def task_report() -> Iterator[dict[str, Any]]:
         """Roll everything up into the report files: two parts, rendered at once by doit -n 2."""
-        from .report.parts import PARTS
         yield {"basename": "report", "name": None,
                "doc": "Roll everything up into reports/ (assurance.{html,md,json}, the CI formats, the argument)."}
         deps = [at(p) for p in (ws.MODEL, ws.DIAGNOSTICS)] + list(snap.values())
         for n in nodes:
             deps += [at(ws.calculus(n)), at(ws.health(n)), at(ws.obligations(n))]
         deps += [at(ws.evidence(o["id"])) for _, o in exported()]
-        for part in REPORT_PARTS:
-            yield {"name": part, "doc": "reports/" + ", ".join(PARTS[part]), "actions": [(act_report, [r, part])],
+        for part, files in REPORT_PARTS.items():
+            yield {"name": part, "doc": "reports/" + ", ".join(files), "actions": [(act_report, [r, part])],
                    "file_dep": deps,
-                   "targets": [at(f"reports/{f}") for f in PARTS[part] if f != "argument.svg"],
+                   "targets": [at(f"reports/{f}") for f in files if f != "argument.svg"],
                    "verbosity": 2, "clean": True}
 
     def task_verify() -> dict[str, Any]:

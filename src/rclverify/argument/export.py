@@ -203,13 +203,13 @@ def too_large(arg: Argument) -> bool:
     return len(arg.elements) > MAX_LAYOUT_ELEMENTS
 
 
-def argument_dot(report: Mapping[str, Any], fragments: FragmentCache | None = None) -> tuple[Argument, str]:
-    """``(argument, DOT text)`` of ``report``, each made once per report dict
+def argument_dot(report: Mapping[str, Any], fragments: FragmentCache | None = None) -> str:
+    """The DOT text of ``report``'s argument, made once per report dict
     (``fragments`` as for :func:`to_dot`)."""
     arg, dot = _built(report)
     if not dot:
         dot.append(to_dot(arg, f"assurance argument of {report['meta']['workspace']}", fragments=fragments))
-    return arg, dot[0]
+    return dot[0]
 
 
 def argument_layout(report: Mapping[str, Any], fragments: FragmentCache | None = None) -> Callable[[], diagram.Rendering]:
@@ -219,7 +219,7 @@ def argument_layout(report: Mapping[str, Any], fragments: FragmentCache | None =
     argument is laid out at all; the call itself only waits for Graphviz,
     so it can run in a thread (``fragments`` as for :func:`to_dot`)."""
     arg = _built(report)[0]
-    dot = None if too_large(arg) else argument_dot(report, fragments)[1]
+    dot = None if too_large(arg) else argument_dot(report, fragments)
     return lambda: layout(arg, dot)
 
 
@@ -235,7 +235,7 @@ def argument_view(report: Mapping[str, Any], rendering: diagram.Rendering | None
     ``fragments`` as for :func:`to_dot`."""
     arg = _built(report)[0]
     large = too_large(arg)
-    dot = None if large else argument_dot(report, fragments)[1]
+    dot = None if large else argument_dot(report, fragments)
     drawn = layout(arg, dot) if rendering is None or large else rendering
     top = arg.elements[arg.top]
     goals = [top] + [arg.elements[g] for s in top.supported_by for g in arg.elements[s].supported_by]
@@ -266,7 +266,7 @@ def write_argument(report: Mapping[str, Any], out_dir: Path, fragments: Fragment
     if FILES[1] in files:
         texts[FILES[1]] = to_gsn_yaml(arg, title, fragments=fragments)
     if FILES[2] in files:
-        texts[FILES[2]] = argument_dot(report, fragments)[1]
+        texts[FILES[2]] = argument_dot(report, fragments)
     svg = None
     if FILES[3] in files:
         svg = (rendering if rendering is not None else argument_layout(report, fragments)()).svg

@@ -28,14 +28,12 @@ from typing import Any, Mapping
 from ..argument.export import FILES as ARGUMENT_FILES
 from ..argument.export import argument_layout, write_argument
 from .ci import CI_FILES, write_ci_reports
+from ..pipeline import REPORT_PARTS
 from .fragments import FragmentCache
 from .render import REPORT_FILES, render_files
 
 #: Each part's files under ``reports/`` (``argument.svg`` only when the argument is laid out).
-PARTS: dict[str, tuple[str, ...]] = {
-    "html": ("assurance.html", "assurance.json", *CI_FILES, "argument.svg"),
-    "text": ("assurance.md", "argument.json", "argument.gsn.yaml", "argument.dot"),
-}
+PARTS = REPORT_PARTS
 
 #: Each part's fragment cache, relative to the workspace root.
 FRAGMENTS = {part: f"artifacts/cache/report-fragments.{part}.pickle" for part in PARTS}

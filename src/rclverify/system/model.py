@@ -112,11 +112,11 @@ class SystemModel:
         """Encoder aliases: each connected input becomes its producer's output
         symbol.  Built once per model (the calculus asks for it per node);
         read-only."""
-        return self._alias
+        return MappingProxyType(self._alias)
 
     @cached_property
-    def _alias(self) -> Mapping[tuple[str, str, str], str]:
-        return MappingProxyType({(l.to_node, "in", l.to_var): f"{l.from_node}.out.{l.from_var}" for l in self.links})
+    def _alias(self) -> dict[tuple[str, str, str], str]:
+        return {(l.to_node, "in", l.to_var): f"{l.from_node}.out.{l.from_var}" for l in self.links}
 
     def links_into(self, node: str) -> tuple[Link, ...]:
         """The links feeding ``node``, in link order (indexed once per model)."""
