@@ -1,7 +1,10 @@
 """Report summaries and the loop view (report/build.py, system/model.py)."""
 from __future__ import annotations
 
-from rclverify.report.build import _evidence_of_cone, _headline
+import random
+
+from rclverify.evidence.records import SEVERITY, worst
+from rclverify.report.build import CONE_NAMES, ConeEvidence, _evidence_of_cone, _headline
 from rclverify.system.model import Link, SystemModel
 
 
@@ -26,6 +29,41 @@ def test_a_long_cone_names_ten_contracts_per_status_and_counts_the_rest():
     assert st == "failed"
     assert note == ("rests on 1 failed node contract: N3; 24 pending node contracts: "
                     + ", ".join(f"N{k}" for k in range(11) if k != 3) + " and 14 more")
+
+
+def _note_by_grouping(cone: list[str], node_evidence: dict[str, str]) -> tuple[str, str]:
+    """The rule written out plainly: group the cone's names by status, name
+    the first CONE_NAMES of each status that is not discharged."""
+    by: dict[str, list[str]] = {}
+    for m in cone:
+        by.setdefault(node_evidence.get(m, "pending"), []).append(m)
+    if set(by) == {"discharged"}:
+        return "discharged", "every node contract it rests on is discharged"
+    parts = []
+    for st in sorted(by, key=lambda x: -SEVERITY[x]):
+        if st != "discharged":
+            ns = by[st]
+            more = f" and {len(ns) - CONE_NAMES} more" if len(ns) > CONE_NAMES else ""
+            parts.append(f"{len(ns)} {st} node contract{'s' if len(ns) != 1 else ''}: {', '.join(ns[:CONE_NAMES])}{more}")
+    return worst(list(by)), "rests on " + "; ".join(parts)
+
+
+def test_cone_notes_of_a_whole_system_match_the_rule_on_random_cones():
+    rng = random.Random(7)
+    names = [f"N{k}" for k in range(60)]
+    statuses = ["discharged", "failed", "pending", "stale", "inconclusive"]
+    for _ in range(40):
+        evidence = {n: rng.choice(statuses) for n in names if rng.random() < 0.9}  # some nodes have none
+        side_conditions = {n: rng.choice(statuses) for n in names}
+        cones = ConeEvidence(evidence, side_conditions)
+        for _ in range(20):
+            cone = rng.sample(names, rng.randint(1, 60)) + (["Outside"] if rng.random() < 0.2 else [])
+            derivation = worst([side_conditions.get(m, "pending") for m in cone])
+            assert cones.summary(cone) == (derivation, *_note_by_grouping(cone, evidence))
+    discharged = {n: "discharged" for n in names}
+    assert ConeEvidence(discharged, discharged).summary(names) == (
+        "discharged", "discharged", "every node contract it rests on is discharged")
+    assert ConeEvidence({}).summary([]) == ("discharged", "discharged", "derived; rests on no node contract")
 
 
 def test_cycles_follow_existing_connections_only():

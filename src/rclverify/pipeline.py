@@ -84,6 +84,9 @@ class Workspace:
     #: Set by :func:`rclverify.wscache.restore`: fills ``plan`` and ``parsed``
     #: from the cache the first time the plan or the checked contracts are needed.
     deferred: Callable[["Workspace"], None] | None = dataclasses.field(default=None, repr=False, compare=False)
+    #: Set by :func:`rclverify.wscache.restore`: the sha256 of each contract file it found, taken
+    #: before any file was parsed; :func:`rclverify.wscache.save` writes them into the new cache.
+    cache_shas: dict[str, str] | None = dataclasses.field(default=None, repr=False, compare=False)
 
     def path(self, rel: str) -> Path:
         return self.root / rel
@@ -195,16 +198,17 @@ def stage_check(ws: Workspace) -> dict[str, Any]:
 
     Returns the diagnostics JSON (lint warnings).  Raises RclError/PlanError.
     """
+    from .contract_texts import ContractTexts
     from .rcl import ast
-    from .rcl.lint import lint
     from .rcl.printer import to_rcl
     checked, model = ws.checked, ws.model
-    warnings = [d.to_json() for s in checked.specs for d in lint(s)]
+    texts = ContractTexts(ws)  # each file's lint and each node's RCL text, kept by the file's sha256
+    warnings = [w for s in checked.specs for w in texts.lint(s)]
     write_json(ws.path(ws.DIAGNOSTICS), {"warnings": warnings})
     context_text = to_rcl(ast.Spec(tuple(c for s in checked.specs for c in s.contexts), ()))
     for name, cn in checked.nodes.items():
         snap = {
-            "node": name, "rcl": to_rcl(ast.Spec((), (cn.node,))), "context": context_text,
+            "node": name, "rcl": texts.node(cn.node)["rcl"], "context": context_text,
             "facts": [f.text for f in ws.plan.facts.get(name, ())],
             "instances": list(ws.plan.instances[name]) if name in ws.plan.instances else None,
             "evidence": [dict(e.config) for e in ws.plan.evidence.get(name, ())],
@@ -212,6 +216,10 @@ def stage_check(ws: Workspace) -> dict[str, Any]:
             "source": f"{cn.node.loc.file}:{cn.node.loc.line}",
         }
         write_json(ws.path(ws.snapshot(name)), snap)
+    try:
+        texts.save()
+    except OSError:
+        pass  # a cache that cannot be written is not written: the texts are made again next time
     write_json(ws.path(ws.MODEL), model.to_json())
     return {"warnings": warnings}
 

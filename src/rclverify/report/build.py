@@ -24,17 +24,18 @@ while any of its evidence is failed, pending, stale or missing:
 """
 from __future__ import annotations
 
+from functools import reduce
+from operator import or_
 from typing import Any
 
 import z3
 
 from .. import __version__
+from ..contract_texts import ContractTexts
 from ..evidence.records import SEVERITY, Obligation, worst
 from ..evidence.store import EvidenceStore, read_obligations
 from ..pipeline import Workspace, read_artifact
 from ..rcl import ast
-from ..rcl.latex import to_latex
-from ..rcl.printer import expr_to_rcl, type_to_rcl
 from ..system.model import cycles_kept
 from .expected import expected_rows
 
@@ -85,29 +86,96 @@ CONE_NAMES = 10
 def _evidence_of_cone(cone: list[str], node_evidence: dict[str, str]) -> tuple[str, str]:
     """(worst evidence status of the nodes of ``cone``, the sentence saying
     which node contracts a derived property rests on that are not yet
-    established: "derived; rests on 1 failed node contract: RadiationSensor")."""
-    if not cone:
-        return "discharged", "derived; rests on no node contract"
-    if {node_evidence.get(m, "pending") for m in cone} == {"discharged"}:
-        # the usual case, without building the per-status lists (cones of a long chain are long)
-        return "discharged", "every node contract it rests on is discharged"
-    by: dict[str, list[str]] = {}
-    for m in cone:
-        by.setdefault(node_evidence.get(m, "pending"), []).append(m)
-    parts = []
-    for st in sorted(by, key=lambda x: -SEVERITY.get(x, 0)):
-        if st == "discharged":
-            continue
-        ns = by[st]
-        named = ", ".join(ns[:CONE_NAMES]) + (f" and {len(ns) - CONE_NAMES} more" if len(ns) > CONE_NAMES else "")
-        parts.append(f"{len(ns)} {st} node contract{'s' if len(ns) != 1 else ''}: {named}")
-    note = "rests on " + "; ".join(parts) if parts else "every node contract it rests on is discharged"
-    return worst(list(by)), note
+    established: "derived; rests on 1 failed node contract: RadiationSensor").
+    A node missing from ``node_evidence`` is ``pending``.  One cone; the
+    report asks :class:`ConeEvidence`, which answers every cone of a system
+    in linear time."""
+    return ConeEvidence(node_evidence).summary(cone)[1:]
+
+
+class ConeEvidence:
+    """The derivation status and the evidence status and note of the cones
+    of one system (:func:`_evidence_of_cone` for each cone, the same text).
+
+    The cones of a 1000-node chain hold half a million names.  Looking each
+    name up and grouping it by status took 0.3-0.5 s of every report build
+    (docs/scale.md, seventh round).  Here each status is a bit mask over
+    the system's nodes, so a cone's count per status is a popcount.  Its
+    names are then taken in cone order until :data:`CONE_NAMES` of each
+    status are found.  That scan usually stops within the first names of a
+    cone.
+
+    ``node_evidence`` maps node names to evidence statuses (the worst of a
+    node's guarantees); ``side_conditions`` maps them to the worst status
+    of their side conditions.  A cone may name nodes either lacks: they are
+    ``pending`` there.
+    """
+
+    def __init__(self, node_evidence: dict[str, str], side_conditions: dict[str, str] | None = None) -> None:
+        self.node_evidence = node_evidence
+        self.bit: dict[str, int] = {}
+        self.evidence_masks: dict[str, int] = {}
+        self.side_condition_masks: dict[str, int] = {}
+        for n in (*node_evidence, *(side_conditions or {})):
+            if n not in self.bit:
+                self.bit[n] = 1 << len(self.bit)
+        for statuses, masks in ((node_evidence, self.evidence_masks), (side_conditions or {}, self.side_condition_masks)):
+            missing = 0
+            for n, b in self.bit.items():
+                st = statuses.get(n)
+                if st is None:
+                    missing |= b
+                else:
+                    masks[st] = masks.get(st, 0) | b
+            if missing:
+                masks["pending"] = masks.get("pending", 0) | missing
+
+    def _mask(self, cone: list[str]) -> int:
+        bit = self.bit
+        try:
+            return reduce(or_, map(bit.__getitem__, cone), 0)
+        except KeyError:  # a node neither map knows: pending in both, with a bit of its own
+            for m in cone:
+                if m not in bit:
+                    b = bit[m] = 1 << len(bit)
+                    for masks in (self.evidence_masks, self.side_condition_masks):
+                        masks["pending"] = masks.get("pending", 0) | b
+            return reduce(or_, map(bit.__getitem__, cone), 0)
+
+    def summary(self, cone: list[str]) -> tuple[str, str, str]:
+        """(worst side-condition status of the nodes of ``cone`` -- its
+        derivation, ``discharged`` for an empty cone --, their worst
+        evidence status, the evidence note of :func:`_evidence_of_cone`)."""
+        if not cone:
+            return "discharged", "discharged", "derived; rests on no node contract"
+        mask = self._mask(cone)
+        derivation = worst([st for st, m in self.side_condition_masks.items() if mask & m])
+        counts = {st: (mask & m).bit_count() for st, m in self.evidence_masks.items() if mask & m}
+        if counts.keys() == {"discharged"}:
+            return derivation, "discharged", "every node contract it rests on is discharged"
+        wanted = {st: min(c, CONE_NAMES) for st, c in counts.items() if st != "discharged"}
+        named: dict[str, list[str]] = {st: [] for st in wanted}
+        left = sum(wanted.values())
+        for m in cone:  # the first names of each status, in cone order
+            st = self.node_evidence.get(m, "pending")
+            got = named.get(st)
+            if got is not None and len(got) < wanted[st] and m not in got:
+                got.append(m)
+                left -= 1
+                if not left:
+                    break
+        parts = []
+        for st in sorted(wanted, key=lambda x: -SEVERITY.get(x, 0)):
+            n = counts[st]
+            more = f" and {n - CONE_NAMES} more" if n > CONE_NAMES else ""
+            parts.append(f"{n} {st} node contract{'s' if n != 1 else ''}: {', '.join(named[st])}{more}")
+        return derivation, worst(list(counts)), "rests on " + "; ".join(parts)
 
 
 def build_report(ws: Workspace) -> dict[str, Any]:
     """Read every artifact of ``ws`` and return the report dict (see render.py)."""
     checked, model, plan = ws.checked, ws.model, ws.plan
+    texts = ContractTexts(ws)  # each node's RCL and LaTeX texts, kept by its file's sha256 (read only here)
     store = EvidenceStore(ws.root)
     obligations: list[Obligation] = []
     for n in checked.nodes:
@@ -185,21 +253,21 @@ def build_report(ws: Workspace) -> dict[str, Any]:
             if l.from_node == name:
                 consumers.setdefault(l.from_var, []).append(f"{l.to_node}.{l.to_var}")
         env_texts = {e["text"] for e in comps[name].get("environment_assumptions", [])}
+        tx = texts.node(cn.node)
         guarantees: list[dict[str, Any]] = [
-            {"index": k, "text": expr_to_rcl(g.formula), "source": _src(g.loc), "status": g_status(name, k),
+            {"index": k, "text": text, "source": src, "status": g_status(name, k),
              "obligations": sorted(o.id for o in by_node.get(name, []) if applies(o, name, k))}
-            for k, g in enumerate(cn.node.guarantees, 1)]
+            for k, (text, src) in enumerate(tx["guarantees"], 1)]
         status = worst([g["status"] for g in guarantees] + [sc_status[name]])
         node_status[name] = status
         node_evidence[name] = worst([g["status"] for g in guarantees], empty="pending")
         nodes.append({
             "name": name, "source": _src(cn.node.loc), "status": status,
-            "inputs": [{"name": v.name, "type": type_to_rcl(v.type), "producer": internal.get(v.name)} for v in cn.node.inputs],
-            "outputs": [{"name": v.name, "type": type_to_rcl(v.type), "consumers": consumers.get(v.name, [])}
-                        for v in cn.node.outputs],
-            "assumptions": [{"text": expr_to_rcl(a.formula), "source": _src(a.loc),
-                             "environment": expr_to_rcl(a.formula) in env_texts} for a in cn.node.assumes],
-            "guarantees": guarantees, "latex": to_latex(ast.Spec((), (cn.node,))),
+            "inputs": [{"name": v, "type": t, "producer": internal.get(v)} for v, t in tx["inputs"]],
+            "outputs": [{"name": v, "type": t, "consumers": consumers.get(v, [])} for v, t in tx["outputs"]],
+            "assumptions": [{"text": text, "source": src, "environment": text in env_texts}
+                            for text, src in tx["assumptions"]],
+            "guarantees": guarantees, "latex": tx["latex"],
         })
 
     requirements: list[dict[str, Any]] = []
@@ -207,20 +275,20 @@ def build_report(ws: Workspace) -> dict[str, Any]:
         support: list[dict[str, Any]] = []
         for s in r.support:
             for k in s.guarantees:
-                g = checked.nodes[s.node].node.guarantees[k - 1]
-                support.append({"node": s.node, "guarantee": k, "text": expr_to_rcl(g.formula), "source": _src(g.loc),
+                text, src = texts.node(checked.nodes[s.node].node)["guarantees"][k - 1]
+                support.append({"node": s.node, "guarantee": k, "text": text, "source": src,
                                 "status": g_status(s.node, k),
                                 "obligations": sorted(o.id for o in obligations if applies(o, s.node, k))})
         st = worst([x["status"] for x in support] + [sc_status[x["node"]] for x in support]) if support else "pending"
         requirements.append({"id": r.id, "text": r.text, "status": st, "support": support})
 
     derived = []
+    cones = ConeEvidence(node_evidence, sc_status)
     for n in checked.nodes:
         c = comps[n]
         if not c:
             continue
-        derivation = worst([sc_status[m] for m in c["cone"]], empty="discharged")
-        ev_status, ev_note = _evidence_of_cone(c["cone"], node_evidence)
+        derivation, ev_status, ev_note = cones.summary(c["cone"])
         derived.append({"node": n, "rules": c["rules"], "instances": c["instances"],
                         "environment_assumptions": c["cone_environment_assumptions"], "property": c["derived_property"],
                         # the derivation: every side condition of the cone discharged

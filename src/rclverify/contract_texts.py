@@ -1,0 +1,123 @@
+"""Texts made from each contract file's syntax tree, kept between runs.
+
+The check stage and the report print every node of the system again on
+every run: its RCL text (the snapshot), the RCL text of each assumption and
+guarantee, its LaTeX, and each file's lint warnings.  For a 1000-node
+system that was 0.2 s of the check task and 0.2-0.3 s of each report task
+after a one-contract edit (docs/scale.md, seventh round), although only the
+edited file's texts can differ.  They are pure functions of a file's text,
+so they are kept in ``artifacts/cache/contract-texts.pickle``, per contract
+file, keyed by the sha256 of the text that was parsed
+(``Workspace.parsed``) and salted with the rclverify code
+(:func:`rclverify.wscache.code_stamp`: a changed printer misses).
+
+The check task (:func:`rclverify.pipeline.stage_check`) fills and writes the
+file; the report tasks, which run after it, only read it and make what it
+lacks.  A damaged, missing or foreign file is an empty cache; the texts are
+the same with or without it (``tests/test_contract_texts.py``).  Like the
+workspace cache it is trusted code of the workspace (pickle), and deleting
+``artifacts/cache`` is always safe.
+"""
+from __future__ import annotations
+
+import pickle
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+from .evidence.store import atomic_write_bytes
+from .rcl import ast
+
+if TYPE_CHECKING:
+    from .pipeline import Workspace
+
+CACHE = "artifacts/cache/contract-texts.pickle"
+
+
+def _src(loc: ast.Loc) -> str:
+    return f"{loc.file}:{loc.line}:{loc.col}"
+
+
+def node_texts(node: ast.Node) -> dict[str, Any]:
+    """The texts of one node: ``{"rcl": the node as RCL (the snapshot's
+    text), "latex": its LaTeX, "inputs"/"outputs": [[name, type as RCL],
+    ...], "assumptions"/"guarantees": [[formula as RCL, "file:line:col"],
+    ...]}`` (lists, in declaration order)."""
+    from .rcl.latex import to_latex
+    from .rcl.printer import expr_to_rcl, to_rcl, type_to_rcl
+    return {
+        "rcl": to_rcl(ast.Spec((), (node,))), "latex": to_latex(ast.Spec((), (node,))),
+        "inputs": [[v.name, type_to_rcl(v.type)] for v in node.inputs],
+        "outputs": [[v.name, type_to_rcl(v.type)] for v in node.outputs],
+        "assumptions": [[expr_to_rcl(a.formula), _src(a.loc)] for a in node.assumes],
+        "guarantees": [[expr_to_rcl(g.formula), _src(g.loc)] for g in node.guarantees],
+    }
+
+
+def lint_json(spec: ast.Spec) -> list[dict[str, Any]]:
+    """The lint warnings of one parsed file (:func:`rclverify.rcl.lint.lint`) as JSON."""
+    from .rcl.lint import lint
+    return [d.to_json() for d in lint(spec)]
+
+
+class ContractTexts:
+    """The texts of the contract files of ``ws`` (whose contracts check:
+    ``ws.checked`` is read), from the cache file when it has them.
+
+    :meth:`node` and :meth:`lint` make what the cache lacks; :meth:`save`
+    writes the texts of the workspace's current files when anything was
+    made.  Never raises for a bad cache file.
+    """
+
+    def __init__(self, ws: "Workspace") -> None:
+        from .wscache import code_stamp
+        self.ws = ws
+        ws.checked  # fills ws.parsed with the sha256 of each file's parsed text
+        self.path: Path = ws.path(CACHE)
+        self._salt = code_stamp()
+        self._shas = {rel: sha for rel, (sha, _) in ws.parsed.items()}
+        self._files: dict[str, dict[str, Any]] = {}
+        self._made = False
+        try:
+            with open(self.path, "rb") as fh:
+                stored = pickle.load(fh)
+        except Exception:  # missing, damaged or foreign: an empty cache  # noqa: BLE001
+            return
+        if isinstance(stored, dict) and stored.get("salt") == self._salt and isinstance(stored.get("files"), dict):
+            self._files = {rel: entry for rel, (sha, entry) in stored["files"].items() if self._shas.get(rel) == sha}
+
+    def _entry(self, rel: str) -> dict[str, Any]:
+        entry = self._files.get(rel)
+        if entry is None:
+            entry = self._files[rel] = {"nodes": {}}
+        return entry
+
+    def node(self, node: ast.Node) -> dict[str, Any]:
+        """:func:`node_texts` of ``node`` (a node of ``ws.checked``)."""
+        got: dict[str, Any] | None = self._entry(node.loc.file)["nodes"].get(node.name)
+        if got is None:
+            got = self._entry(node.loc.file)["nodes"][node.name] = node_texts(node)
+            self._made = True
+        return got
+
+    def lint(self, spec: ast.Spec) -> list[dict[str, Any]]:
+        """:func:`lint_json` of ``spec`` (a file of ``ws.checked``)."""
+        entry = self._entry(spec.file)
+        got: list[dict[str, Any]] | None = entry.get("lint")
+        if got is None:
+            got = entry["lint"] = lint_json(spec)
+            self._made = True
+        return got
+
+    def save(self) -> bool:
+        """Write the texts of the workspace's parsed files atomically when
+        any were made (those of files no longer parsed are dropped).
+        Returns whether the file was written; raises ``OSError`` when the
+        cache directory cannot be written."""
+        if not self._made:
+            return False
+        files = {rel: (self._shas[rel], entry) for rel, entry in self._files.items() if rel in self._shas}
+        self.path.parent.mkdir(parents=True, exist_ok=True)
+        atomic_write_bytes(self.path, pickle.dumps({"salt": self._salt, "files": files},
+                                                   protocol=pickle.HIGHEST_PROTOCOL))
+        self._made = False
+        return True
