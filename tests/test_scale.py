@@ -117,6 +117,17 @@ def test_workspace_cache_is_used_only_while_the_inputs_are_unchanged(tmp_path: P
     assert not wscache.restore(Workspace(tmp_path))
 
 
+def test_a_background_save_is_complete_when_the_next_restore_reads_it(tmp_path: Path) -> None:
+    ws = _ws(tmp_path)
+    ws.model
+    wscache.save_in_background(ws)  # a forked child writes the file
+    again = Workspace(tmp_path)
+    assert wscache.restore(again)  # restore waits for this process's saves first
+    assert again.node_names() == ["A"]
+    wscache.wait()  # nothing left to wait for
+    assert not wscache._PENDING
+
+
 def test_a_damaged_cache_is_ignored(tmp_path: Path) -> None:
     ws = _ws(tmp_path)
     (tmp_path / wscache.CACHE).parent.mkdir(parents=True)

@@ -49,7 +49,7 @@ from doit import create_after as _create_after
 from doit.exceptions import TaskFailed
 from doit.tools import config_changed
 
-from . import wscache
+from . import heap, wscache
 from .pipeline import REPORT_PARTS, TaskIndex, Workspace
 from .rcl.errors import RclError
 
@@ -79,6 +79,7 @@ def _ws(root: str) -> Workspace:
     next run, whose ``check`` sees the changed file.  Without a seeded entry
     (a worker process that did not inherit it) the workspace is loaded here.
     """
+    heap.freeze_inherited()  # a doit -n worker: its inherited heap stays live (rclverify.heap)
     ws = _WORKSPACES.get(root)
     if ws is None:
         ws = Workspace(Path(root))
@@ -308,7 +309,19 @@ DOIT_IMPLICIT_TASK_DEP: list[Callable[..., None]] = []
 
 
 def build_tasks(root: str | Path, plan_file: str = "contracts/plan.yaml") -> dict[str, Callable[[], Any]]:
-    """The ``task_*`` functions for a dodo.py of the workspace at ``root``."""
+    """The ``task_*`` functions for a dodo.py of the workspace at ``root``.
+
+    The loaded workspace stays live for the run: it is loaded without
+    cyclic garbage collection and then frozen for the run
+    (:mod:`rclverify.heap`; the progress reporter gives it back to the
+    collector when doit completes the run)."""
+    with heap.loading():
+        creators = _build_tasks(root, plan_file)
+        heap.freeze_for_run()  # before collecting again: what was made while loading is not looked at
+    return creators
+
+
+def _build_tasks(root: str | Path, plan_file: str) -> dict[str, Callable[[], Any]]:
     _use_linear_implicit_task_dep()
     rootp = Path(root).resolve()
     r = str(rootp)
@@ -324,7 +337,7 @@ def build_tasks(root: str | Path, plan_file: str = "contracts/plan.yaml") -> dic
     if ok:
         _WORKSPACES[r] = ws
         if not restored:
-            wscache.save(ws)
+            wscache.save_in_background(ws)
     else:
         _WORKSPACES.pop(r, None)
     try:

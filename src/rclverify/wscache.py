@@ -26,12 +26,15 @@ parsed contracts are unpickled only when a task first needs them
 """
 from __future__ import annotations
 
+import atexit
 import gc
 import hashlib
 import os
 import pickle
 import sys
 import tempfile
+import threading
+from functools import lru_cache
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -49,8 +52,10 @@ def _sha(path: Path) -> str:
         return "-"
 
 
-def _code_stamp() -> str:
-    """Changes whenever a file of the installed rclverify package changes."""
+@lru_cache(maxsize=1)
+def code_stamp() -> str:
+    """Changes whenever a file of the installed rclverify package changes
+    (taken once per process: a run's code does not change under it)."""
     pkg = Path(__file__).resolve().parent
     h = hashlib.sha256(f"{_FORMAT} {sys.version}".encode())
     for p in sorted(pkg.rglob("*")):
@@ -60,9 +65,14 @@ def _code_stamp() -> str:
     return h.hexdigest()
 
 
-def _header(ws: "Workspace", contracts: tuple[str, ...]) -> dict[str, Any]:
-    return {"root": str(ws.root.resolve()), "plan_file": ws.plan_file, "code": _code_stamp(),
-            "plan": _sha(ws.root / ws.plan_file), "contracts": {c: _sha(ws.root / c) for c in contracts}}
+def _header(ws: "Workspace", contracts: tuple[str, ...], known: dict[str, str] | None = None) -> dict[str, Any]:
+    """The header of ``ws``'s cache: what it was computed from.  ``known``
+    gives sha256s of contract files already taken in this run (by
+    :func:`restore`, before the files were parsed)."""
+    known = known or {}
+    return {"root": str(ws.root.resolve()), "plan_file": ws.plan_file, "code": code_stamp(),
+            "plan": _sha(ws.root / ws.plan_file),
+            "contracts": {c: known[c] if c in known else _sha(ws.root / c) for c in contracts}}
 
 
 def restore(ws: "Workspace") -> bool:
@@ -86,12 +96,14 @@ def restore(ws: "Workspace") -> bool:
     against the contracts again).  Editing one contract of a large system
     then re-parses one file.
     """
+    wait()  # a save of this process still under way
     try:
         with open(ws.root / CACHE, "rb") as fh:
             header = pickle.load(fh)
             if not isinstance(header, dict):
                 return False
             now = _header(ws, tuple(header.get("contracts", ())))
+            ws.cache_shas = now["contracts"]  # taken before any file is parsed: save() reuses them
             if any(header.get(k) != now[k] for k in ("root", "plan_file", "code")):
                 return False
             index = pickle.load(fh)
@@ -140,10 +152,14 @@ def _load_deferred(ws: "Workspace", header: dict[str, Any], offset: int) -> None
 
 def save(ws: "Workspace") -> None:
     """Write the cache for a workspace whose model loaded without error.
-    Never raises (a cache that cannot be written is not written)."""
+    Never raises (a cache that cannot be written is not written).
+
+    The contract files' sha256s are those :func:`restore` took in this
+    process, before the files were parsed (a file edited since is then
+    parsed again next time), or taken now."""
     path = ws.root / CACHE
     try:
-        header = _header(ws, tuple(ws.plan.contracts))
+        header = _header(ws, tuple(ws.plan.contracts), ws.cache_shas)
         path.parent.mkdir(parents=True, exist_ok=True)
         fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=".workspace.", suffix=".tmp")
         with os.fdopen(fd, "wb") as fh:
@@ -155,4 +171,54 @@ def save(ws: "Workspace") -> None:
         try:
             os.unlink(tmp)
         except (OSError, UnboundLocalError):
+            pass
+
+
+#: Background saves of this process: (pid of the process that forked, pid of the child).
+_PENDING: list[tuple[int, int]] = []
+
+
+def save_in_background(ws: "Workspace") -> None:
+    """:func:`save` in a forked child process, so that pickling the parsed
+    contracts (0.3 s for 1000 nodes, on every run after an edit) overlaps
+    with the rest of the run instead of delaying its first task
+    (docs/scale.md, seventh round).  The process that forked waits for the
+    child before it exits, and :func:`restore` first waits for it, so a
+    run's cache is complete when the run ends, as with :func:`save`.
+    Saves in this process where ``fork`` is missing or other threads run
+    (forking a threaded process is unsafe).  Never raises."""
+    if not hasattr(os, "fork") or threading.active_count() > 1:
+        save(ws)
+        return
+    wait()
+    try:
+        pid = os.fork()
+    except OSError:
+        save(ws)
+        return
+    if pid == 0:  # the child: save, then leave without running the parent's exit handlers
+        try:
+            save(ws)
+        finally:
+            os._exit(0)
+    if not _registered:
+        atexit.register(wait)
+        _registered.append(True)
+    _PENDING.append((os.getpid(), pid))
+
+
+_registered: list[bool] = []
+
+
+def wait() -> None:
+    """Wait for the background saves this process started (none in a
+    process forked from it).  Never raises."""
+    me = os.getpid()
+    while _PENDING:
+        parent, pid = _PENDING.pop()
+        if parent != me:
+            continue
+        try:
+            os.waitpid(pid, 0)
+        except OSError:
             pass
