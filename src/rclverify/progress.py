@@ -79,29 +79,6 @@ if hasattr(os, "register_at_fork"):
     os.register_at_fork(after_in_child=_after_fork_in_child)
 
 
-_FREEZE_REGISTERED = False
-
-
-def freeze_heap_at_exit() -> None:
-    """At interpreter exit, move every object to the garbage collector's
-    permanent generation (``gc.freeze``) before Python finalises its
-    modules, so the final collection does not traverse the heap of a large
-    run (the loaded workspace, doit's thousands of tasks, the report).  At
-    1000 nodes that collection took 0.6-0.9 s of every edit run after the
-    work was done (docs/scale.md).  Registered once per process with
-    ``atexit`` (handlers run last-registered first, so this runs before the
-    earlier ones; nothing is frozen while the process still works, as in a
-    test session that runs doit in-process).  Memory goes back to the
-    operating system at exit either way."""
-    global _FREEZE_REGISTERED
-    if _FREEZE_REGISTERED:
-        return
-    import atexit
-    import gc
-    atexit.register(gc.freeze)
-    _FREEZE_REGISTERED = True
-
-
 def backend_of(obligation_id: str) -> str:
     """The backend named in an obligation id ``Node.gK.backend.instance``
     (``''`` when the id has fewer parts)."""
@@ -133,7 +110,11 @@ class ProgressReporter(ConsoleReporter):  # type: ignore[misc]
             super().write(text)
 
     def initialize(self, tasks: Mapping[str, Any], selected_tasks: Any) -> None:
-        """Remember doit's task table (it grows when delayed tasks are created)."""
+        """Remember doit's task table (it grows when delayed tasks are created),
+        and freeze doit's task objects for the run with the workspace
+        (:func:`rclverify.heap.freeze_for_run`)."""
+        from .heap import freeze_for_run
+        freeze_for_run()
         self.tasks = tasks
         if self.live_mode:
             from rich.console import Console
@@ -176,14 +157,17 @@ class ProgressReporter(ConsoleReporter):  # type: ignore[misc]
     def complete_run(self) -> None:
         """Stop the live line, then let doit report failures as usual; and
         have the process skip the cyclic garbage collection of its whole
-        heap when it exits (:func:`freeze_heap_at_exit`)."""
+        heap when it exits (:mod:`rclverify.heap`: the heap frozen for the
+        run is given back to the collector, then frozen again at exit)."""
         if self.live is not None:
             global _LIVE_ACTIVE
             _LIVE_ACTIVE = False
             self.live.stop()
             self.live = None
         super().complete_run()
-        freeze_heap_at_exit()
+        from .heap import freeze_at_exit, release_after_run
+        release_after_run()
+        freeze_at_exit()
 
     # -- the status line -----------------------------------------------------------
     def _line(self) -> Text:
