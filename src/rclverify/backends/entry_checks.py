@@ -16,9 +16,10 @@ from ..rcl.types import Checked
 
 
 def check_entries(plan: Plan, checked: Checked) -> list[Diagnostic]:
-    """Diagnostics for every experiment/review entry of ``plan`` that does not check."""
-    from .experiment.config import read_config
-    from .review.backend import read_record
+    """Diagnostics for every experiment/review entry of ``plan`` that does not check.
+    (The two backends are imported only for a plan that has such entries:
+    the experiment backend brings Z3 and matplotlib's helpers, a tenth of a
+    second of every run that loads the plan.)"""
     out: list[Diagnostic] = []
     for node, entries in plan.evidence.items():
         if node not in checked.nodes:
@@ -36,8 +37,10 @@ def check_entries(plan: Plan, checked: Checked) -> list[Diagnostic]:
                 return plan.locs.get(full, _e.loc)
             try:
                 if e.backend == "experiment":
+                    from .experiment.config import read_config
                     read_config(plan.root, e.config, len(checked.nodes[node].node.guarantees), loc)
                 else:
+                    from .review.backend import read_record
                     read_record(plan.root, e.config, loc)
             except PlanError as exc:
                 out.extend(exc.diagnostics)
