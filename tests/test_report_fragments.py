@@ -12,7 +12,7 @@ from test_pipeline_e2e import _doit, workspace  # noqa: F401
 from rclverify.evidence.store import dumps
 from rclverify.pipeline import Workspace
 from rclverify.report.build import build_report
-from rclverify.report.fragments import FragmentCache, cached_dumps
+from rclverify.report.fragments import FragmentCache, cached_dumps, fingerprint
 from rclverify.report.parts import FRAGMENTS, PARTS, write_part
 
 #: Every file the report task writes (argument.svg only with Graphviz).
@@ -92,6 +92,19 @@ def test_a_damaged_or_foreign_cache_file_is_an_empty_cache(tmp_path: Path) -> No
     assert again.text("k", {"a": 1}, lambda: "y") == "x"  # kept
     assert again.text("k", {"a": 2}, lambda: "y") == "y"  # other data, other piece
     assert again.text("other", {"a": 1}, lambda: "z") == "z"  # other kind, other piece
+
+
+def test_fingerprints_tell_apart_what_renders_differently() -> None:
+    from markupsafe import Markup
+    same = [{"a": [1, "x"], "b": None}, {"a": [1, "x"], "b": None}]
+    assert fingerprint(same[0]) == fingerprint(same[1])
+    # each of these renders differently (JSON, HTML or text), so none may share a key
+    values = [1, True, 1.0, "1", [1], (1,), {"a": 1}, {"a": "1"}, None, "", Markup("<b>"), "<b>", [], {}]
+    prints = [fingerprint(v) for v in values]
+    assert len(set(prints)) == len(values)
+    assert fingerprint(Markup("<b>")).startswith(b"j")  # marshal cannot hold a str subclass: canonical JSON
+    with pytest.raises(TypeError):
+        fingerprint({"a": object()})
 
 
 def test_only_the_pieces_used_last_are_kept(tmp_path: Path) -> None:

@@ -34,7 +34,7 @@ import jinja2
 
 from ..evidence.store import atomic_write_text, dumps
 from ..report import diagram
-from ..report.fragments import FragmentCache, cached_dumps, canonical
+from ..report.fragments import FragmentCache, cached_dumps, fingerprint
 from .build import build_argument
 from .model import Argument, Element
 
@@ -69,8 +69,8 @@ def to_json_text(arg: Argument, fragments: FragmentCache | None = None) -> str:
     return dumps(arg.to_json()) if fragments is None else cached_dumps(arg.to_json(), fragments)
 
 
-#: The last argument whose elements were keyed, the link prefix and the keys' canonical JSON.
-_keyed: list[tuple[Argument, str, list[str]]] = []
+#: The last argument whose elements were keyed, the link prefix and the keys' fingerprints.
+_keyed: list[tuple[Argument, str, list[bytes]]] = []
 #: Ends each element's text in a batch render (JSON-quoted YAML and DOT strings escape control characters).
 _SEP = "\x00"
 
@@ -81,11 +81,11 @@ def _pieces(arg: Argument, fragments: FragmentCache | None, template: str, link_
     ``items``, each followed by ``sep``), from ``fragments`` when the element
     (its JSON form) and ``link_prefix`` were rendered before.  The elements
     not kept are rendered in one call (a template call per element cost more
-    than the rendering); the canonical JSON of each element is computed once
+    than the rendering); the fingerprint of each element is computed once
     per argument for the three kinds of piece (DOT node, DOT edges, YAML)."""
     cache = fragments if fragments is not None else FragmentCache()
     if not (_keyed and _keyed[0][0] is arg and _keyed[0][1] == link_prefix):
-        _keyed[:] = [(arg, link_prefix, [canonical({"e": e.to_json(), "link_prefix": link_prefix})
+        _keyed[:] = [(arg, link_prefix, [fingerprint({"e": e.to_json(), "link_prefix": link_prefix})
                                          for e in arg.elements.values()])]
     keys = _keyed[0][2]
     texts = [cache.lookup(template, k) for k in keys]
