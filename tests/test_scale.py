@@ -194,3 +194,16 @@ def test_a_plan_edited_after_the_cache_was_read_is_loaded_from_the_file(tmp_path
     _, again = _cached_and_restored(tmp_path)
     (tmp_path / "contracts" / "plan.yaml").write_text("contracts: [contracts/a.rcl]\nname: edited\n")
     assert again.plan.name == "edited"
+
+
+def test_upstream_masks_are_the_upstream_cones_also_through_loops() -> None:
+    rng = random.Random(11)
+    for _ in range(60):
+        nodes = [f"N{k}" for k in range(rng.randint(1, 25))]
+        links = [Link(rng.choice(nodes), f"o{k}", rng.choice(nodes), f"i{k}", "name")
+                 for k in range(rng.randint(0, 40))]
+        model = SystemModel(tuple(rng.sample(nodes, len(nodes))), tuple(links), (), ())
+        masks = model.upstream_masks()
+        for n in model.nodes:
+            cone = [m for i, m in enumerate(model.nodes) if masks[n] >> i & 1]
+            assert cone == model.upstream(n)

@@ -329,7 +329,10 @@ def composition_json(c: NodeComposition, smt2_paths: Sequence[str]) -> dict[str,
         "node": c.node, "rules": list(c.rules), "producers": list(c.producers),
         "side_conditions": [sc.to_json(p) for sc, p in zip(c.side_conditions, smt2_paths)],
         "environment_assumptions": list(c.environment_assumptions), "instances": list(c.instances),
-        "derived_property": c.derived_property, "cone": list(c.cone), "loop_assumption": c.loop_assumption,
+        "derived_property": c.derived_property, "loop_assumption": c.loop_assumption,
+        # the cone's size only: the list is model.upstream(node) (the report takes every cone at once from
+        # SystemModel.upstream_masks); a list per node was quadratic along a chain, 70% of these artifacts
+        "cone_size": len(c.cone),
         "cone_environment_assumptions": [f"{text}  [{node}]" for node, text in c.cone_environment],
         "guarantee": c.guarantee,
     }

@@ -26,7 +26,7 @@ from __future__ import annotations
 
 from functools import reduce
 from operator import or_
-from typing import Any
+from typing import Any, Iterable, Mapping, Sequence
 
 import z3
 
@@ -78,8 +78,8 @@ def _evidence_extras(ws: Workspace, details: Any) -> dict[str, Any]:
 _DERIVATION = {"discharged": "derived", "failed": "not derived"}
 #: Most node names a derived property's note lists per status ("3 pending node contracts: A, B, C");
 #: the rest are counted.  A property at the end of a 1000-node chain rests on 999 contracts: its
-#: note named them all, a quadratic amount of report text nobody reads (the cone itself is in the
-#: calculus artifact and the report's JSON).
+#: note named them all, a quadratic amount of report text nobody reads (the cone itself is the
+#: system model's: ``SystemModel.upstream``).
 CONE_NAMES = 10
 
 
@@ -87,88 +87,70 @@ def _evidence_of_cone(cone: list[str], node_evidence: dict[str, str]) -> tuple[s
     """(worst evidence status of the nodes of ``cone``, the sentence saying
     which node contracts a derived property rests on that are not yet
     established: "derived; rests on 1 failed node contract: RadiationSensor").
-    A node missing from ``node_evidence`` is ``pending``.  One cone; the
-    report asks :class:`ConeEvidence`, which answers every cone of a system
-    in linear time."""
-    return ConeEvidence(node_evidence).summary(cone)[1:]
+    A node missing from ``node_evidence`` is ``pending``; the note names
+    nodes in ``cone`` order.  One cone; the report asks
+    :class:`ConeEvidence`, which answers every cone of a system in linear
+    time."""
+    cones = ConeEvidence(list(dict.fromkeys(cone)), node_evidence)
+    return cones.summary(cones.mask(cone))[1:]
 
 
 class ConeEvidence:
     """The derivation status and the evidence status and note of the cones
     of one system (:func:`_evidence_of_cone` for each cone, the same text).
 
-    The cones of a 1000-node chain hold half a million names.  Looking each
-    name up and grouping it by status took 0.3-0.5 s of every report build
-    (docs/scale.md, seventh round).  Here each status is a bit mask over
-    the system's nodes, so a cone's count per status is a popcount.  Its
-    names are then taken in cone order until :data:`CONE_NAMES` of each
-    status are found.  That scan usually stops within the first names of a
-    cone.
+    The cones of a 1000-node chain hold half a million names; grouping them
+    name by name took 0.3-0.5 s of every report build (docs/scale.md,
+    seventh round).  Here a cone is a bit mask over the system's nodes
+    (``order``; :meth:`rclverify.system.model.SystemModel.upstream_masks`)
+    and so is each status, so a cone's count per status is a popcount and
+    the first :data:`CONE_NAMES` names of a status are its lowest bits.
 
     ``node_evidence`` maps node names to evidence statuses (the worst of a
     node's guarantees); ``side_conditions`` maps them to the worst status
-    of their side conditions.  A cone may name nodes either lacks: they are
+    of their side conditions.  A node of ``order`` that either lacks is
     ``pending`` there.
     """
 
-    def __init__(self, node_evidence: dict[str, str], side_conditions: dict[str, str] | None = None) -> None:
-        self.node_evidence = node_evidence
-        self.bit: dict[str, int] = {}
-        self.evidence_masks: dict[str, int] = {}
-        self.side_condition_masks: dict[str, int] = {}
-        for n in (*node_evidence, *(side_conditions or {})):
-            if n not in self.bit:
-                self.bit[n] = 1 << len(self.bit)
-        for statuses, masks in ((node_evidence, self.evidence_masks), (side_conditions or {}, self.side_condition_masks)):
-            missing = 0
-            for n, b in self.bit.items():
-                st = statuses.get(n)
-                if st is None:
-                    missing |= b
-                else:
-                    masks[st] = masks.get(st, 0) | b
-            if missing:
-                masks["pending"] = masks.get("pending", 0) | missing
+    def __init__(self, order: Sequence[str], node_evidence: Mapping[str, str],
+                 side_conditions: Mapping[str, str] | None = None) -> None:
+        self.order = list(order)
+        self.bit = {n: 1 << i for i, n in enumerate(self.order)}
+        self.evidence_masks = self._masks(node_evidence)
+        self.side_condition_masks = self._masks(side_conditions or {})
 
-    def _mask(self, cone: list[str]) -> int:
-        bit = self.bit
-        try:
-            return reduce(or_, map(bit.__getitem__, cone), 0)
-        except KeyError:  # a node neither map knows: pending in both, with a bit of its own
-            for m in cone:
-                if m not in bit:
-                    b = bit[m] = 1 << len(bit)
-                    for masks in (self.evidence_masks, self.side_condition_masks):
-                        masks["pending"] = masks.get("pending", 0) | b
-            return reduce(or_, map(bit.__getitem__, cone), 0)
+    def _masks(self, statuses: Mapping[str, str]) -> dict[str, int]:
+        masks: dict[str, int] = {}
+        for n, b in self.bit.items():
+            st = statuses.get(n, "pending")
+            masks[st] = masks.get(st, 0) | b
+        return masks
 
-    def summary(self, cone: list[str]) -> tuple[str, str, str]:
-        """(worst side-condition status of the nodes of ``cone`` -- its
-        derivation, ``discharged`` for an empty cone --, their worst
+    def mask(self, cone: Iterable[str]) -> int:
+        """The bit mask of the nodes ``cone`` names (``KeyError`` for a node not in ``order``)."""
+        return reduce(or_, map(self.bit.__getitem__, cone), 0)
+
+    def summary(self, mask: int) -> tuple[str, str, str]:
+        """(worst side-condition status of the nodes of the cone ``mask`` --
+        its derivation, ``discharged`` for an empty cone --, their worst
         evidence status, the evidence note of :func:`_evidence_of_cone`)."""
-        if not cone:
+        if not mask:
             return "discharged", "discharged", "derived; rests on no node contract"
-        mask = self._mask(cone)
         derivation = worst([st for st, m in self.side_condition_masks.items() if mask & m])
         counts = {st: (mask & m).bit_count() for st, m in self.evidence_masks.items() if mask & m}
         if counts.keys() == {"discharged"}:
             return derivation, "discharged", "every node contract it rests on is discharged"
-        wanted = {st: min(c, CONE_NAMES) for st, c in counts.items() if st != "discharged"}
-        named: dict[str, list[str]] = {st: [] for st in wanted}
-        left = sum(wanted.values())
-        for m in cone:  # the first names of each status, in cone order
-            st = self.node_evidence.get(m, "pending")
-            got = named.get(st)
-            if got is not None and len(got) < wanted[st] and m not in got:
-                got.append(m)
-                left -= 1
-                if not left:
-                    break
         parts = []
-        for st in sorted(wanted, key=lambda x: -SEVERITY.get(x, 0)):
-            n = counts[st]
+        for st in sorted(counts, key=lambda x: -SEVERITY.get(x, 0)):
+            if st == "discharged":
+                continue
+            n, rest, named = counts[st], mask & self.evidence_masks[st], []
+            while rest and len(named) < CONE_NAMES:  # the lowest bits: the first nodes in system order
+                low = rest & -rest
+                named.append(self.order[low.bit_length() - 1])
+                rest ^= low
             more = f" and {n - CONE_NAMES} more" if n > CONE_NAMES else ""
-            parts.append(f"{n} {st} node contract{'s' if n != 1 else ''}: {', '.join(named[st])}{more}")
+            parts.append(f"{n} {st} node contract{'s' if n != 1 else ''}: {', '.join(named)}{more}")
         return derivation, worst(list(counts)), "rests on " + "; ".join(parts)
 
 
@@ -283,12 +265,12 @@ def build_report(ws: Workspace) -> dict[str, Any]:
         requirements.append({"id": r.id, "text": r.text, "status": st, "support": support})
 
     derived = []
-    cones = ConeEvidence(node_evidence, sc_status)
+    cones, cone_of = ConeEvidence(model.nodes, node_evidence, sc_status), model.upstream_masks()
     for n in checked.nodes:
         c = comps[n]
         if not c:
             continue
-        derivation, ev_status, ev_note = cones.summary(c["cone"])
+        derivation, ev_status, ev_note = cones.summary(cone_of[n])  # the cone of the calculus (model.upstream)
         derived.append({"node": n, "rules": c["rules"], "instances": c["instances"],
                         "environment_assumptions": c["cone_environment_assumptions"], "property": c["derived_property"],
                         # the derivation: every side condition of the cone discharged

@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+from collections import deque
 from dataclasses import dataclass
 from functools import cached_property
 from pathlib import Path
@@ -107,6 +108,56 @@ class SystemModel:
                     seen.add(p)
                     todo.append(p)
         return [n for n in self.nodes if n in seen]
+
+    def upstream_masks(self) -> Mapping[str, int]:
+        """Every node's upstream cone (:meth:`upstream`) at once, as a bit
+        mask over :attr:`nodes` (bit ``i`` is ``nodes[i]``); read-only,
+        built once per model.
+
+        :meth:`upstream` for every node costs the sum of the cones' sizes,
+        quadratic along a chain (half a million names at 1000 nodes).  Here
+        each node's mask is its own bit or-ed with its producers' masks, taken
+        in an order that puts producers first (a depth-first post-order over
+        the producer edges), so a system without loops needs one union per
+        link; a loop's nodes are revisited until their masks stop growing
+        (the least fixpoint: exactly the nodes that reach each node)."""
+        return MappingProxyType(self._upstream_masks)
+
+    @cached_property
+    def _upstream_masks(self) -> dict[str, int]:
+        index = self._index
+        mask = {n: 1 << i for i, n in enumerate(self.nodes)}
+        order: list[str] = []
+        seen: set[str] = set()
+        for root in self.nodes:  # iterative depth-first post-order over the producer edges
+            if root in seen:
+                continue
+            seen.add(root)
+            stack = [(root, iter(index[root][0]))]
+            while stack:
+                n, producers = stack[-1]
+                for p in producers:
+                    if p not in seen:
+                        seen.add(p)
+                        stack.append((p, iter(index[p][0])))
+                        break
+                else:
+                    stack.pop()
+                    order.append(n)
+        todo, queued = deque(order), set(order)
+        while todo:
+            n = todo.popleft()
+            queued.discard(n)
+            m = mask[n]
+            for p in index[n][0]:
+                m |= mask[p]
+            if m != mask[n]:
+                mask[n] = m
+                for c in index[n][1]:
+                    if c not in queued:
+                        todo.append(c)
+                        queued.add(c)
+        return mask
 
     def alias(self) -> Mapping[tuple[str, str, str], str]:
         """Encoder aliases: each connected input becomes its producer's output
