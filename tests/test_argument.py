@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import copy
+import dataclasses
 import json
 import shutil
 from typing import Any
@@ -146,6 +147,8 @@ def test_propagation_takes_the_worst_child_and_rejects_malformed_structures() ->
     ]}
     arg = propagate(Argument("G1", els))
     assert [arg.status(i) for i in ("G1", "S1", "G2", "G3", "C1")] == ["stale", "stale", "pending", "stale", None]
+    # only the status changes: every other field (all of them, also ones added later) is kept
+    assert all(arg.elements[i] == dataclasses.replace(e, status=arg.status(i)) for i, e in els.items())
     with pytest.raises(ArgumentError, match="cycle"):
         propagate(Argument("G1", {**els, "G3": Element("G3", "goal", "x", supported_by=("G1",))}))
     with pytest.raises(ArgumentError, match="cannot link"):
