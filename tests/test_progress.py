@@ -71,14 +71,17 @@ def test_a_completed_run_freezes_the_heap_only_at_exit(monkeypatch: Any) -> None
     import atexit
     import gc
 
-    from rclverify import progress
+    from rclverify import heap
     registered: list[Any] = []
     monkeypatch.setattr(atexit, "register", registered.append)
-    monkeypatch.setattr(progress, "_FREEZE_REGISTERED", False)
-    frozen_before = gc.get_freeze_count()
+    monkeypatch.setattr(heap, "_EXIT", [])
+    heap.release_after_run()  # the heap frozen by a build_tasks of an earlier test
+    assert gc.get_freeze_count() == 0
     for _ in range(2):
         rep = ProgressReporter(io.StringIO(), {})
         rep.live_mode = False
-        rep.complete_run()
+        rep.initialize({}, [])  # the run's heap is frozen while doit runs the tasks ...
+        assert gc.get_freeze_count() > 0
+        rep.complete_run()  # ... and given back when it completes
     assert registered == [gc.freeze]  # once per process, and nothing frozen while it still runs
-    assert gc.get_freeze_count() == frozen_before
+    assert gc.get_freeze_count() == 0

@@ -182,6 +182,8 @@ class Workspace:
     MODEL = "artifacts/system/model.json"
     DOT = "artifacts/system/model.dot"
     DIAGNOSTICS = "artifacts/check/diagnostics.json"
+    #: What ``verify`` prints (:func:`rclverify.report.summary.summary_data`), written with the report.
+    SUMMARY = "artifacts/report/summary.json"
 
     def target(self, node: str, index: int) -> NodeTarget:
         from .backends.base import NodeTarget
@@ -367,6 +369,9 @@ def stage_report(ws: Workspace, parts: Sequence[str] = tuple(REPORT_PARTS),
         fragments = FragmentCache(ws.path(FRAGMENTS[part]))
         paths += write_part(report, out, part, fragments)
         fragments.save()
+        if part == "html":  # with assurance.json: what verify prints
+            from .report.summary import summary_data
+            write_json(ws.path(ws.SUMMARY), summary_data(report))
     # the one fragment cache of the single report task of earlier versions (38 MB at 1000 nodes)
     ws.path("artifacts/cache/report-fragments.pickle").unlink(missing_ok=True)
     return report, paths

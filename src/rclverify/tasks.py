@@ -198,15 +198,17 @@ def act_report(root: str, part: str) -> Any:
 
 
 def act_verify(root: str, strict: bool) -> Any:
-    path = Path(root) / "reports" / "assurance.json"
-    report = json.loads(path.read_text(encoding="utf-8"))
-    s = report["summary"]
+    from .report.summary import print_summary, summary_data
+    try:  # written by the report's html part with assurance.json
+        data = json.loads((Path(root) / Workspace.SUMMARY).read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        data = summary_data(json.loads((Path(root) / REPORTS[2]).read_text(encoding="utf-8")))
+    s = data["summary"]
     print(f"overall: {s['status']} -- {s['headline']}")
     for p in s["problems"]:
         print(f"  problem: {p}")
-    from .report.summary import print_summary
-    print_summary(report, "reports/assurance.html")
-    if strict and not report["meta"]["strict_ok"]:
+    print_summary(data, "reports/assurance.html", rows=data["rows"])
+    if strict and not data["meta"]["strict_ok"]:
         return TaskFailed("--strict: some evidence is failed, inconclusive, pending, stale or error, or a side condition "
                           "or contract health check is not proved (see reports/assurance.html)")
     return None
@@ -437,7 +439,8 @@ def _build_tasks(root: str | Path, plan_file: str) -> dict[str, Callable[[], Any
         for part, files in REPORT_PARTS.items():
             yield {"name": part, "doc": "reports/" + ", ".join(files), "actions": [(act_report, [r, part])],
                    "file_dep": deps,
-                   "targets": [at(f"reports/{f}") for f in files if f != "argument.svg"],
+                   "targets": [at(f"reports/{f}") for f in files if f != "argument.svg"]
+                   + ([at(ws.SUMMARY)] if part == "html" else []),
                    "verbosity": 2, "clean": True}
 
     def task_verify() -> dict[str, Any]:
