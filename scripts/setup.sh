@@ -29,3 +29,6 @@ fi
 PY=${PYTHON:-python3}
 echo "setup: installing rclverify and its Python dependencies"
 "$PY" -m pip install --quiet --disable-pip-version-check -e '.[test]'
+# The package's bytecode, compiled once here: an editable install compiles nothing, and a shell
+# with PYTHONDONTWRITEBYTECODE set would otherwise compile every module in every doit process.
+"$PY" -m compileall -q src/rclverify >/dev/null || true
