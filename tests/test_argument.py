@@ -164,6 +164,13 @@ def test_json_round_trips_and_is_deterministic() -> None:
     text = to_json_text(arg)
     assert Argument.from_json(json.loads(text)) == arg
     assert to_json_text(build_argument(copy.deepcopy(_report()))) == text
+    from rclverify.evidence.store import dumps
+    from rclverify.report.fragments import FragmentCache
+    assert text == dumps(arg.to_json())
+    cache = FragmentCache()
+    assert to_json_text(arg, cache) == text and cache.misses > 0  # rendered piece by piece
+    misses = cache.misses
+    assert to_json_text(build_argument(copy.deepcopy(_report())), cache) == text and cache.misses == misses  # all kept
 
 
 def test_gsn2x_yaml_has_the_documented_shape() -> None:

@@ -34,7 +34,7 @@ import jinja2
 
 from ..evidence.store import atomic_write_text, dumps
 from ..report import diagram
-from ..report.fragments import FragmentCache, cached_dumps, fingerprint
+from ..report.fragments import FragmentCache, fingerprint
 from .build import build_argument
 from .model import Argument, Element
 
@@ -63,10 +63,20 @@ def _with_status(e: Element) -> str:
     return f"{e.text} [{e.status}]" if e.status is not None else e.text
 
 
-def to_json_text(arg: Argument, fragments: FragmentCache | None = None) -> str:
-    """The argument as deterministic JSON text (sorted keys, final newline);
-    ``fragments`` keeps each element's text between runs (same text)."""
-    return dumps(arg.to_json()) if fragments is None else cached_dumps(arg.to_json(), fragments)
+def to_json_text(arg: Argument, fragments: FragmentCache | None = None, link_prefix: str = "../") -> str:
+    """The argument as deterministic JSON text: :func:`rclverify.evidence.store.dumps`
+    of :meth:`Argument.to_json` (sorted keys, two-space indent, final
+    newline).  ``fragments`` keeps each element's text between runs, keyed
+    like its DOT and YAML pieces (:func:`_pieces`; ``link_prefix`` is part
+    of that key only): the same text."""
+    if fragments is None or not arg.elements:
+        return dumps(arg.to_json())
+    # each element as the standard encoder indents it two levels down: {"elements": [ <here> ], "top": ...}
+    elements = _pieces(arg, fragments, None, link_prefix,
+                       lambda e: json.dumps(e.to_json(), sort_keys=True, indent=2, ensure_ascii=False).replace(
+                           "\n", "\n    "))
+    return ('{\n  "elements": [\n    ' + ",\n    ".join(elements) + '\n  ],\n  "top": '
+            + json.dumps(arg.top, ensure_ascii=False) + "\n}\n")
 
 
 #: The last argument whose elements were keyed, the link prefix and the keys' fingerprints.
@@ -75,22 +85,30 @@ _keyed: list[tuple[Argument, str, list[bytes]]] = []
 _SEP = "\x00"
 
 
-def _pieces(arg: Argument, fragments: FragmentCache | None, template: str, link_prefix: str,
+def _pieces(arg: Argument, fragments: FragmentCache | None, template: str | None, link_prefix: str,
             data: Callable[[Element], Any]) -> list[str]:
     """The text of every element in order by ``template`` (which renders
     ``items``, each followed by ``sep``), from ``fragments`` when the element
     (its JSON form) and ``link_prefix`` were rendered before.  The elements
     not kept are rendered in one call (a template call per element cost more
     than the rendering); the fingerprint of each element is computed once
-    per argument for the three kinds of piece (DOT node, DOT edges, YAML)."""
+    per argument for the four kinds of piece (DOT node, DOT edges, YAML,
+    JSON).  With no ``template``, ``data`` gives an element's text itself
+    (the JSON kind)."""
     cache = fragments if fragments is not None else FragmentCache()
     if not (_keyed and _keyed[0][0] is arg and _keyed[0][1] == link_prefix):
         _keyed[:] = [(arg, link_prefix, [fingerprint({"e": e.to_json(), "link_prefix": link_prefix})
                                          for e in arg.elements.values()])]
     keys = _keyed[0][2]
-    texts = [cache.lookup(template, k) for k in keys]
+    kind = template or "argument.json-element"
+    texts = [cache.lookup(kind, k) for k in keys]
     missing = [i for i, t in enumerate(texts) if t is None]
-    if missing:
+    if missing and template is None:
+        elements = list(arg.elements.values())
+        for i in missing:
+            texts[i] = data(elements[i])
+            cache.store(kind, keys[i], texts[i])
+    elif missing:
         elements = list(arg.elements.values())
         rendered = _environment().get_template(template).render(items=[data(elements[i]) for i in missing], sep=_SEP)
         parts = rendered.split(_SEP)
@@ -261,8 +279,7 @@ def write_argument(report: Mapping[str, Any], out_dir: Path, fragments: Fragment
     title = f"assurance argument of {report['meta']['workspace']}"
     texts: dict[str, str] = {}
     if FILES[0] in files:
-        as_json = arg.to_json()
-        texts[FILES[0]] = dumps(as_json) if fragments is None else cached_dumps(as_json, fragments)
+        texts[FILES[0]] = to_json_text(arg, fragments)
     if FILES[1] in files:
         texts[FILES[1]] = to_gsn_yaml(arg, title, fragments=fragments)
     if FILES[2] in files:

@@ -46,7 +46,7 @@ from typing import Any, Callable
 
 from ..evidence.store import atomic_write_bytes
 
-_FORMAT = 2
+_FORMAT = 3
 _ENCODE = json.JSONEncoder(sort_keys=True, separators=(",", ":"), ensure_ascii=False).encode
 
 
@@ -99,12 +99,13 @@ class FragmentCache:
     def __init__(self, path: Path | None = None) -> None:
         self.path = path
         self._salt = salt()
-        self._old: dict[str, str] = self._load() if path is not None else {}
-        self._used: dict[str, str] = {}
+        self._prefixes: dict[str, Any] = {}
+        self._old: dict[bytes, str] = self._load() if path is not None else {}
+        self._used: dict[bytes, str] = {}
         self.hits = 0
         self.misses = 0
 
-    def _load(self) -> dict[str, str]:
+    def _load(self) -> dict[bytes, str]:
         assert self.path is not None
         try:
             with open(self.path, "rb") as fh:
@@ -115,17 +116,20 @@ class FragmentCache:
             return {}
         if not isinstance(stored, dict) or stored.get("salt") != self._salt or not isinstance(stored.get("pieces"), dict):
             return {}
-        pieces: dict[str, str] = stored["pieces"]
+        pieces: dict[bytes, str] = stored["pieces"]
         return pieces
 
-    def key(self, kind: str, data: Any) -> str:
-        """Hex sha256 of the salt, ``kind`` and the :func:`fingerprint` of ``data``."""
+    def key(self, kind: str, data: Any) -> bytes:
+        """The sha256 of the salt, ``kind`` and the :func:`fingerprint` of ``data``."""
         return self._key(kind, fingerprint(data))
 
-    def _key(self, kind: str, fingerprint_of_data: bytes) -> str:
-        h = hashlib.sha256(f"{self._salt}\0{kind}\0".encode())
+    def _key(self, kind: str, fingerprint_of_data: bytes) -> bytes:
+        prefix = self._prefixes.get(kind)
+        if prefix is None:  # the salt and the kind hashed once per kind; each key copies that state
+            prefix = self._prefixes[kind] = hashlib.sha256(f"{self._salt}\0{kind}\0".encode())
+        h = prefix.copy()
         h.update(fingerprint_of_data)
-        return h.hexdigest()
+        return h.digest()
 
     def text(self, kind: str, data: Any, render: Callable[[], str]) -> str:
         """The text of the piece ``kind`` rendered from ``data``: the cached
