@@ -3,6 +3,7 @@
 The bundled workspace's files are checked in tests/test_pipeline_e2e.py."""
 from __future__ import annotations
 
+import copy
 import json
 from pathlib import Path
 from typing import Any
@@ -110,3 +111,17 @@ def test_junit_outcomes_follow_the_statuses(tmp_path: Path) -> None:
 def test_outputs_are_deterministic() -> None:
     assert render_sarif(_report()) == render_sarif(_report())
     assert render_junit(_report()) == render_junit(_report())
+
+
+def test_junit_from_kept_suites_is_the_junit_built_whole() -> None:
+    from rclverify.report.fragments import FragmentCache
+    report = _report()
+    whole = render_junit(report)
+    cache = FragmentCache()
+    assert render_junit(report, cache) == whole and cache.misses == len(report["nodes"])
+    assert render_junit(copy.deepcopy(report), cache) == whole and cache.misses == len(report["nodes"])  # all kept
+    hostile = copy.deepcopy(report)
+    hostile["meta"]["workspace"] = 'w "<&>"\n\ue000'
+    assert render_junit(hostile, FragmentCache()) == render_junit(hostile)
+    empty = {**copy.deepcopy(report), "nodes": []}
+    assert render_junit(empty, FragmentCache()) == render_junit(empty)

@@ -27,7 +27,7 @@ def _render(ws: Path, out: Path, fragments: FragmentCache | None) -> dict[str, b
     from rclverify.report.render import render_all
     report = build_report(Workspace(ws))
     render_all(report, out, fragments=fragments)
-    write_ci_reports(report, out)
+    write_ci_reports(report, out, fragments)
     write_argument(report, out, fragments)
     return {name: (out / name).read_bytes() for name in FILES if (out / name).exists()}
 

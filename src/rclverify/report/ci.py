@@ -9,6 +9,7 @@ from pathlib import Path
 from typing import Any, Mapping
 
 from ..evidence.store import atomic_write_text
+from .fragments import FragmentCache
 from .junit import render_junit
 from .sarif import render_sarif
 
@@ -16,9 +17,10 @@ from .sarif import render_sarif
 CI_FILES: tuple[str, ...] = ("assurance.sarif", "assurance.junit.xml")
 
 
-def write_ci_reports(report: Mapping[str, Any], out_dir: Path) -> list[Path]:
+def write_ci_reports(report: Mapping[str, Any], out_dir: Path, fragments: FragmentCache | None = None) -> list[Path]:
     """Render ``report`` (the dict of ``build_report``) as SARIF 2.1.0 and JUnit
-    XML and write both to ``out_dir``.
+    XML and write both to ``out_dir``; ``fragments`` keeps the JUnit text of
+    each node between runs (:func:`rclverify.report.junit.render_junit`).
 
     Both texts are rendered before anything is written, so an error leaves the
     previous files untouched; each write is atomic (and skipped when the text
@@ -26,7 +28,7 @@ def write_ci_reports(report: Mapping[str, Any], out_dir: Path) -> list[Path]:
     ``KeyError`` for a malformed report and ``OSError`` when ``out_dir``
     cannot be written.
     """
-    texts = dict(zip(CI_FILES, (render_sarif(report), render_junit(report))))
+    texts = dict(zip(CI_FILES, (render_sarif(report), render_junit(report, fragments))))
     paths = []
     for name, text in texts.items():
         path = Path(out_dir) / name

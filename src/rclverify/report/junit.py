@@ -23,9 +23,11 @@ every text is escaped; it is deterministic for a given report dict.
 """
 from __future__ import annotations
 
+import json
 import xml.etree.ElementTree as ET
 from typing import Any, Mapping
 
+from .fragments import FragmentCache
 from .sarif import split_location
 from .render import model_text
 
@@ -65,6 +67,25 @@ def junit_tree(report: Mapping[str, Any]) -> ET.Element:
     ``obligations``, ``evidence``, ``pending``, ``side_conditions``,
     ``findings`` and ``meta``.
     """
+    root = ET.Element("testsuites", {"name": f"rclverify: {report['meta']['workspace']}"})
+    totals = {"tests": 0, "failures": 0, "errors": 0, "skipped": 0}
+    total_time = 0.0
+    for node, data in _suite_data(report):
+        suite, counts, time = _suite(node, data)
+        root.append(suite)
+        for k, v in counts.items():
+            totals[k] += v
+        total_time += time
+    for k, v in totals.items():
+        root.set(k, str(v))
+    root.set("time", f"{total_time:.3f}")
+    return root
+
+
+def _suite_data(report: Mapping[str, Any]) -> list[tuple[Mapping[str, Any], dict[str, Any]]]:
+    """Per node of ``report``, in order: the node and exactly what its
+    ``<testsuite>`` is made from (its obligations, side conditions and
+    findings, the evidence records and pending reasons of its obligations)."""
     evidence = {str(e["obligation"]): e for e in report["evidence"]}
     reasons: dict[str, str] = {}
     for p in report["pending"]:
@@ -73,55 +94,59 @@ def junit_tree(report: Mapping[str, Any]) -> ET.Element:
     for kind in ("obligations", "side_conditions", "findings"):
         for item in report[kind]:
             by_node.setdefault(item["node"], {}).setdefault(kind, []).append(item)
-    root = ET.Element("testsuites", {"name": f"rclverify: {report['meta']['workspace']}"})
-    totals = {"tests": 0, "failures": 0, "errors": 0, "skipped": 0}
-    total_time = 0.0
+    out = []
     for node in report["nodes"]:
-        name = str(node["name"])
-        suite = ET.SubElement(root, "testsuite", {"name": name})
-        counts = {"tests": 0, "failures": 0, "errors": 0, "skipped": 0}
-        time = 0.0
+        items = by_node.get(str(node["name"]), {})
+        ids = [str(o["id"]) for o in items.get("obligations", ())]
+        out.append((node, {"items": items, "evidence": {i: evidence[i] for i in ids if i in evidence},
+                           "reasons": {i: reasons[i] for i in ids if i in reasons}}))
+    return out
 
-        def tally(case: ET.Element, status: str, summary: str, detail: str, seconds: Any) -> None:
-            nonlocal time
-            counts["tests"] += 1
-            time += float(seconds or 0.0)
-            bumped = _outcome(case, status, summary, detail)
-            if bumped:
-                counts[bumped] += 1
 
-        for o in by_node.get(name, {}).get("obligations", ()):
-            ev = evidence.get(str(o["id"]))
-            secs = ev["duration_s"] if ev is not None else 0.0
-            case = _case(suite, f"{name}.obligation", str(o["id"]), str(o["source"]), secs)
-            expl = str(ev["explanation"]) if ev is not None else reasons.get(str(o["id"]), "no evidence record yet")
-            cex = model_text(ev.get("counterexample")) if ev is not None else ""
-            tally(case, str(o["status"]), expl.splitlines()[0] if expl else str(o["status"]),
-                  _lines(f"obligation ({o['backend']}, {o['kind']}) of guarantee {o['guarantee']}: {o['statement']}",
-                         f"source: {o['source']}", expl, f"counterexample: {cex}" if cex else ""), secs)
-        for sc in by_node.get(name, {}).get("side_conditions", ()):
-            case = _case(suite, f"{name}.side_condition", str(sc["id"]), str(sc["source"]), sc.get("duration_s"))
-            model = model_text(sc.get("model"))
-            tally(case, str(sc["status"]), str(sc.get("explanation") or sc["status"]),
-                  _lines(f"side condition ({sc['rule']}): {sc['conjunct']}", f"source: {sc['source']}",
-                         str(sc.get("explanation") or ""), f"counterexample: {model}" if model else ""),
-                  sc.get("duration_s"))
-        for f in by_node.get(name, {}).get("findings", ()):
-            case = _case(suite, f"{name}.health", str(f["id"]), _source_of(node, f), f.get("duration_s"))
-            core = "; ".join(str(c) for c in f.get("core") or [])
-            model = model_text(f.get("model"))
-            tally(case, str(f["status"]), str(f["message"]),
-                  _lines(str(f["message"]), str(f.get("explanation") or ""), f"unsat core: {core}" if core else "",
-                         f"counterexample: {model}" if model else ""), f.get("duration_s"))
-        for k, v in counts.items():
-            suite.set(k, str(v))
-            totals[k] += v
-        suite.set("time", f"{time:.3f}")
-        total_time += time
-    for k, v in totals.items():
-        root.set(k, str(v))
-    root.set("time", f"{total_time:.3f}")
-    return root
+def _suite(node: Mapping[str, Any], data: Mapping[str, Any]) -> tuple[ET.Element, dict[str, int], float]:
+    """The ``<testsuite>`` of one node from :func:`_suite_data`, its counts
+    (``tests``, ``failures``, ``errors``, ``skipped``) and its time in seconds."""
+    name = str(node["name"])
+    items, evidence, reasons = data["items"], data["evidence"], data["reasons"]
+    suite = ET.Element("testsuite", {"name": name})
+    counts = {"tests": 0, "failures": 0, "errors": 0, "skipped": 0}
+    time = 0.0
+
+    def tally(case: ET.Element, status: str, summary: str, detail: str, seconds: Any) -> None:
+        nonlocal time
+        counts["tests"] += 1
+        time += float(seconds or 0.0)
+        bumped = _outcome(case, status, summary, detail)
+        if bumped:
+            counts[bumped] += 1
+
+    for o in items.get("obligations", ()):
+        ev = evidence.get(str(o["id"]))
+        secs = ev["duration_s"] if ev is not None else 0.0
+        case = _case(suite, f"{name}.obligation", str(o["id"]), str(o["source"]), secs)
+        expl = str(ev["explanation"]) if ev is not None else reasons.get(str(o["id"]), "no evidence record yet")
+        cex = model_text(ev.get("counterexample")) if ev is not None else ""
+        tally(case, str(o["status"]), expl.splitlines()[0] if expl else str(o["status"]),
+              _lines(f"obligation ({o['backend']}, {o['kind']}) of guarantee {o['guarantee']}: {o['statement']}",
+                     f"source: {o['source']}", expl, f"counterexample: {cex}" if cex else ""), secs)
+    for sc in items.get("side_conditions", ()):
+        case = _case(suite, f"{name}.side_condition", str(sc["id"]), str(sc["source"]), sc.get("duration_s"))
+        model = model_text(sc.get("model"))
+        tally(case, str(sc["status"]), str(sc.get("explanation") or sc["status"]),
+              _lines(f"side condition ({sc['rule']}): {sc['conjunct']}", f"source: {sc['source']}",
+                     str(sc.get("explanation") or ""), f"counterexample: {model}" if model else ""),
+              sc.get("duration_s"))
+    for f in items.get("findings", ()):
+        case = _case(suite, f"{name}.health", str(f["id"]), _source_of(node, f), f.get("duration_s"))
+        core = "; ".join(str(c) for c in f.get("core") or [])
+        model = model_text(f.get("model"))
+        tally(case, str(f["status"]), str(f["message"]),
+              _lines(str(f["message"]), str(f.get("explanation") or ""), f"unsat core: {core}" if core else "",
+                     f"counterexample: {model}" if model else ""), f.get("duration_s"))
+    for k, v in counts.items():
+        suite.set(k, str(v))
+    suite.set("time", f"{time:.3f}")
+    return suite, counts, time
 
 
 def _source_of(node: Mapping[str, Any], finding: Mapping[str, Any]) -> str:
@@ -131,8 +156,41 @@ def _source_of(node: Mapping[str, Any], finding: Mapping[str, Any]) -> str:
     return str(node["source"])
 
 
-def render_junit(report: Mapping[str, Any]) -> str:
-    """:func:`junit_tree` as indented UTF-8 XML text with a declaration."""
-    root = junit_tree(report)
-    ET.indent(root)
-    return '<?xml version="1.0" encoding="utf-8"?>\n' + ET.tostring(root, encoding="unicode") + "\n"
+_DECLARATION = '<?xml version="1.0" encoding="utf-8"?>\n'
+
+
+def render_junit(report: Mapping[str, Any], fragments: FragmentCache | None = None) -> str:
+    """:func:`junit_tree` as indented UTF-8 XML text with a declaration.
+
+    With ``fragments``, each node's ``<testsuite>`` (its indented text, its
+    counts and time) is kept between runs, keyed by the data it is made
+    from (:func:`_suite_data`; :mod:`rclverify.report.fragments`): the same
+    text, without building and serialising the XML of unchanged nodes."""
+    if fragments is None or not report["nodes"]:
+        root = junit_tree(report)
+        ET.indent(root)
+        return _DECLARATION + ET.tostring(root, encoding="unicode") + "\n"
+    texts: list[str] = []
+    totals = {"tests": 0, "failures": 0, "errors": 0, "skipped": 0}
+    total_time = 0.0
+    for node, data in _suite_data(report):
+        def render(node: Mapping[str, Any] = node, data: dict[str, Any] = data) -> str:
+            suite, counts, time = _suite(node, data)
+            ET.indent(suite, level=1)  # as ET.indent(root) indents a child of the root
+            return json.dumps({"xml": ET.tostring(suite, encoding="unicode"), "counts": counts, "time": time})
+        piece = json.loads(fragments.text("junit-testsuite", {"node": node, **data}, render))
+        texts.append(piece["xml"])
+        for k, v in piece["counts"].items():
+            totals[k] += v
+        total_time += piece["time"]
+    root = ET.Element("testsuites", {"name": f"rclverify: {report['meta']['workspace']}"})
+    for k, v in totals.items():
+        root.set(k, str(v))
+    root.set("time", f"{total_time:.3f}")
+    root.text = _MARK  # the root's tags as ElementTree writes them, around the suites' kept texts
+    head, tail = ET.tostring(root, encoding="unicode").rsplit(_MARK, 1)
+    return _DECLARATION + head + "\n  " + "\n  ".join(texts) + "\n" + tail + "\n"
+
+
+#: Stands in for the root's children while its tags are serialised (no escaped text contains it).
+_MARK = "\ue000rclverify-junit-suites\ue000"

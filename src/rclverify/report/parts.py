@@ -57,7 +57,7 @@ def write_part(report: Mapping[str, Any], out_dir: Path, part: str, fragments: F
     paths = render_files(report, out_dir, [n for n in REPORT_FILES if n in names], fragments=fragments,
                          argument=argument)
     if any(n in names for n in CI_FILES):
-        paths += write_ci_reports(report, out_dir)
+        paths += write_ci_reports(report, out_dir, fragments)
     files = tuple(n for n in ARGUMENT_FILES if n in names)
     if files:
         paths += write_argument(report, out_dir, fragments, files, argument() if argument is not None else None)
