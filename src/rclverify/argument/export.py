@@ -103,20 +103,19 @@ def _pieces(arg: Argument, fragments: FragmentCache | None, template: str | None
     kind = template or "argument.json-element"
     texts = [cache.lookup(kind, k) for k in keys]
     missing = [i for i, t in enumerate(texts) if t is None]
-    if missing and template is None:
-        elements = list(arg.elements.values())
-        for i in missing:
-            texts[i] = data(elements[i])
-            cache.store(kind, keys[i], texts[i])
-    elif missing:
-        elements = list(arg.elements.values())
+    if not missing:
+        return [t for t in texts if t is not None]
+    elements = list(arg.elements.values())
+    if template is None:
+        made = [data(elements[i]) for i in missing]
+    else:
         rendered = _environment().get_template(template).render(items=[data(elements[i]) for i in missing], sep=_SEP)
-        parts = rendered.split(_SEP)
-        if len(parts) != len(missing) + 1 or parts[-1]:
+        made = rendered.split(_SEP)
+        if len(made) != len(missing) + 1 or made[-1]:
             raise ValueError(f"{template}: an element's text contains the separator")  # not from escaped text
-        for i, text in zip(missing, parts):
-            cache.store(template, keys[i], text)
-            texts[i] = text
+    for i, text in zip(missing, made):
+        cache.store(kind, keys[i], text)
+        texts[i] = text
     return [t for t in texts if t is not None]
 
 

@@ -144,7 +144,8 @@ class ConeEvidence:
         for st in sorted(counts, key=lambda x: -SEVERITY.get(x, 0)):
             if st == "discharged":
                 continue
-            n, rest, named = counts[st], mask & self.evidence_masks[st], []
+            n, rest = counts[st], mask & self.evidence_masks[st]
+            named: list[str] = []
             while rest and len(named) < CONE_NAMES:  # the lowest bits: the first nodes in system order
                 low = rest & -rest
                 named.append(self.order[low.bit_length() - 1])
