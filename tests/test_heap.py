@@ -13,13 +13,13 @@ from rclverify import heap
 def test_loading_restores_the_collector_also_after_an_error() -> None:
     assert gc.isenabled()
     with pytest.raises(ValueError):
-        with heap.loading():
+        with heap.no_collection():
             assert not gc.isenabled()
             raise ValueError("bad input")
     assert gc.isenabled()
     gc.disable()
     try:
-        with heap.loading():
+        with heap.no_collection():
             pass
         assert not gc.isenabled()  # it was off before: left off
     finally:

@@ -11,8 +11,10 @@ and about 0.4 s of each report task after a one-contract edit, and
 cyclic either way; these functions only keep the collector from walking
 objects that cannot be garbage yet:
 
-* :func:`loading` -- no collection while :func:`rclverify.tasks.build_tasks`
-  loads the workspace and defines the tasks;
+* :func:`no_collection` -- no collection while :func:`rclverify.tasks.build_tasks`
+  loads the workspace and defines the tasks (also while the parser builds
+  syntax trees and the workspace cache is unpickled: everything made there
+  is live);
 * :func:`freeze_for_run` -- then the main process's heap goes to the
   collector's permanent generation (``gc.freeze``) for the run, and
   :func:`release_after_run` gives it back when doit completes the run (a
@@ -36,9 +38,10 @@ _EXIT: list[bool] = []
 
 
 @contextmanager
-def loading() -> Iterator[None]:
+def no_collection() -> Iterator[None]:
     """No cyclic collection inside the block (the collector's state is
-    restored after it, also on an exception)."""
+    restored after it, also on an exception).  For blocks that make many
+    objects that all stay live: collecting there only walks them again."""
     was_enabled = gc.isenabled()
     gc.disable()
     try:

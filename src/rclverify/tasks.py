@@ -317,7 +317,7 @@ def build_tasks(root: str | Path, plan_file: str = "contracts/plan.yaml") -> dic
     cyclic garbage collection and then frozen for the run
     (:mod:`rclverify.heap`; the progress reporter gives it back to the
     collector when doit completes the run)."""
-    with heap.loading():
+    with heap.no_collection():
         creators = _build_tasks(root, plan_file)
         heap.freeze_for_run()  # before collecting again: what was made while loading is not looked at
     return creators

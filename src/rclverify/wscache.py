@@ -27,7 +27,6 @@ parsed contracts are unpickled only when a task first needs them
 from __future__ import annotations
 
 import atexit
-import gc
 import hashlib
 import os
 import pickle
@@ -37,6 +36,8 @@ import threading
 from functools import lru_cache
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
+
+from .heap import no_collection
 
 if TYPE_CHECKING:
     from .pipeline import Workspace
@@ -122,13 +123,8 @@ def restore(ws: "Workspace") -> bool:
 
 
 def _load_large(fh: Any) -> Any:
-    gc_was_enabled = gc.isenabled()
-    gc.disable()  # the loaded objects are all live: collecting during the load only costs time
-    try:
+    with no_collection():  # the loaded objects are all live: collecting during the load only costs time
         return pickle.load(fh)
-    finally:
-        if gc_was_enabled:
-            gc.enable()
 
 
 def _load_deferred(ws: "Workspace", header: dict[str, Any], offset: int) -> None:

@@ -24,23 +24,22 @@ size of the system (bench/parse_scale.py).
 from __future__ import annotations
 
 import dataclasses
-import gc
 from itertools import accumulate
 import os
 import re
 import sys
 import threading
-from contextlib import contextmanager
 from functools import lru_cache
 from importlib import resources
 from pathlib import Path
-from typing import Any, Callable, Iterable, Iterator, Mapping, cast
+from typing import Any, Callable, Iterable, Mapping, cast
 
 import lark
 from lark import Lark, Token, Transformer
 from lark.parsers.lalr_analysis import Shift
 from lark.exceptions import UnexpectedCharacters, UnexpectedEOF, UnexpectedInput, UnexpectedToken
 
+from ..heap import no_collection
 from . import ast
 from .errors import Diagnostic, RclError, error
 
@@ -575,7 +574,9 @@ def parse_formula(text: str, file: str = "<string>", line: int = 1, col: int = 1
 
 def _parse(text: str, file: str, start: str, dline: int, dcol: int) -> Any:
     parser = _lark()
-    with _LOCK, _gc_paused():
+    # parse trees and AST nodes hold no reference cycles; without the pause the collector
+    # scans the growing heap again and again (about 2x slower at a thousand nodes, bench/parse_scale.py)
+    with _LOCK, no_collection():
         _BUILDER.reset(file, dline, dcol)
         try:
             result = parser.parse(text, start=start)
@@ -662,23 +663,6 @@ def ast_from_tree(tree: Any, file: str = "<string>") -> Any:
             return _BUILDER.transform(tree)
         finally:
             _BUILDER.reset("<string>", 0, 0)
-
-
-@contextmanager
-def _gc_paused() -> Iterator[None]:
-    """Pause the cyclic garbage collector while parsing.
-
-    Parse trees and AST nodes hold no reference cycles, so reference counting
-    frees them; without the pause the collector repeatedly scans the growing
-    heap and parsing a large system becomes superlinear (about 2x slower at a
-    thousand nodes, see bench/parse_scale.py)."""
-    was_enabled = gc.isenabled()
-    gc.disable()
-    try:
-        yield
-    finally:
-        if was_enabled:
-            gc.enable()
 
 
 def parse_file(path: str | Path) -> ast.Spec:
