@@ -21,6 +21,8 @@ from __future__ import annotations
 
 import dataclasses
 import hashlib
+import json
+import os
 from dataclasses import dataclass
 from functools import cached_property
 from pathlib import Path
@@ -378,8 +380,11 @@ def stage_report(ws: Workspace, parts: Sequence[str] = tuple(REPORT_PARTS),
 
 
 def read_artifact(ws: Workspace, rel: str, default: Any = None) -> Any:
-    """JSON of an artifact, or ``default`` when it does not exist yet."""
+    """JSON of an artifact, or ``default`` when it does not exist yet.  (The
+    path is joined as text and the bytes decoded by ``json``: the report
+    reads thousands of artifacts, and ``pathlib`` was a third of that.)"""
     try:
-        return read_json(ws.path(rel))
+        with open(os.path.join(ws.root, rel), "rb") as fh:
+            return json.loads(fh.read())
     except FileNotFoundError:
         return default

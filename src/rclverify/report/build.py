@@ -33,7 +33,7 @@ import z3
 from .. import __version__
 from ..contract_texts import ContractTexts
 from ..evidence.records import SEVERITY, Obligation, worst
-from ..evidence.store import EvidenceStore, read_obligations
+from ..evidence.store import EvidenceStore
 from ..pipeline import Workspace, read_artifact
 from ..rcl import ast
 from ..system.model import cycles_kept
@@ -162,10 +162,7 @@ def build_report(ws: Workspace) -> dict[str, Any]:
     store = EvidenceStore(ws.root)
     obligations: list[Obligation] = []
     for n in checked.nodes:
-        try:
-            obligations.extend(read_obligations(ws.path(ws.obligations(n))))
-        except FileNotFoundError:
-            pass
+        obligations.extend(Obligation.from_json(d) for d in read_artifact(ws, ws.obligations(n), []))
     ev_rows: list[dict[str, Any]] = []
     ob_rows: list[dict[str, Any]] = []
     pending: list[dict[str, Any]] = []
