@@ -288,3 +288,27 @@ def test_query_budgets_are_resource_steps_not_wall_clock() -> None:
     r1 = prove(x * x * x + y * y * y != 1729, [x > 1, y > x], timeout_ms=5)
     r2 = prove(x * x * x + y * y * y != 1729, [x > 1, y > x], timeout_ms=5)
     assert r1.status == r2.status == "inconclusive"
+
+
+def test_model_terms_of_any_depth_render_without_recursion() -> None:
+    # a newer Z3 gave a health check's function table a symbolic `else` of several
+    # hundred nested ifs, deeper than Python's recursion limit
+    import sys
+
+    import z3
+
+    from rclverify.logic.encode import term_to_rcl, value_to_rcl
+    p = z3.Int("p1")
+    depth = sys.getrecursionlimit() * 3
+    term: z3.ExprRef = z3.IntVal(0)
+    for k in range(depth, 0, -1):
+        term = z3.If(p == k, z3.IntVal(k), term)
+    text = term_to_rcl(term)
+    assert text.startswith("(if (p1 == 1) then 1 else (if (p1 == 2) then 2 else")
+    assert text.endswith("else 0" + ")" * depth) and text.count("if ") == depth
+    assert term_to_rcl(z3.And(z3.Not(p > 2), z3.Distinct(p, z3.IntVal(3)))) == "(not (p1 > 2) and (p1 != 3))"
+    pair = z3.Datatype("Pair")
+    pair.declare("mk", ("a", z3.RealSort()), ("b", z3.IntSort()))
+    Pair = pair.create()
+    assert value_to_rcl(z3.simplify(Pair.mk(z3.RealVal("3/2"), z3.IntVal(7)))) == "mk(1.5, 7)"
+    assert value_to_rcl(z3.RealVal("1/3")) == "1/3" and value_to_rcl(z3.BoolVal(True)) == "TRUE"

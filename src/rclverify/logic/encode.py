@@ -26,7 +26,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from fractions import Fraction
-from typing import Any, Callable, Mapping, cast
+from typing import Any, Callable, Mapping, Sequence, cast
 
 import z3
 
@@ -617,27 +617,59 @@ class _Ctx:
 MAX_RANGE_ITEMS = 10_000
 
 
-def value_to_rcl(v: z3.ExprRef) -> str:
-    """Render a Z3 model value in RCL notation (``move(1.5, 0)``, ``green``, ``7/3``)."""
+#: How a term is rendered: its text (a leaf), or its children and what joins their texts.
+_Parts = tuple[str | None, Sequence[z3.ExprRef], Callable[[list[str]], str] | None]
+
+
+def _render(root: z3.ExprRef, parts: Callable[[z3.ExprRef], _Parts]) -> str:
+    """Render ``root`` bottom-up with an explicit stack: Z3 models can hold
+    terms thousands of levels deep (a function table's ``else`` branch as a
+    chain of ``if``s), deeper than Python's recursion limit."""
+    todo: list[tuple[z3.ExprRef, tuple[int, Callable[[list[str]], str]] | None]] = [(root, None)]
+    done: list[str] = []
+    while todo:
+        e, pending = todo.pop()
+        if pending is not None:  # its children are rendered: the last n texts
+            n, combine = pending
+            texts = done[len(done) - n:]
+            del done[len(done) - n:]
+            done.append(combine(texts))
+            continue
+        leaf, kids, join = parts(e)
+        if leaf is not None or join is None:
+            done.append(leaf if leaf is not None else str(e))
+            continue
+        todo.append((e, (len(kids), join)))
+        todo.extend((k, None) for k in reversed(kids))  # the first child is rendered first
+    return done[0]
+
+
+def _value_parts(v: z3.ExprRef) -> _Parts:
     if z3.is_int_value(v):
-        return str(v.as_long())
+        return str(v.as_long()), (), None
     if z3.is_rational_value(v):
         fr = Fraction(v.numerator_as_long(), v.denominator_as_long())
         if fr.denominator == 1:
-            return str(fr.numerator)
+            return str(fr.numerator), (), None
         dec = float(fr)
-        return repr(dec) if Fraction(dec) == fr else f"{fr.numerator}/{fr.denominator}"
+        return (repr(dec) if Fraction(dec) == fr else f"{fr.numerator}/{fr.denominator}"), (), None
     if z3.is_algebraic_value(v):
-        return str(v.as_decimal(6))
+        return str(v.as_decimal(6)), (), None
     if z3.is_true(v):
-        return "TRUE"
+        return "TRUE", (), None
     if z3.is_false(v):
-        return "FALSE"
+        return "FALSE", (), None
     if z3.is_app(v) and v.num_args() > 0:
-        return f"{v.decl().name()}(" + ", ".join(value_to_rcl(a) for a in v.children()) + ")"
+        name = v.decl().name()
+        return None, v.children(), lambda xs: f"{name}(" + ", ".join(xs) + ")"
     if z3.is_app(v):
-        return str(v.decl().name())
-    return str(v)
+        return str(v.decl().name()), (), None
+    return str(v), (), None
+
+
+def value_to_rcl(v: z3.ExprRef) -> str:
+    """Render a Z3 model value in RCL notation (``move(1.5, 0)``, ``green``, ``7/3``)."""
+    return _render(v, _value_parts)
 
 
 _OPS = {z3.Z3_OP_AND: " and ", z3.Z3_OP_OR: " or ", z3.Z3_OP_EQ: " == ", z3.Z3_OP_LE: " <= ", z3.Z3_OP_LT: " < ",
@@ -645,26 +677,32 @@ _OPS = {z3.Z3_OP_AND: " and ", z3.Z3_OP_OR: " or ", z3.Z3_OP_EQ: " == ", z3.Z3_O
         z3.Z3_OP_IMPLIES: " -> ", z3.Z3_OP_DIV: " / "}
 
 
-def term_to_rcl(e: z3.ExprRef) -> str:
-    """Render a (small) Z3 term from a model in RCL notation, e.g. a function
-    table's symbolic ``else`` branch: ``p1 == 2 and p2 == 3``."""
+def _term_parts(e: z3.ExprRef) -> _Parts:
     if z3.is_int_value(e) or z3.is_rational_value(e) or z3.is_true(e) or z3.is_false(e):
-        return value_to_rcl(e)
+        return value_to_rcl(e), (), None
     if not z3.is_app(e):
-        return str(e)
+        return str(e), (), None
     k = e.decl().kind()
     kids = e.children()
     if k in _OPS and kids:
-        return "(" + _OPS[k].join(term_to_rcl(c) for c in kids) + ")"
+        op = _OPS[k]
+        return None, kids, lambda xs: "(" + op.join(xs) + ")"
     if k == z3.Z3_OP_NOT:
-        return f"not {term_to_rcl(kids[0])}"
+        return None, kids[:1], lambda xs: f"not {xs[0]}"
     if k == z3.Z3_OP_ITE:
-        c, a, b = (term_to_rcl(x) for x in kids)
-        return f"(if {c} then {a} else {b})"
+        return None, kids, lambda xs: f"(if {xs[0]} then {xs[1]} else {xs[2]})"
     if k == z3.Z3_OP_DISTINCT:
-        return "(" + " != ".join(term_to_rcl(c) for c in kids) + ")"
+        return None, kids, lambda xs: "(" + " != ".join(xs) + ")"
     if k == z3.Z3_OP_TO_REAL and kids:
-        return term_to_rcl(kids[0])
+        return None, kids[:1], lambda xs: xs[0]
     if kids:
-        return f"{e.decl().name()}(" + ", ".join(term_to_rcl(c) for c in kids) + ")"
-    return value_to_rcl(e)
+        name = e.decl().name()
+        return None, kids, lambda xs: f"{name}(" + ", ".join(xs) + ")"
+    return value_to_rcl(e), (), None
+
+
+def term_to_rcl(e: z3.ExprRef) -> str:
+    """Render a Z3 term from a model in RCL notation, e.g. a function
+    table's symbolic ``else`` branch: ``p1 == 2 and p2 == 3``.  Terms of any
+    depth (rendered with an explicit stack, :func:`_render`)."""
+    return _render(e, _term_parts)
