@@ -4,7 +4,7 @@ from __future__ import annotations
 import random
 
 from rclverify.evidence.records import SEVERITY, worst
-from rclverify.report.build import CONE_NAMES, ConeEvidence, _evidence_of_cone, _headline
+from rclverify.report.build import CONE_NAMES, ConeEvidence, _headline
 from rclverify.system.model import Link, SystemModel
 
 
@@ -15,6 +15,12 @@ def test_headline_has_no_empty_fragments():
     rows = [{"status": "pending"}]
     h = _headline(rows, {"pending": 1}, [{"status": "discharged"}], [{"status": "problem"}])
     assert h == "1 obligation: 1 pending; 1/1 side conditions discharged; 1 contract health problem."
+
+
+def _evidence_of_cone(cone: list[str], node_evidence: dict[str, str]) -> tuple[str, str]:
+    """(worst evidence status, note) of one cone, listed in system order."""
+    cones = ConeEvidence(cone, node_evidence)
+    return cones.summary(cones.mask(cone))[1:]
 
 
 def test_evidence_note_names_the_node_contracts_a_derivation_rests_on():

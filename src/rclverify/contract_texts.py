@@ -33,10 +33,6 @@ if TYPE_CHECKING:
 CACHE = "artifacts/cache/contract-texts.pickle"
 
 
-def _src(loc: ast.Loc) -> str:
-    return f"{loc.file}:{loc.line}:{loc.col}"
-
-
 def node_texts(node: ast.Node) -> dict[str, Any]:
     """The texts of one node: ``{"rcl": the node as RCL (the snapshot's
     text), "latex": its LaTeX, "inputs"/"outputs": [[name, type as RCL],
@@ -48,8 +44,8 @@ def node_texts(node: ast.Node) -> dict[str, Any]:
         "rcl": to_rcl(ast.Spec((), (node,))), "latex": to_latex(ast.Spec((), (node,))),
         "inputs": [[v.name, type_to_rcl(v.type)] for v in node.inputs],
         "outputs": [[v.name, type_to_rcl(v.type)] for v in node.outputs],
-        "assumptions": [[expr_to_rcl(a.formula), _src(a.loc)] for a in node.assumes],
-        "guarantees": [[expr_to_rcl(g.formula), _src(g.loc)] for g in node.guarantees],
+        "assumptions": [[expr_to_rcl(a.formula), str(a.loc)] for a in node.assumes],
+        "guarantees": [[expr_to_rcl(g.formula), str(g.loc)] for g in node.guarantees],
     }
 
 

@@ -35,17 +35,12 @@ from ..contract_texts import ContractTexts
 from ..evidence.records import SEVERITY, Obligation, worst
 from ..evidence.store import EvidenceStore
 from ..pipeline import Workspace, read_artifact
-from ..rcl import ast
 from ..system.model import cycles_kept
 from .expected import expected_rows
 
 _FINDING_AS = {"ok": "discharged", "problem": "failed", "inconclusive": "inconclusive",
                # a health warning (health/shape.py) is shown but changes no status
                "warning": "discharged"}
-
-
-def _src(l: ast.Loc) -> str:
-    return f"{l.file}:{l.line}:{l.col}"
 
 
 def _brief(text: str, limit: int = 300) -> str:
@@ -83,21 +78,11 @@ _DERIVATION = {"discharged": "derived", "failed": "not derived"}
 CONE_NAMES = 10
 
 
-def _evidence_of_cone(cone: list[str], node_evidence: dict[str, str]) -> tuple[str, str]:
-    """(worst evidence status of the nodes of ``cone``, the sentence saying
-    which node contracts a derived property rests on that are not yet
-    established: "derived; rests on 1 failed node contract: RadiationSensor").
-    A node missing from ``node_evidence`` is ``pending``; the note names
-    nodes in ``cone`` order.  One cone; the report asks
-    :class:`ConeEvidence`, which answers every cone of a system in linear
-    time."""
-    cones = ConeEvidence(list(dict.fromkeys(cone)), node_evidence)
-    return cones.summary(cones.mask(cone))[1:]
-
-
 class ConeEvidence:
     """The derivation status and the evidence status and note of the cones
-    of one system (:func:`_evidence_of_cone` for each cone, the same text).
+    of one system: the note says which node contracts a derived property
+    rests on that are not yet established ("rests on 1 failed node
+    contract: RadiationSensor"), at most :data:`CONE_NAMES` per status.
 
     The cones of a 1000-node chain hold half a million names; grouping them
     name by name took 0.3-0.5 s of every report build (docs/scale.md,
@@ -133,7 +118,7 @@ class ConeEvidence:
     def summary(self, mask: int) -> tuple[str, str, str]:
         """(worst side-condition status of the nodes of the cone ``mask`` --
         its derivation, ``discharged`` for an empty cone --, their worst
-        evidence status, the evidence note of :func:`_evidence_of_cone`)."""
+        evidence status, the evidence note)."""
         if not mask:
             return "discharged", "discharged", "derived; rests on no node contract"
         derivation = worst([st for st, m in self.side_condition_masks.items() if mask & m])
@@ -242,7 +227,7 @@ def build_report(ws: Workspace) -> dict[str, Any]:
         node_status[name] = status
         node_evidence[name] = worst([g["status"] for g in guarantees], empty="pending")
         nodes.append({
-            "name": name, "source": _src(cn.node.loc), "status": status,
+            "name": name, "source": str(cn.node.loc), "status": status,
             "inputs": [{"name": v, "type": t, "producer": internal.get(v)} for v, t in tx["inputs"]],
             "outputs": [{"name": v, "type": t, "consumers": consumers.get(v, [])} for v, t in tx["outputs"]],
             "assumptions": [{"text": text, "source": src, "environment": text in env_texts}
