@@ -204,6 +204,15 @@ def test_upstream_masks_are_the_upstream_cones_also_through_loops() -> None:
                  for k in range(rng.randint(0, 40))]
         model = SystemModel(tuple(rng.sample(nodes, len(nodes))), tuple(links), (), ())
         masks = model.upstream_masks()
-        for n in model.nodes:
-            cone = [m for i, m in enumerate(model.nodes) if masks[n] >> i & 1]
-            assert cone == model.upstream(n)
+        preds: dict[str, set[str]] = {n: set() for n in model.nodes}
+        for l in links:
+            preds[l.to_node].add(l.from_node)
+        for n in model.nodes:  # reachability written out plainly: a search backwards from n
+            seen, todo = {n}, [n]
+            while todo:
+                for p in preds[todo.pop()] - seen:
+                    seen.add(p)
+                    todo.append(p)
+            cone = [m for m in model.nodes if m in seen]
+            assert [m for i, m in enumerate(model.nodes) if masks[n] >> i & 1] == cone
+            assert model.upstream(n) == cone

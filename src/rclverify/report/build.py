@@ -35,7 +35,7 @@ from ..contract_texts import ContractTexts
 from ..evidence.records import SEVERITY, Obligation, worst
 from ..evidence.store import EvidenceStore
 from ..pipeline import Workspace, read_artifact
-from ..system.model import cycles_kept
+from ..system.model import cycles_kept, names_of
 from .expected import expected_rows
 
 _FINDING_AS = {"ok": "discharged", "problem": "failed", "inconclusive": "inconclusive",
@@ -129,12 +129,8 @@ class ConeEvidence:
         for st in sorted(counts, key=lambda x: -SEVERITY.get(x, 0)):
             if st == "discharged":
                 continue
-            n, rest = counts[st], mask & self.evidence_masks[st]
-            named: list[str] = []
-            while rest and len(named) < CONE_NAMES:  # the lowest bits: the first nodes in system order
-                low = rest & -rest
-                named.append(self.order[low.bit_length() - 1])
-                rest ^= low
+            n = counts[st]
+            named = names_of(mask & self.evidence_masks[st], self.order, CONE_NAMES)  # the first in system order
             more = f" and {n - CONE_NAMES} more" if n > CONE_NAMES else ""
             parts.append(f"{n} {st} node contract{'s' if n != 1 else ''}: {', '.join(named)}{more}")
         return derivation, worst(list(counts)), "rests on " + "; ".join(parts)

@@ -46,6 +46,17 @@ class Link:
                 "to_var": self.to_var, "via": self.via}
 
 
+def names_of(mask: int, order: Sequence[str], limit: int | None = None) -> list[str]:
+    """The names of ``order`` whose bits are set in ``mask`` (bit ``i`` is
+    ``order[i]``), in that order; at most ``limit`` of them."""
+    out: list[str] = []
+    while mask and (limit is None or len(out) < limit):
+        low = mask & -mask
+        out.append(order[low.bit_length() - 1])
+        mask ^= low
+    return out
+
+
 @dataclass(frozen=True)
 class SystemModel:
     """Nodes (source order), links, environment inputs and loops.
@@ -100,23 +111,19 @@ class SystemModel:
         return out
 
     def upstream(self, node: str) -> list[str]:
-        """The upstream cone of ``node``: itself and every node that reaches it."""
-        seen, todo = {node}, [node]
-        while todo:
-            for p in self.producers(todo.pop()):
-                if p not in seen:
-                    seen.add(p)
-                    todo.append(p)
-        return [n for n in self.nodes if n in seen]
+        """The upstream cone of ``node``: itself and every node that reaches
+        it, in source order (from :meth:`upstream_masks`; ``[]`` for a node
+        not in the model)."""
+        return names_of(self._upstream_masks.get(node, 0), self.nodes)
 
     def upstream_masks(self) -> Mapping[str, int]:
         """Every node's upstream cone (:meth:`upstream`) at once, as a bit
         mask over :attr:`nodes` (bit ``i`` is ``nodes[i]``); read-only,
         built once per model.
 
-        :meth:`upstream` for every node costs the sum of the cones' sizes,
-        quadratic along a chain (half a million names at 1000 nodes).  Here
-        each node's mask is its own bit or-ed with its producers' masks, taken
+        A search per node would cost the sum of the cones' sizes, quadratic
+        along a chain (half a million names at 1000 nodes).  Here each
+        node's mask is its own bit or-ed with its producers' masks, taken
         in an order that puts producers first (a depth-first post-order over
         the producer edges), so a system without loops needs one union per
         link; a loop's nodes are revisited until their masks stop growing
