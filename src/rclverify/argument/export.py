@@ -33,6 +33,7 @@ from typing import Any, Callable, Mapping
 import jinja2
 
 from ..evidence.store import atomic_write_text, dumps
+from ..memo import last_call
 from ..report import diagram
 from ..report.fragments import FragmentCache, fingerprint
 from .build import build_argument
@@ -79,10 +80,15 @@ def to_json_text(arg: Argument, fragments: FragmentCache | None = None, link_pre
             + json.dumps(arg.top, ensure_ascii=False) + "\n}\n")
 
 
-#: The last argument whose elements were keyed, the link prefix and the keys' fingerprints.
-_keyed: list[tuple[Argument, str, list[bytes]]] = []
 #: Ends each element's text in a batch render (JSON-quoted YAML and DOT strings escape control characters).
 _SEP = "\x00"
+
+
+@last_call
+def _element_keys(arg: Argument, link_prefix: str) -> list[bytes]:
+    """The fingerprint of each element of ``arg`` with ``link_prefix``: the
+    key of its pieces of every kind."""
+    return [fingerprint({"e": e.to_json(), "link_prefix": link_prefix}) for e in arg.elements.values()]
 
 
 def _pieces(arg: Argument, fragments: FragmentCache | None, template: str | None, link_prefix: str,
@@ -96,10 +102,7 @@ def _pieces(arg: Argument, fragments: FragmentCache | None, template: str | None
     JSON).  With no ``template``, ``data`` gives an element's text itself
     (the JSON kind)."""
     cache = fragments if fragments is not None else FragmentCache()
-    if not (_keyed and _keyed[0][0] is arg and _keyed[0][1] == link_prefix):
-        _keyed[:] = [(arg, link_prefix, [fingerprint({"e": e.to_json(), "link_prefix": link_prefix})
-                                         for e in arg.elements.values()])]
-    keys = _keyed[0][2]
+    keys = _element_keys(arg, link_prefix)
     kind = template or "argument.json-element"
     texts = [cache.lookup(kind, k) for k in keys]
     missing = [i for i, t in enumerate(texts) if t is None]
@@ -200,19 +203,12 @@ def to_dot(arg: Argument, title: str = "assurance argument", link_prefix: str = 
         edges=_pieces(arg, fragments, "argument.dot-edges.j2", link_prefix, edges))
 
 
-#: The last report built (kept, so its ``id`` is not reused), its argument, and its DOT text once
-#: made (``[]`` until then).
-_last: list[tuple[Mapping[str, Any], Argument, list[str]]] = []
-
-
-def _built(report: Mapping[str, Any]) -> tuple[Argument, list[str]]:
-    """``(argument, [DOT text] or [])`` of ``report``.  One report run shows
-    the argument several times (HTML, Markdown, ``reports/argument.*``) from
-    the same report dict, which no renderer changes; it is built once for
-    that dict."""
-    if not (_last and _last[0][0] is report):
-        _last[:] = [(report, build_argument(report), [])]
-    return _last[0][1], _last[0][2]
+@last_call
+def _built(report: Mapping[str, Any]) -> Argument:
+    """The argument of ``report``.  One report run shows the argument several
+    times (HTML, Markdown, ``reports/argument.*``) from the same report
+    dict, which no renderer changes; it is built once for that dict."""
+    return build_argument(report)
 
 
 def too_large(arg: Argument) -> bool:
@@ -223,10 +219,12 @@ def too_large(arg: Argument) -> bool:
 def argument_dot(report: Mapping[str, Any], fragments: FragmentCache | None = None) -> str:
     """The DOT text of ``report``'s argument, made once per report dict
     (``fragments`` as for :func:`to_dot`)."""
-    arg, dot = _built(report)
-    if not dot:
-        dot.append(to_dot(arg, f"assurance argument of {report['meta']['workspace']}", fragments=fragments))
-    return dot[0]
+    return _dot_text(report, fragments=fragments)
+
+
+@last_call
+def _dot_text(report: Mapping[str, Any], *, fragments: FragmentCache | None) -> str:
+    return to_dot(_built(report), f"assurance argument of {report['meta']['workspace']}", fragments=fragments)
 
 
 def argument_layout(report: Mapping[str, Any], fragments: FragmentCache | None = None) -> Callable[[], diagram.Rendering]:
@@ -235,7 +233,7 @@ def argument_layout(report: Mapping[str, Any], fragments: FragmentCache | None =
     (the fragment cache is not shared between threads), and only when the
     argument is laid out at all; the call itself only waits for Graphviz,
     so it can run in a thread (``fragments`` as for :func:`to_dot`)."""
-    arg = _built(report)[0]
+    arg = _built(report)
     dot = None if too_large(arg) else argument_dot(report, fragments)
     return lambda: layout(arg, dot)
 
@@ -250,7 +248,7 @@ def argument_view(report: Mapping[str, Any], rendering: diagram.Rendering | None
     of inlining it) and ``goals`` (the requirement and contract goals with
     their statuses, for the tables).  ``rendering`` replaces running ``dot``;
     ``fragments`` as for :func:`to_dot`."""
-    arg = _built(report)[0]
+    arg = _built(report)
     large = too_large(arg)
     dot = None if large else argument_dot(report, fragments)
     drawn = layout(arg, dot) if rendering is None or large else rendering
@@ -274,7 +272,7 @@ def write_argument(report: Mapping[str, Any], out_dir: Path, fragments: Fragment
     :data:`FILES` order.  Raises ``KeyError`` for a malformed report and
     ``OSError`` when ``out_dir`` cannot be written.
     """
-    arg = _built(report)[0]
+    arg = _built(report)
     title = f"assurance argument of {report['meta']['workspace']}"
     texts: dict[str, str] = {}
     if FILES[0] in files:

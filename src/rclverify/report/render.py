@@ -27,6 +27,7 @@ from markupsafe import Markup, escape
 
 from ..evidence.records import SEVERITY
 from ..evidence.store import atomic_write_text, dumps
+from ..memo import last_call
 from . import diagram
 from .fragments import FragmentCache, cached_dumps
 
@@ -485,15 +486,9 @@ def _argument(report: Mapping[str, Any], rendering: diagram.Rendering | None,
     return argument_view(report, rendering, fragments)
 
 
-#: The last report whose system diagram was made, and its DOT text (the HTML report's layout and
-#: page both show it: made once per report dict, which no renderer changes).
-_dot_of: list[tuple[Mapping[str, Any], str]] = []
-
-
+@last_call  # the HTML report's layout and page both show it
 def _system_dot(report: Mapping[str, Any]) -> str:
-    if not (_dot_of and _dot_of[0][0] is report):
-        _dot_of[:] = [(report, diagram.system_dot(report["system"], title=f"system model of {report['meta']['workspace']}"))]
-    return _dot_of[0][1]
+    return diagram.system_dot(report["system"], title=f"system model of {report['meta']['workspace']}")
 
 
 def render_html(report: Mapping[str, Any], link_prefix: str = "../",
