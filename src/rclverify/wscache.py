@@ -172,6 +172,8 @@ def save(ws: "Workspace") -> None:
 
 #: Background saves of this process: (pid of the process that forked, pid of the child).
 _PENDING: list[tuple[int, int]] = []
+#: Whether :func:`wait` is registered to run at exit (once per process).
+_registered: list[bool] = []
 
 
 def save_in_background(ws: "Workspace") -> None:
@@ -201,9 +203,6 @@ def save_in_background(ws: "Workspace") -> None:
         atexit.register(wait)
         _registered.append(True)
     _PENDING.append((os.getpid(), pid))
-
-
-_registered: list[bool] = []
 
 
 def wait() -> None:
