@@ -85,3 +85,29 @@ def test_a_completed_run_freezes_the_heap_only_at_exit(monkeypatch: Any) -> None
         rep.complete_run()  # ... and given back when it completes
     assert registered == [gc.freeze]  # once per process, and nothing frozen while it still runs
     assert gc.get_freeze_count() == 0
+
+
+def test_verify_prints_the_summary_written_with_the_report(tmp_path: Any, capsys: Any) -> None:
+    import json
+
+    from doit.exceptions import TaskFailed
+
+    from rclverify.pipeline import Workspace
+    from rclverify.report.summary import summary_data
+    from rclverify.tasks import act_verify
+    report = _report(3)
+    report["meta"]["strict_ok"] = False
+    report["summary"] = {"status": "failed", "headline": "from the JSON report", "problems": ["N7 is bad"]}
+    (tmp_path / "reports").mkdir()
+    (tmp_path / "reports" / "assurance.json").write_text(json.dumps(report))
+    # without the summary file (a report written by an earlier version): taken from the JSON report
+    assert isinstance(act_verify(str(tmp_path), True), TaskFailed)
+    out = capsys.readouterr().out
+    assert "overall: failed -- from the JSON report" in out and "problem: N7 is bad" in out and "N2" in out
+    data = summary_data(report)
+    data["summary"] = {**data["summary"], "headline": "from the summary file"}
+    data["meta"]["strict_ok"] = True
+    (tmp_path / Workspace.SUMMARY).parent.mkdir(parents=True)
+    (tmp_path / Workspace.SUMMARY).write_text(json.dumps(data))
+    assert act_verify(str(tmp_path), True) is None
+    assert "overall: failed -- from the summary file" in capsys.readouterr().out
