@@ -23,6 +23,7 @@ Quantifiers are decided by enumeration:
 from __future__ import annotations
 
 import itertools
+import math
 from fractions import Fraction
 from typing import Any, Callable, Iterable, Mapping
 
@@ -227,6 +228,7 @@ class Evaluator:
         self.values = values
         self._numbers: set[Any] | None = None
         self._slots: dict[int, tuple[list[tuple[str, ...]], list[list[tuple[Any, ...]]]]] = {}
+        self._plans: dict[int, tuple[Any, ...]] = {}
 
     def numbers(self) -> set[Any]:
         if self._numbers is None:
@@ -331,6 +333,12 @@ class Evaluator:
         if op == "<=>":
             return bool(self.eval(e.left, b)) == bool(self.eval(e.right, b))
         x, y = self.eval(e.left, b), self.eval(e.right, b)
+        # REAL is exact (DESIGN.md: REAL -> Z3 Real): a float operand is taken
+        # as the rational it denotes, so no rounding and no overflow to inf
+        if type(x) is float:
+            x = Fraction(x)
+        if type(y) is float:
+            y = Fraction(y)
         if op == "+":
             return x + y
         if op == "-":
@@ -342,7 +350,8 @@ class Evaluator:
         return Fraction(x) / Fraction(y)
 
     # -- quantifiers -------------------------------------------------------------
-    def domain(self, binding: ast.Binding, name: str, body: ast.Expr, b: Mapping[str, Any]) -> list[Any]:
+    def domain(self, binding: ast.Binding, name: str, body: ast.Expr, b: Mapping[str, Any],
+               kind: str = "forall") -> list[Any]:
         dom = binding.domain
         if isinstance(dom, ast.TBase):
             base = dom.name
@@ -360,6 +369,9 @@ class Evaluator:
         if isinstance(typ, T.Scalar) and typ.name == "BOOL":
             return [False, True]
         if isinstance(typ, T.Scalar):
+            bounded = _integer_range(body, name, typ.name, kind)
+            if bounded is not None:
+                return bounded
             return self.candidates(name, typ.name, body, b)
         raise Undecided(f"quantifier over {dom} is not finite")
 
@@ -467,15 +479,25 @@ class Evaluator:
                 self._slots[id(e)] = cached
         slots, doms = cached
         if e.kind in ("forall", "exists"):
-            if e.kind == "forall" and isinstance(e.body, ast.Binary) and e.body.op == "->":
-                guards = _conjuncts(e.body.left)
-            elif e.kind == "exists":
-                guards = _conjuncts(e.body)
-            else:
-                guards = []
-            staged = _stage(guards, slots)
-            found = self._search(e, slots, doms, staged, 0, dict(b))
+            plan = self._plans.get(id(e))
+            if plan is None or plan[0] is not e:
+                if e.kind == "forall" and isinstance(e.body, ast.Binary) and e.body.op == "->":
+                    guards = _conjuncts(e.body.left)
+                elif e.kind == "exists":
+                    guards = _conjuncts(e.body)
+                else:
+                    guards = []
+                staged = _stage(guards, slots)
+                bindings = {n: bd for bd in e.bindings for n in bd.names}
+                pins = [_pin(staged[k], names, bindings, self.env.ctors) for k, names in enumerate(slots)]
+                plan = (e, slots, staged, pins)
+                if id(e) in self._slots:
+                    self._plans[id(e)] = plan
+            found = self._search(e, slots, doms, plan[2], 0, dict(b), plan[3])
             return (not found) if e.kind == "forall" else found
+        for dom in doms:
+            if isinstance(dom, _NoDomain):
+                raise Undecided(dom.reason)
         count = 0
         for combo in itertools.product(*doms):
             cur = dict(b)
@@ -512,7 +534,10 @@ class Evaluator:
                     doms.append(group[1])
                 continue
             slots.append((n,))
-            doms.append([(v,) for v in self.domain(bindings[n], n, e.body, b)])
+            try:
+                doms.append([(v,) for v in self.domain(bindings[n], n, e.body, b, e.kind)])
+            except Undecided as exc:  # may still be pinned by an equality guard (see _search)
+                doms.append(_NoDomain(str(exc)))  # type: ignore[arg-type]
         return slots, doms
 
     def _joint(self, e: ast.Quant, b: Mapping[str, Any],
@@ -552,23 +577,195 @@ class Evaluator:
                     return group, cands
         return None
 
-    def _search(self, e: ast.Quant, slots: list[tuple[str, ...]], doms: list[list[tuple[Any, ...]]],
-                staged: list[list[ast.Expr]], depth: int, cur: dict[str, Any]) -> bool:
+    def _search(self, e: ast.Quant, slots: list[tuple[str, ...]], doms: list[Any],
+                staged: list[list[ast.Expr]], depth: int, cur: dict[str, Any],
+                pins: list[Any] | None = None) -> bool:
         """True when some assignment is a counterexample (forall) or a witness (exists);
-        guards whose variables are all bound are checked as soon as possible."""
+        guards whose variables are all bound are checked as soon as possible.  A slot
+        pinned by a guard ``v == t`` (or ``move(x, y) == t``, ``t`` free of the slot's
+        variables) takes only the value of ``t``: no other value passes that guard."""
         if depth == len(slots):
             v = bool(self.eval(e.body, cur))
             return (not v) if e.kind == "forall" else v
         names = slots[depth]
-        for values in doms[depth]:
+        pin = pins[depth] if pins is not None else None
+        dom: Any = doms[depth]
+        if pin is not None and not (pin.ctor is not None and pin.ctor in cur):
+            dom = pin.values(self.eval(pin.term, cur))
+        elif isinstance(dom, _NoDomain):
+            raise Undecided(dom.reason)
+        for values in dom:
             for n, value in zip(names, values):
                 cur[n] = value.value if isinstance(value, _Fresh) else value
             if all(self.eval(g, cur) for g in staged[depth]):
-                if self._search(e, slots, doms, staged, depth + 1, cur):
+                if self._search(e, slots, doms, staged, depth + 1, cur, pins):
                     return True
         for n in names:
             cur.pop(n, None)
         return False
+
+
+class _NoDomain:
+    """A slot whose values cannot be enumerated (``reason``); usable only when pinned."""
+
+    __slots__ = ("reason",)
+
+    def __init__(self, reason: str) -> None:
+        self.reason = reason
+
+
+def _integral(v: Any) -> int | None:
+    if isinstance(v, bool) or not isinstance(v, (int, float, Fraction)):
+        return None
+    if isinstance(v, int):
+        return v
+    if isinstance(v, float) and not v.is_integer():
+        return None
+    q = Fraction(v)
+    return int(q) if q.denominator == 1 else None
+
+
+def _fit(v: Any, kind: str) -> tuple[bool, Any]:
+    """``(True, v')`` when number ``v`` is a value of ``kind`` (REAL/INTEGER/NATURAL), as ``v'``."""
+    if kind == "REAL":
+        ok = not isinstance(v, bool) and isinstance(v, (int, float, Fraction))
+        return ok, v
+    k = _integral(v)
+    if k is None or (kind == "NATURAL" and k < 0):
+        return False, None
+    return True, k
+
+
+class _Pin:
+    """A guard ``slot == term`` that fixes a slot's values (see ``Evaluator._search``)."""
+
+    __slots__ = ("term", "ctor", "kinds")
+
+    def __init__(self, term: Any, ctor: str | None, kinds: tuple[str, ...]) -> None:
+        self.term, self.ctor, self.kinds = term, ctor, kinds
+
+    def values(self, v: Any) -> list[tuple[Any, ...]]:
+        """The slot's only candidate tuple given the term's value ``v`` (or none)."""
+        if self.ctor is None:
+            args: tuple[Any, ...] = (v,)
+        else:
+            if not isinstance(v, Term) or v.name != self.ctor or len(v.args) != len(self.kinds):
+                return []
+            args = v.args
+        out = []
+        for a, kind in zip(args, self.kinds):
+            ok, a2 = _fit(a, kind)
+            if not ok:
+                return []
+            out.append(a2)
+        return [tuple(out)]
+
+
+def _pin(guards: list[Any], names: tuple[str, ...], bindings: Mapping[str, ast.Binding],
+         ctors: Any) -> _Pin | None:
+    """A guard among ``guards`` of the form ``n == t`` (one variable of REAL/INTEGER/NATURAL)
+    or ``c(n1, ..., nk) == t`` (constructor ``c``, the slot's variables in order), ``t`` not
+    mentioning them."""
+    kinds = []
+    for n in names:
+        dom = bindings[n].domain
+        if not (isinstance(dom, ast.TBase) and dom.name in _INFINITE):
+            return None
+        kinds.append(dom.name)
+    for g in guards:
+        if not isinstance(g, ast.Compare) or tuple(g.ops) != ("==",):
+            continue
+        left, right = g.operands
+        for side, other in ((left, right), (right, left)):
+            ctor: str | None = None
+            if len(names) == 1 and isinstance(side, ast.Var) and side.prefix is None and side.name == names[0]:
+                pass
+            elif (isinstance(side, ast.Apply) and side.func.prefix is None and side.func.name in ctors
+                  and len(side.args) == len(names)
+                  and all(isinstance(a, ast.Var) and a.prefix is None and a.name == n
+                          for a, n in zip(side.args, names))):
+                ctor = side.func.name
+            else:
+                continue
+            used: set[str] = set()
+            _free(other, set(names), used)
+            if not used:
+                return _Pin(other, ctor, tuple(kinds))
+    return None
+
+
+#: The most values a guard-bounded INTEGER/NATURAL quantifier is enumerated over.
+MAX_RANGE = 4096
+_RANGES: dict[tuple[int, str, str, str], tuple[Any, Any]] = {}
+
+
+def _bound_of(e: Any, name: str) -> tuple[str, Fraction] | None:
+    """``("hi"|"lo", c)`` when guard ``e`` is ``name <= c``, ``name < c``,
+    ``c >= name``, ... with a numeric literal ``c`` (integer-rounded)."""
+    if not isinstance(e, ast.Compare) or len(e.ops) != 1:
+        return None
+    op, (a, c) = e.ops[0], e.operands
+
+    def lit(x: Any) -> Fraction | None:
+        if isinstance(x, ast.NumLit):
+            return Fraction(x.value)
+        if isinstance(x, ast.Unary) and x.op == "-" and isinstance(x.operand, ast.NumLit):
+            return -Fraction(x.operand.value)
+        return None
+
+    def is_name(x: Any) -> bool:
+        return isinstance(x, ast.Var) and x.prefix is None and x.name == name
+    flip = {"<": ">", "<=": ">=", ">": "<", ">=": "<="}
+    if is_name(c) and lit(a) is not None and op in flip:
+        op, a, c = flip[op], c, a
+    k = lit(c)
+    if not is_name(a) or k is None:
+        return None
+    if op == "<=":
+        return "hi", Fraction(math.floor(k))
+    if op == "<":
+        return "hi", Fraction(math.ceil(k) - 1)
+    if op == ">=":
+        return "lo", Fraction(math.ceil(k))
+    if op == ">":
+        return "lo", Fraction(math.floor(k) + 1)
+    return None
+
+
+def _integer_range(body: Any, name: str, scalar: str, kind: str) -> list[int] | None:
+    """Every value of an INTEGER/NATURAL variable ``name`` that can make the
+    quantifier's body differ from its value outside a literal bound: the
+    bound comes from the guard (the conjuncts left of ``->`` under
+    ``forall``, the conjuncts of the body under ``exists``/``exists_unique``),
+    and outside it the body is TRUE (forall) or FALSE (exists), so only the
+    values inside matter.  ``None`` when there is no such finite range (or it
+    has more than :data:`MAX_RANGE` values)."""
+    if scalar not in ("INTEGER", "NATURAL"):
+        return None
+    key = (id(body), name, scalar, kind)
+    hit = _RANGES.get(key)
+    if hit is not None and hit[0] is body:
+        return hit[1]
+    if kind == "forall":
+        guards = _conjuncts(body.left) if isinstance(body, ast.Binary) and body.op == "->" else []
+    else:
+        guards = _conjuncts(body)
+    lo: Fraction | None = Fraction(0) if scalar == "NATURAL" else None
+    hi: Fraction | None = None
+    for g in guards:
+        found = _bound_of(g, name)
+        if found is None:
+            continue
+        side, k = found
+        if side == "hi":
+            hi = k if hi is None else min(hi, k)
+        else:
+            lo = k if lo is None else max(lo, k)
+    result = None
+    if lo is not None and hi is not None and hi - lo < MAX_RANGE:
+        result = list(range(int(lo), int(hi) + 1))
+    _RANGES[key] = (body, result)
+    return result
 
 
 def _fits(v: Any, kind: str) -> bool:

@@ -4,15 +4,18 @@ Shared by the backend (:mod:`.backend`) and the pytest files it writes under
 ``artifacts/property_tests/<Node>/``, so that both check exactly the same
 thing (docs/property-tests.md).
 
-Per example: inputs are drawn (:mod:`.strategies`) and kept only when Z3
-says the node's assumption holds on them (a filter, so Hypothesis's
+Per example: inputs are drawn (:mod:`.strategies`) and kept only when the
+node's assumption holds on them (a filter, so Hypothesis's
 ``filter_too_much`` health check watches the rejection rate); the
 implementation is called with one keyword argument per input; its outputs
 must be a mapping with exactly the node's output names, each value of its
 RCL type (:func:`rclverify.values.conforms`); then every top-level conjunct
-of the guarantee is checked on the inputs and outputs by Z3
-(:func:`rclverify.logic.concrete.check_concrete`).  A violation is shrunk by
-Hypothesis; Z3's ``unknown`` counts as inconclusive, never as passed.
+of the guarantee is checked on the inputs and outputs
+(:func:`rclverify.logic.decide.decide`: direct evaluation, Z3 only where it
+cannot decide).  A violation is shrunk by Hypothesis; Z3's ``unknown``
+counts as inconclusive, never as passed.  The reported counterexample is
+confirmed by Z3 (:func:`rclverify.logic.concrete.check_concrete`): the facts
+hold on its inputs and its outputs violate the conjunct.
 """
 from __future__ import annotations
 
@@ -31,6 +34,7 @@ from hypothesis import strategies as st
 from hypothesis.errors import FailedHealthCheck, Unsatisfiable
 
 from ...logic.concrete import check_concrete
+from ...logic.decide import decide
 from ...logic.encode import EncodingError
 from ...rcl import ast
 from ...rcl.printer import expr_to_rcl
@@ -189,6 +193,8 @@ class GuaranteeRun:
     stop_at_failure: bool = True  # False: count violations and go on (benchmarks); no shrinking then
     counts: Counts = field(default_factory=Counts)
     last_failure: dict[str, str] | None = None
+    #: the values, outputs and conjunct of ``last_failure`` (for the Z3 confirmation)
+    last_values: tuple[dict[str, Any], dict[str, Any] | None, ast.Expr | None] | None = None
     unknown: set[str] = field(default_factory=set)
 
     @property
@@ -198,7 +204,7 @@ class GuaranteeRun:
     def assumption_holds(self, values: Mapping[str, Any]) -> bool:
         self.counts.drawn += 1
         for clause in self.node.node.assumes:
-            ok, why = check_concrete(clause.formula, self.checked, self.node, values)
+            ok, why = decide(clause.formula, self.checked, self.node, values)
             if ok is None:
                 self.counts.assumption_unknown += 1
                 self.unknown.add(f"assumption: {why}")
@@ -206,7 +212,7 @@ class GuaranteeRun:
                 self.counts.rejected += 1
                 return False
         for fact in self.used_facts:
-            ok, why = check_concrete(fact, self.checked, self.node, values)
+            ok, why = decide(fact, self.checked, self.node, values)
             if ok is None:
                 self.counts.assumption_unknown += 1
                 self.unknown.add(f"fact: {why}")
@@ -252,6 +258,7 @@ class GuaranteeRun:
             cex["facts"] = f"{self.facts_text()}: all hold on these inputs (checked by Z3)"
         cex["reason"] = reason
         self.last_failure = cex
+        self.last_values = (dict(inputs), None if outputs is None else dict(outputs), conjunct)
         if self.stop_at_failure:
             raise _Violation(reason)
 
@@ -281,7 +288,7 @@ class GuaranteeRun:
         values = {**inputs, **{f"out.{k}": v for k, v in outputs.items()}}
         g = self.node.node.guarantees[self.guarantee - 1]
         for c in conjuncts(g.formula):
-            ok, why = check_concrete(c, self.checked, self.node, values)
+            ok, why = decide(c, self.checked, self.node, values)
             if ok is None:
                 self.counts.inconclusive += 1
                 self.unknown.add(why)
@@ -307,6 +314,27 @@ class GuaranteeRun:
                         # the counterexample does not already say
                         phases=[Phase.explicit, Phase.reuse, Phase.generate, Phase.target, Phase.shrink])
 
+    def confirm_with_z3(self) -> str:
+        """Re-check the reported counterexample with Z3 alone: every used fact
+        holds on its inputs and its outputs violate the conjunct.  Returns ''
+        when Z3 confirms it (or answers unknown: then direct evaluation's
+        verdict stands), else a message saying where the engines disagree."""
+        if self.last_values is None:
+            return ""
+        inputs, outputs, conjunct = self.last_values
+        for fact in self.used_facts:
+            ok, _ = check_concrete(fact, self.checked, self.node, inputs)
+            if ok is False:
+                return (f"internal: direct evaluation and Z3 disagree on the fact {expr_to_rcl(fact)} "
+                        f"for the counterexample {_example_text(self.last_failure or {})}")
+        if conjunct is not None and outputs is not None:
+            values = {**inputs, **{f"out.{k}": v for k, v in outputs.items()}}
+            ok, _ = check_concrete(conjunct, self.checked, self.node, values)
+            if ok is True:
+                return (f"internal: direct evaluation and Z3 disagree on {expr_to_rcl(conjunct)} "
+                        f"for the counterexample {_example_text(self.last_failure or {})}")
+        return ""
+
     def run(self) -> Outcome:
         """Run Hypothesis; never raises for a failing, inconclusive or starved run."""
         test = hypothesis.seed(self.cfg.seed)(self.settings()(given(self.strategy())(self.body)))
@@ -314,6 +342,13 @@ class GuaranteeRun:
             test()
         except _Violation as exc:
             assert self.last_failure is not None
+            try:
+                wrong = self.confirm_with_z3()
+            except EncodingError as enc:
+                return Outcome("error", f"Z3 cannot express the formula: {enc}", self.counts, None,
+                               sorted(self.unknown))
+            if wrong:
+                return Outcome("error", wrong, self.counts, None, sorted(self.unknown))
             return Outcome("failed", f"{exc} on the shrunk example {_example_text(self.last_failure)}",
                            self.counts, self.last_failure, sorted(self.unknown))
         except (FailedHealthCheck, Unsatisfiable) as exc:
@@ -327,6 +362,9 @@ class GuaranteeRun:
             return Outcome("error", f"Z3 cannot express the formula: {exc}", self.counts, None, sorted(self.unknown))
         if self.counts.failures:  # only without stop_at_failure: the last violation, not shrunk
             assert self.last_failure is not None
+            wrong = self.confirm_with_z3()
+            if wrong:
+                return Outcome("error", wrong, self.counts, None, sorted(self.unknown))
             return Outcome("failed", f"{self.counts.failures} example(s) violate guarantee {self.guarantee}, e.g. "
                            f"{_example_text(self.last_failure)} (not shrunk)", self.counts, self.last_failure,
                            sorted(self.unknown))

@@ -14,7 +14,8 @@ constrained by the node's assumption (docs/property-tests.md, "Strategies").
   functions over the same domain (the Agent's ``at`` and ``wayP``) share
   their points; values inside tables are small (NATURAL 0..5, INTEGER -5..5).
 * What the bounds do not capture is enforced by filtering with the whole
-  assumption, checked by Z3 (:func:`~rclverify.logic.concrete.check_concrete`).
+  assumption, checked by :func:`~rclverify.logic.decide.decide` (direct evaluation, Z3 where
+  it cannot decide).
 """
 from __future__ import annotations
 
