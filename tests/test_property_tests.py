@@ -197,14 +197,14 @@ def test_check_concrete_rejects_unknown_name(checked: Any) -> None:
 
 def test_z3_unknown_is_inconclusive_never_passed(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     from rclverify.backends.property_tests import harness
-    real = harness.check_concrete
+    real = harness.decide
 
     def unknown_on_guarantee(formula: Any, checked: Any, node: Any, values: Any, **kw: Any) -> Any:
         if any(k.startswith("out.") for k in values):  # the guarantee check, not the assumption's
             return None, "timeout"
         return real(formula, checked, node, values, **kw)
 
-    monkeypatch.setattr(harness, "check_concrete", unknown_on_guarantee)
+    monkeypatch.setattr(harness, "decide", unknown_on_guarantee)
     ev = run(workspace(tmp_path, GOOD))
     assert ev.status == "inconclusive"
     assert ev.details["examples"]["inconclusive"] == 100 and ev.details["unknown_reasons"] == ["timeout"]

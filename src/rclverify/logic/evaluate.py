@@ -104,51 +104,77 @@ def _shift(e: Any, name: str) -> Fraction | None:
     return None
 
 
-def _offsets(e: Any, name: str, out: set[Fraction]) -> bool:
-    """Collect the shifts under which ``name`` occurs in ``e``; False on a use
-    that is not an argument or an ``==``/``!=`` operand."""
-    if isinstance(e, ast.Quant) and name in e.variables:
+def _closed(e: Any, local: frozenset[str], refs: set[str]) -> bool:
+    """Does every value of ``e`` come from a finite, known set: a literal, an I/O
+    variable's value, a function's result (its table's results or default), or
+    a variable bound outside the quantifier (named in ``refs``)?  ``local``:
+    the variables of the quantifier under analysis and of those inside it."""
+    if isinstance(e, ast.NumLit):
         return True
+    if isinstance(e, ast.Unary) and e.op == "-" and isinstance(e.operand, ast.NumLit):
+        return True
+    if isinstance(e, ast.Var):
+        if e.prefix is None:
+            if e.name in local:
+                return False
+            refs.add(e.name)
+        return True
+    return isinstance(e, ast.Apply)
+
+
+def _offsets(e: Any, name: str, out: set[Fraction], local: frozenset[str] = frozenset(),
+             refs: set[str] | None = None) -> bool:
+    """Collect the shifts under which ``name`` occurs in ``e``; False on a use
+    that is not an argument or an ``==``/``!=`` operand compared with a
+    :func:`_closed` term (bare names on such other sides go to ``refs``)."""
+    if refs is None:
+        refs = set()
+    if isinstance(e, ast.Quant):
+        if name in e.variables:
+            return True
+        local = local | frozenset(e.variables)
     if isinstance(e, ast.Apply):
         for a in e.args:
             k = _shift(a, name)
             if k is not None:
                 out.add(k)
-            elif not _offsets(a, name, out):
+            elif not _offsets(a, name, out, local, refs):
                 return False
         return True
     if isinstance(e, ast.Compare):
         for op, (a, b) in zip(e.ops, zip(e.operands, e.operands[1:])):
-            for side in (a, b):
+            for side, other in ((a, b), (b, a)):
                 k = _shift(side, name)
                 if k is not None:
-                    if op not in ("==", "!="):
+                    if op not in ("==", "!=") or not _closed(other, local | {name}, refs):
                         return False
                     out.add(k)
-                elif not _offsets(side, name, out):
+                elif not _offsets(side, name, out, local, refs):
                     return False
         return True
     if isinstance(e, ast.Var):
         return not (e.prefix is None and e.name == name)
-    return all(_offsets(c, name, out) for c in _children(e))
+    return all(_offsets(c, name, out, local, refs) for c in _children(e))
 
 
 _STATIC: dict[tuple[int, str, str], tuple[Any, Any]] = {}
 
 
-def _static_shifts(body: Any, name: str) -> set[Fraction] | None:
-    """:func:`_offsets` of ``body`` for ``name`` plus 0, memoised per AST node
-    (the node is kept in the memo, so its id stays its own); None when ``name``
-    has a use that is not an argument or an equality operand."""
-    key = (id(body), name, "shifts")
+def _static_shifts(body: Any, name: str, local: frozenset[str] = frozenset()) -> tuple[set[Fraction], frozenset[str]] | None:
+    """:func:`_offsets` of ``body`` for ``name`` plus 0, and the bare names it
+    is compared with, memoised per AST node (the node is kept in the memo, so
+    its id stays its own); None when ``name`` has a use that is not an argument
+    or an equality with a closed term.  ``local``: the quantifier's variables."""
+    key = (id(body), name, "shifts:" + ",".join(sorted(local)))
     hit = _STATIC.get(key)
     if hit is not None and hit[0] is body:
-        return set(hit[1]) if hit[1] is not None else None
+        return (set(hit[1][0]), hit[1][1]) if hit[1] is not None else None
     shifts: set[Fraction] = set()
-    ok = _offsets(body, name, shifts)
-    result = frozenset(shifts | {Fraction(0)}) if ok else None
+    refs: set[str] = set()
+    ok = _offsets(body, name, shifts, frozenset(local) | {name}, refs)
+    result = (frozenset(shifts | {Fraction(0)}), frozenset(refs)) if ok else None
     _STATIC[key] = (body, result)
-    return set(result) if result is not None else None
+    return (set(result[0]), result[1]) if result is not None else None
 
 
 def _static_literals(body: Any) -> set[Any]:
@@ -215,6 +241,8 @@ def _numbers(v: Any, out: set[Any]) -> None:
 def _literals(e: Any, out: set[Any]) -> None:
     if isinstance(e, ast.NumLit):
         out.add(e.value)
+    if isinstance(e, ast.Unary) and e.op == "-" and isinstance(e.operand, ast.NumLit):
+        out.add(-e.operand.value)
     for c in _children(e):
         _literals(c, out)
 
@@ -229,6 +257,7 @@ class Evaluator:
         self._numbers: set[Any] | None = None
         self._slots: dict[int, tuple[list[tuple[str, ...]], list[list[tuple[Any, ...]]]]] = {}
         self._plans: dict[int, tuple[Any, ...]] = {}
+        self.uncacheable = False  # set when a quantifier's candidates depend on outer bound values
 
     def numbers(self) -> set[Any]:
         if self._numbers is None:
@@ -351,7 +380,7 @@ class Evaluator:
 
     # -- quantifiers -------------------------------------------------------------
     def domain(self, binding: ast.Binding, name: str, body: ast.Expr, b: Mapping[str, Any],
-               kind: str = "forall") -> list[Any]:
+               kind: str = "forall", local: tuple[str, ...] = ()) -> list[Any]:
         dom = binding.domain
         if isinstance(dom, ast.TBase):
             base = dom.name
@@ -372,15 +401,26 @@ class Evaluator:
             bounded = _integer_range(body, name, typ.name, kind)
             if bounded is not None:
                 return bounded
-            return self.candidates(name, typ.name, body, b)
+            return self.candidates(name, typ.name, body, b, local)
         raise Undecided(f"quantifier over {dom} is not finite")
 
-    def candidates(self, name: str, scalar: str, body: ast.Expr, b: Mapping[str, Any]) -> list[Any]:
-        shifts = _static_shifts(body, name)
-        if shifts is None:
-            raise Undecided(f"{name} ranges over {scalar} and is used outside equalities and arguments")
+    def candidates(self, name: str, scalar: str, body: ast.Expr, b: Mapping[str, Any],
+                   local: tuple[str, ...] = ()) -> list[Any]:
+        found_shifts = _static_shifts(body, name, frozenset(local))
+        if found_shifts is None:
+            raise Undecided(f"{name} ranges over {scalar} and is used outside equalities (with a literal, an "
+                            f"I/O value, a function's result or an outer variable) and arguments")
+        shifts, refs = found_shifts
         shifts.add(Fraction(0))
         base: set[Any] = set(self.numbers()) | _static_literals(body)
+        for r in refs:  # outer bound variables and named constants the variable is compared with
+            if r in b:
+                self.uncacheable = True
+                v = b[r]
+                base.add(v.value if isinstance(v, _Fresh) else v)
+            elif r in self.env.constants:
+                base.add(self.eval(self.env.constants[r][1], {}))
+        base = {v for v in base if not isinstance(v, bool) and isinstance(v, (int, float, Fraction))}
         local: set[Any] = set()
         if self._positional(body, name, b, local):
             found = _static_literals(body)
@@ -474,8 +514,9 @@ class Evaluator:
     def quant(self, e: ast.Quant, b: Mapping[str, Any]) -> bool:
         cached = self._slots.get(id(e))
         if cached is None:
+            self.uncacheable = False
             cached = self.slots(e, b)
-            if not any(isinstance(bd.domain, (ast.SetLit, ast.Var)) for bd in e.bindings):
+            if not self.uncacheable and not any(isinstance(bd.domain, (ast.SetLit, ast.Var)) for bd in e.bindings):
                 self._slots[id(e)] = cached
         slots, doms = cached
         if e.kind in ("forall", "exists"):
@@ -535,7 +576,7 @@ class Evaluator:
                 continue
             slots.append((n,))
             try:
-                doms.append([(v,) for v in self.domain(bindings[n], n, e.body, b, e.kind)])
+                doms.append([(v,) for v in self.domain(bindings[n], n, e.body, b, e.kind, tuple(e.variables))])
             except Undecided as exc:  # may still be pinned by an equality guard (see _search)
                 doms.append(_NoDomain(str(exc)))  # type: ignore[arg-type]
         return slots, doms
