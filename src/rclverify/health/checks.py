@@ -25,7 +25,7 @@ not decide within the timeout; never counted as ok).
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, field, replace
+from dataclasses import replace
 from typing import Any, Sequence
 
 import z3
@@ -37,34 +37,14 @@ from ..rcl import ast
 from ..rcl.printer import expr_to_rcl
 from ..rcl.typecheck import domain_type
 from ..rcl.types import NATURAL, Checked, CheckedNode
+from .finding import Finding as Finding  # re-exported: callers import it from here too
+from .shape import shape_findings
 
 HEALTH_TIMEOUT_MS = 5_000
 #: Timeout of one per-instance premise query, and how many undecided
 #: instances in a row (with no vacuous one found) end the scan.
 INSTANCE_TIMEOUT_MS = 2_000
 GIVE_UP_AFTER = 3
-
-
-@dataclass(frozen=True)
-class Finding:
-    id: str
-    node: str
-    check: str
-    guarantee: int | None
-    status: str
-    message: str
-    explanation: str
-    model: dict[str, str] | None = None
-    core: list[str] | None = None
-    duration_s: float = 0.0
-    instances: dict[str, str] | None = None
-    smt2: str = field(default="", compare=False)
-
-    def to_json(self) -> dict[str, Any]:
-        return {"id": self.id, "node": self.node, "check": self.check, "guarantee": self.guarantee,
-                "status": self.status, "message": self.message, "explanation": self.explanation,
-                "model": self.model, "core": self.core, "duration_s": self.duration_s,
-                "instances": self.instances}
 
 
 def _where(l: ast.Loc) -> str:
@@ -200,7 +180,6 @@ def check_node(checked: Checked, node: str, facts: Sequence[tuple[ast.Expr, ast.
         f = _non_vacuity(h, n, k)
         if f is not None:  # only implications have a premise that can be vacuous
             out.append(f)
-    from .shape import shape_findings  # shape builds on Finding: imported here to avoid a cycle
     out += shape_findings(checked, node)
     return out
 

@@ -34,7 +34,7 @@ from ..logic.query import prove
 from ..rcl import ast
 from ..rcl.printer import expr_to_rcl
 from ..rcl.types import Checked, CheckedNode
-from .checks import Finding
+from .finding import Finding
 
 SHAPE_TIMEOUT_MS = 2_000
 

@@ -25,7 +25,7 @@ from __future__ import annotations
 import itertools
 import math
 from fractions import Fraction
-from typing import Any, Callable, Iterable, Mapping
+from typing import Any, Callable, Iterable, Mapping, cast
 
 from ..rcl import ast
 from ..rcl import types as T
@@ -380,7 +380,7 @@ class Evaluator:
 
     # -- quantifiers -------------------------------------------------------------
     def domain(self, binding: ast.Binding, name: str, body: ast.Expr, b: Mapping[str, Any],
-               kind: str = "forall", local: tuple[str, ...] = ()) -> list[Any]:
+               kind: str = "forall", qvars: tuple[str, ...] = ()) -> list[Any]:
         dom = binding.domain
         if isinstance(dom, ast.TBase):
             base = dom.name
@@ -401,12 +401,12 @@ class Evaluator:
             bounded = _integer_range(body, name, typ.name, kind)
             if bounded is not None:
                 return bounded
-            return self.candidates(name, typ.name, body, b, local)
+            return self.candidates(name, typ.name, body, b, qvars)
         raise Undecided(f"quantifier over {dom} is not finite")
 
     def candidates(self, name: str, scalar: str, body: ast.Expr, b: Mapping[str, Any],
-                   local: tuple[str, ...] = ()) -> list[Any]:
-        found_shifts = _static_shifts(body, name, frozenset(local))
+                   qvars: tuple[str, ...] = ()) -> list[Any]:
+        found_shifts = _static_shifts(body, name, frozenset(qvars))
         if found_shifts is None:
             raise Undecided(f"{name} ranges over {scalar} and is used outside equalities (with a literal, an "
                             f"I/O value, a function's result or an outer variable) and arguments")
@@ -757,18 +757,19 @@ def _bound_of(e: Any, name: str) -> tuple[str, Fraction] | None:
     def is_name(x: Any) -> bool:
         return isinstance(x, ast.Var) and x.prefix is None and x.name == name
     flip = {"<": ">", "<=": ">=", ">": "<", ">=": "<="}
+    rel: str = op
     if is_name(c) and lit(a) is not None and op in flip:
-        op, a, c = flip[op], c, a
+        rel, a, c = flip[op], c, a
     k = lit(c)
     if not is_name(a) or k is None:
         return None
-    if op == "<=":
+    if rel == "<=":
         return "hi", Fraction(math.floor(k))
-    if op == "<":
+    if rel == "<":
         return "hi", Fraction(math.ceil(k) - 1)
-    if op == ">=":
+    if rel == ">=":
         return "lo", Fraction(math.ceil(k))
-    if op == ">":
+    if rel == ">":
         return "lo", Fraction(math.floor(k) + 1)
     return None
 
@@ -786,7 +787,7 @@ def _integer_range(body: Any, name: str, scalar: str, kind: str) -> list[int] | 
     key = (id(body), name, scalar, kind)
     hit = _RANGES.get(key)
     if hit is not None and hit[0] is body:
-        return hit[1]
+        return cast("list[int] | None", hit[1])
     if kind == "forall":
         guards = _conjuncts(body.left) if isinstance(body, ast.Binary) and body.op == "->" else []
     else:
