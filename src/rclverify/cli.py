@@ -256,7 +256,9 @@ def cmd_refines(args: argparse.Namespace) -> int:
 
 def cmd_monitor(args: argparse.Namespace) -> int:
     from .backends.monitors.cli import monitor_command
-    return monitor_command(args)
+    from .pipeline import Workspace
+    checked = Workspace(Path(args.workspace), args.plan).checked  # raises RclError, printed located by main
+    return monitor_command(args, checked)
 
 
 def main(argv: Sequence[str] | None = None) -> int:

@@ -13,18 +13,18 @@ from pathlib import Path
 from typing import Any
 
 from ...rcl.errors import RclError
+from ...rcl.types import Checked
 from ...traces import TraceError, read_trace
 from .backend import monitoring_details, summary_line, tool_versions, verdict_status
 from .check import check_trace
 from .config import ConfigError, load_mapping
 
 
-def monitor_command(args: argparse.Namespace) -> int:
-    """Run the command; returns the exit code (never raises for user input)."""
-    from ...pipeline import Workspace
+def monitor_command(args: argparse.Namespace, checked: Checked) -> int:
+    """Run the command on the workspace's checked contracts ``checked`` (the
+    caller, rclverify.cli, loads them: a backend does not import the
+    pipeline); returns the exit code (never raises for user input)."""
     root = Path(args.workspace)
-    ws = Workspace(root, args.plan)
-    checked = ws.checked  # raises RclError, printed located by the caller
     try:
         cfg = load_mapping(root, args.mapping, args.horizon)
     except ConfigError as exc:

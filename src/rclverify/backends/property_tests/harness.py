@@ -393,13 +393,3 @@ def run_guarantee(checked: Checked, node: CheckedNode, guarantee: int, cfg: Conf
 def versions() -> str:
     """``hypothesis <v>; z3 <v>`` of this process."""
     return f"hypothesis {hypothesis.__version__}; z3 {z3.get_version_string()}"
-
-
-def check_from_workspace(root: Path, plan_file: str, node: str, entry: int, guarantee: int) -> Outcome:
-    """What a generated pytest file calls: rebuild the node's target from the
-    workspace at ``root`` and run one guarantee, exactly as the backend does."""
-    from ...pipeline import Workspace
-    ws = Workspace(root, plan_file)
-    target = ws.target(node, entry)
-    cfg = read_config(target.config, target.node, target.root)
-    return run_guarantee(target.checked, target.node, guarantee, cfg, target.root, target.facts)
