@@ -31,6 +31,7 @@ import copy
 from dataclasses import dataclass
 from typing import Any
 
+from ...logic.world import on_fresh
 from ..base import NodeTarget
 
 #: Most triples kept at once (each holds its Z3 terms and rendered texts, some 10 kB).
@@ -67,6 +68,7 @@ def _inputs(target: NodeTarget) -> _Inputs:
 
 
 _KEPT: dict[tuple[str, str, int, str], tuple[_Inputs, Any]] = {}
+on_fresh(_KEPT.clear)  # its triples hold Z3 terms of the context they were made in (rclverify.logic.world)
 
 
 def _key(target: NodeTarget, obligation_id: str) -> tuple[str, str, int, str]:
