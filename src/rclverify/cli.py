@@ -21,10 +21,11 @@ mistake prints ``file:line:col: error: message`` lines, never a traceback.
 from __future__ import annotations
 
 import argparse
+import json
 import os
 import sys
 from pathlib import Path
-from typing import Callable, Sequence
+from typing import Any, Callable, Sequence
 
 from .rcl.errors import RclError
 
@@ -201,6 +202,33 @@ def cmd_init(args: argparse.Namespace) -> int:
     return 0
 
 
+def _report_out_of_date(ws: Any) -> list[str]:
+    """Why the written report no longer says what the evidence says (empty
+    when it does, when there is no report yet, or when the workspace does not
+    check: then the bundle packs what there is, as before).  The report is
+    built again in memory from the recorded artifacts, each evidence
+    record's inputs hashed anew against the current contracts and files
+    (docs/integrity.md); an obligation whose status differs from the written
+    report's is listed: an assessor's bundle never holds a report that
+    calls stale or altered evidence anything else."""
+    from .report.build import build_report
+    try:
+        written = json.loads(ws.path("reports/assurance.json").read_text(encoding="utf-8"))
+        was = {o["id"]: o["status"] for o in written["obligations"]}
+    except (OSError, ValueError, KeyError, TypeError):
+        return []
+    try:
+        now = {o["id"]: o["status"] for o in build_report(ws)["obligations"]}
+    except RclError:
+        return []
+    changed = sorted(k for k in now if was.get(k) != now[k])
+    if not changed:
+        return []
+    shown = ", ".join(f"{k} ({was.get(k, 'absent')} -> {now[k]})" for k in changed[:5])
+    return [f"reports/assurance.json is out of date: {len(changed)} obligation(s) have another status now: "
+            f"{shown}{' ...' if len(changed) > 5 else ''}; run `rclverify report` (or `doit verify`) first"]
+
+
 def cmd_bundle(args: argparse.Namespace) -> int:
     """Write the assessor's bundle, or (``--verify FILE``) check one against its manifest."""
     from .bundle.archive import verify_bundle, write_bundle
@@ -215,6 +243,11 @@ def cmd_bundle(args: argparse.Namespace) -> int:
         print(f"{args.verify}: {len(manifest['files'])} file(s) match MANIFEST.json")
         return 0
     ws = _ws(args)
+    problems = _report_out_of_date(ws)
+    if problems:
+        for problem in problems:
+            print(f"{args.workspace}: error: {problem}", file=sys.stderr)
+        return 1
     name = "".join(c if c.isalnum() or c in "-_." else "-" for c in (ws.plan.name or ws.root.resolve().name)).strip("-")
     out = Path(args.output) if args.output else Path(f"{name or 'workspace'}-bundle.tar.gz")
     try:

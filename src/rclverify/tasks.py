@@ -214,6 +214,45 @@ def act_verify(root: str, strict: bool) -> Any:
     return None
 
 
+class RecordIntact:
+    """doit ``uptodate`` check of an evidence task: its record is as rclverify
+    wrote it.  A record changed by anything else (a hand edit of its status)
+    makes the task run again, so ``doit verify`` produces the evidence anew
+    instead of believing it (the report of a run that does not re-run it,
+    ``rclverify report``, shows it as ``error``: evidence altered).
+
+    Cheap on a no-op run: after the task ran, the record's size and
+    modification time are saved with doit's task values; while they are the
+    same the record is not read.  Otherwise its seal is checked
+    (:meth:`rclverify.evidence.store.EvidenceStore.read`)."""
+
+    __signature__ = inspect.Signature([inspect.Parameter("task", inspect.Parameter.POSITIONAL_OR_KEYWORD),
+                                       inspect.Parameter("values", inspect.Parameter.POSITIONAL_OR_KEYWORD)])
+
+    def __call__(self, task: Any, values: Mapping[str, Any]) -> bool:
+        target = task.targets[0]
+
+        def stat() -> dict[str, Any]:
+            try:
+                st = os.stat(target)
+            except OSError:
+                return {}
+            return {"_record_stat": [st.st_mtime_ns, st.st_size]}
+        task.value_savers.append(stat)
+        now = stat()
+        if not now:
+            return False
+        if values.get("_record_stat") == now["_record_stat"]:
+            return True
+        from .evidence.store import EvidenceStore
+        root, _, name = target.rpartition("/artifacts/evidence/")
+        ev, problem = EvidenceStore(Path(root)).read(name[:-len(".json")])
+        if problem:
+            print(f"{os.path.relpath(target, root)}: {problem}: producing it again")
+            return False
+        return ev is not None
+
+
 def strict_uptodate(task: Any, values: Any) -> bool:
     """``verify`` is up to date unless ``--strict`` asks for the check again."""
     return not bool(task.options.get("strict"))
@@ -250,6 +289,16 @@ def _inputs(config: Any, root: Path, seen: dict[str, tuple[str, ...]]) -> list[s
                 walk(x)
     walk(dict(config))
     return sorted(out)
+
+
+def _z3_version() -> str:
+    """The installed z3-solver's version (from its metadata: importing Z3 costs a no-op run
+    a fifth of a second).  Every verdict comes from Z3, so another version makes them again."""
+    from importlib.metadata import PackageNotFoundError, version
+    try:
+        return version("z3-solver")
+    except PackageNotFoundError:
+        return "-"
 
 
 def _tool_fingerprint() -> dict[str, Any]:
@@ -353,12 +402,17 @@ def _build_tasks(root: str | Path, plan_file: str) -> dict[str, Callable[[], Any
         return f"{r}/{rel}"
 
     snap = {n: at(ws.snapshot(n)) for n in nodes}
+    # Every task that makes a result depends on the rclverify code that makes it: another version
+    # (an upgrade, a changed module) makes every result again, as a clean run would.
+    code_version = {"rclverify": wscache.code_stamp(), "z3": _z3_version()}
+    code = config_changed(code_version)
+    code.__signature__ = inspect.signature(code)  # answered at once by doit (see task_evidence)
 
     def task_check() -> dict[str, Any]:
         """Parse and type-check the contracts, check the plan, lint, build the system model."""
         return {"actions": [(act_check, [r])], "file_dep": [str(rootp / plan_file)] + contract_deps,
                 "targets": list(snap.values()) + [str(rootp / p) for p in (ws.MODEL, ws.DIAGNOSTICS)],
-                "verbosity": 2, "clean": True}
+                "uptodate": [code], "verbosity": 2, "clean": True}
 
     def task_graph() -> dict[str, Any]:
         """Write the system model as DOT and, with graphviz, draw it as SVG (doit graph)."""
@@ -382,7 +436,7 @@ def _build_tasks(root: str | Path, plan_file: str) -> dict[str, Callable[[], Any
             yield {"name": n, "actions": [(act_node, [r, n, deps])],
                    "file_dep": sorted({d for ds in deps.values() for d in ds}),
                    "targets": [at(ws.calculus(n)), at(ws.health(n)), at(ws.obligations(n))],
-                   "verbosity": 2, "clean": True}
+                   "uptodate": [code], "verbosity": 2, "clean": True}
 
     exported_memo: list[list[tuple[str, dict[str, Any]]]] = []
 
@@ -411,8 +465,11 @@ def _build_tasks(root: str | Path, plan_file: str) -> dict[str, Callable[[], Any
         # obligation).  doit inspects an uptodate callable's signature for every task on every run
         # (2000 `inspect.signature` calls, a third of a second at 1000 nodes); a precomputed
         # `__signature__` (PEP 362) answers it at once.
-        tools_unchanged = config_changed(_tool_fingerprint())
+        # One config_changed per task: doit saves every config_changed of a task under one key, so a
+        # second one would overwrite the first's value and the task would never be up to date.
+        tools_unchanged = config_changed({**_tool_fingerprint(), **code_version})
         tools_unchanged.__signature__ = inspect.signature(tools_unchanged)
+        record_intact = RecordIntact()
         input_file: dict[str, str | None] = {}  # input -> its absolute path when it is a file (one stat per input)
 
         def input_dep(rel: str) -> str | None:
@@ -424,7 +481,7 @@ def _build_tasks(root: str | Path, plan_file: str) -> dict[str, Callable[[], Any
             deps = [at(ws.obligation(n, o["id"]))]
             deps += [d for d in map(input_dep, o["inputs"]) if d is not None]
             yield {"name": o["id"], "actions": [(act_run, [r, n, o["id"]])], "file_dep": sorted(set(deps)),
-                   "targets": [at(ws.evidence(o["id"]))], "uptodate": [tools_unchanged],
+                   "targets": [at(ws.evidence(o["id"]))], "uptodate": [tools_unchanged, record_intact],
                    "verbosity": 2, "clean": True}
 
     @create_after(executed="evidence")
@@ -432,13 +489,15 @@ def _build_tasks(root: str | Path, plan_file: str) -> dict[str, Callable[[], Any
         """Roll everything up into the report files: two parts, rendered at once by doit -n 2."""
         yield {"basename": "report", "name": None,
                "doc": "Roll everything up into reports/ (assurance.{html,md,json}, the CI formats, the argument)."}
-        deps = [at(p) for p in (ws.MODEL, ws.DIAGNOSTICS)] + list(snap.values())
+        # The plan itself: the report shows its name, requirements and their tracing, which no
+        # other artifact holds (a plan edit that changes only those re-renders the report).
+        deps = [str(rootp / plan_file)] + [at(p) for p in (ws.MODEL, ws.DIAGNOSTICS)] + list(snap.values())
         for n in nodes:
             deps += [at(ws.calculus(n)), at(ws.health(n)), at(ws.obligations(n))]
         deps += [at(ws.evidence(o["id"])) for _, o in exported()]
         for part, files in REPORT_PARTS.items():
             yield {"name": part, "doc": "reports/" + ", ".join(files), "actions": [(act_report, [r, part])],
-                   "file_dep": deps,
+                   "file_dep": deps, "uptodate": [code],
                    "targets": [at(f"reports/{f}") for f in files if f != "argument.svg"]
                    + ([at(ws.SUMMARY)] if part == "html" else []),
                    "verbosity": 2, "clean": True}

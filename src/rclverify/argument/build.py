@@ -35,7 +35,7 @@ from typing import Any, Mapping
 
 from .model import Argument, Element, propagate
 
-_FINDING_AS = {"ok": "discharged", "problem": "failed", "inconclusive": "inconclusive"}
+_FINDING_AS = {"ok": "discharged", "problem": "failed", "inconclusive": "inconclusive", "stale": "stale"}
 _ID_BAD = re.compile(r"[^A-Za-z0-9_.\-]+")
 
 PERSIST = ("Outputs persist once produced, so the inputs a node receives from several producers are "

@@ -76,6 +76,10 @@ RULES: Mapping[str, Rule] = {r.id: r for r in (
     Rule("RCL-HEALTH-OTHER", "HealthProblem", "error", "A contract health check found a problem."),
     Rule("RCL-HEALTH-INCONCLUSIVE", "HealthInconclusive", "warning",
          "Z3 could not decide a contract health check."),
+    Rule("RCL-SC-STALE", "SideConditionStale", "warning",
+         "The side condition was decided for another text of the contracts or plan than the current one."),
+    Rule("RCL-HEALTH-STALE", "HealthStale", "warning",
+         "The contract health check was made for another text of the contract or plan than the current one."),
 )}
 
 _HEALTH_RULE = {"assumption-satisfiable": "RCL-HEALTH-UNSATISFIABLE-ASSUMPTION",
@@ -153,7 +157,7 @@ def _side_condition_results(report: Mapping[str, Any]) -> list[dict[str, Any]]:
         status = str(sc["status"])
         if status == "discharged":
             continue
-        rule = "RCL-SC-REFUTED" if status == "failed" else "RCL-SC-INCONCLUSIVE"
+        rule = {"failed": "RCL-SC-REFUTED", "stale": "RCL-SC-STALE"}.get(status, "RCL-SC-INCONCLUSIVE")
         words = [f"Side condition {sc['id']} ({sc['rule']}) of {sc['node']} is {status}: {sc['conjunct']}."]
         if sc.get("explanation"):
             words.append(str(sc["explanation"]))
@@ -181,6 +185,7 @@ def _finding_results(report: Mapping[str, Any]) -> list[dict[str, Any]]:
         if f["status"] == "ok":
             continue
         rule = ("RCL-HEALTH-INCONCLUSIVE" if f["status"] == "inconclusive"
+                else "RCL-HEALTH-STALE" if f["status"] == "stale"
                 else _HEALTH_RULE.get(str(f["check"]), "RCL-HEALTH-OTHER"))
         words = [str(f["message"])]
         if f.get("explanation"):
