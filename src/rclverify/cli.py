@@ -13,6 +13,8 @@
 ``rclverify init DIR [--nodes A,B]``  write a new workspace that verifies at once
 ``rclverify bundle [-o FILE]``     the assessor's bundle; ``--verify FILE`` checks one
 ``rclverify review NODE [-o FILE]``  write a review record to fill in
+``rclverify ros scan PATH...``     the ROS computation graph from workspaces (docs/ros.md)
+``rclverify ros check``            the plan's contracts against that graph
 
 Exit codes: 0 success, 1 errors in the input (or, for ``compose``/``verify
 --strict``, an obligation that does not hold), 2 usage errors.  A user's
@@ -308,6 +310,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     r.add_argument("--assume", action="append", metavar="FORMULA",
                    help="RCL condition on the replacement's inputs (repeatable); lets it read extra inputs")
 
+    from .ros.cli import add_parsers as add_ros_parsers
+    add_ros_parsers(sub)
     m = add("monitor", cmd_monitor, "check recorded runs (ROSMonitoring logs, ROS bags) against every "
             "node's contract", True)
     m.add_argument("traces", nargs="+", metavar="TRACE", help="a .jsonl log, a .bag, a ROS 2 bag directory or .mcap")
