@@ -83,5 +83,5 @@ def cmd_scan(args: argparse.Namespace) -> int:
 
 
 def cmd_check(args: argparse.Namespace) -> int:
-    from .ground import run_check
+    from .stage import run_check
     return run_check(Path(args.workspace), args.plan, args.strict, args.json)

@@ -183,7 +183,7 @@ def scan(paths: Sequence[Path], launch: Sequence[Path] = (), launch_args: dict[s
             for frm, to, rsrc in remaps:
                 if names.resolve(frm, ns, full) == names.resolve(e.topic, ns, full):
                     topic, at = names.resolve(to, ns, full), rsrc
-            edge = GraphEdge(topic, e.msg_type, e.src, at)
+            edge = GraphEdge(topic, e.msg_type, e.src, at, e.topic)
             lst = node.publishes if e.kind == "pub" else node.subscribes
             if not any(x.topic == edge.topic and x.msg_type == edge.msg_type for x in lst):
                 lst.append(edge)

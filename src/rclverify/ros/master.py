@@ -65,6 +65,6 @@ def read_master(uri: str, caller: str = "/rclverify") -> Graph:
                     continue
                 ns, _ = names.split(n)
                 node = g.nodes.setdefault(n, GraphNode(n, ns, None, None, origin="master", declared_at=src))
-                e = GraphEdge(topic, canon_type(types.get(topic)), src)
+                e = GraphEdge(topic, canon_type(types.get(topic)), src, None, topic)
                 (node.publishes if kind == "pub" else node.subscribes).append(e)
     return g

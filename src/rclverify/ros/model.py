@@ -63,9 +63,11 @@ class GraphEdge:
     msg_type: str | None
     src: Src  # where the code creates it
     remapped_at: Src | None = None
+    written: str = ""  # the name as the code writes it, before resolution and remapping
 
     def to_json(self) -> dict[str, Any]:
-        d: dict[str, Any] = {"topic": self.topic, "type": self.msg_type, "at": self.src.to_json()}
+        d: dict[str, Any] = {"topic": self.topic, "type": self.msg_type, "as_written": self.written or self.topic,
+                             "at": self.src.to_json()}
         if self.remapped_at is not None:
             d["remapped_at"] = self.remapped_at.to_json()
         return d
