@@ -155,14 +155,15 @@ class TypeTable:
                         self.add_file(f, pkg, show(f), origin, cache, files)
 
     def add_debian_standard(self, cache: ParseCache | None, share: Path = DEBIAN_SHARE) -> list[str]:
-        """Register the message packages Debian installed (``/usr/share/<pkg>/package.xml``
-        with a ``msg`` directory); returns their names."""
+        """Register the message packages Debian installed (``/usr/share/<pkg>/msg``
+        for a ``<pkg>`` with a ``package.xml`` or named ``*_msgs``); returns their names."""
         found: list[str] = []
         if not share.is_dir():
             return found
-        for manifest in sorted(share.glob("*/package.xml")):
-            root = manifest.parent
-            if (root / "msg").is_dir() and root.name not in {p.split("/")[0] for p in self.types}:
+        for root in sorted(p.parent for p in share.glob("*/msg")):
+            if not ((root / "package.xml").is_file() or root.name.endswith("_msgs")):
+                continue
+            if root.name not in {p.split("/")[0] for p in self.types}:
                 self.add_package_dir(root, root.name, lambda f: f"{root.name}/{f.parent.name}/{f.name}",
                                      "debian", cache)
                 found.append(root.name)
