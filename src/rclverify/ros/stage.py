@@ -21,6 +21,8 @@ from ..rcl import ast
 
 GRAPH = "artifacts/ros/graph.json"
 GROUNDING = "artifacts/ros/grounding.json"
+DOT = "artifacts/ros/grounding.dot"
+SVG = "artifacts/ros/grounding.svg"
 CACHE = "artifacts/cache/ros-scan.pickle"
 DEFAULT_MAPPING = "backends/monitors/mapping.yaml"
 
@@ -93,6 +95,20 @@ def stage_ground(ws: Any) -> dict[str, Any]:
             "launch": [str(p.relative_to(ws.root)) for p in launch],
         },
     }
+    from ..report.diagram import dot_to_svg
+    from .draw import grounding_dot
+    from .ground import match_nodes
+    from . import names
+    ignore = {names.normalise(n) for n in ros.get("ignore", []) or []}
+    pairs = match_nodes(ws.checked.nodes, {k: v for k, v in g.nodes.items() if k not in ignore},
+                        dict(ros.get("nodes", {}) or {}))
+    dot = grounding_dot(ws.checked, graph_json, data["findings"], pairs)
+    svg = dot_to_svg(dot)
+    data["drawing"] = {"dot": DOT, "svg": SVG if svg is not None else None}
+    data["matched"] = dict(pairs)
+    atomic_write_text(ws.path(DOT), dot)
+    if svg is not None:
+        atomic_write_text(ws.path(SVG), svg)
     atomic_write_text(ws.path(GRAPH), json.dumps(graph_json, indent=2) + "\n")
     atomic_write_text(ws.path(GROUNDING), json.dumps(data, indent=2) + "\n")
     return data
