@@ -27,7 +27,10 @@ CACHE = "artifacts/cache/ros-scan.pickle"
 DEFAULT_MAPPING = "backends/monitors/mapping.yaml"
 
 
-def _paths(ws: Any, key: str) -> list[Path]:
+def _paths(ws: Any, key: str, missing: list[Any] | None = None) -> list[Path]:
+    """The existing paths of ``ros.<key>``.  A path that leaves the workspace is
+    a plan error (raised); one that does not exist is appended to ``missing``
+    as ``(loc, message)``: a grounding error, which never stops the pipeline."""
     from ..plan.errors import plan_error
     ros = ws.plan.ros
     vals = ros.get(key, []) or []
@@ -39,7 +42,10 @@ def _paths(ws: Any, key: str) -> list[Path]:
             raise plan_error(ws.plan.file, loc.line, loc.col, f"ros.{key}: {v!r} leaves the workspace; "
                                                               f"give a path inside it", "E-path")
         if not (ws.root / p).exists():
-            raise plan_error(ws.plan.file, loc.line, loc.col, f"ros.{key}: {v!r} does not exist", "E-io")
+            if missing is None:
+                raise plan_error(ws.plan.file, loc.line, loc.col, f"ros.{key}: {v!r} does not exist", "E-io")
+            missing.append((loc, f"ros.{key}: {v!r} does not exist; nothing of it was scanned"))
+            continue
         out.append(ws.root / p)
     return out
 
@@ -73,13 +79,16 @@ def stage_ground(ws: Any) -> dict[str, Any]:
     from .graph import scan
     from .ground import ground
     ros = ws.plan.ros
-    wss = _paths(ws, "workspaces")
-    launch = _paths(ws, "launch")
-    bags = _paths(ws, "bags")
+    missing: list[Any] = []
+    wss = _paths(ws, "workspaces", missing)
+    launch = _paths(ws, "launch", missing)
+    bags = _paths(ws, "bags", missing)
     args = {str(k): (str(v).lower() if isinstance(v, bool) else str(v)) for k, v in (ros.get("args") or {}).items()}
     res = scan(wss, launch, args, bags, ws.root / CACHE, base=ws.root)
     plan_loc = ws.plan.locs.get(("ros",), ast.Loc(ws.plan.file, 1, 1))
-    findings = ground(res, ws.checked, ws.plan.file, ros, _fields(ws), plan_loc)
+    from .ground import Finding
+    findings = [Finding("ROS-SCAN", "error", msg, loc, None) for loc, msg in missing]
+    findings += ground(res, ws.checked, ws.plan.file, ros, _fields(ws), plan_loc)
     g = res.graph
     graph_json = g.to_json()
     counts = {"error": sum(f.severity == "error" for f in findings),
