@@ -187,6 +187,9 @@ def cmd_verify(args: argparse.Namespace) -> int:
 
 
 def cmd_init(args: argparse.Namespace) -> int:
+    if getattr(args, "from_ros", None):
+        from .ros.cli import init_from_ros
+        return init_from_ros(args)
     from .scaffold import InitError, init_workspace
     names = [n.strip() for n in args.nodes.split(",")] if args.nodes is not None else None
     try:
@@ -297,6 +300,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     i = add("init", cmd_init, "write a new workspace (dodo.py, example contracts, plan) that verifies at once")
     i.add_argument("dir", help="directory to create (must be new or empty)")
     i.add_argument("--nodes", help="comma-separated node names, in chain order (default: Sensor,Controller,Actuator)")
+    i.add_argument("--from-ros", metavar="PATH", action="append",
+                   help="one contract skeleton per node of the ROS workspace PATH (repeatable; docs/ros.md)")
+    i.add_argument("--launch", action="append", default=[], metavar="FILE",
+                   help="with --from-ros: entry launch file (repeatable)")
     bnd = add("bundle", cmd_bundle, "write the assessor's bundle (reports, artifacts, plan, contracts, manifest)", True)
     bnd.add_argument("-o", "--output", help="archive to write (.tar.gz or .zip; default: <workspace name>-bundle.tar.gz)")
     bnd.add_argument("--verify", metavar="FILE", help="check the archive FILE against its manifest instead")

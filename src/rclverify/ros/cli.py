@@ -82,6 +82,37 @@ def cmd_scan(args: argparse.Namespace) -> int:
     return 1 if errors else 0
 
 
+def init_from_ros(args: argparse.Namespace) -> int:
+    """``rclverify init DIR --from-ros PATH [--launch FILE]``."""
+    from .graph import scan
+    from .skeleton import write_from_ros
+    root = Path(args.dir)
+    if root.exists() and (not root.is_dir() or any(root.iterdir())):
+        print(f"{args.dir}: error: exists and is not an empty directory; rclverify init writes only into a new "
+              f"or empty one", file=sys.stderr)
+        return 1
+    for p in list(args.from_ros) + list(args.launch):
+        if not Path(p).exists():
+            print(f"{p}: error: no such file or directory", file=sys.stderr)
+            return 2
+    res = scan([Path(p) for p in args.from_ros], [Path(p) for p in args.launch])
+    for n in res.graph.notes:
+        print(n, file=sys.stderr)
+    if not res.graph.nodes:
+        print(f"{args.from_ros[0]}: error: no ROS node found (no launch file node, no source naming its node)",
+              file=sys.stderr)
+        return 1
+    try:
+        written = write_from_ros(root, res, [Path(p) for p in args.from_ros], [Path(p) for p in args.launch])
+    except OSError as exc:
+        print(f"{args.dir}: error: cannot write the workspace: {exc.strerror or exc}", file=sys.stderr)
+        return 1
+    for p in written:
+        print(p)
+    print(f"{len(res.graph.nodes)} contract skeleton(s) written; run `doit verify` in {args.dir}")
+    return 0
+
+
 def cmd_check(args: argparse.Namespace) -> int:
     from .stage import run_check
     return run_check(Path(args.workspace), args.plan, args.strict, args.json)
