@@ -130,3 +130,19 @@ def test_plan_ros_paths_stay_in_the_workspace(tmp_path: Path, capsys: pytest.Cap
     ws = _ws(tmp_path, [], [("workspaces: [src]", "workspaces: [../src]")])
     assert main(["ros", "check", "-w", str(ws)]) == 1
     assert "contracts/plan.yaml:6:16: error: ros.workspaces: '../src' leaves the workspace" in capsys.readouterr().err
+
+
+def test_sarif_results_carry_both_locations(tmp_path: Path) -> None:
+    from rclverify.report.sarif import _grounding_results
+    ws = _ws(tmp_path, [("geometry_msgs/Twist cmd_vel", "geometry_msgs/Point cmd_vel")])
+    _check(ws)
+    data = json.loads((ws / "findings.json").read_text())
+    results, rules = _grounding_results({"grounding": data})
+    r = next(x for x in results if x["ruleId"] == "ROS-TYPE-DIFFERS")
+    assert r["level"] == "error"
+    assert r["locations"][0]["physicalLocation"]["artifactLocation"]["uri"] == "contracts/rover.rcl"
+    assert r["locations"][0]["physicalLocation"]["region"] == {"startLine": 20, "startColumn": 11}
+    rel = r["relatedLocations"][0]["physicalLocation"]
+    assert rel["artifactLocation"]["uri"] == "src/rover_control/src/controller.cpp"
+    assert rel["region"] == {"startLine": 25, "startColumn": 13}
+    assert "ROS-TYPE-DIFFERS" in {x.id for x in rules}
