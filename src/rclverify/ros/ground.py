@@ -191,7 +191,8 @@ class Grounder:
         edges = gn.publishes if kind == "pub" else gn.subscribes
         resolved = names.resolve(topic, gn.namespace, gn.name)
         return next((e for e in edges if e.written.lstrip("/") == topic or e.written == topic), None) or \
-            next((e for e in edges if e.topic == resolved), None)
+            next((e for e in edges if e.topic == resolved), None) or \
+            next((e for e in edges if e.written.rstrip("/").rsplit("/", 1)[-1].lstrip("~") == topic), None)
 
     def _node(self, cn: Any, gn: GraphNode, publishers: dict[str, list[tuple[str, GraphEdge]]],
               all_topics: list[str]) -> None:
