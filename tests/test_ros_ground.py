@@ -146,3 +146,19 @@ def test_sarif_results_carry_both_locations(tmp_path: Path) -> None:
     assert rel["artifactLocation"]["uri"] == "src/rover_control/src/controller.cpp"
     assert rel["region"] == {"startLine": 25, "startColumn": 13}
     assert "ROS-TYPE-DIFFERS" in {x.id for x in rules}
+
+
+def test_case_study_is_grounded_in_its_ros_workspace(tmp_path: Path) -> None:
+    root = Path(__file__).parents[1]
+    # one Snapshot definition: the ROS package's is the monitors' one
+    assert (root / "ros/gazebo_radiation_plugin/msg/Snapshot.msg").read_bytes() == \
+        (root / "backends/monitors/msg/gazebo_radiation_plugin/msg/Snapshot.msg").read_bytes()
+    ws = tmp_path / "case"
+    for item in ("contracts", "ros", "backends/monitors/mapping.yaml"):
+        (shutil.copytree if (root / item).is_dir() else shutil.copy)(root / item, ws / item) \
+            if (ws / item).parent.mkdir(parents=True, exist_ok=True) is None else None
+    rc, fs = _check(ws, "--strict")
+    assert rc == 1
+    assert fs == [("ROS-TOPIC-UNPUBLISHED", "contracts/remote_inspection.rcl:45",
+                   "ros/rover_inspection/scripts/navigation.py:12",
+                   "no node of the graph publishes /currentLoc (Navigation's input in.position)")]
