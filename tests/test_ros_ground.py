@@ -154,9 +154,8 @@ def test_case_study_is_grounded_in_its_ros_workspace(tmp_path: Path) -> None:
     assert (root / "ros/gazebo_radiation_plugin/msg/Snapshot.msg").read_bytes() == \
         (root / "backends/monitors/msg/gazebo_radiation_plugin/msg/Snapshot.msg").read_bytes()
     ws = tmp_path / "case"
-    for item in ("contracts", "ros", "backends/monitors/mapping.yaml"):
-        (shutil.copytree if (root / item).is_dir() else shutil.copy)(root / item, ws / item) \
-            if (ws / item).parent.mkdir(parents=True, exist_ok=True) is None else None
+    for item in ("contracts", "ros", "backends"):
+        shutil.copytree(root / item, ws / item)
     rc, fs = _check(ws, "--strict")
     assert rc == 1
     assert fs == [("ROS-TOPIC-UNPUBLISHED", "contracts/remote_inspection.rcl:45",
