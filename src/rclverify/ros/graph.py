@@ -48,13 +48,18 @@ class Shower:
     """Paths as shown in locations: relative to ``base`` when inside it."""
 
     def __init__(self, base: Path | None) -> None:
-        self.base = (base or Path.cwd()).resolve()
+        self.base = os.path.realpath(base or Path.cwd())
+        self._memo: dict[str, str] = {}
 
     def __call__(self, p: Path) -> str:
-        try:
-            return Path(os.path.relpath(p.resolve(), self.base)).as_posix() if p.resolve().is_relative_to(self.base) else str(p)
-        except (OSError, ValueError):
-            return str(p)
+        key = str(p)
+        shown = self._memo.get(key)
+        if shown is None:
+            real = os.path.realpath(key)
+            inside = real == self.base or real.startswith(self.base.rstrip(os.sep) + os.sep)
+            shown = Path(os.path.relpath(real, self.base)).as_posix() if inside else key
+            self._memo[key] = shown
+        return shown
 
 
 def _source_files(root: Path) -> tuple[list[Path], list[Path]]:
@@ -103,7 +108,12 @@ def scan(paths: Sequence[Path], launch: Sequence[Path] = (), launch_args: dict[s
             g.files[shown] = ParseCache.digest(m.read_bytes())
         except OSError:
             pass
-        pkg, notes = read_package(m, shown)
+        try:
+            sha_m = g.files.get(shown) or ParseCache.digest(m.read_bytes())
+        except OSError:
+            sha_m = ""
+        pkg, notes = cache.get(f"pkg:{shown}", sha_m, lambda: read_package(m, shown)) if cache and sha_m \
+            else read_package(m, shown)
         g.notes.extend(notes)
         if pkg is None:
             continue
