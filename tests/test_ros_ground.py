@@ -157,6 +157,15 @@ def test_case_study_is_grounded_in_its_ros_workspace(tmp_path: Path) -> None:
     for item in ("contracts", "ros", "backends"):
         shutil.copytree(root / item, ws / item)
     rc, fs = _check(ws, "--strict")
+    assert rc == 0
+    assert fs == [("ROS-TOPIC-ONLY-RECORDED", "contracts/remote_inspection.rcl:45",
+                   "ros/rover_inspection/scripts/navigation.py:12",
+                   "/currentLoc (Navigation's input in.position) is published in the recorded run "
+                   "backends/monitors/traces/nominal_bag, but by no node of the scanned software")]
+    # without the recorded run, nothing publishes it: an error
+    plan = ws / "contracts/plan.yaml"
+    plan.write_text(plan.read_text().replace("  bags: [backends/monitors/traces/nominal_bag]\n", ""))
+    rc, fs = _check(ws, "--strict")
     assert rc == 1
     assert fs == [("ROS-TOPIC-UNPUBLISHED", "contracts/remote_inspection.rcl:45",
                    "ros/rover_inspection/scripts/navigation.py:12",

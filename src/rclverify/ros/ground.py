@@ -50,6 +50,7 @@ _FLOAT = {"float32", "float64"}
 #: stable rule ids, their severity and one-line description (SARIF rules)
 RULES: dict[str, tuple[str, str]] = {
     "ROS-TOPIC-UNPUBLISHED": ("error", "a contract input's topic that no node of the graph publishes"),
+    "ROS-TOPIC-ONLY-RECORDED": ("warning", "a contract input's topic that only a recorded run publishes, no scanned node"),
     "ROS-TOPIC-NOT-PUBLISHED": ("error", "a contract output's topic that its node does not publish"),
     "ROS-TOPIC-NOT-SUBSCRIBED": ("warning", "a contract input's topic that its node does not subscribe to"),
     "ROS-TYPE-UNKNOWN": ("error", "a contract topic's message type that no package defines"),
@@ -164,6 +165,10 @@ class Grounder:
             for e in n.publishes:
                 publishers.setdefault(e.topic, []).append((n.name, e))
         all_topics = sorted(set(publishers) | {e.topic for n in graph_nodes.values() for e in n.subscribes})
+        self.recorded: dict[str, list[tuple[str, str | None]]] = {}
+        for b in self.g.bags:
+            for t in b["topics"]:
+                self.recorded.setdefault(t["name"], []).append((b["path"], t["type"]))
         first_launch = next((n.declared_at for n in graph_nodes.values() if n.declared_at), None)
         for cname, cn in self.checked.nodes.items():
             node: ast.Node = cn.node
@@ -225,7 +230,13 @@ class Grounder:
                     self.add("ROS-TOPIC-NOT-SUBSCRIBED",
                              f"{node.name}'s input {var.qualified if var else ''} is on topic '{tp.field}', which "
                              f"{gn.name} does not subscribe to", rcl_loc, gn.declared_at, node.name, tp.field)
-                if resolved not in publishers:
+                if resolved not in publishers and resolved in self.recorded:
+                    bag = self.recorded[resolved][0][0]
+                    self.add("ROS-TOPIC-ONLY-RECORDED",
+                             f"{resolved} ({node.name}'s input {var.qualified if var else tp.field}) is published in "
+                             f"the recorded run {bag}, but by no node of the scanned software",
+                             rcl_loc, edge.src if edge else Src(bag, 1), node.name, tp.field)
+                elif resolved not in publishers:
                     close = difflib.get_close_matches(resolved, [t for t in publishers if publishers[t]], 1, 0.5)
                     where = publishers[close[0]][0][1].src if close else (edge.src if edge else gn.declared_at)
                     self.add("ROS-TOPIC-UNPUBLISHED",
@@ -236,6 +247,7 @@ class Grounder:
             info = self.table.get(ctype)
             graph_types = {e.msg_type for e in ([edge] if edge else []) + [pe for _, pe in publishers.get(resolved, [])]
                            if e.msg_type}
+            graph_types |= {t for _b, t in self.recorded.get(resolved, []) if t}
             type_src = edge.src if edge else (publishers[resolved][0][1].src if publishers.get(resolved) else None)
             if info is None:
                 self.add("ROS-TYPE-UNKNOWN", f"message type {tp.msg_type} of topic '{tp.field}' is defined by no "
