@@ -44,6 +44,13 @@ def test_init_from_ros_writes_skeletons_that_verify(tmp_path: Path, monkeypatch:
     assert g["matched"] == {"Driver": "/arm/driver", "Planner": "/arm/planner"}
     # the placeholder guarantee is reported by the health check
     assert any("Guarantee 1 of Planner" in p and "constrains no output" in p for p in report["summary"]["problems"])
+    argument = json.loads((ws / "reports/argument.json").read_text())
+    elements = argument["elements"] if isinstance(argument, dict) and "elements" in argument else argument
+    ctx = [e for e in elements if e["id"].startswith("C-ros")]
+    assert len(ctx) == 1 and ctx[0]["text"].startswith(
+        "Contracts grounded in the ROS software: arm_driver 2.0.0, arm_interfaces 2.0.1, arm_planner 2.0.1; ")
+    top = next(e for e in elements if e["id"] == "G-system")
+    assert ctx[0]["id"] in top["in_context_of"]
     sarif = json.loads((ws / "reports/assurance.sarif").read_text())
     assert not [r for r in sarif["runs"][0]["results"] if r["ruleId"].startswith("ROS-")]
     assert main(["init", str(ws), "--from-ros", str(AMENT)]) == 1  # never over an existing workspace
