@@ -43,7 +43,7 @@ def scan_python(text: str, shown: str) -> dict[str, Any]:
     out: dict[str, Any] = {"nodes": [], "endpoints": [], "notes": []}
     try:
         tree = ast.parse(text, filename=shown)
-    except (SyntaxError, ValueError) as exc:
+    except (SyntaxError, ValueError, RecursionError, MemoryError) as exc:
         line = getattr(exc, "lineno", None) or 1
         col = getattr(exc, "offset", None) or 1
         out["notes"].append(Note(Src(shown, line, col), f"Python source does not parse: {getattr(exc, 'msg', exc)}",
