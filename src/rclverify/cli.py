@@ -13,6 +13,8 @@
 ``rclverify init DIR [--nodes A,B]``  write a new workspace that verifies at once
 ``rclverify bundle [-o FILE]``     the assessor's bundle; ``--verify FILE`` checks one
 ``rclverify review NODE [-o FILE]``  write a review record to fill in
+``rclverify ros scan PATH...``     the ROS computation graph from workspaces (docs/ros.md)
+``rclverify ros check``            the plan's contracts against that graph
 
 Exit codes: 0 success, 1 errors in the input (or, for ``compose``/``verify
 --strict``, an obligation that does not hold), 2 usage errors.  A user's
@@ -186,6 +188,9 @@ def cmd_verify(args: argparse.Namespace) -> int:
 
 
 def cmd_init(args: argparse.Namespace) -> int:
+    if getattr(args, "from_ros", None):
+        from .ros.cli import init_from_ros
+        return init_from_ros(args)
     from .scaffold import InitError, init_workspace
     names = [n.strip() for n in args.nodes.split(",")] if args.nodes is not None else None
     try:
@@ -328,6 +333,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     i = add("init", cmd_init, "write a new workspace (dodo.py, example contracts, plan) that verifies at once")
     i.add_argument("dir", help="directory to create (must be new or empty)")
     i.add_argument("--nodes", help="comma-separated node names, in chain order (default: Sensor,Controller,Actuator)")
+    i.add_argument("--from-ros", metavar="PATH", action="append",
+                   help="one contract skeleton per node of the ROS workspace PATH (repeatable; docs/ros.md)")
+    i.add_argument("--launch", action="append", default=[], metavar="FILE",
+                   help="with --from-ros: entry launch file (repeatable)")
     bnd = add("bundle", cmd_bundle, "write the assessor's bundle (reports, artifacts, plan, contracts, manifest)", True)
     bnd.add_argument("-o", "--output", help="archive to write (.tar.gz or .zip; default: <workspace name>-bundle.tar.gz)")
     bnd.add_argument("--verify", metavar="FILE", help="check the archive FILE against its manifest instead")
@@ -341,6 +350,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     r.add_argument("--assume", action="append", metavar="FORMULA",
                    help="RCL condition on the replacement's inputs (repeatable); lets it read extra inputs")
 
+    from .ros.cli import add_parsers as add_ros_parsers
+    add_ros_parsers(sub)
     m = add("monitor", cmd_monitor, "check recorded runs (ROSMonitoring logs, ROS bags) against every "
             "node's contract", True)
     m.add_argument("traces", nargs="+", metavar="TRACE", help="a .jsonl log, a .bag, a ROS 2 bag directory or .mcap")

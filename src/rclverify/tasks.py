@@ -197,6 +197,43 @@ def act_report(root: str, part: str) -> Any:
     return None
 
 
+def act_ground(root: str) -> Any:
+    """The grounding stage (docs/ros.md): scan the plan's ``ros:`` section,
+    hold the contracts against it; findings go to the report, never to a verdict."""
+    from .ros.stage import stage_ground
+    try:
+        data = stage_ground(_ws(root))
+    except RclError as exc:
+        return _fail(exc)
+    c = data["counts"]
+    print(f"grounding: {c['error']} error(s), {c['warning']} warning(s) (rclverify ros check lists them)")
+    return None
+
+
+def ros_fingerprint(root: Path, ros: Mapping[str, Any]) -> list[tuple[str, int, int]]:
+    """(path, size, mtime_ns) of every file under the ``ros:`` section's paths:
+    the grounding task runs again when one changes (the scan's own cache then
+    re-parses only the changed files)."""
+    out: list[tuple[str, int, int]] = []
+    for key in ("workspaces", "launch", "bags"):
+        for rel in ros.get(key, []) or []:
+            top = root / str(rel)
+            files = [top] if top.is_file() else sorted(p for p in top.rglob("*") if p.is_file()) if top.is_dir() else []
+            for p in files:
+                try:
+                    st = p.stat()
+                except OSError:
+                    continue
+                out.append((str(p.relative_to(root)), st.st_size, st.st_mtime_ns))
+    for key in ("mapping",):
+        if ros.get(key):
+            p = root / str(ros[key])
+            if p.is_file():
+                st = p.stat()
+                out.append((str(ros[key]), st.st_size, st.st_mtime_ns))
+    return out
+
+
 def act_verify(root: str, strict: bool) -> Any:
     from .report.summary import print_summary, summary_data
     try:  # written by the report's html part with assurance.json
@@ -484,6 +521,15 @@ def _build_tasks(root: str | Path, plan_file: str) -> dict[str, Callable[[], Any
                    "targets": [at(ws.evidence(o["id"]))], "uptodate": [tools_unchanged, record_intact],
                    "verbosity": 2, "clean": True}
 
+    ros_section = dict(getattr(ws.plan, "ros", None) or {}) if ok else {}
+
+    def task_ground() -> dict[str, Any]:
+        """Ground the contracts in the ROS software of the plan's ros: section (docs/ros.md)."""
+        return {"actions": [(act_ground, [r])], "file_dep": [str(rootp / plan_file)] + contract_deps,
+                "uptodate": [config_changed({"files": ros_fingerprint(rootp, ros_section)})],
+                "targets": [at("artifacts/ros/grounding.json"), at("artifacts/ros/graph.json")],
+                "task_dep": ["check"], "verbosity": 2, "clean": True}
+
     @create_after(executed="evidence")
     def task_report() -> Iterator[dict[str, Any]]:
         """Roll everything up into the report files: two parts, rendered at once by doit -n 2."""
@@ -495,6 +541,8 @@ def _build_tasks(root: str | Path, plan_file: str) -> dict[str, Callable[[], Any
         for n in nodes:
             deps += [at(ws.calculus(n)), at(ws.health(n)), at(ws.obligations(n))]
         deps += [at(ws.evidence(o["id"])) for _, o in exported()]
+        if ros_section:
+            deps.append(at("artifacts/ros/grounding.json"))
         for part, files in REPORT_PARTS.items():
             yield {"name": part, "doc": "reports/" + ", ".join(files), "actions": [(act_report, [r, part])],
                    "file_dep": deps, "uptodate": [code],
@@ -514,4 +562,6 @@ def _build_tasks(root: str | Path, plan_file: str) -> dict[str, Callable[[], Any
     if ok:
         creators.update({"task_graph": task_graph, "task_node": task_node, "task_evidence": task_evidence,
                          "task_report": task_report})
+        if ros_section:
+            creators["task_ground"] = task_ground
     return creators

@@ -97,6 +97,8 @@ class Plan:
     replacements: Mapping[str, tuple[str, ast.Loc]] = field(default_factory=dict)
     locs: Mapping[Path_, ast.Loc] = field(default_factory=dict)
     name: str = ""
+    #: the ``ros:`` section as written (grounding, docs/ros.md); empty when absent
+    ros: Mapping[str, Any] = field(default_factory=dict)
 
 
 def _schema() -> dict[str, Any]:
@@ -257,7 +259,7 @@ def load_plan(root: Path, plan_rel: str = "contracts/plan.yaml") -> Plan:
         if "replacement" in spec:
             replacements[node] = (spec["replacement"], loc("nodes", node, "replacement"))
     return Plan(plan_rel, root, contracts, tuple(reqs), tuple(conns), facts, instances, evidence, replacements, locs,
-                str(data.get("name", "")))
+                str(data.get("name", "")), dict(data.get("ros") or {}))
 
 
 def resolve(plan: Plan, checked: Checked) -> None:

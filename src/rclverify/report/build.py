@@ -320,6 +320,19 @@ def build_report(ws: Workspace) -> dict[str, Any]:
                  # and no guarantee left without evidence (no obligation exported for it)
                  and all(g_status(name, k) == "discharged" for name, cn in checked.nodes.items()
                          for k in range(1, len(cn.node.guarantees) + 1)))
+    # grounding in the robot's software (docs/ros.md): findings never change a verdict,
+    # but a grounding error fails --strict and is listed among the problems
+    grounding = read_artifact(ws, "artifacts/ros/grounding.json") if getattr(plan, "ros", None) else None
+    if grounding is not None:
+        svg_rel = (grounding.get("drawing") or {}).get("svg")
+        try:
+            grounding["svg_text"] = ws.path(svg_rel).read_text(encoding="utf-8") if svg_rel else None
+        except OSError:
+            grounding["svg_text"] = None
+        strict_ok = strict_ok and not grounding["counts"]["error"]
+        if grounding["counts"]["error"]:
+            problems.append(f"Grounding: {grounding['counts']['error']} contract(s)-vs-ROS error(s) "
+                            f"(rclverify ros check)")
     headline = _headline(ob_rows, counts, side_conditions, findings)
     system = model.view(node_status, cycles_kept(model, ws.path("artifacts/cache/system-cycles.json")))
     return {
@@ -329,7 +342,7 @@ def build_report(ws: Workspace) -> dict[str, Any]:
         "system": system, "requirements": requirements, "nodes": nodes, "side_conditions": side_conditions,
         "derived_properties": derived, "findings": findings, "obligations": ob_rows, "evidence": ev_rows,
         "environment_assumptions": env_assumptions, "pending": pending, "lint": lint_rows,
-        "expected_verdicts": expected,
+        "expected_verdicts": expected, "grounding": grounding,
     }
 
 
