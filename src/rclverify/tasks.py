@@ -51,6 +51,7 @@ from doit.tools import config_changed
 
 from . import heap, wscache
 from .pipeline import REPORT_PARTS, TaskIndex, Workspace
+from .plan.entries import TOOL_KEYS
 from .rcl.errors import RclError
 
 _F = TypeVar("_F", bound=Callable[..., Any])
@@ -222,6 +223,13 @@ def strict_uptodate(task: Any, values: Any) -> bool:
 def _inputs(config: Any, root: Path, seen: dict[str, tuple[str, ...]]) -> list[str]:
     """Workspace files named in a plan evidence entry (strings that are existing paths).
 
+    The values of tool keys (``dafny: PATH``, ``mcapl_home``, ``options``:
+    :data:`rclverify.plan.entries.TOOL_KEYS`) name installed tools, not
+    workspace files, and are never file dependencies (an absolute tool path
+    joined to the workspace root was a dependency on a file that does not
+    exist, a doit DependencyError); nor is any absolute path (the plan check
+    refuses those everywhere else).
+
     ``seen`` memoises the files of each path string across calls (the
     entries of many nodes name the same program or directory: one stat or
     directory walk per distinct string)."""
@@ -240,11 +248,12 @@ def _inputs(config: Any, root: Path, seen: dict[str, tuple[str, ...]]) -> list[s
         return seen[v]
 
     def walk(v: Any) -> None:
-        if isinstance(v, str) and "/" in v:
+        if isinstance(v, str) and "/" in v and not os.path.isabs(v):
             out.update(files(v))
         elif isinstance(v, dict):
-            for x in v.values():
-                walk(x)
+            for k, x in v.items():
+                if k not in TOOL_KEYS:
+                    walk(x)
         elif isinstance(v, list):
             for x in v:
                 walk(x)

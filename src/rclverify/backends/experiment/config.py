@@ -21,6 +21,7 @@ from pathlib import Path
 from typing import Any, Callable, Mapping
 
 from ...plan.errors import PlanError, plan_error
+from ...plan.yamlguard import read_yaml_text
 from ...rcl import ast
 from ...rcl.errors import RclError
 from ...rcl.parser import parse_formula
@@ -66,10 +67,7 @@ def read_config(root: Path, config: Mapping[str, Any], guarantees: int, loc: Loc
     rel = config[key]
     if not isinstance(rel, str) or not (root / rel).is_file():
         raise _err(loc(key), f"experiment {key} file {rel!r} does not exist")
-    try:
-        text = (root / rel).read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as exc:
-        raise _err(loc(key), f"cannot read experiment {key} file {rel!r}: {exc}") from None
+    text = read_yaml_text(root / rel, rel)  # UTF-8 rules (a CSV file too); errors located in the file
     try:
         if key == "summary":
             figures = load_summary(text, rel)
