@@ -68,7 +68,7 @@ REPORTS = ["reports/assurance.html", "reports/assurance.md", "reports/assurance.
 _WORKSPACES: dict[str, Workspace] = {}
 
 
-def _ws(root: str) -> Workspace:
+def _ws(root: str, plan_file: str | None = None) -> Workspace:
     """The workspace at ``root``, loaded once per doit run: every action would
     otherwise parse and check the contracts again.
 
@@ -78,12 +78,14 @@ def _ws(root: str) -> Workspace:
     state its ``check`` task snapshots and every later task depends on.  A
     contract edited while a run is under way is therefore picked up by the
     next run, whose ``check`` sees the changed file.  Without a seeded entry
-    (a worker process that did not inherit it) the workspace is loaded here.
+    (a worker process that did not inherit it) the workspace is loaded here,
+    with ``plan_file`` (the ``check`` task passes the run's plan file; the
+    default plan otherwise).
     """
     heap.freeze_inherited()  # a doit -n worker: its inherited heap stays live (rclverify.heap)
     ws = _WORKSPACES.get(root)
-    if ws is None:
-        ws = Workspace(Path(root))
+    if ws is None or (plan_file is not None and ws.plan_file != plan_file):
+        ws = Workspace(Path(root), plan_file or "contracts/plan.yaml")
         ws.model  # load now: raises RclError for bad input and then caches nothing
         _WORKSPACES[root] = ws
     return ws
@@ -93,12 +95,21 @@ def _fail(exc: RclError) -> TaskFailed:
     return TaskFailed("\n".join(str(d) for d in exc.diagnostics))
 
 
-def act_check(root: str) -> Any:
+def _io_fail(exc: OSError, root: str) -> TaskFailed:
+    """A fault of the machine (read-only directory, full disk) as one plain line
+    (:mod:`rclverify.faults`): the writes are atomic, nothing recorded changed."""
+    from .faults import describe_os_error
+    return TaskFailed(describe_os_error(exc, Path(root)))
+
+
+def act_check(root: str, plan_file: str = "contracts/plan.yaml") -> Any:
     from .pipeline import stage_check
     try:
-        out = stage_check(_ws(root))
+        out = stage_check(_ws(root, plan_file))
     except RclError as exc:
         return _fail(exc)
+    except OSError as exc:
+        return _io_fail(exc, root)
     for w in out["warnings"]:
         print(f"{w['file']}:{w['line']}:{w['col']}: warning: {w['message']}")
     return None
@@ -110,13 +121,15 @@ def act_graph(root: str) -> Any:
     from .report.diagram import dot_to_svg
     try:
         dot = stage_graph(_ws(root))
+        svg = dot_to_svg(dot)
+        if svg is None:
+            print(f"graphviz 'dot' not found: {Workspace.DOT} written, model.svg not drawn")
+            return None
+        atomic_write_text(Path(root) / "artifacts/system/model.svg", svg)
     except RclError as exc:
         return _fail(exc)
-    svg = dot_to_svg(dot)
-    if svg is None:
-        print(f"graphviz 'dot' not found: {Workspace.DOT} written, model.svg not drawn")
-        return None
-    atomic_write_text(Path(root) / "artifacts/system/model.svg", svg)
+    except OSError as exc:
+        return _io_fail(exc, root)
     return None
 
 
@@ -151,6 +164,8 @@ def act_node(root: str, node: str, deps: dict[str, list[str]], changed: list[str
             getattr(pipeline, f"stage_{stage}")(_ws(root), node)
     except RclError as exc:
         return _fail(exc)
+    except OSError as exc:
+        return _io_fail(exc, root)
     print(f"{node}: {', '.join(stages)}")
     return None
 
@@ -168,6 +183,8 @@ def act_run(root: str, node: str, obligation_id: str) -> Any:
         return _fail(exc)
     except cluster.ClusterError as exc:
         return TaskFailed(f"error: {exc}")
+    except OSError as exc:
+        return _io_fail(exc, root)
     print(f"{ev.obligation}: {ev.status}")
     return None
 
@@ -190,6 +207,8 @@ def act_report(root: str, part: str) -> Any:
         report, _ = stage_report(ws, (part,), kept[1] if kept is not None and kept[0] is ws else None)
     except RclError as exc:
         return _fail(exc)
+    except OSError as exc:
+        return _io_fail(exc, root)
     _REPORTS[root] = (ws, report)
     if part == "html":
         print(f"report: reports/assurance.html  ({report['summary']['headline']})")
@@ -319,13 +338,38 @@ def _use_linear_implicit_task_dep() -> None:
 DOIT_IMPLICIT_TASK_DEP: list[Callable[..., None]] = []
 
 
-def build_tasks(root: str | Path, plan_file: str = "contracts/plan.yaml") -> dict[str, Callable[[], Any]]:
+def build_tasks(root: str | Path, plan_file: str = "contracts/plan.yaml", *,
+                wait: bool | None = None) -> dict[str, Callable[[], Any]]:
     """The ``task_*`` functions for a dodo.py of the workspace at ``root``.
+
+    First takes the workspace's run lock (:mod:`rclverify.runlock`: one run
+    at a time; a second run waits with the message ``waiting for the run in
+    progress (pid N)``, or with ``wait=False`` / ``RCLVERIFY_NO_WAIT=1``
+    does not wait).  The lock is given back when doit completes the run
+    (the progress reporter) or the process ends.  When the lock cannot be
+    had without waiting, or its file cannot be created, prints one
+    ``error:`` line and raises ``SystemExit(1)`` (``dodo.py`` has no other
+    way to end a doit command cleanly).
 
     The loaded workspace stays live for the run: it is loaded without
     cyclic garbage collection and then frozen for the run
     (:mod:`rclverify.heap`; the progress reporter gives it back to the
     collector when doit completes the run)."""
+    import sys
+    from . import runlock
+    from .faults import describe_os_error
+    rootp = Path(root)
+    if not rootp.is_dir():
+        print(f"{root}: error: no such workspace directory", file=sys.stderr)
+        raise SystemExit(1)
+    try:
+        runlock.acquire(rootp, wait=wait)
+    except runlock.RunInProgress as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        raise SystemExit(1) from None
+    except OSError as exc:
+        print(describe_os_error(exc, rootp.resolve(), "cannot take the run lock in"), file=sys.stderr)
+        raise SystemExit(1) from None
     with heap.no_collection():
         creators = _build_tasks(root, plan_file)
         heap.freeze_for_run()  # before collecting again: what was made while loading is not looked at
@@ -363,11 +407,17 @@ def _build_tasks(root: str | Path, plan_file: str) -> dict[str, Callable[[], Any
 
     snap = {n: at(ws.snapshot(n)) for n in nodes}
 
+    # Only files that exist are file dependencies (doit refuses a missing one with a DependencyError):
+    # a missing plan or contract makes `check` run, and fail with the located message, every time.
+    named = [str(rootp / plan_file)] + contract_deps
+    check_deps = [d for d in named if os.path.isfile(d)]
+    check_extra: dict[str, Any] = {"uptodate": [False]} if len(check_deps) < len(named) or not ok else {}
+
     def task_check() -> dict[str, Any]:
         """Parse and type-check the contracts, check the plan, lint, build the system model."""
-        return {"actions": [(act_check, [r])], "file_dep": [str(rootp / plan_file)] + contract_deps,
+        return {"actions": [(act_check, [r, plan_file])], "file_dep": check_deps,
                 "targets": list(snap.values()) + [str(rootp / p) for p in (ws.MODEL, ws.DIAGNOSTICS)],
-                "verbosity": 2, "clean": True}
+                "verbosity": 2, "clean": True, **check_extra}
 
     def task_graph() -> dict[str, Any]:
         """Write the system model as DOT and, with graphviz, draw it as SVG (doit graph)."""
