@@ -38,12 +38,15 @@ def _where(filename: object, root: Path | None) -> str:
     return name
 
 
-def describe_os_error(exc: OSError, root: Path | None = None, doing: str = "cannot write") -> str:
+def describe_os_error(exc: OSError, root: Path | None = None, doing: str = "cannot write",
+                      place: str = "") -> str:
     """One line saying which file or directory the fault hit and why, e.g.
     ``error: cannot write reports/: Permission denied; the reports and
     evidence of the last run are unchanged``.  ``root`` (the workspace) makes
-    the path relative; ``doing`` is the verb phrase."""
-    where = _where(exc.filename, root)
+    the path relative; ``doing`` is the verb phrase; ``place`` names where
+    the caller was writing, for an error that carries no file name (a
+    ``write`` on a full disk)."""
+    where = _where(exc.filename, root) or place
     why = exc.strerror or str(exc)
     hint = ""
     if exc.errno == errno.ENOSPC:

@@ -95,11 +95,12 @@ def _fail(exc: RclError) -> TaskFailed:
     return TaskFailed("\n".join(str(d) for d in exc.diagnostics))
 
 
-def _io_fail(exc: OSError, root: str) -> TaskFailed:
+def _io_fail(exc: OSError, root: str, place: str = "artifacts/") -> TaskFailed:
     """A fault of the machine (read-only directory, full disk) as one plain line
-    (:mod:`rclverify.faults`): the writes are atomic, nothing recorded changed."""
+    (:mod:`rclverify.faults`; ``place``: where the action writes, for an
+    error without a file name): the writes are atomic, nothing recorded changed."""
     from .faults import describe_os_error
-    return TaskFailed(describe_os_error(exc, Path(root)))
+    return TaskFailed(describe_os_error(exc, Path(root), place=place))
 
 
 def act_check(root: str, plan_file: str = "contracts/plan.yaml") -> Any:
@@ -184,7 +185,7 @@ def act_run(root: str, node: str, obligation_id: str) -> Any:
     except cluster.ClusterError as exc:
         return TaskFailed(f"error: {exc}")
     except OSError as exc:
-        return _io_fail(exc, root)
+        return _io_fail(exc, root, "artifacts/evidence/")
     print(f"{ev.obligation}: {ev.status}")
     return None
 
@@ -208,7 +209,7 @@ def act_report(root: str, part: str) -> Any:
     except RclError as exc:
         return _fail(exc)
     except OSError as exc:
-        return _io_fail(exc, root)
+        return _io_fail(exc, root, "reports/")
     _REPORTS[root] = (ws, report)
     if part == "html":
         print(f"report: reports/assurance.html  ({report['summary']['headline']})")

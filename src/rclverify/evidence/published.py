@@ -46,5 +46,10 @@ def write_published(path: Path, text: str) -> bool:
             return False
     except FileNotFoundError:
         pass
-    atomic_write_bytes(path, data, mode=mode)
+    try:
+        atomic_write_bytes(path, data, mode=mode)
+    except OSError as exc:
+        if exc.filename is not None:
+            raise
+        raise OSError(exc.errno, exc.strerror, str(path.parent) + os.sep) from None  # e.g. ENOSPC: name the place
     return True
