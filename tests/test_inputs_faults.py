@@ -246,3 +246,43 @@ def test_two_runs_started_together_never_run_a_task_twice(fresh: Path) -> None:
     stdout = "".join(o for o, _ in outs)
     assert stdout.count(".  node:Sensor") == 1 and stdout.count(".  report:html") == 1, outs
     assert sum("waiting for the run in progress" in e for _, e in outs) <= 1
+
+
+# ---------------------------------------------------------------------------
+# A tool that hangs: a per-entry limit
+# ---------------------------------------------------------------------------
+
+def test_an_implementation_that_hangs_is_stopped_by_the_entrys_timeout(fresh: Path) -> None:
+    ws = fresh
+    impl = ws / "backends/property_tests/sensor.py"
+    impl.parent.mkdir(parents=True)
+    impl.write_text("def sensor(reading):\n    while True:\n        pass\n", encoding="utf-8")
+    plan = ws / "contracts/plan.yaml"
+    plan.write_text(plan.read_text(encoding="utf-8").replace(
+        "  Sensor: {}\n", "  Sensor:\n    evidence:\n      - backend: property_tests\n"
+        "        implementation: backends/property_tests/sensor.py:sensor\n        timeout_s: 0.5\n"), encoding="utf-8")
+    t0 = time.monotonic()
+    r = run(ws, "rclverify.cli", "verify", "--strict")
+    assert time.monotonic() - t0 < 60
+    out = r.stdout + r.stderr
+    assert r.returncode == 1 and "Traceback" not in out, out
+    records = sorted((ws / "artifacts/evidence").glob("Sensor.*.json"))
+    assert len(records) == 2
+    for rec in records:
+        data = __import__("json").loads(rec.read_text(encoding="utf-8"))
+        assert data["status"] == "inconclusive"
+        assert "did not finish within 0.5 s" in data["explanation"] and "loop forever" in data["explanation"]
+
+
+def test_timeout_s_is_checked_and_the_limit_fires(fresh: Path) -> None:
+    from rclverify.backends.property_tests.harness import ConfigError, read_config
+    from rclverify.backends.timelimit import TimeLimitExceeded, wall_clock_limit
+    with pytest.raises(ConfigError, match="timeout_s must be a number of seconds"):
+        read_config({"implementation": "contracts/plan.yaml:x", "timeout_s": "soon"}, None, fresh)  # type: ignore[arg-type]
+    with pytest.raises(TimeLimitExceeded):
+        with wall_clock_limit(0.05) as enforced:
+            assert enforced
+            while True:
+                pass
+    with wall_clock_limit(None) as enforced:
+        assert not enforced

@@ -121,3 +121,25 @@ def test_a_tool_path_outside_the_workspace_is_allowed_and_no_file_dependency(tmp
                        text=True, timeout=300, env={"PYTHONPATH": str(SRC), "PATH": "/usr/bin:/bin"})
     assert r.returncode == 0, r.stdout + r.stderr
     assert "DependencyError" not in r.stdout + r.stderr and "1 pending" in r.stdout
+
+
+@pytest.mark.parametrize("entry, message", [
+    ("      - backend: dafny\n        dafny: /nonexistent/bin/dafny\n",
+     "dafny: '/nonexistent/bin/dafny' does not exist (the tool is named by its path"),
+    ("      - backend: dafny\n        dafny: contracts/sensor.rcl\n", "dafny: 'contracts/sensor.rcl' is not executable"),
+    ("      - backend: ajpf\n        agent: a\n        mcapl_home: /nonexistent/mcapl\n",
+     "mcapl_home: '/nonexistent/mcapl' is not a directory"),
+])
+def test_a_tool_named_by_a_path_that_is_missing_is_a_located_error(tmp_path: Path, entry: str, message: str,
+                                                                   capsys: pytest.CaptureFixture[str]) -> None:
+    ws = init_ws(tmp_path, entry)
+    key = message.split(":")[0]
+    where = located(ws, f"{key}: ", len(key) + 2)
+    assert main(["compose", "-w", str(ws)]) == 1
+    err = capsys.readouterr().err
+    assert err.startswith(where + message) and err.count("\n") == 1 and "Traceback" not in err
+
+
+def test_a_tool_named_by_a_command_not_on_path_stays_pending(tmp_path: Path) -> None:
+    ws = init_ws(tmp_path, "      - backend: dafny\n        dafny: no-such-dafny-here\n")
+    assert load_plan(ws).evidence["Sensor"][0].config["dafny"] == "no-such-dafny-here"

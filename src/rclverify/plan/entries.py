@@ -50,7 +50,8 @@ SCHEMAS: dict[str, EntrySchema] = {s.name: s for s in (
     EntrySchema("ajpf", ("agent", "model", "domains", "mapping", "environment_class", "mcapl_home", "timeout_s",
                          "results", "log_info"),
                 path_keys=frozenset({"model", "results"}), tool_keys=frozenset({"mcapl_home"})),
-    EntrySchema("property_tests", ("implementation", "max_examples", "seed", "deadline_ms", "steps", "bounds"),
+    EntrySchema("property_tests", ("implementation", "max_examples", "seed", "deadline_ms", "steps", "bounds",
+                                   "timeout_s"),
                 path_keys=frozenset({"implementation"}), qualified_keys=frozenset({"implementation"})),
     EntrySchema("experiment", ("guarantee", "summary", "data", "column", "unit", "better", "constants", "criterion",
                                "timeout_ms"),
@@ -64,6 +65,12 @@ BACKEND_NAMES: tuple[str, ...] = tuple(SCHEMAS)
 
 #: Every key, of any backend, that names a tool rather than a workspace file.
 TOOL_KEYS: frozenset[str] = frozenset(k for s in SCHEMAS.values() for k in s.tool_keys)
+
+#: Tool keys whose value, when written as a path (with a ``/``), must name an existing
+#: ``executable`` file or ``directory`` (relative paths from the workspace root).  A bare
+#: command name (``dafny: dafny``) is looked up on ``PATH`` when the backend runs, and a
+#: missing one leaves the evidence ``pending`` with the command to run.
+TOOL_PATH_KINDS: dict[str, str] = {"dafny": "executable", "mcapl_home": "directory"}
 
 
 def allowed_keys(backend: str) -> tuple[str, ...]:

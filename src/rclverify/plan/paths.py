@@ -36,7 +36,7 @@ from typing import Any, Iterator, Mapping
 
 from ..rcl import ast
 from ..rcl.errors import Diagnostic
-from .entries import TOOL_KEYS, declared_paths
+from .entries import TOOL_KEYS, TOOL_PATH_KINDS, declared_paths
 from .errors import PlanError, plan_error
 
 __all__ = ["TOOL_KEYS", "check_plan_paths", "escape_reason", "looks_like_path"]
@@ -115,5 +115,35 @@ def check_plan_paths(root: Path, plan_rel: str, data: Mapping[str, Any], locs: M
         elif path in backslashed:
             diags.extend(plan_error(l.file, l.line, l.col, f"path {value!r} uses '\\' as a separator; write plan "
                                     "paths with '/'", "E-path").diagnostics)
+    for node, spec in (data.get("nodes") or {}).items():
+        for i, entry in enumerate(spec.get("evidence") or []):
+            if isinstance(entry, Mapping):
+                for key, kind in TOOL_PATH_KINDS.items():
+                    why = tool_path_problem(root, entry.get(key), kind)
+                    if why is not None:
+                        l = locs.get(("nodes", node, "evidence", i, key), ast.Loc(plan_rel, 1, 1))
+                        diags.extend(plan_error(l.file, l.line, l.col, f"{key}: {why}", "E-tool").diagnostics)
     if diags:
         raise PlanError(diags)
+
+
+def tool_path_problem(root: Path, value: Any, kind: str) -> str | None:
+    """Why the tool path ``value`` of a plan entry cannot be used (``None``
+    when it can, or when it is not a path: a bare command name is looked up
+    on ``PATH`` by the backend).  ``kind`` is ``executable`` or
+    ``directory`` (:data:`rclverify.plan.entries.TOOL_PATH_KINDS`).  A
+    relative path is taken from the workspace root; ``~`` is expanded."""
+    if not isinstance(value, str) or "/" not in value:
+        return None
+    p = Path(value).expanduser()
+    if not p.is_absolute():
+        p = root / p
+    if kind == "directory":
+        return None if p.is_dir() else f"{value!r} is not a directory (the tool's installation is named explicitly, " \
+                                       "so it must exist; leave the key out to use the environment's)"
+    if not p.is_file():
+        return f"{value!r} does not exist (the tool is named by its path, so it must exist; give a command " \
+               "name to look it up on PATH)"
+    if not os.access(p, os.X_OK):
+        return f"{value!r} is not executable"
+    return None
