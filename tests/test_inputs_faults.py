@@ -145,6 +145,39 @@ def test_a_full_disk_is_one_plain_error_and_the_reports_stay(ws: Path) -> None:
         assert p.stat().st_mode & 0o777 == published_mode(), p
 
 
+def test_a_full_disk_under_the_whole_workspace_is_one_plain_error(tmp_path: Path) -> None:
+    # doit's own state file fills up too: its sqlite3 traceback (exit 3) becomes one line and exit 1.
+    disk = tmp_path / "disk"
+    disk.mkdir()
+    if os.geteuid() != 0:
+        pytest.skip("a full file system is simulated with a tmpfs mount, which needs root")
+    try:
+        _mount("-t", "tmpfs", "-o", "size=8m", "tmpfs", str(disk))
+    except (OSError, subprocess.CalledProcessError) as exc:
+        pytest.skip(f"cannot mount a tmpfs here: {exc}")
+    try:
+        ws = disk / "ws"
+        assert main(["init", str(ws)]) == 0
+        assert run(ws, "rclverify.cli", "verify").returncode == 0
+        before = digests(ws, "reports", "artifacts/evidence")
+        edit_contract(ws, 4)
+        with open(disk / "filler", "wb", buffering=0) as fh:
+            with contextlib.suppress(OSError):
+                while True:
+                    fh.write(b"\0" * 4096)
+        for command in COMMANDS:
+            r = run(ws, *command)
+            out = r.stdout + r.stderr
+            assert r.returncode == 1 and "Traceback" not in out and out.count("error: ") == 1, out
+            assert "No space left on device" in out or "disk is full" in out, out
+        assert digests(ws, "reports", "artifacts/evidence") == before
+        (disk / "filler").unlink()
+        r = run(ws, *COMMANDS[1])
+        assert r.returncode == 0, r.stdout + r.stderr
+    finally:
+        subprocess.run(["umount", str(disk)], check=True, timeout=30)
+
+
 def test_missing_workspace_and_missing_plan_are_one_error_each(tmp_path: Path, fresh: Path) -> None:
     ws = fresh
     r = run(tmp_path, "rclverify.cli", "verify", "-w", str(tmp_path / "nope"))

@@ -160,8 +160,6 @@ def cmd_report(args: argparse.Namespace) -> int:
 
 
 def cmd_verify(args: argparse.Namespace) -> int:
-    from doit.cmd_base import ModuleTaskLoader
-    from doit.doit_cmd import DoitMain
     from .tasks import DEP_FILE, build_tasks, doit_config
     if not Path(args.workspace).is_dir():  # before doit opens its state file there (a sqlite3 traceback)
         print(f"{args.workspace}: error: no such workspace directory", file=sys.stderr)
@@ -176,11 +174,20 @@ def cmd_verify(args: argparse.Namespace) -> int:
     argv = ["verify"] + (["--strict"] if args.strict else [])
     if args.jobs > 1:
         argv = ["-n", str(args.jobs)] + argv
-    if not args.cluster:
+    try:  # SystemExit: a fault while doit saves its state, already reported in one line (tasks._guard_dep_dump)
+        return _run_doit(module, argv, args.cluster)
+    except SystemExit as exc:
+        return int(exc.code) if isinstance(exc.code, int) else 1
+
+
+def _run_doit(module: object, argv: list[str], cluster: str | None) -> int:
+    from doit.cmd_base import ModuleTaskLoader
+    from doit.doit_cmd import DoitMain
+    if not cluster:
         return int(DoitMain(ModuleTaskLoader(module)).run(argv))
     from .cluster import CLUSTER_ENV  # read by the evidence tasks, also in doit's worker processes
     before = os.environ.get(CLUSTER_ENV)
-    os.environ[CLUSTER_ENV] = args.cluster
+    os.environ[CLUSTER_ENV] = cluster
     try:
         return int(DoitMain(ModuleTaskLoader(module)).run(argv))
     finally:

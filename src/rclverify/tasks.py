@@ -339,6 +339,36 @@ def _use_linear_implicit_task_dep() -> None:
 DOIT_IMPLICIT_TASK_DEP: list[Callable[..., None]] = []
 
 
+def _guard_dep_writes() -> None:
+    """Make a full disk (or a read-only workspace) while doit writes its task
+    state end the run with one plain line and exit code 1, instead of doit's
+    traceback (``sqlite3.OperationalError: database or disk is full``, exit
+    3).  Wraps the writing methods of ``doit.dependency.SqliteDB`` (the store
+    :func:`doit_config` selects: ``dump`` at the end of a run, ``remove`` when
+    a task fails) once per process; what the run wrote is complete (every
+    write is atomic), only doit's record of it is lost, so its tasks run
+    again next time.  ``SystemExit`` passes through doit's own handler."""
+    import sqlite3
+    import sys
+    from doit.dependency import SqliteDB
+
+    def guard(method: Callable[..., Any]) -> Callable[..., Any]:
+        def guarded(self: Any, *args: Any) -> Any:
+            try:
+                return method(self, *args)
+            except (sqlite3.Error, OSError) as exc:
+                print(f"error: cannot save doit's task state in {os.path.basename(self.name)}: {exc} (free some "
+                      "space or make the workspace writable, and run again); what this run wrote is complete, and "
+                      "its tasks run again next time", file=sys.stderr)
+                raise SystemExit(1) from None
+        guarded._rclverify_guarded = True  # type: ignore[attr-defined]
+        return guarded
+    for name in ("dump", "remove"):
+        method = getattr(SqliteDB, name)
+        if not getattr(method, "_rclverify_guarded", False):
+            setattr(SqliteDB, name, guard(method))
+
+
 def build_tasks(root: str | Path, plan_file: str = "contracts/plan.yaml", *,
                 wait: bool | None = None) -> dict[str, Callable[[], Any]]:
     """The ``task_*`` functions for a dodo.py of the workspace at ``root``.
@@ -379,6 +409,7 @@ def build_tasks(root: str | Path, plan_file: str = "contracts/plan.yaml", *,
 
 def _build_tasks(root: str | Path, plan_file: str) -> dict[str, Callable[[], Any]]:
     _use_linear_implicit_task_dep()
+    _guard_dep_writes()
     rootp = Path(root).resolve()
     r = str(rootp)
     ws = Workspace(rootp, plan_file)
