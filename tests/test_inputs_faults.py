@@ -319,3 +319,17 @@ def test_timeout_s_is_checked_and_the_limit_fires(fresh: Path) -> None:
                 pass
     with wall_clock_limit(None) as enforced:
         assert not enforced
+
+
+def test_fault_messages_name_the_place_and_the_cause() -> None:
+    import errno
+    from rclverify.faults import describe_os_error
+    root = Path("/w")
+    tmp = PermissionError(errno.EACCES, "Permission denied", "/w/reports/.assurance.html.x1.tmp")
+    assert describe_os_error(tmp, root).startswith("error: cannot write reports/: Permission denied (make it writable")
+    read = PermissionError(errno.EACCES, "Permission denied", "/w/contracts/a.rcl")
+    assert describe_os_error(read, root).startswith("error: cannot access contracts/a.rcl: Permission denied (check")
+    full = OSError(errno.ENOSPC, "No space left on device")
+    assert describe_os_error(full, root, place="artifacts/evidence/") == (
+        "error: cannot write artifacts/evidence/: No space left on device (free some space and run again); "
+        "the reports and evidence of the last run are unchanged")

@@ -38,19 +38,31 @@ def _where(filename: object, root: Path | None) -> str:
     return name
 
 
-def describe_os_error(exc: OSError, root: Path | None = None, doing: str = "cannot write",
+#: Errors that can only come from writing.
+_WRITE_ERRORS = frozenset({errno.ENOSPC, errno.EROFS, errno.EDQUOT, errno.EFBIG})
+
+
+def describe_os_error(exc: OSError, root: Path | None = None, doing: str | None = None,
                       place: str = "") -> str:
     """One line saying which file or directory the fault hit and why, e.g.
     ``error: cannot write reports/: Permission denied; the reports and
     evidence of the last run are unchanged``.  ``root`` (the workspace) makes
-    the path relative; ``doing`` is the verb phrase; ``place`` names where
-    the caller was writing, for an error that carries no file name (a
-    ``write`` on a full disk)."""
+    the path relative; ``doing`` is the verb phrase (default: ``cannot
+    write`` for an error only a write gives -- a full disk, a read-only file
+    system -- or a temporary file, ``cannot access`` otherwise); ``place``
+    names where the caller was writing, for an error that carries no file
+    name (a ``write`` on a full disk)."""
     where = _where(exc.filename, root) or place
+    if doing is None:
+        name = os.fsdecode(exc.filename) if isinstance(exc.filename, (str, bytes, os.PathLike)) else ""
+        tmp = os.path.basename(name).endswith(".tmp")
+        doing = "cannot write" if exc.errno in _WRITE_ERRORS or tmp or not name else "cannot access"
     why = exc.strerror or str(exc)
     hint = ""
     if exc.errno == errno.ENOSPC:
         hint = " (free some space and run again)"
-    elif exc.errno in (errno.EACCES, errno.EPERM, errno.EROFS):
+    elif exc.errno == errno.EROFS or (exc.errno in (errno.EACCES, errno.EPERM) and doing == "cannot write"):
         hint = " (make it writable and run again)"
+    elif exc.errno in (errno.EACCES, errno.EPERM):
+        hint = " (check its permissions and run again)"
     return f"error: {doing} {where or 'a file'}: {why}{hint}; {UNTOUCHED}"
