@@ -143,3 +143,16 @@ def test_a_tool_named_by_a_path_that_is_missing_is_a_located_error(tmp_path: Pat
 def test_a_tool_named_by_a_command_not_on_path_stays_pending(tmp_path: Path) -> None:
     ws = init_ws(tmp_path, "      - backend: dafny\n        dafny: no-such-dafny-here\n")
     assert load_plan(ws).evidence["Sensor"][0].config["dafny"] == "no-such-dafny-here"
+
+
+def test_contract_and_replacement_paths_with_backslashes_are_refused(tmp_path: Path) -> None:
+    ws = init_ws(tmp_path)
+    plan = ws / "contracts/plan.yaml"
+    text = plan.read_text(encoding="utf-8")
+    plan.write_text(text.replace("  - contracts/actuator.rcl", '  - "contracts\\\\actuator.rcl"').replace(
+        "  Sensor: {}\n", '  Sensor:\n    replacement: "..\\\\other\\\\sensor.rcl:Sensor"\n'), encoding="utf-8")
+    with pytest.raises(PlanError) as exc:
+        load_plan(ws)
+    messages = [d.message for d in exc.value.diagnostics]
+    assert messages[0] == "path 'contracts\\\\actuator.rcl' uses '\\' as a separator; write plan paths with '/'"
+    assert messages[1].startswith("path '..\\\\other\\\\sensor.rcl' climbs out of the workspace")

@@ -93,10 +93,11 @@ def check_plan_paths(root: Path, plan_rel: str, data: Mapping[str, Any], locs: M
     :class:`PlanError` listing every path that leaves the workspace.
     """
     candidates: list[tuple[Path_, str]] = [(("contracts", i), c) for i, c in enumerate(data.get("contracts") or [])]
-    backslashed: set[Path_] = set()
     for node, spec in (data.get("nodes") or {}).items():
         if isinstance(spec.get("replacement"), str):
             candidates.append((("nodes", node, "replacement"), spec["replacement"].rpartition(":")[0]))
+    backslashed: set[Path_] = {p for p, v in candidates if "\\" in v}
+    for node, spec in (data.get("nodes") or {}).items():
         for i, entry in enumerate(spec.get("evidence") or []):
             base = ("nodes", node, "evidence", i)
             declared = {base + p: v for p, v in declared_paths(entry)} if isinstance(entry, Mapping) else {}
