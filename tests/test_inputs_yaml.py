@@ -6,6 +6,7 @@ UTF-8 are one located message naming the encoding."""
 from __future__ import annotations
 
 import codecs
+import shutil
 from pathlib import Path
 
 import pytest
@@ -104,6 +105,18 @@ def test_the_guarded_loader_agrees_with_safe_load_on_plain_yaml() -> None:
     assert data == {"a": [1, {"b": 2}], 1: "x"} and (locs[("a", 1, "b")].line, locs[("a", 1, "b")].col) == (3, 9)
     with pytest.raises(PlanError, match=r"^m\.yaml:3:3: error: duplicate key 'x'"):
         safe_load_guarded("t:\n  x: 1\n  x: 2\n", "m.yaml")
+    with pytest.raises(PlanError, match=r"^m\.yaml:3:3: error: merge keys \('<<'\)"):
+        safe_load_guarded("a: &x {k: 1}\nb:\n  <<: *x\n", "m.yaml")
+    assert safe_load_guarded("a: &x [1, 2]\nb: *x\n", "m.yaml") == {"a": [1, 2], "b": [1, 2]}
+
+
+def test_a_duplicate_key_in_a_trace_mapping_is_located_in_the_mapping(tmp_path: Path) -> None:
+    copy_workspace(tmp_path)
+    shutil.copytree(REPO / "backends/monitors", tmp_path / "backends/monitors")
+    mapping = tmp_path / "backends/monitors/mapping.yaml"
+    mapping.write_text(mapping.read_text(encoding="utf-8") + "horizon: 3.0\n", encoding="utf-8")
+    n = len(mapping.read_text(encoding="utf-8").splitlines())
+    assert f"backends/monitors/mapping.yaml:{n}:1: error: duplicate key 'horizon'" in str(act_check(str(tmp_path)))
 
 
 def test_a_utf8_byte_order_mark_is_accepted_in_rcl_and_yaml(tmp_path: Path) -> None:

@@ -36,7 +36,9 @@ also refuses (docs/plan.md, "YAML rules"):
   line of the first;
 * a tag on a list or a mapping other than the standard ``!!seq``/``!!map``
   (``!!python/tuple``, ``!!set``, ``!custom``...), as the safe constructor
-  refuses a non-standard tag on a scalar.
+  refuses a non-standard tag on a scalar;
+* a merge key ``<<`` (YAML 1.1 only; the plan never read it, and reading it
+  in the other files would make the same text mean two things).
 
 Every refusal is a :class:`~rclverify.plan.errors.PlanError` located in the
 file (``E-yaml-limit`` for the bounds, ``E-yaml`` for the rules above);
@@ -193,6 +195,9 @@ def to_data(node: yaml.Node, file: str, *, locs: dict[Path_, ast.Loc] | None = N
         for k, v in n.value:
             if not isinstance(k, yaml.ScalarNode):
                 raise err(k.start_mark, "a mapping key must be a plain value, not a list or a mapping")
+            if k.tag == "tag:yaml.org,2002:merge":
+                raise err(k.start_mark, "merge keys ('<<') are a YAML 1.1 extension rclverify does not read; "
+                                        "write the keys out")
             key = k.value if raw_keys else construct(k)
             try:
                 seen = key in first_at
