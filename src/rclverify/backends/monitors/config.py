@@ -99,11 +99,12 @@ def _check_msg_dirs(root: Path, rel: str, path: Path, dirs: list[str]) -> None:
     from ...plan.errors import PlanError, plan_error
     from ...plan.paths import escape_reason
     from ...plan.yamlguard import load_located
+    from ...rcl.errors import Diagnostic
     bad = [(i, d, why) for i, d in enumerate(dirs) for why in [escape_reason(root, d)] if why is not None]
     if not bad:
         return
     _, locs = load_located(read_yaml_text(path, rel), rel)
-    diags = []
+    diags: list[Diagnostic] = []
     for i, d, why in bad:
         at = locs.get(("msg_dirs", i))
         line, col = (at.line, at.col) if at is not None else (1, 1)

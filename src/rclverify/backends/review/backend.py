@@ -23,6 +23,7 @@ from ...plan.errors import PlanError, plan_error
 from ...plan.paths import escape_reason
 from ...plan.yamlguard import load_located, read_yaml_text
 from ...rcl import ast
+from ...rcl.errors import Diagnostic
 from ..base import NodeTarget, Stopwatch, make_evidence
 from .record import Question, RecordError, ReviewRecord, checklist, judge, parse_record
 
@@ -63,7 +64,7 @@ def check_reviewed_paths(root: Path, rel: str, text: str, record: ReviewRecord) 
     if not bad:
         return
     _, locs = load_located(text, rel)
-    diags = []
+    diags: list[Diagnostic] = []
     for i, p, why in bad:
         at = locs.get(("files", i, "path"), locs.get(("files", i), ast.Loc(rel, 1, 1)))
         diags.extend(plan_error(at.file, at.line, at.col, f"reviewed file {p!r} {why}; a review record may list "
