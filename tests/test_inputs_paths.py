@@ -141,8 +141,17 @@ def test_a_tool_named_by_a_path_that_is_missing_is_a_located_error(tmp_path: Pat
 
 
 def test_a_tool_named_by_a_command_not_on_path_stays_pending(tmp_path: Path) -> None:
+    from rclverify.pipeline import Workspace, stage_check, stage_export, stage_run
     ws = init_ws(tmp_path, "      - backend: dafny\n        dafny: no-such-dafny-here\n")
     assert load_plan(ws).evidence["Sensor"][0].config["dafny"] == "no-such-dafny-here"
+    impl = ws / "backends/dafny/sensor.dfy"
+    impl.parent.mkdir(parents=True)
+    impl.write_text("// the implementation would refine the generated contract module\n", encoding="utf-8")
+    w = Workspace(ws)
+    stage_check(w)
+    ids = [o["id"] for o in stage_export(w, "Sensor")]
+    ev = stage_run(w, "Sensor", ids[0])
+    assert ev.status == "pending" and "no 'no-such-dafny-here' on PATH" in ev.explanation
 
 
 def test_contract_and_replacement_paths_with_backslashes_are_refused(tmp_path: Path) -> None:
