@@ -40,6 +40,17 @@ def test_no_module_under_plan_imports_the_backends() -> None:
     assert offenders == {}
 
 
+def test_the_plan_imports_only_the_layer_below_it() -> None:
+    # layers (docs/architecture.md): rcl -> plan -> system/logic -> ... -> backends -> ...
+    offenders = {}
+    for path in sorted((SRC / "plan").glob("*.py")):
+        bad = sorted(m for m in _imports(path, "rclverify.plan")
+                     if not m.startswith(("rclverify.rcl", "rclverify.plan")) and m != "rclverify")
+        if bad:
+            offenders[path.name] = bad
+    assert offenders == {}
+
+
 def test_the_import_checker_sees_a_relative_import_into_the_backends(tmp_path: Path) -> None:
     f = tmp_path / "m.py"
     f.write_text("def f():\n    from ..backends.entry_checks import check_entries\n", encoding="utf-8")
