@@ -174,10 +174,13 @@ def cmd_verify(args: argparse.Namespace) -> int:
     argv = ["verify"] + (["--strict"] if args.strict else [])
     if args.jobs > 1:
         argv = ["-n", str(args.jobs)] + argv
-    try:  # SystemExit: a fault while doit saves its state, already reported in one line (tasks._guard_dep_dump)
+    try:  # SystemExit: a fault while doit saves its state, already reported in one line (tasks._guard_dep_writes)
         return _run_doit(module, argv, args.cluster)
     except SystemExit as exc:
         return int(exc.code) if isinstance(exc.code, int) else 1
+    finally:  # the run lock, also when doit ended before completing the run (in-process callers go on)
+        from .runlock import release
+        release(Path(args.workspace))
 
 
 def _run_doit(module: object, argv: list[str], cluster: str | None) -> int:
