@@ -8,7 +8,7 @@
 ``rclverify health [NODE...]``     contract consistency and vacuity findings
 ``rclverify export``               export obligations to the plan's backends
 ``rclverify report``               rebuild reports/ from the artifacts
-``rclverify verify [--strict]``    the whole pipeline through doit
+``rclverify verify [--strict] [--no-wait]``  the whole pipeline through doit (one run at a time per workspace)
 ``rclverify refines A.rcl:N B.rcl:M``  may contract M replace contract N?
 ``rclverify init DIR [--nodes A,B]``  write a new workspace that verifies at once
 ``rclverify bundle [-o FILE]``     the assessor's bundle; ``--verify FILE`` checks one
@@ -163,21 +163,37 @@ def cmd_report(args: argparse.Namespace) -> int:
 
 
 def cmd_verify(args: argparse.Namespace) -> int:
-    from doit.cmd_base import ModuleTaskLoader
-    from doit.doit_cmd import DoitMain
     from .tasks import DEP_FILE, build_tasks, doit_config
-    tasks = build_tasks(Path(args.workspace), args.plan)
+    if not Path(args.workspace).is_dir():  # before doit opens its state file there (a sqlite3 traceback)
+        print(f"{args.workspace}: error: no such workspace directory", file=sys.stderr)
+        return 1
+    try:  # takes the workspace's run lock: waits for a run in progress unless --no-wait
+        tasks = build_tasks(Path(args.workspace), args.plan, wait=False if args.no_wait else None)
+    except SystemExit as exc:  # build_tasks printed the one-line reason
+        return int(exc.code) if isinstance(exc.code, int) else 1
     module = type(sys)("rclverify_dodo")
     module.__dict__.update(tasks)
     module.DOIT_CONFIG = doit_config(str(Path(args.workspace) / DEP_FILE))  # type: ignore[attr-defined]
     argv = ["verify"] + (["--strict"] if args.strict else [])
     if args.jobs > 1:
         argv = ["-n", str(args.jobs)] + argv
-    if not args.cluster:
+    try:  # SystemExit: a fault while doit saves its state, already reported in one line (tasks._guard_dep_writes)
+        return _run_doit(module, argv, args.cluster)
+    except SystemExit as exc:
+        return int(exc.code) if isinstance(exc.code, int) else 1
+    finally:  # the run lock, also when doit ended before completing the run (in-process callers go on)
+        from .runlock import release
+        release(Path(args.workspace))
+
+
+def _run_doit(module: object, argv: list[str], cluster: str | None) -> int:
+    from doit.cmd_base import ModuleTaskLoader
+    from doit.doit_cmd import DoitMain
+    if not cluster:
         return int(DoitMain(ModuleTaskLoader(module)).run(argv))
     from .cluster import CLUSTER_ENV  # read by the evidence tasks, also in doit's worker processes
     before = os.environ.get(CLUSTER_ENV)
-    os.environ[CLUSTER_ENV] = args.cluster
+    os.environ[CLUSTER_ENV] = cluster
     try:
         return int(DoitMain(ModuleTaskLoader(module)).run(argv))
     finally:
@@ -327,6 +343,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     v.add_argument("--strict", action="store_true",
                    help="exit 1 unless every obligation, side condition and health check holds")
     v.add_argument("-n", "--jobs", type=int, default=1, help="parallel doit processes")
+    v.add_argument("--no-wait", action="store_true",
+                   help="exit 1 instead of waiting when another run is in progress in the workspace "
+                        "(also: RCLVERIFY_NO_WAIT=1)")
     v.add_argument("--cluster", metavar="ADDRESS",
                    help="send backend jobs to the Dask scheduler at ADDRESS (e.g. tcp://127.0.0.1:8786); "
                         "default: run them locally")
@@ -365,6 +384,11 @@ def main(argv: Sequence[str] | None = None) -> int:
         return _print_diags(exc)
     except KeyboardInterrupt:
         return 130
+    except OSError as exc:  # a fault of the machine (read-only directory, full disk): one plain line
+        from .faults import describe_os_error
+        root = getattr(args, "workspace", None)
+        print(describe_os_error(exc, Path(root).resolve() if root else None), file=sys.stderr)
+        return 1
     except RecursionError:
         # Last line of defence: the parser bounds nesting (rcl/parser.py
         # NESTING_LIMIT), so this means a stage built a deeper formula itself.

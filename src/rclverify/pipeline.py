@@ -123,12 +123,17 @@ class Workspace:
         self._run_deferred()
         from .plan.load import resolve
         from .rcl.parser import parse_text
+        from .rcl.source import read_text as read_source
         from .rcl.typecheck import check
         plan = self.plan
         specs = []
         diags: list[Diagnostic] = []
         for rel in plan.contracts:  # parsed under their workspace-relative names
-            text = (self.root / rel).read_text(encoding="utf-8")
+            try:
+                text = read_source(self.root / rel, rel)
+            except RclError as exc:
+                diags.extend(exc.diagnostics)
+                continue
             sha = hashlib.sha256(text.encode("utf-8")).hexdigest()
             if rel in self.parsed and self.parsed[rel][0] == sha:
                 specs.append(self.parsed[rel][1])
@@ -143,8 +148,22 @@ class Workspace:
         if diags:
             raise RclError(diags)
         c = check(specs)
-        resolve(self.plan, c)
+        from .plan.errors import PlanError
+        try:
+            resolve(self.plan, c)
+        except PlanError as exc:
+            raise PlanError(list(exc.diagnostics) + self._entry_diagnostics(c)) from None
+        entry_diags = self._entry_diagnostics(c)
+        if entry_diags:
+            raise PlanError(entry_diags)
         return c
+
+    def _entry_diagnostics(self, c: Checked) -> list[Diagnostic]:
+        """The backends' check-time validation of the plan's entries (experiment
+        data, review records, trace mappings): run here, above both the plan and
+        the backends, so that no plan module imports backend code."""
+        from .backends.entry_checks import check_entries
+        return check_entries(self.plan, c)
 
     @cached_property
     def model(self) -> SystemModel:
@@ -403,8 +422,9 @@ def replacement_finding(ws: Workspace, node: str) -> Finding:
     from .rcl.typecheck import check
     spec, loc = ws.plan.replacements[node]
     rel, name = split_spec(spec)
+    from .rcl.source import decode_text
     try:
-        text = (ws.root / rel).read_text(encoding="utf-8")
+        text = decode_text((ws.root / rel).read_bytes(), rel)
     except OSError as exc:
         raise RclError([error(loc, f"cannot read replacement contract {rel!r}: {exc.strerror or exc}", "E-io")]) from None
     other = check([parse_text(text, rel)])

@@ -169,6 +169,8 @@ class ProgressReporter(ConsoleReporter):  # type: ignore[misc]
             self.live = None
         super().complete_run()
         from .heap import freeze_at_exit, release_after_run
+        from .runlock import release
+        release()  # the workspace's run lock (rclverify.runlock): the next run may start
         release_after_run()
         freeze_at_exit()
 
