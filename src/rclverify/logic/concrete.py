@@ -25,6 +25,7 @@ from ..rcl.types import Checked, CheckedNode, DataT, EnumT, FuncT, Scalar, SeqT,
 from ..values import FiniteFunction, Term, exact
 from .encode import Encoder, sort_of, widen
 from .retry import SAFETY_TIMEOUT_MS
+from .world import on_fresh
 
 
 class ConcreteValueError(ValueError):
@@ -92,6 +93,7 @@ def _io_type(node: CheckedNode, qualified: str) -> Type:
 
 
 _ENCODED: dict[tuple[int, str], tuple[ast.Expr, z3.BoolRef, dict[str, Any]]] = {}
+on_fresh(_ENCODED.clear)  # its formulas belong to the Z3 context they were made in
 
 
 def _encoded(formula: ast.Expr, checked: Checked, node: CheckedNode) -> tuple[z3.BoolRef, dict[str, Any]]:

@@ -20,7 +20,7 @@ from typing import Any, Mapping
 import yaml
 
 from ...traces.mapping import TopicRule, load_rules
-from ...plan.yamlguard import safe_load_guarded
+from ...plan.yamlguard import read_yaml_text, safe_load_guarded
 
 DEFAULT_MAPPING = "backends/monitors/mapping.yaml"
 DEFAULT_HORIZON = 5.0
@@ -61,7 +61,7 @@ def load_mapping(root: Path, rel: str | None, horizon: Any = None, traces: Any =
     raw: Any = {}
     if path.is_file():
         try:
-            raw = safe_load_guarded(path.read_text(encoding="utf-8"), rel or DEFAULT_MAPPING) or {}
+            raw = safe_load_guarded(read_yaml_text(path, rel or DEFAULT_MAPPING), rel or DEFAULT_MAPPING) or {}
         except yaml.YAMLError as exc:
             mark = getattr(exc, "problem_mark", None)
             line = f"{mark.line + 1}:{mark.column + 1}" if mark is not None else "1:1"
@@ -83,6 +83,31 @@ def load_mapping(root: Path, rel: str | None, horizon: Any = None, traces: Any =
         if not (root / str(t)).exists():
             raise ConfigError(f"no such trace: {t}", "traces", k)
     ros = str(raw.get("ros_version", "ros2"))
+    msg_dirs = raw.get("msg_dirs", ()) or ()
+    if isinstance(msg_dirs, list):
+        _check_msg_dirs(root, rel or DEFAULT_MAPPING, path, [str(d) for d in msg_dirs])
     return MonitorConfig(rel or DEFAULT_MAPPING if path.is_file() else "", rules,
                          tuple(str(d) for d in raw.get("msg_dirs", ()) or ()), float(h), ros,
                          tuple(str(t) for t in traces))
+
+
+def _check_msg_dirs(root: Path, rel: str, path: Path, dirs: list[str]) -> None:
+    """Refuse message directories outside the workspace (the rules of
+    :mod:`rclverify.plan.paths`): the ``.msg`` files are inputs of the
+    evidence and belong in the assessor's bundle.  Raises ``PlanError``
+    located at the directory in the mapping file."""
+    from ...plan.errors import PlanError, plan_error
+    from ...plan.paths import escape_reason
+    from ...plan.yamlguard import load_located
+    from ...rcl.errors import Diagnostic
+    bad = [(i, d, why) for i, d in enumerate(dirs) for why in [escape_reason(root, d)] if why is not None]
+    if not bad:
+        return
+    _, locs = load_located(read_yaml_text(path, rel), rel)
+    diags: list[Diagnostic] = []
+    for i, d, why in bad:
+        at = locs.get(("msg_dirs", i))
+        line, col = (at.line, at.col) if at is not None else (1, 1)
+        diags.extend(plan_error(rel, line, col, f"message directory {d!r} {why}; the mapping may name only "
+                                "directories inside the workspace", "E-path").diagnostics)
+    raise PlanError(diags)
