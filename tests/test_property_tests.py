@@ -209,3 +209,44 @@ def test_z3_unknown_is_inconclusive_never_passed(tmp_path: Path, monkeypatch: py
     assert ev.status == "inconclusive"
     assert ev.details["examples"]["inconclusive"] == 100 and ev.details["unknown_reasons"] == ["timeout"]
     assert "Z3 answered unknown on 100 example(s)" in ev.explanation
+
+
+# -- one evaluator: direct evaluation first, Z3 only where it cannot decide -------------------------
+
+def _count_z3(monkeypatch: pytest.MonkeyPatch) -> list[str]:
+    from rclverify.backends.property_tests import harness
+    from rclverify.logic import decide as decide_module
+    calls: list[str] = []
+    for module in (decide_module, harness):
+        real = module.check_concrete
+
+        def counting(*args: Any, _real: Any = real, _where: str = module.__name__, **kw: Any) -> Any:
+            calls.append(_where)
+            return _real(*args, **kw)
+        monkeypatch.setattr(module, "check_concrete", counting)
+    return calls
+
+
+def test_examples_are_checked_by_direct_evaluation(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """The Radiation Sensor's quantified guarantee is decided without Z3 on every example."""
+    calls = _count_z3(monkeypatch)
+    ev = run(workspace(tmp_path, GOOD))
+    assert ev.status == "discharged" and ev.details["examples"]["valid"] == 100
+    assert calls == []
+
+
+def test_counterexample_is_confirmed_by_z3(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """A failed run asks Z3 once more, on the reported counterexample only."""
+    calls = _count_z3(monkeypatch)
+    ev = run(workspace(tmp_path, OFF_BY_ONE))
+    assert ev.status == "failed"
+    assert calls == ["rclverify.backends.property_tests.harness"]
+
+
+def test_engines_disagreeing_on_a_counterexample_is_an_error(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """Should Z3 not confirm the counterexample direct evaluation found, the evidence says so: error, not failed."""
+    from rclverify.backends.property_tests import harness
+    monkeypatch.setattr(harness, "check_concrete", lambda *a, **k: (True, ""))
+    ev = run(workspace(tmp_path, OFF_BY_ONE))
+    assert ev.status == "error"
+    assert "direct evaluation and Z3 disagree" in ev.explanation
