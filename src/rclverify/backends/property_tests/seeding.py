@@ -39,7 +39,6 @@ import z3
 from ...logic.concrete import to_z3
 from ...logic.encode import Encoder, EncodingError, sort_of
 from ...logic.retry import SAFETY_TIMEOUT_MS
-from ...logic.world import on_fresh
 from ...rcl import ast
 from ...rcl.types import Checked, CheckedNode, DataT, EnumT, FuncT, Scalar, Type
 from ...values import FiniteFunction, Term
@@ -107,8 +106,13 @@ def _points(args: tuple[Type, ...], n: int) -> list[tuple[Any, ...]] | None:
     return [tuple(float(j) if a == Scalar("REAL") else j for a in args) for j in range(n)]
 
 
+#: Base models by node, input types and formulas.  They hold plain values of
+#: rclverify.values, no Z3 object, and each is computed in a Z3 context of its
+#: own from the formulas' SMT-LIB text, so it does not depend on the process's
+#: Z3 state: it is kept across rclverify.logic.world.fresh() (a clean run and
+#: an incremental one draw from the same model; the Agent's three guarantees
+#: share one instead of solving it three times).
 _BASE: dict[tuple[Any, ...], dict[str, Any] | None] = {}
-on_fresh(_BASE.clear)  # kept per Z3 context (rclverify.logic.world)
 
 
 @dataclass
@@ -184,7 +188,8 @@ class Seeder:
     def base(self) -> dict[str, Any] | None:
         """A model of the formulas with the fewest table entries in :data:`EXTRA_SIZES`
         (cached per node and formulas; ``None``: none found)."""
-        key = (self.node.name, tuple(map(str, self.formulas)))
+        key = (self.node.name, tuple((k, str(t)) for k, t in self.node.inputs.items()),
+               tuple(map(str, self.formulas)))
         if key not in _BASE:
             found = None
             for n in EXTRA_SIZES:
