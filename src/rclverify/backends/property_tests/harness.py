@@ -331,6 +331,9 @@ class GuaranteeRun:
         inputs, outputs, conjunct = self.last_values
         for fact in self.used_facts:
             ok, _ = check_concrete(fact, self.checked, self.node, inputs)
+            if ok is None and self.last_failure is not None:  # say what checked the facts
+                self.last_failure["facts"] = (f"{self.facts_text()}: all hold on these inputs (checked by direct "
+                                              f"evaluation; Z3 answered unknown)")
             if ok is False:
                 return (f"internal: direct evaluation and Z3 disagree on the fact {expr_to_rcl(fact)} "
                         f"for the counterexample {_example_text(self.last_failure or {})}")
@@ -342,6 +345,14 @@ class GuaranteeRun:
                         f"for the counterexample {_example_text(self.last_failure or {})}")
         return ""
 
+    def _unconfirmed(self) -> Outcome | None:
+        """The ``error`` outcome when Z3 does not confirm the counterexample, else None."""
+        try:
+            wrong = self.confirm_with_z3()
+        except EncodingError as exc:
+            return Outcome("error", f"Z3 cannot express the formula: {exc}", self.counts, None, sorted(self.unknown))
+        return Outcome("error", wrong, self.counts, None, sorted(self.unknown)) if wrong else None
+
     def run(self) -> Outcome:
         """Run Hypothesis; never raises for a failing, inconclusive or starved run."""
         test = hypothesis.seed(self.cfg.seed)(self.settings()(given(self.strategy())(self.body)))
@@ -349,13 +360,9 @@ class GuaranteeRun:
             test()
         except _Violation as exc:
             assert self.last_failure is not None
-            try:
-                wrong = self.confirm_with_z3()
-            except EncodingError as enc:
-                return Outcome("error", f"Z3 cannot express the formula: {enc}", self.counts, None,
-                               sorted(self.unknown))
-            if wrong:
-                return Outcome("error", wrong, self.counts, None, sorted(self.unknown))
+            unconfirmed = self._unconfirmed()
+            if unconfirmed is not None:
+                return unconfirmed
             return Outcome("failed", f"{exc} on the shrunk example {_example_text(self.last_failure)}",
                            self.counts, self.last_failure, sorted(self.unknown))
         except (FailedHealthCheck, Unsatisfiable) as exc:
@@ -369,9 +376,9 @@ class GuaranteeRun:
             return Outcome("error", f"Z3 cannot express the formula: {exc}", self.counts, None, sorted(self.unknown))
         if self.counts.failures:  # only without stop_at_failure: the last violation, not shrunk
             assert self.last_failure is not None
-            wrong = self.confirm_with_z3()
-            if wrong:
-                return Outcome("error", wrong, self.counts, None, sorted(self.unknown))
+            unconfirmed = self._unconfirmed()
+            if unconfirmed is not None:
+                return unconfirmed
             return Outcome("failed", f"{self.counts.failures} example(s) violate guarantee {self.guarantee}, e.g. "
                            f"{_example_text(self.last_failure)} (not shrunk)", self.counts, self.last_failure,
                            sorted(self.unknown))
