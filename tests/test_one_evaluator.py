@@ -131,8 +131,11 @@ def quantified(draw: Draw, scope: Scope, depth: int) -> str:
         binding = f"{names[0]} in {sort}"
     body = formula_text(draw, inner, depth - 1)
     glue = "->" if kind == "forall" else "and"
-    if sort == "REAL2" and draw(st.booleans()):  # a guard over a function table, as the Agent's
+    guard = draw(st.integers(0, 2)) if sort == "REAL2" else 0
+    if guard == 1:  # a guard over a function table, as the Agent's
         return f"{kind}({binding} | in.g({names[0]}, {names[1]}) == {term(draw, 'NATURAL', inner, 0)} {glue} {body})"
+    if guard == 2:  # the pair fixed by a constructor term, as the Agent's `out.command == move(x, y)`
+        return f"{kind}({binding} | move({names[0]}, {names[1]}) == {term(draw, 'Cmd', scope, 1)} {glue} {body})"
     if sort in ("NATURAL", "INTEGER") and draw(st.booleans()):  # a literal bound on the variable
         lo = "" if sort == "NATURAL" else f"{names[0]} >= (0 - 2) and "
         return f"{kind}({binding} | {lo}{names[0]} <= {draw(st.integers(0, 4))} {glue} {body})"
