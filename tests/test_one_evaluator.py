@@ -241,6 +241,10 @@ BASE = {"in.r": 0, "in.k": 0, "in.z": 0, "in.b": False, "in.c": "red", "in.cmd":
     ("forall(k in NATURAL | k <= 3 -> in.f(k) == FALSE)", True),
     ("exists(k in INTEGER | k >= -2 and k <= 2 and k * k == 4)", True),
     ("exists(v in REAL | v == in.r + 0.1 and v * 3 > 0.2)", True),
+    # found by the random test: a constructor term of the formula itself, not of the values
+    ("exists_unique(x0, y0 in REAL | move(x0, y0) == move(0, 0) and 0 < 1)", True),
+    ("exists(x, y in REAL | not (move(x, y) != move(1.5, -2)))", True),
+    ("exists(v in NATURAL | not (inspect(v) != inspect(in.k + 2)))", True),
     # REAL arithmetic is exact: 0.1 + 0.2 is not the float 0.30000000000000004
     ("in.r + 0.1 + 0.2 == 0.3", True),
 ])

@@ -258,6 +258,7 @@ class Evaluator:
         self._slots: dict[int, tuple[list[tuple[str, ...]], list[list[tuple[Any, ...]]]]] = {}
         self._plans: dict[int, tuple[Any, ...]] = {}
         self.uncacheable = False  # set when a quantifier's candidates depend on outer bound values
+        self.io_names = frozenset(node.inputs) | frozenset(node.outputs)
 
     def numbers(self) -> set[Any]:
         if self._numbers is None:
@@ -407,6 +408,9 @@ class Evaluator:
     def candidates(self, name: str, scalar: str, body: ast.Expr, b: Mapping[str, Any],
                    qvars: tuple[str, ...] = ()) -> list[Any]:
         found_shifts = _static_shifts(body, name, frozenset(qvars))
+        if found_shifts is not None and _ctor_uses(body, frozenset({name}), self.env.ctors, self.io_names) is None:
+            raise Undecided(f"{name} is an argument of a constructor term compared with a term whose value is "
+                            f"not an input or output value, a function's result or a literal term")
         if found_shifts is None:
             raise Undecided(f"{name} ranges over {scalar} and is used outside equalities (with a literal, an "
                             f"I/O value, a function's result or an outer variable) and arguments")
@@ -456,6 +460,7 @@ class Evaluator:
             elif isinstance(v, FiniteFunction):
                 for res in v.table.values():
                     walk(res)
+                walk(v.default)
             elif isinstance(v, (tuple, frozenset)):
                 for a in v:
                     walk(a)
@@ -600,7 +605,10 @@ class Evaluator:
                 uses: list[ast.Apply] = []
                 if not _only_as(e.body, group, uses):
                     continue
-                keys: set[tuple[Any, ...]] = set()
+                literal_keys = _ctor_uses(e.body, frozenset(group), self.env.ctors, self.io_names)
+                if literal_keys is None:
+                    continue
+                keys: set[tuple[Any, ...]] = set(literal_keys)
                 for app in uses:
                     if app.func.prefix is None and app.func.name in self.env.ctors and app.func.name not in b:
                         keys.update(tuple(t.args) for t in self._terms(app.func.name) if len(t.args) == len(group))
@@ -807,6 +815,68 @@ def _integer_range(body: Any, name: str, scalar: str, kind: str) -> list[int] | 
     if lo is not None and hi is not None and hi - lo < MAX_RANGE:
         result = list(range(int(lo), int(hi) + 1))
     _RANGES[key] = (body, result)
+    return result
+
+
+def _literal_number(e: Any) -> Any:
+    if isinstance(e, ast.NumLit):
+        v = e.value
+    elif isinstance(e, ast.Unary) and e.op == "-" and isinstance(e.operand, ast.NumLit):
+        v = -e.operand.value
+    else:
+        return None
+    return int(v) if v.denominator == 1 else v
+
+
+def _ctor_uses(body: Any, names: frozenset[str], ctors: Any, io: frozenset[str]) -> frozenset[tuple[Any, ...]] | None:
+    """Check that every constructor term with one of ``names`` (possibly shifted)
+    as an argument is an operand of ``==``/``!=`` whose other side takes only
+    values the candidates know: an I/O variable (its value), a function's
+    result (its table's results or default), or a term of the same
+    constructor with literal arguments.  Returns those literal argument
+    tuples (the candidates must include them), or None when some use is
+    otherwise (the variable cannot be decided by candidates).  Memoised."""
+    key = (id(body), ",".join(sorted(names)), "ctor-uses")
+    hit = _STATIC.get(key)
+    if hit is not None and hit[0] is body:
+        return cast("frozenset[tuple[Any, ...]] | None", hit[1])
+    literal: set[tuple[Any, ...]] = set()
+    cleared: set[int] = set()
+
+    def mentions(app: Any, live: frozenset[str]) -> bool:
+        return (isinstance(app, ast.Apply) and app.func.prefix is None and app.func.name in ctors
+                and any(_shift(a, n) is not None for a in app.args for n in live))
+
+    def closed(other: Any, ctor: str) -> bool:
+        if isinstance(other, ast.Var):
+            return other.prefix is not None or other.name in io
+        if isinstance(other, ast.Apply) and not (other.func.prefix is None and other.func.name in ctors):
+            return True  # a function's result
+        if isinstance(other, ast.Apply) and other.func.name == ctor:
+            nums = tuple(_literal_number(a) for a in other.args)
+            if all(n is not None for n in nums):
+                literal.add(nums)
+                return True
+        return False
+
+    def walk(e: Any, live: frozenset[str]) -> bool:
+        if isinstance(e, ast.Quant):
+            live = live - frozenset(e.variables)
+            if not live:
+                return True
+        if isinstance(e, ast.Compare):
+            for op, (a, b) in zip(e.ops, zip(e.operands, e.operands[1:])):
+                for side, other in ((a, b), (b, a)):
+                    if op in ("==", "!=") and mentions(side, live):
+                        if not closed(other, side.func.name):
+                            return False
+                        cleared.add(id(side))
+        if mentions(e, live) and id(e) not in cleared:
+            return False
+        return all(walk(c, live) for c in _children(e))
+
+    result = frozenset(literal) if walk(body, names) else None
+    _STATIC[key] = (body, result)
     return result
 
 
