@@ -1,24 +1,38 @@
 """Direct evaluation of an RCL formula on a node's concrete values (no solver).
 
 Used by the offline trace checker (:mod:`rclverify.backends.monitors`) on
-every event, so it must be fast.  Values follow :mod:`rclverify.values`;
-the environment is keyed by qualified names (``"in.r"``,
-``"out.radiationStatus"``), a bare name resolving inputs first, like
-:meth:`CheckedNode.io_type`.
+every event and by the property tests on every example
+(:func:`rclverify.logic.decide.decide`), so it must be fast.  Values follow
+:mod:`rclverify.values`; the environment is keyed by qualified names
+(``"in.r"``, ``"out.radiationStatus"``), a bare name resolving inputs first,
+like :meth:`CheckedNode.io_type`.  REAL arithmetic is exact (a float is the
+rational it denotes), as in the Z3 encoding (shared/DESIGN.md).
 
 Quantifiers are decided by enumeration:
 
 * over ``BOOL``, an enumeration, a set literal or a finite set value: every
   element;
-* over ``REAL``/``INTEGER``/``NATURAL``: exactly, when the bound variable
-  occurs only as an argument of a function-typed input or of a constructor,
-  or as an operand of ``==``/``!=`` (possibly shifted by a literal,
-  ``i + 1``).  Then only the values the environment and the formula mention
-  (shifted back by those literals) can make an atom true; every other value
-  behaves like one fresh value, which is enumerated once.  For
-  ``exists_unique`` a fresh value satisfying the body stands for infinitely
-  many, so uniqueness fails.  Any other use (``x < 3``, ``x * y``) makes the
-  quantifier undecidable here and :func:`evaluate` answers ``None``.
+* over ``INTEGER``/``NATURAL`` bounded by literal guards (``k <= 12 -> ...``
+  under ``forall``, ``k >= -2 and k <= 2 and ...`` under ``exists``): every
+  value in the range (at most :data:`MAX_RANGE`);
+* a variable (or a pair ``x, y``) fixed by an equality guard ``v == t`` or
+  ``move(x, y) == t`` (``t`` free of it): only the value of ``t``;
+* over ``REAL``/``INTEGER``/``NATURAL`` otherwise: exactly, when the bound
+  variable occurs only as an argument of a function or of a constructor, or
+  as an operand of ``==``/``!=`` (possibly shifted by a literal, ``i + 1``)
+  whose other side is a literal, an I/O value, a function's result or a
+  variable bound outside; a constructor term holding it must itself be
+  compared with an I/O value, a function's result or a literal term.  Then
+  only the values the environment and the formula mention (shifted back by
+  those literals) can make an atom true; every other value behaves like one
+  fresh value, which is enumerated once.  For ``exists_unique`` a fresh
+  value satisfying the body stands for infinitely many, so uniqueness fails.
+  Any other use (``x < 3``, ``x * y``, ``x == in.r + 1``) makes the
+  quantifier undecidable here and :func:`evaluate` answers ``None`` (the
+  callers then ask Z3).
+
+tests/test_one_evaluator.py checks on random formulas and values that
+wherever this module and Z3 (:mod:`.concrete`) both decide, they agree.
 """
 from __future__ import annotations
 
