@@ -40,7 +40,7 @@ PACKAGE = "rclverify"
 #: pipeline/tasks -> cli; the other modules are placed by what they are and
 #: what they import:
 LAYERS: list[tuple[str, tuple[str, ...]]] = [
-    # Process-wide helpers that know nothing of RCL: the package's version
+    # Process-wide utilities that know nothing of RCL: the package's version
     # (``rclverify/__init__``; this entry is that module only, not the
     # package), when the garbage collector runs (heap.py, used by the
     # parser), the one-entry result memo (memo.py), machine faults worded as
