@@ -13,7 +13,7 @@ from __future__ import annotations
 
 from collections import Counter
 from fractions import Fraction
-from typing import Any, Callable
+from typing import Any, Callable, Iterator
 
 import pytest
 from hypothesis import HealthCheck, given, settings
@@ -22,6 +22,7 @@ from hypothesis import strategies as st
 from rclverify.logic.concrete import check_concrete
 from rclverify.logic.decide import decide
 from rclverify.logic.encode import EncodingError
+from rclverify.logic import world
 from rclverify.logic.evaluate import evaluate
 from rclverify.rcl.parser import parse_formula, parse_text
 from rclverify.rcl.typecheck import check
@@ -29,14 +30,14 @@ from rclverify.values import FiniteFunction, Term
 
 SIGNATURE = """
 context {
-  Color : {red, green, blue} ;
+  Hue : {red, green, blue} ;
   Cmd : { move(REAL, REAL), inspect(NATURAL) } ;
   Seen : NATURAL --> BOOL ;
   Way : REAL x REAL --> NATURAL ;
 }
 node n {
-  inputs( r : REAL, k : NATURAL, z : INTEGER, b : BOOL, c : Color, cmd : Cmd, f : Seen, g : Way )
-  outputs( o : REAL, m : NATURAL, oc : Color, ocmd : Cmd )
+  inputs( r : REAL, k : NATURAL, z : INTEGER, b : BOOL, c : Hue, cmd : Cmd, f : Seen, g : Way )
+  outputs( o : REAL, m : NATURAL, oc : Hue, ocmd : Cmd )
   guarantee( TRUE )
 }
 """
@@ -53,7 +54,7 @@ Draw = Callable[..., Any]
 LITERALS = {"NATURAL": ["0", "1", "2", "3"], "INTEGER": ["0", "1", "2", "(0 - 1)", "(0 - 2)"],
             "REAL": ["0", "1", "0.5", "1.5", "2.25", "(0 - 0.5)", "0.1"]}
 FREE = {"NATURAL": ["in.k", "out.m"], "INTEGER": ["in.z", "in.k"], "REAL": ["in.r", "out.o", "in.k"],
-        "BOOL": ["TRUE", "FALSE", "in.b"], "Color": ["red", "green", "blue", "in.c", "out.oc"],
+        "BOOL": ["TRUE", "FALSE", "in.b"], "Hue": ["red", "green", "blue", "in.c", "out.oc"],
         "Cmd": ["in.cmd", "out.ocmd"]}
 
 
@@ -62,7 +63,7 @@ def pick(draw: Draw, options: list[Any]) -> Any:
 
 
 def term(draw: Draw, sort: str, scope: Scope, depth: int) -> str:
-    """An RCL term of ``sort`` (NATURAL, INTEGER, REAL, BOOL, Color, Cmd)."""
+    """An RCL term of ``sort`` (NATURAL, INTEGER, REAL, BOOL, Hue, Cmd)."""
     ok = {sort} if sort not in NUMERIC else set(NUMERIC[:NUMERIC.index(sort) + 1])
     bound = [v for v, s in scope if s in ok]
     choice = draw(st.integers(0, 3 if depth > 0 else 2))
@@ -94,10 +95,10 @@ def atom(draw: Draw, scope: Scope) -> str:
         sort = NUMERIC[kind]
         return f"({term(draw, sort, scope, 1)} {pick(draw, ['<', '<=', '==', '!=', '>', '>='])} {term(draw, sort, scope, 1)})"
     if kind <= 5:
-        sort = ("Color", "Cmd", "BOOL")[kind - 3]
+        sort = ("Hue", "Cmd", "BOOL")[kind - 3]
         return f"({term(draw, sort, scope, 1)} {pick(draw, ['==', '!='])} {term(draw, sort, scope, 1)})"
     if kind == 6:
-        return f"({term(draw, 'Color', scope, 0)} {pick(draw, ['in', '!in'])} {{red, blue}})"
+        return f"({term(draw, 'Hue', scope, 0)} {pick(draw, ['in', '!in'])} {{red, blue}})"
     if kind == 7:
         return pick(draw, [lambda: f"({term(draw, 'NATURAL', scope, 1)} in {{0, 2}})",
                            lambda: f"({term(draw, 'INTEGER', scope, 1)} in NATURAL)"])()
@@ -119,7 +120,7 @@ def formula_text(draw: Draw, scope: Scope, depth: int) -> str:
 
 def quantified(draw: Draw, scope: Scope, depth: int) -> str:
     kind = pick(draw, ["forall", "exists", "exists_unique"])
-    sort = pick(draw, ["NATURAL", "INTEGER", "REAL", "BOOL", "Color", "REAL2"])
+    sort = pick(draw, ["NATURAL", "INTEGER", "REAL", "BOOL", "Hue", "REAL2"])
     k = len(scope)
     if sort == "REAL2":  # two variables, as the Agent's x, y
         names: tuple[str, ...] = (f"x{k}", f"y{k}")
@@ -172,6 +173,14 @@ def values(draw: Draw) -> dict[str, Any]:
 
 
 STATS: Counter[str] = Counter()
+
+
+@pytest.fixture(scope="module", autouse=True)
+def _fresh_z3_afterwards() -> Iterator[None]:
+    """The signature's sorts (an enumeration, a datatype) are declared in Z3's main
+    context; start a fresh one afterwards so that later tests do not meet them."""
+    yield
+    world.fresh()
 
 
 @settings(max_examples=700, deadline=None, database=None, derandomize=True,
