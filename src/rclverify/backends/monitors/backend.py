@@ -186,6 +186,8 @@ class MonitorsBackend:
                                           cfg.rules, cfg.horizon)
         except TraceError as exc:
             return evidence("error", f"the trace could not be read: {exc}", log=str(exc))
+        except Exception as exc:  # a recorded run is user input: whatever the checker meets is this record's error
+            return evidence("error", f"the trace could not be checked: {type(exc).__name__}: {exc}", log=str(exc))
         res = results[0]
         details = monitoring_details(res, trace, events, trace_sha256(target.root, trace), versions, cfg.horizon)
         status, explanation = verdict_status(res, trace)

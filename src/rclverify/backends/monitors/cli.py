@@ -41,6 +41,10 @@ def monitor_command(args: argparse.Namespace) -> int:
             _emit(report, args.json)
             print(str(exc), file=sys.stderr)
             return 2
+        except Exception as exc:  # a recorded run is user input: a located message, never a traceback
+            _emit(report, args.json)
+            print(f"{trace}: error: the trace could not be checked: {type(exc).__name__}: {exc}", file=sys.stderr)
+            return 2
         for res in results:
             status, explanation = verdict_status(res, trace)
             violated = violated or status == "failed"
