@@ -229,12 +229,13 @@ class NodeMonitor:
 
     # -- streaming ---------------------------------------------------------------
     def feed(self, ev: Event) -> None:
-        """Process one event (ignored unless on one of the node's topics)."""
+        """Process one event: every event moves the clock (closing obligations
+        past their horizon); only events on the node's topics change its state."""
+        self.advance(ev.time)
         vs = self.topics.get(ev.topic)
         if vs is None:
             return
         self.result.events += 1
-        self.advance(ev.time)
         is_input = False
         for key, typ, inp in vs:
             try:
@@ -396,6 +397,8 @@ def check_trace(checked: Checked, nodes: Iterable[CheckedNode], events: Iterable
     for ev in events:
         count += 1
         last_time = ev.time
+        for m in monitors:  # the clock first (as a live monitor's timer would), then the message
+            m.advance(ev.time)
         for m in monitors:
             m.feed(ev)
     for m in monitors:
