@@ -310,10 +310,20 @@ def main(argv: Sequence[str] | None = None) -> int:
 
     m = add("monitor", cmd_monitor, "check recorded runs (ROSMonitoring logs, ROS bags) against every "
             "node's contract", True)
-    m.add_argument("traces", nargs="+", metavar="TRACE", help="a .jsonl log, a .bag, a ROS 2 bag directory or .mcap")
+    m.add_argument("traces", nargs="*", metavar="TRACE", help="a .jsonl log, a .bag, a ROS 2 bag directory or .mcap")
     m.add_argument("--mapping", help="mapping file (default: backends/monitors/mapping.yaml if present)")
     m.add_argument("--horizon", type=float, help="seconds an input event may wait for its answer (default 5.0)")
     m.add_argument("--json", action="store_true", help="print the verdicts as JSON")
+    lv = m.add_argument_group("live monitoring (ROS 1; docs/monitors.md)")
+    lv.add_argument("--live", action="store_true", help="monitor the running ROS 1 system (ROS_MASTER_URI) instead")
+    lv.add_argument("--log", default="monitor_live.jsonl", help="JSON-lines log of events and verdicts to write")
+    lv.add_argument("--evidence", help="write the monitoring evidence record (JSON) here when stopped")
+    lv.add_argument("--duration", type=float, help="stop after this many seconds (default: at SIGINT/SIGTERM)")
+    lv.add_argument("--reorder-window", type=float, default=0.05, help="seconds to wait for stamp ordering")
+    lv.add_argument("--silence", type=float, default=0.0, help="report a topic silent for this many seconds (0: off)")
+    lv.add_argument("--status", type=float, default=1.0, help="seconds between status lines (0: off)")
+    lv.add_argument("--verdict-topic", default="/rclverify/verdict", help="topic of the per-event verdicts")
+    lv.add_argument("--node", dest="nodes", action="append", metavar="NODE", help="monitor only NODE (repeatable)")
     args = p.parse_args(argv)
     try:
         return int(args.fn(args))

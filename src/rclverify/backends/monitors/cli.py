@@ -1,8 +1,10 @@
-"""``rclverify monitor [-w WS] TRACE...``: check recorded runs against every node's contract.
+"""``rclverify monitor [-w WS] TRACE...``: check recorded runs against every node's contract;
+``rclverify monitor --live``: monitor the running ROS 1 system.
 
 Exit status: 0 when no contract is violated, 1 when one is, 2 for a trace
 or configuration that cannot be read (a located message on stderr; the
-verdicts of the traces already checked are printed first).
+verdicts of the traces already checked are printed first) or when ROS 1
+cannot be reached in ``--live`` mode.
 """
 from __future__ import annotations
 
@@ -29,6 +31,12 @@ def monitor_command(args: argparse.Namespace) -> int:
         cfg = load_mapping(root, args.mapping, args.horizon)
     except ConfigError as exc:
         print(f"{exc}" if ":" in str(exc).split(" ")[0] else f"{args.mapping}: error: {exc}", file=sys.stderr)
+        return 2
+    if getattr(args, "live", False):
+        return live_command(args, checked, cfg, root)
+    if not args.traces:
+        print("rclverify monitor: error: name a TRACE to check, or --live to monitor the running system",
+              file=sys.stderr)
         return 2
     violated = False
     report: list[dict[str, Any]] = []
@@ -57,6 +65,47 @@ def monitor_command(args: argparse.Namespace) -> int:
                 print(f"  {status}: {explanation}")
     _emit(report, args.json)
     return 1 if violated else 0
+
+
+def live_command(args: argparse.Namespace, checked: Any, cfg: Any, root: Path) -> int:
+    """``--live``: monitor the running ROS 1 system until SIGINT/SIGTERM or ``--duration``.
+
+    Writes the log (``--log``) and, on stop, the evidence record
+    (``--evidence``); prints a status line per ``--status`` seconds.  Exit
+    status 1 when a contract was violated, 0 otherwise, 2 when ROS 1 or a
+    message class is unavailable (one message on stderr)."""
+    import signal
+    import threading
+    from functools import partial
+
+    from .live import LiveSession, run_ros1
+    from .ros1 import RosUnavailable
+    if args.traces:
+        print("rclverify monitor: error: --live takes no TRACE (it monitors the running system)", file=sys.stderr)
+        return 2
+    unknown = [n for n in args.nodes or () if n not in checked.nodes]
+    if unknown:
+        print(f"rclverify monitor: error: no node named {unknown[0]!r}; nodes: {', '.join(checked.nodes)}",
+              file=sys.stderr)
+        return 2
+    nodes = [checked.nodes[n] for n in args.nodes] if args.nodes else list(checked.nodes.values())
+    log = Path(args.log)
+    factory = partial(LiveSession, checked, nodes, cfg.rules, cfg.horizon, log,
+                      reorder_window=args.reorder_window, silence_s=args.silence)
+    stop = threading.Event()
+    for sig in (signal.SIGINT, signal.SIGTERM):
+        signal.signal(sig, lambda *_: stop.set())
+    try:
+        record = run_ros1(factory, checked, nodes, [root / d for d in cfg.msg_dirs], verdict_topic=args.verdict_topic,
+                          last_prefix=args.verdict_topic.rsplit("/", 1)[0] or "/rclverify", node_name="rclverify_monitor",
+                          duration=args.duration, tick_s=0.02, status_s=args.status, stop=stop,
+                          evidence=Path(args.evidence) if args.evidence else None,
+                          out=lambda line: print(line, flush=True))
+    except RosUnavailable as exc:
+        print(f"rclverify monitor --live: error: {exc}", file=sys.stderr)
+        return 2
+    print(f"{log}: {record['events']} event(s), {record['verdicts']} verdict(s); sha256 {record['sha256']}")
+    return 1 if any(n["status"] == "failed" for n in record["nodes"]) else 0
 
 
 def _emit(report: list[dict[str, Any]], as_json: bool) -> None:

@@ -77,7 +77,9 @@ class TopicStatus:
 class OnlineEngine:
     """Every node's monitor, fed message by message.
 
-    ``on_verdict(Verdict)`` receives each event's verdict when decided;
+    ``on_event(Event)`` receives each message as it is released to the
+    monitors (in order, before its verdicts); ``on_verdict(Verdict)``
+    receives each event's verdict when decided;
     ``on_silence(topic, seconds, silent)`` when a topic goes silent
     (``silent`` True) or comes back (False).  Times are seconds on one clock
     (ROS time live, the trace's clock in a replay).
@@ -91,6 +93,7 @@ class OnlineEngine:
     silence_s: float = 0.0
     on_verdict: Callable[[Verdict], None] | None = None
     on_silence: Callable[[str, float, bool], None] | None = None
+    on_event: Callable[[Event], None] | None = None
     monitors: list[NodeMonitor] = field(init=False)
     topics: dict[str, TopicStatus] = field(init=False)
     late: int = field(init=False, default=0)
@@ -146,6 +149,10 @@ class OnlineEngine:
             self._clock = t
             ev = Event(self.released, t, topic, fields, where or f"message {self.released}")
             self.released += 1
+            if self.on_event is not None:
+                self.on_event(ev)
+            for m in self.monitors:
+                m.advance(t)
             for m in self.monitors:
                 m.feed(ev)
 
