@@ -3,6 +3,7 @@ run as a rospy publisher: what the live monitor's test and benchmark watch.
 
     python3 scripts/ros1_case_study.py sensor [--misclassify]
     python3 scripts/ros1_case_study.py replay RUN.jsonl [--rate K] [--skip TOPIC ...]
+    python3 scripts/ros1_case_study.py listen TOPIC --out FILE [--count N]
 
 ``sensor`` runs the bundled Python Radiation Sensor
 (``backends/property_tests/radiation_sensor.py``, the function the
@@ -14,8 +15,11 @@ ROSMonitoring log at their recorded times divided by ``--rate``, leaving out
 the ``--skip`` topics (those a live node produces), after waiting for
 ``--wait-for`` subscribers on every topic.  All topics carry
 ``gazebo_radiation_plugin/Snapshot`` from the workspace's ``.msg`` file
-(generated with genpy at run time, docs/monitors.md).  ROS_MASTER_URI says
-which master; both stop at SIGINT/SIGTERM or when done.
+(generated with genpy at run time, docs/monitors.md).  ``listen`` writes
+each ``std_msgs/String`` message of TOPIC (the live monitor's verdicts) as a
+JSON line ``{"received": ROS time, "data": ...}``, flushed at once, until
+SIGINT/SIGTERM or ``--count`` messages.  ROS_MASTER_URI says which master;
+each stops at SIGINT/SIGTERM or when done.
 """
 from __future__ import annotations
 
@@ -71,7 +75,27 @@ def sensor(misclassify: bool) -> int:
     return 0
 
 
-def replay(run: Path, rate: float, skip: set[str], wait_for: int, timeout: float) -> int:
+def listen(topic: str, out: Path, count: int) -> int:
+    from rclverify.backends.monitors.ros1 import import_rospy
+    rospy = import_rospy()
+    from std_msgs.msg import String
+    rospy.init_node("verdict_listener", anonymous=True)
+    got = [0]
+    with out.open("w", encoding="utf-8") as fh:
+        def on_msg(msg: Any) -> None:
+            fh.write(json.dumps({"received": rospy.get_time(), "data": json.loads(msg.data)}) + "\n")
+            fh.flush()
+            got[0] += 1
+            if count and got[0] >= count:
+                rospy.signal_shutdown("enough")
+        rospy.Subscriber(topic, String, on_msg, queue_size=10000)
+        print(f"listening on {topic}", flush=True)
+        rospy.spin()
+    return 0
+
+
+def replay(run: Path, rate: float, skip: set[str], wait_for: int, timeout: float,
+           need: dict[str, int] | None = None) -> int:
     from rclverify.backends.monitors.ros1 import build_message, import_rospy, message_class
     rospy = import_rospy()
     Snapshot = message_class(SNAPSHOT, MSG_DIRS)
@@ -80,7 +104,8 @@ def replay(run: Path, rate: float, skip: set[str], wait_for: int, timeout: float
     rospy.init_node("replay", anonymous=True)
     pubs = {t: rospy.Publisher("/" + t, Snapshot, queue_size=1000) for t in sorted({e["topic"].lstrip("/") for e in events})}
     deadline = time.monotonic() + timeout
-    while any(p.get_num_connections() < wait_for for p in pubs.values()):
+    need = need or {}
+    while any(p.get_num_connections() < need.get(t, wait_for) for t, p in pubs.items()):
         if time.monotonic() > deadline or rospy.is_shutdown():
             print("replay: error: subscribers did not connect in time", file=sys.stderr)
             return 2
@@ -107,11 +132,19 @@ def main() -> int:
     r.add_argument("--rate", type=float, default=1.0)
     r.add_argument("--skip", nargs="*", default=[])
     r.add_argument("--wait-for", type=int, default=1, help="subscribers each topic needs before the replay starts")
+    r.add_argument("--need", nargs="*", default=[], metavar="TOPIC=N", help="subscribers a topic needs (overrides --wait-for)")
     r.add_argument("--timeout", type=float, default=20.0)
+    li = sub.add_parser("listen")
+    li.add_argument("topic")
+    li.add_argument("--out", type=Path, required=True)
+    li.add_argument("--count", type=int, default=0)
     a = p.parse_args()
     if a.what == "sensor":
         return sensor(a.misclassify)
-    return replay(a.run, a.rate, set(a.skip), a.wait_for, a.timeout)
+    if a.what == "listen":
+        return listen(a.topic, a.out, a.count)
+    need = {t: int(n) for t, _, n in (x.partition("=") for x in a.need)}
+    return replay(a.run, a.rate, set(a.skip), a.wait_for, a.timeout, need)
 
 
 if __name__ == "__main__":
