@@ -259,6 +259,11 @@ def cmd_monitor(args: argparse.Namespace) -> int:
     return monitor_command(args)
 
 
+def cmd_oracle(args: argparse.Namespace) -> int:
+    from .backends.monitors.cli import oracle_command
+    return oracle_command(args)
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``rclverify`` console script; returns the exit code."""
     p = argparse.ArgumentParser(prog="rclverify", description="Compositional verification from RCL contracts.")
@@ -324,6 +329,12 @@ def main(argv: Sequence[str] | None = None) -> int:
     lv.add_argument("--status", type=float, default=1.0, help="seconds between status lines (0: off)")
     lv.add_argument("--verdict-topic", default="/rclverify/verdict", help="topic of the per-event verdicts")
     lv.add_argument("--node", dest="nodes", action="append", metavar="NODE", help="monitor only NODE (repeatable)")
+    o = add("oracle", cmd_oracle, "serve the contracts as a ROSMonitoring oracle over WebSocket", True)
+    o.add_argument("--port", type=int, default=8080, help="TCP port (default 8080)")
+    o.add_argument("--host", default="127.0.0.1", help="address to bind (default 127.0.0.1)")
+    o.add_argument("--node", dest="nodes", action="append", metavar="NODE", help="serve only NODE (repeatable)")
+    o.add_argument("--mapping", help="mapping file (default: backends/monitors/mapping.yaml if present)")
+    o.add_argument("--horizon", type=float, help="seconds an input event may wait for its answer")
     args = p.parse_args(argv)
     try:
         return int(args.fn(args))

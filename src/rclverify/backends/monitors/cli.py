@@ -108,6 +108,49 @@ def live_command(args: argparse.Namespace, checked: Any, cfg: Any, root: Path) -
     return 1 if any(n["status"] == "failed" for n in record["nodes"]) else 0
 
 
+def oracle_command(args: argparse.Namespace) -> int:
+    """``rclverify oracle --port N``: serve the contracts as a ROSMonitoring oracle
+    (WebSocket, :mod:`.oracle`) until SIGINT/SIGTERM.  Exit 2 for a port that
+    cannot be bound or a configuration that cannot be read."""
+    import asyncio
+    import signal
+
+    from ...pipeline import Workspace
+    from .oracle import serve
+    root = Path(args.workspace)
+    checked = Workspace(root, args.plan).checked
+    try:
+        cfg = load_mapping(root, args.mapping, args.horizon)
+    except ConfigError as exc:
+        print(f"{args.mapping}: error: {exc}", file=sys.stderr)
+        return 2
+    unknown = [n for n in args.nodes or () if n not in checked.nodes]
+    if unknown:
+        print(f"rclverify oracle: error: no node named {unknown[0]!r}; nodes: {', '.join(checked.nodes)}",
+              file=sys.stderr)
+        return 2
+    nodes = [checked.nodes[n] for n in args.nodes] if args.nodes else list(checked.nodes.values())
+
+    async def main() -> None:
+        stop, ready = asyncio.Event(), asyncio.Event()
+        loop = asyncio.get_running_loop()
+        for sig in (signal.SIGINT, signal.SIGTERM):
+            loop.add_signal_handler(sig, stop.set)
+        task = asyncio.create_task(serve(checked, nodes, cfg.rules, cfg.horizon, args.port, args.host, ready, stop))
+        done, _ = await asyncio.wait([task, asyncio.create_task(ready.wait())], return_when=asyncio.FIRST_COMPLETED)
+        if task in done:
+            task.result()  # raises the bind error
+        print(f"oracle for {', '.join(n.name for n in nodes)} on ws://{args.host}:{args.port}", flush=True)
+        await task
+    try:
+        asyncio.run(main())
+    except OSError as exc:
+        print(f"rclverify oracle: error: cannot listen on {args.host}:{args.port}: {exc.strerror or exc}",
+              file=sys.stderr)
+        return 2
+    return 0
+
+
 def _emit(report: list[dict[str, Any]], as_json: bool) -> None:
     if as_json:
         print(json.dumps(report, indent=2, sort_keys=True))
