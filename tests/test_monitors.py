@@ -208,7 +208,9 @@ def test_config_is_yaml_with_the_documented_keys(checked: Any) -> None:
         ids.append(mon["id"])
         assert set(mon["oracle"]) == {"url", "port", "action"}
         for t in mon["topics"]:
-            assert set(t) == {"name", "type", "action"} and t["type"] == "gazebo_radiation_plugin.msg.Snapshot"
+            assert set(t) == {"name", "type", "action", "ordering"}
+            assert t["type"] == "gazebo_radiation_plugin.msg.Snapshot"
+            assert t["ordering"] == {"enabled": True, "source": "header_stamp", "max_delay_ms": 50}
     assert len(set(ids)) == len(ids) == 4
     assert render_config(checked, "ros2") == render_config(checked, "ros2")
 
