@@ -111,3 +111,36 @@ def test_a_silent_topic_is_reported_once_and_its_return_too(case_study: tuple[An
 ])
 def test_header_stamp(fields: dict[str, Any], stamp: float | None) -> None:
     assert header_stamp(fields) == stamp
+
+
+def test_live_session_logs_publishes_and_writes_evidence_the_offline_check_agrees_with(
+        case_study: tuple[Any, Any], tmp_path: Path) -> None:
+    """The part of the live monitor below the middleware (what the ROS 2 layer uses too)."""
+    import hashlib
+    import json
+
+    from rclverify.backends.monitors.live import VERDICT_LOG_TOPIC, LiveSession
+    checked, cfg = case_study
+    published: list[dict[str, Any]] = []
+    last: dict[str, dict[str, Any]] = {}
+    log = tmp_path / "live.jsonl"
+    session = LiveSession(checked, list(checked.nodes.values()), cfg.rules, cfg.horizon, log, reorder_window=0.05,
+                          silence_s=5.0, publish=published.append, publish_last=lambda n, m: last.__setitem__(n, m))
+    for ev in read_trace(TRACES / "sensor_fault.jsonl", MSG):
+        session.tick(ev.time)
+        session.push("/" + ev.topic, {**ev.fields, "nan": float("nan")}, ev.time)
+    session.tick(40.0)
+    assert "RadiationSensor:" in session.status_line() and "silent:" in session.status_line()
+    record = session.stop(tmp_path / "evidence.json")
+    assert json.loads((tmp_path / "evidence.json").read_text()) == record
+    assert record["sha256"] == hashlib.sha256(log.read_bytes()).hexdigest()
+    assert record["silent_topics"] and all(s["silent"] for s in record["silent_topics"])
+    verdicts = [m for m in published if m["node"]]
+    assert len(verdicts) == record["verdicts"]
+    assert last["RadiationSensor"] == [m for m in verdicts if m["node"] == "RadiationSensor"][-1]
+    sensor = {n["node"]: n for n in record["nodes"]}["RadiationSensor"]
+    assert sensor["status"] == "failed" and sensor["first_violation"]["guarantee"] == 1
+    # the log re-checks offline to the same counts; its verdict lines are skipped
+    _, results = check_trace(checked, list(checked.nodes.values()), read_trace(log), cfg.rules, cfg.horizon)
+    assert {r.node: r.counts for r in results} == {n["node"]: n["counts"] for n in record["nodes"]}
+    assert sum(1 for line in log.read_text().splitlines() if VERDICT_LOG_TOPIC in line) == record["verdicts"]

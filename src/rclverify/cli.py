@@ -329,6 +329,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     lv.add_argument("--status", type=float, default=1.0, help="seconds between status lines (0: off)")
     lv.add_argument("--verdict-topic", default="/rclverify/verdict", help="topic of the per-event verdicts")
     lv.add_argument("--node", dest="nodes", action="append", metavar="NODE", help="monitor only NODE (repeatable)")
+    lv.add_argument("--ros", choices=("1", "2"), help="ROS version (default: $ROS_VERSION, else 1)")
     o = add("oracle", cmd_oracle, "serve the contracts as a ROSMonitoring oracle over WebSocket", True)
     o.add_argument("--port", type=int, default=8080, help="TCP port (default 8080)")
     o.add_argument("--host", default="127.0.0.1", help="address to bind (default 127.0.0.1)")

@@ -78,8 +78,11 @@ def live_command(args: argparse.Namespace, checked: Any, cfg: Any, root: Path) -
     import threading
     from functools import partial
 
+    import os
+
     from .live import LiveSession, run_ros1
     from .ros1 import RosUnavailable
+    from .ros2 import Ros2Unavailable, run_ros2
     if args.traces:
         print("rclverify monitor: error: --live takes no TRACE (it monitors the running system)", file=sys.stderr)
         return 2
@@ -95,13 +98,17 @@ def live_command(args: argparse.Namespace, checked: Any, cfg: Any, root: Path) -
     stop = threading.Event()
     for sig in (signal.SIGINT, signal.SIGTERM):
         signal.signal(sig, lambda *_: stop.set())
+    ros = args.ros or os.environ.get("ROS_VERSION", "1")  # ROS's setup scripts set ROS_VERSION
+    common: dict[str, Any] = dict(
+        verdict_topic=args.verdict_topic, last_prefix=args.verdict_topic.rsplit("/", 1)[0] or "/rclverify",
+        node_name="rclverify_monitor", duration=args.duration, tick_s=0.02, status_s=args.status, stop=stop,
+        evidence=Path(args.evidence) if args.evidence else None, out=lambda line: print(line, flush=True))
     try:
-        record = run_ros1(factory, checked, nodes, [root / d for d in cfg.msg_dirs], verdict_topic=args.verdict_topic,
-                          last_prefix=args.verdict_topic.rsplit("/", 1)[0] or "/rclverify", node_name="rclverify_monitor",
-                          duration=args.duration, tick_s=0.02, status_s=args.status, stop=stop,
-                          evidence=Path(args.evidence) if args.evidence else None,
-                          out=lambda line: print(line, flush=True))
-    except RosUnavailable as exc:
+        if ros == "2":
+            record = run_ros2(factory, checked, nodes, **common)
+        else:
+            record = run_ros1(factory, checked, nodes, [root / d for d in cfg.msg_dirs], **common)
+    except (RosUnavailable, Ros2Unavailable) as exc:
         print(f"rclverify monitor --live: error: {exc}", file=sys.stderr)
         return 2
     print(f"{log}: {record['events']} event(s), {record['verdicts']} verdict(s); sha256 {record['sha256']}")

@@ -164,12 +164,16 @@ def run_ros1(session_factory: Callable[..., LiveSession], checked: Checked, node
     ``<last_prefix>/<node>/last_verdict`` (latched).  Raises
     :class:`~.ros1.RosUnavailable` when rospy or a message class is missing.
     """
-    from .ros1 import contract_topics, flatten, import_rospy, message_class
+    from .ros1 import RosUnavailable, contract_topics, flatten, import_rospy, message_class
     rospy = import_rospy()
     from std_msgs.msg import String
     topics = contract_topics(checked, nodes)
     classes = {t: message_class(typ, msg_dirs) for t, typ in topics.items()}  # fail early, located
     by_type = {c._type: c for c in classes.values()}  # type: ignore[attr-defined]
+    import rosgraph
+    if not rosgraph.is_master_online():
+        raise RosUnavailable(f"no ROS master answers at {rosgraph.get_master_uri()} (start roscore, or set "
+                             "ROS_MASTER_URI)")
     rospy.init_node(node_name, anonymous=False, disable_signals=True)
     pub = rospy.Publisher(verdict_topic, String, queue_size=10000)
     lasts: dict[str, Any] = {}
