@@ -109,8 +109,7 @@ def live_run(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
 
 def _live_verdicts(log: Path) -> list[dict[str, Any]]:
     rows = [json.loads(line) for line in log.read_text().splitlines()]
-    return [{k[len("verdict_"):]: v for k, v in r.items() if k.startswith("verdict_")}
-            for r in rows if r["topic"] == VERDICT_LOG_TOPIC]
+    return [r["verdict"] for r in rows if r["topic"] == VERDICT_LOG_TOPIC]
 
 
 def _key(v: dict[str, Any]) -> tuple[Any, ...]:

@@ -121,8 +121,8 @@ def test_live_session_logs_publishes_and_writes_evidence_the_offline_check_agree
 
     from rclverify.backends.monitors.live import VERDICT_LOG_TOPIC, LiveSession
     checked, cfg = case_study
-    published: list[dict[str, Any]] = []
-    last: dict[str, dict[str, Any]] = {}
+    published: list[str] = []
+    last: dict[str, str] = {}
     log = tmp_path / "live.jsonl"
     session = LiveSession(checked, list(checked.nodes.values()), cfg.rules, cfg.horizon, log, reorder_window=0.05,
                           silence_s=5.0, publish=published.append, publish_last=lambda n, m: last.__setitem__(n, m))
@@ -135,9 +135,9 @@ def test_live_session_logs_publishes_and_writes_evidence_the_offline_check_agree
     assert json.loads((tmp_path / "evidence.json").read_text()) == record
     assert record["sha256"] == hashlib.sha256(log.read_bytes()).hexdigest()
     assert record["silent_topics"] and all(s["silent"] for s in record["silent_topics"])
-    verdicts = [m for m in published if m["node"]]
+    verdicts = [m for m in map(json.loads, published) if m["node"]]
     assert len(verdicts) == record["verdicts"]
-    assert last["RadiationSensor"] == [m for m in verdicts if m["node"] == "RadiationSensor"][-1]
+    assert json.loads(last["RadiationSensor"]) == [m for m in verdicts if m["node"] == "RadiationSensor"][-1]
     sensor = {n["node"]: n for n in record["nodes"]}["RadiationSensor"]
     assert sensor["status"] == "failed" and sensor["first_violation"]["guarantee"] == 1
     # the log re-checks offline to the same counts; its verdict lines are skipped

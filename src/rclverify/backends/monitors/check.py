@@ -180,6 +180,8 @@ class NodeMonitor:
                 self.values[key] = initial_value(typ, rules.get(topic, TopicRule()))
         self.assumption = tuple(c.formula for c in node.node.assumes)
         self.guarantees = tuple(c.formula for c in node.node.guarantees)
+        self._texts = {k: expr_to_rcl(f) for k, f in enumerate(self.guarantees, 1)}  # printed once, not per verdict
+        self._renders: dict[int, tuple[Any, str]] = {}
         needed: set[str] = set()
         for f in self.assumption + self.guarantees:
             _names(f, needed)
@@ -212,7 +214,19 @@ class NodeMonitor:
 
 
     def _rendered(self, values: Mapping[str, Any]) -> dict[str, str]:
-        return {k: render(v) for k, v in sorted(values.items()) if v is not None}
+        return {k: self._render(v) for k, v in sorted(values.items()) if v is not None}
+
+    def _render(self, v: Any) -> str:
+        """``render(v)``, remembered per value object (a table is rendered once
+        while it stays the state, not at every verdict that shows it)."""
+        hit = self._renders.get(id(v))
+        if hit is not None and hit[0] is v:
+            return hit[1]
+        if len(self._renders) >= 256:
+            self._renders.clear()
+        text = render(v)
+        self._renders[id(v)] = (v, text)
+        return text
 
     def _observed(self, prefix: str) -> dict[str, Any]:
         """The values with ``prefix`` observed so far (an unobserved variable has no entry)."""
@@ -329,6 +343,8 @@ class NodeMonitor:
         self._expire(self.now)
 
     def _expire(self, now: float) -> None:
+        if not self.pending:
+            return
         empty = []
         for key, g in self.pending.items():
             while g.events and g.events[0].time + self.horizon < now:
@@ -352,7 +368,7 @@ class NodeMonitor:
             out, k, outputs = g.last
             first = {
                 "event": out.index, "time": out.time, "where": out.where, "guarantee": k,
-                "formula": expr_to_rcl(self.guarantees[k - 1]), "trigger": trigger.index,
+                "formula": self._texts[k], "trigger": trigger.index,
                 "trigger_time": trigger.time, "trigger_where": trigger.where,
                 "values": self._rendered({**g.inputs, **outputs}),
                 "reason": f"guarantee {k} is false on the output at {out.where} answering the input at "

@@ -8,9 +8,10 @@ ROS 2 layer (:mod:`.ros2`) only move messages in and verdicts out.  It
   ROSMonitoring's log format (``topic``, ``time``, the fields flattened;
   verdicts on the topic :data:`VERDICT_LOG_TOPIC`, which no contract names,
   so ``rclverify monitor LOG`` re-checks the messages and skips them);
-* hands each verdict, as a JSON-ready dict, to ``publish`` (node,
-  guarantee, verdict, time, the first violation's values ...), and the
-  node's latest verdict to ``publish_last`` (a latched topic);
+* hands each verdict, as JSON text, to ``publish`` (node, guarantee,
+  verdict, time, the first violation's values ...), and each node's latest
+  verdict to ``publish_last`` (a latched topic) at every timer tick where
+  it changed;
 * keeps a one-line status per node (:meth:`status_line`);
 * on :meth:`stop` writes a monitoring evidence record shaped like the
   offline one (events, verdict counts, first violation, the log's sha256).
@@ -42,18 +43,27 @@ VERDICT_LOG_TOPIC = "rclverify/verdict"
 def _json_safe(v: Any) -> Any:
     if isinstance(v, float) and not math.isfinite(v):
         return repr(v)  # JSON has no NaN; the reader would refuse the line
-    if isinstance(v, Mapping):
+    if isinstance(v, dict):
         return {str(k): _json_safe(x) for k, x in v.items()}
     if isinstance(v, (list, tuple)):
         return [_json_safe(x) for x in v]
     return v
 
 
+def dumps(obj: Any) -> str:
+    """Compact JSON; a NaN or an infinity (no JSON number) is written as its
+    string (``"nan"``), so every line stays readable by the log reader."""
+    try:
+        return json.dumps(obj, allow_nan=False, separators=(", ", ": "))
+    except ValueError:
+        return json.dumps(_json_safe(obj), separators=(", ", ": "))
+
+
 class LiveSession:
     """One live run: engine, log, verdict sinks, status and evidence.
 
     ``log`` is the JSON-lines file to write (created, truncated);
-    ``publish(dict)`` / ``publish_last(node, dict)`` the verdict sinks;
+    ``publish(text)`` / ``publish_last(node, text)`` the verdict sinks (JSON text);
     ``horizon``, ``reorder_window`` and ``silence_s`` in seconds.  Thread
     safe: :meth:`push` and :meth:`tick` may come from different threads.
     """
@@ -73,23 +83,20 @@ class LiveSession:
         self.engine = OnlineEngine(checked, list(nodes), rules, horizon, reorder_window, silence_s,
                                    on_verdict=self._verdict, on_silence=self._silence, on_event=self._event)
         self.results: list[NodeResult] | None = None
+        self._last: dict[str, str] = {}  # node -> latest verdict not yet published as its last verdict
 
     # -- engine callbacks (called under the lock) ----------------------------------
-    def _write(self, obj: Mapping[str, Any]) -> None:
-        self._log.write(json.dumps(_json_safe(obj), sort_keys=False) + "\n")
-
     def _event(self, ev: Event) -> None:
-        self._write({"topic": ev.topic, "time": ev.time, **{k: v for k, v in ev.fields.items()
-                                                            if k not in ("topic", "time")}})
+        self._log.write(dumps({"topic": ev.topic, "time": ev.time, **{k: v for k, v in ev.fields.items()
+                                                                       if k not in ("topic", "time")}}) + "\n")
 
     def _verdict(self, v: Verdict) -> None:
         self.verdicts += 1
-        msg = v.to_json()
-        self._write({"topic": VERDICT_LOG_TOPIC, "time": v.decided_at, **{f"verdict_{k}": x for k, x in msg.items()}})
+        text = dumps(v.to_json())  # serialised once: the log line and the published message
+        self._log.write(f'{{"topic": "{VERDICT_LOG_TOPIC}", "time": {v.decided_at!r}, "verdict": {text}}}\n')
         if self.publish is not None:
-            self.publish(msg)
-        if self.publish_last is not None:
-            self.publish_last(v.node, msg)
+            self.publish(text)
+        self._last[v.node] = text
 
     def _silence(self, topic: str, seconds: float, silent: bool) -> None:
         note = {"topic": topic, "silent": silent, "for_s": round(seconds, 3),
@@ -97,8 +104,8 @@ class LiveSession:
         if silent:
             self.silences.append(note)
         if self.publish is not None:
-            self.publish({"node": "", "verdict": "silent" if silent else "resumed", "topic": topic,
-                          "silent_for_s": round(seconds, 3), "time": note["time"]})
+            self.publish(dumps({"node": "", "verdict": "silent" if silent else "resumed", "topic": topic,
+                                "silent_for_s": round(seconds, 3), "time": note["time"]}))
 
     # -- input ---------------------------------------------------------------------
     def push(self, topic: str, fields: Mapping[str, Any], received: float) -> None:
@@ -112,7 +119,16 @@ class LiveSession:
         with self.lock:
             if self.results is None:
                 self.engine.tick(now)
+                self._flush_last()
                 self._log.flush()
+
+    def _flush_last(self) -> None:
+        """Publish each node's latest verdict (latched), once per timer tick
+        rather than at every event: the topic holds the last one either way."""
+        if self.publish_last is not None:
+            for node, text in self._last.items():
+                self.publish_last(node, text)
+        self._last.clear()
 
     def status_line(self) -> str:
         """``Node: 3 satisfied, 1 violated | Node2: ...`` (a live per-node status)."""
@@ -129,6 +145,7 @@ class LiveSession:
         with self.lock:
             if self.results is None:
                 self.results = self.engine.finish()
+                self._flush_last()
                 self._log.close()
         sha = hashlib.sha256(self.log_path.read_bytes()).hexdigest()
         versions = tool_versions()
@@ -179,8 +196,8 @@ def run_ros1(session_factory: Callable[..., LiveSession], checked: Checked, node
     lasts: dict[str, Any] = {}
     for n in nodes:
         lasts[n.name] = rospy.Publisher(f"{last_prefix}/{n.name}/last_verdict", String, queue_size=1, latch=True)
-    session = session_factory(publish=lambda m: pub.publish(String(json.dumps(_json_safe(m)))),
-                              publish_last=lambda n, m: lasts[n].publish(String(json.dumps(_json_safe(m)))))
+    session = session_factory(publish=lambda text: pub.publish(String(text)),
+                              publish_last=lambda n, text: lasts[n].publish(String(text)))
     decode_errors: dict[str, int] = {}
 
     def callback(raw: Any, topic: str) -> None:

@@ -19,13 +19,12 @@ exercised by the test suite: docs/monitors.md says so.
 """
 from __future__ import annotations
 
-import json
 import threading
 import time as _time
 from typing import Any, Callable
 
 from ...rcl.types import Checked, CheckedNode
-from .live import LiveSession, _json_safe
+from .live import LiveSession
 
 
 class Ros2Unavailable(Exception):
@@ -66,9 +65,9 @@ def run_ros2(session_factory: Callable[..., LiveSession], checked: Checked, node
     pub = node.create_publisher(String, verdict_topic, 1000)
     lasts = {n.name: node.create_publisher(String, f"{last_prefix}/{n.name}/last_verdict", latched) for n in nodes}
 
-    def text(m: Any) -> Any:
+    def text(data: str) -> Any:
         s = String()
-        s.data = json.dumps(_json_safe(m))
+        s.data = data
         return s
     session = session_factory(publish=lambda m: pub.publish(text(m)),
                               publish_last=lambda n, m: lasts[n].publish(text(m)))
