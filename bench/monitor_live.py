@@ -2,8 +2,8 @@
 
 Live (ROS 1, needs rosmaster and rospy): starts a master on 127.0.0.1 (a
 free port), ``rclverify monitor --live`` on the case study's contracts (all
-four nodes, ``--reorder-window 0``: the case study's messages carry no
-header stamp), a listener on the verdict topic, and a publisher sending the
+four nodes, or the ``--node`` ones; ``--reorder-window 0``: the case
+study's messages carry no header stamp), a listener on the verdict topic, and a publisher sending the
 bundled nominal run's messages round-robin over its eight topics at
 ``--rate`` messages/s for ``--seconds`` s.  Prints
 
@@ -27,7 +27,8 @@ Targets the issue names: 2,000 messages/s kept up with, latency median
 under 5 ms and 99th percentile under 50 ms; the oracle at 10,000 events/s.
 The figures are printed, not asserted.  Usage::
 
-    python3 bench/monitor_live.py [--rate 2000 --seconds 5] [--oracle-events 20000] [--no-live | --no-oracle]
+    python3 bench/monitor_live.py [--rate 2000 --seconds 5] [--node NODE ...] [--oracle-events 20000]
+                                  [--no-live | --no-oracle]
 """
 from __future__ import annotations
 
@@ -56,12 +57,17 @@ def _lines() -> list[dict[str, Any]]:
 
 # -- helper processes ------------------------------------------------------------
 
-def publisher(rate: float, seconds: float, out: Path, wait_for: int) -> int:
-    """Publish the run's messages round-robin at ``rate``/s; write (topic, k, t_pub) per message."""
-    from rclverify.backends.monitors.ros1 import build_message, import_rospy, message_class
+def publisher(rate: float, seconds: float, out: Path, wait_for: int, nodes: list[str]) -> int:
+    """Publish the run's messages on the monitored nodes' topics round-robin at
+    ``rate``/s; write (topic, t_pub) per message."""
+    from rclverify.backends.monitors.ros1 import build_message, contract_topics, import_rospy, message_class
+    from rclverify.rcl.typecheck import load
     rospy = import_rospy()
     Snapshot = message_class("gazebo_radiation_plugin/Snapshot", [ROOT / "backends/monitors/msg"])
-    lines = _lines()
+    checked = load([ROOT / "contracts" / "remote_inspection.rcl"])
+    topics = {t.lstrip("/") for t in contract_topics(checked, [checked.nodes[n] for n in nodes] if nodes
+                                                     else checked.nodes.values())}
+    lines = [e for e in _lines() if e["topic"] in topics]
     rospy.init_node("bench_publisher", anonymous=True)
     pubs = {t: rospy.Publisher("/" + t, Snapshot, queue_size=100000) for t in sorted({e["topic"] for e in lines})}
     deadline = time.monotonic() + 20
@@ -137,7 +143,7 @@ def _cpu_seconds(pid: int) -> float | None:
         return None
 
 
-def bench_live(rate: float, seconds: float) -> None:
+def bench_live(rate: float, seconds: float, nodes: list[str]) -> None:
     from rclverify.backends.monitors.ros1 import LocalMaster, RosUnavailable, import_rospy
     try:
         import_rospy()
@@ -159,11 +165,13 @@ def bench_live(rate: float, seconds: float) -> None:
                 lis = start([__file__, "--listener", str(tmp / "verdicts.json")], "listener.out")
                 mon = start(["-m", "rclverify.cli", "monitor", "--live", "-w", str(ROOT), "--horizon", "2.0",
                              "--reorder-window", "0", "--status", "0", "--log", str(tmp / "live.jsonl"),
-                             "--evidence", str(tmp / "evidence.json")], "monitor.out")
+                             "--evidence", str(tmp / "evidence.json"),
+                             *[x for n in nodes for x in ("--node", n)]], "monitor.out")
                 _wait_text(tmp / "listener.out", "listening", 30)
                 _wait_text(tmp / "monitor.out", "monitoring", 30)
                 pub = start([__file__, "--publisher", str(tmp / "sent.json"), "--rate", str(rate),
-                             "--seconds", str(seconds)], "publisher.out")
+                             "--seconds", str(seconds), *[x for n in nodes for x in ("--node", n)]],
+                            "publisher.out")
                 pub.wait(seconds * 10 + 60)
                 time.sleep(2.5)  # the horizon passes; the timer resolves what waits
                 cpu = _cpu_seconds(mon.pid)
@@ -190,6 +198,7 @@ def bench_live(rate: float, seconds: float) -> None:
             continue
         per_topic.append((topic, seen.get(topic, 0)))
         seen[topic] = seen.get(topic, 0) + 1
+    print(f"live: nodes monitored: {', '.join(nodes) or 'all four'}")
     print(f"live: published {len(sent)} message(s) in {pub_out['elapsed']:.2f} s "
           f"({len(sent) / pub_out['elapsed']:.0f} msg/s, asked {rate:.0f}); the monitor checked {record['events']} "
           f"event(s) and published {record['verdicts']} verdict(s); {len(verdicts)} verdict message(s) received")
@@ -279,17 +288,18 @@ def main() -> int:
     p.add_argument("--rate", type=float, default=2000.0)
     p.add_argument("--seconds", type=float, default=5.0)
     p.add_argument("--oracle-events", type=int, default=20000)
+    p.add_argument("--node", dest="nodes", action="append", default=[], help="monitor only NODE (repeatable)")
     p.add_argument("--no-live", action="store_true")
     p.add_argument("--no-oracle", action="store_true")
     p.add_argument("--publisher", type=Path, help=argparse.SUPPRESS)
     p.add_argument("--listener", type=Path, help=argparse.SUPPRESS)
     a = p.parse_args()
     if a.publisher:
-        return publisher(a.rate, a.seconds, a.publisher, wait_for=1)
+        return publisher(a.rate, a.seconds, a.publisher, wait_for=1, nodes=a.nodes)
     if a.listener:
         return listener("/rclverify/verdict", a.listener)
     if not a.no_live:
-        bench_live(a.rate, a.seconds)
+        bench_live(a.rate, a.seconds, a.nodes)
     if not a.no_oracle:
         for node in (None, "RadiationSensor"):  # one oracle for all; one per monitor, as config.yaml deploys it
             bench_oracle(a.oracle_events, node)
