@@ -203,7 +203,8 @@ def bench_live(rate: float, seconds: float, nodes: list[str]) -> None:
           f"({len(sent) / pub_out['elapsed']:.0f} msg/s, asked {rate:.0f}); the monitor checked {record['events']} "
           f"event(s) and published {record['verdicts']} verdict(s); {len(verdicts)} verdict message(s) received")
     print(f"live: kept up: {'yes' if record['events'] == len(sent) else 'NO'} "
-          f"(lost {len(sent) - record['events']}, late {record['late_events']})")
+          f"(lost {len(sent) - record['events']}; {record['late_events']} released after a later-stamped one, "
+          f"by at most {record['max_late_s'] * 1000:.2f} ms)")
     if cpu is not None:
         print(f"live: monitor process CPU {cpu:.2f} s (start-up included) = {cpu / len(sent) * 1e6:.0f} us per message: "
               f"about {len(sent) / cpu:,.0f} messages/s on one free core; load average now "

@@ -160,6 +160,7 @@ class LiveSession:
                   "started": self.started,
                   "stopped": datetime.now(timezone.utc).isoformat(timespec="seconds"),
                   "events": self.engine.released, "late_events": self.engine.late,
+                  "max_late_s": round(self.engine.max_late_s, 6),
                   "reorder_window_s": self.engine.reorder_window, "verdicts": self.verdicts,
                   "silent_topics": self.silences, "nodes": nodes}
         if evidence is not None:

@@ -10,7 +10,8 @@ a running system adds (docs/monitors.md, "Live monitoring"):
   for ``reorder_window`` seconds and are released to the monitors in stamp
   order (ties in arrival order).  A message older than the last one
   released arrives too late to be ordered: it is still checked (at the
-  current clock, never dropped silently) and counted in ``late``;
+  current clock, never dropped silently) and counted in ``late`` (the
+  largest lag in ``max_late_s``);
 * **time**: :meth:`tick` (a timer, e.g. every 50 ms) moves every monitor's
   clock to ``now - reorder_window``, so an obligation whose horizon (the
   contract's response time) has passed is resolved ``violated`` without
@@ -97,6 +98,7 @@ class OnlineEngine:
     monitors: list[NodeMonitor] = field(init=False)
     topics: dict[str, TopicStatus] = field(init=False)
     late: int = field(init=False, default=0)
+    max_late_s: float = field(init=False, default=0.0)
     released: int = field(init=False, default=0)
     _heap: list[tuple[float, int, str, Mapping[str, Any], str]] = field(init=False, default_factory=list)
     _seq: Any = field(init=False, default_factory=itertools.count)
@@ -145,6 +147,7 @@ class OnlineEngine:
             t, _, topic, fields, where = heapq.heappop(self._heap)
             if t < self._clock:
                 self.late += 1
+                self.max_late_s = max(self.max_late_s, self._clock - t)
                 t = self._clock
             self._clock = t
             ev = Event(self.released, t, topic, fields, where or f"message {self.released}")
