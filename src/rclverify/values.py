@@ -98,7 +98,7 @@ class FiniteFunction(Mapping[tuple[Any, ...], Any]):
         if h is None:  # immutable: hashed once (monitors hash the same table at every event)
             h = hash((frozenset(self._items), self.default, self.arity))
             object.__setattr__(self, "_hash", h)
-        return h  # type: ignore[no-any-return]
+        return int(h)
 
     def __eq__(self, other: object) -> bool:
         return (isinstance(other, FiniteFunction) and self.arity == other.arity

@@ -359,6 +359,7 @@ class NodeMonitor:
             self._first_inconclusive(trigger, g.undecided)
             self._verdict("inconclusive", trigger, reason=g.undecided)
             return
+        first: dict[str, Any]
         if g.last is None:
             first = {
                 "event": trigger.index, "time": trigger.time, "where": trigger.where, "guarantee": None,

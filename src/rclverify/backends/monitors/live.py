@@ -70,8 +70,8 @@ class LiveSession:
 
     def __init__(self, checked: Checked, nodes: Iterable[CheckedNode], rules: Mapping[str, TopicRule],
                  horizon: float, log: Path, *, reorder_window: float = 0.05, silence_s: float = 0.0,
-                 publish: Callable[[dict[str, Any]], None] | None = None,
-                 publish_last: Callable[[str, dict[str, Any]], None] | None = None) -> None:
+                 publish: Callable[[str], None] | None = None,
+                 publish_last: Callable[[str, str], None] | None = None) -> None:
         self.log_path = log
         log.parent.mkdir(parents=True, exist_ok=True)
         self._log: IO[str] = log.open("w", encoding="utf-8")
