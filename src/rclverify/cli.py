@@ -325,7 +325,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     lv.add_argument("--evidence", help="write the monitoring evidence record (JSON) here when stopped")
     lv.add_argument("--duration", type=float, help="stop after this many seconds (default: at SIGINT/SIGTERM)")
     lv.add_argument("--reorder-window", type=float, default=0.05, help="seconds to wait for stamp ordering")
-    lv.add_argument("--silence", type=float, default=0.0, help="report a topic silent for this many seconds (0: off)")
+    lv.add_argument("--silence", type=float, default=10.0,
+                    help="report a contract topic not received for this many seconds (default 10; 0: off)")
     lv.add_argument("--status", type=float, default=1.0, help="seconds between status lines (0: off)")
     lv.add_argument("--verdict-topic", default="/rclverify/verdict", help="topic of the per-event verdicts")
     lv.add_argument("--node", dest="nodes", action="append", metavar="NODE", help="monitor only NODE (repeatable)")
