@@ -136,7 +136,7 @@ def test_the_injected_fault_is_reported_online_within_the_response_time(live_run
     assert first["data"]["values"]["in.r"] == "300.0" and first["data"]["values"]["out.radiationStatus"] == "orange"
     # reported by the timer once the response time passed, not at the next message or at the end
     delay = first["received"] - first["data"]["time"]
-    assert HORIZON <= delay < HORIZON + 0.5, delay
+    assert HORIZON <= delay < HORIZON + 1.0, delay
     # every verdict the log records was published on the topic
     assert len(got) == len(_live_verdicts(live_run["tmp"] / "live.jsonl"))
 
