@@ -55,7 +55,7 @@ def _lines() -> list[dict[str, Any]]:
     return [json.loads(line) for line in RUN.read_text().splitlines() if line.strip()]
 
 
-# -- helper processes ------------------------------------------------------------
+# -- processes the benchmark starts ------------------------------------------------------------
 
 def publisher(rate: float, seconds: float, out: Path, wait_for: int, nodes: list[str]) -> int:
     """Publish the run's messages on the monitored nodes' topics round-robin at

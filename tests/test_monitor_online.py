@@ -113,25 +113,25 @@ def test_header_stamp(fields: dict[str, Any], stamp: float | None) -> None:
     assert header_stamp(fields) == stamp
 
 
-def test_live_session_logs_publishes_and_writes_evidence_the_offline_check_agrees_with(
+def test_live_run_logs_publishes_and_writes_evidence_the_offline_check_agrees_with(
         case_study: tuple[Any, Any], tmp_path: Path) -> None:
     """The part of the live monitor below the middleware (what the ROS 2 layer uses too)."""
     import hashlib
     import json
 
-    from rclverify.backends.monitors.live import VERDICT_LOG_TOPIC, LiveSession
+    from rclverify.backends.monitors.live import VERDICT_LOG_TOPIC, LiveRun
     checked, cfg = case_study
     published: list[str] = []
     last: dict[str, str] = {}
     log = tmp_path / "live.jsonl"
-    session = LiveSession(checked, list(checked.nodes.values()), cfg.rules, cfg.horizon, log, reorder_window=0.05,
+    live = LiveRun(checked, list(checked.nodes.values()), cfg.rules, cfg.horizon, log, reorder_window=0.05,
                           silence_s=5.0, publish=published.append, publish_last=lambda n, m: last.__setitem__(n, m))
     for ev in read_trace(TRACES / "sensor_fault.jsonl", MSG):
-        session.tick(ev.time)
-        session.push("/" + ev.topic, {**ev.fields, "nan": float("nan")}, ev.time)
-    session.tick(40.0)
-    assert "RadiationSensor:" in session.status_line() and "silent:" in session.status_line()
-    record = session.stop(tmp_path / "evidence.json")
+        live.tick(ev.time)
+        live.push("/" + ev.topic, {**ev.fields, "nan": float("nan")}, ev.time)
+    live.tick(40.0)
+    assert "RadiationSensor:" in live.status_line() and "silent:" in live.status_line()
+    record = live.stop(tmp_path / "evidence.json")
     assert json.loads((tmp_path / "evidence.json").read_text()) == record
     assert record["sha256"] == hashlib.sha256(log.read_bytes()).hexdigest()
     assert record["silent_topics"] and all(s["silent"] for s in record["silent_topics"])

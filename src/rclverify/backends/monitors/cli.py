@@ -80,7 +80,7 @@ def live_command(args: argparse.Namespace, checked: Any, cfg: Any, root: Path) -
 
     import os
 
-    from .live import LiveSession, run_ros1
+    from .live import LiveRun, run_ros1
     from .ros1 import RosUnavailable
     from .ros2 import Ros2Unavailable, run_ros2
     if args.traces:
@@ -93,7 +93,7 @@ def live_command(args: argparse.Namespace, checked: Any, cfg: Any, root: Path) -
         return 2
     nodes = [checked.nodes[n] for n in args.nodes] if args.nodes else list(checked.nodes.values())
     log = Path(args.log)
-    factory = partial(LiveSession, checked, nodes, cfg.rules, cfg.horizon, log,
+    factory = partial(LiveRun, checked, nodes, cfg.rules, cfg.horizon, log,
                       reorder_window=args.reorder_window, silence_s=args.silence)
     stop = threading.Event()
     for sig in (signal.SIGINT, signal.SIGTERM):

@@ -1,6 +1,6 @@
-"""A live monitoring session, independent of the middleware.
+"""A live monitoring run, independent of the middleware.
 
-:class:`LiveSession` is what ``rclverify monitor --live`` runs around the
+:class:`LiveRun` is what ``rclverify monitor --live`` runs around the
 :class:`~.online.OnlineEngine`; the ROS 1 runner (:func:`run_ros1`) and the
 ROS 2 layer (:mod:`.ros2`) only move messages in and verdicts out.  It
 
@@ -59,7 +59,7 @@ def dumps(obj: Any) -> str:
         return json.dumps(_json_safe(obj), separators=(", ", ": "))
 
 
-class LiveSession:
+class LiveRun:
     """One live run: engine, log, verdict sinks, status and evidence.
 
     ``log`` is the JSON-lines file to write (created, truncated);
@@ -168,11 +168,11 @@ class LiveSession:
         return record
 
 
-def run_ros1(session_factory: Callable[..., LiveSession], checked: Checked, nodes: list[CheckedNode],
+def run_ros1(run_factory: Callable[..., LiveRun], checked: Checked, nodes: list[CheckedNode],
              msg_dirs: list[Path], *, verdict_topic: str, last_prefix: str, node_name: str,
              duration: float | None, tick_s: float, status_s: float, evidence: Path | None,
              stop: threading.Event, out: Callable[[str], None]) -> dict[str, Any]:
-    """Run a live session on a ROS 1 master (``ROS_MASTER_URI``) until ``stop``
+    """Run live monitoring on a ROS 1 master (``ROS_MASTER_URI``) until ``stop``
     is set or ``duration`` seconds passed; returns the evidence record.
 
     Subscribes with ``rospy.AnyMsg`` to every topic the contracts name and
@@ -197,7 +197,7 @@ def run_ros1(session_factory: Callable[..., LiveSession], checked: Checked, node
     lasts: dict[str, Any] = {}
     for n in nodes:
         lasts[n.name] = rospy.Publisher(f"{last_prefix}/{n.name}/last_verdict", String, queue_size=1, latch=True)
-    session = session_factory(publish=lambda text: pub.publish(String(text)),
+    live = run_factory(publish=lambda text: pub.publish(String(text)),
                               publish_last=lambda n, text: lasts[n].publish(String(text)))
     decode_errors: dict[str, int] = {}
 
@@ -210,7 +210,7 @@ def run_ros1(session_factory: Callable[..., LiveSession], checked: Checked, node
         except Exception:  # a publisher of another type on a contract topic: counted, never a crash
             decode_errors[topic] = decode_errors.get(topic, 0) + 1
             return
-        session.push(topic, flatten(msg), received)
+        live.push(topic, flatten(msg), received)
 
     subs = [rospy.Subscriber(t, rospy.AnyMsg, callback, callback_args=t, queue_size=10000) for t in topics]
     out(f"monitoring {len(topics)} topic(s) for {len(nodes)} node(s); verdicts on {verdict_topic}")
@@ -221,20 +221,20 @@ def run_ros1(session_factory: Callable[..., LiveSession], checked: Checked, node
             if duration is not None and _time.monotonic() - t0 >= duration:
                 break
             stop.wait(tick_s)
-            session.tick(rospy.get_time())
+            live.tick(rospy.get_time())
             if status_s > 0 and _time.monotonic() >= next_status:
-                out(session.status_line())
+                out(live.status_line())
                 next_status += status_s
     finally:
         for s in subs:
             s.unregister()
-        record = session.stop(evidence)
+        record = live.stop(evidence)
         record["decode_errors"] = decode_errors
         if evidence is not None:
             atomic_write_text(evidence, json.dumps(record, indent=2, sort_keys=True) + "\n")
-        out(session.status_line())
+        out(live.status_line())
         rospy.signal_shutdown("monitor stopped")
     return record
 
 
-__all__ = ["LiveSession", "VERDICT_LOG_TOPIC", "run_ros1"]
+__all__ = ["LiveRun", "VERDICT_LOG_TOPIC", "run_ros1"]

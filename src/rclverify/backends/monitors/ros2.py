@@ -1,9 +1,9 @@
 """ROS 2 (rclpy) layer of the live monitor: as thin as possible over the shared engine.
 
 Everything that decides a verdict, writes the log or the evidence is
-:class:`~.live.LiveSession` (tested with ROS 1 and without middleware);
+:class:`~.live.LiveRun` (tested with ROS 1 and without middleware);
 this module only subscribes, stamps messages with the node's clock, calls
-the session's timer and publishes:
+the run's timer and publishes:
 
 * every verdict as ``std_msgs/msg/String`` JSON on the verdict topic;
 * each node's latest verdict on ``<prefix>/<Node>/last_verdict`` with
@@ -24,18 +24,18 @@ import time as _time
 from typing import Any, Callable
 
 from ...rcl.types import Checked, CheckedNode
-from .live import LiveSession
+from .live import LiveRun
 
 
 class Ros2Unavailable(Exception):
     """rclpy (or a message type) cannot be imported here; ``str`` says why."""
 
 
-def run_ros2(session_factory: Callable[..., LiveSession], checked: Checked, nodes: list[CheckedNode], *,
+def run_ros2(run_factory: Callable[..., LiveRun], checked: Checked, nodes: list[CheckedNode], *,
              verdict_topic: str, last_prefix: str, node_name: str, duration: float | None, tick_s: float,
              status_s: float, stop: threading.Event, out: Callable[[str], None],
              evidence: Any = None) -> dict[str, Any]:
-    """Run a live session on ROS 2 until ``stop`` or ``duration`` s; returns the evidence record.
+    """Run live monitoring on ROS 2 until ``stop`` or ``duration`` s; returns the evidence record.
 
     Same contract as :func:`~.live.run_ros1`.  Raises :class:`Ros2Unavailable`."""
     try:
@@ -69,12 +69,12 @@ def run_ros2(session_factory: Callable[..., LiveSession], checked: Checked, node
         s = String()
         s.data = data
         return s
-    session = session_factory(publish=lambda m: pub.publish(text(m)),
+    live = run_factory(publish=lambda m: pub.publish(text(m)),
                               publish_last=lambda n, m: lasts[n].publish(text(m)))
     for topic, cls in classes.items():
-        node.create_subscription(cls, topic, lambda msg, t=topic: session.push(t, dict(message_to_ordereddict(msg)),
+        node.create_subscription(cls, topic, lambda msg, t=topic: live.push(t, dict(message_to_ordereddict(msg)),
                                                                                now()), 1000)
-    node.create_timer(tick_s, lambda: session.tick(now()))
+    node.create_timer(tick_s, lambda: live.tick(now()))
     out(f"monitoring {len(topics)} topic(s) for {len(nodes)} node(s); verdicts on {verdict_topic}")
     t0 = _time.monotonic()
     next_status = t0 + status_s
@@ -84,11 +84,11 @@ def run_ros2(session_factory: Callable[..., LiveSession], checked: Checked, node
                 break
             rclpy.spin_once(node, timeout_sec=tick_s)
             if status_s > 0 and _time.monotonic() >= next_status:
-                out(session.status_line())
+                out(live.status_line())
                 next_status += status_s
     finally:
-        record = session.stop(evidence)
-        out(session.status_line())
+        record = live.stop(evidence)
+        out(live.status_line())
         node.destroy_node()
         rclpy.shutdown()
     return record
