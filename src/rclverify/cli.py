@@ -315,6 +315,13 @@ def cmd_monitor(args: argparse.Namespace) -> int:
     return monitor_command(args, checked)
 
 
+def cmd_oracle(args: argparse.Namespace) -> int:
+    from .backends.monitors.cli import oracle_command
+    from .pipeline import Workspace
+    checked = Workspace(Path(args.workspace), args.plan).checked  # raises RclError, printed located by main
+    return oracle_command(args, checked)
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``rclverify`` console script; returns the exit code."""
     p = argparse.ArgumentParser(prog="rclverify", description="Compositional verification from RCL contracts.")
@@ -375,10 +382,28 @@ def main(argv: Sequence[str] | None = None) -> int:
     add_ros_parsers(sub)
     m = add("monitor", cmd_monitor, "check recorded runs (ROSMonitoring logs, ROS bags) against every "
             "node's contract", True)
-    m.add_argument("traces", nargs="+", metavar="TRACE", help="a .jsonl log, a .bag, a ROS 2 bag directory or .mcap")
+    m.add_argument("traces", nargs="*", metavar="TRACE", help="a .jsonl log, a .bag, a ROS 2 bag directory or .mcap")
     m.add_argument("--mapping", help="mapping file (default: backends/monitors/mapping.yaml if present)")
     m.add_argument("--horizon", type=float, help="seconds an input event may wait for its answer (default 5.0)")
     m.add_argument("--json", action="store_true", help="print the verdicts as JSON")
+    lv = m.add_argument_group("live monitoring (ROS 1; docs/monitors.md)")
+    lv.add_argument("--live", action="store_true", help="monitor the running ROS 1 system (ROS_MASTER_URI) instead")
+    lv.add_argument("--log", default="monitor_live.jsonl", help="JSON-lines log of events and verdicts to write")
+    lv.add_argument("--evidence", help="write the monitoring evidence record (JSON) here when stopped")
+    lv.add_argument("--duration", type=float, help="stop after this many seconds (default: at SIGINT/SIGTERM)")
+    lv.add_argument("--reorder-window", type=float, default=0.05, help="seconds to wait for stamp ordering")
+    lv.add_argument("--silence", type=float, default=10.0,
+                    help="report a contract topic not received for this many seconds (default 10; 0: off)")
+    lv.add_argument("--status", type=float, default=1.0, help="seconds between status lines (0: off)")
+    lv.add_argument("--verdict-topic", default="/rclverify/verdict", help="topic of the per-event verdicts")
+    lv.add_argument("--node", dest="nodes", action="append", metavar="NODE", help="monitor only NODE (repeatable)")
+    lv.add_argument("--ros", choices=("1", "2"), help="ROS version (default: $ROS_VERSION, else 1)")
+    o = add("oracle", cmd_oracle, "serve the contracts as a ROSMonitoring oracle over WebSocket", True)
+    o.add_argument("--port", type=int, default=8080, help="TCP port (default 8080)")
+    o.add_argument("--host", default="127.0.0.1", help="address to bind (default 127.0.0.1)")
+    o.add_argument("--node", dest="nodes", action="append", metavar="NODE", help="serve only NODE (repeatable)")
+    o.add_argument("--mapping", help="mapping file (default: backends/monitors/mapping.yaml if present)")
+    o.add_argument("--horizon", type=float, help="seconds an input event may wait for its answer")
     args = p.parse_args(argv)
     try:
         return int(args.fn(args))

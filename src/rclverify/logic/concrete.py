@@ -40,13 +40,18 @@ def to_z3(value: Any, typ: Type, enc: Encoder) -> z3.ExprRef:
     """
     if isinstance(typ, Scalar):
         if typ.name == "BOOL":
-            return z3.BoolVal(bool(value))
-        if typ.name == "REAL":
+            if not isinstance(value, bool):
+                raise ConcreteValueError(f"{value!r} is not a BOOL")
+            return z3.BoolVal(value)
+        try:
             q = exact(value)
+        except (TypeError, ValueError) as exc:  # None (unobserved), a string, NaN: not an RCL number
+            raise ConcreteValueError(f"{value!r} is not a value of {typ.name}: {exc}") from None
+        if typ.name == "REAL":
             return z3.RealVal(f"{q.numerator}/{q.denominator}")
-        if isinstance(value, Fraction):
-            value = int(value)
-        return z3.IntVal(int(value))
+        if q.denominator != 1:
+            raise ConcreteValueError(f"{value!r} is not a value of {typ.name}")
+        return z3.IntVal(int(q))
     if isinstance(typ, EnumT):
         return enc.enum_value(str(value))
     if isinstance(typ, DataT):

@@ -9,11 +9,16 @@ Plan entry (``nodes.<Node>.evidence[k]``)::
 
 Mapping file: ``msg_dirs`` (directories holding ``<pkg>/msg/<Type>.msg``),
 ``topics`` (:func:`rclverify.traces.mapping.load_rules`), optional
-``ros_version`` (``ros1``/``ros2``, default ``ros2``) and ``horizon``.
+``ros_version`` (``ros1``/``ros2``, default ``ros2``), ``horizon`` and
+``ros_nodes`` (contract node -> ``{name, package, path}`` of the ROS node
+to instrument, as ROSMonitoring's configuration lists it)::
+
+    ros_nodes:
+      RadiationSensor: {name: radiation_sensor, package: rover, path: launch/rover.launch}
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Mapping
 
@@ -46,6 +51,7 @@ class MonitorConfig:
     horizon: float
     ros_version: str
     traces: tuple[str, ...] = ()
+    ros_nodes: Mapping[str, Mapping[str, str]] = field(default_factory=dict)
 
     def msg_files(self, root: Path) -> list[str]:
         """Workspace-relative ``.msg`` files under the message directories, sorted."""
@@ -86,9 +92,16 @@ def load_mapping(root: Path, rel: str | None, horizon: Any = None, traces: Any =
     msg_dirs = raw.get("msg_dirs", ()) or ()
     if isinstance(msg_dirs, list):
         _check_msg_dirs(root, rel or DEFAULT_MAPPING, path, [str(d) for d in msg_dirs])
+    ros_nodes = raw.get("ros_nodes") or {}
+    if not isinstance(ros_nodes, Mapping) or not all(
+            isinstance(v, Mapping) and isinstance(v.get("name"), str) and set(v) <= {"name", "package", "path"}
+            for v in ros_nodes.values()):
+        raise ConfigError(f"{rel or DEFAULT_MAPPING}:1:1: error: ros_nodes must map each contract node to "
+                          "{name, package, path} (name required)")
     return MonitorConfig(rel or DEFAULT_MAPPING if path.is_file() else "", rules,
                          tuple(str(d) for d in raw.get("msg_dirs", ()) or ()), float(h), ros,
-                         tuple(str(t) for t in traces))
+                         tuple(str(t) for t in traces),
+                         {str(k): {f: str(x) for f, x in v.items()} for k, v in ros_nodes.items()})
 
 
 def _check_msg_dirs(root: Path, rel: str, path: Path, dirs: list[str]) -> None:
