@@ -882,7 +882,7 @@ def _ctor_uses(body: Any, names: frozenset[str], ctors: Any, io: frozenset[str])
         if isinstance(e, ast.Compare):
             for op, (a, b) in zip(e.ops, zip(e.operands, e.operands[1:])):
                 for side, other in ((a, b), (b, a)):
-                    if op in ("==", "!=") and mentions(side, live):
+                    if op in ("==", "!=") and isinstance(side, ast.Apply) and mentions(side, live):
                         if not closed(other, side.func.name):
                             return False
                         cleared.add(id(side))
