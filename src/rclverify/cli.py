@@ -8,6 +8,7 @@
 ``rclverify health [NODE...]``     contract consistency and vacuity findings
 ``rclverify export``               export obligations to the plan's backends
 ``rclverify report``               rebuild reports/ from the artifacts
+``rclverify requirements``         check each formal requirement with Z3 and print its status
 ``rclverify verify [--strict]``    the whole pipeline through doit
 ``rclverify refines A.rcl:N B.rcl:M``  may contract M replace contract N?
 ``rclverify init DIR [--nodes A,B]``  write a new workspace that verifies at once
@@ -150,6 +151,18 @@ def cmd_export(args: argparse.Namespace) -> int:
     return 0
 
 
+def cmd_requirements(args: argparse.Namespace) -> int:
+    """Check the requirements (only those whose inputs changed, unless
+    ``--force``) and print each with its status; exit 1 when one is refuted,
+    proved from an inconsistency or inconclusive."""
+    from .requirements.show import show_requirements
+    from .pipeline import stage_check, stage_requirements
+    ws = _ws(args)
+    stage_check(ws)
+    stage_requirements(ws, force=args.force)
+    return show_requirements(ws, sys.stdout)
+
+
 def cmd_report(args: argparse.Namespace) -> int:
     from .pipeline import stage_report
     report, paths = stage_report(_ws(args))
@@ -285,6 +298,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     add("health", cmd_health, "contract consistency and vacuity checks", True).add_argument("nodes", nargs="*")
     add("export", cmd_export, "export obligations to the plan's backends", True)
     add("report", cmd_report, "rebuild the assurance report from the artifacts", True)
+    add("requirements", cmd_requirements, "check each formal requirement with Z3 from the composed contracts and "
+        "print its status", True).add_argument("--force", action="store_true", help="check every requirement again")
     v = add("verify", cmd_verify, "run the whole pipeline with doit", True)
     v.add_argument("--strict", action="store_true",
                    help="exit 1 unless every obligation, side condition and health check holds")

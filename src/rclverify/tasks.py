@@ -13,6 +13,9 @@ Stages and their real file dependencies, per node ``N``:
                    export   snapshot of N + the backend input files -> obligations/N.json
 ``evidence:ID``     one obligation's record + the files it reads -> its evidence record
                    (created after ``node`` ran, when the obligations are known)
+``requirements``   plan + model + contract snapshots (+ Doorstop files) ->
+                   artifacts/requirements/<ID>.json; inside, only requirements whose
+                   cone's snapshots or statements changed are checked again
 ``report:html``    every artifact above -> reports/assurance.{html,json}, the CI formats
                    reports/assurance.sarif, assurance.junit.xml, argument.svg
 ``report:text``    every artifact above -> reports/assurance.md, argument.{json,gsn.yaml,dot}
@@ -194,6 +197,19 @@ def act_report(root: str, part: str) -> Any:
         print(f"report: reports/assurance.html  ({report['summary']['headline']})")
     else:
         print("report: reports/assurance.md, reports/argument.{json,gsn.yaml,dot}")
+    return None
+
+
+def act_requirements(root: str) -> Any:
+    """Check the requirements whose inputs changed (:mod:`rclverify.requirements.stage`)."""
+    from .pipeline import stage_requirements
+    try:
+        rows = stage_requirements(_ws(root))
+    except RclError as exc:
+        return _fail(exc)
+    again = [rec["id"] for rec, now in rows if now]
+    print(f"requirements: {len(again)} of {len(rows)} checked" + (f" ({', '.join(again[:10])}"
+                                                                  + (", ..." if len(again) > 10 else "") + ")" if again else ""))
     return None
 
 
@@ -427,6 +443,19 @@ def _build_tasks(root: str | Path, plan_file: str) -> dict[str, Callable[[], Any
                    "targets": [at(ws.evidence(o["id"]))], "uptodate": [tools_unchanged],
                    "verbosity": 2, "clean": True}
 
+    def task_requirements() -> dict[str, Any]:
+        """Check each requirement's formal statement with Z3 from the guarantees of its cone."""
+        assert index is not None
+        from .requirements.stage import INDEX
+        extra: list[str] = []
+        if index.requirement_dirs:
+            from .plan.doorstop import doorstop_files
+            for d in index.requirement_dirs:
+                extra += [str(rootp / f) for f in doorstop_files(rootp, d)]
+        return {"actions": [(act_requirements, [r])],
+                "file_dep": [str(rootp / plan_file), at(ws.MODEL)] + list(snap.values()) + extra,
+                "targets": [at(INDEX)], "verbosity": 2, "clean": True}
+
     @create_after(executed="evidence")
     def task_report() -> Iterator[dict[str, Any]]:
         """Roll everything up into the report files: two parts, rendered at once by doit -n 2."""
@@ -436,6 +465,7 @@ def _build_tasks(root: str | Path, plan_file: str) -> dict[str, Callable[[], Any
         for n in nodes:
             deps += [at(ws.calculus(n)), at(ws.health(n)), at(ws.obligations(n))]
         deps += [at(ws.evidence(o["id"])) for _, o in exported()]
+        deps.append(at("artifacts/requirements/index.json"))  # the requirements task's target
         for part, files in REPORT_PARTS.items():
             yield {"name": part, "doc": "reports/" + ", ".join(files), "actions": [(act_report, [r, part])],
                    "file_dep": deps,
@@ -454,5 +484,5 @@ def _build_tasks(root: str | Path, plan_file: str) -> dict[str, Callable[[], Any
     creators: dict[str, Callable[[], Any]] = {"task_check": task_check, "task_verify": task_verify}
     if ok:
         creators.update({"task_graph": task_graph, "task_node": task_node, "task_evidence": task_evidence,
-                         "task_report": task_report})
+                         "task_report": task_report, "task_requirements": task_requirements})
     return creators
