@@ -274,7 +274,7 @@ def build_report(ws: Workspace) -> dict[str, Any]:
         if f["status"] == "problem":
             problems.append(f"Contract health: {f['message']}")
     for rq in requirements:
-        if rq["verdict"] in ("refuted", "proved from an inconsistency"):
+        if rq["verdict"] in ("refuted", "proved from an inconsistency", "proved vacuously"):
             problems.append(f"Requirement {rq['id']} is {rq['verdict']}: {_brief(rq['note'])}")
     for sc in side_conditions:
         if sc["status"] != "discharged":
@@ -313,7 +313,7 @@ def build_report(ws: Workspace) -> dict[str, Any]:
 
 #: The fields of a requirement's check record (requirements/check.py) the report carries.
 _CHECK_FIELDS = ("origin", "source", "formal", "assuming", "cone", "used", "traced_not_needed", "consistency",
-                 "inconsistent_core", "counterexample", "failed_to_prevent", "reason", "smt2", "explanation")
+                 "inconsistent_core", "vacuity", "vacuity_core", "counterexample", "failed_to_prevent", "reason", "smt2", "explanation")
 
 
 def requirement_check(record: Mapping[str, Any] | None, traced_status: str, g_status: Any,

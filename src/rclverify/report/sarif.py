@@ -82,6 +82,9 @@ RULES: Mapping[str, Rule] = {r.id: r for r in (
     Rule("RCL-REQ-INCONSISTENT", "RequirementProvedFromInconsistency", "error",
          "A formal requirement is proved only because the premises its proof used contradict each other: it holds "
          "vacuously, not because the system meets it."),
+    Rule("RCL-REQ-VACUOUS", "RequirementProvedVacuously", "error",
+         "A formal requirement of the form P -> Q is proved only because P can never hold with the premises of its "
+         "cone: it never applies."),
     Rule("RCL-REQ-INCONCLUSIVE", "RequirementInconclusive", "warning",
          "Z3 could not decide a formal requirement (or whether the premises of its proof are consistent)."),
     Rule("RCL-REQ-EVIDENCE", "RequirementEvidenceOutstanding", "note",
@@ -91,6 +94,7 @@ RULES: Mapping[str, Rule] = {r.id: r for r in (
          "A requirement has no formal statement: it is traced to guarantees, never checked, never met."),
 )}
 _REQUIREMENT_RULE = {"refuted": "RCL-REQ-REFUTED", "proved from an inconsistency": "RCL-REQ-INCONSISTENT",
+                     "proved vacuously": "RCL-REQ-VACUOUS",
                      "inconclusive": "RCL-REQ-INCONCLUSIVE", "proved, evidence outstanding": "RCL-REQ-EVIDENCE",
                      "informal": "RCL-REQ-INFORMAL"}
 

@@ -55,6 +55,12 @@ from ..rcl.walk import subexpressions
 from ..system.model import SystemModel
 
 NEGATED = "negated requirement"
+#: The first attempt's budget of the consistency and vacuity queries, which
+#: look for a model (sat): Z3's default strategy rarely finds a model of a
+#: quantified formula it did not find at once, while the retries of
+#: :mod:`rclverify.logic.retry` (finite instantiation, MBQI) often do; a short
+#: first attempt hands over to them sooner (an unknown is never upgraded).
+MODEL_TIMEOUT_MS = 1_000
 
 
 def _where(l: ast.Loc) -> str:
@@ -108,7 +114,7 @@ def _io_symbols(e: ast.Expr, cn: CheckedNode, enc: Encoder) -> set[str]:
 
 @solver_session()
 def check_requirement(req: Requirement, checked: Checked, model: SystemModel, plan: Plan, *,
-                      timeout_ms: int = DEFAULT_TIMEOUT_MS) -> dict[str, Any]:
+                      timeout_ms: int = DEFAULT_TIMEOUT_MS, model_ms: int = MODEL_TIMEOUT_MS) -> dict[str, Any]:
     """Decide ``req`` (module docstring).  Returns its JSON record:
 
     ``id``, ``text``, ``origin``, ``source`` (``file:line:col`` of the formal
@@ -117,10 +123,14 @@ def check_requirement(req: Requirement, checked: Checked, model: SystemModel, pl
     ``inconclusive``/``informal``), ``used`` (premises in the unsat core:
     ``{label, kind, node, index, text, source}``), ``traced_not_needed``,
     ``consistency`` (``consistent``/``inconsistent``/``undecided``, proved
-    only) with ``inconsistent_core``, ``counterexample`` (``[{node, values:
+    only) with ``inconsistent_core``, ``vacuity`` (``non-vacuous``/
+    ``vacuous``/``undecided``, proved implications only) with
+    ``vacuity_core``, ``counterexample`` (``[{node, values:
     {var: value}}]``, refuted only), ``failed_to_prevent`` (premises), ``reason``
     (Z3's, inconclusive only), ``smt2`` (the query's text), ``duration_s``.
 
+    ``timeout_ms`` is the validity query's budget, ``model_ms`` the first
+    attempt's of the consistency and vacuity queries (:data:`MODEL_TIMEOUT_MS`).
     Raises :class:`~rclverify.rcl.errors.RclError` for a statement that does
     not check (the plan's ``resolve`` reports those first); never raises on
     solver trouble.
@@ -178,7 +188,7 @@ def check_requirement(req: Requirement, checked: Checked, model: SystemModel, pl
         if NEGATED not in (r.core or []):
             out.update(consistency="inconsistent", inconsistent_core=used, consistency_duration_s=0.0)
         else:
-            r2 = satisfiable([(lbl, f) for lbl, f in labelled if lbl in core], enc, timeout_ms=timeout_ms,
+            r2 = satisfiable([(lbl, f) for lbl, f in labelled if lbl in core], enc, timeout_ms=model_ms,
                              comment=f"rclverify requirement {req.id}: are the premises its proof used consistent?")
             out["consistency_duration_s"] = r2.duration_s
             if r2.status == "unsat":
@@ -187,6 +197,17 @@ def check_requirement(req: Requirement, checked: Checked, model: SystemModel, pl
                 out.update(consistency="consistent")
             else:
                 out.update(consistency="undecided", consistency_reason=r2.reason)
+        premise = _premise(formal.expr)
+        if out["consistency"] == "consistent" and premise is not None:
+            r3 = satisfiable([(lbl, f) for lbl, f in labelled if lbl != NEGATED]
+                             + [("requirement premise", enc.formula(premise, formal.scope, symbols))], enc,
+                             timeout_ms=model_ms,
+                             comment=f"rclverify requirement {req.id}: can its premise hold with every premise of the cone?")
+            out["vacuity_duration_s"] = r3.duration_s
+            if r3.status == "unsat":
+                out.update(vacuity="vacuous", vacuity_core=[by_label[c] for c in (r3.core or []) if c in by_label])
+            else:
+                out["vacuity"] = {"sat": "non-vacuous", "inconclusive": "undecided"}.get(r3.status, "undecided")
         return out
     out.update(used=[], traced_not_needed=[])
     if r.status == "sat":
@@ -198,6 +219,19 @@ def check_requirement(req: Requirement, checked: Checked, model: SystemModel, pl
         return out
     out.update(verdict="inconclusive", reason=r.reason or "unknown")
     return out
+
+
+def _premise(e: ast.Expr) -> ast.Expr | None:
+    """``exists(bs | P)`` for a requirement ``forall(bs | P -> Q)`` (or ``P``
+    for ``P -> Q``): the condition under which it demands something; ``None``
+    for a requirement of another shape."""
+    bindings: list[ast.Binding] = []
+    while isinstance(e, ast.Quant) and e.kind == "forall":
+        bindings.extend(e.bindings)
+        e = e.body
+    if not (isinstance(e, ast.Binary) and e.op == "->"):
+        return None
+    return ast.Quant("exists", tuple(bindings), e.left, e.loc) if bindings else e.left
 
 
 def _counterexample(model: dict[str, str], cone: Sequence[str], checked: Checked, enc: Encoder) -> list[dict[str, Any]]:

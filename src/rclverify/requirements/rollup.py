@@ -10,6 +10,7 @@ verdict (``check``)                what the proof rests on      status shown (``
                                    discharged                   the worst of that evidence
 ``proved``, premises inconsistent  (anything)                   ``proved from an inconsistency`` /
                                                                 ``failed``
+``proved``, premise never holds    (anything)                   ``proved vacuously`` / ``failed``
 ``proved``, consistency undecided  (anything)                   ``inconclusive`` / ``inconclusive``
 ``refuted``                                                     ``refuted`` / ``failed``
 ``inconclusive``                                                ``inconclusive`` / ``inconclusive``
@@ -29,7 +30,8 @@ from ..evidence.records import worst
 MET = "met"
 OUTSTANDING = "proved, evidence outstanding"
 INCONSISTENT = "proved from an inconsistency"
-VERDICTS = (MET, OUTSTANDING, INCONSISTENT, "refuted", "inconclusive", "informal")
+VACUOUS = "proved vacuously"
+VERDICTS = (MET, OUTSTANDING, INCONSISTENT, VACUOUS, "refuted", "inconclusive", "informal")
 
 
 def roll_up(record: Mapping[str, Any] | None, g_status: Callable[[str, int], str], sc_status: Mapping[str, str],
@@ -56,6 +58,10 @@ def roll_up(record: Mapping[str, Any] | None, g_status: Callable[[str, int], str
         core = ", ".join(p["label"] for p in record.get("inconsistent_core", []))
         return INCONSISTENT, "failed", (f"the premises the proof used contradict each other ({core}): the "
                                         "requirement follows vacuously, not because the system meets it")
+    if record.get("vacuity") == "vacuous":
+        core = ", ".join(p["label"] for p in record.get("vacuity_core", []))
+        return VACUOUS, "failed", ("the requirement's premise can never hold together with the premises of its cone "
+                                   f"({core}): it is proved only because it never applies")
     if record.get("consistency") != "consistent":
         return "inconclusive", "inconclusive", ("proved, but Z3 could not decide whether the premises it used are "
                                                 f"consistent ({record.get('consistency_reason', 'unknown')})")

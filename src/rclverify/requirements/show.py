@@ -7,7 +7,7 @@ if TYPE_CHECKING:
     from ..pipeline import Workspace
 
 #: Verdicts that make ``rclverify requirements`` exit 1.
-BAD = ("refuted", "proved from an inconsistency", "inconclusive")
+BAD = ("refuted", "proved from an inconsistency", "proved vacuously", "inconclusive")
 
 
 def show_requirements(ws: "Workspace", out: TextIO) -> int:
@@ -34,6 +34,8 @@ def show_requirements(ws: "Workspace", out: TextIO) -> int:
             out.write(f"    traced, not needed: {p['label']}\n")
         for p in c.get("inconsistent_core") or []:
             out.write(f"    contradictory: {p['label']}: {p['text']}  ({p['source']})\n")
+        for p in c.get("vacuity_core") or []:
+            out.write(f"    premise never holds with: {p['label']}: {p['text']}  ({p['source']})\n")
         for row in c.get("counterexample") or []:
             out.write(f"    counterexample {row['node']}: " + ", ".join(f"{k} = {v}" for k, v in row["values"].items()) + "\n")
         for p in c.get("failed_to_prevent") or []:
