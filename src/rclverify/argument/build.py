@@ -222,7 +222,7 @@ def build_argument(report: Mapping[str, Any]) -> Argument:
     req_goals = []
     for r in reqs:
         rid = str(r["id"])
-        if r.get("verdict") is not None:  # checked by Z3 (docs/requirements.md): entailment, or undeveloped
+        if "verdict" in r:  # checked by Z3 (docs/requirements.md): entailment, or undeveloped
             req_goals.append(_requirement_goal(b, r, guarantee_goal, sides, j_calc))
             continue
         kids: list[str] = []

@@ -190,7 +190,7 @@ def _requirement_results(report: Mapping[str, Any]) -> list[dict[str, Any]]:
     (the plan, or the Doorstop item's file); a refuted one carries the
     counterexample node by node and the guarantees that did not prevent it."""
     out = []
-    for r in report["requirements"]:
+    for r in report.get("requirements", ()):
         rule = _REQUIREMENT_RULE.get(str(r.get("verdict")))
         if rule is None:
             continue
