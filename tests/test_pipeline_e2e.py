@@ -147,7 +147,12 @@ def test_ci_formats_carry_the_case_study_findings_at_their_rcl_locations(workspa
     assert {r["Severity"] for r in records if r["Code"] == "RCL-OBL-PENDING"} == {"note"}
     xml = junitparser.JUnitXml.fromfile(str(reports / "assurance.junit.xml"))
     suites = {s.name: s for s in xml}
-    assert set(suites) == {"Localisation", "Navigation", "Agent", "RadiationSensor"}
+    assert set(suites) == {"Localisation", "Navigation", "Agent", "RadiationSensor", "requirements"}
+    reqs = {c.name: c for c in suites["requirements"]}
+    assert set(reqs) == {"REQ1", "REQ2", "REQ3", "REQ4"}
+    assert isinstance(reqs["REQ1"].result[0], junitparser.Failure)  # proved vacuously: not met
+    assert isinstance(reqs["REQ4"].result[0], junitparser.Skipped)  # informal
+    assert ("RCL-REQ-VACUOUS", "contracts/plan.yaml", 28) in at
     cases = {c.name: c for s in xml for c in s}
     report = json.loads((reports / "assurance.json").read_text())
     assert {o["id"] for o in report["obligations"]} | {sc["id"] for sc in report["side_conditions"]} <= set(cases)

@@ -53,7 +53,8 @@ class Source:
 
     @property
     def loc(self) -> ast.Loc:
-        return ast.Loc(self.file, self.line, self.col)
+        """Where the formula's first character (after indentation) is."""
+        return _loc_at(self, len(self.text) - len(self.text.lstrip()))
 
 
 @dataclass(frozen=True)
