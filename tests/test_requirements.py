@@ -38,6 +38,7 @@ def _copy(tmp: Path, controller_m: str = "0.5") -> Path:
 def _verify(ws: Path) -> subprocess.CompletedProcess[str]:
     r = subprocess.run([sys.executable, "-m", "doit", "verify"], cwd=ws, capture_output=True, text=True, timeout=300)
     assert r.returncode == 0, r.stdout + r.stderr
+    (ws / "verify.out").write_text(r.stdout)
     return r
 
 
@@ -114,6 +115,11 @@ def test_the_met_requirement_goal_rests_on_the_proof_and_the_evidence_of_the_gua
     els = {e["id"]: e for e in json.loads((proved / "reports/argument.json").read_text())["elements"]}
     assert els["G-STOP"]["status"] == "discharged"
     assert els["S-STOP"]["supported_by"][:2] == ["Sn-req.STOP", "G-SpeedController.g1"]
+
+
+def test_verify_ends_with_the_requirements_line(refuted: Path, proved: Path) -> None:
+    assert "requirements: 1 refuted (STOP), 2 met, 1 informal\n" in (refuted / "verify.out").read_text()
+    assert "requirements: 3 met, 1 informal\n" in (proved / "verify.out").read_text()
 
 
 def test_the_cli_prints_the_counterexample_and_exits_1(refuted: Path, capsys: pytest.CaptureFixture[str]) -> None:

@@ -224,10 +224,25 @@ def act_verify(root: str, strict: bool) -> Any:
     for p in s["problems"]:
         print(f"  problem: {p}")
     print_summary(data, "reports/assurance.html", rows=data["rows"])
+    if data.get("requirements"):
+        print(requirements_line(data["requirements"]))
     if strict and not data["meta"]["strict_ok"]:
         return TaskFailed("--strict: some evidence is failed, inconclusive, pending, stale or error, or a side condition "
                           "or contract health check is not proved (see reports/assurance.html)")
     return None
+
+
+def requirements_line(rows: Sequence[Sequence[str]]) -> str:
+    """``requirements: 1 met, 1 refuted (STOP), 1 informal`` from the summary's
+    ``[id, verdict, status]`` rows (docs/requirements.md), verdicts in order of
+    first appearance; the ids of those that are not met, informal or
+    outstanding are named."""
+    by: dict[str, list[str]] = {}
+    for rid, verdict, _ in rows:
+        by.setdefault(verdict or "traced", []).append(rid)
+    named = ("refuted", "proved from an inconsistency", "proved vacuously", "inconclusive")
+    return "requirements: " + ", ".join(f"{len(ids)} {v}" + (f" ({', '.join(ids[:5])}{', ...' if len(ids) > 5 else ''})"
+                                                            if v in named else "") for v, ids in by.items())
 
 
 def strict_uptodate(task: Any, values: Any) -> bool:

@@ -21,8 +21,9 @@ nothing itself.  Layout (decisions in ``docs/ci.md``):
   (``classname`` ``requirement``, name its id, at its formal statement):
   it passes only when the requirement is ``met``; a refuted one (or one
   proved from an inconsistency) is a ``<failure>`` with the counterexample
-  node by node; outstanding evidence, inconclusive and informal are
-  ``<skipped>`` (or a ``<failure>`` when evidence it rests on failed).
+  node by node; outstanding evidence and inconclusive are ``<skipped>``
+  (a ``<failure>`` when evidence the proof rests on failed), informal
+  ones ``<skipped>``.
 
 ``time`` is the recorded duration of the check in seconds (0 when the
 record has none).  The XML is built with :mod:`xml.etree.ElementTree`, so

@@ -14,12 +14,15 @@ verdict (``check``)                what the proof rests on      status shown (``
 ``proved``, consistency undecided  (anything)                   ``inconclusive`` / ``inconclusive``
 ``refuted``                                                     ``refuted`` / ``failed``
 ``inconclusive``                                                ``inconclusive`` / ``inconclusive``
-``informal`` (no formal statement) the traced guarantees        ``informal`` / the worst of
-                                                                ``pending`` and the traced evidence
+``informal`` (no formal statement) (nothing: traced only)        ``informal`` / ``pending``
 =================================  ==========================  ==================================
 
 Only ``met`` has the status ``discharged`` (the green tick of every report
-format); an informal requirement is never better than ``pending``.
+format).  An informal requirement is ``pending`` whatever its traced
+guarantees' evidence says (the note names their worst status, the
+traceability table shows each): nothing decided it, so it is neither
+verified nor refuted, and its goal in the assurance argument is undeveloped
+(GSN: pending), the same status.
 """
 from __future__ import annotations
 
@@ -48,7 +51,8 @@ def roll_up(record: Mapping[str, Any] | None, g_status: Callable[[str, int], str
         return "inconclusive", "pending", "not checked yet: run `rclverify requirements` or `doit verify`"
     v = record.get("verdict")
     if v == "informal":
-        return "informal", worst([traced_status, "pending"]), ("no formal statement: traced only, never shown as met")
+        return "informal", "pending", (f"no formal statement: traced only, never shown as met (its traced guarantees: "
+                                       f"{traced_status})")
     if v == "refuted":
         who = ", ".join(p["label"] for p in record.get("failed_to_prevent", [])) or "no guarantee of the cone"
         return "refuted", "failed", f"Z3 found a counterexample that every premise allows; it is not prevented by: {who}"
@@ -62,15 +66,16 @@ def roll_up(record: Mapping[str, Any] | None, g_status: Callable[[str, int], str
         core = ", ".join(p["label"] for p in record.get("vacuity_core", []))
         return VACUOUS, "failed", ("the requirement's premise can never hold together with the premises of its cone "
                                    f"({core}): it is proved only because it never applies")
-    if record.get("consistency") != "consistent":
-        return "inconclusive", "inconclusive", ("proved, but Z3 could not decide whether the premises it used are "
-                                                f"consistent ({record.get('consistency_reason', 'unknown')})")
     statuses: dict[str, str] = {}
     for p in record.get("used", []):
         if p["kind"] == "guarantee":
             statuses[p["label"]] = g_status(p["node"], p["index"])
             statuses[f"side conditions of {p['node']}"] = sc_status.get(p["node"], "discharged")
     ev = worst(list(statuses.values()), empty="discharged")
+    if record.get("consistency") != "consistent":  # the worst of that and the evidence, as the argument has it
+        return "inconclusive", worst(["inconclusive", ev]), (
+            "proved, but Z3 could not decide whether the premises it used are consistent "
+            f"({record.get('consistency_reason', 'unknown')})")
     if ev == "discharged":
         return MET, "discharged", "proved from the used premises, and all the evidence they rest on is discharged"
     open_ = ", ".join(f"{k} ({s})" for k, s in statuses.items() if s != "discharged")
