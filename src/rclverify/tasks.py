@@ -415,6 +415,21 @@ def _build_tasks(root: str | Path, plan_file: str) -> dict[str, Callable[[], Any
                    "targets": [at(ws.calculus(n)), at(ws.health(n)), at(ws.obligations(n))],
                    "verbosity": 2, "clean": True}
 
+    def task_requirements() -> dict[str, Any]:
+        """Check each requirement's formal statement with Z3 from the guarantees of its cone.  Defined before
+        the evidence and report tasks: doit orders tasks by where their creators are defined, and the
+        report parts must run in their usual order after it (their fragment caches, report/fragments.py)."""
+        assert index is not None
+        from .requirements.stage import INDEX
+        extra: list[str] = []
+        if index.requirement_dirs:
+            from .plan.doorstop import doorstop_files
+            for d in index.requirement_dirs:
+                extra += [str(rootp / f) for f in doorstop_files(rootp, d)]
+        return {"actions": [(act_requirements, [r])],
+                "file_dep": [str(rootp / plan_file), at(ws.MODEL)] + list(snap.values()) + extra,
+                "targets": [at(INDEX)], "verbosity": 2, "clean": True}
+
     exported_memo: list[list[tuple[str, dict[str, Any]]]] = []
 
     def exported() -> list[tuple[str, dict[str, Any]]]:
@@ -458,19 +473,6 @@ def _build_tasks(root: str | Path, plan_file: str) -> dict[str, Callable[[], Any
                    "targets": [at(ws.evidence(o["id"]))], "uptodate": [tools_unchanged],
                    "verbosity": 2, "clean": True}
 
-    def task_requirements() -> dict[str, Any]:
-        """Check each requirement's formal statement with Z3 from the guarantees of its cone."""
-        assert index is not None
-        from .requirements.stage import INDEX
-        extra: list[str] = []
-        if index.requirement_dirs:
-            from .plan.doorstop import doorstop_files
-            for d in index.requirement_dirs:
-                extra += [str(rootp / f) for f in doorstop_files(rootp, d)]
-        return {"actions": [(act_requirements, [r])],
-                "file_dep": [str(rootp / plan_file), at(ws.MODEL)] + list(snap.values()) + extra,
-                "targets": [at(INDEX)], "verbosity": 2, "clean": True}
-
     @create_after(executed="evidence")
     def task_report() -> Iterator[dict[str, Any]]:
         """Roll everything up into the report files: two parts, rendered at once by doit -n 2."""
@@ -490,7 +492,9 @@ def _build_tasks(root: str | Path, plan_file: str) -> dict[str, Callable[[], Any
 
     def task_verify() -> dict[str, Any]:
         """The whole pipeline: check, compose, health, export, run, report.  --strict fails on any open evidence."""
-        return {"actions": [(act_verify, [r])], "task_dep": ["check", "report"] if ok else ["check"],
+        # `requirements` before `report`: reached only through the report's file dependencies, it would make
+        # report:html wait and report:text run first (their fragment caches expect html first)
+        return {"actions": [(act_verify, [r])], "task_dep": ["check", "requirements", "report"] if ok else ["check"],
                 "file_dep": [str(rootp / REPORTS[2])] if ok else [],
                 "params": [{"name": "strict", "long": "strict", "type": bool, "default": False,
                             "help": "fail unless every obligation, side condition and health check holds"}],
@@ -498,6 +502,6 @@ def _build_tasks(root: str | Path, plan_file: str) -> dict[str, Callable[[], Any
 
     creators: dict[str, Callable[[], Any]] = {"task_check": task_check, "task_verify": task_verify}
     if ok:
-        creators.update({"task_graph": task_graph, "task_node": task_node, "task_evidence": task_evidence,
-                         "task_report": task_report, "task_requirements": task_requirements})
+        creators.update({"task_graph": task_graph, "task_node": task_node, "task_requirements": task_requirements,
+                         "task_evidence": task_evidence, "task_report": task_report})
     return creators
