@@ -226,3 +226,33 @@ def test_mistakes_in_a_formal_statement_are_located_errors(tmp_path: Path, forma
     err = capsys.readouterr().err
     assert err.startswith("contracts/plan.yaml:19:"), err
     assert message in err and "Traceback" not in err
+
+
+def test_the_bundle_carries_the_doorstop_tree_and_the_requirement_records(tmp_path: Path) -> None:
+    ws = _copy(tmp_path)
+    assert main(["requirements", "-w", str(ws), "--plan", "contracts/plan_doorstop.yaml"]) == 1
+    from rclverify.bundle.manifest import collect
+    from rclverify.plan.load import load_plan
+    files, missing = collect(ws, load_plan(ws, "contracts/plan_doorstop.yaml"))
+    assert {"reqs/.doorstop.yml", "reqs/SYS001.yml", "artifacts/requirements/SYS002.json"} <= set(files)
+    assert not missing
+
+
+def test_a_type_error_in_a_doorstop_item_is_located_in_its_file(tmp_path: Path,
+                                                               capsys: pytest.CaptureFixture[str]) -> None:
+    ws = _copy(tmp_path)
+    item = ws / "reqs/SYS001.yml"
+    item.write_text(item.read_text().replace("MotorDriver.in.speed_cmd == 0", "MotorDriver.in.speed_cmd == red"))
+    assert main(["requirements", "-w", str(ws), "--plan", "contracts/plan_doorstop.yaml"]) == 1
+    err = capsys.readouterr().err
+    assert err == "reqs/SYS001.yml:7:73: error: unknown name 'red'\n"  # the column of `red` in the item file
+
+
+def test_init_writes_formal_requirements_that_are_proved(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["init", str(tmp_path / "w")]) == 0
+    assert main(["requirements", "-w", str(tmp_path / "w")]) == 0
+    out = capsys.readouterr().out
+    # proved; not met until the nodes have evidence (the new plan has none yet)
+    assert "REQ1: proved, evidence outstanding [pending]" in out
+    assert "REQ2: proved, evidence outstanding [pending]" in out
+    assert "used: Sensor guarantee 2" in out and "used: Actuator guarantee 2" in out
