@@ -122,6 +122,17 @@ def test_verify_ends_with_the_requirements_line(refuted: Path, proved: Path) -> 
     assert "requirements: 3 met, 1 informal\n" in (proved / "verify.out").read_text()
 
 
+def test_the_html_report_shows_the_checks_with_balanced_tags(refuted: Path) -> None:
+    from test_report_render import _TagBalance
+    html = (refuted / "reports/assurance.html").read_text()
+    parser = _TagBalance()
+    parser.feed(html)
+    assert parser.errors == [] and parser.stack == []
+    section = html[html.index('id="requirement-checks"'):html.index('<section id="calculus">')]
+    assert "<strong>refuted</strong>" in section and "did not prevent it: SpeedController guarantee 1" in section
+    assert "SpeedController (in.distance = <code>" in section
+
+
 def test_the_cli_prints_the_counterexample_and_exits_1(refuted: Path, capsys: pytest.CaptureFixture[str]) -> None:
     assert main(["requirements", "-w", str(refuted)]) == 1
     out = capsys.readouterr().out
