@@ -223,9 +223,9 @@ def act_verify(root: str, strict: bool) -> Any:
     print(f"overall: {s['status']} -- {s['headline']}")
     for p in s["problems"]:
         print(f"  problem: {p}")
-    print_summary(data, "reports/assurance.html", rows=data["rows"])
     if data.get("requirements"):
         print(requirements_line(data["requirements"]))
+    print_summary(data, "reports/assurance.html", rows=data["rows"])
     if strict and not data["meta"]["strict_ok"]:
         return TaskFailed("--strict: some evidence is failed, inconclusive, pending, stale or error, or a side condition "
                           "or contract health check is not proved (see reports/assurance.html)")
