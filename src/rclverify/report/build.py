@@ -245,7 +245,7 @@ def build_report(ws: Workspace) -> dict[str, Any]:
                                 "obligations": sorted(o.id for o in obligations if applies(o, s.node, k))})
         st = worst([x["status"] for x in support] + [sc_status[x["node"]] for x in support]) if support else "pending"
         requirements.append({"id": r.id, "text": r.text, "status": st, "support": support,
-                             **requirement_check(checks.get(r.id), st, g_status, sc_status)})
+                             **requirement_check(current_record(r, checks.get(r.id)), st, g_status, sc_status)})
 
     derived = []
     cones, cone_of = ConeEvidence(model.nodes, node_evidence, sc_status), model.upstream_masks()
@@ -314,6 +314,20 @@ def build_report(ws: Workspace) -> dict[str, Any]:
 #: The fields of a requirement's check record (requirements/check.py) the report carries.
 _CHECK_FIELDS = ("origin", "source", "formal", "assuming", "cone", "used", "traced_not_needed", "consistency",
                  "inconsistent_core", "vacuity", "vacuity_core", "counterexample", "failed_to_prevent", "reason", "smt2", "explanation")
+
+
+def current_record(req: Any, record: Mapping[str, Any] | None) -> Mapping[str, Any] | None:
+    """``record`` when it was made from ``req``'s current statements (else
+    ``None``: not checked yet, e.g. ``rclverify report`` after a plan edit,
+    before the ``requirements`` stage ran); an informal requirement needs no
+    record."""
+    formal = " ".join(req.formal.text.split()) if req.formal else None
+    if record is not None and record.get("formal") == formal \
+            and record.get("assuming", []) == [" ".join(a.text.split()) for a in req.assuming]:
+        return record
+    if formal is None:
+        return {"verdict": "informal", "source": f"{req.loc.file}:{req.loc.line}:{req.loc.col}", "origin": req.origin}
+    return None
 
 
 def requirement_check(record: Mapping[str, Any] | None, traced_status: str, g_status: Any,
