@@ -313,7 +313,8 @@ def build_report(ws: Workspace) -> dict[str, Any]:
 
 #: The fields of a requirement's check record (requirements/check.py) the report carries.
 _CHECK_FIELDS = ("origin", "source", "formal", "assuming", "cone", "used", "traced_not_needed", "consistency",
-                 "inconsistent_core", "vacuity", "vacuity_core", "counterexample", "failed_to_prevent", "reason", "smt2", "explanation")
+                 "inconsistent_core", "vacuity", "vacuity_core", "counterexample", "failed_to_prevent", "reason", "smt2", "explanation",
+                 "duration_s")
 
 
 def current_record(req: Any, record: Mapping[str, Any] | None) -> Mapping[str, Any] | None:

@@ -168,7 +168,9 @@ def check_requirement(req: Requirement, checked: Checked, model: SystemModel, pl
             add(f"{n} environment assumption {k}", "environment assumption", n, k, c, enc.formula(c, cn))
         for k, fact in enumerate(plan.facts.get(n, ()), 1):
             add(f"{n} environment fact {k}", "environment fact", n, k, fact.expr, enc.formula(fact.expr, cn))
-    symbols = {f"{'in' if p == 'in' else 'out'}.{n}.{p}.{v}": enc.io_symbol(checked.nodes[n], p, v)
+    # the statements' variables are named Node.in.x in their pseudo node (plan/formal.py); the encoder looks
+    # an input/output up as "<in|out>.<name>", here "in.Node.in.x", and takes the node's own symbol
+    symbols = {f"{p}.{n}.{p}.{v}": enc.io_symbol(checked.nodes[n], p, v)
                for f in (formal, *assuming) for n, p, v in f.mentions}
     for k, a in enumerate(assuming, 1):
         add(f"assuming {k}", "assuming", None, k, a.expr, enc.formula(a.expr, a.scope, symbols))

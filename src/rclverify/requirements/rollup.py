@@ -64,8 +64,8 @@ def roll_up(record: Mapping[str, Any] | None, g_status: Callable[[str, int], str
                                         "requirement follows vacuously, not because the system meets it")
     if record.get("vacuity") == "vacuous":
         core = ", ".join(p["label"] for p in record.get("vacuity_core", []))
-        return VACUOUS, "failed", ("the requirement's premise can never hold together with the premises of its cone "
-                                   f"({core}): it is proved only because it never applies")
+        why = f"together with the premises of its cone ({core})" if core else "(it contradicts itself)"
+        return VACUOUS, "failed", f"the requirement's premise can never hold {why}: it is proved only because it never applies"
     statuses: dict[str, str] = {}
     for p in record.get("used", []):
         if p["kind"] == "guarantee":
