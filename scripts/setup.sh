@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # Installs everything rclverify needs on a fresh Debian/Ubuntu machine:
-#   - Debian packages: dafny (the Dafny backend's verifier) and graphviz
-#     (the system model diagram); both optional, their evidence is pending
-#     or the diagram replaced by DOT source when they are missing;
+#   - Debian packages (below): Dafny, graphviz, ROS 1 and Chromium; each
+#     optional, their evidence is pending, the diagram replaced by DOT
+#     source, or the live tests skipped with the reason when missing;
 #   - the rclverify package itself with its Python dependencies and pytest.
 # Safe to run again.
 set -euo pipefail
@@ -12,18 +12,32 @@ as_root() {
   if [ "$(id -u)" = 0 ]; then "$@"; elif command -v sudo >/dev/null 2>&1; then sudo "$@"; else return 1; fi
 }
 
+# Debian packages, each optional (what is missing is said in the evidence, or the test that needs it
+# is skipped with the reason):
+#   dafny, graphviz          the Dafny backend's verifier; the system and argument diagrams
+#   ROS 1 (ros-core ...)     a real ROS master and rospy nodes for the live monitor and the graph read
+#                            from a running system; message definitions for grounding
+#   chromium(-driver)        the browser test of the HTML report
+DEBIAN_PACKAGES=(
+  dafny graphviz
+  ros-core python3-rospy python3-rosbag python3-rosgraph python3-roslaunch python3-genpy python3-catkin-pkg
+  python3-std-msgs python3-geometry-msgs python3-sensor-msgs python3-nav-msgs
+  ros-std-msgs ros-geometry-msgs ros-sensor-msgs ros-nav-msgs
+  chromium chromium-driver
+)
 if command -v apt-get >/dev/null 2>&1; then
   need=()
-  command -v dafny >/dev/null 2>&1 || need+=(dafny)
-  command -v dot >/dev/null 2>&1 || need+=(graphviz)
+  for p in "${DEBIAN_PACKAGES[@]}"; do
+    dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || need+=("$p")
+  done
   if [ ${#need[@]} -gt 0 ]; then
     echo "setup: installing Debian packages: ${need[*]}"
     as_root env DEBIAN_FRONTEND=noninteractive apt-get update -qq \
       && as_root env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq "${need[@]}" >/dev/null \
-      || echo "setup: could not install ${need[*]}; the Dafny evidence will be pending and the diagram shown as DOT"
+      || echo "setup: could not install ${need[*]}; what needs them is pending or skipped, with the reason"
   fi
 else
-  echo "setup: apt-get not found; install dafny and graphviz yourself for the Dafny backend and the diagram"
+  echo "setup: apt-get not found; install ${DEBIAN_PACKAGES[*]} yourself for Dafny, the diagrams, ROS 1 and the browser test"
 fi
 
 PY=${PYTHON:-python3}

@@ -53,7 +53,7 @@ nodes:
       - {backend: review, record: backends/review/n1.yaml}
 """
 
-TIMING = ("started", "duration_s")
+TIMING = ("started", "duration_s", "record_sha256")  # the seal covers the timing fields too
 
 
 def _workspace(path: Path) -> Path:

@@ -208,9 +208,17 @@ def test_config_is_yaml_with_the_documented_keys(checked: Any) -> None:
         ids.append(mon["id"])
         assert set(mon["oracle"]) == {"url", "port", "action"}
         for t in mon["topics"]:
-            assert set(t) == {"name", "type", "action"} and t["type"] == "gazebo_radiation_plugin.msg.Snapshot"
+            assert set(t) == {"name", "type", "action", "ordering"}
+            assert t["type"] == "gazebo_radiation_plugin.msg.Snapshot"
+            assert t["ordering"] == {"enabled": True, "source": "header_stamp", "max_delay_ms": 50}
     assert len(set(ids)) == len(ids) == 4
     assert render_config(checked, "ros2") == render_config(checked, "ros2")
+    assert data["nodes"] == []
+    named = yaml.safe_load(render_config(checked, "ros1", {
+        "RadiationSensor": {"name": "radiation_sensor", "package": "rover", "path": "launch/rover.launch"},
+        "Agent": {"name": "agent"}}))
+    assert named["nodes"] == [{"node": {"name": "agent"}},
+                              {"node": {"name": "radiation_sensor", "package": "rover", "path": "launch/rover.launch"}}]
 
 
 def test_backend_evidence_for_the_bundled_runs(exported: Path) -> None:
@@ -274,3 +282,12 @@ def test_joint_enumeration_of_argument_tuples_matches_brute_force(checked: Any) 
             got_all = ev(checked, "Agent", f"forall(x, y in REAL | in.wayP(x, y) == {k} -> out.command == move(x, y))",
                          vals)
             assert got_all is want_all, (cmd, k)
+
+
+def test_mapping_ros_nodes_are_checked(tmp_path: Path) -> None:
+    from rclverify.backends.monitors.config import ConfigError
+    (tmp_path / "m.yaml").write_text("ros_nodes:\n  Agent: {name: agent, launch: x}\n")
+    with pytest.raises(ConfigError, match="ros_nodes must map"):
+        load_mapping(tmp_path, "m.yaml")
+    (tmp_path / "m.yaml").write_text("ros_nodes:\n  Agent: {name: agent, package: rover}\n")
+    assert load_mapping(tmp_path, "m.yaml").ros_nodes == {"Agent": {"name": "agent", "package": "rover"}}

@@ -20,7 +20,7 @@ def _doit(ws: Path, *args: str) -> subprocess.CompletedProcess[str]:
 @pytest.fixture(scope="module")
 def workspace(tmp_path_factory: pytest.TempPathFactory) -> Path:
     ws = tmp_path_factory.mktemp("ws")
-    for item in ("contracts", "backends", "dodo.py"):
+    for item in ("contracts", "backends", "ros", "dodo.py"):
         src = ROOT / item
         (shutil.copytree if src.is_dir() else shutil.copy)(src, ws / item)
     r = _doit(ws, "verify")
@@ -271,7 +271,7 @@ def _statuses(report: dict) -> dict:
 
 
 def test_parallel_run_gives_the_serial_results(report: dict, tmp_path: Path) -> None:
-    for item in ("contracts", "backends", "dodo.py"):
+    for item in ("contracts", "backends", "ros", "dodo.py"):
         src = ROOT / item
         (shutil.copytree if src.is_dir() else shutil.copy)(src, tmp_path / item)
     r = _doit(tmp_path, "-n", "2", "verify")

@@ -9,11 +9,13 @@
 ``rclverify export``               export obligations to the plan's backends
 ``rclverify report``               rebuild reports/ from the artifacts
 ``rclverify requirements``         check each formal requirement with Z3 and print its status
-``rclverify verify [--strict]``    the whole pipeline through doit
+``rclverify verify [--strict] [--no-wait]``  the whole pipeline through doit (one run at a time per workspace)
 ``rclverify refines A.rcl:N B.rcl:M``  may contract M replace contract N?
 ``rclverify init DIR [--nodes A,B]``  write a new workspace that verifies at once
 ``rclverify bundle [-o FILE]``     the assessor's bundle; ``--verify FILE`` checks one
 ``rclverify review NODE [-o FILE]``  write a review record to fill in
+``rclverify ros scan PATH...``     the ROS computation graph from workspaces (docs/ros.md)
+``rclverify ros check``            the plan's contracts against that graph
 
 Exit codes: 0 success, 1 errors in the input (or, for ``compose``/``verify
 --strict``, an obligation that does not hold), 2 usage errors.  A user's
@@ -22,10 +24,11 @@ mistake prints ``file:line:col: error: message`` lines, never a traceback.
 from __future__ import annotations
 
 import argparse
+import json
 import os
 import sys
 from pathlib import Path
-from typing import Callable, Sequence
+from typing import Any, Callable, Sequence
 
 from .rcl.errors import RclError
 
@@ -173,21 +176,37 @@ def cmd_report(args: argparse.Namespace) -> int:
 
 
 def cmd_verify(args: argparse.Namespace) -> int:
-    from doit.cmd_base import ModuleTaskLoader
-    from doit.doit_cmd import DoitMain
     from .tasks import DEP_FILE, build_tasks, doit_config
-    tasks = build_tasks(Path(args.workspace), args.plan)
+    if not Path(args.workspace).is_dir():  # before doit opens its state file there (a sqlite3 traceback)
+        print(f"{args.workspace}: error: no such workspace directory", file=sys.stderr)
+        return 1
+    try:  # takes the workspace's run lock: waits for a run in progress unless --no-wait
+        tasks = build_tasks(Path(args.workspace), args.plan, wait=False if args.no_wait else None)
+    except SystemExit as exc:  # build_tasks printed the one-line reason
+        return int(exc.code) if isinstance(exc.code, int) else 1
     module = type(sys)("rclverify_dodo")
     module.__dict__.update(tasks)
     module.DOIT_CONFIG = doit_config(str(Path(args.workspace) / DEP_FILE))  # type: ignore[attr-defined]
     argv = ["verify"] + (["--strict"] if args.strict else [])
     if args.jobs > 1:
         argv = ["-n", str(args.jobs)] + argv
-    if not args.cluster:
+    try:  # SystemExit: a fault while doit saves its state, already reported in one line (tasks._guard_dep_writes)
+        return _run_doit(module, argv, args.cluster)
+    except SystemExit as exc:
+        return int(exc.code) if isinstance(exc.code, int) else 1
+    finally:  # the run lock, also when doit ended before completing the run (in-process callers go on)
+        from .runlock import release
+        release(Path(args.workspace))
+
+
+def _run_doit(module: object, argv: list[str], cluster: str | None) -> int:
+    from doit.cmd_base import ModuleTaskLoader
+    from doit.doit_cmd import DoitMain
+    if not cluster:
         return int(DoitMain(ModuleTaskLoader(module)).run(argv))
     from .cluster import CLUSTER_ENV  # read by the evidence tasks, also in doit's worker processes
     before = os.environ.get(CLUSTER_ENV)
-    os.environ[CLUSTER_ENV] = args.cluster
+    os.environ[CLUSTER_ENV] = cluster
     try:
         return int(DoitMain(ModuleTaskLoader(module)).run(argv))
     finally:
@@ -198,6 +217,9 @@ def cmd_verify(args: argparse.Namespace) -> int:
 
 
 def cmd_init(args: argparse.Namespace) -> int:
+    if getattr(args, "from_ros", None):
+        from .ros.cli import init_from_ros
+        return init_from_ros(args)
     from .scaffold import InitError, init_workspace
     names = [n.strip() for n in args.nodes.split(",")] if args.nodes is not None else None
     try:
@@ -214,6 +236,33 @@ def cmd_init(args: argparse.Namespace) -> int:
     return 0
 
 
+def _report_out_of_date(ws: Any) -> list[str]:
+    """Why the written report no longer says what the evidence says (empty
+    when it does, when there is no report yet, or when the workspace does not
+    check: then the bundle packs what there is, as before).  The report is
+    built again in memory from the recorded artifacts, each evidence
+    record's inputs hashed anew against the current contracts and files
+    (docs/integrity.md); an obligation whose status differs from the written
+    report's is listed: an assessor's bundle never holds a report that
+    calls stale or altered evidence anything else."""
+    from .report.build import build_report
+    try:
+        written = json.loads(ws.path("reports/assurance.json").read_text(encoding="utf-8"))
+        was = {o["id"]: o["status"] for o in written["obligations"]}
+    except (OSError, ValueError, KeyError, TypeError):
+        return []
+    try:
+        now = {o["id"]: o["status"] for o in build_report(ws)["obligations"]}
+    except RclError:
+        return []
+    changed = sorted(k for k in now if was.get(k) != now[k])
+    if not changed:
+        return []
+    shown = ", ".join(f"{k} ({was.get(k, 'absent')} -> {now[k]})" for k in changed[:5])
+    return [f"reports/assurance.json is out of date: {len(changed)} obligation(s) have another status now: "
+            f"{shown}{' ...' if len(changed) > 5 else ''}; run `rclverify report` (or `doit verify`) first"]
+
+
 def cmd_bundle(args: argparse.Namespace) -> int:
     """Write the assessor's bundle, or (``--verify FILE``) check one against its manifest."""
     from .bundle.archive import verify_bundle, write_bundle
@@ -228,6 +277,11 @@ def cmd_bundle(args: argparse.Namespace) -> int:
         print(f"{args.verify}: {len(manifest['files'])} file(s) match MANIFEST.json")
         return 0
     ws = _ws(args)
+    problems = _report_out_of_date(ws)
+    if problems:
+        for problem in problems:
+            print(f"{args.workspace}: error: {problem}", file=sys.stderr)
+        return 1
     name = "".join(c if c.isalnum() or c in "-_." else "-" for c in (ws.plan.name or ws.root.resolve().name)).strip("-")
     out = Path(args.output) if args.output else Path(f"{name or 'workspace'}-bundle.tar.gz")
     try:
@@ -272,6 +326,11 @@ def cmd_monitor(args: argparse.Namespace) -> int:
     return monitor_command(args)
 
 
+def cmd_oracle(args: argparse.Namespace) -> int:
+    from .backends.monitors.cli import oracle_command
+    return oracle_command(args)
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``rclverify`` console script; returns the exit code."""
     p = argparse.ArgumentParser(prog="rclverify", description="Compositional verification from RCL contracts.")
@@ -304,12 +363,19 @@ def main(argv: Sequence[str] | None = None) -> int:
     v.add_argument("--strict", action="store_true",
                    help="exit 1 unless every obligation, side condition and health check holds")
     v.add_argument("-n", "--jobs", type=int, default=1, help="parallel doit processes")
+    v.add_argument("--no-wait", action="store_true",
+                   help="exit 1 instead of waiting when another run is in progress in the workspace "
+                        "(also: RCLVERIFY_NO_WAIT=1)")
     v.add_argument("--cluster", metavar="ADDRESS",
                    help="send backend jobs to the Dask scheduler at ADDRESS (e.g. tcp://127.0.0.1:8786); "
                         "default: run them locally")
     i = add("init", cmd_init, "write a new workspace (dodo.py, example contracts, plan) that verifies at once")
     i.add_argument("dir", help="directory to create (must be new or empty)")
     i.add_argument("--nodes", help="comma-separated node names, in chain order (default: Sensor,Controller,Actuator)")
+    i.add_argument("--from-ros", metavar="PATH", action="append",
+                   help="one contract skeleton per node of the ROS workspace PATH (repeatable; docs/ros.md)")
+    i.add_argument("--launch", action="append", default=[], metavar="FILE",
+                   help="with --from-ros: entry launch file (repeatable)")
     bnd = add("bundle", cmd_bundle, "write the assessor's bundle (reports, artifacts, plan, contracts, manifest)", True)
     bnd.add_argument("-o", "--output", help="archive to write (.tar.gz or .zip; default: <workspace name>-bundle.tar.gz)")
     bnd.add_argument("--verify", metavar="FILE", help="check the archive FILE against its manifest instead")
@@ -323,12 +389,32 @@ def main(argv: Sequence[str] | None = None) -> int:
     r.add_argument("--assume", action="append", metavar="FORMULA",
                    help="RCL condition on the replacement's inputs (repeatable); lets it read extra inputs")
 
+    from .ros.cli import add_parsers as add_ros_parsers
+    add_ros_parsers(sub)
     m = add("monitor", cmd_monitor, "check recorded runs (ROSMonitoring logs, ROS bags) against every "
             "node's contract", True)
-    m.add_argument("traces", nargs="+", metavar="TRACE", help="a .jsonl log, a .bag, a ROS 2 bag directory or .mcap")
+    m.add_argument("traces", nargs="*", metavar="TRACE", help="a .jsonl log, a .bag, a ROS 2 bag directory or .mcap")
     m.add_argument("--mapping", help="mapping file (default: backends/monitors/mapping.yaml if present)")
     m.add_argument("--horizon", type=float, help="seconds an input event may wait for its answer (default 5.0)")
     m.add_argument("--json", action="store_true", help="print the verdicts as JSON")
+    lv = m.add_argument_group("live monitoring (ROS 1; docs/monitors.md)")
+    lv.add_argument("--live", action="store_true", help="monitor the running ROS 1 system (ROS_MASTER_URI) instead")
+    lv.add_argument("--log", default="monitor_live.jsonl", help="JSON-lines log of events and verdicts to write")
+    lv.add_argument("--evidence", help="write the monitoring evidence record (JSON) here when stopped")
+    lv.add_argument("--duration", type=float, help="stop after this many seconds (default: at SIGINT/SIGTERM)")
+    lv.add_argument("--reorder-window", type=float, default=0.05, help="seconds to wait for stamp ordering")
+    lv.add_argument("--silence", type=float, default=10.0,
+                    help="report a contract topic not received for this many seconds (default 10; 0: off)")
+    lv.add_argument("--status", type=float, default=1.0, help="seconds between status lines (0: off)")
+    lv.add_argument("--verdict-topic", default="/rclverify/verdict", help="topic of the per-event verdicts")
+    lv.add_argument("--node", dest="nodes", action="append", metavar="NODE", help="monitor only NODE (repeatable)")
+    lv.add_argument("--ros", choices=("1", "2"), help="ROS version (default: $ROS_VERSION, else 1)")
+    o = add("oracle", cmd_oracle, "serve the contracts as a ROSMonitoring oracle over WebSocket", True)
+    o.add_argument("--port", type=int, default=8080, help="TCP port (default 8080)")
+    o.add_argument("--host", default="127.0.0.1", help="address to bind (default 127.0.0.1)")
+    o.add_argument("--node", dest="nodes", action="append", metavar="NODE", help="serve only NODE (repeatable)")
+    o.add_argument("--mapping", help="mapping file (default: backends/monitors/mapping.yaml if present)")
+    o.add_argument("--horizon", type=float, help="seconds an input event may wait for its answer")
     args = p.parse_args(argv)
     try:
         return int(args.fn(args))
@@ -336,6 +422,11 @@ def main(argv: Sequence[str] | None = None) -> int:
         return _print_diags(exc)
     except KeyboardInterrupt:
         return 130
+    except OSError as exc:  # a fault of the machine (read-only directory, full disk): one plain line
+        from .faults import describe_os_error
+        root = getattr(args, "workspace", None)
+        print(describe_os_error(exc, Path(root).resolve() if root else None), file=sys.stderr)
+        return 1
     except RecursionError:
         # Last line of defence: the parser bounds nesting (rcl/parser.py
         # NESTING_LIMIT), so this means a stage built a deeper formula itself.

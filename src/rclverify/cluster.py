@@ -73,6 +73,7 @@ def remote_run(root: str, plan_file: str, key: str, node: str, obligation_id: st
     from .backends import get_backend
     from .evidence.records import Obligation
     from .evidence.store import read_json
+    from .logic.world import fresh as fresh_z3
     from .pipeline import Workspace
     ws = _WORKER_WORKSPACES.get((root, plan_file, key))
     if ws is None:
@@ -81,6 +82,7 @@ def remote_run(root: str, plan_file: str, key: str, node: str, obligation_id: st
         _WORKER_WORKSPACES.clear()
         _WORKER_WORKSPACES[(root, plan_file, key)] = ws
     o = Obligation.from_json(read_json(ws.path(ws.obligation(node, obligation_id))))
+    fresh_z3()  # as a local run does (pipeline.stage_run): the same Z3 state for every job
     ev = get_backend(o.backend).run(o, ws.target(node, int(o.data.get("entry", 0))))
     return json.dumps(ev.to_json())
 

@@ -30,7 +30,8 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any, Callable, Sequence, cast
 
 from .evidence.records import Evidence, Obligation
-from .evidence.store import EvidenceStore, atomic_write_text, read_json, write_json, write_obligations
+from .evidence.store import EvidenceStore, atomic_write_text, dumps, read_json, write_json, write_obligations
+from .logic.world import fresh as fresh_z3
 from .rcl.errors import RclError, error
 
 if TYPE_CHECKING:
@@ -126,12 +127,17 @@ class Workspace:
         self._run_deferred()
         from .plan.load import resolve
         from .rcl.parser import parse_text
+        from .rcl.source import read_text as read_source
         from .rcl.typecheck import check
         plan = self.plan
         specs = []
         diags: list[Diagnostic] = []
         for rel in plan.contracts:  # parsed under their workspace-relative names
-            text = (self.root / rel).read_text(encoding="utf-8")
+            try:
+                text = read_source(self.root / rel, rel)
+            except RclError as exc:
+                diags.extend(exc.diagnostics)
+                continue
             sha = hashlib.sha256(text.encode("utf-8")).hexdigest()
             if rel in self.parsed and self.parsed[rel][0] == sha:
                 specs.append(self.parsed[rel][1])
@@ -146,8 +152,22 @@ class Workspace:
         if diags:
             raise RclError(diags)
         c = check(specs)
-        resolve(self.plan, c)
+        from .plan.errors import PlanError
+        try:
+            resolve(self.plan, c)
+        except PlanError as exc:
+            raise PlanError(list(exc.diagnostics) + self._entry_diagnostics(c)) from None
+        entry_diags = self._entry_diagnostics(c)
+        if entry_diags:
+            raise PlanError(entry_diags)
         return c
+
+    def _entry_diagnostics(self, c: Checked) -> list[Diagnostic]:
+        """The backends' check-time validation of the plan's entries (experiment
+        data, review records, trace mappings): run here, above both the plan and
+        the backends, so that no plan module imports backend code."""
+        from .backends.entry_checks import check_entries
+        return check_entries(self.plan, c)
 
     @cached_property
     def model(self) -> SystemModel:
@@ -185,6 +205,11 @@ class Workspace:
     def evidence(obligation_id: str) -> str:
         return f"artifacts/evidence/{obligation_id}.json"
 
+    @staticmethod
+    def provenance(node: str) -> str:
+        """What each of the node's stages was made from (:func:`record_provenance`)."""
+        return f"artifacts/provenance/{node}.json"
+
     MODEL = "artifacts/system/model.json"
     DOT = "artifacts/system/model.dot"
     DIAGNOSTICS = "artifacts/check/diagnostics.json"
@@ -201,28 +226,74 @@ class Workspace:
             plan_locs=self.plan.locs)
 
 
+def node_snapshots(ws: Workspace, texts: Any = None) -> dict[str, dict[str, Any]]:
+    """The snapshot of every node of ``ws`` (``{node: snapshot}``, source order):
+    everything the node's own stages (compose, health, export) and its
+    evidence read of the contracts and the plan, locations included.
+
+    A snapshot holds the node's canonical RCL text, the shared context, its
+    plan facts (text and location), instance range, evidence entries,
+    replacement, and the source locations of the node, of each assumption and
+    guarantee and of every value the plan gives for the node (so a comment
+    that moves a guarantee, or a plan edit that moves an entry, changes the
+    snapshot, and whatever shows those locations is made again).
+    ``stage_check`` writes them (``artifacts/contracts/<Node>.json``); the
+    report recomputes them from the current files to find evidence produced
+    from another contract text (:func:`current_snapshot_hashes`).  ``texts``
+    is a :class:`~rclverify.contract_texts.ContractTexts` (made when omitted).
+    Raises RclError/PlanError for contracts or a plan that do not check."""
+    from .contract_texts import ContractTexts
+    from .rcl import ast
+    from .rcl.printer import to_rcl
+    checked, plan = ws.checked, ws.plan
+    if texts is None:
+        texts = ContractTexts(ws)
+    context_text = to_rcl(ast.Spec(tuple(c for s in checked.specs for c in s.contexts), ()))
+    plan_locs: dict[str, dict[str, str]] = {}  # node -> {value path under nodes.<node>: "line:col"}
+    for path, loc in plan.locs.items():
+        if len(path) > 1 and path[0] == "nodes":
+            plan_locs.setdefault(str(path[1]), {})["/".join(map(str, path[2:]))] = f"{loc.line}:{loc.col}"
+    out: dict[str, dict[str, Any]] = {}
+    for name, cn in checked.nodes.items():
+        tx = texts.node(cn.node)
+        out[name] = {
+            "node": name, "rcl": tx["rcl"], "context": context_text,
+            "facts": [f.text for f in plan.facts.get(name, ())],
+            "fact_sources": [str(f.loc) for f in plan.facts.get(name, ())],
+            "instances": list(plan.instances[name]) if name in plan.instances else None,
+            "evidence": [dict(e.config) for e in plan.evidence.get(name, ())],
+            "replacement": plan.replacements[name][0] if name in plan.replacements else None,
+            "source": f"{cn.node.loc.file}:{cn.node.loc.line}",
+            "sources": {"node": str(cn.node.loc), "assumptions": [src for _, src in tx["assumptions"]],
+                        "guarantees": [src for _, src in tx["guarantees"]]},
+            "plan_locations": dict(sorted(plan_locs.get(name, {}).items())),
+        }
+    return out
+
+
+def current_snapshot_hashes(ws: Workspace, texts: Any = None) -> dict[str, str]:
+    """``{artifacts/contracts/<Node>.json: sha256}`` of the snapshots the
+    current contract and plan files give (:func:`node_snapshots`), whatever
+    the files under ``artifacts/`` say: the hashes an evidence record's
+    ``input_hashes`` are compared with, so evidence produced from another
+    contract text is ``stale`` even when no ``check`` ran since the edit
+    (``rclverify report``).  Raises like :func:`node_snapshots`."""
+    return {ws.snapshot(n): hashlib.sha256(dumps(snap).encode("utf-8")).hexdigest()
+            for n, snap in node_snapshots(ws, texts).items()}
+
+
 def stage_check(ws: Workspace) -> dict[str, Any]:
-    """Parse, type-check, resolve the plan, lint; write snapshots and the system model.
+    """Parse, type-check, resolve the plan, lint; write snapshots (:func:`node_snapshots`)
+    and the system model.
 
     Returns the diagnostics JSON (lint warnings).  Raises RclError/PlanError.
     """
     from .contract_texts import ContractTexts
-    from .rcl import ast
-    from .rcl.printer import to_rcl
     checked, model = ws.checked, ws.model
     texts = ContractTexts(ws)  # each file's lint and each node's RCL text, kept by the file's sha256
     warnings = [w for s in checked.specs for w in texts.lint(s)]
     write_json(ws.path(ws.DIAGNOSTICS), {"warnings": warnings})
-    context_text = to_rcl(ast.Spec(tuple(c for s in checked.specs for c in s.contexts), ()))
-    for name, cn in checked.nodes.items():
-        snap = {
-            "node": name, "rcl": texts.node(cn.node)["rcl"], "context": context_text,
-            "facts": [f.text for f in ws.plan.facts.get(name, ())],
-            "instances": list(ws.plan.instances[name]) if name in ws.plan.instances else None,
-            "evidence": [dict(e.config) for e in ws.plan.evidence.get(name, ())],
-            "replacement": ws.plan.replacements[name][0] if name in ws.plan.replacements else None,
-            "source": f"{cn.node.loc.file}:{cn.node.loc.line}",
-        }
+    for name, snap in node_snapshots(ws, texts).items():
         write_json(ws.path(ws.snapshot(name)), snap)
     try:
         texts.save()
@@ -244,8 +315,70 @@ def stage_graph(ws: Workspace) -> str:
     return dot
 
 
+def record_provenance(ws: Workspace, node: str, stage: str, inputs: Sequence[str]) -> None:
+    """Record in ``artifacts/provenance/<node>.json`` the sha256 of each
+    workspace-relative file in ``inputs``, after ``stage`` of ``node`` wrote
+    its outputs from them (a stage killed before that records nothing).  The report compares them with
+    the inputs' current hashes (:func:`stale_stages`), so the side conditions
+    or health findings of a contract edited since are shown ``stale``, never
+    with the status of the old text (``rclverify report`` runs no stage).
+    Raises ``OSError`` when the file cannot be written."""
+    from .evidence.records import hash_inputs
+    rel = ws.provenance(node)
+    current = read_artifact(ws, rel, {})
+    if not isinstance(current, dict):
+        current = {}
+    current[stage] = hash_inputs(ws.root, list(inputs))
+    write_json(ws.path(rel), current)
+
+
+def stage_inputs(ws: Workspace, node: str, stage: str) -> list[str]:
+    """The workspace-relative files the contents of ``stage`` (``compose`` or
+    ``health``) of ``node`` are made from: its snapshot, for ``compose`` its
+    producers' snapshots and the system model, for ``health`` the plan's
+    replacement contract file if any.  (Export's are the inputs of each
+    obligation, hashed into its evidence.)"""
+    if stage == "compose":
+        return [ws.snapshot(node), *(ws.snapshot(p) for p in ws.model.producers(node)), ws.MODEL]
+    repl = ws.plan.replacements.get(node)
+    return [ws.snapshot(node)] + ([repl[0].rpartition(":")[0]] if repl else [])
+
+
+def stale_stages(ws: Workspace, current: dict[str, str]) -> dict[str, set[str]]:
+    """``{node: {stage, ...}}`` for every node of ``ws`` whose ``compose`` or
+    ``health`` artifacts were made from files other than those the current
+    contracts and plan give: a recorded hash differs from ``current`` (path
+    -> sha256; :func:`current_snapshot_hashes` plus :func:`current_model_hash`;
+    other files are hashed here and added to it), or nothing was recorded.
+    Nodes with no artifacts yet are left out."""
+    from .evidence.records import hash_inputs
+    out: dict[str, set[str]] = {}
+    for n in ws.checked.nodes:
+        rec = read_artifact(ws, ws.provenance(n), None)
+        for stage, artifact in (("compose", ws.calculus(n)), ("health", ws.health(n))):
+            if not os.path.exists(os.path.join(ws.root, artifact)):
+                continue
+            made = rec.get(stage) if isinstance(rec, dict) else None
+            if not isinstance(made, dict) or set(made) != set(stage_inputs(ws, n, stage)):
+                out.setdefault(n, set()).add(stage)
+                continue
+            missing = [p for p in made if p not in current]
+            if missing:
+                current.update(hash_inputs(ws.root, missing))
+            if any(current[p] != h for p, h in made.items()):
+                out.setdefault(n, set()).add(stage)
+    return out
+
+
+def current_model_hash(ws: Workspace) -> dict[str, str]:
+    """``{artifacts/system/model.json: sha256}`` of the model the current
+    contracts and plan give (what ``check`` would write)."""
+    return {ws.MODEL: hashlib.sha256(dumps(ws.model.to_json()).encode("utf-8")).hexdigest()}
+
+
 def stage_compose(ws: Workspace, node: str) -> dict[str, Any]:
     """Apply the calculus to ``node``; writes its JSON and one .smt2 per side condition."""
+    fresh_z3()  # the same Z3 state whatever ran before in this process (logic/world.py)
     from .calculus.compose import compose_node, composition_json
     comp = compose_node(ws.checked, ws.model, node)
     paths = []
@@ -255,11 +388,13 @@ def stage_compose(ws: Workspace, node: str) -> dict[str, Any]:
         paths.append(rel)
     out = composition_json(comp, paths)
     write_json(ws.path(ws.calculus(node)), out)
+    record_provenance(ws, node, "compose", stage_inputs(ws, node, "compose"))  # after: a killed stage records nothing
     return out
 
 
 def stage_health(ws: Workspace, node: str) -> list[dict[str, Any]]:
     """Run the contract health checks of ``node``; writes its findings JSON."""
+    fresh_z3()  # the same Z3 state whatever ran before in this process (logic/world.py)
     from .health.checks import check_node
     facts = [(f.expr, f.loc) for f in ws.plan.facts.get(node, ())]
     checked = check_node(ws.checked, node, facts, ws.plan.instances.get(node))
@@ -273,6 +408,7 @@ def stage_health(ws: Workspace, node: str) -> list[dict[str, Any]]:
             atomic_write_text(ws.path(j["smt2"]), f.smt2)
         findings.append(j)
     write_json(ws.path(ws.health(node)), findings)
+    record_provenance(ws, node, "health", stage_inputs(ws, node, "health"))
     return findings
 
 
@@ -290,8 +426,9 @@ def replacement_finding(ws: Workspace, node: str) -> Finding:
     from .rcl.typecheck import check
     spec, loc = ws.plan.replacements[node]
     rel, name = split_spec(spec)
+    from .rcl.source import decode_text
     try:
-        text = (ws.root / rel).read_text(encoding="utf-8")
+        text = decode_text((ws.root / rel).read_bytes(), rel)
     except OSError as exc:
         raise RclError([error(loc, f"cannot read replacement contract {rel!r}: {exc.strerror or exc}", "E-io")]) from None
     other = check([parse_text(text, rel)])
@@ -306,6 +443,7 @@ def replacement_finding(ws: Workspace, node: str) -> Finding:
 
 def stage_export(ws: Workspace, node: str) -> list[dict[str, Any]]:
     """Export ``node``'s obligations for every evidence entry of the plan."""
+    fresh_z3()  # the same Z3 state whatever ran before in this process (logic/world.py)
     from .backends import get_backend
     obligations = []
     shared = set(ws.plan.contracts) | {ws.plan.file}
@@ -332,6 +470,7 @@ def stage_export(ws: Workspace, node: str) -> list[dict[str, Any]]:
 def stage_run(ws: Workspace, node: str, obligation_id: str) -> Evidence:
     """Run the backend of one exported obligation and store its evidence record
     atomically (an earlier record is replaced only by a complete new one)."""
+    fresh_z3()  # the same Z3 state whatever ran before in this process (logic/world.py)
     from .backends import get_backend
     o = Obligation.from_json(read_json(ws.path(ws.obligation(node, obligation_id))))
     ev = get_backend(o.backend).run(o, ws.target(node, int(o.data.get("entry", 0))))

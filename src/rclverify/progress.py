@@ -25,6 +25,7 @@ from typing import TYPE_CHECKING
 
 from doit.reporter import ConsoleReporter
 
+from .doitstate import save_finished
 from .report.summary import is_terminal
 
 if TYPE_CHECKING:  # rich is imported when the live line starts (a terminal): doit imports this on every run
@@ -141,10 +142,12 @@ class ProgressReporter(ConsoleReporter):  # type: ignore[misc]
             self.done.add(task.name)
 
     def add_success(self, task: Any) -> None:
+        save_finished()  # doit saved the task's state in memory just before: on disk now (doitstate)
         self._finish(task)
         super().add_success(task)
 
     def add_failure(self, task: Any, fail: Any) -> None:
+        save_finished()
         self._finish(task)
         super().add_failure(task, fail)
 
@@ -166,6 +169,8 @@ class ProgressReporter(ConsoleReporter):  # type: ignore[misc]
             self.live = None
         super().complete_run()
         from .heap import freeze_at_exit, release_after_run
+        from .runlock import release
+        release()  # the workspace's run lock (rclverify.runlock): the next run may start
         release_after_run()
         freeze_at_exit()
 

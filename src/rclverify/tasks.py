@@ -54,6 +54,7 @@ from doit.tools import config_changed
 
 from . import heap, wscache
 from .pipeline import REPORT_PARTS, TaskIndex, Workspace
+from .plan.entries import TOOL_KEYS
 from .rcl.errors import RclError
 
 _F = TypeVar("_F", bound=Callable[..., Any])
@@ -70,7 +71,7 @@ REPORTS = ["reports/assurance.html", "reports/assurance.md", "reports/assurance.
 _WORKSPACES: dict[str, Workspace] = {}
 
 
-def _ws(root: str) -> Workspace:
+def _ws(root: str, plan_file: str | None = None) -> Workspace:
     """The workspace at ``root``, loaded once per doit run: every action would
     otherwise parse and check the contracts again.
 
@@ -80,12 +81,14 @@ def _ws(root: str) -> Workspace:
     state its ``check`` task snapshots and every later task depends on.  A
     contract edited while a run is under way is therefore picked up by the
     next run, whose ``check`` sees the changed file.  Without a seeded entry
-    (a worker process that did not inherit it) the workspace is loaded here.
+    (a worker process that did not inherit it) the workspace is loaded here,
+    with ``plan_file`` (the ``check`` task passes the run's plan file; the
+    default plan otherwise).
     """
     heap.freeze_inherited()  # a doit -n worker: its inherited heap stays live (rclverify.heap)
     ws = _WORKSPACES.get(root)
-    if ws is None:
-        ws = Workspace(Path(root))
+    if ws is None or (plan_file is not None and ws.plan_file != plan_file):
+        ws = Workspace(Path(root), plan_file or "contracts/plan.yaml")
         ws.model  # load now: raises RclError for bad input and then caches nothing
         _WORKSPACES[root] = ws
     return ws
@@ -95,12 +98,22 @@ def _fail(exc: RclError) -> TaskFailed:
     return TaskFailed("\n".join(str(d) for d in exc.diagnostics))
 
 
-def act_check(root: str) -> Any:
+def _io_fail(exc: OSError, root: str, place: str = "artifacts/") -> TaskFailed:
+    """A fault of the machine (read-only directory, full disk) as one plain line
+    (:mod:`rclverify.faults`; ``place``: where the action writes, for an
+    error without a file name): the writes are atomic, nothing recorded changed."""
+    from .faults import describe_os_error
+    return TaskFailed(describe_os_error(exc, Path(root), place=place))
+
+
+def act_check(root: str, plan_file: str = "contracts/plan.yaml") -> Any:
     from .pipeline import stage_check
     try:
-        out = stage_check(_ws(root))
+        out = stage_check(_ws(root, plan_file))
     except RclError as exc:
         return _fail(exc)
+    except OSError as exc:
+        return _io_fail(exc, root)
     for w in out["warnings"]:
         print(f"{w['file']}:{w['line']}:{w['col']}: warning: {w['message']}")
     return None
@@ -112,13 +125,15 @@ def act_graph(root: str) -> Any:
     from .report.diagram import dot_to_svg
     try:
         dot = stage_graph(_ws(root))
+        svg = dot_to_svg(dot)
+        if svg is None:
+            print(f"graphviz 'dot' not found: {Workspace.DOT} written, model.svg not drawn")
+            return None
+        atomic_write_text(Path(root) / "artifacts/system/model.svg", svg)
     except RclError as exc:
         return _fail(exc)
-    svg = dot_to_svg(dot)
-    if svg is None:
-        print(f"graphviz 'dot' not found: {Workspace.DOT} written, model.svg not drawn")
-        return None
-    atomic_write_text(Path(root) / "artifacts/system/model.svg", svg)
+    except OSError as exc:
+        return _io_fail(exc, root)
     return None
 
 
@@ -153,6 +168,8 @@ def act_node(root: str, node: str, deps: dict[str, list[str]], changed: list[str
             getattr(pipeline, f"stage_{stage}")(_ws(root), node)
     except RclError as exc:
         return _fail(exc)
+    except OSError as exc:
+        return _io_fail(exc, root)
     print(f"{node}: {', '.join(stages)}")
     return None
 
@@ -170,6 +187,8 @@ def act_run(root: str, node: str, obligation_id: str) -> Any:
         return _fail(exc)
     except cluster.ClusterError as exc:
         return TaskFailed(f"error: {exc}")
+    except OSError as exc:
+        return _io_fail(exc, root, "artifacts/evidence/")
     print(f"{ev.obligation}: {ev.status}")
     return None
 
@@ -192,6 +211,8 @@ def act_report(root: str, part: str) -> Any:
         report, _ = stage_report(ws, (part,), kept[1] if kept is not None and kept[0] is ws else None)
     except RclError as exc:
         return _fail(exc)
+    except OSError as exc:
+        return _io_fail(exc, root, "reports/")
     _REPORTS[root] = (ws, report)
     if part == "html":
         print(f"report: reports/assurance.html  ({report['summary']['headline']})")
@@ -211,6 +232,43 @@ def act_requirements(root: str) -> Any:
     print(f"requirements: {len(again)} of {len(rows)} checked" + (f" ({', '.join(again[:10])}"
                                                                   + (", ..." if len(again) > 10 else "") + ")" if again else ""))
     return None
+
+
+def act_ground(root: str) -> Any:
+    """The grounding stage (docs/ros.md): scan the plan's ``ros:`` section,
+    hold the contracts against it; findings go to the report, never to a verdict."""
+    from .ros.stage import stage_ground
+    try:
+        data = stage_ground(_ws(root))
+    except RclError as exc:
+        return _fail(exc)
+    c = data["counts"]
+    print(f"grounding: {c['error']} error(s), {c['warning']} warning(s) (rclverify ros check lists them)")
+    return None
+
+
+def ros_fingerprint(root: Path, ros: Mapping[str, Any]) -> list[tuple[str, int, int]]:
+    """(path, size, mtime_ns) of every file under the ``ros:`` section's paths:
+    the grounding task runs again when one changes (the scan's own cache then
+    re-parses only the changed files)."""
+    out: list[tuple[str, int, int]] = []
+    for key in ("workspaces", "launch", "bags"):
+        for rel in ros.get(key, []) or []:
+            top = root / str(rel)
+            files = [top] if top.is_file() else sorted(p for p in top.rglob("*") if p.is_file()) if top.is_dir() else []
+            for p in files:
+                try:
+                    st = p.stat()
+                except OSError:
+                    continue
+                out.append((str(p.relative_to(root)), st.st_size, st.st_mtime_ns))
+    for key in ("mapping",):
+        if ros.get(key):
+            p = root / str(ros[key])
+            if p.is_file():
+                st = p.stat()
+                out.append((str(ros[key]), st.st_size, st.st_mtime_ns))
+    return out
 
 
 def act_verify(root: str, strict: bool) -> Any:
@@ -245,6 +303,45 @@ def requirements_line(rows: Sequence[Sequence[str]]) -> str:
                                                             if v in named else "") for v, ids in by.items())
 
 
+class RecordIntact:
+    """doit ``uptodate`` check of an evidence task: its record is as rclverify
+    wrote it.  A record changed by anything else (a hand edit of its status)
+    makes the task run again, so ``doit verify`` produces the evidence anew
+    instead of believing it (the report of a run that does not re-run it,
+    ``rclverify report``, shows it as ``error``: evidence altered).
+
+    Cheap on a no-op run: after the task ran, the record's size and
+    modification time are saved with doit's task values; while they are the
+    same the record is not read.  Otherwise its seal is checked
+    (:meth:`rclverify.evidence.store.EvidenceStore.read`)."""
+
+    __signature__ = inspect.Signature([inspect.Parameter("task", inspect.Parameter.POSITIONAL_OR_KEYWORD),
+                                       inspect.Parameter("values", inspect.Parameter.POSITIONAL_OR_KEYWORD)])
+
+    def __call__(self, task: Any, values: Mapping[str, Any]) -> bool:
+        target = task.targets[0]
+
+        def stat() -> dict[str, Any]:
+            try:
+                st = os.stat(target)
+            except OSError:
+                return {}
+            return {"_record_stat": [st.st_mtime_ns, st.st_size]}
+        task.value_savers.append(stat)
+        now = stat()
+        if not now:
+            return False
+        if values.get("_record_stat") == now["_record_stat"]:
+            return True
+        from .evidence.store import EvidenceStore
+        root, _, name = target.rpartition("/artifacts/evidence/")
+        ev, problem = EvidenceStore(Path(root)).read(name[:-len(".json")])
+        if problem:
+            print(f"{os.path.relpath(target, root)}: {problem}: producing it again")
+            return False
+        return ev is not None
+
+
 def strict_uptodate(task: Any, values: Any) -> bool:
     """``verify`` is up to date unless ``--strict`` asks for the check again."""
     return not bool(task.options.get("strict"))
@@ -252,6 +349,13 @@ def strict_uptodate(task: Any, values: Any) -> bool:
 
 def _inputs(config: Any, root: Path, seen: dict[str, tuple[str, ...]]) -> list[str]:
     """Workspace files named in a plan evidence entry (strings that are existing paths).
+
+    The values of tool keys (``dafny: PATH``, ``mcapl_home``, ``options``:
+    :data:`rclverify.plan.entries.TOOL_KEYS`) name installed tools, not
+    workspace files, and are never file dependencies (an absolute tool path
+    joined to the workspace root was a dependency on a file that does not
+    exist, a doit DependencyError); nor is any absolute path (the plan check
+    refuses those everywhere else).
 
     ``seen`` memoises the files of each path string across calls (the
     entries of many nodes name the same program or directory: one stat or
@@ -271,16 +375,27 @@ def _inputs(config: Any, root: Path, seen: dict[str, tuple[str, ...]]) -> list[s
         return seen[v]
 
     def walk(v: Any) -> None:
-        if isinstance(v, str) and "/" in v:
+        if isinstance(v, str) and "/" in v and not os.path.isabs(v):
             out.update(files(v))
         elif isinstance(v, dict):
-            for x in v.values():
-                walk(x)
+            for k, x in v.items():
+                if k not in TOOL_KEYS:
+                    walk(x)
         elif isinstance(v, list):
             for x in v:
                 walk(x)
     walk(dict(config))
     return sorted(out)
+
+
+def _z3_version() -> str:
+    """The installed z3-solver's version (from its metadata: importing Z3 costs a no-op run
+    a fifth of a second).  Every verdict comes from Z3, so another version makes them again."""
+    from importlib.metadata import PackageNotFoundError, version
+    try:
+        return version("z3-solver")
+    except PackageNotFoundError:
+        return "-"
 
 
 def _tool_fingerprint() -> dict[str, Any]:
@@ -341,13 +456,68 @@ def _use_linear_implicit_task_dep() -> None:
 DOIT_IMPLICIT_TASK_DEP: list[Callable[..., None]] = []
 
 
-def build_tasks(root: str | Path, plan_file: str = "contracts/plan.yaml") -> dict[str, Callable[[], Any]]:
+def _guard_dep_writes() -> None:
+    """Make a full disk (or a read-only workspace) while doit writes its task
+    state end the run with one plain line and exit code 1, instead of doit's
+    traceback (``sqlite3.OperationalError: database or disk is full``, exit
+    3).  Wraps the writing methods of ``doit.dependency.SqliteDB`` (the store
+    :func:`doit_config` selects: ``dump`` at the end of a run, ``remove`` when
+    a task fails) once per process; what the run wrote is complete (every
+    write is atomic), only doit's record of it is lost, so its tasks run
+    again next time.  ``SystemExit`` passes through doit's own handler."""
+    import sqlite3
+    import sys
+    from doit.dependency import SqliteDB
+
+    def guard(method: Callable[..., Any]) -> Callable[..., Any]:
+        def guarded(self: Any, *args: Any) -> Any:
+            try:
+                return method(self, *args)
+            except (sqlite3.Error, OSError) as exc:
+                print(f"error: cannot save doit's task state in {os.path.basename(self.name)}: {exc} (free some "
+                      "space or make the workspace writable, and run again); what this run wrote is complete, and "
+                      "its tasks run again next time", file=sys.stderr)
+                raise SystemExit(1) from None
+        guarded._rclverify_guarded = True  # type: ignore[attr-defined]
+        return guarded
+    for name in ("dump", "remove"):
+        method = getattr(SqliteDB, name)
+        if not getattr(method, "_rclverify_guarded", False):
+            setattr(SqliteDB, name, guard(method))
+
+
+def build_tasks(root: str | Path, plan_file: str = "contracts/plan.yaml", *,
+                wait: bool | None = None) -> dict[str, Callable[[], Any]]:
     """The ``task_*`` functions for a dodo.py of the workspace at ``root``.
+
+    First takes the workspace's run lock (:mod:`rclverify.runlock`: one run
+    at a time; a second run waits with the message ``waiting for the run in
+    progress (pid N)``, or with ``wait=False`` / ``RCLVERIFY_NO_WAIT=1``
+    does not wait).  The lock is given back when doit completes the run
+    (the progress reporter) or the process ends.  When the lock cannot be
+    had without waiting, or its file cannot be created, prints one
+    ``error:`` line and raises ``SystemExit(1)`` (``dodo.py`` has no other
+    way to end a doit command cleanly).
 
     The loaded workspace stays live for the run: it is loaded without
     cyclic garbage collection and then frozen for the run
     (:mod:`rclverify.heap`; the progress reporter gives it back to the
     collector when doit completes the run)."""
+    import sys
+    from . import runlock
+    from .faults import describe_os_error
+    rootp = Path(root)
+    if not rootp.is_dir():
+        print(f"{root}: error: no such workspace directory", file=sys.stderr)
+        raise SystemExit(1)
+    try:
+        runlock.acquire(rootp, wait=wait)
+    except runlock.RunInProgress as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        raise SystemExit(1) from None
+    except OSError as exc:
+        print(describe_os_error(exc, rootp.resolve(), "cannot take the run lock in"), file=sys.stderr)
+        raise SystemExit(1) from None
     with heap.no_collection():
         creators = _build_tasks(root, plan_file)
         heap.freeze_for_run()  # before collecting again: what was made while loading is not looked at
@@ -356,6 +526,7 @@ def build_tasks(root: str | Path, plan_file: str = "contracts/plan.yaml") -> dic
 
 def _build_tasks(root: str | Path, plan_file: str) -> dict[str, Callable[[], Any]]:
     _use_linear_implicit_task_dep()
+    _guard_dep_writes()
     rootp = Path(root).resolve()
     r = str(rootp)
     ws = Workspace(rootp, plan_file)
@@ -384,12 +555,23 @@ def _build_tasks(root: str | Path, plan_file: str) -> dict[str, Callable[[], Any
         return f"{r}/{rel}"
 
     snap = {n: at(ws.snapshot(n)) for n in nodes}
+    # Every task that makes a result depends on the rclverify code that makes it: another version
+    # (an upgrade, a changed module) makes every result again, as a clean run would.
+    code_version = {"rclverify": wscache.code_stamp(), "z3": _z3_version()}
+    code = config_changed(code_version)
+    code.__signature__ = inspect.signature(code)  # answered at once by doit (see task_evidence)
+
+    # Only files that exist are file dependencies (doit refuses a missing one with a DependencyError):
+    # a missing plan or contract makes `check` run, and fail with the located message, every time.
+    named = [str(rootp / plan_file)] + contract_deps
+    check_deps = [d for d in named if os.path.isfile(d)]
+    check_extra: dict[str, Any] = {"uptodate": [False] if len(check_deps) < len(named) or not ok else [code]}
 
     def task_check() -> dict[str, Any]:
         """Parse and type-check the contracts, check the plan, lint, build the system model."""
-        return {"actions": [(act_check, [r])], "file_dep": [str(rootp / plan_file)] + contract_deps,
+        return {"actions": [(act_check, [r, plan_file])], "file_dep": check_deps,
                 "targets": list(snap.values()) + [str(rootp / p) for p in (ws.MODEL, ws.DIAGNOSTICS)],
-                "verbosity": 2, "clean": True}
+                "verbosity": 2, "clean": True, **check_extra}
 
     def task_graph() -> dict[str, Any]:
         """Write the system model as DOT and, with graphviz, draw it as SVG (doit graph)."""
@@ -413,7 +595,7 @@ def _build_tasks(root: str | Path, plan_file: str) -> dict[str, Callable[[], Any
             yield {"name": n, "actions": [(act_node, [r, n, deps])],
                    "file_dep": sorted({d for ds in deps.values() for d in ds}),
                    "targets": [at(ws.calculus(n)), at(ws.health(n)), at(ws.obligations(n))],
-                   "verbosity": 2, "clean": True}
+                   "uptodate": [code], "verbosity": 2, "clean": True}
 
     def task_requirements() -> dict[str, Any]:
         """Check each requirement's formal statement with Z3 from the guarantees of its cone.  Defined before
@@ -428,7 +610,7 @@ def _build_tasks(root: str | Path, plan_file: str) -> dict[str, Callable[[], Any
                 extra += [str(rootp / f) for f in doorstop_files(rootp, d)]
         return {"actions": [(act_requirements, [r])],
                 "file_dep": [str(rootp / plan_file), at(ws.MODEL)] + list(snap.values()) + extra,
-                "targets": [at(INDEX)], "verbosity": 2, "clean": True}
+                "targets": [at(INDEX)], "uptodate": [code], "verbosity": 2, "clean": True}
 
     exported_memo: list[list[tuple[str, dict[str, Any]]]] = []
 
@@ -457,8 +639,11 @@ def _build_tasks(root: str | Path, plan_file: str) -> dict[str, Callable[[], Any
         # obligation).  doit inspects an uptodate callable's signature for every task on every run
         # (2000 `inspect.signature` calls, a third of a second at 1000 nodes); a precomputed
         # `__signature__` (PEP 362) answers it at once.
-        tools_unchanged = config_changed(_tool_fingerprint())
+        # One config_changed per task: doit saves every config_changed of a task under one key, so a
+        # second one would overwrite the first's value and the task would never be up to date.
+        tools_unchanged = config_changed({**_tool_fingerprint(), **code_version})
         tools_unchanged.__signature__ = inspect.signature(tools_unchanged)
+        record_intact = RecordIntact()
         input_file: dict[str, str | None] = {}  # input -> its absolute path when it is a file (one stat per input)
 
         def input_dep(rel: str) -> str | None:
@@ -470,22 +655,35 @@ def _build_tasks(root: str | Path, plan_file: str) -> dict[str, Callable[[], Any
             deps = [at(ws.obligation(n, o["id"]))]
             deps += [d for d in map(input_dep, o["inputs"]) if d is not None]
             yield {"name": o["id"], "actions": [(act_run, [r, n, o["id"]])], "file_dep": sorted(set(deps)),
-                   "targets": [at(ws.evidence(o["id"]))], "uptodate": [tools_unchanged],
+                   "targets": [at(ws.evidence(o["id"]))], "uptodate": [tools_unchanged, record_intact],
                    "verbosity": 2, "clean": True}
+
+    ros_section = dict(getattr(ws.plan, "ros", None) or {}) if ok else {}
+
+    def task_ground() -> dict[str, Any]:
+        """Ground the contracts in the ROS software of the plan's ros: section (docs/ros.md)."""
+        return {"actions": [(act_ground, [r])], "file_dep": [str(rootp / plan_file)] + contract_deps,
+                "uptodate": [config_changed({"files": ros_fingerprint(rootp, ros_section)})],
+                "targets": [at("artifacts/ros/grounding.json"), at("artifacts/ros/graph.json")],
+                "task_dep": ["check"], "verbosity": 2, "clean": True}
 
     @create_after(executed="evidence")
     def task_report() -> Iterator[dict[str, Any]]:
         """Roll everything up into the report files: two parts, rendered at once by doit -n 2."""
         yield {"basename": "report", "name": None,
                "doc": "Roll everything up into reports/ (assurance.{html,md,json}, the CI formats, the argument)."}
-        deps = [at(p) for p in (ws.MODEL, ws.DIAGNOSTICS)] + list(snap.values())
+        # The plan itself: the report shows its name, requirements and their tracing, which no
+        # other artifact holds (a plan edit that changes only those re-renders the report).
+        deps = [str(rootp / plan_file)] + [at(p) for p in (ws.MODEL, ws.DIAGNOSTICS)] + list(snap.values())
         for n in nodes:
             deps += [at(ws.calculus(n)), at(ws.health(n)), at(ws.obligations(n))]
         deps += [at(ws.evidence(o["id"])) for _, o in exported()]
         deps.append(at("artifacts/requirements/index.json"))  # the requirements task's target
+        if ros_section:
+            deps.append(at("artifacts/ros/grounding.json"))
         for part, files in REPORT_PARTS.items():
             yield {"name": part, "doc": "reports/" + ", ".join(files), "actions": [(act_report, [r, part])],
-                   "file_dep": deps,
+                   "file_dep": deps, "uptodate": [code],
                    "targets": [at(f"reports/{f}") for f in files if f != "argument.svg"]
                    + ([at(ws.SUMMARY)] if part == "html" else []),
                    "verbosity": 2, "clean": True}
@@ -504,4 +702,6 @@ def _build_tasks(root: str | Path, plan_file: str) -> dict[str, Callable[[], Any
     if ok:
         creators.update({"task_graph": task_graph, "task_node": task_node, "task_requirements": task_requirements,
                          "task_evidence": task_evidence, "task_report": task_report})
+        if ros_section:
+            creators["task_ground"] = task_ground
     return creators

@@ -94,7 +94,11 @@ class FiniteFunction(Mapping[tuple[Any, ...], Any]):
         return len(self.table)
 
     def __hash__(self) -> int:
-        return hash((frozenset(self._items), self.default, self.arity))
+        h = self.__dict__.get("_hash")
+        if h is None:  # immutable: hashed once (monitors hash the same table at every event)
+            h = hash((frozenset(self._items), self.default, self.arity))
+            object.__setattr__(self, "_hash", h)
+        return int(h)
 
     def __eq__(self, other: object) -> bool:
         return (isinstance(other, FiniteFunction) and self.arity == other.arity

@@ -30,12 +30,14 @@ goal the status the report shows for it.
 """
 from __future__ import annotations
 
+import hashlib
+
 import re
 from typing import Any, Mapping
 
 from .model import Argument, Element, propagate
 
-_FINDING_AS = {"ok": "discharged", "problem": "failed", "inconclusive": "inconclusive"}
+_FINDING_AS = {"ok": "discharged", "problem": "failed", "inconclusive": "inconclusive", "stale": "stale"}
 _ID_BAD = re.compile(r"[^A-Za-z0-9_.\-]+")
 
 PERSIST = ("Outputs persist once produced, so the inputs a node receives from several producers are "
@@ -145,6 +147,17 @@ def build_argument(report: Mapping[str, Any]) -> Argument:
                            f"Verification plan {meta['plan']} and contracts {', '.join(map(str, meta['contracts']))} "
                            f"of {meta['workspace']}", url=str(meta["plan"])))
     a_persist = b.add(Element(ident("A", "persist"), "assumption", PERSIST))
+    grounding = report.get("grounding")
+    top_ctx: tuple[str, ...] = (c_plan,)
+    if grounding:  # docs/ros.md: which software version the contracts were grounded in
+        ctx = grounding["context"]
+        digest = hashlib.sha256("".join(f"{f['path']}\0{f['sha256']}\n" for f in ctx["files"]).encode()).hexdigest()
+        top_ctx += (b.add(Element(ident("C", "ros"), "context", _clip(
+            "Contracts grounded in the ROS software: "
+            + ", ".join(f"{p['name']} {p['version']}" for p in ctx["packages"])
+            + f"; {len(ctx['files'])} scanned files (sha256 of their sha256 list {digest[:16]}, each in "
+              f"artifacts/ros/graph.json); {grounding['counts']['error']} grounding error(s), "
+              f"{grounding['counts']['warning']} warning(s)"), url="artifacts/ros/graph.json")),)
     loop_ids: dict[str, str] = {}  # R4's assumption text -> its element (one per loop)
     loop_of: dict[str, str] = {}
     for d in report["derived_properties"]:
@@ -253,5 +266,5 @@ def build_argument(report: Mapping[str, Any]) -> Argument:
                                 supported_by=tuple(contract_goals), in_context_of=(a_persist, *loops)))
     ids = ", ".join(str(r["id"]) for r in reqs) or "no requirement listed"
     b.els = {top: Element(top, "goal", f"The system {meta['workspace']} meets its requirements ({ids})",
-                          supported_by=(s_reqs, s_contracts), in_context_of=(c_plan,)), **b.els}
+                          supported_by=(s_reqs, s_contracts), in_context_of=top_ctx), **b.els}
     return propagate(Argument(top, b.els))

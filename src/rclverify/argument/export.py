@@ -32,7 +32,8 @@ from typing import Any, Callable, Mapping
 
 import jinja2
 
-from ..evidence.store import atomic_write_text, dumps
+from ..evidence.published import write_published
+from ..evidence.store import dumps
 from ..memo import last_call
 from ..report import diagram
 from ..report.fragments import FragmentCache, fingerprint
@@ -286,7 +287,7 @@ def write_argument(report: Mapping[str, Any], out_dir: Path, fragments: Fragment
         svg = (rendering if rendering is not None else argument_layout(report, fragments)()).svg
     paths = []
     for name, text in texts.items():
-        atomic_write_text(out_dir / name, text)
+        write_published(out_dir / name, text)
         paths.append(out_dir / name)
     if FILES[3] not in files:
         return paths
@@ -294,6 +295,6 @@ def write_argument(report: Mapping[str, Any], out_dir: Path, fragments: Fragment
     if svg is None:
         svg_path.unlink(missing_ok=True)
     else:
-        atomic_write_text(svg_path, svg)
+        write_published(svg_path, svg)
         paths.append(svg_path)
     return paths

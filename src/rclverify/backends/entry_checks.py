@@ -1,14 +1,18 @@
-"""Check-time validation of the plan's ``experiment`` and ``review`` entries.
+"""Check-time validation of the plan's ``experiment``, ``review`` and ``monitors`` entries.
 
-Called by :func:`rclverify.plan.load.resolve`, so ``rclverify``/``doit
-check`` reports a missing data or record file, a malformed record or a bad
-criterion at once, located in the plan, before any evidence is touched.
+Called by :attr:`rclverify.pipeline.Workspace.checked` right after
+:func:`rclverify.plan.load.resolve` (the layer above both the plan and the
+backends: the plan imports no backend code), so ``rclverify``/``doit
+check`` reports a missing data or record file, a malformed record, a bad
+criterion, a reviewed file or message directory outside the workspace, or a
+bad trace mapping at once, located in the plan or in the file that names
+it, before any evidence is touched.
 """
 from __future__ import annotations
 
 from typing import Any
 
-from ..plan.errors import PlanError
+from ..plan.errors import PlanError, plan_error
 from ..plan.load import KEY, Plan
 from ..rcl import ast
 from ..rcl.errors import Diagnostic
@@ -25,7 +29,7 @@ def check_entries(plan: Plan, checked: Checked) -> list[Diagnostic]:
         if node not in checked.nodes:
             continue
         for e in entries:
-            if e.backend not in ("experiment", "review"):
+            if e.backend not in ("experiment", "review", "monitors"):
                 continue
 
             def loc(*path: Any, key: bool = False, _e: Any = e) -> ast.Loc:
@@ -39,9 +43,27 @@ def check_entries(plan: Plan, checked: Checked) -> list[Diagnostic]:
                 if e.backend == "experiment":
                     from .experiment.config import read_config
                     read_config(plan.root, e.config, len(checked.nodes[node].node.guarantees), loc)
-                else:
+                elif e.backend == "review":
                     from .review.backend import read_record
                     read_record(plan.root, e.config, loc)
+                else:
+                    _check_monitors(plan, e.config, loc)
             except PlanError as exc:
                 out.extend(exc.diagnostics)
     return out
+
+
+def _check_monitors(plan: Plan, config: Any, loc: Any) -> None:
+    """Read the monitors entry's trace mapping when it exists (its YAML and
+    its ``msg_dirs``, which must lie inside the workspace).  A missing
+    mapping or trace is left to the export stage (a workspace may record its
+    traces after writing the plan).  Raises :class:`PlanError`."""
+    from .monitors.config import DEFAULT_MAPPING, ConfigError, load_mapping
+    rel = config.get("mapping")
+    if not isinstance(rel, (str, type(None))) or not (plan.root / (rel or DEFAULT_MAPPING)).is_file():
+        return
+    try:
+        load_mapping(plan.root, rel, config.get("horizon"), ())
+    except ConfigError as exc:
+        l = loc(*exc.path)
+        raise plan_error(l.file, l.line, l.col, str(exc)) from None

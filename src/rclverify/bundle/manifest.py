@@ -78,6 +78,11 @@ def _named(plan: Plan) -> set[str]:
     for entries in plan.evidence.values():
         for e in entries:
             walk({k: v for k, v in e.config.items() if k != "backend"})
+    ros = getattr(plan, "ros", None) or {}  # the software the contracts are grounded in (docs/ros.md)
+    for key in ("workspaces", "launch", "bags"):
+        out.update(str(v) for v in ros.get(key, []) or [])
+    if ros.get("mapping"):
+        out.add(str(ros["mapping"]))
     return out
 
 

@@ -6,11 +6,12 @@ leaves a half-written record and never loses the record already there.
 """
 from __future__ import annotations
 
+import hashlib
 import json
 import os
 import tempfile
 from pathlib import Path
-from typing import Any, Iterable
+from typing import Any, Iterable, Mapping
 
 from .records import Evidence, Obligation, hash_inputs
 
@@ -88,6 +89,17 @@ def read_json(path: Path) -> Any:
     return json.loads(path.read_text(encoding="utf-8"))
 
 
+#: The key of an evidence record's seal: the sha256 of the record's other keys (:func:`seal_of`).
+SEAL = "record_sha256"
+
+
+def seal_of(record: Mapping[str, Any]) -> str:
+    """The seal of an evidence record (its JSON mapping): the sha256 of
+    :func:`dumps` of every key but :data:`SEAL` itself, hex."""
+    body = {k: v for k, v in record.items() if k != SEAL}
+    return hashlib.sha256(dumps(body).encode("utf-8")).hexdigest()
+
+
 class EvidenceStore:
     """Evidence records under ``<root>/artifacts/evidence/<obligation id>.json``.
 
@@ -102,17 +114,45 @@ class EvidenceStore:
         return self.dir / f"{obligation_id}.json"
 
     def put(self, ev: Evidence) -> Path:
-        """Store ``ev`` atomically, replacing the previous record for its obligation."""
+        """Store ``ev`` atomically, replacing the previous record for its
+        obligation.  The record carries its own seal (:data:`SEAL`, the
+        sha256 of the rest of the record, :func:`seal_of`) in the same atomic
+        write, so a record and its seal are never out of step, even after a
+        kill; :meth:`read` finds a record changed by anything else."""
         p = self.path(ev.obligation)
-        write_json(p, ev.to_json(), durable=True)
+        d = ev.to_json()
+        d[SEAL] = seal_of(d)
+        write_json(p, d, durable=True)
         return p
 
-    def get(self, obligation_id: str) -> Evidence | None:
-        """The stored record, or ``None`` when there is none (or it is unreadable)."""
+    def read(self, obligation_id: str) -> tuple[Evidence | None, str]:
+        """``(record, problem)``: the stored record (``None`` when there is
+        none or it cannot be read as a record) and ``""``, or a sentence
+        saying why it cannot be believed: it was changed after rclverify
+        wrote it (its content does not match its seal), it carries no seal,
+        or it is not a readable evidence record."""
         try:
-            return Evidence.from_json(read_json(self.path(obligation_id)))
-        except (FileNotFoundError, ValueError, KeyError, TypeError):
-            return None
+            raw = read_json(self.path(obligation_id))
+        except FileNotFoundError:
+            return None, ""
+        except (OSError, ValueError) as exc:
+            return None, f"evidence record unreadable ({exc.__class__.__name__}): not written by rclverify"
+        try:
+            ev = Evidence.from_json(raw)
+        except (ValueError, KeyError, TypeError) as exc:
+            return None, f"evidence record malformed ({exc}): altered outside rclverify"
+        if not isinstance(raw, dict) or SEAL not in raw:
+            return ev, "evidence altered outside rclverify: the record carries no seal (rclverify seals every record it writes)"
+        if raw[SEAL] != seal_of(raw):
+            return ev, ("evidence altered outside rclverify: the record's content does not match the sha256 rclverify "
+                        f"wrote with it (it says {ev.status!r}; run `doit verify` to produce it again)")
+        return ev, ""
+
+    def get(self, obligation_id: str) -> Evidence | None:
+        """The stored record, or ``None`` when there is none, it is
+        unreadable, or it was altered outside rclverify (:meth:`read`)."""
+        ev, problem = self.read(obligation_id)
+        return None if problem else ev
 
     def all(self) -> list[Evidence]:
         """Every readable record, sorted by obligation id."""

@@ -25,6 +25,7 @@ from ..rcl.types import Checked, CheckedNode, DataT, EnumT, FuncT, Scalar, SeqT,
 from ..values import FiniteFunction, Term, exact
 from .encode import Encoder, sort_of, widen
 from .retry import SAFETY_TIMEOUT_MS
+from .world import on_fresh
 
 
 class ConcreteValueError(ValueError):
@@ -39,13 +40,18 @@ def to_z3(value: Any, typ: Type, enc: Encoder) -> z3.ExprRef:
     """
     if isinstance(typ, Scalar):
         if typ.name == "BOOL":
-            return z3.BoolVal(bool(value))
-        if typ.name == "REAL":
+            if not isinstance(value, bool):
+                raise ConcreteValueError(f"{value!r} is not a BOOL")
+            return z3.BoolVal(value)
+        try:
             q = exact(value)
+        except (TypeError, ValueError) as exc:  # None (unobserved), a string, NaN: not an RCL number
+            raise ConcreteValueError(f"{value!r} is not a value of {typ.name}: {exc}") from None
+        if typ.name == "REAL":
             return z3.RealVal(f"{q.numerator}/{q.denominator}")
-        if isinstance(value, Fraction):
-            value = int(value)
-        return z3.IntVal(int(value))
+        if q.denominator != 1:
+            raise ConcreteValueError(f"{value!r} is not a value of {typ.name}")
+        return z3.IntVal(int(q))
     if isinstance(typ, EnumT):
         return enc.enum_value(str(value))
     if isinstance(typ, DataT):
@@ -92,6 +98,7 @@ def _io_type(node: CheckedNode, qualified: str) -> Type:
 
 
 _ENCODED: dict[tuple[int, str], tuple[ast.Expr, z3.BoolRef, dict[str, Any]]] = {}
+on_fresh(_ENCODED.clear)  # its formulas belong to the Z3 context they were made in
 
 
 def _encoded(formula: ast.Expr, checked: Checked, node: CheckedNode) -> tuple[z3.BoolRef, dict[str, Any]]:

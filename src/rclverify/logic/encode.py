@@ -31,6 +31,7 @@ from typing import Any, Callable, Mapping, Sequence, cast
 import z3
 
 from ..rcl import ast
+from .world import on_fresh
 from ..rcl.types import (BOOL, NATURAL, CheckedNode, DataT, EmptyT, EnumT, Env, FuncT, Scalar, SeqT,
                          SetT, TupleT, Type, qualified_base)
 from ..rcl.printer import FLAT_CHAINS, chain_operands, is_type
@@ -151,6 +152,13 @@ def tuple_sort(fields: list[z3.SortRef]) -> z3.SortRef:
 
 
 _TUPLE_SORTS: dict[str, z3.SortRef] = {}
+
+
+@on_fresh
+def _forget_sorts() -> None:
+    """A new Z3 context (:func:`rclverify.logic.world.fresh`) makes every kept sort and constant anew."""
+    for cache in (_SORTS, _SORT_NAMES, _ENUM_CONSTS, _TUPLE_SORTS):
+        cache.clear()
 
 
 def _tuple_fields(s: z3.SortRef) -> list[z3.SortRef] | None:

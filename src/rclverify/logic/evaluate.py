@@ -244,9 +244,10 @@ class Evaluator:
             key = "in." + v.name
         else:
             key = "out." + v.name
-        if key not in self.values:
+        value = self.values.get(key)
+        if value is None:  # absent, or not observed yet: nothing to evaluate on
             raise Undecided(f"no value for {key}")
-        return self.values[key]
+        return value
 
     def var(self, v: ast.Var, bound: Mapping[str, Any]) -> Any:
         if v.prefix is None and v.name in bound:

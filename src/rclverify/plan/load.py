@@ -23,11 +23,10 @@ from ..rcl.errors import Diagnostic, RclError
 from ..rcl.types import BOOL, Checked
 from .errors import PlanError, plan_error
 from .formal import Source
-from .yamlguard import check_size, compose_guarded
+from .yamlguard import KEY, Blocks, compose_guarded, read_yaml_text, to_data
 
 Path_ = tuple[Any, ...]
-#: Marker in a location path: ``path + (key, KEY)`` is where the key itself is written.
-KEY = "\0key"
+__all__ = ["KEY", "Plan", "load_plan", "read_plan_data", "resolve"]
 
 
 @dataclass(frozen=True)
@@ -109,6 +108,8 @@ class Plan:
     replacements: Mapping[str, tuple[str, ast.Loc]] = field(default_factory=dict)
     locs: Mapping[Path_, ast.Loc] = field(default_factory=dict)
     name: str = ""
+    #: the ``ros:`` section as written (grounding, docs/ros.md); empty when absent
+    ros: Mapping[str, Any] = field(default_factory=dict)
     #: ``requirements_from: {doorstop: DIR}``: Doorstop document trees read for
     #: more requirements (:func:`.doorstop.read_requirements`), with the entry's location.
     requirements_from: tuple[tuple[str, ast.Loc], ...] = ()
@@ -116,46 +117,6 @@ class Plan:
 
 def _schema() -> dict[str, Any]:
     return json.loads(resources.files("rclverify.plan").joinpath("plan.schema.json").read_text(encoding="utf-8"))  # type: ignore[no-any-return]
-
-
-#: Block scalars (``|``/``>``) by value path: (first content line, the content's
-#: source lines with their indentation), so a formula in one is parsed from its
-#: source text and every diagnostic maps exactly onto the plan file.
-Blocks = dict[Path_, tuple[int, str]]
-
-
-def _to_py(node: yaml.Node, path: Path_, locs: dict[Path_, ast.Loc], file: str, lines: list[str],
-           blocks: Blocks) -> Any:
-    mark = node.start_mark
-    quoted = isinstance(node, yaml.ScalarNode) and node.style in ("'", '"')
-    locs[path] = ast.Loc(file, mark.line + 1, mark.column + 1 + (1 if quoted else 0))
-    if isinstance(node, yaml.ScalarNode) and node.style in ("|", ">"):
-        first, last = mark.line + 1, node.end_mark.line
-        raw = lines[first:last + 1] if node.end_mark.column else lines[first:last]
-        blocks[path] = (first + 1, "\n".join(raw))
-    if isinstance(node, yaml.MappingNode):
-        out: dict[Any, Any] = {}
-        for k, v in node.value:
-            if not isinstance(k, yaml.ScalarNode):
-                raise plan_error(file, k.start_mark.line + 1, k.start_mark.column + 1,
-                                 "a mapping key must be a plain value, not a list or a mapping", "E-yaml")
-            key = k.value
-            out[key] = _to_py(v, path + (key,), locs, file, lines, blocks)
-            locs[path + (key, KEY)] = ast.Loc(file, k.start_mark.line + 1, k.start_mark.column + 1)
-        return out
-    if isinstance(node, yaml.SequenceNode):
-        return [_to_py(v, path + (i,), locs, file, lines, blocks) for i, v in enumerate(node.value)]
-    return _construct(node)
-
-
-def _construct(node: yaml.Node) -> Any:
-    """The plain value of ``node`` by PyYAML's safe constructor (an unknown
-    tag raises ``yaml.YAMLError`` with the node's mark)."""
-    loader = yaml.SafeLoader("")
-    try:
-        return loader.construct_object(node, deep=True)
-    finally:
-        loader.dispose()
 
 
 def read_plan_data(root: Path, plan_rel: str) -> tuple[dict[str, Any], dict[Path_, ast.Loc]]:
@@ -169,11 +130,14 @@ def read_plan_data(root: Path, plan_rel: str) -> tuple[dict[str, Any], dict[Path
 
 def _read_plan_source(root: Path, plan_rel: str) -> tuple[dict[str, Any], dict[Path_, ast.Loc], Blocks]:
     p = root / plan_rel
-    check_size(p, plan_rel)
     try:
-        text = p.read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as exc:
-        raise plan_error(plan_rel, 1, 1, f"cannot read the verification plan: {getattr(exc, 'strerror', None) or exc}", "E-io") from None
+        text = read_yaml_text(p, plan_rel)
+    except PlanError as exc:
+        d = exc.diagnostics[0]
+        if d.code != "E-io":
+            raise
+        raise plan_error(plan_rel, 1, 1, d.message.replace("cannot read file", "cannot read the verification plan"),
+                         "E-io") from None
     try:
         node = compose_guarded(text, plan_rel)
     except yaml.YAMLError as exc:
@@ -183,7 +147,7 @@ def _read_plan_source(root: Path, plan_rel: str) -> tuple[dict[str, Any], dict[P
     locs: dict[Path_, ast.Loc] = {}
     blocks: Blocks = {}
     try:
-        data = _to_py(node, (), locs, plan_rel, text.splitlines(), blocks) if node is not None else None
+        data = to_data(node, plan_rel, locs=locs, lines=text.splitlines(), blocks=blocks) if node is not None else None
     except yaml.YAMLError as exc:  # e.g. a tag the safe loader does not construct
         mark = getattr(exc, "problem_mark", None) or getattr(exc, "context_mark", None)
         line, col = (mark.line + 1, mark.column + 1) if mark else (1, 1)
@@ -279,7 +243,7 @@ def load_plan(root: Path, plan_rel: str = "contracts/plan.yaml") -> Plan:
             replacements[node] = (spec["replacement"], loc("nodes", node, "replacement"))
     rfrom = tuple((str(v), loc("requirements_from", k)) for k, v in (data.get("requirements_from") or {}).items())
     return Plan(plan_rel, root, contracts, tuple(reqs), tuple(conns), facts, instances, evidence, replacements, locs,
-                str(data.get("name", "")), rfrom)
+                str(data.get("name", "")), dict(data.get("ros") or {}), rfrom)
 
 
 def _source(path: Path_, holder: Mapping[str, Any], key: str, locs: Mapping[Path_, ast.Loc], blocks: Blocks,
@@ -334,8 +298,12 @@ def resolve(plan: Plan, checked: Checked) -> None:
 
     Every node named must exist, guarantee indices must be in range,
     connection endpoints must be an output and an input of equal type, and
-    environment facts must be well-typed formulas of their node.  Raises
-    :class:`PlanError` listing every problem.
+    environment facts must be well-typed formulas of their node, and every
+    evidence entry must name a registered backend (:mod:`.entries`) and only
+    its keys.  Raises :class:`PlanError` listing every problem.  A backend's
+    own check of its entries' files is
+    :func:`rclverify.backends.entry_checks.check_entries`, which the caller
+    runs after this (``Workspace.checked``).
     """
     from ..rcl.typecheck import infer
     diags: list[Diagnostic] = []
@@ -384,21 +352,21 @@ def resolve(plan: Plan, checked: Checked) -> None:
                 continue
             if t != BOOL:
                 bad(f.loc, f"an environment fact must be a formula, found {t}")
-    from ..backends import KNOWN
-    from ..backends.keys import unknown_key_messages
+    from .entries import BACKEND_NAMES, unknown_key_messages
     for node, entries in plan.evidence.items():
         if entries:
             node_ok(node, entries[0].loc)
         for e in entries:
-            if e.backend not in KNOWN:
+            if e.backend not in BACKEND_NAMES:
                 bl = plan.locs.get(("nodes", node, "evidence", e.index, "backend"), e.loc)
-                bad(bl, f"unknown backend {e.backend!r}; known backends: {', '.join(KNOWN)}")
+                bad(bl, f"unknown backend {e.backend!r}; known backends: {', '.join(BACKEND_NAMES)}")
             for key, msg in unknown_key_messages(e.backend, e.config):
                 path = ("nodes", node, "evidence", e.index, key)
                 bad(plan.locs.get(path + (KEY,), plan.locs.get(path, e.loc)), msg)
-    # experiment and review entries name data files and criteria: check them now
-    from ..backends.entry_checks import check_entries
-    diags.extend(check_entries(plan, checked))
+    # The backends' own check-time validation (experiment data and criteria,
+    # review records, trace mappings) is run by the layer above both
+    # (rclverify.pipeline.Workspace.checked calls backends.entry_checks), so
+    # the plan imports no backend code.
     # expected verdicts: a malformed entry is an error here, not a report row
     from .expected import check_expected
     diags.extend(check_expected(plan, checked))

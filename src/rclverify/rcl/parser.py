@@ -563,7 +563,11 @@ def _syntax_error(exc: UnexpectedInput, file: str, text: str, dline: int, dcol: 
 
 
 def parse_text(text: str, file: str = "<string>") -> ast.Spec:
-    """Parse a whole RCL file's text.  Raises :class:`RclError` on a syntax error."""
+    """Parse a whole RCL file's text.  Raises :class:`RclError` on a syntax error.
+    A UTF-8 byte-order mark left at the start of ``text`` is ignored
+    (:mod:`rclverify.rcl.source`)."""
+    if text.startswith("\ufeff"):
+        text = text[1:]
     return _parse(text, file, "start", 0, 0)  # type: ignore[no-any-return]
 
 
@@ -667,12 +671,13 @@ def ast_from_tree(tree: Any, file: str = "<string>") -> Any:
 
 def parse_file(path: str | Path) -> ast.Spec:
     """Read and parse an RCL file.  A missing/unreadable file is an RclError."""
+    from .source import decode_text
     p = Path(path)
     try:
-        text = p.read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as exc:
-        raise RclError([error(ast.Loc(str(path), 1, 1), f"cannot read RCL file: {getattr(exc, 'strerror', None) or exc}", "E-io")]) from None
-    return parse_text(text, str(path))
+        data = p.read_bytes()
+    except OSError as exc:
+        raise RclError([error(ast.Loc(str(path), 1, 1), f"cannot read RCL file: {exc.strerror or exc}", "E-io")]) from None
+    return parse_text(decode_text(data, str(path)), str(path))
 
 
 def parse_files(paths: Iterable[str | Path]) -> list[ast.Spec]:

@@ -34,13 +34,15 @@ from .. import __version__
 from ..contract_texts import ContractTexts
 from ..evidence.records import SEVERITY, Obligation, worst
 from ..evidence.store import EvidenceStore
-from ..pipeline import Workspace, read_artifact
+from ..pipeline import Workspace, current_model_hash, current_snapshot_hashes, read_artifact, stale_stages
 from ..system.model import cycles_kept, names_of
 from .expected import expected_rows
 
 _FINDING_AS = {"ok": "discharged", "problem": "failed", "inconclusive": "inconclusive",
                # a health warning (health/shape.py) is shown but changes no status
-               "warning": "discharged"}
+               "warning": "discharged",
+               # made from another contract text (pipeline.stale_stages)
+               "stale": "stale"}
 
 
 def _brief(text: str, limit: int = 300) -> str:
@@ -148,18 +150,31 @@ def build_report(ws: Workspace) -> dict[str, Any]:
     ob_rows: list[dict[str, Any]] = []
     pending: list[dict[str, Any]] = []
     ob_status: dict[str, str] = {}
-    hashes: dict[str, str] = {}  # input sha256s, taken once per file: nothing changes while the report is built
+    problems_altered: list[str] = []  # records that cannot be read as rclverify wrote them
+    # input sha256s, taken once per file: nothing changes while the report is built.  Each node's
+    # snapshot is taken from the current contracts and plan, not from artifacts/contracts/, so
+    # evidence of another contract text is stale even when no check ran since the edit.
+    hashes: dict[str, str] = {**current_snapshot_hashes(ws, texts), **current_model_hash(ws)}
+    stale = stale_stages(ws, hashes)  # calculus or health made from another contract text
     for o in obligations:
-        ev = store.get(o.id)
-        status = store.current_status(ev, hashes) if ev else "pending"
+        ev, altered = store.read(o.id)
+        if altered:
+            status = "error"
+        else:
+            status = store.current_status(ev, hashes) if ev else "pending"
         ob_status[o.id] = status
         ob_rows.append({"id": o.id, "node": o.node, "guarantee": o.guarantee, "backend": o.backend, "kind": o.kind,
                         "instance": o.instance, "statement": o.statement, "source": str(o.source),
                         "artifact": o.artifact, "status": status})
         if ev is None:
+            if altered:
+                problems_altered.append(f"Evidence {o.id} is error: {altered}")
+                continue
             pending.append({"obligation": o.id, "backend": o.backend, "reason": "no evidence record yet: run `doit verify`"})
             continue
         expl = ev.explanation
+        if altered:
+            expl = f"{altered[0].upper()}{altered[1:]}. The record's own text follows, not to be believed: " + expl
         if status == "stale" and ev.status != "stale":
             expl = f"STALE: an input changed since this evidence was produced (recorded status {ev.status}). " + expl
         ev_rows.append({"obligation": ev.obligation, "backend": ev.backend, "kind": ev.kind, "status": status,
@@ -179,6 +194,16 @@ def build_report(ws: Workspace) -> dict[str, Any]:
     expected = expected_rows(plan, ob_rows)
     comps = {n: read_artifact(ws, ws.calculus(n), {}) for n in checked.nodes}
     health = {n: read_artifact(ws, ws.health(n), []) for n in checked.nodes}
+    for n, stages in stale.items():  # never the status of an old contract text
+        note = ("STALE: made from another text of the contracts or plan than the current one "
+                "(run `doit verify`); recorded status ")
+        if "compose" in stages:
+            comps[n] = {**comps[n], "side_conditions": [
+                {**sc, "status": "stale", "explanation": note + sc["status"] + ". " + str(sc.get("explanation", ""))}
+                for sc in comps[n].get("side_conditions", [])]}
+        if "health" in stages:
+            health[n] = [{**f, "status": "stale", "message": note + f["status"] + ". " + f["message"]}
+                         for f in health[n]]
     side_conditions = [sc for n in checked.nodes for sc in comps[n].get("side_conditions", [])]
     sc_status = {n: worst([sc["status"] for sc in comps[n].get("side_conditions", [])], empty="discharged")
                  for n in checked.nodes}
@@ -273,12 +298,16 @@ def build_report(ws: Workspace) -> dict[str, Any]:
     for f in findings:
         if f["status"] == "problem":
             problems.append(f"Contract health: {f['message']}")
+        elif f["status"] == "stale":
+            problems.append(f"Contract health of {f['node']} is stale: made for another text of its contract or plan "
+                            "(run `doit verify`)")
     for rq in requirements:
         if rq["verdict"] in ("refuted", "proved from an inconsistency", "proved vacuously"):
             problems.append(f"Requirement {rq['id']} is {rq['verdict']}: {_brief(rq['note'])}")
     for sc in side_conditions:
         if sc["status"] != "discharged":
             problems.append(f"Side condition {sc['id']} is {sc['status']}: {sc['conjunct']}")
+    problems.extend(problems_altered)
     for e in ev_rows:
         if e["status"] in ("failed", "error", "stale"):
             problems.append(f"Evidence {e['obligation']} is {e['status']}: {_brief(e['explanation'])}")
@@ -298,6 +327,19 @@ def build_report(ws: Workspace) -> dict[str, Any]:
                  # and no guarantee left without evidence (no obligation exported for it)
                  and all(g_status(name, k) == "discharged" for name, cn in checked.nodes.items()
                          for k in range(1, len(cn.node.guarantees) + 1)))
+    # grounding in the robot's software (docs/ros.md): findings never change a verdict,
+    # but a grounding error fails --strict and is listed among the problems
+    grounding = read_artifact(ws, "artifacts/ros/grounding.json") if getattr(plan, "ros", None) else None
+    if grounding is not None:
+        svg_rel = (grounding.get("drawing") or {}).get("svg")
+        try:
+            grounding["svg_text"] = ws.path(svg_rel).read_text(encoding="utf-8") if svg_rel else None
+        except OSError:
+            grounding["svg_text"] = None
+        strict_ok = strict_ok and not grounding["counts"]["error"]
+        if grounding["counts"]["error"]:
+            problems.append(f"Grounding: {grounding['counts']['error']} contract(s)-vs-ROS error(s) "
+                            f"(rclverify ros check)")
     headline = _headline(ob_rows, counts, side_conditions, findings)
     system = model.view(node_status, cycles_kept(model, ws.path("artifacts/cache/system-cycles.json")))
     return {
@@ -307,7 +349,7 @@ def build_report(ws: Workspace) -> dict[str, Any]:
         "system": system, "requirements": requirements, "nodes": nodes, "side_conditions": side_conditions,
         "derived_properties": derived, "findings": findings, "obligations": ob_rows, "evidence": ev_rows,
         "environment_assumptions": env_assumptions, "pending": pending, "lint": lint_rows,
-        "expected_verdicts": expected,
+        "expected_verdicts": expected, "grounding": grounding,
     }
 
 

@@ -8,7 +8,7 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any, Mapping
 
-from ..evidence.store import atomic_write_text
+from ..evidence.published import write_published
 from .fragments import FragmentCache
 from .junit import render_junit
 from .sarif import render_sarif
@@ -32,6 +32,6 @@ def write_ci_reports(report: Mapping[str, Any], out_dir: Path, fragments: Fragme
     paths = []
     for name, text in texts.items():
         path = Path(out_dir) / name
-        atomic_write_text(path, text)
+        write_published(path, text)
         paths.append(path)
     return paths

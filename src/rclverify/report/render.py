@@ -26,7 +26,8 @@ import jinja2
 from markupsafe import Markup, escape
 
 from ..evidence.records import SEVERITY
-from ..evidence.store import atomic_write_text, dumps
+from ..evidence.published import write_published
+from ..evidence.store import dumps
 from ..memo import last_call
 from . import diagram
 from .fragments import FragmentCache, cached_dumps
@@ -595,6 +596,6 @@ def render_files(report: Mapping[str, Any], out_dir: Path, names: Sequence[str] 
     for name in REPORT_FILES:
         if name in texts:
             path = Path(out_dir) / name
-            atomic_write_text(path, texts[name])
+            write_published(path, texts[name])
             paths.append(path)
     return paths

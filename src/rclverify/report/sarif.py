@@ -76,6 +76,10 @@ RULES: Mapping[str, Rule] = {r.id: r for r in (
     Rule("RCL-HEALTH-OTHER", "HealthProblem", "error", "A contract health check found a problem."),
     Rule("RCL-HEALTH-INCONCLUSIVE", "HealthInconclusive", "warning",
          "Z3 could not decide a contract health check."),
+    Rule("RCL-SC-STALE", "SideConditionStale", "warning",
+         "The side condition was decided for another text of the contracts or plan than the current one."),
+    Rule("RCL-HEALTH-STALE", "HealthStale", "warning",
+         "The contract health check was made for another text of the contract or plan than the current one."),
     Rule("RCL-REQ-REFUTED", "RequirementRefuted", "error",
          "Z3 found a counterexample to a formal requirement that the guarantees of its cone allow: the composed "
          "contracts do not meet it."),
@@ -173,7 +177,7 @@ def _side_condition_results(report: Mapping[str, Any]) -> list[dict[str, Any]]:
         status = str(sc["status"])
         if status == "discharged":
             continue
-        rule = "RCL-SC-REFUTED" if status == "failed" else "RCL-SC-INCONCLUSIVE"
+        rule = {"failed": "RCL-SC-REFUTED", "stale": "RCL-SC-STALE"}.get(status, "RCL-SC-INCONCLUSIVE")
         words = [f"Side condition {sc['id']} ({sc['rule']}) of {sc['node']} is {status}: {sc['conjunct']}."]
         if sc.get("explanation"):
             words.append(str(sc["explanation"]))
@@ -225,6 +229,7 @@ def _finding_results(report: Mapping[str, Any]) -> list[dict[str, Any]]:
         if f["status"] == "ok":
             continue
         rule = ("RCL-HEALTH-INCONCLUSIVE" if f["status"] == "inconclusive"
+                else "RCL-HEALTH-STALE" if f["status"] == "stale"
                 else _HEALTH_RULE.get(str(f["check"]), "RCL-HEALTH-OTHER"))
         words = [str(f["message"])]
         if f.get("explanation"):
@@ -252,6 +257,33 @@ def _lint_results(report: Mapping[str, Any]) -> tuple[list[dict[str, Any]], list
     return out, sorted(rules.values(), key=lambda r: r.id)
 
 
+def _grounding_results(report: Mapping[str, Any]) -> tuple[list[dict[str, Any]], list[Rule]]:
+    """Grounding findings (docs/ros.md): located at the RCL line, with the
+    software line it contradicts as a related location."""
+    g = report.get("grounding")
+    if not g:
+        return [], []
+    from ..ros.ground import RULES as ROS_RULES
+    rules = [Rule(code, "Ros" + "".join(w.capitalize() for w in code.split("-")[1:]),
+                  "error" if sev == "error" else "warning", text) for code, (sev, text) in ROS_RULES.items()]
+    out = []
+    for k, f in enumerate(g["findings"]):
+        rcl, ros = f.get("rcl"), f.get("ros")
+        main = rcl or ros
+        where = f"{main['file']}:{main['line']}:{main['col']}" if main else ""
+        res = _result(str(f["code"]), "error" if f["severity"] == "error" else "warning", str(f["message"]), where,
+                      f"grounding:{f['code']}:{f.get('node', '')}:{f.get('topic', '')}:{k}",
+                      {"node": f.get("node", ""), "topic": f.get("topic", "")})
+        if rcl and ros:
+            rel = _location(f"{ros['file']}:{ros['line']}:{ros['col']}")
+            for i, loc in enumerate(rel):
+                loc["id"] = i
+                loc["message"] = {"text": "the software this contradicts"}
+            res["relatedLocations"] = rel
+        out.append(res)
+    return out, rules
+
+
 def _descriptor(r: Rule) -> dict[str, Any]:
     return {"id": r.id, "name": r.name, "shortDescription": {"text": r.text},
             "defaultConfiguration": {"level": r.level}}
@@ -268,9 +300,10 @@ def sarif_log(report: Mapping[str, Any]) -> dict[str, Any]:
     ``KeyError`` for a report dict without those keys.
     """
     lint, lint_rules = _lint_results(report)
-    results = (_obligation_results(report) + _side_condition_results(report) + _finding_results(report) + lint
+    ground, ground_rules = _grounding_results(report)
+    results = (_obligation_results(report) + _side_condition_results(report) + _finding_results(report) + lint + ground
                + _requirement_results(report))
-    rules: Sequence[Rule] = list(RULES.values()) + lint_rules
+    rules: Sequence[Rule] = list(RULES.values()) + lint_rules + ground_rules
     index = {r.id: i for i, r in enumerate(rules)}
     for res in results:
         res["ruleIndex"] = index[res["ruleId"]]

@@ -7,6 +7,7 @@ them (its ``log`` action).  Blank lines are skipped.
 from __future__ import annotations
 
 import json
+import math
 from pathlib import Path
 from typing import Any, Iterator
 
@@ -16,8 +17,9 @@ from .events import Event, TraceError
 def read_jsonl(path: Path) -> Iterator[Event]:
     """Stream the events of a ROSMonitoring log.
 
-    Raises :class:`TraceError` ``file:line: error: ...`` on the first line
-    that is not a JSON object with a string ``topic`` and a numeric ``time``;
+    Raises :class:`TraceError` ``file:line:col: error: ...`` on the first line
+    that is not a JSON object with a string ``topic`` and a finite numeric
+    ``time`` (JSON's ``NaN``/``Infinity``, which Python accepts, are refused);
     the events before it have already been yielded.
     """
     index = 0
@@ -36,6 +38,8 @@ def read_jsonl(path: Path) -> Iterator[Event]:
                 raise TraceError(f"{path}:{lineno}:1: error: the event has no string 'topic'")
             if isinstance(time, bool) or not isinstance(time, (int, float)):
                 raise TraceError(f"{path}:{lineno}:1: error: the event has no numeric 'time'")
+            if not math.isfinite(time):
+                raise TraceError(f"{path}:{lineno}:1: error: the event's 'time' is {time!r}, not a finite number")
             fields = {k: v for k, v in obj.items() if k not in ("topic", "time")}
             yield Event(index, float(time), topic.lstrip("/"), fields, f"{path.name}:{lineno}")
             index += 1

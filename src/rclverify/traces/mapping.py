@@ -28,6 +28,7 @@ otherwise): bespoke rules in the paper's sense.
 """
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from fractions import Fraction
 from typing import Any, Mapping, Sequence
@@ -59,6 +60,9 @@ class _Fields:
         for k, (name, v) in enumerate(self.items):
             if k in self.used:
                 continue
+            if isinstance(v, float) and not math.isfinite(v):
+                # NaN or an infinity is no RCL number: the event cannot be mapped (not a reading to compare)
+                raise MappingError(f"field {name!r} is {v!r}, not a finite number, for {what} of type {want}")
             got = _scalar(v, want)
             if got is not _NO:
                 self.used.add(k)

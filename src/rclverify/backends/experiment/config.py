@@ -21,6 +21,8 @@ from pathlib import Path
 from typing import Any, Callable, Mapping
 
 from ...plan.errors import PlanError, plan_error
+from ...plan.yamlguard import read_yaml_text
+from ...rcl.source import read_text as read_source
 from ...rcl import ast
 from ...rcl.errors import RclError
 from ...rcl.parser import parse_formula
@@ -66,10 +68,13 @@ def read_config(root: Path, config: Mapping[str, Any], guarantees: int, loc: Loc
     rel = config[key]
     if not isinstance(rel, str) or not (root / rel).is_file():
         raise _err(loc(key), f"experiment {key} file {rel!r} does not exist")
-    try:
-        text = (root / rel).read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as exc:
-        raise _err(loc(key), f"cannot read experiment {key} file {rel!r}: {exc}") from None
+    if key == "summary":
+        text = read_yaml_text(root / rel, rel)  # size bound and UTF-8 rules; errors located in the file
+    else:  # a CSV file: the UTF-8 rules, no YAML size bound
+        try:
+            text = read_source(root / rel, rel)
+        except RclError as exc:
+            raise PlanError(exc.diagnostics) from None
     try:
         if key == "summary":
             figures = load_summary(text, rel)

@@ -6,8 +6,7 @@ Modules: :mod:`.lang` (language: AST, parser, printer; grammar ``imp.lark``),
 :mod:`.check` (static checking), :mod:`.wp` (weakest preconditions),
 :mod:`.obligations` (guarantee -> triples), :mod:`.solve` (Z3 checks,
 counterexamples), :mod:`.outline` (proof outlines), :mod:`.backend`
-(:class:`HoareBackend`), :mod:`.memo` (an export's triples kept for the
-runs of the same process).
+(:class:`HoareBackend`).
 """
 from .backend import HoareBackend
 

@@ -32,7 +32,6 @@ from ...logic.encode import EncodingError, Encoder
 from ...rcl.errors import RclError, error
 from ..base import NodeTarget, Stopwatch, make_evidence
 from .obligations import Conjunct, EncodedTriple, HoareConfig, conjuncts, encode_triple, load_program, statement
-from . import memo
 from .outline import OutlineLine, outline_text, render_outline, term_printer
 from .solve import TripleResult, check_all
 from .wp import VC, WP, ProgramModel, main_vc, wp
@@ -186,11 +185,9 @@ class HoareBackend:
         Raises :class:`PlanError`/:class:`RclError` for user mistakes (located).
         """
         obligations = []
-        kept: list[tuple[str, tuple[Prepared, Rendered]]] = []
         for p in prepare(target):
             r = render(target, p)
             atomic_write_text(p.artifact, r.text)
-            kept.append((p.id, (p, r)))
             inputs = tuple(sorted({p.config.program, *target.contract_files, target.plan_file}))
             data: dict[str, Any] = {
                 "program": p.config.program, "guarantee": p.conjunct.guarantee, "conjunct": p.conjunct.index,
@@ -205,7 +202,6 @@ class HoareBackend:
                 id=p.id, node=target.node.name, guarantee=p.conjunct.guarantee, backend=NAME, kind=KIND,
                 statement=p.statement, source=p.source, instance=p.instance, artifact=target.rel(p.artifact),
                 inputs=inputs, data=data))
-        memo.keep(target, kept)  # for the run of these triples in this process
         return obligations
 
     def run(self, obligation: Obligation, target: NodeTarget) -> Evidence:
@@ -218,19 +214,18 @@ class HoareBackend:
             return make_evidence(target, obligation, status, tool="z3", tool_version=version, clock=clock,
                                  explanation=explanation, **kw)
 
-        kept = memo.take(target, obligation.id)  # what the export of the same inputs built, if it ran here
-        if kept is not None:
-            p, rendered = kept
-        else:
-            try:
-                prepared = {p.id: p for p in prepare(target, only=obligation.id)}
-            except RclError as exc:
-                return evidence("error", f"the obligation could not be rebuilt: {exc}", log=str(exc))
-            found = prepared.get(obligation.id)
-            if found is None:
-                return evidence("error", "the plan entry, program or contract no longer yields this obligation; "
-                                "export again")
-            p, rendered = found, render(target, found)
+        # Rebuilt here, in the run's own fresh Z3 context (logic/world.py): a triple kept from the
+        # export would carry the Z3 state of another unit of work, and its counterexample could differ
+        # between an incremental and a clean run.
+        try:
+            prepared = {p.id: p for p in prepare(target, only=obligation.id)}
+        except RclError as exc:
+            return evidence("error", f"the obligation could not be rebuilt: {exc}", log=str(exc))
+        found = prepared.get(obligation.id)
+        if found is None:
+            return evidence("error", "the plan entry, program or contract no longer yields this obligation; "
+                            "export again")
+        p, rendered = found, render(target, found)
         atomic_write_text(p.artifact, rendered.text)  # not rewritten when the export wrote the same text
         artifacts = [target.rel(p.artifact)]
         if p.pending or p.triple is None:

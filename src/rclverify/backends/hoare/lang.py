@@ -462,13 +462,13 @@ def parse_program_file(path: str | Path, display: str | None = None) -> Program:
     path); defaults to ``str(path)``.  An unreadable file is an
     :class:`RclError` (code ``E-io``) located at line 1.
     """
+    from ...rcl.source import decode_text  # UTF-8 rules of every input (a BOM accepted, UTF-16/32 named)
     name = display if display is not None else str(path)
     try:
-        text = Path(path).read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as exc:
-        reason = getattr(exc, "strerror", None) or str(exc)
-        raise RclError([error(Loc(name, 1, 1), f"cannot read program: {reason}", "E-io")]) from None
-    return parse_program(text, name)
+        data = Path(path).read_bytes()
+    except OSError as exc:
+        raise RclError([error(Loc(name, 1, 1), f"cannot read program: {exc.strerror or exc}", "E-io")]) from None
+    return parse_program(decode_text(data, name), name)
 
 
 def parse_expression(text: str, file: str = "<string>", line: int = 1, col: int = 1) -> Expr:

@@ -24,18 +24,29 @@ Every message on an input topic is an *input event*:
   ``open``.
 
 A node with no input topics checks its guarantees on every output event.
-Memory holds only the state and the pending obligations (grouped by equal
-inputs), never the trace.
+A variable not observed yet has no value (never ``None`` passed to the
+formulas): an obligation whose guarantees need an output not yet seen waits
+for it ("no output" when none comes within the horizon).
+
+This is one engine for recorded and live runs: :meth:`NodeMonitor.feed`
+takes one event, :meth:`NodeMonitor.advance` moves the clock without an
+event (a live monitor's timer), and every input event's verdict is passed,
+as soon as it is decided, to the ``on_verdict`` callback as a
+:class:`Verdict`.  :func:`check_trace` is that engine run over a recorded
+trace.  Memory holds only the state, the evaluation cache (bounded) and the
+pending obligations (grouped by equal inputs, those within the horizon),
+never the trace.
 """
 from __future__ import annotations
 
 from collections import deque
 from dataclasses import dataclass, field
-from typing import Any, Iterable, Mapping
+from typing import Any, Callable, Iterable, Mapping
 
 import z3
 
 from ...logic.concrete import check_concrete
+from ...logic.encode import EncodingError
 from ...logic.evaluate import evaluate, why_undecided
 from ...rcl import ast
 from ...rcl.printer import expr_to_rcl
@@ -56,6 +67,36 @@ def _names(e: Any, out: set[str]) -> None:
             continue
         for x in (c if isinstance(c, tuple) else (c,)):
             _names(x, out)
+
+
+@dataclass(frozen=True)
+class Verdict:
+    """The verdict of one event of one node, as soon as it is decided.
+
+    ``verdict`` one of :data:`VERDICTS`; ``event``/``time``/``where``/``topic``
+    identify the input event it is about (for a node without inputs, the
+    output event); ``guarantee`` the 1-based guarantee that failed (0 when
+    none or for the assumption); ``decided_at`` the time (s, trace clock)
+    when it was decided; ``values`` the rendered values of the first failure
+    (inputs and the outputs that failed), ``reason`` one sentence.
+    """
+
+    node: str
+    verdict: str
+    event: int
+    time: float
+    where: str
+    topic: str
+    decided_at: float
+    guarantee: int = 0
+    values: Mapping[str, str] = field(default_factory=dict)
+    reason: str = ""
+
+    def to_json(self) -> dict[str, Any]:
+        """A JSON-ready dict (the live monitor's verdict message)."""
+        return {"node": self.node, "verdict": self.verdict, "event": self.event, "time": self.time,
+                "where": self.where, "topic": self.topic, "decided_at": self.decided_at,
+                "guarantee": self.guarantee, "values": dict(self.values), "reason": self.reason}
 
 
 @dataclass
@@ -116,9 +157,11 @@ class NodeMonitor:
     cache_size = 4096
 
     def __init__(self, checked: Checked, node: CheckedNode, rules: Mapping[str, TopicRule],
-                 horizon: float) -> None:
+                 horizon: float, on_verdict: Callable[[Verdict], None] | None = None) -> None:
         self.checked, self.node, self.horizon = checked, node, horizon
         self.rules = rules
+        self.on_verdict = on_verdict
+        self.now = float("-inf")
         self.result = NodeResult(node.name)
         self.topics: dict[str, list[tuple[str, Any, bool]]] = {}
         for t in node.node.topics:
@@ -137,6 +180,8 @@ class NodeMonitor:
                 self.values[key] = initial_value(typ, rules.get(topic, TopicRule()))
         self.assumption = tuple(c.formula for c in node.node.assumes)
         self.guarantees = tuple(c.formula for c in node.node.guarantees)
+        self._texts = {k: expr_to_rcl(f) for k, f in enumerate(self.guarantees, 1)}  # printed once, not per verdict
+        self._renders: dict[int, tuple[Any, str]] = {}
         needed: set[str] = set()
         for f in self.assumption + self.guarantees:
             _names(f, needed)
@@ -159,7 +204,7 @@ class NodeMonitor:
             if "no value for" not in reason:  # undecided directly: Z3 on the concrete values
                 try:
                     v, reason = check_concrete(formula, self.checked, self.node, values)
-                except (ValueError, KeyError, z3.Z3Exception) as exc:  # a value Z3 cannot take: undecided, with the reason
+                except (ValueError, TypeError, KeyError, EncodingError, z3.Z3Exception) as exc:  # a value Z3 cannot take: undecided, with the reason
                     v, reason = None, f"{reason}; Z3 on concrete values failed: {exc}"
         if self.cache_size:
             if len(self._cache) >= self.cache_size:
@@ -169,16 +214,42 @@ class NodeMonitor:
 
 
     def _rendered(self, values: Mapping[str, Any]) -> dict[str, str]:
-        return {k: render(v) for k, v in sorted(values.items()) if v is not None}
+        return {k: self._render(v) for k, v in sorted(values.items()) if v is not None}
+
+    def _render(self, v: Any) -> str:
+        """``render(v)``, remembered per value object (a table is rendered once
+        while it stays the state, not at every verdict that shows it)."""
+        hit = self._renders.get(id(v))
+        if hit is not None and hit[0] is v:
+            return hit[1]
+        if len(self._renders) >= 256:
+            self._renders.clear()
+        text = render(v)
+        self._renders[id(v)] = (v, text)
+        return text
+
+    def _observed(self, prefix: str) -> dict[str, Any]:
+        """The values with ``prefix`` observed so far (an unobserved variable has no entry)."""
+        return {k: v for k, v in self.values.items() if k.startswith(prefix) and v is not None}
+
+    def _verdict(self, verdict: str, ev: Event, guarantee: int = 0, values: Mapping[str, str] | None = None,
+                 reason: str = "", n: int = 1) -> None:
+        self.result.counts[verdict] += n
+        if self.on_verdict is not None:
+            v = Verdict(self.node.name, verdict, ev.index, ev.time, ev.where, ev.topic, max(self.now, ev.time),
+                        guarantee, dict(values or {}), reason)
+            for _ in range(n):
+                self.on_verdict(v)
 
     # -- streaming ---------------------------------------------------------------
     def feed(self, ev: Event) -> None:
-        """Process one event (ignored unless on one of the node's topics)."""
+        """Process one event: every event moves the clock (closing obligations
+        past their horizon); only events on the node's topics change its state."""
+        self.advance(ev.time)
         vs = self.topics.get(ev.topic)
         if vs is None:
             return
         self.result.events += 1
-        self._expire(ev.time)
         is_input = False
         for key, typ, inp in vs:
             try:
@@ -198,23 +269,25 @@ class NodeMonitor:
     def _input(self, ev: Event) -> None:
         for g in self.pending.values():
             g.answered = True
-        inputs = {k: v for k, v in self.values.items() if k.startswith("in.")}
-        if any(inputs.get(k) is None for k in self.needed_inputs):
-            self.result.counts["incomplete input"] += 1
+        inputs = self._observed("in.")
+        missing = [k for k in self.needed_inputs if k not in inputs]
+        if missing:
+            self._verdict("incomplete input", ev, reason="no value yet for " + ", ".join(missing))
             return
         for formula in self.assumption:
             ok, reason = self._truth(-1, formula, inputs, ("A", id(formula), tuple(inputs.items())))
             if ok is False:
-                self.result.counts["assumption violated"] += 1
+                mentioned: set[str] = set()
+                _names(formula, mentioned)
+                blamed = sorted({p for k in inputs if k in mentioned or k[3:] in mentioned
+                                 for p in producers(self.checked, self.node, k[3:])})
+                blame = ("upstream node(s) " + ", ".join(blamed)) if blamed else "environment"
                 if self.result.first_assumption_violation is None:
-                    mentioned: set[str] = set()
-                    _names(formula, mentioned)
-                    blamed = sorted({p for k in inputs if k in mentioned or k[3:] in mentioned
-                                     for p in producers(self.checked, self.node, k[3:])})
                     self.result.first_assumption_violation = {
                         "event": ev.index, "time": ev.time, "where": ev.where, "assumption": expr_to_rcl(formula),
-                        "values": self._rendered(inputs),
-                        "blame": ("upstream node(s) " + ", ".join(blamed)) if blamed else "environment"}
+                        "values": self._rendered(inputs), "blame": blame}
+                self._verdict("assumption violated", ev, values=self._rendered(inputs),
+                              reason=f"assumption {expr_to_rcl(formula)} is false; blamed on the {blame}")
                 return
             if ok is None:
                 self._note_inconclusive(ev, 0, f"assumption undecided: {reason}")
@@ -232,19 +305,26 @@ class NodeMonitor:
         groups = self.pending.items() if only is None else [(only, self.pending[only])]
         for key, g in groups:
             values = dict(g.inputs)
-            values.update((k, v) for k, v in self.values.items() if k.startswith("out."))
+            values.update(self._observed("out."))
             failed: tuple[int, str] | None = None
             undecided = ""
+            waiting = False
             for k, formula in enumerate(self.guarantees, 1):
                 ok, reason = self._truth(k, formula, values, key)
                 if ok is False:
                     failed = (k, "")
                     break
                 if ok is None:
-                    undecided = f"guarantee {k}: {reason}"
+                    if reason.startswith("no value for out."):  # an output not seen yet: wait for it
+                        waiting = True
+                    else:
+                        undecided = f"guarantee {k}: {reason}"
                     break
+            if waiting:
+                continue
             if failed is None and not undecided:
-                self.result.counts["satisfied"] += len(g.events)
+                for trigger in g.events:
+                    self._verdict("satisfied", trigger)
                 done.append(key)
             elif failed is not None and (g.last is None or not g.answered):
                 g.last, g.undecided = (ev, failed[0], {k: v for k, v in values.items() if k.startswith("out.")}), ""
@@ -253,7 +333,18 @@ class NodeMonitor:
         for key in done:
             del self.pending[key]
 
+    def advance(self, now: float) -> None:
+        """Move the monitor's clock to ``now`` (s): obligations whose horizon has
+        passed are closed (``violated`` or ``inconclusive``).  A live monitor
+        calls it from a timer, so a missing answer is reported without waiting
+        for the next message.  A time before the clock is ignored."""
+        if now > self.now:
+            self.now = now
+        self._expire(self.now)
+
     def _expire(self, now: float) -> None:
+        if not self.pending:
+            return
         empty = []
         for key, g in self.pending.items():
             while g.events and g.events[0].time + self.horizon < now:
@@ -265,30 +356,32 @@ class NodeMonitor:
 
     def _close(self, g: _Group, trigger: Event) -> None:
         if g.undecided and g.last is None:
-            self.result.counts["inconclusive"] += 1
             self._first_inconclusive(trigger, g.undecided)
+            self._verdict("inconclusive", trigger, reason=g.undecided)
             return
-        self.result.counts["violated"] += 1
-        if self.result.first_violation is not None:
-            return
+        first: dict[str, Any]
         if g.last is None:
-            self.result.first_violation = {
+            first = {
                 "event": trigger.index, "time": trigger.time, "where": trigger.where, "guarantee": None,
                 "formula": "", "values": self._rendered(g.inputs),
                 "reason": f"no output satisfying the guarantees within {self.horizon} s of the input event"}
-            return
-        out, k, outputs = g.last
-        self.result.first_violation = {
-            "event": out.index, "time": out.time, "where": out.where, "guarantee": k,
-            "formula": expr_to_rcl(self.guarantees[k - 1]), "trigger": trigger.index,
-            "trigger_time": trigger.time, "trigger_where": trigger.where,
-            "values": self._rendered({**g.inputs, **outputs}),
-            "reason": f"guarantee {k} is false on the output at {out.where} answering the input at "
-                      f"{trigger.where}, and no output within {self.horizon} s satisfied it"}
+        else:
+            out, k, outputs = g.last
+            first = {
+                "event": out.index, "time": out.time, "where": out.where, "guarantee": k,
+                "formula": self._texts[k], "trigger": trigger.index,
+                "trigger_time": trigger.time, "trigger_where": trigger.where,
+                "values": self._rendered({**g.inputs, **outputs}),
+                "reason": f"guarantee {k} is false on the output at {out.where} answering the input at "
+                          f"{trigger.where}, and no output within {self.horizon} s satisfied it"}
+        if self.result.first_violation is None:
+            self.result.first_violation = first
+        self._verdict("violated", trigger, guarantee=first["guarantee"] or 0, values=first["values"],
+                      reason=first["reason"])
 
     def _note_inconclusive(self, ev: Event, k: int, reason: str) -> None:
-        self.result.counts["inconclusive"] += 1
         self._first_inconclusive(ev, reason)
+        self._verdict("inconclusive", ev, guarantee=k, reason=reason)
 
     def _first_inconclusive(self, ev: Event, reason: str) -> None:
         if self.result.first_inconclusive is None:
@@ -298,26 +391,33 @@ class NodeMonitor:
     def finish(self) -> NodeResult:
         """Close the run: obligations past their horizon are violated, the rest open."""
         for g in self.pending.values():
-            self.result.counts["open"] += len(g.events)
+            for trigger in g.events:
+                self._verdict("open", trigger, reason=f"unanswered when the run ended, within {self.horizon} s")
         self.pending.clear()
         return self.result
 
 
 def check_trace(checked: Checked, nodes: Iterable[CheckedNode], events: Iterable[Event],
-                rules: Mapping[str, TopicRule], horizon: float) -> tuple[int, list[NodeResult]]:
+                rules: Mapping[str, TopicRule], horizon: float,
+                on_verdict: Callable[[Verdict], None] | None = None) -> tuple[int, list[NodeResult]]:
     """Stream ``events`` through a monitor per node; returns (events read, results).
 
-    Raises whatever the event source raises (:class:`TraceError`) after the
-    events before it were processed.
+    The online engine (:class:`NodeMonitor`) run over a recorded trace: each
+    event is fed in order, the clock advanced to the last event's time at the
+    end, then every monitor finished.  ``on_verdict`` receives every event's
+    verdict as it is decided.  Raises whatever the event source raises
+    (:class:`TraceError`) after the events before it were processed.
     """
-    monitors = [NodeMonitor(checked, n, rules, horizon) for n in nodes]
+    monitors = [NodeMonitor(checked, n, rules, horizon, on_verdict) for n in nodes]
     count = 0
     last_time = 0.0
     for ev in events:
         count += 1
         last_time = ev.time
+        for m in monitors:  # the clock first (as a live monitor's timer would), then the message
+            m.advance(ev.time)
         for m in monitors:
             m.feed(ev)
     for m in monitors:
-        m._expire(last_time)
+        m.advance(last_time)
     return count, [m.finish() for m in monitors]

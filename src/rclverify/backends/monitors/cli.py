@@ -1,8 +1,10 @@
-"""``rclverify monitor [-w WS] TRACE...``: check recorded runs against every node's contract.
+"""``rclverify monitor [-w WS] TRACE...``: check recorded runs against every node's contract;
+``rclverify monitor --live``: monitor the running ROS 1 system.
 
 Exit status: 0 when no contract is violated, 1 when one is, 2 for a trace
 or configuration that cannot be read (a located message on stderr; the
-verdicts of the traces already checked are printed first).
+verdicts of the traces already checked are printed first) or when ROS 1
+cannot be reached in ``--live`` mode.
 """
 from __future__ import annotations
 
@@ -30,6 +32,12 @@ def monitor_command(args: argparse.Namespace) -> int:
     except ConfigError as exc:
         print(f"{exc}" if ":" in str(exc).split(" ")[0] else f"{args.mapping}: error: {exc}", file=sys.stderr)
         return 2
+    if getattr(args, "live", False):
+        return live_command(args, checked, cfg, root)
+    if not args.traces:
+        print("rclverify monitor: error: name a TRACE to check, or --live to monitor the running system",
+              file=sys.stderr)
+        return 2
     violated = False
     report: list[dict[str, Any]] = []
     for trace in args.traces:
@@ -40,6 +48,10 @@ def monitor_command(args: argparse.Namespace) -> int:
         except TraceError as exc:
             _emit(report, args.json)
             print(str(exc), file=sys.stderr)
+            return 2
+        except Exception as exc:  # a recorded run is user input: a located message, never a traceback
+            _emit(report, args.json)
+            print(f"{trace}: error: the trace could not be checked: {type(exc).__name__}: {exc}", file=sys.stderr)
             return 2
         for res in results:
             status, explanation = verdict_status(res, trace)
@@ -53,6 +65,97 @@ def monitor_command(args: argparse.Namespace) -> int:
                 print(f"  {status}: {explanation}")
     _emit(report, args.json)
     return 1 if violated else 0
+
+
+def live_command(args: argparse.Namespace, checked: Any, cfg: Any, root: Path) -> int:
+    """``--live``: monitor the running ROS 1 system until SIGINT/SIGTERM or ``--duration``.
+
+    Writes the log (``--log``) and, on stop, the evidence record
+    (``--evidence``); prints a status line per ``--status`` seconds.  Exit
+    status 1 when a contract was violated, 0 otherwise, 2 when ROS 1 or a
+    message class is unavailable (one message on stderr)."""
+    import signal
+    import threading
+    from functools import partial
+
+    import os
+
+    from .live import LiveRun, run_ros1
+    from .ros1 import RosUnavailable
+    from .ros2 import Ros2Unavailable, run_ros2
+    if args.traces:
+        print("rclverify monitor: error: --live takes no TRACE (it monitors the running system)", file=sys.stderr)
+        return 2
+    unknown = [n for n in args.nodes or () if n not in checked.nodes]
+    if unknown:
+        print(f"rclverify monitor: error: no node named {unknown[0]!r}; nodes: {', '.join(checked.nodes)}",
+              file=sys.stderr)
+        return 2
+    nodes = [checked.nodes[n] for n in args.nodes] if args.nodes else list(checked.nodes.values())
+    log = Path(args.log)
+    factory = partial(LiveRun, checked, nodes, cfg.rules, cfg.horizon, log,
+                      reorder_window=args.reorder_window, silence_s=args.silence)
+    stop = threading.Event()
+    for sig in (signal.SIGINT, signal.SIGTERM):
+        signal.signal(sig, lambda *_: stop.set())
+    ros = args.ros or os.environ.get("ROS_VERSION", "1")  # ROS's setup scripts set ROS_VERSION
+    common: dict[str, Any] = dict(
+        verdict_topic=args.verdict_topic, last_prefix=args.verdict_topic.rsplit("/", 1)[0] or "/rclverify",
+        node_name="rclverify_monitor", duration=args.duration, tick_s=0.02, status_s=args.status, stop=stop,
+        evidence=Path(args.evidence) if args.evidence else None, out=lambda line: print(line, flush=True))
+    try:
+        if ros == "2":
+            record = run_ros2(factory, checked, nodes, **common)
+        else:
+            record = run_ros1(factory, checked, nodes, [root / d for d in cfg.msg_dirs], **common)
+    except (RosUnavailable, Ros2Unavailable) as exc:
+        print(f"rclverify monitor --live: error: {exc}", file=sys.stderr)
+        return 2
+    print(f"{log}: {record['events']} event(s), {record['verdicts']} verdict(s); sha256 {record['sha256']}")
+    return 1 if any(n["status"] == "failed" for n in record["nodes"]) else 0
+
+
+def oracle_command(args: argparse.Namespace) -> int:
+    """``rclverify oracle --port N``: serve the contracts as a ROSMonitoring oracle
+    (WebSocket, :mod:`.oracle`) until SIGINT/SIGTERM.  Exit 2 for a port that
+    cannot be bound or a configuration that cannot be read."""
+    import asyncio
+    import signal
+
+    from ...pipeline import Workspace
+    from .oracle import serve
+    root = Path(args.workspace)
+    checked = Workspace(root, args.plan).checked
+    try:
+        cfg = load_mapping(root, args.mapping, args.horizon)
+    except ConfigError as exc:
+        print(f"{args.mapping}: error: {exc}", file=sys.stderr)
+        return 2
+    unknown = [n for n in args.nodes or () if n not in checked.nodes]
+    if unknown:
+        print(f"rclverify oracle: error: no node named {unknown[0]!r}; nodes: {', '.join(checked.nodes)}",
+              file=sys.stderr)
+        return 2
+    nodes = [checked.nodes[n] for n in args.nodes] if args.nodes else list(checked.nodes.values())
+
+    async def main() -> None:
+        stop, ready = asyncio.Event(), asyncio.Event()
+        loop = asyncio.get_running_loop()
+        for sig in (signal.SIGINT, signal.SIGTERM):
+            loop.add_signal_handler(sig, stop.set)
+        task = asyncio.create_task(serve(checked, nodes, cfg.rules, cfg.horizon, args.port, args.host, ready, stop))
+        done, _ = await asyncio.wait([task, asyncio.create_task(ready.wait())], return_when=asyncio.FIRST_COMPLETED)
+        if task in done:
+            task.result()  # raises the bind error
+        print(f"oracle for {', '.join(n.name for n in nodes)} on ws://{args.host}:{args.port}", flush=True)
+        await task
+    try:
+        asyncio.run(main())
+    except OSError as exc:
+        print(f"rclverify oracle: error: cannot listen on {args.host}:{args.port}: {exc.strerror or exc}",
+              file=sys.stderr)
+        return 2
+    return 0
 
 
 def _emit(report: list[dict[str, Any]], as_json: bool) -> None:

@@ -9,18 +9,23 @@ Plan entry (``nodes.<Node>.evidence[k]``)::
 
 Mapping file: ``msg_dirs`` (directories holding ``<pkg>/msg/<Type>.msg``),
 ``topics`` (:func:`rclverify.traces.mapping.load_rules`), optional
-``ros_version`` (``ros1``/``ros2``, default ``ros2``) and ``horizon``.
+``ros_version`` (``ros1``/``ros2``, default ``ros2``), ``horizon`` and
+``ros_nodes`` (contract node -> ``{name, package, path}`` of the ROS node
+to instrument, as ROSMonitoring's configuration lists it)::
+
+    ros_nodes:
+      RadiationSensor: {name: radiation_sensor, package: rover, path: launch/rover.launch}
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Mapping
 
 import yaml
 
 from ...traces.mapping import TopicRule, load_rules
-from ...plan.yamlguard import safe_load_guarded
+from ...plan.yamlguard import read_yaml_text, safe_load_guarded
 
 DEFAULT_MAPPING = "backends/monitors/mapping.yaml"
 DEFAULT_HORIZON = 5.0
@@ -46,6 +51,7 @@ class MonitorConfig:
     horizon: float
     ros_version: str
     traces: tuple[str, ...] = ()
+    ros_nodes: Mapping[str, Mapping[str, str]] = field(default_factory=dict)
 
     def msg_files(self, root: Path) -> list[str]:
         """Workspace-relative ``.msg`` files under the message directories, sorted."""
@@ -61,7 +67,7 @@ def load_mapping(root: Path, rel: str | None, horizon: Any = None, traces: Any =
     raw: Any = {}
     if path.is_file():
         try:
-            raw = safe_load_guarded(path.read_text(encoding="utf-8"), rel or DEFAULT_MAPPING) or {}
+            raw = safe_load_guarded(read_yaml_text(path, rel or DEFAULT_MAPPING), rel or DEFAULT_MAPPING) or {}
         except yaml.YAMLError as exc:
             mark = getattr(exc, "problem_mark", None)
             line = f"{mark.line + 1}:{mark.column + 1}" if mark is not None else "1:1"
@@ -83,6 +89,38 @@ def load_mapping(root: Path, rel: str | None, horizon: Any = None, traces: Any =
         if not (root / str(t)).exists():
             raise ConfigError(f"no such trace: {t}", "traces", k)
     ros = str(raw.get("ros_version", "ros2"))
+    msg_dirs = raw.get("msg_dirs", ()) or ()
+    if isinstance(msg_dirs, list):
+        _check_msg_dirs(root, rel or DEFAULT_MAPPING, path, [str(d) for d in msg_dirs])
+    ros_nodes = raw.get("ros_nodes") or {}
+    if not isinstance(ros_nodes, Mapping) or not all(
+            isinstance(v, Mapping) and isinstance(v.get("name"), str) and set(v) <= {"name", "package", "path"}
+            for v in ros_nodes.values()):
+        raise ConfigError(f"{rel or DEFAULT_MAPPING}:1:1: error: ros_nodes must map each contract node to "
+                          "{name, package, path} (name required)")
     return MonitorConfig(rel or DEFAULT_MAPPING if path.is_file() else "", rules,
                          tuple(str(d) for d in raw.get("msg_dirs", ()) or ()), float(h), ros,
-                         tuple(str(t) for t in traces))
+                         tuple(str(t) for t in traces),
+                         {str(k): {f: str(x) for f, x in v.items()} for k, v in ros_nodes.items()})
+
+
+def _check_msg_dirs(root: Path, rel: str, path: Path, dirs: list[str]) -> None:
+    """Refuse message directories outside the workspace (the rules of
+    :mod:`rclverify.plan.paths`): the ``.msg`` files are inputs of the
+    evidence and belong in the assessor's bundle.  Raises ``PlanError``
+    located at the directory in the mapping file."""
+    from ...plan.errors import PlanError, plan_error
+    from ...plan.paths import escape_reason
+    from ...plan.yamlguard import load_located
+    from ...rcl.errors import Diagnostic
+    bad = [(i, d, why) for i, d in enumerate(dirs) for why in [escape_reason(root, d)] if why is not None]
+    if not bad:
+        return
+    _, locs = load_located(read_yaml_text(path, rel), rel)
+    diags: list[Diagnostic] = []
+    for i, d, why in bad:
+        at = locs.get(("msg_dirs", i))
+        line, col = (at.line, at.col) if at is not None else (1, 1)
+        diags.extend(plan_error(rel, line, col, f"message directory {d!r} {why}; the mapping may name only "
+                                "directories inside the workspace", "E-path").diagnostics)
+    raise PlanError(diags)

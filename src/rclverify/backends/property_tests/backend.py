@@ -2,7 +2,7 @@
 with Hypothesis against the node's contract, every example checked by Z3.
 
 * ``export`` reads the plan entry ``{backend: property_tests, implementation:
-  <file.py>:<callable>, max_examples, seed, deadline_ms, steps, bounds}``,
+  <file.py>:<callable>, max_examples, seed, deadline_ms, steps, bounds, timeout_s}``,
   makes one obligation per guarantee of the node (all guarantees are tested
   on the same examples: same seed, same strategy) and renders one readable
   pytest file, ``artifacts/property_tests/<Node>/test_<node>_e<entry>.py``;
@@ -31,6 +31,7 @@ from ...evidence.store import atomic_write_text
 from ...plan.errors import PlanError
 from ...rcl.printer import expr_to_rcl
 from ..base import NodeTarget, Stopwatch, make_evidence
+from ..timelimit import TimeLimitExceeded, wall_clock_limit
 from .seeding import split_facts
 from .harness import Config, ConfigError, Outcome, load_implementation, read_config, run_guarantee, versions
 
@@ -140,7 +141,12 @@ class PropertyTestsBackend:
                 return evidence("error", "the contract no longer has this guarantee; export again")
             path = test_file(target)
             atomic_write_text(path, render_tests(target, cfg, _is_class(target, cfg)))
-            outcome = run_guarantee(target.checked, target.node, k, cfg, target.root, target.facts)
+            with wall_clock_limit(cfg.timeout_s):
+                outcome = run_guarantee(target.checked, target.node, k, cfg, target.root, target.facts)
+        except TimeLimitExceeded as exc:
+            return evidence("inconclusive", f"{cfg.implementation}: the run of guarantee {k} {exc} (timeout_s of "
+                            f"the plan entry, {target.config_loc('timeout_s') if 'timeout_s' in target.config else 'default'}"
+                            "); does the implementation loop forever?", details={"timeout_s": cfg.timeout_s})
         except ConfigError as exc:
             return evidence("error", f"{target.config_loc(*exc.path)}: error: {exc}")
         except PlanError as exc:  # the implementation no longer imports

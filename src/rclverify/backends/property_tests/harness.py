@@ -42,6 +42,8 @@ from .strategies import conjuncts, input_space
 DEFAULT_MAX_EXAMPLES = 200
 DEFAULT_SEED = 20260
 DEFAULT_STEPS = 4
+#: Wall-clock limit of one guarantee's run when the entry gives no ``timeout_s`` (seconds).
+DEFAULT_TIMEOUT_S = 600.0
 
 
 class ConfigError(Exception):
@@ -64,6 +66,8 @@ class Config:
     deadline_ms: int | None = None
     steps: int = DEFAULT_STEPS
     bounds: Mapping[str, tuple[Fraction | None, Fraction | None]] = field(default_factory=dict)
+    #: Wall-clock limit of one guarantee's run, in seconds (``timeout_s``; :mod:`..timelimit`).
+    timeout_s: float = 600.0
 
 
 def _positive(raw: Mapping[str, Any], key: str, default: int) -> int:
@@ -99,8 +103,11 @@ def read_config(raw: Mapping[str, Any], node: CheckedNode, root: Path) -> Config
                 or any(x is not None and (isinstance(x, bool) or not isinstance(x, (int, float))) for x in v)):
             raise ConfigError(f"bounds of {k} must be [lo, hi] (numbers or null)", "bounds", k)
         bounds[name] = (None if v[0] is None else Fraction(v[0]), None if v[1] is None else Fraction(v[1]))
+    timeout = raw.get("timeout_s", DEFAULT_TIMEOUT_S)
+    if isinstance(timeout, bool) or not isinstance(timeout, (int, float)) or not 0 < timeout <= 86400:
+        raise ConfigError("timeout_s must be a number of seconds, above 0 and at most 86400", "timeout_s")
     return Config(impl, file, attr, _positive(raw, "max_examples", DEFAULT_MAX_EXAMPLES), seed, deadline,
-                  _positive(raw, "steps", DEFAULT_STEPS), bounds)
+                  _positive(raw, "steps", DEFAULT_STEPS), bounds, float(timeout))
 
 
 def load_implementation(root: Path, cfg: Config) -> Any:

@@ -39,6 +39,7 @@ import z3
 from ...logic.concrete import to_z3
 from ...logic.encode import Encoder, EncodingError, sort_of
 from ...logic.retry import SAFETY_TIMEOUT_MS
+from ...logic.world import on_fresh
 from ...rcl import ast
 from ...rcl.types import Checked, CheckedNode, DataT, EnumT, FuncT, Scalar, Type
 from ...values import FiniteFunction, Term
@@ -107,6 +108,7 @@ def _points(args: tuple[Type, ...], n: int) -> list[tuple[Any, ...]] | None:
 
 
 _BASE: dict[tuple[Any, ...], dict[str, Any] | None] = {}
+on_fresh(_BASE.clear)  # kept per Z3 context (rclverify.logic.world)
 
 
 @dataclass

@@ -20,6 +20,10 @@ from typing import Any
 
 from ...evidence.records import Evidence, Obligation, SourceRef, make_obligation_id
 from ...plan.errors import PlanError, plan_error
+from ...plan.paths import escape_reason
+from ...plan.yamlguard import load_located, read_yaml_text
+from ...rcl import ast
+from ...rcl.errors import Diagnostic
 from ..base import NodeTarget, Stopwatch, make_evidence
 from .record import Question, RecordError, ReviewRecord, checklist, judge, parse_record
 
@@ -38,10 +42,34 @@ def read_record(root: Path, config: Any, loc: Any) -> tuple[str, ReviewRecord]:
     if not (root / rel).is_file():
         raise plan_error(l.file, l.line, l.col, f"review record {rel!r} does not exist "
                          "(write a blank one with `rclverify review NODE -o FILE`)", "E-io")
+    text = read_yaml_text(root / rel, rel)
     try:
-        return rel, parse_record((root / rel).read_text(encoding="utf-8"), rel)
-    except (RecordError, OSError, UnicodeDecodeError) as exc:
+        record = parse_record(text, rel)
+    except RecordError as exc:
         raise plan_error(l.file, l.line, l.col, f"review record: {exc}") from None
+    check_reviewed_paths(root, rel, text, record)
+    return rel, record
+
+
+def check_reviewed_paths(root: Path, rel: str, text: str, record: ReviewRecord) -> None:
+    """Refuse a record whose ``files:`` name a file outside the workspace
+    (absolute, ``..``, a backslash, or a symbolic link leading out; the
+    rules of :mod:`rclverify.plan.paths`): the reviewed files are inputs of
+    the evidence and must be in the assessor's bundle.  Raises
+    :class:`PlanError` listing each, located at the path in the record
+    (``rel:line:col``)."""
+    bad = [(i, p, why) for i, (p, _) in enumerate(record.files)
+           for why in [escape_reason(root, p) or ("uses '\\' as a separator; write paths with '/'" if "\\" in p else None)]
+           if why is not None]
+    if not bad:
+        return
+    _, locs = load_located(text, rel)
+    diags: list[Diagnostic] = []
+    for i, p, why in bad:
+        at = locs.get(("files", i, "path"), locs.get(("files", i), ast.Loc(rel, 1, 1)))
+        diags.extend(plan_error(at.file, at.line, at.col, f"reviewed file {p!r} {why}; a review record may list "
+                                "only files inside the workspace", "E-path").diagnostics)
+    raise PlanError(diags)
 
 
 def _load(target: NodeTarget) -> tuple[str, ReviewRecord]:

@@ -1,0 +1,311 @@
+"""How fast the live monitor and the oracle answer.
+
+Live (ROS 1, needs rosmaster and rospy): starts a master on 127.0.0.1 (a
+free port), ``rclverify monitor --live`` on the case study's contracts (all
+four nodes, or the ``--node`` ones; ``--reorder-window 0``: the case
+study's messages carry no header stamp), a listener on the verdict topic, and a publisher sending the
+bundled nominal run's messages round-robin over its eight topics at
+``--rate`` messages/s for ``--seconds`` s.  Prints
+
+* messages published, events the monitor checked, verdicts received, the
+  rate achieved and whether the monitor kept up (every message checked, no
+  backlog when the publisher stopped);
+* the verdict latency, publish to verdict received, median / 99th
+  percentile / max (ms), over the events decided on arrival (satisfied at
+  once, assumption violated, incomplete input).  An input event whose
+  verdict waits for the node's answer is decided by that answer, which is
+  the node's latency, not the monitor's.
+
+Oracle (needs only ``websockets``): ``rclverify``'s oracle on a free port,
+serving all four nodes, then only the Radiation Sensor (the generated
+config.yaml gives each node's monitor its own oracle); ``--oracle-events``
+events of the nominal run (repeated, time shifted) sent by one client, one
+at a time (ROSMonitoring's monitors wait for each verdict) and pipelined;
+prints events/s for both.
+
+Targets the issue names: 2,000 messages/s kept up with, latency median
+under 5 ms and 99th percentile under 50 ms; the oracle at 10,000 events/s.
+The figures are printed, not asserted.  Usage::
+
+    python3 bench/monitor_live.py [--rate 2000 --seconds 5] [--node NODE ...] [--oracle-events 20000]
+                                  [--no-live | --no-oracle]
+"""
+from __future__ import annotations
+
+import argparse
+import asyncio
+import json
+import os
+import signal
+import statistics
+import subprocess
+import sys
+import tempfile
+import threading
+import time
+from pathlib import Path
+from typing import Any
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT / "src"))
+RUN = ROOT / "backends" / "monitors" / "traces" / "nominal.jsonl"
+
+
+def _lines() -> list[dict[str, Any]]:
+    return [json.loads(line) for line in RUN.read_text().splitlines() if line.strip()]
+
+
+# -- processes the benchmark starts ------------------------------------------------------------
+
+def publisher(rate: float, seconds: float, out: Path, wait_for: int, nodes: list[str]) -> int:
+    """Publish the run's messages on the monitored nodes' topics round-robin at
+    ``rate``/s; write (topic, t_pub) per message."""
+    from rclverify.backends.monitors.ros1 import build_message, contract_topics, import_rospy, message_class
+    from rclverify.rcl.typecheck import load
+    rospy = import_rospy()
+    Snapshot = message_class("gazebo_radiation_plugin/Snapshot", [ROOT / "backends/monitors/msg"])
+    checked = load([ROOT / "contracts" / "remote_inspection.rcl"])
+    topics = {t.lstrip("/") for t in contract_topics(checked, [checked.nodes[n] for n in nodes] if nodes
+                                                     else checked.nodes.values())}
+    lines = [e for e in _lines() if e["topic"] in topics]
+    rospy.init_node("bench_publisher", anonymous=True)
+    pubs = {t: rospy.Publisher("/" + t, Snapshot, queue_size=100000) for t in sorted({e["topic"] for e in lines})}
+    deadline = time.monotonic() + 20
+    while any(p.get_num_connections() < wait_for for p in pubs.values()):
+        if time.monotonic() > deadline:
+            print("publisher: subscribers did not connect", file=sys.stderr)
+            return 2
+        time.sleep(0.05)
+    time.sleep(0.5)
+    msgs = [(e["topic"], build_message(Snapshot, e)) for e in lines]
+    n = int(rate * seconds)
+    sent: list[tuple[str, float]] = []
+    start = time.monotonic()
+    for k in range(n):
+        due = start + k / rate
+        wait = due - time.monotonic()
+        if wait > 0:
+            time.sleep(wait)
+        topic, msg = msgs[k % len(msgs)]
+        t = time.time()
+        pubs[topic].publish(msg)
+        sent.append((topic, t))
+    elapsed = time.monotonic() - start
+    out.write_text(json.dumps({"sent": sent, "elapsed": elapsed}))
+    time.sleep(1.0)
+    return 0
+
+
+def listener(topic: str, out: Path) -> int:
+    """Collect (received, verdict) until SIGTERM, then write them."""
+    from rclverify.backends.monitors.ros1 import import_rospy
+    rospy = import_rospy()
+    from std_msgs.msg import String
+    got: list[tuple[float, str]] = []
+    rospy.init_node("bench_listener", anonymous=True, disable_signals=True)
+    rospy.Subscriber(topic, String, lambda m: got.append((time.time(), m.data)), queue_size=100000)
+    stop = threading.Event()
+    signal.signal(signal.SIGTERM, lambda *_: stop.set())
+    print("listening", flush=True)
+    while not stop.is_set():
+        stop.wait(0.1)
+    out.write_text(json.dumps([(t, json.loads(d)) for t, d in got]))
+    rospy.signal_shutdown("done")
+    return 0
+
+
+# -- live benchmark ------------------------------------------------------------------
+
+def _wait_text(path: Path, text: str, timeout: float) -> None:
+    deadline = time.monotonic() + timeout
+    while not (path.exists() and text in path.read_text(errors="replace")):
+        if time.monotonic() > deadline:
+            raise SystemExit(f"{path.name} never said {text!r}")
+        time.sleep(0.05)
+
+
+def _stop(p: subprocess.Popen[bytes], sig: int = signal.SIGTERM) -> None:
+    if p.poll() is None:
+        os.killpg(p.pid, sig)
+        try:
+            p.wait(20)
+        except subprocess.TimeoutExpired:
+            os.killpg(p.pid, signal.SIGKILL)
+            p.wait(5)
+
+
+def _cpu_seconds(pid: int) -> float | None:
+    """User + system CPU seconds of a process (Linux ``/proc``), or None."""
+    try:
+        fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
+        return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
+    except (OSError, IndexError, ValueError):
+        return None
+
+
+def bench_live(rate: float, seconds: float, nodes: list[str]) -> None:
+    from rclverify.backends.monitors.ros1 import LocalMaster, RosUnavailable, import_rospy
+    try:
+        import_rospy()
+    except RosUnavailable as exc:
+        print(f"live: skipped: {exc}")
+        return
+    with tempfile.TemporaryDirectory() as d:
+        tmp = Path(d)
+        with LocalMaster(tmp / "ros") as env:
+            env = {**env, "PYTHONPATH": str(ROOT / "src")}
+            procs = []
+
+            def start(args: list[str], name: str) -> subprocess.Popen[bytes]:
+                p = subprocess.Popen([sys.executable, *args], env=env, cwd=ROOT, stdout=(tmp / name).open("wb"),
+                                     stderr=subprocess.STDOUT, start_new_session=True)
+                procs.append(p)
+                return p
+            try:
+                lis = start([__file__, "--listener", str(tmp / "verdicts.json")], "listener.out")
+                mon = start(["-m", "rclverify.cli", "monitor", "--live", "-w", str(ROOT), "--horizon", "2.0",
+                             "--reorder-window", "0", "--status", "0", "--log", str(tmp / "live.jsonl"),
+                             "--evidence", str(tmp / "evidence.json"),
+                             *[x for n in nodes for x in ("--node", n)]], "monitor.out")
+                _wait_text(tmp / "listener.out", "listening", 30)
+                _wait_text(tmp / "monitor.out", "monitoring", 30)
+                pub = start([__file__, "--publisher", str(tmp / "sent.json"), "--rate", str(rate),
+                             "--seconds", str(seconds), *[x for n in nodes for x in ("--node", n)]],
+                            "publisher.out")
+                pub.wait(seconds * 10 + 60)
+                time.sleep(2.5)  # the horizon passes; the timer resolves what waits
+                cpu = _cpu_seconds(mon.pid)
+                _stop(mon, signal.SIGINT)
+                _stop(lis)
+            finally:
+                for p in procs:
+                    _stop(p)
+            pub_out = json.loads((tmp / "sent.json").read_text())
+            verdicts = json.loads((tmp / "verdicts.json").read_text())
+            record = json.loads((tmp / "evidence.json").read_text())
+            log_topics = [json.loads(line)["topic"] for line in (tmp / "live.jsonl").read_text().splitlines()]
+    sent = pub_out["sent"]
+    # the j-th message published on a topic is the j-th event the monitor released on it
+    pub_times: dict[tuple[str, int], float] = {}
+    seen: dict[str, int] = {}
+    for topic, t in sent:
+        pub_times[(topic, seen.get(topic, 0))] = t
+        seen[topic] = seen.get(topic, 0) + 1
+    per_topic: list[tuple[str, int]] = []  # released event index -> (topic, j)
+    seen.clear()
+    for topic in log_topics:
+        if topic == "rclverify/verdict":
+            continue
+        per_topic.append((topic, seen.get(topic, 0)))
+        seen[topic] = seen.get(topic, 0) + 1
+    print(f"live: nodes monitored: {', '.join(nodes) or 'all four'}")
+    print(f"live: published {len(sent)} message(s) in {pub_out['elapsed']:.2f} s "
+          f"({len(sent) / pub_out['elapsed']:.0f} msg/s, asked {rate:.0f}); the monitor checked {record['events']} "
+          f"event(s) and published {record['verdicts']} verdict(s); {len(verdicts)} verdict message(s) received")
+    print(f"live: kept up: {'yes' if record['events'] == len(sent) else 'NO'} "
+          f"(lost {len(sent) - record['events']}; {record['late_events']} released after a later-stamped one, "
+          f"by at most {record['max_late_s'] * 1000:.2f} ms)")
+    if cpu is not None:
+        print(f"live: monitor process CPU {cpu:.2f} s (start-up included) = {cpu / len(sent) * 1e6:.0f} us per message: "
+              f"about {len(sent) / cpu:,.0f} messages/s on one free core; load average now "
+              f"{os.getloadavg()[0]:.1f} on {os.cpu_count()} core(s)")
+    lat = []
+    for recv, v in verdicts:
+        if not v.get("node") or abs(v["decided_at"] - v["time"]) > 1e-9:
+            continue  # decided by a later answer or by the timer: not the monitor's latency
+        if v["event"] >= len(per_topic):
+            continue
+        t_pub = pub_times.get(per_topic[v["event"]])
+        if t_pub is not None:
+            lat.append((recv - t_pub) * 1000)
+    if lat:
+        lat.sort()
+        p99 = lat[min(len(lat) - 1, int(0.99 * len(lat)))]
+        print(f"live: verdict latency, publish -> verdict received, over {len(lat)} verdict(s) decided on "
+              f"arrival: median {statistics.median(lat):.2f} ms, p99 {p99:.2f} ms, max {lat[-1]:.2f} ms")
+
+
+# -- oracle benchmark ----------------------------------------------------------------
+
+def bench_oracle(n: int, node: str | None) -> None:
+    from websockets.sync.client import connect
+
+    from rclverify.backends.monitors.config import load_mapping
+    from rclverify.backends.monitors.oracle import serve
+    from rclverify.backends.monitors.ros1 import free_port
+    from rclverify.rcl.typecheck import load
+    checked = load([ROOT / "contracts" / "remote_inspection.rcl"])
+    cfg = load_mapping(ROOT, "backends/monitors/mapping.yaml", 2.0)
+    port = free_port()
+    loop = asyncio.new_event_loop()
+    ready = threading.Event()
+    stop_holder: dict[str, Any] = {}
+
+    def run() -> None:
+        asyncio.set_event_loop(loop)
+
+        async def main() -> None:
+            stop, up = asyncio.Event(), asyncio.Event()
+            stop_holder["stop"] = stop
+            nodes = [checked.nodes[node]] if node else list(checked.nodes.values())
+            task = asyncio.create_task(serve(checked, nodes, cfg.rules, cfg.horizon, port, ready=up, stop=stop))
+            await up.wait()
+            ready.set()
+            await task
+        loop.run_until_complete(main())
+    th = threading.Thread(target=run, daemon=True)
+    th.start()
+    ready.wait(20)
+    lines = _lines()
+    span = lines[-1]["time"] + 1.0
+    events = [json.dumps({**lines[k % len(lines)], "time": lines[k % len(lines)]["time"] + span * (k // len(lines))})
+              for k in range(n)]
+    with connect(f"ws://127.0.0.1:{port}") as ws:
+        t0 = time.perf_counter()
+        for e in events:
+            ws.send(e)
+            ws.recv()
+        seq = time.perf_counter() - t0
+    with connect(f"ws://127.0.0.1:{port}", max_size=None) as ws:
+        t0 = time.perf_counter()
+
+        def drain() -> None:
+            for _ in range(n):
+                ws.recv()
+        rd = threading.Thread(target=drain)
+        rd.start()
+        for e in events:
+            ws.send(e)
+        rd.join()
+        pipe = time.perf_counter() - t0
+    loop.call_soon_threadsafe(stop_holder["stop"].set)
+    th.join(10)
+    print(f"oracle: {n} event(s), {node or 'all four nodes'}: one at a time {n / seq:,.0f} events/s "
+          f"({seq / n * 1e6:.0f} us round trip); pipelined {n / pipe:,.0f} events/s")
+
+
+def main() -> int:
+    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--rate", type=float, default=2000.0)
+    p.add_argument("--seconds", type=float, default=5.0)
+    p.add_argument("--oracle-events", type=int, default=20000)
+    p.add_argument("--node", dest="nodes", action="append", default=[], help="monitor only NODE (repeatable)")
+    p.add_argument("--no-live", action="store_true")
+    p.add_argument("--no-oracle", action="store_true")
+    p.add_argument("--publisher", type=Path, help=argparse.SUPPRESS)
+    p.add_argument("--listener", type=Path, help=argparse.SUPPRESS)
+    a = p.parse_args()
+    if a.publisher:
+        return publisher(a.rate, a.seconds, a.publisher, wait_for=1, nodes=a.nodes)
+    if a.listener:
+        return listener("/rclverify/verdict", a.listener)
+    if not a.no_live:
+        bench_live(a.rate, a.seconds, a.nodes)
+    if not a.no_oracle:
+        for node in (None, "RadiationSensor"):  # one oracle for all; one per monitor, as config.yaml deploys it
+            bench_oracle(a.oracle_events, node)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

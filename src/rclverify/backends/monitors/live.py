@@ -1,0 +1,240 @@
+"""A live monitoring run, independent of the middleware.
+
+:class:`LiveRun` is what ``rclverify monitor --live`` runs around the
+:class:`~.online.OnlineEngine`; the ROS 1 runner (:func:`run_ros1`) and the
+ROS 2 layer (:mod:`.ros2`) only move messages in and verdicts out.  It
+
+* writes every released message and every verdict as JSON lines in
+  ROSMonitoring's log format (``topic``, ``time``, the fields flattened;
+  verdicts on the topic :data:`VERDICT_LOG_TOPIC`, which no contract names,
+  so ``rclverify monitor LOG`` re-checks the messages and skips them);
+* hands each verdict, as JSON text, to ``publish`` (node, guarantee,
+  verdict, time, the first violation's values ...), and each node's latest
+  verdict to ``publish_last`` (a latched topic) at every timer tick where
+  it changed;
+* keeps a one-line status per node (:meth:`status_line`);
+* on :meth:`stop` writes a monitoring evidence record shaped like the
+  offline one (events, verdict counts, first violation, the log's sha256).
+
+docs/monitors.md ("Live monitoring") gives the decisions.
+"""
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+import threading
+import time as _time
+from datetime import datetime, timezone
+from pathlib import Path
+from typing import IO, Any, Callable, Iterable, Mapping
+
+from ...evidence.store import atomic_write_text
+from ...rcl.types import Checked, CheckedNode
+from ...traces.events import Event
+from ...traces.mapping import TopicRule
+from .backend import monitoring_details, summary_line, tool_versions, verdict_status
+from .check import NodeResult, Verdict
+from .online import OnlineEngine
+
+VERDICT_LOG_TOPIC = "rclverify/verdict"
+
+
+def _json_safe(v: Any) -> Any:
+    if isinstance(v, float) and not math.isfinite(v):
+        return repr(v)  # JSON has no NaN; the reader would refuse the line
+    if isinstance(v, dict):
+        return {str(k): _json_safe(x) for k, x in v.items()}
+    if isinstance(v, (list, tuple)):
+        return [_json_safe(x) for x in v]
+    return v
+
+
+def dumps(obj: Any) -> str:
+    """Compact JSON; a NaN or an infinity (no JSON number) is written as its
+    string (``"nan"``), so every line stays readable by the log reader."""
+    try:
+        return json.dumps(obj, allow_nan=False, separators=(", ", ": "))
+    except ValueError:
+        return json.dumps(_json_safe(obj), separators=(", ", ": "))
+
+
+class LiveRun:
+    """One live run: engine, log, verdict sinks, status and evidence.
+
+    ``log`` is the JSON-lines file to write (created, truncated);
+    ``publish(text)`` / ``publish_last(node, text)`` the verdict sinks (JSON text);
+    ``horizon``, ``reorder_window`` and ``silence_s`` in seconds.  Thread
+    safe: :meth:`push` and :meth:`tick` may come from different threads.
+    """
+
+    def __init__(self, checked: Checked, nodes: Iterable[CheckedNode], rules: Mapping[str, TopicRule],
+                 horizon: float, log: Path, *, reorder_window: float = 0.05, silence_s: float = 0.0,
+                 publish: Callable[[str], None] | None = None,
+                 publish_last: Callable[[str, str], None] | None = None) -> None:
+        self.log_path = log
+        log.parent.mkdir(parents=True, exist_ok=True)
+        self._log: IO[str] = log.open("w", encoding="utf-8")
+        self.publish, self.publish_last = publish, publish_last
+        self.lock = threading.Lock()
+        self.started = datetime.now(timezone.utc).isoformat(timespec="seconds")
+        self.silences: list[dict[str, Any]] = []
+        self.verdicts = 0
+        self.engine = OnlineEngine(checked, list(nodes), rules, horizon, reorder_window, silence_s,
+                                   on_verdict=self._verdict, on_silence=self._silence, on_event=self._event)
+        self.results: list[NodeResult] | None = None
+        self._last: dict[str, str] = {}  # node -> latest verdict not yet published as its last verdict
+
+    # -- engine callbacks (called under the lock) ----------------------------------
+    def _event(self, ev: Event) -> None:
+        self._log.write(dumps({"topic": ev.topic, "time": ev.time, **{k: v for k, v in ev.fields.items()
+                                                                       if k not in ("topic", "time")}}) + "\n")
+
+    def _verdict(self, v: Verdict) -> None:
+        self.verdicts += 1
+        text = dumps(v.to_json())  # serialised once: the log line and the published message
+        self._log.write(f'{{"topic": "{VERDICT_LOG_TOPIC}", "time": {v.decided_at!r}, "verdict": {text}}}\n')
+        if self.publish is not None:
+            self.publish(text)
+        self._last[v.node] = text
+
+    def _silence(self, topic: str, seconds: float, silent: bool) -> None:
+        note = {"topic": topic, "silent": silent, "for_s": round(seconds, 3),
+                "time": self.engine.monitors[0].now if self.engine.monitors else 0.0}
+        if silent:
+            self.silences.append(note)
+        if self.publish is not None:
+            self.publish(dumps({"node": "", "verdict": "silent" if silent else "resumed", "topic": topic,
+                                "silent_for_s": round(seconds, 3), "time": note["time"]}))
+
+    # -- input ---------------------------------------------------------------------
+    def push(self, topic: str, fields: Mapping[str, Any], received: float) -> None:
+        """One message from the middleware (receipt time in seconds)."""
+        with self.lock:
+            if self.results is None:
+                self.engine.push(topic, fields, received)
+
+    def tick(self, now: float) -> None:
+        """The timer (see :meth:`OnlineEngine.tick`)."""
+        with self.lock:
+            if self.results is None:
+                self.engine.tick(now)
+                self._flush_last()
+                self._log.flush()
+
+    def _flush_last(self) -> None:
+        """Publish each node's latest verdict (latched), once per timer tick
+        rather than at every event: the topic holds the last one either way."""
+        if self.publish_last is not None:
+            for node, text in self._last.items():
+                self.publish_last(node, text)
+        self._last.clear()
+
+    def status_line(self) -> str:
+        """``Node: 3 satisfied, 1 violated | Node2: ...`` (a live per-node status)."""
+        with self.lock:
+            parts = [summary_line(m.result) for m in self.engine.monitors]
+        silent = [t for t, s in self.engine.topics.items() if s.silent]
+        return " | ".join(parts) + (f" | silent: {', '.join(sorted(silent))}" if silent else "")
+
+    # -- stop ------------------------------------------------------------------------
+    def stop(self, evidence: Path | None = None) -> dict[str, Any]:
+        """Finish the run (obligations still within their horizon are ``open``),
+        close the log and write the evidence record (atomically) when
+        ``evidence`` is given; returns the record."""
+        with self.lock:
+            if self.results is None:
+                self.results = self.engine.finish()
+                self._flush_last()
+                self._log.close()
+        sha = hashlib.sha256(self.log_path.read_bytes()).hexdigest()
+        versions = tool_versions()
+        horizon = self.engine.horizon
+        nodes = []
+        for res in self.results:
+            status, explanation = verdict_status(res, self.log_path.name)
+            nodes.append({"node": res.node, "status": status, "explanation": explanation,
+                          **monitoring_details(res, self.log_path.name, self.engine.released, sha, versions,
+                                               horizon)})
+        record = {"kind": "monitoring", "mode": "live", "log": self.log_path.name, "sha256": sha,
+                  "started": self.started,
+                  "stopped": datetime.now(timezone.utc).isoformat(timespec="seconds"),
+                  "events": self.engine.released, "late_events": self.engine.late,
+                  "max_late_s": round(self.engine.max_late_s, 6),
+                  "reorder_window_s": self.engine.reorder_window, "verdicts": self.verdicts,
+                  "silent_topics": self.silences, "nodes": nodes}
+        if evidence is not None:
+            atomic_write_text(evidence, json.dumps(record, indent=2, sort_keys=True) + "\n")
+        return record
+
+
+def run_ros1(run_factory: Callable[..., LiveRun], checked: Checked, nodes: list[CheckedNode],
+             msg_dirs: list[Path], *, verdict_topic: str, last_prefix: str, node_name: str,
+             duration: float | None, tick_s: float, status_s: float, evidence: Path | None,
+             stop: threading.Event, out: Callable[[str], None]) -> dict[str, Any]:
+    """Run live monitoring on a ROS 1 master (``ROS_MASTER_URI``) until ``stop``
+    is set or ``duration`` seconds passed; returns the evidence record.
+
+    Subscribes with ``rospy.AnyMsg`` to every topic the contracts name and
+    decodes each message with the class of its connection's type
+    (:func:`~.ros1.message_class`); publishes every verdict as
+    ``std_msgs/String`` JSON on ``verdict_topic`` and each node's latest on
+    ``<last_prefix>/<node>/last_verdict`` (latched).  Raises
+    :class:`~.ros1.RosUnavailable` when rospy or a message class is missing.
+    """
+    from .ros1 import RosUnavailable, contract_topics, flatten, import_rospy, message_class
+    rospy = import_rospy()
+    from std_msgs.msg import String
+    topics = contract_topics(checked, nodes)
+    classes = {t: message_class(typ, msg_dirs) for t, typ in topics.items()}  # fail early, located
+    by_type = {c._type: c for c in classes.values()}  # type: ignore[attr-defined]
+    import rosgraph
+    if not rosgraph.is_master_online():
+        raise RosUnavailable(f"no ROS master answers at {rosgraph.get_master_uri()} (start roscore, or set "
+                             "ROS_MASTER_URI)")
+    rospy.init_node(node_name, anonymous=False, disable_signals=True)
+    pub = rospy.Publisher(verdict_topic, String, queue_size=10000)
+    lasts: dict[str, Any] = {}
+    for n in nodes:
+        lasts[n.name] = rospy.Publisher(f"{last_prefix}/{n.name}/last_verdict", String, queue_size=1, latch=True)
+    live = run_factory(publish=lambda text: pub.publish(String(text)),
+                              publish_last=lambda n, text: lasts[n].publish(String(text)))
+    decode_errors: dict[str, int] = {}
+
+    def callback(raw: Any, topic: str) -> None:
+        received = rospy.get_time()
+        typ = raw._connection_header.get("type", "") if getattr(raw, "_connection_header", None) else ""
+        cls = by_type.get(typ, classes[topic])
+        try:
+            msg = cls().deserialize(raw._buff)
+        except Exception:  # a publisher of another type on a contract topic: counted, never a crash
+            decode_errors[topic] = decode_errors.get(topic, 0) + 1
+            return
+        live.push(topic, flatten(msg), received)
+
+    subs = [rospy.Subscriber(t, rospy.AnyMsg, callback, callback_args=t, queue_size=10000) for t in topics]
+    out(f"monitoring {len(topics)} topic(s) for {len(nodes)} node(s); verdicts on {verdict_topic}")
+    t0 = _time.monotonic()
+    next_status = t0 + status_s
+    try:
+        while not stop.is_set() and not rospy.is_shutdown():
+            if duration is not None and _time.monotonic() - t0 >= duration:
+                break
+            stop.wait(tick_s)
+            live.tick(rospy.get_time())
+            if status_s > 0 and _time.monotonic() >= next_status:
+                out(live.status_line())
+                next_status += status_s
+    finally:
+        for s in subs:
+            s.unregister()
+        record = live.stop(evidence)
+        record["decode_errors"] = decode_errors
+        if evidence is not None:
+            atomic_write_text(evidence, json.dumps(record, indent=2, sort_keys=True) + "\n")
+        out(live.status_line())
+        rospy.signal_shutdown("monitor stopped")
+    return record
+
+
+__all__ = ["LiveRun", "VERDICT_LOG_TOPIC", "run_ros1"]

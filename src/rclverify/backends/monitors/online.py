@@ -1,0 +1,171 @@
+"""The online verdict engine: the offline checker fed one message at a time.
+
+:class:`OnlineEngine` wraps one :class:`~.check.NodeMonitor` per node (the
+very code :func:`~.check.check_trace` runs over a recorded trace) with what
+a running system adds (docs/monitors.md, "Live monitoring"):
+
+* **ordering**: a message is stamped with its ``header.stamp`` when it has
+  one (ROS 1 ``secs``/``nsecs``, ROS 2 ``sec``/``nanosec``, nested or
+  flattened), else with its receipt time; messages wait in a reorder buffer
+  for ``reorder_window`` seconds and are released to the monitors in stamp
+  order (ties in arrival order).  A message older than the last one
+  released arrives too late to be ordered: it is still checked (at the
+  current clock, never dropped silently) and counted in ``late`` (the
+  largest lag in ``max_late_s``);
+* **time**: :meth:`tick` (a timer, e.g. every 50 ms) moves every monitor's
+  clock to ``now - reorder_window``, so an obligation whose horizon (the
+  contract's response time) has passed is resolved ``violated`` without
+  waiting for the next message;
+* **silence**: a contract topic that has not been received for
+  ``silence_s`` seconds is reported once by :meth:`tick` (and again when it
+  comes back).
+
+Memory per node is the monitor's (state, bounded cache, obligations within
+the horizon) plus the reorder buffer (messages within the window).
+"""
+from __future__ import annotations
+
+import heapq
+import itertools
+import math
+from dataclasses import dataclass, field
+from typing import Any, Callable, Iterable, Mapping
+
+from ...rcl.types import Checked, CheckedNode
+from ...traces.events import Event
+from ...traces.mapping import TopicRule
+from .check import NodeMonitor, NodeResult, Verdict
+
+
+def header_stamp(fields: Mapping[str, Any]) -> float | None:
+    """The message's ``header.stamp`` in seconds, or ``None`` when it has none.
+
+    Accepts a nested header (``{"header": {"stamp": {"secs": 1, "nsecs": 5}}}``,
+    ROS 1; ``sec``/``nanosec``, ROS 2), a stamp already in seconds, and
+    ROSMonitoring's flattened form (``"header.stamp.secs"``).  A stamp that
+    is not a finite non-negative number is ignored (``None``).
+    """
+    h = fields.get("header")
+    stamp: Any = h.get("stamp") if isinstance(h, Mapping) else None
+    if stamp is None and ("header.stamp.secs" in fields or "header.stamp.sec" in fields):
+        stamp = {k.rsplit(".", 1)[1]: v for k, v in fields.items() if k.startswith("header.stamp.")}
+    if isinstance(stamp, Mapping):
+        s = stamp.get("secs", stamp.get("sec"))
+        ns = stamp.get("nsecs", stamp.get("nanosec", 0))
+        if _num(s) and _num(ns):
+            t = float(s) + float(ns) / 1e9
+            return t if t > 0 else None  # a zero stamp is ROS's "not set"
+        return None
+    if _num(stamp) and float(stamp) > 0:
+        return float(stamp)
+    return None
+
+
+def _num(x: Any) -> bool:
+    return isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x)
+
+
+@dataclass
+class TopicStatus:
+    """Per contract topic: messages received, last receipt time (s), silent now?"""
+
+    received: int = 0
+    last: float | None = None
+    silent: bool = False
+
+
+@dataclass
+class OnlineEngine:
+    """Every node's monitor, fed message by message.
+
+    ``on_event(Event)`` receives each message as it is released to the
+    monitors (in order, before its verdicts); ``on_verdict(Verdict)``
+    receives each event's verdict when decided;
+    ``on_silence(topic, seconds, silent)`` when a topic goes silent
+    (``silent`` True) or comes back (False).  Times are seconds on one clock
+    (ROS time live, the trace's clock in a replay).
+    """
+
+    checked: Checked
+    nodes: Iterable[CheckedNode]
+    rules: Mapping[str, TopicRule]
+    horizon: float
+    reorder_window: float = 0.0
+    silence_s: float = 0.0
+    on_verdict: Callable[[Verdict], None] | None = None
+    on_silence: Callable[[str, float, bool], None] | None = None
+    on_event: Callable[[Event], None] | None = None
+    monitors: list[NodeMonitor] = field(init=False)
+    topics: dict[str, TopicStatus] = field(init=False)
+    late: int = field(init=False, default=0)
+    max_late_s: float = field(init=False, default=0.0)
+    released: int = field(init=False, default=0)
+    _heap: list[tuple[float, int, str, Mapping[str, Any], str]] = field(init=False, default_factory=list)
+    _seq: Any = field(init=False, default_factory=itertools.count)
+    _clock: float = field(init=False, default=-math.inf)
+
+    def __post_init__(self) -> None:
+        self.monitors = [NodeMonitor(self.checked, n, self.rules, self.horizon, self.on_verdict)
+                         for n in self.nodes]
+        self.topics = {t: TopicStatus() for m in self.monitors for t in m.topics}
+
+    # -- input -------------------------------------------------------------------
+    def push(self, topic: str, fields: Mapping[str, Any], received: float, where: str = "") -> None:
+        """One message as received: ``topic`` (with or without ``/``), its fields,
+        the receipt time (s).  Ordered by its header stamp when it has one."""
+        topic = topic.lstrip("/")
+        status = self.topics.get(topic)
+        if status is None:
+            return  # no contract names it
+        status.received += 1
+        status.last = received if status.last is None else max(status.last, received)
+        if status.silent:
+            status.silent = False
+            if self.on_silence is not None:
+                self.on_silence(topic, 0.0, False)
+        stamp = header_stamp(fields)
+        t = received if stamp is None else stamp
+        heapq.heappush(self._heap, (t, next(self._seq), topic, fields, where))
+        if self.reorder_window <= 0:
+            self._release(math.inf)
+
+    def tick(self, now: float) -> None:
+        """The timer: release messages older than the reorder window, resolve
+        obligations whose horizon has passed, report silent topics."""
+        self._release(now - self.reorder_window)
+        for m in self.monitors:
+            m.advance(max(self._clock, now - self.reorder_window))
+        if self.silence_s > 0:
+            for topic, st in self.topics.items():
+                if st.last is not None and not st.silent and now - st.last > self.silence_s:
+                    st.silent = True
+                    if self.on_silence is not None:
+                        self.on_silence(topic, now - st.last, True)
+
+    def _release(self, upto: float) -> None:
+        while self._heap and self._heap[0][0] <= upto:
+            t, _, topic, fields, where = heapq.heappop(self._heap)
+            if t < self._clock:
+                self.late += 1
+                self.max_late_s = max(self.max_late_s, self._clock - t)
+                t = self._clock
+            self._clock = t
+            ev = Event(self.released, t, topic, fields, where or f"message {self.released}")
+            self.released += 1
+            if self.on_event is not None:
+                self.on_event(ev)
+            for m in self.monitors:
+                m.advance(t)
+            for m in self.monitors:
+                m.feed(ev)
+
+    def finish(self) -> list[NodeResult]:
+        """Release what is buffered, close the horizons up to the last message,
+        and give each node's result (obligations still within it are ``open``)."""
+        self._release(math.inf)
+        for m in self.monitors:
+            m.advance(self._clock)
+        return [m.finish() for m in self.monitors]
+
+
+__all__ = ["OnlineEngine", "TopicStatus", "header_stamp"]

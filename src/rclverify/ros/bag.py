@@ -1,0 +1,25 @@
+"""The topics and message types present in a recorded run: a ROS 1 ``.bag``
+or a ROS 2 bag (directory or ``.mcap``), through ``rosbags``' AnyReader."""
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+from .model import Note, Src, canon_type
+
+
+def bag_topics(path: Path, shown: str) -> tuple[dict[str, Any] | None, list[Note]]:
+    """``{"path", "topics": [{"name", "type", "count"}]}`` or a located error note."""
+    from rosbags.highlevel import AnyReader
+    try:
+        with AnyReader([path]) as reader:
+            topics = [{"name": c.topic if c.topic.startswith("/") else "/" + c.topic,
+                       "type": canon_type(c.msgtype), "count": int(c.msgcount)}
+                      for c in reader.connections]
+    except Exception as exc:  # rosbags raises its own reader errors on bad files
+        return None, [Note(Src(shown), f"cannot read bag: {' '.join(str(exc).split())[:300]}", "ROS-PARSE", "error")]
+    merged: dict[tuple[str, str], int] = {}
+    for t in topics:
+        merged[(t["name"], t["type"])] = merged.get((t["name"], t["type"]), 0) + t["count"]
+    return {"path": shown, "topics": [{"name": n, "type": ty, "count": c}
+                                      for (n, ty), c in sorted(merged.items())]}, []

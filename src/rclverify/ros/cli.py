@@ -1,0 +1,118 @@
+"""``rclverify ros scan`` and ``rclverify ros check`` (docs/ros.md).
+
+Exit codes: 0 the graph (or the findings) was written; 1 an input file could
+not be read (``ROS-PARSE`` error, the graph is still written from the rest),
+or for ``check --strict`` a grounding error; 2 usage errors.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+from typing import Any
+
+
+def add_parsers(sub: Any) -> None:
+    """Add the ``ros`` command and its subcommands to ``rclverify``'s parser."""
+    r = sub.add_parser("ros", help="read the ROS computation graph from workspaces; check contracts against it",
+                       description="read the ROS computation graph from workspaces; check contracts against it")
+    rs = r.add_subparsers(dest="ros_command", required=True)
+    s = rs.add_parser("scan", help="recover the computation graph from ROS 1/ROS 2 workspaces, launch files, bags, a master")
+    s.add_argument("paths", nargs="*", metavar="PATH", help="workspace (or package) directories")
+    s.add_argument("--launch", action="append", default=[], metavar="FILE", help="entry launch file (repeatable)")
+    s.add_argument("--arg", action="append", default=[], metavar="NAME:=VALUE", help="launch argument (repeatable)")
+    s.add_argument("--bag", action="append", default=[], metavar="BAG", help="recorded run: .bag, ROS 2 bag dir, .mcap")
+    s.add_argument("--master", metavar="URI", help="also read the running ROS 1 master at URI (http://127.0.0.1:11311)")
+    s.add_argument("--json", metavar="FILE", help="write the graph as JSON (docs/ros-graph.schema.json)")
+    s.add_argument("--cache", metavar="DIR", help="per-file parse cache directory (e.g. artifacts/cache)")
+    s.set_defaults(fn=cmd_scan)
+    c = rs.add_parser("check", help="check the plan's contracts against the graph of its ros: section")
+    c.add_argument("-w", "--workspace", default=".", help="workspace root (default: .)")
+    c.add_argument("--plan", default="contracts/plan.yaml", help="plan file, relative to the workspace")
+    c.add_argument("--strict", action="store_true", help="exit 1 when a grounding error is found")
+    c.add_argument("--json", metavar="FILE", help="write the findings as JSON")
+    c.set_defaults(fn=cmd_check)
+
+
+def _launch_args(items: list[str]) -> dict[str, str]:
+    out = {}
+    for it in items:
+        k, sep, v = it.partition(":=")
+        if not sep or not k:
+            raise SystemExit(f"error: --arg {it!r}: expected NAME:=VALUE")
+        out[k] = v
+    return out
+
+
+def cmd_scan(args: argparse.Namespace) -> int:
+    from ..evidence.store import atomic_write_text
+    from .graph import scan
+    from .master import MasterError, read_master
+    for p in list(args.paths) + list(args.launch) + list(args.bag):
+        if not Path(p).exists():
+            print(f"{p}: error: no such file or directory", file=sys.stderr)
+            return 2
+    try:
+        largs = _launch_args(args.arg)
+    except SystemExit as exc:
+        print(exc, file=sys.stderr)
+        return 2
+    res = scan([Path(p) for p in args.paths], [Path(p) for p in args.launch], largs, [Path(b) for b in args.bag],
+               Path(args.cache) / "ros-scan.pickle" if args.cache else None)
+    g = res.graph
+    data: dict[str, Any] = g.to_json()
+    if args.master:
+        try:
+            mg = read_master(args.master)
+        except MasterError as exc:
+            print(f"{args.master}: error: {exc}", file=sys.stderr)
+            return 1
+        data["master"] = {"uri": args.master, "nodes": [n.to_json() for _, n in sorted(mg.nodes.items())]}
+    for n in g.notes:
+        print(n, file=sys.stderr)
+    if args.json:
+        atomic_write_text(Path(args.json), json.dumps(data, indent=2, sort_keys=False) + "\n")
+    else:
+        print(json.dumps(data, indent=2))
+    errors = sum(1 for n in g.notes if n.severity == "error")
+    print(f"{len(g.packages)} package(s), {len(g.nodes)} node(s), {len(data['topics'])} topic(s), "
+          f"{len(g.types)} message type(s); {errors} error(s), {len(g.notes) - errors} warning(s)",
+          file=sys.stderr)
+    return 1 if errors else 0
+
+
+def init_from_ros(args: argparse.Namespace) -> int:
+    """``rclverify init DIR --from-ros PATH [--launch FILE]``."""
+    from .graph import scan
+    from .skeleton import write_from_ros
+    root = Path(args.dir)
+    if root.exists() and (not root.is_dir() or any(root.iterdir())):
+        print(f"{args.dir}: error: exists and is not an empty directory; rclverify init writes only into a new "
+              f"or empty one", file=sys.stderr)
+        return 1
+    for p in list(args.from_ros) + list(args.launch):
+        if not Path(p).exists():
+            print(f"{p}: error: no such file or directory", file=sys.stderr)
+            return 2
+    res = scan([Path(p) for p in args.from_ros], [Path(p) for p in args.launch])
+    for n in res.graph.notes:
+        print(n, file=sys.stderr)
+    if not res.graph.nodes:
+        print(f"{args.from_ros[0]}: error: no ROS node found (no launch file node, no source naming its node)",
+              file=sys.stderr)
+        return 1
+    try:
+        written = write_from_ros(root, res, [Path(p) for p in args.from_ros], [Path(p) for p in args.launch])
+    except OSError as exc:
+        print(f"{args.dir}: error: cannot write the workspace: {exc.strerror or exc}", file=sys.stderr)
+        return 1
+    for p in written:
+        print(p)
+    print(f"{len(res.graph.nodes)} contract skeleton(s) written; run `doit verify` in {args.dir}")
+    return 0
+
+
+def cmd_check(args: argparse.Namespace) -> int:
+    from .stage import run_check
+    return run_check(Path(args.workspace), args.plan, args.strict, args.json)

@@ -1,0 +1,263 @@
+"""``rclverify ros scan``: one computation graph from ROS 1 and ROS 2
+workspaces, launch files, node sources and bags (docs/ros.md).
+
+Nodes come from the launch files given (``launch``); without any, each
+node source that names its node (``rospy.init_node('n')``,
+``ros::init(.., "n")``, ``Node("n")`` ...) is one node in the root
+namespace.  A node's topics are its sources' publishers and subscribers,
+resolved in the node's namespace (ROS name rules, :mod:`names`) and then
+remapped by the launch file's ``remap`` elements (the last matching remap wins).
+"""
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Sequence
+
+from . import names
+from .cache import ParseCache
+from .executables import executables
+from .interfaces import TypeTable
+from .launch import El, Interpreter, LaunchNode, read_xml, read_yaml
+from .launch_ros2 import read_python
+from .model import Endpoint, Graph, GraphEdge, GraphNode, Note, Src
+from .packages import Package, find_manifests, read_package
+from .sources_cpp import scan_cpp
+from .sources_py import scan_python
+
+_CPP = {".cpp", ".cc", ".cxx", ".hpp", ".h", ".hh"}
+_SKIP_DIRS = {"build", "devel", "install", "log", "test", "tests", "launch", "msg", "srv", "action", "__pycache__"}
+MAX_SOURCE_BYTES = 2_000_000
+
+
+@dataclass
+class ScanResult:
+    """The graph plus what the scan used: packages, the type table, and
+    each file's parse results (``sources[shown] = {nodes, endpoints, notes}``)."""
+
+    graph: Graph
+    packages: dict[str, Package]
+    table: TypeTable
+    sources: dict[str, dict[str, Any]] = field(default_factory=dict)
+    cache_hits: int = 0
+    cache_misses: int = 0
+
+
+class Shower:
+    """Paths as shown in locations: relative to ``base`` when inside it."""
+
+    def __init__(self, base: Path | None) -> None:
+        self.base = os.path.realpath(base or Path.cwd())
+        self._memo: dict[str, str] = {}
+
+    def __call__(self, p: Path) -> str:
+        key = str(p)
+        shown = self._memo.get(key)
+        if shown is None:
+            real = os.path.realpath(key)
+            inside = real == self.base or real.startswith(self.base.rstrip(os.sep) + os.sep)
+            shown = Path(os.path.relpath(real, self.base)).as_posix() if inside else key
+            self._memo[key] = shown
+        return shown
+
+
+def _source_files(root: Path) -> tuple[list[Path], list[Path]]:
+    py, cpp = [], []
+    for dirpath, dirnames, filenames in os.walk(root):
+        dirnames[:] = sorted(d for d in dirnames if d not in _SKIP_DIRS and not d.startswith("."))
+        for f in sorted(filenames):
+            p = Path(dirpath) / f
+            if f.endswith(".py") and f != "setup.py" and not f.endswith(".launch.py") and f != "__init__.py":
+                py.append(p)
+            elif p.suffix in _CPP:
+                cpp.append(p)
+            elif not p.suffix and (Path(dirpath).name in ("scripts", "nodes", "bin")):
+                py.append(p)  # ROS 1 scripts without extension
+    return py, cpp
+
+
+def _load_launch(path: Path, shown: str) -> tuple[El | None, list[Note]]:
+    n = path.name
+    if n.endswith(".py"):
+        return read_python(path, shown)
+    if n.endswith((".yaml", ".yml")):
+        return read_yaml(path, shown)
+    return read_xml(path, shown)
+
+
+def scan(paths: Sequence[Path], launch: Sequence[Path] = (), launch_args: dict[str, str] | None = None,
+         bags: Sequence[Path] = (), cache_path: Path | None = None, base: Path | None = None,
+         standard: bool = True) -> ScanResult:
+    """Scan workspaces ``paths`` (directories holding packages) into a graph.
+
+    ``launch``: entry launch files (with ``launch_args``); ``bags``: recorded
+    runs; ``cache_path``: the per-file parse cache (``None``: no cache);
+    ``base``: paths in locations are shown relative to it (default: the
+    current directory). Never raises on bad input: unreadable files become
+    located notes (``ROS-PARSE`` errors) in ``graph.notes``.
+    """
+    show = Shower(base)
+    cache = ParseCache(cache_path) if cache_path is not None else None
+    g = Graph()
+    table = TypeTable()
+    pkgs: dict[str, Package] = {}
+    for m in find_manifests([Path(p) for p in paths]):
+        shown = show(m)
+        try:
+            g.files[shown] = ParseCache.digest(m.read_bytes())
+        except OSError:
+            pass
+        try:
+            sha_m = g.files.get(shown) or ParseCache.digest(m.read_bytes())
+        except OSError:
+            sha_m = ""
+        pkg, notes = cache.get(f"pkg:{shown}", sha_m, lambda: read_package(m, shown)) if cache and sha_m \
+            else read_package(m, shown)
+        g.notes.extend(notes)
+        if pkg is None:
+            continue
+        if pkg.name in pkgs:
+            g.notes.append(Note(Src(shown), f"package '{pkg.name}' also at {show(pkgs[pkg.name].manifest)}; "
+                                            f"this one is ignored", "ROS-MANIFEST"))
+            continue
+        pkgs[pkg.name] = pkg
+        g.packages[pkg.name] = pkg.to_json(shown)
+    for name in sorted(pkgs):
+        table.add_package_dir(pkgs[name].root, name, show, "workspace", cache, g.files)
+    # Debian's ros-*-msgs packages are ROS 1 (Noetic) definitions: used unless
+    # every scanned package is a ROS 2 one, whose standard types come from
+    # rosbags' ROS 2 store instead (docs/ros.md).
+    if standard and (not pkgs or any(p.ros == 1 for p in pkgs.values())):
+        table.add_debian_standard(cache)
+    for tname, fname, missing in table.unknown_refs():
+        info = table.types[tname]
+        g.notes.append(Note(Src(info.file or tname, info.lines.get(fname, 1)),
+                            f"field '{fname}' of {tname} has type {missing}, which no scanned package "
+                            f"or standard package defines", "ROS-TYPE"))
+    g.notes.extend(table.notes)
+
+    res = ScanResult(g, pkgs, table)
+    exes: dict[str, dict[str, list[Path]]] = {}
+    for name in sorted(pkgs):
+        root = pkgs[name].root
+        py, cpp = _source_files(root)
+        py_nodes = []
+        for f in py + cpp:
+            try:
+                data = f.read_bytes()
+            except OSError as exc:
+                g.notes.append(Note(Src(show(f)), f"cannot read: {exc}", "ROS-PARSE", "error"))
+                continue
+            if len(data) > MAX_SOURCE_BYTES:
+                g.notes.append(Note(Src(show(f)), "source file larger than 2 MB: not scanned", "ROS-PARSE"))
+                continue
+            shown = show(f)
+            sha = ParseCache.digest(data)
+            is_py = f in py
+            if is_py and not f.suffix and not data.startswith(b"#!") :
+                continue
+            fn = (lambda d=data, s=shown: scan_python(d.decode("utf-8", errors="replace"), s)) if is_py \
+                else (lambda d=data, s=shown: scan_cpp(d, s))
+            r = cache.get(f"{'py' if is_py else 'cpp'}:{shown}", sha, fn) if cache else fn()
+            if not (r["nodes"] or r["endpoints"] or r["notes"]):
+                continue
+            g.files[shown] = sha
+            res.sources[shown] = r
+            if is_py and (r["nodes"] or r["endpoints"]):
+                py_nodes.append(f)
+        exes[name] = executables(root, name, py_nodes)
+
+    def endpoints_of(files: list[Path]) -> tuple[list[Endpoint], list[tuple[str, Src]], list[str]]:
+        eps: list[Endpoint] = []
+        inits: list[tuple[str, Src]] = []
+        shown_files = []
+        for f in files:
+            s = show(f)
+            shown_files.append(s)
+            r = res.sources.get(s)
+            if r:
+                eps.extend(r["endpoints"])
+                inits.extend(r["nodes"])
+        return eps, inits, shown_files
+
+    def add_node(full: str, ns: str, pkg: str | None, exe: str | None, files: list[str], declared: Src,
+                 eps: list[Endpoint], remaps: list[tuple[str, str, Src]], origin: str) -> None:
+        if full in g.nodes:
+            g.notes.append(Note(declared, f"node {full} is started twice (first at {g.nodes[full].declared_at}); "
+                                          f"ROS keeps only the last one", "ROS-LAUNCH"))
+        node = GraphNode(full, ns, pkg, exe, files, declared, origin=origin)
+        for e in eps:
+            topic = names.resolve(e.topic, ns, full)
+            at = None
+            for frm, to, rsrc in remaps:
+                if names.resolve(frm, ns, full) == names.resolve(e.topic, ns, full):
+                    topic, at = names.resolve(to, ns, full), rsrc
+            edge = GraphEdge(topic, e.msg_type, e.src, at, e.topic)
+            lst = node.publishes if e.kind == "pub" else node.subscribes
+            if not any(x.topic == edge.topic and x.msg_type == edge.msg_type for x in lst):
+                lst.append(edge)
+        g.nodes[full] = node
+
+    if launch:
+        interp = Interpreter(lambda p: pkgs[p].root.resolve() if p in pkgs else None,
+                             lambda p: _load_launch(p, show(p)), show)
+        for lf in launch:
+            interp.run(Path(lf), dict(launch_args or {}))
+        for f in interp.files:
+            try:
+                g.files[show(f)] = ParseCache.digest(f.read_bytes())
+            except OSError:
+                pass
+        g.notes.extend(interp.notes)
+        for ln in interp.nodes:
+            _launch_node(ln, pkgs, exes, endpoints_of, add_node, g)
+    else:
+        for shown, r in sorted(res.sources.items()):
+            for (nname, src) in r["nodes"][:1]:
+                full = names.join("/", nname)
+                pkg = next((p for p, pk in pkgs.items() if shown.startswith(show(pk.root) + "/")), None)
+                add_node(full, "/", pkg, None, [shown], src, r["endpoints"], [], "source")
+            if not r["nodes"] and r["endpoints"]:
+                g.notes.append(Note(r["endpoints"][0].src, "publishers/subscribers in a file that names no node "
+                                                          "and is started by no launch file: not in the graph",
+                                    "ROS-UNRESOLVED"))
+    for shown, r in sorted(res.sources.items()):
+        g.notes.extend(r["notes"])
+    for b in bags:
+        from .bag import bag_topics
+        info, notes = bag_topics(Path(b), show(Path(b)))
+        g.notes.extend(notes)
+        if info is not None:
+            g.bags.append(info)
+    used = {e.msg_type for n in g.nodes.values() for e in n.publishes + n.subscribes if e.msg_type}
+    used |= {t["type"] for b in g.bags for t in b["topics"] if t["type"]}
+    used |= {k for k, v in table.types.items() if v.origin == "workspace"}
+    g.types = {k: v.to_json() for k, v in table.closure(sorted(used)).items()}
+    if cache is not None:
+        cache.save()
+        res.cache_hits, res.cache_misses = cache.hits, cache.misses
+    return res
+
+
+def _launch_node(ln: LaunchNode, pkgs: dict[str, Package], exes: dict[str, dict[str, list[Path]]],
+                 endpoints_of: Any, add_node: Any, g: Graph) -> None:
+    if ln.pkg not in pkgs:
+        g.notes.append(Note(ln.src, f"node package '{ln.pkg}' is not in the scanned workspaces; "
+                                    f"its topics are unknown", "ROS-LAUNCH"))
+        files: list[Path] = []
+    else:
+        files = exes.get(ln.pkg, {}).get(ln.exe, [])
+        if not files:
+            g.notes.append(Note(ln.src, f"executable '{ln.exe}' of package '{ln.pkg}' has no source found "
+                                        f"(CMakeLists.txt add_executable, setup.py console_scripts, scripts/); "
+                                        f"its topics are unknown", "ROS-LAUNCH"))
+    eps, inits, shown = endpoints_of(files)
+    name = ln.name or (inits[0][0] if inits else ln.exe)
+    if name.startswith("/"):
+        full = names.normalise(name)
+        ns = names.split(full)[0]
+    else:
+        full = names.join(ln.ns, name)
+        ns = ln.ns
+    add_node(full, ns, ln.pkg, ln.exe, shown, ln.src, eps, ln.remaps, "launch")

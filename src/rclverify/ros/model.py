@@ -1,0 +1,181 @@
+"""Values of the recovered ROS computation graph and their JSON form.
+
+The JSON form is documented by ``docs/ros-graph.schema.json`` (docs/ros.md).
+Message types are kept in ROS 2's three-part form (``pkg/msg/Type``), the
+form rosbags' type system uses; :func:`canon_type` maps ROS 1's ``pkg/Type``
+and C++'s ``pkg::msg::Type`` to it.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+SCHEMA_ID = "rclverify-ros-graph/1"
+
+
+@dataclass(frozen=True)
+class Src:
+    """A location in a scanned file: path as given, 1-based line and column."""
+
+    file: str
+    line: int = 1
+    col: int = 1
+
+    def __str__(self) -> str:
+        return f"{self.file}:{self.line}:{self.col}"
+
+    def to_json(self) -> dict[str, Any]:
+        return {"file": self.file, "line": self.line, "col": self.col}
+
+
+@dataclass(frozen=True)
+class Endpoint:
+    """One publisher or subscriber in code: ``topic`` as written (before
+    resolution), ``msg_type`` canonical or ``None`` when unknown."""
+
+    kind: str  # "pub" | "sub"
+    topic: str
+    msg_type: str | None
+    src: Src
+
+
+@dataclass(frozen=True)
+class Note:
+    """A located warning: something that could not be resolved statically."""
+
+    src: Src
+    message: str
+    code: str = "ROS-UNRESOLVED"
+    severity: str = "warning"  # "error" for a file that could not be read at all
+
+    def __str__(self) -> str:
+        return f"{self.src}: {self.severity}: {self.message}"
+
+    def to_json(self) -> dict[str, Any]:
+        return {**self.src.to_json(), "severity": self.severity, "message": self.message, "code": self.code}
+
+
+@dataclass
+class GraphEdge:
+    """A resolved publication/subscription of one node."""
+
+    topic: str  # fully resolved, leading '/'
+    msg_type: str | None
+    src: Src  # where the code creates it
+    remapped_at: Src | None = None
+    written: str = ""  # the name as the code writes it, before resolution and remapping
+
+    def to_json(self) -> dict[str, Any]:
+        d: dict[str, Any] = {"topic": self.topic, "type": self.msg_type, "as_written": self.written or self.topic,
+                             "at": self.src.to_json()}
+        if self.remapped_at is not None:
+            d["remapped_at"] = self.remapped_at.to_json()
+        return d
+
+
+@dataclass
+class GraphNode:
+    """A node of the computation graph (fully resolved name, e.g. ``/rover/sensor``)."""
+
+    name: str
+    namespace: str
+    package: str | None
+    executable: str | None
+    sources: list[str] = field(default_factory=list)
+    declared_at: Src | None = None  # launch file line, or the init call in code
+    publishes: list[GraphEdge] = field(default_factory=list)
+    subscribes: list[GraphEdge] = field(default_factory=list)
+    origin: str = "launch"  # "launch" | "source" | "master"
+
+    def to_json(self) -> dict[str, Any]:
+        return {
+            "name": self.name, "namespace": self.namespace, "package": self.package,
+            "executable": self.executable, "sources": list(self.sources), "origin": self.origin,
+            "declared_at": self.declared_at.to_json() if self.declared_at else None,
+            "publishes": [e.to_json() for e in sorted(self.publishes, key=_ek)],
+            "subscribes": [e.to_json() for e in sorted(self.subscribes, key=_ek)],
+        }
+
+
+def _ek(e: GraphEdge) -> tuple[str, str]:
+    return (e.topic, e.msg_type or "")
+
+
+@dataclass
+class Graph:
+    """The whole recovered graph; see docs/ros.md for each part."""
+
+    packages: dict[str, dict[str, Any]] = field(default_factory=dict)
+    nodes: dict[str, GraphNode] = field(default_factory=dict)
+    types: dict[str, dict[str, Any]] = field(default_factory=dict)
+    notes: list[Note] = field(default_factory=list)
+    files: dict[str, str] = field(default_factory=dict)  # path -> sha256
+    bags: list[dict[str, Any]] = field(default_factory=list)
+
+    def topics(self) -> dict[str, dict[str, Any]]:
+        """``{topic: {"types": [...], "publishers": [...], "subscribers": [...]}}``."""
+        out: dict[str, dict[str, Any]] = {}
+        for n in sorted(self.nodes.values(), key=lambda n: n.name):
+            for kind, edges in (("publishers", n.publishes), ("subscribers", n.subscribes)):
+                for e in edges:
+                    t = out.setdefault(e.topic, {"types": [], "publishers": [], "subscribers": []})
+                    if e.msg_type and e.msg_type not in t["types"]:
+                        t["types"].append(e.msg_type)
+                    if n.name not in t[kind]:
+                        t[kind].append(n.name)
+        for b in self.bags:
+            for bt in b["topics"]:
+                t = out.setdefault(bt["name"], {"types": [], "publishers": [], "subscribers": []})
+                if bt["type"] not in t["types"]:
+                    t["types"].append(bt["type"])
+                t.setdefault("recorded_in", []).append(b["path"])
+        for t in out.values():
+            t["types"].sort()
+        return dict(sorted(out.items()))
+
+    def to_json(self) -> dict[str, Any]:
+        return {
+            "schema": SCHEMA_ID,
+            "packages": [self.packages[k] for k in sorted(self.packages)],
+            "nodes": [self.nodes[k].to_json() for k in sorted(self.nodes)],
+            "topics": [{"name": k, **v} for k, v in self.topics().items()],
+            "types": {k: self.types[k] for k in sorted(self.types)},
+            "unresolved": [n.to_json() for n in self.notes],
+            "bags": self.bags,
+            "files": [{"path": k, "sha256": v} for k, v in sorted(self.files.items())],
+        }
+
+    def edges(self) -> set[tuple[str, str, str, str | None]]:
+        """``{(node, "pub"|"sub", topic, type)}``: the graph's shape, for comparisons."""
+        return {(n.name, kind, e.topic, e.msg_type)
+                for n in self.nodes.values()
+                for kind, es in (("pub", n.publishes), ("sub", n.subscribes)) for e in es}
+
+
+def canon_type(name: str | None) -> str | None:
+    """``pkg/Type``, ``pkg::Type``, ``pkg::msg::Type``, ``pkg.msg.Type`` -> ``pkg/msg/Type``.
+
+    ``Header`` alone is ``std_msgs/msg/Header`` (ROS 1 .msg rule). Returns
+    ``None`` for ``None`` or an empty name.
+    """
+    if not name:
+        return None
+    n = name.strip().replace("::", "/").replace(".", "/")
+    for suffix in ("/ConstPtr", "/Ptr", "/SharedPtr", "/UniquePtr", "/ConstSharedPtr"):
+        if n.endswith(suffix):
+            n = n[: -len(suffix)]
+    n = n.strip("/")
+    parts = [p for p in n.split("/") if p]
+    if len(parts) == 1:
+        return "std_msgs/msg/Header" if parts[0] == "Header" else parts[0]
+    if len(parts) == 2:
+        return f"{parts[0]}/msg/{parts[1]}"
+    return "/".join(parts[-3:])
+
+
+def short_type(name: str | None) -> str:
+    """``pkg/msg/Type`` -> ``pkg/Type`` (the form RCL contracts use)."""
+    if not name:
+        return "?"
+    p = name.split("/")
+    return f"{p[0]}/{p[-1]}" if len(p) == 3 else name

@@ -1,0 +1,218 @@
+"""``rclverify init DIR --from-ros PATH``: one contract skeleton per node of
+the scanned graph, a plan with the ``ros:`` section, and a copy of the
+scanned packages under ``DIR/ros`` (docs/ros.md).
+
+From ROS field types to RCL (the paper's Scalar, Collection and Function
+rules, lines 535-548), for a topic's message:
+
+* one base field: a scalar -- ``float32``/``float64`` REAL, signed integers
+  INTEGER, unsigned integers (``uint*``, ``byte``, ``char``) NATURAL,
+  ``bool`` BOOL, ``string`` STRING;
+* one integer field with constants of its type (``uint8 RED=2``): an
+  enumeration of the constants' names in lower case (Collection rule);
+* several base fields (nested messages flattened to three levels, arrays,
+  ``time``/``duration`` and ``header`` left out): a predicate over them,
+  ``T1 x ... x Tn --> BOOL`` (Function rule: the message asserts the tuple);
+* no base field: the empty type ``{}``.
+
+The fields chosen are written to the plan's ``ros.fields`` so the grounding
+check and the reader agree.  Every guarantee is ``TRUE``, a placeholder the
+health check reports (a tautology promises nothing) and the argument shows
+undeveloped (no evidence).
+"""
+from __future__ import annotations
+
+import re
+import shutil
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import jinja2
+
+from ..evidence.store import atomic_write_text
+from .graph import ScanResult
+from .interfaces import TypeTable, elem_type
+from .model import GraphNode, short_type
+
+_ENV = jinja2.Environment(loader=jinja2.PackageLoader("rclverify.ros", "templates"), autoescape=False,
+                          undefined=jinja2.StrictUndefined, trim_blocks=True, lstrip_blocks=True,
+                          keep_trailing_newline=True)
+_UNSIGNED = {"uint8", "uint16", "uint32", "uint64", "byte", "char", "octet"}
+_SIGNED = {"int8", "int16", "int32", "int64"}
+_RCL_WORDS = {"node", "context", "inputs", "outputs", "topics", "assume", "guarantee", "forall", "exists",
+              "exists_unique", "and", "or", "not", "in", "out", "TRUE", "FALSE", "REAL", "INTEGER", "NATURAL",
+              "BOOL", "STRING", "matches", "set", "seq"}
+_SKIP_FIELDS = {"header", "stamp"}
+#: the context declarations shared by every skeleton (one RCL type per message type)
+TYPES_FILE = "contracts/ros_types.rcl"
+
+
+def rcl_scalar(ros_type: str) -> str | None:
+    """The RCL scalar for a ROS base type, ``None`` for others."""
+    t = ros_type.split("<=")[0]
+    if t in ("float32", "float64"):
+        return "REAL"
+    if t in _SIGNED:
+        return "INTEGER"
+    if t in _UNSIGNED:
+        return "NATURAL"
+    if t == "bool":
+        return "BOOL"
+    if t in ("string", "wstring"):
+        return "STRING"
+    return None
+
+
+def _base_fields(table: TypeTable, msg: str, prefix: str = "", depth: int = 0) -> list[tuple[str, str]]:
+    info = table.get(msg)
+    if info is None or depth > 3:
+        return []
+    out: list[tuple[str, str]] = []
+    for name, desc in info.fields:
+        t, arr = elem_type(desc)
+        if arr or name in _SKIP_FIELDS:
+            continue
+        if rcl_scalar(t):
+            out.append((prefix + name, t))
+        elif "/" in t and not t.startswith("builtin_interfaces/"):
+            out.extend(_base_fields(table, t, f"{prefix}{name}.", depth + 1))
+    return out
+
+
+def ident(text: str, camel: bool = False) -> str:
+    """An RCL identifier from a ROS name (``radiation_sensor`` -> ``RadiationSensor`` with ``camel``)."""
+    parts = [p for p in re.split(r"[^A-Za-z0-9]+", text) if p]
+    if not parts:
+        parts = ["x"]
+    if camel:
+        s = "".join(p[:1].upper() + p[1:] for p in parts)
+    else:
+        s = parts[0][:1].lower() + parts[0][1:] + "".join(p[:1].upper() + p[1:] for p in parts[1:])
+    if s[0].isdigit():
+        s = "n" + s
+    return s + "_" if s in _RCL_WORDS else s
+
+
+@dataclass
+class _Node:
+    name: str
+    ros_name: str
+    package: str | None
+    executable: str | None
+    sources: list[str]
+    file: str
+    inputs: list[str] = field(default_factory=list)
+    outputs: list[str] = field(default_factory=list)
+    topics: list[str] = field(default_factory=list)
+    context: list[dict[str, str]] = field(default_factory=list)
+
+
+def _type_name(msg: str, taken: dict[str, str]) -> str:
+    """A context type name for message ``msg`` (``rover_msgs/msg/Status`` -> ``Status``,
+    ``PkgStatus`` when another package's ``Status`` has it already)."""
+    pkg, base = msg.split("/")[0], msg.split("/")[-1]
+    name = ident(base, camel=True)
+    if name in _RCL_WORDS or taken.get(name, msg) != msg:
+        name = ident(pkg, camel=True) + name
+    taken[name] = msg
+    return name
+
+
+def _var_type(table: TypeTable, msg: str | None, var: str,
+              taken: dict[str, str] | None = None) -> tuple[str, list[str], dict[str, str] | None]:
+    """(RCL type text, field paths, context declaration or None); types are named
+    after their message (:func:`_type_name`), so one message has one RCL type."""
+    taken = {} if taken is None else taken
+    if msg is None or table.get(msg) is None:
+        return "{}", [], None
+    fields = _base_fields(table, msg)
+    info = table.get(msg)
+    assert info is not None
+    if len(fields) == 1:
+        path, t = fields[0]
+        consts = [n for n, ct, _ in info.consts if ct == t] if "." not in path else []
+        if consts and t in _UNSIGNED | _SIGNED:
+            tname = _type_name(msg, taken) + ident(path, camel=True)
+            return tname, [path], {"name": tname, "type": "{" + ", ".join(ident(c.lower()) for c in consts) + "}"}
+        return rcl_scalar(t) or "{}", [path], None
+    if not fields:
+        return "{}", [], None
+    tname = _type_name(msg, taken)
+    sig = " x ".join(rcl_scalar(t) or "REAL" for _, t in fields) + " --> BOOL"
+    return tname, [p for p, _ in fields], {"name": tname, "type": sig}
+
+
+def build_skeletons(res: ScanResult) -> tuple[list[_Node], dict[str, list[str]], list[str], list[dict[str, str]]]:
+    """Contract skeletons (one per graph node), the plan's ``fields``, the ``external``
+    topics and the shared context declarations (one per message type used)."""
+    g, table = res.graph, res.table
+    taken: dict[str, str] = {}
+    context: dict[str, dict[str, str]] = {}
+    nodes: list[_Node] = []
+    fields: dict[str, list[str]] = {}
+    used_names: set[str] = set()
+    for gname in sorted(g.nodes):
+        gn: GraphNode = g.nodes[gname]
+        cname = ident(gname.rsplit("/", 1)[-1], camel=True)
+        while cname in used_names:
+            cname += "_"
+        used_names.add(cname)
+        n = _Node(cname, gname, gn.package, gn.executable, gn.sources, f"contracts/{ident(cname)}.rcl")
+        seen: set[str] = set()
+        for kind, edges in (("in", gn.subscribes), ("out", gn.publishes)):
+            for e in sorted(edges, key=lambda e: e.topic):
+                base = (e.written or e.topic).rstrip("/").rsplit("/", 1)[-1].lstrip("~")
+                topic_name = base if re.fullmatch(r"[A-Za-z_][A-Za-z0-9_]*", base) and base not in _RCL_WORDS \
+                    else ident(base)
+                var = ident(base)
+                while var in seen:
+                    var += "_"
+                seen.add(var)
+                typ, paths, ctx = _var_type(table, e.msg_type, var, taken)
+                if ctx is not None:
+                    context.setdefault(ctx["name"], ctx)
+                (n.inputs if kind == "in" else n.outputs).append(f"{var} : {typ}")
+                n.topics.append(f"{short_type(e.msg_type) if e.msg_type else 'std_msgs/Empty'} {topic_name} "
+                                f"matches({kind}.{var})")
+                if paths:
+                    fields.setdefault(topic_name, paths)
+        nodes.append(n)
+    published = {e.topic for n in g.nodes.values() for e in n.publishes}
+    external = sorted({e.topic for n in g.nodes.values() for e in n.subscribes} - published)
+    return nodes, fields, external, list(context.values())
+
+
+def write_from_ros(root: Path, res: ScanResult, scanned: list[Path], launch: list[Path]) -> list[Path]:
+    """Write the workspace: ``dodo.py``, ``contracts/*.rcl``, ``contracts/plan.yaml``,
+    ``ros/`` (a copy of each scanned package directory) and empty ``backends``,
+    ``artifacts``, ``reports``.  Returns the paths written.  Raises ``OSError``."""
+    from ..scaffold import EMPTY_DIRS, _env as scaffold_env
+    nodes, fields, external, context = build_skeletons(res)
+    written: list[Path] = []
+    name = root.resolve().name or "workspace"
+    ros_dir = root / "ros"
+    launch_rel: list[str] = []
+    for pkg in sorted(res.packages.values(), key=lambda p: p.name):
+        dst = ros_dir / pkg.name
+        shutil.copytree(pkg.root, dst, ignore=shutil.ignore_patterns("build", "devel", "install", "log", ".git",
+                                                                     "__pycache__"), dirs_exist_ok=True)
+        written.append(dst)
+        for lf in launch:
+            try:
+                rel = lf.resolve().relative_to(pkg.root.resolve())
+            except ValueError:
+                continue
+            launch_rel.append(f"ros/{pkg.name}/{rel.as_posix()}")
+    files: dict[str, str] = {"dodo.py": scaffold_env().get_template("dodo.py.j2").render(name=name)}
+    for n in nodes:
+        files[n.file] = _ENV.get_template("skeleton.rcl.j2").render(node=n)
+    files[TYPES_FILE] = _ENV.get_template("skeleton-types.rcl.j2").render(context=context)
+    files["contracts/plan.yaml"] = _ENV.get_template("skeleton-plan.yaml.j2").render(
+        name=name, nodes=nodes, types=TYPES_FILE, launch=launch_rel, external=external, fields=sorted(fields.items()))
+    for rel, text in files.items():
+        atomic_write_text(root / rel, text)
+        written.append(root / rel)
+    for d in EMPTY_DIRS:
+        (root / d).mkdir(parents=True, exist_ok=True)
+    return written

@@ -1,0 +1,146 @@
+"""One verdict engine: the online path (message by message, timer, reorder
+window) gives the offline verdicts on every bundled run, event for event."""
+from __future__ import annotations
+
+import random
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from rclverify.backends.monitors.check import check_trace
+from rclverify.backends.monitors.config import load_mapping
+from rclverify.backends.monitors.online import OnlineEngine, header_stamp
+from rclverify.rcl.typecheck import load
+from rclverify.traces import read_trace
+
+REPO = Path(__file__).resolve().parents[1]
+TRACES = REPO / "backends" / "monitors" / "traces"
+MSG = [REPO / "backends" / "monitors" / "msg"]
+RUNS = sorted(p.name for p in TRACES.iterdir())
+
+
+@pytest.fixture(scope="module")
+def case_study() -> tuple[Any, Any]:
+    return load([REPO / "contracts" / "remote_inspection.rcl"]), load_mapping(REPO, "backends/monitors/mapping.yaml", 2.0)
+
+
+def offline(checked: Any, cfg: Any, run: str) -> tuple[list[Any], list[Any]]:
+    seen: list[Any] = []
+    _, results = check_trace(checked, list(checked.nodes.values()), read_trace(TRACES / run, MSG), cfg.rules,
+                             cfg.horizon, seen.append)
+    return seen, results
+
+
+def key(v: Any) -> tuple[Any, ...]:
+    return (v.node, v.where, v.verdict, v.guarantee, tuple(sorted(v.values.items())), v.reason)
+
+
+@pytest.mark.parametrize("run", RUNS)
+def test_online_replay_gives_the_offline_verdicts_event_for_event(case_study: tuple[Any, Any], run: str) -> None:
+    checked, cfg = case_study
+    expected, results = offline(checked, cfg, run)
+    got: list[Any] = []
+    eng = OnlineEngine(checked, list(checked.nodes.values()), cfg.rules, cfg.horizon, on_verdict=got.append)
+    for ev in read_trace(TRACES / run, MSG):
+        eng.tick(ev.time)  # the timer fires before each message arrives
+        eng.push(ev.topic, ev.fields, ev.time, ev.where)
+    live = eng.finish()
+    assert [key(v) for v in got] == [key(v) for v in expected]
+    assert [r.to_json() for r in live] == [r.to_json() for r in results]
+    assert any(v.verdict == "satisfied" for v in got)
+
+
+def test_reordered_arrivals_within_the_window_give_the_same_verdicts(case_study: tuple[Any, Any]) -> None:
+    checked, cfg = case_study
+    expected, _ = offline(checked, cfg, "sensor_fault.jsonl")
+    events = list(read_trace(TRACES / "sensor_fault.jsonl", MSG))
+    rng = random.Random(7)
+    delay = {t: rng.uniform(0, 0.04) for t in {e.time for e in events}}
+    arrivals = sorted(events, key=lambda e: (e.time + delay[e.time], e.index))
+    assert [e.index for e in arrivals] != [e.index for e in events]  # the network did reorder them
+    got: list[Any] = []
+    eng = OnlineEngine(checked, list(checked.nodes.values()), cfg.rules, cfg.horizon, reorder_window=0.05,
+                       on_verdict=got.append)
+    for e in arrivals:
+        eng.tick(e.time + delay[e.time])
+        stamp = {"secs": int(e.time), "nsecs": round((e.time - int(e.time)) * 1e9)}
+        eng.push(e.topic, {**e.fields, "header": {"stamp": stamp}}, e.time + delay[e.time], e.where)
+    eng.finish()
+    assert eng.late == 0
+    assert sorted(key(v) for v in got) == sorted(key(v) for v in expected)
+
+
+def test_the_timer_resolves_an_unanswered_input_without_a_new_message(case_study: tuple[Any, Any]) -> None:
+    checked, cfg = case_study
+    got: list[Any] = []
+    eng = OnlineEngine(checked, [checked.nodes["RadiationSensor"]], cfg.rules, horizon=0.5, on_verdict=got.append)
+    eng.push("r", {"value": 300.0}, 1.0)
+    eng.push("command", {"command": "inspect", "posx": 0.0, "posy": 0.0, "id": 4}, 1.1)
+    eng.push("radiationStatus", {"level": "orange"}, 1.2)  # misclassified: 300 is red
+    eng.tick(1.5)
+    assert [v.verdict for v in got] == ["incomplete input"]  # the reading before any command; the command waits
+    got.clear()
+    eng.tick(1.7)
+    [v] = [v for v in got if v.verdict == "violated"]
+    assert v.guarantee == 1 and v.decided_at == pytest.approx(1.7) and v.values["out.radiationStatus"] == "orange"
+
+
+def test_a_silent_topic_is_reported_once_and_its_return_too(case_study: tuple[Any, Any]) -> None:
+    checked, cfg = case_study
+    notes: list[tuple[str, bool]] = []
+    eng = OnlineEngine(checked, [checked.nodes["RadiationSensor"]], cfg.rules, 2.0, silence_s=1.0,
+                       on_silence=lambda t, s, silent: notes.append((t, silent)))
+    eng.push("r", {"value": 3.0}, 0.0)
+    eng.tick(0.5)
+    eng.tick(1.6)
+    eng.tick(2.0)
+    eng.push("/r", {"value": 3.0}, 2.1)
+    assert notes == [("r", True), ("r", False)]
+    assert eng.topics["r"].received == 2 and eng.topics["command"].received == 0
+
+
+@pytest.mark.parametrize("fields, stamp", [
+    ({"header": {"stamp": {"secs": 3, "nsecs": 500_000_000}}}, 3.5),
+    ({"header": {"stamp": {"sec": 3, "nanosec": 250_000_000}}}, 3.25),
+    ({"header.stamp.secs": 2, "header.stamp.nsecs": 0}, 2.0),
+    ({"header": {"stamp": {"secs": 0, "nsecs": 0}}}, None),
+    ({"header": {"stamp": {"secs": "x"}}}, None),
+    ({"header": 3}, None),
+    ({"value": 1.0}, None),
+])
+def test_header_stamp(fields: dict[str, Any], stamp: float | None) -> None:
+    assert header_stamp(fields) == stamp
+
+
+def test_live_run_logs_publishes_and_writes_evidence_the_offline_check_agrees_with(
+        case_study: tuple[Any, Any], tmp_path: Path) -> None:
+    """The part of the live monitor below the middleware (what the ROS 2 layer uses too)."""
+    import hashlib
+    import json
+
+    from rclverify.backends.monitors.live import VERDICT_LOG_TOPIC, LiveRun
+    checked, cfg = case_study
+    published: list[str] = []
+    last: dict[str, str] = {}
+    log = tmp_path / "live.jsonl"
+    live = LiveRun(checked, list(checked.nodes.values()), cfg.rules, cfg.horizon, log, reorder_window=0.05,
+                          silence_s=5.0, publish=published.append, publish_last=lambda n, m: last.__setitem__(n, m))
+    for ev in read_trace(TRACES / "sensor_fault.jsonl", MSG):
+        live.tick(ev.time)
+        live.push("/" + ev.topic, {**ev.fields, "nan": float("nan")}, ev.time)
+    live.tick(40.0)
+    assert "RadiationSensor:" in live.status_line() and "silent:" in live.status_line()
+    record = live.stop(tmp_path / "evidence.json")
+    assert json.loads((tmp_path / "evidence.json").read_text()) == record
+    assert record["sha256"] == hashlib.sha256(log.read_bytes()).hexdigest()
+    assert record["silent_topics"] and all(s["silent"] for s in record["silent_topics"])
+    verdicts = [m for m in map(json.loads, published) if m["node"]]
+    assert len(verdicts) == record["verdicts"]
+    assert json.loads(last["RadiationSensor"]) == [m for m in verdicts if m["node"] == "RadiationSensor"][-1]
+    sensor = {n["node"]: n for n in record["nodes"]}["RadiationSensor"]
+    assert sensor["status"] == "failed" and sensor["first_violation"]["guarantee"] == 1
+    # the log re-checks offline to the same counts; its verdict lines are skipped
+    _, results = check_trace(checked, list(checked.nodes.values()), read_trace(log), cfg.rules, cfg.horizon)
+    assert {r.node: r.counts for r in results} == {n["node"]: n["counts"] for n in record["nodes"]}
+    assert sum(1 for line in log.read_text().splitlines() if VERDICT_LOG_TOPIC in line) == record["verdicts"]

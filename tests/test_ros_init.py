@@ -1,0 +1,57 @@
+"""``rclverify init DIR --from-ros PATH``: contract skeletons from the ament
+test workspace; the workspace verifies at once and is grounded (docs/ros.md)."""
+from __future__ import annotations
+
+import json
+import os
+from pathlib import Path
+
+import pytest
+
+from rclverify.cli import main
+from rclverify.ros.skeleton import rcl_scalar
+
+AMENT = Path(__file__).parent / "data" / "ros" / "ament_ws"
+
+
+def test_ros_field_types_to_rcl() -> None:
+    assert [rcl_scalar(t) for t in ("float32", "float64", "int16", "uint8", "byte", "bool", "string", "string<=8",
+                                    "geometry_msgs/msg/Point")] == \
+        ["REAL", "REAL", "INTEGER", "NATURAL", "NATURAL", "BOOL", "STRING", "STRING", None]
+
+
+def test_init_from_ros_writes_skeletons_that_verify(tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
+                                                    capsys: pytest.CaptureFixture[str]) -> None:
+    ws = tmp_path / "arm"
+    assert main(["init", str(ws), "--from-ros", str(AMENT),
+                 "--launch", str(AMENT / "src/arm_planner/launch/arm.launch.py")]) == 0
+    assert (ws / "contracts/planner.rcl").read_text().split("node Planner {\n", 1)[1].split("  //")[0] == (
+        "  inputs( jointStates : {} )\n"
+        "  outputs( jointGoal : JointGoal )\n"
+        "  topics( sensor_msgs/JointState joint_states matches(in.jointStates),\n"
+        "          arm_interfaces/JointGoal joint_goal matches(out.jointGoal) )\n")
+    assert "  JointGoal : STRING x REAL x REAL x REAL --> BOOL ;" in (ws / "contracts/ros_types.rcl").read_text()
+    plan = (ws / "contracts/plan.yaml").read_text()
+    assert "    - ros/arm_planner/launch/arm.launch.py\n" in plan
+    assert "    joint_goal: [joint, position, tolerance.lower, tolerance.upper]\n" in plan
+    assert (ws / "ros/arm_driver/src/driver.cpp").is_file()
+    capsys.readouterr()
+    monkeypatch.chdir(ws)
+    assert main(["verify"]) == 0  # doit verify runs at once
+    report = json.loads((ws / "reports/assurance.json").read_text())
+    g = report["grounding"]
+    assert g["counts"] == {"error": 0, "warning": 0}
+    assert g["matched"] == {"Driver": "/arm/driver", "Planner": "/arm/planner"}
+    # the placeholder guarantee is reported by the health check
+    assert any("Guarantee 1 of Planner" in p and "constrains no output" in p for p in report["summary"]["problems"])
+    argument = json.loads((ws / "reports/argument.json").read_text())
+    elements = argument["elements"] if isinstance(argument, dict) and "elements" in argument else argument
+    ctx = [e for e in elements if e["id"].startswith("C-ros")]
+    assert len(ctx) == 1 and ctx[0]["text"].startswith(
+        "Contracts grounded in the ROS software: arm_driver 2.0.0, arm_interfaces 2.0.1, arm_planner 2.0.1; ")
+    top = next(e for e in elements if e["id"] == "G-system")
+    assert ctx[0]["id"] in top["in_context_of"]
+    sarif = json.loads((ws / "reports/assurance.sarif").read_text())
+    assert not [r for r in sarif["runs"][0]["results"] if r["ruleId"].startswith("ROS-")]
+    assert main(["init", str(ws), "--from-ros", str(AMENT)]) == 1  # never over an existing workspace
+    os.chdir(tmp_path)
