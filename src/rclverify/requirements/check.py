@@ -83,13 +83,14 @@ def formals_of(req: Requirement, checked: Checked) -> tuple[Formal | None, list[
     return f, [parse_formal(a, checked, f"{req.id} assuming") for a in req.assuming]
 
 
-def fingerprint(req: Requirement, cone_snapshots: Sequence[str], model_json: str) -> str:
+def fingerprint(req: Requirement, cone_snapshots: Sequence[str], model_json: str, code: str = "") -> str:
     """A sha256 of everything a requirement's record is computed from: its
     statements (and where they are written) and traced guarantees, the contract snapshots of its cone
     (artifacts/contracts/<Node>.json, which include the node's plan facts) and
-    the system model.  An unchanged fingerprint means the recorded verdict
-    still holds (the ``requirements`` task re-checks only changed ones)."""
-    h = hashlib.sha256()
+    the system model, and ``code`` (the rclverify code and Z3 version that
+    decide it).  An unchanged fingerprint means the recorded verdict still
+    holds (the ``requirements`` task re-checks only changed ones)."""
+    h = hashlib.sha256(code.encode())
     h.update(json.dumps([req.id, req.text, [req.formal.text, req.formal.line, req.formal.col] if req.formal else None,
                          [[a.text, a.line, a.col] for a in req.assuming], str(req.loc),
                          [[s.node, list(s.guarantees)] for s in req.support], req.origin]).encode())

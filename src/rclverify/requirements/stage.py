@@ -46,7 +46,12 @@ def stage_requirements(ws: "Workspace", *, force: bool = False) -> list[tuple[di
     then the Doorstop items').  Raises ``RclError`` for contracts or a plan
     that do not check."""
     from ..plan.load import all_requirements
+    import z3
+
+    from ..logic.world import fresh
+    from ..wscache import code_stamp
     from .check import check_requirement, cone_of, fingerprint, formals_of
+    code = f"{code_stamp()} z3 {z3.get_version_string()}"
     checked, model, plan = ws.checked, ws.model, ws.plan
     model_text = (ws.root / ws.MODEL).read_text(encoding="utf-8") if (ws.root / ws.MODEL).is_file() else \
         json.dumps(model.to_json(), sort_keys=True)
@@ -63,13 +68,14 @@ def stage_requirements(ws: "Workspace", *, force: bool = False) -> list[tuple[di
     for req in all_requirements(plan):
         formal, assuming = formals_of(req, checked)
         cone = cone_of([formal, *assuming], model) if formal is not None else []
-        fp = fingerprint(req, [snap(n) for n in cone], model_text if formal is not None else "")
+        fp = fingerprint(req, [snap(n) for n in cone], model_text if formal is not None else "", code)
         rel = record_path(req.id)
         keep.add(rel.rsplit("/", 1)[1])
         old = None if force else _read(ws.root / rel)
         if old is not None and old.get("fingerprint") == fp:
             rec, now = old, False
         else:
+            fresh()  # each check in the same Z3 state whatever ran before it (logic/world.py)
             rec = check_requirement(req, checked, model, plan)
             smt2 = rec.pop("smt2", None)
             if smt2 is not None:
