@@ -690,9 +690,10 @@ def _build_tasks(root: str | Path, plan_file: str) -> dict[str, Callable[[], Any
 
     def task_verify() -> dict[str, Any]:
         """The whole pipeline: check, compose, health, export, run, report.  --strict fails on any open evidence."""
-        # `requirements` before `report`: reached only through the report's file dependencies, it would make
-        # report:html wait and report:text run first (their fragment caches expect html first)
-        return {"actions": [(act_verify, [r])], "task_dep": ["check", "requirements", "report"] if ok else ["check"],
+        # `requirements` (and `ground`) before `report`: reached only through the report's file dependencies,
+        # they would make report:html wait and report:text run first (their fragment caches expect html first)
+        before = ["requirements"] + (["ground"] if ros_section else [])
+        return {"actions": [(act_verify, [r])], "task_dep": ["check", *before, "report"] if ok else ["check"],
                 "file_dep": [str(rootp / REPORTS[2])] if ok else [],
                 "params": [{"name": "strict", "long": "strict", "type": bool, "default": False,
                             "help": "fail unless every obligation, side condition and health check holds"}],
