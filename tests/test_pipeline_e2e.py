@@ -147,7 +147,12 @@ def test_ci_formats_carry_the_case_study_findings_at_their_rcl_locations(workspa
     assert {r["Severity"] for r in records if r["Code"] == "RCL-OBL-PENDING"} == {"note"}
     xml = junitparser.JUnitXml.fromfile(str(reports / "assurance.junit.xml"))
     suites = {s.name: s for s in xml}
-    assert set(suites) == {"Localisation", "Navigation", "Agent", "RadiationSensor"}
+    assert set(suites) == {"Localisation", "Navigation", "Agent", "RadiationSensor", "requirements"}
+    reqs = {c.name: c for c in suites["requirements"]}
+    assert set(reqs) == {"REQ1", "REQ2", "REQ3", "REQ4"}
+    assert isinstance(reqs["REQ1"].result[0], junitparser.Failure)  # proved vacuously: not met
+    assert isinstance(reqs["REQ4"].result[0], junitparser.Skipped)  # informal
+    assert ("RCL-REQ-VACUOUS", "contracts/plan.yaml", 28) in at
     cases = {c.name: c for s in xml for c in s}
     report = json.loads((reports / "assurance.json").read_text())
     assert {o["id"] for o in report["obligations"]} | {sc["id"] for sc in report["side_conditions"]} <= set(cases)
@@ -296,9 +301,11 @@ def test_editing_one_contract_reruns_that_node_its_consumers_and_the_report(work
         ran = {l[3:] for l in r.stdout.splitlines() if l.startswith(".  ")}
         evidence = {t for t in ran if t.startswith("evidence:")}
         assert evidence and all(t.startswith("evidence:RadiationSensor.") for t in evidence)
-        # grounding reads every contract's topics (the case study's plan has a ros: section)
-        assert ran - evidence == {"check", "ground", "node:RadiationSensor", "node:Agent", "report:html", "report:text",
-                                  "verify"}
+        # `ground` too: the grounding of the plan's ros: section reads every contract (its file_dep)
+        assert ran - evidence == {"check", "node:RadiationSensor", "node:Agent", "requirements", "ground",
+                                  "report:html", "report:text", "verify"}
+        # the formal requirements whose cone holds RadiationSensor (all three: the loop), not the informal REQ4
+        assert "requirements: 3 of 4 checked (REQ1, REQ2, REQ3)" in r.stdout
         # in the node tasks, only the stages whose own inputs changed: the consumer's side conditions
         assert "RadiationSensor: compose, health, export" in r.stdout
         assert re.search(r"Agent: compose(?!,)", r.stdout)

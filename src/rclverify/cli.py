@@ -8,6 +8,7 @@
 ``rclverify health [NODE...]``     contract consistency and vacuity findings
 ``rclverify export``               export obligations to the plan's backends
 ``rclverify report``               rebuild reports/ from the artifacts
+``rclverify requirements``         check each formal requirement with Z3 and print its status
 ``rclverify verify [--strict] [--no-wait]``  the whole pipeline through doit (one run at a time per workspace)
 ``rclverify refines A.rcl:N B.rcl:M``  may contract M replace contract N?
 ``rclverify init DIR [--nodes A,B]``  write a new workspace that verifies at once
@@ -151,6 +152,18 @@ def cmd_export(args: argparse.Namespace) -> int:
         for o in stage_export(ws, n):
             print(f"{o['id']}  [{o['backend']}]  {o['artifact'] or ''}")
     return 0
+
+
+def cmd_requirements(args: argparse.Namespace) -> int:
+    """Check the requirements (only those whose inputs changed, unless
+    ``--force``) and print each with its status; exit 1 when one is refuted,
+    proved from an inconsistency or inconclusive."""
+    from .requirements.show import show_requirements
+    from .pipeline import stage_check, stage_requirements
+    ws = _ws(args)
+    stage_check(ws)
+    stage_requirements(ws, force=args.force)
+    return show_requirements(ws, sys.stdout)
 
 
 def cmd_report(args: argparse.Namespace) -> int:
@@ -348,6 +361,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     add("health", cmd_health, "contract consistency and vacuity checks", True).add_argument("nodes", nargs="*")
     add("export", cmd_export, "export obligations to the plan's backends", True)
     add("report", cmd_report, "rebuild the assurance report from the artifacts", True)
+    add("requirements", cmd_requirements, "check each formal requirement with Z3 from the composed contracts and "
+        "print its status", True).add_argument("--force", action="store_true", help="check every requirement again")
     v = add("verify", cmd_verify, "run the whole pipeline with doit", True)
     v.add_argument("--strict", action="store_true",
                    help="exit 1 unless every obligation, side condition and health check holds")

@@ -16,6 +16,7 @@ Artifact layout (workspace-relative)::
     artifacts/health/<Node>.json         contract health findings
     artifacts/obligations/<Node>.json    exported obligations of the node
     artifacts/evidence/<obligation>.json one evidence record per obligation
+    artifacts/requirements/<ID>.json     a requirement's Z3 check (proved/refuted/...)
 """
 from __future__ import annotations
 
@@ -69,6 +70,8 @@ class TaskIndex:
     contracts: tuple[str, ...]
     replacement: dict[str, str]
     entries: dict[str, tuple[Any, ...]]
+    #: The plan's ``requirements_from`` Doorstop folders (their files are inputs of ``requirements``).
+    requirement_dirs: tuple[str, ...] = ()
 
 
 @dataclass
@@ -116,7 +119,8 @@ class Workspace:
         return TaskIndex(
             nodes=tuple(self.checked.nodes), producers={n: tuple(model.producers(n)) for n in self.checked.nodes},
             contracts=tuple(plan.contracts), replacement={n: r[0].rpartition(":")[0] for n, r in plan.replacements.items()},
-            entries={n: tuple(e.config for e in es) for n, es in plan.evidence.items()})
+            entries={n: tuple(e.config for e in es) for n, es in plan.evidence.items()},
+            requirement_dirs=tuple(d for d, _ in plan.requirements_from))
 
     @cached_property
     def checked(self) -> Checked:
@@ -472,6 +476,12 @@ def stage_run(ws: Workspace, node: str, obligation_id: str) -> Evidence:
     ev = get_backend(o.backend).run(o, ws.target(node, int(o.data.get("entry", 0))))
     EvidenceStore(ws.root).put(ev)
     return ev
+
+
+def stage_requirements(ws: Workspace, *, force: bool = False) -> list[tuple[dict[str, Any], bool]]:
+    """Check every requirement with Z3; see :mod:`rclverify.requirements.stage`."""
+    from .requirements.stage import stage_requirements as run
+    return run(ws, force=force)
 
 
 #: The report's files under ``reports/`` in two parts, each written by a doit task of its own

@@ -13,6 +13,9 @@ Stages and their real file dependencies, per node ``N``:
                    export   snapshot of N + the backend input files -> obligations/N.json
 ``evidence:ID``     one obligation's record + the files it reads -> its evidence record
                    (created after ``node`` ran, when the obligations are known)
+``requirements``   plan + model + contract snapshots (+ Doorstop files) ->
+                   artifacts/requirements/<ID>.json; inside, only requirements whose
+                   cone's snapshots or statements changed are checked again
 ``report:html``    every artifact above -> reports/assurance.{html,json}, the CI formats
                    reports/assurance.sarif, assurance.junit.xml, argument.svg
 ``report:text``    every artifact above -> reports/assurance.md, argument.{json,gsn.yaml,dot}
@@ -218,6 +221,19 @@ def act_report(root: str, part: str) -> Any:
     return None
 
 
+def act_requirements(root: str) -> Any:
+    """Check the requirements whose inputs changed (:mod:`rclverify.requirements.stage`)."""
+    from .pipeline import stage_requirements
+    try:
+        rows = stage_requirements(_ws(root))
+    except RclError as exc:
+        return _fail(exc)
+    again = [rec["id"] for rec, now in rows if now]
+    print(f"requirements: {len(again)} of {len(rows)} checked" + (f" ({', '.join(again[:10])}"
+                                                                  + (", ..." if len(again) > 10 else "") + ")" if again else ""))
+    return None
+
+
 def act_ground(root: str) -> Any:
     """The grounding stage (docs/ros.md): scan the plan's ``ros:`` section,
     hold the contracts against it; findings go to the report, never to a verdict."""
@@ -265,11 +281,26 @@ def act_verify(root: str, strict: bool) -> Any:
     print(f"overall: {s['status']} -- {s['headline']}")
     for p in s["problems"]:
         print(f"  problem: {p}")
+    if data.get("requirements"):
+        print(requirements_line(data["requirements"]))
     print_summary(data, "reports/assurance.html", rows=data["rows"])
     if strict and not data["meta"]["strict_ok"]:
         return TaskFailed("--strict: some evidence is failed, inconclusive, pending, stale or error, or a side condition "
                           "or contract health check is not proved (see reports/assurance.html)")
     return None
+
+
+def requirements_line(rows: Sequence[Sequence[str]]) -> str:
+    """``requirements: 1 met, 1 refuted (STOP), 1 informal`` from the summary's
+    ``[id, verdict, status]`` rows (docs/requirements.md), verdicts in order of
+    first appearance; the ids of those that are not met, informal or
+    outstanding are named."""
+    by: dict[str, list[str]] = {}
+    for rid, verdict, _ in rows:
+        by.setdefault(verdict or "traced", []).append(rid)
+    named = ("refuted", "proved from an inconsistency", "proved vacuously", "inconclusive")
+    return "requirements: " + ", ".join(f"{len(ids)} {v}" + (f" ({', '.join(ids[:5])}{', ...' if len(ids) > 5 else ''})"
+                                                            if v in named else "") for v, ids in by.items())
 
 
 class RecordIntact:
@@ -566,6 +597,21 @@ def _build_tasks(root: str | Path, plan_file: str) -> dict[str, Callable[[], Any
                    "targets": [at(ws.calculus(n)), at(ws.health(n)), at(ws.obligations(n))],
                    "uptodate": [code], "verbosity": 2, "clean": True}
 
+    def task_requirements() -> dict[str, Any]:
+        """Check each requirement's formal statement with Z3 from the guarantees of its cone.  Defined before
+        the evidence and report tasks: doit orders tasks by where their creators are defined, and the
+        report parts must run in their usual order after it (their fragment caches, report/fragments.py)."""
+        assert index is not None
+        from .requirements.stage import INDEX
+        extra: list[str] = []
+        if index.requirement_dirs:
+            from .plan.doorstop import doorstop_files
+            for d in index.requirement_dirs:
+                extra += [str(rootp / f) for f in doorstop_files(rootp, d)]
+        return {"actions": [(act_requirements, [r])],
+                "file_dep": [str(rootp / plan_file), at(ws.MODEL)] + list(snap.values()) + extra,
+                "targets": [at(INDEX)], "uptodate": [code], "verbosity": 2, "clean": True}
+
     exported_memo: list[list[tuple[str, dict[str, Any]]]] = []
 
     def exported() -> list[tuple[str, dict[str, Any]]]:
@@ -632,6 +678,7 @@ def _build_tasks(root: str | Path, plan_file: str) -> dict[str, Callable[[], Any
         for n in nodes:
             deps += [at(ws.calculus(n)), at(ws.health(n)), at(ws.obligations(n))]
         deps += [at(ws.evidence(o["id"])) for _, o in exported()]
+        deps.append(at("artifacts/requirements/index.json"))  # the requirements task's target
         if ros_section:
             deps.append(at("artifacts/ros/grounding.json"))
         for part, files in REPORT_PARTS.items():
@@ -643,7 +690,10 @@ def _build_tasks(root: str | Path, plan_file: str) -> dict[str, Callable[[], Any
 
     def task_verify() -> dict[str, Any]:
         """The whole pipeline: check, compose, health, export, run, report.  --strict fails on any open evidence."""
-        return {"actions": [(act_verify, [r])], "task_dep": ["check", "report"] if ok else ["check"],
+        # `requirements` (and `ground`) before `report`: reached only through the report's file dependencies,
+        # they would make report:html wait and report:text run first (their fragment caches expect html first)
+        before = ["requirements"] + (["ground"] if ros_section else [])
+        return {"actions": [(act_verify, [r])], "task_dep": ["check", *before, "report"] if ok else ["check"],
                 "file_dep": [str(rootp / REPORTS[2])] if ok else [],
                 "params": [{"name": "strict", "long": "strict", "type": bool, "default": False,
                             "help": "fail unless every obligation, side condition and health check holds"}],
@@ -651,8 +701,8 @@ def _build_tasks(root: str | Path, plan_file: str) -> dict[str, Callable[[], Any
 
     creators: dict[str, Callable[[], Any]] = {"task_check": task_check, "task_verify": task_verify}
     if ok:
-        creators.update({"task_graph": task_graph, "task_node": task_node, "task_evidence": task_evidence,
-                         "task_report": task_report})
+        creators.update({"task_graph": task_graph, "task_node": task_node, "task_requirements": task_requirements,
+                         "task_evidence": task_evidence, "task_report": task_report})
         if ros_section:
             creators["task_ground"] = task_ground
     return creators

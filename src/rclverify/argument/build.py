@@ -58,6 +58,53 @@ def _clip(text: str, n: int = 400) -> str:
     return text if len(text) <= n else text[: n - 3] + "..."
 
 
+ENTAILMENT = ("Z3 decides the requirement from the guarantees of the nodes it mentions and of every node upstream "
+              "of them, the environment assumptions and facts of those nodes and the requirement's own assumptions "
+              "(docs/requirements.md); the proof is only as good as the evidence of the guarantees it used and the "
+              "consistency of its premises.")
+_PROOF_STATUS = {"met": "discharged", "proved, evidence outstanding": "discharged",
+                 "proved from an inconsistency": "failed", "proved vacuously": "failed", "refuted": "failed", "inconclusive": "inconclusive"}
+
+
+def _requirement_goal(b: "_Builder", r: Mapping[str, Any], guarantee_goal: Mapping[tuple[str, int], str],
+                      sides: Mapping[str, list[Mapping[str, Any]]], j_calc: str) -> str:
+    """The goal of a requirement the report's requirement check decided
+    (its ``verdict``): an informal one is an undeveloped goal; a formal one is
+    supported by a formal-entailment strategy whose children are the Z3
+    proof (a solution with the check's verdict) and the goals of the
+    guarantees the proof used, with the side conditions of their nodes."""
+    rid = str(r["id"])
+    c = r.get("check") or {}
+    if r["verdict"] == "informal":
+        traced = ", ".join(f"{s['node']} guarantee {s['guarantee']}" for s in r["support"]) or "no guarantee"
+        return b.add(Element(ident("G", rid), "goal",
+                             _clip(f"{rid}: {r['text']} (informal: no formal statement; traced to {traced})"),
+                             undeveloped=True, ref=rid))
+    sn = b.add(Element(ident("Sn", "req", rid), "solution",
+                       _clip(f"Z3 {('proof' if r['verdict'] in ('met', 'proved, evidence outstanding') else 'check')} "
+                             f"of {rid} ({c.get('smt2') or 'not checked yet'}): {r['verdict']}. {r['note']}"),
+                       status=_PROOF_STATUS.get(str(r["verdict"]), "pending"), ref=rid, url=str(c.get("smt2") or "")))
+    kids = [sn]
+    nodes_used: list[str] = []
+    for p in c.get("used") or []:
+        if p.get("kind") == "guarantee" and (str(p["node"]), int(p["index"])) in guarantee_goal:
+            kids.append(guarantee_goal[(str(p["node"]), int(p["index"]))])
+            if p["node"] not in nodes_used:
+                nodes_used.append(str(p["node"]))
+    for name in nodes_used:
+        kids += [ident("G", "sc", sc["id"]) for sc in sides.get(name, [])]
+    ctx = [j_calc] + [b.add(Element(ident("A", rid, "assuming", k), "assumption",
+                                    _clip(f"{rid} assumes: {a}"), ref=rid))
+                      for k, a in enumerate(c.get("assuming") or [], 1)]
+    strategy = b.add(Element(
+        ident("S", rid), "strategy",
+        _clip(f"Argument by formal entailment: {c.get('formal')} follows from the premises Z3 used"
+              + (f" ({', '.join(p['label'] for p in c.get('used') or [])})" if c.get("used") else "")
+              + ". " + ENTAILMENT),
+        supported_by=tuple(dict.fromkeys(kids)), in_context_of=tuple(ctx), ref=rid))
+    return b.add(Element(ident("G", rid), "goal", _clip(f"{rid}: {r['text']}"), supported_by=(strategy,), ref=rid))
+
+
 class _Builder:
     def __init__(self) -> None:
         self.els: dict[str, Element] = {}
@@ -188,6 +235,9 @@ def build_argument(report: Mapping[str, Any]) -> Argument:
     req_goals = []
     for r in reqs:
         rid = str(r["id"])
+        if "verdict" in r:  # checked by Z3 (docs/requirements.md): entailment, or undeveloped
+            req_goals.append(_requirement_goal(b, r, guarantee_goal, sides, j_calc))
+            continue
         kids: list[str] = []
         nodes_used: list[str] = []
         for s in r["support"]:

@@ -6,7 +6,8 @@ Collected (workspace-relative POSIX paths, sorted):
   such as the temporary files of atomic writes, are left out, and so is
   ``artifacts/cache/``: a machine-local speed-up holding pickled data, which
   an assessor must never be handed to load);
-* the plan, its contract files and replacement contracts;
+* the plan, its contract files and replacement contracts, and the
+  Doorstop folders it reads requirements from (``requirements_from``);
 * every file the plan's evidence entries name (a directory contributes the
   files under it; the same paths :mod:`rclverify.plan.paths` checks), and
   every input an evidence record was hashed over;
@@ -59,6 +60,10 @@ def _named(plan: Plan) -> set[str]:
     """Workspace-relative paths the plan names (contracts, replacements, evidence inputs)."""
     out = {plan.file, *plan.contracts}
     out.update(spec.rpartition(":")[0] for spec, _ in plan.replacements.values())
+    if plan.requirements_from:  # Doorstop trees: their items are requirements (with each .doorstop.yml)
+        from ..plan.doorstop import doorstop_files
+        for folder, _ in plan.requirements_from:
+            out.update(doorstop_files(plan.root, folder) or [folder])
 
     def walk(v: Any) -> None:
         if isinstance(v, str) and looks_like_path(plan.root, v):

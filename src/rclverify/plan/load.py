@@ -22,6 +22,7 @@ from ..rcl import ast
 from ..rcl.errors import Diagnostic, RclError
 from ..rcl.types import BOOL, Checked
 from .errors import PlanError, plan_error
+from .formal import Source
 from .yamlguard import KEY, Blocks, compose_guarded, read_yaml_text, to_data
 
 Path_ = tuple[Any, ...]
@@ -39,10 +40,21 @@ class Support:
 
 @dataclass(frozen=True)
 class Requirement:
+    """A requirement of the plan (or of a Doorstop item, :mod:`.doorstop`).
+
+    ``formal`` is its formal statement (``None``: informal, traced only) and
+    ``assuming`` its own environment assumptions, both RCL over
+    ``Node.in.x``/``Node.out.y`` (:mod:`.formal`); ``origin`` is ``"plan"``
+    or the Doorstop item's workspace-relative file.
+    """
+
     id: str
     text: str
     support: tuple[Support, ...]
     loc: ast.Loc
+    formal: Source | None = None
+    assuming: tuple[Source, ...] = ()
+    origin: str = "plan"
 
 
 @dataclass(frozen=True)
@@ -98,6 +110,9 @@ class Plan:
     name: str = ""
     #: the ``ros:`` section as written (grounding, docs/ros.md); empty when absent
     ros: Mapping[str, Any] = field(default_factory=dict)
+    #: ``requirements_from: {doorstop: DIR}``: Doorstop document trees read for
+    #: more requirements (:func:`.doorstop.read_requirements`), with the entry's location.
+    requirements_from: tuple[tuple[str, ast.Loc], ...] = ()
 
 
 def _schema() -> dict[str, Any]:
@@ -182,7 +197,13 @@ def load_plan(root: Path, plan_rel: str = "contracts/plan.yaml") -> Plan:
     for i, r in enumerate(data.get("requirements", [])):
         sup = tuple(Support(s["node"], tuple(s["guarantees"]), loc("requirements", i, "supported_by", j))
                     for j, s in enumerate(r.get("supported_by", [])))
-        reqs.append(Requirement(str(r["id"]), str(r["text"]).strip(), sup, loc("requirements", i)))
+        formal = _source(("requirements", i, "formal"), r, "formal", locs, blocks, plan_rel)
+        assuming = r.get("assuming", [])
+        assuming = [assuming] if isinstance(assuming, str) else assuming
+        srcs = tuple(_source(("requirements", i, "assuming") + ((j,) if isinstance(r["assuming"], list) else ()),
+                             {"v": a}, "v", locs, blocks, plan_rel) for j, a in enumerate(assuming))
+        reqs.append(Requirement(str(r["id"]), str(r["text"]).strip(), sup, loc("requirements", i), formal,
+                                tuple(x for x in srcs if x is not None)))
     conns = []
     for i, c in enumerate(data.get("connections", []) or []):
         fn, fv = c["from"].split(".", 1)
@@ -220,8 +241,56 @@ def load_plan(root: Path, plan_rel: str = "contracts/plan.yaml") -> Plan:
                                for i, e in enumerate(spec.get("evidence", [])))
         if "replacement" in spec:
             replacements[node] = (spec["replacement"], loc("nodes", node, "replacement"))
+    rfrom = tuple((str(v), loc("requirements_from", k)) for k, v in (data.get("requirements_from") or {}).items())
     return Plan(plan_rel, root, contracts, tuple(reqs), tuple(conns), facts, instances, evidence, replacements, locs,
-                str(data.get("name", "")), dict(data.get("ros") or {}))
+                str(data.get("name", "")), dict(data.get("ros") or {}), rfrom)
+
+
+def _source(path: Path_, holder: Mapping[str, Any], key: str, locs: Mapping[Path_, ast.Loc], blocks: Blocks,
+            file: str) -> Source | None:
+    """The :class:`~.formal.Source` of a formula written at ``path`` of the
+    plan (``holder[key]``), or ``None`` when absent: a block scalar is read
+    from its source lines, so every diagnostic maps onto the plan file."""
+    if key not in holder:
+        return None
+    block = blocks.get(path)
+    if block is not None:
+        return Source(block[1], block[0], 1, file)
+    l = locs.get(path, ast.Loc(file, 1, 1))
+    return Source(str(holder[key]), l.line, l.col, file)
+
+
+def all_requirements(plan: Plan) -> tuple[Requirement, ...]:
+    """The plan's requirements, then those of its ``requirements_from``
+    Doorstop trees (:mod:`.doorstop`).  Raises :class:`PlanError` when a tree
+    cannot be read."""
+    out = list(plan.requirements)
+    if plan.requirements_from:
+        from .doorstop import read_requirements
+        for folder, l in plan.requirements_from:
+            out.extend(read_requirements(plan.root, folder, l))
+    return tuple(out)
+
+
+def check_formal(reqs: tuple[Requirement, ...], checked: Checked) -> list[Diagnostic]:
+    """Located errors of the requirements' ids (each once) and formal
+    statements (:func:`.formal.parse_formal`: unknown node or variable, an
+    input written as an output, a type error)."""
+    from .formal import parse_formal
+    diags: list[Diagnostic] = []
+    seen: dict[str, Requirement] = {}
+    for r in reqs:
+        if r.id in seen:
+            o = seen[r.id]
+            diags.extend(plan_error(r.loc.file, r.loc.line, r.loc.col, f"requirement id {r.id!r} is used twice "
+                                    f"(first at {o.loc.file}:{o.loc.line}:{o.loc.col})").diagnostics)
+        seen.setdefault(r.id, r)
+        for src, what in ([(r.formal, f"{r.id} formal")] if r.formal else []) + [(a, f"{r.id} assuming") for a in r.assuming]:
+            try:
+                parse_formal(src, checked, what)
+            except RclError as exc:
+                diags.extend(exc.diagnostics)
+    return diags
 
 
 def resolve(plan: Plan, checked: Checked) -> None:
@@ -249,13 +318,19 @@ def resolve(plan: Plan, checked: Checked) -> None:
         bad(l, f"no node named {name!r} in the contracts; nodes are: {', '.join(nodes)}")
         return False
 
-    for r in plan.requirements:
+    try:
+        reqs = all_requirements(plan)
+    except PlanError as exc:
+        diags.extend(exc.diagnostics)
+        reqs = plan.requirements
+    for r in reqs:
         for s in r.support:
             if node_ok(s.node, s.loc):
                 n = len(nodes[s.node].node.guarantees)
                 for g in s.guarantees:
                     if not 1 <= g <= n:
                         bad(s.loc, f"{r.id}: node {s.node} has {n} guarantee(s); there is no guarantee {g}")
+    diags.extend(check_formal(reqs, checked))
     for c in plan.connections:
         if node_ok(c.from_node, c.loc) and node_ok(c.to_node, c.loc):
             ot = nodes[c.from_node].outputs.get(c.from_var)

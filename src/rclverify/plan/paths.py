@@ -93,6 +93,7 @@ def check_plan_paths(root: Path, plan_rel: str, data: Mapping[str, Any], locs: M
     :class:`PlanError` listing every path that leaves the workspace.
     """
     candidates: list[tuple[Path_, str]] = [(("contracts", i), c) for i, c in enumerate(data.get("contracts") or [])]
+    candidates += [(("requirements_from", k), v) for k, v in (data.get("requirements_from") or {}).items()]
     for node, spec in (data.get("nodes") or {}).items():
         if isinstance(spec.get("replacement"), str):
             candidates.append((("nodes", node, "replacement"), spec["replacement"].rpartition(":")[0]))

@@ -257,7 +257,10 @@ def build_report(ws: Workspace) -> dict[str, Any]:
         })
 
     requirements: list[dict[str, Any]] = []
-    for r in plan.requirements:
+    from ..plan.load import all_requirements
+    from ..requirements.stage import read_records
+    checks = read_records(ws)
+    for r in all_requirements(plan):
         support: list[dict[str, Any]] = []
         for s in r.support:
             for k in s.guarantees:
@@ -266,7 +269,8 @@ def build_report(ws: Workspace) -> dict[str, Any]:
                                 "status": g_status(s.node, k),
                                 "obligations": sorted(o.id for o in obligations if applies(o, s.node, k))})
         st = worst([x["status"] for x in support] + [sc_status[x["node"]] for x in support]) if support else "pending"
-        requirements.append({"id": r.id, "text": r.text, "status": st, "support": support})
+        requirements.append({"id": r.id, "text": r.text, "status": st, "support": support,
+                             **requirement_check(current_record(r, checks.get(r.id)), st, g_status, sc_status)})
 
     derived = []
     cones, cone_of = ConeEvidence(model.nodes, node_evidence, sc_status), model.upstream_masks()
@@ -297,6 +301,9 @@ def build_report(ws: Workspace) -> dict[str, Any]:
         elif f["status"] == "stale":
             problems.append(f"Contract health of {f['node']} is stale: made for another text of its contract or plan "
                             "(run `doit verify`)")
+    for rq in requirements:
+        if rq["verdict"] in ("refuted", "proved from an inconsistency", "proved vacuously"):
+            problems.append(f"Requirement {rq['id']} is {rq['verdict']}: {_brief(rq['note'])}")
     for sc in side_conditions:
         if sc["status"] != "discharged":
             problems.append(f"Side condition {sc['id']} is {sc['status']}: {sc['conjunct']}")
@@ -344,6 +351,38 @@ def build_report(ws: Workspace) -> dict[str, Any]:
         "environment_assumptions": env_assumptions, "pending": pending, "lint": lint_rows,
         "expected_verdicts": expected, "grounding": grounding,
     }
+
+
+#: The fields of a requirement's check record (requirements/check.py) the report carries.
+_CHECK_FIELDS = ("origin", "source", "formal", "assuming", "cone", "used", "traced_not_needed", "consistency",
+                 "inconsistent_core", "vacuity", "vacuity_core", "counterexample", "failed_to_prevent", "reason", "smt2", "explanation",
+                 "duration_s")
+
+
+def current_record(req: Any, record: Mapping[str, Any] | None) -> Mapping[str, Any] | None:
+    """``record`` when it was made from ``req``'s current statements (else
+    ``None``: not checked yet, e.g. ``rclverify report`` after a plan edit,
+    before the ``requirements`` stage ran); an informal requirement needs no
+    record."""
+    formal = " ".join(req.formal.text.split()) if req.formal else None
+    if record is not None and record.get("formal") == formal \
+            and record.get("assuming", []) == [" ".join(a.text.split()) for a in req.assuming]:
+        return record
+    if formal is None:
+        return {"verdict": "informal", "source": f"{req.loc.file}:{req.loc.line}:{req.loc.col}", "origin": req.origin}
+    return None
+
+
+def requirement_check(record: Mapping[str, Any] | None, traced_status: str, g_status: Any,
+                      sc_status: Mapping[str, str]) -> dict[str, Any]:
+    """The requirement row's fields from its Z3 check: ``verdict`` (met /
+    proved, evidence outstanding / proved from an inconsistency / refuted /
+    inconclusive / informal), ``status`` (only ``met`` is ``discharged``),
+    ``note`` and the check's details (:mod:`rclverify.requirements.rollup`)."""
+    from ..requirements.rollup import roll_up
+    verdict, status, note = roll_up(record, g_status, sc_status, traced_status)
+    details = {k: (record or {}).get(k) for k in _CHECK_FIELDS}
+    return {"status": status, "verdict": verdict, "note": note, "check": details}
 
 
 def _headline(ob_rows: list[dict[str, Any]], counts: dict[str, int], side_conditions: list[dict[str, Any]],

@@ -15,7 +15,15 @@ nothing itself.  Layout (decisions in ``docs/ci.md``):
   counterexample (or unsat core); ``stale`` is a ``<failure>`` of type
   ``stale`` (the evidence no longer vouches for the current inputs);
   ``error`` is an ``<error>``; ``pending`` and ``inconclusive`` are
-  ``<skipped>`` with the reason.
+  ``<skipped>`` with the reason;
+* after the nodes, when the plan has requirements, one ``<testsuite>``
+  named ``requirements`` with one ``<testcase>`` per requirement
+  (``classname`` ``requirement``, name its id, at its formal statement):
+  it passes only when the requirement is ``met``; a refuted one (or one
+  proved from an inconsistency) is a ``<failure>`` with the counterexample
+  node by node; outstanding evidence and inconclusive are ``<skipped>``
+  (a ``<failure>`` when evidence the proof rests on failed), informal
+  ones ``<skipped>``.
 
 ``time`` is the recorded duration of the check in seconds (0 when the
 record has none).  The XML is built with :mod:`xml.etree.ElementTree`, so
@@ -76,10 +84,49 @@ def junit_tree(report: Mapping[str, Any]) -> ET.Element:
         for k, v in counts.items():
             totals[k] += v
         total_time += time
+    req = _requirements_suite(report)
+    if req is not None:
+        root.append(req[0])
+        for k, v in req[1].items():
+            totals[k] += v
+        total_time += req[2]
     for k, v in totals.items():
         root.set(k, str(v))
     root.set("time", f"{total_time:.3f}")
     return root
+
+
+def _requirements_suite(report: Mapping[str, Any]) -> tuple[ET.Element, dict[str, int], float] | None:
+    """The ``requirements`` ``<testsuite>`` (module docstring), its counts and
+    time; ``None`` when the report has no requirements."""
+    reqs = report.get("requirements") or []
+    if not reqs:
+        return None
+    suite = ET.Element("testsuite", {"name": "requirements"})
+    counts = {"tests": 0, "failures": 0, "errors": 0, "skipped": 0}
+    time = 0.0
+    for r in reqs:
+        c = r.get("check") or {}
+        secs = float(c.get("duration_s") or 0.0) if isinstance(c.get("duration_s"), (int, float)) else 0.0
+        case = _case(suite, "requirement", str(r["id"]), str(c.get("source") or ""), secs)
+        cex = "; ".join(f"{row['node']}: " + ", ".join(f"{k} = {v}" for k, v in row["values"].items())
+                        for row in c.get("counterexample") or [])
+        used = "; ".join(f"{p['label']} ({p['source']})" for p in c.get("used") or [])
+        prevent = "; ".join(f"{p['label']}: {p['text']} ({p['source']})" for p in c.get("failed_to_prevent") or [])
+        counts["tests"] += 1
+        time += secs
+        bumped = _outcome(case, str(r["status"]), f"{r['verdict']}: {r['note']}",
+                          _lines(f"requirement {r['id']}: {r['text']}",
+                                 f"formal: {c['formal']}" if c.get("formal") else "",
+                                 f"verdict: {r['verdict']}", str(r["note"]),
+                                 f"used: {used}" if used else "", f"counterexample: {cex}" if cex else "",
+                                 f"not prevented by: {prevent}" if prevent else ""))
+        if bumped:
+            counts[bumped] += 1
+    for k, v in counts.items():
+        suite.set(k, str(v))
+    suite.set("time", f"{time:.3f}")
+    return suite, counts, time
 
 
 def _suite_data(report: Mapping[str, Any]) -> list[tuple[Mapping[str, Any], dict[str, Any]]]:
@@ -183,6 +230,13 @@ def render_junit(report: Mapping[str, Any], fragments: FragmentCache | None = No
         for k, v in piece["counts"].items():
             totals[k] += v
         total_time += piece["time"]
+    req = _requirements_suite(report)
+    if req is not None:
+        ET.indent(req[0], level=1)
+        texts.append(ET.tostring(req[0], encoding="unicode"))
+        for k, v in req[1].items():
+            totals[k] += v
+        total_time += req[2]
     root = ET.Element("testsuites", {"name": f"rclverify: {report['meta']['workspace']}"})
     for k, v in totals.items():
         root.set(k, str(v))

@@ -80,7 +80,27 @@ RULES: Mapping[str, Rule] = {r.id: r for r in (
          "The side condition was decided for another text of the contracts or plan than the current one."),
     Rule("RCL-HEALTH-STALE", "HealthStale", "warning",
          "The contract health check was made for another text of the contract or plan than the current one."),
+    Rule("RCL-REQ-REFUTED", "RequirementRefuted", "error",
+         "Z3 found a counterexample to a formal requirement that the guarantees of its cone allow: the composed "
+         "contracts do not meet it."),
+    Rule("RCL-REQ-INCONSISTENT", "RequirementProvedFromInconsistency", "error",
+         "A formal requirement is proved only because the premises its proof used contradict each other: it holds "
+         "vacuously, not because the system meets it."),
+    Rule("RCL-REQ-VACUOUS", "RequirementProvedVacuously", "error",
+         "A formal requirement of the form P -> Q is proved only because P can never hold with the premises of its "
+         "cone: it never applies."),
+    Rule("RCL-REQ-INCONCLUSIVE", "RequirementInconclusive", "warning",
+         "Z3 could not decide a formal requirement (or whether the premises of its proof are consistent)."),
+    Rule("RCL-REQ-EVIDENCE", "RequirementEvidenceOutstanding", "note",
+         "A formal requirement is proved from the guarantees, but the evidence of the guarantees its proof used "
+         "is not all discharged."),
+    Rule("RCL-REQ-INFORMAL", "RequirementInformal", "note",
+         "A requirement has no formal statement: it is traced to guarantees, never checked, never met."),
 )}
+_REQUIREMENT_RULE = {"refuted": "RCL-REQ-REFUTED", "proved from an inconsistency": "RCL-REQ-INCONSISTENT",
+                     "proved vacuously": "RCL-REQ-VACUOUS",
+                     "inconclusive": "RCL-REQ-INCONCLUSIVE", "proved, evidence outstanding": "RCL-REQ-EVIDENCE",
+                     "informal": "RCL-REQ-INFORMAL"}
 
 _HEALTH_RULE = {"assumption-satisfiable": "RCL-HEALTH-UNSATISFIABLE-ASSUMPTION",
                 "contract-consistent": "RCL-HEALTH-INCONSISTENT",
@@ -166,6 +186,30 @@ def _side_condition_results(report: Mapping[str, Any]) -> list[dict[str, Any]]:
         props = {"sideCondition": sc["id"], "node": sc["node"], "rule": sc["rule"], "status": status}
         out.append(_result(rule, RULES[rule].level, " ".join(words), str(sc["source"]), f"side-condition:{sc['id']}",
                            props))
+    return out
+
+
+def _requirement_results(report: Mapping[str, Any]) -> list[dict[str, Any]]:
+    """One result per requirement that is not met, at its formal statement
+    (the plan, or the Doorstop item's file); a refuted one carries the
+    counterexample node by node and the guarantees that did not prevent it."""
+    out = []
+    for r in report.get("requirements", ()):
+        rule = _REQUIREMENT_RULE.get(str(r.get("verdict")))
+        if rule is None:
+            continue
+        c = r.get("check") or {}
+        words = [f"Requirement {r['id']} is {r['verdict']}" + (f": {c['formal']}." if c.get("formal") else ".")]
+        words.append(str(r["note"]) + ".")
+        if c.get("counterexample"):
+            words.append("Counterexample: " + "; ".join(
+                f"{row['node']}: " + ", ".join(f"{k} = {v}" for k, v in row["values"].items())
+                for row in c["counterexample"]) + ".")
+        for p in c.get("failed_to_prevent") or []:
+            words.append(f"Not prevented by {p['label']} ({p['text']}, {p['source']}).")
+        props = {"requirement": r["id"], "verdict": r["verdict"], "status": r["status"]}
+        out.append(_result(rule, RULES[rule].level, " ".join(words), str(c.get("source") or ""),
+                           f"requirement:{r['id']}", props))
     return out
 
 
@@ -257,7 +301,8 @@ def sarif_log(report: Mapping[str, Any]) -> dict[str, Any]:
     """
     lint, lint_rules = _lint_results(report)
     ground, ground_rules = _grounding_results(report)
-    results = _obligation_results(report) + _side_condition_results(report) + _finding_results(report) + lint + ground
+    results = (_obligation_results(report) + _side_condition_results(report) + _finding_results(report) + lint + ground
+               + _requirement_results(report))
     rules: Sequence[Rule] = list(RULES.values()) + lint_rules + ground_rules
     index = {r.id: i for i, r in enumerate(rules)}
     for res in results:

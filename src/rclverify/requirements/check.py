@@ -1,0 +1,257 @@
+"""Decide a formal requirement from the composed contracts with Z3.
+
+For a requirement ``R`` (its ``formal:`` statement, :mod:`rclverify.plan.formal`)
+the premises are, over the **cone**: the nodes ``R`` (or its ``assuming:``)
+mentions and every node upstream of them (``SystemModel.upstream``, the cone
+of the calculus's derived properties, paper lines 556-768):
+
+* every guarantee of every node of the cone (``Node guarantee k``);
+* the connections: a consumer's input is the same Z3 symbol as the producer
+  output feeding it (``SystemModel.alias``), so they are no formulas of
+  their own;
+* the environment conjuncts of the cone's assumptions (those over inputs
+  nothing in the system produces: what the calculus leaves to the user,
+  ``split_assumption``) and the plan's environment facts of the cone's nodes;
+* the requirement's own ``assuming:`` formulas.
+
+The internal conjuncts of the assumptions are not premises: the calculus
+discharges them as side conditions from the producers' guarantees, and a
+guarantee used by a proof only counts once its node's side conditions are
+discharged (the roll-up, :mod:`.rollup`).
+
+One labelled satisfiability query of ``premises and not R`` decides it:
+
+``proved``        unsat.  The unsat core, mapped back to the labelled premises
+                  with their RCL source locations, is what the proof used; the
+                  traced (``supported_by``) guarantees outside it are listed as
+                  not needed.  A second query checks the used premises without
+                  ``not R``: unsat means the proof rests on an inconsistency
+                  (``consistency: inconsistent``, with that core), and the
+                  requirement holds only vacuously.
+``refuted``       sat.  The model is the counterexample, every I/O variable of
+                  the cone in RCL names, node by node (a consumer's input shows
+                  the value of the output it reads); the guarantees that failed
+                  to prevent it are those of the cone that constrain a variable
+                  ``R`` mentions, the traced ones first.
+``inconclusive``  unknown (budget, quantifiers): never proved.
+"""
+from __future__ import annotations
+
+import hashlib
+import json
+from typing import Any, Sequence
+
+import z3
+
+from ..calculus.compose import split_assumption
+from ..logic.encode import Encoder
+from ..logic.query import DEFAULT_TIMEOUT_MS, satisfiable, solver_session
+from ..plan.formal import Formal, parse_formal
+from ..plan.load import Plan, Requirement
+from ..rcl import ast
+from ..rcl.printer import expr_to_rcl
+from ..rcl.types import Checked, CheckedNode
+from ..rcl.walk import subexpressions
+from ..system.model import SystemModel
+
+NEGATED = "negated requirement"
+#: The first attempt's budget of the consistency and vacuity queries, which
+#: look for a model (sat): Z3's default strategy rarely finds a model of a
+#: quantified formula it did not find at once, while the retries of
+#: :mod:`rclverify.logic.retry` (finite instantiation, MBQI) often do; a short
+#: first attempt hands over to them sooner (an unknown is never upgraded).
+MODEL_TIMEOUT_MS = 1_000
+
+
+def _where(l: ast.Loc) -> str:
+    return f"{l.file}:{l.line}:{l.col}"
+
+
+def cone_of(formals: Sequence[Formal], model: SystemModel) -> list[str]:
+    """The nodes the statements mention and every node upstream of them, in
+    the model's (source) order."""
+    want: set[str] = set()
+    for f in formals:
+        for n in f.nodes:
+            want.update(model.upstream(n) or [n])
+    return [n for n in model.nodes if n in want]
+
+
+def formals_of(req: Requirement, checked: Checked) -> tuple[Formal | None, list[Formal]]:
+    """The parsed formal statement (``None`` when informal) and ``assuming:`` formulas."""
+    f = parse_formal(req.formal, checked, f"{req.id} formal") if req.formal else None
+    return f, [parse_formal(a, checked, f"{req.id} assuming") for a in req.assuming]
+
+
+def fingerprint(req: Requirement, cone_snapshots: Sequence[str], model_json: str, code: str = "") -> str:
+    """A sha256 of everything a requirement's record is computed from: its
+    statements (and where they are written) and traced guarantees, the contract snapshots of its cone
+    (artifacts/contracts/<Node>.json, which include the node's plan facts) and
+    the system model, and ``code`` (the rclverify code and Z3 version that
+    decide it).  An unchanged fingerprint means the recorded verdict still
+    holds (the ``requirements`` task re-checks only changed ones)."""
+    h = hashlib.sha256(code.encode())
+    h.update(json.dumps([req.id, req.text, [req.formal.text, req.formal.line, req.formal.col] if req.formal else None,
+                         [[a.text, a.line, a.col] for a in req.assuming], str(req.loc),
+                         [[s.node, list(s.guarantees)] for s in req.support], req.origin]).encode())
+    for s in cone_snapshots:
+        h.update(b"\0" + s.encode())
+    h.update(b"\0" + model_json.encode())
+    return h.hexdigest()
+
+
+def _io_symbols(e: ast.Expr, cn: CheckedNode, enc: Encoder) -> set[str]:
+    """The Z3 symbol names of the I/O variables formula ``e`` of ``cn`` mentions (bound names excluded)."""
+    from ..rcl.walk import free_names
+    free = free_names(e)
+    out = set()
+    for v in subexpressions(e):
+        if isinstance(v, ast.Var):
+            if v.prefix is not None:
+                out.add(enc.symbol_name(cn.name, v.prefix, v.name))
+            elif v.name in free and (v.name in cn.inputs or v.name in cn.outputs):
+                out.add(enc.symbol_name(cn.name, "in" if v.name in cn.inputs else "out", v.name))
+    return out
+
+
+@solver_session()
+def check_requirement(req: Requirement, checked: Checked, model: SystemModel, plan: Plan, *,
+                      timeout_ms: int = DEFAULT_TIMEOUT_MS, model_ms: int = MODEL_TIMEOUT_MS) -> dict[str, Any]:
+    """Decide ``req`` (module docstring).  Returns its JSON record:
+
+    ``id``, ``text``, ``origin``, ``source`` (``file:line:col`` of the formal
+    statement or of the requirement), ``formal``, ``assuming`` (RCL text),
+    ``cone`` (node names), ``verdict`` (``proved``/``refuted``/
+    ``inconclusive``/``informal``), ``used`` (premises in the unsat core:
+    ``{label, kind, node, index, text, source}``), ``traced_not_needed``,
+    ``consistency`` (``consistent``/``inconsistent``/``undecided``, proved
+    only) with ``inconsistent_core``, ``vacuity`` (``non-vacuous``/
+    ``vacuous``/``undecided``, proved implications only) with
+    ``vacuity_core``, ``counterexample`` (``[{node, values:
+    {var: value}}]``, refuted only), ``failed_to_prevent`` (premises), ``reason``
+    (Z3's, inconclusive only), ``smt2`` (the query's text), ``duration_s``.
+
+    ``timeout_ms`` is the validity query's budget, ``model_ms`` the first
+    attempt's of the consistency and vacuity queries (:data:`MODEL_TIMEOUT_MS`).
+    Raises :class:`~rclverify.rcl.errors.RclError` for a statement that does
+    not check (the plan's ``resolve`` reports those first); never raises on
+    solver trouble.
+    """
+    base: dict[str, Any] = {
+        "id": req.id, "text": req.text, "origin": req.origin,
+        "source": _where(req.formal.loc if req.formal else req.loc),
+        "formal": " ".join(req.formal.text.split()) if req.formal else None,
+        "assuming": [" ".join(a.text.split()) for a in req.assuming],
+        "traced": [{"node": s.node, "guarantee": k} for s in req.support for k in s.guarantees],
+    }
+    formal, assuming = formals_of(req, checked)
+    if formal is None:
+        return {**base, "verdict": "informal", "cone": [], "used": [], "traced_not_needed": [],
+                "explanation": "No formal statement: the requirement is traced to guarantees, never checked, never met."}
+    cone = cone_of([formal, *assuming], model)
+    enc = Encoder(checked.env, model.alias())
+    premises: list[dict[str, Any]] = []
+    labelled: list[tuple[str, z3.BoolRef]] = []
+
+    def add(label: str, kind: str, node: str | None, index: int, e: ast.Expr, f: z3.BoolRef, text: str | None = None) -> None:
+        premises.append({"label": label, "kind": kind, "node": node, "index": index,
+                         "text": text if text is not None else expr_to_rcl(e), "source": _where(e.loc)})
+        labelled.append((label, f))
+
+    g_symbols: dict[str, set[str]] = {}
+    for n in cone:
+        cn = checked.nodes[n]
+        for k, g in enumerate(cn.node.guarantees, 1):
+            label = f"{n} guarantee {k}"
+            add(label, "guarantee", n, k, g.formula, enc.formula(g.formula, cn))
+            g_symbols[label] = _io_symbols(g.formula, cn, enc)
+        for k, c in enumerate(split_assumption(checked, model, n)[1], 1):
+            add(f"{n} environment assumption {k}", "environment assumption", n, k, c, enc.formula(c, cn))
+        for k, fact in enumerate(plan.facts.get(n, ()), 1):
+            add(f"{n} environment fact {k}", "environment fact", n, k, fact.expr, enc.formula(fact.expr, cn))
+    # the statements' variables are named Node.in.x in their pseudo node (plan/formal.py); the encoder looks
+    # an input/output up as "<in|out>.<name>", here "in.Node.in.x", and takes the node's own symbol
+    symbols = {f"{p}.{n}.{p}.{v}": enc.io_symbol(checked.nodes[n], p, v)
+               for f in (formal, *assuming) for n, p, v in f.mentions}
+    for k, a in enumerate(assuming, 1):
+        add(f"assuming {k}", "assuming", None, k, a.expr, enc.formula(a.expr, a.scope, symbols))
+    goal = enc.formula(formal.expr, formal.scope, symbols)
+    labelled.append((NEGATED, z3.Not(goal)))
+    head = (f"rclverify requirement {req.id}: {base['formal']}\nsource {base['source']}; "
+            "unsat means the requirement follows from the premises")
+    r = satisfiable(labelled, enc, timeout_ms=timeout_ms, comment=head)
+    out: dict[str, Any] = {**base, "cone": cone, "premises": len(premises), "smt2": r.smt2,
+                           "duration_s": r.duration_s}
+    by_label = {p["label"]: p for p in premises}
+    traced = [f"{t['node']} guarantee {t['guarantee']}" for t in base["traced"]]
+    if r.status == "unsat":
+        core = [c for c in (r.core or []) if c != NEGATED]
+        used = [by_label[c] for c in core]
+        out.update(verdict="proved", used=used,
+                   traced_not_needed=[by_label.get(t, {"label": t, "kind": "guarantee"}) for t in traced if t not in core])
+        if NEGATED not in (r.core or []):
+            out.update(consistency="inconsistent", inconsistent_core=used, consistency_duration_s=0.0)
+        else:
+            r2 = satisfiable([(lbl, f) for lbl, f in labelled if lbl in core], enc, timeout_ms=model_ms,
+                             comment=f"rclverify requirement {req.id}: are the premises its proof used consistent?")
+            out["consistency_duration_s"] = r2.duration_s
+            if r2.status == "unsat":
+                out.update(consistency="inconsistent", inconsistent_core=[by_label[c] for c in (r2.core or [])])
+            elif r2.status == "sat":
+                out.update(consistency="consistent")
+            else:
+                out.update(consistency="undecided", consistency_reason=r2.reason)
+        premise = _premise(formal.expr)
+        if out["consistency"] == "consistent" and premise is not None:
+            r3 = satisfiable([(lbl, f) for lbl, f in labelled if lbl != NEGATED]
+                             + [("requirement premise", enc.formula(premise, formal.scope, symbols))], enc,
+                             timeout_ms=model_ms,
+                             comment=f"rclverify requirement {req.id}: can its premise hold with every premise of the cone?")
+            out["vacuity_duration_s"] = r3.duration_s
+            if r3.status == "unsat":
+                out.update(vacuity="vacuous", vacuity_core=[by_label[c] for c in (r3.core or []) if c in by_label])
+            else:
+                out["vacuity"] = {"sat": "non-vacuous", "inconclusive": "undecided"}.get(r3.status, "undecided")
+        return out
+    out.update(used=[], traced_not_needed=[])
+    if r.status == "sat":
+        mentioned = {enc.symbol_name(n, p, v) for f in (formal,) for n, p, v in f.mentions}
+        hit = [lbl for lbl, syms in g_symbols.items() if syms & mentioned]
+        first = [l for l in hit if l in traced] or hit
+        out.update(verdict="refuted", counterexample=_counterexample(r.model or {}, cone, checked, enc),
+                   failed_to_prevent=[by_label[l] for l in first])
+        return out
+    out.update(verdict="inconclusive", reason=r.reason or "unknown")
+    return out
+
+
+def _premise(e: ast.Expr) -> ast.Expr | None:
+    """``exists(bs | P)`` for a requirement ``forall(bs | P -> Q)`` (or ``P``
+    for ``P -> Q``): the condition under which it demands something; ``None``
+    for a requirement of another shape."""
+    bindings: list[ast.Binding] = []
+    while isinstance(e, ast.Quant) and e.kind == "forall":
+        bindings.extend(e.bindings)
+        e = e.body
+    if not (isinstance(e, ast.Binary) and e.op == "->"):
+        return None
+    return ast.Quant("exists", tuple(bindings), e.left, e.loc) if bindings else e.left
+
+
+def _counterexample(model: dict[str, str], cone: Sequence[str], checked: Checked, enc: Encoder) -> list[dict[str, Any]]:
+    """The model's values of every I/O variable of the cone, node by node in
+    the cone's order: ``[{"node": N, "values": {"in.x": value, "out.y": value}}]``
+    (a consumer's input shows the value of the producer's output it reads)."""
+    shown = {s.z3name: s.display for s in enc.symbols.values()}
+    out: list[dict[str, Any]] = []
+    for n in cone:
+        cn = checked.nodes[n]
+        row: dict[str, str] = {}
+        for p, table in (("in", cn.inputs), ("out", cn.outputs)):
+            for v in table:
+                z = enc.symbol_name(n, p, v)
+                if z in shown and shown[z] in model:
+                    row[f"{p}.{v}"] = model[shown[z]]
+        if row:
+            out.append({"node": n, "values": row})
+    return out

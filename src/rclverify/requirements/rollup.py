@@ -1,0 +1,82 @@
+"""A requirement's status: its Z3 verdict rolled up with the evidence it rests on.
+
+=================================  ==========================  ==================================
+verdict (``check``)                what the proof rests on      status shown (``verdict`` / ``status``)
+=================================  ==========================  ==================================
+``proved``, premises consistent    every used guarantee         ``met`` / ``discharged``
+                                   discharged, and the side
+                                   conditions of its node
+``proved``, premises consistent    some evidence not            ``proved, evidence outstanding`` /
+                                   discharged                   the worst of that evidence
+``proved``, premises inconsistent  (anything)                   ``proved from an inconsistency`` /
+                                                                ``failed``
+``proved``, premise never holds    (anything)                   ``proved vacuously`` / ``failed``
+``proved``, consistency undecided  (anything)                   ``inconclusive`` / ``inconclusive``
+``refuted``                                                     ``refuted`` / ``failed``
+``inconclusive``                                                ``inconclusive`` / ``inconclusive``
+``informal`` (no formal statement) (nothing: traced only)        ``informal`` / ``pending``
+=================================  ==========================  ==================================
+
+Only ``met`` has the status ``discharged`` (the green tick of every report
+format).  An informal requirement is ``pending`` whatever its traced
+guarantees' evidence says (the note names their worst status, the
+traceability table shows each): nothing decided it, so it is neither
+verified nor refuted, and its goal in the assurance argument is undeveloped
+(GSN: pending), the same status.
+"""
+from __future__ import annotations
+
+from typing import Any, Callable, Mapping
+
+from ..evidence.records import worst
+
+MET = "met"
+OUTSTANDING = "proved, evidence outstanding"
+INCONSISTENT = "proved from an inconsistency"
+VACUOUS = "proved vacuously"
+VERDICTS = (MET, OUTSTANDING, INCONSISTENT, VACUOUS, "refuted", "inconclusive", "informal")
+
+
+def roll_up(record: Mapping[str, Any] | None, g_status: Callable[[str, int], str], sc_status: Mapping[str, str],
+            traced_status: str) -> tuple[str, str, str]:
+    """``(verdict, status, note)`` of one requirement.
+
+    ``record`` is the requirement's check record (:func:`.check.check_requirement`;
+    ``None`` when not checked yet), ``g_status(node, k)`` a guarantee's
+    evidence status, ``sc_status[node]`` the worst of a node's side
+    conditions, ``traced_status`` the worst status of the traced guarantees
+    (the roll-up of an informal requirement).
+    """
+    if record is None:
+        return "inconclusive", "pending", "not checked yet: run `rclverify requirements` or `doit verify`"
+    v = record.get("verdict")
+    if v == "informal":
+        return "informal", "pending", (f"no formal statement: traced only, never shown as met (its traced guarantees: "
+                                       f"{traced_status})")
+    if v == "refuted":
+        who = ", ".join(p["label"] for p in record.get("failed_to_prevent", [])) or "no guarantee of the cone"
+        return "refuted", "failed", f"Z3 found a counterexample that every premise allows; it is not prevented by: {who}"
+    if v != "proved":
+        return "inconclusive", "inconclusive", f"Z3 could not decide it ({record.get('reason', 'unknown')}); not proved"
+    if record.get("consistency") == "inconsistent":
+        core = ", ".join(p["label"] for p in record.get("inconsistent_core", []))
+        return INCONSISTENT, "failed", (f"the premises the proof used contradict each other ({core}): the "
+                                        "requirement follows vacuously, not because the system meets it")
+    if record.get("vacuity") == "vacuous":
+        core = ", ".join(p["label"] for p in record.get("vacuity_core", []))
+        why = f"together with the premises of its cone ({core})" if core else "(it contradicts itself)"
+        return VACUOUS, "failed", f"the requirement's premise can never hold {why}: it is proved only because it never applies"
+    statuses: dict[str, str] = {}
+    for p in record.get("used", []):
+        if p["kind"] == "guarantee":
+            statuses[p["label"]] = g_status(p["node"], p["index"])
+            statuses[f"side conditions of {p['node']}"] = sc_status.get(p["node"], "discharged")
+    ev = worst(list(statuses.values()), empty="discharged")
+    if record.get("consistency") != "consistent":  # the worst of that and the evidence, as the argument has it
+        return "inconclusive", worst(["inconclusive", ev]), (
+            "proved, but Z3 could not decide whether the premises it used are consistent "
+            f"({record.get('consistency_reason', 'unknown')})")
+    if ev == "discharged":
+        return MET, "discharged", "proved from the used premises, and all the evidence they rest on is discharged"
+    open_ = ", ".join(f"{k} ({s})" for k, s in statuses.items() if s != "discharged")
+    return OUTSTANDING, ev, f"proved, but the evidence it rests on is not all discharged: {open_}"
