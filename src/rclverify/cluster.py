@@ -74,7 +74,7 @@ def remote_run(root: str, plan_file: str, key: str, node: str, obligation_id: st
     from .evidence.records import Obligation
     from .evidence.store import read_json
     from .logic.world import fresh as fresh_z3
-    from .pipeline import Workspace
+    from .workspace import Workspace
     ws = _WORKER_WORKSPACES.get((root, plan_file, key))
     if ws is None:
         ws = Workspace(Path(root), plan_file)

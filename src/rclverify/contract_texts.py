@@ -28,7 +28,7 @@ from .evidence.store import atomic_write_bytes
 from .rcl import ast
 
 if TYPE_CHECKING:
-    from .pipeline import Workspace
+    from .workspace import Workspace
 
 CACHE = "artifacts/cache/contract-texts.pickle"
 

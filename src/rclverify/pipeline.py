@@ -21,266 +21,24 @@ Artifact layout (workspace-relative)::
 from __future__ import annotations
 
 import dataclasses
-import hashlib
-import json
-import os
-from dataclasses import dataclass
-from functools import cached_property
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, Callable, Sequence, cast
+from typing import TYPE_CHECKING, Any, Sequence
 
 from .evidence.records import Evidence, Obligation
-from .evidence.store import EvidenceStore, atomic_write_text, dumps, read_json, write_json, write_obligations
+from .evidence.store import EvidenceStore, atomic_write_text, read_json, write_json, write_obligations
 from .logic.world import fresh as fresh_z3
 from .rcl.errors import RclError, error
+# The workspace and what is derived from it without a stage live below the report
+# (rclverify.workspace); re-exported here for the stages' callers.
+from .workspace import (PLAN, REPORT_PARTS, TaskIndex, Workspace, current_model_hash, current_snapshot_hashes,  # noqa: F401
+                        node_snapshots, read_artifact, record_provenance, stage_inputs, stale_stages)
 
 if TYPE_CHECKING:
-    from .backends.base import NodeTarget
     from .health.checks import Finding
-    from .plan.load import Plan
-    from .rcl import ast
-    from .rcl.errors import Diagnostic
-    from .rcl.types import Checked
-    from .system.model import SystemModel
 
 # The parser, type checker, calculus, health checks, lint and backends are
 # imported where a stage uses them: a doit run that reuses the cached
 # workspace and runs no such stage (a no-op) never needs them (docs/scale.md).
-
-PLAN = "contracts/plan.yaml"
-
-
-@dataclass(frozen=True)
-class TaskIndex:
-    """What defining a workspace's doit tasks needs of its loaded plan and
-    model (:func:`rclverify.tasks.build_tasks`), small enough to be read on
-    every run: a no-op run of a large system reads this and not the checked
-    contracts (:mod:`rclverify.wscache`, docs/scale.md).
-
-    ``nodes`` in source order; ``producers[n]`` the nodes feeding ``n`` (system
-    model, rule R3's premises); ``contracts`` the plan's contract files;
-    ``replacement[n]`` the file of ``n``'s replacement contract (plan
-    ``replacements``); ``entries[n]`` the config mappings of ``n``'s plan
-    evidence entries, in plan order (the files they name are dependencies of
-    the export stage of ``node:n``).  Paths are workspace-relative strings.
-    """
-
-    nodes: tuple[str, ...]
-    producers: dict[str, tuple[str, ...]]
-    contracts: tuple[str, ...]
-    replacement: dict[str, str]
-    entries: dict[str, tuple[Any, ...]]
-    #: The plan's ``requirements_from`` Doorstop folders (their files are inputs of ``requirements``).
-    requirement_dirs: tuple[str, ...] = ()
-
-
-@dataclass
-class Workspace:
-    """A workspace root plus its plan; loads and checks lazily (cached).
-
-    Raises :class:`~rclverify.rcl.errors.RclError` (or PlanError) from the
-    properties when the contracts or the plan are wrong.
-    """
-
-    root: Path
-    plan_file: str = PLAN
-    #: Parsed contract files of an earlier load, ``rel -> (sha256 of the text, Spec)``;
-    #: a file whose text has the same hash is not parsed again (see :mod:`rclverify.wscache`).
-    parsed: dict[str, tuple[str, ast.Spec]] = dataclasses.field(default_factory=dict, repr=False, compare=False)
-    #: Set by :func:`rclverify.wscache.restore`: fills ``plan`` and ``parsed``
-    #: from the cache the first time the plan or the checked contracts are needed.
-    deferred: Callable[["Workspace"], None] | None = dataclasses.field(default=None, repr=False, compare=False)
-    #: Set by :func:`rclverify.wscache.restore`: the sha256 of each contract file it found, taken
-    #: before any file was parsed; :func:`rclverify.wscache.save` writes them into the new cache.
-    cache_shas: dict[str, str] | None = dataclasses.field(default=None, repr=False, compare=False)
-
-    def path(self, rel: str) -> Path:
-        return self.root / rel
-
-    def _run_deferred(self) -> None:
-        """Run the deferred cache load (once): it may fill ``plan`` and ``parsed``."""
-        if self.deferred is not None:
-            load, self.deferred = self.deferred, None
-            load(self)
-
-    @cached_property
-    def plan(self) -> Plan:
-        self._run_deferred()
-        cached = self.__dict__.get("plan")
-        if cached is not None:
-            return cast("Plan", cached)
-        from .plan.load import load_plan
-        return load_plan(self.root, self.plan_file)
-
-    @cached_property
-    def index(self) -> TaskIndex:
-        """The :class:`TaskIndex` of the loaded workspace (raises like :attr:`model`)."""
-        plan, model = self.plan, self.model
-        return TaskIndex(
-            nodes=tuple(self.checked.nodes), producers={n: tuple(model.producers(n)) for n in self.checked.nodes},
-            contracts=tuple(plan.contracts), replacement={n: r[0].rpartition(":")[0] for n, r in plan.replacements.items()},
-            entries={n: tuple(e.config for e in es) for n, es in plan.evidence.items()},
-            requirement_dirs=tuple(d for d, _ in plan.requirements_from))
-
-    @cached_property
-    def checked(self) -> Checked:
-        self._run_deferred()
-        from .plan.load import resolve
-        from .rcl.parser import parse_text
-        from .rcl.source import read_text as read_source
-        from .rcl.typecheck import check
-        plan = self.plan
-        specs = []
-        diags: list[Diagnostic] = []
-        for rel in plan.contracts:  # parsed under their workspace-relative names
-            try:
-                text = read_source(self.root / rel, rel)
-            except RclError as exc:
-                diags.extend(exc.diagnostics)
-                continue
-            sha = hashlib.sha256(text.encode("utf-8")).hexdigest()
-            if rel in self.parsed and self.parsed[rel][0] == sha:
-                specs.append(self.parsed[rel][1])
-                continue
-            try:
-                spec = parse_text(text, rel)
-            except RclError as exc:
-                diags.extend(exc.diagnostics)
-                continue
-            self.parsed[rel] = (sha, spec)
-            specs.append(spec)
-        if diags:
-            raise RclError(diags)
-        c = check(specs)
-        from .plan.errors import PlanError
-        try:
-            resolve(self.plan, c)
-        except PlanError as exc:
-            raise PlanError(list(exc.diagnostics) + self._entry_diagnostics(c)) from None
-        entry_diags = self._entry_diagnostics(c)
-        if entry_diags:
-            raise PlanError(entry_diags)
-        return c
-
-    def _entry_diagnostics(self, c: Checked) -> list[Diagnostic]:
-        """The backends' check-time validation of the plan's entries (experiment
-        data, review records, trace mappings): run here, above both the plan and
-        the backends, so that no plan module imports backend code."""
-        from .backends.entry_checks import check_entries
-        return check_entries(self.plan, c)
-
-    @cached_property
-    def model(self) -> SystemModel:
-        from .system.model import build
-        return build(self.checked, self.plan.connections)
-
-    def node_names(self) -> list[str]:
-        if "index" in self.__dict__:
-            return list(self.index.nodes)
-        return list(self.checked.nodes)
-
-    # -- artifact paths ---------------------------------------------------------------
-    @staticmethod
-    def snapshot(node: str) -> str:
-        return f"artifacts/contracts/{node}.json"
-
-    @staticmethod
-    def calculus(node: str) -> str:
-        return f"artifacts/calculus/{node}.json"
-
-    @staticmethod
-    def health(node: str) -> str:
-        return f"artifacts/health/{node}.json"
-
-    @staticmethod
-    def obligations(node: str) -> str:
-        return f"artifacts/obligations/{node}.json"
-
-    @staticmethod
-    def obligation(node: str, obligation_id: str) -> str:
-        """One obligation's own record: the input of its evidence task."""
-        return f"artifacts/obligations/{node}/{obligation_id}.json"
-
-    @staticmethod
-    def evidence(obligation_id: str) -> str:
-        return f"artifacts/evidence/{obligation_id}.json"
-
-    @staticmethod
-    def provenance(node: str) -> str:
-        """What each of the node's stages was made from (:func:`record_provenance`)."""
-        return f"artifacts/provenance/{node}.json"
-
-    MODEL = "artifacts/system/model.json"
-    DOT = "artifacts/system/model.dot"
-    DIAGNOSTICS = "artifacts/check/diagnostics.json"
-    #: What ``verify`` prints (:func:`rclverify.report.summary.summary_data`), written with the report.
-    SUMMARY = "artifacts/report/summary.json"
-
-    def target(self, node: str, index: int) -> NodeTarget:
-        from .backends.base import NodeTarget
-        entry = self.plan.evidence[node][index]
-        return NodeTarget(
-            root=self.root.resolve(), checked=self.checked, node=self.checked.nodes[node], config=entry.config,
-            facts=tuple(f.expr for f in self.plan.facts.get(node, ())), contract_files=self.plan.contracts,
-            plan_file=self.plan.file, artifacts=(self.root / "artifacts" / entry.backend / node).resolve(), index=index,
-            plan_locs=self.plan.locs)
-
-
-def node_snapshots(ws: Workspace, texts: Any = None) -> dict[str, dict[str, Any]]:
-    """The snapshot of every node of ``ws`` (``{node: snapshot}``, source order):
-    everything the node's own stages (compose, health, export) and its
-    evidence read of the contracts and the plan, locations included.
-
-    A snapshot holds the node's canonical RCL text, the shared context, its
-    plan facts (text and location), instance range, evidence entries,
-    replacement, and the source locations of the node, of each assumption and
-    guarantee and of every value the plan gives for the node (so a comment
-    that moves a guarantee, or a plan edit that moves an entry, changes the
-    snapshot, and whatever shows those locations is made again).
-    ``stage_check`` writes them (``artifacts/contracts/<Node>.json``); the
-    report recomputes them from the current files to find evidence produced
-    from another contract text (:func:`current_snapshot_hashes`).  ``texts``
-    is a :class:`~rclverify.contract_texts.ContractTexts` (made when omitted).
-    Raises RclError/PlanError for contracts or a plan that do not check."""
-    from .contract_texts import ContractTexts
-    from .rcl import ast
-    from .rcl.printer import to_rcl
-    checked, plan = ws.checked, ws.plan
-    if texts is None:
-        texts = ContractTexts(ws)
-    context_text = to_rcl(ast.Spec(tuple(c for s in checked.specs for c in s.contexts), ()))
-    plan_locs: dict[str, dict[str, str]] = {}  # node -> {value path under nodes.<node>: "line:col"}
-    for path, loc in plan.locs.items():
-        if len(path) > 1 and path[0] == "nodes":
-            plan_locs.setdefault(str(path[1]), {})["/".join(map(str, path[2:]))] = f"{loc.line}:{loc.col}"
-    out: dict[str, dict[str, Any]] = {}
-    for name, cn in checked.nodes.items():
-        tx = texts.node(cn.node)
-        out[name] = {
-            "node": name, "rcl": tx["rcl"], "context": context_text,
-            "facts": [f.text for f in plan.facts.get(name, ())],
-            "fact_sources": [str(f.loc) for f in plan.facts.get(name, ())],
-            "instances": list(plan.instances[name]) if name in plan.instances else None,
-            "evidence": [dict(e.config) for e in plan.evidence.get(name, ())],
-            "replacement": plan.replacements[name][0] if name in plan.replacements else None,
-            "source": f"{cn.node.loc.file}:{cn.node.loc.line}",
-            "sources": {"node": str(cn.node.loc), "assumptions": [src for _, src in tx["assumptions"]],
-                        "guarantees": [src for _, src in tx["guarantees"]]},
-            "plan_locations": dict(sorted(plan_locs.get(name, {}).items())),
-        }
-    return out
-
-
-def current_snapshot_hashes(ws: Workspace, texts: Any = None) -> dict[str, str]:
-    """``{artifacts/contracts/<Node>.json: sha256}`` of the snapshots the
-    current contract and plan files give (:func:`node_snapshots`), whatever
-    the files under ``artifacts/`` say: the hashes an evidence record's
-    ``input_hashes`` are compared with, so evidence produced from another
-    contract text is ``stale`` even when no ``check`` ran since the edit
-    (``rclverify report``).  Raises like :func:`node_snapshots`."""
-    return {ws.snapshot(n): hashlib.sha256(dumps(snap).encode("utf-8")).hexdigest()
-            for n, snap in node_snapshots(ws, texts).items()}
-
 
 def stage_check(ws: Workspace) -> dict[str, Any]:
     """Parse, type-check, resolve the plan, lint; write snapshots (:func:`node_snapshots`)
@@ -313,67 +71,6 @@ def stage_graph(ws: Workspace) -> str:
     dot = system_dot(ws.model.view({}))
     atomic_write_text(ws.path(ws.DOT), dot)
     return dot
-
-
-def record_provenance(ws: Workspace, node: str, stage: str, inputs: Sequence[str]) -> None:
-    """Record in ``artifacts/provenance/<node>.json`` the sha256 of each
-    workspace-relative file in ``inputs``, after ``stage`` of ``node`` wrote
-    its outputs from them (a stage killed before that records nothing).  The report compares them with
-    the inputs' current hashes (:func:`stale_stages`), so the side conditions
-    or health findings of a contract edited since are shown ``stale``, never
-    with the status of the old text (``rclverify report`` runs no stage).
-    Raises ``OSError`` when the file cannot be written."""
-    from .evidence.records import hash_inputs
-    rel = ws.provenance(node)
-    current = read_artifact(ws, rel, {})
-    if not isinstance(current, dict):
-        current = {}
-    current[stage] = hash_inputs(ws.root, list(inputs))
-    write_json(ws.path(rel), current)
-
-
-def stage_inputs(ws: Workspace, node: str, stage: str) -> list[str]:
-    """The workspace-relative files the contents of ``stage`` (``compose`` or
-    ``health``) of ``node`` are made from: its snapshot, for ``compose`` its
-    producers' snapshots and the system model, for ``health`` the plan's
-    replacement contract file if any.  (Export's are the inputs of each
-    obligation, hashed into its evidence.)"""
-    if stage == "compose":
-        return [ws.snapshot(node), *(ws.snapshot(p) for p in ws.model.producers(node)), ws.MODEL]
-    repl = ws.plan.replacements.get(node)
-    return [ws.snapshot(node)] + ([repl[0].rpartition(":")[0]] if repl else [])
-
-
-def stale_stages(ws: Workspace, current: dict[str, str]) -> dict[str, set[str]]:
-    """``{node: {stage, ...}}`` for every node of ``ws`` whose ``compose`` or
-    ``health`` artifacts were made from files other than those the current
-    contracts and plan give: a recorded hash differs from ``current`` (path
-    -> sha256; :func:`current_snapshot_hashes` plus :func:`current_model_hash`;
-    other files are hashed here and added to it), or nothing was recorded.
-    Nodes with no artifacts yet are left out."""
-    from .evidence.records import hash_inputs
-    out: dict[str, set[str]] = {}
-    for n in ws.checked.nodes:
-        rec = read_artifact(ws, ws.provenance(n), None)
-        for stage, artifact in (("compose", ws.calculus(n)), ("health", ws.health(n))):
-            if not os.path.exists(os.path.join(ws.root, artifact)):
-                continue
-            made = rec.get(stage) if isinstance(rec, dict) else None
-            if not isinstance(made, dict) or set(made) != set(stage_inputs(ws, n, stage)):
-                out.setdefault(n, set()).add(stage)
-                continue
-            missing = [p for p in made if p not in current]
-            if missing:
-                current.update(hash_inputs(ws.root, missing))
-            if any(current[p] != h for p, h in made.items()):
-                out.setdefault(n, set()).add(stage)
-    return out
-
-
-def current_model_hash(ws: Workspace) -> dict[str, str]:
-    """``{artifacts/system/model.json: sha256}`` of the model the current
-    contracts and plan give (what ``check`` would write)."""
-    return {ws.MODEL: hashlib.sha256(dumps(ws.model.to_json()).encode("utf-8")).hexdigest()}
 
 
 def stage_compose(ws: Workspace, node: str) -> dict[str, Any]:
@@ -484,15 +181,6 @@ def stage_requirements(ws: Workspace, *, force: bool = False) -> list[tuple[dict
     return run(ws, force=force)
 
 
-#: The report's files under ``reports/`` in two parts, each written by a doit task of its own
-#: (:mod:`rclverify.report.parts`; ``argument.svg`` only when the argument is laid out).  Here, not
-#: there: the task definitions of every run name these files, and the report modules import jinja2.
-REPORT_PARTS: dict[str, tuple[str, ...]] = {
-    "html": ("assurance.html", "assurance.json", "assurance.sarif", "assurance.junit.xml", "argument.svg"),
-    "text": ("assurance.md", "argument.json", "argument.gsn.yaml", "argument.dot"),
-}
-
-
 def stage_report(ws: Workspace, parts: Sequence[str] = tuple(REPORT_PARTS),
                  report: dict[str, Any] | None = None) -> tuple[dict[str, Any], list[Path]]:
     """Build the report dict of ``ws`` (unless ``report`` gives it) and write
@@ -528,12 +216,3 @@ def stage_report(ws: Workspace, parts: Sequence[str] = tuple(REPORT_PARTS),
     return report, paths
 
 
-def read_artifact(ws: Workspace, rel: str, default: Any = None) -> Any:
-    """JSON of an artifact, or ``default`` when it does not exist yet.  (The
-    path is joined as text and the bytes decoded by ``json``: the report
-    reads thousands of artifacts, and ``pathlib`` was a third of that.)"""
-    try:
-        with open(os.path.join(ws.root, rel), "rb") as fh:
-            return json.loads(fh.read())
-    except FileNotFoundError:
-        return default

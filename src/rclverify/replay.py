@@ -15,7 +15,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from .backends.property_tests.harness import Outcome, read_config, run_guarantee
-from .pipeline import Workspace
+from .workspace import Workspace
 
 
 def check_from_workspace(root: Path, plan_file: str, node: str, entry: int, guarantee: int) -> Outcome:

@@ -40,7 +40,7 @@ from typing import TYPE_CHECKING, Any
 from .heap import no_collection
 
 if TYPE_CHECKING:
-    from .pipeline import Workspace
+    from .workspace import Workspace
 
 CACHE = "artifacts/cache/workspace.pickle"
 _FORMAT = 3

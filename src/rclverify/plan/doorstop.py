@@ -72,7 +72,7 @@ def read_requirements(root: Path, folder: str, loc: ast.Loc) -> tuple[Any, ...]:
     folder holds no document or Doorstop cannot read it, and located in an
     item's file when an attribute has the wrong shape.
     """
-    from .load import Requirement, Support
+    from .model import Requirement, Support
     base = root / folder
     if not base.is_dir():
         raise plan_error(loc.file, loc.line, loc.col, f"requirements_from: {folder!r} is not a folder", "E-io")

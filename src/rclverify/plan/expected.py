@@ -19,7 +19,8 @@ from typing import Any, Mapping
 from ..rcl import ast
 from ..rcl.errors import Diagnostic, error
 from ..rcl.types import Checked
-from .load import KEY, Plan
+from .model import Plan
+from .yamlguard import KEY
 
 #: The verdicts an expectation may state (an obligation's decided statuses).
 VERDICTS = ("discharged", "failed")

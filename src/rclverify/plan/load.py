@@ -11,7 +11,6 @@ file.  The format is documented in docs/plan.md.
 from __future__ import annotations
 
 import json
-from dataclasses import dataclass, field
 from importlib import resources
 from pathlib import Path
 from typing import Any, Mapping
@@ -25,94 +24,10 @@ from .errors import PlanError, plan_error
 from .formal import Source
 from .yamlguard import KEY, Blocks, compose_guarded, read_yaml_text, to_data
 
-Path_ = tuple[Any, ...]
+# The plan's values live in plan/model.py (below this loader and what it calls); re-exported here.
+from .model import Connection, EvidenceEntry, Fact, Path_, Plan, Requirement, Support  # noqa: E402,F401
+
 __all__ = ["KEY", "Plan", "load_plan", "read_plan_data", "resolve"]
-
-
-@dataclass(frozen=True)
-class Support:
-    """One ``supported_by`` row: a node and 1-based guarantee indices."""
-
-    node: str
-    guarantees: tuple[int, ...]
-    loc: ast.Loc
-
-
-@dataclass(frozen=True)
-class Requirement:
-    """A requirement of the plan (or of a Doorstop item, :mod:`.doorstop`).
-
-    ``formal`` is its formal statement (``None``: informal, traced only) and
-    ``assuming`` its own environment assumptions, both RCL over
-    ``Node.in.x``/``Node.out.y`` (:mod:`.formal`); ``origin`` is ``"plan"``
-    or the Doorstop item's workspace-relative file.
-    """
-
-    id: str
-    text: str
-    support: tuple[Support, ...]
-    loc: ast.Loc
-    formal: Source | None = None
-    assuming: tuple[Source, ...] = ()
-    origin: str = "plan"
-
-
-@dataclass(frozen=True)
-class Connection:
-    """An explicit connection ``from: Producer.var`` -> ``to: Consumer.var``."""
-
-    from_node: str
-    from_var: str
-    to_node: str
-    to_var: str
-    loc: ast.Loc
-
-
-@dataclass(frozen=True)
-class Fact:
-    """An environment fact: an RCL formula over one node's inputs/outputs."""
-
-    node: str
-    text: str
-    expr: ast.Expr
-    loc: ast.Loc
-
-
-@dataclass(frozen=True)
-class EvidenceEntry:
-    """``nodes.<Node>.evidence[index]``: a backend and its configuration."""
-
-    node: str
-    index: int
-    backend: str
-    config: Mapping[str, Any]
-    loc: ast.Loc
-
-
-@dataclass(frozen=True)
-class Plan:
-    """A loaded plan.  Paths are workspace-relative strings.
-
-    ``instances`` maps a node to the inclusive NATURAL range ``(lo, hi)``
-    used by the health checks to instantiate quantified formulas.
-    """
-
-    file: str
-    root: Path
-    contracts: tuple[str, ...]
-    requirements: tuple[Requirement, ...]
-    connections: tuple[Connection, ...]
-    facts: Mapping[str, tuple[Fact, ...]]
-    instances: Mapping[str, tuple[int, int]]
-    evidence: Mapping[str, tuple[EvidenceEntry, ...]]
-    replacements: Mapping[str, tuple[str, ast.Loc]] = field(default_factory=dict)
-    locs: Mapping[Path_, ast.Loc] = field(default_factory=dict)
-    name: str = ""
-    #: the ``ros:`` section as written (grounding, docs/ros.md); empty when absent
-    ros: Mapping[str, Any] = field(default_factory=dict)
-    #: ``requirements_from: {doorstop: DIR}``: Doorstop document trees read for
-    #: more requirements (:func:`.doorstop.read_requirements`), with the entry's location.
-    requirements_from: tuple[tuple[str, ast.Loc], ...] = ()
 
 
 def _schema() -> dict[str, Any]:

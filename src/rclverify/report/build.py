@@ -34,7 +34,7 @@ from .. import __version__
 from ..contract_texts import ContractTexts
 from ..evidence.records import SEVERITY, Obligation, worst
 from ..evidence.store import EvidenceStore
-from ..pipeline import Workspace, current_model_hash, current_snapshot_hashes, read_artifact, stale_stages
+from ..workspace import Workspace, current_model_hash, current_snapshot_hashes, read_artifact, stale_stages
 from ..system.model import cycles_kept, names_of
 from .expected import expected_rows
 

@@ -27,7 +27,7 @@ from typing import Any, Mapping
 
 from ..argument.export import FILES as ARGUMENT_FILES
 from ..argument.export import argument_layout, write_argument
-from ..pipeline import REPORT_PARTS
+from ..workspace import REPORT_PARTS
 from .ci import CI_FILES, write_ci_reports
 from .fragments import FragmentCache
 from .render import REPORT_FILES, render_files

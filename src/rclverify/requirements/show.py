@@ -4,7 +4,7 @@ from __future__ import annotations
 from typing import TYPE_CHECKING, TextIO
 
 if TYPE_CHECKING:
-    from ..pipeline import Workspace
+    from ..workspace import Workspace
 
 #: Verdicts that make ``rclverify requirements`` exit 1.
 BAD = ("refuted", "proved from an inconsistency", "proved vacuously", "inconclusive")

@@ -20,7 +20,7 @@ from typing import TYPE_CHECKING, Any
 from ..evidence.store import atomic_write_text, write_json
 
 if TYPE_CHECKING:
-    from ..pipeline import Workspace
+    from ..workspace import Workspace
 
 DIR = "artifacts/requirements"
 INDEX = f"{DIR}/index.json"

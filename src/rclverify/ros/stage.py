@@ -127,7 +127,7 @@ def run_check(root: Path, plan: str, strict: bool, json_out: str | None) -> int:
     """``rclverify ros check``: print each finding, a count line; exit 1 on
     ``--strict`` with a grounding error (or a plan/contract error), else 0."""
     from ..evidence.store import atomic_write_text
-    from ..pipeline import Workspace
+    from ..workspace import Workspace
     ws = Workspace(root, plan)
     if not has_ros(ws):
         print(f"{ws.plan.file}:1:1: error: the plan has no ros: section (docs/ros.md)", file=sys.stderr)

@@ -1,0 +1,101 @@
+"""The loaded verification plan as values (docs/plan.md): the plan, its
+requirements and their tracing, connections, environment facts and evidence
+entries.  Below the loader (:mod:`.load`) and the modules it calls
+(:mod:`.doorstop`, :mod:`.expected`), which all make or read these values.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Mapping
+
+from ..rcl import ast
+from .formal import Source
+
+Path_ = tuple[Any, ...]
+
+
+@dataclass(frozen=True)
+class Support:
+    """One ``supported_by`` row: a node and 1-based guarantee indices."""
+
+    node: str
+    guarantees: tuple[int, ...]
+    loc: ast.Loc
+
+
+@dataclass(frozen=True)
+class Requirement:
+    """A requirement of the plan (or of a Doorstop item, :mod:`.doorstop`).
+
+    ``formal`` is its formal statement (``None``: informal, traced only) and
+    ``assuming`` its own environment assumptions, both RCL over
+    ``Node.in.x``/``Node.out.y`` (:mod:`.formal`); ``origin`` is ``"plan"``
+    or the Doorstop item's workspace-relative file.
+    """
+
+    id: str
+    text: str
+    support: tuple[Support, ...]
+    loc: ast.Loc
+    formal: Source | None = None
+    assuming: tuple[Source, ...] = ()
+    origin: str = "plan"
+
+
+@dataclass(frozen=True)
+class Connection:
+    """An explicit connection ``from: Producer.var`` -> ``to: Consumer.var``."""
+
+    from_node: str
+    from_var: str
+    to_node: str
+    to_var: str
+    loc: ast.Loc
+
+
+@dataclass(frozen=True)
+class Fact:
+    """An environment fact: an RCL formula over one node's inputs/outputs."""
+
+    node: str
+    text: str
+    expr: ast.Expr
+    loc: ast.Loc
+
+
+@dataclass(frozen=True)
+class EvidenceEntry:
+    """``nodes.<Node>.evidence[index]``: a backend and its configuration."""
+
+    node: str
+    index: int
+    backend: str
+    config: Mapping[str, Any]
+    loc: ast.Loc
+
+
+@dataclass(frozen=True)
+class Plan:
+    """A loaded plan.  Paths are workspace-relative strings.
+
+    ``instances`` maps a node to the inclusive NATURAL range ``(lo, hi)``
+    used by the health checks to instantiate quantified formulas.
+    """
+
+    file: str
+    root: Path
+    contracts: tuple[str, ...]
+    requirements: tuple[Requirement, ...]
+    connections: tuple[Connection, ...]
+    facts: Mapping[str, tuple[Fact, ...]]
+    instances: Mapping[str, tuple[int, int]]
+    evidence: Mapping[str, tuple[EvidenceEntry, ...]]
+    replacements: Mapping[str, tuple[str, ast.Loc]] = field(default_factory=dict)
+    locs: Mapping[Path_, ast.Loc] = field(default_factory=dict)
+    name: str = ""
+    #: the ``ros:`` section as written (grounding, docs/ros.md); empty when absent
+    ros: Mapping[str, Any] = field(default_factory=dict)
+    #: ``requirements_from: {doorstop: DIR}``: Doorstop document trees read for
+    #: more requirements (:func:`.doorstop.read_requirements`), with the entry's location.
+    requirements_from: tuple[tuple[str, ast.Loc], ...] = ()
