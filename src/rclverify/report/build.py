@@ -36,6 +36,7 @@ from ..evidence.records import SEVERITY, Obligation, worst
 from ..evidence.store import EvidenceStore
 from ..pipeline import Workspace, current_model_hash, current_snapshot_hashes, read_artifact, stale_stages
 from ..system.model import cycles_kept, names_of
+from ..diagnosis.build import diagnose
 from .expected import expected_rows
 
 _FINDING_AS = {"ok": "discharged", "problem": "failed", "inconclusive": "inconclusive",
@@ -322,7 +323,7 @@ def build_report(ws: Workspace) -> dict[str, Any]:
                          for k in range(1, len(cn.node.guarantees) + 1)))
     headline = _headline(ob_rows, counts, side_conditions, findings)
     system = model.view(node_status, cycles_kept(model, ws.path("artifacts/cache/system-cycles.json")))
-    return {
+    report = {
         "meta": {"tool": "rclverify", "version": __version__, "workspace": plan.name or ws.root.resolve().name, "plan": plan.file,
                  "contracts": list(plan.contracts), "z3_version": z3.get_version_string(), "strict_ok": strict_ok},
         "summary": {"status": overall, "counts": counts, "headline": headline, "problems": problems},
@@ -331,6 +332,9 @@ def build_report(ws: Workspace) -> dict[str, Any]:
         "environment_assumptions": env_assumptions, "pending": pending, "lint": lint_rows,
         "expected_verdicts": expected,
     }
+    # one diagnosis record per problem, with repairs checked by Z3 (docs/diagnosis.md)
+    report["diagnoses"] = diagnose(ws, report)
+    return report
 
 
 def _headline(ob_rows: list[dict[str, Any]], counts: dict[str, int], side_conditions: list[dict[str, Any]],
