@@ -203,10 +203,8 @@ def act_verify(root: str, strict: bool) -> Any:
         data = json.loads((Path(root) / Workspace.SUMMARY).read_text(encoding="utf-8"))
     except (OSError, ValueError):
         data = summary_data(json.loads((Path(root) / REPORTS[2]).read_text(encoding="utf-8")))
-    s = data["summary"]
-    print(f"overall: {s['status']} -- {s['headline']}")
-    for p in s["problems"]:
-        print(f"  problem: {p}")
+    from .diagnosis.text import status_lines
+    print("\n".join(status_lines(data)))
     print_summary(data, "reports/assurance.html", rows=data["rows"])
     if strict and not data["meta"]["strict_ok"]:
         return TaskFailed("--strict: some evidence is failed, inconclusive, pending, stale or error, or a side condition "

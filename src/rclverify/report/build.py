@@ -334,6 +334,8 @@ def build_report(ws: Workspace) -> dict[str, Any]:
     }
     # one diagnosis record per problem, with repairs checked by Z3 (docs/diagnosis.md)
     report["diagnoses"] = diagnose(ws, report)
+    report["summary"]["diagnoses"] = [{"id": d["id"], "kind": d["kind"], "sentence": d["sentence"],
+                                       "repairs": len(d["repairs"])} for d in report["diagnoses"]]
     return report
 
 
