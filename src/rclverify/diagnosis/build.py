@@ -31,6 +31,7 @@ import z3
 
 from .. import __version__
 from ..evidence.store import atomic_write_text
+from ..rcl.errors import RclError
 from . import repairs as rep
 from .culprits import culprits, parse_core, plan_facts
 from .table import counterexample_table
@@ -68,7 +69,11 @@ class _Cache:
                 pass
         k = h.hexdigest()
         if k not in self.data:
-            self.data[k] = make()
+            try:
+                self.data[k] = make()
+            except (z3.Z3Exception, RclError, OSError, ValueError, KeyError):
+                # a checker that misbehaves gives no repair (and nothing is kept)
+                return None
         self.used[k] = self.data[k]
         return self.used[k]
 
@@ -201,8 +206,8 @@ def _side_condition(ws: Any, report: Mapping[str, Any], sc: Mapping[str, Any], c
     if sc["status"] == "inconclusive":
         sentence = f"Z3 could not decide whether {sc['node']}'s assumption `{sc['conjunct']}` ({sc['source']}) follows from " \
                    + (_and(said) if said else "its producers' guarantees") + "."
-    reps = cache.get(["side-condition", sc["id"], sc["conjunct"], dict(sc_before)],
-                     lambda: rep.side_condition_repairs(ws, sc, sc_before)) if sc["status"] == "failed" else []
+    reps = (cache.get(["side-condition", sc["id"], sc["conjunct"], dict(sc_before)],
+                      lambda: rep.side_condition_repairs(ws, sc, sc_before)) or []) if sc["status"] == "failed" else []
     return _record(sc["id"], "side-condition", sc["node"], sc["status"], sentence, culprits=cul,
                    counterexample=table, repairs=reps)
 

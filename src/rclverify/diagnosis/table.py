@@ -12,9 +12,10 @@ if-then-else text.
 from __future__ import annotations
 
 import re
-from decimal import Decimal, localcontext
 from fractions import Fraction
 from typing import Any, Mapping
+
+from ..values import decimal_text
 
 #: Most rows of one function table; the rest are counted ("... and 40 more points").
 MAX_ROWS = 8
@@ -22,29 +23,6 @@ MAX_ROWS = 8
 MAX_VALUE = 120
 
 _RATIONAL = re.compile(r"(?<![\w.])(-?\d+)/(\d+)(?![\w.])")
-
-
-def decimal_text(fr: Fraction) -> str | None:
-    """``fr`` as an exact decimal (``Fraction(1, 5)`` -> ``"0.2"``), or
-    ``None`` when its denominator has a prime factor other than 2 and 5
-    (``1/3`` has no finite decimal)."""
-    d = fr.denominator
-    twos = fives = 0
-    while d % 2 == 0:
-        d //= 2
-        twos += 1
-    while d % 5 == 0:
-        d //= 5
-        fives += 1
-    if d != 1:
-        return None
-    with localcontext() as ctx:
-        ctx.prec = max(28, len(str(fr.numerator)) + max(twos, fives) + 2)
-        q = Decimal(fr.numerator) / Decimal(fr.denominator)
-    text = format(q, "f")
-    if "." in text:
-        text = text.rstrip("0").rstrip(".")
-    return text
 
 
 def decimals(text: str) -> str:
