@@ -37,6 +37,8 @@ from .culprits import culprits, parse_core, plan_facts
 from .table import counterexample_table
 
 CACHE = "artifacts/cache/diagnosis.json"
+#: Most entries the cache keeps.
+KEEP = 200
 _META_KEYS = {"conjunct", "facts", "guarantee", "reason", "replay", "source"}
 
 
@@ -70,7 +72,9 @@ class _Cache:
         k = h.hexdigest()
         if k not in self.data:
             try:
-                self.data[k] = make()
+                # as the cache file holds it (sorted keys), so a fresh result and a kept one are the same
+                # data, key order included (the report's kept pieces are keyed by it: report/fragments.py)
+                self.data[k] = json.loads(json.dumps(make(), sort_keys=True))
             except (z3.Z3Exception, RclError, OSError, ValueError, KeyError):
                 # a checker that misbehaves gives no repair (and nothing is kept)
                 return None
@@ -79,7 +83,13 @@ class _Cache:
 
     def save(self) -> None:
         try:
-            atomic_write_text(self.path, json.dumps(self.used, sort_keys=True, indent=0))
+            # what this report used, and earlier entries up to KEEP in all (an edit undone finds them again)
+            kept = dict(self.used)
+            for k, v in self.data.items():
+                if len(kept) >= KEEP:
+                    break
+                kept.setdefault(k, v)
+            atomic_write_text(self.path, json.dumps(kept, sort_keys=True, indent=0))
         except OSError:
             pass  # a pure speed-up
 
