@@ -123,8 +123,10 @@ def diagnose(ws: Any, report: Mapping[str, Any]) -> list[dict[str, Any]]:
 
     def guard(node: str, c: int) -> dict[str, Any] | None:
         vs = sorted(victims.get((node, c), []), key=lambda v: v[0])
-        return cache.get(["guard", node, c, vs, health_by_node.get(node, {})],
-                         lambda: rep.guard_repair(ws, node, c, vs, health_by_node.get(node, {})))
+        found: dict[str, Any] | None = cache.get(["guard", node, c, vs, health_by_node.get(node, {})],
+                                                 lambda: rep.guard_repair(ws, node, c, vs,
+                                                                          health_by_node.get(node, {})))
+        return found
 
     for f in report["findings"]:
         if f["status"] != "problem":
@@ -228,8 +230,8 @@ def _obligation_record(ws: Any, node: str, oid: str) -> Mapping[str, Any]:
     except (OSError, ValueError):
         records = []
     for o in records:
-        if o.get("id") == oid:
-            return o
+        if isinstance(o, dict) and o.get("id") == oid:
+            return dict(o)
     return {}
 
 

@@ -125,7 +125,7 @@ def premise_fires(ws: Any, checked: Checked, node: str, k: int, at: int | None =
     r = h.sat(prem[0], comment=f"repair check {node}: can the premise of guarantee {k} hold?",
               timeout_ms=INSTANCE_TIMEOUT_MS)
     if r.status != "inconclusive":
-        return r.status
+        return str(r.status)
     return finite_witness(h, prem[0], _points(ws, node))
 
 
@@ -137,7 +137,7 @@ def consistent(ws: Any, checked: Checked, node: str) -> str:
     h = _health(ws, checked, node)
     r = h.sat([], comment=f"repair check {node}: is the contract consistent?", timeout_ms=INSTANCE_TIMEOUT_MS)
     if r.status != "inconclusive":
-        return r.status
+        return str(r.status)
     return finite_witness(h, [], _points(ws, node))
 
 

@@ -37,6 +37,7 @@ from ..evidence.store import EvidenceStore
 from ..pipeline import Workspace, current_model_hash, current_snapshot_hashes, read_artifact, stale_stages
 from ..system.model import cycles_kept, names_of
 from ..diagnosis.build import diagnose
+from ..diagnosis.text import natural_sorted  # p1 < p2 < p10
 from .expected import expected_rows
 
 _FINDING_AS = {"ok": "discharged", "problem": "failed", "inconclusive": "inconclusive",
@@ -243,7 +244,7 @@ def build_report(ws: Workspace) -> dict[str, Any]:
         tx = texts.node(cn.node)
         guarantees: list[dict[str, Any]] = [
             {"index": k, "text": text, "source": src, "status": g_status(name, k),
-             "obligations": sorted(o.id for o in by_node.get(name, []) if applies(o, name, k))}
+             "obligations": natural_sorted([o.id for o in by_node.get(name, []) if applies(o, name, k)])}
             for k, (text, src) in enumerate(tx["guarantees"], 1)]
         status = worst([g["status"] for g in guarantees] + [sc_status[name]])
         node_status[name] = status
@@ -265,7 +266,7 @@ def build_report(ws: Workspace) -> dict[str, Any]:
                 text, src = texts.node(checked.nodes[s.node].node)["guarantees"][k - 1]
                 support.append({"node": s.node, "guarantee": k, "text": text, "source": src,
                                 "status": g_status(s.node, k),
-                                "obligations": sorted(o.id for o in obligations if applies(o, s.node, k))})
+                                "obligations": natural_sorted([o.id for o in obligations if applies(o, s.node, k)])})
         st = worst([x["status"] for x in support] + [sc_status[x["node"]] for x in support]) if support else "pending"
         requirements.append({"id": r.id, "text": r.text, "status": st, "support": support})
 
@@ -323,7 +324,7 @@ def build_report(ws: Workspace) -> dict[str, Any]:
                          for k in range(1, len(cn.node.guarantees) + 1)))
     headline = _headline(ob_rows, counts, side_conditions, findings)
     system = model.view(node_status, cycles_kept(model, ws.path("artifacts/cache/system-cycles.json")))
-    report = {
+    report: dict[str, Any] = {
         "meta": {"tool": "rclverify", "version": __version__, "workspace": plan.name or ws.root.resolve().name, "plan": plan.file,
                  "contracts": list(plan.contracts), "z3_version": z3.get_version_string(), "strict_ok": strict_ok},
         "summary": {"status": overall, "counts": counts, "headline": headline, "problems": problems},
