@@ -4,6 +4,10 @@ from __future__ import annotations
 from typing import Any, Mapping, Sequence
 
 
+#: Longest diagnosis sentence ``status`` prints (``explain`` prints it whole).
+SENTENCE = 400
+
+
 def _natural_key(text: str) -> list[Any]:
     import re
     return [int(t) if t.isdigit() else t for t in re.split(r"(\d+)", text)]
@@ -69,7 +73,9 @@ def status_lines(data: Mapping[str, Any]) -> list[str]:
     out = [f"overall: {s['status']} -- {s['headline']}"]
     out += [f"  problem: {p}" for p in s["problems"]]
     for d in s.get("diagnoses", []):
-        more = f" ({d['repairs']} checked repair{'s' if d['repairs'] != 1 else ''}: rclverify explain {d['id']})" \
-            if d.get("repairs") else ""
-        out.append(f"  diagnosis {d['id']}: {d['sentence']}{more}")
+        sentence = d["sentence"]
+        if len(sentence) > SENTENCE:
+            sentence = sentence[:SENTENCE].rsplit(" ", 1)[0] + " ..."
+        more = (f"{d['repairs']} checked repair{'s' if d['repairs'] != 1 else ''}: " if d.get("repairs") else "")
+        out.append(f"  diagnosis {d['id']}: {sentence} ({more}rclverify explain {d['id']})")
     return out
