@@ -28,7 +28,7 @@ from .edits import Edit
 
 #: Points of each function table :func:`finite_witness` gives values (at least the plan's instances).
 WITNESS_POINTS = 4
-WITNESS_TIMEOUT_MS = 20_000
+WITNESS_TIMEOUT_MS = 5_000
 
 
 def source_text(ws: Any, rel: str) -> str:
@@ -52,13 +52,33 @@ def edited_system(ws: Any, edit: Edit) -> tuple[Checked, SystemModel] | None:
         return None
 
 
-def health(ws: Any, checked: Checked, node: str) -> dict[str, str]:
-    """``{finding id: status}`` of the health checks of ``node`` in ``checked``
-    (the plan's facts and instances for the node; a fresh Z3 world)."""
-    from ..health.checks import check_node
+def health(ws: Any, checked: Checked, node: str, instances: Mapping[int, int] | None = None) -> dict[str, str]:
+    """``{finding id: status}`` of the health checks of ``node`` in
+    ``checked``, each asked as the health stage asks it but with a short
+    budget and no instance scan (the full stage takes a minute on the case
+    study's Agent): a check Z3 cannot decide in its budget is decided by a
+    witness of the shape :func:`finite_witness` looks for (``ok``), else
+    ``inconclusive``; an ``unsat`` answer is a ``problem``.  The
+    non-vacuity of guarantee ``k`` is asked at ``instances[k]`` when given
+    (where it was vacuous before).  The shape findings
+    (:mod:`rclverify.health.shape`) are the stage's own.  The replacement
+    check is not asked again."""
+    from ..health.checks import INSTANCE_TIMEOUT_MS
+    from ..health.shape import shape_findings
+    as_status = {"sat": "ok", "unsat": "problem"}
+    h = _health(ws, checked, node)
+    out: dict[str, str] = {}
+    r = h.sat([], guarantees=False, comment=f"repair check {node}: assumption", timeout_ms=INSTANCE_TIMEOUT_MS)
+    out[f"{node}.assumption-satisfiable"] = as_status.get(r.status, "inconclusive")
+    # the guarantees with a premise, asked before the next queries start a fresh Z3 world
+    premised = [k for k in range(1, len(checked.nodes[node].node.guarantees) + 1) if h.premise(k) is not None]
+    out[f"{node}.contract-consistent"] = as_status.get(consistent(ws, checked, node), "inconclusive")
+    for k in premised:
+        out[f"{node}.g{k}.non-vacuous"] = as_status.get(
+            premise_fires(ws, checked, node, k, (instances or {}).get(k)), "inconclusive")
     world.fresh()
-    facts = [(f.expr, f.loc) for f in ws.plan.facts.get(node, ())]
-    return {f.id: f.status for f in check_node(checked, node, facts, ws.plan.instances.get(node))}
+    out.update({f.id: f.status for f in shape_findings(checked, node)})
+    return out
 
 
 def _health(ws: Any, checked: Checked, node: str) -> Any:

@@ -122,7 +122,7 @@ def guard_repair(ws: Any, node: str, culprit: int, victims: Sequence[tuple[int, 
                 continue
             if recheck.consistent(ws, checked, node) != "sat":
                 continue
-            after = recheck.health(ws, checked, node)
+            after = recheck.health(ws, checked, node, {k: at for k, at in victims if at is not None})
             checks = [{"check": f"{node}.contract-consistent", "status": "consistent (Z3: sat, witness found)"}]
             checks += [{"check": f"{node}.g{k}.non-vacuous" + (f" at {at}" if at is not None else ""),
                         "status": "can fire (Z3: sat, witness found)"} for k, at in victims]
@@ -131,8 +131,9 @@ def guard_repair(ws: Any, node: str, culprit: int, victims: Sequence[tuple[int, 
             summary = (f"Guard guarantee {culprit} of {node} with `{guard}`: Z3 found witnesses that the guarded "
                        f"contract is consistent" + (f" and that {fired} can fire" if victims else "")
                        + f"; no guard of fewer atoms among the {len(atoms)} candidate atoms passed.")
+            # compared with the stage's own statuses: the checks asked again (not the replacement check)
             return _record("guard", summary, edit, source, checks,
-                           recheck.changes({k: v for k, v in before.items() if k in after}, after))
+                           recheck.changes({k: v for k, v in before.items() if k in after or ".g" in k}, after))
     return None
 
 
@@ -185,7 +186,7 @@ def side_condition_repairs(ws: Any, sc: Mapping[str, Any], before_sc: Mapping[st
             return None
         h_before: dict[str, str] = {}
         h_after: dict[str, str] = {}
-        for n in health_nodes:
+        for n in health_nodes:  # both asked the same way, so a change is the edit's
             h_before.update(recheck.health(ws, ws.checked, n))
             h_after.update(recheck.health(ws, checked, n))
             if h_after.get(f"{n}.contract-consistent") != "ok":
