@@ -119,8 +119,9 @@ def finite_witness(h: Any, extra: list[tuple[str, z3.BoolRef]], points: int) -> 
     formulas = [f for _, f in labelled] + list(h.enc.axioms())
     if subs:
         formulas = [z3.substitute_funs(f, *subs) for f in formulas]
-    s = z3.Solver()
-    s.set("timeout", WITNESS_TIMEOUT_MS)
+    # a budget in Z3's resource steps, so the answer does not depend on the machine's load (logic/query.py)
+    from ..logic.query import budgeted_solver
+    s = budgeted_solver(WITNESS_TIMEOUT_MS)
     return "sat" if s.check(*formulas) == z3.sat else "inconclusive"
 
 
