@@ -257,7 +257,8 @@ def _evidence(ws: Any, report: Mapping[str, Any], e: Mapping[str, Any], o: Mappi
                        counterexample=counterexample_table(fv.get("values"), node), guarantee=gk)
     if backend == "property_tests" and isinstance(e.get("counterexample"), dict):
         cex = {kk: v for kk, v in e["counterexample"].items() if kk not in _META_KEYS}
-        sentence = (f"Hypothesis found inputs on which {o.get('data', {}).get('implementation', 'the implementation')} "
+        impl = _obligation_record(ws, node, e["obligation"]).get("data", {}).get("implementation", "the implementation")
+        sentence = (f"Hypothesis found inputs on which {impl} "
                     f"violates {where}; replay: `{e['counterexample'].get('replay', '')}`.")
         return _record(e["obligation"], "property-test", node, e["status"], sentence,
                        culprits=[{"what": where, "source": src, "text": text}],
