@@ -173,6 +173,10 @@ def cmd_verify(args: argparse.Namespace) -> int:
     from doit.cmd_base import ModuleTaskLoader
     from doit.doit_cmd import DoitMain
     from .tasks import DEP_FILE, build_tasks, doit_config
+    if not (Path(args.workspace) / args.plan).is_file():
+        # a missing workspace or plan: the located error `compose` gives, not doit's traceback
+        # when it opens its state file in a directory that does not exist
+        _ws(args).plan
     tasks = build_tasks(Path(args.workspace), args.plan)
     module = type(sys)("rclverify_dodo")
     module.__dict__.update(tasks)
