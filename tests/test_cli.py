@@ -112,7 +112,9 @@ def test_compose_discharges_the_agent_side_condition(tmp_path: Path, capsys: pyt
     ws = copy_workspace(tmp_path)
     assert main(["compose", "-w", str(ws)]) == 0
     out = capsys.readouterr().out
-    assert re.search(r"side condition Agent\.sc1 \[discharged\]: in\.radiationStatus in \{red, orange, green\}", out)
+    # each discharged side condition says which variant discharged it (the paper's rules use guarantees only)
+    assert re.search(r"side condition Agent\.sc1 \[discharged\] \((as written|with producers' assumptions)\): "
+                     r"in\.radiationStatus in \{red, orange, green\}  \(contracts/remote_inspection\.rcl:\d+:\d+\)", out)
     assert "side condition Navigation.sc1 [discharged]" in out
     assert "Localisation: rules (source node)" in out
     assert (ws / "artifacts" / "calculus" / "Agent.sc1.smt2").is_file()
@@ -184,3 +186,15 @@ def test_strict_gate_counts_side_conditions_not_only_evidence(tmp_path: Path) ->
     assert main(["report", "-w", str(tmp_path)]) == 0
     report = json.loads((tmp_path / "reports" / "assurance.json").read_text())
     assert report["obligations"] == [] and report["meta"]["strict_ok"] is False
+
+
+def test_verify_with_a_missing_workspace_or_plan_is_one_located_error(tmp_path: Path,
+                                                                      capsys: pytest.CaptureFixture[str]) -> None:
+    """Not doit's sqlite3.OperationalError or DependencyError: the message compose gives, exit 1."""
+    assert main(["verify", "-w", str(tmp_path / "missing")]) == 1
+    err = capsys.readouterr().err
+    assert err.startswith("contracts/plan.yaml:1:1: error: cannot read the verification plan") and "Traceback" not in err
+    ws = copy_workspace(tmp_path / "ws")
+    assert main(["verify", "-w", str(ws), "--plan", "contracts/missing.yaml"]) == 1
+    assert capsys.readouterr().err.startswith("contracts/missing.yaml:1:1: error: cannot read the verification plan")
+    assert not (tmp_path / "missing").exists()

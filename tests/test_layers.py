@@ -68,6 +68,10 @@ LAYERS: list[tuple[str, tuple[str, ...]]] = [
     # writes into, its terminal listing (show.py) with the commands.
     ("calculus/health", ("rclverify.calculus", "rclverify.health", "rclverify.requirements")),
     ("backends", ("rclverify.backends",)),
+    # diagnosis/: each problem of the report explained and repairs checked by
+    # re-running the calculus, health checks and Hoare triples on edited text
+    # (so above the backends); the report shows the records.
+    ("diagnosis", ("rclverify.diagnosis",)),
     # The workspace (workspace.py: the loaded plan and contracts, artifact
     # paths, snapshots and what makes a result stale) and the cache of its
     # load between runs (wscache.py): read by the report, the stages and the

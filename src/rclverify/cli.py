@@ -10,6 +10,8 @@
 ``rclverify report``               rebuild reports/ from the artifacts
 ``rclverify requirements``         check each formal requirement with Z3 and print its status
 ``rclverify verify [--strict] [--no-wait]``  the whole pipeline through doit (one run at a time per workspace)
+``rclverify status``               the last run's summary and problems, running nothing
+``rclverify explain ID``           one problem's or obligation's diagnosis, counterexample and repairs
 ``rclverify refines A.rcl:N B.rcl:M``  may contract M replace contract N?
 ``rclverify init DIR [--nodes A,B]``  write a new workspace that verifies at once
 ``rclverify bundle [-o FILE]``     the assessor's bundle; ``--verify FILE`` checks one
@@ -114,10 +116,17 @@ def cmd_compose(args: argparse.Namespace) -> int:
         c = stage_compose(ws, n)
         print(f"{n}: rules {', '.join(c['rules']) or '(source node)'}; producers {', '.join(c['producers']) or 'none'}")
         for sc in c["side_conditions"]:
-            print(f"  side condition {sc['id']} [{sc['status']}]: {sc['conjunct']}")
+            variant = f" ({sc['variant']})" if sc["status"] == "discharged" and sc.get("variant") else ""
+            print(f"  side condition {sc['id']} [{sc['status']}]{variant}: {sc['conjunct']}  ({sc['source']})")
+            if sc["status"] != "discharged":
+                print(f"      consumer: {n} assumes {sc['conjunct']}")
+                for h in sc.get("hypotheses", []):
+                    print(f"      producer: {h}")
             if sc["model"]:
-                for k, v in sc["model"].items():
-                    print(f"      {k} = {v}")
+                from .diagnosis.table import counterexample_table
+                from .diagnosis.text import table_lines
+                print("      counterexample:")
+                print("\n".join(table_lines(counterexample_table(sc["model"], n), "        ")))
             bad += sc["status"] != "discharged"
         for inst in c["instances"]:
             print(f"  {inst['rule']} instance conclusion: {inst['conclusion']}")
@@ -180,6 +189,9 @@ def cmd_verify(args: argparse.Namespace) -> int:
     if not Path(args.workspace).is_dir():  # before doit opens its state file there (a sqlite3 traceback)
         print(f"{args.workspace}: error: no such workspace directory", file=sys.stderr)
         return 1
+    if not (Path(args.workspace) / args.plan).is_file():
+        # a missing plan: the located error `compose` gives, not doit's DependencyError
+        _ws(args).plan
     try:  # takes the workspace's run lock: waits for a run in progress unless --no-wait
         tasks = build_tasks(Path(args.workspace), args.plan, wait=False if args.no_wait else None)
     except SystemExit as exc:  # build_tasks printed the one-line reason
@@ -214,6 +226,63 @@ def _run_doit(module: object, argv: list[str], cluster: str | None) -> int:
             del os.environ[CLUSTER_ENV]
         else:
             os.environ[CLUSTER_ENV] = before
+
+
+def _last_run(args: argparse.Namespace, name: str) -> Any:
+    """The JSON file ``name`` of the last run of the workspace, or a located
+    error (exit 1) when there is none."""
+    path = Path(args.workspace) / name
+    try:
+        return json.loads(path.read_text(encoding="utf-8"))
+    except FileNotFoundError:
+        raise RclError([_io_error(path, "no report yet: run `rclverify verify` (or `doit verify`) first")]) from None
+    except (OSError, ValueError) as exc:
+        raise RclError([_io_error(path, f"cannot read it: {exc}")]) from None
+
+
+def _io_error(path: Path, message: str) -> Any:
+    from .rcl.ast import Loc
+    from .rcl.errors import error
+    return error(Loc(str(path), 1, 1), message, "E-io")
+
+
+def cmd_status(args: argparse.Namespace) -> int:
+    """Print the last run's summary table, problems and diagnoses from
+    ``artifacts/report/summary.json`` (the JSON report when there is none);
+    runs nothing.  Exit 0."""
+    from .diagnosis.text import status_lines
+    from .pipeline import Workspace
+    from .report.summary import print_summary, summary_data
+    try:
+        data = _last_run(args, Workspace.SUMMARY)
+    except RclError:
+        data = summary_data(_last_run(args, "reports/assurance.json"))
+    print("\n".join(status_lines(data)))
+    print_summary(data, "reports/assurance.html", rows=data["rows"])
+    return 0
+
+
+def cmd_explain(args: argparse.Namespace) -> int:
+    """Print the diagnosis of the problem or obligation ``args.id`` from the
+    last JSON report (``reports/assurance.json``): sentence, culprits,
+    counterexample table, repairs.  Exit 0; 1 (located) for an unknown id."""
+    from .diagnosis.text import explain_lines, natural_sorted
+    report = _last_run(args, "reports/assurance.json")
+    wanted = args.id
+    for d in report.get("diagnoses", []):
+        if d["id"] == wanted:
+            print("\n".join(explain_lines(d)))
+            return 0
+    for key, kind in (("obligations", "obligation"), ("side_conditions", "side condition"), ("findings", "health check")):
+        for x in report.get(key, []):
+            if x["id"] == wanted:
+                print(f"{wanted} [{x['status']}] ({kind}): no problem to diagnose"
+                      + (f"; {x.get('statement') or x.get('conjunct') or x.get('message')}" if kind else ""))
+                return 0
+    ids = natural_sorted([d["id"] for d in report.get("diagnoses", [])])
+    raise RclError([_io_error(Path(args.workspace) / "reports/assurance.json",
+                              f"no problem or obligation {wanted!r} in the last report"
+                              + (f"; problems: {', '.join(ids)}" if ids else "; it lists no problem"))])
 
 
 def cmd_init(args: argparse.Namespace) -> int:
@@ -363,6 +432,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     add("report", cmd_report, "rebuild the assurance report from the artifacts", True)
     add("requirements", cmd_requirements, "check each formal requirement with Z3 from the composed contracts and "
         "print its status", True).add_argument("--force", action="store_true", help="check every requirement again")
+    add("status", cmd_status, "print the last run's summary and problems (runs nothing)", True)
+    add("explain", cmd_explain, "print one problem's or obligation's diagnosis, counterexample and repairs",
+        True).add_argument("id", help="a problem id (as `rclverify status` lists them) or an obligation id")
     v = add("verify", cmd_verify, "run the whole pipeline with doit", True)
     v.add_argument("--strict", action="store_true",
                    help="exit 1 unless every obligation, side condition and health check holds")

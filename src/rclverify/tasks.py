@@ -277,10 +277,8 @@ def act_verify(root: str, strict: bool) -> Any:
         data = json.loads((Path(root) / Workspace.SUMMARY).read_text(encoding="utf-8"))
     except (OSError, ValueError):
         data = summary_data(json.loads((Path(root) / REPORTS[2]).read_text(encoding="utf-8")))
-    s = data["summary"]
-    print(f"overall: {s['status']} -- {s['headline']}")
-    for p in s["problems"]:
-        print(f"  problem: {p}")
+    from .diagnosis.text import status_lines
+    print("\n".join(status_lines(data)))
     if data.get("requirements"):
         print(requirements_line(data["requirements"]))
     print_summary(data, "reports/assurance.html", rows=data["rows"])

@@ -191,6 +191,29 @@ def conforms(value: Any, typ: T.Type) -> str | None:
     return f"values of type {typ} are not supported"
 
 
+def decimal_text(fr: Fraction) -> str | None:
+    """``fr`` as an exact decimal (``Fraction(1, 5)`` -> ``"0.2"``), or
+    ``None`` when its denominator has a prime factor other than 2 and 5
+    (``1/3`` has no finite decimal).  Counterexamples and models print a
+    rational so where it is exact (docs/values.md)."""
+    d = fr.denominator
+    twos = fives = 0
+    while d % 2 == 0:
+        d //= 2
+        twos += 1
+    while d % 5 == 0:
+        d //= 5
+        fives += 1
+    if d != 1:
+        return None
+    places = max(twos, fives)
+    digits = str(abs(fr.numerator) * 10 ** places // fr.denominator).rjust(places + 1, "0")
+    text = digits[:len(digits) - places] + ("." + digits[len(digits) - places:] if places else "")
+    if "." in text:
+        text = text.rstrip("0").rstrip(".")
+    return ("-" if fr.numerator < 0 else "") + text
+
+
 def render_key(key: tuple[Any, ...]) -> str:
     """``(1.5, 2)`` for a function-table key (``1.5`` for arity 1)."""
     return render(key[0]) if len(key) == 1 else "(" + ", ".join(render(k) for k in key) + ")"
@@ -209,7 +232,9 @@ def render(value: Any) -> str:
     if isinstance(value, float):
         return repr(value)
     if isinstance(value, Fraction):
-        return str(value.numerator) if value.denominator == 1 else f"{value.numerator}/{value.denominator}"
+        if value.denominator == 1:
+            return str(value.numerator)
+        return decimal_text(value) or f"{value.numerator}/{value.denominator}"
     if isinstance(value, str):
         return value
     if isinstance(value, Term):

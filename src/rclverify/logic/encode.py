@@ -36,6 +36,7 @@ from ..rcl.types import (BOOL, NATURAL, CheckedNode, DataT, EmptyT, EnumT, Env, 
                          SetT, TupleT, Type, qualified_base)
 from ..rcl.printer import FLAT_CHAINS, chain_operands, is_type
 from ..rcl.typecheck import domain_type
+from ..values import decimal_text
 
 _SORTS: dict[Type, Any] = {}
 _SORT_NAMES: dict[str, Type] = {}
@@ -660,7 +661,10 @@ def _value_parts(v: z3.ExprRef) -> _Parts:
         if fr.denominator == 1:
             return str(fr.numerator), (), None
         dec = float(fr)
-        return (repr(dec) if Fraction(dec) == fr else f"{fr.numerator}/{fr.denominator}"), (), None
+        if Fraction(dec) == fr:
+            return repr(dec), (), None
+        exact = decimal_text(fr)  # 0.2, not 1/5 (docs/values.md)
+        return (exact or f"{fr.numerator}/{fr.denominator}"), (), None
     if z3.is_algebraic_value(v):
         return str(v.as_decimal(6)), (), None
     if z3.is_true(v):

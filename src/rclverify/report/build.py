@@ -36,6 +36,8 @@ from ..evidence.records import SEVERITY, Obligation, worst
 from ..evidence.store import EvidenceStore
 from ..workspace import Workspace, current_model_hash, current_snapshot_hashes, read_artifact, stale_stages
 from ..system.model import cycles_kept, names_of
+from ..diagnosis.build import diagnose
+from ..diagnosis.text import natural_sorted  # p1 < p2 < p10
 from .expected import expected_rows
 
 _FINDING_AS = {"ok": "discharged", "problem": "failed", "inconclusive": "inconclusive",
@@ -242,7 +244,7 @@ def build_report(ws: Workspace) -> dict[str, Any]:
         tx = texts.node(cn.node)
         guarantees: list[dict[str, Any]] = [
             {"index": k, "text": text, "source": src, "status": g_status(name, k),
-             "obligations": sorted(o.id for o in by_node.get(name, []) if applies(o, name, k))}
+             "obligations": natural_sorted([o.id for o in by_node.get(name, []) if applies(o, name, k)])}
             for k, (text, src) in enumerate(tx["guarantees"], 1)]
         status = worst([g["status"] for g in guarantees] + [sc_status[name]])
         node_status[name] = status
@@ -267,7 +269,7 @@ def build_report(ws: Workspace) -> dict[str, Any]:
                 text, src = texts.node(checked.nodes[s.node].node)["guarantees"][k - 1]
                 support.append({"node": s.node, "guarantee": k, "text": text, "source": src,
                                 "status": g_status(s.node, k),
-                                "obligations": sorted(o.id for o in obligations if applies(o, s.node, k))})
+                                "obligations": natural_sorted([o.id for o in obligations if applies(o, s.node, k)])})
         st = worst([x["status"] for x in support] + [sc_status[x["node"]] for x in support]) if support else "pending"
         requirements.append({"id": r.id, "text": r.text, "status": st, "support": support,
                              **requirement_check(current_record(r, checks.get(r.id)), st, g_status, sc_status)})
@@ -342,7 +344,7 @@ def build_report(ws: Workspace) -> dict[str, Any]:
                             f"(rclverify ros check)")
     headline = _headline(ob_rows, counts, side_conditions, findings)
     system = model.view(node_status, cycles_kept(model, ws.path("artifacts/cache/system-cycles.json")))
-    return {
+    report: dict[str, Any] = {
         "meta": {"tool": "rclverify", "version": __version__, "workspace": plan.name or ws.root.resolve().name, "plan": plan.file,
                  "contracts": list(plan.contracts), "z3_version": z3.get_version_string(), "strict_ok": strict_ok},
         "summary": {"status": overall, "counts": counts, "headline": headline, "problems": problems},
@@ -351,6 +353,11 @@ def build_report(ws: Workspace) -> dict[str, Any]:
         "environment_assumptions": env_assumptions, "pending": pending, "lint": lint_rows,
         "expected_verdicts": expected, "grounding": grounding,
     }
+    # one diagnosis record per problem, with repairs checked by Z3 (docs/diagnosis.md)
+    report["diagnoses"] = diagnose(ws, report)
+    report["summary"]["diagnoses"] = [{"id": d["id"], "kind": d["kind"], "sentence": d["sentence"],
+                                       "repairs": len(d["repairs"])} for d in report["diagnoses"]]
+    return report
 
 
 #: The fields of a requirement's check record (requirements/check.py) the report carries.

@@ -284,6 +284,26 @@ def _grounding_results(report: Mapping[str, Any]) -> tuple[list[dict[str, Any]],
     return out, rules
 
 
+def _attach_diagnoses(report: Mapping[str, Any], results: Sequence[dict[str, Any]]) -> None:
+    """Give each result its diagnosis (``properties.diagnosis``: the
+    sentence naming the culprit) and its repairs as SARIF ``fix`` objects
+    (§3.55; each repair was checked by Z3 before it entered the report,
+    docs/diagnosis.md).  A report without ``diagnoses`` is left as it is."""
+    from ..diagnosis.edits import sarif_fix
+    by_key: dict[str, Mapping[str, Any]] = {}
+    for d in report.get("diagnoses", []):
+        for prefix in ("health", "side-condition", "obligation"):
+            by_key[f"{prefix}:{d['id']}"] = d
+    for res in results:
+        d = by_key.get(res["partialFingerprints"]["rclverifyItem/v1"])
+        if d is None:
+            continue
+        res["properties"]["diagnosis"] = d["sentence"]
+        fixes = [sarif_fix(r["summary"], r["edit"]) for r in d.get("repairs", []) if r.get("edit")]
+        if fixes:
+            res["fixes"] = fixes
+
+
 def _descriptor(r: Rule) -> dict[str, Any]:
     return {"id": r.id, "name": r.name, "shortDescription": {"text": r.text},
             "defaultConfiguration": {"level": r.level}}
@@ -303,6 +323,7 @@ def sarif_log(report: Mapping[str, Any]) -> dict[str, Any]:
     ground, ground_rules = _grounding_results(report)
     results = (_obligation_results(report) + _side_condition_results(report) + _finding_results(report) + lint + ground
                + _requirement_results(report))
+    _attach_diagnoses(report, results)
     rules: Sequence[Rule] = list(RULES.values()) + lint_rules + ground_rules
     index = {r.id: i for i, r in enumerate(rules)}
     for res in results:

@@ -1,0 +1,308 @@
+"""One diagnosis record per problem of the report dict.
+
+:func:`diagnose` reads the report dict (:func:`rclverify.report.build.build_report`)
+and the workspace and returns ``[record, ...]``, each::
+
+    {"id": problem id (finding, side condition or obligation id),
+     "kind": "vacuity" | "inconsistency" | "unsatisfiable-assumption" | "refinement"
+             | "side-condition" | "hoare" | "monitor" | "property-test" | "evidence",
+     "node": str, "status": str,
+     "sentence": one sentence naming the culprit by source location,
+     "culprits": [{"what": str, "source": "file:line:col", "text": str}],
+     "counterexample": [{"node", "variable", "value", "table"}]  (diagnosis.table),
+     "repairs": [repair, ...]  (diagnosis.repairs; each checked by Z3),
+     "related": [ids of other problems of the same node and guarantee]}
+
+Repairs cost Z3 queries (a minute for the case study's Agent), so each
+problem's repairs are kept in ``artifacts/cache/diagnosis.json`` keyed by the
+sha256 of everything they are computed from: the problem record, the
+contract files, the plan, the program, and the rclverify and Z3 versions.
+Deleting the cache is always safe.
+"""
+from __future__ import annotations
+
+import hashlib
+import json
+import re
+from pathlib import Path
+from typing import Any, Callable, Mapping
+
+import z3
+
+from .. import __version__
+from ..evidence.store import atomic_write_text
+from ..rcl.errors import RclError
+from . import repairs as rep
+from .culprits import culprits, parse_core, plan_facts
+from .table import counterexample_table
+
+CACHE = "artifacts/cache/diagnosis.json"
+#: Most entries the cache keeps.
+KEEP = 200
+_META_KEYS = {"conjunct", "facts", "guarantee", "reason", "replay", "source"}
+
+
+class _Cache:
+    def __init__(self, ws: Any) -> None:
+        self.ws = ws
+        self.path = ws.path(CACHE)
+        try:
+            self.data: dict[str, Any] = json.loads(self.path.read_text(encoding="utf-8"))
+        except (OSError, ValueError):
+            self.data = {}
+        self.used: dict[str, Any] = {}
+        files = sorted({*ws.plan.contracts, ws.plan.file})
+        h = hashlib.sha256(f"{__version__} {z3.get_version_string()}".encode())
+        for src in sorted(Path(__file__).parent.glob("*.py")):  # the repair search's own code
+            h.update(src.read_bytes())
+        for rel in files:
+            try:
+                h.update(rel.encode() + b"\0" + ws.path(rel).read_bytes())
+            except OSError:
+                pass
+        self.base = h.hexdigest()
+
+    def get(self, key: Any, make: Callable[[], Any], extra_file: str | None = None) -> Any:
+        h = hashlib.sha256((self.base + json.dumps(key, sort_keys=True, default=str)).encode())
+        if extra_file:
+            try:
+                h.update(self.ws.path(extra_file).read_bytes())
+            except OSError:
+                pass
+        k = h.hexdigest()
+        if k not in self.data:
+            try:
+                # as the cache file holds it (sorted keys), so a fresh result and a kept one are the same
+                # data, key order included (the report's kept pieces are keyed by it: report/fragments.py)
+                self.data[k] = json.loads(json.dumps(make(), sort_keys=True))
+            except (z3.Z3Exception, RclError, OSError, ValueError, KeyError):
+                # a checker that misbehaves gives no repair (and nothing is kept)
+                return None
+        self.used[k] = self.data[k]
+        return self.used[k]
+
+    def save(self) -> None:
+        try:
+            # what this report used, and earlier entries up to KEEP in all (an edit undone finds them again)
+            kept = dict(self.used)
+            for k, v in self.data.items():
+                if len(kept) >= KEEP:
+                    break
+                kept.setdefault(k, v)
+            atomic_write_text(self.path, json.dumps(kept, sort_keys=True, indent=0))
+        except OSError:
+            pass  # a pure speed-up
+
+
+def _guarantee_source(report: Mapping[str, Any], node: str, k: int) -> tuple[str, str]:
+    for n in report["nodes"]:
+        if n["name"] == node and 1 <= k <= len(n["guarantees"]):
+            g = n["guarantees"][k - 1]
+            return g["text"], g["source"]
+    return "", ""
+
+
+def diagnose(ws: Any, report: Mapping[str, Any]) -> list[dict[str, Any]]:
+    """The diagnosis records of every problem of ``report`` (see the module
+    docstring), in the order of the report's problems list: health
+    findings, side conditions, evidence."""
+    cache = _Cache(ws)
+    out: list[dict[str, Any]] = []
+    health_by_node: dict[str, dict[str, str]] = {}
+    for f in report["findings"]:
+        health_by_node.setdefault(f["node"], {})[f["id"]] = f["status"]
+    # which guarantees of a node each culprit guarantee makes vacuous (one guard repair for all of them)
+    victims: dict[tuple[str, int], list[tuple[int, int | None]]] = {}
+    for f in report["findings"]:
+        if f["status"] == "problem" and f["check"] == "non-vacuous":
+            vac = sorted(int(x) for x, st in (f.get("instances") or {}).items() if st == "vacuous")
+            victim = (f["guarantee"], vac[0] if vac else None)  # where it was vacuous
+            for m in culprits(parse_core(f.get("core")), f["guarantee"]):
+                if m.kind == "guarantee" and victim not in victims.setdefault((f["node"], m.index), []):
+                    victims[(f["node"], m.index)].append(victim)
+
+    def guard(node: str, c: int) -> dict[str, Any] | None:
+        vs = sorted(victims.get((node, c), []), key=lambda v: v[0])
+        found: dict[str, Any] | None = cache.get(["guard", node, c, vs, health_by_node.get(node, {})],
+                                                 lambda: rep.guard_repair(ws, node, c, vs,
+                                                                          health_by_node.get(node, {})))
+        return found
+
+    for f in report["findings"]:
+        if f["status"] != "problem":
+            continue
+        out.append(_finding(ws, report, f, guard))
+    sc_before = {sc["id"]: sc["status"] for sc in report["side_conditions"]}
+    for sc in report["side_conditions"]:
+        if sc["status"] in ("failed", "inconclusive"):
+            out.append(_side_condition(ws, report, sc, cache, sc_before))
+    obligations = {o["id"]: o for o in report["obligations"]}
+    for e in report["evidence"]:
+        if e["status"] in ("failed", "error"):
+            out.append(_evidence(ws, report, e, obligations.get(e["obligation"], {}), cache))
+    # the same node and guarantee found by several techniques: each record names the others
+    by_key: dict[tuple[str, Any], list[str]] = {}
+    for d in out:
+        by_key.setdefault((d["node"], d.get("guarantee")), []).append(d["id"])
+    for d in out:
+        d["related"] = [x for x in by_key[(d["node"], d.get("guarantee"))] if x != d["id"]] if d.get("guarantee") else []
+    cache.save()
+    return out
+
+
+def _record(id: str, kind: str, node: str, status: str, sentence: str, **kw: Any) -> dict[str, Any]:
+    return {"id": id, "kind": kind, "node": node, "status": status, "sentence": sentence,
+            "culprits": kw.get("culprits", []), "counterexample": kw.get("counterexample", []),
+            "repairs": [r for r in kw.get("repairs", []) if r], "guarantee": kw.get("guarantee")}
+
+
+def _finding(ws: Any, report: Mapping[str, Any], f: Mapping[str, Any], guard: Callable[[str, int], Any]) -> dict[str, Any]:
+    node, k = f["node"], f["guarantee"]
+    facts = plan_facts(ws, node)
+    members = parse_core(f.get("core"), facts)
+    table = counterexample_table(f.get("model"), node)
+    if f["check"] == "non-vacuous":
+        text, src = _guarantee_source(report, node, k)
+        cs = culprits(members, k)
+        names = [m.name() for m in cs]
+        sentence = (f"Guarantee {k} of {node} ({src}) can never fire"
+                    + (f" for {_after(f['message'], ' is vacuous for ', ':')}" if " is vacuous for " in f["message"] else "")
+                    + ": " + (_and(names) + (" exclude" if len(names) > 1 else " excludes") + " its premise"
+                              if names else "its premise contradicts the node's contract") + ".")
+        reps = [guard(node, m.index) for m in cs if m.kind == "guarantee"]
+        kind = "vacuity"
+    elif f["check"] in ("contract-consistent", "assumption-satisfiable"):
+        names = [m.name() for m in members]
+        kind = "inconsistency" if f["check"] == "contract-consistent" else "unsatisfiable-assumption"
+        what = "contract" if kind == "inconsistency" else "assumption"
+        sentence = (f"The {what} of {node} cannot hold: " + (_and(names) + " contradict each other" if names
+                                                               else "Z3 found no way to satisfy it") + ".")
+        cs = members
+        reps = [guard(node, m.index) for m in members if m.kind == "guarantee"] if kind == "inconsistency" else []
+    else:
+        cs, reps, kind = [], [], "refinement" if f["check"] == "replacement-refines" else f["check"]
+        sentence = f["message"] + (" " + f["explanation"] if f.get("explanation") else "")
+    return _record(f["id"], kind, node, "failed", sentence,
+                   culprits=[{"what": m.name(), "source": m.source, "text": m.text} for m in cs],
+                   counterexample=table, repairs=[r for r in reps if r], guarantee=k)
+
+
+def _after(text: str, start: str, stop: str) -> str:
+    return text.split(start, 1)[1].split(stop, 1)[0]
+
+
+def _and(items: list[str]) -> str:
+    return items[0] if len(items) == 1 else ", ".join(items[:-1]) + " and " + items[-1]
+
+
+def _side_condition(ws: Any, report: Mapping[str, Any], sc: Mapping[str, Any], cache: _Cache,
+                    sc_before: Mapping[str, str]) -> dict[str, Any]:
+    pairs = rep._link_pairs(sc)
+    cul = [{"what": f"assumption of {sc['node']}: `{sc['conjunct']}`", "source": sc["source"], "text": sc["conjunct"]}]
+    said = []
+    for p, ov, _, _ in pairs:
+        for n in report["nodes"]:
+            if n["name"] != p:
+                continue
+            for g in n["guarantees"]:
+                if re.search(rf"out\.{re.escape(ov)}(?!\w)", g["text"]):
+                    cul.append({"what": f"guarantee {g['index']} of {p}: `{g['text']}`", "source": g["source"],
+                                "text": g["text"]})
+                    said.append(f"{p}'s guarantee {g['index']} ({g['source']}) `{g['text']}`")
+    table = counterexample_table(sc.get("model"), sc["node"])
+    cex = ", ".join(f"{r['node']}.{r['variable']} = {r['value']}" for r in table)
+    sentence = (f"{sc['node']} assumes `{sc['conjunct']}` ({sc['source']}), but "
+                + (_and(said) if said else "its producers' guarantees")
+                + (" allow" if len(said) > 1 else " allows") + " values outside it"
+                + (f": Z3's counterexample {cex}" if cex else "") + ".")
+    if sc["status"] == "inconclusive":
+        sentence = f"Z3 could not decide whether {sc['node']}'s assumption `{sc['conjunct']}` ({sc['source']}) follows from " \
+                   + (_and(said) if said else "its producers' guarantees") + "."
+    reps = (cache.get(["side-condition", sc["id"], sc["conjunct"], dict(sc_before)],
+                      lambda: rep.side_condition_repairs(ws, sc, sc_before)) or []) if sc["status"] == "failed" else []
+    return _record(sc["id"], "side-condition", sc["node"], sc["status"], sentence, culprits=cul,
+                   counterexample=table, repairs=reps)
+
+
+def _obligation_record(ws: Any, node: str, oid: str) -> Mapping[str, Any]:
+    try:
+        records = json.loads(ws.path(ws.obligations(node)).read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        records = []
+    for o in records:
+        if isinstance(o, dict) and o.get("id") == oid:
+            return dict(o)
+    return {}
+
+
+def _evidence(ws: Any, report: Mapping[str, Any], e: Mapping[str, Any], o: Mapping[str, Any],
+              cache: _Cache) -> dict[str, Any]:
+    node, k = o.get("node", e["obligation"].split(".", 1)[0]), o.get("guarantee", 0)
+    backend = e["backend"]
+    text, src = _guarantee_source(report, node, k) if k else ("", o.get("source", ""))
+    where = f"guarantee {k} of {node} ({src})" if k else f"the contract of {node} ({o.get('source', '')})"
+    if backend == "hoare" and e["status"] == "failed":
+        return _hoare(ws, report, e, o, cache)
+    mon = e.get("monitoring") or {}
+    fv = mon.get("first_violation") if isinstance(mon, dict) else None
+    if backend == "monitors" and fv:
+        gk = fv.get("guarantee")
+        gtext, gsrc = _guarantee_source(report, node, gk) if gk else ("", "")
+        sentence = (f"In {mon.get('trace', 'the trace')}, the output at {fv.get('where')} (t = {fv.get('time')} s) "
+                    f"answering the input at {fv.get('trigger_where')} violates guarantee {gk} of {node} ({gsrc})"
+                    f"; {mon.get('counts', {}).get('violated', '?')} input event(s) of the run violate the contract.")
+        return _record(e["obligation"], "monitor", node, e["status"], sentence,
+                       culprits=[{"what": f"event {fv.get('where')}", "source": fv.get("where", ""), "text": ""},
+                                 {"what": f"guarantee {gk} of {node}", "source": gsrc, "text": gtext}],
+                       counterexample=counterexample_table(fv.get("values"), node), guarantee=gk)
+    if backend == "property_tests" and isinstance(e.get("counterexample"), dict):
+        cex = {kk: v for kk, v in e["counterexample"].items() if kk not in _META_KEYS}
+        impl = _obligation_record(ws, node, e["obligation"]).get("data", {}).get("implementation", "the implementation")
+        sentence = (f"Hypothesis found inputs on which {impl} "
+                    f"violates {where}; replay: `{e['counterexample'].get('replay', '')}`.")
+        return _record(e["obligation"], "property-test", node, e["status"], sentence,
+                       culprits=[{"what": where, "source": src, "text": text}],
+                       counterexample=counterexample_table(cex, node), guarantee=k)
+    expl = str(e.get("explanation", ""))
+    first = expl.split("; ")[0] if len(expl) > 300 else expl
+    return _record(e["obligation"], "evidence", node, e["status"],
+                   f"{backend} evidence for {where} is {e['status']}: {first}",
+                   culprits=[{"what": where, "source": src, "text": text}],
+                   counterexample=counterexample_table(e.get("counterexample") if isinstance(e.get("counterexample"), dict) else None, node),
+                   guarantee=k)
+
+
+def _hoare(ws: Any, report: Mapping[str, Any], e: Mapping[str, Any], o: Mapping[str, Any], cache: _Cache) -> dict[str, Any]:
+    from ..backends.hoare import lang
+    node, k = o["node"], o["guarantee"]
+    rec = _obligation_record(ws, node, e["obligation"])
+    data = rec.get("data", {})
+    program = data.get("program", "")
+    conj, conj_src = data.get("conjunct_rcl", ""), data.get("conjunct_source", "")
+    prog_consts: list[str] = []
+    try:
+        prog = lang.parse_program(ws.path(program).read_text(encoding="utf-8"), program)
+        prog_consts = [f"{program}:{n.loc.line}: {n.text}" for n in rep._numbers(prog.body)]
+        prog_texts = [n.text for n in rep._numbers(prog.body)]
+    except Exception:  # noqa: BLE001 - a program that no longer parses: no constants named
+        prog_texts = []
+    # the guarantee's thresholds the program does not use (0, a sign bound, is no threshold)
+    gtext, gsrc = _guarantee_source(report, node, k)
+    conj_nums = sorted(set(re.findall(r"(?<![\w.])\d+(?:\.\d+)?(?![\w.])", gtext)) - set(prog_texts) - {"0"},
+                       key=float)
+    cex = e.get("counterexample") or {}
+    table = counterexample_table({kk: v for kk, v in cex.items() if "(final)" not in kk}, node)
+    inputs = ", ".join(f"{kk} = {v}" for kk, v in cex.items() if kk.startswith("in."))
+    outputs = ", ".join(f"{kk} = {v}" for kk, v in cex.items() if kk.startswith("out."))
+    sentence = (f"{program} and guarantee {k} of {node} ({gsrc}) disagree on their constants: the program "
+                f"compares with {'/'.join(prog_texts) or 'other constants'} (" + ", ".join(prog_consts) + ") where the "
+                f"guarantee uses {'/'.join(conj_nums) or 'other constants'}; on {inputs or 'the counterexample'} the "
+                f"program gives {outputs or 'another output'}, which the conjunct `{conj}` ({conj_src}) rules out.")
+    before = {ob["id"]: ob["status"] for ob in report["obligations"]
+              if ob["node"] == node and ob["backend"] == "hoare" and ob["instance"].split(".c")[0] == e["obligation"].split(".hoare.", 1)[-1].split(".c")[0]}
+    reps = cache.get(["hoare", e["obligation"], program, before],
+                     lambda: rep.hoare_repair(ws, node, k, program, before), extra_file=program)
+    return _record(e["obligation"], "hoare", node, e["status"], sentence,
+                   culprits=[{"what": f"{program} line {c.split(':')[1]}", "source": c.rsplit(':', 1)[0], "text": c.rsplit(': ', 1)[1]}
+                             for c in prog_consts] + [{"what": f"conjunct of guarantee {k} of {node}", "source": conj_src, "text": conj}],
+                   counterexample=table, repairs=[reps] if reps else [], guarantee=k)

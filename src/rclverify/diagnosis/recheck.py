@@ -1,0 +1,208 @@
+"""The workspace's contracts (or a backend's program) with one edit made,
+checked again by the pipeline's own Z3 checks.
+
+Nothing here writes to the workspace: an edited contract file is parsed
+from text under its own name, an edited program is written to a temporary
+directory that stands in for the workspace root.  Every answer comes from
+the real checks (:func:`rclverify.health.checks.check_node`,
+:func:`rclverify.calculus.compose.compose_node`, the Hoare backend's
+:func:`~rclverify.backends.hoare.solve.check_all`).
+"""
+from __future__ import annotations
+
+import shutil
+import tempfile
+from dataclasses import replace
+from pathlib import Path
+from typing import Any, Mapping
+
+import z3
+
+from ..logic import world
+from ..rcl.errors import RclError
+from ..rcl.parser import parse_text
+from ..rcl.typecheck import check
+from ..rcl.types import Checked
+from ..system.model import SystemModel, build
+from .edits import Edit
+
+#: Points of each function table :func:`finite_witness` gives values (at least the plan's instances).
+WITNESS_POINTS = 4
+WITNESS_TIMEOUT_MS = 5_000
+
+
+def source_text(ws: Any, rel: str) -> str:
+    """The text of the workspace file ``rel``."""
+    return str(ws.path(rel).read_text(encoding="utf-8"))
+
+
+def edited_system(ws: Any, edit: Edit) -> tuple[Checked, SystemModel] | None:
+    """The type-checked system and its model with ``edit`` made to one
+    contract file; ``None`` when the edited text does not parse or check."""
+    specs = []
+    try:
+        for rel in ws.plan.contracts:
+            text = source_text(ws, rel)
+            if rel == edit.file:
+                text = edit.apply(text)
+            specs.append(parse_text(text, rel))
+        checked = check(specs)
+        return checked, build(checked, ws.plan.connections)
+    except (RclError, KeyError, ValueError):
+        return None
+
+
+def health(ws: Any, checked: Checked, node: str, instances: Mapping[int, int] | None = None) -> dict[str, str]:
+    """``{finding id: status}`` of the health checks of ``node`` in
+    ``checked``, each asked as the health stage asks it but with a short
+    budget and no instance scan (the full stage takes a minute on the case
+    study's Agent): a check Z3 cannot decide in its budget is decided by a
+    witness of the shape :func:`finite_witness` looks for (``ok``), else
+    ``inconclusive``; an ``unsat`` answer is a ``problem``.  The
+    non-vacuity of guarantee ``k`` is asked at ``instances[k]`` when given
+    (where it was vacuous before).  The shape findings
+    (:mod:`rclverify.health.shape`) are the stage's own.  The replacement
+    check is not asked again."""
+    from ..health.checks import INSTANCE_TIMEOUT_MS
+    from ..health.shape import shape_findings
+    as_status = {"sat": "ok", "unsat": "problem"}
+    h = _health(ws, checked, node)
+    out: dict[str, str] = {}
+    r = h.sat([], guarantees=False, comment=f"repair check {node}: assumption", timeout_ms=INSTANCE_TIMEOUT_MS)
+    out[f"{node}.assumption-satisfiable"] = as_status.get(r.status, "inconclusive")
+    # the guarantees with a premise, asked before the next queries start a fresh Z3 world
+    premised = [k for k in range(1, len(checked.nodes[node].node.guarantees) + 1) if h.premise(k) is not None]
+    out[f"{node}.contract-consistent"] = as_status.get(consistent(ws, checked, node), "inconclusive")
+    for k in premised:
+        out[f"{node}.g{k}.non-vacuous"] = as_status.get(
+            premise_fires(ws, checked, node, k, (instances or {}).get(k)), "inconclusive")
+    world.fresh()
+    out.update({f.id: f.status for f in shape_findings(checked, node)})
+    return out
+
+
+def _health(ws: Any, checked: Checked, node: str) -> Any:
+    from ..health.checks import _NodeHealth, INSTANCE_TIMEOUT_MS
+    world.fresh()
+    facts = [(f.expr, f.loc) for f in ws.plan.facts.get(node, ())]
+    return _NodeHealth(checked, checked.nodes[node], facts, None, INSTANCE_TIMEOUT_MS)
+
+
+def finite_witness(h: Any, extra: list[tuple[str, z3.BoolRef]], points: int) -> str:
+    """Look for a witness of ``h``'s assumption, guarantees and facts and
+    ``extra`` in which every function-typed input is a finite table: its
+    value at the ``points`` points ``(j, 0, ..., 0)`` (``j = 0..points-1``;
+    arguments of REAL, INTEGER or NATURAL type) is a free constant, and one
+    free constant elsewhere.  A model of that is a model of the original
+    query (the functions interpreted as those tables), so ``sat`` is a
+    witness; ``unsat`` only says there is none of this shape and is
+    returned as ``inconclusive``.  Z3 decides these quickly where the
+    general query with uninterpreted functions over the reals is
+    ``unknown`` (the case study's Agent)."""
+    labelled = list(h.assume) + list(h.guars) + list(h.facts) + list(extra)
+    subs = []
+    for name, sym in list(h.enc.symbols.items()):
+        d = sym.decl
+        if not isinstance(d, z3.FuncDeclRef) or d.arity() == 0:
+            continue
+        if not all(d.domain(m) in (z3.RealSort(), z3.IntSort()) for m in range(d.arity())):
+            continue
+        params = [z3.Var(j, d.domain(j)) for j in range(d.arity())]
+        body: z3.ExprRef = z3.Const(f"{name}!else", d.range())
+        for j in range(points):
+            pt = [(z3.RealVal(j if m == 0 else 0) if d.domain(m) == z3.RealSort() else z3.IntVal(j if m == 0 else 0))
+                  for m in range(d.arity())]
+            # de Bruijn: Var(0) is the last argument
+            cond = z3.And(*[params[d.arity() - 1 - m] == pt[m] for m in range(d.arity())])
+            body = z3.If(cond, z3.Const(f"{name}!v{j}", d.range()), body)
+        subs.append((d, body))
+    formulas = [f for _, f in labelled] + list(h.enc.axioms())
+    if subs:
+        formulas = [z3.substitute_funs(f, *subs) for f in formulas]
+    # a budget in Z3's resource steps, so the answer does not depend on the machine's load (logic/query.py)
+    from ..logic.query import budgeted_solver
+    s = budgeted_solver(WITNESS_TIMEOUT_MS)
+    return "sat" if s.check(*formulas) == z3.sat else "inconclusive"
+
+
+def _points(ws: Any, node: str) -> int:
+    inst = ws.plan.instances.get(node)
+    return max(WITNESS_POINTS, inst[1] + 1) if inst else WITNESS_POINTS
+
+
+def premise_fires(ws: Any, checked: Checked, node: str, k: int, at: int | None = None) -> str:
+    """Can the premise of guarantee ``k`` of ``node`` (at ``at`` for its
+    first NATURAL variable, when given) hold together with the assumption,
+    every guarantee and the facts?  ``sat`` when Z3 found a witness: for the
+    query of the health check ``non-vacuous``, or, when Z3 cannot decide
+    that, of the shape :func:`finite_witness` looks for; else ``unsat`` or
+    ``inconclusive``."""
+    from ..health.checks import INSTANCE_TIMEOUT_MS
+    h = _health(ws, checked, node)
+    var = h.natural_vars(k)
+    prem = h.premise(k, {var[0]: at} if at is not None and var else None)
+    if prem is None:
+        return "inconclusive"
+    r = h.sat(prem[0], comment=f"repair check {node}: can the premise of guarantee {k} hold?",
+              timeout_ms=INSTANCE_TIMEOUT_MS)
+    if r.status != "inconclusive":
+        return str(r.status)
+    return finite_witness(h, prem[0], _points(ws, node))
+
+
+def consistent(ws: Any, checked: Checked, node: str) -> str:
+    """Can the assumption, every guarantee and the facts of ``node`` hold
+    together?  ``sat`` (a witness: the general query or :func:`finite_witness`),
+    ``unsat`` or ``inconclusive``."""
+    from ..health.checks import INSTANCE_TIMEOUT_MS
+    h = _health(ws, checked, node)
+    r = h.sat([], comment=f"repair check {node}: is the contract consistent?", timeout_ms=INSTANCE_TIMEOUT_MS)
+    if r.status != "inconclusive":
+        return str(r.status)
+    return finite_witness(h, [], _points(ws, node))
+
+
+def side_conditions(checked: Checked, model: SystemModel, node: str) -> dict[str, str]:
+    """``{side condition id: status}`` of ``node`` in the edited system (a fresh Z3 world)."""
+    from ..calculus.compose import compose_node
+    world.fresh()
+    return {sc.id: sc.status for sc in compose_node(checked, model, node).side_conditions}
+
+
+def hoare_statuses(ws: Any, node: str, index: int, program: str, new_text: str) -> dict[str, str]:
+    """``{obligation id: status}`` of every Hoare triple of the plan entry
+    ``index`` of ``node`` with its program replaced by ``new_text`` (written to
+    a temporary copy of the program's path; the workspace is not touched).
+    A pending triple is ``pending``; a triple Z3 cannot decide ``inconclusive``."""
+    from ..backends.hoare.backend import prepare
+    from ..backends.hoare.solve import check_all
+    world.fresh()
+    tmp = Path(tempfile.mkdtemp(prefix="rclverify-repair-"))
+    try:
+        dest = tmp / program
+        dest.parent.mkdir(parents=True, exist_ok=True)
+        dest.write_text(new_text, encoding="utf-8")
+        target = replace(ws.target(node, index), root=tmp, artifacts=tmp / "artifacts")
+        out: dict[str, str] = {}
+        for p in prepare(target):
+            if p.pending or p.triple is None:
+                out[p.id] = "pending"
+                continue
+            res = check_all(p.vcs, p.triple.background, p.model, p.config.timeout_ms, p.triple.observe,
+                            p.triple.observe_final, p.triple.names)
+            out[p.id] = res.status if res.status in ("discharged", "failed") else "inconclusive"
+        return out
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)
+
+
+def changes(before: Mapping[str, str], after: Mapping[str, str]) -> list[dict[str, str]]:
+    """What changes status: ``[{"check", "before", "after"}]`` for every key
+    of either mapping whose status differs (a check that disappears is
+    ``absent``)."""
+    out = []
+    for k in sorted(set(before) | set(after)):
+        a, b = before.get(k, "absent"), after.get(k, "absent")
+        if a != b:
+            out.append({"check": k, "before": a, "after": b})
+    return out

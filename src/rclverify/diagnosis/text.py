@@ -1,0 +1,81 @@
+"""Diagnosis records as terminal text (``rclverify explain``, ``status``)."""
+from __future__ import annotations
+
+from typing import Any, Mapping, Sequence
+
+
+#: Longest diagnosis sentence ``status`` prints (``explain`` prints it whole).
+SENTENCE = 400
+
+
+def _natural_key(text: str) -> list[Any]:
+    import re
+    return [int(t) if t.isdigit() else t for t in re.split(r"(\d+)", text)]
+
+
+def natural_sorted(ids: Sequence[str]) -> list[str]:
+    """``ids`` in natural order (``p1 < p2 < p10``)."""
+    return sorted(ids, key=_natural_key)
+
+
+def table_lines(rows: Sequence[Mapping[str, Any]], indent: str = "  ") -> list[str]:
+    """A counterexample table (:func:`rclverify.diagnosis.table.counterexample_table`)
+    as aligned text: node, variable, value; a function's finite table below it."""
+    if not rows:
+        return []
+    w_node = max(len("node"), *(len(str(r["node"])) for r in rows))
+    w_var = max(len("variable"), *(len(str(r["variable"])) for r in rows))
+    out = [f"{indent}{'node':<{w_node}}  {'variable':<{w_var}}  value"]
+    for r in rows:
+        t = r.get("table")
+        if t:
+            out.append(f"{indent}{r['node']:<{w_node}}  {r['variable']:<{w_var}}  function:")
+            for args, v in t["rows"]:
+                out.append(f"{indent}{'':<{w_node}}  {'':<{w_var}}    {args} -> {v}")
+            if t.get("more"):
+                out.append(f"{indent}{'':<{w_node}}  {'':<{w_var}}    ... {t['more']} more points")
+            out.append(f"{indent}{'':<{w_node}}  {'':<{w_var}}    elsewhere -> {t['else']}")
+        else:
+            out.append(f"{indent}{r['node']:<{w_node}}  {r['variable']:<{w_var}}  {r['value']}")
+    return out
+
+
+def explain_lines(d: Mapping[str, Any]) -> list[str]:
+    """One diagnosis record as text: sentence, culprits, counterexample, repairs with their diffs and cost."""
+    out = [f"{d['id']} [{d['status']}] ({d['kind']})", f"  {d['sentence']}"]
+    if d.get("culprits"):
+        out.append("  culprits:")
+        out += [f"    {c['what']}" + (f"  ({c['source']})" if c.get("source") and c["source"] not in c["what"] else "")
+                for c in d["culprits"]]
+    if d.get("counterexample"):
+        out.append("  counterexample:")
+        out += table_lines(d["counterexample"], "    ")
+    if d.get("related"):
+        out.append("  the same guarantee, found by: " + ", ".join(natural_sorted(d["related"])))
+    if not d.get("repairs"):
+        out.append("  repairs: none that Z3 could check")
+    for k, r in enumerate(d.get("repairs", []), 1):
+        out.append(f"  repair {k} ({r['kind']}, checked by {r['checked_by']}): {r['summary']}")
+        for c in r.get("checks", []):
+            out.append(f"    checked: {c['check']}: {c['status']}")
+        if r.get("cost"):
+            out += [f"    changes: {c['check']}: {c['before']} -> {c['after']}" for c in r["cost"]]
+        else:
+            out.append("    changes: no other check changes status")
+        out += ["    " + line for line in r["diff"].rstrip("\n").splitlines()]
+    return out
+
+
+def status_lines(data: Mapping[str, Any]) -> list[str]:
+    """The overall line, the problems and their one-sentence diagnoses of a
+    summary (``artifacts/report/summary.json``)."""
+    s = data["summary"]
+    out = [f"overall: {s['status']} -- {s['headline']}"]
+    out += [f"  problem: {p}" for p in s["problems"]]
+    for d in s.get("diagnoses", []):
+        sentence = d["sentence"]
+        if len(sentence) > SENTENCE:
+            sentence = sentence[:SENTENCE].rsplit(" ", 1)[0] + " ..."
+        more = (f"{d['repairs']} checked repair{'s' if d['repairs'] != 1 else ''}: " if d.get("repairs") else "")
+        out.append(f"  diagnosis {d['id']}: {sentence} ({more}rclverify explain {d['id']})")
+    return out

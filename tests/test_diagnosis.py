@@ -1,0 +1,242 @@
+"""Diagnosis records and repairs checked by Z3 (docs/diagnosis.md): the
+culprit named by source location, counterexamples as tables, and repairs
+shown only after Z3 checked them, on small real workspaces."""
+from __future__ import annotations
+
+import json
+import shutil
+from fractions import Fraction
+from pathlib import Path
+from typing import Any
+
+import jsonschema
+import pytest
+import z3
+
+from rclverify.cli import main
+from rclverify.diagnosis.build import CACHE, diagnose
+from rclverify.diagnosis.table import counterexample_table, decimals, function_table
+from rclverify.values import decimal_text
+from rclverify.diagnosis.text import natural_sorted
+from rclverify.pipeline import Workspace, stage_check, stage_compose, stage_export, stage_health, stage_run
+from rclverify.report.build import build_report
+from rclverify.report.sarif import sarif_log
+
+REPO = Path(__file__).resolve().parents[1]
+SARIF_SCHEMA = REPO / "tests" / "data" / "sarif-schema-2.1.0.json"
+
+
+def _run(root: Path) -> tuple[Workspace, dict[str, Any]]:
+    """Check, compose, health, export and run every obligation of ``root``; the report dict."""
+    ws = Workspace(root)
+    stage_check(ws)
+    for n in ws.node_names():
+        stage_compose(ws, n)
+        stage_health(ws, n)
+        for o in stage_export(ws, n):
+            stage_run(ws, n, o["id"])
+    return ws, build_report(ws)
+
+
+@pytest.fixture()
+def newcomer(tmp_path: Path) -> Path:
+    """The newcomer's three-node system: Planner guarantees speed <= 2.0, Controller assumes <= 1.5."""
+    shutil.copytree(REPO / "tests" / "data" / "newcomer", tmp_path / "ws")
+    return tmp_path / "ws"
+
+
+SENSOR_PLAN = """name: sensor
+contracts: [contracts/sensor.rcl]
+requirements: []
+connections: []
+environment: {}
+nodes:
+  RadiationSensor:
+    evidence:
+      - backend: hoare
+        program: backends/hoare/radiation_sensor_appendix_b.imp
+        binding: {in.r: radiation_at(i), out.radiationStatus: output}
+"""
+
+
+@pytest.fixture()
+def sensor(tmp_path: Path) -> Path:
+    """The case study's Radiation Sensor alone, with appendix B's program (thresholds 10 and 20)."""
+    root = tmp_path / "sensor"
+    text = (REPO / "contracts" / "remote_inspection.rcl").read_text(encoding="utf-8")
+    context = text[text.index("context {"):text.index("\n}", text.index("context {")) + 2]
+    node = text[text.index("node RadiationSensor"):]
+    (root / "contracts").mkdir(parents=True)
+    (root / "contracts" / "sensor.rcl").write_text(context + "\n\n" + node, encoding="utf-8")
+    (root / "contracts" / "plan.yaml").write_text(SENSOR_PLAN, encoding="utf-8")
+    (root / "backends" / "hoare").mkdir(parents=True)
+    shutil.copy(REPO / "backends" / "hoare" / "radiation_sensor_appendix_b.imp", root / "backends" / "hoare")
+    return root
+
+
+# A guarantee made vacuous by another one, as the Agent's guarantee 3 makes guarantees 1 and 2:
+# guarantee 2 binds i universally, so at i = 6 its premise holds and it demands c == 0 always.
+VACUOUS = """node N {
+  inputs( a : NATURAL --> BOOL )
+  outputs( c : NATURAL )
+  assume( TRUE )
+  guarantee( forall(i in NATURAL | in.a(i) == TRUE -> out.c == i + 1) )
+  guarantee( forall(i in NATURAL | in.a(i) == FALSE or i > 5 -> out.c == 0) )
+}
+"""
+
+
+@pytest.fixture()
+def vacuous(tmp_path: Path) -> Path:
+    root = tmp_path / "vac"
+    (root / "contracts").mkdir(parents=True)
+    (root / "contracts" / "n.rcl").write_text(VACUOUS, encoding="utf-8")
+    (root / "contracts" / "plan.yaml").write_text(
+        "name: vac\ncontracts: [contracts/n.rcl]\nrequirements: []\nconnections: []\nenvironment: {}\nnodes: {}\n",
+        encoding="utf-8")
+    return root
+
+
+# ---------------------------------------------------------------------------------------------
+# tables and numbers
+
+def test_rationals_are_decimals_where_exact() -> None:
+    assert decimal_text(Fraction(1, 5)) == "0.2"
+    assert decimal_text(Fraction(-7, 4)) == "-1.75"
+    assert decimal_text(Fraction(1, 3)) is None
+    assert decimals("move(1/5, 3/2) and 1/3") == "move(0.2, 1.5) and 1/3"
+    # where models are printed: Z3 values and the Python values of traces and property tests
+    from rclverify.logic.encode import value_to_rcl
+    from rclverify.values import render
+    assert value_to_rcl(z3.RealVal("1/5")) == "0.2" and value_to_rcl(z3.RealVal("1/3")) == "1/3"
+    assert render(Fraction(1, 5)) == "0.2" and render(Fraction(2, 3)) == "2/3"
+
+
+def test_function_values_become_finite_tables_never_if_then_else() -> None:
+    nested = "{(p1, p2) -> (if ((p2 == 2) and not (p1 == 39) and (p1 == 41)) then 1 else " \
+             "(if ((p1 == 3) and (p2 == 1/2)) then 5 else 17))}"
+    t = function_table(nested)
+    assert t == {"rows": [["(41, 2)", "1"], ["(3, 0.5)", "5"]], "more": 0, "else": "17"}
+    assert function_table("{(0, 0) |-> 3, else |-> 0}") == {"rows": [["(0, 0)", "3"]], "more": 0, "else": "0"}
+    big = "{(p1) -> " + "".join(f"(if (p1 == {k}) then {k} else " for k in range(40)) + "0" + ")" * 40 + "}"
+    rows = counterexample_table({"Agent.in.f": big, "Agent.out.c": "move(1/5, 2)"})
+    f = next(r for r in rows if r["variable"] == "in.f")
+    assert f["node"] == "Agent" and f["table"]["more"] == 32 and len(f["table"]["rows"]) == 8
+    assert "if" not in f["value"] and "more" in f["value"]
+    assert next(r for r in rows if r["variable"] == "out.c")["value"] == "move(0.2, 2)"
+
+
+def test_ids_sort_naturally() -> None:
+    assert natural_sorted(["A.p10_i9", "A.p2_i1", "A.p1_i0"]) == ["A.p1_i0", "A.p2_i1", "A.p10_i9"]
+
+
+# ---------------------------------------------------------------------------------------------
+# side conditions
+
+def test_newcomer_speed_mismatch_gets_side_condition_repairs(newcomer: Path) -> None:
+    ws, report = _run(newcomer)
+    d = next(x for x in report["diagnoses"] if x["id"] == "Controller.sc2")
+    assert d["kind"] == "side-condition"
+    assert "in.speed <= 1.5" in d["sentence"] and "Planner's guarantee 1" in d["sentence"]
+    assert "contracts/rover.rcl:15:29" in d["sentence"] and "contracts/rover.rcl:9:3" in d["sentence"]
+    assert {"node": "Planner", "variable": "out.speed", "value": "2", "table": None} in d["counterexample"]
+    kinds = {r["kind"]: r for r in d["repairs"]}
+    assert set(kinds) == {"strengthen-producer", "weaken-consumer"}
+    assert "+  guarantee( out.speed <= 1.5 )" in kinds["strengthen-producer"]["diff"]
+    assert "+  assume( 0 <= in.speed and in.speed <= 2.0 )" in kinds["weaken-consumer"]["diff"]
+    for r in d["repairs"]:
+        assert {"check": "Controller.sc2", "before": "failed", "after": "discharged"} in r["cost"]
+    # SARIF: the repairs as fix objects; the log still validates against the 2.1.0 schema
+    log = sarif_log(report)
+    jsonschema.validate(log, json.loads(SARIF_SCHEMA.read_text(encoding="utf-8")))
+    res = next(r for r in log["runs"][0]["results"] if r["properties"].get("sideCondition") == "Controller.sc2")
+    assert res["properties"]["diagnosis"] == d["sentence"]
+    fix = res["fixes"][0]["artifactChanges"][0]
+    assert fix["artifactLocation"]["uri"] == "contracts/rover.rcl"
+    rep = fix["replacements"][0]
+    assert rep["insertedContent"]["text"] == "\n  guarantee( out.speed <= 1.5 )"
+    assert rep["deletedRegion"] == {"startLine": 9, "startColumn": 51, "endLine": 9, "endColumn": 51}
+
+
+def test_a_broken_checker_shows_no_repair(newcomer: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """Every Z3 query answers unknown: the problem is still diagnosed, no repair is shown."""
+    ws, report = _run(newcomer)
+    ws.path(CACHE).unlink(missing_ok=True)
+    monkeypatch.setattr(z3.Solver, "check", lambda self, *a, **k: z3.unknown)
+    ds = diagnose(ws, report)
+    d = next(x for x in ds if x["id"] == "Controller.sc2")
+    assert "Planner's guarantee 1" in d["sentence"]
+    assert d["repairs"] == []
+
+
+def test_a_checker_that_answers_sat_to_everything_shows_no_repair(newcomer: Path,
+                                                                  monkeypatch: pytest.MonkeyPatch) -> None:
+    """sat means "refuted" for a validity query: a repair needs Z3 to prove the side condition."""
+    ws, report = _run(newcomer)
+    ws.path(CACHE).unlink(missing_ok=True)
+    real_check = z3.Solver.check
+    monkeypatch.setattr(z3.Solver, "check", lambda self, *a, **k: (real_check(self, *a, **k), z3.sat)[1])
+    assert next(x for x in diagnose(ws, report) if x["id"] == "Controller.sc2")["repairs"] == []
+
+
+# ---------------------------------------------------------------------------------------------
+# Hoare
+
+def test_appendix_b_refutations_name_the_constants_and_get_the_change(sensor: Path) -> None:
+    ws, report = _run(sensor)
+    hoare = [d for d in report["diagnoses"] if d["kind"] == "hoare"]
+    assert {d["id"].rsplit(".", 1)[1] for d in hoare} == {"c2", "c3"}
+    for d in hoare:
+        assert "10/20" in d["sentence"] and "120/250" in d["sentence"]
+        assert "radiation_sensor_appendix_b.imp:15" in d["sentence"]
+        [r] = d["repairs"]
+        assert r["kind"] == "constant"
+        assert "-IF (input < 10) THEN\n+IF (input < 120) THEN" in r["diff"]
+        assert "-   IF (input < 20) THEN\n+   IF (input < 250) THEN" in r["diff"]
+        assert {c["after"] for c in r["cost"]} == {"discharged"}
+    # the program file itself is untouched
+    assert "input < 10" in (sensor / "backends/hoare/radiation_sensor_appendix_b.imp").read_text()
+
+
+# ---------------------------------------------------------------------------------------------
+# vacuity
+
+def test_vacuity_names_the_other_guarantee_and_gets_a_guard(vacuous: Path) -> None:
+    ws, report = _run(vacuous)
+    d = next(x for x in report["diagnoses"] if x["id"] == "N.g1.non-vacuous")
+    assert d["kind"] == "vacuity"
+    assert "guarantee 2 (contracts/n.rcl:6:3)" in d["sentence"]
+    assert [c["source"] for c in d["culprits"]] == ["contracts/n.rcl:6:3"]
+    [r] = d["repairs"]
+    assert r["kind"] == "guard"
+    assert "+  guarantee( forall(i in NATURAL | in.a(i) == TRUE and (in.a(i) == FALSE or i > 5) -> out.c == 0) )" \
+        in r["diff"]
+    assert {"check": "N.g1.non-vacuous", "before": "problem", "after": "ok"} in r["cost"]
+
+
+def test_explain_and_status_read_the_last_run(newcomer: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["status", "-w", str(newcomer)]) == 1  # no report yet: located error
+    assert "no report yet" in capsys.readouterr().err
+    ws, report = _run(newcomer)
+    from rclverify.pipeline import stage_report
+    stage_report(ws, report=report)
+    html = (newcomer / "reports" / "assurance.html").read_text(encoding="utf-8")
+    assert 'id="diagnosis-Controller-sc2"' in html and "+  guarantee( out.speed &lt;= 1.5 )" in html
+    assert "+  guarantee( out.speed <= 1.5 )" in (newcomer / "reports" / "assurance.md").read_text(encoding="utf-8")
+    assert json.loads((newcomer / "reports" / "assurance.json").read_text())["diagnoses"][0]["id"] == "Controller.sc2"
+    assert main(["status", "-w", str(newcomer)]) == 0
+    out = capsys.readouterr().out
+    assert "diagnosis Controller.sc2" in out and "rclverify explain Controller.sc2" in out and "Controller" in out
+    assert main(["explain", "-w", str(newcomer), "Controller.sc2"]) == 0
+    out = capsys.readouterr().out
+    assert "counterexample:" in out and "Planner  out.speed  2" in out and "+++ b/contracts/rover.rcl" in out
+    assert main(["explain", "-w", str(newcomer), "Nope.sc9"]) == 1
+    assert "error: no problem or obligation 'Nope.sc9'" in capsys.readouterr().err
+
+
+def test_a_broken_checker_shows_no_guard(vacuous: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    ws, report = _run(vacuous)
+    ws.path(CACHE).unlink(missing_ok=True)
+    monkeypatch.setattr(z3.Solver, "check", lambda self, *a, **k: z3.unknown)
+    d = next(x for x in diagnose(ws, report) if x["id"] == "N.g1.non-vacuous")
+    assert "guarantee 2 (contracts/n.rcl:6:3)" in d["sentence"] and d["repairs"] == []
