@@ -39,11 +39,27 @@ def atomic_write_text(path: Path, text: str, *, durable: bool = False) -> bool:
     return True
 
 
+_MODE: list[int] = []
+
+
+def _default_mode() -> int:
+    """The permission bits a plain ``open()`` gives a new file: 0666 less the
+    process's umask (0644 under the usual 022), read once per process
+    (``mkstemp`` creates 0600, which left artifacts unreadable to a colleague
+    or a CI artifact server)."""
+    if not _MODE:
+        mask = os.umask(0)
+        os.umask(mask)
+        _MODE.append(0o666 & ~mask)
+    return _MODE[0]
+
+
 def atomic_write_bytes(path: Path, data: bytes, *, durable: bool = False, mode: int | None = None) -> None:
     """Write ``data`` to ``path`` through a temporary file in the same
     directory renamed into place (:func:`os.replace`): readers see the old
     content or the new, never a part.  ``durable=True`` fsyncs before the
-    rename; ``mode`` sets the permission bits (``mkstemp`` creates 0600).
+    rename; ``mode`` sets the permission bits (default: what ``open()``
+    gives under the process's umask, :func:`_default_mode`).
 
     Missing parent directories are created (only when the first attempt
     finds the directory missing: a ``mkdir`` before each of the ~18,000
@@ -57,8 +73,7 @@ def atomic_write_bytes(path: Path, data: bytes, *, durable: bool = False, mode: 
         path.parent.mkdir(parents=True, exist_ok=True)
         fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
     try:
-        if mode is not None:
-            os.chmod(tmp, mode)
+        os.chmod(tmp, _default_mode() if mode is None else mode)
         with os.fdopen(fd, "wb") as fh:
             fh.write(data)
             if durable:
