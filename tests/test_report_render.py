@@ -373,3 +373,20 @@ def test_huge_model_values_are_clipped_in_html_and_markdown_but_kept_in_json() -
     assert shown.startswith(value[:CLIP_CHARS]) and len(shown) < CLIP_CHARS + 80
     assert f"{len(value) - CLIP_CHARS} more characters in the JSON report" in shown
     assert clip("short") == "short"
+
+
+def test_identical_outstanding_items_are_one_group() -> None:
+    """39 AJPF instances pending for one reason are one row (issue: diagnosis and report); a
+    different reason, status or backend is a row of its own."""
+    from rclverify.report.render import group_items
+
+    def item(ref: str, msg: str, status: str = "pending", where: str = "ajpf (model checking)") -> dict:
+        return {"status": status, "kind": "evidence", "ref": ref, "anchor": ref, "where": where, "message": msg,
+                "formula": ""}
+    items = [item(f"Agent.g1.ajpf.p{k}_i{k}", f"AJPF is not installed; run instance {k} with MCAPL") for k in range(39)]
+    items += [item("Localisation.g1.review.e0", "the review names no reviewed file", where="review (review)"),
+              item("X.g1.ajpf.p1_i1", "AJPF is not installed; run instance 1 with MCAPL", status="stale")]
+    groups = group_items(items)
+    assert [len(g["items"]) for g in groups] == [39, 1, 1]
+    assert groups[0]["message"] == "AJPF is not installed; run instance 0 with MCAPL"
+    assert [it["ref"] for it in groups[0]["items"]] == [f"Agent.g1.ajpf.p{k}_i{k}" for k in range(39)]

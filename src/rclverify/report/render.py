@@ -344,6 +344,27 @@ def _attention(report: Mapping[str, Any], ev_anchor: Sequence[str]) -> tuple[lis
     return problems, outstanding
 
 
+_NUMBERS = re.compile(r"\d+")
+
+
+def group_items(items: Sequence[dict[str, Any]]) -> list[dict[str, Any]]:
+    """Attention items grouped when they say the same thing: equal status,
+    kind and backend (``where``), and a message that is equal once its
+    numbers are left out (39 AJPF instances pending for one reason are one
+    group).  Each group is ``{"status", "kind", "where", "message" (the
+    first item's), "items" (in order)}``; groups keep the order of their
+    first items."""
+    groups: dict[tuple[str, str, str, str], dict[str, Any]] = {}
+    for it in items:
+        key = (it["status"], it["kind"], it["where"], _NUMBERS.sub("#", it["message"]))
+        g = groups.get(key)
+        if g is None:
+            g = groups[key] = {"status": it["status"], "kind": it["kind"], "where": it["where"],
+                               "message": it["message"], "items": []}
+        g["items"].append(it)
+    return list(groups.values())
+
+
 def view(report: Mapping[str, Any]) -> dict[str, Any]:
     """Derived lookups the templates need (pure function of ``report``).
 
@@ -415,9 +436,15 @@ def view(report: Mapping[str, Any]) -> dict[str, Any]:
         return str(o["node"]) if o is not None else ""
 
     problems, outstanding = _attention(report, ev_anchor)
+    outstanding_groups = group_items(outstanding)
+    pending_groups: dict[tuple[str, str], dict[str, Any]] = {}  # the same reason, numbers aside: one row
+    for p in report["pending"]:
+        key = (str(p["backend"]), _NUMBERS.sub("#", str(p["reason"])))
+        pending_groups.setdefault(key, {"backend": p["backend"], "reason": p["reason"], "items": []})["items"].append(p)
     unmet = [r for r in report["requirements"] if rank(r["status"]) > 0]
     return {
-        "counts": counts, "problems": problems, "outstanding": outstanding,
+        "counts": counts, "problems": problems, "outstanding": outstanding, "outstanding_groups": outstanding_groups,
+        "pending_groups": list(pending_groups.values()),
         "unmet_requirements": unmet, "ev_anchor": ev_anchor, "evidence_of": evidence_of,
         "obligation": obligation, "trace": trace, "sections": sections,
         "lint_errors": sum(1 for x in report["lint"] if str(x["severity"]).lower() == "error"),
