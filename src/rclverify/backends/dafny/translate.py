@@ -47,8 +47,26 @@ from ...rcl import ast
 from ...rcl.errors import error
 from ...rcl.printer import is_type
 from ...rcl.typecheck import domain_type
-from ...rcl.types import (BOOL, INTEGER, NATURAL, REAL, STRING, CheckedNode, DataT, EmptyT, EnumT, Env, FuncT, SeqT, SetT,
-                          TupleT, Type, numeric_join, qualified_base)
+from ...rcl.types import (
+    BOOL,
+    INTEGER,
+    NATURAL,
+    REAL,
+    STRING,
+    CheckedNode,
+    DataT,
+    EmptyT,
+    EnumT,
+    Env,
+    FuncT,
+    SeqT,
+    SetT,
+    TupleT,
+    Type,
+    numeric_join,
+    qualified_base,
+)
+from ...values import decimal_text
 from .types import dafny_ident, dafny_type
 
 _BASE_NAMES = {"REAL": REAL, "INTEGER": INTEGER, "NATURAL": NATURAL, "BOOL": BOOL}
@@ -66,22 +84,11 @@ def real_literal(value: Fraction) -> str:
     Values whose decimal expansion does not terminate are written as a
     quotient ``(1.0 / 3.0)``.
     """
-    sign = "-" if value < 0 else ""
-    v = abs(value)
-    d = v.denominator
-    twos = fives = 0
-    while d % 2 == 0:
-        d //= 2
-        twos += 1
-    while d % 5 == 0:
-        d //= 5
-        fives += 1
-    if d != 1:
-        return f"({sign}{v.numerator}.0 / {v.denominator}.0)"
-    k = max(twos, fives)
-    digits = str(v.numerator * 10 ** k // v.denominator).rjust(k + 1, "0")
-    whole, frac = (digits[:-k], digits[-k:]) if k else (digits, "0")
-    return f"{sign}{whole}.{frac}"
+    text = decimal_text(value)
+    if text is None:
+        v = abs(value)
+        return f"({'-' if value < 0 else ''}{v.numerator}.0 / {v.denominator}.0)"
+    return text if "." in text else text + ".0"
 
 
 @dataclass

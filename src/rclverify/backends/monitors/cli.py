@@ -22,6 +22,18 @@ from .check import check_trace
 from .config import ConfigError, load_mapping
 
 
+
+def selected_nodes(checked: Any, names: Any, command: str) -> list[Any] | None:
+    """The checked nodes ``names`` (``--node``) selects, every node when it
+    is empty; ``None`` after printing one error line when a name is not a
+    node of the contracts."""
+    unknown = [n for n in names or () if n not in checked.nodes]
+    if unknown:
+        print(f"rclverify {command}: error: no node named {unknown[0]!r}; nodes: {', '.join(checked.nodes)}",
+              file=sys.stderr)
+        return None
+    return [checked.nodes[n] for n in names] if names else list(checked.nodes.values())
+
 def monitor_command(args: argparse.Namespace, checked: Checked) -> int:
     """Run the command on the workspace's checked contracts ``checked`` (the
     caller, rclverify.cli, loads them: a backend does not import the
@@ -86,12 +98,9 @@ def live_command(args: argparse.Namespace, checked: Any, cfg: Any, root: Path) -
     if args.traces:
         print("rclverify monitor: error: --live takes no TRACE (it monitors the running system)", file=sys.stderr)
         return 2
-    unknown = [n for n in args.nodes or () if n not in checked.nodes]
-    if unknown:
-        print(f"rclverify monitor: error: no node named {unknown[0]!r}; nodes: {', '.join(checked.nodes)}",
-              file=sys.stderr)
+    nodes = selected_nodes(checked, args.nodes, "monitor")
+    if nodes is None:
         return 2
-    nodes = [checked.nodes[n] for n in args.nodes] if args.nodes else list(checked.nodes.values())
     log = Path(args.log)
     factory = partial(LiveRun, checked, nodes, cfg.rules, cfg.horizon, log,
                       reorder_window=args.reorder_window, silence_s=args.silence)
@@ -131,12 +140,9 @@ def oracle_command(args: argparse.Namespace, checked: Checked) -> int:
     except ConfigError as exc:
         print(f"{args.mapping}: error: {exc}", file=sys.stderr)
         return 2
-    unknown = [n for n in args.nodes or () if n not in checked.nodes]
-    if unknown:
-        print(f"rclverify oracle: error: no node named {unknown[0]!r}; nodes: {', '.join(checked.nodes)}",
-              file=sys.stderr)
+    nodes = selected_nodes(checked, args.nodes, "oracle")
+    if nodes is None:
         return 2
-    nodes = [checked.nodes[n] for n in args.nodes] if args.nodes else list(checked.nodes.values())
 
     async def main() -> None:
         stop, ready = asyncio.Event(), asyncio.Event()
