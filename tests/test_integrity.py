@@ -115,6 +115,7 @@ def test_a_hand_edited_evidence_record_is_not_believed(verified: Path, tmp_path:
     ev = next(e for e in report["evidence"] if e["obligation"] == "Navigation.g1.experiment.e0")
     assert ev["status"] == "error" and "altered outside rclverify" in ev["explanation"]
     assert any("altered outside rclverify" in p for p in report["summary"]["problems"])
+    assert not report["meta"]["strict_ok"]  # --strict fails on it
     sarif = json.loads((ws / "reports/assurance.sarif").read_text(encoding="utf-8"))
     assert any(r["ruleId"] == "RCL-OBL-ERROR" and "altered outside rclverify" in r["message"]["text"]
                for r in sarif["runs"][0]["results"])
