@@ -172,11 +172,16 @@ PROBE = ("import resource, subprocess, sys, json\n"
          " 'maxrss_kb': u.ru_maxrss, 'cpu': u.ru_utime + u.ru_stime}))\n")
 
 
-def doit_verify(root: Path, jobs: int) -> Run:
-    """Run ``python -m doit [-n jobs] verify`` in ``root``; time, peak memory, executed tasks."""
+def doit_verify(root: Path, jobs: int, src: str | None = None) -> Run:
+    """Run ``python -m doit [-n jobs] verify`` in ``root``; time, peak memory,
+    executed tasks.  ``src``: the rclverify source tree to run (put first on
+    ``PYTHONPATH``; default: the installed one)."""
     cmd = [sys.executable, "-m", "doit"] + (["-n", str(jobs)] if jobs > 1 else []) + ["verify"]
+    env = dict(os.environ)
+    if src:
+        env["PYTHONPATH"] = os.pathsep.join([str(Path(src).resolve())] + ([env["PYTHONPATH"]] if env.get("PYTHONPATH") else []))
     t0 = time.perf_counter()
-    p = subprocess.run([sys.executable, "-c", PROBE, *cmd], cwd=root, capture_output=True, text=True)
+    p = subprocess.run([sys.executable, "-c", PROBE, *cmd], cwd=root, capture_output=True, text=True, env=env)
     seconds = time.perf_counter() - t0
     res = json.loads(p.stdout)
     ran = [line[3:] for line in res["out"].splitlines() if line.startswith(".  ")]
@@ -224,6 +229,12 @@ def _sizes(values: Sequence[str]) -> list[int]:
     return out
 
 
+def figures(cold: Run, noop: Run, edit: Run) -> str:
+    """One row's columns: cold s, (cpu), MB, no-op s, (cpu), ran, edit s, (cpu), MB."""
+    return (f"{cold.seconds:>7.1f} {cold.cpu:>7.1f} {cold.peak_mb:>5.0f} {noop.seconds:>7.2f} {noop.cpu:>6.2f} "
+            f"{len(noop.ran):>3} {edit.seconds:>6.2f} {edit.cpu:>6.2f} {edit.peak_mb:>5.0f}")
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--sizes", nargs="+", default=["10", "100", "500", "1000"],
@@ -235,8 +246,15 @@ def main(argv: Sequence[str] | None = None) -> int:
     ap.add_argument("--hoare", type=int, default=1, metavar="EVERY",
                     help="give every EVERY-th node a hoare entry (default 1: every node; 0: none, the calculus "
                          "and health checks alone, the workload the issue's aims were measured on)")
+    ap.add_argument("--compare", metavar="OLD_SRC",
+                    help="also run the rclverify source tree OLD_SRC (e.g. a git worktree's src/ of the code "
+                         "before a change) on its own copy of each workspace, alternating with this tree's runs, "
+                         "and print both rows and the ratio new/old")
+    ap.add_argument("--src", metavar="NEW_SRC", help="the source tree to measure (default: the installed rclverify)")
     args = ap.parse_args(argv)
     sizes = _sizes(args.sizes)
+    if args.compare:
+        return compare(sizes, args)
     pt = has_property_tests() and args.property_tests > 0
     base = Path(args.keep) if args.keep else Path(tempfile.mkdtemp(prefix="rclverify-bench-"))
     print(f"pipeline scale: doit{' -n ' + str(args.jobs) if args.jobs > 1 else ''} verify, "
@@ -262,14 +280,59 @@ def main(argv: Sequence[str] | None = None) -> int:
             edited = edit_one(root, n)
             edit = doit_verify(root, args.jobs)
             ran = summarise([t for t in edit.ran if t != "verify"])
-            print(f"{n:>6} {nob:>7} {nsc:>7} {cold.seconds:>7.1f} {cold.cpu:>7.1f} {cold.peak_mb:>5.0f} "
-                  f"{noop.seconds:>7.2f} {noop.cpu:>6.2f} {len(noop.ran):>3} {edit.seconds:>6.2f} {edit.cpu:>6.2f} "
-                  f"{edit.peak_mb:>5.0f}  ({edited}) {ran}", flush=True)
+            print(f"{n:>6} {nob:>7} {nsc:>7} {figures(cold, noop, edit)}  ({edited}) {ran}", flush=True)
     finally:
         if not args.keep:
             shutil.rmtree(base, ignore_errors=True)
     print("cold/no-op/edit: wall-clock seconds of one `doit verify`; (cpu): CPU seconds (user+sys) of doit and its "
           "children; MB: peak RSS of the largest process; ran: tasks the no-op run executed (0 expected).")
+    return 0
+
+
+def compare(sizes: list[int], args: argparse.Namespace) -> int:
+    """Old and new code side by side: for each N, each code on its own copy
+    of the same workspace, each run of one code followed by the same run of
+    the other (the order swapped from one run to the next, so neither
+    always runs on a warmer machine): cold, no-op, edit."""
+    pt = has_property_tests() and args.property_tests > 0
+    base = Path(args.keep) if args.keep else Path(tempfile.mkdtemp(prefix="rclverify-bench-"))
+    trees = {"old": args.compare, "new": args.src}
+    print(f"pipeline scale, old ({args.compare}) against new ({args.src or 'installed'}), alternating; "
+          f"doit{' -n ' + str(args.jobs) if args.jobs > 1 else ''} verify, {os.cpu_count()} CPU(s)")
+    header = f"{'nodes':>6} {'code':>4} {'cold s':>7} {'(cpu)':>7} {'MB':>5} {'no-op s':>7} {'(cpu)':>6} {'ran':>3} {'edit s':>6} {'(cpu)':>6} {'MB':>5}"
+    print(header)
+    print("-" * len(header))
+    try:
+        for n in sizes:
+            roots = {}
+            for name in trees:
+                roots[name] = base / f"n{n}-{name}"
+                if roots[name].exists():
+                    shutil.rmtree(roots[name])
+                generate(roots[name], n, pt, args.property_tests, args.hoare)
+            runs: dict[str, dict[str, Run]] = {"old": {}, "new": {}}
+            order = ["old", "new"]
+            for phase in ("cold", "no-op", "edit"):
+                for name in order:
+                    if phase == "edit":
+                        edit_one(roots[name], n)
+                    r = doit_verify(roots[name], args.jobs, trees[name])
+                    if r.rc != 0:
+                        print(f"{n:>6} {name:>4}  {phase} run failed (exit {r.rc}):\n{r.output[-3000:]}")
+                        return 1
+                    runs[name][phase] = r
+                order.reverse()
+            for name in ("old", "new"):
+                print(f"{n:>6} {name:>4} {figures(runs[name]['cold'], runs[name]['no-op'], runs[name]['edit'])}", flush=True)
+            o, w = runs["old"], runs["new"]
+            print(f"{n:>6} {'new/old':>9} cold {w['cold'].seconds / o['cold'].seconds:.2f} (cpu {w['cold'].cpu / o['cold'].cpu:.2f}), "
+                  f"no-op {w['no-op'].seconds / o['no-op'].seconds:.2f} (cpu {w['no-op'].cpu / o['no-op'].cpu:.2f}), "
+                  f"edit {w['edit'].seconds / o['edit'].seconds:.2f} (cpu {w['edit'].cpu / o['edit'].cpu:.2f})", flush=True)
+    finally:
+        if not args.keep:
+            shutil.rmtree(base, ignore_errors=True)
+    print("ratios below 1.00 mean the new code is faster; wall-clock figures move with the machine's load, "
+          "CPU seconds much less.")
     return 0
 
 

@@ -39,10 +39,9 @@ PACKAGE = "rclverify"
 LAYERS: list[tuple[str, tuple[str, ...]]] = [
     # Process-wide utilities that know nothing of RCL: the package's version
     # (``rclverify/__init__``; this entry is that module only, not the
-    # package), when the garbage collector runs (heap.py, used by the
-    # parser), the one-entry result memo (memo.py), machine faults worded as
-    # one line (faults.py).  They import no other module of the package.
-    ("foundation", ("rclverify", "rclverify.heap", "rclverify.memo", "rclverify.faults")),
+    # package), machine faults worded as one line (faults.py).  They import
+    # no other module of the package.
+    ("foundation", ("rclverify", "rclverify.faults")),
     # The evidence record format (records.py: obligations, evidence records,
     # input hashes) and its atomic store (store.py).  Every stage writes
     # these records and the report reads them, so the format sits below all
@@ -50,6 +49,13 @@ LAYERS: list[tuple[str, tuple[str, ...]]] = [
     # the data flow (backends -> evidence -> report) is the pipeline's
     # evidence stage, which lives in the pipeline layer.
     ("evidence records", ("rclverify.evidence",)),
+    # cache/: everything kept between runs (one keying function, one file
+    # format, one rule of what is kept), the workspace's load among it
+    # (cache/workspace.py, which sees the workspace only through its
+    # attributes), when the garbage collector runs (cache/heap.py, used by
+    # the parser) and the one-entry result memo (cache/memo.py).  It writes
+    # through the evidence store's atomic writer and knows nothing of RCL.
+    ("cache", ("rclverify.cache",)),
     ("rcl", ("rclverify.rcl",)),
     # values.py: the Python convention for RCL values (built on rcl's types),
     # shared by the logic (evaluation on concrete values), the traces and the
@@ -73,10 +79,9 @@ LAYERS: list[tuple[str, tuple[str, ...]]] = [
     # (so above the backends); the report shows the records.
     ("diagnosis", ("rclverify.diagnosis",)),
     # The workspace (workspace.py: the loaded plan and contracts, artifact
-    # paths, snapshots and what makes a result stale) and the cache of its
-    # load between runs (wscache.py): read by the report, the stages and the
-    # caches above; they import the layers below only.
-    ("workspace", ("rclverify.workspace", "rclverify.wscache", "rclverify.requirements.stage")),
+    # paths, snapshots and what makes a result stale): read by the report,
+    # the stages and the commands; it imports the layers below only.
+    ("workspace", ("rclverify.workspace", "rclverify.requirements.stage")),
     # report/ and argument/ render the results; contract_texts.py makes the
     # texts of the contracts the report shows (RCL, LaTeX, lint), so it
     # belongs with the report.

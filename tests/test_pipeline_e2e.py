@@ -202,6 +202,25 @@ def test_second_run_executes_no_task(workspace: Path) -> None:
     assert executed == [], executed
 
 
+def test_everything_kept_between_runs_is_in_the_cache_layer(workspace: Path) -> None:
+    """One cache layer (issue 25): every file a run keeps under artifacts/cache is in the cache
+    layer's format, written by this code, and `rclverify cache` lists each one; only jinja2's own
+    bytecode cache and the layout blobs are directories."""
+    from rclverify.cache import kept_files
+    rows = kept_files(workspace)
+    files = {r["file"].removeprefix("artifacts/cache/"): r for r in rows}
+    assert {"workspace.pickle", "contract-texts.pickle", "report-fragments.html.pickle", "report-fragments.text.pickle",
+            "diagnosis.pickle", "system-cycles.pickle", "ros-scan.pickle", "layout/"} <= files.keys(), sorted(files)
+    for name, r in files.items():
+        if name.endswith("/"):
+            assert name in ("layout/", "templates/"), name
+        else:
+            assert r["current"] and r["kind"], r
+    out = subprocess.run([sys.executable, "-m", "rclverify.cli", "cache", "-w", str(workspace)],
+                         capture_output=True, text=True, timeout=60)
+    assert out.returncode == 0 and "report-fragments" in out.stdout and "other code" not in out.stdout, out.stdout
+
+
 def test_the_model_diagram_is_drawn_by_doit_graph_not_by_verify(workspace: Path) -> None:
     system = workspace / "artifacts" / "system"
     assert not (system / "model.dot").exists() and not (system / "model.svg").exists()  # verify ran before

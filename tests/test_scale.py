@@ -8,7 +8,7 @@ from pathlib import Path
 
 import pytest
 
-from rclverify import wscache
+from rclverify.cache import workspace as wscache
 from rclverify.pipeline import Workspace
 from rclverify.system.model import Link, SystemModel, _loops, cycles_kept
 

@@ -35,7 +35,7 @@ def test_layout_is_reused_byte_for_byte(tmp_path: Path, monkeypatch: pytest.Monk
         first = diagram.render_dot(dot)
         assert first.svg is not None and first.svg.startswith("<svg")
         assert len(list((tmp_path / "layout").glob("*.svg"))) == 1
-        layoutcache._memory.clear()  # as in a new process: only the directory remains
+        layoutcache.forget()  # as in a new process: only the directory remains
 
         def no_dot(*args: object, **kwargs: object) -> None:
             raise AssertionError("dot ran although its layout was cached")
@@ -46,4 +46,4 @@ def test_layout_is_reused_byte_for_byte(tmp_path: Path, monkeypatch: pytest.Monk
         assert diagram.render_dot(dot + "// changed\n").svg is None
     finally:
         layoutcache.use_directory(None)
-        layoutcache._memory.clear()
+        layoutcache.forget()

@@ -285,6 +285,33 @@ def cmd_explain(args: argparse.Namespace) -> int:
                               + (f"; problems: {', '.join(ids)}" if ids else "; it lists no problem"))])
 
 
+def cmd_cache(args: argparse.Namespace) -> int:
+    """List what the workspace keeps between runs under ``artifacts/cache``
+    (:func:`rclverify.cache.kept_files`: file, kind, entries, size, whether
+    this rclverify code wrote it), or delete it all with ``--clear`` (always
+    safe: every entry is a pure speed-up).  Exit 0; 1 (located) for a
+    missing workspace."""
+    import shutil
+
+    from .cache import CACHE_DIR, kept_files
+    root = Path(args.workspace)
+    if not root.is_dir():
+        raise RclError([_io_error(root, "no such workspace directory")])
+    if args.clear:
+        shutil.rmtree(root / CACHE_DIR, ignore_errors=True)
+        print(f"{CACHE_DIR}: cleared")
+        return 0
+    rows = kept_files(root)
+    if not rows:
+        print(f"{CACHE_DIR}: empty")
+    for r in rows:
+        entries = "" if r["entries"] is None else f"{r['entries']} files"
+        current = {True: "current", False: "other code: not used", None: ""}[r["current"]]
+        print(f"{r['file']:<48} {r['kind'] or '?':<18} {r['bytes'] / 1024:>9.1f} KiB  {entries:<10} {current}")
+    print("Why a task ran again, or did not: `doit info TASK` in the workspace (docs/scale.md).")
+    return 0
+
+
 def cmd_init(args: argparse.Namespace) -> int:
     if getattr(args, "from_ros", None):
         from .ros.cli import init_from_ros
@@ -432,6 +459,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     add("report", cmd_report, "rebuild the assurance report from the artifacts", True)
     add("requirements", cmd_requirements, "check each formal requirement with Z3 from the composed contracts and "
         "print its status", True).add_argument("--force", action="store_true", help="check every requirement again")
+    add("cache", cmd_cache, "list what the workspace keeps between runs (artifacts/cache), or clear it",
+        True).add_argument("--clear", action="store_true", help="delete artifacts/cache (always safe)")
     add("status", cmd_status, "print the last run's summary and problems (runs nothing)", True)
     add("explain", cmd_explain, "print one problem's or obligation's diagnosis, counterexample and repairs",
         True).add_argument("id", help="a problem id (as `rclverify status` lists them) or an obligation id")

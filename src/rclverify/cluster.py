@@ -69,7 +69,7 @@ def remote_run(root: str, plan_file: str, key: str, node: str, obligation_id: st
     submitting process does).  The workspace is loaded once per worker and
     ``key`` (see :func:`workspace_key`).
     """
-    from . import wscache
+    from .cache import workspace as wscache
     from .backends import get_backend
     from .evidence.records import Obligation
     from .evidence.store import read_json

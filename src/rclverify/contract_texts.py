@@ -6,25 +6,23 @@ guarantee, its LaTeX, and each file's lint warnings.  For a 1000-node
 system that was 0.2 s of the check task and 0.2-0.3 s of each report task
 after a one-contract edit (docs/scale.md, seventh round), although only the
 edited file's texts can differ.  They are pure functions of a file's text,
-so they are kept in ``artifacts/cache/contract-texts.pickle``, per contract
-file, keyed by the sha256 of the text that was parsed
-(``Workspace.parsed``) and salted with the rclverify code
-(:func:`rclverify.wscache.code_stamp`: a changed printer misses).
+so they are kept in ``artifacts/cache/contract-texts.pickle``, a
+:class:`~rclverify.cache.store.Shelf` of kind ``contract-texts``, per
+contract file, keyed by the file's name and the sha256 of the text that was
+parsed (``Workspace.parsed``; the kind's salt holds the rclverify code: a
+changed printer misses).
 
 The check task (:func:`rclverify.pipeline.stage_check`) fills and writes the
 file; the report tasks, which run after it, only read it and make what it
 lacks.  A damaged, missing or foreign file is an empty cache; the texts are
-the same with or without it (``tests/test_contract_texts.py``).  Like the
-workspace cache it is trusted code of the workspace (pickle), and deleting
-``artifacts/cache`` is always safe.
+the same with or without it (``tests/test_contract_texts.py``).
 """
 from __future__ import annotations
 
-import pickle
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from .evidence.store import atomic_write_bytes
+from .cache import Shelf
 from .rcl import ast
 
 if TYPE_CHECKING:
@@ -65,25 +63,17 @@ class ContractTexts:
     """
 
     def __init__(self, ws: "Workspace") -> None:
-        from .wscache import code_stamp
         self.ws = ws
         ws.checked  # fills ws.parsed with the sha256 of each file's parsed text
         self.path: Path = ws.path(CACHE)
-        self._salt = code_stamp()
-        self._shas = {rel: sha for rel, (sha, _) in ws.parsed.items()}
+        self._shelf = Shelf(self.path, "contract-texts")
         self._files: dict[str, dict[str, Any]] = {}
-        self._made = False
-        try:
-            with open(self.path, "rb") as fh:
-                stored = pickle.load(fh)
-        except Exception:  # missing, damaged or foreign: an empty cache  # noqa: BLE001
-            return
-        if isinstance(stored, dict) and stored.get("salt") == self._salt and isinstance(stored.get("files"), dict):
-            self._files = {rel: entry for rel, (sha, entry) in stored["files"].items() if self._shas.get(rel) == sha}
+        for rel, (sha, _) in ws.parsed.items():
+            self._files[rel] = self._shelf.get_or_make(self._shelf.key("file", rel, sha), lambda: {"nodes": {}})
 
     def _entry(self, rel: str) -> dict[str, Any]:
         entry = self._files.get(rel)
-        if entry is None:
+        if entry is None:  # not a parsed file of the workspace: kept for this object only
             entry = self._files[rel] = {"nodes": {}}
         return entry
 
@@ -92,7 +82,7 @@ class ContractTexts:
         got: dict[str, Any] | None = self._entry(node.loc.file)["nodes"].get(node.name)
         if got is None:
             got = self._entry(node.loc.file)["nodes"][node.name] = node_texts(node)
-            self._made = True
+            self._shelf.changed()
         return got
 
     def lint(self, spec: ast.Spec) -> list[dict[str, Any]]:
@@ -101,7 +91,7 @@ class ContractTexts:
         got: list[dict[str, Any]] | None = entry.get("lint")
         if got is None:
             got = entry["lint"] = lint_json(spec)
-            self._made = True
+            self._shelf.changed()
         return got
 
     def save(self) -> bool:
@@ -109,11 +99,4 @@ class ContractTexts:
         any were made (those of files no longer parsed are dropped).
         Returns whether the file was written; raises ``OSError`` when the
         cache directory cannot be written."""
-        if not self._made:
-            return False
-        files = {rel: (self._shas[rel], entry) for rel, entry in self._files.items() if rel in self._shas}
-        self.path.parent.mkdir(parents=True, exist_ok=True)
-        atomic_write_bytes(self.path, pickle.dumps({"salt": self._salt, "files": files},
-                                                   protocol=pickle.HIGHEST_PROTOCOL))
-        self._made = False
-        return True
+        return self._shelf.save()

@@ -113,8 +113,8 @@ class ProgressReporter(ConsoleReporter):  # type: ignore[misc]
     def initialize(self, tasks: Mapping[str, Any], selected_tasks: Any) -> None:
         """Remember doit's task table (it grows when delayed tasks are created),
         and freeze doit's task objects for the run with the workspace
-        (:func:`rclverify.heap.freeze_for_run`)."""
-        from .heap import freeze_for_run
+        (:func:`rclverify.cache.heap.freeze_for_run`)."""
+        from .cache.heap import freeze_for_run
         freeze_for_run()
         self.tasks = tasks
         if self.live_mode:
@@ -160,7 +160,7 @@ class ProgressReporter(ConsoleReporter):  # type: ignore[misc]
     def complete_run(self) -> None:
         """Stop the live line, then let doit report failures as usual; and
         have the process skip the cyclic garbage collection of its whole
-        heap when it exits (:mod:`rclverify.heap`: the heap frozen for the
+        heap when it exits (:mod:`rclverify.cache.heap`: the heap frozen for the
         run is given back to the collector, then frozen again at exit)."""
         if self.live is not None:
             global _LIVE_ACTIVE
@@ -168,7 +168,7 @@ class ProgressReporter(ConsoleReporter):  # type: ignore[misc]
             self.live.stop()
             self.live = None
         super().complete_run()
-        from .heap import freeze_at_exit, release_after_run
+        from .cache.heap import freeze_at_exit, release_after_run
         from .runlock import release
         release()  # the workspace's run lock (rclverify.runlock): the next run may start
         release_after_run()

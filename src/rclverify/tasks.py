@@ -52,7 +52,8 @@ from doit import create_after as _create_after
 from doit.exceptions import TaskFailed
 from doit.tools import config_changed
 
-from . import heap, wscache
+from .cache import code_stamp, heap
+from .cache import workspace as wscache
 from .pipeline import REPORT_PARTS, TaskIndex, Workspace
 from .plan.entries import TOOL_KEYS
 from .rcl.errors import RclError
@@ -85,7 +86,7 @@ def _ws(root: str, plan_file: str | None = None) -> Workspace:
     with ``plan_file`` (the ``check`` task passes the run's plan file; the
     default plan otherwise).
     """
-    heap.freeze_inherited()  # a doit -n worker: its inherited heap stays live (rclverify.heap)
+    heap.freeze_inherited()  # a doit -n worker: its inherited heap stays live (rclverify.cache.heap)
     ws = _WORKSPACES.get(root)
     if ws is None or (plan_file is not None and ws.plan_file != plan_file):
         ws = Workspace(Path(root), plan_file or "contracts/plan.yaml")
@@ -499,7 +500,7 @@ def build_tasks(root: str | Path, plan_file: str = "contracts/plan.yaml", *,
 
     The loaded workspace stays live for the run: it is loaded without
     cyclic garbage collection and then frozen for the run
-    (:mod:`rclverify.heap`; the progress reporter gives it back to the
+    (:mod:`rclverify.cache.heap`; the progress reporter gives it back to the
     collector when doit completes the run)."""
     import sys
     from . import runlock
@@ -555,7 +556,7 @@ def _build_tasks(root: str | Path, plan_file: str) -> dict[str, Callable[[], Any
     snap = {n: at(ws.snapshot(n)) for n in nodes}
     # Every task that makes a result depends on the rclverify code that makes it: another version
     # (an upgrade, a changed module) makes every result again, as a clean run would.
-    code_version = {"rclverify": wscache.code_stamp(), "z3": _z3_version()}
+    code_version = {"rclverify": code_stamp(), "z3": _z3_version()}
     code = config_changed(code_version)
     code.__signature__ = inspect.signature(code)  # answered at once by doit (see task_evidence)
 

@@ -2,7 +2,7 @@
 what is derived from them without running a stage.
 
 Below the stages and the report: :mod:`rclverify.pipeline` (the stages),
-:mod:`rclverify.report` (the roll-up), :mod:`rclverify.wscache` and
+:mod:`rclverify.report` (the roll-up), :mod:`rclverify.cache.workspace` and
 :mod:`rclverify.contract_texts` (kept between runs) all read a
 :class:`Workspace`; this module imports none of them (the layers of
 ``tests/test_layers.py``).  It holds:
@@ -45,7 +45,7 @@ class TaskIndex:
     """What defining a workspace's doit tasks needs of its loaded plan and
     model (:func:`rclverify.tasks.build_tasks`), small enough to be read on
     every run: a no-op run of a large system reads this and not the checked
-    contracts (:mod:`rclverify.wscache`, docs/scale.md).
+    contracts (:mod:`rclverify.cache.workspace`, docs/scale.md).
 
     ``nodes`` in source order; ``producers[n]`` the nodes feeding ``n`` (system
     model, rule R3's premises); ``contracts`` the plan's contract files;
@@ -75,13 +75,13 @@ class Workspace:
     root: Path
     plan_file: str = PLAN
     #: Parsed contract files of an earlier load, ``rel -> (sha256 of the text, Spec)``;
-    #: a file whose text has the same hash is not parsed again (see :mod:`rclverify.wscache`).
+    #: a file whose text has the same hash is not parsed again (see :mod:`rclverify.cache.workspace`).
     parsed: dict[str, tuple[str, ast.Spec]] = dataclasses.field(default_factory=dict, repr=False, compare=False)
-    #: Set by :func:`rclverify.wscache.restore`: fills ``plan`` and ``parsed``
+    #: Set by :func:`rclverify.cache.workspace.restore`: fills ``plan`` and ``parsed``
     #: from the cache the first time the plan or the checked contracts are needed.
     deferred: Callable[["Workspace"], None] | None = dataclasses.field(default=None, repr=False, compare=False)
-    #: Set by :func:`rclverify.wscache.restore`: the sha256 of each contract file it found, taken
-    #: before any file was parsed; :func:`rclverify.wscache.save` writes them into the new cache.
+    #: Set by :func:`rclverify.cache.workspace.restore`: the sha256 of each contract file it found, taken
+    #: before any file was parsed; :func:`rclverify.cache.workspace.save` writes them into the new cache.
     cache_shas: dict[str, str] | None = dataclasses.field(default=None, repr=False, compare=False)
 
     def path(self, rel: str) -> Path:

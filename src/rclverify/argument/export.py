@@ -34,9 +34,10 @@ import jinja2
 
 from ..evidence.published import write_published
 from ..evidence.store import dumps
-from ..memo import last_call
+from ..cache.memo import last_call
 from ..report import diagram
-from ..report.fragments import FragmentCache, fingerprint
+from ..cache import fingerprint
+from ..report.fragments import FragmentCache
 from .build import build_argument
 from .model import Argument, Element
 

@@ -38,7 +38,7 @@ FORMAT = "rclverify-bundle/1"
 MANIFEST = "MANIFEST.json"
 #: Workspace folders packed whole.
 TREES = ("reports", "artifacts")
-#: Left out of the trees: the workspace cache (rclverify.wscache), pickled.
+#: Left out of the trees: the workspace cache (rclverify.cache), pickled.
 EXCLUDED = ("artifacts/cache/",)
 
 

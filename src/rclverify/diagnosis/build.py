@@ -14,82 +14,63 @@ and the workspace and returns ``[record, ...]``, each::
      "related": [ids of other problems of the same node and guarantee]}
 
 Repairs cost Z3 queries (a minute for the case study's Agent), so each
-problem's repairs are kept in ``artifacts/cache/diagnosis.json`` keyed by the
-sha256 of everything they are computed from: the problem record, the
+problem's repairs are kept in ``artifacts/cache/diagnosis.pickle`` (:class:`_Cache`)
+keyed by everything they are computed from: the problem record, the
 contract files, the plan, the program, and the rclverify and Z3 versions.
 Deleting the cache is always safe.
 """
 from __future__ import annotations
 
-import hashlib
 import json
 import re
-from pathlib import Path
 from typing import Any, Callable, Mapping
 
 import z3
 
-from .. import __version__
-from ..evidence.store import atomic_write_text
+from ..cache import Shelf, file_digest
 from ..rcl.errors import RclError
 from . import repairs as rep
 from .culprits import culprits, parse_core, plan_facts
 from .table import counterexample_table
 
-CACHE = "artifacts/cache/diagnosis.json"
+CACHE = "artifacts/cache/diagnosis.pickle"
 #: Most entries the cache keeps.
 KEEP = 200
 _META_KEYS = {"conjunct", "facts", "guarantee", "reason", "replay", "source"}
 
 
 class _Cache:
+    """The repairs of this workspace's problems, kept between runs: a
+    :class:`~rclverify.cache.store.Shelf` of kind ``diagnosis`` (salted with
+    Z3's version besides the rclverify code), keyed by the contract and plan
+    files' sha256 and the problem's own key.  Keeps what this report used
+    and earlier entries up to :data:`KEEP` in all (an edit undone finds them
+    again: a repair search costs Z3 seconds)."""
+
     def __init__(self, ws: Any) -> None:
         self.ws = ws
-        self.path = ws.path(CACHE)
-        try:
-            self.data: dict[str, Any] = json.loads(self.path.read_text(encoding="utf-8"))
-        except (OSError, ValueError):
-            self.data = {}
-        self.used: dict[str, Any] = {}
+        self.shelf = Shelf(ws.path(CACHE), "diagnosis", (f"z3 {z3.get_version_string()}",), keep=KEEP)
         files = sorted({*ws.plan.contracts, ws.plan.file})
-        h = hashlib.sha256(f"{__version__} {z3.get_version_string()}".encode())
-        for src in sorted(Path(__file__).parent.glob("*.py")):  # the repair search's own code
-            h.update(src.read_bytes())
-        for rel in files:
-            try:
-                h.update(rel.encode() + b"\0" + ws.path(rel).read_bytes())
-            except OSError:
-                pass
-        self.base = h.hexdigest()
+        self.base = [f"{rel}\0{file_digest(ws.path(rel))}" for rel in files]
 
     def get(self, key: Any, make: Callable[[], Any], extra_file: str | None = None) -> Any:
-        h = hashlib.sha256((self.base + json.dumps(key, sort_keys=True, default=str)).encode())
-        if extra_file:
+        k = self.shelf.key("repairs", *self.base, json.dumps(key, sort_keys=True, default=str),
+                           file_digest(self.ws.path(extra_file)) if extra_file else "")
+        got = self.shelf.get(k)
+        if got is None:
             try:
-                h.update(self.ws.path(extra_file).read_bytes())
-            except OSError:
-                pass
-        k = h.hexdigest()
-        if k not in self.data:
-            try:
-                # as the cache file holds it (sorted keys), so a fresh result and a kept one are the same
+                # as JSON gives it back (sorted keys), so a fresh result and a kept one are the same
                 # data, key order included (the report's kept pieces are keyed by it: report/fragments.py)
-                self.data[k] = json.loads(json.dumps(make(), sort_keys=True))
+                got = [json.loads(json.dumps(make(), sort_keys=True))]
             except (z3.Z3Exception, RclError, OSError, ValueError, KeyError):
                 # a checker that misbehaves gives no repair (and nothing is kept)
                 return None
-        self.used[k] = self.data[k]
-        return self.used[k]
+            self.shelf.put(k, got)
+        return got[0]
 
     def save(self) -> None:
         try:
-            # what this report used, and earlier entries up to KEEP in all (an edit undone finds them again)
-            kept = dict(self.used)
-            for k, v in self.data.items():
-                if len(kept) >= KEEP:
-                    break
-                kept.setdefault(k, v)
-            atomic_write_text(self.path, json.dumps(kept, sort_keys=True, indent=0))
+            self.shelf.save()
         except OSError:
             pass  # a pure speed-up
 

@@ -42,7 +42,7 @@ class Loc:
         """Pickle as a constructor call: the dataclass default for a frozen
         class with slots looks its fields up on every object, which made
         Locs (one per AST node and plan value) most of the cost of the
-        workspace cache (:mod:`rclverify.wscache`): 4x faster to write, 1.7x to read."""
+        workspace cache (:mod:`rclverify.cache.workspace`): 4x faster to write, 1.7x to read."""
         return (Loc, (self.file, self.line, self.col, self.end_line, self.end_col))
 
 

@@ -39,7 +39,7 @@ from lark import Lark, Token, Transformer
 from lark.parsers.lalr_analysis import Shift
 from lark.exceptions import UnexpectedCharacters, UnexpectedEOF, UnexpectedInput, UnexpectedToken
 
-from ..heap import no_collection
+from ..cache.heap import no_collection
 from . import ast
 from .errors import Diagnostic, RclError, error
 

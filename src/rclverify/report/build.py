@@ -343,7 +343,7 @@ def build_report(ws: Workspace) -> dict[str, Any]:
             problems.append(f"Grounding: {grounding['counts']['error']} contract(s)-vs-ROS error(s) "
                             f"(rclverify ros check)")
     headline = _headline(ob_rows, counts, side_conditions, findings)
-    system = model.view(node_status, cycles_kept(model, ws.path("artifacts/cache/system-cycles.json")))
+    system = model.view(node_status, cycles_kept(model, ws.path("artifacts/cache/system-cycles.pickle")))
     report: dict[str, Any] = {
         "meta": {"tool": "rclverify", "version": __version__, "workspace": plan.name or ws.root.resolve().name, "plan": plan.file,
                  "contracts": list(plan.contracts), "z3_version": z3.get_version_string(), "strict_ok": strict_ok},

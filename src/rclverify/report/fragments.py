@@ -5,176 +5,76 @@ report -- a node's section of the HTML and Markdown report, its rows of the
 health and obligation tables, an evidence record's block, an element of the
 JSON report -- is the same text as last run.  Rendering them all again was
 most of such a run (docs/scale.md).  A piece is a pure function of the data
-it is rendered from, so its text can be reused when that data is equal:
+it is rendered from, so its text can be reused when that data is equal.
 
-* a **key** is the sha256 of a *salt* (the rclverify, Python and jinja2
-  versions and the text of every report template: a changed template
-  misses), the kind of piece, and the :func:`fingerprint` of exactly the
-  data the piece is rendered from: its ``marshal`` serialisation (format
-  version 2, which writes every string the same way), from which the data
-  can be read back, so equal bytes mean equal data.  Equal data built in
-  another order (dict insertion order) gives other bytes: a miss, never a
-  wrong hit.  ``marshal`` is four times faster than canonical JSON, which
-  keyed the pieces before (docs/scale.md, seventh round), and much faster
-  than the rendering it saves;
-* :meth:`FragmentCache.text` returns the cached text for a key or renders it
-  (the callable gets nothing else: whatever the piece shows must be in the
-  data the key is computed from);
-* :meth:`FragmentCache.save` writes the pieces used in this run (and only
-  those: pieces of an old version of a node are dropped) to its file
-  atomically, when they differ from what was loaded (each part of the report
-  has its own file, ``artifacts/cache/report-fragments.<part>.pickle``:
-  :mod:`rclverify.report.parts`).
+The pieces are a :class:`~rclverify.cache.store.Shelf` of kind
+``report-fragments`` (salted with the jinja2 version besides the rclverify
+code, which covers every template), one file per part of the report
+(``artifacts/cache/report-fragments.<part>.pickle``:
+:mod:`rclverify.report.parts`), keyed by the piece's kind and the
+:func:`~rclverify.cache.keys.fingerprint` of exactly the data it is
+rendered from (:func:`rclverify.cache.keys.Keyer`).
+:meth:`FragmentCache.text` returns the kept text for a key or renders it
+(the callable gets nothing else: whatever the piece shows must be in the
+data the key is computed from); :meth:`FragmentCache.save` keeps the pieces
+used in this run (pieces of an old version of a node are dropped).
 
-A damaged or missing file, or one from another salt, is an empty cache.
-The cache is machine-local and a pure speed-up: deleting ``artifacts/cache``
-is always safe, and a report rendered with a warm cache is byte for byte
-the one rendered without (``tests/test_report_fragments.py``).  Like the
-workspace cache it is trusted code of the workspace (pickle).
+A report rendered with a warm cache is byte for byte the one rendered
+without (``tests/test_report_fragments.py``).
 """
 from __future__ import annotations
 
-import hashlib
 import json
-import marshal
-import pickle
-import sys
-from functools import lru_cache
-from importlib.resources import files
 from pathlib import Path
 from typing import Any, Callable
 
-from ..evidence.store import atomic_write_bytes
+from ..cache import Shelf, fingerprint
 
-_FORMAT = 3
-_ENCODE = json.JSONEncoder(sort_keys=True, separators=(",", ":"), ensure_ascii=False).encode
+__all__ = ["FragmentCache", "cached_dumps", "fingerprint"]
+
+KIND = "report-fragments"
 
 
-@lru_cache(maxsize=1)
-def salt() -> str:
-    """Hex sha256 of what every piece's text also depends on: the cache
-    format, the rclverify and jinja2 versions and the text of every template
-    under ``rclverify/report/templates`` and ``rclverify/argument/templates``."""
+def _versions() -> tuple[str, ...]:
     import jinja2
-
-    from .. import __version__
-    h = hashlib.sha256(f"{_FORMAT} {__version__} {jinja2.__version__} {sys.version} {marshal.version}\n".encode())
-    for package in ("rclverify.report", "rclverify.argument"):
-        root = files(package) / "templates"
-        for entry in sorted(_walk(root), key=lambda e: e[0]):
-            h.update(entry[0].encode() + b"\0" + entry[1] + b"\0")
-    return h.hexdigest()
+    return (f"jinja2 {jinja2.__version__}",)
 
 
-def _walk(root: Any, prefix: str = "") -> list[tuple[str, bytes]]:
-    out: list[tuple[str, bytes]] = []
-    for item in root.iterdir():
-        name = f"{prefix}{item.name}"
-        if item.is_dir():
-            out += _walk(item, name + "/")
-        elif item.name.endswith(".j2"):
-            out.append((name, item.read_bytes()))
-    return out
-
-
-def fingerprint(data: Any) -> bytes:
-    """Bytes that are equal only for equal ``data`` (see the module
-    docstring): its ``marshal`` form, or, for a value ``marshal`` cannot
-    hold (a ``str`` subclass such as jinja2's ``Markup``), its canonical
-    JSON (sorted keys, no whitespace), each with its own prefix.  Raises
-    ``TypeError`` for a value neither can hold."""
-    try:
-        return b"m" + marshal.dumps(data, 2)
-    except ValueError:
-        return b"j" + _ENCODE(data).encode("utf-8", "surrogatepass")
-
-
-class FragmentCache:
+class FragmentCache(Shelf):
     """Pieces of rendered text by key; see the module docstring.
 
-    ``path`` is the pickle file (``None``: keep pieces in memory only, for
-    this object's life -- what a render without a workspace uses).
+    ``path`` is the file (``None``: keep pieces in memory only, for this
+    object's life -- what a render without a workspace uses).
     """
 
     def __init__(self, path: Path | None = None) -> None:
-        self.path = path
-        self._salt = salt()
-        self._prefixes: dict[str, Any] = {}
-        self._old: dict[bytes, str] = self._load() if path is not None else {}
-        self._used: dict[bytes, str] = {}
-        self.hits = 0
-        self.misses = 0
-
-    def _load(self) -> dict[bytes, str]:
-        assert self.path is not None
-        try:
-            with open(self.path, "rb") as fh:
-                stored = pickle.load(fh)
-        except FileNotFoundError:
-            return {}
-        except Exception:  # a damaged or foreign file is an empty cache  # noqa: BLE001
-            return {}
-        if not isinstance(stored, dict) or stored.get("salt") != self._salt or not isinstance(stored.get("pieces"), dict):
-            return {}
-        pieces: dict[bytes, str] = stored["pieces"]
-        return pieces
-
-    def key(self, kind: str, data: Any) -> bytes:
-        """The sha256 of the salt, ``kind`` and the :func:`fingerprint` of ``data``."""
-        return self._key(kind, fingerprint(data))
-
-    def _key(self, kind: str, fingerprint_of_data: bytes) -> bytes:
-        prefix = self._prefixes.get(kind)
-        if prefix is None:  # the salt and the kind hashed once per kind; each key copies that state
-            prefix = self._prefixes[kind] = hashlib.sha256(f"{self._salt}\0{kind}\0".encode())
-        h = prefix.copy()
-        h.update(fingerprint_of_data)
-        return h.digest()
+        super().__init__(path, KIND, _versions())
 
     def text(self, kind: str, data: Any, render: Callable[[], str]) -> str:
-        """The text of the piece ``kind`` rendered from ``data``: the cached
+        """The text of the piece ``kind`` rendered from ``data``: the kept
         one, or ``render()`` (which must depend on ``data`` only)."""
         return self.text_of_fingerprint(kind, fingerprint(data), render)
 
     def text_of_fingerprint(self, kind: str, fingerprint_of_data: bytes, render: Callable[[], str]) -> str:
-        """:meth:`text` for data already fingerprinted (:func:`fingerprint`),
-        for data that keys several kinds of piece."""
-        got = self.lookup(kind, fingerprint_of_data)
+        """:meth:`text` for data already fingerprinted
+        (:func:`~rclverify.cache.keys.fingerprint`), for data that keys
+        several kinds of piece."""
+        k = self.key(kind, fingerprint_of_data)
+        got: str | None = self.get(k)
         if got is None:
             got = render()
-            self.store(kind, fingerprint_of_data, got)
+            self.put(k, got)
         return got
 
     def lookup(self, kind: str, fingerprint_of_data: bytes) -> str | None:
         """The kept text of the piece ``kind`` of ``fingerprint_of_data``, or
         ``None`` (then :meth:`store` it: the caller renders many misses at once)."""
-        k = self._key(kind, fingerprint_of_data)
-        got = self._used.get(k)
-        if got is None:
-            got = self._old.get(k)
-            if got is None:
-                return None
-            self._used[k] = got
-        self.hits += 1
+        got: str | None = self.get(self.key(kind, fingerprint_of_data))
         return got
 
     def store(self, kind: str, fingerprint_of_data: bytes, text: str) -> None:
         """Keep ``text`` as the piece ``kind`` of ``fingerprint_of_data``."""
-        self._used[self._key(kind, fingerprint_of_data)] = text
-        self.misses += 1
-
-    def save(self) -> bool:
-        """Write the pieces used since this cache was made to :attr:`path`
-        (atomically; nothing when there is no path or nothing changed).
-        Returns whether a file was written; raises ``OSError`` when the
-        directory cannot be written."""
-        if self.path is None or self._used.keys() == self._old.keys():
-            return False
-        self.path.parent.mkdir(parents=True, exist_ok=True)
-        data = pickle.dumps({"salt": self._salt, "pieces": self._used}, protocol=pickle.HIGHEST_PROTOCOL)
-        atomic_write_bytes(self.path, data)
-        self._old = dict(self._used)
-        return True
+        self.put(self.key(kind, fingerprint_of_data), text)
 
 
 def cached_dumps(value: Any, cache: FragmentCache, depth: int = 2) -> str:

@@ -28,7 +28,7 @@ from markupsafe import Markup, escape
 from ..evidence.records import SEVERITY
 from ..evidence.published import write_published
 from ..evidence.store import dumps
-from ..memo import last_call
+from ..cache.memo import last_call
 from . import diagram
 from .fragments import FragmentCache, cached_dumps
 

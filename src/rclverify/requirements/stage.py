@@ -49,7 +49,7 @@ def stage_requirements(ws: "Workspace", *, force: bool = False) -> list[tuple[di
     import z3
 
     from ..logic.world import fresh
-    from ..wscache import code_stamp
+    from ..cache import code_stamp
     from .check import check_requirement, cone_of, fingerprint, formals_of
     code = f"{code_stamp()} z3 {z3.get_version_string()}"
     checked, model, plan = ws.checked, ws.model, ws.plan

@@ -16,7 +16,6 @@ is an error asking for an explicit connection in the plan.
 """
 from __future__ import annotations
 
-import hashlib
 import json
 from collections import deque
 from dataclasses import dataclass
@@ -25,7 +24,6 @@ from pathlib import Path
 from types import MappingProxyType
 from typing import Any, Iterable, Iterator, Mapping, Sequence
 
-from ..evidence.store import atomic_write_text
 from ..plan.load import Connection
 from ..rcl.errors import RclError, error
 from ..rcl.types import Checked, EmptyT
@@ -353,25 +351,20 @@ def _loops(nodes: Sequence[str], links: Iterable[Link]) -> tuple[tuple[str, ...]
 
 
 def cycles_kept(model: SystemModel, path: Path) -> list[list[str]]:
-    """``model.cycles()``, kept in the JSON file ``path`` for the next run
-    with the same nodes and connections (the key is the sha256 of the
-    model's nodes and links).  Finding the cycles of a 1000-node system
+    """``model.cycles()``, kept in ``path`` (a
+    :class:`~rclverify.cache.store.Shelf` of kind ``system-cycles``) for the
+    next run with the same nodes and connections (the key is the model's
+    nodes and links as JSON).  Finding the cycles of a 1000-node system
     takes half a second, in each report task after every edit, while an
-    edit seldom changes a connection (docs/scale.md, sixth round).  A
-    missing, damaged or foreign file is recomputed and replaced
-    atomically; raises nothing for an unwritable cache (the cycles are
-    returned anyway)."""
-    key = hashlib.sha256(json.dumps([list(model.nodes), [l.to_json() for l in model.links]],
-                                    sort_keys=True).encode()).hexdigest()
+    edit seldom changes a connection (docs/scale.md).  A missing, damaged
+    or foreign file is recomputed and replaced atomically; raises nothing
+    for an unwritable cache (the cycles are returned anyway)."""
+    from ..cache import Shelf
+    shelf = Shelf(path, "system-cycles")
+    k = shelf.key("cycles", json.dumps([list(model.nodes), [l.to_json() for l in model.links]], sort_keys=True))
+    cycles: list[list[str]] = [list(c) for c in shelf.get_or_make(k, model.cycles)]
     try:
-        kept = json.loads(path.read_text(encoding="utf-8"))
-        if isinstance(kept, dict) and kept.get("key") == key and isinstance(kept.get("cycles"), list):
-            return [list(c) for c in kept["cycles"]]
-    except (OSError, ValueError):
-        pass
-    cycles = model.cycles()
-    try:
-        atomic_write_text(path, json.dumps({"key": key, "cycles": cycles}) + "\n")
+        shelf.save()
     except OSError:
         pass
     return cycles

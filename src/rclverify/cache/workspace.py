@@ -9,13 +9,15 @@ when nothing it was computed from changed:
 
 * the sha256 of the plan file and of every contract file it lists,
 * the workspace's absolute path and the plan's path,
-* the rclverify code (name, size and modification time of every file of the
-  package) and the Python version.
+* the rclverify code (the salt of the kind ``workspace``,
+  :func:`rclverify.cache.keys.salt`: name, size and modification time of
+  every file of the package, and the Python version).
 
 When a file changed, the parsed contract files whose text is unchanged and
 an unchanged plan are still reused (see :func:`restore`); a damaged or
 missing cache, another code version or another path means a normal load.  Only workspaces that load without error are cached, so
-an error is always reported from the files themselves.  The cache is written
+an error is always reported from the files themselves.  The file has the
+format of every kept file (:mod:`rclverify.cache.store`): it is written
 atomically and is a pure speed-up: deleting ``artifacts/cache`` is always
 safe.  Like ``dodo.py`` it is trusted code of the workspace (pickle).
 
@@ -27,65 +29,42 @@ parsed contracts are unpickled only when a task first needs them
 from __future__ import annotations
 
 import atexit
-import hashlib
 import os
 import pickle
-import sys
-import tempfile
 import threading
-from functools import lru_cache
-from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import Any, BinaryIO
 
-from .heap import no_collection
-
-if TYPE_CHECKING:
-    from .workspace import Workspace
+from .keys import file_digest, salt
+from .store import open_stream, write_stream
 
 CACHE = "artifacts/cache/workspace.pickle"
-_FORMAT = 3
+KIND = "workspace"
 
 
-def _sha(path: Path) -> str:
-    try:
-        return hashlib.sha256(path.read_bytes()).hexdigest()
-    except OSError:
-        return "-"
-
-
-@lru_cache(maxsize=1)
-def code_stamp() -> str:
-    """Changes whenever a file of the installed rclverify package changes
-    (taken once per process: a run's code does not change under it)."""
-    pkg = Path(__file__).resolve().parent
-    h = hashlib.sha256(f"{_FORMAT} {sys.version}".encode())
-    for p in sorted(pkg.rglob("*")):
-        if p.suffix in (".py", ".lark", ".json", ".j2"):
-            st = p.stat()
-            h.update(f"{p.relative_to(pkg)} {st.st_size} {st.st_mtime_ns}\n".encode())
-    return h.hexdigest()
-
-
-def _header(ws: "Workspace", contracts: tuple[str, ...], known: dict[str, str] | None = None) -> dict[str, Any]:
-    """The header of ``ws``'s cache: what it was computed from.  ``known``
-    gives sha256s of contract files already taken in this run (by
-    :func:`restore`, before the files were parsed)."""
+def _inputs(ws: Any, contracts: tuple[str, ...], known: dict[str, str] | None = None) -> dict[str, Any]:
+    """What ``ws``'s (a :class:`rclverify.workspace.Workspace`) cache was
+    computed from.  ``known`` gives sha256s of contract files already taken
+    in this run (by :func:`restore`, before the files were parsed)."""
     known = known or {}
-    return {"root": str(ws.root.resolve()), "plan_file": ws.plan_file, "code": code_stamp(),
-            "plan": _sha(ws.root / ws.plan_file),
-            "contracts": {c: known[c] if c in known else _sha(ws.root / c) for c in contracts}}
+    return {"root": str(ws.root.resolve()), "plan_file": ws.plan_file,
+            "plan": file_digest(ws.root / ws.plan_file),
+            "contracts": {c: known[c] if c in known else file_digest(ws.root / c) for c in contracts}}
 
 
-def restore(ws: "Workspace") -> bool:
+def _open(ws: Any) -> BinaryIO | None:
+    return open_stream(ws.root / CACHE, KIND, salt(KIND))
+
+
+def restore(ws: Any) -> bool:
     """Fill ``ws``'s task index now, and its plan and parsed contracts on
     first use, from the cache when it is valid for the files on disk.
     Returns whether it did; never raises.
 
-    The cache holds the header, then the small :class:`~rclverify.pipeline.TaskIndex`,
-    then the large part: the plan and the parsed contract files.  The
-    checked contracts and the model are not kept: type-checking 1000 parsed
-    nodes and building the model take 0.04 s, unpickling them took 0.4 s
-    and pickling them 0.3 s.
+    The cache holds, after its header, what it was computed from, then the
+    small :class:`~rclverify.workspace.TaskIndex`, then the large part: the
+    plan and the parsed contract files.  The checked contracts and the
+    model are not kept: type-checking 1000 parsed nodes and building the
+    model take 0.04 s, unpickling them took 0.4 s and pickling them 0.3 s.
     A valid cache sets ``ws.index`` at once and leaves the large part for
     ``ws.deferred`` (:func:`_load_deferred`): a no-op doit run defines its
     tasks from the index alone and never unpickles the contracts.
@@ -98,76 +77,73 @@ def restore(ws: "Workspace") -> bool:
     then re-parses one file.
     """
     wait()  # a save of this process still under way
+    fh = _open(ws)
+    if fh is None:
+        return False
     try:
-        with open(ws.root / CACHE, "rb") as fh:
-            header = pickle.load(fh)
-            if not isinstance(header, dict):
+        with fh:
+            kept = pickle.load(fh)
+            if not isinstance(kept, dict):
                 return False
-            now = _header(ws, tuple(header.get("contracts", ())))
+            now = _inputs(ws, tuple(kept.get("contracts", ())))
             ws.cache_shas = now["contracts"]  # taken before any file is parsed: save() reuses them
-            if any(header.get(k) != now[k] for k in ("root", "plan_file", "code")):
+            if any(kept.get(k) != now[k] for k in ("root", "plan_file")):
                 return False
             index = pickle.load(fh)
-            if header == now:
+            if kept == now:
                 offset = fh.tell()
                 ws.__dict__["index"] = index
-                ws.deferred = lambda w: _load_deferred(w, header, offset)
+                ws.deferred = lambda w: _load_deferred(w, kept, offset)
                 return True
             plan, parsed = _load_large(fh)
-    except Exception:  # a missing, damaged or foreign cache is simply not used
+    except Exception:  # a damaged or foreign cache is simply not used  # noqa: BLE001
         return False
     ws.parsed.update(parsed)  # re-validated per file by Workspace.checked
-    if header.get("plan") == now["plan"] and all((ws.root / c).is_file() for c in plan.contracts):
+    if kept.get("plan") == now["plan"] and all((ws.root / c).is_file() for c in plan.contracts):
         ws.__dict__["plan"] = plan
     return False
 
 
 def _load_large(fh: Any) -> Any:
+    from .heap import no_collection
     with no_collection():  # the loaded objects are all live: collecting during the load only costs time
         return pickle.load(fh)
 
 
-def _load_deferred(ws: "Workspace", header: dict[str, Any], offset: int) -> None:
+def _load_deferred(ws: Any, kept: dict[str, Any], offset: int) -> None:
     """Fill ``ws``'s plan and parsed contracts from the cache that
     :func:`restore` validated, if the cache file is still the one read then
     and the plan file is unchanged; else fill nothing (``ws`` then loads from
     the files, reusing nothing).  A contract file edited since is parsed
     again: ``Workspace.checked`` compares each parsed file's sha256 with the
     file.  Never raises."""
+    fh = _open(ws)
+    if fh is None:
+        return
     try:
-        with open(ws.root / CACHE, "rb") as fh:
-            if pickle.load(fh) != header or _sha(ws.root / ws.plan_file) != header["plan"]:
+        with fh:
+            if pickle.load(fh) != kept or file_digest(ws.root / ws.plan_file) != kept["plan"]:
                 return  # the cache was rewritten or the plan changed since the run started
             fh.seek(offset)
             plan, parsed = _load_large(fh)
-    except Exception:
+    except Exception:  # noqa: BLE001
         return
     ws.__dict__["plan"] = plan  # the cached_property slot
     ws.parsed.update(parsed)  # Workspace.checked type-checks these (0.03 s for 1000 nodes)
 
 
-def save(ws: "Workspace") -> None:
+def save(ws: Any) -> None:
     """Write the cache for a workspace whose model loaded without error.
     Never raises (a cache that cannot be written is not written).
 
     The contract files' sha256s are those :func:`restore` took in this
     process, before the files were parsed (a file edited since is then
     parsed again next time), or taken now."""
-    path = ws.root / CACHE
     try:
-        header = _header(ws, tuple(ws.plan.contracts), ws.cache_shas)
-        path.parent.mkdir(parents=True, exist_ok=True)
-        fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=".workspace.", suffix=".tmp")
-        with os.fdopen(fd, "wb") as fh:
-            pickle.dump(header, fh, protocol=pickle.HIGHEST_PROTOCOL)
-            pickle.dump(ws.index, fh, protocol=pickle.HIGHEST_PROTOCOL)
-            pickle.dump((ws.plan, ws.parsed), fh, protocol=pickle.HIGHEST_PROTOCOL)
-        os.replace(tmp, path)
-    except Exception:
-        try:
-            os.unlink(tmp)
-        except (OSError, UnboundLocalError):
-            pass
+        kept = _inputs(ws, tuple(ws.plan.contracts), ws.cache_shas)
+        write_stream(ws.root / CACHE, KIND, salt(KIND), [kept, ws.index, (ws.plan, ws.parsed)])
+    except Exception:  # noqa: BLE001
+        pass
 
 
 #: Background saves of this process: (pid of the process that forked, pid of the child).
@@ -176,7 +152,7 @@ _PENDING: list[tuple[int, int]] = []
 _registered: list[bool] = []
 
 
-def save_in_background(ws: "Workspace") -> None:
+def save_in_background(ws: Any) -> None:
     """:func:`save` in a forked child process, so that pickling the parsed
     contracts (0.3 s for 1000 nodes, on every run after an edit) overlaps
     with the rest of the run instead of delaying its first task
