@@ -2,12 +2,12 @@
 system model's per-node index, and the cached workspace of a doit run."""
 from __future__ import annotations
 
-import json
 import random
 from pathlib import Path
 
 import pytest
 
+from rclverify.cache import Shelf
 from rclverify.cache import workspace as wscache
 from rclverify.pipeline import Workspace
 from rclverify.system.model import Link, SystemModel, _loops, cycles_kept
@@ -70,14 +70,16 @@ def test_model_index_answers_like_a_scan_of_the_links() -> None:
 def test_cycles_are_kept_for_the_same_connections_and_found_again_for_others(tmp_path: Path) -> None:
     ring = SystemModel(("A", "B", "C"), (Link("A", "o", "B", "i", "name"), Link("B", "o", "C", "i", "name"),
                                          Link("C", "o", "A", "i", "name")), (), (("A", "B", "C"),))
-    path = tmp_path / "cache" / "cycles.json"
+    path = tmp_path / "cache" / "cycles.pickle"
     assert cycles_kept(ring, path) == [["A", "B", "C"]] == ring.cycles()
-    kept = json.loads(path.read_text())
-    path.write_text(json.dumps({"key": kept["key"], "cycles": [["from", "the", "file"]]}))
+    shelf = Shelf(path, "system-cycles")
+    (key,) = [k for k in shelf._old]  # the one entry: the ring's connections
+    shelf.put(key, [["from", "the", "file"]])
+    shelf.save()
     assert cycles_kept(ring, path) == [["from", "the", "file"]]  # served from the file: same connections
     chain = SystemModel(ring.nodes, ring.links[:2], (), ())
     assert cycles_kept(chain, path) == []  # other connections: found again, and the file replaced
-    assert json.loads(path.read_text())["cycles"] == []
+    assert len(Shelf(path, "system-cycles")) == 1
     path.write_text("{damaged")
     assert cycles_kept(ring, path) == [["A", "B", "C"]]
 

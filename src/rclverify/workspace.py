@@ -62,6 +62,8 @@ class TaskIndex:
     entries: dict[str, tuple[Any, ...]]
     #: The plan's ``requirements_from`` Doorstop folders (their files are inputs of ``requirements``).
     requirement_dirs: tuple[str, ...] = ()
+    #: The plan's ``ros:`` section (docs/ros.md): what the ``ground`` task reads; empty: no such task.
+    ros: dict[str, Any] = dataclasses.field(default_factory=dict)
 
 
 @dataclass
@@ -110,7 +112,8 @@ class Workspace:
             nodes=tuple(self.checked.nodes), producers={n: tuple(model.producers(n)) for n in self.checked.nodes},
             contracts=tuple(plan.contracts), replacement={n: r[0].rpartition(":")[0] for n, r in plan.replacements.items()},
             entries={n: tuple(e.config for e in es) for n, es in plan.evidence.items()},
-            requirement_dirs=tuple(d for d, _ in plan.requirements_from))
+            requirement_dirs=tuple(d for d, _ in plan.requirements_from),
+            ros=dict(getattr(plan, "ros", None) or {}))
 
     @cached_property
     def checked(self) -> Checked:

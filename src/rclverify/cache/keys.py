@@ -76,10 +76,11 @@ def fingerprint(data: Any) -> bytes:
         return b"j" + _ENCODE(data).encode("utf-8", "surrogatepass")
 
 
-def file_digest(path: Path) -> str:
+def file_digest(path: Path | str) -> str:
     """Hex sha256 of the file's bytes, or ``"-"`` when it cannot be read."""
     try:
-        return hashlib.sha256(path.read_bytes()).hexdigest()
+        with open(path, "rb") as fh:
+            return hashlib.sha256(fh.read()).hexdigest()
     except OSError:
         return "-"
 

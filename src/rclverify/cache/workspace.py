@@ -46,9 +46,10 @@ def _inputs(ws: Any, contracts: tuple[str, ...], known: dict[str, str] | None = 
     computed from.  ``known`` gives sha256s of contract files already taken
     in this run (by :func:`restore`, before the files were parsed)."""
     known = known or {}
-    return {"root": str(ws.root.resolve()), "plan_file": ws.plan_file,
-            "plan": file_digest(ws.root / ws.plan_file),
-            "contracts": {c: known[c] if c in known else file_digest(ws.root / c) for c in contracts}}
+    root = str(ws.root.resolve())
+    return {"root": root, "plan_file": ws.plan_file,
+            "plan": file_digest(f"{root}/{ws.plan_file}"),
+            "contracts": {c: known[c] if c in known else file_digest(f"{root}/{c}") for c in contracts}}
 
 
 def _open(ws: Any) -> BinaryIO | None:

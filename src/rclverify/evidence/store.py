@@ -115,6 +115,25 @@ def seal_of(record: Mapping[str, Any]) -> str:
     return hashlib.sha256(dumps(body).encode("utf-8")).hexdigest()
 
 
+def _sealed_text(text: str, seal: Any) -> bool:
+    """Whether ``text`` is exactly the record :meth:`EvidenceStore.put` writes
+    with ``seal``: the file without its seal line is then :func:`dumps` of
+    the sealed body (keys are sorted and ``record_sha256`` is never the
+    last key, so the line ends with a comma), and hashing that text decides
+    the seal without encoding the record again (a report reads every record:
+    0.3 s of each report task at 1000 nodes).  ``False`` only means "not
+    decided here": the caller then compares :func:`seal_of` of the content,
+    so a record re-formatted but not changed still reads as intact."""
+    if not isinstance(seal, str):
+        return False
+    line = f'  "{SEAL}": "{seal}",\n'
+    at = text.find(line)
+    if at < 0 or text.find(line, at + 1) >= 0:
+        return False
+    body = text[:at] + text[at + len(line):]
+    return hashlib.sha256(body.encode("utf-8")).hexdigest() == seal
+
+
 class EvidenceStore:
     """Evidence records under ``<root>/artifacts/evidence/<obligation id>.json``.
 
@@ -147,7 +166,8 @@ class EvidenceStore:
         wrote it (its content does not match its seal), it carries no seal,
         or it is not a readable evidence record."""
         try:
-            raw = read_json(self.path(obligation_id))
+            text = self.path(obligation_id).read_text(encoding="utf-8")
+            raw = json.loads(text)
         except FileNotFoundError:
             return None, ""
         except (OSError, ValueError) as exc:
@@ -158,7 +178,7 @@ class EvidenceStore:
             return None, f"evidence record malformed ({exc}): altered outside rclverify"
         if not isinstance(raw, dict) or SEAL not in raw:
             return ev, "evidence altered outside rclverify: the record carries no seal (rclverify seals every record it writes)"
-        if raw[SEAL] != seal_of(raw):
+        if not _sealed_text(text, raw[SEAL]) and raw[SEAL] != seal_of(raw):
             return ev, ("evidence altered outside rclverify: the record's content does not match the sha256 rclverify "
                         f"wrote with it (it says {ev.status!r}; run `doit verify` to produce it again)")
         return ev, ""
