@@ -161,3 +161,34 @@ def test_invalid_utf8_is_located_at_the_bad_byte(tmp_path: Path) -> None:
     with pytest.raises(RclError, match=r"a\.rcl:1:2: error: NUL character"):
         decode_text("a\0b".encode("utf-8"), "a.rcl")
     assert decode_text(codecs.BOM_UTF8 + "é\n".encode(), "a.rcl") == "é\n"
+
+
+def test_libyaml_composes_the_nodes_pyyaml_does() -> None:
+    """The guarded loader composes with libyaml where PyYAML has it; every YAML file of the
+    repository gives the same node graph (kinds, tags, values, styles and marks) either way."""
+    import yaml
+
+    from rclverify.plan import yamlguard
+    if yamlguard._COMPOSER is yaml.SafeLoader:
+        pytest.skip("PyYAML built without libyaml: only its own loader is used")
+
+    def shape(node: yaml.Node) -> object:
+        marks = (node.start_mark.line, node.start_mark.column, node.end_mark.line, node.end_mark.column)
+        if isinstance(node, yaml.ScalarNode):
+            return ("s", node.tag, node.value, node.style or None, marks)  # plain: None or ""
+        if isinstance(node, yaml.SequenceNode):
+            return ("q", node.tag, [shape(c) for c in node.value], marks)
+        return ("m", node.tag, [(shape(k), shape(v)) for k, v in node.value], marks)
+    root = Path(__file__).resolve().parents[1]
+    files = [p for p in root.rglob("*.yaml") if ".git" not in p.parts] + list(root.rglob("*.yml"))
+    assert len(files) > 10
+    for p in files:
+        text = p.read_text(encoding="utf-8")
+        try:
+            c = yaml.compose(text, Loader=yamlguard._COMPOSER)
+        except yaml.YAMLError:
+            continue  # malformed on purpose: composed again by PyYAML's loader for its message
+        py = yaml.compose(text, Loader=yaml.SafeLoader)
+        assert (c is None) == (py is None), p
+        if c is not None:
+            assert shape(c) == shape(py), p
