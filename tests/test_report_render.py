@@ -177,7 +177,7 @@ def test_html_sections_in_order_and_anchors_resolve() -> None:
 
 
 class _TagBalance(HTMLParser):
-    VOID = {"br", "meta", "link", "img", "hr", "input", "path", "polygon", "ellipse", "polyline"}
+    VOID = {"br", "meta", "link", "img", "hr", "input", "path", "polygon", "ellipse", "polyline", "col", "wbr"}
 
     def __init__(self) -> None:
         super().__init__()

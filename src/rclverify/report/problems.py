@@ -92,7 +92,7 @@ class _Places:
         rows = self.by_file.get(file)
         if rows is None:
             rid = f"line:{file}:{line}"
-            self.info.setdefault(rid, {"what": f"{file} line {line}", "source": f"{file}:{line}", "anchor": None})
+            self.info.setdefault(rid, {"what": "", "source": f"{file}:{line}", "anchor": None})
             return rid
         i = bisect.bisect_right([r[0] for r in rows], line) - 1
         return rows[i][1] if i >= 0 else None
@@ -128,7 +128,7 @@ def group_problems(report: Mapping[str, Any], items: Sequence[Mapping[str, Any]]
     problems, each::
 
         {"key": [root culprit ids], "status": worst member status,
-         "sentence": the first member's diagnosis sentence,
+         "sentence": the first sentence of the first member's diagnosis (first_sentence),
          "culprits": [{"id", "what", "source", "file", "anchor" (fragment id or "")}],
          "members": [{"id", "kind", "status", "sentence", "anchor", "diagnosis": bool}],
          "repairs": [{"diagnosis": id, "index": n}]  (distinct diffs, each checked by Z3)}
@@ -186,7 +186,7 @@ def group_problems(report: Mapping[str, Any], items: Sequence[Mapping[str, Any]]
         key = tuple(sorted(roots)) if roots else (f"problem:{m['id']}",)
         g = groups.get(key)
         if g is None:
-            g = groups[key] = {"key": list(key), "status": m["status"], "sentence": m["sentence"],
+            g = groups[key] = {"key": list(key), "status": m["status"], "sentence": first_sentence(m["sentence"]),
                                "culprits": [_culprit(r, places, anchor) for r in key if r in places.info],
                                "members": [], "repairs": []}
         g["members"].append(m)
@@ -203,6 +203,21 @@ def group_problems(report: Mapping[str, Any], items: Sequence[Mapping[str, Any]]
     out = list(groups.values())
     out.sort(key=lambda g: -_severity(g["status"]))  # stable: report order within a status
     return out
+
+
+_SENTENCE_END = re.compile(r"(?<=[.;])\s+(?=[A-Z])")
+#: Longest sentence a group's row shows (characters); the whole text is in its findings.
+SENTENCE_CHARS = 400
+
+
+def first_sentence(text: str, limit: int = SENTENCE_CHARS) -> str:
+    """The first sentence of ``text`` (up to a ``.`` or ``;`` followed by a
+    capital letter), cut at a word boundary to ``limit`` characters with
+    ``...`` when longer."""
+    s = _SENTENCE_END.split(str(text).strip(), 1)[0]
+    if len(s) > limit:
+        s = s[:limit].rsplit(" ", 1)[0] + " ..."
+    return s
 
 
 def _default_anchor(d: Mapping[str, Any], anchor: Callable[..., str]) -> str:
