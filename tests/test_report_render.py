@@ -463,6 +463,7 @@ def _grouping_report() -> dict[str, Any]:
 def test_problems_with_the_same_culprit_are_one_row() -> None:
     from rclverify.report.problems import group_problems
     rep = _grouping_report()
+    rep["diagnoses"][1]["sentence"] = "G3 excludes it. More to read."
     groups = group_problems(rep, render.problem_items(rep), render.anchor)
     by_key = {tuple(g["key"]): g for g in groups}
     agent = by_key[("guarantee:Agent:3",)]
@@ -472,7 +473,7 @@ def test_problems_with_the_same_culprit_are_one_row() -> None:
                                   "source": "contracts/mini.rcl:22:3", "file": "contracts/mini.rcl",
                                   "anchor": "g-Agent-3"}]
     assert agent["repairs"] == [{"diagnosis": "Agent.g1.non-vacuous", "index": 0}]  # the same diff once
-    assert agent["sentence"] == "Agent.g1.non-vacuous is wrong."
+    assert agent["sentence"] == "G3 excludes it."  # the shortest first sentence of the row's diagnoses
     hoare = by_key[("line:backends/hoare/s.imp:15", "line:backends/hoare/s.imp:18")]
     assert [m["id"] for m in hoare["members"]] == ["Sensor.g1.hoare.c2", "Sensor.g1.hoare.c3"]
     assert hoare["culprits"][0]["anchor"] == "" and hoare["culprits"][0]["file"] == "backends/hoare/s.imp"

@@ -46,6 +46,11 @@ from ..evidence.records import SEVERITY
 _SOURCE = re.compile(r"^(.*?):(\d+)(?::(\d+))?$")
 #: Diagnosis kinds whose victim guarantee is a defect of the contract itself.
 _CONTRACT_DEFECTS = ("vacuity", "inconsistency")
+#: Diagnosis kinds whose sentence names the cause rather than the symptom, most telling first: a
+#: contract defect names the guarantees that exclude each other, a side condition producer and
+#: consumer, a Hoare refutation the constants; a test or a monitor names only the guarantee broken.
+_TELLING = {"vacuity": 0, "inconsistency": 0, "unsatisfiable-assumption": 0, "side-condition": 1, "hoare": 1,
+            "refinement": 2, "monitor": 3}
 #: Requirement verdicts that are problems (report/build.py lists them too).
 BAD_VERDICTS = ("refuted", "proved from an inconsistency", "proved vacuously")
 #: Status words of diagnosis records and health findings as evidence statuses.
@@ -128,7 +133,8 @@ def group_problems(report: Mapping[str, Any], items: Sequence[Mapping[str, Any]]
     problems, each::
 
         {"key": [root culprit ids], "status": worst member status,
-         "sentence": the first sentence of the first member's diagnosis (first_sentence),
+         "sentence": the first sentence (first_sentence) of the diagnosis of a member with
+                     the worst status: the most telling kind (_TELLING), then the shortest,
          "culprits": [{"id", "what", "source", "file", "anchor" (fragment id or "")}],
          "members": [{"id", "kind", "status", "sentence", "anchor", "diagnosis": bool}],
          "repairs": [{"diagnosis": id, "index": n}]  (distinct diffs, each checked by Z3)}
@@ -194,6 +200,11 @@ def group_problems(report: Mapping[str, Any], items: Sequence[Mapping[str, Any]]
             g["status"] = m["status"]
     by_id = {str(d["id"]): d for d in diagnoses}
     for g in groups.values():
+        # the row's sentence: from the diagnosis that says most about the cause (_TELLING), the shortest
+        worst = [m for m in g["members"] if _severity(m["status"]) == _severity(g["status"])]
+        told = [m for m in worst if m["diagnosis"]] or worst
+        best = min(told, key=lambda m: (_TELLING.get(m["kind"], len(_TELLING)), len(first_sentence(m["sentence"]))))
+        g["sentence"] = first_sentence(best["sentence"])
         diffs: set[str] = set()
         for m in g["members"]:
             for k, rep in enumerate((by_id.get(m["id"]) or {}).get("repairs", []) if m["diagnosis"] else []):
