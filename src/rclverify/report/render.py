@@ -520,7 +520,9 @@ def dashboard(report: Mapping[str, Any], evidence_of: Mapping[str, Sequence[tupl
 def view(report: Mapping[str, Any]) -> dict[str, Any]:
     """Derived lookups the templates need (pure function of ``report``).
 
-    Keys: ``counts`` (``[(status, n)]`` worst first), ``problems`` and
+    Keys: ``dashboard`` (:func:`dashboard`), ``problem_groups`` (the
+    problems grouped by root cause, :func:`problem_groups`), ``diagnosis``
+    (diagnosis id -> record), ``counts`` (``[(status, n)]`` worst first), ``problems`` and
     ``outstanding`` (see :func:`_attention`), ``unmet_requirements``,
     ``ev_anchor`` (one fragment id per evidence record, in order),
     ``evidence_of`` (obligation id -> ``[(anchor, record)]``), ``obligation``
