@@ -28,7 +28,9 @@ its diagnosis record (:mod:`rclverify.diagnosis.build`, ``culprits``):
    the key.
 
 Problems with the same key are one group; a problem with no culprit at all
-(a refinement that fails, a lint error) is its own group.  Requirements
+(a refinement that fails, a lint error) is its own group.  A derived
+property that is not derived joins the group of the side conditions of its
+cone that are not discharged (the reason it is not derived).  Requirements
 refuted, proved vacuously or from an inconsistency take their culprits from
 the check's core (``vacuity_core``, ``inconsistent_core``,
 ``failed_to_prevent``); attention items without a diagnosis record
@@ -172,6 +174,7 @@ def group_problems(report: Mapping[str, Any], items: Sequence[Mapping[str, Any]]
                          "anchor": anchor("req", q["id"]), "diagnosis": False}, roots))
     covered = {m["id"] for m, _ in members}
     obligation = {str(o["id"]): o for o in report.get("obligations", [])}
+    roots_of = {m["id"]: roots for m, roots in members}
     for it in items:
         ref = str(it["ref"])
         if ref in covered:
@@ -179,6 +182,11 @@ def group_problems(report: Mapping[str, Any], items: Sequence[Mapping[str, Any]]
         o = obligation.get(ref)
         roots = [f"guarantee:{o['node']}:{o['guarantee']}"] if o is not None and o.get("guarantee") else []
         roots = [r for r in roots if r in places.info]
+        if it["kind"] == "derived property":
+            # not derived because a side condition of its cone is not discharged: that side condition's cause
+            for sc in _cone_side_conditions(report, ref):
+                roots += [r for r in (roots_of.get(sc) or [f"problem:{sc}"]) if r not in roots]
+        roots_of[ref] = roots
         members.append(({"id": ref, "kind": str(it["kind"]), "status": str(it["status"]),
                          "sentence": str(it["message"]) + (f" `{it['formula']}`" if it.get("formula") else ""),
                          "anchor": str(it["anchor"]), "diagnosis": False}, roots))
@@ -229,6 +237,23 @@ def first_sentence(text: str, limit: int = SENTENCE_CHARS) -> str:
     if len(s) > limit:
         s = s[:limit].rsplit(" ", 1)[0] + " ..."
     return s
+
+
+def _cone_side_conditions(report: Mapping[str, Any], node: str) -> list[str]:
+    """The ids of the side conditions not discharged in the cone of ``node``:
+    of the node and every node upstream of it along the system's
+    connections (the cone a derived property rests on, paper section 4)."""
+    upstream: dict[str, set[str]] = {}
+    for c in report.get("system", {}).get("connections", []):
+        upstream.setdefault(str(c["to_node"]), set()).add(str(c["from_node"]))
+    cone, todo = {node}, [node]
+    while todo:
+        for u in upstream.get(todo.pop(), ()):
+            if u not in cone:
+                cone.add(u)
+                todo.append(u)
+    return [str(sc["id"]) for sc in report.get("side_conditions", [])
+            if str(sc["node"]) in cone and sc["status"] != "discharged"]
 
 
 def _default_anchor(d: Mapping[str, Any], anchor: Callable[..., str]) -> str:
