@@ -28,7 +28,13 @@ from typing import Any
 
 import pytest
 
-from rclverify.pipeline import Workspace, stage_check, stage_compose, stage_health, stage_report
+from rclverify.pipeline import (
+    Workspace,
+    stage_check,
+    stage_compose,
+    stage_health,
+    stage_report,
+)
 from rclverify.report.render import render_files
 
 REPO = Path(__file__).resolve().parents[1]

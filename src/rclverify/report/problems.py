@@ -41,7 +41,8 @@ from __future__ import annotations
 
 import bisect
 import re
-from typing import Any, Callable, Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
+from typing import Any
 
 from ..evidence.records import SEVERITY
 
@@ -53,6 +54,8 @@ _CONTRACT_DEFECTS = ("vacuity", "inconsistency")
 #: consumer, a Hoare refutation the constants; a test or a monitor names only the guarantee broken.
 _TELLING = {"vacuity": 0, "inconsistency": 0, "unsatisfiable-assumption": 0, "side-condition": 1, "hoare": 1,
             "refinement": 2, "monitor": 3}
+#: Rank of every other kind (a property test, other evidence, a requirement, an attention item).
+_LEAST_TELLING = 4
 #: Requirement verdicts that are problems (report/build.py lists them too).
 BAD_VERDICTS = ("refuted", "proved from an inconsistency", "proved vacuously")
 #: Status words of diagnosis records and health findings as evidence statuses.
@@ -114,7 +117,7 @@ def _roots(culprits: Sequence[Mapping[str, Any]], places: _Places, victim: str |
         rid = places.locate(str(c.get("source", "")))
         if rid is None:
             continue
-        if what.startswith("environment fact") or what.startswith("event "):
+        if what.startswith(("environment fact", "event ")):
             places.info[rid] = {**places.info.get(rid, {}), "what": what.split(" `")[0], "anchor": None}
             context.append(rid)
         elif rid not in roots:
@@ -154,7 +157,7 @@ def group_problems(report: Mapping[str, Any], items: Sequence[Mapping[str, Any]]
     explains: dict[str, list[str]] = {}
     for d in diagnoses:
         roots = _roots(d.get("culprits", []), places, victim_of(d.get("node"), d.get("guarantee")))
-        m = {"id": str(d["id"]), "kind": str(d["kind"]), "status": str(d["status"]), "sentence": str(d["sentence"]),
+        m: dict[str, Any] = {"id": str(d["id"]), "kind": str(d["kind"]), "status": str(d["status"]), "sentence": str(d["sentence"]),
              "anchor": item_anchor.get(str(d["id"])) or _default_anchor(d, anchor), "diagnosis": True}
         members.append((m, roots))
         victim = victim_of(d.get("node"), d.get("guarantee"))
@@ -211,7 +214,7 @@ def group_problems(report: Mapping[str, Any], items: Sequence[Mapping[str, Any]]
         # the row's sentence: from the diagnosis that says most about the cause (_TELLING), the shortest
         worst = [m for m in g["members"] if _severity(m["status"]) == _severity(g["status"])]
         told = [m for m in worst if m["diagnosis"]] or worst
-        best = min(told, key=lambda m: (_TELLING.get(m["kind"], len(_TELLING)), len(first_sentence(m["sentence"]))))
+        best = min(told, key=lambda m: (_TELLING.get(m["kind"], _LEAST_TELLING), len(first_sentence(m["sentence"]))))
         g["sentence"] = first_sentence(best["sentence"])
         diffs: set[str] = set()
         for m in g["members"]:
