@@ -177,7 +177,7 @@ def test_html_sections_in_order_and_anchors_resolve() -> None:
 
 
 class _TagBalance(HTMLParser):
-    VOID = {"br", "meta", "link", "img", "hr", "input", "path", "polygon", "ellipse", "polyline"}
+    VOID = {"br", "meta", "link", "img", "hr", "input", "path", "polygon", "ellipse", "polyline", "col", "wbr"}
 
     def __init__(self) -> None:
         super().__init__()
@@ -390,3 +390,121 @@ def test_identical_outstanding_items_are_one_group() -> None:
     assert [len(g["items"]) for g in groups] == [39, 1, 1]
     assert groups[0]["message"] == "AJPF is not installed; run instance 0 with MCAPL"
     assert [it["ref"] for it in groups[0]["items"]] == [f"Agent.g1.ajpf.p{k}_i{k}" for k in range(39)]
+
+
+def test_dashboard_cells_are_the_worst_status_of_each_technique_and_link_to_it() -> None:
+    rep = _report()
+    v = render.view(rep)
+    dash = v["dashboard"]
+    assert dash["columns"][:3] == ["health", "side conditions", "hoare"]
+    cells = {row["node"]: dict(zip(dash["columns"], row["cells"])) for row in dash["rows"]}
+    assert [row["node"] for row in dash["rows"]] == ["Sensor", "Agent"]
+    assert cells["Sensor"]["hoare"]["status"] == "failed" and cells["Sensor"]["hoare"]["anchor"] == "ev-Sensor.g1.hoare"
+    assert cells["Sensor"]["side conditions"]["status"] == "failed"
+    assert cells["Sensor"]["dafny"] is None
+    assert cells["Agent"]["health"] == {"status": "failed", "worst": 1, "total": 1, "counts": [("failed", 1)],
+                                        "anchor": "finding-Agent.health.g2"}
+    assert cells["Agent"]["ajpf"]["status"] == "pending" and cells["Agent"]["dafny"]["status"] == "discharged"
+    # a healthy finding counts as discharged; a worse item of the same kind wins
+    assert cells["Sensor"]["health"]["status"] == "discharged"
+    rep["evidence"].append({**rep["evidence"][1], "obligation": "Agent.g2.dafny", "status": "stale"})
+    rep["obligations"][1]["status"] = "stale"
+    cells = dict(zip(render.view(rep)["dashboard"]["columns"], render.view(rep)["dashboard"]["rows"][1]["cells"]))
+    assert cells["dafny"]["status"] == "stale" and cells["dafny"]["anchor"] == "ev-Agent.g2.dafny"
+    html = render.render_html(rep, rendering=NO_DOT)
+    dashboard = _section(html, 'id="dashboard"', "</section>")
+    assert 'href="#ev-Sensor.g1.hoare"' in dashboard and "REQ1" in dashboard
+    assert html.index('id="dashboard"') < html.index('id="attention"') < html.index('id="system"')
+    md = render.render_markdown(rep)
+    assert "## Dashboard" in md and "(#ev-Sensor.g1.hoare)" in md
+
+
+def _grouping_report() -> dict[str, Any]:
+    """The case study's pattern in small: guarantee 3 of Agent makes 1 and 2
+    vacuous (with different facts in their cores), a property test fails on
+    guarantee 1, a requirement is vacuous through guarantee 2, two Hoare
+    triples fail on the same program constants; a lone refinement problem."""
+    rep = _report()
+    rep["nodes"][1]["guarantees"].append({"index": 3, "text": "out.command == go", "source": "contracts/mini.rcl:22:3",
+                                          "status": "failed", "obligations": []})
+    fact = {"what": "environment fact 1 (contracts/plan.yaml:9:10) `in.n <= 12`", "source": "contracts/plan.yaml:9:10"}
+    fact2 = {"what": "environment fact 2 (contracts/plan.yaml:10:10)", "source": "contracts/plan.yaml:10:10"}
+    g3 = {"what": "guarantee 3 (contracts/mini.rcl:22:3) at i=13", "source": "contracts/mini.rcl:22:3"}
+    prog = [{"what": "backends/hoare/s.imp line 15", "source": "backends/hoare/s.imp:15"},
+            {"what": "backends/hoare/s.imp line 18", "source": "backends/hoare/s.imp:18"}]
+
+    def d(id: str, kind: str, node: str, k: Any, culprits: list[dict[str, str]], repairs: Any = ()) -> dict[str, Any]:
+        return {"id": id, "kind": kind, "node": node, "status": "failed", "sentence": f"{id} is wrong. More.",
+                "culprits": culprits, "counterexample": [], "repairs": list(repairs), "guarantee": k, "related": []}
+    guard = {"kind": "guard", "checked_by": "z3", "summary": "Guard guarantee 3.", "checks": [], "cost": [],
+             "diff": "--- a\n+++ b\n"}
+    const = {"kind": "constant", "checked_by": "z3", "summary": "10 -> 120.", "checks": [], "cost": [],
+             "diff": "--- p\n+++ p\n"}
+    rep["diagnoses"] = [
+        d("Agent.g1.non-vacuous", "vacuity", "Agent", 1, [fact, g3, fact2], [guard]),
+        d("Agent.g2.non-vacuous", "vacuity", "Agent", 2, [fact, g3], [guard]),
+        d("Agent.replacement-refines", "refinement", "Agent", None, []),
+        d("Agent.g1.property_tests.e2", "property-test", "Agent", 1,
+          [{"what": "guarantee 1 of Agent (contracts/mini.rcl:20:3)", "source": "contracts/mini.rcl:20:3"}]),
+        d("Sensor.g1.hoare.c2", "hoare", "Sensor", 1,
+          [*prog, {"what": "conjunct of guarantee 1 of Sensor", "source": "contracts/mini.rcl:12:11"}], [const]),
+        d("Sensor.g1.hoare.c3", "hoare", "Sensor", 1,
+          [*prog, {"what": "conjunct of guarantee 1 of Sensor", "source": "contracts/mini.rcl:13:5"}], [const]),
+    ]
+    rep["requirements"][0].update(verdict="proved vacuously", note="its premise never holds", check={
+        "formal": "in.r >= 250 -> out.command == stop", "source": "contracts/plan.yaml:5:11", "assuming": [],
+        "used": [], "traced_not_needed": [], "inconsistent_core": None, "counterexample": None,
+        "failed_to_prevent": None,
+        "vacuity_core": [{"label": "Agent guarantee 2", "source": "contracts/mini.rcl:21:14", "text": "x"},
+                         {"label": "Sensor guarantee 1", "source": "contracts/mini.rcl:12:14", "text": "y"}]})
+    return rep
+
+
+def test_problems_with_the_same_culprit_are_one_row() -> None:
+    from rclverify.report.problems import group_problems
+    rep = _grouping_report()
+    rep["diagnoses"][1]["sentence"] = "G3 excludes it. More to read."
+    groups = group_problems(rep, render.problem_items(rep), render.anchor)
+    by_key = {tuple(g["key"]): g for g in groups}
+    agent = by_key[("guarantee:Agent:3",)]
+    assert [m["id"] for m in agent["members"]] == ["Agent.g1.non-vacuous", "Agent.g2.non-vacuous",
+                                                   "Agent.g1.property_tests.e2", "REQ1"]
+    assert agent["culprits"] == [{"id": "guarantee:Agent:3", "what": "guarantee 3 of Agent",
+                                  "source": "contracts/mini.rcl:22:3", "file": "contracts/mini.rcl",
+                                  "anchor": "g-Agent-3"}]
+    assert agent["repairs"] == [{"diagnosis": "Agent.g1.non-vacuous", "index": 0}]  # the same diff once
+    assert agent["sentence"] == "G3 excludes it."  # the shortest first sentence of the row's diagnoses
+    hoare = by_key[("line:backends/hoare/s.imp:15", "line:backends/hoare/s.imp:18")]
+    assert [m["id"] for m in hoare["members"]] == ["Sensor.g1.hoare.c2", "Sensor.g1.hoare.c3"]
+    assert hoare["culprits"][0]["anchor"] == "" and hoare["culprits"][0]["file"] == "backends/hoare/s.imp"
+    assert [m["id"] for m in by_key[("problem:Agent.replacement-refines",)]["members"]] == ["Agent.replacement-refines"]
+    # attention items without a diagnosis: the refuted side condition of Sensor's assumption, the health problem
+    # of the fixture (its own guarantee), the failed Hoare evidence is covered by its diagnosis... each once
+    ids = [m["id"] for g in groups for m in g["members"]]
+    assert len(ids) == len(set(ids))
+    assert {"Sensor.sc1", "Agent.health.g2", "Sensor.g1.hoare"} <= set(ids)
+    # Agent's derived property is not derived because Sensor.sc1 (upstream of it, on the loop) is refuted
+    sc_row = next(g for g in groups if any(m["id"] == "Sensor.sc1" for m in g["members"]))
+    assert [m["id"] for m in sc_row["members"]] == ["Sensor.sc1", "Agent"]
+    # the JSON report carries the grouping as it is rendered
+    html = render.render_html({**rep, "problems": groups}, rendering=NO_DOT)
+    assert html == render.render_html(rep, rendering=NO_DOT)
+    attention = _section(html, 'id="attention"', "</section>")
+    assert attention.count('<tr id="problem-') == len(groups)
+    assert 'id="diagnosis-Agent-g2-non-vacuous"' in attention and "10 -&gt; 120." in attention
+    md = _section(render.render_markdown(rep), "## What needs attention", "## System model")
+    assert "| 4: [`Agent.g1.non-vacuous`](#finding-Agent.g1.non-vacuous)" in md
+
+
+def test_long_formulas_are_folded_and_broken_at_connectives() -> None:
+    short = "in.r >= 250 -> out.status == red"
+    assert render.formula_html(short) == f"<code>{short.replace('>', '&gt;')}</code>"
+    long = ("forall(i in NATURAL | in.a(i) == TRUE and in.b(i) == FALSE or not exists(x in REAL | in.w(x) == i + 1) "
+            "-> exists(y in REAL | in.w(y) == 0 and out.c == move(y)))")
+    html = render.formula_html(long, limit=60)
+    assert html.startswith('<details class="formula"><summary><code>forall(i in NATURAL')
+    lines = render.formula_lines(long).split("\n")
+    assert lines[0] == "forall(i in NATURAL |" and lines[1] == "  in.a(i) == TRUE"
+    assert "  -> exists(y in REAL |" in lines and "    and out.c == move(y)))" in lines
+    assert " ".join(x.strip() for x in lines) == long
+    assert render.breakable("a/b_c.d") == "a/<wbr>b_<wbr>c.<wbr>d"

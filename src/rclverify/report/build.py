@@ -357,6 +357,10 @@ def build_report(ws: Workspace) -> dict[str, Any]:
     report["diagnoses"] = diagnose(ws, report)
     report["summary"]["diagnoses"] = [{"id": d["id"], "kind": d["kind"], "sentence": d["sentence"],
                                        "repairs": len(d["repairs"])} for d in report["diagnoses"]]
+    # the problems grouped by root cause: one row per culprit (report/problems.py, docs/reading-the-report.md)
+    from .problems import group_problems
+    from .render import anchor, problem_items
+    report["problems"] = group_problems(report, problem_items(report), anchor)
     return report
 
 

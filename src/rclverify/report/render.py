@@ -31,6 +31,7 @@ from ..evidence.store import dumps
 from ..cache.memo import last_call
 from . import diagram
 from .fragments import FragmentCache, cached_dumps
+from .problems import group_problems
 
 _T = TypeVar("_T")
 
@@ -214,6 +215,63 @@ def model_text(model: Mapping[str, Any] | None) -> str:
     return ", ".join(f"{k} = {clip(v)}" for k, v in sorted((model or {}).items()))
 
 
+#: Formulas longer than this (characters) are folded in the HTML report: the
+#: first part shows, the whole formula opens below broken at its connectives.
+FOLD_CHARS = 140
+_CONNECTIVE = re.compile(r" (<->|->|and|or) |\| ")
+
+
+def formula_lines(text: Any) -> str:
+    """An RCL formula broken into lines before each connective (``and``,
+    ``or``, ``->``, ``<->``) and after a quantifier's ``|``, each line
+    indented by its bracket depth, so a long guarantee reads as its
+    structure.  The words are unchanged: joining the lines with single
+    spaces gives the text back (runs of whitespace aside)."""
+    s = _WS.sub(" ", str(text)).strip()
+    lines: list[str] = []
+    depth = line_depth = 0
+    start = i = 0
+    while i < len(s):
+        ch = s[i]
+        m = _CONNECTIVE.match(s, i) if ch in " |" else None
+        if m:
+            cut = i + 1 if ch == "|" else i  # '|' ends its line, a connective starts the next
+            lines.append("  " * line_depth + s[start:cut].strip())
+            start, line_depth = (m.end() if ch == "|" else i + 1), depth
+            i = m.end()
+            continue
+        if ch in "({[":
+            depth += 1
+        elif ch in ")}]":
+            depth = max(0, depth - 1)
+        i += 1
+    lines.append("  " * line_depth + s[start:].strip())
+    return "\n".join(line for line in lines if line.strip())
+
+
+_BREAK_AFTER = re.compile(r"([/._])")
+
+
+def breakable(text: Any) -> Markup:
+    """``text`` (an identifier or a path) escaped, with a line-break
+    opportunity (``<wbr>``) after each ``/``, ``.`` and ``_``, so a narrow
+    column breaks it between its parts, never inside a word."""
+    return Markup("<wbr>").join(escape(p) for p in re.split(r"(?<=[/._])", str(text)))
+
+
+def formula_html(text: Any, limit: int = FOLD_CHARS) -> Markup:
+    """A formula as HTML: ``<code>`` when at most ``limit`` characters, else
+    a ``<details>`` whose summary is its start and which opens to the whole
+    formula broken at its connectives (:func:`formula_lines`).  Text is
+    escaped."""
+    s = _WS.sub(" ", str(text)).strip()
+    if len(s) <= limit:
+        return Markup("<code>%s</code>") % s
+    cut = s[:limit].rsplit(" ", 1)[0] if " " in s[:limit] else s[:limit]
+    return Markup('<details class="formula"><summary><code>%s</code> &hellip;</summary>'
+                  '<pre class="formula">%s</pre></details>') % (cut, formula_lines(s))
+
+
 @lru_cache(maxsize=1)
 def environment() -> jinja2.Environment:
     """The report's jinja2 environment.
@@ -237,6 +295,7 @@ def environment() -> jinja2.Environment:
     env.filters.update(
         anchor=anchor, badge=html_badge, md=md_text, code=md_code, fence=md_fence,
         mdbadge=md_badge, secs=seconds, comment_safe=comment_safe, style=style, clip=clip,
+        formula=formula_html, lines=formula_lines, wbr=breakable,
     )
     env.globals.update(anchor=anchor, rank=rank)
     return env
@@ -365,10 +424,105 @@ def group_items(items: Sequence[dict[str, Any]]) -> list[dict[str, Any]]:
     return list(groups.values())
 
 
+def evidence_anchors(report: Mapping[str, Any]) -> list[str]:
+    """One fragment id per evidence record of ``report``, in order:
+    ``ev-<obligation>``, then ``ev-<obligation>-2`` ... for further records
+    of the same obligation."""
+    seen: dict[str, int] = defaultdict(int)
+    out = []
+    for ev in report["evidence"]:
+        ob = str(ev["obligation"])
+        seen[ob] += 1
+        out.append(anchor("ev", ob) if seen[ob] == 1 else anchor("ev", ob, seen[ob]))
+    return out
+
+
+def problem_items(report: Mapping[str, Any]) -> list[dict[str, Any]]:
+    """The attention items of ``report`` that are problems (worse than
+    pending), worst first (see :func:`_attention`)."""
+    return _attention(report, evidence_anchors(report))[0]
+
+
+def problem_groups(report: Mapping[str, Any]) -> list[dict[str, Any]]:
+    """The report's problems grouped by root cause
+    (:func:`rclverify.report.problems.group_problems`): the report dict's
+    ``problems`` when it has them, else computed from ``report``."""
+    if report.get("problems") is not None:
+        return list(report["problems"])
+    return group_problems(report, problem_items(report), anchor)
+
+
+#: The techniques of the dashboard's columns, in order: contract health, the
+#: calculus' side conditions, then the backends (docs/reading-the-report.md).
+#: A backend outside this list gets a column after them when it has evidence.
+TECHNIQUES: tuple[str, ...] = ("health", "side conditions", "hoare", "dafny", "ajpf", "property_tests",
+                               "monitors", "experiment", "review")
+
+
+#: A contract health status as the evidence status the dashboard ranks it by
+#: (as report/build.py rolls health into a node's status: a warning is shown
+#: but changes no status).
+_HEALTH_AS: Mapping[str, str] = {"ok": "discharged", "problem": "failed", "warning": "discharged",
+                                 "unknown": "inconclusive"}
+
+
+def dashboard(report: Mapping[str, Any], evidence_of: Mapping[str, Sequence[tuple[str, Any]]]) -> dict[str, Any]:
+    """The dashboard's matrix of nodes (rows) against techniques (columns).
+
+    Each cell is the WORST status of the node's items of that technique
+    (evidence severity: failed > error > stale > inconclusive > pending >
+    discharged, :data:`rclverify.evidence.records.SEVERITY`): for a backend,
+    the statuses of the node's obligations of that backend (an obligation's
+    status is that of its evidence, pending when it has none); for
+    ``health``, the node's contract health checks (ok counts as
+    discharged, a problem as failed, unknown as inconclusive); for ``side
+    conditions``, the side conditions the node's assumptions give rise to.
+    A cell is ``None`` when the node has no item of that technique, else
+    ``{"status", "worst" (how many items have it), "total", "counts"
+    ([(status, n)] worst first), "anchor"}``: ``anchor`` is the fragment id
+    of the first item with the worst status (its first evidence record,
+    else its obligation row; the health finding; the side condition).
+    Returns ``{"columns": [technique], "rows": [{"node", "status",
+    "cells": [cell]}]}``."""
+    items: dict[tuple[str, str], list[tuple[str, str]]] = defaultdict(list)
+    for o in report["obligations"]:
+        evs = evidence_of.get(str(o["id"]), [])
+        items[(str(o["node"]), str(o["backend"]))].append(
+            (str(o["status"]), evs[0][0] if evs else anchor("ob", o["id"])))
+    for f in report["findings"]:
+        items[(str(f["node"]), "health")].append((_HEALTH_AS.get(str(f["status"]), str(f["status"])),
+                                                  anchor("finding", f["id"])))
+    for sc in report["side_conditions"]:
+        items[(str(sc["node"]), "side conditions")].append((str(sc["status"]), anchor("sc", sc["id"])))
+    extra = sorted({b for _, b in items} - set(TECHNIQUES))
+    columns = [*TECHNIQUES, *extra]
+    rows = []
+    for n in report["nodes"]:
+        name = str(n["name"])
+        cells: list[dict[str, Any] | None] = []
+        for col in columns:
+            got = items.get((name, col))
+            if not got:
+                cells.append(None)
+                continue
+            worst_rank = max(rank(st) for st, _ in got)
+            first = next((st, a) for st, a in got if rank(st) == worst_rank)
+            tally: dict[str, int] = defaultdict(int)
+            for st, _ in got:
+                tally[st] += 1
+            counts = sorted(tally.items(), key=lambda kv: (-rank(kv[0]), kv[0]))
+            cells.append({"status": first[0], "worst": tally[first[0]], "total": len(got), "counts": counts,
+                          "anchor": first[1]})
+        rows.append({"node": name, "status": n["status"], "cells": cells})
+    return {"columns": columns, "rows": rows}
+
+
 def view(report: Mapping[str, Any]) -> dict[str, Any]:
     """Derived lookups the templates need (pure function of ``report``).
 
-    Keys: ``counts`` (``[(status, n)]`` worst first), ``problems`` and
+    Keys: ``dashboard`` (:func:`dashboard`), ``problem_groups`` (the
+    problems grouped by root cause, :func:`problem_groups`), ``diagnosis``
+    (diagnosis id -> record), ``counts`` (``[(status, n)]`` worst first), ``problems`` and
     ``outstanding`` (see :func:`_attention`), ``unmet_requirements``,
     ``ev_anchor`` (one fragment id per evidence record, in order),
     ``evidence_of`` (obligation id -> ``[(anchor, record)]``), ``obligation``
@@ -382,15 +536,10 @@ def view(report: Mapping[str, Any]) -> dict[str, Any]:
     report order, cut into runs of one node each (:func:`runs`).
     """
     validate(report)
-    seen: dict[str, int] = defaultdict(int)
-    ev_anchor: list[str] = []
+    ev_anchor = evidence_anchors(report)
     evidence_of: dict[str, list[tuple[str, Mapping[str, Any]]]] = defaultdict(list)
-    for ev in report["evidence"]:
-        ob = str(ev["obligation"])
-        seen[ob] += 1
-        aid = anchor("ev", ob) if seen[ob] == 1 else anchor("ev", ob, seen[ob])
-        ev_anchor.append(aid)
-        evidence_of[ob].append((aid, ev))
+    for aid, ev in zip(ev_anchor, report["evidence"]):
+        evidence_of[str(ev["obligation"])].append((aid, ev))
     obligation = {str(o["id"]): o for o in report["obligations"]}
 
     counts_in = report["summary"]["counts"]
@@ -442,7 +591,11 @@ def view(report: Mapping[str, Any]) -> dict[str, Any]:
         key = (str(p["backend"]), _NUMBERS.sub("#", str(p["reason"])))
         pending_groups.setdefault(key, {"backend": p["backend"], "reason": p["reason"], "items": []})["items"].append(p)
     unmet = [r for r in report["requirements"] if rank(r["status"]) > 0]
+    groups = (list(report["problems"]) if report.get("problems") is not None
+              else group_problems(report, problems, anchor))
     return {
+        "dashboard": dashboard(report, evidence_of), "problem_groups": groups,
+        "diagnosis": {str(d["id"]): d for d in report.get("diagnoses") or []},
         "counts": counts, "problems": problems, "outstanding": outstanding, "outstanding_groups": outstanding_groups,
         "pending_groups": list(pending_groups.values()),
         "unmet_requirements": unmet, "ev_anchor": ev_anchor, "evidence_of": evidence_of,

@@ -1,0 +1,275 @@
+"""The report's problems grouped by root cause: one row per problem.
+
+The same defect is often found by several techniques: the Agent's guarantee
+3 makes guarantees 1 and 2 vacuous (contract health), the requirement REQ1
+that rests on guarantee 2 is proved only vacuously (the requirements
+check), a monitor and a property test see guarantee 3 violated.  This
+module puts every problem the report lists into the group of its *root
+cause*, so the report shows one row per root cause with the list of
+findings behind it (docs/reading-the-report.md, "What needs attention").
+
+The root-cause key of a problem is the set of its *root culprits*, read from
+its diagnosis record (:mod:`rclverify.diagnosis.build`, ``culprits``):
+
+1. every culprit is placed by its source location: a location inside a
+   node's contract is that node's guarantee, assumption or contract header
+   (the last one starting at or before that line of the file); a location in
+   another file (a program line) is that line; an environment fact of the
+   plan and an event of a trace are context and evidence, not culprits
+   (kept only when nothing else is named);
+2. the problem's own guarantee (the *victim*: the guarantee a Hoare triple or
+   a property test checks) is left out when something else is named (for a
+   refuted Hoare triple the program's constants remain);
+3. a culprit guarantee that is itself the victim of a vacuity or
+   inconsistency problem of contract health stands for that problem's root
+   culprits: the contract defect explains what is found on top of it (the
+   property test of a vacuous guarantee, a requirement proved vacuously
+   because of it); when any culprit is explained so, the explained ones make
+   the key.
+
+Problems with the same key are one group; a problem with no culprit at all
+(a refinement that fails, a lint error) is its own group.  A derived
+property that is not derived joins the group of the side conditions of its
+cone that are not discharged (the reason it is not derived).  Requirements
+refuted, proved vacuously or from an inconsistency take their culprits from
+the check's core (``vacuity_core``, ``inconsistent_core``,
+``failed_to_prevent``); attention items without a diagnosis record
+(inconclusive or stale evidence, undecided side conditions, derived
+properties, lint errors) take the guarantee their obligation belongs to.
+"""
+from __future__ import annotations
+
+import bisect
+import re
+from collections.abc import Callable, Mapping, Sequence
+from typing import Any
+
+from ..evidence.records import SEVERITY
+
+_SOURCE = re.compile(r"^(.*?):(\d+)(?::(\d+))?$")
+#: Diagnosis kinds whose victim guarantee is a defect of the contract itself.
+_CONTRACT_DEFECTS = ("vacuity", "inconsistency")
+#: Diagnosis kinds whose sentence names the cause rather than the symptom, most telling first: a
+#: contract defect names the guarantees that exclude each other, a side condition producer and
+#: consumer, a Hoare refutation the constants; a test or a monitor names only the guarantee broken.
+_TELLING = {"vacuity": 0, "inconsistency": 0, "unsatisfiable-assumption": 0, "side-condition": 1, "hoare": 1,
+            "refinement": 2, "monitor": 3}
+#: Rank of every other kind (a property test, other evidence, a requirement, an attention item).
+_LEAST_TELLING = 4
+#: Requirement verdicts that are problems (report/build.py lists them too).
+BAD_VERDICTS = ("refuted", "proved from an inconsistency", "proved vacuously")
+#: Status words of diagnosis records and health findings as evidence statuses.
+_AS_EVIDENCE = {"problem": "failed", "refuted": "failed", "unknown": "inconclusive", "warning": "pending"}
+
+
+def _severity(status: str) -> int:
+    return SEVERITY.get(_AS_EVIDENCE.get(status, status), SEVERITY["error"])
+
+
+class _Places:
+    """Source locations of the contract members of ``report["nodes"]``."""
+
+    def __init__(self, report: Mapping[str, Any]) -> None:
+        self.by_file: dict[str, list[tuple[int, str, dict[str, Any]]]] = {}
+        for n in report["nodes"]:
+            name = str(n["name"])
+            self._add(n.get("source", ""), f"contract:{name}",
+                      {"what": f"the contract of {name}", "source": n.get("source", ""), "anchor": ("node", name)})
+            for k, a in enumerate(n.get("assumptions", []), 1):
+                self._add(a.get("source", ""), f"assumption:{name}:{k}",
+                          {"what": f"assumption {k} of {name}", "source": a.get("source", ""),
+                           "anchor": ("node", name)})
+            for g in n.get("guarantees", []):
+                self._add(g.get("source", ""), f"guarantee:{name}:{g['index']}",
+                          {"what": f"guarantee {g['index']} of {name}", "source": g.get("source", ""),
+                           "anchor": ("g", name, g["index"])})
+        for rows in self.by_file.values():
+            rows.sort(key=lambda r: r[0])
+        self.info: dict[str, dict[str, Any]] = {rid: info for rows in self.by_file.values() for _, rid, info in rows}
+
+    def _add(self, source: str, rid: str, info: dict[str, Any]) -> None:
+        m = _SOURCE.match(str(source))
+        if m:
+            self.by_file.setdefault(m.group(1), []).append((int(m.group(2)), rid, info))
+
+    def locate(self, source: str) -> str | None:
+        """The id of the contract member at ``source`` (``file:line[:col]``),
+        ``line:file:line`` for a line of another file, ``None`` for no location."""
+        m = _SOURCE.match(str(source))
+        if not m:
+            return None
+        file, line = m.group(1), int(m.group(2))
+        rows = self.by_file.get(file)
+        if rows is None:
+            rid = f"line:{file}:{line}"
+            self.info.setdefault(rid, {"what": "", "source": f"{file}:{line}", "anchor": None})
+            return rid
+        i = bisect.bisect_right([r[0] for r in rows], line) - 1
+        return rows[i][1] if i >= 0 else None
+
+
+def _roots(culprits: Sequence[Mapping[str, Any]], places: _Places, victim: str | None) -> list[str]:
+    """Root culprit ids of one problem (rules 1 and 2 of the module docstring)."""
+    roots: list[str] = []
+    context: list[str] = []
+    for c in culprits:
+        what = str(c.get("what", ""))
+        rid = places.locate(str(c.get("source", "")))
+        if rid is None:
+            continue
+        if what.startswith(("environment fact", "event ")):
+            places.info[rid] = {**places.info.get(rid, {}), "what": what.split(" `")[0], "anchor": None}
+            context.append(rid)
+        elif rid not in roots:
+            roots.append(rid)
+    if victim is not None and len([r for r in roots if r != victim]) > 0:
+        roots = [r for r in roots if r != victim]
+    return roots or context
+
+
+def group_problems(report: Mapping[str, Any], items: Sequence[Mapping[str, Any]],
+                   anchor: Callable[..., str]) -> list[dict[str, Any]]:
+    """The problems of ``report`` grouped by root cause (module docstring).
+
+    ``items`` are the report's attention problems (``render.problem_items``:
+    dicts with ``status``, ``kind``, ``ref``, ``anchor``, ``message``);
+    ``anchor`` builds a fragment id from parts (``render.anchor``).  Returns
+    ``[group]``, worst status first and then in the order of the report's
+    problems, each::
+
+        {"key": [root culprit ids], "status": worst member status,
+         "sentence": the first sentence (first_sentence) of the diagnosis of a member with
+                     the worst status: the most telling kind (_TELLING), then the shortest,
+         "culprits": [{"id", "what", "source", "file", "anchor" (fragment id or "")}],
+         "members": [{"id", "kind", "status", "sentence", "anchor", "diagnosis": bool}],
+         "repairs": [{"diagnosis": id, "index": n}]  (distinct diffs, each checked by Z3)}
+
+    Raises ``KeyError`` for a report dict without ``nodes``.
+    """
+    places = _Places(report)
+    diagnoses = list(report.get("diagnoses") or [])
+    item_anchor = {str(it["ref"]): str(it["anchor"]) for it in items}
+    members: list[tuple[dict[str, Any], list[str]]] = []
+
+    def victim_of(node: Any, k: Any) -> str | None:
+        return f"guarantee:{node}:{k}" if node and k else None
+
+    explains: dict[str, list[str]] = {}
+    for d in diagnoses:
+        roots = _roots(d.get("culprits", []), places, victim_of(d.get("node"), d.get("guarantee")))
+        m: dict[str, Any] = {"id": str(d["id"]), "kind": str(d["kind"]), "status": str(d["status"]), "sentence": str(d["sentence"]),
+             "anchor": item_anchor.get(str(d["id"])) or _default_anchor(d, anchor), "diagnosis": True}
+        members.append((m, roots))
+        victim = victim_of(d.get("node"), d.get("guarantee"))
+        if d["kind"] in _CONTRACT_DEFECTS and victim and roots and victim not in roots:
+            explains.setdefault(victim, [])
+            explains[victim] += [r for r in roots if r not in explains[victim]]
+    for q in report.get("requirements", []):
+        if q.get("verdict") not in BAD_VERDICTS:
+            continue
+        check = q.get("check") or {}
+        core = [*(check.get("vacuity_core") or []), *(check.get("inconsistent_core") or []),
+                *(check.get("failed_to_prevent") or [])]
+        roots = _roots([{"what": str(p.get("label", "")), "source": p.get("source", "")} for p in core], places, None)
+        note = str(q.get("note") or "")
+        members.append(({"id": str(q["id"]), "kind": "requirement", "status": str(q["status"]),
+                         "sentence": f"Requirement {q['id']} is {q['verdict']}" + (f": {note}" if note else "") + ".",
+                         "anchor": anchor("req", q["id"]), "diagnosis": False}, roots))
+    covered = {m["id"] for m, _ in members}
+    obligation = {str(o["id"]): o for o in report.get("obligations", [])}
+    roots_of = {m["id"]: roots for m, roots in members}
+    for it in items:
+        ref = str(it["ref"])
+        if ref in covered:
+            continue
+        o = obligation.get(ref)
+        roots = [f"guarantee:{o['node']}:{o['guarantee']}"] if o is not None and o.get("guarantee") else []
+        roots = [r for r in roots if r in places.info]
+        if it["kind"] == "derived property":
+            # not derived because a side condition of its cone is not discharged: that side condition's cause
+            for sc in _cone_side_conditions(report, ref):
+                roots += [r for r in (roots_of.get(sc) or [f"problem:{sc}"]) if r not in roots]
+        roots_of[ref] = roots
+        members.append(({"id": ref, "kind": str(it["kind"]), "status": str(it["status"]),
+                         "sentence": str(it["message"]) + (f" `{it['formula']}`" if it.get("formula") else ""),
+                         "anchor": str(it["anchor"]), "diagnosis": False}, roots))
+        covered.add(ref)
+
+    groups: dict[tuple[str, ...], dict[str, Any]] = {}
+    for m, roots in members:
+        explained = [e for r in roots for e in explains.get(r, [])]
+        if explained:
+            roots = list(dict.fromkeys(explained))
+        key = tuple(sorted(roots)) if roots else (f"problem:{m['id']}",)
+        g = groups.get(key)
+        if g is None:
+            g = groups[key] = {"key": list(key), "status": m["status"], "sentence": first_sentence(m["sentence"]),
+                               "culprits": [_culprit(r, places, anchor) for r in key if r in places.info],
+                               "members": [], "repairs": []}
+        g["members"].append(m)
+        if _severity(m["status"]) > _severity(g["status"]):
+            g["status"] = m["status"]
+    by_id = {str(d["id"]): d for d in diagnoses}
+    for g in groups.values():
+        # the row's sentence: from the diagnosis that says most about the cause (_TELLING), the shortest
+        worst = [m for m in g["members"] if _severity(m["status"]) == _severity(g["status"])]
+        told = [m for m in worst if m["diagnosis"]] or worst
+        best = min(told, key=lambda m: (_TELLING.get(m["kind"], _LEAST_TELLING), len(first_sentence(m["sentence"]))))
+        g["sentence"] = first_sentence(best["sentence"])
+        diffs: set[str] = set()
+        for m in g["members"]:
+            for k, rep in enumerate((by_id.get(m["id"]) or {}).get("repairs", []) if m["diagnosis"] else []):
+                if rep.get("diff") not in diffs:
+                    diffs.add(rep.get("diff"))
+                    g["repairs"].append({"diagnosis": m["id"], "index": k})
+    out = list(groups.values())
+    out.sort(key=lambda g: -_severity(g["status"]))  # stable: report order within a status
+    return out
+
+
+_SENTENCE_END = re.compile(r"(?<=[.;])\s+(?=[A-Z])")
+#: Longest sentence a group's row shows (characters); the whole text is in its findings.
+SENTENCE_CHARS = 400
+
+
+def first_sentence(text: str, limit: int = SENTENCE_CHARS) -> str:
+    """The first sentence of ``text`` (up to a ``.`` or ``;`` followed by a
+    capital letter), cut at a word boundary to ``limit`` characters with
+    ``...`` when longer."""
+    s = _SENTENCE_END.split(str(text).strip(), 1)[0]
+    if len(s) > limit:
+        s = s[:limit].rsplit(" ", 1)[0] + " ..."
+    return s
+
+
+def _cone_side_conditions(report: Mapping[str, Any], node: str) -> list[str]:
+    """The ids of the side conditions not discharged in the cone of ``node``:
+    of the node and every node upstream of it along the system's
+    connections (the cone a derived property rests on, paper section 4)."""
+    upstream: dict[str, set[str]] = {}
+    for c in report.get("system", {}).get("connections", []):
+        upstream.setdefault(str(c["to_node"]), set()).add(str(c["from_node"]))
+    cone, todo = {node}, [node]
+    while todo:
+        for u in upstream.get(todo.pop(), ()):
+            if u not in cone:
+                cone.add(u)
+                todo.append(u)
+    return [str(sc["id"]) for sc in report.get("side_conditions", [])
+            if str(sc["node"]) in cone and sc["status"] != "discharged"]
+
+
+def _default_anchor(d: Mapping[str, Any], anchor: Callable[..., str]) -> str:
+    if d["kind"] in ("side-condition",):
+        return anchor("sc", d["id"])
+    if d["kind"] in ("vacuity", "inconsistency", "unsatisfiable-assumption", "refinement"):
+        return anchor("finding", d["id"])
+    return anchor("ev", d["id"])
+
+
+def _culprit(rid: str, places: _Places, anchor: Callable[..., str]) -> dict[str, Any]:
+    info = places.info[rid]
+    a = info.get("anchor")
+    m = _SOURCE.match(str(info["source"]))
+    return {"id": rid, "what": info["what"], "source": info["source"], "file": m.group(1) if m else "",
+            "anchor": anchor(*a) if a else ""}
