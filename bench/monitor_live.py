@@ -143,6 +143,11 @@ def _cpu_seconds(pid: int) -> float | None:
         return None
 
 
+def _p99(xs: list[float]) -> float:
+    ys = sorted(xs)
+    return ys[min(len(ys) - 1, int(0.99 * len(ys)))]
+
+
 def bench_live(rate: float, seconds: float, nodes: list[str]) -> None:
     from rclverify.backends.monitors.ros1 import LocalMaster, RosUnavailable, import_rospy
     try:
@@ -210,6 +215,7 @@ def bench_live(rate: float, seconds: float, nodes: list[str]) -> None:
               f"about {len(sent) / cpu:,.0f} messages/s on one free core; load average now "
               f"{os.getloadavg()[0]:.1f} on {os.cpu_count()} core(s)")
     lat = []
+    by_second: dict[int, list[float]] = {}
     for recv, v in verdicts:
         if not v.get("node") or abs(v["decided_at"] - v["time"]) > 1e-9:
             continue  # decided by a later answer or by the timer: not the monitor's latency
@@ -218,11 +224,14 @@ def bench_live(rate: float, seconds: float, nodes: list[str]) -> None:
         t_pub = pub_times.get(per_topic[v["event"]])
         if t_pub is not None:
             lat.append((recv - t_pub) * 1000)
+            by_second.setdefault(int(t_pub - sent[0][1]), []).append((recv - t_pub) * 1000)
     if lat:
         lat.sort()
         p99 = lat[min(len(lat) - 1, int(0.99 * len(lat)))]
         print(f"live: verdict latency, publish -> verdict received, over {len(lat)} verdict(s) decided on "
               f"arrival: median {statistics.median(lat):.2f} ms, p99 {p99:.2f} ms, max {lat[-1]:.2f} ms")
+        print("live: per second of the run (published in it), median / p99 / max ms: " + "; ".join(
+            f"{s}: {statistics.median(xs):.1f} / {_p99(xs):.1f} / {max(xs):.1f}" for s, xs in sorted(by_second.items())))
 
 
 # -- oracle benchmark ----------------------------------------------------------------

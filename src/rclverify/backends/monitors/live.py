@@ -36,6 +36,7 @@ from ...traces.mapping import TopicRule
 from .backend import monitoring_details, summary_line, tool_versions, verdict_status
 from .check import NodeResult, Verdict
 from .online import OnlineEngine
+from .worker import EngineWorker
 
 VERDICT_LOG_TOPIC = "rclverify/verdict"
 
@@ -201,18 +202,21 @@ def run_ros1(run_factory: Callable[..., LiveRun], checked: Checked, nodes: list[
                               publish_last=lambda n, text: lasts[n].publish(String(text)))
     decode_errors: dict[str, int] = {}
 
-    def callback(raw: Any, topic: str) -> None:
-        received = rospy.get_time()
+    def decode(topic: str, raw: Any) -> Mapping[str, Any] | None:
         typ = raw._connection_header.get("type", "") if getattr(raw, "_connection_header", None) else ""
         cls = by_type.get(typ, classes[topic])
         try:
             msg = cls().deserialize(raw._buff)
         except Exception:  # a publisher of another type on a contract topic: counted, never a crash
             decode_errors[topic] = decode_errors.get(topic, 0) + 1
-            return
-        live.push(topic, flatten(msg), received)
+            return None
+        return flatten(msg)  # type: ignore[no-any-return]
 
-    subs = [rospy.Subscriber(t, rospy.AnyMsg, callback, callback_args=t, queue_size=10000) for t in topics]
+    # the callbacks only stamp and queue; one worker thread decodes, checks,
+    # publishes and runs the timer (worker.py: why)
+    worker = EngineWorker(live, decode, rospy.get_time, tick_s=tick_s).start()
+    subs = [rospy.Subscriber(t, rospy.AnyMsg, lambda raw, t=t: worker.offer(t, raw, rospy.get_time()),
+                             queue_size=10000, tcp_nodelay=True) for t in topics]
     out(f"monitoring {len(topics)} topic(s) for {len(nodes)} node(s); verdicts on {verdict_topic}")
     t0 = _time.monotonic()
     next_status = t0 + status_s
@@ -220,16 +224,17 @@ def run_ros1(run_factory: Callable[..., LiveRun], checked: Checked, nodes: list[
         while not stop.is_set() and not rospy.is_shutdown():
             if duration is not None and _time.monotonic() - t0 >= duration:
                 break
-            stop.wait(tick_s)
-            live.tick(rospy.get_time())
+            stop.wait(min(0.1, tick_s * 5))
             if status_s > 0 and _time.monotonic() >= next_status:
                 out(live.status_line())
                 next_status += status_s
     finally:
         for s in subs:
             s.unregister()
+        worker.stop()
         record = live.stop(evidence)
         record["decode_errors"] = decode_errors
+        record["backlog_max"] = worker.backlog_max
         if evidence is not None:
             atomic_write_text(evidence, json.dumps(record, indent=2, sort_keys=True) + "\n")
         out(live.status_line())
