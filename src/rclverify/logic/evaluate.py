@@ -270,7 +270,6 @@ class Evaluator:
         self.values = values
         self._numbers: set[Any] | None = None
         self._slots: dict[int, tuple[list[tuple[str, ...]], list[list[tuple[Any, ...]]]]] = {}
-        self._plans: dict[int, tuple[Any, ...]] = {}
         self.uncacheable = False  # set when a quantifier's candidates depend on outer bound values
         self.io_names = frozenset(node.inputs) | frozenset(node.outputs)
 
@@ -444,9 +443,9 @@ class Evaluator:
         if self._positional(body, name, b, local):
             found = _static_literals(body)
             raw = {v for v in local if not isinstance(v, bool) and isinstance(v, (int, float, Fraction))}
-            raw |= {v - k for v in found for k in shifts}
+            raw |= {v - k if k else v for v in found for k in shifts}
         else:
-            raw = {v - k for v in base for k in shifts}
+            raw = {v - k if k else v for v in base for k in shifts}
         cands: set[Any] = set()
         for c in raw:
             if scalar != "REAL":
@@ -510,13 +509,13 @@ class Evaluator:
                         return False
                     continue
                 if e.func.prefix is None and e.func.name in self.env.ctors and e.func.name not in b:
-                    vals.update(t.args[p] - k for t in self._terms(e.func.name)
+                    vals.update((t.args[p] - k if k else t.args[p]) for t in self._terms(e.func.name)
                                 if p < len(t.args) and isinstance(t.args[p], (int, float, Fraction)))
                     continue
                 f = self.var(e.func, b)
                 if not isinstance(f, FiniteFunction):
                     return False
-                vals.update(key[p] - k for key in f.table if isinstance(key[p], (int, float, Fraction)))
+                vals.update((key[p] - k if k else key[p]) for key in f.table if isinstance(key[p], (int, float, Fraction)))
             return True
         if isinstance(e, ast.Compare):
             for a, c in zip(e.operands, e.operands[1:]):
@@ -527,7 +526,7 @@ class Evaluator:
                     res = self._results(other, b)
                     if res is None:
                         return False
-                    vals.update(v - k for v in res if isinstance(v, (int, float, Fraction)) and not isinstance(v, bool))
+                    vals.update((v - k if k else v) for v in res if isinstance(v, (int, float, Fraction)) and not isinstance(v, bool))
             return all(self._positional(o, name, b, vals) for o in e.operands if _shift(o, name) is None)
         return all(self._positional(c, name, b, vals) for c in _children(e))
 
@@ -540,21 +539,8 @@ class Evaluator:
                 self._slots[id(e)] = cached
         slots, doms = cached
         if e.kind in ("forall", "exists"):
-            plan = self._plans.get(id(e))
-            if plan is None or plan[0] is not e:
-                if e.kind == "forall" and isinstance(e.body, ast.Binary) and e.body.op == "->":
-                    guards = _conjuncts(e.body.left)
-                elif e.kind == "exists":
-                    guards = _conjuncts(e.body)
-                else:
-                    guards = []
-                staged = _stage(guards, slots)
-                bindings = {n: bd for bd in e.bindings for n in bd.names}
-                pins = [_pin(staged[k], names, bindings, self.env.ctors) for k, names in enumerate(slots)]
-                plan = (e, slots, staged, pins)
-                if id(e) in self._slots:
-                    self._plans[id(e)] = plan
-            found = self._search(e, slots, doms, plan[2], 0, dict(b), plan[3])
+            staged, pins = _plan(e, slots, self.env.ctors)
+            found = self._search(e, slots, doms, staged, 0, dict(b), pins)
             return (not found) if e.kind == "forall" else found
         for dom in doms:
             if isinstance(dom, _NoDomain):
@@ -603,42 +589,23 @@ class Evaluator:
 
     def _joint(self, e: ast.Quant, b: Mapping[str, Any],
                bindings: Mapping[str, ast.Binding]) -> tuple[tuple[str, ...], list[tuple[Any, ...]]] | None:
-        names = set(e.variables)
-        apps: list[ast.Apply] = []
-        _tuple_apps(e.body, names, apps)
-        for first in apps:
-            group = tuple(a.name for a in first.args if isinstance(a, ast.Var))
-            if len(group) < 2 or len(set(group)) != len(group):
-                continue
-            kinds = []
-            for n in group:
-                dom = bindings[n].domain
-                if not (isinstance(dom, ast.TBase) and dom.name in _INFINITE):
+        for group, kinds, uses, literal_keys in _joint_groups(e, bindings, self.env.ctors, self.io_names):
+            keys: set[tuple[Any, ...]] = set(literal_keys)
+            for app in uses:
+                if app.func.prefix is None and app.func.name in self.env.ctors and app.func.name not in b:
+                    keys.update(tuple(t.args) for t in self._terms(app.func.name) if len(t.args) == len(group))
+                    continue
+                f = self.var(app.func, b)
+                if not isinstance(f, FiniteFunction):
                     break
-                kinds.append(dom.name)
+                keys.update(f.table)
             else:
-                uses: list[ast.Apply] = []
-                if not _only_as(e.body, group, uses):
-                    continue
-                literal_keys = _ctor_uses(e.body, frozenset(group), self.env.ctors, self.io_names)
-                if literal_keys is None:
-                    continue
-                keys: set[tuple[Any, ...]] = set(literal_keys)
-                for app in uses:
-                    if app.func.prefix is None and app.func.name in self.env.ctors and app.func.name not in b:
-                        keys.update(tuple(t.args) for t in self._terms(app.func.name) if len(t.args) == len(group))
-                        continue
-                    f = self.var(app.func, b)
-                    if not isinstance(f, FiniteFunction):
-                        break
-                    keys.update(f.table)
-                else:
-                    ok = [k for k in keys if all(_fits(v, kind) for v, kind in zip(k, kinds))]
-                    top: set[Any] = set(self.numbers()) | _static_literals(e.body)
-                    fresh = int(max((abs(v) for v in top), default=0)) + 1
-                    cands: list[tuple[Any, ...]] = sorted(ok, key=repr)
-                    cands.append(tuple(_Fresh(fresh) for _ in group))
-                    return group, cands
+                ok = [k for k in keys if all(_fits(v, kind) for v, kind in zip(k, kinds))]
+                top: set[Any] = set(self.numbers()) | _static_literals(e.body)
+                fresh = int(max((abs(v) for v in top), default=0)) + 1
+                cands: list[tuple[Any, ...]] = sorted(ok, key=repr)
+                cands.append(tuple(_Fresh(fresh) for _ in group))
+                return group, cands
         return None
 
     def _search(self, e: ast.Quant, slots: list[tuple[str, ...]], doms: list[Any],
@@ -667,6 +634,65 @@ class Evaluator:
         for n in names:
             cur.pop(n, None)
         return False
+
+
+def _joint_groups(e: ast.Quant, bindings: Mapping[str, ast.Binding], ctors: Any,
+                  io: frozenset[str]) -> list[tuple[tuple[str, ...], list[str], list[ast.Apply], frozenset[Any]]]:
+    """The candidate joint slots of quantifier ``e`` in the order
+    ``Evaluator._joint`` tries them: (variables, their base types, the
+    applications using them, the literal argument tuples of constructor
+    terms), those that pass the static checks (:func:`_only_as`,
+    :func:`_ctor_uses`).  A function of the formula alone, memoised per AST
+    node (the dynamic part, the function tables, is read per evaluation)."""
+    key = (id(e), "", "joint")
+    hit = _STATIC.get(key)
+    if hit is not None and hit[0] is e:
+        return cast("list[tuple[tuple[str, ...], list[str], list[ast.Apply], frozenset[Any]]]", hit[1])
+    out = []
+    apps: list[ast.Apply] = []
+    _tuple_apps(e.body, set(e.variables), apps)
+    for first in apps:
+        group = tuple(a.name for a in first.args if isinstance(a, ast.Var))
+        if len(group) < 2 or len(set(group)) != len(group):
+            continue
+        kinds = []
+        for n in group:
+            dom = bindings[n].domain
+            if not (isinstance(dom, ast.TBase) and dom.name in _INFINITE):
+                break
+            kinds.append(dom.name)
+        else:
+            uses: list[ast.Apply] = []
+            if not _only_as(e.body, group, uses):
+                continue
+            literal_keys = _ctor_uses(e.body, frozenset(group), ctors, io)
+            if literal_keys is None:
+                continue
+            out.append((group, kinds, uses, literal_keys))
+    _STATIC[key] = (e, out)
+    return out
+
+
+def _plan(e: ast.Quant, slots: list[tuple[str, ...]], ctors: Any) -> tuple[list[list[Any]], list[Any]]:
+    """The search plan of ``forall``/``exists`` ``e`` over ``slots``: its guards
+    staged by slot (:func:`_stage`) and each slot's pinning guard
+    (:func:`_pin`).  A function of the formula and the slots' layout only,
+    memoised per (AST node, layout)."""
+    key = (id(e), repr(slots), "plan")
+    hit = _STATIC.get(key)
+    if hit is not None and hit[0] is e:
+        return cast("tuple[list[list[Any]], list[Any]]", hit[1])
+    if e.kind == "forall" and isinstance(e.body, ast.Binary) and e.body.op == "->":
+        guards = _conjuncts(e.body.left)
+    elif e.kind == "exists":
+        guards = _conjuncts(e.body)
+    else:
+        guards = []
+    staged = _stage(guards, slots)
+    bindings = {n: bd for bd in e.bindings for n in bd.names}
+    pins = [_pin(staged[k], names, bindings, ctors) for k, names in enumerate(slots)]
+    _STATIC[key] = (e, (staged, pins))
+    return staged, pins
 
 
 class _NoDomain:
