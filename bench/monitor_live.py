@@ -215,6 +215,8 @@ def bench_live(rate: float, seconds: float, nodes: list[str]) -> None:
         print(f"live: monitor process CPU {cpu:.2f} s (start-up included) = {cpu / len(sent) * 1e6:.0f} us per message: "
               f"about {len(sent) / cpu:,.0f} messages/s on one free core; load average now "
               f"{os.getloadavg()[0]:.1f} on {os.cpu_count()} core(s)")
+    print(f"live: engine thread CPU {record.get('engine_cpu_us_per_message', float('nan')):.0f} us per message "
+          f"(decode, check, log, publish the verdicts); longest queue {record.get('backlog_max', 0)} message(s)")
     lat = []
     by_second: dict[int, list[float]] = {}
     for recv, v in verdicts:

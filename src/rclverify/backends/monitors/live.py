@@ -194,7 +194,11 @@ def run_ros1(run_factory: Callable[..., LiveRun], checked: Checked, nodes: list[
         raise RosUnavailable(f"no ROS master answers at {rosgraph.get_master_uri()} (start roscore, or set "
                              "ROS_MASTER_URI)")
     rospy.init_node(node_name, anonymous=False, disable_signals=True)
-    pub = rospy.Publisher(verdict_topic, String, queue_size=10000)
+    # synchronous: the engine thread writes each verdict to the subscribers'
+    # sockets itself; rospy's queued publisher hands every message to a writer
+    # thread and then yields the GIL (time.sleep(0)), which cost the engine
+    # thread a GIL hand-over per verdict (docs/monitors.md, "Latency")
+    pub = rospy.Publisher(verdict_topic, String, queue_size=None)
     lasts: dict[str, Any] = {}
     for n in nodes:
         lasts[n.name] = rospy.Publisher(f"{last_prefix}/{n.name}/last_verdict", String, queue_size=1, latch=True)
@@ -235,6 +239,7 @@ def run_ros1(run_factory: Callable[..., LiveRun], checked: Checked, nodes: list[
         record = live.stop(evidence)
         record["decode_errors"] = decode_errors
         record["backlog_max"] = worker.backlog_max
+        record["engine_cpu_us_per_message"] = round(worker.cpu_s / max(worker.handled, 1) * 1e6, 1)
         if evidence is not None:
             atomic_write_text(evidence, json.dumps(record, indent=2, sort_keys=True) + "\n")
         out(live.status_line())

@@ -46,7 +46,9 @@ class EngineWorker:
     fields (``None``: skip it); ``now()`` is the clock of the timer (s, the
     same clock as the receipt times given to :meth:`offer`); ``tick_s`` the
     timer period (s); ``batch`` the most messages processed between two
-    timer checks.  :attr:`backlog_max` is the longest queue seen (messages).
+    timer checks.  :attr:`backlog_max` is the longest queue seen (messages),
+    :attr:`handled` the messages taken, :attr:`cpu_s` the worker thread's CPU
+    seconds (set when it ends).
     """
 
     def __init__(self, live: LiveRun, decode: Callable[[str, Any], Mapping[str, Any] | None],
@@ -56,6 +58,8 @@ class EngineWorker:
         self._q: queue.SimpleQueue[Any] = queue.SimpleQueue()
         self._thread = threading.Thread(target=self._run, name="rclverify-engine", daemon=True)
         self.backlog_max = 0
+        self.cpu_s = 0.0  # CPU seconds the worker thread spent (decode, check, publish, timer)
+        self.handled = 0  # messages taken from the queue
         self.error: BaseException | None = None
 
     def start(self) -> "EngineWorker":
@@ -79,6 +83,8 @@ class EngineWorker:
             self._loop()
         except BaseException as exc:  # kept for stop(): a dead engine must not look like a quiet one
             self.error = exc
+        finally:
+            self.cpu_s = _time.thread_time()  # this thread's own CPU time, whatever the machine's load
 
     def _loop(self) -> None:
         q, live = self._q, self.live
@@ -100,6 +106,7 @@ class EngineWorker:
                 if fields is not None:
                     live.push(topic, fields, received)
                 n += 1
+                self.handled += 1
                 if n >= self.batch:
                     break
                 try:
