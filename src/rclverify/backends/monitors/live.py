@@ -239,6 +239,13 @@ def run_ros1(run_factory: Callable[..., LiveRun], checked: Checked, nodes: list[
         record = live.stop(evidence)
         record["decode_errors"] = decode_errors
         record["backlog_max"] = worker.backlog_max
+        record["dropped_messages"] = worker.dropped
+        if worker.dropped:  # verdicts that miss messages prove nothing: not discharged
+            for n in record["nodes"]:
+                if n["status"] in ("discharged", "pending"):
+                    n["status"] = "inconclusive"
+                    n["explanation"] = (f"{worker.dropped} message(s) were dropped because the monitor fell "
+                                        f"{worker.max_queue} messages behind; the verdicts do not cover them")
         record["engine_cpu_us_per_message"] = round(worker.cpu_s / max(worker.handled, 1) * 1e6, 1)
         if evidence is not None:
             atomic_write_text(evidence, json.dumps(record, indent=2, sort_keys=True) + "\n")

@@ -22,12 +22,16 @@ milliseconds with spikes of hundreds (docs/monitors.md, "Live monitoring",
   flush and one latched-verdict publication per batch, not per message);
 * the timer (:meth:`~.live.LiveRun.tick`) runs in the same thread every
   ``tick_s`` seconds, so a horizon is closed without a new message and the
-  engine is never entered by two threads.
+  engine is never entered by two threads.  While messages still wait in the
+  queue the timer's time is that of the last message checked, not the
+  clock's: the clock never passes a message received earlier, so a backlog
+  cannot close an obligation before the answer waiting behind it is read.
 
 :meth:`stop` processes what is still queued, then ends the thread.
 """
 from __future__ import annotations
 
+import math
 import queue
 import threading
 import time as _time
@@ -46,15 +50,18 @@ class EngineWorker:
     fields (``None``: skip it); ``now()`` is the clock of the timer (s, the
     same clock as the receipt times given to :meth:`offer`); ``tick_s`` the
     timer period (s); ``batch`` the most messages processed between two
-    timer checks.  :attr:`backlog_max` is the longest queue seen (messages),
+    timer checks; ``max_queue`` the most messages waiting (more are dropped,
+    counted in :attr:`dropped`).  :attr:`backlog_max` is the longest queue seen (messages),
     :attr:`handled` the messages taken, :attr:`cpu_s` the worker thread's CPU
     seconds (set when it ends).
     """
 
     def __init__(self, live: LiveRun, decode: Callable[[str, Any], Mapping[str, Any] | None],
-                 now: Callable[[], float], tick_s: float = 0.02, batch: int = 256) -> None:
+                 now: Callable[[], float], tick_s: float = 0.02, batch: int = 256,
+                 max_queue: int = 100_000) -> None:
         self.live, self.decode, self.now = live, decode, now
-        self.tick_s, self.batch = tick_s, batch
+        self.tick_s, self.batch, self.max_queue = tick_s, batch, max_queue
+        self.dropped = 0  # messages refused because max_queue were already waiting
         self._q: queue.SimpleQueue[Any] = queue.SimpleQueue()
         self._thread = threading.Thread(target=self._run, name="rclverify-engine", daemon=True)
         self.backlog_max = 0
@@ -67,7 +74,13 @@ class EngineWorker:
         return self
 
     def offer(self, topic: str, payload: Any, received: float) -> None:
-        """Queue one message (thread safe, never blocks, never evaluates)."""
+        """Queue one message (thread safe, never blocks, never evaluates).  When
+        ``max_queue`` messages already wait (the engine is that far behind) the
+        message is dropped and counted in :attr:`dropped`: memory stays bounded
+        and the loss is reported, never silent."""
+        if self._q.qsize() >= self.max_queue:
+            self.dropped += 1
+            return
         self._q.put((topic, payload, received))
 
     def stop(self, timeout: float = 30.0) -> None:
@@ -89,6 +102,7 @@ class EngineWorker:
     def _loop(self) -> None:
         q, live = self._q, self.live
         next_tick = _time.monotonic() + self.tick_s
+        last = -math.inf  # receipt time of the last message pushed
         while True:
             wait = next_tick - _time.monotonic()
             try:
@@ -102,6 +116,7 @@ class EngineWorker:
                     done = True
                     break
                 topic, payload, received = item
+                last = received
                 fields = self.decode(topic, payload)
                 if fields is not None:
                     live.push(topic, fields, received)
@@ -118,7 +133,13 @@ class EngineWorker:
                 if size > self.backlog_max:
                     self.backlog_max = size
             if done or _time.monotonic() >= next_tick:
-                live.tick(self.now())
+                now = self.now()
+                if not q.empty():
+                    # messages received before `now` still wait in the queue: the
+                    # clock must not pass them (an obligation they answer would be
+                    # closed as violated before its answer is checked)
+                    now = min(now, last)
+                live.tick(now)
                 next_tick = _time.monotonic() + self.tick_s
             if done:
                 return
