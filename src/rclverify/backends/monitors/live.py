@@ -169,6 +169,24 @@ class LiveRun:
         return record
 
 
+def _no_delay(pub: Any) -> None:
+    """Turn Nagle's algorithm off on the verdict publisher's subscriber
+    connections (TCP_NODELAY), whether or not the subscriber asked for it:
+    with it on, a verdict written while the previous one is not yet
+    acknowledged waits for the subscriber's delayed ACK, up to 40 ms on
+    Linux (docs/monitors.md, "Latency").  Reaches rospy's publisher
+    connections (``impl.connections``, each with its ``socket``); a rospy
+    without them is left as it is."""
+    import socket
+    for c in list(getattr(getattr(pub, "impl", None), "connections", None) or ()):
+        sock = getattr(c, "socket", None)
+        if sock is not None:  # idempotent, one system call per connection every 0.1 s
+            try:
+                sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+            except (OSError, AttributeError):
+                pass
+
+
 def run_ros1(run_factory: Callable[..., LiveRun], checked: Checked, nodes: list[CheckedNode],
              msg_dirs: list[Path], *, verdict_topic: str, last_prefix: str, node_name: str,
              duration: float | None, tick_s: float, status_s: float, evidence: Path | None,
@@ -198,7 +216,10 @@ def run_ros1(run_factory: Callable[..., LiveRun], checked: Checked, nodes: list[
     # sockets itself; rospy's queued publisher hands every message to a writer
     # thread and then yields the GIL (time.sleep(0)), which cost the engine
     # thread a GIL hand-over per verdict (docs/monitors.md, "Latency")
-    pub = rospy.Publisher(verdict_topic, String, queue_size=None)
+    import warnings
+    with warnings.catch_warnings():  # rospy warns about queue_size=None; here it is the choice made above
+        warnings.simplefilter("ignore", SyntaxWarning)
+        pub = rospy.Publisher(verdict_topic, String, queue_size=None)
     lasts: dict[str, Any] = {}
     for n in nodes:
         lasts[n.name] = rospy.Publisher(f"{last_prefix}/{n.name}/last_verdict", String, queue_size=1, latch=True)
@@ -229,6 +250,7 @@ def run_ros1(run_factory: Callable[..., LiveRun], checked: Checked, nodes: list[
             if duration is not None and _time.monotonic() - t0 >= duration:
                 break
             stop.wait(min(0.1, tick_s * 5))
+            _no_delay(pub)
             if status_s > 0 and _time.monotonic() >= next_status:
                 out(live.status_line())
                 next_status += status_s
