@@ -573,14 +573,24 @@ class Evaluator:
         bindings = {n: bd for bd in e.bindings for n in bd.names}
         group = self._joint(e, b, bindings)
         slots: list[tuple[str, ...]] = []
-        doms: list[list[tuple[Any, ...]]] = []
         for n in e.variables:
             if group and n in group[0]:
                 if n == group[0][0]:
                     slots.append(group[0])
-                    doms.append(group[1])
                 continue
             slots.append((n,))
+        # a single-variable slot pinned by an equality guard (``v == t``) takes
+        # only t's value in _search, never its domain: the domain is not computed
+        pins = _plan(e, slots, self.env.ctors)[1] if e.kind in ("forall", "exists") else [None] * len(slots)
+        doms: list[list[tuple[Any, ...]]] = []
+        for names, pin in zip(slots, pins):
+            if group and names == group[0]:
+                doms.append(group[1])
+                continue
+            n = names[0]
+            if pin is not None and pin.ctor is None:
+                doms.append(_NoDomain("pinned by an equality guard"))  # type: ignore[arg-type]
+                continue
             try:
                 doms.append([(v,) for v in self.domain(bindings[n], n, e.body, b, e.kind, tuple(e.variables))])
             except Undecided as exc:  # may still be pinned by an equality guard (see _search)
@@ -655,7 +665,7 @@ def _joint_groups(e: ast.Quant, bindings: Mapping[str, ast.Binding], ctors: Any,
         group = tuple(a.name for a in first.args if isinstance(a, ast.Var))
         if len(group) < 2 or len(set(group)) != len(group):
             continue
-        kinds = []
+        kinds: list[str] = []
         for n in group:
             dom = bindings[n].domain
             if not (isinstance(dom, ast.TBase) and dom.name in _INFINITE):

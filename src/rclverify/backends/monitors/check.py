@@ -217,7 +217,7 @@ class NodeMonitor:
             self._deps[k] = tuple(v for v in sorted(self.values) if v in mentioned or v.split(".", 1)[1] in mentioned)
         self.pending: dict[Any, _Group] = {}
         self._due = float("inf")  # the earliest horizon among the pending obligations (s)
-        self._cache: dict[tuple[int, Any, Any], tuple[bool | None, str]] = {}
+        self._cache: dict[tuple[Any, tuple[Any, ...]], tuple[bool | None, str]] = {}
 
     # -- evaluation --------------------------------------------------------------
     def _truth(self, k: Any, formula: ast.Expr, values: Mapping[str, Any]) -> tuple[bool | None, str]:
@@ -327,8 +327,7 @@ class NodeMonitor:
         if group is None:
             group = self.pending[key] = _Group(inputs)
         group.events.append(ev)
-        if ev.time + self.horizon < self._due:
-            self._due = ev.time + self.horizon
+        self._due = min(self._due, ev.time + self.horizon)
         if len(group.events) == 1:
             self._output(ev, only=key)
 

@@ -35,10 +35,16 @@ import math
 import queue
 import threading
 import time as _time
-from typing import TYPE_CHECKING, Any, Callable, Mapping
+from collections.abc import Callable, Mapping
+from typing import Any, Protocol
 
-if TYPE_CHECKING:
-    from .live import LiveRun
+
+class Sink(Protocol):
+    """What the worker feeds: :class:`~.live.LiveRun` (push a message, run the timer)."""
+
+    def push(self, topic: str, fields: Mapping[str, Any], received: float) -> None: ...
+
+    def tick(self, now: float) -> None: ...
 
 _STOP = object()
 
@@ -56,7 +62,7 @@ class EngineWorker:
     seconds (set when it ends).
     """
 
-    def __init__(self, live: LiveRun, decode: Callable[[str, Any], Mapping[str, Any] | None],
+    def __init__(self, live: Sink, decode: Callable[[str, Any], Mapping[str, Any] | None],
                  now: Callable[[], float], tick_s: float = 0.02, batch: int = 256,
                  max_queue: int = 100_000) -> None:
         self.live, self.decode, self.now = live, decode, now
@@ -69,7 +75,7 @@ class EngineWorker:
         self.handled = 0  # messages taken from the queue
         self.error: BaseException | None = None
 
-    def start(self) -> "EngineWorker":
+    def start(self) -> EngineWorker:
         self._thread.start()
         return self
 
@@ -94,7 +100,7 @@ class EngineWorker:
     def _run(self) -> None:
         try:
             self._loop()
-        except BaseException as exc:  # kept for stop(): a dead engine must not look like a quiet one
+        except BaseException as exc:  # noqa: BLE001 - kept for stop(): a dead engine must not look like a quiet one
             self.error = exc
         finally:
             self.cpu_s = _time.thread_time()  # this thread's own CPU time, whatever the machine's load
@@ -130,8 +136,7 @@ class EngineWorker:
                     item = None
             if n:
                 size = q.qsize() + n
-                if size > self.backlog_max:
-                    self.backlog_max = size
+                self.backlog_max = max(self.backlog_max, size)
             if done or _time.monotonic() >= next_tick:
                 now = self.now()
                 if not q.empty():
