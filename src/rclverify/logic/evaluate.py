@@ -36,6 +36,7 @@ wherever this module and Z3 (:mod:`.concrete`) both decide, they agree.
 """
 from __future__ import annotations
 
+import dataclasses
 import itertools
 import math
 from fractions import Fraction
@@ -591,6 +592,9 @@ class Evaluator:
             if pin is not None and pin.ctor is None:
                 doms.append(_NoDomain("pinned by an equality guard"))  # type: ignore[arg-type]
                 continue
+            if e.kind in ("forall", "exists") and _unused(e, n, bindings[n]):
+                doms.append([(0,)])  # the body does not depend on it and the domain is not empty: one value
+                continue
             try:
                 doms.append([(v,) for v in self.domain(bindings[n], n, e.body, b, e.kind, tuple(e.variables))])
             except Undecided as exc:  # may still be pinned by an equality guard (see _search)
@@ -681,6 +685,36 @@ def _joint_groups(e: ast.Quant, bindings: Mapping[str, ast.Binding], ctors: Any,
             out.append((group, kinds, uses, literal_keys))
     _STATIC[key] = (e, out)
     return out
+
+
+def _unused(e: ast.Quant, name: str, binding: ast.Binding) -> bool:
+    """True when ``name`` ranges over REAL, INTEGER or NATURAL (never empty) and
+    does not occur free in ``e``'s body: the body's value is the same for every
+    value of it, so ``forall``/``exists`` over it need one value (not for
+    ``exists_unique``, where a true body has infinitely many witnesses).
+    Memoised per AST node."""
+    dom = binding.domain
+    if not (isinstance(dom, ast.TBase) and dom.name in _INFINITE):
+        return False
+    key = (id(e), name, "unused")
+    hit = _STATIC.get(key)
+    if hit is not None and hit[0] is e:
+        return bool(hit[1])
+    unused = not _mentions(e.body, name)
+    _STATIC[key] = (e, unused)
+    return unused
+
+
+def _mentions(e: Any, name: str) -> bool:
+    """Does ``name`` occur as a bare variable anywhere in ``e`` (quantifier
+    domains included, shadowing ignored: a conservative answer)?"""
+    if isinstance(e, ast.Var):
+        return e.prefix is None and e.name == name
+    if isinstance(e, tuple):
+        return any(_mentions(x, name) for x in e)
+    if dataclasses.is_dataclass(e) and not isinstance(e, (type, ast.Loc)):
+        return any(_mentions(getattr(e, f.name), name) for f in dataclasses.fields(e))
+    return False
 
 
 def _plan(e: ast.Quant, slots: list[tuple[str, ...]], ctors: Any) -> tuple[list[list[Any]], list[Any]]:
