@@ -10,11 +10,15 @@ bundled nominal run's messages round-robin over its eight topics at
 * messages published, events the monitor checked, verdicts received, the
   rate achieved and whether the monitor kept up (every message checked, no
   backlog when the publisher stopped);
+* the monitor process's CPU per message and its engine thread's (decode,
+  check, log, publish; from the evidence record), and the longest queue of
+  messages waiting for the engine thread;
 * the verdict latency, publish to verdict received, median / 99th
   percentile / max (ms), over the events decided on arrival (satisfied at
-  once, assumption violated, incomplete input).  An input event whose
-  verdict waits for the node's answer is decided by that answer, which is
-  the node's latency, not the monitor's.
+  once, assumption violated, incomplete input), for the whole run and per
+  second of it (the first second holds the first states' evaluations).
+  An input event whose verdict waits for the node's answer is decided by
+  that answer, which is the node's latency, not the monitor's.
 
 Oracle (needs only ``websockets``): ``rclverify oracle`` as its own
 process on a free port, serving all four nodes, then only the Radiation
