@@ -206,6 +206,7 @@ class NodeMonitor:
         self.needed_inputs = sorted(k for k in self.values if k.startswith("in.") and
                                     (k in needed or k[3:] in needed))
         self._outputs = sorted(k for k in self.values if k.startswith("out."))
+        self._keys = {p: [k for k in self.values if k.startswith(p)] for p in ("in.", "out.")}  # in state order
         # the dependency index: each formula's truth is a function of the I/O
         # variables it mentions, so its cached evaluations are keyed on those
         # values only (a guarantee that does not read `at` is not evaluated
@@ -260,7 +261,8 @@ class NodeMonitor:
 
     def _observed(self, prefix: str) -> dict[str, Any]:
         """The values with ``prefix`` observed so far (an unobserved variable has no entry)."""
-        return {k: v for k, v in self.values.items() if k.startswith(prefix) and v is not None}
+        values = self.values
+        return {k: values[k] for k in self._keys[prefix] if values[k] is not None}
 
     def _verdict(self, verdict: str, ev: Event, guarantee: int = 0, values: Mapping[str, str] | None = None,
                  reason: str = "", n: int = 1) -> None:
@@ -334,9 +336,10 @@ class NodeMonitor:
     def _output(self, ev: Event, only: Any = None) -> None:
         done = []
         groups = self.pending.items() if only is None else [(only, self.pending[only])]
+        outputs = self._observed("out.")
         for key, g in groups:
             values = dict(g.inputs)
-            values.update(self._observed("out."))
+            values.update(outputs)
             failed: tuple[int, str] | None = None
             undecided = ""
             waiting = False
