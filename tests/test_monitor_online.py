@@ -217,3 +217,24 @@ def test_a_full_queue_drops_and_counts_instead_of_growing(case_study: tuple[Any,
     assert worker.dropped == 3
     worker.start().stop()
     assert worker.handled == 5 and live.stop()["events"] == 5
+
+
+def test_verdict_connections_get_tcp_nodelay() -> None:
+    """The verdict publisher's subscriber sockets (rospy keeps them as
+    ``impl.connections[*].socket``) get TCP_NODELAY; anything else is left alone."""
+    import socket
+    from types import SimpleNamespace
+
+    from rclverify.backends.monitors.live import _no_delay
+    server = socket.create_server(("127.0.0.1", 0))
+    client = socket.create_connection(server.getsockname())
+    peer, _ = server.accept()
+    try:
+        assert peer.getsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY) == 0
+        pub = SimpleNamespace(impl=SimpleNamespace(connections=[SimpleNamespace(socket=peer), SimpleNamespace()]))
+        _no_delay(pub)
+        assert peer.getsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY) == 1
+        _no_delay(SimpleNamespace())  # a publisher without rospy's internals: nothing to do, no error
+    finally:
+        for s in (client, peer, server):
+            s.close()
