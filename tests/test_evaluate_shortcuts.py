@@ -1,5 +1,5 @@
 """The evaluator's shortcuts for the monitors' speed (docs/monitors.md,
-"Latency"): a quantified variable pinned by an equality guard is not
+"Direct evaluation"): a quantified variable pinned by an equality guard is not
 enumerated, one the body never mentions is bound once (forall/exists only),
 and the answers are those of full enumeration and of Z3."""
 from __future__ import annotations

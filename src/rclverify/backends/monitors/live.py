@@ -174,7 +174,7 @@ def _no_delay(pub: Any) -> None:
     connections (TCP_NODELAY), whether or not the subscriber asked for it:
     with it on, a verdict written while the previous one is not yet
     acknowledged waits for the subscriber's delayed ACK, up to 40 ms on
-    Linux (docs/monitors.md, "Latency").  Reaches rospy's publisher
+    Linux (docs/monitors.md, "Live monitoring", "Threads").  Reaches rospy's publisher
     connections (``impl.connections``, each with its ``socket``); a rospy
     without them is left as it is."""
     import socket
@@ -215,7 +215,7 @@ def run_ros1(run_factory: Callable[..., LiveRun], checked: Checked, nodes: list[
     # synchronous: the engine thread writes each verdict to the subscribers'
     # sockets itself; rospy's queued publisher hands every message to a writer
     # thread and then yields the GIL (time.sleep(0)), which cost the engine
-    # thread a GIL hand-over per verdict (docs/monitors.md, "Latency")
+    # thread a GIL hand-over per verdict (docs/monitors.md, "Live monitoring", "Threads")
     import warnings
     with warnings.catch_warnings():  # rospy warns about queue_size=None; here it is the choice made above
         warnings.simplefilter("ignore", SyntaxWarning)
@@ -250,6 +250,8 @@ def run_ros1(run_factory: Callable[..., LiveRun], checked: Checked, nodes: list[
             if duration is not None and _time.monotonic() - t0 >= duration:
                 break
             stop.wait(min(0.1, tick_s * 5))
+            if worker.error is not None:
+                break  # the engine thread died: stop and say so, never monitor on silently
             _no_delay(pub)
             if status_s > 0 and _time.monotonic() >= next_status:
                 out(live.status_line())
@@ -257,9 +259,19 @@ def run_ros1(run_factory: Callable[..., LiveRun], checked: Checked, nodes: list[
     finally:
         for s in subs:
             s.unregister()
-        worker.stop()
+        engine_error = ""
+        try:
+            worker.stop()
+        except Exception as exc:  # noqa: BLE001 - a bug in the engine: reported in the evidence, the log kept
+            engine_error = f"{type(exc).__name__}: {exc}"
+            out(f"rclverify monitor --live: error: the verdict engine stopped: {engine_error}")
         record = live.stop(evidence)
         record["decode_errors"] = decode_errors
+        if engine_error:
+            record["engine_error"] = engine_error
+            for n in record["nodes"]:
+                n["status"] = "error"
+                n["explanation"] = f"the verdict engine stopped during the run ({engine_error}); verdicts are partial"
         record["backlog_max"] = worker.backlog_max
         record["dropped_messages"] = worker.dropped
         if worker.dropped:  # verdicts that miss messages prove nothing: not discharged

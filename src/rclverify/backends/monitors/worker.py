@@ -7,7 +7,7 @@ queued on that lock behind each other's evaluations and the verdict
 publisher's writer thread, and each hand-over waited for Python's GIL
 switch interval: at 2,000 messages/s the verdict latency grew to tens of
 milliseconds with spikes of hundreds (docs/monitors.md, "Live monitoring",
-"Latency").  :class:`EngineWorker` decouples them:
+"Threads").  :class:`EngineWorker` decouples them:
 
 * :meth:`offer` (called from any callback) stamps nothing and evaluates
   nothing: it appends ``(topic, payload, received)`` to a
