@@ -263,7 +263,13 @@ def _literals(e: Any, out: set[Any]) -> None:
 
 
 class Evaluator:
-    """One evaluation context: the node, its values and the candidate numbers."""
+    """One evaluation context: the node, its values and the candidate numbers.
+
+    ``compiled`` (class attribute, True): evaluate through the compiled
+    closures; False walks the tree (:meth:`interpret`) everywhere, the
+    reference the tests compare the closures with."""
+
+    compiled = True
 
     def __init__(self, checked: Checked, node: CheckedNode, values: Mapping[str, Any]) -> None:
         self.env = checked.env
@@ -308,6 +314,23 @@ class Evaluator:
 
     # -- expressions -----------------------------------------------------------
     def eval(self, e: ast.Expr, b: Mapping[str, Any]) -> Any:
+        """The value of ``e`` under bound variables ``b``: the expression is
+        compiled once (per AST node and I/O node) into nested closures that
+        do what :meth:`interpret` does, node for node (:func:`_compile`)."""
+        if not self.compiled:
+            return self.interpret(e, b)
+        key = (id(e), id(self.node), id(self.env))
+        hit = _COMPILED.get(key)
+        if hit is None or hit[0] is not e or hit[1] is not self.node or hit[2] is not self.env:
+            if len(_COMPILED) >= COMPILED_SIZE:
+                _COMPILED.clear()
+            hit = _COMPILED[key] = (e, self.node, self.env, _compile(e, self.env, self.node))
+        return hit[3](self, b)
+
+    def interpret(self, e: ast.Expr, b: Mapping[str, Any]) -> Any:
+        """The value of ``e`` under ``b`` by walking the tree (the reference the
+        compiled closures follow; what they delegate membership, set and
+        tuple literals and quantifiers to)."""
         if isinstance(e, ast.BoolLit):
             return e.value
         if isinstance(e, ast.NumLit):
@@ -826,6 +849,126 @@ def _pin(guards: list[Any], names: tuple[str, ...], bindings: Mapping[str, ast.B
             if not used:
                 return _Pin(other, ctor, tuple(kinds))
     return None
+
+
+#: Compiled expressions kept (per AST node and I/O node); cleared when full.
+COMPILED_SIZE = 50_000
+_Fn = Callable[["Evaluator", Mapping[str, Any]], Any]
+_COMPILED: dict[tuple[int, int, int], tuple[Any, Any, Any, _Fn]] = {}
+
+
+def _compile(e: Any, env: Any, node: CheckedNode) -> _Fn:
+    """``e`` as a closure ``fn(evaluator, bound) -> value`` doing exactly what
+    :meth:`Evaluator.interpret` does for it (same order of evaluation, same
+    values, same exceptions), with the tree walk and the name resolution
+    that does not depend on the bound variables done once.  Membership,
+    set/tuple literals and quantifiers are handed to the evaluator."""
+    if isinstance(e, ast.Var):
+        return _compile_var(e, env, node)
+    if isinstance(e, ast.NumLit):
+        lit = _LIT.get(e.text)
+        if lit is None:
+            v = e.value
+            lit = _LIT[e.text] = int(v) if v.denominator == 1 else v
+        value = lit
+        return lambda ev, b: value
+    if isinstance(e, ast.BoolLit):
+        truth = e.value
+        return lambda ev, b: truth
+    if isinstance(e, ast.Apply):
+        args = tuple(_compile(a, env, node) for a in e.args)
+        func = e.func
+        fname, qualified = func.name, func.qualified
+        ctor = func.prefix is None and fname in env.ctors
+        fvar = _compile_var(func, env, node)
+
+        def apply(ev: Evaluator, b: Mapping[str, Any]) -> Any:
+            vals = tuple([a(ev, b) for a in args])
+            if ctor and fname not in b:
+                return Term(fname, vals)
+            f = fvar(ev, b)
+            if not callable(f):
+                raise Undecided(f"{qualified} is not a function value")
+            return f(*vals)
+        return apply
+    if isinstance(e, ast.Unary):
+        operand = _compile(e.operand, env, node)
+        if e.op == "not":
+            return lambda ev, b: not operand(ev, b)
+        return lambda ev, b: -operand(ev, b)
+    if isinstance(e, ast.Binary):
+        return _compile_binary(e, env, node)
+    if isinstance(e, ast.Compare):
+        operands = tuple(_compile(o, env, node) for o in e.operands)
+        cmps = tuple(_CMP[op] for op in e.ops)
+        if len(cmps) == 1:
+            first, second = operands
+            cmp = cmps[0]
+            return lambda ev, b: bool(cmp(first(ev, b), second(ev, b)))  # all() of one comparison
+
+        def compare(ev: Evaluator, b: Mapping[str, Any]) -> Any:
+            vals = [o(ev, b) for o in operands]
+            return all(c(x, y) for c, x, y in zip(cmps, vals, vals[1:]))
+        return compare
+    return lambda ev, b: ev.interpret(e, b)
+
+
+def _compile_var(v: ast.Var, env: Any, node: CheckedNode) -> _Fn:
+    """:meth:`Evaluator.var` for ``v``: a bound variable first, then (fixed by
+    the context) an enumeration value, a constant, a constructor, else the
+    I/O value (:meth:`Evaluator.io`)."""
+    if v.prefix is not None:
+        key = v.qualified
+    else:
+        key = ("in." + v.name) if v.name in node.inputs else ("out." + v.name)
+
+    def io(ev: Evaluator, b: Mapping[str, Any]) -> Any:
+        value = ev.values.get(key)
+        if value is None:
+            raise Undecided(f"no value for {key}")
+        return value
+    if v.prefix is not None:
+        return io
+    name = v.name
+    if name in env.enum_values:
+        return lambda ev, b: b.get(name, name)
+    if name in env.constants:
+        const = _compile(env.constants[name][1], env, node)
+        return lambda ev, b: b[name] if name in b else const(ev, {})
+    if name in env.ctors:
+        return lambda ev, b: b[name] if name in b else Term(name, ())
+    return lambda ev, b: b[name] if name in b else io(ev, b)
+
+
+def _compile_binary(e: ast.Binary, env: Any, node: CheckedNode) -> _Fn:
+    """:meth:`Evaluator.binary` for ``e``."""
+    op = e.op
+    left, right = _compile(e.left, env, node), _compile(e.right, env, node)
+    if op == "and":
+        return lambda ev, b: bool(left(ev, b)) and bool(right(ev, b))
+    if op == "or":
+        return lambda ev, b: bool(left(ev, b)) or bool(right(ev, b))
+    if op == "->":
+        return lambda ev, b: (not left(ev, b)) or bool(right(ev, b))
+    if op == "<=>":
+        return lambda ev, b: bool(left(ev, b)) == bool(right(ev, b))
+
+    def arithmetic(ev: Evaluator, b: Mapping[str, Any]) -> Any:
+        x, y = left(ev, b), right(ev, b)
+        if type(x) is float:
+            x = Fraction(x)
+        if type(y) is float:
+            y = Fraction(y)
+        if op == "+":
+            return x + y
+        if op == "-":
+            return x - y
+        if op == "*":
+            return x * y
+        if y == 0:
+            raise Undecided("division by zero")
+        return Fraction(x) / Fraction(y)
+    return arithmetic
 
 
 #: The most values a guard-bounded INTEGER/NATURAL quantifier is enumerated over.
