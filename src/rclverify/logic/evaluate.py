@@ -852,7 +852,7 @@ def _pin(guards: list[Any], names: tuple[str, ...], bindings: Mapping[str, ast.B
 
 
 #: Compiled expressions kept (per AST node and I/O node); cleared when full.
-COMPILED_SIZE = 50_000
+COMPILED_SIZE = 10_000
 _Fn = Callable[["Evaluator", Mapping[str, Any]], Any]
 _COMPILED: dict[tuple[int, int, int], tuple[Any, Any, Any, _Fn]] = {}
 
