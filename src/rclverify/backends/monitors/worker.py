@@ -46,6 +46,7 @@ class Sink(Protocol):
 
     def tick(self, now: float) -> None: ...
 
+
 _STOP = object()
 
 
@@ -68,6 +69,7 @@ class EngineWorker:
         self.live, self.decode, self.now = live, decode, now
         self.tick_s, self.batch, self.max_queue = tick_s, batch, max_queue
         self.dropped = 0  # messages refused because max_queue were already waiting
+        self._drop_lock = threading.Lock()
         self._q: queue.SimpleQueue[Any] = queue.SimpleQueue()
         self._thread = threading.Thread(target=self._run, name="rclverify-engine", daemon=True)
         self.backlog_max = 0
@@ -85,7 +87,8 @@ class EngineWorker:
         message is dropped and counted in :attr:`dropped`: memory stays bounded
         and the loss is reported, never silent."""
         if self._q.qsize() >= self.max_queue:
-            self.dropped += 1
+            with self._drop_lock:  # callbacks of several topics may drop at once: count each
+                self.dropped += 1
             return
         self._q.put((topic, payload, received))
 
