@@ -144,3 +144,97 @@ def test_live_run_logs_publishes_and_writes_evidence_the_offline_check_agrees_wi
     _, results = check_trace(checked, list(checked.nodes.values()), read_trace(log), cfg.rules, cfg.horizon)
     assert {r.node: r.counts for r in results} == {n["node"]: n["counts"] for n in record["nodes"]}
     assert sum(1 for line in log.read_text().splitlines() if VERDICT_LOG_TOPIC in line) == record["verdicts"]
+
+
+def _worker_run(checked: Any, cfg: Any, tmp_path: Path, run: str, *, before_start: bool) -> tuple[list[Any], Any]:
+    """Offer a bundled run's messages to an EngineWorker (all queued before the
+    thread starts, or while it runs) with a clock already at each offered
+    message; returns (verdict keys, evidence record)."""
+    import json
+
+    from rclverify.backends.monitors.live import LiveRun
+    from rclverify.backends.monitors.worker import EngineWorker
+    published: list[str] = []
+    live = LiveRun(checked, list(checked.nodes.values()), cfg.rules, cfg.horizon, tmp_path / f"{run}.jsonl",
+                   reorder_window=0.0, publish=published.append)
+    clock = {"t": 0.0}
+    worker = EngineWorker(live, lambda topic, fields: None if topic == "undecodable" else fields,
+                          lambda: clock["t"], tick_s=0.0005, batch=3)
+    if not before_start:
+        worker.start()
+    events = list(read_trace(TRACES / run, MSG))
+    for ev in events:
+        clock["t"] = ev.time  # the middleware's clock runs ahead of what the engine has checked
+        worker.offer(ev.topic, ev.fields, ev.time)
+        worker.offer("undecodable", b"", ev.time)  # a message the decoder refuses: skipped
+    if before_start:
+        worker.start()
+    worker.stop()
+    record = live.stop()
+    assert worker.handled == 2 * len(events) and worker.backlog_max >= 1 and worker.cpu_s > 0
+    verdicts = [m for m in map(json.loads, published) if m["node"]]
+    return [(m["node"], m["event"], m["verdict"], m["guarantee"], sorted(m["values"].items())) for m in verdicts], record
+
+
+@pytest.mark.parametrize("before_start", [True, False])
+@pytest.mark.parametrize("run", ["sensor_fault.jsonl", "nominal.jsonl"])
+def test_the_engine_thread_gives_the_offline_verdicts_even_with_a_backlog(
+        case_study: tuple[Any, Any], tmp_path: Path, run: str, before_start: bool) -> None:
+    """Callbacks only queue; the worker thread checks.  With the whole run queued
+    before the thread starts, the timer's clock is already at the run's end:
+    it must not pass the queued messages (or the sensor's answers would come
+    after their obligations were closed as violated)."""
+    checked, cfg = case_study
+    expected, results = offline(checked, cfg, run)
+    got, record = _worker_run(checked, cfg, tmp_path, run, before_start=before_start)
+    assert got == [(v.node, v.event, v.verdict, v.guarantee, sorted(v.values.items())) for v in expected]
+    assert {n["node"]: n["counts"] for n in record["nodes"]} == {r.node: r.counts for r in results}
+
+
+def test_an_error_in_the_engine_thread_is_raised_by_stop(case_study: tuple[Any, Any], tmp_path: Path) -> None:
+    from rclverify.backends.monitors.live import LiveRun
+    from rclverify.backends.monitors.worker import EngineWorker
+    checked, cfg = case_study
+    live = LiveRun(checked, list(checked.nodes.values()), cfg.rules, cfg.horizon, tmp_path / "x.jsonl")
+
+    def decode(topic: str, payload: Any) -> Any:
+        raise RuntimeError("decoder bug")
+    worker = EngineWorker(live, decode, lambda: 0.0).start()
+    worker.offer("r", {}, 0.0)
+    with pytest.raises(RuntimeError, match="decoder bug"):
+        worker.stop()
+    live.stop()
+
+
+def test_a_full_queue_drops_and_counts_instead_of_growing(case_study: tuple[Any, Any], tmp_path: Path) -> None:
+    from rclverify.backends.monitors.live import LiveRun
+    from rclverify.backends.monitors.worker import EngineWorker
+    checked, cfg = case_study
+    live = LiveRun(checked, list(checked.nodes.values()), cfg.rules, cfg.horizon, tmp_path / "x.jsonl")
+    worker = EngineWorker(live, lambda topic, fields: fields, lambda: 1.0, max_queue=5)
+    for k in range(8):  # the thread is not running yet: nothing is taken from the queue
+        worker.offer("r", {"value": 1.0}, k * 0.1)
+    assert worker.dropped == 3
+    worker.start().stop()
+    assert worker.handled == 5 and live.stop()["events"] == 5
+
+
+def test_verdict_connections_get_tcp_nodelay() -> None:
+    """The verdict publisher's subscriber sockets (rospy keeps them as
+    ``impl.connections[*].socket``) get TCP_NODELAY; anything else is left alone."""
+    import socket
+    from types import SimpleNamespace
+
+    from rclverify.backends.monitors.live import _no_delay
+    server = socket.create_server(("127.0.0.1", 0))
+    client = socket.create_connection(server.getsockname())
+    peer, _ = server.accept()
+    try:
+        assert peer.getsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY) == 0
+        pub = SimpleNamespace(impl=SimpleNamespace(connections=[SimpleNamespace(socket=peer), SimpleNamespace()]))
+        _no_delay(pub)
+        assert peer.getsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY) == 1
+        _no_delay(SimpleNamespace())  # a publisher without rospy's internals: nothing to do, no error
+    finally:
+        for s in (client, peer, server):
+            s.close()

@@ -110,3 +110,20 @@ def test_a_busy_port_is_one_located_error(oracle: Any) -> None:
                        env=dict(os.environ, PYTHONPATH=str(REPO / "src")))
     assert r.returncode == 2 and "Traceback" not in r.stderr
     assert r.stderr.startswith(f"rclverify oracle: error: cannot listen on 127.0.0.1:{port}")
+
+
+def test_pipelined_events_get_the_answers_of_one_at_a_time_in_order(oracle: Any) -> None:
+    """A monitor that does not wait for each verdict: the events that arrive
+    together are answered together (one socket write), each in its own text
+    frame, in order, with the same answers as one at a time."""
+    url, _ = oracle
+    one_by_one = _send_run(url, "sensor_fault.jsonl")
+    lines = (TRACES / "sensor_fault.jsonl").read_text().splitlines() * 20
+    with connect(url, open_timeout=10, close_timeout=5) as ws:
+        for line in lines:  # all sent before any answer is read
+            ws.send(line)
+        frames = [ws.recv(timeout=10) for _ in lines]
+    assert all(isinstance(f, str) for f in frames)  # text frames, as ROSMonitoring reads them
+    answers = [json.loads(f) for f in frames]
+    assert answers[:len(one_by_one)] == one_by_one
+    assert {a["verdict"] for a in answers[len(one_by_one):]} == {"false"}  # the repeated run stays false

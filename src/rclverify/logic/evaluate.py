@@ -36,6 +36,7 @@ wherever this module and Z3 (:mod:`.concrete`) both decide, they agree.
 """
 from __future__ import annotations
 
+import dataclasses
 import itertools
 import math
 from fractions import Fraction
@@ -262,7 +263,13 @@ def _literals(e: Any, out: set[Any]) -> None:
 
 
 class Evaluator:
-    """One evaluation context: the node, its values and the candidate numbers."""
+    """One evaluation context: the node, its values and the candidate numbers.
+
+    ``compiled`` (class attribute, True): evaluate through the compiled
+    closures; False walks the tree (:meth:`interpret`) everywhere, the
+    reference the tests compare the closures with."""
+
+    compiled = True
 
     def __init__(self, checked: Checked, node: CheckedNode, values: Mapping[str, Any]) -> None:
         self.env = checked.env
@@ -270,7 +277,6 @@ class Evaluator:
         self.values = values
         self._numbers: set[Any] | None = None
         self._slots: dict[int, tuple[list[tuple[str, ...]], list[list[tuple[Any, ...]]]]] = {}
-        self._plans: dict[int, tuple[Any, ...]] = {}
         self.uncacheable = False  # set when a quantifier's candidates depend on outer bound values
         self.io_names = frozenset(node.inputs) | frozenset(node.outputs)
 
@@ -308,6 +314,23 @@ class Evaluator:
 
     # -- expressions -----------------------------------------------------------
     def eval(self, e: ast.Expr, b: Mapping[str, Any]) -> Any:
+        """The value of ``e`` under bound variables ``b``: the expression is
+        compiled once (per AST node and I/O node) into nested closures that
+        do what :meth:`interpret` does, node for node (:func:`_compile`)."""
+        if not self.compiled:
+            return self.interpret(e, b)
+        key = (id(e), id(self.node), id(self.env))
+        hit = _COMPILED.get(key)
+        if hit is None or hit[0] is not e or hit[1] is not self.node or hit[2] is not self.env:
+            if len(_COMPILED) >= COMPILED_SIZE:
+                _COMPILED.clear()
+            hit = _COMPILED[key] = (e, self.node, self.env, _compile(e, self.env, self.node))
+        return hit[3](self, b)
+
+    def interpret(self, e: ast.Expr, b: Mapping[str, Any]) -> Any:
+        """The value of ``e`` under ``b`` by walking the tree (the reference the
+        compiled closures follow; what they delegate membership, set and
+        tuple literals and quantifiers to)."""
         if isinstance(e, ast.BoolLit):
             return e.value
         if isinstance(e, ast.NumLit):
@@ -444,9 +467,9 @@ class Evaluator:
         if self._positional(body, name, b, local):
             found = _static_literals(body)
             raw = {v for v in local if not isinstance(v, bool) and isinstance(v, (int, float, Fraction))}
-            raw |= {v - k for v in found for k in shifts}
+            raw |= {v - k if k else v for v in found for k in shifts}
         else:
-            raw = {v - k for v in base for k in shifts}
+            raw = {v - k if k else v for v in base for k in shifts}
         cands: set[Any] = set()
         for c in raw:
             if scalar != "REAL":
@@ -510,13 +533,13 @@ class Evaluator:
                         return False
                     continue
                 if e.func.prefix is None and e.func.name in self.env.ctors and e.func.name not in b:
-                    vals.update(t.args[p] - k for t in self._terms(e.func.name)
+                    vals.update((t.args[p] - k if k else t.args[p]) for t in self._terms(e.func.name)
                                 if p < len(t.args) and isinstance(t.args[p], (int, float, Fraction)))
                     continue
                 f = self.var(e.func, b)
                 if not isinstance(f, FiniteFunction):
                     return False
-                vals.update(key[p] - k for key in f.table if isinstance(key[p], (int, float, Fraction)))
+                vals.update((key[p] - k if k else key[p]) for key in f.table if isinstance(key[p], (int, float, Fraction)))
             return True
         if isinstance(e, ast.Compare):
             for a, c in zip(e.operands, e.operands[1:]):
@@ -527,7 +550,7 @@ class Evaluator:
                     res = self._results(other, b)
                     if res is None:
                         return False
-                    vals.update(v - k for v in res if isinstance(v, (int, float, Fraction)) and not isinstance(v, bool))
+                    vals.update((v - k if k else v) for v in res if isinstance(v, (int, float, Fraction)) and not isinstance(v, bool))
             return all(self._positional(o, name, b, vals) for o in e.operands if _shift(o, name) is None)
         return all(self._positional(c, name, b, vals) for c in _children(e))
 
@@ -540,21 +563,8 @@ class Evaluator:
                 self._slots[id(e)] = cached
         slots, doms = cached
         if e.kind in ("forall", "exists"):
-            plan = self._plans.get(id(e))
-            if plan is None or plan[0] is not e:
-                if e.kind == "forall" and isinstance(e.body, ast.Binary) and e.body.op == "->":
-                    guards = _conjuncts(e.body.left)
-                elif e.kind == "exists":
-                    guards = _conjuncts(e.body)
-                else:
-                    guards = []
-                staged = _stage(guards, slots)
-                bindings = {n: bd for bd in e.bindings for n in bd.names}
-                pins = [_pin(staged[k], names, bindings, self.env.ctors) for k, names in enumerate(slots)]
-                plan = (e, slots, staged, pins)
-                if id(e) in self._slots:
-                    self._plans[id(e)] = plan
-            found = self._search(e, slots, doms, plan[2], 0, dict(b), plan[3])
+            staged, pins = _plan(e, slots, self.env.ctors)
+            found = self._search(e, slots, doms, staged, 0, dict(b), pins)
             return (not found) if e.kind == "forall" else found
         for dom in doms:
             if isinstance(dom, _NoDomain):
@@ -587,14 +597,27 @@ class Evaluator:
         bindings = {n: bd for bd in e.bindings for n in bd.names}
         group = self._joint(e, b, bindings)
         slots: list[tuple[str, ...]] = []
-        doms: list[list[tuple[Any, ...]]] = []
         for n in e.variables:
             if group and n in group[0]:
                 if n == group[0][0]:
                     slots.append(group[0])
-                    doms.append(group[1])
                 continue
             slots.append((n,))
+        # a single-variable slot pinned by an equality guard (``v == t``) takes
+        # only t's value in _search, never its domain: the domain is not computed
+        pins = _plan(e, slots, self.env.ctors)[1] if e.kind in ("forall", "exists") else [None] * len(slots)
+        doms: list[list[tuple[Any, ...]]] = []
+        for names, pin in zip(slots, pins):
+            if group and names == group[0]:
+                doms.append(group[1])
+                continue
+            n = names[0]
+            if pin is not None and pin.ctor is None:
+                doms.append(_NoDomain("pinned by an equality guard"))  # type: ignore[arg-type]
+                continue
+            if e.kind in ("forall", "exists") and _unused(e, n, bindings[n]):
+                doms.append([(0,)])  # the body does not depend on it and the domain is not empty: one value
+                continue
             try:
                 doms.append([(v,) for v in self.domain(bindings[n], n, e.body, b, e.kind, tuple(e.variables))])
             except Undecided as exc:  # may still be pinned by an equality guard (see _search)
@@ -603,42 +626,23 @@ class Evaluator:
 
     def _joint(self, e: ast.Quant, b: Mapping[str, Any],
                bindings: Mapping[str, ast.Binding]) -> tuple[tuple[str, ...], list[tuple[Any, ...]]] | None:
-        names = set(e.variables)
-        apps: list[ast.Apply] = []
-        _tuple_apps(e.body, names, apps)
-        for first in apps:
-            group = tuple(a.name for a in first.args if isinstance(a, ast.Var))
-            if len(group) < 2 or len(set(group)) != len(group):
-                continue
-            kinds = []
-            for n in group:
-                dom = bindings[n].domain
-                if not (isinstance(dom, ast.TBase) and dom.name in _INFINITE):
+        for group, kinds, uses, literal_keys in _joint_groups(e, bindings, self.env.ctors, self.io_names):
+            keys: set[tuple[Any, ...]] = set(literal_keys)
+            for app in uses:
+                if app.func.prefix is None and app.func.name in self.env.ctors and app.func.name not in b:
+                    keys.update(tuple(t.args) for t in self._terms(app.func.name) if len(t.args) == len(group))
+                    continue
+                f = self.var(app.func, b)
+                if not isinstance(f, FiniteFunction):
                     break
-                kinds.append(dom.name)
+                keys.update(f.table)
             else:
-                uses: list[ast.Apply] = []
-                if not _only_as(e.body, group, uses):
-                    continue
-                literal_keys = _ctor_uses(e.body, frozenset(group), self.env.ctors, self.io_names)
-                if literal_keys is None:
-                    continue
-                keys: set[tuple[Any, ...]] = set(literal_keys)
-                for app in uses:
-                    if app.func.prefix is None and app.func.name in self.env.ctors and app.func.name not in b:
-                        keys.update(tuple(t.args) for t in self._terms(app.func.name) if len(t.args) == len(group))
-                        continue
-                    f = self.var(app.func, b)
-                    if not isinstance(f, FiniteFunction):
-                        break
-                    keys.update(f.table)
-                else:
-                    ok = [k for k in keys if all(_fits(v, kind) for v, kind in zip(k, kinds))]
-                    top: set[Any] = set(self.numbers()) | _static_literals(e.body)
-                    fresh = int(max((abs(v) for v in top), default=0)) + 1
-                    cands: list[tuple[Any, ...]] = sorted(ok, key=repr)
-                    cands.append(tuple(_Fresh(fresh) for _ in group))
-                    return group, cands
+                ok = [k for k in keys if all(_fits(v, kind) for v, kind in zip(k, kinds))]
+                top: set[Any] = set(self.numbers()) | _static_literals(e.body)
+                fresh = int(max((abs(v) for v in top), default=0)) + 1
+                cands: list[tuple[Any, ...]] = sorted(ok, key=repr)
+                cands.append(tuple(_Fresh(fresh) for _ in group))
+                return group, cands
         return None
 
     def _search(self, e: ast.Quant, slots: list[tuple[str, ...]], doms: list[Any],
@@ -667,6 +671,95 @@ class Evaluator:
         for n in names:
             cur.pop(n, None)
         return False
+
+
+def _joint_groups(e: ast.Quant, bindings: Mapping[str, ast.Binding], ctors: Any,
+                  io: frozenset[str]) -> list[tuple[tuple[str, ...], list[str], list[ast.Apply], frozenset[Any]]]:
+    """The candidate joint slots of quantifier ``e`` in the order
+    ``Evaluator._joint`` tries them: (variables, their base types, the
+    applications using them, the literal argument tuples of constructor
+    terms), those that pass the static checks (:func:`_only_as`,
+    :func:`_ctor_uses`).  A function of the formula alone, memoised per AST
+    node (the dynamic part, the function tables, is read per evaluation)."""
+    key = (id(e), "", "joint")
+    hit = _STATIC.get(key)
+    if hit is not None and hit[0] is e:
+        return cast("list[tuple[tuple[str, ...], list[str], list[ast.Apply], frozenset[Any]]]", hit[1])
+    out = []
+    apps: list[ast.Apply] = []
+    _tuple_apps(e.body, set(e.variables), apps)
+    for first in apps:
+        group = tuple(a.name for a in first.args if isinstance(a, ast.Var))
+        if len(group) < 2 or len(set(group)) != len(group):
+            continue
+        kinds: list[str] = []
+        for n in group:
+            dom = bindings[n].domain
+            if not (isinstance(dom, ast.TBase) and dom.name in _INFINITE):
+                break
+            kinds.append(dom.name)
+        else:
+            uses: list[ast.Apply] = []
+            if not _only_as(e.body, group, uses):
+                continue
+            literal_keys = _ctor_uses(e.body, frozenset(group), ctors, io)
+            if literal_keys is None:
+                continue
+            out.append((group, kinds, uses, literal_keys))
+    _STATIC[key] = (e, out)
+    return out
+
+
+def _unused(e: ast.Quant, name: str, binding: ast.Binding) -> bool:
+    """True when ``name`` ranges over REAL, INTEGER or NATURAL (never empty) and
+    does not occur free in ``e``'s body: the body's value is the same for every
+    value of it, so ``forall``/``exists`` over it need one value (not for
+    ``exists_unique``, where a true body has infinitely many witnesses).
+    Memoised per AST node."""
+    dom = binding.domain
+    if not (isinstance(dom, ast.TBase) and dom.name in _INFINITE):
+        return False
+    key = (id(e), name, "unused")
+    hit = _STATIC.get(key)
+    if hit is not None and hit[0] is e:
+        return bool(hit[1])
+    unused = not _mentions(e.body, name)
+    _STATIC[key] = (e, unused)
+    return unused
+
+
+def _mentions(e: Any, name: str) -> bool:
+    """Does ``name`` occur as a bare variable anywhere in ``e`` (quantifier
+    domains included, shadowing ignored: a conservative answer)?"""
+    if isinstance(e, ast.Var):
+        return e.prefix is None and e.name == name
+    if isinstance(e, tuple):
+        return any(_mentions(x, name) for x in e)
+    if dataclasses.is_dataclass(e) and not isinstance(e, (type, ast.Loc)):
+        return any(_mentions(getattr(e, f.name), name) for f in dataclasses.fields(e))
+    return False
+
+
+def _plan(e: ast.Quant, slots: list[tuple[str, ...]], ctors: Any) -> tuple[list[list[Any]], list[Any]]:
+    """The search plan of ``forall``/``exists`` ``e`` over ``slots``: its guards
+    staged by slot (:func:`_stage`) and each slot's pinning guard
+    (:func:`_pin`).  A function of the formula and the slots' layout only,
+    memoised per (AST node, layout)."""
+    key = (id(e), repr(slots), "plan")
+    hit = _STATIC.get(key)
+    if hit is not None and hit[0] is e:
+        return cast("tuple[list[list[Any]], list[Any]]", hit[1])
+    if e.kind == "forall" and isinstance(e.body, ast.Binary) and e.body.op == "->":
+        guards = _conjuncts(e.body.left)
+    elif e.kind == "exists":
+        guards = _conjuncts(e.body)
+    else:
+        guards = []
+    staged = _stage(guards, slots)
+    bindings = {n: bd for bd in e.bindings for n in bd.names}
+    pins = [_pin(staged[k], names, bindings, ctors) for k, names in enumerate(slots)]
+    _STATIC[key] = (e, (staged, pins))
+    return staged, pins
 
 
 class _NoDomain:
@@ -756,6 +849,126 @@ def _pin(guards: list[Any], names: tuple[str, ...], bindings: Mapping[str, ast.B
             if not used:
                 return _Pin(other, ctor, tuple(kinds))
     return None
+
+
+#: Compiled expressions kept (per AST node and I/O node); cleared when full.
+COMPILED_SIZE = 10_000
+_Fn = Callable[["Evaluator", Mapping[str, Any]], Any]
+_COMPILED: dict[tuple[int, int, int], tuple[Any, Any, Any, _Fn]] = {}
+
+
+def _compile(e: Any, env: Any, node: CheckedNode) -> _Fn:
+    """``e`` as a closure ``fn(evaluator, bound) -> value`` doing exactly what
+    :meth:`Evaluator.interpret` does for it (same order of evaluation, same
+    values, same exceptions), with the tree walk and the name resolution
+    that does not depend on the bound variables done once.  Membership,
+    set/tuple literals and quantifiers are handed to the evaluator."""
+    if isinstance(e, ast.Var):
+        return _compile_var(e, env, node)
+    if isinstance(e, ast.NumLit):
+        lit = _LIT.get(e.text)
+        if lit is None:
+            v = e.value
+            lit = _LIT[e.text] = int(v) if v.denominator == 1 else v
+        value = lit
+        return lambda ev, b: value
+    if isinstance(e, ast.BoolLit):
+        truth = e.value
+        return lambda ev, b: truth
+    if isinstance(e, ast.Apply):
+        args = tuple(_compile(a, env, node) for a in e.args)
+        func = e.func
+        fname, qualified = func.name, func.qualified
+        ctor = func.prefix is None and fname in env.ctors
+        fvar = _compile_var(func, env, node)
+
+        def apply(ev: Evaluator, b: Mapping[str, Any]) -> Any:
+            vals = tuple([a(ev, b) for a in args])
+            if ctor and fname not in b:
+                return Term(fname, vals)
+            f = fvar(ev, b)
+            if not callable(f):
+                raise Undecided(f"{qualified} is not a function value")
+            return f(*vals)
+        return apply
+    if isinstance(e, ast.Unary):
+        operand = _compile(e.operand, env, node)
+        if e.op == "not":
+            return lambda ev, b: not operand(ev, b)
+        return lambda ev, b: -operand(ev, b)
+    if isinstance(e, ast.Binary):
+        return _compile_binary(e, env, node)
+    if isinstance(e, ast.Compare):
+        operands = tuple(_compile(o, env, node) for o in e.operands)
+        cmps = tuple(_CMP[op] for op in e.ops)
+        if len(cmps) == 1:
+            first, second = operands
+            cmp = cmps[0]
+            return lambda ev, b: bool(cmp(first(ev, b), second(ev, b)))  # all() of one comparison
+
+        def compare(ev: Evaluator, b: Mapping[str, Any]) -> Any:
+            vals = [o(ev, b) for o in operands]
+            return all(c(x, y) for c, x, y in zip(cmps, vals, vals[1:]))
+        return compare
+    return lambda ev, b: ev.interpret(e, b)
+
+
+def _compile_var(v: ast.Var, env: Any, node: CheckedNode) -> _Fn:
+    """:meth:`Evaluator.var` for ``v``: a bound variable first, then (fixed by
+    the context) an enumeration value, a constant, a constructor, else the
+    I/O value (:meth:`Evaluator.io`)."""
+    if v.prefix is not None:
+        key = v.qualified
+    else:
+        key = ("in." + v.name) if v.name in node.inputs else ("out." + v.name)
+
+    def io(ev: Evaluator, b: Mapping[str, Any]) -> Any:
+        value = ev.values.get(key)
+        if value is None:
+            raise Undecided(f"no value for {key}")
+        return value
+    if v.prefix is not None:
+        return io
+    name = v.name
+    if name in env.enum_values:
+        return lambda ev, b: b.get(name, name)
+    if name in env.constants:
+        const = _compile(env.constants[name][1], env, node)
+        return lambda ev, b: b[name] if name in b else const(ev, {})
+    if name in env.ctors:
+        return lambda ev, b: b[name] if name in b else Term(name, ())
+    return lambda ev, b: b[name] if name in b else io(ev, b)
+
+
+def _compile_binary(e: ast.Binary, env: Any, node: CheckedNode) -> _Fn:
+    """:meth:`Evaluator.binary` for ``e``."""
+    op = e.op
+    left, right = _compile(e.left, env, node), _compile(e.right, env, node)
+    if op == "and":
+        return lambda ev, b: bool(left(ev, b)) and bool(right(ev, b))
+    if op == "or":
+        return lambda ev, b: bool(left(ev, b)) or bool(right(ev, b))
+    if op == "->":
+        return lambda ev, b: (not left(ev, b)) or bool(right(ev, b))
+    if op == "<=>":
+        return lambda ev, b: bool(left(ev, b)) == bool(right(ev, b))
+
+    def arithmetic(ev: Evaluator, b: Mapping[str, Any]) -> Any:
+        x, y = left(ev, b), right(ev, b)
+        if type(x) is float:
+            x = Fraction(x)
+        if type(y) is float:
+            y = Fraction(y)
+        if op == "+":
+            return x + y
+        if op == "-":
+            return x - y
+        if op == "*":
+            return x * y
+        if y == 0:
+            raise Undecided("division by zero")
+        return Fraction(x) / Fraction(y)
+    return arithmetic
 
 
 #: The most values a guard-bounded INTEGER/NATURAL quantifier is enumerated over.

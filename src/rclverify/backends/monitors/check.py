@@ -39,6 +39,7 @@ never the trace.
 """
 from __future__ import annotations
 
+import dataclasses
 from collections import deque
 from dataclasses import dataclass, field
 from typing import Any, Callable, Iterable, Mapping
@@ -56,6 +57,23 @@ from ...traces.mapping import MappingError, TopicRule, initial_value, map_value
 from ...values import render
 
 VERDICTS = ("satisfied", "violated", "open", "assumption violated", "inconclusive", "incomplete input")
+
+
+def _reads(e: Any, out: set[str]) -> None:
+    """Every name a formula mentions: each :class:`ast.Var`'s qualified and bare
+    name, anywhere in the tree (quantifier domains included); a superset of
+    the I/O variables it reads."""
+    if isinstance(e, ast.Var):
+        out.add(e.qualified)
+        out.add(e.name)
+        return
+    if isinstance(e, tuple):
+        for x in e:
+            _reads(x, out)
+        return
+    if dataclasses.is_dataclass(e) and not isinstance(e, (type, ast.Loc)):
+        for f in dataclasses.fields(e):
+            _reads(getattr(e, f.name), out)
 
 
 def _names(e: Any, out: set[str]) -> None:
@@ -188,12 +206,25 @@ class NodeMonitor:
         self.needed_inputs = sorted(k for k in self.values if k.startswith("in.") and
                                     (k in needed or k[3:] in needed))
         self._outputs = sorted(k for k in self.values if k.startswith("out."))
+        self._keys = {p: [k for k in self.values if k.startswith(p)] for p in ("in.", "out.")}  # in state order
+        # the dependency index: each formula's truth is a function of the I/O
+        # variables it mentions, so its cached evaluations are keyed on those
+        # values only (a guarantee that does not read `at` is not evaluated
+        # again when only `at` changed)
+        self._deps: dict[Any, tuple[str, ...]] = {}
+        for k, f in [(("A", j), f) for j, f in enumerate(self.assumption)] + list(enumerate(self.guarantees, 1)):
+            mentioned: set[str] = set()
+            _reads(f, mentioned)
+            self._deps[k] = tuple(v for v in sorted(self.values) if v in mentioned or v.split(".", 1)[1] in mentioned)
         self.pending: dict[Any, _Group] = {}
-        self._cache: dict[tuple[int, Any, Any], tuple[bool | None, str]] = {}
+        self._due = float("inf")  # the earliest horizon among the pending obligations (s)
+        self._cache: dict[tuple[Any, tuple[Any, ...]], tuple[bool | None, str]] = {}
 
     # -- evaluation --------------------------------------------------------------
-    def _truth(self, k: int, formula: ast.Expr, values: Mapping[str, Any], key: Any) -> tuple[bool | None, str]:
-        ck = (k, key, tuple(self.values[o] for o in self._outputs))
+    def _truth(self, k: Any, formula: ast.Expr, values: Mapping[str, Any]) -> tuple[bool | None, str]:
+        """(truth, reason) of guarantee ``k`` (``("A", j)``: assumption ``j``)
+        on ``values``; remembered per (formula, values of the variables it reads)."""
+        ck = (k, tuple([values.get(d) for d in self._deps[k]]))
         hit = self._cache.get(ck)
         if hit is not None:
             return hit
@@ -230,7 +261,8 @@ class NodeMonitor:
 
     def _observed(self, prefix: str) -> dict[str, Any]:
         """The values with ``prefix`` observed so far (an unobserved variable has no entry)."""
-        return {k: v for k, v in self.values.items() if k.startswith(prefix) and v is not None}
+        values = self.values
+        return {k: values[k] for k in self._keys[prefix] if values[k] is not None}
 
     def _verdict(self, verdict: str, ev: Event, guarantee: int = 0, values: Mapping[str, str] | None = None,
                  reason: str = "", n: int = 1) -> None:
@@ -274,8 +306,8 @@ class NodeMonitor:
         if missing:
             self._verdict("incomplete input", ev, reason="no value yet for " + ", ".join(missing))
             return
-        for formula in self.assumption:
-            ok, reason = self._truth(-1, formula, inputs, ("A", id(formula), tuple(inputs.items())))
+        for j, formula in enumerate(self.assumption):
+            ok, reason = self._truth(("A", j), formula, inputs)
             if ok is False:
                 mentioned: set[str] = set()
                 _names(formula, mentioned)
@@ -297,20 +329,22 @@ class NodeMonitor:
         if group is None:
             group = self.pending[key] = _Group(inputs)
         group.events.append(ev)
+        self._due = min(self._due, ev.time + self.horizon)
         if len(group.events) == 1:
             self._output(ev, only=key)
 
     def _output(self, ev: Event, only: Any = None) -> None:
         done = []
         groups = self.pending.items() if only is None else [(only, self.pending[only])]
+        outputs = self._observed("out.")
         for key, g in groups:
             values = dict(g.inputs)
-            values.update(self._observed("out."))
+            values.update(outputs)
             failed: tuple[int, str] | None = None
             undecided = ""
             waiting = False
             for k, formula in enumerate(self.guarantees, 1):
-                ok, reason = self._truth(k, formula, values, key)
+                ok, reason = self._truth(k, formula, values)
                 if ok is False:
                     failed = (k, "")
                     break
@@ -343,8 +377,8 @@ class NodeMonitor:
         self._expire(self.now)
 
     def _expire(self, now: float) -> None:
-        if not self.pending:
-            return
+        if not self.pending or now <= self._due:
+            return  # no obligation's horizon has passed yet
         empty = []
         for key, g in self.pending.items():
             while g.events and g.events[0].time + self.horizon < now:
@@ -353,6 +387,7 @@ class NodeMonitor:
                 empty.append(key)
         for key in empty:
             del self.pending[key]
+        self._due = min((g.events[0].time + self.horizon for g in self.pending.values()), default=float("inf"))
 
     def _close(self, g: _Group, trigger: Event) -> None:
         if g.undecided and g.last is None:

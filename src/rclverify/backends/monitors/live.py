@@ -36,6 +36,7 @@ from ...traces.mapping import TopicRule
 from .backend import monitoring_details, summary_line, tool_versions, verdict_status
 from .check import NodeResult, Verdict
 from .online import OnlineEngine
+from .worker import EngineWorker
 
 VERDICT_LOG_TOPIC = "rclverify/verdict"
 
@@ -168,6 +169,24 @@ class LiveRun:
         return record
 
 
+def _no_delay(pub: Any) -> None:
+    """Turn Nagle's algorithm off on the verdict publisher's subscriber
+    connections (TCP_NODELAY), whether or not the subscriber asked for it:
+    with it on, a verdict written while the previous one is not yet
+    acknowledged waits for the subscriber's delayed ACK, up to 40 ms on
+    Linux (docs/monitors.md, "Live monitoring", "Threads").  Reaches rospy's publisher
+    connections (``impl.connections``, each with its ``socket``); a rospy
+    without them is left as it is."""
+    import socket
+    for c in list(getattr(getattr(pub, "impl", None), "connections", None) or ()):
+        sock = getattr(c, "socket", None)
+        if sock is not None:  # idempotent, one system call per connection every 0.1 s
+            try:
+                sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+            except (OSError, AttributeError):
+                pass
+
+
 def run_ros1(run_factory: Callable[..., LiveRun], checked: Checked, nodes: list[CheckedNode],
              msg_dirs: list[Path], *, verdict_topic: str, last_prefix: str, node_name: str,
              duration: float | None, tick_s: float, status_s: float, evidence: Path | None,
@@ -193,7 +212,14 @@ def run_ros1(run_factory: Callable[..., LiveRun], checked: Checked, nodes: list[
         raise RosUnavailable(f"no ROS master answers at {rosgraph.get_master_uri()} (start roscore, or set "
                              "ROS_MASTER_URI)")
     rospy.init_node(node_name, anonymous=False, disable_signals=True)
-    pub = rospy.Publisher(verdict_topic, String, queue_size=10000)
+    # synchronous: the engine thread writes each verdict to the subscribers'
+    # sockets itself; rospy's queued publisher hands every message to a writer
+    # thread and then yields the GIL (time.sleep(0)), which cost the engine
+    # thread a GIL hand-over per verdict (docs/monitors.md, "Live monitoring", "Threads")
+    import warnings
+    with warnings.catch_warnings():  # rospy warns about queue_size=None; here it is the choice made above
+        warnings.simplefilter("ignore", SyntaxWarning)
+        pub = rospy.Publisher(verdict_topic, String, queue_size=None)
     lasts: dict[str, Any] = {}
     for n in nodes:
         lasts[n.name] = rospy.Publisher(f"{last_prefix}/{n.name}/last_verdict", String, queue_size=1, latch=True)
@@ -201,18 +227,21 @@ def run_ros1(run_factory: Callable[..., LiveRun], checked: Checked, nodes: list[
                               publish_last=lambda n, text: lasts[n].publish(String(text)))
     decode_errors: dict[str, int] = {}
 
-    def callback(raw: Any, topic: str) -> None:
-        received = rospy.get_time()
+    def decode(topic: str, raw: Any) -> Mapping[str, Any] | None:
         typ = raw._connection_header.get("type", "") if getattr(raw, "_connection_header", None) else ""
         cls = by_type.get(typ, classes[topic])
         try:
             msg = cls().deserialize(raw._buff)
         except Exception:  # a publisher of another type on a contract topic: counted, never a crash
             decode_errors[topic] = decode_errors.get(topic, 0) + 1
-            return
-        live.push(topic, flatten(msg), received)
+            return None
+        return flatten(msg)  # type: ignore[no-any-return]
 
-    subs = [rospy.Subscriber(t, rospy.AnyMsg, callback, callback_args=t, queue_size=10000) for t in topics]
+    # the callbacks only stamp and queue; one worker thread decodes, checks,
+    # publishes and runs the timer (worker.py: why)
+    worker = EngineWorker(live, decode, rospy.get_time, tick_s=tick_s).start()
+    subs = [rospy.Subscriber(t, rospy.AnyMsg, lambda raw, t=t: worker.offer(t, raw, rospy.get_time()),
+                             queue_size=10000, tcp_nodelay=True) for t in topics]
     out(f"monitoring {len(topics)} topic(s) for {len(nodes)} node(s); verdicts on {verdict_topic}")
     t0 = _time.monotonic()
     next_status = t0 + status_s
@@ -220,16 +249,38 @@ def run_ros1(run_factory: Callable[..., LiveRun], checked: Checked, nodes: list[
         while not stop.is_set() and not rospy.is_shutdown():
             if duration is not None and _time.monotonic() - t0 >= duration:
                 break
-            stop.wait(tick_s)
-            live.tick(rospy.get_time())
+            stop.wait(min(0.1, tick_s * 5))
+            if worker.error is not None:
+                break  # the engine thread died: stop and say so, never monitor on silently
+            _no_delay(pub)
             if status_s > 0 and _time.monotonic() >= next_status:
                 out(live.status_line())
                 next_status += status_s
     finally:
         for s in subs:
             s.unregister()
+        engine_error = ""
+        try:
+            worker.stop()
+        except Exception as exc:  # noqa: BLE001 - a bug in the engine: reported in the evidence, the log kept
+            engine_error = f"{type(exc).__name__}: {exc}"
+            out(f"rclverify monitor --live: error: the verdict engine stopped: {engine_error}")
         record = live.stop(evidence)
         record["decode_errors"] = decode_errors
+        if engine_error:
+            record["engine_error"] = engine_error
+            for n in record["nodes"]:
+                n["status"] = "error"
+                n["explanation"] = f"the verdict engine stopped during the run ({engine_error}); verdicts are partial"
+        record["backlog_max"] = worker.backlog_max
+        record["dropped_messages"] = worker.dropped
+        if worker.dropped:  # verdicts that miss messages prove nothing: not discharged
+            for n in record["nodes"]:
+                if n["status"] in ("discharged", "pending"):
+                    n["status"] = "inconclusive"
+                    n["explanation"] = (f"{worker.dropped} message(s) were dropped because the monitor fell "
+                                        f"{worker.max_queue} messages behind; the verdicts do not cover them")
+        record["engine_cpu_us_per_message"] = round(worker.cpu_s / max(worker.handled, 1) * 1e6, 1)
         if evidence is not None:
             atomic_write_text(evidence, json.dumps(record, indent=2, sort_keys=True) + "\n")
         out(live.status_line())

@@ -89,6 +89,50 @@ class OracleRun:
         return {"verdict": verdict, "rclverify": decided}
 
 
+def encode(reply: Mapping[str, Any]) -> bytes:
+    """A reply as compact UTF-8 JSON (a NaN or an infinity, which JSON has no
+    number for, is written as its string, ``"nan"``)."""
+    try:
+        return json.dumps(reply, allow_nan=False, separators=(",", ":")).encode()
+    except ValueError:
+        return json.dumps(_json_safe(reply), separators=(",", ":")).encode()
+
+
+def _json_safe(v: Any) -> Any:
+    if isinstance(v, float) and not math.isfinite(v):
+        return repr(v)
+    if isinstance(v, dict):
+        return {str(k): _json_safe(x) for k, x in v.items()}
+    if isinstance(v, (list, tuple)):
+        return [_json_safe(x) for x in v]
+    return v
+
+
+async def _send_batch(ws: Any, replies: list[bytes]) -> None:
+    """Send each reply as its own WebSocket text frame, the frames written to the
+    socket in one write (one system call and one TCP segment for a batch,
+    instead of one each): websockets' documented pattern for writing from
+    user code (``send_context`` around ``protocol.send_text``), with the
+    protocol's output joined."""
+    if len(replies) == 1:
+        await ws.send(replies[0], text=True)
+        return
+    async with ws.send_context():
+        for r in replies:
+            ws.protocol.send_text(r)
+        chunks = ws.protocol.data_to_send()
+        if all(chunks):  # no end-of-stream marker among them: one write
+            ws.transport.write(b"".join(chunks))
+        else:  # a close queued meanwhile: websockets' own handling of each chunk
+            for c in chunks:
+                if c:
+                    ws.transport.write(c)
+                elif ws.transport.can_write_eof():
+                    ws.transport.write_eof()
+                else:
+                    ws.transport.close()
+
+
 async def serve(checked: Checked, nodes: list[CheckedNode], rules: Mapping[str, TopicRule], horizon: float,
                 port: int, host: str = "127.0.0.1", ready: Any = None, stop: Any = None) -> None:
     """Serve until ``stop`` (an :class:`asyncio.Event`) is set, or forever.
@@ -100,11 +144,41 @@ async def serve(checked: Checked, nodes: list[CheckedNode], rules: Mapping[str, 
 
     async def handler(ws: Any) -> None:
         run = OracleRun(checked, nodes, rules, horizon)
+        inbox: list[Any] = []
+        wake = asyncio.Event()
+        closed = False
+
+        async def read() -> None:
+            # websockets hands over every message already received without
+            # suspending, so `inbox` fills with everything that arrived in one
+            # read from the socket before write() runs
+            nonlocal closed
+            try:
+                async for message in ws:
+                    inbox.append(message)
+                    wake.set()
+            except ConnectionClosed:
+                pass
+            finally:
+                closed = True
+                wake.set()
+
+        reader = asyncio.create_task(read())
         try:
-            async for message in ws:
-                await ws.send(json.dumps(run.answer(message)))
+            while True:
+                await wake.wait()
+                wake.clear()
+                if inbox:
+                    batch = inbox[:]
+                    del inbox[:]
+                    replies = [encode(run.answer(m)) for m in batch]
+                    await _send_batch(ws, replies)
+                elif closed:
+                    return
         except ConnectionClosed:
             return
+        finally:
+            reader.cancel()
 
     async with ws_serve(handler, host, port, ping_interval=None, max_size=2**22):
         if ready is not None:
