@@ -259,28 +259,8 @@ def run_ros1(run_factory: Callable[..., LiveRun], checked: Checked, nodes: list[
     finally:
         for s in subs:
             s.unregister()
-        engine_error = ""
-        try:
-            worker.stop()
-        except Exception as exc:  # noqa: BLE001 - a bug in the engine: reported in the evidence, the log kept
-            engine_error = f"{type(exc).__name__}: {exc}"
-            out(f"rclverify monitor --live: error: the verdict engine stopped: {engine_error}")
-        record = live.stop(evidence)
+        record = stop_and_record(worker, live, evidence, out)
         record["decode_errors"] = decode_errors
-        if engine_error:
-            record["engine_error"] = engine_error
-            for n in record["nodes"]:
-                n["status"] = "error"
-                n["explanation"] = f"the verdict engine stopped during the run ({engine_error}); verdicts are partial"
-        record["backlog_max"] = worker.backlog_max
-        record["dropped_messages"] = worker.dropped
-        if worker.dropped:  # verdicts that miss messages prove nothing: not discharged
-            for n in record["nodes"]:
-                if n["status"] in ("discharged", "pending"):
-                    n["status"] = "inconclusive"
-                    n["explanation"] = (f"{worker.dropped} message(s) were dropped because the monitor fell "
-                                        f"{worker.max_queue} messages behind; the verdicts do not cover them")
-        record["engine_cpu_us_per_message"] = round(worker.cpu_s / max(worker.handled, 1) * 1e6, 1)
         if evidence is not None:
             atomic_write_text(evidence, json.dumps(record, indent=2, sort_keys=True) + "\n")
         out(live.status_line())
@@ -288,4 +268,36 @@ def run_ros1(run_factory: Callable[..., LiveRun], checked: Checked, nodes: list[
     return record
 
 
-__all__ = ["LiveRun", "VERDICT_LOG_TOPIC", "run_ros1"]
+def stop_and_record(worker: EngineWorker, live: LiveRun, evidence: Any, out: Callable[[str], None]) -> dict[str, Any]:
+    """Stop ``worker`` (it checks what is still queued), then ``live``, and
+    return the monitoring evidence record with the worker's figures: the
+    longest queue, the messages dropped and the engine's CPU per message
+    (µs).  Verdicts that miss dropped messages prove nothing, so a node that
+    would be discharged or pending is ``inconclusive``; an engine that died
+    makes every node ``error``.  Shared by the ROS 1 and ROS 2 layers; the
+    caller writes the record."""
+    engine_error = ""
+    try:
+        worker.stop()
+    except Exception as exc:  # noqa: BLE001 - a bug in the engine: reported in the evidence, the log kept
+        engine_error = f"{type(exc).__name__}: {exc}"
+        out(f"rclverify monitor --live: error: the verdict engine stopped: {engine_error}")
+    record = live.stop(evidence)
+    if engine_error:
+        record["engine_error"] = engine_error
+        for n in record["nodes"]:
+            n["status"] = "error"
+            n["explanation"] = f"the verdict engine stopped during the run ({engine_error}); verdicts are partial"
+    record["backlog_max"] = worker.backlog_max
+    record["dropped_messages"] = worker.dropped
+    if worker.dropped:
+        for n in record["nodes"]:
+            if n["status"] in ("discharged", "pending"):
+                n["status"] = "inconclusive"
+                n["explanation"] = (f"{worker.dropped} message(s) were dropped because the monitor fell "
+                                    f"{worker.max_queue} messages behind; the verdicts do not cover them")
+    record["engine_cpu_us_per_message"] = round(worker.cpu_s / max(worker.handled, 1) * 1e6, 1)
+    return record
+
+
+__all__ = ["LiveRun", "VERDICT_LOG_TOPIC", "run_ros1", "stop_and_record"]

@@ -1,9 +1,11 @@
 """ROS 2 (rclpy) layer of the live monitor: as thin as possible over the shared engine.
 
 Everything that decides a verdict, writes the log or the evidence is
-:class:`~.live.LiveRun` (tested with ROS 1 and without middleware);
-this module only subscribes, stamps messages with the node's clock, calls
-the run's timer and publishes:
+:class:`~.live.LiveRun`, fed by the same engine thread as ROS 1
+(:class:`~.worker.EngineWorker`: callbacks only queue, one thread decodes,
+checks, publishes and runs the timer, whose clock never passes a queued
+message; tested with ROS 1 and without middleware).  This module only
+subscribes, stamps messages with the node's clock and publishes:
 
 * every verdict as ``std_msgs/msg/String`` JSON on the verdict topic;
 * each node's latest verdict on ``<prefix>/<Node>/last_verdict`` with
@@ -19,12 +21,15 @@ exercised by the test suite: docs/monitors.md says so.
 """
 from __future__ import annotations
 
+import json
 import threading
 import time as _time
 from typing import Any, Callable
 
+from ...evidence.store import atomic_write_text
 from ...rcl.types import Checked, CheckedNode
-from .live import LiveRun
+from .live import LiveRun, stop_and_record
+from .worker import EngineWorker
 
 
 class Ros2Unavailable(Exception):
@@ -71,10 +76,9 @@ def run_ros2(run_factory: Callable[..., LiveRun], checked: Checked, nodes: list[
         return s
     live = run_factory(publish=lambda m: pub.publish(text(m)),
                               publish_last=lambda n, m: lasts[n].publish(text(m)))
+    worker = EngineWorker(live, lambda _t, msg: dict(message_to_ordereddict(msg)), now, tick_s=tick_s).start()
     for topic, cls in classes.items():
-        node.create_subscription(cls, topic, lambda msg, t=topic: live.push(t, dict(message_to_ordereddict(msg)),
-                                                                               now()), 1000)
-    node.create_timer(tick_s, lambda: live.tick(now()))
+        node.create_subscription(cls, topic, lambda msg, t=topic: worker.offer(t, msg, now()), 1000)
     out(f"monitoring {len(topics)} topic(s) for {len(nodes)} node(s); verdicts on {verdict_topic}")
     t0 = _time.monotonic()
     next_status = t0 + status_s
@@ -83,11 +87,15 @@ def run_ros2(run_factory: Callable[..., LiveRun], checked: Checked, nodes: list[
             if duration is not None and _time.monotonic() - t0 >= duration:
                 break
             rclpy.spin_once(node, timeout_sec=tick_s)
+            if worker.error is not None:
+                break  # the engine thread died: stop and say so, never monitor on silently
             if status_s > 0 and _time.monotonic() >= next_status:
                 out(live.status_line())
                 next_status += status_s
     finally:
-        record = live.stop(evidence)
+        record = stop_and_record(worker, live, evidence, out)
+        if evidence is not None:
+            atomic_write_text(evidence, json.dumps(record, indent=2, sort_keys=True) + "\n")
         out(live.status_line())
         node.destroy_node()
         rclpy.shutdown()
