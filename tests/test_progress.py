@@ -71,7 +71,7 @@ def test_a_completed_run_freezes_the_heap_only_at_exit(monkeypatch: Any) -> None
     import atexit
     import gc
 
-    from rclverify import heap
+    from rclverify.cache import heap
     registered: list[Any] = []
     monkeypatch.setattr(atexit, "register", registered.append)
     monkeypatch.setattr(heap, "_EXIT", [])
