@@ -226,7 +226,11 @@ def test_explain_and_status_read_the_last_run(newcomer: Path, capsys: pytest.Cap
     assert json.loads((newcomer / "reports" / "assurance.json").read_text())["diagnoses"][0]["id"] == "Controller.sc2"
     assert main(["status", "-w", str(newcomer)]) == 0
     out = capsys.readouterr().out
-    assert "diagnosis Controller.sc2" in out and "rclverify explain Controller.sc2" in out and "Controller" in out
+    # one entry per root cause, as in the report: the side condition and the derived properties it blocks
+    assert "1 problem by root cause" in out and "rclverify explain ID" in out, out
+    (entry,) = [line for line in out.splitlines() if line.startswith("  1. [failed]")]
+    assert "checked repair" in entry and "findings" in entry
+    assert "findings: Controller.sc2" in out
     assert main(["explain", "-w", str(newcomer), "Controller.sc2"]) == 0
     out = capsys.readouterr().out
     assert "counterexample:" in out and "Planner  out.speed  2" in out and "+++ b/contracts/rover.rcl" in out

@@ -66,16 +66,35 @@ def explain_lines(d: Mapping[str, Any]) -> list[str]:
     return out
 
 
+def _short(sentence: str) -> str:
+    return sentence if len(sentence) <= SENTENCE else sentence[:SENTENCE].rsplit(" ", 1)[0] + " ..."
+
+
 def status_lines(data: Mapping[str, Any]) -> list[str]:
-    """The overall line, the problems and their one-sentence diagnoses of a
-    summary (``artifacts/report/summary.json``)."""
+    """The overall line, then the problems of a summary
+    (``artifacts/report/summary.json``): one entry per root cause, as the
+    report's "What needs attention" shows them (status, culprits, the
+    findings behind it, one sentence, checked repairs), or, for a summary
+    without that grouping, each problem and diagnosis on a line."""
     s = data["summary"]
     out = [f"overall: {s['status']} -- {s['headline']}"]
+    groups = data.get("problems")
+    if groups:
+        found = sum(len(g["members"]) for g in groups)
+        out.append(f"{len(groups)} problem{'s' if len(groups) != 1 else ''} by root cause ({found} finding"
+                   f"{'s' if found != 1 else ''}); `rclverify explain ID` prints a finding's diagnosis:")
+        for k, g in enumerate(groups, 1):
+            cause = "; ".join(g["culprits"]) or "(no culprit named)"
+            repairs = f", {g['repairs']} checked repair{'s' if g['repairs'] != 1 else ''}" if g["repairs"] else ""
+            out.append(f"  {k}. [{g['status']}] {cause}: {len(g['members'])} finding"
+                       f"{'s' if len(g['members']) != 1 else ''}{repairs}")
+            if g["sentence"]:
+                out.append(f"     {_short(g['sentence'])}")
+            out.append(f"     findings: {', '.join(g['members'])}")
+        return out
     out += [f"  problem: {p}" for p in s["problems"]]
     for d in s.get("diagnoses", []):
-        sentence = d["sentence"]
-        if len(sentence) > SENTENCE:
-            sentence = sentence[:SENTENCE].rsplit(" ", 1)[0] + " ..."
+        sentence = _short(d["sentence"])
         more = (f"{d['repairs']} checked repair{'s' if d['repairs'] != 1 else ''}: " if d.get("repairs") else "")
         out.append(f"  diagnosis {d['id']}: {sentence} ({more}rclverify explain {d['id']})")
     return out

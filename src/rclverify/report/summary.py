@@ -85,15 +85,28 @@ def _merge(rows: list[dict[str, Any]], label: str) -> dict[str, Any]:
     return out
 
 
+def _culprit(c: Mapping[str, Any]) -> str:
+    """A root culprit as ``what (file:line:col)``; a program line has only its source."""
+    what, source = c.get("what") or "", c.get("source") or ""
+    return f"{what} ({source})" if what and source else what or source or "?"
+
+
 def summary_data(report: Mapping[str, Any]) -> dict[str, Any]:
     """What ``doit verify`` prints at its end, taken from ``report``:
     ``{"meta": {"workspace", "strict_ok"}, "summary": report["summary"],
-    "rows": node_rows(report), "requirements": [[id, verdict, status], ...]}``.  The report task writes it next to the
+    "rows": node_rows(report), "requirements": [[id, verdict, status], ...],
+    "problems": [{"status", "sentence", "culprits": ["what (file:line:col)"],
+    "members": [finding ids], "repairs": int}, ...]}`` (the problems grouped by
+    root cause, :mod:`rclverify.report.problems`).  The report task writes it next to the
     report (``artifacts/report/summary.json``), so ``verify`` reads a few
     kilobytes instead of the whole JSON report (6 MB at 1000 nodes)."""
     return {"meta": {"workspace": report["meta"]["workspace"], "strict_ok": report["meta"]["strict_ok"]},
             "summary": report["summary"], "rows": node_rows(report),
-            "requirements": [[r["id"], r.get("verdict", ""), r["status"]] for r in report.get("requirements", ())]}
+            "requirements": [[r["id"], r.get("verdict", ""), r["status"]] for r in report.get("requirements", ())],
+            "problems": [{"status": g["status"], "sentence": g.get("sentence", ""),
+                          "culprits": [_culprit(c) for c in g.get("culprits", [])],
+                          "members": [m["id"] for m in g.get("members", [])], "repairs": len(g.get("repairs", []))}
+                         for g in report.get("problems", ())]}
 
 
 def summary_table(report: Mapping[str, Any], colour: bool, rows: list[dict[str, Any]] | None = None) -> Table:
