@@ -214,6 +214,54 @@ def test_vacuity_names_the_other_guarantee_and_gets_a_guard(vacuous: Path) -> No
     assert {"check": "N.g1.non-vacuous", "before": "problem", "after": "ok"} in r["cost"]
 
 
+# The Agent's pattern in small: guarantee 2 binds i universally and fires for every i without a
+# successor waypoint (i = 3 under the facts: waypoints 0..3), so it demands c == 0 always and
+# guarantee 1 (c == i + 1 at a waypoint) can never fire.
+SUCCESSOR = """context {
+  WayP : REAL x REAL --> NATURAL ;
+}
+
+node W {
+  inputs( wayP : WayP, at : NATURAL, red : BOOL )
+  outputs( c : NATURAL )
+  assume( TRUE )
+  guarantee( forall(i in NATURAL | in.at == i and in.red == FALSE -> out.c == i + 1) )
+  guarantee( forall(i in NATURAL |
+    in.red == TRUE or not exists(x, y in REAL | in.wayP(x, y) == i + 1) -> out.c == 0) )
+}
+"""
+SUCCESSOR_PLAN = """name: successor
+contracts: [contracts/w.rcl]
+requirements: []
+connections: []
+environment:
+  W:
+    facts:
+      - "forall(x, y in REAL | in.wayP(x, y) <= 3)"
+      - "forall(k in NATURAL | k <= 3 -> exists(x, y in REAL | in.wayP(x, y) == k))"
+nodes: {}
+"""
+
+
+def test_vacuity_repair_restricts_i_to_waypoints_with_a_successor(tmp_path: Path) -> None:
+    """Issue 24: the guard offered for the culprit restricts its bound variable to waypoints that
+    have a successor (from the facts' bound on the waypoint function), checked by Z3, and says that
+    Z3 proved it equivalent to the successor's existence under the facts."""
+    root = tmp_path / "succ"
+    (root / "contracts").mkdir(parents=True)
+    (root / "contracts" / "w.rcl").write_text(SUCCESSOR, encoding="utf-8")
+    (root / "contracts" / "plan.yaml").write_text(SUCCESSOR_PLAN, encoding="utf-8")
+    ws, report = _run(root)
+    d = next(x for x in report["diagnoses"] if x["id"] == "W.g1.non-vacuous")
+    assert "guarantee 2" in d["sentence"]
+    [r] = d["repairs"]
+    assert r["kind"] == "guard"
+    assert r["edit"]["inserted"].startswith("i + 1 <= 3 and (in.red == TRUE or not exists(")
+    assert "the same as `exists(x, y in REAL | in.wayP(x, y) == i + 1)` under the environment facts" in r["summary"]
+    assert {"check": "W.g1.non-vacuous", "before": "problem", "after": "ok"} in r["cost"]
+    assert r["checks"][0] == {"check": "W.contract-consistent", "status": "consistent (Z3: sat, witness found)"}
+
+
 def test_explain_and_status_read_the_last_run(newcomer: Path, capsys: pytest.CaptureFixture[str]) -> None:
     assert main(["status", "-w", str(newcomer)]) == 1  # no report yet: located error
     assert "no report yet" in capsys.readouterr().err
