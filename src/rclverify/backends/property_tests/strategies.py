@@ -229,6 +229,13 @@ class InputSpace:
             return FiniteFunction(table, draw(self.value(t.result, small=True)), len(t.args))
         return draw_fn()
 
+    def points(self, args: tuple[Type, ...]) -> st.SearchStrategy[tuple[Any, ...]]:
+        """Argument tuples of a function over ``args`` (full-size values), built once."""
+        key = ("points", args)
+        if key not in self.cache:
+            self.cache[key] = st.tuples(*[self.value(a) for a in args])  # type: ignore[index]
+        return self.cache[key]  # type: ignore[index]
+
     def inputs(self) -> st.SearchStrategy[dict[str, Any]]:
         """One example: qualified input name -> value."""
         @st.composite
@@ -254,14 +261,17 @@ class InputSpace:
         the model's result.  The harness's filter checks the facts again."""
         arity = base.arity
         args = self.node_arg_types.get(arity)
+        # the strategy of a new point is built once, not per key and example (building one costs
+        # more than drawing from it)
+        point = self.points(args) if args is not None else None
         table: dict[tuple[Any, ...], Any] = {}
         for key, res in base.table.items():
             choice = draw(_MOVE)
             moved = key
             if choice == 1 and pool:
                 moved = draw(st.sampled_from(pool))
-            elif choice == 2 and args is not None:
-                moved = draw(st.tuples(*[self.value(a) for a in args]))
+            elif choice == 2 and point is not None:
+                moved = draw(point)
             table[moved if moved not in table and moved not in base.table else key] = res
         for key, res in drawn.table.items():
             if key not in table or draw(_BOOLS):
