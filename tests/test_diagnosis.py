@@ -4,6 +4,7 @@ shown only after Z3 checked them, on small real workspaces."""
 from __future__ import annotations
 
 import json
+import os
 import shutil
 from fractions import Fraction
 from pathlib import Path
@@ -288,3 +289,24 @@ def test_a_broken_checker_shows_no_guard(vacuous: Path, monkeypatch: pytest.Monk
     monkeypatch.setattr(z3.Solver, "check", lambda self, *a, **k: z3.unknown)
     d = next(x for x in diagnose(ws, report) if x["id"] == "N.g1.non-vacuous")
     assert "guarantee 2 (contracts/n.rcl:6:3)" in d["sentence"] and d["repairs"] == []
+
+
+def test_parallel_report_tasks_diagnose_one_at_a_time(newcomer: Path) -> None:
+    """doit -n 2 builds the report dict in two processes: the second waits on the diagnosis lock,
+    then finds the first's repairs in the cache instead of computing them again."""
+    import fcntl
+    import threading
+    from rclverify.diagnosis.build import LOCK
+    ws, report = _run(newcomer)
+    ws.path(CACHE).unlink(missing_ok=True)
+    fd = os.open(ws.path(LOCK), os.O_RDWR | os.O_CREAT)
+    fcntl.flock(fd, fcntl.LOCK_EX)  # another process diagnosing
+    done: list[Any] = []
+    t = threading.Thread(target=lambda: done.append(diagnose(ws, report)))
+    t.start()
+    t.join(1.0)
+    assert not done and not ws.path(CACHE).exists()  # waiting, nothing computed
+    os.close(fd)
+    t.join(60)
+    assert done and ws.path(CACHE).exists()
+    assert next(x for x in done[0] if x["id"] == "Controller.sc2")["repairs"]
