@@ -143,6 +143,7 @@ class InputSpace:
     cache: dict[tuple[Type, int, bool], st.SearchStrategy[Any]] = field(default_factory=dict)
     seed: Mapping[str, Any] | None = None  # a Z3 model of the assumption and facts (.seeding)
     node_arg_types: dict[int, tuple[Type, ...]] = field(default_factory=dict)
+    point_cache: dict[tuple[Type, ...], st.SearchStrategy[tuple[Any, ...]]] = field(default_factory=dict)
 
     def real(self, bd: Bound | None, small: bool = False) -> st.SearchStrategy[Any]:
         lo = float(bd.lo) if bd and bd.lo is not None else (-1000.0 if small else None)
@@ -231,10 +232,9 @@ class InputSpace:
 
     def points(self, args: tuple[Type, ...]) -> st.SearchStrategy[tuple[Any, ...]]:
         """Argument tuples of a function over ``args`` (full-size values), built once."""
-        key = ("points", args)
-        if key not in self.cache:
-            self.cache[key] = st.tuples(*[self.value(a) for a in args])  # type: ignore[index]
-        return self.cache[key]  # type: ignore[index]
+        if args not in self.point_cache:
+            self.point_cache[args] = st.tuples(*[self.value(a) for a in args])
+        return self.point_cache[args]
 
     def inputs(self) -> st.SearchStrategy[dict[str, Any]]:
         """One example: qualified input name -> value."""
