@@ -25,6 +25,7 @@ from rclverify.report.sarif import sarif_log
 
 REPO = Path(__file__).resolve().parents[1]
 SARIF_SCHEMA = REPO / "tests" / "data" / "sarif-schema-2.1.0.json"
+RCL_FILE = "contracts/remote_inspection.rcl"
 
 
 def _run(root: Path) -> tuple[Workspace, dict[str, Any]]:
@@ -261,6 +262,29 @@ def test_vacuity_repair_restricts_i_to_waypoints_with_a_successor(tmp_path: Path
     assert "the same as `exists(x, y in REAL | in.wayP(x, y) == i + 1)` under the environment facts" in r["summary"]
     assert {"check": "W.g1.non-vacuous", "before": "problem", "after": "ok"} in r["cost"]
     assert r["checks"][0] == {"check": "W.contract-consistent", "status": "consistent (Z3: sat, witness found)"}
+
+
+def test_the_agents_guarantee_3_gets_the_successor_restriction(tmp_path: Path) -> None:
+    """The case study's own Agent (issue 24): the guard for guarantee 3, which makes guarantees 1
+    (vacuous from i = 0) and 2 vacuous, restricts i to waypoints that have a successor, and Z3 checked
+    it.  The health stage's statuses are given (running it takes a minute); the repair search runs."""
+    from rclverify.diagnosis.repairs import guard_repair
+    root = tmp_path / "cs"
+    for d in ("contracts", "backends", "ros"):
+        shutil.copytree(REPO / d, root / d)
+    ws = Workspace(root)
+    before = {"Agent.assumption-satisfiable": "ok", "Agent.contract-consistent": "ok",
+              "Agent.g1.non-vacuous": "problem", "Agent.g2.non-vacuous": "problem", "Agent.g3.non-vacuous": "ok"}
+    r = guard_repair(ws, "Agent", 3, [(1, 0), (2, None)], before)
+    assert r is not None and r["kind"] == "guard"
+    assert r["edit"]["inserted"] == ("i + 1 <= 12 and (in.radiationStatus in {red, orange} or "
+                                     "not exists(x, y in REAL | in.wayP(x, y) == i + 1))")
+    assert "the same as `exists(x, y in REAL | in.wayP(x, y) == i + 1)` under the environment facts" in r["summary"]
+    assert {c["check"] for c in r["checks"]} == {"Agent.contract-consistent", "Agent.g1.non-vacuous at 0",
+                                                 "Agent.g2.non-vacuous"}
+    assert {(c["check"], c["after"]) for c in r["cost"]} == {("Agent.g1.non-vacuous", "ok"),
+                                                            ("Agent.g2.non-vacuous", "ok")}
+    assert (root / "contracts" / "remote_inspection.rcl").read_text() == (REPO / RCL_FILE).read_text()
 
 
 def test_explain_and_status_read_the_last_run(newcomer: Path, capsys: pytest.CaptureFixture[str]) -> None:
