@@ -4,6 +4,7 @@ shown only after Z3 checked them, on small real workspaces."""
 from __future__ import annotations
 
 import json
+import os
 import shutil
 from fractions import Fraction
 from pathlib import Path
@@ -24,6 +25,7 @@ from rclverify.report.sarif import sarif_log
 
 REPO = Path(__file__).resolve().parents[1]
 SARIF_SCHEMA = REPO / "tests" / "data" / "sarif-schema-2.1.0.json"
+RCL_FILE = "contracts/remote_inspection.rcl"
 
 
 def _run(root: Path) -> tuple[Workspace, dict[str, Any]]:
@@ -214,6 +216,77 @@ def test_vacuity_names_the_other_guarantee_and_gets_a_guard(vacuous: Path) -> No
     assert {"check": "N.g1.non-vacuous", "before": "problem", "after": "ok"} in r["cost"]
 
 
+# The Agent's pattern in small: guarantee 2 binds i universally and fires for every i without a
+# successor waypoint (i = 3 under the facts: waypoints 0..3), so it demands c == 0 always and
+# guarantee 1 (c == i + 1 at a waypoint) can never fire.
+SUCCESSOR = """context {
+  WayP : REAL x REAL --> NATURAL ;
+}
+
+node W {
+  inputs( wayP : WayP, at : NATURAL, red : BOOL )
+  outputs( c : NATURAL )
+  assume( TRUE )
+  guarantee( forall(i in NATURAL | in.at == i and in.red == FALSE -> out.c == i + 1) )
+  guarantee( forall(i in NATURAL |
+    in.red == TRUE or not exists(x, y in REAL | in.wayP(x, y) == i + 1) -> out.c == 0) )
+}
+"""
+SUCCESSOR_PLAN = """name: successor
+contracts: [contracts/w.rcl]
+requirements: []
+connections: []
+environment:
+  W:
+    facts:
+      - "forall(x, y in REAL | in.wayP(x, y) <= 3)"
+      - "forall(k in NATURAL | k <= 3 -> exists(x, y in REAL | in.wayP(x, y) == k))"
+nodes: {}
+"""
+
+
+def test_vacuity_repair_restricts_i_to_waypoints_with_a_successor(tmp_path: Path) -> None:
+    """Issue 24: the guard offered for the culprit restricts its bound variable to waypoints that
+    have a successor (from the facts' bound on the waypoint function), checked by Z3, and says that
+    Z3 proved it equivalent to the successor's existence under the facts."""
+    root = tmp_path / "succ"
+    (root / "contracts").mkdir(parents=True)
+    (root / "contracts" / "w.rcl").write_text(SUCCESSOR, encoding="utf-8")
+    (root / "contracts" / "plan.yaml").write_text(SUCCESSOR_PLAN, encoding="utf-8")
+    ws, report = _run(root)
+    d = next(x for x in report["diagnoses"] if x["id"] == "W.g1.non-vacuous")
+    assert "guarantee 2" in d["sentence"]
+    [r] = d["repairs"]
+    assert r["kind"] == "guard"
+    assert r["edit"]["inserted"].startswith("i + 1 <= 3 and (in.red == TRUE or not exists(")
+    assert "the same as `exists(x, y in REAL | in.wayP(x, y) == i + 1)` under the environment facts" in r["summary"]
+    assert {"check": "W.g1.non-vacuous", "before": "problem", "after": "ok"} in r["cost"]
+    assert r["checks"][0] == {"check": "W.contract-consistent", "status": "consistent (Z3: sat, witness found)"}
+
+
+def test_the_agents_guarantee_3_gets_the_successor_restriction(tmp_path: Path) -> None:
+    """The case study's own Agent (issue 24): the guard for guarantee 3, which makes guarantees 1
+    (vacuous from i = 0) and 2 vacuous, restricts i to waypoints that have a successor, and Z3 checked
+    it.  The health stage's statuses are given (running it takes a minute); the repair search runs."""
+    from rclverify.diagnosis.repairs import guard_repair
+    root = tmp_path / "cs"
+    for d in ("contracts", "backends", "ros"):
+        shutil.copytree(REPO / d, root / d)
+    ws = Workspace(root)
+    before = {"Agent.assumption-satisfiable": "ok", "Agent.contract-consistent": "ok",
+              "Agent.g1.non-vacuous": "problem", "Agent.g2.non-vacuous": "problem", "Agent.g3.non-vacuous": "ok"}
+    r = guard_repair(ws, "Agent", 3, [(1, 0), (2, None)], before)
+    assert r is not None and r["kind"] == "guard"
+    assert r["edit"]["inserted"] == ("i + 1 <= 12 and (in.radiationStatus in {red, orange} or "
+                                     "not exists(x, y in REAL | in.wayP(x, y) == i + 1))")
+    assert "the same as `exists(x, y in REAL | in.wayP(x, y) == i + 1)` under the environment facts" in r["summary"]
+    assert {c["check"] for c in r["checks"]} == {"Agent.contract-consistent", "Agent.g1.non-vacuous at 0",
+                                                 "Agent.g2.non-vacuous"}
+    assert {(c["check"], c["after"]) for c in r["cost"]} == {("Agent.g1.non-vacuous", "ok"),
+                                                            ("Agent.g2.non-vacuous", "ok")}
+    assert (root / "contracts" / "remote_inspection.rcl").read_text() == (REPO / RCL_FILE).read_text()
+
+
 def test_explain_and_status_read_the_last_run(newcomer: Path, capsys: pytest.CaptureFixture[str]) -> None:
     assert main(["status", "-w", str(newcomer)]) == 1  # no report yet: located error
     assert "no report yet" in capsys.readouterr().err
@@ -244,3 +317,24 @@ def test_a_broken_checker_shows_no_guard(vacuous: Path, monkeypatch: pytest.Monk
     monkeypatch.setattr(z3.Solver, "check", lambda self, *a, **k: z3.unknown)
     d = next(x for x in diagnose(ws, report) if x["id"] == "N.g1.non-vacuous")
     assert "guarantee 2 (contracts/n.rcl:6:3)" in d["sentence"] and d["repairs"] == []
+
+
+def test_parallel_report_tasks_diagnose_one_at_a_time(newcomer: Path) -> None:
+    """doit -n 2 builds the report dict in two processes: the second waits on the diagnosis lock,
+    then finds the first's repairs in the cache instead of computing them again."""
+    import fcntl
+    import threading
+    from rclverify.diagnosis.build import LOCK
+    ws, report = _run(newcomer)
+    ws.path(CACHE).unlink(missing_ok=True)
+    fd = os.open(ws.path(LOCK), os.O_RDWR | os.O_CREAT)
+    fcntl.flock(fd, fcntl.LOCK_EX)  # another process diagnosing
+    done: list[Any] = []
+    t = threading.Thread(target=lambda: done.append(diagnose(ws, report)))
+    t.start()
+    t.join(1.0)
+    assert not done and not ws.path(CACHE).exists()  # waiting, nothing computed
+    os.close(fd)
+    t.join(60)
+    assert done and ws.path(CACHE).exists()
+    assert next(x for x in done[0] if x["id"] == "Controller.sc2")["repairs"]

@@ -166,6 +166,34 @@ def test_same_seed_same_evidence(tmp_path: Path) -> None:
     assert a == b
 
 
+LOGGING = GOOD.replace("def sensor(r, command):\n", """def sensor(r, command):
+    import pathlib
+    with open(pathlib.Path(__file__).parent / "drawn.log", "a") as log:
+        log.write(repr((r, command)) + "\\n")
+""")
+
+
+def test_same_seed_same_examples_whatever_the_process_imported_before(tmp_path: Path) -> None:
+    """Hypothesis mixes constants from the source of the process's local modules into its draws;
+    which modules a doit worker has loaded depends on what it ran before, so the examples did too.
+    A local module with new numeric constants imported between two runs changes no example."""
+    root = workspace(tmp_path / "ws", LOGGING)
+    assert run(root).status == "discharged"
+    first = (root / "drawn.log").read_text()
+    (root / "drawn.log").unlink()
+    mod = tmp_path / "mods" / "noise_constants_module.py"
+    mod.parent.mkdir()
+    mod.write_text("".join(f"C{k} = {v}\n" for k, v in enumerate((119.5, 121.25, 249.75, 251.5, 7.25e3, 1e-300))))
+    sys.path.insert(0, str(mod.parent))
+    try:
+        import noise_constants_module  # noqa: F401  (a local module, new to the process)
+        assert run(root).status == "discharged"
+    finally:
+        sys.path.remove(str(mod.parent))
+        sys.modules.pop("noise_constants_module", None)
+    assert (root / "drawn.log").read_text() == first
+
+
 def test_bad_entry_is_a_located_plan_error(tmp_path: Path) -> None:
     root = workspace(tmp_path, GOOD)
     plan = (root / "contracts/plan.yaml").read_text().replace("impl.py:sensor", "impl.py:nosuch")

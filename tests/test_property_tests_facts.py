@@ -147,3 +147,24 @@ def test_z3_model_does_not_depend_on_earlier_z3_work(tmp_path: Path, monkeypatch
     assert s.check() == z3.sat
     monkeypatch.setattr(seeding, "_BASE", {})
     assert first is not None and seeding.Seeder(target.checked, target.node, formulas).base() == first
+
+
+def test_table_sizes_that_cannot_hold_the_facts_are_skipped(monkeypatch: pytest.MonkeyPatch) -> None:
+    """13 waypoints need 13 distinct results: tables under 12 entries (and a default) cannot, so
+    Z3 is not asked about them; the first size tried that works is the one found before."""
+    from rclverify.rcl.parser import parse_formula
+    facts = tuple(parse_formula(t, "plan.yaml", 1, 1) for t in (
+        "forall(x, y in REAL | in.wayP(x, y) <= 12)",
+        "forall(k in NATURAL | k <= 12 -> exists(x, y in REAL | in.wayP(x, y) == k))"))
+    assert seeding.min_entries(facts) == 12
+    assert seeding.min_entries(facts[:1]) == 0
+    assert seeding.min_entries((parse_formula(
+        "forall(k in NATURAL | k < 5 -> exists(x in REAL | in.f(x) == k))", "plan.yaml", 1, 1),)) == 4
+    tried: list[int] = []
+    real = seeding.Seeder._solve
+    monkeypatch.setattr(seeding.Seeder, "_solve", lambda self, n: tried.append(n) or real(self, n))
+    monkeypatch.setattr(seeding, "_BASE", {})
+    ws = Workspace(Path(__file__).resolve().parents[1])
+    node = ws.checked.nodes["Agent"]
+    base = seeding.Seeder(ws.checked, node, tuple(f.expr for f in ws.plan.facts["Agent"])).base()
+    assert tried == [16] and base is not None and len(base["in.wayP"].table) == 16

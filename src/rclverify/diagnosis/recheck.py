@@ -52,7 +52,8 @@ def edited_system(ws: Any, edit: Edit) -> tuple[Checked, SystemModel] | None:
         return None
 
 
-def health(ws: Any, checked: Checked, node: str, instances: Mapping[int, int] | None = None) -> dict[str, str]:
+def health(ws: Any, checked: Checked, node: str, instances: Mapping[int, int] | None = None, *,
+           known: Mapping[str, str] | None = None) -> dict[str, str]:
     """``{finding id: status}`` of the health checks of ``node`` in
     ``checked``, each asked as the health stage asks it but with a short
     budget and no instance scan (the full stage takes a minute on the case
@@ -62,19 +63,24 @@ def health(ws: Any, checked: Checked, node: str, instances: Mapping[int, int] | 
     non-vacuity of guarantee ``k`` is asked at ``instances[k]`` when given
     (where it was vacuous before).  The shape findings
     (:mod:`rclverify.health.shape`) are the stage's own.  The replacement
-    check is not asked again."""
+    check is not asked again.  ``known``: statuses of checks the caller has
+    just asked Z3 on the same ``checked`` (``{"Agent.g1.non-vacuous":
+    "ok"}``), taken as they are instead of being asked twice."""
     from ..health.checks import INSTANCE_TIMEOUT_MS
     from ..health.shape import shape_findings
     as_status = {"sat": "ok", "unsat": "problem"}
+    known = known or {}
     h = _health(ws, checked, node)
     out: dict[str, str] = {}
     r = h.sat([], guarantees=False, comment=f"repair check {node}: assumption", timeout_ms=INSTANCE_TIMEOUT_MS)
     out[f"{node}.assumption-satisfiable"] = as_status.get(r.status, "inconclusive")
     # the guarantees with a premise, asked before the next queries start a fresh Z3 world
     premised = [k for k in range(1, len(checked.nodes[node].node.guarantees) + 1) if h.premise(k) is not None]
-    out[f"{node}.contract-consistent"] = as_status.get(consistent(ws, checked, node), "inconclusive")
+    cid = f"{node}.contract-consistent"
+    out[cid] = known[cid] if cid in known else as_status.get(consistent(ws, checked, node), "inconclusive")
     for k in premised:
-        out[f"{node}.g{k}.non-vacuous"] = as_status.get(
+        gid = f"{node}.g{k}.non-vacuous"
+        out[gid] = known[gid] if gid in known else as_status.get(
             premise_fires(ws, checked, node, k, (instances or {}).get(k)), "inconclusive")
     world.fresh()
     out.update({f.id: f.status for f in shape_findings(checked, node)})
@@ -122,7 +128,10 @@ def finite_witness(h: Any, extra: list[tuple[str, z3.BoolRef]], points: int) -> 
     # a budget in Z3's resource steps, so the answer does not depend on the machine's load (logic/query.py)
     from ..logic.query import budgeted_solver
     s = budgeted_solver(WITNESS_TIMEOUT_MS)
-    return "sat" if s.check(*formulas) == z3.sat else "inconclusive"
+    if s.check(*formulas) != z3.sat:
+        return "inconclusive"
+    s.model()  # the witness itself (raises when the solver has none: a misbehaving checker shows no repair)
+    return "sat"
 
 
 def _points(ws: Any, node: str) -> int:
@@ -133,9 +142,9 @@ def _points(ws: Any, node: str) -> int:
 def premise_fires(ws: Any, checked: Checked, node: str, k: int, at: int | None = None) -> str:
     """Can the premise of guarantee ``k`` of ``node`` (at ``at`` for its
     first NATURAL variable, when given) hold together with the assumption,
-    every guarantee and the facts?  ``sat`` when Z3 found a witness: for the
-    query of the health check ``non-vacuous``, or, when Z3 cannot decide
-    that, of the shape :func:`finite_witness` looks for; else ``unsat`` or
+    every guarantee and the facts?  ``sat`` when Z3 found a witness: of the
+    shape :func:`finite_witness` looks for (asked first), or for the query
+    of the health check ``non-vacuous``; else that query's ``unsat`` or
     ``inconclusive``."""
     from ..health.checks import INSTANCE_TIMEOUT_MS
     h = _health(ws, checked, node)
@@ -143,11 +152,13 @@ def premise_fires(ws: Any, checked: Checked, node: str, k: int, at: int | None =
     prem = h.premise(k, {var[0]: at} if at is not None and var else None)
     if prem is None:
         return "inconclusive"
+    # the finite-table witness first: its sat is a witness of the general query too, and it is
+    # found in a fraction of the time in which the general query runs out of budget (the Agent)
+    if finite_witness(h, prem[0], _points(ws, node)) == "sat":
+        return "sat"
     r = h.sat(prem[0], comment=f"repair check {node}: can the premise of guarantee {k} hold?",
               timeout_ms=INSTANCE_TIMEOUT_MS)
-    if r.status != "inconclusive":
-        return str(r.status)
-    return finite_witness(h, prem[0], _points(ws, node))
+    return str(r.status)
 
 
 def consistent(ws: Any, checked: Checked, node: str) -> str:
@@ -156,10 +167,10 @@ def consistent(ws: Any, checked: Checked, node: str) -> str:
     ``unsat`` or ``inconclusive``."""
     from ..health.checks import INSTANCE_TIMEOUT_MS
     h = _health(ws, checked, node)
+    if finite_witness(h, [], _points(ws, node)) == "sat":  # first, as in premise_fires
+        return "sat"
     r = h.sat([], comment=f"repair check {node}: is the contract consistent?", timeout_ms=INSTANCE_TIMEOUT_MS)
-    if r.status != "inconclusive":
-        return str(r.status)
-    return finite_witness(h, [], _points(ws, node))
+    return str(r.status)
 
 
 def side_conditions(checked: Checked, model: SystemModel, node: str) -> dict[str, str]:

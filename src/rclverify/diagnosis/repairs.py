@@ -42,7 +42,9 @@ import z3
 from ..calculus.compose import conjuncts
 from ..rcl import ast
 from ..rcl.printer import expr_to_rcl
-from ..rcl.walk import free_names
+from ..rcl.errors import RclError
+from ..rcl.walk import free_names, subexpressions
+from ..logic import world
 from . import recheck
 from .edits import Edit
 
@@ -67,6 +69,128 @@ def _record(kind: str, summary: str, edit: Edit, source: str, checks: list[dict[
             "checked_by": f"z3 {z3.get_version_string()}"}
 
 
+def _disjuncts(e: ast.Expr) -> list[ast.Expr]:
+    if isinstance(e, ast.Binary) and e.op == "or":
+        return _disjuncts(e.left) + _disjuncts(e.right)
+    return [e]
+
+
+_FLIP = {"==": "!=", "!=": "==", "<": ">=", "<=": ">", ">": "<=", ">=": "<"}
+
+
+def _negation(e: ast.Expr) -> str:
+    """RCL text of ``not e``, written as a reader would: ``not exists(..)``
+    -> ``exists(..)``, ``i > 5`` -> ``i <= 5``, ``f(i) == FALSE`` ->
+    ``f(i) == TRUE``."""
+    if isinstance(e, ast.Unary) and e.op == "not":
+        return expr_to_rcl(e.operand)
+    if isinstance(e, ast.Compare) and len(e.ops) == 1:
+        a, b = e.operands
+        if e.ops[0] in ("==", "!=") and isinstance(b, ast.BoolLit):
+            flipped = b.value if e.ops[0] == "!=" else not b.value
+            return f"{expr_to_rcl(a)} == {'TRUE' if flipped else 'FALSE'}"
+        return f"{expr_to_rcl(a)} {_FLIP[e.ops[0]]} {expr_to_rcl(b)}"
+    return f"not ({expr_to_rcl(e)})"
+
+
+def _fact_bounds(facts: Sequence[ast.Expr]) -> dict[str, tuple[str, str]]:
+    """``{function name: (op, bound text)}`` of the facts of the form
+    ``forall(x, y in D | in.f(x, y) <= N)`` (``<``, ``<=``; a numeric
+    literal ``N``): every result of ``f`` is at most (below) ``N``."""
+    out: dict[str, tuple[str, str]] = {}
+    for f in facts:
+        _, body = _peel(f)
+        if (isinstance(body, ast.Compare) and len(body.ops) == 1 and body.ops[0] in ("<", "<=")
+                and isinstance(body.operands[0], ast.Apply) and isinstance(body.operands[1], ast.NumLit)):
+            out[body.operands[0].func.name] = (body.ops[0], body.operands[1].text)
+    return out
+
+
+def _shifted(e: ast.Expr, names: set[str]) -> bool:
+    """Is ``e`` a variable of ``names``, or one shifted by a literal (``i + 1``)?"""
+    if isinstance(e, ast.Var) and e.prefix is None:
+        return e.name in names
+    return (isinstance(e, ast.Binary) and e.op in ("+", "-") and isinstance(e.right, ast.NumLit)
+            and _shifted(e.left, names))
+
+
+def range_guards(premise: ast.Expr, numeric: Sequence[str], facts: Sequence[ast.Expr]) -> list[tuple[str, str]]:
+    """Guards that restrict the numeric bound variables ``numeric`` of a
+    guarantee ``forall .. | premise -> ..`` to the instances it was meant
+    for, as RCL texts, in the order built:
+
+    1. the negation of each disjunct of the premise that speaks of one of
+       them (``.. or not exists(x, y in REAL | in.wayP(x, y) == i + 1)`` ->
+       ``exists(x, y in REAL | in.wayP(x, y) == i + 1)``: ``i`` has a
+       successor): the guarantee no longer fires merely because its
+       variable is out of range;
+    2. the environment facts' bound on a function (``in.wayP(x, y) <= 12``)
+       applied to the term the premise compares that function's result
+       with (``in.wayP(x, y) == i + 1`` -> ``i + 1 <= 12``).
+
+    Returns ``[(guard text, what it says), ...]`` without repeats.
+    """
+    names = set(numeric)
+    out: dict[str, str] = {}
+    for d in _disjuncts(premise):
+        if free_names(d) & names:
+            out.setdefault(_negation(d), f"drops the premise's disjunct `{expr_to_rcl(d)}`")
+    bounds = _fact_bounds(facts)
+    for e in subexpressions(premise):
+        if isinstance(e, ast.Compare) and len(e.ops) == 1 and e.ops[0] == "==":
+            for f, t in (e.operands, e.operands[::-1]):
+                if isinstance(f, ast.Apply) and f.func.name in bounds and _shifted(t, names):
+                    op, n = bounds[f.func.name]
+                    out.setdefault(f"{expr_to_rcl(t)} {op} {n}",
+                                   f"keeps `{expr_to_rcl(t)}` among the values the environment facts allow "
+                                   f"`{expr_to_rcl(f.func)}` (`{op} {n}`)")
+    return list(out.items())
+
+
+def _weakest_first(ws: Any, node: str, guards: list[str], var_types: Mapping[str, str]) -> tuple[list[str], dict[str, list[str]]]:
+    """``guards`` ordered so that no guard comes after one Z3 proves
+    strictly weaker under the node's environment facts (``g -> h`` valid
+    and not ``h -> g``: ``h`` is weaker), ties in the given order; and, for
+    each guard, the others Z3 proves equivalent to it.  A pair Z3 cannot
+    decide in its budget counts as incomparable.  Among guards no other is
+    strictly weaker than, one without quantifiers comes first (Z3 decides
+    the checks of the guarded contract more easily; of two equivalent
+    guards either is the weakest)."""
+    from ..health.checks import INSTANCE_TIMEOUT_MS
+    from ..logic.encode import Encoder
+    from ..logic.query import prove
+    from ..rcl.parser import parse_formula
+    if len(guards) < 2:
+        return guards, {g: [] for g in guards}
+    checked = ws.checked
+    cn = checked.nodes[node]
+    binds = ", ".join(f"{v} in {t}" for v, t in var_types.items())
+    world.fresh()
+    enc = Encoder(checked.env)
+    facts = [enc.formula(f.expr, cn) for f in ws.plan.facts.get(node, ())]
+    implies: dict[tuple[str, str], bool] = {}
+    for g in guards:
+        for h in guards:
+            if g == h:
+                continue
+            try:
+                goal = enc.formula(parse_formula(f"forall({binds} | ({g}) -> ({h}))", "<guard>", 1, 1), cn)
+            except (RclError, KeyError, ValueError, z3.Z3Exception):
+                implies[(g, h)] = False
+                continue
+            implies[(g, h)] = prove(goal, facts, enc, timeout_ms=INSTANCE_TIMEOUT_MS,
+                                    comment=f"repair: does `{g}` imply `{h}`?").status == "proved"
+    todo, order = sorted(guards, key=lambda g: "exists(" in g or "forall(" in g), []
+    while todo:
+        # the first guard no remaining guard is strictly weaker than
+        pick = next((g for g in todo if not any(implies[(g, h)] and not implies[(h, g)] for h in todo if h != g)),
+                    todo[0])
+        order.append(pick)
+        todo.remove(pick)
+    equiv = {g: [h for h in guards if h != g and implies[(g, h)] and implies[(h, g)]] for g in guards}
+    return order, equiv
+
+
 def guard_repair(ws: Any, node: str, culprit: int, victims: Sequence[tuple[int, int | None]],
                  before: Mapping[str, str]) -> dict[str, Any] | None:
     """A guard for guarantee ``culprit`` of ``node`` under which each
@@ -74,7 +198,14 @@ def guard_repair(ws: Any, node: str, culprit: int, victims: Sequence[tuple[int, 
     first NATURAL variable where it was vacuous, or ``None`` -- can fire and
     the contract is consistent, or ``None`` when no candidate passes Z3.
     ``before`` is the node's health ``{finding id: status}`` before the edit
-    (for the cost, which re-runs every health check of the node)."""
+    (for the cost, which re-runs every health check of the node).
+
+    Candidates, in the order tried (docs/diagnosis.md, "Guard"): first the
+    range restrictions of the guarantee's numeric bound variables
+    (:func:`range_guards`), weakest first under the environment facts
+    (:func:`_weakest_first`); then conjunctions of the atoms of the node's
+    other premises on the guarantee's bound variables, fewest atoms first.
+    The first candidate Z3 accepts is returned."""
     cn = ws.checked.nodes[node]
     gs = cn.node.guarantees
     if not 1 <= culprit <= len(gs):
@@ -100,41 +231,75 @@ def guard_repair(ws: Any, node: str, culprit: int, victims: Sequence[tuple[int, 
     # atoms on the variables the guarantee binds and never uses first (the lint's hint)
     unused = {v for v in bound if v not in used}
     atoms.sort(key=lambda t: not any(re.search(rf"(?<![\w']){re.escape(v)}(?![\w'])", t) for v in unused))
+    numeric = _numeric_vars(ws, cn, gs[culprit - 1].formula)
+    ranged_why = dict(range_guards(premise, list(numeric), [f.expr for f in ws.plan.facts.get(node, ())]))
+    ranged, equiv = _weakest_first(ws, node, list(ranged_why), numeric)
     loc = premise.loc
     if not loc.end_line:
         return None
     rel = loc.file
     source = recheck.source_text(ws, rel)
     old = Edit(rel, loc.line, loc.col, loc.end_line, loc.end_col, "").deleted(source)
-    tried = 0
+    candidates: list[tuple[str, str]] = [(g, "range") for g in ranged]
     for size in range(1, min(MAX_GUARD_ATOMS, len(atoms)) + 1):
-        for combo in itertools.combinations(atoms, size):
-            if tried >= MAX_CANDIDATES:
-                return None
-            tried += 1
-            guard = " and ".join(combo)
-            edit = Edit(rel, loc.line, loc.col, loc.end_line, loc.end_col, f"{guard} and ({old})")
-            system = recheck.edited_system(ws, edit)
-            if system is None:
-                continue
-            checked, _ = system
-            if any(recheck.premise_fires(ws, checked, node, k, at) != "sat" for k, at in victims):
-                continue
-            if recheck.consistent(ws, checked, node) != "sat":
-                continue
-            after = recheck.health(ws, checked, node, {k: at for k, at in victims if at is not None})
-            checks = [{"check": f"{node}.contract-consistent", "status": "consistent (Z3: sat, witness found)"}]
-            checks += [{"check": f"{node}.g{k}.non-vacuous" + (f" at {at}" if at is not None else ""),
-                        "status": "can fire (Z3: sat, witness found)"} for k, at in victims]
-            fired = ", ".join(f"guarantee {k}" + (f" (at the instance {at} where it was vacuous)" if at is not None else "")
-                              for k, at in victims)
-            summary = (f"Guard guarantee {culprit} of {node} with `{guard}`: Z3 found witnesses that the guarded "
-                       f"contract is consistent" + (f" and that {fired} can fire" if victims else "")
-                       + f"; no guard of fewer atoms among the {len(atoms)} candidate atoms passed.")
-            # compared with the stage's own statuses: the checks asked again (not the replacement check)
-            return _record("guard", summary, edit, source, checks,
-                           recheck.changes({k: v for k, v in before.items() if k in after or ".g" in k}, after))
+        candidates += [(" and ".join(combo), "atoms") for combo in itertools.combinations(atoms, size)]
+    for guard, how in candidates[:MAX_CANDIDATES]:
+        edit = Edit(rel, loc.line, loc.col, loc.end_line, loc.end_col, f"{guard} and ({old})")
+        system = recheck.edited_system(ws, edit)
+        if system is None:
+            continue
+        checked, _ = system
+        fired = {}
+        for k, at in victims:
+            fired[f"{node}.g{k}.non-vacuous"] = recheck.premise_fires(ws, checked, node, k, at)
+            if fired[f"{node}.g{k}.non-vacuous"] != "sat":
+                break
+        if any(v != "sat" for v in fired.values()):
+            continue
+        if recheck.consistent(ws, checked, node) != "sat":
+            continue
+        # the checks just answered are not asked again
+        known = {**{k: "ok" for k in fired}, f"{node}.contract-consistent": "ok"}
+        after = recheck.health(ws, checked, node, {k: at for k, at in victims if at is not None}, known=known)
+        checks = [{"check": f"{node}.contract-consistent", "status": "consistent (Z3: sat, witness found)"}]
+        checks += [{"check": f"{node}.g{k}.non-vacuous" + (f" at {at}" if at is not None else ""),
+                    "status": "can fire (Z3: sat, witness found)"} for k, at in victims]
+        fired_text = ", ".join(f"guarantee {k}" + (f" (at the instance {at} where it was vacuous)" if at is not None else "")
+                               for k, at in victims)
+        if how == "range":
+            same = equiv.get(guard, [])
+            why = (f"restricts {_and_text([f'`{v}`' for v in numeric])}: it {ranged_why[guard]}"
+                   + (f"; Z3 proved it the same as `{'`, `'.join(same)}` under the environment facts" if same else "")
+                   + "; no weaker range restriction passed")
+        else:
+            why = f"no guard of fewer atoms among the {len(atoms)} candidate atoms passed"
+        summary = (f"Guard guarantee {culprit} of {node} with `{guard}`: Z3 found witnesses that the guarded "
+                   f"contract is consistent" + (f" and that {fired_text} can fire" if victims else "")
+                   + f"; the guard {why}.")
+        # compared with the stage's own statuses: the checks asked again (not the replacement check)
+        return _record("guard", summary, edit, source, checks,
+                       recheck.changes({k: v for k, v in before.items() if k in after or ".g" in k}, after))
     return None
+
+
+def _and_text(xs: Sequence[str]) -> str:
+    return xs[0] if len(xs) == 1 else ", ".join(xs[:-1]) + " and " + xs[-1]
+
+
+def _numeric_vars(ws: Any, cn: Any, formula: ast.Expr) -> dict[str, str]:
+    """``{name: "NATURAL" | "INTEGER"}`` of the outer ``forall``'s bound
+    variables of those types, in binding order."""
+    from ..rcl.typecheck import domain_type
+    from ..rcl.types import Scalar
+    out: dict[str, str] = {}
+    e = formula
+    while isinstance(e, ast.Quant) and e.kind == "forall":
+        for b in e.bindings:
+            t = domain_type(b, cn, ws.checked.env)
+            if isinstance(t, Scalar) and t.name in ("NATURAL", "INTEGER"):
+                out.update({v: t.name for v in b.names})
+        e = e.body
+    return out
 
 
 def _link_pairs(sc: Mapping[str, Any]) -> list[tuple[str, str, str, str]]:

@@ -98,11 +98,11 @@ class _NodeHealth:
         return out
 
     def sat(self, extra: Sequence[tuple[str, z3.BoolRef]], *, guarantees: bool = True, comment: str = "",
-            timeout_ms: int | None = None) -> QueryResult:
+            timeout_ms: int | None = None, retry: bool | None = None) -> QueryResult:
         labelled = list(self.assume) + (list(self.guars) + list(self.facts) + list(self.lemmas) if guarantees else [])
         # per-instance queries (own timeout) are not retried: the instance scan is their fallback
         return satisfiable(labelled + list(extra), self.enc, timeout_ms=timeout_ms or self.timeout, comment=comment,
-                           retry=timeout_ms is None)
+                           retry=timeout_ms is None if retry is None else retry)
 
     def premise(self, k: int, fixed: dict[str, int] | None = None) -> tuple[list[tuple[str, z3.BoolRef]], str] | None:
         g = self.node.node.guarantees[k - 1]
@@ -196,7 +196,10 @@ def _non_vacuity(h: _NodeHealth, n: str, k: int) -> Finding | None:
     if prem is None:
         return None  # not forall ... (premise -> conclusion): no premise to examine
     extra, ptext = prem
-    r = h.sat(extra, comment=f"health {n}: can the premise of guarantee {k} hold? {ptext}")
+    # with an instance range the scan is the fallback of an undecided general query, so the retries of
+    # logic/retry.py are not tried first (the Agent's guarantee 1: 4 CPU s of retries that all give up)
+    scan = bool(h.instances and h.natural_vars(k))
+    r = h.sat(extra, comment=f"health {n}: can the premise of guarantee {k} hold? {ptext}", retry=not scan)
     return _noted(replace(_premise_finding(h, n, k, r, ptext), smt2=r.smt2), r)
 
 

@@ -143,6 +143,7 @@ class InputSpace:
     cache: dict[tuple[Type, int, bool], st.SearchStrategy[Any]] = field(default_factory=dict)
     seed: Mapping[str, Any] | None = None  # a Z3 model of the assumption and facts (.seeding)
     node_arg_types: dict[int, tuple[Type, ...]] = field(default_factory=dict)
+    point_cache: dict[tuple[Type, ...], st.SearchStrategy[tuple[Any, ...]]] = field(default_factory=dict)
 
     def real(self, bd: Bound | None, small: bool = False) -> st.SearchStrategy[Any]:
         lo = float(bd.lo) if bd and bd.lo is not None else (-1000.0 if small else None)
@@ -229,6 +230,12 @@ class InputSpace:
             return FiniteFunction(table, draw(self.value(t.result, small=True)), len(t.args))
         return draw_fn()
 
+    def points(self, args: tuple[Type, ...]) -> st.SearchStrategy[tuple[Any, ...]]:
+        """Argument tuples of a function over ``args`` (full-size values), built once."""
+        if args not in self.point_cache:
+            self.point_cache[args] = st.tuples(*[self.value(a) for a in args])
+        return self.point_cache[args]
+
     def inputs(self) -> st.SearchStrategy[dict[str, Any]]:
         """One example: qualified input name -> value."""
         @st.composite
@@ -254,14 +261,17 @@ class InputSpace:
         the model's result.  The harness's filter checks the facts again."""
         arity = base.arity
         args = self.node_arg_types.get(arity)
+        # the strategy of a new point is built once, not per key and example (building one costs
+        # more than drawing from it)
+        point = self.points(args) if args is not None else None
         table: dict[tuple[Any, ...], Any] = {}
         for key, res in base.table.items():
             choice = draw(_MOVE)
             moved = key
             if choice == 1 and pool:
                 moved = draw(st.sampled_from(pool))
-            elif choice == 2 and args is not None:
-                moved = draw(st.tuples(*[self.value(a) for a in args]))
+            elif choice == 2 and point is not None:
+                moved = draw(point)
             table[moved if moved not in table and moved not in base.table else key] = res
         for key, res in drawn.table.items():
             if key not in table or draw(_BOOLS):

@@ -1,0 +1,40 @@
+"""The fast renderer of Z3 model terms (logic/encode.term_to_rcl) gives the
+same text as the tree walk it replaces, on random terms shaped like Z3's
+function-table ``else`` branches (chains of ``if`` sharing conditions)."""
+from __future__ import annotations
+
+import random
+
+import z3
+
+from rclverify.logic.encode import _term_to_rcl_reference, term_to_rcl
+
+
+def _random_term(rng: random.Random, depth: int, p1: z3.ArithRef, p2: z3.ArithRef, shared: list[z3.BoolRef]) -> z3.ExprRef:
+    if depth == 0:
+        return rng.choice([z3.IntVal(rng.randint(-3, 60)), z3.RealVal(f"{rng.randint(-9, 9)}/{rng.randint(1, 7)}"),
+                           z3.ToReal(p1) + 1, p2])
+    cond = rng.choice(shared) if shared and rng.random() < 0.5 else z3.And(
+        p2 == rng.randint(0, 5), z3.Not(p1 == rng.randint(0, 50)), z3.Distinct(p1, p2 + 1))
+    shared.append(cond)
+    other = _random_term(rng, depth - 1, p1, p2, shared)
+    leaf = rng.choice([z3.IntVal(rng.randint(0, 12)), p1 * 2 - p2, z3.If(z3.Or(p1 < 3, p2 >= 1), p1, p2)])
+    return z3.If(cond, leaf, other)
+
+
+def test_fast_render_matches_the_tree_walk() -> None:
+    rng = random.Random(7)
+    p1, p2 = z3.Ints("p1 p2")
+    for _ in range(15):
+        t = _random_term(rng, rng.randint(0, 40), p1, p2, [])
+        assert term_to_rcl(t) == _term_to_rcl_reference(t)
+
+
+def test_deep_chain_beyond_the_recursion_limit() -> None:
+    p1 = z3.Int("p1")
+    t: z3.ExprRef = z3.IntVal(0)
+    for k in range(1200):
+        t = z3.If(p1 == k, z3.IntVal(k % 13), t)
+    text = term_to_rcl(t)
+    assert text == _term_to_rcl_reference(t)
+    assert text.startswith("(if (p1 == 1199) then 3 else (if (p1 == 1198)")
