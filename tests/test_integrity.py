@@ -100,6 +100,26 @@ def test_report_shows_evidence_of_an_edited_contract_as_stale(verified: Path, tm
     assert "stale" not in {o["status"] for o in _report(ws)["obligations"]}
 
 
+def test_a_check_index_that_does_not_match_its_seal_is_not_believed(verified: Path, tmp_path: Path) -> None:
+    """The report takes the snapshots' hashes from check's index only while the index is sealed and
+    its inputs are the current files; an index edited to list the edited file's new hash is ignored,
+    the snapshots are made again and the edited node's evidence is stale."""
+    from rclverify.cache import file_digest
+    ws = _copy(verified, tmp_path)
+    rcl = ws / "contracts/remote_inspection.rcl"
+    rcl.write_text(rcl.read_text(encoding="utf-8").replace("(250 <= in.r -> out.radiationStatus == red)",
+                                                           "(250 <= in.r -> out.radiationStatus == orange)"),
+                   encoding="utf-8")
+    index = ws / "artifacts/check/index.json"
+    data = json.loads(index.read_text(encoding="utf-8"))
+    data["inputs"]["contracts/remote_inspection.rcl"] = file_digest(rcl)  # claims the new text was checked
+    index.write_text(json.dumps(data, indent=2, sort_keys=True) + "\n", encoding="utf-8")
+    proc = _rclverify(ws, "report")
+    assert proc.returncode == 0, proc.stdout + proc.stderr
+    after = {o["id"]: o["status"] for o in _report(ws)["obligations"]}
+    assert after["RadiationSensor.g1.hoare.radiation_sensor.c4"] == "stale"
+
+
 def test_a_hand_edited_evidence_record_is_not_believed(verified: Path, tmp_path: Path) -> None:
     ws = _copy(verified, tmp_path)
     record = ws / "artifacts/evidence/Navigation.g1.experiment.e0.json"

@@ -20,18 +20,21 @@ Artifact layout (workspace-relative)::
 """
 from __future__ import annotations
 
+import hashlib
+
 import dataclasses
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Sequence
 
 from .evidence.records import Evidence, Obligation
-from .evidence.store import EvidenceStore, atomic_write_text, read_json, write_json, write_obligations
+from .evidence.store import EvidenceStore, atomic_write_text, dumps, read_json, write_json, write_obligations
 from .logic.world import fresh as fresh_z3
 from .rcl.errors import RclError, error
 # The workspace and what is derived from it without a stage live below the report
 # (rclverify.workspace); re-exported here for the stages' callers.
 from .workspace import (PLAN, REPORT_PARTS, TaskIndex, Workspace, current_model_hash, current_snapshot_hashes,  # noqa: F401
-                        node_snapshots, read_artifact, record_provenance, stage_inputs, stale_stages)
+                        node_snapshots, read_artifact, record_provenance, stage_inputs, stale_stages,
+                        write_check_index)
 
 if TYPE_CHECKING:
     from .health.checks import Finding
@@ -51,13 +54,19 @@ def stage_check(ws: Workspace) -> dict[str, Any]:
     texts = ContractTexts(ws)  # each file's lint and each node's RCL text, kept by the file's sha256
     warnings = [w for s in checked.specs for w in texts.lint(s)]
     write_json(ws.path(ws.DIAGNOSTICS), {"warnings": warnings})
+    hashes: dict[str, str] = {}
     for name, snap in node_snapshots(ws, texts).items():
-        write_json(ws.path(ws.snapshot(name)), snap)
+        text = dumps(snap)
+        atomic_write_text(ws.path(ws.snapshot(name)), text)
+        hashes[ws.snapshot(name)] = hashlib.sha256(text.encode("utf-8")).hexdigest()
     try:
         texts.save()
     except OSError:
         pass  # a cache that cannot be written is not written: the texts are made again next time
-    write_json(ws.path(ws.MODEL), model.to_json())
+    text = dumps(model.to_json())
+    atomic_write_text(ws.path(ws.MODEL), text)
+    hashes[ws.MODEL] = hashlib.sha256(text.encode("utf-8")).hexdigest()
+    write_check_index(ws, hashes)  # the report then needs not make every snapshot again
     return {"warnings": warnings}
 
 

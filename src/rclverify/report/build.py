@@ -34,7 +34,7 @@ from .. import __version__
 from ..contract_texts import ContractTexts
 from ..evidence.records import SEVERITY, Obligation, worst
 from ..evidence.store import EvidenceStore
-from ..workspace import Workspace, current_model_hash, current_snapshot_hashes, read_artifact, stale_stages
+from ..workspace import Workspace, current_snapshot_hashes, read_artifact, stale_stages
 from ..system.model import cycles_kept, names_of
 from ..diagnosis.build import diagnose
 from ..diagnosis.text import natural_sorted  # p1 < p2 < p10
@@ -156,7 +156,7 @@ def build_report(ws: Workspace) -> dict[str, Any]:
     # input sha256s, taken once per file: nothing changes while the report is built.  Each node's
     # snapshot is taken from the current contracts and plan, not from artifacts/contracts/, so
     # evidence of another contract text is stale even when no check ran since the edit.
-    hashes: dict[str, str] = {**current_snapshot_hashes(ws, texts), **current_model_hash(ws)}
+    hashes: dict[str, str] = current_snapshot_hashes(ws, texts)  # the model's too
     stale = stale_stages(ws, hashes)  # calculus or health made from another contract text
     for o in obligations:
         ev, altered = store.read(o.id)
