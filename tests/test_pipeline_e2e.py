@@ -202,6 +202,23 @@ def test_second_run_executes_no_task(workspace: Path) -> None:
     assert executed == [], executed
 
 
+def test_the_browser_tests_stored_report_is_this_codes_report(report: dict) -> None:
+    """tests/data/case-study-report.json.gz, from which the browser test renders the case study's
+    page, is the report this code makes: same statuses, problems by root cause and repairs. When
+    this fails, regenerate it from `reports/assurance.json` of `doit verify` in a copy of the
+    repository root (docs/reading-the-report.md)."""
+    import gzip
+    with gzip.open(ROOT / "tests" / "data" / "case-study-report.json.gz", "rt", encoding="utf-8") as f:
+        stored = json.load(f)
+
+    def gist(r: dict) -> object:
+        return ({o["id"]: o["status"] for o in r["obligations"]}, {f["id"]: f["status"] for f in r["findings"]},
+                [(p["key"], sorted(m["id"] for m in p["members"])) for p in r["problems"]],
+                {d["id"]: [x["summary"] for x in d["repairs"]] for d in r["diagnoses"]},
+                [(q["id"], q.get("verdict"), q["status"]) for q in r["requirements"]])
+    assert gist(stored) == gist(report)
+
+
 def test_everything_kept_between_runs_is_in_the_cache_layer(workspace: Path) -> None:
     """One cache layer (issue 25): every file a run keeps under artifacts/cache is in the cache
     layer's format, written by this code, and `rclverify cache` lists each one; only jinja2's own
