@@ -262,6 +262,26 @@ def _literals(e: Any, out: set[Any]) -> None:
         _literals(c, out)
 
 
+def arithmetic(op: str, x: Any, y: Any) -> Any:
+    """``x op y`` for ``op`` in ``+ - * /`` on RCL numbers.  REAL is exact
+    (DESIGN.md: REAL -> Z3 Real): a float operand is taken as the rational
+    it denotes, so no rounding and no overflow to inf.  Raises
+    :class:`Undecided` for a division by zero (RCL leaves it unspecified)."""
+    if type(x) is float:
+        x = Fraction(x)
+    if type(y) is float:
+        y = Fraction(y)
+    if op == "+":
+        return x + y
+    if op == "-":
+        return x - y
+    if op == "*":
+        return x * y
+    if y == 0:
+        raise Undecided("division by zero")
+    return Fraction(x) / Fraction(y)
+
+
 class Evaluator:
     """One evaluation context: the node, its values and the candidate numbers.
 
@@ -400,22 +420,7 @@ class Evaluator:
             return (not self.eval(e.left, b)) or bool(self.eval(e.right, b))
         if op == "<=>":
             return bool(self.eval(e.left, b)) == bool(self.eval(e.right, b))
-        x, y = self.eval(e.left, b), self.eval(e.right, b)
-        # REAL is exact (DESIGN.md: REAL -> Z3 Real): a float operand is taken
-        # as the rational it denotes, so no rounding and no overflow to inf
-        if type(x) is float:
-            x = Fraction(x)
-        if type(y) is float:
-            y = Fraction(y)
-        if op == "+":
-            return x + y
-        if op == "-":
-            return x - y
-        if op == "*":
-            return x * y
-        if y == 0:
-            raise Undecided("division by zero")
-        return Fraction(x) / Fraction(y)
+        return arithmetic(op, self.eval(e.left, b), self.eval(e.right, b))
 
     # -- quantifiers -------------------------------------------------------------
     def domain(self, binding: ast.Binding, name: str, body: ast.Expr, b: Mapping[str, Any],
@@ -953,22 +958,7 @@ def _compile_binary(e: ast.Binary, env: Any, node: CheckedNode) -> _Fn:
     if op == "<=>":
         return lambda ev, b: bool(left(ev, b)) == bool(right(ev, b))
 
-    def arithmetic(ev: Evaluator, b: Mapping[str, Any]) -> Any:
-        x, y = left(ev, b), right(ev, b)
-        if type(x) is float:
-            x = Fraction(x)
-        if type(y) is float:
-            y = Fraction(y)
-        if op == "+":
-            return x + y
-        if op == "-":
-            return x - y
-        if op == "*":
-            return x * y
-        if y == 0:
-            raise Undecided("division by zero")
-        return Fraction(x) / Fraction(y)
-    return arithmetic
+    return lambda ev, b: arithmetic(op, left(ev, b), right(ev, b))
 
 
 #: The most values a guard-bounded INTEGER/NATURAL quantifier is enumerated over.
