@@ -42,7 +42,7 @@ def code_stamp() -> str:
     ``.lark``, ``.json`` and ``.j2`` file) or the Python version does.
     Taken once per process: a run's code does not change under it."""
     pkg = Path(__file__).resolve().parent.parent
-    h = hashlib.sha256(f"3 {sys.version}".encode())
+    h = hashlib.sha256(f"{FORMAT} {sys.version}".encode())
     for p in sorted(pkg.rglob("*")):
         if p.suffix in (".py", ".lark", ".json", ".j2"):
             st = p.stat()

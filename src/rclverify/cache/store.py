@@ -43,7 +43,7 @@ from typing import Any, BinaryIO, Callable, Iterable
 
 from ..evidence.store import atomic_write_bytes
 from .heap import no_collection
-from .keys import FORMAT, Keyer, code_stamp, salt
+from .keys import CACHE_DIR, FORMAT, Keyer, code_stamp, salt
 
 _PROTOCOL = pickle.HIGHEST_PROTOCOL
 
@@ -127,7 +127,8 @@ class Shelf:
         self._used: dict[bytes, Any] = {}
 
     def get(self, k: bytes) -> Any | None:
-        """The entry kept under ``k`` (marked used), or ``None``."""
+        """The entry kept under ``k`` (marked used), or ``None`` (so an entry
+        is never ``None``: wrap a result that may be, e.g. in a 1-tuple)."""
         got = self._used.get(k)
         if got is None:
             got = self._old.get(k)
@@ -224,7 +225,6 @@ def kept_files(root: Path) -> list[dict[str, Any]]:
     "current": whether it was written by this rclverify code}, ...]``,
     sorted by file.  A directory of :class:`Blobs` is one row (its files'
     bytes summed).  Never raises."""
-    from .keys import CACHE_DIR
     base = root / CACHE_DIR
     out: list[dict[str, Any]] = []
     try:
