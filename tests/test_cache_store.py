@@ -115,3 +115,14 @@ def test_rclverify_cache_lists_and_clears(tmp_path: Path) -> None:
                              capture_output=True, text=True, timeout=60)
     assert missing.returncode == 1 and "no such workspace directory" in missing.stderr
     assert "Traceback" not in missing.stderr
+
+
+def test_a_shelf_that_keeps_earlier_entries_is_not_rewritten_when_nothing_changed(tmp_path: Path) -> None:
+    path = tmp_path / "s.pickle"
+    s = Shelf(path, "t", keep=5)
+    for x in "abc":
+        s.put(s.key("e", x), x)
+    assert s.save()
+    again = Shelf(path, "t", keep=5)
+    assert again.get(again.key("e", "a")) == "a"
+    assert not again.save()  # used one, keeps all three: the file already holds them

@@ -168,6 +168,8 @@ class Shelf:
             if len(kept) >= self.keep:
                 break
             kept.setdefault(k, v)
+        if not self._changed and kept.keys() == self._old.keys():
+            return False  # with keep: the same entries as the file holds
         write_stream(self.path, self.kind, self.salt, [kept])
         self._old = kept
         self._changed = False
