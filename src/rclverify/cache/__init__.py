@@ -35,8 +35,8 @@ and the versions of the programs whose output is kept.  Deleting
 :mod:`.heap` decides when Python's collector looks at what a run keeps
 live; :mod:`.memo` keeps one result per function for a report run.
 """
-from .keys import CACHE_DIR, Keyer, code_stamp, file_digest, fingerprint, key, salt
+from .keys import CACHE_DIR, Keyer, code_stamp, file_digest, fingerprint, salt
 from .store import Blobs, Shelf, kept_files, read_stream, write_stream
 
-__all__ = ["CACHE_DIR", "Blobs", "Keyer", "Shelf", "code_stamp", "file_digest", "fingerprint", "key",
+__all__ = ["CACHE_DIR", "Blobs", "Keyer", "Shelf", "code_stamp", "file_digest", "fingerprint",
            "kept_files", "read_stream", "salt", "write_stream"]

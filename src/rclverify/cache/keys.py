@@ -11,7 +11,7 @@ A kept result is found only under the key of what it was computed from
 * the **content** of its inputs: sha256 of files (:func:`file_digest`) or
   the :func:`fingerprint` of the data it is rendered from.
 
-:func:`key` hashes the two together.  Equal keys therefore mean equal
+:class:`Keyer` hashes the two together.  Equal keys therefore mean equal
 inputs under equal code, and there is no other invalidation to get wrong:
 an entry whose inputs changed is simply never looked up again, and the
 store drops it at its next save (:mod:`rclverify.cache.store`).
@@ -24,7 +24,7 @@ import marshal
 import sys
 from functools import lru_cache
 from pathlib import Path
-from typing import Any, Iterable
+from typing import Any
 
 #: Where every kept file lives, relative to the workspace root.  Deleting it
 #: is always safe: each entry is a pure speed-up.
@@ -86,9 +86,10 @@ def file_digest(path: Path | str) -> str:
 
 
 class Keyer:
-    """:func:`key` for one salt, with the salt and each part-kind hashed once
-    (a report keys tens of thousands of pieces: hashing the salt again for
-    each cost more than the lookups)."""
+    """The keying function for one salt (:func:`salt`): the sha256 of the
+    salt, a sub-kind and the entry's input contents, with the salt and each
+    sub-kind hashed once (a report keys tens of thousands of pieces: hashing
+    the salt again for each cost more than the lookups)."""
 
     def __init__(self, salt_hex: str) -> None:
         self.salt = salt_hex
@@ -107,9 +108,3 @@ class Keyer:
             h.update(len(b).to_bytes(8, "little"))
             h.update(b)
         return h.digest()
-
-
-def key(kind: str, part: str, contents: Iterable[bytes | str], versions: tuple[str, ...] = ()) -> bytes:
-    """The key of an entry of ``kind`` (sub-kind ``part``) computed from
-    ``contents`` under the current code: ``Keyer(salt(kind, versions))(part, *contents)``."""
-    return Keyer(salt(kind, versions))(part, *contents)
