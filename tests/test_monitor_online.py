@@ -219,6 +219,35 @@ def test_a_full_queue_drops_and_counts_instead_of_growing(case_study: tuple[Any,
     assert worker.handled == 5 and live.stop()["events"] == 5
 
 
+def test_the_evidence_of_a_run_that_dropped_messages_or_lost_its_engine_is_not_discharged(
+        case_study: tuple[Any, Any], tmp_path: Path) -> None:
+    """stop_and_record (both ROS layers): verdicts that miss dropped messages prove nothing, so no node
+    reads discharged or pending; an engine that died makes every node error, with the reason."""
+    from rclverify.backends.monitors.live import LiveRun, stop_and_record
+    from rclverify.backends.monitors.worker import EngineWorker
+    checked, cfg = case_study
+    lines: list[str] = []
+
+    def run(decode: Any) -> dict[str, Any]:
+        live = LiveRun(checked, list(checked.nodes.values()), cfg.rules, cfg.horizon, tmp_path / "x.jsonl")
+        worker = EngineWorker(live, decode, lambda: 1.0, max_queue=2)
+        for k in range(4):
+            worker.offer("r", {"value": 1.0}, k * 0.1)
+        worker.start()
+        return stop_and_record(worker, live, None, lines.append)
+    dropped = run(lambda topic, fields: fields)
+    assert dropped["dropped_messages"] == 2 and dropped["backlog_max"] >= 2
+    assert {n["status"] for n in dropped["nodes"]} <= {"inconclusive", "failed"}
+    assert any("dropped" in n.get("explanation", "") for n in dropped["nodes"])
+
+    def broken(topic: str, payload: Any) -> Any:
+        raise RuntimeError("decoder bug")
+    died = run(broken)
+    assert died["engine_error"] == "RuntimeError: decoder bug"
+    assert {n["status"] for n in died["nodes"]} == {"error"}
+    assert any("verdict engine stopped" in line for line in lines)
+
+
 def test_verdict_connections_get_tcp_nodelay() -> None:
     """The verdict publisher's subscriber sockets (rospy keeps them as
     ``impl.connections[*].socket``) get TCP_NODELAY; anything else is left alone."""
