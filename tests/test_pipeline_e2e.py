@@ -202,6 +202,14 @@ def test_second_run_executes_no_task(workspace: Path) -> None:
     assert executed == [], executed
 
 
+def test_a_run_with_nothing_to_do_still_prints_the_status_and_the_problems_by_root_cause(workspace: Path) -> None:
+    r = _doit(workspace, "verify")
+    assert r.returncode == 0
+    assert "overall: failed" in r.stdout and "5 problems by root cause (13 findings)" in r.stdout, r.stdout
+    assert "1. [failed] guarantee 3 of Agent (contracts/remote_inspection.rcl:72:3): 7 findings" in r.stdout
+    assert "| Agent " in r.stdout and "report: reports/assurance.html" in r.stdout
+
+
 def test_the_browser_tests_stored_report_is_this_codes_report(report: dict) -> None:
     """tests/data/case-study-report.json.gz, from which the browser test renders the case study's
     page, is the report this code makes: same statuses, problems by root cause and repairs. When

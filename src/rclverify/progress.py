@@ -19,6 +19,7 @@ import io
 import os
 import sys
 import time
+from pathlib import Path
 from typing import Any, Mapping
 
 from typing import TYPE_CHECKING
@@ -101,6 +102,9 @@ class ProgressReporter(ConsoleReporter):  # type: ignore[misc]
         self.done: set[str] = set()
         self.started = time.monotonic()
         self.live: Live | None = None
+        #: The workspace root of a ``verify`` task doit found up to date: its
+        #: action (the status and summary) did not run, so :meth:`complete_run` prints them.
+        self.verify_root: str | None = None
 
     # -- doit reporter interface -------------------------------------------------
     def write(self, text: str) -> None:
@@ -152,6 +156,8 @@ class ProgressReporter(ConsoleReporter):  # type: ignore[misc]
         super().add_failure(task, fail)
 
     def skip_uptodate(self, task: Any) -> None:
+        if task.name == "verify" and task.actions and getattr(task.actions[0], "args", None):
+            self.verify_root = str(task.actions[0].args[0])
         if not self.live_mode:
             super().skip_uptodate(task)
             return
@@ -168,6 +174,12 @@ class ProgressReporter(ConsoleReporter):  # type: ignore[misc]
             self.live.stop()
             self.live = None
         super().complete_run()
+        if self.verify_root is not None:  # nothing had to run: the last run's status all the same
+            from .report.summary import print_last_run
+            try:
+                print_last_run(Path(self.verify_root))
+            except (OSError, ValueError):
+                pass  # no report to show (verify is up to date only after one was written)
         from .cache.heap import freeze_at_exit, release_after_run
         from .runlock import release
         release()  # the workspace's run lock (rclverify.runlock): the next run may start

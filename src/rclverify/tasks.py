@@ -273,33 +273,15 @@ def ros_fingerprint(root: Path, ros: Mapping[str, Any]) -> list[tuple[str, int, 
 
 
 def act_verify(root: str, strict: bool) -> Any:
-    from .report.summary import print_summary, summary_data
-    try:  # written by the report's html part with assurance.json
-        data = json.loads((Path(root) / Workspace.SUMMARY).read_text(encoding="utf-8"))
-    except (OSError, ValueError):
-        data = summary_data(json.loads((Path(root) / REPORTS[2]).read_text(encoding="utf-8")))
-    from .diagnosis.text import status_lines
-    print("\n".join(status_lines(data)))
-    if data.get("requirements"):
-        print(requirements_line(data["requirements"]))
-    print_summary(data, "reports/assurance.html", rows=data["rows"])
+    """The ``verify`` task: print the run's status, problems and summary table
+    (:func:`rclverify.report.summary.print_last_run`); with ``strict``, fail
+    unless every item holds."""
+    from .report.summary import print_last_run
+    data = print_last_run(Path(root))
     if strict and not data["meta"]["strict_ok"]:
         return TaskFailed("--strict: some evidence is failed, inconclusive, pending, stale or error, or a side condition "
                           "or contract health check is not proved (see reports/assurance.html)")
     return None
-
-
-def requirements_line(rows: Sequence[Sequence[str]]) -> str:
-    """``requirements: 1 met, 1 refuted (STOP), 1 informal`` from the summary's
-    ``[id, verdict, status]`` rows (docs/requirements.md), verdicts in order of
-    first appearance; the ids of those that are not met, informal or
-    outstanding are named."""
-    by: dict[str, list[str]] = {}
-    for rid, verdict, _ in rows:
-        by.setdefault(verdict or "traced", []).append(rid)
-    named = ("refuted", "proved from an inconsistency", "proved vacuously", "inconclusive")
-    return "requirements: " + ", ".join(f"{len(ids)} {v}" + (f" ({', '.join(ids[:5])}{', ...' if len(ids) > 5 else ''})"
-                                                            if v in named else "") for v, ids in by.items())
 
 
 class RecordIntact:

@@ -9,7 +9,8 @@ tables.  On a terminal the table has colours; otherwise it is plain ASCII
 from __future__ import annotations
 
 import sys
-from typing import IO, TYPE_CHECKING, Any, Mapping
+from pathlib import Path
+from typing import IO, TYPE_CHECKING, Any, Mapping, Sequence
 
 if TYPE_CHECKING:  # rich is imported where a table is drawn: doit imports this module on every run
     from rich.table import Table
@@ -151,3 +152,39 @@ def print_summary(report: Mapping[str, Any], report_path: str, file: IO[str] | N
                       width=None if tty else 120, soft_wrap=False)
     console.print(summary_table(report, tty, rows))
     console.print(f"report: {report_path}", markup=False)
+
+
+def requirements_line(rows: Sequence[Sequence[str]]) -> str:
+    """``requirements: 1 met, 1 refuted (STOP), 1 informal`` from the summary's
+    ``[id, verdict, status]`` rows (docs/requirements.md), verdicts in order of
+    first appearance; the ids of those that are not met, informal or
+    outstanding are named."""
+    by: dict[str, list[str]] = {}
+    for rid, verdict, _ in rows:
+        by.setdefault(verdict or "traced", []).append(rid)
+    named = ("refuted", "proved from an inconsistency", "proved vacuously", "inconclusive")
+    return "requirements: " + ", ".join(f"{len(ids)} {v}" + (f" ({', '.join(ids[:5])}{', ...' if len(ids) > 5 else ''})"
+                                                            if v in named else "") for v, ids in by.items())
+
+
+def print_last_run(root: Path) -> dict[str, Any]:
+    """Print what ``doit verify`` ends with, from the last run's files in the
+    workspace ``root``: the overall line and the problems by root cause
+    (:func:`rclverify.diagnosis.text.status_lines`), the requirements line
+    and the summary table.  Read from ``artifacts/report/summary.json``
+    (written with the report), else from ``reports/assurance.json``.
+    Returns the summary data (:func:`summary_data`).  Raises ``OSError`` /
+    ``ValueError`` when neither file can be read."""
+    import json
+
+    from ..diagnosis.text import status_lines
+    from ..workspace import Workspace
+    try:
+        data: dict[str, Any] = json.loads((root / Workspace.SUMMARY).read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        data = summary_data(json.loads((root / "reports" / "assurance.json").read_text(encoding="utf-8")))
+    print("\n".join(status_lines(data)))
+    if data.get("requirements"):
+        print(requirements_line(data["requirements"]))
+    print_summary(data, "reports/assurance.html", rows=data["rows"])
+    return data
