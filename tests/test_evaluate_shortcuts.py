@@ -52,12 +52,30 @@ VALUES = {"in.r": 2.0, "in.f": FiniteFunction({(1,): True, (2,): False}, False, 
     ("exists(k in NATURAL | exists(x, y in REAL | in.g(x, y) == k and in.f(k) == TRUE))", True),
     ("forall(k in NATURAL | exists(x, y in REAL | in.g(x, y) == k and in.f(k) == FALSE))", False),
     ("exists(x, y in REAL | out.ocmd == move(x, y) and in.g(x, y) == 1)", True),
+    # a slot guarded by f(slot) == t, t's value not f's default: only the table keys with that
+    # result are tried, so a body that uses the variable any way (n * n) is decided
+    ("exists(n in NATURAL | in.f(n) == TRUE and n * n == 1)", True),
+    ("exists(n in NATURAL | in.f(n) == TRUE and n * n == 4)", False),
+    ("forall(x, y in REAL | in.g(x, y) == 2 -> x * y == 6.0)", True),
+    ("forall(x, y in REAL | in.g(x, y) == 1 -> x < y)", False),
+    ("forall(k in NATURAL | k <= 2 -> exists(x, y in REAL | in.g(x, y) == k))", True),
+    ("forall(k in NATURAL | k <= 3 -> exists(x, y in REAL | in.g(x, y) == k))", False),
 ])
 def test_shortcut_answers_agree_with_z3(text: str, expected: bool) -> None:
     f = parse_formula(text)
     assert evaluate(f, CHECKED, NODE, VALUES) is expected, why_undecided(f, CHECKED, NODE, VALUES)
     z3_answer, reason = check_concrete(f, CHECKED, NODE, VALUES)
     assert z3_answer in (None, expected), reason
+
+
+def test_a_guard_that_the_default_meets_leaves_the_slot_to_its_domain() -> None:
+    """``in.f(n) == FALSE`` holds at every point outside f's table (its
+    default is FALSE), so the guard cannot narrow ``n`` to table keys; with
+    ``n * n`` in the body the quantifier is left to Z3."""
+    f = parse_formula("exists(n in NATURAL | in.f(n) == FALSE and n * n == 9)")
+    assert evaluate(f, CHECKED, NODE, VALUES) is None
+    assert "n" in why_undecided(f, CHECKED, NODE, VALUES)
+    assert check_concrete(f, CHECKED, NODE, VALUES)[0] is True
 
 
 # -- the compiled closures against the tree walk ----------------------------------------------

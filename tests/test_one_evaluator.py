@@ -137,6 +137,8 @@ def quantified(draw: Draw, scope: Scope, depth: int) -> str:
         return f"{kind}({binding} | in.g({names[0]}, {names[1]}) == {term(draw, 'NATURAL', inner, 0)} {glue} {body})"
     if guard == 2:  # the pair fixed by a constructor term, as the Agent's `out.command == move(x, y)`
         return f"{kind}({binding} | move({names[0]}, {names[1]}) == {term(draw, 'Cmd', scope, 1)} {glue} {body})"
+    if sort == "NATURAL" and draw(st.integers(0, 3)) == 0:  # a guard f(v) == t (the preimage of t)
+        return f"{kind}({binding} | in.f({names[0]}) == {term(draw, 'BOOL', scope, 1)} {glue} {body})"
     if sort in ("NATURAL", "INTEGER") and draw(st.booleans()):  # a literal bound on the variable
         lo = "" if sort == "NATURAL" else f"{names[0]} >= (0 - 2) and "
         return f"{kind}({binding} | {lo}{names[0]} <= {draw(st.integers(0, 4))} {glue} {body})"

@@ -17,6 +17,11 @@ Quantifiers are decided by enumeration:
   value in the range (at most :data:`MAX_RANGE`);
 * a variable (or a pair ``x, y``) fixed by an equality guard ``v == t`` or
   ``move(x, y) == t`` (``t`` free of it): only the value of ``t``;
+* a variable (or a tuple ``x, y``) guarded by ``f(x, y) == t`` (``f`` a
+  function value given as a finite table, ``t`` free of them) when ``t``'s
+  value is not ``f``'s default: only the table's keys with that result (every
+  other point gives the default, which fails the guard), whatever else the
+  body does with the variables;
 * over ``REAL``/``INTEGER``/``NATURAL`` otherwise: exactly, when the bound
   variable occurs only as an argument of a function or of a constructor, or
   as an operand of ``==``/``!=`` (possibly shifted by a literal, ``i + 1``)
@@ -601,6 +606,11 @@ class Evaluator:
         """
         bindings = {n: bd for bd in e.bindings for n in bd.names}
         group = self._joint(e, b, bindings)
+        if group is None and e.kind in ("forall", "exists"):
+            names = _preimage_group(e, bindings, self.env.ctors)
+            if names is not None:  # enumerable only through its guard's preimage (_search)
+                group = (names, _NoDomain(f"{', '.join(names)} are used outside function arguments and "
+                                          f"their guard's value is the function's default"))  # type: ignore[assignment]
         slots: list[tuple[str, ...]] = []
         for n in e.variables:
             if group and n in group[0]:
@@ -617,7 +627,7 @@ class Evaluator:
                 doms.append(group[1])
                 continue
             n = names[0]
-            if pin is not None and pin.ctor is None:
+            if isinstance(pin, _Pin) and pin.ctor is None:
                 doms.append(_NoDomain("pinned by an equality guard"))  # type: ignore[arg-type]
                 continue
             if e.kind in ("forall", "exists") and _unused(e, n, bindings[n]):
@@ -663,7 +673,13 @@ class Evaluator:
         names = slots[depth]
         pin = pins[depth] if pins is not None else None
         dom: Any = doms[depth]
-        if pin is not None and not (pin.ctor is not None and pin.ctor in cur):
+        if isinstance(pin, _Preimage):
+            keys = pin.keys(self, cur)
+            if keys is not None:
+                dom = keys
+            elif isinstance(dom, _NoDomain):
+                raise Undecided(dom.reason)
+        elif pin is not None and not (pin.ctor is not None and pin.ctor in cur):
             dom = pin.values(self.eval(pin.term, cur))
         elif isinstance(dom, _NoDomain):
             raise Undecided(dom.reason)
@@ -713,6 +729,43 @@ def _joint_groups(e: ast.Quant, bindings: Mapping[str, ast.Binding], ctors: Any,
             out.append((group, kinds, uses, literal_keys))
     _STATIC[key] = (e, out)
     return out
+
+
+def _preimage_group(e: ast.Quant, bindings: Mapping[str, ast.Binding], ctors: Any) -> tuple[str, ...] | None:
+    """Two or more variables of ``forall``/``exists`` ``e`` that a guard
+    ``f(v1, ..., vk) == t`` names as the whole argument list of a function
+    (not a constructor; ``t`` free of them; each over REAL, INTEGER or
+    NATURAL): one slot, enumerated through that guard's preimage
+    (:class:`_Preimage`).  Memoised per AST node."""
+    key = (id(e), "", "preimage")
+    hit = _STATIC.get(key)
+    if hit is not None and hit[0] is e:
+        return cast("tuple[str, ...] | None", hit[1])
+    if e.kind == "forall" and isinstance(e.body, ast.Binary) and e.body.op == "->":
+        guards = _conjuncts(e.body.left)
+    else:
+        guards = _conjuncts(e.body) if e.kind == "exists" else []
+    found: tuple[str, ...] | None = None
+    for g in guards:
+        if found is not None or not isinstance(g, ast.Compare) or tuple(g.ops) != ("==",):
+            continue
+        for side, other in (tuple(g.operands), tuple(reversed(g.operands))):
+            if not (isinstance(side, ast.Apply) and len(side.args) >= 2
+                    and not (side.func.prefix is None and (side.func.name in ctors or side.func.name in bindings))
+                    and all(isinstance(a, ast.Var) and a.prefix is None and a.name in bindings for a in side.args)):
+                continue
+            names = tuple(cast(ast.Var, a).name for a in side.args)
+            if len(set(names)) != len(names) or not all(
+                    isinstance(bindings[n].domain, ast.TBase) and cast(ast.TBase, bindings[n].domain).name in _INFINITE
+                    for n in names):
+                continue
+            used: set[str] = set()
+            _free(other, set(names), used)
+            if not used:
+                found = names
+                break
+    _STATIC[key] = (e, found)
+    return found
 
 
 def _unused(e: ast.Quant, name: str, binding: ast.Binding) -> bool:
@@ -853,7 +906,57 @@ def _pin(guards: list[Any], names: tuple[str, ...], bindings: Mapping[str, ast.B
             _free(other, set(names), used)
             if not used:
                 return _Pin(other, ctor, tuple(kinds))
+    for g in guards:
+        if not isinstance(g, ast.Compare) or tuple(g.ops) != ("==",):
+            continue
+        left, right = g.operands
+        for side, other in ((left, right), (right, left)):
+            if (isinstance(side, ast.Apply) and not (side.func.prefix is None and side.func.name in ctors)
+                    and not (side.func.prefix is None and side.func.name in names)
+                    and len(side.args) == len(names)
+                    and all(isinstance(a, ast.Var) and a.prefix is None and a.name == n
+                            for a, n in zip(side.args, names))):
+                used = set()
+                _free(other, set(names), used)
+                if not used:
+                    return _Preimage(side.func, other, tuple(kinds))
     return None
+
+
+class _Preimage:
+    """A guard ``f(n1, ..., nk) == t`` (``f`` a function value, the slot's
+    variables in order, ``t`` free of them): when ``f`` is a finite table
+    whose default differs from ``t``'s value, only the table's keys with that
+    result pass the guard, so only they are enumerated (``Evaluator._search``);
+    otherwise the slot's own candidates are."""
+
+    __slots__ = ("func", "term", "kinds")
+    ctor = None
+
+    def __init__(self, func: ast.Var, term: Any, kinds: tuple[str, ...]) -> None:
+        self.func, self.term, self.kinds = func, term, kinds
+
+    def keys(self, ev: "Evaluator", cur: Mapping[str, Any]) -> list[tuple[Any, ...]] | None:
+        """The slot's candidate tuples under ``cur``, or None (use its domain)."""
+        f = ev.var(self.func, cur)
+        if not isinstance(f, FiniteFunction) or f.arity != len(self.kinds):
+            return None
+        v = ev.eval(self.term, cur)
+        if f.default == v:
+            return None
+        out = []
+        for key, r in f.table.items():
+            if r != v:
+                continue
+            fitted = []
+            for a, kind in zip(key, self.kinds):
+                ok, a2 = _fit(a, kind)
+                if not ok:
+                    break
+                fitted.append(a2)
+            else:
+                out.append(tuple(fitted))
+        return out
 
 
 #: Compiled expressions kept (per AST node and I/O node); cleared when full.
