@@ -204,6 +204,7 @@ class GuaranteeRun:
     #: the values, outputs and conjunct of ``last_failure`` (for the Z3 confirmation)
     last_values: tuple[dict[str, Any], dict[str, Any] | None, ast.Expr | None] | None = None
     unknown: set[str] = field(default_factory=set)
+    _used_facts: tuple[ast.Expr, ...] | None = field(default=None, repr=False)
 
     @property
     def stateful(self) -> bool:
@@ -232,8 +233,11 @@ class GuaranteeRun:
 
     @property
     def used_facts(self) -> tuple[ast.Expr, ...]:
-        """The facts inputs are drawn under: those naming no output."""
-        return split_facts(self.facts, self.node)[0]
+        """The facts inputs are drawn under: those naming no output (worked out once:
+        the filter asks for them on every drawn example)."""
+        if self._used_facts is None:
+            self._used_facts = split_facts(self.facts, self.node)[0]
+        return self._used_facts
 
     def facts_text(self) -> str:
         """The facts as RCL text with their plan locations ("" when there are none)."""

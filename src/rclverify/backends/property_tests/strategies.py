@@ -23,7 +23,7 @@ import math
 from functools import partial
 from dataclasses import dataclass, field
 from fractions import Fraction
-from typing import Any, Callable, Mapping
+from typing import Any, Callable, Mapping, cast
 
 from hypothesis import strategies as st
 
@@ -34,8 +34,8 @@ from ...values import FiniteFunction, Term
 SMALL_NAT = 5
 POOL_SIZE = 4
 _POOL_COUNT = st.integers(min_value=1, max_value=POOL_SIZE)
-_BOOLS = st.booleans()
-_MOVE = st.integers(min_value=0, max_value=2)  # keep a seeded key, move it to a pool point, to a new point
+MAX_EDITS = 4
+_EDITS = st.integers(min_value=0, max_value=MAX_EDITS)
 
 
 @dataclass
@@ -142,8 +142,8 @@ class InputSpace:
     pools: dict[tuple[Type, ...], list[tuple[Any, ...]]] = field(default_factory=dict)
     cache: dict[tuple[Type, int, bool], st.SearchStrategy[Any]] = field(default_factory=dict)
     seed: Mapping[str, Any] | None = None  # a Z3 model of the assumption and facts (.seeding)
-    node_arg_types: dict[int, tuple[Type, ...]] = field(default_factory=dict)
-    point_cache: dict[tuple[Type, ...], st.SearchStrategy[tuple[Any, ...]]] = field(default_factory=dict)
+    point_cache: dict[tuple[Any, ...], st.SearchStrategy[tuple[Any, ...]]] = field(default_factory=dict)
+    misc_cache: dict[tuple[Any, ...], Any] = field(default_factory=dict)
 
     def real(self, bd: Bound | None, small: bool = False) -> st.SearchStrategy[Any]:
         lo = float(bd.lo) if bd and bd.lo is not None else (-1000.0 if small else None)
@@ -213,22 +213,59 @@ class InputSpace:
         raise ValueError(f"no strategy for {t}")
 
     def function(self, t: FuncT) -> st.SearchStrategy[FiniteFunction]:
-        points = st.tuples(*[self.value(a, small=True) for a in t.args])
-
         @st.composite
         def draw_fn(draw: Callable[..., Any]) -> FiniteFunction:
-            pool = self.pools.get(t.args)
-            if pool is None:
-                pool = []
-                for _ in range(draw(_POOL_COUNT)):
-                    point = draw(points)
-                    if point not in pool:
-                        pool.append(point)
-                self.pools[t.args] = pool
-            keys = [k for k in pool if draw(_BOOLS)]
-            table = {k: draw(self.value(t.result, small=True)) for k in keys}
-            return FiniteFunction(table, draw(self.value(t.result, small=True)), len(t.args))
+            return self.table(draw, t)
         return draw_fn()
+
+    def table(self, draw: Callable[..., Any], t: FuncT) -> FiniteFunction:
+        """A finite table over ``t``, drawn inside a composite strategy: which
+        points of the example's pool it has (one choice, a bit mask), a small
+        result for each, and a default."""
+        pool = self.pool(draw, t.args)
+        mask = draw(self._index(1 << len(pool)))
+        result = self.value(t.result, small=True)
+        table = {k: draw(result) for j, k in enumerate(pool) if mask >> j & 1}
+        return FiniteFunction(table, draw(result), len(t.args))
+
+    def pool(self, draw: Callable[..., Any], args: tuple[Type, ...]) -> list[tuple[Any, ...]]:
+        """This example's pool of argument tuples over ``args`` (drawn at its
+        first use in the example): 1 to :data:`POOL_SIZE` points, each a key
+        of a seeded table over the same arguments (one choice: which) or a
+        new small point, so functions over one domain (the Agent's ``at`` and
+        ``wayP``) meet."""
+        pool = self.pools.get(args)
+        if pool is None:
+            pool = []
+            seeded = self.seeded_keys(args)
+            pick = self._index(len(seeded) + 1)
+            for _ in range(draw(_POOL_COUNT)):
+                j = draw(pick) if seeded else len(seeded)
+                p = seeded[j] if j < len(seeded) else draw(self.small_points(args))
+                if p not in pool:
+                    pool.append(p)
+            self.pools[args] = pool
+        return pool
+
+    def seeded_keys(self, args: tuple[Type, ...]) -> list[tuple[Any, ...]]:
+        """The keys of the seeded tables over ``args`` (sorted, worked out once)."""
+        key = ("seeded",) + args
+        if key not in self.misc_cache:
+            self.misc_cache[key] = sorted({k for q, base in (self.seed or {}).items()
+                                           if isinstance(base, FiniteFunction) and self._args_of(q) == args
+                                           for k in base.table}, key=repr)
+        return cast("list[tuple[Any, ...]]", self.misc_cache[key])
+
+    def _args_of(self, q: str) -> tuple[Type, ...] | None:
+        t = self.node.inputs.get(q.removeprefix("in."))
+        return t.args if isinstance(t, FuncT) else None
+
+    def small_points(self, args: tuple[Type, ...]) -> st.SearchStrategy[tuple[Any, ...]]:
+        """Argument tuples of small values over ``args``, built once."""
+        key = ("small",) + args
+        if key not in self.point_cache:
+            self.point_cache[key] = st.tuples(*[self.value(a, small=True) for a in args])
+        return self.point_cache[key]
 
     def points(self, args: tuple[Type, ...]) -> st.SearchStrategy[tuple[Any, ...]]:
         """Argument tuples of a function over ``args`` (full-size values), built once."""
@@ -237,46 +274,69 @@ class InputSpace:
         return self.point_cache[args]
 
     def inputs(self) -> st.SearchStrategy[dict[str, Any]]:
-        """One example: qualified input name -> value."""
+        """One example: qualified input name -> value.
+
+        A function-typed input with a seeded table (a Z3 model of the
+        assumption and facts, :mod:`.seeding`) is that table with a few edits
+        (:meth:`vary`), drawn after the other inputs so that its edits may use
+        their pool; every other input is drawn from its type (a function's
+        table by :meth:`table`, without a composite strategy of its own)."""
+        seeded = {q: base for q, base in (self.seed or {}).items()
+                  if isinstance(base, FiniteFunction) and self._args_of(q) is not None}
+
         @st.composite
         def draw_inputs(draw: Callable[..., Any]) -> dict[str, Any]:
             self.pools = {}
-            drawn = {f"in.{n}": draw(self.value(t, self.bounds.get(n))) for n, t in self.node.inputs.items()}
-            if self.seed:
-                for q, base in self.seed.items():
-                    if isinstance(base, FiniteFunction):
-                        t = self.node.inputs[q[3:]]
-                        assert isinstance(t, FuncT)
-                        self.node_arg_types[base.arity] = t.args
-                        drawn[q] = self.vary(draw, base, drawn[q], self.pools.get(t.args, []))
-            return drawn
+            drawn: dict[str, Any] = {}
+            for n, t in self.node.inputs.items():
+                q = f"in.{n}"
+                if q in seeded:
+                    continue
+                drawn[q] = self.table(draw, t) if isinstance(t, FuncT) else draw(self.value(t, self.bounds.get(n)))
+            for q, base in seeded.items():
+                drawn[q] = self.vary(draw, base, cast(FuncT, self.node.inputs[q[3:]]))
+            return {f"in.{n}": drawn[f"in.{n}"] for n in self.node.inputs}
         return draw_inputs()
 
-    def vary(self, draw: Callable[..., Any], base: FiniteFunction, drawn: FiniteFunction,
-             pool: list[tuple[Any, ...]]) -> FiniteFunction:
-        """``base`` (a table from a Z3 model of the facts) varied by Hypothesis: each
-        of its keys may move to a point of this example's pool (so other
-        functions over the same domain meet it) or to a new point; the drawn
-        table's entries are added, each at a seeded key possibly overriding
-        the model's result.  The harness's filter checks the facts again."""
-        arity = base.arity
-        args = self.node_arg_types.get(arity)
-        # the strategy of a new point is built once, not per key and example (building one costs
-        # more than drawing from it)
-        point = self.points(args) if args is not None else None
-        table: dict[tuple[Any, ...], Any] = {}
-        for key, res in base.table.items():
-            choice = draw(_MOVE)
-            moved = key
-            if choice == 1 and pool:
-                moved = draw(st.sampled_from(pool))
-            elif choice == 2 and point is not None:
-                moved = draw(point)
-            table[moved if moved not in table and moved not in base.table else key] = res
-        for key, res in drawn.table.items():
-            if key not in table or draw(_BOOLS):
-                table[key] = res
-        return FiniteFunction(table, base.default, arity)
+    def vary(self, draw: Callable[..., Any], base: FiniteFunction, t: FuncT) -> FiniteFunction:
+        """``base`` (a table from a Z3 model of the facts) with 0 to
+        :data:`MAX_EDITS` edits drawn by Hypothesis, each on one of its
+        entries (which entry and which edit: one choice): move the entry to
+        a point of this example's pool (so other functions over the same
+        domain meet it), move it to a new point, or swap its result with
+        another entry's.  A move onto a key the table already has is
+        skipped.  The edits keep the model's results and default, so facts
+        about which results exist and what they are bounded by still hold
+        (the harness's filter checks every fact again); few choices keep an
+        example cheap (each Hypothesis choice costs about 25 microseconds).
+        Shrinking removes edits, towards the model itself."""
+        table = dict(base.table)
+        if not table:
+            return base
+        where = list(table)
+        pick = self._index(len(where) * 3)
+        for _ in range(draw(_EDITS)):
+            i, kind = divmod(draw(pick), 3)
+            if kind == 2:
+                j = draw(self._index(len(where)))
+                table[where[i]], table[where[j]] = table[where[j]], table[where[i]]
+                continue
+            if kind == 0:
+                pool = self.pool(draw, t.args)
+                moved = pool[draw(self._index(len(pool)))]
+            else:
+                moved = draw(self.points(t.args))
+            if moved not in table:
+                table[moved] = table.pop(where[i])
+                where[i] = moved
+        return FiniteFunction(table, base.default, base.arity)
+
+    def _index(self, n: int) -> st.SearchStrategy[int]:
+        """``0 .. n - 1`` (built once per ``n``)."""
+        key = ("index", n)
+        if key not in self.misc_cache:
+            self.misc_cache[key] = st.integers(min_value=0, max_value=n - 1)
+        return self.misc_cache[key]
 
 
 def input_space(node: CheckedNode, plan_bounds: Mapping[str, tuple[Fraction | None, Fraction | None]],
