@@ -18,6 +18,7 @@ from typing import Any, Mapping
 
 import z3
 
+from ..health.witness import finite_witness as table_witness, points_for
 from ..logic import world
 from ..rcl.errors import RclError
 from ..rcl.parser import parse_text
@@ -26,9 +27,6 @@ from ..rcl.types import Checked
 from ..system.model import SystemModel, build
 from .edits import Edit
 
-#: Points of each function table :func:`finite_witness` gives values (at least the plan's instances).
-WITNESS_POINTS = 4
-WITNESS_TIMEOUT_MS = 5_000
 
 
 def source_text(ws: Any, rel: str) -> str:
@@ -95,48 +93,17 @@ def _health(ws: Any, checked: Checked, node: str) -> Any:
 
 
 def finite_witness(h: Any, extra: list[tuple[str, z3.BoolRef]], points: int) -> str:
-    """Look for a witness of ``h``'s assumption, guarantees and facts and
-    ``extra`` in which every function-typed input is a finite table: its
-    value at the ``points`` points ``(j, 0, ..., 0)`` (``j = 0..points-1``;
-    arguments of REAL, INTEGER or NATURAL type) is a free constant, and one
-    free constant elsewhere.  A model of that is a model of the original
-    query (the functions interpreted as those tables), so ``sat`` is a
-    witness; ``unsat`` only says there is none of this shape and is
-    returned as ``inconclusive``.  Z3 decides these quickly where the
-    general query with uninterpreted functions over the reals is
-    ``unknown`` (the case study's Agent)."""
+    """``"sat"`` when Z3 finds a witness of ``h``'s assumption, guarantees,
+    facts and ``extra`` in which every function-typed input is a finite
+    table of ``points`` points (:func:`rclverify.health.witness.finite_witness`),
+    else ``"inconclusive"`` (no witness of that shape, which is not a proof
+    that there is none)."""
     labelled = list(h.assume) + list(h.guars) + list(h.facts) + list(extra)
-    subs = []
-    for name, sym in list(h.enc.symbols.items()):
-        d = sym.decl
-        if not isinstance(d, z3.FuncDeclRef) or d.arity() == 0:
-            continue
-        if not all(d.domain(m) in (z3.RealSort(), z3.IntSort()) for m in range(d.arity())):
-            continue
-        params = [z3.Var(j, d.domain(j)) for j in range(d.arity())]
-        body: z3.ExprRef = z3.Const(f"{name}!else", d.range())
-        for j in range(points):
-            pt = [(z3.RealVal(j if m == 0 else 0) if d.domain(m) == z3.RealSort() else z3.IntVal(j if m == 0 else 0))
-                  for m in range(d.arity())]
-            # de Bruijn: Var(0) is the last argument
-            cond = z3.And(*[params[d.arity() - 1 - m] == pt[m] for m in range(d.arity())])
-            body = z3.If(cond, z3.Const(f"{name}!v{j}", d.range()), body)
-        subs.append((d, body))
-    formulas = [f for _, f in labelled] + list(h.enc.axioms())
-    if subs:
-        formulas = [z3.substitute_funs(f, *subs) for f in formulas]
-    # a budget in Z3's resource steps, so the answer does not depend on the machine's load (logic/query.py)
-    from ..logic.query import budgeted_solver
-    s = budgeted_solver(WITNESS_TIMEOUT_MS)
-    if s.check(*formulas) != z3.sat:
-        return "inconclusive"
-    s.model()  # the witness itself (raises when the solver has none: a misbehaving checker shows no repair)
-    return "sat"
+    return table_witness(h.enc, [f for _, f in labelled], points).status
 
 
 def _points(ws: Any, node: str) -> int:
-    inst = ws.plan.instances.get(node)
-    return max(WITNESS_POINTS, inst[1] + 1) if inst else WITNESS_POINTS
+    return points_for(ws.plan.instances.get(node))
 
 
 def premise_fires(ws: Any, checked: Checked, node: str, k: int, at: int | None = None) -> str:

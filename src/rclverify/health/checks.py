@@ -25,20 +25,22 @@ not decide within the timeout; never counted as ok).
 """
 from __future__ import annotations
 
+import time
 from dataclasses import replace
-from typing import Any, Sequence
+from typing import Any, Callable, Sequence
 
 import z3
 
 from ..calculus.refinement import RefinementResult
 from ..logic.encode import Encoder
-from ..logic.query import QueryResult, satisfiable, solver_session
+from ..logic.query import QueryResult, satisfiable, smt2_script, solver_session
 from ..rcl import ast
 from ..rcl.printer import expr_to_rcl
 from ..rcl.typecheck import domain_type
 from ..rcl.types import NATURAL, Checked, CheckedNode
 from .finding import Finding as Finding  # re-exported: callers import it from here too
 from .shape import shape_findings
+from .witness import finite_witness, has_tables, points_for
 
 HEALTH_TIMEOUT_MS = 5_000
 #: Timeout of one per-instance premise query, and how many undecided
@@ -104,6 +106,12 @@ class _NodeHealth:
         return satisfiable(labelled + list(extra), self.enc, timeout_ms=timeout_ms or self.timeout, comment=comment,
                            retry=timeout_ms is None if retry is None else retry)
 
+    def statement(self, extra: Sequence[tuple[str, z3.BoolRef]], *, comment: str = "") -> Callable[[], str]:
+        """The SMT-LIB2 text of the query :meth:`sat` would ask (made when
+        called), for a finding answered without asking it."""
+        labelled = list(self.assume) + list(self.guars) + list(self.facts) + list(self.lemmas) + list(extra)
+        return smt2_script(self.enc.axioms() + [f for _, f in labelled], comment or "satisfiability query")
+
     def premise(self, k: int, fixed: dict[str, int] | None = None) -> tuple[list[tuple[str, z3.BoolRef]], str] | None:
         g = self.node.node.guarantees[k - 1]
         bindings, body = _peel(g.formula)
@@ -158,13 +166,15 @@ def check_node(checked: Checked, node: str, facts: Sequence[tuple[ast.Expr, ast.
                            f"Z3 could not decide whether the assumption of {n} can hold.", r.reason, duration_s=r.duration_s))
 
     out[mark] = _noted(replace(out[mark], smt2=r.smt2), r)
-    r = h.sat([], comment=f"health {n}: can the assumption, every guarantee and the environment facts hold together?")
+    comment = f"health {n}: can the assumption, every guarantee and the environment facts hold together?"
+    r = _table_witness(h, comment) or h.sat([], comment=comment)
     mark = len(out)
     check = "contract-consistent"
     if r.status == "sat":
         out.append(Finding(f"{n}.{check}", n, check, None, "ok",
                            f"The assumption and guarantees of {n} (with the environment facts) can hold together.",
-                           "Z3 found a witness (below).", r.model, duration_s=r.duration_s))
+                           "Z3 found a witness in which each function-typed input is a finite table (below)."
+                           if r.strategy == TABLES else "Z3 found a witness (below).", r.model, duration_s=r.duration_s))
     elif r.status == "unsat":
         out.append(Finding(f"{n}.{check}", n, check, None, "problem",
                            f"The contract of {n} contradicts itself: no output can satisfy its guarantees.",
@@ -184,9 +194,35 @@ def check_node(checked: Checked, node: str, facts: Sequence[tuple[ast.Expr, ast.
     return out
 
 
+#: ``QueryResult.strategy`` of a witness found by :func:`_table_witness`.
+TABLES = "finite tables"
+
+
+def _table_witness(h: _NodeHealth, comment: str) -> QueryResult | None:
+    """A witness of the consistency query in which each function-typed
+    input is a finite table (:mod:`.witness`), asked before the general
+    query when the contract has such inputs: Z3 finds one in a fraction of
+    the time it takes to find a model with uninterpreted functions (the
+    case study's Agent: 0.14 s instead of 3 s).  Its ``sat`` is a model of
+    the general query, so the finding is the same (``ok``), with the
+    general query's SMT-LIB2 text as its statement; anything else (None)
+    leaves the question to the general query.  Not used for non-vacuity:
+    there, an undecided general query is what starts the instance scan
+    that finds a guarantee vacuous for some instances only (the Agent's
+    guarantee 1), and a witness at one instance would hide that."""
+    if not has_tables(h.enc):
+        return None
+    t0 = time.perf_counter()
+    w = finite_witness(h.enc, [f for _, f in (*h.assume, *h.guars, *h.facts, *h.lemmas)], points_for(h.instances))
+    if w.status != "sat":
+        return None
+    return QueryResult("sat", h.statement([], comment=comment), round(time.perf_counter() - t0, 4),
+                       model=w.model, strategy=TABLES)
+
+
 def _noted(f: Finding, r: QueryResult) -> Finding:
     """``f`` with the retry strategy that answered its query (logic/retry.py) stated."""
-    if not r.strategy:
+    if not r.strategy or r.strategy == TABLES:
         return f
     return replace(f, explanation=f"{f.explanation} Z3's default strategy gave up; answered with {r.strategy}.")
 

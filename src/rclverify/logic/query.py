@@ -157,8 +157,12 @@ def query_solver(timeout_ms: int, *, cores: bool = False) -> Iterator[z3.Solver]
         s.pop()
 
 
-def _smt2(formulas: Sequence[z3.BoolRef], comment: str) -> Callable[[], str]:
+def smt2_script(formulas: Sequence[z3.BoolRef], comment: str) -> Callable[[], str]:
+    """A function making the SMT-LIB2 script of ``formulas`` (headed by
+    ``comment`` as SMT-LIB comments) when called: most queries' text is
+    never kept, and printing it costs more than many queries."""
     return lambda: _script(formulas, comment)
+
 
 
 def _script(formulas: Sequence[z3.BoolRef], comment: str) -> str:
@@ -209,7 +213,7 @@ def prove(goal: z3.BoolRef, hypotheses: Sequence[z3.BoolRef], enc: Encoder | Non
         t0 = time.perf_counter()
         r = s.check()
         dt = round(time.perf_counter() - t0, 4)
-        script = _smt2(formulas, comment or "validity query: unsat means the goal follows from the hypotheses")
+        script = smt2_script(formulas, comment or "validity query: unsat means the goal follows from the hypotheses")
         if r == z3.unsat:
             return QueryResult("proved", script, dt)
         if r == z3.sat:
@@ -249,7 +253,7 @@ def satisfiable(labelled: Sequence[tuple[str, z3.BoolRef]], enc: Encoder | None 
         t0 = time.perf_counter()
         r = s.check()
         dt = round(time.perf_counter() - t0, 4)
-        script = _smt2(background + [f for _, f in labelled], comment or "satisfiability query")
+        script = smt2_script(background + [f for _, f in labelled], comment or "satisfiability query")
         if r == z3.sat:
             return QueryResult("sat", script, dt, model=render_model(s.model(), enc))
         if r == z3.unsat:

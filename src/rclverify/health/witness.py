@@ -1,0 +1,117 @@
+"""Witnesses in which every function-typed input is a finite table.
+
+A satisfiability query over a contract with uninterpreted functions over
+the reals (the case study's Agent: ``wayP``, ``at``, ``inspected``) can keep
+Z3's quantifier instantiation busy for its whole budget before it finds a
+model.  Asking for a model of a fixed shape is far cheaper: each such
+function takes a free value at ``points`` points ``(j, 0, ..., 0)``
+(``j = 0 .. points - 1``) and one free value elsewhere.  A model of that
+query is a model of the original one (the functions interpreted as those
+tables), so ``sat`` is a witness; anything else says only that no witness
+of this shape was found, never that there is none.
+
+Used by the health stage's consistency check (:mod:`.checks`, asked before
+the general query) and by the diagnosis's repair checks
+(:mod:`rclverify.diagnosis.recheck`).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any, Sequence
+
+import z3
+
+from ..logic.encode import value_to_rcl
+from ..logic.query import SAFETY_FACTOR, STEPS_PER_MS, render_model
+
+#: Points of each function table (at least the plan's instances: see :func:`points_for`).
+WITNESS_POINTS = 4
+#: Budget of one witness query, in milliseconds' worth of Z3 resource steps
+#: (:data:`rclverify.logic.query.STEPS_PER_MS`), so the answer does not depend on load.
+WITNESS_TIMEOUT_MS = 5_000
+
+
+@dataclass(frozen=True)
+class Witness:
+    """``status``: ``sat`` (``model`` maps each symbol's RCL name to its value
+    in RCL syntax, a function to its table) or ``inconclusive``."""
+
+    status: str
+    model: dict[str, str] | None = None
+
+
+def points_for(instances: tuple[int, int] | None) -> int:
+    """The table size for a node with the plan's ``instances: [lo, hi]``:
+    at least :data:`WITNESS_POINTS`, and ``hi + 1`` so that every instance
+    has a point of its own."""
+    return max(WITNESS_POINTS, instances[1] + 1) if instances else WITNESS_POINTS
+
+
+def _tabled(d: z3.FuncDeclRef) -> bool:
+    return d.arity() > 0 and all(d.domain(m) in (z3.RealSort(d.ctx), z3.IntSort(d.ctx)) for m in range(d.arity()))
+
+
+def has_tables(enc: Any) -> bool:
+    """Does the encoder ``enc`` hold a function symbol over numbers (one
+    :func:`finite_witness` would make a table of)?  Without one the witness
+    query is the general query and asking it first only costs time."""
+    return any(isinstance(s.decl, z3.FuncDeclRef) and _tabled(s.decl) for s in enc.symbols.values())
+
+
+def _coordinate(d: z3.FuncDeclRef, m: int, v: int) -> z3.ExprRef:
+    """``v`` as a value of argument ``m`` of ``d`` (REAL or INTEGER sort)."""
+    return z3.RealVal(v, d.ctx) if d.domain(m) == z3.RealSort(d.ctx) else z3.IntVal(v, d.ctx)
+
+
+def finite_witness(enc: Any, formulas: Sequence[z3.BoolRef], points: int,
+                   budget_ms: int = WITNESS_TIMEOUT_MS) -> Witness:
+    """Look for a model of ``formulas`` (and ``enc``'s typing axioms) in
+    which every function symbol of ``enc`` over REAL/INTEGER/NATURAL
+    arguments is a table of ``points`` points and a default (module
+    docstring).  Returns a :class:`Witness`; never raises on solver
+    trouble (an unknown answer is ``inconclusive``)."""
+    ctx = z3.Context()  # the process's context is left as it was: its later queries search as before
+    subs = []
+    tables: dict[str, tuple[str, z3.FuncDeclRef]] = {}
+    for name, sym in list(enc.symbols.items()):
+        d = sym.decl
+        if not isinstance(d, z3.FuncDeclRef) or not _tabled(d):
+            continue
+        # a FuncDeclRef of the fresh context (translate() hands back a plain AST handle)
+        d = z3.FuncDeclRef(z3.Z3_to_func_decl(ctx.ref(), d.translate(ctx).as_ast()), ctx)
+        params = [z3.Var(j, d.domain(j)) for j in range(d.arity())]
+        body: z3.ExprRef = z3.Const(f"{name}!else", d.range())
+        for j in range(points):
+            pt = [_coordinate(d, m, j if m == 0 else 0) for m in range(d.arity())]
+            # in z3.substitute_funs, Var(m) stands for argument m (not de Bruijn order)
+            cond = z3.And(*[params[m] == pt[m] for m in range(d.arity())])
+            body = z3.If(cond, z3.Const(f"{name}!v{j}", d.range()), body)
+        subs.append((d, body))
+        tables[name] = (sym.display, d)
+    all_formulas = [f.translate(ctx) for f in list(formulas) + list(enc.axioms())]
+    if subs:
+        all_formulas = [z3.substitute_funs(f, *subs) for f in all_formulas]
+    s = z3.Solver(ctx=ctx)
+    s.set("rlimit", int(budget_ms) * STEPS_PER_MS)
+    s.set("timeout", int(budget_ms) * SAFETY_FACTOR)
+    if s.check(*all_formulas) != z3.sat:
+        return Witness("inconclusive")
+    return Witness("sat", _render(s.model(), enc, tables, points))
+
+
+def _render(model: z3.ModelRef, enc: Any, tables: dict[str, tuple[str, z3.FuncDeclRef]],
+            points: int) -> dict[str, str]:
+    """The witness in RCL terms, as :func:`rclverify.logic.query.render_model`
+    shows a model, each tabled function as ``{(0, 0) -> v0, (1, 0) -> v1,
+    ..., else -> v}``."""
+    out = render_model(model, enc)
+    for name, (display, d) in tables.items():
+        rows = []
+        for j in range(points):
+            args = ", ".join(value_to_rcl(_coordinate(d, m, j if m == 0 else 0)) for m in range(d.arity()))
+            value = model.eval(z3.Const(f"{name}!v{j}", d.range()), model_completion=True)
+            rows.append(f"({args}) -> {value_to_rcl(value)}")
+        default = model.eval(z3.Const(f"{name}!else", d.range()), model_completion=True)
+        rows.append(f"else -> {value_to_rcl(default)}")
+        out[display] = "{" + ", ".join(rows) + "}"
+    return dict(sorted(out.items()))
