@@ -6,6 +6,7 @@ from pathlib import Path
 import pytest
 
 from rclverify.health.checks import check_node
+from rclverify.logic import world
 from rclverify.plan.load import load_plan, resolve
 from rclverify.rcl.parser import parse_text
 from rclverify.rcl.typecheck import check, load
@@ -57,6 +58,7 @@ def agent_findings():
     checked = load([ROOT / c for c in plan.contracts])
     resolve(plan, checked)
     facts = [(f.expr, f.loc) for f in plan.facts["Agent"]]
+    world.fresh()  # the Z3 state of the node task (logic/world.py), whatever this worker ran before
     return {f.id: f for f in check_node(checked, "Agent", facts, plan.instances["Agent"])}
 
 
@@ -147,3 +149,12 @@ def test_no_finite_table_witness_leaves_consistency_to_the_general_query():
     c = f["n.contract-consistent"]
     assert c.status == "problem" and "finite table" not in c.explanation
     assert sorted(c.core) == ["guarantee 1 (t.rcl:3:7)", "guarantee 2 (t.rcl:3:35)"]
+
+
+def test_case_study_agent_guarantee_3_can_fire(agent_findings):
+    """Guarantee 3 of the Agent can fire (its premise holds whenever i has no
+    successor waypoint), decided by the general query in the node task's Z3
+    state; asking the consistency witness in a context of its own leaves
+    that state as it was (health/witness.py)."""
+    g3 = agent_findings["Agent.g3.non-vacuous"]
+    assert g3.status == "ok" and g3.model is not None
