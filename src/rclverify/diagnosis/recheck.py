@@ -28,7 +28,6 @@ from ..system.model import SystemModel, build
 from .edits import Edit
 
 
-
 def source_text(ws: Any, rel: str) -> str:
     """The text of the workspace file ``rel``."""
     return str(ws.path(rel).read_text(encoding="utf-8"))

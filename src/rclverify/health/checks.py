@@ -203,7 +203,7 @@ def _table_witness(h: _NodeHealth, comment: str) -> QueryResult | None:
     input is a finite table (:mod:`.witness`), asked before the general
     query when the contract has such inputs: Z3 finds one in a fraction of
     the time it takes to find a model with uninterpreted functions (the
-    case study's Agent: 0.14 s instead of 3 s).  Its ``sat`` is a model of
+    case study's Agent: 0.1-0.3 s instead of 3 s).  Its ``sat`` is a model of
     the general query, so the finding is the same (``ok``), with the
     general query's SMT-LIB2 text as its statement; anything else (None)
     leaves the question to the general query.  Not used for non-vacuity:

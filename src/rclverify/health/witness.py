@@ -10,6 +10,10 @@ query is a model of the original one (the functions interpreted as those
 tables), so ``sat`` is a witness; anything else says only that no witness
 of this shape was found, never that there is none.
 
+The query is built and solved in a Z3 context of its own (the formulas are
+translated into it), so asking it leaves the process's context, and with it
+the search of the queries asked after it, as it was.
+
 Used by the health stage's consistency check (:mod:`.checks`, asked before
 the general query) and by the diagnosis's repair checks
 (:mod:`rclverify.diagnosis.recheck`).
@@ -22,7 +26,7 @@ from typing import Any, Sequence
 import z3
 
 from ..logic.encode import value_to_rcl
-from ..logic.query import SAFETY_FACTOR, STEPS_PER_MS, render_model
+from ..logic.query import budgeted_solver, render_model
 
 #: Points of each function table (at least the plan's instances: see :func:`points_for`).
 WITNESS_POINTS = 4
@@ -91,9 +95,7 @@ def finite_witness(enc: Any, formulas: Sequence[z3.BoolRef], points: int,
     all_formulas = [f.translate(ctx) for f in list(formulas) + list(enc.axioms())]
     if subs:
         all_formulas = [z3.substitute_funs(f, *subs) for f in all_formulas]
-    s = z3.Solver(ctx=ctx)
-    s.set("rlimit", int(budget_ms) * STEPS_PER_MS)
-    s.set("timeout", int(budget_ms) * SAFETY_FACTOR)
+    s = budgeted_solver(budget_ms, ctx)
     if s.check(*all_formulas) != z3.sat:
         return Witness("inconclusive")
     return Witness("sat", _render(s.model(), enc, tables, points))

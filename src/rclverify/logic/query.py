@@ -73,11 +73,12 @@ STEPS_PER_MS = 2_000
 SAFETY_FACTOR = 10
 
 
-def budgeted_solver(timeout_ms: int) -> z3.Solver:
-    """A solver in the process's context whose budget is ``timeout_ms``
-    milliseconds' worth of Z3 resource steps (:data:`STEPS_PER_MS`), with a
-    wall-clock safety net :data:`SAFETY_FACTOR` times longer."""
-    s = z3.Solver()
+def budgeted_solver(timeout_ms: int, ctx: z3.Context | None = None) -> z3.Solver:
+    """A solver in ``ctx`` (default: the process's main context) whose
+    budget is ``timeout_ms`` milliseconds' worth of Z3 resource steps
+    (:data:`STEPS_PER_MS`), with a wall-clock safety net
+    :data:`SAFETY_FACTOR` times longer."""
+    s = z3.Solver(ctx=ctx)
     s.set("rlimit", int(timeout_ms) * STEPS_PER_MS)
     s.set("timeout", int(timeout_ms) * SAFETY_FACTOR)
     return s
@@ -162,7 +163,6 @@ def smt2_script(formulas: Sequence[z3.BoolRef], comment: str) -> Callable[[], st
     ``comment`` as SMT-LIB comments) when called: most queries' text is
     never kept, and printing it costs more than many queries."""
     return lambda: _script(formulas, comment)
-
 
 
 def _script(formulas: Sequence[z3.BoolRef], comment: str) -> str:
