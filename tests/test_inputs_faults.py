@@ -257,6 +257,31 @@ def test_a_second_run_waits_and_proceeds_when_the_first_ends(fresh: Path) -> Non
     assert "-- verify" in out or ".  verify" in out
 
 
+def test_report_and_bundle_wait_for_a_run_in_progress(ws: Path) -> None:
+    """`rclverify report` rewrites reports/ and `rclverify bundle` packs the
+    report with the evidence it is checked against: both take the run lock,
+    so neither works on what a `doit verify` in progress is rewriting."""
+    before = digests(ws, "reports")
+    with holder(ws) as h:
+        for argv in (("report", "--no-wait"), ("bundle", "--no-wait", "-o", "b.tar.gz")):
+            r = run(ws, "rclverify.cli", *argv)
+            assert r.returncode == 1 and "Traceback" not in r.stderr, r.stderr
+            assert f"error: not waiting for the run in progress (pid {h.pid})" in r.stderr
+        assert digests(ws, "reports") == before and not (ws / "b.tar.gz").exists()
+        p = subprocess.Popen([sys.executable, "-m", "rclverify.cli", "report"], cwd=ws, env=ENV,
+                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        assert p.stderr is not None
+        assert p.stderr.readline() == f"waiting for the run in progress (pid {h.pid})\n"
+        time.sleep(0.5)
+        assert p.poll() is None  # still waiting
+        h.stdin.close()  # type: ignore[union-attr]  # the run ends
+        out, err = p.communicate(timeout=120)
+    assert p.returncode == 0, out + err
+    assert "reports/assurance.html" in out
+    r = run(ws, "rclverify.cli", "bundle", "--no-wait", "-o", "b.tar.gz")
+    assert r.returncode == 0 and (ws / "b.tar.gz").is_file(), r.stderr
+
+
 def test_a_killed_run_leaves_no_stale_lock(fresh: Path) -> None:
     ws = fresh
     with holder(ws) as h:

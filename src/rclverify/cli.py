@@ -7,7 +7,7 @@
 ``rclverify compose``              apply the calculus and print side conditions
 ``rclverify health [NODE...]``     contract consistency and vacuity findings
 ``rclverify export``               export obligations to the plan's backends
-``rclverify report``               rebuild reports/ from the artifacts
+``rclverify report [--no-wait]``   rebuild reports/ from the artifacts (waits for a run in progress)
 ``rclverify requirements``         check each formal requirement with Z3 and print its status
 ``rclverify verify [--strict] [--no-wait]``  the whole pipeline through doit (one run at a time per workspace)
 ``rclverify status``               the last run's summary and problems, running nothing
@@ -30,7 +30,8 @@ import json
 import os
 import sys
 from pathlib import Path
-from typing import Any, Callable, Sequence
+from contextlib import contextmanager
+from typing import Any, Callable, Iterator, Sequence
 
 from .rcl.errors import RclError
 
@@ -175,9 +176,32 @@ def cmd_requirements(args: argparse.Namespace) -> int:
     return show_requirements(ws, sys.stdout)
 
 
+@contextmanager
+def _run_lock(args: argparse.Namespace) -> Iterator[None]:
+    """Hold the workspace's run lock (:mod:`rclverify.runlock`) for the block:
+    a command that writes ``reports/`` or reads the evidence as a whole
+    (``report``, ``bundle``) waits for a ``doit verify`` in progress, which
+    would otherwise rewrite them under it.  ``--no-wait``/``RCLVERIFY_NO_WAIT=1``
+    make it exit 1 instead (:class:`~rclverify.runlock.RunInProgress`,
+    printed by :func:`main`).  Released at the end of the block; a lock this
+    process already held stays held."""
+    from . import runlock
+    root = Path(args.workspace)
+    try:
+        took = runlock.acquire(root, wait=False if getattr(args, "no_wait", False) else None)
+    except PermissionError:  # a read-only artifacts/: no rclverify run can write there either
+        took = False
+    try:
+        yield
+    finally:
+        if took:
+            runlock.release(root)
+
+
 def cmd_report(args: argparse.Namespace) -> int:
     from .pipeline import stage_report
-    report, paths = stage_report(_ws(args))
+    with _run_lock(args):
+        report, paths = stage_report(_ws(args))
     for p in paths:
         print(p)
     print(report["summary"]["headline"])
@@ -373,19 +397,21 @@ def cmd_bundle(args: argparse.Namespace) -> int:
         print(f"{args.verify}: {len(manifest['files'])} file(s) match MANIFEST.json")
         return 0
     ws = _ws(args)
-    problems = _report_out_of_date(ws)
-    if problems:
-        for problem in problems:
-            print(f"{args.workspace}: error: {problem}", file=sys.stderr)
-        return 1
-    name = "".join(c if c.isalnum() or c in "-_." else "-" for c in (ws.plan.name or ws.root.resolve().name)).strip("-")
-    out = Path(args.output) if args.output else Path(f"{name or 'workspace'}-bundle.tar.gz")
-    try:
-        manifest = write_bundle(ws.root, ws.plan, out)
-    except BundleError as exc:
-        for problem in exc.problems:
-            print(f"{args.workspace}: error: {problem}", file=sys.stderr)
-        return 1
+    with _run_lock(args):  # the report and the evidence it is checked against, as one run left them
+        problems = _report_out_of_date(ws)
+        if problems:
+            for problem in problems:
+                print(f"{args.workspace}: error: {problem}", file=sys.stderr)
+            return 1
+        name = "".join(c if c.isalnum() or c in "-_." else "-"
+                       for c in (ws.plan.name or ws.root.resolve().name)).strip("-")
+        out = Path(args.output) if args.output else Path(f"{name or 'workspace'}-bundle.tar.gz")
+        try:
+            manifest = write_bundle(ws.root, ws.plan, out)
+        except BundleError as exc:
+            for problem in exc.problems:
+                print(f"{args.workspace}: error: {problem}", file=sys.stderr)
+            return 1
     for m in manifest["missing"]:
         print(f"warning: {m}: named by the plan but does not exist; not in the bundle", file=sys.stderr)
     print(f"{out}: {len(manifest['files'])} file(s) and MANIFEST.json; check with: rclverify bundle --verify {out}")
@@ -456,7 +482,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     add("compose", cmd_compose, "apply the calculus: side conditions and derived properties", True)
     add("health", cmd_health, "contract consistency and vacuity checks", True).add_argument("nodes", nargs="*")
     add("export", cmd_export, "export obligations to the plan's backends", True)
-    add("report", cmd_report, "rebuild the assurance report from the artifacts", True)
+    rep = add("report", cmd_report, "rebuild the assurance report from the artifacts", True)
     add("requirements", cmd_requirements, "check each formal requirement with Z3 from the composed contracts and "
         "print its status", True).add_argument("--force", action="store_true", help="check every requirement again")
     add("cache", cmd_cache, "list what the workspace keeps between runs (artifacts/cache), or clear it",
@@ -484,6 +510,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     bnd = add("bundle", cmd_bundle, "write the assessor's bundle (reports, artifacts, plan, contracts, manifest)", True)
     bnd.add_argument("-o", "--output", help="archive to write (.tar.gz or .zip; default: <workspace name>-bundle.tar.gz)")
     bnd.add_argument("--verify", metavar="FILE", help="check the archive FILE against its manifest instead")
+    for sp in (rep, bnd):
+        sp.add_argument("--no-wait", action="store_true",
+                        help="exit 1 instead of waiting when a run is in progress in the workspace "
+                             "(also: RCLVERIFY_NO_WAIT=1)")
     rv = add("review", cmd_review, "write a review record to fill in for NODE (checklist from its guarantees)", True)
     rv.add_argument("node")
     rv.add_argument("-o", "--output", help="write the record to this file instead of standard output")
@@ -521,10 +551,14 @@ def main(argv: Sequence[str] | None = None) -> int:
     o.add_argument("--mapping", help="mapping file (default: backends/monitors/mapping.yaml if present)")
     o.add_argument("--horizon", type=float, help="seconds an input event may wait for its answer")
     args = p.parse_args(argv)
+    from .runlock import RunInProgress
     try:
         return int(args.fn(args))
     except RclError as exc:
         return _print_diags(exc)
+    except RunInProgress as exc:  # report/bundle --no-wait while a run holds the workspace
+        print(f"{args.workspace}: error: {exc}", file=sys.stderr)
+        return 1
     except KeyboardInterrupt:
         return 130
     except OSError as exc:  # a fault of the machine (read-only directory, full disk): one plain line

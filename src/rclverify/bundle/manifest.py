@@ -5,7 +5,9 @@ Collected (workspace-relative POSIX paths, sorted):
 * every regular file under ``reports/`` and ``artifacts/`` (hidden files,
   such as the temporary files of atomic writes, are left out, and so is
   ``artifacts/cache/``: a machine-local speed-up holding pickled data, which
-  an assessor must never be handed to load);
+  an assessor must never be handed to load, and the lock files
+  ``artifacts/run.lock`` and ``artifacts/diagnosis.lock``, which order runs
+  on one machine);
 * the plan, its contract files and replacement contracts, and the
   Doorstop folders it reads requirements from (``requirements_from``);
 * every file the plan's evidence entries name (a directory contributes the
@@ -38,8 +40,10 @@ FORMAT = "rclverify-bundle/1"
 MANIFEST = "MANIFEST.json"
 #: Workspace folders packed whole.
 TREES = ("reports", "artifacts")
-#: Left out of the trees: the workspace cache (rclverify.cache), pickled.
-EXCLUDED = ("artifacts/cache/",)
+#: Left out of the trees: the workspace cache (rclverify.cache), pickled, and the
+#: lock files that order runs on this machine (rclverify.runlock's run.lock, the
+#: diagnosis's diagnosis.lock: a process id, no evidence).
+EXCLUDED = ("artifacts/cache/", "artifacts/run.lock", "artifacts/diagnosis.lock")
 
 
 class BundleError(Exception):
