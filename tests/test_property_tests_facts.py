@@ -81,6 +81,21 @@ def test_fact_filtering_cannot_satisfy_still_gives_valid_examples(tmp_path: Path
     assert len({repr(sorted(v["in.f"].table.items())) for v in seen}) > 5
 
 
+def test_examples_leave_the_model_results_and_default(tmp_path: Path) -> None:
+    """The facts' Z3 model is where examples start, not where they stay: some
+    examples give an entry another result or take another default (a bug
+    that shows only off the model's values must stay findable), and every
+    example still satisfies the facts."""
+    target = Workspace(workspace(tmp_path)).target("Lookup", 0)
+    run, seen = recording(target, 1)
+    formulas = tuple(c.formula for c in target.node.node.assumes) + run.used_facts
+    model = seeding.Seeder(target.checked, target.node, formulas).base()["in.f"]
+    assert run.run().status == "discharged"
+    assert_facts_hold(target, seen)
+    assert any(v["in.f"].default != model.default for v in seen)
+    assert any(sorted(v["in.f"].table.values()) != sorted(model.table.values()) for v in seen)
+
+
 def test_without_the_z3_model_filtering_starves_with_a_clear_message(tmp_path: Path,
                                                                     monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.setattr(seeding.Seeder, "base", lambda self: None)

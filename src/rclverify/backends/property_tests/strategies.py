@@ -34,7 +34,7 @@ from ...values import FiniteFunction, Term
 SMALL_NAT = 5
 POOL_SIZE = 4
 _POOL_COUNT = st.integers(min_value=1, max_value=POOL_SIZE)
-MAX_EDITS = 4
+MAX_EDITS = 3
 _EDITS = st.integers(min_value=0, max_value=MAX_EDITS)
 
 
@@ -300,36 +300,60 @@ class InputSpace:
 
     def vary(self, draw: Callable[..., Any], base: FiniteFunction, t: FuncT) -> FiniteFunction:
         """``base`` (a table from a Z3 model of the facts) with 0 to
-        :data:`MAX_EDITS` edits drawn by Hypothesis, each on one of its
-        entries (which entry and which edit: one choice): move the entry to
-        a point of this example's pool (so other functions over the same
-        domain meet it), move it to a new point, or swap its result with
-        another entry's.  A move onto a key the table already has is
-        skipped.  The edits keep the model's results and default, so facts
-        about which results exist and what they are bounded by still hold
-        (the harness's filter checks every fact again); few choices keep an
-        example cheap (each Hypothesis choice costs about 25 microseconds).
-        Shrinking removes edits, towards the model itself."""
+        :data:`MAX_EDITS` edits drawn by Hypothesis.  An edit works on one
+        slot, an entry of the table or "elsewhere" (the default), and which
+        slot and which edit is one choice:
+
+        * an entry: move it to a point of this example's pool (so other
+          functions over the same domain meet it) or to a new point, swap
+          its result with another entry's, or give it a new result;
+        * elsewhere: add an entry at a pool point or a new point, swap the
+          default with an entry's result, or take a new default.
+
+        A new result is one of the model's results or a small value of the
+        result type, so results the model does not use are tested too.  A
+        move or an added entry onto a key the table already has is skipped.
+        Moves and swaps keep every fact about which results exist and what
+        bounds them; a new result may break one, and the harness's filter
+        rejects that example.  Few choices keep an example cheap (each
+        Hypothesis choice costs about 25 microseconds).  Shrinking removes
+        edits, towards the model itself."""
         table = dict(base.table)
-        if not table:
-            return base
+        default = base.default
         where = list(table)
-        pick = self._index(len(where) * 3)
+        n = len(where)
+        pick = self._index((n + 1) * 4)
         for _ in range(draw(_EDITS)):
-            i, kind = divmod(draw(pick), 3)
-            if kind == 2:
-                j = draw(self._index(len(where)))
-                table[where[i]], table[where[j]] = table[where[j]], table[where[i]]
+            i, kind = divmod(draw(pick), 4)
+            if kind == 3:  # a new result (of the entry, or the default)
+                value = draw(self._result(base, t))
+                if i < n:
+                    table[where[i]] = value
+                else:
+                    default = value
+                continue
+            if kind == 2:  # swap with an entry's result
+                if not n:
+                    continue
+                j = where[draw(self._index(n))]
+                if i < n:
+                    table[where[i]], table[j] = table[j], table[where[i]]
+                else:
+                    default, table[j] = table[j], default
                 continue
             if kind == 0:
                 pool = self.pool(draw, t.args)
-                moved = pool[draw(self._index(len(pool)))]
+                point = pool[draw(self._index(len(pool)))]
             else:
-                moved = draw(self.points(t.args))
-            if moved not in table:
-                table[moved] = table.pop(where[i])
-                where[i] = moved
-        return FiniteFunction(table, base.default, base.arity)
+                point = draw(self.points(t.args))
+            if point in table:
+                continue
+            if i < n:  # move the entry
+                table[point] = table.pop(where[i])
+                where[i] = point
+            else:  # add one
+                table[point] = draw(self._result(base, t))
+        return FiniteFunction(table, default, base.arity)
 
     def _index(self, n: int) -> st.SearchStrategy[int]:
         """``0 .. n - 1`` (built once per ``n``)."""
@@ -337,6 +361,15 @@ class InputSpace:
         if key not in self.misc_cache:
             self.misc_cache[key] = st.integers(min_value=0, max_value=n - 1)
         return self.misc_cache[key]
+
+    def _result(self, base: FiniteFunction, t: FuncT) -> st.SearchStrategy[Any]:
+        """A new result for a seeded table: one of the model's results (and
+        default), or a small value of the result type (built once per table)."""
+        key = ("result", id(base))
+        if key not in self.misc_cache:
+            results = sorted({*base.table.values(), base.default}, key=repr)
+            self.misc_cache[key] = st.one_of(st.sampled_from(results), self.value(t.result, small=True))
+        return cast("st.SearchStrategy[Any]", self.misc_cache[key])
 
 
 def input_space(node: CheckedNode, plan_bounds: Mapping[str, tuple[Fraction | None, Fraction | None]],
