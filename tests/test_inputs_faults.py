@@ -282,6 +282,16 @@ def test_report_and_bundle_wait_for_a_run_in_progress(ws: Path) -> None:
     assert r.returncode == 0 and (ws / "b.tar.gz").is_file(), r.stderr
 
 
+def test_report_and_bundle_of_a_missing_workspace_make_no_lock_file(tmp_path: Path) -> None:
+    """The run lock is taken only where there is a workspace: a mistyped -w
+    gives the command's own error and leaves no directory behind."""
+    missing = tmp_path / "no-such-ws"
+    for argv in (("report",), ("bundle", "-o", str(tmp_path / "b.tar.gz"))):
+        r = run(tmp_path, "rclverify.cli", *argv, "-w", str(missing))
+        assert r.returncode == 1 and "Traceback" not in r.stderr, r.stderr
+        assert not missing.exists()
+
+
 def test_a_killed_run_leaves_no_stale_lock(fresh: Path) -> None:
     ws = fresh
     with holder(ws) as h:

@@ -187,10 +187,14 @@ def _run_lock(args: argparse.Namespace) -> Iterator[None]:
     process already held stays held."""
     from . import runlock
     root = Path(args.workspace)
-    try:
-        took = runlock.acquire(root, wait=False if getattr(args, "no_wait", False) else None)
-    except PermissionError:  # a read-only artifacts/: no rclverify run can write there either
-        took = False
+    took = False
+    # no workspace or no plan: the command fails with its own located error, and no
+    # artifacts/run.lock is made where there is no workspace
+    if root.is_dir() and (root / args.plan).is_file():
+        try:
+            took = runlock.acquire(root, wait=False if getattr(args, "no_wait", False) else None)
+        except PermissionError:  # a read-only artifacts/: no rclverify run can write there either
+            took = False
     try:
         yield
     finally:
