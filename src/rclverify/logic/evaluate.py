@@ -741,29 +741,18 @@ def _preimage_group(e: ast.Quant, bindings: Mapping[str, ast.Binding], ctors: An
     hit = _STATIC.get(key)
     if hit is not None and hit[0] is e:
         return cast("tuple[str, ...] | None", hit[1])
-    if e.kind == "forall" and isinstance(e.body, ast.Binary) and e.body.op == "->":
-        guards = _conjuncts(e.body.left)
-    else:
-        guards = _conjuncts(e.body) if e.kind == "exists" else []
     found: tuple[str, ...] | None = None
-    for g in guards:
-        if found is not None or not isinstance(g, ast.Compare) or tuple(g.ops) != ("==",):
+    for side, other in _equalities(_guards(e)):
+        names = _function_args(side, ctors, bindings)
+        if (names is None or len(names) < 2 or len(set(names)) != len(names)
+                or not all(n in bindings and isinstance(bindings[n].domain, ast.TBase)
+                           and cast(ast.TBase, bindings[n].domain).name in _INFINITE for n in names)):
             continue
-        for side, other in (tuple(g.operands), tuple(reversed(g.operands))):
-            if not (isinstance(side, ast.Apply) and len(side.args) >= 2
-                    and not (side.func.prefix is None and (side.func.name in ctors or side.func.name in bindings))
-                    and all(isinstance(a, ast.Var) and a.prefix is None and a.name in bindings for a in side.args)):
-                continue
-            names = tuple(cast(ast.Var, a).name for a in side.args)
-            if len(set(names)) != len(names) or not all(
-                    isinstance(bindings[n].domain, ast.TBase) and cast(ast.TBase, bindings[n].domain).name in _INFINITE
-                    for n in names):
-                continue
-            used: set[str] = set()
-            _free(other, set(names), used)
-            if not used:
-                found = names
-                break
+        used: set[str] = set()
+        _free(other, set(names), used)
+        if not used:
+            found = names
+            break
     _STATIC[key] = (e, found)
     return found
 
@@ -807,13 +796,7 @@ def _plan(e: ast.Quant, slots: list[tuple[str, ...]], ctors: Any) -> tuple[list[
     hit = _STATIC.get(key)
     if hit is not None and hit[0] is e:
         return cast("tuple[list[list[Any]], list[Any]]", hit[1])
-    if e.kind == "forall" and isinstance(e.body, ast.Binary) and e.body.op == "->":
-        guards = _conjuncts(e.body.left)
-    elif e.kind == "exists":
-        guards = _conjuncts(e.body)
-    else:
-        guards = []
-    staged = _stage(guards, slots)
+    staged = _stage(_guards(e), slots)
     bindings = {n: bd for bd in e.bindings for n in bd.names}
     pins = [_pin(staged[k], names, bindings, ctors) for k, names in enumerate(slots)]
     _STATIC[key] = (e, (staged, pins))
@@ -877,50 +860,69 @@ class _Pin:
 
 
 def _pin(guards: list[Any], names: tuple[str, ...], bindings: Mapping[str, ast.Binding],
-         ctors: Any) -> _Pin | None:
+         ctors: Any) -> _Pin | _Preimage | None:
     """A guard among ``guards`` of the form ``n == t`` (one variable of REAL/INTEGER/NATURAL)
     or ``c(n1, ..., nk) == t`` (constructor ``c``, the slot's variables in order), ``t`` not
-    mentioning them."""
+    mentioning them; failing that, ``f(n1, ..., nk) == t`` (``f`` a function value:
+    :class:`_Preimage`)."""
     kinds = []
     for n in names:
         dom = bindings[n].domain
         if not (isinstance(dom, ast.TBase) and dom.name in _INFINITE):
             return None
         kinds.append(dom.name)
-    for g in guards:
-        if not isinstance(g, ast.Compare) or tuple(g.ops) != ("==",):
+    equalities = _equalities(guards)
+    for side, other in equalities:
+        ctor: str | None = None
+        if len(names) == 1 and isinstance(side, ast.Var) and side.prefix is None and side.name == names[0]:
+            pass
+        elif (isinstance(side, ast.Apply) and side.func.prefix is None and side.func.name in ctors
+              and len(side.args) == len(names)
+              and all(isinstance(a, ast.Var) and a.prefix is None and a.name == n
+                      for a, n in zip(side.args, names))):
+            ctor = side.func.name
+        else:
             continue
-        left, right = g.operands
-        for side, other in ((left, right), (right, left)):
-            ctor: str | None = None
-            if len(names) == 1 and isinstance(side, ast.Var) and side.prefix is None and side.name == names[0]:
-                pass
-            elif (isinstance(side, ast.Apply) and side.func.prefix is None and side.func.name in ctors
-                  and len(side.args) == len(names)
-                  and all(isinstance(a, ast.Var) and a.prefix is None and a.name == n
-                          for a, n in zip(side.args, names))):
-                ctor = side.func.name
-            else:
-                continue
-            used: set[str] = set()
+        used: set[str] = set()
+        _free(other, set(names), used)
+        if not used:
+            return _Pin(other, ctor, tuple(kinds))
+    for side, other in equalities:
+        if _function_args(side, ctors, names) == names:
+            used = set()
             _free(other, set(names), used)
             if not used:
-                return _Pin(other, ctor, tuple(kinds))
-    for g in guards:
-        if not isinstance(g, ast.Compare) or tuple(g.ops) != ("==",):
-            continue
-        left, right = g.operands
-        for side, other in ((left, right), (right, left)):
-            if (isinstance(side, ast.Apply) and not (side.func.prefix is None and side.func.name in ctors)
-                    and not (side.func.prefix is None and side.func.name in names)
-                    and len(side.args) == len(names)
-                    and all(isinstance(a, ast.Var) and a.prefix is None and a.name == n
-                            for a, n in zip(side.args, names))):
-                used = set()
-                _free(other, set(names), used)
-                if not used:
-                    return _Preimage(side.func, other, tuple(kinds))
+                return _Preimage(cast(ast.Apply, side).func, other, tuple(kinds))
     return None
+
+
+def _guards(e: ast.Quant) -> list[Any]:
+    """The guards of ``forall``/``exists`` ``e``: the conjuncts left of ``->``
+    under ``forall``, the conjuncts of the body under ``exists``; none else."""
+    if e.kind == "forall" and isinstance(e.body, ast.Binary) and e.body.op == "->":
+        return _conjuncts(e.body.left)
+    return _conjuncts(e.body) if e.kind == "exists" else []
+
+
+def _equalities(guards: list[Any]) -> list[tuple[Any, Any]]:
+    """``(side, other)`` for each guard ``a == b``, both ways round."""
+    out = []
+    for g in guards:
+        if isinstance(g, ast.Compare) and tuple(g.ops) == ("==",):
+            left, right = g.operands
+            out += [(left, right), (right, left)]
+    return out
+
+
+def _function_args(side: Any, ctors: Any, bound: Any) -> tuple[str, ...] | None:
+    """The variable names of ``side`` when it applies a function value (not a
+    constructor, not a name in ``bound``) to bare variables only, else None."""
+    if not isinstance(side, ast.Apply) or (side.func.prefix is None and (side.func.name in ctors
+                                                                         or side.func.name in bound)):
+        return None
+    if not all(isinstance(a, ast.Var) and a.prefix is None for a in side.args):
+        return None
+    return tuple(cast(ast.Var, a).name for a in side.args)
 
 
 class _Preimage:
@@ -931,7 +933,6 @@ class _Preimage:
     otherwise the slot's own candidates are."""
 
     __slots__ = ("func", "term", "kinds")
-    ctor = None
 
     def __init__(self, func: ast.Var, term: Any, kinds: tuple[str, ...]) -> None:
         self.func, self.term, self.kinds = func, term, kinds
