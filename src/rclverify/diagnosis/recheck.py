@@ -97,8 +97,7 @@ def finite_witness(h: Any, extra: list[tuple[str, z3.BoolRef]], points: int) -> 
     table of ``points`` points (:func:`rclverify.health.witness.finite_witness`),
     else ``"inconclusive"`` (no witness of that shape, which is not a proof
     that there is none)."""
-    labelled = list(h.assume) + list(h.guars) + list(h.facts) + list(extra)
-    return table_witness(h.enc, [f for _, f in labelled], points).status
+    return table_witness(h.enc, [f for _, f in h.labelled(extra)], points).status
 
 
 def _points(ws: Any, node: str) -> int:

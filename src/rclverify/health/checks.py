@@ -99,18 +99,23 @@ class _NodeHealth:
                     out.append((f"{label} at {v}={k}", self.enc.formula(body, self.node, bound={v: z3.IntVal(k)})))
         return out
 
+    def labelled(self, extra: Sequence[tuple[str, z3.BoolRef]] = (), *,
+                 guarantees: bool = True) -> list[tuple[str, z3.BoolRef]]:
+        """The labelled formulas of a query: the assumption, then (``guarantees``)
+        every guarantee, fact and instance lemma, then ``extra``."""
+        return (list(self.assume) + (list(self.guars) + list(self.facts) + list(self.lemmas) if guarantees else [])
+                + list(extra))
+
     def sat(self, extra: Sequence[tuple[str, z3.BoolRef]], *, guarantees: bool = True, comment: str = "",
             timeout_ms: int | None = None, retry: bool | None = None) -> QueryResult:
-        labelled = list(self.assume) + (list(self.guars) + list(self.facts) + list(self.lemmas) if guarantees else [])
         # per-instance queries (own timeout) are not retried: the instance scan is their fallback
-        return satisfiable(labelled + list(extra), self.enc, timeout_ms=timeout_ms or self.timeout, comment=comment,
-                           retry=timeout_ms is None if retry is None else retry)
+        return satisfiable(self.labelled(extra, guarantees=guarantees), self.enc, timeout_ms=timeout_ms or self.timeout,
+                           comment=comment, retry=timeout_ms is None if retry is None else retry)
 
     def statement(self, extra: Sequence[tuple[str, z3.BoolRef]], *, comment: str = "") -> Callable[[], str]:
         """The SMT-LIB2 text of the query :meth:`sat` would ask (made when
         called), for a finding answered without asking it."""
-        labelled = list(self.assume) + list(self.guars) + list(self.facts) + list(self.lemmas) + list(extra)
-        return smt2_script(self.enc.axioms() + [f for _, f in labelled], comment or "satisfiability query")
+        return smt2_script(self.enc.axioms() + [f for _, f in self.labelled(extra)], comment or "satisfiability query")
 
     def premise(self, k: int, fixed: dict[str, int] | None = None) -> tuple[list[tuple[str, z3.BoolRef]], str] | None:
         g = self.node.node.guarantees[k - 1]
@@ -167,14 +172,15 @@ def check_node(checked: Checked, node: str, facts: Sequence[tuple[ast.Expr, ast.
 
     out[mark] = _noted(replace(out[mark], smt2=r.smt2), r)
     comment = f"health {n}: can the assumption, every guarantee and the environment facts hold together?"
-    r = _table_witness(h, comment) or h.sat([], comment=comment)
+    tables = _table_witness(h, comment)
+    r = tables or h.sat([], comment=comment)
     mark = len(out)
     check = "contract-consistent"
     if r.status == "sat":
         out.append(Finding(f"{n}.{check}", n, check, None, "ok",
                            f"The assumption and guarantees of {n} (with the environment facts) can hold together.",
                            "Z3 found a witness in which each function-typed input is a finite table (below)."
-                           if r.strategy == TABLES else "Z3 found a witness (below).", r.model, duration_s=r.duration_s))
+                           if tables else "Z3 found a witness (below).", r.model, duration_s=r.duration_s))
     elif r.status == "unsat":
         out.append(Finding(f"{n}.{check}", n, check, None, "problem",
                            f"The contract of {n} contradicts itself: no output can satisfy its guarantees.",
@@ -194,10 +200,6 @@ def check_node(checked: Checked, node: str, facts: Sequence[tuple[ast.Expr, ast.
     return out
 
 
-#: ``QueryResult.strategy`` of a witness found by :func:`_table_witness`.
-TABLES = "finite tables"
-
-
 def _table_witness(h: _NodeHealth, comment: str) -> QueryResult | None:
     """A witness of the consistency query in which each function-typed
     input is a finite table (:mod:`.witness`), asked before the general
@@ -213,16 +215,15 @@ def _table_witness(h: _NodeHealth, comment: str) -> QueryResult | None:
     if not has_tables(h.enc):
         return None
     t0 = time.perf_counter()
-    w = finite_witness(h.enc, [f for _, f in (*h.assume, *h.guars, *h.facts, *h.lemmas)], points_for(h.instances))
+    w = finite_witness(h.enc, [f for _, f in h.labelled()], points_for(h.instances))
     if w.status != "sat":
         return None
-    return QueryResult("sat", h.statement([], comment=comment), round(time.perf_counter() - t0, 4),
-                       model=w.model, strategy=TABLES)
+    return QueryResult("sat", h.statement([], comment=comment), round(time.perf_counter() - t0, 4), model=w.model)
 
 
 def _noted(f: Finding, r: QueryResult) -> Finding:
     """``f`` with the retry strategy that answered its query (logic/retry.py) stated."""
-    if not r.strategy or r.strategy == TABLES:
+    if not r.strategy:
         return f
     return replace(f, explanation=f"{f.explanation} Z3's default strategy gave up; answered with {r.strategy}.")
 
