@@ -92,6 +92,17 @@ _BROKEN_LINKS = """
     return out;"""
 
 
+def _screenshot(driver: Any, tmp_path: Path, name: str) -> None:
+    """Save the page as ``name``: it must be a real image; with
+    RCLVERIFY_SCREENSHOTS set it is kept in reports/screenshots/ (a CI artifact)."""
+    shot = tmp_path / name
+    assert driver.save_screenshot(str(shot)) and shot.stat().st_size > 1000
+    if os.environ.get("RCLVERIFY_SCREENSHOTS"):
+        dest = REPO / "reports" / "screenshots"
+        dest.mkdir(parents=True, exist_ok=True)
+        shutil.copy(shot, dest / name)
+
+
 def test_the_html_report_renders_in_chromium(tmp_path: Path, driver: Any) -> None:
     root = tmp_path / "ws"
     shutil.copytree(REPO / "tests" / "data" / "newcomer", root)
@@ -127,12 +138,7 @@ def test_the_html_report_renders_in_chromium(tmp_path: Path, driver: Any) -> Non
     # the dashboard: one row per node, and Controller's side conditions cell is failed
     cell = driver.find_element("xpath", "//table[contains(@class,'matrix')]//tr[th/a[text()='Controller']]/td[2]")
     assert "failed" in cell.text
-    shot = tmp_path / "assurance.png"
-    assert driver.save_screenshot(str(shot)) and shot.stat().st_size > 1000
-    if os.environ.get("RCLVERIFY_SCREENSHOTS"):
-        dest = REPO / "reports" / "screenshots"
-        dest.mkdir(parents=True, exist_ok=True)
-        shutil.copy(shot, dest / "assurance-newcomer.png")
+    _screenshot(driver, tmp_path, "assurance-newcomer.png")
 
 
 def test_the_case_study_report_is_short_and_its_dashboard_links_resolve(tmp_path: Path, driver: Any) -> None:
@@ -161,9 +167,4 @@ def test_the_case_study_report_is_short_and_its_dashboard_links_resolve(tmp_path
     text = row.get_attribute("textContent")
     assert "contracts/remote_inspection.rcl:72:3" in text and "Agent.g2.non-vacuous" in text
     assert "Agent.g0.monitors.nominal_jsonl" in text
-    shot = tmp_path / "case-study.png"
-    assert driver.save_screenshot(str(shot)) and shot.stat().st_size > 1000
-    if os.environ.get("RCLVERIFY_SCREENSHOTS"):
-        dest = REPO / "reports" / "screenshots"
-        dest.mkdir(parents=True, exist_ok=True)
-        shutil.copy(shot, dest / "assurance-case-study.png")
+    _screenshot(driver, tmp_path, "assurance-case-study.png")
