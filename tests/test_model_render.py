@@ -38,3 +38,37 @@ def test_deep_chain_beyond_the_recursion_limit() -> None:
     text = term_to_rcl(t)
     assert text == _term_to_rcl_reference(t)
     assert text.startswith("(if (p1 == 1199) then 3 else (if (p1 == 1198)")
+
+
+def test_a_function_model_names_its_arguments_in_order() -> None:
+    """In a function interpretation Var(j) is argument j: f(x, y) = x - 2y is
+    printed with p1 for x (it was printed transposed)."""
+    from rclverify.logic.query import render_model
+    f = z3.Function("f", z3.IntSort(), z3.IntSort(), z3.IntSort())
+    x, y = z3.Ints("x y")
+    s = z3.Solver()
+    s.add(z3.ForAll([x, y], f(x, y) == x - 2 * y))
+    assert s.check() == z3.sat
+    text = render_model(s.model(), None)["f"]
+    assert text.startswith("{(p1, p2) -> ") and "(-2 * p2)" in text and "(-2 * p1)" not in text, text
+
+
+def test_a_function_constant_off_a_grid_of_points_is_an_exact_table() -> None:
+    """An interpretation whose conditions only compare arguments with numerals
+    is printed as the points where it differs from its value elsewhere, and
+    that value (logic/functable.py). Z3 answers this one with a disjunctive
+    first branch of value 1 and an unreachable last ``else`` of 2, which a
+    reading of the text would have called the value elsewhere."""
+    from rclverify.logic.query import render_model
+    g = z3.Function("g", z3.RealSort(), z3.RealSort(), z3.IntSort())
+    a, b = z3.Reals("a b")
+    s = z3.Solver()
+    s.add(g(5, 4) == 12, g(3, 2) == 7,
+          z3.ForAll([a, b], z3.Implies(z3.And(z3.Or(a != 5, b != 4), z3.Or(a != 3, b != 2)), g(a, b) == 1)))
+    assert s.check() == z3.sat
+    m = s.model()
+    text = render_model(m, None)["g"]
+    assert text == "{(3, 2) -> 7, (5, 4) -> 12, else -> 1}", text
+    from rclverify.diagnosis.table import function_table
+    assert function_table(text) == {"rows": [["(3, 2)", "7"], ["(5, 4)", "12"]], "more": 0, "else": "1"}
+    assert m.eval(g(z3.RealVal(3), z3.RealVal(4))).as_long() == 1  # a point on a numeral's line is elsewhere

@@ -26,6 +26,7 @@ from typing import Callable, Iterator, Sequence
 import z3
 
 from .encode import Encoder, term_to_rcl, value_to_rcl
+from .functable import finite_table
 from .retry import attempts, bounded_solver, load_canonical, variants
 
 DEFAULT_TIMEOUT_MS = 10_000
@@ -328,7 +329,12 @@ def render_model(model: z3.ModelRef, enc: Encoder | None) -> dict[str, str]:
         elif z3.is_app(else_v) and else_v.num_args() == 0 or z3.is_rational_value(else_v) or z3.is_int_value(else_v):
             rows.append(f"else -> {value_to_rcl(else_v)}")
         else:
-            body = z3.substitute_vars(else_v, *reversed(params)) if params else else_v
-            rows.append(f"({', '.join(map(str, params))}) -> {term_to_rcl(body)}")
+            table = finite_table(model, d, else_v, value_to_rcl)
+            if table is not None:  # an exact table: the points that differ, then the value elsewhere
+                rows = [f"({args}) -> {v}" for args, v in table[0]] + [f"else -> {table[1]}"]
+            else:
+                # Var(j) of a function interpretation stands for argument j (first to last)
+                body = z3.substitute_vars(else_v, *params) if params else else_v
+                rows.append(f"({', '.join(map(str, params))}) -> {term_to_rcl(body)}")
         out[display] = "{" + ", ".join(rows) + "}"
     return out
