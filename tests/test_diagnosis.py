@@ -338,3 +338,15 @@ def test_parallel_report_tasks_diagnose_one_at_a_time(newcomer: Path) -> None:
     t.join(60)
     assert done and ws.path(CACHE).exists()
     assert next(x for x in done[0] if x["id"] == "Controller.sc2")["repairs"]
+
+
+def test_a_branch_that_is_not_one_point_gives_no_table() -> None:
+    """Model-based instantiation writes branches as disjunctions or leaves an
+    argument free; then the last ``else`` is not the value elsewhere (the case
+    study's replacement counterexample read 128 there although every other
+    point maps to 0), so no table is claimed and the text is shown, cut."""
+    disjunct = "{(p1, p2) -> (if (((p1 == 1) and (p2 == 2)) or ((p1 == 3) and (p2 == 4))) then 0 else 128)}"
+    free = "{(p1, p2) -> (if (not (p1 == 1) and (p2 == 2)) then 0 else 128)}"
+    assert function_table(disjunct) is None and function_table(free) is None
+    row = counterexample_table({"Agent.in.wayP": disjunct})[0]
+    assert row["table"] is None and "128" in row["value"] and "else -> 128" not in row["value"]

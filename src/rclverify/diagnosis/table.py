@@ -5,7 +5,9 @@ A Z3 model arrives in RCL names (:func:`rclverify.logic.query.render_model`):
 Function-typed values become their finite table: one row per point the
 interpretation names (the positive equalities of each ``if`` branch), then
 the ``else`` value; a table longer than :data:`MAX_ROWS` rows is cut and
-the rest counted.  Exact rationals are printed as decimals (``0.2``, not
+the rest counted.  When a branch is not one point (a disjunction, or an
+argument it leaves free) the text is not a table, and it is shown as it is
+(cut): reading the last ``else`` as the value "elsewhere" would be false.  Exact rationals are printed as decimals (``0.2``, not
 ``1/5``; :func:`decimal_text`).  Nothing is ever shown as nested
 if-then-else text.
 """
@@ -135,12 +137,33 @@ def function_table(text: str, max_rows: int = MAX_ROWS) -> dict[str, Any] | None
             then_at = body.index(" then ", end)
             else_at = _top_else(body, then_at + 6)
             value = body[then_at + 6:else_at].strip()
+            point = _point(cond, params)
+            if "*" in point or _has_top_or(cond):
+                # a branch that is not one point (a disjunction, a free argument): the branches
+                # then say nothing of where the last else applies, so there is no table to show
+                return None
             if len(rows) < max_rows:
-                rows.append([_point(cond, params), decimals(value)])
+                rows.append([point, decimals(value)])
             else:
                 more += 1
             i = else_at + 6
     return {"rows": rows, "more": more, "else": default}
+
+
+def _has_top_or(cond: str) -> bool:
+    """Does the condition (parenthesised or not) have an ``or`` outside its inner parentheses?"""
+    body = cond.strip()
+    if body.startswith("(") and _balanced(body, 0) == len(body):
+        body = body[1:-1]
+    depth = 0
+    for j, c in enumerate(body):
+        if c == "(":
+            depth += 1
+        elif c == ")":
+            depth -= 1
+        elif depth == 0 and body.startswith(" or ", j):
+            return True
+    return False
 
 
 def _top_else(s: str, j: int = 0) -> int:
