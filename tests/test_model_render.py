@@ -72,3 +72,16 @@ def test_a_function_constant_off_a_grid_of_points_is_an_exact_table() -> None:
     from rclverify.diagnosis.table import function_table
     assert function_table(text) == {"rows": [["(3, 2)", "7"], ["(5, 4)", "12"]], "more": 0, "else": "1"}
     assert m.eval(g(z3.RealVal(3), z3.RealVal(4))).as_long() == 1  # a point on a numeral's line is elsewhere
+
+
+def test_a_function_that_returns_its_argument_is_not_made_a_table() -> None:
+    """f(x) = x except f(3) = 7 takes infinitely many values: it is printed as
+    its term, never as a table with one value elsewhere."""
+    from rclverify.logic.query import render_model
+    f = z3.Function("f", z3.IntSort(), z3.IntSort())
+    x = z3.Int("x")
+    s = z3.Solver()
+    s.add(z3.ForAll([x], z3.Implies(x != 3, f(x) == x)), f(3) == 7)
+    assert s.check() == z3.sat
+    text = render_model(s.model(), None)["f"]
+    assert "p1" in text and "else -> 4" not in text, text

@@ -52,7 +52,9 @@ def _numerals(body: z3.ExprRef, arity: int) -> list[set[Fraction]] | None:
         if e.get_id() in seen:
             continue
         seen.add(e.get_id())
-        if z3.is_var(e) or _numeral(e) is not None or z3.is_true(e) or z3.is_false(e):
+        if z3.is_var(e):  # an argument used as a value (f(x) = x): not constant on the grid's cells
+            return None
+        if _numeral(e) is not None or z3.is_true(e) or z3.is_false(e):
             continue
         if z3.is_and(e) or z3.is_or(e) or z3.is_not(e) or z3.is_app_of(e, z3.Z3_OP_ITE):
             todo.extend(e.children())
