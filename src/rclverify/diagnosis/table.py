@@ -155,19 +155,16 @@ def _has_top_or(cond: str) -> bool:
     body = cond.strip()
     if body.startswith("(") and _balanced(body, 0) == len(body):
         body = body[1:-1]
-    depth = 0
-    for j, c in enumerate(body):
-        if c == "(":
-            depth += 1
-        elif c == ")":
-            depth -= 1
-        elif depth == 0 and body.startswith(" or ", j):
-            return True
-    return False
+    return _top_level(body, " or ") < len(body)
 
 
 def _top_else(s: str, j: int = 0) -> int:
     """Index of the first `` else `` of ``s`` from ``j`` on, outside parentheses."""
+    return _top_level(s, " else ", j)
+
+
+def _top_level(s: str, word: str, j: int = 0) -> int:
+    """Index of the first ``word`` of ``s`` from ``j`` on outside parentheses (``len(s)`` if none)."""
     depth = 0
     while j < len(s):
         c = s[j]
@@ -175,7 +172,7 @@ def _top_else(s: str, j: int = 0) -> int:
             depth += 1
         elif c == ")":
             depth -= 1
-        elif depth == 0 and s.startswith(" else ", j):
+        elif depth == 0 and s.startswith(word, j):
             return j
         j += 1
     return len(s)
