@@ -11,7 +11,7 @@
 ``rclverify requirements``         check each formal requirement with Z3 and print its status
 ``rclverify verify [--strict] [--no-wait]``  the whole pipeline through doit (one run at a time per workspace)
 ``rclverify status``               the last run's summary and problems, running nothing
-``rclverify explain ID``           one problem's or obligation's diagnosis, counterexample and repairs
+``rclverify explain ID``           what the last report says of any id an output shows
 ``rclverify refines A.rcl:N B.rcl:M``  may contract M replace contract N?
 ``rclverify init DIR [--nodes A,B]``  write a new workspace that verifies at once
 ``rclverify bundle [-o FILE]``     the assessor's bundle; ``--verify FILE`` checks one
@@ -256,18 +256,6 @@ def _run_doit(module: object, argv: list[str], cluster: str | None) -> int:
             os.environ[CLUSTER_ENV] = before
 
 
-def _last_run(args: argparse.Namespace, name: str) -> Any:
-    """The JSON file ``name`` of the last run of the workspace, or a located
-    error (exit 1) when there is none."""
-    path = Path(args.workspace) / name
-    try:
-        return json.loads(path.read_text(encoding="utf-8"))
-    except FileNotFoundError:
-        raise RclError([_io_error(path, "no report yet: run `rclverify verify` (or `doit verify`) first")]) from None
-    except (OSError, ValueError) as exc:
-        raise RclError([_io_error(path, f"cannot read it: {exc}")]) from None
-
-
 def _io_error(path: Path, message: str) -> Any:
     from .rcl.ast import Loc
     from .rcl.errors import error
@@ -275,42 +263,46 @@ def _io_error(path: Path, message: str) -> Any:
 
 
 def cmd_status(args: argparse.Namespace) -> int:
-    """Print the last run's summary table, problems and diagnoses from
+    """Print the last run's overall line, problems (ROS grounding errors
+    among them), requirements line and summary table from
     ``artifacts/report/summary.json`` (the JSON report when there is none);
-    runs nothing.  Exit 0."""
-    from .diagnosis.text import status_lines
-    from .pipeline import Workspace
-    from .report.summary import print_summary, summary_data
-    try:
-        data = _last_run(args, Workspace.SUMMARY)
-    except RclError:
-        data = summary_data(_last_run(args, "reports/assurance.json"))
-    print("\n".join(status_lines(data)))
-    print_summary(data, "reports/assurance.html", rows=data["rows"])
+    runs nothing.  Exit 0; 1 (one located line) when neither is there or the
+    file read is of another shape (:mod:`rclverify.report.lastrun`)."""
+    from .report.summary import print_last_run
+    print_last_run(Path(args.workspace))
     return 0
 
 
 def cmd_explain(args: argparse.Namespace) -> int:
-    """Print the diagnosis of the problem or obligation ``args.id`` from the
-    last JSON report (``reports/assurance.json``): sentence, culprits,
-    counterexample table, repairs.  Exit 0; 1 (located) for an unknown id."""
-    from .diagnosis.text import explain_lines, natural_sorted
-    report = _last_run(args, "reports/assurance.json")
-    wanted = args.id
-    for d in report.get("diagnoses", []):
-        if d["id"] == wanted:
-            print("\n".join(explain_lines(d)))
-            return 0
-    for key, kind in (("obligations", "obligation"), ("side_conditions", "side condition"), ("findings", "health check")):
-        for x in report.get(key, []):
-            if x["id"] == wanted:
-                print(f"{wanted} [{x['status']}] ({kind}): no problem to diagnose"
-                      + (f"; {x.get('statement') or x.get('conjunct') or x.get('message')}" if kind else ""))
-                return 0
-    ids = natural_sorted([d["id"] for d in report.get("diagnoses", [])])
-    raise RclError([_io_error(Path(args.workspace) / "reports/assurance.json",
-                              f"no problem or obligation {wanted!r} in the last report"
-                              + (f"; problems: {', '.join(ids)}" if ids else "; it lists no problem"))])
+    """Print what the last JSON report (``reports/assurance.json``) says of
+    ``args.id``: any id an output shows (:mod:`rclverify.report.explain`:
+    requirement, node, guarantee, obligation, side condition, health check,
+    diagnosis, problem number, SARIF rule, ROS or lint code, argument
+    element).  Exit 0; 1 (one located line, with the closest ids) for an
+    unknown id or a report of another shape."""
+    from .report.explain import explain, id_kinds, near_ids
+    from .report.lastrun import located, read_report
+    root = Path(args.workspace)
+    report = read_report(root)
+    extra = []
+    for name in ("reports/assurance.sarif", "reports/argument.json"):
+        try:  # optional: their ids are looked up when they are there and readable
+            extra.append(json.loads((root / name).read_text(encoding="utf-8")))
+        except (OSError, ValueError):
+            extra.append(None)
+    try:
+        lines = explain(report, args.id, *extra)
+        near = [] if lines is not None else near_ids(report, args.id, *extra)
+    except (KeyError, TypeError, AttributeError, ValueError) as exc:  # a deeper field of another shape
+        raise located(root / "reports/assurance.json", f"not an rclverify report: cannot read it ({exc!r}); "
+                      "run `rclverify verify` (or `doit verify`) to write it again") from None
+    if lines is not None:
+        print("\n".join(lines))
+        return 0
+    hint = f"; did you mean {', '.join(near)}?" if near else ""
+    kinds = id_kinds(report)
+    raise located(root / "reports/assurance.json", f"no id {args.id!r} in the last report{hint}"
+                  + (f" (ids: {kinds})" if kinds else " (it has no requirement, node or problem)"))
 
 
 def cmd_cache(args: argparse.Namespace) -> int:
@@ -492,8 +484,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     add("cache", cmd_cache, "list what the workspace keeps between runs (artifacts/cache), or clear it",
         True).add_argument("--clear", action="store_true", help="delete artifacts/cache (always safe)")
     add("status", cmd_status, "print the last run's summary and problems (runs nothing)", True)
-    add("explain", cmd_explain, "print one problem's or obligation's diagnosis, counterexample and repairs",
-        True).add_argument("id", help="a problem id (as `rclverify status` lists them) or an obligation id")
+    add("explain", cmd_explain, "print what the last report says of an id: a requirement, node, guarantee "
+        "(Agent.g3), problem, obligation, side condition, health check, SARIF rule or ROS code", True).add_argument(
+        "id", help="any id an output shows (`rclverify status` lists the problems and their findings)")
     v = add("verify", cmd_verify, "run the whole pipeline with doit", True)
     v.add_argument("--strict", action="store_true",
                    help="exit 1 unless every obligation, side condition and health check holds")

@@ -24,6 +24,7 @@ from typing import Any, Mapping
 
 from typing import TYPE_CHECKING
 
+from doit.exceptions import TaskFailed
 from doit.reporter import ConsoleReporter
 
 from .doitstate import save_finished
@@ -79,6 +80,13 @@ def _after_fork_in_child() -> None:
 
 if hasattr(os, "register_at_fork"):
     os.register_at_fork(after_in_child=_after_fork_in_child)
+
+
+class PlainFailure(TaskFailed):  # type: ignore[misc]
+    """A task failure the user caused or asked for (``verify --strict`` on
+    open evidence, a last-run file of another shape): :class:`ProgressReporter`
+    prints its message alone, one plain line, instead of doit's
+    ``TaskFailed - taskid:NAME`` header; the run still exits 1."""
 
 
 def backend_of(obligation_id: str) -> str:
@@ -153,6 +161,9 @@ class ProgressReporter(ConsoleReporter):  # type: ignore[misc]
     def add_failure(self, task: Any, fail: Any) -> None:
         save_finished()
         self._finish(task)
+        if isinstance(fail, PlainFailure):  # one plain sentence, not doit's header (issue 30)
+            self.write(fail.message.rstrip("\n") + "\n")
+            return
         super().add_failure(task, fail)
 
     def skip_uptodate(self, task: Any) -> None:
@@ -175,11 +186,12 @@ class ProgressReporter(ConsoleReporter):  # type: ignore[misc]
             self.live = None
         super().complete_run()
         if self.verify_root is not None:  # nothing had to run: the last run's status all the same
+            from .rcl.errors import RclError
             from .report.summary import print_last_run
             try:
                 print_last_run(Path(self.verify_root))
-            except (OSError, ValueError):
-                pass  # no report to show (verify is up to date only after one was written)
+            except RclError as exc:  # no report to show, or one of another shape: its one located line
+                self.write("".join(f"{d}\n" for d in exc.diagnostics))
         from .cache.heap import freeze_at_exit, release_after_run
         from .runlock import release
         release()  # the workspace's run lock (rclverify.runlock): the next run may start

@@ -276,11 +276,15 @@ def act_verify(root: str, strict: bool) -> Any:
     """The ``verify`` task: print the run's status, problems and summary table
     (:func:`rclverify.report.summary.print_last_run`); with ``strict``, fail
     unless every item holds."""
-    from .report.summary import print_last_run
-    data = print_last_run(Path(root))
+    from .progress import PlainFailure
+    from .rcl.errors import RclError
+    from .report.summary import print_last_run, strict_sentence
+    try:
+        data = print_last_run(Path(root))
+    except RclError as exc:  # the last run's summary is missing or of another shape: one located line
+        return PlainFailure("\n".join(str(d) for d in exc.diagnostics))
     if strict and not data["meta"]["strict_ok"]:
-        return TaskFailed("--strict: some evidence is failed, inconclusive, pending, stale or error, or a side condition "
-                          "or contract health check is not proved (see reports/assurance.html)")
+        return PlainFailure(strict_sentence(data))  # one sentence naming why (issue 30)
     return None
 
 

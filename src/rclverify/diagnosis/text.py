@@ -1,11 +1,13 @@
 """Diagnosis records as terminal text (``rclverify explain``, ``status``)."""
 from __future__ import annotations
 
+import re
 from typing import Any, Mapping, Sequence
 
 
-#: Longest diagnosis sentence ``status`` prints (``explain`` prints it whole).
-SENTENCE = 400
+#: Longest diagnosis sentence ``status`` prints whole (``explain`` prints it
+#: whole always); a longer one is cut at a clause boundary (:func:`clause_cut`).
+SENTENCE = 600
 
 
 def _natural_key(text: str) -> list[Any]:
@@ -66,8 +68,47 @@ def explain_lines(d: Mapping[str, Any]) -> list[str]:
     return out
 
 
+_SENTENCE_END = re.compile(r"(?<=[.;])\s+(?=[A-Z])")
+
+
+def whole_first_sentence(text: str) -> str:
+    """The first sentence of ``text`` (up to a ``.`` or ``;`` followed by a
+    capital letter), never cut."""
+    return _SENTENCE_END.split(str(text).strip(), 1)[0]
+
+
+def _boundaries(text: str) -> list[int]:
+    """Where ``text`` may be cut: after a ``.``, ``;`` or ``:`` followed by a
+    space, outside parentheses, brackets, braces and backquoted formulas (a
+    ``:`` of ``file:line:col`` or a ``;`` inside a formula is no boundary)."""
+    out, depth, quoted = [], 0, False
+    for k, ch in enumerate(text):
+        if ch == "`":
+            quoted = not quoted
+        elif quoted:
+            continue
+        elif ch in "([{":
+            depth += 1
+        elif ch in ")]}":
+            depth = max(0, depth - 1)
+        elif ch in ".;:" and depth == 0 and text[k + 1:k + 2] == " ":
+            out.append(k + 1)
+    return out
+
+
+def clause_cut(text: str, limit: int = SENTENCE) -> str:
+    """``text`` whole when at most ``limit`` characters; otherwise cut at the
+    last sentence or clause boundary (:func:`_boundaries`) within ``limit``,
+    with `` ...``; whole again when it has no such boundary.  Never cuts
+    inside a clause: a cut text always ends at the end of one."""
+    if len(text) <= limit:
+        return text
+    cuts = [k for k in _boundaries(text) if k <= limit]
+    return text[:cuts[-1]] + " ..." if cuts else text
+
+
 def _short(sentence: str) -> str:
-    return sentence if len(sentence) <= SENTENCE else sentence[:SENTENCE].rsplit(" ", 1)[0] + " ..."
+    return clause_cut(sentence)
 
 
 def status_lines(data: Mapping[str, Any]) -> list[str]:

@@ -104,10 +104,103 @@ def summary_data(report: Mapping[str, Any]) -> dict[str, Any]:
     return {"meta": {"workspace": report["meta"]["workspace"], "strict_ok": report["meta"]["strict_ok"]},
             "summary": report["summary"], "rows": node_rows(report),
             "requirements": [[r["id"], r.get("verdict", ""), r["status"]] for r in report.get("requirements", ())],
-            "problems": [{"status": g["status"], "sentence": g.get("sentence", ""),
+            "problems": [{"status": g["status"], "sentence": group_sentence(g),
                           "culprits": [_culprit(c) for c in g.get("culprits", [])],
                           "members": [m["id"] for m in g.get("members", [])], "repairs": len(g.get("repairs", []))}
-                         for g in report.get("problems", ())]}
+                         for g in report.get("problems", ())],
+            "grounding": _grounding(report.get("grounding")), "strict": strict_reasons(report)}
+
+
+def group_sentence(group: Mapping[str, Any]) -> str:
+    """The first sentence of a problem group, whole: the report's row
+    (report/problems.py) cuts it to a length; the terminal cuts it only at
+    a clause boundary (:func:`rclverify.diagnosis.text.clause_cut`)."""
+    from ..diagnosis.text import whole_first_sentence
+    short = str(group.get("sentence", ""))
+    stem = short[:-4] if short.endswith(" ...") else None
+    for m in group.get("members", []):
+        whole = whole_first_sentence(m.get("sentence", ""))
+        if whole == short or (stem and whole.startswith(stem)):
+            return whole
+    return short
+
+
+def _grounding(g: Any) -> dict[str, Any] | None:
+    """The ROS grounding (docs/ros.md) as the terminal shows it: ``{"error":
+    n, "warning": m, "errors": ["file:line:col: message (CODE)", ...]}``;
+    ``None`` when the plan has no ``ros:`` section."""
+    if not isinstance(g, Mapping):
+        return None
+    errors = []
+    for f in g.get("findings", []):
+        if f.get("severity") == "error":
+            at = f.get("rcl") or f.get("ros") or {}
+            where = f"{at['file']}:{at.get('line', 1)}:{at.get('col', 1)}: " if at.get("file") else ""
+            errors.append(f"{where}{f.get('message', '')} ({f.get('code', '')})")
+    counts = g.get("counts", {})
+    return {"error": int(counts.get("error", len(errors))), "warning": int(counts.get("warning", 0)), "errors": errors}
+
+
+def strict_reasons(report: Mapping[str, Any]) -> list[str]:
+    """Why ``verify --strict`` fails on ``report``, as clauses (empty when
+    ``report["meta"]["strict_ok"]``): obligations not discharged by status,
+    guarantees no obligation covers, side conditions not proved, health
+    checks with a problem or undecided, ROS grounding errors (the gate of
+    :func:`rclverify.report.build.build_report`)."""
+    if report["meta"]["strict_ok"]:
+        return []
+    out = []
+    counts = {k: v for k, v in report["summary"].get("counts", {}).items() if k != "discharged" and v}
+    if counts:
+        n = sum(counts.values())
+        out.append(f"{n} obligation{'s are' if n != 1 else ' is'} not discharged ("
+                   + ", ".join(f"{v} {k}" for k, v in sorted(counts.items(), key=lambda kv: -_rank(kv[0]))) + ")")
+    bare = [f"{n['name']}.g{g['index']}" for n in report["nodes"] for g in n.get("guarantees", [])
+            if not g.get("obligations")]
+    if bare:
+        out.append(f"{len(bare)} guarantee{'s have' if len(bare) != 1 else ' has'} no evidence, no evidence entry "
+                   f"of the plan covers {'them' if len(bare) != 1 else 'it'} ("
+                   + ", ".join(bare[:4]) + (", ..." if len(bare) > 4 else "") + ")")
+    sc = [x for x in report["side_conditions"] if x["status"] != "discharged"]
+    if sc:
+        out.append(f"{len(sc)} side condition{'s are' if len(sc) != 1 else ' is'} not proved")
+    fs = [f for f in report["findings"] if f["status"] not in ("ok", "warning")]
+    if fs:
+        out.append(f"{len(fs)} contract health check{'s' if len(fs) != 1 else ''} found a problem or could not decide")
+    g = _grounding(report.get("grounding"))
+    if g and g["error"]:
+        out.append(f"{g['error']} ROS grounding error{'s' if g['error'] != 1 else ''} (`rclverify ros check`)")
+    return out
+
+
+def strict_sentence(data: Mapping[str, Any]) -> str:
+    """The one sentence a failed ``verify --strict`` ends with, from the
+    summary ``data`` (:func:`summary_data`): its ``strict`` reasons."""
+    reasons = list(data.get("strict") or [])
+    why = "; ".join(reasons) if reasons else ("some evidence is failed, inconclusive, pending, stale or error, or a "
+                                               "side condition or contract health check is not proved")
+    return f"--strict failed: {why} (reports/assurance.html)."
+
+
+def status_text(data: Mapping[str, Any]) -> list[str]:
+    """The overall line and the problems of the summary ``data``
+    (:func:`rclverify.diagnosis.text.status_lines`), with the ROS grounding
+    errors: counted on the overall line and listed one a line (they change
+    no verdict, docs/ros.md, but fail ``--strict``)."""
+    from ..diagnosis.text import status_lines
+    g = data.get("grounding") or {}
+    errors = int(g.get("error", 0) or 0)
+    if errors:  # listed below one a line, not as the report's one summary problem
+        data = {**data, "summary": {**data["summary"], "problems": [
+            p for p in data["summary"]["problems"] if not str(p).startswith("Grounding: ")]}}
+    lines = status_lines(data)
+    if errors:
+        plural = "s" if errors != 1 else ""
+        lines[0] = lines[0].rstrip(".") + f"; {errors} ROS grounding error{plural}."
+        lines.append(f"{errors} ROS grounding error{plural}: the contracts do not match the ROS software "
+                     f"(no verdict changes; `--strict` fails; `rclverify ros check`, docs/ros.md):")
+        lines += [f"  {e}" for e in g.get("errors", [])]
+    return lines
 
 
 def summary_table(report: Mapping[str, Any], colour: bool, rows: list[dict[str, Any]] | None = None) -> Table:
@@ -173,17 +266,13 @@ def print_last_run(root: Path) -> dict[str, Any]:
     (:func:`rclverify.diagnosis.text.status_lines`), the requirements line
     and the summary table.  Read from ``artifacts/report/summary.json``
     (written with the report), else from ``reports/assurance.json``.
-    Returns the summary data (:func:`summary_data`).  Raises ``OSError`` /
-    ``ValueError`` when neither file can be read."""
-    import json
-
-    from ..diagnosis.text import status_lines
-    from ..workspace import Workspace
-    try:
-        data: dict[str, Any] = json.loads((root / Workspace.SUMMARY).read_text(encoding="utf-8"))
-    except (OSError, ValueError):
-        data = summary_data(json.loads((root / "reports" / "assurance.json").read_text(encoding="utf-8")))
-    print("\n".join(status_lines(data)))
+    Returns the summary data (:func:`summary_data`).  Raises
+    :class:`~rclverify.rcl.errors.RclError` (one located line) when neither
+    file can be read or the one read is of another shape
+    (:mod:`rclverify.report.lastrun`)."""
+    from .lastrun import read_summary
+    data = read_summary(root)
+    print("\n".join(status_text(data)))
     if data.get("requirements"):
         print(requirements_line(data["requirements"]))
     print_summary(data, "reports/assurance.html", rows=data["rows"])

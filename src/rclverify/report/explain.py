@@ -1,0 +1,313 @@
+"""``rclverify explain ID``: any id an output of rclverify shows, looked up
+in the last report.
+
+The ids are those of the terminal (``status``, ``requirements``, the
+summary table), the reports and the CI files: requirements (``REQ1``),
+nodes (``FlightController``, also ``flight_controller``), guarantees
+(``Agent.g3``, ``Agent g3``, ``Agent guarantee 3``), obligations, side
+conditions, health findings, diagnoses, the problems ``status`` numbers
+(``1``), SARIF rule ids (``RCL-OBL-FAILED``), ROS grounding codes
+(``ROS-NODE-NOT-IN-GRAPH``), lint codes (``W-unused-bound``) and the
+assurance argument's elements (``G-system``).  An exact id wins; then the
+same id up to case, ``_`` and the separator between a node and its
+guarantee.  :func:`explain` gives the lines to print, :func:`near_ids` the
+closest ids (``difflib``) when nothing matches.
+"""
+from __future__ import annotations
+
+import difflib
+import re
+from typing import Any, Iterator, Mapping, Sequence
+
+from ..diagnosis.table import counterexample_table
+from ..diagnosis.text import clause_cut, explain_lines as diagnosis_lines, natural_sorted, table_lines
+from .summary import group_sentence
+
+_GUARANTEE = re.compile(r"^(?P<node>[A-Za-z_]\w*)\s*(?:[.:/#-]\s*|\s+)(?:g|guarantee\s*)(?P<k>\d+)$", re.IGNORECASE)
+_PROBLEM = re.compile(r"^(?:problem\s*|p)?(?P<k>\d+)\.?$", re.IGNORECASE)
+
+
+def _fold(text: str) -> str:
+    """An id up to case, ``_``/``-`` and spaces (``battery_monitor`` ~ ``BatteryMonitor``)."""
+    return re.sub(r"[\s_-]+", "", str(text)).lower()
+
+
+def requirement_lines(r: Mapping[str, Any]) -> list[str]:
+    """One requirement of the report as text: id, verdict, status, source;
+    its statement, formal statement, assumptions, the note; the premises a
+    proof used, those traced but not needed, an inconsistent or vacuity
+    core; a counterexample node by node and the guarantees that did not
+    prevent it (docs/requirements.md)."""
+    c = r.get("check") or {}
+    out = [f"{r['id']}: {r.get('verdict') or 'traced'} [{r['status']}]  {c.get('source') or ''}".rstrip(),
+           f"  {r.get('text') or ''}"]
+    if c.get("formal"):
+        out.append(f"  formal: {c['formal']}")
+    out += [f"  assuming: {a}" for a in c.get("assuming") or []]
+    if r.get("note"):
+        out.append(f"  {r['note']}")
+    out += [f"    used: {p['label']}: {p['text']}  ({p['source']})" for p in c.get("used") or []]
+    out += [f"    traced, not needed: {p['label']}" for p in c.get("traced_not_needed") or []]
+    out += [f"    contradictory: {p['label']}: {p['text']}  ({p['source']})" for p in c.get("inconsistent_core") or []]
+    out += [f"    premise never holds with: {p['label']}: {p['text']}  ({p['source']})"
+            for p in c.get("vacuity_core") or []]
+    for row in c.get("counterexample") or []:
+        out.append(f"    counterexample {row['node']}: " + ", ".join(f"{k} = {v}" for k, v in row["values"].items()))
+    out += [f"    did not prevent it: {p['label']}: {p['text']}  ({p['source']})" for p in c.get("failed_to_prevent") or []]
+    return out
+
+
+class _Index:
+    """The report's items by id (see the module docstring)."""
+
+    def __init__(self, report: Mapping[str, Any], sarif: Any = None, argument: Any = None) -> None:
+        self.report = report
+        self.diagnoses = {d["id"]: d for d in report.get("diagnoses") or []}
+        self.nodes = {n["name"]: n for n in report["nodes"]}
+        self.requirements = {r["id"]: r for r in report["requirements"]}
+        self.items: dict[str, tuple[str, Mapping[str, Any]]] = {}
+        for key, kind in (("findings", "health check"), ("side_conditions", "side condition"),
+                          ("obligations", "obligation")):
+            for x in report[key]:
+                self.items[x["id"]] = (kind, x)
+        self.evidence = {e.get("obligation"): e for e in report.get("evidence") or [] if isinstance(e, Mapping)}
+        self.problems = [g for g in report.get("problems") or [] if isinstance(g, Mapping)]
+        g = report.get("grounding") or {}
+        self.ros: dict[str, list[Mapping[str, Any]]] = {}
+        for f in g.get("findings") or []:
+            self.ros.setdefault(str(f.get("code", "")), []).append(f)
+        self.lint: dict[str, list[Mapping[str, Any]]] = {}
+        for w in report.get("lint") or []:
+            self.lint.setdefault(str(w.get("code", "")), []).append(w)
+        self.rules: dict[str, Mapping[str, Any]] = {}
+        self.results: dict[str, list[Mapping[str, Any]]] = {}
+        for run in (sarif or {}).get("runs", []) if isinstance(sarif, Mapping) else []:
+            for rule in run.get("tool", {}).get("driver", {}).get("rules", []):
+                self.rules[str(rule.get("id"))] = rule
+            for res in run.get("results", []):
+                self.results.setdefault(str(res.get("ruleId")), []).append(res)
+        elements = argument.get("elements") if isinstance(argument, Mapping) else None
+        self.argument = {str(e["id"]): e for e in elements or [] if isinstance(e, Mapping) and "id" in e}
+
+    def ids(self) -> list[str]:
+        """Every id this index answers to, for suggestions."""
+        out = list(self.requirements) + list(self.nodes)
+        out += [f"{n}.g{g['index']}" for n, node in self.nodes.items() for g in node.get("guarantees") or []]
+        out += list(self.diagnoses) + list(self.items) + list(self.rules) + list(self.results)
+        out += [c for c in self.ros if c] + [c for c in self.lint if c] + list(self.argument)
+        return list(dict.fromkeys(out))
+
+    # -- lookups, exact first ----------------------------------------------------
+    def find(self, wanted: str) -> list[str] | None:
+        for exact in (True, False):
+            for finder in (self._requirement, self._node, self._guarantee, self._item, self._problem,
+                           self._rule, self._argument):
+                lines = finder(wanted, exact)
+                if lines is not None:
+                    return lines
+        return None
+
+    def _match(self, wanted: str, keys: Iterator[str] | Sequence[str], exact: bool) -> str | None:
+        for k in keys:
+            if (k == wanted) if exact else (_fold(k) == _fold(wanted)):
+                return k
+        return None
+
+    def _with_diagnosis(self, key: str, lines: list[str]) -> list[str]:
+        d = self.diagnoses.get(key)
+        return lines + (["", "diagnosis:"] + diagnosis_lines(d) if d else [])
+
+    def _requirement(self, wanted: str, exact: bool) -> list[str] | None:
+        key = self._match(wanted, self.requirements, exact)
+        if key is None:
+            return None
+        lines = [f"requirement {requirement_lines(self.requirements[key])[0]}"] + requirement_lines(self.requirements[key])[1:]
+        return self._with_diagnosis(key, lines)
+
+    def _node(self, wanted: str, exact: bool) -> list[str] | None:
+        key = self._match(wanted, self.nodes, exact)
+        return None if key is None else self.node_lines(key)
+
+    def _guarantee(self, wanted: str, exact: bool) -> list[str] | None:
+        m = _GUARANTEE.match(wanted.strip())
+        if not m:
+            return None
+        key = self._match(m["node"], self.nodes, exact)
+        if key is None:
+            return None
+        for g in self.nodes[key].get("guarantees") or []:
+            if g["index"] == int(m["k"]):
+                return self.guarantee_lines(key, g)
+        return None
+
+    def _item(self, wanted: str, exact: bool) -> list[str] | None:
+        key = self._match(wanted, self.diagnoses, exact)  # a diagnosis says all an item row says, and more
+        if key is not None:
+            return diagnosis_lines(self.diagnoses[key])
+        key = self._match(wanted, self.items, exact)
+        return None if key is None else self.item_lines(key)
+
+    def _problem(self, wanted: str, exact: bool) -> list[str] | None:
+        m = _PROBLEM.match(wanted.strip())
+        if not exact or not m or not 1 <= int(m["k"]) <= len(self.problems):
+            return None
+        g = self.problems[int(m["k"]) - 1]
+        culprits = "; ".join(str(c.get("what") or c.get("source") or "") for c in g.get("culprits", [])) or "(no culprit named)"
+        out = [f"problem {m['k']} [{g.get('status')}]: {culprits}", f"  {clause_cut(group_sentence(g))}", "  findings:"]
+        for mem in g.get("members", []):
+            out.append(f"    {mem.get('id')} [{mem.get('status')}] ({mem.get('kind')}): `rclverify explain {mem.get('id')}`")
+        return out
+
+    def _rule(self, wanted: str, exact: bool) -> list[str] | None:
+        key = self._match(wanted, list(dict.fromkeys(list(self.rules) + list(self.results))), exact)
+        if key is not None:
+            rule = self.rules.get(key, {})
+            text = (rule.get("fullDescription") or rule.get("shortDescription") or {}).get("text", "")
+            results = self.results.get(key, [])
+            out = [f"{key} ({rule.get('name', 'SARIF rule')}): {text}".rstrip(": "),
+                   f"  {len(results)} result{'s' if len(results) != 1 else ''} in reports/assurance.sarif"
+                   + (":" if results else "")]
+            for res in results:
+                out.append(f"  {_sarif_place(res)}{clause_cut(_first_line(res.get('message', {}).get('text', '')))}")
+            return out
+        key = self._match(wanted, [c for c in self.ros if c], exact)
+        if key is not None:
+            return [f"{key}: {len(self.ros[key])} ROS grounding finding(s) (`rclverify ros check`, docs/ros.md):"] + [
+                f"  {_place(f.get('rcl') or f.get('ros'))}{f.get('severity')}: {f.get('message')}" for f in self.ros[key]]
+        key = self._match(wanted, [c for c in self.lint if c], exact)
+        if key is not None:
+            return [f"{key}: {len(self.lint[key])} lint warning(s):"] + [
+                f"  {w.get('location')}: {w.get('message')}" for w in self.lint[key]]
+        return None
+
+    def _argument(self, wanted: str, exact: bool) -> list[str] | None:
+        key = self._match(wanted, self.argument, exact)
+        if key is None:
+            return None
+        e = self.argument[key]
+        out = [f"{key} [{e.get('status') or '-'}] (argument {e.get('type')})", f"  {e.get('text', '')}"]
+        if e.get("supported_by"):
+            out.append("  supported by: " + ", ".join(e["supported_by"]))
+        if e.get("in_context_of"):
+            out.append("  in context of: " + ", ".join(e["in_context_of"]))
+        return out
+
+    # -- what is printed ---------------------------------------------------------
+    def item_lines(self, key: str) -> list[str]:
+        kind, x = self.items[key]
+        text = x.get("statement") or x.get("conjunct") or x.get("message") or ""
+        out = [f"{key} [{x['status']}] ({kind} of {x['node']}" + (f", {x['source']}" if x.get("source") else "") + ")",
+               f"  {text}"]
+        if kind == "obligation":
+            ev = self.evidence.get(key) or {}
+            out.append(f"  backend: {x.get('backend')}" + (f"; {ev['explanation']}" if ev.get("explanation") else ""))
+        elif x.get("explanation"):
+            out.append(f"  {x['explanation']}")
+        out += [f"  hypothesis: {h}" for h in x.get("hypotheses") or []]
+        out += [f"  core: {c}" for c in x.get("core") or []]
+        if x.get("model"):  # a health check's model when it holds is a witness, otherwise a counterexample
+            label = "witness" if x["status"] in ("discharged", "ok", "warning") else "counterexample"
+            out += [f"  {label}:"] + table_lines(counterexample_table(x["model"], x["node"]), "    ")
+        if x["status"] in ("discharged", "ok", "warning") and key not in self.diagnoses:
+            out.append("  no problem to diagnose")
+        return out
+
+    def guarantee_lines(self, node: str, g: Mapping[str, Any], indent: str = "") -> list[str]:
+        k = g["index"]
+        out = [f"{indent}{node}.g{k} [{g['status']}] (guarantee {k} of {node}, {g.get('source', '')})",
+               f"{indent}  {g['text']}"]
+        obs = [x for kind, x in self.items.values() if kind == "obligation" and x["node"] == node and x.get("guarantee") == k]
+        if not obs and not g.get("obligations"):
+            out.append(f"{indent}  evidence: none: no evidence entry of the plan covers it (`pending`; docs/plan.md)")
+        for o in obs:
+            out.append(f"{indent}  evidence: {o['id']} [{o['status']}] ({o.get('backend')})")
+        supports = [r["id"] for r in self.requirements.values()
+                    for s in r.get("support") or [] if s.get("node") == node and s.get("guarantee") == k]
+        if supports:
+            out.append(f"{indent}  supports: {', '.join(supports)}")
+        for f in self.report["findings"]:
+            if f["node"] == node and f.get("guarantee") == k and f["status"] not in ("ok", "warning"):
+                out.append(f"{indent}  health: {f['id']} [{f['status']}]: {clause_cut(f.get('message', ''), 300)}")
+        problems = [d for d in natural_sorted(list(self.diagnoses)) if d.startswith(f"{node}.g{k}.")]
+        if problems:
+            out.append(f"{indent}  problems: {', '.join(problems)} (`rclverify explain ID`)")
+        return out
+
+    def node_lines(self, node: str) -> list[str]:
+        n = self.nodes[node]
+        out = [f"{node} [{n['status']}] (node, {n.get('source', '')})"]
+        for label, key in (("inputs", "inputs"), ("outputs", "outputs")):
+            vs = n.get(key) or []
+            if vs:
+                out.append(f"  {label}: " + ", ".join(f"{v.get('name')} : {v.get('type')}" for v in vs))
+        out += [f"  assumption: {a.get('text')}  ({a.get('source')})" for a in n.get("assumptions") or []]
+        for g in n.get("guarantees") or []:
+            out += self.guarantee_lines(node, g, "  ")
+        sides = [x for kind, x in self.items.values() if kind == "side condition" and x["node"] == node]
+        if sides:
+            proved = sum(x["status"] == "discharged" for x in sides)
+            out.append(f"  side conditions: {proved}/{len(sides)} proved"
+                       + "".join(f"; {x['id']} [{x['status']}]" for x in sides if x["status"] != "discharged"))
+        health = [x for kind, x in self.items.values() if kind == "health check" and x["node"] == node]
+        bad = [x for x in health if x["status"] not in ("ok", "warning")]
+        if health:
+            out.append(f"  health: {len(health) - len(bad)}/{len(health)} ok" + "".join(f"; {x['id']} [{x['status']}]" for x in bad))
+        problems = [d for d in natural_sorted(list(self.diagnoses)) if d.split(".", 1)[0] == node]
+        out.append(f"  problems: {', '.join(problems)} (`rclverify explain ID`)" if problems else "  problems: none")
+        for f in (g for fs in self.ros.values() for g in fs):
+            if f.get("node") == node:
+                out.append(f"  ROS grounding {f.get('severity')}: {f.get('message')} ({f.get('code')})")
+        return out
+
+
+def _place(at: Any) -> str:
+    if isinstance(at, Mapping) and at.get("file"):
+        return f"{at['file']}:{at.get('line', 1)}:{at.get('col', 1)}: "
+    return ""
+
+
+def _sarif_place(res: Mapping[str, Any]) -> str:
+    for loc in res.get("locations") or []:
+        phys = loc.get("physicalLocation") or {}
+        uri = (phys.get("artifactLocation") or {}).get("uri")
+        region = phys.get("region") or {}
+        if uri:
+            return f"{uri}:{region.get('startLine', 1)}:{region.get('startColumn', 1)}: "
+    return ""
+
+
+def _first_line(text: str) -> str:
+    return str(text).strip().splitlines()[0] if str(text).strip() else ""
+
+
+def explain(report: Mapping[str, Any], wanted: str, sarif: Any = None, argument: Any = None) -> list[str] | None:
+    """The lines ``rclverify explain wanted`` prints from ``report`` (the
+    JSON report, shape-checked by :mod:`rclverify.report.lastrun`), the
+    parsed ``reports/assurance.sarif`` and ``reports/argument.json`` (either
+    may be ``None``); ``None`` when no id matches."""
+    return _Index(report, sarif, argument).find(wanted)
+
+
+def near_ids(report: Mapping[str, Any], wanted: str, sarif: Any = None, argument: Any = None,
+             n: int = 5) -> list[str]:
+    """At most ``n`` ids of ``report`` close to ``wanted``: ``difflib``'s
+    closest (case-folded), then those containing it."""
+    ids = _Index(report, sarif, argument).ids()
+    folded: dict[str, str] = {}
+    for i in ids:
+        folded.setdefault(i.lower(), i)
+    close = [folded[c] for c in difflib.get_close_matches(wanted.lower(), list(folded), n=n, cutoff=0.6)]
+    contains = [i for i in ids if wanted and _fold(wanted) in _fold(i)]
+    return list(dict.fromkeys(close + contains))[:n]
+
+
+def id_kinds(report: Mapping[str, Any]) -> str:
+    """A few ids of each kind, for the message when nothing matches."""
+    reqs = [r["id"] for r in report["requirements"]]
+    nodes = [n["name"] for n in report["nodes"]]
+    parts: list[tuple[str, Sequence[str]]] = [("requirements", reqs), ("nodes", nodes)]
+    if nodes and report["nodes"][0].get("guarantees"):
+        parts.append(("guarantees", [f"{nodes[0]}.g1"]))
+    parts.append(("problems", natural_sorted([d["id"] for d in report.get("diagnoses") or []])))
+    shown = [f"{what} {', '.join(list(xs)[:4])}{', ...' if len(xs) > 4 else ''}" for what, xs in parts if xs]
+    return "; ".join(shown)
