@@ -34,6 +34,18 @@ SUMMARY_SHAPE: dict[str, Any] = {
     "strict?": [str],
 }
 
+#: What :func:`rclverify.report.summary.summary_data` reads of a JSON report.
+_ROW = {"status": str, "node": str}
+SUMMARY_SOURCE_SHAPE: dict[str, Any] = {
+    "meta": {"workspace": str, "strict_ok": bool},
+    "summary": {"status": str, "headline": str, "problems": [str]},
+    "nodes": [{"name": str, "status": str}],
+    "obligations": [_ROW], "side_conditions": [_ROW], "findings": [_ROW],
+    "requirements?": [{"id": str, "status": str}],
+    "problems?": [dict],
+    "grounding?": (dict, type(None)),
+}
+
 _ITEM = {"id": str, "status": str, "node": str}
 REPORT_SHAPE: dict[str, Any] = {
     "meta": {"workspace": str, "strict_ok": bool},
@@ -140,7 +152,7 @@ def read_summary(root: Path) -> dict[str, Any]:
     if path.exists():
         data: dict[str, Any] = read_checked(path, SUMMARY_SHAPE, "an rclverify summary")
         return data
-    report = read_report(root)
+    report = read_checked(root / "reports/assurance.json", SUMMARY_SOURCE_SHAPE, "an rclverify report")
     try:
         return summary_data(report)
     except (KeyError, TypeError, AttributeError, ValueError) as exc:  # a deeper field of another shape
