@@ -94,6 +94,17 @@ def ident(text: str, camel: bool = False) -> str:
     return s + "_" if s in _RCL_WORDS else s
 
 
+def _contract_file(cname: str, nodes: list["_Node"]) -> str:
+    """``contracts/battery_monitor.rcl`` for node ``BatteryMonitor``: snake
+    case, as ``rclverify init`` names contract files; ``_`` appended while
+    another node already has the name (``ABc`` and ``Abc``)."""
+    stem = re.sub(r"(?<=[a-z0-9])(?=[A-Z])", "_", cname).lower()
+    taken = {n.file for n in nodes}
+    while f"contracts/{stem}.rcl" in taken or f"contracts/{stem}.rcl" == TYPES_FILE:
+        stem += "_"
+    return f"contracts/{stem}.rcl"
+
+
 @dataclass
 class _Node:
     name: str
@@ -158,7 +169,7 @@ def build_skeletons(res: ScanResult) -> tuple[list[_Node], dict[str, list[str]],
         while cname in used_names:
             cname += "_"
         used_names.add(cname)
-        n = _Node(cname, gname, gn.package, gn.executable, gn.sources, f"contracts/{ident(cname)}.rcl")
+        n = _Node(cname, gname, gn.package, gn.executable, gn.sources, _contract_file(cname, nodes))
         seen: set[str] = set()
         for kind, edges in (("in", gn.subscribes), ("out", gn.publishes)):
             for e in sorted(edges, key=lambda e: e.topic):
