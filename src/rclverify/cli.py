@@ -55,7 +55,9 @@ def cmd_check(args: argparse.Namespace) -> int:
     grouped = group_files(args.files, args.workspace, args.plan)
     for note in grouped.notes:
         print(note, file=sys.stderr)
-    errors, warnings = [], []
+    from .rcl.errors import Diagnostic
+    errors: list[Diagnostic] = []
+    warnings: list[Diagnostic] = []
     for scope in grouped.scopes:
         if scope.why and len(grouped.scopes) > 1:
             print(f"{', '.join(scope.files)}: {scope.why}")

@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import difflib
 import re
-from typing import Any, Iterator, Mapping, Sequence
+from typing import Any, Iterable, Mapping, Sequence
 
 from ..diagnosis.table import counterexample_table
 from ..diagnosis.text import clause_cut, explain_lines as diagnosis_lines, natural_sorted, table_lines
@@ -107,7 +107,7 @@ class _Index:
                     return lines
         return None
 
-    def _match(self, wanted: str, keys: Iterator[str] | Sequence[str], exact: bool) -> str | None:
+    def _match(self, wanted: str, keys: Iterable[str], exact: bool) -> str | None:
         for k in keys:
             if (k == wanted) if exact else (_fold(k) == _fold(wanted)):
                 return k
@@ -121,8 +121,8 @@ class _Index:
         key = self._match(wanted, self.requirements, exact)
         if key is None:
             return None
-        lines = [f"requirement {requirement_lines(self.requirements[key])[0]}"] + requirement_lines(self.requirements[key])[1:]
-        return self._with_diagnosis(key, lines)
+        first, *rest = requirement_lines(self.requirements[key])
+        return self._with_diagnosis(key, [f"requirement {first}", *rest])
 
     def _node(self, wanted: str, exact: bool) -> list[str] | None:
         key = self._match(wanted, self.nodes, exact)

@@ -1,7 +1,8 @@
 """The last run's JSON files, read with their shape checked.
 
 ``rclverify status``, ``rclverify explain`` and the end of ``doit verify``
-read ``artifacts/report/summary.json`` (:func:`rclverify.report.summary.summary_data`)
+read ``artifacts/report/summary.json`` (:func:`rclverify.report.summary.summary_data`;
+:func:`rclverify.report.summary.read_summary` reads it with these checks)
 and ``reports/assurance.json`` (:func:`rclverify.report.build.build_report`).
 Both are written by rclverify, but a user can edit, truncate or replace
 them; a file of another shape (``[]``, ``null``, a string, a missing key, a
@@ -138,25 +139,6 @@ def read_checked(path: Path, shape: Any, what: str) -> Any:
     if problem:
         raise located(path, f"not {what}: {problem}; run `rclverify verify` (or `doit verify`) to write it again")
     return data
-
-
-def read_summary(root: Path) -> dict[str, Any]:
-    """What ``status`` and ``verify`` print, from the workspace ``root``:
-    ``artifacts/report/summary.json`` when it is there (of any shape: a
-    broken one is an error, not silently replaced), else made from
-    ``reports/assurance.json``.  Raises :class:`RclError` as
-    :func:`read_checked` does."""
-    from ..workspace import Workspace
-    from .summary import summary_data
-    path = root / Workspace.SUMMARY
-    if path.exists():
-        data: dict[str, Any] = read_checked(path, SUMMARY_SHAPE, "an rclverify summary")
-        return data
-    report = read_checked(root / "reports/assurance.json", SUMMARY_SOURCE_SHAPE, "an rclverify report")
-    try:
-        return summary_data(report)
-    except (KeyError, TypeError, AttributeError, ValueError) as exc:  # a deeper field of another shape
-        raise located(root / "reports/assurance.json", f"not an rclverify report: cannot summarise it ({exc!r})") from None
 
 
 def read_report(root: Path) -> dict[str, Any]:

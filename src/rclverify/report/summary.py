@@ -131,7 +131,7 @@ def _grounding(g: Any) -> dict[str, Any] | None:
     ``None`` when the plan has no ``ros:`` section."""
     if not isinstance(g, Mapping):
         return None
-    errors = []
+    errors: list[str] = []
     for f in g.get("findings", []):
         if f.get("severity") == "error":
             at = f.get("rcl") or f.get("ros") or {}
@@ -149,7 +149,7 @@ def strict_reasons(report: Mapping[str, Any]) -> list[str]:
     :func:`rclverify.report.build.build_report`)."""
     if report["meta"]["strict_ok"]:
         return []
-    out = []
+    out: list[str] = []
     counts = {k: v for k, v in report["summary"].get("counts", {}).items() if k != "discharged" and v}
     if counts:
         n = sum(counts.values())
@@ -260,6 +260,26 @@ def requirements_line(rows: Sequence[Sequence[str]]) -> str:
                                                             if v in named else "") for v, ids in by.items())
 
 
+def read_summary(root: Path) -> dict[str, Any]:
+    """What ``status`` and ``verify`` print, from the workspace ``root``:
+    ``artifacts/report/summary.json`` when it is there (of any shape: a
+    broken one is an error, not silently replaced), else made from
+    ``reports/assurance.json``.  Raises
+    :class:`~rclverify.rcl.errors.RclError` (one located line) as
+    :func:`rclverify.report.lastrun.read_checked` does."""
+    from ..workspace import Workspace
+    from .lastrun import SUMMARY_SHAPE, SUMMARY_SOURCE_SHAPE, located, read_checked
+    path = root / Workspace.SUMMARY
+    if path.exists():
+        data: dict[str, Any] = read_checked(path, SUMMARY_SHAPE, "an rclverify summary")
+        return data
+    report = read_checked(root / "reports/assurance.json", SUMMARY_SOURCE_SHAPE, "an rclverify report")
+    try:
+        return summary_data(report)
+    except (KeyError, TypeError, AttributeError, ValueError) as exc:  # a deeper field of another shape
+        raise located(root / "reports/assurance.json", f"not an rclverify report: cannot summarise it ({exc!r})") from None
+
+
 def print_last_run(root: Path) -> dict[str, Any]:
     """Print what ``doit verify`` ends with, from the last run's files in the
     workspace ``root``: the overall line and the problems by root cause
@@ -270,7 +290,6 @@ def print_last_run(root: Path) -> dict[str, Any]:
     :class:`~rclverify.rcl.errors.RclError` (one located line) when neither
     file can be read or the one read is of another shape
     (:mod:`rclverify.report.lastrun`)."""
-    from .lastrun import read_summary
     data = read_summary(root)
     print("\n".join(status_text(data)))
     if data.get("requirements"):
