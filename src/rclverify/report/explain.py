@@ -21,7 +21,16 @@ from typing import Any, Iterable, Mapping, Sequence
 
 from ..diagnosis.table import counterexample_table
 from ..diagnosis.text import clause_cut, explain_lines as diagnosis_lines, natural_sorted, table_lines
+from ..evidence.records import SEVERITY
 from .summary import group_sentence
+
+#: At most this many obligations of one guarantee are listed one a line; more are counted.
+SHOWN_OBLIGATIONS = 6
+
+
+def _rank(status: str) -> int:
+    return SEVERITY.get(status, SEVERITY["error"])
+
 
 _GUARANTEE = re.compile(r"^(?P<node>[A-Za-z_]\w*)\s*(?:[.:/#-]\s*|\s+)(?:g|guarantee\s*)(?P<k>\d+)$", re.IGNORECASE)
 _PROBLEM = re.compile(r"^(?:problem\s*|p)?(?P<k>\d+)\.?$", re.IGNORECASE)
@@ -135,6 +144,8 @@ class _Index:
         key = self._match(m["node"], self.nodes, exact)
         if key is None:
             return None
+        if int(m["k"]) == 0:  # "guarantee 0" of obligation ids (Agent.g0.dafny.contract): the whole contract
+            return self.node_lines(key)
         for g in self.nodes[key].get("guarantees") or []:
             if g["index"] == int(m["k"]):
                 return self.guarantee_lines(key, g)
@@ -219,8 +230,16 @@ class _Index:
         obs = [x for kind, x in self.items.values() if kind == "obligation" and x["node"] == node and x.get("guarantee") == k]
         if not obs and not g.get("obligations"):
             out.append(f"{indent}  evidence: none: no evidence entry of the plan covers it (`pending`; docs/plan.md)")
-        for o in obs:
-            out.append(f"{indent}  evidence: {o['id']} [{o['status']}] ({o.get('backend')})")
+        if len(obs) <= SHOWN_OBLIGATIONS:
+            out += [f"{indent}  evidence: {o['id']} [{o['status']}] ({o.get('backend')})" for o in obs]
+        else:  # many instances (AJPF's one per waypoint): counted, the bad ones named
+            groups: dict[tuple[str, str], int] = {}
+            for o in obs:
+                groups[(o["status"], str(o.get("backend")))] = groups.get((o["status"], str(o.get("backend"))), 0) + 1
+            out.append(f"{indent}  evidence: {len(obs)} obligations: " + ", ".join(
+                f"{n} {st} ({be})" for (st, be), n in sorted(groups.items(), key=lambda kv: -_rank(kv[0][0]))))
+            out += [f"{indent}    {o['id']} [{o['status']}]" for o in obs
+                    if o["status"] not in ("discharged", "pending")]
         supports = [r["id"] for r in self.requirements.values()
                     for s in r.get("support") or [] if s.get("node") == node and s.get("guarantee") == k]
         if supports:
@@ -241,6 +260,9 @@ class _Index:
             if vs:
                 out.append(f"  {label}: " + ", ".join(f"{v.get('name')} : {v.get('type')}" for v in vs))
         out += [f"  assumption: {a.get('text')}  ({a.get('source')})" for a in n.get("assumptions") or []]
+        whole = [x for kind, x in self.items.values()
+                 if kind == "obligation" and x["node"] == node and x.get("guarantee") in (0, None)]
+        out += [f"  evidence for the whole contract: {o['id']} [{o['status']}] ({o.get('backend')})" for o in whole]
         for g in n.get("guarantees") or []:
             out += self.guarantee_lines(node, g, "  ")
         sides = [x for kind, x in self.items.values() if kind == "side condition" and x["node"] == node]
