@@ -81,7 +81,8 @@ def _boundaries(text: str) -> list[int]:
     """Where ``text`` may be cut: after a ``.``, ``;`` or ``:`` followed by a
     space, outside parentheses, brackets, braces and backquoted formulas (a
     ``:`` of ``file:line:col`` or a ``;`` inside a formula is no boundary)."""
-    out, depth, quoted = [], 0, False
+    out: list[int] = []
+    depth, quoted = 0, False
     for k, ch in enumerate(text):
         if ch == "`":
             quoted = not quoted

@@ -17,8 +17,8 @@ def show_requirements(ws: "Workspace", out: TextIO) -> int:
     refuted one, the counterexample node by node.  Returns the exit code:
     1 when one is refuted, proved from an inconsistency or inconclusive."""
     from ..report.build import build_report
-    report = build_report(ws)
     from ..report.explain import requirement_lines
+    report = build_report(ws)
     bad = 0
     for r in report["requirements"]:
         out.write("".join(line + "\n" for line in requirement_lines(r)))
