@@ -290,3 +290,16 @@ def test_the_readme_lists_every_ros_command() -> None:
     for name in commands:
         assert f"rclverify ros {name}" in block, name
     assert "rclverify init DIR --from-ros PATH" in block
+
+
+def test_explain_leaves_out_an_optional_file_of_another_shape(drone: Path, tmp_path: Path,
+                                                              capsys: pytest.CaptureFixture[str]) -> None:
+    ws = tmp_path / "ws"
+    shutil.copytree(drone, ws)
+    (ws / "reports/assurance.sarif").write_text('{"runs": "x"}', encoding="utf-8")
+    (ws / "reports/argument.json").write_text('{"elements": 3}', encoding="utf-8")
+    assert main(["explain", "-w", str(ws), "SAFE-ALT"]) == 0
+    assert capsys.readouterr().out.startswith("requirement SAFE-ALT: ")
+    assert main(["explain", "-w", str(ws), "RCL-REQ-EVIDENCE"]) == 1  # known only from the SARIF log
+    (line,) = capsys.readouterr().err.splitlines()
+    assert LOCATED.match(line) and "Traceback" not in line

@@ -90,13 +90,17 @@ class _Index:
             self.lint.setdefault(str(w.get("code", "")), []).append(w)
         self.rules: dict[str, Mapping[str, Any]] = {}
         self.results: dict[str, list[Mapping[str, Any]]] = {}
-        for run in (sarif or {}).get("runs", []) if isinstance(sarif, Mapping) else []:
-            for rule in run.get("tool", {}).get("driver", {}).get("rules", []):
-                self.rules[str(rule.get("id"))] = rule
-            for res in run.get("results", []):
-                self.results.setdefault(str(res.get("ruleId")), []).append(res)
+        try:  # the SARIF log and the argument are optional: one of another shape is left out
+            for run in sarif.get("runs", []) if isinstance(sarif, Mapping) else []:
+                for rule in run.get("tool", {}).get("driver", {}).get("rules", []):
+                    self.rules[str(rule.get("id"))] = rule
+                for res in run.get("results", []):
+                    self.results.setdefault(str(res.get("ruleId")), []).append(res)
+        except (AttributeError, TypeError):
+            self.rules, self.results = {}, {}
         elements = argument.get("elements") if isinstance(argument, Mapping) else None
-        self.argument = {str(e["id"]): e for e in elements or [] if isinstance(e, Mapping) and "id" in e}
+        self.argument = {str(e["id"]): e for e in elements if isinstance(e, Mapping) and "id" in e} \
+            if isinstance(elements, list) else {}
 
     def ids(self) -> list[str]:
         """Every id this index answers to, for suggestions."""
