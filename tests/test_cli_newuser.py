@@ -280,9 +280,9 @@ def test_the_readme_lists_every_ros_command() -> None:
     import argparse
 
     from rclverify.ros.cli import add_parsers
-    p = argparse.ArgumentParser()
-    add_parsers(p.add_subparsers(dest="command"))
-    ros = p._subparsers._group_actions[0].choices["ros"]  # type: ignore[union-attr]
+    sub = argparse.ArgumentParser().add_subparsers(dest="command")
+    add_parsers(sub)
+    ros = sub.choices["ros"]
     commands: Any = next(a for a in ros._actions if isinstance(a, argparse._SubParsersAction)).choices
     readme = (ROOT / "README.md").read_text(encoding="utf-8")
     block = readme.split("## Command line", 1)[1].split("```", 2)[1]
