@@ -175,9 +175,24 @@ def _syntax_error(exc: UnexpectedInput, text: str, file: str) -> GwendolenError:
         return located(file, line, col, f"unexpected character {text[exc.pos_in_stream]!r}")
     tok = exc.token if isinstance(exc, UnexpectedToken) else None
     shown = repr(str(tok)) if tok is not None else "input"
-    expected = sorted(getattr(exc, "expected", ()) or ())
-    hint = f" (expected one of: {', '.join(expected[:8])})" if expected else ""
+    expected = sorted({_terminal_text(name) for name in getattr(exc, "expected", ()) or ()})
+    hint = f" (expected one of: {', '.join(expected[:12])})" if expected else ""
     return located(file, line, col, f"unexpected {shown}{hint}")
+
+
+_TERMINAL_WORDS = {"NAME": "a name", "VAR": "a variable", "NUMBER": "a number", "STRING": "a string",
+                   "SIGN": "'+' or '-'", "RULES_HDR": "':Reasoning Rules:'", "_END": "';'", "DOT_NAME": "'.name'", "CMP": "a comparison"}
+
+
+def _terminal_text(name: str) -> str:
+    """A terminal of the grammar as a reader knows it (``':'`` rather than ``COLON``)."""
+    if name in _TERMINAL_WORDS:
+        return _TERMINAL_WORDS[name]
+    try:
+        pattern = _parser().get_terminal(name).pattern
+    except KeyError:  # pragma: no cover - every expected terminal is the grammar's
+        return name
+    return repr(pattern.value) if pattern.type == "str" else name
 
 
 class _Builder:
@@ -256,7 +271,7 @@ class _Builder:
     def trigger(self, node: Tree) -> Trigger:
         kids = node.children
         if node.data == "unsupported_trigger":
-            raise self._unsupported(kids[1], f"{kids[0]}{kids[1]} (as a plan trigger)")
+            raise self._unsupported(node, f"{kids[0]}{kids[1]} (as a plan trigger)")
         sign = str(kids[0])
         if node.data == "goal_trigger":
             gtype = self.goal_type(kids[2]) if len(kids) > 2 else DEFAULT_GOAL_TYPE
