@@ -212,6 +212,8 @@ def test_environment_from_plan_shape_and_defaults():
     assert env.choices(2)[1] == (psl.Compound("movebase_result", (psl.Num("2"), psl.Num("3"))),)
     every = environment_from_plan({"percepts": ["a", "b"], "at_most": 2})
     assert every.after is None and every.reacts_to(psl.Sym("anything")) and len(every.choices(1)) == 4
+    always = environment_from_plan({"percepts": ["a", "b"], "at_least": 1})
+    assert always.choices(1) == [(psl.Sym("a"),), (psl.Sym("b"),)]
 
 
 @pytest.mark.parametrize("raw, message, path", [
@@ -222,6 +224,7 @@ def test_environment_from_plan_shape_and_defaults():
     ({"percepts": ["a", "f(X)"]}, "percepts[1] 'f(X)' is not a term", ("percepts", 1)),
     ({"percepts": ["a", "a"]}, "percepts[1] 'a' is listed twice", ("percepts", 1)),
     ({"percepts": ["a"], "at_most": 2}, "'at_most' must be an integer from 1 to 1", ("at_most",)),
+    ({"percepts": ["a"], "at_least": 2}, "'at_least' must be an integer from 0 to 1", ("at_least",)),
     ({"percepts": ["a"], "after": ["Move"]}, "'after' must be \"action\"", ("after",)),
     ({"percepts": ["a"], "initial": ["f(_)"]}, "initial[0] 'f(_)': an initial percept must be ground", ("initial", 0)),
 ])

@@ -14,12 +14,13 @@ environment")::
       percepts: ["movebase_result(_, 3)", "movebase_result(_, 2)", danger_red, danger_orange]
       after: [move]          # or "action": after every action (the default)
       at_most: 1             # how many of the percepts at once (default 1)
+      at_least: 0            # 1: the environment always sends something (default 0)
       initial: []            # the percepts before the first action (default none)
 
 After each action whose name is in ``after``, the environment *reacts*: it
-replaces its percepts by any set of at most ``at_most`` of the declared
-percepts (the empty set among them: nothing is perceived, the previous
-percepts are retracted).  Each choice is a branch of the explored graph.
+replaces its percepts by any set of at least ``at_least`` and at most
+``at_most`` of the declared percepts (with ``at_least`` 0 the empty set is
+among them: nothing is perceived, the previous percepts are retracted).  Each choice is a branch of the explored graph.
 ``_`` in a declared percept stands for the identifier of the action the
 reaction answers: 1 for the first reaction, then 2, 1, 2 ... alternately,
 so that the result of the second ``move`` is a new percept even when it
@@ -39,7 +40,7 @@ from ...plan.errors import PlanError, plan_error
 from ...rcl.ast import Loc
 from ..ajpf import psl
 
-KEYS = ("percepts", "after", "at_most", "initial")
+KEYS = ("percepts", "after", "at_most", "at_least", "initial")
 #: Bound on the branches of one reaction (subsets of the declared percepts).
 MAX_CHOICES = 4096
 
@@ -52,14 +53,15 @@ class Environment:
 
     ``percepts`` the declared percepts (ground but for ``_``, the reaction
     number); ``after`` the action names it reacts to, ``None`` for every
-    action; ``at_most`` the largest number of percepts at once; ``initial``
-    the percepts of the initial state (ground).
+    action; ``at_most``/``at_least`` the largest/smallest number of percepts
+    at once; ``initial`` the percepts of the initial state (ground).
     """
 
     percepts: tuple[psl.Term, ...]
     after: tuple[str, ...] | None = None
     at_most: int = 1
     initial: tuple[psl.Term, ...] = ()
+    at_least: int = 0
 
     def reacts_to(self, action: psl.Term) -> bool:
         """Whether the environment reacts after ``action``."""
@@ -68,11 +70,11 @@ class Environment:
 
     def choices(self, reaction: int) -> list[tuple[psl.Term, ...]]:
         """The percept sets the ``reaction``-th reaction may choose, in a fixed
-        order: nothing first, then single percepts in declared order, then
-        pairs ...; ``_`` replaced by ``reaction``."""
+        order: nothing first (unless ``at_least`` > 0), then single percepts
+        in declared order, then pairs ...; ``_`` replaced by ``reaction``."""
         filled = [fill(p, reaction) for p in self.percepts]
         out: list[tuple[psl.Term, ...]] = []
-        for k in range(0, min(self.at_most, len(filled)) + 1):
+        for k in range(self.at_least, min(self.at_most, len(filled)) + 1):
             out.extend(tuple(c) for c in combinations(filled, k))
         return out
 
@@ -80,7 +82,8 @@ class Environment:
         """One line for reports: ``after move: one of movebase_result(_, 3), ... or nothing``."""
         when = "after every action" if self.after is None else "after " + ", ".join(self.after)
         what = ", ".join(psl.term_text(p) for p in self.percepts)
-        return f"{when}: at most {self.at_most} of {what} (or nothing)"
+        nothing = " (or nothing)" if self.at_least == 0 else ""
+        return f"{when}: {self.at_least} to {self.at_most} of {what}{nothing}"
 
 
 def fill(term: psl.Term, reaction: int) -> psl.Term:
@@ -108,7 +111,8 @@ def environment_from_plan(raw: Mapping[str, Any], locate: Locate | None = None) 
     key, a missing or empty ``percepts``, a percept that is not a term, a
     variable in a percept, ``_`` in an initial percept, an ``after`` that is
     neither ``"action"`` nor a list of action names, an ``at_most`` that is
-    not an integer from 1 to the number of percepts, or more than
+    not an integer from 1 to the number of percepts, an ``at_least`` not
+    from 0 to ``at_most``, or more than
     :data:`MAX_CHOICES` branches per reaction.
     """
     def err(message: str, *path: Any, col_offset: int = 0) -> PlanError:
@@ -142,8 +146,11 @@ def environment_from_plan(raw: Mapping[str, Any], locate: Locate | None = None) 
     if isinstance(at_most, bool) or not isinstance(at_most, int) or not 1 <= at_most <= len(percepts):
         raise err(f"'at_most' must be an integer from 1 to {len(percepts)} (the number of percepts), "
                   f"found {at_most!r}", "at_most")
-    env = Environment(tuple(percepts), after, at_most, tuple(initial))
-    branches = sum(comb(len(percepts), k) for k in range(at_most + 1))
+    at_least = raw.get("at_least", 0)
+    if isinstance(at_least, bool) or not isinstance(at_least, int) or not 0 <= at_least <= at_most:
+        raise err(f"'at_least' must be an integer from 0 to {at_most} ('at_most'), found {at_least!r}", "at_least")
+    env = Environment(tuple(percepts), after, at_most, tuple(initial), at_least)
+    branches = sum(comb(len(percepts), k) for k in range(at_least, at_most + 1))
     if branches > MAX_CHOICES:
         raise err(f"{branches} choices per reaction exceed the bound of {MAX_CHOICES}; lower 'at_most'",
                   "at_most")
