@@ -184,6 +184,18 @@ def test_unbound_variable_in_a_deed_is_a_located_error(tmp_path):
         explore(p, "unbound.gwen", QUIET)
 
 
+def test_runaway_rules_and_wildcard_additions_are_located_errors(tmp_path):
+    loop = tmp_path / "loop.gwen"
+    loop.write_text("GWENDOLEN\n:name: a\n:Reasoning Rules:\nup :- up;\n:Initial Goals:\ng [perform]\n"
+                    ":Plans:\n+!g [perform] : { B up } <- go;\n")
+    with pytest.raises(GwendolenError, match=r"^loop.gwen:4:1: error: reasoning rules nest deeper than 64"):
+        explore(loop, "loop.gwen", QUIET)
+    wild = tmp_path / "wild.gwen"
+    wild.write_text("GWENDOLEN\n:name: a\n:Initial Goals:\ng [perform]\n:Plans:\n+!g [perform] <- +seen(_);\n")
+    with pytest.raises(GwendolenError, match=r"^wild.gwen:6:18: error: '_' in deed \+seen\(_\)"):
+        explore(wild, "wild.gwen", QUIET)
+
+
 # -- the verification environment --------------------------------------------
 
 def test_environment_branches_after_the_declared_actions_only():
@@ -272,6 +284,33 @@ def test_jackal_inspects_and_records_every_waypoint(jackal):
     at12 = [i for i in n if g.holds(i, atom("B(jackal, going(12))")) and g.holds(i, atom("B(jackal, movebase_result(_, 3))"))
             and g.holds(i, atom("B(jackal, inspected(11))"))]
     assert at12 and all(any(g.holds(j, atom("B(jackal, going(0))")) for j in reachable(g, i)) for i in at12)
+
+
+DIGEST = """
+import hashlib, sys
+from pathlib import Path
+from rclverify.backends.ajpf import psl
+from rclverify.backends.model_checking.environment import environment_from_plan
+from rclverify.backends.model_checking.explore import explore
+g = explore(Path(sys.argv[1]), "jackal.gwen", environment_from_plan(%r))
+rows = [sorted(psl.term_text(t) for t in s.beliefs) + ["|"] + sorted(psl.term_text(t) for t in s.goals)
+        + ["|", psl.term_text(s.last_action) if s.last_action else ""] for s in g.states]
+print(hashlib.sha256(repr((rows, g.transitions)).encode()).hexdigest())
+""" % (CASE_STUDY_ENV,)
+
+
+def test_the_graph_does_not_depend_on_the_hash_seed():
+    """State numbering and labels are the same in every process (evidence is reproducible)."""
+    import os
+    import subprocess
+    import sys
+    digests = set()
+    for seed in ("1", "2"):
+        env = {**os.environ, "PYTHONHASHSEED": seed}
+        out = subprocess.run([sys.executable, "-c", DIGEST, str(JACKAL)], env=env, capture_output=True, text=True,
+                             timeout=120, check=True)
+        digests.add(out.stdout.strip())
+    assert len(digests) == 1
 
 
 def test_bounds_cut_the_exploration(jackal):
