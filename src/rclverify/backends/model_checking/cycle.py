@@ -25,12 +25,12 @@ choices with the perception each one causes.
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
-from typing import Iterable, NamedTuple
+from typing import Iterable, Iterator, NamedTuple
 
 from ..ajpf import psl
 from .environment import Environment
-from .gwendolen import Deed, Plan, Program, Term, located
-from .unify import Beliefs, Subst, ground, unify
+from .gwendolen import Deed, Plan, Program, Term, as_psl, located
+from .unify import Beliefs, Subst, ground, substitute, unify
 
 
 @dataclass(frozen=True)
@@ -94,8 +94,8 @@ def _sorted(terms: Iterable[psl.Term]) -> tuple[psl.Term, ...]:
 
 def initial_state(program: Program, env: Environment) -> AgentState:
     """Initial beliefs, one intention per initial goal (in order), the initial percepts perceived."""
-    intents = tuple((Frame(Event("+", g, t)),) for g, t in program.goals)  # type: ignore[arg-type]
-    state = AgentState(_sorted(program.beliefs), intents)  # type: ignore[arg-type]
+    intents = tuple((Frame(Event("+", as_psl(g), t)),) for g, t in program.goals)
+    state = AgentState(_sorted(as_psl(b) for b in program.beliefs), intents)
     return perceive(state, _sorted(env.initial))
 
 
@@ -194,7 +194,7 @@ class Cycle:
                 return plan, answer
         return None
 
-    def _guard(self, plan: Plan, i: int, s: Subst, bel: Beliefs, gs: list[psl.Term]):
+    def _guard(self, plan: Plan, i: int, s: Subst, bel: Beliefs, gs: list[psl.Term]) -> Iterator[Subst]:
         if i == len(plan.guard):
             yield s
             return
@@ -202,9 +202,12 @@ class Cycle:
         if lit.kind == "T":
             answers: Iterable[Subst] = [s]
         elif lit.kind == "B":
-            answers = bel.solve(lit.term, s)  # type: ignore[arg-type]
+            assert lit.term is not None
+            answers = bel.solve(lit.term, s)
         else:
-            answers = (s2 for g in gs if (s2 := unify(lit.term, g, s)) is not None)  # type: ignore[arg-type]
+            query = lit.term
+            assert query is not None
+            answers = (s2 for g in gs if (s2 := unify(query, g, s)) is not None)
         if lit.positive:
             for s2 in answers:
                 yield from self._guard(plan, i + 1, s2, bel, gs)
@@ -213,7 +216,6 @@ class Cycle:
 
     def _ground_deed(self, deed: Deed, s: Subst) -> Deed:
         if deed.kind == "-b":  # a deletion may keep '_' and unbound variables: it deletes every match
-            from .unify import substitute
             return replace(deed, term=substitute(deed.term, s))
         return replace(deed, term=ground(deed.term, s, self.src, deed.line, deed.col, f"deed {deed.text()}"))
 
@@ -225,30 +227,30 @@ class Cycle:
         assert top.deeds
         deed, remaining = top.deeds[0], top.deeds[1:]
         intent = intent[:-1] + (replace(top, deeds=remaining),)
-        term = deed.term
+        term = as_psl(deed.term)  # ground, but for '_' and unbound variables in a deletion
         beliefs = list(state.beliefs)
         last, pending = state.last_action, None
         if deed.kind == "+b":
             _no_wild(term, deed, self.src)
             if term not in beliefs:
-                beliefs.append(term)  # type: ignore[arg-type]
-                posted.append((Frame(Event("+", term)),))  # type: ignore[arg-type]
+                beliefs.append(term)
+                posted.append((Frame(Event("+", term)),))
         elif deed.kind == "-b":
             for b in [b for b in beliefs if unify(term, b, {}) is not None]:
                 beliefs.remove(b)
                 posted.append((Frame(Event("-", b)),))
         elif deed.kind == "+!":
             _no_wild(term, deed, self.src)
-            intent = intent + (Frame(Event("+", term, deed.goal_type)),)  # type: ignore[arg-type]
+            intent = intent + (Frame(Event("+", term, deed.goal_type)),)
         elif deed.kind == "-!":
             bel = self.beliefs(replace(state, beliefs=_sorted(beliefs)))
             rest = tuple(i for i in (self._drop_goal(i, term, deed.goal_type, bel) for i in rest) if i)
             intent = self._drop_goal(intent, term, deed.goal_type, bel)
-            posted.append((Frame(Event("-", term, deed.goal_type)),))  # type: ignore[arg-type]
+            posted.append((Frame(Event("-", term, deed.goal_type)),))
         else:
             _no_wild(term, deed, self.src)
             last = term
-            if self.env.reacts_to(term):  # type: ignore[arg-type]
+            if self.env.reacts_to(term):
                 pending = term
         new = replace(state, beliefs=_sorted(beliefs), last_action=last, pending=pending)
         intent = self.settle(intent, self.beliefs(new))

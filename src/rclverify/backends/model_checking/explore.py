@@ -17,20 +17,20 @@ from ..ajpf import psl
 from .cycle import AgentState, Cycle, goals, initial_state
 from .environment import Environment
 from .graph import MentalState, StateGraph, Transition
-from .gwendolen import Program, parse_file
+from .gwendolen import Program, as_psl, parse_file
 
 
 def mental_state(state: AgentState) -> MentalState:
     """What the property language's atoms see of ``state`` (graph.MentalState's fields)."""
     bases = [i[0].event.term for i in state.intentions if i[0].event.goal_type and i[0].event.sign == "+"]
-    acts = [i[-1].deeds[0].term for i in state.intentions
-            if i[-1].deeds and i[-1].deeds[0].kind == "act"]
+    acts = [as_psl(deeds[0].term) for i in state.intentions
+            if (deeds := i[-1].deeds) and deeds[0].kind == "act"]
     return MentalState(
         beliefs=frozenset(state.beliefs),
         goals=frozenset(goals(state)),
         last_action=state.last_action,
         intentions=frozenset(bases),
-        intended_actions=frozenset(acts),  # type: ignore[arg-type]
+        intended_actions=frozenset(acts),
         percepts=frozenset(state.percepts),
     )
 

@@ -24,7 +24,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from functools import lru_cache
 from pathlib import Path
-from typing import Union
+from typing import Union, cast
 
 from lark import Lark, Token, Tree
 from lark.exceptions import UnexpectedCharacters, UnexpectedEOF, UnexpectedInput, UnexpectedToken
@@ -201,15 +201,15 @@ class _Builder:
     def __init__(self, file: str) -> None:
         self.file = file
 
-    def _err(self, node: Tree | Token, message: str) -> GwendolenError:
+    def _err(self, node: Tree[Token] | Token, message: str) -> GwendolenError:
         line, col = _pos(node)
         return located(self.file, line, col, message)
 
-    def _unsupported(self, node: Tree | Token, what: str) -> GwendolenError:
+    def _unsupported(self, node: Tree[Token] | Token, what: str) -> GwendolenError:
         line, col = _pos(node)
         return unsupported(self.file, line, col, what)
 
-    def program(self, tree: Tree) -> Program:
+    def program(self, tree: Tree[Token]) -> Program:
         agents = [c for c in tree.children if isinstance(c, Tree)]
         if len(agents) > 1:
             raise self._unsupported(agents[1], "a second agent in one file (multi-agent systems)")
@@ -236,19 +236,19 @@ class _Builder:
                 plans.extend(self.plan(node, len(plans) + i) for i, node in enumerate(items))
         return Program(name, self.file, tuple(beliefs), tuple(rules), tuple(goals), tuple(plans))
 
-    def _ground(self, node: Tree, what: str) -> Term:
+    def _ground(self, node: Tree[Token], what: str) -> Term:
         term = self.term(node)
         if not is_ground(term):
             raise self._err(node, f"{what} must be ground (no variables): {psl.term_text(_show(term))}")
         return term
 
-    def goal_type(self, node: Tree) -> str:
+    def goal_type(self, node: Tree[Token]) -> str:
         tok = node.children[0]
         if str(tok) not in GOAL_TYPES:
             raise self._err(tok, f"unknown goal type [{tok}] (Gwendolen's are [achieve] and [perform])")
         return str(tok)
 
-    def rule(self, node: Tree) -> Rule:
+    def rule(self, node: Tree[Token]) -> Rule:
         head = self.term(node.children[0])
         body = []
         for lit in node.children[1:]:
@@ -256,7 +256,7 @@ class _Builder:
             body.append((positive, self.term(lit.children[-1])))
         return Rule(head, tuple(body), _pos(node)[0])
 
-    def plan(self, node: Tree, index: int) -> Plan:
+    def plan(self, node: Tree[Token], index: int) -> Plan:
         trig_node = node.children[0]
         trigger = self.trigger(trig_node)
         guard: tuple[GuardLit, ...] = ()
@@ -268,7 +268,7 @@ class _Builder:
                 body = tuple(self.deed(d) for d in part.children)
         return Plan(trigger, guard, body, _pos(node)[0], index)
 
-    def trigger(self, node: Tree) -> Trigger:
+    def trigger(self, node: Tree[Token]) -> Trigger:
         kids = node.children
         if node.data == "unsupported_trigger":
             raise self._unsupported(node, f"{kids[0]}{kids[1]} (as a plan trigger)")
@@ -278,7 +278,7 @@ class _Builder:
             return Trigger(sign, self.term(kids[1]), True, gtype)
         return Trigger(sign, self.term(kids[1]))
 
-    def guard_lit(self, node: Tree) -> GuardLit:
+    def guard_lit(self, node: Tree[Token]) -> GuardLit:
         kids = node.children
         positive = not (isinstance(kids[0], Token) and kids[0].type == "NEG")
         rest = kids if positive else kids[1:]
@@ -290,7 +290,7 @@ class _Builder:
             raise self._unsupported(rest[0], f"{rest[0]} (in a guard)")
         raise self._unsupported(kids[1], f"comparison '{kids[1]}' (in a guard)")
 
-    def deed(self, node: Tree) -> Deed:
+    def deed(self, node: Tree[Token]) -> Deed:
         kids = node.children
         line, col = _pos(node)
         if node.data == "unsupported_deed":
@@ -307,7 +307,7 @@ class _Builder:
             return Deed(f"{kids[0]}b", self.term(kids[1]), line, col)
         return Deed("act", self.term(kids[0]), line, col)
 
-    def term(self, node: Tree | Token) -> Term:
+    def term(self, node: Tree[Token] | Token) -> Term:
         if isinstance(node, Token):  # pragma: no cover - every term is a tree
             raise self._err(node, f"unexpected {node!s}")
         kind = node.data
@@ -326,7 +326,7 @@ class _Builder:
         return psl.Compound(str(tok), tuple(self.term(a) for a in args))
 
 
-def _pos(node: Tree | Token) -> tuple[int, int]:
+def _pos(node: Tree[Token] | Token) -> tuple[int, int]:
     if isinstance(node, Token):
         return node.line or 1, node.column or 1
     meta = node.meta
@@ -340,6 +340,11 @@ def is_ground(term: Term) -> bool:
     if isinstance(term, psl.Compound):
         return all(is_ground(a) for a in term.args)
     return True
+
+
+def as_psl(term: Term) -> psl.Term:
+    """``term``, known to hold no :class:`Var`, as the psl term it then is."""
+    return cast(psl.Term, term)
 
 
 def _show(term: Term) -> psl.Term:

@@ -18,12 +18,12 @@ from __future__ import annotations
 from typing import Iterator, Sequence
 
 from ..ajpf import psl
-from .gwendolen import Rule, Term, Var, located
+from .gwendolen import Rule, Term, Var, as_psl, located
 
 #: How deep reasoning rules may call each other before the query is refused.
 MAX_RULE_DEPTH = 64
 
-Subst = dict
+Subst = dict[str, Term]
 
 
 def walk(t: Term, s: Subst) -> Term:
@@ -149,8 +149,8 @@ class Beliefs:
             for s in self.solve(head, {}):
                 t = substitute(head, s)
                 if not variables(t) and not _has_wild(t):
-                    out.add(t)  # type: ignore[arg-type]
-        return frozenset(out) - frozenset(self.beliefs)  # type: ignore[arg-type]
+                    out.add(as_psl(t))
+        return frozenset(out - {as_psl(b) for b in self.beliefs})
 
 
 def _has_wild(t: Term) -> bool:
@@ -165,4 +165,4 @@ def ground(t: Term, s: Subst, source: str, line: int, col: int, what: str) -> ps
     free = variables(g)
     if free:
         raise located(source, line, col, f"variable {free[0]} of {what} is not bound by the plan's trigger or guard")
-    return g  # type: ignore[return-value]
+    return as_psl(g)
