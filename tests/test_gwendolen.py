@@ -320,3 +320,8 @@ def test_bounds_cut_the_exploration(jackal):
     shallow = explore(JACKAL, "backends/ajpf/jackal.gwen", env, max_depth=10)
     assert not shallow.complete and shallow.cut == "depth > 10" and shallow.depth == 10
     assert len(shallow.states) < len(jackal.states)
+    # a bound the exploration does not reach does not cut it
+    exact = explore(JACKAL, "backends/ajpf/jackal.gwen", env, max_depth=jackal.depth,
+                    max_states=len(jackal.states))
+    assert exact.complete and exact.transitions == jackal.transitions
+    assert not explore(JACKAL, "backends/ajpf/jackal.gwen", env, max_depth=jackal.depth - 1).complete

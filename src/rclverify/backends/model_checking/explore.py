@@ -49,10 +49,11 @@ def explore_program(program: Program, environment: Environment, max_states: int 
     deepest = 0
     while queue:
         i = queue.popleft()
-        if depth[i] >= max_depth:
+        steps = cycle.successors(states[i])
+        if steps and depth[i] >= max_depth:
             cut = cut or f"depth > {max_depth}"
             continue
-        for step in cycle.successors(states[i]):
+        for step in steps:
             j = index.get(step.state)
             if j is None:
                 if len(states) >= max_states:
