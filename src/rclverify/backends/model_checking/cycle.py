@@ -24,6 +24,7 @@ choices with the perception each one causes.
 """
 from __future__ import annotations
 
+import bisect
 from dataclasses import dataclass, replace
 from typing import Iterable, Iterator, NamedTuple
 
@@ -31,6 +32,54 @@ from ..ajpf import psl
 from .environment import Environment
 from .gwendolen import Deed, Plan, Program, Term, as_psl, located
 from .unify import Beliefs, Subst, ground, substitute, unify
+
+
+class TermSet(tuple[psl.Term, ...]):
+    """Ground terms sorted by text, without repeats: a belief base or a set of
+    percepts.  Its frozenset is built once, from its parent's when it is one
+    term more or less (CPython keeps each element's hash in the set, so that
+    costs one term's hash), and its hash is the frozenset's: a state's hash
+    does not walk the terms again."""
+
+    def __new__(cls, items: Iterable[psl.Term] = (), frozen: frozenset[psl.Term] | None = None) -> "TermSet":
+        self = super().__new__(cls, items)
+        self.__dict__["_f"] = frozen
+        return self
+
+    def __hash__(self) -> int:
+        return hash(self.frozen())
+
+    def __eq__(self, other: object) -> bool:
+        return isinstance(other, TermSet) and self.frozen() == other.frozen()
+
+    def __ne__(self, other: object) -> bool:
+        return not self == other
+
+    def frozen(self) -> frozenset[psl.Term]:
+        f = self.__dict__["_f"]
+        if f is None:
+            f = self.__dict__["_f"] = frozenset(self)
+        return f  # type: ignore[no-any-return]
+
+    def adding(self, term: psl.Term) -> "TermSet":
+        """This set with ``term`` (the same object if it is in already)."""
+        if term in self.frozen():
+            return self
+        items = list(self)
+        bisect.insort(items, term, key=psl.term_text)
+        return TermSet(items, self.frozen() | {term})
+
+    def removing(self, terms: Iterable[psl.Term]) -> "TermSet":
+        """This set without ``terms`` (the same object if none is in it)."""
+        gone = {t for t in terms if t in self.frozen()}
+        return TermSet((t for t in self if t not in gone), self.frozen() - gone) if gone else self
+
+
+EMPTY = TermSet()
+
+
+def _sorted(terms: Iterable[psl.Term]) -> TermSet:
+    return TermSet(sorted(set(terms), key=psl.term_text))
 
 
 @dataclass(frozen=True)
@@ -70,11 +119,11 @@ class AgentState:
     see :mod:`.environment`); ``pending`` the action it must react to next.
     """
 
-    beliefs: tuple[psl.Term, ...]
+    beliefs: TermSet
     intentions: tuple[Intention, ...] = ()
     last_action: psl.Term | None = None
-    perceived: tuple[psl.Term, ...] = ()
-    percepts: tuple[psl.Term, ...] = ()
+    perceived: TermSet = EMPTY
+    percepts: TermSet = EMPTY
     reactions: int = 0
     pending: psl.Term | None = None
 
@@ -86,10 +135,6 @@ class Step(NamedTuple):
     line: int | None
     stage: str
     state: AgentState
-
-
-def _sorted(terms: Iterable[psl.Term]) -> tuple[psl.Term, ...]:
-    return tuple(sorted(set(terms), key=psl.term_text))
 
 
 def initial_state(program: Program, env: Environment) -> AgentState:
@@ -228,22 +273,22 @@ class Cycle:
         deed, remaining = top.deeds[0], top.deeds[1:]
         intent = intent[:-1] + (replace(top, deeds=remaining),)
         term = as_psl(deed.term)  # ground, but for '_' and unbound variables in a deletion
-        beliefs = list(state.beliefs)
+        beliefs = state.beliefs
         last, pending = state.last_action, None
         if deed.kind == "+b":
             _no_wild(term, deed, self.src)
             if term not in beliefs:
-                beliefs.append(term)
+                beliefs = beliefs.adding(term)
                 posted.append((Frame(Event("+", term)),))
         elif deed.kind == "-b":
-            for b in [b for b in beliefs if unify(term, b, {}) is not None]:
-                beliefs.remove(b)
-                posted.append((Frame(Event("-", b)),))
+            gone = [b for b in beliefs if unify(term, b, {}) is not None]
+            beliefs = beliefs.removing(gone)
+            posted.extend((Frame(Event("-", b)),) for b in gone)
         elif deed.kind == "+!":
             _no_wild(term, deed, self.src)
             intent = intent + (Frame(Event("+", term, deed.goal_type)),)
         elif deed.kind == "-!":
-            bel = self.beliefs(replace(state, beliefs=_sorted(beliefs)))
+            bel = self.beliefs(replace(state, beliefs=beliefs))
             rest = tuple(i for i in (self._drop_goal(i, term, deed.goal_type, bel) for i in rest) if i)
             intent = self._drop_goal(intent, term, deed.goal_type, bel)
             posted.append((Frame(Event("-", term, deed.goal_type)),))
@@ -252,7 +297,7 @@ class Cycle:
             last = term
             if self.env.reacts_to(term):
                 pending = term
-        new = replace(state, beliefs=_sorted(beliefs), last_action=last, pending=pending)
+        new = replace(state, beliefs=beliefs, last_action=last, pending=pending)
         intent = self.settle(intent, self.beliefs(new))
         return replace(new, intentions=_requeue(rest, posted, intent)), intent, deed.text()
 
@@ -288,21 +333,20 @@ def _wild(t: Term) -> bool:
     return isinstance(t, psl.Wild) or (isinstance(t, psl.Compound) and any(_wild(a) for a in t.args))
 
 
-def perceive(state: AgentState, percepts: tuple[psl.Term, ...]) -> AgentState:
+def perceive(state: AgentState, percepts: TermSet) -> AgentState:
     """Stage E: percepts gone are deleted from the beliefs (``-p`` events),
     new percepts added (``+p`` events), each event a new intention at the
     back of the queue (deletions first, each group in canonical order)."""
-    beliefs = set(state.beliefs)
+    beliefs = state.beliefs
     new_intents: list[Intention] = []
-    for p in state.perceived:
-        if p not in percepts and p in beliefs:
-            beliefs.discard(p)
-            new_intents.append((Frame(Event("-", p)),))
+    gone = [p for p in state.perceived if p not in percepts and p in beliefs]
+    beliefs = beliefs.removing(gone)
+    new_intents.extend((Frame(Event("-", p)),) for p in gone)
     for p in percepts:
         if p not in state.perceived and p not in beliefs:
-            beliefs.add(p)
+            beliefs = beliefs.adding(p)
             new_intents.append((Frame(Event("+", p)),))
-    return replace(state, beliefs=_sorted(beliefs), perceived=percepts, percepts=percepts,
+    return replace(state, beliefs=beliefs, perceived=percepts, percepts=percepts,
                    intentions=state.intentions + tuple(new_intents))
 
 

@@ -26,12 +26,12 @@ def mental_state(state: AgentState) -> MentalState:
     acts = [as_psl(deeds[0].term) for i in state.intentions
             if (deeds := i[-1].deeds) and deeds[0].kind == "act"]
     return MentalState(
-        beliefs=frozenset(state.beliefs),
+        beliefs=state.beliefs.frozen(),
         goals=frozenset(goals(state)),
         last_action=state.last_action,
         intentions=frozenset(bases),
         intended_actions=frozenset(acts),
-        percepts=frozenset(state.percepts),
+        percepts=state.percepts.frozen(),
     )
 
 
