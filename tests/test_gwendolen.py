@@ -115,6 +115,17 @@ def test_syntax_errors_are_located_and_say_what_was_expected():
         parse_text("GWENDOLEN :name: a :Initial Beliefs: at(X)", "p.gwen")
     with pytest.raises(GwendolenError, match="unexpected end of the program"):
         parse_text("GWENDOLEN :name: a :Plans: +b <- a", "p.gwen")
+    with pytest.raises(GwendolenError, match="^p.gwen:1:1: error: empty program"):
+        parse_text("\n", "p.gwen")
+
+
+def test_terminators_comments_and_empty_argument_lists():
+    prog = parse_text("GWENDOLEN\n/* block\n comment */ :name: a // line comment\n:Reasoning Rules:\nr :- s.\n"
+                      ":Plans:\n+!g() [perform] : { True } <- act(), +b(\"text\", -1.5, _).\n+b <- c;\n", "p.gwen")
+    assert prog.rules[0].line == 5
+    assert [p.trigger.text() for p in prog.plans] == ["+!g [perform]", "+b"]
+    assert [d.text() for d in prog.plans[0].body] == ["act", '+b("text", -1.5, _)']
+    assert [p.line for p in prog.plans] == [7, 8]
 
 
 # -- the reasoning cycle -----------------------------------------------------

@@ -159,6 +159,8 @@ def parse_file(path: Path, source_name: str) -> Program:
 
 def parse_text(text: str, source_name: str = "<string>") -> Program:
     """Parse a Gwendolen program text (see :func:`parse_file`)."""
+    if not text.strip():
+        raise located(source_name, 1, 1, "empty program: a Gwendolen program starts with GWENDOLEN and :name:")
     try:
         tree = _parser().parse(text)
     except UnexpectedInput as exc:
