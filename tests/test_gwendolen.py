@@ -181,6 +181,16 @@ def test_perform_goal_runs_its_whole_plan_where_achieve_stops_at_belief(tmp_path
     assert runs == {"achieve": [], "perform": ["after"]}
 
 
+def test_dropping_a_goal_removes_its_subgoals_and_posts_the_drop_event():
+    g = run("drop_goal.gwen")
+    assert actions(g) == ["cleaned_up"]
+    assert "plan tests/data/gwendolen/drop_goal.gwen:14 +!step [perform]: deed -!work [achieve]" in trace(g)
+    step = next(i for i in range(len(g.states)) if g.holds(i, atom("G(quitter, step)")))
+    assert g.holds(step, atom("G(quitter, work)")) and g.holds(step, atom("I(quitter, work)"))
+    final = len(g.states) - 1
+    assert not g.holds(final, atom("G(quitter, work)")) and not g.holds(final, atom("G(quitter, step)"))
+
+
 def test_reasoning_rules_answer_guards_and_derived_beliefs():
     g = run("rules.gwen")
     assert actions(g) == ["walk_out(hall)"]
