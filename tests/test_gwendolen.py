@@ -12,7 +12,7 @@ import pytest
 
 from rclverify.backends.ajpf import psl
 from rclverify.backends.model_checking.environment import Environment, environment_from_plan
-from rclverify.backends.model_checking.explore import explore
+from rclverify.backends.model_checking.explore import explore, explore_program
 from rclverify.backends.model_checking.graph import StateGraph
 from rclverify.backends.model_checking.gwendolen import GwendolenError, parse_file, parse_text
 from rclverify.plan.errors import PlanError
@@ -126,6 +126,30 @@ def test_terminators_comments_and_empty_argument_lists():
     assert [p.trigger.text() for p in prog.plans] == ["+!g [perform]", "+b"]
     assert [d.text() for d in prog.plans[0].body] == ["act", '+b("text", -1.5, _)']
     assert [p.line for p in prog.plans] == [7, 8]
+
+
+def test_mutated_programs_give_a_program_or_one_located_error():
+    """Never a traceback: each damaged copy of the case study's program parses
+    and explores, or fails with a GwendolenError located in the file."""
+    import random
+    rnd = random.Random(31)
+    text = JACKAL.read_text()
+    pieces = list("+-!~_.,;:(){}[]<>*?\"/ \nBGX0") + ["<-", ":-", "True", ".send", "[achieve]", "going(0)", "L2"]
+    env = environment_from_plan(CASE_STUDY_ENV)
+    outcomes = {"parsed": 0, "refused": 0}
+    for _ in range(300):
+        t = text
+        for _ in range(rnd.randint(1, 2)):
+            i = rnd.randrange(len(t))
+            t = t[:i] + rnd.choice(pieces) + t[i + rnd.randint(0, 4):]
+        try:
+            prog = parse_text(t, "f.gwen")
+            explore_program(prog, env, max_states=2000)
+            outcomes["parsed"] += 1
+        except GwendolenError as exc:
+            assert str(exc).startswith("f.gwen:") and ": error: " in str(exc)
+            outcomes["refused"] += 1
+    assert outcomes["parsed"] > 0 and outcomes["refused"] > 0
 
 
 # -- the reasoning cycle -----------------------------------------------------
@@ -312,7 +336,7 @@ import hashlib, sys
 from pathlib import Path
 from rclverify.backends.ajpf import psl
 from rclverify.backends.model_checking.environment import environment_from_plan
-from rclverify.backends.model_checking.explore import explore
+from rclverify.backends.model_checking.explore import explore, explore_program
 g = explore(Path(sys.argv[1]), "jackal.gwen", environment_from_plan(%r))
 rows = [sorted(psl.term_text(t) for t in s.beliefs) + ["|"] + sorted(psl.term_text(t) for t in s.goals)
         + ["|", psl.term_text(s.last_action) if s.last_action else ""] for s in g.states]
