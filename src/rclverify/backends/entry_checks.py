@@ -65,5 +65,7 @@ def _check_monitors(plan: Plan, config: Any, loc: Any) -> None:
     try:
         load_mapping(plan.root, rel, config.get("horizon"), ())
     except ConfigError as exc:
+        if exc.located:  # an error inside the mapping file: located there
+            raise plan_error(*exc.located) from None
         l = loc(*exc.path)
         raise plan_error(l.file, l.line, l.col, str(exc)) from None
