@@ -111,7 +111,7 @@ def load_mapping(root: Path, rel: str | None, horizon: Any = None, traces: Any =
             raise ConfigError(f"no such trace: {t}", "traces", k)
     ros = str(raw.get("ros_version", "ros2"))
     msg_dirs = raw.get("msg_dirs", ()) or ()
-    if not isinstance(msg_dirs, list):
+    if not isinstance(msg_dirs, (list, tuple)):
         raise ConfigError(f"{rel or DEFAULT_MAPPING}:{_at(path, rel or DEFAULT_MAPPING, ('msg_dirs',))}: error: msg_dirs must be a list of "
                           f"directories, not {msg_dirs!r}")
     if msg_dirs:
