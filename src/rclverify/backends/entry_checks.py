@@ -48,8 +48,8 @@ def check_entries(plan: Plan, checked: Checked) -> list[Diagnostic]:
                     read_record(plan.root, e.config, loc)
                 else:
                     _check_monitors(plan, e.config, loc)
-            except PlanError as exc:
-                out.extend(exc.diagnostics)
+            except PlanError as exc:  # once each: entries sharing a mapping file share its errors
+                out.extend(d for d in exc.diagnostics if d not in out)
     return out
 
 
