@@ -170,6 +170,15 @@ async def _send_batch(ws: Any, replies: list[bytes]) -> None:
                     ws.transport.close()
 
 
+def _answer(run: OracleRun, message: Any) -> dict[str, Any]:
+    """``run.answer(message)``; an error the engine did not foresee is
+    answered ``unknown`` with its reason instead of closing the connection."""
+    try:
+        return run.answer(message)
+    except Exception as exc:  # noqa: BLE001 - one event's failure must not end the run or the server
+        return {"verdict": "unknown", "error": f"the event could not be checked: {exc.__class__.__name__}: {exc}"}
+
+
 @dataclass
 class OracleLimits:
     """What one connection may hold (back-pressure, docs/monitors.md,
@@ -253,7 +262,7 @@ async def serve(checked: Checked, nodes: list[CheckedNode], rules: Mapping[str, 
                     batch = inbox[:]
                     del inbox[:]
                     held[0] = 0
-                    replies = [encode(run.answer(m)) for m in batch]
+                    replies = [encode(_answer(run, m)) for m in batch]
                     st.answered += len(batch)
                     space.set()
                     try:
