@@ -58,7 +58,8 @@ def json_depth(text: str | bytes) -> int:
     """How deeply the arrays and objects of the JSON ``text`` nest (0 for a
     scalar; brackets inside strings do not count), in one pass without
     recursion; for a text with at most :data:`MAX_EVENT_DEPTH` brackets in
-    all, their number (an upper bound, found without a scan).  Raises
+    all, their number (an upper bound, found without a scan), and for one
+    nested deeper than the limit, ``MAX_EVENT_DEPTH + 1`` (the scan stops there).  Raises
     ``UnicodeDecodeError`` for bytes that are not UTF-8."""
     if isinstance(text, bytes):
         text = text.decode("utf-8")
@@ -69,7 +70,10 @@ def json_depth(text: str | bytes) -> int:
         c = m.group()
         if c in "[{":
             depth += 1
-            deepest = max(deepest, depth)
+            if depth > deepest:
+                deepest = depth
+                if deepest > MAX_EVENT_DEPTH:
+                    return deepest  # deeper than the limit: how much deeper does not matter
         elif c in "]}":
             depth -= 1
     return deepest
@@ -94,8 +98,8 @@ class OracleRun:
         try:
             depth = json_depth(text)
             if depth > MAX_EVENT_DEPTH:
-                return {"verdict": "unknown", "error": f"the event nests {depth} levels deep "
-                                                       f"(limit {MAX_EVENT_DEPTH})"}
+                return {"verdict": "unknown", "error": f"the event nests deeper than {MAX_EVENT_DEPTH} levels "
+                                                       f"(arrays and objects; limit {MAX_EVENT_DEPTH})"}
             event = json.loads(text)
         except (ValueError, UnicodeDecodeError, RecursionError) as exc:
             return {"verdict": "unknown", "error": f"not JSON: {str(exc) or exc.__class__.__name__}"}
