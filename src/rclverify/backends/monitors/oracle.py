@@ -29,6 +29,13 @@ RV-LTL's four values (docs/monitors.md, "ROSMonitoring oracle"):
 Assumption violations do not make the answer ``false`` (the node is not at
 fault); they are listed with the event's other verdicts under
 ``rclverify`` (node, verdict, guarantee, values ...) beside ``verdict``.
+
+A client cannot make the server grow or fail (docs/monitors.md, "Hostile
+clients"): JSON nested deeper than :data:`MAX_EVENT_DEPTH` is answered
+``unknown`` before it is decoded, a connection holds a bounded number of
+unanswered events (:class:`OracleLimits`: past it the server stops
+reading, so the client's sends wait) and is dropped when it does not read
+its answers within ``stall_s`` seconds; its state goes when it closes.
 """
 from __future__ import annotations
 
@@ -199,7 +206,7 @@ class OracleLimits:
 
 @dataclass
 class OracleStats:
-    """What the server holds, for tests and ``--verbose`` output: open
+    """What the server holds, for tests and monitoring of the server: open
     ``connections``, the most events one connection held unanswered
     (``peak_inbox``, never above :attr:`OracleLimits.inbox`), ``answered``
     events, connections ``dropped`` because the client did not read its
