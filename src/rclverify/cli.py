@@ -36,6 +36,18 @@ from typing import Any, Callable, Iterator, Sequence
 from .rcl.errors import RclError
 
 
+def seconds(text: str) -> float:
+    """argparse type of a duration option: a finite number of seconds >= 0
+    (``nan``, ``inf`` and negative values are usage errors, exit 2)."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a number of seconds") from None
+    if not (value >= 0 and value != float("inf")):
+        raise argparse.ArgumentTypeError(f"{text!r} is not a finite number of seconds >= 0")
+    return value
+
+
 def _print_diags(exc: RclError) -> int:
     for d in exc.diagnostics:
         print(d, file=sys.stderr)
@@ -553,17 +565,17 @@ def main(argv: Sequence[str] | None = None) -> int:
             "node's contract", True)
     m.add_argument("traces", nargs="*", metavar="TRACE", help="a .jsonl log, a .bag, a ROS 2 bag directory or .mcap")
     m.add_argument("--mapping", help="mapping file (default: backends/monitors/mapping.yaml if present)")
-    m.add_argument("--horizon", type=float, help="seconds an input event may wait for its answer (default 5.0)")
+    m.add_argument("--horizon", type=seconds, help="seconds an input event may wait for its answer (default 5.0)")
     m.add_argument("--json", action="store_true", help="print the verdicts as JSON")
     lv = m.add_argument_group("live monitoring (ROS 1; docs/monitors.md)")
     lv.add_argument("--live", action="store_true", help="monitor the running ROS 1 system (ROS_MASTER_URI) instead")
     lv.add_argument("--log", default="monitor_live.jsonl", help="JSON-lines log of events and verdicts to write")
     lv.add_argument("--evidence", help="write the monitoring evidence record (JSON) here when stopped")
-    lv.add_argument("--duration", type=float, help="stop after this many seconds (default: at SIGINT/SIGTERM)")
-    lv.add_argument("--reorder-window", type=float, default=0.05, help="seconds to wait for stamp ordering")
-    lv.add_argument("--silence", type=float, default=10.0,
+    lv.add_argument("--duration", type=seconds, help="stop after this many seconds (default: at SIGINT/SIGTERM)")
+    lv.add_argument("--reorder-window", type=seconds, default=0.05, help="seconds to wait for stamp ordering")
+    lv.add_argument("--silence", type=seconds, default=10.0,
                     help="report a contract topic not received for this many seconds (default 10; 0: off)")
-    lv.add_argument("--status", type=float, default=1.0, help="seconds between status lines (0: off)")
+    lv.add_argument("--status", type=seconds, default=1.0, help="seconds between status lines (0: off)")
     lv.add_argument("--verdict-topic", default="/rclverify/verdict", help="topic of the per-event verdicts")
     lv.add_argument("--node", dest="nodes", action="append", metavar="NODE", help="monitor only NODE (repeatable)")
     lv.add_argument("--ros", choices=("1", "2"), help="ROS version (default: $ROS_VERSION, else 1)")
@@ -572,7 +584,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     o.add_argument("--host", default="127.0.0.1", help="address to bind (default 127.0.0.1)")
     o.add_argument("--node", dest="nodes", action="append", metavar="NODE", help="serve only NODE (repeatable)")
     o.add_argument("--mapping", help="mapping file (default: backends/monitors/mapping.yaml if present)")
-    o.add_argument("--horizon", type=float, help="seconds an input event may wait for its answer")
+    o.add_argument("--horizon", type=seconds, help="seconds an input event may wait for its answer")
     args = p.parse_args(argv)
     from .runlock import RunInProgress
     try:

@@ -206,11 +206,12 @@ def stage_report(ws: Workspace, parts: Sequence[str] = tuple(REPORT_PARTS),
     from .report.build import build_report
     from .report.fragments import FragmentCache
     from .report.parts import FRAGMENTS, write_part
+    from .cache.keys import user_cache_dir
     from .report.render import use_bytecode_cache
     if report is None:
         report = build_report(ws)
     layoutcache.use_directory(ws.path("artifacts/cache/layout"))
-    use_bytecode_cache(ws.path("artifacts/cache/templates"))
+    use_bytecode_cache(user_cache_dir("templates"))  # compiled code: never in the workspace (docs/scale.md)
     out = ws.path("reports")
     paths: list[Path] = []
     for part in parts:

@@ -48,8 +48,8 @@ def check_entries(plan: Plan, checked: Checked) -> list[Diagnostic]:
                     read_record(plan.root, e.config, loc)
                 else:
                     _check_monitors(plan, e.config, loc)
-            except PlanError as exc:
-                out.extend(exc.diagnostics)
+            except PlanError as exc:  # once each: entries sharing a mapping file share its errors
+                out.extend(d for d in exc.diagnostics if d not in out)
     return out
 
 
@@ -65,5 +65,7 @@ def _check_monitors(plan: Plan, config: Any, loc: Any) -> None:
     try:
         load_mapping(plan.root, rel, config.get("horizon"), ())
     except ConfigError as exc:
+        if exc.located:  # an error inside the mapping file: located there
+            raise plan_error(*exc.located) from None
         l = loc(*exc.path)
         raise plan_error(l.file, l.line, l.col, str(exc)) from None

@@ -24,9 +24,12 @@ file                                   kind                 keyed by
                                                             (:mod:`rclverify.ros.cache`)
 ``system-cycles.pickle``               ``system-cycles``    the system model's nodes and links
                                                             (:func:`rclverify.system.model.cycles_kept`)
-``templates/``                         (jinja2's own)       template name and source checksum
-                                                            (:func:`rclverify.report.render.use_bytecode_cache`)
 =====================================  ===================  ==========================================
+
+The files are read by :mod:`.safeload`, which constructs only
+rclverify's own value classes: a poisoned pickle in a cloned workspace is
+a cache miss, never run.  jinja2's compiled templates, which are code, are
+kept in the user's cache (:func:`.keys.user_cache_dir`), not here.
 
 Every key also holds the kind's salt: the cache format, the rclverify code
 and the versions of the programs whose output is kept.  Deleting

@@ -21,6 +21,7 @@ from __future__ import annotations
 import hashlib
 import json
 import marshal
+import os
 import sys
 from functools import lru_cache
 from pathlib import Path
@@ -31,6 +32,22 @@ from typing import Any
 CACHE_DIR = "artifacts/cache"
 #: The cache format; a change misses every entry once.
 FORMAT = 4
+
+def user_cache_dir(name: str) -> Path | None:
+    """``$XDG_CACHE_HOME/rclverify/<name>`` (else ``~/.cache/rclverify/<name>``),
+    made if missing (readable by the user only), or ``None`` when it cannot
+    be made.  For what is compiled from rclverify's own files and may hold
+    code: jinja2's compiled templates (:func:`rclverify.report.render.use_bytecode_cache`),
+    like lark's parser tables (:func:`rclverify.rcl.parser.lark_cache_file`).
+    Never under a workspace, whose files may come from anyone's repository."""
+    base = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
+    folder = Path(base) / "rclverify" / name
+    try:
+        folder.mkdir(parents=True, exist_ok=True, mode=0o700)
+    except OSError:
+        return None
+    return folder
+
 
 _ENCODE = json.JSONEncoder(sort_keys=True, separators=(",", ":"), ensure_ascii=False).encode
 

@@ -32,7 +32,11 @@ this process; nothing else is kept across calls (:mod:`rclverify.cache.memo`
 keeps one result per function; :mod:`rclverify.cache.heap` decides when the
 collector looks at what is kept).
 
-Like ``dodo.py`` the files are trusted code of the workspace (pickle).
+The files are pickles, but reading one never runs code from it: every
+read goes through :func:`rclverify.cache.safeload.load`, which constructs
+only rclverify's own value classes (dataclasses, enumerations, named
+tuples) and a few plain ones; a file naming anything else (a poisoned
+cache in a cloned workspace) reads as damaged, a cache miss.
 """
 from __future__ import annotations
 
@@ -44,6 +48,7 @@ from typing import Any, BinaryIO, Callable, Iterable
 from ..evidence.store import atomic_write_bytes
 from .heap import no_collection
 from .keys import CACHE_DIR, FORMAT, Keyer, code_stamp, salt
+from .safeload import load
 
 _PROTOCOL = pickle.HIGHEST_PROTOCOL
 
@@ -56,8 +61,8 @@ def header(kind: str, salt_hex: str) -> dict[str, Any]:
 def read_header(fh: BinaryIO) -> dict[str, Any] | None:
     """The header of an open kept file, or ``None`` when it has none.  Never raises."""
     try:
-        got = pickle.load(fh)
-    except Exception:  # damaged, truncated or not a pickle  # noqa: BLE001
+        got = load(fh)
+    except Exception:  # damaged, truncated, not a pickle, or naming a class rclverify does not keep  # noqa: BLE001
         return None
     return got if isinstance(got, dict) and "salt" in got else None
 
@@ -87,8 +92,8 @@ def read_stream(path: Path, kind: str, salt_hex: str, count: int = 1) -> list[An
         return None
     try:
         with fh, no_collection():
-            return [pickle.load(fh) for _ in range(count)]
-    except Exception:  # truncated or damaged after the header  # noqa: BLE001
+            return [load(fh) for _ in range(count)]
+    except Exception:  # truncated, damaged or poisoned after the header  # noqa: BLE001
         return None
 
 

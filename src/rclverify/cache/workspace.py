@@ -19,7 +19,8 @@ missing cache, another code version or another path means a normal load.  Only w
 an error is always reported from the files themselves.  The file has the
 format of every kept file (:mod:`rclverify.cache.store`): it is written
 atomically and is a pure speed-up: deleting ``artifacts/cache`` is always
-safe.  Like ``dodo.py`` it is trusted code of the workspace (pickle).
+safe.  Reading it never runs code from it (:mod:`rclverify.cache.safeload`):
+a file naming a class rclverify does not keep is a miss.
 
 A no-op run needs only the :class:`~rclverify.pipeline.TaskIndex` (node
 names, producers, plan entries) to define its tasks; the plan and the
@@ -30,11 +31,11 @@ from __future__ import annotations
 
 import atexit
 import os
-import pickle
 import threading
 from typing import Any, BinaryIO
 
 from .keys import file_digest, salt
+from .safeload import load
 from .store import open_stream, write_stream
 
 CACHE = "artifacts/cache/workspace.pickle"
@@ -83,14 +84,14 @@ def restore(ws: Any) -> bool:
         return False
     try:
         with fh:
-            kept = pickle.load(fh)
+            kept = load(fh)
             if not isinstance(kept, dict):
                 return False
             now = _inputs(ws, tuple(kept.get("contracts", ())))
             ws.cache_shas = now["contracts"]  # taken before any file is parsed: save() reuses them
             if any(kept.get(k) != now[k] for k in ("root", "plan_file")):
                 return False
-            index = pickle.load(fh)
+            index = load(fh)
             if kept == now:
                 offset = fh.tell()
                 ws.__dict__["index"] = index
@@ -108,7 +109,7 @@ def restore(ws: Any) -> bool:
 def _load_large(fh: Any) -> Any:
     from .heap import no_collection
     with no_collection():  # the loaded objects are all live: collecting during the load only costs time
-        return pickle.load(fh)
+        return load(fh)
 
 
 def _load_deferred(ws: Any, kept: dict[str, Any], offset: int) -> None:
@@ -123,7 +124,7 @@ def _load_deferred(ws: Any, kept: dict[str, Any], offset: int) -> None:
         return
     try:
         with fh:
-            if pickle.load(fh) != kept or file_digest(ws.root / ws.plan_file) != kept["plan"]:
+            if load(fh) != kept or file_digest(ws.root / ws.plan_file) != kept["plan"]:
                 return  # the cache was rewritten or the plan changed since the run started
             fh.seek(offset)
             plan, parsed = _load_large(fh)

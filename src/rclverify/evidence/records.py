@@ -160,6 +160,11 @@ class Evidence:
 
     @staticmethod
     def from_json(d: Mapping[str, Any]) -> "Evidence":
+        """The record of the JSON object ``d``.  Raises ``TypeError`` when
+        ``d`` is not an object (a record file holding ``[]`` or ``null``),
+        ``KeyError``/``ValueError`` for a missing field or an unknown status."""
+        if not isinstance(d, Mapping):
+            raise TypeError(f"an evidence record is a JSON object, not {type(d).__name__}")
         if d.get("status") not in SEVERITY:
             raise ValueError(f"unknown evidence status {d.get('status')!r}")
         return Evidence(

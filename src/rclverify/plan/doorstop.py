@@ -64,6 +64,29 @@ def _formula_source(rel: str, lines: list[str], key: str, value: str, index: int
     return Source(value, k + 1, 1, rel)
 
 
+def _item_file(root: Path, path: Path, loc: ast.Loc) -> str:
+    """The workspace-relative name of the item file ``path`` (as Doorstop
+    found it, under ``root``).  Raises a located :class:`PlanError` (``E-path``,
+    at the item file, or at ``loc`` when even its name lies outside) when the
+    file resolves outside the workspace, e.g. through a symbolic link: every
+    file a requirement rests on must be in the workspace, so that the
+    assessor's bundle holds it (:mod:`.paths`)."""
+    from .paths import escape_reason
+    rel = path
+    for a, b in ((path, root), (path.absolute(), root.absolute())):
+        try:
+            rel = a.relative_to(b)
+            break
+        except ValueError:
+            continue
+    why = "lies outside the workspace" if rel.is_absolute() else escape_reason(root, str(rel))
+    if why is None:
+        return rel.as_posix()
+    at = (str(rel), 1, 1) if not rel.is_absolute() else (loc.file, loc.line, loc.col)
+    raise plan_error(*at, f"requirements_from: the Doorstop item file {str(rel)!r} {why}; every file the plan "
+                          "names must lie inside the workspace (so the assessor's bundle contains it)", "E-path")
+
+
 def read_requirements(root: Path, folder: str, loc: ast.Loc) -> tuple[Any, ...]:
     """The requirements of the Doorstop documents under ``root/folder``.
 
@@ -95,7 +118,7 @@ def read_requirements(root: Path, folder: str, loc: ast.Loc) -> tuple[Any, ...]:
         for it in items:
             if not it.active or it.heading or not it.normative:
                 continue
-            rel = str(Path(str(it.path)).resolve().relative_to(root.resolve()))
+            rel = _item_file(root, Path(str(it.path)), loc)
             lines = Path(str(it.path)).read_text(encoding="utf-8").splitlines()
             first = ast.Loc(rel, 1, 1)
 

@@ -343,7 +343,11 @@ class _ToAst(Transformer[Token, Any]):
         return ast.Member(c[0], c[2], True, self._span(c))
 
     def number(self, c: list[Any]) -> ast.NumLit:
-        return ast.NumLit(str(c[0]), self._span(c))
+        text, loc = str(c[0]), self._span(c)
+        problem = numeral_problem(text)
+        if problem:
+            raise RclError([error(loc, problem, "E-number")])
+        return ast.NumLit(text, loc)
 
     def true(self, c: list[Any]) -> ast.BoolLit:
         return ast.BoolLit(True, self._span(c))
@@ -429,6 +433,31 @@ class _ToAst(Transformer[Token, Any]):
             e = dataclasses.replace(e, parenthesised=True)
         self.wrapped[id(e)] = (e, self._span(c))
         return e
+
+
+#: Most digits a numeral may have (before and after its point) and largest
+#: magnitude of its exponent.  A literal within both limits has an exact value
+#: of at most 2,001 digits, so every stage (Fraction arithmetic, Z3, printing
+#: the value in JSON or text: Python refuses to print integers above 4,300
+#: digits) handles it; a longer one is a located ``E-number`` error at parse
+#: time (docs/rcl-language.md, "Robustness limits").
+NUMERAL_DIGITS_LIMIT = 1000
+NUMERAL_EXPONENT_LIMIT = 1000
+
+
+def numeral_problem(text: str) -> str | None:
+    """Why the numeral ``text`` (the ``NUMBER`` terminal of ``rcl.lark``:
+    digits, an optional fraction, an optional exponent) is refused, or
+    ``None`` when it is within :data:`NUMERAL_DIGITS_LIMIT` digits and its
+    exponent within :data:`NUMERAL_EXPONENT_LIMIT` in magnitude."""
+    mantissa, _, exponent = text.lower().partition("e")
+    digits = len(mantissa) - ("." in mantissa)
+    if digits > NUMERAL_DIGITS_LIMIT:
+        return f"numeral too long: {digits} digits (limit {NUMERAL_DIGITS_LIMIT})"
+    exp_digits = exponent.lstrip("+-").lstrip("0")
+    if len(exp_digits) > 4 or (exp_digits and int(exp_digits) > NUMERAL_EXPONENT_LIMIT):
+        return f"numeral's exponent too large (limit {NUMERAL_EXPONENT_LIMIT} in magnitude)"
+    return None
 
 
 #: Deepest nesting of expressions and types the parser accepts (AST depth;

@@ -305,8 +305,10 @@ def use_bytecode_cache(directory: Path | None) -> None:
     """Keep the report's compiled templates in ``directory`` (jinja2's
     ``FileSystemBytecodeCache``, keyed by template name and source checksum;
     ``None``: compile in memory only).  Compiling the report's templates is
-    about 0.3 s of every report run.  Raises ``OSError`` when ``directory``
-    cannot be created."""
+    about 0.3 s of every report run.  The files are code: the report run
+    keeps them in the user's cache, never in a workspace
+    (:func:`rclverify.cache.keys.user_cache_dir`).  Raises ``OSError`` when
+    ``directory`` cannot be created."""
     if directory is None:
         environment().bytecode_cache = None
         return

@@ -134,19 +134,39 @@ def initial_value(typ: T.Type, rule: TopicRule) -> Any:
     return None
 
 
-def load_rules(raw: Mapping[str, Any] | None) -> dict[str, TopicRule]:
-    """Topic rules from the plan's ``topics`` mapping (``{topic: {fields, update, default}}``).
+class RuleError(ValueError):
+    """A malformed topic rule of the mapping file: the message names the
+    topic; ``path`` is the key path of the value at fault in the mapping
+    file (``("topics", topic, "fields")``), for locating it."""
 
-    Raises ``ValueError`` naming the topic for a malformed rule.
+    def __init__(self, message: str, *path: Any) -> None:
+        super().__init__(message)
+        self.path = path
+
+
+def load_rules(raw: Any) -> dict[str, TopicRule]:
+    """Topic rules from the plan's ``topics`` mapping (``{topic: {fields, update, default}}``):
+    ``fields`` a list of field names, ``update`` ``accumulate`` or ``replace``.
+
+    Raises :class:`RuleError` (a ``ValueError``) naming the topic and the
+    key at fault for a malformed rule (``topics`` not a mapping, ``fields``
+    not a list of names, an unknown ``update``).
     """
     out: dict[str, TopicRule] = {}
+    if raw is not None and not isinstance(raw, Mapping):
+        raise RuleError(f"topics must map each topic to its rule, not {raw!r}", "topics")
     for topic, spec in (raw or {}).items():
         spec = spec or {}
         if not isinstance(spec, Mapping):
-            raise ValueError(f"topic {topic}: expected a mapping")
-        fields: Sequence[Any] = spec.get("fields", ()) or ()
+            raise RuleError(f"topic {topic}: expected a mapping", "topics", topic)
+        fields: Any = spec.get("fields", ()) or ()
+        if not isinstance(fields, (list, tuple)) or not all(isinstance(f, (str, int)) and not isinstance(f, bool)
+                                                            for f in fields):
+            raise RuleError(f"topic {topic}: fields must be a list of message field names, not {fields!r}",
+                            "topics", topic, "fields")
         update = spec.get("update", "accumulate")
         if update not in ("accumulate", "replace"):
-            raise ValueError(f"topic {topic}: update must be accumulate or replace, not {update!r}")
+            raise RuleError(f"topic {topic}: update must be accumulate or replace, not {update!r}",
+                            "topics", topic, "update")
         out[str(topic).lstrip("/")] = TopicRule(tuple(str(f) for f in fields), update, spec.get("default"))
     return out

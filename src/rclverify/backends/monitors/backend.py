@@ -132,6 +132,9 @@ class MonitorsBackend:
         try:
             return load_mapping(target.root, c.get("mapping"), c.get("horizon"), c.get("traces", ()))
         except ConfigError as exc:
+            if exc.located:  # an error inside the mapping file: located there
+                from ...plan.errors import plan_error
+                raise plan_error(*exc.located) from None
             if exc.path:
                 raise target.config_error(str(exc), *exc.path) from None
             raise target.config_error(str(exc)) from None

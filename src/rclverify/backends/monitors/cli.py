@@ -42,7 +42,7 @@ def monitor_command(args: argparse.Namespace, checked: Checked) -> int:
     try:
         cfg = load_mapping(root, args.mapping, args.horizon)
     except ConfigError as exc:
-        print(f"{exc}" if ":" in str(exc).split(" ")[0] else f"{args.mapping}: error: {exc}", file=sys.stderr)
+        print(f"{exc}" if exc.located else f"{args.mapping or 'rclverify monitor'}: error: {exc}", file=sys.stderr)
         return 2
     if getattr(args, "live", False):
         return live_command(args, checked, cfg, root)
@@ -138,7 +138,7 @@ def oracle_command(args: argparse.Namespace, checked: Checked) -> int:
     try:
         cfg = load_mapping(root, args.mapping, args.horizon)
     except ConfigError as exc:
-        print(f"{args.mapping}: error: {exc}", file=sys.stderr)
+        print(f"{exc}" if exc.located else f"{args.mapping or 'rclverify oracle'}: error: {exc}", file=sys.stderr)
         return 2
     nodes = selected_nodes(checked, args.nodes, "oracle")
     if nodes is None:

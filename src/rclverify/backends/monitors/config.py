@@ -18,13 +18,15 @@ to instrument, as ROSMonitoring's configuration lists it)::
 """
 from __future__ import annotations
 
+import math
+import re
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Mapping
 
 import yaml
 
-from ...traces.mapping import TopicRule, load_rules
+from ...traces.mapping import RuleError, TopicRule, load_rules
 from ...plan.yamlguard import read_yaml_text, safe_load_guarded
 
 DEFAULT_MAPPING = "backends/monitors/mapping.yaml"
@@ -38,6 +40,14 @@ class ConfigError(Exception):
     def __init__(self, message: str, *path: Any) -> None:
         super().__init__(message)
         self.path = path
+
+    @property
+    def located(self) -> tuple[str, int, int, str] | None:
+        """``(file, line, col, message)`` when the error is located in the
+        mapping file itself (its text starts ``file:line:col: error: ``),
+        else ``None`` (locate it at the plan key :attr:`path`)."""
+        m = re.match(r"^(.+?):(\d+):(\d+): error: (.*)$", str(self), re.S)
+        return (m[1], int(m[2]), int(m[3]), m[4]) if m else None
 
 
 @dataclass(frozen=True)
@@ -56,6 +66,14 @@ class MonitorConfig:
     def msg_files(self, root: Path) -> list[str]:
         """Workspace-relative ``.msg`` files under the message directories, sorted."""
         return sorted(p.relative_to(root).as_posix() for d in self.msg_dirs for p in (root / d).rglob("*.msg"))
+
+
+def is_seconds(value: Any) -> bool:
+    """``value`` is a duration in seconds: a finite number >= 0 (not a
+    boolean, not NaN, not an infinity: a NaN horizon would leave every
+    response obligation open, docs/monitors.md)."""
+    return (not isinstance(value, bool) and isinstance(value, (int, float)) and math.isfinite(value)
+            and value >= 0)
 
 
 def load_mapping(root: Path, rel: str | None, horizon: Any = None, traces: Any = ()) -> MonitorConfig:
@@ -78,11 +96,14 @@ def load_mapping(root: Path, rel: str | None, horizon: Any = None, traces: Any =
         raise ConfigError(f"{rel or DEFAULT_MAPPING}:1:1: error: expected a mapping")
     try:
         rules = load_rules(raw.get("topics"))
-    except ValueError as exc:
-        raise ConfigError(f"{rel or DEFAULT_MAPPING}:1:1: error: {exc}") from None
+    except RuleError as exc:
+        raise ConfigError(f"{rel or DEFAULT_MAPPING}:{_at(path, rel or DEFAULT_MAPPING, exc.path)}: error: {exc}") from None
     h = horizon if horizon is not None else raw.get("horizon", DEFAULT_HORIZON)
-    if isinstance(h, bool) or not isinstance(h, (int, float)) or h < 0:
-        raise ConfigError(f"horizon must be a number of seconds >= 0, not {h!r}", "horizon")
+    if not is_seconds(h):
+        msg = f"horizon must be a finite number of seconds >= 0, not {h!r}"
+        if horizon is not None:  # the plan entry's (or --horizon): located by the caller
+            raise ConfigError(msg, "horizon")
+        raise ConfigError(f"{rel or DEFAULT_MAPPING}:{_at(path, rel or DEFAULT_MAPPING, ('horizon',))}: error: {msg}")
     if isinstance(traces, str) or not isinstance(traces, (list, tuple)):
         raise ConfigError("traces must be a list of files", "traces")
     for k, t in enumerate(traces):
@@ -90,7 +111,10 @@ def load_mapping(root: Path, rel: str | None, horizon: Any = None, traces: Any =
             raise ConfigError(f"no such trace: {t}", "traces", k)
     ros = str(raw.get("ros_version", "ros2"))
     msg_dirs = raw.get("msg_dirs", ()) or ()
-    if isinstance(msg_dirs, list):
+    if not isinstance(msg_dirs, (list, tuple)):
+        raise ConfigError(f"{rel or DEFAULT_MAPPING}:{_at(path, rel or DEFAULT_MAPPING, ('msg_dirs',))}: error: msg_dirs must be a list of "
+                          f"directories, not {msg_dirs!r}")
+    if msg_dirs:
         _check_msg_dirs(root, rel or DEFAULT_MAPPING, path, [str(d) for d in msg_dirs])
     ros_nodes = raw.get("ros_nodes") or {}
     if not isinstance(ros_nodes, Mapping) or not all(
@@ -102,6 +126,21 @@ def load_mapping(root: Path, rel: str | None, horizon: Any = None, traces: Any =
                          tuple(str(d) for d in raw.get("msg_dirs", ()) or ()), float(h), ros,
                          tuple(str(t) for t in traces),
                          {str(k): {f: str(x) for f, x in v.items()} for k, v in ros_nodes.items()})
+
+
+def _at(path: Path, rel: str, keys: tuple[Any, ...]) -> str:
+    """``line:col`` of the value at ``keys`` in the mapping file (``1:1``
+    when it cannot be found)."""
+    from ...plan.errors import PlanError
+    from ...plan.yamlguard import load_located
+    try:
+        _, locs = load_located(read_yaml_text(path, rel), rel)
+    except (PlanError, yaml.YAMLError):
+        return "1:1"
+    while keys and keys not in locs:
+        keys = keys[:-1]
+    at = locs.get(keys)
+    return f"{at.line}:{at.col}" if at is not None else "1:1"
 
 
 def _check_msg_dirs(root: Path, rel: str, path: Path, dirs: list[str]) -> None:

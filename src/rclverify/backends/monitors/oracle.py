@@ -29,12 +29,21 @@ RV-LTL's four values (docs/monitors.md, "ROSMonitoring oracle"):
 Assumption violations do not make the answer ``false`` (the node is not at
 fault); they are listed with the event's other verdicts under
 ``rclverify`` (node, verdict, guarantee, values ...) beside ``verdict``.
+
+A client cannot make the server grow or fail (docs/monitors.md, "Hostile
+clients"): JSON nested deeper than :data:`MAX_EVENT_DEPTH` is answered
+``unknown`` before it is decoded, a connection holds a bounded number of
+unanswered events (:class:`OracleLimits`: past it the server stops
+reading, so the client's sends wait) and is dropped when it does not read
+its answers within ``stall_s`` seconds; its state goes when it closes.
 """
 from __future__ import annotations
 
 import asyncio
 import json
 import math
+import re
+from dataclasses import dataclass
 from typing import Any, Iterable, Mapping
 
 from ...rcl.types import Checked, CheckedNode
@@ -43,6 +52,38 @@ from .check import Verdict
 from .online import OnlineEngine
 
 ORACLE_VERDICTS = ("currently_true", "currently_false", "true", "false", "unknown")
+
+#: Deepest nesting of arrays and objects an event may have.  ROSMonitoring
+#: flattens a message's fields beside ``topic`` and ``time`` (a field may
+#: be an array or an object of a few levels); deeper JSON is answered
+#: ``unknown`` before it is decoded (Python's decoder recurses per level).
+MAX_EVENT_DEPTH = 64
+_STRUCTURE = re.compile(r'"(?:[^"\\]|\\.)*"|[\[\]{}]')
+
+
+def json_depth(text: str | bytes) -> int:
+    """How deeply the arrays and objects of the JSON ``text`` nest (0 for a
+    scalar; brackets inside strings do not count), in one pass without
+    recursion; for a text with at most :data:`MAX_EVENT_DEPTH` brackets in
+    all, their number (an upper bound, found without a scan), and for one
+    nested deeper than the limit, ``MAX_EVENT_DEPTH + 1`` (the scan stops there).  Raises
+    ``UnicodeDecodeError`` for bytes that are not UTF-8."""
+    if isinstance(text, bytes):
+        text = text.decode("utf-8")
+    if text.count("[") + text.count("{") <= MAX_EVENT_DEPTH:
+        return text.count("[") + text.count("{")  # an upper bound, within the limit: no scan
+    depth = deepest = 0
+    for m in _STRUCTURE.finditer(text):
+        c = m.group()
+        if c in "[{":
+            depth += 1
+            if depth > deepest:
+                deepest = depth
+                if deepest > MAX_EVENT_DEPTH:
+                    return deepest  # deeper than the limit: how much deeper does not matter
+        elif c in "]}":
+            depth -= 1
+    return deepest
 
 
 class OracleRun:
@@ -57,11 +98,18 @@ class OracleRun:
         self.events = 0
 
     def answer(self, text: str | bytes) -> dict[str, Any]:
-        """The reply (a JSON-ready dict) to one event message."""
+        """The reply (a JSON-ready dict) to one event message.  Never raises
+        for what a client sends: JSON nested deeper than
+        :data:`MAX_EVENT_DEPTH` is refused before it is decoded (``unknown``
+        with ``error``), as is anything else that is not an event."""
         try:
+            depth = json_depth(text)
+            if depth > MAX_EVENT_DEPTH:
+                return {"verdict": "unknown", "error": f"the event nests deeper than {MAX_EVENT_DEPTH} levels "
+                                                       f"(arrays and objects; limit {MAX_EVENT_DEPTH})"}
             event = json.loads(text)
-        except (ValueError, UnicodeDecodeError) as exc:
-            return {"verdict": "unknown", "error": f"not JSON: {exc}"}
+        except (ValueError, UnicodeDecodeError, RecursionError) as exc:
+            return {"verdict": "unknown", "error": f"not JSON: {str(exc) or exc.__class__.__name__}"}
         if not isinstance(event, dict):
             return {"verdict": "unknown", "error": "the event is not a JSON object"}
         topic, time = event.get("topic"), event.get("time")
@@ -133,36 +181,89 @@ async def _send_batch(ws: Any, replies: list[bytes]) -> None:
                     ws.transport.close()
 
 
+def _answer(run: OracleRun, message: Any) -> dict[str, Any]:
+    """``run.answer(message)``; an error the engine did not foresee is
+    answered ``unknown`` with its reason instead of closing the connection."""
+    try:
+        return run.answer(message)
+    except Exception as exc:  # noqa: BLE001 - one event's failure must not end the run or the server
+        return {"verdict": "unknown", "error": f"the event could not be checked: {exc.__class__.__name__}: {exc}"}
+
+
+@dataclass
+class OracleLimits:
+    """What one connection may hold (back-pressure, docs/monitors.md,
+    "ROSMonitoring oracle"): ``inbox`` events and ``inbox_bytes`` bytes of
+    them received but not answered yet (past either, the server stops
+    reading the connection, so the client's sends wait: TCP flow control),
+    and ``stall_s`` seconds that a batch of replies may wait for the client
+    to read them before the connection is dropped."""
+
+    inbox: int = 256
+    inbox_bytes: int = 2**22
+    stall_s: float = 30.0
+
+
+@dataclass
+class OracleStats:
+    """What the server holds, for tests and monitoring of the server: open
+    ``connections``, the most events one connection held unanswered
+    (``peak_inbox``, never above :attr:`OracleLimits.inbox`), ``answered``
+    events, connections ``dropped`` because the client did not read its
+    replies within :attr:`OracleLimits.stall_s`."""
+
+    connections: int = 0
+    peak_inbox: int = 0
+    answered: int = 0
+    dropped: int = 0
+
+
 async def serve(checked: Checked, nodes: list[CheckedNode], rules: Mapping[str, TopicRule], horizon: float,
-                port: int, host: str = "127.0.0.1", ready: Any = None, stop: Any = None) -> None:
+                port: int, host: str = "127.0.0.1", ready: Any = None, stop: Any = None,
+                limits: OracleLimits | None = None, stats: OracleStats | None = None) -> None:
     """Serve until ``stop`` (an :class:`asyncio.Event`) is set, or forever.
 
     ``ready`` (an :class:`asyncio.Event`) is set once the socket listens.
+    ``limits`` bound what a connection holds (:class:`OracleLimits`); the
+    server counts into ``stats`` (:class:`OracleStats`).  A connection's
+    run and its queues are freed when it closes.
     Raises ``OSError`` when the port cannot be bound."""
     from websockets.asyncio.server import serve as ws_serve
     from websockets.exceptions import ConnectionClosed
 
+    lim = limits or OracleLimits()
+    st = stats if stats is not None else OracleStats()
+
     async def handler(ws: Any) -> None:
         run = OracleRun(checked, nodes, rules, horizon)
         inbox: list[Any] = []
-        wake = asyncio.Event()
+        held = [0]  # bytes in inbox
+        wake, space = asyncio.Event(), asyncio.Event()
         closed = False
 
         async def read() -> None:
             # websockets hands over every message already received without
             # suspending, so `inbox` fills with everything that arrived in one
-            # read from the socket before write() runs
+            # read from the socket before write() runs; a full inbox stops the
+            # reading until the replies went out (websockets then stops reading
+            # the socket: the client's sends wait)
             nonlocal closed
             try:
                 async for message in ws:
                     inbox.append(message)
+                    held[0] += len(message)
+                    st.peak_inbox = max(st.peak_inbox, len(inbox))
                     wake.set()
+                    while len(inbox) >= lim.inbox or held[0] >= lim.inbox_bytes:
+                        space.clear()
+                        await space.wait()
             except ConnectionClosed:
                 pass
             finally:
                 closed = True
                 wake.set()
 
+        st.connections += 1
         reader = asyncio.create_task(read())
         try:
             while True:
@@ -171,14 +272,24 @@ async def serve(checked: Checked, nodes: list[CheckedNode], rules: Mapping[str, 
                 if inbox:
                     batch = inbox[:]
                     del inbox[:]
-                    replies = [encode(run.answer(m)) for m in batch]
-                    await _send_batch(ws, replies)
+                    held[0] = 0
+                    replies = [encode(_answer(run, m)) for m in batch]
+                    st.answered += len(batch)
+                    space.set()
+                    try:
+                        await asyncio.wait_for(_send_batch(ws, replies), lim.stall_s)
+                    except asyncio.TimeoutError:  # the client does not read its replies: drop it
+                        st.dropped += 1
+                        ws.transport.abort()
+                        return
                 elif closed:
                     return
         except ConnectionClosed:
             return
         finally:
             reader.cancel()
+            inbox.clear()
+            st.connections -= 1
 
     async with ws_serve(handler, host, port, ping_interval=None, max_size=2**22):
         if ready is not None:
@@ -189,4 +300,4 @@ async def serve(checked: Checked, nodes: list[CheckedNode], rules: Mapping[str, 
             await stop.wait()
 
 
-__all__ = ["ORACLE_VERDICTS", "OracleRun", "serve"]
+__all__ = ["MAX_EVENT_DEPTH", "ORACLE_VERDICTS", "OracleLimits", "OracleRun", "OracleStats", "json_depth", "serve"]
