@@ -11,9 +11,9 @@ Artifact layout (workspace-relative)::
     artifacts/contracts/<Node>.json      canonical snapshot of one node's contract,
                                          the shared context, its facts and plan entries
     artifacts/system/model.json|.dot     the system model
-    artifacts/calculus/<Node>.json       rule instances, side conditions, derived property
+    artifacts/calculus/<Node>.json       rule instances, side conditions, derived property (sealed)
     artifacts/calculus/<Node>.sc<k>.smt2 each side condition as SMT-LIB2
-    artifacts/health/<Node>.json         contract health findings
+    artifacts/health/<Node>.json         contract health findings ({"node", "findings"}, sealed)
     artifacts/obligations/<Node>.json    exported obligations of the node
     artifacts/evidence/<obligation>.json one evidence record per obligation
     artifacts/requirements/<ID>.json     a requirement's Z3 check (proved/refuted/...)
@@ -27,6 +27,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any, Sequence
 
 from .evidence.records import Evidence, Obligation
+from .evidence.sealed import write_sealed
 from .evidence.store import EvidenceStore, atomic_write_text, dumps, read_json, write_json, write_obligations
 from .logic.world import fresh as fresh_z3
 from .rcl.errors import RclError, error
@@ -53,7 +54,7 @@ def stage_check(ws: Workspace) -> dict[str, Any]:
     checked, model = ws.checked, ws.model
     texts = ContractTexts(ws)  # each file's lint and each node's RCL text, kept by the file's sha256
     warnings = [w for s in checked.specs for w in texts.lint(s)]
-    write_json(ws.path(ws.DIAGNOSTICS), {"warnings": warnings})
+    write_sealed(ws.path(ws.DIAGNOSTICS), {"warnings": warnings})
     hashes: dict[str, str] = {}
     for name, snap in node_snapshots(ws, texts).items():
         text = dumps(snap)
@@ -93,7 +94,7 @@ def stage_compose(ws: Workspace, node: str) -> dict[str, Any]:
         atomic_write_text(ws.path(rel), sc.smt2)
         paths.append(rel)
     out = composition_json(comp, paths)
-    write_json(ws.path(ws.calculus(node)), out)
+    write_sealed(ws.path(ws.calculus(node)), out)
     record_provenance(ws, node, "compose", stage_inputs(ws, node, "compose"))  # after: a killed stage records nothing
     return out
 
@@ -113,7 +114,7 @@ def stage_health(ws: Workspace, node: str) -> list[dict[str, Any]]:
             j["smt2"] = f"artifacts/health/{f.id}.smt2"
             atomic_write_text(ws.path(j["smt2"]), f.smt2)
         findings.append(j)
-    write_json(ws.path(ws.health(node)), findings)
+    write_sealed(ws.path(ws.health(node)), {"node": node, "findings": findings})
     record_provenance(ws, node, "health", stage_inputs(ws, node, "health"))
     return findings
 
@@ -219,7 +220,7 @@ def stage_report(ws: Workspace, parts: Sequence[str] = tuple(REPORT_PARTS),
         fragments.save()
         if part == "html":  # with assurance.json: what verify prints
             from .report.summary import summary_data
-            write_json(ws.path(ws.SUMMARY), summary_data(report))
+            write_sealed(ws.path(ws.SUMMARY), summary_data(report))
     # the one fragment cache of the single report task of earlier versions (38 MB at 1000 nodes)
     ws.path("artifacts/cache/report-fragments.pickle").unlink(missing_ok=True)
     return report, paths

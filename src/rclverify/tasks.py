@@ -279,8 +279,9 @@ def act_verify(root: str, strict: bool) -> Any:
     from .report.summary import print_last_run
     data = print_last_run(Path(root))
     if strict and not data["meta"]["strict_ok"]:
-        return TaskFailed("--strict: some evidence is failed, inconclusive, pending, stale or error, or a side condition "
-                          "or contract health check is not proved (see reports/assurance.html)")
+        return TaskFailed("--strict: some evidence is failed, inconclusive, pending, stale or error, a side condition "
+                          "or contract health check is not proved, or a formal requirement is not met "
+                          "(see reports/assurance.html)")
     return None
 
 
@@ -546,7 +547,9 @@ def _build_tasks(root: str | Path, plan_file: str) -> dict[str, Callable[[], Any
     # a missing plan or contract makes `check` run, and fail with the located message, every time.
     named = [str(rootp / plan_file)] + contract_deps
     check_deps = [d for d in named if os.path.isfile(d)]
-    check_extra: dict[str, Any] = {"uptodate": [False] if len(check_deps) < len(named) or not ok else [code]}
+    from .evidence.sealed import TargetsSealed  # a sealed record altered outside rclverify is made again
+    sealed = TargetsSealed()
+    check_extra: dict[str, Any] = {"uptodate": [False] if len(check_deps) < len(named) or not ok else [code, sealed]}
 
     def task_check() -> dict[str, Any]:
         """Parse and type-check the contracts, check the plan, lint, build the system model."""
@@ -576,7 +579,7 @@ def _build_tasks(root: str | Path, plan_file: str) -> dict[str, Callable[[], Any
             yield {"name": n, "actions": [(act_node, [r, n, deps])],
                    "file_dep": sorted({d for ds in deps.values() for d in ds}),
                    "targets": [at(ws.calculus(n)), at(ws.health(n)), at(ws.obligations(n))],
-                   "uptodate": [code], "verbosity": 2, "clean": True}
+                   "uptodate": [code, sealed], "verbosity": 2, "clean": True}
 
     def task_requirements() -> dict[str, Any]:
         """Check each requirement's formal statement with Z3 from the guarantees of its cone.  Defined before
@@ -591,7 +594,7 @@ def _build_tasks(root: str | Path, plan_file: str) -> dict[str, Callable[[], Any
                 extra += [str(rootp / f) for f in doorstop_files(rootp, d)]
         return {"actions": [(act_requirements, [r])],
                 "file_dep": [str(rootp / plan_file), at(ws.MODEL)] + list(snap.values()) + extra,
-                "targets": [at(INDEX)], "uptodate": [code], "verbosity": 2, "clean": True}
+                "targets": [at(INDEX)], "uptodate": [code, sealed], "verbosity": 2, "clean": True}
 
     exported_memo: list[list[tuple[str, dict[str, Any]]]] = []
 
@@ -644,7 +647,7 @@ def _build_tasks(root: str | Path, plan_file: str) -> dict[str, Callable[[], Any
     def task_ground() -> dict[str, Any]:
         """Ground the contracts in the ROS software of the plan's ros: section (docs/ros.md)."""
         return {"actions": [(act_ground, [r])], "file_dep": [str(rootp / plan_file)] + contract_deps,
-                "uptodate": [config_changed({"files": ros_fingerprint(rootp, ros_section)})],
+                "uptodate": [config_changed({"files": ros_fingerprint(rootp, ros_section)}), sealed],
                 "targets": [at("artifacts/ros/grounding.json"), at("artifacts/ros/graph.json")],
                 "task_dep": ["check"], "verbosity": 2, "clean": True}
 
@@ -664,7 +667,7 @@ def _build_tasks(root: str | Path, plan_file: str) -> dict[str, Callable[[], Any
             deps.append(at("artifacts/ros/grounding.json"))
         for part, files in REPORT_PARTS.items():
             yield {"name": part, "doc": "reports/" + ", ".join(files), "actions": [(act_report, [r, part])],
-                   "file_dep": deps, "uptodate": [code],
+                   "file_dep": deps, "uptodate": [code, sealed],
                    "targets": [at(f"reports/{f}") for f in files if f != "argument.svg"]
                    + ([at(ws.SUMMARY)] if part == "html" else []),
                    "verbosity": 2, "clean": True}

@@ -48,7 +48,7 @@ def node_rows(report: Mapping[str, Any]) -> list[dict[str, Any]]:
         fs = findings.get(name, [])
         rows.append({"node": name, "status": n["status"], "obligations": obs, "order": k,
                      "sc_proved": sum(sc["status"] == "discharged" for sc in scs), "sc_total": len(scs),
-                     "health_problems": sum(f["status"] == "problem" for f in fs),
+                     "health_problems": sum(f["status"] in ("problem", "error") for f in fs),
                      "health_open": sum(f["status"] == "inconclusive" for f in fs), "health_total": len(fs)})
     rows.sort(key=lambda r: (-_rank(r["status"]), r["order"]))
     return rows
@@ -167,6 +167,26 @@ def requirements_line(rows: Sequence[Sequence[str]]) -> str:
                                                             if v in named else "") for v, ids in by.items())
 
 
+def last_summary(root: Path) -> dict[str, Any]:
+    """The last run's summary data: ``artifacts/report/summary.json`` when
+    it is there and its seal holds (:mod:`rclverify.evidence.sealed`), else
+    :func:`summary_data` of ``reports/assurance.json``.  A summary altered
+    outside rclverify is never shown: ``<path>: error: ... altered outside
+    rclverify`` goes to stderr and the JSON report is read instead.  Raises
+    ``OSError`` / ``ValueError`` when neither can be read."""
+    import json
+    import sys
+
+    from ..evidence.sealed import read_sealed
+    from ..workspace import Workspace
+    data, problem = read_sealed(root / Workspace.SUMMARY, "summary record")
+    if problem:
+        print(f"{Workspace.SUMMARY}: error: {problem}; showing reports/assurance.json instead", file=sys.stderr)
+    if data is None or problem:
+        data = summary_data(json.loads((root / "reports" / "assurance.json").read_text(encoding="utf-8")))
+    return data
+
+
 def print_last_run(root: Path) -> dict[str, Any]:
     """Print what ``doit verify`` ends with, from the last run's files in the
     workspace ``root``: the overall line and the problems by root cause
@@ -178,11 +198,7 @@ def print_last_run(root: Path) -> dict[str, Any]:
     import json
 
     from ..diagnosis.text import status_lines
-    from ..workspace import Workspace
-    try:
-        data: dict[str, Any] = json.loads((root / Workspace.SUMMARY).read_text(encoding="utf-8"))
-    except (OSError, ValueError):
-        data = summary_data(json.loads((root / "reports" / "assurance.json").read_text(encoding="utf-8")))
+    data = last_summary(root)
     print("\n".join(status_lines(data)))
     if data.get("requirements"):
         print(requirements_line(data["requirements"]))

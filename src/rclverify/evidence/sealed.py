@@ -1,0 +1,158 @@
+"""Sealed JSON records: every record under ``artifacts/`` that a report reads.
+
+An evidence record carries its seal, ``record_sha256`` (:data:`.store.SEAL`:
+the sha256 of the record's other keys in :func:`.store.dumps`), written in
+the same atomic write as the record (docs/integrity.md).  The other records
+the report, ``rclverify status``, the argument and the bundle read get the
+same treatment here: requirement checks (``artifacts/requirements/``),
+contract health findings (``artifacts/health/``), side conditions and
+derived properties (``artifacts/calculus/``), stage provenance
+(``artifacts/provenance/``), lint diagnostics, the grounding and the last
+run's summary.
+
+A record is a JSON object.  :func:`write_sealed` adds the seal;
+:func:`read_sealed` returns the record without it and a problem sentence
+when it cannot be believed: its content does not match its seal, it has no
+seal, or it cannot be read.  Readers show such a record as ``error``
+("altered outside rclverify"), never with what it says, and the doit task
+that writes it runs again (:func:`targets_intact`).  The seal detects hand
+edits and damage; it is not a signature against someone who recomputes it.
+"""
+from __future__ import annotations
+
+import json
+import os
+from pathlib import Path
+from typing import Any, Mapping
+
+from .store import SEAL, _sealed_text, seal_of, write_json
+
+#: Workspace-relative directories and files whose JSON records are sealed (:func:`is_sealed_path`).
+SEALED_DIRS = ("artifacts/requirements/", "artifacts/health/", "artifacts/calculus/", "artifacts/provenance/")
+SEALED_FILES = ("artifacts/check/diagnostics.json", "artifacts/report/summary.json", "artifacts/ros/grounding.json",
+                "artifacts/check/index.json")
+
+
+def is_sealed_path(rel: str) -> bool:
+    """Whether the workspace-relative POSIX path ``rel`` names a record written sealed."""
+    return rel.endswith(".json") and (rel in SEALED_FILES or rel.startswith(SEALED_DIRS))
+
+
+def sealed(record: Mapping[str, Any]) -> dict[str, Any]:
+    """``record`` (a JSON object, without a seal) with its seal added."""
+    body = {k: v for k, v in record.items() if k != SEAL}
+    return {**body, SEAL: seal_of(body)}
+
+
+def write_sealed(path: Path, record: Mapping[str, Any], *, durable: bool = False) -> bool:
+    """Write ``record`` sealed, atomically (:func:`.store.write_json`);
+    returns ``True`` when the file changed.  Raises ``OSError``."""
+    return write_json(path, sealed(record), durable=durable)
+
+
+def check_text(text: str, what: str = "record") -> tuple[dict[str, Any] | None, str]:
+    """``(record without its seal, problem)`` of the JSON text ``text``.
+
+    ``problem`` is ``""`` when the seal holds, else a sentence beginning
+    with ``what`` ("requirement record ...") saying why the record cannot be
+    believed; the record is then still returned when it parses as an
+    object (callers name what it claims, never show it as a result)."""
+    try:
+        raw = json.loads(text)
+    except ValueError as exc:
+        return None, f"{what} unreadable ({exc.__class__.__name__}): altered outside rclverify"
+    if not isinstance(raw, dict):
+        return None, f"{what} is not a JSON object: altered outside rclverify"
+    body = {k: v for k, v in raw.items() if k != SEAL}
+    if SEAL not in raw:
+        return body, f"{what} altered outside rclverify: it carries no seal (rclverify seals every record it writes)"
+    if not _sealed_text(text, raw[SEAL]) and raw[SEAL] != seal_of(raw):
+        return body, (f"{what} altered outside rclverify: its content does not match the sha256 rclverify wrote "
+                      "with it (run `doit verify` to produce it again)")
+    return body, ""
+
+
+def read_sealed(path: Path | str, what: str = "record") -> tuple[dict[str, Any] | None, str]:
+    """``(record, problem)`` of the sealed record at ``path``: ``(None, "")``
+    when there is none, else as :func:`check_text`."""
+    try:
+        with open(path, "rb") as fh:
+            text = fh.read().decode("utf-8")
+    except FileNotFoundError:
+        return None, ""
+    except (OSError, UnicodeDecodeError) as exc:
+        return None, f"{what} unreadable ({exc.__class__.__name__}): altered outside rclverify"
+    return check_text(text, what)
+
+
+def first_altered(root: str, rels: list[str]) -> str | None:
+    """The first of the workspace-relative ``rels`` (under ``root``) that
+    exists and whose seal does not hold, with the problem: ``"rel: problem"``;
+    ``None`` when every one is intact or absent."""
+    for rel in rels:
+        _, problem = read_sealed(os.path.join(root, rel))
+        if problem:
+            return f"{rel}: {problem}"
+    return None
+
+
+def _companions(path: str) -> list[str]:
+    """The sealed records a doit target stands for besides itself: a node's
+    provenance with its calculus record, every requirement record with the
+    requirement index."""
+    head, sep, rel = path.rpartition("/artifacts/")
+    if not sep:
+        return []
+    if rel.startswith("calculus/") and rel.endswith(".json"):
+        return [f"{head}/artifacts/provenance/{rel[len('calculus/'):]}"]
+    if rel == "requirements/index.json":
+        index, problem = read_sealed(path)
+        records = (index or {}).get("records")
+        if problem or not isinstance(records, dict):
+            return []
+        import re
+        return [f"{head}/artifacts/requirements/{re.sub(r'[^A-Za-z0-9_.-]+', '_', str(rid))}.json" for rid in records]
+    return []
+
+
+class TargetsSealed:
+    """doit ``uptodate`` check: every sealed record among the task's targets
+    (:func:`is_sealed_path`), and those they stand for (a node's provenance,
+    the requirement records of the index), is as rclverify wrote it.  A
+    record altered by anything else makes the task run again, so
+    ``doit verify`` produces it anew instead of believing it (``rclverify
+    report`` shows it as ``error``).  Cheap on a no-op run: the files' sizes
+    and modification times are saved with doit's task values after the task
+    ran, and the seals are checked only when one differs."""
+
+    KEY = "_sealed_stat"
+
+    def __call__(self, task: Any, values: Mapping[str, Any]) -> bool:
+        def files() -> list[str]:
+            out = []
+            for t in task.targets:
+                _, sep, rel = str(t).rpartition("/artifacts/")
+                if sep and is_sealed_path("artifacts/" + rel):
+                    out += [str(t), *_companions(str(t))]
+            return out
+
+        def stat() -> dict[str, Any]:
+            rows = []
+            for f in files():
+                try:
+                    st = os.stat(f)
+                    rows.append([f, st.st_mtime_ns, st.st_size])
+                except OSError:
+                    rows.append([f, None, None])
+            return {self.KEY: rows}
+        task.value_savers.append(stat)
+        now = stat()[self.KEY]
+        if values.get(self.KEY) == now:
+            return True
+        for f, _, _ in now:
+            _, problem = read_sealed(f)
+            if problem:
+                root, _, rel = f.rpartition("/artifacts/")
+                print(f"artifacts/{rel}: {problem}: producing it again")
+                return False
+        return True
