@@ -680,7 +680,7 @@ def _build_tasks(root: str | Path, plan_file: str) -> dict[str, Callable[[], Any
         return {"actions": [(act_verify, [r])], "task_dep": ["check", *before, "report"] if ok else ["check"],
                 "file_dep": [str(rootp / REPORTS[2])] if ok else [],
                 "params": [{"name": "strict", "long": "strict", "type": bool, "default": False,
-                            "help": "fail unless every obligation, side condition and health check holds"}],
+                            "help": "fail unless every obligation, side condition, health check and formal requirement holds"}],
                 "uptodate": [strict_uptodate], "verbosity": 2}
 
     creators: dict[str, Callable[[], Any]] = {"task_check": task_check, "task_verify": task_verify}
