@@ -263,3 +263,25 @@ def test_6_bundle_verify_streams_members_and_refuses_a_huge_one_in_one_line(
                    "a bundle member may have; not checked"]
     with pytest.raises(BundleError):
         verify_bundle(bomb)
+
+
+def test_2_an_obligation_list_altered_outside_rclverify_is_error_and_exported_again(tmp_path: Path) -> None:
+    ws = _copy(tmp_path)
+    assert _doit(ws, "verify").returncode == 0
+    listed = ws / "artifacts/obligations/SpeedController.json"
+    one = ws / "artifacts/obligations/SpeedController/SpeedController.g2.hoare.speed_controller.c1.json"
+    # drop an obligation from the list, and weaken one obligation's own record
+    _forge(listed, lambda d: d["obligations"].pop() if isinstance(d, dict) else d.pop())
+    _forge(one, lambda d: d.update(statement="true"))
+    assert main(["report", "-w", str(ws)]) == 0
+    report = _report(ws)
+    rows = [o for o in report["obligations"] if o["node"] == "SpeedController"]
+    assert [(o["id"], o["status"]) for o in rows] == [("SpeedController.obligations", "error")]
+    node = next(n for n in report["nodes"] if n["name"] == "SpeedController")
+    assert node["status"] == "error" and not report["meta"]["strict_ok"]
+    r = _doit(ws, "verify")
+    assert r.returncode == 0, r.stdout + r.stderr
+    assert "artifacts/obligations/SpeedController.json: " in r.stdout and "producing it again" in r.stdout
+    assert read_sealed(one)[0]["statement"] != "true"  # exported again before its evidence ran
+    rows = [o for o in _report(ws)["obligations"] if o["node"] == "SpeedController"]
+    assert [o["status"] for o in rows] == ["discharged", "discharged"]

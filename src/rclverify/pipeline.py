@@ -28,7 +28,7 @@ from typing import TYPE_CHECKING, Any, Sequence
 
 from .evidence.records import Evidence, Obligation
 from .evidence.sealed import write_sealed
-from .evidence.store import EvidenceStore, atomic_write_text, dumps, read_json, write_json, write_obligations
+from .evidence.store import EvidenceStore, atomic_write_text, dumps, write_obligations
 from .logic.world import fresh as fresh_z3
 from .rcl.errors import RclError, error
 # The workspace and what is derived from it without a stage live below the report
@@ -166,7 +166,7 @@ def stage_export(ws: Workspace, node: str) -> list[dict[str, Any]]:
     write_obligations(ws.path(ws.obligations(node)), obligations)
     keep = set()
     for o in obligations:  # rewritten only when changed, so only changed obligations re-run
-        write_json(ws.path(ws.obligation(node, o.id)), o.to_json())
+        write_sealed(ws.path(ws.obligation(node, o.id)), o.to_json())
         keep.add(f"{o.id}.json")
     for old in ws.path(f"artifacts/obligations/{node}").glob("*.json"):
         if old.name not in keep:
@@ -174,12 +174,25 @@ def stage_export(ws: Workspace, node: str) -> list[dict[str, Any]]:
     return [o.to_json() for o in obligations]
 
 
+def ast_loc(rel: str) -> Any:
+    """Line 1, column 1 of the workspace file ``rel`` (a located error about a whole record)."""
+    from .rcl.ast import Loc
+    return Loc(rel, 1, 1)
+
+
 def stage_run(ws: Workspace, node: str, obligation_id: str) -> Evidence:
     """Run the backend of one exported obligation and store its evidence record
-    atomically (an earlier record is replaced only by a complete new one)."""
+    atomically (an earlier record is replaced only by a complete new one).
+    Raises ``RclError`` when the obligation's record was altered outside
+    rclverify (its seal does not hold): the backend is never run on it."""
     fresh_z3()  # the same Z3 state whatever ran before in this process (logic/world.py)
     from .backends import get_backend
-    o = Obligation.from_json(read_json(ws.path(ws.obligation(node, obligation_id))))
+    from .evidence.sealed import read_sealed
+    rel = ws.obligation(node, obligation_id)
+    raw, altered = read_sealed(ws.path(rel), "obligation record")
+    if altered or raw is None:  # never run a backend on an obligation rclverify did not export
+        raise RclError([error(ast_loc(rel), altered or "no such obligation: run `doit verify`", "E-io")])
+    o = Obligation.from_json(raw)
     ev = get_backend(o.backend).run(o, ws.target(node, int(o.data.get("entry", 0))))
     EvidenceStore(ws.root).put(ev)
     return ev

@@ -42,7 +42,6 @@ from __future__ import annotations
 
 import glob
 import inspect
-import json
 import os
 import shutil
 from pathlib import Path
@@ -606,13 +605,11 @@ def _build_tasks(root: str | Path, plan_file: str) -> dict[str, Callable[[], Any
         return exported_memo[0]
 
     def read_exported() -> list[tuple[str, dict[str, Any]]]:
+        from .evidence.sealed import obligation_list
         out: list[tuple[str, dict[str, Any]]] = []
         for n in nodes:
-            try:
-                with open(at(ws.obligations(n)), encoding="utf-8") as fh:
-                    out.extend((n, o) for o in json.load(fh))
-            except (OSError, ValueError):
-                continue
+            records, _ = obligation_list(at(ws.obligations(n)))  # sealed: an altered list is made again first
+            out.extend((n, o) for o in records or [])
         return out
 
     @create_after(executed="node")

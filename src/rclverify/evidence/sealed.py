@@ -7,8 +7,9 @@ the report, ``rclverify status``, the argument and the bundle read get the
 same treatment here: requirement checks (``artifacts/requirements/``),
 contract health findings (``artifacts/health/``), side conditions and
 derived properties (``artifacts/calculus/``), stage provenance
-(``artifacts/provenance/``), lint diagnostics, the grounding and the last
-run's summary.
+(``artifacts/provenance/``), exported obligations (``artifacts/obligations/``:
+each node's list and each obligation's own file), lint diagnostics, the
+grounding and the last run's summary.
 
 A record is a JSON object.  :func:`write_sealed` adds the seal;
 :func:`read_sealed` returns the record without it and a problem sentence
@@ -28,7 +29,8 @@ from typing import Any, Mapping
 from .store import SEAL, _sealed_text, seal_of, write_json
 
 #: Workspace-relative directories and files whose JSON records are sealed (:func:`is_sealed_path`).
-SEALED_DIRS = ("artifacts/requirements/", "artifacts/health/", "artifacts/calculus/", "artifacts/provenance/")
+SEALED_DIRS = ("artifacts/requirements/", "artifacts/health/", "artifacts/calculus/", "artifacts/provenance/",
+               "artifacts/obligations/")
 SEALED_FILES = ("artifacts/check/diagnostics.json", "artifacts/report/summary.json", "artifacts/ros/grounding.json",
                 "artifacts/check/index.json")
 
@@ -85,6 +87,20 @@ def read_sealed(path: Path | str, what: str = "record") -> tuple[dict[str, Any] 
     return check_text(text, what)
 
 
+def obligation_list(path: Path | str) -> tuple[list[dict[str, Any]] | None, str]:
+    """``(obligation JSON objects, problem)`` of a node's obligation list
+    (``artifacts/obligations/<Node>.json``, :func:`.store.write_obligations`):
+    ``(None, "")`` when there is none; the list is ``[]`` with a problem
+    sentence when the record's seal does not hold or it is malformed."""
+    body, problem = read_sealed(path, "obligation list")
+    if body is None and not problem:
+        return None, ""
+    records = (body or {}).get("obligations")
+    if not problem and not (isinstance(records, list) and all(isinstance(o, dict) for o in records)):
+        problem = "obligation list malformed: altered outside rclverify"
+    return ([] if problem else list(records or [])), problem
+
+
 def first_altered(root: str, rels: list[str]) -> str | None:
     """The first of the workspace-relative ``rels`` (under ``root``) that
     exists and whose seal does not hold, with the problem: ``"rel: problem"``;
@@ -98,13 +114,18 @@ def first_altered(root: str, rels: list[str]) -> str | None:
 
 def _companions(path: str) -> list[str]:
     """The sealed records a doit target stands for besides itself: a node's
-    provenance with its calculus record, every requirement record with the
+    provenance with its calculus record, each obligation's own file with
+    the node's obligation list, every requirement record with the
     requirement index."""
     head, sep, rel = path.rpartition("/artifacts/")
     if not sep:
         return []
     if rel.startswith("calculus/") and rel.endswith(".json"):
         return [f"{head}/artifacts/provenance/{rel[len('calculus/'):]}"]
+    if rel.startswith("obligations/") and rel.count("/") == 1 and rel.endswith(".json"):
+        records, problem = obligation_list(path)
+        return [f"{head}/artifacts/obligations/{rel[len('obligations/'):-5]}/{o.get('id')}.json"
+                for o in (records or [])] if not problem else []
     if rel == "requirements/index.json":
         index, problem = read_sealed(path)
         records = (index or {}).get("records")

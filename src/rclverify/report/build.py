@@ -34,7 +34,7 @@ from .. import __version__
 from ..contract_texts import ContractTexts
 from ..evidence.records import SEVERITY, Obligation, worst
 from ..evidence.store import EvidenceStore
-from ..workspace import Workspace, current_snapshot_hashes, read_artifact, stale_stages
+from ..workspace import Workspace, current_snapshot_hashes, stale_stages
 from ..system.model import cycles_kept, names_of
 from ..diagnosis.build import diagnose
 from ..diagnosis.text import natural_sorted  # p1 < p2 < p10
@@ -147,9 +147,14 @@ def build_report(ws: Workspace) -> dict[str, Any]:
     checked, model, plan = ws.checked, ws.model, ws.plan
     texts = ContractTexts(ws)  # each node's RCL and LaTeX texts, kept by its file's sha256 (read only here)
     store = EvidenceStore(ws.root)
+    from .records import node_obligations
     obligations: list[Obligation] = []
+    altered_lists: dict[str, str] = {}  # placeholder obligation id -> why its node's list is not believed
     for n in checked.nodes:
-        obligations.extend(Obligation.from_json(d) for d in read_artifact(ws, ws.obligations(n), []))
+        obs, why = node_obligations(ws, n)  # sealed: a list altered outside rclverify is one error row
+        obligations.extend(obs)
+        if why:
+            altered_lists[obs[0].id] = why
     ev_rows: list[dict[str, Any]] = []
     ob_rows: list[dict[str, Any]] = []
     pending: list[dict[str, Any]] = []
@@ -162,7 +167,7 @@ def build_report(ws: Workspace) -> dict[str, Any]:
     made_from, ev_inputs = dict(hashes), dict[str, Any]()  # what the report is built from (meta.inputs_sha256)
     stale = stale_stages(ws, hashes)  # calculus or health made from another contract text
     for o in obligations:
-        ev, altered = store.read(o.id)
+        ev, altered = (None, altered_lists[o.id]) if o.id in altered_lists else store.read(o.id)
         ev_inputs[o.id] = dict(ev.input_hashes) if ev is not None else None
         if altered:
             status = "error"

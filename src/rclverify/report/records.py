@@ -15,7 +15,8 @@ from __future__ import annotations
 import hashlib
 from typing import Any, Iterable, Mapping
 
-from ..evidence.sealed import read_sealed
+from ..evidence.records import Obligation, SourceRef
+from ..evidence.sealed import obligation_list, read_sealed
 from ..workspace import Workspace
 
 
@@ -54,6 +55,20 @@ def node_records(ws: Workspace, nodes: Iterable[str]) -> tuple[dict[str, dict[st
             why = "contract health record malformed: altered outside rclverify"
         health[n] = [_error_finding(n, f"{rel}: {why}")] if why else list(findings)
     return comps, health
+
+
+def node_obligations(ws: Workspace, node: str) -> tuple[list[Obligation], str]:
+    """``(obligations, problem)`` of ``node``'s obligation list: ``([], "")``
+    before export; when its seal does not hold, one placeholder obligation
+    ``<node>.obligations`` bearing on every guarantee (guarantee 0) and the
+    problem sentence: the caller shows it ``error`` (a list with a failing
+    obligation removed by hand is never believed)."""
+    rel = ws.obligations(node)
+    records, problem = obligation_list(ws.path(rel))
+    if problem:
+        return [Obligation(id=f"{node}.obligations", node=node, guarantee=0, backend="record", kind="proof",
+                           statement=f"error: {rel}: {problem}", source=SourceRef(rel, 1, 1))], f"{rel}: {problem}"
+    return [Obligation.from_json(d) for d in records or []], ""
 
 
 def diagnostics(ws: Workspace) -> list[dict[str, Any]]:
