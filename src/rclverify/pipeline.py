@@ -14,7 +14,7 @@ Artifact layout (workspace-relative)::
     artifacts/calculus/<Node>.json       rule instances, side conditions, derived property (sealed)
     artifacts/calculus/<Node>.sc<k>.smt2 each side condition as SMT-LIB2
     artifacts/health/<Node>.json         contract health findings ({"node", "findings"}, sealed)
-    artifacts/obligations/<Node>.json    exported obligations of the node
+    artifacts/obligations/<Node>.json    exported obligations of the node ({"obligations"}, sealed)
     artifacts/evidence/<obligation>.json one evidence record per obligation
     artifacts/requirements/<ID>.json     a requirement's Z3 check (proved/refuted/...)
 """

@@ -236,10 +236,8 @@ def read_obligations(path: Path) -> list[Obligation]:
     """Read obligations written by :func:`write_obligations`.  Raises
     ``FileNotFoundError``, and ``ValueError`` for a record altered outside
     rclverify (its seal does not hold) or malformed."""
-    from .sealed import obligation_list
-    records, problem = obligation_list(path)
-    if problem:
-        raise ValueError(f"{path}: {problem}")
-    if records is None:
-        raise FileNotFoundError(str(path))
+    raw = read_json(path)
+    records = raw.get("obligations") if isinstance(raw, dict) else None
+    if not isinstance(records, list) or raw.get(SEAL) != seal_of(raw):
+        raise ValueError(f"{path}: obligation list altered outside rclverify (its seal does not hold)")
     return [Obligation.from_json(d) for d in records]
