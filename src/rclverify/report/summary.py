@@ -162,7 +162,7 @@ def requirements_line(rows: Sequence[Sequence[str]]) -> str:
     by: dict[str, list[str]] = {}
     for rid, verdict, _ in rows:
         by.setdefault(verdict or "traced", []).append(rid)
-    named = ("refuted", "proved from an inconsistency", "proved vacuously", "inconclusive")
+    named = ("refuted", "proved from an inconsistency", "proved vacuously", "inconclusive", "stale", "error")
     return "requirements: " + ", ".join(f"{len(ids)} {v}" + (f" ({', '.join(ids[:5])}{', ...' if len(ids) > 5 else ''})"
                                                             if v in named else "") for v, ids in by.items())
 
