@@ -285,3 +285,23 @@ def test_2_an_obligation_list_altered_outside_rclverify_is_error_and_exported_ag
     assert read_sealed(one)[0]["statement"] != "true"  # exported again before its evidence ran
     rows = [o for o in _report(ws)["obligations"] if o["node"] == "SpeedController"]
     assert [o["status"] for o in rows] == ["discharged", "discharged"]
+
+
+def test_2_a_grounding_altered_or_made_from_other_files_is_not_believed(tmp_path: Path) -> None:
+    from rclverify.report.records import grounding
+    from rclverify.ros.stage import GROUNDING, stage_ground
+    from rclverify.workspace import Workspace
+    root = Path(__file__).parents[1]
+    for item in ("contracts", "ros", "backends"):
+        shutil.copytree(root / item, tmp_path / item)
+    ws = Workspace(tmp_path, "contracts/plan.yaml")
+    made = stage_ground(ws)
+    assert made["counts"]["error"] == 0 and "stale" not in grounding(ws, GROUNDING)
+    # the software edited after the grounding was made: stale
+    script = tmp_path / "ros/rover_inspection/scripts/navigation.py"
+    script.write_text(script.read_text() + "# edited\n")
+    assert "made from other files" in grounding(ws, GROUNDING)["stale"]
+    # a grounding error removed by hand: an error, not a clean grounding
+    _forge(tmp_path / GROUNDING, lambda d: d.update(findings=[], counts={"error": 0, "warning": 0}))
+    g = grounding(ws, GROUNDING)
+    assert g["counts"]["error"] == 1 and "altered outside rclverify" in g["findings"][0]["message"]

@@ -39,6 +39,8 @@ from ..system.model import cycles_kept, names_of
 from ..diagnosis.build import diagnose
 from ..diagnosis.text import natural_sorted  # p1 < p2 < p10
 from .expected import expected_rows
+from .records import diagnostics as read_diagnostics, grounding as read_grounding, inputs_sha256, node_obligations, \
+    node_records
 
 _FINDING_AS = {"ok": "discharged", "problem": "failed", "inconclusive": "inconclusive",
                # a health warning (health/shape.py) is shown but changes no status
@@ -147,7 +149,6 @@ def build_report(ws: Workspace) -> dict[str, Any]:
     checked, model, plan = ws.checked, ws.model, ws.plan
     texts = ContractTexts(ws)  # each node's RCL and LaTeX texts, kept by its file's sha256 (read only here)
     store = EvidenceStore(ws.root)
-    from .records import node_obligations
     obligations: list[Obligation] = []
     altered_lists: dict[str, str] = {}  # placeholder obligation id -> why its node's list is not believed
     for n in checked.nodes:
@@ -203,7 +204,6 @@ def build_report(ws: Workspace) -> dict[str, Any]:
             pending.append({"obligation": o.id, "backend": o.backend, "reason": ev.explanation})
 
     expected = expected_rows(plan, ob_rows)
-    from .records import diagnostics as read_diagnostics, grounding as read_grounding, inputs_sha256, node_records
     comps, health = node_records(ws, checked.nodes)  # sealed: an altered record is error, never what it says
     for n, stages in stale.items():  # never the status of an old contract text
         note = ("STALE: made from another text of the contracts or plan than the current one "
@@ -352,7 +352,9 @@ def build_report(ws: Workspace) -> dict[str, Any]:
             grounding["svg_text"] = ws.path(svg_rel).read_text(encoding="utf-8") if svg_rel else None
         except OSError:
             grounding["svg_text"] = None
-        strict_ok = strict_ok and not grounding["counts"]["error"]
+        strict_ok = strict_ok and not grounding["counts"]["error"] and not grounding.get("stale")
+        if grounding.get("stale"):
+            problems.append(f"Grounding is stale: {grounding['stale']}")
         if grounding["counts"]["error"]:
             problems.append(f"Grounding: {grounding['counts']['error']} contract(s)-vs-ROS error(s) "
                             f"(rclverify ros check)")

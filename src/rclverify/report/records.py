@@ -84,7 +84,9 @@ def diagnostics(ws: Workspace) -> list[dict[str, Any]]:
 
 def grounding(ws: Workspace, rel: str) -> dict[str, Any] | None:
     """The grounding record ``rel`` (``None`` before it was made); when its
-    seal does not hold, a record of one error and no findings."""
+    seal does not hold, a record of one error and no findings; when the
+    files it was made from (its ``inputs``, path -> sha256) changed since,
+    the record with ``stale`` (a sentence) added."""
     body, why = read_sealed(ws.path(rel), "grounding record")
     if why:
         return {"counts": {"error": 1, "warning": 0}, "altered": f"{rel}: {why}",
@@ -92,6 +94,14 @@ def grounding(ws: Workspace, rel: str) -> dict[str, Any] | None:
                               "topic": None, "rcl": None, "ros": None}],
                 "context": {"packages": [], "files": []}, "drawing": {"dot": "", "svg": None},
                 "graph": {"nodes": []}, "matched": {}}
+    if body is not None:
+        from ..evidence.records import hash_inputs
+        from ..ros.inputs import input_files
+        made = body.get("inputs")
+        now = input_files(ws)
+        if not isinstance(made, dict) or set(made) != set(now) or hash_inputs(ws.root, now) != made:
+            body["stale"] = (f"{rel} was made from other files of the plan, contracts or ROS software than the "
+                             "current ones (run `doit verify`)")
     return body
 
 
