@@ -154,42 +154,52 @@ def _companions(path: str) -> list[str]:
 
 class TargetsSealed:
     """doit ``uptodate`` check: every sealed record among the task's targets
-    (:func:`is_sealed_path`), and those they stand for (a node's provenance,
-    the requirement records of the index), is as rclverify wrote it.  A
-    record altered by anything else makes the task run again, so
-    ``doit verify`` produces it anew instead of believing it (``rclverify
-    report`` shows it as ``error``).  Cheap on a no-op run: the files' sizes
-    and modification times are saved with doit's task values after the task
-    ran, and the seals are checked only when one differs."""
+    (:func:`is_sealed_path`), and those they stand for (a node's provenance
+    and each obligation's record, the requirement records of the index), is
+    as rclverify wrote it.  A record altered by anything else makes the task
+    run again, so ``doit verify`` produces it anew instead of believing it
+    (``rclverify report`` shows it as ``error``).
+
+    Cheap on a no-op run: after the task ran, the files' paths, sizes and
+    modification times are saved with doit's task values; while every one
+    is the same, nothing is read (not even the lists that name the records
+    they stand for).  Otherwise every seal is checked."""
 
     KEY = "_sealed_stat"
 
     def __call__(self, task: Any, values: Mapping[str, Any]) -> bool:
-        def files() -> list[str]:
+        def sealed_targets() -> list[str]:
             out = []
             for t in task.targets:
                 _, sep, rel = str(t).rpartition("/artifacts/")
                 if sep and is_sealed_path("artifacts/" + rel):
-                    out += [str(t), *_companions(str(t))]
+                    out.append(str(t))
             return out
 
+        def stat_of(f: str) -> list[Any]:
+            try:
+                st = os.stat(f)
+                return [f, st.st_mtime_ns, st.st_size]
+            except OSError:
+                return [f, None, None]
+
+        def files() -> list[str]:
+            return [g for t in sealed_targets() for g in (t, *_companions(t))]
+
         def stat() -> dict[str, Any]:
-            rows = []
-            for f in files():
-                try:
-                    st = os.stat(f)
-                    rows.append([f, st.st_mtime_ns, st.st_size])
-                except OSError:
-                    rows.append([f, None, None])
-            return {self.KEY: rows}
+            return {self.KEY: [stat_of(f) for f in files()]}
         task.value_savers.append(stat)
-        now = stat()[self.KEY]
-        if values.get(self.KEY) == now:
+        targets = sealed_targets()
+        if not targets:
             return True
-        for f, _, _ in now:
+        saved = values.get(self.KEY)
+        if isinstance(saved, list) and {r[0] for r in saved if isinstance(r, list) and r} >= set(targets) \
+                and all(isinstance(r, list) and len(r) == 3 and stat_of(r[0]) == r for r in saved):
+            return True
+        for f in files():
             _, problem = read_sealed(f)
             if problem:
-                root, _, rel = f.rpartition("/artifacts/")
+                _, _, rel = f.rpartition("/artifacts/")
                 print(f"artifacts/{rel}: {problem}: producing it again")
                 return False
         return True
