@@ -387,30 +387,10 @@ def cmd_init(args: argparse.Namespace) -> int:
 
 
 def _report_out_of_date(ws: Any) -> list[str]:
-    """Why the written report no longer says what the evidence says (empty
-    when it does, when there is no report yet, or when the workspace does not
-    check: then the bundle packs what there is, as before).  The report is
-    built again in memory from the recorded artifacts, each evidence
-    record's inputs hashed anew against the current contracts and files
-    (docs/integrity.md); an obligation whose status differs from the written
-    report's is listed: an assessor's bundle never holds a report that
-    calls stale or altered evidence anything else."""
-    from .report.build import build_report
-    try:
-        written = json.loads(ws.path("reports/assurance.json").read_text(encoding="utf-8"))
-        was = {o["id"]: o["status"] for o in written["obligations"]}
-    except (OSError, ValueError, KeyError, TypeError):
-        return []
-    try:
-        now = {o["id"]: o["status"] for o in build_report(ws)["obligations"]}
-    except RclError:
-        return []
-    changed = sorted(k for k in now if was.get(k) != now[k])
-    if not changed:
-        return []
-    shown = ", ".join(f"{k} ({was.get(k, 'absent')} -> {now[k]})" for k in changed[:5])
-    return [f"reports/assurance.json is out of date: {len(changed)} obligation(s) have another status now: "
-            f"{shown}{' ...' if len(changed) > 5 else ''}; run `rclverify report` (or `doit verify`) first"]
+    """Why the written report no longer says what the recorded artifacts say
+    (:func:`rclverify.bundle.fresh.report_out_of_date`)."""
+    from .bundle.fresh import report_out_of_date
+    return report_out_of_date(ws)
 
 
 def cmd_bundle(args: argparse.Namespace) -> int:

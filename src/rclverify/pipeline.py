@@ -11,10 +11,10 @@ Artifact layout (workspace-relative)::
     artifacts/contracts/<Node>.json      canonical snapshot of one node's contract,
                                          the shared context, its facts and plan entries
     artifacts/system/model.json|.dot     the system model
-    artifacts/calculus/<Node>.json       rule instances, side conditions, derived property
+    artifacts/calculus/<Node>.json       rule instances, side conditions, derived property (sealed)
     artifacts/calculus/<Node>.sc<k>.smt2 each side condition as SMT-LIB2
-    artifacts/health/<Node>.json         contract health findings
-    artifacts/obligations/<Node>.json    exported obligations of the node
+    artifacts/health/<Node>.json         contract health findings ({"node", "findings"}, sealed)
+    artifacts/obligations/<Node>.json    exported obligations of the node ({"obligations"}, sealed)
     artifacts/evidence/<obligation>.json one evidence record per obligation
     artifacts/requirements/<ID>.json     a requirement's Z3 check (proved/refuted/...)
 """
@@ -27,7 +27,8 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any, Sequence
 
 from .evidence.records import Evidence, Obligation
-from .evidence.store import EvidenceStore, atomic_write_text, dumps, read_json, write_json, write_obligations
+from .evidence.sealed import write_sealed
+from .evidence.store import EvidenceStore, atomic_write_text, dumps, write_obligations
 from .logic.world import fresh as fresh_z3
 from .rcl.errors import RclError, error
 # The workspace and what is derived from it without a stage live below the report
@@ -53,7 +54,7 @@ def stage_check(ws: Workspace) -> dict[str, Any]:
     checked, model = ws.checked, ws.model
     texts = ContractTexts(ws)  # each file's lint and each node's RCL text, kept by the file's sha256
     warnings = [w for s in checked.specs for w in texts.lint(s)]
-    write_json(ws.path(ws.DIAGNOSTICS), {"warnings": warnings})
+    write_sealed(ws.path(ws.DIAGNOSTICS), {"warnings": warnings})
     hashes: dict[str, str] = {}
     for name, snap in node_snapshots(ws, texts).items():
         text = dumps(snap)
@@ -93,7 +94,7 @@ def stage_compose(ws: Workspace, node: str) -> dict[str, Any]:
         atomic_write_text(ws.path(rel), sc.smt2)
         paths.append(rel)
     out = composition_json(comp, paths)
-    write_json(ws.path(ws.calculus(node)), out)
+    write_sealed(ws.path(ws.calculus(node)), out)
     record_provenance(ws, node, "compose", stage_inputs(ws, node, "compose"))  # after: a killed stage records nothing
     return out
 
@@ -113,7 +114,7 @@ def stage_health(ws: Workspace, node: str) -> list[dict[str, Any]]:
             j["smt2"] = f"artifacts/health/{f.id}.smt2"
             atomic_write_text(ws.path(j["smt2"]), f.smt2)
         findings.append(j)
-    write_json(ws.path(ws.health(node)), findings)
+    write_sealed(ws.path(ws.health(node)), {"node": node, "findings": findings})
     record_provenance(ws, node, "health", stage_inputs(ws, node, "health"))
     return findings
 
@@ -165,7 +166,7 @@ def stage_export(ws: Workspace, node: str) -> list[dict[str, Any]]:
     write_obligations(ws.path(ws.obligations(node)), obligations)
     keep = set()
     for o in obligations:  # rewritten only when changed, so only changed obligations re-run
-        write_json(ws.path(ws.obligation(node, o.id)), o.to_json())
+        write_sealed(ws.path(ws.obligation(node, o.id)), o.to_json())
         keep.add(f"{o.id}.json")
     for old in ws.path(f"artifacts/obligations/{node}").glob("*.json"):
         if old.name not in keep:
@@ -173,12 +174,25 @@ def stage_export(ws: Workspace, node: str) -> list[dict[str, Any]]:
     return [o.to_json() for o in obligations]
 
 
+def ast_loc(rel: str) -> Any:
+    """Line 1, column 1 of the workspace file ``rel`` (a located error about a whole record)."""
+    from .rcl.ast import Loc
+    return Loc(rel, 1, 1)
+
+
 def stage_run(ws: Workspace, node: str, obligation_id: str) -> Evidence:
     """Run the backend of one exported obligation and store its evidence record
-    atomically (an earlier record is replaced only by a complete new one)."""
+    atomically (an earlier record is replaced only by a complete new one).
+    Raises ``RclError`` when the obligation's record was altered outside
+    rclverify (its seal does not hold): the backend is never run on it."""
     fresh_z3()  # the same Z3 state whatever ran before in this process (logic/world.py)
     from .backends import get_backend
-    o = Obligation.from_json(read_json(ws.path(ws.obligation(node, obligation_id))))
+    from .evidence.sealed import read_sealed
+    rel = ws.obligation(node, obligation_id)
+    raw, altered = read_sealed(ws.path(rel), "obligation record")
+    if altered or raw is None:  # never run a backend on an obligation rclverify did not export
+        raise RclError([error(ast_loc(rel), altered or "no such obligation: run `doit verify`", "E-io")])
+    o = Obligation.from_json(raw)
     ev = get_backend(o.backend).run(o, ws.target(node, int(o.data.get("entry", 0))))
     EvidenceStore(ws.root).put(ev)
     return ev
@@ -220,7 +234,7 @@ def stage_report(ws: Workspace, parts: Sequence[str] = tuple(REPORT_PARTS),
         fragments.save()
         if part == "html":  # with assurance.json: what verify prints
             from .report.summary import summary_data
-            write_json(ws.path(ws.SUMMARY), summary_data(report))
+            write_sealed(ws.path(ws.SUMMARY), summary_data(report))
     # the one fragment cache of the single report task of earlier versions (38 MB at 1000 nodes)
     ws.path("artifacts/cache/report-fragments.pickle").unlink(missing_ok=True)
     return report, paths

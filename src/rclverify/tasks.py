@@ -42,7 +42,6 @@ from __future__ import annotations
 
 import glob
 import inspect
-import json
 import os
 import shutil
 from pathlib import Path
@@ -553,7 +552,9 @@ def _build_tasks(root: str | Path, plan_file: str) -> dict[str, Callable[[], Any
     # a missing plan or contract makes `check` run, and fail with the located message, every time.
     named = [str(rootp / plan_file)] + contract_deps
     check_deps = [d for d in named if os.path.isfile(d)]
-    check_extra: dict[str, Any] = {"uptodate": [False] if len(check_deps) < len(named) or not ok else [code]}
+    from .evidence.sealed import TargetsSealed  # a sealed record altered outside rclverify is made again
+    sealed = TargetsSealed()
+    check_extra: dict[str, Any] = {"uptodate": [False] if len(check_deps) < len(named) or not ok else [code, sealed]}
 
     def task_check() -> dict[str, Any]:
         """Parse and type-check the contracts, check the plan, lint, build the system model."""
@@ -583,7 +584,7 @@ def _build_tasks(root: str | Path, plan_file: str) -> dict[str, Callable[[], Any
             yield {"name": n, "actions": [(act_node, [r, n, deps])],
                    "file_dep": sorted({d for ds in deps.values() for d in ds}),
                    "targets": [at(ws.calculus(n)), at(ws.health(n)), at(ws.obligations(n))],
-                   "uptodate": [code], "verbosity": 2, "clean": True}
+                   "uptodate": [code, sealed], "verbosity": 2, "clean": True}
 
     def task_requirements() -> dict[str, Any]:
         """Check each requirement's formal statement with Z3 from the guarantees of its cone.  Defined before
@@ -598,7 +599,7 @@ def _build_tasks(root: str | Path, plan_file: str) -> dict[str, Callable[[], Any
                 extra += [str(rootp / f) for f in doorstop_files(rootp, d)]
         return {"actions": [(act_requirements, [r])],
                 "file_dep": [str(rootp / plan_file), at(ws.MODEL)] + list(snap.values()) + extra,
-                "targets": [at(INDEX)], "uptodate": [code], "verbosity": 2, "clean": True}
+                "targets": [at(INDEX)], "uptodate": [code, sealed], "verbosity": 2, "clean": True}
 
     exported_memo: list[list[tuple[str, dict[str, Any]]]] = []
 
@@ -610,13 +611,11 @@ def _build_tasks(root: str | Path, plan_file: str) -> dict[str, Callable[[], Any
         return exported_memo[0]
 
     def read_exported() -> list[tuple[str, dict[str, Any]]]:
+        from .evidence.sealed import obligation_list
         out: list[tuple[str, dict[str, Any]]] = []
         for n in nodes:
-            try:
-                with open(at(ws.obligations(n)), encoding="utf-8") as fh:
-                    out.extend((n, o) for o in json.load(fh))
-            except (OSError, ValueError):
-                continue
+            records, _ = obligation_list(at(ws.obligations(n)))  # sealed: an altered list is made again first
+            out.extend((n, o) for o in records or [])
         return out
 
     @create_after(executed="node")
@@ -651,7 +650,7 @@ def _build_tasks(root: str | Path, plan_file: str) -> dict[str, Callable[[], Any
     def task_ground() -> dict[str, Any]:
         """Ground the contracts in the ROS software of the plan's ros: section (docs/ros.md)."""
         return {"actions": [(act_ground, [r])], "file_dep": [str(rootp / plan_file)] + contract_deps,
-                "uptodate": [config_changed({"files": ros_fingerprint(rootp, ros_section)})],
+                "uptodate": [config_changed({"files": ros_fingerprint(rootp, ros_section)}), sealed],
                 "targets": [at("artifacts/ros/grounding.json"), at("artifacts/ros/graph.json")],
                 "task_dep": ["check"], "verbosity": 2, "clean": True}
 
@@ -671,7 +670,7 @@ def _build_tasks(root: str | Path, plan_file: str) -> dict[str, Callable[[], Any
             deps.append(at("artifacts/ros/grounding.json"))
         for part, files in REPORT_PARTS.items():
             yield {"name": part, "doc": "reports/" + ", ".join(files), "actions": [(act_report, [r, part])],
-                   "file_dep": deps, "uptodate": [code],
+                   "file_dep": deps, "uptodate": [code, sealed],
                    "targets": [at(f"reports/{f}") for f in files if f != "argument.svg"]
                    + ([at(ws.SUMMARY)] if part == "html" else []),
                    "verbosity": 2, "clean": True}
@@ -684,7 +683,7 @@ def _build_tasks(root: str | Path, plan_file: str) -> dict[str, Callable[[], Any
         return {"actions": [(act_verify, [r])], "task_dep": ["check", *before, "report"] if ok else ["check"],
                 "file_dep": [str(rootp / REPORTS[2])] if ok else [],
                 "params": [{"name": "strict", "long": "strict", "type": bool, "default": False,
-                            "help": "fail unless every obligation, side condition and health check holds"}],
+                            "help": "fail unless every obligation, side condition, health check and formal requirement holds"}],
                 "uptodate": [strict_uptodate], "verbosity": 2}
 
     creators: dict[str, Callable[[], Any]] = {"task_check": task_check, "task_verify": task_verify}

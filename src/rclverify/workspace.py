@@ -320,12 +320,13 @@ def record_provenance(ws: Workspace, node: str, stage: str, inputs: Sequence[str
     with the status of the old text (``rclverify report`` runs no stage).
     Raises ``OSError`` when the file cannot be written."""
     from .evidence.records import hash_inputs
+    from .evidence.sealed import read_sealed, write_sealed
     rel = ws.provenance(node)
-    current = read_artifact(ws, rel, {})
-    if not isinstance(current, dict):
+    current, problem = read_sealed(ws.path(rel))
+    if problem or current is None:  # an altered record is not kept: the other stage then reads as stale
         current = {}
     current[stage] = hash_inputs(ws.root, list(inputs))
-    write_json(ws.path(rel), current)
+    write_sealed(ws.path(rel), current)
 
 
 def stage_inputs(ws: Workspace, node: str, stage: str) -> list[str]:
@@ -348,9 +349,12 @@ def stale_stages(ws: Workspace, current: dict[str, str]) -> dict[str, set[str]]:
     other files are hashed here and added to it), or nothing was recorded.
     Nodes with no artifacts yet are left out."""
     from .evidence.records import hash_inputs
+    from .evidence.sealed import read_sealed
     out: dict[str, set[str]] = {}
     for n in ws.checked.nodes:
-        rec = read_artifact(ws, ws.provenance(n), None)
+        rec, altered = read_sealed(ws.path(ws.provenance(n)))
+        if altered:  # sealed (evidence/sealed.py): what an altered record says is not believed
+            rec = None
         for stage, artifact in (("compose", ws.calculus(n)), ("health", ws.health(n))):
             if not os.path.exists(os.path.join(ws.root, artifact)):
                 continue

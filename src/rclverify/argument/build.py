@@ -63,7 +63,8 @@ ENTAILMENT = ("Z3 decides the requirement from the guarantees of the nodes it me
               "(docs/requirements.md); the proof is only as good as the evidence of the guarantees it used and the "
               "consistency of its premises.")
 _PROOF_STATUS = {"met": "discharged", "proved, evidence outstanding": "discharged",
-                 "proved from an inconsistency": "failed", "proved vacuously": "failed", "refuted": "failed", "inconclusive": "inconclusive"}
+                 "proved from an inconsistency": "failed", "proved vacuously": "failed", "refuted": "failed", "inconclusive": "inconclusive",
+                 "stale": "stale", "error": "error"}
 
 
 def _requirement_goal(b: "_Builder", r: Mapping[str, Any], guarantee_goal: Mapping[tuple[str, int], str],

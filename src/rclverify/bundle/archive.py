@@ -12,16 +12,18 @@ never leaves a half-written archive or destroys an earlier one.
 from __future__ import annotations
 
 import gzip
+import hashlib
 import io
 import json
 import tarfile
 import zipfile
+import zlib
 from pathlib import Path, PurePosixPath
 from typing import Any, Mapping
 
 from ..evidence.store import atomic_write_bytes, dumps
 from ..plan.load import Plan
-from .manifest import MANIFEST, BundleError, build_manifest, collect, sha256_bytes, tool_versions
+from .manifest import MANIFEST, BundleError, build_manifest, collect, tool_versions
 
 _ZIP_TIME = (1980, 1, 1, 0, 0, 0)
 
@@ -118,19 +120,115 @@ def read_members(path: Path) -> dict[str, bytes]:
     return out
 
 
+#: Largest member ``--verify`` hashes (bytes): a bundle holds text records, contracts, reports and the
+#: plan's inputs; a larger member is refused from its header, before any of it is read (a small
+#: compressed archive can declare gigabytes: a decompression bomb).
+MAX_MEMBER_BYTES = 512 * 1024 * 1024
+#: Largest total of the members' sizes ``--verify`` reads (bytes).
+MAX_TOTAL_BYTES = 2 * 1024 * 1024 * 1024
+#: Largest ``MANIFEST.json`` (bytes): the one member read into memory.
+MAX_MANIFEST_BYTES = 64 * 1024 * 1024
+_CHUNK = 1024 * 1024
+
+
+def _hash_stream(name: str, fh: Any, limit: int) -> tuple[str, int, bytes | None]:
+    """``(sha256 hex, size, bytes or None)`` of the stream ``fh`` read in
+    chunks of :data:`_CHUNK`: memory stays bounded whatever the member's
+    size.  The bytes are kept only for :data:`MANIFEST`.  Raises
+    :class:`BundleError` when more than ``limit`` bytes come out (a zip
+    member whose header understates its size)."""
+    h = hashlib.sha256()
+    size = 0
+    kept: list[bytes] | None = [] if name == MANIFEST else None
+    while chunk := fh.read(_CHUNK):
+        size += len(chunk)
+        if size > limit:
+            raise BundleError([f"{name}: more than {limit} bytes, the most a bundle member may have; not checked"])
+        h.update(chunk)
+        if kept is not None:
+            kept.append(chunk)
+    return h.hexdigest(), size, b"".join(kept) if kept is not None else None
+
+
+def scan_members(path: Path) -> tuple[bytes | None, dict[str, tuple[str, int]]]:
+    """``(MANIFEST.json bytes or None, {member: (sha256, size)})`` of the
+    archive at ``path`` (tar.gz or zip), every member streamed and hashed in
+    chunks (bounded memory), nothing extracted to disk.
+
+    Raises :class:`BundleError` for an unreadable or corrupt archive, for
+    members that are links, devices, absolute or ``..`` paths, or repeated,
+    and, with one sentence and before reading it, for a member larger than
+    :data:`MAX_MEMBER_BYTES` (:data:`MAX_MANIFEST_BYTES` for the manifest)
+    or members larger than :data:`MAX_TOTAL_BYTES` together.
+    """
+    out: dict[str, tuple[str, int]] = {}
+    manifest: bytes | None = None
+    problems: list[str] = []
+    total = 0
+
+    def admit(name: str, size: int) -> int:
+        nonlocal total
+        limit = MAX_MANIFEST_BYTES if name == MANIFEST else MAX_MEMBER_BYTES
+        if size > limit:
+            raise BundleError([f"{name}: {size} bytes, more than the {limit} a bundle member may have; not checked"])
+        total += size
+        if total > MAX_TOTAL_BYTES:
+            raise BundleError([f"{name}: the members come to more than {MAX_TOTAL_BYTES} bytes, the most a bundle "
+                               "may hold; not checked"])
+        return limit
+
+    def record(name: str, fh: Any, limit: int) -> None:
+        nonlocal manifest
+        digest, size, data = _hash_stream(name, fh, limit)
+        out[name] = (digest, size)
+        if data is not None:
+            manifest = data
+    try:
+        if zipfile.is_zipfile(path):
+            with zipfile.ZipFile(path) as zf:
+                for info in zf.infolist():
+                    if info.is_dir():
+                        continue
+                    if _unsafe(info.filename) or info.filename in out:
+                        problems.append(f"{info.filename}: unsafe or repeated member")
+                        continue
+                    limit = admit(info.filename, info.file_size)
+                    with zf.open(info) as fh:
+                        record(info.filename, fh, limit)
+        else:
+            with tarfile.open(path, "r:*") as tar:
+                for m in tar:  # streamed: members are visited in order, never all held
+                    if m.isdir():
+                        continue
+                    if not m.isfile() or _unsafe(m.name) or m.name in out:
+                        problems.append(f"{m.name}: unsafe, repeated or not a regular file")
+                        continue
+                    limit = admit(m.name, m.size)
+                    fh = tar.extractfile(m)
+                    record(m.name, fh if fh is not None else io.BytesIO(b""), limit)
+                    tar.members = []  # tarfile keeps every header it read: not needed here
+    except (OSError, tarfile.TarError, zipfile.BadZipFile, EOFError, zlib.error) as exc:
+        raise BundleError([f"cannot read the archive: {exc}"]) from None
+    if problems:
+        raise BundleError(problems)
+    return manifest, out
+
+
 def verify_bundle(path: Path) -> dict[str, Any]:
     """Check the archive at ``path`` against its ``MANIFEST.json``.
 
     Returns the manifest when every listed file is present with its sha256
     and nothing else is in the archive.  Raises :class:`BundleError` listing
     each changed, missing or extra file by name (and a missing or malformed
-    manifest).
+    manifest, and a member too large to check, :func:`scan_members`).
+    Members are streamed: memory stays bounded whatever their size.
     """
-    members = read_members(path)
-    if MANIFEST not in members:
+    manifest_bytes, members = scan_members(path)
+    if manifest_bytes is None:
         raise BundleError([f"{MANIFEST}: missing from the archive"])
+    members.pop(MANIFEST, None)
     try:
-        manifest = json.loads(members.pop(MANIFEST).decode("utf-8"))
+        manifest = json.loads(manifest_bytes.decode("utf-8"))
         listed = {str(k): str(v["sha256"]) for k, v in manifest["files"].items()}
     except (ValueError, KeyError, TypeError, AttributeError) as exc:
         raise BundleError([f"{MANIFEST}: malformed manifest ({exc})"]) from None
@@ -138,7 +236,7 @@ def verify_bundle(path: Path) -> dict[str, Any]:
     for name in sorted(listed):
         if name not in members:
             problems.append(f"{name}: missing from the archive")
-        elif (h := sha256_bytes(members[name])) != listed[name]:
+        elif (h := members[name][0]) != listed[name]:
             problems.append(f"{name}: changed (sha256 {h}, manifest says {listed[name]})")
     problems += [f"{name}: in the archive but not in the manifest" for name in sorted(set(members) - set(listed))]
     if problems:

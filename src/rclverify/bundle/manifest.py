@@ -79,9 +79,16 @@ def _named(plan: Plan) -> set[str]:
         elif isinstance(v, list):
             for x in v:
                 walk(x)
+    from ..plan.entries import declared_paths
     for entries in plan.evidence.values():
         for e in entries:
-            walk({k: v for k, v in e.config.items() if k != "backend"})
+            # the backend's declared path keys, a "<file>:<callable>" value by its file part (plan/entries.py),
+            # as the plan check reads them; other strings that look like paths as they are
+            entry = {"backend": e.backend, **e.config}
+            declared = dict(declared_paths(entry))
+            out.update(declared.values())
+            keys = {p[0] for p in declared}
+            walk({k: v for k, v in e.config.items() if k != "backend" and k not in keys})
     ros = getattr(plan, "ros", None) or {}  # the software the contracts are grounded in (docs/ros.md)
     for key in ("workspaces", "launch", "bags"):
         out.update(str(v) for v in ros.get(key, []) or [])

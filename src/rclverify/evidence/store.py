@@ -225,10 +225,19 @@ class EvidenceStore:
 
 
 def write_obligations(path: Path, obligations: Iterable[Obligation]) -> bool:
-    """Write a list of obligations (sorted by id) atomically as JSON."""
-    return write_json(path, [o.to_json() for o in sorted(obligations, key=lambda o: o.id)])
+    """Write a list of obligations (sorted by id) atomically as a sealed
+    record ``{"obligations": [...], "record_sha256": ...}``
+    (:mod:`.sealed`): the report believes only the list rclverify wrote."""
+    body = {"obligations": [o.to_json() for o in sorted(obligations, key=lambda o: o.id)]}
+    return write_json(path, {**body, SEAL: seal_of(body)})
 
 
 def read_obligations(path: Path) -> list[Obligation]:
-    """Read obligations written by :func:`write_obligations`."""
-    return [Obligation.from_json(d) for d in read_json(path)]
+    """Read obligations written by :func:`write_obligations`.  Raises
+    ``FileNotFoundError``, and ``ValueError`` for a record altered outside
+    rclverify (its seal does not hold) or malformed."""
+    raw = read_json(path)
+    records = raw.get("obligations") if isinstance(raw, dict) else None
+    if not isinstance(records, list) or raw.get(SEAL) != seal_of(raw):
+        raise ValueError(f"{path}: obligation list altered outside rclverify (its seal does not hold)")
+    return [Obligation.from_json(d) for d in records]

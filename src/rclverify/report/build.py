@@ -34,17 +34,21 @@ from .. import __version__
 from ..contract_texts import ContractTexts
 from ..evidence.records import SEVERITY, Obligation, worst
 from ..evidence.store import EvidenceStore
-from ..workspace import Workspace, current_snapshot_hashes, read_artifact, stale_stages
+from ..workspace import Workspace, current_snapshot_hashes, stale_stages
 from ..system.model import cycles_kept, names_of
 from ..diagnosis.build import diagnose
 from ..diagnosis.text import natural_sorted  # p1 < p2 < p10
 from .expected import expected_rows
+from .records import diagnostics as read_diagnostics, grounding as read_grounding, inputs_sha256, node_obligations, \
+    node_records
 
 _FINDING_AS = {"ok": "discharged", "problem": "failed", "inconclusive": "inconclusive",
                # a health warning (health/shape.py) is shown but changes no status
                "warning": "discharged",
                # made from another contract text (pipeline.stale_stages)
-               "stale": "stale"}
+               "stale": "stale",
+               # its record altered outside rclverify (report/records.py)
+               "error": "error"}
 
 
 def _brief(text: str, limit: int = 300) -> str:
@@ -146,8 +150,12 @@ def build_report(ws: Workspace) -> dict[str, Any]:
     texts = ContractTexts(ws)  # each node's RCL and LaTeX texts, kept by its file's sha256 (read only here)
     store = EvidenceStore(ws.root)
     obligations: list[Obligation] = []
+    altered_lists: dict[str, str] = {}  # placeholder obligation id -> why its node's list is not believed
     for n in checked.nodes:
-        obligations.extend(Obligation.from_json(d) for d in read_artifact(ws, ws.obligations(n), []))
+        obs, why = node_obligations(ws, n)  # sealed: a list altered outside rclverify is one error row
+        obligations.extend(obs)
+        if why:
+            altered_lists[obs[0].id] = why
     ev_rows: list[dict[str, Any]] = []
     ob_rows: list[dict[str, Any]] = []
     pending: list[dict[str, Any]] = []
@@ -157,9 +165,11 @@ def build_report(ws: Workspace) -> dict[str, Any]:
     # snapshot is taken from the current contracts and plan, not from artifacts/contracts/, so
     # evidence of another contract text is stale even when no check ran since the edit.
     hashes: dict[str, str] = current_snapshot_hashes(ws, texts)  # the model's too
+    made_from, ev_inputs = dict(hashes), dict[str, Any]()  # what the report is built from (meta.inputs_sha256)
     stale = stale_stages(ws, hashes)  # calculus or health made from another contract text
     for o in obligations:
-        ev, altered = store.read(o.id)
+        ev, altered = (None, altered_lists[o.id]) if o.id in altered_lists else store.read(o.id)
+        ev_inputs[o.id] = dict(ev.input_hashes) if ev is not None else None
         if altered:
             status = "error"
         else:
@@ -194,17 +204,18 @@ def build_report(ws: Workspace) -> dict[str, Any]:
             pending.append({"obligation": o.id, "backend": o.backend, "reason": ev.explanation})
 
     expected = expected_rows(plan, ob_rows)
-    comps = {n: read_artifact(ws, ws.calculus(n), {}) for n in checked.nodes}
-    health = {n: read_artifact(ws, ws.health(n), []) for n in checked.nodes}
+    comps, health = node_records(ws, checked.nodes)  # sealed: an altered record is error, never what it says
     for n, stages in stale.items():  # never the status of an old contract text
         note = ("STALE: made from another text of the contracts or plan than the current one "
                 "(run `doit verify`); recorded status ")
         if "compose" in stages:
             comps[n] = {**comps[n], "side_conditions": [
+                sc if sc["status"] == "error" else  # an altered record stays error
                 {**sc, "status": "stale", "explanation": note + sc["status"] + ". " + str(sc.get("explanation", ""))}
                 for sc in comps[n].get("side_conditions", [])]}
         if "health" in stages:
-            health[n] = [{**f, "status": "stale", "message": note + f["status"] + ". " + f["message"]}
+            health[n] = [f if f["status"] == "error" else
+                         {**f, "status": "stale", "message": note + f["status"] + ". " + f["message"]}
                          for f in health[n]]
     side_conditions = [sc for n in checked.nodes for sc in comps[n].get("side_conditions", [])]
     sc_status = {n: worst([sc["status"] for sc in comps[n].get("side_conditions", [])], empty="discharged")
@@ -261,7 +272,7 @@ def build_report(ws: Workspace) -> dict[str, Any]:
     requirements: list[dict[str, Any]] = []
     from ..plan.load import all_requirements
     from ..requirements.stage import read_records
-    checks = read_records(ws)
+    checks = read_records(ws, hashes)  # sealed and hashed: altered -> error, other inputs -> stale
     for r in all_requirements(plan):
         support: list[dict[str, Any]] = []
         for s in r.support:
@@ -290,21 +301,22 @@ def build_report(ws: Workspace) -> dict[str, Any]:
                         "loop_assumption": c["loop_assumption"]})
 
     findings = [f for n in checked.nodes for f in health[n]]
-    diagnostics = read_artifact(ws, ws.DIAGNOSTICS, {"warnings": []})
     lint_rows = [{"severity": d["severity"], "location": f"{d['file']}:{d['line']}:{d['col']}", "message": d["message"],
                   "code": d.get("code", "")}
-                 for d in diagnostics["warnings"]]
+                 for d in read_diagnostics(ws)]
     env_assumptions = [e for n in checked.nodes for e in comps[n].get("environment_assumptions", [])]
 
     problems = []
     for f in findings:
         if f["status"] == "problem":
             problems.append(f"Contract health: {f['message']}")
+        elif f["status"] == "error":
+            problems.append(f"Contract health of {f['node']} is error: {f['message']}")
         elif f["status"] == "stale":
             problems.append(f"Contract health of {f['node']} is stale: made for another text of its contract or plan "
                             "(run `doit verify`)")
     for rq in requirements:
-        if rq["verdict"] in ("refuted", "proved from an inconsistency", "proved vacuously"):
+        if rq["verdict"] in ("refuted", "proved from an inconsistency", "proved vacuously", "error", "stale"):
             problems.append(f"Requirement {rq['id']} is {rq['verdict']}: {_brief(rq['note'])}")
     for sc in side_conditions:
         if sc["status"] != "discharged":
@@ -328,17 +340,21 @@ def build_report(ws: Workspace) -> dict[str, Any]:
                  and all(f["status"] in ("ok", "warning") for f in findings)
                  # and no guarantee left without evidence (no obligation exported for it)
                  and all(g_status(name, k) == "discharged" for name, cn in checked.nodes.items()
-                         for k in range(1, len(cn.node.guarantees) + 1)))
+                         for k in range(1, len(cn.node.guarantees) + 1))
+                 # and every formal requirement met (docs/requirements.md, "--strict"); an informal one is listed only
+                 and all(rq["verdict"] in ("met", "informal") for rq in requirements))
     # grounding in the robot's software (docs/ros.md): findings never change a verdict,
     # but a grounding error fails --strict and is listed among the problems
-    grounding = read_artifact(ws, "artifacts/ros/grounding.json") if getattr(plan, "ros", None) else None
+    grounding = read_grounding(ws, "artifacts/ros/grounding.json") if getattr(plan, "ros", None) else None
     if grounding is not None:
         svg_rel = (grounding.get("drawing") or {}).get("svg")
         try:
             grounding["svg_text"] = ws.path(svg_rel).read_text(encoding="utf-8") if svg_rel else None
         except OSError:
             grounding["svg_text"] = None
-        strict_ok = strict_ok and not grounding["counts"]["error"]
+        strict_ok = strict_ok and not grounding["counts"]["error"] and not grounding.get("stale")
+        if grounding.get("stale"):
+            problems.append(f"Grounding is stale: {grounding['stale']}")
         if grounding["counts"]["error"]:
             problems.append(f"Grounding: {grounding['counts']['error']} contract(s)-vs-ROS error(s) "
                             f"(rclverify ros check)")
@@ -346,7 +362,8 @@ def build_report(ws: Workspace) -> dict[str, Any]:
     system = model.view(node_status, cycles_kept(model, ws.path("artifacts/cache/system-cycles.pickle")))
     report: dict[str, Any] = {
         "meta": {"tool": "rclverify", "version": __version__, "workspace": plan.name or ws.root.resolve().name, "plan": plan.file,
-                 "contracts": list(plan.contracts), "z3_version": z3.get_version_string(), "strict_ok": strict_ok},
+                 "contracts": list(plan.contracts), "z3_version": z3.get_version_string(), "strict_ok": strict_ok,
+                 "inputs_sha256": inputs_sha256(ws, made_from, ev_inputs, checks)},
         "summary": {"status": overall, "counts": counts, "headline": headline, "problems": problems},
         "system": system, "requirements": requirements, "nodes": nodes, "side_conditions": side_conditions,
         "derived_properties": derived, "findings": findings, "obligations": ob_rows, "evidence": ev_rows,
@@ -414,4 +431,7 @@ def _headline(ob_rows: list[dict[str, Any]], counts: dict[str, int], side_condit
     problems = sum(1 for f in findings if f["status"] == "problem")
     parts.append(f"{problems} contract health problem{'s' if problems != 1 else ''}" if problems
                  else "no contract health problem")
+    altered = sum(1 for f in findings if f["status"] == "error")
+    if altered:
+        parts.append(f"{altered} contract health record{'s' if altered != 1 else ''} altered outside rclverify")
     return "; ".join(parts) + "."

@@ -94,13 +94,17 @@ RULES: Mapping[str, Rule] = {r.id: r for r in (
     Rule("RCL-REQ-EVIDENCE", "RequirementEvidenceOutstanding", "note",
          "A formal requirement is proved from the guarantees, but the evidence of the guarantees its proof used "
          "is not all discharged."),
+    Rule("RCL-REQ-STALE", "RequirementStale", "warning",
+         "A requirement's check was made from another text of the contracts, plan or model than the current one."),
+    Rule("RCL-REQ-ERROR", "RequirementRecordAltered", "error",
+         "A requirement's check record was altered outside rclverify (its seal does not hold): its verdict is not shown."),
     Rule("RCL-REQ-INFORMAL", "RequirementInformal", "note",
          "A requirement has no formal statement: it is traced to guarantees, never checked, never met."),
 )}
 _REQUIREMENT_RULE = {"refuted": "RCL-REQ-REFUTED", "proved from an inconsistency": "RCL-REQ-INCONSISTENT",
                      "proved vacuously": "RCL-REQ-VACUOUS",
                      "inconclusive": "RCL-REQ-INCONCLUSIVE", "proved, evidence outstanding": "RCL-REQ-EVIDENCE",
-                     "informal": "RCL-REQ-INFORMAL"}
+                     "informal": "RCL-REQ-INFORMAL", "stale": "RCL-REQ-STALE", "error": "RCL-REQ-ERROR"}
 
 _HEALTH_RULE = {"assumption-satisfiable": "RCL-HEALTH-UNSATISFIABLE-ASSUMPTION",
                 "contract-consistent": "RCL-HEALTH-INCONSISTENT",

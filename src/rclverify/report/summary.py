@@ -48,7 +48,7 @@ def node_rows(report: Mapping[str, Any]) -> list[dict[str, Any]]:
         fs = findings.get(name, [])
         rows.append({"node": name, "status": n["status"], "obligations": obs, "order": k,
                      "sc_proved": sum(sc["status"] == "discharged" for sc in scs), "sc_total": len(scs),
-                     "health_problems": sum(f["status"] == "problem" for f in fs),
+                     "health_problems": sum(f["status"] in ("problem", "error") for f in fs),
                      "health_open": sum(f["status"] == "inconclusive" for f in fs), "health_total": len(fs)})
     rows.sort(key=lambda r: (-_rank(r["status"]), r["order"]))
     return rows
@@ -145,7 +145,8 @@ def strict_reasons(report: Mapping[str, Any]) -> list[str]:
     """Why ``verify --strict`` fails on ``report``, as clauses (empty when
     ``report["meta"]["strict_ok"]``): obligations not discharged by status,
     guarantees no obligation covers, side conditions not proved, health
-    checks with a problem or undecided, ROS grounding errors (the gate of
+    checks with a problem or undecided, formal requirements not met, ROS
+    grounding errors (the gate of
     :func:`rclverify.report.build.build_report`)."""
     if report["meta"]["strict_ok"]:
         return []
@@ -167,6 +168,10 @@ def strict_reasons(report: Mapping[str, Any]) -> list[str]:
     fs = [f for f in report["findings"] if f["status"] not in ("ok", "warning")]
     if fs:
         out.append(f"{len(fs)} contract health check{'s' if len(fs) != 1 else ''} found a problem or could not decide")
+    rq = [r["id"] for r in report.get("requirements", []) if r.get("verdict", "informal") not in ("met", "informal")]
+    if rq:
+        out.append(f"{len(rq)} formal requirement{'s are' if len(rq) != 1 else ' is'} not met ("
+                   + ", ".join(rq[:4]) + (", ..." if len(rq) > 4 else "") + ")")
     g = _grounding(report.get("grounding"))
     if g and g["error"]:
         out.append(f"{g['error']} ROS grounding error{'s' if g['error'] != 1 else ''} (`rclverify ros check`)")
@@ -255,7 +260,7 @@ def requirements_line(rows: Sequence[Sequence[str]]) -> str:
     by: dict[str, list[str]] = {}
     for rid, verdict, _ in rows:
         by.setdefault(verdict or "traced", []).append(rid)
-    named = ("refuted", "proved from an inconsistency", "proved vacuously", "inconclusive")
+    named = ("refuted", "proved from an inconsistency", "proved vacuously", "inconclusive", "stale", "error")
     return "requirements: " + ", ".join(f"{len(ids)} {v}" + (f" ({', '.join(ids[:5])}{', ...' if len(ids) > 5 else ''})"
                                                             if v in named else "") for v, ids in by.items())
 
@@ -269,10 +274,17 @@ def read_summary(root: Path) -> dict[str, Any]:
     :func:`rclverify.report.lastrun.read_checked` does."""
     from ..workspace import Workspace
     from .lastrun import SUMMARY_SHAPE, SUMMARY_SOURCE_SHAPE, located, read_checked
+    import sys
+
+    from ..evidence.sealed import read_sealed
     path = root / Workspace.SUMMARY
     if path.exists():
-        data: dict[str, Any] = read_checked(path, SUMMARY_SHAPE, "an rclverify summary")
-        return data
+        # sealed: a summary altered outside rclverify is said so and never shown (docs/integrity.md)
+        _, problem = read_sealed(path, "summary record")
+        if not problem:
+            data: dict[str, Any] = read_checked(path, SUMMARY_SHAPE, "an rclverify summary")
+            return data
+        print(f"{Workspace.SUMMARY}: error: {problem}; showing reports/assurance.json instead", file=sys.stderr)
     report = read_checked(root / "reports/assurance.json", SUMMARY_SOURCE_SHAPE, "an rclverify report")
     try:
         return summary_data(report)

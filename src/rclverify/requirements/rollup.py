@@ -12,9 +12,14 @@ verdict (``check``)                what the proof rests on      status shown (``
                                                                 ``failed``
 ``proved``, premise never holds    (anything)                   ``proved vacuously`` / ``failed``
 ``proved``, consistency undecided  (anything)                   ``inconclusive`` / ``inconclusive``
+``proved``, vacuity undecided      (anything)                   ``inconclusive`` / ``inconclusive``
+                                   (Z3 could not say whether
+                                   the premise can ever hold)
 ``refuted``                                                     ``refuted`` / ``failed``
 ``inconclusive``                                                ``inconclusive`` / ``inconclusive``
 ``informal`` (no formal statement) (nothing: traced only)        ``informal`` / ``pending``
+``stale`` (made from other inputs)  (not shown)                  ``stale`` / ``stale``
+``error`` (record altered)          (not shown)                  ``error`` / ``error``
 =================================  ==========================  ==================================
 
 Only ``met`` has the status ``discharged`` (the green tick of every report
@@ -34,7 +39,7 @@ MET = "met"
 OUTSTANDING = "proved, evidence outstanding"
 INCONSISTENT = "proved from an inconsistency"
 VACUOUS = "proved vacuously"
-VERDICTS = (MET, OUTSTANDING, INCONSISTENT, VACUOUS, "refuted", "inconclusive", "informal")
+VERDICTS = (MET, OUTSTANDING, INCONSISTENT, VACUOUS, "refuted", "inconclusive", "informal", "stale", "error")
 
 
 def roll_up(record: Mapping[str, Any] | None, g_status: Callable[[str, int], str], sc_status: Mapping[str, str],
@@ -50,6 +55,11 @@ def roll_up(record: Mapping[str, Any] | None, g_status: Callable[[str, int], str
     if record is None:
         return "inconclusive", "pending", "not checked yet: run `rclverify requirements` or `doit verify`"
     v = record.get("verdict")
+    if v == "error":  # the seal does not hold (requirements/stage.read_records): what it claims is not shown
+        return "error", "error", f"error: {record.get('reason', 'record altered outside rclverify')}; run `doit verify`"
+    if v == "stale":
+        return "stale", "stale", (f"STALE: {record.get('reason', 'made from other inputs')} than the current one "
+                                  f"(recorded verdict {record.get('recorded_verdict')}); run `doit verify`")
     if v == "informal":
         return "informal", "pending", (f"no formal statement: traced only, never shown as met (its traced guarantees: "
                                        f"{traced_status})")
@@ -76,6 +86,10 @@ def roll_up(record: Mapping[str, Any] | None, g_status: Callable[[str, int], str
         return "inconclusive", worst(["inconclusive", ev]), (
             "proved, but Z3 could not decide whether the premises it used are consistent "
             f"({record.get('consistency_reason', 'unknown')})")
+    if record.get("vacuity") not in (None, "non-vacuous"):  # undecided: never met (it may hold only vacuously)
+        return "inconclusive", worst(["inconclusive", ev]), (
+            "proved, but Z3 could not decide whether the requirement's premise can ever hold together with the "
+            "premises of its cone: it may be proved only because it never applies (vacuity undecided)")
     if ev == "discharged":
         return MET, "discharged", "proved from the used premises, and all the evidence they rest on is discharged"
     open_ = ", ".join(f"{k} ({s})" for k, s in statuses.items() if s != "discharged")

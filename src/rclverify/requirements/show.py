@@ -7,7 +7,7 @@ if TYPE_CHECKING:
     from ..workspace import Workspace
 
 #: Verdicts that make ``rclverify requirements`` exit 1.
-BAD = ("refuted", "proved from an inconsistency", "proved vacuously", "inconclusive")
+BAD = ("refuted", "proved from an inconsistency", "proved vacuously", "inconclusive", "stale", "error")
 
 
 def show_requirements(ws: "Workspace", out: TextIO) -> int:

@@ -1,10 +1,13 @@
 """The ``requirements`` stage: check every requirement, write its record.
 
 Writes ``artifacts/requirements/<ID>.json`` (the record of
-:func:`.check.check_requirement` plus its ``fingerprint``),
+:func:`.check.check_requirement` plus its ``fingerprint`` and ``inputs``,
+the sha256 of each contract snapshot of its cone and of the system model),
 ``artifacts/requirements/<ID>.smt2`` (the query) and
-``artifacts/requirements/index.json`` (``{id: sha256 of the record}``, in
-requirement order: the report tasks depend on it).  A requirement whose
+``artifacts/requirements/index.json`` (``{"records": {id: sha256 of the
+record}}``, in requirement order: the report tasks depend on it).  Records
+and index are sealed (:mod:`rclverify.evidence.sealed`); a record whose seal
+does not hold is checked again, never reused.  A requirement whose
 fingerprint (its statements, the contract snapshots of its cone, the system
 model) equals the recorded one is not checked again, so editing one
 contract re-checks only the requirements whose cone contains that node.
@@ -17,7 +20,8 @@ import json
 import re
 from typing import TYPE_CHECKING, Any
 
-from ..evidence.store import atomic_write_text, write_json
+from ..evidence.sealed import read_sealed, write_sealed
+from ..evidence.store import atomic_write_text, dumps
 
 if TYPE_CHECKING:
     from ..workspace import Workspace
@@ -32,12 +36,10 @@ def record_path(req_id: str) -> str:
     return f"{DIR}/{_SAFE.sub('_', req_id)}.json"
 
 
-def _read(path: Any) -> Any:
-    try:
-        with open(path, "rb") as fh:
-            return json.loads(fh.read())
-    except (OSError, ValueError):
-        return None
+def _read(path: Any) -> dict[str, Any] | None:
+    """The sealed record at ``path``; ``None`` when absent or not intact."""
+    rec, problem = read_sealed(path)
+    return None if problem else rec
 
 
 def stage_requirements(ws: "Workspace", *, force: bool = False) -> list[tuple[dict[str, Any], bool]]:
@@ -55,6 +57,7 @@ def stage_requirements(ws: "Workspace", *, force: bool = False) -> list[tuple[di
     checked, model, plan = ws.checked, ws.model, ws.plan
     model_text = (ws.root / ws.MODEL).read_text(encoding="utf-8") if (ws.root / ws.MODEL).is_file() else \
         json.dumps(model.to_json(), sort_keys=True)
+    model_hash = hashlib.sha256(dumps(model.to_json()).encode("utf-8")).hexdigest()  # as the report takes it
     snaps: dict[str, str] = {}
 
     def snap(n: str) -> str:
@@ -83,13 +86,14 @@ def stage_requirements(ws: "Workspace", *, force: bool = False) -> list[tuple[di
                 atomic_write_text(ws.root / rec["smt2"], smt2)
                 keep.add(rec["smt2"].rsplit("/", 1)[1])
             rec["fingerprint"] = fp
-            write_json(ws.root / rel, rec)
+            rec["inputs"] = input_hashes(ws, cone, snap, model_hash) if formal is not None else {}
+            write_sealed(ws.root / rel, rec)
             now = True
         if rec.get("smt2"):
             keep.add(rec["smt2"].rsplit("/", 1)[1])
         index[req.id] = hashlib.sha256((ws.root / rel).read_bytes()).hexdigest()
         out.append((rec, now))
-    write_json(ws.root / INDEX, index)
+    write_sealed(ws.root / INDEX, {"records": index})
     keep.add("index.json")
     for old_file in (ws.root / DIR).glob("*"):
         if old_file.is_file() and old_file.name not in keep:
@@ -97,12 +101,49 @@ def stage_requirements(ws: "Workspace", *, force: bool = False) -> list[tuple[di
     return out
 
 
-def read_records(ws: "Workspace") -> dict[str, dict[str, Any]]:
-    """The records named by ``index.json`` (``{}`` before the stage ran), by requirement id."""
-    index = _read(ws.root / INDEX) or {}
-    out = {}
-    for rid in index:
-        rec = _read(ws.root / record_path(rid))
-        if rec is not None:
-            out[rid] = rec
+def input_hashes(ws: "Workspace", cone: list[str], snap: Any, model_hash: str) -> dict[str, str]:
+    """``{artifacts/contracts/<Node>.json: sha256, artifacts/system/model.json: sha256}``
+    of the snapshots of ``cone`` (``snap(node)`` gives a snapshot's text) and
+    the model a record is made from: the hashes the report compares with the
+    current ones (:func:`read_records`)."""
+    out = {ws.snapshot(n): hashlib.sha256(snap(n).encode("utf-8")).hexdigest() for n in cone}
+    out[ws.MODEL] = model_hash
+    return out
+
+
+def read_records(ws: "Workspace", current: dict[str, str] | None = None) -> dict[str, dict[str, Any]]:
+    """The records named by ``index.json`` (``{}`` before the stage ran), by
+    requirement id, as the report may show them:
+
+    * a record (or the index) whose seal does not hold is replaced by
+      ``{"verdict": "error", "reason": why, ...}`` (keeping the statements it
+      claims to be about, so that :func:`rclverify.report.build.current_record`
+      matches it): never the verdict it claims;
+    * with ``current`` (path -> sha256 of the contract snapshots and model
+      the current contracts and plan give,
+      :func:`rclverify.workspace.current_snapshot_hashes`), a record made
+      from other inputs (a hash differs, or it records none) is replaced by
+      ``{"verdict": "stale", "recorded_verdict": ..., ...}``.
+    """
+    index, problem = read_sealed(ws.root / INDEX, "requirement index")
+    if index is None:
+        return {}
+    ids = index.get("records") if isinstance(index.get("records"), dict) else {}
+    out: dict[str, dict[str, Any]] = {}
+    for rid in ids:
+        rec, why = read_sealed(ws.root / record_path(rid), "requirement record")
+        if rec is None and not why:
+            continue
+        keep = {k: rec.get(k) for k in ("id", "formal", "assuming", "source", "origin", "text")} if rec else {}
+        if why or problem:
+            out[rid] = {**keep, "verdict": "error", "reason": f"{record_path(rid)}: {why or problem}"}
+            continue
+        assert rec is not None
+        made = rec.get("inputs")
+        if current is not None and rec.get("verdict") != "informal" and (
+                not isinstance(made, dict) or any(current.get(p) != h for p, h in made.items())):
+            out[rid] = {**keep, "verdict": "stale", "recorded_verdict": rec.get("verdict"),
+                        "reason": f"{record_path(rid)} was made from another text of the contracts or plan"}
+            continue
+        out[rid] = rec
     return out

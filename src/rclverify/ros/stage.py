@@ -119,7 +119,11 @@ def stage_ground(ws: Any) -> dict[str, Any]:
     if svg is not None:
         atomic_write_text(ws.path(SVG), svg)
     atomic_write_text(ws.path(GRAPH), json.dumps(graph_json, indent=2) + "\n")
-    atomic_write_text(ws.path(GROUNDING), json.dumps(data, indent=2) + "\n")
+    from ..evidence.records import hash_inputs
+    from ..evidence.sealed import write_sealed
+    from .inputs import input_files
+    data["inputs"] = hash_inputs(ws.root, input_files(ws))
+    write_sealed(ws.path(GROUNDING), data)  # sealed: the report reads it (evidence/sealed.py)
     return data
 
 

@@ -1,0 +1,125 @@
+"""The sealed stage records the report reads, never believed when altered.
+
+Each node's side conditions (``artifacts/calculus/<Node>.json``) and
+contract health findings (``artifacts/health/<Node>.json``), the lint
+diagnostics and the grounding are sealed records
+(:mod:`rclverify.evidence.sealed`, docs/integrity.md).  A record whose seal
+does not hold is shown as ``error`` ("... altered outside rclverify"),
+never with the statuses it claims: its side conditions are each ``error``
+(one placeholder when it cannot be read at all), its findings are replaced
+by one ``error`` finding, which fails ``--strict`` and is listed among the
+problems.
+"""
+from __future__ import annotations
+
+import hashlib
+from typing import Any, Iterable, Mapping
+
+from ..evidence.records import Obligation, SourceRef
+from ..evidence.sealed import obligation_list, read_sealed
+from ..workspace import Workspace
+
+
+def _error_side_conditions(node: str, body: dict[str, Any] | None, why: str) -> dict[str, Any]:
+    scs = (body or {}).get("side_conditions")
+    rows = [sc for sc in scs if isinstance(sc, dict) and "id" in sc] if isinstance(scs, list) else []
+    if not rows:  # nothing to name: one placeholder, so the node is never shown with no open side condition
+        rows = [{"id": f"{node}.calculus", "node": node, "rule": "", "conjunct": "(the node's side conditions)",
+                 "source": "", "hypotheses": [], "duration_s": 0.0, "smt2": "", "model": None, "variant": "",
+                 "links": []}]
+    return {**(body or {}), "node": node, "side_conditions": [
+        {**sc, "status": "error", "model": None, "explanation": f"error: {why}; recorded status not shown"}
+        for sc in rows]}
+
+
+def _error_finding(node: str, why: str) -> dict[str, Any]:
+    return {"id": f"{node}.health-record", "node": node, "check": "record", "guarantee": None, "status": "error",
+            "message": f"error: contract health of {node}: {why}", "explanation": "", "model": None, "core": [],
+            "duration_s": 0.0, "instances": None}
+
+
+def node_records(ws: Workspace, nodes: Iterable[str]) -> tuple[dict[str, dict[str, Any]], dict[str, list[dict[str, Any]]]]:
+    """``(compositions, health findings)`` of ``nodes``, by node: ``{}`` /
+    ``[]`` before the stage ran, the records' content when their seals hold,
+    and ``error`` rows otherwise (module docstring)."""
+    comps: dict[str, dict[str, Any]] = {}
+    health: dict[str, list[dict[str, Any]]] = {}
+    for n in nodes:
+        rel = ws.calculus(n)
+        body, why = read_sealed(ws.path(rel), "side-condition record")
+        comps[n] = _error_side_conditions(n, body, f"{rel}: {why}") if why else (body or {})
+        rel = ws.health(n)
+        body, why = read_sealed(ws.path(rel), "contract health record")
+        findings = (body or {}).get("findings", [])
+        if not why and body is not None and not isinstance(findings, list):
+            why = "contract health record malformed: altered outside rclverify"
+        health[n] = [_error_finding(n, f"{rel}: {why}")] if why else list(findings)
+    return comps, health
+
+
+def node_obligations(ws: Workspace, node: str) -> tuple[list[Obligation], str]:
+    """``(obligations, problem)`` of ``node``'s obligation list: ``([], "")``
+    before export; when its seal does not hold, one placeholder obligation
+    ``<node>.obligations`` bearing on every guarantee (guarantee 0) and the
+    problem sentence: the caller shows it ``error`` (a list with a failing
+    obligation removed by hand is never believed)."""
+    rel = ws.obligations(node)
+    records, problem = obligation_list(ws.path(rel))
+    if problem:
+        return [Obligation(id=f"{node}.obligations", node=node, guarantee=0, backend="record", kind="proof",
+                           statement=f"error: {rel}: {problem}", source=SourceRef(rel, 1, 1))], f"{rel}: {problem}"
+    return [Obligation.from_json(d) for d in records or []], ""
+
+
+def diagnostics(ws: Workspace) -> list[dict[str, Any]]:
+    """The lint warnings rows of ``artifacts/check/diagnostics.json`` (its
+    ``warnings``); when its seal does not hold, one ``error`` row saying so
+    in their place."""
+    body, why = read_sealed(ws.path(ws.DIAGNOSTICS), "lint record")
+    if why:
+        return [{"severity": "error", "file": ws.DIAGNOSTICS, "line": 1, "col": 1, "code": "E-altered",
+                 "message": f"{why}; the lint warnings it claims are not shown"}]
+    return list((body or {}).get("warnings", []))
+
+
+def grounding(ws: Workspace, rel: str) -> dict[str, Any] | None:
+    """The grounding record ``rel`` (``None`` before it was made); when its
+    seal does not hold, a record of one error and no findings; when the
+    files it was made from (its ``inputs``, path -> sha256) changed since,
+    the record with ``stale`` (a sentence) added."""
+    body, why = read_sealed(ws.path(rel), "grounding record")
+    if why:
+        return {"counts": {"error": 1, "warning": 0}, "altered": f"{rel}: {why}",
+                "findings": [{"code": "ROS-RECORD", "severity": "error", "message": f"{rel}: {why}", "node": None,
+                              "topic": None, "rcl": None, "ros": None}],
+                "context": {"packages": [], "files": []}, "drawing": {"dot": "", "svg": None},
+                "graph": {"nodes": []}, "matched": {}}
+    if body is not None:
+        from ..evidence.records import hash_inputs
+        from ..ros.inputs import input_files
+        made = body.get("inputs")
+        now = input_files(ws)
+        if not isinstance(made, dict) or set(made) != set(now) or hash_inputs(ws.root, now) != made:
+            body["stale"] = (f"{rel} was made from other files of the plan, contracts or ROS software than the "
+                             "current ones (run `doit verify`)")
+    return body
+
+
+def inputs_sha256(ws: Workspace, made_from: Mapping[str, str], evidence_inputs: Mapping[str, Any],
+                  checks: Mapping[str, Mapping[str, Any]]) -> str:
+    """One sha256 over what a report is built from, recorded in its
+    ``meta.inputs_sha256``: the sha256 of the plan, contract and replacement
+    files (:func:`rclverify.workspace.check_inputs`), of the contract
+    snapshots and system model they give (``made_from``), the
+    ``input_hashes`` of each obligation's evidence record
+    (``evidence_inputs``: obligation id -> hashes, ``None`` without a
+    record), and each requirement record's verdict, fingerprint and inputs
+    (``checks``).  Timestamps and durations are left out, so an incremental
+    run and a clean one give the same value.  The bundle compares it with
+    the value of a report built now (docs/argument.md): a report written
+    before the evidence was produced again is not packed."""
+    from ..evidence.store import dumps
+    from ..workspace import check_inputs
+    body = {"files": check_inputs(ws), "made_from": dict(made_from), "evidence": dict(evidence_inputs),
+            "requirements": {k: [v.get("verdict"), v.get("fingerprint"), v.get("inputs")] for k, v in checks.items()}}
+    return hashlib.sha256(dumps(body).encode("utf-8")).hexdigest()
