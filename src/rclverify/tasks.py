@@ -279,6 +279,10 @@ def act_verify(root: str, strict: bool) -> Any:
     from .report.summary import print_last_run
     data = print_last_run(Path(root))
     if strict and not data["meta"]["strict_ok"]:
+        from .report.unverified import strict_sentence
+        unverified = strict_sentence(data.get("unverified") or [])
+        if unverified:
+            return TaskFailed(f"--strict: {unverified} (see reports/assurance.html for every item not discharged)")
         return TaskFailed("--strict: some evidence is failed, inconclusive, pending, stale or error, or a side condition "
                           "or contract health check is not proved (see reports/assurance.html)")
     return None

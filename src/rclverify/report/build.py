@@ -8,7 +8,9 @@ while any of its evidence is failed, pending, stale or missing:
 * obligation: its evidence's *current* status (``stale`` when an input's
   sha256 changed since the evidence was produced), ``pending`` when there is
   no evidence record;
-* guarantee: worst of its obligations (``pending`` when it has none), and
+* guarantee: worst of its obligations (``unverified`` when it has none: no
+  evidence entry of the plan exports an obligation for it; each such
+  guarantee is listed under ``unverified`` and is a problem of its own), and
   ``failed`` when the health checks found it vacuous or the contract
   contradictory (``inconclusive`` when they could not decide);
 * node: worst of its guarantees and its side conditions;
@@ -225,7 +227,7 @@ def build_report(ws: Workspace) -> dict[str, Any]:
 
     def g_status(node: str, k: int) -> str:
         sts = [ob_status[o.id] for o in by_node.get(node, []) if applies(o, node, k)]
-        s = worst(sts) if sts else "pending"
+        s = worst(sts) if sts else "unverified"
         for f in health[node]:
             if f["guarantee"] in (None, k) and f["status"] != "ok":
                 s = worst([s, _FINDING_AS[f["status"]]])
@@ -257,6 +259,9 @@ def build_report(ws: Workspace) -> dict[str, Any]:
                             for text, src in tx["assumptions"]],
             "guarantees": guarantees, "latex": tx["latex"],
         })
+
+    from .unverified import unverified_guarantees
+    unverified = unverified_guarantees(plan, nodes)
 
     requirements: list[dict[str, Any]] = []
     from ..plan.load import all_requirements
@@ -310,6 +315,7 @@ def build_report(ws: Workspace) -> dict[str, Any]:
         if sc["status"] != "discharged":
             problems.append(f"Side condition {sc['id']} is {sc['status']}: {sc['conjunct']}")
     problems.extend(problems_altered)
+    problems.extend(u["message"] for u in unverified)
     for e in ev_rows:
         if e["status"] in ("failed", "error", "stale"):
             problems.append(f"Evidence {e['obligation']} is {e['status']}: {_brief(e['explanation'])}")
@@ -342,7 +348,7 @@ def build_report(ws: Workspace) -> dict[str, Any]:
         if grounding["counts"]["error"]:
             problems.append(f"Grounding: {grounding['counts']['error']} contract(s)-vs-ROS error(s) "
                             f"(rclverify ros check)")
-    headline = _headline(ob_rows, counts, side_conditions, findings)
+    headline = _headline(ob_rows, counts, side_conditions, findings, unverified)
     system = model.view(node_status, cycles_kept(model, ws.path("artifacts/cache/system-cycles.pickle")))
     report: dict[str, Any] = {
         "meta": {"tool": "rclverify", "version": __version__, "workspace": plan.name or ws.root.resolve().name, "plan": plan.file,
@@ -351,7 +357,7 @@ def build_report(ws: Workspace) -> dict[str, Any]:
         "system": system, "requirements": requirements, "nodes": nodes, "side_conditions": side_conditions,
         "derived_properties": derived, "findings": findings, "obligations": ob_rows, "evidence": ev_rows,
         "environment_assumptions": env_assumptions, "pending": pending, "lint": lint_rows,
-        "expected_verdicts": expected, "grounding": grounding,
+        "expected_verdicts": expected, "grounding": grounding, "unverified": unverified,
     }
     # one diagnosis record per problem, with repairs checked by Z3 (docs/diagnosis.md)
     report["diagnoses"] = diagnose(ws, report)
@@ -397,15 +403,20 @@ def requirement_check(record: Mapping[str, Any] | None, traced_status: str, g_st
 
 
 def _headline(ob_rows: list[dict[str, Any]], counts: dict[str, int], side_conditions: list[dict[str, Any]],
-              findings: list[dict[str, Any]]) -> str:
+              findings: list[dict[str, Any]], unverified: Sequence[Mapping[str, Any]] = ()) -> str:
     """The one-line summary, without empty fragments: a kind with nothing
-    in it is said in words ("no obligations"), never as "0 obligations: ;"."""
+    in it is said in words ("no obligations"), never as "0 obligations: ;".
+    Guarantees no obligation covers (``unverified``) are counted after the
+    obligations: "5 obligations: 5 discharged" alone would read as all done."""
     parts = []
     if ob_rows:
         parts.append(f"{len(ob_rows)} obligation{'s' if len(ob_rows) != 1 else ''}: "
                      + ", ".join(f"{counts[s]} {s}" for s in sorted(counts, key=lambda x: SEVERITY.get(x, 99))))
     else:
         parts.append("no obligations")
+    if unverified:
+        parts.append(f"{len(unverified)} guarantee{'s' if len(unverified) != 1 else ''} unverified "
+                     "(no obligation covers " + ("it" if len(unverified) == 1 else "them") + ")")
     if side_conditions:
         parts.append(f"{sum(1 for sc in side_conditions if sc['status'] == 'discharged')}/{len(side_conditions)} "
                      "side conditions discharged")

@@ -177,10 +177,20 @@ def group_problems(report: Mapping[str, Any], items: Sequence[Mapping[str, Any]]
                          "anchor": anchor("req", q["id"]), "diagnosis": False}, roots))
     covered = {m["id"] for m, _ in members}
     obligation = {str(o["id"]): o for o in report.get("obligations", [])}
+    unverified = {str(u["id"]): u for u in report.get("unverified") or ()}
     roots_of = {m["id"]: roots for m, roots in members}
     for it in items:
         ref = str(it["ref"])
         if ref in covered:
+            continue
+        if it["kind"] == "guarantee":  # unverified: no obligation covers it, a problem of its own
+            u = unverified.get(ref)
+            rid = f"guarantee:{u['node']}:{u['guarantee']}" if u is not None else None
+            members.append(({"id": ref, "kind": "unverified guarantee", "status": str(it["status"]),
+                             "sentence": f"Guarantee {ref} is unverified: {u['reason'] if u else it['message']}.",
+                             "anchor": str(it["anchor"]), "diagnosis": False},
+                            [f"unverified:{ref}"] + ([rid] if rid in places.info else [])))
+            covered.add(ref)
             continue
         o = obligation.get(ref)
         roots = [f"guarantee:{o['node']}:{o['guarantee']}"] if o is not None and o.get("guarantee") else []
@@ -197,7 +207,8 @@ def group_problems(report: Mapping[str, Any], items: Sequence[Mapping[str, Any]]
 
     groups: dict[tuple[str, ...], dict[str, Any]] = {}
     for m, roots in members:
-        explained = [e for r in roots for e in explains.get(r, [])]
+        # an unverified guarantee stays a row of its own, even when a contract defect explains the guarantee
+        explained = [] if m["kind"] == "unverified guarantee" else [e for r in roots for e in explains.get(r, [])]
         if explained:
             roots = list(dict.fromkeys(explained))
         key = tuple(sorted(roots)) if roots else (f"problem:{m['id']}",)
