@@ -31,7 +31,7 @@ import z3
 
 from ..cache import Shelf, file_digest
 from ..rcl.errors import RclError
-from . import repairs as rep
+from . import blame, repairs as rep
 from .culprits import culprits, parse_core, plan_facts
 from .table import counterexample_table
 
@@ -158,6 +158,9 @@ def _diagnose(ws: Any, report: Mapping[str, Any]) -> list[dict[str, Any]]:
     for sc in report["side_conditions"]:
         if sc["status"] in ("failed", "inconclusive"):
             out.append(_side_condition(ws, report, sc, cache, sc_before))
+    for q in report.get("requirements", []):
+        if q.get("verdict") == "refuted":
+            out.append(_requirement(ws, report, q, cache))
     obligations = {o["id"]: o for o in report["obligations"]}
     for e in report["evidence"]:
         if e["status"] in ("failed", "error"):
@@ -222,19 +225,30 @@ def _side_condition(ws: Any, report: Mapping[str, Any], sc: Mapping[str, Any], c
     pairs = rep._link_pairs(sc)
     cul = [{"what": f"assumption of {sc['node']}: `{sc['conjunct']}`", "source": sc["source"], "text": sc["conjunct"]}]
     said = []
+    # a producer guarantee is named only when strengthening it discharges the side condition (blame.py)
+    shown = (cache.get(["sc-culprits", sc["id"], sc["conjunct"]],
+                       lambda: [list(x) for x in blame.side_condition_culprits(ws, sc)]) or []) \
+        if sc["status"] == "failed" else []
+    blamed = {(str(p), int(k)) for p, k in shown}
     for p, ov, _, _ in pairs:
         for n in report["nodes"]:
             if n["name"] != p:
                 continue
             for g in n["guarantees"]:
-                if re.search(rf"out\.{re.escape(ov)}(?!\w)", g["text"]):
-                    cul.append({"what": f"guarantee {g['index']} of {p}: `{g['text']}`", "source": g["source"],
-                                "text": g["text"]})
-                    said.append(f"{p}'s guarantee {g['index']} ({g['source']}) `{g['text']}`")
-    table = counterexample_table(sc.get("model"), sc["node"])
+                if not re.search(rf"out\.{re.escape(ov)}(?!\w)", g["text"]):
+                    continue
+                if sc["status"] == "failed" and (p, int(g["index"])) not in blamed:
+                    continue
+                if any(c["source"] == g["source"] for c in cul):
+                    continue
+                cul.append({"what": f"guarantee {g['index']} of {p}: `{g['text']}`", "source": g["source"],
+                            "text": g["text"]})
+                said.append(f"{p}'s guarantee {g['index']} ({g['source']}) `{g['text']}`")
+    involved = {str(sc["node"])} | {p for p, _, _, _ in pairs}
+    table = [r for r in counterexample_table(sc.get("model"), sc["node"]) if str(r["node"]) in involved]
     cex = ", ".join(f"{r['node']}.{r['variable']} = {r['value']}" for r in table)
     sentence = (f"{sc['node']} assumes `{sc['conjunct']}` ({sc['source']}), but "
-                + (_and(said) if said else "its producers' guarantees")
+                + (_and(said) if said else "its producers' guarantees (together; no one of them alone)")
                 + (" allow" if len(said) > 1 else " allows") + " values outside it"
                 + (f": Z3's counterexample {cex}" if cex else "") + ".")
     if sc["status"] == "inconclusive":
@@ -244,6 +258,82 @@ def _side_condition(ws: Any, report: Mapping[str, Any], sc: Mapping[str, Any], c
                       lambda: rep.side_condition_repairs(ws, sc, sc_before)) or []) if sc["status"] == "failed" else []
     return _record(sc["id"], "side-condition", sc["node"], sc["status"], sentence, culprits=cul,
                    counterexample=table, repairs=reps)
+
+
+def _requirement(ws: Any, report: Mapping[str, Any], q: Mapping[str, Any], cache: _Cache) -> dict[str, Any]:
+    """The diagnosis of a refuted requirement: the guarantees Z3 showed a
+    strengthening of proves it (:func:`blame.requirement_culprits`), each
+    with that strengthening as a repair; the counterexample shown for the
+    nodes involved only (the nodes the statement mentions, the culprits'
+    nodes and the nodes between them)."""
+    check = q.get("check") or {}
+    cone = [str(n) for n in check.get("cone") or []]
+
+    def find() -> list[dict[str, Any]]:
+        rows = []
+        for f in blame.requirement_culprits(ws, str(q["id"]), cone):
+            source = rep.recheck.source_text(ws, f["edit"].file)
+            text, src = _guarantee_source(report, f["node"], f["guarantee"])
+            what = f"guarantee {f['guarantee']} of {f['node']}"
+            if f["how"] == "bound":
+                summary = (f"Tighten the bound of {what} ({src}): {f['old']} becomes {f['new']}; Z3 proves "
+                           f"{q['id']} from consistent premises. {f['node']}'s evidence must then establish it.")
+            else:
+                summary = (f"Strengthen {what} ({src}) by `{f['new']}`; Z3 proves {q['id']} from consistent premises. "
+                           f"{f['node']}'s evidence must then establish it.")
+            rows.append({"node": f["node"], "guarantee": f["guarantee"], "how": f["how"], "old": f["old"],
+                         "new": f["new"], "text": text, "source": src,
+                         "repair": rep._record("tighten-bound" if f["how"] == "bound" else "strengthen-guarantee",
+                                               summary, f["edit"], source,
+                                               [{"check": str(q["id"]), "status": "proved (Z3: unsat)"}],
+                                               blame.cost(ws, report, f["node"], f["edit"]))})
+        return rows
+    found = cache.get(["requirement", q["id"], check.get("formal"), cone], find) or []
+    cul = [{"what": f"guarantee {f['guarantee']} of {f['node']}: `{f['text']}`", "source": f["source"],
+            "text": f["text"]} for f in found]
+    mentioned = {str(r["node"]) for r in check.get("counterexample") or []
+                 if re.search(rf"(?<![\w.]){re.escape(str(r['node']))}\.(in|out)\.", str(check.get("formal") or ""))}
+    blamed = {str(f["node"]) for f in found}
+    involved = mentioned | blamed | _between(report, blamed, mentioned)
+    table = [{"node": r["node"], "variable": v, "value": x, "table": None}
+             for r in check.get("counterexample") or [] if not involved or str(r["node"]) in involved
+             for v, x in r["values"].items()]
+    cex = ", ".join(f"{r['node']}.{r['variable']} = {r['value']}" for r in table)
+    if found:
+        f = found[0]
+        how = (f"its bound {f['old']} lets the counterexample through; with {f['new']} Z3 proves {q['id']}"
+               if f["how"] == "bound" else f"strengthened by `{f['new']}` it lets Z3 prove {q['id']}")
+        sentence = (f"Requirement {q['id']} (`{check.get('formal')}`, {check.get('source')}) is refuted because of "
+                    f"guarantee {f['guarantee']} of {f['node']} ({f['source']}) `{f['text']}`: {how}"
+                    + (f". Z3's counterexample: {cex}" if cex else "") + ".")
+    else:
+        sentence = (f"Requirement {q['id']} (`{check.get('formal')}`, {check.get('source')}) is refuted: the guarantees "
+                    "of its cone allow a counterexample, and no single strengthening Z3 tried proves it"
+                    + (f". Z3's counterexample: {cex}" if cex else "") + ".")
+    return _record(str(q["id"]), "requirement", found[0]["node"] if found else "", "failed", sentence, culprits=cul,
+                   counterexample=table, repairs=[f["repair"] for f in found])
+
+
+def _between(report: Mapping[str, Any], sources: set[str], sinks: set[str]) -> set[str]:
+    """The nodes on a path of the system's connections from a node of
+    ``sources`` to a node of ``sinks`` (both excluded)."""
+    down: dict[str, set[str]] = {}
+    for c in report.get("system", {}).get("connections", []):
+        down.setdefault(str(c["from_node"]), set()).add(str(c["to_node"]))
+    up: dict[str, set[str]] = {}
+    for a, bs in down.items():
+        for b in bs:
+            up.setdefault(b, set()).add(a)
+
+    def reach(start: set[str], edges: Mapping[str, set[str]]) -> set[str]:
+        seen, todo = set(start), list(start)
+        while todo:
+            for m in edges.get(todo.pop(), ()):
+                if m not in seen:
+                    seen.add(m)
+                    todo.append(m)
+        return seen
+    return (reach(sources, down) & reach(sinks, up)) - sources - sinks
 
 
 def _obligation_record(ws: Any, node: str, oid: str) -> Mapping[str, Any]:

@@ -84,7 +84,8 @@ def status_lines(data: Mapping[str, Any]) -> list[str]:
         out.append(f"{len(groups)} problem{'s' if len(groups) != 1 else ''} by root cause ({found} finding"
                    f"{'s' if found != 1 else ''}); `rclverify explain ID` prints a finding's diagnosis:")
         for k, g in enumerate(groups, 1):
-            cause = "; ".join(g["culprits"]) or "(no culprit named)"
+            # no culprit Z3 showed: the problem's own location, when it has one
+            cause = "; ".join(g["culprits"]) or (f"at {g['where']}" if g.get("where") else "(no culprit named)")
             repairs = f", {g['repairs']} checked repair{'s' if g['repairs'] != 1 else ''}" if g["repairs"] else ""
             out.append(f"  {k}. [{g['status']}] {cause}: {len(g['members'])} finding"
                        f"{'s' if len(g['members']) != 1 else ''}{repairs}")

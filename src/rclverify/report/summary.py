@@ -110,7 +110,7 @@ def summary_data(report: Mapping[str, Any]) -> dict[str, Any]:
             "unverified": [str(u["id"]) for u in report.get("unverified") or ()],
             "requirements": [[r["id"], r.get("verdict", ""), r["status"]] for r in report.get("requirements", ())],
             "problems": [{"status": g["status"], "sentence": g.get("sentence", ""),
-                          "culprits": [_culprit(c) for c in g.get("culprits", [])],
+                          "culprits": [_culprit(c) for c in g.get("culprits", [])], "where": g.get("where", ""),
                           "members": [m["id"] for m in g.get("members", [])], "repairs": len(g.get("repairs", []))}
                          for g in report.get("problems", ())]}
 
