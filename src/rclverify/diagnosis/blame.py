@@ -70,16 +70,17 @@ def conclusion_edit(ws: Any, node: str, k: int, extra: str) -> Edit | None:
     return Edit(g.loc.file, *span, f"({old}) and ({extra})")
 
 
-def side_condition_culprits(ws: Any, sc: Mapping[str, Any]) -> list[tuple[str, int]]:
-    """``[(producer, guarantee index)]`` of the failed side condition ``sc``
-    (a report row with ``id``, ``node``, ``conjunct``, ``links``): the
-    producer guarantees on the linked outputs whose conclusion, strengthened
-    by the conjunct, makes Z3 discharge ``sc`` (module docstring)."""
+def side_condition_culprits(ws: Any, sc: Mapping[str, Any]) -> tuple[list[tuple[str, int]], int]:
+    """``([(producer, guarantee index)], undecided)`` of the failed side
+    condition ``sc`` (a report row with ``id``, ``node``, ``conjunct``,
+    ``links``): the producer guarantees on the linked outputs whose
+    conclusion, strengthened by the conjunct, makes Z3 discharge ``sc``
+    (module docstring), and how many candidates Z3 could not decide."""
     pairs = _link_pairs(sc)
     to_producer = [(f"in.{iv}", f"out.{ov}") for _, ov, _, iv in pairs]
     extra = _rename(str(sc["conjunct"]), to_producer)
     out: list[tuple[str, int]] = []
-    trials = 0
+    trials = undecided = 0
     for p in sorted({p for p, _, _, _ in pairs}):
         outs = [ov for q, ov, _, _ in pairs if q == p]
         for k, g in enumerate(ws.checked.nodes[p].node.guarantees, 1):
@@ -87,15 +88,18 @@ def side_condition_culprits(ws: Any, sc: Mapping[str, Any]) -> list[tuple[str, i
             if not any(re.search(rf"(?<![\w.])out\.{re.escape(ov)}(?!\w)", text) for ov in outs):
                 continue
             if trials >= MAX_TRIALS:
-                return out
+                return out, undecided + 1
             trials += 1
             edit = conclusion_edit(ws, p, k, extra)
             system = recheck.edited_system(ws, edit) if edit is not None else None
             if system is None:
                 continue
-            if recheck.side_conditions(*system, sc["node"]).get(str(sc["id"])) == "discharged":
+            status = recheck.side_conditions(*system, sc["node"]).get(str(sc["id"]))
+            if status == "discharged":
                 out.append((p, k))
-    return out
+            elif status != "failed":
+                undecided += 1
+    return out, undecided
 
 
 def _proved(req: Any, system: Any, plan: Any) -> bool:

@@ -226,10 +226,12 @@ def _side_condition(ws: Any, report: Mapping[str, Any], sc: Mapping[str, Any], c
     cul = [{"what": f"assumption of {sc['node']}: `{sc['conjunct']}`", "source": sc["source"], "text": sc["conjunct"]}]
     said = []
     # a producer guarantee is named only when strengthening it discharges the side condition (blame.py)
-    shown = (cache.get(["sc-culprits", sc["id"], sc["conjunct"]],
-                       lambda: [list(x) for x in blame.side_condition_culprits(ws, sc)]) or []) \
-        if sc["status"] == "failed" else []
-    blamed = {(str(p), int(k)) for p, k in shown}
+    def find() -> dict[str, Any]:
+        found, undecided = blame.side_condition_culprits(ws, sc)
+        return {"culprits": [list(x) for x in found], "undecided": undecided}
+    shown = (cache.get(["sc-culprits", sc["id"], sc["conjunct"]], find) if sc["status"] == "failed" else None) \
+        or {"culprits": [], "undecided": 1}
+    blamed = {(str(p), int(k)) for p, k in shown["culprits"]}
     for p, ov, _, _ in pairs:
         for n in report["nodes"]:
             if n["name"] != p:
@@ -247,9 +249,11 @@ def _side_condition(ws: Any, report: Mapping[str, Any], sc: Mapping[str, Any], c
     involved = {str(sc["node"])} | {p for p, _, _, _ in pairs}
     table = [r for r in counterexample_table(sc.get("model"), sc["node"]) if str(r["node"]) in involved]
     cex = ", ".join(f"{r['node']}.{r['variable']} = {r['value']}" for r in table)
+    together = ("its producers' guarantees (Z3 could not show which)" if shown["undecided"]
+                else "its producers' guarantees (together: strengthening any one of them alone does not discharge it)")
     sentence = (f"{sc['node']} assumes `{sc['conjunct']}` ({sc['source']}), but "
-                + (_and(said) if said else "its producers' guarantees (together; no one of them alone)")
-                + (" allow" if len(said) > 1 else " allows") + " values outside it"
+                + (_and(said) if said else together)
+                + (" allows" if len(said) == 1 else " allow") + " values outside it"
                 + (f": Z3's counterexample {cex}" if cex else "") + ".")
     if sc["status"] == "inconclusive":
         sentence = f"Z3 could not decide whether {sc['node']}'s assumption `{sc['conjunct']}` ({sc['source']}) follows from " \
