@@ -27,7 +27,16 @@ its diagnosis record (:mod:`rclverify.diagnosis.build`, ``culprits``):
    because of it); when any culprit is explained so, the explained ones make
    the key.
 
-Problems with the same key are one group; a problem with no culprit at all
+4. the guarantees of one node that no obligation covers (``unverified``,
+   :mod:`rclverify.report.unverified`) are one group of their own, keyed
+   ``unverified:<Node>``, each guarantee a finding and a culprit at its
+   location; a contract defect never absorbs them.
+
+The culprits a diagnosis record names are the ones Z3 showed
+(:mod:`rclverify.diagnosis.blame`): strengthening each alone removes the
+counterexample, so unrelated bugs that only mention the same variable do
+not share a key.  Findings are named fully (a derived property is
+``<Node>.derived``).  Problems with the same key are one group; a problem with no culprit at all
 (a refinement that fails, a lint error) is its own group.  A derived
 property that is not derived joins the group of the side conditions of its
 cone that are not discharged (the reason it is not derived).  Requirements
