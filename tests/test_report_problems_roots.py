@@ -114,3 +114,17 @@ def test_every_group_of_the_drone_has_a_location(tmp_path: Path) -> None:
     assert [g["where"] for g in report["problems"]] == ["contracts/battery_monitor.rcl:10:3",
                                                         "contracts/mission_planner.rcl:10:31",
                                                         "contracts/plan.yaml:12:14"]
+
+
+def test_explain_prints_findings_without_a_record_of_their_own(tmp_path: Path, capsys) -> None:
+    """Every finding `status` lists can be explained: a derived property by its full name."""
+    from rclverify.cli import main
+    root = copy(tmp_path, "drone")
+    verify(root)
+    capsys.readouterr()
+    assert main(["explain", "-w", str(root), "FlightController.derived"]) == 0
+    out = capsys.readouterr().out
+    assert out.startswith("FlightController.derived [failed] (derived property)")
+    assert "guarantee 2 of BatteryMonitor (contracts/battery_monitor.rcl:12:3)" in out
+    assert "the same root cause, found by: MissionPlanner.sc2, MissionPlanner.derived" in out
+    assert main(["explain", "-w", str(root), "FlightController"]) == 1  # a bare node name is no finding

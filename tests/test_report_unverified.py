@@ -125,3 +125,14 @@ def test_the_overall_status_is_never_better_than_unverified(tmp_path: Path) -> N
     _, report = verify(root)
     assert report["summary"]["status"] == "discharged" and report["unverified"] == []
     assert report["meta"]["strict_ok"] is True
+
+
+def test_explain_prints_an_unverified_guarantee(tmp_path: Path, capsys) -> None:
+    from rclverify.cli import main
+    root = _partly_covered(tmp_path)
+    verify(root)
+    capsys.readouterr()
+    assert main(["explain", "-w", str(root), "Geofence.g1"]) == 0
+    out = capsys.readouterr().out
+    assert out.startswith("Geofence.g1 [unverified] (unverified guarantee)")
+    assert "guarantee 1 of Geofence (contracts/geofence.rcl:8:3)" in out

@@ -307,6 +307,11 @@ def cmd_explain(args: argparse.Namespace) -> int:
                 print(f"{wanted} [{x['status']}] ({kind}): no problem to diagnose"
                       + (f"; {x.get('statement') or x.get('conjunct') or x.get('message')}" if kind else ""))
                 return 0
+    from .diagnosis.text import finding_lines  # an unverified guarantee, a derived property: no record of its own
+    lines = finding_lines(report, wanted)
+    if lines:
+        print("\n".join(lines))
+        return 0
     ids = natural_sorted([d["id"] for d in report.get("diagnoses", [])])
     raise RclError([_io_error(Path(args.workspace) / "reports/assurance.json",
                               f"no problem or obligation {wanted!r} in the last report"

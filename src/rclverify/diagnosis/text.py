@@ -66,6 +66,30 @@ def explain_lines(d: Mapping[str, Any]) -> list[str]:
     return out
 
 
+def finding_lines(report: Mapping[str, Any], wanted: str) -> list[str]:
+    """A finding of the report's problems by root cause that has no
+    diagnosis record of its own (an unverified guarantee ``Node.g<k>``, a
+    derived property ``Node.derived``, a requirement): its id, status and
+    kind, its sentence, the row it is in (culprits or where it was found)
+    and the other findings of that row; ``[]`` when ``wanted`` is none."""
+    for g in report.get("problems") or ():
+        for m in g.get("members", ()):
+            if m.get("id") != wanted:
+                continue
+            out = [f"{wanted} [{m['status']}] ({m['kind']})", f"  {m['sentence']}"]
+            cs = [f"{c['what']} ({c['source']})" if c.get("what") else str(c.get("source", ""))
+                  for c in g.get("culprits", ())]
+            if cs:
+                out += ["  culprits:"] + [f"    {c}" for c in cs]
+            elif g.get("where"):
+                out.append(f"  found at {g['where']}")
+            others = [x["id"] for x in g.get("members", ()) if x["id"] != wanted]
+            if others:
+                out.append("  the same root cause, found by: " + ", ".join(others))
+            return out
+    return []
+
+
 def _short(sentence: str) -> str:
     return sentence if len(sentence) <= SENTENCE else sentence[:SENTENCE].rsplit(" ", 1)[0] + " ..."
 
