@@ -96,6 +96,9 @@ def test_a_side_condition_names_only_the_guarantee_whose_strengthening_discharge
     assert "guarantee 1" not in d["sentence"]
     assert {row["node"] for row in d["counterexample"]} == {"BatteryMonitor"}
     assert "Geofence" not in d["sentence"]
+    # the side condition's own model, as the calculus section, SARIF and JUnit show it
+    sc = next(s for s in report["side_conditions"] if s["id"] == "MissionPlanner.sc2")
+    assert set(sc["model"]) == {"BatteryMonitor.in.voltage", "BatteryMonitor.out.battery"}
 
 
 def test_a_row_without_a_culprit_shows_where_it_was_found() -> None:

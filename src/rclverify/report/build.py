@@ -208,7 +208,8 @@ def build_report(ws: Workspace) -> dict[str, Any]:
         if "health" in stages:
             health[n] = [{**f, "status": "stale", "message": note + f["status"] + ". " + f["message"]}
                          for f in health[n]]
-    side_conditions = [sc for n in checked.nodes for sc in comps[n].get("side_conditions", [])]
+    # a counterexample shows the nodes involved only: the consumer and the producers of the linked variables
+    side_conditions = [involved_model(sc) for n in checked.nodes for sc in comps[n].get("side_conditions", [])]
     sc_status = {n: worst([sc["status"] for sc in comps[n].get("side_conditions", [])], empty="discharged")
                  for n in checked.nodes}
 
@@ -368,6 +369,21 @@ def build_report(ws: Workspace) -> dict[str, Any]:
     from .render import anchor, problem_items
     report["problems"] = group_problems(report, problem_items(report), anchor)
     return report
+
+
+def involved_model(sc: Mapping[str, Any]) -> Mapping[str, Any]:
+    """``sc`` (a side-condition row of the calculus) with its Z3 ``model``
+    (``{"Node.in.x": value}``) cut to the nodes its conjunct involves: the
+    consumer and the producers of its ``links`` (``"P.out.v -> C.in.w
+    (...)"``).  The query holds every producer of the consumer (the drone's
+    Geofence with the battery mismatch), whose values say nothing about
+    this conjunct.  Unchanged without a model or links."""
+    model = sc.get("model")
+    nodes = {str(sc.get("node", ""))} | {str(l).split(".", 1)[0] for l in sc.get("links") or ()}
+    if not isinstance(model, dict) or not sc.get("links"):
+        return sc
+    kept = {k: v for k, v in model.items() if str(k).split(".", 1)[0] in nodes}
+    return {**sc, "model": kept} if kept and len(kept) < len(model) else sc
 
 
 #: The fields of a requirement's check record (requirements/check.py) the report carries.
