@@ -5,7 +5,8 @@ and the workspace and returns ``[record, ...]``, each::
 
     {"id": problem id (finding, side condition or obligation id),
      "kind": "vacuity" | "inconsistency" | "unsatisfiable-assumption" | "refinement"
-             | "side-condition" | "hoare" | "monitor" | "property-test" | "evidence",
+             | "side-condition" | "hoare" | "monitor" | "property-test" | "evidence"
+             | "requirement" (a refuted one: diagnosis/requirement.py),
      "node": str, "status": str,
      "sentence": one sentence naming the culprit by source location,
      "culprits": [{"what": str, "source": "file:line:col", "text": str}],
@@ -32,6 +33,7 @@ import z3
 from ..cache import Shelf, file_digest
 from ..rcl.errors import RclError
 from . import blame, repairs as rep
+from .requirement import requirement_record
 from .culprits import culprits, parse_core, plan_facts
 from .table import counterexample_table
 
@@ -160,7 +162,7 @@ def _diagnose(ws: Any, report: Mapping[str, Any]) -> list[dict[str, Any]]:
             out.append(_side_condition(ws, report, sc, cache, sc_before))
     for q in report.get("requirements", []):
         if q.get("verdict") == "refuted":
-            out.append(_requirement(ws, report, q, cache))
+            out.append(requirement_record(ws, report, q, cache, _guarantee_source))
     obligations = {o["id"]: o for o in report["obligations"]}
     for e in report["evidence"]:
         if e["status"] in ("failed", "error"):
@@ -262,82 +264,6 @@ def _side_condition(ws: Any, report: Mapping[str, Any], sc: Mapping[str, Any], c
                       lambda: rep.side_condition_repairs(ws, sc, sc_before)) or []) if sc["status"] == "failed" else []
     return _record(sc["id"], "side-condition", sc["node"], sc["status"], sentence, culprits=cul,
                    counterexample=table, repairs=reps)
-
-
-def _requirement(ws: Any, report: Mapping[str, Any], q: Mapping[str, Any], cache: _Cache) -> dict[str, Any]:
-    """The diagnosis of a refuted requirement: the guarantees Z3 showed a
-    strengthening of proves it (:func:`blame.requirement_culprits`), each
-    with that strengthening as a repair; the counterexample shown for the
-    nodes involved only (the nodes the statement mentions, the culprits'
-    nodes and the nodes between them)."""
-    check = q.get("check") or {}
-    cone = [str(n) for n in check.get("cone") or []]
-
-    def find() -> list[dict[str, Any]]:
-        rows = []
-        for f in blame.requirement_culprits(ws, str(q["id"]), cone):
-            source = rep.recheck.source_text(ws, f["edit"].file)
-            text, src = _guarantee_source(report, f["node"], f["guarantee"])
-            what = f"guarantee {f['guarantee']} of {f['node']}"
-            if f["how"] == "bound":
-                summary = (f"Tighten the bound of {what} ({src}): {f['old']} becomes {f['new']}; Z3 proves "
-                           f"{q['id']} from consistent premises. {f['node']}'s evidence must then establish it.")
-            else:
-                summary = (f"Strengthen {what} ({src}) by `{f['new']}`; Z3 proves {q['id']} from consistent premises. "
-                           f"{f['node']}'s evidence must then establish it.")
-            rows.append({"node": f["node"], "guarantee": f["guarantee"], "how": f["how"], "old": f["old"],
-                         "new": f["new"], "text": text, "source": src,
-                         "repair": rep._record("tighten-bound" if f["how"] == "bound" else "strengthen-guarantee",
-                                               summary, f["edit"], source,
-                                               [{"check": str(q["id"]), "status": "proved (Z3: unsat)"}],
-                                               blame.cost(ws, report, f["node"], f["edit"]))})
-        return rows
-    found = cache.get(["requirement", q["id"], check.get("formal"), cone], find) or []
-    cul = [{"what": f"guarantee {f['guarantee']} of {f['node']}: `{f['text']}`", "source": f["source"],
-            "text": f["text"]} for f in found]
-    mentioned = {str(r["node"]) for r in check.get("counterexample") or []
-                 if re.search(rf"(?<![\w.]){re.escape(str(r['node']))}\.(in|out)\.", str(check.get("formal") or ""))}
-    blamed = {str(f["node"]) for f in found}
-    involved = mentioned | blamed | _between(report, blamed, mentioned)
-    table = [{"node": r["node"], "variable": v, "value": x, "table": None}
-             for r in check.get("counterexample") or [] if not involved or str(r["node"]) in involved
-             for v, x in r["values"].items()]
-    cex = ", ".join(f"{r['node']}.{r['variable']} = {r['value']}" for r in table)
-    if found:
-        f = found[0]
-        how = (f"its bound {f['old']} lets the counterexample through; with {f['new']} Z3 proves {q['id']}"
-               if f["how"] == "bound" else f"strengthened by `{f['new']}` it lets Z3 prove {q['id']}")
-        sentence = (f"Requirement {q['id']} (`{check.get('formal')}`, {check.get('source')}) is refuted because of "
-                    f"guarantee {f['guarantee']} of {f['node']} ({f['source']}) `{f['text']}`: {how}"
-                    + (f". Z3's counterexample: {cex}" if cex else "") + ".")
-    else:
-        sentence = (f"Requirement {q['id']} (`{check.get('formal')}`, {check.get('source')}) is refuted: the guarantees "
-                    "of its cone allow a counterexample, and no single strengthening Z3 tried proves it"
-                    + (f". Z3's counterexample: {cex}" if cex else "") + ".")
-    return _record(str(q["id"]), "requirement", found[0]["node"] if found else "", "failed", sentence, culprits=cul,
-                   counterexample=table, repairs=[f["repair"] for f in found])
-
-
-def _between(report: Mapping[str, Any], sources: set[str], sinks: set[str]) -> set[str]:
-    """The nodes on a path of the system's connections from a node of
-    ``sources`` to a node of ``sinks`` (both excluded)."""
-    down: dict[str, set[str]] = {}
-    for c in report.get("system", {}).get("connections", []):
-        down.setdefault(str(c["from_node"]), set()).add(str(c["to_node"]))
-    up: dict[str, set[str]] = {}
-    for a, bs in down.items():
-        for b in bs:
-            up.setdefault(b, set()).add(a)
-
-    def reach(start: set[str], edges: Mapping[str, set[str]]) -> set[str]:
-        seen, todo = set(start), list(start)
-        while todo:
-            for m in edges.get(todo.pop(), ()):
-                if m not in seen:
-                    seen.add(m)
-                    todo.append(m)
-        return seen
-    return (reach(sources, down) & reach(sinks, up)) - sources - sinks
 
 
 def _obligation_record(ws: Any, node: str, oid: str) -> Mapping[str, Any]:

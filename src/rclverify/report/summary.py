@@ -19,8 +19,8 @@ from ..evidence.records import SEVERITY
 #: At most this many node rows (worst first); the rest are summed in one row.
 MAX_ROWS = 15
 
-_COLOUR = {"discharged": "green", "pending": "yellow", "unverified": "dark_orange", "inconclusive": "yellow", "stale": "magenta",
-           "error": "red", "failed": "red"}
+_COLOUR = {"discharged": "green", "pending": "yellow", "unverified": "dark_orange", "inconclusive": "yellow",
+           "stale": "magenta", "error": "red", "failed": "red"}
 
 
 def _rank(status: str) -> int:
