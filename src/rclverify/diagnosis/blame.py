@@ -75,7 +75,8 @@ def side_condition_culprits(ws: Any, sc: Mapping[str, Any]) -> tuple[list[tuple[
     condition ``sc`` (a report row with ``id``, ``node``, ``conjunct``,
     ``links``): the producer guarantees on the linked outputs whose
     conclusion, strengthened by the conjunct, makes Z3 discharge ``sc``
-    (module docstring), and how many candidates Z3 could not decide."""
+    (module docstring), and how many candidates could not be decided (Z3
+    answered unknown, or the strengthened text does not type-check)."""
     pairs = _link_pairs(sc)
     to_producer = [(f"in.{iv}", f"out.{ov}") for _, ov, _, iv in pairs]
     extra = _rename(str(sc["conjunct"]), to_producer)
@@ -92,7 +93,8 @@ def side_condition_culprits(ws: Any, sc: Mapping[str, Any]) -> tuple[list[tuple[
             trials += 1
             edit = conclusion_edit(ws, p, k, extra)
             system = recheck.edited_system(ws, edit) if edit is not None else None
-            if system is None:
+            if system is None:  # the conjunct does not read in the producer's names: nothing shown either way
+                undecided += 1
                 continue
             status = recheck.side_conditions(*system, sc["node"]).get(str(sc["id"]))
             if status == "discharged":
