@@ -22,7 +22,8 @@ its diagnosis record (:mod:`rclverify.diagnosis.build`, ``culprits``):
    refuted Hoare triple the program's constants remain);
 3. a culprit guarantee that is itself the victim of a vacuity or
    inconsistency problem of contract health stands for that problem's root
-   culprits: the contract defect explains what is found on top of it (the
+   culprits (except for a failed side condition, whose culprits are the
+   ones Z3 showed for it: it is its own root unless those name another): the contract defect explains what is found on top of it (the
    property test of a vacuous guarantee, a requirement proved vacuously
    because of it); when any culprit is explained so, the explained ones make
    the key.
@@ -218,8 +219,10 @@ def group_problems(report: Mapping[str, Any], items: Sequence[Mapping[str, Any]]
 
     groups: dict[tuple[str, ...], dict[str, Any]] = {}
     for m, roots in members:
-        # an unverified guarantee stays a row of its own, even when a contract defect explains the guarantee
-        explained = [] if m["kind"] == "unverified guarantee" else [e for r in roots for e in explains.get(r, [])]
+        # an unverified guarantee stays a row of its own, even when a contract defect explains the guarantee;
+        # so does a failed side condition: its culprits are the ones Z3 showed for it (diagnosis/blame.py)
+        explained = ([] if m["kind"] in ("unverified guarantee", "side-condition")
+                     else [e for r in roots for e in explains.get(r, [])])
         if explained:
             roots = list(dict.fromkeys(explained))
         key = tuple(sorted(roots)) if roots else (f"problem:{m['id']}",)
