@@ -161,13 +161,16 @@ def test_newcomer_speed_mismatch_gets_side_condition_repairs(newcomer: Path) -> 
 
 
 def test_a_broken_checker_shows_no_repair(newcomer: Path, monkeypatch: pytest.MonkeyPatch) -> None:
-    """Every Z3 query answers unknown: the problem is still diagnosed, no repair is shown."""
+    """Every Z3 query answers unknown: the problem is still diagnosed, no repair is shown, and no
+    producer guarantee is named (a culprit is named only when Z3 showed it, diagnosis/blame.py)."""
     ws, report = _run(newcomer)
     ws.path(CACHE).unlink(missing_ok=True)
     monkeypatch.setattr(z3.Solver, "check", lambda self, *a, **k: z3.unknown)
     ds = diagnose(ws, report)
     d = next(x for x in ds if x["id"] == "Controller.sc2")
-    assert "Planner's guarantee 1" in d["sentence"]
+    assert "Controller assumes `in.speed <= 1.5`" in d["sentence"] and "Planner's guarantee 1" not in d["sentence"]
+    assert "Z3 could not show which" in d["sentence"]
+    assert [c["source"] for c in d["culprits"]] == ["contracts/rover.rcl:15:29"]
     assert d["repairs"] == []
 
 
@@ -299,8 +302,11 @@ def test_explain_and_status_read_the_last_run(newcomer: Path, capsys: pytest.Cap
     assert json.loads((newcomer / "reports" / "assurance.json").read_text())["diagnoses"][0]["id"] == "Controller.sc2"
     assert main(["status", "-w", str(newcomer)]) == 0
     out = capsys.readouterr().out
-    # one entry per root cause, as in the report: the side condition and the derived properties it blocks
-    assert "1 problem by root cause" in out and "rclverify explain ID" in out, out
+    # one entry per root cause, as in the report: the side condition and the derived properties it blocks,
+    # then each node whose guarantees no obligation covers (the newcomer's plan has no evidence entry)
+    assert "4 problems by root cause" in out and "rclverify explain ID" in out, out
+    assert "findings: Controller.sc2, Controller.derived, Motor.derived" in out
+    assert sum(1 for line in out.splitlines() if line.startswith("  ") and "[unverified]" in line) == 3
     (entry,) = [line for line in out.splitlines() if line.startswith("  1. [failed]")]
     assert "checked repair" in entry and "findings" in entry
     assert "findings: Controller.sc2" in out

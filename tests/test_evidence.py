@@ -29,7 +29,7 @@ def test_roll_up_takes_the_worst_and_missing_is_pending() -> None:
     assert worst(["discharged", "inconclusive"]) == "inconclusive"
     assert worst([]) == "pending"
     assert [s for s, _ in sorted(SEVERITY.items(), key=lambda kv: kv[1])] == \
-        ["discharged", "pending", "inconclusive", "stale", "error", "failed"]
+        ["discharged", "pending", "unverified", "inconclusive", "stale", "error", "failed"]
     with pytest.raises(KeyError):
         worst(["proved"])
 

@@ -42,7 +42,10 @@ def test_init_then_doit_verify_works_in_a_fresh_directory(tmp_path: Path) -> Non
     assert all(sc["status"] == "discharged" and sc["rule"] == "R1" for sc in report["side_conditions"])
     assert report["findings"] and all(f["status"] == "ok" for f in report["findings"])
     # without evidence entries nothing reads as verified
-    assert all(g["status"] == "pending" for n in report["nodes"] for g in n["guarantees"])
+    # no evidence entry yet: every guarantee is unverified (no obligation covers it), each listed
+    assert all(g["status"] == "unverified" for n in report["nodes"] for g in n["guarantees"])
+    assert {u["id"] for u in report["unverified"]} == {f"{n['name']}.g{g['index']}" for n in report["nodes"]
+                                                      for g in n["guarantees"]}
     assert (ws / "reports" / "assurance.sarif").is_file() and (ws / "reports" / "assurance.junit.xml").is_file()
     # --strict does not pass a system whose guarantees have no evidence yet
     assert report["meta"]["strict_ok"] is False

@@ -263,7 +263,7 @@ def test_init_writes_formal_requirements_that_are_proved(tmp_path: Path, capsys:
     assert main(["init", str(tmp_path / "w")]) == 0
     assert main(["requirements", "-w", str(tmp_path / "w")]) == 0
     out = capsys.readouterr().out
-    # proved; not met until the nodes have evidence (the new plan has none yet)
-    assert "REQ1: proved, evidence outstanding [pending]" in out
-    assert "REQ2: proved, evidence outstanding [pending]" in out
+    # proved; not met until the nodes have evidence (the new plan has none yet: the guarantees are unverified)
+    assert "REQ1: proved, evidence outstanding [unverified]" in out
+    assert "REQ2: proved, evidence outstanding [unverified]" in out
     assert "used: Sensor guarantee 2" in out and "used: Actuator guarantee 2" in out

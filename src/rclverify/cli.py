@@ -329,6 +329,9 @@ def cmd_explain(args: argparse.Namespace) -> int:
     except (KeyError, TypeError, AttributeError, ValueError) as exc:  # a deeper field of another shape
         raise located(root / "reports/assurance.json", f"not an rclverify report: cannot read it ({exc!r}); "
                       "run `rclverify verify` (or `doit verify`) to write it again") from None
+    if lines is None:  # an unverified guarantee, a derived property: a finding with no record of its own
+        from .diagnosis.text import finding_lines
+        lines = finding_lines(report, args.id) or None
     if lines is not None:
         print("\n".join(lines))
         return 0

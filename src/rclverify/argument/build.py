@@ -190,7 +190,7 @@ def build_argument(report: Mapping[str, Any]) -> Argument:
         if not mine:
             kids.append(b.add(Element(ident("G", node, f"g{k}", "evidence"), "goal",
                                       f"Evidence that {node} guarantee {k} holds: no obligation was exported for it",
-                                      undeveloped=True, ref=f"{node}.g{k}")))
+                                      undeveloped=True, ref=f"{node}.g{k}", status="unverified")))
         for f in findings.get(node, []):
             if f["guarantee"] in (None, k):
                 kids.append(b.add(Element(

@@ -135,7 +135,8 @@ def validate(arg: Argument) -> None:
 
 def propagate(arg: Argument) -> Argument:
     """The same structure with every goal's and strategy's status computed
-    bottom-up: undeveloped -> ``pending``; otherwise the worst status of its
+    bottom-up: undeveloped -> ``pending`` (``unverified`` when the goal is
+    marked so: the evidence of a guarantee no obligation covers); otherwise the worst status of its
     ``supported_by`` children (a goal with no children and not marked
     undeveloped is also ``pending``: nothing shows it).  Solutions keep
     their status; contexts and assumptions get ``None``.  Raises
@@ -155,7 +156,8 @@ def propagate(arg: Argument) -> Argument:
         elif e.type in CONTEXT_TYPES:
             s = None
         elif e.undeveloped:
-            s = UNDEVELOPED_STATUS
+            # an undeveloped goal may say why it is worse than pending (a guarantee no obligation covers)
+            s = e.status if e.status == "unverified" else UNDEVELOPED_STATUS
         else:
             kids = [status(x) for x in e.supported_by]
             s = worst([k for k in kids if k is not None], empty=UNDEVELOPED_STATUS)

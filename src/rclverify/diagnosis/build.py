@@ -5,7 +5,8 @@ and the workspace and returns ``[record, ...]``, each::
 
     {"id": problem id (finding, side condition or obligation id),
      "kind": "vacuity" | "inconsistency" | "unsatisfiable-assumption" | "refinement"
-             | "side-condition" | "hoare" | "monitor" | "property-test" | "evidence",
+             | "side-condition" | "hoare" | "monitor" | "property-test" | "evidence"
+             | "requirement" (a refuted one: diagnosis/requirement.py),
      "node": str, "status": str,
      "sentence": one sentence naming the culprit by source location,
      "culprits": [{"what": str, "source": "file:line:col", "text": str}],
@@ -31,7 +32,8 @@ import z3
 
 from ..cache import Shelf, file_digest
 from ..rcl.errors import RclError
-from . import repairs as rep
+from . import blame, repairs as rep
+from .requirement import requirement_record
 from .culprits import culprits, parse_core, plan_facts
 from .table import counterexample_table
 
@@ -158,6 +160,9 @@ def _diagnose(ws: Any, report: Mapping[str, Any]) -> list[dict[str, Any]]:
     for sc in report["side_conditions"]:
         if sc["status"] in ("failed", "inconclusive"):
             out.append(_side_condition(ws, report, sc, cache, sc_before))
+    for q in report.get("requirements", []):
+        if q.get("verdict") == "refuted":
+            out.append(requirement_record(ws, report, q, cache, _guarantee_source))
     obligations = {o["id"]: o for o in report["obligations"]}
     for e in report["evidence"]:
         if e["status"] in ("failed", "error"):
@@ -222,20 +227,35 @@ def _side_condition(ws: Any, report: Mapping[str, Any], sc: Mapping[str, Any], c
     pairs = rep._link_pairs(sc)
     cul = [{"what": f"assumption of {sc['node']}: `{sc['conjunct']}`", "source": sc["source"], "text": sc["conjunct"]}]
     said = []
+    # a producer guarantee is named only when strengthening it discharges the side condition (blame.py)
+    def find() -> dict[str, Any]:
+        found, undecided = blame.side_condition_culprits(ws, sc)
+        return {"culprits": [list(x) for x in found], "undecided": undecided}
+    shown = (cache.get(["sc-culprits", sc["id"], sc["conjunct"]], find) if sc["status"] == "failed" else None) \
+        or {"culprits": [], "undecided": 1}
+    blamed = {(str(p), int(k)) for p, k in shown["culprits"]}
     for p, ov, _, _ in pairs:
         for n in report["nodes"]:
             if n["name"] != p:
                 continue
             for g in n["guarantees"]:
-                if re.search(rf"out\.{re.escape(ov)}(?!\w)", g["text"]):
-                    cul.append({"what": f"guarantee {g['index']} of {p}: `{g['text']}`", "source": g["source"],
-                                "text": g["text"]})
-                    said.append(f"{p}'s guarantee {g['index']} ({g['source']}) `{g['text']}`")
-    table = counterexample_table(sc.get("model"), sc["node"])
+                if not re.search(rf"out\.{re.escape(ov)}(?!\w)", g["text"]):
+                    continue
+                if sc["status"] == "failed" and (p, int(g["index"])) not in blamed:
+                    continue
+                if any(c["source"] == g["source"] for c in cul):
+                    continue
+                cul.append({"what": f"guarantee {g['index']} of {p}: `{g['text']}`", "source": g["source"],
+                            "text": g["text"]})
+                said.append(f"{p}'s guarantee {g['index']} ({g['source']}) `{g['text']}`")
+    involved = {str(sc["node"])} | {p for p, _, _, _ in pairs}
+    table = [r for r in counterexample_table(sc.get("model"), sc["node"]) if str(r["node"]) in involved]
     cex = ", ".join(f"{r['node']}.{r['variable']} = {r['value']}" for r in table)
+    together = ("its producers' guarantees (Z3 could not show which)" if shown["undecided"]
+                else "its producers' guarantees (together: strengthening any one of them alone does not discharge it)")
     sentence = (f"{sc['node']} assumes `{sc['conjunct']}` ({sc['source']}), but "
-                + (_and(said) if said else "its producers' guarantees")
-                + (" allow" if len(said) > 1 else " allows") + " values outside it"
+                + (_and(said) if said else together)
+                + (" allows" if len(said) == 1 else " allow") + " values outside it"
                 + (f": Z3's counterexample {cex}" if cex else "") + ".")
     if sc["status"] == "inconclusive":
         sentence = f"Z3 could not decide whether {sc['node']}'s assumption `{sc['conjunct']}` ({sc['source']}) follows from " \

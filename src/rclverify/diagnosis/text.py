@@ -106,6 +106,28 @@ def clause_cut(text: str, limit: int = SENTENCE) -> str:
         return text
     cuts = [k for k in _boundaries(text) if k <= limit]
     return text[:cuts[-1]] + " ..." if cuts else text
+def finding_lines(report: Mapping[str, Any], wanted: str) -> list[str]:
+    """A finding of the report's problems by root cause that has no
+    diagnosis record of its own (an unverified guarantee ``Node.g<k>``, a
+    derived property ``Node.derived``, a requirement): its id, status and
+    kind, its sentence, the row it is in (culprits or where it was found)
+    and the other findings of that row; ``[]`` when ``wanted`` is none."""
+    for g in report.get("problems") or ():
+        for m in g.get("members", ()):
+            if m.get("id") != wanted:
+                continue
+            out = [f"{wanted} [{m['status']}] ({m['kind']})", f"  {m['sentence']}"]
+            cs = [f"{c['what']} ({c['source']})" if c.get("what") else str(c.get("source", ""))
+                  for c in g.get("culprits", ())]
+            if cs:
+                out += ["  culprits:"] + [f"    {c}" for c in cs]
+            elif g.get("where"):
+                out.append(f"  found at {g['where']}")
+            others = [x["id"] for x in g.get("members", ()) if x["id"] != wanted]
+            if others:
+                out.append("  the same root cause, found by: " + ", ".join(others))
+            return out
+    return []
 
 
 def _short(sentence: str) -> str:
@@ -126,7 +148,8 @@ def status_lines(data: Mapping[str, Any]) -> list[str]:
         out.append(f"{len(groups)} problem{'s' if len(groups) != 1 else ''} by root cause ({found} finding"
                    f"{'s' if found != 1 else ''}); `rclverify explain ID` prints a finding's diagnosis:")
         for k, g in enumerate(groups, 1):
-            cause = "; ".join(g["culprits"]) or "(no culprit named)"
+            # no culprit Z3 showed: the problem's own location, when it has one
+            cause = "; ".join(g["culprits"]) or (f"at {g['where']}" if g.get("where") else "(no culprit named)")
             repairs = f", {g['repairs']} checked repair{'s' if g['repairs'] != 1 else ''}" if g["repairs"] else ""
             out.append(f"  {k}. [{g['status']}] {cause}: {len(g['members'])} finding"
                        f"{'s' if len(g['members']) != 1 else ''}{repairs}")

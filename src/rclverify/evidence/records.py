@@ -31,10 +31,13 @@ from typing import Any, Mapping, Sequence
 SEVERITY: Mapping[str, int] = {
     "discharged": 0,
     "pending": 1,
-    "inconclusive": 2,
-    "stale": 3,
-    "error": 4,
-    "failed": 5,
+    # a guarantee no obligation covers: nothing was planned to establish it (report/build.py);
+    # never an evidence record's status
+    "unverified": 2,
+    "inconclusive": 3,
+    "stale": 4,
+    "error": 5,
+    "failed": 6,
 }
 #: Roll-up status for a parent with no evidence at all.
 MISSING = "pending"
@@ -165,7 +168,7 @@ class Evidence:
         ``KeyError``/``ValueError`` for a missing field or an unknown status."""
         if not isinstance(d, Mapping):
             raise TypeError(f"an evidence record is a JSON object, not {type(d).__name__}")
-        if d.get("status") not in SEVERITY:
+        if d.get("status") not in SEVERITY or d.get("status") == "unverified":
             raise ValueError(f"unknown evidence status {d.get('status')!r}")
         return Evidence(
             obligation=d["obligation"], backend=d["backend"], kind=d["kind"], status=d["status"],

@@ -8,7 +8,9 @@ while any of its evidence is failed, pending, stale or missing:
 * obligation: its evidence's *current* status (``stale`` when an input's
   sha256 changed since the evidence was produced), ``pending`` when there is
   no evidence record;
-* guarantee: worst of its obligations (``pending`` when it has none), and
+* guarantee: worst of its obligations (``unverified`` when it has none: no
+  evidence entry of the plan exports an obligation for it; each such
+  guarantee is listed under ``unverified`` and is a problem of its own), and
   ``failed`` when the health checks found it vacuous or the contract
   contradictory (``inconclusive`` when they could not decide);
 * node: worst of its guarantees and its side conditions;
@@ -217,7 +219,8 @@ def build_report(ws: Workspace) -> dict[str, Any]:
             health[n] = [f if f["status"] == "error" else
                          {**f, "status": "stale", "message": note + f["status"] + ". " + f["message"]}
                          for f in health[n]]
-    side_conditions = [sc for n in checked.nodes for sc in comps[n].get("side_conditions", [])]
+    # a counterexample shows the nodes involved only: the consumer and the producers of the linked variables
+    side_conditions = [involved_model(sc) for n in checked.nodes for sc in comps[n].get("side_conditions", [])]
     sc_status = {n: worst([sc["status"] for sc in comps[n].get("side_conditions", [])], empty="discharged")
                  for n in checked.nodes}
 
@@ -236,7 +239,7 @@ def build_report(ws: Workspace) -> dict[str, Any]:
 
     def g_status(node: str, k: int) -> str:
         sts = [ob_status[o.id] for o in by_node.get(node, []) if applies(o, node, k)]
-        s = worst(sts) if sts else "pending"
+        s = worst(sts) if sts else "unverified"
         for f in health[node]:
             if f["guarantee"] in (None, k) and f["status"] != "ok":
                 s = worst([s, _FINDING_AS[f["status"]]])
@@ -268,6 +271,9 @@ def build_report(ws: Workspace) -> dict[str, Any]:
                             for text, src in tx["assumptions"]],
             "guarantees": guarantees, "latex": tx["latex"],
         })
+
+    from .unverified import unverified_guarantees
+    unverified = unverified_guarantees(plan, nodes)
 
     requirements: list[dict[str, Any]] = []
     from ..plan.load import all_requirements
@@ -322,6 +328,7 @@ def build_report(ws: Workspace) -> dict[str, Any]:
         if sc["status"] != "discharged":
             problems.append(f"Side condition {sc['id']} is {sc['status']}: {sc['conjunct']}")
     problems.extend(problems_altered)
+    problems.extend(u["message"] for u in unverified)
     for e in ev_rows:
         if e["status"] in ("failed", "error", "stale"):
             problems.append(f"Evidence {e['obligation']} is {e['status']}: {_brief(e['explanation'])}")
@@ -358,7 +365,7 @@ def build_report(ws: Workspace) -> dict[str, Any]:
         if grounding["counts"]["error"]:
             problems.append(f"Grounding: {grounding['counts']['error']} contract(s)-vs-ROS error(s) "
                             f"(rclverify ros check)")
-    headline = _headline(ob_rows, counts, side_conditions, findings)
+    headline = _headline(ob_rows, counts, side_conditions, findings, unverified)
     system = model.view(node_status, cycles_kept(model, ws.path("artifacts/cache/system-cycles.pickle")))
     report: dict[str, Any] = {
         "meta": {"tool": "rclverify", "version": __version__, "workspace": plan.name or ws.root.resolve().name, "plan": plan.file,
@@ -368,7 +375,7 @@ def build_report(ws: Workspace) -> dict[str, Any]:
         "system": system, "requirements": requirements, "nodes": nodes, "side_conditions": side_conditions,
         "derived_properties": derived, "findings": findings, "obligations": ob_rows, "evidence": ev_rows,
         "environment_assumptions": env_assumptions, "pending": pending, "lint": lint_rows,
-        "expected_verdicts": expected, "grounding": grounding,
+        "expected_verdicts": expected, "grounding": grounding, "unverified": unverified,
     }
     # one diagnosis record per problem, with repairs checked by Z3 (docs/diagnosis.md)
     report["diagnoses"] = diagnose(ws, report)
@@ -379,6 +386,21 @@ def build_report(ws: Workspace) -> dict[str, Any]:
     from .render import anchor, problem_items
     report["problems"] = group_problems(report, problem_items(report), anchor)
     return report
+
+
+def involved_model(sc: Mapping[str, Any]) -> Mapping[str, Any]:
+    """``sc`` (a side-condition row of the calculus) with its Z3 ``model``
+    (``{"Node.in.x": value}``) cut to the nodes its conjunct involves: the
+    consumer and the producers of its ``links`` (``"P.out.v -> C.in.w
+    (...)"``).  The query holds every producer of the consumer (the drone's
+    Geofence with the battery mismatch), whose values say nothing about
+    this conjunct.  Unchanged without a model or links."""
+    model = sc.get("model")
+    nodes = {str(sc.get("node", ""))} | {str(l).split(".", 1)[0] for l in sc.get("links") or ()}
+    if not isinstance(model, dict) or not sc.get("links"):
+        return sc
+    kept = {k: v for k, v in model.items() if str(k).split(".", 1)[0] in nodes}
+    return {**sc, "model": kept} if kept and len(kept) < len(model) else sc
 
 
 #: The fields of a requirement's check record (requirements/check.py) the report carries.
@@ -414,15 +436,20 @@ def requirement_check(record: Mapping[str, Any] | None, traced_status: str, g_st
 
 
 def _headline(ob_rows: list[dict[str, Any]], counts: dict[str, int], side_conditions: list[dict[str, Any]],
-              findings: list[dict[str, Any]]) -> str:
+              findings: list[dict[str, Any]], unverified: Sequence[Mapping[str, Any]] = ()) -> str:
     """The one-line summary, without empty fragments: a kind with nothing
-    in it is said in words ("no obligations"), never as "0 obligations: ;"."""
+    in it is said in words ("no obligations"), never as "0 obligations: ;".
+    Guarantees no obligation covers (``unverified``) are counted after the
+    obligations: "5 obligations: 5 discharged" alone would read as all done."""
     parts = []
     if ob_rows:
         parts.append(f"{len(ob_rows)} obligation{'s' if len(ob_rows) != 1 else ''}: "
                      + ", ".join(f"{counts[s]} {s}" for s in sorted(counts, key=lambda x: SEVERITY.get(x, 99))))
     else:
         parts.append("no obligations")
+    if unverified:
+        parts.append(f"{len(unverified)} guarantee{'s' if len(unverified) != 1 else ''} unverified "
+                     "(no obligation covers " + ("it" if len(unverified) == 1 else "them") + ")")
     if side_conditions:
         parts.append(f"{sum(1 for sc in side_conditions if sc['status'] == 'discharged')}/{len(side_conditions)} "
                      "side conditions discharged")

@@ -26,6 +26,7 @@ from . import layoutcache
 _NODE_COLOURS: Mapping[str, tuple[str, str]] = {
     "discharged": ("#dafbe1", "#1a7f37"),
     "pending": ("#eaeef2", "#6e7781"),
+    "unverified": ("#fff1e5", "#bc4c00"),
     "inconclusive": ("#fff8c5", "#9a6700"),
     "stale": ("#fbefff", "#8250df"),
     "error": ("#ffebe9", "#82071e"),

@@ -16,6 +16,10 @@ nothing itself.  Layout (decisions in ``docs/ci.md``):
   ``stale`` (the evidence no longer vouches for the current inputs);
   ``error`` is an ``<error>``; ``pending`` and ``inconclusive`` are
   ``<skipped>`` with the reason;
+* one ``<testcase>`` per guarantee no obligation covers (``classname``
+  ``<Node>.guarantee``, name ``<Node>.g<k>``, at the guarantee): a
+  ``<failure>`` of type ``unverified`` with the reason (nothing was planned
+  to establish it, and ``--strict`` fails on it; report/unverified.py);
 * after the nodes, when the plan has requirements, one ``<testsuite>``
   named ``requirements`` with one ``<testcase>`` per requirement
   (``classname`` ``requirement``, name its id, at its formal statement):
@@ -141,6 +145,8 @@ def _suite_data(report: Mapping[str, Any]) -> list[tuple[Mapping[str, Any], dict
     for kind in ("obligations", "side_conditions", "findings"):
         for item in report[kind]:
             by_node.setdefault(item["node"], {}).setdefault(kind, []).append(item)
+    for u in report.get("unverified") or ():
+        by_node.setdefault(u["node"], {}).setdefault("unverified", []).append(u)
     out = []
     for node in report["nodes"]:
         items = by_node.get(str(node["name"]), {})
@@ -190,6 +196,11 @@ def _suite(node: Mapping[str, Any], data: Mapping[str, Any]) -> tuple[ET.Element
         tally(case, str(f["status"]), str(f["message"]),
               _lines(str(f["message"]), str(f.get("explanation") or ""), f"unsat core: {core}" if core else "",
                      f"counterexample: {model}" if model else ""), f.get("duration_s"))
+    for u in items.get("unverified", ()):
+        case = _case(suite, f"{name}.guarantee", str(u["id"]), str(u["source"]), 0.0)
+        tally(case, str(u["status"]), f"unverified: {u['reason']}",
+              _lines(f"guarantee {u['guarantee']} of {name}: {u['text']}", f"source: {u['source']}",
+                     f"unverified: {u['reason']}"), 0.0)
     for k, v in counts.items():
         suite.set(k, str(v))
     suite.set("time", f"{time:.3f}")

@@ -22,12 +22,22 @@ its diagnosis record (:mod:`rclverify.diagnosis.build`, ``culprits``):
    refuted Hoare triple the program's constants remain);
 3. a culprit guarantee that is itself the victim of a vacuity or
    inconsistency problem of contract health stands for that problem's root
-   culprits: the contract defect explains what is found on top of it (the
+   culprits (except for a failed side condition, whose culprits are the
+   ones Z3 showed for it: it is its own root unless those name another): the contract defect explains what is found on top of it (the
    property test of a vacuous guarantee, a requirement proved vacuously
    because of it); when any culprit is explained so, the explained ones make
    the key.
 
-Problems with the same key are one group; a problem with no culprit at all
+4. the guarantees of one node that no obligation covers (``unverified``,
+   :mod:`rclverify.report.unverified`) are one group of their own, keyed
+   ``unverified:<Node>``, each guarantee a finding and a culprit at its
+   location; a contract defect never absorbs them.
+
+The culprits a diagnosis record names are the ones Z3 showed
+(:mod:`rclverify.diagnosis.blame`): strengthening each alone removes the
+counterexample, so unrelated bugs that only mention the same variable do
+not share a key.  Findings are named fully (a derived property is
+``<Node>.derived``).  Problems with the same key are one group; a problem with no culprit at all
 (a refinement that fails, a lint error) is its own group.  A derived
 property that is not derived joins the group of the side conditions of its
 cone that are not discharged (the reason it is not derived).  Requirements
@@ -141,6 +151,7 @@ def group_problems(report: Mapping[str, Any], items: Sequence[Mapping[str, Any]]
          "sentence": the first sentence (first_sentence) of the diagnosis of a member with
                      the worst status: the most telling kind (_TELLING), then the shortest,
          "culprits": [{"id", "what", "source", "file", "anchor" (fragment id or "")}],
+         "where": file:line:col of the first member that has one (shown when no culprit is named),
          "members": [{"id", "kind", "status", "sentence", "anchor", "diagnosis": bool}],
          "repairs": [{"diagnosis": id, "index": n}]  (distinct diffs, each checked by Z3)}
 
@@ -164,8 +175,9 @@ def group_problems(report: Mapping[str, Any], items: Sequence[Mapping[str, Any]]
         if d["kind"] in _CONTRACT_DEFECTS and victim and roots and victim not in roots:
             explains.setdefault(victim, [])
             explains[victim] += [r for r in roots if r not in explains[victim]]
+    diagnosed = {str(d["id"]) for d in diagnoses}
     for q in report.get("requirements", []):
-        if q.get("verdict") not in BAD_VERDICTS:
+        if q.get("verdict") not in BAD_VERDICTS or str(q["id"]) in diagnosed:
             continue
         check = q.get("check") or {}
         core = [*(check.get("vacuity_core") or []), *(check.get("inconsistent_core") or []),
@@ -177,17 +189,27 @@ def group_problems(report: Mapping[str, Any], items: Sequence[Mapping[str, Any]]
                          "anchor": anchor("req", q["id"]), "diagnosis": False}, roots))
     covered = {m["id"] for m, _ in members}
     obligation = {str(o["id"]): o for o in report.get("obligations", [])}
+    unverified = {str(u["id"]): u for u in report.get("unverified") or ()}
     roots_of = {m["id"]: roots for m, roots in members}
     for it in items:
         ref = str(it["ref"])
         if ref in covered:
             continue
+        if it["kind"] == "guarantee":  # unverified: no obligation covers it (rule 4 of the module docstring)
+            u = unverified.get(ref)
+            members.append(({"id": ref, "kind": "unverified guarantee", "status": str(it["status"]),
+                             "sentence": f"Guarantee {ref} is unverified: {u['reason'] if u else it['message']}.",
+                             "anchor": str(it["anchor"]), "diagnosis": False},
+                            [f"unverified:{u['node'] if u else ref}"]))
+            covered.add(ref)
+            continue
         o = obligation.get(ref)
         roots = [f"guarantee:{o['node']}:{o['guarantee']}"] if o is not None and o.get("guarantee") else []
         roots = [r for r in roots if r in places.info]
         if it["kind"] == "derived property":
+            ref = f"{ref}.derived"  # named fully: the derived property of the node, never the bare node name
             # not derived because a side condition of its cone is not discharged: that side condition's cause
-            for sc in _cone_side_conditions(report, ref):
+            for sc in _cone_side_conditions(report, str(it["ref"])):
                 roots += [r for r in (roots_of.get(sc) or [f"problem:{sc}"]) if r not in roots]
         roots_of[ref] = roots
         members.append(({"id": ref, "kind": str(it["kind"]), "status": str(it["status"]),
@@ -197,7 +219,10 @@ def group_problems(report: Mapping[str, Any], items: Sequence[Mapping[str, Any]]
 
     groups: dict[tuple[str, ...], dict[str, Any]] = {}
     for m, roots in members:
-        explained = [e for r in roots for e in explains.get(r, [])]
+        # an unverified guarantee stays a row of its own, even when a contract defect explains the guarantee;
+        # so does a failed side condition: its culprits are the ones Z3 showed for it (diagnosis/blame.py)
+        explained = ([] if m["kind"] in ("unverified guarantee", "side-condition")
+                     else [e for r in roots for e in explains.get(r, [])])
         if explained:
             roots = list(dict.fromkeys(explained))
         key = tuple(sorted(roots)) if roots else (f"problem:{m['id']}",)
@@ -209,8 +234,24 @@ def group_problems(report: Mapping[str, Any], items: Sequence[Mapping[str, Any]]
         g["members"].append(m)
         if _severity(m["status"]) > _severity(g["status"]):
             g["status"] = m["status"]
+    for key, g in groups.items():  # a node's unverified guarantees: each one a culprit at its location
+        if key[0].startswith("unverified:"):
+            node = key[0].split(":", 1)[1]
+            ids = [m["id"] for m in g["members"]]
+            g["culprits"] = [_culprit(f"guarantee:{u['node']}:{u['guarantee']}", places, anchor)
+                             for u in (unverified.get(i) for i in ids) if u is not None
+                             and f"guarantee:{u['node']}:{u['guarantee']}" in places.info]
+            first = unverified.get(ids[0])
+            if len(ids) > 1 and first is not None:
+                g["sentence"] = first_sentence(f"{len(ids)} guarantees of {node} are unverified "
+                                               f"({', '.join(ids)}): {first['reason'].replace('covers it', 'covers them')}.")
+    where = _sources(report)
+    for g in groups.values():  # where the problem is, for a row that names no culprit
+        g["where"] = next((where[m["id"]] for m in g["members"] if where.get(m["id"])), "")
     by_id = {str(d["id"]): d for d in diagnoses}
     for g in groups.values():
+        if g["key"][0].startswith("unverified:"):
+            continue
         # the row's sentence: from the diagnosis that says most about the cause (_TELLING), the shortest
         worst = [m for m in g["members"] if _severity(m["status"]) == _severity(g["status"])]
         told = [m for m in worst if m["diagnosis"]] or worst
@@ -257,6 +298,32 @@ def _cone_side_conditions(report: Mapping[str, Any], node: str) -> list[str]:
                 todo.append(u)
     return [str(sc["id"]) for sc in report.get("side_conditions", [])
             if str(sc["node"]) in cone and sc["status"] != "discharged"]
+
+
+def _sources(report: Mapping[str, Any]) -> dict[str, str]:
+    """``{problem id: file:line:col}`` of the report's items: a side
+    condition's conjunct, an obligation's clause, a health finding's
+    guarantee (else its node), a requirement's statement, a derived
+    property's node (``Node.derived``), a lint error's location."""
+    out: dict[str, str] = {}
+    node_src = {str(n["name"]): str(n.get("source", "")) for n in report.get("nodes", [])}
+    g_src = {(str(n["name"]), g["index"]): str(g.get("source", "")) for n in report.get("nodes", [])
+             for g in n.get("guarantees", [])}
+    for sc in report.get("side_conditions", []):
+        out[str(sc["id"])] = str(sc.get("source", ""))
+    for o in report.get("obligations", []):
+        out[str(o["id"])] = str(o.get("source", ""))
+    for f in report.get("findings", []):
+        out[str(f["id"])] = g_src.get((str(f["node"]), f.get("guarantee")), node_src.get(str(f["node"]), ""))
+    for q in report.get("requirements", []):
+        out[str(q["id"])] = str((q.get("check") or {}).get("source") or "")
+    for d in report.get("derived_properties", []):
+        out[f"{d['node']}.derived"] = node_src.get(str(d["node"]), "")
+    for x in report.get("lint", []):
+        out[str(x["location"])] = str(x["location"])
+    for u in report.get("unverified") or ():
+        out[str(u["id"])] = str(u["source"])
+    return out
 
 
 def _default_anchor(d: Mapping[str, Any], anchor: Callable[..., str]) -> str:

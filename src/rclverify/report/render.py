@@ -47,6 +47,7 @@ REPORT_KEYS: tuple[str, ...] = (
 STATUS_STYLE: Mapping[str, str] = {
     "discharged": "discharged",
     "pending": "pending",
+    "unverified": "unverified",
     "inconclusive": "inconclusive",
     "stale": "stale",
     "error": "error",
@@ -66,14 +67,16 @@ STATUS_STYLE: Mapping[str, str] = {
 #: Severity of a status word for ordering the attention list (larger is
 #: worse).  A word outside the vocabulary ranks as an error: the report cannot
 #: vouch for what it does not understand.
-_RANK: Mapping[str, int] = {**SEVERITY, "ok": 0, "proved": 0, "problem": 5, "refuted": 5, "unknown": 2,
-                            "derived": 0, "not derived": 5, "undecided": 2, "warning": 1}
+_RANK: Mapping[str, int] = {**SEVERITY, "ok": 0, "proved": 0, "problem": SEVERITY["failed"],
+                            "refuted": SEVERITY["failed"], "unknown": SEVERITY["inconclusive"], "derived": 0,
+                            "not derived": SEVERITY["failed"], "undecided": SEVERITY["inconclusive"], "warning": 1}
 _UNKNOWN_RANK = SEVERITY["error"]
 
 #: Marker shown in Markdown next to a status (no colours there).
 _MD_MARK: Mapping[str, str] = {
     "discharged": "\u2705",
     "pending": "\u23f3",
+    "unverified": "\u2754",
     "inconclusive": "\u26a0\ufe0f",
     "stale": "\U0001f7e3",
     "error": "\u26d4",
@@ -85,7 +88,7 @@ _COUNT_ORDER = sorted(SEVERITY, key=lambda s: -SEVERITY[s])
 
 
 def rank(status: str) -> int:
-    """Severity of ``status`` (0 = fine ... 5 = failed/problem)."""
+    """Severity of ``status`` (0 = fine ... ``SEVERITY["failed"]`` = failed/problem)."""
     return _RANK.get(status, _UNKNOWN_RANK)
 
 
@@ -378,6 +381,9 @@ def _attention(report: Mapping[str, Any], ev_anchor: Sequence[str]) -> tuple[lis
         if o["id"] not in evidenced and rank(o["status"]) > 0:
             add(o["status"], "obligation", o["id"], anchor("ob", o["id"]), str(o["backend"]),
                 "No evidence record for this obligation.")
+    for u in report.get("unverified") or ():  # a guarantee no obligation covers (report/unverified.py)
+        add(str(u["status"]), "guarantee", str(u["id"]), anchor("g", u["node"], u["guarantee"]), str(u["source"]),
+            f"Unverified: {u['reason']}.")
     for sc in report["side_conditions"]:
         if rank(sc["status"]) > 0:
             add(sc["status"], "side condition", sc["id"], anchor("sc", sc["id"]),
@@ -398,7 +404,7 @@ def _attention(report: Mapping[str, Any], ev_anchor: Sequence[str]) -> tuple[lis
             add("error", "lint", str(lint["location"]), anchor("lint", k + 1), str(lint["location"]),
                 str(lint["message"]))
 
-    kind_order = {"evidence": 0, "obligation": 1, "side condition": 2, "derived property": 4, "lint": 5}
+    kind_order = {"evidence": 0, "obligation": 1, "guarantee": 1, "side condition": 2, "derived property": 4, "lint": 5}
     items.sort(key=lambda it: (-rank(it["status"]), kind_order.get(it["kind"], 3), it["kind"], it["ref"]))
     problems = [it for it in items if rank(it["status"]) > SEVERITY["pending"]]
     outstanding = [it for it in items if rank(it["status"]) <= SEVERITY["pending"]]
@@ -476,6 +482,8 @@ def dashboard(report: Mapping[str, Any], evidence_of: Mapping[str, Sequence[tupl
     discharged, :data:`rclverify.evidence.records.SEVERITY`): for a backend,
     the statuses of the node's obligations of that backend (an obligation's
     status is that of its evidence, pending when it has none); for
+    ``no evidence`` (only when there is one), the node's guarantees no
+    obligation covers (``unverified``); for
     ``health``, the node's contract health checks (ok counts as
     discharged, a problem as failed, unknown as inconclusive); for ``side
     conditions``, the side conditions the node's assumptions give rise to.
@@ -496,7 +504,10 @@ def dashboard(report: Mapping[str, Any], evidence_of: Mapping[str, Sequence[tupl
                                                   anchor("finding", f["id"])))
     for sc in report["side_conditions"]:
         items[(str(sc["node"]), "side conditions")].append((str(sc["status"]), anchor("sc", sc["id"])))
-    extra = sorted({b for _, b in items} - set(TECHNIQUES))
+    for u in report.get("unverified") or ():  # no obligation at all: a column of its own, after the techniques
+        items[(str(u["node"]), "no evidence")].append((str(u["status"]), anchor("g", u["node"], u["guarantee"])))
+    extra = sorted({b for _, b in items} - set(TECHNIQUES) - {"no evidence"})
+    extra += ["no evidence"] if any(b == "no evidence" for _, b in items) else []
     columns = [*TECHNIQUES, *extra]
     rows = []
     for n in report["nodes"]:

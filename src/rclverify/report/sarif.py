@@ -9,6 +9,8 @@ One ``result`` per item that needs attention:
 * an obligation whose status is ``failed``, ``error``, ``stale``,
   ``inconclusive`` or ``pending`` (a discharged one gives none);
 * a side condition of the calculus that is not ``discharged``;
+* a guarantee no obligation covers (``unverified``, rule
+  ``RCL-GUARANTEE-UNVERIFIED``, at the guarantee);
 * a contract health finding whose status is ``problem`` or ``inconclusive``;
 * a lint warning.
 
@@ -59,6 +61,9 @@ RULES: Mapping[str, Rule] = {r.id: r for r in (
          "The backend could not decide the obligation (unknown, timeout or bounded search)."),
     Rule("RCL-OBL-PENDING", "ObligationPending", "note",
          "The obligation has no evidence yet (the backend cannot run here or is not implemented)."),
+    Rule("RCL-GUARANTEE-UNVERIFIED", "GuaranteeUnverified", "warning",
+         "No obligation covers the guarantee: no evidence entry of the plan exports one for it, so nothing "
+         "establishes it."),
     Rule("RCL-SC-REFUTED", "SideConditionRefuted", "error",
          "Z3 refuted a side condition of the composition calculus: the producers' guarantees do not entail "
          "this conjunct of the consumer's assumption."),
@@ -173,6 +178,15 @@ def _obligation_results(report: Mapping[str, Any]) -> list[dict[str, Any]]:
             props["counterexample"] = dict(ev["counterexample"])
         out.append(_result(rule, RULES[rule].level, " ".join(words), str(o["source"]), f"obligation:{o['id']}", props))
     return out
+
+
+def _unverified_results(report: Mapping[str, Any]) -> list[dict[str, Any]]:
+    """One result per guarantee no obligation covers, at the guarantee (report/unverified.py)."""
+    rule = RULES["RCL-GUARANTEE-UNVERIFIED"]
+    return [_result(rule.id, rule.level, f"Guarantee {u['guarantee']} of {u['node']} is unverified: {u['reason']}. "
+                    f"The guarantee: {u['text']}", str(u["source"]), f"guarantee:{u['id']}",
+                    {"guarantee": u["id"], "node": u["node"], "status": u["status"]})
+            for u in report.get("unverified") or ()]
 
 
 def _side_condition_results(report: Mapping[str, Any]) -> list[dict[str, Any]]:
@@ -325,7 +339,7 @@ def sarif_log(report: Mapping[str, Any]) -> dict[str, Any]:
     """
     lint, lint_rules = _lint_results(report)
     ground, ground_rules = _grounding_results(report)
-    results = (_obligation_results(report) + _side_condition_results(report) + _finding_results(report) + lint + ground
+    results = (_obligation_results(report) + _unverified_results(report) + _side_condition_results(report) + _finding_results(report) + lint + ground
                + _requirement_results(report))
     _attach_diagnoses(report, results)
     rules: Sequence[Rule] = list(RULES.values()) + lint_rules + ground_rules

@@ -19,8 +19,8 @@ from ..evidence.records import SEVERITY
 #: At most this many node rows (worst first); the rest are summed in one row.
 MAX_ROWS = 15
 
-_COLOUR = {"discharged": "green", "pending": "yellow", "inconclusive": "yellow", "stale": "magenta",
-           "error": "red", "failed": "red"}
+_COLOUR = {"discharged": "green", "pending": "yellow", "unverified": "dark_orange", "inconclusive": "yellow",
+           "stale": "magenta", "error": "red", "failed": "red"}
 
 
 def _rank(status: str) -> int:
@@ -30,7 +30,8 @@ def _rank(status: str) -> int:
 def node_rows(report: Mapping[str, Any]) -> list[dict[str, Any]]:
     """One row per node of ``report``: ``{"node", "status", "obligations"
     (status -> count), "sc_proved", "sc_total", "health_problems",
-    "health_open", "health_total"}``, worst status first, then report order."""
+    "health_open", "health_total", "unverified" (``["g<k>"]``: the node's
+    guarantees no obligation covers)}``, worst status first, then report order."""
     def by_node(items: list[Mapping[str, Any]]) -> dict[Any, list[Mapping[str, Any]]]:
         # one pass per kind: a scan of every item per node was quadratic in the system size
         out: dict[Any, list[Mapping[str, Any]]] = {}
@@ -38,6 +39,7 @@ def node_rows(report: Mapping[str, Any]) -> list[dict[str, Any]]:
             out.setdefault(it["node"], []).append(it)
         return out
     obligations, sides, findings = (by_node(report[k]) for k in ("obligations", "side_conditions", "findings"))
+    unverified = by_node(list(report.get("unverified") or ()))
     rows = []
     for k, n in enumerate(report["nodes"]):
         name = n["name"]
@@ -49,7 +51,8 @@ def node_rows(report: Mapping[str, Any]) -> list[dict[str, Any]]:
         rows.append({"node": name, "status": n["status"], "obligations": obs, "order": k,
                      "sc_proved": sum(sc["status"] == "discharged" for sc in scs), "sc_total": len(scs),
                      "health_problems": sum(f["status"] in ("problem", "error") for f in fs),
-                     "health_open": sum(f["status"] == "inconclusive" for f in fs), "health_total": len(fs)})
+                     "health_open": sum(f["status"] == "inconclusive" for f in fs), "health_total": len(fs),
+                     "unverified": [f"g{u['guarantee']}" for u in unverified.get(name, [])]})
     rows.sort(key=lambda r: (-_rank(r["status"]), r["order"]))
     return rows
 
@@ -80,6 +83,7 @@ def _merge(rows: list[dict[str, Any]], label: str) -> dict[str, Any]:
                            "obligations": {}}
     for key in ("sc_proved", "sc_total", "health_problems", "health_open", "health_total"):
         out[key] = sum(r[key] for r in rows)
+    out["unverified"] = [f"{r['node']}.{g}" for r in rows for g in r.get("unverified", [])]
     for r in rows:
         for s, c in r["obligations"].items():
             out["obligations"][s] = out["obligations"].get(s, 0) + c
@@ -103,9 +107,10 @@ def summary_data(report: Mapping[str, Any]) -> dict[str, Any]:
     kilobytes instead of the whole JSON report (6 MB at 1000 nodes)."""
     return {"meta": {"workspace": report["meta"]["workspace"], "strict_ok": report["meta"]["strict_ok"]},
             "summary": report["summary"], "rows": node_rows(report),
+            "unverified": [str(u["id"]) for u in report.get("unverified") or ()],
             "requirements": [[r["id"], r.get("verdict", ""), r["status"]] for r in report.get("requirements", ())],
             "problems": [{"status": g["status"], "sentence": group_sentence(g),
-                          "culprits": [_culprit(c) for c in g.get("culprits", [])],
+                          "culprits": [_culprit(c) for c in g.get("culprits", [])], "where": g.get("where", ""),
                           "members": [m["id"] for m in g.get("members", [])], "repairs": len(g.get("repairs", []))}
                          for g in report.get("problems", ())],
             "grounding": _grounding(report.get("grounding")), "strict": strict_reasons(report)}
@@ -223,12 +228,20 @@ def summary_table(report: Mapping[str, Any], colour: bool, rows: list[dict[str, 
     total = _merge(rows, "total")
     cols = [("node", total["node"]), ("status", total["status"]), ("obligations", _counts(total["obligations"], colour)),
             ("side conditions", f"{total['sc_proved']}/{total['sc_total']} proved"), ("health", _health(total))]
+    # guarantees no obligation covers: a column only when there are any (report/unverified.py)
+    gaps = bool(total["unverified"])
+    if gaps:
+        cols.append(("unverified", f"{len(total['unverified'])} guarantee{'s' if len(total['unverified']) != 1 else ''}"))
     for head, foot in cols:
         table.add_column(head, footer=foot, overflow="fold", no_wrap=head in ("node", "status"))
     for r in shown:
         st = f"[{_COLOUR.get(r['status'], 'red')}]{r['status']}[/]" if colour else r["status"]
-        table.add_row(r["node"], st, _counts(r["obligations"], colour),
-                      f"{r['sc_proved']}/{r['sc_total']} proved" if r["sc_total"] else "-", _health(r))
+        cells = [r["node"], st, _counts(r["obligations"], colour),
+                 f"{r['sc_proved']}/{r['sc_total']} proved" if r["sc_total"] else "-", _health(r)]
+        if gaps:
+            own = r.get("unverified", [])
+            cells.append(", ".join(own) if 0 < len(own) <= 4 else f"{len(own)} guarantees" if own else "-")
+        table.add_row(*cells)
     return table
 
 

@@ -1,0 +1,179 @@
+"""Culprits Z3 has shown: a guarantee is named as the cause of a problem
+only when strengthening that guarantee alone removes the counterexample.
+
+A side condition ``G_p => c`` fails with a counterexample; a requirement is
+refuted with one.  Naming every guarantee that mentions the variables
+involved blames bystanders: a guarantee whose premise never fires (the
+vacuous ``in.voltage > 30 -> out.battery == 0``) or a node that only passes
+a value on (``out.altitude <= in.target_altitude``) while the gap is another
+node's bound.  Here each candidate is strengthened on its own, the edited
+contracts are checked again by the pipeline's own checks, and the candidate
+is a culprit only when the problem is gone (docs/diagnosis.md, "Who is
+named"):
+
+* side condition: the candidate's *conclusion* gets the consumer's conjunct
+  (in the producer's output names): ``P -> Q`` becomes ``P -> (Q) and (c)``,
+  an unconditional ``Q`` becomes ``(Q) and (c)``; a culprit when Z3 then
+  discharges the side condition (:func:`side_condition_culprits`);
+* refuted requirement: a numeric bound of a guarantee of the cone is
+  replaced by a constant of the requirement's statement (the bound that
+  lets the counterexample through); a culprit when Z3 then proves the
+  requirement from consistent premises, non-vacuously.  When no bound does
+  it, a guarantee of a node the statement mentions gets the statement (in
+  that node's names) added to its conclusion, as above
+  (:func:`requirement_culprits`).
+
+Every check is made on an edited copy of the contract text
+(:func:`rclverify.diagnosis.recheck.edited_system`); nothing is written.
+"""
+from __future__ import annotations
+
+import re
+from collections.abc import Mapping, Sequence
+from typing import Any
+
+from ..logic import world
+from ..rcl import ast
+from ..rcl.printer import expr_to_rcl
+from . import recheck
+from .edits import Edit
+from .repairs import _link_pairs, _numbers, _peel, _rename
+
+#: Most edited systems checked per problem (each costs a parse, a type check and a Z3 query).
+MAX_TRIALS = 24
+
+
+def _span(e: Any) -> tuple[int, int, int, int] | None:
+    loc = getattr(e, "loc", None)
+    if loc is None or not loc.line:
+        return None
+    if loc.end_line:
+        return loc.line, loc.col, loc.end_line, loc.end_col
+    if isinstance(e, ast.NumLit):
+        return loc.line, loc.col, loc.line, loc.col + len(e.text)
+    return None
+
+
+def conclusion_edit(ws: Any, node: str, k: int, extra: str) -> Edit | None:
+    """The edit adding ``extra`` (RCL text in ``node``'s names) to the
+    conclusion of guarantee ``k`` of ``node`` (the right side of its
+    top-level ``->`` under its ``forall``s, else the whole body); ``None``
+    when the clause has no exact location."""
+    g = ws.checked.nodes[node].node.guarantees[k - 1]
+    _, body = _peel(g.formula)
+    target = body.right if isinstance(body, ast.Binary) and body.op == "->" else body
+    span = _span(target)
+    if span is None:
+        return None
+    probe = Edit(g.loc.file, *span, "")
+    old = probe.deleted(recheck.source_text(ws, g.loc.file))
+    return Edit(g.loc.file, *span, f"({old}) and ({extra})")
+
+
+def side_condition_culprits(ws: Any, sc: Mapping[str, Any]) -> tuple[list[tuple[str, int]], int]:
+    """``([(producer, guarantee index)], undecided)`` of the failed side
+    condition ``sc`` (a report row with ``id``, ``node``, ``conjunct``,
+    ``links``): the producer guarantees on the linked outputs whose
+    conclusion, strengthened by the conjunct, makes Z3 discharge ``sc``
+    (module docstring), and how many candidates could not be decided (Z3
+    answered unknown, or the strengthened text does not type-check)."""
+    pairs = _link_pairs(sc)
+    to_producer = [(f"in.{iv}", f"out.{ov}") for _, ov, _, iv in pairs]
+    extra = _rename(str(sc["conjunct"]), to_producer)
+    out: list[tuple[str, int]] = []
+    trials = undecided = 0
+    for p in sorted({p for p, _, _, _ in pairs}):
+        outs = [ov for q, ov, _, _ in pairs if q == p]
+        for k, g in enumerate(ws.checked.nodes[p].node.guarantees, 1):
+            text = expr_to_rcl(g.formula)
+            if not any(re.search(rf"(?<![\w.])out\.{re.escape(ov)}(?!\w)", text) for ov in outs):
+                continue
+            if trials >= MAX_TRIALS:
+                return out, undecided + 1
+            trials += 1
+            edit = conclusion_edit(ws, p, k, extra)
+            system = recheck.edited_system(ws, edit) if edit is not None else None
+            if system is None:  # the conjunct does not read in the producer's names: nothing shown either way
+                undecided += 1
+                continue
+            status = recheck.side_conditions(*system, sc["node"]).get(str(sc["id"]))
+            if status == "discharged":
+                out.append((p, k))
+            elif status != "failed":
+                undecided += 1
+    return out, undecided
+
+
+def _proved(req: Any, system: Any, plan: Any) -> bool:
+    from ..requirements.check import check_requirement
+    world.fresh()
+    rec = check_requirement(req, system[0], system[1], plan, timeout_ms=5000, model_ms=2000)
+    return rec.get("verdict") == "proved" and rec.get("consistency") == "consistent" \
+        and rec.get("vacuity") != "vacuous"
+
+
+def requirement_culprits(ws: Any, req_id: str, cone: Sequence[str]) -> list[dict[str, Any]]:
+    """The guarantees of ``cone`` (node names) to blame for the refuted
+    requirement ``req_id`` (module docstring), each ``{"node", "guarantee",
+    "edit": Edit, "how": "bound" | "conclusion", "old", "new"}`` with the
+    strengthening Z3 checked.  ``[]`` when no single strengthening proves it."""
+    from ..plan.load import all_requirements
+    from ..requirements.check import formals_of
+    req = next((r for r in all_requirements(ws.plan) if r.id == req_id), None)
+    if req is None:
+        return []
+    formal, _ = formals_of(req, ws.checked)
+    if formal is None:
+        return []
+    consts = list(dict.fromkeys(n.text for n in _numbers(formal.expr)))
+    found: list[dict[str, Any]] = []
+    trials = 0
+    for n in cone:
+        for k, g in enumerate(ws.checked.nodes[n].node.guarantees, 1):
+            for lit in _numbers(g.formula):
+                span = _span(lit)
+                for c in consts:
+                    if span is None or c == lit.text or trials >= MAX_TRIALS:
+                        continue
+                    trials += 1
+                    edit = Edit(g.loc.file, *span, c)
+                    system = recheck.edited_system(ws, edit)
+                    if system is not None and _proved(req, system, ws.plan):
+                        found.append({"node": n, "guarantee": k, "edit": edit, "how": "bound",
+                                      "old": lit.text, "new": c})
+                        break
+    if found:
+        return found
+    # no bound: the statement itself, in the names of a node it mentions, added to that node's guarantees
+    mentioned = sorted({m[0] for m in formal.mentions})
+    if len(mentioned) != 1:
+        return []
+    n = mentioned[0]
+    extra = re.sub(rf"(?<![\w.]){re.escape(n)}\.(in|out)\.", r"\1.", " ".join(req.formal.text.split()))
+    for k, _g in enumerate(ws.checked.nodes[n].node.guarantees, 1):
+        if trials >= MAX_TRIALS:
+            break
+        trials += 1
+        edit = conclusion_edit(ws, n, k, extra)
+        system = recheck.edited_system(ws, edit) if edit is not None else None
+        if system is not None and _proved(req, system, ws.plan):
+            found.append({"node": n, "guarantee": k, "edit": edit, "how": "conclusion", "old": "", "new": extra})
+    return found
+
+
+def cost(ws: Any, report: Mapping[str, Any], node: str, edit: Edit) -> list[dict[str, str]]:
+    """What else changes status when ``edit`` strengthens a guarantee of
+    ``node``: the side conditions of the nodes it feeds and ``node``'s own
+    health checks, asked before and after the edit the same way
+    (:func:`rclverify.diagnosis.recheck.changes`)."""
+    system = recheck.edited_system(ws, edit)
+    if system is None:
+        return []
+    consumers = sorted({l.to_node for l in system[1].links if l.from_node == node})
+    after: dict[str, str] = {}
+    for n in consumers:
+        after.update(recheck.side_conditions(*system, n))
+    before = {str(sc["id"]): str(sc["status"]) for sc in report["side_conditions"] if str(sc["id"]) in after}
+    h_before = recheck.health(ws, ws.checked, node)
+    h_after = recheck.health(ws, system[0], node)
+    return recheck.changes({**before, **h_before}, {**after, **h_after})

@@ -1,0 +1,93 @@
+"""The diagnosis record of a refuted requirement (docs/diagnosis.md, "Who
+is named"): the guarantee whose bound lets Z3's counterexample through,
+found by :func:`rclverify.diagnosis.blame.requirement_culprits`, with the
+tightened bound as a checked repair."""
+from __future__ import annotations
+
+import re
+from collections.abc import Callable, Mapping
+from typing import Any
+
+from . import blame, recheck
+from .repairs import _record as _repair
+
+
+def requirement_record(ws: Any, report: Mapping[str, Any], q: Mapping[str, Any], cache: Any,
+                       guarantee_source: Callable[[Mapping[str, Any], str, int], tuple[str, str]]) -> dict[str, Any]:
+    """The diagnosis record (:mod:`rclverify.diagnosis.build`) of the refuted
+    requirement ``q`` (a report row): the guarantees Z3 showed a
+    strengthening of proves it (:func:`blame.requirement_culprits`), each
+    with that strengthening as a repair; the counterexample shown for the
+    nodes involved only (the nodes the statement mentions, the culprits'
+    nodes and the nodes between them).  ``cache`` keeps the culprits
+    (``build._Cache``); ``guarantee_source(report, node, k)`` gives a
+    guarantee's (text, source)."""
+    check = q.get("check") or {}
+    cone = [str(n) for n in check.get("cone") or []]
+
+    def find() -> list[dict[str, Any]]:
+        rows = []
+        for f in blame.requirement_culprits(ws, str(q["id"]), cone):
+            source = recheck.source_text(ws, f["edit"].file)
+            text, src = guarantee_source(report, f["node"], f["guarantee"])
+            what = f"guarantee {f['guarantee']} of {f['node']}"
+            if f["how"] == "bound":
+                summary = (f"Tighten the bound of {what} ({src}): {f['old']} becomes {f['new']}; Z3 proves "
+                           f"{q['id']} from consistent premises. {f['node']}'s evidence must then establish it.")
+            else:
+                summary = (f"Strengthen {what} ({src}) by `{f['new']}`; Z3 proves {q['id']} from consistent premises. "
+                           f"{f['node']}'s evidence must then establish it.")
+            rows.append({"node": f["node"], "guarantee": f["guarantee"], "how": f["how"], "old": f["old"],
+                         "new": f["new"], "text": text, "source": src,
+                         "repair": _repair("tighten-bound" if f["how"] == "bound" else "strengthen-guarantee",
+                                           summary, f["edit"], source,
+                                           [{"check": str(q["id"]), "status": "proved (Z3: unsat)"}],
+                                           blame.cost(ws, report, f["node"], f["edit"]))})
+        return rows
+    found = cache.get(["requirement", q["id"], check.get("formal"), cone], find) or []
+    cul = [{"what": f"guarantee {f['guarantee']} of {f['node']}: `{f['text']}`", "source": f["source"],
+            "text": f["text"]} for f in found]
+    mentioned = {str(r["node"]) for r in check.get("counterexample") or []
+                 if re.search(rf"(?<![\w.]){re.escape(str(r['node']))}\.(in|out)\.", str(check.get("formal") or ""))}
+    blamed = {str(f["node"]) for f in found}
+    involved = mentioned | blamed | _between(report, blamed, mentioned)
+    table = [{"node": r["node"], "variable": v, "value": x, "table": None}
+             for r in check.get("counterexample") or [] if not involved or str(r["node"]) in involved
+             for v, x in r["values"].items()]
+    cex = ", ".join(f"{r['node']}.{r['variable']} = {r['value']}" for r in table)
+    if found:
+        f = found[0]
+        how = (f"its bound {f['old']} lets the counterexample through; with {f['new']} Z3 proves {q['id']}"
+               if f["how"] == "bound" else f"strengthened by `{f['new']}` it lets Z3 prove {q['id']}")
+        sentence = (f"Requirement {q['id']} (`{check.get('formal')}`, {check.get('source')}) is refuted because of "
+                    f"guarantee {f['guarantee']} of {f['node']} ({f['source']}) `{f['text']}`: {how}"
+                    + (f". Z3's counterexample: {cex}" if cex else "") + ".")
+    else:
+        sentence = (f"Requirement {q['id']} (`{check.get('formal')}`, {check.get('source')}) is refuted: the guarantees "
+                    "of its cone allow a counterexample, and no single strengthening Z3 tried proves it"
+                    + (f". Z3's counterexample: {cex}" if cex else "") + ".")
+    return {"id": str(q["id"]), "kind": "requirement", "node": found[0]["node"] if found else "", "status": "failed",
+            "sentence": sentence, "culprits": cul, "counterexample": table,
+            "repairs": [f["repair"] for f in found], "guarantee": None}
+
+
+def _between(report: Mapping[str, Any], sources: set[str], sinks: set[str]) -> set[str]:
+    """The nodes on a path of the system's connections from a node of
+    ``sources`` to a node of ``sinks`` (both excluded)."""
+    down: dict[str, set[str]] = {}
+    for c in report.get("system", {}).get("connections", []):
+        down.setdefault(str(c["from_node"]), set()).add(str(c["to_node"]))
+    up: dict[str, set[str]] = {}
+    for a, bs in down.items():
+        for b in bs:
+            up.setdefault(b, set()).add(a)
+
+    def reach(start: set[str], edges: Mapping[str, set[str]]) -> set[str]:
+        seen, todo = set(start), list(start)
+        while todo:
+            for m in edges.get(todo.pop(), ()):
+                if m not in seen:
+                    seen.add(m)
+                    todo.append(m)
+        return seen
+    return (reach(sources, down) & reach(sinks, up)) - sources - sinks
