@@ -32,6 +32,8 @@ from ..cache.memo import last_call
 from . import diagram
 from .fragments import FragmentCache, cached_dumps
 from .problems import group_problems
+from . import htmlfilters
+from .textfmt import natural_key, natural_sorted, natural_within
 
 _T = TypeVar("_T")
 
@@ -298,6 +300,7 @@ def environment() -> jinja2.Environment:
         formula=formula_html, lines=formula_lines, wbr=breakable,
     )
     env.globals.update(anchor=anchor, rank=rank)
+    htmlfilters.register(env)  # prose, natsort, readable_svg, reqbadges, latex_frame
     return env
 
 
@@ -397,7 +400,7 @@ def _attention(report: Mapping[str, Any], ev_anchor: Sequence[str]) -> tuple[lis
                 str(lint["message"]))
 
     kind_order = {"evidence": 0, "obligation": 1, "side condition": 2, "derived property": 4, "lint": 5}
-    items.sort(key=lambda it: (-rank(it["status"]), kind_order.get(it["kind"], 3), it["kind"], it["ref"]))
+    items.sort(key=lambda it: (-rank(it["status"]), kind_order.get(it["kind"], 3), it["kind"], natural_key(it["ref"])))
     problems = [it for it in items if rank(it["status"]) > SEVERITY["pending"]]
     outstanding = [it for it in items if rank(it["status"]) <= SEVERITY["pending"]]
     return problems, outstanding
@@ -564,8 +567,8 @@ def view(report: Mapping[str, Any]) -> dict[str, Any]:
         trace.append({"req": req, "rows": rows, "rowspan": max(1, len(rows))})
 
     derived = _by(report["derived_properties"], "node")
-    sides = _by(report["side_conditions"], "node")
-    findings = _by(report["findings"], "node")
+    sides = _by(natural_sorted(report["side_conditions"], key=lambda sc: sc["id"]), "node")
+    findings = _by(natural_sorted(report["findings"], key=lambda f: f["id"]), "node")
     sections = []
     named = [str(n["name"]) for n in report["nodes"]]
     for n in report["nodes"]:
@@ -587,7 +590,7 @@ def view(report: Mapping[str, Any]) -> dict[str, Any]:
     problems, outstanding = _attention(report, ev_anchor)
     outstanding_groups = group_items(outstanding)
     pending_groups: dict[tuple[str, str], dict[str, Any]] = {}  # the same reason, numbers aside: one row
-    for p in report["pending"]:
+    for p in natural_sorted(report["pending"], key=lambda p: p["obligation"]):
         key = (str(p["backend"]), _NUMBERS.sub("#", str(p["reason"])))
         pending_groups.setdefault(key, {"backend": p["backend"], "reason": p["reason"], "items": []})["items"].append(p)
     unmet = [r for r in report["requirements"] if rank(r["status"]) > 0]
@@ -601,11 +604,13 @@ def view(report: Mapping[str, Any]) -> dict[str, Any]:
         "unmet_requirements": unmet, "ev_anchor": ev_anchor, "evidence_of": evidence_of,
         "obligation": obligation, "trace": trace, "sections": sections,
         "lint_errors": sum(1 for x in report["lint"] if str(x["severity"]).lower() == "error"),
-        "finding_runs": runs(report["findings"], lambda f: str(f["node"])),
+        "finding_runs": runs(natural_within(report["findings"], lambda f: str(f["node"]), lambda f: f["id"]),
+                             lambda f: str(f["node"])),
         "obligation_runs": runs([{"obligation": o, "evidence": [aid for aid, _ in evidence_of.get(str(o["id"]), [])]}
-                                 for o in report["obligations"]], lambda row: str(row["obligation"]["node"])),
-        "evidence_runs": runs([{"anchor": aid, "record": ev} for aid, ev in zip(ev_anchor, report["evidence"])],
-                              node_of_evidence),
+                                 for o in natural_within(report["obligations"], lambda o: str(o["node"]),
+                                                         lambda o: o["id"])], lambda row: str(row["obligation"]["node"])),
+        "evidence_runs": runs(natural_within([{"anchor": aid, "record": ev} for aid, ev in zip(ev_anchor, report["evidence"])],
+                                             node_of_evidence, lambda it: it["record"]["obligation"]), node_of_evidence),
     }
 
 
