@@ -33,7 +33,7 @@ from . import diagram
 from .fragments import FragmentCache, cached_dumps
 from .problems import group_problems
 from . import htmlfilters
-from .textfmt import natural_key, natural_sorted, natural_within
+from .textfmt import FOLD_CHARS, breakable, formula_html, formula_lines, natural_key, natural_sorted, natural_within
 
 _T = TypeVar("_T")
 
@@ -215,63 +215,6 @@ def model_text(model: Mapping[str, Any] | None) -> str:
     each value clipped (:func:`clip`); ``""`` for none.  For the one-line
     messages of SARIF and JUnit."""
     return ", ".join(f"{k} = {clip(v)}" for k, v in sorted((model or {}).items()))
-
-
-#: Formulas longer than this (characters) are folded in the HTML report: the
-#: first part shows, the whole formula opens below broken at its connectives.
-FOLD_CHARS = 140
-_CONNECTIVE = re.compile(r" (<->|->|and|or) |\| ")
-
-
-def formula_lines(text: Any) -> str:
-    """An RCL formula broken into lines before each connective (``and``,
-    ``or``, ``->``, ``<->``) and after a quantifier's ``|``, each line
-    indented by its bracket depth, so a long guarantee reads as its
-    structure.  The words are unchanged: joining the lines with single
-    spaces gives the text back (runs of whitespace aside)."""
-    s = _WS.sub(" ", str(text)).strip()
-    lines: list[str] = []
-    depth = line_depth = 0
-    start = i = 0
-    while i < len(s):
-        ch = s[i]
-        m = _CONNECTIVE.match(s, i) if ch in " |" else None
-        if m:
-            cut = i + 1 if ch == "|" else i  # '|' ends its line, a connective starts the next
-            lines.append("  " * line_depth + s[start:cut].strip())
-            start, line_depth = (m.end() if ch == "|" else i + 1), depth
-            i = m.end()
-            continue
-        if ch in "({[":
-            depth += 1
-        elif ch in ")}]":
-            depth = max(0, depth - 1)
-        i += 1
-    lines.append("  " * line_depth + s[start:].strip())
-    return "\n".join(line for line in lines if line.strip())
-
-
-_BREAK_AFTER = re.compile(r"([/._])")
-
-
-def breakable(text: Any) -> Markup:
-    """``text`` (an identifier or a path) escaped, with a line-break
-    opportunity (``<wbr>``) after each ``/``, ``.`` and ``_``, so a narrow
-    column breaks it between its parts, never inside a word."""
-    return Markup("<wbr>").join(escape(p) for p in re.split(r"(?<=[/._])", str(text)))
-
-
-def formula_html(text: Any, limit: int = FOLD_CHARS) -> Markup:
-    """A formula as HTML: ``<code>`` when at most ``limit`` characters, else
-    a ``<details>`` whose summary is its start and which opens to the whole
-    formula broken at its connectives (:func:`formula_lines`).  Text is
-    escaped."""
-    s = _WS.sub(" ", str(text)).strip()
-    if len(s) <= limit:
-        return Markup("<code>%s</code>") % s
-    cut = s[:limit].rsplit(" ", 1)[0] if " " in s[:limit] else s[:limit]
-    return Markup('<details class="formula"><summary><code>%s</code> &hellip;</summary>'
-                  '<pre class="formula">%s</pre></details>') % (cut, formula_lines(s))
 
 
 @lru_cache(maxsize=1)

@@ -1,4 +1,4 @@
-"""Text of the HTML report: prose with code spans, and ids in natural order.
+"""Text of the HTML report: prose with code spans, ids in natural order, formulas and ids broken well.
 
 The messages of the report dict (explanations, reasons, diagnosis
 sentences, repair summaries) are written once for every format and mark
@@ -9,6 +9,10 @@ Markdown report keeps the backticks; the HTML report shows each span as
 Ids are shown in natural order, their digit runs compared as numbers
 (``p1_i0 < p2_i1 < p10_i9``; :func:`natural_key`), wherever the HTML report
 lists them.
+
+RCL formulas are folded when long (:func:`formula_html`, broken at their
+connectives by :func:`formula_lines`); ids and paths may break only after
+``/ . _`` (:func:`breakable`).
 """
 from __future__ import annotations
 
@@ -17,11 +21,13 @@ from typing import Any, Callable, Iterable, Sequence, TypeVar
 
 from markupsafe import Markup, escape
 
-__all__ = ["natural_key", "natural_sorted", "natural_within", "prose"]
+__all__ = ["FOLD_CHARS", "breakable", "formula_html", "formula_lines", "natural_key", "natural_sorted",
+           "natural_within", "prose"]
 
 _T = TypeVar("_T")
 
 _DIGITS = re.compile(r"(\d+)")
+_WS = re.compile(r"\s*[\r\n]+\s*")
 
 
 def natural_key(text: Any) -> tuple[Any, ...]:
@@ -82,3 +88,60 @@ def prose(text: Any) -> Markup:
         pos = close.end()
     out.append(escape(s[pos:]))
     return Markup("").join(out)
+
+
+#: Formulas longer than this (characters) are folded in the HTML report: the
+#: first part shows, the whole formula opens below broken at its connectives.
+FOLD_CHARS = 140
+_CONNECTIVE = re.compile(r" (<->|->|and|or) |\| ")
+
+
+def formula_lines(text: Any) -> str:
+    """An RCL formula broken into lines before each connective (``and``,
+    ``or``, ``->``, ``<->``) and after a quantifier's ``|``, each line
+    indented by its bracket depth, so a long guarantee reads as its
+    structure.  The words are unchanged: joining the lines with single
+    spaces gives the text back (runs of whitespace aside)."""
+    s = _WS.sub(" ", str(text)).strip()
+    lines: list[str] = []
+    depth = line_depth = 0
+    start = i = 0
+    while i < len(s):
+        ch = s[i]
+        m = _CONNECTIVE.match(s, i) if ch in " |" else None
+        if m:
+            cut = i + 1 if ch == "|" else i  # '|' ends its line, a connective starts the next
+            lines.append("  " * line_depth + s[start:cut].strip())
+            start, line_depth = (m.end() if ch == "|" else i + 1), depth
+            i = m.end()
+            continue
+        if ch in "({[":
+            depth += 1
+        elif ch in ")}]":
+            depth = max(0, depth - 1)
+        i += 1
+    lines.append("  " * line_depth + s[start:].strip())
+    return "\n".join(line for line in lines if line.strip())
+
+
+_BREAK_AFTER = re.compile(r"([/._])")
+
+
+def breakable(text: Any) -> Markup:
+    """``text`` (an identifier or a path) escaped, with a line-break
+    opportunity (``<wbr>``) after each ``/``, ``.`` and ``_``, so a narrow
+    column breaks it between its parts, never inside a word."""
+    return Markup("<wbr>").join(escape(p) for p in re.split(r"(?<=[/._])", str(text)))
+
+
+def formula_html(text: Any, limit: int = FOLD_CHARS) -> Markup:
+    """A formula as HTML: ``<code>`` when at most ``limit`` characters, else
+    a ``<details>`` whose summary is its start and which opens to the whole
+    formula broken at its connectives (:func:`formula_lines`).  Text is
+    escaped."""
+    s = _WS.sub(" ", str(text)).strip()
+    if len(s) <= limit:
+        return Markup("<code>%s</code>") % s
+    cut = s[:limit].rsplit(" ", 1)[0] if " " in s[:limit] else s[:limit]
+    return Markup('<details class="formula"><summary><code>%s</code> &hellip;</summary>'
+                  '<pre class="formula">%s</pre></details>') % (cut, formula_lines(s))
