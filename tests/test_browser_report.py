@@ -10,7 +10,10 @@ The case study's report is rendered from its report dict
 when the report dict changes shape) and measured at 1400 px: at most
 31,600 px tall (40% of the 79,000 px of issue 24), the system diagram within
 the first two screens, every cell of the dashboard linked to an element
-that exists.
+that exists; and it reads well (issue 30, item 6): no backtick outside
+``<code>``/``<pre>``, every badge inside its cell, obligation ids in natural
+order, the diagrams' text at least 9 px, no word broken inside itself, the
+LaTeX appendix one document with one preamble and no ``<string>``.
 
 The screenshot goes to the test's temporary directory, and also to
 ``reports/screenshots/`` of the repository when the environment variable
@@ -36,6 +39,7 @@ from rclverify.pipeline import (
     stage_report,
 )
 from rclverify.report.render import render_files
+from rclverify.report.textfmt import natural_key
 
 REPO = Path(__file__).resolve().parents[1]
 #: Tallest the case study's HTML report may be at 1400 px (CSS px): 40% of the 79,000 px of issue 24.
@@ -168,3 +172,117 @@ def test_the_case_study_report_is_short_and_its_dashboard_links_resolve(tmp_path
     assert "contracts/remote_inspection.rcl:72:3" in text and "Agent.g2.non-vacuous" in text
     assert "Agent.g0.monitors.nominal_jsonl" in text
     _screenshot(driver, tmp_path, "assurance-case-study.png")
+
+
+#: Text nodes of the page (not in code, pre, script, style or a drawing) that hold a backtick.
+_STRAY_BACKTICKS = """
+    const out = [], w = document.createTreeWalker(document.body, NodeFilter.SHOW_TEXT);
+    for (let n; (n = w.nextNode());) {
+      if (n.data.includes('`') && !n.parentElement.closest('code, pre, script, style, svg')) out.push(n.data.trim());
+    }
+    return out;"""
+
+#: Badges shown that stick out of their table cell (CSS px, half a pixel allowed).
+_BADGES_OUTSIDE = """
+    const out = [];
+    for (const b of document.querySelectorAll('td .badge, th .badge')) {
+      const r = b.getBoundingClientRect();
+      if (!r.width) continue;  // not shown
+      const c = b.closest('td, th').getBoundingClientRect();
+      if (r.left < c.left - .5 || r.right > c.right + .5 || r.top < c.top - .5 || r.bottom > c.bottom + .5)
+        out.push(b.textContent + ' in ' + b.closest('tr').textContent.slice(0, 60));
+    }
+    return out;"""
+
+#: The smallest text of the drawings, in CSS px as shown: each label's font size times its scale on screen.
+_SMALLEST_DIAGRAM_TEXT = """
+    let least = Infinity, n = 0;
+    for (const t of document.querySelectorAll('.diagram svg text')) {
+      const m = t.getScreenCTM();
+      least = Math.min(least, parseFloat(getComputedStyle(t).fontSize) * Math.hypot(m.a, m.b)); n++;
+    }
+    return [least, n];"""
+
+#: Words shown on two lines broken inside themselves: a line ends inside a run of non-space characters of
+#: one text node after a character that is not a sensible break (- / . _ , and the like; <wbr> after . / _
+#: splits the text node, so a break there is between nodes).
+_BROKEN_WORDS = """
+    const ok = new Set(['-', '/', '.', '_', ',', '(', ')', '|', ':', ';', '=', '>', '<', '&', '+', '*']);
+    const out = [], w = document.createTreeWalker(document.body, NodeFilter.SHOW_TEXT);
+    for (let n; (n = w.nextNode());) {
+      const p = n.parentElement;
+      if (p.closest('pre, svg, script, style') || !p.getClientRects().length) continue;
+      for (const m of n.data.matchAll(/\\S{2,}/g)) {
+        const r = document.createRange();
+        r.setStart(n, m.index); r.setEnd(n, m.index + m[0].length);
+        if (Array.from(r.getClientRects()).filter(x => x.width > 0).length < 2) continue;
+        let top = null;
+        for (let i = 0; i < m[0].length; i++) {
+          r.setStart(n, m.index + i); r.setEnd(n, m.index + i + 1);
+          const cr = r.getClientRects();
+          if (!cr.length) continue;
+          if (top !== null && cr[0].top > top + 2 && !ok.has(m[0][i - 1])) {
+            out.push(m[0].slice(0, i) + '|' + m[0].slice(i)); break;
+          }
+          top = cr[0].top;
+        }
+      }
+    }
+    return out;"""
+
+
+def _case_study_page(tmp_path: Path, driver: Any) -> dict[str, Any]:
+    """Open the case study's report (rendered from the stored report dict); returns the dict."""
+    with gzip.open(REPO / "tests" / "data" / "case-study-report.json.gz", "rt", encoding="utf-8") as f:
+        report: dict[str, Any] = json.load(f)
+    report.pop("problems", None)
+    out = tmp_path / "reports"
+    out.mkdir()
+    render_files(report, out, ("assurance.html",))
+    driver.get((out / "assurance.html").as_uri())
+    return report
+
+
+def test_the_case_study_report_reads_well(tmp_path: Path, driver: Any) -> None:
+    report = _case_study_page(tmp_path, driver)
+    assert driver.execute_script(_STRAY_BACKTICKS) == []
+    assert driver.execute_script("return document.querySelectorAll('code').length") > 100
+    # the drawings' text is at least 9 px as shown at 1400 px (the argument scrolls in its box)
+    least, labels = driver.execute_script(_SMALLEST_DIAGRAM_TEXT)
+    print(f"smallest diagram text: {least:.1f} px of {labels} labels")
+    assert labels > 50 and least >= 9
+    # the obligations: one folded table per node, ids in natural order (p1_i0 < p2_i1 < p10_i9)
+    tables = driver.execute_script("""
+        return Array.from(document.querySelectorAll('details.obligations')).map(d => [d.open,
+          Array.from(d.querySelectorAll('tr[id] > td:first-child > code')).map(c => c.textContent)]);""")
+    assert len(tables) == len({o["node"] for o in report["obligations"]})
+    assert not any(is_open for is_open, _ in tables)
+    ids = [i for _, t in tables for i in t]
+    assert sorted(ids) == sorted(o["id"] for o in report["obligations"])
+    for _, t in tables:
+        assert t == sorted(t, key=natural_key)
+    agent = next(t for _, t in tables if "Agent.g1.ajpf.p1_i0" in t)
+    assert agent.index("Agent.g1.ajpf.p2_i1") < agent.index("Agent.g1.ajpf.p10_i9")
+    # a link to an obligation opens its node's table
+    driver.execute_script("document.querySelector('a[href=\"#ob-Agent.g1.ajpf.p10_i9\"]').click()")
+    assert driver.execute_script("return document.getElementById('ob-Agent.g1.ajpf.p10_i9')"
+                                 ".closest('details').open")
+    # the requirement proved vacuously is one warning badge; a proved one shows its evidence apart
+    row = driver.find_element("xpath", "//table[contains(@class,'requirements')]//tr[td/a[text()='REQ1']]")
+    assert [b.text for b in row.find_elements("css selector", ".badge")] == ["proved vacuously"]
+    row = driver.find_element("xpath", "//table[contains(@class,'requirements')]//tr[td/a[text()='REQ2']]")
+    assert [b.text for b in row.find_elements("css selector", ".badge")] == ["proved", "evidence: failed"]
+    # the LaTeX appendix is one document: one preamble, each node's block, one end; no <string>
+    appendix = driver.find_element("id", "appendix").get_attribute("textContent")
+    assert appendix.count("\\documentclass") == appendix.count("\\begin{document}") == 1
+    assert appendix.count("\\end{document}") == 1 and appendix.count("\\paragraph{") == len(report["nodes"])
+    assert "% node Agent (contracts/remote_inspection.rcl:" in appendix
+    assert "<string>" not in driver.execute_script("return document.body.textContent")
+    # with every fold open: no badge sticks out of its cell, no word is broken inside itself, no
+    # sideways scrolling of the page
+    driver.execute_script("document.querySelectorAll('details').forEach(d => d.open = true)")
+    assert driver.execute_script(_BADGES_OUTSIDE) == []
+    assert driver.execute_script(_BROKEN_WORDS) == []
+    assert driver.execute_script("return document.documentElement.scrollWidth <= window.innerWidth")
+    driver.execute_script("document.getElementById('argument').scrollIntoView()")
+    _screenshot(driver, tmp_path, "assurance-case-study-argument.png")

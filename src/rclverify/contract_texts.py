@@ -33,13 +33,14 @@ CACHE = "artifacts/cache/contract-texts.pickle"
 
 def node_texts(node: ast.Node) -> dict[str, Any]:
     """The texts of one node: ``{"rcl": the node as RCL (the snapshot's
-    text), "latex": its LaTeX, "inputs"/"outputs": [[name, type as RCL],
+    text), "latex": its LaTeX block (:func:`rclverify.rcl.latex.node_latex`:
+    no preamble, its real file name), "inputs"/"outputs": [[name, type as RCL],
     ...], "assumptions"/"guarantees": [[formula as RCL, "file:line:col"],
     ...]}`` (lists, in declaration order)."""
-    from .rcl.latex import to_latex
+    from .rcl.latex import node_latex
     from .rcl.printer import expr_to_rcl, to_rcl, type_to_rcl
     return {
-        "rcl": to_rcl(ast.Spec((), (node,))), "latex": to_latex(ast.Spec((), (node,))),
+        "rcl": to_rcl(ast.Spec((), (node,))), "latex": node_latex(node),
         "inputs": [[v.name, type_to_rcl(v.type)] for v in node.inputs],
         "outputs": [[v.name, type_to_rcl(v.type)] for v in node.outputs],
         "assumptions": [[expr_to_rcl(a.formula), str(a.loc)] for a in node.assumes],

@@ -36,6 +36,7 @@ import re
 from typing import Any, Mapping
 
 from .model import Argument, Element, propagate
+from ..report.textfmt import natural_key
 
 _FINDING_AS = {"ok": "discharged", "problem": "failed", "inconclusive": "inconclusive", "stale": "stale"}
 _ID_BAD = re.compile(r"[^A-Za-z0-9_.\-]+")
@@ -121,7 +122,8 @@ def build_argument(report: Mapping[str, Any]) -> Argument:
     :data:`rclverify.report.render.REPORT_KEYS`), statuses propagated.
 
     Returns an :class:`Argument` whose element order is deterministic
-    (requirements and nodes in report order, obligations sorted by id).
+    (requirements and nodes in report order, obligations in natural order
+    of their ids: ``p1_i0 < p2_i1 < p10_i9``).
     Raises ``KeyError`` for a missing report key and
     :class:`.model.ArgumentError` if the result were malformed.
     """
@@ -129,7 +131,7 @@ def build_argument(report: Mapping[str, Any]) -> Argument:
     meta = report["meta"]
     reqs = report["requirements"]
     ev_of = {str(e["obligation"]): e for e in report["evidence"]}
-    obligations = sorted(report["obligations"], key=lambda o: str(o["id"]))
+    obligations = sorted(report["obligations"], key=lambda o: natural_key(o["id"]))  # p1 < p2 < p10
     obligations_of: dict[str, list[Mapping[str, Any]]] = {}  # by node, still sorted by id
     for o in obligations:
         obligations_of.setdefault(str(o["node"]), []).append(o)

@@ -32,6 +32,8 @@ from ..cache.memo import last_call
 from . import diagram
 from .fragments import FragmentCache, cached_dumps
 from .problems import group_problems
+from . import htmlfilters
+from .textfmt import FOLD_CHARS, breakable, formula_html, formula_lines, natural_key, natural_sorted, natural_within
 
 _T = TypeVar("_T")
 
@@ -218,63 +220,6 @@ def model_text(model: Mapping[str, Any] | None) -> str:
     return ", ".join(f"{k} = {clip(v)}" for k, v in sorted((model or {}).items()))
 
 
-#: Formulas longer than this (characters) are folded in the HTML report: the
-#: first part shows, the whole formula opens below broken at its connectives.
-FOLD_CHARS = 140
-_CONNECTIVE = re.compile(r" (<->|->|and|or) |\| ")
-
-
-def formula_lines(text: Any) -> str:
-    """An RCL formula broken into lines before each connective (``and``,
-    ``or``, ``->``, ``<->``) and after a quantifier's ``|``, each line
-    indented by its bracket depth, so a long guarantee reads as its
-    structure.  The words are unchanged: joining the lines with single
-    spaces gives the text back (runs of whitespace aside)."""
-    s = _WS.sub(" ", str(text)).strip()
-    lines: list[str] = []
-    depth = line_depth = 0
-    start = i = 0
-    while i < len(s):
-        ch = s[i]
-        m = _CONNECTIVE.match(s, i) if ch in " |" else None
-        if m:
-            cut = i + 1 if ch == "|" else i  # '|' ends its line, a connective starts the next
-            lines.append("  " * line_depth + s[start:cut].strip())
-            start, line_depth = (m.end() if ch == "|" else i + 1), depth
-            i = m.end()
-            continue
-        if ch in "({[":
-            depth += 1
-        elif ch in ")}]":
-            depth = max(0, depth - 1)
-        i += 1
-    lines.append("  " * line_depth + s[start:].strip())
-    return "\n".join(line for line in lines if line.strip())
-
-
-_BREAK_AFTER = re.compile(r"([/._])")
-
-
-def breakable(text: Any) -> Markup:
-    """``text`` (an identifier or a path) escaped, with a line-break
-    opportunity (``<wbr>``) after each ``/``, ``.`` and ``_``, so a narrow
-    column breaks it between its parts, never inside a word."""
-    return Markup("<wbr>").join(escape(p) for p in re.split(r"(?<=[/._])", str(text)))
-
-
-def formula_html(text: Any, limit: int = FOLD_CHARS) -> Markup:
-    """A formula as HTML: ``<code>`` when at most ``limit`` characters, else
-    a ``<details>`` whose summary is its start and which opens to the whole
-    formula broken at its connectives (:func:`formula_lines`).  Text is
-    escaped."""
-    s = _WS.sub(" ", str(text)).strip()
-    if len(s) <= limit:
-        return Markup("<code>%s</code>") % s
-    cut = s[:limit].rsplit(" ", 1)[0] if " " in s[:limit] else s[:limit]
-    return Markup('<details class="formula"><summary><code>%s</code> &hellip;</summary>'
-                  '<pre class="formula">%s</pre></details>') % (cut, formula_lines(s))
-
-
 @lru_cache(maxsize=1)
 def environment() -> jinja2.Environment:
     """The report's jinja2 environment.
@@ -301,6 +246,7 @@ def environment() -> jinja2.Environment:
         formula=formula_html, lines=formula_lines, wbr=breakable,
     )
     env.globals.update(anchor=anchor, rank=rank)
+    htmlfilters.register(env)  # prose, natsort, readable_svg, reqbadges, latex_frame
     return env
 
 
@@ -405,7 +351,7 @@ def _attention(report: Mapping[str, Any], ev_anchor: Sequence[str]) -> tuple[lis
                 str(lint["message"]))
 
     kind_order = {"evidence": 0, "obligation": 1, "guarantee": 1, "side condition": 2, "derived property": 4, "lint": 5}
-    items.sort(key=lambda it: (-rank(it["status"]), kind_order.get(it["kind"], 3), it["kind"], it["ref"]))
+    items.sort(key=lambda it: (-rank(it["status"]), kind_order.get(it["kind"], 3), it["kind"], natural_key(it["ref"])))
     problems = [it for it in items if rank(it["status"]) > SEVERITY["pending"]]
     outstanding = [it for it in items if rank(it["status"]) <= SEVERITY["pending"]]
     return problems, outstanding
@@ -577,8 +523,8 @@ def view(report: Mapping[str, Any]) -> dict[str, Any]:
         trace.append({"req": req, "rows": rows, "rowspan": max(1, len(rows))})
 
     derived = _by(report["derived_properties"], "node")
-    sides = _by(report["side_conditions"], "node")
-    findings = _by(report["findings"], "node")
+    sides = _by(natural_sorted(report["side_conditions"], key=lambda sc: sc["id"]), "node")
+    findings = _by(natural_sorted(report["findings"], key=lambda f: f["id"]), "node")
     sections = []
     named = [str(n["name"]) for n in report["nodes"]]
     for n in report["nodes"]:
@@ -600,7 +546,7 @@ def view(report: Mapping[str, Any]) -> dict[str, Any]:
     problems, outstanding = _attention(report, ev_anchor)
     outstanding_groups = group_items(outstanding)
     pending_groups: dict[tuple[str, str], dict[str, Any]] = {}  # the same reason, numbers aside: one row
-    for p in report["pending"]:
+    for p in natural_sorted(report["pending"], key=lambda p: p["obligation"]):
         key = (str(p["backend"]), _NUMBERS.sub("#", str(p["reason"])))
         pending_groups.setdefault(key, {"backend": p["backend"], "reason": p["reason"], "items": []})["items"].append(p)
     unmet = [r for r in report["requirements"] if rank(r["status"]) > 0]
@@ -614,11 +560,13 @@ def view(report: Mapping[str, Any]) -> dict[str, Any]:
         "unmet_requirements": unmet, "ev_anchor": ev_anchor, "evidence_of": evidence_of,
         "obligation": obligation, "trace": trace, "sections": sections,
         "lint_errors": sum(1 for x in report["lint"] if str(x["severity"]).lower() == "error"),
-        "finding_runs": runs(report["findings"], lambda f: str(f["node"])),
+        "finding_runs": runs(natural_within(report["findings"], lambda f: str(f["node"]), lambda f: f["id"]),
+                             lambda f: str(f["node"])),
         "obligation_runs": runs([{"obligation": o, "evidence": [aid for aid, _ in evidence_of.get(str(o["id"]), [])]}
-                                 for o in report["obligations"]], lambda row: str(row["obligation"]["node"])),
-        "evidence_runs": runs([{"anchor": aid, "record": ev} for aid, ev in zip(ev_anchor, report["evidence"])],
-                              node_of_evidence),
+                                 for o in natural_within(report["obligations"], lambda o: str(o["node"]),
+                                                         lambda o: o["id"])], lambda row: str(row["obligation"]["node"])),
+        "evidence_runs": runs(natural_within([{"anchor": aid, "record": ev} for aid, ev in zip(ev_anchor, report["evidence"])],
+                                             node_of_evidence, lambda it: it["record"]["obligation"]), node_of_evidence),
     }
 
 

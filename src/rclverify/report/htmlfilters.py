@@ -1,0 +1,42 @@
+"""The HTML report's jinja2 filters and globals beyond those of render.py.
+
+``prose`` (Markdown code spans as ``<code>``), ``natsort`` (ids in natural
+order): :mod:`.textfmt`; ``readable_svg`` (a large drawing at a size whose
+text can be read): :mod:`.svgfit`; ``reqbadges`` (a requirement's proof and
+evidence as two badges): :mod:`.badges`; ``tally`` (statuses counted,
+worst first); the global ``latex_frame(sources)``
+(the LaTeX appendix's one preamble and its end):
+:func:`rclverify.rcl.latex.document_frame`.
+"""
+from __future__ import annotations
+
+from collections import Counter
+from typing import Any, Iterable
+
+import jinja2
+
+from ..rcl.latex import document_frame
+from .badges import requirement_badges
+from .svgfit import readable_svg
+from .textfmt import natural_sorted, prose
+
+
+def _natsort(items: Iterable[Any], attribute: str | None = None) -> list[Any]:
+    if attribute is None:
+        return natural_sorted(items)
+    return natural_sorted(items, key=lambda it: it[attribute])
+
+
+@jinja2.pass_environment
+def _tally(env: jinja2.Environment, statuses: Iterable[Any]) -> list[tuple[str, int]]:
+    """``[(status, how many)]`` of ``statuses``, worst first (the ``rank``
+    global), then by word."""
+    counts = Counter(str(s) for s in statuses)
+    return sorted(counts.items(), key=lambda kv: (-env.globals["rank"](kv[0]), kv[0]))
+
+
+def register(env: jinja2.Environment) -> None:
+    """Add this module's filters and globals to ``env`` (the report's environment)."""
+    env.filters.update(prose=prose, natsort=_natsort, readable_svg=readable_svg, reqbadges=requirement_badges,
+                       tally=_tally)
+    env.globals.update(latex_frame=document_frame)

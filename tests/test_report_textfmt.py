@@ -1,0 +1,65 @@
+"""The HTML report's text helpers (issue 30, item 6): Markdown code spans as
+``<code>``, natural order of ids, a large drawing at a readable size, a
+requirement's proof and evidence as two badges."""
+from __future__ import annotations
+
+import re
+
+from rclverify.report.render import environment
+from rclverify.report.svgfit import readable_svg, smallest_font
+from rclverify.report.textfmt import natural_key, natural_sorted, natural_within, prose
+
+
+def test_code_spans_become_code_and_everything_is_escaped() -> None:
+    assert prose("guard it with `i + 1 <= 12`: done") == "guard it with <code>i + 1 &lt;= 12</code>: done"
+    assert prose("a `x` and ``y ` z`` b") == "a <code>x</code> and <code>y ` z</code> b"
+    assert prose("`` `tick` ``") == "<code>`tick`</code>"  # one space stripped at each end
+    assert prose("<b>no</b> `<i>`") == "&lt;b&gt;no&lt;/b&gt; <code>&lt;i&gt;</code>"
+    assert prose("an odd ` tick stays") == "an odd ` tick stays"
+    assert prose("no ticks & more") == "no ticks &amp; more"
+
+
+def test_natural_order_compares_digit_runs_as_numbers() -> None:
+    ids = ["A.g1.ajpf.p10_i9", "A.g1.ajpf.p1_i0", "A.g1.ajpf.p2_i1", "A.g10.x", "A.g2.x", "A.g1.ajpf.p01_i0"]
+    assert natural_sorted(ids) == ["A.g1.ajpf.p01_i0", "A.g1.ajpf.p1_i0", "A.g1.ajpf.p2_i1", "A.g1.ajpf.p10_i9",
+                                   "A.g2.x", "A.g10.x"]
+    assert natural_key("p9") < natural_key("p10") < natural_key("q1") and natural_key("") < natural_key("1")
+    rows = [("Loc", "Loc.g1"), ("Agent", "Agent.g10"), ("Agent", "Agent.g2"), ("Loc", "Loc.g0")]
+    # groups keep the order of their first row; ids are natural within a group
+    assert natural_within(rows, lambda r: r[0], lambda r: r[1]) == [
+        ("Loc", "Loc.g0"), ("Loc", "Loc.g1"), ("Agent", "Agent.g2"), ("Agent", "Agent.g10")]
+
+
+SVG = ('<?xml version="1.0"?>\n<svg width="2514pt" height="3771pt"\n viewBox="0.00 0.00 2514.11 3770.60" '
+       'xmlns="http://www.w3.org/2000/svg">\n<g><text font-size="14.00">a</text><text font-size="9.00">b</text></g></svg>')
+
+
+def test_a_drawing_gets_the_size_at_which_its_smallest_text_is_readable() -> None:
+    assert smallest_font(SVG) == 9.0
+    out = str(readable_svg(SVG, min_px=10))
+    root = re.search(r"<svg[^>]*>", out).group(0)  # type: ignore[union-attr]
+    assert 'class="fixed"' in root and 'width="2793px"' in root and 'height="4190px"' in root
+    assert "pt\"" not in root and out.count("<svg") == 1 and out.endswith("</svg>")
+    # 10 px text: the drawing's width over its viewBox width times the smallest font size
+    assert abs(2793 / 2514.11 * 9 - 10) < 0.01
+    assert str(readable_svg("<svg><g/></svg>")) == "<svg><g/></svg>"  # no text: unchanged
+
+
+def _badges(req: dict) -> list[tuple[str, str]]:
+    html = environment().from_string("{{ req|reqbadges }}").render(req=req)
+    return re.findall(r'<span class="badge st-([a-z]+)"[^>]*>([^<]*)</span>', html)
+
+
+def test_a_requirement_shows_its_proof_and_its_evidence_apart() -> None:
+    assert _badges({"status": "failed", "verdict": "proved, evidence outstanding"}) == [
+        ("discharged", "proved"), ("failed", "evidence: failed")]
+    assert _badges({"status": "discharged", "verdict": "met"}) == [
+        ("discharged", "proved"), ("discharged", "evidence: discharged")]
+    assert _badges({"status": "failed", "verdict": "proved vacuously", "note": "its premise <never> holds"}) == [
+        ("warning", "proved vacuously")]
+    assert _badges({"status": "failed", "verdict": "refuted"}) == [("failed", "refuted")]
+    assert _badges({"status": "pending", "verdict": "informal"}) == [("pending", "informal")]
+    assert _badges({"status": "pending"}) == [("pending", "pending")]  # no verdict: the status
+    html = environment().from_string("{{ req|reqbadges }}").render(
+        req={"status": "failed", "verdict": "proved vacuously", "note": "its premise <never> holds"})
+    assert 'title="status: failed; its premise &lt;never&gt; holds"' in html
