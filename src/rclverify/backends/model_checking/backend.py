@@ -58,6 +58,8 @@ WHAT = "checked by SPIN on rclverify's exploration of the Gwendolen program"
 _GRAPHS: dict[str, StateGraph | RclError] = {}
 #: Built models: key (graph key, claims) -> (model, its verifier's directory, exploration seconds, build seconds).
 _MODELS: dict[str, tuple[PromelaModel, Path, float]] = {}
+#: Claims of an entry: key (the property files' texts) -> (claims, digest of their names and texts).
+_CLAIMS: dict[str, tuple[list[Claim], str]] = {}
 #: pan results: (model key, claim) -> result.
 _RESULTS: dict[tuple[str, str], spin.CheckResult] = {}
 
@@ -134,16 +136,22 @@ def extra_obligations(target: NodeTarget, cfg: SpinConfig, agent: str, model: st
     return out
 
 
-def _claims(target: NodeTarget, cfg: SpinConfig) -> list[Claim]:
-    """Every property of the entry: ``agent.psl``'s (``p<n>``) and the extra files' (``x<k>_<label>``)."""
+def _claims(target: NodeTarget, cfg: SpinConfig) -> tuple[list[Claim], str]:
+    """Every property of the entry: ``agent.psl``'s (``p<n>``) and the extra files' (``x<k>_<label>``),
+    and a digest of their names and texts (read once per content in a process)."""
     psl_path = target.artifacts / "agent.psl"
-    derived = parse_psl_text(psl_path.read_text(encoding="utf-8"), target.rel(psl_path)) \
-        if psl_path.is_file() else []
-    claims = [Claim(f"p{p.label}", p.formula, f"property {p.label} of agent.psl") for p in derived]
-    for k, rel in enumerate(cfg.properties):
-        claims += [Claim(f"x{k}_{p.label}", p.formula, f"{rel}:{p.line} {p.label}")
-                   for p in read_psl_file(target.root, rel)]
-    return claims
+    texts = [psl_path.read_bytes() if psl_path.is_file() else b""]
+    texts += [(target.root / rel).read_bytes() for rel in cfg.properties]
+    key = hashlib.sha256(repr((target.rel(psl_path), cfg.properties, texts)).encode()).hexdigest()
+    if key not in _CLAIMS:
+        derived = parse_psl_text(texts[0].decode("utf-8"), target.rel(psl_path))
+        claims = [Claim(f"p{p.label}", p.formula, f"property {p.label} of agent.psl") for p in derived]
+        for k, rel in enumerate(cfg.properties):
+            claims += [Claim(f"x{k}_{p.label}", p.formula, f"{rel}:{p.line} {p.label}")
+                       for p in read_psl_file(target.root, rel)]
+        _CLAIMS[key] = (claims, hashlib.sha256(repr([(c.name, psl.to_text(c.formula))
+                                                     for c in claims]).encode()).hexdigest())
+    return _CLAIMS[key]
 
 
 def _graph(target: NodeTarget, model: str, cfg: SpinConfig) -> tuple[str, StateGraph | RclError, float]:
@@ -182,29 +190,33 @@ def run_spin(obligation: Obligation, target: NodeTarget, model: str, timeout_s: 
     if isinstance(graph, RclError):
         return make_evidence(target, obligation, "error", tool=TOOL, tool_version=tools.version, clock=clock,
                              explanation=f"the agent program could not be explored: {graph}")
-    claims = _claims(target, cfg)
+    claims, digest = _claims(target, cfg)
     claim = str(data.get("claim") or f"p{data.get('property')}")
     mine = next((c for c in claims if c.name == claim), None)
     if mine is None or psl.to_text(mine.formula) != data.get("psl"):
         return make_evidence(target, obligation, "stale", tool=TOOL, tool_version=tools.version, clock=clock,
                              explanation=f"property {claim} is no longer the one exported; export again")
-    return check_graph(obligation, target, graph, claims, claim, tools=tools, graph_key=gkey,
+    return check_graph(obligation, target, graph, claims, claim, tools=tools, graph_key=gkey, claims_key=digest,
                        bounds=(cfg.max_states, cfg.max_depth), explore_s=explore_s, timeout_s=timeout_s, clock=clock)
 
 
 def check_graph(obligation: Obligation, target: NodeTarget, graph: StateGraph, claims: list[Claim], claim: str, *,
-                tools: spin.Tools, graph_key: str, bounds: tuple[int, int], explore_s: float = 0.0,
+                tools: spin.Tools, graph_key: str, bounds: tuple[int, int], claims_key: str | None = None,
+                explore_s: float = 0.0,
                 timeout_s: float = 3600.0, clock: Stopwatch | None = None) -> Evidence:
     """Evidence that ``graph`` satisfies the claim named ``claim`` (one of
     ``claims``, all of which go into one model, built once per
-    ``graph_key`` and claims): see :func:`run_spin` for the statuses.
+    ``graph_key`` (what identifies the graph) and ``claims_key`` (the claims;
+    computed when ``None``)): see :func:`run_spin` for the statuses.
     ``bounds`` are the exploration bounds ``(max_states, max_depth)`` the
     graph was made with, for the record.  Writes ``spin/model.pml`` and, for
     a counterexample, ``spin/<claim>.trail.txt`` under ``target.artifacts``.
     """
     clock = clock or Stopwatch()
     mine = next(c for c in claims if c.name == claim)
-    mkey = hashlib.sha256((graph_key + repr([(c.name, psl.to_text(c.formula)) for c in claims])).encode()).hexdigest()
+    if claims_key is None:
+        claims_key = repr([(c.name, psl.to_text(c.formula)) for c in claims])
+    mkey = hashlib.sha256((graph_key + claims_key).encode()).hexdigest()
     spin_dir = target.artifacts / "spin"
     t0 = time.perf_counter()
     if mkey not in _MODELS or not (_MODELS[mkey][1] / "pan").is_file():
@@ -219,10 +231,11 @@ def check_graph(obligation: Obligation, target: NodeTarget, graph: StateGraph, c
     pml, built, build_s = _MODELS[mkey]
     depth_bound = max(10_000, 20 * (pml.states + pml.transitions))
     if (mkey, claim) not in _RESULTS:
-        _RESULTS[(mkey, claim)] = spin.check(tools, built, claim, depth_bound, timeout_s)
+        _RESULTS[(mkey, claim)] = spin.check(tools, built, claim, depth_bound, timeout_s,
+                                                 size=pml.states + pml.transitions)
     res = _RESULTS[(mkey, claim)]
     details: dict[str, Any] = {
-        "model_checker": "spin", "claim": claim, "psl": data.get("psl"), "states": pml.states,
+        "model_checker": "spin", "claim": claim, "psl": psl.to_text(mine.formula), "states": pml.states,
         "transitions": pml.transitions, "complete": graph.complete, "cut": graph.cut, "depth": graph.depth,
         "max_states": bounds[0], "max_depth": bounds[1], "spin_verdict": res.verdict,
         "spin_states_stored": res.stored, "explore_s": explore_s, "build_s": build_s, "pan_s": res.duration_s,
@@ -265,4 +278,5 @@ def clear_caches() -> None:
     _GRAPHS.clear()
     _MODELS.clear()
     _RESULTS.clear()
+    _CLAIMS.clear()
 

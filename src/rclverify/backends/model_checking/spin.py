@@ -16,7 +16,8 @@ with "pan: out of memory" rather than swapping), ``-O0`` (the verifier of
 an explored graph runs in milliseconds; optimising it costs seconds of
 ``gcc``).  Search flags: ``-a`` acceptance cycles, no ``-f`` (weak
 fairness is about processes; the model has one), ``-n`` no unreached-code
-listing, ``-m<depth>`` a search depth no path of the model can exceed.  A
+listing, ``-m<depth>`` a search depth no path of the model can exceed,
+``-w<bits>`` a hash table sized to the model (:func:`hash_bits`).  A
 search cut by depth or memory is ``incomplete``, never ``holds``.
 
 A compiled verifier is kept in ``<cache>/<sha256 of the model>/`` (built
@@ -81,10 +82,14 @@ class CheckResult:
     duration_s: float = 0.0
 
 
+_FOUND: dict[tuple[str, str], Tools] = {}
+
+
 def find_tools(path: str | None = None) -> tuple[Tools | None, str]:
     """``(tools, "")`` when ``spin`` and ``gcc`` are on ``path`` (default
     ``$PATH``), else ``(None, reason)`` naming what is missing and the
-    command that installs it."""
+    command that installs it.  Versions are asked once per executable pair
+    in a process."""
     spin = shutil.which("spin", path=path)
     gcc = shutil.which("gcc", path=path) or shutil.which("cc", path=path)
     missing = [name for name, exe in (("spin", spin), ("gcc", gcc)) if exe is None]
@@ -92,8 +97,11 @@ def find_tools(path: str | None = None) -> tuple[Tools | None, str]:
         return None, (f"{' and '.join(missing)} not found on PATH: SPIN needs both "
                       f"(install with: {INSTALL})")
     assert spin is not None and gcc is not None
-    return Tools(spin, gcc, _version([spin, "-V"], r"Spin Version (\S+) -- (.+?)\s*$", "Spin {0} ({1})"),
-                 _version([gcc, "--version"], r"(\d+\.\d+(?:\.\d+)?)", "gcc {0}")), ""
+    if (spin, gcc) not in _FOUND:
+        _FOUND[(spin, gcc)] = Tools(
+            spin, gcc, _version([spin, "-V"], r"Spin Version (\S+) -- (.+?)\s*$", "Spin {0} ({1})"),
+            _version([gcc, "--version"], r"(\d+\.\d+(?:\.\d+)?)", "gcc {0}"))
+    return _FOUND[(spin, gcc)], ""
 
 
 def _version(cmd: list[str], pattern: str, fmt: str) -> str:
@@ -165,13 +173,24 @@ _STORED = re.compile(r"(\d+)\s+states, stored")
 _DEPTH = re.compile(r"depth reached\s+(\d+)")
 
 
-def check(tools: Tools, built: Path, claim: str, max_depth: int, timeout_s: float) -> CheckResult:
+def hash_bits(size: int) -> int:
+    """pan's ``-w`` for a model of ``size`` states and transitions: a hash
+    table of about four slots per product state (never below 2**12 or above
+    2**24, pan's default, which pan would otherwise allocate and clear for
+    every run: 128 MB).  The table's size changes speed, not the verdict."""
+    return max(12, min(24, (4 * max(size, 1)).bit_length()))
+
+
+def check(tools: Tools, built: Path, claim: str, max_depth: int, timeout_s: float, size: int = 1 << 22
+          ) -> CheckResult:
     """Search ``built``'s verifier for a violation of ``claim``; on one, replay
-    its trail with SPIN (the replay's text is ``CheckResult.trail``)."""
+    its trail with SPIN (the replay's text is ``CheckResult.trail``).
+    ``size`` (states plus transitions of the graph) sizes pan's hash table."""
     with tempfile.TemporaryDirectory(prefix=".run-", dir=built.parent) as tmp:
         work = Path(tmp)
         shutil.copy(built / "model.pml", work / "model.pml")
-        out, code, secs = _run([str(built / "pan"), "-a", "-n", f"-N{claim}", f"-m{max_depth}"], work, timeout_s)
+        out, code, secs = _run([str(built / "pan"), "-a", "-n", f"-N{claim}", f"-m{max_depth}",
+                                 f"-w{hash_bits(size)}"], work, timeout_s)
         stored = _int(_STORED, out)
         depth = _int(_DEPTH, out)
         if code is None:

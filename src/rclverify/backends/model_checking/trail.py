@@ -19,7 +19,6 @@ from typing import Any, Sequence
 
 from .graph import StateGraph
 from .ltl import Propositions, atom_text
-from .promela import truth_table
 
 _STEP = re.compile(r"^\s*@([TS])\s+(\d+)\s*$")
 CYCLE_MARK = "START OF CYCLE"
@@ -62,12 +61,13 @@ def counterexample(graph: StateGraph, replay: Replay, props: Propositions | None
     a transition or state the graph does not have, or its steps do not
     form a path from state 0 (the model was not made from this graph).
     """
-    props = props or Propositions()
-    atoms = props.atoms()
-    table = truth_table(graph, props) if atoms else [() for _ in graph.states]
+    atoms = [a for _, a in (props or Propositions()).atoms()]
+    memo: dict[int, list[str]] = {}
 
-    def holds(state: int) -> list[str]:
-        return [atom_text(a) for (_, a), v in zip(atoms, table[state]) if v]
+    def holds(state: int) -> list[str]:  # only the states on the path are evaluated
+        if state not in memo:
+            memo[state] = [atom_text(a) for a in atoms if graph.holds(state, a)]
+        return memo[state]
 
     steps: list[dict[str, Any]] = []
     at = 0
