@@ -87,8 +87,12 @@ def read_spin_config(target: NodeTarget) -> SpinConfig:
                                   "model_checker")
     env = None
     if "environment" in cfg:
-        from .environment import environment_from_plan  # stage one
-        env = environment_from_plan(cfg["environment"], lambda *p: target.config_loc("environment", *p))
+        try:
+            from .environment import environment_from_plan  # stage one
+        except ImportError:  # an installation without stage one: its evidence says so (run_spin)
+            environment_from_plan = None
+        if environment_from_plan is not None:
+            env = environment_from_plan(cfg["environment"], lambda *p: target.config_loc("environment", *p))
     elif checker == "spin":
         raise target.config_error("model_checker spin needs an 'environment': the percepts the verification "
                                   "environment may send (docs/plan.md, ajpf)", "model_checker")
@@ -161,7 +165,7 @@ def _graph(target: NodeTarget, model: str, cfg: SpinConfig) -> tuple[str, StateG
     t0 = time.perf_counter()
     if key not in _GRAPHS:
         from .explore import explore  # stage one
-        assert cfg.environment is not None
+        assert cfg.environment is not None  # run_spin checked it
         try:
             _GRAPHS[key] = explore(target.root / model, model, cfg.environment, cfg.max_states, cfg.max_depth)
         except RclError as exc:  # an error in the program, located in it
@@ -186,6 +190,10 @@ def run_spin(obligation: Obligation, target: NodeTarget, model: str, timeout_s: 
                              explanation=f"{reason}; then re-run the verification",
                              details={"reason": reason, "install": spin.INSTALL})
     cfg = read_spin_config(target)
+    if cfg.environment is None:
+        return make_evidence(target, obligation, "error", tool=TOOL, tool_version=tools.version, clock=clock,
+                             explanation="stage one of the model checking (rclverify.backends.model_checking."
+                                         "explore, the Gwendolen explorer) is not part of this installation")
     gkey, graph, explore_s = _graph(target, model, cfg)
     if isinstance(graph, RclError):
         return make_evidence(target, obligation, "error", tool=TOOL, tool_version=tools.version, clock=clock,
