@@ -173,8 +173,10 @@ def test_property_that_holds_is_discharged(tmp_path: Path) -> None:
 def test_violated_property_fails_with_the_lasso_mapped_to_source_lines(tmp_path: Path) -> None:
     ev = decide(tmp_path, rover(), {"red": RED, "insp": INSPECTED}, "insp")
     assert ev.status == "failed", ev.explanation
-    cex = ev.counterexample
-    assert cex is not None and cex["kind"] == "lasso" and cex["source"] == SRC
+    cex = ev.details["lasso"]
+    assert cex["kind"] == "lasso" and cex["source"] == SRC
+    assert ev.counterexample == {"lasso": "a lasso of 3 steps then a cycle of 1; Gwendolen lines 72, 87 of agent.gwen",
+                                 "trace": cex["trace"]}
     # the only violating path: set off, red radiation, head home -- and stay there (final state stutters)
     assert [s.get("transition") for s in cex["prefix"]] == [0, 2, 5]
     assert [(s["line"], s["stage"]) for s in cex["prefix"]] == [(72, "D"), (None, "env"), (87, "D")]
@@ -190,7 +192,7 @@ def test_violated_property_fails_with_the_lasso_mapped_to_source_lines(tmp_path:
 def test_violation_on_a_real_cycle(tmp_path: Path) -> None:
     ev = decide(tmp_path, looping(), {"w": "<> B(jackal, inspected(1))"}, "w")
     assert ev.status == "failed", ev.explanation
-    cex = ev.counterexample
+    cex = ev.details["lasso"]
     steps = cex["prefix"] + cex["cycle"]
     assert [s["transition"] for s in steps][:1] == [0]
     assert sorted(s["line"] for s in cex["cycle"]) == [12, 13]  # the loop 1 -> 2 -> 1, for ever
@@ -257,9 +259,82 @@ def test_case_study_instances_all_decided(tmp_path: Path, monkeypatch: pytest.Mo
         assert e.tool == "SPIN" and e.details["complete"] is True
         assert (e.status == "failed") == (e.details["spin_verdict"] == "violated")
         if e.status == "failed":
-            assert e.counterexample and e.counterexample["prefix"][0]["from"] == 0
+            assert e.counterexample["trace"] and e.details["lasso"]["prefix"][0]["from"] == 0
         if e.status == "inconclusive":  # only partial coverage of a guarantee turns a verified property so
             assert "PARTIAL COVERAGE" in e.explanation and e.details["spin_verdict"] == "holds"
     by_label = {o.data["label"]: e.status for o, e in zip(authors, evs[len(derived):])}
     assert by_label["phi3a"] == by_label["phi3b"] == "discharged"
     assert len(mc._GRAPHS) == 1 and len(mc._MODELS) == 1  # one exploration, one verifier for all 78
+
+
+# -- reading replays, plan keys ---------------------------------------------
+
+def test_replay_text_is_read_and_checked_against_the_graph() -> None:
+    from rclverify.backends.model_checking.trail import counterexample, read_replay
+    text = "starting claim 2\n@T 0\n  2:\tproc  0 (agent:1) model.pml:20 ...\n@T 2\n<<<<<START OF CYCLE>>>>>\n@T 5\n@S 6\n"
+    replay = read_replay(text)
+    assert replay.steps == (("T", 0), ("T", 2), ("T", 5), ("S", 6)) and replay.cycle_start == 2
+    cex = counterexample(rover(), replay)
+    assert [s["to"] for s in cex["prefix"]] == [1, 5] and [s["to"] for s in cex["cycle"]] == [6, 6]
+    with pytest.raises(ValueError, match="takes transition 3 from state 2, but is in state 1"):
+        counterexample(rover(), read_replay("@T 0\n@T 3\n"))
+    with pytest.raises(ValueError, match="names transition 99"):
+        counterexample(rover(), read_replay("@T 99\n"))
+
+
+PLAN_SPIN = """\
+contracts:
+  - contracts/remote_inspection.rcl
+nodes:
+  Agent:
+    evidence:
+      - backend: ajpf
+        agent: jackal
+        model: backends/ajpf/jackal.gwen
+        domains: {{i: [0, 12]}}
+{extra}"""
+
+
+def spin_workspace(root: Path, extra: str) -> NodeTarget:
+    from rclverify.workspace import Workspace
+    (root / "contracts").mkdir(parents=True, exist_ok=True)
+    (root / "backends/ajpf").mkdir(parents=True, exist_ok=True)
+    shutil.copy(REPO / "contracts/remote_inspection.rcl", root / "contracts")
+    shutil.copy(REPO / "backends/ajpf/jackal.gwen", root / "backends/ajpf")
+    (root / "contracts/plan.yaml").write_text(PLAN_SPIN.format(extra=extra))
+    return Workspace(root).target("Agent", 0)
+
+
+@pytest.mark.parametrize("extra, where, message", [
+    ("        model_checker: nusmv\n", 10, "'model_checker' must be one of spin, ajpf"),
+    ("        model_checker: spin\n", 10, "model_checker spin needs an 'environment'"),
+    ("        max_states: 0\n", 10, "'max_states' must be a positive integer"),
+    ("        properties: [backends/ajpf/none.psl]\n", 10, "property file 'backends/ajpf/none.psl' does not exist"),
+])
+def test_spin_keys_are_checked_with_located_errors(tmp_path: Path, extra: str, where: int, message: str) -> None:
+    from rclverify.backends.ajpf import AjpfBackend
+    target = spin_workspace(tmp_path, extra)
+    with pytest.raises(PlanError) as e:
+        AjpfBackend().export(target)
+    assert str(e.value).startswith(f"contracts/plan.yaml:{where}:") and message in str(e.value)
+
+
+def test_property_files_give_obligations_of_their_own(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    from rclverify.backends.ajpf import AjpfBackend
+    monkeypatch.delenv("MCAPL_HOME", raising=False)
+    monkeypatch.delenv("AJPF_HOME", raising=False)
+    (tmp_path / "backends/ajpf").mkdir(parents=True)
+    (tmp_path / "backends/ajpf/extra.psl").write_text("# mine\nsafe: [] ~B(jackal, danger_red)\n")
+    target = spin_workspace(tmp_path, "        properties: [backends/ajpf/extra.psl]\n")
+    obs = AjpfBackend().export(target)
+    [extra] = [o for o in obs if o.guarantee == 0]
+    assert extra.id == "Agent.g0.ajpf.extra_safe" and extra.statement == "safe: [] ~B(jackal, danger_red)"
+    assert (extra.source.file, extra.source.line, extra.source.col) == ("backends/ajpf/extra.psl", 2, 7)
+    assert extra.data["claim"] == "x0_safe" and "backends/ajpf/extra.psl" in extra.inputs
+    # no environment declared: the AJPF runner is the default, and it checks agent.psl only
+    ev = AjpfBackend().run(extra, target)
+    assert ev.status == "pending" and "model_checker: spin" in ev.explanation
+    (tmp_path / "backends/ajpf/extra.psl").write_text("safe: [] ~B(jackal danger_red)\n")
+    with pytest.raises(PlanError) as e:
+        AjpfBackend().export(target)
+    assert str(e.value).startswith("backends/ajpf/extra.psl:1:")

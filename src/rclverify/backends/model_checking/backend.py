@@ -260,6 +260,7 @@ def check_graph(obligation: Obligation, target: NodeTarget, graph: StateGraph, c
             return make_evidence(target, obligation, "error", tool=TOOL, tool_version=tools.version, clock=clock,
                                  log=res.output + res.trail, details=details,
                                  explanation=f"{what}: SPIN's trail does not map back to the graph: {exc}")
+        details["lasso"] = cex
         trail_path = spin_dir / f"{claim}.trail.txt"
         atomic_write_text(trail_path, "\n".join(cex["trace"]) + "\n")
         arts.append(target.rel(trail_path))
@@ -276,8 +277,11 @@ def check_graph(obligation: Obligation, target: NodeTarget, graph: StateGraph, c
         status, why = "inconclusive", f"SPIN's search was cut: {res.reason}"
     else:
         status, why = "error", f"SPIN failed: {res.reason}"
+    # the counterexample as AJPF's results give it (a summary and the path, one line per step);
+    # the steps as data are details["lasso"]
+    shown = {"lasso": summary(cex), "trace": cex["trace"]} if cex else None
     return make_evidence(target, obligation, status, tool=TOOL, tool_version=tools.version, clock=clock,
-                         log=res.output, artifacts=tuple(arts), counterexample=cex, details=details,
+                         log=res.output, artifacts=tuple(arts), counterexample=shown, details=details,
                          explanation=f"{what}: {why}")
 
 

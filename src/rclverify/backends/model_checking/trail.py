@@ -49,7 +49,7 @@ def read_replay(text: str) -> Replay:
 
 
 def counterexample(graph: StateGraph, replay: Replay, props: Propositions | None = None) -> dict[str, Any]:
-    """The replay as a JSON-ready lasso over ``graph``.
+    """The replay as a JSON-ready lasso over ``graph`` (evidence ``details["lasso"]``).
 
     ``{"kind": "lasso" | "prefix", "source": file, "initial": {state...},
     "prefix": [step, ...], "cycle": [step, ...], "trace": [line, ...]}``;
