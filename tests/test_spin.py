@@ -338,3 +338,15 @@ def test_property_files_give_obligations_of_their_own(tmp_path: Path, monkeypatc
     with pytest.raises(PlanError) as e:
         AjpfBackend().export(target)
     assert str(e.value).startswith("backends/ajpf/extra.psl:1:")
+
+
+@needs_spin
+def test_safety_violation_is_a_finite_bad_prefix(tmp_path: Path) -> None:
+    ev = decide(tmp_path, rover(), {"safe": "[] ~B(jackal, danger_red)"}, "safe")
+    assert ev.status == "failed", ev.explanation
+    lasso = ev.details["lasso"]
+    assert lasso["kind"] == "prefix" and lasso["cycle"] == []
+    assert ev.counterexample["lasso"] == ("a path of 2 steps after which the property cannot hold; "
+                                          "Gwendolen line 72 of agent.gwen")
+    assert [s["to"] for s in lasso["prefix"]][-1] == 5  # the first state believing danger_red
+    assert lasso["prefix"][-1]["holds"] == ["B(jackal, danger_red)"]

@@ -111,7 +111,8 @@ def summary(cex: dict[str, Any]) -> str:
     """One sentence: the lasso's size and the source lines it passes through."""
     steps: Sequence[dict[str, Any]] = [*cex["prefix"], *cex["cycle"]]
     lines = sorted({s["line"] for s in steps if s.get("line")})
-    where = f"; Gwendolen lines {', '.join(map(str, lines))} of {cex['source']}" if lines else ""
+    where = (f"; Gwendolen line{'s' if len(lines) > 1 else ''} {', '.join(map(str, lines))} of {cex['source']}"
+             if lines else "")
     if cex["kind"] == "lasso":
         return f"a lasso of {len(cex['prefix'])} steps then a cycle of {len(cex['cycle'])}{where}"
     return f"a path of {len(cex['prefix'])} steps after which the property cannot hold{where}"
