@@ -350,3 +350,14 @@ def test_safety_violation_is_a_finite_bad_prefix(tmp_path: Path) -> None:
                                           "Gwendolen line 72 of agent.gwen")
     assert [s["to"] for s in lasso["prefix"]][-1] == 5  # the first state believing danger_red
     assert lasso["prefix"][-1]["holds"] == ["B(jackal, danger_red)"]
+
+
+@needs_spin
+def test_a_search_cut_by_pan_s_depth_bound_is_incomplete(tmp_path: Path) -> None:
+    tools, _ = spin.find_tools()
+    assert tools is not None
+    model = build_model(looping(), [Claim("w", psl.parse("[] ~B(jackal, inspected(1))"))])
+    built = spin.compile_model(tools, model.text, tmp_path / "build")
+    res = spin.check(tools, built, "w", max_depth=2, timeout_s=60)
+    assert res.verdict == "incomplete" and "search depth bound 2" in res.reason
+    assert spin.check(tools, built, "w", max_depth=1000, timeout_s=60).verdict == "holds"
