@@ -54,8 +54,8 @@ DEFAULT_MAX_STATES = 100_000
 DEFAULT_MAX_DEPTH = 10_000
 WHAT = "checked by SPIN on rclverify's exploration of the Gwendolen program"
 
-#: Explored graphs of this process: key (program text, environment, bounds) -> graph or the error.
-_GRAPHS: dict[str, StateGraph | RclError] = {}
+#: Explored graphs of this process: key (program text, environment, bounds) -> (graph or the error, seconds).
+_GRAPHS: dict[str, tuple[StateGraph | RclError, float]] = {}
 #: Built models: key (graph key, claims) -> (model, its verifier's directory, exploration seconds, build seconds).
 _MODELS: dict[str, tuple[PromelaModel, Path, float]] = {}
 #: Claims of an entry: key (the property files' texts) -> (claims, digest of their names and texts).
@@ -159,18 +159,22 @@ def _claims(target: NodeTarget, cfg: SpinConfig) -> tuple[list[Claim], str]:
 
 
 def _graph(target: NodeTarget, model: str, cfg: SpinConfig) -> tuple[str, StateGraph | RclError, float]:
+    """The graph of ``model`` under the entry's environment and bounds (explored once per
+    process): its cache key, the graph (or the program's error) and the seconds it took."""
     text = (target.root / model).read_bytes()
     key = hashlib.sha256(text + json.dumps([model, cfg.environment_raw, cfg.max_states, cfg.max_depth],
                                            sort_keys=True, default=str).encode()).hexdigest()
-    t0 = time.perf_counter()
     if key not in _GRAPHS:
         from .explore import explore  # stage one
         assert cfg.environment is not None  # run_spin checked it
+        t0 = time.perf_counter()
+        graph: StateGraph | RclError
         try:
-            _GRAPHS[key] = explore(target.root / model, model, cfg.environment, cfg.max_states, cfg.max_depth)
+            graph = explore(target.root / model, model, cfg.environment, cfg.max_states, cfg.max_depth)
         except RclError as exc:  # an error in the program, located in it
-            _GRAPHS[key] = exc
-    return key, _GRAPHS[key], round(time.perf_counter() - t0, 3)
+            graph = exc
+        _GRAPHS[key] = (graph, round(time.perf_counter() - t0, 3))
+    return key, *_GRAPHS[key]
 
 
 def run_spin(obligation: Obligation, target: NodeTarget, model: str, timeout_s: float) -> Evidence:
