@@ -15,11 +15,12 @@ as_root() {
 # Debian packages, each optional (what is missing is said in the evidence, or the test that needs it
 # is skipped with the reason):
 #   dafny, graphviz          the Dafny backend's verifier; the system and argument diagrams
+#   spin, gcc                the Agent's model checking (SPIN compiles its verifier with gcc)
 #   ROS 1 (ros-core ...)     a real ROS master and rospy nodes for the live monitor and the graph read
 #                            from a running system; message definitions for grounding
 #   chromium(-driver)        the browser test of the HTML report
 DEBIAN_PACKAGES=(
-  dafny graphviz
+  dafny graphviz spin gcc
   ros-core python3-rospy python3-rosbag python3-rosgraph python3-roslaunch python3-genpy python3-catkin-pkg
   python3-std-msgs python3-geometry-msgs python3-sensor-msgs python3-nav-msgs
   ros-std-msgs ros-geometry-msgs ros-sensor-msgs ros-nav-msgs
@@ -37,7 +38,7 @@ if command -v apt-get >/dev/null 2>&1; then
       || echo "setup: could not install ${need[*]}; what needs them is pending or skipped, with the reason"
   fi
 else
-  echo "setup: apt-get not found; install ${DEBIAN_PACKAGES[*]} yourself for Dafny, the diagrams, ROS 1 and the browser test"
+  echo "setup: apt-get not found; install ${DEBIAN_PACKAGES[*]} yourself for Dafny, the diagrams, SPIN, ROS 1 and the browser test"
 fi
 
 PY=${PYTHON:-python3}

@@ -388,7 +388,7 @@ def _z3_version() -> str:
 def _tool_fingerprint() -> dict[str, Any]:
     from . import __version__
     return {"rclverify": __version__, "dafny": shutil.which("dafny"), "mcapl": os.environ.get("MCAPL_HOME") or os.environ.get("AJPF_HOME"),
-            "dot": shutil.which("dot")}
+            "dot": shutil.which("dot"), "spin": shutil.which("spin")}
 
 
 #: Where doit keeps the state of each task (its file_dep signatures), relative to the workspace.

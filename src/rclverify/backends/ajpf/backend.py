@@ -31,6 +31,15 @@ Plan entry keys (``nodes.<Node>.evidence[k]``)::
     timeout_s: 3600                     # per AJPF run, seconds
     results: backends/ajpf/results      # where imported logs are looked for
     log_info: [ ... ]                   # loggers at info level in the .jpf
+    model_checker: spin                 # or ajpf (default: see model_checking.backend)
+    environment: {percepts: [...]}      # SPIN: the verification environment
+    max_states: 100000                  # SPIN: exploration bounds
+    max_depth: 10000
+    properties: [file.psl, ...]         # extra properties, one obligation each
+
+With ``model_checker: spin`` the evidence comes from
+:mod:`rclverify.backends.model_checking.backend` (SPIN on rclverify's own
+exploration of the Gwendolen program) instead of AJPF.
 """
 from __future__ import annotations
 
@@ -81,6 +90,7 @@ class AjpfConfig:
     timeout_s: float = DEFAULT_TIMEOUT_S
     results: str = DEFAULT_RESULTS
     log_info: tuple[str, ...] = DEFAULT_LOG_INFO
+    spin: Any = None  # model_checking.backend.SpinConfig: the SPIN keys, checked
 
 
 @lru_cache(maxsize=1)  # one environment per process: jinja2 then compiles each template once
@@ -127,8 +137,9 @@ def read_config(target: NodeTarget) -> AjpfConfig:
     if not isinstance(log_info, list) or not all(isinstance(x, str) and _JAVA_CLASS.match(x) for x in log_info):
         raise target.config_error("'log_info' must be a list of logger (class) names", "log_info")
     rows = _rows(cfg.get("mapping", []), target, agent, domains)
+    from ..model_checking.backend import read_spin_config  # lazily: model_checking imports ajpf.psl
     return AjpfConfig(agent, model, domains, rows, env_class, home, float(timeout), results.rstrip("/"),
-                      tuple(log_info))
+                      tuple(log_info), read_spin_config(target))
 
 
 def _domains(raw: Any, target: NodeTarget) -> dict[str, tuple[int, int]]:
@@ -265,9 +276,10 @@ class AjpfBackend:
             for u in inst.unmapped:
                 if u not in per_guarantee.setdefault(g, []):
                     per_guarantee[g].append(u)
+        from ..model_checking.backend import extra_obligations
         return [self._obligation(target, cfg, g, clause, inst, numbers, psl_rel, ail_rel, per_guarantee.get(g, []),
                                  coverage.get((g, inst.label), []))
-                for g, clause, inst in planned]
+                for g, clause, inst in planned] + extra_obligations(target, cfg.spin, cfg.agent, cfg.model)
 
     def _obligation(self, target: NodeTarget, cfg: AjpfConfig, g: int, clause: ast.Clause, inst: Instance,
                     numbers: Mapping[str, int], psl_rel: str, ail_rel: str, g_unmapped: Sequence[str],
@@ -315,25 +327,35 @@ class AjpfBackend:
         status = "inconclusive" if ev.status == "discharged" else ev.status
         prefix = "PARTIAL COVERAGE of guarantee " + str(obligation.guarantee) + ": " + "; ".join(notes) + ". "
         if ev.status == "discharged":
-            prefix += "AJPF verified the property, but it does not check the whole guarantee. "
+            prefix += f"{ev.tool.split()[0]} verified the property, but it does not check the whole guarantee. "
         return replace(ev, status=status, explanation=prefix + ev.explanation)
 
     def _run_one(self, obligation: Obligation, target: NodeTarget) -> Evidence:
         """Evidence for one exported obligation.
 
-        Order: an obligation with unmapped atoms is ``pending``; a log at
+        Order: an obligation with unmapped atoms is ``pending``; with
+        ``model_checker: spin`` SPIN gives the evidence; a log at
         ``data["log"]`` is imported; else AJPF runs when MCAPL is installed;
         else ``pending`` with the command to run.  Never ``discharged``
         without a log of a completed AJPF search saying "no errors detected".
         """
         clock = Stopwatch()
         data = obligation.data
-        if "property" not in data:
+        if "property" not in data and "claim" not in data:
             return make_evidence(
                 target, obligation, "pending", tool=TOOL, tool_version="", clock=clock,
                 explanation=("no AJPF property: " + "; ".join(data.get("unmapped", []))
                              + " -- add mapping rows for these atoms to the plan"),
                 details={"unmapped": list(data.get("unmapped", []))})
+        from ..model_checking.backend import chosen_checker, run_spin
+        if chosen_checker(target.config) == "spin":
+            return run_spin(obligation, target, str(target.config["model"]), float(target.config.get(
+                "timeout_s", DEFAULT_TIMEOUT_S)))
+        if "log" not in data:  # a property of the plan's `properties` files
+            return make_evidence(
+                target, obligation, "pending", tool=TOOL, tool_version="", clock=clock,
+                explanation=(f"the AJPF runner checks the derived properties of agent.psl only; check "
+                             f"{data.get('property_file')} with model_checker: spin, or run AJPF on it yourself"))
         log_rel = str(data["log"])
         log_path = target.root / log_rel
         if log_path.is_file():

@@ -1,0 +1,298 @@
+"""The ``ajpf`` plan entry checked by SPIN on rclverify's exploration of the agent program.
+
+The ``ajpf`` backend (:mod:`rclverify.backends.ajpf.backend`) exports one
+obligation per guarantee instance and renders them as the numbered
+properties of ``agent.psl``; with ``model_checker: spin`` this module gives
+their evidence, in two stages as AJPF's own SPIN export does (paper lines
+1338-1475 for the case study's properties):
+
+1. stage one explores the Gwendolen program under the plan's verification
+   ``environment`` into a :class:`StateGraph` (:mod:`.explore`), once per
+   program text, environment and bounds in a process (:data:`_GRAPHS`);
+2. stage two renders the graph with every property of the entry as one
+   Promela model (:mod:`.promela`), compiles its verifier once
+   (:mod:`.spin`) and runs it per property; a violation's trail is mapped
+   back to the graph and the Gwendolen source (:mod:`.trail`).
+
+Plan entry keys this module reads (besides the ``ajpf`` ones)::
+
+    model_checker: spin        # or ajpf; default: ajpf when MCAPL is configured
+                               # (mcapl_home, MCAPL_HOME, AJPF_HOME) or no
+                               # environment is declared, else spin
+    environment: {percepts: [...], after: [...], ...}   # see .environment
+    max_states: 100000         # exploration bounds (a cut graph is inconclusive)
+    max_depth: 10000
+    properties: [backends/ajpf/authors.psl]   # extra property files
+"""
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+import time
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING, Any, Mapping
+
+from ...evidence.records import Evidence, Obligation, SourceRef, make_obligation_id
+from ...evidence.store import atomic_write_text
+from ...rcl.errors import RclError
+from ..ajpf import psl
+from ..base import NodeTarget, Stopwatch, make_evidence
+from . import spin
+from .graph import StateGraph
+from .ltl import Propositions, parse_psl_text, read_psl_file
+from .promela import Claim, PromelaModel, build_model
+from .trail import counterexample, read_replay, summary
+
+if TYPE_CHECKING:
+    from .environment import Environment
+
+TOOL = "SPIN"
+CHECKERS = ("spin", "ajpf")
+DEFAULT_MAX_STATES = 100_000
+DEFAULT_MAX_DEPTH = 10_000
+WHAT = "checked by SPIN on rclverify's exploration of the Gwendolen program"
+
+#: Explored graphs of this process: key (program text, environment, bounds) -> (graph or the error, seconds).
+_GRAPHS: dict[str, tuple[StateGraph | RclError, float]] = {}
+#: Built models: key (graph key, claims) -> (model, its verifier's directory, exploration seconds, build seconds).
+_MODELS: dict[str, tuple[PromelaModel, Path, float]] = {}
+#: Claims of an entry: key (the property files' texts) -> (claims, digest of their names and texts).
+_CLAIMS: dict[str, tuple[list[Claim], str]] = {}
+#: pan results: (model key, claim) -> result.
+_RESULTS: dict[tuple[str, str], spin.CheckResult] = {}
+
+
+@dataclass(frozen=True)
+class SpinConfig:
+    """The SPIN keys of an ``ajpf`` entry, checked (module docstring)."""
+
+    environment: "Environment | None"
+    environment_raw: Any
+    max_states: int
+    max_depth: int
+    properties: tuple[str, ...]
+
+
+def read_spin_config(target: NodeTarget) -> SpinConfig:
+    """Check the SPIN keys of ``target.config``.  Raises a located
+    :class:`PlanError` for a bad ``model_checker``, ``environment``,
+    ``max_states``/``max_depth`` or ``properties`` value, and for
+    ``model_checker: spin`` without an ``environment``."""
+    cfg = target.config
+    checker = cfg.get("model_checker")
+    if checker is not None and checker not in CHECKERS:
+        raise target.config_error(f"'model_checker' must be one of {', '.join(CHECKERS)}, found {checker!r}",
+                                  "model_checker")
+    env = None
+    if "environment" in cfg:
+        try:
+            from .environment import environment_from_plan  # stage one
+        except ImportError:  # an installation without stage one: its evidence says so (run_spin)
+            environment_from_plan = None
+        if environment_from_plan is not None:
+            env = environment_from_plan(cfg["environment"], lambda *p: target.config_loc("environment", *p))
+    elif checker == "spin":
+        raise target.config_error("model_checker spin needs an 'environment': the percepts the verification "
+                                  "environment may send (docs/plan.md, ajpf)", "model_checker")
+    bounds = {}
+    for key, default in (("max_states", DEFAULT_MAX_STATES), ("max_depth", DEFAULT_MAX_DEPTH)):
+        v = cfg.get(key, default)
+        if isinstance(v, bool) or not isinstance(v, int) or v < 1:
+            raise target.config_error(f"'{key}' must be a positive integer", key)
+        bounds[key] = v
+    props = cfg.get("properties", [])
+    if not isinstance(props, list) or not all(isinstance(p, str) and p for p in props):
+        raise target.config_error("'properties' must be a list of property files (workspace-relative)",
+                                  "properties")
+    for i, p in enumerate(props):
+        if not (target.root / p).is_file():
+            raise target.config_error(f"property file {p!r} does not exist", "properties", i)
+    return SpinConfig(env, cfg.get("environment"), bounds["max_states"], bounds["max_depth"], tuple(props))
+
+
+def chosen_checker(config: Mapping[str, Any], environ: Mapping[str, str] | None = None) -> str:
+    """``spin`` or ``ajpf`` for an entry (see the module docstring for the default)."""
+    checker = config.get("model_checker")
+    if checker in CHECKERS:
+        return str(checker)
+    env = os.environ if environ is None else environ
+    mcapl = config.get("mcapl_home") or env.get("MCAPL_HOME") or env.get("AJPF_HOME")
+    return "spin" if "environment" in config and not mcapl else "ajpf"
+
+
+def extra_obligations(target: NodeTarget, cfg: SpinConfig, agent: str, model: str) -> list[Obligation]:
+    """One obligation per property of the entry's ``properties`` files,
+    ``<Node>.g0.ajpf.<file stem>_<label>`` (guarantee 0: not derived from a
+    guarantee).  Raises a located :class:`PlanError` for a bad file."""
+    out = []
+    for k, rel in enumerate(cfg.properties):
+        stem = Path(rel).stem
+        for p in read_psl_file(target.root, rel):
+            out.append(Obligation(
+                id=make_obligation_id(target.node.name, 0, "ajpf", f"{stem}_{p.label}"), node=target.node.name,
+                guarantee=0, backend="ajpf", kind="model checking", statement=f"{p.label}: {p.text}",
+                source=SourceRef(rel, p.line, p.col), instance=f"{stem}:{p.label}", artifact=rel,
+                inputs=(model, rel),
+                data={"agent": agent, "psl": psl.to_text(p.formula), "property_file": rel, "label": p.label,
+                      "claim": f"x{k}_{p.label}"}))
+    return out
+
+
+def _claims(target: NodeTarget, cfg: SpinConfig) -> tuple[list[Claim], str]:
+    """Every property of the entry: ``agent.psl``'s (``p<n>``) and the extra files' (``x<k>_<label>``),
+    and a digest of their names and texts (read once per content in a process)."""
+    psl_path = target.artifacts / "agent.psl"
+    texts = [psl_path.read_bytes() if psl_path.is_file() else b""]
+    texts += [(target.root / rel).read_bytes() for rel in cfg.properties]
+    key = hashlib.sha256(repr((target.rel(psl_path), cfg.properties, texts)).encode()).hexdigest()
+    if key not in _CLAIMS:
+        derived = parse_psl_text(texts[0].decode("utf-8"), target.rel(psl_path))
+        claims = [Claim(f"p{p.label}", p.formula, f"property {p.label} of agent.psl") for p in derived]
+        for k, rel in enumerate(cfg.properties):
+            claims += [Claim(f"x{k}_{p.label}", p.formula, f"{rel}:{p.line} {p.label}")
+                       for p in read_psl_file(target.root, rel)]
+        _CLAIMS[key] = (claims, hashlib.sha256(repr([(c.name, psl.to_text(c.formula))
+                                                     for c in claims]).encode()).hexdigest())
+    return _CLAIMS[key]
+
+
+def _graph(target: NodeTarget, model: str, cfg: SpinConfig) -> tuple[str, StateGraph | RclError, float]:
+    """The graph of ``model`` under the entry's environment and bounds (explored once per
+    process): its cache key, the graph (or the program's error) and the seconds it took."""
+    text = (target.root / model).read_bytes()
+    key = hashlib.sha256(text + json.dumps([model, cfg.environment_raw, cfg.max_states, cfg.max_depth],
+                                           sort_keys=True, default=str).encode()).hexdigest()
+    if key not in _GRAPHS:
+        from .explore import explore  # stage one
+        assert cfg.environment is not None  # run_spin checked it
+        t0 = time.perf_counter()
+        graph: StateGraph | RclError
+        try:
+            graph = explore(target.root / model, model, cfg.environment, cfg.max_states, cfg.max_depth)
+        except RclError as exc:  # an error in the program, located in it
+            graph = exc
+        _GRAPHS[key] = (graph, round(time.perf_counter() - t0, 3))
+    return key, *_GRAPHS[key]
+
+
+def run_spin(obligation: Obligation, target: NodeTarget, model: str, timeout_s: float) -> Evidence:
+    """Evidence for one obligation of an ``ajpf`` entry checked by SPIN.
+
+    ``pending`` when SPIN or gcc is missing (with the install command);
+    ``error`` for an error in the program or a failed build; ``failed``
+    with the lasso for a violated property; ``inconclusive`` when the
+    exploration or pan's search was cut by a bound; ``discharged`` only
+    when pan searched the whole product of a complete graph without error.
+    """
+    clock = Stopwatch()
+    data = obligation.data
+    tools, reason = spin.find_tools()
+    if tools is None:
+        return make_evidence(target, obligation, "pending", tool=TOOL, tool_version="not installed", clock=clock,
+                             explanation=f"{reason}; then re-run the verification",
+                             details={"reason": reason, "install": spin.INSTALL})
+    cfg = read_spin_config(target)
+    if cfg.environment is None:
+        return make_evidence(target, obligation, "error", tool=TOOL, tool_version=tools.version, clock=clock,
+                             explanation="stage one of the model checking (rclverify.backends.model_checking."
+                                         "explore, the Gwendolen explorer) is not part of this installation")
+    gkey, graph, explore_s = _graph(target, model, cfg)
+    if isinstance(graph, RclError):
+        return make_evidence(target, obligation, "error", tool=TOOL, tool_version=tools.version, clock=clock,
+                             explanation=f"the agent program could not be explored: {graph}")
+    claims, digest = _claims(target, cfg)
+    claim = str(data.get("claim") or f"p{data.get('property')}")
+    mine = next((c for c in claims if c.name == claim), None)
+    if mine is None or psl.to_text(mine.formula) != data.get("psl"):
+        return make_evidence(target, obligation, "stale", tool=TOOL, tool_version=tools.version, clock=clock,
+                             explanation=f"property {claim} is no longer the one exported; export again")
+    return check_graph(obligation, target, graph, claims, claim, tools=tools, graph_key=gkey, claims_key=digest,
+                       bounds=(cfg.max_states, cfg.max_depth), explore_s=explore_s, timeout_s=timeout_s, clock=clock)
+
+
+def check_graph(obligation: Obligation, target: NodeTarget, graph: StateGraph, claims: list[Claim], claim: str, *,
+                tools: spin.Tools, graph_key: str, bounds: tuple[int, int], claims_key: str | None = None,
+                explore_s: float = 0.0,
+                timeout_s: float = 3600.0, clock: Stopwatch | None = None) -> Evidence:
+    """Evidence that ``graph`` satisfies the claim named ``claim`` (one of
+    ``claims``, all of which go into one model, built once per
+    ``graph_key`` (what identifies the graph) and ``claims_key`` (the claims;
+    computed when ``None``)): see :func:`run_spin` for the statuses.
+    ``bounds`` are the exploration bounds ``(max_states, max_depth)`` the
+    graph was made with, for the record.  Writes ``spin/model.pml`` and, for
+    a counterexample, ``spin/<claim>.trail.txt`` under ``target.artifacts``.
+    """
+    clock = clock or Stopwatch()
+    mine = next(c for c in claims if c.name == claim)
+    if claims_key is None:
+        claims_key = repr([(c.name, psl.to_text(c.formula)) for c in claims])
+    mkey = hashlib.sha256((graph_key + claims_key).encode()).hexdigest()
+    spin_dir = target.artifacts / "spin"
+    t0 = time.perf_counter()
+    if mkey not in _MODELS or not (_MODELS[mkey][1] / "pan").is_file():
+        pml = build_model(graph, claims)
+        atomic_write_text(spin_dir / "model.pml", pml.text)
+        try:
+            built = spin.compile_model(tools, pml.text, spin_dir / "build", timeout_s)
+        except spin.CompileError as exc:
+            return make_evidence(target, obligation, "error", tool=TOOL, tool_version=tools.version, clock=clock,
+                                 explanation=f"SPIN could not build the verifier: {exc}", log=str(exc))
+        _MODELS[mkey] = (pml, built, round(time.perf_counter() - t0, 3))
+    pml, built, build_s = _MODELS[mkey]
+    depth_bound = max(10_000, 20 * (pml.states + pml.transitions))
+    if (mkey, claim) not in _RESULTS:
+        _RESULTS[(mkey, claim)] = spin.check(tools, built, claim, depth_bound, timeout_s,
+                                                 size=pml.states + pml.transitions)
+    res = _RESULTS[(mkey, claim)]
+    details: dict[str, Any] = {
+        "model_checker": "spin", "claim": claim, "psl": psl.to_text(mine.formula), "states": pml.states,
+        "transitions": pml.transitions, "complete": graph.complete, "cut": graph.cut, "depth": graph.depth,
+        "max_states": bounds[0], "max_depth": bounds[1], "spin_verdict": res.verdict,
+        "spin_states_stored": res.stored, "explore_s": explore_s, "build_s": build_s, "pan_s": res.duration_s,
+        "promela": target.rel(spin_dir / "model.pml"), "propositions": dict(pml.props)}
+    arts = [target.rel(spin_dir / "model.pml")]
+    what = (f"{WHAT} {graph.source} under its verification environment ({pml.states} states, {pml.transitions} "
+            f"transitions; bounds max_states={bounds[0]}, max_depth={bounds[1]})")
+    cex = None
+    if res.verdict == "violated":
+        props = Propositions([mine.formula])
+        try:
+            cex = counterexample(graph, read_replay(res.trail), props)
+        except ValueError as exc:
+            return make_evidence(target, obligation, "error", tool=TOOL, tool_version=tools.version, clock=clock,
+                                 log=res.output + res.trail, details=details,
+                                 explanation=f"{what}: SPIN's trail does not map back to the graph: {exc}")
+        details["lasso"] = cex
+        trail_path = spin_dir / f"{claim}.trail.txt"
+        atomic_write_text(trail_path, "\n".join(cex["trace"]) + "\n")
+        arts.append(target.rel(trail_path))
+    if not graph.complete:
+        status = "inconclusive"
+        why = (f"the exploration was cut ({graph.cut}), so the graph is not the program's whole state space; "
+               f"SPIN's verdict on the cut graph: {res.verdict}" + (f" ({summary(cex)})" if cex else ""))
+    elif res.verdict == "holds":
+        status, why = "discharged", "the property holds on every path (pan: errors: 0, full search)"
+    elif res.verdict == "violated":
+        assert cex is not None
+        status, why = "failed", f"property violated; counterexample: {summary(cex)}"
+    elif res.verdict == "incomplete":
+        status, why = "inconclusive", f"SPIN's search was cut: {res.reason}"
+    else:
+        status, why = "error", f"SPIN failed: {res.reason}"
+    # the counterexample as AJPF's results give it (a summary and the path, one line per step);
+    # the steps as data are details["lasso"]
+    shown = {"lasso": summary(cex), "trace": cex["trace"]} if cex else None
+    return make_evidence(target, obligation, status, tool=TOOL, tool_version=tools.version, clock=clock,
+                         log=res.output, artifacts=tuple(arts), counterexample=shown, details=details,
+                         explanation=f"{what}: {why}")
+
+
+def clear_caches() -> None:
+    """Forget explored graphs, built models and results (tests; a long-lived process)."""
+    _GRAPHS.clear()
+    _MODELS.clear()
+    _RESULTS.clear()
+    _CLAIMS.clear()
+

@@ -1,0 +1,223 @@
+"""Running SPIN: finding it, compiling a model's verifier once, checking one claim.
+
+SPIN's standard procedure (SPIN manual, "Verification"): ``spin -a
+model.pml`` writes the verifier's C source ``pan.c`` (with every ``ltl``
+block of the model as a never claim), ``gcc`` compiles it, and ``./pan -a
+-N <claim>`` searches for acceptance cycles of the system with the claim
+named -- a path on which the negation of the property holds.  The verdict
+is the line ``State-vector ... errors: N``: ``0`` the property holds on
+every path, else ``pan: wrote model.pml.trail``; ``spin -t -p -k <trail>
+model.pml`` replays the trail (:mod:`.trail` reads it).
+
+Compilation flags: ``-DNOREDUCE`` (no partial-order reduction: it brings
+nothing to a one-process model, and without it every interleaving is
+explored by construction), ``-DMEMLIM=<MB>`` (bounded memory: pan stops
+with "pan: out of memory" rather than swapping), ``-O0`` (the verifier of
+an explored graph runs in milliseconds; optimising it costs seconds of
+``gcc``).  Search flags: ``-a`` acceptance cycles, no ``-f`` (weak
+fairness is about processes; the model has one), ``-n`` no unreached-code
+listing, ``-m<depth>`` a search depth no path of the model can exceed,
+``-w<bits>`` a hash table sized to the model (:func:`hash_bits`).  A
+search cut by depth or memory is ``incomplete``, never ``holds``.
+
+A compiled verifier is kept in ``<cache>/<sha256 of the model>/`` (built
+in a temporary directory and renamed into place, so concurrent runs never
+see half a build); each check runs in a fresh temporary directory of its
+own, as ``pan`` writes its trail into its working directory.
+"""
+from __future__ import annotations
+
+import hashlib
+import os
+import re
+import shutil
+import signal
+import subprocess
+import tempfile
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+#: Install command shown when SPIN or gcc is missing (Debian/Ubuntu).
+INSTALL = "apt-get install spin gcc"
+#: pan's memory bound, megabytes.
+MEMLIM_MB = 1024
+CFLAGS = ("-O0", "-DNOREDUCE", f"-DMEMLIM={MEMLIM_MB}")
+
+
+@dataclass(frozen=True)
+class Tools:
+    """SPIN and the C compiler found: executables and their versions."""
+
+    spin: str
+    gcc: str
+    spin_version: str
+    gcc_version: str
+
+    @property
+    def version(self) -> str:
+        """``Spin 6.5.2 (6 December 2019), gcc 12.2.0``."""
+        return f"{self.spin_version}, {self.gcc_version}"
+
+
+@dataclass(frozen=True)
+class CheckResult:
+    """One ``pan`` run on one claim.
+
+    ``verdict``  ``holds`` (errors: 0, search complete), ``violated`` (an
+                 acceptance cycle or a claim reaching its end: counterexample
+                 in ``trail``), ``incomplete`` (search cut: ``reason``) or
+                 ``error`` (``reason``);
+    ``output``   pan's output; ``trail`` the trail file's text ('' if none);
+    ``stored``   states stored by pan (product of model and claim); ``depth``
+                 the depth reached; ``duration_s`` seconds.
+    """
+
+    verdict: str
+    output: str
+    trail: str = ""
+    reason: str = ""
+    stored: int | None = None
+    depth: int | None = None
+    duration_s: float = 0.0
+
+
+_FOUND: dict[tuple[str, str], Tools] = {}
+
+
+def find_tools(path: str | None = None) -> tuple[Tools | None, str]:
+    """``(tools, "")`` when ``spin`` and ``gcc`` are on ``path`` (default
+    ``$PATH``), else ``(None, reason)`` naming what is missing and the
+    command that installs it.  Versions are asked once per executable pair
+    in a process."""
+    spin = shutil.which("spin", path=path)
+    gcc = shutil.which("gcc", path=path) or shutil.which("cc", path=path)
+    missing = [name for name, exe in (("spin", spin), ("gcc", gcc)) if exe is None]
+    if missing:
+        return None, (f"{' and '.join(missing)} not found on PATH: SPIN needs both "
+                      f"(install with: {INSTALL})")
+    assert spin is not None and gcc is not None
+    if (spin, gcc) not in _FOUND:
+        _FOUND[(spin, gcc)] = Tools(
+            spin, gcc, _version([spin, "-V"], r"Spin Version (\S+) -- (.+?)\s*$", "Spin {0} ({1})"),
+            _version([gcc, "--version"], r"(\d+\.\d+(?:\.\d+)?)", "gcc {0}"))
+    return _FOUND[(spin, gcc)], ""
+
+
+def _version(cmd: list[str], pattern: str, fmt: str) -> str:
+    try:
+        out = subprocess.run(cmd, capture_output=True, text=True, timeout=30).stdout
+    except (OSError, subprocess.SubprocessError):
+        return "unknown"
+    m = re.search(pattern, out.splitlines()[0] if out.strip() else "", re.MULTILINE)
+    return fmt.format(*m.groups()) if m else (out.strip().splitlines() or ["unknown"])[0]
+
+
+def _run(cmd: list[str], cwd: Path, timeout_s: float) -> tuple[str, int | None, float]:
+    """Run ``cmd``; returns (stdout+stderr, exit code or None on timeout, seconds)."""
+    t0 = time.perf_counter()
+    proc = subprocess.Popen(cmd, cwd=cwd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, start_new_session=True)
+    try:
+        out, _ = proc.communicate(timeout=max(timeout_s, 0.1))
+        code: int | None = proc.returncode
+    except subprocess.TimeoutExpired:
+        try:
+            os.killpg(proc.pid, signal.SIGKILL)
+        except ProcessLookupError:
+            pass
+        out, _ = proc.communicate()
+        code = None
+    return out.decode("utf-8", errors="replace"), code, round(time.perf_counter() - t0, 3)
+
+
+class CompileError(RuntimeError):
+    """``spin -a`` or ``gcc`` failed (or timed out); the message holds their output."""
+
+
+def compile_model(tools: Tools, text: str, cache: Path, timeout_s: float = 300.0) -> Path:
+    """The directory holding ``model.pml`` and its compiled ``pan`` for the
+    model ``text``, built unless ``cache`` already has it.  Raises
+    :class:`CompileError`; ``OSError`` when ``cache`` cannot be written."""
+    digest = hashlib.sha256(text.encode("utf-8")).hexdigest()[:16]
+    final = cache / digest
+    if (final / "pan").is_file():
+        return final
+    cache.mkdir(parents=True, exist_ok=True)
+    tmp = Path(tempfile.mkdtemp(prefix=".build-", dir=cache))
+    try:
+        (tmp / "model.pml").write_text(text, encoding="utf-8")
+        out, code, _ = _run([tools.spin, "-a", "model.pml"], tmp, timeout_s)
+        if code != 0 or not (tmp / "pan.c").is_file():
+            raise CompileError("spin -a model.pml " + ("timed out" if code is None else f"failed:\n{out}"))
+        out2, code2, _ = _run([tools.gcc, *CFLAGS, "-o", "pan", "pan.c"], tmp, timeout_s)
+        if code2 != 0:
+            raise CompileError("gcc pan.c " + ("timed out" if code2 is None else f"failed:\n{out2}"))
+        for junk in tmp.glob("pan.[bchmpt]"):
+            junk.unlink()
+        try:
+            os.rename(tmp, final)
+        except OSError:  # another run built it first
+            if not (final / "pan").is_file():
+                raise
+        else:
+            for old in cache.iterdir():  # verifiers of earlier models
+                if old.name != digest and not old.name.startswith("."):
+                    shutil.rmtree(old, ignore_errors=True)
+        return final
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)
+
+
+_ERRORS = re.compile(r"errors:\s*(\d+)")
+_STORED = re.compile(r"(\d+)\s+states, stored")
+_DEPTH = re.compile(r"depth reached\s+(\d+)")
+
+
+def hash_bits(size: int) -> int:
+    """pan's ``-w`` for a model of ``size`` states and transitions: a hash
+    table of about four slots per product state (never below 2**12 or above
+    2**24, pan's default, which pan would otherwise allocate and clear for
+    every run: 128 MB).  The table's size changes speed, not the verdict."""
+    return max(12, min(24, (4 * max(size, 1)).bit_length()))
+
+
+def check(tools: Tools, built: Path, claim: str, max_depth: int, timeout_s: float, size: int = 1 << 22
+          ) -> CheckResult:
+    """Search ``built``'s verifier for a violation of ``claim``; on one, replay
+    its trail with SPIN (the replay's text is ``CheckResult.trail``).
+    ``size`` (states plus transitions of the graph) sizes pan's hash table."""
+    with tempfile.TemporaryDirectory(prefix=".run-", dir=built.parent) as tmp:
+        work = Path(tmp)
+        shutil.copy(built / "model.pml", work / "model.pml")
+        out, code, secs = _run([str(built / "pan"), "-a", "-n", f"-N{claim}", f"-m{max_depth}",
+                                 f"-w{hash_bits(size)}"], work, timeout_s)
+        stored = _int(_STORED, out)
+        depth = _int(_DEPTH, out)
+        if code is None:
+            return CheckResult("incomplete", out, reason=f"pan did not finish within {timeout_s:g} s",
+                               stored=stored, depth=depth, duration_s=secs)
+        errors = _int(_ERRORS, out)
+        trail_file = work / "model.pml.trail"
+        if errors and trail_file.is_file():
+            replay, rcode, rsecs = _run([tools.spin, "-T", "-t", "-p", "-k", "model.pml.trail", "model.pml"],
+                                        work, timeout_s)
+            if rcode != 0 and "@" not in replay:
+                return CheckResult("error", out, reason=f"spin could not replay the trail:\n{replay}",
+                                   stored=stored, depth=depth, duration_s=secs + rsecs)
+            return CheckResult("violated", out, trail=replay, stored=stored, depth=depth,
+                               duration_s=round(secs + rsecs, 3))
+        if "out of memory" in out:
+            return CheckResult("incomplete", out, reason=f"pan ran out of memory ({MEMLIM_MB} MB)",
+                               stored=stored, depth=depth, duration_s=secs)
+        if "max search depth too small" in out:
+            return CheckResult("incomplete", out, reason=f"pan's search depth bound {max_depth} was reached",
+                               stored=stored, depth=depth, duration_s=secs)
+        if errors == 0 and code == 0:
+            return CheckResult("holds", out, stored=stored, depth=depth, duration_s=secs)
+        return CheckResult("error", out, reason=f"pan stopped without a verdict (exit code {code})",
+                           stored=stored, depth=depth, duration_s=secs)
+
+
+def _int(pattern: re.Pattern[str], text: str) -> int | None:
+    m = pattern.search(text)
+    return int(m.group(1)) if m else None
