@@ -88,24 +88,24 @@ def test_explain_accepts_requirement_node_and_guarantee_ids(drone: Path, capsys:
     assert "requirements: 2 proved, evidence outstanding" in out and "| FlightController " in out
     assert main(["explain", *w, "SAFE-ALT"]) == 0
     out = capsys.readouterr().out
-    assert out.startswith("requirement SAFE-ALT: proved, evidence outstanding [pending]")
+    assert out.startswith("requirement SAFE-ALT: proved, evidence outstanding [unverified]")
     assert "The output of FlightController stays within 0..100." in out  # its statement
     assert "formal: 0 <= FlightController.out.flight_controller_value" in out
     assert "used: FlightController guarantee 1: " in out and "(contracts/flight_controller.rcl:23:14)" in out
     # a node: its guarantees, their evidence status, its problems
     assert main(["explain", *w, "FlightController"]) == 0
     out = capsys.readouterr().out
-    assert out.startswith("FlightController [pending] (node, contracts/flight_controller.rcl:")
-    assert "FlightController.g1 [pending]" in out and "FlightController.g2 [pending]" in out
+    assert out.startswith("FlightController [unverified] (node, contracts/flight_controller.rcl:")
+    assert "FlightController.g1 [unverified]" in out and "FlightController.g2 [unverified]" in out
     assert "evidence: none: no evidence entry of the plan covers it" in out
     assert "supports: SAFE-ALT" in out and "side conditions: 2/2 proved" in out and "problems: none" in out
     # the same node by its file stem, a guarantee in the forms the outputs use
     assert main(["explain", *w, "flight_controller"]) == 0
-    assert capsys.readouterr().out.startswith("FlightController [pending] (node,")
+    assert capsys.readouterr().out.startswith("FlightController [unverified] (node,")
     for form in ("Geofence.g2", "Geofence g2", "geofence guarantee 2"):
         assert main(["explain", *w, form]) == 0
         out = capsys.readouterr().out
-        assert out.startswith("Geofence.g2 [pending] (guarantee 2 of Geofence, contracts/geofence.rcl:26:3)"), form
+        assert out.startswith("Geofence.g2 [unverified] (guarantee 2 of Geofence, contracts/geofence.rcl:26:3)"), form
         assert "in.battery_monitor_value <= 50 -> out.geofence_value <= in.battery_monitor_value" in out
         assert "supports: REQ2" in out
     # a side condition, a health check, a SARIF rule id
@@ -155,8 +155,8 @@ def test_a_broken_summary_ends_doit_verify_in_one_line_not_a_traceback(drone: Pa
     (ws / "artifacts/report/summary.json").write_text("[]", encoding="utf-8")
     r = _run(ws, "-m", "rclverify.cli", "status")
     assert r.returncode == 1 and "Traceback" not in r.stderr
-    assert r.stderr.strip() == f"{Path('artifacts/report/summary.json')}:1:1: error: not an rclverify summary: " \
-                               "the file is a list, not an object; run `rclverify verify` (or `doit verify`) to write it again"
+    assert r.stderr.strip() == f"{Path('artifacts/report/summary.json')}:1:1: error: summary record is not a JSON " \
+                               "object: altered outside rclverify; run `rclverify verify` (or `doit verify`) to write it again"
 
 
 # ---------------------------------------------------------------------------
@@ -188,8 +188,9 @@ def test_strict_ends_in_one_sentence_naming_why(grounded: tuple[Path, subprocess
     assert r.returncode == 1
     assert "TaskFailed" not in r.stdout + r.stderr and "taskid" not in r.stdout + r.stderr
     last = r.stdout.rstrip().splitlines()[-1]
-    assert last == ("--strict failed: 8 guarantees have no evidence, no evidence entry of the plan covers them "
-                    "(BatteryMonitor.g1, BatteryMonitor.g2, Geofence.g1, Geofence.g2, ...); 2 ROS grounding errors "
+    assert last == ("--strict failed: 8 guarantees are unverified (no obligation covers them): "
+                    "BatteryMonitor.g1, BatteryMonitor.g2, Geofence.g1, Geofence.g2, ...; 2 formal requirements are "
+                    "not met (SAFE-ALT, REQ2); 2 ROS grounding errors "
                     "(`rclverify ros check`) (reports/assurance.html)."), last
     r2 = _run(ws, "-m", "rclverify.cli", "verify", "--strict")
     assert r2.returncode == 1 and r2.stdout.rstrip().splitlines()[-1] == last
@@ -271,7 +272,7 @@ def test_init_from_ros_names_contract_files_in_snake_case_as_init_does(tmp_path:
 def test_a_no_op_run_prints_the_table_and_the_docs_say_so(drone: Path) -> None:
     r = _run(drone, "-m", "doit", "verify")
     assert r.returncode == 0 and ".  " not in r.stdout  # no task ran
-    assert "| total " in r.stdout and r.stdout.startswith("-- ") and "overall: pending" in r.stdout
+    assert "| total " in r.stdout and r.stdout.startswith("-- ") and "overall: unverified" in r.stdout
     ci = (ROOT / "docs/ci.md").read_text(encoding="utf-8")
     assert "prints\n  no table" not in ci and "no table" not in ci.replace("\n  ", " ")
 

@@ -137,8 +137,10 @@ def test_2_records_altered_outside_rclverify_are_error_and_made_again(tmp_path: 
     # a summary edited to look green is not shown by `rclverify status`
     capsys.readouterr()
     _forge(ws / "artifacts/report/summary.json", lambda d: d["summary"].update(status="discharged"))
-    assert main(["status", "-w", str(ws)]) == 0
-    assert "artifacts/report/summary.json: error: summary record altered outside rclverify" in capsys.readouterr().err
+    assert main(["status", "-w", str(ws)]) == 1
+    err = capsys.readouterr().err
+    assert "artifacts/report/summary.json:1:1: error: summary record altered outside rclverify" in err
+    assert "discharged" not in err
 
     # `doit verify` does not believe them either: it makes each again, and says so
     r = _doit(ws, "verify")
@@ -164,7 +166,7 @@ def test_2_records_altered_outside_rclverify_are_error_and_made_again(tmp_path: 
 def test_3_strict_fails_on_a_formal_requirement_not_met_and_not_on_an_informal_one(tmp_path: Path) -> None:
     refuted = _copy(tmp_path, "0.3")
     r = _doit(refuted, "verify", "--strict")
-    assert r.returncode != 0 and "a formal requirement is not met" in r.stdout + r.stderr
+    assert r.returncode != 0 and "1 formal requirement is not met (STOP)" in r.stdout + r.stderr
     # every obligation is discharged: the refuted requirement alone fails it
     assert {o["status"] for o in _report(refuted)["obligations"]} == {"discharged"}
     assert _reqs(refuted)["STOP"]["verdict"] == "refuted"

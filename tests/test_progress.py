@@ -108,6 +108,7 @@ def test_verify_prints_the_summary_written_with_the_report(tmp_path: Any, capsys
     data["summary"] = {**data["summary"], "headline": "from the summary file"}
     data["meta"]["strict_ok"] = True
     (tmp_path / Workspace.SUMMARY).parent.mkdir(parents=True)
-    (tmp_path / Workspace.SUMMARY).write_text(json.dumps(data))
+    from rclverify.evidence.sealed import write_sealed
+    write_sealed(tmp_path / Workspace.SUMMARY, data)  # as the report task writes it: sealed
     assert act_verify(str(tmp_path), True) is None
     assert "overall: failed -- from the summary file" in capsys.readouterr().out

@@ -130,7 +130,9 @@ def test_explain_prints_findings_without_a_record_of_their_own(tmp_path: Path, c
     assert out.startswith("FlightController.derived [failed] (derived property)")
     assert "guarantee 2 of BatteryMonitor (contracts/battery_monitor.rcl:12:3)" in out
     assert "the same root cause, found by: MissionPlanner.sc2, MissionPlanner.derived" in out
-    assert main(["explain", "-w", str(root), "FlightController"]) == 1  # a bare node name is no finding
+    capsys.readouterr()
+    assert main(["explain", "-w", str(root), "FlightController"]) == 0  # a node: explained as a node, not a finding
+    assert capsys.readouterr().out.startswith("FlightController [")
 
 
 def test_a_stored_report_without_where_or_unverified_still_renders() -> None:

@@ -134,5 +134,5 @@ def test_explain_prints_an_unverified_guarantee(tmp_path: Path, capsys) -> None:
     capsys.readouterr()
     assert main(["explain", "-w", str(root), "Geofence.g1"]) == 0
     out = capsys.readouterr().out
-    assert out.startswith("Geofence.g1 [unverified] (unverified guarantee)")
-    assert "guarantee 1 of Geofence (contracts/geofence.rcl:8:3)" in out
+    assert out.startswith("Geofence.g1 [unverified] (guarantee 1 of Geofence, contracts/geofence.rcl:8:3)")
+    assert "no evidence entry of the plan covers it (`unverified`" in out

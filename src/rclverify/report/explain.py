@@ -229,11 +229,12 @@ class _Index:
 
     def guarantee_lines(self, node: str, g: Mapping[str, Any], indent: str = "") -> list[str]:
         k = g["index"]
-        out = [f"{indent}{node}.g{k} [{g['status']}] (guarantee {k} of {node}, {g.get('source', '')})",
-               f"{indent}  {g['text']}"]
         obs = [x for kind, x in self.items.values() if kind == "obligation" and x["node"] == node and x.get("guarantee") == k]
+        status = "unverified" if not obs and not g.get("obligations") else g["status"]  # no obligation covers it
+        out = [f"{indent}{node}.g{k} [{status}] (guarantee {k} of {node}, {g.get('source', '')})",
+               f"{indent}  {g['text']}"]
         if not obs and not g.get("obligations"):
-            out.append(f"{indent}  evidence: none: no evidence entry of the plan covers it (`pending`; docs/plan.md)")
+            out.append(f"{indent}  evidence: none: no evidence entry of the plan covers it (`unverified`; docs/plan.md)")
         if len(obs) <= SHOWN_OBLIGATIONS:
             out += [f"{indent}  evidence: {o['id']} [{o['status']}] ({o.get('backend')})" for o in obs]
         else:  # many instances (AJPF's one per waypoint): counted, the bad ones named

@@ -164,9 +164,8 @@ def strict_reasons(report: Mapping[str, Any]) -> list[str]:
     bare = [f"{n['name']}.g{g['index']}" for n in report["nodes"] for g in n.get("guarantees", [])
             if not g.get("obligations")]
     if bare:
-        out.append(f"{len(bare)} guarantee{'s have' if len(bare) != 1 else ' has'} no evidence, no evidence entry "
-                   f"of the plan covers {'them' if len(bare) != 1 else 'it'} ("
-                   + ", ".join(bare[:4]) + (", ..." if len(bare) > 4 else "") + ")")
+        out.append(f"{len(bare)} guarantee{'s are' if len(bare) != 1 else ' is'} unverified (no obligation covers "
+                   f"{'them' if len(bare) != 1 else 'it'}): " + ", ".join(bare[:4]) + (", ..." if len(bare) > 4 else ""))
     sc = [x for x in report["side_conditions"] if x["status"] != "discharged"]
     if sc:
         out.append(f"{len(sc)} side condition{'s are' if len(sc) != 1 else ' is'} not proved")
@@ -287,17 +286,15 @@ def read_summary(root: Path) -> dict[str, Any]:
     :func:`rclverify.report.lastrun.read_checked` does."""
     from ..workspace import Workspace
     from .lastrun import SUMMARY_SHAPE, SUMMARY_SOURCE_SHAPE, located, read_checked
-    import sys
-
     from ..evidence.sealed import read_sealed
     path = root / Workspace.SUMMARY
     if path.exists():
         # sealed: a summary altered outside rclverify is said so and never shown (docs/integrity.md)
         _, problem = read_sealed(path, "summary record")
-        if not problem:
-            data: dict[str, Any] = read_checked(path, SUMMARY_SHAPE, "an rclverify summary")
-            return data
-        print(f"{Workspace.SUMMARY}: error: {problem}; showing reports/assurance.json instead", file=sys.stderr)
+        if problem:
+            raise located(path, f"{problem}; run `rclverify verify` (or `doit verify`) to write it again")
+        data: dict[str, Any] = read_checked(path, SUMMARY_SHAPE, "an rclverify summary")
+        return data
     report = read_checked(root / "reports/assurance.json", SUMMARY_SOURCE_SHAPE, "an rclverify report")
     try:
         return summary_data(report)
