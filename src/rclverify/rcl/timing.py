@@ -44,6 +44,19 @@ def seconds(d: ast.Deadline) -> Fraction | None:
     return Fraction(d.amount) * UNITS[d.unit]
 
 
+def parse_duration(text: str) -> Fraction | None:
+    """``"500 ms"`` -> ``Fraction(1, 2)``; ``None`` when the number or the
+    unit (``ns``, ``us``, ``ms``, ``s``, ``min``) is missing or unknown."""
+    parts = str(text).split()
+    if len(parts) != 2 or parts[1] not in UNITS:
+        return None
+    try:
+        value = Fraction(parts[0])
+    except (ValueError, ZeroDivisionError):
+        return None
+    return value * UNITS[parts[1]] if value > 0 else None
+
+
 def check_links(n: ast.Node, err: Report) -> bool:
     """Check the service and action links of node ``n``; report each misuse
     through ``err(loc, message, code)``.  Returns ``True`` when all hold."""
