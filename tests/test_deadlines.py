@@ -140,3 +140,29 @@ def test_plan_deadline_without_unit_or_unknown_node_is_located(tmp_path: Path,
     plan.write_text(text.replace("path: [Teleop, Base]", "path: [Teleop, Bse]"))
     assert main(["deadlines", "-w", str(ws)]) == 1
     assert "contracts/plan.yaml:12:15: error: no node named 'Bse' in the contracts" in capsys.readouterr().err
+
+
+def test_backends_say_they_check_the_untimed_part_only(tmp_path: Path) -> None:
+    ws = _copy(tmp_path)
+    assert main(["verify", "-w", str(ws)]) == 0
+    ev = {p.stem: json.loads(p.read_text()) for p in (ws / "artifacts" / "evidence").glob("*.json")}
+    hoare = ev["Base.g1.hoare.base.c1"]
+    assert hoare["status"] == "discharged"
+    assert hoare["explanation"].startswith("untimed part only: hoare checks guarantee 1's formula, not its "
+                                           "timing 'triggered by in.stop_req within 200 ms'")
+    assert hoare["details"]["timing"]["checked"] is False
+    prop = ev["Mover.g1.property_tests.e0"]
+    assert prop["details"]["timing"]["clause"] == "triggered by in.target within 2 s"
+    untimed = ev["Mover.g2.property_tests.e0"]  # guarantee 2 has no timing: nothing added
+    assert "timing" not in untimed["details"] and "untimed" not in untimed["explanation"]
+
+
+@pytest.mark.parametrize("backend", ["dafny", "ajpf", "hoare", "property_tests", "experiment", "review"])
+def test_every_untimed_backend_says_so_and_the_monitors_do_not(backend: str) -> None:
+    from rclverify.backends.timing_scope import scope
+    checked, _ = system((EXAMPLE / "contracts" / "safety_stop.rcl").read_text())
+    base = checked.nodes["Base"]
+    text, details = scope(backend, base, 1, "ran", {"k": 1})
+    assert text.startswith(f"untimed part only: {backend} checks guarantee 1's formula") and text.endswith(". ran")
+    assert details["k"] == 1 and details["timing"]["clause"] == "triggered by in.stop_req within 200 ms"
+    assert scope("monitors", base, 1, "ran", {}) == ("ran", {})
