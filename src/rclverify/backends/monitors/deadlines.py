@@ -29,6 +29,7 @@ actionlib's ``a/goal``, ``a/feedback`` and ``a/result`` (the message's
 """
 from __future__ import annotations
 
+from collections import deque
 from dataclasses import dataclass, field
 from typing import Any, Callable, Iterable, Mapping
 
@@ -60,11 +61,14 @@ class DeadlineVerdict:
     answer: float | None = None
     answer_where: str = ""
     reason: str = ""
+    #: the late answer of a trigger already judged ``false`` when its deadline expired (not a new verdict)
+    update: bool = False
 
     def to_json(self) -> dict[str, Any]:
         return {"node": self.node, "guarantee": self.guarantee, "verdict": self.verdict,
                 "trigger_where": self.trigger_where, "trigger_stamp": self.trigger_stamp, "due": self.due,
-                "answer": self.answer, "answer_where": self.answer_where, "reason": self.reason}
+                "answer": self.answer, "answer_where": self.answer_where, "reason": self.reason,
+                "update": self.update}
 
 
 @dataclass
@@ -131,10 +135,17 @@ class DeadlineMonitor:
             self.timed.append((k, cl, f"in.{cl.trigger.name}", outs, float(seconds(cl.deadline))))  # type: ignore[arg-type]
         self.values: dict[str, Any] = {}
         self.pending: list[_Pending] = []
+        self.expired: deque[_Pending] = deque(maxlen=256)  # judged false, waiting for a late answer to show
         self.now = float("-inf")
         self.result = DeadlineResult(node.name)
 
     def _emit(self, v: DeadlineVerdict) -> None:
+        if v.update:  # the answer of an expired obligation: shown, not counted again
+            if self.result.first_false is not None and self.result.first_false.trigger_where == v.trigger_where:
+                self.result.first_false = v
+            if self.on_verdict is not None:
+                self.on_verdict(v)
+            return
         self.result.counts[v.verdict] += 1
         if v.verdict == "false" and self.result.first_false is None:
             self.result.first_false = v
@@ -172,6 +183,13 @@ class DeadlineMonitor:
                 self.pending.append(_Pending(k, ev, stamp, stamp + d, inputs))
 
     def _answer(self, ev: Event, stamp: float, outs: set[str]) -> None:
+        for p in list(self.expired):
+            if self._answers(p, stamp, outs):
+                self.expired.remove(p)
+                self._emit(DeadlineVerdict(self.node.name, p.k, "false", p.trigger.where, p.stamp, p.due, stamp,
+                                           ev.where, f"answered after {_ms(stamp - p.stamp)}, "
+                                           f"{_ms(stamp - p.due)} past the deadline of {_ms(p.due - p.stamp)}",
+                                           update=True))
         keep: list[_Pending] = []
         for p in self.pending:
             k, cl, _, gouts, d = next(t for t in self.timed if t[0] == p.k)
@@ -192,6 +210,15 @@ class DeadlineMonitor:
                                            f"{_ms(stamp - p.due)} past the deadline of {_ms(d)}"))
         self.pending = keep
 
+    def _answers(self, p: _Pending, stamp: float, outs: set[str]) -> bool:
+        """Whether outputs ``outs`` now (stamp ``stamp``) answer obligation ``p``."""
+        _, cl, _, gouts, _ = next(t for t in self.timed if t[0] == p.k)
+        if not (gouts & outs) or stamp < p.stamp:
+            return False
+        values = dict(p.inputs)
+        values.update({key: v for key, v in self.values.items() if key.startswith("out.")})
+        return evaluate(cl.formula, self.checked, self.node, values) is True
+
     def advance(self, now: float) -> None:
         """Move the clock to ``now`` (s); obligations due before it are ``false``."""
         if now <= self.now:
@@ -203,6 +230,7 @@ class DeadlineMonitor:
                 d = p.due - p.stamp
                 self._emit(DeadlineVerdict(self.node.name, p.k, "false", p.trigger.where, p.stamp, p.due, None, "",
                                            f"no answer within the deadline of {_ms(d)} (clock at {now:.3f} s)"))
+                self.expired.append(p)
             else:
                 keep.append(p)
         self.pending = keep
