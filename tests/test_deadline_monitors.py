@@ -109,3 +109,19 @@ def test_monitors_evidence_carries_the_deadlines(tmp_path: Path) -> None:
     mover = json.loads((ws / "artifacts" / "evidence" / "Mover.g0.monitors.nominal_jsonl.json").read_text())
     # guarantee 2 is untimed and nothing carried it: the deadlines alone do not discharge the node
     assert mover["status"] == "pending" and mover["details"]["deadlines"]["counts"]["true"] == 1
+
+
+def test_a_trigger_without_deadline_is_bounded_by_the_horizon() -> None:
+    text = """node Echo {
+  inputs( x : REAL )
+  outputs( y : REAL )
+  topics( std_msgs/Float64 x matches(in.x), std_msgs/Float64 y matches(out.y) )
+  guarantee( out.y == in.x ) triggered by in.x
+}"""
+    checked = check([parse_text(text, "e.rcl")])
+    echo = checked.nodes["Echo"]
+    evs = [_ev(0, "x", 0.0, data=1.0), _ev(1, "y", 0.4, data=1.0), _ev(2, "x", 1.0, data=2.0), _ev(3, "y", 3.0, data=2.0)]
+    r = check_deadlines(checked, [echo], evs, {}, horizon=1.0)[0]
+    assert r.counts == {"true": 1, "currently_false": 0, "false": 1}
+    assert r.first_false is not None and r.first_false.answer == 3.0
+    assert check_deadlines(checked, [echo], evs, {})[0].counts["true"] == 0  # no horizon: not checked

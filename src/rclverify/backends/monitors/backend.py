@@ -220,12 +220,13 @@ def with_deadlines(target: NodeTarget, cfg: MonitorConfig, trace: str, status: s
     same trace (:mod:`.deadlines`): the worse status wins; returns
     ``(status, explanation, {"deadlines": ...})``."""
     res = check_deadlines(target.checked, [target.node],
-                          read_trace(target.root / trace, [target.root / d for d in cfg.msg_dirs]), cfg.rules)[0]
+                          read_trace(target.root / trace, [target.root / d for d in cfg.msg_dirs]), cfg.rules,
+                          horizon=cfg.horizon)[0]
     dstatus, dexpl = deadline_status(res, trace)
     rank = {"discharged": 0, "pending": 1, "inconclusive": 2, "failed": 3}
     # An untimed check that saw nothing (pending) leaves the verdict to the deadline monitor only when every
     # guarantee is timed (it then evaluated each one on each answer); else the worse of the two wins.
-    all_timed = all(c.deadline is not None for c in target.node.node.guarantees)
+    all_timed = all(c.trigger is not None for c in target.node.node.guarantees)
     worse = dstatus if (status == "pending" and all_timed) or rank.get(dstatus, 0) > rank.get(status, 0) else status
     return worse, f"deadlines: {dexpl}; untimed: {explanation}", {"deadlines": res.to_json()}
 

@@ -78,7 +78,8 @@ def monitor_command(args: argparse.Namespace, checked: Checked) -> int:
                 print(f"  {status}: {explanation}")
         timed = [n for n in checked.nodes.values() if has_deadlines(n)]
         try:
-            dres = check_deadlines(checked, timed, read_trace(path, [root / d for d in cfg.msg_dirs]), cfg.rules)
+            dres = check_deadlines(checked, timed, read_trace(path, [root / d for d in cfg.msg_dirs]), cfg.rules,
+                                   horizon=cfg.horizon)
         except Exception as exc:  # read once already: a second read failing is still a located message
             _emit(report, args.json)
             print(f"{trace}: error: the deadlines could not be checked: {type(exc).__name__}: {exc}", file=sys.stderr)

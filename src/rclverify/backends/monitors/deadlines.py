@@ -14,6 +14,10 @@ ROSMonitoring's terms:
 * ``currently_false``: not answered yet and the deadline not yet expired (a
   run that ends then, or a live query before the deadline).
 
+A ``triggered by`` without ``within`` is checked the same way with the
+monitor's ``horizon`` as its bound (offline; the live proxy has none, so
+it checks only guarantees with a deadline).
+
 **Clock.**  An event's time is its message's ``header.stamp`` when it has one
 (:func:`~.online.header_stamp`), else the time the trace gives it (the
 recording time of a bag, ``time`` of a ROSMonitoring log line).  A service
@@ -123,16 +127,20 @@ class DeadlineMonitor:
     ``finish()`` the result.  ``on_verdict`` gets every decided verdict."""
 
     def __init__(self, checked: Checked, node: CheckedNode, rules: Mapping[str, TopicRule],
-                 on_verdict: Callable[[DeadlineVerdict], None] | None = None) -> None:
+                 on_verdict: Callable[[DeadlineVerdict], None] | None = None, horizon: float | None = None) -> None:
         self.checked, self.node, self.rules, self.on_verdict = checked, node, rules, on_verdict
         self.bindings = topic_bindings(node)
         self.timed: list[tuple[int, ast.Clause, str, frozenset[str], float]] = []
         for k, cl in enumerate(node.node.guarantees, 1):
-            if cl.trigger is None or cl.deadline is None or seconds(cl.deadline) is None:
+            if cl.trigger is None:
+                continue
+            # `triggered by` without `within`: answered at all, judged after the monitor's horizon (s)
+            bound = seconds(cl.deadline) if cl.deadline is not None else horizon
+            if bound is None:
                 continue
             outs = frozenset(f"out.{e.name}" for e in subexpressions(cl.formula)
                              if isinstance(e, ast.Var) and e.prefix == "out")
-            self.timed.append((k, cl, f"in.{cl.trigger.name}", outs, float(seconds(cl.deadline))))  # type: ignore[arg-type]
+            self.timed.append((k, cl, f"in.{cl.trigger.name}", outs, float(bound)))
         self.values: dict[str, Any] = {}
         self.pending: list[_Pending] = []
         self.expired: deque[_Pending] = deque(maxlen=256)  # judged false, waiting for a late answer to show
@@ -249,10 +257,11 @@ class DeadlineMonitor:
 
 
 def check_deadlines(checked: Checked, nodes: Iterable[CheckedNode], events: Iterable[Event],
-                    rules: Mapping[str, TopicRule],
-                    on_verdict: Callable[[DeadlineVerdict], None] | None = None) -> list[DeadlineResult]:
-    """The deadline monitors of ``nodes`` run over a recorded trace, in order."""
-    monitors = [DeadlineMonitor(checked, n, rules, on_verdict) for n in nodes]
+                    rules: Mapping[str, TopicRule], on_verdict: Callable[[DeadlineVerdict], None] | None = None,
+                    horizon: float | None = None) -> list[DeadlineResult]:
+    """The deadline monitors of ``nodes`` run over a recorded trace, in
+    order; ``horizon`` (s) bounds a ``triggered by`` without ``within``."""
+    monitors = [DeadlineMonitor(checked, n, rules, on_verdict, horizon) for n in nodes]
     for ev in events:
         for m in monitors:
             m.feed(ev)
@@ -260,8 +269,8 @@ def check_deadlines(checked: Checked, nodes: Iterable[CheckedNode], events: Iter
 
 
 def has_deadlines(node: CheckedNode) -> bool:
-    """Whether ``node`` has a guarantee with a deadline."""
-    return any(c.deadline is not None for c in node.node.guarantees)
+    """Whether ``node`` has a guarantee with a trigger (with or without a deadline)."""
+    return any(c.trigger is not None for c in node.node.guarantees)
 
 
 def _ms(x: float) -> str:

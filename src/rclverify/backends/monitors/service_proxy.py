@@ -39,7 +39,7 @@ from typing import Any, Sequence
 from ...rcl.errors import RclError
 from ...rcl.typecheck import load
 from ...traces.events import Event
-from .deadlines import DeadlineMonitor, DeadlineVerdict, has_deadlines
+from .deadlines import DeadlineMonitor, DeadlineVerdict
 from .ros1 import RosUnavailable, flatten, import_rospy
 from .ros1_interfaces import action_classes, service_class
 
@@ -109,7 +109,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         print(str(exc), file=sys.stderr)
         return 2
     forwards = dict(f.split("=", 1) for f in args.forward if "=" in f)
-    nodes = [n for n in checked.nodes.values() if has_deadlines(n)]
+    nodes = [n for n in checked.nodes.values() if any(c.deadline is not None for c in n.node.guarantees)]
     dirs = [Path(d) for d in args.interfaces]
     try:
         rospy = import_rospy()
