@@ -135,3 +135,9 @@ def test_cli_check_reports_located_errors_without_traceback(tmp_path: Path,
     err = capsys.readouterr().err
     assert f"{f}:7:69: error: deadline 'within 200' has no unit" in err
     assert "Traceback" not in err
+
+
+def test_a_triggered_guarantee_must_mention_an_output() -> None:
+    text = BASE.replace("guarantee( out.res or not out.res )", "guarantee( in.goal >= 0 ) triggered by in.goal")
+    assert errors_of(text) == ["f.rcl:9:42: error: a guarantee triggered by in.goal must mention an output "
+                               "(out.y): the output is what answers the trigger"]

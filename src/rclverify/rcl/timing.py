@@ -8,7 +8,8 @@ The rules (docs/rcl-language.md, "Services, actions and deadlines"):
   round.  An action link lists goal, feedback and result: the server reads
   the goal and writes feedback and result, a client the opposite.
 * ``triggered by in.x`` names an input of the node (the event the output
-  answers); an output there is an error.
+  answers); an output there is an error, and so is a guarantee that mentions
+  no output (nothing could answer the trigger).
 * ``within N unit`` needs a unit (``ns``, ``us``, ``ms``, ``s``, ``min``),
   a positive amount, and a trigger to measure from.
 
@@ -21,6 +22,7 @@ from fractions import Fraction
 from typing import Callable
 
 from . import ast
+from .walk import subexpressions
 
 #: Seconds per unit of a deadline.
 UNITS: dict[str, Fraction] = {"ns": Fraction(1, 10**9), "us": Fraction(1, 10**6), "ms": Fraction(1, 1000),
@@ -103,6 +105,10 @@ def check_clause(n: ast.Node, cl: ast.Clause, err: Report) -> bool:
             err(t.loc, f"'triggered by' must name an input of node {n.name} (in.x), found {_show(t)}",
                 "E-trigger")
             ok = False
+    if t is not None and not any(isinstance(e, ast.Var) and e.prefix == "out" for e in subexpressions(cl.formula)):
+        err(t.loc, f"a guarantee triggered by {_show(t)} must mention an output (out.y): the output is what "
+            "answers the trigger", "E-trigger")
+        ok = False
     d = cl.deadline
     if d is not None:
         if d.unit is None:
