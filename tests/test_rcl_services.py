@@ -141,3 +141,9 @@ def test_a_triggered_guarantee_must_mention_an_output() -> None:
     text = BASE.replace("guarantee( out.res or not out.res )", "guarantee( in.goal >= 0 ) triggered by in.goal")
     assert errors_of(text) == ["f.rcl:9:42: error: a guarantee triggered by in.goal must mention an output "
                                "(out.y): the output is what answers the trigger"]
+
+
+def test_zero_and_huge_deadlines_are_refused_quickly() -> None:
+    for amount in ("0", "1e999999999"):
+        msgs = errors_of(BASE.replace("within 200 ms", f"within {amount} ms"))
+        assert msgs == ["f.rcl:7:69: error: a deadline must be positive and at most 1e+09 ms"]

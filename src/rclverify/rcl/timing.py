@@ -38,12 +38,30 @@ _SERVER_SIDE: dict[str, tuple[str, ...]] = {"service": ("in", "out"), "action": 
 Report = Callable[[ast.Loc, str, str], None]
 
 
+#: The largest amount a deadline may be written with (a hostile ``1e999999999``
+#: would otherwise be expanded to an exact integer of a billion digits).
+MAX_AMOUNT = 1e9
+
+
+def _amount(text: str) -> Fraction | None:
+    """``text`` as an exact positive number, ``None`` when it is not one or
+    exceeds :data:`MAX_AMOUNT`."""
+    try:
+        f = float(text)
+    except ValueError:
+        return None
+    if not 0 < f <= MAX_AMOUNT:
+        return None
+    return Fraction(text)
+
+
 def seconds(d: ast.Deadline) -> Fraction | None:
     """The deadline in seconds (exact), or ``None`` when its unit is missing
-    or unknown.  ``within 200 ms`` -> ``Fraction(1, 5)``."""
+    or unknown or its amount not in (0, 1e9].  ``within 200 ms`` -> ``Fraction(1, 5)``."""
     if d.unit is None or d.unit not in UNITS:
         return None
-    return Fraction(d.amount) * UNITS[d.unit]
+    a = _amount(d.amount)
+    return None if a is None else a * UNITS[d.unit]
 
 
 def parse_duration(text: str) -> Fraction | None:
@@ -52,11 +70,8 @@ def parse_duration(text: str) -> Fraction | None:
     parts = str(text).split()
     if len(parts) != 2 or parts[1] not in UNITS:
         return None
-    try:
-        value = Fraction(parts[0])
-    except (ValueError, ZeroDivisionError):
-        return None
-    return value * UNITS[parts[1]] if value > 0 else None
+    value = _amount(parts[0])
+    return None if value is None else value * UNITS[parts[1]]
 
 
 def check_links(n: ast.Node, err: Report) -> bool:
@@ -118,8 +133,8 @@ def check_clause(n: ast.Node, cl: ast.Clause, err: Report) -> bool:
         elif d.unit not in UNITS:
             err(d.loc, f"unknown time unit {d.unit!r} in deadline (units: {', '.join(UNITS)})", "E-deadline")
             ok = False
-        elif Fraction(d.amount) <= 0:
-            err(d.loc, "a deadline must be positive", "E-deadline")
+        elif _amount(d.amount) is None:
+            err(d.loc, f"a deadline must be positive and at most {MAX_AMOUNT:g} {d.unit}", "E-deadline")
             ok = False
         if t is None:
             err(d.loc, "a deadline needs 'triggered by in.x' before it: the time is measured from that input",
