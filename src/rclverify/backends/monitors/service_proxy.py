@@ -133,12 +133,19 @@ def main(argv: Sequence[str] | None = None) -> int:
     for name, cls in svc_classes.items():
         real = forwards["/" + name.lstrip("/")]
 
-        def handle(req: Any, name: str = name, cls: Any = cls, real: str = real) -> Any:
+        rospy.wait_for_service(real, timeout=30)
+        # one persistent connection to the real server: a call's stamps do not include connecting anew
+        conn = {"proxy": rospy.ServiceProxy(real, cls, persistent=True)}
+
+        def handle(req: Any, name: str = name, cls: Any = cls, real: str = real, conn: dict[str, Any] = conn) -> Any:
             run.event(f"{name}/request", flatten(req), now())
-            resp = rospy.ServiceProxy(real, cls)(req)  # a failure reaches the caller as a ServiceException
+            try:
+                resp = conn["proxy"](req)
+            except rospy.ServiceException:  # the server restarted: connect again once; a second failure reaches the caller
+                conn["proxy"] = rospy.ServiceProxy(real, cls, persistent=True)
+                resp = conn["proxy"](req)
             run.event(f"{name}/response", flatten(resp), now())
             return resp
-        rospy.wait_for_service(real, timeout=30)
         keep.append(rospy.Service("/" + name.lstrip("/"), cls, handle))
     for name, classes in act_classes.items():
         for part, cls in classes.items():
