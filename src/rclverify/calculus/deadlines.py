@@ -21,7 +21,7 @@ from typing import Any, Sequence
 import z3
 
 from ..rcl import ast
-from ..rcl.timing import parse_duration, seconds  # noqa: F401  (parse_duration re-exported)
+from ..rcl.timing import seconds
 from ..rcl.types import Checked
 from ..rcl.walk import subexpressions
 from ..system.model import SystemModel
