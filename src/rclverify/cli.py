@@ -209,6 +209,19 @@ def cmd_requirements(args: argparse.Namespace) -> int:
     return show_requirements(ws, sys.stdout)
 
 
+def cmd_deadlines(args: argparse.Namespace) -> int:
+    """Decide every requirement's end-to-end deadline (rule D3,
+    calculus/deadlines.py), write ``artifacts/deadlines.json`` and print
+    each result; exit 1 when one is refuted or inconclusive."""
+    from .calculus.deadlines import PROVED, decide_plan, show
+    from .evidence.store import write_json
+    ws = _ws(args)
+    results = decide_plan(ws.plan, ws.checked, ws.model)
+    write_json(ws.root / "artifacts" / "deadlines.json", [r.to_json() for r in results])
+    sys.stdout.write(json.dumps([r.to_json() for r in results], indent=2) + "\n" if args.json else show(results))
+    return 0 if all(r.status == PROVED for r in results) else 1
+
+
 @contextmanager
 def _run_lock(args: argparse.Namespace) -> Iterator[None]:
     """Hold the workspace's run lock (:mod:`rclverify.runlock`) for the block:
@@ -502,6 +515,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     rep = add("report", cmd_report, "rebuild the assurance report from the artifacts", True)
     add("requirements", cmd_requirements, "check each formal requirement with Z3 from the composed contracts and "
         "print its status", True).add_argument("--force", action="store_true", help="check every requirement again")
+    add("deadlines", cmd_deadlines, "decide each requirement's end-to-end deadline with Z3 (deadlines add along "
+        "the path)", True).add_argument("--json", action="store_true", help="print the results as JSON")
     add("cache", cmd_cache, "list what the workspace keeps between runs (artifacts/cache), or clear it",
         True).add_argument("--clear", action="store_true", help="delete artifacts/cache (always safe)")
     add("status", cmd_status, "print the last run's summary and problems (runs nothing)", True)

@@ -153,7 +153,11 @@ def make_evidence(
     """Build an :class:`Evidence` record for ``obligation``, hashing its inputs now.
 
     ``status`` must be one of the statuses in :mod:`rclverify.evidence.records`.
+    For a timed guarantee a backend that does not check time says so in the
+    explanation and ``details["timing"]`` (:mod:`.timing_scope`).
     """
+    from .timing_scope import scope
+    explanation, details = scope(obligation.backend, target.node, obligation.guarantee, explanation, details or {})
     return Evidence(
         obligation=obligation.id, backend=obligation.backend, kind=obligation.kind, status=status,
         tool=tool, tool_version=tool_version, started=clock.started, duration_s=clock.elapsed(),

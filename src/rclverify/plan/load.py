@@ -25,7 +25,7 @@ from .formal import Source
 from .yamlguard import KEY, Blocks, compose_guarded, read_yaml_text, to_data
 
 # The plan's values live in plan/model.py (below this loader and what it calls); re-exported here.
-from .model import Connection, EvidenceEntry, Fact, Path_, Plan, Requirement, Support  # noqa: E402,F401
+from .model import Connection, DeadlineSpec, EvidenceEntry, Fact, Path_, Plan, Requirement, Support  # noqa: E402,F401
 
 __all__ = ["KEY", "Plan", "load_plan", "read_plan_data", "resolve"]
 
@@ -157,8 +157,27 @@ def load_plan(root: Path, plan_rel: str = "contracts/plan.yaml") -> Plan:
         if "replacement" in spec:
             replacements[node] = (spec["replacement"], loc("nodes", node, "replacement"))
     rfrom = tuple((str(v), loc("requirements_from", k)) for k, v in (data.get("requirements_from") or {}).items())
+    deadlines = _deadlines(data, loc, plan_rel)
     return Plan(plan_rel, root, contracts, tuple(reqs), tuple(conns), facts, instances, evidence, replacements, locs,
-                str(data.get("name", "")), dict(data.get("ros") or {}), rfrom)
+                str(data.get("name", "")), dict(data.get("ros") or {}), rfrom, deadlines)
+
+
+def _deadlines(data: Mapping[str, Any], loc: Any, plan_rel: str) -> tuple[DeadlineSpec, ...]:
+    """The requirements' ``deadline:`` entries (rule D3); a duration without
+    a unit is a located plan error."""
+    from ..rcl.timing import UNITS, parse_duration
+    out = []
+    for i, r in enumerate(data.get("requirements", [])):
+        d = r.get("deadline")
+        if d is None:
+            continue
+        within = parse_duration(d["within"])
+        if within is None:
+            l = loc("requirements", i, "deadline", "within")
+            raise plan_error(plan_rel, l.line, l.col, f"deadline 'within: {d['within']}' must be a positive number "
+                             f"and a unit, e.g. '500 ms' (units: {', '.join(UNITS)})", "E-deadline")
+        out.append(DeadlineSpec(str(r["id"]), tuple(d["path"]), within, loc("requirements", i, "deadline")))
+    return tuple(out)
 
 
 def _source(path: Path_, holder: Mapping[str, Any], key: str, locs: Mapping[Path_, ast.Loc], blocks: Blocks,
@@ -246,6 +265,10 @@ def resolve(plan: Plan, checked: Checked) -> None:
                     if not 1 <= g <= n:
                         bad(s.loc, f"{r.id}: node {s.node} has {n} guarantee(s); there is no guarantee {g}")
     diags.extend(check_formal(reqs, checked))
+    for d in plan.deadlines:
+        for n in d.path:
+            if not node_ok(n, d.loc):
+                break
     for c in plan.connections:
         if node_ok(c.from_node, c.loc) and node_ok(c.to_node, c.loc):
             ot = nodes[c.from_node].outputs.get(c.from_var)

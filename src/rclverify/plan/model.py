@@ -6,6 +6,7 @@ entries.  Below the loader (:mod:`.load`) and the modules it calls
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from fractions import Fraction
 from pathlib import Path
 from typing import Any, Mapping
 
@@ -41,6 +42,17 @@ class Requirement:
     formal: Source | None = None
     assuming: tuple[Source, ...] = ()
     origin: str = "plan"
+
+
+@dataclass(frozen=True)
+class DeadlineSpec:
+    """A requirement's ``deadline: {path: [A, B], within: 500 ms}``:
+    ``within`` in seconds (exact), ``loc`` the entry's location."""
+
+    requirement: str
+    path: tuple[str, ...]
+    within: Fraction
+    loc: ast.Loc
 
 
 @dataclass(frozen=True)
@@ -99,3 +111,5 @@ class Plan:
     #: ``requirements_from: {doorstop: DIR}``: Doorstop document trees read for
     #: more requirements (:func:`.doorstop.read_requirements`), with the entry's location.
     requirements_from: tuple[tuple[str, ast.Loc], ...] = ()
+    #: the requirements' end-to-end deadlines (rule D3, calculus/deadlines.py)
+    deadlines: tuple[DeadlineSpec, ...] = ()

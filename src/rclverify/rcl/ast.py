@@ -425,10 +425,47 @@ class Topic:
 
 
 @dataclass(frozen=True)
+class Deadline:
+    """``within 200 ms`` after a guarantee (docs/rcl-language.md, "Services,
+    actions and deadlines").  ``amount`` is the number as written, ``unit``
+    the unit name (``None`` when missing: a located type error), ``seconds``
+    is left to the type checker."""
+
+    amount: str
+    unit: str | None
+    loc: Loc = _loc()
+
+
+@dataclass(frozen=True)
 class Clause:
-    """One ``assume(...)`` or ``guarantee(...)`` clause."""
+    """One ``assume(...)`` or ``guarantee(...)`` clause.
+
+    A guarantee may carry ``triggered by in.x`` (``trigger``: the output is
+    produced in response to input ``x``) and ``within N unit``
+    (``deadline``); both are ``None`` for every contract written before
+    them, so those keep their meaning."""
 
     formula: Expr
+    loc: Loc = _loc()
+    trigger: Var | None = None
+    deadline: Deadline | None = None
+
+
+@dataclass(frozen=True)
+class Link:
+    """``pkg/Type name serves(in.req, out.resp)`` in ``services(...)`` or
+    ``pkg/Action name calls(out.goal, in.feedback, in.result)`` in
+    ``actions(...)``.
+
+    ``kind`` is ``"service"`` or ``"action"``; ``role`` ``"serves"`` or
+    ``"calls"``; ``parts`` the contract variables of the request and response
+    (service) or goal, feedback and result (action), in that order."""
+
+    kind: str
+    ros_type: str
+    name: str
+    role: str
+    parts: tuple[Var, ...]
     loc: Loc = _loc()
 
 
@@ -443,6 +480,7 @@ class Node:
     assumes: tuple[Clause, ...]
     guarantees: tuple[Clause, ...]
     loc: Loc = _loc()
+    links: tuple[Link, ...] = ()
 
 
 @dataclass(frozen=True)

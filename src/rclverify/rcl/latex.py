@@ -246,6 +246,21 @@ def _io(vs: tuple[ast.IOVar, ...]) -> str:
     return "(" + ", ".join(f"{name_to_latex(v.name)} : {type_to_latex(v.type)}" for v in vs) + ")"
 
 
+def _timing(c: ast.Clause) -> str:
+    """`` triggered by $in.x$ within 200~ms`` after a guarantee (empty when untimed)."""
+    s = r" triggered by $" + _var(c.trigger) + "$" if c.trigger is not None else ""
+    if c.deadline is not None:
+        s += " within " + escape(c.deadline.amount) + (r"~\textrm{" + escape(c.deadline.unit) + "}"
+                                                        if c.deadline.unit else "")
+    return s
+
+
+def _link(lk: ast.Link) -> str:
+    parts = ", ".join("$" + _var(v) + "$" for v in lk.parts)
+    return (lk.kind + r" \texttt{" + escape(lk.ros_type) + r"}~\texttt{" + escape(lk.name) + "} "
+            + lk.role + "(" + parts + ")")
+
+
 def _topic(t: ast.Topic) -> str:
     s = r"\texttt{" + escape(t.msg_type) + r"}~\texttt{" + escape(t.field) + "}"
     if t.match is not None:
@@ -281,6 +296,8 @@ def to_latex(spec: ast.Spec, document: bool = True, explicit: bool = False, head
         "topics": [_topic(t) for t in n.topics],
         "assumes": [expr_to_latex(c.formula, explicit) for c in n.assumes],
         "guarantees": [expr_to_latex(c.formula, explicit) for c in n.guarantees],
+        "timing": [_timing(c) for c in n.guarantees],
+        "links": [_link(lk) for lk in n.links],
     } for n in spec.nodes]
     return _env().get_template("contracts.tex.j2").render(
         source=source, document=document, header=header, contexts=contexts, nodes=nodes)

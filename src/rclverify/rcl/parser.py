@@ -217,9 +217,10 @@ class _ToAst(Transformer[Token, Any]):
         if rest and rest[0][0] == "topics":
             topics = rest[0][1]
             rest = rest[1:]
+        links = tuple(lk for kind, group in rest if kind == "links" for lk in group)
         assumes = tuple(cl for kind, cl in rest if kind == "assume")
         guarantees = tuple(cl for kind, cl in rest if kind == "guarantee")
-        return ast.Node(name, inputs, outputs, topics, assumes, guarantees, self._span(c))
+        return ast.Node(name, inputs, outputs, topics, assumes, guarantees, self._span(c), links)
 
     def inputs(self, c: list[Any]) -> tuple[ast.IOVar, ...]:
         return tuple(x for x in _vals(c) if x is not None)
@@ -245,7 +246,39 @@ class _ToAst(Transformer[Token, Any]):
         return ("assume", ast.Clause(_vals(c)[0], self._span(c)))
 
     def guarantee(self, c: list[Any]) -> tuple[str, ast.Clause]:
-        return ("guarantee", ast.Clause(_vals(c)[0], self._span(c)))
+        v = _vals(c)
+        trigger = v[1].value if len(v) > 1 and v[1] is not None else None
+        deadline = v[2] if len(v) > 2 else None
+        return ("guarantee", ast.Clause(v[0], self._span([x for x in c if x is not None]), trigger, deadline))
+
+    def trigger(self, c: list[Any]) -> _Spanned:
+        return _Spanned(_vals(c)[0], self._span(c))
+
+    def deadline(self, c: list[Any]) -> ast.Deadline:
+        v = _vals(c)
+        unit = str(v[1]) if v[1] is not None else None
+        return ast.Deadline(str(v[0]), unit, self._span([x for x in c if x is not None]))
+
+    def services(self, c: list[Any]) -> tuple[str, tuple[ast.Link, ...]]:
+        return ("links", tuple(x for x in _vals(c) if x is not None))
+
+    actions = services
+
+    def serves(self, c: list[Any]) -> str:
+        return "serves"
+
+    def calls(self, c: list[Any]) -> str:
+        return "calls"
+
+    def _link(self, kind: str, c: list[Any]) -> ast.Link:
+        v = _vals(c)
+        return ast.Link(kind, str(v[0]), str(v[1]), v[2], tuple(v[3:]), self._span(c))
+
+    def service_link(self, c: list[Any]) -> ast.Link:
+        return self._link("service", c)
+
+    def action_link(self, c: list[Any]) -> ast.Link:
+        return self._link("action", c)
 
     # -- types ---------------------------------------------------------------
     def base_name(self, c: list[Token]) -> Token:

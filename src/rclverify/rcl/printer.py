@@ -305,6 +305,18 @@ def _topic(t: ast.Topic) -> str:
     return f"{t.msg_type} {t.field}{match}"
 
 
+def _link(lk: ast.Link) -> str:
+    return f"{lk.ros_type} {lk.name} {lk.role}({', '.join(v.qualified for v in lk.parts)})"
+
+
+def _timing(c: ast.Clause) -> str:
+    """`` triggered by in.x within N unit`` (empty for an untimed clause)."""
+    s = f" triggered by {c.trigger.qualified}" if c.trigger is not None else ""
+    if c.deadline is not None:
+        s += f" within {c.deadline.amount}" + (f" {c.deadline.unit}" if c.deadline.unit else "")
+    return s
+
+
 def _io(vs: tuple[ast.IOVar, ...]) -> str:
     return ", ".join(f"{v.name} : {type_to_rcl(v.type)}" for v in vs)
 
@@ -318,8 +330,14 @@ def node_to_rcl(n: ast.Node, explicit: bool = False) -> str:
     if n.topics:
         sep = ",\n          "
         lines.append(f"  topics( {sep.join(_topic(t) for t in n.topics)} )")
+    if n.links:
+        for kind in ("service", "action"):
+            group = [lk for lk in n.links if lk.kind == kind]
+            if group:
+                sep = ",\n          "
+                lines.append(f"  {kind}s( {sep.join(_link(lk) for lk in group)} )")
     lines += [f"  assume( {expr_to_rcl(c.formula, explicit)} )" for c in n.assumes]
-    lines += [f"  guarantee( {expr_to_rcl(c.formula, explicit)} )" for c in n.guarantees]
+    lines += [f"  guarantee( {expr_to_rcl(c.formula, explicit)} ){_timing(c)}" for c in n.guarantees]
     return "\n".join(lines) + "\n}\n"
 
 

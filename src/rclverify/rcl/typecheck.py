@@ -31,7 +31,7 @@ import difflib
 from pathlib import Path
 from typing import Iterable, Mapping, Sequence
 
-from . import ast
+from . import ast, timing
 from .errors import Diagnostic, RclError, error
 from .parser import parse_files
 from .types import (BASE_NAMES, BOOL, INTEGER, NATURAL, REAL, STRING, Checked, qualified_base, CheckedNode, DataT, EmptyT, EnumT, Env, FuncT,
@@ -204,6 +204,11 @@ class _Checker:
                     self.var(t.match, cn, {})
                 except _Fail:
                     ok = False
+        if n.links and not timing.check_links(n, self.err):
+            ok = False
+        for cl in n.guarantees:
+            if (cl.trigger is not None or cl.deadline is not None) and not timing.check_clause(n, cl, self.err):
+                ok = False
         if not n.guarantees:
             self.err(n.loc, f"node {n.name} has no guarantee; a contract needs at least one guarantee(...)", "E-contract")
             ok = False

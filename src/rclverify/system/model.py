@@ -6,7 +6,9 @@ models) are found, for each input of each node, in this order:
 1. the plan's explicit ``connections`` (``via = "plan"``);
 2. an output of another node with the same name and the same type
    (``via = "name"``);
-3. an output of another node bound to the same ROS topic field
+3. the other end of a service or action link of the same name (rule S1,
+   :mod:`.services`; ``via = "service"``);
+4. an output of another node bound to the same ROS topic field
    (``msg_type`` and ``field``; ``via = "topic"``).
 
 Anything unconnected is an *environment input*.  Inputs of the empty type
@@ -27,6 +29,7 @@ from typing import Any, Iterable, Iterator, Mapping, Sequence
 from ..plan.load import Connection
 from ..rcl.errors import RclError, error
 from ..rcl.types import Checked, EmptyT
+from .services import peers as service_peers, side_conditions as service_conditions
 
 
 @dataclass(frozen=True)
@@ -269,6 +272,8 @@ def build(checked: Checked, connections: Sequence[Connection] = ()) -> SystemMod
                 continue
             by_name = [m for m, ot in outputs.get(iv.name, []) if m != n and ot == t]
             via, cands = "name", [(m, iv.name) for m in by_name]
+            if not cands and cn.node.links:
+                via, cands = "service", service_peers(checked, n, iv.name)
             if not cands:
                 via, cands = "topic", _by_topic(checked, n, iv.name)
             if len(cands) > 1:
@@ -278,6 +283,7 @@ def build(checked: Checked, connections: Sequence[Connection] = ()) -> SystemMod
                 links.append(Link(cands[0][0], cands[0][1], n, iv.name, via))
             else:
                 env.append((n, iv.name, str(t)))
+    diags += service_conditions(checked)
     if diags:
         raise RclError(diags)
     return SystemModel(tuple(nodes), tuple(links), tuple(env), _loops(nodes, links))

@@ -31,6 +31,7 @@ from ...traces.bag import custom_types
 from ..base import NodeTarget, Stopwatch, make_evidence
 from .check import NodeResult, check_trace
 from .config import ConfigError, MonitorConfig, load_mapping
+from .deadlines import check_deadlines, deadline_status, has_deadlines
 from .rml import Spec, rml_id, translate
 
 NAME = "monitors"
@@ -204,9 +205,33 @@ class MonitorsBackend:
         res = results[0]
         details = monitoring_details(res, trace, events, trace_sha256(target.root, trace), versions, cfg.horizon)
         status, explanation = verdict_status(res, trace)
-        return evidence(status, explanation, details={"monitoring": details},
+        extra: dict[str, Any] = {}
+        if has_deadlines(target.node):
+            try:
+                status, explanation, extra = with_deadlines(target, cfg, trace, status, explanation)
+            except Exception as exc:  # as above: the record's error, never a crash
+                return evidence("error", f"the deadlines could not be checked: {type(exc).__name__}: {exc}",
+                                log=str(exc))
+        return evidence(status, explanation, details={"monitoring": details, **extra},
                         artifacts=(str(obligation.data.get("rml", "")), str(obligation.data.get("config", ""))),
                         log=summary_line(res))
+
+
+def with_deadlines(target: NodeTarget, cfg: MonitorConfig, trace: str, status: str,
+                   explanation: str) -> tuple[str, str, dict[str, Any]]:
+    """The untimed verdict combined with the node's deadline verdicts on the
+    same trace (:mod:`.deadlines`): the worse status wins; returns
+    ``(status, explanation, {"deadlines": ...})``."""
+    res = check_deadlines(target.checked, [target.node],
+                          read_trace(target.root / trace, [target.root / d for d in cfg.msg_dirs]), cfg.rules,
+                          horizon=cfg.horizon)[0]
+    dstatus, dexpl = deadline_status(res, trace)
+    rank = {"discharged": 0, "pending": 1, "inconclusive": 2, "failed": 3}
+    # An untimed check that saw nothing (pending) leaves the verdict to the deadline monitor only when every
+    # guarantee is timed (it then evaluated each one on each answer); else the worse of the two wins.
+    all_timed = all(c.trigger is not None for c in target.node.node.guarantees)
+    worse = dstatus if (status == "pending" and all_timed) or rank.get(dstatus, 0) > rank.get(status, 0) else status
+    return worse, f"deadlines: {dexpl}; untimed: {explanation}", {"deadlines": res.to_json()}
 
 
 def monitoring_details(res: NodeResult, trace: str, events: int, sha: str, versions: str,

@@ -19,6 +19,7 @@ from ...rcl.types import Checked
 from ...traces import TraceError, read_trace
 from .backend import monitoring_details, summary_line, tool_versions, verdict_status
 from .check import check_trace
+from .deadlines import check_deadlines, deadline_status, has_deadlines
 from .config import ConfigError, load_mapping
 
 
@@ -74,6 +75,23 @@ def monitor_command(args: argparse.Namespace, checked: Checked) -> int:
             report.append(entry)
             if not args.json:
                 print(f"{trace}: {summary_line(res)}")
+                print(f"  {status}: {explanation}")
+        timed = [n for n in checked.nodes.values() if has_deadlines(n)]
+        try:
+            dres = check_deadlines(checked, timed, read_trace(path, [root / d for d in cfg.msg_dirs]), cfg.rules,
+                                   horizon=cfg.horizon)
+        except Exception as exc:  # read once already: a second read failing is still a located message
+            _emit(report, args.json)
+            print(f"{trace}: error: the deadlines could not be checked: {type(exc).__name__}: {exc}", file=sys.stderr)
+            return 2
+        for d in dres:
+            status, explanation = deadline_status(d, trace)
+            violated = violated or status == "failed"
+            report.append({"node": d.node, "status": status, "explanation": explanation, "trace": trace,
+                           "deadlines": d.to_json()})
+            if not args.json:
+                print(f"{trace}: {d.node} deadlines: " + (", ".join(f"{n} {v}" for v, n in d.counts.items() if n)
+                                                            or "no trigger event"))
                 print(f"  {status}: {explanation}")
     _emit(report, args.json)
     return 1 if violated else 0

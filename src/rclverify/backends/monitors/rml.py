@@ -169,8 +169,10 @@ class Translator:
     def event_type(self, key: str, name: str, wants: list[T.Type], fixed: tuple[tuple[int, str], ...] = (),
                    negated: bool = False, guard: str = "") -> EventType:
         topic = self.topic_of.get(key)
-        if topic is None:
-            raise KeyError(key)
+        if topic is None:  # e.g. a variable bound only to a service or action link
+            prefix, _, var = key.partition(".")
+            raise Inexpressible(ast.Var(var, prefix), "no topic in topics(...) carries it, so no RML event "  # type: ignore[arg-type]
+                                "type observes it")
         fields = self._fields(topic, wants)
         fixed_map = dict(fixed)
         params = tuple(f"x{k}" for k in range(1, len(wants) + 1) if (k - 1) not in fixed_map)

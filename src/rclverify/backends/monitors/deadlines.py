@@ -1,0 +1,299 @@
+"""Deadlines of timed guarantees checked against message stamps (issue 33).
+
+A guarantee ``G(phi) triggered by in.x within d`` (rule D1,
+docs/architecture.md) is monitored per trigger event: the event on ``in.x``
+with stamp ``t`` opens an obligation due at ``t + d``; the first later
+message on an output ``phi`` mentions, with ``phi`` true on the trigger's
+inputs and the outputs as they stand, answers it.  Verdicts, in
+ROSMonitoring's terms:
+
+* ``true``: answered with a stamp ``<= t + d``;
+* ``false``: the deadline expired, the clock (the latest stamp seen, or a
+  live monitor's timer) passed ``t + d`` with no answer; a late answer's
+  stamp is given when it came;
+* ``currently_false``: not answered yet and the deadline not yet expired (a
+  run that ends then, or a live query before the deadline).
+
+A ``triggered by`` without ``within`` is checked the same way with the
+monitor's ``horizon`` as its bound (offline; the live proxy has none, so
+it checks only guarantees with a deadline).
+
+**Clock.**  An event's time is its message's ``header.stamp`` when it has one
+(:func:`~.online.header_stamp`), else the time the trace gives it (the
+recording time of a bag, ``time`` of a ROSMonitoring log line).  A service
+call seen through the monitor's proxy is two events, ``<svc>/request`` and
+``<svc>/response``, both stamped by the proxy's clock when it received the
+request and when the server's response came back (docs/monitors.md).  All
+stamps of one check must come from one clock (rule D2's side condition (c)).
+
+**Topics.**  A node's timed guarantee reads the node's ``topics(...)`` and its
+links: service ``s`` is ``s/request`` and ``s/response``; action ``a`` is
+actionlib's ``a/goal``, ``a/feedback`` and ``a/result`` (the message's
+``goal``/``feedback``/``result`` part is what maps to the contract variable).
+"""
+from __future__ import annotations
+
+from collections import deque
+from dataclasses import dataclass, field
+from typing import Any, Callable, Iterable, Mapping
+
+from ...logic.evaluate import evaluate
+from ...rcl import ast
+from ...rcl.timing import seconds
+from ...rcl.types import Checked, CheckedNode
+from ...rcl.walk import subexpressions
+from ...traces.events import Event
+from ...traces.mapping import MappingError, TopicRule, map_value
+from .online import header_stamp
+
+DEADLINE_VERDICTS = ("true", "currently_false", "false")
+#: Topic suffixes of a link's parts, in the order of ``Link.parts``.
+LINK_TOPICS = {"service": ("request", "response"), "action": ("goal", "feedback", "result")}
+
+
+@dataclass(frozen=True)
+class DeadlineVerdict:
+    """One trigger event's deadline verdict.  Times in seconds on the stamps'
+    clock; ``answer`` is the answering message's stamp (``None``: none)."""
+
+    node: str
+    guarantee: int
+    verdict: str
+    trigger_where: str
+    trigger_stamp: float
+    due: float
+    answer: float | None = None
+    answer_where: str = ""
+    reason: str = ""
+    #: the late answer of a trigger already judged ``false`` when its deadline expired (not a new verdict)
+    update: bool = False
+
+    def to_json(self) -> dict[str, Any]:
+        return {"node": self.node, "guarantee": self.guarantee, "verdict": self.verdict,
+                "trigger_where": self.trigger_where, "trigger_stamp": self.trigger_stamp, "due": self.due,
+                "answer": self.answer, "answer_where": self.answer_where, "reason": self.reason,
+                "update": self.update}
+
+
+@dataclass
+class _Pending:
+    k: int
+    trigger: Event
+    stamp: float
+    due: float
+    inputs: dict[str, Any]
+
+
+@dataclass
+class DeadlineResult:
+    """Counts per verdict and the first ``false`` of one node on one run."""
+
+    node: str
+    counts: dict[str, int] = field(default_factory=lambda: {v: 0 for v in DEADLINE_VERDICTS})
+    first_false: DeadlineVerdict | None = None
+
+    def to_json(self) -> dict[str, Any]:
+        return {"node": self.node, "counts": dict(self.counts),
+                "first_false": None if self.first_false is None else self.first_false.to_json()}
+
+
+def event_stamp(ev: Event) -> float:
+    """The event's time on the stamps' clock (module docstring, "Clock")."""
+    s = header_stamp(ev.fields)
+    return ev.time if s is None else s
+
+
+def topic_bindings(node: CheckedNode) -> dict[str, list[tuple[str, str]]]:
+    """topic (no leading ``/``) -> ``[(key, part)]``: ``key`` is ``in.x`` or
+    ``out.y``; ``part`` the message part that maps to it (``""``: the whole
+    message, ``"goal"``/``"feedback"``/``"result"`` for an actionlib topic)."""
+    out: dict[str, list[tuple[str, str]]] = {}
+    for t in node.node.topics:
+        if t.match is not None:
+            prefix = t.match.prefix or ("in" if t.match.name in node.inputs else "out")
+            out.setdefault(t.field.lstrip("/"), []).append((f"{prefix}.{t.match.name}", ""))
+    for lk in node.node.links:
+        for suffix, v in zip(LINK_TOPICS[lk.kind], lk.parts):
+            part = suffix if lk.kind == "action" else ""
+            out.setdefault(f"{lk.name.lstrip('/')}/{suffix}", []).append((f"{v.prefix}.{v.name}", part))
+    return out
+
+
+class DeadlineMonitor:
+    """Streams events through the timed guarantees of one node.
+
+    ``feed(ev)`` one event; ``advance(now)`` the clock (expires deadlines);
+    ``pending_verdicts()`` the ``currently_false`` obligations now;
+    ``finish()`` the result.  ``on_verdict`` gets every decided verdict."""
+
+    def __init__(self, checked: Checked, node: CheckedNode, rules: Mapping[str, TopicRule],
+                 on_verdict: Callable[[DeadlineVerdict], None] | None = None, horizon: float | None = None) -> None:
+        self.checked, self.node, self.rules, self.on_verdict = checked, node, rules, on_verdict
+        self.bindings = topic_bindings(node)
+        self.timed: list[tuple[int, ast.Clause, str, frozenset[str], float]] = []
+        for k, cl in enumerate(node.node.guarantees, 1):
+            if cl.trigger is None:
+                continue
+            # `triggered by` without `within`: answered at all, judged after the monitor's horizon (s)
+            bound = seconds(cl.deadline) if cl.deadline is not None else horizon
+            if bound is None:
+                continue
+            outs = frozenset(f"out.{e.name}" for e in subexpressions(cl.formula)
+                             if isinstance(e, ast.Var) and e.prefix == "out")
+            self.timed.append((k, cl, f"in.{cl.trigger.name}", outs, float(bound)))
+        self.values: dict[str, Any] = {}
+        self.pending: list[_Pending] = []
+        self.expired: deque[_Pending] = deque(maxlen=256)  # judged false, waiting for a late answer to show
+        self.now = float("-inf")
+        self.result = DeadlineResult(node.name)
+
+    def _emit(self, v: DeadlineVerdict) -> None:
+        if v.update:  # the answer of an expired obligation: shown, not counted again
+            if self.result.first_false is not None and self.result.first_false.trigger_where == v.trigger_where:
+                self.result.first_false = v
+            if self.on_verdict is not None:
+                self.on_verdict(v)
+            return
+        self.result.counts[v.verdict] += 1
+        if v.verdict == "false" and self.result.first_false is None:
+            self.result.first_false = v
+        if self.on_verdict is not None:
+            self.on_verdict(v)
+
+    def feed(self, ev: Event) -> None:
+        """Process one event (any topic; only the node's move its state)."""
+        stamp = event_stamp(ev)
+        keys = self.bindings.get(ev.topic.lstrip("/"))
+        if not keys or not self.timed:
+            self.advance(stamp)
+            return
+        changed: list[str] = []
+        for key, part in keys:
+            fields = ev.fields.get(part) if part else ev.fields
+            if not isinstance(fields, Mapping):
+                continue
+            fields = {k: v for k, v in fields.items() if k != "header"}
+            typ = self.node.inputs.get(key[3:]) if key.startswith("in.") else self.node.outputs.get(key[4:])
+            if typ is None:
+                continue
+            try:
+                self.values[key] = map_value(typ, fields, self.rules.get(ev.topic, TopicRule()), self.values.get(key))
+            except MappingError:
+                continue
+            changed.append(key)
+        outs = {c for c in changed if c.startswith("out.")}
+        if outs:
+            self._answer(ev, stamp, outs)
+        self.advance(stamp)
+        for k, cl, trig, _, d in self.timed:
+            if trig in changed:
+                inputs = {key: v for key, v in self.values.items() if key.startswith("in.")}
+                self.pending.append(_Pending(k, ev, stamp, stamp + d, inputs))
+
+    def _answer(self, ev: Event, stamp: float, outs: set[str]) -> None:
+        for p in list(self.expired):
+            if self._answers(p, stamp, outs):
+                self.expired.remove(p)
+                self._emit(DeadlineVerdict(self.node.name, p.k, "false", p.trigger.where, p.stamp, p.due, stamp,
+                                           ev.where, f"answered after {_ms(stamp - p.stamp)}, "
+                                           f"{_ms(stamp - p.due)} past the deadline of {_ms(p.due - p.stamp)}",
+                                           update=True))
+        keep: list[_Pending] = []
+        for p in self.pending:
+            k, cl, _, gouts, d = next(t for t in self.timed if t[0] == p.k)
+            if not (gouts & outs) or stamp < p.stamp:
+                keep.append(p)
+                continue
+            values = dict(p.inputs)
+            values.update({key: v for key, v in self.values.items() if key.startswith("out.")})
+            if evaluate(cl.formula, self.checked, self.node, values) is not True:
+                keep.append(p)
+                continue
+            if stamp <= p.due:
+                self._emit(DeadlineVerdict(self.node.name, p.k, "true", p.trigger.where, p.stamp, p.due, stamp,
+                                           ev.where, f"answered after {_ms(stamp - p.stamp)} (deadline {_ms(d)})"))
+            else:
+                self._emit(DeadlineVerdict(self.node.name, p.k, "false", p.trigger.where, p.stamp, p.due, stamp,
+                                           ev.where, f"answered after {_ms(stamp - p.stamp)}, "
+                                           f"{_ms(stamp - p.due)} past the deadline of {_ms(d)}"))
+        self.pending = keep
+
+    def _answers(self, p: _Pending, stamp: float, outs: set[str]) -> bool:
+        """Whether outputs ``outs`` now (stamp ``stamp``) answer obligation ``p``."""
+        _, cl, _, gouts, _ = next(t for t in self.timed if t[0] == p.k)
+        if not (gouts & outs) or stamp < p.stamp:
+            return False
+        values = dict(p.inputs)
+        values.update({key: v for key, v in self.values.items() if key.startswith("out.")})
+        return evaluate(cl.formula, self.checked, self.node, values) is True
+
+    def advance(self, now: float) -> None:
+        """Move the clock to ``now`` (s); obligations due before it are ``false``."""
+        if now <= self.now:
+            return
+        self.now = now
+        keep = []
+        for p in self.pending:
+            if p.due < now:
+                d = p.due - p.stamp
+                self._emit(DeadlineVerdict(self.node.name, p.k, "false", p.trigger.where, p.stamp, p.due, None, "",
+                                           f"no answer within the deadline of {_ms(d)} (clock at {now:.3f} s)"))
+                self.expired.append(p)
+            else:
+                keep.append(p)
+        self.pending = keep
+
+    def pending_verdicts(self) -> list[DeadlineVerdict]:
+        """The obligations not answered whose deadline has not expired yet."""
+        return [DeadlineVerdict(self.node.name, p.k, "currently_false", p.trigger.where, p.stamp, p.due, None, "",
+                                f"not answered yet; {_ms(p.due - self.now)} left") for p in self.pending]
+
+    def finish(self) -> DeadlineResult:
+        """End of the run: obligations still within their deadline are ``currently_false``."""
+        for v in self.pending_verdicts():
+            self._emit(v)
+        self.pending = []
+        return self.result
+
+
+def check_deadlines(checked: Checked, nodes: Iterable[CheckedNode], events: Iterable[Event],
+                    rules: Mapping[str, TopicRule], on_verdict: Callable[[DeadlineVerdict], None] | None = None,
+                    horizon: float | None = None) -> list[DeadlineResult]:
+    """The deadline monitors of ``nodes`` run over a recorded trace, in
+    order; ``horizon`` (s) bounds a ``triggered by`` without ``within``."""
+    monitors = [DeadlineMonitor(checked, n, rules, on_verdict, horizon) for n in nodes]
+    for ev in events:
+        for m in monitors:
+            m.feed(ev)
+    return [m.finish() for m in monitors]
+
+
+def has_deadlines(node: CheckedNode) -> bool:
+    """Whether ``node`` has a guarantee with a trigger (with or without a deadline)."""
+    return any(c.trigger is not None for c in node.node.guarantees)
+
+
+def _ms(x: float) -> str:
+    return f"{x * 1000:.0f} ms" if abs(x) < 10 else f"{x:.3f} s"
+
+
+def deadline_status(res: DeadlineResult, trace: str) -> tuple[str, str]:
+    """Evidence status and explanation of one node's deadline verdicts on a
+    trace: any ``false`` -> ``failed`` (the first named with its stamps);
+    only ``currently_false`` -> ``inconclusive``; else ``discharged``, or
+    ``pending`` when no trigger event was seen."""
+    c = res.counts
+    f = res.first_false
+    if c["false"] and f is not None:
+        late = (f"answered at {f.answer:.3f} s ({f.answer_where})" if f.answer is not None else "never answered")
+        return "failed", (f"{c['false']} trigger event(s) of {trace} missed {res.node}'s deadline; the first: "
+                          f"guarantee {f.guarantee}, triggered at {f.trigger_where} (stamp {f.trigger_stamp:.3f} s), "
+                          f"due {f.due:.3f} s, {late}: {f.reason}")
+    if c["currently_false"] and not c["true"]:
+        return "inconclusive", (f"{c['currently_false']} trigger event(s) were unanswered and within their "
+                                f"deadline when {trace} ended")
+    if not c["true"]:
+        return "pending", f"{trace} has no trigger event of {res.node}'s timed guarantees: nothing was checked"
+    extra = (f"; {c['currently_false']} more still within their deadline when the run ended"
+             if c["currently_false"] else "")
+    return "discharged", f"all {c['true']} trigger event(s) were answered within their deadline{extra}"

@@ -1,0 +1,64 @@
+"""Rule S1: a service's or action's client and server linked
+(docs/architecture.md, "Services, actions and deadlines").
+
+A request (action goal) is the client's output and the server's input; the
+response (feedback, result) the other way round.  :func:`peers` answers, for
+one input of one node, which output of which node feeds it through a link;
+:func:`side_conditions` reports, located, a link whose two ends disagree on
+the ROS type, and a second server of one name.
+"""
+from __future__ import annotations
+
+from ..rcl import ast
+from ..rcl.errors import Diagnostic, error
+from ..rcl.types import Checked
+
+
+def _links(checked: Checked) -> list[tuple[str, ast.Link]]:
+    return [(n, lk) for n, cn in checked.nodes.items() for lk in cn.node.links]
+
+
+def peers(checked: Checked, node: str, var: str) -> list[tuple[str, str]]:
+    """The ``(node, output)`` pairs that feed ``node.in.var`` through a
+    service or action link of the same kind and name (the other role), with
+    the same ROS type and RCL type.  Usually zero or one pair."""
+    cn = checked.nodes[node]
+    out: list[tuple[str, str]] = []
+    for lk in cn.node.links:
+        for i, v in enumerate(lk.parts):
+            if v.prefix != "in" or v.name != var:
+                continue
+            for m, other in _links(checked):
+                if m == node or other.kind != lk.kind or other.name != lk.name or other.role == lk.role:
+                    continue
+                if other.ros_type != lk.ros_type:
+                    continue
+                w = other.parts[i]
+                ocn = checked.nodes[m]
+                if w.prefix == "out" and w.name in ocn.outputs and ocn.outputs[w.name] == cn.inputs[var]:
+                    out.append((m, w.name))
+    return out
+
+
+def side_conditions(checked: Checked) -> list[Diagnostic]:
+    """Located errors of S1's side conditions (a) one ROS type per service or
+    action name and (b) at most one server per name; empty when they hold."""
+    diags: list[Diagnostic] = []
+    first: dict[tuple[str, str], tuple[str, ast.Link]] = {}
+    server: dict[tuple[str, str], str] = {}
+    for n, lk in _links(checked):
+        key = (lk.kind, lk.name)
+        if key in first:
+            m, f = first[key]
+            if f.ros_type != lk.ros_type:
+                diags.append(error(lk.loc, f"{lk.kind} {lk.name!r} has type {lk.ros_type} here but "
+                                   f"{f.ros_type} in node {m} ({f.loc})", "E-link"))
+        else:
+            first[key] = (n, lk)
+        if lk.role == "serves":
+            if key in server:
+                diags.append(error(lk.loc, f"{lk.kind} {lk.name!r} already has a server, node {server[key]}; "
+                                   "ROS allows one", "E-link"))
+            else:
+                server[key] = n
+    return diags

@@ -1,0 +1,125 @@
+"""Services, actions and deadlines monitored live on ROS 1 (issue 33).
+
+A ROS 1 master on 127.0.0.1 (a free port), the safety-stop example's nodes
+as rospy processes, and the service proxy monitor: the estop server answers
+its second call 400 ms late (its deadline is 200 ms), the move action's
+feedback comes 0.5 s after the goal (deadline 2 s).  The monitor's log must
+hold a ``false`` verdict with the late call's stamps and a ``true`` one for
+the feedback.  Every process is stopped in a ``finally``; skipped, with the
+reason, only where ROS 1 cannot be imported.
+"""
+from __future__ import annotations
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from rclverify.backends.monitors.ros1 import LocalMaster, RosUnavailable, import_rospy
+
+REPO = Path(__file__).resolve().parents[1]
+EXAMPLE = REPO / "examples" / "safety_stop"
+NODES = EXAMPLE / "nodes" / "ros1_nodes.py"
+
+try:
+    import_rospy()
+    REASON = ""
+except RosUnavailable as exc:
+    REASON = str(exc)
+pytestmark = pytest.mark.skipif(bool(REASON), reason=f"ROS 1 unavailable: {REASON}")
+
+
+def _start(args: list[str], env: dict[str, str], out: Path) -> subprocess.Popen[bytes]:
+    return subprocess.Popen([sys.executable, *args], env=env, cwd=EXAMPLE, stdout=out.open("wb"),
+                            stderr=subprocess.STDOUT, start_new_session=True)
+
+
+def _stop(p: subprocess.Popen[bytes], sig: int = signal.SIGTERM) -> None:
+    if p.poll() is None:
+        os.killpg(p.pid, sig)
+        try:
+            p.wait(10)
+        except subprocess.TimeoutExpired:
+            os.killpg(p.pid, signal.SIGKILL)
+            p.wait(5)
+
+
+def _wait_for(path: Path, text: str, timeout: float) -> None:
+    end = time.monotonic() + timeout
+    while time.monotonic() < end:
+        if path.exists() and text in path.read_text(errors="replace"):
+            return
+        time.sleep(0.05)
+    raise AssertionError(f"{path.name} never said {text!r}: {path.read_text(errors='replace')[-2000:]}")
+
+
+@pytest.fixture(scope="module")
+def live_log(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
+    tmp = tmp_path_factory.mktemp("svc")
+    procs: list[subprocess.Popen[bytes]] = []
+    log = tmp / "monitor.jsonl"
+    with LocalMaster(tmp / "ros") as env:
+        env = {**env, "PYTHONPATH": str(REPO / "src") + os.pathsep + os.environ.get("PYTHONPATH", "")}
+        try:
+            base = _start([str(NODES), "base", "--serve", "/estop_real", "--late-call", "2", "--delay", "0.4"],
+                          env, tmp / "base.out")
+            mover = _start([str(NODES), "mover", "--feedback-after", "0.5"], env, tmp / "mover.out")
+            procs += [base, mover]
+            _wait_for(tmp / "base.out", "ready", 60)
+            _wait_for(tmp / "mover.out", "ready", 60)
+            monitor = _start(["-m", "rclverify.backends.monitors.service_proxy", "--contracts",
+                              str(EXAMPLE / "contracts" / "safety_stop.rcl"), "--interfaces",
+                              str(EXAMPLE / "interfaces"), "--forward", "/estop=/estop_real", "--log", str(log),
+                              "--duration", "60"], env, tmp / "monitor.out")
+            procs.append(monitor)
+            _wait_for(tmp / "monitor.out", "service_proxy: ready", 60)
+            teleop = _start([str(NODES), "teleop", "--call", "/estop", "--count", "2", "--every", "0.3"],
+                            env, tmp / "teleop.out")
+            mission = _start([str(NODES), "mission", "--target", "2.0"], env, tmp / "mission.out")
+            procs += [teleop, mission]
+            assert teleop.wait(60) == 0, (tmp / "teleop.out").read_text()
+            assert mission.wait(60) == 0, (tmp / "mission.out").read_text()
+            _wait_for(log, '"node": "Mover"', 30)
+            _stop(monitor, signal.SIGINT)
+            code = monitor.returncode
+        finally:
+            for p in reversed(procs):
+                _stop(p)
+    lines = [json.loads(x) for x in log.read_text().splitlines()]
+    return {"lines": lines, "code": code, "tmp": tmp}
+
+
+def test_the_late_service_answer_is_false_with_the_calls_stamps(live_log: dict[str, Any]) -> None:
+    verdicts = [x for x in live_log["lines"] if x["kind"] == "verdict" and x["node"] == "Base"]
+    assert [(v["verdict"], v["update"]) for v in verdicts] == [("true", False), ("false", False), ("false", True)]
+    expired, late = verdicts[1], verdicts[2]
+    # false as soon as the clock passed the deadline (the proxy's timer), before the answer came ...
+    assert expired["answer"] is None and expired["reason"].startswith("no answer within the deadline of 200 ms")
+    # ... and the late answer, when it came, shown with the call's stamps
+    assert late["trigger_where"] == expired["trigger_where"] and late["guarantee"] == 1
+    assert late["due"] == pytest.approx(late["trigger_stamp"] + 0.2)
+    assert late["answer"] - late["trigger_stamp"] >= 0.4  # the server slept 400 ms
+    # the stamps are those of the second call's request and response events, as the proxy logged them
+    events = {x["index"] + 1: x for x in live_log["lines"] if x["kind"] == "event"}
+    req = events[int(late["trigger_where"].split(":")[1])]
+    resp = events[int(late["answer_where"].split(":")[1])]
+    assert (req["topic"], resp["topic"]) == ("estop/request", "estop/response")
+    assert (req["time"], resp["time"]) == (late["trigger_stamp"], late["answer"])
+    assert live_log["code"] == 1  # a false verdict: the monitor's exit code says so
+
+
+def test_the_action_feedback_arrives_in_time(live_log: dict[str, Any]) -> None:
+    verdicts = [x for x in live_log["lines"] if x["kind"] == "verdict" and x["node"] == "Mover"]
+    assert [v["verdict"] for v in verdicts] == ["true"], verdicts
+    v = verdicts[0]
+    assert 0.4 <= v["answer"] - v["trigger_stamp"] <= 2.0
+    topics = [x["topic"] for x in live_log["lines"] if x["kind"] == "event"]
+    assert {"move/goal", "move/feedback", "move/result"} <= set(topics)
+    summary = live_log["lines"][-1]
+    assert summary["kind"] == "summary" and summary["false"] == 1
