@@ -53,7 +53,7 @@ from typing import Any, Callable, Sequence, TypeVar
 from lark import Lark
 
 from rclverify.rcl import ast
-from rclverify.rcl.parser import _gc_paused as gc_paused
+from rclverify.cache.heap import no_collection as gc_paused
 from rclverify.rcl.parser import ast_from_tree, grammar_text, parse_text
 
 T = TypeVar("T")
