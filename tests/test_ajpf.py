@@ -10,7 +10,8 @@ from typing import Iterator
 import pytest
 from rclverify.pipeline import Workspace
 
-from rclverify.backends.ajpf import AjpfBackend, psl
+from rclverify.backends.ajpf import psl
+from rclverify.backends.ajpf.backend import AjpfBackend
 from rclverify.backends.ajpf.instantiate import Translator
 from rclverify.backends.ajpf.mapping import Canon, Row, RowError, build_row, dnf
 from rclverify.backends.ajpf.results import parse_log

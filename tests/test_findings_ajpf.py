@@ -5,7 +5,7 @@ from pathlib import Path
 
 import pytest
 
-from rclverify.backends.ajpf import AjpfBackend
+from rclverify.backends.ajpf.backend import AjpfBackend
 from test_ajpf import make_target
 
 

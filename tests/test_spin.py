@@ -231,7 +231,7 @@ STAGE_ONE = importlib.util.find_spec("rclverify.backends.model_checking.explore"
 @needs_spin
 @pytest.mark.skipif(not STAGE_ONE, reason="stage one not present")
 def test_case_study_instances_all_decided(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
-    from rclverify.backends.ajpf import AjpfBackend
+    from rclverify.backends.ajpf.backend import AjpfBackend
     from rclverify.workspace import Workspace
     monkeypatch.delenv("MCAPL_HOME", raising=False)
     monkeypatch.delenv("AJPF_HOME", raising=False)
@@ -312,7 +312,7 @@ def spin_workspace(root: Path, extra: str) -> NodeTarget:
     ("        properties: [backends/ajpf/none.psl]\n", 10, "property file 'backends/ajpf/none.psl' does not exist"),
 ])
 def test_spin_keys_are_checked_with_located_errors(tmp_path: Path, extra: str, where: int, message: str) -> None:
-    from rclverify.backends.ajpf import AjpfBackend
+    from rclverify.backends.ajpf.backend import AjpfBackend
     target = spin_workspace(tmp_path, extra)
     with pytest.raises(PlanError) as e:
         AjpfBackend().export(target)
@@ -320,7 +320,7 @@ def test_spin_keys_are_checked_with_located_errors(tmp_path: Path, extra: str, w
 
 
 def test_property_files_give_obligations_of_their_own(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
-    from rclverify.backends.ajpf import AjpfBackend
+    from rclverify.backends.ajpf.backend import AjpfBackend
     monkeypatch.delenv("MCAPL_HOME", raising=False)
     monkeypatch.delenv("AJPF_HOME", raising=False)
     (tmp_path / "backends/ajpf").mkdir(parents=True)

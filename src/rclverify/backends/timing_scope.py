@@ -17,9 +17,12 @@ from ..rcl.types import CheckedNode
 TIMED_BACKENDS: frozenset[str] = frozenset({"monitors"})
 
 
-def timing_of(node: CheckedNode, guarantee: int) -> str:
+def timing_of(node: CheckedNode | None, guarantee: int) -> str:
     """`` triggered by in.x within 200 ms`` of guarantee ``guarantee``
-    (1-based) of ``node``, or ``""`` when it is untimed or out of range."""
+    (1-based) of ``node``, or ``""`` when it is untimed, out of range, or
+    there is no checked node (a target made without contracts)."""
+    if node is None:
+        return ""
     gs = node.node.guarantees
     if not 1 <= guarantee <= len(gs):
         return ""
@@ -30,7 +33,7 @@ def timing_of(node: CheckedNode, guarantee: int) -> str:
     return s.strip()
 
 
-def scope(backend: str, node: CheckedNode, guarantee: int, explanation: str,
+def scope(backend: str, node: CheckedNode | None, guarantee: int, explanation: str,
           details: Mapping[str, Any]) -> tuple[str, dict[str, Any]]:
     """The explanation and details of an evidence record of ``backend`` for
     guarantee ``guarantee`` of ``node``, with the untimed-only note added when
