@@ -81,3 +81,49 @@ def test_unbounded_eventually_never_reached_is_not_proved():
                           lambda s, t: t["x"] == s["x"])
     v = check_eventually(ts, lambda s: s["x"] == 1, ranking=lambda s: s["x"], bound=3)
     assert v.status == "inconclusive"
+
+
+# --- the statement layer over RCL formulas (plan/temporal.py) ---------------
+
+import pytest  # noqa: E402
+
+from rclverify.plan.formal import Formal, Source  # noqa: E402
+from rclverify.plan.temporal import Temporal, parse_temporal  # noqa: E402
+from rclverify.rcl.errors import RclError  # noqa: E402
+from rclverify.rcl.typecheck import load  # noqa: E402
+
+
+@pytest.fixture(scope="module")
+def checked():
+    return load(["contracts/remote_inspection.rcl"])
+
+
+def _p(text, checked):
+    return parse_temporal(Source(text, 3, 12, "plan.yaml"), checked)
+
+
+def test_state_statement_stays_a_formal(checked):
+    assert isinstance(_p("RadiationSensor.out.radiationStatus == red", checked), Formal)
+
+
+def test_temporal_operators_nest_with_bound_and_until(checked):
+    t = _p("always (eventually[<= 4] (RadiationSensor.out.radiationStatus == red))", checked)
+    assert t.op == "always" and isinstance(t.args[0], Temporal)
+    inner = t.args[0]
+    assert (inner.op, inner.bound) == ("eventually", 4) and isinstance(inner.args[0], Formal)
+    u = _p("RadiationSensor.out.radiationStatus == green until "
+           "RadiationSensor.out.radiationStatus == red", checked)
+    assert u.op == "until" and all(isinstance(a, Formal) for a in u.args)
+    n = _p("next previous RadiationSensor.in.r > 0", checked)
+    assert (n.op, n.args[0].op) == ("next", "previous")
+
+
+def test_errors_in_an_operand_keep_the_plan_column(checked):
+    with pytest.raises(RclError) as e:
+        _p("always Nobody.out.x = 1", checked)
+    assert "plan.yaml:3:19" in str(e.value)
+    with pytest.raises(RclError) as e:
+        _p("eventually[<= many] RadiationSensor.in.r > 0", checked)
+    assert "natural number" in str(e.value) and "plan.yaml:3:26" in str(e.value)
+    with pytest.raises(RclError):
+        _p("always", checked)
