@@ -1,0 +1,110 @@
+"""Temporal requirement statements: a small layer above the RCL formula.
+
+Syntax (docs/requirements.md, "Temporal requirements"), read only in a
+requirement's ``formal:`` so that RCL's grammar and every contract keep
+their meaning::
+
+    T ::= always T | eventually T | eventually[<= N] T
+        | next T | previous T | F until F | F
+
+where ``F`` is a state formula read by :func:`rclverify.plan.formal.parse_formal`
+(``Node.in.x``/``Node.out.y``).  The operators bind like prefixes, ``until``
+splits the text at its first occurrence outside brackets.  An operand is
+parsed from the statement's text with everything else blanked out by
+spaces, so every line and column the RCL parser and type checker report is
+the one in the plan.  A statement with no temporal operator is a
+:class:`~rclverify.plan.formal.Formal`, unchanged.
+
+Errors (a bound that is not a natural number, an empty operand) are
+located :class:`~rclverify.rcl.errors.RclError` diagnostics (``E-syntax``).
+"""
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+
+from ..rcl.errors import RclError, error
+from ..rcl.types import Checked
+from .formal import Formal, Source, _loc_at, parse_formal
+
+_PREFIX = re.compile(r"\s*(always|eventually|next|previous)\b")
+_BOUND = re.compile(r"\s*\[\s*<=\s*([^\]]*)\]")
+_UNTIL = re.compile(r"(?<![A-Za-z0-9_.'])until(?![A-Za-z0-9_'])")
+
+
+@dataclass(frozen=True)
+class Temporal:
+    """A temporal statement: ``op`` is ``always`` | ``eventually`` |
+    ``next`` | ``previous`` | ``until``; ``args`` its one or two operands
+    (each a :class:`Temporal` or a :class:`Formal`); ``bound`` the step
+    bound of ``eventually[<= N]`` (None: unbounded)."""
+
+    op: str
+    args: tuple["Temporal | Formal", ...]
+    bound: int | None = None
+
+
+def _blank(text: str, start: int, end: int) -> str:
+    """``text`` with everything outside [start, end) replaced by spaces
+    (newlines kept), so offsets inside are unchanged."""
+    keep = lambda s: re.sub(r"[^\n]", " ", s)  # noqa: E731
+    return keep(text[:start]) + text[start:end] + keep(text[end:])
+
+
+def _until_at(text: str, start: int, end: int) -> int | None:
+    """Offset of the first ``until`` in [start, end) outside brackets."""
+    for m in _UNTIL.finditer(text, start, end):
+        seg = text[start:m.start()]
+        if sum(seg.count(c) for c in "([{") == sum(seg.count(c) for c in ")]}"):
+            return m.start()
+    return None
+
+
+def _closing(text: str, i: int, end: int) -> int | None:
+    """Offset of the bracket closing the one at ``i`` (before ``end``)."""
+    depth = 0
+    for k in range(i, end):
+        depth += text[k] in "([{"
+        depth -= text[k] in ")]}"
+        if depth == 0:
+            return k
+    return None
+
+
+def parse_temporal(src: Source, checked: Checked, what: str = "requirement") -> Temporal | Formal:
+    """Parse and type-check a possibly temporal statement (module docstring).
+
+    Returns a :class:`Temporal`, or a :class:`Formal` if it has no temporal
+    operator; raises :class:`RclError` with located diagnostics.
+    """
+    return _parse(src, 0, len(src.text), checked, what)
+
+
+def _parse(src: Source, start: int, end: int, checked: Checked, what: str) -> Temporal | Formal:
+    text = src.text
+    if not text[start:end].strip():
+        raise RclError([error(_loc_at(src, start), f"{what}: a temporal operator needs an operand",
+                              "E-syntax")])
+    i = start + len(text[start:end]) - len(text[start:end].lstrip())
+    j = start + len(text[start:end].rstrip())
+    if text[i] == "(" and _closing(text, i, j) == j - 1:
+        return _parse(src, i + 1, j - 1, checked, what)
+    m = _PREFIX.match(text, start, end)
+    if m:
+        op, pos, bound = m.group(1), m.end(), None
+        if op == "eventually":
+            b = _BOUND.match(text, pos, end)
+            if b:
+                if not b.group(1).strip().isdigit():
+                    raise RclError([error(_loc_at(src, b.start(1)), f"{what}: the bound of eventually[<= N] "
+                                          f"must be a natural number of steps, found {b.group(1).strip()!r}",
+                                          "E-syntax")])
+                bound, pos = int(b.group(1)), b.end()
+        return Temporal(op, (_parse(src, pos, end, checked, what),), bound)
+    u = _until_at(text, start, end)
+    if u is not None:
+        return Temporal("until", (_parse(src, start, u, checked, what),
+                                  _parse(src, u + 5, end, checked, what)))
+    if start == 0 and end == len(text):
+        return parse_formal(src, checked, what)
+    return parse_formal(Source(_blank(text, start, end), src.line, src.col, src.file), checked, what)
