@@ -22,7 +22,8 @@ as_root() {
 DEBIAN_PACKAGES=(
   dafny graphviz spin gcc
   ros-core python3-rospy python3-rosbag python3-rosgraph python3-roslaunch python3-genpy python3-catkin-pkg
-  python3-std-msgs python3-geometry-msgs python3-sensor-msgs python3-nav-msgs
+  python3-std-msgs python3-geometry-msgs python3-sensor-msgs python3-nav-msgs python3-std-srvs
+  python3-actionlib python3-actionlib-msgs ros-actionlib-msgs ros-std-srvs
   ros-std-msgs ros-geometry-msgs ros-sensor-msgs ros-nav-msgs
   chromium chromium-driver
 )
