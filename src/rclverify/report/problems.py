@@ -55,6 +55,7 @@ from collections.abc import Callable, Mapping, Sequence
 from typing import Any
 
 from ..evidence.records import SEVERITY
+from . import problems_mc as mc
 
 _SOURCE = re.compile(r"^(.*?):(\d+)(?::(\d+))?$")
 #: Diagnosis kinds whose victim guarantee is a defect of the contract itself.
@@ -159,6 +160,7 @@ def group_problems(report: Mapping[str, Any], items: Sequence[Mapping[str, Any]]
     """
     places = _Places(report)
     diagnoses = list(report.get("diagnoses") or [])
+    by_id = {str(d["id"]): d for d in diagnoses}
     item_anchor = {str(it["ref"]): str(it["anchor"]) for it in items}
     members: list[tuple[dict[str, Any], list[str]]] = []
 
@@ -166,8 +168,14 @@ def group_problems(report: Mapping[str, Any], items: Sequence[Mapping[str, Any]]
         return f"guarantee:{node}:{k}" if node and k else None
 
     explains: dict[str, list[str]] = {}
+    mc_obl = mc.mc_obligations(report)
+    direct: set[str] = set()  # model-checking evidence: grouped only by the culprits it names (problems_mc)
     for d in diagnoses:
         roots = _roots(d.get("culprits", []), places, victim_of(d.get("node"), d.get("guarantee")))
+        if str(d["id"]) in mc_obl:
+            direct.add(str(d["id"]))
+            roots = ([r for r in roots if r != victim_of(d.get("node"), d.get("guarantee"))]
+                     or [mc.mc_key(mc_obl[str(d["id"])], str(d["status"]))])
         m: dict[str, Any] = {"id": str(d["id"]), "kind": str(d["kind"]), "status": str(d["status"]), "sentence": str(d["sentence"]),
              "anchor": item_anchor.get(str(d["id"])) or _default_anchor(d, anchor), "diagnosis": True}
         members.append((m, roots))
@@ -206,6 +214,9 @@ def group_problems(report: Mapping[str, Any], items: Sequence[Mapping[str, Any]]
         o = obligation.get(ref)
         roots = [f"guarantee:{o['node']}:{o['guarantee']}"] if o is not None and o.get("guarantee") else []
         roots = [r for r in roots if r in places.info]
+        if ref in mc_obl:  # model-checking evidence without a diagnosis (inconclusive): outstanding, by guarantee
+            direct.add(ref)
+            roots = [mc.mc_key(mc_obl[ref], str(it["status"]))]
         if it["kind"] == "derived property":
             ref = f"{ref}.derived"  # named fully: the derived property of the node, never the bare node name
             # not derived because a side condition of its cone is not discharged: that side condition's cause
@@ -221,7 +232,7 @@ def group_problems(report: Mapping[str, Any], items: Sequence[Mapping[str, Any]]
     for m, roots in members:
         # an unverified guarantee stays a row of its own, even when a contract defect explains the guarantee;
         # so does a failed side condition: its culprits are the ones Z3 showed for it (diagnosis/blame.py)
-        explained = ([] if m["kind"] in ("unverified guarantee", "side-condition")
+        explained = ([] if m["kind"] in ("unverified guarantee", "side-condition") or m["id"] in direct
                      else [e for r in roots for e in explains.get(r, [])])
         if explained:
             roots = list(dict.fromkeys(explained))
@@ -245,10 +256,13 @@ def group_problems(report: Mapping[str, Any], items: Sequence[Mapping[str, Any]]
             if len(ids) > 1 and first is not None:
                 g["sentence"] = first_sentence(f"{len(ids)} guarantees of {node} are unverified "
                                                f"({', '.join(ids)}): {first['reason'].replace('covers it', 'covers them')}.")
+    for key, g in groups.items():  # model-checking rows: the Gwendolen lines the counterexamples pass through
+        if key[0].startswith(mc.FAILED_PREFIX):
+            lines = [places.locate(src) for m in g["members"] for src in mc.trail_sources(by_id.get(m["id"]))]
+            g["culprits"] = [_culprit(r, places, anchor) for r in dict.fromkeys(lines) if r is not None]
     where = _sources(report)
     for g in groups.values():  # where the problem is, for a row that names no culprit
         g["where"] = next((where[m["id"]] for m in g["members"] if where.get(m["id"])), "")
-    by_id = {str(d["id"]): d for d in diagnoses}
     for g in groups.values():
         if g["key"][0].startswith("unverified:"):
             continue
@@ -263,6 +277,10 @@ def group_problems(report: Mapping[str, Any], items: Sequence[Mapping[str, Any]]
                 if rep.get("diff") not in diffs:
                     diffs.add(rep.get("diff"))
                     g["repairs"].append({"diagnosis": m["id"], "index": k})
+        if g["key"][0].startswith((mc.FAILED_PREFIX, mc.OUTSTANDING_PREFIX)):
+            cex = next((str(r.get("value", "")) for m in g["members"]
+                        for r in (by_id.get(m["id"]) or {}).get("counterexample") or [] if r.get("variable") == "lasso"), "")
+            g["sentence"] = first_sentence(mc.row_sentence(g["key"][0], g["members"], first_sentence(g["members"][0]["sentence"]), cex))
     out = list(groups.values())
     out.sort(key=lambda g: -_severity(g["status"]))  # stable: report order within a status
     return out
