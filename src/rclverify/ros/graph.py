@@ -10,6 +10,8 @@ remapped by the launch file's ``remap`` elements (the last matching remap wins).
 """
 from __future__ import annotations
 
+from . import safefs
+
 import os
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -97,19 +99,36 @@ def scan(paths: Sequence[Path], launch: Sequence[Path] = (), launch_args: dict[s
     current directory). Never raises on bad input: unreadable files become
     located notes (``ROS-PARSE`` errors) in ``graph.notes``.
     """
+    from .interfaces import DEBIAN_SHARE
+    # Reads are confined to the workspace (``base``, else the scanned paths
+    # and entry launch files as given): links leaving it are skipped (docs/ros.md).
+    tops = [base] if base is not None else [*paths, *(Path(lf).parent for lf in launch)]
+    with safefs.confined([*tops, DEBIAN_SHARE]):
+        return _scan(paths, launch, launch_args, bags, cache_path, base, standard)
+
+
+def _scan(paths: Sequence[Path], launch: Sequence[Path], launch_args: dict[str, str] | None,
+          bags: Sequence[Path], cache_path: Path | None, base: Path | None, standard: bool) -> ScanResult:
     show = Shower(base)
     cache = ParseCache(cache_path) if cache_path is not None else None
     g = Graph()
     table = TypeTable()
     pkgs: dict[str, Package] = {}
-    for m in find_manifests([Path(p) for p in paths]):
+    tops = []
+    for p in paths:
+        if safefs.inside(p):
+            tops.append(Path(p))
+        else:
+            g.notes.append(Note(Src(show(Path(p))), "workspace path resolves outside the workspace "
+                                                    "(symlink): not scanned", "ROS-PARSE"))
+    for m in find_manifests(tops):
         shown = show(m)
         try:
-            g.files[shown] = ParseCache.digest(m.read_bytes())
+            g.files[shown] = ParseCache.digest(safefs.read_bytes(m))
         except OSError:
             pass
         try:
-            sha_m = g.files.get(shown) or ParseCache.digest(m.read_bytes())
+            sha_m = g.files.get(shown) or ParseCache.digest(safefs.read_bytes(m))
         except OSError:
             sha_m = ""
         pkg, notes = cache.get(f"pkg:{shown}", sha_m, lambda: read_package(m, shown)) if cache and sha_m \
@@ -145,9 +164,9 @@ def scan(paths: Sequence[Path], launch: Sequence[Path] = (), launch_args: dict[s
         py_nodes = []
         for f in py + cpp:
             try:
-                data = f.read_bytes()
+                data = safefs.read_bytes(f)
             except OSError as exc:
-                g.notes.append(Note(Src(show(f)), f"cannot read: {exc}", "ROS-PARSE", "error"))
+                g.notes.append(Note(Src(show(f)), f"cannot read: {exc}", "ROS-PARSE", "warning" if isinstance(exc, safefs.Refused) else "error"))
                 continue
             if len(data) > MAX_SOURCE_BYTES:
                 g.notes.append(Note(Src(show(f)), "source file larger than 2 MB: not scanned", "ROS-PARSE"))
@@ -206,7 +225,7 @@ def scan(paths: Sequence[Path], launch: Sequence[Path] = (), launch_args: dict[s
             interp.run(Path(lf), dict(launch_args or {}))
         for f in interp.files:
             try:
-                g.files[show(f)] = ParseCache.digest(f.read_bytes())
+                g.files[show(f)] = ParseCache.digest(safefs.read_bytes(f))
             except OSError:
                 pass
         g.notes.extend(interp.notes)

@@ -27,6 +27,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Callable
 
+from . import safefs
 from . import names
 from .model import Note, Src
 
@@ -290,7 +291,7 @@ def read_yaml(path: Path, shown: str) -> tuple[El | None, list[Note]]:
         return d
     _L.add_constructor(yaml.resolver.BaseResolver.DEFAULT_MAPPING_TAG, _map)
     try:
-        text = path.read_text(encoding="utf-8", errors="replace")
+        text = safefs.read_text(path)
         if len(text) > 5_000_000:
             return None, [Note(Src(shown), "launch file too large", "ROS-PARSE", "error")]
         data = yaml.load(text, Loader=_L)  # noqa: S506 (a SafeLoader subclass)

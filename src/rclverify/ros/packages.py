@@ -7,6 +7,8 @@ A directory holding ``CATKIN_IGNORE``, ``COLCON_IGNORE`` or
 """
 from __future__ import annotations
 
+from . import safefs
+
 import os
 from dataclasses import dataclass
 from pathlib import Path
@@ -62,7 +64,7 @@ def read_package(manifest: Path, shown: str) -> tuple[Package | None, list[Note]
         return None, [note]
     warnings: list[str] = []
     try:
-        pkg = parse_package_string(manifest.read_text(encoding="utf-8", errors="replace"), str(manifest), warnings)
+        pkg = parse_package_string(safefs.read_text(manifest), str(manifest), warnings)
     except InvalidPackage as exc:
         msg = " ".join(str(exc).replace(str(manifest), shown).split())
         return None, [Note(Src(shown), f"invalid package.xml: {msg}", "ROS-PARSE", "error")]

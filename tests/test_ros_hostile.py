@@ -1,0 +1,94 @@
+"""The ROS scan against a hostile workspace (docs/ros.md, "Hostile
+workspaces"): FIFOs, device links and links leaving the workspace are
+skipped with a located warning, never read.  Scans run in a subprocess with
+a timeout so a regression (a blocking FIFO read) fails instead of hanging."""
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+MARK = "OUTSIDE_MARKER_7f3a91"
+MANIFEST = ('<?xml version="1.0"?><package format="2"><name>p</name><version>0.0.1</version>'
+            '<description>d</description><maintainer email="m@example.com">m</maintainer>'
+            '<license>MIT</license></package>\n')
+CLI = "import sys; from rclverify.cli import main; sys.exit(main(sys.argv[1:]))"
+NODE = "import rospy\nrospy.init_node('n')\nrospy.Publisher('/t', String)\n"
+
+
+def _scan(ws: Path, *extra: str) -> tuple[subprocess.CompletedProcess[str], dict]:
+    out = ws.parent / "graph.json"
+    proc = subprocess.run([sys.executable, "-c", CLI, "ros", "scan", ".", "--json", str(out), *extra],
+                          cwd=ws, capture_output=True, text=True, timeout=60)
+    graph = json.loads(out.read_text()) if out.is_file() else {}
+    return proc, graph
+
+
+def _pkg(ws: Path) -> Path:
+    p = ws / "p"
+    (p / "scripts").mkdir(parents=True)
+    (p / "package.xml").write_text(MANIFEST)
+    return p
+
+
+def _outside(tmp: Path) -> Path:
+    o = tmp / "outside"
+    o.mkdir()
+    (o / "x.py").write_text(f"# {MARK}\nrospy.Publisher('/{MARK}', String)\n")
+    (o / "Leak.msg").write_text(f"int32 {MARK.lower()}\n")
+    (o / "out.launch").write_text(f'<launch><node pkg="p" type="x.py" name="{MARK}"/></launch>\n')
+    return o
+
+
+@pytest.mark.skipif(not hasattr(os, "mkfifo"), reason="needs FIFOs")
+def test_fifo_and_device_link_are_skipped_not_read(tmp_path: Path) -> None:
+    """Item 8: a FIFO ``package.xml``/script and a link to /dev/zero are skipped, located."""
+    ws = tmp_path / "ws"
+    p = _pkg(ws)
+    (p / "scripts" / "good.py").write_text(NODE)
+    os.mkfifo(p / "scripts" / "x.py")
+    os.symlink("/dev/zero", p / "scripts" / "z.py")
+    q = ws / "q"
+    q.mkdir()
+    os.mkfifo(q / "package.xml")
+    proc, graph = _scan(ws)
+    assert "Traceback" not in proc.stderr
+    msgs = {(u["file"], u["message"]) for u in graph["unresolved"]}
+    assert any(f == "p/scripts/x.py" and "not a regular file" in m for f, m in msgs)
+    assert any(f == "p/scripts/z.py" and "skipped" in m for f, m in msgs)
+    assert any(f == "q/package.xml" and "not a regular file" in m for f, m in msgs)
+    assert [pk["name"] for pk in graph["packages"]] == ["p"]
+
+
+def test_large_source_is_capped(tmp_path: Path) -> None:
+    """Item 8: a source file over the 8 MiB cap is skipped with a warning."""
+    from rclverify.ros import safefs
+    big = tmp_path / "big.py"
+    big.write_bytes(b"#" * (safefs.MAX_FILE_BYTES + 1))
+    with pytest.raises(safefs.Refused, match="larger than 8 MiB"):
+        safefs.read_bytes(big)
+
+
+def test_links_and_includes_leaving_the_workspace_are_not_read(tmp_path: Path) -> None:
+    """Item 5: a linked workspace dir, a linked script, a linked .msg and an
+    absolute include outside the workspace: nothing of them in the output."""
+    o = _outside(tmp_path)
+    ws = tmp_path / "ws"
+    p = _pkg(ws)
+    os.symlink(o, ws / "ros_ext")
+    os.symlink(o / "x.py", p / "scripts" / "o.py")
+    (p / "msg").mkdir()
+    os.symlink(o / "Leak.msg", p / "msg" / "Leak.msg")
+    (p / "launch").mkdir()
+    (p / "launch" / "main.launch").write_text(f'<launch><include file="{o / "out.launch"}"/></launch>\n')
+    proc, graph = _scan(ws, "--launch", "p/launch/main.launch")
+    assert "Traceback" not in proc.stderr
+    text = json.dumps(graph) + proc.stdout + proc.stderr
+    assert MARK not in text and MARK.lower() not in text
+    warned = {u["file"] for u in graph["unresolved"] if "outside the workspace" in u["message"]}
+    assert {"p/scripts/o.py", "p/msg/Leak.msg"} <= warned
+    assert graph["nodes"] == []
