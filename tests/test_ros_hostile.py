@@ -92,3 +92,41 @@ def test_links_and_includes_leaving_the_workspace_are_not_read(tmp_path: Path) -
     warned = {u["file"] for u in graph["unresolved"] if "outside the workspace" in u["message"]}
     assert {"p/scripts/o.py", "p/msg/Leak.msg"} <= warned
     assert graph["nodes"] == []
+
+
+def test_init_from_ros_copies_no_link_target_and_does_not_loop(tmp_path: Path) -> None:
+    """Item 7: ``init --from-ros`` copies neither what a link outside points to
+    nor loops on ``a -> .``; an inside link to a regular file is copied."""
+    o = _outside(tmp_path)
+    ws = tmp_path / "ws"
+    p = _pkg(ws)
+    (p / "scripts" / "good.py").write_text(NODE)
+    os.symlink(o / "x.py", p / "leak.py")
+    os.symlink(".", p / "a")
+    os.symlink("scripts/good.py", p / "alias.py")
+    new = tmp_path / "new"
+    proc = subprocess.run([sys.executable, "-c", CLI, "init", str(new), "--from-ros", str(ws)],
+                          capture_output=True, text=True, timeout=60)
+    assert proc.returncode == 0, proc.stderr
+    assert "Traceback" not in proc.stderr
+    assert "leak.py: warning: link leaving the package: skipped" in proc.stderr
+    assert "a: warning: directory link not followed" in proc.stderr
+    copied = sorted(q.relative_to(new / "ros" / "p").as_posix() for q in (new / "ros" / "p").rglob("*"))
+    assert copied == ["alias.py", "package.xml", "scripts", "scripts/good.py"]
+    assert not any((new / "ros" / "p" / c).is_symlink() for c in copied)
+    for q in new.rglob("*"):
+        if q.is_file():
+            assert MARK not in q.read_text(errors="replace")
+
+
+def test_copy_package_is_bounded(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """Item 7: the copy stops at its file bound and says so."""
+    from rclverify.ros import safecopy
+    src = tmp_path / "src"
+    src.mkdir()
+    for i in range(5):
+        (src / f"f{i}.txt").write_text("x")
+    monkeypatch.setattr(safecopy, "MAX_FILES", 3)
+    warns = safecopy.copy_package(src, tmp_path / "dst")
+    assert len(list((tmp_path / "dst").iterdir())) == 3
+    assert "copy limit reached" in warns[-1]
