@@ -130,3 +130,24 @@ def test_copy_package_is_bounded(tmp_path: Path, monkeypatch: pytest.MonkeyPatch
     warns = safecopy.copy_package(src, tmp_path / "dst")
     assert len(list((tmp_path / "dst").iterdir())) == 3
     assert "copy limit reached" in warns[-1]
+
+
+def test_cache_in_copied_workspace_scans_the_copy(tmp_path: Path) -> None:
+    """Item 6: a scan cache made in ``ws`` and carried by ``cp -a ws ws2``
+    does not make ``ws2``'s scan read ``ws``: an edit in the copy is seen,
+    and the cached scan equals a clean one."""
+    import shutil
+
+    from rclverify.ros.graph import scan
+    ws = tmp_path / "ws"
+    p = _pkg(ws)
+    (p / "scripts" / "good.py").write_text(NODE)
+    cache = ws / "artifacts" / "cache" / "ros-scan.pickle"
+    scan([ws], cache_path=cache, base=ws).graph
+    ws2 = tmp_path / "ws2"
+    shutil.copytree(ws, ws2, symlinks=True)
+    (ws2 / "p" / "scripts" / "good.py").write_text(NODE.replace("'/t'", "'/edited'"))
+    cached = scan([ws2], cache_path=ws2 / "artifacts" / "cache" / "ros-scan.pickle", base=ws2).graph
+    clean = scan([ws2], base=ws2).graph
+    assert {e[2] for e in cached.edges()} == {"/edited"}
+    assert cached.to_json() == clean.to_json()

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 from . import safefs
 
+import dataclasses
 import os
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -136,6 +137,9 @@ def _scan(paths: Sequence[Path], launch: Sequence[Path], launch_args: dict[str, 
         g.notes.extend(notes)
         if pkg is None:
             continue
+        # the cache is keyed by workspace-relative path and content: the
+        # directory is this tree's, never the one the entry was made in
+        pkg = dataclasses.replace(pkg, root=m.parent, manifest=m)
         if pkg.name in pkgs:
             g.notes.append(Note(Src(shown), f"package '{pkg.name}' also at {show(pkgs[pkg.name].manifest)}; "
                                             f"this one is ignored", "ROS-MANIFEST"))
