@@ -151,3 +151,35 @@ def test_cache_in_copied_workspace_scans_the_copy(tmp_path: Path) -> None:
     clean = scan([ws2], base=ws2).graph
     assert {e[2] for e in cached.edges()} == {"/edited"}
     assert cached.to_json() == clean.to_json()
+
+
+def test_launch_fanout_deep_args_yaml_bomb_and_many_depends_are_bounded(tmp_path: Path) -> None:
+    """Item 9: 20 files each including the next 4 times, ``$(arg)`` defaults
+    nested 40 levels (4^40 characters), a YAML alias bomb and 5,000
+    ``<depend>``s each end quickly with a located warning saying what was cut."""
+    ws = tmp_path / "ws"
+    p = _pkg(ws)
+    (p / "launch").mkdir()
+    for i in range(20):
+        inc = "".join(f'<include file="$(dirname)/f{i + 1}.launch"/>' for _ in range(4)) if i < 19 else ""
+        (p / "launch" / f"f{i}.launch").write_text(f'<launch><node pkg="p" type="x" name="n{i}"/>{inc}</launch>\n')
+    args = '<arg name="a0" default="xxxx"/>' + "".join(
+        f'<arg name="a{i}" default="$(arg a{i - 1})$(arg a{i - 1})$(arg a{i - 1})$(arg a{i - 1})"/>'
+        for i in range(1, 41))
+    (p / "launch" / "deep.launch").write_text(f'<launch>{args}<node pkg="p" type="x" name="$(arg a40)"/></launch>\n')
+    bomb = 'a: &a ["x","x","x","x","x","x","x","x","x","x"]\n' + "".join(
+        f'{c}: &{c} [*{b},*{b},*{b},*{b},*{b},*{b},*{b},*{b},*{b},*{b}]\n' for b, c in zip("abcdefgh", "bcdefghi"))
+    (p / "launch" / "bomb.launch.yaml").write_text(bomb + "launch: [*i]\n")
+    q = ws / "q"
+    q.mkdir()
+    (q / "package.xml").write_text(MANIFEST.replace("<name>p</name>", "<name>q</name>").replace(
+        "<license>MIT</license>", "<license>MIT</license>" + "<depend>d</depend>" * 5000))
+    proc, graph = _scan(ws, "--launch", "p/launch/deep.launch", "--launch", "p/launch/bomb.launch.yaml",
+                        "--launch", "p/launch/f0.launch")
+    assert "Traceback" not in proc.stderr
+    notes = [(u["file"], u["message"]) for u in graph["unresolved"]]
+    assert any("more than 256 launch files" in m for _, m in notes)
+    assert any(f == "p/launch/deep.launch" and "expands beyond 65536 characters" in m for f, m in notes)
+    assert any(f == "p/launch/bomb.launch.yaml" and "refused" in m for f, m in notes)
+    assert any(f == "q/package.xml" and "5000 dependency elements" in m for f, m in notes)
+    assert {n["name"] for n in graph["nodes"]} == {f"/n{i}" for i in range(20)}

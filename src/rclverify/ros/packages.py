@@ -37,6 +37,9 @@ class Package:
                 "ros": self.ros, "manifest": shown}
 
 
+MAX_DEPENDS = 1000  # <*depend> elements in one package.xml (catkin_pkg is quadratic in them)
+
+
 def find_manifests(paths: list[Path]) -> list[Path]:
     """Every ``package.xml`` under ``paths`` (a path may be a package itself), sorted."""
     out: list[Path] = []
@@ -62,6 +65,10 @@ def read_package(manifest: Path, shown: str) -> tuple[Package | None, list[Note]
     root, note = parse_xml(manifest, shown)
     if note is not None:
         return None, [note]
+    deps = sum(1 for el in root.iter() if isinstance(el.tag, str) and el.tag.endswith("depend"))
+    if deps > MAX_DEPENDS:
+        return None, [Note(Src(shown), f"package.xml has {deps} dependency elements, more than {MAX_DEPENDS}: "
+                                       f"not parsed", "ROS-PARSE", "error")]
     warnings: list[str] = []
     try:
         pkg = parse_package_string(safefs.read_text(manifest), str(manifest), warnings)
