@@ -183,3 +183,22 @@ def test_launch_fanout_deep_args_yaml_bomb_and_many_depends_are_bounded(tmp_path
     assert any(f == "p/launch/bomb.launch.yaml" and "refused" in m for f, m in notes)
     assert any(f == "q/package.xml" and "5000 dependency elements" in m for f, m in notes)
     assert {n["name"] for n in graph["nodes"]} == {f"/n{i}" for i in range(20)}
+
+
+@pytest.mark.skipif(sys.platform == "darwin", reason="needs a filesystem that takes any bytes in names")
+def test_non_utf8_names_are_skipped_with_an_escaped_warning(tmp_path: Path) -> None:
+    """Item 10: a directory or file whose name is not UTF-8 is skipped, named with escapes, no traceback."""
+    ws = tmp_path / "ws"
+    p = _pkg(ws)
+    (p / "scripts" / "good.py").write_text(NODE)
+    bad_dir = os.fsencode(p / "scripts") + b"/\xff\xfe"
+    os.mkdir(bad_dir)
+    with open(bad_dir + b"/n.py", "w") as f:
+        f.write(NODE)
+    with open(os.fsencode(p / "scripts") + b"/b\xffad.py", "w") as f:
+        f.write(NODE)
+    proc, graph = _scan(ws)
+    assert "Traceback" not in proc.stderr
+    warned = {u["file"] for u in graph["unresolved"] if "not valid UTF-8" in u["message"]}
+    assert warned == {"p/scripts/\\xff\\xfe", "p/scripts/b\\xffad.py"}
+    assert "p/scripts/\\xff\\xfe:1:1: warning: name is not valid UTF-8: skipped" in proc.stderr

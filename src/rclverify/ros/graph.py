@@ -65,11 +65,12 @@ class Shower:
         return shown
 
 
-def _source_files(root: Path) -> tuple[list[Path], list[Path]]:
+def _source_files(root: Path, skipped: list[str] | None = None) -> tuple[list[Path], list[Path]]:
     py, cpp = [], []
     for dirpath, dirnames, filenames in os.walk(root):
-        dirnames[:] = sorted(d for d in dirnames if d not in _SKIP_DIRS and not d.startswith("."))
-        for f in sorted(filenames):
+        dirnames[:] = sorted(d for d in safefs.keep_names(dirpath, dirnames, skipped)
+                             if d not in _SKIP_DIRS and not d.startswith("."))
+        for f in sorted(safefs.keep_names(dirpath, filenames, skipped)):
             p = Path(dirpath) / f
             if f.endswith(".py") and f != "setup.py" and not f.endswith(".launch.py") and f != "__init__.py":
                 py.append(p)
@@ -122,7 +123,8 @@ def _scan(paths: Sequence[Path], launch: Sequence[Path], launch_args: dict[str, 
         else:
             g.notes.append(Note(Src(show(Path(p))), "workspace path resolves outside the workspace "
                                                     "(symlink): not scanned", "ROS-PARSE"))
-    for m in find_manifests(tops):
+    skipped: list[str] = []
+    for m in find_manifests(tops, skipped):
         shown = show(m)
         try:
             g.files[shown] = ParseCache.digest(safefs.read_bytes(m))
@@ -164,13 +166,14 @@ def _scan(paths: Sequence[Path], launch: Sequence[Path], launch_args: dict[str, 
     exes: dict[str, dict[str, list[Path]]] = {}
     for name in sorted(pkgs):
         root = pkgs[name].root
-        py, cpp = _source_files(root)
+        py, cpp = _source_files(root, skipped)
         py_nodes = []
         for f in py + cpp:
             try:
                 data = safefs.read_bytes(f)
             except OSError as exc:
-                g.notes.append(Note(Src(show(f)), f"cannot read: {exc}", "ROS-PARSE", "warning" if isinstance(exc, safefs.Refused) else "error"))
+                sev = "warning" if isinstance(exc, safefs.Refused) else "error"
+                g.notes.append(Note(Src(show(f)), f"cannot read: {exc}", "ROS-PARSE", sev))
                 continue
             if len(data) > MAX_SOURCE_BYTES:
                 g.notes.append(Note(Src(show(f)), "source file larger than 2 MB: not scanned", "ROS-PARSE"))
@@ -190,6 +193,8 @@ def _scan(paths: Sequence[Path], launch: Sequence[Path], launch_args: dict[str, 
             if is_py and (r["nodes"] or r["endpoints"]):
                 py_nodes.append(f)
         exes[name] = executables(root, name, py_nodes)
+    for bad in sorted({safefs.escaped(show(Path(b))) for b in skipped}):
+        g.notes.append(Note(Src(bad), "name is not valid UTF-8: skipped", "ROS-PARSE"))
 
     def endpoints_of(files: list[Path]) -> tuple[list[Endpoint], list[tuple[str, Src]], list[str]]:
         eps: list[Endpoint] = []

@@ -40,8 +40,9 @@ class Package:
 MAX_DEPENDS = 1000  # <*depend> elements in one package.xml (catkin_pkg is quadratic in them)
 
 
-def find_manifests(paths: list[Path]) -> list[Path]:
-    """Every ``package.xml`` under ``paths`` (a path may be a package itself), sorted."""
+def find_manifests(paths: list[Path], skipped: list[str] | None = None) -> list[Path]:
+    """Every ``package.xml`` under ``paths`` (a path may be a package itself), sorted;
+    directories whose name is not valid UTF-8 are not entered (appended, escaped, to ``skipped``)."""
     out: list[Path] = []
     for top in paths:
         if top.is_file() and top.name == "package.xml":
@@ -51,7 +52,8 @@ def find_manifests(paths: list[Path]) -> list[Path]:
             if any(f in filenames for f in _IGNORE_FILES):
                 dirnames[:] = []
                 continue
-            dirnames[:] = sorted(d for d in dirnames if d not in _SKIP_DIRS and not d.startswith("."))
+            dirnames[:] = sorted(d for d in safefs.keep_names(dirpath, dirnames, skipped)
+                                 if d not in _SKIP_DIRS and not d.startswith("."))
             if "package.xml" in filenames:
                 out.append(Path(dirpath) / "package.xml")
                 # a package does not nest packages (REP 140)

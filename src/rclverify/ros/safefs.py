@@ -70,3 +70,29 @@ def read_bytes(path: str | Path, limit: int = MAX_FILE_BYTES) -> bytes:
 def read_text(path: str | Path, limit: int = MAX_FILE_BYTES) -> str:
     """:func:`read_bytes` decoded as UTF-8 (bad bytes replaced)."""
     return read_bytes(path, limit).decode("utf-8", errors="replace")
+
+
+def utf8_name(name: str) -> bool:
+    """Whether a file or directory name (as ``os`` gives it) is valid UTF-8."""
+    try:
+        name.encode("utf-8")
+    except UnicodeEncodeError:
+        return False
+    return True
+
+
+def escaped(path: str | Path) -> str:
+    """``path`` with bytes that are not UTF-8 shown as ``\\xNN`` escapes."""
+    return os.fsencode(path).decode("utf-8", errors="backslashreplace")
+
+
+def keep_names(dirpath: str, names: list[str], skipped: list[str] | None) -> list[str]:
+    """The ``names`` in ``dirpath`` that are valid UTF-8; each other one is
+    appended (joined to ``dirpath``, escaped) to ``skipped``."""
+    out = []
+    for n in names:
+        if utf8_name(n):
+            out.append(n)
+        elif skipped is not None:
+            skipped.append(escaped(os.path.join(dirpath, n)))
+    return out
