@@ -202,3 +202,75 @@ def test_non_utf8_names_are_skipped_with_an_escaped_warning(tmp_path: Path) -> N
     warned = {u["file"] for u in graph["unresolved"] if "not valid UTF-8" in u["message"]}
     assert warned == {"p/scripts/\\xff\\xfe", "p/scripts/b\\xffad.py"}
     assert "p/scripts/\\xff\\xfe:1:1: warning: name is not valid UTF-8: skipped" in proc.stderr
+
+
+def _hostile_workspace(tmp: Path, seed: int) -> tuple[Path, Path]:
+    import random
+    rnd = random.Random(seed)
+    o = _outside(tmp)
+    (o / "secret.launch").write_text(f'<launch><node pkg="p" type="x" name="{MARK}"/></launch>\n')
+    ws = tmp / "ws"
+    p = _pkg(ws)
+    (p / "scripts" / "good.py").write_text(NODE)
+    (p / "launch").mkdir()
+    entry = p / "launch" / "main.launch"
+    makers = [
+        lambda d: os.mkfifo(d / "package.xml") if not (d / "package.xml").exists() else None,
+        lambda d: os.mkfifo(d / f"f{rnd.randrange(99)}.py"),
+        lambda d: os.symlink(".", d / f"loop{rnd.randrange(99)}"),
+        lambda d: os.symlink(o, d / f"ext{rnd.randrange(99)}"),
+        lambda d: os.symlink(o / "x.py", d / f"o{rnd.randrange(99)}.py"),
+        lambda d: os.symlink("/dev/zero", d / f"z{rnd.randrange(99)}.py"),
+        lambda d: os.truncate(_touch(d / f"huge{rnd.randrange(99)}.py"), 9 * 1024 * 1024),
+        lambda d: (d / f"bin{rnd.randrange(99)}.cpp").write_bytes(bytes(rnd.randrange(256) for _ in range(4096))),
+        lambda d: os.mkdir(os.fsencode(d) + bytes([0x80 + rnd.randrange(64)]) + b"dir"),
+    ]
+    for _ in range(12):
+        d = rnd.choice([ws, p, p / "scripts", p / "launch"])
+        try:
+            rnd.choice(makers)(d)
+        except FileExistsError:
+            pass
+    kind = rnd.randrange(3)
+    if kind == 0:  # fan-out
+        for i in range(12):
+            inc = "".join(f'<include file="$(dirname)/g{i + 1}.launch"/>' for _ in range(4)) if i < 11 else ""
+            (p / "launch" / f"g{i}.launch").write_text(f"<launch>{inc}</launch>\n")
+        entry.write_text(f'<launch><include file="$(dirname)/g0.launch"/>'
+                         f'<include file="{o / "secret.launch"}"/></launch>\n')
+    elif kind == 1:  # deep args
+        args = '<arg name="a0" default="yy"/>' + "".join(
+            f'<arg name="a{i}" default="$(arg a{i - 1})$(arg a{i - 1})$(arg a{i - 1})"/>' for i in range(1, 35))
+        entry.write_text(f'<launch>{args}<node pkg="p" type="x" name="$(arg a34)"/></launch>\n')
+    else:  # include through a link leaving the workspace
+        os.symlink(o / "secret.launch", p / "launch" / "s.launch")
+        entry.write_text('<launch><include file="$(dirname)/s.launch"/></launch>\n')
+    return ws, entry
+
+
+def _touch(p: Path) -> Path:
+    p.write_bytes(b"")
+    return p
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_fuzz_hostile_workspaces(tmp_path: Path, seed: int) -> None:
+    """Generated hostile workspaces: every scan and ``init --from-ros`` ends
+    within its bound, without a traceback, and nothing from the outside
+    directory (its marker) appears in stdout, stderr, graph.json or the new workspace."""
+    ws, entry = _hostile_workspace(tmp_path, seed)
+    proc, graph = _scan(ws, "--launch", entry.relative_to(ws).as_posix())
+    assert proc.returncode in (0, 1)
+    assert "Traceback" not in proc.stderr
+    text = proc.stdout + proc.stderr + json.dumps(graph)
+    assert MARK not in text and MARK.lower() not in text
+    new = tmp_path / "new"
+    init = subprocess.run([sys.executable, "-c", CLI, "init", str(new), "--from-ros", str(ws)],
+                          cwd=ws, capture_output=True, text=True, timeout=60)
+    assert init.returncode == 0, init.stderr  # package p (good.py) is always found: the copy is exercised
+    assert "Traceback" not in init.stderr
+    assert MARK not in init.stdout + init.stderr
+    for q in new.rglob("*"):
+        assert not q.is_symlink()
+        if q.is_file():
+            assert MARK.encode() not in q.read_bytes()
