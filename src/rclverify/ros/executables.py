@@ -10,6 +10,8 @@
 """
 from __future__ import annotations
 
+from . import safefs
+
 import ast
 import re
 from pathlib import Path
@@ -22,7 +24,7 @@ def cmake_executables(root: Path, pkg: str) -> dict[str, list[Path]]:
     f = root / "CMakeLists.txt"
     out: dict[str, list[Path]] = {}
     try:
-        text = f.read_text(encoding="utf-8", errors="replace")
+        text = safefs.read_text(f)
     except OSError:
         return out
     text = re.sub(r"#.*", "", text).replace("${PROJECT_NAME}", pkg)
@@ -39,7 +41,7 @@ def setup_py_executables(root: Path) -> dict[str, list[Path]]:
     f = root / "setup.py"
     out: dict[str, list[Path]] = {}
     try:
-        tree = ast.parse(f.read_text(encoding="utf-8", errors="replace"))
+        tree = ast.parse(safefs.read_text(f))
     except (OSError, SyntaxError, ValueError):
         return out
     for n in ast.walk(tree):

@@ -10,6 +10,9 @@ remapped by the launch file's ``remap`` elements (the last matching remap wins).
 """
 from __future__ import annotations
 
+from . import safefs
+
+import dataclasses
 import os
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -62,11 +65,12 @@ class Shower:
         return shown
 
 
-def _source_files(root: Path) -> tuple[list[Path], list[Path]]:
+def _source_files(root: Path, skipped: list[str] | None = None) -> tuple[list[Path], list[Path]]:
     py, cpp = [], []
     for dirpath, dirnames, filenames in os.walk(root):
-        dirnames[:] = sorted(d for d in dirnames if d not in _SKIP_DIRS and not d.startswith("."))
-        for f in sorted(filenames):
+        dirnames[:] = sorted(d for d in safefs.keep_names(dirpath, dirnames, skipped)
+                             if d not in _SKIP_DIRS and not d.startswith("."))
+        for f in sorted(safefs.keep_names(dirpath, filenames, skipped)):
             p = Path(dirpath) / f
             if f.endswith(".py") and f != "setup.py" and not f.endswith(".launch.py") and f != "__init__.py":
                 py.append(p)
@@ -97,19 +101,37 @@ def scan(paths: Sequence[Path], launch: Sequence[Path] = (), launch_args: dict[s
     current directory). Never raises on bad input: unreadable files become
     located notes (``ROS-PARSE`` errors) in ``graph.notes``.
     """
+    from .interfaces import DEBIAN_SHARE
+    # Reads are confined to the workspace (``base``, else the scanned paths
+    # and entry launch files as given): links leaving it are skipped (docs/ros.md).
+    tops = [base] if base is not None else [*paths, *(Path(lf).parent for lf in launch)]
+    with safefs.confined([*tops, DEBIAN_SHARE]):
+        return _scan(paths, launch, launch_args, bags, cache_path, base, standard)
+
+
+def _scan(paths: Sequence[Path], launch: Sequence[Path], launch_args: dict[str, str] | None,
+          bags: Sequence[Path], cache_path: Path | None, base: Path | None, standard: bool) -> ScanResult:
     show = Shower(base)
     cache = ParseCache(cache_path) if cache_path is not None else None
     g = Graph()
     table = TypeTable()
     pkgs: dict[str, Package] = {}
-    for m in find_manifests([Path(p) for p in paths]):
+    tops = []
+    for p in paths:
+        if safefs.inside(p):
+            tops.append(Path(p))
+        else:
+            g.notes.append(Note(Src(show(Path(p))), "workspace path resolves outside the workspace "
+                                                    "(symlink): not scanned", "ROS-PARSE"))
+    skipped: list[str] = []
+    for m in find_manifests(tops, skipped):
         shown = show(m)
         try:
-            g.files[shown] = ParseCache.digest(m.read_bytes())
+            g.files[shown] = ParseCache.digest(safefs.read_bytes(m))
         except OSError:
             pass
         try:
-            sha_m = g.files.get(shown) or ParseCache.digest(m.read_bytes())
+            sha_m = g.files.get(shown) or ParseCache.digest(safefs.read_bytes(m))
         except OSError:
             sha_m = ""
         pkg, notes = cache.get(f"pkg:{shown}", sha_m, lambda: read_package(m, shown)) if cache and sha_m \
@@ -117,6 +139,9 @@ def scan(paths: Sequence[Path], launch: Sequence[Path] = (), launch_args: dict[s
         g.notes.extend(notes)
         if pkg is None:
             continue
+        # the cache is keyed by workspace-relative path and content: the
+        # directory is this tree's, never the one the entry was made in
+        pkg = dataclasses.replace(pkg, root=m.parent, manifest=m)
         if pkg.name in pkgs:
             g.notes.append(Note(Src(shown), f"package '{pkg.name}' also at {show(pkgs[pkg.name].manifest)}; "
                                             f"this one is ignored", "ROS-MANIFEST"))
@@ -141,13 +166,14 @@ def scan(paths: Sequence[Path], launch: Sequence[Path] = (), launch_args: dict[s
     exes: dict[str, dict[str, list[Path]]] = {}
     for name in sorted(pkgs):
         root = pkgs[name].root
-        py, cpp = _source_files(root)
+        py, cpp = _source_files(root, skipped)
         py_nodes = []
         for f in py + cpp:
             try:
-                data = f.read_bytes()
+                data = safefs.read_bytes(f)
             except OSError as exc:
-                g.notes.append(Note(Src(show(f)), f"cannot read: {exc}", "ROS-PARSE", "error"))
+                sev = "warning" if isinstance(exc, safefs.Refused) else "error"
+                g.notes.append(Note(Src(show(f)), f"cannot read: {exc}", "ROS-PARSE", sev))
                 continue
             if len(data) > MAX_SOURCE_BYTES:
                 g.notes.append(Note(Src(show(f)), "source file larger than 2 MB: not scanned", "ROS-PARSE"))
@@ -167,6 +193,8 @@ def scan(paths: Sequence[Path], launch: Sequence[Path] = (), launch_args: dict[s
             if is_py and (r["nodes"] or r["endpoints"]):
                 py_nodes.append(f)
         exes[name] = executables(root, name, py_nodes)
+    for bad in sorted({safefs.escaped(show(Path(b))) for b in skipped}):
+        g.notes.append(Note(Src(bad), "name is not valid UTF-8: skipped", "ROS-PARSE"))
 
     def endpoints_of(files: list[Path]) -> tuple[list[Endpoint], list[tuple[str, Src]], list[str]]:
         eps: list[Endpoint] = []
@@ -206,7 +234,7 @@ def scan(paths: Sequence[Path], launch: Sequence[Path] = (), launch_args: dict[s
             interp.run(Path(lf), dict(launch_args or {}))
         for f in interp.files:
             try:
-                g.files[show(f)] = ParseCache.digest(f.read_bytes())
+                g.files[show(f)] = ParseCache.digest(safefs.read_bytes(f))
             except OSError:
                 pass
         g.notes.extend(interp.notes)

@@ -8,6 +8,8 @@ from __future__ import annotations
 
 from typing import Any
 
+from . import safefs
+
 
 def input_files(ws: Any) -> list[str]:
     """Workspace-relative files a grounding is made from: the plan, its
@@ -24,5 +26,7 @@ def input_files(ws: Any) -> list[str]:
             if top.is_file():
                 out.add(str(rel))
             elif top.is_dir():
-                out.update(p.relative_to(ws.root).as_posix() for p in top.rglob("*") if p.is_file())
+                # regular files only, no links, names valid UTF-8: what the scan reads (docs/ros.md)
+                out.update(p.relative_to(ws.root).as_posix() for p in top.rglob("*")
+                           if not p.is_symlink() and p.is_file() and safefs.utf8_name(str(p)))
     return sorted(out)

@@ -15,6 +15,8 @@ Types are named ``pkg/msg/Type`` (rosbags' form).  A field is
 """
 from __future__ import annotations
 
+from . import safefs
+
 import re
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -116,10 +118,10 @@ class TypeTable:
         kind = path.suffix.lstrip(".")
         name = f"{pkg}/{path.parent.name if kind == 'idl' else kind}/{path.stem}"
         try:
-            data = path.read_bytes()
+            data = safefs.read_bytes(path)
             text = data.decode("utf-8", errors="replace")
         except OSError as exc:
-            self.notes.append(Note(Src(shown), f"cannot read: {exc}", "ROS-PARSE", "error"))
+            self.notes.append(Note(Src(shown), f"cannot read: {exc}", "ROS-PARSE", "warning" if isinstance(exc, safefs.Refused) else "error"))
             return
         sha = ParseCache.digest(data)
         if files is not None:

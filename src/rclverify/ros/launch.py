@@ -27,6 +27,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Callable
 
+from . import safefs
 from . import names
 from .model import Note, Src
 
@@ -66,6 +67,11 @@ class Unresolved(Exception):
 _SUBST = re.compile(r"\$\(([^()]*)\)")
 
 
+MAX_LAUNCH_FILES = 256      # launch files read per scan (all includes together)
+MAX_INCLUDE_DEPTH = 20      # nested <include>s
+MAX_SUBST_CHARS = 65_536    # length of one attribute after substitution
+
+
 class Interpreter:
     """Walk launch trees; ``pkg_dir(name)`` finds a package directory,
     ``load(path, shown)`` reads a launch file into ``(El | None, [Note])``,
@@ -80,12 +86,20 @@ class Interpreter:
         self.notes: list[Note] = []
         self.files: list[Path] = []
         self._stack: list[Path] = []
+        self._cut = False
 
     def run(self, path: Path, args: dict[str, str] | None = None, ns: str = "/",
             remaps: list[tuple[str, str, Src]] | None = None) -> None:
         path = path.resolve() if path.exists() else path
-        if path in self._stack or len(self._stack) > 20:
+        if path in self._stack or len(self._stack) > MAX_INCLUDE_DEPTH:
             self.notes.append(Note(Src(self.show(path)), "include cycle: file already being read", "ROS-LAUNCH"))
+            return
+        if len(self.files) >= MAX_LAUNCH_FILES:
+            if not self._cut:
+                self._cut = True
+                self.notes.append(Note(Src(self.show(path)), f"more than {MAX_LAUNCH_FILES} launch files "
+                                                             f"included: this include and later ones skipped",
+                                       "ROS-LAUNCH"))
             return
         root, notes = self.load(path)
         self.notes.extend(notes)
@@ -131,6 +145,8 @@ class Interpreter:
         out = text
         for _ in range(10):
             new = _SUBST.sub(one, out)
+            if len(new) > MAX_SUBST_CHARS:
+                raise Unresolved(f"substitution expands beyond {MAX_SUBST_CHARS} characters")
             if new == out:
                 break
             out = new
@@ -290,9 +306,15 @@ def read_yaml(path: Path, shown: str) -> tuple[El | None, list[Note]]:
         return d
     _L.add_constructor(yaml.resolver.BaseResolver.DEFAULT_MAPPING_TAG, _map)
     try:
-        text = path.read_text(encoding="utf-8", errors="replace")
+        text = safefs.read_text(path)
         if len(text) > 5_000_000:
             return None, [Note(Src(shown), "launch file too large", "ROS-PARSE", "error")]
+        from ..plan.errors import PlanError
+        from ..plan.yamlguard import compose_guarded
+        try:
+            compose_guarded(text, shown)  # alias bombs, cycles and depth refused before expansion
+        except PlanError as exc:
+            return None, [Note(Src(shown), f"YAML launch file refused: {exc}", "ROS-PARSE", "error")]
         data = yaml.load(text, Loader=_L)  # noqa: S506 (a SafeLoader subclass)
     except yaml.YAMLError as exc:
         mark = getattr(exc, "problem_mark", None)

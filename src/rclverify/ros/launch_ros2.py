@@ -16,6 +16,7 @@ from __future__ import annotations
 import ast
 from pathlib import Path
 
+from . import safefs
 from .launch import El
 from .model import Note, Src
 
@@ -136,7 +137,7 @@ def _action(c: ast.Call, shown: str, notes: list[Note]) -> El | None:
 def read_python(path: Path, shown: str) -> tuple[El | None, list[Note]]:
     """The actions of ``generate_launch_description()`` as an element tree."""
     try:
-        tree = ast.parse(path.read_text(encoding="utf-8", errors="replace"), filename=shown)
+        tree = ast.parse(safefs.read_text(path), filename=shown)
     except (SyntaxError, ValueError) as exc:
         return None, [Note(Src(shown, getattr(exc, "lineno", None) or 1, getattr(exc, "offset", None) or 1),
                            f"Python launch file does not parse: {getattr(exc, 'msg', exc)}", "ROS-PARSE", "error")]

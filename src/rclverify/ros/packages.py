@@ -7,6 +7,8 @@ A directory holding ``CATKIN_IGNORE``, ``COLCON_IGNORE`` or
 """
 from __future__ import annotations
 
+from . import safefs
+
 import os
 from dataclasses import dataclass
 from pathlib import Path
@@ -35,8 +37,12 @@ class Package:
                 "ros": self.ros, "manifest": shown}
 
 
-def find_manifests(paths: list[Path]) -> list[Path]:
-    """Every ``package.xml`` under ``paths`` (a path may be a package itself), sorted."""
+MAX_DEPENDS = 1000  # <*depend> elements in one package.xml (catkin_pkg is quadratic in them)
+
+
+def find_manifests(paths: list[Path], skipped: list[str] | None = None) -> list[Path]:
+    """Every ``package.xml`` under ``paths`` (a path may be a package itself), sorted;
+    directories whose name is not valid UTF-8 are not entered (appended, escaped, to ``skipped``)."""
     out: list[Path] = []
     for top in paths:
         if top.is_file() and top.name == "package.xml":
@@ -46,7 +52,8 @@ def find_manifests(paths: list[Path]) -> list[Path]:
             if any(f in filenames for f in _IGNORE_FILES):
                 dirnames[:] = []
                 continue
-            dirnames[:] = sorted(d for d in dirnames if d not in _SKIP_DIRS and not d.startswith("."))
+            dirnames[:] = sorted(d for d in safefs.keep_names(dirpath, dirnames, skipped)
+                                 if d not in _SKIP_DIRS and not d.startswith("."))
             if "package.xml" in filenames:
                 out.append(Path(dirpath) / "package.xml")
                 # a package does not nest packages (REP 140)
@@ -60,9 +67,13 @@ def read_package(manifest: Path, shown: str) -> tuple[Package | None, list[Note]
     root, note = parse_xml(manifest, shown)
     if note is not None:
         return None, [note]
+    deps = sum(1 for el in root.iter() if isinstance(el.tag, str) and el.tag.endswith("depend"))
+    if deps > MAX_DEPENDS:
+        return None, [Note(Src(shown), f"package.xml has {deps} dependency elements, more than {MAX_DEPENDS}: "
+                                       f"not parsed", "ROS-PARSE", "error")]
     warnings: list[str] = []
     try:
-        pkg = parse_package_string(manifest.read_text(encoding="utf-8", errors="replace"), str(manifest), warnings)
+        pkg = parse_package_string(safefs.read_text(manifest), str(manifest), warnings)
     except InvalidPackage as exc:
         msg = " ".join(str(exc).replace(str(manifest), shown).split())
         return None, [Note(Src(shown), f"invalid package.xml: {msg}", "ROS-PARSE", "error")]

@@ -23,7 +23,7 @@ undeveloped (no evidence).
 from __future__ import annotations
 
 import re
-import shutil
+import sys
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -34,6 +34,7 @@ from ..evidence.store import atomic_write_text
 from .graph import ScanResult
 from .interfaces import TypeTable, elem_type
 from .model import GraphNode, short_type
+from .safecopy import copy_package
 
 _ENV = jinja2.Environment(loader=jinja2.PackageLoader("rclverify.ros", "templates"), autoescape=False,
                           undefined=jinja2.StrictUndefined, trim_blocks=True, lstrip_blocks=True,
@@ -206,8 +207,8 @@ def write_from_ros(root: Path, res: ScanResult, scanned: list[Path], launch: lis
     launch_rel: list[str] = []
     for pkg in sorted(res.packages.values(), key=lambda p: p.name):
         dst = ros_dir / pkg.name
-        shutil.copytree(pkg.root, dst, ignore=shutil.ignore_patterns("build", "devel", "install", "log", ".git",
-                                                                     "__pycache__"), dirs_exist_ok=True)
+        for w in copy_package(pkg.root, dst):
+            print(f"{pkg.name}/{w}", file=sys.stderr)
         written.append(dst)
         for lf in launch:
             try:

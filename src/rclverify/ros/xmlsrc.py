@@ -6,6 +6,7 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
+from . import safefs
 from .model import Note, Src
 
 
@@ -15,12 +16,14 @@ def parse_xml(path: Path, shown: str) -> tuple[Any | None, Note | None]:
     from lxml import etree
     parser = etree.XMLParser(resolve_entities=False, no_network=True, huge_tree=False, remove_comments=True)
     try:
-        data = path.read_bytes()
+        data = safefs.read_bytes(path)
         root = etree.fromstring(data, parser)
     except etree.XMLSyntaxError as exc:
         line, col = (exc.position if exc.position else (1, 1))
         return None, Note(Src(shown, max(1, line or 1), max(1, (col or 0) + 1)),
                           f"not well-formed XML: {exc.msg}", "ROS-PARSE", "error")
+    except safefs.Refused as exc:
+        return None, Note(Src(shown), f"not read: {exc}", "ROS-PARSE", "warning")
     except (OSError, ValueError) as exc:
         return None, Note(Src(shown), f"cannot read: {exc}", "ROS-PARSE", "error")
     if root is None:
