@@ -44,8 +44,10 @@ from rclverify.report.textfmt import natural_key
 REPO = Path(__file__).resolve().parents[1]
 #: Tallest the case study's HTML report may be at 1400 px (CSS px): 40% of the 79,000 px of issue 24.
 MAX_HEIGHT = 31_600
-#: The system diagram starts within the first two screens (CSS px).
-MAX_DIAGRAM_TOP = 2_000
+#: The system diagram starts within the first two and a half screens (CSS px): "What needs attention"
+#: above it now has nine rows (the model checker's instances are rows of their own, not members of the
+#: guarantee-3 row), which put the diagram at 2,081 px.
+MAX_DIAGRAM_TOP = 2_300
 #: The browser flags: no sandbox (containers), no GPU, nothing fetched from the network.
 FLAGS = ("--headless=new", "--no-sandbox", "--disable-gpu", "--disable-background-networking",
          "--disable-component-update", "--no-first-run", "--disable-sync", "--window-size=1400,1000")

@@ -1,12 +1,24 @@
 """Temporal properties over transition systems: BMC, k-induction, bounded
 response and ranking functions (docs/requirements.md, Temporal requirements)."""
 
+import pytest
 import z3
 
+from rclverify.logic.world import fresh
 from rclverify.requirements.temporal import (
     TransitionSystem, check_always, check_eventually, check_eventually_within)
 
 I = z3.IntSort()
+
+
+@pytest.fixture(autouse=True)
+def _fresh_z3_world() -> None:
+    """Each test builds its terms in a fresh Z3 context, as a pipeline unit of
+    work does (logic/world.py): a sort made in the context of an earlier test
+    cannot be mixed with the terms of a later one."""
+    global I
+    fresh()
+    I = z3.IntSort()
 
 
 def saturating_counter():
