@@ -19,7 +19,7 @@ import tarfile
 import zipfile
 import zlib
 from pathlib import Path, PurePosixPath
-from typing import Any, Mapping
+from typing import Any, Iterator, Mapping
 
 from ..evidence.store import atomic_write_bytes, dumps
 from ..plan.load import Plan
@@ -84,6 +84,42 @@ def _unsafe(name: str) -> bool:
     return p.is_absolute() or ".." in p.parts or "\\" in name
 
 
+def _each_member(path: Path, problems: list[str]) -> Iterator[tuple[str, int, Any]]:
+    """``(name, declared size, open binary stream)`` of each regular-file
+    member of the archive at ``path`` (tar.gz or zip), in order, streamed
+    (tarfile's headers are not kept).  A member that is a link, a device, an
+    absolute or ``..`` path, or repeated is not yielded but named in
+    ``problems``.  Archive errors propagate (callers turn them into
+    :class:`BundleError`)."""
+    seen: set[str] = set()
+    if zipfile.is_zipfile(path):
+        with zipfile.ZipFile(path) as zf:
+            for info in zf.infolist():
+                if info.is_dir():
+                    continue
+                if _unsafe(info.filename) or info.filename in seen:
+                    problems.append(f"{info.filename}: unsafe or repeated member")
+                    continue
+                seen.add(info.filename)
+                with zf.open(info) as fh:
+                    yield info.filename, info.file_size, fh
+    else:
+        with tarfile.open(path, "r:*") as tar:
+            for m in tar:  # streamed: members are visited in order, never all held
+                if m.isdir():
+                    continue
+                if not m.isfile() or _unsafe(m.name) or m.name in seen:
+                    problems.append(f"{m.name}: unsafe, repeated or not a regular file")
+                    continue
+                seen.add(m.name)
+                fh = tar.extractfile(m)
+                yield m.name, m.size, fh if fh is not None else io.BytesIO(b"")
+                tar.members = []  # tarfile keeps every header it read: not needed here
+
+
+_ARCHIVE_ERRORS = (OSError, tarfile.TarError, zipfile.BadZipFile, EOFError, zlib.error)
+
+
 def read_members(path: Path) -> dict[str, bytes]:
     """The regular-file members of the archive at ``path`` (tar.gz or zip).
 
@@ -91,29 +127,10 @@ def read_members(path: Path) -> dict[str, bytes]:
     members that are links, devices, absolute or ``..`` paths, or repeated.
     Nothing is extracted to disk.
     """
-    out: dict[str, bytes] = {}
     problems: list[str] = []
     try:
-        if zipfile.is_zipfile(path):
-            with zipfile.ZipFile(path) as zf:
-                for info in zf.infolist():
-                    if info.is_dir():
-                        continue
-                    if _unsafe(info.filename) or info.filename in out:
-                        problems.append(f"{info.filename}: unsafe or repeated member")
-                        continue
-                    out[info.filename] = zf.read(info)
-        else:
-            with tarfile.open(path, "r:*") as tar:
-                for m in tar.getmembers():
-                    if m.isdir():
-                        continue
-                    if not m.isfile() or _unsafe(m.name) or m.name in out:
-                        problems.append(f"{m.name}: unsafe, repeated or not a regular file")
-                        continue
-                    f = tar.extractfile(m)
-                    out[m.name] = f.read() if f is not None else b""
-    except (OSError, tarfile.TarError, zipfile.BadZipFile, EOFError) as exc:
+        out = {name: fh.read() for name, _, fh in _each_member(path, problems)}
+    except _ARCHIVE_ERRORS as exc:
         raise BundleError([f"cannot read the archive: {exc}"]) from None
     if problems:
         raise BundleError(problems)
@@ -184,30 +201,9 @@ def scan_members(path: Path) -> tuple[bytes | None, dict[str, tuple[str, int]]]:
         if data is not None:
             manifest = data
     try:
-        if zipfile.is_zipfile(path):
-            with zipfile.ZipFile(path) as zf:
-                for info in zf.infolist():
-                    if info.is_dir():
-                        continue
-                    if _unsafe(info.filename) or info.filename in out:
-                        problems.append(f"{info.filename}: unsafe or repeated member")
-                        continue
-                    limit = admit(info.filename, info.file_size)
-                    with zf.open(info) as fh:
-                        record(info.filename, fh, limit)
-        else:
-            with tarfile.open(path, "r:*") as tar:
-                for m in tar:  # streamed: members are visited in order, never all held
-                    if m.isdir():
-                        continue
-                    if not m.isfile() or _unsafe(m.name) or m.name in out:
-                        problems.append(f"{m.name}: unsafe, repeated or not a regular file")
-                        continue
-                    limit = admit(m.name, m.size)
-                    fh = tar.extractfile(m)
-                    record(m.name, fh if fh is not None else io.BytesIO(b""), limit)
-                    tar.members = []  # tarfile keeps every header it read: not needed here
-    except (OSError, tarfile.TarError, zipfile.BadZipFile, EOFError, zlib.error) as exc:
+        for name, size, fh in _each_member(path, problems):
+            record(name, fh, admit(name, size))
+    except _ARCHIVE_ERRORS as exc:
         raise BundleError([f"cannot read the archive: {exc}"]) from None
     if problems:
         raise BundleError(problems)
