@@ -20,13 +20,11 @@ from __future__ import annotations
 import os
 import re
 import shutil
-import signal
-import subprocess
 import tempfile
-import time
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Mapping
+from ..bounded import run_bounded
 
 #: Where RunJPF.jar lives inside an MCAPL distribution.
 RUNJPF = Path("lib") / "3rdparty" / "RunJPF.jar"
@@ -116,19 +114,7 @@ def run(install: McaplInstall, root: Path, jpf: str, timeout_s: float) -> RunOut
             site.write_text(f"mcapl = {install.home.as_posix()}\n", encoding="utf-8")
             cmd.append(f"+site={site.as_posix()}")
         cmd.append(jpf)
-        t0 = time.perf_counter()
-        proc = subprocess.Popen(cmd, cwd=root, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
-                                start_new_session=True)
-        try:
-            out, _ = proc.communicate(timeout=timeout_s)
-            timed_out = False
-        except subprocess.TimeoutExpired:
-            try:
-                os.killpg(proc.pid, signal.SIGKILL)
-            except ProcessLookupError:
-                pass
-            out, _ = proc.communicate()
-            timed_out = True
-        duration = round(time.perf_counter() - t0, 3)
-    return RunOutcome(out.decode("utf-8", errors="replace"), None if timed_out else proc.returncode, timed_out,
+        out, code, duration = run_bounded(cmd, root, timeout_s, env)
+        timed_out = code is None
+    return RunOutcome(out, code, timed_out,
                       duration)

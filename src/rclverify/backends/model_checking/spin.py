@@ -31,12 +31,11 @@ import hashlib
 import os
 import re
 import shutil
-import signal
 import subprocess
 import tempfile
-import time
 from dataclasses import dataclass
 from pathlib import Path
+from ..bounded import run_bounded
 
 #: Install command shown when SPIN or gcc is missing (Debian/Ubuntu).
 INSTALL = "apt-get install spin gcc"
@@ -115,19 +114,7 @@ def _version(cmd: list[str], pattern: str, fmt: str) -> str:
 
 def _run(cmd: list[str], cwd: Path, timeout_s: float) -> tuple[str, int | None, float]:
     """Run ``cmd``; returns (stdout+stderr, exit code or None on timeout, seconds)."""
-    t0 = time.perf_counter()
-    proc = subprocess.Popen(cmd, cwd=cwd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, start_new_session=True)
-    try:
-        out, _ = proc.communicate(timeout=max(timeout_s, 0.1))
-        code: int | None = proc.returncode
-    except subprocess.TimeoutExpired:
-        try:
-            os.killpg(proc.pid, signal.SIGKILL)
-        except ProcessLookupError:
-            pass
-        out, _ = proc.communicate()
-        code = None
-    return out.decode("utf-8", errors="replace"), code, round(time.perf_counter() - t0, 3)
+    return run_bounded(cmd, cwd, timeout_s)
 
 
 class CompileError(RuntimeError):
