@@ -151,3 +151,9 @@ def test_a_stored_report_without_where_or_unverified_still_renders() -> None:
     assert any(not g["culprits"] for g in report["problems"])
     md = render_markdown(report)
     assert "`Agent.replacement-refines`" in md and "Nothing is pending." not in md
+
+
+def test_the_terminal_writes_a_file_once_for_culprits_on_several_of_its_lines() -> None:
+    from rclverify.diagnosis.text import same_file_lines
+    assert same_file_lines(["a.gwen:72", "a.gwen:74", "b.imp:15", "guarantee 3 of Agent (x.rcl:72:3)", "b.imp:18"]) \
+        == ["a.gwen:72, 74", "b.imp:15", "guarantee 3 of Agent (x.rcl:72:3)", "b.imp:18"]

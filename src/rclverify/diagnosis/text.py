@@ -106,6 +106,21 @@ def clause_cut(text: str, limit: int = SENTENCE) -> str:
         return text
     cuts = [k for k in _boundaries(text) if k <= limit]
     return text[:cuts[-1]] + " ..." if cuts else text
+def same_file_lines(culprits: Sequence[str]) -> list[str]:
+    """``culprits`` with consecutive ``file:line`` entries of one file written
+    once (``a.gwen:72, 74, 77``), in their order; any other entry as it is."""
+    out: list[str] = []
+    last_file = None
+    for c in culprits:
+        file, sep, line = str(c).rpartition(":")
+        if sep and line.isdigit() and file == last_file:
+            out[-1] += f", {line}"
+            continue
+        out.append(str(c))
+        last_file = file if sep and line.isdigit() else None
+    return out
+
+
 def finding_lines(report: Mapping[str, Any], wanted: str) -> list[str]:
     """A finding of the report's problems by root cause that has no
     diagnosis record of its own (an unverified guarantee ``Node.g<k>``, a
@@ -149,7 +164,7 @@ def status_lines(data: Mapping[str, Any]) -> list[str]:
                    f"{'s' if found != 1 else ''}); `rclverify explain ID` prints a finding's diagnosis:")
         for k, g in enumerate(groups, 1):
             # no culprit Z3 showed: the problem's own location, when it has one
-            cause = "; ".join(g["culprits"]) or (f"at {g['where']}" if g.get("where") else "(no culprit named)")
+            cause = "; ".join(same_file_lines(g["culprits"])) or (f"at {g['where']}" if g.get("where") else "(no culprit named)")
             repairs = f", {g['repairs']} checked repair{'s' if g['repairs'] != 1 else ''}" if g["repairs"] else ""
             out.append(f"  {k}. [{g['status']}] {cause}: {len(g['members'])} finding"
                        f"{'s' if len(g['members']) != 1 else ''}{repairs}")
