@@ -222,7 +222,7 @@ def _scan(paths: Sequence[Path], launch: Sequence[Path], launch_args: dict[str, 
                 if names.resolve(frm, ns, full) == names.resolve(e.topic, ns, full):
                     topic, at = names.resolve(to, ns, full), rsrc
             edge = GraphEdge(topic, e.msg_type, e.src, at, e.topic)
-            lst = node.publishes if e.kind == "pub" else node.subscribes
+            lst = node.edges_of(e.kind)
             if not any(x.topic == edge.topic and x.msg_type == edge.msg_type for x in lst):
                 lst.append(edge)
         g.nodes[full] = node

@@ -33,10 +33,16 @@ class Endpoint:
     """One publisher or subscriber in code: ``topic`` as written (before
     resolution), ``msg_type`` canonical or ``None`` when unknown."""
 
-    kind: str  # "pub" | "sub"
-    topic: str
+    kind: str  # "pub" | "sub" | one of ``SERVICE_ROLES``
+    topic: str  # the topic, service or action name as written
     msg_type: str | None
     src: Src
+
+
+# The four service/action roles an :class:`Endpoint` may have besides "pub"/"sub", each the
+# name of the :class:`GraphNode` list it lands in.  A service's type is ``pkg/srv/Type``, an
+# action's ``pkg/action/Type`` (docs/ros.md, "Services and actions").
+SERVICE_ROLES = ("service_servers", "service_clients", "action_servers", "action_clients")
 
 
 @dataclass(frozen=True)
@@ -86,15 +92,36 @@ class GraphNode:
     publishes: list[GraphEdge] = field(default_factory=list)
     subscribes: list[GraphEdge] = field(default_factory=list)
     origin: str = "launch"  # "launch" | "source" | "master"
+    # services and actions: GraphEdge.topic is the resolved service/action name, msg_type its
+    # pkg/srv/Type or pkg/action/Type (None when the code does not say it statically)
+    service_servers: list[GraphEdge] = field(default_factory=list)
+    service_clients: list[GraphEdge] = field(default_factory=list)
+    action_servers: list[GraphEdge] = field(default_factory=list)
+    action_clients: list[GraphEdge] = field(default_factory=list)
+
+    def edges_of(self, kind: str) -> list[GraphEdge]:
+        """The list an :class:`Endpoint` of ``kind`` ("pub", "sub" or one of ``SERVICE_ROLES``)
+        lands in. Raises ``KeyError`` for another kind."""
+        if kind == "pub":
+            return self.publishes
+        if kind == "sub":
+            return self.subscribes
+        if kind not in SERVICE_ROLES:
+            raise KeyError(kind)
+        lst: list[GraphEdge] = getattr(self, kind)
+        return lst
 
     def to_json(self) -> dict[str, Any]:
-        return {
+        d: dict[str, Any] = {
             "name": self.name, "namespace": self.namespace, "package": self.package,
             "executable": self.executable, "sources": list(self.sources), "origin": self.origin,
             "declared_at": self.declared_at.to_json() if self.declared_at else None,
             "publishes": [e.to_json() for e in sorted(self.publishes, key=_ek)],
             "subscribes": [e.to_json() for e in sorted(self.subscribes, key=_ek)],
         }
+        for role in SERVICE_ROLES:
+            d[role] = [e.to_json() for e in sorted(getattr(self, role), key=_ek)]
+        return d
 
 
 def _ek(e: GraphEdge) -> tuple[str, str]:
@@ -133,27 +160,48 @@ class Graph:
             t["types"].sort()
         return dict(sorted(out.items()))
 
+    def services(self, kind: str = "service") -> dict[str, dict[str, Any]]:
+        """``{name: {"types": [...], "servers": [...], "clients": [...]}}`` of the graph's
+        services (``kind="service"``) or actions (``kind="action"``), node names sorted."""
+        out: dict[str, dict[str, Any]] = {}
+        for n in sorted(self.nodes.values(), key=lambda n: n.name):
+            for role in ("servers", "clients"):
+                for e in getattr(n, f"{kind}_{role}"):
+                    t = out.setdefault(e.topic, {"types": [], "servers": [], "clients": []})
+                    if e.msg_type and e.msg_type not in t["types"]:
+                        t["types"].append(e.msg_type)
+                    if n.name not in t[role]:
+                        t[role].append(n.name)
+        for t in out.values():
+            t["types"].sort()
+        return dict(sorted(out.items()))
+
     def to_json(self) -> dict[str, Any]:
         return {
             "schema": SCHEMA_ID,
             "packages": [self.packages[k] for k in sorted(self.packages)],
             "nodes": [self.nodes[k].to_json() for k in sorted(self.nodes)],
             "topics": [{"name": k, **v} for k, v in self.topics().items()],
+            "services": [{"name": k, **v} for k, v in self.services("service").items()],
+            "actions": [{"name": k, **v} for k, v in self.services("action").items()],
             "types": {k: self.types[k] for k in sorted(self.types)},
             "unresolved": [n.to_json() for n in self.notes],
             "bags": self.bags,
             "files": [{"path": k, "sha256": v} for k, v in sorted(self.files.items())],
         }
 
-    def edges(self) -> set[tuple[str, str, str, str | None]]:
-        """``{(node, "pub"|"sub", topic, type)}``: the graph's shape, for comparisons."""
+    def edges(self, with_services: bool = False) -> set[tuple[str, str, str, str | None]]:
+        """``{(node, kind, name, type)}``: the graph's shape, for comparisons; ``kind`` is
+        "pub"/"sub", and with ``with_services`` also one of ``SERVICE_ROLES``."""
+        kinds = ("pub", "sub") + (SERVICE_ROLES if with_services else ())
         return {(n.name, kind, e.topic, e.msg_type)
-                for n in self.nodes.values()
-                for kind, es in (("pub", n.publishes), ("sub", n.subscribes)) for e in es}
+                for n in self.nodes.values() for kind in kinds for e in n.edges_of(kind)}
 
 
-def canon_type(name: str | None) -> str | None:
-    """``pkg/Type``, ``pkg::Type``, ``pkg::msg::Type``, ``pkg.msg.Type`` -> ``pkg/msg/Type``.
+def canon_type(name: str | None, kind: str = "msg") -> str | None:
+    """``pkg/Type``, ``pkg::Type``, ``pkg::msg::Type``, ``pkg.msg.Type`` -> ``pkg/msg/Type``;
+    with ``kind="srv"`` or ``"action"`` a two-part name becomes ``pkg/srv/Type`` or
+    ``pkg/action/Type`` (a three-part name keeps its middle part).
 
     ``Header`` alone is ``std_msgs/msg/Header`` (ROS 1 .msg rule). Returns
     ``None`` for ``None`` or an empty name.
@@ -168,6 +216,8 @@ def canon_type(name: str | None) -> str | None:
     parts = [p for p in n.split("/") if p]
     if len(parts) == 1:
         return "std_msgs/msg/Header" if parts[0] == "Header" else parts[0]
+    if len(parts) == 2 and kind in ("srv", "action"):
+        return f"{parts[0]}/{kind}/{parts[1]}"
     if len(parts) == 2:
         return f"{parts[0]}/msg/{parts[1]}"
     return "/".join(parts[-3:])
