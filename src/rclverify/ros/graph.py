@@ -20,7 +20,7 @@ from typing import Any, Sequence
 
 from . import names
 from .cache import ParseCache
-from .executables import executables
+from .executables import cmake_components, executables
 from .interfaces import TypeTable
 from .launch import El, Interpreter, LaunchNode, read_xml, read_yaml
 from .launch_ros2 import read_python
@@ -164,6 +164,7 @@ def _scan(paths: Sequence[Path], launch: Sequence[Path], launch_args: dict[str, 
 
     res = ScanResult(g, pkgs, table)
     exes: dict[str, dict[str, list[Path]]] = {}
+    comps: dict[str, dict[str, tuple[str, int]]] = {}  # package -> executable -> (component class, line)
     for name in sorted(pkgs):
         root = pkgs[name].root
         py, cpp = _source_files(root, skipped)
@@ -193,6 +194,8 @@ def _scan(paths: Sequence[Path], launch: Sequence[Path], launch_args: dict[str, 
             if is_py and (r["nodes"] or r["endpoints"]):
                 py_nodes.append(f)
         exes[name] = executables(root, name, py_nodes)
+        comps[name] = cmake_components(root, name)[0]
+    classes = _classes(pkgs, res.sources, show)
     for bad in sorted({safefs.escaped(show(Path(b))) for b in skipped}):
         g.notes.append(Note(Src(bad), "name is not valid UTF-8: skipped", "ROS-PARSE"))
 
@@ -209,19 +212,34 @@ def _scan(paths: Sequence[Path], launch: Sequence[Path], launch_args: dict[str, 
                 inits.extend(r["nodes"])
         return eps, inits, shown_files
 
+    launch_params: dict[str, tuple[str, Src]] = {}
+
     def add_node(full: str, ns: str, pkg: str | None, exe: str | None, files: list[str], declared: Src,
-                 eps: list[Endpoint], remaps: list[tuple[str, str, Src]], origin: str) -> None:
+                 eps: list[Endpoint], remaps: list[tuple[str, str, Src]], origin: str,
+                 params: dict[str, tuple[str, Src]] | None = None) -> None:
         if full in g.nodes:
             g.notes.append(Note(declared, f"node {full} is started twice (first at {g.nodes[full].declared_at}); "
                                           f"ROS keeps only the last one", "ROS-LAUNCH"))
         node = GraphNode(full, ns, pkg, exe, files, declared, origin=origin)
+        mine = {names.resolve(k, ns, full): v for k, v in (params or {}).items()}
         for e in eps:
-            topic = names.resolve(e.topic, ns, full)
+            written, pname, set_at = e.topic, None, None
+            if e.param is not None:
+                pname = names.resolve(e.param, ns, full)
+                got = mine.get(pname) or launch_params.get(pname)
+                if got is not None:
+                    written, set_at = got
+                elif not e.topic:
+                    g.notes.append(Note(e.src, f"name of {e.kind} comes from parameter {pname}, which has no "
+                                               f"default in the code and no value in the launch files: "
+                                               f"not resolved statically"))
+                    continue
+            topic = names.resolve(written, ns, full)
             at = None
             for frm, to, rsrc in remaps:
-                if names.resolve(frm, ns, full) == names.resolve(e.topic, ns, full):
+                if names.resolve(frm, ns, full) == topic:
                     topic, at = names.resolve(to, ns, full), rsrc
-            edge = GraphEdge(topic, e.msg_type, e.src, at, e.topic)
+            edge = GraphEdge(topic, e.msg_type, e.src, at, written, pname, set_at)
             lst = node.edges_of(e.kind)
             if not any(x.topic == edge.topic and x.msg_type == edge.msg_type for x in lst):
                 lst.append(edge)
@@ -238,10 +256,24 @@ def _scan(paths: Sequence[Path], launch: Sequence[Path], launch_args: dict[str, 
             except OSError:
                 pass
         g.notes.extend(interp.notes)
+        launch_params.update(interp.params)
         for ln in interp.nodes:
-            _launch_node(ln, pkgs, exes, endpoints_of, add_node, g)
+            _launch_node(ln, pkgs, exes, endpoints_of, add_node, g, classes, comps)
     else:
+        in_class = set()
+        for cls, info in sorted(classes.items()):
+            if info["nodes"]:  # a class that names its node (a component, a Node subclass): one node
+                nname, src = info["nodes"][0]
+                in_class |= {id(e) for e in info["endpoints"]}
+                add_node(names.join("/", nname), "/", info["package"], None, info["files"], src,
+                         info["endpoints"], [], "source")
         for shown, r in sorted(res.sources.items()):
+            if r.get("classes") and any(classes.get(c, {}).get("nodes") for c in r["classes"]):
+                rest = [e for e in r["endpoints"] if id(e) not in in_class]
+                if rest:
+                    g.notes.append(Note(rest[0].src, "endpoints outside the file's node classes, in a file that is "
+                                                     "started by no launch file: not in the graph"))
+                continue
             for (nname, src) in r["nodes"][:1]:
                 full = names.join("/", nname)
                 pkg = next((p for p, pk in pkgs.items() if shown.startswith(show(pk.root) + "/")), None)
@@ -268,8 +300,50 @@ def _scan(paths: Sequence[Path], launch: Sequence[Path], launch_args: dict[str, 
     return res
 
 
+def _classes(pkgs: dict[str, Package], sources: dict[str, dict[str, Any]], show: Any) -> dict[str, dict[str, Any]]:
+    """``{qualified class: {"package", "files", "nodes", "endpoints"}}`` over every C++ source
+    (a class written over several files is merged)."""
+    out: dict[str, dict[str, Any]] = {}
+    roots = sorted(((show(pk.root) + "/", p) for p, pk in pkgs.items()), key=lambda x: -len(x[0]))
+    for shown, r in sorted(sources.items()):
+        for cls, info in (r.get("classes") or {}).items():
+            pkg = next((p for pre, p in roots if shown.startswith(pre)), None)
+            c = out.setdefault(cls, {"package": pkg, "files": [], "nodes": [], "endpoints": []})
+            c["files"].append(shown)
+            c["nodes"].extend(info["nodes"])
+            c["endpoints"].extend(info["endpoints"])
+    return out
+
+
+def _find_class(plugin: str, pkg: str | None, classes: dict[str, dict[str, Any]]) -> str | None:
+    """The class a plugin name (``ns::Class``) names: exact, else the one class of
+    ``pkg`` with that last name part."""
+    p = plugin.strip().lstrip(":")
+    if p in classes:
+        return p
+    last = p.split("::")[-1]
+    hits = [c for c, i in classes.items() if c.split("::")[-1] == last and (pkg is None or i["package"] == pkg)]
+    return hits[0] if len(hits) == 1 else None
+
+
 def _launch_node(ln: LaunchNode, pkgs: dict[str, Package], exes: dict[str, dict[str, list[Path]]],
-                 endpoints_of: Any, add_node: Any, g: Graph) -> None:
+                 endpoints_of: Any, add_node: Any, g: Graph, classes: dict[str, dict[str, Any]],
+                 comps: dict[str, dict[str, tuple[str, int]]]) -> None:
+    plugin = ln.plugin or (comps.get(ln.pkg, {}).get(ln.exe, ("", 0))[0] if ln.exe else None)
+    if plugin:
+        cls = _find_class(plugin, ln.pkg, classes)
+        if cls is None:
+            g.notes.append(Note(ln.src, f"component class '{plugin}' of package '{ln.pkg}' is not found in the "
+                                        f"scanned C++ sources; its topics are unknown", "ROS-LAUNCH"))
+            info: dict[str, Any] = {"files": [], "nodes": [], "endpoints": []}
+        else:
+            info = classes[cls]
+        name = ln.name or (info["nodes"][0][0] if info["nodes"] else plugin.split("::")[-1])
+        full = names.normalise(name) if name.startswith("/") else names.join(ln.ns, name)
+        ns = names.split(full)[0] if name.startswith("/") else ln.ns
+        add_node(full, ns, ln.pkg, ln.exe or None, list(info["files"]), ln.src, info["endpoints"], ln.remaps,
+                 "launch", ln.params)
+        return
     if ln.pkg not in pkgs:
         g.notes.append(Note(ln.src, f"node package '{ln.pkg}' is not in the scanned workspaces; "
                                     f"its topics are unknown", "ROS-LAUNCH"))
@@ -288,4 +362,4 @@ def _launch_node(ln: LaunchNode, pkgs: dict[str, Package], exes: dict[str, dict[
     else:
         full = names.join(ln.ns, name)
         ns = ln.ns
-    add_node(full, ns, ln.pkg, ln.exe, shown, ln.src, eps, ln.remaps, "launch")
+    add_node(full, ns, ln.pkg, ln.exe, shown, ln.src, eps, ln.remaps, "launch", ln.params)

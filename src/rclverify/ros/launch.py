@@ -12,7 +12,11 @@ interpreted here:
 * ``group`` with ``ns`` (ROS 1) or a ``push-ros-namespace`` child (ROS 2);
   ``if`` / ``unless`` on any element (``true``/``1`` or ``false``/``0``);
 * ``node`` (``pkg``, ``type``/``exec``, ``name``, ``ns``/``namespace``) with
-  ``remap`` children, and ``remap`` in a scope (applies to the nodes after it);
+  ``remap`` and ``param`` (``name``/``value``: the node's private parameter)
+  children, and ``remap``/``param`` in a scope (applies to the nodes after it);
+* ROS 2 ``node_container`` / ``load_composable_node`` with ``composable_node``
+  children (``pkg``, ``plugin``, ``name``, ``namespace``, ``remap``, ``param``):
+  each is a node of class ``plugin`` (the container process itself is not);
 * ``include`` (``file``, ``ns``, ``arg`` children, ``pass_all_args``), found
   relative to the packages of the scanned workspaces; include cycles stop.
 
@@ -51,6 +55,9 @@ class LaunchNode:
     ns: str
     remaps: list[tuple[str, str, Src]]
     src: Src
+    plugin: str | None = None  # a composable node's class (``ns::Class``); ``exe`` is then ""
+    # the node's private parameters the launch file sets: ``~name`` -> (value, where set)
+    params: dict[str, tuple[str, Src]] = field(default_factory=dict)
 
 
 @dataclass
@@ -85,6 +92,8 @@ class Interpreter:
         self.nodes: list[LaunchNode] = []
         self.notes: list[Note] = []
         self.files: list[Path] = []
+        # parameters set outside any node (ROS 1 ``<param>`` in a scope): resolved name -> (value, where)
+        self.params: dict[str, tuple[str, Src]] = {}
         self._stack: list[Path] = []
         self._cut = False
 
@@ -111,6 +120,44 @@ class Interpreter:
             self._body(root.children, _Scope(ns, dict(args or {}), list(remaps or [])), path)
         finally:
             self._stack.pop()
+
+    def _node_children(self, el: El, scope: _Scope, path: Path, node_ns: str,
+                       name: str | None) -> tuple[list[tuple[str, str, Src]], dict[str, tuple[str, Src]]]:
+        """A node's ``remap`` and ``param`` children (a node's ``param`` is private:
+        ``~name``, kept as ``~name`` when the node's name is not known here)."""
+        remaps = list(scope.remaps)
+        params: dict[str, tuple[str, Src]] = {}
+        for c in el.children:
+            if c.tag not in ("remap", "param"):
+                continue
+            try:
+                if not self._cond(c, scope, path):
+                    continue
+                if c.tag == "remap":
+                    frm, to = self._attr(c, "from", scope, path), self._attr(c, "to", scope, path)
+                    if not frm or not to:
+                        raise Unresolved("remap needs 'from' and 'to'")
+                    remaps.append((frm, to, c.src))
+                else:
+                    pn, pv = self._attr(c, "name", scope, path), self._attr(c, "value", scope, path)
+                    if not pn or pv is None:
+                        raise Unresolved("param needs 'name' and 'value' (a parameter file is not read)")
+                    params["~" + pn.lstrip("~/")] = (pv, c.src)
+            except Unresolved as exc:
+                self.notes.append(Note(c.src, f"<{c.tag}>: {exc}; element skipped", "ROS-LAUNCH"))
+        return remaps, params
+
+    def _composable(self, el: El, scope: _Scope, path: Path) -> None:
+        """A ``composable_node`` (ROS 2 XML/YAML, or ``ComposableNode`` read by
+        :mod:`launch_ros2`): the node of class ``plugin`` from package ``pkg``."""
+        pkg, plugin = self._attr(el, "pkg", scope, path), self._attr(el, "plugin", scope, path)
+        if not pkg or not plugin:
+            raise Unresolved("composable_node needs 'pkg' and 'plugin'")
+        name = self._attr(el, "name", scope, path)
+        ns = self._attr(el, "namespace", scope, path) or self._attr(el, "ns", scope, path)
+        node_ns = names.join(scope.ns, ns) if ns else scope.ns
+        remaps, params = self._node_children(el, scope, path, node_ns, name)
+        self.nodes.append(LaunchNode(pkg, "", name, node_ns, remaps, el.src, plugin, params))
 
     # -- substitutions
     def sub(self, text: str, scope: _Scope, path: Path) -> str:
@@ -205,6 +252,18 @@ class Interpreter:
             if not frm or not to:
                 raise Unresolved("remap needs 'from' and 'to'")
             scope.remaps.append((frm, to, el.src))
+        elif t == "param":
+            name, val = self._attr(el, "name", scope, path), self._attr(el, "value", scope, path)
+            if name and val is not None:
+                self.params[names.join(scope.ns, name)] = (val, el.src)
+        elif t in ("node_container", "load_composable_node"):
+            for c in el.children:
+                if c.tag == "composable_node":
+                    try:
+                        if self._cond(c, scope, path):
+                            self._composable(c, scope, path)
+                    except Unresolved as exc:
+                        self.notes.append(Note(c.src, f"<composable_node>: {exc}; element skipped", "ROS-LAUNCH"))
         elif t == "node":
             pkg = self._attr(el, "pkg", scope, path)
             exe = self._attr(el, "type", scope, path) or self._attr(el, "exec", scope, path)
@@ -213,19 +272,8 @@ class Interpreter:
             name = self._attr(el, "name", scope, path)
             ns = self._attr(el, "ns", scope, path) or self._attr(el, "namespace", scope, path)
             node_ns = names.join(scope.ns, ns) if ns else scope.ns
-            remaps = list(scope.remaps)
-            for c in el.children:
-                if c.tag == "remap":
-                    try:
-                        if self._cond(c, scope, path):
-                            frm, to = self._attr(c, "from", scope, path), self._attr(c, "to", scope, path)
-                            if frm and to:
-                                remaps.append((frm, to, c.src))
-                            else:
-                                raise Unresolved("remap needs 'from' and 'to'")
-                    except Unresolved as exc:
-                        self.notes.append(Note(c.src, f"<remap>: {exc}; element skipped", "ROS-LAUNCH"))
-            self.nodes.append(LaunchNode(pkg, exe, name, node_ns, remaps, el.src))
+            remaps, params = self._node_children(el, scope, path, node_ns, name)
+            self.nodes.append(LaunchNode(pkg, exe, name, node_ns, remaps, el.src, None, params))
         elif t == "include":
             f = self._attr(el, "file", scope, path)
             if not f:
@@ -244,7 +292,7 @@ class Interpreter:
                     if n and v is not None:
                         args[n] = v
             self.run(target, args, names.join(scope.ns, ns) if ns else scope.ns, scope.remaps)
-        # param, rosparam, env, machine, test, executable ...: not part of the topic graph
+        # rosparam, env, machine, test, executable ...: not part of the topic graph
 
 
 # -- readers ------------------------------------------------------------
@@ -271,7 +319,7 @@ def _yaml_el(tag: str, body: Any, shown: str, line: int) -> El:
     kids: list[El] = []
     if isinstance(body, dict):
         for k, v in body.items():
-            if k in ("remap", "arg", "param") and isinstance(v, list):
+            if k in ("remap", "arg", "param", "composable_node") and isinstance(v, list):
                 for item in v:
                     kids.append(_yaml_el(str(k), item, shown, line))
             elif k == "children" and isinstance(v, list):

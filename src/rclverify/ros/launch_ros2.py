@@ -8,7 +8,11 @@ remappings=[(a, b)])``, ``DeclareLaunchArgument('x', default_value='v')``,
 launch_arguments={...}.items())`` with ``path`` built from string literals,
 ``os.path.join``, ``get_package_share_directory('pkg')``,
 ``FindPackageShare('pkg')`` and ``PathJoinSubstitution([...])``;
-``LaunchConfiguration('x')`` becomes ``$(var x)``.  Whatever else a value
+``LaunchConfiguration('x')`` becomes ``$(var x)``; ``parameters=[{k: v}]``
+of a node become ``param`` elements; ``ComposableNodeContainer`` /
+``LoadComposableNodes`` with ``composable_node_descriptions=[ComposableNode(
+package=, plugin=, name=, namespace=, remappings=, parameters=)]`` become
+``node_container`` / ``load_composable_node`` with ``composable_node`` children.  Whatever else a value
 is (a variable, a call), it is reported unresolved at its line.
 """
 from __future__ import annotations
@@ -84,17 +88,31 @@ def _action(c: ast.Call, shown: str, notes: list[Note]) -> El | None:
                 v = _kw(c, py)
                 if v is not None:
                     attrs[key] = _value(v)
+            return El("node", attrs, _node_kids(c, shown, notes), src)
+        if name == "ComposableNode":
+            attrs = {}
+            for py, key in (("package", "pkg"), ("plugin", "plugin"), ("name", "name"), ("namespace", "namespace")):
+                v = _kw(c, py)
+                if v is not None:
+                    attrs[key] = _value(v)
+            return El("composable_node", attrs, _node_kids(c, shown, notes), src)
+        if name in ("ComposableNodeContainer", "LoadComposableNodes"):
+            descs = _kw(c, "composable_node_descriptions")
             kids = []
-            rm = _kw(c, "remappings")
-            if rm is not None:
-                if not isinstance(rm, (ast.List, ast.Tuple)):
-                    raise _Unres(f"remappings '{ast.unparse(rm)}'")
-                for pair in rm.elts:
-                    if not isinstance(pair, (ast.Tuple, ast.List)) or len(pair.elts) != 2:
-                        raise _Unres(f"remapping '{ast.unparse(pair)}'")
-                    kids.append(El("remap", {"from": _value(pair.elts[0]), "to": _value(pair.elts[1])}, [],
-                                   Src(shown, pair.lineno, pair.col_offset + 1)))
-            return El("node", attrs, kids, src)
+            if descs is not None:
+                if not isinstance(descs, (ast.List, ast.Tuple)):
+                    raise _Unres(f"composable_node_descriptions '{ast.unparse(descs)}'")
+                for d in descs.elts:
+                    if isinstance(d, ast.Call) and _callee(d) == "ComposableNode":
+                        el = _action(d, shown, notes)
+                        if el is not None:
+                            kids.append(el)
+                    else:
+                        notes.append(Note(Src(shown, d.lineno, d.col_offset + 1), f"composable node "
+                                          f"'{ast.unparse(d)}' is not a literal ComposableNode(...): not resolved "
+                                          f"statically", "ROS-LAUNCH"))
+            tag = "node_container" if name == "ComposableNodeContainer" else "load_composable_node"
+            return El(tag, {}, kids, src)
         if name == "DeclareLaunchArgument":
             n = c.args[0] if c.args else _kw(c, "name")
             d = _kw(c, "default_value")
@@ -132,6 +150,43 @@ def _action(c: ast.Call, shown: str, notes: list[Note]) -> El | None:
         notes.append(Note(src, f"{name}(...): {exc} is not a literal: not resolved statically; action skipped",
                           "ROS-LAUNCH"))
     return None
+
+
+def _node_kids(c: ast.Call, shown: str, notes: list[Note]) -> list[El]:
+    """``remappings=[(a, b)]`` and ``parameters=[{name: value}]`` of a ``Node`` or
+    ``ComposableNode`` as ``remap`` and ``param`` elements; a parameter file (a
+    path in ``parameters``) is not read, said with a located note."""
+    kids = []
+    rm = _kw(c, "remappings")
+    if rm is not None:
+        if not isinstance(rm, (ast.List, ast.Tuple)):
+            raise _Unres(f"remappings '{ast.unparse(rm)}'")
+        for pair in rm.elts:
+            if not isinstance(pair, (ast.Tuple, ast.List)) or len(pair.elts) != 2:
+                raise _Unres(f"remapping '{ast.unparse(pair)}'")
+            kids.append(El("remap", {"from": _value(pair.elts[0]), "to": _value(pair.elts[1])}, [],
+                           Src(shown, pair.lineno, pair.col_offset + 1)))
+    ps = _kw(c, "parameters")
+    if isinstance(ps, (ast.List, ast.Tuple)):
+        for item in ps.elts:
+            at = Src(shown, item.lineno, item.col_offset + 1)
+            if not isinstance(item, ast.Dict):
+                notes.append(Note(at, f"parameters '{ast.unparse(item)}' are not a literal dict (a parameter "
+                                      f"file is not read): not resolved statically", "ROS-LAUNCH"))
+                continue
+            for k, v in zip(item.keys, item.values):
+                try:
+                    if k is not None:
+                        kids.append(El("param", {"name": _value(k), "value": _value(v)}, [],
+                                       Src(shown, v.lineno, v.col_offset + 1)))
+                except _Unres as exc:
+                    notes.append(Note(at, f"parameter value {exc} is not a literal: not resolved statically",
+                                      "ROS-LAUNCH"))
+    elif ps is not None:
+        notes.append(Note(Src(shown, ps.lineno, ps.col_offset + 1), f"parameters '{ast.unparse(ps)}' are not a "
+                                                                    f"literal list: not resolved statically",
+                          "ROS-LAUNCH"))
+    return kids
 
 
 def read_python(path: Path, shown: str) -> tuple[El | None, list[Note]]:

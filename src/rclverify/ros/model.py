@@ -31,12 +31,19 @@ class Src:
 @dataclass(frozen=True)
 class Endpoint:
     """One publisher or subscriber in code: ``topic`` as written (before
-    resolution), ``msg_type`` canonical or ``None`` when unknown."""
+    resolution), ``msg_type`` canonical or ``None`` when unknown.
+
+    ``param``: when the code takes the name from a parameter, that parameter's
+    name as ROS resolves it for the node (``~topic`` private, ``topic``
+    relative, ``/topic`` global; ROS 2 parameters are always ``~name``), and
+    ``topic`` is then the code's default (``""`` when it gives none); the
+    launch file's value for the parameter wins (docs/ros.md, "Reading real code")."""
 
     kind: str  # "pub" | "sub" | one of ``SERVICE_ROLES``
     topic: str  # the topic, service or action name as written
     msg_type: str | None
     src: Src
+    param: str | None = None
 
 
 # The four service/action roles an :class:`Endpoint` may have besides "pub"/"sub", each the
@@ -70,12 +77,18 @@ class GraphEdge:
     src: Src  # where the code creates it
     remapped_at: Src | None = None
     written: str = ""  # the name as the code writes it, before resolution and remapping
+    param: str | None = None  # the parameter the code takes the name from (resolved), if any
+    param_set_at: Src | None = None  # the launch file's value of that parameter, when it sets one
 
     def to_json(self) -> dict[str, Any]:
         d: dict[str, Any] = {"topic": self.topic, "type": self.msg_type, "as_written": self.written or self.topic,
                              "at": self.src.to_json()}
         if self.remapped_at is not None:
             d["remapped_at"] = self.remapped_at.to_json()
+        if self.param is not None:
+            d["param"] = self.param
+        if self.param_set_at is not None:
+            d["param_set_at"] = self.param_set_at.to_json()
         return d
 
 

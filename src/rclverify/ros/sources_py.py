@@ -1,16 +1,30 @@
-"""Publishers, subscribers and node names in Python node sources, read with
-Python's ``ast`` (the code is never imported or run).
+"""Publishers, subscribers, services, actions and node names in Python node
+sources, read with Python's ``ast`` (the code is never imported or run); a
+file ``ast`` cannot parse (a Python 2 script, a broken file) is read by the
+tolerant reader :mod:`sources_py_tolerant` (tree-sitter-python) instead.
 
-Recognised (rospy API, ROS 1; rclpy API, ROS 2):
+Both readers give the same record of the file (:class:`PyModule`: imports,
+calls, assignments), read here.  Recognised (rospy and actionlib, ROS 1;
+rclpy, ROS 2):
 
-* ``rospy.Publisher(name, data_class, ...)``, ``rospy.Subscriber(name, data_class, ...)``
-  (also imported bare, and as keywords ``name=``/``data_class=``);
-* ``<x>.create_publisher(msg_type, topic, ...)``, ``<x>.create_subscription(msg_type, topic, ...)``;
+* ``rospy.Publisher(name, data_class)``, ``rospy.Subscriber(name, data_class, cb)``,
+  ``rospy.Service(name, service_class, handler)``, ``rospy.ServiceProxy(name, service_class)``
+  (also imported bare; keyword arguments too);
+* ``actionlib.SimpleActionServer(name, XAction, ...)`` / ``ActionServer``,
+  ``actionlib.SimpleActionClient(name, XAction)`` / ``ActionClient``
+  (``pkg.msg.XAction`` is the action ``pkg/action/X``);
+* ``<x>.create_publisher(T, topic)``, ``<x>.create_subscription(T, topic, cb)``,
+  ``<x>.create_service(T, name, cb)``, ``<x>.create_client(T, name)``,
+  ``rclpy.action.ActionServer(node, T, name, cb)`` / ``ActionClient(node, T, name)``;
+* a name held in a variable or attribute (``self.topic = ...``), a literal or a
+  parameter: ``rospy.get_param('~topic', 'default')`` (the name as written:
+  ``~`` private, else relative), rclpy ``declare_parameter('topic', 'default')``
+  with ``get_parameter('topic')...`` (ROS 2 parameters are the node's: ``~topic``);
 * node names from ``rospy.init_node('n')``, ``rclpy.create_node('n')``,
   ``Node('n')`` and ``super().__init__('n')`` / ``super().__init__(node_name='n')``.
 
-A topic name that is not a string literal (a variable, a parameter, an
-expression) is reported unresolved at its location, never guessed.
+A name that is neither a literal nor a parameter is reported unresolved at
+its location, never guessed.
 """
 from __future__ import annotations
 
@@ -18,9 +32,29 @@ import ast
 from typing import Any
 
 from .model import Endpoint, Note, Src, canon_type
+from .pyrecords import PyCall, PyModule, PyVal
+from .sources_cpp import action_type, service_type
 
-_ROSPY = {"Publisher": "pub", "Subscriber": "sub"}
-_RCLPY = {"create_publisher": "pub", "create_subscription": "sub"}
+
+# (role, index and keyword of the name, index and keyword of the type), by callee
+_CTORS = {
+    "rospy.Publisher": ("pub", 0, "name", 1, "data_class"),
+    "rospy.Subscriber": ("sub", 0, "name", 1, "data_class"),
+    "rospy.Service": ("service_servers", 0, "name", 1, "service_class"),
+    "rospy.ServiceProxy": ("service_clients", 0, "name", 1, "service_class"),
+    "SimpleActionServer": ("action_servers", 0, "name", 1, "ActionSpec"),
+    "SimpleActionClient": ("action_clients", 0, "ns", 1, "ActionSpec"),
+    "ActionServer": ("action_servers", 0, "ns", 1, "ActionSpec"),
+    "ActionClient": ("action_clients", 0, "ns", 1, "ActionSpec"),
+    "rclpy.ActionServer": ("action_servers", 2, "action_name", 1, "action_type"),
+    "rclpy.ActionClient": ("action_clients", 2, "action_name", 1, "action_type"),
+}
+_METHODS = {"create_publisher": ("pub", 1, "topic", 0, "msg_type"),
+            "create_subscription": ("sub", 1, "topic", 0, "msg_type"),
+            "create_service": ("service_servers", 1, "srv_name", 0, "srv_type"),
+            "create_client": ("service_clients", 1, "srv_name", 0, "srv_type")}
+_WHAT = {"pub": "publisher topic", "sub": "subscriber topic", "service_servers": "service server",
+         "service_clients": "service client", "action_servers": "action server", "action_clients": "action client"}
 
 
 def _dotted(e: ast.AST) -> str | None:
@@ -32,93 +66,169 @@ def _dotted(e: ast.AST) -> str | None:
     return None
 
 
-def _str(e: ast.AST | None) -> str | None:
-    return e.value if isinstance(e, ast.Constant) and isinstance(e.value, str) else None
+def _ast_module(tree: ast.AST, shown: str) -> PyModule:
+    mod = PyModule()
+    made: dict[int, PyCall] = {}
+
+    def loc(e: ast.AST) -> Src:
+        return Src(shown, getattr(e, "lineno", 1), getattr(e, "col_offset", 0) + 1)
+
+    def call(c: ast.Call) -> PyCall:
+        if id(c) not in made:
+            f = c.func
+            func = _dotted(f) or ""
+            if isinstance(f, ast.Attribute) and isinstance(f.value, ast.Call) and _dotted(f.value.func) == "super":
+                func = f"super().{f.attr}"
+            elif not func and isinstance(f, ast.Attribute):
+                func = f".{f.attr}"
+            made[id(c)] = PyCall(func, [val(a) for a in c.args],
+                                 {k.arg: val(k.value) for k in c.keywords if k.arg}, loc(c))
+        return made[id(c)]
+
+    def val(e: ast.AST) -> PyVal:
+        if isinstance(e, ast.Constant) and isinstance(e.value, str):
+            return PyVal("str", e.value, loc(e))
+        d = _dotted(e)
+        if d is not None:
+            return PyVal("name", d, loc(e))
+        inner = [call(c) for c in ast.walk(e) if isinstance(c, ast.Call)]
+        if isinstance(e, ast.Call):
+            return PyVal("call", ast.unparse(e), loc(e), call(e), inner)
+        return PyVal("other", ast.unparse(e), loc(e), None, inner)
+
+    for n in ast.walk(tree):
+        if isinstance(n, ast.ImportFrom) and n.module:
+            for a in n.names:
+                mod.imports[a.asname or a.name] = f"{n.module}.{a.name}"
+        elif isinstance(n, ast.Import):
+            for a in n.names:
+                mod.imports[a.asname or a.name.split(".")[0]] = a.name if a.asname else a.name.split(".")[0]
+        elif isinstance(n, ast.Call):
+            mod.calls.append(call(n))
+        elif isinstance(n, (ast.Assign, ast.AnnAssign)) and n.value is not None:
+            for t in (n.targets if isinstance(n, ast.Assign) else [n.target]):
+                d = _dotted(t)
+                if d is not None:
+                    mod.assigns.append((d, val(n.value)))
+    return mod
 
 
 def scan_python(text: str, shown: str) -> dict[str, Any]:
     """``{"nodes": [(name, Src)], "endpoints": [Endpoint], "notes": [Note]}`` for one file.
 
-    A file that does not parse gives one located ``ROS-PARSE`` error note."""
-    out: dict[str, Any] = {"nodes": [], "endpoints": [], "notes": []}
+    A file that ``ast`` cannot parse is read by the tolerant reader, with one
+    located ``ROS-PARSE`` warning naming the lines it could not read either."""
     try:
         tree = ast.parse(text, filename=shown)
     except (SyntaxError, ValueError, RecursionError, MemoryError) as exc:
+        from .sources_py_tolerant import tolerant_module
         line = getattr(exc, "lineno", None) or 1
         col = getattr(exc, "offset", None) or 1
-        out["notes"].append(Note(Src(shown, line, col), f"Python source does not parse: {getattr(exc, 'msg', exc)}",
-                                 "ROS-PARSE", "error"))
+        mod, unread = tolerant_module(text, shown)
+        why = f"not Python 3 ({getattr(exc, 'msg', exc)})"
+        if mod is None:
+            return {"nodes": [], "endpoints": [],
+                    "notes": [Note(Src(shown, line, col), f"Python source does not parse: {why}; {unread}",
+                                   "ROS-PARSE", "error")]}
+        out = extract(mod, shown)
+        out["notes"].insert(0, Note(Src(shown, line, col), f"Python source is {why}: read with the tolerant "
+                                                           f"reader (tree-sitter-python); {unread}", "ROS-PARSE"))
         return out
-    imports: dict[str, str] = {}  # local name -> dotted origin
-    for n in ast.walk(tree):
-        if isinstance(n, ast.ImportFrom) and n.module:
-            for a in n.names:
-                imports[a.asname or a.name] = f"{n.module}.{a.name}"
-        elif isinstance(n, ast.Import):
-            for a in n.names:
-                imports[a.asname or a.name.split(".")[0]] = a.name if a.asname else a.name.split(".")[0]
+    return extract(_ast_module(tree, shown), shown)
 
-    def full(e: ast.AST | None) -> str | None:
-        d = _dotted(e) if e is not None else None
-        if d is None:
-            return None
+
+def extract(mod: PyModule, shown: str) -> dict[str, Any]:
+    """Nodes, endpoints and notes from a file's :class:`PyModule` (either reader)."""
+    out: dict[str, Any] = {"nodes": [], "endpoints": [], "notes": []}
+
+    def full(d: str) -> str:
         head, _, rest = d.partition(".")
-        base = imports.get(head, head)
+        base = mod.imports.get(head, head)
         return f"{base}.{rest}" if rest else base
 
-    def msg_type(e: ast.AST | None) -> str | None:
-        d = full(e)
-        if d is None:
+    def type_of(v: PyVal | None, kind: str) -> str | None:
+        if v is None or v.kind != "name":
             return None
-        parts = d.split(".")
-        if len(parts) >= 3 and parts[-2] in ("msg", "srv", "action"):
-            return canon_type("/".join(parts[-3:]))
+        parts = full(v.text).split(".")
+        if len(parts) < 3 or parts[-2] not in ("msg", "srv", "action"):
+            return None
+        dotted = "/".join(parts[-3:])
+        if kind.startswith("service"):
+            return service_type(dotted)
+        if kind.startswith("action"):
+            return action_type(dotted)
+        t = canon_type(dotted)
+        return t if t and parts[-2] == "msg" else None
+
+    declared: dict[str, str | None] = {}
+    for c in mod.calls:
+        if c.func.endswith("declare_parameter") and c.args and c.args[0].kind == "str":
+            d = c.args[1] if len(c.args) > 1 else c.kwargs.get("value")
+            declared.setdefault("~" + c.args[0].text.lstrip("~"), d.text if d is not None and d.kind == "str" else None)
+    binds: dict[str, list[PyVal]] = {}
+    for t, v in mod.assigns:
+        binds.setdefault(t, []).append(v)
+
+    def getter(c: PyCall) -> tuple[str | None, str] | None:
+        f = full(c.func) if c.func else ""
+        if not c.args or c.args[0].kind != "str":
+            return None
+        name = c.args[0].text
+        if f in ("rospy.get_param", "rospy.client.get_param"):
+            d = c.args[1] if len(c.args) > 1 else c.kwargs.get("default")
+            return (d.text if d is not None and d.kind == "str" else None), name
+        last = c.func.rsplit(".", 1)[-1]
+        if last in ("get_parameter", "declare_parameter", "get_parameter_or"):
+            p = "~" + name.lstrip("~")
+            d = c.args[1] if last != "get_parameter" and len(c.args) > 1 else None
+            return (d.text if d is not None and d.kind == "str" else declared.get(p)), p
         return None
 
-    def arg(call: ast.Call, pos: int, kw: tuple[str, ...]) -> ast.AST | None:
-        for k in call.keywords:
-            if k.arg in kw:
-                return k.value
-        return call.args[pos] if len(call.args) > pos else None
+    def resolve(v: PyVal, depth: int = 0) -> tuple[str | None, str | None]:
+        if v.kind == "str":
+            return v.text, None
+        if v.kind == "name" and depth < 5:
+            vs = binds.get(v.text, [])
+            got = {resolve(x, depth + 1) for x in vs}
+            return next(iter(got)) if len(got) == 1 else (None, None)
+        for c in ([v.call] if v.call else []) + v.calls:
+            g = getter(c)
+            if g is not None:
+                return g
+        return None, None
 
-    def loc(e: ast.AST) -> Src:
-        return Src(shown, getattr(e, "lineno", 1), getattr(e, "col_offset", 0) + 1)
-
-    for call in ast.walk(tree):
-        if not isinstance(call, ast.Call):
+    for c in mod.calls:
+        f = full(c.func) if c.func else ""
+        last = c.func.rsplit(".", 1)[-1]
+        if f in ("rospy.init_node", "rclpy.create_node", "rclpy.node.Node") or c.func == "super().__init__":
+            v = c.args[0] if c.args else c.kwargs.get("name") or c.kwargs.get("node_name")
+            if v is not None and v.kind == "str":
+                out["nodes"].append((v.text, c.src))
+            elif v is not None and c.func != "super().__init__":
+                out["notes"].append(Note(v.src, "node name is not a string literal: not resolved statically"))
             continue
-        fn = full(call.func) or ""
-        attr = call.func.attr if isinstance(call.func, ast.Attribute) else (call.func.id if isinstance(call.func, ast.Name) else "")
-        kind = None
-        if fn in ("rospy.Publisher", "rospy.Subscriber"):
-            kind = _ROSPY[fn.split(".")[1]]
-            name_e, type_e = arg(call, 0, ("name",)), arg(call, 1, ("data_class",))
-        elif attr in _RCLPY and isinstance(call.func, ast.Attribute):
-            kind = _RCLPY[attr]
-            type_e, name_e = arg(call, 0, ("msg_type",)), arg(call, 1, ("topic",))
-        elif fn in ("rospy.init_node", "rclpy.create_node", "rclpy.node.Node") or (
-                isinstance(call.func, ast.Attribute) and attr == "__init__"
-                and isinstance(call.func.value, ast.Call) and _dotted(call.func.value.func) == "super"):
-            name_e = arg(call, 0, ("name", "node_name"))
-            name = _str(name_e)
-            if name is not None:
-                out["nodes"].append((name, loc(call)))
-            elif name_e is not None and fn != "" and attr != "__init__":
-                out["notes"].append(Note(loc(name_e), "node name is not a string literal: not resolved statically"))
+        spec = _CTORS.get(f)
+        if spec is None and "actionlib" in f and last in _CTORS:
+            spec = _CTORS[last]
+        if spec is None and f.startswith("rclpy.action") and last in ("ActionServer", "ActionClient"):
+            spec = _CTORS[f"rclpy.{last}"]
+        if spec is None and "." in c.func and last in _METHODS:
+            spec = _METHODS[last]
+        if spec is None:
             continue
-        if kind is None:
+        kind, ni, nk, ti, tk = spec
+        name_v = c.kwargs.get(nk) or (c.args[ni] if len(c.args) > ni else None)
+        type_v = c.kwargs.get(tk) or (c.args[ti] if len(c.args) > ti else None)
+        if name_v is None:
             continue
-        topic = _str(name_e)
-        t = msg_type(type_e)
-        where = loc(call)
-        if topic is None:
-            what = ast.unparse(name_e) if name_e is not None else "nothing"
-            out["notes"].append(Note(loc(name_e) if name_e is not None else where,
-                                     f"{'publisher' if kind == 'pub' else 'subscriber'} topic name is "
-                                     f"'{what}', not a string literal: not resolved statically"))
+        topic, param = resolve(name_v)
+        if topic is None and param is None:
+            out["notes"].append(Note(name_v.src, f"{_WHAT[kind]} name is '{name_v.text}', not a string literal "
+                                                 f"or a parameter: not resolved statically"))
             continue
-        if t is None and type_e is not None:
-            out["notes"].append(Note(loc(type_e), f"message type '{ast.unparse(type_e)}' of topic "
-                                                  f"'{topic}' not resolved statically"))
-        out["endpoints"].append(Endpoint(kind, topic, t, where))
+        t = type_of(type_v, kind)
+        if t is None and type_v is not None:
+            out["notes"].append(Note(type_v.src, f"type '{type_v.text}' of {_WHAT[kind]} '{topic or param}' "
+                                                 f"not resolved statically"))
+        out["endpoints"].append(Endpoint(kind, topic or "", t, c.src, param))
     return out

@@ -1,0 +1,149 @@
+"""The tolerant reader of Python node sources: a file Python 3's ``ast``
+cannot parse (a Python 2 script with ``print "x"`` or ``except E, e:``, a
+file with a syntax error) is read with tree-sitter's Python grammar
+(``tree-sitter-python``), which accepts Python 2's print and exec statements
+and recovers from errors: what lies in its ERROR regions is not read, and
+those lines are named in the note the caller emits.
+
+The result is the same :class:`~.sources_py.PyModule` record the ``ast``
+reader gives (imports, calls with their arguments, assignments), so one
+extractor (:func:`~.sources_py.extract`) reads both.
+Source of the syntax: the Python 2.7 and 3 language references.
+"""
+from __future__ import annotations
+
+from typing import Any
+
+from .model import Src
+from .pyrecords import PyCall, PyModule, PyVal
+
+_PARSER: Any = None
+MAX_DEPTH = 400  # nesting read; deeper expressions are left as text
+
+
+def _parser() -> Any:
+    global _PARSER
+    if _PARSER is None:
+        import tree_sitter_python
+        from tree_sitter import Language, Parser
+        _PARSER = Parser(Language(tree_sitter_python.language()))
+    return _PARSER
+
+
+def _txt(n: Any) -> str:
+    return n.text.decode("utf-8", errors="replace") if n is not None else ""
+
+
+def _ranges(lines: list[int]) -> str:
+    """``[3, 7, 8, 9]`` -> ``"3, 7-9"``."""
+    spans: list[list[int]] = []
+    for ln in sorted(set(lines)):
+        if spans and spans[-1][1] == ln - 1:
+            spans[-1][1] = ln
+        else:
+            spans.append([ln, ln])
+    return ", ".join(str(a) if a == b else f"{a}-{b}" for a, b in spans)
+
+
+def tolerant_module(text: str, shown: str) -> tuple[Any, str]:
+    """``(PyModule or None, what was not read)`` for ``text``: the second part is
+    ``"every line read"`` or ``"lines 3, 7-9 not read"`` (the ERROR regions and
+    missing tokens tree-sitter reported). ``None`` only when the grammar is not
+    installed (said in the second part)."""
+    try:
+        parser = _parser()
+    except ImportError:
+        return None, "tree-sitter-python is not installed, so the file was not read"
+    root = parser.parse(text.encode("utf-8", errors="replace")).root_node
+    mod = PyModule()
+    made: dict[int, PyCall] = {}
+
+    def loc(n: Any) -> Src:
+        return Src(shown, n.start_point[0] + 1, n.start_point[1] + 1)
+
+    def dotted(n: Any) -> str | None:
+        if n.type == "identifier":
+            return _txt(n)
+        if n.type == "attribute":
+            o, a = n.child_by_field_name("object"), n.child_by_field_name("attribute")
+            base = dotted(o) if o is not None else None
+            return f"{base}.{_txt(a)}" if base and a is not None else None
+        return None
+
+    def calls_in(n: Any) -> list[Any]:
+        found, stack = [], [n]
+        while stack:
+            x = stack.pop()
+            if x.type == "call":
+                found.append(x)
+            stack.extend(x.children)
+        return found
+
+    def call(c: Any, depth: int) -> PyCall:
+        if c.id not in made:
+            f = c.child_by_field_name("function")
+            func = dotted(f) if f is not None else None
+            if func is None and f is not None and f.type == "attribute":
+                o = f.child_by_field_name("object")
+                a = _txt(f.child_by_field_name("attribute"))
+                is_super = o is not None and o.type == "call" and _txt(o.child_by_field_name("function")) == "super"
+                func = f"super().{a}" if is_super else f".{a}"
+            pc = PyCall(func or "", [], {}, loc(c))
+            made[c.id] = pc
+            a = c.child_by_field_name("arguments")
+            for x in (a.named_children if a is not None else []):
+                if x.type == "keyword_argument":
+                    k, v = x.child_by_field_name("name"), x.child_by_field_name("value")
+                    if k is not None and v is not None:
+                        pc.kwargs[_txt(k)] = val(v, depth + 1)
+                elif x.type != "comment":
+                    pc.args.append(val(x, depth + 1))
+        return made[c.id]
+
+    def val(n: Any, depth: int) -> PyVal:
+        if n.type == "string" and not any(c.type == "interpolation" for c in n.children):
+            prefix = _txt(n.children[0]) if n.children else ""
+            if "b" not in prefix.lower():
+                return PyVal("str", "".join(_txt(c) for c in n.children if c.type == "string_content"), loc(n))
+        d = dotted(n)
+        if d is not None:
+            return PyVal("name", d, loc(n))
+        if depth > MAX_DEPTH:
+            return PyVal("other", _txt(n), loc(n))
+        inner = [call(c, depth + 1) for c in calls_in(n)]
+        if n.type == "call":
+            return PyVal("call", _txt(n), loc(n), call(n, depth), inner)
+        return PyVal("other", _txt(n), loc(n), None, inner)
+
+    unread: list[int] = []
+    stack = [root]
+    while stack:
+        n = stack.pop()
+        t = n.type
+        if t == "ERROR" or n.is_missing:
+            unread.extend(range(n.start_point[0] + 1, n.end_point[0] + 2))
+        if t == "import_statement":
+            for x in n.children_by_field_name("name"):
+                if x.type == "aliased_import":
+                    mod.imports[_txt(x.child_by_field_name("alias"))] = _txt(x.child_by_field_name("name"))
+                else:
+                    mod.imports[_txt(x).split(".")[0]] = _txt(x).split(".")[0]
+        elif t == "import_from_statement":
+            m = _txt(n.child_by_field_name("module_name"))
+            for x in n.children_by_field_name("name"):
+                if x.type == "aliased_import":
+                    mod.imports[_txt(x.child_by_field_name("alias"))] = f"{m}.{_txt(x.child_by_field_name('name'))}"
+                else:
+                    mod.imports[_txt(x)] = f"{m}.{_txt(x)}"
+        elif t == "call":
+            mod.calls.append(call(n, 0))
+        elif t == "assignment":
+            left, right = n.child_by_field_name("left"), n.child_by_field_name("right")
+            d = dotted(left) if left is not None else None
+            if d is not None and right is not None:
+                mod.assigns.append((d, val(right, 0)))
+        stack.extend(reversed(n.children))
+    mod.calls.sort(key=lambda c: (c.src.line, c.src.col))
+    word = "line" if len(set(unread)) == 1 else "lines"
+    return mod, (f"{word} {_ranges(unread)} not read (syntax tree-sitter could not recover)"
+                 if unread else "every line read")
