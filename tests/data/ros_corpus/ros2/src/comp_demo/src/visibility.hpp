@@ -1,0 +1,2 @@
+#pragma once
+#define COMP_DEMO_PUBLIC __attribute__((visibility("default")))
