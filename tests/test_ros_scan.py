@@ -29,7 +29,6 @@ def test_catkin_workspace_exact_graph() -> None:
         ("/rover/controller", "sub", "/rover/radiation", "rover_msgs/msg/Reading"),    # type from the callback
         ("/rover/controller", "pub", "/rover/status", "rover_msgs/msg/Status"),
         ("/rover/controller", "pub", "/mobile_base/cmd_vel", "geometry_msgs/msg/Twist"),  # include arg -> remap
-        ("/rover/sensor", "pub", "/rover/debug", "std_msgs/msg/String"),  # ~debug_topic's default
     }
     ctl = g.nodes["/rover/controller"]
     assert (ctl.package, ctl.executable, ctl.namespace) == ("rover_control", "controller", "/rover")
@@ -43,11 +42,10 @@ def test_catkin_workspace_exact_graph() -> None:
     assert {k: (v["version"], v["build_type"], v["ros"]) for k, v in g.packages.items()} == {
         "rover_msgs": ("0.3.1", "catkin", 1), "rover_sensing": ("0.3.1", "catkin", 1),
         "rover_control": ("1.2.0", "catkin", 1)}
-    # the parameter-held topic takes the code's default (the launch file sets no value), and says so
-    assert ("/rover/sensor", "pub", "/rover/debug", "std_msgs/msg/String") in g.edges()
-    debug = next(e for e in g.nodes["/rover/sensor"].publishes if e.topic == "/rover/debug")
-    assert (debug.param, debug.written, debug.param_set_at) == ("/rover/sensor/debug_topic", "debug", None)
-    assert [str(n) for n in g.notes] == []
+    # the parameter-held topic is reported, located, never guessed
+    assert [str(n) for n in g.notes] == [
+        "catkin_ws/src/rover_sensing/scripts/sensor.py:14:38: warning: publisher topic name is 'debug_topic', "
+        "not a string literal: not resolved statically"]
 
 
 def test_catkin_launch_arguments_change_the_graph() -> None:
@@ -114,14 +112,12 @@ def test_python_and_cpp_sources_unresolved_are_located() -> None:
     assert [(e.kind, e.topic, e.msg_type, str(e.src)) for e in py["endpoints"]] == [
         ("sub", "/abs", "std_msgs/msg/String", "n.py:5:1")]
     assert [str(n) for n in py["notes"]] == [
-        "n.py:4:17: warning: publisher topic name is 't', not a string literal or a parameter: "
-        "not resolved statically"]
+        "n.py:4:17: warning: publisher topic name is 't', not a string literal: not resolved statically"]
     cpp = scan_cpp(b'void f(){ auto p = n.advertise<std_msgs::String>(topic_name, 1);\n'
                    b'  auto q = node->create_publisher<std_msgs::msg::Bool>("~/ok", 1); }\n', "n.cpp")
     assert [(e.topic, e.msg_type, str(e.src)) for e in cpp["endpoints"]] == [("~/ok", "std_msgs/msg/Bool", "n.cpp:2:12")]
     assert [str(n) for n in cpp["notes"]] == [
-        "n.cpp:1:50: warning: publisher name is 'topic_name', not a string literal or a parameter: "
-        "not resolved statically"]
+        "n.cpp:1:50: warning: publisher topic name is 'topic_name', not a string literal: not resolved statically"]
 
 
 def test_cli_scan_writes_json_matching_the_schema(tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
@@ -142,7 +138,7 @@ def test_cli_scan_writes_json_matching_the_schema(tmp_path: Path, monkeypatch: p
     assert {f["path"] for f in data["files"]} >= {"catkin_ws/src/rover_control/src/controller.cpp",
                                                   "catkin_ws/src/rover_control/launch/control.launch"}
     err = capsys.readouterr().err
-    assert "3 package(s), 2 node(s), 5 topic(s)" in err
+    assert "3 package(s), 2 node(s), 4 topic(s)" in err
     assert main(["ros", "scan", "no/such/dir"]) == 2
 
 

@@ -165,9 +165,12 @@ class Bindings:
 
 
 def _calls(n: Any):  # type: ignore[no-untyped-def]
-    stack = [n]
-    while stack:
-        x = stack.pop()
+    """A call and the calls on its result (``get_parameter("t").as_string()``), never
+    calls in its arguments (``f(get_parameter("t"))`` is not the parameter)."""
+    x = n
+    while x is not None and x.type in ("call_expression", "field_expression"):
         if x.type == "call_expression":
             yield x
-        stack.extend(x.children)
+            x = x.child_by_field_name("function")
+        else:
+            x = x.child_by_field_name("argument")

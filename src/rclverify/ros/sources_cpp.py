@@ -42,7 +42,7 @@ _CALLS = {"advertise": "pub", "subscribe": "sub", "create_publisher": "pub", "cr
 _ACTIONLIB = {"SimpleActionServer": "action_servers", "ActionServer": "action_servers",
               "SimpleActionClient": "action_clients", "ActionClient": "action_clients"}
 _NODE_TYPES = ("Node", "rclcpp::Node", "LifecycleNode", "rclcpp_lifecycle::LifecycleNode")
-_WHAT = {"pub": "publisher", "sub": "subscriber", "service_servers": "service server",
+_WHAT = {"pub": "publisher topic", "sub": "subscriber topic", "service_servers": "service server",
          "service_clients": "service client", "action_servers": "action server", "action_clients": "action client"}
 _MACRO = re.compile(rb"\b(?:class|struct)\s+((?:[A-Z][A-Z0-9_]*[A-Z0-9]\s+)+)(?=[A-Za-z_]\w*\s*(?:final\s*)?[:{])")
 _REGISTER = re.compile(rb"\bRCLCPP_COMPONENTS_REGISTER_NODE\s*\(\s*([A-Za-z_][\w:]*)\s*\)")
@@ -343,8 +343,8 @@ def _emit(kind: str, name_arg: Any, msg_type: str | None, n: Any, out: dict[str,
     if topic is None and binds is not None:
         topic, param = binds.lookup(name_arg)
     if topic is None and param is None:
-        out["notes"].append(Note(src(name_arg), f"{what} name is '{_txt(name_arg)}', not a string literal or a "
-                                                f"parameter: not resolved statically"))
+        out["notes"].append(Note(src(name_arg), f"{what} name is '{_txt(name_arg)}', not a string literal: "
+                                                f"not resolved statically"))
         return
     if topic and handle_ns and not topic.startswith("/"):
         topic = f"~{topic}" if handle_ns == "~" else f"{handle_ns.rstrip('/')}/{topic}"

@@ -91,10 +91,16 @@ def _ast_module(tree: ast.AST, shown: str) -> PyModule:
         d = _dotted(e)
         if d is not None:
             return PyVal("name", d, loc(e))
-        inner = [call(c) for c in ast.walk(e) if isinstance(c, ast.Call)]
+        chain, x = [], e  # a call and the attributes/calls on its result: get_parameter('t').value
+        while isinstance(x, (ast.Call, ast.Attribute)):
+            if isinstance(x, ast.Call):
+                chain.append(call(x))
+                x = x.func
+            else:
+                x = x.value
         if isinstance(e, ast.Call):
-            return PyVal("call", ast.unparse(e), loc(e), call(e), inner)
-        return PyVal("other", ast.unparse(e), loc(e), None, inner)
+            return PyVal("call", ast.unparse(e), loc(e), call(e), chain)
+        return PyVal("other", ast.unparse(e), loc(e), None, chain if isinstance(e, ast.Attribute) else [])
 
     for n in ast.walk(tree):
         if isinstance(n, ast.ImportFrom) and n.module:
@@ -223,8 +229,8 @@ def extract(mod: PyModule, shown: str) -> dict[str, Any]:
             continue
         topic, param = resolve(name_v)
         if topic is None and param is None:
-            out["notes"].append(Note(name_v.src, f"{_WHAT[kind]} name is '{name_v.text}', not a string literal "
-                                                 f"or a parameter: not resolved statically"))
+            out["notes"].append(Note(name_v.src, f"{_WHAT[kind]} name is '{name_v.text}', not a string literal: "
+                                                 f"not resolved statically"))
             continue
         t = type_of(type_v, kind)
         if t is None and type_v is not None:

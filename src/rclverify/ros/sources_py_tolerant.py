@@ -70,15 +70,6 @@ def tolerant_module(text: str, shown: str) -> tuple[Any, str]:
             return f"{base}.{_txt(a)}" if base and a is not None else None
         return None
 
-    def calls_in(n: Any) -> list[Any]:
-        found, stack = [], [n]
-        while stack:
-            x = stack.pop()
-            if x.type == "call":
-                found.append(x)
-            stack.extend(x.children)
-        return found
-
     def call(c: Any, depth: int) -> PyCall:
         if c.id not in made:
             f = c.child_by_field_name("function")
@@ -110,7 +101,13 @@ def tolerant_module(text: str, shown: str) -> tuple[Any, str]:
             return PyVal("name", d, loc(n))
         if depth > MAX_DEPTH:
             return PyVal("other", _txt(n), loc(n))
-        inner = [call(c, depth + 1) for c in calls_in(n)]
+        inner, x = [], n  # a call and the attributes/calls on its result: get_parameter('t').value
+        while x is not None and x.type in ("call", "attribute"):
+            if x.type == "call":
+                inner.append(call(x, depth + 1))
+                x = x.child_by_field_name("function")
+            else:
+                x = x.child_by_field_name("object")
         if n.type == "call":
             return PyVal("call", _txt(n), loc(n), call(n, depth), inner)
         return PyVal("other", _txt(n), loc(n), None, inner)

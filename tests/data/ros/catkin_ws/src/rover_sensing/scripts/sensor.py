@@ -10,7 +10,7 @@ class Sensor:
     def __init__(self):
         self.pub = rospy.Publisher('radiation', Reading, queue_size=10)
         rospy.Subscriber('odom', Odometry, self.on_odom)
-        debug_topic = rospy.get_param('~debug_topic', 'debug')
+        debug_topic = rospy.get_param('~debug_prefix', '') + 'debug'
         self.debug = rospy.Publisher(debug_topic, String, queue_size=1)
 
     def on_odom(self, msg):
