@@ -129,3 +129,18 @@ def test_source_mode_makes_one_node_per_node_class() -> None:
     g = scan([CORPUS / "ros2"], base=CORPUS, standard=False).graph
     assert set(g.nodes) == {"/relay", "/gauge", "/probe", "/watchdog"}
     assert ("/relay", "service_servers", "/relay/flush", "std_srvs/srv/Trigger") in g.edges(with_services=True)
+
+
+def test_yaml_launch_composable_node_with_parameter(tmp_path: Path) -> None:
+    import shutil
+    ws = tmp_path / "ws"
+    shutil.copytree(CORPUS / "ros2", ws)
+    lf = ws / "src" / "comp_demo" / "launch" / "one.launch.yaml"
+    lf.write_text("launch:\n- node_container:\n    pkg: rclcpp_components\n    exec: component_container\n"
+                  "    name: c\n    namespace: ''\n    composable_node:\n    - pkg: comp_demo\n"
+                  "      plugin: comp_demo::Relay\n      name: yrelay\n      namespace: y\n"
+                  "      param:\n      - name: output\n        value: /shared/out\n")
+    g = scan([ws], [lf], base=tmp_path, standard=False).graph
+    assert set(g.nodes) == {"/y/yrelay"}
+    assert ("/y/yrelay", "pub", "/shared/out", "std_msgs/msg/String") in g.edges()
+    assert ("/y/yrelay", "action_servers", "/y/sweep", "corpus_interfaces/action/Sweep") in g.edges(True)

@@ -343,7 +343,7 @@ def _emit(kind: str, name_arg: Any, msg_type: str | None, n: Any, out: dict[str,
     if topic is None and binds is not None:
         topic, param = binds.lookup(name_arg)
     if topic is None and param is None:
-        out["notes"].append(Note(src(name_arg), f"{what} name is '{_txt(name_arg)}', not a string literal: "
+        out["notes"].append(Note(src(name_arg), f"{what} name is '{_txt(name_arg)[:80]}', not a string literal: "
                                                 f"not resolved statically"))
         return
     if topic and handle_ns and not topic.startswith("/"):

@@ -57,6 +57,11 @@ _WHAT = {"pub": "publisher topic", "sub": "subscriber topic", "service_servers":
          "service_clients": "service client", "action_servers": "action server", "action_clients": "action client"}
 
 
+def _short(text: str, limit: int = 80) -> str:
+    """Source text quoted in a note, cut to ``limit`` characters."""
+    return text if len(text) <= limit else text[: limit - 3] + "..."
+
+
 def _dotted(e: ast.AST) -> str | None:
     if isinstance(e, ast.Name):
         return e.id
@@ -130,7 +135,10 @@ def scan_python(text: str, shown: str) -> dict[str, Any]:
         from .sources_py_tolerant import tolerant_module
         line = getattr(exc, "lineno", None) or 1
         col = getattr(exc, "offset", None) or 1
-        mod, unread = tolerant_module(text, shown)
+        try:
+            mod, unread = tolerant_module(text, shown)
+        except RecursionError:
+            mod, unread = None, "its nesting is too deep to read"
         why = f"not Python 3 ({getattr(exc, 'msg', exc)})"
         if mod is None:
             return {"nodes": [], "endpoints": [],
@@ -140,7 +148,11 @@ def scan_python(text: str, shown: str) -> dict[str, Any]:
         out["notes"].insert(0, Note(Src(shown, line, col), f"Python source is {why}: read with the tolerant "
                                                            f"reader (tree-sitter-python); {unread}", "ROS-PARSE"))
         return out
-    return extract(_ast_module(tree, shown), shown)
+    try:
+        return extract(_ast_module(tree, shown), shown)
+    except RecursionError:
+        return {"nodes": [], "endpoints": [], "notes": [Note(Src(shown), "Python source nested too deeply to read",
+                                                             "ROS-PARSE", "error")]}
 
 
 def extract(mod: PyModule, shown: str) -> dict[str, Any]:
@@ -229,12 +241,12 @@ def extract(mod: PyModule, shown: str) -> dict[str, Any]:
             continue
         topic, param = resolve(name_v)
         if topic is None and param is None:
-            out["notes"].append(Note(name_v.src, f"{_WHAT[kind]} name is '{name_v.text}', not a string literal: "
+            out["notes"].append(Note(name_v.src, f"{_WHAT[kind]} name is '{_short(name_v.text)}', not a string literal: "
                                                  f"not resolved statically"))
             continue
         t = type_of(type_v, kind)
         if t is None and type_v is not None:
-            out["notes"].append(Note(type_v.src, f"type '{type_v.text}' of {_WHAT[kind]} '{topic or param}' "
+            out["notes"].append(Note(type_v.src, f"type '{_short(type_v.text)}' of {_WHAT[kind]} '{topic or param}' "
                                                  f"not resolved statically"))
         out["endpoints"].append(Endpoint(kind, topic or "", t, c.src, param))
     return out

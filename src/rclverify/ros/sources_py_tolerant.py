@@ -18,7 +18,7 @@ from .model import Src
 from .pyrecords import PyCall, PyModule, PyVal
 
 _PARSER: Any = None
-MAX_DEPTH = 400  # nesting read; deeper expressions are left as text
+MAX_DEPTH = 100  # nesting read; deeper expressions are left as text
 
 
 def _parser() -> Any:
