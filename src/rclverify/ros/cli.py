@@ -79,6 +79,8 @@ def cmd_scan(args: argparse.Namespace) -> int:
             print(f"{args.master}: error: {exc}", file=sys.stderr)
             return 1
         data["master"] = {"uri": args.master, "nodes": [n.to_json() for _, n in sorted(mg.nodes.items())]}
+        for n in mg.notes:  # a service whose type the probe could not read
+            print(f"{args.master}: {n.severity}: {n.message}", file=sys.stderr)
     for n in g.notes:
         print(n, file=sys.stderr)
     if args.json:

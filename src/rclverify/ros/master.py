@@ -42,8 +42,6 @@ INFRA_SERVICE_SUFFIXES = ("/get_loggers", "/set_logger_level")
 #: actionlib's topics under an action's name, and which of them the server subscribes to
 ACTION_TOPICS = ("goal", "cancel", "status", "feedback", "result")
 ACTION_SERVER_SUBSCRIBES = ("goal", "cancel")
-#: seconds one service probe may take (connect and read the header)
-PROBE_TIMEOUT = 3.0
 
 
 class MasterError(Exception):
@@ -85,13 +83,7 @@ def service_type(master: Any, name: str, probe: Any) -> tuple[str | None, str]:
         return None, "its type is not read: Debian's rosservice module is not installed (python3-rosservice)"
     try:
         uri = master.lookupService(name)
-        import socket
-        old = socket.getdefaulttimeout()
-        socket.setdefaulttimeout(PROBE_TIMEOUT)
-        try:
-            header = probe.get_service_headers(name, uri)
-        finally:
-            socket.setdefaulttimeout(old)
+        header = probe.get_service_headers(name, uri)  # connects with its own 5 s timeout
     except Exception as exc:  # the server went away, refused, or sent no header
         return None, f"its type is not read: the server did not answer the probe ({' '.join(str(exc).split())[:200]})"
     t = header.get("type") if isinstance(header, dict) else None
