@@ -10,5 +10,6 @@ files), ``launch_ros1`` / ``launch_ros2`` (launch files read statically),
 ``bag`` (recorded runs), ``master`` (a live ROS 1 master), ``cache``
 (per-file parse cache keyed by sha256), ``graph`` (the scan), ``check``
 (grounding findings; ``ground_services`` for services and actions),
-``diff`` (the code's graph against a master or a bag, ``ros diff``), ``skeleton`` (``init --from-ros``).
+``diff`` (the code's graph against a master or a bag, ``ros diff``),
+``skeleton`` (``init --from-ros``).
 """
