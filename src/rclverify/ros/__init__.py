@@ -9,5 +9,7 @@ via rosbags' type system), ``sources_py`` / ``sources_cpp`` (node sources via
 files), ``launch_ros1`` / ``launch_ros2`` (launch files read statically),
 ``bag`` (recorded runs), ``master`` (a live ROS 1 master), ``cache``
 (per-file parse cache keyed by sha256), ``graph`` (the scan), ``check``
-(grounding findings), ``skeleton`` (``init --from-ros``).
+(grounding findings; ``ground_services`` for services and actions),
+``diff`` (the code's graph against a master or a bag, ``ros diff``),
+``skeleton`` (``init --from-ros``).
 """

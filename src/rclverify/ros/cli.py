@@ -1,4 +1,4 @@
-"""``rclverify ros scan`` and ``rclverify ros check`` (docs/ros.md).
+"""``rclverify ros scan``, ``rclverify ros diff`` and ``rclverify ros check`` (docs/ros.md).
 
 Exit codes: 0 the graph (or the findings) was written; 1 an input file could
 not be read (``ROS-PARSE`` error, the graph is still written from the rest),
@@ -27,6 +27,16 @@ def add_parsers(sub: Any) -> None:
     s.add_argument("--json", metavar="FILE", help="write the graph as JSON (docs/ros-graph.schema.json)")
     s.add_argument("--cache", metavar="DIR", help="per-file parse cache directory (e.g. artifacts/cache)")
     s.set_defaults(fn=cmd_scan)
+    d = rs.add_parser("diff", help="the graph the code promises against a running ROS 1 master or a recorded run",
+                      description="compare the static graph (PATH..., --launch, --arg) with a running ROS 1 "
+                                  "master (--master) or a bag (--bag): exit 0 equal, 1 they differ, 2 usage")
+    d.add_argument("paths", nargs="*", metavar="PATH", help="workspace (or package) directories")
+    d.add_argument("--launch", action="append", default=[], metavar="FILE", help="entry launch file (repeatable)")
+    d.add_argument("--arg", action="append", default=[], metavar="NAME:=VALUE", help="launch argument (repeatable)")
+    d.add_argument("--master", metavar="URI", help="the running ROS 1 master (http://127.0.0.1:11311)")
+    d.add_argument("--bag", metavar="BAG", help="a recorded run: .bag, ROS 2 bag dir, .mcap (topics and types only)")
+    d.add_argument("--json", metavar="FILE", help="write both lists as JSON (docs/ros.md)")
+    d.set_defaults(fn=cmd_diff)
     c = rs.add_parser("check", help="check the plan's contracts against the graph of its ros: section")
     c.add_argument("-w", "--workspace", default=".", help="workspace root (default: .)")
     c.add_argument("--plan", default="contracts/plan.yaml", help="plan file, relative to the workspace")
@@ -69,6 +79,8 @@ def cmd_scan(args: argparse.Namespace) -> int:
             print(f"{args.master}: error: {exc}", file=sys.stderr)
             return 1
         data["master"] = {"uri": args.master, "nodes": [n.to_json() for _, n in sorted(mg.nodes.items())]}
+        for n in mg.notes:  # a service whose type the probe could not read
+            print(f"{args.master}: {n.severity}: {n.message}", file=sys.stderr)
     for n in g.notes:
         print(n, file=sys.stderr)
     if args.json:
@@ -80,6 +92,61 @@ def cmd_scan(args: argparse.Namespace) -> int:
           f"{len(g.types)} message type(s); {errors} error(s), {len(g.notes) - errors} warning(s)",
           file=sys.stderr)
     return 1 if errors else 0
+
+
+def cmd_diff(args: argparse.Namespace) -> int:
+    """``rclverify ros diff``: print the missing and extra lists (docs/ros.md,
+    "Expected against observed"); exit 0 equal, 1 they differ (or the master cannot
+    be read, or a scanned file cannot be), 2 usage."""
+    from ..evidence.store import atomic_write_text
+    from .bag import bag_topics
+    from .diff import diff_bag, diff_master, render_text
+    from .graph import scan
+    from .master import MasterError, read_master
+    if (args.master is None) == (args.bag is None):
+        print("error: ros diff needs exactly one running side: --master URI or --bag BAG", file=sys.stderr)
+        return 2
+    if not args.paths and not args.launch:
+        print("error: ros diff needs the code: PATH... and/or --launch FILE", file=sys.stderr)
+        return 2
+    for p in list(args.paths) + list(args.launch) + ([args.bag] if args.bag else []):
+        if not Path(p).exists():
+            print(f"{p}: error: no such file or directory", file=sys.stderr)
+            return 2
+    try:
+        largs = _launch_args(args.arg)
+    except SystemExit as exc:
+        print(exc, file=sys.stderr)
+        return 2
+    res = scan([Path(p) for p in args.paths], [Path(p) for p in args.launch], largs)
+    for n in res.graph.notes:
+        print(n, file=sys.stderr)
+    if args.master:
+        try:
+            running = read_master(args.master)
+        except MasterError as exc:
+            print(f"{args.master}: error: {exc}", file=sys.stderr)
+            return 1
+        for n in running.notes:
+            print(f"{args.master}: {n.severity}: {n.message}", file=sys.stderr)
+        result = diff_master(res.graph, running, args.master)
+    else:
+        bag, notes = bag_topics(Path(args.bag), args.bag)
+        if bag is None:
+            for n in notes:
+                print(n, file=sys.stderr)
+            return 1
+        result = diff_bag(res.graph, bag)
+    for line in render_text(result):
+        print(line)
+    if args.json:
+        try:
+            atomic_write_text(Path(args.json), json.dumps(result.to_json(), indent=2) + "\n")
+        except OSError as exc:
+            print(f"{args.json}: error: cannot write: {exc.strerror or exc}", file=sys.stderr)
+            return 1
+    errors = any(n.severity == "error" for n in res.graph.notes)
+    return 0 if result.equal and not errors else 1
 
 
 def init_from_ros(args: argparse.Namespace) -> int:

@@ -41,6 +41,8 @@ from ..rcl import ast
 from ..rcl import types as T
 from . import names
 from .graph import ScanResult
+from .ground_services import RULES as SERVICE_RULES
+from .ground_services import folded, ground_links
 from .interfaces import BASE_TYPES, TypeTable, field_path
 from .model import GraphEdge, GraphNode, Src, canon_type, short_type
 
@@ -61,6 +63,7 @@ RULES: dict[str, tuple[str, str]] = {
     "ROS-NODE-NO-CONTRACT": ("warning", "a graph node without a contract"),
     "ROS-NODE-NOT-IN-GRAPH": ("error", "a contract node that is not in the graph"),
     "ROS-SCAN": ("warning", "something the scan could not read or resolve statically"),
+    **SERVICE_RULES,  # services and actions (ground_services.py)
 }
 
 
@@ -142,7 +145,7 @@ class Grounder:
     def __init__(self, scan: ScanResult, checked: Any, plan_file: str, ros: Mapping[str, Any],
                  fields_by_topic: Mapping[str, list[str]], plan_loc: ast.Loc) -> None:
         self.scan = scan
-        self.g = scan.graph
+        self.g = folded(scan.graph)  # actions on raw actionlib topics are actions (master.py's rule)
         self.table: TypeTable = scan.table
         self.checked = checked
         self.plan_file = plan_file
@@ -158,6 +161,7 @@ class Grounder:
         ignore = {names.normalise(n) for n in self.ros.get("ignore", []) or []}
         external = {names.normalise(t) for t in self.ros.get("external", []) or []}
         graph_nodes = {k: v for k, v in self.g.nodes.items() if k not in ignore}
+        self.graph_nodes, self.external = graph_nodes, external
         explicit = dict(self.ros.get("nodes", {}) or {})
         pairs = match_nodes(self.checked.nodes, graph_nodes, explicit)
         publishers: dict[str, list[tuple[str, GraphEdge]]] = {t: [] for t in external}
@@ -267,6 +271,7 @@ class Grounder:
                 what = "publishes" if e in gn.publishes else "subscribes to"
                 self.add("ROS-TOPIC-UNDOCUMENTED", f"{gn.name} {what} {e.topic} ({short_type(e.msg_type)}), which "
                          f"{node.name}'s contract leaves out of topics(...)", node.loc, e.src, node.name, e.written)
+        ground_links(self.add, node, gn, self.graph_nodes, self.external, self.table)
 
     def _fields(self, cn: Any, tp: ast.Topic, var: ast.Var, ctype: str, rcl_loc: ast.Loc) -> None:
         info = self.table.get(ctype)
