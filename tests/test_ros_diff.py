@@ -184,7 +184,7 @@ def test_command_against_a_bag(tmp_path: Path, capsys: pytest.CaptureFixture[str
     data = json.loads(out.read_text())
     assert [(i["name"], i["at"]["file"], i["at"]["line"]) for i in data["missing"]] == [
         ("/cmd", "tests/data/ros/diff_ws/src/diff_demo/scripts/planner.py", 8),
-        ("/range", "tests/data/ros/diff_ws/src/diff_demo/scripts/sensor.py", 9)]
+        ("/range", "tests/data/ros/diff_ws/src/diff_demo/scripts/sensor.py", 10)]
     assert [i["name"] for i in data["extra"]] == ["/at", "/command", "/currentLoc", "/inspected", "/position",
                                                   "/r", "/radiationStatus", "/wayPNow"]
     assert all(i["at"] is None and i["observed"] == bag for i in data["extra"])
