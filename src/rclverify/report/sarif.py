@@ -339,10 +339,11 @@ def sarif_log(report: Mapping[str, Any]) -> dict[str, Any]:
     """
     lint, lint_rules = _lint_results(report)
     ground, ground_rules = _grounding_results(report)
+    from .deadlines import SARIF_RULES, sarif_results
     results = (_obligation_results(report) + _unverified_results(report) + _side_condition_results(report) + _finding_results(report) + lint + ground
-               + _requirement_results(report))
+               + _requirement_results(report) + sarif_results(report, _result))
     _attach_diagnoses(report, results)
-    rules: Sequence[Rule] = list(RULES.values()) + lint_rules + ground_rules
+    rules: Sequence[Rule] = list(RULES.values()) + [Rule(*r) for r in SARIF_RULES] + lint_rules + ground_rules
     index = {r.id: i for i, r in enumerate(rules)}
     for res in results:
         res["ruleIndex"] = index[res["ruleId"]]
