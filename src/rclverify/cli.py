@@ -571,6 +571,11 @@ def main(argv: Sequence[str] | None = None) -> int:
     lv.add_argument("--live", action="store_true", help="monitor the running ROS 1 system (ROS_MASTER_URI) instead")
     lv.add_argument("--log", default="monitor_live.jsonl", help="JSON-lines log of events and verdicts to write")
     lv.add_argument("--evidence", help="write the monitoring evidence record (JSON) here when stopped")
+    lv.add_argument("--forward", action="append", default=[], metavar="SVC=REAL",
+                    help="serve SVC (a service a contract serves) and forward each call to REAL, checking its "
+                         "deadline (repeatable; docs/monitors.md, \"Services, actions and deadlines\")")
+    lv.add_argument("--interfaces", action="append", default=[], metavar="DIR",
+                    help="directory of <pkg>/srv and <pkg>/action files (workspace-relative; repeatable)")
     lv.add_argument("--duration", type=seconds, help="stop after this many seconds (default: at SIGINT/SIGTERM)")
     lv.add_argument("--reorder-window", type=seconds, default=0.05, help="seconds to wait for stamp ordering")
     lv.add_argument("--silence", type=seconds, default=10.0,
