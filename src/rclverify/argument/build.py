@@ -23,6 +23,9 @@ whatever produced it.  Structure (docs/argument.md)::
                     goal per obligation without a record, or when no
                     obligation was exported at all
     G-<Node>.sc<k>  supported by the Z3 query's solution
+    G-<REQ>.deadline  a requirement's end-to-end deadline, under its goal
+                    (:mod:`.deadlines`: Z3's decision, the chain's timed
+                    guarantees, the monitors' evidence)
 
 Statuses then propagate upward (:func:`.model.propagate`): with the
 report's own roll-up rules this gives every requirement, guarantee and node

@@ -27,7 +27,9 @@ nothing itself.  Layout (decisions in ``docs/ci.md``):
   proved from an inconsistency) is a ``<failure>`` with the counterexample
   node by node; outstanding evidence and inconclusive are ``<skipped>``
   (a ``<failure>`` when evidence the proof rests on failed), informal
-  ones ``<skipped>``.
+  ones ``<skipped>``;
+* when the plan has end-to-end deadlines, a ``deadlines`` ``<testsuite>``
+  with one ``<testcase>`` per deadline (:func:`.deadlines.junit_suite`).
 
 ``time`` is the recorded duration of the check in seconds (0 when the
 record has none).  The XML is built with :mod:`xml.etree.ElementTree`, so

@@ -12,7 +12,10 @@ One ``result`` per item that needs attention:
 * a guarantee no obligation covers (``unverified``, rule
   ``RCL-GUARANTEE-UNVERIFIED``, at the guarantee);
 * a contract health finding whose status is ``problem`` or ``inconclusive``;
-* a lint warning.
+* a lint warning;
+* an end-to-end deadline that is not proved (``RCL-DEADLINE-REFUTED`` /
+  ``RCL-DEADLINE-INCONCLUSIVE`` at the plan's ``deadline:`` entry, the
+  chain in the message; :mod:`.deadlines`).
 
 Each result names a stable rule id per kind of finding (:data:`RULES`,
 :func:`lint_rule_id`), a level (``error``/``warning``/``note``), the RCL
