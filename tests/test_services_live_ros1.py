@@ -80,6 +80,11 @@ def live_log(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
                               "--evidence", str(tmp / "live.json"), "--duration", "60"], env, tmp / "monitor.out")
             procs.append(monitor)
             _wait_for(tmp / "monitor.out", "monitoring ", 60)
+            # the deadline verdicts on the live monitor's verdict topic, as a subscriber sees them
+            echo = subprocess.Popen(["rostopic", "echo", "/rclverify/verdict"], env=env, stdout=(tmp / "echo.out").open("wb"),
+                                    stderr=subprocess.STDOUT, start_new_session=True)
+            procs.append(echo)
+            time.sleep(1.0)  # subscribed before the first call
             teleop = _start([str(NODES), "teleop", "--call", "/estop", "--count", "2", "--every", "0.3"],
                             env, tmp / "teleop.out")
             mission = _start([str(NODES), "mission", "--target", "2.0"], env, tmp / "mission.out")
@@ -95,6 +100,7 @@ def live_log(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
     # the proxy's lines ("kind": event, verdict, summary) among the live monitor's own
     lines = [x for x in map(json.loads, log.read_text().splitlines()) if "kind" in x]
     return {"lines": lines, "code": code, "tmp": tmp, "out": (tmp / "monitor.out").read_text(),
+            "echo": (tmp / "echo.out").read_text(errors="replace"),
             "record": json.loads((tmp / "live.json").read_text())}
 
 
@@ -130,3 +136,5 @@ def test_the_action_feedback_arrives_in_time(live_log: dict[str, Any]) -> None:
     assert live_log["record"]["deadlines"]["false"] == 1
     assert [r["node"] for r in live_log["record"]["deadlines"]["results"]] == ["Teleop", "Base", "Mover"]
     assert "deadlines: 1 call(s) or goal(s) missed their deadline" in live_log["out"]
+    published = live_log["echo"]
+    assert '\\"kind\\": \\"deadline\\"' in published and '\\"verdict\\": \\"false\\"' in published, published[-2000:]
