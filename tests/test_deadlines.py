@@ -122,8 +122,9 @@ def test_cli_proves_the_example_and_refutes_a_tighter_requirement(tmp_path: Path
     assert "STOP: end-to-end deadline 200 ms along Teleop -> Base: refuted" in out
     assert ("the chain Teleop guarantee 1 (in.button -> out.stop_req within 50 ms) -> Base guarantee 1 "
             "(in.stop_req -> out.stopped within 200 ms) sums to 250 ms > 200 ms") in out
-    rec = json.loads((ws / "artifacts" / "deadlines.json").read_text())
+    rec = json.loads((ws / "artifacts" / "deadlines" / "index.json").read_text())["results"]
     assert [r["status"] for r in rec] == ["refuted", "proved"]
+    assert rec[0]["smt2"] == "artifacts/deadlines/STOP.smt2" and (ws / rec[0]["smt2"]).is_file()
     assert [h["node"] for h in rec[0]["chain"]] == ["Teleop", "Base"]
 
 

@@ -81,7 +81,9 @@ LAYERS: list[tuple[str, tuple[str, ...]]] = [
     # The workspace (workspace.py: the loaded plan and contracts, artifact
     # paths, snapshots and what makes a result stale): read by the report,
     # the stages and the commands; it imports the layers below only.
-    ("workspace", ("rclverify.workspace", "rclverify.requirements.stage")),
+    # The deadlines stage (calculus/deadline_stage.py) writes and reads its sealed record
+    # in the workspace, as the requirements stage does.
+    ("workspace", ("rclverify.workspace", "rclverify.requirements.stage", "rclverify.calculus.deadline_stage")),
     # report/ and argument/ render the results; contract_texts.py makes the
     # texts of the contracts the report shows (RCL, LaTeX, lint), so it
     # belongs with the report.

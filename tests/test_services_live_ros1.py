@@ -1,7 +1,8 @@
 """Services, actions and deadlines monitored live on ROS 1 (issue 33).
 
 A ROS 1 master on 127.0.0.1 (a free port), the safety-stop example's nodes
-as rospy processes, and the service proxy monitor: the estop server answers
+as rospy processes, and ``rclverify monitor --live --forward /estop=/estop_real
+--interfaces interfaces`` (the service proxy inside the live monitor): the estop server answers
 its second call 400 ms late (its deadline is 200 ms), the move action's
 feedback comes 0.5 s after the goal (deadline 2 s).  The monitor's log must
 hold a ``false`` verdict with the late call's stamps and a ``true`` one for
@@ -73,12 +74,17 @@ def live_log(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
             procs += [base, mover]
             _wait_for(tmp / "base.out", "ready", 60)
             _wait_for(tmp / "mover.out", "ready", 60)
-            monitor = _start(["-m", "rclverify.backends.monitors.service_proxy", "--contracts",
-                              str(EXAMPLE / "contracts" / "safety_stop.rcl"), "--interfaces",
-                              str(EXAMPLE / "interfaces"), "--forward", "/estop=/estop_real", "--log", str(log),
-                              "--duration", "60"], env, tmp / "monitor.out")
+            # the proxy inside the live monitor: one process, one log, one verdict topic
+            monitor = _start(["-m", "rclverify.cli", "monitor", "-w", str(EXAMPLE), "--live", "--interfaces",
+                              "interfaces", "--forward", "/estop=/estop_real", "--log", str(log),
+                              "--evidence", str(tmp / "live.json"), "--duration", "60"], env, tmp / "monitor.out")
             procs.append(monitor)
-            _wait_for(tmp / "monitor.out", "service_proxy: ready", 60)
+            _wait_for(tmp / "monitor.out", "monitoring ", 60)
+            # the deadline verdicts on the live monitor's verdict topic, as a subscriber sees them
+            echo = subprocess.Popen(["rostopic", "echo", "/rclverify/verdict"], env=env, stdout=(tmp / "echo.out").open("wb"),
+                                    stderr=subprocess.STDOUT, start_new_session=True)
+            procs.append(echo)
+            time.sleep(1.0)  # subscribed before the first call
             teleop = _start([str(NODES), "teleop", "--call", "/estop", "--count", "2", "--every", "0.3"],
                             env, tmp / "teleop.out")
             mission = _start([str(NODES), "mission", "--target", "2.0"], env, tmp / "mission.out")
@@ -91,8 +97,11 @@ def live_log(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
         finally:
             for p in reversed(procs):
                 _stop(p)
-    lines = [json.loads(x) for x in log.read_text().splitlines()]
-    return {"lines": lines, "code": code, "tmp": tmp}
+    # the proxy's lines ("kind": event, verdict, summary) among the live monitor's own
+    lines = [x for x in map(json.loads, log.read_text().splitlines()) if "kind" in x]
+    return {"lines": lines, "code": code, "tmp": tmp, "out": (tmp / "monitor.out").read_text(),
+            "echo": (tmp / "echo.out").read_text(errors="replace"),
+            "record": json.loads((tmp / "live.json").read_text())}
 
 
 def test_the_late_service_answer_is_false_with_the_calls_stamps(live_log: dict[str, Any]) -> None:
@@ -121,5 +130,11 @@ def test_the_action_feedback_arrives_in_time(live_log: dict[str, Any]) -> None:
     assert 0.4 <= v["answer"] - v["trigger_stamp"] <= 2.0
     topics = [x["topic"] for x in live_log["lines"] if x["kind"] == "event"]
     assert {"move/goal", "move/feedback", "move/result"} <= set(topics)
-    summary = live_log["lines"][-1]
-    assert summary["kind"] == "summary" and summary["false"] == 1
+    summary = [x for x in live_log["lines"] if x["kind"] == "summary"]
+    assert len(summary) == 1 and summary[0]["false"] == 1
+    # the command's evidence record and output carry the deadline verdicts too
+    assert live_log["record"]["deadlines"]["false"] == 1
+    assert [r["node"] for r in live_log["record"]["deadlines"]["results"]] == ["Teleop", "Base", "Mover"]
+    assert "deadlines: 1 call(s) or goal(s) missed their deadline" in live_log["out"]
+    published = live_log["echo"]
+    assert '\\"kind\\": \\"deadline\\"' in published and '\\"verdict\\": \\"false\\"' in published, published[-2000:]

@@ -211,14 +211,16 @@ def cmd_requirements(args: argparse.Namespace) -> int:
 
 def cmd_deadlines(args: argparse.Namespace) -> int:
     """Decide every requirement's end-to-end deadline (rule D3,
-    calculus/deadlines.py), write ``artifacts/deadlines.json`` and print
+    calculus/deadlines.py), write ``artifacts/deadlines/index.json`` (the
+    stage's sealed record, calculus/deadline_stage.py) and print
     each result; exit 1 when one is refuted or inconclusive."""
-    from .calculus.deadlines import PROVED, decide_plan, show
-    from .evidence.store import write_json
+    from .calculus.deadline_stage import stage_deadlines
+    from .calculus.deadlines import PROVED, show
+    from .pipeline import stage_check
     ws = _ws(args)
-    results = decide_plan(ws.plan, ws.checked, ws.model)
-    write_json(ws.root / "artifacts" / "deadlines.json", [r.to_json() for r in results])
-    sys.stdout.write(json.dumps([r.to_json() for r in results], indent=2) + "\n" if args.json else show(results))
+    stage_check(ws)  # the snapshots the record's inputs name
+    results, records = stage_deadlines(ws)
+    sys.stdout.write(json.dumps(records, indent=2) + "\n" if args.json else show(results))
     return 0 if all(r.status == PROVED for r in results) else 1
 
 
@@ -569,6 +571,11 @@ def main(argv: Sequence[str] | None = None) -> int:
     lv.add_argument("--live", action="store_true", help="monitor the running ROS 1 system (ROS_MASTER_URI) instead")
     lv.add_argument("--log", default="monitor_live.jsonl", help="JSON-lines log of events and verdicts to write")
     lv.add_argument("--evidence", help="write the monitoring evidence record (JSON) here when stopped")
+    lv.add_argument("--forward", action="append", default=[], metavar="SVC=REAL",
+                    help="serve SVC (a service a contract serves) and forward each call to REAL, checking its "
+                         "deadline (repeatable; docs/monitors.md, \"Services, actions and deadlines\")")
+    lv.add_argument("--interfaces", action="append", default=[], metavar="DIR",
+                    help="directory of <pkg>/srv and <pkg>/action files (workspace-relative; repeatable)")
     lv.add_argument("--duration", type=seconds, help="stop after this many seconds (default: at SIGINT/SIGTERM)")
     lv.add_argument("--reorder-window", type=seconds, default=0.05, help="seconds to wait for stamp ordering")
     lv.add_argument("--silence", type=seconds, default=10.0,

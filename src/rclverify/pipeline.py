@@ -17,6 +17,8 @@ Artifact layout (workspace-relative)::
     artifacts/obligations/<Node>.json    exported obligations of the node ({"obligations"}, sealed)
     artifacts/evidence/<obligation>.json one evidence record per obligation
     artifacts/requirements/<ID>.json     a requirement's Z3 check (proved/refuted/...)
+    artifacts/deadlines/index.json       the end-to-end deadlines decided by rule D3 (sealed),
+                                         each query as artifacts/deadlines/<ID>.smt2
 """
 from __future__ import annotations
 
@@ -202,6 +204,13 @@ def stage_requirements(ws: Workspace, *, force: bool = False) -> list[tuple[dict
     """Check every requirement with Z3; see :mod:`rclverify.requirements.stage`."""
     from .requirements.stage import stage_requirements as run
     return run(ws, force=force)
+
+
+def stage_deadlines(ws: Workspace) -> list[dict[str, Any]]:
+    """Decide every end-to-end deadline with Z3 (rule D3); see
+    :mod:`rclverify.calculus.deadline_stage`.  Returns the records written."""
+    from .calculus.deadline_stage import stage_deadlines as run
+    return run(ws)[1]
 
 
 def stage_report(ws: Workspace, parts: Sequence[str] = tuple(REPORT_PARTS),

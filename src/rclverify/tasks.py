@@ -16,6 +16,9 @@ Stages and their real file dependencies, per node ``N``:
 ``requirements``   plan + model + contract snapshots (+ Doorstop files) ->
                    artifacts/requirements/<ID>.json; inside, only requirements whose
                    cone's snapshots or statements changed are checked again
+``deadlines``      plan + model + snapshots of the nodes on a deadline's path ->
+                   artifacts/deadlines/index.json (rule D3, every end-to-end deadline;
+                   only when the plan has one)
 ``report:html``    every artifact above -> reports/assurance.{html,json}, the CI formats
                    reports/assurance.sarif, assurance.junit.xml, argument.svg
 ``report:text``    every artifact above -> reports/assurance.md, argument.{json,gsn.yaml,dot}
@@ -231,6 +234,19 @@ def act_requirements(root: str) -> Any:
     again = [rec["id"] for rec, now in rows if now]
     print(f"requirements: {len(again)} of {len(rows)} checked" + (f" ({', '.join(again[:10])}"
                                                                   + (", ..." if len(again) > 10 else "") + ")" if again else ""))
+    return None
+
+
+def act_deadlines(root: str) -> Any:
+    """Decide the end-to-end deadlines (rule D3, :mod:`rclverify.calculus.deadline_stage`)."""
+    from .pipeline import stage_deadlines
+    try:
+        records = stage_deadlines(_ws(root))
+    except RclError as exc:
+        return _fail(exc)
+    except OSError as exc:
+        return _io_fail(exc, root)
+    print("deadlines: " + ", ".join(f"{r['requirement']} {r['status']}" for r in records))
     return None
 
 
@@ -601,6 +617,16 @@ def _build_tasks(root: str | Path, plan_file: str) -> dict[str, Callable[[], Any
                 "file_dep": [str(rootp / plan_file), at(ws.MODEL)] + list(snap.values()) + extra,
                 "targets": [at(INDEX)], "uptodate": [code, sealed], "verbosity": 2, "clean": True}
 
+    deadline_nodes = list(index.deadline_nodes) if index is not None else []
+
+    def task_deadlines() -> dict[str, Any]:
+        """Decide each requirement's end-to-end deadline with Z3 (rule D3: deadlines add along its path)."""
+        from .calculus.deadline_stage import INDEX as DEADLINES
+        return {"actions": [(act_deadlines, [r])],
+                "file_dep": [str(rootp / plan_file), at(ws.MODEL)] + [snap[n] for n in deadline_nodes if n in snap],
+                "targets": [at(DEADLINES)], "uptodate": [code, sealed], "task_dep": ["check"], "verbosity": 2,
+                "clean": True}
+
     exported_memo: list[list[tuple[str, dict[str, Any]]]] = []
 
     def exported() -> list[tuple[str, dict[str, Any]]]:
@@ -668,6 +694,8 @@ def _build_tasks(root: str | Path, plan_file: str) -> dict[str, Callable[[], Any
         deps.append(at("artifacts/requirements/index.json"))  # the requirements task's target
         if ros_section:
             deps.append(at("artifacts/ros/grounding.json"))
+        if deadline_nodes:
+            deps.append(at("artifacts/deadlines/index.json"))  # the deadlines task's target
         for part, files in REPORT_PARTS.items():
             yield {"name": part, "doc": "reports/" + ", ".join(files), "actions": [(act_report, [r, part])],
                    "file_dep": deps, "uptodate": [code, sealed],
@@ -679,7 +707,7 @@ def _build_tasks(root: str | Path, plan_file: str) -> dict[str, Callable[[], Any
         """The whole pipeline: check, compose, health, export, run, report.  --strict fails on any open evidence."""
         # `requirements` (and `ground`) before `report`: reached only through the report's file dependencies,
         # they would make report:html wait and report:text run first (their fragment caches expect html first)
-        before = ["requirements"] + (["ground"] if ros_section else [])
+        before = ["requirements"] + (["deadlines"] if deadline_nodes else []) + (["ground"] if ros_section else [])
         return {"actions": [(act_verify, [r])], "task_dep": ["check", *before, "report"] if ok else ["check"],
                 "file_dep": [str(rootp / REPORTS[2])] if ok else [],
                 "params": [{"name": "strict", "long": "strict", "type": bool, "default": False,
@@ -692,4 +720,6 @@ def _build_tasks(root: str | Path, plan_file: str) -> dict[str, Callable[[], Any
                          "task_evidence": task_evidence, "task_report": task_report})
         if ros_section:
             creators["task_ground"] = task_ground
+        if deadline_nodes:
+            creators["task_deadlines"] = task_deadlines
     return creators

@@ -64,6 +64,9 @@ class TaskIndex:
     requirement_dirs: tuple[str, ...] = ()
     #: The plan's ``ros:`` section (docs/ros.md): what the ``ground`` task reads; empty: no such task.
     ros: dict[str, Any] = dataclasses.field(default_factory=dict)
+    #: The nodes on the paths of the plan's end-to-end deadlines (rule D3): their snapshots are the
+    #: inputs of the ``deadlines`` task; empty: the plan has no deadline and there is no such task.
+    deadline_nodes: tuple[str, ...] = ()
 
 
 @dataclass
@@ -113,7 +116,8 @@ class Workspace:
             contracts=tuple(plan.contracts), replacement={n: r[0].rpartition(":")[0] for n, r in plan.replacements.items()},
             entries={n: tuple(e.config for e in es) for n, es in plan.evidence.items()},
             requirement_dirs=tuple(d for d, _ in plan.requirements_from),
-            ros=dict(getattr(plan, "ros", None) or {}))
+            ros=dict(getattr(plan, "ros", None) or {}),
+            deadline_nodes=tuple(dict.fromkeys(n for d in plan.deadlines for n in d.path)))
 
     @cached_property
     def checked(self) -> Checked:

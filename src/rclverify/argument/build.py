@@ -23,6 +23,9 @@ whatever produced it.  Structure (docs/argument.md)::
                     goal per obligation without a record, or when no
                     obligation was exported at all
     G-<Node>.sc<k>  supported by the Z3 query's solution
+    G-<REQ>.deadline  a requirement's end-to-end deadline, under its goal
+                    (:mod:`.deadlines`: Z3's decision, the chain's timed
+                    guarantees, the monitors' evidence)
 
 Statuses then propagate upward (:func:`.model.propagate`): with the
 report's own roll-up rules this gives every requirement, guarantee and node
@@ -35,6 +38,7 @@ import hashlib
 import re
 from typing import Any, Mapping
 
+from .deadlines import own_check, with_deadline
 from .model import Argument, Element, propagate
 from ..report.textfmt import natural_key
 
@@ -239,7 +243,8 @@ def build_argument(report: Mapping[str, Any]) -> Argument:
     for r in reqs:
         rid = str(r["id"])
         if "verdict" in r:  # checked by Z3 (docs/requirements.md): entailment, or undeveloped
-            req_goals.append(_requirement_goal(b, r, guarantee_goal, sides, j_calc))
+            gid = _requirement_goal(b, own_check(r), guarantee_goal, sides, j_calc)
+            req_goals.append(with_deadline(b.els, gid, r, guarantee_goal))  # its end-to-end deadline (rule D3)
             continue
         kids: list[str] = []
         nodes_used: list[str] = []

@@ -67,11 +67,19 @@ class DeadlineResult:
     loc: ast.Loc = field(default_factory=ast.Loc, compare=False)
 
     def to_json(self) -> dict[str, Any]:
+        """The result as JSON: times exact (``within_s``, ``total_s``: a
+        fraction of seconds as text, ``"1/5"``) and as the reader writes them
+        (``within``, ``total``: ``"200 ms"``); each hop of ``chain`` with its
+        guarantee's location (``loc``: ``file:line:col``)."""
         return {"requirement": self.requirement, "path": list(self.path), "within_s": str(self.within),
                 "status": self.status, "reason": self.reason,
+                "within": _show(self.within),
                 "chain": [{"node": h.node, "guarantee": h.index, "trigger": f"in.{h.trigger}",
-                           "outputs": [f"out.{o}" for o in h.outputs], "within_s": str(h.bound)} for h in self.chain],
+                           "outputs": [f"out.{o}" for o in h.outputs], "within_s": str(h.bound),
+                           "within": _show(h.bound), "loc": f"{h.loc.file}:{h.loc.line}:{h.loc.col}"}
+                          for h in self.chain],
                 "total_s": None if self.total is None else str(self.total),
+                "total": None if self.total is None else _show(self.total),
                 "stamps": [{"event": e, "t_s": str(t)} for e, t in self.stamps],
                 "loc": f"{self.loc.file}:{self.loc.line}:{self.loc.col}"}
 
@@ -156,6 +164,10 @@ def _show(x: Fraction) -> str:
     if x < 1 and ms.denominator == 1:
         return f"{ms.numerator} ms"
     return f"{float(x):g} s" if x.denominator != 1 else f"{x.numerator} s"
+
+
+#: Seconds as the reader writes them (the report's name for :func:`_show`).
+show_seconds = _show
 
 
 def decide_plan(plan: Any, checked: Checked, model: SystemModel) -> list[DeadlineResult]:

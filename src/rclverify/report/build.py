@@ -291,6 +291,10 @@ def build_report(ws: Workspace) -> dict[str, Any]:
         requirements.append({"id": r.id, "text": r.text, "status": st, "support": support,
                              **requirement_check(current_record(r, checks.get(r.id)), st, g_status, sc_status)})
 
+    from .deadlines import deadline_rows, fold_into, strict_ok as deadlines_ok
+    deadlines = deadline_rows(ws, hashes, g_status, ob_rows)  # rule D3, rolled into each requirement
+    fold_into(requirements, deadlines)
+
     derived = []
     cones, cone_of = ConeEvidence(model.nodes, node_evidence, sc_status), model.upstream_masks()
     for n in checked.nodes:
@@ -349,7 +353,8 @@ def build_report(ws: Workspace) -> dict[str, Any]:
                  and all(g_status(name, k) == "discharged" for name, cn in checked.nodes.items()
                          for k in range(1, len(cn.node.guarantees) + 1))
                  # and every formal requirement met (docs/requirements.md, "--strict"); an informal one is listed only
-                 and all(rq["verdict"] in ("met", "informal") for rq in requirements))
+                 and all(rq["verdict"] in ("met", "informal") for rq in requirements)
+                 and deadlines_ok(deadlines))  # and every end-to-end deadline proved
     # grounding in the robot's software (docs/ros.md): findings never change a verdict,
     # but a grounding error fails --strict and is listed among the problems
     grounding = read_grounding(ws, "artifacts/ros/grounding.json") if getattr(plan, "ros", None) else None
@@ -375,7 +380,7 @@ def build_report(ws: Workspace) -> dict[str, Any]:
         "system": system, "requirements": requirements, "nodes": nodes, "side_conditions": side_conditions,
         "derived_properties": derived, "findings": findings, "obligations": ob_rows, "evidence": ev_rows,
         "environment_assumptions": env_assumptions, "pending": pending, "lint": lint_rows,
-        "expected_verdicts": expected, "grounding": grounding, "unverified": unverified,
+        "expected_verdicts": expected, "grounding": grounding, "unverified": unverified, "deadlines": deadlines,
     }
     # one diagnosis record per problem, with repairs checked by Z3 (docs/diagnosis.md)
     report["diagnoses"] = diagnose(ws, report)

@@ -27,7 +27,9 @@ nothing itself.  Layout (decisions in ``docs/ci.md``):
   proved from an inconsistency) is a ``<failure>`` with the counterexample
   node by node; outstanding evidence and inconclusive are ``<skipped>``
   (a ``<failure>`` when evidence the proof rests on failed), informal
-  ones ``<skipped>``.
+  ones ``<skipped>``;
+* when the plan has end-to-end deadlines, a ``deadlines`` ``<testsuite>``
+  with one ``<testcase>`` per deadline (:func:`.deadlines.junit_suite`).
 
 ``time`` is the recorded duration of the check in seconds (0 when the
 record has none).  The XML is built with :mod:`xml.etree.ElementTree`, so
@@ -88,8 +90,10 @@ def junit_tree(report: Mapping[str, Any]) -> ET.Element:
         for k, v in counts.items():
             totals[k] += v
         total_time += time
-    req = _requirements_suite(report)
-    if req is not None:
+    from .deadlines import junit_suite
+    for req in (_requirements_suite(report), junit_suite(report, _case, _outcome)):
+        if req is None:
+            continue
         root.append(req[0])
         for k, v in req[1].items():
             totals[k] += v
@@ -241,8 +245,10 @@ def render_junit(report: Mapping[str, Any], fragments: FragmentCache | None = No
         for k, v in piece["counts"].items():
             totals[k] += v
         total_time += piece["time"]
-    req = _requirements_suite(report)
-    if req is not None:
+    from .deadlines import junit_suite
+    for req in (_requirements_suite(report), junit_suite(report, _case, _outcome)):
+        if req is None:
+            continue
         ET.indent(req[0], level=1)
         texts.append(ET.tostring(req[0], encoding="unicode"))
         for k, v in req[1].items():

@@ -12,7 +12,10 @@ One ``result`` per item that needs attention:
 * a guarantee no obligation covers (``unverified``, rule
   ``RCL-GUARANTEE-UNVERIFIED``, at the guarantee);
 * a contract health finding whose status is ``problem`` or ``inconclusive``;
-* a lint warning.
+* a lint warning;
+* an end-to-end deadline that is not proved (``RCL-DEADLINE-REFUTED`` /
+  ``RCL-DEADLINE-INCONCLUSIVE`` at the plan's ``deadline:`` entry, the
+  chain in the message; :mod:`.deadlines`).
 
 Each result names a stable rule id per kind of finding (:data:`RULES`,
 :func:`lint_rule_id`), a level (``error``/``warning``/``note``), the RCL
@@ -339,10 +342,11 @@ def sarif_log(report: Mapping[str, Any]) -> dict[str, Any]:
     """
     lint, lint_rules = _lint_results(report)
     ground, ground_rules = _grounding_results(report)
+    from .deadlines import SARIF_RULES, sarif_results
     results = (_obligation_results(report) + _unverified_results(report) + _side_condition_results(report) + _finding_results(report) + lint + ground
-               + _requirement_results(report))
+               + _requirement_results(report) + sarif_results(report, _result))
     _attach_diagnoses(report, results)
-    rules: Sequence[Rule] = list(RULES.values()) + lint_rules + ground_rules
+    rules: Sequence[Rule] = list(RULES.values()) + [Rule(*r) for r in SARIF_RULES] + lint_rules + ground_rules
     index = {r.id: i for i, r in enumerate(rules)}
     for res in results:
         res["ruleIndex"] = index[res["ruleId"]]

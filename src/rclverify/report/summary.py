@@ -176,6 +176,8 @@ def strict_reasons(report: Mapping[str, Any]) -> list[str]:
     if rq:
         out.append(f"{len(rq)} formal requirement{'s are' if len(rq) != 1 else ' is'} not met ("
                    + ", ".join(rq[:4]) + (", ..." if len(rq) > 4 else "") + ")")
+    from .deadlines import strict_reason
+    out += strict_reason(report)  # end-to-end deadlines not proved
     g = _grounding(report.get("grounding"))
     if g and g["error"]:
         out.append(f"{g['error']} ROS grounding error{'s' if g['error'] != 1 else ''} (`rclverify ros check`)")

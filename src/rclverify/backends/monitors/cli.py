@@ -130,16 +130,24 @@ def live_command(args: argparse.Namespace, checked: Any, cfg: Any, root: Path) -
         verdict_topic=args.verdict_topic, last_prefix=args.verdict_topic.rsplit("/", 1)[0] or "/rclverify",
         node_name="rclverify_monitor", duration=args.duration, tick_s=0.02, status_s=args.status, stop=stop,
         evidence=Path(args.evidence) if args.evidence else None, out=lambda line: print(line, flush=True))
+    from .service_proxy import ProxyUsage, proxy_factory
     try:
+        proxy = proxy_factory(checked, nodes, getattr(args, "forward", []),
+                              [root / d for d in getattr(args, "interfaces", [])])
         if ros == "2":
+            if proxy is not None:
+                raise ProxyUsage("--forward and --interfaces need ROS 1 (the service proxy is a rospy node)")
             record = run_ros2(factory, checked, nodes, **common)
         else:
-            record = run_ros1(factory, checked, nodes, [root / d for d in cfg.msg_dirs], **common)
-    except (RosUnavailable, Ros2Unavailable) as exc:
+            record = run_ros1(factory, checked, nodes, [root / d for d in cfg.msg_dirs], **common, proxy=proxy)
+    except (RosUnavailable, Ros2Unavailable, ProxyUsage) as exc:
         print(f"rclverify monitor --live: error: {exc}", file=sys.stderr)
         return 2
     print(f"{log}: {record['events']} event(s), {record['verdicts']} verdict(s); sha256 {record['sha256']}")
-    return 1 if any(n["status"] == "failed" for n in record["nodes"]) else 0
+    if "deadlines" in record:
+        print(f"deadlines: {record['deadlines']['false']} call(s) or goal(s) missed their deadline")
+    late = bool(record.get("deadlines", {}).get("false"))
+    return 1 if late or any(n["status"] == "failed" for n in record["nodes"]) else 0
 
 
 def oracle_command(args: argparse.Namespace, checked: Checked) -> int:

@@ -123,6 +123,13 @@ class LiveRun:
                 self._flush_last()
                 self._log.flush()
 
+    def note(self, obj: Mapping[str, Any]) -> None:
+        """One more line of the log (the service proxy's events and deadline
+        verdicts, :mod:`.service_proxy`); dropped once the run stopped."""
+        with self.lock:
+            if self.results is None:
+                self._log.write(dumps(dict(obj)) + "\n")
+
     def _flush_last(self) -> None:
         """Publish each node's latest verdict (latched), once per timer tick
         rather than at every event: the topic holds the last one either way."""
@@ -190,7 +197,8 @@ def _no_delay(pub: Any) -> None:
 def run_ros1(run_factory: Callable[..., LiveRun], checked: Checked, nodes: list[CheckedNode],
              msg_dirs: list[Path], *, verdict_topic: str, last_prefix: str, node_name: str,
              duration: float | None, tick_s: float, status_s: float, evidence: Path | None,
-             stop: threading.Event, out: Callable[[str], None]) -> dict[str, Any]:
+             stop: threading.Event, out: Callable[[str], None],
+             proxy: Callable[[Any, LiveRun, Callable[[str], None]], Any] | None = None) -> dict[str, Any]:
     """Run live monitoring on a ROS 1 master (``ROS_MASTER_URI``) until ``stop``
     is set or ``duration`` seconds passed; returns the evidence record.
 
@@ -200,6 +208,12 @@ def run_ros1(run_factory: Callable[..., LiveRun], checked: Checked, nodes: list[
     ``std_msgs/String`` JSON on ``verdict_topic`` and each node's latest on
     ``<last_prefix>/<node>/last_verdict`` (latched).  Raises
     :class:`~.ros1.RosUnavailable` when rospy or a message class is missing.
+
+    ``proxy(rospy, live, publish)``, when given, starts the service proxy
+    and action subscriptions in this process (:mod:`.service_proxy`,
+    ``--forward``/``--interfaces``) and returns its run (``tick(now)``,
+    ``close()``): its events and deadline verdicts go to the same log and
+    verdict topic, its summary to the record's ``deadlines``.
     """
     from .ros1 import RosUnavailable, contract_topics, flatten, import_rospy, message_class
     rospy = import_rospy()
@@ -225,6 +239,7 @@ def run_ros1(run_factory: Callable[..., LiveRun], checked: Checked, nodes: list[
         lasts[n.name] = rospy.Publisher(f"{last_prefix}/{n.name}/last_verdict", String, queue_size=1, latch=True)
     live = run_factory(publish=lambda text: pub.publish(String(text)),
                               publish_last=lambda n, text: lasts[n].publish(String(text)))
+    calls = proxy(rospy, live, lambda text: pub.publish(String(text))) if proxy is not None else None
     decode_errors: dict[str, int] = {}
 
     def decode(topic: str, raw: Any) -> Mapping[str, Any] | None:
@@ -250,6 +265,8 @@ def run_ros1(run_factory: Callable[..., LiveRun], checked: Checked, nodes: list[
             if duration is not None and _time.monotonic() - t0 >= duration:
                 break
             stop.wait(min(0.1, tick_s * 5))
+            if calls is not None:
+                calls.tick(rospy.get_time())  # an unanswered call is false once its deadline expired
             if worker.error is not None:
                 break  # the engine thread died: stop and say so, never monitor on silently
             _no_delay(pub)
@@ -259,7 +276,10 @@ def run_ros1(run_factory: Callable[..., LiveRun], checked: Checked, nodes: list[
     finally:
         for s in subs:
             s.unregister()
+        deadlines = calls.close() if calls is not None else None  # before the log closes
         record = stop_and_record(worker, live, evidence, out)
+        if deadlines is not None:
+            record["deadlines"] = {"results": deadlines["results"], "false": deadlines["false"]}
         record["decode_errors"] = decode_errors
         if evidence is not None:
             atomic_write_text(evidence, json.dumps(record, indent=2, sort_keys=True) + "\n")

@@ -34,7 +34,7 @@ import tempfile
 import threading
 import time
 from pathlib import Path
-from typing import Any, Sequence
+from typing import Any, Callable, Mapping, Sequence
 
 from ...rcl.errors import RclError
 from ...rcl.typecheck import load
@@ -45,21 +45,34 @@ from .ros1_interfaces import action_classes, service_class
 
 
 class ProxyRun:
-    """The monitors and the log of one live run (thread-safe)."""
+    """The monitors and the log of one live run (thread-safe).
 
-    def __init__(self, monitors: list[DeadlineMonitor], log: Path) -> None:
+    ``log``: the JSON-lines file to write (this module's own command); or
+    ``write(obj)``, a sink for each line's object (``rclverify monitor
+    --live``: the live monitor's log) and ``publish(text)`` for each
+    deadline verdict as JSON text (its verdict topic)."""
+
+    def __init__(self, monitors: list[DeadlineMonitor], log: Path | None = None, *,
+                 write: Callable[[dict[str, Any]], None] | None = None,
+                 publish: Callable[[str], None] | None = None) -> None:
         self.monitors, self.lock, self.index, self.false = monitors, threading.Lock(), 0, 0
         for m in monitors:
             m.on_verdict = self._verdict
-        self.fh = log.open("w", encoding="utf-8")
+        self.fh = log.open("w", encoding="utf-8") if log is not None else None
+        self.sink, self.publish = write, publish
 
     def _write(self, obj: dict[str, Any]) -> None:
-        self.fh.write(json.dumps(obj, sort_keys=True) + "\n")
-        self.fh.flush()
+        if self.sink is not None:
+            self.sink(obj)
+        if self.fh is not None:
+            self.fh.write(json.dumps(obj, sort_keys=True) + "\n")
+            self.fh.flush()
 
     def _verdict(self, v: DeadlineVerdict) -> None:
         self.false += v.verdict == "false" and not v.update
         self._write({"kind": "verdict", **v.to_json()})
+        if self.publish is not None:
+            self.publish(json.dumps({"kind": "deadline", **v.to_json()}, sort_keys=True))
 
     def event(self, topic: str, fields: dict[str, Any], stamp: float) -> None:
         """One observed message; ``stamp`` (s) is set as its header stamp when it has none."""
@@ -83,7 +96,8 @@ class ProxyRun:
             results = [m.finish().to_json() for m in self.monitors]
             summary = {"kind": "summary", "results": results, "false": self.false}
             self._write(summary)
-            self.fh.close()
+            if self.fh is not None:
+                self.fh.close()
         return summary
 
 
@@ -100,35 +114,32 @@ def _parser() -> argparse.ArgumentParser:
     return p
 
 
-def main(argv: Sequence[str] | None = None) -> int:
-    """Run the proxy (module docstring); returns the exit code."""
-    args = _parser().parse_args(argv)
-    try:
-        checked = load(args.contracts)
-    except RclError as exc:
-        print(str(exc), file=sys.stderr)
-        return 2
-    forwards = dict(f.split("=", 1) for f in args.forward if "=" in f)
-    nodes = [n for n in checked.nodes.values() if any(c.deadline is not None for c in n.node.guarantees)]
-    dirs = [Path(d) for d in args.interfaces]
-    try:
-        rospy = import_rospy()
-        services = {lk.name: lk for n in nodes for lk in n.node.links if lk.kind == "service" and lk.role == "serves"}
-        actions = {lk.name: lk for n in nodes for lk in n.node.links if lk.kind == "action"}
-        missing = [s for s in services if "/" + s.lstrip("/") not in forwards]
-        if missing:
-            print(f"service_proxy: error: say where {', '.join(missing)} is served: --forward /{missing[0]}=/REAL",
-                  file=sys.stderr)
-            return 2
-        svc_classes = {s: service_class(lk.ros_type, dirs) for s, lk in services.items()}
-        gen = Path(tempfile.mkdtemp(prefix="rclverify-actions-"))
-        act_classes = {a: action_classes(lk.ros_type, dirs, gen) for a, lk in actions.items()}
-    except RosUnavailable as exc:
-        print(f"service_proxy: error: {exc}", file=sys.stderr)
-        return 2
-    run = ProxyRun([DeadlineMonitor(checked, n, {}) for n in nodes], Path(args.log))
-    rospy.init_node("rclverify_service_monitor", anonymous=True, disable_signals=True)
-    now = lambda: rospy.Time.now().to_sec()  # noqa: E731  (the one clock of the proxy)
+class ProxyUsage(ValueError):
+    """A live run that cannot start as asked (a served service without ``--forward``)."""
+
+
+def deadline_nodes(checked: Any) -> list[Any]:
+    """The checked nodes with a guarantee that has a deadline: what the proxy monitors."""
+    return [n for n in checked.nodes.values() if any(c.deadline is not None for c in n.node.guarantees)]
+
+
+def start_proxy(rospy: Any, checked: Any, forwards: Mapping[str, str], dirs: Sequence[Path], run: ProxyRun,
+                now: Callable[[], float]) -> list[Any]:
+    """Serve each monitored service (``forwards``: ``/svc`` -> the real
+    server's name) and subscribe to each linked action's actionlib topics,
+    feeding ``run``; ``rospy.init_node`` must have run.  Returns the rospy
+    handles (keep them for the run).  Raises :class:`ProxyUsage` for a
+    served service without a forward and :class:`~.ros1.RosUnavailable` when
+    a class cannot be made from the interface files."""
+    nodes = deadline_nodes(checked)
+    services = {lk.name: lk for n in nodes for lk in n.node.links if lk.kind == "service" and lk.role == "serves"}
+    actions = {lk.name: lk for n in nodes for lk in n.node.links if lk.kind == "action"}
+    missing = [s for s in services if "/" + s.lstrip("/") not in forwards]
+    if missing:
+        raise ProxyUsage(f"say where {', '.join(missing)} is served: --forward /{missing[0].lstrip('/')}=/REAL")
+    svc_classes = {s: service_class(lk.ros_type, list(dirs)) for s, lk in services.items()}
+    gen = Path(tempfile.mkdtemp(prefix="rclverify-actions-"))
+    act_classes = {a: action_classes(lk.ros_type, list(dirs), gen) for a, lk in actions.items()}
     keep: list[Any] = []
     for name, cls in svc_classes.items():
         real = forwards["/" + name.lstrip("/")]
@@ -152,6 +163,68 @@ def main(argv: Sequence[str] | None = None) -> int:
             topic = f"{name.lstrip('/')}/{part}"
             keep.append(rospy.Subscriber("/" + topic, cls,
                                          lambda msg, topic=topic: run.event(topic, flatten(msg), now())))
+    return keep
+
+
+def proxy_factory(checked: Any, nodes: Sequence[Any], forward: Sequence[str],
+                  dirs: Sequence[Path]) -> Callable[[Any, Any, Callable[[str], None]], ProxyRun] | None:
+    """The ``proxy`` argument of :func:`.live.run_ros1` for ``rclverify
+    monitor --live --forward SVC=REAL --interfaces DIR``: ``None`` when
+    neither option is given; else a function that starts the proxy for the
+    selected ``nodes`` with a deadline, writing to the live run's log
+    (``LiveRun.note``) and publishing each deadline verdict on its verdict
+    topic.  Raises :class:`ProxyUsage` for a malformed ``--forward``."""
+    if not forward and not dirs:
+        return None
+    forwards = parse_forwards(forward)
+    timed = {n.name for n in deadline_nodes(checked)}
+
+    def start(rospy: Any, live: Any, publish: Callable[[str], None]) -> ProxyRun:
+        run = ProxyRun([DeadlineMonitor(checked, n, {}) for n in nodes if n.name in timed], write=live.note,
+                       publish=publish)
+        run.handles = start_proxy(rospy, checked, forwards, dirs, run,  # type: ignore[attr-defined]
+                                  lambda: rospy.Time.now().to_sec())
+        return run
+    return start
+
+
+def parse_forwards(items: Sequence[str]) -> dict[str, str]:
+    """``["/estop=/estop_real"]`` -> ``{"/estop": "/estop_real"}``; raises
+    :class:`ProxyUsage` for an item without ``=``."""
+    out = {}
+    for f in items:
+        if "=" not in f:
+            raise ProxyUsage(f"--forward {f}: write SVC=REAL, e.g. --forward /estop=/estop_real")
+        a, b = f.split("=", 1)
+        out["/" + a.strip().lstrip("/")] = b.strip()
+    return out
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Run the proxy (module docstring); returns the exit code."""
+    args = _parser().parse_args(argv)
+    try:
+        checked = load(args.contracts)
+    except RclError as exc:
+        print(str(exc), file=sys.stderr)
+        return 2
+    dirs = [Path(d) for d in args.interfaces]
+    try:
+        forwards = parse_forwards(args.forward)
+        rospy = import_rospy()
+    except (ProxyUsage, RosUnavailable) as exc:
+        print(f"service_proxy: error: {exc}", file=sys.stderr)
+        return 2
+    run = ProxyRun([DeadlineMonitor(checked, n, {}) for n in deadline_nodes(checked)], Path(args.log))
+    rospy.init_node("rclverify_service_monitor", anonymous=True, disable_signals=True)
+    now = lambda: rospy.Time.now().to_sec()  # noqa: E731  (the one clock of the proxy)
+    try:
+        keep = start_proxy(rospy, checked, forwards, dirs, run, now)  # noqa: F841  (kept for the run)
+    except (ProxyUsage, RosUnavailable) as exc:
+        print(f"service_proxy: error: {exc}", file=sys.stderr)
+        run.close()
+        rospy.signal_shutdown("usage")
+        return 2
     stop = threading.Event()
     for sig in (signal.SIGINT, signal.SIGTERM):
         signal.signal(sig, lambda *_: stop.set())

@@ -1,0 +1,247 @@
+"""End-to-end deadlines in the report (rule D3; docs/requirements.md,
+"End-to-end deadlines"; docs/reading-the-report.md).
+
+The ``deadlines`` stage (:mod:`rclverify.calculus.deadline_stage`) decides
+each requirement's ``deadline:`` with Z3.  Here its sealed record becomes
+one row per deadline of the current plan (:func:`deadline_rows`):
+
+* ``verdict``: ``proved`` / ``refuted`` / ``inconclusive`` as decided;
+  ``status``: a refuted one ``failed``, a proved one the worst evidence
+  status of its chain's guarantees (``discharged`` only when all are:
+  proved from premises not yet established is no green tick);
+  ``pending`` before the stage ran (or when the record is about another
+  path or bound than the plan's now); ``stale`` when made from another
+  text of the contracts or plan; ``error`` when its seal does not hold
+  (never what it claims);
+* ``chain``: the hops node by node, each guarantee's deadline, location,
+  evidence status and the deadline verdicts the monitors recorded for its
+  node (``true`` / ``currently_false`` / ``false`` counts, the first
+  ``false`` with its stamps);
+* ``total`` (the sum), ``within`` (the requirement's bound), ``reason``
+  (the chain named), ``stamps`` (a late run, for a refuted one), ``smt2``.
+
+:func:`fold_into` rolls a row into its requirement: a requirement whose
+deadline is refuted is ``refuted`` (status ``failed``), never met; a met
+one whose deadline is proved from a chain with outstanding evidence is
+``proved, evidence outstanding``; one
+whose deadline is not decided (inconclusive, pending) is at best
+``inconclusive``; stale and error carry over.  A proved deadline leaves
+the requirement's own verdict (an informal requirement stays informal:
+its text is not checked).  ``--strict`` fails unless every deadline is
+proved (:func:`strict_ok`, :func:`strict_reason`).  SARIF
+(``RCL-DEADLINE-REFUTED``, ``RCL-DEADLINE-INCONCLUSIVE``) and JUnit (a
+``deadlines`` test suite) are laid out here too.
+"""
+from __future__ import annotations
+
+import xml.etree.ElementTree as ET
+from typing import Any, Callable, Mapping, Sequence
+
+from ..evidence.records import worst
+from ..workspace import Workspace
+
+#: A deadline verdict as an evidence status (the report's badges and roll-up).
+STATUS_OF = {"proved": "discharged", "refuted": "failed", "inconclusive": "inconclusive", "pending": "pending",
+             "stale": "stale", "error": "error"}
+#: Requirement verdicts a deadline that is not proved never improves.
+_WORSE = ("refuted", "proved from an inconsistency", "proved vacuously", "error")
+
+
+def _spec_of(rec: Mapping[str, Any], spec: Any) -> bool:
+    """Whether the record ``rec`` was decided for the plan's ``spec`` (same path and bound)."""
+    from fractions import Fraction
+    try:
+        within = Fraction(str(rec.get("within_s")))
+    except (ValueError, ZeroDivisionError):
+        return False
+    return list(rec.get("path") or []) == list(spec.path) and within == spec.within
+
+
+def deadline_rows(ws: Workspace, current: Mapping[str, str], g_status: Callable[[str, int], str],
+                  ob_rows: Sequence[Mapping[str, Any]]) -> list[dict[str, Any]]:
+    """One row per ``deadline:`` of ``ws``'s plan, in plan order (module
+    docstring).  ``current``: path -> sha256 of the current snapshots and
+    model (:func:`rclverify.workspace.current_snapshot_hashes`);
+    ``g_status(node, k)``: a guarantee's evidence status; ``ob_rows``: the
+    report's obligation rows (``id``, ``node``, ``backend``, ``status``).
+    Returns ``[]`` for a plan without deadlines."""
+    from ..calculus.deadline_stage import INDEX, read_deadlines
+    from ..calculus.deadlines import show_seconds as _show
+    specs = list(ws.plan.deadlines)
+    if not specs:
+        return []
+    records, why = read_deadlines(ws, current)
+    by_req = {str(r.get("requirement")): r for r in records or []}
+    monitors = _monitor_verdicts(ws, ob_rows, {n for s in specs for n in s.path})
+    rows = []
+    for spec in specs:
+        base = {"requirement": spec.requirement, "path": list(spec.path), "within": _show(spec.within),
+                "source": f"{spec.loc.file}:{spec.loc.line}:{spec.loc.col}", "chain": [], "total": None,
+                "stamps": [], "smt2": ""}
+        rec = by_req.get(spec.requirement)
+        if why:
+            rows.append({**base, "verdict": "error", "reason": f"error: {why}; the recorded verdict is not shown"})
+            continue
+        if rec is None or not _spec_of(rec, spec):
+            rows.append({**base, "verdict": "pending",
+                         "reason": f"not decided yet for this path and bound ({INDEX}): run `doit verify`"})
+            continue
+        chain = [{**h, "status": g_status(str(h["node"]), int(h["guarantee"])),
+                  "monitors": monitors.get(str(h["node"]), [])} for h in rec.get("chain") or []]
+        verdict = str(rec.get("status"))
+        reason = str(rec.get("reason", ""))
+        if verdict == "stale":
+            reason = f"STALE: {reason}; recorded verdict {rec.get('recorded_status')}"
+        rows.append({**base, "verdict": verdict if verdict in STATUS_OF else "error", "reason": reason,
+                     "chain": chain, "total": rec.get("total"), "stamps": list(rec.get("stamps") or []),
+                     "smt2": str(rec.get("smt2") or "")})
+    for row in rows:
+        # the timed guarantees the decision rests on: their evidence (the monitors check the stamps)
+        row["evidence_status"] = worst([h["status"] for h in row["chain"]], empty="pending")
+        # proved is a green tick only when every hop's guarantee is discharged (as a requirement's "met")
+        row["status"] = row["evidence_status"] if row["verdict"] == "proved" else STATUS_OF[row["verdict"]]
+    return rows
+
+
+def _monitor_verdicts(ws: Workspace, ob_rows: Sequence[Mapping[str, Any]],
+                      nodes: set[str]) -> dict[str, list[dict[str, Any]]]:
+    """node -> the deadline verdicts of its monitors' evidence records
+    (``details["deadlines"]``, backends/monitors/deadlines.py):
+    ``[{"obligation", "status", "counts", "first_false"}]``."""
+    from ..evidence.store import EvidenceStore
+    store = EvidenceStore(ws.root)
+    out: dict[str, list[dict[str, Any]]] = {}
+    for o in ob_rows:
+        if o["backend"] != "monitors" or o["node"] not in nodes:
+            continue
+        ev, problem = store.read(str(o["id"]))
+        d = ev.details.get("deadlines") if ev is not None and not problem and isinstance(ev.details, dict) else None
+        if isinstance(d, dict):
+            out.setdefault(str(o["node"]), []).append({"obligation": o["id"], "status": o["status"],
+                                                       "counts": dict(d.get("counts") or {}),
+                                                       "first_false": d.get("first_false")})
+    return out
+
+
+def fold_into(requirements: list[dict[str, Any]], rows: Sequence[Mapping[str, Any]]) -> None:
+    """Roll each deadline row into its requirement row (module docstring):
+    sets the requirement's ``deadline`` (the row) and, unless the deadline is
+    proved, its ``verdict``, ``status`` and ``note``."""
+    by_req = {str(r["requirement"]): r for r in rows}
+    for rq in requirements:
+        row = by_req.get(str(rq["id"]))
+        if row is None:
+            continue
+        rq["deadline"] = row
+        # the requirement as its own check left it: its own argument is built from it (argument/deadlines.py)
+        rq["without_deadline"] = {k: rq.get(k) for k in ("verdict", "status", "note")}
+        v, st = row["verdict"], row["status"]
+        if v == "proved":
+            if st != "discharged":  # the chain's evidence is outstanding: not met yet
+                if rq.get("verdict") == "met":
+                    rq["verdict"] = "proved, evidence outstanding"
+                rq["status"] = worst([str(rq.get("status", "pending")), st])
+                rq["note"] = (f"end-to-end deadline proved, evidence of its chain {st}"
+                              + (f"; {rq['note']}" if rq.get("note") else ""))
+            continue
+        said = f"end-to-end deadline {row['within']} along {' -> '.join(row['path'])} {v}: {row['reason']}"
+        old = rq.get("verdict")
+        note = str(rq.get("note") or "")
+        if v == "refuted" and old != "error":
+            rq["verdict"] = "refuted"
+        elif v in ("stale", "error") and old not in _WORSE:
+            rq["verdict"] = v
+        elif v in ("inconclusive", "pending") and old not in _WORSE and old != "stale":
+            rq["verdict"] = "inconclusive"
+        rq["status"] = worst([str(rq.get("status", "pending")), st])
+        rq["note"] = said + (f"; {note}" if note and old != "informal" else "")
+
+
+def strict_ok(rows: Sequence[Mapping[str, Any]]) -> bool:
+    """``--strict`` holds for the deadlines: every one is proved."""
+    return all(r["verdict"] == "proved" for r in rows)
+
+
+def strict_reason(report: Mapping[str, Any]) -> list[str]:
+    """The clause ``verify --strict`` names for deadlines that are not
+    proved (``[]`` when every one is): "1 end-to-end deadline is refuted
+    (STOP)"."""
+    bad = [r for r in report.get("deadlines") or () if r["verdict"] != "proved"]
+    if not bad:
+        return []
+    verdicts = sorted({str(r["verdict"]) for r in bad})
+    return [f"{len(bad)} end-to-end deadline{'s are' if len(bad) != 1 else ' is'} {' or '.join(verdicts)} ("
+            + ", ".join(str(r["requirement"]) for r in bad[:4]) + (", ..." if len(bad) > 4 else "") + ")"]
+
+
+def _chain_text(row: Mapping[str, Any]) -> str:
+    return " -> ".join(f"{h['node']} guarantee {h['guarantee']} ({h['trigger']} -> {', '.join(h['outputs'])} "
+                       f"within {h['within']}, {h['loc']})" for h in row["chain"]) or "no chain"
+
+
+#: SARIF rules of the deadlines (``id``, ``name``, ``level``, ``text``), listed by report/sarif.py.
+SARIF_RULES = (
+    ("RCL-DEADLINE-REFUTED", "DeadlineRefuted", "error",
+     "A requirement's end-to-end deadline is refuted: the deadlines of the timed guarantees along its path sum "
+     "past its bound (rule D3); the chain is named."),
+    ("RCL-DEADLINE-INCONCLUSIVE", "DeadlineInconclusive", "warning",
+     "A requirement's end-to-end deadline is not decided: no chain of timed guarantees along its path, not "
+     "decided yet, made from other inputs (stale) or its record altered."),
+)
+
+
+def sarif_results(report: Mapping[str, Any], result: Callable[..., dict[str, Any]]) -> list[dict[str, Any]]:
+    """One SARIF result per deadline that is not proved, at the plan's
+    ``deadline:`` entry; ``result(rule, level, text, where, key, props)``
+    is report/sarif.py's result maker."""
+    out = []
+    for r in report.get("deadlines") or ():
+        if r["verdict"] == "proved":
+            continue
+        rule, level = (("RCL-DEADLINE-REFUTED", "error") if r["verdict"] == "refuted"
+                       else ("RCL-DEADLINE-INCONCLUSIVE", "warning"))
+        words = [f"End-to-end deadline of {r['requirement']} ({r['within']} along {' -> '.join(r['path'])}) is "
+                 f"{r['verdict']}: {r['reason']}."]
+        if r["chain"]:
+            words.append(f"Chain: {_chain_text(r)}; sum {r['total']}.")
+        if r["stamps"]:
+            words.append("A late run: " + ", ".join(f"{s['event']} at t0 + {float_text(s['t_s'])} s"
+                                                   for s in r["stamps"]) + ".")
+        props = {"requirement": r["requirement"], "verdict": r["verdict"], "within": r["within"],
+                 "total": r["total"], "chain": [f"{h['node']}.g{h['guarantee']}" for h in r["chain"]]}
+        out.append(result(rule, level, " ".join(words), r["source"], f"deadline:{r['requirement']}", props))
+    return out
+
+
+def float_text(fraction: Any) -> str:
+    """An exact fraction of seconds as text (``"1/4"``) in decimal (``0.25``)."""
+    from fractions import Fraction
+    try:
+        return f"{float(Fraction(str(fraction))):g}"
+    except (ValueError, ZeroDivisionError):
+        return str(fraction)
+
+
+def junit_suite(report: Mapping[str, Any], case: Callable[..., ET.Element],
+                outcome: Callable[..., str]) -> tuple[ET.Element, dict[str, int], float] | None:
+    """The ``deadlines`` ``<testsuite>``: one ``<testcase>`` per deadline
+    (``classname`` ``deadline``, name the requirement id, at the plan's
+    entry), passing only when proved; ``case`` and ``outcome`` are
+    report/junit.py's.  ``None`` without deadlines."""
+    rows = report.get("deadlines") or []
+    if not rows:
+        return None
+    suite = ET.Element("testsuite", {"name": "deadlines"})
+    counts = {"tests": 0, "failures": 0, "errors": 0, "skipped": 0}
+    for r in rows:
+        c = case(suite, "deadline", str(r["requirement"]), str(r["source"]), 0.0)
+        counts["tests"] += 1
+        bumped = outcome(c, str(r["status"]), f"{r['verdict']}: {r['reason']}",
+                         "\n".join([f"deadline {r['within']} along {' -> '.join(r['path'])}",
+                                    f"chain: {_chain_text(r)}", f"sum: {r['total']}", f"verdict: {r['verdict']}"]))
+        if bumped:
+            counts[bumped] += 1
+    for k, v in counts.items():
+        suite.set(k, str(v))
+    suite.set("time", "0.000")
+    return suite, counts, 0.0
