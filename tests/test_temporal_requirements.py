@@ -139,3 +139,24 @@ def test_a_state_variable_outside_a_temporal_operator_is_an_error(tmp_path: Path
     with pytest.raises(PlanError) as e:
         Workspace(ws).checked
     assert "under a temporal operator" in str(e.value.diagnostics[0])
+
+
+def test_report_and_sarif_show_the_refuted_trace(loop) -> None:
+    from rclverify.report.build import build_report
+    from rclverify.report.render import render_html, render_markdown
+    from rclverify.report.sarif import sarif_log
+    ws, _ = loop
+    w = Workspace(ws)
+    stage_check(w)
+    stage_requirements(w)  # the plan as the fixture wrote it (another test edits and restores it)
+    report = build_report(w)
+    sarif = sarif_log(report)
+    res = next(r for r in sarif["runs"][0]["results"] if r.get("properties", {}).get("requirement") == "T2")
+    msg = res["message"]["text"]
+    assert "Temporal check: refuted by bmc, 7 steps checked" in msg and "step 7: Inc (in.a = " in msg
+    loc = res["locations"][0]["physicalLocation"]
+    assert loc["artifactLocation"]["uri"] == "contracts/plan.yaml" and loc["region"]["startLine"] == 8
+    md = render_markdown(report)
+    assert "temporal check: proved by k-induction, k = 1" in md and "| 7 | Inc | " in md
+    html = render_html(report)
+    assert '<table class="trace">' in html

@@ -35,7 +35,7 @@ from typing import Any, Callable
 
 import z3
 
-from ..plan.formal import Formal
+from ..plan.formal import Formal, parse_formal
 from ..plan.load import Plan, Requirement
 from ..plan.state import state_types
 from ..plan.temporal import Temporal, operands, parse_temporal
@@ -159,13 +159,13 @@ def check_temporal(req: Requirement, checked: Checked, model: SystemModel, plan:
     requirement.  Raises :class:`RclError` for a statement that does not
     check; never raises on solver trouble."""
     from ..logic.encode import Encoder
-    from .check import assuming_of, cone_of
     t0 = time.perf_counter()
     t = statement(req, checked, plan)
     shape(t, req.formal.loc if req.formal else req.loc)
-    assuming = assuming_of(req, checked)
+    assuming = [parse_formal(a, checked, f"{req.id} assuming") for a in req.assuming]
     ops = operands(t)
-    cone = cone_of([*ops, *assuming], model)
+    want = {u for f in (*ops, *assuming) for n in f.nodes for u in (model.upstream(n) or [n])}
+    cone = [n for n in model.nodes if n in want]  # as requirements/check.cone_of
     sys = build_system(cone, checked, model, plan)
     enc = Encoder(checked.env)
 
