@@ -49,7 +49,7 @@ from .transition import ComposedSystem, build_system
 #: The bound of BMC for an unbounded ``eventually`` and of k-induction's k.
 DEFAULT_BOUND = 10
 #: Each Z3 query's budget (ms): an unknown is inconclusive, never upgraded.
-TIMEOUT_MS = 5_000
+TIMEOUT_MS = 2_000
 
 
 def shape(t: Temporal | Formal, loc: Any) -> str:
