@@ -160,3 +160,11 @@ def test_report_and_sarif_show_the_refuted_trace(loop) -> None:
     assert "temporal check: proved by k-induction, k = 1" in md and "| 7 | Inc | " in md
     html = render_html(report)
     assert '<table class="trace">' in html
+
+
+def test_an_undecided_nesting_is_a_located_error(tmp_path: Path) -> None:
+    ws = _ws(tmp_path, ["eventually always Inc.state.n <= 10"])
+    with pytest.raises(PlanError) as e:
+        Workspace(ws).checked
+    d = str(e.value.diagnostics[0])
+    assert d.startswith("contracts/plan.yaml:5:14: error") and "not decided" in d

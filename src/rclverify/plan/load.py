@@ -215,7 +215,7 @@ def check_formal(reqs: tuple[Requirement, ...], checked: Checked, states: tuple[
     ``states`` the plan's declared state variables, :mod:`.state`)."""
     from .formal import parse_formal
     from .state import state_types
-    from .temporal import parse_temporal
+    from .temporal import Temporal, parse_temporal, shape
     stypes = state_types(tuple(states), checked)
     diags: list[Diagnostic] = []
     seen: dict[str, Requirement] = {}
@@ -227,7 +227,9 @@ def check_formal(reqs: tuple[Requirement, ...], checked: Checked, states: tuple[
         seen.setdefault(r.id, r)
         if r.formal:
             try:
-                parse_temporal(r.formal, checked, f"{r.id} formal", stypes)
+                t = parse_temporal(r.formal, checked, f"{r.id} formal", stypes)
+                if isinstance(t, Temporal):
+                    shape(t, r.formal.loc)  # a nesting that is not decided: a located E-temporal error
             except RclError as exc:
                 diags.extend(exc.diagnostics)
         for src, what in [(a, f"{r.id} assuming") for a in r.assuming]:

@@ -22,7 +22,7 @@ from __future__ import annotations
 
 import re
 from dataclasses import dataclass
-from typing import Mapping
+from typing import Any, Mapping
 
 from ..rcl.errors import RclError, error
 from ..rcl.types import Checked, Type
@@ -123,3 +123,20 @@ def _parse(src: Source, start: int, end: int, checked: Checked, what: str,
     if start == 0 and end == len(text):
         return parse_formal(src, checked, what, states)
     return parse_formal(Source(_blank(text, start, end), src.line, src.col, src.file), checked, what, states)
+
+
+def shape(t: Temporal | Formal, loc: Any) -> str:
+    """The decided shape of a statement (module table): ``always``,
+    ``always next``, ``eventually``, ``next``, ``until``; raises
+    :class:`RclError` (``E-temporal`` at ``loc``) for another nesting."""
+    if isinstance(t, Temporal):
+        a = t.args[0]
+        if t.op in ("always", "eventually", "next") and isinstance(a, Formal):
+            return t.op
+        if t.op == "always" and isinstance(a, Temporal) and a.op == "next" and isinstance(a.args[0], Formal):
+            return "always next"
+        if t.op == "until" and all(isinstance(x, Formal) for x in t.args):
+            return "until"
+    raise RclError([error(loc, "this nesting of temporal operators is not decided; write always F, always next F, "
+                               "eventually F, eventually[<= N] F, next F or F until G with F, G state formulas "
+                               "(docs/requirements.md, Temporal requirements)", "E-temporal")])

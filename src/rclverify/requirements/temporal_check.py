@@ -38,8 +38,7 @@ import z3
 from ..plan.formal import Formal, parse_formal
 from ..plan.load import Plan, Requirement
 from ..plan.state import state_types
-from ..plan.temporal import Temporal, operands, parse_temporal
-from ..rcl.errors import RclError, error
+from ..plan.temporal import Temporal, operands, parse_temporal, shape
 from ..rcl.types import Checked
 from ..system.model import SystemModel
 from .temporal import (TemporalVerdict, TransitionSystem, check_always, check_eventually,
@@ -50,23 +49,6 @@ from .transition import ComposedSystem, build_system
 DEFAULT_BOUND = 10
 #: Each Z3 query's budget (ms): an unknown is inconclusive, never upgraded.
 TIMEOUT_MS = 2_000
-
-
-def shape(t: Temporal | Formal, loc: Any) -> str:
-    """The decided shape of a statement (module table): ``always``,
-    ``always next``, ``eventually``, ``next``, ``until``; raises
-    :class:`RclError` (``E-temporal`` at ``loc``) for another nesting."""
-    if isinstance(t, Temporal):
-        a = t.args[0]
-        if t.op in ("always", "eventually", "next") and isinstance(a, Formal):
-            return t.op
-        if t.op == "always" and isinstance(a, Temporal) and a.op == "next" and isinstance(a.args[0], Formal):
-            return "always next"
-        if t.op == "until" and all(isinstance(x, Formal) for x in t.args):
-            return "until"
-    raise RclError([error(loc, "this nesting of temporal operators is not decided; write always F, always next F, "
-                               "eventually F, eventually[<= N] F, next F or F until G with F, G state formulas "
-                               "(docs/requirements.md, Temporal requirements)", "E-temporal")])
 
 
 def is_temporal(req: Requirement, checked: Checked, plan: Plan) -> bool:
