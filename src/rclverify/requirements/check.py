@@ -34,6 +34,11 @@ One labelled satisfiability query of ``premises and not R`` decides it:
                   to prevent it are those of the cone that constrain a variable
                   ``R`` mentions, the traced ones first.
 ``inconclusive``  unknown (budget, quantifiers): never proved.
+
+A statement with a temporal operator (``always``, ``eventually``, ...) is
+decided over the runs of the composed contracts instead: the check
+dispatches to :mod:`.temporal_check`, whose record has the same fields plus
+``temporal`` (docs/requirements.md, "Temporal requirements").
 """
 from __future__ import annotations
 
