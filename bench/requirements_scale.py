@@ -56,7 +56,7 @@ def node_text(c: int, k: int) -> str:
             f"  guarantee( in.{x} <= 50 -> out.{y} <= in.{x} )\n}}\n")
 
 
-def write_workspace(root: Path, chains: int, depth: int) -> None:
+def write_workspace(root: Path, chains: int, depth: int, temporal: bool = False) -> None:
     (root / "contracts").mkdir(parents=True)
     files, reqs = [], []
     for c in range(chains):
@@ -64,6 +64,14 @@ def write_workspace(root: Path, chains: int, depth: int) -> None:
         (root / rel).write_text("".join(node_text(c, k) for k in range(depth)))
         files.append(rel)
         last = depth - 1
+        if temporal:  # a cone of 5..10 nodes: the chain up to node k; proved by 1-induction from node k's guarantee 1
+            # (not `always out <= 100`: a first input outside the assumption leaves the first output free)
+            k = min(last, 4 + c % 6)
+            x = f"c{c}_{k - 1}" if k else f"c{c}_e"
+            reqs.append(f"  - id: T{c}\n    text: node {k} of chain {c} always answers a valid reading in range\n"
+                        f"    formal: \"always (0 <= C{c}N{k}.in.{x} and C{c}N{k}.in.{x} <= 100 -> "
+                        f"C{c}N{k}.out.c{c}_{k} <= 100)\"\n")
+            continue
         reqs.append(f"  - id: R{c}\n    text: chain {c} never raises a low reading\n"
                     f"    formal: \"C{c}N0.in.c{c}_e <= 50 -> C{c}N{last}.out.c{c}_{last} <= C{c}N0.in.c{c}_e\"\n")
     (root / "contracts/plan.yaml").write_text("name: requirements-scale\ncontracts:\n"
@@ -87,13 +95,15 @@ def main() -> int:
     ap.add_argument("--chains", type=int, default=100)
     ap.add_argument("--depth", type=int, default=10)
     ap.add_argument("--keep", help="write the workspace here and keep it")
+    ap.add_argument("--temporal", action="store_true",
+                    help="temporal requirements instead (always ..., a cone of 5-10 nodes each; docs/requirements.md)")
     a = ap.parse_args()
     root = Path(a.keep) if a.keep else Path(tempfile.mkdtemp(prefix="reqscale-")) / "ws"
     if root.exists():
         shutil.rmtree(root)
-    write_workspace(root, a.chains, a.depth)
+    write_workspace(root, a.chains, a.depth, a.temporal)
     n = a.chains * a.depth
-    print(f"{n} nodes, {a.chains} formal requirements over chains of depth {a.depth}")
+    print(f"{n} nodes, {a.chains} {'temporal' if a.temporal else 'formal'} requirements over chains of depth {a.depth}")
 
     ws = Workspace(root)
     _, s, c = timed(lambda: stage_check(ws))
@@ -102,6 +112,8 @@ def main() -> int:
     verdicts: dict[str, int] = {}
     for rec, _ in rows:
         key = rec["verdict"] + (f"/{rec.get('consistency')}/{rec.get('vacuity')}" if rec["verdict"] == "proved" else "")
+        if rec.get("temporal"):
+            key = f"{rec['verdict']}/{rec['temporal']['method']}/k={rec['temporal']['k']}"
         verdicts[key] = verdicts.get(key, 0) + 1
     print(f"cold: {sum(now for _, now in rows):4d} checked   {s:7.2f} s  ({c:.2f} CPU s)  verdicts {verdicts}")
     rows, s, c = timed(lambda: stage_requirements(Workspace(root)))

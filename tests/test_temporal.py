@@ -92,7 +92,8 @@ def test_unbounded_eventually_never_reached_is_not_proved():
     ts = TransitionSystem({"x": I}, lambda s: s["x"] == 0,
                           lambda s, t: t["x"] == s["x"])
     v = check_eventually(ts, lambda s: s["x"] == 1, ranking=lambda s: s["x"], bound=3)
-    assert v.status == "inconclusive"
+    # x stays 0: the run s0 -> s1 == s0 repeats forever, a lasso (a counterexample to liveness)
+    assert (v.status, v.method, v.loop) == ("refuted", "lasso", 0)
 
 
 # --- the statement layer over RCL formulas (plan/temporal.py) ---------------

@@ -88,7 +88,8 @@ def _requirement_goal(b: "_Builder", r: Mapping[str, Any], guarantee_goal: Mappi
                              undeveloped=True, ref=rid))
     sn = b.add(Element(ident("Sn", "req", rid), "solution",
                        _clip(f"Z3 {('proof' if r['verdict'] in ('met', 'proved, evidence outstanding') else 'check')} "
-                             f"of {rid} ({c.get('smt2') or 'not checked yet'}): {r['verdict']}. {r['note']}"),
+                             f"of {rid} ({c.get('smt2') or _temporal_what(c) or 'not checked yet'}): {r['verdict']}. "
+                             f"{r['note']}"),
                        status=_PROOF_STATUS.get(str(r["verdict"]), "pending"), ref=rid, url=str(c.get("smt2") or "")))
     kids = [sn]
     nodes_used: list[str] = []
@@ -276,3 +277,12 @@ def build_argument(report: Mapping[str, Any]) -> Argument:
     b.els = {top: Element(top, "goal", f"The system {meta['workspace']} meets its requirements ({ids})",
                           supported_by=(s_reqs, s_contracts), in_context_of=top_ctx), **b.els}
     return propagate(Argument(top, b.els))
+
+
+def _temporal_what(c: Mapping[str, Any]) -> str:
+    """How a temporal requirement was decided (requirements/temporal_check.py), for its solution's text."""
+    t = c.get("temporal")
+    if not isinstance(t, Mapping):
+        return ""
+    steps = "no step checked" if t.get("bound") is None else f"{t['bound']} steps checked"
+    return f"temporal, {t.get('method')}, {steps}"

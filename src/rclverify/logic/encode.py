@@ -411,6 +411,8 @@ class _Ctx:
         fn = self.var(f, b)
         if isinstance(fn, z3.FuncDeclRef):
             return fn(*[widen(a, fn.domain(k)) for k, a in enumerate(args)])
+        if z3.is_array(fn):  # a function-typed variable given as an array (a step of requirements/transition.py)
+            return z3.Select(fn, *[widen(a, fn.sort().domain_n(k)) for k, a in enumerate(args)])
         raise EncodingError(x.loc, f"{f.qualified} cannot be applied")
 
     def e_Unary(self, x: ast.Unary, b: Mapping[str, Any]) -> Any:

@@ -33,7 +33,7 @@ from ..rcl.errors import RclError, error
 from ..rcl.types import BOOL, Checked, CheckedNode, Type
 
 #: ``Node.in.x`` / ``Node.out.y`` (primes allowed, as in RCL names).
-QUALIFIED = re.compile(r"(?<![A-Za-z0-9_.'])([A-Za-z_][A-Za-z0-9_]*)\.(in|out)\.([A-Za-z_][A-Za-z0-9_]*'*)")
+QUALIFIED = re.compile(r"(?<![A-Za-z0-9_.'])([A-Za-z_][A-Za-z0-9_]*)\.(in|out|state)\.([A-Za-z_][A-Za-z0-9_]*'*)")
 #: An unqualified ``in.x`` / ``out.x``.
 UNQUALIFIED = re.compile(r"(?<![A-Za-z0-9_.'])(in|out)\.([A-Za-z_][A-Za-z0-9_]*)")
 #: The pseudo node's name (never a valid RCL node name, so never a real one).
@@ -79,10 +79,11 @@ class Formal:
         return tuple(seen)
 
 
-def system_scope(checked: Checked) -> CheckedNode:
-    """The pseudo node whose inputs are every ``Node.in.x`` and whose outputs
-    are every ``Node.out.y`` of the checked contracts."""
-    ins: dict[str, Type] = {}
+def system_scope(checked: Checked, states: Mapping[tuple[str, str], Type] | None = None) -> CheckedNode:
+    """The pseudo node whose inputs are every ``Node.in.x`` (and every
+    declared ``Node.state.v`` of ``states``) and whose outputs are every
+    ``Node.out.y`` of the checked contracts."""
+    ins: dict[str, Type] = {f"{n}.state.{v}": t for (n, v), t in (states or {}).items()}
     outs: dict[str, Type] = {}
     for name, cn in checked.nodes.items():
         ins.update({f"{name}.in.{v}": t for v, t in cn.inputs.items()})
@@ -99,8 +100,14 @@ def _loc_at(src: Source, offset: int) -> ast.Loc:
     return ast.Loc(src.file, line, col)
 
 
-def parse_formal(src: Source, checked: Checked, what: str = "requirement") -> Formal:
+def parse_formal(src: Source, checked: Checked, what: str = "requirement",
+                 states: Mapping[tuple[str, str], Type] | None = None) -> Formal:
     """Parse and type-check one formal statement (module docstring).
+
+    ``states`` (``{(node, name): type}``, :mod:`.state`) are the declared
+    state variables the statement may name as ``Node.state.v``: only a
+    temporal statement's operands are given them (:mod:`.temporal`); in a
+    state requirement ``Node.state.v`` is an ``E-name`` error.
 
     Returns a :class:`Formal`; raises :class:`RclError` with located
     diagnostics (``E-name`` for names, ``E-type`` for typing, RCL syntax
@@ -120,6 +127,15 @@ def parse_formal(src: Source, checked: Checked, what: str = "requirement") -> Fo
         if cn is None:
             diags.append(error(loc, f"{what}: no node named {node!r} in the system; nodes are: "
                                     f"{', '.join(checked.nodes) or 'none'}", "E-name"))
+        elif prefix == "state":
+            if (node, var) not in (states or {}):
+                declared = [f"{n}.state.{v}" for n, v in (states or {})]
+                diags.append(error(loc, f"{what}: {node}.state.{var} is not a state variable read here: "
+                                        + (f"the declared ones are {', '.join(declared)}, read only under a temporal "
+                                           "operator" if declared else "declare it in the plan's state: section and "
+                                           "read it under a temporal operator (docs/plan.md)"), "E-name"))
+            else:
+                mentions.setdefault((node, prefix, var), None)
         else:
             table, other = (cn.inputs, cn.outputs) if prefix == "in" else (cn.outputs, cn.inputs)
             kind, okind = ("input", "output") if prefix == "in" else ("output", "input")
@@ -148,7 +164,7 @@ def parse_formal(src: Source, checked: Checked, what: str = "requirement") -> Fo
         raise RclError(diags)
     expr = parse_formula(text, src.file, src.line, src.col)
     expr = _rename(expr, names)
-    scope = system_scope(checked)
+    scope = system_scope(checked, states)
     t = infer(expr, scope, checked.env)
     if t != BOOL:
         raise RclError([error(src.loc, f"{what}: must be a formula, found a term of type {t}", "E-type")])

@@ -158,8 +158,10 @@ def load_plan(root: Path, plan_rel: str = "contracts/plan.yaml") -> Plan:
             replacements[node] = (spec["replacement"], loc("nodes", node, "replacement"))
     rfrom = tuple((str(v), loc("requirements_from", k)) for k, v in (data.get("requirements_from") or {}).items())
     deadlines = _deadlines(data, loc, plan_rel)
+    from .state import read_state
+    states = read_state(data, locs, blocks, plan_rel)
     return Plan(plan_rel, root, contracts, tuple(reqs), tuple(conns), facts, instances, evidence, replacements, locs,
-                str(data.get("name", "")), dict(data.get("ros") or {}), rfrom, deadlines)
+                str(data.get("name", "")), dict(data.get("ros") or {}), rfrom, deadlines, states)
 
 
 def _deadlines(data: Mapping[str, Any], loc: Any, plan_rel: str) -> tuple[DeadlineSpec, ...]:
@@ -206,11 +208,15 @@ def all_requirements(plan: Plan) -> tuple[Requirement, ...]:
     return tuple(out)
 
 
-def check_formal(reqs: tuple[Requirement, ...], checked: Checked) -> list[Diagnostic]:
+def check_formal(reqs: tuple[Requirement, ...], checked: Checked, states: tuple[Any, ...] = ()) -> list[Diagnostic]:
     """Located errors of the requirements' ids (each once) and formal
-    statements (:func:`.formal.parse_formal`: unknown node or variable, an
-    input written as an output, a type error)."""
+    statements (:func:`.temporal.parse_temporal`: unknown node or variable, an
+    input written as an output, a type error, a temporal operator's bound;
+    ``states`` the plan's declared state variables, :mod:`.state`)."""
     from .formal import parse_formal
+    from .state import state_types
+    from .temporal import Temporal, parse_temporal, shape
+    stypes = state_types(tuple(states), checked)
     diags: list[Diagnostic] = []
     seen: dict[str, Requirement] = {}
     for r in reqs:
@@ -219,7 +225,14 @@ def check_formal(reqs: tuple[Requirement, ...], checked: Checked) -> list[Diagno
             diags.extend(plan_error(r.loc.file, r.loc.line, r.loc.col, f"requirement id {r.id!r} is used twice "
                                     f"(first at {o.loc.file}:{o.loc.line}:{o.loc.col})").diagnostics)
         seen.setdefault(r.id, r)
-        for src, what in ([(r.formal, f"{r.id} formal")] if r.formal else []) + [(a, f"{r.id} assuming") for a in r.assuming]:
+        if r.formal:
+            try:
+                t = parse_temporal(r.formal, checked, f"{r.id} formal", stypes)
+                if isinstance(t, Temporal):
+                    shape(t, r.formal.loc)  # a nesting that is not decided: a located E-temporal error
+            except RclError as exc:
+                diags.extend(exc.diagnostics)
+        for src, what in [(a, f"{r.id} assuming") for a in r.assuming]:
             try:
                 parse_formal(src, checked, what)
             except RclError as exc:
@@ -264,7 +277,9 @@ def resolve(plan: Plan, checked: Checked) -> None:
                 for g in s.guarantees:
                     if not 1 <= g <= n:
                         bad(s.loc, f"{r.id}: node {s.node} has {n} guarantee(s); there is no guarantee {g}")
-    diags.extend(check_formal(reqs, checked))
+    diags.extend(check_formal(reqs, checked, plan.states))
+    from .state import check_states
+    diags.extend(check_states(plan.states, checked))
     for d in plan.deadlines:
         for n in d.path:
             if not node_ok(n, d.loc):

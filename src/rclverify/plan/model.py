@@ -12,6 +12,7 @@ from typing import Any, Mapping
 
 from ..rcl import ast
 from .formal import Source
+from .state import StateVar
 
 Path_ = tuple[Any, ...]
 
@@ -113,3 +114,5 @@ class Plan:
     requirements_from: tuple[tuple[str, ast.Loc], ...] = ()
     #: the requirements' end-to-end deadlines (rule D3, calculus/deadlines.py)
     deadlines: tuple[DeadlineSpec, ...] = ()
+    #: declared state variables of nodes (``state:``, :mod:`.state`), read by temporal requirements
+    states: tuple[StateVar, ...] = ()

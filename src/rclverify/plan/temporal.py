@@ -22,9 +22,10 @@ from __future__ import annotations
 
 import re
 from dataclasses import dataclass
+from typing import Any, Mapping
 
 from ..rcl.errors import RclError, error
-from ..rcl.types import Checked
+from ..rcl.types import Checked, Type
 from .formal import Formal, Source, _loc_at, parse_formal
 
 _PREFIX = re.compile(r"\s*(always|eventually|next|previous)\b")
@@ -71,16 +72,30 @@ def _closing(text: str, i: int, end: int) -> int | None:
     return None
 
 
-def parse_temporal(src: Source, checked: Checked, what: str = "requirement") -> Temporal | Formal:
+def parse_temporal(src: Source, checked: Checked, what: str = "requirement",
+                   states: Mapping[tuple[str, str], Type] | None = None) -> Temporal | Formal:
     """Parse and type-check a possibly temporal statement (module docstring).
 
-    Returns a :class:`Temporal`, or a :class:`Formal` if it has no temporal
-    operator; raises :class:`RclError` with located diagnostics.
+    ``states`` are the plan's declared state variables (:mod:`.state`),
+    readable as ``Node.state.v`` in the operands of a temporal operator
+    only.  Returns a :class:`Temporal`, or a :class:`Formal` if it has no
+    temporal operator; raises :class:`RclError` with located diagnostics.
     """
-    return _parse(src, 0, len(src.text), checked, what)
+    out = _parse(src, 0, len(src.text), checked, what, states or {})
+    if isinstance(out, Formal) and states:  # a state requirement: Node.state.v is an error there
+        return parse_formal(src, checked, what)
+    return out
 
 
-def _parse(src: Source, start: int, end: int, checked: Checked, what: str) -> Temporal | Formal:
+def operands(t: "Temporal | Formal") -> list[Formal]:
+    """The state formulas of a statement, left to right."""
+    if isinstance(t, Formal):
+        return [t]
+    return [f for a in t.args for f in operands(a)]
+
+
+def _parse(src: Source, start: int, end: int, checked: Checked, what: str,
+           states: Mapping[tuple[str, str], Type]) -> Temporal | Formal:
     text = src.text
     if not text[start:end].strip():
         raise RclError([error(_loc_at(src, start), f"{what}: a temporal operator needs an operand",
@@ -88,7 +103,7 @@ def _parse(src: Source, start: int, end: int, checked: Checked, what: str) -> Te
     i = start + len(text[start:end]) - len(text[start:end].lstrip())
     j = start + len(text[start:end].rstrip())
     if text[i] == "(" and _closing(text, i, j) == j - 1:
-        return _parse(src, i + 1, j - 1, checked, what)
+        return _parse(src, i + 1, j - 1, checked, what, states)
     m = _PREFIX.match(text, start, end)
     if m:
         op, pos, bound = m.group(1), m.end(), None
@@ -100,11 +115,28 @@ def _parse(src: Source, start: int, end: int, checked: Checked, what: str) -> Te
                                           f"must be a natural number of steps, found {b.group(1).strip()!r}",
                                           "E-syntax")])
                 bound, pos = int(b.group(1)), b.end()
-        return Temporal(op, (_parse(src, pos, end, checked, what),), bound)
+        return Temporal(op, (_parse(src, pos, end, checked, what, states),), bound)
     u = _until_at(text, start, end)
     if u is not None:
-        return Temporal("until", (_parse(src, start, u, checked, what),
-                                  _parse(src, u + 5, end, checked, what)))
+        return Temporal("until", (_parse(src, start, u, checked, what, states),
+                                  _parse(src, u + 5, end, checked, what, states)))
     if start == 0 and end == len(text):
-        return parse_formal(src, checked, what)
-    return parse_formal(Source(_blank(text, start, end), src.line, src.col, src.file), checked, what)
+        return parse_formal(src, checked, what, states)
+    return parse_formal(Source(_blank(text, start, end), src.line, src.col, src.file), checked, what, states)
+
+
+def shape(t: Temporal | Formal, loc: Any) -> str:
+    """The decided shape of a statement (module table): ``always``,
+    ``always next``, ``eventually``, ``next``, ``until``; raises
+    :class:`RclError` (``E-temporal`` at ``loc``) for another nesting."""
+    if isinstance(t, Temporal):
+        a = t.args[0]
+        if t.op in ("always", "eventually", "next") and isinstance(a, Formal):
+            return t.op
+        if t.op == "always" and isinstance(a, Temporal) and a.op == "next" and isinstance(a.args[0], Formal):
+            return "always next"
+        if t.op == "until" and all(isinstance(x, Formal) for x in t.args):
+            return "until"
+    raise RclError([error(loc, "this nesting of temporal operators is not decided; write always F, always next F, "
+                               "eventually F, eventually[<= N] F, next F or F until G with F, G state formulas "
+                               "(docs/requirements.md, Temporal requirements)", "E-temporal")])

@@ -411,6 +411,7 @@ def involved_model(sc: Mapping[str, Any]) -> Mapping[str, Any]:
 #: The fields of a requirement's check record (requirements/check.py) the report carries.
 _CHECK_FIELDS = ("origin", "source", "formal", "assuming", "cone", "used", "traced_not_needed", "consistency",
                  "inconsistent_core", "vacuity", "vacuity_core", "counterexample", "failed_to_prevent", "reason", "smt2", "explanation",
+                 "temporal",  # a temporal requirement's verdict, k, bound and trace (requirements/temporal_check.py)
                  "duration_s")
 
 

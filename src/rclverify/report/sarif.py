@@ -226,6 +226,9 @@ def _requirement_results(report: Mapping[str, Any]) -> list[dict[str, Any]]:
             words.append("Counterexample: " + "; ".join(
                 f"{row['node']}: " + ", ".join(f"{k} = {v}" for k, v in row["values"].items())
                 for row in c["counterexample"]) + ".")
+        if c.get("temporal"):  # a temporal requirement: its method, bound and trace step by step
+            from .temporal import temporal_words
+            words.append(temporal_words(c["temporal"]))
         for p in c.get("failed_to_prevent") or []:
             words.append(f"Not prevented by {p['label']} ({p['text']}, {p['source']}).")
         props = {"requirement": r["id"], "verdict": r["verdict"], "status": r["status"]}

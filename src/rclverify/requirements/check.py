@@ -34,6 +34,11 @@ One labelled satisfiability query of ``premises and not R`` decides it:
                   to prevent it are those of the cone that constrain a variable
                   ``R`` mentions, the traced ones first.
 ``inconclusive``  unknown (budget, quantifiers): never proved.
+
+A statement with a temporal operator (``always``, ``eventually``, ...) is
+decided over the runs of the composed contracts instead: the check
+dispatches to :mod:`.temporal_check`, whose record has the same fields plus
+``temporal`` (docs/requirements.md, "Temporal requirements").
 """
 from __future__ import annotations
 
@@ -81,6 +86,30 @@ def formals_of(req: Requirement, checked: Checked) -> tuple[Formal | None, list[
     """The parsed formal statement (``None`` when informal) and ``assuming:`` formulas."""
     f = parse_formal(req.formal, checked, f"{req.id} formal") if req.formal else None
     return f, [parse_formal(a, checked, f"{req.id} assuming") for a in req.assuming]
+
+
+def statement_formals(req: Requirement, checked: Checked, plan: Plan) -> list[Formal]:
+    """The state formulas a requirement's cone is computed from: its formal
+    statement (every operand of a temporal one) and its ``assuming:``;
+    ``[]`` for an informal requirement."""
+    if req.formal is None:
+        return []
+    from ..plan.state import state_types
+    from ..plan.temporal import operands, parse_temporal
+    t = parse_temporal(req.formal, checked, f"{req.id} formal", state_types(plan.states, checked))
+    return [*operands(t), *assuming_of(req, checked)]
+
+
+def assuming_of(req: Requirement, checked: Checked) -> list[Formal]:
+    """The parsed ``assuming:`` formulas of ``req``."""
+    return [parse_formal(a, checked, f"{req.id} assuming") for a in req.assuming]
+
+
+def state_text(plan: Plan, cone: Sequence[str]) -> str:
+    """The plan's state declarations of the nodes of ``cone`` as text (part
+    of a temporal requirement's fingerprint)."""
+    return json.dumps([[s.node, s.name, s.type_name, s.init.text, s.next.text, str(s.loc)]
+                       for s in plan.states if s.node in cone])
 
 
 def fingerprint(req: Requirement, cone_snapshots: Sequence[str], model_json: str, code: str = "") -> str:
@@ -144,6 +173,10 @@ def check_requirement(req: Requirement, checked: Checked, model: SystemModel, pl
         "assuming": [" ".join(a.text.split()) for a in req.assuming],
         "traced": [{"node": s.node, "guarantee": k} for s in req.support for k in s.guarantees],
     }
+    if req.formal is not None and plan is not None:
+        from .temporal_check import check_temporal, is_temporal
+        if is_temporal(req, checked, plan):  # over the composed system's runs (requirements/temporal_check.py)
+            return check_temporal(req, checked, model, plan, base)
     formal, assuming = formals_of(req, checked)
     if formal is None:
         return {**base, "verdict": "informal", "cone": [], "used": [], "traced_not_needed": [],

@@ -52,7 +52,7 @@ def stage_requirements(ws: "Workspace", *, force: bool = False) -> list[tuple[di
 
     from ..logic.world import fresh
     from ..cache import code_stamp
-    from .check import check_requirement, cone_of, fingerprint, formals_of
+    from .check import check_requirement, cone_of, fingerprint, state_text, statement_formals
     code = f"{code_stamp()} z3 {z3.get_version_string()}"
     checked, model, plan = ws.checked, ws.model, ws.plan
     model_text = (ws.root / ws.MODEL).read_text(encoding="utf-8") if (ws.root / ws.MODEL).is_file() else \
@@ -69,9 +69,12 @@ def stage_requirements(ws: "Workspace", *, force: bool = False) -> list[tuple[di
     index: dict[str, str] = {}
     keep = set()
     for req in all_requirements(plan):
-        formal, assuming = formals_of(req, checked)
-        cone = cone_of([formal, *assuming], model) if formal is not None else []
-        fp = fingerprint(req, [snap(n) for n in cone], model_text if formal is not None else "", code)
+        formals = statement_formals(req, checked, plan)
+        formal = formals[0] if formals else None
+        cone = cone_of(formals, model) if formal is not None else []
+        # a temporal requirement also reads the state declarations of its cone (plan.states)
+        fp = fingerprint(req, [snap(n) for n in cone] + [state_text(plan, cone)],
+                         model_text if formal is not None else "", code)
         rel = record_path(req.id)
         keep.add(rel.rsplit("/", 1)[1])
         old = None if force else _read(ws.root / rel)

@@ -66,11 +66,13 @@ class TemporalVerdict:
     bound: int | None = None
     trace: list[dict[str, str]] = field(default_factory=list)
     detail: str = ""
+    #: a lasso's loop: the last state of ``trace`` equals state ``loop``
+    loop: int | None = None
 
     def to_json(self) -> dict:
         """The record fields (a JSON-ready dict)."""
         return {"status": self.status, "method": self.method, "k": self.k,
-                "bound": self.bound, "trace": self.trace, "detail": self.detail}
+                "bound": self.bound, "trace": self.trace, "detail": self.detail, "loop": self.loop}
 
 
 def _unroll(ts: TransitionSystem, n: int) -> tuple[list[State], list[z3.BoolRef]]:
@@ -169,10 +171,40 @@ def check_eventually(ts: TransitionSystem, prop: Pred, *,
                 return TemporalVerdict("proved", "ranking",
                                        k=iv.k if iv else None)
     bounded = check_eventually_within(ts, prop, bound, timeout_ms=timeout_ms)
+    if bounded.status == "inconclusive":  # the solver could not say: nothing was checked, and no lasso is sought
+        return TemporalVerdict("inconclusive", "bounded", bound=None,
+                               detail=f"Z3 could not decide whether a run of {bound} steps misses it "
+                                      f"({bounded.detail}); no step was checked")
     if bounded.status == "met":
         # every run reaches prop within `bound` steps: a proof, not a guess
         return TemporalVerdict("proved", "bounded", bound=bound,
                                detail=f"reached within {bound} steps on every run")
+    lasso = find_lasso(ts, prop, bound, timeout_ms=timeout_ms)
+    if lasso is not None:
+        return lasso
     why = "ranking function not valid" if ranking is not None else "no ranking function"
     return TemporalVerdict("inconclusive", "bounded", bound=bound, trace=bounded.trace,
                            detail=f"{why}; a run of {bound} steps does not reach it")
+
+
+def find_lasso(ts: TransitionSystem, prop: Pred, bound: int, *,
+               timeout_ms: int = 10_000) -> TemporalVerdict | None:
+    """A counterexample to unbounded ``eventually prop``: a run s0..sn
+    (n <= ``bound``) missing ``prop`` whose last state equals an earlier
+    one, s_n == s_j.  Repeating s_j..s_n forever is an infinite run of the
+    system (a step depends on its two states only) on which ``prop`` never
+    holds: ``refuted`` (method ``lasso``, ``loop = j``).  ``None`` when no
+    such run of up to ``bound`` steps exists or the solver cannot say.
+    """
+    for n in range(1, bound + 1):
+        states, steps = _unroll(ts, n)
+        s = z3.Solver()
+        s.set("timeout", timeout_ms)
+        same = [z3.And(*[states[n][v] == states[j][v] for v in ts.sorts]) for j in range(n)]
+        s.add(ts.init(states[0]), *steps, *[z3.Not(prop(st)) for st in states], z3.Or(*same))
+        if s.check() == z3.sat:
+            m = s.model()
+            loop = next(j for j in range(n) if z3.is_true(m.eval(same[j], model_completion=True)))
+            return TemporalVerdict("refuted", "lasso", bound=n, trace=_trace(m, states), loop=loop,
+                                   detail=f"a run whose step {n} returns to step {loop} and never reaches it")
+    return None

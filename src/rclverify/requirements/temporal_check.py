@@ -1,0 +1,188 @@
+"""Decide a temporal requirement over the composed system (docs/requirements.md).
+
+The statement (:mod:`rclverify.plan.temporal`) is decided over the
+transition system of its cone (:mod:`.transition`) by the engine of
+:mod:`.temporal`:
+
+==========================  ===============================================
+statement                   decided by
+==========================  ===============================================
+``always F``                BMC then k-induction (``proved`` with k)
+``always next F``           the same from step 1 on
+``eventually[<= N] F``      unrolling N steps (exact)
+``eventually F``            every run reaches F within the bound (proved);
+                            a lasso missing F (refuted); else inconclusive
+                            with the bound checked: never met on a bound
+``next F``                  one step (exact)
+``F until G``               ``always (G seen or F)`` and ``eventually G``
+==========================  ===============================================
+
+Other nestings raise a located ``E-temporal`` error (the plan's
+``resolve`` reports it through :func:`shape`).  The record has the fields of
+a state requirement's (:func:`.check.check_requirement`) so that the
+roll-up (:mod:`.rollup`) treats both alike, plus ``temporal``: ``{status,
+method, k, bound, loop, detail, trace}`` with ``trace`` one entry per step,
+``{"step": i, "nodes": [{"node", "values": {"in.x": v}}]}``.  A proof uses
+every premise of the cone (there is no unsat core of an induction), so
+``met`` needs the evidence of every guarantee of the cone discharged; a
+system with no run at all (its premises contradict each other) proves
+anything, and is reported ``consistency: inconsistent``.
+"""
+from __future__ import annotations
+
+import time
+from typing import Any, Callable
+
+import z3
+
+from ..plan.formal import Formal, parse_formal
+from ..plan.load import Plan, Requirement
+from ..plan.state import state_types
+from ..plan.temporal import Temporal, operands, parse_temporal, shape
+from ..rcl.types import Checked
+from ..system.model import SystemModel
+from .temporal import (TemporalVerdict, TransitionSystem, check_always, check_eventually,
+                       check_eventually_within)
+from .transition import ComposedSystem, build_system
+
+#: The bound of BMC for an unbounded ``eventually`` and of k-induction's k.
+DEFAULT_BOUND = 10
+#: Each Z3 query's budget (ms): an unknown is inconclusive, never upgraded.
+TIMEOUT_MS = 2_000
+
+
+def is_temporal(req: Requirement, checked: Checked, plan: Plan) -> bool:
+    """Whether ``req``'s formal statement has a temporal operator."""
+    if req.formal is None:
+        return False
+    return isinstance(parse_temporal(req.formal, checked, req.id, state_types(plan.states, checked)), Temporal)
+
+
+def statement(req: Requirement, checked: Checked, plan: Plan) -> Temporal:
+    """The parsed temporal statement of ``req`` (raises :class:`RclError`)."""
+    t = parse_temporal(req.formal, checked, f"{req.id} formal", state_types(plan.states, checked))
+    assert isinstance(t, Temporal)
+    return t
+
+
+def _with_flag(ts: TransitionSystem, name: str, init: Callable[[Any], Any], step: Callable[[Any, Any], Any]) -> TransitionSystem:
+    """``ts`` with one more Boolean variable ``name``: ``init(s)`` its first
+    value, ``step(s, t)`` its next (a history variable: constrains nothing)."""
+    sorts = {**ts.sorts, name: z3.BoolSort()}
+    return TransitionSystem(sorts, lambda s: z3.And(ts.init(s), s[name] == init(s)),
+                            lambda s, t: z3.And(ts.trans(s, t), t[name] == step(s, t)))
+
+
+def decide(t: Temporal, sys: ComposedSystem, pred: Callable[[Formal], Callable[[Any], Any]], *,
+           bound: int = DEFAULT_BOUND, timeout_ms: int = 10_000) -> TemporalVerdict:
+    """Decide statement ``t`` over ``sys`` (module table); ``pred(F)`` is
+    F as a predicate over one state."""
+    kind = shape(t, None)
+    ts = sys.ts
+    if kind == "always":
+        return check_always(ts, pred(t.args[0]), max_k=bound, timeout_ms=timeout_ms)
+    if kind == "always next":
+        f = pred(t.args[0].args[0])  # type: ignore[union-attr]
+        ts2 = _with_flag(ts, "<started>", lambda s: z3.BoolVal(False), lambda s, u: z3.BoolVal(True))
+        return check_always(ts2, lambda s: z3.Or(z3.Not(s["<started>"]), f(s)), max_k=bound, timeout_ms=timeout_ms)
+    if kind == "next":
+        f = pred(t.args[0])
+        a, b = ts.state(0), ts.state(1)
+        s = z3.Solver()
+        s.set("timeout", timeout_ms)
+        s.add(ts.init(a), ts.trans(a, b), z3.Not(f(b)))
+        r = s.check()
+        if r == z3.unsat:
+            return TemporalVerdict("proved", "bounded", bound=1, detail="holds at step 1 of every run")
+        if r == z3.sat:
+            m = s.model()
+            return TemporalVerdict("refuted", "bmc", bound=1, detail="fails at step 1",
+                                   trace=[{n: str(m.eval(x, model_completion=True)) for n, x in st.items()}
+                                          for st in (a, b)])
+        return TemporalVerdict("inconclusive", "bmc", bound=1, detail=f"solver: {s.reason_unknown()}")
+    if kind == "eventually":
+        f = pred(t.args[0])
+        if t.bound is not None:
+            v = check_eventually_within(ts, f, t.bound, timeout_ms=timeout_ms)
+            return TemporalVerdict("proved", v.method, bound=v.bound, detail=v.detail) if v.status == "met" else v
+        return check_eventually(ts, f, bound=bound, timeout_ms=timeout_ms)
+    # until: safety part always (seen(G) or F), liveness part eventually G
+    f, g = pred(t.args[0]), pred(t.args[1])
+    ts2 = _with_flag(ts, "<G seen>", g, lambda s, u: z3.Or(s["<G seen>"], g(u)))
+    safe = check_always(ts2, lambda s: z3.Or(s["<G seen>"], f(s)), max_k=bound, timeout_ms=timeout_ms)
+    if safe.status == "refuted":
+        return safe
+    live = check_eventually(ts, g, bound=bound, timeout_ms=timeout_ms)
+    if live.status == "refuted" or (safe.status == "proved" and live.status == "proved"):
+        return TemporalVerdict(live.status, f"{safe.method} + {live.method}", k=safe.k, bound=live.bound,
+                               trace=live.trace, loop=live.loop, detail=live.detail)
+    return TemporalVerdict("inconclusive", f"{safe.method} + {live.method}", k=safe.k, bound=live.bound,
+                           trace=live.trace, detail=f"safety part {safe.status}; liveness part {live.status}: "
+                                                    f"{live.detail or safe.detail}")
+
+
+def _steps(trace: list[dict[str, str]], sys: ComposedSystem) -> list[dict[str, Any]]:
+    """A trace as steps x nodes: ``[{"step": i, "nodes": [{"node", "values"}]}]``."""
+    out = []
+    for i, st in enumerate(trace):
+        rows: dict[str, dict[str, str]] = {}
+        for name, value in st.items():
+            if name in sys.variables:
+                n, p, v = sys.variables[name]
+                rows.setdefault(n, {})[f"{p}.{v}"] = " ".join(value.split())
+        out.append({"step": i, "nodes": [{"node": n, "values": rows[n]} for n in sys.cone if n in rows]})
+    return out
+
+
+def check_temporal(req: Requirement, checked: Checked, model: SystemModel, plan: Plan, base: dict[str, Any],
+                   *, bound: int = DEFAULT_BOUND, timeout_ms: int = TIMEOUT_MS) -> dict[str, Any]:
+    """The record of temporal requirement ``req`` (module docstring);
+    ``base`` the fields :func:`.check.check_requirement` fills for every
+    requirement.  Raises :class:`RclError` for a statement that does not
+    check; never raises on solver trouble."""
+    from ..logic.encode import Encoder
+    t0 = time.perf_counter()
+    t = statement(req, checked, plan)
+    shape(t, req.formal.loc if req.formal else req.loc)
+    assuming = [parse_formal(a, checked, f"{req.id} assuming") for a in req.assuming]
+    ops = operands(t)
+    want = {u for f in (*ops, *assuming) for n in f.nodes for u in (model.upstream(n) or [n])}
+    cone = [n for n in model.nodes if n in want]  # as requirements/check.cone_of
+    sys = build_system(cone, checked, model, plan)
+    enc = Encoder(checked.env)
+
+    def pred(f: Formal) -> Callable[[Any], Any]:
+        return lambda s: enc.formula(f.expr, f.scope, sys.statement_symbols(s))
+    if assuming:  # the requirement's own assumptions hold in every state
+        holds = [pred(a) for a in assuming]
+        ts = sys.ts
+        sys.ts = TransitionSystem(ts.sorts, lambda s: z3.And(ts.init(s), *[h(s) for h in holds]),
+                                  lambda s, u: z3.And(ts.trans(s, u), *[h(s) for h in holds], *[h(u) for h in holds]))
+        for k, a in enumerate(assuming, 1):
+            sys.premises.append({"label": f"assuming {k}", "kind": "assuming", "node": None, "index": k,
+                                 "text": base["assuming"][k - 1], "source": base["source"]})
+    v = decide(t, sys, pred, bound=bound, timeout_ms=timeout_ms)
+    out: dict[str, Any] = {**base, "cone": cone, "premises": len(sys.premises), "used": [], "traced_not_needed": [],
+                           "temporal": {**v.to_json(), "trace": _steps(v.trace, sys)}}
+    if v.status in ("proved", "met"):
+        a, b = sys.ts.state(0), sys.ts.state(1)
+        s = z3.Solver()
+        s.set("timeout", timeout_ms)
+        s.add(sys.ts.init(a), sys.ts.trans(a, b))
+        r = s.check()
+        used = sys.premises
+        out.update(verdict="proved", used=used)
+        if r == z3.unsat:
+            out.update(consistency="inconsistent", inconsistent_core=used)
+        elif r == z3.sat:
+            out.update(consistency="consistent")
+        else:
+            out.update(consistency="undecided", consistency_reason=s.reason_unknown())
+    elif v.status == "refuted":
+        mentioned = {n for f in ops for n in f.nodes}
+        out.update(verdict="refuted", failed_to_prevent=[p for p in sys.premises
+                                                          if p["kind"] == "guarantee" and p["node"] in mentioned])
+    else:
+        out.update(verdict="inconclusive", reason=v.detail or "undecided")
+    out["duration_s"] = round(time.perf_counter() - t0, 4)
+    return out
