@@ -287,7 +287,7 @@ def test_the_readme_lists_every_ros_command() -> None:
     commands: Any = next(a for a in ros._actions if isinstance(a, argparse._SubParsersAction)).choices
     readme = (ROOT / "README.md").read_text(encoding="utf-8")
     block = readme.split("## Command line", 1)[1].split("```", 2)[1]
-    assert sorted(commands) == ["check", "scan"]
+    assert sorted(commands) == ["check", "diff", "scan"]
     for name in commands:
         assert f"rclverify ros {name}" in block, name
     assert "rclverify init DIR --from-ros PATH" in block
