@@ -106,3 +106,10 @@ def test_a_chain_past_the_bound_is_refuted_in_the_report_sarif_junit_and_strict(
 
 def test_incremental_equals_clean(runs: dict[str, Any]) -> None:
     assert runs["record"] == runs["clean_record"]
+
+
+def test_the_end_of_verify_names_each_deadline_and_its_sums(runs: dict[str, Any]) -> None:
+    from rclverify.report.summary import deadlines_line
+    rows = runs["refuted"]["summary"]["deadlines"]
+    assert [r[:4] for r in rows] == [["STOP", "refuted", "250 ms", "200 ms"], ["MOVE-FEEDBACK", "proved", "2 s", "2 s"]]
+    assert deadlines_line(rows).startswith("deadlines: STOP refuted (250 ms > 200 ms")

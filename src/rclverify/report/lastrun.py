@@ -30,6 +30,7 @@ SUMMARY_SHAPE: dict[str, Any] = {
     "rows": [{"node": str, "status": str, "obligations": dict, "sc_proved": _NUM, "sc_total": _NUM,
               "health_problems": _NUM, "health_open": _NUM, "health_total": _NUM}],
     "requirements?": [list],
+    "deadlines?": [list],
     "problems?": [{"status": str, "sentence": str, "culprits": [str], "members": [str], "repairs": _NUM}],
     "grounding?": (dict, type(None)),
     "strict?": [str],

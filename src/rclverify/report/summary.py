@@ -109,6 +109,9 @@ def summary_data(report: Mapping[str, Any]) -> dict[str, Any]:
             "summary": report["summary"], "rows": node_rows(report),
             "unverified": [str(u["id"]) for u in report.get("unverified") or ()],
             "requirements": [[r["id"], r.get("verdict", ""), r["status"]] for r in report.get("requirements", ())],
+            "deadlines": [[str(d.get("requirement", "?")), str(d.get("verdict", "")), str(d.get("total") or "?"),
+                           str(d.get("within") or "?"), str(d.get("evidence_status") or "")]
+                          for d in report.get("deadlines") or ()],
             "problems": [{"status": g["status"], "sentence": group_sentence(g),
                           "culprits": [_culprit(c) for c in g.get("culprits", [])], "where": g.get("where", ""),
                           "members": [m["id"] for m in g.get("members", [])], "repairs": len(g.get("repairs", []))}
@@ -279,6 +282,18 @@ def requirements_line(rows: Sequence[Sequence[str]]) -> str:
                                                             if v in named else "") for v, ids in by.items())
 
 
+def deadlines_line(rows: Sequence[Sequence[str]]) -> str:
+    """``deadlines: STOP proved (250 ms <= 300 ms; evidence of its chain unverified)``
+    from the summary's ``[requirement, verdict, chain total, bound, evidence status]``
+    rows (rule D3, calculus/deadlines.py; docs/requirements.md)."""
+    parts = []
+    for rid, verdict, total, within, evidence in rows:
+        cmp = "<=" if verdict == "proved" else ">" if verdict == "refuted" else "vs"
+        ev = f"; evidence of its chain {evidence}" if evidence and evidence != "discharged" else ""
+        parts.append(f"{rid} {verdict} ({total} {cmp} {within}{ev})")
+    return "deadlines: " + ", ".join(parts)
+
+
 def read_summary(root: Path) -> dict[str, Any]:
     """What ``status`` and ``verify`` print, from the workspace ``root``:
     ``artifacts/report/summary.json`` when it is there (of any shape: a
@@ -318,5 +333,7 @@ def print_last_run(root: Path) -> dict[str, Any]:
     print("\n".join(status_text(data)))
     if data.get("requirements"):
         print(requirements_line(data["requirements"]))
+    if data.get("deadlines"):
+        print(deadlines_line(data["deadlines"]))
     print_summary(data, "reports/assurance.html", rows=data["rows"])
     return data
