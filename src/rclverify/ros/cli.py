@@ -55,21 +55,30 @@ def _launch_args(items: list[str]) -> dict[str, str]:
     return out
 
 
-def cmd_scan(args: argparse.Namespace) -> int:
-    from ..evidence.store import atomic_write_text
+def _scan_args(args: argparse.Namespace, bags: list[str], cache: Path | None,
+               also_exist: list[str] | None = None) -> Any:
+    """The scan of ``args.paths``/``args.launch``/``args.arg`` (and ``bags``) shared by
+    ``ros scan`` and ``ros diff``: ``graph.scan``'s result, or ``None`` after one
+    usage message on standard error (a path that does not exist, a bad ``--arg``)."""
     from .graph import scan
-    from .master import MasterError, read_master
-    for p in list(args.paths) + list(args.launch) + list(args.bag):
+    for p in list(args.paths) + list(args.launch) + bags + list(also_exist or ()):
         if not Path(p).exists():
             print(f"{p}: error: no such file or directory", file=sys.stderr)
-            return 2
+            return None
     try:
         largs = _launch_args(args.arg)
     except SystemExit as exc:
         print(exc, file=sys.stderr)
+        return None
+    return scan([Path(p) for p in args.paths], [Path(p) for p in args.launch], largs, [Path(b) for b in bags], cache)
+
+
+def cmd_scan(args: argparse.Namespace) -> int:
+    from ..evidence.store import atomic_write_text
+    from .master import MasterError, read_master
+    res = _scan_args(args, list(args.bag), Path(args.cache) / "ros-scan.pickle" if args.cache else None)
+    if res is None:
         return 2
-    res = scan([Path(p) for p in args.paths], [Path(p) for p in args.launch], largs, [Path(b) for b in args.bag],
-               Path(args.cache) / "ros-scan.pickle" if args.cache else None)
     g = res.graph
     data: dict[str, Any] = g.to_json()
     if args.master:
@@ -101,7 +110,6 @@ def cmd_diff(args: argparse.Namespace) -> int:
     from ..evidence.store import atomic_write_text
     from .bag import bag_topics
     from .diff import diff_bag, diff_master, render_text
-    from .graph import scan
     from .master import MasterError, read_master
     if (args.master is None) == (args.bag is None):
         print("error: ros diff needs exactly one running side: --master URI or --bag BAG", file=sys.stderr)
@@ -109,16 +117,9 @@ def cmd_diff(args: argparse.Namespace) -> int:
     if not args.paths and not args.launch:
         print("error: ros diff needs the code: PATH... and/or --launch FILE", file=sys.stderr)
         return 2
-    for p in list(args.paths) + list(args.launch) + ([args.bag] if args.bag else []):
-        if not Path(p).exists():
-            print(f"{p}: error: no such file or directory", file=sys.stderr)
-            return 2
-    try:
-        largs = _launch_args(args.arg)
-    except SystemExit as exc:
-        print(exc, file=sys.stderr)
+    res = _scan_args(args, [], None, [args.bag] if args.bag else [])
+    if res is None:
         return 2
-    res = scan([Path(p) for p in args.paths], [Path(p) for p in args.launch], largs)
     for n in res.graph.notes:
         print(n, file=sys.stderr)
     if args.master:
