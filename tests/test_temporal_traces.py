@@ -120,3 +120,21 @@ def test_case_study_req4_on_the_nominal_run_is_currently_false() -> None:
                              cfg.rules)
     # the run ends after 6 of the 13 waypoints, the radiation never red: not reached, not failed
     assert v.verdict == "currently_false" and v.steps == 44
+
+
+def test_state_edit_shows_the_requirement_record_stale_before_the_stage_ran(tmp_path: Path) -> None:
+    from rclverify.pipeline import stage_check, stage_requirements
+    from rclverify.report.build import build_report
+    (tmp_path / "contracts").mkdir()
+    (tmp_path / "contracts/n.rcl").write_text(RCL)
+    plan = ("contracts: [contracts/n.rcl]\nrequirements:\n  - id: T1\n    text: t\n"
+            "    formal: \"eventually[<= 2] Inc.state.n >= 2\"\n" + STATE)
+    (tmp_path / "contracts/plan.yaml").write_text(plan)
+    w = Workspace(tmp_path)
+    stage_check(w)
+    stage_requirements(w)
+    before = {r["id"]: r for r in build_report(Workspace(tmp_path))["requirements"]}
+    assert before["T1"]["verdict"] != "stale"
+    (tmp_path / "contracts/plan.yaml").write_text(plan.replace("state.n + 1", "state.n"))
+    after = {r["id"]: r for r in build_report(Workspace(tmp_path))["requirements"]}
+    assert after["T1"]["verdict"] == "stale"

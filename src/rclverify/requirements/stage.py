@@ -109,7 +109,9 @@ def input_hashes(ws: "Workspace", cone: list[str], snap: Any, model_hash: str) -
     of the snapshots of ``cone`` (``snap(node)`` gives a snapshot's text) and
     the model a record is made from: the hashes the report compares with the
     current ones (:func:`read_records`)."""
+    from ..plan.state import state_key, state_sha256
     out = {ws.snapshot(n): hashlib.sha256(snap(n).encode("utf-8")).hexdigest() for n in cone}
+    out.update({state_key(n): state_sha256(ws.plan.states, n) for n in cone})  # a state: edit is stale too
     out[ws.MODEL] = model_hash
     return out
 
