@@ -138,3 +138,38 @@ def test_state_edit_shows_the_requirement_record_stale_before_the_stage_ran(tmp_
     (tmp_path / "contracts/plan.yaml").write_text(plan.replace("state.n + 1", "state.n"))
     after = {r["id"]: r for r in build_report(Workspace(tmp_path))["requirements"]}
     assert after["T1"]["verdict"] == "stale"
+
+
+def test_recorded_runs_are_evidence_of_the_temporal_requirement_in_the_report(tmp_path: Path) -> None:
+    from rclverify.pipeline import stage_check, stage_requirements
+    from rclverify.report.build import build_report
+    (tmp_path / "contracts").mkdir()
+    (tmp_path / "contracts/n.rcl").write_text(RCL)
+    (tmp_path / "contracts/plan.yaml").write_text(
+        "contracts: [contracts/n.rcl]\nrequirements:\n"
+        "  - id: T1\n    text: b stays small\n    formal: \"always Inc.out.b <= 3\"\n"
+        "  - id: T2\n    text: b reaches 3\n    formal: \"eventually Inc.out.b == 3\"\n"
+        "nodes:\n  Inc:\n    evidence:\n      - backend: monitors\n        traces: [run.jsonl]\n" + STATE)
+    w = Workspace(tmp_path)
+    _trace(w, "run.jsonl", RUN)
+    stage_check(w)
+    stage_requirements(w)
+    from rclverify.report.render import render_html, render_markdown
+    report = build_report(Workspace(tmp_path))
+    md, html = render_markdown(report), render_html(report)
+    assert "recorded run `run.jsonl`: failed (trace verdict false, step 5 at t = 0.5 s)" in md
+    assert "recorded run <code>run.jsonl</code>" in html
+    reqs = {r["id"]: r for r in report["requirements"]}
+    t1, t2 = reqs["T1"], reqs["T2"]
+    row = t1["check"]["traces"][0]
+    assert (row["trace"], row["status"], row["verdict"]["verdict"], row["verdict"]["step"]) == \
+        ("run.jsonl", "failed", "false", 5)
+    # a failed run refutes it whatever Z3 says; Z3's own verdict is kept beside it
+    assert t1["status"] == "failed" and "run.jsonl refutes it" in t1["note"]
+    assert t2["check"]["traces"][0]["status"] == "discharged" and t2["status"] != "discharged"
+    # an edited trace: the record is stale before the stage ran again
+    _trace(w, "run.jsonl", [("b", 1)] + RUN[:4])
+    assert {r["id"]: r for r in build_report(Workspace(tmp_path))["requirements"]}["T1"]["verdict"] == "stale"
+    stage_requirements(Workspace(tmp_path))
+    again = {r["id"]: r for r in build_report(Workspace(tmp_path))["requirements"]}
+    assert again["T1"]["check"]["traces"][0]["verdict"]["verdict"] == "true"
