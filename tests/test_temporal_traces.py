@@ -173,3 +173,7 @@ def test_recorded_runs_are_evidence_of_the_temporal_requirement_in_the_report(tm
     stage_requirements(Workspace(tmp_path))
     again = {r["id"]: r for r in build_report(Workspace(tmp_path))["requirements"]}
     assert again["T1"]["check"]["traces"][0]["verdict"]["verdict"] == "true"
+    # doit re-runs the requirements stage when a recorded run changes
+    from rclverify.tasks import build_tasks
+    assert str(tmp_path / "run.jsonl") in build_tasks(tmp_path)["task_requirements"]()["file_dep"]
+

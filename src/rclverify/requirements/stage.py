@@ -53,7 +53,7 @@ def stage_requirements(ws: "Workspace", *, force: bool = False) -> list[tuple[di
     from ..logic.world import fresh
     from ..cache import code_stamp
     from .check import check_requirement, cone_of, fingerprint, state_text, statement_formals
-    from ..backends.monitors.temporal_evidence import requirement_traces, trace_hashes, trace_rows
+    from ..backends.monitors.temporal_evidence import fingerprint_text, requirement_traces, trace_hashes, trace_rows
     code = f"{code_stamp()} z3 {z3.get_version_string()}"
     checked, model, plan = ws.checked, ws.model, ws.plan
     model_text = (ws.root / ws.MODEL).read_text(encoding="utf-8") if (ws.root / ws.MODEL).is_file() else \
@@ -76,7 +76,7 @@ def stage_requirements(ws: "Workspace", *, force: bool = False) -> list[tuple[di
         # a temporal requirement also reads the state declarations of its cone (plan.states)
         traces = requirement_traces(req, checked, plan)  # recorded runs checked against it (docs/plan.md)
         th = trace_hashes(ws.root, traces)
-        fp = fingerprint(req, [snap(n) for n in cone] + [state_text(plan, cone)] + ([dumps(th)] if th else []),
+        fp = fingerprint(req, [snap(n) for n in cone] + [state_text(plan, cone)] + ([fingerprint_text(ws.root, traces)] if traces else []),
                          model_text if formal is not None else "", code)
         rel = record_path(req.id)
         keep.add(rel.rsplit("/", 1)[1])

@@ -84,6 +84,19 @@ def trace_hashes(root: Path, traces: list[tuple[str, str | None]]) -> dict[str, 
     return out
 
 
+def fingerprint_text(root: Path, traces: list[tuple[str, str | None]]) -> str:
+    """What a requirement's fingerprint adds for its recorded runs: each
+    trace's sha256 and its mapping file's (the mapping decides the values)."""
+    import hashlib
+    import json
+    out = []
+    for tr, mapping in traces:
+        m = root / mapping if mapping else None
+        msha = hashlib.sha256(m.read_bytes()).hexdigest() if m is not None and m.is_file() else ""
+        out.append([tr, trace_hashes(root, [(tr, mapping)])[trace_key(tr)], mapping, msha])
+    return json.dumps(out)
+
+
 def trace_rows(req: Requirement, checked: Checked, plan: Plan, root: Path) -> list[dict[str, Any]]:
     """One row per trace of ``req`` (module table); never raises for a
     user-caused problem (an unreadable trace or mapping is an ``error`` row)."""
@@ -107,4 +120,4 @@ def trace_rows(req: Requirement, checked: Checked, plan: Plan, root: Path) -> li
     return rows
 
 
-__all__ = ["STATUS", "requirement_traces", "trace_hashes", "trace_key", "trace_rows"]
+__all__ = ["STATUS", "fingerprint_text", "requirement_traces", "trace_hashes", "trace_key", "trace_rows"]
