@@ -13,7 +13,7 @@ Stages and their real file dependencies, per node ``N``:
                    export   snapshot of N + the backend input files -> obligations/N.json
 ``evidence:ID``     one obligation's record + the files it reads -> its evidence record
                    (created after ``node`` ran, when the obligations are known)
-``requirements``   plan + model + contract snapshots (+ Doorstop files) ->
+``requirements``   plan + model + contract snapshots (+ Doorstop files, recorded runs) ->
                    artifacts/requirements/<ID>.json; inside, only requirements whose
                    cone's snapshots or statements changed are checked again
 ``deadlines``      plan + model + snapshots of the nodes on a deadline's path ->
