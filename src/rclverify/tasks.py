@@ -13,7 +13,7 @@ Stages and their real file dependencies, per node ``N``:
                    export   snapshot of N + the backend input files -> obligations/N.json
 ``evidence:ID``     one obligation's record + the files it reads -> its evidence record
                    (created after ``node`` ran, when the obligations are known)
-``requirements``   plan + model + contract snapshots (+ Doorstop files) ->
+``requirements``   plan + model + contract snapshots (+ Doorstop files, recorded runs) ->
                    artifacts/requirements/<ID>.json; inside, only requirements whose
                    cone's snapshots or statements changed are checked again
 ``deadlines``      plan + model + snapshots of the nodes on a deadline's path ->
@@ -613,8 +613,16 @@ def _build_tasks(root: str | Path, plan_file: str) -> dict[str, Callable[[], Any
             from .plan.doorstop import doorstop_files
             for d in index.requirement_dirs:
                 extra += [str(rootp / f) for f in doorstop_files(rootp, d)]
+        for configs in index.entries.values():  # recorded runs checked against temporal requirements (docs/plan.md)
+            for c in configs:
+                if hasattr(c, "get") and c.get("traces") and isinstance(c.get("mapping"), str) \
+                        and (rootp / c["mapping"]).is_file():
+                    extra.append(str(rootp / c["mapping"]))
+            for tr in (t for c in configs if hasattr(c, "get") for t in c.get("traces") or () if isinstance(t, str)):
+                p = rootp / tr
+                extra += sorted(str(f) for f in p.rglob("*") if f.is_file()) if p.is_dir() else [str(p)] if p.is_file() else []
         return {"actions": [(act_requirements, [r])],
-                "file_dep": [str(rootp / plan_file), at(ws.MODEL)] + list(snap.values()) + extra,
+                "file_dep": [str(rootp / plan_file), at(ws.MODEL)] + list(snap.values()) + sorted(set(extra)),
                 "targets": [at(INDEX)], "uptodate": [code, sealed], "verbosity": 2, "clean": True}
 
     deadline_nodes = list(index.deadline_nodes) if index is not None else []

@@ -310,9 +310,18 @@ def current_snapshot_hashes(ws: Workspace, texts: Any) -> dict[str, str]:
     kept = read_artifact(ws, ws.CHECK_INDEX, None)
     if (isinstance(kept, dict) and kept.get("code") == code_stamp() and isinstance(kept.get("hashes"), dict)
             and kept.get(SEAL) == seal_of(kept) and kept.get("inputs") == check_inputs(ws)):
-        return dict(kept["hashes"])
+        return {**kept["hashes"], **state_hashes(ws)}
     return {**{ws.snapshot(n): hashlib.sha256(dumps(snap).encode("utf-8")).hexdigest()
-               for n, snap in node_snapshots(ws, texts).items()}, **current_model_hash(ws)}
+               for n, snap in node_snapshots(ws, texts).items()}, **current_model_hash(ws), **state_hashes(ws)}
+
+
+def state_hashes(ws: Workspace) -> dict[str, str]:
+    """``{"state:<Node>": sha256}`` of every node's declarations in the
+    plan's ``state:`` (:func:`rclverify.plan.state.state_sha256`): a
+    requirement record holds those of its cone's nodes, so a ``state:`` edit
+    shows it stale in ``rclverify report`` before the requirements stage ran."""
+    from .plan.state import state_key, state_sha256
+    return {state_key(n): state_sha256(ws.plan.states, n) for n in ws.checked.nodes}
 
 
 def record_provenance(ws: Workspace, node: str, stage: str, inputs: Sequence[str]) -> None:

@@ -183,3 +183,18 @@ def check_states(states: tuple[StateVar, ...], checked: Checked) -> list[Diagnos
         except RclError as exc:
             diags.extend(exc.diagnostics)
     return diags
+
+
+def state_key(node: str) -> str:
+    """The key of ``node``'s state declarations among the hashes a
+    requirement record is compared with (``rclverify.workspace.state_hashes``)."""
+    return f"state:{node}"
+
+
+def state_sha256(states: tuple[StateVar, ...], node: str) -> str:
+    """sha256 of ``node``'s state declarations (type, init, next; none: the
+    empty list), so that a ``state:`` edit makes the records that read them stale."""
+    import hashlib
+    import json
+    text = json.dumps([[s.name, s.type_name, s.init.text, s.next.text] for s in states if s.node == node])
+    return hashlib.sha256(text.encode("utf-8")).hexdigest()

@@ -412,6 +412,7 @@ def involved_model(sc: Mapping[str, Any]) -> Mapping[str, Any]:
 _CHECK_FIELDS = ("origin", "source", "formal", "assuming", "cone", "used", "traced_not_needed", "consistency",
                  "inconsistent_core", "vacuity", "vacuity_core", "counterexample", "failed_to_prevent", "reason", "smt2", "explanation",
                  "temporal",  # a temporal requirement's verdict, k, bound and trace (requirements/temporal_check.py)
+                 "traces",  # its recorded runs' verdicts (backends/monitors/temporal_evidence.py)
                  "duration_s")
 
 

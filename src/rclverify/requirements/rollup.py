@@ -63,6 +63,10 @@ def roll_up(record: Mapping[str, Any] | None, g_status: Callable[[str, int], str
     if v == "informal":
         return "informal", "pending", (f"no formal statement: traced only, never shown as met (its traced guarantees: "
                                        f"{traced_status})")
+    bad = [t for t in record.get("traces") or [] if t.get("status") == "failed"]
+    if bad:  # a recorded run refutes it: never met, whatever Z3 says (backends/monitors/temporal_evidence.py)
+        w = bad[0].get("verdict", {})
+        return "refuted", "failed", f"the recorded run {bad[0]['trace']} refutes it: {w.get('reason', '')} (Z3: {v})"
     if v == "refuted":
         who = ", ".join(p["label"] for p in record.get("failed_to_prevent", [])) or "no guarantee of the cone"
         return "refuted", "failed", f"Z3 found a counterexample that every premise allows; it is not prevented by: {who}"

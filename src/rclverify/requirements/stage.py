@@ -53,6 +53,7 @@ def stage_requirements(ws: "Workspace", *, force: bool = False) -> list[tuple[di
     from ..logic.world import fresh
     from ..cache import code_stamp
     from .check import check_requirement, cone_of, fingerprint, state_text, statement_formals
+    from ..backends.monitors.temporal_evidence import fingerprint_text, requirement_traces, trace_hashes, trace_rows
     code = f"{code_stamp()} z3 {z3.get_version_string()}"
     checked, model, plan = ws.checked, ws.model, ws.plan
     model_text = (ws.root / ws.MODEL).read_text(encoding="utf-8") if (ws.root / ws.MODEL).is_file() else \
@@ -73,7 +74,9 @@ def stage_requirements(ws: "Workspace", *, force: bool = False) -> list[tuple[di
         formal = formals[0] if formals else None
         cone = cone_of(formals, model) if formal is not None else []
         # a temporal requirement also reads the state declarations of its cone (plan.states)
-        fp = fingerprint(req, [snap(n) for n in cone] + [state_text(plan, cone)],
+        traces = requirement_traces(req, checked, plan)  # recorded runs checked against it (docs/plan.md)
+        th = trace_hashes(ws.root, traces)
+        fp = fingerprint(req, [snap(n) for n in cone] + [state_text(plan, cone)] + ([fingerprint_text(ws.root, traces)] if traces else []),
                          model_text if formal is not None else "", code)
         rel = record_path(req.id)
         keep.add(rel.rsplit("/", 1)[1])
@@ -90,6 +93,9 @@ def stage_requirements(ws: "Workspace", *, force: bool = False) -> list[tuple[di
                 keep.add(rec["smt2"].rsplit("/", 1)[1])
             rec["fingerprint"] = fp
             rec["inputs"] = input_hashes(ws, cone, snap, model_hash) if formal is not None else {}
+            if traces:
+                rec["traces"] = trace_rows(req, checked, plan, ws.root)
+                rec["inputs"].update(th)
             write_sealed(ws.root / rel, rec)
             now = True
         if rec.get("smt2"):
@@ -109,7 +115,9 @@ def input_hashes(ws: "Workspace", cone: list[str], snap: Any, model_hash: str) -
     of the snapshots of ``cone`` (``snap(node)`` gives a snapshot's text) and
     the model a record is made from: the hashes the report compares with the
     current ones (:func:`read_records`)."""
+    from ..plan.state import state_key, state_sha256
     out = {ws.snapshot(n): hashlib.sha256(snap(n).encode("utf-8")).hexdigest() for n in cone}
+    out.update({state_key(n): state_sha256(ws.plan.states, n) for n in cone})  # a state: edit is stale too
     out[ws.MODEL] = model_hash
     return out
 
@@ -143,6 +151,10 @@ def read_records(ws: "Workspace", current: dict[str, str] | None = None) -> dict
             continue
         assert rec is not None
         made = rec.get("inputs")
+        if current is not None and isinstance(made, dict):  # a recorded run's sha256 now (trace:<path>)
+            from ..backends.monitors.temporal_evidence import trace_hashes
+            current = {**current, **trace_hashes(ws.root, [(p[6:], None) for p in made
+                                                           if p.startswith("trace:") and p not in current])}
         if current is not None and rec.get("verdict") != "informal" and (
                 not isinstance(made, dict) or any(current.get(p) != h for p, h in made.items())):
             out[rid] = {**keep, "verdict": "stale", "recorded_verdict": rec.get("verdict"),
