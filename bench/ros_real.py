@@ -67,8 +67,8 @@ def measure(root: Path, truth: dict) -> dict[str, tuple[int, ...]]:
     found_sites = sum(holds(s) for s in static)
     reported = sum(any(nt.src.file == s[0] and s[1] <= nt.src.line <= s[1] + 3 for nt in g.notes)
                    for s in runtime)
-    right = sum(any(s[0] == e.src.file and s[3] == r and s[4] == e.topic and s[5] == e.msg_type for s in static)
-                for _n, r, e in edges)
+    right = sum(any(s[0] == e.src.file and s[2] in (None, n.name) and s[3] == r and s[4] == e.topic and s[5] == e.msg_type for s in static)
+                for n, r, e in edges)
     out = {"sites": (len(static), len(edges), found_sites, right), "sites_runtime": (len(runtime), 0, reported)}
     want_nodes = {s[2] for s in sites if s[2]} | set(truth.get("nodes", []))
     got_nodes = {n.name for n in nodes}
