@@ -4,7 +4,8 @@ workspaces, launch files, node sources and bags (docs/ros.md).
 Nodes come from the launch files given (``launch``); without any, each
 node source that names its node (``rospy.init_node('n')``,
 ``ros::init(.., "n")``, ``Node("n")`` ...) is one node in the root
-namespace.  A node's topics are its sources' publishers and subscribers,
+namespace (programs naming the same node are one node with all their
+endpoints; a Python file's node classes are one node each).  A node's topics are its sources' publishers and subscribers,
 resolved in the node's namespace (ROS name rules, :mod:`names`) and then
 remapped by the launch file's ``remap`` elements (the last matching remap wins).
 """
