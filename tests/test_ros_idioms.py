@@ -144,3 +144,49 @@ def test_yaml_launch_composable_node_with_parameter(tmp_path: Path) -> None:
     assert set(g.nodes) == {"/y/yrelay"}
     assert ("/y/yrelay", "pub", "/shared/out", "std_msgs/msg/String") in g.edges()
     assert ("/y/yrelay", "action_servers", "/y/sweep", "corpus_interfaces/action/Sweep") in g.edges(True)
+
+
+def test_programs_taking_one_node_name_without_launch_are_one_node_with_all_endpoints() -> None:
+    # Published packages ship several test scripts that call init_node with the
+    # same name; nothing starts them together, so none of them is dropped.
+    _, g = _graph("loose_sources")
+    node = g.nodes["/rig_jogger"]
+    assert node.sources == ["loose/src/bench_tools/scripts/jog_linear.py",
+                            "loose/src/bench_tools/scripts/jog_spin.py"]
+    assert {e.topic for e in node.service_clients} == {"/rig/home", "/rig/stop"}
+    [note] = [n for n in g.notes if n.code == "ROS-LAUNCH"]
+    assert str(note) == ("loose/src/bench_tools/scripts/jog_spin.py:7:1: warning: node /rig_jogger is also named "
+                         "at loose/src/bench_tools/scripts/jog_linear.py:10:9; no launch file starts these "
+                         "programs: shown as one node with the endpoints of all of them")
+
+
+def test_nodes_named_alike_are_merged_only_without_launch_files() -> None:
+    _, g = _graph("ros1_robot")  # launched: no merging note
+    assert not any("also named" in n.message for n in g.notes)
+
+
+@pytest.mark.parametrize("py2", [False, True])
+def test_python_node_classes_own_the_endpoints_written_in_them(py2: bool) -> None:
+    text = ("import rclpy\nfrom rclpy.node import Node\nfrom std_msgs.msg import String\n"
+            "class A(Node):\n"
+            "    def __init__(self):\n"
+            "        super().__init__('a')\n"
+            "        self.p = self.create_publisher(String, 'x', 1)\n"
+            "class B(Node):\n"
+            "    def __init__(self):\n"
+            "        super().__init__('b')\n"
+            "        self.s = self.create_subscription(String, 'x', None, 1)\n"
+            "def main():\n"
+            "    n = rclpy.create_node('c')\n"
+            "    n.create_publisher(String, 'y', 1)\n"
+            + ("    print 'py2'\n" if py2 else ""))
+    r = scan_python(text, "two.py")
+    assert [n for n, _ in r["nodes"]] == ["a", "b", "c"]
+    assert [(r["nodes"][o][0], e.topic) for o, e in zip(r["owners"], r["endpoints"])] == [
+        ("a", "x"), ("b", "x"), ("c", "y")]
+    assert bool(r["notes"]) is py2  # the tolerant reader gives the same classes
+
+
+def test_one_node_file_has_no_owners() -> None:
+    r = scan_python("import rospy\nrospy.init_node('n')\nclass K(object):\n    pass\n", "one.py")
+    assert r["owners"] == []

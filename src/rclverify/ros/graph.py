@@ -4,7 +4,8 @@ workspaces, launch files, node sources and bags (docs/ros.md).
 Nodes come from the launch files given (``launch``); without any, each
 node source that names its node (``rospy.init_node('n')``,
 ``ros::init(.., "n")``, ``Node("n")`` ...) is one node in the root
-namespace.  A node's topics are its sources' publishers and subscribers,
+namespace (programs naming the same node are one node with all their
+endpoints; a Python file's node classes are one node each).  A node's topics are its sources' publishers and subscribers,
 resolved in the node's namespace (ROS name rules, :mod:`names`) and then
 remapped by the launch file's ``remap`` elements (the last matching remap wins).
 """
@@ -217,10 +218,18 @@ def _scan(paths: Sequence[Path], launch: Sequence[Path], launch_args: dict[str, 
     def add_node(full: str, ns: str, pkg: str | None, exe: str | None, files: list[str], declared: Src,
                  eps: list[Endpoint], remaps: list[tuple[str, str, Src]], origin: str,
                  params: dict[str, tuple[str, Src]] | None = None) -> None:
-        if full in g.nodes:
+        node = GraphNode(full, ns, pkg, exe, files, declared, origin=origin)
+        if full in g.nodes and origin == "source" and g.nodes[full].origin == "source":
+            # no launch file starts them: several programs that take the same
+            # name are one node of the graph with all their endpoints (docs/ros.md)
+            node = g.nodes[full]
+            g.notes.append(Note(declared, f"node {full} is also named at {node.declared_at}; no launch file "
+                                          f"starts these programs: shown as one node with the endpoints of "
+                                          f"all of them", "ROS-LAUNCH"))
+            node.sources.extend(f for f in files if f not in node.sources)
+        elif full in g.nodes:
             g.notes.append(Note(declared, f"node {full} is started twice (first at {g.nodes[full].declared_at}); "
                                           f"ROS keeps only the last one", "ROS-LAUNCH"))
-        node = GraphNode(full, ns, pkg, exe, files, declared, origin=origin)
         mine = {names.resolve(k, ns, full): v for k, v in (params or {}).items()}
         for e in eps:
             written, pname, set_at = e.topic, None, None
@@ -274,10 +283,16 @@ def _scan(paths: Sequence[Path], launch: Sequence[Path], launch_args: dict[str, 
                     g.notes.append(Note(rest[0].src, "endpoints outside the file's node classes, in a file that is "
                                                      "started by no launch file: not in the graph"))
                 continue
-            for (nname, src) in r["nodes"][:1]:
-                full = names.join("/", nname)
-                pkg = next((p for p, pk in pkgs.items() if shown.startswith(show(pk.root) + "/")), None)
-                add_node(full, "/", pkg, None, [shown], src, r["endpoints"], [], "source")
+            # a Python file naming several nodes in their own classes: one node
+            # each, with the endpoints of its class (sources_py.owners)
+            own = r.get("owners") or []
+            firsts: dict[str, Src] = {}
+            for nname, src in (r["nodes"] if own else r["nodes"][:1]):
+                firsts.setdefault(nname, src)
+            pkg = next((p for p, pk in pkgs.items() if shown.startswith(show(pk.root) + "/")), None)
+            for nname, src in firsts.items():
+                eps = [e for k, e in enumerate(r["endpoints"]) if not own or r["nodes"][own[k]][0] == nname]
+                add_node(names.join("/", nname), "/", pkg, None, [shown], src, eps, [], "source")
             if not r["nodes"] and r["endpoints"]:
                 g.notes.append(Note(r["endpoints"][0].src, "publishers/subscribers in a file that names no node "
                                                           "and is started by no launch file: not in the graph",

@@ -35,8 +35,10 @@ class PyCall:
 @dataclass
 class PyModule:
     """What the readers give: ``imports`` (local name -> dotted origin), every call,
-    and the assignments ``(target as written, value)``."""
+    the assignments ``(target as written, value)``, and each class statement's
+    ``(name, first line, last line)``."""
 
     imports: dict[str, str] = field(default_factory=dict)
     calls: list[PyCall] = field(default_factory=list)
     assigns: list[tuple[str, PyVal]] = field(default_factory=list)
+    classes: list[tuple[str, int, int]] = field(default_factory=list)

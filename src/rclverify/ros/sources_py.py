@@ -116,11 +116,14 @@ def _ast_module(tree: ast.AST, shown: str) -> PyModule:
                 mod.imports[a.asname or a.name.split(".")[0]] = a.name if a.asname else a.name.split(".")[0]
         elif isinstance(n, ast.Call):
             mod.calls.append(call(n))
+        elif isinstance(n, ast.ClassDef):
+            mod.classes.append((n.name, n.lineno, getattr(n, "end_lineno", None) or n.lineno))
         elif isinstance(n, (ast.Assign, ast.AnnAssign)) and n.value is not None:
             for t in (n.targets if isinstance(n, ast.Assign) else [n.target]):
                 d = _dotted(t)
                 if d is not None:
                     mod.assigns.append((d, val(n.value)))
+    mod.calls.sort(key=lambda c: (c.src.line, c.src.col))  # source order, as the tolerant reader gives
     return mod
 
 
@@ -249,4 +252,40 @@ def extract(mod: PyModule, shown: str) -> dict[str, Any]:
             out["notes"].append(Note(type_v.src, f"type '{_short(type_v.text)}' of {_WHAT[kind]} '{topic or param}' "
                                                  f"not resolved statically"))
         out["endpoints"].append(Endpoint(kind, topic or "", t, c.src, param))
+    out["owners"] = owners(mod.classes, out["nodes"], out["endpoints"])
+    return out
+
+
+def owners(classes: list[tuple[str, int, int]], nodes: list[tuple[str, Src]], eps: list[Endpoint]) -> list[int]:
+    """For each endpoint, the index in ``nodes`` of the node it belongs to.
+
+    A file that names several nodes, each in its own class (``class
+    Talker(Node)`` with ``super().__init__('talker')``), gives each node the
+    endpoints written inside its class (the innermost class holding the call,
+    ``classes`` as ``(name, first line, last line)``); endpoints outside every
+    such class belong to the first node named outside them (``create_node``
+    in ``main``), else to the first node. Returns ``[]`` when the file names
+    fewer than two distinct nodes (every endpoint is the one node's)."""
+    if len({n for n, _ in nodes}) < 2:
+        return []
+
+    def cls(line: int) -> tuple[str, int, int] | None:
+        inside = [c for c in classes if c[1] <= line <= c[2]]
+        return min(inside, key=lambda c: c[2] - c[1]) if inside else None
+
+    of_class: dict[tuple[str, int, int], int] = {}
+    loose = None
+    for i, (_name, src) in enumerate(nodes):
+        c = cls(src.line)
+        if c is not None:
+            of_class.setdefault(c, i)
+        elif loose is None:
+            loose = i
+    out = []
+    for e in eps:
+        c = cls(e.src.line)
+        while c is not None and c not in of_class:  # a nested class: look outwards
+            outer = [k for k in classes if k[1] <= c[1] and k[2] >= c[2] and k != c]
+            c = min(outer, key=lambda k: k[2] - k[1]) if outer else None
+        out.append(of_class[c] if c is not None else (loose if loose is not None else 0))
     return out

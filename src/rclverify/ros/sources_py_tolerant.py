@@ -134,6 +134,8 @@ def tolerant_module(text: str, shown: str) -> tuple[Any, str]:
                     mod.imports[_txt(x)] = f"{m}.{_txt(x)}"
         elif t == "call":
             mod.calls.append(call(n, 0))
+        elif t == "class_definition" and n.child_by_field_name("name") is not None:
+            mod.classes.append((_txt(n.child_by_field_name("name")), n.start_point[0] + 1, n.end_point[0] + 1))
         elif t == "assignment":
             left, right = n.child_by_field_name("left"), n.child_by_field_name("right")
             d = dotted(left) if left is not None else None
