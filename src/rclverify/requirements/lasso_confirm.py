@@ -112,7 +112,9 @@ def _confirm(trace: Sequence[Mapping[str, Any]], loop: int, cone: Sequence[str],
                 for k, g in enumerate(cn.node.guarantees, 1):
                     if not _holds(g.formula, checked, cn, vals, f"step {i}: {n} guarantee {k}"):
                         raise _Unconfirmed(f"step {i}: {n}'s guarantee {k} does not hold")
-        pseudo = {f"in.{name}": v for name, v in st.items()}
+        # the statement's pseudo node names Node.out.y an output, every other variable an input (plan/formal.py)
+        pseudo = {f"{'out' if variables[name][1] == 'out' else 'in'}.{name}": v
+                  for name, v in st.items() if name in variables}
         for k, a in enumerate(assuming, 1):
             if not _holds(a.expr, checked, a.scope, pseudo, f"step {i}: assuming {k}"):
                 raise _Unconfirmed(f"step {i}: the requirement's assuming {k} does not hold")
