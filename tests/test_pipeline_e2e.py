@@ -159,8 +159,8 @@ def test_ci_formats_carry_the_case_study_findings_at_their_rcl_locations(workspa
     reqs = {c.name: c for c in suites["requirements"]}
     assert set(reqs) == {"REQ1", "REQ2", "REQ3", "REQ4"}
     assert isinstance(reqs["REQ1"].result[0], junitparser.Failure)  # proved vacuously: not met
-    # temporal, inconclusive (Z3 cannot decide a state of the composed contracts in its budget): skipped, never passed
-    assert isinstance(reqs["REQ4"].result[0], junitparser.Skipped)
+    # temporal, refuted by a lasso (the rover never arrives where it is commanded): a failure, never passed
+    assert isinstance(reqs["REQ4"].result[0], junitparser.Failure)
     assert ("RCL-REQ-VACUOUS", "contracts/plan.yaml", 28) in at
     cases = {c.name: c for s in xml for c in s}
     report = json.loads((reports / "assurance.json").read_text())
@@ -214,7 +214,7 @@ def test_second_run_executes_no_task(workspace: Path) -> None:
 def test_a_run_with_nothing_to_do_still_prints_the_status_and_the_problems_by_root_cause(workspace: Path) -> None:
     r = _doit(workspace, "verify")
     assert r.returncode == 0
-    assert "overall: failed" in r.stdout and "9 problems by root cause (52 findings)" in r.stdout, r.stdout
+    assert "overall: failed" in r.stdout and "10 problems by root cause (53 findings)" in r.stdout, r.stdout
     # 7: the Agent's model-checking instances are rows of their own (report/problems_mc.py), not this one
     assert "1. [failed] guarantee 3 of Agent (contracts/remote_inspection.rcl:72:3): 7 findings" in r.stdout
     assert "| Agent " in r.stdout and "report: reports/assurance.html" in r.stdout

@@ -24,6 +24,8 @@ def requirement_record(ws: Any, report: Mapping[str, Any], q: Mapping[str, Any],
     guarantee's (text, source)."""
     check = q.get("check") or {}
     cone = [str(n) for n in check.get("cone") or []]
+    if check.get("temporal"):
+        return _temporal_record(q, check)
 
     def find() -> list[dict[str, Any]]:
         rows = []
@@ -91,3 +93,26 @@ def _between(report: Mapping[str, Any], sources: set[str], sinks: set[str]) -> s
                     todo.append(m)
         return seen
     return (reach(sources, down) & reach(sinks, up)) - sources - sinks
+
+
+def _temporal_record(q: Mapping[str, Any], check: Mapping[str, Any]) -> dict[str, Any]:
+    """The diagnosis of a refuted temporal requirement: its counterexample
+    run (docs/requirements.md, "Temporal requirements"), the state it loops
+    through shown node by node.  No culprit is named: the run meets every
+    contract, and no strengthening is searched for a temporal statement
+    (docs/diagnosis.md: only what Z3 showed is named)."""
+    t = check["temporal"]
+    trace = t.get("trace") or []
+    loop = t.get("loop")
+    shown = trace[loop] if loop is not None and 0 <= loop < len(trace) else (trace[-1] if trace else {"nodes": []})
+    table = [{"node": r["node"], "variable": v, "value": x, "table": None}
+             for r in shown.get("nodes", []) for v, x in r["values"].items()]
+    run = (f"a run of {len(trace)} states whose last returns to step {loop} and repeats forever"
+           if loop is not None else f"a run of {len(trace)} states")
+    cex = ", ".join(f"{r['node']}.{r['variable']} = {r['value']}" for r in table)
+    sentence = (f"Requirement {q['id']} (`{check.get('formal')}`, {check.get('source')}) is refuted by {run} that "
+                f"meets every contract of its cone ({t.get('method')}; {t.get('detail')}). "
+                f"The state it repeats: {cex}. No guarantee of the cone prevents it: "
+                "a guarantee that forces progress, or an assuming: that excludes the run, is needed.")
+    return {"id": str(q["id"]), "kind": "requirement", "node": "", "status": "failed", "sentence": sentence,
+            "culprits": [], "counterexample": table, "repairs": [], "guarantee": None}

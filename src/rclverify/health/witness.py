@@ -67,6 +67,29 @@ def _coordinate(d: z3.FuncDeclRef, m: int, v: int) -> z3.ExprRef:
     return z3.RealVal(v, d.ctx) if d.domain(m) == z3.RealSort(d.ctx) else z3.IntVal(v, d.ctx)
 
 
+def table_point(sorts: Sequence[z3.SortRef], j: int) -> list[z3.ExprRef]:
+    """Point ``j`` of a table over arguments of ``sorts`` (each REAL or
+    INTEGER): ``(j, 0, ..., 0)``."""
+    return [(z3.RealVal if s == z3.RealSort(s.ctx) else z3.IntVal)(j if m == 0 else 0, s.ctx)
+            for m, s in enumerate(sorts)]
+
+
+def table_term(args: Sequence[z3.ExprRef], name: str, result: z3.SortRef,
+               points: int) -> tuple[z3.ExprRef, list[z3.ExprRef]]:
+    """The finite table of the module docstring applied to ``args`` (each
+    of REAL or INTEGER sort): ``If(args == point 0, name!v0, If(...,
+    name!else))``.  Returns the term and its free value constants
+    ``[name!v0, ..., name!v<points-1>, name!else]`` (of sort ``result``):
+    two tables with equal constants are the same function.  Also used for
+    the runs of :mod:`rclverify.requirements.lasso`."""
+    values = [z3.Const(f"{name}!v{j}", result) for j in range(points)] + [z3.Const(f"{name}!else", result)]
+    body: z3.ExprRef = values[-1]
+    for j in range(points):
+        pt = table_point([a.sort() for a in args], j)
+        body = z3.If(z3.And(*[a == p for a, p in zip(args, pt)]), values[j], body)
+    return body, values
+
+
 def finite_witness(enc: Any, formulas: Sequence[z3.BoolRef], points: int,
                    budget_ms: int = WITNESS_TIMEOUT_MS) -> Witness:
     """Look for a model of ``formulas`` (and ``enc``'s typing axioms) in
@@ -83,13 +106,8 @@ def finite_witness(enc: Any, formulas: Sequence[z3.BoolRef], points: int,
             continue
         # a FuncDeclRef of the fresh context (translate() hands back a plain AST handle)
         d = z3.FuncDeclRef(z3.Z3_to_func_decl(ctx.ref(), d.translate(ctx).as_ast()), ctx)
-        params = [z3.Var(j, d.domain(j)) for j in range(d.arity())]
-        body: z3.ExprRef = z3.Const(f"{name}!else", d.range())
-        for j in range(points):
-            pt = [_coordinate(d, m, j if m == 0 else 0) for m in range(d.arity())]
-            # in z3.substitute_funs, Var(m) stands for argument m (not de Bruijn order)
-            cond = z3.And(*[params[m] == pt[m] for m in range(d.arity())])
-            body = z3.If(cond, z3.Const(f"{name}!v{j}", d.range()), body)
+        # in z3.substitute_funs, Var(m) stands for argument m (not de Bruijn order)
+        body, _ = table_term([z3.Var(j, d.domain(j)) for j in range(d.arity())], name, d.range(), points)
         subs.append((d, body))
         tables[name] = (sym.display, d)
     all_formulas = [f.translate(ctx) for f in list(formulas) + list(enc.axioms())]

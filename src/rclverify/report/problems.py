@@ -349,6 +349,8 @@ def _default_anchor(d: Mapping[str, Any], anchor: Callable[..., str]) -> str:
         return anchor("sc", d["id"])
     if d["kind"] in ("vacuity", "inconsistency", "unsatisfiable-assumption", "refinement"):
         return anchor("finding", d["id"])
+    if d["kind"] == "requirement":  # a refuted requirement's diagnosis: its row in the requirements table
+        return anchor("req", d["id"])
     return anchor("ev", d["id"])
 
 

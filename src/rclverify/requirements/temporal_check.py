@@ -39,11 +39,15 @@ from ..plan.formal import Formal, parse_formal
 from ..plan.load import Plan, Requirement
 from ..plan.state import state_types
 from ..plan.temporal import Temporal, operands, parse_temporal, shape
-from ..rcl.types import Checked
+from ..health.witness import points_for
+from ..rcl.types import Checked, EmptyT
+from ..values import render
 from ..system.model import SystemModel
 from .temporal import (TemporalVerdict, TransitionSystem, check_always, check_eventually,
                        check_eventually_within)
-from .transition import ComposedSystem, build_system
+from .lasso import find_table_lasso
+from .lasso_confirm import confirm_lasso
+from .transition import ComposedSystem, build_system, variable_types
 
 #: The bound of BMC for an unbounded ``eventually`` and of k-induction's k.
 DEFAULT_BOUND = 10
@@ -74,11 +78,20 @@ def _with_flag(ts: TransitionSystem, name: str, init: Callable[[Any], Any], step
 
 
 def decide(t: Temporal, sys: ComposedSystem, pred: Callable[[Formal], Callable[[Any], Any]], *,
-           bound: int = DEFAULT_BOUND, timeout_ms: int = 10_000) -> TemporalVerdict:
+           bound: int = DEFAULT_BOUND, timeout_ms: int = 10_000,
+           tables: Callable[[Formal, TemporalVerdict], TemporalVerdict] | None = None,
+           ranking: Callable[[Any], Any] | None = None, invariant: Callable[[Any], Any] | None = None) -> TemporalVerdict:
     """Decide statement ``t`` over ``sys`` (module table); ``pred(F)`` is
-    F as a predicate over one state."""
+    F as a predicate over one state.  ``tables(F, v)`` is asked when the
+    verdict ``v`` on an unbounded ``eventually F`` is inconclusive (the
+    finite-table lasso search of :func:`check_temporal`); ``ranking`` and
+    ``invariant`` (over one state) are the plan's, for that ``eventually``."""
     kind = shape(t, None)
     ts = sys.ts
+
+    def eventually(g: Formal) -> TemporalVerdict:
+        v = check_eventually(ts, pred(g), ranking=ranking, invariant=invariant, bound=bound, timeout_ms=timeout_ms)
+        return tables(g, v) if tables is not None and v.status == "inconclusive" else v
     if kind == "always":
         return check_always(ts, pred(t.args[0]), max_k=bound, timeout_ms=timeout_ms)
     if kind == "always next":
@@ -105,14 +118,14 @@ def decide(t: Temporal, sys: ComposedSystem, pred: Callable[[Formal], Callable[[
         if t.bound is not None:
             v = check_eventually_within(ts, f, t.bound, timeout_ms=timeout_ms)
             return TemporalVerdict("proved", v.method, bound=v.bound, detail=v.detail) if v.status == "met" else v
-        return check_eventually(ts, f, bound=bound, timeout_ms=timeout_ms)
+        return eventually(t.args[0])  # type: ignore[arg-type]
     # until: safety part always (seen(G) or F), liveness part eventually G
     f, g = pred(t.args[0]), pred(t.args[1])
     ts2 = _with_flag(ts, "<G seen>", g, lambda s, u: z3.Or(s["<G seen>"], g(u)))
     safe = check_always(ts2, lambda s: z3.Or(s["<G seen>"], f(s)), max_k=bound, timeout_ms=timeout_ms)
     if safe.status == "refuted":
         return safe
-    live = check_eventually(ts, g, bound=bound, timeout_ms=timeout_ms)
+    live = eventually(t.args[1])  # type: ignore[arg-type]
     if live.status == "refuted" or (safe.status == "proved" and live.status == "proved"):
         return TemporalVerdict(live.status, f"{safe.method} + {live.method}", k=safe.k, bound=live.bound,
                                trace=live.trace, loop=live.loop, detail=live.detail)
@@ -161,7 +174,32 @@ def check_temporal(req: Requirement, checked: Checked, model: SystemModel, plan:
         for k, a in enumerate(assuming, 1):
             sys.premises.append({"label": f"assuming {k}", "kind": "assuming", "node": None, "index": k,
                                  "text": base["assuming"][k - 1], "source": base["source"]})
-    v = decide(t, sys, pred, bound=bound, timeout_ms=timeout_ms)
+    types = variable_types(sys, checked, plan)
+    points = max([points_for(plan.instances.get(n)) for n in cone] or [points_for(None)])
+
+    def tables(goal: Formal, v: TemporalVerdict) -> TemporalVerdict:
+        """The finite-table lasso search, confirmed on the trace (:mod:`.lasso`)."""
+        if any(isinstance(ty, EmptyT) for ty in types.values()):
+            return v
+        try:
+            found = find_table_lasso(sys.ts, pred(goal), types, bound=bound, points=points)
+        except (ValueError, z3.Z3Exception) as exc:
+            found = f"the finite-table search failed ({exc})"
+        if isinstance(found, str):
+            return TemporalVerdict(v.status, v.method, k=v.k, bound=v.bound, trace=v.trace, loop=v.loop,
+                                   detail=f"{v.detail}; {found}")
+        why = confirm_lasso(found.values, found.loop, cone, sys.variables, types, checked, model, plan, goal, assuming)
+        if why is not None:
+            return TemporalVerdict(v.status, v.method, k=v.k, bound=v.bound, trace=v.trace, loop=v.loop,
+                                   detail=f"{v.detail}; a lasso with {points}-point tables was found but not "
+                                          f"confirmed on its values ({why})")
+        n = len(found.values) - 1
+        return TemporalVerdict("refuted", "lasso", bound=n, loop=found.loop,
+                               trace=[{k: render(x) for k, x in st.items()} for st in found.values],
+                               detail=f"a run whose step {n} returns to step {found.loop} and never reaches it "
+                                      f"(found with every function a {points}-point table, confirmed on the "
+                                      f"trace's values)")
+    v = decide(t, sys, pred, bound=bound, timeout_ms=timeout_ms, tables=tables)
     out: dict[str, Any] = {**base, "cone": cone, "premises": len(sys.premises), "used": [], "traced_not_needed": [],
                            "temporal": {**v.to_json(), "trace": _steps(v.trace, sys)}}
     if v.status in ("proved", "met"):

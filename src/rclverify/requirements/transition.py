@@ -85,6 +85,16 @@ class ComposedSystem:
         return out
 
 
+def variable_types(sys: ComposedSystem, checked: Checked, plan: Plan) -> dict[str, Type]:
+    """The RCL type of each variable of ``sys`` (``{name: type}``)."""
+    out: dict[str, Type] = {}
+    declared = {(sv.node, sv.name): sv for sv in plan.states}
+    for name, (n, p, v) in sys.variables.items():
+        cn = checked.nodes[n]
+        out[name] = state_type(declared[(n, v)], checked) if p == "state" else (cn.inputs if p == "in" else cn.outputs)[v]
+    return out
+
+
 def build_system(cone: Sequence[str], checked: Checked, model: SystemModel, plan: Plan) -> ComposedSystem:
     """The transition system of ``cone`` (module docstring).
 
