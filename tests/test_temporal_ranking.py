@@ -125,6 +125,7 @@ def test_an_edit_of_ranking_rechecks_that_requirement_only(countdown) -> None:
     ({"formal": C0, "ranking": "Cnt.state.c == 0"}, "plan.yaml:6:15:", "must be an INTEGER or NATURAL term, found BOOL"),
     ({"formal": "always Cnt.state.c <= 50", "ranking": "Cnt.state.c"}, "plan.yaml:6:15:", "only for a liveness"),
     ({"formal": "eventually[<= 60] Cnt.state.c == 0", "invariant": "TRUE"}, "plan.yaml:6:17:", "only for a liveness"),
+    ({"ranking": "Cnt.state.c"}, "plan.yaml:5:15:", "need a liveness statement in formal:"),
     ({"formal": C0, "ranking": "Cnt.state.q"}, "plan.yaml:6:15:", "Cnt.state.q is not a state variable"),
 ])
 def test_ranking_and_invariant_errors_are_located(tmp_path: Path, req: dict, where: str, what: str) -> None:
