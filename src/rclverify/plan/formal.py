@@ -113,6 +113,20 @@ def parse_formal(src: Source, checked: Checked, what: str = "requirement",
     diagnostics (``E-name`` for names, ``E-type`` for typing, RCL syntax
     errors as the parser gives them).
     """
+    expr, scope, mentions, t = read_expr(src, checked, what, states)
+    if t != BOOL:
+        raise RclError([error(src.loc, f"{what}: must be a formula, found a term of type {t}", "E-type")])
+    return Formal(expr, scope, mentions)
+
+
+def read_expr(src: Source, checked: Checked, what: str = "requirement",
+              states: Mapping[tuple[str, str], Type] | None = None
+              ) -> tuple[ast.Expr, CheckedNode, tuple[tuple[str, str, str], ...], Type]:
+    """Parse and type one RCL expression over ``Node.in.x``/``Node.out.y``
+    (and ``Node.state.v`` of ``states``), read as :func:`parse_formal` reads
+    a formula but of any type: returns ``(expr, scope, mentions, type)``
+    with the fields of :class:`Formal` and the inferred type.  Raises
+    :class:`RclError` with located diagnostics (as :func:`parse_formal`)."""
     from ..rcl.parser import parse_formula
     from ..rcl.typecheck import infer
     diags = []
@@ -165,10 +179,7 @@ def parse_formal(src: Source, checked: Checked, what: str = "requirement",
     expr = parse_formula(text, src.file, src.line, src.col)
     expr = _rename(expr, names)
     scope = system_scope(checked, states)
-    t = infer(expr, scope, checked.env)
-    if t != BOOL:
-        raise RclError([error(src.loc, f"{what}: must be a formula, found a term of type {t}", "E-type")])
-    return Formal(expr, scope, tuple(mentions))
+    return expr, scope, tuple(mentions), infer(expr, scope, checked.env)
 
 
 def _rename(e: Any, names: Mapping[str, str]) -> Any:

@@ -18,7 +18,7 @@ from typing import Any, Mapping
 import yaml
 
 from ..rcl import ast
-from ..rcl.errors import Diagnostic, RclError
+from ..rcl.errors import Diagnostic, RclError, error
 from ..rcl.types import BOOL, Checked
 from .errors import PlanError, plan_error
 from .formal import Source
@@ -118,7 +118,10 @@ def load_plan(root: Path, plan_rel: str = "contracts/plan.yaml") -> Plan:
         srcs = tuple(_source(("requirements", i, "assuming") + ((j,) if isinstance(r["assuming"], list) else ()),
                              {"v": a}, "v", locs, blocks, plan_rel) for j, a in enumerate(assuming))
         reqs.append(Requirement(str(r["id"]), str(r["text"]).strip(), sup, loc("requirements", i), formal,
-                                tuple(x for x in srcs if x is not None)))
+                                tuple(x for x in srcs if x is not None),
+                                ranking=_source(("requirements", i, "ranking"), r, "ranking", locs, blocks, plan_rel),
+                                invariant=_source(("requirements", i, "invariant"), r, "invariant", locs, blocks,
+                                                  plan_rel)))
     conns = []
     for i, c in enumerate(data.get("connections", []) or []):
         fn, fv = c["from"].split(".", 1)
@@ -214,6 +217,7 @@ def check_formal(reqs: tuple[Requirement, ...], checked: Checked, states: tuple[
     input written as an output, a type error, a temporal operator's bound;
     ``states`` the plan's declared state variables, :mod:`.state`)."""
     from .formal import parse_formal
+    from .ranking import parse_hints
     from .state import state_types
     from .temporal import Temporal, parse_temporal, shape
     stypes = state_types(tuple(states), checked)
@@ -230,8 +234,14 @@ def check_formal(reqs: tuple[Requirement, ...], checked: Checked, states: tuple[
                 t = parse_temporal(r.formal, checked, f"{r.id} formal", stypes)
                 if isinstance(t, Temporal):
                     shape(t, r.formal.loc)  # a nesting that is not decided: a located E-temporal error
+                parse_hints(r.ranking, r.invariant, t, checked, r.id, stypes)  # ranking:/invariant: (.ranking)
             except RclError as exc:
                 diags.extend(exc.diagnostics)
+        elif r.ranking or r.invariant:
+            src = r.ranking or r.invariant
+            assert src is not None
+            diags.append(error(src.loc, f"{r.id}: ranking:/invariant: need a liveness statement in formal: "
+                                        "(eventually F, or F until G)", "E-temporal"))
         for src, what in [(a, f"{r.id} assuming") for a in r.assuming]:
             try:
                 parse_formal(src, checked, what)

@@ -33,7 +33,9 @@ class Requirement:
     ``formal`` is its formal statement (``None``: informal, traced only) and
     ``assuming`` its own environment assumptions, both RCL over
     ``Node.in.x``/``Node.out.y`` (:mod:`.formal`); ``origin`` is ``"plan"``
-    or the Doorstop item's workspace-relative file.
+    or the Doorstop item's workspace-relative file; ``ranking`` and
+    ``invariant`` the sources of a liveness statement's ranking function
+    and invariant (:mod:`.ranking`; ``None`` when not given).
     """
 
     id: str
@@ -43,6 +45,8 @@ class Requirement:
     formal: Source | None = None
     assuming: tuple[Source, ...] = ()
     origin: str = "plan"
+    ranking: Source | None = None
+    invariant: Source | None = None
 
 
 @dataclass(frozen=True)

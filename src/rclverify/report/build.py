@@ -422,8 +422,11 @@ def current_record(req: Any, record: Mapping[str, Any] | None) -> Mapping[str, A
     before the ``requirements`` stage ran); an informal requirement needs no
     record."""
     formal = " ".join(req.formal.text.split()) if req.formal else None
+    hints = [" ".join(x.text.split()) if x else None for x in (getattr(req, "ranking", None),
+                                                                 getattr(req, "invariant", None))]
     if record is not None and record.get("formal") == formal \
-            and record.get("assuming", []) == [" ".join(a.text.split()) for a in req.assuming]:
+            and record.get("assuming", []) == [" ".join(a.text.split()) for a in req.assuming] \
+            and [record.get("ranking"), record.get("invariant")] == hints:
         return record
     if formal is None:
         return {"verdict": "informal", "source": f"{req.loc.file}:{req.loc.line}:{req.loc.col}", "origin": req.origin}

@@ -88,16 +88,20 @@ def formals_of(req: Requirement, checked: Checked) -> tuple[Formal | None, list[
     return f, [parse_formal(a, checked, f"{req.id} assuming") for a in req.assuming]
 
 
-def statement_formals(req: Requirement, checked: Checked, plan: Plan) -> list[Formal]:
+def statement_formals(req: Requirement, checked: Checked, plan: Plan) -> list[Any]:
     """The state formulas a requirement's cone is computed from: its formal
-    statement (every operand of a temporal one) and its ``assuming:``;
-    ``[]`` for an informal requirement."""
+    statement (every operand of a temporal one), its ``assuming:``, then
+    its ``ranking:`` term and ``invariant:`` (:mod:`rclverify.plan.ranking`),
+    each with ``nodes``; ``[]`` for an informal requirement."""
     if req.formal is None:
         return []
+    from ..plan.ranking import parse_hints
     from ..plan.state import state_types
     from ..plan.temporal import operands, parse_temporal
-    t = parse_temporal(req.formal, checked, f"{req.id} formal", state_types(plan.states, checked))
-    return [*operands(t), *assuming_of(req, checked)]
+    stypes = state_types(plan.states, checked)
+    t = parse_temporal(req.formal, checked, f"{req.id} formal", stypes)
+    hints = [h for h in parse_hints(req.ranking, req.invariant, t, checked, req.id, stypes) if h is not None]
+    return [*operands(t), *assuming_of(req, checked), *hints]
 
 
 def assuming_of(req: Requirement, checked: Checked) -> list[Formal]:
@@ -122,6 +126,7 @@ def fingerprint(req: Requirement, cone_snapshots: Sequence[str], model_json: str
     h = hashlib.sha256(code.encode())
     h.update(json.dumps([req.id, req.text, [req.formal.text, req.formal.line, req.formal.col] if req.formal else None,
                          [[a.text, a.line, a.col] for a in req.assuming], str(req.loc),
+                         [[x.text, x.line, x.col] if x else None for x in (req.ranking, req.invariant)],
                          [[s.node, list(s.guarantees)] for s in req.support], req.origin]).encode())
     for s in cone_snapshots:
         h.update(b"\0" + s.encode())
@@ -171,6 +176,8 @@ def check_requirement(req: Requirement, checked: Checked, model: SystemModel, pl
         "source": _where(req.formal.loc if req.formal else req.loc),
         "formal": " ".join(req.formal.text.split()) if req.formal else None,
         "assuming": [" ".join(a.text.split()) for a in req.assuming],
+        "ranking": " ".join(req.ranking.text.split()) if req.ranking else None,
+        "invariant": " ".join(req.invariant.text.split()) if req.invariant else None,
         "traced": [{"node": s.node, "guarantee": k} for s in req.support for k in s.guarantees],
     }
     if req.formal is not None and plan is not None:

@@ -145,7 +145,8 @@ def read_records(ws: "Workspace", current: dict[str, str] | None = None) -> dict
         rec, why = read_sealed(ws.root / record_path(rid), "requirement record")
         if rec is None and not why:
             continue
-        keep = {k: rec.get(k) for k in ("id", "formal", "assuming", "source", "origin", "text")} if rec else {}
+        keep = {k: rec.get(k) for k in ("id", "formal", "assuming", "ranking", "invariant", "source",
+                                           "origin", "text")} if rec else {}
         if why or problem:
             out[rid] = {**keep, "verdict": "error", "reason": f"{record_path(rid)}: {why or problem}"}
             continue

@@ -159,17 +159,18 @@ def check_eventually(ts: TransitionSystem, prop: Pred, *,
     ``prop``, that is a proof (``proved``, method ``bounded``).
     """
     inv = invariant or (lambda st: z3.BoolVal(True))
+    why: str | None = "no ranking function"
     if ranking is not None:
-        iv = check_always(ts, inv, timeout_ms=timeout_ms) if invariant else None
-        if iv is None or iv.status == "proved":
-            a, b = ts.state(0), ts.state(1)
-            s = z3.Solver()
-            s.set("timeout", timeout_ms)
-            s.add(inv(a), z3.Not(prop(a)), ts.trans(a, b))
-            s.add(z3.Or(ranking(a) < 0, z3.Not(ranking(b) < ranking(a))))
-            if s.check() == z3.unsat:
-                return TemporalVerdict("proved", "ranking",
-                                       k=iv.k if iv else None)
+        iv = check_always(ts, inv, max_k=bound, timeout_ms=timeout_ms) if invariant else None
+        if iv is not None and iv.status != "proved":
+            why = (f"ranking function not used: its invariant is not proved ({iv.status} by {iv.method}"
+                   + (f": {iv.detail}" if iv.detail else "") + ")")
+        else:
+            why = _ranking_fails(ts, prop, inv, ranking, timeout_ms)
+            if why is None:
+                return TemporalVerdict("proved", "ranking", k=iv.k if iv else None,
+                                       detail="in every state of the invariant where it does not hold, the "
+                                              "ranking function is >= 0 and every step decreases it")
     bounded = check_eventually_within(ts, prop, bound, timeout_ms=timeout_ms)
     if bounded.status == "inconclusive":  # the solver could not say: nothing was checked, and no lasso is sought
         return TemporalVerdict("inconclusive", "bounded", bound=None,
@@ -182,9 +183,34 @@ def check_eventually(ts: TransitionSystem, prop: Pred, *,
     lasso = find_lasso(ts, prop, bound, timeout_ms=timeout_ms)
     if lasso is not None:
         return lasso
-    why = "ranking function not valid" if ranking is not None else "no ranking function"
     return TemporalVerdict("inconclusive", "bounded", bound=bound, trace=bounded.trace,
                            detail=f"{why}; a run of {bound} steps does not reach it")
+
+
+def _ranking_fails(ts: TransitionSystem, prop: Pred, inv: Pred, ranking: Callable[[State], z3.ArithRef],
+                   timeout_ms: int) -> str | None:
+    """Which condition of the ranking rule fails (``None``: both hold):
+    (1) in a state of ``inv`` where ``prop`` is false, rank >= 0; (2) every
+    step from such a state decreases the rank strictly.  A condition the
+    solver cannot decide fails (never a proof on an unknown)."""
+    a, b = ts.state(0), ts.state(1)
+    for cond, text in ((ranking(a) >= 0, "is not >= 0"),
+                       (ranking(b) < ranking(a), "does not decrease on every step")):
+        s = z3.Solver()
+        s.set("timeout", timeout_ms)
+        s.add(inv(a), z3.Not(prop(a)), ts.trans(a, b), z3.Not(cond))
+        r = s.check()
+        if r != z3.unsat:
+            where = "in a state of the invariant where the goal does not hold"
+            if r == z3.unknown:
+                return f"ranking function not accepted: Z3 could not decide whether it {text} {where} " \
+                       f"({s.reason_unknown()})"
+            m = s.model()
+            vals = f"{m.eval(ranking(a), model_completion=True)}"
+            if "decrease" in text:
+                vals += f" then {m.eval(ranking(b), model_completion=True)}"
+            return f"ranking function not accepted: it {text} {where} (rank {vals})"
+    return None
 
 
 def find_lasso(ts: TransitionSystem, prop: Pred, bound: int, *,

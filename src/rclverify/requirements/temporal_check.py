@@ -10,9 +10,11 @@ statement                   decided by
 ``always F``                BMC then k-induction (``proved`` with k)
 ``always next F``           the same from step 1 on
 ``eventually[<= N] F``      unrolling N steps (exact)
-``eventually F``            every run reaches F within the bound (proved);
-                            a lasso missing F (refuted); else inconclusive
-                            with the bound checked: never met on a bound
+``eventually F``            the plan's ``ranking:`` (and ``invariant:``)
+                            valid (proved, method ``ranking``); every run
+                            reaches F within the bound (proved); a lasso
+                            missing F (refuted); else inconclusive with the
+                            bound checked: never met on a bound
 ``next F``                  one step (exact)
 ``F until G``               ``always (G seen or F)`` and ``eventually G``
 ==========================  ===============================================
@@ -37,6 +39,7 @@ import z3
 
 from ..plan.formal import Formal, parse_formal
 from ..plan.load import Plan, Requirement
+from ..plan.ranking import parse_hints
 from ..plan.state import state_types
 from ..plan.temporal import Temporal, operands, parse_temporal, shape
 from ..health.witness import points_for
@@ -158,8 +161,10 @@ def check_temporal(req: Requirement, checked: Checked, model: SystemModel, plan:
     t = statement(req, checked, plan)
     shape(t, req.formal.loc if req.formal else req.loc)
     assuming = [parse_formal(a, checked, f"{req.id} assuming") for a in req.assuming]
+    rank, inv = parse_hints(req.ranking, req.invariant, t, checked, req.id, state_types(plan.states, checked))
     ops = operands(t)
-    want = {u for f in (*ops, *assuming) for n in f.nodes for u in (model.upstream(n) or [n])}
+    hints = [h for h in (rank, inv) if h is not None]
+    want = {u for f in (*ops, *assuming, *hints) for n in f.nodes for u in (model.upstream(n) or [n])}
     cone = [n for n in model.nodes if n in want]  # as requirements/check.cone_of
     sys = build_system(cone, checked, model, plan)
     enc = Encoder(checked.env)
@@ -199,9 +204,12 @@ def check_temporal(req: Requirement, checked: Checked, model: SystemModel, plan:
                                detail=f"a run whose step {n} returns to step {found.loop} and never reaches it "
                                       f"(found with every function a {points}-point table, confirmed on the "
                                       f"trace's values)")
-    v = decide(t, sys, pred, bound=bound, timeout_ms=timeout_ms, tables=tables)
+    ranking = (lambda s: enc.term(rank.expr, rank.scope, sys.statement_symbols(s))) if rank is not None else None
+    v = decide(t, sys, pred, bound=bound, timeout_ms=timeout_ms, tables=tables, ranking=ranking,
+               invariant=pred(inv) if inv is not None else None)
     out: dict[str, Any] = {**base, "cone": cone, "premises": len(sys.premises), "used": [], "traced_not_needed": [],
-                           "temporal": {**v.to_json(), "trace": _steps(v.trace, sys)}}
+                           "temporal": {**v.to_json(), "trace": _steps(v.trace, sys),
+                                        "ranking": base.get("ranking"), "invariant": base.get("invariant")}}
     if v.status in ("proved", "met"):
         a, b = sys.ts.state(0), sys.ts.state(1)
         s = z3.Solver()
