@@ -54,6 +54,7 @@ def _graph(**changes: Any) -> Graph:
 
 def _ground(g: Graph, text: str = RCL, ros: dict[str, Any] | None = None) -> list[tuple[str, str, str, str]]:
     table = TypeTable()
+    table.add_debian_standard(None)  # as the scan of a ROS 1 workspace does (std_srvs/SetBool)
     table.add_file(MOVE, "rclverify_examples", "interfaces/rclverify_examples/action/Move.action", "workspace", None)
     checked = check([parse_text(text, "s.rcl")])
     fs = ground(ScanResult(g, {}, table), checked, "plan.yaml", ros or {}, {}, ast.Loc("plan.yaml", 1, 1))

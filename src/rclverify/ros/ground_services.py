@@ -23,7 +23,6 @@ from __future__ import annotations
 
 import copy
 import difflib
-from pathlib import Path
 from typing import Any, Callable, Mapping
 
 from ..rcl import ast
@@ -138,23 +137,10 @@ def ground_links(add: Add, node: ast.Node, gn: GraphNode, graph_nodes: Mapping[s
 
 def known(table: TypeTable, ctype: str | None, kind: str) -> bool:
     """Whether the ``.srv`` (``kind="service"``) or ``.action`` type ``ctype``
-    (``pkg/srv/T``, ``pkg/action/T``) is defined: by the scanned workspace, rosbags'
-    store, or Debian's ``/usr/share/<pkg>/srv|action`` (which the scan registers only
-    for message packages; found there, it is added to ``table``)."""
-    if not ctype:
-        return False
-    if table.get(f"{ctype}{_PART[kind]}") is not None:
-        return True
-    from .interfaces import DEBIAN_SHARE
-    parts = ctype.split("/")
-    if len(parts) != 3 or any(p in ("", ".", "..") for p in parts):
-        return False
-    ext = "srv" if kind == "service" else "action"
-    f = Path(DEBIAN_SHARE) / parts[0] / ext / f"{parts[2]}.{ext}"
-    if not f.is_file():
-        return False
-    table.add_file(f, parts[0], f"{parts[0]}/{ext}/{f.name}", "debian", None)
-    return table.get(f"{ctype}{_PART[kind]}") is not None
+    (``pkg/srv/T``, ``pkg/action/T``) is defined: by the scanned workspace, Debian's
+    interface packages the scan registered (``TypeTable.add_debian_standard``), or
+    rosbags' store."""
+    return bool(ctype) and table.get(f"{ctype}{_PART[kind]}") is not None
 
 
 def _closest(edges: list[GraphEdge], name: str) -> GraphEdge | None:

@@ -157,13 +157,15 @@ class TypeTable:
                         self.add_file(f, pkg, show(f), origin, cache, files)
 
     def add_debian_standard(self, cache: ParseCache | None, share: Path = DEBIAN_SHARE) -> list[str]:
-        """Register the message packages Debian installed (``/usr/share/<pkg>/msg``
-        for a ``<pkg>`` with a ``package.xml`` or named ``*_msgs``); returns their names."""
+        """Register the interface packages Debian installed (``/usr/share/<pkg>/msg``,
+        ``srv`` and ``action`` for a ``<pkg>`` with a ``package.xml`` or named ``*_msgs``
+        or ``*_srvs``, e.g. ``std_srvs``, which has no message); returns their names."""
         found: list[str] = []
         if not share.is_dir():
             return found
-        for root in sorted(p.parent for p in share.glob("*/msg")):
-            if not ((root / "package.xml").is_file() or root.name.endswith("_msgs")):
+        roots = {p.parent for sub in ("msg", "srv", "action") for p in share.glob(f"*/{sub}")}
+        for root in sorted(roots):
+            if not ((root / "package.xml").is_file() or root.name.endswith(("_msgs", "_srvs"))):
                 continue
             if root.name not in {p.split("/")[0] for p in self.types}:
                 self.add_package_dir(root, root.name, lambda f: f"{root.name}/{f.parent.name}/{f.name}",
