@@ -19,9 +19,7 @@ def add_parsers(sub: Any) -> None:
                        description="read the ROS computation graph from workspaces; check contracts against it")
     rs = r.add_subparsers(dest="ros_command", required=True)
     s = rs.add_parser("scan", help="recover the computation graph from ROS 1/ROS 2 workspaces, launch files, bags, a master")
-    s.add_argument("paths", nargs="*", metavar="PATH", help="workspace (or package) directories")
-    s.add_argument("--launch", action="append", default=[], metavar="FILE", help="entry launch file (repeatable)")
-    s.add_argument("--arg", action="append", default=[], metavar="NAME:=VALUE", help="launch argument (repeatable)")
+    _code_args(s)
     s.add_argument("--bag", action="append", default=[], metavar="BAG", help="recorded run: .bag, ROS 2 bag dir, .mcap")
     s.add_argument("--master", metavar="URI", help="also read the running ROS 1 master at URI (http://127.0.0.1:11311)")
     s.add_argument("--json", metavar="FILE", help="write the graph as JSON (docs/ros-graph.schema.json)")
@@ -30,9 +28,7 @@ def add_parsers(sub: Any) -> None:
     d = rs.add_parser("diff", help="the graph the code promises against a running ROS 1 master or a recorded run",
                       description="compare the static graph (PATH..., --launch, --arg) with a running ROS 1 "
                                   "master (--master) or a bag (--bag): exit 0 equal, 1 they differ, 2 usage")
-    d.add_argument("paths", nargs="*", metavar="PATH", help="workspace (or package) directories")
-    d.add_argument("--launch", action="append", default=[], metavar="FILE", help="entry launch file (repeatable)")
-    d.add_argument("--arg", action="append", default=[], metavar="NAME:=VALUE", help="launch argument (repeatable)")
+    _code_args(d)
     d.add_argument("--master", metavar="URI", help="the running ROS 1 master (http://127.0.0.1:11311)")
     d.add_argument("--bag", metavar="BAG", help="a recorded run: .bag, ROS 2 bag dir, .mcap (topics and types only)")
     d.add_argument("--json", metavar="FILE", help="write both lists as JSON (docs/ros.md)")
@@ -53,6 +49,13 @@ def _launch_args(items: list[str]) -> dict[str, str]:
             raise SystemExit(f"error: --arg {it!r}: expected NAME:=VALUE")
         out[k] = v
     return out
+
+
+def _code_args(p: argparse.ArgumentParser) -> None:
+    """The code side of ``ros scan`` and ``ros diff``: ``PATH...``, ``--launch``, ``--arg``."""
+    p.add_argument("paths", nargs="*", metavar="PATH", help="workspace (or package) directories")
+    p.add_argument("--launch", action="append", default=[], metavar="FILE", help="entry launch file (repeatable)")
+    p.add_argument("--arg", action="append", default=[], metavar="NAME:=VALUE", help="launch argument (repeatable)")
 
 
 def _scan_args(args: argparse.Namespace, bags: list[str], cache: Path | None,

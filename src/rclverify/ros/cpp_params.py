@@ -21,12 +21,10 @@ from __future__ import annotations
 
 from typing import Any
 
+from . import treesitter
+
 _ROS1 = {"param", "getParam", "getParamCached"}
 _ROS2 = {"declare_parameter", "get_parameter", "get_parameter_or"}
-
-
-def _txt(n: Any) -> str:
-    return n.text.decode("utf-8", errors="replace") if n is not None else ""
 
 
 def string_value(n: Any) -> str | None:
@@ -37,7 +35,7 @@ def string_value(n: Any) -> str | None:
     if n.type in ("call_expression", "compound_literal_expression"):
         a = n.child_by_field_name("arguments") or n.child_by_field_name("value")
         fn = n.child_by_field_name("function") or n.child_by_field_name("type")
-        if _txt(fn) in ("std::string", "string") and a is not None and len(a.named_children) == 1:
+        if treesitter.text(fn) in ("std::string", "string") and a is not None and len(a.named_children) == 1:
             return string_value(a.named_children[0])
         return None
     if n.type != "string_literal":
@@ -45,11 +43,11 @@ def string_value(n: Any) -> str | None:
     if any(c.type == "escape_sequence" for c in n.children):
         return None
     parts = [c for c in n.children if c.type == "string_content"]
-    return _txt(parts[0]) if parts else ""
+    return treesitter.text(parts[0]) if parts else ""
 
 
 def _key(n: Any) -> str:
-    return _txt(n).replace("this->", "").lstrip("*&").strip()
+    return treesitter.text(n).replace("this->", "").lstrip("*&").strip()
 
 
 class Bindings:
@@ -90,11 +88,11 @@ class Bindings:
         f = fn.child_by_field_name("field") if fn.type == "field_expression" else fn
         if f is not None and f.type in ("template_method", "template_function"):
             f = f.child_by_field_name("name")
-        last = _txt(f).split("::")[-1]
+        last = treesitter.text(f).split("::")[-1]
         pname = string_value(args[0])
         if pname is None:
             return None
-        full = _txt(fn)
+        full = treesitter.text(fn)
         if last in _ROS1 and (fn.type == "field_expression" or full.startswith("ros::param::")):
             if full.startswith("ros::param::") and last not in ("get", "param"):
                 return None

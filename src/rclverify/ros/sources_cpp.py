@@ -33,6 +33,7 @@ import re
 from typing import Any
 
 from .cpp_params import Bindings, string_value
+from . import treesitter
 from .model import Endpoint, Note, Src, canon_type
 
 _CALLS = {"advertise": "pub", "subscribe": "sub", "create_publisher": "pub", "create_subscription": "sub",
@@ -46,20 +47,6 @@ _WHAT = {"pub": "publisher topic", "sub": "subscriber topic", "service_servers":
          "service_clients": "service client", "action_servers": "action server", "action_clients": "action client"}
 _MACRO = re.compile(rb"\b(?:class|struct)\s+((?:[A-Z][A-Z0-9_]*[A-Z0-9]\s+)+)(?=[A-Za-z_]\w*\s*(?:final\s*)?[:{])")
 _REGISTER = re.compile(rb"\bRCLCPP_COMPONENTS_REGISTER_NODE\s*\(\s*([A-Za-z_][\w:]*)\s*\)")
-_PARSER: Any = None
-
-
-def _parser() -> Any:
-    global _PARSER
-    if _PARSER is None:
-        import tree_sitter_cpp
-        from tree_sitter import Language, Parser
-        _PARSER = Parser(Language(tree_sitter_cpp.language()))
-    return _PARSER
-
-
-def _txt(n: Any) -> str:
-    return n.text.decode("utf-8", errors="replace") if n is not None else ""
 
 
 def _walk(n: Any):  # type: ignore[no-untyped-def]
@@ -105,18 +92,18 @@ def _scope_of(n: Any) -> str | None:
     p = n.parent
     while p is not None:
         if p.type in ("class_specifier", "struct_specifier") and p.child_by_field_name("body") is not None:
-            cls.insert(0, _txt(p.child_by_field_name("name")))
+            cls.insert(0, treesitter.text(p.child_by_field_name("name")))
         elif p.type == "function_definition" and not cls:
             d = p.child_by_field_name("declarator")
             while d is not None and d.type not in ("function_declarator",):
                 d = d.child_by_field_name("declarator")
             q = d.child_by_field_name("declarator") if d is not None else None
             if q is not None and q.type == "qualified_identifier":
-                scope = _txt(q.child_by_field_name("scope"))
+                scope = treesitter.text(q.child_by_field_name("scope"))
                 if scope:
                     cls.insert(0, scope)
         elif p.type == "namespace_definition" and p.child_by_field_name("name") is not None:
-            nss.insert(0, _txt(p.child_by_field_name("name")))
+            nss.insert(0, treesitter.text(p.child_by_field_name("name")))
         p = p.parent
     if not cls:
         return None
@@ -134,7 +121,7 @@ def _targ(t: Any, aliases: dict[str, str]) -> str | None:
     """The first template argument's text, following ``using``/``typedef`` aliases."""
     if t is None or not t.named_children:
         return None
-    s = _txt(t.named_children[0])
+    s = treesitter.text(t.named_children[0])
     for _ in range(4):
         s2 = aliases.get(s) or aliases.get(s.split("::")[-1])
         if s2 is None or s2 == s:
@@ -161,7 +148,7 @@ def scan_cpp(data: bytes, shown: str) -> dict[str, Any]:
         out["components"].append((m.group(1).decode().lstrip(":"), Src(shown, line, 1)))
     # the registration macro has no semicolon: blanked so that it is not read as a syntax error
     data = _REGISTER.sub(lambda m: b" " * len(m.group(0)), data)
-    root = _parser().parse(data).root_node
+    root = treesitter.parser("cpp").parse(data).root_node
     callbacks: dict[str, str] = {}  # function name -> raw type text of its first parameter
     aliases: dict[str, str] = {}
     fields: dict[str, tuple[str, str]] = {}  # member/variable -> (actionlib role, type text)
@@ -170,25 +157,25 @@ def scan_cpp(data: bytes, shown: str) -> dict[str, Any]:
     for n in all_nodes:
         t = n.type
         if t == "function_declarator":
-            name = _txt(n.child_by_field_name("declarator")).split("::")[-1]
+            name = treesitter.text(n.child_by_field_name("declarator")).split("::")[-1]
             params = n.child_by_field_name("parameters")
             first = next((c for c in (params.children if params else []) if c.type == "parameter_declaration"), None)
             if first is not None and first.child_by_field_name("type") is not None:
-                callbacks[name] = _txt(first.child_by_field_name("type"))
+                callbacks[name] = treesitter.text(first.child_by_field_name("type"))
         elif t == "alias_declaration":
             ty = n.child_by_field_name("type")
-            aliases[_txt(n.child_by_field_name("name"))] = _txt(ty)
+            aliases[treesitter.text(n.child_by_field_name("name"))] = treesitter.text(ty)
         elif t == "type_definition":
             ty = n.child_by_field_name("type")
             for d in n.children_by_field_name("declarator"):
-                aliases[_txt(d)] = _txt(ty)
+                aliases[treesitter.text(d)] = treesitter.text(ty)
         elif t in ("field_declaration", "declaration", "parameter_declaration"):
             ty = n.child_by_field_name("type")
-            tt = _txt(ty)
+            tt = treesitter.text(ty)
             base = tt.split("<")[0].split("::")[-1].strip()
             for d in n.children_by_field_name("declarator"):
                 var = d.child_by_field_name("declarator") if d.type == "init_declarator" else d
-                vname = _txt(var).lstrip("*&").strip()
+                vname = treesitter.text(var).lstrip("*&").strip()
                 if base in _ACTIONLIB and _tmpl(ty) is not None:
                     fields[vname] = (_ACTIONLIB[base], _targ(_tmpl(ty).child_by_field_name("arguments"), aliases) or "")
                     if d.type == "init_declarator":
@@ -201,10 +188,10 @@ def scan_cpp(data: bytes, shown: str) -> dict[str, Any]:
                     if v is not None and v.named_children and string_value(v.named_children[0]) is not None:
                         handles[vname] = string_value(v.named_children[0]) or ""
     for n in all_nodes:  # NodeHandle members given a namespace in a constructor: pnh_("~")
-        if n.type == "field_initializer" and n.named_children and _txt(n.named_children[0]) in handles:
+        if n.type == "field_initializer" and n.named_children and treesitter.text(n.named_children[0]) in handles:
             a = next((c for c in n.children if c.type in ("argument_list", "initializer_list")), None)
             if a is not None and a.named_children and string_value(a.named_children[0]) is not None:
-                handles[_txt(n.named_children[0])] = string_value(a.named_children[0]) or ""
+                handles[treesitter.text(n.named_children[0])] = string_value(a.named_children[0]) or ""
     binds = Bindings(all_nodes, handles)
     if root.has_error:
         err = next((n for n in all_nodes if n.type == "ERROR" or n.is_missing), root)
@@ -223,7 +210,7 @@ def scan_cpp(data: bytes, shown: str) -> dict[str, Any]:
             args = next((c for c in n.children if c.type in ("argument_list", "initializer_list")), None)
             if head is None or args is None:
                 continue
-            h = _txt(head)
+            h = treesitter.text(head)
             if h in _NODE_TYPES:
                 s = string_value(args.named_children[0]) if args.named_children else None
                 if s is not None:
@@ -233,7 +220,7 @@ def scan_cpp(data: bytes, shown: str) -> dict[str, Any]:
             continue
         if n.type == "new_expression":
             ty = n.child_by_field_name("type")
-            base = _txt(ty).split("<")[0].split("::")[-1].strip()
+            base = treesitter.text(ty).split("<")[0].split("::")[-1].strip()
             a = n.child_by_field_name("arguments")
             if base in _ACTIONLIB and _tmpl(ty) is not None and a is not None:
                 role = (_ACTIONLIB[base], _targ(_tmpl(ty).child_by_field_name("arguments"), aliases) or "")
@@ -252,12 +239,12 @@ def scan_cpp(data: bytes, shown: str) -> dict[str, Any]:
                 and f.child_by_field_name("name").type in ("template_function", "template_method"):
             f = f.child_by_field_name("name")
         if f is not None and f.type in ("template_method", "template_function"):
-            name = _txt(f.child_by_field_name("name"))
+            name = treesitter.text(f.child_by_field_name("name"))
             targs = f.child_by_field_name("arguments")
         elif f is not None:
-            name = _txt(f)
+            name = treesitter.text(f)
         name_last = (name or "").split("::")[-1]
-        full = _txt(fn)
+        full = treesitter.text(fn)
         if full == "ros::init" and len(args) >= 3:
             s = string_value(args[2])
             if s is not None:
@@ -266,11 +253,11 @@ def scan_cpp(data: bytes, shown: str) -> dict[str, Any]:
                 out["notes"].append(Note(src(args[2]), "node name is not a string literal: not resolved statically"))
             continue
         if name_last == "make_shared" and args:
-            tt = _txt(targs)
+            tt = treesitter.text(targs)
             if targs is not None and any(x in tt for x in _ACTIONLIB) and targs.named_children:
                 inner = targs.named_children[0]
                 ty = inner.child_by_field_name("type") if inner.type == "type_descriptor" else inner
-                base = _txt(ty).split("<")[0].split("::")[-1].strip()
+                base = treesitter.text(ty).split("<")[0].split("::")[-1].strip()
                 if base in _ACTIONLIB and _tmpl(ty) is not None:
                     role = (_ACTIONLIB[base], _targ(_tmpl(ty).child_by_field_name("arguments"), aliases) or "")
                     _actionlib(n, args, role, out, src, aliases, handles, binds)
@@ -297,13 +284,13 @@ def scan_cpp(data: bytes, shown: str) -> dict[str, Any]:
         if kind in ("pub", "sub"):
             msg_type = canon_type(ta) if ta else None
             if msg_type is None and kind == "sub" and name_last == "subscribe" and len(args) >= 3:
-                cb = _txt(args[2]).lstrip("&").split("::")[-1]
+                cb = treesitter.text(args[2]).lstrip("&").split("::")[-1]
                 c = canon_type(callbacks.get(cb))
                 msg_type = c if c and c.count("/") == 2 else None
         elif kind.startswith("service"):
             msg_type = service_type(ta)
             if msg_type is None and name_last == "advertiseService" and len(args) >= 2:
-                cb = _txt(args[1]).lstrip("&").split("::")[-1]
+                cb = treesitter.text(args[1]).lstrip("&").split("::")[-1]
                 msg_type = service_type(callbacks.get(cb))
         else:
             msg_type = action_type(ta)
@@ -313,7 +300,7 @@ def scan_cpp(data: bytes, shown: str) -> dict[str, Any]:
 
 
 def _recv(n: Any) -> str:
-    return _txt(n).replace("this->", "").lstrip("*&").strip()
+    return treesitter.text(n).replace("this->", "").lstrip("*&").strip()
 
 
 def _actionlib(n: Any, args: list[Any], role: tuple[str, str], out: dict[str, Any], src: Any,
@@ -325,7 +312,7 @@ def _actionlib(n: Any, args: list[Any], role: tuple[str, str], out: dict[str, An
         return
     first = _recv(args[0])
     ns = ""
-    if len(args) >= 2 and (first in handles or "NodeHandle" in _txt(args[0])):
+    if len(args) >= 2 and (first in handles or "NodeHandle" in treesitter.text(args[0])):
         ns = handles.get(first, "")
         name_arg = args[1]
     else:
@@ -343,7 +330,7 @@ def _emit(kind: str, name_arg: Any, msg_type: str | None, n: Any, out: dict[str,
     if topic is None and binds is not None:
         topic, param = binds.lookup(name_arg)
     if topic is None and param is None:
-        out["notes"].append(Note(src(name_arg), f"{what} name is '{_txt(name_arg)[:80]}', not a string literal: "
+        out["notes"].append(Note(src(name_arg), f"{what} name is '{treesitter.text(name_arg)[:80]}', not a string literal: "
                                                 f"not resolved statically"))
         return
     if topic and handle_ns and not topic.startswith("/"):

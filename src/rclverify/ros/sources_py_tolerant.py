@@ -14,24 +14,11 @@ from __future__ import annotations
 
 from typing import Any
 
+from . import treesitter
 from .model import Src
 from .pyrecords import PyCall, PyModule, PyVal
 
-_PARSER: Any = None
 MAX_DEPTH = 100  # nesting read; deeper expressions are left as text
-
-
-def _parser() -> Any:
-    global _PARSER
-    if _PARSER is None:
-        import tree_sitter_python
-        from tree_sitter import Language, Parser
-        _PARSER = Parser(Language(tree_sitter_python.language()))
-    return _PARSER
-
-
-def _txt(n: Any) -> str:
-    return n.text.decode("utf-8", errors="replace") if n is not None else ""
 
 
 def _ranges(lines: list[int]) -> str:
@@ -51,7 +38,7 @@ def tolerant_module(text: str, shown: str) -> tuple[Any, str]:
     missing tokens tree-sitter reported). ``None`` only when the grammar is not
     installed (said in the second part)."""
     try:
-        parser = _parser()
+        parser = treesitter.parser("python")
     except ImportError:
         return None, "tree-sitter-python is not installed, so the file was not read"
     root = parser.parse(text.encode("utf-8", errors="replace")).root_node
@@ -63,11 +50,11 @@ def tolerant_module(text: str, shown: str) -> tuple[Any, str]:
 
     def dotted(n: Any) -> str | None:
         if n.type == "identifier":
-            return _txt(n)
+            return treesitter.text(n)
         if n.type == "attribute":
             o, a = n.child_by_field_name("object"), n.child_by_field_name("attribute")
             base = dotted(o) if o is not None else None
-            return f"{base}.{_txt(a)}" if base and a is not None else None
+            return f"{base}.{treesitter.text(a)}" if base and a is not None else None
         return None
 
     def call(c: Any, depth: int) -> PyCall:
@@ -76,8 +63,8 @@ def tolerant_module(text: str, shown: str) -> tuple[Any, str]:
             func = dotted(f) if f is not None else None
             if func is None and f is not None and f.type == "attribute":
                 o = f.child_by_field_name("object")
-                a = _txt(f.child_by_field_name("attribute"))
-                is_super = o is not None and o.type == "call" and _txt(o.child_by_field_name("function")) == "super"
+                a = treesitter.text(f.child_by_field_name("attribute"))
+                is_super = o is not None and o.type == "call" and treesitter.text(o.child_by_field_name("function")) == "super"
                 func = f"super().{a}" if is_super else f".{a}"
             pc = PyCall(func or "", [], {}, loc(c))
             made[c.id] = pc
@@ -86,21 +73,21 @@ def tolerant_module(text: str, shown: str) -> tuple[Any, str]:
                 if x.type == "keyword_argument":
                     k, v = x.child_by_field_name("name"), x.child_by_field_name("value")
                     if k is not None and v is not None:
-                        pc.kwargs[_txt(k)] = val(v, depth + 1)
+                        pc.kwargs[treesitter.text(k)] = val(v, depth + 1)
                 elif x.type != "comment":
                     pc.args.append(val(x, depth + 1))
         return made[c.id]
 
     def val(n: Any, depth: int) -> PyVal:
         if n.type == "string" and not any(c.type == "interpolation" for c in n.children):
-            prefix = _txt(n.children[0]) if n.children else ""
+            prefix = treesitter.text(n.children[0]) if n.children else ""
             if "b" not in prefix.lower():
-                return PyVal("str", "".join(_txt(c) for c in n.children if c.type == "string_content"), loc(n))
+                return PyVal("str", "".join(treesitter.text(c) for c in n.children if c.type == "string_content"), loc(n))
         d = dotted(n)
         if d is not None:
             return PyVal("name", d, loc(n))
         if depth > MAX_DEPTH:
-            return PyVal("other", _txt(n), loc(n))
+            return PyVal("other", treesitter.text(n), loc(n))
         inner, x = [], n  # a call and the attributes/calls on its result: get_parameter('t').value
         while x is not None and x.type in ("call", "attribute"):
             if x.type == "call":
@@ -109,8 +96,8 @@ def tolerant_module(text: str, shown: str) -> tuple[Any, str]:
             else:
                 x = x.child_by_field_name("object")
         if n.type == "call":
-            return PyVal("call", _txt(n), loc(n), call(n, depth), inner)
-        return PyVal("other", _txt(n), loc(n), None, inner)
+            return PyVal("call", treesitter.text(n), loc(n), call(n, depth), inner)
+        return PyVal("other", treesitter.text(n), loc(n), None, inner)
 
     unread: list[int] = []
     stack = [root]
@@ -122,20 +109,20 @@ def tolerant_module(text: str, shown: str) -> tuple[Any, str]:
         if t == "import_statement":
             for x in n.children_by_field_name("name"):
                 if x.type == "aliased_import":
-                    mod.imports[_txt(x.child_by_field_name("alias"))] = _txt(x.child_by_field_name("name"))
+                    mod.imports[treesitter.text(x.child_by_field_name("alias"))] = treesitter.text(x.child_by_field_name("name"))
                 else:
-                    mod.imports[_txt(x).split(".")[0]] = _txt(x).split(".")[0]
+                    mod.imports[treesitter.text(x).split(".")[0]] = treesitter.text(x).split(".")[0]
         elif t == "import_from_statement":
-            m = _txt(n.child_by_field_name("module_name"))
+            m = treesitter.text(n.child_by_field_name("module_name"))
             for x in n.children_by_field_name("name"):
                 if x.type == "aliased_import":
-                    mod.imports[_txt(x.child_by_field_name("alias"))] = f"{m}.{_txt(x.child_by_field_name('name'))}"
+                    mod.imports[treesitter.text(x.child_by_field_name("alias"))] = f"{m}.{treesitter.text(x.child_by_field_name('name'))}"
                 else:
-                    mod.imports[_txt(x)] = f"{m}.{_txt(x)}"
+                    mod.imports[treesitter.text(x)] = f"{m}.{treesitter.text(x)}"
         elif t == "call":
             mod.calls.append(call(n, 0))
         elif t == "class_definition" and n.child_by_field_name("name") is not None:
-            mod.classes.append((_txt(n.child_by_field_name("name")), n.start_point[0] + 1, n.end_point[0] + 1))
+            mod.classes.append((treesitter.text(n.child_by_field_name("name")), n.start_point[0] + 1, n.end_point[0] + 1))
         elif t == "assignment":
             left, right = n.child_by_field_name("left"), n.child_by_field_name("right")
             d = dotted(left) if left is not None else None
