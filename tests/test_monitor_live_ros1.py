@@ -131,9 +131,13 @@ def test_the_injected_fault_is_reported_online_within_the_response_time(live_run
     got = [json.loads(line) for line in (live_run["tmp"] / "topic.jsonl").read_text().splitlines()]
     bad = [g for g in got if g["data"]["node"] == "RadiationSensor" and g["data"]["verdict"] == "violated"]
     assert bad, got[-5:]
-    first = bad[0]
+    # the injected fault (r = 300 classified orange); on a loaded machine the live sensor may also
+    # answer another reading after the response time, which the monitor rightly reports as well
+    fault = [g for g in bad if g["data"]["values"].get("in.r") == "300.0"]
+    assert fault, [g["data"]["values"] for g in bad]
+    first = fault[0]
     assert first["data"]["guarantee"] == 1
-    assert first["data"]["values"]["in.r"] == "300.0" and first["data"]["values"]["out.radiationStatus"] == "orange"
+    assert first["data"]["values"]["out.radiationStatus"] == "orange"
     # reported by the timer once the response time passed, not at the next message or at the end
     delay = first["received"] - first["data"]["time"]
     assert HORIZON <= delay < HORIZON + 1.0, delay
