@@ -248,7 +248,7 @@ def _io(vs: tuple[ast.IOVar, ...]) -> str:
                            for v in vs) + ")"
 
 
-_UNIT_TOKEN = re.compile(r"\^([+-]?\d+)|([A-Za-z_][A-Za-z0-9_]*|1)|([*/()%])")
+_UNIT_TOKEN = re.compile(r"\^([+-]?\d+)|(\w+)|([*/()%])")
 _UNIT_SYMBOL = {"us": r"\mu\mathrm{s}", "Ohm": r"\Omega", "deg": r"{}^{\circ}", "degC": r"{}^{\circ}\mathrm{C}",
                 "percent": r"\%"}
 
@@ -266,6 +266,8 @@ def unit_to_latex(u: ast.UnitAnn | None, brackets: bool = False) -> str:
         exp, sym, op = m.groups()
         if exp is not None:
             out.append("^{" + exp.lstrip("+") + "}")
+        elif sym is not None and sym[0] in "\u00b5\u03bc" and len(sym) > 1:  # the micro sign
+            out.append(r"\mu\mathrm{" + escape(sym[1:]) + "}")
         elif sym is not None:
             out.append(_UNIT_SYMBOL.get(sym, r"\mathrm{" + escape(sym) + "}"))
         else:

@@ -41,7 +41,7 @@ from typing import Callable, Mapping
 from . import ast
 from .printer import expr_to_rcl
 from .types import CheckedNode, Scalar, Type, is_numeric
-from .units import Unit, UnitError, describe, dimension_name, factor_text, parse_unit
+from .units import Unit, UnitError, best_name, describe, dimension_name, factor_text, parse_unit
 
 Report = Callable[[ast.Loc, str, str], None]
 
@@ -264,13 +264,14 @@ class UnitChecker:
         ua = a.unit if a.kind == "unit" else None
         ub = b.unit if b.kind == "unit" else None
         if e.op == "*":
-            u = ua.times(ub) if ua is not None and ub is not None else (ua or ub)
+            u = ua.times(ub, f"{_wrap(ua.text)}*{_wrap(ub.text)}") if ua is not None and ub is not None else (ua or ub)
         elif ua is not None and ub is not None:
-            u = ua.over(ub)
+            u = ua.over(ub, f"{_wrap(ua.text)}/{_wrap(ub.text)}")
         else:
-            u = ua if ua is not None else ub.power(-1)  # type: ignore[union-attr]
+            u = ua if ua is not None else ub.power(-1, f"1/{_wrap(ub.text)}")  # type: ignore[union-attr]
         assert u is not None
-        return Q("unit", u, e)
+        name = best_name(u)  # [mm/m]*[m] is shown as [mm]
+        return Q("unit", Unit(u.dims, u.factor, u.pi, u.offset, name) if name else u, e)
 
 
 def _conversion(a: Q, b: Q) -> str:
@@ -310,7 +311,7 @@ def _conversion(a: Q, b: Q) -> str:
 
 
 def _wrap(text: str) -> str:
-    return f"({text})" if any(c in text for c in "*/") else text
+    return f"({text})" if any(c in text for c in "*/") else (text or "?")
 
 
 def _decimal(f: Fraction) -> str:

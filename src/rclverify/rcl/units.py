@@ -82,7 +82,7 @@ class Unit:
         return (self.dims, self.factor, self.pi, self.offset)
 
     def __str__(self) -> str:
-        return f"[{self.text or canonical_text(self)}]"
+        return f"[{self.text or best_name(self) or canonical_text(self)}]"
 
     def times(self, other: "Unit", text: str = "") -> "Unit":
         """The product of two units (no affine unit may take part)."""
@@ -150,11 +150,11 @@ ALIASES: dict[str, str] = {"sec": "s", "secs": "s", "second": "s", "seconds": "s
                            "ohm": "Ohm", "pct": "%", "kelvin": "K", "kmh": "km/h", "mps": "m/s"}
 
 #: SI prefixes (SI Brochure table 7) that may precede a prefixable symbol;
-#: ``u`` is micro (ASCII for the micro sign).
+#: ``u`` is micro (ASCII for the micro sign, which is accepted too).
 PREFIXES: dict[str, Fraction] = {
     "p": Fraction(1, 10**12), "n": Fraction(1, 10**9), "u": Fraction(1, 10**6), "m": Fraction(1, 1000),
     "c": Fraction(1, 100), "d": Fraction(1, 10), "h": Fraction(100), "k": Fraction(1000), "M": Fraction(10**6),
-    "G": Fraction(10**9),
+    "G": Fraction(10**9), "\u00b5": Fraction(1, 10**6), "\u03bc": Fraction(1, 10**6),
 }
 
 #: Names of dimensions that have one (shown beside a unit in messages).
@@ -317,6 +317,24 @@ class _Reader:
         return u
 
 
+def best_name(u: Unit) -> str | None:
+    """The shortest symbol of the table, prefixed or not, that denotes ``u``
+    (``mm`` for the unit the algebra makes of ``[mm/m]*[m]``), ``None`` when
+    there is none."""
+    return _NAMES.get(u.key)
+
+
+def _all_names() -> dict[tuple[Dims, Fraction, int, Fraction | None], str]:
+    out: dict[tuple[Dims, Fraction, int, Fraction | None], str] = {}
+    names = [n for n in SYMBOLS if n != "percent"]
+    names += [p + n for p in PREFIXES if p.isascii() for n, y in SYMBOLS.items() if y.prefixable]
+    for n in sorted(names, key=len):
+        u = lookup(n)
+        if u is not None:
+            out.setdefault(u.key, n)
+    return out
+
+
 def dimension_name(dims: Dims) -> str:
     """``"length"``, ``"velocity"``, ``"length^2*time^-1"``: the dimension in words."""
     if dims in _NAMED:
@@ -389,13 +407,15 @@ def _decimal(f: Fraction) -> str:
 
 
 def _name(u: Unit) -> str:
-    return u.text or canonical_text(u)
+    return u.text or best_name(u) or canonical_text(u)
 
 
 def describe(u: Unit) -> str:
     """``"[mm] (length)"``: a unit with its dimension, for messages."""
     return f"{u} ({dimension_name(u.dims)})"
 
+
+_NAMES = _all_names()
 
 #: The time units of deadlines (``within 200 ms``): every symbol of
 #: :data:`SYMBOLS` or prefixed symbol of dimension time that
