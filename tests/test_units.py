@@ -350,3 +350,35 @@ def test_optimised_range_against_enumeration(lo, width, c, shift):
     facts = [lo <= r, r <= lo + width, d == c * r + shift]
     values = [c * x + shift for x in range(lo, lo + width + 1)]
     assert _range(d, facts) == (Fraction(min(values)), Fraction(max(values)))
+
+
+def test_snapshots_follow_units_incremental_equals_clean(tmp_path):
+    """A changed unit changes the node's snapshot (so every stage made from
+    it is made again), and the snapshot after the edit in a workspace that
+    kept its texts equals the one a clean workspace makes; the check stage
+    lists a unit declared at one end only among its warnings."""
+    import shutil
+    from rclverify.pipeline import Workspace, stage_check
+
+    def ws(root, text):
+        (root / "contracts").mkdir(parents=True, exist_ok=True)
+        (root / "contracts" / "robot.rcl").write_text(text, encoding="utf-8")
+        (root / "contracts" / "plan.yaml").write_text("contracts: [contracts/robot.rcl]\n", encoding="utf-8")
+        return Workspace(root)
+
+    same = _SYSTEM.replace("d : REAL [m], w", "d : REAL [mm], w")
+    inc = tmp_path / "inc"
+    out = stage_check(ws(inc, same))
+    assert [w["code"] for w in out["warnings"] if w["code"].startswith("W-unit")] == ["W-unit-missing"]
+    before = (inc / "artifacts/contracts/Controller.json").read_text(encoding="utf-8")
+    edited = same.replace("d : REAL [mm], w : REAL [m/s]", "d : REAL [um], w : REAL [m/s]").replace(
+        "d : REAL [mm], w : REAL )", "d : REAL [um], w : REAL )").replace("1000 [mm/m]", "1000000 [um/m]")
+    stage_check(ws(inc, edited))
+    after = (inc / "artifacts/contracts/Controller.json").read_text(encoding="utf-8")
+    assert after != before and "d : REAL [um]" in after
+    clean = tmp_path / "clean"
+    stage_check(ws(clean, edited))
+    for node in ("Lidar", "Controller"):
+        assert (clean / f"artifacts/contracts/{node}.json").read_text(encoding="utf-8") == \
+            (inc / f"artifacts/contracts/{node}.json").read_text(encoding="utf-8")
+    shutil.rmtree(clean)

@@ -154,7 +154,8 @@ class UnitChecker:
     def same(self, a: Q, b: Q, loc: ast.Loc, where: str) -> Q:
         """``a`` and ``b`` meet in ``where`` (an operator or place, for the
         message): report a mismatch of two known units at ``loc``; return
-        the kind of the result (the known one wins)."""
+        the kind of the result (the known one wins; unknown after a
+        mismatch, so one mistake gives one message)."""
         if a.kind == "unit" and b.kind == "unit":
             assert a.unit is not None and b.unit is not None
             bad = mismatch(a.unit, b.unit)
@@ -165,6 +166,7 @@ class UnitChecker:
                     hint = f"; RCL does not convert units: {_conversion(a, b)}"
                 self.err(loc, f"unit mismatch in {where}: {_show(a.expr)} is {describe(a.unit)} but "
                               f"{_show(b.expr)} is {describe(b.unit)}: {reason}{hint}", code)
+                return UNKNOWN  # reported once: what contains it is not checked again
             return a
         if a.kind == "unit":
             return a
