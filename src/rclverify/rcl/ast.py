@@ -512,4 +512,8 @@ class Spec:
     contexts: tuple[Context, ...]
     nodes: tuple[Node, ...]
     file: str = field(default="<string>", compare=False)
+    #: whether the file may write a unit of measure anywhere (the parser sets
+    #: ``False`` when it read none, so the type checker skips the unit pass of
+    #: a system without units; a tree made by a program keeps ``True``)
+    has_units: bool = field(default=True, compare=False)
 

@@ -142,6 +142,7 @@ class _ToAst(Transformer[Token, Any]):
     def reset(self, file: str, dline: int, dcol: int) -> None:
         """Prepare for one parse of ``file`` (offsets as in :func:`parse_formula`)."""
         self.file, self.dline, self.dcol = file, dline, dcol
+        self.units_seen = False  # a UNIT token was read (Spec.has_units)
         # id(node) -> (node, span with the parentheses) for parenthesised
         # expressions: a parent spans its operand's parentheses, while the
         # operand's own location is the text inside them.  The node is held
@@ -195,7 +196,7 @@ class _ToAst(Transformer[Token, Any]):
     def start(self, c: list[Any]) -> ast.Spec:
         ctx = tuple(i for i in c if isinstance(i, ast.Context))
         nodes = tuple(i for i in c if isinstance(i, ast.Node))
-        return ast.Spec(ctx, nodes, file=self.file)
+        return ast.Spec(ctx, nodes, file=self.file, has_units=self.units_seen)
 
     def context_clause(self, c: list[Any]) -> ast.Context:
         return ast.Context(tuple(_vals(c)), self._span(c))
@@ -216,6 +217,7 @@ class _ToAst(Transformer[Token, Any]):
         blanks, located at the opening bracket."""
         if tok is None:
             return None
+        self.units_seen = True
         return ast.UnitAnn("".join(str(tok)[1:-1].split()), self._span([tok]))
 
     def node_clause(self, c: list[Any]) -> ast.Node:

@@ -70,8 +70,10 @@ class _Checker:
         self.unknown_types: set[str] = set()
         self.failed_io: set[tuple[str, str]] = set()
         self.failed_consts: set[str] = set()
-        # units of measure (docs/rcl-language.md, "Units of measure"): declarations and formulas
+        # units of measure (docs/rcl-language.md, "Units of measure"): declarations and formulas,
+        # checked only when some file of the system writes a unit (check() sets it)
         self.units = UnitChecker(self.err)
+        self.with_units = True
 
     # -- diagnostics -------------------------------------------------------------
     def err(self, loc: ast.Loc, msg: str, code: str = "E-type") -> None:
@@ -183,7 +185,8 @@ class _Checker:
                 except _Fail:
                     self.failed_consts.add(d.name)
                     continue
-                self.units.constant(d, vt)
+                if self.with_units:
+                    self.units.constant(d, vt)
 
     # -- nodes --------------------------------------------------------------------------
     def node(self, n: ast.Node) -> CheckedNode | None:
@@ -224,7 +227,7 @@ class _Checker:
                 if ft != BOOL:
                     self.err(cl.formula.loc, f"a contract clause must be a formula (BOOL), found {ft}")
                     ok = False
-                else:
+                elif self.with_units:
                     self.units.clause(cl.formula, cn)
             except _Fail:
                 ok = False
@@ -469,6 +472,7 @@ def check(specs: Sequence[ast.Spec]) -> Checked:
     every error found (sorted by file, line, column).
     """
     c = _Checker()
+    c.with_units = any(getattr(s, "has_units", True) for s in specs)
     c.contexts(specs)
     nodes: dict[str, CheckedNode] = {}
     seen: dict[str, ast.Loc] = {}
