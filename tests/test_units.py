@@ -382,3 +382,17 @@ def test_snapshots_follow_units_incremental_equals_clean(tmp_path):
         assert (clean / f"artifacts/contracts/{node}.json").read_text(encoding="utf-8") == \
             (inc / f"artifacts/contracts/{node}.json").read_text(encoding="utf-8")
     shutil.rmtree(clean)
+
+
+def test_fmt_command_round_trip_and_literal_units_alone(tmp_path, capsys):
+    f = tmp_path / "robot.rcl"
+    f.write_text(_SYSTEM, encoding="utf-8")
+    assert main(["fmt", str(f)]) == 0
+    printed = capsys.readouterr().out
+    assert "outputs( d : REAL [mm], w : REAL )" in printed and "1000 [mm/m] * in.r" in printed
+    assert parse_text(printed) == parse_text(_SYSTEM)
+    # a file without any unit is parsed as such, and skips the unit pass; a unit on a number alone is checked
+    assert parse_text("node A { inputs( r : REAL ) outputs( d : REAL ) guarantee( out.d > 2 ) }").has_units is False
+    [(line, col, code, _)] = _errors("node A { inputs( r : REAL ) outputs( d : REAL )\n"
+                                     "  guarantee( out.d > 0 and 2 [m] < 3 [s] ) }")
+    assert (line, col, code) == (2, 36, "E-unit-dimension")
