@@ -38,7 +38,9 @@ VOCAB = ["(", ")", "{", "}", "<", ">", "<>", ",", ";", ":", "|", "=", "==", "!="
          "exists!(", "A(", "G(", "assume(", "guarantee(", "node", "context", "inputs(", "outputs(", "topics(",
          "matches", "set(", "seq(", "REAL", "INTEGER", "NATURAL", "BOOL", "STRING", "TRUE", "FALSE", "0", "1",
          "2.5", "1e400", '"s"', '"', "'", "in.a", "out.o", "a", "o", "u", "v", "(u, v)", "[", "]", "/*", "*/",
-         "//", "\n", "\t", "é", "\x00", "pkg/Msg", ".", "REAL.REAL", "NATURAL.INTEGER", "(1, 2)", "(in.a, 1)"]
+         "//", "\n", "\t", "é", "\x00", "pkg/Msg", ".", "REAL.REAL", "NATURAL.INTEGER", "(1, 2)", "(in.a, 1)",
+         # units of measure (docs/rcl-language.md): well-formed, unknown, malformed, affine
+         "[m]", "[mm/m]", "[s^-2]", "[degC]", "[furlong]", "[m/]", "[(m]", "in.b", "[]"]
 
 FUZZ = settings(derandomize=True, deadline=None, database=None, max_examples=800,
                 suppress_health_check=list(HealthCheck))
@@ -101,7 +103,8 @@ def test_mutated_contracts(seed: str, ops: list[tuple[str, float, int, str]]) ->
 def test_generated_formulas(tokens: list[str]) -> None:
     body = " ".join(tokens)
     run_front_end("context { K = 3 ; E : {e1, e2} ; }\n"
-                  "node n { inputs(a : REAL, s : set((E, E))) outputs(o : BOOL)\n guarantee(" + body + ") }\n")
+                  "node n { inputs(a : REAL, b : REAL [mm], s : set((E, E))) outputs(o : BOOL)\n guarantee(" + body
+                  + ") }\n")
 
 
 YAML_VOCAB = ["&a ", "*a", "&b ", "*b", "[", "]", "{", "}", ": ", "- ", "\n", "  ", "contracts", "x", "'", '"',

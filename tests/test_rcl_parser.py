@@ -323,7 +323,7 @@ def test_parse_formula_locations_are_offset_into_the_plan() -> None:
 def test_missing_parenthesis() -> None:
     loc, msg = syntax_error("node n { inputs(a : REAL outputs(o : REAL) guarantee(o > a) }")
     assert (loc.file, loc.line, loc.col) == ("f.rcl", 1, 26)
-    assert msg == "unexpected 'outputs'; expected one of ')', ',', '-->', 'x'"
+    assert msg == "unexpected 'outputs'; expected one of ')', ',', '-->', 'x', a unit such as [m]"
 
 
 def test_missing_closing_parenthesis_of_a_quantifier() -> None:

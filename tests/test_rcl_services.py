@@ -88,7 +88,7 @@ def test_untimed_contracts_keep_their_meaning() -> None:
 def test_deadline_without_unit_is_located() -> None:
     text = BASE.replace("within 200 ms", "within 200")
     assert errors_of(text) == ["f.rcl:7:69: error: deadline 'within 200' has no unit; write e.g. "
-                               "'within 200 ms' (units: ns, us, ms, s, min)"]
+                               "'within 200 ms' (units: ns, us, ms, s, min, h)"]
 
 
 def test_unknown_unit_and_deadline_without_trigger() -> None:

@@ -75,11 +75,14 @@ def cmd_check(args: argparse.Namespace) -> int:
             print(f"{', '.join(scope.files)}: {scope.why}")
         try:
             specs = parse_files(scope.files)
-            check(specs)
+            checked = check(specs)
         except RclError as exc:
             errors += exc.diagnostics
             continue
         warnings += [d for s in specs for d in file_warnings(s)] + [d for s in specs for d in lint(s)]
+        from .system.model import unit_diagnostics  # units at both ends of each connection (docs/rcl-language.md)
+        for d in unit_diagnostics(checked):
+            (errors if d.severity == "error" else warnings).append(d)
     if errors:  # the located errors only, as for one scope
         for d in errors:
             print(d, file=sys.stderr)

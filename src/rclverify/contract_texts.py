@@ -34,15 +34,15 @@ CACHE = "artifacts/cache/contract-texts.pickle"
 def node_texts(node: ast.Node) -> dict[str, Any]:
     """The texts of one node: ``{"rcl": the node as RCL (the snapshot's
     text), "latex": its LaTeX block (:func:`rclverify.rcl.latex.node_latex`:
-    no preamble, its real file name), "inputs"/"outputs": [[name, type as RCL],
+    no preamble, its real file name), "inputs"/"outputs": [[name, type as RCL with its unit, ``REAL [m]``],
     ...], "assumptions"/"guarantees": [[formula as RCL, "file:line:col"],
     ...]}`` (lists, in declaration order)."""
     from .rcl.latex import node_latex
-    from .rcl.printer import expr_to_rcl, to_rcl, type_to_rcl
+    from .rcl.printer import expr_to_rcl, to_rcl, type_to_rcl, unit_to_rcl
     return {
         "rcl": to_rcl(ast.Spec((), (node,))), "latex": node_latex(node),
-        "inputs": [[v.name, type_to_rcl(v.type)] for v in node.inputs],
-        "outputs": [[v.name, type_to_rcl(v.type)] for v in node.outputs],
+        "inputs": [[v.name, type_to_rcl(v.type) + unit_to_rcl(v.unit)] for v in node.inputs],
+        "outputs": [[v.name, type_to_rcl(v.type) + unit_to_rcl(v.unit)] for v in node.outputs],
         "assumptions": [[expr_to_rcl(a.formula), str(a.loc)] for a in node.assumes],
         "guarantees": [[expr_to_rcl(g.formula), str(g.loc)] for g in node.guarantees],
     }

@@ -53,6 +53,7 @@ from ..rcl.printer import expr_to_rcl
 from ..rcl.walk import free_names, subexpressions
 from ..rcl.types import Checked
 from ..system.model import SystemModel
+from .scale import probable_mismatches
 
 STATUS = {"proved": "discharged", "refuted": "failed", "inconclusive": "inconclusive"}
 
@@ -108,12 +109,17 @@ class SideCondition:
     explanation: str = ""
     variant: str = ""
     links: tuple[str, ...] = ()
+    #: probable scale mismatches behind a side condition that is not discharged (:mod:`.scale`)
+    scale: tuple[dict[str, Any], ...] = ()
 
     def to_json(self, smt2_path: str) -> dict[str, Any]:
-        return {"id": self.id, "node": self.node, "rule": self.rule, "conjunct": self.conjunct,
-                "source": self.source, "hypotheses": list(self.hypotheses), "status": self.status,
-                "duration_s": self.duration_s, "smt2": smt2_path, "model": self.model,
-                "explanation": self.explanation, "variant": self.variant, "links": list(self.links)}
+        out = {"id": self.id, "node": self.node, "rule": self.rule, "conjunct": self.conjunct,
+               "source": self.source, "hypotheses": list(self.hypotheses), "status": self.status,
+               "duration_s": self.duration_s, "smt2": smt2_path, "model": self.model,
+               "explanation": self.explanation, "variant": self.variant, "links": list(self.links)}
+        if self.scale:  # only when there is one: records without it are unchanged
+            out["scale_mismatch"] = list(self.scale)
+        return out
 
 
 @dataclass(frozen=True)
@@ -270,9 +276,12 @@ def compose_node(checked: Checked, model: SystemModel, node: str, *,
                          "is not shown.")
         if r.strategy:
             expl += f" Z3's default strategy gave up; answered with {r.strategy}."
+        scale = probable_mismatches(checked, model.links_into(node), enc, node, c) if status != "discharged" else ()
+        for m in scale:
+            expl += f" {m['message'][0].upper()}{m['message'][1:]}."
         scs.append(SideCondition(f"{node}.sc{k}", node, rule, expr_to_rcl(c), _loc(c.loc), used_text,
                                  status, round(first.duration_s + (r.duration_s if r is not first else 0.0), 4),
-                                 r.smt2, r.model, expl, variant, tuple(links)))
+                                 r.smt2, r.model, expl, variant, tuple(links), scale))
     env_assumptions = tuple({"node": node, "text": expr_to_rcl(c), "source": _loc(c.loc)} for c in env)
     g_text = contract_text([g.formula for g in cn.node.guarantees])
     a_text = contract_text([a.formula for a in cn.node.assumes])

@@ -183,11 +183,28 @@ class BoolLit:
 
 
 @dataclass(frozen=True)
-class NumLit:
-    """A numeric literal; ``text`` is kept for printing, ``value`` is exact."""
+class UnitAnn:
+    """A unit of measure as written between brackets, ``[m/s^2]``
+    (docs/rcl-language.md, "Units of measure").  ``text`` is the text
+    between the brackets with its blanks removed (``m/s^2``); ``loc`` is the
+    opening bracket.  The unit it denotes is read by
+    :func:`rclverify.rcl.units.parse_unit` in the type checker."""
 
     text: str
     loc: Loc = _loc()
+
+
+@dataclass(frozen=True)
+class NumLit:
+    """A numeric literal; ``text`` is kept for printing, ``value`` is exact.
+    ``unit`` is the unit written after it (``1000 [mm/m]``), ``None`` for a
+    bare number (which takes the unit of what it is added to or compared
+    with).  The unit does not change the value: every term's number is read
+    in its own unit."""
+
+    text: str
+    loc: Loc = _loc()
+    unit: UnitAnn | None = None
 
     @property
     def value(self) -> Fraction:
@@ -383,13 +400,15 @@ class ConstDecl:
     """``Name = value ;`` in a context clause (a named constant).
 
     ``type`` is optional: ``MaxLevel : REAL = 250 ;`` declares it, plain
-    ``MaxLevel = 250 ;`` lets the checker infer it from ``value``.
+    ``MaxLevel = 250 ;`` lets the checker infer it from ``value``.  ``unit``
+    is the unit written after the type (``MaxRange : REAL [m] = 30 ;``).
     """
 
     name: str
     value: Expr
     type: TypeExpr | None = None
     loc: Loc = _loc()
+    unit: UnitAnn | None = None
 
 
 @dataclass(frozen=True)
@@ -402,11 +421,14 @@ class Context:
 
 @dataclass(frozen=True)
 class IOVar:
-    """``name : TypeName`` in ``inputs(...)``/``outputs(...)``."""
+    """``name : TypeName`` in ``inputs(...)``/``outputs(...)``; ``unit`` is
+    the unit of measure written after the type (``d : REAL [m]``), ``None``
+    when none is declared."""
 
     name: str
     type: TypeExpr
     loc: Loc = _loc()
+    unit: UnitAnn | None = None
 
 
 @dataclass(frozen=True)
@@ -490,4 +512,8 @@ class Spec:
     contexts: tuple[Context, ...]
     nodes: tuple[Node, ...]
     file: str = field(default="<string>", compare=False)
+    #: whether the file may write a unit of measure anywhere (the parser sets
+    #: ``False`` when it read none, so the type checker skips the unit pass of
+    #: a system without units; a tree made by a program keeps ``True``)
+    has_units: bool = field(default=True, compare=False)
 

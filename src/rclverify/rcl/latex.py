@@ -20,6 +20,7 @@ The document structure comes from the jinja2 template
 """
 from __future__ import annotations
 
+import re
 from functools import lru_cache
 from pathlib import PurePath
 from typing import Sequence, Union
@@ -148,7 +149,7 @@ class _Tex:
         if isinstance(e, ast.BoolLit):
             return r"\mathit{TRUE}" if e.value else r"\mathit{FALSE}"
         if isinstance(e, ast.NumLit):
-            return _number(e.text)
+            return _number(e.text) + unit_to_latex(e.unit)
         if isinstance(e, ast.Apply):
             return f"{_var(e.func)}({self.items(e.args)})"
         if isinstance(e, ast.Unary):
@@ -243,7 +244,36 @@ def _where(loc: ast.Loc) -> str:
 
 
 def _io(vs: tuple[ast.IOVar, ...]) -> str:
-    return "(" + ", ".join(f"{name_to_latex(v.name)} : {type_to_latex(v.type)}" for v in vs) + ")"
+    return "(" + ", ".join(f"{name_to_latex(v.name)} : {type_to_latex(v.type)}{unit_to_latex(v.unit, True)}"
+                           for v in vs) + ")"
+
+
+_UNIT_TOKEN = re.compile(r"\^([+-]?\d+)|(\w+)|([*/()%])")
+_UNIT_SYMBOL = {"us": r"\mu\mathrm{s}", "Ohm": r"\Omega", "deg": r"{}^{\circ}", "degC": r"{}^{\circ}\mathrm{C}",
+                "percent": r"\%"}
+
+
+def unit_to_latex(u: ast.UnitAnn | None, brackets: bool = False) -> str:
+    """A unit of measure in math mode after a thin space, upright as SI
+    writes it: ``[m/s^2]`` -> ``\\,\\mathrm{m}/\\mathrm{s}^{2}``, ``[mm]`` ->
+    ``\\,\\mathrm{mm}``, ``[us]`` -> ``\\,\\mu\\mathrm{s}``; ``""`` for none.
+    With ``brackets`` (a declaration: ``d : \\mathbb{R}\\,[\\mathrm{m}]``)
+    the unit is in square brackets, as RCL writes it."""
+    if u is None:
+        return ""
+    out = []
+    for m in _UNIT_TOKEN.finditer(u.text):
+        exp, sym, op = m.groups()
+        if exp is not None:
+            out.append("^{" + exp.lstrip("+") + "}")
+        elif sym is not None and sym[0] in "\u00b5\u03bc" and len(sym) > 1:  # the micro sign
+            out.append(r"\mu\mathrm{" + escape(sym[1:]) + "}")
+        elif sym is not None:
+            out.append(_UNIT_SYMBOL.get(sym, r"\mathrm{" + escape(sym) + "}"))
+        else:
+            out.append({"*": r"\cdot ", "%": r"\%"}.get(op, op))
+    body = "".join(out)
+    return r"\,[" + body + "]" if brackets else r"\," + body
 
 
 def _timing(c: ast.Clause) -> str:
@@ -271,7 +301,7 @@ def _topic(t: ast.Topic) -> str:
 def _decl(d: Union[ast.TypeDecl, ast.ConstDecl], explicit: bool) -> dict[str, str]:
     if isinstance(d, ast.TypeDecl):
         return {"name": name_to_latex(d.name), "sep": ":", "body": type_to_latex(d.type), "line": str(d.loc.line)}
-    typed = f" : {type_to_latex(d.type)}" if d.type is not None else ""
+    typed = f" : {type_to_latex(d.type)}{unit_to_latex(d.unit, True)}" if d.type is not None else ""
     return {"name": name_to_latex(d.name) + typed, "sep": "=",
             "body": expr_to_latex(d.value, explicit), "line": str(d.loc.line)}
 

@@ -48,13 +48,14 @@ _FRIENDLY = {
     "CMP_OP": "a comparison", "EXISTS_BANG": "'exists!'", "$END": "end of file",
     "BASE_TYPE": "REAL/INTEGER/NATURAL/BOOL/STRING",
     "QUALIFIED_BASE": "a qualified built-in such as REAL.REAL", "STRING_LIT": "a string", "LT": "'<'", "GT": "'>'",
+    "UNIT": "a unit such as [m]",
 }
 
 # Terminals whose text is data; every other token (keywords, punctuation) is
 # syntax, kept in the children only for its position.  "QUANT" is the
 # quantifier-kind token the transformer itself makes.
 _VALUE_TERMINALS = frozenset({"NAME", "IO_NAME", "NUMBER", "ROS_TYPE", "CMP_OP", "BASE_TYPE", "EXISTS_BANG",
-                              "QUANT", "STRING_LIT", "QUALIFIED_BASE"})
+                              "QUANT", "STRING_LIT", "QUALIFIED_BASE", "UNIT"})
 
 
 def grammar_text() -> str:
@@ -141,6 +142,7 @@ class _ToAst(Transformer[Token, Any]):
     def reset(self, file: str, dline: int, dcol: int) -> None:
         """Prepare for one parse of ``file`` (offsets as in :func:`parse_formula`)."""
         self.file, self.dline, self.dcol = file, dline, dcol
+        self.units_seen = False  # a UNIT token was read (Spec.has_units)
         # id(node) -> (node, span with the parentheses) for parenthesised
         # expressions: a parent spans its operand's parentheses, while the
         # operand's own location is the text inside them.  The node is held
@@ -194,7 +196,7 @@ class _ToAst(Transformer[Token, Any]):
     def start(self, c: list[Any]) -> ast.Spec:
         ctx = tuple(i for i in c if isinstance(i, ast.Context))
         nodes = tuple(i for i in c if isinstance(i, ast.Node))
-        return ast.Spec(ctx, nodes, file=self.file)
+        return ast.Spec(ctx, nodes, file=self.file, has_units=self.units_seen)
 
     def context_clause(self, c: list[Any]) -> ast.Context:
         return ast.Context(tuple(_vals(c)), self._span(c))
@@ -205,9 +207,18 @@ class _ToAst(Transformer[Token, Any]):
 
     def const_decl(self, c: list[Any]) -> ast.ConstDecl:
         v = _vals(c)
-        if len(v) == 3:
-            return ast.ConstDecl(str(v[0]), v[2], v[1], self._span(c))
+        if len(v) == 4:  # NAME type [UNIT] expr
+            return ast.ConstDecl(str(v[0]), v[3], v[1], self._span(c), self._unit(v[2]))
         return ast.ConstDecl(str(v[0]), v[1], None, self._span(c))
+
+    def _unit(self, tok: Token | None) -> ast.UnitAnn | None:
+        """The :class:`~rclverify.rcl.ast.UnitAnn` of a ``UNIT`` token
+        (``None`` for an absent one): its text without the brackets and
+        blanks, located at the opening bracket."""
+        if tok is None:
+            return None
+        self.units_seen = True
+        return ast.UnitAnn("".join(str(tok)[1:-1].split()), self._span([tok]))
 
     def node_clause(self, c: list[Any]) -> ast.Node:
         v = _vals(c)
@@ -229,7 +240,7 @@ class _ToAst(Transformer[Token, Any]):
 
     def io_var(self, c: list[Any]) -> ast.IOVar:
         v = _vals(c)
-        return ast.IOVar(str(v[0]), v[1], self._span(c))
+        return ast.IOVar(str(v[0]), v[1], self._span(c), self._unit(v[2]))
 
     def topics(self, c: list[Any]) -> tuple[str, tuple[ast.Topic, ...]]:
         return ("topics", tuple(x for x in _vals(c) if x is not None))
@@ -376,10 +387,13 @@ class _ToAst(Transformer[Token, Any]):
         return ast.Member(c[0], c[2], True, self._span(c))
 
     def number(self, c: list[Any]) -> ast.NumLit:
-        text, loc = str(c[0]), self._span(c)
+        text, loc = str(c[0]), self._span([c[0]])
         problem = numeral_problem(text)
         if problem:
             raise RclError([error(loc, problem, "E-number")])
+        unit = c[1] if len(c) > 1 else None
+        if unit is not None:
+            return ast.NumLit(text, self._span(c), self._unit(unit))
         return ast.NumLit(text, loc)
 
     def true(self, c: list[Any]) -> ast.BoolLit:

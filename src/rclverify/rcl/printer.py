@@ -226,7 +226,7 @@ def _expr(p: _Printer, e: ast.Expr) -> str:
     if isinstance(e, ast.BoolLit):
         return "TRUE" if e.value else "FALSE"
     if isinstance(e, ast.NumLit):
-        return e.text
+        return e.text + unit_to_rcl(e.unit)
     if isinstance(e, ast.Apply):
         return f"{e.func.qualified}({p.items(e.args)})"
     if isinstance(e, ast.Unary):
@@ -287,10 +287,21 @@ def _expr(p: _Printer, e: ast.Expr) -> str:
 # Declarations
 # ---------------------------------------------------------------------------
 
+def unit_to_rcl(u: ast.UnitAnn | None) -> str:
+    """`` [m/s^2]`` (with the leading blank) for a unit of measure, ``""``
+    for none (docs/rcl-language.md, "Units of measure")."""
+    return f" [{u.text}]" if u is not None else ""
+
+
+def io_var_to_rcl(v: ast.IOVar) -> str:
+    """``d : REAL [m]``: one input or output declaration, its unit included."""
+    return f"{v.name} : {type_to_rcl(v.type)}{unit_to_rcl(v.unit)}"
+
+
 def _decl(d: Union[ast.TypeDecl, ast.ConstDecl], explicit: bool) -> str:
     if isinstance(d, ast.TypeDecl):
         return f"{d.name} : {type_to_rcl(d.type)} ;"
-    typed = f" : {type_to_rcl(d.type)}" if d.type is not None else ""
+    typed = f" : {type_to_rcl(d.type)}{unit_to_rcl(d.unit)}" if d.type is not None else ""
     return f"{d.name}{typed} = {expr_to_rcl(d.value, explicit)} ;"
 
 
@@ -318,7 +329,7 @@ def _timing(c: ast.Clause) -> str:
 
 
 def _io(vs: tuple[ast.IOVar, ...]) -> str:
-    return ", ".join(f"{v.name} : {type_to_rcl(v.type)}" for v in vs)
+    return ", ".join(io_var_to_rcl(v) for v in vs)
 
 
 def node_to_rcl(n: ast.Node, explicit: bool = False) -> str:

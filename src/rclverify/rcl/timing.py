@@ -10,8 +10,10 @@ The rules (docs/rcl-language.md, "Services, actions and deadlines"):
 * ``triggered by in.x`` names an input of the node (the event the output
   answers); an output there is an error, and so is a guarantee that mentions
   no output (nothing could answer the trigger).
-* ``within N unit`` needs a unit (``ns``, ``us``, ``ms``, ``s``, ``min``),
-  a positive amount, and a trigger to measure from.
+* ``within N unit`` needs a unit of time (``ns``, ``us``, ``ms``, ``s``,
+  ``min``, ``h``: the time units of :mod:`rclverify.rcl.units`, the same
+  symbols and factors a declaration ``t : REAL [ms]`` uses), a positive
+  amount, and a trigger to measure from.
 
 Every violation is a located diagnostic (``file:line:col``); nothing here
 raises.
@@ -22,11 +24,12 @@ from fractions import Fraction
 from typing import Callable
 
 from . import ast
+from .units import TIME_UNITS, dimension_name, lookup
 from .walk import subexpressions
 
-#: Seconds per unit of a deadline.
-UNITS: dict[str, Fraction] = {"ns": Fraction(1, 10**9), "us": Fraction(1, 10**6), "ms": Fraction(1, 1000),
-                              "s": Fraction(1), "min": Fraction(60)}
+#: Seconds per unit of a deadline: the time units of the unit table
+#: (docs/rcl-language.md, "Units of measure").
+UNITS: dict[str, Fraction] = dict(TIME_UNITS)
 
 #: Part names of a link, by kind.
 PARTS: dict[str, tuple[str, ...]] = {"service": ("request", "response"),
@@ -66,7 +69,7 @@ def seconds(d: ast.Deadline) -> Fraction | None:
 
 def parse_duration(text: str) -> Fraction | None:
     """``"500 ms"`` -> ``Fraction(1, 2)``; ``None`` when the number or the
-    unit (``ns``, ``us``, ``ms``, ``s``, ``min``) is missing or unknown."""
+    unit (``ns``, ``us``, ``ms``, ``s``, ``min``, ``h``) is missing or unknown."""
     parts = str(text).split()
     if len(parts) != 2 or parts[1] not in UNITS:
         return None
@@ -131,7 +134,10 @@ def check_clause(n: ast.Node, cl: ast.Clause, err: Report) -> bool:
                 f"(units: {', '.join(UNITS)})", "E-deadline")
             ok = False
         elif d.unit not in UNITS:
-            err(d.loc, f"unknown time unit {d.unit!r} in deadline (units: {', '.join(UNITS)})", "E-deadline")
+            other = lookup(d.unit)
+            what = (f"{d.unit!r} is a unit of {dimension_name(other.dims)}, not of time" if other is not None
+                    else f"unknown time unit {d.unit!r}")
+            err(d.loc, f"{what} in deadline (units: {', '.join(UNITS)})", "E-deadline")
             ok = False
         elif _amount(d.amount) is None:
             err(d.loc, f"a deadline must be positive and at most {MAX_AMOUNT:g} {d.unit}", "E-deadline")

@@ -34,6 +34,7 @@ from typing import Iterable, Mapping, Sequence
 from . import ast, timing
 from .errors import Diagnostic, RclError, error
 from .parser import parse_files
+from .unitcheck import UnitChecker
 from .types import (BASE_NAMES, BOOL, INTEGER, NATURAL, REAL, STRING, Checked, qualified_base, CheckedNode, DataT, EmptyT, EnumT, Env, FuncT,
                     Scalar, SeqT, SetT, TupleT, Type, assignable, comparable, is_numeric, numeric_join)
 
@@ -69,6 +70,10 @@ class _Checker:
         self.unknown_types: set[str] = set()
         self.failed_io: set[tuple[str, str]] = set()
         self.failed_consts: set[str] = set()
+        # units of measure (docs/rcl-language.md, "Units of measure"): declarations and formulas,
+        # checked only when some file of the system writes a unit (check() sets it)
+        self.units = UnitChecker(self.err)
+        self.with_units = True
 
     # -- diagnostics -------------------------------------------------------------
     def err(self, loc: ast.Loc, msg: str, code: str = "E-type") -> None:
@@ -76,7 +81,7 @@ class _Checker:
 
     @property
     def env(self) -> Env:
-        return Env(self.types, self.constants, self.enum_values, self.ctors)
+        return Env(self.types, self.constants, self.enum_values, self.ctors, self.units.constants)
 
     # -- types ----------------------------------------------------------------------
     def resolve(self, t: ast.TypeExpr, name: str) -> Type:
@@ -179,6 +184,9 @@ class _Checker:
                     self.constants[d.name] = (vt, d.value)
                 except _Fail:
                     self.failed_consts.add(d.name)
+                    continue
+                if self.with_units:
+                    self.units.constant(d, vt)
 
     # -- nodes --------------------------------------------------------------------------
     def node(self, n: ast.Node) -> CheckedNode | None:
@@ -197,7 +205,8 @@ class _Checker:
                 except _Fail:
                     self.failed_io.add((prefix, v.name))
                     ok = False
-        cn = CheckedNode(n, inputs, outputs)
+        typed = {f"in.{k}": t for k, t in inputs.items()} | {f"out.{k}": t for k, t in outputs.items()}
+        cn = CheckedNode(n, inputs, outputs, self.units.declare(n, typed))
         for t in n.topics:
             if t.match is not None:
                 try:
@@ -218,6 +227,8 @@ class _Checker:
                 if ft != BOOL:
                     self.err(cl.formula.loc, f"a contract clause must be a formula (BOOL), found {ft}")
                     ok = False
+                elif self.with_units:
+                    self.units.clause(cl.formula, cn)
             except _Fail:
                 ok = False
         return cn if ok else None
@@ -461,6 +472,7 @@ def check(specs: Sequence[ast.Spec]) -> Checked:
     every error found (sorted by file, line, column).
     """
     c = _Checker()
+    c.with_units = any(getattr(s, "has_units", True) for s in specs)
     c.contexts(specs)
     nodes: dict[str, CheckedNode] = {}
     seen: dict[str, ast.Loc] = {}

@@ -14,6 +14,7 @@ from dataclasses import dataclass, field
 from typing import Literal, Mapping, Union
 
 from . import ast
+from .units import Unit
 
 ScalarName = Literal["REAL", "INTEGER", "NATURAL", "BOOL", "STRING"]
 
@@ -162,22 +163,29 @@ class Env:
     ``types``        context type name -> resolved type;
     ``constants``    constant name -> (type, defining expression);
     ``enum_values``  enumeration value -> its enumeration type;
-    ``ctors``        constructor name -> its constructor-set type.
+    ``ctors``        constructor name -> its constructor-set type;
+    ``units``        constant name -> its unit of measure (declared, or the
+                     unit of its value), for the constants that have one.
     """
 
     types: Mapping[str, Type] = field(default_factory=dict)
     constants: Mapping[str, tuple[Type, ast.Expr]] = field(default_factory=dict)
     enum_values: Mapping[str, EnumT] = field(default_factory=dict)
     ctors: Mapping[str, DataT] = field(default_factory=dict)
+    units: Mapping[str, Unit] = field(default_factory=dict)
 
 
 @dataclass(frozen=True)
 class CheckedNode:
-    """A node whose contract type-checked: its AST and resolved I/O types."""
+    """A node whose contract type-checked: its AST and resolved I/O types.
+    ``units`` maps ``"in.x"``/``"out.y"`` to the declared unit of measure of
+    the inputs and outputs that declare one (docs/rcl-language.md, "Units of
+    measure")."""
 
     node: ast.Node
     inputs: Mapping[str, Type]
     outputs: Mapping[str, Type]
+    units: Mapping[str, Unit] = field(default_factory=dict)
 
     @property
     def name(self) -> str:
@@ -190,6 +198,11 @@ class CheckedNode:
         if var.prefix == "out":
             return self.outputs.get(var.name)
         return self.inputs.get(var.name) or self.outputs.get(var.name)
+
+    def unit_of(self, prefix: str, name: str) -> Unit | None:
+        """The declared unit of ``in.name``/``out.name`` (``prefix`` ``"in"``
+        or ``"out"``), ``None`` when it declares none."""
+        return self.units.get(f"{prefix}.{name}")
 
 
 @dataclass(frozen=True)

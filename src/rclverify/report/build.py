@@ -311,6 +311,8 @@ def build_report(ws: Workspace) -> dict[str, Any]:
                         "loop_assumption": c["loop_assumption"]})
 
     findings = [f for n in checked.nodes for f in health[n]]
+    from ..calculus.scale import scale_findings  # a side condition's ranges a power of ten apart (a warning)
+    findings += scale_findings(side_conditions)
     lint_rows = [{"severity": d["severity"], "location": f"{d['file']}:{d['line']}:{d['col']}", "message": d["message"],
                   "code": d.get("code", "")}
                  for d in read_diagnostics(ws)]

@@ -30,7 +30,7 @@ def _rank(status: str) -> int:
 def node_rows(report: Mapping[str, Any]) -> list[dict[str, Any]]:
     """One row per node of ``report``: ``{"node", "status", "obligations"
     (status -> count), "sc_proved", "sc_total", "health_problems",
-    "health_open", "health_total", "unverified" (``["g<k>"]``: the node's
+    "health_open", "health_total", "health_warnings", "unverified" (``["g<k>"]``: the node's
     guarantees no obligation covers)}``, worst status first, then report order."""
     def by_node(items: list[Mapping[str, Any]]) -> dict[Any, list[Mapping[str, Any]]]:
         # one pass per kind: a scan of every item per node was quadratic in the system size
@@ -52,6 +52,7 @@ def node_rows(report: Mapping[str, Any]) -> list[dict[str, Any]]:
                      "sc_proved": sum(sc["status"] == "discharged" for sc in scs), "sc_total": len(scs),
                      "health_problems": sum(f["status"] in ("problem", "error") for f in fs),
                      "health_open": sum(f["status"] == "inconclusive" for f in fs), "health_total": len(fs),
+                     "health_warnings": sum(f["status"] == "warning" for f in fs),
                      "unverified": [f"g{u['guarantee']}" for u in unverified.get(name, [])]})
     rows.sort(key=lambda r: (-_rank(r["status"]), r["order"]))
     return rows
@@ -75,14 +76,19 @@ def _health(r: Mapping[str, Any]) -> str:
         words.append(f"{r['health_problems']} problem")
     if r["health_open"]:
         words.append(f"{r['health_open']} undecided")
+    warned = r.get("health_warnings", 0)  # a warning (a probable scale mismatch) is shown, not counted as ok
+    if warned and not words:
+        words.append(f"{r['health_total'] - warned} ok")
+    if warned:
+        words.append(f"{warned} warning{'s' if warned != 1 else ''}")
     return ", ".join(words) or f"{r['health_total']} ok"
 
 
 def _merge(rows: list[dict[str, Any]], label: str) -> dict[str, Any]:
     out: dict[str, Any] = {"node": label, "status": max((r["status"] for r in rows), key=_rank, default="discharged"),
                            "obligations": {}}
-    for key in ("sc_proved", "sc_total", "health_problems", "health_open", "health_total"):
-        out[key] = sum(r[key] for r in rows)
+    for key in ("sc_proved", "sc_total", "health_problems", "health_open", "health_total", "health_warnings"):
+        out[key] = sum(r.get(key, 0) for r in rows)
     out["unverified"] = [f"{r['node']}.{g}" for r in rows for g in r.get("unverified", [])]
     for r in rows:
         for s, c in r["obligations"].items():

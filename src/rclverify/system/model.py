@@ -30,6 +30,7 @@ from ..plan.load import Connection
 from ..rcl.errors import RclError, error
 from ..rcl.types import Checked, EmptyT
 from .services import peers as service_peers, side_conditions as service_conditions
+from .units import connection_diagnostics, connection_errors
 
 
 @dataclass(frozen=True)
@@ -249,7 +250,9 @@ def build(checked: Checked, connections: Sequence[Connection] = ()) -> SystemMod
     """Build the system model of the checked contracts.
 
     Raises :class:`RclError` (located at the input's declaration) when an
-    input could be fed by several nodes and the plan does not say which.
+    input could be fed by several nodes and the plan does not say which, and
+    (located at both declarations) when the two ends of a connection declare
+    different units of measure (:mod:`.units`).
     """
     nodes = list(checked.nodes)
     links: list[Link] = []
@@ -284,9 +287,22 @@ def build(checked: Checked, connections: Sequence[Connection] = ()) -> SystemMod
             else:
                 env.append((n, iv.name, str(t)))
     diags += service_conditions(checked)
+    diags += connection_errors(checked, links)
     if diags:
         raise RclError(diags)
     return SystemModel(tuple(nodes), tuple(links), tuple(env), _loops(nodes, links))
+
+
+def unit_diagnostics(checked: Checked, connections: Sequence[Connection] = ()) -> list[Any]:
+    """The unit errors and warnings of the connections :func:`build` finds
+    (:func:`rclverify.system.units.connection_diagnostics`), also when the
+    build fails for another reason (an ambiguous input): what ``rclverify
+    check`` shows of a system's connections without running the calculus."""
+    try:
+        model = build(checked, connections)
+    except RclError as exc:
+        return [d for d in exc.diagnostics if d.code.startswith(("E-unit", "W-unit"))]
+    return connection_diagnostics(checked, model.links)
 
 
 def _by_topic(checked: Checked, node: str, var: str) -> list[tuple[str, str]]:
