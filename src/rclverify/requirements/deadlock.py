@@ -8,12 +8,15 @@ trans(s, t)``, so a reachable deadlock is an exists-forall query: a path
 ``s0 .. sk`` from ``init`` with ``forall t. not trans(sk, t)``.  It is
 asked of Z3 as such:
 
-* the bound variables of finite sorts (BOOL, enumerations, constructor
-  sets) are written out first (:func:`rclverify.logic.retry.expand_finite`,
-  an equivalence), so over finite domains the query is quantifier-free;
-* what stays quantified is left to Z3's quantifier instantiation, and when
-  the first attempt answers ``unknown`` it is asked once more with
-  model-based instantiation alone (``smt.ematching=false``);
+* the successor's variables of finite sorts (BOOL, enumerations) are
+  written out first, one case per combination of values, and so are the
+  quantifiers over finite sorts inside the step relation
+  (:func:`rclverify.logic.retry.expand_finite`; both equivalences), so over
+  finite domains the query is quantifier-free;
+* what stays quantified is first eliminated where Z3's ``qe`` tactic can
+  (linear arithmetic: an equivalence), then left to Z3's quantifier
+  instantiation, and when that answers ``unknown`` it is asked once more
+  with model-based instantiation alone (``smt.ematching=false``);
 * an ``unknown`` after that is ``inconclusive``: never deadlock-free.
 
 Two checks:
@@ -34,12 +37,13 @@ stop.
 """
 from __future__ import annotations
 
+import itertools
 import time
 from typing import Sequence
 
 import z3
 
-from ..logic.retry import expand_finite
+from ..logic.retry import MAX_INSTANCES, expand_finite
 from .tsys import Pred, State, TemporalVerdict, TransitionSystem, distinct, trace_of, unroll
 
 #: The step-by-step search of :func:`find_deadlock` stops (``inconclusive``)
@@ -49,11 +53,37 @@ STOPS = ("no next state satisfies the contracts, the environment facts, the stat
          "requirement's assumptions")
 
 
+def _finite(s: z3.SortRef) -> list[z3.ExprRef] | None:
+    """Every value of a finite sort (BOOL, an enumeration), else ``None``."""
+    if s.kind() == z3.Z3_BOOL_SORT:
+        return [z3.BoolVal(False), z3.BoolVal(True)]
+    if isinstance(s, z3.DatatypeSortRef):
+        cons = [s.constructor(k) for k in range(s.num_constructors())]
+        if cons and all(c.arity() == 0 for c in cons):
+            return [c() for c in cons]
+    return None
+
+
 def successor_exists(ts: TransitionSystem, s: State) -> z3.BoolRef:
-    """``exists t. trans(s, t)`` over a fresh successor state, with the
-    bound variables of finite sorts written out (module docstring)."""
+    """``exists t. trans(s, t)`` over a fresh successor state.  The
+    successor's variables of finite sorts are written out (one disjunct per
+    combination of their values, up to :data:`MAX_INSTANCES`; an
+    equivalence), and quantifiers inside ``trans`` over finite sorts too
+    (:func:`rclverify.logic.retry.expand_finite`) where any sort is finite;
+    the other variables stay bound by ``exists``."""
     t = {n: z3.Const(f"{n}@succ", srt) for n, srt in ts.sorts.items()}  # bound: no clash with a step's
-    return expand_finite(z3.Exists(list(t.values()), ts.trans(s, t)))  # type: ignore[return-value]
+    body = ts.trans(s, t)
+    if any(_finite(srt) is not None or isinstance(srt, z3.DatatypeSortRef) for srt in ts.sorts.values()):
+        body = expand_finite(body)
+    finite = {n: vs for n, vs in ((n, _finite(srt)) for n, srt in ts.sorts.items()) if vs is not None}
+    rest = [t[n] for n in ts.sorts if n not in finite]
+    combos = list(itertools.islice(itertools.product(*finite.values()), MAX_INSTANCES + 1))
+    if not t:
+        return body
+    if not finite or len(combos) > MAX_INSTANCES:
+        return z3.Exists(list(t.values()), body)
+    cases = [z3.substitute(body, *[(t[n], v) for n, v in zip(finite, combo)]) for combo in combos]
+    return z3.Or(*[z3.Exists(rest, c) if rest else c for c in cases])
 
 
 def no_successor(ts: TransitionSystem, s: State) -> z3.BoolRef:
@@ -61,24 +91,40 @@ def no_successor(ts: TransitionSystem, s: State) -> z3.BoolRef:
     return z3.Not(successor_exists(ts, s))
 
 
+def _attempts(timeout_ms: int) -> list[tuple[str, z3.Solver]]:
+    """The solvers a deadlock query is asked of, in order (module docstring)."""
+    qe = z3.Then("qe", "smt").solver()  # eliminates the successor's quantifier over linear arithmetic
+    plain = z3.Solver()
+    mbqi = z3.Solver()
+    mbqi.set("smt.ematching", False)
+    for s in (qe, plain, mbqi):
+        s.set("timeout", timeout_ms)
+    return [("quantifier elimination", qe), ("default", plain), ("model-based instantiation", mbqi)]
+
+
 def _check(solver: z3.Solver, extra: Sequence[z3.BoolRef], timeout_ms: int) -> tuple[z3.CheckSatResult, z3.ModelRef | None, str]:
     """``solver``'s assertions and ``extra``: (answer, model when sat, why
-    when unknown).  An unknown is asked once more with model-based
-    quantifier instantiation alone, in a solver of its own."""
-    r = solver.check(*extra)
-    if r == z3.sat:
-        return r, solver.model(), ""
-    if r == z3.unsat:
-        return r, None, ""
-    why = solver.reason_unknown()
-    again = z3.Solver()
-    again.set("timeout", timeout_ms)
-    again.set("smt.ematching", False)
-    again.add(*solver.assertions(), *extra)
-    r = again.check()
-    if r == z3.sat:
-        return r, again.model(), ""
-    return r, None, "" if r == z3.unsat else f"{why}; with model-based instantiation: {again.reason_unknown()}"
+    when unknown).  Without ``extra`` ``solver`` answers (incrementally);
+    with ``extra`` (the quantified deadlock condition) each of
+    :func:`_attempts` is asked in turn, in a solver of its own, until one
+    answers sat or unsat."""
+    if not extra:
+        r = solver.check()
+        return r, solver.model() if r == z3.sat else None, solver.reason_unknown() if r == z3.unknown else ""
+    whys = []
+    for name, s in _attempts(timeout_ms):
+        s.add(*solver.assertions(), *extra)
+        try:
+            r = s.check()
+        except z3.Z3Exception as exc:  # a tactic that refuses the query: that attempt is undecided
+            whys.append(f"{name}: {exc}")
+            continue
+        if r == z3.sat:
+            return r, s.model(), ""
+        if r == z3.unsat:
+            return r, None, ""
+        whys.append(f"{name}: {s.reason_unknown()}")
+    return z3.unknown, None, "; ".join(whys)
 
 
 def _solver(timeout_ms: int) -> z3.Solver:
@@ -162,7 +208,7 @@ def check_deadlock_free(ts: TransitionSystem, *, staying: Pred | None = None, in
             r, _, why = _check(base, [], timeout_ms)
             if r == z3.unsat:  # no run stays in `staying` for k-1 steps: none stops there later
                 return TemporalVerdict("proved", "bounded", bound=k - 1,
-                                       deadlock=f"no run stops{what} (no run gets that far as step {k - 1})")
+                                       deadlock=f"no run stops{what}: none gets to step {k - 1}")
             if r == z3.unknown:
                 return TemporalVerdict("inconclusive", "deadlock", bound=k - 1,
                                        detail=f"Z3 could not decide whether a run reaches step {k - 1} ({why})",
