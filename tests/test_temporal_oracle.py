@@ -139,29 +139,33 @@ def oracle(m: System) -> dict[str, bool]:
 
 # --- the system in Z3 ----------------------------------------------------------------------------
 
-def _is(s: dict[str, z3.ExprRef], v: S, has_b: bool) -> z3.BoolRef:
-    return z3.And(s["x"] == v[0], s["b"] == v[1]) if has_b else s["x"] == v[0]
-
-
-def _one_of(s: dict[str, z3.ExprRef], vs: Any, has_b: bool) -> z3.BoolRef:
-    vs = sorted(vs)
-    return z3.Or(*[_is(s, v, has_b) for v in vs]) if vs else z3.BoolVal(False)
-
-
 def encode(m: System) -> tuple[TransitionSystem, Any, Any, Any, Any]:
+    """``m`` as a :class:`TransitionSystem` and its predicates, ranking and invariant."""
     sorts = {"x": z3.IntSort(), **({"b": z3.BoolSort()} if m.has_b else {})}
-    pairs = [(a, c) for a in m.states for c in sorted(m.succ[a])]
-    ts = TransitionSystem(sorts, lambda s: _one_of(s, m.init, m.has_b),
-                          lambda s, t: z3.Or(*[z3.And(_is(s, a, m.has_b), _is(t, c, m.has_b)) for a, c in pairs])
-                          if pairs else z3.BoolVal(False))
+    memo: dict[tuple[int, ...], tuple[Any, z3.BoolRef]] = {}  # keeps the keyed terms alive
+
+    def is_(s: dict[str, z3.ExprRef], v: S) -> z3.BoolRef:
+        terms = [s[n] for n in sorts]
+        key = (*[x.get_id() for x in terms], v[0], int(v[1]))
+        if key not in memo:
+            memo[key] = (terms, z3.And(s["x"] == v[0], s["b"] == v[1]) if m.has_b else s["x"] == v[0])
+        return memo[key][1]
+
+    def one_of(s: dict[str, z3.ExprRef], vs: Any) -> z3.BoolRef:
+        vs = sorted(vs)
+        return z3.Or(*[is_(s, v) for v in vs]) if vs else z3.BoolVal(False)
+
+    def trans(s: dict[str, z3.ExprRef], t: dict[str, z3.ExprRef]) -> z3.BoolRef:
+        return z3.Or(*[z3.And(is_(s, a), one_of(t, m.succ[a])) for a in m.states])
 
     def rank(s: dict[str, z3.ExprRef]) -> z3.ArithRef:
         out: z3.ArithRef = z3.IntVal(-1)  # outside the domain
         for v in m.states:
-            out = z3.If(_is(s, v, m.has_b), m.rank[v], out)
+            out = z3.If(is_(s, v), m.rank[v], out)
         return out
-    inv = None if m.inv is None else (lambda s: _one_of(s, m.inv, m.has_b))
-    return ts, (lambda s: _one_of(s, m.p, m.has_b)), (lambda s: _one_of(s, m.q, m.has_b)), rank, inv
+    inv = None if m.inv is None else (lambda s: one_of(s, m.inv))
+    ts = TransitionSystem(sorts, lambda s: one_of(s, m.init), trans)
+    return ts, (lambda s: one_of(s, m.p)), (lambda s: one_of(s, m.q)), rank, inv
 
 
 def _state(row: dict[str, str], has_b: bool) -> S:
