@@ -15,8 +15,9 @@ spaces, so every line and column the RCL parser and type checker report is
 the one in the plan.  A statement with no temporal operator is a
 :class:`~rclverify.plan.formal.Formal`, unchanged.
 
-Errors (a bound that is not a natural number, an empty operand) are
-located :class:`~rclverify.rcl.errors.RclError` diagnostics (``E-syntax``).
+Errors (a bound that is not a natural number in the digits 0-9, an empty
+operand) are located :class:`~rclverify.rcl.errors.RclError` diagnostics
+(``E-syntax``); a bound above :data:`MAX_BOUND` is ``E-temporal``.
 """
 from __future__ import annotations
 
@@ -30,6 +31,12 @@ from .formal import Formal, Source, _loc_at, parse_formal
 
 _PREFIX = re.compile(r"\s*(always|eventually|next|previous)\b")
 _BOUND = re.compile(r"\s*\[\s*<=\s*([^\]]*)\]")
+_DIGITS = re.compile(r"[0-9]+", re.ASCII)
+#: The largest N of ``eventually[<= N]``: deciding it unrolls the composed
+#: system N steps and, where no run stopping before the goal is excluded by
+#: induction, searches such runs step by step (cost growing with N squared;
+#: docs/requirements.md, "Limits").
+MAX_BOUND = 1000
 _UNTIL = re.compile(r"(?<![A-Za-z0-9_.'])until(?![A-Za-z0-9_'])")
 
 
@@ -110,11 +117,7 @@ def _parse(src: Source, start: int, end: int, checked: Checked, what: str,
         if op == "eventually":
             b = _BOUND.match(text, pos, end)
             if b:
-                if not b.group(1).strip().isdigit():
-                    raise RclError([error(_loc_at(src, b.start(1)), f"{what}: the bound of eventually[<= N] "
-                                          f"must be a natural number of steps, found {b.group(1).strip()!r}",
-                                          "E-syntax")])
-                bound, pos = int(b.group(1)), b.end()
+                bound, pos = _bound(src, b, what), b.end()
         return Temporal(op, (_parse(src, pos, end, checked, what, states),), bound)
     u = _until_at(text, start, end)
     if u is not None:
@@ -123,6 +126,25 @@ def _parse(src: Source, start: int, end: int, checked: Checked, what: str,
     if start == 0 and end == len(text):
         return parse_formal(src, checked, what, states)
     return parse_formal(Source(_blank(text, start, end), src.line, src.col, src.file), checked, what, states)
+
+
+def _bound(src: Source, b: "re.Match[str]", what: str) -> int:
+    """The step bound of ``eventually[<= N]`` (``b`` the match of
+    :data:`_BOUND`): ASCII digits only (``str.isdigit`` also takes ``'²'``
+    and other scripts' digits), at most :data:`MAX_BOUND`; else a located
+    error at the bound (``E-syntax``, ``E-temporal``)."""
+    text = b.group(1).strip()
+    at = _loc_at(src, b.start(1) + len(b.group(1)) - len(b.group(1).lstrip()))
+    if not _DIGITS.fullmatch(text):
+        raise RclError([error(at, f"{what}: the bound of eventually[<= N] must be a natural number of steps "
+                                  f"written in the digits 0-9, found {text!r}", "E-syntax")])
+    digits = text.lstrip("0") or "0"
+    if len(digits) > len(str(MAX_BOUND)) or int(digits) > MAX_BOUND:  # no int() of a huge literal
+        shown = digits if len(digits) <= 20 else f"{digits[:8]}...({len(digits)} digits)"
+        raise RclError([error(at, f"{what}: the bound of eventually[<= N] is at most {MAX_BOUND} steps, found "
+                                  f"{shown}; state a longer response as eventually F with a ranking function "
+                                  f"(docs/requirements.md, Temporal requirements)", "E-temporal")])
+    return int(digits)
 
 
 def shape(t: Temporal | Formal, loc: Any) -> str:

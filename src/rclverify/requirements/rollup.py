@@ -16,6 +16,7 @@ verdict (``check``)                what the proof rests on      status shown (``
                                    (Z3 could not say whether
                                    the premise can ever hold)
 ``refuted``                                                     ``refuted`` / ``failed``
+``refuted`` by a run that stops    (temporal: a deadlock)       ``refuted`` / ``failed``
 ``inconclusive``                                                ``inconclusive`` / ``inconclusive``
 ``informal`` (no formal statement) (nothing: traced only)        ``informal`` / ``pending``
 ``stale`` (made from other inputs)  (not shown)                  ``stale`` / ``stale``
@@ -67,6 +68,10 @@ def roll_up(record: Mapping[str, Any] | None, g_status: Callable[[str, int], str
     if bad:  # a recorded run refutes it: never met, whatever Z3 says (backends/monitors/temporal_evidence.py)
         w = bad[0].get("verdict", {})
         return "refuted", "failed", f"the recorded run {bad[0]['trace']} refutes it: {w.get('reason', '')} (Z3: {v})"
+    if v == "refuted" and "deadlock" in str((record.get("temporal") or {}).get("method")).split(" + "):
+        t = record["temporal"]
+        return "refuted", "failed", (f"a run of the system stops at step {t.get('bound')}: no next state satisfies the "
+                                     "premises of its cone (a deadlock), and the runs of the system must not stop")
     if v == "refuted":
         who = ", ".join(p["label"] for p in record.get("failed_to_prevent", [])) or "no guarantee of the cone"
         return "refuted", "failed", f"Z3 found a counterexample that every premise allows; it is not prevented by: {who}"

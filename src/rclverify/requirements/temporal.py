@@ -3,87 +3,43 @@
 The composed system is read as a transition system (docs/requirements.md,
 "Temporal requirements"): a state assigns a value to every state variable
 (nodes' inputs and outputs, the environment's facts, declared memory), and
-one step relates the current state to the next.  This module decides, over
-such a system:
+one step relates the current state to the next.  A *run* is a maximal path
+from an initial state: infinite, or finite and ending in a state with no
+successor (a run that stops: :mod:`.deadlock`).  This module decides, over
+such a system, with the finite-run semantics of docs/requirements.md:
 
 * ``always P`` -- refuted by bounded model checking (a counterexample trace,
   one state per step), proved by k-induction (the k used is returned);
-* ``eventually P within N`` -- a bounded response, decided exactly by
-  unrolling N steps (met: every run reaches P within N steps; refuted: a
-  run of N steps that never reaches P, returned as its trace);
-* ``eventually P`` without bound -- proved only through a ranking function
-  the user supplies; otherwise ``inconclusive`` with the bound checked.
-  Never ``met`` on a bound alone.
+* ``eventually P within N`` -- a bounded response, decided exactly: met
+  when no run of N steps misses P *and* no run stops before step N without
+  reaching P; refuted with either run as the trace;
+* ``eventually P`` without bound -- proved through a ranking function the
+  user supplies, or because every run reaches P within the bound; refuted
+  by a lasso or by a run that stops before reaching P; otherwise
+  ``inconclusive`` with the bound checked.  Never ``met`` on a bound alone;
+* ``next P`` (a next state exists and satisfies P) and ``P until Q``.
+
+Whether the system's runs may stop at all (the rule every temporal
+requirement is held to) is :func:`rclverify.requirements.deadlock.runs_go_on`.
 
 Source of the rules: k-induction (Sheeran, Singh, Stalmarck, FMCAD 2000)
-as used by Kind 2 and AGREE; the paper's stream model
+as used by Kind 2 and AGREE; lassos as counterexamples to liveness (Biere,
+Cimatti, Clarke, Zhu, TACAS 1999); the paper's stream model
 (compositional-verification-paper.tex, contracts consume one input and
 persist outputs) fixes what a step is.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
 from typing import Callable
 
 import z3
 
-State = dict[str, z3.ExprRef]
-Pred = Callable[[State], z3.BoolRef]
-Trans = Callable[[State, State], z3.BoolRef]
+from .deadlock import check_deadlock_free, find_deadlock
+from .tsys import Pred, State, TemporalVerdict, Trans, TransitionSystem, distinct, trace_of, unroll, with_flag
 
-
-@dataclass(frozen=True)
-class TransitionSystem:
-    """A symbolic transition system.
-
-    ``sorts`` maps each state variable's name to a Z3 sort; ``init`` is a
-    predicate over the first state; ``trans`` relates a state to the next.
-    """
-
-    sorts: dict[str, z3.SortRef]
-    init: Pred
-    trans: Trans
-
-    def state(self, step: int) -> State:
-        """Fresh Z3 constants for the state at ``step`` (0-based)."""
-        return {n: z3.Const(f"{n}@{step}", s) for n, s in self.sorts.items()}
-
-
-@dataclass
-class TemporalVerdict:
-    """The verdict on one temporal property.
-
-    ``status`` is ``proved`` | ``met`` | ``refuted`` | ``inconclusive``;
-    ``method`` names how (``k-induction``, ``bounded``, ``ranking``, ``bmc``);
-    ``k`` the induction depth used; ``bound`` the number of steps checked;
-    ``trace`` the counterexample, one ``{variable: value}`` per step.
-    """
-
-    status: str
-    method: str
-    k: int | None = None
-    bound: int | None = None
-    trace: list[dict[str, str]] = field(default_factory=list)
-    detail: str = ""
-    #: a lasso's loop: the last state of ``trace`` equals state ``loop``
-    loop: int | None = None
-
-    def to_json(self) -> dict:
-        """The record fields (a JSON-ready dict)."""
-        return {"status": self.status, "method": self.method, "k": self.k,
-                "bound": self.bound, "trace": self.trace, "detail": self.detail, "loop": self.loop}
-
-
-def _unroll(ts: TransitionSystem, n: int) -> tuple[list[State], list[z3.BoolRef]]:
-    states = [ts.state(i) for i in range(n + 1)]
-    steps = [ts.trans(states[i], states[i + 1]) for i in range(n)]
-    return states, steps
-
-
-def _trace(model: z3.ModelRef, states: list[State]) -> list[dict[str, str]]:
-    return [{n: str(model.eval(v, model_completion=True)) for n, v in s.items()}
-            for s in states]
+__all__ = ["Pred", "State", "TemporalVerdict", "Trans", "TransitionSystem", "check_always", "check_eventually",
+           "check_eventually_within", "check_next", "check_until", "find_lasso", "with_flag"]
 
 
 def check_always(ts: TransitionSystem, prop: Pred, *, max_k: int = 10,
@@ -92,12 +48,12 @@ def check_always(ts: TransitionSystem, prop: Pred, *, max_k: int = 10,
 
     For each k: the base case asks for a run of k-1 steps from ``init``
     violating ``prop`` (found: ``refuted`` with that shortest trace); the
-    step case asks whether k consecutive states satisfying ``prop`` can be
-    followed by one violating it (unsat: ``proved`` with k).  No k up to
+    step case asks whether k consecutive distinct states satisfying ``prop``
+    can be followed by one violating it (unsat: ``proved`` with k).  No k up to
     ``max_k`` decides it: ``inconclusive`` with ``bound = max_k``.
     """
     for k in range(1, max_k + 1):
-        states, steps = _unroll(ts, k - 1)
+        states, steps = unroll(ts, k - 1)
         base = z3.Solver()
         base.set("timeout", timeout_ms)
         base.add(ts.init(states[0]), *steps)
@@ -105,15 +61,15 @@ def check_always(ts: TransitionSystem, prop: Pred, *, max_k: int = 10,
         r = base.check()
         if r == z3.sat:
             return TemporalVerdict("refuted", "bmc", bound=k - 1,
-                                   trace=_trace(base.model(), states),
+                                   trace=trace_of(base.model(), states),
                                    detail=f"violated at step {k - 1}")
         if r == z3.unknown:
             return TemporalVerdict("inconclusive", "bmc", bound=k - 1,
                                    detail=f"solver: {base.reason_unknown()}")
-        states, steps = _unroll(ts, k)
+        states, steps = unroll(ts, k)
         ind = z3.Solver()
         ind.set("timeout", timeout_ms)
-        ind.add(*steps, *[prop(s) for s in states[:-1]])
+        ind.add(*steps, *[prop(s) for s in states[:-1]], *distinct(states))
         ind.add(z3.Not(prop(states[-1])))
         if ind.check() == z3.unsat:
             return TemporalVerdict("proved", "k-induction", k=k, bound=k - 1)
@@ -125,40 +81,113 @@ def check_always(ts: TransitionSystem, prop: Pred, *, max_k: int = 10,
 def check_eventually_within(ts: TransitionSystem, prop: Pred, bound: int, *,
                             timeout_ms: int = 10_000) -> TemporalVerdict:
     """Decide ``eventually[<= bound] prop``: every run reaches ``prop`` at
-    some step 0..``bound``.  Exact: ``met`` if no run of ``bound`` steps
-    avoids it, else ``refuted`` with such a run as the trace.
+    some step 0..``bound``.  A run misses it in two ways: it goes on for
+    ``bound`` steps outside ``prop``, or it stops (no successor) at a step
+    before ``bound`` without having reached it (:func:`.deadlock.find_deadlock`).
+    Exact: ``met`` when neither run exists; ``refuted`` with the run as the
+    trace (method ``bounded``, or ``deadlock`` for a run that stops);
+    ``inconclusive`` when Z3 cannot decide a query.
     """
-    states, steps = _unroll(ts, bound)
+    states, steps = unroll(ts, bound)
     s = z3.Solver()
     s.set("timeout", timeout_ms)
     s.add(ts.init(states[0]), *steps, *[z3.Not(prop(st)) for st in states])
     r = s.check()
-    if r == z3.unsat:
-        return TemporalVerdict("met", "bounded", bound=bound)
     if r == z3.sat:
         return TemporalVerdict("refuted", "bounded", bound=bound,
-                               trace=_trace(s.model(), states),
+                               trace=trace_of(s.model(), states),
                                detail=f"not reached within {bound} steps")
+    if r == z3.unknown:
+        return TemporalVerdict("inconclusive", "bounded", bound=bound,
+                               detail=f"solver: {s.reason_unknown()}")
+    # no run goes on for `bound` steps outside prop: does one stop before reaching it?  First by
+    # induction (a few queries whatever the bound), then step by step up to the bound
+    outside = lambda st: z3.Not(prop(st))  # noqa: E731
+    quick = check_deadlock_free(ts, staying=outside, max_k=min(bound, 2), timeout_ms=timeout_ms,
+                                what=" before reaching it") if bound > 0 else None
+    if quick is not None and quick.status == "refuted":  # it stops at a step < 2 <= bound
+        return quick
+    stop = None if quick is not None and quick.status == "proved" else find_deadlock(
+        ts, bound, staying=outside, timeout_ms=timeout_ms, what=" before reaching it")
+    if stop is None:
+        return TemporalVerdict("met", "bounded", bound=bound,
+                               deadlock=f"no run stops before reaching it within {bound} steps")
+    if stop.status == "refuted":
+        return stop
     return TemporalVerdict("inconclusive", "bounded", bound=bound,
-                           detail=f"solver: {s.reason_unknown()}")
+                           detail=f"no run of {bound} steps misses it, but {stop.detail[0].lower()}"
+                                  f"{stop.detail[1:]}", deadlock=stop.deadlock)
+
+
+def check_next(ts: TransitionSystem, prop: Pred, *, timeout_ms: int = 10_000) -> TemporalVerdict:
+    """Decide ``next prop``: every run has a step 1, and ``prop`` holds
+    there.  ``refuted`` by a step whose next state misses it (method
+    ``bmc``) or by a run that stops at step 0 (method ``deadlock``);
+    ``proved`` (method ``bounded``) otherwise; ``inconclusive`` on an
+    unknown."""
+    a, b = ts.state(0), ts.state(1)
+    s = z3.Solver()
+    s.set("timeout", timeout_ms)
+    s.add(ts.init(a), ts.trans(a, b), z3.Not(prop(b)))
+    r = s.check()
+    if r == z3.sat:
+        return TemporalVerdict("refuted", "bmc", bound=1, detail="fails at step 1", trace=trace_of(s.model(), [a, b]))
+    if r == z3.unknown:
+        return TemporalVerdict("inconclusive", "bmc", bound=1, detail=f"solver: {s.reason_unknown()}")
+    stop = find_deadlock(ts, 1, timeout_ms=timeout_ms, what=" (there is no step 1)")
+    if stop is None:
+        return TemporalVerdict("proved", "bounded", bound=1, detail="holds at step 1 of every run",
+                               deadlock="no run stops at step 0")
+    return stop if stop.status == "refuted" else TemporalVerdict(
+        "inconclusive", "bmc", bound=1, detail=f"holds at every step 1, but {stop.detail}", deadlock=stop.deadlock)
+
+
+def check_until(ts: TransitionSystem, prop: Pred, goal: Pred, *,
+                eventually: Callable[[], TemporalVerdict] | None = None, max_k: int = 10,
+                timeout_ms: int = 10_000) -> TemporalVerdict:
+    """Decide ``prop until goal``: every run reaches ``goal``, and ``prop``
+    holds at every step before.  Decided as its safety part, ``always (goal
+    seen or prop)`` over ``ts`` with a history flag (:func:`check_always`),
+    and its liveness part ``eventually goal`` (``eventually()``; default
+    :func:`check_eventually` with ``bound = max_k``).  ``refuted`` when
+    either part is; ``proved`` when both are; else ``inconclusive`` with
+    both parts' statuses."""
+    ts2 = with_flag(ts, "<G seen>", goal, lambda s, u: z3.Or(s["<G seen>"], goal(u)))
+    safe = check_always(ts2, lambda s: z3.Or(s["<G seen>"], prop(s)), max_k=max_k, timeout_ms=timeout_ms)
+    if safe.status == "refuted":
+        return safe
+    live = eventually() if eventually is not None else check_eventually(ts, goal, bound=max_k, timeout_ms=timeout_ms)
+    if live.status == "refuted" or (safe.status == "proved" and live.status == "proved"):
+        return TemporalVerdict(live.status, f"{safe.method} + {live.method}", k=safe.k, bound=live.bound,
+                               trace=live.trace, loop=live.loop, detail=live.detail, deadlock=live.deadlock)
+    return TemporalVerdict("inconclusive", f"{safe.method} + {live.method}", k=safe.k, bound=live.bound,
+                           trace=live.trace, detail=f"safety part {safe.status}; liveness part {live.status}: "
+                                                    f"{live.detail or safe.detail}", deadlock=live.deadlock)
 
 
 def check_eventually(ts: TransitionSystem, prop: Pred, *,
                      ranking: Callable[[State], z3.ArithRef] | None = None,
                      invariant: Pred | None = None, bound: int = 10,
                      timeout_ms: int = 10_000) -> TemporalVerdict:
-    """Decide unbounded ``eventually prop``.
+    """Decide unbounded ``eventually prop``: every run, infinite or one
+    that stops, reaches ``prop``.
 
-    Proved only through a user-supplied integer ``ranking`` function and
-    an ``invariant`` (default true) that is itself proved by k-induction:
-    in every invariant state where ``prop`` is false, the rank is >= 0
-    and every step decreases it strictly.  Without a ranking function, or
-    if its conditions fail: a run of ``bound`` steps missing ``prop`` is
-    reported as ``inconclusive`` with its trace (it is not a lasso, so not
-    a counterexample to liveness).  If every run of ``bound`` steps reaches
-    ``prop``, that is a proof (``proved``, method ``bounded``).
+    ``proved`` (method ``ranking``) through a user-supplied integer
+    ``ranking`` function and an ``invariant`` (default true) that is itself
+    proved by k-induction: in every invariant state where ``prop`` is
+    false, the rank is >= 0 and every step decreases it strictly, so no
+    infinite run misses ``prop``; and no run stops before reaching it
+    (:func:`.deadlock.check_deadlock_free` outside ``prop``, by k-induction
+    strengthened by the invariant).  ``proved`` (method ``bounded``) when
+    every run reaches ``prop`` within ``bound`` steps
+    (:func:`check_eventually_within`).  ``refuted`` by a run that stops
+    before reaching it (method ``deadlock``) or by a lasso missing it
+    (:func:`find_lasso`).  Otherwise ``inconclusive``: a run of ``bound``
+    steps missing ``prop`` is not a counterexample to liveness (it is
+    reported as the trace).
     """
     inv = invariant or (lambda st: z3.BoolVal(True))
+    outside = lambda st: z3.Not(prop(st))  # noqa: E731
     why: str | None = "no ranking function"
     if ranking is not None:
         iv = check_always(ts, inv, max_k=bound, timeout_ms=timeout_ms) if invariant else None
@@ -168,22 +197,36 @@ def check_eventually(ts: TransitionSystem, prop: Pred, *,
         else:
             why = _ranking_fails(ts, prop, inv, ranking, timeout_ms)
             if why is None:
-                return TemporalVerdict("proved", "ranking", k=iv.k if iv else None,
-                                       detail="in every state of the invariant where it does not hold, the "
-                                              "ranking function is >= 0 and every step decreases it")
+                stops = check_deadlock_free(ts, staying=outside, invariant=invariant, max_k=bound,
+                                            timeout_ms=timeout_ms, what=" before reaching it")
+                if stops.status == "refuted":
+                    return stops
+                if stops.status == "proved":
+                    return TemporalVerdict("proved", "ranking", k=iv.k if iv else None, deadlock=stops.deadlock,
+                                           detail="in every state of the invariant where it does not hold, the "
+                                                  "ranking function is >= 0 and every step decreases it; no run "
+                                                  "stops before reaching it")
+                why = (f"the ranking function holds, but whether a run stops before reaching it is undecided "
+                       f"({stops.detail})")
     bounded = check_eventually_within(ts, prop, bound, timeout_ms=timeout_ms)
-    if bounded.status == "inconclusive":  # the solver could not say: nothing was checked, and no lasso is sought
-        return TemporalVerdict("inconclusive", "bounded", bound=None,
+    if bounded.status == "inconclusive":  # the solver could not say: nothing was decided, and no lasso is sought
+        return TemporalVerdict("inconclusive", "bounded", bound=None, deadlock=bounded.deadlock,
                                detail=f"Z3 could not decide whether a run of {bound} steps misses it "
                                       f"({bounded.detail}); no step was checked")
     if bounded.status == "met":
-        # every run reaches prop within `bound` steps: a proof, not a guess
-        return TemporalVerdict("proved", "bounded", bound=bound,
+        # every run reaches prop within `bound` steps, and none stops before: a proof, not a guess
+        return TemporalVerdict("proved", "bounded", bound=bound, deadlock=bounded.deadlock,
                                detail=f"reached within {bound} steps on every run")
+    if bounded.method == "deadlock":  # a run that stops before reaching it: a counterexample
+        return bounded
     lasso = find_lasso(ts, prop, bound, timeout_ms=timeout_ms)
     if lasso is not None:
         return lasso
+    stop = find_deadlock(ts, bound, staying=outside, timeout_ms=timeout_ms, what=" before reaching it")
+    if stop is not None and stop.status == "refuted":
+        return stop
     return TemporalVerdict("inconclusive", "bounded", bound=bound, trace=bounded.trace,
+                           deadlock=stop.deadlock if stop is not None else "",
                            detail=f"{why}; a run of {bound} steps does not reach it")
 
 
@@ -223,7 +266,7 @@ def find_lasso(ts: TransitionSystem, prop: Pred, bound: int, *,
     such run of up to ``bound`` steps exists or the solver cannot say.
     """
     for n in range(1, bound + 1):
-        states, steps = _unroll(ts, n)
+        states, steps = unroll(ts, n)
         s = z3.Solver()
         s.set("timeout", timeout_ms)
         same = [z3.And(*[states[n][v] == states[j][v] for v in ts.sorts]) for j in range(n)]
@@ -231,6 +274,6 @@ def find_lasso(ts: TransitionSystem, prop: Pred, bound: int, *,
         if s.check() == z3.sat:
             m = s.model()
             loop = next(j for j in range(n) if z3.is_true(m.eval(same[j], model_completion=True)))
-            return TemporalVerdict("refuted", "lasso", bound=n, trace=_trace(m, states), loop=loop,
+            return TemporalVerdict("refuted", "lasso", bound=n, trace=trace_of(m, states), loop=loop,
                                    detail=f"a run whose step {n} returns to step {loop} and never reaches it")
     return None

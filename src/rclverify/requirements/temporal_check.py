@@ -46,8 +46,9 @@ from ..health.witness import points_for
 from ..rcl.types import Checked, EmptyT
 from ..values import render
 from ..system.model import SystemModel
+from .deadlock import runs_go_on
 from .temporal import (TemporalVerdict, TransitionSystem, check_always, check_eventually,
-                       check_eventually_within)
+                       check_eventually_within, check_next, check_until, with_flag)
 from .lasso import find_table_lasso
 from .lasso_confirm import confirm_lasso
 from .transition import ComposedSystem, build_system, variable_types
@@ -72,14 +73,6 @@ def statement(req: Requirement, checked: Checked, plan: Plan) -> Temporal:
     return t
 
 
-def _with_flag(ts: TransitionSystem, name: str, init: Callable[[Any], Any], step: Callable[[Any, Any], Any]) -> TransitionSystem:
-    """``ts`` with one more Boolean variable ``name``: ``init(s)`` its first
-    value, ``step(s, t)`` its next (a history variable: constrains nothing)."""
-    sorts = {**ts.sorts, name: z3.BoolSort()}
-    return TransitionSystem(sorts, lambda s: z3.And(ts.init(s), s[name] == init(s)),
-                            lambda s, t: z3.And(ts.trans(s, t), t[name] == step(s, t)))
-
-
 def decide(t: Temporal, sys: ComposedSystem, pred: Callable[[Formal], Callable[[Any], Any]], *,
            bound: int = DEFAULT_BOUND, timeout_ms: int = 10_000,
            tables: Callable[[Formal, TemporalVerdict], TemporalVerdict] | None = None,
@@ -88,7 +81,16 @@ def decide(t: Temporal, sys: ComposedSystem, pred: Callable[[Formal], Callable[[
     F as a predicate over one state.  ``tables(F, v)`` is asked when the
     verdict ``v`` on an unbounded ``eventually F`` is inconclusive (the
     finite-table lasso search of :func:`check_temporal`); ``ranking`` and
-    ``invariant`` (over one state) are the plan's, for that ``eventually``."""
+    ``invariant`` (over one state) are the plan's, for that ``eventually``.
+    A verdict ``proved`` stands only if no run of the system stops
+    (:func:`.deadlock.runs_go_on`)."""
+    return runs_go_on(sys.ts, _decide(t, sys, pred, bound, timeout_ms, tables, ranking, invariant),
+                      max_k=bound, timeout_ms=timeout_ms)
+
+
+def _decide(t: Temporal, sys: ComposedSystem, pred: Callable[[Formal], Callable[[Any], Any]], bound: int,
+            timeout_ms: int, tables: Callable[[Formal, TemporalVerdict], TemporalVerdict] | None,
+            ranking: Callable[[Any], Any] | None, invariant: Callable[[Any], Any] | None) -> TemporalVerdict:
     kind = shape(t, None)
     ts = sys.ts
 
@@ -99,42 +101,19 @@ def decide(t: Temporal, sys: ComposedSystem, pred: Callable[[Formal], Callable[[
         return check_always(ts, pred(t.args[0]), max_k=bound, timeout_ms=timeout_ms)
     if kind == "always next":
         f = pred(t.args[0].args[0])  # type: ignore[union-attr]
-        ts2 = _with_flag(ts, "<started>", lambda s: z3.BoolVal(False), lambda s, u: z3.BoolVal(True))
+        ts2 = with_flag(ts, "<started>", lambda s: z3.BoolVal(False), lambda s, u: z3.BoolVal(True))
         return check_always(ts2, lambda s: z3.Or(z3.Not(s["<started>"]), f(s)), max_k=bound, timeout_ms=timeout_ms)
     if kind == "next":
-        f = pred(t.args[0])
-        a, b = ts.state(0), ts.state(1)
-        s = z3.Solver()
-        s.set("timeout", timeout_ms)
-        s.add(ts.init(a), ts.trans(a, b), z3.Not(f(b)))
-        r = s.check()
-        if r == z3.unsat:
-            return TemporalVerdict("proved", "bounded", bound=1, detail="holds at step 1 of every run")
-        if r == z3.sat:
-            m = s.model()
-            return TemporalVerdict("refuted", "bmc", bound=1, detail="fails at step 1",
-                                   trace=[{n: str(m.eval(x, model_completion=True)) for n, x in st.items()}
-                                          for st in (a, b)])
-        return TemporalVerdict("inconclusive", "bmc", bound=1, detail=f"solver: {s.reason_unknown()}")
+        return check_next(ts, pred(t.args[0]), timeout_ms=timeout_ms)
     if kind == "eventually":
         f = pred(t.args[0])
         if t.bound is not None:
             v = check_eventually_within(ts, f, t.bound, timeout_ms=timeout_ms)
-            return TemporalVerdict("proved", v.method, bound=v.bound, detail=v.detail) if v.status == "met" else v
+            return TemporalVerdict("proved", v.method, bound=v.bound, detail=v.detail,
+                                   deadlock=v.deadlock) if v.status == "met" else v
         return eventually(t.args[0])  # type: ignore[arg-type]
-    # until: safety part always (seen(G) or F), liveness part eventually G
-    f, g = pred(t.args[0]), pred(t.args[1])
-    ts2 = _with_flag(ts, "<G seen>", g, lambda s, u: z3.Or(s["<G seen>"], g(u)))
-    safe = check_always(ts2, lambda s: z3.Or(s["<G seen>"], f(s)), max_k=bound, timeout_ms=timeout_ms)
-    if safe.status == "refuted":
-        return safe
-    live = eventually(t.args[1])  # type: ignore[arg-type]
-    if live.status == "refuted" or (safe.status == "proved" and live.status == "proved"):
-        return TemporalVerdict(live.status, f"{safe.method} + {live.method}", k=safe.k, bound=live.bound,
-                               trace=live.trace, loop=live.loop, detail=live.detail)
-    return TemporalVerdict("inconclusive", f"{safe.method} + {live.method}", k=safe.k, bound=live.bound,
-                           trace=live.trace, detail=f"safety part {safe.status}; liveness part {live.status}: "
-                                                    f"{live.detail or safe.detail}")
+    return check_until(ts, pred(t.args[0]), pred(t.args[1]), eventually=lambda: eventually(t.args[1]),  # type: ignore[arg-type]
+                       max_k=bound, timeout_ms=timeout_ms)
 
 
 def _steps(trace: list[dict[str, str]], sys: ComposedSystem) -> list[dict[str, Any]]:
@@ -226,8 +205,8 @@ def check_temporal(req: Requirement, checked: Checked, model: SystemModel, plan:
             out.update(consistency="undecided", consistency_reason=s.reason_unknown())
     elif v.status == "refuted":
         mentioned = {n for f in ops for n in f.nodes}
-        out.update(verdict="refuted", failed_to_prevent=[p for p in sys.premises
-                                                          if p["kind"] == "guarantee" and p["node"] in mentioned])
+        out.update(verdict="refuted", failed_to_prevent=[] if "deadlock" in v.method.split(" + ") else [
+            p for p in sys.premises if p["kind"] == "guarantee" and p["node"] in mentioned])
     else:
         out.update(verdict="inconclusive", reason=v.detail or "undecided")
     out["duration_s"] = round(time.perf_counter() - t0, 4)

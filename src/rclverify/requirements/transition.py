@@ -161,7 +161,22 @@ def build_system(cone: Sequence[str], checked: Checked, model: SystemModel, plan
     def assumed(n: str, s: State) -> z3.BoolRef:
         return z3.And(*[holds(n, a, s) for a in internal[n]]) if internal[n] else z3.BoolVal(True)
 
+    # what valid/trans encode is a function of the states' terms: encoded once per state (pair).  The
+    # cache keeps the terms it is keyed by alive, so their ids cannot be reused for other terms.
+    memo: dict[tuple[int, ...], tuple[list[z3.ExprRef], z3.BoolRef]] = {}
+
+    def cached(tag: int, states_: tuple[State, ...], make: Any) -> z3.BoolRef:
+        terms = [st[name] for st in states_ for name in sorts]
+        key = (tag, *[x.get_id() for x in terms])
+        hit = memo.get(key)
+        if hit is None:
+            hit = memo[key] = (terms, make())
+        return hit[1]
+
     def valid(s: State) -> z3.BoolRef:
+        return cached(0, (s,), lambda: _valid(s))
+
+    def _valid(s: State) -> z3.BoolRef:
         parts = [c for c in (_typing(s[name], types[name]) for name in sorts) if c is not None]
         for n in cone:
             parts += [holds(n, a, s) for a in env[n]] + [holds(n, f, s) for f in facts[n]]
@@ -187,6 +202,9 @@ def build_system(cone: Sequence[str], checked: Checked, model: SystemModel, plan
                                   for sv in states])
 
     def trans(s: State, t: State) -> z3.BoolRef:
+        return cached(1, (s, t), lambda: _trans(s, t))
+
+    def _trans(s: State, t: State) -> z3.BoolRef:
         parts = [valid(s), valid(t)] + [t[c] == s[p] for c, p in links]
         for n in cone:
             outs = [t[f"{n}.out.{v}"] == s[f"{n}.out.{v}"] for v in checked.nodes[n].outputs if f"{n}.out.{v}" in s]
