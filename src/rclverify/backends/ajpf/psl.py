@@ -462,6 +462,12 @@ def constant_value(f: Formula) -> bool | None:
     g = simplify(f)
     if isinstance(g, Const):
         return g.value
+    as_written = _table_value(f)  # before negation normal form: ~<> p and <> p share their atom
+    return as_written if as_written is not None else _table_value(g)
+
+
+def _table_value(g: Formula) -> bool | None:
+    """The constant value of ``g`` by truth table over its opaque atoms, if any (see :func:`constant_value`)."""
     atoms: list[Formula] = []
 
     def opaque(h: Formula) -> None:

@@ -68,7 +68,7 @@ def explore_program(program: Program, environment: Environment, max_states: int 
     deadline = None if time_limit_s is None else time.monotonic() + time_limit_s
     while queue:
         i = queue.popleft()
-        if deadline is not None and len(states) % 64 == 0 and time.monotonic() > deadline:
+        if deadline is not None and time.monotonic() > deadline:
             cut = f"time > {time_limit_s:g} s"
             break
         try:
