@@ -162,7 +162,8 @@ def build_model(graph: StateGraph, claims: Sequence[Claim]) -> PromelaModel:
     for k, line in enumerate(rendered.splitlines(), 1):
         if line.lstrip().startswith("#"):  # never: every workspace text goes through comment_text
             raise ValueError(f"the Promela model's line {k} would be a preprocessor directive: {line[:80]!r}")
-    truth = {a: frozenset(k for k, row in enumerate(table) if row[i]) for i, (_, a) in enumerate(props.atoms())}
+    truth: dict[psl.Formula, frozenset[int]] = {
+        a: frozenset(k for k, row in enumerate(table) if row[i]) for i, (_, a) in enumerate(props.atoms())}
     return PromelaModel(rendered, tuple((n, atom_text(a)) for n, a in props.atoms()), tuple(claims),
                         len(graph.states), len(graph.transitions), truth)
 
