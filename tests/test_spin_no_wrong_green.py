@@ -40,6 +40,7 @@ from test_spin import HAVE_SPIN
 
 REPO = Path(__file__).resolve().parents[1]
 needs_spin = pytest.mark.skipif(not HAVE_SPIN, reason="spin or gcc not installed (apt-get install spin)")
+needs_proc = pytest.mark.skipif(not Path("/proc/self/stat").is_file(), reason="reads processes from /proc (Linux)")
 
 NOTHING = "GWENDOLEN\n:name: jackal\n"
 DONE = "GWENDOLEN\n:name: jackal\n:Initial Goals:\ngo [perform]\n:Plans:\n+!go [perform] <- +done;\n"
@@ -248,6 +249,7 @@ def test_a_tool_stopped_from_outside_raises_instead_of_giving_a_result(tmp_path:
     assert code == -signal.SIGSEGV
 
 
+@needs_proc
 def test_the_time_limit_kills_the_whole_process_group(tmp_path: Path) -> None:
     pidfile = tmp_path / "child.pid"
     out, code, secs = run_bounded(["sh", "-c", f"sleep 60 & echo $! > {pidfile}; wait"], tmp_path, 0.5)
@@ -324,6 +326,7 @@ def _wait_for_compiler(proc: subprocess.Popen[str]) -> int:
 
 
 @needs_spin
+@needs_proc
 def test_a_compiler_killed_from_outside_records_nothing(tmp_path: Path) -> None:
     proc, root, _, oid = _start_run(tmp_path)
     try:
@@ -337,6 +340,7 @@ def test_a_compiler_killed_from_outside_records_nothing(tmp_path: Path) -> None:
 
 
 @needs_spin
+@needs_proc
 @pytest.mark.parametrize("signum", [signal.SIGTERM, signal.SIGKILL])
 def test_no_tool_and_no_build_directory_outlive_rclverify(tmp_path: Path, signum: int) -> None:
     proc, root, cache, oid = _start_run(tmp_path)

@@ -20,28 +20,11 @@ written down in docs/architecture.md, "Model-checking coverage").
 """
 from __future__ import annotations
 
-import re
 from typing import Mapping, Sequence
 
 from . import psl
 from .instantiate import Instance
 from .mapping import Row
-
-
-def constant_rows(rows: Sequence[Row]) -> dict[int, Row]:
-    """Rows (by 0-based index) whose AJPF formula is a constant whatever their
-    placeholders are (``T``, ``~T``, ``F || F`` ...: :func:`psl.constant_value`
-    on the formula with every placeholder read as ``0``).  The per-instance
-    record is ``Instance.constants``; this is the plan-level view."""
-    out = {}
-    for r in rows:
-        try:
-            f = psl.parse(re.sub(r"\{[^{}]*\}", "0", r.ajpf))
-        except ValueError:
-            continue
-        if psl.constant_value(f) is not None:
-            out[r.index] = r
-    return out
 
 
 def _ranges(labels: Sequence[str]) -> str:
