@@ -314,13 +314,18 @@ def _start_run(tmp_path: Path) -> tuple[subprocess.Popen[str], Path, Path, str]:
     return proc, root, cache, oid
 
 
-def _wait_for_compiler(proc: subprocess.Popen[str]) -> int:
-    """The pid of the compiler (gcc) ``proc`` started, once it runs."""
+def _wait_for_compiler(proc: subprocess.Popen[str]) -> tuple[int, int]:
+    """The pid and session of the compiler (``gcc ... pan.c``) ``proc`` started, once it runs
+    (not ``gcc --version``, which finding the tools runs first)."""
     deadline = time.monotonic() + 120
     while time.monotonic() < deadline and proc.poll() is None:
-        found = [pid for pid, name, ppid, _ in _procs() if ppid == proc.pid and name in ("gcc", "cc")]
-        if found:
-            return found[0]
+        for pid, name, ppid, sid in _procs():
+            if ppid == proc.pid and name in ("gcc", "cc"):
+                try:
+                    if b"pan.c" in Path(f"/proc/{pid}/cmdline").read_bytes().split(b"\0"):
+                        return pid, sid
+                except OSError:
+                    continue
         time.sleep(0.01)
     raise AssertionError(f"gcc never ran: {proc.communicate()[0] if proc.poll() is not None else 'still running'}")
 
@@ -330,7 +335,7 @@ def _wait_for_compiler(proc: subprocess.Popen[str]) -> int:
 def test_a_compiler_killed_from_outside_records_nothing(tmp_path: Path) -> None:
     proc, root, _, oid = _start_run(tmp_path)
     try:
-        os.kill(_wait_for_compiler(proc), signal.SIGKILL)
+        os.kill(_wait_for_compiler(proc)[0], signal.SIGKILL)
         out, _ = proc.communicate(timeout=120)
     finally:
         proc.kill()
@@ -345,8 +350,7 @@ def test_a_compiler_killed_from_outside_records_nothing(tmp_path: Path) -> None:
 def test_no_tool_and_no_build_directory_outlive_rclverify(tmp_path: Path, signum: int) -> None:
     proc, root, cache, oid = _start_run(tmp_path)
     try:
-        gcc = _wait_for_compiler(proc)
-        session = next(sid for pid, _, _, sid in _procs() if pid == gcc)
+        _, session = _wait_for_compiler(proc)
         os.kill(proc.pid, signum)
         proc.communicate(timeout=60)
         deadline = time.monotonic() + 30

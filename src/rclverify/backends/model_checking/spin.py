@@ -47,7 +47,6 @@ from pathlib import Path
 
 from ...cache.keys import user_cache_dir
 from ...rcl.ast import Loc
-from ...rcl.errors import RclError
 from ..bounded import forget_directory, register_directory, run_bounded, temporary_directory
 
 #: Install command shown when SPIN or gcc is missing (Debian/Ubuntu).
@@ -125,9 +124,9 @@ def find_tools(path: str | None = None) -> tuple[Tools | None, str]:
 
 
 def _version(cmd: list[str], pattern: str, fmt: str) -> str:
-    try:
+    try:  # stopped from outside: ToolInterrupted goes up (an interrupted run records nothing)
         out = run_bounded(cmd, Path(tempfile.gettempdir()), 30.0)[0]
-    except (OSError, RclError):  # not startable, or stopped from outside
+    except OSError:
         return "unknown"
     m = re.search(pattern, out.splitlines()[0] if out.strip() else "", re.MULTILINE)
     return fmt.format(*m.groups()) if m else (out.strip().splitlines() or ["unknown"])[0]
