@@ -28,6 +28,14 @@ needs_spin = pytest.mark.skipif(not HAVE_SPIN, reason="spin or gcc not installed
 SRC = "agent.gwen"
 
 
+@pytest.fixture(autouse=True, scope="module")
+def own_verifier_cache(tmp_path_factory: pytest.TempPathFactory):
+    """The verifiers this module builds go to a cache of its own, not the user's."""
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setenv("XDG_CACHE_HOME", str(tmp_path_factory.mktemp("xdg-cache")))
+        yield
+
+
 def t(text: str) -> psl.Term:
     f = psl.parse(f"P({text})")
     assert isinstance(f, psl.Percept)

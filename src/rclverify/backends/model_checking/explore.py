@@ -20,7 +20,7 @@ from .cycle import AgentState, Cycle, goals, initial_state
 from .environment import Environment
 from .graph import MentalState, StateGraph, Transition
 from .gwendolen import Program, as_psl, parse_file
-from .identifiers import FRESH, analyse, numbers
+from .identifiers import ALTERNATE, FRESH, analyse, numbers
 from .unify import BoundReached
 
 
@@ -56,7 +56,7 @@ def explore_program(program: Program, environment: Environment, max_states: int 
     """Explore ``program`` (see :func:`explore`)."""
     use = analyse(program, environment.percepts, environment.initial)
     extra = frozenset(program_numbers(program, environment) | set(avoid)) if use.mode == FRESH else frozenset()
-    cycle = Cycle(program, environment, use.mode if use.mode == FRESH else "alternate", extra)
+    cycle = Cycle(program, environment, FRESH if use.mode == FRESH else ALTERNATE, extra)
     init = initial_state(program, environment)
     index: dict[AgentState, int] = {init: 0}
     states: list[AgentState] = [init]
