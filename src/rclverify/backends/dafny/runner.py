@@ -30,7 +30,7 @@ from __future__ import annotations
 import os
 import re
 import shutil
-import subprocess
+import tempfile
 from dataclasses import dataclass, field
 from functools import lru_cache
 from pathlib import Path
@@ -69,12 +69,13 @@ _BANNER = re.compile(r"Dafny\s+(?:version\s+)?((\d+)\.\d+\.\d+(?:\.\d+)?)")
 
 
 def _probe(exe: str, arg: str, timeout_s: float) -> str:
+    """``exe arg``'s output ("" when it cannot start or exceeds ``timeout_s``); bounded and
+    killed with rclverify like every tool (:func:`~rclverify.backends.bounded.run_bounded`)."""
     try:
-        p = subprocess.run([exe, arg], capture_output=True, text=True, timeout=timeout_s,
-                           stdin=subprocess.DEVNULL, errors="replace")
-    except (OSError, subprocess.TimeoutExpired):
+        out, code, _ = run_bounded([exe, arg], Path(tempfile.gettempdir()), timeout_s, tool="Dafny")
+    except OSError:
         return ""
-    return (p.stdout or "") + (p.stderr or "")
+    return "" if code is None else out
 
 
 @lru_cache(maxsize=8)
