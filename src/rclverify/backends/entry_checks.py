@@ -1,4 +1,4 @@
-"""Check-time validation of the plan's ``experiment``, ``review`` and ``monitors`` entries.
+"""Check-time validation of the plan's ``experiment``, ``review``, ``monitors`` and ``ajpf`` entries.
 
 Called by :attr:`rclverify.pipeline.Workspace.checked` right after
 :func:`rclverify.plan.load.resolve` (the layer above both the plan and the
@@ -7,6 +7,13 @@ check`` reports a missing data or record file, a malformed record, a bad
 criterion, a reviewed file or message directory outside the workspace, or a
 bad trace mapping at once, located in the plan or in the file that names
 it, before any evidence is touched.
+
+A node has at most one ``ajpf`` entry: its obligations are named
+``<Node>.g<k>.ajpf.p<n>_...`` and its files are ``artifacts/ajpf/<Node>/``,
+so a second entry would give the same obligations (doit refuses the
+duplicated task names) and overwrite the first's artifacts.  The second is
+refused at its ``backend`` key; extra properties belong in the first
+entry's ``properties:`` list.
 """
 from __future__ import annotations
 
@@ -28,6 +35,7 @@ def check_entries(plan: Plan, checked: Checked) -> list[Diagnostic]:
     for node, entries in plan.evidence.items():
         if node not in checked.nodes:
             continue
+        out.extend(_one_ajpf_entry(plan, node, entries))
         for e in entries:
             if e.backend not in ("experiment", "review", "monitors"):
                 continue
@@ -50,6 +58,25 @@ def check_entries(plan: Plan, checked: Checked) -> list[Diagnostic]:
                     _check_monitors(plan, e.config, loc)
             except PlanError as exc:  # once each: entries sharing a mapping file share its errors
                 out.extend(d for d in exc.diagnostics if d not in out)
+    return out
+
+
+def _one_ajpf_entry(plan: Plan, node: str, entries: Any) -> list[Diagnostic]:
+    """An error at the ``backend`` key of every ``ajpf`` entry of ``node`` after the first."""
+    first: ast.Loc | None = None
+    out = []
+    for e in entries:
+        if e.backend != "ajpf":
+            continue
+        path = ("nodes", node, "evidence", e.index, "backend")
+        loc = plan.locs.get(path, e.loc)
+        if first is None:
+            first = loc
+            continue
+        out.append(plan_error(loc.file, loc.line, loc.col,
+                              f"node {node} has a second ajpf entry (the first is at {first.file}:{first.line}:"
+                              f"{first.col}): both would give the same obligations and write artifacts/ajpf/{node}/; "
+                              "keep one entry and list further property files under its 'properties'").diagnostics[0])
     return out
 
 

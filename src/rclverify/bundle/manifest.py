@@ -7,7 +7,11 @@ Collected (workspace-relative POSIX paths, sorted):
   ``artifacts/cache/``: a machine-local speed-up holding pickled data, which
   an assessor must never be handed to load, and the lock files
   ``artifacts/run.lock`` and ``artifacts/diagnosis.lock``, which order runs
-  on one machine);
+  on one machine, and build products: compiled verifiers left under
+  ``artifacts/<backend>/<Node>/spin/build/`` by earlier versions, and any
+  compiled executable (ELF, Mach-O) under ``artifacts/`` -- rclverify
+  builds executables in the user's cache only, and an assessor is never
+  handed one to run);
 * the plan, its contract files and replacement contracts, and the
   Doorstop folders it reads requirements from (``requirements_from``);
 * every file the plan's evidence entries name (a directory contributes the
@@ -24,6 +28,7 @@ from __future__ import annotations
 import hashlib
 import json
 import platform
+import re
 import shutil
 import subprocess
 from pathlib import Path
@@ -44,6 +49,26 @@ TREES = ("reports", "artifacts")
 #: lock files that order runs on this machine (rclverify.runlock's run.lock, the
 #: diagnosis's diagnosis.lock: a process id, no evidence).
 EXCLUDED = ("artifacts/cache/", "artifacts/run.lock", "artifacts/diagnosis.lock")
+#: Build products under artifacts/ (a compiled SPIN verifier and its sources): never bundled.
+_BUILD = re.compile(r"^artifacts/[^/]+/[^/]+/spin/build/")
+#: The first bytes of a compiled executable: ELF, Mach-O (64 and 32 bit).
+_EXECUTABLE_MAGIC = (b"\x7fELF", b"\xcf\xfa\xed\xfe", b"\xce\xfa\xed\xfe")
+
+
+def build_product(root: Path, rel: str) -> bool:
+    """Whether the workspace file ``rel`` is a build product that must not be
+    bundled: under a ``spin/build/`` folder of ``artifacts/``, or a file
+    under ``artifacts/`` that starts like a compiled executable."""
+    if _BUILD.match(rel):
+        return True
+    if not rel.startswith("artifacts/"):
+        return False
+    try:
+        with open(root / rel, "rb") as f:
+            head = f.read(4)
+    except OSError:
+        return False
+    return head.startswith(_EXECUTABLE_MAGIC)
 
 
 class BundleError(Exception):
@@ -116,7 +141,7 @@ def _files_under(root: Path, rel: str) -> list[str]:
     for p in base.rglob("*"):
         r = p.relative_to(root)
         if any(part.startswith(".") for part in r.parts) or not p.is_file() \
-                or r.as_posix().startswith(EXCLUDED):
+                or r.as_posix().startswith(EXCLUDED) or build_product(root, r.as_posix()):
             continue
         out.append(r.as_posix())
     return out

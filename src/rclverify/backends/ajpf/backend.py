@@ -28,7 +28,8 @@ Plan entry keys (``nodes.<Node>.evidence[k]``)::
     environment_class: <Java class>     # AIL verification environment
                                         # (default ail.mas.DefaultEnvironment)
     mcapl_home: <dir>                   # optional; else MCAPL_HOME / AJPF_HOME
-    timeout_s: 3600                     # per AJPF run, seconds
+    timeout_s: 600                      # per AJPF run, seconds (with SPIN: per tool
+                                        # run and for the exploration, default 300)
     results: backends/ajpf/results      # where imported logs are looked for
     log_info: [ ... ]                   # loggers at info level in the .jpf
     model_checker: spin                 # or ajpf (default: see model_checking.backend)
@@ -67,7 +68,8 @@ from .results import AjpfResult, parse_log
 TOOL = "AJPF (MCAPL)"
 DEFAULT_ENV = "ail.mas.DefaultEnvironment"
 DEFAULT_RESULTS = "backends/ajpf/results"
-DEFAULT_TIMEOUT_S = 3600.0
+#: AJPF's time limit per run, seconds: minutes, not hours (a run that hits it is inconclusive and says so).
+DEFAULT_TIMEOUT_S = 600.0
 #: Loggers at info level: the property echo, the environment's actions and the
 #: product automaton's path (used to give counterexamples their actions).
 DEFAULT_LOG_INFO = ("ail.util.AJPF_w_AIL", "ail.mas.DefaultEnvironment", "ajpf.product.Product")
@@ -347,10 +349,9 @@ class AjpfBackend:
                 explanation=("no AJPF property: " + "; ".join(data.get("unmapped", []))
                              + " -- add mapping rows for these atoms to the plan"),
                 details={"unmapped": list(data.get("unmapped", []))})
-        from ..model_checking.backend import chosen_checker, run_spin
+        from ..model_checking.backend import chosen_checker, run_spin, spin_timeout
         if chosen_checker(target.config) == "spin":
-            return run_spin(obligation, target, str(target.config["model"]), float(target.config.get(
-                "timeout_s", DEFAULT_TIMEOUT_S)))
+            return run_spin(obligation, target, str(target.config["model"]), spin_timeout(target.config))
         if "log" not in data:  # a property of the plan's `properties` files
             return make_evidence(
                 target, obligation, "pending", tool=TOOL, tool_version="", clock=clock,
@@ -410,7 +411,7 @@ class AjpfBackend:
         timeout = float(target.config.get("timeout_s", DEFAULT_TIMEOUT_S))
         if key not in self._runs:
             try:
-                outcome = runner.run(install, target.root, jpf_rel, timeout)
+                outcome = runner.run(install, target.root, jpf_rel, timeout, where=target.config_loc("backend"))
             except OSError as exc:
                 return make_evidence(target, obligation, "error", tool=TOOL, tool_version="", clock=clock,
                                      explanation=f"AJPF could not be started: {exc}")

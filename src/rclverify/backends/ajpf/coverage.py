@@ -2,10 +2,13 @@
 
 A property instance covers its guarantee only partially when
 
-* a mapping row maps a *parameterised* RCL predicate (one that mentions a
-  domain variable such as ``i``) to the constant ``T`` or ``F``: the agent is
-  never asked about that predicate, the plan decides it (for the case study,
-  "there is no waypoint ``i + 1``" is decided by the 13-waypoint map); or
+* a mapping row, as applied in the instance, maps an RCL predicate to a
+  formula that is a constant after simplification -- ``T``, ``F``, but also
+  ``~T``, ``T & T``, ``F || F`` or ``B(ag, a) || ~B(ag, a)``
+  (:func:`psl.constant_value`, recorded per instance in
+  ``Instance.constants``): the agent is never asked about that predicate,
+  the plan decides it (for the case study, "there is no waypoint ``i + 1``"
+  is decided by the 13-waypoint map); or
 * several instances of one guarantee collapse to the same AJPF formula: the
   model check of that one formula says nothing about what distinguished the
   instances in RCL (paper lines 1396-1412 translate each instance by hand).
@@ -24,22 +27,6 @@ from .instantiate import Instance
 from .mapping import Row
 
 
-def constant_rows(rows: Sequence[Row]) -> dict[int, Row]:
-    """Rows (by 0-based index) that map a predicate with domain variables to
-    ``T`` or ``F``."""
-    out = {}
-    for r in rows:
-        if not r.dom_vars:
-            continue
-        try:
-            f = psl.parse(r.ajpf)
-        except ValueError:
-            continue
-        if isinstance(f, psl.Const):
-            out[r.index] = r
-    return out
-
-
 def _ranges(labels: Sequence[str]) -> str:
     return ", ".join(labels) if len(labels) <= 3 else f"{labels[0]} ... {labels[-1]} ({len(labels)} instances)"
 
@@ -51,17 +38,20 @@ def coverage_notes(rows: Sequence[Row], planned: Sequence[tuple[int, Instance]],
     ``planned``: ``(guarantee index, instance)`` pairs as exported;
     ``texts``: the AJPF formula text of each mapped ``(guarantee, label)``.
     Returns only the instances with something to say."""
-    const = constant_rows(rows)
+    by_index = {r.index: r for r in rows}
     notes: dict[tuple[int, str], list[str]] = {}
     for g, inst in planned:
         if inst.formula is None:
             continue
-        for k in inst.rows:
-            if k in const:
-                r = const[k]
-                notes.setdefault((g, inst.label), []).append(
-                    f"mapping row {k + 1} maps `{r.rcl}` (parameterised by {', '.join(sorted(r.dom_vars))}) to the "
-                    f"constant {r.ajpf}{' when ' + r.when_text if r.when_text else ''}: the agent is not checked on it")
+        for k, value in inst.constants:
+            r = by_index[k]
+            param = f" (parameterised by {', '.join(sorted(r.dom_vars))})" if r.dom_vars else ""
+            shown = "T" if value else "F"
+            as_written = (f"the constant {shown}" if r.ajpf.strip() == shown
+                          else f"`{r.ajpf.strip()}`, the constant {shown} after simplification,")
+            notes.setdefault((g, inst.label), []).append(
+                f"mapping row {k + 1} maps `{r.rcl}`{param} to {as_written}"
+                f"{' when ' + r.when_text if r.when_text else ''}: the agent is not checked on it")
     groups: dict[tuple[int, str], list[str]] = {}
     for g, inst in planned:
         key = (g, inst.label)

@@ -68,7 +68,11 @@ class Instance:
     ``unmapped``   RCL text of every atom no row covers (as written, with the
                    guarantee's variable names; ``values`` says which instance);
     ``rows``       0-based indices of the rows used, sorted;
-    ``notes``      further remarks (variables that cannot be eliminated ...).
+    ``notes``      further remarks (variables that cannot be eliminated ...);
+    ``constants``  ``(row index, value)`` of every row whose formula, as
+                   applied in this instance, is a constant after
+                   simplification (:func:`psl.constant_value`): the agent is
+                   not checked on the atoms it covers.
     """
 
     guarantee: int
@@ -77,6 +81,7 @@ class Instance:
     unmapped: tuple[str, ...] = ()
     rows: tuple[int, ...] = ()
     notes: tuple[str, ...] = ()
+    constants: tuple[tuple[int, bool], ...] = ()
 
     @property
     def label(self) -> str:
@@ -187,6 +192,7 @@ class Translator:
         inst = dict(values)
         unmapped: list[str] = []
         used_rows: set[int] = set()
+        constants: dict[int, bool] = {}
         extra_notes = list(notes)
         sides: list[psl.Formula] = []
         for side in (hyp, concl):
@@ -204,12 +210,17 @@ class Translator:
                 if why and why not in extra_notes:
                     extra_notes.append(why)
                 used_rows.update(a.row.index for a in apps)
+                for a in apps:
+                    value = psl.constant_value(a.formula)
+                    if value is not None and a.row.index not in constants:
+                        constants[a.row.index] = value
                 disjuncts.append(psl.And(tuple(a.formula for a in apps)) if apps else psl.TRUE)
             sides.append(psl.Or(tuple(disjuncts)) if disjuncts else psl.FALSE)
         if unmapped:
             return Instance(index, values, None, tuple(unmapped), tuple(sorted(used_rows)), tuple(extra_notes))
         prop = psl.simplify(psl.Always(psl.Implies(sides[0], psl.Eventually(sides[1]))))
-        return Instance(index, values, prop, (), tuple(sorted(used_rows)), tuple(extra_notes))
+        return Instance(index, values, prop, (), tuple(sorted(used_rows)), tuple(extra_notes),
+                        tuple(sorted(constants.items())))
 
     # -- covering ----------------------------------------------------------
     def cover(self, items: Sequence[Item], evars: frozenset[str], values: Mapping[str, int]

@@ -148,6 +148,33 @@ TRUE = Const(True)
 FALSE = Const(False)
 
 
+#: Deepest nesting of a formula or term (operators, parentheses, compound
+#: terms): deeper input is refused with a located error, so that no
+#: recursive function over formulas and terms meets Python's recursion limit.
+MAX_NESTING = 64
+
+
+def depth(x: "Formula | Term") -> int:
+    """The nesting depth of a formula or term (an atom's term counts inside
+    it), computed without recursion: 1 for ``T``, ``danger_red``."""
+    best = 0
+    stack: list[tuple[object, int]] = [(x, 1)]
+    while stack:
+        node, d = stack.pop()
+        best = max(best, d)
+        if isinstance(node, (Not, Always, Eventually)):
+            stack.append((node.operand, d + 1))
+        elif isinstance(node, (And, Or)):
+            stack.extend((p, d + 1) for p in node.parts)
+        elif isinstance(node, (Implies, Until, Release)):
+            stack.extend(((node.left, d + 1), (node.right, d + 1)))
+        elif isinstance(node, (Modal, Percept)):
+            stack.append((node.term, d + 1))
+        elif isinstance(node, Compound):
+            stack.extend((a, d + 1) for a in node.args)
+    return best
+
+
 class PslSyntaxError(ValueError):
     """A malformed property text; ``col`` is the 1-based column of the problem."""
 
@@ -196,6 +223,12 @@ class _Parser:
     def __init__(self, text: str) -> None:
         self.toks = _tokens(text)
         self.i = 0
+        self.nesting = 0
+
+    def deeper(self, col: int) -> None:
+        self.nesting += 1
+        if self.nesting > MAX_NESTING:
+            raise PslSyntaxError(f"nested deeper than {MAX_NESTING} levels (the limit of properties and terms)", col)
 
     @property
     def tok(self) -> _Tok:
@@ -213,6 +246,8 @@ class _Parser:
         f, _ = self.level(0)
         if self.tok.kind != "end":
             raise PslSyntaxError(f"unexpected {self.tok.text!r}", self.tok.col)
+        if depth(f) > MAX_NESTING:  # chains of U and R nest without parentheses
+            raise PslSyntaxError(f"nested deeper than {MAX_NESTING} levels (the limit of properties and terms)", 1)
         return f
 
     def level(self, k: int) -> tuple[Formula, str | None]:
@@ -247,6 +282,13 @@ class _Parser:
         return f, op
 
     def unary(self) -> Formula:
+        self.deeper(self.tok.col)
+        try:
+            return self._unary()
+        finally:
+            self.nesting -= 1
+
+    def _unary(self) -> Formula:
         t = self.tok
         if t.text == "[]":
             self.take()
@@ -300,12 +342,14 @@ class _Parser:
                                  t.col)
         if self.tok.text != "(":
             return Sym(t.text)
+        self.deeper(self.tok.col)
         self.take("(")
         args = [self.term()]
         while self.tok.text == ",":
             self.take()
             args.append(self.term())
         self.take(")")
+        self.nesting -= 1
         return Compound(t.text, tuple(args))
 
 
@@ -314,8 +358,9 @@ def parse(text: str) -> Formula:
 
     Returns the formula as written (negations are not pushed inwards; see
     :func:`nnf`).  Raises :class:`PslSyntaxError` (with a 1-based column)
-    on malformed input, on non-ground terms and on ``&``/``||`` mixed or
-    ``->`` chained without parentheses.
+    on malformed input, on non-ground terms, on ``&``/``||`` mixed or
+    ``->`` chained without parentheses, and on nesting deeper than
+    :data:`MAX_NESTING`.
     """
     return _Parser(text).formula()
 
@@ -396,6 +441,72 @@ def simplify(f: Formula) -> Formula:
     order of the input is preserved).  The result is equivalent to ``f``.
     """
     return _simp(nnf(f))
+
+
+#: Most opaque atoms :func:`constant_value` enumerates (2**12 assignments).
+MAX_TRUTH_TABLE_ATOMS = 12
+
+
+def constant_value(f: Formula) -> bool | None:
+    """``True``/``False`` when ``f`` is a constant whatever the agent does,
+    ``None`` when it is not (or not decided).
+
+    Decided after :func:`simplify` (``~T``, ``T & T``, ``F || F`` are
+    constants), then by a truth table in which every proposition and every
+    temporal subformula is an opaque atom: a formula true (false) under
+    every assignment is valid (unsatisfiable) in LTL too, e.g.
+    ``B(ag, a) || ~B(ag, a)``.  With more than
+    :data:`MAX_TRUTH_TABLE_ATOMS` opaque atoms only the simplification
+    decides.
+    """
+    g = simplify(f)
+    if isinstance(g, Const):
+        return g.value
+    as_written = _table_value(f)  # before negation normal form: ~<> p and <> p share their atom
+    return as_written if as_written is not None else _table_value(g)
+
+
+def _table_value(g: Formula) -> bool | None:
+    """The constant value of ``g`` by truth table over its opaque atoms, if any (see :func:`constant_value`)."""
+    atoms: list[Formula] = []
+
+    def opaque(h: Formula) -> None:
+        if isinstance(h, (Modal, Percept, Always, Eventually, Until, Release)):
+            if h not in atoms:
+                atoms.append(h)
+        elif isinstance(h, Not):
+            opaque(h.operand)
+        elif isinstance(h, (And, Or)):
+            for p in h.parts:
+                opaque(p)
+        elif isinstance(h, Implies):
+            opaque(h.left)
+            opaque(h.right)
+
+    opaque(g)
+    if len(atoms) > MAX_TRUTH_TABLE_ATOMS:
+        return None
+
+    def value(h: Formula, v: dict[Formula, bool]) -> bool:
+        if isinstance(h, Const):
+            return h.value
+        if h in v:
+            return v[h]
+        if isinstance(h, Not):
+            return not value(h.operand, v)
+        if isinstance(h, And):
+            return all(value(p, v) for p in h.parts)
+        if isinstance(h, Or):
+            return any(value(p, v) for p in h.parts)
+        assert isinstance(h, Implies)
+        return not value(h.left, v) or value(h.right, v)
+
+    seen = set()
+    for bits in range(1 << len(atoms)):
+        seen.add(value(g, {a: bool(bits >> k & 1) for k, a in enumerate(atoms)}))
+        if len(seen) == 2:
+            return None
+    return seen.pop()
 
 
 def _simp(f: Formula) -> Formula:

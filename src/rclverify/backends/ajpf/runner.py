@@ -24,6 +24,8 @@ import tempfile
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Mapping
+
+from ...rcl.ast import Loc
 from ..bounded import run_bounded
 
 #: Where RunJPF.jar lives inside an MCAPL distribution.
@@ -99,11 +101,14 @@ def _site_defines_mcapl(home_dir: Path) -> bool:
     return re.search(r"^\s*mcapl\s*[=:]", text, re.MULTILINE) is not None
 
 
-def run(install: McaplInstall, root: Path, jpf: str, timeout_s: float) -> RunOutcome:
+def run(install: McaplInstall, root: Path, jpf: str, timeout_s: float, where: Loc | None = None) -> RunOutcome:
     """Run AJPF on the workspace-relative configuration ``jpf``.
 
-    Kills the whole process group after ``timeout_s`` seconds.  Raises
-    ``OSError`` when the process cannot be started at all.
+    Kills the whole process group after ``timeout_s`` seconds (and when
+    rclverify is stopped: :func:`~rclverify.backends.bounded.run_bounded`).
+    Raises ``OSError`` when the process cannot be started at all, and
+    :class:`~rclverify.backends.bounded.ToolInterrupted` (located at
+    ``where``) when it was stopped from outside: nothing is recorded then.
     """
     env = dict(os.environ)
     env["AJPF_HOME"] = str(install.home)
@@ -114,7 +119,7 @@ def run(install: McaplInstall, root: Path, jpf: str, timeout_s: float) -> RunOut
             site.write_text(f"mcapl = {install.home.as_posix()}\n", encoding="utf-8")
             cmd.append(f"+site={site.as_posix()}")
         cmd.append(jpf)
-        out, code, duration = run_bounded(cmd, root, timeout_s, env)
+        out, code, duration = run_bounded(cmd, root, timeout_s, env, where=where, tool="AJPF (java)")
         timed_out = code is None
     return RunOutcome(out, code, timed_out,
                       duration)

@@ -30,12 +30,14 @@ from __future__ import annotations
 import os
 import re
 import shutil
-import subprocess
-import time
+import tempfile
 from dataclasses import dataclass, field
 from functools import lru_cache
 from pathlib import Path
 from typing import Mapping, Sequence
+
+from ...rcl.ast import Loc
+from ..bounded import run_bounded
 
 
 # ---------------------------------------------------------------------------
@@ -67,12 +69,13 @@ _BANNER = re.compile(r"Dafny\s+(?:version\s+)?((\d+)\.\d+\.\d+(?:\.\d+)?)")
 
 
 def _probe(exe: str, arg: str, timeout_s: float) -> str:
+    """``exe arg``'s output ("" when it cannot start or exceeds ``timeout_s``); bounded and
+    killed with rclverify like every tool (:func:`~rclverify.backends.bounded.run_bounded`)."""
     try:
-        p = subprocess.run([exe, arg], capture_output=True, text=True, timeout=timeout_s,
-                           stdin=subprocess.DEVNULL, errors="replace")
-    except (OSError, subprocess.TimeoutExpired):
+        out, code, _ = run_bounded([exe, arg], Path(tempfile.gettempdir()), timeout_s, tool="Dafny")
+    except OSError:
         return ""
-    return (p.stdout or "") + (p.stderr or "")
+    return "" if code is None else out
 
 
 @lru_cache(maxsize=8)
@@ -156,22 +159,17 @@ class RunOutput:
 def run(argv: Sequence[str], cwd: Path, timeout_s: float, env: Mapping[str, str] | None = None) -> RunOutput:
     """Run Dafny in ``cwd`` and capture stdout+stderr; kill it after ``timeout_s`` seconds.
 
-    Raises ``OSError`` when the executable cannot be started.
+    Dafny runs through :func:`rclverify.backends.bounded.run_bounded`: in a
+    process group of its own, so Z3 and every other child die with it at
+    the time limit and when rclverify is stopped.  Raises ``OSError`` when
+    the executable cannot be started, and
+    :class:`~rclverify.backends.bounded.ToolInterrupted` (located at the
+    first ``.dfy`` file of ``argv``) when Dafny was stopped from outside:
+    that run is not a result.
     """
-    t0 = time.perf_counter()
-    try:
-        p = subprocess.run(list(argv), cwd=cwd, capture_output=True, text=True, timeout=timeout_s,
-                           stdin=subprocess.DEVNULL, env=dict(env) if env is not None else None, errors="replace")
-    except subprocess.TimeoutExpired as exc:
-        out = _text(exc.stdout) + _text(exc.stderr)
-        return RunOutput(tuple(argv), None, out, round(time.perf_counter() - t0, 3), True)
-    return RunOutput(tuple(argv), p.returncode, (p.stdout or "") + (p.stderr or ""), round(time.perf_counter() - t0, 3))
-
-
-def _text(b: bytes | str | None) -> str:
-    if b is None:
-        return ""
-    return b if isinstance(b, str) else b.decode("utf-8", "replace")
+    dfy = next((a for a in argv if a.endswith(".dfy")), str(argv[0]))
+    out, code, secs = run_bounded(list(argv), cwd, timeout_s, env, where=Loc(dfy, 1, 1), tool="Dafny")
+    return RunOutput(tuple(argv), code, out, secs, code is None)
 
 
 # ---------------------------------------------------------------------------

@@ -29,6 +29,7 @@ from __future__ import annotations
 import hashlib
 import json
 import os
+import shutil
 import time
 from dataclasses import dataclass
 from pathlib import Path
@@ -36,14 +37,17 @@ from typing import TYPE_CHECKING, Any, Mapping
 
 from ...evidence.records import Evidence, Obligation, SourceRef, make_obligation_id
 from ...evidence.store import atomic_write_text
+from ...rcl.ast import Loc
 from ...rcl.errors import RclError
 from ..ajpf import psl
 from ..base import NodeTarget, Stopwatch, make_evidence
 from . import spin
 from .graph import StateGraph
+from .identifiers import named_identifiers, numbers
 from .ltl import Propositions, parse_psl_text, read_psl_file
 from .promela import Claim, PromelaModel, build_model
 from .trail import counterexample, read_replay, summary
+from .vacuity import antecedents, check_vacuity, temporal_checks
 
 if TYPE_CHECKING:
     from .environment import Environment
@@ -62,6 +66,8 @@ _MODELS: dict[str, tuple[PromelaModel, Path, float]] = {}
 _CLAIMS: dict[str, tuple[list[Claim], str]] = {}
 #: pan results: (model key, claim) -> result.
 _RESULTS: dict[tuple[str, str], spin.CheckResult] = {}
+#: Atom truth per graph, for the vacuity check: graph key -> atom -> states where it holds.
+_MEMO: dict[str, dict[psl.Formula, frozenset[int]]] = {}
 
 
 @dataclass(frozen=True)
@@ -158,33 +164,53 @@ def _claims(target: NodeTarget, cfg: SpinConfig) -> tuple[list[Claim], str]:
     return _CLAIMS[key]
 
 
-def _graph(target: NodeTarget, model: str, cfg: SpinConfig) -> tuple[str, StateGraph | RclError, float]:
+def _numbers_of(claims: list[Claim]) -> tuple[float, ...]:
+    """Every number in the claims' atoms (a fresh identifier differs from them)."""
+    terms = [a.term for c in claims for a in psl.propositions(c.formula) if isinstance(a, (psl.Modal, psl.Percept))]
+    return tuple(sorted(numbers(terms)))
+
+
+def _graph(target: NodeTarget, model: str, cfg: SpinConfig, time_limit_s: float, avoid: tuple[float, ...] = ()
+           ) -> tuple[str, StateGraph | RclError, float]:
     """The graph of ``model`` under the entry's environment and bounds (explored once per
     process): its cache key, the graph (or the program's error) and the seconds it took."""
     text = (target.root / model).read_bytes()
-    key = hashlib.sha256(text + json.dumps([model, cfg.environment_raw, cfg.max_states, cfg.max_depth],
-                                           sort_keys=True, default=str).encode()).hexdigest()
+    key = hashlib.sha256(text + json.dumps([model, cfg.environment_raw, cfg.max_states, cfg.max_depth,
+                                            time_limit_s, avoid], sort_keys=True, default=str).encode()).hexdigest()
     if key not in _GRAPHS:
         from .explore import explore  # stage one
         assert cfg.environment is not None  # run_spin checked it
         t0 = time.perf_counter()
         graph: StateGraph | RclError
         try:
-            graph = explore(target.root / model, model, cfg.environment, cfg.max_states, cfg.max_depth)
+            graph = explore(target.root / model, model, cfg.environment, cfg.max_states, cfg.max_depth,
+                            time_limit_s, avoid)
         except RclError as exc:  # an error in the program, located in it
             graph = exc
         _GRAPHS[key] = (graph, round(time.perf_counter() - t0, 3))
     return key, *_GRAPHS[key]
 
 
+def spin_timeout(config: Mapping[str, Any]) -> float:
+    """The entry's ``timeout_s`` (checked by the ajpf backend's read_config), else
+    :data:`spin.DEFAULT_TIMEOUT_S`: the limit of each tool run and of the exploration."""
+    v = config.get("timeout_s")
+    return float(v) if isinstance(v, (int, float)) and not isinstance(v, bool) and v > 0 else spin.DEFAULT_TIMEOUT_S
+
+
 def run_spin(obligation: Obligation, target: NodeTarget, model: str, timeout_s: float) -> Evidence:
     """Evidence for one obligation of an ``ajpf`` entry checked by SPIN.
 
     ``pending`` when SPIN or gcc is missing (with the install command);
-    ``error`` for an error in the program or a failed build; ``failed``
-    with the lasso for a violated property; ``inconclusive`` when the
-    exploration or pan's search was cut by a bound; ``discharged`` only
-    when pan searched the whole product of a complete graph without error.
+    ``error`` for an error in the program or a failed build;
+    ``inconclusive`` when the exploration was cut by a bound (SPIN is then
+    not run), when pan's search was cut, when the property passes vacuously
+    or names an identifier value; ``failed`` with the lasso for a violated
+    property; ``discharged`` only when pan searched the whole product of a
+    complete graph without error and the property's antecedents hold
+    somewhere.  ``timeout_s`` bounds the exploration and each tool run.
+    Raises :class:`~rclverify.backends.bounded.ToolInterrupted` when a tool
+    was stopped from outside (nothing is recorded then).
     """
     clock = Stopwatch()
     data = obligation.data
@@ -198,99 +224,162 @@ def run_spin(obligation: Obligation, target: NodeTarget, model: str, timeout_s: 
         return make_evidence(target, obligation, "error", tool=TOOL, tool_version=tools.version, clock=clock,
                              explanation="stage one of the model checking (rclverify.backends.model_checking."
                                          "explore, the Gwendolen explorer) is not part of this installation")
-    gkey, graph, explore_s = _graph(target, model, cfg)
+    claims, digest = _claims(target, cfg)
+    gkey, graph, explore_s = _graph(target, model, cfg, timeout_s, _numbers_of(claims))
     if isinstance(graph, RclError):
         return make_evidence(target, obligation, "error", tool=TOOL, tool_version=tools.version, clock=clock,
                              explanation=f"the agent program could not be explored: {graph}")
-    claims, digest = _claims(target, cfg)
     claim = str(data.get("claim") or f"p{data.get('property')}")
     mine = next((c for c in claims if c.name == claim), None)
     if mine is None or psl.to_text(mine.formula) != data.get("psl"):
         return make_evidence(target, obligation, "stale", tool=TOOL, tool_version=tools.version, clock=clock,
                              explanation=f"property {claim} is no longer the one exported; export again")
     return check_graph(obligation, target, graph, claims, claim, tools=tools, graph_key=gkey, claims_key=digest,
-                       bounds=(cfg.max_states, cfg.max_depth), explore_s=explore_s, timeout_s=timeout_s, clock=clock)
+                       bounds=(cfg.max_states, cfg.max_depth), explore_s=explore_s, timeout_s=timeout_s, clock=clock,
+                       percepts=cfg.environment.percepts)
+
+
+def _where(target: NodeTarget, graph: StateGraph) -> Loc:
+    """Where a stopped tool is reported: the entry's ``model_checker`` key in the plan, else the program."""
+    try:
+        return target.config_loc("model_checker")
+    except (AttributeError, TypeError):  # a target without a plan (tests, a graph checked on its own)
+        return Loc(graph.source, 1, 1)
+
+
+def _vacuity_claims(claims: list[Claim]) -> list[Claim]:
+    """For every claim, one claim per temporal antecedent: true exactly when that
+    antecedent never holds where it is evaluated (:func:`.vacuity.temporal_checks`)."""
+    out = []
+    for c in claims:
+        for k, a in enumerate(x for x in antecedents(c.formula) if not x.state):
+            out.append(Claim(f"v_{c.name}_{k}", temporal_checks(a), f"vacuity of {c.name}: {a.text} never holds"))
+    return out
 
 
 def check_graph(obligation: Obligation, target: NodeTarget, graph: StateGraph, claims: list[Claim], claim: str, *,
                 tools: spin.Tools, graph_key: str, bounds: tuple[int, int], claims_key: str | None = None,
-                explore_s: float = 0.0,
-                timeout_s: float = 3600.0, clock: Stopwatch | None = None) -> Evidence:
+                explore_s: float = 0.0, timeout_s: float = spin.DEFAULT_TIMEOUT_S, clock: Stopwatch | None = None,
+                percepts: tuple[psl.Term, ...] = ()) -> Evidence:
     """Evidence that ``graph`` satisfies the claim named ``claim`` (one of
     ``claims``, all of which go into one model, built once per
     ``graph_key`` (what identifies the graph) and ``claims_key`` (the claims;
     computed when ``None``)): see :func:`run_spin` for the statuses.
     ``bounds`` are the exploration bounds ``(max_states, max_depth)`` the
-    graph was made with, for the record.  Writes ``spin/model.pml`` and, for
-    a counterexample, ``spin/<claim>.trail.txt`` under ``target.artifacts``.
+    graph was made with, for the record; ``percepts`` the environment's
+    declared percepts (a claim naming one of their identifier values is
+    inconclusive).  Writes ``spin/model.pml`` and, for a counterexample,
+    ``spin/<claim>.trail.txt`` under ``target.artifacts``; the verifier is
+    built in the user's cache (:func:`.spin.cache_dir`), never in the
+    workspace.  Raises :class:`~rclverify.backends.bounded.ToolInterrupted`
+    when a tool was stopped from outside.
     """
     clock = clock or Stopwatch()
     mine = next(c for c in claims if c.name == claim)
     if claims_key is None:
         claims_key = repr([(c.name, psl.to_text(c.formula)) for c in claims])
-    mkey = hashlib.sha256((graph_key + claims_key).encode()).hexdigest()
     spin_dir = target.artifacts / "spin"
+    shutil.rmtree(spin_dir / "build", ignore_errors=True)  # verifiers built by earlier versions: never run
+    what = (f"{WHAT} {graph.source} under its verification environment ({len(graph.states)} states, "
+            f"{len(graph.transitions)} transitions; bounds max_states={bounds[0]}, max_depth={bounds[1]}, "
+            f"timeout_s={timeout_s:g})")
+    details: dict[str, Any] = {
+        "model_checker": "spin", "claim": claim, "psl": psl.to_text(mine.formula), "states": len(graph.states),
+        "transitions": len(graph.transitions), "complete": graph.complete, "cut": graph.cut, "depth": graph.depth,
+        "max_states": bounds[0], "max_depth": bounds[1], "timeout_s": timeout_s, "explore_s": explore_s,
+        "identifiers": graph.identifiers}
+
+    def evidence(status: str, why: str, **kw: Any) -> Evidence:
+        return make_evidence(target, obligation, status, tool=TOOL, tool_version=tools.version, clock=clock,
+                             details=details, explanation=f"{what}: {why}", **kw)
+
+    if not graph.complete:
+        details["spin_verdict"] = "not run"
+        details["bounded"] = True
+        return evidence("inconclusive", f"the exploration was cut ({graph.cut}), so the graph is not the program's "
+                                        "whole state space and SPIN was not run on it (bounded: raise the bound "
+                                        "named to decide)")
+    named = named_identifiers(mine.formula, percepts)
+    if named:
+        details["spin_verdict"] = "not run"
+        return evidence("inconclusive", f"the property names an identifier value ({', '.join(named)}); an "
+                                        "identifier is any fresh value (docs/model-checking.md, Identifiers), so "
+                                        "the property has no meaning: write '_' at the identifier's place")
+    mkey = hashlib.sha256((graph_key + claims_key).encode()).hexdigest()
+    where = _where(target, graph)
     t0 = time.perf_counter()
     if mkey not in _MODELS or not (_MODELS[mkey][1] / "pan").is_file():
-        pml = build_model(graph, claims)
+        pml = build_model(graph, list(claims) + _vacuity_claims(claims))
         atomic_write_text(spin_dir / "model.pml", pml.text)
         try:
-            built = spin.compile_model(tools, pml.text, spin_dir / "build", timeout_s)
+            built = spin.compile_model(tools, pml.text, None, timeout_s, where)
         except spin.CompileError as exc:
-            return make_evidence(target, obligation, "error", tool=TOOL, tool_version=tools.version, clock=clock,
-                                 explanation=f"SPIN could not build the verifier: {exc}", log=str(exc))
+            details["spin_verdict"] = "not run"
+            return evidence("inconclusive" if exc.timed_out else "error",
+                            f"SPIN could not build the verifier: {exc}", log=str(exc))
         _MODELS[mkey] = (pml, built, round(time.perf_counter() - t0, 3))
     pml, built, build_s = _MODELS[mkey]
     depth_bound = max(10_000, 20 * (pml.states + pml.transitions))
-    if (mkey, claim) not in _RESULTS:
-        _RESULTS[(mkey, claim)] = spin.check(tools, built, claim, depth_bound, timeout_s,
-                                                 size=pml.states + pml.transitions)
-    res = _RESULTS[(mkey, claim)]
-    details: dict[str, Any] = {
-        "model_checker": "spin", "claim": claim, "psl": psl.to_text(mine.formula), "states": pml.states,
-        "transitions": pml.transitions, "complete": graph.complete, "cut": graph.cut, "depth": graph.depth,
-        "max_states": bounds[0], "max_depth": bounds[1], "spin_verdict": res.verdict,
-        "spin_states_stored": res.stored, "explore_s": explore_s, "build_s": build_s, "pan_s": res.duration_s,
-        "promela": target.rel(spin_dir / "model.pml"), "propositions": dict(pml.props)}
+
+    def run(name: str) -> spin.CheckResult:
+        if (mkey, name) not in _RESULTS:
+            _RESULTS[(mkey, name)] = spin.check(tools, built, name, depth_bound, timeout_s,
+                                                size=pml.states + pml.transitions, where=where)
+        return _RESULTS[(mkey, name)]
+
+    res = run(claim)
+    details.update({"spin_verdict": res.verdict, "spin_states_stored": res.stored, "build_s": build_s,
+                    "pan_s": res.duration_s, "promela": target.rel(spin_dir / "model.pml"),
+                    "propositions": dict(pml.props)})
     arts = [target.rel(spin_dir / "model.pml")]
-    what = (f"{WHAT} {graph.source} under its verification environment ({pml.states} states, {pml.transitions} "
-            f"transitions; bounds max_states={bounds[0]}, max_depth={bounds[1]})")
-    cex = None
     if res.verdict == "violated":
         props = Propositions([mine.formula])
         try:
             cex = counterexample(graph, read_replay(res.trail), props)
         except ValueError as exc:
-            return make_evidence(target, obligation, "error", tool=TOOL, tool_version=tools.version, clock=clock,
-                                 log=res.output + res.trail, details=details,
-                                 explanation=f"{what}: SPIN's trail does not map back to the graph: {exc}")
+            return evidence("error", f"SPIN's trail does not map back to the graph: {exc}", log=res.output + res.trail)
         details["lasso"] = cex
         trail_path = spin_dir / f"{claim}.trail.txt"
         atomic_write_text(trail_path, "\n".join(cex["trace"]) + "\n")
         arts.append(target.rel(trail_path))
-    if not graph.complete:
-        status = "inconclusive"
-        why = (f"the exploration was cut ({graph.cut}), so the graph is not the program's whole state space; "
-               f"SPIN's verdict on the cut graph: {res.verdict}" + (f" ({summary(cex)})" if cex else ""))
-    elif res.verdict == "holds":
-        status, why = "discharged", "the property holds on every path (pan: errors: 0, full search)"
-    elif res.verdict == "violated":
-        assert cex is not None
-        status, why = "failed", f"property violated; counterexample: {summary(cex)}"
-    elif res.verdict == "incomplete":
-        status, why = "inconclusive", f"SPIN's search was cut: {res.reason}"
-    else:
-        status, why = "error", f"SPIN failed: {res.reason}"
-    # the counterexample as AJPF's results give it (a summary and the path, one line per step);
-    # the steps as data are details["lasso"]
-    shown = {"lasso": summary(cex), "trace": cex["trace"]} if cex else None
-    return make_evidence(target, obligation, status, tool=TOOL, tool_version=tools.version, clock=clock,
-                         log=res.output, artifacts=tuple(arts), counterexample=shown, details=details,
-                         explanation=f"{what}: {why}")
+        # the counterexample as AJPF's results give it (a summary and the path, one line per step);
+        # the steps as data are details["lasso"]
+        return evidence("failed", f"property violated; counterexample: {summary(cex)}", log=res.output,
+                        artifacts=tuple(arts), counterexample={"lasso": summary(cex), "trace": cex["trace"]})
+    if res.verdict == "incomplete":
+        return evidence("inconclusive", f"SPIN's search was cut: {res.reason}", log=res.output, artifacts=tuple(arts))
+    if res.verdict != "holds":
+        return evidence("error", f"SPIN failed: {res.reason}", log=res.output, artifacts=tuple(arts))
+    memo = _MEMO.setdefault(graph_key, {})
+    memo.update({a: ks for a, ks in pml.truth.items() if a not in memo})  # the model's own truth table
+    vac = check_vacuity(graph, mine.formula, memo)
+    vacuous = list(vac.vacuous)
+    undecided = []
+    aux = [c for c in _vacuity_claims([mine])]
+    for a, c in zip(vac.pending, aux):
+        r = run(c.name)
+        if r.verdict == "holds":
+            vacuous.append(f"the antecedent {a.text} holds on no path" + ("" if a.temporal_context else
+                                                                          " from the initial state"))
+        elif r.verdict != "violated":
+            undecided.append(f"whether the antecedent {a.text} ever holds: {r.reason or r.verdict}")
+    details["antecedents"] = [{"antecedent": t, "holds_in_state": k} for t, k in vac.witnessed]
+    if vacuous:
+        details["vacuous"] = vacuous
+        return evidence("inconclusive", "the property holds on every path (pan: errors: 0, full search), but "
+                                        "vacuously: " + "; ".join(vacuous) + " -- it says nothing about what the "
+                                        "agent does (vacuous)", log=res.output, artifacts=tuple(arts))
+    if undecided:
+        return evidence("inconclusive", "the property holds on every path (pan: errors: 0, full search), but its "
+                                        "vacuity was not decided: " + "; ".join(undecided),
+                        log=res.output, artifacts=tuple(arts))
+    return evidence("discharged", "the property holds on every path (pan: errors: 0, full search), and every "
+                                  "antecedent holds in some state (not vacuous)", log=res.output, artifacts=tuple(arts))
 
 
 def clear_caches() -> None:
     """Forget explored graphs, built models and results (tests; a long-lived process)."""
+    _MEMO.clear()
     _GRAPHS.clear()
     _MODELS.clear()
     _RESULTS.clear()

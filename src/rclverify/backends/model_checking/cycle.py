@@ -30,8 +30,9 @@ from typing import Iterable, Iterator, NamedTuple
 
 from ..ajpf import psl
 from .environment import Environment
-from .gwendolen import Deed, Plan, Program, Term, as_psl, located
-from .unify import Beliefs, Subst, ground, substitute, unify
+from .gwendolen import MAX_TERM_DEPTH, Deed, Plan, Program, Term, as_psl, located
+from .identifiers import ALTERNATE, FRESH, fresh_identifier, numbers
+from .unify import Beliefs, BoundReached, Subst, ground, substitute, term_depth, unify
 
 
 class TermSet(tuple[psl.Term, ...]):
@@ -114,9 +115,11 @@ class AgentState:
 
     ``beliefs`` and ``perceived`` (what the agent last perceived) and
     ``percepts`` (the environment's current ones) are sorted by text;
-    ``intentions`` the queue, first to run first; ``reactions`` the number of
-    the environment's last reaction (0 before the first, then 1, 2, 1, 2 ...:
-    see :mod:`.environment`); ``pending`` the action it must react to next.
+    ``intentions`` the queue, first to run first; ``reactions`` the
+    identifier of the environment's last reaction when identifiers
+    alternate (0 before the first, then 1, 2, 1, 2 ...; always 0 with fresh
+    identifiers: see :mod:`.identifiers`); ``pending`` the action it must
+    react to next.
     """
 
     beliefs: TermSet
@@ -150,12 +153,20 @@ def goals(state: AgentState) -> list[psl.Term]:
 
 
 class Cycle:
-    """The reasoning cycle of one program under one environment."""
+    """The reasoning cycle of one program under one environment.
 
-    def __init__(self, program: Program, env: Environment) -> None:
+    ``identifiers`` is how reactions get their identifiers
+    (:data:`.identifiers.ALTERNATE` or :data:`.identifiers.FRESH`);
+    ``avoid`` the numbers a fresh identifier must differ from besides the
+    state's (the program's, the environment's and the properties')."""
+
+    def __init__(self, program: Program, env: Environment, identifiers: str = ALTERNATE,
+                 avoid: frozenset[float] = frozenset()) -> None:
         self.program = program
         self.env = env
         self.src = program.source
+        self.identifiers = identifiers
+        self.avoid = avoid
 
     def beliefs(self, state: AgentState) -> Beliefs:
         return Beliefs(state.beliefs, self.program.rules, self.src)
@@ -166,6 +177,8 @@ class Cycle:
         must react, else the one agent step (none when the agent has nothing
         to do: a final state)."""
         if state.pending is not None:
+            if self.identifiers == FRESH:
+                return environment_steps(self.env, state, fresh_identifier(state_numbers(state) | self.avoid))
             return environment_steps(self.env, state)
         step = self.drop_achieved(state)
         if step is not None:
@@ -261,7 +274,10 @@ class Cycle:
 
     def _ground_deed(self, deed: Deed, s: Subst) -> Deed:
         if deed.kind == "-b":  # a deletion may keep '_' and unbound variables: it deletes every match
-            return replace(deed, term=substitute(deed.term, s))
+            term = substitute(deed.term, s)
+            if term_depth(term) > MAX_TERM_DEPTH:
+                raise BoundReached(f"term depth > {MAX_TERM_DEPTH}")
+            return replace(deed, term=term)
         return replace(deed, term=ground(deed.term, s, self.src, deed.line, deed.col, f"deed {deed.text()}"))
 
     # -- stage D ------------------------------------------------------------
@@ -350,15 +366,27 @@ def perceive(state: AgentState, percepts: TermSet) -> AgentState:
                    intentions=state.intentions + tuple(new_intents))
 
 
-def environment_steps(env: Environment, state: AgentState) -> list[Step]:
+def state_numbers(state: AgentState) -> set[float]:
+    """Every number in ``state``'s terms (beliefs, percepts, intentions, actions)."""
+    terms: list[Term | None] = [*state.beliefs, *state.perceived, *state.percepts, state.last_action, state.pending]
+    for intent in state.intentions:
+        for f in intent:
+            terms.append(f.event.term)
+            terms.extend(d.term for d in f.deeds or ())
+    return numbers(terms)
+
+
+def environment_steps(env: Environment, state: AgentState, fresh: int | None = None) -> list[Step]:
     """The environment's reaction to ``state.pending``: one step per choice,
-    each followed by the agent's perception (stage E)."""
-    n = 2 if state.reactions == 1 else 1
+    each followed by the agent's perception (stage E).  ``_`` in a percept is
+    ``fresh`` when given, else 1 and 2 alternately (:mod:`.identifiers`)."""
+    n = fresh if fresh is not None else 2 if state.reactions == 1 else 1
+    kept = 0 if fresh is not None else n
     action = psl.term_text(state.pending) if state.pending is not None else "?"
     out = []
     for choice in env.choices(n):
         chosen = _sorted(choice)
         what = ", ".join(psl.term_text(p) for p in chosen) if chosen else "nothing"
-        base = replace(state, reactions=n, pending=None)
+        base = replace(state, reactions=kept, pending=None)
         out.append(Step(f"environment after {action}: asserts {what}", None, "env", perceive(base, chosen)))
     return out

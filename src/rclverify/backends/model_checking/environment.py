@@ -22,12 +22,13 @@ replaces its percepts by any set of at least ``at_least`` and at most
 ``at_most`` of the declared percepts (with ``at_least`` 0 the empty set is
 among them: nothing is perceived, the previous percepts are retracted).  Each choice is a branch of the explored graph.
 ``_`` in a declared percept stands for the identifier of the action the
-reaction answers: 1 for the first reaction, then 2, 1, 2 ... alternately,
-so that the result of the second ``move`` is a new percept even when it
-equals the first's (``movebase_result(2, 3)`` after ``movebase_result(1,
-3)``: a ``+`` event again).  Two values suffice because a reaction retracts
-the previous reaction's percepts; a growing counter would make every state
-after it new, and the graph of a program that acts in a loop infinite.
+reaction answers, a fresh value at every reaction, so that the result of
+the second ``move`` is a new percept even when it equals the first's
+(``movebase_result(2, 3)`` after ``movebase_result(1, 3)``: a ``+`` event
+again).  How the explorer chooses the values -- 1, 2, 1, 2 ... for a
+program that never keeps or tests an identifier, else the smallest number
+the state and the program do not hold -- and why that is sound is
+:mod:`.identifiers`'s.
 """
 from __future__ import annotations
 
@@ -69,9 +70,10 @@ class Environment:
         return self.after is None or name in self.after
 
     def choices(self, reaction: int) -> list[tuple[psl.Term, ...]]:
-        """The percept sets the ``reaction``-th reaction may choose, in a fixed
-        order: nothing first (unless ``at_least`` > 0), then single percepts
-        in declared order, then pairs ...; ``_`` replaced by ``reaction``."""
+        """The percept sets a reaction with identifier ``reaction`` may choose,
+        in a fixed order: nothing first (unless ``at_least`` > 0), then single
+        percepts in declared order, then pairs ...; ``_`` replaced by
+        ``reaction``."""
         filled = [fill(p, reaction) for p in self.percepts]
         out: list[tuple[psl.Term, ...]] = []
         for k in range(self.at_least, min(self.at_most, len(filled)) + 1):

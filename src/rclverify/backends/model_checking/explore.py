@@ -10,14 +10,18 @@ place of AJPF's JPF run.
 """
 from __future__ import annotations
 
+import time
 from collections import deque
 from pathlib import Path
+from typing import Iterable
 
 from ..ajpf import psl
 from .cycle import AgentState, Cycle, goals, initial_state
 from .environment import Environment
 from .graph import MentalState, StateGraph, Transition
 from .gwendolen import Program, as_psl, parse_file
+from .identifiers import ALTERNATE, FRESH, analyse, numbers
+from .unify import BoundReached
 
 
 def mental_state(state: AgentState) -> MentalState:
@@ -35,10 +39,24 @@ def mental_state(state: AgentState) -> MentalState:
     )
 
 
+def program_numbers(program: Program, environment: Environment) -> set[float]:
+    """Every number written in ``program`` (beliefs, rules, goals, plans) and in ``environment``'s percepts."""
+    terms: list[object] = [*program.beliefs, *(g for g, _ in program.goals), *environment.percepts,
+                           *environment.initial]
+    for rule in program.rules:
+        terms += [rule.head, *(t for _, t in rule.body)]
+    for plan in program.plans:
+        terms += [plan.trigger.term, *(lit.term for lit in plan.guard), *(d.term for d in plan.body)]
+    return numbers(terms)  # type: ignore[arg-type]
+
+
 def explore_program(program: Program, environment: Environment, max_states: int = 100_000,
-                    max_depth: int = 10_000) -> StateGraph:
+                    max_depth: int = 10_000, time_limit_s: float | None = None,
+                    avoid: Iterable[float] = ()) -> StateGraph:
     """Explore ``program`` (see :func:`explore`)."""
-    cycle = Cycle(program, environment)
+    use = analyse(program, environment.percepts, environment.initial)
+    extra = frozenset(program_numbers(program, environment) | set(avoid)) if use.mode == FRESH else frozenset()
+    cycle = Cycle(program, environment, FRESH if use.mode == FRESH else ALTERNATE, extra)
     init = initial_state(program, environment)
     index: dict[AgentState, int] = {init: 0}
     states: list[AgentState] = [init]
@@ -47,9 +65,20 @@ def explore_program(program: Program, environment: Environment, max_states: int 
     queue = deque([0])
     cut = ""
     deepest = 0
+    deadline = None if time_limit_s is None else time.monotonic() + time_limit_s
     while queue:
         i = queue.popleft()
-        steps = cycle.successors(states[i])
+        if deadline is not None and time.monotonic() > deadline:
+            cut = f"time > {time_limit_s:g} s"
+            break
+        try:
+            steps = cycle.successors(states[i])
+        except BoundReached as exc:  # the program builds ever deeper terms, or its rules explode
+            cut = exc.bound
+            break
+        except RecursionError:  # a last resort: Python's stack, not a verdict
+            cut = "recursion depth of the interpreter"
+            break
         if steps and depth[i] >= max_depth:
             cut = cut or f"depth > {max_depth}"
             continue
@@ -68,28 +97,42 @@ def explore_program(program: Program, environment: Environment, max_states: int 
                 queue.append(j)
             transitions.append(Transition(i, j, step.label, step.line, step.stage))
     derived: dict[int, frozenset[psl.Term]] = {}
-    if program.rules:
-        for k, s in enumerate(states):
-            d = cycle.beliefs(s).derived()
-            if d:
-                derived[k] = d
+    if program.rules and not cut:
+        try:
+            for k, s in enumerate(states):
+                d = cycle.beliefs(s).derived()
+                if d:
+                    derived[k] = d
+        except BoundReached as exc:
+            cut = exc.bound
+        except RecursionError:
+            cut = "recursion depth of the interpreter"
     return StateGraph(agent=program.name, source=program.source,
                       states=tuple(mental_state(s) for s in states), transitions=tuple(transitions),
-                      complete=not cut, cut=cut, depth=deepest, derived=derived)
+                      complete=not cut, cut=cut, depth=deepest, identifiers=use.describe(), derived=derived)
 
 
 def explore(program_path: Path, source_name: str, environment: Environment, max_states: int = 100_000,
-            max_depth: int = 10_000) -> StateGraph:
+            max_depth: int = 10_000, time_limit_s: float | None = None, avoid: Iterable[float] = ()
+            ) -> StateGraph:
     """Parse the Gwendolen program at ``program_path`` and explore it under ``environment``.
 
     ``source_name`` is the workspace-relative path used in messages and
     labels.  Every state reachable within the bounds is a node (state 0 the
     initial state); every agent step and environment choice a transition.
-    When more than ``max_states`` states are found, or a state at depth
-    ``max_depth`` (transitions from state 0) has successors, exploration
-    stops there: the graph has ``complete=False`` and ``cut`` names the
-    bound.  Raises :class:`~.gwendolen.GwendolenError` for errors in the
-    program, also those found while running it (an unbound variable in a
-    deed, rules nesting without end).
+    When more than ``max_states`` states are found, a state at depth
+    ``max_depth`` (transitions from state 0) has successors, the exploration
+    has run ``time_limit_s`` seconds, the program builds a term nested
+    deeper than :data:`~.gwendolen.MAX_TERM_DEPTH` or its reasoning rules
+    take more than :data:`~.unify.MAX_RESOLUTION_STEPS` steps in one state,
+    exploration stops there: the graph has ``complete=False`` and ``cut``
+    names the bound (``"states > 100000"``, ``"time > 300 s"``,
+    ``"term depth > 64"``).  Identifiers are chosen as
+    :func:`.identifiers.analyse` decides; ``avoid`` are further numbers a
+    fresh identifier must differ from (the properties').  Raises
+    :class:`~.gwendolen.GwendolenError` for errors in the program, also those
+    found while running it (an unbound variable in a deed, rules nesting
+    deeper than :data:`~.unify.MAX_RULE_DEPTH` calls).
     """
-    return explore_program(parse_file(program_path, source_name), environment, max_states, max_depth)
+    return explore_program(parse_file(program_path, source_name), environment, max_states, max_depth,
+                           time_limit_s, avoid)

@@ -75,7 +75,10 @@ class StateGraph:
     ``complete``    False when a state or depth bound cut the exploration
                     (then no verdict may be ``discharged``);
     ``cut``         the bound that cut it (``"states > 100000"``), else ``""``;
-    ``depth``       the greatest depth reached (transitions from state 0).
+    ``depth``       the greatest depth reached (transitions from state 0);
+    ``identifiers`` how the environment's reactions got their identifiers,
+                    one sentence (:meth:`.identifiers.IdentifierUse.describe`;
+                    ``""`` for a graph not made by the explorer).
     """
 
     agent: str
@@ -85,6 +88,7 @@ class StateGraph:
     complete: bool = True
     cut: str = ""
     depth: int = 0
+    identifiers: str = ""
     derived: dict[int, frozenset[psl.Term]] = field(default_factory=dict, compare=False)
 
     def holds(self, state: int, atom: psl.Modal | psl.Percept) -> bool:

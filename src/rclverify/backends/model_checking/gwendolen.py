@@ -35,6 +35,9 @@ from ...rcl.source import read_text
 from ..ajpf import psl
 
 GOAL_TYPES = ("achieve", "perform")
+#: Deepest term the interpreter accepts in a program and builds while running
+#: one (a deeper one cuts the exploration: docs/model-checking.md, "Bounds").
+MAX_TERM_DEPTH = psl.MAX_NESTING
 DEFAULT_GOAL_TYPE = "achieve"  # MCAPL: a goal written without a type is an achievement goal
 
 
@@ -309,9 +312,11 @@ class _Builder:
             return Deed(f"{kids[0]}b", self.term(kids[1]), line, col)
         return Deed("act", self.term(kids[0]), line, col)
 
-    def term(self, node: Tree[Token] | Token) -> Term:
+    def term(self, node: Tree[Token] | Token, depth: int = 1) -> Term:
         if isinstance(node, Token):  # pragma: no cover - every term is a tree
             raise self._err(node, f"unexpected {node!s}")
+        if depth > MAX_TERM_DEPTH:
+            raise self._err(node, f"term nested deeper than {MAX_TERM_DEPTH} levels (the interpreter's limit)")
         kind = node.data
         tok = node.children[0]
         if kind == "var":
@@ -325,7 +330,7 @@ class _Builder:
         args = node.children[1].children if len(node.children) > 1 else []
         if not args:
             return psl.Sym(str(tok))
-        return psl.Compound(str(tok), tuple(self.term(a) for a in args))
+        return psl.Compound(str(tok), tuple(self.term(a, depth + 1) for a in args))
 
 
 def _pos(node: Tree[Token] | Token) -> tuple[int, int]:

@@ -23,15 +23,24 @@ repeating its last state for ever, the usual reading of LTL over finite
 runs and AJPF's (docs/model-checking.md, "Fairness and stuttering").  The
 model therefore never terminates and has no invalid end states.
 
+Text that comes from the workspace (the program's path, property texts and
+the files they come from) appears only inside comments, through
+:func:`comment_text`, which keeps it on one line, in printable ASCII, and
+unable to close the comment: SPIN passes the model through the C
+preprocessor, so a path holding ``*/`` and a newline followed by
+``#define`` or ``#include`` would otherwise rewrite the model or copy a file
+into it.  :func:`build_model` also refuses a rendered model with a line that
+starts with ``#``.
+
 Every transition prints ``@T <index>`` and every stutter ``@S <state>``;
 printing is off while ``pan`` verifies and on when SPIN replays a trail,
 which is how a counterexample is mapped back to the graph (:mod:`.trail`).
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from functools import lru_cache
-from typing import Any, Sequence
+from typing import Any, Mapping, Sequence
 
 from jinja2 import Environment, PackageLoader, StrictUndefined
 
@@ -57,20 +66,56 @@ class Claim:
 @dataclass(frozen=True)
 class PromelaModel:
     """The rendered model: its ``text``, the propositions as ``(name, AJPF
-    text)``, the ``claims`` in it and the graph's size."""
+    text)``, the ``claims`` in it, the graph's size, and for each
+    proposition the states where it holds (``truth``)."""
 
     text: str
     props: tuple[tuple[str, str], ...]
     claims: tuple[Claim, ...]
     states: int
     transitions: int
+    truth: Mapping[psl.Formula, frozenset[int]] = field(default_factory=dict, compare=False)
+
+
+def comment_text(text: object) -> str:
+    """``text`` made safe inside a C/Promela block comment on one line.
+
+    Printable ASCII is kept except ``\\``, written ``\\\\``; every other
+    character (newlines, control characters, non-ASCII) becomes ``\\n``,
+    ``\\t``, ``\\xNN``, ``\\uNNNN`` or ``\\UNNNNNNNN``; then ``*/``, ``/*`` and
+    ``??`` (a trigraph's start) are broken by a backslash.  The result has no
+    line break, so no preprocessor directive and no line splice can come
+    from it, and it cannot end the comment it is written in.
+    """
+    out = []
+    for ch in str(text):
+        if ch == "\\":
+            out.append("\\\\")
+        elif " " <= ch <= "~":
+            out.append(ch)
+        elif ch == "\n":
+            out.append("\\n")
+        elif ch == "\t":
+            out.append("\\t")
+        elif ord(ch) < 0x100:
+            out.append(f"\\x{ord(ch):02x}")
+        elif ord(ch) < 0x10000:
+            out.append(f"\\u{ord(ch):04x}")
+        else:
+            out.append(f"\\U{ord(ch):08x}")
+    safe = "".join(out)
+    while "*/" in safe or "/*" in safe or "??" in safe:
+        safe = safe.replace("*/", "*\\/").replace("/*", "/\\*").replace("??", "?\\?")
+    return safe
 
 
 @lru_cache(maxsize=1)
 def _templates() -> Environment:
-    return Environment(loader=PackageLoader("rclverify.backends.model_checking", "templates"),
-                       undefined=StrictUndefined, keep_trailing_newline=True, trim_blocks=True,
-                       lstrip_blocks=True, autoescape=False)
+    env = Environment(loader=PackageLoader("rclverify.backends.model_checking", "templates"),
+                      undefined=StrictUndefined, keep_trailing_newline=True, trim_blocks=True,
+                      lstrip_blocks=True, autoescape=False)
+    env.filters["comment"] = comment_text
+    return env
 
 
 def truth_table(graph: StateGraph, props: Propositions) -> list[tuple[bool, ...]]:
@@ -114,13 +159,17 @@ def build_model(graph: StateGraph, claims: Sequence[Claim]) -> PromelaModel:
         initial_n=degree[0], initial_props=[(n, int(v)) for n, v in zip(pnames, table[0])],
         claims=[{"name": c.name, "ltl": to_spin(c.formula, props), "comment": _comment(c)} for c in claims],
         ranks=ranks)
+    for k, line in enumerate(rendered.splitlines(), 1):
+        if line.lstrip().startswith("#"):  # never: every workspace text goes through comment_text
+            raise ValueError(f"the Promela model's line {k} would be a preprocessor directive: {line[:80]!r}")
+    truth: dict[psl.Formula, frozenset[int]] = {
+        a: frozenset(k for k, row in enumerate(table) if row[i]) for i, (_, a) in enumerate(props.atoms())}
     return PromelaModel(rendered, tuple((n, atom_text(a)) for n, a in props.atoms()), tuple(claims),
-                        len(graph.states), len(graph.transitions))
+                        len(graph.states), len(graph.transitions), truth)
 
 
 def _comment(c: Claim) -> str:
-    text = (c.comment + ": " if c.comment else "") + psl.to_text(c.formula)
-    return text.replace("*/", "* /")
+    return (c.comment + ": " if c.comment else "") + psl.to_text(c.formula)
 
 
 def _tree(branches: list[dict[str, Any]]) -> dict[str, Any]:

@@ -18,10 +18,25 @@ from __future__ import annotations
 from typing import Iterator, Sequence
 
 from ..ajpf import psl
-from .gwendolen import Rule, Term, Var, as_psl, located
+from .gwendolen import MAX_TERM_DEPTH, Rule, Term, Var, as_psl, located
 
 #: How deep reasoning rules may call each other before the query is refused.
 MAX_RULE_DEPTH = 64
+#: Unification attempts the reasoning rules may make for one state (all its
+#: queries together) before the exploration is cut there.
+MAX_RESOLUTION_STEPS = 200_000
+
+
+class BoundReached(Exception):
+    """A bound of the interpreter was reached while running the program (a
+    term nested deeper than :data:`MAX_TERM_DEPTH`, more than
+    :data:`MAX_RESOLUTION_STEPS` resolution steps for one state): not an
+    error of the program, but the exploration cannot go on from that state;
+    it is cut there (``bound``: which one, for the graph's ``cut``)."""
+
+    def __init__(self, bound: str) -> None:
+        super().__init__(bound)
+        self.bound = bound
 
 Subst = dict[str, Term]
 
@@ -105,9 +120,18 @@ class Beliefs:
         self.rules = rules
         self.source = source
         self._fresh = 0
+        self._steps = 0
+
+    def _step(self, n: int) -> None:
+        self._steps += n
+        if self._steps > MAX_RESOLUTION_STEPS:
+            raise BoundReached(f"resolution steps > {MAX_RESOLUTION_STEPS} in one state")
 
     def solve(self, query: Term, s: Subst, depth: int = 0) -> Iterator[Subst]:
-        """Every answer to ``B query`` extending ``s``, in SLD order."""
+        """Every answer to ``B query`` extending ``s``, in SLD order.  Raises
+        :class:`BoundReached` past :data:`MAX_RESOLUTION_STEPS` (counted over
+        this object's queries)."""
+        self._step(len(self.beliefs) + len(self.rules) if self.rules else len(self.beliefs))
         for b in self.beliefs:
             s2 = unify(query, b, s)
             if s2 is not None:
@@ -149,6 +173,8 @@ class Beliefs:
             for s in self.solve(head, {}):
                 t = substitute(head, s)
                 if not variables(t) and not _has_wild(t):
+                    if term_depth(t) > MAX_TERM_DEPTH:
+                        raise BoundReached(f"term depth > {MAX_TERM_DEPTH}")
                     out.add(as_psl(t))
         return frozenset(out - {as_psl(b) for b in self.beliefs})
 
@@ -159,9 +185,24 @@ def _has_wild(t: Term) -> bool:
     return isinstance(t, psl.Compound) and any(_has_wild(a) for a in t.args)
 
 
+def term_depth(t: Term) -> int:
+    """Nesting depth of ``t`` (1 for a name, number or variable), without recursion."""
+    best, stack = 0, [(t, 1)]
+    while stack:
+        u, d = stack.pop()
+        best = max(best, d)
+        if isinstance(u, psl.Compound):
+            stack.extend((a, d + 1) for a in u.args)
+    return best
+
+
 def ground(t: Term, s: Subst, source: str, line: int, col: int, what: str) -> psl.Term:
-    """``t`` under ``s``, which must leave no variable; else a located error naming it."""
+    """``t`` under ``s``, which must leave no variable; else a located error
+    naming it.  Raises :class:`BoundReached` when the result nests deeper
+    than :data:`MAX_TERM_DEPTH` (a program that builds ever deeper terms)."""
     g = substitute(t, s)
+    if term_depth(g) > MAX_TERM_DEPTH:
+        raise BoundReached(f"term depth > {MAX_TERM_DEPTH}")
     free = variables(g)
     if free:
         raise located(source, line, col, f"variable {free[0]} of {what} is not bound by the plan's trigger or guard")
