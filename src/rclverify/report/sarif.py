@@ -316,7 +316,10 @@ def _attach_diagnoses(report: Mapping[str, Any], results: Sequence[dict[str, Any
     from ..diagnosis.edits import sarif_fix
     by_key: dict[str, Mapping[str, Any]] = {}
     for d in report.get("diagnoses", []):
-        for prefix in ("health", "side-condition", "obligation"):
+        if d.get("kind") == "deadline":
+            by_key[f"deadline:{d.get('requirement')}"] = d
+            continue
+        for prefix in ("health", "side-condition", "obligation", "requirement"):
             by_key[f"{prefix}:{d['id']}"] = d
     for res in results:
         d = by_key.get(res["partialFingerprints"]["rclverifyItem/v1"])
