@@ -1,0 +1,164 @@
+"""Advice a user can act on (issue 40): the right culprit and a repair that
+costs the user least, on small workspaces of ``tests/data/advice``.
+
+* a deadline chain over its budget is its own problem row naming its chain,
+  each hop's bound and the budget, with repairs that split the budget,
+  checked by Z3 deciding rule D3 again;
+* millimetres published where metres are assumed: the first repair fixes the
+  producer (a strengthening that would leave it unimplementable is said, not
+  offered), the consumer's assumption is widened last and only with the
+  evidence it invalidates named;
+* a coefficient (``1000 * in.r``, ``in.d / 10``) is never rewritten as a bound.
+"""
+from __future__ import annotations
+
+import json
+import shutil
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from rclverify.cli import main
+
+DATA = Path(__file__).parent / "data" / "advice"
+
+
+def _verify(tmp: Path, name: str, plan_extra: str = "") -> tuple[Path, dict[str, Any]]:
+    ws = tmp / name
+    shutil.copytree(DATA / name, ws)
+    if plan_extra:
+        plan = ws / "contracts" / "plan.yaml"
+        plan.write_text(plan.read_text(encoding="utf-8").replace("requirements: []\n", plan_extra), encoding="utf-8")
+    assert main(["verify", "-w", str(ws)]) == 0
+    return ws, json.loads((ws / "reports" / "assurance.json").read_text(encoding="utf-8"))
+
+
+def _diag(report: dict[str, Any], did: str) -> dict[str, Any]:
+    return next(d for d in report["diagnoses"] if d["id"] == did)
+
+
+@pytest.fixture(scope="module")
+def deadline(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, dict[str, Any]]:
+    return _verify(tmp_path_factory.mktemp("advice"), "deadline")
+
+
+def test_a_deadline_over_its_budget_is_its_own_row_naming_chain_hops_and_budget(deadline) -> None:
+    ws, report = deadline
+    d = _diag(report, "STOP.deadline")
+    assert (d["kind"], d["status"]) == ("deadline", "failed")
+    s = d["sentence"]
+    assert s.startswith("The end-to-end deadline of STOP (150 ms along Lidar -> Detector -> Planner, "
+                        "contracts/plan.yaml:9:15) is refuted")
+    for hop in ("Lidar guarantee 1 within 40 ms (contracts/chain.rcl:9:3)",
+                "Detector guarantee 1 within 60 ms (contracts/chain.rcl:16:3)",
+                "Planner guarantee 1 within 100 ms (contracts/chain.rcl:23:3)"):
+        assert hop in s
+    assert "sums to 200 ms, 50 ms over the budget" in s
+    # the requirement is not blamed on a bound of its cone (Lidar's 30 m): its formula is proved
+    assert not any(x["id"] == "STOP" for x in report["diagnoses"])
+    [row] = [g for g in report["problems"] if "STOP.deadline" in [m["id"] for m in g["members"]]]
+    assert row["key"] == ["deadline:STOP"] and row["status"] == "failed"
+    assert [m["id"] for m in row["members"]] == ["STOP.deadline", "STOP"]
+    assert [(c["what"], c["source"]) for c in row["culprits"]] == [
+        ("guarantee 1 of Lidar: within 40 ms", "contracts/chain.rcl:9:3"),
+        ("guarantee 1 of Detector: within 60 ms", "contracts/chain.rcl:16:3"),
+        ("guarantee 1 of Planner: within 100 ms", "contracts/chain.rcl:23:3")]
+    assert row["sentence"].startswith("The end-to-end deadline of STOP")
+    # no other row holds it
+    assert sum("STOP.deadline" in [m["id"] for m in g["members"]] for g in report["problems"]) == 1
+
+
+def test_the_deadlines_repairs_split_the_budget_and_z3_checked_them(deadline) -> None:
+    ws, report = deadline
+    reps = _diag(report, "STOP.deadline")["repairs"]
+    assert [r["kind"] for r in reps] == ["tighten-hop", "tighten-hop", "split-budget"]
+    # which hop must become how fast: the smallest relative cut first (Planner 100 -> 50 ms halves it)
+    assert reps[0]["summary"].startswith("Make Planner answer within 50 ms instead of 100 ms")
+    assert reps[0]["edit"]["deleted"] == "within 100 ms" and reps[0]["edit"]["inserted"] == "within 50 ms"
+    assert reps[1]["summary"].startswith("Make Detector answer within 10 ms instead of 60 ms")
+    assert "Lidar 40 ms -> 30 ms, Detector 60 ms -> 45 ms, Planner 100 ms -> 75 ms" in reps[2]["summary"]
+    for r in reps:
+        assert r["checks"] == [{"check": "STOP.deadline", "status": "proved (Z3: unsat: no run later than 150 ms)"}]
+        assert {"check": "STOP.deadline", "before": "refuted", "after": "proved"} in r["cost"]
+        assert r["proves"] == "the end-to-end deadline of STOP follows from the chain (rule D3)"
+        assert "must show it" in r["not_shown"]
+        # only time budgets are edited: never Lidar's 30 m range or any other bound
+        assert all(line.count("within") == 1 for line in r["diff"].splitlines() if line[:1] in "+-"
+                   and not line.startswith(("+++", "---")))
+    # the contract file is untouched
+    assert "within 100 ms" in (ws / "contracts" / "chain.rcl").read_text(encoding="utf-8")
+    # SARIF: the deadline's result carries the diagnosis and the repairs as fixes
+    sarif = json.loads((ws / "reports" / "assurance.sarif").read_text(encoding="utf-8"))
+    [res] = [x for x in sarif["runs"][0]["results"] if x["ruleId"] == "RCL-DEADLINE-REFUTED"]
+    assert res["properties"]["diagnosis"] == _diag(report, "STOP.deadline")["sentence"]
+    assert len(res["fixes"]) == 3
+
+
+@pytest.fixture(scope="module")
+def millimetres(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, dict[str, Any]]:
+    return _verify(tmp_path_factory.mktemp("advice"), "millimetres")
+
+
+def test_millimetres_against_metres_fixes_the_producer_first(millimetres) -> None:
+    ws, report = millimetres
+    d = _diag(report, "Controller.sc2")
+    reps = d["repairs"]
+    assert reps and reps[0]["kind"] != "weaken-consumer"
+    # the producer's coefficient rescaled as a unit conversion, never the consumer widened first
+    assert reps[0]["kind"] == "rescale-producer"
+    assert reps[0]["edit"]["deleted"] == "1000 * in.r" and reps[0]["edit"]["inserted"] == "in.r"
+    assert "a factor of 1000" in reps[0]["summary"] and "unit conversion, not a bound" in reps[0]["summary"]
+    assert {"check": "Ranger implementable",
+            "status": "yes: every input its assumption allows has an answer (Z3: proved)"} in reps[0]["checks"]
+    assert reps[0]["proves"] == "Controller.sc2 follows from the edited contracts"
+    assert "which unit is right" in reps[0]["not_shown"]
+    # adding `out.d <= 30` to Ranger discharges the side condition but leaves Ranger unimplementable: said, not offered
+    assert not any(r["kind"] == "strengthen-producer" for r in reps)
+    [why] = d["not_offered"]
+    assert why.startswith("Strengthening Ranger by `out.d <= 30` discharges Controller.sc2 but leaves Ranger "
+                          "unimplementable: for Ranger.in.r = ")
+
+
+def test_a_weakened_assumption_comes_last_naming_the_evidence_it_invalidates(millimetres) -> None:
+    ws, report = millimetres
+    reps = _diag(report, "Controller.sc2")["repairs"]
+    weak = [k for k, r in enumerate(reps) if r["kind"] == "weaken-consumer"]
+    assert weak == [len(reps) - 1]
+    w = reps[-1]
+    assert "`in.d <= 30` becomes `in.d <= 30000`" in w["summary"]
+    # the consumer's guarantee that reads the widened input, and its evidence established under the old assumption
+    assert "guarantee 1 `0 <= out.v and out.v <= in.d / 10` must then hold for the wider inputs" in w["summary"]
+    assert ("Controller.g1.hoare.controller.c1 (discharged), Controller.g1.hoare.controller.c2 (discharged) must be "
+            "established again") in w["summary"]
+    assert "Probably unsafe: the ranges differ by a factor of 1000" in w["summary"]
+
+
+COEFFICIENTS = """requirements:
+  - id: HALF
+    text: The controller commands at most a twentieth of the distance as speed.
+    formal: "Controller.out.v <= Controller.in.d / 20"
+  - id: MM
+    text: Ranger's output is at most half its input.
+    formal: "Ranger.out.d <= 0.5 * Ranger.in.r"
+"""
+
+
+def test_a_coefficient_is_never_rewritten_as_a_bound(tmp_path: Path) -> None:
+    """``in.d / 10`` -> ``in.d / 20`` and ``1000 * in.r`` -> ``0.5 * in.r`` would let Z3 prove the two
+    requirements, and say nothing an engineer can implement: no repair touches a coefficient."""
+    ws, report = _verify(tmp_path, "millimetres", COEFFICIENTS)
+    half, mm = _diag(report, "HALF"), _diag(report, "MM")
+    for d in (half, mm):
+        for r in d["repairs"]:
+            assert r["kind"] != "tighten-bound", r
+            assert r["edit"]["deleted"] not in ("10", "1000")
+            assert "becomes 0.5" not in r["summary"] and "1000 becomes" not in r["summary"]
+    # HALF: the controller's guarantee strengthened by the statement, which it can implement
+    [r] = half["repairs"]
+    assert r["kind"] == "strengthen-guarantee" and "`out.v <= in.d / 20`" in r["summary"]
+    assert {"check": "Controller implementable",
+            "status": "yes: every input its assumption allows has an answer (Z3: proved)"} in r["checks"]
+    # MM: Ranger strengthened by `out.d <= 0.5 * in.r` would answer only in.r = 0: no repair, no culprit
+    assert mm["repairs"] == [] and mm["culprits"] == []
+    assert "no single strengthening Z3 tried proves it" in mm["sentence"]
