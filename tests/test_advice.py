@@ -162,3 +162,48 @@ def test_a_coefficient_is_never_rewritten_as_a_bound(tmp_path: Path) -> None:
     # MM: Ranger strengthened by `out.d <= 0.5 * in.r` would answer only in.r = 0: no repair, no culprit
     assert mm["repairs"] == [] and mm["culprits"] == []
     assert "no single strengthening Z3 tried proves it" in mm["sentence"]
+
+
+BAD_PLAN = """name: deadline chain
+contracts:
+  - contracts/chain.rcl
+requirements:
+  - id: STOP
+    text: The planner orders the stop within 150 ms of a scan.
+    formal: "eventualy Planner.out.stop"
+    deadline: {path: [Lidar, Detektor, Planner], within: 150 ms}
+  - id: NEAR
+    text: The planner stops near an obstacle.
+    formal: "Planer.in.d <= 1 -> Planner.out.stop"
+  - id: SYNTAX
+    text: A statement with a missing operator.
+    formal: "Planner.in.d <= 1 Planner.out.stop"
+nodes: {}
+"""
+
+
+def test_check_reads_the_plans_statements_with_located_messages(tmp_path: Path, capsys: pytest.CaptureFixture[str],
+                                                               monkeypatch: pytest.MonkeyPatch) -> None:
+    """`rclverify check` reports what `doit verify` would stop on in the plan's statements: an unknown node
+    in `formal:` and in `deadline:`, a misspelled temporal operator, a syntax error, each located and in the
+    plan's own words (never the parser's internal placeholder names)."""
+    ws = tmp_path / "ws"
+    shutil.copytree(DATA / "deadline", ws)
+    (ws / "contracts" / "plan.yaml").write_text(BAD_PLAN, encoding="utf-8")
+    monkeypatch.chdir(ws)
+    assert main(["check", "contracts/chain.rcl"]) == 1
+    err = capsys.readouterr().err.splitlines()
+    assert ("contracts/plan.yaml:7:14: error: STOP formal: unknown temporal operator 'eventualy': did you mean "
+            "'eventually'? The operators are always, eventually, eventually[<= N], next, previous and until "
+            "(docs/requirements.md, Temporal requirements)") in err
+    assert ("contracts/plan.yaml:11:14: error: NEAR formal: no node named 'Planer' in the system; nodes are: "
+            "Lidar, Detector, Planner") in err
+    assert ("contracts/plan.yaml:8:15: error: no node named 'Detektor' in the contracts; nodes are: "
+            "Lidar, Detector, Planner") in err
+    syntax = [x for x in err if x.startswith("contracts/plan.yaml:14:")]
+    assert syntax and "unexpected 'Planner.out.stop'" in syntax[0], err
+    assert not any("__q" in x for x in err)
+    # the same plan without its mistakes checks clean
+    (ws / "contracts" / "plan.yaml").write_text((DATA / "deadline" / "contracts" / "plan.yaml").read_text(), encoding="utf-8")
+    assert main(["check", "contracts/chain.rcl"]) == 0
+    assert "0 errors" in capsys.readouterr().out

@@ -59,7 +59,7 @@ def cmd_check(args: argparse.Namespace) -> int:
     :func:`rclverify.plan.scopes.group_files` (the plan's system together,
     a replacement contract in its own scope; docs/rcl-language.md).  Every
     scope is checked; exit 1 when one has an error."""
-    from .plan.scopes import group_files
+    from .plan.scopes import group_files, plan_diagnostics
     from .rcl.filewarn import file_warnings
     from .rcl.lint import lint
     from .rcl.parser import parse_files
@@ -75,11 +75,17 @@ def cmd_check(args: argparse.Namespace) -> int:
             print(f"{', '.join(scope.files)}: {scope.why}")
         try:
             specs = parse_files(scope.files)
-            check(specs)
+            checked = check(specs)
         except RclError as exc:
             errors += exc.diagnostics
             continue
         warnings += [d for s in specs for d in file_warnings(s)] + [d for s in specs for d in lint(s)]
+        if scope.why == "the plan's system" or (grouped.plan and len(grouped.scopes) == 1):
+            # the plan's statements (formal:, deadline:, ...) against the system they name (docs/requirements.md)
+            found, note = plan_diagnostics(scope.files, checked, args.workspace, args.plan)
+            errors += [d for d in found if getattr(d, "severity", "error") == "error"]
+            if note:
+                print(note, file=sys.stderr)
     if errors:  # the located errors only, as for one scope
         for d in errors:
             print(d, file=sys.stderr)
