@@ -207,3 +207,119 @@ def test_check_reads_the_plans_statements_with_located_messages(tmp_path: Path, 
     (ws / "contracts" / "plan.yaml").write_text((DATA / "deadline" / "contracts" / "plan.yaml").read_text(), encoding="utf-8")
     assert main(["check", "contracts/chain.rcl"]) == 0
     assert "0 errors" in capsys.readouterr().out
+
+
+# -- one severity per finding ---------------------------------------------------------------------------------
+
+#: What the terminal prints for a gating item of each kind, in `verify --strict`'s last sentence.
+STRICT_CLAUSE = {"obligation": "not discharged", "guarantee": "unverified (no obligation covers",
+                 "side-condition": "side condition", "health:error": "found a problem or could not decide",
+                 "health:warning": "contract health warning", "requirement": "formal requirement",
+                 "deadline": "end-to-end deadline", "lint": "lint diagnostic"}
+#: JUnit outcomes an item of each severity may have (report/severity.py).
+JUNIT = {"error": {"failure", "error"}, "warning": {"failure", "skipped"}, "note": {"skipped"}}
+
+
+def _junit_cases(xml: str) -> dict[tuple[str, str], str]:
+    import xml.etree.ElementTree as ET
+    out = {}
+    for case in ET.fromstring(xml).iter("testcase"):
+        child = next(iter(case), None)
+        out[(case.get("classname", ""), case.get("name", ""))] = child.tag if child is not None else "pass"
+    return out
+
+
+def test_every_finding_kind_has_one_severity_in_all_five_outputs(tmp_path: Path,
+                                                                 capsys: pytest.CaptureFixture[str]) -> None:
+    """Issue 40: a redundant conjunct was `warning` on the terminal and in HTML, SARIF `error`, JUnit failures,
+    and `--strict` ignored it.  Every finding kind of a small workspace (obligations failed and pending, a
+    guarantee no obligation covers, a refuted side condition, health problems and warnings, requirements
+    refuted and informal, a refuted deadline, a lint warning) has the one severity of report/severity.py in the
+    terminal, the HTML report, SARIF, JUnit and --strict."""
+    from rclverify.report.render import anchor
+    from rclverify.report.severity import items
+    ws = tmp_path / "severity"
+    shutil.copytree(DATA / "severity", ws)
+    from rclverify.report.summary import read_summary, strict_sentence
+    assert main(["verify", "-w", str(ws), "--strict"]) == 1
+    capsys.readouterr()
+    # the terminal: what `verify` ends with (`status` prints the same), the lint of `check`, --strict's sentence
+    assert main(["status", "-w", str(ws)]) == 0
+    assert main(["check", "--plan", "contracts/plan.yaml", "-w", str(ws), str(ws / "contracts" / "plant.rcl")]) == 0
+    got = capsys.readouterr()
+    terminal = got.out + got.err + strict_sentence(read_summary(ws)) + "\n"
+    rep = ws / "reports"
+    report = json.loads((rep / "assurance.json").read_text(encoding="utf-8"))
+    sarif = json.loads((rep / "assurance.sarif").read_text(encoding="utf-8"))["runs"][0]["results"]
+    junit = _junit_cases((rep / "assurance.junit.xml").read_text(encoding="utf-8"))
+    html = (rep / "assurance.html").read_text(encoding="utf-8")
+    found = items(report)
+    assert {(k, sev) for k, _, _, sev in found} >= {
+        ("obligation", "error"), ("obligation", "warning"), ("guarantee", "warning"), ("side-condition", "error"),
+        ("health", "error"), ("health", "warning"), ("requirement", "error"), ("requirement", "note"),
+        ("deadline", "error"), ("lint", "warning")}
+    [strict_line] = [x for x in terminal.splitlines() if x.startswith("--strict failed: ")]
+    assert report["meta"]["strict_ok"] is False
+    for kind, ident, status, sev in found:
+        where = f"{kind} {ident} ({status}, {sev})"
+        # SARIF: the level is the severity
+        key = {"guarantee": f"guarantee:{ident}", "deadline": f"deadline:{ident.rsplit('.', 1)[0]}",
+               "lint": f"lint:{ident}:"}.get(kind, f"{kind}:{ident}")
+        res = [r for r in sarif if r["partialFingerprints"]["rclverifyItem/v1"].startswith(key)
+               and (kind == "lint" or r["partialFingerprints"]["rclverifyItem/v1"] == key)]
+        assert [r["level"] for r in res] == [sev], where
+        # JUnit: a failure or error for an error, a failure or a skip for a warning, a skip for a note
+        loc, _, code = ident.rpartition(":")
+        name = {"deadline": ("deadline", ident.rsplit(".", 1)[0]), "requirement": ("requirement", ident),
+                "lint": ("lint", f"{code} {loc}")}.get(kind)
+        outcome = junit[name] if name else next(v for (c, n), v in junit.items() if n == ident)
+        assert outcome in JUNIT[sev], where
+        # --strict: an error or a warning fails it and is named in its last sentence; a note does not
+        clause = STRICT_CLAUSE.get(f"{kind}:{sev}", STRICT_CLAUSE.get(kind, ""))
+        if sev in ("error", "warning"):
+            assert clause in strict_line, where
+        else:
+            assert ident not in strict_line, where
+        # HTML: the item's row shows its status word (the badge's word and colour follow it)
+        node = ident.split(".", 1)[0]
+        a = {"obligation": anchor("ob", ident), "guarantee": anchor("g", node, ident.rsplit(".g", 1)[-1]),
+             "side-condition": anchor("sc", ident), "health": anchor("finding", ident),
+             "requirement": anchor("req", ident), "deadline": anchor("deadline", ident.rsplit(".", 1)[0]),
+             "lint": anchor("lint", 1)}[kind]
+        i = html.index(f'id="{a}"')
+        row = html[i:html.index("</tr>", i)]
+        assert f">{status}<" in row, where
+        # the terminal: the same word where the item is counted or named
+        term = {"obligation": f"{status}", "guarantee": ident.rpartition(".")[2], "side-condition": "0/1 proved",
+                "health": status,
+                "requirement": f"{status} (" if sev != "note" else f"1 {status}",
+                "deadline": f"{ident.rsplit('.', 1)[0]} {status}", "lint": f"{loc}: {sev}:"}[kind]
+        assert term in terminal, where
+    # the redundant conjunct of the issue: one word, warning, everywhere
+    red = "Sense.g1.c3.redundant"
+    assert [r["level"] for r in sarif if r["partialFingerprints"]["rclverifyItem/v1"] == f"health:{red}"] == ["warning"]
+    assert "2 contract health warnings (Sense.g1.c3.redundant, Act.g2.c1.redundant)" in strict_line
+    assert "| 1 problem, 1 warning " in terminal
+
+
+def test_the_severity_table() -> None:
+    """The one table every output reads (report/severity.py), for the statuses a small workspace does not
+    show: stale, inconclusive and error records, evidence outstanding, a grounding warning."""
+    from rclverify.report.severity import blocking, junit_outcome, of
+    assert [of("obligation", s) for s in ("discharged", "failed", "error", "stale", "inconclusive", "pending")] == [
+        None, "error", "error", "warning", "warning", "warning"]
+    assert [of("health", s) for s in ("ok", "problem", "warning", "inconclusive", "stale", "error")] == [
+        None, "error", "warning", "warning", "warning", "error"]
+    assert [of("requirement", v) for v in ("met", "refuted", "proved vacuously", "proved, evidence outstanding",
+                                           "inconclusive", "stale", "error", "informal")] == [
+        None, "error", "error", "warning", "warning", "warning", "error", "note"]
+    assert [of("deadline", v) for v in ("proved", "refuted", "inconclusive", "pending", "stale", "error")] == [
+        None, "error", "warning", "warning", "warning", "error"]
+    assert of("lint", "warning") == "warning" and of("lint", "error") == "error" and of("obligation", "??") == "error"
+    assert [junit_outcome("obligation", s) for s in ("discharged", "failed", "error", "stale", "pending")] == [
+        "pass", "failure", "error", "failure", "skipped"]
+    assert junit_outcome("health", "warning") == "failure" and junit_outcome("requirement", "informal") == "skipped"
+    # a ROS grounding warning names software the contracts need not describe: it does not fail --strict
+    report = {"grounding": {"findings": [{"severity": "warning", "code": "ROS-NODE-NO-CONTRACT"},
+                                         {"severity": "error", "code": "ROS-NODE-NOT-IN-GRAPH"}]}}
+    assert blocking(report) == [("grounding", "ROS-NODE-NOT-IN-GRAPH", "error", "error")]

@@ -31,7 +31,9 @@ import z3
 from ..calculus.compose import free_io
 from ..logic import world
 from ..logic.encode import Encoder, EncodingError
+from ..rcl import ast
 from ..rcl.types import Checked, FuncT
+from ..rcl.walk import subexpressions
 
 #: Budget of each query (milliseconds).
 TIMEOUT_MS = 3000
@@ -77,10 +79,14 @@ def implementable(ws: Any, checked: Checked, node: str) -> tuple[str, dict[str, 
 def extreme(ws: Any, checked: Checked, node: str, output: str, largest: bool) -> Fraction | None:
     """The largest (``largest``) or smallest value of ``node``'s numeric
     output ``output`` that its assumption, guarantees and environment facts
-    allow, exact; ``None`` when it is unbounded, not numeric, or Z3 cannot
-    say in its budget."""
+    allow, exact; ``None`` when it is unbounded, not numeric, the contract
+    has a quantifier (Z3's ``Optimize`` takes none), or Z3 cannot say in its
+    budget."""
     world.fresh()
     cn = checked.nodes[node]
+    exprs = [a.formula for a in cn.node.assumes] + [g.formula for g in cn.node.guarantees] + _facts(ws, node)
+    if any(isinstance(x, ast.Quant) for e in exprs for x in subexpressions(e)):
+        return None  # Z3's Optimize does not take quantifiers (it would print a warning and answer nothing)
     enc = Encoder(checked.env)
     try:
         parts = [enc.formula(a.formula, cn) for a in cn.node.assumes]
