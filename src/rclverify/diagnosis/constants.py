@@ -3,17 +3,42 @@ the guarantee's (docs/diagnosis.md, "Refuted Hoare triple: the constant
 change").  Numeric literals of the program that the guarantee does not use
 are replaced by literals of the guarantee, fewest replacements first and
 keeping their order (a larger threshold stays larger), until Z3 discharges
-every triple of the program's plan entry.  The edited program is written to
-a temporary directory (:func:`rclverify.diagnosis.recheck.hoare_statuses`),
-never over the workspace's."""
+every triple of the program's plan entry.  Only thresholds are exchanged: a
+program literal compared with something (``IF (input < 10)``) for a bound
+of the guarantee (:func:`.bounds.bound_literals`), never a coefficient or
+a scale factor of either.  The edited program is written to a temporary
+directory (:func:`rclverify.diagnosis.recheck.hoare_statuses`), never over
+the workspace's."""
 from __future__ import annotations
 
 import itertools
 from typing import Any, Mapping, Sequence
 
 from . import recheck
+from .bounds import bound_literals
 from .edits import Edit
-from .repairs import MAX_CANDIDATES, _numbers, _record
+from .repairs import MAX_CANDIDATES, _record
+
+_ORDERING = ("<", "<=", ">", ">=")
+
+
+def _thresholds(e: Any) -> list[Any]:
+    """The numeric literals of a Hoare program (any node of
+    :mod:`rclverify.backends.hoare.lang`) that are a direct operand of an
+    ordering comparison, in source order."""
+    out: list[Any] = []
+    todo = [e]
+    while todo:
+        x = todo.pop()
+        if isinstance(x, (tuple, list)):
+            todo.extend(x)
+            continue
+        if not hasattr(x, "__dataclass_fields__"):
+            continue
+        if type(x).__name__ == "Binary" and getattr(x, "op", None) in _ORDERING:
+            out += [o for o in (x.left, x.right) if type(o).__name__ == "Num" and getattr(o, "loc", None) is not None]
+        todo.extend(getattr(x, f) for f in x.__dataclass_fields__ if f != "loc")
+    return sorted(out, key=lambda n: (n.loc.line, n.loc.col))
 
 
 def _num_value(text: str) -> float:
@@ -36,10 +61,10 @@ def hoare_repair(ws: Any, node: str, guarantee: int, program: str,
         return None
     source = recheck.source_text(ws, program)
     prog = lang.parse_program(source, program)
-    prog_nums = [n for n in _numbers(prog.body) if n.loc.end_line]
+    prog_nums = [n for n in _thresholds(prog.body) if n.loc.end_line]
     g = ws.checked.nodes[node].node.guarantees[guarantee - 1]
     contract = []
-    for n in _numbers(g.formula):
+    for n in bound_literals(g.formula):
         if n.text not in contract:
             contract.append(n.text)
     distinct = sorted({n.text for n in prog_nums if n.text not in contract}, key=_num_value)

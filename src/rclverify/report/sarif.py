@@ -343,7 +343,10 @@ def _attach_diagnoses(report: Mapping[str, Any], results: Sequence[dict[str, Any
         if d is None:
             continue
         res["properties"]["diagnosis"] = d["sentence"]
-        fixes = [sarif_fix(r["summary"], r["edit"]) for r in d.get("repairs", []) if r.get("edit")]
+        # what Z3 showed and what it did not, with each fix: "checked by Z3" is no safety claim (docs/diagnosis.md)
+        fixes = [sarif_fix(f"{r['summary']} Z3 shows: {r.get('proves') or 'the problem no longer follows'}; not shown: "
+                           f"{r.get('not_shown') or 'that the change is safe'}.", r["edit"])
+                 for r in d.get("repairs", []) if r.get("edit")]
         if fixes:
             res["fixes"] = fixes
 
