@@ -29,6 +29,7 @@ import json
 import os
 import re
 from contextlib import contextmanager
+from functools import partial
 from typing import Any, Callable, Iterator, Mapping
 
 import z3
@@ -175,7 +176,8 @@ def _diagnose(ws: Any, report: Mapping[str, Any]) -> list[dict[str, Any]]:
         if row.get("verdict") in ("refuted", "inconclusive"):
             key = ["deadline", row["requirement"], row.get("path"), row.get("within"), row.get("chain") and
                    [[h["node"], h["guarantee"], h["within_s"]] for h in row["chain"]]]
-            reps = (cache.get(key, lambda row=row: budget_repairs(ws, row)) or []) if row["verdict"] == "refuted" else []
+            reps: list[dict[str, Any]] = ((cache.get(key, partial(budget_repairs, ws, row)) or [])
+                                          if row["verdict"] == "refuted" else [])
             out.append(deadline_record(ws, report, row, reps))
     obligations = {o["id"]: o for o in report["obligations"]}
     for e in report["evidence"]:

@@ -51,7 +51,7 @@ def _bound_shape(target: ast.Expr, inputs: set[str]) -> tuple[str, bool, ast.Num
     if not (isinstance(target, ast.Compare) and len(target.ops) == 1 and target.ops[0] in _UPPER):
         return None
     a, b = target.operands
-    op = target.ops[0]
+    op: str = target.ops[0]
     if isinstance(b, ast.Var) and isinstance(a, ast.NumLit):
         a, b, op = b, a, _MIRROR[op]
     if isinstance(a, ast.Var) and a.prefix in ("in", None) and a.name in inputs and isinstance(b, ast.NumLit):
