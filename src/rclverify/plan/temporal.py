@@ -142,11 +142,15 @@ def _misspelled(src: Source, start: int, end: int, checked: Checked, what: str) 
     operator (``eventualy``: did you mean ``eventually``?), or ``None``."""
     import difflib
     known = set(checked.env.constants) | set(checked.env.enum_values) | set(checked.env.ctors) | _RCL_WORDS
+    segment = src.text[start:end]
+    first = start + len(segment) - len(segment.lstrip())
     for m in _WORD.finditer(src.text, start, end):
         word = m.group(1)
         if word in known or word in OPERATORS:
             continue
-        close = difflib.get_close_matches(word.lower(), OPERATORS, n=1, cutoff=0.75)
+        # a prefix operator is the operand's first word; `until` stands between two operands
+        close = difflib.get_close_matches(word.lower(), OPERATORS if m.start(1) == first else ("until",), n=1,
+                                          cutoff=0.75)
         if close:
             return error(_loc_at(src, m.start(1)), f"{what}: unknown temporal operator {word!r}: did you mean "
                                                     f"{close[0]!r}? The operators are always, eventually, "
