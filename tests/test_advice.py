@@ -323,3 +323,21 @@ def test_the_severity_table() -> None:
     report = {"grounding": {"findings": [{"severity": "warning", "code": "ROS-NODE-NO-CONTRACT"},
                                          {"severity": "error", "code": "ROS-NODE-NOT-IN-GRAPH"}]}}
     assert blocking(report) == [("grounding", "ROS-NODE-NOT-IN-GRAPH", "error", "error")]
+
+
+def test_an_undecided_deadline_is_its_own_row_naming_where_the_chain_breaks(tmp_path: Path) -> None:
+    ws = tmp_path / "deadline"
+    shutil.copytree(DATA / "deadline", ws)
+    rcl = ws / "contracts" / "chain.rcl"
+    rcl.write_text(rcl.read_text().replace("guarantee( out.d == in.r ) triggered by in.r within 60 ms",
+                                           "guarantee( out.d == in.r )"))
+    assert main(["verify", "-w", str(ws)]) == 0
+    report = json.loads((ws / "reports" / "assurance.json").read_text(encoding="utf-8"))
+    d = _diag(report, "STOP.deadline")
+    assert (d["kind"], d["status"], d["repairs"]) == ("deadline", "inconclusive", [])
+    assert d["sentence"] == ("The end-to-end deadline of STOP (150 ms along Lidar -> Detector -> Planner, "
+                             "contracts/plan.yaml:9:15) is not decided: no timed guarantee of Detector is triggered "
+                             "by an output of Lidar's timed guarantees (out.r).")
+    assert [c["what"] for c in d["culprits"]] == ["the contract of Detector"]
+    [row] = [g for g in report["problems"] if g["key"] == ["deadline:STOP"]]
+    assert row["status"] == "inconclusive" and [c["what"] for c in row["culprits"]] == ["the contract of Detector"]
