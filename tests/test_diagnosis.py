@@ -308,7 +308,7 @@ def test_explain_and_status_read_the_last_run(newcomer: Path, capsys: pytest.Cap
     assert "findings: Controller.sc2, Controller.derived, Motor.derived" in out
     assert sum(1 for line in out.splitlines() if line.startswith("  ") and "[unverified]" in line) == 3
     (entry,) = [line for line in out.splitlines() if line.startswith("  1. [failed]")]
-    assert "checked repair" in entry and "findings" in entry
+    assert "2 repairs (Z3 shows the problem gone, not that the change is safe)" in entry and "findings" in entry
     assert "findings: Controller.sc2" in out
     assert main(["explain", "-w", str(newcomer), "Controller.sc2"]) == 0
     out = capsys.readouterr().out

@@ -72,7 +72,7 @@ def test_sarif_validates_and_maps_each_kind_to_its_rule_and_level() -> None:
             or "lint", r["ruleId"], r["level"]) for r in run["results"]}
     assert got == {("N.bad", "RCL-OBL-FAILED", "error"), ("N.err", "RCL-OBL-ERROR", "error"),
                    ("N.old", "RCL-OBL-STALE", "warning"), ("N.maybe", "RCL-OBL-INCONCLUSIVE", "warning"),
-                   ("N.open", "RCL-OBL-PENDING", "note"), ("N.sc1", "RCL-SC-REFUTED", "error"),
+                   ("N.open", "RCL-OBL-PENDING", "warning"), ("N.sc1", "RCL-SC-REFUTED", "error"),
                    ("N.sc2", "RCL-SC-INCONCLUSIVE", "warning"), ("N.g1.non-vacuous", "RCL-HEALTH-VACUOUS", "error"),
                    ("lint", "RCL-LINT-UNUSED-BOUND", "warning")}
     rules = run["tool"]["driver"]["rules"]
@@ -91,7 +91,10 @@ def test_junit_outcomes_follow_the_statuses(tmp_path: Path) -> None:
     paths = write_ci_reports(_report(), tmp_path)
     assert [p.name for p in paths] == ["assurance.sarif", "assurance.junit.xml"]
     xml = junitparser.JUnitXml.fromfile(str(paths[1]))
-    [suite] = list(xml)
+    [suite, lint] = list(xml)
+    # the lint warning fails --strict, so it is a failing test case too (report/severity.py)
+    assert lint.name == "lint" and [(c.name, type(c.result[0]).__name__, c.result[0].type) for c in lint] == [
+        ("W-unused-bound contracts/n.rcl:4:21", "Failure", "warning")]
     assert suite.name == "N" and suite.tests == 10
     cases = {c.name: c for c in suite}
     kinds = {name: type(c.result[0]).__name__ if c.result else "pass" for name, c in cases.items()}

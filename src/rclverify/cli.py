@@ -59,7 +59,7 @@ def cmd_check(args: argparse.Namespace) -> int:
     :func:`rclverify.plan.scopes.group_files` (the plan's system together,
     a replacement contract in its own scope; docs/rcl-language.md).  Every
     scope is checked; exit 1 when one has an error."""
-    from .plan.scopes import group_files
+    from .plan.scopes import group_files, plan_diagnostics
     from .rcl.filewarn import file_warnings
     from .rcl.lint import lint
     from .rcl.parser import parse_files
@@ -83,6 +83,12 @@ def cmd_check(args: argparse.Namespace) -> int:
         from .system.model import unit_diagnostics  # units at both ends of each connection (docs/rcl-language.md)
         for d in unit_diagnostics(checked):
             (errors if d.severity == "error" else warnings).append(d)
+        if scope.why == "the plan's system" or (grouped.plan and len(grouped.scopes) == 1):
+            # the plan's statements (formal:, deadline:, ...) against the system they name (docs/requirements.md)
+            found, note = plan_diagnostics(scope.files, checked, args.workspace, args.plan)
+            errors += [d for d in found if getattr(d, "severity", "error") == "error"]
+            if note:
+                print(note, file=sys.stderr)
     if errors:  # the located errors only, as for one scope
         for d in errors:
             print(d, file=sys.stderr)

@@ -15,12 +15,16 @@ named"):
   (in the producer's output names): ``P -> Q`` becomes ``P -> (Q) and (c)``,
   an unconditional ``Q`` becomes ``(Q) and (c)``; a culprit when Z3 then
   discharges the side condition (:func:`side_condition_culprits`);
-* refuted requirement: a numeric bound of a guarantee of the cone is
-  replaced by a constant of the requirement's statement (the bound that
-  lets the counterexample through); a culprit when Z3 then proves the
-  requirement from consistent premises, non-vacuously.  When no bound does
-  it, a guarantee of a node the statement mentions gets the statement (in
-  that node's names) added to its conclusion, as above
+* refuted requirement: a numeric bound of a guarantee of the cone (a
+  literal compared with something, :func:`.bounds.bound_literals`: never a
+  coefficient, a scale factor or a unit, such as ``1000`` in ``out.d ==
+  1000 * in.r``) is replaced by a constant of the requirement's statement
+  (the bound that lets the counterexample through); a culprit when Z3 then
+  proves the requirement from consistent premises, non-vacuously, and the
+  edited node stays implementable (:func:`.realize.implementable`: not
+  refuted).  When no bound does it, a guarantee of a node the statement
+  mentions gets the statement (in that node's names) added to its
+  conclusion, as above, with the same checks
   (:func:`requirement_culprits`).
 
 Every check is made on an edited copy of the contract text
@@ -35,7 +39,8 @@ from typing import Any
 from ..logic import world
 from ..rcl import ast
 from ..rcl.printer import expr_to_rcl
-from . import recheck
+from . import realize, recheck
+from .bounds import bound_literals
 from .edits import Edit
 from .repairs import _link_pairs, _numbers, _peel, _rename
 
@@ -112,11 +117,20 @@ def _proved(req: Any, system: Any, plan: Any) -> bool:
         and rec.get("vacuity") != "vacuous"
 
 
+def _implementable(ws: Any, system: Any, node: str) -> str:
+    """``proved`` / ``inconclusive`` when the edited ``node`` is not shown
+    unimplementable, ``""`` when it is (a strengthening that answers only
+    some of the inputs its assumption allows is no repair)."""
+    status = realize.implementable(ws, system[0], node)[0]
+    return "" if status == "refuted" else status
+
+
 def requirement_culprits(ws: Any, req_id: str, cone: Sequence[str]) -> list[dict[str, Any]]:
     """The guarantees of ``cone`` (node names) to blame for the refuted
     requirement ``req_id`` (module docstring), each ``{"node", "guarantee",
     "edit": Edit, "how": "bound" | "conclusion", "old", "new"}`` with the
-    strengthening Z3 checked.  ``[]`` when no single strengthening proves it."""
+    strengthening Z3 checked and ``"implementable"`` (``proved`` or
+    ``inconclusive``).  ``[]`` when no single strengthening proves it."""
     from ..plan.load import all_requirements
     from ..requirements.check import formals_of
     req = next((r for r in all_requirements(ws.plan) if r.id == req_id), None)
@@ -130,7 +144,7 @@ def requirement_culprits(ws: Any, req_id: str, cone: Sequence[str]) -> list[dict
     trials = 0
     for n in cone:
         for k, g in enumerate(ws.checked.nodes[n].node.guarantees, 1):
-            for lit in _numbers(g.formula):
+            for lit in bound_literals(g.formula):  # bounds only: a coefficient is no bound to tighten
                 span = _span(lit)
                 for c in consts:
                     if span is None or c == lit.text or trials >= MAX_TRIALS:
@@ -138,9 +152,10 @@ def requirement_culprits(ws: Any, req_id: str, cone: Sequence[str]) -> list[dict
                     trials += 1
                     edit = Edit(g.loc.file, *span, c)
                     system = recheck.edited_system(ws, edit)
-                    if system is not None and _proved(req, system, ws.plan):
+                    impl = _implementable(ws, system, n) if system is not None and _proved(req, system, ws.plan) else ""
+                    if impl:
                         found.append({"node": n, "guarantee": k, "edit": edit, "how": "bound",
-                                      "old": lit.text, "new": c})
+                                      "old": lit.text, "new": c, "implementable": impl})
                         break
     if found:
         return found
@@ -156,8 +171,10 @@ def requirement_culprits(ws: Any, req_id: str, cone: Sequence[str]) -> list[dict
         trials += 1
         edit = conclusion_edit(ws, n, k, extra)
         system = recheck.edited_system(ws, edit) if edit is not None else None
-        if system is not None and _proved(req, system, ws.plan):
-            found.append({"node": n, "guarantee": k, "edit": edit, "how": "conclusion", "old": "", "new": extra})
+        impl = _implementable(ws, system, n) if system is not None and _proved(req, system, ws.plan) else ""
+        if impl:
+            found.append({"node": n, "guarantee": k, "edit": edit, "how": "conclusion", "old": "", "new": extra,
+                          "implementable": impl})
     return found
 
 

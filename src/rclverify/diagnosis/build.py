@@ -6,12 +6,15 @@ and the workspace and returns ``[record, ...]``, each::
     {"id": problem id (finding, side condition or obligation id),
      "kind": "vacuity" | "inconsistency" | "unsatisfiable-assumption" | "refinement"
              | "side-condition" | "hoare" | "monitor" | "property-test" | "evidence"
-             | "requirement" (a refuted one: diagnosis/requirement.py),
+             | "requirement" (a refuted one: diagnosis/requirement.py)
+             | "deadline" (a refuted or undecided end-to-end deadline: diagnosis/deadline.py),
      "node": str, "status": str,
      "sentence": one sentence naming the culprit by source location,
      "culprits": [{"what": str, "source": "file:line:col", "text": str}],
      "counterexample": [{"node", "variable", "value", "table"}]  (diagnosis.table),
-     "repairs": [repair, ...]  (diagnosis.repairs; each checked by Z3),
+     "repairs": [repair, ...]  (diagnosis.repairs; each checked by Z3, cheapest for the user first),
+     "not_offered": [sentences]  (repairs Z3 showed do not work, e.g. a strengthening that
+                                  leaves the node unimplementable; side conditions only),
      "related": [ids of other problems of the same node and guarantee]}
 
 Repairs cost Z3 queries (a minute for the case study's Agent), so each
@@ -26,6 +29,7 @@ import json
 import os
 import re
 from contextlib import contextmanager
+from functools import partial
 from typing import Any, Callable, Iterator, Mapping
 
 import z3
@@ -33,7 +37,10 @@ import z3
 from ..cache import Shelf, file_digest
 from ..rcl.errors import RclError
 from . import blame, repairs as rep
+from .constants import hoare_repair
+from .deadline import budget_repairs, deadline_record
 from .requirement import requirement_record
+from .sidecond import side_condition_repairs
 from .culprits import culprits, parse_core, plan_facts
 from .table import counterexample_table
 
@@ -161,8 +168,17 @@ def _diagnose(ws: Any, report: Mapping[str, Any]) -> list[dict[str, Any]]:
         if sc["status"] in ("failed", "inconclusive"):
             out.append(_side_condition(ws, report, sc, cache, sc_before))
     for q in report.get("requirements", []):
-        if q.get("verdict") == "refuted":
+        # a requirement refuted only by its end-to-end deadline is the deadline's problem (below), not its formula's
+        own = (q.get("without_deadline") or {}).get("verdict", q.get("verdict")) if q.get("deadline") else q.get("verdict")
+        if q.get("verdict") == "refuted" and own == "refuted":
             out.append(requirement_record(ws, report, q, cache, _guarantee_source))
+    for row in report.get("deadlines") or ():
+        if row.get("verdict") in ("refuted", "inconclusive"):
+            key = ["deadline", row["requirement"], row.get("path"), row.get("within"), row.get("chain") and
+                   [[h["node"], h["guarantee"], h["within_s"]] for h in row["chain"]]]
+            reps: list[dict[str, Any]] = ((cache.get(key, partial(budget_repairs, ws, row)) or [])
+                                          if row["verdict"] == "refuted" else [])
+            out.append(deadline_record(ws, report, row, reps))
     obligations = {o["id"]: o for o in report["obligations"]}
     for e in report["evidence"]:
         if e["status"] in ("failed", "error"):
@@ -260,10 +276,14 @@ def _side_condition(ws: Any, report: Mapping[str, Any], sc: Mapping[str, Any], c
     if sc["status"] == "inconclusive":
         sentence = f"Z3 could not decide whether {sc['node']}'s assumption `{sc['conjunct']}` ({sc['source']}) follows from " \
                    + (_and(said) if said else "its producers' guarantees") + "."
-    reps = (cache.get(["side-condition", sc["id"], sc["conjunct"], dict(sc_before)],
-                      lambda: rep.side_condition_repairs(ws, sc, sc_before)) or []) if sc["status"] == "failed" else []
-    return _record(sc["id"], "side-condition", sc["node"], sc["status"], sentence, culprits=cul,
-                   counterexample=table, repairs=reps)
+    # what a weakened assumption of the consumer invalidates: its evidence, established under the old one
+    evidence = [f"{o['id']} ({o['status']})" for o in report["obligations"] if o["node"] == sc["node"]]
+    found = (cache.get(["side-condition", sc["id"], sc["conjunct"], dict(sc_before), evidence],
+                       lambda: side_condition_repairs(ws, sc, sc_before, evidence)) or {}) if sc["status"] == "failed" else {}
+    rec = _record(sc["id"], "side-condition", sc["node"], sc["status"], sentence, culprits=cul,
+                  counterexample=table, repairs=list(found.get("repairs") or []))
+    rec["not_offered"] = list(found.get("not_offered") or [])
+    return rec
 
 
 def _obligation_record(ws: Any, node: str, oid: str) -> Mapping[str, Any]:
@@ -341,7 +361,7 @@ def _hoare(ws: Any, report: Mapping[str, Any], e: Mapping[str, Any], o: Mapping[
     before = {ob["id"]: ob["status"] for ob in report["obligations"]
               if ob["node"] == node and ob["backend"] == "hoare" and ob["instance"].split(".c")[0] == e["obligation"].split(".hoare.", 1)[-1].split(".c")[0]}
     reps = cache.get(["hoare", e["obligation"], program, before],
-                     lambda: rep.hoare_repair(ws, node, k, program, before), extra_file=program)
+                     lambda: hoare_repair(ws, node, k, program, before), extra_file=program)
     return _record(e["obligation"], "hoare", node, e["status"], sentence,
                    culprits=[{"what": f"{program} line {c.split(':')[1]}", "source": c.rsplit(':', 1)[0], "text": c.rsplit(': ', 1)[1]}
                              for c in prog_consts] + [{"what": f"conjunct of guarantee {k} of {node}", "source": conj_src, "text": conj}],

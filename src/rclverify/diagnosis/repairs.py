@@ -1,38 +1,32 @@
-"""Repair suggestions, each checked by Z3 before it is returned.
+"""Repair suggestions, each checked by Z3 before it is returned: the record
+every repair is (:func:`_record`), the guard of a vacuous or inconsistent
+guarantee, and the helpers the other kinds share.
 
-Three kinds (docs/diagnosis.md):
+The kinds (docs/diagnosis.md), each in its module:
 
-``guard``
+``guard`` (here)
     a vacuous or inconsistent guarantee ``forall v | P -> Q`` whose
     unsat core names another guarantee ``G_c = forall w | P_c -> Q_c`` of
-    the same node: ``P_c`` gets a guard ``g and (P_c)``.  Candidates are
-    the conjunctions of the atoms of the node's other premises that speak
-    of ``G_c``'s bound variables (atoms on variables ``G_c`` binds and never
-    uses first), fewest atoms first: the first that Z3 accepts is the
-    weakest guard among the candidates.
-``strengthen-producer`` / ``weaken-consumer``
-    a failed side condition ``G_p => c``: the producer's guarantees get
-    ``c`` (in the producer's output names) as a new guarantee -- the weakest
-    strengthening of ``G_p`` that entails ``c`` --; or the consumer's
-    conjunct ``c`` is replaced by the strongest of the producer's own
-    conjuncts on the linked variables (in the consumer's input names) that
-    Z3 proves entailed.
-``constant``
-    a refuted Hoare triple: numeric literals of the program are replaced by
-    numeric literals of the guarantee's conjunct, fewest replacements first,
-    until every triple of the program's plan entry is discharged.
+    the same node: ``P_c`` gets a guard ``g and (P_c)``: range restrictions
+    of its bound variables first, weakest first, then conjunctions of the
+    atoms of the node's other premises, fewest atoms first.
+``strengthen-producer`` / ``rescale-producer`` / ``weaken-consumer`` (:mod:`.sidecond`)
+    a failed side condition, ranked by what the repair costs the user.
+``split-budget`` (:mod:`.deadline`)
+    an end-to-end deadline over its budget: which hop must become how fast.
+``tighten-bound`` / ``strengthen-guarantee`` (:mod:`.requirement`)
+    a refuted requirement.
+``constant`` (:mod:`.constants`)
+    a refuted Hoare triple: the program's constants changed to the guarantee's.
 
 A suggestion is returned only when Z3 *showed* (``sat`` or ``proved``, never
-``unknown``): the edited contract still parses and type-checks, it is
-consistent (the health check ``contract-consistent`` is ``ok``), the
-problem is gone (the guarantee can fire / the side condition is
-discharged / every triple is discharged), and what else changes status
-(``cost``: every health finding, side condition or triple whose status
-differs from before the edit).
+``unknown``) that the problem is gone on the edited text.  That is all Z3
+shows: the record's ``proves`` says what followed, ``not_shown`` what the
+engineer must still judge (that the change is right for the robot, and the
+evidence it asks for), and ``cost`` what else changes status.
 """
 from __future__ import annotations
 
-import difflib
 import itertools
 import re
 from typing import Any, Mapping, Sequence
@@ -63,9 +57,18 @@ def _peel(e: ast.Expr) -> tuple[list[str], ast.Expr]:
 
 
 def _record(kind: str, summary: str, edit: Edit, source: str, checks: list[dict[str, str]],
-            cost: list[dict[str, str]]) -> dict[str, Any]:
+            cost: list[dict[str, str]], proves: str = "", not_shown: str = "") -> dict[str, Any]:
+    """One repair: ``kind``, ``summary`` (what to change and why), the
+    ``edit`` (JSON, :meth:`Edit.to_json`) and its unified ``diff``, the
+    ``checks`` Z3 answered, the ``cost`` (status changes), ``proves``
+    (what Z3 showed follows from the edited text: "Controller.sc2 follows
+    from the edited contracts") and ``not_shown`` (what Z3 did not show:
+    that the change is safe; the evidence it asks for), ``checked_by`` (Z3's
+    version)."""
     return {"kind": kind, "summary": summary, "file": edit.file, "edit": edit.to_json(source),
             "diff": edit.diff(source), "checks": checks, "cost": cost,
+            "proves": proves or "the problem no longer follows from the edited text",
+            "not_shown": not_shown or "that the change is right for the robot",
             "checked_by": f"z3 {z3.get_version_string()}"}
 
 
@@ -278,7 +281,11 @@ def guard_repair(ws: Any, node: str, culprit: int, victims: Sequence[tuple[int, 
                    + f"; the guard {why}.")
         # compared with the stage's own statuses: the checks asked again (not the replacement check)
         return _record("guard", summary, edit, source, checks,
-                       recheck.changes({k: v for k, v in before.items() if k in after or ".g" in k}, after))
+                       recheck.changes({k: v for k, v in before.items() if k in after or ".g" in k}, after),
+                       proves=(f"{fired_text} can fire and {node}'s contract is consistent (witnesses found)"
+                               if victims else f"{node}'s contract is consistent (a witness found)"),
+                       not_shown=(f"that guarantee {culprit} still says what {node} is meant to do where the guard "
+                                  f"is false; {node}'s evidence must then establish the guarded guarantee"))
     return None
 
 
@@ -319,111 +326,6 @@ def _rename(text: str, pairs: Sequence[tuple[str, str]]) -> str:
     return text
 
 
-def side_condition_repairs(ws: Any, sc: Mapping[str, Any], before_sc: Mapping[str, str]) -> list[dict[str, Any]]:
-    """Repairs of the failed side condition ``sc`` (a report row): a
-    strengthened producer guarantee, and a weakened consumer assumption,
-    each returned only when Z3 discharged the side condition on the edited
-    contracts and the edited node's contract is consistent.  ``before_sc``
-    maps every side condition id of the system to its status before."""
-    pairs = _link_pairs(sc)
-    if not pairs:
-        return []
-    consumer = sc["node"]
-    producers = sorted({p for p, _, _, _ in pairs})
-    out: list[dict[str, Any]] = []
-    # the conjunct of the consumer's assumption, located
-    cons = ws.checked.nodes[consumer].node
-    target = None
-    for a in cons.assumes:
-        for c in conjuncts(a.formula):
-            if expr_to_rcl(c) == sc["conjunct"] and c.loc.end_line:
-                target = c
-    if target is None:
-        return []
-    to_producer = [(f"in.{iv}", f"out.{ov}") for _, ov, _, iv in pairs]
-    to_consumer = [(f"out.{ov}", f"in.{iv}") for _, ov, _, iv in pairs]
-
-    def cost_of(checked: Any, model: Any, nodes: Sequence[str], health_nodes: Sequence[str]) -> tuple[dict[str, str], list[dict[str, str]]] | None:
-        after: dict[str, str] = {}
-        for n in nodes:
-            after.update(recheck.side_conditions(checked, model, n))
-        if after.get(sc["id"]) != "discharged":
-            return None
-        h_before: dict[str, str] = {}
-        h_after: dict[str, str] = {}
-        for n in health_nodes:  # both asked the same way, so a change is the edit's
-            h_before.update(recheck.health(ws, ws.checked, n))
-            h_after.update(recheck.health(ws, checked, n))
-            if h_after.get(f"{n}.contract-consistent") != "ok":
-                return None
-        before = {k: v for k, v in before_sc.items() if k in after}
-        return after, recheck.changes({**before, **h_before}, {**after, **h_after})
-
-    # 1. strengthen the producer: the conjunct, in its output names, as a new guarantee
-    if len(producers) == 1:
-        p = producers[0]
-        pn = ws.checked.nodes[p].node
-        last = pn.guarantees[-1] if pn.guarantees else None
-        if last is not None and last.loc.end_line:
-            rel = last.loc.file
-            source = recheck.source_text(ws, rel)
-            line = source.splitlines()[last.loc.line - 1]
-            indent = line[:len(line) - len(line.lstrip())]
-            new_g = _rename(sc["conjunct"], to_producer)
-            edit = Edit(rel, last.loc.end_line, last.loc.end_col, last.loc.end_line, last.loc.end_col,
-                        f"\n{indent}guarantee( {new_g} )")
-            system = recheck.edited_system(ws, edit)
-            if system is not None:
-                consumers = sorted({l.to_node for l in system[1].links if l.from_node == p})
-                res = cost_of(*system, consumers, [p])
-                if res is not None:
-                    out.append(_record(
-                        "strengthen-producer",
-                        f"Strengthen {p}: add the guarantee `{new_g}`, the weakest strengthening of {p}'s "
-                        f"guarantees that entails {consumer}'s assumption `{sc['conjunct']}`; Z3 discharged "
-                        f"{sc['id']} and {p}'s contract stays consistent. {p}'s evidence must then establish "
-                        "the new guarantee.",
-                        edit, source,
-                        [{"check": sc["id"], "status": "discharged (Z3: proved)"},
-                         {"check": f"{p}.contract-consistent", "status": "ok (Z3: sat)"}], res[1]))
-    # 2. weaken the consumer: replace the conjunct by a producer conjunct on the same variables
-    cands: list[str] = []
-    linked = {f"out.{ov}" for _, ov, _, _ in pairs}
-    for p in producers:
-        for g in ws.checked.nodes[p].node.guarantees:
-            for c in conjuncts(g.formula):
-                t = expr_to_rcl(c)
-                if any(re.search(rf"(?<![\w.']){re.escape(v)}(?![\w'])", t) for v in linked):
-                    t2 = _rename(t, to_consumer)
-                    if "out." not in t2 and t2 != sc["conjunct"] and t2 not in cands:
-                        cands.append(t2)
-    # not what the consumer already assumes; closest to the conjunct it replaces first
-    already = {expr_to_rcl(c) for a in cons.assumes for c in conjuncts(a.formula)}
-    cands = [t for t in cands if t not in already]
-    cands.sort(key=lambda t: -difflib.SequenceMatcher(None, t, sc["conjunct"]).ratio())
-    rel = target.loc.file
-    source = recheck.source_text(ws, rel)
-    for t in cands[:MAX_CANDIDATES]:
-        edit = Edit(rel, target.loc.line, target.loc.col, target.loc.end_line, target.loc.end_col, t)
-        system = recheck.edited_system(ws, edit)
-        if system is None:
-            continue
-        res = cost_of(*system, [consumer], [consumer])
-        if res is None:
-            continue
-        out.append(_record(
-            "weaken-consumer",
-            f"Weaken {consumer}'s assumption: `{sc['conjunct']}` becomes `{t}`, what "
-            f"{' and '.join(producers)} guarantee{'s' if len(producers) == 1 else ''}; Z3 discharged {sc['id']} and "
-            f"{consumer}'s contract stays consistent. {consumer}'s evidence must then establish its guarantees "
-            "for the wider inputs.",
-            edit, source,
-            [{"check": sc["id"], "status": "discharged (Z3: proved)"},
-             {"check": f"{consumer}.contract-consistent", "status": "ok (Z3: sat)"}], res[1]))
-        break
-    return out
-
-
 def _numbers(e: Any) -> list[Any]:
     """Every numeric literal (``Num``/``NumLit`` with a location) under ``e``, in source order."""
     out: list[Any] = []
@@ -438,93 +340,3 @@ def _numbers(e: Any) -> list[Any]:
         elif hasattr(x, "__dataclass_fields__"):
             todo.extend(reversed([getattr(x, f) for f in x.__dataclass_fields__ if f != "loc"]))
     return sorted(out, key=lambda n: (n.loc.line, n.loc.col))
-
-
-def _num_value(text: str) -> float:
-    try:
-        return float(text)
-    except ValueError:
-        return float("nan")
-
-
-def hoare_repair(ws: Any, node: str, guarantee: int, program: str,
-                 before: Mapping[str, str]) -> dict[str, Any] | None:
-    """The change of program constants (to constants of guarantee
-    ``guarantee`` of ``node``) under which every triple of the plan entry of
-    ``program`` is discharged, fewest changes first; ``None`` when none
-    passes.  ``before`` maps the entry's obligation ids to their statuses."""
-    from ..backends.hoare import lang
-    idx = next((i for i, e in enumerate(ws.plan.evidence.get(node, ()))
-                if e.backend == "hoare" and e.config.get("program") == program), None)
-    if idx is None:
-        return None
-    source = recheck.source_text(ws, program)
-    prog = lang.parse_program(source, program)
-    prog_nums = [n for n in _numbers(prog.body) if n.loc.end_line]
-    g = ws.checked.nodes[node].node.guarantees[guarantee - 1]
-    contract = []
-    for n in _numbers(g.formula):
-        if n.text not in contract:
-            contract.append(n.text)
-    distinct = sorted({n.text for n in prog_nums if n.text not in contract}, key=_num_value)
-    if not distinct or not contract:
-        return None
-    tried = 0
-    for size in range(1, len(distinct) + 1):
-        for olds in itertools.combinations(distinct, size):
-            for news in itertools.product(contract, repeat=size):
-                if tried >= MAX_CANDIDATES * 4:
-                    return None
-                # keep the order of the thresholds: a larger constant stays larger
-                if list(news) != sorted(news, key=_num_value) or len(set(news)) != size:
-                    continue
-                tried += 1
-                mapping = dict(zip(olds, news))
-                new_text = _replace_numbers(source, prog_nums, mapping)
-                after = recheck.hoare_statuses(ws, node, idx, program, new_text)
-                if not after or any(s not in ("discharged", "pending") for s in after.values()):
-                    continue
-                if not any(s == "discharged" for s in after.values()):
-                    continue
-                first = [n for n in prog_nums if n.text in mapping]
-                lo = min(first, key=lambda n: (n.loc.line, n.loc.col))
-                hi = max(first, key=lambda n: (n.loc.end_line, n.loc.end_col))
-                span = Edit(program, lo.loc.line, lo.loc.col, hi.loc.end_line, hi.loc.end_col, "")
-                region = span.deleted(source)
-                edit = Edit(program, lo.loc.line, lo.loc.col, hi.loc.end_line, hi.loc.end_col,
-                            _replace_numbers(region, [_shift(n, lo) for n in first], mapping))
-                said = ", ".join(f"{a} -> {b}" for a, b in mapping.items())
-                return _record(
-                    "constant",
-                    f"Change the constants of {program}: {said} (the constants of guarantee {guarantee} of "
-                    f"{node}); Z3 then discharges every triple of the program ({len(after)} in all, "
-                    f"{sum(1 for s in after.values() if s == 'pending')} still pending for what the program "
-                    "does not model).",
-                    edit, source, [{"check": k, "status": v + (" (Z3: proved)" if v == "discharged" else "")}
-                                   for k, v in sorted(after.items())],
-                    recheck.changes(before, after))
-    return None
-
-
-class _At:
-    def __init__(self, text: str, line: int, col: int, end_line: int, end_col: int) -> None:
-        from ..rcl.ast import Loc
-        self.text = text
-        self.loc = Loc("", line, col, end_line, end_col)
-
-
-def _shift(n: Any, lo: Any) -> _At:
-    """``n``'s location relative to the start of ``lo`` (line 1, col 1)."""
-    line = n.loc.line - lo.loc.line + 1
-    col = n.loc.col - (lo.loc.col - 1 if n.loc.line == lo.loc.line else 0)
-    end_col = n.loc.end_col - (lo.loc.col - 1 if n.loc.end_line == lo.loc.line else 0)
-    return _At(n.text, line, col, n.loc.end_line - lo.loc.line + 1, end_col)
-
-
-def _replace_numbers(text: str, nums: Sequence[Any], mapping: Mapping[str, str]) -> str:
-    """``text`` with each literal of ``nums`` whose text ``mapping`` names
-    replaced (from the last to the first, so earlier positions hold)."""
-    for n in sorted(nums, key=lambda n: (n.loc.line, n.loc.col), reverse=True):
-        if n.text in mapping:
-            text = Edit("", n.loc.line, n.loc.col, n.loc.end_line, n.loc.end_col, mapping[n.text]).apply(text)
-    return text

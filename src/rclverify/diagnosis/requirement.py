@@ -1,7 +1,9 @@
 """The diagnosis record of a refuted requirement (docs/diagnosis.md, "Who
 is named"): the guarantee whose bound lets Z3's counterexample through,
 found by :func:`rclverify.diagnosis.blame.requirement_culprits`, with the
-tightened bound as a checked repair."""
+tightened bound (a bound, never a coefficient) as a repair Z3 checked.  A
+requirement refuted only by its end-to-end deadline is not diagnosed here:
+its deadline is (:mod:`rclverify.diagnosis.deadline`)."""
 from __future__ import annotations
 
 import re
@@ -43,8 +45,16 @@ def requirement_record(ws: Any, report: Mapping[str, Any], q: Mapping[str, Any],
                          "new": f["new"], "text": text, "source": src,
                          "repair": _repair("tighten-bound" if f["how"] == "bound" else "strengthen-guarantee",
                                            summary, f["edit"], source,
-                                           [{"check": str(q["id"]), "status": "proved (Z3: unsat)"}],
-                                           blame.cost(ws, report, f["node"], f["edit"]))})
+                                           [{"check": str(q["id"]), "status": "proved (Z3: unsat)"},
+                                            {"check": f"{f['node']} implementable",
+                                             "status": "yes: every input its assumption allows has an answer "
+                                                       "(Z3: proved)" if f.get("implementable") == "proved"
+                                                       else "not decided (Z3 could not say in its budget)"}],
+                                           blame.cost(ws, report, f["node"], f["edit"]),
+                                           proves=f"{q['id']} follows from the edited contracts, from consistent "
+                                                  "premises",
+                                           not_shown=f"that {f['node']} can meet the stronger guarantee: its "
+                                                     "evidence must establish it")})
         return rows
     found = cache.get(["requirement", q["id"], check.get("formal"), cone], find) or []
     cul = [{"what": f"guarantee {f['guarantee']} of {f['node']}: `{f['text']}`", "source": f["source"],

@@ -57,7 +57,9 @@ def explain_lines(d: Mapping[str, Any]) -> list[str]:
     if not d.get("repairs"):
         out.append("  repairs: none that Z3 could check")
     for k, r in enumerate(d.get("repairs", []), 1):
-        out.append(f"  repair {k} ({r['kind']}, checked by {r['checked_by']}): {r['summary']}")
+        out.append(f"  repair {k} ({r['kind']}): {r['summary']}")
+        out.append(f"    Z3 ({r['checked_by']}) shows: {r.get('proves') or 'the problem no longer follows'}; "
+                   f"not shown: {r.get('not_shown') or 'that the change is safe'}")
         for c in r.get("checks", []):
             out.append(f"    checked: {c['check']}: {c['status']}")
         if r.get("cost"):
@@ -65,6 +67,8 @@ def explain_lines(d: Mapping[str, Any]) -> list[str]:
         else:
             out.append("    changes: no other check changes status")
         out += ["    " + line for line in r["diff"].rstrip("\n").splitlines()]
+    for why in d.get("not_offered") or ():
+        out.append(f"  not offered: {why}")
     return out
 
 
@@ -153,7 +157,7 @@ def status_lines(data: Mapping[str, Any]) -> list[str]:
     """The overall line, then the problems of a summary
     (``artifacts/report/summary.json``): one entry per root cause, as the
     report's "What needs attention" shows them (status, culprits, the
-    findings behind it, one sentence, checked repairs), or, for a summary
+    findings behind it, one sentence, how many repairs Z3 checked), or, for a summary
     without that grouping, each problem and diagnosis on a line."""
     s = data["summary"]
     out = [f"overall: {s['status']} -- {s['headline']}"]
@@ -165,7 +169,8 @@ def status_lines(data: Mapping[str, Any]) -> list[str]:
         for k, g in enumerate(groups, 1):
             # no culprit Z3 showed: the problem's own location, when it has one
             cause = "; ".join(same_file_lines(g["culprits"])) or (f"at {g['where']}" if g.get("where") else "(no culprit named)")
-            repairs = f", {g['repairs']} checked repair{'s' if g['repairs'] != 1 else ''}" if g["repairs"] else ""
+            repairs = (f", {g['repairs']} repair{'s' if g['repairs'] != 1 else ''} (Z3 shows the problem gone, not "
+                       "that the change is safe)") if g["repairs"] else ""
             out.append(f"  {k}. [{g['status']}] {cause}: {len(g['members'])} finding"
                        f"{'s' if len(g['members']) != 1 else ''}{repairs}")
             if g["sentence"]:
@@ -175,6 +180,6 @@ def status_lines(data: Mapping[str, Any]) -> list[str]:
     out += [f"  problem: {p}" for p in s["problems"]]
     for d in s.get("diagnoses", []):
         sentence = _short(d["sentence"])
-        more = (f"{d['repairs']} checked repair{'s' if d['repairs'] != 1 else ''}: " if d.get("repairs") else "")
+        more = (f"{d['repairs']} repair{'s' if d['repairs'] != 1 else ''} Z3 checked: " if d.get("repairs") else "")
         out.append(f"  diagnosis {d['id']}: {sentence} ({more}rclverify explain {d['id']})")
     return out

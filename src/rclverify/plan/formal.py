@@ -176,10 +176,22 @@ def read_expr(src: Source, checked: Checked, what: str = "requirement",
                            "E-name"))
     if diags:
         raise RclError(diags)
-    expr = parse_formula(text, src.file, src.line, src.col)
+    try:
+        expr = parse_formula(text, src.file, src.line, src.col)
+    except RclError as exc:  # the parser saw placeholders: its messages name what the plan wrote
+        raise RclError([dataclasses.replace(d, message=_unplaceholder(d.message, names)) for d in exc.diagnostics]) \
+            from None
     expr = _rename(expr, names)
     scope = system_scope(checked, states)
     return expr, scope, tuple(mentions), infer(expr, scope, checked.env)
+
+
+def _unplaceholder(message: str, names: Mapping[str, str]) -> str:
+    """``message`` with every placeholder the parser was given written back
+    as the ``Node.in.x`` it stands for (no internal name reaches a user)."""
+    for ph in sorted(names, key=len, reverse=True):
+        message = message.replace(ph, names[ph])
+    return message
 
 
 def _rename(e: Any, names: Mapping[str, str]) -> Any:

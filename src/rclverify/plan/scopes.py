@@ -13,6 +13,13 @@ The rule (docs/rcl-language.md, "Files and scopes"):
 * Without a plan, all the files given form one scope, as before: the files
   of one system may share the context one of them declares.
 
+When the plan's system is given whole (every file of its ``contracts:``),
+the plan itself is read and its statements checked against it
+(:func:`plan_diagnostics`): requirement ids, ``formal:`` and
+``assuming:`` statements, ``deadline:`` paths, ``supported_by``,
+connections, environment facts and evidence entries' keys, the checks
+``doit verify`` makes before it runs anything (docs/requirements.md).
+
 The plan is ``WORKSPACE/PLAN`` (``-w``, ``--plan``; default
 ``./contracts/plan.yaml``) when that exists, else ``plan.yaml`` beside the
 first file given that has one (its workspace root is then that folder's
@@ -99,3 +106,34 @@ def group_files(files: Sequence[str], workspace: str = ".", plan_rel: str = "con
         else:
             scopes.append(Scope([f], "not in the plan's contracts, checked alone"))
     return Scopes(scopes, shown)
+
+
+def plan_diagnostics(files: Sequence[str], checked: object, workspace: str = ".",
+                     plan_rel: str = "contracts/plan.yaml") -> tuple[list[object], str]:
+    """The located errors of the plan that groups ``files`` (see
+    :func:`find_plan`), read and resolved against ``checked``, the checked
+    system of ``files`` (:func:`rclverify.plan.load.resolve`: every
+    statement of the plan that names the contracts).  Returns
+    ``(diagnostics, note)``: ``note`` is ``""`` when the plan was checked,
+    else why not (no plan, or ``files`` are not the plan's whole system, so
+    its node names could not be checked)."""
+    found = find_plan(files, workspace, plan_rel)
+    if found is None:
+        return [], ""
+    root, rel = found
+    from .load import load_plan, read_plan_data, resolve
+    try:
+        data, _ = read_plan_data(root, rel)
+    except RclError:
+        return [], ""  # group_files said so already
+    system = {_key(root / str(c)) for c in data.get("contracts") or [] if isinstance(c, str)}
+    given = {_key(Path(f)) for f in files}
+    if not system or not system <= given:
+        return [], (f"{root / rel}: note: the plan's statements are checked when every file of its contracts: "
+                    "is given")
+    try:
+        plan = load_plan(root, rel)
+        resolve(plan, checked)  # type: ignore[arg-type]
+    except RclError as exc:
+        return list(exc.diagnostics), ""
+    return [], ""

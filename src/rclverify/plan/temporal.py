@@ -123,9 +123,43 @@ def _parse(src: Source, start: int, end: int, checked: Checked, what: str,
     if u is not None:
         return Temporal("until", (_parse(src, start, u, checked, what, states),
                                   _parse(src, u + 5, end, checked, what, states)))
-    if start == 0 and end == len(text):
-        return parse_formal(src, checked, what, states)
-    return parse_formal(Source(_blank(text, start, end), src.line, src.col, src.file), checked, what, states)
+    leaf = src if start == 0 and end == len(text) else Source(_blank(text, start, end), src.line, src.col, src.file)
+    try:
+        return parse_formal(leaf, checked, what, states)
+    except RclError as exc:
+        slip = _misspelled(src, start, end, checked, what)
+        if slip is None:
+            raise
+        raise RclError([slip]) from None
+
+
+#: The temporal operators, for the suggestion of a misspelled one.
+OPERATORS = ("always", "eventually", "next", "previous", "until")
+_WORD = re.compile(r"(?<![\w.'])([A-Za-z_][A-Za-z0-9_]*)(?![\w.'(])")
+_RCL_WORDS = {"and", "or", "not", "in", "forall", "exists", "TRUE", "FALSE", "true", "false"}
+
+
+def _misspelled(src: Source, start: int, end: int, checked: Checked, what: str) -> Any:
+    """A located error naming the first word of ``src.text[start:end]``
+    that is no name of the system and reads like a misspelled temporal
+    operator (``eventualy``: did you mean ``eventually``?), or ``None``."""
+    import difflib
+    known = set(checked.env.constants) | set(checked.env.enum_values) | set(checked.env.ctors) | _RCL_WORDS
+    segment = src.text[start:end]
+    first = start + len(segment) - len(segment.lstrip())
+    for m in _WORD.finditer(src.text, start, end):
+        word = m.group(1)
+        if word in known or word in OPERATORS:
+            continue
+        # a prefix operator is the operand's first word; `until` stands between two operands
+        close = difflib.get_close_matches(word.lower(), OPERATORS if m.start(1) == first else ("until",), n=1,
+                                          cutoff=0.75)
+        if close:
+            return error(_loc_at(src, m.start(1)), f"{what}: unknown temporal operator {word!r}: did you mean "
+                                                    f"{close[0]!r}? The operators are always, eventually, "
+                                                    "eventually[<= N], next, previous and until "
+                                                    "(docs/requirements.md, Temporal requirements)", "E-syntax")
+    return None
 
 
 def _bound(src: Source, b: "re.Match[str]", what: str) -> int:

@@ -347,7 +347,8 @@ def build_report(ws: Workspace) -> dict[str, Any]:
         counts[row["status"]] = counts.get(row["status"], 0) + 1
     overall = worst([r["status"] for r in requirements] + list(node_status.values()) + [d["status"] for d in derived])
     # the --strict gate: every obligation discharged, every side condition proved,
-    # and no health check that found a problem or could not decide
+    # and no health check that found a problem or could not decide (and, below, no finding of severity
+    # error or warning at all: report/severity.py)
     strict_ok = (all(o["status"] == "discharged" for o in ob_rows)
                  and all(sc["status"] == "discharged" for sc in side_conditions)
                  and all(f["status"] in ("ok", "warning") for f in findings)
@@ -384,6 +385,10 @@ def build_report(ws: Workspace) -> dict[str, Any]:
         "environment_assumptions": env_assumptions, "pending": pending, "lint": lint_rows,
         "expected_verdicts": expected, "grounding": grounding, "unverified": unverified, "deadlines": deadlines,
     }
+    # one severity per finding (report/severity.py): --strict fails on every error and warning, health and lint
+    # warnings included, as SARIF, JUnit and the terminal show them
+    from .severity import blocking
+    report["meta"]["strict_ok"] = bool(strict_ok) and not blocking(report)
     # one diagnosis record per problem, with repairs checked by Z3 (docs/diagnosis.md)
     report["diagnoses"] = diagnose(ws, report)
     report["summary"]["diagnoses"] = [{"id": d["id"], "kind": d["kind"], "sentence": d["sentence"],

@@ -186,7 +186,7 @@ SARIF_RULES = (
      "past its bound (rule D3); the chain is named."),
     ("RCL-DEADLINE-INCONCLUSIVE", "DeadlineInconclusive", "warning",
      "A requirement's end-to-end deadline is not decided: no chain of timed guarantees along its path, not "
-     "decided yet, made from other inputs (stale) or its record altered."),
+     "decided yet, made from other inputs (stale) or its record altered (then at level error)."),
 )
 
 
@@ -198,8 +198,9 @@ def sarif_results(report: Mapping[str, Any], result: Callable[..., dict[str, Any
     for r in report.get("deadlines") or ():
         if r["verdict"] == "proved":
             continue
-        rule, level = (("RCL-DEADLINE-REFUTED", "error") if r["verdict"] == "refuted"
-                       else ("RCL-DEADLINE-INCONCLUSIVE", "warning"))
+        from .severity import of
+        rule = "RCL-DEADLINE-REFUTED" if r["verdict"] == "refuted" else "RCL-DEADLINE-INCONCLUSIVE"
+        level = of("deadline", str(r["verdict"])) or "note"  # one severity in every output (report/severity.py)
         words = [f"End-to-end deadline of {r['requirement']} ({r['within']} along {' -> '.join(r['path'])}) is "
                  f"{r['verdict']}: {r['reason']}."]
         if r["chain"]:

@@ -29,7 +29,14 @@ nothing itself.  Layout (decisions in ``docs/ci.md``):
   (a ``<failure>`` when evidence the proof rests on failed), informal
   ones ``<skipped>``;
 * when the plan has end-to-end deadlines, a ``deadlines`` ``<testsuite>``
-  with one ``<testcase>`` per deadline (:func:`.deadlines.junit_suite`).
+  with one ``<testcase>`` per deadline (:func:`.deadlines.junit_suite`);
+* when the contracts have lint diagnostics, a ``lint`` ``<testsuite>`` with
+  one failing ``<testcase>`` per diagnostic (:func:`_lint_suite`).
+
+Every outcome is the item's one severity (:mod:`.severity`, docs/ci.md):
+an ``error`` is a ``<failure>`` (``<error>`` for a record not believed), a
+``warning`` a ``<failure>`` or, when undecided or not run yet, a
+``<skipped>``; a ``note`` (an informal requirement) ``<skipped>``.
 
 ``time`` is the recorded duration of the check in seconds (0 when the
 record has none).  The XML is built with :mod:`xml.etree.ElementTree`, so
@@ -54,19 +61,22 @@ def _case(suite: ET.Element, classname: str, name: str, where: str, seconds: Any
     return ET.SubElement(suite, "testcase", attrs)
 
 
-def _outcome(case: ET.Element, status: str, summary: str, detail: str) -> str:
-    """Attach the child element for ``status``; return the counter it bumps
-    (``failures``, ``errors``, ``skipped``) or '' for a pass."""
-    if status in ("discharged", "ok"):
+def _outcome(case: ET.Element, status: str, summary: str, detail: str, kind: str = "obligation") -> str:
+    """Attach the child element for an item of ``kind`` with ``status`` (its
+    one severity, :func:`.severity.junit_outcome`); return the counter it
+    bumps (``failures``, ``errors``, ``skipped``) or '' for a pass."""
+    from .severity import junit_outcome
+    how = junit_outcome(kind, status)
+    if how == "pass":
         return ""
-    if status in ("pending", "inconclusive"):
+    if how == "skipped":
         ET.SubElement(case, "skipped", {"message": f"{status}: {summary}"}).text = detail or None
         return "skipped"
-    if status == "error":
+    if how == "error":
         ET.SubElement(case, "error", {"type": "error", "message": summary}).text = detail or None
         return "errors"
-    kind = "failed" if status in ("failed", "problem") else status
-    ET.SubElement(case, "failure", {"type": kind, "message": summary}).text = detail or None
+    failure = "failed" if status in ("failed", "problem") else status
+    ET.SubElement(case, "failure", {"type": failure, "message": summary}).text = detail or None
     return "failures"
 
 
@@ -91,7 +101,7 @@ def junit_tree(report: Mapping[str, Any]) -> ET.Element:
             totals[k] += v
         total_time += time
     from .deadlines import junit_suite
-    for req in (_requirements_suite(report), junit_suite(report, _case, _outcome)):
+    for req in (_requirements_suite(report), junit_suite(report, _case, _outcome), _lint_suite(report)):
         if req is None:
             continue
         root.append(req[0])
@@ -135,6 +145,29 @@ def _requirements_suite(report: Mapping[str, Any]) -> tuple[ET.Element, dict[str
         suite.set(k, str(v))
     suite.set("time", f"{time:.3f}")
     return suite, counts, time
+
+
+def _lint_suite(report: Mapping[str, Any]) -> tuple[ET.Element, dict[str, int], float] | None:
+    """The ``lint`` ``<testsuite>``: one ``<testcase>`` per lint diagnostic
+    (``classname`` ``lint``, name its code and location, at its location), a
+    ``<failure>`` of type ``warning`` or ``error`` (its one severity,
+    :mod:`.severity`: ``--strict`` fails on it); ``None`` without lint."""
+    rows = report.get("lint") or []
+    if not rows:
+        return None
+    suite = ET.Element("testsuite", {"name": "lint"})
+    counts = {"tests": 0, "failures": 0, "errors": 0, "skipped": 0}
+    for x in rows:
+        sev = str(x["severity"]).lower()
+        case = _case(suite, "lint", f"{x.get('code') or 'lint'} {x['location']}", str(x["location"]), 0.0)
+        counts["tests"] += 1
+        bumped = _outcome(case, sev, str(x["message"]), f"{x['location']}: {sev}: {x['message']}", kind="lint")
+        if bumped:
+            counts[bumped] += 1
+    for k, v in counts.items():
+        suite.set(k, str(v))
+    suite.set("time", "0.000")
+    return suite, counts, 0.0
 
 
 def _suite_data(report: Mapping[str, Any]) -> list[tuple[Mapping[str, Any], dict[str, Any]]]:
@@ -246,7 +279,7 @@ def render_junit(report: Mapping[str, Any], fragments: FragmentCache | None = No
             totals[k] += v
         total_time += piece["time"]
     from .deadlines import junit_suite
-    for req in (_requirements_suite(report), junit_suite(report, _case, _outcome)):
+    for req in (_requirements_suite(report), junit_suite(report, _case, _outcome), _lint_suite(report)):
         if req is None:
             continue
         ET.indent(req[0], level=1)

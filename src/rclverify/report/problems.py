@@ -33,6 +33,14 @@ its diagnosis record (:mod:`rclverify.diagnosis.build`, ``culprits``):
    ``unverified:<Node>``, each guarantee a finding and a culprit at its
    location; a contract defect never absorbs them.
 
+5. an end-to-end deadline that is refuted or not decided
+   (:mod:`rclverify.diagnosis.deadline`) is one group of its own, keyed
+   ``deadline:<REQ>``, its culprits the hops of its chain with their bounds
+   (or the node where its path breaks); the requirement it makes not met
+   (when its own statement is not refuted) is a finding of that group.  A
+   hop's guarantee found wanting elsewhere (a monitor, a vacuity) is
+   another problem: a deadline is about time, not about what is answered.
+
 The culprits a diagnosis record names are the ones Z3 showed
 (:mod:`rclverify.diagnosis.blame`): strengthening each alone removes the
 counterexample, so unrelated bugs that only mention the same variable do
@@ -64,13 +72,25 @@ _CONTRACT_DEFECTS = ("vacuity", "inconsistency")
 #: contract defect names the guarantees that exclude each other, a side condition producer and
 #: consumer, a Hoare refutation the constants; a test or a monitor names only the guarantee broken.
 _TELLING = {"vacuity": 0, "inconsistency": 0, "unsatisfiable-assumption": 0, "side-condition": 1, "hoare": 1,
-            "refinement": 2, "monitor": 3}
+            "deadline": 1, "refinement": 2, "monitor": 3}
 #: Rank of every other kind (a property test, other evidence, a requirement, an attention item).
 _LEAST_TELLING = 4
 #: Requirement verdicts that are problems (report/build.py lists them too).
 BAD_VERDICTS = ("refuted", "proved from an inconsistency", "proved vacuously")
 #: Status words of diagnosis records and health findings as evidence statuses.
 _AS_EVIDENCE = {"problem": "failed", "refuted": "failed", "unknown": "inconclusive", "warning": "pending"}
+
+
+#: Group key prefix of an end-to-end deadline's row (rule 5).
+DEADLINE_PREFIX = "deadline:"
+
+
+def _by_deadline(q: Mapping[str, Any]) -> bool:
+    """Is requirement row ``q`` not met only because of its end-to-end
+    deadline (refuted or undecided), its own statement not refuted?"""
+    row = q.get("deadline") or {}
+    own = (q.get("without_deadline") or {}).get("verdict")
+    return row.get("verdict") in ("refuted", "inconclusive") and own not in BAD_VERDICTS
 
 
 def _severity(status: str) -> int:
@@ -172,6 +192,8 @@ def group_problems(report: Mapping[str, Any], items: Sequence[Mapping[str, Any]]
     direct: set[str] = set()  # model-checking evidence: grouped only by the culprits it names (problems_mc)
     for d in diagnoses:
         roots = _roots(d.get("culprits", []), places, victim_of(d.get("node"), d.get("guarantee")))
+        if d["kind"] == "deadline":  # its own row, whatever else its hops' guarantees are found in (rule 5)
+            roots = [f"{DEADLINE_PREFIX}{d.get('requirement')}"]
         if str(d["id"]) in mc_obl:
             direct.add(str(d["id"]))
             roots = ([r for r in roots if r != victim_of(d.get("node"), d.get("guarantee"))]
@@ -191,6 +213,8 @@ def group_problems(report: Mapping[str, Any], items: Sequence[Mapping[str, Any]]
         core = [*(check.get("vacuity_core") or []), *(check.get("inconsistent_core") or []),
                 *(check.get("failed_to_prevent") or [])]
         roots = _roots([{"what": str(p.get("label", "")), "source": p.get("source", "")} for p in core], places, None)
+        if _by_deadline(q):  # not met because of its end-to-end deadline only: the deadline's row (rule 5)
+            roots = [f"{DEADLINE_PREFIX}{q['id']}"]
         note = str(q.get("note") or "")
         members.append(({"id": str(q["id"]), "kind": "requirement", "status": str(q["status"]),
                          "sentence": f"Requirement {q['id']} is {q['verdict']}" + (f": {note}" if note else "") + ".",
@@ -233,6 +257,7 @@ def group_problems(report: Mapping[str, Any], items: Sequence[Mapping[str, Any]]
         # an unverified guarantee stays a row of its own, even when a contract defect explains the guarantee;
         # so does a failed side condition: its culprits are the ones Z3 showed for it (diagnosis/blame.py)
         explained = ([] if m["kind"] in ("unverified guarantee", "side-condition") or m["id"] in direct
+                     or any(r.startswith(DEADLINE_PREFIX) for r in roots)
                      else [e for r in roots for e in explains.get(r, [])])
         if explained:
             roots = list(dict.fromkeys(explained))
@@ -256,6 +281,15 @@ def group_problems(report: Mapping[str, Any], items: Sequence[Mapping[str, Any]]
             if len(ids) > 1 and first is not None:
                 g["sentence"] = first_sentence(f"{len(ids)} guarantees of {node} are unverified "
                                                f"({', '.join(ids)}): {first['reason'].replace('covers it', 'covers them')}.")
+    for key, g in groups.items():  # a deadline's row: the hops of its chain, each with its bound (rule 5)
+        if key[0].startswith(DEADLINE_PREFIX):
+            d = next((by_id[m["id"]] for m in g["members"] if m["id"] in by_id and by_id[m["id"]]["kind"] == "deadline"),
+                     None)
+            g["culprits"] = []
+            for c in (d or {}).get("culprits") or ():
+                rid = places.locate(str(c.get("source", "")))
+                if rid is not None and rid in places.info:
+                    g["culprits"].append({**_culprit(rid, places, anchor), "what": str(c["what"])})
     for key, g in groups.items():  # model-checking rows: the Gwendolen lines the counterexamples pass through
         if key[0].startswith(mc.FAILED_PREFIX):
             lines = [places.locate(src) for m in g["members"] for src in mc.trail_sources(by_id.get(m["id"]))]
@@ -351,6 +385,8 @@ def _default_anchor(d: Mapping[str, Any], anchor: Callable[..., str]) -> str:
         return anchor("finding", d["id"])
     if d["kind"] == "requirement":  # a refuted requirement's diagnosis: its row in the requirements table
         return anchor("req", d["id"])
+    if d["kind"] == "deadline":  # its row in the deadlines table
+        return anchor("deadline", d.get("requirement", ""))
     return anchor("ev", d["id"])
 
 

@@ -63,7 +63,7 @@ STATUS_STYLE: Mapping[str, str] = {
     "derived": "discharged",
     "not derived": "failed",
     "undecided": "inconclusive",
-    "warning": "pending",
+    "warning": "warning",  # a health warning: its own colour, never a pass (report/severity.py)
 }
 
 #: Severity of a status word for ordering the attention list (larger is
@@ -413,11 +413,11 @@ TECHNIQUES: tuple[str, ...] = ("health", "side conditions", "hoare", "dafny", "a
                                "monitors", "experiment", "review")
 
 
-#: A contract health status as the evidence status the dashboard ranks it by
-#: (as report/build.py rolls health into a node's status: a warning is shown
-#: but changes no status).
-_HEALTH_AS: Mapping[str, str] = {"ok": "discharged", "problem": "failed", "warning": "discharged",
-                                 "unknown": "inconclusive"}
+#: A contract health status as the evidence status the dashboard ranks it by.
+#: A warning stays ``warning`` (ranked with pending): it changes no node's
+#: status (report/build.py) but it is no pass either; it fails ``--strict``
+#: as in every other output (report/severity.py).
+_HEALTH_AS: Mapping[str, str] = {"ok": "discharged", "problem": "failed", "unknown": "inconclusive"}
 
 
 def dashboard(report: Mapping[str, Any], evidence_of: Mapping[str, Sequence[tuple[str, Any]]]) -> dict[str, Any]:

@@ -62,8 +62,9 @@ RULES: Mapping[str, Rule] = {r.id: r for r in (
          "An input of the obligation changed after its evidence was produced; the evidence no longer vouches for it."),
     Rule("RCL-OBL-INCONCLUSIVE", "ObligationInconclusive", "warning",
          "The backend could not decide the obligation (unknown, timeout or bounded search)."),
-    Rule("RCL-OBL-PENDING", "ObligationPending", "note",
-         "The obligation has no evidence yet (the backend cannot run here or is not implemented)."),
+    Rule("RCL-OBL-PENDING", "ObligationPending", "warning",
+         "The obligation has no evidence yet (the backend cannot run here or is not implemented): the guarantee "
+         "is not established, and --strict fails on it."),
     Rule("RCL-GUARANTEE-UNVERIFIED", "GuaranteeUnverified", "warning",
          "No obligation covers the guarantee: no evidence entry of the plan exports one for it, so nothing "
          "establishes it."),
@@ -81,6 +82,13 @@ RULES: Mapping[str, Rule] = {r.id: r for r in (
          "it promises nothing."),
     Rule("RCL-HEALTH-REPLACEMENT", "ReplacementDoesNotRefine", "error",
          "The replacement contract offered for the node does not refine the node's contract."),
+    Rule("RCL-HEALTH-TAUTOLOGY", "GuaranteeTautology", "error",
+         "A conjunct of a guarantee holds whatever the inputs and outputs: it promises nothing."),
+    Rule("RCL-HEALTH-NO-OUTPUT", "GuaranteeConstrainsNoOutput", "error",
+         "A guarantee mentions no output of its node: an implementation meets it whatever it outputs."),
+    Rule("RCL-HEALTH-REDUNDANT", "ConjunctRedundant", "warning",
+         "A conjunct of a guarantee follows from the assumption and the other conjuncts: it adds nothing (often a "
+         "copy-paste slip)."),
     Rule("RCL-HEALTH-OTHER", "HealthProblem", "error", "A contract health check found a problem."),
     Rule("RCL-HEALTH-INCONCLUSIVE", "HealthInconclusive", "warning",
          "Z3 could not decide a contract health check."),
@@ -99,7 +107,7 @@ RULES: Mapping[str, Rule] = {r.id: r for r in (
          "cone: it never applies."),
     Rule("RCL-REQ-INCONCLUSIVE", "RequirementInconclusive", "warning",
          "Z3 could not decide a formal requirement (or whether the premises of its proof are consistent)."),
-    Rule("RCL-REQ-EVIDENCE", "RequirementEvidenceOutstanding", "note",
+    Rule("RCL-REQ-EVIDENCE", "RequirementEvidenceOutstanding", "warning",
          "A formal requirement is proved from the guarantees, but the evidence of the guarantees its proof used "
          "is not all discharged."),
     Rule("RCL-REQ-STALE", "RequirementStale", "warning",
@@ -117,10 +125,18 @@ _REQUIREMENT_RULE = {"refuted": "RCL-REQ-REFUTED", "proved from an inconsistency
 _HEALTH_RULE = {"assumption-satisfiable": "RCL-HEALTH-UNSATISFIABLE-ASSUMPTION",
                 "contract-consistent": "RCL-HEALTH-INCONSISTENT",
                 "non-vacuous": "RCL-HEALTH-VACUOUS",
-                "replacement-refines": "RCL-HEALTH-REPLACEMENT"}
+                "replacement-refines": "RCL-HEALTH-REPLACEMENT",
+                "tautology": "RCL-HEALTH-TAUTOLOGY",
+                "constrains-no-output": "RCL-HEALTH-NO-OUTPUT",
+                "redundant": "RCL-HEALTH-REDUNDANT"}
 _OBLIGATION_RULE = {"failed": "RCL-OBL-FAILED", "error": "RCL-OBL-ERROR", "stale": "RCL-OBL-STALE",
                     "inconclusive": "RCL-OBL-INCONCLUSIVE", "pending": "RCL-OBL-PENDING"}
-_LINT_LEVEL = {"error": "error", "warning": "warning"}
+
+
+def _level(kind: str, status: str) -> str:
+    """The SARIF level of an item: its one severity (:mod:`.severity`)."""
+    from .severity import of
+    return of(kind, status) or "note"
 
 
 def lint_rule_id(code: str) -> str:
@@ -179,14 +195,15 @@ def _obligation_results(report: Mapping[str, Any]) -> list[dict[str, Any]]:
                  "status": o["status"]}
         if ev is not None and ev.get("counterexample"):
             props["counterexample"] = dict(ev["counterexample"])
-        out.append(_result(rule, RULES[rule].level, " ".join(words), str(o["source"]), f"obligation:{o['id']}", props))
+        out.append(_result(rule, _level("obligation", str(o["status"])), " ".join(words), str(o["source"]),
+                           f"obligation:{o['id']}", props))
     return out
 
 
 def _unverified_results(report: Mapping[str, Any]) -> list[dict[str, Any]]:
     """One result per guarantee no obligation covers, at the guarantee (report/unverified.py)."""
     rule = RULES["RCL-GUARANTEE-UNVERIFIED"]
-    return [_result(rule.id, rule.level, f"Guarantee {u['guarantee']} of {u['node']} is unverified: {u['reason']}. "
+    return [_result(rule.id, _level("guarantee", "unverified"), f"Guarantee {u['guarantee']} of {u['node']} is unverified: {u['reason']}. "
                     f"The guarantee: {u['text']}", str(u["source"]), f"guarantee:{u['id']}",
                     {"guarantee": u["id"], "node": u["node"], "status": u["status"]})
             for u in report.get("unverified") or ()]
@@ -205,8 +222,8 @@ def _side_condition_results(report: Mapping[str, Any]) -> list[dict[str, Any]]:
         if sc.get("model"):
             words.append(f"Counterexample: {model_text(sc['model'])}.")
         props = {"sideCondition": sc["id"], "node": sc["node"], "rule": sc["rule"], "status": status}
-        out.append(_result(rule, RULES[rule].level, " ".join(words), str(sc["source"]), f"side-condition:{sc['id']}",
-                           props))
+        out.append(_result(rule, _level("side-condition", status), " ".join(words), str(sc["source"]),
+                           f"side-condition:{sc['id']}", props))
     return out
 
 
@@ -232,8 +249,8 @@ def _requirement_results(report: Mapping[str, Any]) -> list[dict[str, Any]]:
         for p in c.get("failed_to_prevent") or []:
             words.append(f"Not prevented by {p['label']} ({p['text']}, {p['source']}).")
         props = {"requirement": r["id"], "verdict": r["verdict"], "status": r["status"]}
-        out.append(_result(rule, RULES[rule].level, " ".join(words), str(c.get("source") or ""),
-                           f"requirement:{r['id']}", props))
+        out.append(_result(rule, _level("requirement", str(r.get("verdict"))), " ".join(words),
+                           str(c.get("source") or ""), f"requirement:{r['id']}", props))
     return out
 
 
@@ -263,7 +280,7 @@ def _finding_results(report: Mapping[str, Any]) -> list[dict[str, Any]]:
         if f.get("model"):
             words.append(f"Counterexample: {model_text(f['model'])}.")
         props = {"finding": f["id"], "node": f["node"], "check": f["check"], "status": f["status"]}
-        out.append(_result(rule, RULES[rule].level, " ".join(words), _finding_location(report, f),
+        out.append(_result(rule, _level("health", str(f["status"])), " ".join(words), _finding_location(report, f),
                            f"health:{f['id']}", props))
     return out
 
@@ -273,7 +290,7 @@ def _lint_results(report: Mapping[str, Any]) -> tuple[list[dict[str, Any]], list
     rules: dict[str, Rule] = {}
     for k, d in enumerate(report["lint"]):
         rid = lint_rule_id(str(d.get("code", "")))
-        level = _LINT_LEVEL.get(str(d["severity"]).lower(), "note")
+        level = _level("lint", str(d["severity"]))
         rules.setdefault(rid, Rule(rid, "Lint" + "".join(w.capitalize() for w in rid.split("-")[2:]), level,
                                    "RCL lint: a contract clause that is legal but probably not what was meant."))
         out.append(_result(rid, level, str(d["message"]), str(d["location"]),
@@ -316,14 +333,20 @@ def _attach_diagnoses(report: Mapping[str, Any], results: Sequence[dict[str, Any
     from ..diagnosis.edits import sarif_fix
     by_key: dict[str, Mapping[str, Any]] = {}
     for d in report.get("diagnoses", []):
-        for prefix in ("health", "side-condition", "obligation"):
+        if d.get("kind") == "deadline":
+            by_key[f"deadline:{d.get('requirement')}"] = d
+            continue
+        for prefix in ("health", "side-condition", "obligation", "requirement"):
             by_key[f"{prefix}:{d['id']}"] = d
     for res in results:
         d = by_key.get(res["partialFingerprints"]["rclverifyItem/v1"])
         if d is None:
             continue
         res["properties"]["diagnosis"] = d["sentence"]
-        fixes = [sarif_fix(r["summary"], r["edit"]) for r in d.get("repairs", []) if r.get("edit")]
+        # what Z3 showed and what it did not, with each fix: "checked by Z3" is no safety claim (docs/diagnosis.md)
+        fixes = [sarif_fix(f"{r['summary']} Z3 shows: {r.get('proves') or 'the problem no longer follows'}; not shown: "
+                           f"{r.get('not_shown') or 'that the change is safe'}.", r["edit"])
+                 for r in d.get("repairs", []) if r.get("edit")]
         if fixes:
             res["fixes"] = fixes
 

@@ -76,7 +76,7 @@ def _health(r: Mapping[str, Any]) -> str:
         words.append(f"{r['health_problems']} problem")
     if r["health_open"]:
         words.append(f"{r['health_open']} undecided")
-    warned = r.get("health_warnings", 0)  # a warning (a probable scale mismatch) is shown, not counted as ok
+    warned = int(r.get("health_warnings", 0) or 0)  # a warning fails --strict: never counted as ok (report/severity.py)
     if warned and not words:
         words.append(f"{r['health_total'] - warned} ok")
     if warned:
@@ -88,7 +88,7 @@ def _merge(rows: list[dict[str, Any]], label: str) -> dict[str, Any]:
     out: dict[str, Any] = {"node": label, "status": max((r["status"] for r in rows), key=_rank, default="discharged"),
                            "obligations": {}}
     for key in ("sc_proved", "sc_total", "health_problems", "health_open", "health_total", "health_warnings"):
-        out[key] = sum(r.get(key, 0) for r in rows)
+        out[key] = sum(int(r.get(key, 0) or 0) for r in rows)
     out["unverified"] = [f"{r['node']}.{g}" for r in rows for g in r.get("unverified", [])]
     for r in rows:
         for s, c in r["obligations"].items():
@@ -159,8 +159,9 @@ def strict_reasons(report: Mapping[str, Any]) -> list[str]:
     """Why ``verify --strict`` fails on ``report``, as clauses (empty when
     ``report["meta"]["strict_ok"]``): obligations not discharged by status,
     guarantees no obligation covers, side conditions not proved, health
-    checks with a problem or undecided, formal requirements not met, ROS
-    grounding errors (the gate of
+    checks with a problem or undecided, health and lint warnings (one
+    severity per finding, :mod:`.severity`), formal requirements not met,
+    ROS grounding errors (the gate of
     :func:`rclverify.report.build.build_report`)."""
     if report["meta"]["strict_ok"]:
         return []
@@ -181,6 +182,14 @@ def strict_reasons(report: Mapping[str, Any]) -> list[str]:
     fs = [f for f in report["findings"] if f["status"] not in ("ok", "warning")]
     if fs:
         out.append(f"{len(fs)} contract health check{'s' if len(fs) != 1 else ''} found a problem or could not decide")
+    warned = [str(f["id"]) for f in report["findings"] if f["status"] == "warning"]
+    if warned:  # one severity per finding: a warning fails --strict as it is a warning everywhere (report/severity.py)
+        out.append(f"{len(warned)} contract health warning{'s' if len(warned) != 1 else ''} ("
+                   + ", ".join(warned[:4]) + (", ..." if len(warned) > 4 else "") + ")")
+    lint = [x for x in report.get("lint") or () if str(x.get("severity", "")).lower() in ("warning", "error")]
+    if lint:
+        out.append(f"{len(lint)} lint diagnostic{'s' if len(lint) != 1 else ''} (`rclverify check`: "
+                   + ", ".join(str(x["location"]) for x in lint[:3]) + (", ..." if len(lint) > 3 else "") + ")")
     rq = [r["id"] for r in report.get("requirements", []) if r.get("verdict", "informal") not in ("met", "informal")]
     if rq:
         out.append(f"{len(rq)} formal requirement{'s are' if len(rq) != 1 else ' is'} not met ("

@@ -1,0 +1,295 @@
+"""Repairs of a failed side condition ``G_p => c`` on the link
+``P.out.v -> C.in.w``, ranked by what they cost the user (docs/diagnosis.md,
+"Side condition: repairs ranked by what they cost").
+
+1. ``strengthen-producer``: ``c`` (in ``P``'s output names) becomes a new
+   guarantee of ``P``, the weakest strengthening of ``G_p`` that entails
+   ``c``.  Offered only when ``P`` stays *implementable* (every input its
+   assumption allows still has an answer, :func:`.realize.implementable`):
+   adding ``out.d <= 30`` to ``out.d == 1000 * in.r`` is consistent but
+   answers only ``in.r <= 0.03``; that is said (``not_offered``), not
+   offered.
+2. ``rescale-producer``: when the producer's range and the consumer's
+   bound differ by a power of ten (``P`` reaches 30000 where ``C`` assumes
+   at most 30: millimetres against metres), the coefficient of ``P``'s
+   guarantee is rescaled (``1000 * in.r`` becomes ``in.r``), as a unit
+   conversion, never as a bound.
+3. ``weaken-consumer``: ``c`` widened to what ``P`` guarantees (the
+   producer's extreme value, or one of its conjuncts), offered last and
+   only with what it invalidates named: ``C``'s guarantees that read ``w``
+   and ``C``'s evidence, established under ``c`` only; with a
+   power-of-ten mismatch it is said to be probably unsafe (``C`` would
+   read millimetres as metres).
+
+Every repair is returned only when Z3 discharged the side condition on the
+edited contracts and the edited node stays consistent; that is what its
+``proves`` says, and ``not_shown`` what Z3 did not show.
+"""
+from __future__ import annotations
+
+import difflib
+import re
+from fractions import Fraction
+from typing import Any, Mapping, Sequence
+
+from ..calculus.compose import conjuncts
+from ..rcl import ast
+from ..rcl.printer import expr_to_rcl
+from . import realize, recheck
+from .bounds import coefficient_literals, number_text, power_of_ten, value
+from .edits import Edit
+from .repairs import MAX_CANDIDATES, _and_text, _link_pairs, _record, _rename
+
+_UPPER = {"<=": True, "<": True, ">=": False, ">": False}
+_MIRROR = {"<=": ">=", "<": ">", ">=": "<=", ">": "<"}
+
+
+def _bound_shape(target: ast.Expr, inputs: set[str]) -> tuple[str, bool, ast.NumLit] | None:
+    """``(input, upper, literal)`` when the conjunct is ``in.w op N`` or
+    ``N op in.w`` with an ordering ``op``: ``upper`` when it bounds ``w``
+    from above."""
+    if not (isinstance(target, ast.Compare) and len(target.ops) == 1 and target.ops[0] in _UPPER):
+        return None
+    a, b = target.operands
+    op: str = target.ops[0]
+    if isinstance(b, ast.Var) and isinstance(a, ast.NumLit):
+        a, b, op = b, a, _MIRROR[op]
+    if isinstance(a, ast.Var) and a.prefix in ("in", None) and a.name in inputs and isinstance(b, ast.NumLit):
+        return a.name, _UPPER[op], b
+    return None
+
+
+def _implementable_check(status: str, node: str) -> dict[str, str]:
+    return {"check": f"{node} implementable", "status": {
+        "proved": "yes: every input its assumption allows has an answer (Z3: proved)",
+        "inconclusive": "not decided (Z3 could not say in its budget)"}.get(status, status)}
+
+
+def side_condition_repairs(ws: Any, sc: Mapping[str, Any], before_sc: Mapping[str, str],
+                           consumer_evidence: Sequence[str] = ()) -> dict[str, Any]:
+    """The repairs of the failed side condition ``sc`` (a report row), in
+    the order of the module docstring: ``{"repairs": [repair records],
+    "not_offered": [sentences]}``.  ``before_sc`` maps every side condition
+    id of the system to its status before the edit; ``consumer_evidence``
+    names the consumer's evidence (``"Controller.g1.hoare.c1 (discharged)"``)
+    that a weakened assumption invalidates."""
+    out: dict[str, Any] = {"repairs": [], "not_offered": []}
+    pairs = _link_pairs(sc)
+    if not pairs:
+        return out
+    consumer = str(sc["node"])
+    producers = sorted({p for p, _, _, _ in pairs})
+    cons = ws.checked.nodes[consumer].node
+    target = None
+    for a in cons.assumes:
+        for c in conjuncts(a.formula):
+            if expr_to_rcl(c) == sc["conjunct"] and c.loc.end_line:
+                target = c
+    if target is None:
+        return out
+    to_producer = [(f"in.{iv}", f"out.{ov}") for _, ov, _, iv in pairs]
+    to_consumer = [(f"out.{ov}", f"in.{iv}") for _, ov, _, iv in pairs]
+
+    def cost_of(checked: Any, model: Any, nodes: Sequence[str], health_nodes: Sequence[str]) -> list[dict[str, str]] | None:
+        after: dict[str, str] = {}
+        for n in nodes:
+            after.update(recheck.side_conditions(checked, model, n))
+        if after.get(sc["id"]) != "discharged":
+            return None
+        h_before: dict[str, str] = {}
+        h_after: dict[str, str] = {}
+        for n in health_nodes:  # both asked the same way, so a change is the edit's
+            h_before.update(recheck.health(ws, ws.checked, n))
+            h_after.update(recheck.health(ws, checked, n))
+            if h_after.get(f"{n}.contract-consistent") != "ok":
+                return None
+        before = {k: v for k, v in before_sc.items() if k in after}
+        return recheck.changes({**before, **h_before}, {**after, **h_after})
+
+    # the consumer's bound against how far the producer's contract lets the value go
+    shape = _bound_shape(target, {iv for _, _, _, iv in pairs})
+    extreme: Fraction | None = None
+    scale: int | None = None
+    single = len(producers) == 1 and len({ov for _, ov, _, _ in pairs}) == 1
+    if shape is not None and single:
+        extreme = realize.extreme(ws, ws.checked, producers[0], pairs[0][1], shape[1])
+        b = value(shape[2].text)
+        scale = power_of_ten(extreme, b) if extreme is not None and b is not None else None
+    discharged = {"check": str(sc["id"]), "status": "discharged (Z3: proved)"}
+
+    if single:
+        out["repairs"] += _strengthen(ws, sc, producers[0], _rename(str(sc["conjunct"]), to_producer), cost_of,
+                                      discharged, out["not_offered"])
+        if scale is not None and extreme is not None:
+            out["repairs"] += _rescale(ws, sc, producers[0], pairs[0][1], scale, extreme, cost_of, discharged)
+    out["repairs"] += _weaken(ws, sc, target, shape, extreme, scale, producers, to_consumer, cost_of, discharged,
+                              consumer_evidence)
+    return out
+
+
+def _strengthen(ws: Any, sc: Mapping[str, Any], p: str, new_g: str, cost_of: Any, discharged: dict[str, str],
+                not_offered: list[str]) -> list[dict[str, Any]]:
+    """1. the consumer's conjunct as a new guarantee of ``p`` (module docstring)."""
+    pn = ws.checked.nodes[p].node
+    last = pn.guarantees[-1] if pn.guarantees else None
+    if last is None or not last.loc.end_line:
+        return []
+    rel = last.loc.file
+    source = recheck.source_text(ws, rel)
+    line = source.splitlines()[last.loc.line - 1]
+    indent = line[:len(line) - len(line.lstrip())]
+    edit = Edit(rel, last.loc.end_line, last.loc.end_col, last.loc.end_line, last.loc.end_col,
+                f"\n{indent}guarantee( {new_g} )")
+    system = recheck.edited_system(ws, edit)
+    if system is None:
+        return []
+    consumers = sorted({l.to_node for l in system[1].links if l.from_node == p})
+    cost = cost_of(*system, consumers, [p])
+    if cost is None:
+        return []
+    impl, witness = realize.implementable(ws, system[0], p)
+    if impl == "refuted":
+        at = ", ".join(f"{k} = {v}" for k, v in witness.items()) or "an input"
+        not_offered.append(f"Strengthening {p} by `{new_g}` discharges {sc['id']} but leaves {p} unimplementable: "
+                           f"for {at}, which its assumption allows, no output meets its guarantees.")
+        return []
+    undecided = " (Z3 could not decide whether it stays implementable)" if impl != "proved" else ""
+    return [_record(
+        "strengthen-producer",
+        f"Strengthen {p}: add the guarantee `{new_g}`, the weakest strengthening of {p}'s guarantees that entails "
+        f"{sc['node']}'s assumption `{sc['conjunct']}`; {p} stays consistent{' and implementable' if not undecided else ''}"
+        f"{undecided}. {p}'s evidence must then establish the new guarantee.",
+        edit, recheck.source_text(ws, rel),
+        [discharged, {"check": f"{p}.contract-consistent", "status": "ok (Z3: sat)"}, _implementable_check(impl, p)],
+        cost, proves=f"{sc['id']} follows from the edited contracts",
+        not_shown=f"that {p} can be made to meet `{new_g}`: its evidence must establish it")]
+
+
+def _rescale(ws: Any, sc: Mapping[str, Any], p: str, ov: str, k: int, extreme: Fraction, cost_of: Any,
+             discharged: dict[str, str]) -> list[dict[str, Any]]:
+    """2. a coefficient of ``p``'s guarantees on ``out.ov`` divided by ``10**k`` (module docstring)."""
+    factor = Fraction(10) ** k
+    for g in ws.checked.nodes[p].node.guarantees:
+        if not re.search(rf"(?<![\w.])out\.{re.escape(ov)}(?!\w)", expr_to_rcl(g.formula)):
+            continue
+        for lit, parent in coefficient_literals(g.formula):
+            v = value(lit.text)
+            if v is None or not (lit.loc.end_line and parent.loc.end_line):
+                continue
+            new = v / factor if parent.op == "*" else v * factor
+            text = number_text(new)
+            if text is None:
+                continue
+            rel = g.loc.file
+            source = recheck.source_text(ws, rel)
+            if new == 1:  # `1000 * in.r` becomes `in.r`, `in.r / 0.001` becomes `in.r`
+                other = parent.left if parent.op == "/" or parent.right is lit else parent.right
+                probe = Edit(rel, other.loc.line, other.loc.col, other.loc.end_line, other.loc.end_col, "")
+                if not other.loc.end_line:
+                    continue
+                edit = Edit(rel, parent.loc.line, parent.loc.col, parent.loc.end_line, parent.loc.end_col,
+                            probe.deleted(source))
+            else:
+                edit = Edit(rel, lit.loc.line, lit.loc.col, lit.loc.end_line, lit.loc.end_col, text)
+            system = recheck.edited_system(ws, edit)
+            if system is None:
+                continue
+            consumers = sorted({l.to_node for l in system[1].links if l.from_node == p})
+            cost = cost_of(*system, consumers, [p])
+            if cost is None:
+                continue
+            impl, _ = realize.implementable(ws, system[0], p)
+            if impl == "refuted":
+                continue
+            old, new_text = edit.deleted(source), edit.text
+            bigger = "larger" if k > 0 else "smaller"
+            return [_record(
+                "rescale-producer",
+                f"{p}'s contract lets `out.{ov}` reach {number_text(extreme) or extreme} where {sc['node']} assumes "
+                f"`{sc['conjunct']}`: a factor of {number_text(abs(factor) if k > 0 else 1 / factor)}, so {p} "
+                f"probably publishes `{ov}` in a unit {number_text(factor if k > 0 else 1 / factor)} times {bigger} "
+                f"than {sc['node']} reads (millimetres against metres). Convert it in {p}: `{old}` becomes "
+                f"`{new_text}`. This is a unit conversion, not a bound: {p}'s implementation must publish in "
+                f"{sc['node']}'s unit.",
+                edit, source,
+                [discharged, {"check": f"{p}.contract-consistent", "status": "ok (Z3: sat)"},
+                 _implementable_check(impl, p)],
+                cost, proves=f"{sc['id']} follows from the edited contracts",
+                not_shown=(f"which unit is right: {p}'s code must publish `{ov}` in the unit {sc['node']} reads, "
+                           f"and {p}'s evidence be established again for the rescaled guarantee"))]
+    return []
+
+
+def _conjunct_after(target: ast.Expr, edit: Edit, source: str) -> str:
+    """The text of the conjunct ``target`` once ``edit`` (inside it, on one line) is made."""
+    loc = target.loc
+    if (edit.line, edit.col, edit.end_line, edit.end_col) == (loc.line, loc.col, loc.end_line, loc.end_col):
+        return edit.text
+    delta = len(edit.text) - (edit.end_col - edit.col) if edit.end_line == loc.end_line == edit.line else 0
+    return Edit(edit.file, loc.line, loc.col, loc.end_line, loc.end_col + delta, "").deleted(edit.apply(source))
+
+
+def _weaken(ws: Any, sc: Mapping[str, Any], target: ast.Expr, shape: tuple[str, bool, ast.NumLit] | None,
+            extreme: Fraction | None, scale: int | None, producers: Sequence[str],
+            to_consumer: Sequence[tuple[str, str]], cost_of: Any, discharged: dict[str, str],
+            consumer_evidence: Sequence[str]) -> list[dict[str, Any]]:
+    """3. the consumer's conjunct widened to what the producers guarantee, last (module docstring)."""
+    consumer = str(sc["node"])
+    cons = ws.checked.nodes[consumer].node
+    rel = target.loc.file
+    source = recheck.source_text(ws, rel)
+    cands: list[str] = []
+    linked = {a for a, _ in to_consumer}
+    for p in producers:
+        for g in ws.checked.nodes[p].node.guarantees:
+            for c in conjuncts(g.formula):
+                t = expr_to_rcl(c)
+                if any(re.search(rf"(?<![\w.']){re.escape(v)}(?![\w'])", t) for v in linked):
+                    t2 = _rename(t, to_consumer)
+                    if "out." not in t2 and t2 != sc["conjunct"] and t2 not in cands:
+                        cands.append(t2)
+    already = {expr_to_rcl(c) for a in cons.assumes for c in conjuncts(a.formula)}
+    cands = [t for t in cands if t not in already]
+    cands.sort(key=lambda t: -difflib.SequenceMatcher(None, t, sc["conjunct"]).ratio())
+    loc = target.loc
+    # the producers' own conjuncts first (their words), then the consumer's bound moved to the producer's extreme
+    edits = [Edit(rel, loc.line, loc.col, loc.end_line, loc.end_col, t) for t in cands]
+    if shape is not None and extreme is not None and shape[2].loc.end_line and number_text(extreme):
+        lit = shape[2]
+        edits.append(Edit(rel, lit.loc.line, lit.loc.col, lit.loc.end_line, lit.loc.end_col, str(number_text(extreme))))
+    reads = [f"guarantee {k} `{expr_to_rcl(g.formula)}`" for k, g in enumerate(cons.guarantees, 1)
+             if shape is None or re.search(rf"(?<![\w.])(in\.)?{re.escape(shape[0])}(?![\w'])", expr_to_rcl(g.formula))]
+    for edit in edits[:MAX_CANDIDATES]:
+        system = recheck.edited_system(ws, edit)
+        if system is None:
+            continue
+        cost = cost_of(*system, [consumer], [consumer])
+        if cost is None:
+            continue
+        impl, witness = realize.implementable(ws, system[0], consumer)
+        if impl == "refuted":
+            continue
+        wider = _conjunct_after(target, edit, source)
+        evidence = (f"{consumer}'s evidence was established under `{sc['conjunct']}` and no longer covers the wider "
+                    f"inputs: {', '.join(consumer_evidence)} must be established again"
+                    if consumer_evidence else
+                    f"{consumer} has no evidence yet; whatever it gets must cover the wider inputs")
+        unsafe = (f" Probably unsafe: the ranges differ by a factor of "
+                  f"{number_text(Fraction(10) ** abs(scale))}, the signature of a unit mismatch; widening the "
+                  f"assumption makes {consumer} read {producers[0]}'s values in the wrong unit instead of converting "
+                  "them." if scale is not None else "")
+        return [_record(
+            "weaken-consumer",
+            f"Weaken {consumer}'s assumption (last resort): `{sc['conjunct']}` becomes "
+            f"`{wider}`, what {_and_text(list(producers))} "
+            f"guarantee{'s' if len(producers) == 1 else ''}; {consumer} stays consistent. It invalidates what was "
+            f"shown for the narrower inputs: {consumer}'s {_and_text(reads) if reads else 'guarantees'} must then hold "
+            f"for the wider inputs, and {evidence}.{unsafe}",
+            edit, source,
+            [discharged, {"check": f"{consumer}.contract-consistent", "status": "ok (Z3: sat)"},
+             _implementable_check(impl, consumer)],
+            cost, proves=f"{sc['id']} follows from the edited contracts",
+            not_shown=(f"that {consumer} behaves correctly on the wider inputs: its evidence must be established "
+                       "again" + ("; the ranges suggest a unit mismatch, which widening does not convert"
+                              if scale is not None else "")))]
+    return []

@@ -1,0 +1,124 @@
+"""One severity per finding, the same in every output (docs/ci.md, "One
+severity per finding").
+
+Every item the report lists has one severity, decided here from its kind
+and status and read by every output:
+
+============  ==============================================  =========  ==================  ===========
+severity      what                                            SARIF      JUnit               --strict
+============  ==============================================  =========  ==================  ===========
+``error``     shown not to hold, or its record not believed   error      failure (error for  fails
+              (failed, refuted, a health problem, error)                 a status error)
+``warning``   not established (inconclusive, stale,           warning    failure, or         fails
+              pending, unverified, proved with evidence                  skipped when
+              outstanding, a deadline not decided) or a                  undecided or not
+              slip in the text (a redundant conjunct, a lint             run yet
+              warning)
+``note``      nothing can decide it: an informal requirement  note       skipped             passes
+============  ==============================================  =========  ==================  ===========
+
+The terminal and the HTML report show the status word of the item (its
+severity in the colour of the badge); ``--strict`` fails exactly on the
+items of severity ``error`` or ``warning`` (the ``-Werror`` reading of a
+strict mode: a warning is not a pass), and names them
+(:func:`blocking`).  ROS grounding findings keep the rule of docs/ros.md:
+their errors fail ``--strict``, their warnings (software the contracts
+need not describe: a graph node without a contract) do not.
+
+Kinds: ``obligation``, ``guarantee`` (one no obligation covers),
+``side-condition``, ``health``, ``requirement`` (by verdict), ``deadline``
+(by verdict), ``lint`` (by its severity word).
+"""
+from __future__ import annotations
+
+from typing import Any, Mapping
+
+ERROR, WARNING, NOTE = "error", "warning", "note"
+#: Severities that fail ``--strict``.
+GATING = (ERROR, WARNING)
+
+_HOLDS = {"discharged", "ok", "met", "proved"}
+_ERROR_WORDS = {"failed", "error", "problem", "refuted", "proved from an inconsistency", "proved vacuously"}
+#: Statuses of something not decided or not run yet (JUnit ``<skipped>``).
+UNDECIDED = {"inconclusive", "pending", "unknown", "informal", "proved, evidence outstanding"}
+
+
+def of(kind: str, status: str) -> str | None:
+    """The severity of an item of ``kind`` with ``status`` (for a
+    requirement or a deadline: its verdict; for lint: its severity word),
+    ``None`` when the item holds (it is no finding).  A word this table does
+    not know is an ``error``: the report cannot vouch for what it does not
+    understand."""
+    s = str(status)
+    if s in _HOLDS:
+        return None
+    if kind == "requirement" and s == "informal":
+        return NOTE
+    if kind == "lint":
+        return ERROR if s.lower() == "error" else WARNING
+    if s in _ERROR_WORDS:
+        return ERROR
+    if s in ("stale", "inconclusive", "pending", "unverified", "unknown", "warning", "proved, evidence outstanding"):
+        return WARNING
+    return ERROR
+
+
+def gates(severity: str | None) -> bool:
+    """Does an item of ``severity`` fail ``--strict``?"""
+    return severity in GATING
+
+
+def junit_outcome(kind: str, status: str) -> str:
+    """``pass`` / ``skipped`` / ``failure`` / ``error``: how JUnit shows an
+    item (module table).  ``status`` as for :func:`of`."""
+    sev = of(kind, status)
+    if sev is None:
+        return "pass"
+    if str(status) == "error":
+        return "error"
+    if sev == NOTE or str(status) in UNDECIDED:
+        return "skipped"
+    return "failure"
+
+
+def items(report: Mapping[str, Any]) -> list[tuple[str, str, str, str]]:
+    """Every finding of ``report`` as ``(kind, id, status, severity)``, in
+    the report's order (obligations, guarantees no obligation covers, side
+    conditions, health checks, requirements, deadlines, lint); items that
+    hold are left out."""
+    out: list[tuple[str, str, str, str]] = []
+
+    def add(kind: str, ident: str, status: str) -> None:
+        sev = of(kind, status)
+        if sev is not None:
+            out.append((kind, ident, status, sev))
+    for o in report.get("obligations") or ():
+        add("obligation", str(o["id"]), str(o["status"]))
+    for u in report.get("unverified") or ():
+        add("guarantee", str(u["id"]), "unverified")
+    for sc in report.get("side_conditions") or ():
+        add("side-condition", str(sc["id"]), str(sc["status"]))
+    for f in report.get("findings") or ():
+        add("health", str(f["id"]), str(f["status"]))
+    for r in report.get("requirements") or ():
+        add("requirement", str(r["id"]), str(r.get("verdict", "informal")))
+    for d in report.get("deadlines") or ():
+        add("deadline", f"{d['requirement']}.deadline", str(d["verdict"]))
+    for x in report.get("lint") or ():
+        add("lint", f"{x['location']}:{x.get('code', '')}", str(x["severity"]))
+    return out
+
+
+def blocking(report: Mapping[str, Any]) -> list[tuple[str, str, str, str]]:
+    """The findings that fail ``--strict`` (severity ``error`` or
+    ``warning``), as :func:`items` gives them, plus the ROS grounding
+    errors (``("grounding", code, "error", "error")``) and a stale grounding."""
+    out = [x for x in items(report) if gates(x[3])]
+    g = report.get("grounding")
+    if isinstance(g, Mapping):
+        for f in g.get("findings") or ():
+            if f.get("severity") == "error":
+                out.append(("grounding", str(f.get("code", "")), "error", ERROR))
+        if g.get("stale"):
+            out.append(("grounding", "stale", "stale", WARNING))
+    return out
