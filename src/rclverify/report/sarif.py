@@ -89,6 +89,9 @@ RULES: Mapping[str, Rule] = {r.id: r for r in (
     Rule("RCL-HEALTH-REDUNDANT", "ConjunctRedundant", "warning",
          "A conjunct of a guarantee follows from the assumption and the other conjuncts: it adds nothing (often a "
          "copy-paste slip)."),
+    Rule("RCL-HEALTH-SCALE", "ProbableScaleMismatch", "warning",
+         "A side condition fails and the producer's range and the consumer's differ by a power of ten: probably one "
+         "end is in other units (mm against m); declare the units (docs/rcl-language.md)."),
     Rule("RCL-HEALTH-OTHER", "HealthProblem", "error", "A contract health check found a problem."),
     Rule("RCL-HEALTH-INCONCLUSIVE", "HealthInconclusive", "warning",
          "Z3 could not decide a contract health check."),
@@ -128,7 +131,8 @@ _HEALTH_RULE = {"assumption-satisfiable": "RCL-HEALTH-UNSATISFIABLE-ASSUMPTION",
                 "replacement-refines": "RCL-HEALTH-REPLACEMENT",
                 "tautology": "RCL-HEALTH-TAUTOLOGY",
                 "constrains-no-output": "RCL-HEALTH-NO-OUTPUT",
-                "redundant": "RCL-HEALTH-REDUNDANT"}
+                "redundant": "RCL-HEALTH-REDUNDANT",
+                "probable-scale-mismatch": "RCL-HEALTH-SCALE"}
 _OBLIGATION_RULE = {"failed": "RCL-OBL-FAILED", "error": "RCL-OBL-ERROR", "stale": "RCL-OBL-STALE",
                     "inconclusive": "RCL-OBL-INCONCLUSIVE", "pending": "RCL-OBL-PENDING"}
 
