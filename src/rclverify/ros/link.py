@@ -1,0 +1,446 @@
+"""The linker: one program's endpoints and node names, read across all the
+files it runs (docs/ros.md, "Reading real code").
+
+From the program's entry units (:mod:`programs`) the linker follows what
+they construct and call (C++ ``Sensor s(nh, "scan")``, a member initialised
+in a constructor, ``new``/``make_shared``, a default-constructed member, a
+base class; Python ``Sensor(self, 'scan')``, ``self.start('x')``, an
+imported class or function) to every class and function the program runs.
+Endpoints created there belong to the program; names that their file left
+symbolic (:mod:`symbols`) are evaluated here:
+
+* a parameter of a function or constructor takes the value each call site
+  passes (its default argument when the site passes none): one endpoint per
+  distinct name, each at the creating call's line;
+* a member takes what the class's constructor (or any method) binds to it,
+  a node handle member the node's own handle when nothing binds it;
+* an imported Python constant is looked up in the package module that
+  defines it;
+* a node handle's namespaces are those of the handle each call site passes.
+
+Helper objects held as members (``tf2_ros::TransformBroadcaster br_;``, an
+actionlib server initialised in a constructor, a ``message_filters``
+subscriber whose ``subscribe`` is called) get their class from the
+program's declarations.  When the program names several nodes, each
+endpoint belongs to the node whose class creates it or constructs (directly
+or not) the class that does; the rest to the node named outside any class.
+Work is bounded (:data:`MAX_DEPTH` nested calls, :data:`MAX_VALUES` values).
+"""
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass, field
+from typing import Any, Callable
+
+from . import cpp_helpers, emit, symbols
+from .cpp_scope import is_node_type
+from .cpp_types import action_type, message_type, service_type, split_template
+from .model import Endpoint, Note, Src
+from .programs import PackageCode, Program
+
+MAX_DEPTH = 8
+MAX_VALUES = 32
+_ACTIONLIB = {"SimpleActionServer": "action_servers", "ActionServer": "action_servers",
+              "SimpleActionClient": "action_clients", "ActionClient": "action_clients"}
+_IDENT = re.compile(r"[A-Za-z_][\w:]*")
+
+
+@dataclass
+class Linked:
+    """A linked program: ``nodes`` ``[(name, where named, namespace or None)]``,
+    ``endpoints`` ``[(Endpoint, index of its node in nodes, or -1)]``, ``notes``
+    and the ``files`` that gave any of them."""
+
+    nodes: list[tuple[str, Src, str | None]] = field(default_factory=list)
+    endpoints: list[tuple[Endpoint, int]] = field(default_factory=list)
+    notes: list[Note] = field(default_factory=list)
+    files: list[str] = field(default_factory=list)
+
+
+def _limit(xs: list[Any]) -> list[Any]:
+    out: list[Any] = []
+    for x in xs:
+        if x not in out:
+            out.append(x)
+            if len(out) >= MAX_VALUES:
+                break
+    return out
+
+
+class Linker:
+    """Link one program of a package (see the module docstring); ``known(t)`` says
+    whether the scan's type table defines message type ``t``."""
+
+    def __init__(self, prog: Program, code: PackageCode, known: Callable[[str], bool]) -> None:
+        self.prog, self.code, self.known = prog, code, known
+        self.recs = {f: code.records[f] for f in prog.files if f in code.records}
+        self.fns: dict[str, tuple[str, list[str], list[str], list[Any]]] = {}
+        self.units: dict[str, dict[str, Any]] = {}
+        self.fields: dict[tuple[str, str], list[Any]] = {}
+        self.callbacks: dict[str, str] = {}
+        self.calls: list[tuple[Any, ...]] = []
+        entry_units: set[str] = set()
+        for f, r in self.recs.items():
+            for k, (unit, params, ptypes, defaults) in r.get("fns", {}).items():
+                old = self.fns.get(k)
+                if old is not None and len(old[1]) == len(params):
+                    defaults = [d if d is not None else o for d, o in zip(defaults, old[3])]
+                self.fns[k] = (unit, params, ptypes, defaults)
+                if f in prog.entry:
+                    entry_units.add(unit)
+            for u, info in r.get("units", {}).items():
+                cur = self.units.setdefault(u, {"bases": [], "members": {}})
+                cur["bases"] += [b for b in info["bases"] if b not in cur["bases"]]
+                cur["members"].update(info["members"])
+                if f in prog.entry:
+                    entry_units.add(u)
+            for key, vals in r.get("fields", {}).items():
+                self.fields.setdefault(key, []).extend(vals)
+            for k, v in r.get("callbacks", {}).items():
+                self.callbacks.setdefault(k, v)
+            for c in r.get("calls", []):
+                self.calls.append(tuple(c) + (({},) if len(c) == 6 else ()))
+            if r.get("lang") == "py":
+                entry_units.add(f"{f}::<module>")  # a module's code runs when it is imported
+        self.py = bool(self.recs) and all(r.get("lang") == "py" for r in self.recs.values())
+        self.classes = [] if self.py else sorted(self.units)
+        self.entry = prog.units if prog.units is not None else entry_units
+        self.sites: dict[str, list[tuple[list[Any], dict[str, Any], str | None]]] = {}
+        self.edges: dict[str, set[str]] = {}
+        for c in self.calls:
+            kind, callee, args, fkey, unit, _src, kwargs = c
+            ck, cu = self.callee(kind, callee, unit)
+            if cu is not None and unit is not None:
+                self.edges.setdefault(unit, set()).add(cu)
+            if ck is not None:
+                self.sites.setdefault(ck, []).append((args, kwargs, fkey))
+        for u, info in self.units.items():
+            for ty in list(info["members"].values()) + info["bases"]:
+                for ident in _IDENT.findall(ty):
+                    m = self.match(ident, u) if not ident.startswith(("std::", "ros::", "rclcpp::")) else None
+                    if m is not None and m != u:
+                        self.edges.setdefault(u, set()).add(m)
+        self.reach = self._reach(self.entry)
+        self._memo: dict[str, list[dict[int, Any]]] = {}
+        self._stack: set[str] = set()
+
+    # -- program structure
+    def match(self, name: str, caller: str | None) -> str | None:
+        """The program's class a C++ type name (``Sensor``, ``ns::Sensor``) names."""
+        t = split_template(name.replace("*", "").replace("&", "").strip())[0].strip(":")
+        if not t:
+            return None
+        cands = [u for u in self.classes if u == t or u.endswith("::" + t)]
+        if not cands:
+            return None
+        if len(cands) > 1 and caller:
+            ns = caller.rsplit("::", 1)[0]
+            near = [u for u in cands if u.startswith(ns + "::")]
+            cands = near or cands
+        return sorted(cands, key=len)[0]
+
+    def callee(self, kind: str, callee: str, unit: str | None) -> tuple[str | None, str | None]:
+        """``(callable key, unit)`` a call record names in this program."""
+        if self.py:
+            return self._py_callee(callee)
+        if kind == "member":
+            info = self.units.get(unit or "", {})
+            ty = info.get("members", {}).get(callee)
+            cls = self.match(_held(ty), unit) if ty else None
+            if cls is None and any(b.split("<")[0].split("::")[-1] == callee.split("::")[-1] for b in info.get("bases", [])):
+                cls = self.match(callee, unit)
+            return (self._ctor(cls), cls) if cls else (None, None)
+        if kind == "ctor":
+            cls = self.match(callee, unit)
+            return (self._ctor(cls), cls) if cls else (None, None)
+        meth, recv = callee, None
+        for sep in ("->", "."):
+            if sep in meth:
+                recv, meth = meth.rsplit(sep, 1)
+        if "::" in meth and recv is None:
+            head, last = meth.rsplit("::", 1)
+            cls = self.match(head, unit)
+            if cls is not None and f"{cls}::{last}" in self.fns:
+                return f"{cls}::{last}", cls
+            cls = self.match(meth, unit)
+            if cls is not None:
+                return self._ctor(cls), cls
+        if recv is not None and recv.replace("this", "").strip("()*&") and unit:
+            ty = self.units.get(unit, {}).get("members", {}).get(recv.replace("this->", "").strip())
+            cls = self.match(_held(ty), unit) if ty else None
+            return (f"{cls}::{meth}", cls) if cls and f"{cls}::{meth}" in self.fns else (None, None)
+        if unit and f"{unit}::{meth}" in self.fns:
+            return f"{unit}::{meth}", unit
+        cls = self.match(meth, unit)
+        if cls is not None and recv is None:
+            return self._ctor(cls), cls
+        free = [k for k, v in self.fns.items() if v[0] == k and (k == meth or k.endswith("::" + meth))]
+        return (free[0], free[0]) if len(free) == 1 else (None, None)
+
+    def _ctor(self, cls: str) -> str:
+        return f"{cls}::{cls.split('::')[-1]}"
+
+    def _py_callee(self, callee: str) -> tuple[str | None, str | None]:
+        if callee.startswith("ext:"):
+            hit = self.code.module(callee[4:])
+            if hit is None or not hit[1]:
+                return None, None
+            callee = f"{hit[0]}::{hit[1]}"
+        if callee in self.units:
+            return f"{callee}.__init__", callee
+        if callee in self.fns:
+            return callee, self.fns[callee][0]
+        return None, None
+
+    def _reach(self, start: set[str]) -> set[str]:
+        seen, todo = set(), list(start)
+        while todo:
+            u = todo.pop()
+            if u in seen:
+                continue
+            seen.add(u)
+            todo.extend(self.edges.get(u, ()))
+        return seen
+
+    # -- values
+    def contexts(self, fkey: str | None, depth: int = 0) -> list[dict[int, Any]]:
+        """The parameter values each call site of ``fkey`` gives (``[{}]``: none known)."""
+        if fkey is None or fkey not in self.fns:
+            return [{}]
+        if fkey in self._memo:
+            return self._memo[fkey]
+        if depth > MAX_DEPTH or fkey in self._stack:
+            return [{}]
+        self._stack.add(fkey)
+        params = self.fns[fkey][1]
+        envs: list[dict[int, Any]] = []
+        for args, kwargs, caller in self.sites.get(fkey, []):
+            if caller is not None and self.fns.get(caller, ("",))[0] not in self.reach:
+                continue
+            for cenv in self.contexts(caller, depth + 1):
+                partial: list[dict[int, Any]] = [{}]
+                pairs = list(enumerate(args)) + [(params.index(k), v) for k, v in kwargs.items() if k in params]
+                for i, a in pairs:
+                    vals = self.eval(a, cenv, caller, depth + 1)
+                    partial = _limit([{**e, i: v} for e in partial for v in vals])
+                envs.extend(partial)
+        self._stack.discard(fkey)
+        out = _limit(envs) or [{}]
+        self._memo[fkey] = out
+        return out
+
+    def eval(self, v: Any, env: dict[int, Any], fkey: str | None, depth: int = 0) -> list[Any]:
+        """Every concrete value ``v`` takes in function ``fkey`` called with ``env``."""
+        if v is None or depth > MAX_DEPTH:
+            return [None]
+        k = v[0]
+        if k in ("str", "node"):
+            return [v]
+        if k == "arg":
+            if v[1] == fkey and v[2] in env:
+                return [env[v[2]]]
+            if v[1] == fkey or v[1] not in self.fns:
+                return self._default(v[1], v[2], depth)
+            out: list[Any] = []
+            for e in self.contexts(v[1], depth + 1):
+                out += self.eval(v, e, v[1], depth + 1) if v[2] in e else self._default(v[1], v[2], depth)
+            return _limit(out)
+        if k == "field":
+            return self._field(v[1], v[2], depth)
+        if k == "ext":
+            hit = self.code.module(v[1])
+            rec = self.code.records.get(hit[0], {}) if hit else {}
+            c = rec.get("consts", {}).get(hit[1]) if hit else None
+            return self.eval(c, {}, None, depth + 1) if c is not None else [None]
+        if k == "param":
+            return [("param", v[1], v[2], h) for h in (self.eval(v[3], env, fkey, depth + 1) if v[3] else [None])]
+        if k == "nh":
+            segs: list[tuple[Any, ...]] = [()]
+            for kind, x in v[1]:
+                xs = self.eval(x, env, fkey, depth + 1) if x is not None else [None]
+                if kind == "h":
+                    xs = [y if y is not None and y[0] == "nh" else None for y in xs]
+                segs = _limit([s + ((kind, y),) for s in segs for y in xs])
+            return [("nh", s) for s in segs]
+        if k == "cat":
+            parts: list[list[Any]] = [[]]
+            for x in v[1]:
+                parts = _limit([p + [y] for p in parts for y in self.eval(x, env, fkey, depth + 1)])
+            return _limit([symbols.cat(p) for p in parts])
+        if k == "ops":
+            return [("ops", v[1], n, v[3], v[4]) for n in self.eval(v[2], env, fkey, depth + 1)]
+        return [None]
+
+    def _default(self, fkey: str, i: int, depth: int) -> list[Any]:
+        f = self.fns.get(fkey)
+        d = f[3][i] if f is not None and i < len(f[3]) else None
+        return self.eval(d, {}, fkey, depth + 1) if d is not None else [None]
+
+    def _field(self, unit: str, name: str, depth: int) -> list[Any]:
+        ty, binds = None, None
+        for u in [unit] + [b for b in (self.match(x, unit) for x in self.units.get(unit, {}).get("bases", [])) if b]:
+            ty = ty or self.units.get(u, {}).get("members", {}).get(name)
+            binds = binds or self.fields.get((u, name))
+        handle = ty is not None and is_node_type(ty)
+        if not binds:
+            if handle:
+                return [("nh", ())]
+            consts = [r.get("consts", {}).get(name) for r in self.recs.values()]
+            got = {c for c in consts if c is not None}
+            return self.eval(next(iter(got)), {}, None, depth + 1) if len(got) == 1 else [None]
+        out: list[Any] = []
+        for b in binds:
+            for x in self.eval(b, {}, None, depth + 1):
+                if handle and x is not None and x[0] != "nh":
+                    x = ("nh", (("ns", x),))
+                out.append(x)
+        return _limit(out)
+
+    # -- the program's endpoints and nodes
+    def run(self) -> Linked:
+        out = Linked()
+        said: set[tuple[Src, str]] = set()
+        eps: list[Endpoint] = []
+
+        def note(n: Note) -> None:
+            if (n.src, n.message) not in said:
+                said.add((n.src, n.message))
+                out.notes.append(n)
+
+        def take(f: str, e: Endpoint) -> None:
+            if e.unit is not None and e.unit not in self.reach:
+                return
+            if e.unit is None and f not in self.prog.entry:
+                return
+            for x in self.resolve(e, note):
+                if x not in eps:
+                    eps.append(x)
+                    if f not in out.files:
+                        out.files.append(f)
+
+        for f, r in self.recs.items():
+            for e in r.get("endpoints", []):
+                take(f, e)
+            for e in self.members(r):
+                take(f, e)
+        named: list[tuple[str, Src, str | None, str | None]] = []
+        for f, r in self.recs.items():
+            for v, src, unit, fkey, ns in r.get("node_names", []):
+                if unit is not None and unit not in self.reach or unit is None and f not in self.prog.entry:
+                    continue
+                for env in self.contexts(fkey):
+                    for name in self.eval(v, env, fkey):
+                        t = symbols.text(name) if name is not None and name[0] in ("str", "cat") else None
+                        if t is None:
+                            note(Note(src, "node name is not a string literal: not resolved statically"))
+                            continue
+                        nsv = self.eval(ns, env, fkey)[0] if ns is not None else None
+                        item = (t, src, symbols.text(nsv) if nsv is not None else None, unit)
+                        if not any(x[0] == t and x[2] == item[2] for x in named):
+                            named.append(item)
+                        if f not in out.files:
+                            out.files.append(f)
+        out.nodes = [(n, s, ns) for n, s, ns, _u in named]
+        owners = self.owners([u for *_x, u in named], eps)
+        out.endpoints = list(zip(eps, owners))
+        return out
+
+    def resolve(self, e: Endpoint, note: Callable[[Note], None]) -> list[Endpoint]:
+        """The concrete endpoints a (possibly pending) endpoint stands for."""
+        if e.pending is None:
+            return [e]
+        name, handle, cb, fkey, written, nsrc = e.pending
+        t = e.msg_type if e.msg_type is not None else self.cb_type(e.kind, cb)
+        got: list[Endpoint] = []
+        for env in self.contexts(fkey):
+            for n in self.eval(name, env, fkey):
+                for h in self.eval(handle, env, fkey) if handle is not None else [None]:
+                    if n is not None and n[0] == "ops":
+                        n = n[2]
+                    x, bad = emit.resolve(e.kind, n, h, t, e.src, e.unit, written, nsrc)
+                    if bad is not None:
+                        note(bad)
+                    if x is not None and x not in got:
+                        got.append(x)
+        if got and t is None:
+            note(emit.type_note(got[0]))
+        return got
+
+    def cb_type(self, kind: str, cb: Any) -> str | None:
+        """The type a callback (C++: its name; Python: ``("cands", types)`` of a star
+        import) gives an endpoint of role ``kind``."""
+        if isinstance(cb, tuple) and cb and cb[0] == "cands":
+            known = [t for t in cb[1] if self.known(t)]
+            return known[0] if len(known) == 1 else None
+        if not isinstance(cb, str):
+            return None
+        text = self.callbacks.get(cb)
+        return message_type(text) if kind in ("pub", "sub") else service_type(text) if text else None
+
+    def members(self, r: dict[str, Any]) -> list[Endpoint]:
+        """Pending endpoints of helper objects held as members (their class found in
+        the program's declarations): made in a constructor's initialiser list, or
+        by default where none initialises them; and of their methods' calls."""
+        out: list[Endpoint] = []
+        for unit, m, ty, src in r.get("member_decls", []):
+            if unit not in self.reach:
+                continue
+            inits = [c for c in self.calls if c[0] == "member" and c[1] == m and c[4] == unit]
+            for c in inits or [None]:
+                args = c[2] if c else []
+                at, fkey = (c[5], c[3]) if c else (src, None)
+                for kind, nv, t, hv in self.helper(ty, args) or []:
+                    out.append(Endpoint(kind, "", t, at, None, (), unit,
+                                        (nv, hv, None, fkey, symbols.text(nv) or m, at)))
+        for unit, m, meth, args, texts, src, fkey in r.get("member_calls", []):
+            if unit not in self.reach:
+                continue
+            ty = self.units.get(unit, {}).get("members", {}).get(m)
+            for b in self.units.get(unit, {}).get("bases", []):
+                cls = self.match(b, unit)
+                ty = ty or (self.units.get(cls, {}).get("members", {}).get(m) if cls else None)
+            specs = cpp_helpers.method(ty, meth, args, [], lambda x: x, None) if ty else None
+            for kind, nv, t, hv in specs or []:
+                k = 1 if kind == "sub" and meth == "subscribe" else 0
+                out.append(Endpoint(kind, "", t, src, None, (), unit,
+                                    (nv, hv, None, fkey, texts[k] if k < len(texts) else m, src)))
+        return out
+
+    def helper(self, ty: str, args: list[Any]) -> list[cpp_helpers.Spec] | None:
+        head, targs = split_template(ty.replace(" ", ""))
+        last = head.split("::")[-1]
+        if last in _ACTIONLIB and targs:
+            if not args:
+                return []
+            first = args[0]
+            if len(args) >= 2 and first is not None and first[0] in ("nh", "field", "arg"):
+                return [(_ACTIONLIB[last], args[1], action_type(targs[0]), first)]
+            return [(_ACTIONLIB[last], first, action_type(targs[0]), None)]
+        return cpp_helpers.constructed(ty, args, lambda x: x, False)
+
+    def owners(self, units: list[str | None], eps: list[Endpoint]) -> list[int]:
+        """Each endpoint's node (an index in the named nodes; -1 when none)."""
+        if len(units) <= 1:
+            return [0 if units else -1] * len(eps)
+        reach = {i: self._reach({u}) if u else set() for i, u in enumerate(units)}
+        loose = next((i for i, u in enumerate(units) if u is None or u not in self.units or u.endswith("<module>")), 0)
+        out = []
+        for e in eps:
+            own = next((i for i, u in enumerate(units) if u is not None and u == e.unit), None)
+            if own is None and self.py:  # a nested class belongs to its enclosing node class
+                inner = [i for i, u in enumerate(units) if u and u in self.units and (e.unit or "").startswith(u + ".")]
+                own = max(inner, key=lambda i: len(units[i] or "")) if inner else None
+            if own is None:
+                own = next((i for i in reach if units[i] in self.units and e.unit in reach[i]), loose)
+            out.append(own)
+        return out
+
+
+def _held(ty: str | None) -> str:
+    """The class a member's type holds: ``std::shared_ptr<ns::Sensor>`` -> ``ns::Sensor``."""
+    if not ty:
+        return ""
+    head, args = split_template(ty.replace(" ", ""))
+    if head.split("::")[-1] in ("shared_ptr", "unique_ptr", "weak_ptr", "Ptr", "SharedPtr", "vector", "optional") and args:
+        return _held(args[0])
+    return head
