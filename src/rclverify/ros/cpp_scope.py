@@ -107,6 +107,7 @@ class CppScope:
 
     def __init__(self, nodes: list[Any]) -> None:
         self.fns: dict[int, Fn] = {}
+        self.decls: dict[str, Fn] = {}  # methods declared in a class body, by key
         self.classes: dict[str, dict[str, Any]] = {}
         self.consts: dict[str, list[Any]] = {}
         self.locals: dict[tuple[int, str], list[Any]] = {}
@@ -115,6 +116,7 @@ class CppScope:
         self.using_ns: list[str] = []
         self.declared: dict[str, str | None] = {}  # ROS 2 parameter -> its declared default
         self._fn_of: dict[int, Fn | None] = {}
+        self.override: Fn | None = None
         for n in nodes:
             t = n.type
             if t == "function_definition":
@@ -190,6 +192,10 @@ class CppScope:
             if c.type == "base_class_clause":
                 info["bases"].extend(_T(b) for b in c.named_children if b.type != "access_specifier")
         for f in n.child_by_field_name("body").named_children:
+            if f.type == "declaration" or f.type == "field_declaration" and any(
+                    d.type == "function_declarator" for d in f.children_by_field_name("declarator")):
+                self._method_decl(f, name)
+                continue
             if f.type != "field_declaration":
                 continue
             ty = _T(f.child_by_field_name("type"))
@@ -207,6 +213,25 @@ class CppScope:
                     if any(c.type in ("storage_class_specifier",) and _T(c) == "static" for c in f.children):
                         self.consts.setdefault(_T(nm), []).append(v)
                         self.consts.setdefault(f"{name.split('::')[-1]}::{_T(nm)}", []).append(v)
+
+    def _method_decl(self, f: Any, cls: str) -> None:
+        """A method or constructor declared (not defined) in class ``cls``: its
+        parameters and default arguments (often only the header has them)."""
+        fd = next((d for d in f.children_by_field_name("declarator") if d.type == "function_declarator"), None)
+        if fd is None:
+            return
+        name = _T(fd.child_by_field_name("declarator")).split("<")[0]
+        last = cls.split("::")[-1]
+        key = f"{cls}::{last}" if name == last else f"{cls}::{name}"
+        fn = Fn(key, cls, True, -1)
+        params = fd.child_by_field_name("parameters")
+        for p in params.named_children if params is not None else []:
+            if p.type in ("parameter_declaration", "optional_parameter_declaration"):
+                d = _declarator_name(p.child_by_field_name("declarator"))
+                fn.params.append(_T(d) if d is not None else "")
+                fn.ptypes.append(_T(p.child_by_field_name("type")))
+                fn.defaults.append(p.child_by_field_name("default_value"))
+        self.decls[key] = fn
 
     def _declaration(self, n: Any) -> None:
         fn = self.fn_of(n)
@@ -258,7 +283,10 @@ class CppScope:
 
     # -- lookups
     def fn_of(self, n: Any) -> Fn | None:
-        """The function definition ``n`` lies in (``None`` at namespace scope)."""
+        """The function definition ``n`` lies in (``None`` at namespace scope); while
+        :attr:`override` is set, that function (for expressions re-read out of place)."""
+        if self.override is not None:
+            return self.override
         p = n.parent
         chain = []
         while p is not None:
@@ -326,6 +354,8 @@ class CppScope:
             return symbols.NODE
         if base_name(ftext) in _HANDLE_TYPES:
             return self.handle(args, depth)
+        if last == "create_sub_node" and len(args) == 1 and (fn is None or fn.type != "field_expression"):
+            return ("nh", (("ns", self.value(args[0], depth + 1)),))
         if last in ("getPrivateNodeHandle", "getMTPrivateNodeHandle"):
             return ("nh", (("ns", symbols.lit("~")),))
         if last in ("getNodeHandle", "getMTNodeHandle", "shared_from_this"):

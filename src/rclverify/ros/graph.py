@@ -194,7 +194,7 @@ def _scan(paths: Sequence[Path], launch: Sequence[Path], launch_args: dict[str, 
                     sev = "warning" if isinstance(exc, safefs.Refused) else "error"
                     g.notes.append(Note(Src(show(f)), f"cannot read: {exc}", "ROS-PARSE", sev))
                 continue
-            if f in bare and f not in installed and not _python_shebang(data):
+            if f in bare and not _python_shebang(data) and (f not in installed or data.startswith(b"#!")):
                 continue  # not a Python program (a shell script, a data file)
             if len(data) > MAX_SOURCE_BYTES:
                 g.notes.append(Note(Src(show(f)), "source file larger than 2 MB: not scanned", "ROS-PARSE"))

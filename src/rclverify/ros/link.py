@@ -78,6 +78,7 @@ class Linker:
         self.units: dict[str, dict[str, Any]] = {}
         self.fields: dict[tuple[str, str], list[Any]] = {}
         self.callbacks: dict[str, str] = {}
+        self.aliases: dict[str, str] = {}
         self.calls: list[tuple[Any, ...]] = []
         entry_units: set[str] = set()
         for f, r in self.recs.items():
@@ -98,6 +99,8 @@ class Linker:
                 self.fields.setdefault(key, []).extend(vals)
             for k, v in r.get("callbacks", {}).items():
                 self.callbacks.setdefault(k, v)
+            for k, v in r.get("aliases", {}).items():
+                self.aliases.setdefault(k, v)
             for c in r.get("calls", []):
                 self.calls.append(tuple(c) + (({},) if len(c) == 6 else ()))
             if r.get("lang") == "py":
@@ -147,6 +150,8 @@ class Linker:
             info = self.units.get(unit or "", {})
             ty = info.get("members", {}).get(callee)
             cls = self.match(_held(ty), unit) if ty else None
+            if cls is not None and _held(ty) != split_template(ty.replace(" ", ""))[0].replace("*", "").strip():
+                return None, cls  # a pointer member: made by the new/make_shared it is given
             if cls is None and any(b.split("<")[0].split("::")[-1] == callee.split("::")[-1] for b in info.get("bases", [])):
                 cls = self.match(callee, unit)
             return (self._ctor(cls), cls) if cls else (None, None)
@@ -236,6 +241,14 @@ class Linker:
         k = v[0]
         if k in ("str", "node"):
             return [v]
+        homes = {h for h in _homes(v) if h != fkey and h in self.fns}
+        if len(homes) == 1 and k != "arg":
+            # the parts of one function's parameters are read together, call site by call site
+            home = homes.pop()
+            joint: list[Any] = []
+            for e in self.contexts(home, depth + 1):
+                joint += self.eval(v, e, home, depth + 1)
+            return _limit(joint)
         if k == "arg":
             if v[1] == fkey and v[2] in env:
                 return [env[v[2]]]
@@ -372,10 +385,17 @@ class Linker:
         if isinstance(cb, tuple) and cb and cb[0] == "cands":
             known = [t for t in cb[1] if self.known(t)]
             return known[0] if len(known) == 1 else None
-        if not isinstance(cb, str):
+        if isinstance(cb, tuple) and cb and cb[0] == "type":
+            text: str | None = cb[1]
+            for _ in range(4):
+                text = self.aliases.get(text or "", self.aliases.get((text or "").split("::")[-1], text))
+        elif isinstance(cb, str):
+            text = self.callbacks.get(cb)
+        else:
             return None
-        text = self.callbacks.get(cb)
-        return message_type(text) if kind in ("pub", "sub") else service_type(text) if text else None
+        if kind in ("pub", "sub"):
+            return message_type(text, self.aliases)
+        return service_type(text) if kind.startswith("service") else action_type(text)
 
     def members(self, r: dict[str, Any]) -> list[Endpoint]:
         """Pending endpoints of helper objects held as members (their class found in
@@ -434,6 +454,24 @@ class Linker:
                 own = next((i for i in reach if units[i] in self.units and e.unit in reach[i]), loose)
             out.append(own)
         return out
+
+
+def _homes(v: Any) -> set[str]:
+    """The functions whose parameters value ``v`` reads (directly, in a concatenation,
+    a handle or a parameter read)."""
+    if v is None or not isinstance(v, tuple) or not v:
+        return set()
+    if v[0] == "arg":
+        return {v[1]}
+    if v[0] == "cat":
+        return set().union(*(_homes(x) for x in v[1]))
+    if v[0] == "nh":
+        return set().union(*(_homes(x) for _k, x in v[1]))
+    if v[0] == "param":
+        return _homes(v[3])
+    if v[0] == "ops":
+        return _homes(v[2])
+    return set()
 
 
 def _held(ty: str | None) -> str:

@@ -65,8 +65,7 @@ def _walk(n: Any):  # type: ignore[no-untyped-def]
 def _callee(fn: Any) -> tuple[str, str, list[str]]:
     """``(full text without template arguments, last name part, template argument texts)``."""
     f = fn.child_by_field_name("field") if fn.type == "field_expression" else fn
-    if f is not None and f.type == "qualified_identifier" and f.child_by_field_name("name") is not None \
-            and f.child_by_field_name("name").type in ("template_function", "template_method"):
+    while f is not None and f.type == "qualified_identifier" and f.child_by_field_name("name") is not None:
         f = f.child_by_field_name("name")
     targs: list[str] = []
     if f is not None and f.type in ("template_method", "template_function"):
@@ -85,6 +84,7 @@ def _callee(fn: Any) -> tuple[str, str, list[str]]:
 class _File:
     def __init__(self, data: bytes, shown: str) -> None:
         self.shown = shown
+        self.vex_at: Any = None
         self.out: dict[str, Any] = {"nodes": [], "endpoints": [], "notes": [], "classes": {}, "components": [],
                                     "lang": "cpp", "calls": [], "node_names": [], "member_decls": [],
                                     "member_calls": [], "includes": [], "callbacks": {}}
@@ -105,6 +105,8 @@ class _File:
                                                          "recovered", "ROS-PARSE"))
 
     def src(self, n: Any) -> Src:
+        if self.vex_at is not None:  # an expression re-read out of place: located at its declaration
+            n = self.vex_at
         return Src(self.shown, n.start_point[0] + 1, n.start_point[1] + 1)
 
     def _index(self, n: Any) -> None:
@@ -171,8 +173,9 @@ class _File:
 
     def record(self, kind: str, callee: str, args: list[Any], at: Any) -> None:
         fn = self.scope.fn_of(at)
-        self.out["calls"].append((kind, callee, [self.scope.value(a) for a in args], fn.key if fn else None,
-                                  fn.unit if fn else None, self.src(at)))
+        vals = [self.scope.value(a) for a in args]
+        self.out["calls"].append((kind, callee, vals, fn.key if fn else None, fn.unit if fn else None,
+                                  self.src(at)))
 
     # -- constructions
     def construct(self, type_text: str, args: list[Any], at: Any) -> None:
@@ -216,7 +219,8 @@ class _File:
                 self.call(n)
         s = self.scope
         self.out["fns"] = {f.key: (f.unit, f.params, f.ptypes, [s.value(d) for d in f.defaults])
-                           for f in s.fns.values()}
+                           for f in list(s.decls.values()) + list(s.fns.values())}
+        self.out["aliases"] = self.aliases
         self.out["units"] = {c: {"bases": i["bases"], "members": i["members"]} for c, i in s.classes.items()}
         self.out["fields"] = s.field_values()
         self.out["consts"] = {k: v for k, v in ((k, s._one([s.value(x) if not isinstance(x, tuple) else x
@@ -250,6 +254,26 @@ class _File:
                     self.construct(ty, list(v.named_children), n)
             elif d.type == "identifier":
                 self.construct(ty, [], n)
+            elif d.type == "function_declarator" and self.scope.fn_of(n) is not None:
+                self.vexing(ty, d, n)
+
+    def vexing(self, ty: str, d: Any, n: Any) -> None:
+        """``Sensor s(nh, name());`` in a function body, which the grammar reads as a
+        function declaration (C++'s "most vexing parse"): its parentheses re-read
+        as call arguments, evaluated in the enclosing function."""
+        params = d.child_by_field_name("parameters")
+        if params is None:
+            return
+        tree = treesitter.parser("cpp").parse(b"void f_(){g_" + params.text + b";}").root_node
+        call = next((x for x in _walk(tree) if x.type == "call_expression"), None)
+        a = call.child_by_field_name("arguments") if call is not None else None
+        if a is None:
+            return
+        self.scope.override, self.vex_at = self.scope.fn_of(n), n
+        try:
+            self.construct(ty, list(a.named_children), n)
+        finally:
+            self.scope.override, self.vex_at = None, None
 
     def member(self, n: Any) -> None:
         ty = _T(n.child_by_field_name("type"))
@@ -326,7 +350,7 @@ class _File:
             self.emit(kind, args[0], canon_type(symbols.text(gt)) if gt and gt[0] == "str" else None, n, handle)
             return
         ta = targs[0] if targs else None
-        cb = None
+        cb: Any = None
         if kind in ("pub", "sub"):
             msg_type = self.msg(ta) if ta else None
             if msg_type is None and kind == "sub" and last == "subscribe" and len(args) >= 3:
@@ -337,6 +361,8 @@ class _File:
             if msg_type is None and last == "advertiseService" and len(args) >= 2:
                 cb = _T(args[1]).lstrip("&").split("::")[-1]
                 msg_type = service_type(self.out["callbacks"].get(cb))
+        if msg_type is None and cb is None and ta:
+            cb = ("type", ta)  # an alias of another file (a header's using/typedef): read by the linker
         self.emit(kind, args[0], msg_type, n, handle, cb if msg_type is None else None)
 
     def deferred_method(self, recv: Any, method: str, args: list[Any], at: Any) -> bool:
@@ -368,8 +394,9 @@ class _File:
         k = 4 if len(args) >= 5 and "interface" in _T(args[0]) else 1
         if len(args) <= k:
             return
-        self.emit(kind, args[k], action_type(self.aliases.get(targs[0], targs[0]) if targs else None), n,
-                  self.scope.value(args[0]) if k == 1 else None)
+        t = action_type(self.aliases.get(targs[0], targs[0])) if targs else None
+        self.emit(kind, args[k], t, n, self.scope.value(args[0]) if k == 1 else None,
+                  ("type", targs[0]) if t is None and targs else None)
 
 
 def scan_cpp(data: bytes, shown: str) -> dict[str, Any]:
