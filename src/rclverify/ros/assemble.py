@@ -117,7 +117,7 @@ class Assembly:
                                             f"(CMakeLists.txt add_executable, setup.py console_scripts, scripts/); "
                                             f"its topics are unknown", "ROS-LAUNCH"))
         got = self.linked(prog) if prog is not None else Linked()
-        g.notes.extend(n for n in got.notes if n not in g.notes)
+        g.notes.extend(got.notes)
         eps = [e for e, _o in got.endpoints]
         name = ln.name or (got.nodes[0][0] if got.nodes else (plugin.split("::")[-1] if plugin else ln.exe))
         if name.startswith("/"):

@@ -9,11 +9,18 @@ keeps every byte offset (same length, newlines kept), so locations stay.
   ``_API``, ``_LOCAL``, ``_DECL``, ``_HIDDEN`` ... suffix;
 * ``<cinttypes>`` format macros beside a string literal (``"%" PRId64``)
   become a string literal of the same length;
+* string macros pasted together in an argument (``f(PREFIX_S NAME_S, 1)``:
+  upper-case words side by side between ``(``/``,`` and ``,``/``)``) become
+  string literals of the same length (their values are not kept);
 * ``#ifdef __cplusplus`` / ``#if defined(__cplusplus)`` blocks that only
   open ``extern "C" {`` or close its ``}`` (a C header made includable from
   C++) are blanked, both of them, so the braces balance;
-* ``RCLCPP_COMPONENTS_REGISTER_NODE(ns::C)`` (no semicolon) is blanked, its
-  class recorded by the caller.
+* a statement or member that is only an upper-case macro, with no
+  semicolon (``PLUGINLIB_EXPORT_CLASS(a::B, nodelet::Nodelet)``,
+  ``EIGEN_MAKE_ALIGNED_OPERATOR_NEW``), starting where a statement may start
+  (after ``;``, ``{``, ``}``, ``:`` or a directive) and followed by no ``;``,
+  is blanked; ``RCLCPP_COMPONENTS_REGISTER_NODE(ns::C)`` too, its class
+  recorded by the caller.
 
 Source: the C++ standard's preprocessing and ``<cinttypes>`` macros (C99 7.8.1).
 """
@@ -29,6 +36,10 @@ _FORMAT = re.compile(rb'(?<=")([ \t]*)((?:PRI|SCN)[diouxXcs](?:8|16|32|64|MAX|PT
 _CPLUSPLUS = re.compile(rb'^[ \t]*#[ \t]*if(?:def[ \t]+__cplusplus|[ \t]+defined[ \t]*\(?[ \t]*__cplusplus[ \t]*\)?)'
                         rb'[ \t]*\r?\n[ \t]*(?:extern[ \t]+"C"[ \t]*\{|\})[ \t]*(?://[^\n]*)?\r?\n[ \t]*#[ \t]*endif\b[^\n]*',
                         re.M)
+_PASTED = re.compile(rb"(?<=[(,])([ \t\r\n]*)([A-Z][A-Z0-9_]*(?:[ \t\r\n]+[A-Z][A-Z0-9_]*)+)(?=[ \t\r\n]*[,)])")
+_WORD = re.compile(rb"[A-Z][A-Z0-9_]*")
+_BARE = re.compile(rb"^[ \t]*([A-Z][A-Z0-9_]{2,})[ \t]*(\((?:[^()]|\((?:[^()]|\([^()]*\))*\))*\))?[ \t]*(//[^\n]*)?$",
+                   re.M)
 REGISTER = re.compile(rb"\bRCLCPP_COMPONENTS_REGISTER_NODE\s*\(\s*([A-Za-z_][\w:]*)\s*\)")
 
 
@@ -40,6 +51,38 @@ def blank_macros(data: bytes) -> bytes:
     """``class API Name :`` -> ``class     Name :``: upper-case macro words between
     ``class``/``struct`` and the class name become spaces (offsets unchanged)."""
     return _CLASS_MACRO.sub(lambda m: m.group(0)[: m.start(1) - m.start(0)] + b" " * len(m.group(1)), data)
+
+
+def _statement_start(data: bytes, at: int) -> bool:
+    """Whether a statement may start at offset ``at``: the previous code character
+    (whitespace, ``//`` comments and whole-line ``/* */`` comments skipped) is
+    ``;``, ``{``, ``}`` or ``:``, or a preprocessor line, or nothing."""
+    end = at
+    for _ in range(50):
+        start = data.rfind(b"\n", 0, max(end - 1, 0)) + 1 if end > 0 else 0
+        line = data[start:end]
+        if b"//" in line:
+            line = line[:line.index(b"//")]
+        code = line.strip()
+        if code.startswith(b"#"):
+            return True
+        if code.endswith(b"*/") and b"/*" in code:
+            code = code[:code.rindex(b"/*")].strip()
+        if code:
+            return code[-1:] in (b";", b"{", b"}", b":")
+        if start == 0:
+            return True
+        end = start - 1
+    return False
+
+
+def _bare(data: bytes) -> bytes:
+    def one(m: re.Match[bytes]) -> bytes:
+        rest = data[m.end():m.end() + 200].lstrip()
+        if rest[:1] in (b";", b"(", b"=", b"{", b"<", b".", b"-", b",", b")") or not _statement_start(data, m.start()):
+            return m.group(0)
+        return _spaces(m.group(0))
+    return _BARE.sub(one, data)
 
 
 def _format(m: re.Match[bytes]) -> bytes:
@@ -57,8 +100,10 @@ def prepare(data: bytes) -> bytes:
         data = _MEMBER_MACRO.sub(lambda m: m.group(0)[: m.start(1) - m.start(0)] + b" " * len(m.group(1)), data)
     if b"PRI" in data or b"SCN" in data:
         data = _FORMAT.sub(_format, data)
+    data = _PASTED.sub(lambda m: m.group(1) + _WORD.sub(lambda w: b'"' + b"d" * (len(w.group(0)) - 2) + b'"'
+                                                        if len(w.group(0)) >= 2 else w.group(0), m.group(2)), data)
     if b"__cplusplus" in data:
         data = _CPLUSPLUS.sub(lambda m: _spaces(m.group(0)), data)
     if b"RCLCPP_COMPONENTS_REGISTER_NODE" in data:
         data = REGISTER.sub(lambda m: b" " * len(m.group(0)), data)
-    return data
+    return _bare(data)

@@ -352,6 +352,8 @@ class CppScope:
         last = ftext.split("::")[-1].split(".")[-1].split(">")[-1]
         if ftext.endswith("this_node::getName") or last == "get_fully_qualified_name":
             return symbols.NODE
+        if ftext in ("std::string", "string", "std::string_view") and len(args) == 1:
+            return self.value(args[0], depth + 1)
         if base_name(ftext) in _HANDLE_TYPES:
             return self.handle(args, depth)
         if last == "create_sub_node" and len(args) == 1 and (fn is None or fn.type != "field_expression"):
@@ -378,7 +380,8 @@ class CppScope:
             if rt in _OPTIONS:
                 ops = (_OPTIONS[rt], ftext[ftext.index("<") + 1: ftext.rindex(">")])
         if ops is not None:
-            return ("ops", ops[0], self.value(args[0], depth + 1), ops[1], _T(args[2]) if len(args) > 2 else None)
+            return ("ops", ops[0], self.value(args[0], depth + 1), ops[1], _T(args[2]) if len(args) > 2 else None,
+                    _T(args[0]))
         r = param_read(n)
         if r is not None:
             pname, default, _ref, recv, ros2 = r

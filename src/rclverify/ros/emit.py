@@ -28,12 +28,12 @@ def make(kind: str, name: symbols.Val, handle: symbols.Val, msg_type: str | None
     when both values are concrete (and the type is known or cannot be found
     elsewhere), else pending (``Endpoint.pending``), or ``(None, note)``."""
     if symbols.is_concrete(name) and symbols.is_concrete(handle) and (msg_type is not None or cb is None):
-        return resolve(kind, name, handle, msg_type, src, unit, written, name_src)
-    return Endpoint(kind, "", msg_type, src, None, (), unit, (name, handle, cb, func, written, name_src)), None
+        return resolve(kind, name, handle, msg_type, src, unit, written, name_src, func)
+    return Endpoint(kind, "", msg_type, src, None, (), unit, (name, handle, cb, func, written, name_src), func), None
 
 
 def resolve(kind: str, name: symbols.Val, handle: symbols.Val, msg_type: str | None, src: Src, unit: str | None,
-            written: str, name_src: Src) -> tuple[Endpoint | None, Note | None]:
+            written: str, name_src: Src, func: str | None = None) -> tuple[Endpoint | None, Note | None]:
     """The endpoint for concrete values ``name`` and ``handle`` (see :func:`make`),
     or ``(None, note)`` when either cannot be read."""
     what = WHAT[kind]
@@ -48,11 +48,12 @@ def resolve(kind: str, name: symbols.Val, handle: symbols.Val, msg_type: str | N
         if psegs is None:
             return None, Note(src, f"namespace of the node handle the parameter of {what} '{short(written)}' is "
                                    f"read through is computed at run time: not resolved statically")
-        return Endpoint(kind, name[2] or "", msg_type, src, symbols.param_name(name[1], psegs), tuple(segs), unit), None
+        return Endpoint(kind, name[2] or "", msg_type, src, symbols.param_name(name[1], psegs), tuple(segs), unit,
+                        None, func), None
     t = symbols.text(name)
     if t is None:
         return None, Note(name_src, f"{what} name is '{short(written)}', not a string literal: not resolved statically")
-    return Endpoint(kind, t, msg_type, src, None, tuple(segs), unit), None
+    return Endpoint(kind, t, msg_type, src, None, tuple(segs), unit, None, func), None
 
 
 def type_note(e: Endpoint) -> Note:

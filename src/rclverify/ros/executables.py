@@ -70,22 +70,41 @@ def _glob(root: Path):  # type: ignore[no-untyped-def]
     return g
 
 
-def targets(root: Path, pkg: str) -> Targets:
-    """The :class:`Targets` of the package at ``root`` named ``pkg``."""
-    t = Targets()
-    try:
-        cmds = expand(safefs.read_text(root / "CMakeLists.txt"), pkg, _glob(root))
-    except OSError:
-        cmds = []
+MAX_SUBDIRS = 32  # CMakeLists.txt files read per package (add_subdirectory)
 
+
+def targets(root: Path, pkg: str) -> Targets:
+    """The :class:`Targets` of the package at ``root`` named ``pkg`` (its
+    ``CMakeLists.txt`` and those its ``add_subdirectory`` calls name, each
+    with source paths relative to its own directory)."""
+    t = Targets()
+    todo, seen = [root], 0
+    auto_libs: list[str] = []
+    while todo and seen < MAX_SUBDIRS:
+        here = todo.pop(0)
+        seen += 1
+        try:
+            cmds = expand(safefs.read_text(here / "CMakeLists.txt"), pkg, _glob(here))
+        except OSError:
+            continue
+        _read(cmds, here, t, auto_libs, todo)
+    for exe, srcs in setup_py_executables(root).items():
+        t.programs.setdefault(exe, srcs)
+    return t
+
+
+def _read(cmds: list[tuple[str, list[str], int]], root: Path, t: Targets, auto_libs: list[str],
+          subdirs: list[Path]) -> None:
+    """The targets the commands of one ``CMakeLists.txt`` (in ``root``) declare, into ``t``."""
     def files(srcs: list[str]) -> list[Path]:
         return [root / s for s in srcs if s not in _KEYWORDS and (root / s).is_file()]
 
-    auto_libs: list[str] = []
     for name, args, line in cmds:
         if not args:
             continue
-        if name in _EXE and "IMPORTED" not in args and "ALIAS" not in args:
+        if name == "add_subdirectory" and (root / args[0]).is_dir() and not args[0].startswith(("test", "..")):
+            subdirs.append(root / args[0])
+        elif name in _EXE and "IMPORTED" not in args and "ALIAS" not in args:
             t.executables.setdefault(args[0], []).extend(files(args[1:]))
             if name == "ament_auto_add_executable":
                 t.links.setdefault(args[0], []).extend(auto_libs)
@@ -118,9 +137,6 @@ def targets(root: Path, pkg: str) -> Targets:
                     t.programs.setdefault(f.name, [f])
                     t.programs.setdefault(f.stem, [f])
                 k += 1
-    for exe, srcs in setup_py_executables(root).items():
-        t.programs.setdefault(exe, srcs)
-    return t
 
 
 def cmake_components(root: Path, pkg: str) -> tuple[dict[str, tuple[str, int]], list[str]]:

@@ -267,7 +267,8 @@ def _scan(paths: Sequence[Path], launch: Sequence[Path], launch_args: dict[str, 
     else:
         asm.source_nodes(add_node, g)
     for shown, r in sorted(res.sources.items()):
-        g.notes.extend(n for n in r["notes"] if n not in g.notes)
+        g.notes.extend(r["notes"])
+    g.notes = list(dict.fromkeys(g.notes))  # a note given by several programs (a shared header) once
     for b in bags:
         from .bag import bag_topics
         info, notes = bag_topics(Path(b), show(Path(b)))

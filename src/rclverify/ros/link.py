@@ -109,12 +109,23 @@ class Linker:
         self.classes = [] if self.py else sorted(self.units)
         self.entry = prog.units if prog.units is not None else entry_units
         self.sites: dict[str, list[tuple[list[Any], dict[str, Any], str | None]]] = {}
+        # what runs what: "U:class" (constructed: all its methods run) and "F:function" (called)
         self.edges: dict[str, set[str]] = {}
+        for k, (unit, *_rest) in self.fns.items():
+            if unit in self.units or unit == k:
+                self._edge(f"U:{unit}", f"F:{k}")
+            if unit == k:
+                self._edge(f"F:{k}", f"U:{unit}")
         for c in self.calls:
             kind, callee, args, fkey, unit, _src, kwargs = c
             ck, cu = self.callee(kind, callee, unit)
-            if cu is not None and unit is not None:
-                self.edges.setdefault(unit, set()).add(cu)
+            here = f"F:{fkey}" if fkey else f"U:{unit}" if unit else None
+            made = kind in ("ctor", "member") or (ck is not None and cu is not None and (
+                ck.endswith(".__init__") or ck == self._ctor(cu)))
+            if here is not None and cu is not None and made:
+                self._edge(here, f"U:{cu}")
+            if here is not None and ck is not None:
+                self._edge(here, f"F:{ck}")
             if ck is not None:
                 self.sites.setdefault(ck, []).append((args, kwargs, fkey))
         for u, info in self.units.items():
@@ -122,8 +133,8 @@ class Linker:
                 for ident in _IDENT.findall(ty):
                     m = self.match(ident, u) if not ident.startswith(("std::", "ros::", "rclcpp::")) else None
                     if m is not None and m != u:
-                        self.edges.setdefault(u, set()).add(m)
-        self.reach = self._reach(self.entry)
+                        self._edge(f"U:{u}", f"U:{m}")
+        self.reach = self._reach({f"U:{u}" for u in self.entry})
         self._memo: dict[str, list[dict[int, Any]]] = {}
         self._stack: set[str] = set()
 
@@ -197,6 +208,17 @@ class Linker:
             return callee, self.fns[callee][0]
         return None, None
 
+    def _edge(self, a: str, b: str) -> None:
+        self.edges.setdefault(a, set()).add(b)
+
+    def runs(self, unit: str | None, fkey: str | None, reach: set[str] | None = None) -> bool:
+        """Whether code of function ``fkey`` (else of unit ``unit``) runs in the program
+        (or in ``reach``, a set of reached ``U:``/``F:`` items)."""
+        reach = self.reach if reach is None else reach
+        if fkey is not None and fkey in self.fns:
+            return f"F:{fkey}" in reach
+        return unit is not None and f"U:{unit}" in reach
+
     def _reach(self, start: set[str]) -> set[str]:
         seen, todo = set(), list(start)
         while todo:
@@ -220,7 +242,7 @@ class Linker:
         params = self.fns[fkey][1]
         envs: list[dict[int, Any]] = []
         for args, kwargs, caller in self.sites.get(fkey, []):
-            if caller is not None and self.fns.get(caller, ("",))[0] not in self.reach:
+            if caller is not None and not self.runs(None, caller):
                 continue
             for cenv in self.contexts(caller, depth + 1):
                 partial: list[dict[int, Any]] = [{}]
@@ -321,9 +343,9 @@ class Linker:
                 out.notes.append(n)
 
         def take(f: str, e: Endpoint) -> None:
-            if e.unit is not None and e.unit not in self.reach:
+            if e.unit is None and e.func is None and f not in self.prog.entry:
                 return
-            if e.unit is None and f not in self.prog.entry:
+            if (e.unit is not None or e.func is not None) and not self.runs(e.unit, e.func):
                 return
             for x in self.resolve(e, note):
                 if x not in eps:
@@ -339,7 +361,8 @@ class Linker:
         named: list[tuple[str, Src, str | None, str | None]] = []
         for f, r in self.recs.items():
             for v, src, unit, fkey, ns in r.get("node_names", []):
-                if unit is not None and unit not in self.reach or unit is None and f not in self.prog.entry:
+                if (unit is not None or fkey is not None) and not self.runs(unit, fkey) \
+                        or unit is None and fkey is None and f not in self.prog.entry:
                     continue
                 for env in self.contexts(fkey):
                     for name in self.eval(v, env, fkey):
@@ -370,7 +393,7 @@ class Linker:
                 for h in self.eval(handle, env, fkey) if handle is not None else [None]:
                     if n is not None and n[0] == "ops":
                         n = n[2]
-                    x, bad = emit.resolve(e.kind, n, h, t, e.src, e.unit, written, nsrc)
+                    x, bad = emit.resolve(e.kind, n, h, t, e.src, e.unit, written, nsrc, e.func)
                     if bad is not None:
                         note(bad)
                     if x is not None and x not in got:
@@ -403,7 +426,7 @@ class Linker:
         by default where none initialises them; and of their methods' calls."""
         out: list[Endpoint] = []
         for unit, m, ty, src in r.get("member_decls", []):
-            if unit not in self.reach:
+            if not self.runs(unit, None):
                 continue
             inits = [c for c in self.calls if c[0] == "member" and c[1] == m and c[4] == unit]
             for c in inits or [None]:
@@ -411,9 +434,9 @@ class Linker:
                 at, fkey = (c[5], c[3]) if c else (src, None)
                 for kind, nv, t, hv in self.helper(ty, args) or []:
                     out.append(Endpoint(kind, "", t, at, None, (), unit,
-                                        (nv, hv, None, fkey, symbols.text(nv) or m, at)))
+                                        (nv, hv, None, fkey, symbols.text(nv) or m, at), fkey))
         for unit, m, meth, args, texts, src, fkey in r.get("member_calls", []):
-            if unit not in self.reach:
+            if not self.runs(unit, fkey):
                 continue
             ty = self.units.get(unit, {}).get("members", {}).get(m)
             for b in self.units.get(unit, {}).get("bases", []):
@@ -423,7 +446,7 @@ class Linker:
             for kind, nv, t, hv in specs or []:
                 k = 1 if kind == "sub" and meth == "subscribe" else 0
                 out.append(Endpoint(kind, "", t, src, None, (), unit,
-                                    (nv, hv, None, fkey, texts[k] if k < len(texts) else m, src)))
+                                    (nv, hv, None, fkey, texts[k] if k < len(texts) else m, src), fkey))
         return out
 
     def helper(self, ty: str, args: list[Any]) -> list[cpp_helpers.Spec] | None:
@@ -442,7 +465,7 @@ class Linker:
         """Each endpoint's node (an index in the named nodes; -1 when none)."""
         if len(units) <= 1:
             return [0 if units else -1] * len(eps)
-        reach = {i: self._reach({u}) if u else set() for i, u in enumerate(units)}
+        reach = {i: self._reach({f"U:{u}"}) if u else set() for i, u in enumerate(units)}
         loose = next((i for i, u in enumerate(units) if u is None or u not in self.units or u.endswith("<module>")), 0)
         out = []
         for e in eps:
@@ -451,7 +474,7 @@ class Linker:
                 inner = [i for i, u in enumerate(units) if u and u in self.units and (e.unit or "").startswith(u + ".")]
                 own = max(inner, key=lambda i: len(units[i] or "")) if inner else None
             if own is None:
-                own = next((i for i in reach if units[i] in self.units and e.unit in reach[i]), loose)
+                own = next((i for i in reach if units[i] in self.units and self.runs(e.unit, e.func, reach[i])), loose)
             out.append(own)
         return out
 

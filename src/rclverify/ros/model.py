@@ -42,7 +42,7 @@ class Endpoint:
     ``handle``: the namespaces of the node handle the name is created through
     (``("~",)`` for a private ``ros::NodeHandle``, ``("left",)``; resolved, and
     remapped, by the graph: :mod:`namespaces`).  ``unit``: the class (or free
-    function) whose code creates it.  ``pending``: what the file alone cannot
+    function) whose code creates it; ``func``: the function (method) that does.  ``pending``: what the file alone cannot
     read, for the linker (:mod:`link`): ``(name value, handle value, callback,
     function key, name as written, where the name is written)``, or ``None``."""
 
@@ -54,6 +54,7 @@ class Endpoint:
     handle: tuple[str, ...] = ()
     unit: str | None = None
     pending: Any = None
+    func: str | None = None
 
 
 # The four service/action roles an :class:`Endpoint` may have besides "pub"/"sub", each the

@@ -139,11 +139,12 @@ class _File:
 
     # -- emitting
     def emit(self, kind: str, name_node: Any, msg_type: str | None, at: Any, handle: symbols.Val,
-             cb: str | None = None, name: symbols.Val = "unset") -> None:
+             cb: Any = None, name: symbols.Val = "unset", written: str | None = None) -> None:
         v = self.scope.value(name_node) if name == "unset" else name
         fn = self.scope.fn_of(at)
         unit = fn.unit if fn is not None else None
-        written = _T(name_node) if name_node is not None else emit.short(str(symbols.text(v) or "?"))
+        if written is None:
+            written = _T(name_node) if name_node is not None else emit.short(str(symbols.text(v) or "?"))
         ep, note = emit.make(kind, v, handle, msg_type, self.src(at), unit, fn.key if fn else None, written,
                              self.src(name_node) if name_node is not None else self.src(at), cb)
         if note is not None:
@@ -332,6 +333,12 @@ class _File:
         if last == "create_server":
             return
         handle = s.value(recv) if recv is not None else None
+        if last in ("advertise", "subscribe") and len(args) >= 2 and s.is_handle(args[0]):
+            # advertise(nh, topic, n) / subscribe(nh, topic, n) of an object given the handle
+            # (topic_tools::ShapeShifter, a message_filters subscriber of a class this file does not know)
+            ta = targs[0] if targs else None
+            self.emit(kind, args[1], self.msg(ta) if ta else None, n, s.value(args[0]))
+            return
         if len(args) == 1 and last in ("subscribe", "advertise", "advertiseService"):
             ops = s.value(args[0])
             if ops is not None and ops[0] == "ops":
@@ -340,10 +347,11 @@ class _File:
                 if t is None and cb:
                     ct = self.out["callbacks"].get(cb)
                     t = self.msg(ct) if ops[1] in ("pub", "sub") else service_type(ct)
-                self.emit(ops[1], None, t, n, handle, cb if t is None else None, name=ops[2])
+                self.emit(ops[1], None, t, n, handle, cb if t is None else None, name=ops[2],
+                          written=ops[5] if len(ops) > 5 else None)
             else:
-                self.out["notes"].append(Note(self.src(n), f"options of {last}({_T(args[0])[:60]}) not read "
-                                                           f"statically: not resolved statically"))
+                self.out["notes"].append(Note(self.src(n), f"{last}({_T(args[0])[:60]}): its options are not read "
+                                                           f"statically"))
             return
         if last in ("create_generic_publisher", "create_generic_subscription"):
             gt = s.value(args[1]) if len(args) > 1 else None
