@@ -135,12 +135,13 @@ def _ast_module(tree: ast.AST, shown: str) -> PyModule:
                                [y for h in inner if isinstance(h, ast.ExceptHandler) for y in h.body], prefix, in_class)
 
     for n in ast.walk(tree):
-        if isinstance(n, ast.ImportFrom) and n.module:
-            for a in n.names:
+        if isinstance(n, ast.ImportFrom) and (n.module or n.level):
+            for a in n.names:  # a relative import names the package's own module (``from . import names``)
                 if a.name == "*":
-                    mod.star.append(n.module)
+                    if n.module:
+                        mod.star.append(n.module)
                 else:
-                    mod.bind_import(a.asname or a.name, f"{n.module}.{a.name}", n.lineno)
+                    mod.bind_import(a.asname or a.name, f"{n.module}.{a.name}" if n.module else a.name, n.lineno)
         elif isinstance(n, ast.Import):
             for a in n.names:
                 mod.bind_import(a.asname or a.name.split(".")[0], a.name if a.asname else a.name.split(".")[0],

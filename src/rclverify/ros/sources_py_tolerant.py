@@ -158,15 +158,15 @@ def tolerant_module(text: str, shown: str) -> tuple[Any, str]:
                 else:
                     mod.bind_import(treesitter.text(x).split(".")[0], treesitter.text(x).split(".")[0], line)
         elif t == "import_from_statement":
-            m = treesitter.text(n.child_by_field_name("module_name"))
+            m = treesitter.text(n.child_by_field_name("module_name")).lstrip(".")
             if any(c.type == "wildcard_import" for c in n.children):
                 mod.star.append(m)
             for x in n.children_by_field_name("name"):
                 if x.type == "aliased_import":
                     mod.bind_import(treesitter.text(x.child_by_field_name("alias")),
-                                    f"{m}.{treesitter.text(x.child_by_field_name('name'))}", line)
+                                    f"{m}.{treesitter.text(x.child_by_field_name('name'))}".lstrip("."), line)
                 else:
-                    mod.bind_import(treesitter.text(x), f"{m}.{treesitter.text(x)}", line)
+                    mod.bind_import(treesitter.text(x), f"{m}.{treesitter.text(x)}".lstrip("."), line)
         elif t == "function_definition" and n.child_by_field_name("name") is not None:
             function(n)
         elif t == "call":
