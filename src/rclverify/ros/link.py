@@ -414,6 +414,9 @@ class Linker:
                 text = self.aliases.get(text or "", self.aliases.get((text or "").split("::")[-1], text))
         elif isinstance(cb, str):
             text = self.callbacks.get(cb)
+            if text is None:  # written with another qualification than declared
+                hits = sorted({v for k, v in self.callbacks.items() if k.endswith("::" + cb) or cb.endswith("::" + k)})
+                text = hits[0] if len(hits) == 1 else self.callbacks.get(cb.split("::")[-1])
         else:
             return None
         if kind in ("pub", "sub"):

@@ -37,7 +37,7 @@ from typing import Any
 
 from . import cpp_helpers, emit, symbols, treesitter
 from .cpp_prep import REGISTER, prepare
-from .cpp_scope import CppScope, base_name, is_node_type
+from .cpp_scope import CppScope, base_name, is_node_type, namespaces_of
 from .cpp_types import action_type, message_type, service_type, split_template
 from .model import Note, Src, canon_type
 
@@ -81,6 +81,15 @@ def _callee(fn: Any) -> tuple[str, str, list[str]]:
     return head, name.split("::")[-1], targs
 
 
+def _callback(text: str) -> str:
+    """The function a callback argument names: ``&Listener::callback`` ->
+    ``Listener::callback``; ``boost::bind(&C::f, this, _1)`` -> ``C::f``."""
+    t = text.strip()
+    if "(" in t and "&" in t:  # a bind expression: its first argument
+        t = t[t.index("(") + 1:].split(",")[0]
+    return t.strip().lstrip("&").strip()
+
+
 class _File:
     def __init__(self, data: bytes, shown: str) -> None:
         self.shown = shown
@@ -112,12 +121,16 @@ class _File:
     def _index(self, n: Any) -> None:
         t = n.type
         if t == "function_declarator":
-            name = _T(n.child_by_field_name("declarator")).split("::")[-1]
+            written = _T(n.child_by_field_name("declarator"))
             params = n.child_by_field_name("parameters")
             first = next((c for c in (params.children if params else [])
                           if c.type in ("parameter_declaration", "optional_parameter_declaration")), None)
             if first is not None and first.child_by_field_name("type") is not None:
-                self.out["callbacks"].setdefault(name, _T(first.child_by_field_name("type")))
+                ty = _T(first.child_by_field_name("type"))
+                _nss, cls = namespaces_of(n)
+                # by its name as written, with its class, and alone (the last a fallback)
+                for key in {written, "::".join(cls + [written]), written.split("::")[-1]}:
+                    self.out["callbacks"].setdefault(key, ty)
         elif t == "alias_declaration":
             self.aliases[_T(n.child_by_field_name("name"))] = _T(n.child_by_field_name("type"))
         elif t == "type_definition":
@@ -283,7 +296,6 @@ class _File:
         fn_cls = self.scope.fn_of(n)
         if fn_cls is not None or not (last in _ACTIONLIB or last in cpp_helpers.CONSTRUCTED):
             return
-        from .cpp_scope import namespaces_of
         nss, cls = namespaces_of(n)
         for d in n.children_by_field_name("declarator"):
             if d.type == "field_identifier":  # a value member (a pointer is made elsewhere)
@@ -343,7 +355,7 @@ class _File:
             ops = s.value(args[0])
             if ops is not None and ops[0] == "ops":
                 t = self.msg(ops[3]) if ops[1] in ("pub", "sub") else service_type(self.aliases.get(ops[3], ops[3]))
-                cb = (ops[4] or "").lstrip("&").split("::")[-1] or None
+                cb = _callback(ops[4] or "") or None
                 if t is None and cb:
                     ct = self.out["callbacks"].get(cb)
                     t = self.msg(ct) if ops[1] in ("pub", "sub") else service_type(ct)
@@ -362,12 +374,12 @@ class _File:
         if kind in ("pub", "sub"):
             msg_type = self.msg(ta) if ta else None
             if msg_type is None and kind == "sub" and last == "subscribe" and len(args) >= 3:
-                cb = _T(args[2]).lstrip("&").split("::")[-1]
+                cb = _callback(_T(args[2]))
                 msg_type = self.msg(self.out["callbacks"].get(cb))
         else:
             msg_type = service_type(self.aliases.get(ta, ta) if ta else None)
             if msg_type is None and last == "advertiseService" and len(args) >= 2:
-                cb = _T(args[1]).lstrip("&").split("::")[-1]
+                cb = _callback(_T(args[1]))
                 msg_type = service_type(self.out["callbacks"].get(cb))
         if msg_type is None and cb is None and ta:
             cb = ("type", ta)  # an alias of another file (a header's using/typedef): read by the linker
