@@ -139,3 +139,12 @@ def service_type(name: str | None) -> str | None:
     n = re.sub(r"_(Request|Response)$", "", n)
     t = canon_type(n, "srv")
     return t if t and t.count("/") == 2 else None
+
+
+def callback_name(text: str) -> str:
+    """The function a callback argument names: ``&Listener::callback`` ->
+    ``Listener::callback``; ``boost::bind(&C::f, this, _1)`` -> ``C::f``."""
+    t = text.strip()
+    if "(" in t and "&" in t:  # a bind expression: its first argument
+        t = t[t.index("(") + 1:].split(",")[0]
+    return t.strip().lstrip("&").strip()

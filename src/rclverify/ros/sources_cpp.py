@@ -37,8 +37,9 @@ from typing import Any
 
 from . import cpp_helpers, emit, symbols, treesitter
 from .cpp_prep import REGISTER, prepare
-from .cpp_scope import CppScope, base_name, is_node_type, namespaces_of
-from .cpp_types import action_type, message_type, service_type, split_template
+from .cpp_scope import base_name, callee_parts, namespaces_of
+from .cpp_values import CppValues
+from .cpp_types import action_type, callback_name, message_type, service_type, split_template
 from .model import Note, Src, canon_type
 
 __all__ = ["scan_cpp", "action_type", "service_type"]
@@ -54,42 +55,6 @@ _LIBRARY = ("std::", "ros::", "rclcpp::", "boost::", "RCLCPP_", "ROS_", "tf2::",
 _T = treesitter.text
 
 
-def _walk(n: Any):  # type: ignore[no-untyped-def]
-    stack = [n]
-    while stack:
-        x = stack.pop()
-        yield x
-        stack.extend(reversed(x.children))
-
-
-def _callee(fn: Any) -> tuple[str, str, list[str]]:
-    """``(full text without template arguments, last name part, template argument texts)``."""
-    f = fn.child_by_field_name("field") if fn.type == "field_expression" else fn
-    while f is not None and f.type == "qualified_identifier" and f.child_by_field_name("name") is not None:
-        f = f.child_by_field_name("name")
-    targs: list[str] = []
-    if f is not None and f.type in ("template_method", "template_function"):
-        a = f.child_by_field_name("arguments")
-        targs = [_T(x) for x in a.named_children] if a is not None else []
-        name = _T(f.child_by_field_name("name"))
-    else:
-        name = _T(f)
-    full = _T(fn)
-    head = split_template(full)[0] if "<" in full else full
-    if "<" in full and ">::" in full:  # rclcpp::Node::make_shared / X<T>::create
-        head = head + full[full.rindex(">") + 1:]
-    return head, name.split("::")[-1], targs
-
-
-def _callback(text: str) -> str:
-    """The function a callback argument names: ``&Listener::callback`` ->
-    ``Listener::callback``; ``boost::bind(&C::f, this, _1)`` -> ``C::f``."""
-    t = text.strip()
-    if "(" in t and "&" in t:  # a bind expression: its first argument
-        t = t[t.index("(") + 1:].split(",")[0]
-    return t.strip().lstrip("&").strip()
-
-
 class _File:
     def __init__(self, data: bytes, shown: str) -> None:
         self.shown = shown
@@ -103,11 +68,11 @@ class _File:
         data = prepare(data)
         self.ros2 = b"rclcpp" in data
         root = treesitter.parser("cpp").parse(data).root_node
-        self.nodes = list(_walk(root))
+        self.nodes = list(treesitter.walk(root))
         self.aliases: dict[str, str] = {}
         for n in self.nodes:
             self._index(n)
-        self.scope = CppScope(self.nodes)
+        self.scope = CppValues(self.nodes)
         if root.has_error:
             err = next((n for n in self.nodes if n.type == "ERROR" or n.is_missing), root)
             self.out["notes"].append(Note(self.src(err), "C++ source has syntax errors; read what tree-sitter "
@@ -279,7 +244,7 @@ class _File:
         if params is None:
             return
         tree = treesitter.parser("cpp").parse(b"void f_(){g_" + params.text + b";}").root_node
-        call = next((x for x in _walk(tree) if x.type == "call_expression"), None)
+        call = next((x for x in treesitter.walk(tree) if x.type == "call_expression"), None)
         a = call.child_by_field_name("arguments") if call is not None else None
         if a is None:
             return
@@ -307,7 +272,7 @@ class _File:
         args = list(a.named_children) if a is not None else []
         if fn is None:
             return
-        full, last, targs = _callee(fn)
+        full, last, targs = callee_parts(fn)
         recv = fn.child_by_field_name("argument") if fn.type == "field_expression" else None
         s = self.scope
         if full == "ros::init" and len(args) >= 3:
@@ -355,7 +320,7 @@ class _File:
             ops = s.value(args[0])
             if ops is not None and ops[0] == "ops":
                 t = self.msg(ops[3]) if ops[1] in ("pub", "sub") else service_type(self.aliases.get(ops[3], ops[3]))
-                cb = _callback(ops[4] or "") or None
+                cb = callback_name(ops[4] or "") or None
                 if t is None and cb:
                     ct = self.out["callbacks"].get(cb)
                     t = self.msg(ct) if ops[1] in ("pub", "sub") else service_type(ct)
@@ -374,12 +339,12 @@ class _File:
         if kind in ("pub", "sub"):
             msg_type = self.msg(ta) if ta else None
             if msg_type is None and kind == "sub" and last == "subscribe" and len(args) >= 3:
-                cb = _callback(_T(args[2]))
+                cb = callback_name(_T(args[2]))
                 msg_type = self.msg(self.out["callbacks"].get(cb))
         else:
             msg_type = service_type(self.aliases.get(ta, ta) if ta else None)
             if msg_type is None and last == "advertiseService" and len(args) >= 2:
-                cb = _callback(_T(args[1]))
+                cb = callback_name(_T(args[1]))
                 msg_type = service_type(self.out["callbacks"].get(cb))
         if msg_type is None and cb is None and ta:
             cb = ("type", ta)  # an alias of another file (a header's using/typedef): read by the linker
@@ -429,8 +394,3 @@ def scan_cpp(data: bytes, shown: str) -> dict[str, Any]:
     tree-sitter recovers from syntax errors, so a broken file still yields
     what it can; its ERROR regions are reported as one located warning."""
     return _File(data, shown).run()
-
-
-def is_handle_type(type_text: str) -> bool:
-    """Whether a declared type is a node handle or node (re-exported for the linker)."""
-    return is_node_type(type_text)
