@@ -34,7 +34,7 @@ _MEMBER_MACRO = re.compile(rb"^[ \t]*([A-Z][A-Z0-9]*(?:_[A-Z0-9]+)*_" + _SUFFIX 
 _FORMAT = re.compile(rb'(?<=")([ \t]*)((?:PRI|SCN)[diouxXcs](?:8|16|32|64|MAX|PTR|FAST\d+|LEAST\d+))\b'
                      rb'|\b((?:PRI|SCN)[diouxXcs](?:8|16|32|64|MAX|PTR|FAST\d+|LEAST\d+))(?=[ \t]*")')
 _CPLUSPLUS = re.compile(rb'^[ \t]*#[ \t]*if(?:def[ \t]+__cplusplus|[ \t]+defined[ \t]*\(?[ \t]*__cplusplus[ \t]*\)?)'
-                        rb'[ \t]*\r?\n[ \t]*(?:extern[ \t]+"C"[ \t]*\{|\})[ \t]*(?://[^\n]*)?\r?\n[ \t]*#[ \t]*endif\b[^\n]*',
+                        rb'[ \t]*\r?\n[ \t]*(?:extern[ \t]+"C"[ \t\r\n]*\{|\})[ \t]*(?://[^\n]*)?\r?\n[ \t]*#[ \t]*endif\b[^\n]*',
                         re.M)
 _PASTED = re.compile(rb"(?<=[(,])([ \t\r\n]*)([A-Z][A-Z0-9_]*(?:[ \t\r\n]+[A-Z][A-Z0-9_]*)+)(?=[ \t\r\n]*[,)])")
 _WORD = re.compile(rb"[A-Z][A-Z0-9_]*")
