@@ -151,6 +151,11 @@ def test_cmake_foreach_over_a_macro_and_subdirectories(tmp_path: Path) -> None:
                          "src/nodes/w.cpp": "int main(int c, char** v) { ros::init(c, v, \"w\"); }\n"})
     g = scan([tmp_path / "v"], [], base=tmp_path, standard=False).graph
     assert g.nodes["/w"].executable == "w"
+    # a glob or a subdirectory leaving the package reads nothing there
+    from rclverify.ros.executables import targets
+    (tmp_path / "v" / "CMakeLists.txt").write_text("project(v)\nfile(GLOB_RECURSE S /*.cpp ../*.cpp)\n"
+                                                   "add_executable(z ${S})\nadd_subdirectory(../v/src/nodes)\n")
+    assert targets(tmp_path / "v", "v").executables == {"z": []}
 
 
 def test_star_and_run_time_imports(tmp_path: Path) -> None:

@@ -54,18 +54,30 @@ class Targets:
     programs: dict[str, list[Path]] = field(default_factory=dict)
 
 
+MAX_GLOB_DIRS = 2000  # directories one file(GLOB) pattern may visit
+
+
 def _glob(root: Path):  # type: ignore[no-untyped-def]
+    """``glob(pattern, recurse)`` for :func:`cmake.expand`: the package files a
+    ``file(GLOB ...)`` pattern matches, relative to ``root``; a pattern leaving the
+    package matches nothing (links are not followed; the walk is bounded)."""
+    real_root = os.path.realpath(root)
+
     def g(pattern: str, recurse: bool) -> list[str]:
-        pattern = pattern.lstrip("./") if pattern.startswith("./") else pattern
+        while pattern.startswith("./"):
+            pattern = pattern[2:]
         base, _, pat = pattern.rpartition("/")
         top = root / base if base else root
-        out = []
-        for dirpath, dirnames, filenames in os.walk(top):
+        real = os.path.realpath(top)
+        if not (real == real_root or real.startswith(real_root + os.sep)):
+            return []
+        out: list[str] = []
+        for k, (dirpath, dirnames, filenames) in enumerate(os.walk(top)):
+            if k >= MAX_GLOB_DIRS or len(out) > 10_000:
+                break
             dirnames[:] = sorted(d for d in dirnames if not d.startswith(".")) if recurse else []
             rel = Path(dirpath).relative_to(root).as_posix()
             out.extend(f"{rel}/{f}" if rel != "." else f for f in sorted(filenames) if fnmatch.fnmatch(f, pat))
-            if len(out) > 10_000:
-                break
         return out
     return g
 
@@ -102,7 +114,8 @@ def _read(cmds: list[tuple[str, list[str], int]], root: Path, t: Targets, auto_l
     for name, args, line in cmds:
         if not args:
             continue
-        if name == "add_subdirectory" and (root / args[0]).is_dir() and not args[0].startswith(("test", "..")):
+        if name == "add_subdirectory" and (root / args[0]).is_dir() and not args[0].startswith(("test", "..")) \
+                and ".." not in Path(args[0]).parts and not Path(args[0]).is_absolute():
             subdirs.append(root / args[0])
         elif name in _EXE and "IMPORTED" not in args and "ALIAS" not in args:
             t.executables.setdefault(args[0], []).extend(files(args[1:]))
