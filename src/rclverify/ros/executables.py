@@ -67,7 +67,7 @@ def _glob(root: Path):  # type: ignore[no-untyped-def]
         while pattern.startswith("./"):
             pattern = pattern[2:]
         base, _, pat = pattern.rpartition("/")
-        top = root / base if base else root
+        top = Path(base or "/") if pattern.startswith("/") else root / base if base else root
         real = os.path.realpath(top)
         if not (real == real_root or real.startswith(real_root + os.sep)):
             return []
