@@ -202,16 +202,23 @@ def test_python_launch_variables_are_read_and_a_literal_is_never_called_not_a_li
                   "def generate_launch_description():\n"
                   "    port = LaunchConfiguration('port', default='/dev/ttyACM0')\n"
                   "    ns = LaunchConfiguration('ns')\n"
+                  "    prefix = LaunchConfiguration('prefix', default='')\n"
                   "    return LaunchDescription([\n"
                   "        DeclareLaunchArgument('port', default_value=port),\n"
                   "        DeclareLaunchArgument('ns', default_value='robot'),\n"
                   "        Node(package='p', executable='e', namespace=ns, arguments=['-i', port]),\n"
                   "        Node(package='p', executable='f', name=undefined_name),\n"
+                  "        Node(package='p', executable='g', namespace=prefix),\n"
                   "    ])\n")
     el, notes = read_python(lf, "a.launch.py")
     assert el is not None
     assert [(c.tag, c.attrs) for c in el.children[:3]] == [
-        ("arg", {"name": "port", "default": "$(var port /dev/ttyACM0)"}), ("arg", {"name": "ns", "default": "robot"}),
+        ("arg", {"name": "port", "default": "$(var-default port /dev/ttyACM0)"}), ("arg", {"name": "ns", "default": "robot"}),
         ("node", {"pkg": "p", "exec": "e", "namespace": "$(var ns)"})]
     assert [n.message for n in notes] == ["Node(...): variable 'undefined_name' (not assigned in "
                                           "generate_launch_description()) cannot be read statically; action skipped"]
+    from rclverify.ros.launch import Interpreter
+    it = Interpreter(lambda p: None, lambda p: read_python(p, p.name), lambda p: p.name)
+    it.run(lf, {})
+    assert [(n.exe, n.ns) for n in it.nodes] == [("e", "/robot"), ("g", "/")]  # an empty default is no namespace
+    assert it.notes == notes

@@ -50,7 +50,7 @@ def _value(e: ast.AST, depth: int = 0) -> str:
         if name == "LaunchConfiguration" and len(e.args) == 1:
             var = _value(e.args[0], depth + 1)
             d = _kw(e, "default")
-            return f"$(var {var} {_value(d, depth + 1)})" if d is not None else f"$(var {var})"
+            return f"$(var-default {var} {_value(d, depth + 1)})" if d is not None else f"$(var {var})"
         args = [_value(a, depth + 1) for a in e.args]
         if name in ("get_package_share_directory", "FindPackageShare") and len(args) == 1:
             return f"$(find-pkg-share {args[0]})"
