@@ -111,8 +111,9 @@ class _File:
 
     def msg(self, text: str | None) -> str | None:
         t = message_type(text, self.aliases)
-        if t is None and text and "::" not in text and len(self.scope.using_ns) == 1:
-            t = message_type(f"{self.scope.using_ns[0]}::{text.strip()}", self.aliases)
+        msgs = [ns for ns in self.scope.using_ns if ns.endswith(("::msg", "_msgs"))]
+        if t is None and text and "::" not in text and len(msgs) == 1:  # using namespace pkg::msg;
+            t = message_type(f"{msgs[0]}::{text.strip()}", self.aliases)
         return t
 
     # -- emitting

@@ -16,15 +16,25 @@ rclpy, ROS 2):
 * ``<x>.create_publisher(T, topic)``, ``<x>.create_subscription(T, topic, cb)``,
   ``<x>.create_service(T, name, cb)``, ``<x>.create_client(T, name)``,
   ``rclpy.action.ActionServer(node, T, name, cb)`` / ``ActionClient(node, T, name)``;
-* a name held in a variable or attribute (``self.topic = ...``), a literal or a
-  parameter: ``rospy.get_param('~topic', 'default')`` (the name as written:
-  ``~`` private, else relative), rclpy ``declare_parameter('topic', 'default')``
-  with ``get_parameter('topic')...`` (ROS 2 parameters are the node's: ``~topic``);
-* node names from ``rospy.init_node('n')``, ``rclpy.create_node('n')``,
-  ``Node('n')`` and ``super().__init__('n')`` / ``super().__init__(node_name='n')``.
+* library helpers (:mod:`py_helpers`: tf, message_filters,
+  ``wait_for_message``, interactive markers, parameter events);
+* names (:mod:`pyconst`): literals, constants, concatenations, parameters
+  (``rospy.get_param('~topic', 'default')``; rclpy ``declare_parameter`` /
+  ``get_parameter``: the node's ``~topic``), and what only the program knows
+  (a function's parameter, ``self.topic``, an imported constant), left to
+  the linker (:mod:`link`);
+* types through imports, ``from pkg.msg import *`` (candidates the linker
+  chooses among by the type table) and ``numpy_msg(T)``; a name imported
+  twice (chosen at run time) is read as its first import, said in a note;
+* node names from ``rospy.init_node(n)``, ``rclpy.create_node(n)``,
+  ``Node(n)`` and ``super().__init__(n)`` (``n`` a literal, or any name in a
+  class deriving from ``Node``);
+* for the linker: functions and their parameters, classes, the calls of the
+  package's own classes and functions with their argument values, attribute
+  bindings, module constants, imports.
 
-A name that is neither a literal nor a parameter is reported unresolved at
-its location, never guessed.
+A name that is not read statically is reported unresolved at its location,
+never guessed.
 """
 from __future__ import annotations
 
