@@ -15,7 +15,9 @@ relative to the checkout), entry launch files (``launch``), extra node names
 
 A site with a name is *found* when a graph node that has the site's file
 among its sources (and, when the site names its node, has that name) holds an
-edge of the site's role with the site's resolved name and type.  A site
+edge of the site's role with the site's resolved name and type; it is
+*located* when such an edge is created at the site's file and line
+(``sites_located``: expected = found sites, matched = located ones).  A site
 whose name is computed at run time cannot be in the graph; it is *reported*
 when the scan gives a located note on its file within 3 lines of it.
 Precision: a graph edge coming from a scanned file is right when some site of
@@ -47,7 +49,8 @@ def measure(root: Path, truth: dict) -> dict[str, tuple[int, ...]]:
     """``{what: (expected, found, matched[, right])}`` for one checkout ``root`` against
     ``truth`` (the ground-truth JSON, shape in the module docstring); ``what``
     is ``sites`` (found = graph edges, matched = sites found, right = graph
-    edges some site confirms), ``sites_runtime`` (expected = run-time names,
+    edges some site confirms), ``sites_located`` (expected = sites found,
+    matched = those whose edge is at the site's line), ``sites_runtime`` (expected = run-time names,
     matched = reported), ``nodes``, ``topics``, ``services``, ``actions``."""
     dirs = [root / d for d in truth["scan"]]
     res = scan(dirs, [root / lf for lf in truth.get("launch", [])], base=root)
@@ -65,11 +68,19 @@ def measure(root: Path, truth: dict) -> dict[str, tuple[int, ...]]:
                    and e.topic == name and e.msg_type == typ for n, r, e in edges)
 
     found_sites = sum(holds(s) for s in static)
+
+    def at_line(site: tuple) -> bool:
+        f, line, node, role, name, typ = site
+        return any(f in n.sources and (node is None or n.name == node) and r == role and e.topic == name
+                   and e.msg_type == typ and e.src.file == f and e.src.line == line for n, r, e in edges)
+
+    located = sum(at_line(s) for s in static if holds(s))
     reported = sum(any(nt.src.file == s[0] and s[1] <= nt.src.line <= s[1] + 3 for nt in g.notes)
                    for s in runtime)
     right = sum(any(s[0] == e.src.file and s[2] in (None, n.name) and s[3] == r and s[4] == e.topic and s[5] == e.msg_type for s in static)
                 for n, r, e in edges)
-    out = {"sites": (len(static), len(edges), found_sites, right), "sites_runtime": (len(runtime), 0, reported)}
+    out = {"sites": (len(static), len(edges), found_sites, right), "sites_located": (found_sites, 0, located),
+           "sites_runtime": (len(runtime), 0, reported)}
     want_nodes = {s[2] for s in sites if s[2]} | set(truth.get("nodes", []))
     got_nodes = {n.name for n in nodes}
     out["nodes"] = (len(want_nodes), len(got_nodes), len(want_nodes & got_nodes))

@@ -9,14 +9,18 @@ through a CMake wrapper function and started as launch composable nodes,
 rclpy with parameters, every service and action API).  ``expected/*.json``
 holds, per entry launch file, the graph written by hand from reading the
 code: each node with its publishers, subscribers, service servers/clients and
-action servers/clients, resolved names and types.
+action servers/clients, resolved names and types, and (``[name, type,
+"file:line"]``) the call site that creates each.
 
 Each case is scanned (launch file given, default arguments) and compared:
 an item is a node name, or ``(node, role, resolved name, type)``; a found item
 matches only when name and type both agree.  Printed per package and in
 total, for nodes, topics (pub/sub), services and actions: expected, found,
-matched, recall (matched / expected), precision (matched / found).
-Aims (issue 32): recall >= 0.95, precision 1.0.  Figures are printed, not asserted.
+matched, recall (matched / expected), precision (matched / found), and
+*located*: of the expected edges written with their call site, how many the
+graph's node holds at that file and line (each call site is one edge).
+Aims (issue 42): recall >= 0.98, precision 1.0, every edge located.  Figures
+are printed, not asserted.
 
 Usage::
 
@@ -42,9 +46,23 @@ def items_expected(exp: dict) -> dict[str, set[tuple]]:
     for node, spec in exp["nodes"].items():
         out["nodes"].add((node,))
         for role, group in GROUPS.items():
-            for name, typ in spec.get(role, []):
+            for name, typ, *_at in spec.get(role, []):
                 out[group].add((node, role, name, typ))
     return out
+
+
+def sites_expected(exp: dict) -> list[tuple]:
+    """``[(node, role, name, type, "file:line")]``: the expected edges written with a call site."""
+    return [(node, role, name, typ, at[0]) for node, spec in exp["nodes"].items() for role in GROUPS
+            for name, typ, *at in spec.get(role, []) if at]
+
+
+def located(site: tuple, graph) -> bool:  # type: ignore[no-untyped-def]
+    """Whether the graph's node holds the site's edge created at the site's file and line."""
+    node, role, name, typ, at = site
+    n = graph.nodes.get(node)
+    return n is not None and any(e.topic == name and e.msg_type == typ and f"{e.src.file}:{e.src.line}" == at
+                                 for e in n.edges_of(role))
 
 
 def items_found(graph) -> dict[str, set[tuple]]:  # type: ignore[no-untyped-def]
@@ -64,11 +82,18 @@ def main() -> None:
     a = ap.parse_args()
     # per package: group -> [expected, found, matched]
     table: dict[str, dict[str, list[int]]] = defaultdict(lambda: defaultdict(lambda: [0, 0, 0]))
+    where = [0, 0]  # expected call sites, located
     for case in sorted((a.corpus / "expected").glob("*.json")):
         exp = json.loads(case.read_text())
         ws = a.corpus / exp["workspace"]
         g = scan([ws], [ws / lf for lf in exp["launch"]], base=a.corpus, standard=False).graph
         want, got = items_expected(exp), items_found(g)
+        for site in sites_expected(exp):
+            ok = located(site, g)
+            where[0] += 1
+            where[1] += ok
+            if a.verbose and not ok:
+                print(f"  {case.stem}: not located {site}")
         pkg_of = {n: s.get("package", "?") for n, s in exp["nodes"].items()}
         pkg_of.update({n.name: n.package or "?" for n in g.nodes.values() if n.name not in pkg_of})
         for group in ("nodes", "topics", "services", "actions"):
@@ -93,6 +118,7 @@ def main() -> None:
         print(_row("TOTAL", group, e, f, m))
     e, f, m = (sum(t[k] for t in total.values()) for k in range(3))
     print(_row("TOTAL", "all", e, f, m))
+    print(f"edges located at their call site: {where[1]} of {where[0]}")
 
 
 def _row(pkg: str, group: str, e: int, f: int, m: int) -> str:

@@ -66,7 +66,12 @@ LAYERS: list[tuple[str, tuple[str, ...]]] = [
     # ros/: the ROS computation graph read from the robot's software and the
     # contracts grounded in it, the system as its code shows it, beside the
     # system model (system/); its stage, command and skeleton writer are
-    # placed below with the pipeline and the commands.
+    # placed below with the pipeline and the commands.  The readers of real
+    # code (issue 42) are in this layer too, below the graph (graph.py,
+    # assemble.py) that uses them: programs.py, link.py, link_values.py,
+    # symbols.py, emit.py, cpp_scope.py, cpp_values.py, cpp_types.py,
+    # cpp_prep.py, cpp_helpers.py, py_helpers.py, pyconst.py, namespaces.py;
+    # they import only ros/ modules, the standard library and tree-sitter.
     ("system/logic", ("rclverify.system", "rclverify.logic", "rclverify.ros")),
     # requirements/: formal requirements decided from the composed contracts
     # (check.py, beside the calculus it builds on) and their roll-up with the

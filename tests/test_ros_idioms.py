@@ -29,9 +29,17 @@ def _graph(case: str):  # type: ignore[no-untyped-def]
 def test_corpus_graph_is_exactly_the_hand_written_one(case: str) -> None:
     exp, g = _graph(case)
     want = {(n, role, name, typ) for n, spec in exp["nodes"].items()
-            for role in ("pub", "sub") + SERVICE_ROLES for name, typ in spec.get(role, [])}
+            for role in ("pub", "sub") + SERVICE_ROLES for name, typ, *_at in spec.get(role, [])}
     assert set(g.nodes) == set(exp["nodes"])
     assert g.edges(with_services=True) == want
+    # every call site is its own edge, at its line
+    sites = {(n, role, name, typ, at[0]) for n, spec in exp["nodes"].items()
+             for role in ("pub", "sub") + SERVICE_ROLES for name, typ, *at in spec.get(role, []) if at}
+    got = {(n.name, role, e.topic, e.msg_type, f"{e.src.file}:{e.src.line}")
+           for n in g.nodes.values() for role in ("pub", "sub") + SERVICE_ROLES for e in n.edges_of(role)}
+    assert sites <= got
+    if sites:
+        assert len(sites) == sum(len(n.edges_of(r)) for n in g.nodes.values() for r in ("pub", "sub") + SERVICE_ROLES)
     assert {n: g.nodes[n].package for n in g.nodes} == {n: s["package"] for n, s in exp["nodes"].items()}
 
 

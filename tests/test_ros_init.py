@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import json
 import os
+import subprocess
+import sys
 from pathlib import Path
 
 import pytest
@@ -55,3 +57,40 @@ def test_init_from_ros_writes_skeletons_that_verify(tmp_path: Path, monkeypatch:
     assert not [r for r in sarif["runs"][0]["results"] if r["ruleId"].startswith("ROS-")]
     assert main(["init", str(ws), "--from-ros", str(AMENT)]) == 1  # never over an existing workspace
     os.chdir(tmp_path)
+
+
+DRIVER = Path(__file__).parent / "data" / "ros_corpus" / "driver"
+
+
+def test_init_from_a_robot_driver_matches_its_endpoints_and_grounds_clean(tmp_path: Path) -> None:
+    # A C++ driver whose endpoints are made by helper classes in other files of
+    # the executable (namespaced handles, a parameter-given topic, a tf
+    # broadcaster member, service servers), and a Python guard script.
+    ws = tmp_path / "rover"
+    assert main(["init", str(ws), "--from-ros", str(DRIVER),
+                 "--launch", str(DRIVER / "src/rover_driver/launch/driver.launch")]) == 0
+    driver = (ws / "contracts/rover_driver.rcl").read_text().split("node RoverDriver {\n", 1)[1].split("  //")[0]
+    assert driver == (
+        "  inputs( cmdVel : Twist, wheelTicks : WheelTicks, resetOdometryReq : {}, enableMotorsReq : BOOL )\n"
+        "  outputs( wheelTicks_ : WheelTicks, battery : BatteryState, raw : Imu, odom : Odometry, tf : {}, "
+        "resetOdometryRes : TriggerResponse, enableMotorsRes : SetBoolResponse )\n"
+        "  topics( geometry_msgs/Twist cmd_vel matches(in.cmdVel),\n"
+        "          rover_driver/WheelTicks wheel_ticks matches(in.wheelTicks),\n"
+        "          rover_driver/WheelTicks wheel_ticks matches(out.wheelTicks_),\n"
+        "          sensor_msgs/BatteryState battery matches(out.battery),\n"
+        "          sensor_msgs/Imu raw matches(out.raw),\n"
+        "          nav_msgs/Odometry odom matches(out.odom),\n"
+        "          tf2_msgs/TFMessage tf matches(out.tf) )\n"
+        "  services( std_srvs/Trigger reset_odometry serves(in.resetOdometryReq, out.resetOdometryRes),\n"
+        "            std_srvs/SetBool enable_motors serves(in.enableMotorsReq, out.enableMotorsRes) )\n")
+    guard = (ws / "contracts/battery_guard.rcl").read_text()
+    assert "services( std_srvs/SetBool enable_motors calls(out.enableMotorsReq, in.enableMotorsRes) )" in guard
+    assert "    - /rover/base/cmd_vel\n" in (ws / "contracts/plan.yaml").read_text()
+    # the first `doit verify`, as a new user runs it (its own process: doit's reporter owns the streams)
+    env = {**os.environ, "PYTHONPATH": str(Path(__file__).parents[1] / "src")}
+    r = subprocess.run([sys.executable, "-m", "doit", "verify"], cwd=ws, env=env, capture_output=True, text=True,
+                       timeout=300)
+    assert r.returncode == 0, r.stdout + r.stderr
+    g = json.loads((ws / "reports/assurance.json").read_text())["grounding"]
+    assert g["counts"] == {"error": 0, "warning": 0}
+    assert g["matched"] == {"BatteryGuard": "/rover/battery_guard", "RoverDriver": "/rover/rover_driver"}

@@ -11,16 +11,21 @@ and each call of them is replaced by the body with ``${param}``, ``${ARGV}``,
 ``${ARGN}``, ``${ARGVn}`` substituted (and ``cmake_parse_arguments(PREFIX
 options one-value multi-value ${ARGN})`` evaluated, giving ``${PREFIX_KEY}``),
 so a project's own wrapper of ``rclcpp_components_register_node`` or
-``add_executable`` is traced to the commands it runs.  ``if``/``foreach`` are
-not evaluated: every branch's commands count.  Work is bounded
-(:data:`MAX_COMMANDS`, :data:`MAX_DEPTH`).
+``add_executable`` is traced to the commands it runs.  ``foreach(v items...)``
+(also ``RANGE``, ``IN LISTS``/``IN ITEMS``) runs its body once per item with
+``${v}`` substituted; ``file(GLOB|GLOB_RECURSE var patterns...)`` lists the
+package's files through the caller's ``glob``.  ``if``/``while`` are not
+evaluated: every branch's commands count.  Work is bounded
+(:data:`MAX_COMMANDS`, :data:`MAX_DEPTH`, :data:`MAX_ITEMS`).
 """
 from __future__ import annotations
 
 import re
+from typing import Callable
 
 MAX_COMMANDS = 20_000  # commands produced, expansions included
-MAX_DEPTH = 8  # nested function/macro calls
+MAX_DEPTH = 8  # nested function/macro calls and foreach loops
+MAX_ITEMS = 1000  # items of one foreach
 
 _CMD = re.compile(r"([A-Za-z_][A-Za-z0-9_]*)[ \t]*\(")
 _ARG = re.compile(r'"((?:[^"\\]|\\.)*)"|\[(=*)\[(.*?)\]\2\]|([^\s()"#]+)', re.S)
@@ -85,11 +90,51 @@ def _subst(s: str, env: dict[str, str]) -> str:
     return s
 
 
-def expand(text: str, pkg: str) -> list[tuple[str, list[str], int]]:
-    """The commands ``text`` runs, with variables substituted and calls of the
-    file's own ``function``/``macro`` definitions replaced by their bodies
-    (arguments substituted); each keeps the line of the top-level call.
-    Arguments holding ``;`` lists are split, as CMake does for unquoted ones."""
+def _items(args: list[str], env: dict[str, str]) -> list[str]:
+    """The items of ``foreach(var ...)`` given its substituted arguments after ``var``."""
+    if args[:1] == ["RANGE"]:
+        try:
+            n = [int(a) for a in args[1:4]]
+        except ValueError:
+            return []
+        start, stop, step = (0, n[0], 1) if len(n) == 1 else (n[0], n[1], n[2] if len(n) > 2 else 1)
+        return [str(i) for i in range(start, stop + 1, step or 1)][:MAX_ITEMS] if step > 0 else []
+    if args[:1] == ["IN"]:
+        out, mode = [], None
+        for a in args[1:]:
+            if a in ("LISTS", "ITEMS", "ZIP_LISTS"):
+                mode = a
+            elif mode == "LISTS":
+                out.extend(x for x in env.get(a, "").split(";") if x)
+            elif mode == "ITEMS":
+                out.append(a)
+        return out[:MAX_ITEMS]
+    return args[:MAX_ITEMS]
+
+
+def _block(seq: list[tuple[str, list[str], int]], i: int, opener: str, closer: str) -> tuple[list, int]:
+    """The commands between ``seq[i]`` (an ``opener``) and its matching ``closer``, and
+    the index of that closer (``len(seq)`` when missing)."""
+    body, depth, j = [], 1, i + 1
+    while j < len(seq):
+        if seq[j][0] == opener:
+            depth += 1
+        elif seq[j][0] == closer:
+            depth -= 1
+            if not depth:
+                break
+        body.append(seq[j])
+        j += 1
+    return body, j
+
+
+def expand(text: str, pkg: str, glob: Callable[[str, bool], list[str]] | None = None) -> list[tuple[str, list[str], int]]:
+    """The commands ``text`` runs, with variables substituted, ``foreach`` loops
+    unrolled and calls of the file's own ``function``/``macro`` definitions
+    replaced by their bodies (arguments substituted); each keeps the line of
+    the top-level call.  Arguments holding ``;`` lists are split, as CMake does
+    for unquoted ones.  ``glob(pattern, recurse)`` lists the package files a
+    ``file(GLOB ...)`` pattern matches (relative paths); without it globs are empty."""
     cmds = commands_of(text)
     defs: dict[str, tuple[list[str], list[tuple[str, list[str], int]]]] = {}
     top: list[tuple[str, list[str], int]] = []
@@ -116,11 +161,30 @@ def expand(text: str, pkg: str) -> list[tuple[str, list[str], int]]:
     env = {"PROJECT_NAME": pkg, "CMAKE_CURRENT_SOURCE_DIR": ".", "PROJECT_SOURCE_DIR": "."}
 
     def run(seq: list[tuple[str, list[str], int]], env: dict[str, str], depth: int, at: int | None) -> None:
-        for name, raw, line in seq:
+        i = 0
+        while i < len(seq):
+            name, raw, line = seq[i]
+            i += 1
             if len(out) >= MAX_COMMANDS:
                 return
             args = [x for a in raw for x in _subst(a, env).split(";") if x != ""]
             where = at if at is not None else line
+            if name == "foreach":
+                body, end = _block(seq, i - 1, "foreach", "endforeach")
+                i = end + 1
+                if args and depth < MAX_DEPTH:
+                    for item in _items(args[1:], env):
+                        env[args[0]] = item
+                        run(body, env, depth + 1, where)
+                continue
+            if name == "file" and len(args) >= 2 and args[0] in ("GLOB", "GLOB_RECURSE"):
+                pats = [a for a in args[2:] if a not in ("LIST_DIRECTORIES", "CONFIGURE_DEPENDS", "true", "false")]
+                if "RELATIVE" in pats:
+                    k = pats.index("RELATIVE")
+                    pats = pats[:k] + pats[k + 2:]
+                found = [f for p in pats for f in (glob(p, args[0] == "GLOB_RECURSE") if glob else [])]
+                env[args[1]] = ";".join(sorted(set(found)))
+                continue
             if name == "set" and args:
                 env[args[0]] = ";".join(a for a in args[1:] if a != "PARENT_SCOPE")
             elif name == "project" and args:

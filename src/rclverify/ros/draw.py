@@ -93,6 +93,19 @@ def grounding_dot(checked: Any, graph_json: Mapping[str, Any], findings: list[Ma
     return _ENV.get_template("grounding.dot.j2").render(
         contract_nodes=c_nodes, contract_topics=[{"name": _q(k), "colour": _COLOUR[v]} for k, v in c_topics.items()],
         contract_edges=c_edges, ros_nodes=r_nodes,
-        ros_topics=[{"name": _q(k), "colour": _COLOUR[v]} for k, v in sorted(r_topics.items())], ros_edges=r_edges,
-        contract_links=link_nodes("c", c_links), ros_links=link_nodes("r", r_links), link_edges=l_edges,
+        ros_topics=[{"name": _q(k), "colour": _COLOUR[v]} for k, v in sorted(r_topics.items())],
+        ros_edges=_once(r_edges),  # a topic created at several call sites of a node is one line
+        contract_links=link_nodes("c", c_links), ros_links=link_nodes("r", r_links), link_edges=_once(l_edges),
         matches=[{"contract": _q(c), "ros": _q(r)} for c, r in pairs.items()])
+
+
+def _once(edges: list[dict[str, str]]) -> list[dict[str, str]]:
+    """``edges`` without repeats (the first of equal ones kept, in order)."""
+    seen: set[tuple[tuple[str, str], ...]] = set()
+    out = []
+    for e in edges:
+        k = tuple(sorted(e.items()))
+        if k not in seen:
+            seen.add(k)
+            out.append(e)
+    return out

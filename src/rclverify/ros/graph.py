@@ -20,10 +20,12 @@ from pathlib import Path
 from typing import Any, Sequence
 
 from . import names
+from . import namespaces
+from .assemble import Assembly
 from .cache import ParseCache
-from .executables import cmake_components, executables
+from .executables import Targets, targets
 from .interfaces import TypeTable
-from .launch import El, Interpreter, LaunchNode, read_xml, read_yaml
+from .launch import El, Interpreter, read_xml, read_yaml
 from .launch_ros2 import read_python
 from .model import Endpoint, Graph, GraphEdge, GraphNode, Note, Src
 from .packages import Package, find_manifests, read_package
@@ -32,6 +34,9 @@ from .sources_py import scan_python
 
 _CPP = {".cpp", ".cc", ".cxx", ".hpp", ".h", ".hh"}
 _SKIP_DIRS = {"build", "devel", "install", "log", "test", "tests", "launch", "msg", "srv", "action", "__pycache__"}
+_NOT_SCRIPTS = {"CMakeLists", "Makefile", "LICENSE", "COPYING", "AUTHORS", "CHANGELOG", "README", "CONTRIBUTING",
+                "Doxyfile", "Dockerfile", "COLCON_IGNORE", "CATKIN_IGNORE", "AMENT_IGNORE", "PKG-INFO"}
+_SCRIPT_DIRS = ("scripts", "nodes", "bin")
 MAX_SOURCE_BYTES = 2_000_000
 
 
@@ -66,8 +71,11 @@ class Shower:
         return shown
 
 
-def _source_files(root: Path, skipped: list[str] | None = None) -> tuple[list[Path], list[Path]]:
-    py, cpp = [], []
+def _source_files(root: Path, skipped: list[str] | None = None) -> tuple[list[Path], list[Path], list[Path]]:
+    """``(Python files, C++ files, files without an extension)`` of a package; the last
+    are Python programs when their first line is a Python ``#!`` (or a build file
+    installs them as one)."""
+    py, cpp, bare = [], [], []
     for dirpath, dirnames, filenames in os.walk(root):
         dirnames[:] = sorted(d for d in safefs.keep_names(dirpath, dirnames, skipped)
                              if d not in _SKIP_DIRS and not d.startswith("."))
@@ -77,9 +85,14 @@ def _source_files(root: Path, skipped: list[str] | None = None) -> tuple[list[Pa
                 py.append(p)
             elif p.suffix in _CPP:
                 cpp.append(p)
-            elif not p.suffix and (Path(dirpath).name in ("scripts", "nodes", "bin")):
-                py.append(p)  # ROS 1 scripts without extension
-    return py, cpp
+            elif not p.suffix and not f.startswith(".") and f not in _NOT_SCRIPTS:
+                bare.append(p)
+    return py, cpp, bare
+
+
+def _python_shebang(data: bytes) -> bool:
+    """Whether a file's first line is a ``#!`` naming a Python interpreter."""
+    return data.startswith(b"#!") and b"python" in data.split(b"\n", 1)[0]
 
 
 def _load_launch(path: Path, shown: str) -> tuple[El | None, list[Note]]:
@@ -164,55 +177,41 @@ def _scan(paths: Sequence[Path], launch: Sequence[Path], launch_args: dict[str, 
     g.notes.extend(table.notes)
 
     res = ScanResult(g, pkgs, table)
-    exes: dict[str, dict[str, list[Path]]] = {}
-    comps: dict[str, dict[str, tuple[str, int]]] = {}  # package -> executable -> (component class, line)
+    records: dict[str, dict[str, dict[str, Any]]] = {}
+    tgts: dict[str, Targets] = {}
     for name in sorted(pkgs):
         root = pkgs[name].root
-        py, cpp = _source_files(root, skipped)
-        py_nodes = []
-        for f in py + cpp:
+        tgts[name] = targets(root, name)
+        installed = {p for paths in tgts[name].programs.values() for p in paths}
+        py, cpp, bare = _source_files(root, skipped)
+        recs = records[name] = {}
+        for f in py + cpp + bare:
+            quiet = f in bare and f not in installed and f.parent.name not in _SCRIPT_DIRS
             try:
                 data = safefs.read_bytes(f)
             except OSError as exc:
-                sev = "warning" if isinstance(exc, safefs.Refused) else "error"
-                g.notes.append(Note(Src(show(f)), f"cannot read: {exc}", "ROS-PARSE", sev))
+                if not quiet:
+                    sev = "warning" if isinstance(exc, safefs.Refused) else "error"
+                    g.notes.append(Note(Src(show(f)), f"cannot read: {exc}", "ROS-PARSE", sev))
                 continue
+            if f in bare and not _python_shebang(data) and (f not in installed or data.startswith(b"#!")):
+                continue  # not a Python program (a shell script, a data file)
             if len(data) > MAX_SOURCE_BYTES:
                 g.notes.append(Note(Src(show(f)), "source file larger than 2 MB: not scanned", "ROS-PARSE"))
                 continue
             shown = show(f)
             sha = ParseCache.digest(data)
-            is_py = f in py
-            if is_py and not f.suffix and not data.startswith(b"#!") :
-                continue
+            is_py = f not in cpp
             fn = (lambda d=data, s=shown: scan_python(d.decode("utf-8", errors="replace"), s)) if is_py \
                 else (lambda d=data, s=shown: scan_cpp(d, s))
             r = cache.get(f"{'py' if is_py else 'cpp'}:{shown}", sha, fn) if cache else fn()
-            if not (r["nodes"] or r["endpoints"] or r["notes"]):
-                continue
-            g.files[shown] = sha
-            res.sources[shown] = r
-            if is_py and (r["nodes"] or r["endpoints"]):
-                py_nodes.append(f)
-        exes[name] = executables(root, name, py_nodes)
-        comps[name] = cmake_components(root, name)[0]
-    classes = _classes(pkgs, res.sources, show)
+            recs[shown] = r
+            if r["nodes"] or r["endpoints"] or r["notes"] or r.get("node_names"):
+                g.files[shown] = sha
+                res.sources[shown] = r
     for bad in sorted({safefs.escaped(show(Path(b))) for b in skipped}):
         g.notes.append(Note(Src(bad), "name is not valid UTF-8: skipped", "ROS-PARSE"))
-
-    def endpoints_of(files: list[Path]) -> tuple[list[Endpoint], list[tuple[str, Src]], list[str]]:
-        eps: list[Endpoint] = []
-        inits: list[tuple[str, Src]] = []
-        shown_files = []
-        for f in files:
-            s = show(f)
-            shown_files.append(s)
-            r = res.sources.get(s)
-            if r:
-                eps.extend(r["endpoints"])
-                inits.extend(r["nodes"])
-        return eps, inits, shown_files
-
+    asm = Assembly(pkgs, records, tgts, show, lambda t: table.get(t) is not None)
     launch_params: dict[str, tuple[str, Src]] = {}
 
     def add_node(full: str, ns: str, pkg: str | None, exe: str | None, files: list[str], declared: Src,
@@ -243,14 +242,11 @@ def _scan(paths: Sequence[Path], launch: Sequence[Path], launch_args: dict[str, 
                                                f"default in the code and no value in the launch files: "
                                                f"not resolved statically"))
                     continue
-            topic = names.resolve(written, ns, full)
-            at = None
-            for frm, to, rsrc in remaps:
-                if names.resolve(frm, ns, full) == topic:
-                    topic, at = names.resolve(to, ns, full), rsrc
-            edge = GraphEdge(topic, e.msg_type, e.src, at, written, pname, set_at)
+            topic, at = namespaces.resolve(written, e.handle, ns, full, remaps)
+            edge = GraphEdge(topic, e.msg_type, e.src, at, namespaces.shown(written, e.handle), pname, set_at)
             lst = node.edges_of(e.kind)
-            if not any(x.topic == edge.topic and x.msg_type == edge.msg_type for x in lst):
+            # every call site keeps its own edge (the same name created twice is two edges)
+            if not any(x.topic == edge.topic and x.msg_type == edge.msg_type and x.src == edge.src for x in lst):
                 lst.append(edge)
         g.nodes[full] = node
 
@@ -267,38 +263,12 @@ def _scan(paths: Sequence[Path], launch: Sequence[Path], launch_args: dict[str, 
         g.notes.extend(interp.notes)
         launch_params.update(interp.params)
         for ln in interp.nodes:
-            _launch_node(ln, pkgs, exes, endpoints_of, add_node, g, classes, comps)
+            asm.launch_node(ln, add_node, g)
     else:
-        in_class = set()
-        for cls, info in sorted(classes.items()):
-            if info["nodes"]:  # a class that names its node (a component, a Node subclass): one node
-                nname, src = info["nodes"][0]
-                in_class |= {id(e) for e in info["endpoints"]}
-                add_node(names.join("/", nname), "/", info["package"], None, info["files"], src,
-                         info["endpoints"], [], "source")
-        for shown, r in sorted(res.sources.items()):
-            if r.get("classes") and any(classes.get(c, {}).get("nodes") for c in r["classes"]):
-                rest = [e for e in r["endpoints"] if id(e) not in in_class]
-                if rest:
-                    g.notes.append(Note(rest[0].src, "endpoints outside the file's node classes, in a file that is "
-                                                     "started by no launch file: not in the graph"))
-                continue
-            # a Python file naming several nodes in their own classes: one node
-            # each, with the endpoints of its class (sources_py.owners)
-            own = r.get("owners") or []
-            firsts: dict[str, Src] = {}
-            for nname, src in (r["nodes"] if own else r["nodes"][:1]):
-                firsts.setdefault(nname, src)
-            pkg = next((p for p, pk in pkgs.items() if shown.startswith(show(pk.root) + "/")), None)
-            for nname, src in firsts.items():
-                eps = [e for k, e in enumerate(r["endpoints"]) if not own or r["nodes"][own[k]][0] == nname]
-                add_node(names.join("/", nname), "/", pkg, None, [shown], src, eps, [], "source")
-            if not r["nodes"] and r["endpoints"]:
-                g.notes.append(Note(r["endpoints"][0].src, "publishers/subscribers in a file that names no node "
-                                                          "and is started by no launch file: not in the graph",
-                                    "ROS-UNRESOLVED"))
+        asm.source_nodes(add_node, g)
     for shown, r in sorted(res.sources.items()):
         g.notes.extend(r["notes"])
+    g.notes = list(dict.fromkeys(g.notes))  # a note given by several programs (a shared header) once
     for b in bags:
         from .bag import bag_topics
         info, notes = bag_topics(Path(b), show(Path(b)))
@@ -313,68 +283,3 @@ def _scan(paths: Sequence[Path], launch: Sequence[Path], launch_args: dict[str, 
         cache.save()
         res.cache_hits, res.cache_misses = cache.hits, cache.misses
     return res
-
-
-def _classes(pkgs: dict[str, Package], sources: dict[str, dict[str, Any]], show: Any) -> dict[str, dict[str, Any]]:
-    """``{qualified class: {"package", "files", "nodes", "endpoints"}}`` over every C++ source
-    (a class written over several files is merged)."""
-    out: dict[str, dict[str, Any]] = {}
-    roots = sorted(((show(pk.root) + "/", p) for p, pk in pkgs.items()), key=lambda x: -len(x[0]))
-    for shown, r in sorted(sources.items()):
-        for cls, info in (r.get("classes") or {}).items():
-            pkg = next((p for pre, p in roots if shown.startswith(pre)), None)
-            c = out.setdefault(cls, {"package": pkg, "files": [], "nodes": [], "endpoints": []})
-            c["files"].append(shown)
-            c["nodes"].extend(info["nodes"])
-            c["endpoints"].extend(info["endpoints"])
-    return out
-
-
-def _find_class(plugin: str, pkg: str | None, classes: dict[str, dict[str, Any]]) -> str | None:
-    """The class a plugin name (``ns::Class``) names: exact, else the one class of
-    ``pkg`` with that last name part."""
-    p = plugin.strip().lstrip(":")
-    if p in classes:
-        return p
-    last = p.split("::")[-1]
-    hits = [c for c, i in classes.items() if c.split("::")[-1] == last and (pkg is None or i["package"] == pkg)]
-    return hits[0] if len(hits) == 1 else None
-
-
-def _launch_node(ln: LaunchNode, pkgs: dict[str, Package], exes: dict[str, dict[str, list[Path]]],
-                 endpoints_of: Any, add_node: Any, g: Graph, classes: dict[str, dict[str, Any]],
-                 comps: dict[str, dict[str, tuple[str, int]]]) -> None:
-    plugin = ln.plugin or (comps.get(ln.pkg, {}).get(ln.exe, ("", 0))[0] if ln.exe else None)
-    if plugin:
-        cls = _find_class(plugin, ln.pkg, classes)
-        if cls is None:
-            g.notes.append(Note(ln.src, f"component class '{plugin}' of package '{ln.pkg}' is not found in the "
-                                        f"scanned C++ sources; its topics are unknown", "ROS-LAUNCH"))
-            info: dict[str, Any] = {"files": [], "nodes": [], "endpoints": []}
-        else:
-            info = classes[cls]
-        name = ln.name or (info["nodes"][0][0] if info["nodes"] else plugin.split("::")[-1])
-        full = names.normalise(name) if name.startswith("/") else names.join(ln.ns, name)
-        ns = names.split(full)[0] if name.startswith("/") else ln.ns
-        add_node(full, ns, ln.pkg, ln.exe or None, list(info["files"]), ln.src, info["endpoints"], ln.remaps,
-                 "launch", ln.params)
-        return
-    if ln.pkg not in pkgs:
-        g.notes.append(Note(ln.src, f"node package '{ln.pkg}' is not in the scanned workspaces; "
-                                    f"its topics are unknown", "ROS-LAUNCH"))
-        files: list[Path] = []
-    else:
-        files = exes.get(ln.pkg, {}).get(ln.exe, [])
-        if not files:
-            g.notes.append(Note(ln.src, f"executable '{ln.exe}' of package '{ln.pkg}' has no source found "
-                                        f"(CMakeLists.txt add_executable, setup.py console_scripts, scripts/); "
-                                        f"its topics are unknown", "ROS-LAUNCH"))
-    eps, inits, shown = endpoints_of(files)
-    name = ln.name or (inits[0][0] if inits else ln.exe)
-    if name.startswith("/"):
-        full = names.normalise(name)
-        ns = names.split(full)[0]
-    else:
-        full = names.join(ln.ns, name)
-        ns = ln.ns
-    add_node(full, ns, ln.pkg, ln.exe, shown, ln.src, eps, ln.remaps, "launch", ln.params)

@@ -201,7 +201,8 @@ class Grounder:
         resolved = names.resolve(topic, gn.namespace, gn.name)
         return next((e for e in edges if e.written.lstrip("/") == topic or e.written == topic), None) or \
             next((e for e in edges if e.topic == resolved), None) or \
-            next((e for e in edges if e.written.rstrip("/").rsplit("/", 1)[-1].lstrip("~") == topic), None)
+            next((e for e in edges if e.written.rstrip("/").rsplit("/", 1)[-1].lstrip("~") == topic), None) or \
+            next((e for e in edges if e.written.strip("/~").replace("/", "_").replace("~", "") == topic), None)
 
     def _node(self, cn: Any, gn: GraphNode, publishers: dict[str, list[tuple[str, GraphEdge]]],
               all_topics: list[str]) -> None:
@@ -216,10 +217,9 @@ class Grounder:
             other = self._own_edge(gn, "sub" if is_out else "pub", tp.field)
             ctype = canon_type(tp.msg_type)
             resolved = edge.topic if edge else names.resolve(tp.field, gn.namespace, gn.name)
-            if edge is not None:
-                documented.add(id(edge))
-            if other is not None:
-                documented.add(id(other))
+            # every call site creating the topic is documented by the one entry
+            for e in ([edge] if edge else []) + ([other] if other else []):
+                documented |= {id(x) for x in gn.publishes + gn.subscribes if x.topic == e.topic}
             rcl_loc = tp.loc
             if is_out and edge is None:
                 close = difflib.get_close_matches(tp.field, [e.written for e in gn.publishes], 1, 0.6)

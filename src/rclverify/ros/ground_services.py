@@ -64,7 +64,8 @@ def _own(edges: list[GraphEdge], name: str, gn: GraphNode) -> GraphEdge | None:
     resolved = names.resolve(name, gn.namespace, gn.name)
     return next((e for e in edges if e.written.lstrip("/") == name.lstrip("/") or e.written == name), None) or \
         next((e for e in edges if e.topic == resolved), None) or \
-        next((e for e in edges if e.written.rstrip("/").rsplit("/", 1)[-1].lstrip("~") == name), None)
+        next((e for e in edges if e.written.rstrip("/").rsplit("/", 1)[-1].lstrip("~") == name), None) or \
+        next((e for e in edges if e.written.strip("/~").replace("/", "_").replace("~", "") == name), None)
 
 
 def servers(graph_nodes: Mapping[str, GraphNode], kind: str) -> dict[str, list[tuple[str, GraphEdge]]]:
@@ -90,7 +91,9 @@ def ground_links(add: Add, node: ast.Node, gn: GraphNode, graph_nodes: Mapping[s
         what = lk.kind
         own_s = _own(gn.edges_of(f"{lk.kind}_servers"), lk.name, gn)
         own_c = _own(gn.edges_of(f"{lk.kind}_clients"), lk.name, gn)
-        documented |= {id(e) for e in (own_s, own_c) if e is not None}
+        documented |= {id(x) for e in (own_s, own_c) if e is not None
+                       for x in gn.edges_of(f"{lk.kind}_servers") + gn.edges_of(f"{lk.kind}_clients")
+                       if x.topic == e.topic}
         mine = own_s if lk.role == "serves" else own_c
         resolved = mine.topic if mine else names.resolve(lk.name, gn.namespace, gn.name)
         ctype = canon_type(lk.ros_type, "srv" if lk.kind == "service" else "action")

@@ -166,6 +166,8 @@ class Interpreter:
             if not parts:
                 raise Unresolved("empty substitution $()")
             kind, rest = parts[0], parts[1:]
+            if kind == "var-default" and rest:  # a Python launch file's LaunchConfiguration(name, default=d)
+                return scope.args[rest[0]] if rest[0] in scope.args else " ".join(rest[1:])
             if kind in ("arg", "var") and len(rest) == 1:
                 if rest[0] not in scope.args:
                     raise Unresolved(f"$({kind} {rest[0]}): argument '{rest[0]}' has no value")

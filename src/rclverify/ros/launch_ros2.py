@@ -34,14 +34,24 @@ def _callee(c: ast.Call) -> str:
     return f.attr if isinstance(f, ast.Attribute) else (f.id if isinstance(f, ast.Name) else "")
 
 
-def _value(e: ast.AST) -> str:
+#: the variables ``generate_launch_description()`` assigns, while one file is read
+_ENV: dict[str, ast.AST] = {}
+
+
+def _value(e: ast.AST, depth: int = 0) -> str:
     if isinstance(e, ast.Constant) and isinstance(e.value, (str, int, float, bool)):
         return str(e.value).lower() if isinstance(e.value, bool) else str(e.value)
+    if isinstance(e, ast.Name) and e.id in _ENV and depth < 8:
+        return _value(_ENV[e.id], depth + 1)
+    if isinstance(e, ast.Name):
+        raise _Unres(f"variable '{e.id}' (not assigned in generate_launch_description())")
     if isinstance(e, ast.Call):
         name = _callee(e)
-        args = [_value(a) for a in e.args]
-        if name == "LaunchConfiguration" and len(args) == 1:
-            return f"$(var {args[0]})"
+        if name == "LaunchConfiguration" and len(e.args) == 1:
+            var = _value(e.args[0], depth + 1)
+            d = _kw(e, "default")
+            return f"$(var-default {var} {_value(d, depth + 1)})" if d is not None else f"$(var {var})"
+        args = [_value(a, depth + 1) for a in e.args]
         if name in ("get_package_share_directory", "FindPackageShare") and len(args) == 1:
             return f"$(find-pkg-share {args[0]})"
         if name == "join" and args:
@@ -51,11 +61,11 @@ def _value(e: ast.AST) -> str:
         if name in ("PythonLaunchDescriptionSource", "XMLLaunchDescriptionSource", "YAMLLaunchDescriptionSource",
                     "AnyLaunchDescriptionSource") and len(args) == 1:
             return args[0]
-    if isinstance(e, (ast.List, ast.Tuple)) and all(isinstance(x, ast.Constant) for x in e.elts):
-        return "".join(_value(x) for x in e.elts)  # a list of substitutions concatenates
+    if isinstance(e, (ast.List, ast.Tuple)) and all(isinstance(x, (ast.Constant, ast.Name, ast.Call)) for x in e.elts):
+        return "".join(_value(x, depth + 1) for x in e.elts)  # a list of substitutions concatenates
     if isinstance(e, ast.JoinedStr):
         raise _Unres("an f-string")
-    raise _Unres(f"'{ast.unparse(e)}'")
+    raise _Unres(f"'{ast.unparse(e)}' (not a literal or a known substitution)")
 
 
 def _kw(c: ast.Call, name: str) -> ast.AST | None:
@@ -147,8 +157,7 @@ def _action(c: ast.Call, shown: str, notes: list[Note]) -> El | None:
                 raise _Unres("an include without a source")
             return El("include", {"file": _value(s)}, kids, src)
     except _Unres as exc:
-        notes.append(Note(src, f"{name}(...): {exc} is not a literal: not resolved statically; action skipped",
-                          "ROS-LAUNCH"))
+        notes.append(Note(src, f"{name}(...): {exc} cannot be read statically; action skipped", "ROS-LAUNCH"))
     return None
 
 
@@ -200,10 +209,26 @@ def read_python(path: Path, shown: str) -> tuple[El | None, list[Note]]:
         return None, [Note(Src(shown), f"cannot read: {exc}", "ROS-PARSE", "error")]
     notes: list[Note] = []
     fn = next((f for f in tree.body if isinstance(f, ast.FunctionDef) and f.name == "generate_launch_description"), None)
+    _ENV.clear()
+    try:
+        return _read(fn, shown, notes)
+    finally:
+        _ENV.clear()
+
+
+def _read(fn: ast.FunctionDef | None, shown: str, notes: list[Note]) -> tuple[El | None, list[Note]]:
     if fn is None:
         return None, [Note(Src(shown), "no generate_launch_description() function", "ROS-PARSE", "error")]
     kids: list[El] = []
     assigned: dict[str, ast.AST] = {}
+    counts: dict[str, int] = {}
+    for st in ast.walk(fn):
+        if isinstance(st, ast.Assign) and len(st.targets) == 1 and isinstance(st.targets[0], ast.Name):
+            counts[st.targets[0].id] = counts.get(st.targets[0].id, 0) + 1
+            _ENV[st.targets[0].id] = st.value
+    for name, k in counts.items():
+        if k > 1:
+            _ENV.pop(name)  # assigned twice: not one value
     for st in ast.walk(fn):
         if isinstance(st, ast.Assign) and len(st.targets) == 1 and isinstance(st.targets[0], ast.Name):
             assigned[st.targets[0].id] = st.value

@@ -37,13 +37,24 @@ class Endpoint:
     name as ROS resolves it for the node (``~topic`` private, ``topic``
     relative, ``/topic`` global; ROS 2 parameters are always ``~name``), and
     ``topic`` is then the code's default (``""`` when it gives none); the
-    launch file's value for the parameter wins (docs/ros.md, "Reading real code")."""
+    launch file's value for the parameter wins (docs/ros.md, "Reading real code").
+
+    ``handle``: the namespaces of the node handle the name is created through
+    (``("~",)`` for a private ``ros::NodeHandle``, ``("left",)``; resolved, and
+    remapped, by the graph: :mod:`namespaces`).  ``unit``: the class (or free
+    function) whose code creates it; ``func``: the function (method) that does.  ``pending``: what the file alone cannot
+    read, for the linker (:mod:`link`): ``(name value, handle value, callback,
+    function key, name as written, where the name is written)``, or ``None``."""
 
     kind: str  # "pub" | "sub" | one of ``SERVICE_ROLES``
     topic: str  # the topic, service or action name as written
     msg_type: str | None
     src: Src
     param: str | None = None
+    handle: tuple[str, ...] = ()
+    unit: str | None = None
+    pending: Any = None
+    func: str | None = None
 
 
 # The four service/action roles an :class:`Endpoint` may have besides "pub"/"sub", each the

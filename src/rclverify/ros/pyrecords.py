@@ -11,14 +11,16 @@ from .model import Src
 @dataclass
 class PyVal:
     """An argument or assigned value: ``kind`` "str" (``text`` its value), "name"
-    (a dotted name), "call" (``call``) or "other" (``text`` the source); ``calls``
-    are the calls written inside it."""
+    (a dotted name), "call" (``call``), "cat" (a concatenation ``a + b`` or an
+    f-string: ``parts``) or "other" (``text`` the source); ``calls`` are the
+    calls written inside it."""
 
     kind: str
     text: str
     src: Src
     call: "PyCall | None" = None
     calls: list["PyCall"] = field(default_factory=list)
+    parts: list["PyVal"] = field(default_factory=list)
 
 
 @dataclass
@@ -34,11 +36,25 @@ class PyCall:
 
 @dataclass
 class PyModule:
-    """What the readers give: ``imports`` (local name -> dotted origin), every call,
-    the assignments ``(target as written, value)``, and each class statement's
-    ``(name, first line, last line)``."""
+    """What the readers give: ``imports`` (local name -> dotted origin, the first
+    in source order), ``import_lines`` (local name -> every ``(origin, line)``
+    that binds it: two origins are an import chosen at run time), ``star``
+    (modules imported with ``*``), every call, the assignments ``(target as
+    written, value)``, each class statement's ``(name, first line, last line)``
+    and each function's ``(qualified name, first line, last line, parameters,
+    defaults)`` (a method's ``self``/``cls`` left out; ``Cls.f`` for a method)."""
 
     imports: dict[str, str] = field(default_factory=dict)
     calls: list[PyCall] = field(default_factory=list)
     assigns: list[tuple[str, PyVal]] = field(default_factory=list)
     classes: list[tuple[str, int, int]] = field(default_factory=list)
+    functions: list[tuple[str, int, int, list[str], list["PyVal | None"]]] = field(default_factory=list)
+    star: list[str] = field(default_factory=list)
+    import_lines: dict[str, list[tuple[str, int]]] = field(default_factory=dict)
+    bases: dict[str, list[str]] = field(default_factory=dict)  # class name -> base classes as written
+
+    def bind_import(self, local: str, origin: str, line: int) -> None:
+        """Record that ``local`` is bound to ``origin`` by an import at ``line``."""
+        self.import_lines.setdefault(local, []).append((origin, line))
+        first = min(self.import_lines[local], key=lambda x: x[1])
+        self.imports[local] = first[0]

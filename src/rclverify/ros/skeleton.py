@@ -118,6 +118,8 @@ class _Node:
     outputs: list[str] = field(default_factory=list)
     topics: list[str] = field(default_factory=list)
     context: list[dict[str, str]] = field(default_factory=list)
+    services: list[str] = field(default_factory=list)
+    actions: list[str] = field(default_factory=list)
 
 
 def _type_name(msg: str, taken: dict[str, str]) -> str:
@@ -155,9 +157,56 @@ def _var_type(table: TypeTable, msg: str | None, var: str,
     return tname, [p for p, _ in fields], {"name": tname, "type": sig}
 
 
+def _identifier(written: str, others: list[str]) -> str:
+    """The RCL name a contract gives an endpoint written ``written`` (``~status``,
+    ``base/cmd_vel``): its last segment when no other endpoint of the node (written
+    ``others``) ends in it, else the whole name with ``_`` for ``/`` and ``~``
+    (``base_cmd_vel``), the form the grounding matches (docs/ros.md)."""
+    def last(w: str) -> str:
+        return w.rstrip("/").rsplit("/", 1)[-1].lstrip("~")
+    base = last(written)
+    if sum(1 for o in others if last(o) == base and o.strip("/~") != written.strip("/~")) > 0:
+        base = written.strip("/~").replace("/", "_").replace("~", "")
+    return base if re.fullmatch(r"[A-Za-z_][A-Za-z0-9_]*", base) and base not in _RCL_WORDS else ident(base)
+
+
+def _links(n: "_Node", gn: GraphNode, table: TypeTable, taken: dict[str, str], context: dict[str, dict[str, str]],
+           seen: set[str]) -> None:
+    """The node's service and action links (``services(...)``, ``actions(...)``): a
+    server reads the request (goal) and writes the response (feedback, result), a
+    client the mirror image; each part an input or output typed from the
+    ``.srv``/``.action`` definition."""
+    for kind, parts in (("service", (("Request", "Req"), ("Response", "Res"))),
+                        ("action", (("Goal", "Goal"), ("Feedback", "Feedback"), ("Result", "Result")))):
+        for role in ("servers", "clients"):
+            edges = gn.edges_of(f"{kind}_{role}")
+            written = [e.written or e.topic for e in edges]
+            done: set[str] = set()
+            for e in sorted(edges, key=lambda e: e.topic):
+                if e.topic in done or not e.msg_type:
+                    continue
+                done.add(e.topic)
+                name = _identifier(e.written or e.topic, written)
+                refs = []
+                for k, (part, suffix) in enumerate(parts):
+                    var = ident(name) + suffix
+                    while var in seen:
+                        var += "_"
+                    seen.add(var)
+                    typ, _paths, ctx = _var_type(table, f"{e.msg_type}_{part}", var, taken)
+                    if ctx is not None:
+                        context.setdefault(ctx["name"], ctx)
+                    incoming = (k == 0) == (role == "servers")
+                    (n.inputs if incoming else n.outputs).append(f"{var} : {typ}")
+                    refs.append(f"{'in' if incoming else 'out'}.{var}")
+                verb = "serves" if role == "servers" else "calls"
+                getattr(n, f"{kind}s").append(f"{short_type(e.msg_type)} {name} {verb}({', '.join(refs)})")
+
+
 def build_skeletons(res: ScanResult) -> tuple[list[_Node], dict[str, list[str]], list[str], list[dict[str, str]]]:
     """Contract skeletons (one per graph node), the plan's ``fields``, the ``external``
-    topics and the shared context declarations (one per message type used)."""
+    topics and the shared context declarations (one per message type used).  A
+    topic the node's code creates at several call sites is one input or output."""
     g, table = res.graph, res.table
     taken: dict[str, str] = {}
     context: dict[str, dict[str, str]] = {}
@@ -172,12 +221,15 @@ def build_skeletons(res: ScanResult) -> tuple[list[_Node], dict[str, list[str]],
         used_names.add(cname)
         n = _Node(cname, gname, gn.package, gn.executable, gn.sources, _contract_file(cname, nodes))
         seen: set[str] = set()
+        written = [e.written or e.topic for e in gn.publishes + gn.subscribes]
         for kind, edges in (("in", gn.subscribes), ("out", gn.publishes)):
+            done: set[str] = set()
             for e in sorted(edges, key=lambda e: e.topic):
-                base = (e.written or e.topic).rstrip("/").rsplit("/", 1)[-1].lstrip("~")
-                topic_name = base if re.fullmatch(r"[A-Za-z_][A-Za-z0-9_]*", base) and base not in _RCL_WORDS \
-                    else ident(base)
-                var = ident(base)
+                if e.topic in done:
+                    continue
+                done.add(e.topic)
+                topic_name = _identifier(e.written or e.topic, written)
+                var = ident(topic_name)
                 while var in seen:
                     var += "_"
                 seen.add(var)
@@ -189,6 +241,7 @@ def build_skeletons(res: ScanResult) -> tuple[list[_Node], dict[str, list[str]],
                                 f"matches({kind}.{var})")
                 if paths:
                     fields.setdefault(topic_name, paths)
+        _links(n, gn, table, taken, context, seen)
         nodes.append(n)
     published = {e.topic for n in g.nodes.values() for e in n.publishes}
     external = sorted({e.topic for n in g.nodes.values() for e in n.subscribes} - published)

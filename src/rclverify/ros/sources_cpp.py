@@ -3,342 +3,395 @@ sources, read with tree-sitter's C++ grammar (``tree-sitter``, ``tree-sitter-cpp
 
 Recognised (roscpp and actionlib, ROS 1; rclcpp and rclcpp_action, ROS 2):
 
-* ``<h>.advertise<T>(topic, ...)``, ``<h>.subscribe<T>(topic, ...)`` and
-  ``<h>.subscribe(topic, n, cb)`` (the type then comes from the callback's
-  first parameter, ``const pkg::T::ConstPtr&``, when ``cb`` is a function of
-  the same file); ``create_publisher<T>``, ``create_subscription<T>`` with any
-  receiver (bare, ``this->``, ``node_->``, ``shared_from_this()->``, ``node.``);
-* services: ``advertiseService(name, &cb)`` (type from ``cb``'s
-  ``pkg::Srv::Request&``), ``serviceClient<Srv>(name)``, ``create_service<Srv>``,
-  ``create_client<Srv>``; actions: ``actionlib::SimpleActionServer<pkg::XAction>``
-  / ``SimpleActionClient`` (declared with arguments, as members initialised in
-  a constructor, through ``new`` or ``make_shared``), ``rclcpp_action::create_server<T>``
-  / ``create_client<T>``; ``using``/``typedef`` aliases of the type are followed;
-* names held in variables or members: string literals, and parameters
-  (:mod:`cpp_params`): roscpp ``param``/``getParam``, rclcpp
-  ``declare_parameter``/``get_parameter``; a ``ros::NodeHandle pnh("~")``
-  makes the names created through it private;
-* export/visibility macros before a class name (``class MY_PUBLIC Talker :``)
-  are blanked before parsing (same length, so locations stay);
-* node names from ``ros::init(argc, argv, "n")``, ``Node("n")`` member
-  initialisers, ``std::make_shared<rclcpp::Node>("n")``, ``rclcpp::Node::make_shared("n")``;
-* which class each endpoint and node name belongs to (``classes``), and the
-  classes registered as components (``RCLCPP_COMPONENTS_REGISTER_NODE(ns::C)``).
+* ``<h>.advertise<T>(topic, ...)``, ``<h>.subscribe<T>(topic, ...)``,
+  ``<h>.subscribe(topic, n, cb)`` (the type from the callback's first
+  parameter, :mod:`cpp_types`, found in this file or, by the linker, in the
+  program's other files), ``subscribe(ops)``/``advertise(ops)`` with
+  ``ros::SubscribeOptions::create<T>(...)`` / ``ops.init<T>(...)``;
+  ``create_publisher<T>``, ``create_subscription<T>``,
+  ``create_generic_publisher(topic, "pkg/msg/T")`` with any receiver;
+* services: ``advertiseService(name, &cb)``, ``serviceClient<Srv>(name)``,
+  ``ros::service::call(name, srv)``, ``create_service<Srv>``, ``create_client<Srv>``;
+  actions: actionlib ``SimpleActionServer``/``SimpleActionClient`` (declared,
+  members initialised in a constructor, ``new``, ``make_shared``; a leading
+  node handle is skipped), ``rclcpp_action::create_server<T>`` /
+  ``create_client<T>`` (node, name) or (four node interfaces, name);
+* library helpers (:mod:`cpp_helpers`): tf, message_filters,
+  image_transport, interactive markers, parameter events, ``waitForMessage``;
+* names (:mod:`cpp_scope`): literals, constants, parameters (:mod:`cpp_params`),
+  and what only the program knows (a constructor argument, a member),
+  left to the linker (:mod:`link`); node handles' namespaces;
+* node names from ``ros::init(argc, argv, "n")``, ``Node("n"[, "ns"])``
+  initialisers, ``rclcpp::Node node("n")``, ``std::make_shared<rclcpp::Node>("n")``,
+  ``rclcpp::Node::make_shared("n")``;
+* for the linker: functions and their parameters, classes (members, bases),
+  calls and constructions with their argument values, member bindings,
+  quoted ``#include``\\ s; the classes registered as components.
 
-A name that is not read statically is reported unresolved at its location.
+Text the grammar would misread is blanked first (:mod:`cpp_prep`).  A name
+that is not read statically is reported unresolved at its location.
 """
 from __future__ import annotations
 
-import re
 from typing import Any
 
-from .cpp_params import Bindings, string_value
-from . import treesitter
-from .model import Endpoint, Note, Src, canon_type
+from . import cpp_helpers, emit, symbols, treesitter
+from .cpp_prep import REGISTER, prepare
+from .cpp_scope import base_name, callee_parts, namespaces_of
+from .cpp_values import CppValues
+from .cpp_types import action_type, callback_name, message_type, service_type, split_template
+from .model import Note, Src, canon_type
+
+__all__ = ["scan_cpp", "action_type", "service_type"]
 
 _CALLS = {"advertise": "pub", "subscribe": "sub", "create_publisher": "pub", "create_subscription": "sub",
           "advertiseService": "service_servers", "serviceClient": "service_clients",
           "create_service": "service_servers", "create_client": "service_clients",
-          "create_server": "action_servers"}
+          "create_generic_publisher": "pub", "create_generic_subscription": "sub"}
 _ACTIONLIB = {"SimpleActionServer": "action_servers", "ActionServer": "action_servers",
               "SimpleActionClient": "action_clients", "ActionClient": "action_clients"}
-_NODE_TYPES = ("Node", "rclcpp::Node", "LifecycleNode", "rclcpp_lifecycle::LifecycleNode")
-_WHAT = {"pub": "publisher topic", "sub": "subscriber topic", "service_servers": "service server",
-         "service_clients": "service client", "action_servers": "action server", "action_clients": "action client"}
-_MACRO = re.compile(rb"\b(?:class|struct)\s+((?:[A-Z][A-Z0-9_]*[A-Z0-9]\s+)+)(?=[A-Za-z_]\w*\s*(?:final\s*)?[:{])")
-_REGISTER = re.compile(rb"\bRCLCPP_COMPONENTS_REGISTER_NODE\s*\(\s*([A-Za-z_][\w:]*)\s*\)")
+_NODE_TYPES = {"Node", "LifecycleNode"}
+_LIBRARY = ("std::", "ros::", "rclcpp::", "boost::", "RCLCPP_", "ROS_", "tf2::", "Eigen::", "rcutils_", "rcl_")
+_T = treesitter.text
 
 
-def _walk(n: Any):  # type: ignore[no-untyped-def]
-    stack = [n]
-    while stack:
-        x = stack.pop()
-        yield x
-        stack.extend(reversed(x.children))
+class _File:
+    def __init__(self, data: bytes, shown: str) -> None:
+        self.shown = shown
+        self.vex_at: Any = None
+        self.out: dict[str, Any] = {"nodes": [], "endpoints": [], "notes": [], "classes": {}, "components": [],
+                                    "lang": "cpp", "calls": [], "node_names": [], "member_decls": [],
+                                    "member_calls": [], "includes": [], "callbacks": {}}
+        for m in REGISTER.finditer(data):
+            line = data.count(b"\n", 0, m.start()) + 1
+            self.out["components"].append((m.group(1).decode().lstrip(":"), Src(shown, line, 1)))
+        data = prepare(data)
+        self.ros2 = b"rclcpp" in data
+        root = treesitter.parser("cpp").parse(data).root_node
+        self.nodes = list(treesitter.walk(root))
+        self.aliases: dict[str, str] = {}
+        for n in self.nodes:
+            self._index(n)
+        self.scope = CppValues(self.nodes)
+        if root.has_error:
+            err = next((n for n in self.nodes if n.type == "ERROR" or n.is_missing), root)
+            self.out["notes"].append(Note(self.src(err), "C++ source has syntax errors; read what tree-sitter "
+                                                         "recovered", "ROS-PARSE"))
 
+    def src(self, n: Any) -> Src:
+        if self.vex_at is not None:  # an expression re-read out of place: located at its declaration
+            n = self.vex_at
+        return Src(self.shown, n.start_point[0] + 1, n.start_point[1] + 1)
 
-def blank_macros(data: bytes) -> bytes:
-    """``class API Name :`` -> ``class     Name :``: upper-case macro words between
-    ``class``/``struct`` and the class name become spaces (offsets unchanged)."""
-    return _MACRO.sub(lambda m: m.group(0)[: m.start(1) - m.start(0)] + b" " * len(m.group(1)), data)
+    def _index(self, n: Any) -> None:
+        t = n.type
+        if t == "function_declarator":
+            written = _T(n.child_by_field_name("declarator"))
+            params = n.child_by_field_name("parameters")
+            first = next((c for c in (params.children if params else [])
+                          if c.type in ("parameter_declaration", "optional_parameter_declaration")), None)
+            if first is not None and first.child_by_field_name("type") is not None:
+                ty = _T(first.child_by_field_name("type"))
+                _nss, cls = namespaces_of(n)
+                # by its name as written, with its class, and alone (the last a fallback)
+                for key in {written, "::".join(cls + [written]), written.split("::")[-1]}:
+                    self.out["callbacks"].setdefault(key, ty)
+        elif t == "alias_declaration":
+            self.aliases[_T(n.child_by_field_name("name"))] = _T(n.child_by_field_name("type"))
+        elif t == "type_definition":
+            for d in n.children_by_field_name("declarator"):
+                self.aliases[_T(d)] = _T(n.child_by_field_name("type"))
+        elif t == "using_declaration" and not any(c.type == "namespace" for c in n.children) and n.named_children:
+            full = _T(n.named_children[-1])
+            self.aliases[full.split("::")[-1]] = full
+        elif t == "preproc_include":
+            p = n.child_by_field_name("path")
+            if p is not None:
+                self.out["includes"].append(_T(p).strip('"<>'))
 
+    def msg(self, text: str | None) -> str | None:
+        t = message_type(text, self.aliases)
+        msgs = [ns for ns in self.scope.using_ns if ns.endswith(("::msg", "_msgs"))]
+        if t is None and text and "::" not in text and len(msgs) == 1:  # using namespace pkg::msg;
+            t = message_type(f"{msgs[0]}::{text.strip()}", self.aliases)
+        return t
 
-def action_type(name: str | None) -> str | None:
-    """``pkg::FibonacciAction`` / ``pkg/msg/FibonacciAction`` (ROS 1 actionlib's
-    generated message) and ``pkg::action::Fibonacci`` -> ``pkg/action/Fibonacci``."""
-    t = canon_type(name, "action")
-    if t is None or t.count("/") != 2:
-        return None
-    pkg, mid, last = t.split("/")
-    if mid in ("msg", "action") and last.endswith("Action") and len(last) > 6:
-        last, mid = last[:-6], "action"
-    return f"{pkg}/{mid}/{last}" if mid == "action" else None
+    # -- emitting
+    def emit(self, kind: str, name_node: Any, msg_type: str | None, at: Any, handle: symbols.Val,
+             cb: Any = None, name: symbols.Val = "unset", written: str | None = None) -> None:
+        v = self.scope.value(name_node) if name == "unset" else name
+        fn = self.scope.fn_of(at)
+        unit = fn.unit if fn is not None else None
+        if written is None:
+            written = _T(name_node) if name_node is not None else emit.short(str(symbols.text(v) or "?"))
+        ep, note = emit.make(kind, v, handle, msg_type, self.src(at), unit, fn.key if fn else None, written,
+                             self.src(name_node) if name_node is not None else self.src(at), cb)
+        if note is not None:
+            self.out["notes"].append(note)
+        if ep is None:
+            return
+        if ep.pending is None and ep.msg_type is None:
+            self.out["notes"].append(emit.type_note(ep))
+        self.out["endpoints"].append(ep)
+        if fn is not None and fn.in_class:
+            self.out["classes"].setdefault(fn.unit, {"nodes": [], "endpoints": []})["endpoints"].append(ep)
 
+    def specs(self, specs: list[cpp_helpers.Spec], at: Any) -> None:
+        for kind, v, t, h in specs:
+            self.emit(kind, None, t, at, h, name=v)
 
-def service_type(name: str | None) -> str | None:
-    """``pkg::Srv``, ``pkg::srv::Srv``, ``pkg::Srv::Request`` -> ``pkg/srv/Srv``."""
-    if not name:
-        return None
-    n = re.sub(r"(::|/|\.)(Request|Response)(::\w+)?$", "", name.strip())
-    t = canon_type(n, "srv")
-    return t if t and t.count("/") == 2 else None
+    def node(self, v: symbols.Val, at: Any, ns: symbols.Val = None) -> None:
+        fn = self.scope.fn_of(at)
+        unit = fn.unit if fn is not None else None
+        t = symbols.text(v)
+        if t is not None and symbols.is_concrete(v) and v[0] != "node":
+            self.out["nodes"].append((t, self.src(at)))
+            if fn is not None and fn.in_class:
+                self.out["classes"].setdefault(fn.unit, {"nodes": [], "endpoints": []})["nodes"].append(
+                    (t, self.src(at)))
+        self.out["node_names"].append((v, self.src(at), unit, fn.key if fn else None, ns))
 
+    def record(self, kind: str, callee: str, args: list[Any], at: Any) -> None:
+        fn = self.scope.fn_of(at)
+        vals = [self.scope.value(a) for a in args]
+        self.out["calls"].append((kind, callee, vals, fn.key if fn else None, fn.unit if fn else None,
+                                  self.src(at)))
 
-def _scope_of(n: Any) -> str | None:
-    """The qualified class a node lies in: an enclosing class body, or a member
-    function defined out of line (``ns::C::f``), under its namespaces."""
-    cls: list[str] = []
-    nss: list[str] = []
-    p = n.parent
-    while p is not None:
-        if p.type in ("class_specifier", "struct_specifier") and p.child_by_field_name("body") is not None:
-            cls.insert(0, treesitter.text(p.child_by_field_name("name")))
-        elif p.type == "function_definition" and not cls:
-            d = p.child_by_field_name("declarator")
-            while d is not None and d.type not in ("function_declarator",):
-                d = d.child_by_field_name("declarator")
-            q = d.child_by_field_name("declarator") if d is not None else None
-            if q is not None and q.type == "qualified_identifier":
-                scope = treesitter.text(q.child_by_field_name("scope"))
-                if scope:
-                    cls.insert(0, scope)
-        elif p.type == "namespace_definition" and p.child_by_field_name("name") is not None:
-            nss.insert(0, treesitter.text(p.child_by_field_name("name")))
-        p = p.parent
-    if not cls:
-        return None
-    return "::".join(x for x in nss + cls if x)
+    # -- constructions
+    def construct(self, type_text: str, args: list[Any], at: Any) -> None:
+        head, targs = split_template(type_text.replace("typename", "").strip())
+        base = head.split("::")[-1]
+        if base in _NODE_TYPES and ("rclcpp" in head or head == base) and args:
+            self.node(self.scope.value(args[0]), at, self.scope.value(args[1]) if len(args) > 1 else None)
+            return
+        if base in _ACTIONLIB and targs and "actionlib" in head + type_text:
+            self.actionlib(_ACTIONLIB[base], targs[0], args, at)
+            return
+        specs = cpp_helpers.constructed(type_text, args, self.scope.value, self.ros2, self.aliases)
+        if specs is not None:
+            self.specs(specs, at)
+            return
+        if head and not head.startswith(_LIBRARY):
+            self.record("ctor", head, args, at)
 
+    def actionlib(self, kind: str, ty: str, args: list[Any], at: Any) -> None:
+        if not args:
+            return
+        first_handle = len(args) >= 2 and self.scope.is_handle(args[0])
+        name_arg = args[1] if first_handle else args[0]
+        h = self.scope.value(args[0]) if first_handle else None
+        self.emit(kind, name_arg, action_type(self.aliases.get(ty, ty)), at, h)
 
-def _tmpl(ty: Any) -> Any:
-    """The ``template_type`` inside ``ns::T<A>`` (a qualified identifier), or ``None``."""
-    while ty is not None and ty.type == "qualified_identifier":
-        ty = ty.child_by_field_name("name")
-    return ty if ty is not None and ty.type == "template_type" else None
+    # -- the walk
+    def run(self) -> dict[str, Any]:
+        for n in self.nodes:
+            t = n.type
+            if t == "field_initializer":
+                self.initializer(n)
+            elif t == "new_expression":
+                a = n.child_by_field_name("arguments")
+                self.construct(_T(n.child_by_field_name("type")), list(a.named_children) if a is not None else [], n)
+            elif t == "declaration":
+                self.declaration(n)
+            elif t == "field_declaration":
+                self.member(n)
+            elif t == "call_expression":
+                self.call(n)
+        s = self.scope
+        self.out["fns"] = {f.key: (f.unit, f.params, f.ptypes, [s.value(d) for d in f.defaults])
+                           for f in list(s.decls.values()) + list(s.fns.values())}
+        self.out["aliases"] = self.aliases
+        self.out["units"] = {c: {"bases": i["bases"], "members": i["members"]} for c, i in s.classes.items()}
+        self.out["fields"] = s.field_values()
+        self.out["consts"] = {k: v for k, v in ((k, s._one([s.value(x) if not isinstance(x, tuple) else x
+                                                             for x in vs])) for k, vs in s.consts.items())
+                              if v is not None}
+        self.out["ros2"] = self.ros2
+        return self.out
 
+    def initializer(self, n: Any) -> None:
+        head = n.named_children[0] if n.named_children else None
+        args = next((c for c in n.children if c.type in ("argument_list", "initializer_list")), None)
+        if head is None or args is None:
+            return
+        h = _T(head)
+        if h.split("<")[0].split("::")[-1] in _NODE_TYPES and ("rclcpp" in h or "::" not in h) and args.named_children:
+            a = args.named_children
+            self.node(self.scope.value(a[0]), n, self.scope.value(a[1]) if len(a) > 1 and
+                      self.scope.value(a[1]) is not None and self.scope.value(a[1])[0] == "str" else None)
+            return
+        self.record("member", h, list(args.named_children), n)
 
-def _targ(t: Any, aliases: dict[str, str]) -> str | None:
-    """The first template argument's text, following ``using``/``typedef`` aliases."""
-    if t is None or not t.named_children:
-        return None
-    s = treesitter.text(t.named_children[0])
-    for _ in range(4):
-        s2 = aliases.get(s) or aliases.get(s.split("::")[-1])
-        if s2 is None or s2 == s:
-            break
-        s = s2
-    return s
+    def declaration(self, n: Any) -> None:
+        ty = _T(n.child_by_field_name("type"))
+        base = base_name(ty)
+        if not ty or base in ("auto", "NodeHandle") or n.child_by_field_name("type").type == "primitive_type":
+            return
+        for d in n.children_by_field_name("declarator"):
+            if d.type == "init_declarator":
+                v = d.child_by_field_name("value")
+                if v is not None and v.type in ("argument_list", "initializer_list"):
+                    self.construct(ty, list(v.named_children), n)
+            elif d.type == "identifier":
+                self.construct(ty, [], n)
+            elif d.type == "function_declarator" and self.scope.fn_of(n) is not None:
+                self.vexing(ty, d, n)
+
+    def vexing(self, ty: str, d: Any, n: Any) -> None:
+        """``Sensor s(nh, name());`` in a function body, which the grammar reads as a
+        function declaration (C++'s "most vexing parse"): its parentheses re-read
+        as call arguments, evaluated in the enclosing function."""
+        params = d.child_by_field_name("parameters")
+        if params is None:
+            return
+        tree = treesitter.parser("cpp").parse(b"void f_(){g_" + params.text + b";}").root_node
+        call = next((x for x in treesitter.walk(tree) if x.type == "call_expression"), None)
+        a = call.child_by_field_name("arguments") if call is not None else None
+        if a is None:
+            return
+        self.scope.override, self.vex_at = self.scope.fn_of(n), n
+        try:
+            self.construct(ty, list(a.named_children), n)
+        finally:
+            self.scope.override, self.vex_at = None, None
+
+    def member(self, n: Any) -> None:
+        ty = _T(n.child_by_field_name("type"))
+        head, targs = split_template(ty.replace(" ", ""))
+        last = head.split("::")[-1]
+        fn_cls = self.scope.fn_of(n)
+        if fn_cls is not None or not (last in _ACTIONLIB or last in cpp_helpers.CONSTRUCTED):
+            return
+        nss, cls = namespaces_of(n)
+        for d in n.children_by_field_name("declarator"):
+            if d.type == "field_identifier":  # a value member (a pointer is made elsewhere)
+                self.out["member_decls"].append(("::".join(nss + cls), _T(d), ty, self.src(n)))
+
+    def call(self, n: Any) -> None:
+        fn = n.child_by_field_name("function")
+        a = n.child_by_field_name("arguments")
+        args = list(a.named_children) if a is not None else []
+        if fn is None:
+            return
+        full, last, targs = callee_parts(fn)
+        recv = fn.child_by_field_name("argument") if fn.type == "field_expression" else None
+        s = self.scope
+        if full == "ros::init" and len(args) >= 3:
+            self.node(s.value(args[2]), n)
+            return
+        if last in ("make_shared", "make_unique", "allocate_shared") and targs and recv is None:
+            self.construct(targs[0], args, n)
+            return
+        if full.endswith("Node::make_shared") and args:
+            self.node(s.value(args[0]), n, s.value(args[1]) if len(args) > 1 else None)
+            return
+        if full.endswith("Options::create") or (last == "init" and recv is not None and targs):
+            return  # options: read where subscribe(ops) / advertise(ops) uses them
+        specs = cpp_helpers.free(full, targs, args, s.value, self.aliases) if recv is None else None
+        if specs is None and recv is not None:
+            rt = s.type_of(recv)
+            if rt is not None:
+                specs = cpp_helpers.method(rt, last, args, targs, s.value, s.value(recv), self.aliases)
+            elif not targs and self.helper_form(last, args) and self.deferred_method(recv, last, args, n):
+                return
+        if specs is not None:
+            self.specs(specs, n)
+            return
+        if last in ("create_server", "create_client") and "rclcpp_action" in full:
+            self.action2(last, targs, args, n)
+            return
+        if full in ("ros::service::call",) and len(args) >= 2:
+            self.emit("service_clients", args[0], service_type(s.type_of(args[1])), n, None)
+            return
+        kind = _CALLS.get(last)
+        if kind is None or not args:
+            if not full.startswith(_LIBRARY):
+                self.record("call", full, args, n)
+            return
+        if last == "create_server":
+            return
+        handle = s.value(recv) if recv is not None else None
+        if last in ("advertise", "subscribe") and len(args) >= 2 and s.is_handle(args[0]):
+            # advertise(nh, topic, n) / subscribe(nh, topic, n) of an object given the handle
+            # (topic_tools::ShapeShifter, a message_filters subscriber of a class this file does not know)
+            ta = targs[0] if targs else None
+            self.emit(kind, args[1], self.msg(ta) if ta else None, n, s.value(args[0]))
+            return
+        if len(args) == 1 and last in ("subscribe", "advertise", "advertiseService"):
+            ops = s.value(args[0])
+            if ops is not None and ops[0] == "ops":
+                t = self.msg(ops[3]) if ops[1] in ("pub", "sub") else service_type(self.aliases.get(ops[3], ops[3]))
+                cb = callback_name(ops[4] or "") or None
+                if t is None and cb:
+                    ct = self.out["callbacks"].get(cb)
+                    t = self.msg(ct) if ops[1] in ("pub", "sub") else service_type(ct)
+                self.emit(ops[1], None, t, n, handle, cb if t is None else None, name=ops[2],
+                          written=ops[5] if len(ops) > 5 else None)
+            else:
+                self.out["notes"].append(Note(self.src(n), f"{last}({_T(args[0])[:60]}): its options are not read "
+                                                           f"statically"))
+            return
+        if last in ("create_generic_publisher", "create_generic_subscription"):
+            gt = s.value(args[1]) if len(args) > 1 else None
+            self.emit(kind, args[0], canon_type(symbols.text(gt)) if gt and gt[0] == "str" else None, n, handle)
+            return
+        ta = targs[0] if targs else None
+        cb: Any = None
+        if kind in ("pub", "sub"):
+            msg_type = self.msg(ta) if ta else None
+            if msg_type is None and kind == "sub" and last == "subscribe" and len(args) >= 3:
+                cb = callback_name(_T(args[2]))
+                msg_type = self.msg(self.out["callbacks"].get(cb))
+        else:
+            msg_type = service_type(self.aliases.get(ta, ta) if ta else None)
+            if msg_type is None and last == "advertiseService" and len(args) >= 2:
+                cb = callback_name(_T(args[1]))
+                msg_type = service_type(self.out["callbacks"].get(cb))
+        if msg_type is None and cb is None and ta:
+            cb = ("type", ta)  # an alias of another file (a header's using/typedef): read by the linker
+        self.emit(kind, args[0], msg_type, n, handle, cb if msg_type is None else None)
+
+    def deferred_method(self, recv: Any, method: str, args: list[Any], at: Any) -> bool:
+        """A helper method on a member whose class this file does not declare
+        (``it_.advertise("image", 1)``, ``sub_.subscribe(nh, "t", 1)``): left to
+        the linker, which knows the member's type from the program's other files."""
+        r = recv.child_by_field_name("field") if recv.type == "field_expression" else recv
+        fn = self.scope.fn_of(at)
+        if fn is None or not fn.in_class or r is None or r.type not in ("identifier", "field_identifier"):
+            return False
+        self.out["member_calls"].append((fn.unit, _T(r), method, [self.scope.value(x) for x in args],
+                                         [_T(x) for x in args], self.src(at), fn.key))
+        return True
+
+    def helper_form(self, method: str, args: list[Any]) -> bool:
+        """Whether a call without template arguments has the form of a helper's method
+        only (never of a node handle's): ``advertise(name, n)``, the camera forms,
+        message_filters' ``subscribe(h, name, ...)``, ``on_parameter_event(cb)``."""
+        from .cpp_params import string_value
+        if method in ("advertiseCamera", "subscribeCamera", "on_parameter_event"):
+            return True
+        if method == "advertise":
+            return len(args) >= 2
+        return method == "subscribe" and len(args) >= 2 and (
+            self.scope.is_handle(args[0]) or (string_value(args[0]) is None and string_value(args[1]) is not None))
+
+    def action2(self, last: str, targs: list[str], args: list[Any], n: Any) -> None:
+        kind = "action_servers" if last == "create_server" else "action_clients"
+        k = 4 if len(args) >= 5 and "interface" in _T(args[0]) else 1
+        if len(args) <= k:
+            return
+        t = action_type(self.aliases.get(targs[0], targs[0])) if targs else None
+        self.emit(kind, args[k], t, n, self.scope.value(args[0]) if k == 1 else None,
+                  ("type", targs[0]) if t is None and targs else None)
 
 
 def scan_cpp(data: bytes, shown: str) -> dict[str, Any]:
-    """``{"nodes": [(name, Src)], "endpoints": [Endpoint], "notes": [Note],
-    "classes": {qualified class: {"nodes": [...], "endpoints": [...]}},
-    "components": [(qualified class, Src)]}`` for one file.
+    """The record of one C++ file: ``{"nodes": [(name, Src)], "endpoints": [Endpoint],
+    "notes": [Note], "classes": {qualified class: {"nodes", "endpoints"}},
+    "components": [(qualified class, Src)]}`` and, for the linker (:mod:`link`),
+    ``fns``, ``units``, ``calls``, ``fields``, ``consts``, ``node_names``,
+    ``member_decls``, ``member_calls``, ``includes``, ``callbacks``, ``ros2``.
 
     tree-sitter recovers from syntax errors, so a broken file still yields
     what it can; its ERROR regions are reported as one located warning."""
-    out: dict[str, Any] = {"nodes": [], "endpoints": [], "notes": [], "classes": {}, "components": []}
-    data = blank_macros(data)
-
-    def src(n: Any) -> Src:
-        return Src(shown, n.start_point[0] + 1, n.start_point[1] + 1)
-
-    for m in _REGISTER.finditer(data):
-        line = data.count(b"\n", 0, m.start()) + 1
-        out["components"].append((m.group(1).decode().lstrip(":"), Src(shown, line, 1)))
-    # the registration macro has no semicolon: blanked so that it is not read as a syntax error
-    data = _REGISTER.sub(lambda m: b" " * len(m.group(0)), data)
-    root = treesitter.parser("cpp").parse(data).root_node
-    callbacks: dict[str, str] = {}  # function name -> raw type text of its first parameter
-    aliases: dict[str, str] = {}
-    fields: dict[str, tuple[str, str]] = {}  # member/variable -> (actionlib role, type text)
-    handles: dict[str, str] = {}  # NodeHandle variable -> its namespace ("~" private)
-    all_nodes = list(_walk(root))
-    for n in all_nodes:
-        t = n.type
-        if t == "function_declarator":
-            name = treesitter.text(n.child_by_field_name("declarator")).split("::")[-1]
-            params = n.child_by_field_name("parameters")
-            first = next((c for c in (params.children if params else []) if c.type == "parameter_declaration"), None)
-            if first is not None and first.child_by_field_name("type") is not None:
-                callbacks[name] = treesitter.text(first.child_by_field_name("type"))
-        elif t == "alias_declaration":
-            ty = n.child_by_field_name("type")
-            aliases[treesitter.text(n.child_by_field_name("name"))] = treesitter.text(ty)
-        elif t == "type_definition":
-            ty = n.child_by_field_name("type")
-            for d in n.children_by_field_name("declarator"):
-                aliases[treesitter.text(d)] = treesitter.text(ty)
-        elif t in ("field_declaration", "declaration", "parameter_declaration"):
-            ty = n.child_by_field_name("type")
-            tt = treesitter.text(ty)
-            base = tt.split("<")[0].split("::")[-1].strip()
-            for d in n.children_by_field_name("declarator"):
-                var = d.child_by_field_name("declarator") if d.type == "init_declarator" else d
-                vname = treesitter.text(var).lstrip("*&").strip()
-                if base in _ACTIONLIB and _tmpl(ty) is not None:
-                    fields[vname] = (_ACTIONLIB[base], _targ(_tmpl(ty).child_by_field_name("arguments"), aliases) or "")
-                    if d.type == "init_declarator":
-                        v = d.child_by_field_name("value")
-                        if v is not None and v.type in ("argument_list", "initializer_list"):
-                            _actionlib(n, list(v.named_children), fields[vname], out, src, aliases, handles, None)
-                elif base == "NodeHandle":
-                    handles.setdefault(vname, "")
-                    v = d.child_by_field_name("value") if d.type == "init_declarator" else None
-                    if v is not None and v.named_children and string_value(v.named_children[0]) is not None:
-                        handles[vname] = string_value(v.named_children[0]) or ""
-    for n in all_nodes:  # NodeHandle members given a namespace in a constructor: pnh_("~")
-        if n.type == "field_initializer" and n.named_children and treesitter.text(n.named_children[0]) in handles:
-            a = next((c for c in n.children if c.type in ("argument_list", "initializer_list")), None)
-            if a is not None and a.named_children and string_value(a.named_children[0]) is not None:
-                handles[treesitter.text(n.named_children[0])] = string_value(a.named_children[0]) or ""
-    binds = Bindings(all_nodes, handles)
-    if root.has_error:
-        err = next((n for n in all_nodes if n.type == "ERROR" or n.is_missing), root)
-        out["notes"].append(Note(src(err), "C++ source has syntax errors; read what tree-sitter recovered",
-                                 "ROS-PARSE"))
-
-    def add_node(name: str, n: Any) -> None:
-        out["nodes"].append((name, src(n)))
-        cls = _scope_of(n)
-        if cls:
-            out["classes"].setdefault(cls, {"nodes": [], "endpoints": []})["nodes"].append((name, src(n)))
-
-    for n in all_nodes:
-        if n.type == "field_initializer":
-            head = n.named_children[0] if n.named_children else None
-            args = next((c for c in n.children if c.type in ("argument_list", "initializer_list")), None)
-            if head is None or args is None:
-                continue
-            h = treesitter.text(head)
-            if h in _NODE_TYPES:
-                s = string_value(args.named_children[0]) if args.named_children else None
-                if s is not None:
-                    add_node(s, n)
-            elif h in fields:
-                _actionlib(n, list(args.named_children), fields[h], out, src, aliases, handles, binds)
-            continue
-        if n.type == "new_expression":
-            ty = n.child_by_field_name("type")
-            base = treesitter.text(ty).split("<")[0].split("::")[-1].strip()
-            a = n.child_by_field_name("arguments")
-            if base in _ACTIONLIB and _tmpl(ty) is not None and a is not None:
-                role = (_ACTIONLIB[base], _targ(_tmpl(ty).child_by_field_name("arguments"), aliases) or "")
-                _actionlib(n, list(a.named_children), role, out, src, aliases, handles, binds)
-            continue
-        if n.type != "call_expression":
-            continue
-        fn = n.child_by_field_name("function")
-        args_n = n.child_by_field_name("arguments")
-        args = list(args_n.named_children) if args_n is not None else []
-        if fn is None:
-            continue
-        name, targs = None, None
-        f = fn.child_by_field_name("field") if fn.type == "field_expression" else fn
-        if f is not None and f.type == "qualified_identifier" and f.child_by_field_name("name") is not None \
-                and f.child_by_field_name("name").type in ("template_function", "template_method"):
-            f = f.child_by_field_name("name")
-        if f is not None and f.type in ("template_method", "template_function"):
-            name = treesitter.text(f.child_by_field_name("name"))
-            targs = f.child_by_field_name("arguments")
-        elif f is not None:
-            name = treesitter.text(f)
-        name_last = (name or "").split("::")[-1]
-        full = treesitter.text(fn)
-        if full == "ros::init" and len(args) >= 3:
-            s = string_value(args[2])
-            if s is not None:
-                add_node(s, n)
-            else:
-                out["notes"].append(Note(src(args[2]), "node name is not a string literal: not resolved statically"))
-            continue
-        if name_last == "make_shared" and args:
-            tt = treesitter.text(targs)
-            if targs is not None and any(x in tt for x in _ACTIONLIB) and targs.named_children:
-                inner = targs.named_children[0]
-                ty = inner.child_by_field_name("type") if inner.type == "type_descriptor" else inner
-                base = treesitter.text(ty).split("<")[0].split("::")[-1].strip()
-                if base in _ACTIONLIB and _tmpl(ty) is not None:
-                    role = (_ACTIONLIB[base], _targ(_tmpl(ty).child_by_field_name("arguments"), aliases) or "")
-                    _actionlib(n, args, role, out, src, aliases, handles, binds)
-                continue
-            if (targs is not None and tt.strip("<> ") in _NODE_TYPES) or full.endswith("Node::make_shared"):
-                s = string_value(args[0])
-                if s is not None:
-                    add_node(s, n)
-                continue
-        kind = _CALLS.get(name_last)
-        if kind is None or not args:
-            continue
-        is_action = name_last in ("create_server", "create_client") and "rclcpp_action" in full
-        if name_last == "create_server" and not is_action:
-            continue
-        if is_action:
-            kind = "action_servers" if name_last == "create_server" else "action_clients"
-            if len(args) < 2:
-                continue
-            name_arg = args[1]
-        else:
-            name_arg = args[0]
-        ta = _targ(targs, aliases)
-        if kind in ("pub", "sub"):
-            msg_type = canon_type(ta) if ta else None
-            if msg_type is None and kind == "sub" and name_last == "subscribe" and len(args) >= 3:
-                cb = treesitter.text(args[2]).lstrip("&").split("::")[-1]
-                c = canon_type(callbacks.get(cb))
-                msg_type = c if c and c.count("/") == 2 else None
-        elif kind.startswith("service"):
-            msg_type = service_type(ta)
-            if msg_type is None and name_last == "advertiseService" and len(args) >= 2:
-                cb = treesitter.text(args[1]).lstrip("&").split("::")[-1]
-                msg_type = service_type(callbacks.get(cb))
-        else:
-            msg_type = action_type(ta)
-        recv = fn.child_by_field_name("argument") if fn.type == "field_expression" else None
-        _emit(kind, name_arg, msg_type, n, out, src, binds, handles.get(_recv(recv), "") if recv is not None else "")
-    return out
-
-
-def _recv(n: Any) -> str:
-    return treesitter.text(n).replace("this->", "").lstrip("*&").strip()
-
-
-def _actionlib(n: Any, args: list[Any], role: tuple[str, str], out: dict[str, Any], src: Any,
-               aliases: dict[str, str], handles: dict[str, str], binds: Bindings | None) -> None:
-    """An actionlib server/client constructed with ``args``: the name is the first
-    argument, or the second when the first is a NodeHandle."""
-    kind, ty = role
-    if not args:
-        return
-    first = _recv(args[0])
-    ns = ""
-    if len(args) >= 2 and (first in handles or "NodeHandle" in treesitter.text(args[0])):
-        ns = handles.get(first, "")
-        name_arg = args[1]
-    else:
-        name_arg = args[0]
-    for _ in range(4):
-        if ty in aliases:
-            ty = aliases[ty]
-    _emit(kind, name_arg, action_type(ty), n, out, src, binds, ns)
-
-
-def _emit(kind: str, name_arg: Any, msg_type: str | None, n: Any, out: dict[str, Any], src: Any,
-          binds: Bindings | None, handle_ns: str) -> None:
-    what = _WHAT[kind]
-    topic, param = string_value(name_arg), None
-    if topic is None and binds is not None:
-        topic, param = binds.lookup(name_arg)
-    if topic is None and param is None:
-        out["notes"].append(Note(src(name_arg), f"{what} name is '{treesitter.text(name_arg)[:80]}', not a string literal: "
-                                                f"not resolved statically"))
-        return
-    if topic and handle_ns and not topic.startswith("/"):
-        topic = f"~{topic}" if handle_ns == "~" else f"{handle_ns.rstrip('/')}/{topic}"
-    if msg_type is None:
-        out["notes"].append(Note(src(n), f"type of {what} '{topic or param}' not resolved statically"))
-    ep = Endpoint(kind, topic or "", msg_type, src(n), param)
-    out["endpoints"].append(ep)
-    cls = _scope_of(n)
-    if cls:
-        out["classes"].setdefault(cls, {"nodes": [], "endpoints": []})["endpoints"].append(ep)
+    return _File(data, shown).run()

@@ -16,24 +16,36 @@ rclpy, ROS 2):
 * ``<x>.create_publisher(T, topic)``, ``<x>.create_subscription(T, topic, cb)``,
   ``<x>.create_service(T, name, cb)``, ``<x>.create_client(T, name)``,
   ``rclpy.action.ActionServer(node, T, name, cb)`` / ``ActionClient(node, T, name)``;
-* a name held in a variable or attribute (``self.topic = ...``), a literal or a
-  parameter: ``rospy.get_param('~topic', 'default')`` (the name as written:
-  ``~`` private, else relative), rclpy ``declare_parameter('topic', 'default')``
-  with ``get_parameter('topic')...`` (ROS 2 parameters are the node's: ``~topic``);
-* node names from ``rospy.init_node('n')``, ``rclpy.create_node('n')``,
-  ``Node('n')`` and ``super().__init__('n')`` / ``super().__init__(node_name='n')``.
+* library helpers (:mod:`py_helpers`: tf, message_filters,
+  ``wait_for_message``, interactive markers, parameter events);
+* names (:mod:`pyconst`): literals, constants, concatenations, parameters
+  (``rospy.get_param('~topic', 'default')``; rclpy ``declare_parameter`` /
+  ``get_parameter``: the node's ``~topic``), and what only the program knows
+  (a function's parameter, ``self.topic``, an imported constant), left to
+  the linker (:mod:`link`);
+* types through imports, ``from pkg.msg import *`` (candidates the linker
+  chooses among by the type table) and ``numpy_msg(T)``; a name imported
+  twice (chosen at run time) is read as its first import, said in a note;
+* node names from ``rospy.init_node(n)``, ``rclpy.create_node(n)``,
+  ``Node(n)`` and ``super().__init__(n)`` (``n`` a literal, or any name in a
+  class deriving from ``Node``);
+* for the linker: functions and their parameters, classes, the calls of the
+  package's own classes and functions with their argument values, attribute
+  bindings, module constants, imports.
 
-A name that is neither a literal nor a parameter is reported unresolved at
-its location, never guessed.
+A name that is not read statically is reported unresolved at its location,
+never guessed.
 """
 from __future__ import annotations
 
 import ast
 from typing import Any
 
+from . import emit, py_helpers, symbols
+from .cpp_types import action_type, service_type
 from .model import Endpoint, Note, Src, canon_type
+from .pyconst import PyScope
 from .pyrecords import PyCall, PyModule, PyVal
-from .sources_cpp import action_type, service_type
 
 
 # (role, index and keyword of the name, index and keyword of the type), by callee
@@ -53,13 +65,8 @@ _METHODS = {"create_publisher": ("pub", 1, "topic", 0, "msg_type"),
             "create_subscription": ("sub", 1, "topic", 0, "msg_type"),
             "create_service": ("service_servers", 1, "srv_name", 0, "srv_type"),
             "create_client": ("service_clients", 1, "srv_name", 0, "srv_type")}
-_WHAT = {"pub": "publisher topic", "sub": "subscriber topic", "service_servers": "service server",
-         "service_clients": "service client", "action_servers": "action server", "action_clients": "action client"}
-
-
-def _short(text: str, limit: int = 80) -> str:
-    """Source text quoted in a note, cut to ``limit`` characters."""
-    return text if len(text) <= limit else text[: limit - 3] + "..."
+_WHAT = emit.WHAT
+_short = emit.short
 
 
 def _dotted(e: ast.AST) -> str | None:
@@ -96,6 +103,13 @@ def _ast_module(tree: ast.AST, shown: str) -> PyModule:
         d = _dotted(e)
         if d is not None:
             return PyVal("name", d, loc(e))
+        if isinstance(e, ast.BinOp) and isinstance(e.op, ast.Add):
+            return PyVal("cat", ast.unparse(e), loc(e), parts=[val(e.left), val(e.right)])
+        if isinstance(e, ast.JoinedStr):
+            parts = [val(x.value) if isinstance(x, ast.FormattedValue) and x.conversion == -1 and x.format_spec is None
+                     else val(x) if isinstance(x, ast.Constant) else PyVal("other", ast.unparse(x), loc(e))
+                     for x in e.values]
+            return PyVal("cat", ast.unparse(e), loc(e), parts=parts)
         chain, x = [], e  # a call and the attributes/calls on its result: get_parameter('t').value
         while isinstance(x, (ast.Call, ast.Attribute)):
             if isinstance(x, ast.Call):
@@ -107,22 +121,53 @@ def _ast_module(tree: ast.AST, shown: str) -> PyModule:
             return PyVal("call", ast.unparse(e), loc(e), call(e), chain)
         return PyVal("other", ast.unparse(e), loc(e), None, chain if isinstance(e, ast.Attribute) else [])
 
+    def scopes(body: list[ast.stmt], prefix: str, in_class: bool) -> None:
+        for st in body:
+            if isinstance(st, ast.ClassDef):
+                scopes(st.body, f"{prefix}{st.name}.", True)
+            elif isinstance(st, (ast.FunctionDef, ast.AsyncFunctionDef)):
+                a = st.args
+                pos = a.posonlyargs + a.args
+                static = any(_dotted(d) == "staticmethod" for d in st.decorator_list)
+                names = [x.arg for x in pos] + [x.arg for x in a.kwonlyargs]
+                defaults: list[PyVal | None] = [None] * (len(pos) - len(a.defaults)) + [val(d) for d in a.defaults]
+                defaults += [val(d) if d is not None else None for d in a.kw_defaults]
+                if in_class and not static and names:
+                    names, defaults = names[1:], defaults[1:]
+                mod.functions.append((f"{prefix}{st.name}", st.lineno, getattr(st, "end_lineno", None) or st.lineno,
+                                      names, defaults))
+                scopes(st.body, f"{prefix}{st.name}.<locals>.", False)
+            else:
+                for fld in ("body", "orelse", "finalbody", "handlers"):
+                    inner = getattr(st, fld, None)
+                    if isinstance(inner, list):
+                        scopes([x for x in inner if isinstance(x, ast.stmt)] +
+                               [y for h in inner if isinstance(h, ast.ExceptHandler) for y in h.body], prefix, in_class)
+
     for n in ast.walk(tree):
-        if isinstance(n, ast.ImportFrom) and n.module:
-            for a in n.names:
-                mod.imports[a.asname or a.name] = f"{n.module}.{a.name}"
+        if isinstance(n, ast.ImportFrom) and (n.module or n.level):
+            for a in n.names:  # a relative import names the package's own module (``from . import names``)
+                if a.name == "*":
+                    if n.module:
+                        mod.star.append(n.module)
+                else:
+                    mod.bind_import(a.asname or a.name, f"{n.module}.{a.name}" if n.module else a.name, n.lineno)
         elif isinstance(n, ast.Import):
             for a in n.names:
-                mod.imports[a.asname or a.name.split(".")[0]] = a.name if a.asname else a.name.split(".")[0]
+                mod.bind_import(a.asname or a.name.split(".")[0], a.name if a.asname else a.name.split(".")[0],
+                                n.lineno)
         elif isinstance(n, ast.Call):
             mod.calls.append(call(n))
         elif isinstance(n, ast.ClassDef):
             mod.classes.append((n.name, n.lineno, getattr(n, "end_lineno", None) or n.lineno))
+            mod.bases[n.name] = [d for d in (_dotted(b) for b in n.bases) if d]
         elif isinstance(n, (ast.Assign, ast.AnnAssign)) and n.value is not None:
             for t in (n.targets if isinstance(n, ast.Assign) else [n.target]):
                 d = _dotted(t)
                 if d is not None:
                     mod.assigns.append((d, val(n.value)))
+    if isinstance(tree, ast.Module):
+        scopes(tree.body, "", False)
     mod.calls.sort(key=lambda c: (c.src.line, c.src.col))  # source order, as the tolerant reader gives
     return mod
 
@@ -159,101 +204,137 @@ def scan_python(text: str, shown: str) -> dict[str, Any]:
 
 
 def extract(mod: PyModule, shown: str) -> dict[str, Any]:
-    """Nodes, endpoints and notes from a file's :class:`PyModule` (either reader)."""
-    out: dict[str, Any] = {"nodes": [], "endpoints": [], "notes": []}
+    """The record of a file from its :class:`PyModule` (either reader): nodes,
+    endpoints, notes, ``owners`` and, for the linker (:mod:`link`), ``fns``,
+    ``units``, ``calls``, ``fields``, ``consts``, ``node_names``, ``imports``."""
+    sc = PyScope(mod, shown)
+    ros2 = any(o.split(".")[0] == "rclpy" for o in mod.imports.values())
+    out: dict[str, Any] = {"nodes": [], "endpoints": [], "notes": [], "lang": "py", "calls": [], "node_names": [],
+                           "member_decls": [], "member_calls": [], "includes": [], "callbacks": {}, "ros2": ros2}
+    said: set[str] = set()
 
-    def full(d: str) -> str:
-        head, _, rest = d.partition(".")
-        base = mod.imports.get(head, head)
-        return f"{base}.{rest}" if rest else base
+    def type_of(v: Any, kind: str) -> tuple[str | None, Any]:
+        """(type, candidates for the linker)."""
+        if isinstance(v, str) or v is None:
+            return v, None
+        if v.kind == "call" and v.call is not None and v.call.func.split(".")[-1] == "numpy_msg" and v.call.args:
+            return type_of(v.call.args[0], kind)
+        if v.kind != "name":
+            return None, None
+        head = v.text.split(".")[0]
+        chosen = {o for o, _ln in mod.import_lines.get(head, [])}
+        if len(chosen) > 1 and head not in said:
+            said.add(head)
+            lines = sorted(ln for _o, ln in mod.import_lines[head])
+            out["notes"].append(Note(v.src, f"'{head}' is imported {len(lines)} times (lines "
+                                            f"{', '.join(map(str, lines))}), chosen at run time: read as "
+                                            f"{mod.imports[head]}, the first (line {lines[0]})", "ROS-UNRESOLVED"))
+        if head not in mod.imports and "." not in v.text and mod.star:
+            want = "srv" if kind.startswith("service") else "action" if kind.startswith("action") else "msg"
+            cands = sorted({_typed(f"{m}.{v.text}", kind) for m in mod.star
+                            if m.split(".")[-1] == ("msg" if want == "action" else want)} - {None})
+            if len(cands) == 1:
+                return cands[0], None
+            return None, (("cands", tuple(cands)) if cands else None)
+        return _typed(sc.full(v.text), kind), None
 
-    def type_of(v: PyVal | None, kind: str) -> str | None:
-        if v is None or v.kind != "name":
-            return None
-        parts = full(v.text).split(".")
-        if len(parts) < 3 or parts[-2] not in ("msg", "srv", "action"):
-            return None
-        dotted = "/".join(parts[-3:])
-        if kind.startswith("service"):
-            return service_type(dotted)
-        if kind.startswith("action"):
-            return action_type(dotted)
-        t = canon_type(dotted)
-        return t if t and parts[-2] == "msg" else None
-
-    declared: dict[str, str | None] = {}
-    for c in mod.calls:
-        if c.func.endswith("declare_parameter") and c.args and c.args[0].kind == "str":
-            d = c.args[1] if len(c.args) > 1 else c.kwargs.get("value")
-            declared.setdefault("~" + c.args[0].text.lstrip("~"), d.text if d is not None and d.kind == "str" else None)
-    binds: dict[str, list[PyVal]] = {}
-    for t, v in mod.assigns:
-        binds.setdefault(t, []).append(v)
-
-    def getter(c: PyCall) -> tuple[str | None, str] | None:
-        f = full(c.func) if c.func else ""
-        if not c.args or c.args[0].kind != "str":
-            return None
-        name = c.args[0].text
-        if f in ("rospy.get_param", "rospy.client.get_param"):
-            d = c.args[1] if len(c.args) > 1 else c.kwargs.get("default")
-            return (d.text if d is not None and d.kind == "str" else None), name
-        last = c.func.rsplit(".", 1)[-1]
-        if last in ("get_parameter", "declare_parameter", "get_parameter_or"):
-            p = "~" + name.lstrip("~")
-            d = c.args[1] if last != "get_parameter" and len(c.args) > 1 else None
-            return (d.text if d is not None and d.kind == "str" else declared.get(p)), p
-        return None
-
-    def resolve(v: PyVal, depth: int = 0) -> tuple[str | None, str | None]:
-        if v.kind == "str":
-            return v.text, None
-        if v.kind == "name" and depth < 5:
-            vs = binds.get(v.text, [])
-            got = {resolve(x, depth + 1) for x in vs}
-            return next(iter(got)) if len(got) == 1 else (None, None)
-        for c in ([v.call] if v.call else []) + v.calls:
-            g = getter(c)
-            if g is not None:
-                return g
-        return None, None
+    def add(kind: str, name: Any, type_v: Any, c: PyCall, handle: Any = None) -> None:
+        if isinstance(name, tuple) and name and name[0] == "under":
+            nv = sc.value(name[1]) if name[1] is not None else None
+            val, written, nsrc = symbols.cat([nv, symbols.lit("/" + name[2])]) if nv is not None else None, \
+                (name[1].text if name[1] is not None else "?") + "/" + name[2], c.src
+        elif isinstance(name, PyVal):
+            val, written, nsrc = sc.value(name), name.text, name.src
+        else:
+            val, written, nsrc = name, symbols.text(name) or "?", c.src
+        t, cands = type_of(type_v, kind)
+        unit = sc.unit_at(c.src.line)
+        ep, note = emit.make(kind, val, handle, t, c.src, unit, sc.fn_key(c.src.line), written, nsrc, cands)
+        if note is not None:
+            out["notes"].append(note)
+        if ep is None:
+            return
+        if ep.pending is None and t is None and isinstance(type_v, PyVal):
+            out["notes"].append(Note(type_v.src, f"type '{_short(type_v.text)}' of {_WHAT[kind]} "
+                                                 f"'{ep.topic or ep.param}' not resolved statically"))
+        out["endpoints"].append(ep)
 
     for c in mod.calls:
-        f = full(c.func) if c.func else ""
+        f = sc.full(c.func) if c.func else ""
         last = c.func.rsplit(".", 1)[-1]
         if f in ("rospy.init_node", "rclpy.create_node", "rclpy.node.Node") or c.func == "super().__init__":
             v = c.args[0] if c.args else c.kwargs.get("name") or c.kwargs.get("node_name")
-            if v is not None and v.kind == "str":
-                out["nodes"].append((v.text, c.src))
-            elif v is not None and c.func != "super().__init__":
-                out["notes"].append(Note(v.src, "node name is not a string literal: not resolved statically"))
+            if v is None:
+                continue
+            val = sc.value(v)
+            if c.func == "super().__init__" and v.kind != "str" and not _node_class(mod, sc.class_at(c.src.line)):
+                continue
+            unit = sc.unit_at(c.src.line)
+            if val is not None and val[0] == "str":
+                out["nodes"].append((val[1], c.src))
+            elif symbols.is_concrete(val):
+                if c.func != "super().__init__":
+                    out["notes"].append(Note(v.src, "node name is not a string literal: not resolved statically"))
+                continue
+            out["node_names"].append((val, c.src, unit, sc.fn_key(c.src.line), None))
             continue
         spec = _CTORS.get(f)
         if spec is None and "actionlib" in f and last in _CTORS:
             spec = _CTORS[last]
         if spec is None and f.startswith("rclpy.action") and last in ("ActionServer", "ActionClient"):
             spec = _CTORS[f"rclpy.{last}"]
-        if spec is None and "." in c.func and last in _METHODS:
+        if spec is None and "." in c.func and last in _METHODS and not f.startswith(("rospy.", "os.")):
             spec = _METHODS[last]
         if spec is None:
+            helped = py_helpers.helper(f, c, ros2) if f and "." in f else None
+            if helped is not None:
+                for kind, name, typ in helped:
+                    add(kind, name, typ, c)
+                continue
+            callee = sc.callee(c)
+            if callee is not None:
+                out["calls"].append(("call", callee, [sc.value(a) for a in c.args], sc.fn_key(c.src.line),
+                                     sc.unit_at(c.src.line), c.src, {k: sc.value(v) for k, v in c.kwargs.items()}))
             continue
         kind, ni, nk, ti, tk = spec
         name_v = c.kwargs.get(nk) or (c.args[ni] if len(c.args) > ni else None)
         type_v = c.kwargs.get(tk) or (c.args[ti] if len(c.args) > ti else None)
-        if name_v is None:
-            continue
-        topic, param = resolve(name_v)
-        if topic is None and param is None:
-            out["notes"].append(Note(name_v.src, f"{_WHAT[kind]} name is '{_short(name_v.text)}', not a string literal: "
-                                                 f"not resolved statically"))
-            continue
-        t = type_of(type_v, kind)
-        if t is None and type_v is not None:
-            out["notes"].append(Note(type_v.src, f"type '{_short(type_v.text)}' of {_WHAT[kind]} '{topic or param}' "
-                                                 f"not resolved statically"))
-        out["endpoints"].append(Endpoint(kind, topic or "", t, c.src, param))
+        if name_v is not None:
+            add(kind, name_v, type_v, c)
     out["owners"] = owners(mod.classes, out["nodes"], out["endpoints"])
+    out["fns"] = {f"{shown}::{q}": (sc.unit_at(a), params, [], [sc.value(d) for d in defaults])
+                  for q, a, _b, params, defaults in mod.functions}
+    out["units"] = {f"{shown}::{q}": {"bases": mod.bases.get(q.split(".")[-1], []), "members": {}}
+                    for q, _a, _b in sc.cls}
+    out["fields"] = sc.fields()
+    out["consts"] = sc.consts()
+    out["imports"] = sorted(set(mod.imports.values()) | set(mod.star))
     return out
+
+
+def _typed(dotted: str, kind: str) -> str | None:
+    """``pkg.msg.T`` -> ``pkg/msg/T`` (or the service's, the action's) for role ``kind``."""
+    parts = dotted.split(".")
+    if len(parts) < 3 or parts[-2] not in ("msg", "srv", "action"):
+        return None
+    d = "/".join(parts[-3:])
+    if kind.startswith("service"):
+        return service_type(d)
+    if kind.startswith("action"):
+        return action_type(d)
+    t = canon_type(d)
+    return t if t and parts[-2] == "msg" else None
+
+
+def _node_class(mod: PyModule, cls: str | None, depth: int = 0) -> bool:
+    """Whether class ``cls`` of the file derives from rclpy's ``Node`` (directly or
+    through a class of the same file)."""
+    if cls is None or depth > 5:
+        return False
+    for b in mod.bases.get(cls.split(".")[-1], []):
+        if b.split(".")[-1] in ("Node", "LifecycleNode") or _node_class(mod, b, depth + 1):
+            return True
+    return False
 
 
 def owners(classes: list[tuple[str, int, int]], nodes: list[tuple[str, Src]], eps: list[Endpoint]) -> list[int]:

@@ -79,10 +79,24 @@ def tolerant_module(text: str, shown: str) -> tuple[Any, str]:
         return made[c.id]
 
     def val(n: Any, depth: int) -> PyVal:
-        if n.type == "string" and not any(c.type == "interpolation" for c in n.children):
+        if n.type == "string":
             prefix = treesitter.text(n.children[0]) if n.children else ""
-            if "b" not in prefix.lower():
+            if "b" not in prefix.lower() and not any(c.type == "interpolation" for c in n.children):
                 return PyVal("str", "".join(treesitter.text(c) for c in n.children if c.type == "string_content"), loc(n))
+            if "b" not in prefix.lower() and depth <= MAX_DEPTH:
+                parts = []
+                for c in n.children:
+                    if c.type == "string_content":
+                        parts.append(PyVal("str", treesitter.text(c), loc(c)))
+                    elif c.type == "interpolation":
+                        e = c.child_by_field_name("expression")
+                        plain = e is not None and len(c.named_children) == 1
+                        parts.append(val(e, depth + 1) if plain else PyVal("other", treesitter.text(c), loc(c)))
+                return PyVal("cat", treesitter.text(n), loc(n), parts=parts)
+        if n.type == "binary_operator" and treesitter.text(n.child_by_field_name("operator")) == "+" \
+                and depth <= MAX_DEPTH:
+            return PyVal("cat", treesitter.text(n), loc(n), parts=[val(n.child_by_field_name("left"), depth + 1),
+                                                                   val(n.child_by_field_name("right"), depth + 1)])
         d = dotted(n)
         if d is not None:
             return PyVal("name", d, loc(n))
@@ -99,6 +113,35 @@ def tolerant_module(text: str, shown: str) -> tuple[Any, str]:
             return PyVal("call", treesitter.text(n), loc(n), call(n, depth), inner)
         return PyVal("other", treesitter.text(n), loc(n), None, inner)
 
+    def function(n: Any) -> None:
+        names, p = [], n.parent
+        while p is not None:
+            if p.type in ("class_definition", "function_definition") and p.child_by_field_name("name") is not None:
+                nm = treesitter.text(p.child_by_field_name("name"))
+                names.insert(0, nm if p.type == "class_definition" else f"{nm}.<locals>")
+            p = p.parent
+        prefix = "".join(f"{x}." for x in names)
+        anchor = n.parent if n.parent is not None and n.parent.type == "decorated_definition" else n
+        holder = anchor.parent.parent if anchor.parent is not None else None
+        direct = holder is not None and holder.type == "class_definition"
+        params: list[str] = []
+        defaults: list[PyVal | None] = []
+        ps = n.child_by_field_name("parameters")
+        for x in ps.named_children if ps is not None else []:
+            if x.type in ("identifier", "typed_parameter"):
+                nm = x if x.type == "identifier" else next((c for c in x.named_children if c.type == "identifier"), None)
+                params.append(treesitter.text(nm))
+                defaults.append(None)
+            elif x.type in ("default_parameter", "typed_default_parameter"):
+                params.append(treesitter.text(x.child_by_field_name("name")))
+                v = x.child_by_field_name("value")
+                defaults.append(val(v, 1) if v is not None else None)
+        deco = n.parent.type == "decorated_definition" and "staticmethod" in treesitter.text(n.parent)
+        if direct and not deco and params:
+            params, defaults = params[1:], defaults[1:]
+        mod.functions.append((prefix + treesitter.text(n.child_by_field_name("name")), n.start_point[0] + 1,
+                              n.end_point[0] + 1, params, defaults))
+
     unread: list[int] = []
     stack = [root]
     while stack:
@@ -106,23 +149,33 @@ def tolerant_module(text: str, shown: str) -> tuple[Any, str]:
         t = n.type
         if t == "ERROR" or n.is_missing:
             unread.extend(range(n.start_point[0] + 1, n.end_point[0] + 2))
+        line = n.start_point[0] + 1
         if t == "import_statement":
             for x in n.children_by_field_name("name"):
                 if x.type == "aliased_import":
-                    mod.imports[treesitter.text(x.child_by_field_name("alias"))] = treesitter.text(x.child_by_field_name("name"))
+                    mod.bind_import(treesitter.text(x.child_by_field_name("alias")),
+                                    treesitter.text(x.child_by_field_name("name")), line)
                 else:
-                    mod.imports[treesitter.text(x).split(".")[0]] = treesitter.text(x).split(".")[0]
+                    mod.bind_import(treesitter.text(x).split(".")[0], treesitter.text(x).split(".")[0], line)
         elif t == "import_from_statement":
-            m = treesitter.text(n.child_by_field_name("module_name"))
+            m = treesitter.text(n.child_by_field_name("module_name")).lstrip(".")
+            if any(c.type == "wildcard_import" for c in n.children):
+                mod.star.append(m)
             for x in n.children_by_field_name("name"):
                 if x.type == "aliased_import":
-                    mod.imports[treesitter.text(x.child_by_field_name("alias"))] = f"{m}.{treesitter.text(x.child_by_field_name('name'))}"
+                    mod.bind_import(treesitter.text(x.child_by_field_name("alias")),
+                                    f"{m}.{treesitter.text(x.child_by_field_name('name'))}".lstrip("."), line)
                 else:
-                    mod.imports[treesitter.text(x)] = f"{m}.{treesitter.text(x)}"
+                    mod.bind_import(treesitter.text(x), f"{m}.{treesitter.text(x)}".lstrip("."), line)
+        elif t == "function_definition" and n.child_by_field_name("name") is not None:
+            function(n)
         elif t == "call":
             mod.calls.append(call(n, 0))
         elif t == "class_definition" and n.child_by_field_name("name") is not None:
             mod.classes.append((treesitter.text(n.child_by_field_name("name")), n.start_point[0] + 1, n.end_point[0] + 1))
+            sup = n.child_by_field_name("superclasses")
+            mod.bases[treesitter.text(n.child_by_field_name("name"))] = [
+                d for d in (dotted(b) for b in (sup.named_children if sup is not None else [])) if d]
         elif t == "assignment":
             left, right = n.child_by_field_name("left"), n.child_by_field_name("right")
             d = dotted(left) if left is not None else None

@@ -29,3 +29,13 @@ def text(n: Any) -> str:
     """The source text of syntax node ``n`` (UTF-8, undecodable bytes replaced);
     ``""`` for ``None``."""
     return n.text.decode("utf-8", errors="replace") if n is not None else ""
+
+
+def walk(n: Any):  # type: ignore[no-untyped-def]
+    """Every syntax node under ``n`` (``n`` included), in source order (iterative:
+    no recursion limit on deep trees)."""
+    stack = [n]
+    while stack:
+        x = stack.pop()
+        yield x
+        stack.extend(reversed(x.children))

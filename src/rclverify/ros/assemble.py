@@ -1,0 +1,140 @@
+"""The graph's nodes from the packages' programs (docs/ros.md, "Reading real
+code", "Programs without launch files").
+
+Each package's programs (:mod:`programs`) are linked (:mod:`link`) once.
+
+* Without launch files every program is its nodes: each node it names (a
+  program naming several gets each the endpoints of its own classes), with
+  the endpoints its code creates wherever they are written; a program
+  naming no node is reported, not drawn.
+* A launch file's node is the program of its package and executable (or its
+  component class): all the program's endpoints, under the launch name (or
+  the name the code gives).
+
+The caller's ``add_node`` resolves the names (namespaces, remaps, parameters).
+"""
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any, Callable
+
+from . import names
+from .executables import Targets
+from .launch import LaunchNode
+from .link import Linked, Linker
+from .model import Endpoint, Graph, Note
+from .packages import Package
+from .programs import PackageCode, Program, programs
+
+
+class Assembly:
+    """The programs of every scanned package and their linked endpoints.
+
+    ``records[pkg][shown]``: every parsed source record of the package;
+    ``targets[pkg]``: its build targets; ``known(t)``: whether the scan's type
+    table defines type ``t``."""
+
+    def __init__(self, pkgs: dict[str, Package], records: dict[str, dict[str, dict[str, Any]]],
+                 targets: dict[str, Targets], show: Callable[[Path], str], known: Callable[[str], bool]) -> None:
+        self.pkgs, self.known = pkgs, known
+        self.codes = {p: PackageCode(p, show(pkgs[p].root), records.get(p, {}), show) for p in sorted(pkgs)}
+        self.progs = {p: programs(self.codes[p], targets[p]) for p in sorted(pkgs)}
+        self.targets = targets
+        self._linked: dict[int, Linked] = {}
+
+    def linked(self, prog: Program) -> Linked:
+        """``prog`` linked (once)."""
+        got = self._linked.get(id(prog))
+        if got is None:
+            got = self._linked[id(prog)] = Linker(prog, self.codes[prog.package], self.known).run()
+        return got
+
+    def program(self, pkg: str, exe: str) -> Program | None:
+        """The program of executable ``exe`` of package ``pkg`` (or one of its aliases)."""
+        progs = self.progs.get(pkg, [])
+        return next((p for p in progs if p.exe == exe), None) or next((p for p in progs if exe in p.aliases), None)
+
+    def class_program(self, plugin: str, pkg: str | None) -> tuple[Program | None, str | None]:
+        """The program of a component class (``ns::C``, or its last part when unique in
+        ``pkg``): the target that registers it, else the files that define it."""
+        p = plugin.strip().lstrip(":")
+        hits: list[tuple[str, str, str]] = []  # (package, class, file)
+        for pk, code in self.codes.items():
+            for f, r in code.records.items():
+                for cls in r.get("units", {}) if r.get("lang") != "py" else ():
+                    if cls == p or (cls.split("::")[-1] == p.split("::")[-1] and (pkg is None or pk == pkg)):
+                        hits.append((pk, cls, f))
+        exact = [h for h in hits if h[1] == p]
+        classes = {(h[0], h[1]) for h in (exact or hits)}
+        if len(classes) != 1:
+            return None, None
+        pk, cls = next(iter(classes))
+        prog = next((x for x in self.progs.get(pk, []) if x.units == {cls}), None)
+        if prog is None:
+            files = sorted({h[2] for h in hits if h[1] == cls})
+            from .programs import _closure
+            prog = Program(pk, None, files, _closure(self.codes[pk], files, set()), {cls})
+            self.progs[pk].append(prog)
+        return prog, cls
+
+    def source_nodes(self, add_node: Callable[..., None], g: Graph) -> None:
+        """Without launch files: every program's nodes (see the module docstring)."""
+        for pkg in sorted(self.progs):
+            for prog in self.progs[pkg]:
+                got = self.linked(prog)
+                if not got.nodes:
+                    if got.endpoints:
+                        first = min((e for e, _o in got.endpoints), key=lambda e: (e.src.file, e.src.line))
+                        g.notes.append(Note(first.src, "publishers/subscribers in a file that names no node and is "
+                                                       "started by no launch file: not in the graph",
+                                            "ROS-UNRESOLVED"))
+                    g.notes.extend(got.notes)
+                    continue
+                g.notes.extend(got.notes)
+                for i, (name, src, ns) in enumerate(got.nodes):
+                    eps = [e for e, o in got.endpoints if o == i]
+                    full = names.join(names.join("/", ns or ""), name)
+                    files = _files(prog, got, eps, src.file)
+                    add_node(full, names.split(full)[0], pkg, prog.exe, files, src, eps, [], "source")
+
+    def launch_node(self, ln: LaunchNode, add_node: Callable[..., None], g: Graph) -> None:
+        """The node launch element ``ln`` starts (see the module docstring)."""
+        comp = self.targets.get(ln.pkg, Targets()).components.get(ln.exe) if ln.exe else None
+        plugin = ln.plugin or (comp[0] if comp else None)
+        prog: Program | None = None
+        if plugin:
+            prog, _cls = self.class_program(plugin, ln.pkg)
+            if prog is None:
+                g.notes.append(Note(ln.src, f"component class '{plugin}' of package '{ln.pkg}' is not found in the "
+                                            f"scanned C++ sources; its topics are unknown", "ROS-LAUNCH"))
+        elif ln.pkg not in self.pkgs:
+            g.notes.append(Note(ln.src, f"node package '{ln.pkg}' is not in the scanned workspaces; "
+                                        f"its topics are unknown", "ROS-LAUNCH"))
+        else:
+            prog = self.program(ln.pkg, ln.exe)
+            if prog is None:
+                g.notes.append(Note(ln.src, f"executable '{ln.exe}' of package '{ln.pkg}' has no source found "
+                                            f"(CMakeLists.txt add_executable, setup.py console_scripts, scripts/); "
+                                            f"its topics are unknown", "ROS-LAUNCH"))
+        got = self.linked(prog) if prog is not None else Linked()
+        g.notes.extend(got.notes)
+        eps = [e for e, _o in got.endpoints]
+        name = ln.name or (got.nodes[0][0] if got.nodes else (plugin.split("::")[-1] if plugin else ln.exe))
+        if name.startswith("/"):
+            full = names.normalise(name)
+            ns = names.split(full)[0]
+        else:
+            full, ns = names.join(ln.ns, name), ln.ns
+        files = _files(prog, got, eps, None) if prog is not None else []
+        add_node(full, ns, ln.pkg, ln.exe or None, files, ln.src, eps, ln.remaps, "launch", ln.params)
+
+
+def _files(prog: Program, got: Linked, eps: list[Endpoint], named_in: str | None) -> list[str]:
+    """The sources shown for a node: where it is named, its program's entry files,
+    and every file holding one of its endpoints."""
+    out: list[str] = []
+    entry = list(prog.entry) if prog.units is None else []
+    for f in ([named_in] if named_in else []) + entry + [e.src.file for e in eps]:
+        if f and f not in out:
+            out.append(f)
+    return out

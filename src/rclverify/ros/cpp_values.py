@@ -1,0 +1,205 @@
+"""The value of a C++ name expression in its file's scopes (:mod:`cpp_scope`;
+docs/ros.md, "Reading real code").
+
+:meth:`CppValues.value` gives an expression's :mod:`symbols` value: a
+literal (``"x"``, ``std::string(X)``, a constant or ``#define``, a
+concatenation), a parameter of the enclosing function (``("arg", key, i)``),
+a member of its class (``("field", class, name)``, bound where the program
+constructs it), a ROS parameter read (:mod:`cpp_params`), a node handle
+(``ros::NodeHandle nh("~")``, ``ros::NodeHandle(parent, "ns")``, rclcpp
+``create_sub_node("ns")``, a nodelet's ``getPrivateNodeHandle()``), the node's
+own name (``ros::this_node::getName()``, ``get_fully_qualified_name()``),
+roscpp options (``ros::SubscribeOptions::create<T>(name, ...)``,
+``ops.init<T>(name, ...)``).  A name bound twice to different values is not
+read (``None``).
+"""
+from __future__ import annotations
+
+from typing import Any
+
+from . import symbols, treesitter
+from .cpp_params import param_read, string_value
+from .cpp_scope import _HANDLE_TYPES, MAX_DEPTH, CppScope, Fn, base_name, is_node_type
+
+_T = treesitter.text
+
+
+_OPTIONS = {"SubscribeOptions": "sub", "AdvertiseOptions": "pub", "AdvertiseServiceOptions": "service_servers"}
+
+
+def _options(ftext: str, fn: Any, args: list[Any]) -> tuple[str, str] | None:
+    """``(role, type text)`` of roscpp's ``ros::SubscribeOptions::create<T>(name, ...)``
+    or ``ops.init<T>(name, ...)`` (also ``AdvertiseOptions``, ``AdvertiseServiceOptions``)."""
+    if not args or "<" not in ftext:
+        return None
+    head = ftext.split("<")[0]
+    tpl = ftext[ftext.index("<") + 1: ftext.rindex(">")] if ">" in ftext else ""
+    parts = head.split("::")
+    if len(parts) >= 2 and parts[-1] == "create" and parts[-2] in _OPTIONS:
+        return _OPTIONS[parts[-2]], tpl
+    return None
+
+
+
+class CppValues(CppScope):
+    """A file's scopes with the values of its expressions."""
+
+    def value(self, n: Any, depth: int = 0) -> symbols.Val:
+        """The :mod:`symbols` value of expression ``n`` (``None``: not read statically)."""
+        if n is None or depth > MAX_DEPTH:
+            return None
+        t = n.type
+        s = string_value(n)
+        if s is not None:
+            return symbols.lit(s)
+        if t == "concatenated_string":
+            parts = [string_value(c) for c in n.named_children]
+            return symbols.lit("".join(p for p in parts if p is not None)) if None not in parts else None
+        if t in ("parenthesized_expression",) and n.named_children:
+            return self.value(n.named_children[0], depth + 1)
+        if t == "binary_expression" and _T(n.child_by_field_name("operator")) == "+":
+            return symbols.cat([self.value(n.child_by_field_name("left"), depth + 1),
+                                self.value(n.child_by_field_name("right"), depth + 1)])
+        if t == "call_expression":
+            return self._call_value(n, depth)
+        if t == "this":
+            return ("nh", ())
+        if t in ("identifier", "field_expression", "pointer_expression", "qualified_identifier"):
+            return self._name_value(n, depth)
+        return None
+
+    def _call_value(self, n: Any, depth: int) -> symbols.Val:
+        fn = n.child_by_field_name("function")
+        a = n.child_by_field_name("arguments")
+        args = list(a.named_children) if a is not None else []
+        ftext = _T(fn)
+        last = ftext.split("::")[-1].split(".")[-1].split(">")[-1]
+        if ftext.endswith("this_node::getName") or last == "get_fully_qualified_name":
+            return symbols.NODE
+        if ftext in ("std::string", "string", "std::string_view") and len(args) == 1:
+            return self.value(args[0], depth + 1)
+        if base_name(ftext) in _HANDLE_TYPES:
+            return self.handle(args, depth)
+        if last == "create_sub_node" and len(args) == 1 and (fn is None or fn.type != "field_expression"):
+            return ("nh", (("ns", self.value(args[0], depth + 1)),))
+        if last in ("getPrivateNodeHandle", "getMTPrivateNodeHandle"):
+            return ("nh", (("ns", symbols.lit("~")),))
+        if last in ("getNodeHandle", "getMTNodeHandle", "shared_from_this"):
+            return ("nh", ())
+        if fn is not None and fn.type == "field_expression":
+            method = _T(fn.child_by_field_name("field"))
+            recv = fn.child_by_field_name("argument")
+            if method in ("c_str", "str", "data") and not args:
+                return self.value(recv, depth + 1)
+            if not args and recv is not None and recv.type == "call_expression":
+                inner = self.value(recv, depth + 1)  # get_parameter("t").as_string()
+                if inner is not None and inner[0] == "param":
+                    return inner
+            if method == "create_sub_node" and len(args) == 1:
+                return ("nh", (("h", self.value(recv, depth + 1)), ("ns", self.value(args[0], depth + 1))))
+        ops = _options(ftext, fn, args)
+        if ops is None and fn is not None and fn.type == "field_expression" and args and "<" in ftext \
+                and ftext.split("<")[0].endswith(("init",)):
+            rt = base_name(self.type_of(fn.child_by_field_name("argument")) or "")
+            if rt in _OPTIONS:
+                ops = (_OPTIONS[rt], ftext[ftext.index("<") + 1: ftext.rindex(">")])
+        if ops is not None:
+            return ("ops", ops[0], self.value(args[0], depth + 1), ops[1], _T(args[2]) if len(args) > 2 else None,
+                    _T(args[0]))
+        r = param_read(n)
+        if r is not None:
+            pname, default, _ref, recv, ros2 = r
+            if default is None and ros2:
+                default = self.declared.get(pname)
+            return ("param", pname, default, self.value(recv, depth + 1) if recv is not None and not ros2 else None)
+        return None
+
+    def handle(self, args: list[Any], depth: int = 0) -> symbols.Val:
+        """A ``ros::NodeHandle`` made with constructor arguments ``args``: ``()``,
+        ``(ns)``, ``(parent, ns)``, ``(ns, remappings)``, or a copy ``(other)``."""
+        if not args:
+            return ("nh", ())
+        first = self.value(args[0], depth + 1)
+        if len(args) >= 2 and self.is_handle(args[0]):
+            return ("nh", (("h", first), ("ns", self.value(args[1], depth + 1))))
+        if self.is_handle(args[0]):
+            return ("nh", (("h", first),))
+        return ("nh", (("ns", first),))
+
+    def is_handle(self, n: Any) -> bool:
+        """Whether expression ``n`` is a node handle or node: declared with a handle
+        or node type, ``this``, ``shared_from_this()``, a ``NodeHandle(...)``."""
+        t = n.type
+        if t == "this" or (t == "pointer_expression" and _T(n).lstrip("*&") == "this"):
+            return True
+        if t == "call_expression":
+            f = _T(n.child_by_field_name("function"))
+            return base_name(f) in _HANDLE_TYPES or f.endswith(("shared_from_this", "create_sub_node",
+                                                                 "getNodeHandle", "getPrivateNodeHandle",
+                                                                 "getMTNodeHandle", "getMTPrivateNodeHandle"))
+        if t in ("identifier", "field_expression", "pointer_expression"):
+            return is_node_type(self.type_of(n) or "")
+        return False
+
+    def _name_value(self, n: Any, depth: int) -> symbols.Val:
+        fn = self.fn_of(n)
+        t = n.type
+        if t == "pointer_expression":
+            if _T(n).lstrip("*&") == "this":
+                return ("nh", ())
+            return self.value(n.named_children[-1], depth + 1) if n.named_children else None
+        if t == "field_expression":
+            if _T(n.child_by_field_name("argument")) != "this" or fn is None:
+                return None
+            return self._member(fn, _T(n.child_by_field_name("field")), depth)
+        name = _T(n)
+        if t == "qualified_identifier":
+            vals = self.consts.get(name) or self.consts.get("::".join(name.split("::")[-2:])) or []
+            return self._one([self.value(v, depth + 1) if not isinstance(v, tuple) else v for v in vals])
+        if fn is not None:
+            if name in fn.params:
+                v = ("arg", fn.key, fn.params.index(name))
+                return ("nh", (("h", v),)) if is_node_type(fn.ptypes[fn.params.index(name)]) else v
+            key = (fn.nid, name)
+            if key in self.ltypes or key in self.locals:
+                return self._one([self._bound(fn, b, depth) for b in self.locals.get(key, [])])
+            if fn.in_class and name not in self.consts:
+                return self._member(fn, name, depth)
+        if name in self.consts:
+            return self._one([self.value(v, depth + 1) if not isinstance(v, tuple) else v for v in self.consts[name]])
+        return None
+
+    def _member(self, fn: Fn, name: str, depth: int) -> symbols.Val:
+        v = ("field", fn.unit, name)
+        ty = self.classes.get(fn.unit, {}).get("members", {}).get(name)
+        return ("nh", (("h", v),)) if ty is not None and is_node_type(ty) else v
+
+    def _bound(self, fn: Fn | None, b: Any, depth: int) -> symbols.Val:
+        if isinstance(b, tuple):
+            if b[0] == "nhargs":
+                return self.handle(b[1], depth + 1)
+            if b[0] in ("read", "ops"):
+                return self._call_value(b[1], depth + 1)
+            if b[0] == "init":
+                if len(b[1]) == 1 and not (fn is not None and is_node_type(
+                        self.classes.get(fn.unit, {}).get("members", {}).get(b[2], ""))):
+                    return self.value(b[1][0], depth + 1)
+                return self.handle(b[1], depth + 1)
+            return b
+        return self.value(b, depth + 1)
+
+    @staticmethod
+    def _one(vals: list[symbols.Val]) -> symbols.Val:
+        got = set(vals)
+        return next(iter(got)) if len(got) == 1 else None
+
+    def field_values(self) -> dict[tuple[str, str], list[symbols.Val]]:
+        """``{(class, member): [value, ...]}``: what each member is initialised or
+        assigned with in this file (values relative to the binding function)."""
+        out: dict[tuple[str, str], list[symbols.Val]] = {}
+        for key, binds in self.fields.items():
+            for fn, b in binds:
+                v = self._bound(fn, b, 0) if fn is not None or isinstance(b, tuple) else self.value(b)
+                out.setdefault(key, []).append(v)
+        return out
+

@@ -1,0 +1,380 @@
+"""The linker: one program's endpoints and node names, read across all the
+files it runs (docs/ros.md, "Reading real code").
+
+From the program's entry units (:mod:`programs`) the linker follows what
+they construct and call (C++ ``Sensor s(nh, "scan")``, a member initialised
+in a constructor, ``new``/``make_shared``, a default-constructed member, a
+base class; Python ``Sensor(self, 'scan')``, ``self.start('x')``, an
+imported class or function) to every class and function the program runs.
+Endpoints created there belong to the program; names that their file left
+symbolic (:mod:`symbols`) are evaluated here:
+
+* a parameter of a function or constructor takes the value each call site
+  passes (its default argument when the site passes none): one endpoint per
+  distinct name, each at the creating call's line;
+* a member takes what the class's constructor (or any method) binds to it,
+  a node handle member the node's own handle when nothing binds it;
+* an imported Python constant is looked up in the package module that
+  defines it;
+* a node handle's namespaces are those of the handle each call site passes.
+
+Helper objects held as members (``tf2_ros::TransformBroadcaster br_;``, an
+actionlib server initialised in a constructor, a ``message_filters``
+subscriber whose ``subscribe`` is called) get their class from the
+program's declarations.  When the program names several nodes, each
+endpoint belongs to the node whose class creates it or constructs (directly
+or not) the class that does; the rest to the node named outside any class.
+Values are evaluated by :mod:`link_values` (bounded: :data:`MAX_DEPTH` nested
+calls, :data:`MAX_VALUES` values).
+"""
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass, field
+from typing import Any, Callable
+
+from . import cpp_helpers, emit, symbols
+from .cpp_types import action_type, message_type, service_type, split_template
+from .model import Endpoint, Note, Src
+from .link_values import MAX_DEPTH, MAX_VALUES, Values
+from .programs import PackageCode, Program
+
+__all__ = ["Linked", "Linker", "MAX_DEPTH", "MAX_VALUES"]
+_ACTIONLIB = {"SimpleActionServer": "action_servers", "ActionServer": "action_servers",
+              "SimpleActionClient": "action_clients", "ActionClient": "action_clients"}
+_IDENT = re.compile(r"[A-Za-z_][\w:]*")
+
+
+@dataclass
+class Linked:
+    """A linked program: ``nodes`` ``[(name, where named, namespace or None)]``,
+    ``endpoints`` ``[(Endpoint, index of its node in nodes, or -1)]``, ``notes``
+    and the ``files`` that gave any of them."""
+
+    nodes: list[tuple[str, Src, str | None]] = field(default_factory=list)
+    endpoints: list[tuple[Endpoint, int]] = field(default_factory=list)
+    notes: list[Note] = field(default_factory=list)
+    files: list[str] = field(default_factory=list)
+
+
+class Linker(Values):
+    """Link one program of a package (see the module docstring); ``known(t)`` says
+    whether the scan's type table defines message type ``t``."""
+
+    def __init__(self, prog: Program, code: PackageCode, known: Callable[[str], bool]) -> None:
+        self.prog, self.code, self.known = prog, code, known
+        self.recs = {f: code.records[f] for f in prog.files if f in code.records}
+        self.fns: dict[str, tuple[str, list[str], list[str], list[Any]]] = {}
+        self.units: dict[str, dict[str, Any]] = {}
+        self.fields: dict[tuple[str, str], list[Any]] = {}
+        self.callbacks: dict[str, str] = {}
+        self.aliases: dict[str, str] = {}
+        self.calls: list[tuple[Any, ...]] = []
+        entry_units: set[str] = set()
+        for f, r in self.recs.items():
+            for k, (unit, params, ptypes, defaults) in r.get("fns", {}).items():
+                old = self.fns.get(k)
+                if old is not None and len(old[1]) == len(params):
+                    defaults = [d if d is not None else o for d, o in zip(defaults, old[3])]
+                self.fns[k] = (unit, params, ptypes, defaults)
+                if f in prog.entry:
+                    entry_units.add(unit)
+            for u, info in r.get("units", {}).items():
+                cur = self.units.setdefault(u, {"bases": [], "members": {}})
+                cur["bases"] += [b for b in info["bases"] if b not in cur["bases"]]
+                cur["members"].update(info["members"])
+                if f in prog.entry:
+                    entry_units.add(u)
+            for key, vals in r.get("fields", {}).items():
+                self.fields.setdefault(key, []).extend(vals)
+            for k, v in r.get("callbacks", {}).items():
+                self.callbacks.setdefault(k, v)
+            for k, v in r.get("aliases", {}).items():
+                self.aliases.setdefault(k, v)
+            for c in r.get("calls", []):
+                self.calls.append(tuple(c) + (({},) if len(c) == 6 else ()))
+            if r.get("lang") == "py":
+                entry_units.add(f"{f}::<module>")  # a module's code runs when it is imported
+        self.py = bool(self.recs) and all(r.get("lang") == "py" for r in self.recs.values())
+        self.classes = [] if self.py else sorted(self.units)
+        self.entry = prog.units if prog.units is not None else entry_units
+        self.sites: dict[str, list[tuple[list[Any], dict[str, Any], str | None]]] = {}
+        # what runs what: "U:class" (constructed: all its methods run) and "F:function" (called)
+        self.edges: dict[str, set[str]] = {}
+        for k, (unit, *_rest) in self.fns.items():
+            if unit in self.units or unit == k:
+                self._edge(f"U:{unit}", f"F:{k}")
+            if unit == k:
+                self._edge(f"F:{k}", f"U:{unit}")
+        for c in self.calls:
+            kind, callee, args, fkey, unit, _src, kwargs = c
+            ck, cu = self.callee(kind, callee, unit)
+            here = f"F:{fkey}" if fkey else f"U:{unit}" if unit else None
+            made = kind in ("ctor", "member") or (ck is not None and cu is not None and (
+                ck.endswith(".__init__") or ck == self._ctor(cu)))
+            if here is not None and cu is not None and made:
+                self._edge(here, f"U:{cu}")
+            if here is not None and ck is not None:
+                self._edge(here, f"F:{ck}")
+            if ck is not None:
+                self.sites.setdefault(ck, []).append((args, kwargs, fkey))
+        for u, info in self.units.items():
+            for ty in list(info["members"].values()) + info["bases"]:
+                for ident in _IDENT.findall(ty):
+                    m = self.match(ident, u) if not ident.startswith(("std::", "ros::", "rclcpp::")) else None
+                    if m is not None and m != u:
+                        self._edge(f"U:{u}", f"U:{m}")
+        self.reach = self._reach({f"U:{u}" for u in self.entry})
+        self._memo: dict[str, list[dict[int, Any]]] = {}
+        self._stack: set[str] = set()
+
+    # -- program structure
+    def match(self, name: str, caller: str | None) -> str | None:
+        """The program's class a C++ type name (``Sensor``, ``ns::Sensor``) names."""
+        t = split_template(name.replace("*", "").replace("&", "").strip())[0].strip(":")
+        if not t:
+            return None
+        cands = [u for u in self.classes if u == t or u.endswith("::" + t)]
+        if not cands:
+            return None
+        if len(cands) > 1 and caller:
+            ns = caller.rsplit("::", 1)[0]
+            near = [u for u in cands if u.startswith(ns + "::")]
+            cands = near or cands
+        return sorted(cands, key=len)[0]
+
+    def callee(self, kind: str, callee: str, unit: str | None) -> tuple[str | None, str | None]:
+        """``(callable key, unit)`` a call record names in this program."""
+        if self.py:
+            return self._py_callee(callee)
+        if kind == "member":
+            info = self.units.get(unit or "", {})
+            ty = info.get("members", {}).get(callee)
+            cls = self.match(_held(ty), unit) if ty else None
+            if cls is not None and _held(ty) != split_template(ty.replace(" ", ""))[0].replace("*", "").strip():
+                return None, cls  # a pointer member: made by the new/make_shared it is given
+            if cls is None and any(b.split("<")[0].split("::")[-1] == callee.split("::")[-1] for b in info.get("bases", [])):
+                cls = self.match(callee, unit)
+            return (self._ctor(cls), cls) if cls else (None, None)
+        if kind == "ctor":
+            cls = self.match(callee, unit)
+            return (self._ctor(cls), cls) if cls else (None, None)
+        meth, recv = callee, None
+        for sep in ("->", "."):
+            if sep in meth:
+                recv, meth = meth.rsplit(sep, 1)
+        if "::" in meth and recv is None:
+            head, last = meth.rsplit("::", 1)
+            cls = self.match(head, unit)
+            if cls is not None and f"{cls}::{last}" in self.fns:
+                return f"{cls}::{last}", cls
+            cls = self.match(meth, unit)
+            if cls is not None:
+                return self._ctor(cls), cls
+        if recv is not None and recv.replace("this", "").strip("()*&") and unit:
+            ty = self.units.get(unit, {}).get("members", {}).get(recv.replace("this->", "").strip())
+            cls = self.match(_held(ty), unit) if ty else None
+            return (f"{cls}::{meth}", cls) if cls and f"{cls}::{meth}" in self.fns else (None, None)
+        if unit and f"{unit}::{meth}" in self.fns:
+            return f"{unit}::{meth}", unit
+        cls = self.match(meth, unit)
+        if cls is not None and recv is None:
+            return self._ctor(cls), cls
+        free = [k for k, v in self.fns.items() if v[0] == k and (k == meth or k.endswith("::" + meth))]
+        return (free[0], free[0]) if len(free) == 1 else (None, None)
+
+    def _ctor(self, cls: str) -> str:
+        return f"{cls}::{cls.split('::')[-1]}"
+
+    def _py_callee(self, callee: str) -> tuple[str | None, str | None]:
+        if callee.startswith("ext:"):
+            hit = self.code.module(callee[4:])
+            if hit is None or not hit[1]:
+                return None, None
+            callee = f"{hit[0]}::{hit[1]}"
+        if callee in self.units:
+            return f"{callee}.__init__", callee
+        if callee in self.fns:
+            return callee, self.fns[callee][0]
+        return None, None
+
+    def _edge(self, a: str, b: str) -> None:
+        self.edges.setdefault(a, set()).add(b)
+
+    def runs(self, unit: str | None, fkey: str | None, reach: set[str] | None = None) -> bool:
+        """Whether code of function ``fkey`` (else of unit ``unit``) runs in the program
+        (or in ``reach``, a set of reached ``U:``/``F:`` items)."""
+        reach = self.reach if reach is None else reach
+        if fkey is not None and fkey in self.fns:
+            return f"F:{fkey}" in reach
+        return unit is not None and f"U:{unit}" in reach
+
+    def _reach(self, start: set[str]) -> set[str]:
+        seen, todo = set(), list(start)
+        while todo:
+            u = todo.pop()
+            if u in seen:
+                continue
+            seen.add(u)
+            todo.extend(self.edges.get(u, ()))
+        return seen
+
+    # -- the program's endpoints and nodes
+    def run(self) -> Linked:
+        out = Linked()
+        said: set[tuple[Src, str]] = set()
+        eps: list[Endpoint] = []
+
+        def note(n: Note) -> None:
+            if (n.src, n.message) not in said:
+                said.add((n.src, n.message))
+                out.notes.append(n)
+
+        def take(f: str, e: Endpoint) -> None:
+            if e.unit is None and e.func is None and f not in self.prog.entry:
+                return
+            if (e.unit is not None or e.func is not None) and not self.runs(e.unit, e.func):
+                return
+            for x in self.resolve(e, note):
+                if x not in eps:
+                    eps.append(x)
+                    if f not in out.files:
+                        out.files.append(f)
+
+        for f, r in self.recs.items():
+            for e in r.get("endpoints", []):
+                take(f, e)
+            for e in self.members(r):
+                take(f, e)
+        named: list[tuple[str, Src, str | None, str | None]] = []
+        for f, r in self.recs.items():
+            for v, src, unit, fkey, ns in r.get("node_names", []):
+                if (unit is not None or fkey is not None) and not self.runs(unit, fkey) \
+                        or unit is None and fkey is None and f not in self.prog.entry:
+                    continue
+                for env in self.contexts(fkey):
+                    for name in self.eval(v, env, fkey):
+                        t = symbols.text(name) if name is not None and name[0] in ("str", "cat") else None
+                        if t is None:
+                            note(Note(src, "node name is not a string literal: not resolved statically"))
+                            continue
+                        nsv = self.eval(ns, env, fkey)[0] if ns is not None else None
+                        item = (t, src, symbols.text(nsv) if nsv is not None else None, unit)
+                        if not any(x[0] == t and x[2] == item[2] for x in named):
+                            named.append(item)
+                        if f not in out.files:
+                            out.files.append(f)
+        out.nodes = [(n, s, ns) for n, s, ns, _u in named]
+        owners = self.owners([u for *_x, u in named], eps)
+        out.endpoints = list(zip(eps, owners))
+        return out
+
+    def resolve(self, e: Endpoint, note: Callable[[Note], None]) -> list[Endpoint]:
+        """The concrete endpoints a (possibly pending) endpoint stands for."""
+        if e.pending is None:
+            return [e]
+        name, handle, cb, fkey, written, nsrc = e.pending
+        t = e.msg_type if e.msg_type is not None else self.cb_type(e.kind, cb)
+        got: list[Endpoint] = []
+        for env in self.contexts(fkey):
+            for n in self.eval(name, env, fkey):
+                for h in self.eval(handle, env, fkey) if handle is not None else [None]:
+                    if n is not None and n[0] == "ops":
+                        n = n[2]
+                    x, bad = emit.resolve(e.kind, n, h, t, e.src, e.unit, written, nsrc, e.func)
+                    if bad is not None:
+                        note(bad)
+                    if x is not None and x not in got:
+                        got.append(x)
+        if got and t is None:
+            note(emit.type_note(got[0]))
+        return got
+
+    def cb_type(self, kind: str, cb: Any) -> str | None:
+        """The type a callback (C++: its name; Python: ``("cands", types)`` of a star
+        import) gives an endpoint of role ``kind``."""
+        if isinstance(cb, tuple) and cb and cb[0] == "cands":
+            known = [t for t in cb[1] if self.known(t)]
+            return known[0] if len(known) == 1 else None
+        if isinstance(cb, tuple) and cb and cb[0] == "type":
+            text: str | None = cb[1]
+            for _ in range(4):
+                text = self.aliases.get(text or "", self.aliases.get((text or "").split("::")[-1], text))
+        elif isinstance(cb, str):
+            text = self.callbacks.get(cb)
+            if text is None:  # written with another qualification than declared
+                hits = sorted({v for k, v in self.callbacks.items() if k.endswith("::" + cb) or cb.endswith("::" + k)})
+                text = hits[0] if len(hits) == 1 else self.callbacks.get(cb.split("::")[-1])
+        else:
+            return None
+        if kind in ("pub", "sub"):
+            return message_type(text, self.aliases)
+        return service_type(text) if kind.startswith("service") else action_type(text)
+
+    def members(self, r: dict[str, Any]) -> list[Endpoint]:
+        """Pending endpoints of helper objects held as members (their class found in
+        the program's declarations): made in a constructor's initialiser list, or
+        by default where none initialises them; and of their methods' calls."""
+        out: list[Endpoint] = []
+        for unit, m, ty, src in r.get("member_decls", []):
+            if not self.runs(unit, None):
+                continue
+            inits = [c for c in self.calls if c[0] == "member" and c[1] == m and c[4] == unit]
+            for c in inits or [None]:
+                args = c[2] if c else []
+                at, fkey = (c[5], c[3]) if c else (src, None)
+                for kind, nv, t, hv in self.helper(ty, args) or []:
+                    out.append(Endpoint(kind, "", t, at, None, (), unit,
+                                        (nv, hv, None, fkey, symbols.text(nv) or m, at), fkey))
+        for unit, m, meth, args, texts, src, fkey in r.get("member_calls", []):
+            if not self.runs(unit, fkey):
+                continue
+            ty = self.units.get(unit, {}).get("members", {}).get(m)
+            for b in self.units.get(unit, {}).get("bases", []):
+                cls = self.match(b, unit)
+                ty = ty or (self.units.get(cls, {}).get("members", {}).get(m) if cls else None)
+            specs = cpp_helpers.method(ty, meth, args, [], lambda x: x, None) if ty else None
+            for kind, nv, t, hv in specs or []:
+                k = 1 if kind == "sub" and meth == "subscribe" else 0
+                out.append(Endpoint(kind, "", t, src, None, (), unit,
+                                    (nv, hv, None, fkey, texts[k] if k < len(texts) else m, src), fkey))
+        return out
+
+    def helper(self, ty: str, args: list[Any]) -> list[cpp_helpers.Spec] | None:
+        head, targs = split_template(ty.replace(" ", ""))
+        last = head.split("::")[-1]
+        if last in _ACTIONLIB and targs:
+            if not args:
+                return []
+            first = args[0]
+            if len(args) >= 2 and first is not None and first[0] in ("nh", "field", "arg"):
+                return [(_ACTIONLIB[last], args[1], action_type(targs[0]), first)]
+            return [(_ACTIONLIB[last], first, action_type(targs[0]), None)]
+        return cpp_helpers.constructed(ty, args, lambda x: x, False)
+
+    def owners(self, units: list[str | None], eps: list[Endpoint]) -> list[int]:
+        """Each endpoint's node (an index in the named nodes; -1 when none)."""
+        if len(units) <= 1:
+            return [0 if units else -1] * len(eps)
+        reach = {i: self._reach({f"U:{u}"}) if u else set() for i, u in enumerate(units)}
+        loose = next((i for i, u in enumerate(units) if u is None or u not in self.units or u.endswith("<module>")), 0)
+        out = []
+        for e in eps:
+            own = next((i for i, u in enumerate(units) if u is not None and u == e.unit), None)
+            if own is None and self.py:  # a nested class belongs to its enclosing node class
+                inner = [i for i, u in enumerate(units) if u and u in self.units and (e.unit or "").startswith(u + ".")]
+                own = max(inner, key=lambda i: len(units[i] or "")) if inner else None
+            if own is None:
+                own = next((i for i in reach if units[i] in self.units and self.runs(e.unit, e.func, reach[i])), loose)
+            out.append(own)
+        return out
+
+
+def _held(ty: str | None) -> str:
+    """The class a member's type holds: ``std::shared_ptr<ns::Sensor>`` -> ``ns::Sensor``."""
+    if not ty:
+        return ""
+    head, args = split_template(ty.replace(" ", ""))
+    if head.split("::")[-1] in ("shared_ptr", "unique_ptr", "weak_ptr", "Ptr", "SharedPtr", "vector", "optional") and args:
+        return _held(args[0])
+    return head

@@ -1,0 +1,192 @@
+"""The scopes of one Python source and the value of a name in them
+(docs/ros.md, "Reading real code"): string constants propagated through
+assignments, function parameters, ``self.`` attributes and imports.
+
+From the file's :class:`~.pyrecords.PyModule` (either reader):
+
+* a function's parameter is ``("arg", key, i)`` (key ``FILE::Cls.f``; a
+  method's ``self`` is not counted), bound where the package calls it;
+* a local variable or module constant bound once (``NAME = 'talker'``) is
+  its value; bound to two different values it is not read;
+* ``self.x`` is ``("field", FILE::Cls, "x")``, bound wherever the class
+  assigns it (its constructor usually);
+* a name imported from another module (``from pkg.names import TOPIC``,
+  ``names.TOPIC``) is ``("ext", "pkg.names.TOPIC")``, found by the linker
+  in the package's own modules;
+* ``rospy.get_param('~t', 'd')``, rclpy ``declare_parameter``/``get_parameter``
+  are parameter reads; ``rospy.get_name()`` is the node's own name;
+  ``a + b`` and f-strings are concatenations.
+
+Keys of units (what owns an endpoint): ``FILE::Cls`` for a class,
+``FILE::f`` for a module-level function, ``FILE::<module>`` for module code.
+"""
+from __future__ import annotations
+
+from . import symbols
+from .pyrecords import PyCall, PyModule, PyVal
+
+_ROS = ("rospy", "rclpy", "std_msgs", "actionlib", "tf", "tf2_ros", "message_filters", "os", "sys", "math",
+        "time", "threading", "numpy", "interactive_markers")
+MAX_DEPTH = 10
+
+
+class PyScope:
+    """Scopes of one Python file (see the module docstring)."""
+
+    def __init__(self, mod: PyModule, shown: str) -> None:
+        self.mod, self.shown = mod, shown
+        self.fns = sorted(mod.functions, key=lambda f: (f[1], -f[2]))
+        self.cls = self._class_names()
+        self.binds: dict[tuple[str, ...], list[PyVal]] = {}
+        self.declared: dict[str, str | None] = {}
+        for c in mod.calls:
+            if c.func.endswith("declare_parameter") and c.args and c.args[0].kind == "str":
+                d = c.args[1] if len(c.args) > 1 else c.kwargs.get("value")
+                self.declared.setdefault("~" + c.args[0].text.lstrip("~"),
+                                         d.text if d is not None and d.kind == "str" else None)
+        for target, v in mod.assigns:
+            self.binds.setdefault(self._key(target, v.src.line), []).append(v)
+
+    def _class_names(self) -> list[tuple[str, int, int]]:
+        out = []
+        for name, a, b in self.mod.classes:
+            outer = [c for c in self.mod.classes if c[1] < a and c[2] >= b]
+            q = ".".join([c[0] for c in sorted(outer, key=lambda c: c[1])] + [name])
+            out.append((q, a, b))
+        return out
+
+    # -- where a line is
+    def fn_at(self, line: int) -> tuple[str, int, int, list[str], list[PyVal | None]] | None:
+        """The innermost function whose lines hold ``line``."""
+        inside = [f for f in self.fns if f[1] <= line <= f[2]]
+        return min(inside, key=lambda f: f[2] - f[1]) if inside else None
+
+    def class_at(self, line: int) -> str | None:
+        """The qualified name of the innermost class whose lines hold ``line``."""
+        inside = [c for c in self.cls if c[1] <= line <= c[2]]
+        return min(inside, key=lambda c: c[2] - c[1])[0] if inside else None
+
+    def unit_at(self, line: int) -> str:
+        """The unit owning code at ``line``: its class, else its module-level function,
+        else the module."""
+        c = self.class_at(line)
+        if c is not None:
+            return f"{self.shown}::{c}"
+        f = self.fn_at(line)
+        if f is not None:
+            return f"{self.shown}::{f[0].split('.')[0]}"
+        return f"{self.shown}::<module>"
+
+    def fn_key(self, line: int) -> str | None:
+        f = self.fn_at(line)
+        return f"{self.shown}::{f[0]}" if f is not None else None
+
+    def _key(self, target: str, line: int) -> tuple[str, ...]:
+        if target.startswith("self.") and target.count(".") == 1:
+            return ("field", self.unit_at(line), target[5:])
+        f = self.fn_at(line)
+        return ("local", f[0], target) if f is not None else ("module", target)
+
+    # -- values
+    def full(self, dotted: str) -> str:
+        """A dotted name with its first part replaced by what it was imported as."""
+        head, _, rest = dotted.partition(".")
+        base = self.mod.imports.get(head, head)
+        return f"{base}.{rest}" if rest else base
+
+    def value(self, v: PyVal | None, depth: int = 0) -> symbols.Val:
+        """The :mod:`symbols` value of ``v`` in the scope of its own line."""
+        if v is None or depth > MAX_DEPTH:
+            return None
+        if v.kind == "str":
+            return symbols.lit(v.text)
+        if v.kind == "cat":
+            return symbols.cat([self.value(p, depth + 1) for p in v.parts])
+        if v.kind == "name":
+            return self._name(v.text, v.src.line, depth)
+        for c in ([v.call] if v.call else []) + v.calls:
+            g = self.getter(c)
+            if g is not None:
+                return ("param", g[1], g[0], None)
+        if v.call is not None:
+            f = self.full(v.call.func)
+            if f in ("rospy.get_name", "rospy.names.get_name") or v.call.func.endswith("get_fully_qualified_name"):
+                return symbols.NODE
+            if f == "str" and len(v.call.args) == 1:
+                return self.value(v.call.args[0], depth + 1)
+            if f == "os.path.join" and v.call.args:
+                parts: list[symbols.Val] = []
+                for k, a in enumerate(v.call.args):
+                    parts += ([symbols.lit("/")] if k else []) + [self.value(a, depth + 1)]
+                return symbols.cat(parts)
+        return None
+
+    def _name(self, name: str, line: int, depth: int) -> symbols.Val:
+        f = self.fn_at(line)
+        if name.startswith("self.") and name.count(".") == 1:
+            return ("field", self.unit_at(line), name[5:])
+        if f is not None and name in f[3]:
+            return ("arg", f"{self.shown}::{f[0]}", f[3].index(name))
+        for key in ([("local", f[0], name)] if f is not None else []) + [("module", name)]:
+            if key in self.binds:
+                return self._one(self.binds[key], depth)
+        head = name.split(".")[0]
+        if head in self.mod.imports:
+            origin = self.full(name)
+            if origin.split(".")[0] in _ROS:
+                return None
+            return ("ext", origin)
+        return None
+
+    def _one(self, vals: list[PyVal], depth: int) -> symbols.Val:
+        got = {self.value(x, depth + 1) for x in vals}
+        return next(iter(got)) if len(got) == 1 else None
+
+    def getter(self, c: PyCall) -> tuple[str | None, str] | None:
+        """``(default, parameter)`` when call ``c`` reads a ROS parameter (``rospy.get_param``;
+        rclpy ``get_parameter``/``declare_parameter``: the node's ``~name``)."""
+        f = self.full(c.func) if c.func else ""
+        if not c.args or c.args[0].kind != "str":
+            return None
+        name = c.args[0].text
+        if f in ("rospy.get_param", "rospy.client.get_param"):
+            d = c.args[1] if len(c.args) > 1 else c.kwargs.get("default")
+            return (d.text if d is not None and d.kind == "str" else None), name
+        last = c.func.rsplit(".", 1)[-1]
+        if last in ("get_parameter", "declare_parameter", "get_parameter_or"):
+            p = "~" + name.lstrip("~")
+            d = c.args[1] if last != "get_parameter" and len(c.args) > 1 else None
+            return (d.text if d is not None and d.kind == "str" else self.declared.get(p)), p
+        return None
+
+    def fields(self) -> dict[tuple[str, str], list[symbols.Val]]:
+        """``{(unit, attribute): [value, ...]}`` of every ``self.x = ...`` of the file."""
+        return {(k[1], k[2]): [self.value(v) for v in vs] for k, vs in self.binds.items() if k[0] == "field"}
+
+    def consts(self) -> dict[str, symbols.Val]:
+        """``{name: value}`` of the module's constants (bound once, at module level)."""
+        out = {}
+        for k, vs in self.binds.items():
+            if k[0] == "module":
+                v = self._one(vs, 0)
+                if v is not None:
+                    out[k[1]] = v
+        return out
+
+    def callee(self, c: PyCall) -> str | None:
+        """The key of what call ``c`` calls: ``FILE::Cls.f`` for ``self.f(...)``,
+        ``FILE::Name`` for a class or function of this file, ``ext:pkg.mod.Name``
+        for an imported one; ``None`` for ROS, standard or unknown callees."""
+        f = c.func
+        if not f or f.startswith(("super()", ".")):
+            return None
+        if f.startswith("self.") and f.count(".") == 1:
+            cls = self.class_at(c.src.line)
+            return f"{self.shown}::{cls}.{f[5:]}" if cls else None
+        head = f.split(".")[0]
+        if "." not in f and (any(q == f for q, _a, _b in self.cls) or any(fn[0] == f for fn in self.fns)):
+            return f"{self.shown}::{f}"
+        if head in self.mod.imports:
+            origin = self.full(f)
+            return None if origin.split(".")[0] in _ROS else f"ext:{origin}"
+        return None

@@ -1,0 +1,2 @@
+#!/bin/sh
+avrdude -p m328p -c arduino -P "$1" -U flash:w:firmware.hex
