@@ -64,6 +64,7 @@ def cmd_check(args: argparse.Namespace) -> int:
     from .rcl.lint import lint
     from .rcl.parser import parse_files
     from .rcl.typecheck import check
+    from .system.services import unserved
     grouped = group_files(args.files, args.workspace, args.plan)
     for note in grouped.notes:
         print(note, file=sys.stderr)
@@ -75,11 +76,12 @@ def cmd_check(args: argparse.Namespace) -> int:
             print(f"{', '.join(scope.files)}: {scope.why}")
         try:
             specs = parse_files(scope.files)
-            check(specs)
+            checked = check(specs)
         except RclError as exc:
             errors += exc.diagnostics
             continue
         warnings += [d for s in specs for d in file_warnings(s)] + [d for s in specs for d in lint(s)]
+        warnings += unserved(checked)  # a call no node of the scope answers (W-unserved)
     if errors:  # the located errors only, as for one scope
         for d in errors:
             print(d, file=sys.stderr)

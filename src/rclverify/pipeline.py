@@ -56,6 +56,8 @@ def stage_check(ws: Workspace) -> dict[str, Any]:
     checked, model = ws.checked, ws.model
     texts = ContractTexts(ws)  # each file's lint and each node's RCL text, kept by the file's sha256
     warnings = [w for s in checked.specs for w in texts.lint(s)]
+    from .system.services import unserved
+    warnings += [d.to_json() for d in unserved(checked)]  # a call no node answers (W-unserved)
     write_sealed(ws.path(ws.DIAGNOSTICS), {"warnings": warnings})
     hashes: dict[str, str] = {}
     for name, snap in node_snapshots(ws, texts).items():
