@@ -103,11 +103,13 @@ def render_config(checked: Checked, ros_version: str, ros_nodes: Mapping[str, Ma
 
 
 def trace_files(root: Path, rel: str) -> list[str]:
-    """The files making up a trace (a bag directory's files, sorted), workspace-relative."""
+    """The regular files making up a trace (a bag directory's files, sorted),
+    workspace-relative; a FIFO, device or socket is never among them (hashing
+    it would block: :mod:`rclverify.traces.guard`)."""
     p = root / rel
     if p.is_dir():
         return sorted(f.relative_to(root).as_posix() for f in p.rglob("*") if f.is_file())
-    return [rel]
+    return [rel] if p.is_file() else []
 
 
 def trace_sha256(root: Path, rel: str) -> str:
