@@ -424,7 +424,7 @@ def cmd_bundle(args: argparse.Namespace) -> int:
             for problem in exc.problems:
                 print(f"{args.verify}: error: {problem}", file=sys.stderr)
             return 1
-        print(f"{args.verify}: {len(manifest['files'])} file(s) match MANIFEST.json")
+        print(f"{args.verify}: {len(manifest['files'])} file(s) match MANIFEST.json; every record's seal holds")
         return 0
     ws = _ws(args)
     with _run_lock(args):  # the report and the evidence it is checked against, as one run left them
