@@ -157,6 +157,18 @@ def test_the_online_engine_applies_the_same_rule(simple: Any) -> None:
     assert [(v.event, v.verdict) for v in got] == [(0, "satisfied"), (2, "violated")]
 
 
+def test_a_late_output_live_is_judged_by_its_own_stamp(simple: Any) -> None:
+    """Live, a message older than one already released is checked at the
+    clock; a green stamped before the reading 110 arrives late: it was
+    computed before the question, so it does not answer it."""
+    got: list[Any] = []
+    eng = OnlineEngine(simple, [simple.nodes["Sensor"]], {}, horizon=0.5, on_verdict=got.append)
+    eng.push("r", {"header": {"stamp": {"secs": 2, "nsecs": 0}}, "value": 110.0}, 2.0)
+    eng.push("status", {"header": {"stamp": {"secs": 1, "nsecs": 900_000_000}}, "level": "green"}, 2.05)
+    eng.tick(3.0)
+    assert eng.late == 1 and [v.verdict for v in got] == ["violated"]
+
+
 def test_the_deadline_monitor_applies_the_same_rule(tmp_path: Path) -> None:
     """r = 110 answered on the level topic only: the green current since r = 50
     is no part of the answer, so the deadline passes unanswered."""

@@ -365,7 +365,7 @@ class NodeMonitor:
         if group is None:
             group = self.pending[key] = _Group(inputs, ikey=ikey)
         group.events.append(ev)
-        group.ref = max(group.ref, ev.time)
+        group.ref = max(group.ref, ev.stamped)
         group.superseded = None  # the same question asked again: the answer to come answers both
         self._due = min(self._due, ev.time + self.horizon)
         if len(group.events) == 1:
@@ -385,7 +385,7 @@ class NodeMonitor:
         done: list[Any] = []
         rekey = False
         for key, g in self.pending.items():
-            answered = bool(fresh) and ev.time >= g.ref
+            answered = bool(fresh) and ev.stamped >= g.ref
             if answered:
                 g.outs.update(fresh)
                 rekey = True
