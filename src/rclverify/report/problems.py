@@ -291,7 +291,8 @@ def group_problems(report: Mapping[str, Any], items: Sequence[Mapping[str, Any]]
         if g["key"][0].startswith(OUTSTANDING_WHOLE) and len(g["members"]) > 1:
             _, backend, node = g["key"][0].split(":", 2)
             g["sentence"] = first_sentence(f"{len(g['members'])} {backend} obligations on the contract of {node} are "
-                                           f"{g['status']} (evidence outstanding): {g['sentence']}")
+                                           f"{g['status']} (evidence outstanding): {g['sentence']}",
+                                           SENTENCE_CHARS // 2)  # a summary: each finding holds its whole text
         if g["key"][0].startswith((mc.FAILED_PREFIX, mc.OUTSTANDING_PREFIX)):
             cex = next((str(r.get("value", "")) for m in g["members"]
                         for r in (by_id.get(m["id"]) or {}).get("counterexample") or [] if r.get("variable") == "lasso"), "")
