@@ -1,6 +1,7 @@
 """The assessor's bundle (``rclverify bundle``) and plan paths that leave the workspace."""
 from __future__ import annotations
 
+import hashlib
 import io
 import json
 import os
@@ -12,6 +13,8 @@ import pytest
 from rclverify.bundle.archive import read_members, verify_bundle, write_bundle
 from rclverify.bundle.manifest import MANIFEST, BundleError
 from rclverify.cli import main
+from rclverify.evidence.sealed import sealed
+from rclverify.evidence.store import dumps
 from rclverify.plan.errors import PlanError
 from rclverify.plan.load import load_plan
 
@@ -40,8 +43,9 @@ def _workspace(root: Path, plan: str = PLAN) -> Path:
         "backends/unrelated.txt": "not named by the plan\n",
         "reports/assurance.json": json.dumps({"summary": {"status": "failed", "headline": "1 obligation: 1 failed"}}),
         "reports/assurance.html": "<html></html>\n",
-        "artifacts/evidence/Sensor.g1.hoare.json": json.dumps(
-            {"input_hashes": {"backends/hoare/sensor.imp": "x", "backends/ajpf/never.log": "missing"}}),
+        "artifacts/evidence/Sensor.g1.hoare.json": dumps(sealed(
+            {"obligation": "Sensor.g1.hoare", "status": "failed",
+             "input_hashes": {"backends/hoare/sensor.imp": "x", "backends/ajpf/never.log": "missing"}})),
         "artifacts/.evidence.tmp": "half-written",
         "artifacts/cache/workspace.pickle": "machine-local pickled cache: never bundled",
         "dodo.py": "# tasks\n",
@@ -194,3 +198,55 @@ def test_cli_reports_a_plan_path_error_without_traceback(tmp_path: Path, capsys:
     err = capsys.readouterr().err
     assert err.startswith("contracts/plan.yaml:11:15: error: path '../x.csv' climbs out") and "Traceback" not in err
     assert not (tmp_path / "o.tar.gz").exists()
+
+
+RECORD = "artifacts/evidence/Sensor.g1.hoare.json"
+
+
+def _edited(text: bytes) -> bytes:
+    """The record with its status edited to discharged, its seal left as it was."""
+    return text.replace(b'"status": "failed"', b'"status": "discharged"')
+
+
+def test_verify_recomputes_each_record_seal(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """A record edited to discharged in the archive, the manifest edited to
+    match: every file matches its manifest entry, but the record's seal is
+    broken, so the bundle does not verify."""
+    _, out, manifest = _bundle(tmp_path)
+    members = read_members(out)
+    bad_record = _edited(members[RECORD])
+    assert bad_record != members[RECORD]
+    manifest["files"][RECORD] = {"sha256": hashlib.sha256(bad_record).hexdigest(), "bytes": len(bad_record)}
+    bad = tmp_path / "bad.tar.gz"
+    _rewrite(out, bad, {RECORD: bad_record, MANIFEST: dumps(manifest).encode()})
+    with pytest.raises(BundleError) as exc:
+        verify_bundle(bad)
+    assert exc.value.problems == [f"{RECORD}: seal broken: record altered outside rclverify: its content does not "
+                                  "match the sha256 rclverify wrote with it (run `doit verify` to produce it again)"]
+    assert main(["bundle", "--verify", str(bad)]) == 1
+    assert f"{bad}: error: {RECORD}: seal broken" in capsys.readouterr().err
+    # a record without its seal is no rclverify record either
+    unsealed = json.dumps({k: v for k, v in json.loads(members[RECORD]).items() if k != "record_sha256"}).encode()
+    manifest["files"][RECORD] = {"sha256": hashlib.sha256(unsealed).hexdigest(), "bytes": len(unsealed)}
+    _rewrite(out, bad, {RECORD: unsealed, MANIFEST: dumps(manifest).encode()})
+    with pytest.raises(BundleError, match="seal broken: record altered outside rclverify: it carries no seal"):
+        verify_bundle(bad)
+
+
+def test_a_json_file_rclverify_does_not_seal_is_not_a_record(tmp_path: Path) -> None:
+    ws = _workspace(tmp_path / "ws")
+    (ws / "artifacts" / "dafny").mkdir(parents=True)
+    (ws / "artifacts" / "dafny" / "tool-output.json").write_text('{"verified": 3}\n')
+    out = tmp_path / "b.tar.gz"
+    write_bundle(ws, load_plan(ws), out, tools=TOOLS)
+    assert "artifacts/dafny/tool-output.json" in verify_bundle(out)["files"]
+
+
+def test_no_bundle_of_a_record_whose_seal_is_broken(tmp_path: Path) -> None:
+    ws = _workspace(tmp_path / "ws")
+    rec = ws / RECORD
+    rec.write_bytes(_edited(rec.read_bytes()))
+    with pytest.raises(BundleError) as exc:
+        write_bundle(ws, load_plan(ws), tmp_path / "b.tar.gz", tools=TOOLS)
+    assert exc.value.problems[0].startswith(f"{RECORD}: seal broken: record altered outside rclverify")
+    assert not (tmp_path / "b.tar.gz").exists()

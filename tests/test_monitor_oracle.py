@@ -70,9 +70,13 @@ def _offline(run: str) -> list[tuple[Any, ...]]:
 def test_nominal_run_is_never_false_and_its_verdicts_are_the_offline_ones(oracle: Any) -> None:
     url, _ = oracle
     answers = _send_run(url, "nominal.jsonl")
-    assert {a["verdict"] for a in answers} <= {"currently_true", "currently_false"}
+    assert {a["verdict"] for a in answers} <= {"currently_true", "currently_false", "unknown"}
     assert "currently_false" in {a["verdict"] for a in answers}  # an inspection waiting for the sensor
-    assert answers[-1]["verdict"] == "currently_true"
+    # inspect(3) and inspect(5) arrive with the last waypoint's reading, and the new
+    # reading comes before any answer: which question the answer answers cannot be
+    # told (docs/monitors.md, "An answer comes after its question")
+    assert [a["verdict"] for a in answers].count("unknown") == 2
+    assert answers[-1]["verdict"] == "currently_false"  # inspect(6) the same, and the run ends within the horizon
     got = [(v["verdict"], v["guarantee"], v["time"]) for a in answers for v in a["rclverify"]]
     assert got == _offline("nominal.jsonl")
 

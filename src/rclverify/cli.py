@@ -64,6 +64,7 @@ def cmd_check(args: argparse.Namespace) -> int:
     from .rcl.lint import lint
     from .rcl.parser import parse_files
     from .rcl.typecheck import check
+    from .system.services import unserved
     grouped = group_files(args.files, args.workspace, args.plan)
     for note in grouped.notes:
         print(note, file=sys.stderr)
@@ -89,6 +90,7 @@ def cmd_check(args: argparse.Namespace) -> int:
             errors += [d for d in found if getattr(d, "severity", "error") == "error"]
             if note:
                 print(note, file=sys.stderr)
+        warnings += unserved(checked)  # a call no node of the scope answers (W-unserved)
     if errors:  # the located errors only, as for one scope
         for d in errors:
             print(d, file=sys.stderr)
@@ -431,7 +433,7 @@ def cmd_bundle(args: argparse.Namespace) -> int:
             for problem in exc.problems:
                 print(f"{args.verify}: error: {problem}", file=sys.stderr)
             return 1
-        print(f"{args.verify}: {len(manifest['files'])} file(s) match MANIFEST.json")
+        print(f"{args.verify}: {len(manifest['files'])} file(s) match MANIFEST.json; every record's seal holds")
         return 0
     ws = _ws(args)
     with _run_lock(args):  # the report and the evidence it is checked against, as one run left them

@@ -58,6 +58,8 @@ def stage_check(ws: Workspace) -> dict[str, Any]:
     warnings = [w for s in checked.specs for w in texts.lint(s)]
     from .system.units import connection_warnings  # one end of a connection declares a unit, the other none
     warnings += [d.to_json() for d in connection_warnings(checked, model.links)]
+    from .system.services import unserved
+    warnings += [d.to_json() for d in unserved(checked)]  # a call no node answers (W-unserved)
     write_sealed(ws.path(ws.DIAGNOSTICS), {"warnings": warnings})
     hashes: dict[str, str] = {}
     for name, snap in node_snapshots(ws, texts).items():

@@ -62,7 +62,8 @@ def write_bundle(root: Path, plan: Plan, out: Path, tools: Mapping[str, str] | N
 
     ``tools`` overrides :func:`.manifest.tool_versions` (tests).  Returns the
     manifest.  Raises :class:`BundleError` when the report has not been
-    written yet or a file comes from outside the workspace, ``OSError`` when
+    written yet, a file comes from outside the workspace or a record's seal
+    does not hold (:func:`seal_problem`), ``OSError`` when
     a file cannot be read or ``out`` cannot be written.
     """
     if not (root / "reports" / "assurance.json").is_file():
@@ -71,6 +72,10 @@ def write_bundle(root: Path, plan: Plan, out: Path, tools: Mapping[str, str] | N
     out_res = out.resolve()
     files = [f for f in files if (root / f).resolve() != out_res]
     contents = {f: (root / f).read_bytes() for f in files}
+    # a record whose seal does not hold says what rclverify never recorded: never handed to an assessor
+    broken = [p for f in files if is_record(f) and (p := seal_problem(f, contents[f]))]
+    if broken:
+        raise BundleError(broken)
     manifest = build_manifest(root, plan, files, missing, contents, tools if tools is not None else tool_versions())
     members = {MANIFEST: dumps(manifest).encode("utf-8"), **contents}
     out.parent.mkdir(parents=True, exist_ok=True)
@@ -148,15 +153,37 @@ MAX_MANIFEST_BYTES = 64 * 1024 * 1024
 _CHUNK = 1024 * 1024
 
 
+#: Largest record whose seal ``--verify`` checks (bytes): evidence records are a few KiB; a larger
+#: JSON record under ``artifacts/`` is named as not checked.
+MAX_RECORD_BYTES = 16 * 1024 * 1024
+
+
+def is_record(name: str) -> bool:
+    """Whether member ``name`` may be a sealed record: a JSON file under
+    ``artifacts/`` (its seal is checked when it has one, or must have one:
+    :func:`must_be_sealed`)."""
+    return name.startswith("artifacts/") and name.endswith(".json")
+
+
+def must_be_sealed(name: str) -> bool:
+    """Whether member ``name`` is a record rclverify always writes sealed:
+    an evidence record (``artifacts/evidence/<id>.json``) or one of
+    :func:`rclverify.evidence.sealed.is_sealed_path`."""
+    from ..evidence.sealed import is_sealed_path
+    return (name.startswith("artifacts/evidence/") and name.count("/") == 2 and name.endswith(".json")) \
+        or is_sealed_path(name)
+
+
 def _hash_stream(name: str, fh: Any, limit: int) -> tuple[str, int, bytes | None]:
     """``(sha256 hex, size, bytes or None)`` of the stream ``fh`` read in
     chunks of :data:`_CHUNK`: memory stays bounded whatever the member's
-    size.  The bytes are kept only for :data:`MANIFEST`.  Raises
-    :class:`BundleError` when more than ``limit`` bytes come out (a zip
-    member whose header understates its size)."""
+    size.  The bytes are kept only for :data:`MANIFEST` and for records
+    (:func:`is_record`) of at most :data:`MAX_RECORD_BYTES`, whose seals are
+    checked.  Raises :class:`BundleError` when more than ``limit`` bytes
+    come out (a zip member whose header understates its size)."""
     h = hashlib.sha256()
     size = 0
-    kept: list[bytes] | None = [] if name == MANIFEST else None
+    kept: list[bytes] | None = [] if name == MANIFEST or is_record(name) else None
     while chunk := fh.read(_CHUNK):
         size += len(chunk)
         if size > limit:
@@ -164,13 +191,17 @@ def _hash_stream(name: str, fh: Any, limit: int) -> tuple[str, int, bytes | None
         h.update(chunk)
         if kept is not None:
             kept.append(chunk)
+            if name != MANIFEST and size > MAX_RECORD_BYTES:
+                kept = None
     return h.hexdigest(), size, b"".join(kept) if kept is not None else None
 
 
-def scan_members(path: Path) -> tuple[bytes | None, dict[str, tuple[str, int]]]:
+def scan_members(path: Path, seals: list[str] | None = None) -> tuple[bytes | None, dict[str, tuple[str, int]]]:
     """``(MANIFEST.json bytes or None, {member: (sha256, size)})`` of the
     archive at ``path`` (tar.gz or zip), every member streamed and hashed in
-    chunks (bounded memory), nothing extracted to disk.
+    chunks (bounded memory), nothing extracted to disk.  When ``seals`` is
+    a list, every record member's seal is checked as it is read
+    (:func:`seal_problem`) and each problem appended to it.
 
     Raises :class:`BundleError` for an unreadable or corrupt archive, for
     members that are links, devices, absolute or ``..`` paths, or repeated,
@@ -198,8 +229,12 @@ def scan_members(path: Path) -> tuple[bytes | None, dict[str, tuple[str, int]]]:
         nonlocal manifest
         digest, size, data = _hash_stream(name, fh, limit)
         out[name] = (digest, size)
-        if data is not None:
+        if name == MANIFEST:
             manifest = data
+        elif seals is not None and is_record(name):
+            problem = seal_problem(name, data)
+            if problem:
+                seals.append(problem)
     try:
         for name, size, fh in _each_member(path, problems):
             record(name, fh, admit(name, size))
@@ -210,16 +245,44 @@ def scan_members(path: Path) -> tuple[bytes | None, dict[str, tuple[str, int]]]:
     return manifest, out
 
 
-def verify_bundle(path: Path) -> dict[str, Any]:
-    """Check the archive at ``path`` against its ``MANIFEST.json``.
+def seal_problem(name: str, data: bytes | None) -> str:
+    """Why the record member ``name`` (its bytes ``data``; ``None`` when it
+    was too large to keep) cannot be believed, or ``""``: its seal
+    (``record_sha256``, docs/integrity.md) does not match its content, it
+    has none though rclverify always seals it (:func:`must_be_sealed`), or
+    it cannot be read.  A JSON file with no seal that rclverify does not
+    seal (a tool's own output) is not a record: ``""``."""
+    from ..evidence.sealed import check_text
+    from ..evidence.store import SEAL
+    if data is None:
+        return f"{name}: larger than {MAX_RECORD_BYTES} bytes: its seal was not checked" if must_be_sealed(name) else ""
+    try:
+        text = data.decode("utf-8")
+        raw = json.loads(text)
+    except (UnicodeDecodeError, ValueError):
+        return f"{name}: seal broken: the record is not JSON text" if must_be_sealed(name) else ""
+    if not (isinstance(raw, dict) and SEAL in raw) and not must_be_sealed(name):
+        return ""
+    _, problem = check_text(text, "record")
+    return f"{name}: seal broken: {problem}" if problem else ""
 
-    Returns the manifest when every listed file is present with its sha256
-    and nothing else is in the archive.  Raises :class:`BundleError` listing
-    each changed, missing or extra file by name (and a missing or malformed
-    manifest, and a member too large to check, :func:`scan_members`).
-    Members are streamed: memory stays bounded whatever their size.
+
+def verify_bundle(path: Path) -> dict[str, Any]:
+    """Check the archive at ``path`` against its ``MANIFEST.json``, and
+    every record in it against its own seal.
+
+    Returns the manifest when every listed file is present with its sha256,
+    nothing else is in the archive and every record's seal holds.  Raises
+    :class:`BundleError` listing each changed, missing or extra file by
+    name, and each record whose seal does not hold (:func:`seal_problem`: a
+    record edited before it was packed, or in the archive with the manifest
+    edited to match, says what rclverify never recorded), and a missing or
+    malformed manifest, and a member too large to check
+    (:func:`scan_members`).  Members are streamed: memory stays bounded
+    whatever their size.
     """
-    manifest_bytes, members = scan_members(path)
+    seals: list[str] = []
+    manifest_bytes, members = scan_members(path, seals)
     if manifest_bytes is None:
         raise BundleError([f"{MANIFEST}: missing from the archive"])
     members.pop(MANIFEST, None)
@@ -235,6 +298,7 @@ def verify_bundle(path: Path) -> dict[str, Any]:
         elif (h := members[name][0]) != listed[name]:
             problems.append(f"{name}: changed (sha256 {h}, manifest says {listed[name]})")
     problems += [f"{name}: in the archive but not in the manifest" for name in sorted(set(members) - set(listed))]
+    problems += sorted(seals)
     if problems:
         raise BundleError(problems)
     return dict(manifest)

@@ -16,7 +16,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from fractions import Fraction
-from typing import Any, Sequence
+from typing import Any, Mapping, Sequence
 
 import z3
 
@@ -101,21 +101,53 @@ def hops(checked: Checked, node: str) -> list[Hop]:
 
 def chains(checked: Checked, model: SystemModel, path: Sequence[str]) -> tuple[list[tuple[Hop, ...]], str]:
     """Every chain of hops along ``path`` (D2's side condition (a)), and,
-    when there is none, the reason naming where the path breaks."""
+    when there is none, the reason naming where the path breaks.
+
+    A chain never goes through a service or action that a node ``calls``
+    and no node ``serves`` (:func:`rclverify.system.services.unserved_parts`):
+    a request to it reaches no one (it feeds no hop, whatever name the
+    system model matched it by), a response from it never comes (a hop
+    triggered by it never fires), and a chain whose last hop answers with
+    such a request ends nowhere.  When only such chains exist, the reason
+    names the call."""
+    from ..system.services import unserved_parts
+    dead = unserved_parts(checked)
+    found, why = _chains(checked, model, path, dead)
+    if found or not dead:
+        return found, why
+    through, _ = _chains(checked, model, path, {})
+    touched = sorted({dead[k] for c in through for h in c
+                      for k in [(h.node, h.trigger), *((h.node, o) for o in h.outputs)] if k in dead})
+    if through and touched:
+        return [], f"every chain goes through a call nobody answers: {'; '.join(touched)}"
+    return found, why
+
+
+def _chains(checked: Checked, model: SystemModel, path: Sequence[str],
+            dead: Mapping[tuple[str, str], str]) -> tuple[list[tuple[Hop, ...]], str]:
+    """:func:`chains` with the variables ``dead`` (``(node, var)``) carrying nothing."""
     for n in path:
         if n not in checked.nodes:
             return [], f"node {n!r} of the path has no contract"
-    partial: list[tuple[Hop, ...]] = [(h,) for h in hops(checked, path[0])]
+
+    def live(n: str) -> list[Hop]:
+        return [h for h in hops(checked, n) if (n, h.trigger) not in dead]
+
+    partial: list[tuple[Hop, ...]] = [(h,) for h in live(path[0])]
     if not partial:
         return [], f"{path[0]} has no guarantee with 'triggered by ... within ...'"
     for prev, n in zip(path, path[1:]):
-        fed = {(lk.from_var, lk.to_var) for lk in model.links_into(n) if lk.from_node == prev}
-        nxt = [c + (h,) for c in partial for h in hops(checked, n) if any((o, h.trigger) in fed for o in c[-1].outputs)]
+        fed = {(lk.from_var, lk.to_var) for lk in model.links_into(n)
+               if lk.from_node == prev and (prev, lk.from_var) not in dead}
+        nxt = [c + (h,) for c in partial for h in live(n) if any((o, h.trigger) in fed for o in c[-1].outputs)]
         if not nxt:
             return [], (f"no timed guarantee of {n} is triggered by an output of {prev}'s timed guarantees "
                         f"({', '.join(sorted({'out.' + o for c in partial for o in c[-1].outputs})) or 'none'})")
         partial = nxt
-    return partial, ""
+    ends = [c for c in partial if not any((c[-1].node, o) in dead for o in c[-1].outputs)]
+    if not ends:
+        return [], f"{path[-1]}'s timed guarantees answer with a call nobody answers"
+    return ends, ""
 
 
 def decide(checked: Checked, model: SystemModel, requirement: str, path: Sequence[str], within: Fraction,

@@ -32,6 +32,11 @@ its diagnosis record (:mod:`rclverify.diagnosis.build`, ``culprits``):
    :mod:`rclverify.report.unverified`) are one group of their own, keyed
    ``unverified:<Node>``, each guarantee a finding and a culprit at its
    location; a contract defect never absorbs them.
+5. outstanding evidence (inconclusive or pending, without a diagnosis) on a
+   node's whole contract from one backend, e.g. the recorded runs one
+   ``monitors`` entry checks, is one group, keyed
+   ``outstanding-contract:<backend>:<Node>`` (one cause, one row: each run is a
+   finding of it).
 
 5. an end-to-end deadline that is refuted or not decided
    (:mod:`rclverify.diagnosis.deadline`) is one group of its own, keyed
@@ -64,6 +69,9 @@ from typing import Any
 
 from ..evidence.records import SEVERITY
 from . import problems_mc as mc
+
+#: Key prefix of a group of outstanding evidence on a node's whole contract from one backend (rule 5).
+OUTSTANDING_WHOLE = "outstanding-contract:"
 
 _SOURCE = re.compile(r"^(.*?):(\d+)(?::(\d+))?$")
 #: Diagnosis kinds whose victim guarantee is a defect of the contract itself.
@@ -241,6 +249,9 @@ def group_problems(report: Mapping[str, Any], items: Sequence[Mapping[str, Any]]
         if ref in mc_obl:  # model-checking evidence without a diagnosis (inconclusive): outstanding, by guarantee
             direct.add(ref)
             roots = [mc.mc_key(mc_obl[ref], str(it["status"]))]
+        elif o is not None and not o.get("guarantee") and str(it["status"]) in ("inconclusive", "pending"):
+            roots = [f"{OUTSTANDING_WHOLE}{o.get('backend')}:{o.get('node')}"]  # rule 5
+            direct.add(ref)
         if it["kind"] == "derived property":
             ref = f"{ref}.derived"  # named fully: the derived property of the node, never the bare node name
             # not derived because a side condition of its cone is not discharged: that side condition's cause
@@ -311,6 +322,11 @@ def group_problems(report: Mapping[str, Any], items: Sequence[Mapping[str, Any]]
                 if rep.get("diff") not in diffs:
                     diffs.add(rep.get("diff"))
                     g["repairs"].append({"diagnosis": m["id"], "index": k})
+        if g["key"][0].startswith(OUTSTANDING_WHOLE) and len(g["members"]) > 1:
+            _, backend, node = g["key"][0].split(":", 2)
+            g["sentence"] = first_sentence(f"{len(g['members'])} {backend} obligations on the contract of {node} are "
+                                           f"{g['status']} (evidence outstanding): {g['sentence']}",
+                                           SENTENCE_CHARS // 2)  # a summary: each finding holds its whole text
         if g["key"][0].startswith((mc.FAILED_PREFIX, mc.OUTSTANDING_PREFIX)):
             cex = next((str(r.get("value", "")) for m in g["members"]
                         for r in (by_id.get(m["id"]) or {}).get("counterexample") or [] if r.get("variable") == "lasso"), "")

@@ -9,8 +9,20 @@ from .model import Note, Src, canon_type
 
 
 def bag_topics(path: Path, shown: str) -> tuple[dict[str, Any] | None, list[Note]]:
-    """``{"path", "topics": [{"name", "type", "count"}]}`` or a located error note."""
+    """``{"path", "topics": [{"name", "type", "count"}]}`` or a located error note.
+    Only regular files are opened (:func:`rclverify.traces.guard.check_trace_path`):
+    a bag that is, or whose reader would open, a FIFO, device or socket is an
+    error note; another such entry of a bag directory is skipped with a
+    warning note."""
     from rosbags.highlevel import AnyReader
+
+    from ..traces.events import TraceError
+    from ..traces.guard import check_trace_path
+    try:
+        skipped = check_trace_path(path)
+    except TraceError as exc:
+        return None, [Note(Src(shown), _entry_message(str(exc), path, "error"), "ROS-PARSE", "error")]
+    warnings = [Note(Src(shown), _entry_message(w, path, "warning"), "ROS-PARSE", "warning") for w in skipped]
     try:
         with AnyReader([path]) as reader:
             topics = [{"name": c.topic if c.topic.startswith("/") else "/" + c.topic,
@@ -22,4 +34,12 @@ def bag_topics(path: Path, shown: str) -> tuple[dict[str, Any] | None, list[Note
     for t in topics:
         merged[(t["name"], t["type"])] = merged.get((t["name"], t["type"]), 0) + t["count"]
     return {"path": shown, "topics": [{"name": n, "type": ty, "count": c}
-                                      for (n, ty), c in sorted(merged.items())]}, []
+                                      for (n, ty), c in sorted(merged.items())]}, warnings
+
+
+def _entry_message(text: str, path: Path, severity: str) -> str:
+    """``"<entry>: <reason>"`` from the guard's ``<path>/<entry>: <severity>: <reason>``
+    (the note is located at the bag; the entry is named inside it)."""
+    where, _, reason = text.partition(f": {severity}: ")
+    entry = where[len(str(path)):].lstrip("/")
+    return f"{entry}: {reason}" if entry else reason

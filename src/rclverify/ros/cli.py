@@ -12,6 +12,10 @@ import sys
 from pathlib import Path
 from typing import Any
 
+#: Seconds each call to a master may take by default (ros/master_rpc.py MASTER_TIMEOUT_S; not imported
+#: here, so that building the command line does not load the XML-RPC client)
+MASTER_TIMEOUT_S = 10.0
+
 
 def add_parsers(sub: Any) -> None:
     """Add the ``ros`` command and its subcommands to ``rclverify``'s parser."""
@@ -22,6 +26,8 @@ def add_parsers(sub: Any) -> None:
     _code_args(s)
     s.add_argument("--bag", action="append", default=[], metavar="BAG", help="recorded run: .bag, ROS 2 bag dir, .mcap")
     s.add_argument("--master", metavar="URI", help="also read the running ROS 1 master at URI (http://127.0.0.1:11311)")
+    s.add_argument("--timeout", type=_seconds, default=MASTER_TIMEOUT_S, metavar="S",
+                   help=f"seconds each call to the master may take (default {MASTER_TIMEOUT_S:g})")
     s.add_argument("--json", metavar="FILE", help="write the graph as JSON (docs/ros-graph.schema.json)")
     s.add_argument("--cache", metavar="DIR", help="per-file parse cache directory (e.g. artifacts/cache)")
     s.set_defaults(fn=cmd_scan)
@@ -30,6 +36,8 @@ def add_parsers(sub: Any) -> None:
                                   "master (--master) or a bag (--bag): exit 0 equal, 1 they differ, 2 usage")
     _code_args(d)
     d.add_argument("--master", metavar="URI", help="the running ROS 1 master (http://127.0.0.1:11311)")
+    d.add_argument("--timeout", type=_seconds, default=MASTER_TIMEOUT_S, metavar="S",
+                   help=f"seconds each call to the master may take (default {MASTER_TIMEOUT_S:g})")
     d.add_argument("--bag", metavar="BAG", help="a recorded run: .bag, ROS 2 bag dir, .mcap (topics and types only)")
     d.add_argument("--json", metavar="FILE", help="write both lists as JSON (docs/ros.md)")
     d.set_defaults(fn=cmd_diff)
@@ -39,6 +47,18 @@ def add_parsers(sub: Any) -> None:
     c.add_argument("--strict", action="store_true", help="exit 1 when a grounding error is found")
     c.add_argument("--json", metavar="FILE", help="write the findings as JSON")
     c.set_defaults(fn=cmd_check)
+
+
+def _seconds(text: str) -> float:
+    """A time limit in seconds: a finite number > 0 (argparse type; a usage error otherwise)."""
+    import math
+    try:
+        x = float(text)
+    except ValueError:
+        x = math.nan
+    if not (math.isfinite(x) and x > 0):
+        raise argparse.ArgumentTypeError(f"expected a finite number of seconds > 0, not {text!r}")
+    return x
 
 
 def _launch_args(items: list[str]) -> dict[str, str]:
@@ -86,7 +106,7 @@ def cmd_scan(args: argparse.Namespace) -> int:
     data: dict[str, Any] = g.to_json()
     if args.master:
         try:
-            mg = read_master(args.master)
+            mg = read_master(args.master, timeout=args.timeout)
         except MasterError as exc:
             print(f"{args.master}: error: {exc}", file=sys.stderr)
             return 1
@@ -127,7 +147,7 @@ def cmd_diff(args: argparse.Namespace) -> int:
         print(n, file=sys.stderr)
     if args.master:
         try:
-            running = read_master(args.master)
+            running = read_master(args.master, timeout=args.timeout)
         except MasterError as exc:
             print(f"{args.master}: error: {exc}", file=sys.stderr)
             return 1

@@ -1,19 +1,23 @@
 """The computation graph of a running ROS 1 system, read from its master
-through ``rosgraph``'s master API (``getSystemState``, ``getTopicTypes``,
+through the ROS Master API (``getSystemState``, ``getTopicTypes``,
 ``lookupService``; ROS Master API, wiki.ros.org/ROS/Master_API).
 
-Debian installs rosgraph for its own Python (``/usr/lib/python3/dist-packages``).
-When the running interpreter cannot import it, :func:`import_rosgraph`
-retries once with that directory appended to ``sys.path`` (appended, so it
-never shadows this interpreter's own packages).
+The master is spoken to directly over XML-RPC (:mod:`.master_rpc`), each
+call within :data:`~.master_rpc.MASTER_TIMEOUT_S` seconds and each answer
+checked for the shape the Master API gives it: a master that does not
+answer, or answers something malformed, is one :class:`MasterError`
+naming it, the call and the fault, never a hang or a traceback.
+(:func:`import_rosgraph` remains for the callers that need rospy's
+libraries; reading the master does not.)
 
 Services: ``getSystemState``'s third list gives each service and the nodes
 providing it (ROS 1 registers servers only, never clients).  The master
 does not know a service's type; like ``rosservice type`` it is read from
 the service itself, by the TCPROS probe (a connection header with
-``probe=1``; ROS wiki "ROS/TCPROS") through Debian's ``rosservice`` module.
-Without that module, or when a server does not answer, the type is ``None``
-and a located note says why.
+``probe=1``; ROS wiki "ROS/TCPROS"), each within
+:data:`~.master_rpc.PROBE_TIMEOUT_S` seconds and all of them within
+:data:`PROBES_BUDGET_S`.  When a server does not answer, the type is
+``None`` and a located note says why.
 
 Actions (actionlib, ROS 1 has no action registry): an action ``P`` runs on
 the topics ``P/goal``, ``P/cancel`` (the server subscribes) and
@@ -28,24 +32,18 @@ its topics (docs/ros.md, "Expected against observed").
 from __future__ import annotations
 
 import sys
+import time
 from typing import Any
 
 from . import names
+from .master_rpc import (MASTER_TIMEOUT_S, PROBE_TIMEOUT_S, MasterError, lookup_service, probe_service_type,
+                         system_state, topic_types)
 from .model import Graph, GraphEdge, GraphNode, Note, Src, canon_type
 
+__all__ = ["ACTION_SERVER_SUBSCRIBES", "ACTION_TOPICS", "INFRA_NODES", "INFRA_TOPICS", "MasterError",
+           "PROBES_BUDGET_S", "fold_actions", "import_rosgraph", "read_master", "service_type"]
+
 DEBIAN_DIST = "/usr/lib/python3/dist-packages"
-# nodes of the ROS 1 infrastructure itself, not part of the robot's graph
-INFRA_NODES = {"/rosout"}
-INFRA_TOPICS = {"/rosout", "/rosout_agg"}
-#: services every roscpp/rospy node offers for its own logging (ROS 1 infrastructure)
-INFRA_SERVICE_SUFFIXES = ("/get_loggers", "/set_logger_level")
-#: actionlib's topics under an action's name, and which of them the server subscribes to
-ACTION_TOPICS = ("goal", "cancel", "status", "feedback", "result")
-ACTION_SERVER_SUBSCRIBES = ("goal", "cancel")
-
-
-class MasterError(Exception):
-    """The master cannot be reached or rosgraph is not installed (reason in ``str``)."""
 
 
 def import_rosgraph() -> Any:
@@ -66,28 +64,32 @@ def import_rosgraph() -> Any:
         raise MasterError(f"rosgraph is not installed (apt-get install python3-rosgraph): {exc}") from None
 
 
-def _rosservice() -> Any | None:
-    """Debian's ``rosservice`` module (its TCPROS probe), or ``None`` when it does not import."""
-    import_rosgraph()  # puts Debian's dist-packages on the path when needed
-    try:
-        import rosservice  # type: ignore[import-not-found]
-        return rosservice
-    except Exception:  # ImportError, or rospy's own import-time errors
-        return None
+# nodes of the ROS 1 infrastructure itself, not part of the robot's graph
+INFRA_NODES = {"/rosout"}
+INFRA_TOPICS = {"/rosout", "/rosout_agg"}
+#: services every roscpp/rospy node offers for its own logging (ROS 1 infrastructure)
+INFRA_SERVICE_SUFFIXES = ("/get_loggers", "/set_logger_level")
+#: actionlib's topics under an action's name, and which of them the server subscribes to
+ACTION_TOPICS = ("goal", "cancel", "status", "feedback", "result")
+ACTION_SERVER_SUBSCRIBES = ("goal", "cancel")
+#: Seconds all the service probes of one reading of the master may take together.
+PROBES_BUDGET_S = 60.0
 
 
-def service_type(master: Any, name: str, probe: Any) -> tuple[str | None, str]:
+def service_type(uri: str, name: str, deadline: float, timeout: float = MASTER_TIMEOUT_S) -> tuple[str | None, str]:
     """``(type, "")`` of service ``name`` as ``pkg/srv/Type``, asked of the service itself
-    (TCPROS probe, ``rosservice.get_service_headers``), or ``(None, reason)``."""
-    if probe is None:
-        return None, "its type is not read: Debian's rosservice module is not installed (python3-rosservice)"
+    (``lookupService``, then the TCPROS probe), or ``(None, reason)``; nothing is asked
+    once the monotonic clock passed ``deadline``."""
+    left = deadline - time.monotonic()
+    if left <= 0:
+        return None, (f"its type is not read: the service probes took their time limit of {PROBES_BUDGET_S:g} s "
+                      "together")
     try:
-        uri = master.lookupService(name)
-        header = probe.get_service_headers(name, uri)  # connects with its own 5 s timeout
-    except Exception as exc:  # the server went away, refused, or sent no header
-        return None, f"its type is not read: the server did not answer the probe ({' '.join(str(exc).split())[:200]})"
-    t = header.get("type") if isinstance(header, dict) else None
-    return (canon_type(t, "srv"), "") if t else (None, "its type is not read: the probe's header has no type")
+        service_uri = lookup_service(uri, name, timeout=min(timeout, left))
+        t = probe_service_type(name, service_uri, timeout=min(PROBE_TIMEOUT_S, max(left, 0.1)))
+    except MasterError as exc:  # the server went away, refused, sent no header, or took too long
+        return None, f"its type is not read: {' '.join(str(exc).split())[:240]}"
+    return canon_type(t, "srv"), ""
 
 
 def _infra_service(name: str) -> bool:
@@ -111,21 +113,22 @@ def fold_actions(g: Graph) -> None:
                 node.subscribes[:] = [x for x in node.subscribes if x.topic not in parts]
 
 
-def read_master(uri: str, caller: str = "/rclverify", service_types: bool = True) -> Graph:
+def read_master(uri: str, caller: str = "/rclverify", service_types: bool = True,
+                timeout: float = MASTER_TIMEOUT_S) -> Graph:
     """The graph the master at ``uri`` knows: nodes, what each publishes and
     subscribes to with the registered type, the services each provides (type
     from the TCPROS probe when ``service_types``), and actions recognised on
     their topics (:func:`fold_actions`).  Infrastructure (``/rosout``, the
     logger services) is left out.  Every edge is located at ``Src(uri)``;
-    ``graph.notes`` holds why a service's type is unknown.  Raises
-    :class:`MasterError` when the master cannot be read."""
-    rosgraph = import_rosgraph()
-    master = rosgraph.Master(caller, master_uri=uri)
+    ``graph.notes`` holds why a service's type is unknown.  ``timeout``:
+    seconds each call to the master may take.  Raises :class:`MasterError`
+    when the master cannot be read within that limit or answers something
+    malformed."""
     try:
-        pubs, subs, srvs = master.getSystemState()
-        types = dict(master.getTopicTypes())
-    except Exception as exc:  # socket errors, master errors
-        raise MasterError(f"cannot read the master at {uri}: {' '.join(str(exc).split())}") from None
+        pubs, subs, srvs = system_state(uri, timeout)
+        types = topic_types(uri, timeout)
+    except MasterError as exc:
+        raise MasterError(f"cannot read the master at {uri}: {exc}") from None
     g = Graph()
     src = Src(uri, 1, 1)
 
@@ -142,8 +145,7 @@ def read_master(uri: str, caller: str = "/rclverify", service_types: bool = True
                     node_of(n)
                     continue
                 node_of(n).edges_of(kind).append(GraphEdge(topic, canon_type(types.get(topic)), src, None, topic))
-    probe = _rosservice() if service_types else None
-    said_missing = False
+    deadline = time.monotonic() + PROBES_BUDGET_S
     for service, providers in srvs:
         providers = [n for n in providers if n not in INFRA_NODES and n != caller]
         if _infra_service(service):
@@ -152,10 +154,9 @@ def read_master(uri: str, caller: str = "/rclverify", service_types: bool = True
             continue
         if not providers:
             continue
-        stype, why = service_type(master, service, probe) if service_types else (None, "")
-        if why and not (probe is None and said_missing):
+        stype, why = service_type(uri, service, deadline, timeout) if service_types else (None, "")
+        if why:
             g.notes.append(Note(src, f"service {service}: {why}", "ROS-MASTER"))
-            said_missing = said_missing or probe is None
         for n in providers:
             node_of(n).service_servers.append(GraphEdge(service, stype, src, None, service))
     fold_actions(g)

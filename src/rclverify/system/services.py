@@ -6,11 +6,20 @@ response (feedback, result) the other way round.  :func:`peers` answers, for
 one input of one node, which output of which node feeds it through a link;
 :func:`side_conditions` reports, located, a link whose two ends disagree on
 the ROS type, and a second server of one name.
+
+A client's call reaches a server only through the link: a node that
+``calls`` a service (or action) that no node ``serves`` sends its requests
+to no one and gets no response.  :func:`unserved` warns about it, located
+at the ``calls`` (``W-unserved``); :func:`unserved_parts` names the
+client's variables that such a link carries, so that a deadline chain
+through them is not proved (:mod:`rclverify.calculus.deadlines`).  A server
+no node calls is normal (a service is also called from the command line)
+and is not reported.
 """
 from __future__ import annotations
 
 from ..rcl import ast
-from ..rcl.errors import Diagnostic, error
+from ..rcl.errors import Diagnostic, error, warning
 from ..rcl.types import Checked
 
 
@@ -62,3 +71,31 @@ def side_conditions(checked: Checked) -> list[Diagnostic]:
             else:
                 server[key] = n
     return diags
+
+
+def _unserved_links(checked: Checked) -> list[tuple[str, ast.Link]]:
+    served = {(lk.kind, lk.name) for _, lk in _links(checked) if lk.role == "serves"}
+    return [(n, lk) for n, lk in _links(checked) if lk.role == "calls" and (lk.kind, lk.name) not in served]
+
+
+def unserved(checked: Checked) -> list[Diagnostic]:
+    """Located warnings (``W-unserved``), one per ``calls`` link whose
+    service or action no node of ``checked`` serves, in source order.
+    ``checked``: the type-checked contracts of one system."""
+    return [warning(lk.loc, f"{n} calls {lk.kind} {lk.name!r}, which no node serves: its "
+                    f"{'requests' if lk.kind == 'service' else 'goals'} reach no one and no response comes; "
+                    "a deadline through it is not proved", "W-unserved")
+            for n, lk in _unserved_links(checked)]
+
+
+def unserved_parts(checked: Checked) -> dict[tuple[str, str], str]:
+    """``(node, variable) -> reason`` for every variable a ``calls`` link to
+    an unserved service or action carries (the request or goal output, the
+    response, feedback or result inputs): what the client sends reaches no
+    one, what it waits for never comes."""
+    out: dict[tuple[str, str], str] = {}
+    for n, lk in _unserved_links(checked):
+        for v in lk.parts:
+            out.setdefault((n, v.name), f"{n} calls {lk.kind} {lk.name!r}, which no node serves "
+                                        f"({v.prefix}.{v.name} is part of that call)")
+    return out

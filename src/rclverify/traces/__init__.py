@@ -9,26 +9,34 @@ reader by the file's form.
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Iterator, Sequence
+from typing import Callable, Iterator, Sequence
 
 from .events import Event, TraceError
 
 
-def read_trace(path: Path, msg_dirs: Sequence[Path] = ()) -> Iterator[Event]:
+def read_trace(path: Path, msg_dirs: Sequence[Path] = (), *, streams: bool = False,
+               on_warning: Callable[[str], None] | None = None) -> Iterator[Event]:
     """Events of the trace at ``path`` in order (a generator: memory is flat).
 
     ``.jsonl``/``.log``/``.txt``/``.json`` files are ROSMonitoring logs;
     ``.bag``, ``.mcap``, ``.db3`` or a ROS 2 bag directory are bags, whose
     non-standard message types are read from the ``.msg`` files found under
-    ``msg_dirs``.  Raises :class:`TraceError` (located) for a file it cannot read.
+    ``msg_dirs``.  Only regular files are opened (:mod:`.guard`): a log may
+    also be a FIFO when ``streams`` (a log named on the command line); an
+    entry of a bag directory that is not a regular file and that the reader
+    never opens is skipped, each with a warning line passed to
+    ``on_warning``.  Raises :class:`TraceError` (located) for a trace it
+    cannot read, or one that could block the reader (a FIFO, a device).
     """
-    if path.is_file() and path.suffix in (".jsonl", ".log", ".txt", ".json"):
+    from .guard import LOG_SUFFIXES, check_trace_path
+    for w in check_trace_path(path, streams):
+        if on_warning is not None:
+            on_warning(w)
+    if not path.is_dir() and path.suffix in LOG_SUFFIXES:
         from .jsonl import read_jsonl
         return read_jsonl(path)
-    if path.exists():
-        from .bag import read_bag
-        return read_bag(path, msg_dirs)
-    raise TraceError(f"{path}: error: no such trace")
+    from .bag import read_bag
+    return read_bag(path, msg_dirs)
 
 
 __all__ = ["Event", "TraceError", "read_trace"]

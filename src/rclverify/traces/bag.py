@@ -21,6 +21,8 @@ def custom_types(msg_dirs: Sequence[Path]) -> dict[str, Any]:
     types: dict[str, Any] = {}
     for d in msg_dirs:
         for f in sorted(d.rglob("*.msg")):
+            if not f.is_file():  # a FIFO or device would block the read (traces/guard.py)
+                raise TraceError(f"{f}:1: error: not a regular file (a FIFO, device or socket): not read")
             name = f"{f.parent.parent.name}/msg/{f.stem}"
             try:
                 types.update(get_types_from_msg(f.read_text(encoding="utf-8"), name))

@@ -19,7 +19,11 @@ class Event:
     ``topic``  topic name without leading ``/``;
     ``fields`` the message's fields flattened beside the topic, as
                ROSMonitoring sends them (``{"posx": 1.0, "id": 3, ...}``);
-    ``where``  where it was read (``log.jsonl:12`` or ``run_bag: message 4``).
+    ``where``  where it was read (``log.jsonl:12`` or ``run_bag: message 4``);
+    ``stamp``  the message's own time when ``time`` is not it (``None``
+               otherwise): a live monitor checks a message that arrives too
+               late to be ordered at its clock, but whether it answers an
+               input event is decided by when it was stamped.
     """
 
     index: int
@@ -27,3 +31,9 @@ class Event:
     topic: str
     fields: Mapping[str, Any]
     where: str
+    stamp: float | None = None
+
+    @property
+    def stamped(self) -> float:
+        """The message's own time (s): :attr:`stamp` when set, else :attr:`time`."""
+        return self.time if self.stamp is None else self.stamp

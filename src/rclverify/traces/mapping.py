@@ -25,6 +25,11 @@ Which rule applies depends on the RCL variable's type:
 Which fields a topic's messages contribute, and in which order, is the
 plan's ``fields`` list for the topic (all fields in message order
 otherwise): bespoke rules in the paper's sense.
+
+A topic may be declared a **state** (``state: true``, e.g. a latched pose):
+only then may a node's output on it that was current before an input event
+stand in for the answer to that event (docs/monitors.md, "An answer comes
+after its question").
 """
 from __future__ import annotations
 
@@ -43,11 +48,14 @@ class MappingError(Exception):
 
 @dataclass(frozen=True)
 class TopicRule:
-    """The plan's options for one topic: ``fields`` (order), ``update``, ``default``."""
+    """The plan's options for one topic: ``fields`` (order), ``update``,
+    ``default``, ``state`` (its value persists and may answer a later input
+    event; an event topic's output answers only the input events before it)."""
 
     fields: tuple[str, ...] = ()
     update: str = "accumulate"
     default: Any = None
+    state: bool = False
 
 
 @dataclass
@@ -145,8 +153,9 @@ class RuleError(ValueError):
 
 
 def load_rules(raw: Any) -> dict[str, TopicRule]:
-    """Topic rules from the plan's ``topics`` mapping (``{topic: {fields, update, default}}``):
-    ``fields`` a list of field names, ``update`` ``accumulate`` or ``replace``.
+    """Topic rules from the plan's ``topics`` mapping (``{topic: {fields, update, default, state}}``):
+    ``fields`` a list of field names, ``update`` ``accumulate`` or ``replace``,
+    ``state`` a boolean (default false).
 
     Raises :class:`RuleError` (a ``ValueError``) naming the topic and the
     key at fault for a malformed rule (``topics`` not a mapping, ``fields``
@@ -168,5 +177,12 @@ def load_rules(raw: Any) -> dict[str, TopicRule]:
         if update not in ("accumulate", "replace"):
             raise RuleError(f"topic {topic}: update must be accumulate or replace, not {update!r}",
                             "topics", topic, "update")
-        out[str(topic).lstrip("/")] = TopicRule(tuple(str(f) for f in fields), update, spec.get("default"))
+        state = spec.get("state", False)
+        if not isinstance(state, bool):
+            raise RuleError(f"topic {topic}: state must be true or false, not {state!r}", "topics", topic, "state")
+        unknown = sorted(str(k) for k in spec if k not in ("fields", "update", "default", "state"))
+        if unknown:
+            raise RuleError(f"topic {topic}: unknown key {unknown[0]!r} (expected fields, update, default, state)",
+                            "topics", topic, unknown[0])
+        out[str(topic).lstrip("/")] = TopicRule(tuple(str(f) for f in fields), update, spec.get("default"), state)
     return out

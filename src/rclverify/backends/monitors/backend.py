@@ -103,11 +103,13 @@ def render_config(checked: Checked, ros_version: str, ros_nodes: Mapping[str, Ma
 
 
 def trace_files(root: Path, rel: str) -> list[str]:
-    """The files making up a trace (a bag directory's files, sorted), workspace-relative."""
+    """The regular files making up a trace (a bag directory's files, sorted),
+    workspace-relative; a FIFO, device or socket is never among them (hashing
+    it would block: :mod:`rclverify.traces.guard`)."""
     p = root / rel
     if p.is_dir():
         return sorted(f.relative_to(root).as_posix() for f in p.rglob("*") if f.is_file())
-    return [rel]
+    return [rel] if p.is_file() else []
 
 
 def trace_sha256(root: Path, rel: str) -> str:
@@ -250,8 +252,17 @@ def summary_line(res: NodeResult) -> str:
 
 
 def verdict_status(res: NodeResult, trace: str) -> tuple[str, str]:
-    """Evidence status and explanation for one node's verdicts on a trace."""
+    """Evidence status and explanation for one node's verdicts on a trace:
+    any ``violated`` -> ``failed``; else any ``inconclusive`` or ``open`` ->
+    ``inconclusive``; else nothing satisfied -> ``pending``; else
+    ``discharged``.  Assumption violations are added to the explanation
+    (blamed upstream or on the environment), whatever the status."""
     c = res.counts
+    blame = ""
+    if c["assumption violated"]:
+        a = res.first_assumption_violation or {}
+        blame = (f"; {c['assumption violated']} input event(s) violated the assumption (first at {a.get('where')}, "
+                 f"blamed on the {a.get('blame')}), so the node is not at fault for them")
     if c["violated"]:
         v: Mapping[str, Any] = res.first_violation or {}
         which = f"guarantee {v['guarantee']} ({v.get('formula', '')})" if v.get("guarantee") else "the guarantees"
@@ -260,18 +271,13 @@ def verdict_status(res: NodeResult, trace: str) -> tuple[str, str]:
     if c["inconclusive"]:
         i = res.first_inconclusive or {}
         return "inconclusive", (f"{c['inconclusive']} event(s) could not be decided; first at {i.get('where')}: "
-                                f"{i.get('reason')}")
+                                f"{i.get('reason')}{blame}")
     if c["open"]:
-        return "inconclusive", f"{c['open']} input event(s) were still unanswered when the trace ended"
+        return "inconclusive", f"{c['open']} input event(s) were still unanswered when the trace ended{blame}"
     if not c["satisfied"]:
         return "pending", (f"{trace} has no input event of {res.node} meeting its assumption "
                            f"({c['assumption violated']} violated it): nothing was checked")
-    extra = ""
-    if c["assumption violated"]:
-        a = res.first_assumption_violation or {}
-        extra = (f"; {c['assumption violated']} input event(s) violated the assumption (first at {a.get('where')}, "
-                 f"blamed on the {a.get('blame')}), so the node is not at fault for them")
-    return "discharged", f"all {c['satisfied']} input event(s) meeting the assumption were answered as guaranteed{extra}"
+    return "discharged", f"all {c['satisfied']} input event(s) meeting the assumption were answered as guaranteed{blame}"
 
 
 def _rel(target: NodeTarget, file: str) -> str:

@@ -10,16 +10,22 @@ Every message on an input topic is an *input event*:
   ``assumption violated`` (blamed on the environment or on the upstream
   node producing the input); true -> the event opens an obligation on the
   inputs as they are now;
-* the guarantees are evaluated at once on the outputs as they stand (outputs
-  persist until changed), and again at every later message on an output
-  topic, on the obligation's inputs and the current outputs; all true ->
-  ``satisfied``;
+* **an answer comes after its question** (docs/monitors.md): the guarantees
+  are evaluated on the obligation's inputs and the outputs published after
+  the event (later in the trace, stamped at or after it), at once and again
+  at every later output message; all true -> ``satisfied``.  An output
+  current before the event answered an earlier one and is no answer, unless
+  the mapping declares its topic a ``state`` (then its current value stands
+  in).  An obligation whose answer has not come on an output a guarantee
+  needs waits for it;
 * an obligation not satisfied within ``horizon`` seconds of its event is
   ``violated`` (``inconclusive`` when its last evaluation could not be
   decided).  The violating event reported is the last output event that
   failed the obligation before the node's next input event (the node's
   answer to it), with the guarantee that failed there, or "no output"
-  when none came;
+  when none came.  When the node's next input event came before any output
+  answered the event, and only the outputs after it failed, the verdict is
+  ``inconclusive``: those outputs answer the inputs as they stood then;
 * at the end of the trace, obligations still within their horizon are
   ``open``.
 
@@ -119,13 +125,24 @@ class Verdict:
 
 @dataclass
 class _Group:
-    """Pending input events with equal inputs: their events, deadlines and last outcome."""
+    """Pending input events with equal inputs and equal answers so far: their
+    events, the event outputs published since them (``outs``: only those may
+    answer), the latest event's time (``ref``: an output stamped before it is
+    no answer), deadlines and last outcome."""
 
     inputs: dict[str, Any]
     events: deque[Event] = field(default_factory=deque)
     last: tuple[Event, int, dict[str, Any]] | None = None  # (output event, failing guarantee, outputs)
     undecided: str = ""
     answered: bool = False  # a later input event arrived: the node's answer to these events is complete
+    outs: dict[str, Any] = field(default_factory=dict)
+    ref: float = float("-inf")
+    ikey: tuple[Any, ...] = ()
+    #: the next input event came before any output answered these events: the
+    #: outputs after it answer the inputs as they stood then
+    superseded: Event | None = None
+    #: a partial answer: (output event, guarantee, why it waits, the outputs that came)
+    waiting: tuple[Event, int, str, dict[str, Any]] | None = None
 
 
 @dataclass
@@ -206,6 +223,14 @@ class NodeMonitor:
         self.needed_inputs = sorted(k for k in self.values if k.startswith("in.") and
                                     (k in needed or k[3:] in needed))
         self._outputs = sorted(k for k in self.values if k.startswith("out."))
+        # outputs whose every topic the mapping declares a state: their current
+        # value may stand in for an answer; any other output answers only the
+        # input events before it (docs/monitors.md, "An answer comes after its
+        # question").  A node without inputs checks its outputs as they stand.
+        event_outs = {key for topic, vs in self.topics.items() for key, _, inp in vs
+                      if not inp and not rules.get(topic, TopicRule()).state}
+        self._state_outs = [k for k in self._outputs if k not in event_outs or not self.has_inputs]
+        self._state_set = frozenset(self._state_outs)
         self._keys = {p: [k for k in self.values if k.startswith(p)] for p in ("in.", "out.")}  # in state order
         # the dependency index: each formula's truth is a function of the I/O
         # variables it mentions, so its cached evaluations are keyed on those
@@ -276,13 +301,16 @@ class NodeMonitor:
     # -- streaming ---------------------------------------------------------------
     def feed(self, ev: Event) -> None:
         """Process one event: every event moves the clock (closing obligations
-        past their horizon); only events on the node's topics change its state."""
+        past their horizon); only events on the node's topics change its state.
+        An event's outputs answer the obligations opened before it, then its
+        inputs open a new one (an answer comes after its question)."""
         self.advance(ev.time)
         vs = self.topics.get(ev.topic)
         if vs is None:
             return
         self.result.events += 1
         is_input = False
+        changed: list[str] = []
         for key, typ, inp in vs:
             try:
                 self.values[key] = map_value(typ, ev.fields, self.rules.get(ev.topic, TopicRule()),
@@ -291,16 +319,23 @@ class NodeMonitor:
                 self._note_inconclusive(ev, 0, f"{key}: {exc}")
                 return
             is_input = is_input or inp
-        if is_input:
+            if not inp:
+                changed.append(key)
+        if changed:
+            self._output(ev, changed)
+        if is_input or (changed and not self.has_inputs):
             self._input(ev)
-        if any(not inp for _, _, inp in vs):
-            if not self.has_inputs:
-                self._input(ev)
-            self._output(ev)
+
+    def _state(self) -> dict[str, Any]:
+        """The outputs on state topics as they stand (observed ones only)."""
+        values = self.values
+        return {k: values[k] for k in self._state_outs if values[k] is not None}
 
     def _input(self, ev: Event) -> None:
         for g in self.pending.values():
             g.answered = True
+            if not g.outs and g.superseded is None:
+                g.superseded = ev
         inputs = self._observed("in.")
         missing = [k for k in self.needed_inputs if k not in inputs]
         if missing:
@@ -324,48 +359,90 @@ class NodeMonitor:
             if ok is None:
                 self._note_inconclusive(ev, 0, f"assumption undecided: {reason}")
                 return
-        key = tuple(inputs.items())
+        ikey = tuple(inputs.items())
+        key = (ikey, ())  # no answer yet: only a group that has none either is the same obligation
         group = self.pending.get(key)
         if group is None:
-            group = self.pending[key] = _Group(inputs)
+            group = self.pending[key] = _Group(inputs, ikey=ikey)
         group.events.append(ev)
+        group.ref = max(group.ref, ev.stamped)
+        group.superseded = None  # the same question asked again: the answer to come answers both
         self._due = min(self._due, ev.time + self.horizon)
         if len(group.events) == 1:
-            self._output(ev, only=key)
+            done: list[Any] = []
+            self._evaluate(key, group, ev, self._state(), done)
+            for k in done:
+                del self.pending[k]
 
-    def _output(self, ev: Event, only: Any = None) -> None:
-        done = []
-        groups = self.pending.items() if only is None else [(only, self.pending[only])]
-        outputs = self._observed("out.")
-        for key, g in groups:
-            values = dict(g.inputs)
-            values.update(outputs)
-            failed: tuple[int, str] | None = None
-            undecided = ""
-            waiting = False
-            for k, formula in enumerate(self.guarantees, 1):
-                ok, reason = self._truth(k, formula, values)
-                if ok is False:
-                    failed = (k, "")
-                    break
-                if ok is None:
-                    if reason.startswith("no value for out."):  # an output not seen yet: wait for it
-                        waiting = True
-                    else:
-                        undecided = f"guarantee {k}: {reason}"
-                    break
-            if waiting:
-                continue
-            if failed is None and not undecided:
-                for trigger in g.events:
-                    self._verdict("satisfied", trigger)
-                done.append(key)
-            elif failed is not None and (g.last is None or not g.answered):
-                g.last, g.undecided = (ev, failed[0], {k: v for k, v in values.items() if k.startswith("out.")}), ""
-            else:
-                g.undecided = undecided
+    def _output(self, ev: Event, changed: list[str]) -> None:
+        """Outputs ``changed`` were just set by ``ev``: they answer every pending
+        obligation whose question is not stamped after ``ev``; a state output's
+        new value is seen by every obligation."""
+        values = self.values
+        fresh = {k: values[k] for k in changed if k not in self._state_set and values[k] is not None}
+        state_changed = any(k in self._state_set for k in changed)
+        state = self._state()
+        done: list[Any] = []
+        rekey = False
+        for key, g in self.pending.items():
+            answered = bool(fresh) and ev.stamped >= g.ref
+            if answered:
+                g.outs.update(fresh)
+                rekey = True
+            if answered or state_changed:
+                self._evaluate(key, g, ev, state, done)
         for key in done:
             del self.pending[key]
+        if rekey:
+            self._rekey()
+
+    def _evaluate(self, key: Any, g: _Group, ev: Event, state: Mapping[str, Any], done: list[Any]) -> None:
+        """Evaluate group ``g``'s guarantees on its inputs, the state outputs and
+        the outputs that answered it; satisfied -> verdicts and ``key`` in ``done``."""
+        values = dict(g.inputs)
+        values.update(state)
+        values.update(g.outs)
+        failed: int | None = None
+        undecided = ""
+        for k, formula in enumerate(self.guarantees, 1):
+            ok, reason = self._truth(k, formula, values)
+            if ok is False:
+                failed = k
+                break
+            if ok is None:
+                if reason.startswith("no value for out."):  # no answer on that output yet: wait for it
+                    if g.outs and g.last is None:  # a partial answer: shown if nothing completes it
+                        g.waiting = (ev, k, reason, dict(g.outs))
+                    return
+                undecided = f"guarantee {k}: {reason}"
+                break
+        if failed is None and not undecided:
+            for trigger in g.events:
+                self._verdict("satisfied", trigger)
+            done.append(key)
+        elif failed is not None and (g.last is None or not g.answered):
+            g.last, g.undecided = (ev, failed, {k: v for k, v in values.items() if k.startswith("out.")}), ""
+        else:
+            g.undecided = undecided
+
+    def _rekey(self) -> None:
+        """Regroup the pending obligations by (inputs, answers so far): two groups
+        that now hold equal inputs and equal answers are one obligation from here on."""
+        merged: dict[Any, _Group] = {}
+        for g in self.pending.values():
+            key = (g.ikey, tuple(sorted(g.outs.items())))
+            h = merged.get(key)
+            if h is None:
+                merged[key] = g
+                continue
+            h.events = deque(sorted([*h.events, *g.events], key=lambda e: (e.time, e.index)))
+            h.ref = max(h.ref, g.ref)
+            h.last = h.last or g.last
+            h.waiting = h.waiting or g.waiting
+            h.undecided = h.undecided or g.undecided
+            h.answered = h.answered and g.answered
+            h.superseded = h.superseded if g.superseded is not None else None
+        self.pending = merged
 
     def advance(self, now: float) -> None:
         """Move the monitor's clock to ``now`` (s): obligations whose horizon has
@@ -394,8 +471,25 @@ class NodeMonitor:
             self._first_inconclusive(trigger, g.undecided)
             self._verdict("inconclusive", trigger, reason=g.undecided)
             return
+        if g.last is not None and g.superseded is not None and g.last[0].index > g.superseded.index:
+            reason = (f"the next input event ({g.superseded.where}) came before any output answered the input at "
+                      f"{trigger.where}; the outputs after it (guarantee {g.last[1]} false at {g.last[0].where}) "
+                      f"answer the inputs as they stood then, so this event's own answer cannot be told apart")
+            self._first_inconclusive(trigger, reason)
+            self._verdict("inconclusive", trigger, guarantee=g.last[1], reason=reason)
+            return
         first: dict[str, Any]
-        if g.last is None:
+        if g.last is None and g.waiting is not None:
+            out, k, why, outs = g.waiting
+            first = {
+                "event": out.index, "time": out.time, "where": out.where, "guarantee": k,
+                "formula": self._texts[k], "trigger": trigger.index,
+                "trigger_time": trigger.time, "trigger_where": trigger.where,
+                "values": self._rendered({**g.inputs, **outs}),
+                "reason": f"guarantee {k} is undecided on the outputs published after the input at "
+                          f"{trigger.where} (the last at {out.where}): {why}, and no output within "
+                          f"{self.horizon} s completed the answer"}
+        elif g.last is None:
             first = {
                 "event": trigger.index, "time": trigger.time, "where": trigger.where, "guarantee": None,
                 "formula": "", "values": self._rendered(g.inputs),

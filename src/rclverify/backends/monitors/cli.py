@@ -12,14 +12,14 @@ import argparse
 import json
 import sys
 from pathlib import Path
-from typing import Any
+from typing import Any, Iterable, Iterator
 
 from ...rcl.errors import RclError
 from ...rcl.types import Checked
 from ...traces import TraceError, read_trace
 from .backend import monitoring_details, summary_line, tool_versions, verdict_status
 from .check import check_trace
-from .deadlines import check_deadlines, deadline_status, has_deadlines
+from .deadlines import DeadlineMonitor, deadline_status, has_deadlines
 from .config import ConfigError, load_mapping
 
 
@@ -53,11 +53,23 @@ def monitor_command(args: argparse.Namespace, checked: Checked) -> int:
         return 2
     violated = False
     report: list[dict[str, Any]] = []
+    timed = [n for n in checked.nodes.values() if has_deadlines(n)]
     for trace in args.traces:
         path = Path(trace)
+        # one pass over the run feeds both checks (a log named here may be a stream, read once)
+        dmons = [DeadlineMonitor(checked, n, cfg.rules, horizon=cfg.horizon) for n in timed]
+
+        def tap(events: Iterable[Any]) -> Iterator[Any]:
+            for ev in events:
+                for m in dmons:
+                    m.feed(ev)
+                yield ev
         try:
             events, results = check_trace(checked, list(checked.nodes.values()),
-                                          read_trace(path, [root / d for d in cfg.msg_dirs]), cfg.rules, cfg.horizon)
+                                          tap(read_trace(path, [root / d for d in cfg.msg_dirs], streams=True,
+                                                         on_warning=lambda w: print(w, file=sys.stderr))),
+                                          cfg.rules, cfg.horizon)
+            dres = [m.finish() for m in dmons]
         except TraceError as exc:
             _emit(report, args.json)
             print(str(exc), file=sys.stderr)
@@ -76,14 +88,6 @@ def monitor_command(args: argparse.Namespace, checked: Checked) -> int:
             if not args.json:
                 print(f"{trace}: {summary_line(res)}")
                 print(f"  {status}: {explanation}")
-        timed = [n for n in checked.nodes.values() if has_deadlines(n)]
-        try:
-            dres = check_deadlines(checked, timed, read_trace(path, [root / d for d in cfg.msg_dirs]), cfg.rules,
-                                   horizon=cfg.horizon)
-        except Exception as exc:  # read once already: a second read failing is still a located message
-            _emit(report, args.json)
-            print(f"{trace}: error: the deadlines could not be checked: {type(exc).__name__}: {exc}", file=sys.stderr)
-            return 2
         for d in dres:
             status, explanation = deadline_status(d, trace)
             violated = violated or status == "failed"

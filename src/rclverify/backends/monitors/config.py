@@ -64,8 +64,10 @@ class MonitorConfig:
     ros_nodes: Mapping[str, Mapping[str, str]] = field(default_factory=dict)
 
     def msg_files(self, root: Path) -> list[str]:
-        """Workspace-relative ``.msg`` files under the message directories, sorted."""
-        return sorted(p.relative_to(root).as_posix() for d in self.msg_dirs for p in (root / d).rglob("*.msg"))
+        """Workspace-relative ``.msg`` files under the message directories, sorted
+        (regular files only: hashing a FIFO would block)."""
+        return sorted(p.relative_to(root).as_posix() for d in self.msg_dirs for p in (root / d).rglob("*.msg")
+                      if p.is_file())
 
 
 def is_seconds(value: Any) -> bool:

@@ -4,7 +4,9 @@ A guarantee ``G(phi) triggered by in.x within d`` (rule D1,
 docs/architecture.md) is monitored per trigger event: the event on ``in.x``
 with stamp ``t`` opens an obligation due at ``t + d``; the first later
 message on an output ``phi`` mentions, with ``phi`` true on the trigger's
-inputs and the outputs as they stand, answers it.  Verdicts, in
+inputs and the outputs published since the trigger (an output current
+before it answered an earlier question; only a topic the mapping declares a
+``state`` stands in with its current value), answers it.  Verdicts, in
 ROSMonitoring's terms:
 
 * ``true``: answered with a stamp ``<= t + d``;
@@ -82,6 +84,8 @@ class _Pending:
     stamp: float
     due: float
     inputs: dict[str, Any]
+    #: the outputs published after the trigger (stamp at or after it): only they answer it
+    outs: dict[str, Any] = field(default_factory=dict)
 
 
 @dataclass
@@ -141,6 +145,12 @@ class DeadlineMonitor:
             outs = frozenset(f"out.{e.name}" for e in subexpressions(cl.formula)
                              if isinstance(e, ast.Var) and e.prefix == "out")
             self.timed.append((k, cl, f"in.{cl.trigger.name}", outs, float(bound)))
+        # an output whose every topic the mapping declares a state may stand in
+        # with its current value; any other answers only triggers before it
+        event_outs = {key for topic, keys in self.bindings.items() for key, part in keys
+                      if key.startswith("out.") and (part or not rules.get(topic, TopicRule()).state)}
+        self.state_outs = frozenset(key for keys in self.bindings.values() for key, _ in keys
+                                    if key.startswith("out.") and key not in event_outs)
         self.values: dict[str, Any] = {}
         self.pending: list[_Pending] = []
         self.expired: deque[_Pending] = deque(maxlen=256)  # judged false, waiting for a late answer to show
@@ -183,6 +193,10 @@ class DeadlineMonitor:
             changed.append(key)
         outs = {c for c in changed if c.startswith("out.")}
         if outs:
+            fresh = {c: self.values[c] for c in outs if c not in self.state_outs}
+            for p in (*self.pending, *self.expired):
+                if stamp >= p.stamp:
+                    p.outs.update(fresh)
             self._answer(ev, stamp, outs)
         self.advance(stamp)
         for k, cl, trig, _, d in self.timed:
@@ -204,9 +218,7 @@ class DeadlineMonitor:
             if not (gouts & outs) or stamp < p.stamp:
                 keep.append(p)
                 continue
-            values = dict(p.inputs)
-            values.update({key: v for key, v in self.values.items() if key.startswith("out.")})
-            if evaluate(cl.formula, self.checked, self.node, values) is not True:
+            if evaluate(cl.formula, self.checked, self.node, self._visible(p)) is not True:
                 keep.append(p)
                 continue
             if stamp <= p.due:
@@ -223,9 +235,15 @@ class DeadlineMonitor:
         _, cl, _, gouts, _ = next(t for t in self.timed if t[0] == p.k)
         if not (gouts & outs) or stamp < p.stamp:
             return False
+        return evaluate(cl.formula, self.checked, self.node, self._visible(p)) is True
+
+    def _visible(self, p: _Pending) -> dict[str, Any]:
+        """What obligation ``p`` is judged on: its trigger's inputs, the state
+        outputs as they stand and the outputs published since its trigger."""
         values = dict(p.inputs)
-        values.update({key: v for key, v in self.values.items() if key.startswith("out.")})
-        return evaluate(cl.formula, self.checked, self.node, values) is True
+        values.update({key: v for key, v in self.values.items() if key in self.state_outs and v is not None})
+        values.update(p.outs)
+        return values
 
     def advance(self, now: float) -> None:
         """Move the clock to ``now`` (s); obligations due before it are ``false``."""

@@ -215,31 +215,43 @@ def run_ros1(run_factory: Callable[..., LiveRun], checked: Checked, nodes: list[
     ``close()``): its events and deadline verdicts go to the same log and
     verdict topic, its summary to the record's ``deadlines``.
     """
-    from .ros1 import RosUnavailable, contract_topics, flatten, import_rospy, message_class
+    from ...ros.master_rpc import MASTER_TIMEOUT_S
+    from .ros1 import (REGISTER_TIMEOUT_S, SHUTDOWN_TIMEOUT_S, RosUnavailable, bound_master_calls, check_master,
+                       contract_topics, finish_within, flatten, import_rospy, message_class, run_bounded)
     rospy = import_rospy()
     from std_msgs.msg import String
     topics = contract_topics(checked, nodes)
     classes = {t: message_class(typ, msg_dirs) for t, typ in topics.items()}  # fail early, located
     by_type = {c._type: c for c in classes.values()}  # type: ignore[attr-defined]
     import rosgraph
-    if not rosgraph.is_master_online():
-        raise RosUnavailable(f"no ROS master answers at {rosgraph.get_master_uri()} (start roscore, or set "
-                             "ROS_MASTER_URI)")
-    rospy.init_node(node_name, anonymous=False, disable_signals=True)
-    # synchronous: the engine thread writes each verdict to the subscribers'
-    # sockets itself; rospy's queued publisher hands every message to a writer
-    # thread and then yields the GIL (time.sleep(0)), which cost the engine
-    # thread a GIL hand-over per verdict (docs/monitors.md, "Live monitoring", "Threads")
-    import warnings
-    with warnings.catch_warnings():  # rospy warns about queue_size=None; here it is the choice made above
-        warnings.simplefilter("ignore", SyntaxWarning)
-        pub = rospy.Publisher(verdict_topic, String, queue_size=None)
-    lasts: dict[str, Any] = {}
-    for n in nodes:
-        lasts[n.name] = rospy.Publisher(f"{last_prefix}/{n.name}/last_verdict", String, queue_size=1, latch=True)
+    uri = rosgraph.get_master_uri()
+    # every call to the master is bounded and the registration waits in short
+    # steps, so a master that hangs neither holds the monitor nor makes it deaf
+    # to SIGTERM/SIGINT (ros1.py, "A master is an external peer")
+    bound_master_calls(rospy, uri, MASTER_TIMEOUT_S)
+    until = _time.monotonic() + REGISTER_TIMEOUT_S
+
+    def register_node() -> tuple[Any, dict[str, Any]]:
+        check_master(uri, "/" + node_name, MASTER_TIMEOUT_S)
+        rospy.init_node(node_name, anonymous=False, disable_signals=True)
+        # synchronous: the engine thread writes each verdict to the subscribers'
+        # sockets itself; rospy's queued publisher hands every message to a writer
+        # thread and then yields the GIL (time.sleep(0)), which cost the engine
+        # thread a GIL hand-over per verdict (docs/monitors.md, "Live monitoring", "Threads")
+        import warnings
+        with warnings.catch_warnings():  # rospy warns about queue_size=None; here it is the choice made above
+            warnings.simplefilter("ignore", SyntaxWarning)
+            pub = rospy.Publisher(verdict_topic, String, queue_size=None)
+        return pub, {n.name: rospy.Publisher(f"{last_prefix}/{n.name}/last_verdict", String, queue_size=1,
+                                             latch=True) for n in nodes}
+
+    try:
+        pub, lasts = run_bounded(stop, REGISTER_TIMEOUT_S, f"registering with the master at {uri}", register_node)
+    except RosUnavailable:
+        finish_within(lambda: rospy.signal_shutdown("monitor not started"), SHUTDOWN_TIMEOUT_S)
+        raise
     live = run_factory(publish=lambda text: pub.publish(String(text)),
-                              publish_last=lambda n, text: lasts[n].publish(String(text)))
-    calls = proxy(rospy, live, lambda text: pub.publish(String(text))) if proxy is not None else None
+                       publish_last=lambda n, text: lasts[n].publish(String(text)))
     decode_errors: dict[str, int] = {}
 
     def decode(topic: str, raw: Any) -> Mapping[str, Any] | None:
@@ -255,8 +267,27 @@ def run_ros1(run_factory: Callable[..., LiveRun], checked: Checked, nodes: list[
     # the callbacks only stamp and queue; one worker thread decodes, checks,
     # publishes and runs the timer (worker.py: why)
     worker = EngineWorker(live, decode, rospy.get_time, tick_s=tick_s).start()
-    subs = [rospy.Subscriber(t, rospy.AnyMsg, lambda raw, t=t: worker.offer(t, raw, rospy.get_time()),
-                             queue_size=10000, tcp_nodelay=True) for t in topics]
+    subs: list[Any] = []
+
+    def register_topics() -> Any:
+        calls = proxy(rospy, live, lambda text: pub.publish(String(text))) if proxy is not None else None
+        for t in topics:
+            subs.append(rospy.Subscriber(t, rospy.AnyMsg, lambda raw, t=t: worker.offer(t, raw, rospy.get_time()),
+                                         queue_size=10000, tcp_nodelay=True))
+        return calls
+
+    def unsubscribe() -> None:
+        for s in list(subs):
+            s.unregister()
+
+    try:
+        calls = run_bounded(stop, max(until - _time.monotonic(), 0.1),
+                            f"subscribing at the master at {uri}", register_topics)
+    except RosUnavailable:
+        finish_within(unsubscribe, SHUTDOWN_TIMEOUT_S)
+        stop_and_record(worker, live, None, lambda _line: None)
+        finish_within(lambda: rospy.signal_shutdown("monitor not started"), SHUTDOWN_TIMEOUT_S)
+        raise
     out(f"monitoring {len(topics)} topic(s) for {len(nodes)} node(s); verdicts on {verdict_topic}")
     t0 = _time.monotonic()
     next_status = t0 + status_s
@@ -274,8 +305,10 @@ def run_ros1(run_factory: Callable[..., LiveRun], checked: Checked, nodes: list[
                 out(live.status_line())
                 next_status += status_s
     finally:
-        for s in subs:
-            s.unregister()
+        # unregistering asks the master: bounded, so a master that hangs now cannot hold the exit
+        if not finish_within(unsubscribe, SHUTDOWN_TIMEOUT_S):
+            out(f"rclverify monitor --live: warning: the master at {uri} did not confirm the unsubscriptions "
+                f"within {SHUTDOWN_TIMEOUT_S:g} s")
         deadlines = calls.close() if calls is not None else None  # before the log closes
         record = stop_and_record(worker, live, evidence, out)
         if deadlines is not None:
@@ -284,7 +317,7 @@ def run_ros1(run_factory: Callable[..., LiveRun], checked: Checked, nodes: list[
         if evidence is not None:
             atomic_write_text(evidence, json.dumps(record, indent=2, sort_keys=True) + "\n")
         out(live.status_line())
-        rospy.signal_shutdown("monitor stopped")
+        finish_within(lambda: rospy.signal_shutdown("monitor stopped"), SHUTDOWN_TIMEOUT_S)
     return record
 
 

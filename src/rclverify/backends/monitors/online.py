@@ -145,12 +145,13 @@ class OnlineEngine:
     def _release(self, upto: float) -> None:
         while self._heap and self._heap[0][0] <= upto:
             t, _, topic, fields, where = heapq.heappop(self._heap)
+            stamp = None
             if t < self._clock:
                 self.late += 1
                 self.max_late_s = max(self.max_late_s, self._clock - t)
-                t = self._clock
+                stamp, t = t, self._clock  # checked at the clock; its own stamp decides what it answers
             self._clock = t
-            ev = Event(self.released, t, topic, fields, where or f"message {self.released}")
+            ev = Event(self.released, t, topic, fields, where or f"message {self.released}", stamp)
             self.released += 1
             if self.on_event is not None:
                 self.on_event(ev)

@@ -20,6 +20,18 @@ generators themselves (the same ``.msg`` file the bag reader uses).  The
 workspace's definition wins, so the monitor and the nodes publishing with
 :func:`message_class` agree on the md5sum.
 
+**A master is an external peer.**  rospy calls the master without a time
+limit and retries a registration for ever: against a master that hangs on
+``registerPublisher`` the monitor waited for over ten minutes, deaf to
+SIGTERM and SIGINT.  So the monitor asks the master itself first
+(``getPid``, bounded: :func:`check_master`), gives rospy's master proxy a
+socket timeout (:func:`bound_master_calls`), does every registration in a
+daemon thread that the main thread waits for in short steps
+(:func:`run_bounded`: a signal stops the wait at once, and the whole
+registration has :data:`REGISTER_TIMEOUT_S` seconds), and unregisters and
+shuts rospy down within :data:`SHUTDOWN_TIMEOUT_S` seconds each
+(:func:`finish_within`).
+
 **Flattening.**  A message becomes the fields ROSMonitoring logs beside
 ``topic`` and ``time``: each slot by name, nested messages as dicts, ROS
 times/durations as ``{"secs", "nsecs"}``, arrays as lists (``uint8[]`` as a
@@ -29,15 +41,95 @@ from __future__ import annotations
 
 import importlib
 import sys
+import threading
+import time
 import types
 from pathlib import Path
-from typing import Any, Iterable, Mapping, Sequence
+from typing import Any, Callable, Iterable, Mapping, Sequence
 
 DEBIAN_DIST_PACKAGES = "/usr/lib/python3/dist-packages"
+#: Seconds the live monitor may take to register with the master (node, publishers, subscribers, services).
+REGISTER_TIMEOUT_S = 60.0
+#: Seconds unregistering and shutting rospy down may take when a run stops.
+SHUTDOWN_TIMEOUT_S = 5.0
 
 
 class RosUnavailable(Exception):
-    """ROS 1 (rospy) cannot be imported here; ``str`` says why and what to install."""
+    """ROS 1 (rospy) cannot be imported here, or the master cannot be used;
+    ``str`` says why and what to do."""
+
+
+class RosStopped(RosUnavailable):
+    """A signal stopped the monitor before it was registered with the master."""
+
+
+def check_master(uri: str, caller: str, timeout: float) -> None:
+    """Ask the master at ``uri`` for its pid within ``timeout`` seconds;
+    :class:`RosUnavailable` naming it and why when it does not answer."""
+    from ...ros.master_rpc import MasterError, call
+    try:
+        call(uri, "getPid", caller, timeout=timeout)
+    except MasterError as exc:
+        raise RosUnavailable(f"no ROS master answers at {uri}: {exc} (start roscore, or set ROS_MASTER_URI)") from None
+
+
+def bound_master_calls(rospy: Any, uri: str, timeout: float) -> bool:
+    """Give rospy's proxy for the master at ``uri`` a socket timeout of
+    ``timeout`` seconds (its cache of proxies, ``rospy.core.xmlrpcapi``),
+    so that no call of rospy's to the master waits for ever.  Returns
+    whether this rospy has the cache (an older or newer one is left as it
+    is; the registration is still bounded by :func:`run_bounded`)."""
+    from ...ros.master_rpc import TimeoutTransport
+    core = getattr(rospy, "core", None)
+    cache = getattr(core, "_xmlrpc_cache", None)
+    locked = getattr(core, "_LockedServerProxy", None)
+    if not isinstance(cache, dict) or locked is None:
+        return False
+    cache[uri] = locked(uri, transport=TimeoutTransport(timeout))
+    return True
+
+
+def run_bounded(stop: threading.Event, limit: float, what: str, fn: Callable[[], Any]) -> Any:
+    """``fn()`` in a daemon thread, waited for in steps of 50 ms: its value
+    (or its exception); :class:`RosStopped` as soon as ``stop`` is set (a
+    signal); :class:`RosUnavailable` once ``limit`` seconds passed.  The
+    thread is left behind on abort (a daemon: it never keeps the process)."""
+    box: dict[str, Any] = {}
+
+    def run() -> None:
+        try:
+            box["value"] = fn()
+        except BaseException as exc:  # noqa: BLE001 - handed to the caller
+            box["error"] = exc
+
+    t = threading.Thread(target=run, name="rclverify-ros1-register", daemon=True)
+    t.start()
+    deadline = time.monotonic() + limit
+    while t.is_alive():
+        if stop.is_set():
+            raise RosStopped(f"stopped by a signal while {what}; nothing was monitored")
+        if time.monotonic() > deadline:
+            raise RosUnavailable(f"{what} did not finish within its time limit of {limit:g} s; nothing was monitored")
+        t.join(0.05)
+    if "error" in box:
+        raise box["error"]
+    return box.get("value")
+
+
+def finish_within(fn: Callable[[], Any], limit: float = SHUTDOWN_TIMEOUT_S) -> bool:
+    """``fn()`` (unregistering, ``rospy.signal_shutdown``: calls to the
+    master) in a daemon thread, waited for at most ``limit`` seconds, so a
+    master that hangs cannot hold the exit.  Returns whether it finished
+    (its exception, if any, is dropped: the run is ending)."""
+    def run() -> None:
+        try:
+            fn()
+        except Exception:  # noqa: BLE001 - a shutdown step that fails leaves nothing to do
+            pass
+    t = threading.Thread(target=run, name="rclverify-ros1-shutdown", daemon=True)
+    t.start()
+    t.join(limit)
+    return not t.is_alive()
 
 
 def import_rospy() -> Any:
@@ -202,5 +294,6 @@ class LocalMaster:
                 self.proc.wait(5)
 
 
-__all__ = ["DEBIAN_DIST_PACKAGES", "LocalMaster", "RosUnavailable", "build_message", "contract_topics", "flatten", "free_port",
-           "import_rospy", "message_class"]
+__all__ = ["DEBIAN_DIST_PACKAGES", "LocalMaster", "REGISTER_TIMEOUT_S", "RosStopped", "RosUnavailable",
+           "SHUTDOWN_TIMEOUT_S", "bound_master_calls", "build_message", "check_master", "contract_topics", "flatten",
+           "free_port", "import_rospy", "message_class", "run_bounded", "finish_within"]

@@ -215,26 +215,36 @@ def main(argv: Sequence[str] | None = None) -> int:
     except (ProxyUsage, RosUnavailable) as exc:
         print(f"service_proxy: error: {exc}", file=sys.stderr)
         return 2
-    run = ProxyRun([DeadlineMonitor(checked, n, {}) for n in deadline_nodes(checked)], Path(args.log))
-    rospy.init_node("rclverify_service_monitor", anonymous=True, disable_signals=True)
-    now = lambda: rospy.Time.now().to_sec()  # noqa: E731  (the one clock of the proxy)
-    try:
-        keep = start_proxy(rospy, checked, forwards, dirs, run, now)  # noqa: F841  (kept for the run)
-    except (ProxyUsage, RosUnavailable) as exc:
-        print(f"service_proxy: error: {exc}", file=sys.stderr)
-        run.close()
-        rospy.signal_shutdown("usage")
-        return 2
+    from ...ros.master_rpc import MASTER_TIMEOUT_S
+    from .ros1 import REGISTER_TIMEOUT_S, bound_master_calls, check_master, finish_within, run_bounded
+    import rosgraph
+    uri = rosgraph.get_master_uri()
     stop = threading.Event()
     for sig in (signal.SIGINT, signal.SIGTERM):
         signal.signal(sig, lambda *_: stop.set())
+    run = ProxyRun([DeadlineMonitor(checked, n, {}) for n in deadline_nodes(checked)], Path(args.log))
+    now = lambda: rospy.Time.now().to_sec()  # noqa: E731  (the one clock of the proxy)
+    bound_master_calls(rospy, uri, MASTER_TIMEOUT_S)  # a master that hangs holds nothing (ros1.py)
+
+    def register() -> Any:
+        check_master(uri, "/rclverify_service_monitor", MASTER_TIMEOUT_S)
+        rospy.init_node("rclverify_service_monitor", anonymous=True, disable_signals=True)
+        return start_proxy(rospy, checked, forwards, dirs, run, now)
+
+    try:
+        keep = run_bounded(stop, REGISTER_TIMEOUT_S, f"registering with the master at {uri}", register)  # noqa: F841
+    except (ProxyUsage, RosUnavailable) as exc:
+        print(f"service_proxy: error: {exc}", file=sys.stderr)
+        run.close()
+        finish_within(lambda: rospy.signal_shutdown("usage"))
+        return 2
     print("service_proxy: ready", flush=True)
     end = time.monotonic() + args.duration if args.duration > 0 else float("inf")
     while not stop.is_set() and time.monotonic() < end:
         stop.wait(args.tick)
         run.tick(now())
     summary = run.close()
-    rospy.signal_shutdown("done")
+    finish_within(lambda: rospy.signal_shutdown("done"))
     return 1 if summary["false"] else 0
 
 

@@ -1,0 +1,289 @@
+"""An answer comes after its question (docs/monitors.md, "An answer comes
+after its question"): on a recorded or live run an input event is answered
+only by outputs published after it (in trace order, stamped at or after
+it); the output current before it answered an earlier input.  Only a topic
+the mapping declares a ``state`` stands in with its current value.
+
+The oracle at the end checks the streaming engine (groups of pending
+obligations, merged and re-keyed as answers come) against a direct,
+quadratic reading of the rule on random traces."""
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import pytest
+from hypothesis import given, settings, strategies as st
+
+from rclverify.backends.monitors.check import check_trace
+from rclverify.backends.monitors.deadlines import check_deadlines
+from rclverify.backends.monitors.online import OnlineEngine
+from rclverify.cli import main
+from rclverify.logic.evaluate import evaluate
+from rclverify.rcl.typecheck import load
+from rclverify.traces.events import Event
+from rclverify.traces.mapping import RuleError, load_rules
+
+SENSOR = """
+context { Stat : {red, orange, green} ; }
+node Sensor {
+  inputs( r : REAL, on : BOOL )
+  outputs( status : Stat, level : REAL )
+  topics( pkg/Reading r matches(in.r), pkg/Switch on matches(in.on),
+          pkg/Status status matches(out.status), pkg/Level level matches(out.level) )
+  assume( 0 <= in.r )
+  guarantee( in.on -> ((in.r < 120 -> out.status == green) and (120 <= in.r -> out.status == red)) )
+  guarantee( in.on -> out.level == in.r )
+}
+"""
+
+SIMPLE = """
+context { Stat : {red, orange, green} ; }
+node Sensor {
+  inputs( r : REAL )
+  outputs( status : Stat )
+  topics( pkg/Reading r matches(in.r), pkg/Status status matches(out.status) )
+  assume( 0 <= in.r )
+  guarantee( (0 <= in.r and in.r < 120 -> out.status == green) and (120 <= in.r -> out.status == red) )
+}
+"""
+
+
+@pytest.fixture(scope="module")
+def sensor(tmp_path_factory: pytest.TempPathFactory) -> Any:
+    p = tmp_path_factory.mktemp("answers") / "sensor.rcl"
+    p.write_text(SENSOR)
+    return load([p])
+
+
+@pytest.fixture(scope="module")
+def simple(tmp_path_factory: pytest.TempPathFactory) -> Any:
+    p = tmp_path_factory.mktemp("answers") / "simple.rcl"
+    p.write_text(SIMPLE)
+    return load([p])
+
+
+def _fields(topic: str, value: Any) -> dict[str, Any]:
+    return {"r": {"value": value}, "on": {"flag": value}, "status": {"level": value},
+            "level": {"value": value}}[topic]
+
+
+def events(rows: list[tuple[float, str, Any]]) -> list[Event]:
+    return [Event(k, t, topic, _fields(topic, v), f"run.jsonl:{k + 1}") for k, (t, topic, v) in enumerate(rows)]
+
+
+def run(checked: Any, rows: list[tuple[float, str, Any]], horizon: float = 1.0,
+        rules: Any = None) -> tuple[list[Any], Any]:
+    got: list[Any] = []
+    _, [res] = check_trace(checked, [checked.nodes["Sensor"]], events(rows), rules or {}, horizon, got.append)
+    return sorted(got, key=lambda v: v.event), res
+
+
+def by_event(verdicts: list[Any]) -> dict[int, str]:
+    return {v.event: v.verdict for v in verdicts}
+
+
+# -- the issue's case ------------------------------------------------------------
+
+def test_a_stale_green_does_not_answer_a_later_reading(simple: Any) -> None:
+    """r = 50 is answered green; r = 110 is answered red (wrong: < 120 is green).
+    The green still current when 110 arrives answered 50, not 110."""
+    got, res = run(simple, [(0.0, "r", 50.0), (0.1, "status", "green"), (1.0, "r", 110.0),
+                            (1.1, "status", "red"), (5.0, "r", 60.0), (5.1, "status", "green")])
+    assert by_event(got) == {0: "satisfied", 2: "violated", 4: "satisfied"}
+    v = next(x for x in got if x.event == 2)
+    assert v.guarantee == 1 and v.values["out.status"] == "red" and "run.jsonl:4" in v.reason
+    assert res.first_violation["where"] == "run.jsonl:4"
+
+
+def test_an_unanswered_reading_is_violated_after_the_horizon_and_open_at_the_end(simple: Any) -> None:
+    got, _ = run(simple, [(0.0, "r", 50.0), (0.1, "status", "green"), (1.0, "r", 100.0), (3.0, "r", 90.0)])
+    assert by_event(got) == {0: "satisfied", 2: "violated", 3: "open"}
+    assert "no output" in next(v for v in got if v.event == 2).reason
+
+
+def test_equal_stamps_are_ordered_by_the_trace(simple: Any) -> None:
+    """Same stamp: an output logged after the input answers it (one callback);
+    one logged before it was current before the question."""
+    got, _ = run(simple, [(1.0, "r", 50.0), (1.0, "status", "green")])
+    assert by_event(got) == {0: "satisfied"}
+    got, _ = run(simple, [(1.0, "status", "green"), (1.0, "r", 50.0), (3.0, "r", 130.0)])
+    assert by_event(got)[1] == "violated"
+
+
+def test_an_output_stamped_before_the_input_is_no_answer(simple: Any) -> None:
+    """Logged after the input but stamped before it: computed before the question."""
+    got, _ = run(simple, [(1.0, "r", 50.0), (0.9, "status", "green"), (3.0, "r", 130.0)])
+    assert by_event(got)[0] == "violated"
+
+
+def test_a_state_topic_stands_in_with_its_current_value(simple: Any) -> None:
+    rows = [(0.0, "r", 50.0), (0.1, "status", "green"), (1.0, "r", 60.0), (3.0, "r", 130.0)]
+    got, _ = run(simple, rows)
+    assert by_event(got)[2] == "violated"
+    got, _ = run(simple, rows, rules=load_rules({"status": {"state": True}}))
+    assert by_event(got)[2] == "satisfied"
+
+
+def test_a_question_superseded_before_any_answer_is_inconclusive_not_violated(simple: Any) -> None:
+    """Two readings before the sensor answers: its answer (red, right for 130)
+    answers the inputs as they stood then; whether it ever answered 50 cannot
+    be told: inconclusive with the reason, never satisfied."""
+    got, res = run(simple, [(0.0, "r", 50.0), (0.1, "r", 130.0), (0.2, "status", "red"), (5.0, "r", 10.0)])
+    assert by_event(got) == {0: "inconclusive", 1: "satisfied", 3: "open"}
+    assert "came before any output answered" in res.first_inconclusive["reason"]
+
+
+def test_a_node_that_never_answers_is_violated(simple: Any) -> None:
+    got, _ = run(simple, [(float(t), "r", 50.0 + t) for t in range(6)])
+    assert [v.verdict for v in got][:4] == ["violated"] * 4
+
+
+def test_a_partial_answer_names_the_output_it_waits_for(sensor: Any) -> None:
+    got, res = run(sensor, [(0.0, "on", True), (0.1, "r", 50.0), (0.2, "status", "green"), (3.0, "r", 60.0)])
+    v = next(x for x in got if x.event == 1)
+    assert v.verdict == "violated" and v.guarantee == 2 and "out.level" in v.reason
+    assert res.first_violation["values"]["out.status"] == "green"
+
+
+def test_the_online_engine_applies_the_same_rule(simple: Any) -> None:
+    got: list[Any] = []
+    eng = OnlineEngine(simple, [simple.nodes["Sensor"]], {}, horizon=0.5, on_verdict=got.append)
+    eng.push("r", {"value": 50.0}, 1.0)
+    eng.push("status", {"level": "green"}, 1.1)
+    eng.push("r", {"value": 110.0}, 2.0)
+    eng.push("status", {"level": "red"}, 2.1)
+    eng.tick(3.0)
+    assert [(v.event, v.verdict) for v in got] == [(0, "satisfied"), (2, "violated")]
+
+
+def test_a_late_output_live_is_judged_by_its_own_stamp(simple: Any) -> None:
+    """Live, a message older than one already released is checked at the
+    clock; a green stamped before the reading 110 arrives late: it was
+    computed before the question, so it does not answer it."""
+    got: list[Any] = []
+    eng = OnlineEngine(simple, [simple.nodes["Sensor"]], {}, horizon=0.5, on_verdict=got.append)
+    eng.push("r", {"header": {"stamp": {"secs": 2, "nsecs": 0}}, "value": 110.0}, 2.0)
+    eng.push("status", {"header": {"stamp": {"secs": 1, "nsecs": 900_000_000}}, "level": "green"}, 2.05)
+    eng.tick(3.0)
+    assert eng.late == 1 and [v.verdict for v in got] == ["violated"]
+
+
+def test_the_deadline_monitor_applies_the_same_rule(tmp_path: Path) -> None:
+    """r = 110 answered on the level topic only: the green current since r = 50
+    is no part of the answer, so the deadline passes unanswered."""
+    p = tmp_path / "timed.rcl"
+    p.write_text(SENSOR.replace(
+        "guarantee( in.on -> out.level == in.r )",
+        "guarantee( in.on -> out.level == in.r and (in.r < 120 -> out.status == green) ) "
+        "triggered by in.r within 1 s"))
+    checked = load([p])
+    got: list[Any] = []
+    [res] = check_deadlines(checked, [checked.nodes["Sensor"]],
+                            events([(0.0, "on", True), (0.1, "r", 50.0), (0.2, "status", "green"),
+                                    (0.3, "level", 50.0), (5.0, "r", 110.0), (5.1, "level", 110.0),
+                                    (9.0, "on", True)]), {}, got.append)
+    assert [v.verdict for v in got] == ["true", "false"] and res.counts["false"] == 1
+    got.clear()
+    [res] = check_deadlines(checked, [checked.nodes["Sensor"]],
+                            events([(0.0, "on", True), (0.1, "r", 50.0), (0.2, "status", "green"),
+                                    (0.3, "level", 50.0), (5.0, "r", 110.0), (5.1, "level", 110.0),
+                                    (9.0, "on", True)]), load_rules({"status": {"state": True}}), got.append)
+    assert [v.verdict for v in got] == ["true", "true"]
+
+
+def test_the_cli_reports_the_stale_answer_as_failed(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    (tmp_path / "contracts").mkdir()
+    (tmp_path / "contracts" / "s.rcl").write_text(SIMPLE)
+    (tmp_path / "run.jsonl").write_text(
+        '{"topic": "r", "time": 0.0, "value": 50.0}\n{"topic": "status", "time": 0.1, "level": "green"}\n'
+        '{"topic": "r", "time": 1.0, "value": 110.0}\n{"topic": "status", "time": 1.1, "level": "red"}\n'
+        '{"topic": "r", "time": 9.0, "value": 10.0}\n')
+    (tmp_path / "contracts" / "plan.yaml").write_text("contracts: [contracts/s.rcl]\n")
+    rc = main(["monitor", "-w", str(tmp_path), "--horizon", "2", str(tmp_path / "run.jsonl")])
+    out = capsys.readouterr().out
+    assert rc == 1 and "Sensor: 1 satisfied, 1 violated, 1 open" in out and "failed" in out
+
+
+def test_the_mapping_checks_the_state_flag() -> None:
+    assert load_rules({"pose": {"state": True}})["pose"].state is True
+    assert load_rules({"pose": {}})["pose"].state is False
+    with pytest.raises(RuleError) as e:
+        load_rules({"pose": {"state": "yes"}})
+    assert e.value.path == ("topics", "pose", "state")
+    with pytest.raises(RuleError) as e:
+        load_rules({"pose": {"latched": True}})
+    assert "unknown key 'latched'" in str(e.value)
+
+
+# -- oracle: the streaming engine against a direct reading of the rule ------------
+
+def reference(checked: Any, rows: list[tuple[float, str, Any]], horizon: float, state: frozenset[str]) -> dict[int, str]:
+    """Per input event, from the definition: satisfied iff at the event or at
+    some later message within the horizon, every guarantee is true on the
+    event's inputs, the state outputs as they stand and the other outputs
+    set by messages after the event (an output before it is no answer).
+    Unsatisfied: ``open`` when the run ends within the horizon, else
+    ``closed`` (violated or inconclusive: both say "not met")."""
+    node = checked.nodes["Sensor"]
+    evs = events(rows)
+    out_key = {"status": "out.status", "level": "out.level"}
+    in_key = {"r": "in.r", "on": "in.on"}
+    inputs: dict[str, Any] = {}
+    verdicts: dict[int, str] = {}
+    last = evs[-1].time
+
+    def value(ev: Event) -> Any:
+        return next(iter(ev.fields.values()))
+
+    for k, ev in enumerate(evs):
+        if ev.topic not in in_key:
+            continue
+        inputs[in_key[ev.topic]] = value(ev)
+        if len(inputs) < 2:
+            verdicts[k] = "incomplete input"
+            continue
+        if not inputs["in.r"] >= 0:
+            verdicts[k] = "assumption violated"
+            continue
+        current = {out_key[e.topic]: value(e) for e in evs[:k] if e.topic in out_key and e.topic in state}
+        fresh: dict[str, Any] = {}
+        points = [dict(inputs, **current)]
+        for e in evs[k + 1:]:
+            if e.time > ev.time + horizon:
+                break
+            if e.topic in out_key:
+                if e.topic in state:
+                    current[out_key[e.topic]] = value(e)
+                elif e.time >= ev.time:
+                    fresh[out_key[e.topic]] = value(e)
+                points.append({**inputs, **current, **fresh})
+        ok = any(all(evaluate(c.formula, checked, node, p) is True for c in node.node.guarantees) for p in points)
+        verdicts[k] = "satisfied" if ok else ("open" if ev.time + horizon >= last else "closed")
+    return verdicts
+
+
+ROW = st.one_of(
+    st.tuples(st.just("r"), st.sampled_from([50.0, 110.0, 130.0])),
+    st.tuples(st.just("on"), st.booleans()),
+    st.tuples(st.just("status"), st.sampled_from(["green", "red"])),
+    st.tuples(st.just("level"), st.sampled_from([50.0, 110.0, 130.0])),
+)
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.lists(st.tuples(st.sampled_from([0.0, 0.0, 0.3, 0.6, 1.2]), ROW), min_size=1, max_size=14),
+       st.sampled_from([frozenset(), frozenset({"level"}), frozenset({"status", "level"})]))
+def test_the_engine_agrees_with_a_direct_reading_of_the_rule(sensor: Any, steps: list[Any],
+                                                             state: frozenset[str]) -> None:
+    t = 0.0
+    rows = []
+    for dt, (topic, v) in steps:  # stamps never decrease; equal stamps are common
+        t += dt
+        rows.append((t, topic, v))
+    rules = load_rules({s: {"state": True} for s in state})
+    got, _ = run(sensor, rows, horizon=1.0, rules=rules)
+    want = reference(sensor, rows, 1.0, state)
+    mine = {v.event: ("closed" if v.verdict in ("violated", "inconclusive") else v.verdict) for v in got}
+    assert mine == want
+
