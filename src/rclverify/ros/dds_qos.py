@@ -39,7 +39,8 @@ class QosProfile:
     """The policies that decide matching (times in ns, :data:`INFINITE_NS` for none).
 
     ``depth`` is ``None`` for keep-all history; ``representations`` is the
-    data representation list (the writer uses the first, a reader accepts any)."""
+    data representation list in Cyclone's order, XCDR1 first (a writer uses
+    the first, a reader accepts any)."""
 
     reliable: bool = True
     durability: str = "volatile"

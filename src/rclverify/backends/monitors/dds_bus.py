@@ -20,7 +20,8 @@ located warning, once per publisher and reason, never silence:
 
 :class:`Bus` runs one thread (``rclverify-dds``): it waits on discovery and
 every tap's reader (a Cyclone wait set, which releases the GIL), updates the
-taps, and hands each sample to ``on_sample(tap, raw bytes, sample info,
+taps (discovery at most every ``period_s``, so a busy topic does not make
+it read discovery at every sample), and hands each sample to ``on_sample(tap, raw bytes, sample info,
 receipt time)`` (receipt: ``time.time_ns()``, an integer, so a recorded bag
 holds the very time the engine used); it never decodes or checks (the
 engine thread does, :mod:`.worker`).
@@ -109,18 +110,22 @@ class Bus:
     def _run(self) -> None:
         try:
             self._update()
+            next_poll = 0.0
             while not self._stop.is_set():
                 self.waitset.wait(int(self.period_s * 1e9))
-                if self.discovery.poll():
-                    self._update()
+                now = time.monotonic()
+                if now >= next_poll:  # discovery at most every period, not at every sample
+                    next_poll = now + self.period_s
+                    if self.discovery.poll():
+                        self._update()
                 self._drain()
-            self._drain()
+            self._drain(every=True)
         except BaseException as exc:  # noqa: BLE001 - kept for stop(): a dead reader thread must be said
             self.error = exc
 
-    def _drain(self) -> None:
+    def _drain(self, every: bool = False) -> None:
         for t in self.taps:
-            if t.reader is None:
+            if t.reader is None or not (every or t.condition.triggered):
                 continue
             while True:
                 got = take_raw(t.reader, 256)

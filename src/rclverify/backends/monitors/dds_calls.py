@@ -110,6 +110,7 @@ class CallBook:
         self.results: dict[str, NodeResult] = {}
         self.deadline_results: dict[str, DeadlineResult] = {}
         self.index = 0
+        self.emitted = 0  # verdicts given so far (a tick that gives one is logged, for the replay)
         self.now = float("-inf")
         self.counts = {"calls": 0, "goals": 0, "answered": 0, "unanswered": 0, "orphan_answers": 0, "evicted": 0,
                        "rejected": 0}
@@ -183,6 +184,7 @@ class CallBook:
         """Move every open call's clock to ``now`` (s): horizons and deadlines
         that passed are judged; calls done with are closed."""
         self.now = max(self.now, now)
+        before = self.emitted
         done = []
         for key, call in self.calls.items():
             for m in call.monitors:
@@ -194,6 +196,8 @@ class CallBook:
                 done.append(key)
         for key in done:
             self._close(key)
+        if self.emitted != before:  # this tick decided something: the replay must tick here too
+            self._log({"part": "tick", "time": now})
 
     def _close(self, key: tuple[Any, ...], evicted: bool = False) -> None:
         call = self.calls.pop(key)
@@ -219,16 +223,18 @@ class CallBook:
         for key in list(self.calls):
             self._close(key)
         return {"counts": dict(self.counts),
-                "nodes": [r.to_json() for r in self.results.values()],
-                "deadlines": [r.to_json() for r in self.deadline_results.values()],
+                "nodes": [self.results[n].to_json() for n in sorted(self.results)],
+                "deadlines": [self.deadline_results[n].to_json() for n in sorted(self.deadline_results)],
                 "false": sum(r.counts["false"] for r in self.deadline_results.values())}
 
     # -- sinks ---------------------------------------------------------------------------------
     def _verdict(self, v: Verdict) -> None:
+        self.emitted += 1
         if self.on_verdict is not None:
             self.on_verdict(v)
 
     def _deadline(self, v: DeadlineVerdict) -> None:
+        self.emitted += 1
         if self.on_deadline is not None:
             self.on_deadline(v)
 
@@ -252,23 +258,24 @@ def _add(total: NodeResult, one: NodeResult) -> None:
 
 
 def replay(book: CallBook, lines: Iterable[Mapping[str, Any]]) -> dict[str, Any]:
-    """Run ``book`` over a live log's lines in order and finish it: the
-    offline check of a live run's calls.  A call line with an ``index``
-    opens its call (a request or a goal) or answers it; every other line with
-    a ``time`` (the verdict lines, written at the live clock's time) moves the
-    clock there first, as the live timer had moved it, so a deadline that
-    expired before its late answer arrived expires here too."""
+    """Run ``book`` over a live log's call lines in order and finish it: the
+    offline check of a live run's calls.  A line with an ``index`` opens its
+    call (a request or a goal) or answers it; a ``tick`` line (written where
+    a live tick decided something) moves the clock as the live timer did, so
+    a deadline that expired before its late answer arrived expires here too,
+    with the same clock in its reason."""
     for x in lines:
-        t = x.get("time")
-        if x.get("kind") != "call" or "index" not in x:
-            if isinstance(t, (int, float)) and not isinstance(t, bool):
-                book.tick(float(t))
+        if x.get("kind") != "call":
             continue
-        name, part, key = str(x["link"]), str(x["part"]), tuple(x["key"])
-        if part in ("request", "goal"):
-            book.open(name, key, str(x["where"]).rsplit(" ", 1)[0], x["fields"], float(x["time"]), part)
-        else:
-            book.answer(key, part, x["fields"], float(x["time"]), part != "feedback", name)
+        part = str(x.get("part"))
+        if part == "tick":
+            book.tick(float(x["time"]))
+        elif "index" in x:
+            name, key = str(x["link"]), tuple(x["key"])
+            if part in ("request", "goal"):
+                book.open(name, key, str(x["where"]).rsplit(" ", 1)[0], x["fields"], float(x["time"]), part)
+            else:
+                book.answer(key, part, x["fields"], float(x["time"]), part != "feedback", name)
     return book.finish()
 
 
