@@ -172,7 +172,7 @@ def test_the_action_goal_feedback_and_result(run: dict[str, Any]) -> None:
     assert run["feedbacks"] == [{"progress": 0.5}] and run["result"] == {"arrived": True}
     mover = _call_verdicts(run["log"], "Mover")
     assert [v["verdict"] for v in mover] == ["satisfied"]
-    parts = [x["part"] for x in run["log"] if x.get("kind") == "call" and x["link"] == "move"]
+    parts = [x["part"] for x in run["log"] if x.get("kind") == "call" and x.get("link") == "move"]
     assert {"goal", "feedback", "result", "status"} <= set(parts)
     dl = [x["verdict"] for x in run["log"] if x.get("kind") == "deadline" and x["verdict"]["node"] == "Mover"]
     assert [v["verdict"] for v in dl] == ["true"] and 0.25 <= dl[0]["answer"] - dl[0]["trigger_stamp"] <= 2.0
