@@ -38,6 +38,7 @@ the bag recorder and the republisher of ``--enforce`` (docs/monitors.md,
 """
 from __future__ import annotations
 
+import functools
 import os
 import struct
 from dataclasses import dataclass, field
@@ -334,13 +335,18 @@ def write_raw(writer: Any, data: bytes, timestamp_ns: int | None = None) -> None
         raise DDSException(ret, "write")
 
 
+@functools.lru_cache(maxsize=1)
+def _humble() -> Any:
+    from rosbags.typesys import Stores, get_typestore
+    return get_typestore(Stores.ROS2_HUMBLE)
+
+
 def type_hash_user_data(ros_type_name: str, store: Any = None) -> bytes:
     """``typehash=RIHS01_...;`` for an endpoint's USER_DATA, as ROS 2 Iron and
     newer announce it (the REP-2011 type hash, computed by rosbags' type
     store); empty when the store does not know the type."""
     if store is None:
-        from rosbags.typesys import Stores, get_typestore
-        store = get_typestore(Stores.ROS2_HUMBLE)
+        store = _humble()
     try:
         return f"typehash={store.hash_rihs01(ros_type_name)};".encode()
     except Exception:  # a type the store lacks: no hash, as ROS 2 Humble sends none

@@ -64,6 +64,15 @@ class _Sink:
             self.book.tick(now - self.window)  # the topic engine's timer is as far behind (reorder window)
 
 
+def _status(live: LiveRun, calls: Mapping[tuple[str, str], int]) -> str:
+    """The topic engine's status line, then the calls' verdicts per node."""
+    line = live.status_line()
+    per: dict[str, list[str]] = {}
+    for (node, verdict), n in sorted(dict(calls).items()):  # copied at once: the engine thread adds to it
+        per.setdefault(node, []).append(f"{n} {verdict}")
+    return line + ("" if not per else " | calls: " + "; ".join(f"{n} {', '.join(v)}" for n, v in per.items()))
+
+
 def _version() -> str:
     try:
         return f"cyclonedds {version('cyclonedds')}"
@@ -88,12 +97,18 @@ def run_dds(run_factory: Callable[..., LiveRun], checked: Checked, nodes: list[C
     from .dds_bag import BagError
     try:
         types = TypeBook(type_dirs)
-        topics = contract_topics(checked, nodes)  # "/topic" -> "pkg/Type"
-        structs = {t.strip("/"): types.message(typ) for t, typ in topics.items()}
         string = types.message("std_msgs/String")
     except DdsTypeError as exc:
         raise DdsUnavailable(str(exc)) from None
-    where = {t.field.strip("/"): f"{t.loc.file}:{t.loc.line}:{t.loc.col}" for n in nodes for t in n.node.topics}
+    topics = contract_topics(checked, nodes)  # "/topic" -> "pkg/Type"
+    where = {t.field.strip("/"): f"{t.loc.file}:{t.loc.line}:{t.loc.col}" for n in reversed(nodes)
+             for t in reversed(n.node.topics)}  # the first mention of each topic
+    structs = {}
+    for t, typ in topics.items():
+        try:
+            structs[t.strip("/")] = types.message(typ)
+        except DdsTypeError as exc:
+            raise DdsUnavailable(f"{where.get(t.strip('/'), t)}: error: topic {t} ({typ}): {exc}") from None
     links = [(n, lk) for n in nodes for lk in n.node.links]
     for _n, lk in links:  # every linked type made now: a missing one is one located message, before joining
         try:
@@ -141,8 +156,11 @@ def run_dds(run_factory: Callable[..., LiveRun], checked: Checked, nodes: list[C
     extra = {"release": release} if enforce else {}
     live = run_factory(publish=send, publish_last=lambda n, text: lasts[n].write(string(data=text)), **extra)
     book = calls = None
+    call_counts: dict[tuple[str, str], int] = {}
     if links:
         def on_call_verdict(v: Any) -> None:
+            key = (v.node, v.verdict)
+            call_counts[key] = call_counts.get(key, 0) + 1
             d = {**v.to_json(), "call": True}
             live.note({"topic": VERDICT_LOG_TOPIC, "time": v.decided_at, "verdict": d})
             send(dumps(d))
@@ -190,7 +208,7 @@ def run_dds(run_factory: Callable[..., LiveRun], checked: Checked, nodes: list[C
             if worker.error is not None or bus.error is not None:
                 break  # a dead thread: stop and say so, never monitor on silently
             if status_s > 0 and _time.monotonic() >= next_status:
-                out(live.status_line())
+                out(_status(live, call_counts))
                 next_status += status_s
     finally:
         bus_error = ""
@@ -223,7 +241,7 @@ def run_dds(run_factory: Callable[..., LiveRun], checked: Checked, nodes: list[C
             record_["bag"] = recorder.close()
         if evidence is not None:
             atomic_write_text(evidence, json.dumps(record_, indent=2, sort_keys=True) + "\n")
-        out(live.status_line())
+        out(_status(live, call_counts))
         bus.close()
         dp.__del__()
     return record_
