@@ -301,12 +301,13 @@ def discovery_struct() -> Any:
     import_cyclonedds()
     from cyclonedds.idl import make_idl_struct
     from cyclonedds.idl import types as T
-    gid = make_idl_struct("Gid_", "rmw_dds_common::msg::dds_::Gid_", {"data": T.array[T.uint8, 16]})
+    gid16: Any = T.array[T.uint8, 16]  # type: ignore[misc]
+    gid = make_idl_struct("Gid_", "rmw_dds_common::msg::dds_::Gid_", {"data": gid16})
     node = make_idl_struct("NodeEntitiesInfo_", "rmw_dds_common::msg::dds_::NodeEntitiesInfo_", {
-        "node_namespace": T.bounded_str[256], "node_name": T.bounded_str[256],
-        "reader_gid_seq": T.sequence[gid], "writer_gid_seq": T.sequence[gid]})
+        "node_namespace": T.bounded_str[256], "node_name": T.bounded_str[256],  # type: ignore[misc]
+        "reader_gid_seq": T.sequence[gid], "writer_gid_seq": T.sequence[gid]})  # type: ignore[misc]
     return make_idl_struct("ParticipantEntitiesInfo_", DISCOVERY_TYPE, {
-        "gid": gid, "node_entities_info_seq": T.sequence[node]})
+        "gid": gid, "node_entities_info_seq": T.sequence[node]})  # type: ignore[misc]
 
 
 # -- raw samples ------------------------------------------------------------------------------

@@ -131,7 +131,8 @@ class EnforcingRun(LiveRun):
                  **kw: Any) -> None:
         self.guarded, self.release = dict(guarded), release
         self._raw: dict[int, bytes] = {}
-        self.gate_counts = {t: {"private": p, "released": 0, "blocked": 0} for t, p in self.guarded.items()}
+        self.gate_counts: dict[str, dict[str, Any]] = {t: {"private": p, "released": 0, "blocked": 0}
+                                                        for t, p in self.guarded.items()}
         super().__init__(*args, **kw)
 
     def stash(self, fields: Any, raw: bytes) -> None:
@@ -151,12 +152,11 @@ class EnforcingRun(LiveRun):
             counts["released"] += 1
             return
         counts["blocked"] += 1
-        line = {"topic": BLOCKED_LOG_TOPIC, "time": ev.time, "kind": "blocked", "guarded": ev.topic,
-                "where": ev.where, "verdict": verdict or {"verdict": "inconclusive", "reason": "its bytes were lost"}}
-        self._log.write(dumps(line) + "\n")
+        why: dict[str, Any] = verdict or {"verdict": "inconclusive", "reason": "its bytes were lost"}
+        self._log.write(dumps({"topic": BLOCKED_LOG_TOPIC, "time": ev.time, "kind": "blocked", "guarded": ev.topic,
+                               "where": ev.where, "verdict": why}) + "\n")
         if self.publish is not None:
-            self.publish(dumps({"kind": "blocked", "topic": ev.topic, "where": ev.where, "time": ev.time,
-                                **line["verdict"]}))
+            self.publish(dumps({"kind": "blocked", "topic": ev.topic, "where": ev.where, "time": ev.time, **why}))
 
 
 __all__ = ["BLOCKED_LOG_TOPIC", "EnforceUsage", "EnforcingRun", "judge", "parse_enforce"]

@@ -103,7 +103,7 @@ def run_dds(run_factory: Callable[..., LiveRun], checked: Checked, nodes: list[C
     topics = contract_topics(checked, nodes)  # "/topic" -> "pkg/Type"
     where = {t.field.strip("/"): f"{t.loc.file}:{t.loc.line}:{t.loc.col}" for n in reversed(nodes)
              for t in reversed(n.node.topics)}  # the first mention of each topic
-    structs = {}
+    structs: dict[str, Any] = {}
     for t, typ in topics.items():
         try:
             structs[t.strip("/")] = types.message(typ)
@@ -149,12 +149,15 @@ def run_dds(run_factory: Callable[..., LiveRun], checked: Checked, nodes: list[C
     latched = writer_profile(transient_local=True, depth=1)
     lasts = {n.name: bus.writer(topic_name(f"{last_prefix}/{n.name}/last_verdict"), string, latched, user)
              for n in nodes}
-    send = lambda text: pub.write(string(data=text))  # noqa: E731
+    def send(text: str) -> None:
+        pub.write(string(data=text))
 
     def release(topic: str, raw: bytes) -> None:
         write_raw(republish[topic], raw)  # made when the private topic's reader was (on_reader)
     extra = {"release": release} if enforce else {}
-    live = run_factory(publish=send, publish_last=lambda n, text: lasts[n].write(string(data=text)), **extra)
+    def send_last(node: str, text: str) -> None:
+        lasts[node].write(string(data=text))
+    live = run_factory(publish=send, publish_last=send_last, **extra)
     book = calls = None
     call_counts: dict[tuple[str, str], int] = {}
     if links:
@@ -183,7 +186,7 @@ def run_dds(run_factory: Callable[..., LiveRun], checked: Checked, nodes: list[C
             if calls is not None and key.startswith("call:"):
                 calls.handle(key, raw, source_ns / 1e9, received_ns / 1e9)
                 return None
-            fields = to_fields(structs[key].deserialize(raw))
+            fields: Mapping[str, Any] = to_fields(structs[key].deserialize(raw))
         except Exception:  # bytes that are not the contract's type: counted, never a crash
             decode_errors[key] = decode_errors.get(key, 0) + 1
             return None

@@ -103,14 +103,14 @@ class CallTaps:
             self._remember(request_id(s), gid)
             self._open(name, (gid,), f"{name.strip('/')} goal {gid}", to_fields(s.goal), stamp, "goal")
         elif part == "goal_reply":
-            gid = self._goal_of.pop(request_id(s), None)
-            if gid is not None and not s.accepted:
+            gid = self._goal_of.pop(request_id(s), "")
+            if gid and not s.accepted:
                 self.book.reject((gid,), stamp)
         elif part == "result_request":
             self._remember(request_id(s), bytes(s.goal_id.uuid).hex())
         elif part == "result_reply":
-            gid = self._goal_of.pop(request_id(s), None)
-            if gid is not None:
+            gid = self._goal_of.pop(request_id(s), "")
+            if gid:
                 self._answer((gid,), "result", to_fields(s.result), stamp, True, name, now)
                 self._note_status(name, gid, int(s.status), stamp)
         elif part == "feedback":

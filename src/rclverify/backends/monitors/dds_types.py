@@ -112,7 +112,8 @@ class TypeBook:
                 for f in sorted(d.glob(f"*.{sub}")):
                     if f.is_file():
                         self.table.add_file(f, d.parent.name, str(f), "debian", None)
-        self.table.notes = [n for n in self.table.notes if n.severity != "error" or not n.src.file.startswith(str(share))]
+        self.table.notes = [n for n in self.table.notes
+                            if n.severity != "error" or not n.src.file.startswith(str(share))]
 
     # -- structs ---------------------------------------------------------------------------
     def _info(self, name: str, used_by: str = "") -> Any:
@@ -128,7 +129,7 @@ class TypeBook:
         if kind == 1:
             base, bound = detail
             if base == "string":
-                return (T.bounded_str[int(bound)] if bound else str), None
+                return (T.bounded_str[int(bound)] if bound else str), None  # type: ignore[misc]
             if base in _BASE:
                 return (bool if base == "bool" else getattr(T, _BASE[base])), None
             raise DdsTypeError(f"{owner}: field {fname} has type {base}, which Cyclone's Python binding cannot carry")
@@ -140,8 +141,8 @@ class TypeBook:
         elem, inner = self._field_type(detail[0], owner, fname)
         n = int(detail[1])
         if kind == 3:
-            return T.array[elem, n], inner
-        return (T.sequence[elem, n] if n else T.sequence[elem]), inner
+            return T.array[elem, n], inner  # type: ignore[misc]
+        return (T.sequence[elem, n] if n else T.sequence[elem]), inner  # type: ignore[misc]
 
     def struct(self, name: str, used_by: str = "", header: bool = False) -> type:
         """The struct of type ``name`` (``pkg/msg/T``, ``pkg/srv/T_Request``,
@@ -231,7 +232,7 @@ class TypeBook:
         meta = getattr(ann, "__metadata__", ())
         tag = meta[0] if meta else None
         kind = type(tag).__name__
-        if kind == "array":
+        if kind == "array" and tag is not None:
             return [self._zero(tag.subtype, inner) for _ in range(tag.length)]
         if kind == "sequence":
             return []
