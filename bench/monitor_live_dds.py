@@ -144,13 +144,16 @@ def _run(tmp: Path, env: dict[str, str], rate: float, seconds: float, nodes: lis
         procs.append(p)
         return p
     rss: list[tuple[float, int]] = []
+    lis = None
     try:
-        lis = start([__file__, "--listener", str(tmp / f"verdicts{tag}.json")], f"listener{tag}.out")
+        if not memory:  # the memory run keeps no verdicts (10 minutes of them are hundreds of MB of JSON)
+            lis = start([__file__, "--listener", str(tmp / f"verdicts{tag}.json")], f"listener{tag}.out")
         mon = start(["-m", "rclverify.cli", "monitor", "--live", "--ros2", "-w", str(ROOT), "--horizon", "2.0",
                      "--reorder-window", "0", "--status", "0", "--log", str(tmp / f"live{tag}.jsonl"),
                      "--evidence", str(tmp / f"evidence{tag}.json"), *[x for n in nodes for x in ("--node", n)]],
                     f"monitor{tag}.out")
-        _wait_text(tmp / f"listener{tag}.out", "listening", 30)
+        if lis is not None:
+            _wait_text(tmp / f"listener{tag}.out", "listening", 30)
         _wait_text(tmp / f"monitor{tag}.out", "monitoring", 30)
         pub = start([__file__, "--publisher", str(tmp / f"sent{tag}.json"), "--rate", str(rate), "--seconds",
                      str(seconds), *[x for n in nodes for x in ("--node", n)]], f"publisher{tag}.out")
@@ -163,13 +166,17 @@ def _run(tmp: Path, env: dict[str, str], rate: float, seconds: float, nodes: lis
         time.sleep(2.5)  # the horizon passes; the timer resolves what waits
         cpu = _cpu_seconds(mon.pid)
         _stop(mon, signal.SIGINT)
-        _stop(lis)
+        if lis is not None:
+            _stop(lis)
     finally:
         for p in procs:
             _stop(p)
+    record = json.loads((tmp / f"evidence{tag}.json").read_text())
+    if memory:
+        (tmp / f"live{tag}.jsonl").unlink()
+        return {"sent": json.loads((tmp / f"sent{tag}.json").read_text()), "record": record, "cpu": cpu, "rss": rss}
     return {"sent": json.loads((tmp / f"sent{tag}.json").read_text()),
-            "verdicts": json.loads((tmp / f"verdicts{tag}.json").read_text()),
-            "record": json.loads((tmp / f"evidence{tag}.json").read_text()), "cpu": cpu, "rss": rss,
+            "verdicts": json.loads((tmp / f"verdicts{tag}.json").read_text()), "record": record, "cpu": cpu, "rss": rss,
             "log_topics": [json.loads(x)["topic"] for x in (tmp / f"live{tag}.jsonl").read_text().splitlines()]}
 
 
@@ -213,7 +220,7 @@ def bench_dds(rates: list[float], seconds: float, memory_s: float, nodes: list[s
         (tmp / "cyclonedds.xml").write_text(CONFIG)
         env = {**os.environ, "PYTHONPATH": str(ROOT / "src"), "CYCLONEDDS_URI": (tmp / "cyclonedds.xml").as_uri(),
                "ROS_DOMAIN_ID": str(random.SystemRandom().randint(1, 230))}
-        for rate in rates:
+        for rate in rates if seconds > 0 else ():
             res = _run(tmp, env, rate, seconds, nodes, memory=False)
             sent, rec = res["sent"]["sent"], res["record"]
             lat = _latency(res)
@@ -234,8 +241,10 @@ def bench_dds(rates: list[float], seconds: float, memory_s: float, nodes: list[s
             rss = res["rss"]
             if rss:
                 half = [r for t, r in rss if t >= rss[-1][0] / 2]
-                print(f"ros2: memory over {memory_s:.0f} s at {rates[0]:.0f} msg/s "
-                      f"({res['record']['events']} events): RSS {rss[0][1] / 1024:.1f} MiB at the start, peak "
+                sent = len(res["sent"]["sent"])
+                print(f"ros2: memory over {memory_s:.0f} s at {rates[0]:.0f} msg/s ({sent} published, "
+                      f"{res['record']['events']} checked, {res['record'].get('dropped_messages', 0)} dropped): "
+                      f"RSS {rss[0][1] / 1024:.1f} MiB at the start, peak "
                       f"{max(r for _, r in rss) / 1024:.1f} MiB, {rss[-1][1] / 1024:.1f} MiB at the end; growth over "
                       f"the second half {(half[-1] - half[0]) / 1024:+.1f} MiB")
 
@@ -248,6 +257,7 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--seconds", type=float, default=5.0)
     p.add_argument("--memory-seconds", type=float, default=600.0)
     p.add_argument("--smoke", action="store_true", help="a short memory run (20 s) and 3 s per rate")
+    p.add_argument("--memory-only", action="store_true", help="only the memory run")
     p.add_argument("--node", dest="nodes", action="append", default=[])
     p.add_argument("--publisher", type=Path, help=argparse.SUPPRESS)
     p.add_argument("--listener", type=Path, help=argparse.SUPPRESS)
@@ -257,6 +267,8 @@ def main(argv: list[str] | None = None) -> int:
     if a.listener:
         return listener(a.listener)
     seconds, memory = (3.0, 20.0) if a.smoke else (a.seconds, a.memory_seconds)
+    if a.memory_only:
+        seconds = 0.0
     bench_dds([float(r) for r in a.rates.split(",")], seconds, memory, a.nodes)
     return 0
 

@@ -176,6 +176,8 @@ def live_command(args: argparse.Namespace, checked: Any, cfg: Any, root: Path) -
         print(text if ": error: " in text else f"rclverify monitor --live: error: {text}", file=sys.stderr)
         return 2
     print(f"{log}: {record_['events']} event(s), {record_['verdicts']} verdict(s); sha256 {record_['sha256']}")
+    for n in record_.get("calls", {}).get("nodes", []):
+        print(f"calls: {n['node']}: {n['status']}: {n['explanation']}")
     if "deadlines" in record_:
         print(f"deadlines: {record_['deadlines']['false']} call(s) or goal(s) missed their deadline")
     for topic, c in record_.get("enforce", {}).items():
