@@ -40,6 +40,8 @@ pytest.importorskip("cyclonedds", reason="the cyclonedds binding is not installe
 
 from dds_ros2 import Ros2Participant, dds_env, domain_of, matched, wait_until  # noqa: E402
 
+from rclverify.ros.dds_qos import QosProfile  # noqa: E402
+
 from rclverify.backends.monitors.check import check_trace  # noqa: E402
 from rclverify.backends.monitors.dds_calls import CallBook, replay  # noqa: E402
 from rclverify.backends.monitors.dds_types import TypeBook  # noqa: E402
@@ -77,7 +79,7 @@ def run(tmp_path_factory: pytest.TempPathFactory) -> Iterator[dict[str, Any]]:
          "--duration", "60"],
         env={**os.environ, **env, "PYTHONPATH": str(REPO / "src")}, cwd=tmp, stdout=out.open("wb"),
         stderr=subprocess.STDOUT, start_new_session=True)
-    ros = None
+    ros = other = None
     try:
         wait_until(lambda: "monitoring" in out.read_text() or monitor.poll() is not None, 30, "the monitor started")
         assert monitor.poll() is None, out.read_text()
@@ -96,6 +98,11 @@ def run(tmp_path_factory: pytest.TempPathFactory) -> Iterator[dict[str, Any]]:
         ros.action_server(mover, "/move", "rclverify_examples/Move",
                           lambda goal: ([(0.3, {"progress": 0.5})], {"arrived": True}))
         send = ros.action_client(mission, "/move", "rclverify_examples/Move")
+        echo = ros.subscriber(ros.node("echo"), "/rclverify/verdict", "std_msgs/String")  # `ros2 topic echo`
+        # another participant publishes /range with another type: its messages cannot be heard, and that is said
+        other = Ros2Participant(types, domain_of(env))
+        imposter = other.publisher(other.node("imposter"), "/range", "std_msgs/Float64")
+        other.announce()
         ros.announce()
         # the monitor's readers are made when it discovers a publisher: wait until they are matched
         wait_until(lambda: all(matched(w) >= 1 for w in (limit, speed, rng, *send.writers))
@@ -118,6 +125,13 @@ def run(tmp_path_factory: pytest.TempPathFactory) -> Iterator[dict[str, Any]]:
         wait_until(lambda: got.extend(s.data for s in heard.take(N=16)) or len(got) >= 2, 5, "the released speeds")
         time.sleep(0.3)
         got.extend(s.data for s in heard.take(N=16))
+        echoed = [json.loads(m.data) for m in echo.take(N=1000)]
+        imposter_heard = matched(imposter)  # no reader of the monitor matches it
+        # a subscriber that comes late still gets each node's last verdict (transient-local: ROS 2's latching)
+        late = ros.reader(ros.node("late"), "rt/rclverify/Limiter/last_verdict", types.message("std_msgs/String"),
+                          QosProfile(reliable=True, durability="transient_local", depth=1))
+        latched: list[Any] = []
+        wait_until(lambda: latched.extend(late.take(N=4)) or bool(latched), 5, "the latched last verdict")
         _stop(monitor)
         code = monitor.returncode
     except BaseException:
@@ -125,11 +139,13 @@ def run(tmp_path_factory: pytest.TempPathFactory) -> Iterator[dict[str, Any]]:
         raise
     finally:
         _stop(monitor, signal.SIGKILL)
-        if ros is not None:
-            ros.close()
+        for p in (ros, other):
+            if p is not None:
+                p.close()
         mp.undo()
     log = [json.loads(x) for x in (tmp / "live.jsonl").read_text().splitlines()]
     yield {"tmp": tmp, "code": code, "out": out.read_text(), "log": log, "consumer": got, "replies": replies,
+           "echoed": echoed, "latched": json.loads(latched[-1].data), "imposter": imposter_heard,
            "feedbacks": feedbacks, "result": result, "record": json.loads((tmp / "live.json").read_text())}
 
 
@@ -191,7 +207,20 @@ def test_a_best_effort_publisher_is_heard(run: dict[str, Any]) -> None:
     assert qos["qos"]["reliability"] == "best_effort" and qos["samples"] == 3 and qos["publishers_heard"] == 1
     ranger = next(n for n in run["record"]["nodes"] if n["node"] == "Ranger")
     assert ranger["counts"]["satisfied"] == 3
-    assert run["record"]["warnings"] == []
+    # a publisher of another type on the topic: a located warning, never silence
+    warnings = run["record"]["warnings"]
+    assert len(warnings) == 1 and warnings[0].startswith("contracts/dds.rcl:20:11: warning: range: node /imposter ")
+    assert "publishes std_msgs::msg::dds_::Float64_" in warnings[0] and "not heard" in warnings[0]
+    assert run["imposter"] == 0 and warnings[0] in run["out"]
+
+
+def test_verdicts_are_on_the_bus(run: dict[str, Any]) -> None:
+    """``rt/rclverify/verdict`` (std_msgs/String JSON) as a ROS 2 subscriber reads it, and the latched
+    last verdict per node for a late subscriber."""
+    kinds = {(v.get("kind"), v.get("verdict")) for v in run["echoed"]}
+    assert {(None, "satisfied"), (None, "violated"), ("deadline", "false"), ("blocked", "violated")} <= kinds
+    assert any(v.get("call") and v["node"] == "Base" and v["verdict"] == "violated" for v in run["echoed"])
+    assert run["latched"]["node"] == "Limiter" and run["latched"]["verdict"] == "satisfied"
 
 
 def test_live_verdicts_equal_the_offline_engines(run: dict[str, Any], capsys: pytest.CaptureFixture[str]) -> None:
