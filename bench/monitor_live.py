@@ -35,6 +35,11 @@ The figures are printed, not asserted.  Usage::
 
     python3 bench/monitor_live.py [--rate 2000 --seconds 5] [--node NODE ...] [--oracle-events 20000]
                                   [--no-live | --no-oracle]
+    python3 bench/monitor_live.py --ros2 [--rates 1000,5000] [--seconds 5] [--memory-seconds 600 | --smoke]
+
+``--ros2`` runs the same measurement over DDS instead (ROS 2's wire, Cyclone
+DDS; bench/monitor_live_dds.py): latency p50/p99 at each rate and the
+monitor's memory over a long run.
 """
 from __future__ import annotations
 
@@ -296,6 +301,10 @@ def bench_oracle(n: int, node: str | None) -> None:
 
 
 def main() -> int:
+    if "--ros2" in sys.argv[1:]:  # ROS 2 over DDS: its own script (bench/monitor_live_dds.py)
+        sys.path.insert(0, str(ROOT / "bench"))
+        from monitor_live_dds import main as dds_main
+        return dds_main([a for a in sys.argv[1:] if a != "--ros2"])
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--rate", type=float, default=2000.0)
     p.add_argument("--seconds", type=float, default=5.0)

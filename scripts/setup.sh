@@ -3,7 +3,8 @@
 #   - Debian packages (below): Dafny, graphviz, ROS 1 and Chromium; each
 #     optional, their evidence is pending, the diagram replaced by DOT
 #     source, or the live tests skipped with the reason when missing;
-#   - the rclverify package itself with its Python dependencies and pytest.
+#   - the rclverify package itself with its Python dependencies and pytest (among them
+#     cyclonedds, whose wheel carries Cyclone DDS's C library: ROS 2 live, over DDS).
 # Safe to run again.
 set -euo pipefail
 cd "$(dirname "$0")/.."

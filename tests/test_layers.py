@@ -72,13 +72,25 @@ LAYERS: list[tuple[str, tuple[str, ...]]] = [
     # symbols.py, emit.py, cpp_scope.py, cpp_values.py, cpp_types.py,
     # cpp_prep.py, cpp_helpers.py, py_helpers.py, pyconst.py, namespaces.py;
     # they import only ros/ modules, the standard library and tree-sitter.
-    ("system/logic", ("rclverify.system", "rclverify.logic", "rclverify.ros")),
+    # ros/dds.py, ros/dds_qos.py, ros/dds_discovery.py, ros/diff_dds.py: ROS 2's
+    # conventions on DDS (names, the participant and node announcements, QoS
+    # matching) and the running ROS 2 graph; read by ``ros diff --ros2`` here and
+    # by the live monitor above (backends), so they sit with the graph they feed.
+    ("system/logic", ("rclverify.system", "rclverify.logic", "rclverify.ros", "rclverify.ros.dds",
+                      "rclverify.ros.dds_qos", "rclverify.ros.dds_discovery", "rclverify.ros.diff_dds")),
     # requirements/: formal requirements decided from the composed contracts
     # (check.py, beside the calculus it builds on) and their roll-up with the
     # evidence (rollup.py); its stage (stage.py) sits with the workspace it
     # writes into, its terminal listing (show.py) with the commands.
     ("calculus/health", ("rclverify.calculus", "rclverify.health", "rclverify.requirements")),
-    ("backends", ("rclverify.backends",)),
+    # backends/monitors/dds_*.py: the live monitor over DDS (types made from
+    # the .msg files, the bus and its readers, calls checked one by one with
+    # the monitors' engine, --enforce, the bag recorder); monitors' code,
+    # beside the ROS 1 glue (ros1.py, live.py).
+    ("backends", ("rclverify.backends", "rclverify.backends.monitors.dds_types", "rclverify.backends.monitors.dds_bus",
+                  "rclverify.backends.monitors.dds_calls", "rclverify.backends.monitors.dds_services",
+                  "rclverify.backends.monitors.dds_enforce", "rclverify.backends.monitors.dds_bag",
+                  "rclverify.backends.monitors.dds_live")),
     # diagnosis/: each problem of the report explained and repairs checked by
     # re-running the calculus, health checks and Hoare triples on edited text
     # (so above the backends); the report shows the records.

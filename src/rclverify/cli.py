@@ -578,8 +578,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     m.add_argument("--mapping", help="mapping file (default: backends/monitors/mapping.yaml if present)")
     m.add_argument("--horizon", type=seconds, help="seconds an input event may wait for its answer (default 5.0)")
     m.add_argument("--json", action="store_true", help="print the verdicts as JSON")
-    lv = m.add_argument_group("live monitoring (ROS 1; docs/monitors.md)")
-    lv.add_argument("--live", action="store_true", help="monitor the running ROS 1 system (ROS_MASTER_URI) instead")
+    lv = m.add_argument_group("live monitoring (ROS 1, ROS 2 over DDS; docs/monitors.md)")
+    lv.add_argument("--live", action="store_true", help="monitor the running ROS system instead (ROS 1: "
+                    "ROS_MASTER_URI; ROS 2: --ros2)")
     lv.add_argument("--log", default="monitor_live.jsonl", help="JSON-lines log of events and verdicts to write")
     lv.add_argument("--evidence", help="write the monitoring evidence record (JSON) here when stopped")
     lv.add_argument("--forward", action="append", default=[], metavar="SVC=REAL",
@@ -595,6 +596,14 @@ def main(argv: Sequence[str] | None = None) -> int:
     lv.add_argument("--verdict-topic", default="/rclverify/verdict", help="topic of the per-event verdicts")
     lv.add_argument("--node", dest="nodes", action="append", metavar="NODE", help="monitor only NODE (repeatable)")
     lv.add_argument("--ros", choices=("1", "2"), help="ROS version (default: $ROS_VERSION, else 1)")
+    lv.add_argument("--ros2", dest="ros", action="store_const", const="2",
+                    help="ROS 2 over DDS (Cyclone DDS; ROS_DOMAIN_ID, CYCLONEDDS_URI): same as --ros 2")
+    lv.add_argument("--enforce", action="append", default=[], metavar="TOPIC[:=PRIVATE]",
+                    help="ROS 2: republish TOPIC only when the guarantee holds; the node publishes on PRIVATE "
+                         "(default TOPIC_unchecked) (repeatable)")
+    lv.add_argument("--record", metavar="BAG", help="ROS 2: record the contract topics to a new ROS 2 bag")
+    lv.add_argument("--record-storage", choices=("sqlite3", "mcap"),
+                    help="the bag's storage (default: mcap for a BAG ending .mcap, else sqlite3)")
     o = add("oracle", cmd_oracle, "serve the contracts as a ROSMonitoring oracle over WebSocket", True)
     o.add_argument("--port", type=int, default=8080, help="TCP port (default 8080)")
     o.add_argument("--host", default="127.0.0.1", help="address to bind (default 127.0.0.1)")

@@ -31,13 +31,19 @@ def add_parsers(sub: Any) -> None:
     s.add_argument("--json", metavar="FILE", help="write the graph as JSON (docs/ros-graph.schema.json)")
     s.add_argument("--cache", metavar="DIR", help="per-file parse cache directory (e.g. artifacts/cache)")
     s.set_defaults(fn=cmd_scan)
-    d = rs.add_parser("diff", help="the graph the code promises against a running ROS 1 master or a recorded run",
+    d = rs.add_parser("diff", help="the graph the code promises against a running ROS 1 master, a running ROS 2 "
+                                   "system or a recorded run",
                       description="compare the static graph (PATH..., --launch, --arg) with a running ROS 1 "
-                                  "master (--master) or a bag (--bag): exit 0 equal, 1 they differ, 2 usage")
+                                  "master (--master), the running ROS 2 system on its DDS domain (--ros2) or a bag "
+                                  "(--bag): exit 0 equal, 1 they differ, 2 usage")
     _code_args(d)
     d.add_argument("--master", metavar="URI", help="the running ROS 1 master (http://127.0.0.1:11311)")
     d.add_argument("--timeout", type=_seconds, default=MASTER_TIMEOUT_S, metavar="S",
                    help=f"seconds each call to the master may take (default {MASTER_TIMEOUT_S:g})")
+    d.add_argument("--ros2", action="store_true", help="the running ROS 2 system: its DDS domain (ROS_DOMAIN_ID, "
+                   "CYCLONEDDS_URI), nodes from ros_discovery_info, endpoints and QoS from DDS discovery")
+    d.add_argument("--wait", type=float, default=2.0, metavar="S",
+                   help="--ros2: seconds to listen to discovery before comparing (default 2)")
     d.add_argument("--bag", metavar="BAG", help="a recorded run: .bag, ROS 2 bag dir, .mcap (topics and types only)")
     d.add_argument("--json", metavar="FILE", help="write both lists as JSON (docs/ros.md)")
     d.set_defaults(fn=cmd_diff)
@@ -128,14 +134,14 @@ def cmd_scan(args: argparse.Namespace) -> int:
 
 def cmd_diff(args: argparse.Namespace) -> int:
     """``rclverify ros diff``: print the missing and extra lists (docs/ros.md,
-    "Expected against observed"); exit 0 equal, 1 they differ (or the master cannot
-    be read, or a scanned file cannot be), 2 usage."""
+    "Expected against observed"); exit 0 equal, 1 they differ (or the master or
+    the DDS domain cannot be read, or a scanned file cannot be), 2 usage."""
     from ..evidence.store import atomic_write_text
     from .bag import bag_topics
     from .diff import diff_bag, diff_master, render_text
     from .master import MasterError, read_master
-    if (args.master is None) == (args.bag is None):
-        print("error: ros diff needs exactly one running side: --master URI or --bag BAG", file=sys.stderr)
+    if sum((args.master is not None, args.bag is not None, bool(getattr(args, "ros2", False)))) != 1:
+        print("error: ros diff needs exactly one running side: --master URI, --ros2 or --bag BAG", file=sys.stderr)
         return 2
     if not args.paths and not args.launch:
         print("error: ros diff needs the code: PATH... and/or --launch FILE", file=sys.stderr)
@@ -154,6 +160,21 @@ def cmd_diff(args: argparse.Namespace) -> int:
         for n in running.notes:
             print(f"{args.master}: {n.severity}: {n.message}", file=sys.stderr)
         result = diff_master(res.graph, running, args.master)
+    elif getattr(args, "ros2", False):
+        from .dds import DdsUnavailable
+        from .diff_dds import diff_dds, qos_conflicts, read_dds_graph
+        try:
+            running, disc, source, dp = read_dds_graph(max(0.0, args.wait))
+        except DdsUnavailable as exc:
+            print(f"ros diff --ros2: error: {exc}", file=sys.stderr)
+            return 1
+        try:
+            for n in running.notes:
+                print(f"{source}: {n.severity}: {n.message}", file=sys.stderr)
+            result = diff_dds(res.graph, running, source, qos_conflicts(disc), disc)
+        finally:
+            disc.close()
+            dp.__del__()
     else:
         bag, notes = bag_topics(Path(args.bag), args.bag)
         if bag is None:

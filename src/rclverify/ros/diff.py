@@ -252,7 +252,7 @@ def diff_bag(static: Graph, bag: dict[str, Any]) -> DiffResult:
 def render_text(res: DiffResult) -> list[str]:
     """The lines ``ros diff`` prints: the missing list, the extra list, what was not
     compared, and one summary line."""
-    where = f"the running system at {res.source}" if res.kind == "master" else f"the recorded run {res.source}"
+    where = f"the recorded run {res.source}" if res.kind == "bag" else f"the running system at {res.source}"
     lines: list[str] = []
     if res.missing:
         lines.append(f"in the code, not in {where}:")

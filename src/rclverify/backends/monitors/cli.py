@@ -1,10 +1,11 @@
 """``rclverify monitor [-w WS] TRACE...``: check recorded runs against every node's contract;
-``rclverify monitor --live``: monitor the running ROS 1 system.
+``rclverify monitor --live``: monitor the running ROS 1 system, or with
+``--ros2`` the ROS 2 system over DDS (:mod:`.dds_live`).
 
 Exit status: 0 when no contract is violated, 1 when one is, 2 for a trace
 or configuration that cannot be read (a located message on stderr; the
 verdicts of the traces already checked are printed first) or when ROS 1
-cannot be reached in ``--live`` mode.
+or ROS 2's DDS domain cannot be reached in ``--live`` mode.
 """
 from __future__ import annotations
 
@@ -102,12 +103,14 @@ def monitor_command(args: argparse.Namespace, checked: Checked) -> int:
 
 
 def live_command(args: argparse.Namespace, checked: Any, cfg: Any, root: Path) -> int:
-    """``--live``: monitor the running ROS 1 system until SIGINT/SIGTERM or ``--duration``.
+    """``--live``: monitor the running ROS 1 system (``--ros2``: ROS 2 over DDS) until
+    SIGINT/SIGTERM or ``--duration``.
 
     Writes the log (``--log``) and, on stop, the evidence record
     (``--evidence``); prints a status line per ``--status`` seconds.  Exit
-    status 1 when a contract was violated, 0 otherwise, 2 when ROS 1 or a
-    message class is unavailable (one message on stderr)."""
+    status 1 when a contract was violated (a topic, a call, a deadline), 0
+    otherwise, 2 when ROS 1, the DDS domain or a message type is unavailable
+    (one message on stderr)."""
     import signal
     import threading
     from functools import partial
@@ -116,7 +119,7 @@ def live_command(args: argparse.Namespace, checked: Any, cfg: Any, root: Path) -
 
     from .live import LiveRun, run_ros1
     from .ros1 import RosUnavailable
-    from .ros2 import Ros2Unavailable, run_ros2
+    from ...ros.dds import DdsUnavailable
     if args.traces:
         print("rclverify monitor: error: --live takes no TRACE (it monitors the running system)", file=sys.stderr)
         return 2
@@ -124,34 +127,70 @@ def live_command(args: argparse.Namespace, checked: Any, cfg: Any, root: Path) -
     if nodes is None:
         return 2
     log = Path(args.log)
-    factory = partial(LiveRun, checked, nodes, cfg.rules, cfg.horizon, log,
-                      reorder_window=args.reorder_window, silence_s=args.silence)
+    ros = args.ros or os.environ.get("ROS_VERSION", "1")  # ROS's setup scripts set ROS_VERSION
+    enforce_items, record = getattr(args, "enforce", []), getattr(args, "record", None)
+    if ros != "2" and (enforce_items or record):
+        print("rclverify monitor --live: error: --enforce and --record need ROS 2 (--ros2)", file=sys.stderr)
+        return 2
+    if ros == "2" and getattr(args, "forward", []):
+        print("rclverify monitor --live --ros2: error: --forward is for ROS 1's service proxy; over DDS the "
+              "monitor reads every call on the bus (name the .srv/.action directories with --interfaces)",
+              file=sys.stderr)
+        return 2
+    run_class: Any = LiveRun
+    extra: dict[str, Any] = {}
+    if enforce_items:
+        from .dds_enforce import EnforceUsage, EnforcingRun, parse_enforce
+        try:
+            extra["guarded"] = parse_enforce(enforce_items)
+        except EnforceUsage as exc:
+            print(f"rclverify monitor --live: error: {exc}", file=sys.stderr)
+            return 2
+        unknown = sorted(set(extra["guarded"]) - {t.field.strip("/") for n in nodes for t in n.node.topics})
+        if unknown:
+            print(f"rclverify monitor --live: error: --enforce /{unknown[0]}: no monitored contract names this "
+                  f"topic", file=sys.stderr)
+            return 2
+        run_class = EnforcingRun
+    factory = partial(run_class, checked, nodes, cfg.rules, cfg.horizon, log,
+                      reorder_window=args.reorder_window, silence_s=args.silence, **extra)
     stop = threading.Event()
     for sig in (signal.SIGINT, signal.SIGTERM):
         signal.signal(sig, lambda *_: stop.set())
-    ros = args.ros or os.environ.get("ROS_VERSION", "1")  # ROS's setup scripts set ROS_VERSION
     common: dict[str, Any] = dict(
         verdict_topic=args.verdict_topic, last_prefix=args.verdict_topic.rsplit("/", 1)[0] or "/rclverify",
         node_name="rclverify_monitor", duration=args.duration, tick_s=0.02, status_s=args.status, stop=stop,
         evidence=Path(args.evidence) if args.evidence else None, out=lambda line: print(line, flush=True))
     from .service_proxy import ProxyUsage, proxy_factory
+    interfaces = [root / d for d in getattr(args, "interfaces", [])]
     try:
-        proxy = proxy_factory(checked, nodes, getattr(args, "forward", []),
-                              [root / d for d in getattr(args, "interfaces", [])])
         if ros == "2":
-            if proxy is not None:
-                raise ProxyUsage("--forward and --interfaces need ROS 1 (the service proxy is a rospy node)")
-            record = run_ros2(factory, checked, nodes, **common)
+            from .dds_bag import storage_of
+            from .dds_live import run_dds
+            msg_dirs = [root / d for d in cfg.msg_dirs]
+            rec = (Path(record), storage_of(Path(record), getattr(args, "record_storage", None))) if record else None
+            record_ = run_dds(factory, checked, nodes, msg_dirs + interfaces, **common,
+                              enforce=extra.get("guarded"), record=rec, msg_dirs=msg_dirs,
+                              reorder_window=args.reorder_window)
         else:
-            record = run_ros1(factory, checked, nodes, [root / d for d in cfg.msg_dirs], **common, proxy=proxy)
-    except (RosUnavailable, Ros2Unavailable, ProxyUsage) as exc:
-        print(f"rclverify monitor --live: error: {exc}", file=sys.stderr)
+            proxy = proxy_factory(checked, nodes, getattr(args, "forward", []), interfaces)
+            record_ = run_ros1(factory, checked, nodes, [root / d for d in cfg.msg_dirs], **common, proxy=proxy)
+    except (RosUnavailable, DdsUnavailable, ProxyUsage) as exc:
+        text = str(exc)
+        print(text if ": error: " in text else f"rclverify monitor --live: error: {text}", file=sys.stderr)
         return 2
-    print(f"{log}: {record['events']} event(s), {record['verdicts']} verdict(s); sha256 {record['sha256']}")
-    if "deadlines" in record:
-        print(f"deadlines: {record['deadlines']['false']} call(s) or goal(s) missed their deadline")
-    late = bool(record.get("deadlines", {}).get("false"))
-    return 1 if late or any(n["status"] == "failed" for n in record["nodes"]) else 0
+    print(f"{log}: {record_['events']} event(s), {record_['verdicts']} verdict(s); sha256 {record_['sha256']}")
+    for n in record_.get("calls", {}).get("nodes", []):
+        print(f"calls: {n['node']}: {n['status']}: {n['explanation']}")
+    if "deadlines" in record_:
+        print(f"deadlines: {record_['deadlines']['false']} call(s) or goal(s) missed their deadline")
+    for topic, c in record_.get("enforce", {}).items():
+        print(f"enforce /{topic}: {c['released']} released, {c['blocked']} blocked (read from {c['private']})")
+    if "bag" in record_:
+        print(f"recorded {record_['bag']['messages']} message(s) to {record_['bag']['path']}")
+    late = bool(record_.get("deadlines", {}).get("false"))
+    calls_failed = any(n["status"] == "failed" for n in record_.get("calls", {}).get("nodes", []))
+    return 1 if late or calls_failed or any(n["status"] == "failed" for n in record_["nodes"]) else 0
 
 
 def oracle_command(args: argparse.Namespace, checked: Checked) -> int:

@@ -1,0 +1,200 @@
+"""The live monitor's side of the DDS bus: readers that follow the
+publishers' QoS, and one thread that takes what arrives.
+
+A :class:`Tap` is what the monitor wants to hear: a DDS topic, the struct
+of the contract's type, where the contract names it (for warnings).  Its
+reader is made when a publisher of the topic is discovered, with the QoS
+:func:`~rclverify.ros.dds_qos.reader_for` computes from every publisher's
+offer (so a best-effort sensor is heard), and made again when a publisher
+appears that the current reader cannot match (counted in
+``reader_changes``; messages published while the new reader is being
+matched may be missed, which the evidence says).  What cannot be heard is a
+located warning, once per publisher and reason, never silence:
+
+* a publisher of another type on the topic (its samples are not the
+  contract's type): ``FILE:LINE:COL: warning: /scan: node /lidar publishes
+  sensor_msgs::msg::dds_::Imu_, the contract's type is ...; not heard``;
+* a publisher whose QoS no one reader matches together with the others
+  (exclusive ownership beside shared, partitions): the policy and both
+  sides' QoS.
+
+:class:`Bus` runs one thread (``rclverify-dds``): it waits on discovery and
+every tap's reader (a Cyclone wait set, which releases the GIL), updates the
+taps (discovery at most every ``period_s``, so a busy topic does not make
+it read discovery at every sample), and hands each sample to ``on_sample(tap, raw bytes, sample info,
+receipt time)`` (receipt: ``time.time_ns()``, an integer, so a recorded bag
+holds the very time the engine used); it never decodes or checks (the
+engine thread does, :mod:`.worker`).
+"""
+from __future__ import annotations
+
+import threading
+import time
+from dataclasses import dataclass, field
+from typing import Any, Callable
+
+from ...ros.dds import take_raw
+from ...ros.dds_discovery import Discovery
+from ...ros.dds_qos import QosProfile, mismatches, reader_for, to_dds
+
+
+@dataclass
+class Tap:
+    """One DDS topic the monitor reads (module docstring).  ``key`` is what
+    samples are handed on as; ``where`` locates the contract's mention."""
+
+    key: str
+    dds_topic: str
+    struct: type
+    where: str
+    reader: Any = None
+    condition: Any = None
+    qos: QosProfile | None = None
+    reader_changes: int = 0
+    samples: int = 0
+    heard: set[bytes] = field(default_factory=set)  # writer GUIDs the current reader matches
+    warned: set[tuple[bytes, str]] = field(default_factory=set)
+
+    def to_json(self) -> dict[str, Any]:
+        return {"topic": self.dds_topic, "samples": self.samples, "reader_changes": self.reader_changes,
+                "qos": self.qos.to_json() if self.qos is not None else None, "publishers_heard": len(self.heard)}
+
+
+class Bus:
+    """Discovery, taps and the thread that reads them (module docstring).
+    ``warn(text)`` receives each warning line; ``period_s`` bounds a wait;
+    ``on_reader(tap, publishers)`` is told each time a tap's reader is made
+    (in the bus thread), with the publishers it was made for."""
+
+    def __init__(self, dp: Any, on_sample: Callable[[Tap, bytes, Any, int], None],
+                 warn: Callable[[str], None], period_s: float = 0.05,
+                 on_reader: Callable[[Tap, list[Any]], None] | None = None) -> None:
+        from cyclonedds.core import WaitSet
+        self.dp, self.on_sample, self.warn, self.period_s = dp, on_sample, warn, period_s
+        self.on_reader = on_reader
+        self.discovery = Discovery(dp)
+        self.taps: list[Tap] = []
+        self.waitset = WaitSet(dp)
+        self._conds = self.discovery.conditions()  # kept alive with the wait set
+        for c in self._conds:
+            self.waitset.attach(c)
+        self._stop = threading.Event()
+        self._thread = threading.Thread(target=self._run, name="rclverify-dds", daemon=True)
+        self.error: BaseException | None = None
+        self._lock = threading.Lock()
+
+    def tap(self, key: str, dds_topic: str, struct: type, where: str) -> Tap:
+        """Ask to hear ``dds_topic`` (call before :meth:`start`)."""
+        t = Tap(key, dds_topic, struct, where)
+        self.taps.append(t)
+        return t
+
+    def writer(self, dds_topic: str, struct: type, qos: QosProfile, user_data: bytes = b"") -> Any:
+        """A writer of the monitor on ``dds_topic``."""
+        from cyclonedds.pub import DataWriter
+        from cyclonedds.topic import Topic
+        return DataWriter(self.dp, Topic(self.dp, dds_topic, struct), qos=to_dds(qos, user_data))
+
+    def start(self) -> Bus:
+        self._thread.start()
+        return self
+
+    def stop(self, timeout: float = 10.0) -> None:
+        """End the thread (after it took what had arrived); re-raise what it died of."""
+        self._stop.set()
+        self._thread.join(timeout)
+        if self.error is not None:
+            raise self.error
+
+    # -- the thread --------------------------------------------------------------------------------
+    def _run(self) -> None:
+        try:
+            self._update()
+            next_poll = 0.0
+            while not self._stop.is_set():
+                self.waitset.wait(int(self.period_s * 1e9))
+                now = time.monotonic()
+                if now >= next_poll:  # discovery at most every period, not at every sample
+                    next_poll = now + self.period_s
+                    if self.discovery.poll():
+                        self._update()
+                self._drain()
+            self._drain(every=True)
+        except BaseException as exc:  # noqa: BLE001 - kept for stop(): a dead reader thread must be said
+            self.error = exc
+
+    def _drain(self, every: bool = False) -> None:
+        for t in self.taps:
+            if t.reader is None or not (every or t.condition.triggered):
+                continue
+            while True:
+                got = take_raw(t.reader, 256)
+                if not got:
+                    break
+                now = time.time_ns()
+                t.samples += len(got)
+                for raw, info in got:
+                    self.on_sample(t, raw, info, now)
+                if len(got) < 256:
+                    break
+
+    def _update(self) -> None:
+        """Make or remake each tap's reader for the publishers discovered now; warn."""
+        from cyclonedds.core import InstanceState, ReadCondition, SampleState, ViewState
+        from cyclonedds.sub import DataReader
+        from cyclonedds.topic import Topic
+        disc = self.discovery
+        for t in self.taps:
+            pubs = disc.publishers(t.dds_topic)
+            want = t.struct.__idl_typename__  # type: ignore[attr-defined]
+            same = [p for p in pubs if p.type_name == want]
+            for p in pubs:
+                if p.type_name != want:
+                    self._warn_once(t, p.guid, "type", f"{t.where}: warning: {t.key}: {disc.who(p)} publishes "
+                                    f"{p.type_name}, the contract's type is {want}; its messages are not heard")
+            if not same:
+                continue
+            req, left = reader_for([p.qos for p in same])
+            for k in left:
+                p = same[k]
+                self._warn_once(t, p.guid, "qos", f"{t.where}: warning: {t.key}: {disc.who(p)} offers "
+                                f"{p.qos.describe()}; the monitor's reader ({req.describe()}) cannot match it "
+                                f"together with the other publishers: {'; '.join(mismatches(p.qos, req))}; its "
+                                f"messages are not heard")
+            if t.reader is not None and t.qos is not None and not any(mismatches(p.qos, t.qos) for p in same):
+                t.heard = {p.guid for p in same}
+                continue  # the reader in place hears every publisher: keep it (no gap)
+            if t.reader is not None:
+                self._drain_one(t)
+                self.waitset.detach(t.condition)
+                t.reader.__del__()
+                t.reader_changes += 1
+            t.reader = DataReader(self.dp, Topic(self.dp, t.dds_topic, t.struct), qos=to_dds(req))
+            t.condition = ReadCondition(t.reader, SampleState.Any | ViewState.Any | InstanceState.Any)
+            self.waitset.attach(t.condition)
+            t.qos = req
+            t.heard = {p.guid for k, p in enumerate(same) if k not in left}
+            if self.on_reader is not None:
+                self.on_reader(t, same)
+
+    def _drain_one(self, t: Tap) -> None:
+        got = take_raw(t.reader, 100000)
+        now = time.time_ns()
+        t.samples += len(got)
+        for raw, info in got:
+            self.on_sample(t, raw, info, now)
+
+    def _warn_once(self, t: Tap, guid: bytes, why: str, text: str) -> None:
+        if (guid, why) not in t.warned:
+            t.warned.add((guid, why))
+            self.warn(text)
+
+    def close(self) -> None:
+        """Delete the readers and discovery (the participant stays)."""
+        for t in self.taps:
+            if t.reader is not None:
+                t.reader.__del__()
+        self.discovery.close()
+
+
+__all__ = ["Bus", "Tap"]

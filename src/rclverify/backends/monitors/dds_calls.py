@@ -1,0 +1,282 @@
+"""Service calls and action goals checked one by one with the offline engine.
+
+A ROS 2 service call is a request and a reply that carry the same identity
+(rmw_cyclonedds' request header: the client's request-writer handle and a
+sequence number, :mod:`.dds_types`); an action goal is its ``goal_id`` (a
+UUID) on the send-goal request, the feedback messages and the get-result
+reply.  A third party on the bus sees every call of every client, so calls
+are paired by identity, never by their order, and each call (each goal) is
+checked as a trace of its own (docs/monitors.md, "Services and actions over
+DDS"):
+
+* **the server's guarantee**: the node that ``serves(...)`` the link, seen
+  through the link (:func:`link_view`: its topics are the link's parts,
+  ``<name>/request`` and ``<name>/response``, or ``<name>/goal``,
+  ``/feedback`` and ``/result``, bound to the link's variables), is run by
+  :class:`~.check.NodeMonitor`, the engine of every recorded and live
+  check: the request (the goal) is its input event, the reply (each
+  feedback, the result) its output events.  A wrong answer is ``violated``
+  once the horizon has passed without a right one; a right one is
+  ``satisfied`` at once;
+* **the client's assumption**: the node that ``calls(...)`` it, its
+  guarantees left out (a client promises nothing about the server's
+  answer), the reply (feedback, result) its input events: ``assumption
+  violated`` or ``satisfied`` (the answer met the client's assumption);
+* **deadlines**: each node with a timed guarantee triggered by a variable
+  of the link gets a :class:`~.deadlines.DeadlineMonitor` per call, whose
+  stamps are the DDS source timestamps of the request and the reply (the
+  writers' clocks: one host, or hosts whose clocks are synchronised), its
+  clock advanced by :meth:`CallBook.tick`, so an unanswered call is
+  ``false`` as soon as its deadline has passed, and a late answer is shown
+  with its stamp (an ``update``).
+
+A call is dropped from memory once it is answered and nothing about it is
+pending, or :data:`LINGER_S` seconds after its horizon and deadlines passed
+unanswered; at most ``max_calls`` are kept (the oldest is closed first,
+counted in ``evicted``).  :func:`replay` runs the same book over the
+``call`` lines of a live log: the offline check of a live run's calls.
+"""
+from __future__ import annotations
+
+import dataclasses
+from collections import OrderedDict
+from typing import Any, Callable, Iterable, Mapping
+
+from ...rcl import ast
+from ...rcl.types import Checked, CheckedNode
+from ...traces.events import Event
+from ...traces.mapping import TopicRule
+from .check import NodeMonitor, NodeResult, Verdict
+from .deadlines import LINK_TOPICS, DeadlineMonitor, DeadlineResult, DeadlineVerdict
+
+#: the ``topic`` of a call's log lines: no contract names it, so ``rclverify monitor LOG`` skips them
+CALL_LOG_TOPIC = "rclverify/call"
+#: seconds an unanswered call is kept after its horizon and deadlines passed (a late answer still shown)
+LINGER_S = 10.0
+
+
+def link_view(node: CheckedNode, link: ast.Link) -> CheckedNode:
+    """``node`` as the one link shows it: its topics are the link's parts
+    bound to the link's variables; a client (``calls``) keeps only its
+    assumption (module docstring)."""
+    topics = tuple(ast.Topic(link.ros_type, f"{link.name.strip('/')}/{part}", var, link.loc)
+                   for part, var in zip(LINK_TOPICS[link.kind], link.parts))
+    guarantees = node.node.guarantees if link.role == "serves" else ()
+    return CheckedNode(dataclasses.replace(node.node, topics=topics, guarantees=guarantees), node.inputs,
+                       node.outputs)
+
+
+def _timed_by(node: CheckedNode, link: ast.Link) -> bool:
+    names = {v.name for v in link.parts}
+    return any(c.trigger is not None and c.deadline is not None and c.trigger.name in names
+               for c in node.node.guarantees)
+
+
+@dataclasses.dataclass
+class _Call:
+    key: tuple[Any, ...]
+    name: str
+    label: str
+    opened: float
+    bound: float
+    monitors: list[NodeMonitor]
+    deadlines: list[DeadlineMonitor]
+    answered: bool = False
+
+
+class CallBook:
+    """The calls and goals in flight and what was concluded of those closed.
+
+    ``links`` are the monitored links: ``(node, link)`` pairs (a link name
+    appears once per node that serves or calls it); ``on_verdict(Verdict)``
+    and ``on_deadline(DeadlineVerdict)`` receive every verdict as decided,
+    ``on_event(dict)`` every call event as a log line (``topic``
+    :data:`CALL_LOG_TOPIC`, ``kind: "call"``, the link, the part, the
+    identity ``key``, the source stamp as ``time``, the part's fields).
+    Times are seconds (DDS source timestamps, the timer's wall clock)."""
+
+    def __init__(self, checked: Checked, links: Iterable[tuple[CheckedNode, ast.Link]],
+                 rules: Mapping[str, TopicRule], horizon: float,
+                 on_verdict: Callable[[Verdict], None] | None = None,
+                 on_deadline: Callable[[DeadlineVerdict], None] | None = None,
+                 on_event: Callable[[dict[str, Any]], None] | None = None, max_calls: int = 10_000) -> None:
+        self.checked, self.rules, self.horizon = checked, rules, horizon
+        self.on_verdict, self.on_deadline, self.on_event = on_verdict, on_deadline, on_event
+        self.max_calls = max_calls
+        self.links: dict[str, list[tuple[CheckedNode, CheckedNode, bool]]] = {}
+        for node, lk in links:
+            self.links.setdefault(lk.name.strip("/"), []).append((node, link_view(node, lk), _timed_by(node, lk)))
+        self.calls: OrderedDict[tuple[Any, ...], _Call] = OrderedDict()
+        self.results: dict[str, NodeResult] = {}
+        self.deadline_results: dict[str, DeadlineResult] = {}
+        self.index = 0
+        self.emitted = 0  # verdicts given so far (a tick that gives one is logged, for the replay)
+        self.now = float("-inf")
+        self.counts = {"calls": 0, "goals": 0, "answered": 0, "unanswered": 0, "orphan_answers": 0, "evicted": 0,
+                       "rejected": 0}
+
+    # -- input -------------------------------------------------------------------------------
+    def open(self, name: str, key: tuple[Any, ...], label: str, fields: Mapping[str, Any], stamp: float,
+             part: str = "request") -> None:
+        """A request (``part`` ``request``) or a goal (``goal``) of link ``name``
+        with identity ``key``, stamped ``stamp`` (s)."""
+        name = name.strip("/")
+        views = self.links.get(name)
+        if not views or key in self.calls:
+            return
+        monitors = [NodeMonitor(self.checked, view, self.rules, self.horizon, self._verdict) for _, view, _ in views]
+        deadlines = [DeadlineMonitor(self.checked, node, self.rules, self._deadline) for node, _, timed in views
+                     if timed]
+        bound = max([self.horizon] + [t[4] for d in deadlines for t in d.timed])
+        call = _Call(key, name, label, stamp, bound, monitors, deadlines)
+        self.calls[key] = call
+        self.counts["goals" if part == "goal" else "calls"] += 1
+        self._feed(call, part, fields, stamp)
+        while len(self.calls) > self.max_calls:
+            self._close(next(iter(self.calls)), evicted=True)
+
+    def answer(self, key: tuple[Any, ...], part: str, fields: Mapping[str, Any], stamp: float,
+               final: bool = True, name: str = "") -> bool:
+        """A reply (``response``), feedback or result of the call ``key``;
+        ``final`` for the reply or the result (the call is then answered).
+        Returns False when no open call has that identity (counted)."""
+        call = self.calls.get(key)
+        if call is None:
+            if final:
+                self.counts["orphan_answers"] += 1
+                self._log({"link": name.strip("/"), "part": part, "time": stamp, "key": _key(key), "orphan": True,
+                           "fields": dict(fields)})
+            return False
+        self._feed(call, part, fields, stamp)
+        if final and not call.answered:
+            call.answered = True
+            self.counts["answered"] += 1
+        return True
+
+    def reject(self, key: tuple[Any, ...], stamp: float) -> None:
+        """The server refused goal ``key``: nothing more will answer it; its
+        obligations are closed as they stand (``open``), not judged."""
+        if key in self.calls:
+            self.counts["rejected"] += 1
+            self._log({"link": self.calls[key].name, "part": "rejected", "time": stamp, "key": _key(key)})
+            self._close(key)
+
+    def note(self, obj: dict[str, Any]) -> None:
+        """A line for the log about a call (a status change) that no monitor reads."""
+        self._log(obj)
+
+    def _feed(self, call: _Call, part: str, fields: Mapping[str, Any], stamp: float) -> None:
+        topic = f"{call.name}/{part}"
+        ev = Event(self.index, stamp, topic, dict(fields), f"{call.label} {part}")
+        self.index += 1
+        self._log({"index": ev.index, "link": call.name, "part": part, "time": stamp, "key": _key(call.key),
+                   "where": ev.where, "fields": dict(fields)})
+        for m in call.monitors:
+            m.advance(stamp)
+            m.feed(ev)
+        # a deadline monitor's trigger is the link's variable: the whole part message maps to it
+        dev = Event(ev.index, stamp, topic, {**ev.fields, part: dict(fields)}, ev.where)
+        for d in call.deadlines:
+            d.feed(dev)
+
+    # -- time ----------------------------------------------------------------------------------
+    def tick(self, now: float) -> None:
+        """Move every open call's clock to ``now`` (s): horizons and deadlines
+        that passed are judged; calls done with are closed."""
+        self.now = max(self.now, now)
+        before = self.emitted
+        done = []
+        for key, call in self.calls.items():
+            for m in call.monitors:
+                m.advance(now)
+            for d in call.deadlines:
+                d.advance(now)
+            quiet = not any(m.pending for m in call.monitors) and not any(d.pending for d in call.deadlines)
+            if (call.answered and quiet) or now > call.opened + call.bound + LINGER_S:
+                done.append(key)
+        for key in done:
+            self._close(key)
+        if self.emitted != before:  # this tick decided something: the replay must tick here too
+            self._log({"part": "tick", "time": now})
+
+    def _close(self, key: tuple[Any, ...], evicted: bool = False) -> None:
+        call = self.calls.pop(key)
+        if evicted:
+            self.counts["evicted"] += 1
+        if not call.answered:
+            self.counts["unanswered"] += 1
+        for m in call.monitors:
+            _add(self.results.setdefault(m.node.name, NodeResult(m.node.name)), m.finish())
+        for d in call.deadlines:
+            res = d.finish()
+            total = self.deadline_results.setdefault(res.node, DeadlineResult(res.node))
+            for v, n in res.counts.items():
+                total.counts[v] += n
+            if total.first_false is None:
+                total.first_false = res.first_false
+
+    def finish(self) -> dict[str, Any]:
+        """Close every call (what is within its horizon is ``open``, within its
+        deadline ``currently_false``); returns the summary (``counts``,
+        ``nodes``: per node its :class:`~.check.NodeResult` as JSON,
+        ``deadlines``: per node its deadline result)."""
+        for key in list(self.calls):
+            self._close(key)
+        return {"counts": dict(self.counts),
+                "nodes": [self.results[n].to_json() for n in sorted(self.results)],
+                "deadlines": [self.deadline_results[n].to_json() for n in sorted(self.deadline_results)],
+                "false": sum(r.counts["false"] for r in self.deadline_results.values())}
+
+    # -- sinks ---------------------------------------------------------------------------------
+    def _verdict(self, v: Verdict) -> None:
+        self.emitted += 1
+        if self.on_verdict is not None:
+            self.on_verdict(v)
+
+    def _deadline(self, v: DeadlineVerdict) -> None:
+        self.emitted += 1
+        if self.on_deadline is not None:
+            self.on_deadline(v)
+
+    def _log(self, obj: dict[str, Any]) -> None:
+        if self.on_event is not None:
+            self.on_event({"topic": CALL_LOG_TOPIC, "kind": "call", **obj})
+
+
+def _key(key: tuple[Any, ...]) -> list[Any]:
+    return [k.hex() if isinstance(k, bytes) else k for k in key]
+
+
+def _add(total: NodeResult, one: NodeResult) -> None:
+    """Add one call's result to the node's total (the first of each kind kept)."""
+    total.events += one.events
+    for v, n in one.counts.items():
+        total.counts[v] += n
+    total.first_violation = total.first_violation or one.first_violation
+    total.first_assumption_violation = total.first_assumption_violation or one.first_assumption_violation
+    total.first_inconclusive = total.first_inconclusive or one.first_inconclusive
+
+
+def replay(book: CallBook, lines: Iterable[Mapping[str, Any]]) -> dict[str, Any]:
+    """Run ``book`` over a live log's call lines in order and finish it: the
+    offline check of a live run's calls.  A line with an ``index`` opens its
+    call (a request or a goal) or answers it; a ``tick`` line (written where
+    a live tick decided something) moves the clock as the live timer did, so
+    a deadline that expired before its late answer arrived expires here too,
+    with the same clock in its reason."""
+    for x in lines:
+        if x.get("kind") != "call":
+            continue
+        part = str(x.get("part"))
+        if part == "tick":
+            book.tick(float(x["time"]))
+        elif "index" in x:
+            name, key = str(x["link"]), tuple(x["key"])
+            if part in ("request", "goal"):
+                book.open(name, key, str(x["where"]).rsplit(" ", 1)[0], x["fields"], float(x["time"]), part)
+            else:
+                book.answer(key, part, x["fields"], float(x["time"]), part != "feedback", name)
+    return book.finish()
+
+
+__all__ = ["CALL_LOG_TOPIC", "CallBook", "LINGER_S", "link_view", "replay"]

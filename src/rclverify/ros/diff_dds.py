@@ -1,0 +1,167 @@
+"""The running ROS 2 graph read from DDS, and ``rclverify ros diff --ros2``
+(docs/ros.md, "Expected against observed").
+
+:func:`read_dds_graph` joins the domain (``ROS_DOMAIN_ID``,
+``CYCLONEDDS_URI``), listens to discovery for ``wait_s`` seconds
+(:mod:`.dds_discovery`) and makes the same :class:`~.model.Graph` the ROS 1
+master reader makes (:mod:`.master`):
+
+* a node per entry of ``ros_discovery_info`` (``/ns/name``), each endpoint
+  given to the node that lists its GUID;
+* a writer of ``rt/T`` publishes ``/T``, a reader subscribes to it, with the
+  type ``pkg/msg/T`` from ``pkg::msg::dds_::T_``;
+* a reader of ``rq/SRequest`` serves service ``/S``, a writer of it calls it
+  (ROS 2 registers clients too, unlike a ROS 1 master: they are compared);
+* an action ``/A`` is its hidden ``/A/_action/send_goal`` service: its
+  server and client; its other hidden services and topics are folded into it;
+* ROS 2's own machinery is left out: ``/rosout``, ``/parameter_events``,
+  each node's parameter and type-description services,
+  ``ros_discovery_info``.
+
+Endpoints no node lists (a participant that publishes no
+``ros_discovery_info``: plain DDS, or a ROS 2 process whose announcement
+was not received within the wait) are not in any node; each such topic is
+a note.  :func:`qos_conflicts` finds, per topic, a subscriber and a
+publisher that DDS will not connect because of their QoS (a reliable
+subscription beside a best-effort publisher: the subscriber hears nothing).
+:func:`diff_dds` compares with :func:`.diff.diff_master`'s rules and adds
+the service clients and the QoS conflicts.
+"""
+from __future__ import annotations
+
+import time
+from typing import Any
+
+from .dds import ACTION_INFIX, ACTION_SERVICES, DISCOVERY_TOPIC, domain_id, make_participant, ros_name, ros_type
+from .dds import service_type as _service_type
+from .dds_discovery import Discovery, EndpointInfo
+from .dds_qos import mismatches
+from .diff import DiffResult, Item, _first, _t, diff_master
+from .model import Graph, GraphEdge, GraphNode, Note, Src, short_type
+
+INFRA_TOPICS = {"/rosout", "/parameter_events"}
+#: the services every rclcpp/rclpy node offers about itself (its parameters, its types)
+INFRA_SERVICE_SUFFIXES = ("/describe_parameters", "/get_parameter_types", "/get_parameters", "/list_parameters",
+                          "/set_parameters", "/set_parameters_atomically", "/get_type_description")
+
+
+def _edge_kind(e: EndpointInfo, writer: bool) -> tuple[str, str, str | None] | None:
+    """``(GraphNode edge kind, ROS name, canonical type)`` of an endpoint, or
+    ``None`` for what the graph leaves out (module docstring)."""
+    kind, name = ros_name(e.topic)
+    typ = ros_type(e.type_name)
+    if kind == "topic":
+        if name in INFRA_TOPICS or ACTION_INFIX in name:
+            return None
+        return ("pub" if writer else "sub"), name, typ
+    if kind != "request":
+        return None
+    if ACTION_INFIX in name:
+        base, _, svc = name.partition(ACTION_INFIX)
+        if svc != ACTION_SERVICES[0]:
+            return None  # get_result, cancel_goal: folded into the action
+        atype = _service_type(typ)
+        atype = atype[: -len("_SendGoal")] if atype and atype.endswith("_SendGoal") else atype
+        return ("action_clients" if writer else "action_servers"), base or "/", atype
+    if name.endswith(INFRA_SERVICE_SUFFIXES):
+        return None
+    return ("service_clients" if writer else "service_servers"), name, _service_type(typ)
+
+
+def graph_of(disc: Discovery, source: str) -> Graph:
+    """The :class:`~.model.Graph` of what ``disc`` has discovered (module
+    docstring); every edge located at ``Src(source)``; endpoints outside any
+    node as notes (``ROS-DDS``)."""
+    g = Graph()
+    src = Src(source, 1, 1)
+    for gid_nodes in disc.nodes.values():
+        for n in gid_nodes:
+            ns = "/" + n.namespace.strip("/")
+            g.nodes.setdefault(n.full_name, GraphNode(n.full_name, ns, None, None, origin="dds", declared_at=src))
+    orphans: set[str] = set()
+    for table, writer in ((disc.writers, True), (disc.readers, False)):
+        for e in sorted(table.values(), key=lambda e: (e.topic, e.guid)):
+            if e.topic == DISCOVERY_TOPIC:
+                continue
+            what = _edge_kind(e, writer)
+            if what is None:
+                continue
+            kind, name, typ = what
+            node = disc.node_of(e.guid)
+            if node is None or node not in g.nodes:
+                orphans.add(f"{'publisher' if writer else 'subscriber'} of {e.topic} ({e.type_name}), "
+                            f"participant {e.participant.hex()}")
+                continue
+            edges = g.nodes[node].edges_of(kind)
+            if not any(x.topic == name for x in edges):
+                edges.append(GraphEdge(name, typ, src, None, name))
+    for o in sorted(orphans):
+        g.notes.append(Note(src, f"the {o} is in no ROS 2 node: its participant announced no node on "
+                                 f"ros_discovery_info (plain DDS, or not received within the wait)", "ROS-DDS"))
+    return g
+
+
+def qos_conflicts(disc: Discovery) -> list[tuple[str, EndpointInfo, EndpointInfo, list[str]]]:
+    """``(ROS topic, writer, reader, why)`` for each publisher and subscriber of
+    one topic and type that DDS does not connect because of their QoS."""
+    out = []
+    for r in sorted(disc.readers.values(), key=lambda e: (e.topic, e.guid)):
+        kind, name = ros_name(r.topic)
+        if kind != "topic" or name in INFRA_TOPICS:
+            continue
+        for w in disc.publishers(r.topic):
+            if w.type_name == r.type_name:
+                why = mismatches(w.qos, r.qos)
+                if why:
+                    out.append((name, w, r, why))
+    return out
+
+
+def read_dds_graph(wait_s: float = 2.0, domain: int | None = None) -> tuple[Graph, Discovery, str, Any]:
+    """Listen to the domain for ``wait_s`` seconds; returns the graph, the
+    discovery (for :func:`qos_conflicts`), the source label (``DDS domain
+    N``) and the participant (delete it when done).  Raises
+    :class:`~.dds.DdsUnavailable`."""
+    d = domain_id() if domain is None else domain
+    dp = make_participant(d)
+    disc = Discovery(dp)
+    end = time.monotonic() + wait_s
+    while time.monotonic() < end:
+        disc.poll()
+        time.sleep(0.05)
+    disc.poll()
+    source = f"DDS domain {d}"
+    return graph_of(disc, source), disc, source, dp
+
+
+def diff_dds(static: Graph, running: Graph, source: str,
+             conflicts: list[tuple[str, EndpointInfo, EndpointInfo, list[str]]] = (),  # type: ignore[assignment]
+             disc: Discovery | None = None) -> DiffResult:
+    """Compare the code's graph with the running ROS 2 graph: what
+    :func:`.diff.diff_master` compares, the service clients, and each QoS
+    conflict as a ``qos`` item of the missing list (the connection the code
+    promises is not made).  Pure but for naming nodes through ``disc``."""
+    res = diff_master(static, running, source)
+    res.kind = "dds"
+    res.compared += ["service clients", "QoS of the publishers and subscribers of each topic"]
+    res.not_compared = ["the QoS the code asks for (the diff reports the running endpoints' conflicts)"]
+    for name in sorted(set(static.nodes) & set(running.nodes)):
+        se, re_ = _first(static.nodes[name].edges_of("service_clients")), \
+            _first(running.nodes[name].edges_of("service_clients"))
+        for t in sorted(set(se) - set(re_)):
+            res.missing.append(Item("service client", t, name, se[t].msg_type, None, se[t].src, source,
+                                    f"{name} calls {t}{_t(se[t].msg_type)} in the code, not in the running system"))
+        for t in sorted(set(re_) - set(se)):
+            res.extra.append(Item("service client", t, name, None, re_[t].msg_type, None, source,
+                                  f"{name} calls {t}{_t(re_[t].msg_type)} in the running system, not in the code"))
+    for topic, w, r, why in conflicts:
+        who_w = disc.who(w) if disc is not None else w.label
+        who_r = disc.who(r) if disc is not None else r.label
+        res.missing.append(Item("qos", topic, None, ros_type(w.type_name), None, None, source,
+                                f"{topic} ({short_type(ros_type(w.type_name))}): {who_r} subscribes with "
+                                f"{r.qos.describe()}, {who_w} publishes with {w.qos.describe()}; DDS does not "
+                                f"connect them ({'; '.join(why)}), so the subscriber receives nothing from it"))
+    return res
+
+
+__all__ = ["INFRA_SERVICE_SUFFIXES", "INFRA_TOPICS", "diff_dds", "graph_of", "qos_conflicts", "read_dds_graph"]

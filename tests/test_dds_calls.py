@@ -1,0 +1,155 @@
+"""Calls and goals checked one by one, the ``--enforce`` gate and the bag
+recorder, without a bus (docs/monitors.md, "ROS 2 over DDS").
+
+The call book pairs answers with requests by identity, never by order:
+two clients whose calls interleave get each its own verdict; the same
+calls replayed from the log give the same summary; the gate lets through
+exactly what is shown to satisfy the guarantee; a recorded SQLite 3 bag is
+read back by the offline monitor with the live times.
+"""
+from __future__ import annotations
+
+import random
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from rclverify.backends.monitors.check import check_trace
+from rclverify.backends.monitors.dds_calls import CallBook, link_view, replay
+from rclverify.backends.monitors.dds_enforce import EnforceUsage, judge, parse_enforce
+from rclverify.backends.monitors.online import OnlineEngine
+from rclverify.rcl.typecheck import load
+from rclverify.traces import read_trace
+from rclverify.traces.events import Event
+
+WS = Path(__file__).parent / "data" / "dds_ws"
+CHECKED = load([WS / "contracts" / "dds.rcl"])
+LINKS = [(n, lk) for n in CHECKED.nodes.values() for lk in n.node.links]
+
+
+def _book(lines: list[dict[str, Any]], horizon: float = 1.0) -> CallBook:
+    book = CallBook(CHECKED, LINKS, {}, horizon)
+    book.on_verdict = lambda v: lines.append({"topic": "rclverify/verdict", "time": v.decided_at,
+                                              "verdict": v.to_json()})
+    book.on_deadline = lambda v: lines.append({"topic": "rclverify/verdict", "time": book.now if book.now > 0 else
+                                               v.trigger_stamp, "kind": "deadline", "verdict": v.to_json()})
+    book.on_event = lines.append
+    return book
+
+
+def test_interleaved_calls_are_paired_by_identity_not_by_order() -> None:
+    lines: list[dict[str, Any]] = []
+    book = _book(lines)
+    # client A asks, client B asks, B is answered wrong first, then A right
+    book.open("/estop", (0xA, 1), "estop call a:1", {"data": True}, 10.00)
+    book.open("/estop", (0xB, 1), "estop call b:1", {"data": True}, 10.01)
+    book.answer((0xB, 1), "response", {"success": False, "message": ""}, 10.05)
+    book.answer((0xA, 1), "response", {"success": True, "message": ""}, 10.06)
+    book.tick(11.5)
+    summary = book.finish()
+    base = {x["verdict"]["where"]: x["verdict"]["verdict"] for x in lines
+            if "verdict" in x and x["verdict"].get("node") == "Base" and "kind" not in x}
+    assert base == {"estop call a:1 request": "satisfied", "estop call b:1 request": "violated"}
+    # by order, B's wrong answer would have been A's, and A's right one B's: both judged wrongly
+    deadlines = [x["verdict"] for x in lines if x.get("kind") == "deadline"]
+    assert sorted((d["trigger_where"], d["verdict"]) for d in deadlines) == [
+        ("estop call a:1 request", "true"), ("estop call b:1 request", "false")]
+    assert summary["counts"]["calls"] == 2 and summary["counts"]["answered"] == 2
+    assert replay(_book([]), lines) == summary  # the offline replay of the log's lines
+
+
+def test_a_call_without_answer_is_violated_and_false_and_an_answer_without_call_counted() -> None:
+    lines: list[dict[str, Any]] = []
+    book = _book(lines)
+    book.open("/estop", (1, 1), "estop call 1:1", {"data": True}, 5.0)
+    book.tick(5.3)  # past the 200 ms deadline: false at once
+    assert [x["verdict"]["verdict"] for x in lines if x.get("kind") == "deadline"] == ["false"]
+    book.tick(6.5)  # past the horizon: violated, "no output"
+    assert [x["verdict"]["verdict"] for x in lines if x.get("verdict", {}).get("node") == "Base"
+            and "kind" not in x] == ["violated"]
+    assert not book.answer((9, 9), "response", {"success": True, "message": ""}, 6.6, name="/estop")
+    assert book.finish()["counts"]["orphan_answers"] == 1
+
+
+def test_a_random_call_sequence_replays_to_the_same_verdicts() -> None:
+    """Random interleavings of calls, right, wrong, late and missing answers,
+    a goal with feedback: the live book's lines replayed give the same summary."""
+    rng = random.Random(3)
+    for _ in range(20):
+        lines: list[dict[str, Any]] = []
+        book = _book(lines)
+        t, open_ = 100.0, []
+        for k in range(rng.randint(2, 8)):
+            t += rng.uniform(0.0, 0.3)
+            if open_ and rng.random() < 0.5:
+                key = open_.pop(rng.randrange(len(open_)))
+                book.answer(key, "response", {"success": rng.random() < 0.7, "message": ""}, t)
+            else:
+                key = (rng.randrange(3), k)
+                book.open("/estop", key, f"estop call {key[0]}:{key[1]}", {"data": rng.random() < 0.8}, t)
+                open_.append(key)
+            if rng.random() < 0.4:
+                book.tick(t)
+        gid = ("g",)
+        book.open("/move", gid, "move goal g", {"target": rng.choice([-1.0, 2.0])}, t, "goal")
+        book.answer(gid, "feedback", {"progress": rng.choice([-0.5, 0.5])}, t + 0.1, final=False)
+        book.answer(gid, "result", {"arrived": True}, t + 0.2)
+        book.tick(t + 3.0)
+        assert replay(_book([]), lines) == book.finish()
+
+
+def test_a_link_view_is_the_node_through_its_link() -> None:
+    base = CHECKED.nodes["Base"]
+    view = link_view(base, base.node.links[0])
+    assert [(t.field, t.match.qualified) for t in view.node.topics] == [("estop/request", "in.stop_req"),
+                                                                         ("estop/response", "out.stopped")]
+    teleop = CHECKED.nodes["Teleop"]
+    assert link_view(teleop, teleop.node.links[0]).node.guarantees == ()  # a client is held to its assumption
+
+
+def _engine() -> OnlineEngine:
+    return OnlineEngine(CHECKED, [CHECKED.nodes["Limiter"], CHECKED.nodes["Ranger"]], {}, 1.0)
+
+
+def test_the_gate_releases_only_what_is_shown_to_hold() -> None:
+    eng = _engine()
+    ev = lambda k, topic, v: Event(k, float(k), topic, {"data": v}, f"m{k}")  # noqa: E731
+    ok, why = judge(eng.monitors, CHECKED, ev(0, "speed", 0.5), {})
+    assert not ok and why["verdict"] == "incomplete input"  # no limit received yet: nothing shows it holds
+    eng.push("limit", {"data": 1.0}, 1.0)
+    for k, (v, want) in enumerate([(0.5, True), (1.0, True), (1.5, False), (float("nan"), False)], 2):
+        ok, why = judge(eng.monitors, CHECKED, ev(k, "speed", v), {})
+        assert ok is want, (v, why)
+        if not ok and v == 1.5:
+            assert why["verdict"] == "violated" and why["values"] == {"in.limit": "1.0", "out.speed": "1.5"}
+    assert judge(eng.monitors, CHECKED, ev(9, "range", -1.0), {})[0] is False
+    assert judge(eng.monitors, CHECKED, ev(9, "range", 0.0), {})[0] is True
+    assert parse_enforce(["/speed", "/cmd:=/cmd_raw"]) == {"speed": "/speed_unchecked", "cmd": "/cmd_raw"}
+    for bad in ("/speed:=/speed", ":=/x"):
+        with pytest.raises(EnforceUsage):
+            parse_enforce([bad])
+
+
+@pytest.mark.parametrize("storage", ["sqlite3", "mcap"])
+def test_a_recorded_bag_reads_back_with_the_live_times(storage: str, tmp_path: Path) -> None:
+    pytest.importorskip("cyclonedds", reason="the cyclonedds binding is not installed")
+    from rclverify.backends.monitors.dds_bag import BagError, BagRecorder
+    from rclverify.backends.monitors.dds_types import TypeBook
+    book = TypeBook([])
+    F64 = book.message("std_msgs/Float64")
+    rec = BagRecorder(tmp_path / "run", storage, {"limit": "std_msgs/Float64", "speed": "std_msgs/Float64"}, [])
+    sent = [("limit", 1.0), ("speed", 0.5), ("limit", 2.0), ("speed", 2.5)]
+    times = [1_795_000_000_123_456_789 + k * 50_000_000 for k in range(len(sent))]
+    for (topic, v), t in zip(sent, times):
+        rec.write(topic, t, F64(data=v).serialize(use_version_2=False))
+    assert rec.close()["messages"] == 4
+    events = list(read_trace(tmp_path / "run"))
+    assert [(e.topic, e.time, e.fields) for e in events] == [(tp, t / 1e9, {"data": v}) for (tp, v), t in
+                                                              zip(sent, times)]
+    direct = [Event(k, t / 1e9, tp, {"data": v}, f"m{k}") for k, ((tp, v), t) in enumerate(zip(sent, times))]
+    _, from_bag = check_trace(CHECKED, [CHECKED.nodes["Limiter"]], events, {}, 1.0)
+    _, from_live = check_trace(CHECKED, [CHECKED.nodes["Limiter"]], direct, {}, 1.0)
+    assert from_bag[0].counts == from_live[0].counts and from_bag[0].counts["satisfied"] == 2
+    with pytest.raises(BagError, match="exists"):
+        BagRecorder(tmp_path / "run", storage, {}, [])
