@@ -121,6 +121,9 @@ def run(tmp_path_factory: pytest.TempPathFactory) -> Iterator[dict[str, Any]]:
         replies = [call({"data": True}, 5.0) for _ in range(3)]
         feedbacks, result = send({"target": 2.0}, 5.0)
         time.sleep(1.5)  # the horizon (1 s) passes: the wrong answer is judged
+        # the sensor goes on publishing: the recorded bag, checked offline, reaches past the horizon too
+        rng.write(F32(data=4.0))
+        time.sleep(0.1)
         got: list[float] = []
         wait_until(lambda: got.extend(s.data for s in heard.take(N=16)) or len(got) >= 2, 5, "the released speeds")
         time.sleep(0.3)
@@ -204,9 +207,9 @@ def test_enforce_drops_exactly_the_violating_messages(run: dict[str, Any]) -> No
 
 def test_a_best_effort_publisher_is_heard(run: dict[str, Any]) -> None:
     qos = run["record"]["qos"]["range"]
-    assert qos["qos"]["reliability"] == "best_effort" and qos["samples"] == 3 and qos["publishers_heard"] == 1
+    assert qos["qos"]["reliability"] == "best_effort" and qos["samples"] == 4 and qos["publishers_heard"] == 1
     ranger = next(n for n in run["record"]["nodes"] if n["node"] == "Ranger")
-    assert ranger["counts"]["satisfied"] == 3
+    assert ranger["counts"]["satisfied"] == 4
     # a publisher of another type on the topic: a located warning, never silence
     warnings = run["record"]["warnings"]
     assert len(warnings) == 1 and warnings[0].startswith("contracts/dds.rcl:20:11: warning: range: node /imposter ")
@@ -220,7 +223,10 @@ def test_verdicts_are_on_the_bus(run: dict[str, Any]) -> None:
     kinds = {(v.get("kind"), v.get("verdict")) for v in run["echoed"]}
     assert {(None, "satisfied"), (None, "violated"), ("deadline", "false"), ("blocked", "violated")} <= kinds
     assert any(v.get("call") and v["node"] == "Base" and v["verdict"] == "violated" for v in run["echoed"])
-    assert run["latched"]["node"] == "Limiter" and run["latched"]["verdict"] == "satisfied"
+    # Limiter's last verdict: the limit 1.3 answered by the blocked speed 2.0, judged when the horizon passed
+    # (an answer comes after its question: the earlier 0.8 no longer stands in for it)
+    assert run["latched"]["node"] == "Limiter" and run["latched"]["verdict"] == "violated"
+    assert run["latched"]["values"] == {"in.limit": "1.3", "out.speed": "2.0"}
 
 
 def test_live_verdicts_equal_the_offline_engines(run: dict[str, Any], capsys: pytest.CaptureFixture[str]) -> None:
@@ -229,16 +235,19 @@ def test_live_verdicts_equal_the_offline_engines(run: dict[str, Any], capsys: py
     # the log's messages through the offline checker: the same verdicts, event by event
     events = [e for e in read_jsonl(tmp / "live.jsonl") if not e.topic.startswith("rclverify/")]
     offline: list[Any] = []
-    check_trace(checked, list(checked.nodes.values()), events, {}, 1.0, offline.append)
     live = [x["verdict"] for x in run["log"] if x.get("topic") == "rclverify/verdict" and "kind" not in x
             and not x["verdict"].get("call")]
+    # the live monitor's clock went on after the last message (its timer decides what the horizon ends):
+    # the offline engine is given the same end of the run, the last time the live run logged
+    end = max(float(x["time"]) for x in run["log"] if "time" in x)
+    check_trace(checked, list(checked.nodes.values()), events, {}, 1.0, offline.append, end=end)
     key = lambda v: (v["node"], v["verdict"], v["topic"], v["time"], v["guarantee"], v["values"])  # noqa: E731
     assert live and sorted(map(key, live), key=str) == sorted((key(v.to_json()) for v in offline), key=str)
     # the recorded bag (MCAP) checked offline by the command: the counts the live run recorded
     bag = run["record"]["bag"]
-    assert bag["messages"] == 3 + 2 * len(SPEEDS) and Path(bag["path"], "run.mcap").is_file()
+    assert bag["messages"] == 4 + 2 * len(SPEEDS) and Path(bag["path"], "run.mcap").is_file()
     capsys.readouterr()
-    assert main(["monitor", "-w", str(WS), "--horizon", "1.0", "--json", bag["path"]]) == 0
+    assert main(["monitor", "-w", str(WS), "--horizon", "1.0", "--json", bag["path"]]) == 1  # Limiter violated
     from_bag = {n["node"]: n["counts"] for n in json.loads(capsys.readouterr().out) if "counts" in n}
     assert from_bag == {n["node"]: n["counts"] for n in run["record"]["nodes"]}
     # the calls replayed through the call book: the same summary as the live run's

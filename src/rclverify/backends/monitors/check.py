@@ -528,12 +528,15 @@ class NodeMonitor:
 
 def check_trace(checked: Checked, nodes: Iterable[CheckedNode], events: Iterable[Event],
                 rules: Mapping[str, TopicRule], horizon: float,
-                on_verdict: Callable[[Verdict], None] | None = None) -> tuple[int, list[NodeResult]]:
+                on_verdict: Callable[[Verdict], None] | None = None,
+                end: float | None = None) -> tuple[int, list[NodeResult]]:
     """Stream ``events`` through a monitor per node; returns (events read, results).
 
     The online engine (:class:`NodeMonitor`) run over a recorded trace: each
     event is fed in order, the clock advanced to the last event's time at the
-    end, then every monitor finished.  ``on_verdict`` receives every event's
+    end (or to ``end``, seconds, when the run is known to have gone on after
+    its last event: a live run's log, whose monitor kept its clock), then
+    every monitor finished.  ``on_verdict`` receives every event's
     verdict as it is decided.  Raises whatever the event source raises
     (:class:`TraceError`) after the events before it were processed.
     """
@@ -548,5 +551,5 @@ def check_trace(checked: Checked, nodes: Iterable[CheckedNode], events: Iterable
         for m in monitors:
             m.feed(ev)
     for m in monitors:
-        m.advance(last_time)
+        m.advance(max(last_time, end) if end is not None else last_time)
     return count, [m.finish() for m in monitors]

@@ -37,6 +37,10 @@ from ...ros.dds import take_raw
 from ...ros.dds_discovery import Discovery
 from ...ros.dds_qos import QosProfile, mismatches, reader_for, to_dds
 
+#: Seconds a warning about a publication waits for ros_discovery_info to name its node (a ROS 2 node
+#: announces itself after its endpoints are discovered); past it, the participant's id is named.
+NAME_GRACE_S = 2.0
+
 
 @dataclass
 class Tap:
@@ -82,6 +86,9 @@ class Bus:
         self._thread = threading.Thread(target=self._run, name="rclverify-dds", daemon=True)
         self.error: BaseException | None = None
         self._lock = threading.Lock()
+        #: first sight (monotonic s) of each publication not yet named by ros_discovery_info: its warning
+        #: waits up to NAME_GRACE_S for the node's announcement, which may come after the endpoint's
+        self._unnamed: dict[bytes, float] = {}
 
     def tap(self, key: str, dds_topic: str, struct: type, where: str) -> Tap:
         """Ask to hear ``dds_topic`` (call before :meth:`start`)."""
@@ -116,7 +123,7 @@ class Bus:
                 now = time.monotonic()
                 if now >= next_poll:  # discovery at most every period, not at every sample
                     next_poll = now + self.period_s
-                    if self.discovery.poll():
+                    if self.discovery.poll() or any(now - t0 >= NAME_GRACE_S for t0 in self._unnamed.values()):
                         self._update()
                 self._drain()
             self._drain(every=True)
@@ -149,7 +156,7 @@ class Bus:
             want = t.struct.__idl_typename__  # type: ignore[attr-defined]
             same = [p for p in pubs if p.type_name == want]
             for p in pubs:
-                if p.type_name != want:
+                if p.type_name != want and (p.guid, "type") not in t.warned and self._named(p.guid):
                     self._warn_once(t, p.guid, "type", f"{t.where}: warning: {t.key}: {disc.who(p)} publishes "
                                     f"{p.type_name}, the contract's type is {want}; its messages are not heard")
             if not same:
@@ -157,6 +164,8 @@ class Bus:
             req, left = reader_for([p.qos for p in same])
             for k in left:
                 p = same[k]
+                if (p.guid, "qos") in t.warned or not self._named(p.guid):
+                    continue
                 self._warn_once(t, p.guid, "qos", f"{t.where}: warning: {t.key}: {disc.who(p)} offers "
                                 f"{p.qos.describe()}; the monitor's reader ({req.describe()}) cannot match it "
                                 f"together with the other publishers: {'; '.join(mismatches(p.qos, req))}; its "
@@ -183,6 +192,18 @@ class Bus:
         t.samples += len(got)
         for raw, info in got:
             self.on_sample(t, raw, info, now)
+
+    def _named(self, guid: bytes) -> bool:
+        """May a warning about publication ``guid`` be said now: its node is known, or the grace for
+        ros_discovery_info to name it has passed (then it is said with the participant's id)."""
+        if self.discovery.node_of(guid):
+            self._unnamed.pop(guid, None)
+            return True
+        first = self._unnamed.setdefault(guid, time.monotonic())
+        if time.monotonic() - first >= NAME_GRACE_S:
+            self._unnamed.pop(guid, None)
+            return True
+        return False
 
     def _warn_once(self, t: Tap, guid: bytes, why: str, text: str) -> None:
         if (guid, why) not in t.warned:
