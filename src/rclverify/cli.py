@@ -150,8 +150,17 @@ def cmd_compose(args: argparse.Namespace) -> int:
         c = stage_compose(ws, n)
         print(f"{n}: rules {', '.join(c['rules']) or '(source node)'}; producers {', '.join(c['producers']) or 'none'}")
         for sc in c["side_conditions"]:
-            variant = f" ({sc['variant']})" if sc["status"] == "discharged" and sc.get("variant") else ""
-            print(f"  side condition {sc['id']} [{sc['status']}]{variant}: {sc['conjunct']}  ({sc['source']})")
+            verdict = sc.get("verdict") or sc["status"]
+            variant = f" ({sc['variant']})" if verdict == "discharged" and sc.get("variant") else ""
+            print(f"  side condition {sc['id']} [{verdict}]{variant}: {sc['conjunct']}  ({sc['source']})")
+            ctx = sc.get("context") or {}
+            if verdict == "discharged in context":
+                print(f"      upstream guarantees used: {', '.join(ctx.get('used_nodes') or []) or 'none'} "
+                      f"(cone of {ctx.get('cone')} nodes)")
+            elif ctx and sc["status"] != "discharged":
+                print(f"      checked in context too (cone of {ctx.get('cone')} nodes)"
+                      + (f"; assumption violated upstream in the counterexample: {', '.join(ctx['violated'])}"
+                         if ctx.get("violated") else ""))
             if sc["status"] != "discharged":
                 print(f"      consumer: {n} assumes {sc['conjunct']}")
                 for h in sc.get("hypotheses", []):

@@ -3,12 +3,14 @@
 Stages and their real file dependencies, per node ``N``:
 
 ``check``          contracts + plan -> artifacts/contracts/N.json (one snapshot per
-                   node, rewritten only when that node's text changes), model, lint
+                   node, rewritten only when that node's text changes), artifacts/cones/N.sha256
+                   (a digest of N's upstream cone's snapshots), model, lint
 ``graph``          model -> model.dot, model.svg (when graphviz is installed); not part of
                    ``verify`` (the report lays out its own diagram, with statuses):
                    ``doit graph`` runs it
 ``node:N``         three stages, each run only when one of its own inputs changed:
-                   compose  snapshot of N and of N's producers + model -> calculus/N.json
+                   compose  snapshot of N and of N's producers, N's cone digest (the
+                            snapshots of its whole upstream cone) + model -> calculus/N.json
                    health   snapshot of N (+ replacement contract) -> health/N.json
                    export   snapshot of N + the backend input files -> obligations/N.json
 ``evidence:ID``     one obligation's record + the files it reads -> its evidence record
@@ -28,7 +30,8 @@ Stages and their real file dependencies, per node ``N``:
 
 doit compares file contents (md5), so editing one node's contract changes
 only that node's snapshot: its node task (all three stages) and run tasks,
-its consumers' node tasks (the compose stage only: their side conditions)
+the node tasks downstream of it (the compose stage only: their side conditions,
+checked in context against the whole upstream cone when they fail locally)
 and the report re-run.  The three stages share one doit task per node
 because doit's own cost per task (defining it, checking its dependencies)
 was most of a no-op run of a large system (docs/scale.md); the task's
@@ -575,7 +578,8 @@ def _build_tasks(root: str | Path, plan_file: str) -> dict[str, Callable[[], Any
     def task_check() -> dict[str, Any]:
         """Parse and type-check the contracts, check the plan, lint, build the system model."""
         return {"actions": [(act_check, [r, plan_file])], "file_dep": check_deps,
-                "targets": list(snap.values()) + [str(rootp / p) for p in (ws.MODEL, ws.DIAGNOSTICS)],
+                "targets": list(snap.values()) + [at(ws.cone(n)) for n in nodes]
+                + [str(rootp / p) for p in (ws.MODEL, ws.DIAGNOSTICS)],
                 "verbosity": 2, "clean": True, **check_extra}
 
     def task_graph() -> dict[str, Any]:
@@ -593,7 +597,8 @@ def _build_tasks(root: str | Path, plan_file: str) -> dict[str, Callable[[], Any
         for n in nodes:
             repl = index.replacement.get(n)
             deps = {
-                "compose": [snap[n], *(snap[p] for p in index.producers[n]), model_json],
+                # the cone's digest: side conditions in context read the whole upstream cone (docs/calculus.md)
+                "compose": [snap[n], *(snap[p] for p in index.producers[n]), at(ws.cone(n)), model_json],
                 "health": [snap[n]] + ([str(rootp / repl)] if repl and (rootp / repl).is_file() else []),
                 "export": [snap[n]] + [at(f) for config in index.entries.get(n, ()) for f in _inputs(config, rootp, seen)],
             }

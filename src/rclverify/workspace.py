@@ -24,7 +24,7 @@ import os
 from dataclasses import dataclass
 from functools import cached_property
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, Callable, Sequence, cast
+from typing import TYPE_CHECKING, Any, Callable, Mapping, Sequence, cast
 
 from .evidence.store import dumps, write_json
 from .rcl.errors import RclError
@@ -182,6 +182,12 @@ class Workspace:
         return f"artifacts/contracts/{node}.json"
 
     @staticmethod
+    def cone(node: str) -> str:
+        """The digest of ``node``'s upstream cone's snapshots (:func:`cone_digests`):
+        an input of its ``compose`` stage, whose in-context side conditions read the whole cone."""
+        return f"artifacts/cones/{node}.sha256"
+
+    @staticmethod
     def calculus(node: str) -> str:
         return f"artifacts/calculus/{node}.json"
 
@@ -268,6 +274,60 @@ def node_snapshots(ws: Workspace, texts: Any) -> dict[str, dict[str, Any]]:
     return out
 
 
+def cone_digests(model: Any, snapshot_sha: Mapping[str, str]) -> dict[str, str]:
+    """``{node: text}``: for every node of ``model`` (a
+    :class:`~rclverify.system.model.SystemModel`) the text of its cone
+    digest file (:meth:`Workspace.cone`), a sha256 that changes whenever the
+    snapshot of any node of its upstream cone changes (``snapshot_sha``:
+    node -> sha256 of its snapshot).
+
+    A node's ``compose`` stage reads the contracts and facts of its whole
+    upstream cone (side conditions in context, docs/calculus.md), so that
+    is its input; one file per node instead of every cone snapshot keeps a
+    chain of N nodes at N inputs, not N*N/2.  The digest is a Merkle hash
+    over the cone's strongly connected components, producers first: a
+    component's is the sha256 of its members' snapshot hashes and of the
+    sorted digests of the components feeding it (the links themselves are
+    the model's, another input of the stage).  O(nodes + links)."""
+    comp: dict[str, tuple[str, ...]] = {n: (n,) for n in model.nodes}
+    for loop in model.loops:
+        for n in loop:
+            comp[n] = tuple(loop)
+    feeds: dict[tuple[str, ...], set[tuple[str, ...]]] = {}
+    for c in set(comp.values()):
+        feeds[c] = {comp[p] for m in c for p in model.producers(m)} - {c}
+    digest: dict[tuple[str, ...], str] = {}
+    for root in dict.fromkeys(comp[n] for n in model.nodes):  # iterative post-order over the component DAG
+        if root in digest:
+            continue
+        stack = [(root, iter(sorted(feeds[root])))]
+        while stack:
+            c, it = stack[-1]
+            for f in it:
+                if f not in digest:
+                    stack.append((f, iter(sorted(feeds[f]))))
+                    break
+            else:
+                stack.pop()
+                if c not in digest:
+                    h = hashlib.sha256()
+                    for m in c:
+                        h.update(f"{m} {snapshot_sha[m]}\n".encode())
+                    h.update(b"--\n")
+                    for d in sorted(digest[f] for f in feeds[c]):
+                        h.update(d.encode() + b"\n")
+                    digest[c] = h.hexdigest()
+    return {n: digest[comp[n]] + "\n" for n in model.nodes}
+
+
+def cone_hashes(ws: Workspace, hashes: Mapping[str, str]) -> dict[str, str]:
+    """``{artifacts/cones/<Node>.sha256: sha256 of its text}`` for the
+    snapshot hashes ``hashes`` (artifact path -> sha256, as
+    :func:`current_snapshot_hashes` gives them)."""
+    texts = cone_digests(ws.model, {n: hashes[ws.snapshot(n)] for n in ws.checked.nodes})
+    return {ws.cone(n): hashlib.sha256(t.encode("utf-8")).hexdigest() for n, t in texts.items()}
+
+
 def check_inputs(ws: Workspace) -> dict[str, str]:
     """``{file: sha256}`` of every file the snapshots and the system model
     are made from: the plan, its contract files and the replacement
@@ -311,8 +371,9 @@ def current_snapshot_hashes(ws: Workspace, texts: Any) -> dict[str, str]:
     if (isinstance(kept, dict) and kept.get("code") == code_stamp() and isinstance(kept.get("hashes"), dict)
             and kept.get(SEAL) == seal_of(kept) and kept.get("inputs") == check_inputs(ws)):
         return {**kept["hashes"], **state_hashes(ws)}
-    return {**{ws.snapshot(n): hashlib.sha256(dumps(snap).encode("utf-8")).hexdigest()
-               for n, snap in node_snapshots(ws, texts).items()}, **current_model_hash(ws), **state_hashes(ws)}
+    snaps = {ws.snapshot(n): hashlib.sha256(dumps(snap).encode("utf-8")).hexdigest()
+             for n, snap in node_snapshots(ws, texts).items()}
+    return {**snaps, **cone_hashes(ws, snaps), **current_model_hash(ws), **state_hashes(ws)}
 
 
 def state_hashes(ws: Workspace) -> dict[str, str]:
@@ -342,14 +403,19 @@ def record_provenance(ws: Workspace, node: str, stage: str, inputs: Sequence[str
     write_sealed(ws.path(rel), current)
 
 
-def stage_inputs(ws: Workspace, node: str, stage: str) -> list[str]:
+def stage_inputs(ws: Workspace, node: str, stage: str, in_context: bool = True) -> list[str]:
     """The workspace-relative files the contents of ``stage`` (``compose`` or
     ``health``) of ``node`` are made from: its snapshot, for ``compose`` its
-    producers' snapshots and the system model, for ``health`` the plan's
-    replacement contract file if any.  (Export's are the inputs of each
-    obligation, hashed into its evidence.)"""
+    producers' snapshots, its cone digest (:meth:`Workspace.cone`: the side
+    conditions in context read the whole upstream cone; not with
+    ``in_context=False``: the record of a composition whose side conditions
+    were all decided locally, which the rest of the cone cannot change) and
+    the system model, for ``health`` the plan's replacement contract file
+    if any.  (Export's are the inputs of each obligation, hashed into its
+    evidence.)"""
     if stage == "compose":
-        return [ws.snapshot(node), *(ws.snapshot(p) for p in ws.model.producers(node)), ws.MODEL]
+        return [ws.snapshot(node), *(ws.snapshot(p) for p in ws.model.producers(node)),
+                *([ws.cone(node)] if in_context else []), ws.MODEL]
     repl = ws.plan.replacements.get(node)
     return [ws.snapshot(node)] + ([repl[0].rpartition(":")[0]] if repl else [])
 
@@ -372,7 +438,9 @@ def stale_stages(ws: Workspace, current: dict[str, str]) -> dict[str, set[str]]:
             if not os.path.exists(os.path.join(ws.root, artifact)):
                 continue
             made = rec.get(stage) if isinstance(rec, dict) else None
-            if not isinstance(made, dict) or set(made) != set(stage_inputs(ws, n, stage)):
+            allowed = [set(stage_inputs(ws, n, stage))] + ([set(stage_inputs(ws, n, stage, False))]
+                                                           if stage == "compose" else [])
+            if not isinstance(made, dict) or set(made) not in allowed:
                 out.setdefault(n, set()).add(stage)
                 continue
             missing = [p for p in made if p not in current]

@@ -36,6 +36,15 @@ Two variants, tried in order (docs/architecture.md, "Side conditions"):
 A counterexample is only ever shown from the second variant, so it
 satisfies the producers' assumptions as well as their guarantees.
 
+A side condition that neither variant discharges is tried a third time, ``in
+context`` (:mod:`.context`; docs/calculus.md): against the whole upstream
+cone, each guarantee under its own node's assumption, with the environment
+assumptions and facts of the cone, the cone's loops opened as rule R4 does.
+Its verdict (``verdict``) is ``discharged`` (locally, by one of the two
+variants above), ``discharged in context`` (the upstream premises used are
+named), ``failed`` (with the counterexample of the whole cone; a local
+refutation the cone does not rule out) or ``inconclusive``.
+
 Each rule instance is labelled with the rule actually applied, from the
 graph's shape: R3 (join) when several nodes feed the node, R2 (branch) when
 its single producer's output is also read by another node, R1 (sequence)
@@ -44,9 +53,10 @@ otherwise; R4 is added for a node on a cycle.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any, Sequence
+from typing import Any, Mapping, Sequence
 
 from ..logic.encode import Encoder
+from .context import ConeContext, ContextResult
 from ..logic.query import DEFAULT_TIMEOUT_MS, prove, solver_session
 from ..rcl import ast
 from ..rcl.printer import expr_to_rcl
@@ -108,12 +118,20 @@ class SideCondition:
     explanation: str = ""
     variant: str = ""
     links: tuple[str, ...] = ()
+    #: ``discharged`` (locally), ``discharged in context``, ``failed`` or ``inconclusive`` (module docstring)
+    verdict: str = ""
+    #: how the in-context check went (``None`` when the side condition was discharged locally): ``cone``
+    #: (its size), ``used`` (premises of the proof), ``used_nodes``, ``opened`` (links opened, rule R4),
+    #: ``violated`` (nodes whose assumption the counterexample violates), ``joins``, ``local`` (the
+    #: local verdict: ``status``, ``variant``, ``model``)
+    context: dict[str, Any] | None = None
 
     def to_json(self, smt2_path: str) -> dict[str, Any]:
         return {"id": self.id, "node": self.node, "rule": self.rule, "conjunct": self.conjunct,
                 "source": self.source, "hypotheses": list(self.hypotheses), "status": self.status,
                 "duration_s": self.duration_s, "smt2": smt2_path, "model": self.model,
-                "explanation": self.explanation, "variant": self.variant, "links": list(self.links)}
+                "explanation": self.explanation, "variant": self.variant, "links": list(self.links),
+                "verdict": self.verdict or self.status, "context": self.context}
 
 
 @dataclass(frozen=True)
@@ -135,6 +153,11 @@ class NodeComposition:
 
 VARIANT_AS_WRITTEN = "as written"
 VARIANT_WITH_ASSUMPTIONS = "with producers' assumptions"
+VARIANT_IN_CONTEXT = "in context"
+#: How many premises of an in-context proof its explanation names (all are its hypotheses).
+NAMED = 8
+#: The verdict of a side condition discharged against its upstream cone.
+IN_CONTEXT = "discharged in context"
 
 
 def branch_siblings(model: SystemModel, node: str) -> list[str]:
@@ -205,9 +228,13 @@ def _environment_texts(checked: Checked, model: SystemModel, node: str) -> tuple
 
 @solver_session()
 def compose_node(checked: Checked, model: SystemModel, node: str, *,
+                 facts: Mapping[str, Sequence[ast.Expr]] | None = None,
                  timeout_ms: int = DEFAULT_TIMEOUT_MS) -> NodeComposition:
     """Apply the calculus to ``node``: discharge its side conditions with Z3.
 
+    ``facts`` are the plan's environment facts per node (RCL formulas over
+    that node's inputs and outputs); only a side condition that fails
+    locally reads them, with the rest of its upstream cone (:mod:`.context`).
     Returns a :class:`NodeComposition`.  Never raises on solver trouble
     (an unknown answer is an ``inconclusive`` side condition).  The side
     conditions share one solver session
@@ -233,6 +260,7 @@ def compose_node(checked: Checked, model: SystemModel, node: str, *,
     rule = instance_rule(model, node) or "R1"
     who = ", ".join(producers)
     scs = []
+    cone_ctx: ConeContext | None = None
     for k, c in enumerate(internal, 1):
         goal = enc.formula(c, cn)
         links = _links_of(model, cn, node, c)
@@ -270,9 +298,16 @@ def compose_node(checked: Checked, model: SystemModel, node: str, *,
                          "is not shown.")
         if r.strategy:
             expl += f" Z3's default strategy gave up; answered with {r.strategy}."
-        scs.append(SideCondition(f"{node}.sc{k}", node, rule, expr_to_rcl(c), _loc(c.loc), used_text,
-                                 status, round(first.duration_s + (r.duration_s if r is not first else 0.0), 4),
-                                 r.smt2, r.model, expl, variant, tuple(links)))
+        duration = round(first.duration_s + (r.duration_s if r is not first else 0.0), 4)
+        sc = SideCondition(f"{node}.sc{k}", node, rule, expr_to_rcl(c), _loc(c.loc), used_text,
+                           status, duration, r.smt2, r.model, expl, variant, tuple(links), status)
+        if status != "discharged":  # context before blame (docs/calculus.md)
+            if cone_ctx is None:
+                cone_ctx = ConeContext(checked, model, node, lambda m: split_assumption(checked, model, m)[1], facts)
+            cr = cone_ctx.decide(c, head + "\nvariant: " + VARIANT_IN_CONTEXT + " (the upstream cone; "
+                                 "each guarantee under its node's assumption)", timeout_ms)
+            sc = in_context(sc, cr, cone_ctx, who)
+        scs.append(sc)
     env_assumptions = tuple({"node": node, "text": expr_to_rcl(c), "source": _loc(c.loc)} for c in env)
     g_text = contract_text([g.formula for g in cn.node.guarantees])
     a_text = contract_text([a.formula for a in cn.node.assumes])
@@ -301,6 +336,57 @@ def compose_node(checked: Checked, model: SystemModel, node: str, *,
     return NodeComposition(node, rules, tuple(producers), tuple(scs), env_assumptions, tuple(instances), derived,
                            tuple(cone), R4_ASSUMPTION.format(loop="{" + ", ".join(loop) + "}") if loop else None,
                            cone_env, g_text)
+
+
+def in_context(sc: SideCondition, cr: ContextResult, ctx: ConeContext, who: str) -> SideCondition:
+    """``sc`` (decided locally, not discharged) with the verdict of its
+    in-context check ``cr`` over the cone ``ctx`` (:mod:`.context`): the
+    status, verdict, hypotheses, model, explanation, SMT-LIB2 text (the local
+    query, ``(reset)``, the in-context query) and the ``context`` record."""
+    node = sc.node
+    local = {"status": sc.status, "variant": sc.variant, "model": sc.model}
+    size = len(ctx.cone)
+    record: dict[str, Any] = {"cone": size, "used": [u.split(":", 1)[0] for u in cr.used],
+                              "used_nodes": list(cr.used_nodes),
+                              "opened": list(ctx.cut), "violated": list(cr.violated), "joins": list(cr.joins),
+                              "local": local}
+    opened = ("; the loop of its cone is opened at " + ", ".join(ctx.cut) + " (rule R4, paper lines 717-768: "
+              "the value read there is taken as arbitrary, so no guarantee is used to discharge its own premise)"
+              if ctx.cut else "")
+    cone_words = (f"the upstream cone of {node} ({size} node{'s' if size != 1 else ''}: every guarantee under its "
+                  f"own node's assumption, the environment assumptions and facts{opened})")
+    local_words = (f"The guarantees of {who} alone do not entail this conjunct of {node}'s assumption "
+                   f"({'refuted' if sc.status == 'failed' else 'undecided'} locally, {sc.variant})")
+    smt2 = sc.smt2 + "\n(reset)\n" + cr.smt2
+    duration = round(sc.duration_s + cr.duration_s, 4)
+    strategy = f" Z3's default strategy gave up on the in-context query; answered with {cr.strategy}." if cr.strategy else ""
+    if cr.status == "proved":
+        labels = [u.split(":", 1)[0] for u in cr.used]
+        named = ", ".join(labels[:NAMED]) + (f" and {len(labels) - NAMED} more premises (all listed as its hypotheses)"
+                                              if len(labels) > NAMED else "") if labels else "no premise"
+        expl = (f"Discharged in context. {local_words}, but {cone_words} does: Z3 proved it from {named}. Sound for "
+                f"the composed system as long as the environment assumptions of the cone hold.")
+        if cr.joins:
+            expl += (f" The proof reads {', '.join(cr.joins)} along more than one path; like the requirement checks "
+                     "it rests on R3's simplifying assumption that the outputs a join reads persist and are available "
+                     "together (paper line 660).")
+        return SideCondition(sc.id, node, sc.rule, sc.conjunct, sc.source, tuple(cr.used), "discharged", duration,
+                             smt2, None, expl + strategy, VARIANT_IN_CONTEXT, sc.links, IN_CONTEXT, record)
+    if cr.status == "refuted":
+        expl = (f"{sc.explanation} Checked in context too: with {cone_words}, Z3 still finds values violating it "
+                "(the counterexample of the whole cone below).")
+        if cr.violated:
+            expl += (f" In it the assumption of {', '.join(cr.violated)} does not hold, so "
+                     f"{'its guarantees promise' if len(cr.violated) == 1 else 'their guarantees promise'} nothing "
+                     "there: the side conditions upstream are the first to repair.")
+        if ctx.cut:
+            expl += " The value on an opened link is arbitrary, so the counterexample may use one the loop never produces."
+        return SideCondition(sc.id, node, sc.rule, sc.conjunct, sc.source, sc.hypotheses, "failed", duration,
+                             smt2, cr.model, expl + strategy, VARIANT_IN_CONTEXT, sc.links, "failed", record)
+    expl = (f"{local_words}; checked in context, with {cone_words}, Z3 could not decide it ({cr.reason or 'unknown'}). "
+            "It is not proved, and no counterexample of the whole cone is known.")
+    return SideCondition(sc.id, node, sc.rule, sc.conjunct, sc.source, sc.hypotheses, "inconclusive", duration,
+                         smt2, None, expl + strategy, VARIANT_IN_CONTEXT, sc.links, "inconclusive", record)
 
 
 def _shape(rule: str, producers: Sequence[str], node: str, siblings: Sequence[str]) -> str:
