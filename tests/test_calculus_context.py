@@ -220,6 +220,10 @@ def test_in_context_verdict_equals_brute_force_enumeration(seed: int) -> None:
             from rclverify.rcl.printer import expr_to_rcl
             goal = by_text[expr_to_rcl(c)]
             r = ctx.decide(c, "oracle", 5000)
+            # the encoder's way (every formula through the Z3 API) decides the same
+            slow = ConeContext(checked, model, n, lambda m: split_assumption(checked, model, m)[1], facts, fast=False)
+            assert ctx.all_text and not slow.all_text
+            assert slow.decide(c, "oracle", 5000).status == r.status
             expected = _brute(nodes, n, ctx.cone, goal)
             # premises no valuation satisfies prove nothing: inconclusive, or proved from a consistent part
             allowed = {"holds": {"proved"}, "fails": {"refuted"}, "vacuous": {"proved", "inconclusive"}}[expected]

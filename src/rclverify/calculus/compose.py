@@ -222,8 +222,23 @@ def _environment_texts(checked: Checked, model: SystemModel, node: str) -> tuple
         _ENV_TEXTS["key"], _ENV_TEXTS["texts"] = (checked, model), {}
     texts: dict[str, tuple[str, ...]] = _ENV_TEXTS["texts"]
     if node not in texts:
-        texts[node] = tuple(expr_to_rcl(c) for c in split_assumption(checked, model, node)[1])
+        texts[node] = tuple(expr_to_rcl(c) for c in environment_conjuncts(checked, model, node))
     return texts[node]
+
+
+def environment_conjuncts(checked: Checked, model: SystemModel, node: str) -> tuple[ast.Expr, ...]:
+    """The environment conjuncts of ``node``'s assumption
+    (:func:`split_assumption`), remembered like :func:`_environment_texts`:
+    the in-context check of every node downstream reads them."""
+    if _ENV_TEXTS["key"] is None or _ENV_TEXTS["key"][0] is not checked or _ENV_TEXTS["key"][1] is not model:
+        _ENV_TEXTS["key"], _ENV_TEXTS["texts"] = (checked, model), {}
+    exprs: dict[str, tuple[ast.Expr, ...]] = _ENV_TEXTS.setdefault("exprs", {})
+    if _ENV_TEXTS.get("exprs_key") is not _ENV_TEXTS["key"]:
+        exprs.clear()
+        _ENV_TEXTS["exprs_key"] = _ENV_TEXTS["key"]
+    if node not in exprs:
+        exprs[node] = tuple(split_assumption(checked, model, node)[1])
+    return exprs[node]
 
 
 @solver_session()
@@ -303,7 +318,7 @@ def compose_node(checked: Checked, model: SystemModel, node: str, *,
                            status, duration, r.smt2, r.model, expl, variant, tuple(links), status)
         if status != "discharged":  # context before blame (docs/calculus.md)
             if cone_ctx is None:
-                cone_ctx = ConeContext(checked, model, node, lambda m: split_assumption(checked, model, m)[1], facts)
+                cone_ctx = ConeContext(checked, model, node, lambda m: environment_conjuncts(checked, model, m), facts)
             cr = cone_ctx.decide(c, head + "\nvariant: " + VARIANT_IN_CONTEXT + " (the upstream cone; "
                                  "each guarantee under its node's assumption)", timeout_ms)
             sc = in_context(sc, cr, cone_ctx, who)

@@ -51,11 +51,12 @@ from typing import Any, Callable, Mapping, Sequence
 import z3
 
 from ..logic.encode import Encoder
-from ..logic.query import query_solver, render_model, satisfiable, smt2_script
+from ..logic.query import query_solver, render_model, satisfiable, smt2_script, smtlib_benchmark
 from ..rcl import ast
 from ..rcl.printer import expr_to_rcl
 from ..rcl.types import Checked
 from ..system.model import Link, SystemModel
+from .smttext import SORTS, quote, to_smt
 
 NEGATED = "negated side condition"
 #: Budget of the query that checks the premises of an in-context proof can hold together (milliseconds).
@@ -159,6 +160,71 @@ def _multi_path(model: SystemModel, node: str, cone: Sequence[str], cut: set[tup
     return {v for v, k in paths.items() if k > 1}
 
 
+@dataclass(frozen=True)
+class _NodePremises:
+    """What one node of a cone contributes, as data (no Z3 object), kept
+    per process by :func:`_node_premises`.  ``items``: ``(label, RCL text,
+    kind, index, SMT-LIB text or None)`` with kind ``guarantee``,
+    ``environment`` or ``fact``; ``assumption``: the SMT-LIB text of the
+    node's assumption (``None``: none or ``TRUE``); ``smt``: every formula
+    of the node is in :mod:`.smttext`'s fragment; ``symbols``: ``{symbol
+    name: (prefix, var)}`` of the I/O the texts mention."""
+
+    items: tuple[tuple[str, str, str, int, str | None], ...]
+    assumption: str | None
+    smt: bool
+    symbols: tuple[tuple[str, str, str], ...]
+
+
+_PREMISES: dict[str, Any] = {"key": None, "nodes": {}}
+
+
+def _node_premises(checked: Checked, model: SystemModel, m: str, consumer: bool,
+                   environment: Sequence[ast.Expr], facts: Sequence[ast.Expr],
+                   symbol: Mapping[tuple[str, str], str]) -> _NodePremises:
+    """Node ``m``'s premises (``consumer``: ``m`` is the node whose side
+    condition is decided: its own guarantees are no premise), remembered
+    for the last (checked, model) pair by everything they depend on (the
+    node, its role, its facts' text, the symbols of its I/O): along a chain
+    each node is in the cone of every node after it."""
+    if _PREMISES["key"] is None or _PREMISES["key"][0] is not checked or _PREMISES["key"][1] is not model:
+        _PREMISES["key"], _PREMISES["nodes"] = (checked, model), {}
+    fact_texts = tuple(expr_to_rcl(f) for f in facts)
+    key = (m, consumer, fact_texts, tuple(sorted(symbol.items())))
+    cache: dict[Any, _NodePremises] = _PREMISES["nodes"]
+    hit = cache.get(key)
+    if hit is not None:
+        return hit
+    cn = checked.nodes[m]
+    used: dict[str, str] = {}
+    items: list[tuple[str, str, str, int, str | None]] = []
+    assumption: str | None = None
+    smt = True
+    if not consumer:
+        parts = [a.formula for a in cn.node.assumes if not (isinstance(a.formula, ast.BoolLit) and a.formula.value)]
+        texts = [to_smt(a, cn, symbol, used) for a in parts]
+        smt = smt and all(t is not None for t in texts)
+        if parts and smt:
+            assumption = texts[0] if len(texts) == 1 else "(and " + " ".join(t or "" for t in texts) + ")"
+        for k, g in enumerate(cn.node.guarantees, 1):
+            t = to_smt(g.formula, cn, symbol, used)
+            smt = smt and t is not None
+            items.append((f"{m} guarantee {k}", expr_to_rcl(g.formula) + (" (under its assumption)" if parts else ""),
+                          "guarantee", k, t))
+    for k, c in enumerate(environment, 1):
+        t = to_smt(c, cn, symbol, used)
+        smt = smt and t is not None
+        items.append((f"{m} environment assumption {k}", expr_to_rcl(c), "environment", k, t))
+    for k, (f, ftext) in enumerate(zip(facts, fact_texts), 1):
+        t = to_smt(f, cn, symbol, used)
+        smt = smt and t is not None
+        items.append((f"{m} environment fact {k}", ftext, "fact", k, t))
+    names = {name: pv for pv, name in symbol.items()}
+    out = _NodePremises(tuple(items), assumption, smt, tuple((n, *names[n]) for n in sorted(used)))
+    cache[key] = out
+    return out
+
+
 class ConeContext:
     """The upstream cone of one consumer as labelled Z3 premises, built once
     per node (its side conditions share it) and only when one of them fails
@@ -168,81 +234,166 @@ class ConeContext:
     ``environment(m)`` the environment conjuncts of node ``m``'s assumption
     (the calculus's own split, :func:`.compose.split_assumption`, passed in:
     this module sits below it); ``facts`` the plan's environment facts per
-    node (RCL formulas over that node's I/O).
+    node (RCL formulas over that node's I/O); ``fast``: read the formulas of
+    :mod:`.smttext`'s fragment from their SMT-LIB text (``False``: encode
+    every formula with the encoder; the verdicts are the same, tests).
+
+    Each premise ``k`` is asserted as ``l!k -> premise`` and the query is
+    checked under the literals ``l!k`` (their unsat core names the premises
+    used); each node ``m`` with an assumption has a Boolean ``A!m`` defined
+    as it, so a counterexample says which assumptions it violates.
     """
 
     def __init__(self, checked: Checked, model: SystemModel, node: str,
                  environment: Callable[[str], Sequence[ast.Expr]],
-                 facts: Mapping[str, Sequence[ast.Expr]] | None = None) -> None:
+                 facts: Mapping[str, Sequence[ast.Expr]] | None = None, *, fast: bool = True) -> None:
         self.node = node
         self.cone = model.upstream(node)
         cut = opened_links(model, node)
         self.cut = tuple(link_text(l) for l in cut)
         cut_keys = {(l.to_node, "in", l.to_var) for l in cut}
         alias = {k: v for k, v in model.alias().items() if k not in cut_keys} if cut else model.alias()
-        self.enc = Encoder(checked.env, alias)
+        self.enc = enc = Encoder(checked.env, alias)
         self.checked = checked
-        self.premises: list[tuple[str, z3.BoolRef]] = []
+        self.labels: list[str] = []
+        self.tracked: list[z3.BoolRef] = []  # l!k -> premise k
+        self.literals: list[z3.BoolRef] = []  # l!k
+        self.definitions: list[z3.BoolRef] = []  # A!m == assumption of m
+        self.flags: dict[str, str] = {}  # node -> the name of its A!m
+        self.flag_nodes: list[str] = []  # the node of each definition
         self.text: dict[str, str] = {}
-        self.assumption: dict[str, z3.BoolRef] = {}
         self.node_of: dict[str, str] = {}
         self.joins = _multi_path(model, node, self.cone, {(l.from_node, l.from_var, l.to_node, l.to_var) for l in cut})
-        enc = self.enc
+        described = []
         for m in self.cone:
             cn = checked.nodes[m]
-            if m != node:
-                parts = [enc.formula(a.formula, cn) for a in cn.node.assumes
-                         if not (isinstance(a.formula, ast.BoolLit) and a.formula.value)]
-                a = z3.And(*parts) if len(parts) > 1 else parts[0] if parts else None
-                if a is not None:
-                    self.assumption[m] = a
-                for k, g in enumerate(cn.node.guarantees, 1):
-                    gf = enc.formula(g.formula, cn)
-                    self._add(f"{m} guarantee {k}", m, z3.Implies(a, gf) if a is not None else gf,
-                              expr_to_rcl(g.formula) + (" (under its assumption)" if a is not None else ""))
-            for k, c in enumerate(environment(m), 1):
-                self._add(f"{m} environment assumption {k}", m, enc.formula(c, cn), expr_to_rcl(c))
-            for k, f in enumerate((facts or {}).get(m, ()), 1):
-                self._add(f"{m} environment fact {k}", m, enc.formula(f, cn), expr_to_rcl(f))
+            symbol = {(p, v): enc.symbol_name(m, p, v) for p, table in (("in", cn.inputs), ("out", cn.outputs))
+                      for v in table}
+            described.append((m, _node_premises(checked, model, m, m == node, environment(m),
+                                                (facts or {}).get(m, ()), symbol)))
+        for m, d in described:
+            for label, text, _, _, _ in d.items:
+                self.labels.append(label)
+                self.text[label] = text
+                self.node_of[label] = m
+        self.all_text = fast and all(d.smt for _, d in described)
+        self.script_text = ""
+        lines: list[str] = []  # the fragment's premises, one parse for the whole cone
+        decls: dict[str, str] = {}
+        k = 0
+        for m, d in described:
+            n_items = len(d.items)
+            if fast and d.smt:
+                for name, p, v in d.symbols:
+                    enc.io_symbol(checked.nodes[m], p, v)  # the encoder knows every symbol: models, NATURAL axioms
+                    decls[name] = _sort_of_symbol(checked.nodes[m], p, v)
+                flag = None
+                if d.assumption is not None:
+                    flag = f"A!{m}"
+                    self.flags[m] = flag
+                    lines.append(f"(assert (= {quote(flag)} {d.assumption}))")
+                for j, (_, _, kind, _, t) in enumerate(d.items):
+                    body = f"(=> {quote(flag)} {t})" if kind == "guarantee" and flag else t
+                    lines.append(f"(assert (=> {quote(f'l!{k + j}')} {body}))")
+            k += n_items
+        parsed = iter(z3.parse_smt2_string(_declare(decls, self.flags.values(), len(self.labels)) + "\n".join(lines))
+                      if lines else [])
+        k = 0
+        for m, d in described:
+            if fast and d.smt:
+                if m in self.flags:
+                    self.definitions.append(next(parsed))
+                    self.flag_nodes.append(m)
+                for _ in d.items:
+                    f = next(parsed)
+                    self.tracked.append(f)
+                    self.literals.append(f.arg(0))
+            else:
+                for j, f in enumerate(self._encode(checked.nodes[m], m, m == node, environment(m),
+                                                   (facts or {}).get(m, ()))):
+                    lit = z3.Bool(f"l!{k + j}")
+                    self.tracked.append(z3.Implies(lit, f))
+                    self.literals.append(lit)
+            k += len(d.items)
+        if self.all_text:
+            self.script_text = _declare(decls, self.flags.values(), len(self.labels)) + "\n".join(lines)
 
-    def _add(self, label: str, node: str, f: z3.BoolRef, text: str) -> None:
-        self.premises.append((label, f))
-        self.text[label] = text
-        self.node_of[label] = node
+    def _encode(self, cn: Any, m: str, consumer: bool, environment: Sequence[ast.Expr],
+                facts: Sequence[ast.Expr]) -> list[z3.BoolRef]:
+        """The node's premises (in :class:`_NodePremises` order) through the
+        encoder; its assumption becomes the definition of ``A!m``."""
+        enc, out = self.enc, []
+        if not consumer:
+            parts = [enc.formula(x.formula, cn) for x in cn.node.assumes
+                     if not (isinstance(x.formula, ast.BoolLit) and x.formula.value)]
+            flag = None
+            if parts:
+                self.flags[m] = f"A!{m}"
+                flag = z3.Bool(self.flags[m])
+                self.definitions.append(flag == (z3.And(*parts) if len(parts) > 1 else parts[0]))
+                self.flag_nodes.append(m)
+            out += [z3.Implies(flag, g) if flag is not None else g
+                    for g in (enc.formula(g.formula, cn) for g in cn.node.guarantees)]
+        out += [enc.formula(c, cn) for c in environment]
+        out += [enc.formula(f, cn) for f in facts]
+        return out
 
     def decide(self, conjunct: ast.Expr, comment: str, timeout_ms: int) -> ContextResult:
         """Is ``conjunct`` (of the consumer's assumption) entailed by the
         cone's premises?  Never raises on solver trouble."""
         goal = self.enc.formula(conjunct, self.checked.nodes[self.node])
-        labelled = self.premises + [(NEGATED, z3.Not(goal))]
-        background = self.enc.axioms()
-        script = smt2_script(background + [f for _, f in labelled], comment)
+        negated = z3.Bool("l!goal")
+        background = self.enc.axioms() + self.definitions
+        tracked = self.tracked + [z3.Implies(negated, z3.Not(goal))]
+        literals = self.literals + [negated]
+        labels = self.labels + [NEGATED]
+        script = self._script(background, tracked, literals, comment)
         t0 = time.perf_counter()
         core: list[str] | None = None
         with query_solver(timeout_ms, cores=True) as s:
             s.add(*background)
-            for k, (_, f) in enumerate(labelled):
-                s.assert_and_track(f, z3.Bool(f"__ctx_{k}"))
-            r = s.check()
+            s.add(*tracked)
+            r = s.check(*literals)
             dt = round(time.perf_counter() - t0, 4)
             if r == z3.unsat:
                 found = {str(c) for c in s.unsat_core()}
-                core = [lbl for k, (lbl, _) in enumerate(labelled) if f"__ctx_{k}" in found]
+                core = [lbl for lbl, lit in zip(labels, literals) if str(lit) in found]
             elif r == z3.sat:
                 m = s.model()
-                violated = tuple(n for n, a in self.assumption.items()
-                                 if z3.is_false(m.eval(a, model_completion=True)))
+                violated = tuple(n for n, d in zip(self.flag_nodes, self.definitions)
+                                 if z3.is_false(m.eval(d.arg(0), model_completion=True)))
                 return ContextResult("refuted", script(), dt, model=render_model(m, self.enc), violated=violated)
         if core is not None:  # after the query's scope is popped: the consistency query asks in a scope of its own
             return self._proved(core, script, dt)
         # unknown: the retries of logic/retry.py (fresh solvers), which answer without a Z3 model object
-        rr = satisfiable(labelled, self.enc, timeout_ms=timeout_ms, comment=comment)
+        plain = [(lbl, z3.substitute(f, (lit, z3.BoolVal(True)))) for lbl, f, lit in zip(labels, tracked, literals)]
+        if self.definitions:
+            plain.append(("definitions", z3.And(*self.definitions)))
+        rr = satisfiable(plain, self.enc, timeout_ms=timeout_ms, comment=comment)
         dt = round(time.perf_counter() - t0, 4)
         if rr.status == "unsat":
-            return self._proved(list(rr.core or []), script, dt, rr.strategy)
+            return self._proved([c for c in rr.core or [] if c != "definitions"], script, dt, rr.strategy)
         if rr.status == "sat":
             return ContextResult("refuted", script(), dt, model=rr.model, strategy=rr.strategy)
         return ContextResult("inconclusive", script(), dt, reason=rr.reason or "unknown")
+
+    def _script(self, background: Sequence[z3.BoolRef], tracked: Sequence[z3.BoolRef],
+                literals: Sequence[z3.BoolRef], comment: str) -> Callable[[], str]:
+        """The query's SMT-LIB2 text (made when asked for): the parsed text
+        itself when every premise is in the fragment, else Z3's printing;
+        the premises' literals asserted, so the script's ``(check-sat)`` is
+        the query."""
+        header = "".join(f"; {line}\n" for line in comment.splitlines())
+        if self.all_text:
+            def text() -> str:
+                goal_and_axioms = smtlib_benchmark(list(background[:len(background) - len(self.definitions)])
+                                                   + [tracked[-1], literals[-1]])
+                body = self.script_text + "\n" + "\n".join(f"(assert {quote(f'l!{k}')})"
+                                                              for k in range(len(literals) - 1))
+                # the goal, the axioms and the goal's literal: Z3's printing of those few formulas (with declarations)
+                return header + _merge(body, goal_and_axioms)
+            return text
+        return smt2_script(list(background) + list(tracked) + list(literals), comment)
 
     def _proved(self, core: Sequence[str], script: Any, dt: float, strategy: str = "") -> ContextResult:
         """The unsat answer, believed only when the premises it used can hold
@@ -256,15 +407,46 @@ class ConeContext:
             return ContextResult("inconclusive", script(), dt, used=text, strategy=strategy,
                                  reason="the premises of the cone contradict each other (unsat core: "
                                         + "; ".join(used) + "), so they entail anything")
-        by_label = dict(self.premises)
-        r = satisfiable([(c, by_label[c]) for c in used], self.enc, timeout_ms=CONSISTENCY_TIMEOUT_MS,
-                        comment=f"side condition of {self.node} in context: can the premises its proof used hold together?")
-        dt = round(dt + r.duration_s, 4)
-        if r.status != "sat":
-            why = ("contradict each other (unsat core: " + "; ".join(r.core or []) + ")" if r.status == "unsat"
-                   else f"may contradict each other (Z3 could not decide: {r.reason or 'unknown'})")
+        index = {lbl: k for k, lbl in enumerate(self.labels)}
+        t0 = time.perf_counter()
+        with query_solver(CONSISTENCY_TIMEOUT_MS, cores=True) as s:
+            s.add(*self.enc.axioms(), *self.definitions)
+            s.add(*[self.tracked[index[c]] for c in used])
+            r = s.check(*[self.literals[index[c]] for c in used])
+            ccore = [str(c) for c in s.unsat_core()] if r == z3.unsat else []
+            reason = s.reason_unknown() if r == z3.unknown else ""
+        dt = round(dt + time.perf_counter() - t0, 4)
+        if r != z3.sat:
+            names = {str(self.literals[index[c]]): c for c in used}
+            why = ("contradict each other (unsat core: " + "; ".join(names[c] for c in ccore if c in names) + ")"
+                   if r == z3.unsat else f"may contradict each other (Z3 could not decide: {reason or 'unknown'})")
             return ContextResult("inconclusive", script(), dt, used=text, strategy=strategy,
                                  reason=f"the premises the proof used {why}, so the proof establishes nothing")
         nodes = tuple(dict.fromkeys(self.node_of[c] for c in used if " guarantee " in c))
         return ContextResult("proved", script(), dt, used=text, used_nodes=nodes,
                              joins=tuple(n for n in nodes if n in self.joins), strategy=strategy)
+
+
+def _sort_of_symbol(cn: Any, prefix: str, var: str) -> str:
+    t = (cn.inputs if prefix == "in" else cn.outputs)[var]
+    return SORTS[t]
+
+
+def _declare(symbols: Mapping[str, str], flags: Any, n_literals: int) -> str:
+    """SMT-LIB declarations of the cone's I/O symbols, the assumption flags
+    ``A!m`` and the premise literals ``l!k``."""
+    out = [f"(declare-fun {quote(n)} () {sort})" for n, sort in symbols.items()]
+    out += [f"(declare-fun {quote(f)} () Bool)" for f in flags]
+    out += [f"(declare-fun {quote(f'l!{k}')} () Bool)" for k in range(n_literals)]
+    return "\n".join(out) + "\n"
+
+
+def _merge(body: str, benchmark: str) -> str:
+    """One script: ``body`` (declarations and assertions) and the
+    ``benchmark`` Z3 printed for the goal and axioms, whose declarations of
+    symbols ``body`` already declares are dropped."""
+    declared = {line.split()[1].strip("|") for line in body.splitlines() if line.startswith("(declare-fun ")}
+    kept = [line for line in benchmark.splitlines()
+            if not ((line.startswith("(declare-fun ") or line.startswith("(declare-const "))
+                    and line.split()[1].strip("|") in declared)]
+    return body + "\n" + "\n".join(kept) + "\n"
