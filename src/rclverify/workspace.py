@@ -88,6 +88,9 @@ class Workspace:
     #: Set by :func:`rclverify.cache.workspace.restore`: the sha256 of each contract file it found, taken
     #: before any file was parsed; :func:`rclverify.cache.workspace.save` writes them into the new cache.
     cache_shas: dict[str, str] | None = dataclasses.field(default=None, repr=False, compare=False)
+    #: Nodes that may be declared by their interface only (``rclverify quotient``; the type checker's
+    #: ``interface_only``); no stage of the pipeline loads a workspace with any.
+    interface_only: tuple[str, ...] = ()
 
     def path(self, rel: str) -> Path:
         return self.root / rel
@@ -148,7 +151,7 @@ class Workspace:
             specs.append(spec)
         if diags:
             raise RclError(diags)
-        c = check(specs)
+        c = check(specs, self.interface_only)
         from .plan.errors import PlanError
         try:
             resolve(self.plan, c)
