@@ -86,6 +86,9 @@ RULES: Mapping[str, Rule] = {r.id: r for r in (
     Rule("RCL-HEALTH-VACUOUS", "GuaranteeVacuous", "error",
          "The premise of a guarantee can never hold together with the other guarantees and the facts: "
          "it promises nothing."),
+    Rule("RCL-HEALTH-UNREALIZABLE", "ContractUnrealizable", "error",
+         "Some input the node's assumption (and the environment facts) admit has no output satisfying its "
+         "guarantees: no implementation can meet the contract (the input is in the message)."),
     Rule("RCL-HEALTH-REPLACEMENT", "ReplacementDoesNotRefine", "error",
          "The replacement contract offered for the node does not refine the node's contract."),
     Rule("RCL-HEALTH-OTHER", "HealthProblem", "error", "A contract health check found a problem."),
@@ -124,6 +127,7 @@ _REQUIREMENT_RULE = {"refuted": "RCL-REQ-REFUTED", "proved from an inconsistency
 _HEALTH_RULE = {"assumption-satisfiable": "RCL-HEALTH-UNSATISFIABLE-ASSUMPTION",
                 "contract-consistent": "RCL-HEALTH-INCONSISTENT",
                 "non-vacuous": "RCL-HEALTH-VACUOUS",
+                "realizable": "RCL-HEALTH-UNREALIZABLE",
                 "replacement-refines": "RCL-HEALTH-REPLACEMENT"}
 _OBLIGATION_RULE = {"failed": "RCL-OBL-FAILED", "error": "RCL-OBL-ERROR", "stale": "RCL-OBL-STALE",
                     "inconclusive": "RCL-OBL-INCONCLUSIVE", "pending": "RCL-OBL-PENDING"}
