@@ -21,10 +21,12 @@ globals().update(build_tasks(Path(__file__).parent))
 '''
 
 
-def chain_rcl(n: int, *, weak: dict[int, int] | None = None, missing: Sequence[int] = (), typ: str = "REAL") -> str:
+def chain_rcl(n: int, *, weak: dict[int, int] | None = None, missing: Sequence[int] = (), typ: str = "REAL",
+              bound: int = 100) -> str:
     """The RCL text of the chain: ``weak`` maps a node index to the slope
     constant of its first guarantee (``x_{i+1} <= x_i + c``, default 1);
-    the nodes in ``missing`` are declared with their interface only."""
+    the nodes in ``missing`` are declared with their interface only;
+    ``bound`` is the upper bound of every assumption (100 in the issue)."""
     out = []
     for i in range(n):
         head = f"node N{i} {{\n  inputs( x{i} : {typ} )\n  outputs( x{i + 1} : {typ} )\n"
@@ -32,7 +34,7 @@ def chain_rcl(n: int, *, weak: dict[int, int] | None = None, missing: Sequence[i
             out.append(head + "}\n")
             continue
         c = (weak or {}).get(i, 1)
-        out.append(head + f"  assume( 0 <= in.x{i} and in.x{i} <= 100 )\n"
+        out.append(head + f"  assume( 0 <= in.x{i} and in.x{i} <= {bound} )\n"
                           f"  guarantee( out.x{i + 1} <= in.x{i} + {c} )\n"
                           f"  guarantee( 0 <= out.x{i + 1} )\n}}\n")
     return "\n".join(out)

@@ -44,8 +44,10 @@ violates: their guarantees promise nothing there), ``inconclusive``.
 """
 from __future__ import annotations
 
+import re
 import time
 from dataclasses import dataclass
+from fractions import Fraction
 from typing import Any, Callable, Mapping, Sequence
 
 import z3
@@ -56,6 +58,7 @@ from ..rcl import ast
 from ..rcl.printer import expr_to_rcl
 from ..rcl.types import Checked
 from ..system.model import Link, SystemModel
+from ..values import decimal_text
 from .smttext import SORTS, quote, to_smt
 
 NEGATED = "negated side condition"
@@ -350,6 +353,7 @@ class ConeContext:
         script = self._script(background, tracked, literals, comment)
         t0 = time.perf_counter()
         core: list[str] | None = None
+        consistency: tuple[Any, list[str], str] | None = None
         with query_solver(timeout_ms, cores=True) as s:
             s.add(*background)
             s.add(*tracked)
@@ -358,13 +362,30 @@ class ConeContext:
             if r == z3.unsat:
                 found = {str(c) for c in s.unsat_core()}
                 core = [lbl for lbl, lit in zip(labels, literals) if str(lit) in found]
+                if NEGATED in core:  # can the premises used hold together?  Asked of the same solver, the goal off
+                    used = [lit for lbl, lit in zip(labels, literals) if str(lit) in found and lbl != NEGATED]
+                    t1 = time.perf_counter()
+                    r2 = s.check(*used)
+                    names = {str(lit): lbl for lbl, lit in zip(labels, literals)}
+                    consistency = (r2, [names[str(c)] for c in s.unsat_core()] if r2 == z3.unsat else [],
+                                   s.reason_unknown() if r2 == z3.unknown else "")
+                    dt = round(dt + time.perf_counter() - t1, 4)
             elif r == z3.sat:
                 m = s.model()
-                violated = tuple(n for n, d in zip(self.flag_nodes, self.definitions)
-                                 if z3.is_false(m.eval(d.arg(0), model_completion=True)))
-                return ContextResult("refuted", script(), dt, model=render_model(m, self.enc), violated=violated)
-        if core is not None:  # after the query's scope is popped: the consistency query asks in a scope of its own
-            return self._proved(core, script, dt)
+                read = _read_model(m.sexpr()) if self.all_text else None
+                if read is not None:  # the fragment: values read from the model's text, not one object each
+                    values, flags = read
+                    shown = {sym.display: values[name] for name, sym in sorted(self.enc.symbols.items(),
+                                                                               key=lambda kv: kv[1].display)
+                             if name in values}
+                    violated = tuple(n for n in self.flag_nodes if flags.get(self.flags[n]) is False)
+                else:
+                    shown = render_model(m, self.enc)
+                    violated = tuple(n for n, d in zip(self.flag_nodes, self.definitions)
+                                     if z3.is_false(m.eval(d.arg(0), model_completion=True)))
+                return ContextResult("refuted", script(), dt, model=shown, violated=violated)
+        if core is not None:
+            return self._proved(core, script, dt, consistency=consistency)
         # unknown: the retries of logic/retry.py (fresh solvers), which answer without a Z3 model object
         plain = [(lbl, z3.substitute(f, (lit, z3.BoolVal(True)))) for lbl, f, lit in zip(labels, tracked, literals)]
         if self.definitions:
@@ -395,7 +416,8 @@ class ConeContext:
             return text
         return smt2_script(list(background) + list(tracked) + list(literals), comment)
 
-    def _proved(self, core: Sequence[str], script: Any, dt: float, strategy: str = "") -> ContextResult:
+    def _proved(self, core: Sequence[str], script: Any, dt: float, strategy: str = "",
+                consistency: tuple[Any, list[str], str] | None = None) -> ContextResult:
         """The unsat answer, believed only when the premises it used can hold
         together: a proof from contradictory premises (environment
         assumptions or facts that exclude each other) discharges nothing,
@@ -407,18 +429,20 @@ class ConeContext:
             return ContextResult("inconclusive", script(), dt, used=text, strategy=strategy,
                                  reason="the premises of the cone contradict each other (unsat core: "
                                         + "; ".join(used) + "), so they entail anything")
-        index = {lbl: k for k, lbl in enumerate(self.labels)}
-        t0 = time.perf_counter()
-        with query_solver(CONSISTENCY_TIMEOUT_MS, cores=True) as s:
-            s.add(*self.enc.axioms(), *self.definitions)
-            s.add(*[self.tracked[index[c]] for c in used])
-            r = s.check(*[self.literals[index[c]] for c in used])
-            ccore = [str(c) for c in s.unsat_core()] if r == z3.unsat else []
-            reason = s.reason_unknown() if r == z3.unknown else ""
-        dt = round(dt + time.perf_counter() - t0, 4)
+        if consistency is None:  # a retry answered: ask in a scope of its own
+            index = {lbl: k for k, lbl in enumerate(self.labels)}
+            t0 = time.perf_counter()
+            with query_solver(CONSISTENCY_TIMEOUT_MS, cores=True) as s:
+                s.add(*self.enc.axioms(), *self.definitions)
+                s.add(*[self.tracked[index[c]] for c in used])
+                r = s.check(*[self.literals[index[c]] for c in used])
+                names = {str(self.literals[index[c]]): c for c in used}
+                consistency = (r, [names[str(c)] for c in s.unsat_core()] if r == z3.unsat else [],
+                               s.reason_unknown() if r == z3.unknown else "")
+            dt = round(dt + time.perf_counter() - t0, 4)
+        r, ccore, reason = consistency
         if r != z3.sat:
-            names = {str(self.literals[index[c]]): c for c in used}
-            why = ("contradict each other (unsat core: " + "; ".join(names[c] for c in ccore if c in names) + ")"
+            why = ("contradict each other (unsat core: " + "; ".join(ccore) + ")"
                    if r == z3.unsat else f"may contradict each other (Z3 could not decide: {reason or 'unknown'})")
             return ContextResult("inconclusive", script(), dt, used=text, strategy=strategy,
                                  reason=f"the premises the proof used {why}, so the proof establishes nothing")
@@ -450,3 +474,58 @@ def _merge(body: str, benchmark: str) -> str:
             if not ((line.startswith("(declare-fun ") or line.startswith("(declare-const "))
                     and line.split()[1].strip("|") in declared)]
     return body + "\n" + "\n".join(kept) + "\n"
+
+
+_DEFINE = re.compile(r"\(define-fun (\|[^|]*\||\S+) \(\) (Real|Int|Bool)\s+(.*?)\)\s*(?=\(define-fun |$)", re.S)
+
+
+def _number(text: str) -> str | None:
+    """An SMT-LIB numeral of a model (``5``, ``101.0``, ``(- 5.0)``, ``(/ 1.0 3.0)``,
+    ``(- (/ 1.0 2.0))``) as :func:`rclverify.logic.encode.value_to_rcl` writes it; ``None`` otherwise."""
+    t = " ".join(text.split())
+    sign = 1
+    if t.startswith("(- ") and t.endswith(")"):
+        sign, t = -1, t[3:-1].strip()
+    try:
+        if t.startswith("(/ ") and t.endswith(")"):
+            num, den = t[3:-1].split()
+            fr = Fraction(num) / Fraction(den)
+        else:
+            fr = Fraction(t)
+    except (ValueError, ZeroDivisionError):
+        return None
+    fr *= sign
+    if fr.denominator == 1:
+        return str(fr.numerator)
+    dec = float(fr)
+    if Fraction(dec) == fr:
+        return repr(dec)
+    return decimal_text(fr) or f"{fr.numerator}/{fr.denominator}"
+
+
+def _read_model(text: str) -> tuple[dict[str, str], dict[str, bool]] | None:
+    """``({symbol: RCL value}, {A!m flag: value})`` from a model of the
+    fragment printed by Z3 (``define-fun`` of Real, Int and Bool constants);
+    ``None`` when the text holds anything else (the caller renders the
+    model object instead)."""
+    values: dict[str, str] = {}
+    flags: dict[str, bool] = {}
+    found = _DEFINE.findall(text)
+    if text.count("(define-fun ") != len(found):
+        return None
+    for name, sort, value in found:
+        name = name.strip("|")
+        v = " ".join(value.split())
+        if sort == "Bool":
+            if v not in ("true", "false"):
+                return None
+            if name.startswith("A!"):
+                flags[name] = v == "true"
+            elif not name.startswith("l!"):
+                values[name] = "TRUE" if v == "true" else "FALSE"
+            continue
+        num = _number(v)
+        if num is None:
+            return None
+        values[name] = num
+    return values, flags
