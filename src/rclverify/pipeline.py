@@ -36,7 +36,7 @@ from .rcl.errors import RclError, error
 # The workspace and what is derived from it without a stage live below the report
 # (rclverify.workspace); re-exported here for the stages' callers.
 from .workspace import (PLAN, REPORT_PARTS, TaskIndex, Workspace, cone_digests, current_model_hash,  # noqa: F401
-                        current_snapshot_hashes, node_snapshots, read_artifact, record_provenance, stage_inputs, stale_stages,
+                        current_snapshot_hashes, environment_sha, node_snapshots, read_artifact, record_provenance, stage_inputs, stale_stages,
                         write_check_index)
 
 if TYPE_CHECKING:
@@ -62,7 +62,8 @@ def stage_check(ws: Workspace) -> dict[str, Any]:
         text = dumps(snap)
         atomic_write_text(ws.path(ws.snapshot(name)), text)
         hashes[ws.snapshot(name)] = hashlib.sha256(text.encode("utf-8")).hexdigest()
-    for name, text in cone_digests(model, {n: hashes[ws.snapshot(n)] for n in checked.nodes}).items():
+    for name, text in cone_digests(model, {n: hashes[ws.snapshot(n)] for n in checked.nodes},
+                                   environment_sha(ws)).items():
         _write_if_changed(ws.path(ws.cone(name)), text)  # unchanged: doit and the node's compose stage see no edit
         hashes[ws.cone(name)] = hashlib.sha256(text.encode("utf-8")).hexdigest()
     try:

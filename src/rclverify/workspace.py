@@ -277,21 +277,12 @@ def node_snapshots(ws: Workspace, texts: Any) -> dict[str, dict[str, Any]]:
     return out
 
 
-def cone_digests(model: Any, snapshot_sha: Mapping[str, str]) -> dict[str, str]:
-    """``{node: text}``: for every node of ``model`` (a
-    :class:`~rclverify.system.model.SystemModel`) the text of its cone
-    digest file (:meth:`Workspace.cone`), a sha256 that changes whenever the
-    snapshot of any node of its upstream cone changes (``snapshot_sha``:
-    node -> sha256 of its snapshot).
-
-    A node's ``compose`` stage reads the contracts and facts of its whole
-    upstream cone (side conditions in context, docs/calculus.md), so that
-    is its input; one file per node instead of every cone snapshot keeps a
-    chain of N nodes at N inputs, not N*N/2.  The digest is a Merkle hash
-    over the cone's strongly connected components, producers first: a
-    component's is the sha256 of its members' snapshot hashes and of the
-    sorted digests of the components feeding it (the links themselves are
-    the model's, another input of the stage).  O(nodes + links)."""
+def _merkle(model: Any, leaf: Mapping[str, str]) -> dict[str, str]:
+    """``{node: sha256}`` over the strongly connected components of
+    ``model``, producers first: a component's digest is the sha256 of its
+    members' ``leaf`` values and of the sorted digests of the components
+    feeding it.  It changes whenever the leaf of any node of the upstream
+    cone changes.  O(nodes + links)."""
     comp: dict[str, tuple[str, ...]] = {n: (n,) for n in model.nodes}
     for loop in model.loops:
         for n in loop:
@@ -315,19 +306,42 @@ def cone_digests(model: Any, snapshot_sha: Mapping[str, str]) -> dict[str, str]:
                 if c not in digest:
                     h = hashlib.sha256()
                     for m in c:
-                        h.update(f"{m} {snapshot_sha[m]}\n".encode())
+                        h.update(f"{m} {leaf[m]}\n".encode())
                     h.update(b"--\n")
                     for d in sorted(digest[f] for f in feeds[c]):
                         h.update(d.encode() + b"\n")
                     digest[c] = h.hexdigest()
-    return {n: digest[comp[n]] + "\n" for n in model.nodes}
+    return {n: digest[comp[n]] for n in model.nodes}
+
+
+def cone_digests(model: Any, snapshot_sha: Mapping[str, str], env_sha: Mapping[str, str]) -> dict[str, str]:
+    """``{node: text}``: for every node of ``model`` (a
+    :class:`~rclverify.system.model.SystemModel`) the text of its cone
+    digest file (:meth:`Workspace.cone`), two lines: ``env <sha256>``, a
+    digest of the environment conjuncts of the assumptions of its upstream
+    cone (``env_sha``: node -> sha256 of their text; the derived property
+    reads them), and ``cone <sha256>``, a digest of the snapshots of its
+    whole upstream cone (``snapshot_sha``: node -> sha256 of its snapshot;
+    side conditions in context read them, docs/calculus.md).  Merkle hashes
+    over the cone's strongly connected components (:func:`_merkle`): one
+    file per node, not N*N/2 snapshots along a chain.  Which line a node's
+    ``compose`` stage depends on is :mod:`rclverify.conetask`'s business."""
+    env, full = _merkle(model, env_sha), _merkle(model, snapshot_sha)
+    return {n: f"env {env[n]}\ncone {full[n]}\n" for n in model.nodes}
+
+
+def environment_sha(ws: Workspace) -> dict[str, str]:
+    """``{node: sha256 of the text of the environment conjuncts of its assumption}``."""
+    from .calculus.compose import environment_texts
+    return {n: hashlib.sha256("\n".join(environment_texts(ws.checked, ws.model, n)).encode("utf-8")).hexdigest()
+            for n in ws.checked.nodes}
 
 
 def cone_hashes(ws: Workspace, hashes: Mapping[str, str]) -> dict[str, str]:
     """``{artifacts/cones/<Node>.sha256: sha256 of its text}`` for the
     snapshot hashes ``hashes`` (artifact path -> sha256, as
     :func:`current_snapshot_hashes` gives them)."""
-    texts = cone_digests(ws.model, {n: hashes[ws.snapshot(n)] for n in ws.checked.nodes})
+    texts = cone_digests(ws.model, {n: hashes[ws.snapshot(n)] for n in ws.checked.nodes}, environment_sha(ws))
     return {ws.cone(n): hashlib.sha256(t.encode("utf-8")).hexdigest() for n, t in texts.items()}
 
 
@@ -409,12 +423,13 @@ def record_provenance(ws: Workspace, node: str, stage: str, inputs: Sequence[str
 def stage_inputs(ws: Workspace, node: str, stage: str, in_context: bool = True) -> list[str]:
     """The workspace-relative files the contents of ``stage`` (``compose`` or
     ``health``) of ``node`` are made from: its snapshot, for ``compose`` its
-    producers' snapshots, its cone digest (:meth:`Workspace.cone`: the side
+    producers' snapshots, its cone digest (:meth:`Workspace.cone`: side
     conditions in context read the whole upstream cone; not with
     ``in_context=False``: the record of a composition whose side conditions
-    were all decided locally, which the rest of the cone cannot change) and
-    the system model, for ``health`` the plan's replacement contract file
-    if any.  (Export's are the inputs of each obligation, hashed into its
+    were all decided locally, which the rest of the cone cannot change;
+    :mod:`rclverify.conetask` reads which the record lists) and the system
+    model, for ``health`` the plan's replacement contract file if any.
+    (Export's are the inputs of each obligation, hashed into its
     evidence.)"""
     if stage == "compose":
         return [ws.snapshot(node), *(ws.snapshot(p) for p in ws.model.producers(node)),

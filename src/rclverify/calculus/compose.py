@@ -226,6 +226,12 @@ def _environment_texts(checked: Checked, model: SystemModel, node: str) -> tuple
     return texts[node]
 
 
+def environment_texts(checked: Checked, model: SystemModel, node: str) -> tuple[str, ...]:
+    """The environment conjuncts of ``node``'s assumption as RCL text (what
+    a derived property lists; remembered per (checked, model))."""
+    return _environment_texts(checked, model, node)
+
+
 def environment_conjuncts(checked: Checked, model: SystemModel, node: str) -> tuple[ast.Expr, ...]:
     """The environment conjuncts of ``node``'s assumption
     (:func:`split_assumption`), remembered like :func:`_environment_texts`:
@@ -321,7 +327,9 @@ def compose_node(checked: Checked, model: SystemModel, node: str, *,
                 cone_ctx = ConeContext(checked, model, node, lambda m: environment_conjuncts(checked, model, m), facts)
             cr = cone_ctx.decide(c, head + "\nvariant: " + VARIANT_IN_CONTEXT + " (the upstream cone; "
                                  "each guarantee under its node's assumption)", timeout_ms)
-            sc = in_context(sc, cr, cone_ctx, who)
+            feeders = {x.split(".", 1)[0] for x in links}
+            keep = {node}.union(*(model.upstream(p) for p in feeders)) if feeders else set(cone_ctx.cone)
+            sc = in_context(sc, cr, cone_ctx, who, keep)
         scs.append(sc)
     env_assumptions = tuple({"node": node, "text": expr_to_rcl(c), "source": _loc(c.loc)} for c in env)
     g_text = contract_text([g.formula for g in cn.node.guarantees])
@@ -353,11 +361,15 @@ def compose_node(checked: Checked, model: SystemModel, node: str, *,
                            cone_env, g_text)
 
 
-def in_context(sc: SideCondition, cr: ContextResult, ctx: ConeContext, who: str) -> SideCondition:
+def in_context(sc: SideCondition, cr: ContextResult, ctx: ConeContext, who: str,
+               keep: set[str] | None = None) -> SideCondition:
     """``sc`` (decided locally, not discharged) with the verdict of its
     in-context check ``cr`` over the cone ``ctx`` (:mod:`.context`): the
     status, verdict, hypotheses, model, explanation, SMT-LIB2 text (the local
-    query, ``(reset)``, the in-context query) and the ``context`` record."""
+    query, ``(reset)``, the in-context query) and the ``context`` record.
+    A counterexample shows the nodes of ``keep`` (the consumer and the cones
+    of the producers of the inputs the conjunct reads: the values traced
+    back to their sources, not a sibling branch feeding another input)."""
     node = sc.node
     local = {"status": sc.status, "variant": sc.variant, "model": sc.model}
     size = len(ctx.cone)
@@ -389,15 +401,17 @@ def in_context(sc: SideCondition, cr: ContextResult, ctx: ConeContext, who: str)
                              smt2, None, expl + strategy, VARIANT_IN_CONTEXT, sc.links, IN_CONTEXT, record)
     if cr.status == "refuted":
         expl = (f"{sc.explanation} Checked in context too: with {cone_words}, Z3 still finds values violating it "
-                "(the counterexample of the whole cone below).")
+                "(the counterexample below, traced back through the cone to its sources).")
         if cr.violated:
             expl += (f" In it the assumption of {', '.join(cr.violated)} does not hold, so "
                      f"{'its guarantees promise' if len(cr.violated) == 1 else 'their guarantees promise'} nothing "
                      "there: the side conditions upstream are the first to repair.")
         if ctx.cut:
             expl += " The value on an opened link is arbitrary, so the counterexample may use one the loop never produces."
+        shown = ({k: v for k, v in cr.model.items() if k.split(".", 1)[0] in keep}
+                 if cr.model is not None and keep is not None else cr.model)
         return SideCondition(sc.id, node, sc.rule, sc.conjunct, sc.source, sc.hypotheses, "failed", duration,
-                             smt2, cr.model, expl + strategy, VARIANT_IN_CONTEXT, sc.links, "failed", record)
+                             smt2, shown, expl + strategy, VARIANT_IN_CONTEXT, sc.links, "failed", record)
     expl = (f"{local_words}; checked in context, with {cone_words}, Z3 could not decide it ({cr.reason or 'unknown'}). "
             "It is not proved, and no counterexample of the whole cone is known.")
     return SideCondition(sc.id, node, sc.rule, sc.conjunct, sc.source, sc.hypotheses, "inconclusive", duration,

@@ -135,11 +135,10 @@ def realizability_findings(checked: Checked, node: str, facts: Sequence[tuple[as
                 conflict, model, smt2 = found[0], found[1], found[2] or smt2
                 break
     names = [f"guarantee {k + 1} ({_where(n.guarantees[k].loc)})" for k in conflict]
-    which = ("every guarantee together" if conflict == every and len(every) > 1 else
-             names[0].split(" (")[0] if len(conflict) == 1 else
-             " and ".join(x.split(" (")[0] for x in names) + " together")
+    short = [x.split(" (")[0] for x in names]
+    which = short[0] if len(short) == 1 else ", ".join(short[:-1]) + f" and {short[-1]} together"
     msg = (f"The contract of {node} cannot be implemented: for the input below, which its assumption"
-           + (" and the environment facts" if facts else "") + f" admit, no output satisfies {which}.")
+           + (" and the environment facts admit" if facts else " admits") + f", no output satisfies {which}.")
     expl = ("Realizability (forall in. A(in) -> exists out. G(in, out)) fails: Z3 found an admissible input for which "
             "every output violates " + (" and ".join(x.split(" (")[0] for x in names) if len(names) > 1 else names[0])
             + ". An implementation meeting the contract cannot exist; the guarantees ask for incompatible outputs there.")

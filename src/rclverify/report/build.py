@@ -406,7 +406,7 @@ def involved_model(sc: Mapping[str, Any]) -> Mapping[str, Any]:
     model = sc.get("model")
     nodes = {str(sc.get("node", ""))} | {str(l).split(".", 1)[0] for l in sc.get("links") or ()}
     if not isinstance(model, dict) or not sc.get("links") or sc.get("context"):
-        return sc  # decided in context: the counterexample of the whole cone is the point (docs/calculus.md)
+        return sc  # decided in context: the calculus kept the cones of the producers read (docs/calculus.md)
     kept = {k: v for k, v in model.items() if str(k).split(".", 1)[0] in nodes}
     return {**sc, "model": kept} if kept and len(kept) < len(model) else sc
 
