@@ -48,6 +48,9 @@ def test_the_report_keeps_the_verdict_and_the_whole_cone(chain: Path) -> None:
     assert "Side condition N4.sc2 is failed (checked in context too): in.x4 <= 100" in r["summary"]["problems"]
     md = (chain / "reports/assurance.md").read_text(encoding="utf-8")
     assert "in context" in md and "Discharged in context" in md
+    # a side condition discharged in context is no problem: no diagnosis row; a failed one keeps its row
+    diagnosed = {d["id"] for d in r.get("diagnoses", [])}
+    assert "N4.sc2" in diagnosed and not diagnosed & {"N1.sc2", "N2.sc2", "N3.sc2"}
 
 
 def test_sarif_junit_and_the_argument_keep_the_distinction(chain: Path) -> None:
