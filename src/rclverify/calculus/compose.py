@@ -327,8 +327,9 @@ def compose_node(checked: Checked, model: SystemModel, node: str, *,
                 cone_ctx = ConeContext(checked, model, node, lambda m: environment_conjuncts(checked, model, m), facts)
             cr = cone_ctx.decide(c, head + "\nvariant: " + VARIANT_IN_CONTEXT + " (the upstream cone; "
                                  "each guarantee under its node's assumption)", timeout_ms)
-            feeders = {x.split(".", 1)[0] for x in links}
-            keep = {node}.union(*(model.upstream(p) for p in feeders)) if feeders else set(cone_ctx.cone)
+            read_from = {x.split(".", 1)[0] for x in links}
+            keep: set[str] = ({node}.union(*(model.upstream(p) for p in read_from)) if read_from
+                              else set(cone_ctx.cone))
             sc = in_context(sc, cr, cone_ctx, who, keep)
         scs.append(sc)
     env_assumptions = tuple({"node": node, "text": expr_to_rcl(c), "source": _loc(c.loc)} for c in env)

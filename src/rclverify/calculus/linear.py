@@ -107,7 +107,7 @@ def _valid(hyps: Sequence[z3.BoolRef], goal: z3.BoolRef) -> bool:
     s.set("timeout", STEP_MS)
     s.add(*hyps)
     s.add(z3.Not(goal))
-    return s.check() == z3.unsat
+    return bool(s.check() == z3.unsat)
 
 
 def clauses_under(f: z3.BoolRef, context: Sequence[z3.BoolRef] = ()) -> z3.BoolRef:
@@ -132,12 +132,12 @@ def clauses_under(f: z3.BoolRef, context: Sequence[z3.BoolRef] = ()) -> z3.BoolR
     whole = ctx + [f]
     shrunk: list[list[z3.BoolRef]] = []
     for c in clauses:
-        lits = list(c)
-        for lit in list(lits):
-            rest = [x for x in lits if not x.eq(lit)]
+        kept_lits = list(c)
+        for lit in list(kept_lits):
+            rest = [x for x in kept_lits if not x.eq(lit)]
             if rest and _valid(whole, z3.Or(*rest) if len(rest) > 1 else rest[0]):
-                lits = rest
-        shrunk.append(lits)
+                kept_lits = rest
+        shrunk.append(kept_lits)
     kept = list(shrunk)
     for c in list(shrunk):
         others = [z3.Or(*x) if len(x) > 1 else x[0] for x in kept if x is not c]
@@ -168,7 +168,7 @@ def _num(v: z3.ExprRef) -> str:
     if z3.is_int_value(v):
         n = v.as_long()
         return str(n) if n >= 0 else f"-{-n}"
-    fr = Fraction(v.numerator_as_long(), v.denominator_as_long())  # type: ignore[attr-defined]
+    fr = Fraction(v.numerator_as_long(), v.denominator_as_long())
     if fr.denominator == 1:
         return str(fr.numerator) if fr >= 0 else f"-{-fr.numerator}"
     text = decimal_text(abs(fr))

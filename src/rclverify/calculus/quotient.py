@@ -166,13 +166,13 @@ def targets(sysm: _System) -> tuple[list[Target], list[str]]:
         if node not in cone:
             continue
         enc = sysm.enc
-        prem: list[z3.BoolRef] = []
+        req_prem: list[z3.BoolRef] = []
         for m in cone:
-            prem += sysm.guarantees(m, enc, False) + sysm.env(m, enc)
+            req_prem += sysm.guarantees(m, enc, False) + sysm.env(m, enc)
         symbols = {f"{p}.{n}.{p}.{v}": enc.io_symbol(checked.nodes[n], p, v)
                    for f in (formal, *assuming) for n, p, v in f.mentions}
-        prem += [enc.formula(a.expr, a.scope, symbols) for a in assuming]
-        out.append(Target("requirement", req.id, " ".join(req.formal.text.split()), tuple(prem),
+        req_prem += [enc.formula(a.expr, a.scope, symbols) for a in assuming]
+        out.append(Target("requirement", req.id, " ".join(req.formal.text.split()), tuple(req_prem),
                           enc.formula(formal.expr, formal.scope, symbols)))
     return out, notes
 
@@ -336,7 +336,7 @@ def _rename(e: Any, to: Mapping[str, tuple[str, str]]) -> Any:
             p, n = to[e.name]
             return ast.Var(n, p, e.loc)  # type: ignore[arg-type]
         return e
-    if dataclasses.is_dataclass(e) and not isinstance(e, ast.Loc):
+    if dataclasses.is_dataclass(e) and not isinstance(e, (type, ast.Loc)):
         kw = {}
         for f in dataclasses.fields(e):
             v = getattr(e, f.name)

@@ -66,7 +66,7 @@ def _io(v: ast.Var, node: CheckedNode, symbol: Mapping[tuple[str, str], str], us
     if prefix is None:
         raise Outside  # a context constant, an enumeration value or a bound name
     t = (node.inputs if prefix == "in" else node.outputs).get(v.name)
-    if t not in SORTS:
+    if t is None or t not in SORTS:
         raise Outside
     name = symbol[(prefix, v.name)]
     used[name] = SORTS[t]
