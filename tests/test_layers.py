@@ -82,6 +82,11 @@ LAYERS: list[tuple[str, tuple[str, ...]]] = [
     # (check.py, beside the calculus it builds on) and their roll-up with the
     # evidence (rollup.py); its stage (stage.py) sits with the workspace it
     # writes into, its terminal listing (show.py) with the commands.
+    # calculus/context.py and calculus/smttext.py (side conditions in context)
+    # build on the system model and the logic only; calculus/quotient.py and
+    # calculus/linear.py (the weakest contract of a node) re-check with the
+    # calculus and requirements/check.py, so they sit in this layer too;
+    # health/realizable.py is a peer of the other health checks.
     ("calculus/health", ("rclverify.calculus", "rclverify.health", "rclverify.requirements")),
     # backends/monitors/dds_*.py: the live monitor over DDS (types made from
     # the .msg files, the bus and its readers, calls checked one by one with
@@ -111,9 +116,11 @@ LAYERS: list[tuple[str, tuple[str, ...]]] = [
     # run at a time (runlock.py), the ROS grounding stage (ros/stage.py), the
     # replay of one property test from a workspace (replay.py, what generated
     # pytest files call).
+    # conetask.py: the doit uptodate check that re-runs a node's calculus when the part of its upstream
+    # cone it read changed (beside tasks.py, which uses it; it reads the evidence layer's seals only).
     ("pipeline/tasks", ("rclverify.pipeline", "rclverify.tasks", "rclverify.cluster",
                         "rclverify.progress", "rclverify.doitstate", "rclverify.runlock", "rclverify.ros.stage",
-                        "rclverify.replay")),
+                        "rclverify.replay", "rclverify.conetask")),
     # Commands: the CLI, and what only commands use: scaffold/ (``rclverify
     # init``: a new workspace from templates), bundle/ (``rclverify bundle``:
     # an archive of the evidence with its manifest), ``rclverify ros ...``

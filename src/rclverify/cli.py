@@ -13,6 +13,7 @@
 ``rclverify status``               the last run's summary and problems, running nothing
 ``rclverify explain ID``           what the last report says of any id an output shows
 ``rclverify refines A.rcl:N B.rcl:M``  may contract M replace contract N?
+``rclverify quotient NODE [-o FILE]``  the weakest contract of NODE its neighbours need
 ``rclverify init DIR [--nodes A,B]``  write a new workspace that verifies at once
 ``rclverify bundle [-o FILE]``     the assessor's bundle; ``--verify FILE`` checks one
 ``rclverify review NODE [-o FILE]``  write a review record to fill in
@@ -161,8 +162,17 @@ def cmd_compose(args: argparse.Namespace) -> int:
         c = stage_compose(ws, n)
         print(f"{n}: rules {', '.join(c['rules']) or '(source node)'}; producers {', '.join(c['producers']) or 'none'}")
         for sc in c["side_conditions"]:
-            variant = f" ({sc['variant']})" if sc["status"] == "discharged" and sc.get("variant") else ""
-            print(f"  side condition {sc['id']} [{sc['status']}]{variant}: {sc['conjunct']}  ({sc['source']})")
+            verdict = sc.get("verdict") or sc["status"]
+            variant = f" ({sc['variant']})" if verdict == "discharged" and sc.get("variant") else ""
+            print(f"  side condition {sc['id']} [{verdict}]{variant}: {sc['conjunct']}  ({sc['source']})")
+            ctx = sc.get("context") or {}
+            if verdict == "discharged in context":
+                print(f"      upstream guarantees used: {', '.join(ctx.get('used_nodes') or []) or 'none'} "
+                      f"(cone of {ctx.get('cone')} nodes)")
+            elif ctx and sc["status"] != "discharged":
+                print(f"      checked in context too (cone of {ctx.get('cone')} nodes)"
+                      + (f"; assumption violated upstream in the counterexample: {', '.join(ctx['violated'])}"
+                         if ctx.get("violated") else ""))
             if sc["status"] != "discharged":
                 print(f"      consumer: {n} assumes {sc['conjunct']}")
                 for h in sc.get("hypotheses", []):
@@ -482,6 +492,21 @@ def cmd_refines(args: argparse.Namespace) -> int:
     return refines_main(args.original, args.replacement, assumes=getattr(args, "assume", None) or ())
 
 
+def cmd_quotient(args: argparse.Namespace) -> int:
+    """Print (or write, ``-o FILE``) the weakest contract of ``args.node``
+    (:mod:`rclverify.calculus.quotient`); a contract that cannot be given is
+    one ``error:`` line, exit 1."""
+    from .calculus.quotient import QuotientError, quotient, render
+    from .pipeline import Workspace
+    ws = Workspace(Path(args.workspace), args.plan, interface_only=(args.node,))
+    try:
+        q = quotient(ws.checked, ws.model, ws.plan, args.node)
+    except QuotientError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 1
+    return _emit(render(q), args.output)
+
+
 def cmd_monitor(args: argparse.Namespace) -> int:
     from .backends.monitors.cli import monitor_command
     from .pipeline import Workspace
@@ -564,6 +589,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     rv.add_argument("node")
     rv.add_argument("-o", "--output", help="write the record to this file instead of standard output")
     rv.add_argument("-f", "--files", nargs="*", default=[], help="reviewed files (workspace-relative), listed with their sha256")
+    qt = add("quotient", cmd_quotient, "print the weakest contract of NODE under which its neighbours' side "
+             "conditions and its cone's requirements hold, re-checked by Z3 (docs/calculus.md)", True)
+    qt.add_argument("node", metavar="NODE", help="a node declared by its interface only, or one to replace")
+    qt.add_argument("-o", "--output", metavar="FILE", help="write the contract to FILE instead of standard output")
     r = add("refines", cmd_refines, "check with Z3 that contract B may replace contract A")
     r.add_argument("original", help="FILE.rcl:Node of the contract to replace")
     r.add_argument("replacement", help="FILE.rcl:Node of the replacement contract")

@@ -35,8 +35,8 @@ from .logic.world import fresh as fresh_z3
 from .rcl.errors import RclError, error
 # The workspace and what is derived from it without a stage live below the report
 # (rclverify.workspace); re-exported here for the stages' callers.
-from .workspace import (PLAN, REPORT_PARTS, TaskIndex, Workspace, current_model_hash, current_snapshot_hashes,  # noqa: F401
-                        node_snapshots, read_artifact, record_provenance, stage_inputs, stale_stages,
+from .workspace import (PLAN, REPORT_PARTS, TaskIndex, Workspace, cone_digests, current_model_hash,  # noqa: F401
+                        current_snapshot_hashes, environment_sha, node_snapshots, read_artifact, record_provenance, stage_inputs, stale_stages,
                         write_check_index)
 
 if TYPE_CHECKING:
@@ -66,6 +66,10 @@ def stage_check(ws: Workspace) -> dict[str, Any]:
         text = dumps(snap)
         atomic_write_text(ws.path(ws.snapshot(name)), text)
         hashes[ws.snapshot(name)] = hashlib.sha256(text.encode("utf-8")).hexdigest()
+    for name, text in cone_digests(model, {n: hashes[ws.snapshot(n)] for n in checked.nodes},
+                                   environment_sha(ws)).items():
+        _write_if_changed(ws.path(ws.cone(name)), text)  # unchanged: doit and the node's compose stage see no edit
+        hashes[ws.cone(name)] = hashlib.sha256(text.encode("utf-8")).hexdigest()
     try:
         texts.save()
     except OSError:
@@ -75,6 +79,16 @@ def stage_check(ws: Workspace) -> dict[str, Any]:
     hashes[ws.MODEL] = hashlib.sha256(text.encode("utf-8")).hexdigest()
     write_check_index(ws, hashes)  # the report then needs not make every snapshot again
     return {"warnings": warnings}
+
+
+def _write_if_changed(path: Path, text: str) -> None:
+    """Write ``text`` to ``path`` atomically unless the file already holds it."""
+    try:
+        if path.read_text(encoding="utf-8") == text:
+            return
+    except (OSError, UnicodeDecodeError):
+        pass
+    atomic_write_text(path, text)
 
 
 def stage_graph(ws: Workspace) -> str:
@@ -93,7 +107,7 @@ def stage_compose(ws: Workspace, node: str) -> dict[str, Any]:
     """Apply the calculus to ``node``; writes its JSON and one .smt2 per side condition."""
     fresh_z3()  # the same Z3 state whatever ran before in this process (logic/world.py)
     from .calculus.compose import compose_node, composition_json
-    comp = compose_node(ws.checked, ws.model, node)
+    comp = compose_node(ws.checked, ws.model, node, facts=plan_facts(ws))
     paths = []
     for sc in comp.side_conditions:
         rel = f"artifacts/calculus/{sc.id}.smt2"
@@ -101,8 +115,18 @@ def stage_compose(ws: Workspace, node: str) -> dict[str, Any]:
         paths.append(rel)
     out = composition_json(comp, paths)
     write_sealed(ws.path(ws.calculus(node)), out)
-    record_provenance(ws, node, "compose", stage_inputs(ws, node, "compose"))  # after: a killed stage records nothing
+    # after: a killed stage records nothing; the cone is an input of what it wrote only when a side
+    # condition was decided in context (the doit task re-runs on any change of the cone: derived property)
+    record_provenance(ws, node, "compose", stage_inputs(ws, node, "compose",
+                                                        any(sc.context for sc in comp.side_conditions)))
     return out
+
+
+def plan_facts(ws: Workspace) -> dict[str, list[Any]]:
+    """The plan's environment facts per node, as RCL formulas (what the
+    calculus reads for side conditions in context; each node's facts are
+    part of its snapshot)."""
+    return {n: [f.expr for f in fs] for n, fs in ws.plan.facts.items()}
 
 
 def stage_health(ws: Workspace, node: str) -> list[dict[str, Any]]:

@@ -3,12 +3,16 @@
 Stages and their real file dependencies, per node ``N``:
 
 ``check``          contracts + plan -> artifacts/contracts/N.json (one snapshot per
-                   node, rewritten only when that node's text changes), model, lint
+                   node, rewritten only when that node's text changes), artifacts/cones/N.sha256
+                   (a digest of N's upstream cone's snapshots), model, lint
 ``graph``          model -> model.dot, model.svg (when graphviz is installed); not part of
                    ``verify`` (the report lays out its own diagram, with statuses):
                    ``doit graph`` runs it
 ``node:N``         three stages, each run only when one of its own inputs changed:
-                   compose  snapshot of N and of N's producers + model -> calculus/N.json
+                   compose  snapshot of N and of N's producers + model -> calculus/N.json;
+                            run again too when the part of N's cone digest it read changed
+                            (conetask.py: the whole cone when a side condition was decided in
+                            context, the cone's environment assumptions otherwise)
                    health   snapshot of N (+ replacement contract) -> health/N.json
                    export   snapshot of N + the backend input files -> obligations/N.json
 ``evidence:ID``     one obligation's record + the files it reads -> its evidence record
@@ -28,7 +32,9 @@ Stages and their real file dependencies, per node ``N``:
 
 doit compares file contents (md5), so editing one node's contract changes
 only that node's snapshot: its node task (all three stages) and run tasks,
-its consumers' node tasks (the compose stage only: their side conditions)
+its consumers' node tasks (the compose stage only: their side conditions), the
+node tasks downstream whose side conditions were decided in context against
+the cone (conetask.py)
 and the report re-run.  The three stages share one doit task per node
 because doit's own cost per task (defining it, checking its dependencies)
 was most of a no-op run of a large system (docs/scale.md); the task's
@@ -575,7 +581,8 @@ def _build_tasks(root: str | Path, plan_file: str) -> dict[str, Callable[[], Any
     def task_check() -> dict[str, Any]:
         """Parse and type-check the contracts, check the plan, lint, build the system model."""
         return {"actions": [(act_check, [r, plan_file])], "file_dep": check_deps,
-                "targets": list(snap.values()) + [str(rootp / p) for p in (ws.MODEL, ws.DIAGNOSTICS)],
+                "targets": list(snap.values()) + [at(ws.cone(n)) for n in nodes]
+                + [str(rootp / p) for p in (ws.MODEL, ws.DIAGNOSTICS)],
                 "verbosity": 2, "clean": True, **check_extra}
 
     def task_graph() -> dict[str, Any]:
@@ -585,6 +592,7 @@ def _build_tasks(root: str | Path, plan_file: str) -> dict[str, Callable[[], Any
 
     def task_node() -> Iterator[dict[str, Any]]:
         """One task per node: its calculus, health checks and exported obligations."""
+        from .conetask import ConeUnchanged
         assert index is not None  # registered only when ok, i.e. the model was built
         model_json, seen = at(ws.MODEL), dict[str, tuple[str, ...]]()
         yield {"basename": "node", "name": None,
@@ -597,10 +605,13 @@ def _build_tasks(root: str | Path, plan_file: str) -> dict[str, Callable[[], Any
                 "health": [snap[n]] + ([str(rootp / repl)] if repl and (rootp / repl).is_file() else []),
                 "export": [snap[n]] + [at(f) for config in index.entries.get(n, ()) for f in _inputs(config, rootp, seen)],
             }
+            # the upstream cone: a file the check writes, read by an uptodate check (conetask.py), not a
+            # file_dep: only a composition that read the cone runs again when the cone changes
+            cone = ConeUnchanged(at(ws.cone(n)), at(ws.provenance(n)), ws.cone(n))
             yield {"name": n, "actions": [(act_node, [r, n, deps])],
                    "file_dep": sorted({d for ds in deps.values() for d in ds}),
                    "targets": [at(ws.calculus(n)), at(ws.health(n)), at(ws.obligations(n))],
-                   "uptodate": [code, sealed], "verbosity": 2, "clean": True}
+                   "uptodate": [code, sealed, cone], "verbosity": 2, "clean": True}
 
     def task_requirements() -> dict[str, Any]:
         """Check each requirement's formal statement with Z3 from the guarantees of its cone.  Defined before

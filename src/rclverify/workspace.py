@@ -24,7 +24,7 @@ import os
 from dataclasses import dataclass
 from functools import cached_property
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, Callable, Sequence, cast
+from typing import TYPE_CHECKING, Any, Callable, Mapping, Sequence, cast
 
 from .evidence.store import dumps, write_json
 from .rcl.errors import RclError
@@ -88,6 +88,9 @@ class Workspace:
     #: Set by :func:`rclverify.cache.workspace.restore`: the sha256 of each contract file it found, taken
     #: before any file was parsed; :func:`rclverify.cache.workspace.save` writes them into the new cache.
     cache_shas: dict[str, str] | None = dataclasses.field(default=None, repr=False, compare=False)
+    #: Nodes that may be declared by their interface only (``rclverify quotient``; the type checker's
+    #: ``interface_only``); no stage of the pipeline loads a workspace with any.
+    interface_only: tuple[str, ...] = ()
 
     def path(self, rel: str) -> Path:
         return self.root / rel
@@ -148,7 +151,7 @@ class Workspace:
             specs.append(spec)
         if diags:
             raise RclError(diags)
-        c = check(specs)
+        c = check(specs, self.interface_only)
         from .plan.errors import PlanError
         try:
             resolve(self.plan, c)
@@ -180,6 +183,12 @@ class Workspace:
     @staticmethod
     def snapshot(node: str) -> str:
         return f"artifacts/contracts/{node}.json"
+
+    @staticmethod
+    def cone(node: str) -> str:
+        """The digest of ``node``'s upstream cone's snapshots (:func:`cone_digests`):
+        an input of its ``compose`` stage, whose in-context side conditions read the whole cone."""
+        return f"artifacts/cones/{node}.sha256"
 
     @staticmethod
     def calculus(node: str) -> str:
@@ -268,6 +277,74 @@ def node_snapshots(ws: Workspace, texts: Any) -> dict[str, dict[str, Any]]:
     return out
 
 
+def _merkle(model: Any, leaf: Mapping[str, str]) -> dict[str, str]:
+    """``{node: sha256}`` over the strongly connected components of
+    ``model``, producers first: a component's digest is the sha256 of its
+    members' ``leaf`` values and of the sorted digests of the components
+    feeding it.  It changes whenever the leaf of any node of the upstream
+    cone changes.  O(nodes + links)."""
+    comp: dict[str, tuple[str, ...]] = {n: (n,) for n in model.nodes}
+    for loop in model.loops:
+        for n in loop:
+            comp[n] = tuple(loop)
+    feeds: dict[tuple[str, ...], set[tuple[str, ...]]] = {}
+    for c in set(comp.values()):
+        feeds[c] = {comp[p] for m in c for p in model.producers(m)} - {c}
+    digest: dict[tuple[str, ...], str] = {}
+    for root in dict.fromkeys(comp[n] for n in model.nodes):  # iterative post-order over the component DAG
+        if root in digest:
+            continue
+        stack = [(root, iter(sorted(feeds[root])))]
+        while stack:
+            c, it = stack[-1]
+            for f in it:
+                if f not in digest:
+                    stack.append((f, iter(sorted(feeds[f]))))
+                    break
+            else:
+                stack.pop()
+                if c not in digest:
+                    h = hashlib.sha256()
+                    for m in c:
+                        h.update(f"{m} {leaf[m]}\n".encode())
+                    h.update(b"--\n")
+                    for d in sorted(digest[f] for f in feeds[c]):
+                        h.update(d.encode() + b"\n")
+                    digest[c] = h.hexdigest()
+    return {n: digest[comp[n]] for n in model.nodes}
+
+
+def cone_digests(model: Any, snapshot_sha: Mapping[str, str], env_sha: Mapping[str, str]) -> dict[str, str]:
+    """``{node: text}``: for every node of ``model`` (a
+    :class:`~rclverify.system.model.SystemModel`) the text of its cone
+    digest file (:meth:`Workspace.cone`), two lines: ``env <sha256>``, a
+    digest of the environment conjuncts of the assumptions of its upstream
+    cone (``env_sha``: node -> sha256 of their text; the derived property
+    reads them), and ``cone <sha256>``, a digest of the snapshots of its
+    whole upstream cone (``snapshot_sha``: node -> sha256 of its snapshot;
+    side conditions in context read them, docs/calculus.md).  Merkle hashes
+    over the cone's strongly connected components (:func:`_merkle`): one
+    file per node, not N*N/2 snapshots along a chain.  Which line a node's
+    ``compose`` stage depends on is :mod:`rclverify.conetask`'s business."""
+    env, full = _merkle(model, env_sha), _merkle(model, snapshot_sha)
+    return {n: f"env {env[n]}\ncone {full[n]}\n" for n in model.nodes}
+
+
+def environment_sha(ws: Workspace) -> dict[str, str]:
+    """``{node: sha256 of the text of the environment conjuncts of its assumption}``."""
+    from .calculus.compose import environment_texts
+    return {n: hashlib.sha256("\n".join(environment_texts(ws.checked, ws.model, n)).encode("utf-8")).hexdigest()
+            for n in ws.checked.nodes}
+
+
+def cone_hashes(ws: Workspace, hashes: Mapping[str, str]) -> dict[str, str]:
+    """``{artifacts/cones/<Node>.sha256: sha256 of its text}`` for the
+    snapshot hashes ``hashes`` (artifact path -> sha256, as
+    :func:`current_snapshot_hashes` gives them)."""
+    texts = cone_digests(ws.model, {n: hashes[ws.snapshot(n)] for n in ws.checked.nodes}, environment_sha(ws))
+    return {ws.cone(n): hashlib.sha256(t.encode("utf-8")).hexdigest() for n, t in texts.items()}
+
+
 def check_inputs(ws: Workspace) -> dict[str, str]:
     """``{file: sha256}`` of every file the snapshots and the system model
     are made from: the plan, its contract files and the replacement
@@ -311,8 +388,9 @@ def current_snapshot_hashes(ws: Workspace, texts: Any) -> dict[str, str]:
     if (isinstance(kept, dict) and kept.get("code") == code_stamp() and isinstance(kept.get("hashes"), dict)
             and kept.get(SEAL) == seal_of(kept) and kept.get("inputs") == check_inputs(ws)):
         return {**kept["hashes"], **state_hashes(ws)}
-    return {**{ws.snapshot(n): hashlib.sha256(dumps(snap).encode("utf-8")).hexdigest()
-               for n, snap in node_snapshots(ws, texts).items()}, **current_model_hash(ws), **state_hashes(ws)}
+    snaps = {ws.snapshot(n): hashlib.sha256(dumps(snap).encode("utf-8")).hexdigest()
+             for n, snap in node_snapshots(ws, texts).items()}
+    return {**snaps, **cone_hashes(ws, snaps), **current_model_hash(ws), **state_hashes(ws)}
 
 
 def state_hashes(ws: Workspace) -> dict[str, str]:
@@ -342,14 +420,20 @@ def record_provenance(ws: Workspace, node: str, stage: str, inputs: Sequence[str
     write_sealed(ws.path(rel), current)
 
 
-def stage_inputs(ws: Workspace, node: str, stage: str) -> list[str]:
+def stage_inputs(ws: Workspace, node: str, stage: str, in_context: bool = True) -> list[str]:
     """The workspace-relative files the contents of ``stage`` (``compose`` or
     ``health``) of ``node`` are made from: its snapshot, for ``compose`` its
-    producers' snapshots and the system model, for ``health`` the plan's
-    replacement contract file if any.  (Export's are the inputs of each
-    obligation, hashed into its evidence.)"""
+    producers' snapshots, its cone digest (:meth:`Workspace.cone`: side
+    conditions in context read the whole upstream cone; not with
+    ``in_context=False``: the record of a composition whose side conditions
+    were all decided locally, which the rest of the cone cannot change;
+    :mod:`rclverify.conetask` reads which the record lists) and the system
+    model, for ``health`` the plan's replacement contract file if any.
+    (Export's are the inputs of each obligation, hashed into its
+    evidence.)"""
     if stage == "compose":
-        return [ws.snapshot(node), *(ws.snapshot(p) for p in ws.model.producers(node)), ws.MODEL]
+        return [ws.snapshot(node), *(ws.snapshot(p) for p in ws.model.producers(node)),
+                *([ws.cone(node)] if in_context else []), ws.MODEL]
     repl = ws.plan.replacements.get(node)
     return [ws.snapshot(node)] + ([repl[0].rpartition(":")[0]] if repl else [])
 
@@ -372,7 +456,9 @@ def stale_stages(ws: Workspace, current: dict[str, str]) -> dict[str, set[str]]:
             if not os.path.exists(os.path.join(ws.root, artifact)):
                 continue
             made = rec.get(stage) if isinstance(rec, dict) else None
-            if not isinstance(made, dict) or set(made) != set(stage_inputs(ws, n, stage)):
+            allowed = [set(stage_inputs(ws, n, stage))] + ([set(stage_inputs(ws, n, stage, False))]
+                                                           if stage == "compose" else [])
+            if not isinstance(made, dict) or set(made) not in allowed:
                 out.setdefault(n, set()).add(stage)
                 continue
             missing = [p for p in made if p not in current]

@@ -51,6 +51,11 @@ PERSIST = ("Outputs persist once produced, so the inputs a node receives from se
 CALCULUS = ("Rules R1 (sequence), R2 (branch), R3 (join) and R4 (loop) of the composition calculus "
             "(paper lines 556-768): when each node meets its contract and every side condition is "
             "discharged, each node's guarantee eventually holds in the composed system.")
+IN_CONTEXT = ("Side conditions in context (docs/calculus.md): a conjunct of a node's assumption that its producers' "
+              "guarantees alone do not entail is entailed by the guarantees of its upstream cone, each taken only "
+              "where its own node's assumption holds (the stream semantics, paper lines 462-495), with the "
+              "environment assumptions and facts of the cone; loops are opened as rule R4 composes them (paper "
+              "lines 717-768), so no guarantee discharges its own premise.")
 
 
 def ident(prefix: str, *parts: Any) -> str:
@@ -176,6 +181,9 @@ def build_argument(report: Mapping[str, Any]) -> Argument:
             loop_of[str(d["node"])] = loop_ids[text]
     loops = list(loop_ids.values())
     j_calc = b.add(Element(ident("J", "calculus"), "justification", CALCULUS))
+    j_context = ident("J", "context")
+    if any(sc.get("verdict") == "discharged in context" for sc in report["side_conditions"]):
+        b.add(Element(j_context, "justification", IN_CONTEXT))
 
     def evidence_goals(node: str, k: int) -> list[str]:
         """Solutions and undeveloped goals under guarantee ``k`` of ``node``."""
@@ -209,9 +217,19 @@ def build_argument(report: Mapping[str, Any]) -> Argument:
 
     def side_goal(sc: Mapping[str, Any]) -> str:
         sid = str(sc["id"])
+        verdict = str(sc.get("verdict") or sc["status"])
         sn = b.add(Element(ident("Sn", "sc", sid), "solution",
-                           _clip(f"Z3 query {sc['smt2']}: {sc['status']}. {sc['explanation']}"),
+                           _clip(f"Z3 query {sc['smt2']}: {verdict}. {sc['explanation']}"),
                            status=str(sc["status"]), ref=sid, url=str(sc["smt2"])))
+        if verdict == "discharged in context":  # the claim is the weaker one the proof supports (docs/calculus.md)
+            ctx = sc.get("context") or {}
+            used = sorted({str(u).split(" ", 1)[0] for u in ctx.get("used_nodes") or []})
+            return b.add(Element(ident("G", "sc", sid), "goal",
+                                 _clip(f"Side condition {sid} ({sc['rule']}, {sc['source']}): the conjunct "
+                                       f"{sc['conjunct']} of {sc['node']}'s assumption follows, in context, from the "
+                                       f"guarantees of its upstream cone ({', '.join(used) or 'none'}), each under its "
+                                       "own node's assumption, and the cone's environment assumptions and facts"),
+                                 supported_by=(sn,), in_context_of=(j_context,), ref=sid))
         return b.add(Element(ident("G", "sc", sid), "goal",
                              _clip(f"Side condition {sid} ({sc['rule']}, {sc['source']}): the conjunct "
                                    f"{sc['conjunct']} of {sc['node']}'s assumption follows from its producers' guarantees"),

@@ -36,6 +36,15 @@ Two variants, tried in order (docs/architecture.md, "Side conditions"):
 A counterexample is only ever shown from the second variant, so it
 satisfies the producers' assumptions as well as their guarantees.
 
+A side condition that neither variant discharges is tried a third time, ``in
+context`` (:mod:`.context`; docs/calculus.md): against the whole upstream
+cone, each guarantee under its own node's assumption, with the environment
+assumptions and facts of the cone, the cone's loops opened as rule R4 does.
+Its verdict (``verdict``) is ``discharged`` (locally, by one of the two
+variants above), ``discharged in context`` (the upstream premises used are
+named), ``failed`` (with the counterexample of the whole cone; a local
+refutation the cone does not rule out) or ``inconclusive``.
+
 Each rule instance is labelled with the rule actually applied, from the
 graph's shape: R3 (join) when several nodes feed the node, R2 (branch) when
 its single producer's output is also read by another node, R1 (sequence)
@@ -43,10 +52,13 @@ otherwise; R4 is added for a node on a cycle.
 """
 from __future__ import annotations
 
+import dataclasses
+
 from dataclasses import dataclass
-from typing import Any, Sequence
+from typing import Any, Mapping, Sequence
 
 from ..logic.encode import Encoder
+from .context import ConeContext, ContextResult
 from ..logic.query import DEFAULT_TIMEOUT_MS, prove, solver_session
 from ..rcl import ast
 from ..rcl.printer import expr_to_rcl
@@ -109,17 +121,23 @@ class SideCondition:
     explanation: str = ""
     variant: str = ""
     links: tuple[str, ...] = ()
+    #: ``discharged`` (locally), ``discharged in context``, ``failed`` or ``inconclusive`` (module docstring)
+    verdict: str = ""
+    #: how the in-context check went (``None`` when the side condition was discharged locally): ``cone``
+    #: (its size), ``used`` (premises of the proof), ``used_nodes``, ``opened`` (links opened, rule R4),
+    #: ``violated`` (nodes whose assumption the counterexample violates), ``joins``, ``local`` (the
+    #: local verdict: ``status``, ``variant``, ``model``)
+    context: dict[str, Any] | None = None
     #: probable scale mismatches behind a side condition that is not discharged (:mod:`.scale`)
     scale: tuple[dict[str, Any], ...] = ()
 
     def to_json(self, smt2_path: str) -> dict[str, Any]:
-        out = {"id": self.id, "node": self.node, "rule": self.rule, "conjunct": self.conjunct,
-               "source": self.source, "hypotheses": list(self.hypotheses), "status": self.status,
-               "duration_s": self.duration_s, "smt2": smt2_path, "model": self.model,
-               "explanation": self.explanation, "variant": self.variant, "links": list(self.links)}
-        if self.scale:  # only when there is one: records without it are unchanged
-            out["scale_mismatch"] = list(self.scale)
-        return out
+        return {"id": self.id, "node": self.node, "rule": self.rule, "conjunct": self.conjunct,
+                "source": self.source, "hypotheses": list(self.hypotheses), "status": self.status,
+                "duration_s": self.duration_s, "smt2": smt2_path, "model": self.model,
+                "explanation": self.explanation, "variant": self.variant, "links": list(self.links),
+                "verdict": self.verdict or self.status, "context": self.context,
+                **({"scale_mismatch": list(self.scale)} if self.scale else {})}
 
 
 @dataclass(frozen=True)
@@ -141,6 +159,11 @@ class NodeComposition:
 
 VARIANT_AS_WRITTEN = "as written"
 VARIANT_WITH_ASSUMPTIONS = "with producers' assumptions"
+VARIANT_IN_CONTEXT = "in context"
+#: How many premises of an in-context proof its explanation names (all are its hypotheses).
+NAMED = 8
+#: The verdict of a side condition discharged against its upstream cone.
+IN_CONTEXT = "discharged in context"
 
 
 def branch_siblings(model: SystemModel, node: str) -> list[str]:
@@ -205,15 +228,40 @@ def _environment_texts(checked: Checked, model: SystemModel, node: str) -> tuple
         _ENV_TEXTS["key"], _ENV_TEXTS["texts"] = (checked, model), {}
     texts: dict[str, tuple[str, ...]] = _ENV_TEXTS["texts"]
     if node not in texts:
-        texts[node] = tuple(expr_to_rcl(c) for c in split_assumption(checked, model, node)[1])
+        texts[node] = tuple(expr_to_rcl(c) for c in environment_conjuncts(checked, model, node))
     return texts[node]
+
+
+def environment_texts(checked: Checked, model: SystemModel, node: str) -> tuple[str, ...]:
+    """The environment conjuncts of ``node``'s assumption as RCL text (what
+    a derived property lists; remembered per (checked, model))."""
+    return _environment_texts(checked, model, node)
+
+
+def environment_conjuncts(checked: Checked, model: SystemModel, node: str) -> tuple[ast.Expr, ...]:
+    """The environment conjuncts of ``node``'s assumption
+    (:func:`split_assumption`), remembered like :func:`_environment_texts`:
+    the in-context check of every node downstream reads them."""
+    if _ENV_TEXTS["key"] is None or _ENV_TEXTS["key"][0] is not checked or _ENV_TEXTS["key"][1] is not model:
+        _ENV_TEXTS["key"], _ENV_TEXTS["texts"] = (checked, model), {}
+    exprs: dict[str, tuple[ast.Expr, ...]] = _ENV_TEXTS.setdefault("exprs", {})
+    if _ENV_TEXTS.get("exprs_key") is not _ENV_TEXTS["key"]:
+        exprs.clear()
+        _ENV_TEXTS["exprs_key"] = _ENV_TEXTS["key"]
+    if node not in exprs:
+        exprs[node] = tuple(split_assumption(checked, model, node)[1])
+    return exprs[node]
 
 
 @solver_session()
 def compose_node(checked: Checked, model: SystemModel, node: str, *,
+                 facts: Mapping[str, Sequence[ast.Expr]] | None = None,
                  timeout_ms: int = DEFAULT_TIMEOUT_MS) -> NodeComposition:
     """Apply the calculus to ``node``: discharge its side conditions with Z3.
 
+    ``facts`` are the plan's environment facts per node (RCL formulas over
+    that node's inputs and outputs); only a side condition that fails
+    locally reads them, with the rest of its upstream cone (:mod:`.context`).
     Returns a :class:`NodeComposition`.  Never raises on solver trouble
     (an unknown answer is an ``inconclusive`` side condition).  The side
     conditions share one solver session
@@ -239,6 +287,7 @@ def compose_node(checked: Checked, model: SystemModel, node: str, *,
     rule = instance_rule(model, node) or "R1"
     who = ", ".join(producers)
     scs = []
+    cone_ctx: ConeContext | None = None
     for k, c in enumerate(internal, 1):
         goal = enc.formula(c, cn)
         links = _links_of(model, cn, node, c)
@@ -276,12 +325,24 @@ def compose_node(checked: Checked, model: SystemModel, node: str, *,
                          "is not shown.")
         if r.strategy:
             expl += f" Z3's default strategy gave up; answered with {r.strategy}."
-        scale = probable_mismatches(checked, model.links_into(node), enc, node, c) if status != "discharged" else ()
-        for m in scale:
-            expl += f" {m['message'][0].upper()}{m['message'][1:]}."
-        scs.append(SideCondition(f"{node}.sc{k}", node, rule, expr_to_rcl(c), _loc(c.loc), used_text,
-                                 status, round(first.duration_s + (r.duration_s if r is not first else 0.0), 4),
-                                 r.smt2, r.model, expl, variant, tuple(links), scale))
+        duration = round(first.duration_s + (r.duration_s if r is not first else 0.0), 4)
+        sc = SideCondition(f"{node}.sc{k}", node, rule, expr_to_rcl(c), _loc(c.loc), used_text,
+                           status, duration, r.smt2, r.model, expl, variant, tuple(links), status)
+        if status != "discharged":  # context before blame (docs/calculus.md)
+            if cone_ctx is None:
+                cone_ctx = ConeContext(checked, model, node, lambda m: environment_conjuncts(checked, model, m), facts)
+            cr = cone_ctx.decide(c, head + "\nvariant: " + VARIANT_IN_CONTEXT + " (the upstream cone; "
+                                 "each guarantee under its node's assumption)", timeout_ms)
+            read_from = {x.split(".", 1)[0] for x in links}
+            keep: set[str] = ({node}.union(*(model.upstream(p) for p in read_from)) if read_from
+                              else set(cone_ctx.cone))
+            sc = in_context(sc, cr, cone_ctx, who, keep)
+        if sc.status != "discharged":  # neither locally nor in context: a power of ten between the ranges?
+            scale = tuple(probable_mismatches(checked, model.links_into(node), enc, node, c))
+            if scale:
+                sc = dataclasses.replace(sc, scale=scale, explanation=sc.explanation + "".join(
+                    f" {m['message'][0].upper()}{m['message'][1:]}." for m in scale))
+        scs.append(sc)
     env_assumptions = tuple({"node": node, "text": expr_to_rcl(c), "source": _loc(c.loc)} for c in env)
     g_text = contract_text([g.formula for g in cn.node.guarantees])
     a_text = contract_text([a.formula for a in cn.node.assumes])
@@ -310,6 +371,63 @@ def compose_node(checked: Checked, model: SystemModel, node: str, *,
     return NodeComposition(node, rules, tuple(producers), tuple(scs), env_assumptions, tuple(instances), derived,
                            tuple(cone), R4_ASSUMPTION.format(loop="{" + ", ".join(loop) + "}") if loop else None,
                            cone_env, g_text)
+
+
+def in_context(sc: SideCondition, cr: ContextResult, ctx: ConeContext, who: str,
+               keep: set[str] | None = None) -> SideCondition:
+    """``sc`` (decided locally, not discharged) with the verdict of its
+    in-context check ``cr`` over the cone ``ctx`` (:mod:`.context`): the
+    status, verdict, hypotheses, model, explanation, SMT-LIB2 text (the local
+    query, ``(reset)``, the in-context query) and the ``context`` record.
+    A counterexample shows the nodes of ``keep`` (the consumer and the cones
+    of the producers of the inputs the conjunct reads: the values traced
+    back to their sources, not a sibling branch feeding another input)."""
+    node = sc.node
+    local = {"status": sc.status, "variant": sc.variant, "model": sc.model}
+    size = len(ctx.cone)
+    record: dict[str, Any] = {"cone": size, "used": [u.split(":", 1)[0] for u in cr.used],
+                              "used_nodes": list(cr.used_nodes),
+                              "opened": list(ctx.cut), "violated": list(cr.violated), "joins": list(cr.joins),
+                              "local": local}
+    opened = ("; the loop of its cone is opened at " + ", ".join(ctx.cut) + " (rule R4, paper lines 717-768: "
+              "the value read there is taken as arbitrary, so no guarantee is used to discharge its own premise)"
+              if ctx.cut else "")
+    cone_words = (f"the upstream cone of {node} ({size} node{'s' if size != 1 else ''}: every guarantee under its "
+                  f"own node's assumption, the environment assumptions and facts{opened})")
+    local_words = (f"The guarantees of {who} alone do not entail this conjunct of {node}'s assumption "
+                   f"({'refuted' if sc.status == 'failed' else 'undecided'} locally, {sc.variant})")
+    smt2 = sc.smt2 + "\n(reset)\n" + cr.smt2
+    duration = round(sc.duration_s + cr.duration_s, 4)
+    strategy = f" Z3's default strategy gave up on the in-context query; answered with {cr.strategy}." if cr.strategy else ""
+    if cr.status == "proved":
+        labels = [u.split(":", 1)[0] for u in cr.used]
+        named = ", ".join(labels[:NAMED]) + (f" and {len(labels) - NAMED} more premises (all listed as its hypotheses)"
+                                              if len(labels) > NAMED else "") if labels else "no premise"
+        expl = (f"Discharged in context. {local_words}, but {cone_words} does: Z3 proved it from {named}. Sound for "
+                f"the composed system as long as the environment assumptions of the cone hold.")
+        if cr.joins:
+            expl += (f" The proof reads {', '.join(cr.joins)} along more than one path; like the requirement checks "
+                     "it rests on R3's simplifying assumption that the outputs a join reads persist and are available "
+                     "together (paper line 660).")
+        return SideCondition(sc.id, node, sc.rule, sc.conjunct, sc.source, tuple(cr.used), "discharged", duration,
+                             smt2, None, expl + strategy, VARIANT_IN_CONTEXT, sc.links, IN_CONTEXT, record)
+    if cr.status == "refuted":
+        expl = (f"{sc.explanation} Checked in context too: with {cone_words}, Z3 still finds values violating it "
+                "(the counterexample below, traced back through the cone to its sources).")
+        if cr.violated:
+            expl += (f" In it the assumption of {', '.join(cr.violated)} does not hold, so "
+                     f"{'its guarantees promise' if len(cr.violated) == 1 else 'their guarantees promise'} nothing "
+                     "there: the side conditions upstream are the first to repair.")
+        if ctx.cut:
+            expl += " The value on an opened link is arbitrary, so the counterexample may use one the loop never produces."
+        shown = ({k: v for k, v in cr.model.items() if k.split(".", 1)[0] in keep}
+                 if cr.model is not None and keep is not None else cr.model)
+        return SideCondition(sc.id, node, sc.rule, sc.conjunct, sc.source, sc.hypotheses, "failed", duration,
+                             smt2, shown, expl + strategy, VARIANT_IN_CONTEXT, sc.links, "failed", record)
+    expl = (f"{local_words}; checked in context, with {cone_words}, Z3 could not decide it ({cr.reason or 'unknown'}). "
+            "It is not proved, and no counterexample of the whole cone is known.")
+    return SideCondition(sc.id, node, sc.rule, sc.conjunct, sc.source, sc.hypotheses, "inconclusive", duration,
+                         smt2, None, expl + strategy, VARIANT_IN_CONTEXT, sc.links, "inconclusive", record)
 
 
 def _shape(rule: str, producers: Sequence[str], node: str, siblings: Sequence[str]) -> str:

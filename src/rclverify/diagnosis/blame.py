@@ -101,7 +101,7 @@ def side_condition_culprits(ws: Any, sc: Mapping[str, Any]) -> tuple[list[tuple[
             if system is None:  # the conjunct does not read in the producer's names: nothing shown either way
                 undecided += 1
                 continue
-            status = recheck.side_conditions(*system, sc["node"]).get(str(sc["id"]))
+            status = recheck.side_conditions(*system, sc["node"], ws).get(str(sc["id"]))
             if status == "discharged":
                 out.append((p, k))
             elif status != "failed":
@@ -189,7 +189,7 @@ def cost(ws: Any, report: Mapping[str, Any], node: str, edit: Edit) -> list[dict
     consumers = sorted({l.to_node for l in system[1].links if l.from_node == node})
     after: dict[str, str] = {}
     for n in consumers:
-        after.update(recheck.side_conditions(*system, n))
+        after.update(recheck.side_conditions(*system, n, ws))
     before = {str(sc["id"]): str(sc["status"]) for sc in report["side_conditions"] if str(sc["id"]) in after}
     h_before = recheck.health(ws, ws.checked, node)
     h_after = recheck.health(ws, system[0], node)

@@ -138,11 +138,14 @@ def consistent(ws: Any, checked: Checked, node: str) -> str:
     return str(r.status)
 
 
-def side_conditions(checked: Checked, model: SystemModel, node: str) -> dict[str, str]:
-    """``{side condition id: status}`` of ``node`` in the edited system (a fresh Z3 world)."""
+def side_conditions(checked: Checked, model: SystemModel, node: str, ws: Any = None) -> dict[str, str]:
+    """``{side condition id: status}`` of ``node`` in the edited system (a fresh Z3 world), with the
+    plan's environment facts of ``ws`` (the workspace) as the stage has them: a side condition that
+    fails locally is checked in context with them (docs/calculus.md)."""
     from ..calculus.compose import compose_node
     world.fresh()
-    return {sc.id: sc.status for sc in compose_node(checked, model, node).side_conditions}
+    facts = {n: [f.expr for f in fs] for n, fs in ws.plan.facts.items()} if ws is not None else None
+    return {sc.id: sc.status for sc in compose_node(checked, model, node, facts=facts).side_conditions}
 
 
 def hoare_statuses(ws: Any, node: str, index: int, program: str, new_text: str) -> dict[str, str]:

@@ -93,7 +93,7 @@ def side_condition_repairs(ws: Any, sc: Mapping[str, Any], before_sc: Mapping[st
     def cost_of(checked: Any, model: Any, nodes: Sequence[str], health_nodes: Sequence[str]) -> list[dict[str, str]] | None:
         after: dict[str, str] = {}
         for n in nodes:
-            after.update(recheck.side_conditions(checked, model, n))
+            after.update(recheck.side_conditions(checked, model, n, ws))
         if after.get(sc["id"]) != "discharged":
             return None
         h_before: dict[str, str] = {}

@@ -39,6 +39,7 @@ from ..rcl.printer import expr_to_rcl
 from ..rcl.typecheck import domain_type
 from ..rcl.types import NATURAL, Checked, CheckedNode
 from .finding import Finding as Finding  # re-exported: callers import it from here too
+from .realizable import realizability_findings
 from .shape import shape_findings
 from .witness import finite_witness, has_tables, points_for
 
@@ -146,9 +147,11 @@ class _NodeHealth:
 @solver_session()
 def check_node(checked: Checked, node: str, facts: Sequence[tuple[ast.Expr, ast.Loc]] = (),
                instances: tuple[int, int] | None = None, *, timeout_ms: int = HEALTH_TIMEOUT_MS) -> list[Finding]:
-    """Run the three health checks on ``node``, then the checks of
-    :mod:`rclverify.health.shape` (tautologies, guarantees constraining no
-    output, unconstrained outputs, redundant conjuncts); returns its findings
+    """Run the three health checks on ``node``, then realizability
+    (:mod:`rclverify.health.realizable`: an admissible input no output
+    answers) and the checks of :mod:`rclverify.health.shape` (tautologies,
+    guarantees constraining no output, unconstrained outputs, redundant
+    conjuncts); returns its findings
     in order.  The queries share one solver session
     (:func:`~rclverify.logic.query.solver_session`): they depend on the
     node's contract, facts and instances alone, and run in a fixed order."""
@@ -196,6 +199,7 @@ def check_node(checked: Checked, node: str, facts: Sequence[tuple[ast.Expr, ast.
         f = _non_vacuity(h, n, k)
         if f is not None:  # only implications have a premise that can be vacuous
             out.append(f)
+    out += realizability_findings(checked, node, facts, instances)
     out += shape_findings(checked, node)
     return out
 

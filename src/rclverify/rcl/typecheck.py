@@ -64,6 +64,8 @@ class _Checker:
         self.enum_values: dict[str, EnumT] = {}
         self.ctors: dict[str, DataT] = {}
         self._resolving: set[str] = set()
+        #: nodes allowed without assumption and guarantee (:func:`check`'s ``interface_only``)
+        self.interface_only: frozenset[str] = frozenset()
         # Names whose declaration already failed (an unknown type was
         # reported there): later uses fail silently instead of adding
         # knock-on messages.  ``unknown_types``: reported once per name.
@@ -218,8 +220,10 @@ class _Checker:
         for cl in n.guarantees:
             if (cl.trigger is not None or cl.deadline is not None) and not timing.check_clause(n, cl, self.err):
                 ok = False
-        if not n.guarantees:
-            self.err(n.loc, f"node {n.name} has no guarantee; a contract needs at least one guarantee(...)", "E-contract")
+        if not n.guarantees and not (n.name in self.interface_only and not n.assumes):
+            self.err(n.loc, f"node {n.name} has no guarantee; a contract needs at least one guarantee(...) "
+                            f"(for a node declared by its interface only, `rclverify quotient {n.name}` computes "
+                            "the weakest contract its neighbours need)", "E-contract")
             ok = False
         for cl in n.assumes + n.guarantees:
             try:
@@ -465,14 +469,19 @@ def _is_enum_constant(d: ast.TypeDecl | ast.ConstDecl, decls: Sequence[ast.TypeD
     return not any(i.name in declared for i in d.value.items)  # type: ignore[union-attr]
 
 
-def check(specs: Sequence[ast.Spec]) -> Checked:
+def check(specs: Sequence[ast.Spec], interface_only: Iterable[str] = ()) -> Checked:
     """Type-check parsed RCL files together (contexts are shared by all files).
 
+    ``interface_only`` names nodes that may be declared with their inputs,
+    outputs and topics alone (no assumption, no guarantee): the node whose
+    contract ``rclverify quotient`` computes (docs/calculus.md).  Everywhere
+    else a node needs a guarantee.
     Returns the :class:`Checked` system; raises :class:`RclError` listing
     every error found (sorted by file, line, column).
     """
     c = _Checker()
     c.with_units = any(getattr(s, "has_units", True) for s in specs)
+    c.interface_only = frozenset(interface_only)
     c.contexts(specs)
     nodes: dict[str, CheckedNode] = {}
     seen: dict[str, ast.Loc] = {}

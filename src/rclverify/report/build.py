@@ -332,7 +332,8 @@ def build_report(ws: Workspace) -> dict[str, Any]:
             problems.append(f"Requirement {rq['id']} is {rq['verdict']}: {_brief(rq['note'])}")
     for sc in side_conditions:
         if sc["status"] != "discharged":
-            problems.append(f"Side condition {sc['id']} is {sc['status']}: {sc['conjunct']}")
+            where = " (checked in context too)" if sc.get("context") and sc["status"] != "stale" else ""
+            problems.append(f"Side condition {sc['id']} is {sc['status']}{where}: {sc['conjunct']}")
     problems.extend(problems_altered)
     problems.extend(u["message"] for u in unverified)
     for e in ev_rows:
@@ -406,11 +407,13 @@ def involved_model(sc: Mapping[str, Any]) -> Mapping[str, Any]:
     consumer and the producers of its ``links`` (``"P.out.v -> C.in.w
     (...)"``).  The query holds every producer of the consumer (the drone's
     Geofence with the battery mismatch), whose values say nothing about
-    this conjunct.  Unchanged without a model or links."""
+    this conjunct.  Unchanged without a model or links, and for a side
+    condition decided in context (its ``context`` record), whose
+    counterexample is that of the whole upstream cone."""
     model = sc.get("model")
     nodes = {str(sc.get("node", ""))} | {str(l).split(".", 1)[0] for l in sc.get("links") or ()}
-    if not isinstance(model, dict) or not sc.get("links"):
-        return sc
+    if not isinstance(model, dict) or not sc.get("links") or sc.get("context"):
+        return sc  # decided in context: the calculus kept the cones of the producers read (docs/calculus.md)
     kept = {k: v for k, v in model.items() if str(k).split(".", 1)[0] in nodes}
     return {**sc, "model": kept} if kept and len(kept) < len(model) else sc
 
@@ -468,8 +471,10 @@ def _headline(ob_rows: list[dict[str, Any]], counts: dict[str, int], side_condit
         parts.append(f"{len(unverified)} guarantee{'s' if len(unverified) != 1 else ''} unverified "
                      "(no obligation covers " + ("it" if len(unverified) == 1 else "them") + ")")
     if side_conditions:
+        in_context = sum(1 for sc in side_conditions if sc["status"] == "discharged"
+                         and sc.get("verdict") == "discharged in context")
         parts.append(f"{sum(1 for sc in side_conditions if sc['status'] == 'discharged')}/{len(side_conditions)} "
-                     "side conditions discharged")
+                     "side conditions discharged" + (f" ({in_context} in context)" if in_context else ""))
     else:
         parts.append("no side conditions")
     problems = sum(1 for f in findings if f["status"] == "problem")

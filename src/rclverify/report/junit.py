@@ -10,7 +10,9 @@ nothing itself.  Layout (decisions in ``docs/ci.md``):
   name the obligation id), per side condition of the calculus
   (``<Node>.side_condition``) and per contract health check
   (``<Node>.health``), each with the RCL ``file`` and ``line`` of its clause;
-* outcome from the status: ``discharged``/``ok`` passes; ``failed`` and
+* outcome from the status: ``discharged``/``ok`` passes (a side condition
+  ``discharged in context`` passes with its verdict and the upstream
+  premises its proof used in ``<system-out>``); ``failed`` and
   ``problem`` are a ``<failure>`` whose text carries the explanation and the
   counterexample (or unsat core); ``stale`` is a ``<failure>`` of type
   ``stale`` (the evidence no longer vouches for the current inputs);
@@ -222,10 +224,15 @@ def _suite(node: Mapping[str, Any], data: Mapping[str, Any]) -> tuple[ET.Element
     for sc in items.get("side_conditions", ()):
         case = _case(suite, f"{name}.side_condition", str(sc["id"]), str(sc["source"]), sc.get("duration_s"))
         model = model_text(sc.get("model"))
+        verdict = str(sc.get("verdict") or sc["status"])
         tally(case, str(sc["status"]), str(sc.get("explanation") or sc["status"]),
               _lines(f"side condition ({sc['rule']}): {sc['conjunct']}", f"source: {sc['source']}",
-                     str(sc.get("explanation") or ""), f"counterexample: {model}" if model else ""),
+                     f"verdict: {verdict}", str(sc.get("explanation") or ""),
+                     f"counterexample: {model}" if model else ""),
               sc.get("duration_s"))
+        if sc["status"] == "discharged" and verdict != sc["status"]:  # a pass that rests on the upstream cone
+            ET.SubElement(case, "system-out").text = _lines(
+                f"verdict: {verdict}", "upstream premises used: " + "; ".join(str(h) for h in sc.get("hypotheses") or []))
     for f in items.get("findings", ()):
         case = _case(suite, f"{name}.health", str(f["id"]), _source_of(node, f), f.get("duration_s"))
         core = "; ".join(str(c) for c in f.get("core") or [])

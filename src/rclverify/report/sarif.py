@@ -8,7 +8,10 @@ One ``result`` per item that needs attention:
 
 * an obligation whose status is ``failed``, ``error``, ``stale``,
   ``inconclusive`` or ``pending`` (a discharged one gives none);
-* a side condition of the calculus that is not ``discharged``;
+* a side condition of the calculus that is not ``discharged``, and one
+  ``discharged in context`` (rule ``RCL-SC-IN-CONTEXT``, level ``note``:
+  the premise of R1-R3 as printed fails; the upstream premises the proof
+  used are in ``properties.inContext``);
 * a guarantee no obligation covers (``unverified``, rule
   ``RCL-GUARANTEE-UNVERIFIED``, at the guarantee);
 * a contract health finding whose status is ``problem`` or ``inconclusive``;
@@ -73,6 +76,10 @@ RULES: Mapping[str, Rule] = {r.id: r for r in (
          "this conjunct of the consumer's assumption."),
     Rule("RCL-SC-INCONCLUSIVE", "SideConditionInconclusive", "warning",
          "Z3 could not decide a side condition of the composition calculus."),
+    Rule("RCL-SC-IN-CONTEXT", "SideConditionDischargedInContext", "note",
+         "A side condition the producers' guarantees alone do not entail (the premise of rules R1-R3 as printed) "
+         "is discharged in context: Z3 proved it from the upstream cone, each guarantee under its own node's "
+         "assumption; the upstream premises it rests on are named (docs/calculus.md)."),
     Rule("RCL-HEALTH-UNSATISFIABLE-ASSUMPTION", "AssumptionUnsatisfiable", "error",
          "The node's assumption can never hold: its contract promises nothing."),
     Rule("RCL-HEALTH-INCONSISTENT", "ContractInconsistent", "error",
@@ -80,6 +87,9 @@ RULES: Mapping[str, Rule] = {r.id: r for r in (
     Rule("RCL-HEALTH-VACUOUS", "GuaranteeVacuous", "error",
          "The premise of a guarantee can never hold together with the other guarantees and the facts: "
          "it promises nothing."),
+    Rule("RCL-HEALTH-UNREALIZABLE", "ContractUnrealizable", "error",
+         "Some input the node's assumption (and the environment facts) admit has no output satisfying its "
+         "guarantees: no implementation can meet the contract (the input is in the message)."),
     Rule("RCL-HEALTH-REPLACEMENT", "ReplacementDoesNotRefine", "error",
          "The replacement contract offered for the node does not refine the node's contract."),
     Rule("RCL-HEALTH-TAUTOLOGY", "GuaranteeTautology", "error",
@@ -128,6 +138,7 @@ _REQUIREMENT_RULE = {"refuted": "RCL-REQ-REFUTED", "proved from an inconsistency
 _HEALTH_RULE = {"assumption-satisfiable": "RCL-HEALTH-UNSATISFIABLE-ASSUMPTION",
                 "contract-consistent": "RCL-HEALTH-INCONSISTENT",
                 "non-vacuous": "RCL-HEALTH-VACUOUS",
+                "realizable": "RCL-HEALTH-UNREALIZABLE",
                 "replacement-refines": "RCL-HEALTH-REPLACEMENT",
                 "tautology": "RCL-HEALTH-TAUTOLOGY",
                 "constrains-no-output": "RCL-HEALTH-NO-OUTPUT",
@@ -217,15 +228,24 @@ def _side_condition_results(report: Mapping[str, Any]) -> list[dict[str, Any]]:
     out = []
     for sc in report["side_conditions"]:
         status = str(sc["status"])
-        if status == "discharged":
+        verdict = str(sc.get("verdict") or status)
+        if status == "discharged" and verdict != "discharged in context":
             continue
-        rule = {"failed": "RCL-SC-REFUTED", "stale": "RCL-SC-STALE"}.get(status, "RCL-SC-INCONCLUSIVE")
-        words = [f"Side condition {sc['id']} ({sc['rule']}) of {sc['node']} is {status}: {sc['conjunct']}."]
+        rule = {"failed": "RCL-SC-REFUTED", "stale": "RCL-SC-STALE",
+                "discharged": "RCL-SC-IN-CONTEXT"}.get(status, "RCL-SC-INCONCLUSIVE")
+        said = verdict if status == "discharged" else status
+        words = [f"Side condition {sc['id']} ({sc['rule']}) of {sc['node']} is {said}: {sc['conjunct']}."]
         if sc.get("explanation"):
             words.append(str(sc["explanation"]))
         if sc.get("model"):
             words.append(f"Counterexample: {model_text(sc['model'])}.")
-        props = {"sideCondition": sc["id"], "node": sc["node"], "rule": sc["rule"], "status": status}
+        props: dict[str, Any] = {"sideCondition": sc["id"], "node": sc["node"], "rule": sc["rule"], "status": status,
+                                 "verdict": verdict}
+        ctx = sc.get("context")
+        if isinstance(ctx, Mapping):  # decided in context: the cone and the upstream premises used
+            props["inContext"] = {"cone": ctx.get("cone"), "used": list(ctx.get("used") or []),
+                                  "opened": list(ctx.get("opened") or []), "violated": list(ctx.get("violated") or [])}
+        # one severity (report/severity.py): a side condition discharged in context holds (a note, not gating)
         out.append(_result(rule, _level("side-condition", status), " ".join(words), str(sc["source"]),
                            f"side-condition:{sc['id']}", props))
     return out

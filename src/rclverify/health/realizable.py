@@ -1,0 +1,146 @@
+"""Contract health, realizability: can the guarantees be met for every input
+the assumption admits (docs/architecture.md, "Contract health and lint")?
+
+A contract ``(A, G)`` is *realizable* when ``forall in. A(in) -> exists out.
+G(in, out)``: whatever admissible input arrives, some output satisfies every
+guarantee (the paper's node "verified to preserve its guarantees when its
+assumptions are satisfied", lines 740-768, presupposes one exists; Kind 2
+checks the same of its contracts).  Consistency (:mod:`.checks`) asks only
+that *some* input and output satisfy the contract; a contract can be
+consistent and still leave inputs without an answer: the case study's
+Agent, whose guarantee 2 demands ``inspect(i)`` at an uninspected waypoint
+while its guarantee 3, as published, demands the move to waypoint 0 at
+every step.
+
+The check asks Z3 for an input with no answer::
+
+    A(in) and F_in(in) and forall out. (typing(out) and F_out(in, out) -> not (G1 and ... and Gn))
+
+(``F_in``/``F_out``: the plan's environment facts of the node over its inputs
+only / mentioning an output; ``typing``: an output of a NATURAL type, or a
+constructor's NATURAL field, is ``>= 0``).  With function-typed inputs it
+first asks for such an input in which every function is a finite table
+(:mod:`.witness`), which Z3 finds in a fraction of the general query's time;
+a table witness is a genuine input.  Then it names the guarantees that
+conflict: the smallest set of them (single guarantees, then pairs) that
+already has no answer for some input.
+
+Like the checks of :mod:`.shape` it reports only what it finds: a
+``problem`` finding (check ``realizable``) with the input that has no
+answer, and nothing when the contract is realizable, when Z3 cannot decide
+within the budget, or when an output is function-typed (``forall`` over a
+function is beyond first-order logic: not checked, docs/architecture.md).
+"""
+from __future__ import annotations
+
+import itertools
+import time
+from typing import Sequence
+
+import z3
+
+from ..logic.encode import Encoder
+from ..logic.query import satisfiable, smt2_script
+from ..rcl import ast
+from ..rcl.types import Checked
+from .finding import Finding
+from .shape import outputs_mentioned
+from .witness import finite_witness, has_tables, points_for
+
+#: Budget of one realizability query (milliseconds' worth of Z3 resource steps).
+REALIZABLE_TIMEOUT_MS = 2_000
+#: Guarantees beyond this many are not searched for the conflicting subset.
+MAX_SUBSET_SEARCH = 5
+
+
+def _where(l: ast.Loc) -> str:
+    return f"{l.file}:{l.line}:{l.col}"
+
+
+class _Query:
+    """The node's contract encoded once: inputs' formulas, guarantees, and the outputs to quantify."""
+
+    def __init__(self, checked: Checked, node: str, facts: Sequence[tuple[ast.Expr, ast.Loc]],
+                 instances: tuple[int, int] | None) -> None:
+        cn = checked.nodes[node]
+        self.cn, self.instances = cn, instances
+        self.enc = enc = Encoder(checked.env)
+        self.given = [enc.formula(a.formula, cn) for a in cn.node.assumes]
+        self.given += [enc.formula(f, cn) for f, _ in facts if not outputs_mentioned(f, cn)]
+        self.out_facts = [enc.formula(f, cn) for f, _ in facts if outputs_mentioned(f, cn)]
+        self.guarantees = [enc.formula(g.formula, cn) for g in cn.node.guarantees]
+        self.outs = [enc.io_symbol(cn, "out", v) for v in cn.outputs]
+        typed = Encoder(checked.env)  # the outputs' typing axioms, and only theirs
+        for v in cn.outputs:
+            typed.io_symbol(cn, "out", v)
+        self.typing = typed.axioms()
+        out_names = {typed.symbol_name(cn.name, "out", v) for v in cn.outputs}
+        for name in out_names:  # bound below: not free symbols of the query (models show the inputs)
+            enc.symbols.pop(name, None)
+
+    def formula(self, ks: Sequence[int]) -> z3.BoolRef:
+        """The query with guarantees ``ks`` (0-based) only."""
+        g = [self.guarantees[k] for k in ks]
+        body = z3.Implies(z3.And(*self.typing, *self.out_facts), z3.Not(z3.And(*g)))
+        return z3.And(*self.given, z3.ForAll(self.outs, body))
+
+    def answer(self, ks: Sequence[int], comment: str, general: bool = True
+               ) -> tuple[str, dict[str, str] | None, float, str]:
+        """``(sat|other, input model, seconds, SMT-LIB2 text)`` of the query
+        over guarantees ``ks``; ``general=False``: with function-typed inputs,
+        the table witness only (the search for the conflicting subset)."""
+        f = self.formula(ks)
+        t0 = time.perf_counter()
+        if has_tables(self.enc):
+            w = finite_witness(self.enc, [f], points_for(self.instances), REALIZABLE_TIMEOUT_MS)
+            if w.status == "sat":
+                text = smt2_script(self.enc.axioms() + [f], comment)()
+                return "sat", w.model, round(time.perf_counter() - t0, 4), text
+            if not general:
+                return "inconclusive", None, round(time.perf_counter() - t0, 4), ""
+        r = satisfiable([("no output for this input", f)], self.enc, timeout_ms=REALIZABLE_TIMEOUT_MS,
+                        comment=comment, retry=False)
+        return r.status, r.model, round(time.perf_counter() - t0, 4), r.smt2 if r.status == "sat" else ""
+
+
+def realizability_findings(checked: Checked, node: str, facts: Sequence[tuple[ast.Expr, ast.Loc]] = (),
+                           instances: tuple[int, int] | None = None) -> list[Finding]:
+    """The ``realizable`` finding of ``node`` when its contract is not
+    realizable (module docstring), else ``[]``.  ``facts``: the plan's
+    environment facts of the node with their locations; ``instances``: its
+    ``instances`` range (the tables' size).  Never raises on solver trouble."""
+    cn = checked.nodes[node]
+    n = cn.node
+    if not n.guarantees or not n.outputs:
+        return []
+    q = _Query(checked, node, facts, instances)
+    if any(isinstance(o, z3.FuncDeclRef) for o in q.outs):
+        return []  # forall over a function-typed output: not first-order, not checked
+    every = list(range(len(n.guarantees)))
+    status, model, secs, smt2 = q.answer(every, f"health {node}: is there an input no output answers?")
+    if status != "sat":
+        return []
+    conflict = every
+    if 1 < len(every) <= MAX_SUBSET_SEARCH:
+        for size in range(1, len(every)):
+            found = None
+            for ks in itertools.combinations(every, size):
+                st, m, dt, text = q.answer(ks, f"health {node}: is there an input guarantees "
+                                                f"{', '.join(str(k + 1) for k in ks)} cannot answer?", general=False)
+                secs += dt
+                if st == "sat":
+                    found = (list(ks), m, text)
+                    break
+            if found:
+                conflict, model, smt2 = found[0], found[1], found[2] or smt2
+                break
+    names = [f"guarantee {k + 1} ({_where(n.guarantees[k].loc)})" for k in conflict]
+    short = [x.split(" (")[0] for x in names]
+    which = short[0] if len(short) == 1 else ", ".join(short[:-1]) + f" and {short[-1]} together"
+    msg = (f"The contract of {node} cannot be implemented: for the input below, which its assumption"
+           + (" and the environment facts admit" if facts else " admits") + f", no output satisfies {which}.")
+    expl = ("Realizability (forall in. A(in) -> exists out. G(in, out)) fails: Z3 found an admissible input for which "
+            "every output violates " + (" and ".join(x.split(" (")[0] for x in names) if len(names) > 1 else names[0])
+            + ". An implementation meeting the contract cannot exist; the guarantees ask for incompatible outputs there.")
+    return [Finding(f"{node}.realizable", node, "realizable", conflict[0] + 1 if len(conflict) == 1 else None,
+                    "problem", msg, expl, model, names, secs, smt2=smt2)]

@@ -1,0 +1,122 @@
+"""Realizability (issue 43; docs/calculus.md, "Realizability"): an input the
+assumption admits that no output answers is a health problem with that
+input; the case study's Agent is one; the check against brute-force
+enumeration on small random contracts."""
+from __future__ import annotations
+
+import itertools
+import random
+import re
+from pathlib import Path
+
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from rclverify.health.realizable import realizability_findings
+from rclverify.logic import world
+from rclverify.plan.load import load_plan
+from rclverify.rcl.parser import parse_formula, parse_text
+from rclverify.rcl.typecheck import check, load
+
+ROOT = Path(__file__).resolve().parents[1]
+
+CLAMP = """
+node C {
+  inputs( x : INTEGER, on : BOOL )
+  outputs( y : INTEGER )
+  assume( 0 <= in.x )
+  guarantee( in.on -> out.y == in.x )
+  guarantee( out.y <= 10 )
+}
+"""
+
+
+def _findings(text: str, node: str, facts: list[str] = ()):  # type: ignore[no-untyped-def]
+    checked = check([parse_text(text, "c.rcl")])
+    world.fresh()
+    return realizability_findings(checked, node, [(parse_formula(f), parse_formula(f).loc) for f in facts])
+
+
+def test_an_unrealizable_contract_is_flagged_with_the_input_that_has_no_answer() -> None:
+    [f] = _findings(CLAMP, "C")
+    assert f.check == "realizable" and f.status == "problem" and f.id == "C.realizable"
+    assert "cannot be implemented" in f.message and "guarantee 1 and guarantee 2 together" in f.message
+    assert f.core == ["guarantee 1 (c.rcl:6:3)", "guarantee 2 (c.rcl:7:3)"] and f.guarantee is None
+    x, on = int(f.model["C.in.x"]), f.model["C.in.on"]
+    assert on == "TRUE" and x > 10  # the answer y == x breaks y <= 10
+    assert "C.out.y" not in f.model  # the model is the input alone
+    assert "(check-sat)" in f.smt2
+
+
+def test_a_fact_can_make_it_realizable_and_a_realizable_contract_says_nothing() -> None:
+    assert _findings(CLAMP, "C", ["in.x <= 10"]) == []
+    assert _findings(CLAMP.replace("out.y <= 10", "out.y <= in.x + 10"), "C") == []
+
+
+def test_function_typed_outputs_are_not_checked() -> None:
+    text = """
+context { F : INTEGER --> BOOL ; }
+node S { inputs( x : INTEGER ) outputs( f : F ) assume( TRUE ) guarantee( out.f(1) and not out.f(1) ) }
+"""
+    assert _findings(text, "S") == []
+
+
+def test_the_case_study_agent_is_unrealizable_and_its_other_nodes_are_not_checked() -> None:
+    checked = load([ROOT / "contracts" / "remote_inspection.rcl"])
+    plan = load_plan(ROOT, "contracts/plan.yaml")
+    found = {}
+    for node in checked.nodes:
+        world.fresh()
+        found[node] = realizability_findings(checked, node, [(f.expr, f.loc) for f in plan.facts.get(node, ())],
+                                             plan.instances.get(node))
+    assert {n for n, fs in found.items() if fs} == {"Agent"}
+    [f] = found["Agent"]
+    assert f.status == "problem" and len(f.core or []) == 1  # a single guarantee already has no answer
+    at = f.model["Agent.in.at"]
+    assert at.count("TRUE") >= 2  # the robot "at" two places: nothing says it is at one
+
+
+# ---- the oracle: against enumeration ----------------------------------------------------------------
+
+D = 3
+
+
+def _random_contract(seed: int) -> tuple[str, list[str]]:
+    rng = random.Random(seed)
+    atoms_in = [f"in.a <= {rng.randint(0, D)}", f"in.a >= {rng.randint(0, D)}", "in.a <= in.b", "in.b == 1"]
+    atoms_out = [f"out.y <= in.a + {rng.randint(-1, 1)}", f"out.y >= in.b + {rng.randint(-1, 1)}",
+                 f"out.y == {rng.randint(0, D)}", f"out.y != in.a", "out.z -> out.y <= 1", "in.b >= 2 -> out.z",
+                 f"out.y + in.a <= {rng.randint(0, 2 * D)}", "not out.z or out.y >= in.a"]
+    a = " and ".join(rng.sample(atoms_in, rng.randint(1, 2)))
+    gs = rng.sample(atoms_out, rng.randint(1, 3))
+    text = ("node R { inputs( a : INTEGER, b : INTEGER ) outputs( y : INTEGER, z : BOOL ) "
+            f"assume( {a} ) " + " ".join(f"guarantee( {g} )" for g in gs) + " }")
+    facts = [f"0 <= in.a and in.a <= {D} and 0 <= in.b and in.b <= {D}", f"0 <= out.y and out.y <= {D}"]
+    return text, facts
+
+
+def _holds(formula: str, v: dict[str, object]) -> bool:
+    py = re.sub(r"\b(in|out)\.(\w+)", lambda m: f"v['{m.group(2)}']", formula)
+    py = re.sub(r"(.+?) -> (.+)", r"(not (\1)) or (\2)", py)
+    return bool(eval(py, {"v": v}))  # noqa: S307 (our own atoms)
+
+
+@settings(max_examples=40, deadline=None, derandomize=True)
+@given(seed=st.integers(0, 10**6))
+def test_realizability_equals_brute_force_enumeration(seed: int) -> None:
+    text, facts = _random_contract(seed)
+    a = re.search(r"assume\( (.*?) \)", text).group(1)  # type: ignore[union-attr]
+    gs = re.findall(r"guarantee\( (.*?) \)", text)
+    dom = range(D + 1)
+
+    def answered(ins: dict[str, object]) -> bool:
+        return any(all(_holds(g, {**ins, "y": y, "z": z}) for g in gs) for y in dom for z in (False, True))
+
+    bad = [{"a": x, "b": y} for x, y in itertools.product(dom, dom)
+           if all(_holds(p, {"a": x, "b": y}) for p in a.split(" and ")) and not answered({"a": x, "b": y})]
+    found = _findings(text, "R", facts)
+    assert bool(found) == bool(bad), (text, bad, found)
+    if found:
+        f = found[0]
+        ins = {"a": int(f.model["R.in.a"]), "b": int(f.model["R.in.b"])}
+        assert ins in bad, (text, f.model)
