@@ -197,3 +197,36 @@ def test_fmt_and_latex_keep_the_declarations(tmp_path: Path) -> None:
     assert "  periodic( out.target, 100 ms )\n" in printed and "  progress( eventually )\n" in printed
     tex = to_latex(spec)
     assert "progress & within 2 steps" in tex and r"periodic & $\mathit{out.target}$, 100~\textrm{ms}" in tex
+
+
+def test_an_initial_value_no_output_meets_is_an_inconsistency(tmp_path: Path) -> None:
+    """``initially( out.pose == 0 and out.pose == 1 )`` would force Base to
+    answer at step 0 and so silently remove the runs whose first target it
+    cannot accept: a proof over it is `proved from an inconsistency`, never
+    met, with the initial value as the core."""
+    safe = {"id": "SAFE", "text": "the pose Planner reads is never negative",
+            "formal": "always next Planner.in.pose >= 0"}
+    r = _records(_ws(tmp_path, "progress( within 0 steps )",
+                     "initially( out.pose == 0 and out.pose == 1 )\n  progress( within 1 steps )", [safe]))["SAFE"]
+    assert r["check"]["temporal"]["status"] == "proved"
+    assert (r["verdict"], r["status"]) == ("proved from an inconsistency", "failed")
+    assert [p["label"] for p in r["check"]["inconsistent_core"]] == ["Base initially 1"]
+
+
+def test_declaring_progress_rechecks_and_equals_a_clean_run(tmp_path: Path) -> None:
+    """The declarations are in the node's snapshot: adding one re-checks the
+    requirements whose cone holds the node, and the result equals a clean run."""
+    ws = _ws(tmp_path, "progress( within 0 steps )", "initially( out.pose == 0 )")
+    assert _records(ws)["ARRIVE"]["verdict"] == "refuted"
+    rcl = ws / "contracts/r.rcl"
+    rcl.write_text(rcl.read_text().replace("initially( out.pose == 0 )",
+                                           "initially( out.pose == 0 )\n  progress( within 1 steps )"))
+    w = Workspace(ws)
+    stage_check(w)
+    again = stage_requirements(w)
+    assert [r["id"] for r, now in again if now] == ["ARRIVE"]
+    inc = _records(ws)["ARRIVE"]
+    clean = _records(_ws(tmp_path / "clean", "progress( within 0 steps )",
+                         "initially( out.pose == 0 )\n  progress( within 1 steps )"))["ARRIVE"]
+    assert inc["verdict"] == clean["verdict"] == "proved, evidence outstanding"
+    assert inc["check"]["temporal"] | {"duration_s": 0} == clean["check"]["temporal"] | {"duration_s": 0}

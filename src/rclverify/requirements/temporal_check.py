@@ -235,12 +235,16 @@ def check_temporal(req: Requirement, checked: Checked, model: SystemModel, plan:
         r = s.check()
         used = sys.premises
         out.update(verdict="proved", used=used)
+        # an initial value no output meets forces its node to answer at step 0: it removes runs, as a contradiction
+        bad, why = sys.initial_values_unsatisfiable(timeout_ms)
         if r == z3.unsat:
             out.update(consistency="inconsistent", inconsistent_core=used)
-        elif r == z3.sat:
+        elif bad:
+            out.update(consistency="inconsistent", inconsistent_core=bad)
+        elif r == z3.sat and not why:
             out.update(consistency="consistent")
         else:
-            out.update(consistency="undecided", consistency_reason=s.reason_unknown())
+            out.update(consistency="undecided", consistency_reason=s.reason_unknown() if r != z3.sat else why)
     elif v.status == "refuted":
         mentioned = {n for f in ops for n in f.nodes}
         # a run that stops, or a lasso resting on a node that never answers, is not let through by a guarantee

@@ -108,6 +108,26 @@ class ComposedSystem:
     everyone: tuple[Fairness, ...] = ()
     links: list[tuple[str, str]] = field(default_factory=list)
     bounds: dict[str, int | None] = field(default_factory=dict)
+    #: per node that declares ``initially``: its outputs' types and initial values over one state
+    initial: dict[str, Any] = field(default_factory=dict)
+
+    def initial_values_unsatisfiable(self, timeout_ms: int) -> tuple[list[dict[str, Any]], str]:
+        """The premises of the initial values that no output satisfies (a
+        node that must then answer at step 0, which would silently remove
+        every run whose first input it cannot accept), and the solver's
+        reason for any it could not decide (``""``: none)."""
+        bad: list[dict[str, Any]] = []
+        why = ""
+        for n, holds in self.initial.items():
+            s = z3.Solver()
+            s.set("timeout", timeout_ms)
+            s.add(holds(self.ts.state(0, "initially")))
+            r = s.check()
+            if r == z3.unsat:
+                bad += [p for p in self.premises if p["kind"] == "initial value" and p["node"] == n]
+            elif r == z3.unknown:
+                why = why or f"whether {n}'s initial value can hold ({s.reason_unknown()})"
+        return bad, why
 
     @property
     def eager(self) -> bool:
@@ -317,9 +337,14 @@ def build_system(cone: Sequence[str], checked: Checked, model: SystemModel, plan
         parts += [enc.formula(parsed[sv][1].expr, parsed[sv][1].scope, state_syms(sv, s, t)) for sv in states]
         return z3.And(*parts)
 
+    def initial_of(n: str) -> Any:
+        outs = [f"{n}.out.{v}" for v in checked.nodes[n].outputs if f"{n}.out.{v}" in sorts]
+        return lambda s: z3.And(*[c for c in (_typing(s[o], types[o]) for o in outs) if c is not None],
+                                *[holds(n, f, s) for f in initially[n]])
+
     def progress_of(n: str) -> Fairness:
         return Fairness(n, lambda s: accepted(n, s), lambda s: s[f"{n}.answers"])
     declared = tuple(progress_of(n) for n in answering if fair(checked.nodes[n].node))
     everyone = tuple(progress_of(n) for n in answering)
     return ComposedSystem(TransitionSystem(sorts, init, trans, declared), list(cone), variables, premises, everyone,
-                          links, bounds)
+                          links, bounds, {n: initial_of(n) for n in answering if initially[n]})
