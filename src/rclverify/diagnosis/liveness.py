@@ -49,14 +49,14 @@ def liveness_culprits(temporal: Mapping[str, Any]) -> tuple[str, list[dict[str, 
                     "implementation, to be shown by its evidence")
         return str(gaps[0]["node"]), culprits, sentence
     if stuck:
-        names = list(dict.fromkeys(str(r["node"]) for r in stuck))
+        producers = list(dict.fromkeys(str(r["node"]) for r in stuck))
         culprits = [{"what": f"the contract of {n}: no initial value declared",
                      "source": next(str(r["source"]) for r in stuck if r["node"] == n),
-                     "text": "declares no initially(...)"} for n in names]
+                     "text": "declares no initially(...)"} for n in producers]
         reads = "; ".join(f"{r['consumer']} keeps {r['node']}.{r['output']} = {r['value']} from before the run"
                           for r in stuck)
         sentence = (f"no node of the loop ever accepts its input ({reads}), so none ever answers. Declare the "
-                    f"initial value of the outputs of {', '.join(names)} (initially( ... ), a value the readers' "
+                    f"initial value of the outputs of {', '.join(producers)} (initially( ... ), a value the readers' "
                     "assumptions accept) if they have one before their first answer")
-        return names[0], culprits, sentence
+        return producers[0], culprits, sentence
     return "", [], ""

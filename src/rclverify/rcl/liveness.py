@@ -84,8 +84,8 @@ def check_node(n: ast.Node, inputs: set[str], outputs: set[str], err: Report) ->
                     f"read input {bare[0]}", "E-initially")
                 ok = False
     seen: dict[str, ast.Loc] = {}
-    for p in n.periodic:
-        v = p.output
+    for per in n.periodic:
+        v = per.output
         if v.prefix == "in" or (v.prefix is None and v.name in inputs and v.name not in outputs):
             err(v.loc, f"periodic(...) names input {_show(v)}; a period is a rate of an output of {n.name} (out.y)",
                 "E-periodic")
@@ -96,11 +96,11 @@ def check_node(n: ast.Node, inputs: set[str], outputs: set[str], err: Report) ->
             ok = False
             continue
         if v.name in seen:
-            err(p.loc, f"output out.{v.name} of {n.name} has two periods (first at {seen[v.name]})", "E-periodic")
+            err(per.loc, f"output out.{v.name} of {n.name} has two periods (first at {seen[v.name]})", "E-periodic")
             ok = False
             continue
-        seen[v.name] = p.loc
-        ok = _check_period(n, p, err) and ok
+        seen[v.name] = per.loc
+        ok = _check_period(n, per, err) and ok
     return ok
 
 
@@ -153,10 +153,15 @@ def step_bound(n: ast.Node) -> int | None:
     of ``progress( within K steps )``'s K and ``periodic( out.y, N steps )``'s
     N - 1; ``None`` when it declares neither (a checked node: the rules above
     hold)."""
-    ks = [_steps(p.bound) for p in n.progress if p.bound is not None and p.unit in STEP_WORDS]
-    ks += [_steps(p.amount) - 1 for p in n.periodic  # type: ignore[operator]
-           if p.unit in STEP_WORDS and _steps(p.amount)]
-    ks = [k for k in ks if k is not None]
+    ks: list[int] = []
+    for p in n.progress:
+        k = _steps(p.bound) if p.bound is not None and p.unit in STEP_WORDS else None
+        if k is not None:
+            ks.append(k)
+    for per in n.periodic:
+        k = _steps(per.amount) if per.unit in STEP_WORDS else None
+        if k:
+            ks.append(k - 1)
     return min(ks) if ks else None
 
 

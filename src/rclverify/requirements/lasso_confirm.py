@@ -149,8 +149,8 @@ def _confirm(trace: Sequence[Mapping[str, Any]], loop: int, cone: Sequence[str],
             if f"{n}.answers" in variables:
                 _check_waiting(n, cn, trace, i, accepts, answers)
             if i == 0 and f"{n}.answers" in variables and not answers:
-                for k, c in enumerate(cn.node.initially, 1):
-                    if not _holds(c.formula, checked, cn, vals, f"step 0: {n} initially {k}"):
+                for k, ini in enumerate(cn.node.initially, 1):
+                    if not _holds(ini.formula, checked, cn, vals, f"step 0: {n} initially {k}"):
                         raise _Unconfirmed(f"step 0: {n} does not answer and its initially {k} does not hold")
         # the statement's pseudo node names Node.out.y an output, every other variable an input (plan/formal.py)
         pseudo = {f"{'out' if variables[name][1] == 'out' else 'in'}.{name}": v

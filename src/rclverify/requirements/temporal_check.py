@@ -217,12 +217,12 @@ def check_temporal(req: Requirement, checked: Checked, model: SystemModel, plan:
                                       f"(found with every function a {points}-point table, confirmed on the "
                                       f"trace's values)")
     ranking = (lambda s: enc.term(rank.expr, rank.scope, sys.statement_symbols(s))) if rank is not None else None
-    found: dict[str, Any] = {}
+    missing: dict[str, Any] = {}
     v = decide(t, sys, pred, bound=bound, timeout_ms=timeout_ms, tables=tables, ranking=ranking,
-               invariant=pred(inv) if inv is not None else None, checked=checked, gaps=found)
+               invariant=pred(inv) if inv is not None else None, checked=checked, gaps=missing)
     lasso = v.status == "refuted" and "lasso" in v.method.split(" + ")
-    gaps = found.get("missing_progress", []) if lasso else []
-    stuck = found.get("missing_initially", []) if lasso else []
+    gaps = missing.get("missing_progress", []) if lasso else []
+    stuck = missing.get("missing_initially", []) if lasso else []
     out: dict[str, Any] = {**base, "cone": cone, "premises": len(sys.premises), "used": [], "traced_not_needed": [],
                            "temporal": {**v.to_json(), "trace": _steps(v.trace, sys),
                                         "ranking": base.get("ranking"), "invariant": base.get("invariant"),

@@ -70,9 +70,9 @@ def _typing(v: z3.ExprRef, t: Type) -> z3.BoolRef | None:
     if isinstance(t, DataT):
         ds = v.sort()
         parts = []
-        for i in range(ds.num_constructors()):  # type: ignore[attr-defined]
-            args = t.ctor(ds.constructor(i).name()) or ()  # type: ignore[attr-defined]
-            parts += [z3.Implies(ds.recognizer(i)(v), ds.accessor(i, j)(v) >= 0)  # type: ignore[attr-defined]
+        for i in range(ds.num_constructors()):
+            args = t.ctor(ds.constructor(i).name()) or ()
+            parts += [z3.Implies(ds.recognizer(i)(v), ds.accessor(i, j)(v) >= 0)
                       for j, a in enumerate(args) if a == NATURAL]
         return z3.And(*parts) if parts else None
     if isinstance(t, FuncT) and t.result == NATURAL:
