@@ -42,7 +42,7 @@ def liveness_culprits(temporal: Mapping[str, Any]) -> tuple[str, list[dict[str, 
         steps = ", ".join(str(i) for i in gaps[0].get("accepted_at") or [])
         sentence = (f"{names} never answer{'s' if len(gaps) == 1 else ''} in the loop although "
                     f"{'its' if len(gaps) == 1 else 'their'} assumption holds there (step {steps} of the loop); "
-                    "with every node answering what it accepts the lasso search finds no such run. "
+                    "asked again with every node answering what it accepts, the lasso search found none. "
                     f"Declare progress( eventually ) or progress( within K steps ) on {names} if "
                     f"{'it answers' if len(gaps) == 1 else 'they answer'} every input "
                     f"{'its' if len(gaps) == 1 else 'their'} assumption accepts: that is a claim about the "
