@@ -47,13 +47,15 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "src"))
 from rclverify.pipeline import Workspace, stage_check, stage_requirements  # noqa: E402
 
 
-def node_text(c: int, k: int) -> str:
+def node_text(c: int, k: int, temporal: bool = False) -> str:
     x = f"c{c}_{k - 1}" if k else f"c{c}_e"
     y = f"c{c}_{k}"
+    # the temporal workload's nodes answer every reading they accept at once (docs/requirements.md, "progress")
+    progress = "  progress( within 0 steps )\n" if temporal else ""
     return (f"node C{c}N{k} {{\n  inputs( {x} : REAL )\n  outputs( {y} : REAL )\n"
             f"  assume( 0 <= in.{x} and in.{x} <= 100 )\n"
             f"  guarantee( 0 <= out.{y} and out.{y} <= 100 )\n"
-            f"  guarantee( in.{x} <= 50 -> out.{y} <= in.{x} )\n}}\n")
+            f"  guarantee( in.{x} <= 50 -> out.{y} <= in.{x} )\n{progress}}}\n")
 
 
 def write_workspace(root: Path, chains: int, depth: int, temporal: bool = False) -> None:
@@ -61,7 +63,7 @@ def write_workspace(root: Path, chains: int, depth: int, temporal: bool = False)
     files, reqs = [], []
     for c in range(chains):
         rel = f"contracts/chain{c}.rcl"
-        (root / rel).write_text("".join(node_text(c, k) for k in range(depth)))
+        (root / rel).write_text("".join(node_text(c, k, temporal) for k in range(depth)))
         files.append(rel)
         last = depth - 1
         if temporal:  # a cone of 5..10 nodes: the chain up to node k; proved by 1-induction from node k's guarantee 1

@@ -40,7 +40,10 @@ VOCAB = ["(", ")", "{", "}", "<", ">", "<>", ",", ";", ":", "|", "=", "==", "!="
          "2.5", "1e400", '"s"', '"', "'", "in.a", "out.o", "a", "o", "u", "v", "(u, v)", "[", "]", "/*", "*/",
          "//", "\n", "\t", "é", "\x00", "pkg/Msg", ".", "REAL.REAL", "NATURAL.INTEGER", "(1, 2)", "(in.a, 1)",
          # units of measure (docs/rcl-language.md): well-formed, unknown, malformed, affine
-         "[m]", "[mm/m]", "[s^-2]", "[degC]", "[furlong]", "[m/]", "[(m]", "in.b", "[]"]
+         "[m]", "[mm/m]", "[s^-2]", "[degC]", "[furlong]", "[m/]", "[(m]", "in.b", "[]",
+         # progress, initial values and periodic outputs (docs/rcl-language.md)
+         "initially(", "progress(", "eventually", "within", "steps", "periodic(", "progress( within 2 steps )",
+         "initially( out.o == 0 )", "periodic( out.o, 100 ms )"]
 
 FUZZ = settings(derandomize=True, deadline=None, database=None, max_examples=800,
                 suppress_health_check=list(HealthCheck))
@@ -67,7 +70,7 @@ def run_front_end(text: str) -> None:
     # EncodingError for what it does not support, never anything else.
     enc = Encoder(checked.env)
     for n in spec.nodes:
-        for clause in n.assumes + n.guarantees:
+        for clause in n.assumes + n.guarantees + n.initially:
             try:
                 enc.formula(clause.formula, checked.nodes[n.name])
             except EncodingError as e:

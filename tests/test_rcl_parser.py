@@ -350,7 +350,8 @@ def test_unexpected_end_of_input() -> None:
     text = "node n { inputs(a : REAL) outputs(o : REAL)\n  guarantee(o > a)\n\n"
     loc, msg = syntax_error(text)
     assert (loc.line, loc.col) == (2, 19)  # just after the last token
-    assert msg == "unexpected end of input; expected one of 'A', 'G', 'assume', 'guarantee', 'triggered', 'within', '}'"
+    assert msg == ("unexpected end of input; expected one of 'A', 'G', 'assume', 'guarantee', 'initially', 'periodic', "
+                   "'progress', 'triggered', 'within', '}'")
 
 
 def test_keywords_are_listed_as_expected() -> None:

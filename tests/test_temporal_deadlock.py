@@ -79,8 +79,12 @@ def test_deadlock_freedom_undecided_is_inconclusive_never_proved() -> None:
 
 # --- the issue's workspaces ----------------------------------------------------------------------
 
+# The sensor answers at every step (progress within 0 steps: without it its
+# first output would be free, and `always Sensor.out.value <= 100` refuted at
+# step 0 before any run stops).
 RCL = """node Sensor { inputs( r : INTEGER ) outputs( value : INTEGER )
-  guarantee( out.value <= 100 ) }
+  guarantee( out.value <= 100 )
+  progress( within 0 steps ) }
 """
 PROGRAM = "var r : INTEGER;\nvar value : INTEGER;\nvalue := 7\n"
 COUNTER = ('      init: "state.c == 0"\n'

@@ -23,12 +23,15 @@ from rclverify.logic.encode import Encoder
 from rclverify.values import FiniteFunction
 
 # Pick reads a table f of levels (the environment's, bounded by 9) and
-# outputs a level f takes; Hold keeps the last level it read.
+# outputs a level f takes; Hold keeps the last level it read.  Both answer
+# at every step (progress within 0 steps).
 RCL = """context { Levels : REAL --> NATURAL ; }
 node Pick { inputs( f : Levels ) outputs( k : NATURAL )
-  guarantee( exists(x in REAL | in.f(x) == out.k) ) }
+  guarantee( exists(x in REAL | in.f(x) == out.k) )
+  progress( within 0 steps ) }
 node Hold { inputs( k : NATURAL ) outputs( last : NATURAL )
-  guarantee( out.last == in.k ) }
+  guarantee( out.last == in.k )
+  progress( within 0 steps ) }
 """
 PLAN = """contracts: [contracts/p.rcl]
 requirements:

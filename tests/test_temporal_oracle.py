@@ -8,13 +8,18 @@ A system has a variable ``x`` over 0..n-1 (an INTEGER to Z3, so the
 deadlock queries keep a quantifier over it) and, half the time, a BOOL
 ``b`` (written out by the finite instantiation); its initial states and its
 step relation are explicit random sets, and a state with no successor is a
-deadlock.  The oracle walks the explicit graph: runs are the maximal paths,
-infinite ones found as cycles.  ``proved``/``met`` must be true there and
+deadlock.  Half the systems carry strong fairness constraints (a node's
+declared progress, issue 40: if ``enabled`` holds infinitely often, ``taken``
+does), which only infinite runs must meet.  The oracle walks the explicit
+graph: runs are the maximal paths, infinite ones found as cycles (fair ones
+as the strongly connected components that meet every constraint, the
+Emerson-Lei algorithm).  ``proved``/``met`` must be true there and
 ``refuted`` false (its trace a genuine run of the graph); ``inconclusive``
 is allowed but counted and kept rare.  Real Z3.
 """
 from __future__ import annotations
 
+import dataclasses
 import random
 from collections import Counter
 from dataclasses import dataclass
@@ -28,7 +33,7 @@ from hypothesis import HealthCheck, given, settings, strategies as st
 from rclverify.logic.world import fresh
 from rclverify.requirements.deadlock import check_deadlock_free, runs_go_on
 from rclverify.requirements.temporal import (
-    TemporalVerdict, TransitionSystem, check_always, check_eventually, check_eventually_within, check_next,
+    Fairness, TemporalVerdict, TransitionSystem, check_always, check_eventually, check_eventually_within, check_next,
     check_until, with_flag)
 
 S = tuple[int, bool]
@@ -47,6 +52,7 @@ class System:
     within: int
     rank: dict[S, int]
     inv: frozenset[S] | None
+    fair: tuple[tuple[frozenset[S], frozenset[S]], ...] = ()
 
     @property
     def states(self) -> list[S]:
@@ -70,8 +76,10 @@ def systems(draw: Any) -> System:
     else:  # the longest path to P outside P: a valid ranking function where that part is acyclic
         rank = {s: _longest(s, p, succ) for s in states}
     inv = rnd.choice([None, "domain", "random"])
+    # strong fairness (enabled, taken) pairs in half the systems: a node's progress (taken: it answers)
+    fair = tuple((sub(0.6), sub(0.25)) for _ in range(rnd.randint(1, 2))) if rnd.random() < 0.5 else ()
     return System(n, has_b, init, succ, p, q, within, rank,
-                  None if inv is None else frozenset(states) if inv == "domain" else sub(0.7))
+                  None if inv is None else frozenset(states) if inv == "domain" else sub(0.7), fair)
 
 
 def _longest(s: S, p: frozenset[S], succ: dict[S, frozenset[S]], seen: frozenset[S] = frozenset()) -> int:
@@ -112,6 +120,58 @@ def _cyclic(region: set[S], succ: dict[S, frozenset[S]]) -> bool:
     return gone < len(region)
 
 
+def _sccs(region: set[S], succ: dict[S, frozenset[S]]) -> list[set[S]]:
+    """The strongly connected components of the graph restricted to
+    ``region`` that hold a cycle (Tarjan's algorithm, iterative enough for 8 states)."""
+    index: dict[S, int] = {}
+    low: dict[S, int] = {}
+    stack: list[S] = []
+    on: set[S] = set()
+    out: list[set[S]] = []
+
+    def visit(v: S) -> None:
+        index[v] = low[v] = len(index)
+        stack.append(v)
+        on.add(v)
+        for w in succ[v]:
+            if w not in region:
+                continue
+            if w not in index:
+                visit(w)
+                low[v] = min(low[v], low[w])
+            elif w in on:
+                low[v] = min(low[v], index[w])
+        if low[v] == index[v]:
+            comp = set()
+            while True:
+                w = stack.pop()
+                on.discard(w)
+                comp.add(w)
+                if w == v:
+                    break
+            if len(comp) > 1 or v in succ[v]:
+                out.append(comp)
+    for v in sorted(region):
+        if v not in index:
+            visit(v)
+    return out
+
+
+def _fair_cycle(region: set[S], succ: dict[S, frozenset[S]], fair: tuple[tuple[frozenset[S], frozenset[S]], ...]) -> bool:
+    """Whether the graph restricted to ``region`` has a cycle that meets
+    every strong fairness pair (visits ``taken`` if it visits ``enabled``):
+    Emerson and Lei's algorithm (an SCC that breaks a pair loses that pair's
+    ``enabled`` states and is searched again)."""
+    for comp in _sccs(region, succ):
+        broken = [e for e, t in fair if comp & e and not comp & t]
+        if not broken:
+            return True
+        rest = comp - set().union(*broken)
+        if rest and _fair_cycle(rest, succ, fair):
+            return True
+    return False
+
+
 def oracle(m: System) -> dict[str, bool]:
     """Each property, decided by walking the explicit graph of ``m``."""
     succ, reach = m.succ, _closure(set(m.init), m.succ)
@@ -123,7 +183,7 @@ def oracle(m: System) -> dict[str, bool]:
         region = _closure(set(m.init), succ, lambda s: s not in goal)
         if before is not None and any(s not in before for s in region):
             return True  # a state before the goal where the other operand fails
-        return bool(region & dead) or _cyclic(region, succ)
+        return bool(region & dead) or (_fair_cycle(region, succ, m.fair) if m.fair else _cyclic(region, succ))
 
     @lru_cache(maxsize=None)
     def avoids(s: S, k: int) -> bool:  # a run from s misses P at steps 0..k
@@ -164,7 +224,9 @@ def encode(m: System) -> tuple[TransitionSystem, Any, Any, Any, Any]:
             out = z3.If(is_(s, v), m.rank[v], out)
         return out
     inv = None if m.inv is None else (lambda s: one_of(s, m.inv))
-    ts = TransitionSystem(sorts, lambda s: one_of(s, m.init), trans)
+    fairness = tuple(Fairness(f"f{k}", lambda s, e=e: one_of(s, e), lambda s, t=t: one_of(s, t))
+                     for k, (e, t) in enumerate(m.fair))
+    ts = TransitionSystem(sorts, lambda s: one_of(s, m.init), trans, fairness)
     return ts, (lambda s: one_of(s, m.p)), (lambda s: one_of(s, m.q)), rank, inv
 
 
@@ -182,6 +244,8 @@ def genuine(m: System, v: TemporalVerdict) -> None:
         assert not m.succ[path[-1]], (v, path)
     if v.loop is not None:
         assert path[-1] == path[v.loop], (v, path)
+        ring = set(path[v.loop:-1])
+        assert all(not ring & e or ring & t for e, t in m.fair), (v, path, m.fair)  # a fair loop
 
 
 COUNTS: Counter[str] = Counter()
@@ -204,33 +268,39 @@ def agree(name: str, v: TemporalVerdict, truth: bool, m: System) -> None:
 def _fresh_z3_world() -> Any:
     fresh()
     yield
-    # inconclusive is allowed, but rare: at most one verdict in five for any checker
+    # inconclusive is allowed, but rare: at most one verdict in five for any checker.  Under fairness,
+    # a goal every fair run reaches but an unfair one misses can only be inconclusive (no proof rule uses
+    # fairness: the bounded response and the ranking rule hold of every run; docs/requirements.md): two in five
     print(dict(sorted(COUNTS.items())), dict(sorted(METHODS.items())))
-    for name in {k.split(":")[0] for k in COUNTS}:
+    for name in {k.split(":")[0] for k in COUNTS if ":" in k}:
         total = sum(v for k, v in COUNTS.items() if k.startswith(name + ":"))
-        assert COUNTS[f"{name}: inconclusive"] <= total / 5, (name, dict(COUNTS))
+        share = 2 / 5 if "(fair)" in name else 1 / 5
+        assert COUNTS[f"{name}: inconclusive"] <= total * share, (name, dict(COUNTS))
 
 
 @settings(max_examples=50, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(systems())
 def test_every_verdict_agrees_with_the_explicit_runs(m: System) -> None:
     truth = oracle(m)
+    if m.fair and oracle(dataclasses.replace(m, fair=()))["eventually"] != truth["eventually"]:
+        COUNTS["fairness excludes every run that misses it"] += 1
     ts, p, q, rank, inv = encode(m)
     kw = {"timeout_ms": TIMEOUT_MS}
+    live = " (fair)" if m.fair else ""  # fairness bears on infinite runs only: counted apart where it matters
     verdicts = {"always": check_always(ts, p, max_k=BOUND, **kw),
                 "within": check_eventually_within(ts, p, m.within, **kw),
-                "eventually": check_eventually(ts, p, bound=BOUND, **kw),
-                "eventually, ranking": check_eventually(ts, p, ranking=rank, invariant=inv, bound=BOUND, **kw)}
+                f"eventually{live}": check_eventually(ts, p, bound=BOUND, **kw),
+                f"eventually{live}, ranking": check_eventually(ts, p, ranking=rank, invariant=inv, bound=BOUND, **kw)}
     for name, v in verdicts.items():
-        agree(name, v, truth[name.split(",")[0]], m)
+        key = name.split(",")[0].split(" (")[0]
+        agree(name, v, truth[key], m)
         # the rule every temporal requirement is held to: proved only if no run stops
-        agree(f"{name}, runs go on", runs_go_on(ts, v, max_k=BOUND, **kw),
-              truth[name.split(",")[0]] and truth["deadlock-free"], m)
+        agree(f"{name}, runs go on", runs_go_on(ts, v, max_k=BOUND, **kw), truth[key] and truth["deadlock-free"], m)
     started = with_flag(ts, "<started>", lambda s: z3.BoolVal(False), lambda s, u: z3.BoolVal(True))
     agree("always next", check_always(started, lambda s: z3.Or(z3.Not(s["<started>"]), p(s)), max_k=BOUND, **kw),
           truth["always next"], m)
     agree("next", check_next(ts, p, **kw), truth["next"], m)
-    agree("until", check_until(ts, p, q, max_k=BOUND, **kw), truth["until"], m)
+    agree(f"until{live}", check_until(ts, p, q, max_k=BOUND, **kw), truth["until"], m)
     agree("deadlock-free", check_deadlock_free(ts, max_k=BOUND, **kw), truth["deadlock-free"], m)
 
 

@@ -14,11 +14,14 @@ from rclverify.plan.errors import PlanError
 
 # Inc adds one to what Fwd hands back, up to 10; Fwd forwards it: a loop
 # (Inc.out.b -> Fwd.in.b, Fwd.out.a -> Inc.in.a).  Inc's state n counts its
-# steps up to 10.
+# steps up to 10.  Both answer at every step (progress within 0 steps: the
+# synchronous reading; tests/test_temporal_progress.py has nodes without it).
 RCL = """node Inc { inputs( a : NATURAL ) outputs( b : NATURAL )
-  guarantee( (in.a < 10 -> out.b == in.a + 1) and (in.a >= 10 -> out.b == in.a) ) }
+  guarantee( (in.a < 10 -> out.b == in.a + 1) and (in.a >= 10 -> out.b == in.a) )
+  progress( within 0 steps ) }
 node Fwd { inputs( b : NATURAL ) outputs( a : NATURAL )
-  guarantee( out.a == in.b ) }
+  guarantee( out.a == in.b )
+  progress( within 0 steps ) }
 """
 STATE = """state:
   Inc:
@@ -153,7 +156,7 @@ def test_report_and_sarif_show_the_refuted_trace(loop) -> None:
     sarif = sarif_log(report)
     res = next(r for r in sarif["runs"][0]["results"] if r.get("properties", {}).get("requirement") == "T2")
     msg = res["message"]["text"]
-    assert "Temporal check: refuted by bmc, 7 steps checked" in msg and "step 7: Inc (in.a = " in msg
+    assert "Temporal check: refuted by bmc, 7 steps checked" in msg and "step 7: Inc (answers = True, in.a = " in msg
     loc = res["locations"][0]["physicalLocation"]
     assert loc["artifactLocation"]["uri"] == "contracts/plan.yaml" and loc["region"]["startLine"] == 8
     md = render_markdown(report)

@@ -11,6 +11,7 @@ from collections.abc import Callable, Mapping
 from typing import Any
 
 from . import blame, recheck
+from .liveness import liveness_culprits
 from .repairs import _record as _repair
 
 
@@ -108,9 +109,12 @@ def _between(report: Mapping[str, Any], sources: set[str], sinks: set[str]) -> s
 def _temporal_record(q: Mapping[str, Any], check: Mapping[str, Any]) -> dict[str, Any]:
     """The diagnosis of a refuted temporal requirement: its counterexample
     run (docs/requirements.md, "Temporal requirements"), the state it loops
-    through shown node by node.  No culprit is named: the run meets every
-    contract, and no strengthening is searched for a temporal statement
-    (docs/diagnosis.md: only what Z3 showed is named)."""
+    through shown node by node.  A lasso that rests on a node that never
+    answers (or on a loop stuck on values from before the run) names that
+    node, through :func:`.liveness.liveness_culprits`; otherwise no culprit
+    is named: the run meets every contract, and no strengthening is searched
+    for a temporal statement (docs/diagnosis.md: only what Z3 showed is
+    named)."""
     t = check["temporal"]
     trace = t.get("trace") or []
     loop = t.get("loop")
@@ -120,9 +124,14 @@ def _temporal_record(q: Mapping[str, Any], check: Mapping[str, Any]) -> dict[str
     run = (f"a run of {len(trace)} states whose last returns to step {loop} and repeats forever"
            if loop is not None else f"a run of {len(trace)} states")
     cex = ", ".join(f"{r['node']}.{r['variable']} = {r['value']}" for r in table)
-    sentence = (f"Requirement {q['id']} (`{check.get('formal')}`, {check.get('source')}) is refuted by {run} that "
-                f"meets every contract of its cone ({t.get('method')}; {t.get('detail')}). "
-                f"The state it repeats: {cex}. No guarantee of the cone prevents it: "
-                "a guarantee that forces progress, or an assuming: that excludes the run, is needed.")
-    return {"id": str(q["id"]), "kind": "requirement", "node": "", "status": "failed", "sentence": sentence,
-            "culprits": [], "counterexample": table, "repairs": [], "guarantee": None}
+    node, culprits, missing = liveness_culprits(t)
+    if missing:
+        sentence = (f"Requirement {q['id']} (`{check.get('formal')}`, {check.get('source')}) is refuted by {run} in "
+                    f"which {missing}. The state it repeats: {cex} ({t.get('method')}; {t.get('detail')}).")
+    else:
+        sentence = (f"Requirement {q['id']} (`{check.get('formal')}`, {check.get('source')}) is refuted by {run} that "
+                    f"meets every contract of its cone ({t.get('method')}; {t.get('detail')}). "
+                    f"The state it repeats: {cex}. No guarantee of the cone prevents it: "
+                    "a guarantee that forces progress, or an assuming: that excludes the run, is needed.")
+    return {"id": str(q["id"]), "kind": "requirement", "node": node, "status": "failed", "sentence": sentence,
+            "culprits": culprits, "counterexample": table, "repairs": [], "guarantee": None}

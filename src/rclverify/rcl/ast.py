@@ -492,8 +492,40 @@ class Link:
 
 
 @dataclass(frozen=True)
+class Progress:
+    """``progress( eventually )`` or ``progress( within K steps )`` in a node
+    (docs/rcl-language.md, "Progress, initial values and periodic outputs"):
+    the node answers every input its assumption accepts, eventually or
+    within K steps of the composed system.  ``bound`` is K as written
+    (``None`` for ``eventually``), ``unit`` the word after it (``steps``;
+    another word, or none, is a located type error)."""
+
+    bound: str | None
+    unit: str | None
+    loc: Loc = _loc()
+
+
+@dataclass(frozen=True)
+class Periodic:
+    """``periodic( out.y, 100 ms )`` or ``periodic( out.y, 3 steps )``: the
+    node refreshes output ``y`` at least once per period.  ``amount`` is the
+    number as written, ``unit`` the word after it (a unit of time or
+    ``steps``; checked by :mod:`rclverify.rcl.progress`)."""
+
+    output: Var
+    amount: str
+    unit: str | None
+    loc: Loc = _loc()
+
+
+@dataclass(frozen=True)
 class Node:
-    """``node name { inputs(...) outputs(...) topics(...) assume(...)* guarantee(...)+ }``."""
+    """``node name { inputs(...) outputs(...) topics(...) assume(...)* guarantee(...)+ }``.
+
+    ``initially`` (formulas over the outputs before the node's first answer),
+    ``progress`` and ``periodic`` are the temporal declarations of
+    docs/rcl-language.md; all three are empty for every contract written
+    before them, which keep their meaning."""
 
     name: str
     inputs: tuple[IOVar, ...]
@@ -503,6 +535,9 @@ class Node:
     guarantees: tuple[Clause, ...]
     loc: Loc = _loc()
     links: tuple[Link, ...] = ()
+    initially: tuple[Clause, ...] = ()
+    progress: tuple[Progress, ...] = ()
+    periodic: tuple[Periodic, ...] = ()
 
 
 @dataclass(frozen=True)

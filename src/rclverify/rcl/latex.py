@@ -30,7 +30,7 @@ import jinja2
 from . import ast
 from .types import qualified_base
 from .printer import (BINARY_LEVEL, FLAT_CHAINS, MINUS_LEVEL, NOT_LEVEL, SUM_LEVEL, chain_operands, clarifying_parens,
-                      is_type, level, operand_levels)
+                      is_type, level, operand_levels, progress_to_rcl)
 
 _TEX_SPECIALS = {
     "\\": r"\textbackslash{}", "_": r"\_", "{": r"\{", "}": r"\}", "$": r"\$", "&": r"\&",
@@ -328,6 +328,10 @@ def to_latex(spec: ast.Spec, document: bool = True, explicit: bool = False, head
         "guarantees": [expr_to_latex(c.formula, explicit) for c in n.guarantees],
         "timing": [_timing(c) for c in n.guarantees],
         "links": [_link(lk) for lk in n.links],
+        "initially": [expr_to_latex(c.formula, explicit) for c in n.initially],
+        "progress": [escape(progress_to_rcl(p)) for p in n.progress],
+        "periodic": ["$" + _var(p.output) + "$, " + escape(p.amount)
+                     + (r"~\textrm{" + escape(p.unit) + "}" if p.unit else "") for p in n.periodic],
     } for n in spec.nodes]
     return _env().get_template("contracts.tex.j2").render(
         source=source, document=document, header=header, contexts=contexts, nodes=nodes)

@@ -231,7 +231,10 @@ class _ToAst(Transformer[Token, Any]):
         links = tuple(lk for kind, group in rest if kind == "links" for lk in group)
         assumes = tuple(cl for kind, cl in rest if kind == "assume")
         guarantees = tuple(cl for kind, cl in rest if kind == "guarantee")
-        return ast.Node(name, inputs, outputs, topics, assumes, guarantees, self._span(c), links)
+        return ast.Node(name, inputs, outputs, topics, assumes, guarantees, self._span(c), links,
+                        tuple(cl for kind, cl in rest if kind == "initially"),
+                        tuple(p for kind, p in rest if kind == "progress"),
+                        tuple(p for kind, p in rest if kind == "periodic"))
 
     def inputs(self, c: list[Any]) -> tuple[ast.IOVar, ...]:
         return tuple(x for x in _vals(c) if x is not None)
@@ -261,6 +264,25 @@ class _ToAst(Transformer[Token, Any]):
         trigger = v[1].value if len(v) > 1 and v[1] is not None else None
         deadline = v[2] if len(v) > 2 else None
         return ("guarantee", ast.Clause(v[0], self._span([x for x in c if x is not None]), trigger, deadline))
+
+    def initially(self, c: list[Any]) -> tuple[str, ast.Clause]:
+        return ("initially", ast.Clause(_vals(c)[0], self._span(c)))
+
+    def progress(self, c: list[Any]) -> tuple[str, ast.Progress]:
+        kind = _vals(c)[0]
+        return ("progress", ast.Progress(kind[0], kind[1], self._span(c)))
+
+    def progress_eventually(self, c: list[Any]) -> tuple[str | None, str | None]:
+        return (None, None)
+
+    def progress_within(self, c: list[Any]) -> tuple[str | None, str | None]:
+        v = _vals(c)
+        return (str(v[0]), str(v[1]) if v[1] is not None else None)
+
+    def periodic(self, c: list[Any]) -> tuple[str, ast.Periodic]:
+        v = _vals(c)
+        return ("periodic", ast.Periodic(v[0], str(v[1]), str(v[2]) if v[2] is not None else None,
+                                         self._span(c)))
 
     def trigger(self, c: list[Any]) -> _Spanned:
         return _Spanned(_vals(c)[0], self._span(c))

@@ -335,7 +335,8 @@ def _io(vs: tuple[ast.IOVar, ...]) -> str:
 def node_to_rcl(n: ast.Node, explicit: bool = False) -> str:
     """``node Name { inputs(...) outputs(...) topics(...) assume(...)* guarantee(...)* }``.
 
-    Assumptions are printed before guarantees (the AST keeps them apart);
+    Assumptions are printed before guarantees (the AST keeps them apart),
+    then ``initially``, ``progress`` and ``periodic`` in that order;
     ``topics(...)`` is omitted when the node has none."""
     lines = [f"node {n.name} {{", f"  inputs( {_io(n.inputs)} )", f"  outputs( {_io(n.outputs)} )"]
     if n.topics:
@@ -349,7 +350,17 @@ def node_to_rcl(n: ast.Node, explicit: bool = False) -> str:
                 lines.append(f"  {kind}s( {sep.join(_link(lk) for lk in group)} )")
     lines += [f"  assume( {expr_to_rcl(c.formula, explicit)} )" for c in n.assumes]
     lines += [f"  guarantee( {expr_to_rcl(c.formula, explicit)} ){_timing(c)}" for c in n.guarantees]
+    lines += [f"  initially( {expr_to_rcl(c.formula, explicit)} )" for c in n.initially]
+    lines += [f"  progress( {progress_to_rcl(p)} )" for p in n.progress]
+    lines += [f"  periodic( {p.output.qualified}, {p.amount}{' ' + p.unit if p.unit else ''} )" for p in n.periodic]
     return "\n".join(lines) + "\n}\n"
+
+
+def progress_to_rcl(p: ast.Progress) -> str:
+    """``eventually`` or ``within K steps`` (the text inside ``progress( )``)."""
+    if p.bound is None:
+        return "eventually"
+    return f"within {p.bound}" + (f" {p.unit}" if p.unit else "")
 
 
 def to_rcl(spec: ast.Spec, explicit: bool = False) -> str:

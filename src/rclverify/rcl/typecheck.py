@@ -31,7 +31,7 @@ import difflib
 from pathlib import Path
 from typing import Iterable, Mapping, Sequence
 
-from . import ast, timing
+from . import ast, liveness, timing
 from .errors import Diagnostic, RclError, error
 from .parser import parse_files
 from .unitcheck import UnitChecker
@@ -220,12 +220,15 @@ class _Checker:
         for cl in n.guarantees:
             if (cl.trigger is not None or cl.deadline is not None) and not timing.check_clause(n, cl, self.err):
                 ok = False
+        if (n.progress or n.periodic or n.initially) and not liveness.check_node(
+                n, set(inputs), set(outputs), self.err):
+            ok = False
         if not n.guarantees and not (n.name in self.interface_only and not n.assumes):
             self.err(n.loc, f"node {n.name} has no guarantee; a contract needs at least one guarantee(...) "
                             f"(for a node declared by its interface only, `rclverify quotient {n.name}` computes "
                             "the weakest contract its neighbours need)", "E-contract")
             ok = False
-        for cl in n.assumes + n.guarantees:
+        for cl in n.assumes + n.guarantees + n.initially:
             try:
                 ft = self.infer(cl.formula, cn, {})
                 if ft != BOOL:

@@ -38,9 +38,10 @@ from ..logic.query import budgeted_solver
 from ..rcl.types import DataT, EnumT, FuncT, Type
 from ..values import FiniteFunction, Term
 from .temporal import Pred, State, TransitionSystem
+from .tsys import fair_loop
 
 #: Budget of one lasso query (ms worth of Z3 resource steps).
-LASSO_BUDGET_MS = 3_000
+LASSO_BUDGET_MS = 5_000
 
 
 @dataclass
@@ -120,15 +121,15 @@ def find_table_lasso(ts: TransitionSystem, prop: Pred, types: Mapping[str, Type]
                      extra: Callable[[State], z3.BoolRef] | None = None) -> TableLasso | str:
     """Search lassos s0..sn (n = 1..``bound``) missing ``prop`` with every
     array variable over numbers a table of ``points`` points (module
-    docstring).  ``types`` gives each variable's RCL type (to read the
+    docstring), whose loop meets the fairness constraints of ``ts``.  ``types`` gives each variable's RCL type (to read the
     model back).  Returns the :class:`TableLasso` of the shortest one found,
     or a sentence saying what was tried (no lasso of that shape up to the
     bound, or the solver's unknown at length n)."""
     for n in range(1, bound + 1):
         steps = [table_state(ts, i, points) for i in range(n + 1)]
         states = [s for s, _ in steps]
-        same = [z3.And(*[a == b for v in ts.sorts for a, b in zip(steps[n][1][v], steps[j][1][v])])
-                for j in range(n)]
+        same = [z3.And(*[a == b for v in ts.sorts for a, b in zip(steps[n][1][v], steps[j][1][v])],
+                       fair_loop(ts, states[j:n])) for j in range(n)]
         formulas = [ts.init(states[0]), *[ts.trans(states[i], states[i + 1]) for i in range(n)],
                     *[z3.Not(prop(s)) for s in states], z3.Or(*same)]
         ctx = z3.Context()

@@ -9,15 +9,21 @@ the transition relation (docs/requirements.md, "The transition relation")
 is evaluated on the trace:
 
 * every value conforms to its type (:func:`rclverify.values.conforms`);
-* in every state, each node's environment assumptions and facts hold, and
-  where its internal assumption holds all its guarantees hold;
-* at step 0 every state variable satisfies its ``init``;
+* in every state, each node's environment assumptions and facts hold; its
+  ``accepts`` is whether its internal assumption holds; where it answers,
+  its assumption and all its guarantees hold (a node without an output:
+  where its assumption holds); with ``progress( within K steps )`` its
+  ``waiting`` counts the steps in a row it accepted without answering, at
+  most K (K = 0: it answers wherever it accepts);
+* at step 0 every state variable satisfies its ``init``, a node that does
+  not answer satisfies its ``initially``, and ``waiting`` is at most 1;
 * every step: each connection carries the producer's output to the
-  consumer's next input; a node whose internal assumption fails on the next
-  input keeps its outputs; each state variable takes its ``next`` value;
+  consumer's next input; a node that does not answer keeps its outputs;
+  each state variable takes its ``next`` value;
 * the requirement's ``assuming:`` holds in every state and the goal of
   ``eventually`` holds in none;
-* the last state equals the loop state.
+* the last state equals the loop state, and every node held to fairness
+  (``fair``) that accepts at a step of the loop answers at one of them.
 
 Any check that fails or that the evaluator cannot decide makes the
 confirmation fail, with the first such check named: the verdict then stays
@@ -33,6 +39,7 @@ from ..plan.formal import Formal
 from ..plan.load import Plan
 from ..plan.state import parse_state_formula
 from ..rcl import ast
+from ..rcl.liveness import step_bound
 from ..rcl.printer import expr_to_rcl
 from ..rcl.types import Checked, CheckedNode, Type
 from ..system.model import SystemModel
@@ -60,17 +67,32 @@ def _holds(e: ast.Expr, checked: Checked, scope: CheckedNode, values: Mapping[st
 
 def confirm_lasso(trace: Sequence[Mapping[str, Any]], loop: int, cone: Sequence[str], variables: Mapping[str, tuple[str, str, str]],
                   types: Mapping[str, Type], checked: Checked, model: SystemModel, plan: Plan,
-                  goal: Formal, assuming: Sequence[Formal]) -> str | None:
+                  goal: Formal, assuming: Sequence[Formal], fair: Sequence[str] = ()) -> str | None:
     """Check the lasso ``trace`` (one ``{variable: value}`` per step, the
     last equal to step ``loop``) against every rule of the module docstring.
-    ``goal`` is ``F`` of ``eventually F``.  Returns ``None`` when every check
-    holds, else a sentence naming the first check that failed or was not
-    decided.  Never raises."""
+    ``goal`` is ``F`` of ``eventually F``; ``fair`` the nodes held to
+    fairness in the loop.  Returns ``None`` when every check holds, else a
+    sentence naming the first check that failed or was not decided.  Never
+    raises."""
     try:
-        _confirm(trace, loop, cone, variables, types, checked, model, plan, goal, assuming)
+        _confirm(trace, loop, cone, variables, types, checked, model, plan, goal, assuming, fair)
     except _Unconfirmed as exc:
         return str(exc)
     return None
+
+
+def _check_waiting(n: str, cn: CheckedNode, trace: Sequence[Mapping[str, Any]], i: int, accepts: bool,
+                   answers: bool) -> None:
+    """The progress rules of node ``n`` at step ``i`` (module docstring)."""
+    k = step_bound(cn.node)
+    if k == 0 and accepts and not answers:
+        raise _Unconfirmed(f"step {i}: {n} accepts its input but does not answer (progress within 0 steps)")
+    if not k:
+        return
+    w = trace[i][f"{n}.waiting"]
+    want = 0 if answers or not accepts else (1 if i == 0 else trace[i - 1][f"{n}.waiting"] + 1)
+    if w != want or w > k:
+        raise _Unconfirmed(f"step {i}: {n}.waiting is {w}, not {want} <= {k}")
 
 
 def _node_values(state: Mapping[str, Any], node: str) -> dict[str, Any]:
@@ -84,11 +106,16 @@ def _node_values(state: Mapping[str, Any], node: str) -> dict[str, Any]:
 
 def _confirm(trace: Sequence[Mapping[str, Any]], loop: int, cone: Sequence[str], variables: Mapping[str, tuple[str, str, str]],
              types: Mapping[str, Type], checked: Checked, model: SystemModel, plan: Plan,
-             goal: Formal, assuming: Sequence[Formal]) -> None:
+             goal: Formal, assuming: Sequence[Formal], fair: Sequence[str]) -> None:
     if not trace or not 0 <= loop < len(trace) - 1:
         raise _Unconfirmed("the trace is not a lasso")
     if dict(trace[-1]) != dict(trace[loop]):
         raise _Unconfirmed(f"the last state differs from the loop state {loop}")
+    for n in fair:
+        ring = trace[loop:-1]
+        accepted = [st.get(f"{n}.accepts", True) is True for st in ring]
+        if any(accepted) and not any(st[f"{n}.answers"] is True for st in ring):
+            raise _Unconfirmed(f"{n} accepts its input in the loop but never answers there (its progress)")
     states = [sv for sv in plan.states if sv.node in cone]
     parsed = {sv: (parse_state_formula(sv, "init", checked, plan.states),
                    parse_state_formula(sv, "next", checked, plan.states)) for sv in states}
@@ -108,10 +135,23 @@ def _confirm(trace: Sequence[Mapping[str, Any]], loop: int, cone: Sequence[str],
             for k, e in enumerate([*env, *facts[n]], 1):
                 if not _holds(e, checked, cn, vals, f"step {i}: {n} environment assumption/fact {expr_to_rcl(e)}"):
                     raise _Unconfirmed(f"step {i}: {n}'s environment assumption or fact {k} does not hold")
-            if all(_holds(a, checked, cn, vals, f"step {i}: {n} assumption") for a in internal):
+            accepts = all(_holds(a, checked, cn, vals, f"step {i}: {n} assumption") for a in internal)
+            if f"{n}.accepts" in variables and st[f"{n}.accepts"] is not accepts:
+                raise _Unconfirmed(f"step {i}: {n}.accepts is {st[f'{n}.accepts']} but its assumption "
+                                   f"{'holds' if accepts else 'fails'}")
+            answers = st[f"{n}.answers"] if f"{n}.answers" in variables else accepts
+            if answers and not accepts:
+                raise _Unconfirmed(f"step {i}: {n} answers although its assumption fails")
+            if answers:
                 for k, g in enumerate(cn.node.guarantees, 1):
                     if not _holds(g.formula, checked, cn, vals, f"step {i}: {n} guarantee {k}"):
                         raise _Unconfirmed(f"step {i}: {n}'s guarantee {k} does not hold")
+            if f"{n}.answers" in variables:
+                _check_waiting(n, cn, trace, i, accepts, answers)
+            if i == 0 and f"{n}.answers" in variables and not answers:
+                for k, ini in enumerate(cn.node.initially, 1):
+                    if not _holds(ini.formula, checked, cn, vals, f"step 0: {n} initially {k}"):
+                        raise _Unconfirmed(f"step 0: {n} does not answer and its initially {k} does not hold")
         # the statement's pseudo node names Node.out.y an output, every other variable an input (plan/formal.py)
         pseudo = {f"{'out' if variables[name][1] == 'out' else 'in'}.{name}": v
                   for name, v in st.items() if name in variables}
@@ -131,13 +171,12 @@ def _confirm(trace: Sequence[Mapping[str, Any]], loop: int, cone: Sequence[str],
             if t[c] != s[p]:
                 raise _Unconfirmed(f"step {i + 1}: {c} is not the value {p} had at step {i}")
         for n in cone:
-            cn, internal = checked.nodes[n], split[n][0]
-            if internal and not all(_holds(a, checked, cn, _node_values(t, n), f"step {i + 1}: {n} assumption")
-                                    for a in internal):
+            cn = checked.nodes[n]
+            if f"{n}.answers" in variables and t[f"{n}.answers"] is not True:
                 for v in cn.outputs:
                     name = f"{n}.out.{v}"
                     if name in variables and t[name] != s[name]:
-                        raise _Unconfirmed(f"step {i + 1}: {name} changed although {n}'s assumption fails")
+                        raise _Unconfirmed(f"step {i + 1}: {name} changed although {n} does not answer")
         for sv in states:
             vals = {k: v for k, v in _node_values(s, sv.node).items() if not k.startswith("state.")}
             for o in states:

@@ -7,7 +7,9 @@ verdict (``check``)                what the proof rests on      status shown (``
                                    discharged, and the side
                                    conditions of its node
 ``proved``, premises consistent    some evidence not            ``proved, evidence outstanding`` /
-                                   discharged                   the worst of that evidence
+                                   discharged, or a declared    the worst of that evidence
+                                   progress or initial value    (a declaration: ``pending``)
+                                   (temporal; not verified)
 ``proved``, premises inconsistent  (anything)                   ``proved from an inconsistency`` /
                                                                 ``failed``
 ``proved``, premise never holds    (anything)                   ``proved vacuously`` / ``failed``
@@ -17,6 +19,8 @@ verdict (``check``)                what the proof rests on      status shown (``
                                    the premise can ever hold)
 ``refuted``                                                     ``refuted`` / ``failed``
 ``refuted`` by a run that stops    (temporal: a deadlock)       ``refuted`` / ``failed``
+``refuted`` by a lasso in which a  (temporal: the missing       ``refuted`` / ``failed``
+node never answers                 progress is named)
 ``inconclusive``                                                ``inconclusive`` / ``inconclusive``
 ``informal`` (no formal statement) (nothing: traced only)        ``informal`` / ``pending``
 ``stale`` (made from other inputs)  (not shown)                  ``stale`` / ``stale``
@@ -72,6 +76,20 @@ def roll_up(record: Mapping[str, Any] | None, g_status: Callable[[str, int], str
         t = record["temporal"]
         return "refuted", "failed", (f"a run of the system stops at step {t.get('bound')}: no next state satisfies the "
                                      "premises of its cone (a deadlock), and the runs of the system must not stop")
+    gaps = (record.get("temporal") or {}).get("missing_progress") or []
+    if v == "refuted" and gaps:
+        return "refuted", "failed", (f"a run that never reaches it, because {gaps[0]['node']} never answers in its loop "
+                                     f"although its assumption holds there: no progress declared on "
+                                     + ", ".join(g["node"] for g in gaps)
+                                     + " excludes it (declare progress( eventually ) or progress( within K steps ) "
+                                       "on a node that does answer)")
+    stuck = (record.get("temporal") or {}).get("missing_initially") or []
+    if v == "refuted" and stuck:
+        names = ", ".join(dict.fromkeys(r["node"] for r in stuck))
+        return "refuted", "failed", (f"a run that never reaches it, in which no node waiting on {names} ever accepts "
+                                     f"its input: {stuck[0]['consumer']} keeps the value {stuck[0]['node']}."
+                                     f"{stuck[0]['output']} had before the run, and no initial value is declared "
+                                     f"(declare initially( ... ) on {names})")
     if v == "refuted":
         who = ", ".join(p["label"] for p in record.get("failed_to_prevent", [])) or "no guarantee of the cone"
         return "refuted", "failed", f"Z3 found a counterexample that every premise allows; it is not prevented by: {who}"
@@ -90,6 +108,8 @@ def roll_up(record: Mapping[str, Any] | None, g_status: Callable[[str, int], str
         if p["kind"] == "guarantee":
             statuses[p["label"]] = g_status(p["node"], p["index"])
             statuses[f"side conditions of {p['node']}"] = sc_status.get(p["node"], "discharged")
+        elif p["kind"] in ("progress", "initial value"):  # declared of the implementation; no backend checks it yet
+            statuses[f"{p['label']} (declared, not verified)"] = "pending"
     ev = worst(list(statuses.values()), empty="discharged")
     if record.get("consistency") != "consistent":  # the worst of that and the evidence, as the argument has it
         return "inconclusive", worst(["inconclusive", ev]), (

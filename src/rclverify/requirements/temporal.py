@@ -36,9 +36,10 @@ from typing import Callable
 import z3
 
 from .deadlock import check_deadlock_free, find_deadlock
-from .tsys import Pred, State, TemporalVerdict, Trans, TransitionSystem, distinct, trace_of, unroll, with_flag
+from .tsys import (Fairness, Pred, State, TemporalVerdict, Trans, TransitionSystem, distinct, fair_loop, trace_of, unroll,
+                   with_flag)
 
-__all__ = ["Pred", "State", "TemporalVerdict", "Trans", "TransitionSystem", "check_always", "check_eventually",
+__all__ = ["Fairness", "Pred", "State", "TemporalVerdict", "Trans", "TransitionSystem", "check_always", "check_eventually",
            "check_eventually_within", "check_next", "check_until", "find_lasso", "with_flag"]
 
 
@@ -260,16 +261,19 @@ def find_lasso(ts: TransitionSystem, prop: Pred, bound: int, *,
                timeout_ms: int = 10_000) -> TemporalVerdict | None:
     """A counterexample to unbounded ``eventually prop``: a run s0..sn
     (n <= ``bound``) missing ``prop`` whose last state equals an earlier
-    one, s_n == s_j.  Repeating s_j..s_n forever is an infinite run of the
-    system (a step depends on its two states only) on which ``prop`` never
-    holds: ``refuted`` (method ``lasso``, ``loop = j``).  ``None`` when no
-    such run of up to ``bound`` steps exists or the solver cannot say.
+    one, s_n == s_j, and whose loop s_j..s_{n-1} meets the fairness
+    constraints of ``ts`` (:func:`.tsys.fair_loop`).  Repeating s_j..s_n
+    forever is an infinite run of the system (a step depends on its two
+    states only) on which ``prop`` never holds: ``refuted`` (method
+    ``lasso``, ``loop = j``).  ``None`` when no such run of up to ``bound``
+    steps exists or the solver cannot say.
     """
     for n in range(1, bound + 1):
         states, steps = unroll(ts, n)
         s = z3.Solver()
         s.set("timeout", timeout_ms)
-        same = [z3.And(*[states[n][v] == states[j][v] for v in ts.sorts]) for j in range(n)]
+        same = [z3.And(*[states[n][v] == states[j][v] for v in ts.sorts], fair_loop(ts, states[j:n]))
+                for j in range(n)]
         s.add(ts.init(states[0]), *steps, *[z3.Not(prop(st)) for st in states], z3.Or(*same))
         if s.check() == z3.sat:
             m = s.model()

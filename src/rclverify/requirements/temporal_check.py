@@ -48,9 +48,10 @@ from ..values import render
 from ..system.model import SystemModel
 from .deadlock import runs_go_on
 from .temporal import (TemporalVerdict, TransitionSystem, check_always, check_eventually,
-                       check_eventually_within, check_next, check_until, with_flag)
+                       check_eventually_within, check_next, check_until, find_lasso, with_flag)
 from .lasso import find_table_lasso
 from .lasso_confirm import confirm_lasso
+from .progress_gap import EVEN_SO, explain_idle
 from .transition import ComposedSystem, build_system, variable_types
 
 #: The bound of BMC for an unbounded ``eventually`` and of k-induction's k.
@@ -73,30 +74,60 @@ def statement(req: Requirement, checked: Checked, plan: Plan) -> Temporal:
     return t
 
 
+#: A table search over a system: ``tables(F, v, ts)`` (:func:`check_temporal`).
+Tables = Callable[[Formal, TemporalVerdict, TransitionSystem], TemporalVerdict]
+
+
 def decide(t: Temporal, sys: ComposedSystem, pred: Callable[[Formal], Callable[[Any], Any]], *,
-           bound: int = DEFAULT_BOUND, timeout_ms: int = 10_000,
-           tables: Callable[[Formal, TemporalVerdict], TemporalVerdict] | None = None,
-           ranking: Callable[[Any], Any] | None = None, invariant: Callable[[Any], Any] | None = None) -> TemporalVerdict:
+           bound: int = DEFAULT_BOUND, timeout_ms: int = 10_000, tables: Tables | None = None,
+           ranking: Callable[[Any], Any] | None = None, invariant: Callable[[Any], Any] | None = None,
+           checked: Checked | None = None, gaps: dict[str, Any] | None = None) -> TemporalVerdict:
     """Decide statement ``t`` over ``sys`` (module table); ``pred(F)`` is
-    F as a predicate over one state.  ``tables(F, v)`` is asked when the
-    verdict ``v`` on an unbounded ``eventually F`` is inconclusive (the
-    finite-table lasso search of :func:`check_temporal`); ``ranking`` and
-    ``invariant`` (over one state) are the plan's, for that ``eventually``.
-    A verdict ``proved`` stands only if no run of the system stops
-    (:func:`.deadlock.runs_go_on`)."""
-    return runs_go_on(sys.ts, _decide(t, sys, pred, bound, timeout_ms, tables, ranking, invariant),
+    F as a predicate over one state.  ``tables(F, v, ts)`` is asked when the
+    verdict ``v`` on an unbounded ``eventually F`` over ``ts`` is
+    inconclusive (the finite-table lasso search of :func:`check_temporal`);
+    ``ranking`` and ``invariant`` (over one state) are the plan's, for that
+    ``eventually``.  A lasso in which a node never answers what it accepts
+    is explained (:func:`.progress_gap.explain_idle`, with ``checked``): what
+    is missing is put in ``gaps`` (``missing_progress``, ``missing_initially``).  A verdict ``proved`` stands
+    only if no run of the system stops (:func:`.deadlock.runs_go_on`)."""
+    return runs_go_on(sys.ts, _decide(t, sys, pred, bound, timeout_ms, tables, ranking, invariant, checked,
+                                      gaps if gaps is not None else {}),
                       max_k=bound, timeout_ms=timeout_ms)
 
 
 def _decide(t: Temporal, sys: ComposedSystem, pred: Callable[[Formal], Callable[[Any], Any]], bound: int,
-            timeout_ms: int, tables: Callable[[Formal, TemporalVerdict], TemporalVerdict] | None,
-            ranking: Callable[[Any], Any] | None, invariant: Callable[[Any], Any] | None) -> TemporalVerdict:
+            timeout_ms: int, tables: Tables | None,
+            ranking: Callable[[Any], Any] | None, invariant: Callable[[Any], Any] | None,
+            checked: Checked | None, gaps: dict[str, Any]) -> TemporalVerdict:
     kind = shape(t, None)
     ts = sys.ts
 
     def eventually(g: Formal) -> TemporalVerdict:
         v = check_eventually(ts, pred(g), ranking=ranking, invariant=invariant, bound=bound, timeout_ms=timeout_ms)
-        return tables(g, v) if tables is not None and v.status == "inconclusive" else v
+        by_tables = tables is not None and v.status == "inconclusive"
+        tried_sync = False
+        if by_tables and checked is not None and not sys.eager:
+            # every node answering what it accepts at once: the query Z3 decides best, and a lasso there is one
+            # of the declared system that rests on no missing progress (.progress_gap)
+            w = tables(g, v, sys.synchronous(ts))  # type: ignore[misc]
+            if w.status == "refuted":
+                return TemporalVerdict(w.status, w.method, k=w.k, bound=w.bound, trace=w.trace, loop=w.loop,
+                                       deadlock=w.deadlock, detail=f"{w.detail}; {EVEN_SO}")
+            tried_sync = True
+        if by_tables:
+            v = tables(g, v, ts)  # type: ignore[misc]
+        if checked is None:
+            return v
+
+        def search(ts2: TransitionSystem) -> TemporalVerdict | None:
+            if by_tables:
+                w = tables(g, TemporalVerdict("inconclusive", "lasso"), ts2)  # type: ignore[misc]
+                return w if w.status == "refuted" else None
+            return find_lasso(ts2, pred(g), bound, timeout_ms=timeout_ms)
+        v, found = explain_idle(v, sys, ts, checked, search, tried_sync=tried_sync)
+        gaps.update(found)
+        return v
     if kind == "always":
         return check_always(ts, pred(t.args[0]), max_k=bound, timeout_ms=timeout_ms)
     if kind == "always next":
@@ -124,7 +155,7 @@ def _steps(trace: list[dict[str, str]], sys: ComposedSystem) -> list[dict[str, A
         for name, value in st.items():
             if name in sys.variables:
                 n, p, v = sys.variables[name]
-                rows.setdefault(n, {})[f"{p}.{v}"] = " ".join(value.split())
+                rows.setdefault(n, {})[v if p == "run" else f"{p}.{v}"] = " ".join(value.split())
         out.append({"step": i, "nodes": [{"node": n, "values": rows[n]} for n in sys.cone if n in rows]})
     return out
 
@@ -154,25 +185,27 @@ def check_temporal(req: Requirement, checked: Checked, model: SystemModel, plan:
         holds = [pred(a) for a in assuming]
         ts = sys.ts
         sys.ts = TransitionSystem(ts.sorts, lambda s: z3.And(ts.init(s), *[h(s) for h in holds]),
-                                  lambda s, u: z3.And(ts.trans(s, u), *[h(s) for h in holds], *[h(u) for h in holds]))
+                                  lambda s, u: z3.And(ts.trans(s, u), *[h(s) for h in holds], *[h(u) for h in holds]),
+                                  ts.fairness)
         for k, a in enumerate(assuming, 1):
             sys.premises.append({"label": f"assuming {k}", "kind": "assuming", "node": None, "index": k,
                                  "text": base["assuming"][k - 1], "source": base["source"]})
     types = variable_types(sys, checked, plan)
     points = max([points_for(plan.instances.get(n)) for n in cone] or [points_for(None)])
 
-    def tables(goal: Formal, v: TemporalVerdict) -> TemporalVerdict:
-        """The finite-table lasso search, confirmed on the trace (:mod:`.lasso`)."""
+    def tables(goal: Formal, v: TemporalVerdict, ts: TransitionSystem) -> TemporalVerdict:
+        """The finite-table lasso search over ``ts``, confirmed on the trace (:mod:`.lasso`)."""
         if any(isinstance(ty, EmptyT) for ty in types.values()):
             return v
         try:
-            found = find_table_lasso(sys.ts, pred(goal), types, bound=bound, points=points)
+            found = find_table_lasso(ts, pred(goal), types, bound=bound, points=points)
         except (ValueError, z3.Z3Exception) as exc:
             found = f"the finite-table search failed ({exc})"
         if isinstance(found, str):
             return TemporalVerdict(v.status, v.method, k=v.k, bound=v.bound, trace=v.trace, loop=v.loop,
                                    detail=f"{v.detail}; {found}")
-        why = confirm_lasso(found.values, found.loop, cone, sys.variables, types, checked, model, plan, goal, assuming)
+        why = confirm_lasso(found.values, found.loop, cone, sys.variables, types, checked, model, plan, goal, assuming,
+                            [f.label for f in ts.fairness])
         if why is not None:
             return TemporalVerdict(v.status, v.method, k=v.k, bound=v.bound, trace=v.trace, loop=v.loop,
                                    detail=f"{v.detail}; a lasso with {points}-point tables was found but not "
@@ -184,11 +217,16 @@ def check_temporal(req: Requirement, checked: Checked, model: SystemModel, plan:
                                       f"(found with every function a {points}-point table, confirmed on the "
                                       f"trace's values)")
     ranking = (lambda s: enc.term(rank.expr, rank.scope, sys.statement_symbols(s))) if rank is not None else None
+    missing: dict[str, Any] = {}
     v = decide(t, sys, pred, bound=bound, timeout_ms=timeout_ms, tables=tables, ranking=ranking,
-               invariant=pred(inv) if inv is not None else None)
+               invariant=pred(inv) if inv is not None else None, checked=checked, gaps=missing)
+    lasso = v.status == "refuted" and "lasso" in v.method.split(" + ")
+    gaps = missing.get("missing_progress", []) if lasso else []
+    stuck = missing.get("missing_initially", []) if lasso else []
     out: dict[str, Any] = {**base, "cone": cone, "premises": len(sys.premises), "used": [], "traced_not_needed": [],
                            "temporal": {**v.to_json(), "trace": _steps(v.trace, sys),
-                                        "ranking": base.get("ranking"), "invariant": base.get("invariant")}}
+                                        "ranking": base.get("ranking"), "invariant": base.get("invariant"),
+                                        "missing_progress": gaps, "missing_initially": stuck}}
     if v.status in ("proved", "met"):
         a, b = sys.ts.state(0), sys.ts.state(1)
         s = z3.Solver()
@@ -197,15 +235,20 @@ def check_temporal(req: Requirement, checked: Checked, model: SystemModel, plan:
         r = s.check()
         used = sys.premises
         out.update(verdict="proved", used=used)
+        # an initial value no output meets forces its node to answer at step 0: it removes runs, as a contradiction
+        bad, why = sys.initial_values_unsatisfiable(timeout_ms)
         if r == z3.unsat:
             out.update(consistency="inconsistent", inconsistent_core=used)
-        elif r == z3.sat:
+        elif bad:
+            out.update(consistency="inconsistent", inconsistent_core=bad)
+        elif r == z3.sat and not why:
             out.update(consistency="consistent")
         else:
-            out.update(consistency="undecided", consistency_reason=s.reason_unknown())
+            out.update(consistency="undecided", consistency_reason=s.reason_unknown() if r != z3.sat else why)
     elif v.status == "refuted":
         mentioned = {n for f in ops for n in f.nodes}
-        out.update(verdict="refuted", failed_to_prevent=[] if "deadlock" in v.method.split(" + ") else [
+        # a run that stops, or a lasso resting on a node that never answers, is not let through by a guarantee
+        out.update(verdict="refuted", failed_to_prevent=[] if "deadlock" in v.method.split(" + ") or gaps or stuck else [
             p for p in sys.premises if p["kind"] == "guarantee" and p["node"] in mentioned])
     else:
         out.update(verdict="inconclusive", reason=v.detail or "undecided")

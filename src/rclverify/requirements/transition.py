@@ -7,22 +7,34 @@ transition relation"):
 
 * a **state** gives a value to every input and output of every node of the
   cone (``Node.in.x``, ``Node.out.y``; a function-typed variable is a Z3
-  array) and to every declared state variable (``Node.state.v``,
-  :mod:`rclverify.plan.state`);
+  array), to every declared state variable (``Node.state.v``,
+  :mod:`rclverify.plan.state`) and, for every node with an output, to
+  ``Node.answers`` (whether the node answers in that step), ``Node.accepts``
+  (whether its assumption holds on that step's input; only for a node whose
+  assumption reads a produced input) and, for a node with a step bound,
+  ``Node.waiting`` (how many steps in a row its assumption has held
+  without an answer);
 * **in every state** the environment conjuncts of the cone's assumptions
-  and the plan's environment facts hold (what the environment is known or
-  assumed to do, as in a state requirement), and every node whose internal
-  assumption holds on its current input produces an output satisfying its
-  guarantees over that input;
+  and the plan's environment facts hold (what the environment is assumed
+  to do: every external input meets the assumptions of the nodes that read
+  it), and a node that answers has its assumption hold and an output
+  satisfying its guarantees over that input;
 * **one step** from ``s`` to ``t``: every connection feeds the next input
-  element, ``t[Consumer.in.x] == s[Producer.out.y]``; a node whose internal
-  assumption fails on ``t``'s input produces nothing and its outputs keep
-  their value (they persist); each state variable takes the value its
-  ``next`` formula gives from ``s``; the environment's inputs are free;
-* **initial states**: every declared state variable satisfies its ``init``;
-  the first input elements are otherwise unconstrained (they come from
-  before the run), so nothing is assumed about them that the contracts do
-  not say.
+  element, ``t[Consumer.in.x] == s[Producer.out.y]``; a node that does not
+  answer keeps its outputs (they persist); each state variable takes the
+  value its ``next`` formula gives from ``s``; the environment's inputs are
+  free;
+* **progress** (:mod:`rclverify.rcl.liveness`): a node may answer late or
+  never, unless it declares ``progress( within K steps )`` (no K + 1
+  steps in a row at which its assumption holds without an answer; K = 0:
+  it answers at every such step) or ``progress( eventually )``; every
+  declared progress is also a fairness constraint (:class:`.tsys.Fairness`:
+  on an infinite run on which its assumption holds infinitely often the
+  node answers infinitely often);
+* **initial states**: every declared state variable satisfies its
+  ``init``; a node that does not answer at step 0 has outputs satisfying its
+  ``initially`` (free without one); the first input elements are otherwise
+  unconstrained (they come from before the run).
 """
 from __future__ import annotations
 
@@ -35,10 +47,12 @@ from ..calculus.compose import split_assumption
 from ..logic.encode import Encoder, sort_of
 from ..plan.load import Plan
 from ..plan.state import parse_state_formula, state_type
+from ..rcl.liveness import STEP_WORDS, fair, progress_words, step_bound
 from ..rcl.printer import expr_to_rcl
-from ..rcl.types import NATURAL, Checked, EmptyT, FuncT, Type
+from ..rcl.types import BOOL, INTEGER, NATURAL, Checked, DataT, EmptyT, FuncT, Type
 from ..system.model import SystemModel
 from .temporal import State, TransitionSystem
+from .tsys import Fairness
 
 
 def _sort(t: Type) -> z3.SortRef:
@@ -48,9 +62,19 @@ def _sort(t: Type) -> z3.SortRef:
 
 
 def _typing(v: z3.ExprRef, t: Type) -> z3.BoolRef | None:
-    """NATURAL values are >= 0 (the encoder's typing axioms, per step)."""
+    """NATURAL values are >= 0 (the encoder's typing axioms, per step), also
+    a constructor's NATURAL argument (``inspect(NATURAL)``: a value kept
+    from before the run is still a value of its type)."""
     if t == NATURAL:
         return v >= 0
+    if isinstance(t, DataT):
+        ds = v.sort()
+        parts = []
+        for i in range(ds.num_constructors()):
+            args = t.ctor(ds.constructor(i).name()) or ()
+            parts += [z3.Implies(ds.recognizer(i)(v), ds.accessor(i, j)(v) >= 0)
+                      for j, a in enumerate(args) if a == NATURAL]
+        return z3.And(*parts) if parts else None
     if isinstance(t, FuncT) and t.result == NATURAL:
         xs = [z3.Const(f"_t{k}", sort_of(a)) for k, a in enumerate(t.args)]
         return z3.ForAll(xs, z3.Select(v, *xs) >= 0)
@@ -64,16 +88,69 @@ class ComposedSystem:
     ``ts``        the :class:`~.temporal.TransitionSystem` (variables named
                   ``Node.in.x`` / ``Node.out.y`` / ``Node.state.v``);
     ``cone``      the nodes, in source order;
-    ``variables`` ``{name: (node, "in"|"out"|"state", var)}``;
+    ``variables`` ``{name: (node, "in"|"out"|"state"|"run", var)}`` (``run``:
+                  ``answers``, ``accepts``, ``waiting``);
     ``premises``  what the system is made of, for the record: ``{label,
                   kind, node, index, text, source}`` per guarantee,
-                  assumption, fact and state declaration.
+                  assumption, fact, initial value, progress and state
+                  declaration;
+    ``everyone``  fairness for every node that answers (as if each
+                  declared ``progress( eventually )``): what the diagnosis
+                  of a lasso asks again (:func:`fair_everywhere`);
+    ``links``     the connections inside the cone, ``(consumer input,
+                  producer output)`` by variable name.
     """
 
     ts: TransitionSystem
     cone: list[str]
     variables: dict[str, tuple[str, str, str]]
     premises: list[dict[str, Any]] = field(default_factory=list)
+    everyone: tuple[Fairness, ...] = ()
+    links: list[tuple[str, str]] = field(default_factory=list)
+    bounds: dict[str, int | None] = field(default_factory=dict)
+    #: per node that declares ``initially``: its outputs' types and initial values over one state
+    initial: dict[str, Any] = field(default_factory=dict)
+
+    def initial_values_unsatisfiable(self, timeout_ms: int) -> tuple[list[dict[str, Any]], str]:
+        """The premises of the initial values that no output satisfies (a
+        node that must then answer at step 0, which would silently remove
+        every run whose first input it cannot accept), and the solver's
+        reason for any it could not decide (``""``: none)."""
+        bad: list[dict[str, Any]] = []
+        why = ""
+        for n, holds in self.initial.items():
+            s = z3.Solver()
+            s.set("timeout", timeout_ms)
+            s.add(holds(self.ts.state(0, "initially")))
+            r = s.check()
+            if r == z3.unsat:
+                bad += [p for p in self.premises if p["kind"] == "initial value" and p["node"] == n]
+            elif r == z3.unknown:
+                why = why or f"whether {n}'s initial value can hold ({s.reason_unknown()})"
+        return bad, why
+
+    @property
+    def eager(self) -> bool:
+        """Whether every node that answers declares ``progress( within 0
+        steps )`` (then :meth:`synchronous` is the system itself)."""
+        return all(self.bounds.get(f.label) == 0 for f in self.everyone)
+
+    def fair_everywhere(self, ts: TransitionSystem) -> TransitionSystem:
+        """``ts`` (this system's, possibly restricted further) with every
+        node's fairness, declared or not."""
+        have = {f.label for f in ts.fairness}
+        return TransitionSystem(ts.sorts, ts.init, ts.trans,
+                                ts.fairness + tuple(f for f in self.everyone if f.label not in have))
+
+    def synchronous(self, ts: TransitionSystem) -> TransitionSystem:
+        """``ts`` in which every node answers at every step its assumption
+        holds (as if each declared ``progress( within 0 steps )``): a
+        subsystem of :meth:`fair_everywhere`'s, and the reading before
+        progress could be declared."""
+        def eager(s: State) -> z3.BoolRef:
+            return z3.And(*[z3.Implies(f.enabled(s), f.taken(s)) for f in self.everyone])
+        return TransitionSystem(ts.sorts, lambda s: z3.And(ts.init(s), eager(s)),
+                                lambda s, t: z3.And(ts.trans(s, t), eager(s), eager(t)), ts.fairness)
 
     def statement_symbols(self, s: State) -> dict[str, Any]:
         """The encoder's symbols of a requirement statement at state ``s``
@@ -91,6 +168,9 @@ def variable_types(sys: ComposedSystem, checked: Checked, plan: Plan) -> dict[st
     declared = {(sv.node, sv.name): sv for sv in plan.states}
     for name, (n, p, v) in sys.variables.items():
         cn = checked.nodes[n]
+        if p == "run":
+            out[name] = INTEGER if v == "waiting" else BOOL
+            continue
         out[name] = state_type(declared[(n, v)], checked) if p == "state" else (cn.inputs if p == "in" else cn.outputs)[v]
     return out
 
@@ -141,6 +221,25 @@ def build_system(cone: Sequence[str], checked: Checked, model: SystemModel, plan
         for k, f in enumerate(plan.facts.get(n, ()), 1):
             premises.append({"label": f"{n} environment fact {k}", "kind": "environment fact", "node": n,
                              "index": k, "text": f.text, "source": where(f.expr)})
+    # answering (module docstring): which nodes answer, accept, count their waiting
+    bounds = {n: step_bound(checked.nodes[n].node) for n in cone}
+    initially = {n: [c.formula for c in checked.nodes[n].node.initially] for n in cone}
+    answering = [n for n in cone if any(f"{n}.out.{v}" in sorts for v in checked.nodes[n].outputs)]
+    for n in answering:
+        node = checked.nodes[n].node
+        sorts[f"{n}.answers"], types[f"{n}.answers"], variables[f"{n}.answers"] = z3.BoolSort(), BOOL, (n, "run", "answers")
+        if internal[n]:
+            sorts[f"{n}.accepts"], types[f"{n}.accepts"], variables[f"{n}.accepts"] = z3.BoolSort(), BOOL, (n, "run", "accepts")
+        if bounds[n]:
+            sorts[f"{n}.waiting"], types[f"{n}.waiting"], variables[f"{n}.waiting"] = z3.IntSort(), INTEGER, (n, "run", "waiting")
+        for k, c in enumerate(node.initially, 1):
+            premises.append({"label": f"{n} initially {k}", "kind": "initial value", "node": n, "index": k,
+                             "text": expr_to_rcl(c.formula), "source": where(c)})
+        if fair(node):
+            premises.append({"label": f"{n} progress", "kind": "progress", "node": n, "index": 0,
+                             "text": progress_words(node),
+                             "source": where(node.progress[0] if node.progress else
+                                             next(p for p in node.periodic if p.unit in STEP_WORDS))})
     parsed = {}
     for sv in states:
         parsed[sv] = (parse_state_formula(sv, "init", checked, plan.states),
@@ -176,12 +275,29 @@ def build_system(cone: Sequence[str], checked: Checked, model: SystemModel, plan
     def valid(s: State) -> z3.BoolRef:
         return cached(0, (s,), lambda: _valid(s))
 
+    def accepted(n: str, s: State) -> z3.BoolRef:
+        """The node's assumption holds on ``s``'s input (its ``accepts`` variable, TRUE without one)."""
+        return s[f"{n}.accepts"] if f"{n}.accepts" in s else z3.BoolVal(True)
+
     def _valid(s: State) -> z3.BoolRef:
         parts = [c for c in (_typing(s[name], types[name]) for name in sorts) if c is not None]
         for n in cone:
             parts += [holds(n, a, s) for a in env[n]] + [holds(n, f, s) for f in facts[n]]
-            if guarantees[n]:
-                parts.append(z3.Implies(assumed(n, s), z3.And(*[holds(n, g, s) for g in guarantees[n]])))
+            if f"{n}.accepts" in s:
+                parts.append(s[f"{n}.accepts"] == assumed(n, s))
+            promise = z3.And(*[holds(n, g, s) for g in guarantees[n]]) if guarantees[n] else z3.BoolVal(True)
+            if f"{n}.answers" not in s:  # no output to answer with: its guarantee holds where its assumption does
+                if guarantees[n]:
+                    parts.append(z3.Implies(assumed(n, s), promise))
+                continue
+            answers = s[f"{n}.answers"]
+            parts.append(z3.Implies(answers, z3.And(accepted(n, s), promise)))
+            k = bounds[n]
+            if k == 0:
+                parts.append(z3.Implies(accepted(n, s), answers))
+            elif k:
+                w = s[f"{n}.waiting"]
+                parts.append(z3.If(z3.Or(answers, z3.Not(accepted(n, s))), w == 0, z3.And(w >= 1, w <= k)))
         return z3.And(*parts)
 
     alias = model.alias()
@@ -198,19 +314,37 @@ def build_system(cone: Sequence[str], checked: Checked, model: SystemModel, plan
         return out
 
     def init(s: State) -> z3.BoolRef:
-        return z3.And(valid(s), *[enc.formula(parsed[sv][0].expr, parsed[sv][0].scope, state_syms(sv, s, None))
-                                  for sv in states])
+        parts = [valid(s), *[enc.formula(parsed[sv][0].expr, parsed[sv][0].scope, state_syms(sv, s, None))
+                             for sv in states]]
+        for n in answering:
+            if initially[n]:
+                parts.append(z3.Implies(z3.Not(s[f"{n}.answers"]), z3.And(*[holds(n, f, s) for f in initially[n]])))
+            if bounds[n]:
+                parts.append(s[f"{n}.waiting"] <= 1)
+        return z3.And(*parts)
 
     def trans(s: State, t: State) -> z3.BoolRef:
         return cached(1, (s, t), lambda: _trans(s, t))
 
     def _trans(s: State, t: State) -> z3.BoolRef:
         parts = [valid(s), valid(t)] + [t[c] == s[p] for c, p in links]
-        for n in cone:
+        for n in answering:
             outs = [t[f"{n}.out.{v}"] == s[f"{n}.out.{v}"] for v in checked.nodes[n].outputs if f"{n}.out.{v}" in s]
-            if internal[n] and outs:
-                parts.append(z3.Implies(z3.Not(assumed(n, t)), z3.And(*outs)))
+            parts.append(z3.Implies(z3.Not(t[f"{n}.answers"]), z3.And(*outs)))
+            if bounds[n]:
+                parts.append(z3.Implies(z3.And(z3.Not(t[f"{n}.answers"]), accepted(n, t)),
+                                        t[f"{n}.waiting"] == s[f"{n}.waiting"] + 1))
         parts += [enc.formula(parsed[sv][1].expr, parsed[sv][1].scope, state_syms(sv, s, t)) for sv in states]
         return z3.And(*parts)
 
-    return ComposedSystem(TransitionSystem(sorts, init, trans), list(cone), variables, premises)
+    def initial_of(n: str) -> Any:
+        outs = [f"{n}.out.{v}" for v in checked.nodes[n].outputs if f"{n}.out.{v}" in sorts]
+        return lambda s: z3.And(*[c for c in (_typing(s[o], types[o]) for o in outs) if c is not None],
+                                *[holds(n, f, s) for f in initially[n]])
+
+    def progress_of(n: str) -> Fairness:
+        return Fairness(n, lambda s: accepted(n, s), lambda s: s[f"{n}.answers"])
+    declared = tuple(progress_of(n) for n in answering if fair(checked.nodes[n].node))
+    everyone = tuple(progress_of(n) for n in answering)
+    return ComposedSystem(TransitionSystem(sorts, init, trans, declared), list(cone), variables, premises, everyone,
+                          links, bounds, {n: initial_of(n) for n in answering if initially[n]})

@@ -24,16 +24,33 @@ Trans = Callable[[State, State], z3.BoolRef]
 
 
 @dataclass(frozen=True)
+class Fairness:
+    """A strong fairness (compassion) constraint on infinite runs: if
+    ``enabled`` holds at infinitely many steps, ``taken`` holds at infinitely
+    many (Manna and Pnueli, 1992).  ``label`` names it in verdicts (a node's
+    progress: the node, ``enabled`` its assumption, ``taken`` its answer)."""
+
+    label: str
+    enabled: Pred
+    taken: Pred
+
+
+@dataclass(frozen=True)
 class TransitionSystem:
     """A symbolic transition system.
 
     ``sorts`` maps each state variable's name to a Z3 sort; ``init`` is a
-    predicate over the first state; ``trans`` relates a state to the next.
+    predicate over the first state; ``trans`` relates a state to the next;
+    ``fairness`` the constraints every infinite run meets (a lasso that
+    breaks one is not a run: :func:`fair_loop`).  Finite prefixes are not
+    held to them (a safety counterexample need not extend to a fair run, as
+    in SPIN's and NuSMV's invariant checks).
     """
 
     sorts: dict[str, z3.SortRef]
     init: Pred
     trans: Trans
+    fairness: tuple[Fairness, ...] = ()
 
     def state(self, step: int, tag: str = "") -> State:
         """Fresh Z3 constants for the state at ``step`` (0-based); ``tag``
@@ -99,4 +116,12 @@ def with_flag(ts: TransitionSystem, name: str, init: Callable[[Any], Any],
     nothing, and every state of ``ts`` with a successor still has one)."""
     sorts = {**ts.sorts, name: z3.BoolSort()}
     return TransitionSystem(sorts, lambda s: z3.And(ts.init(s), s[name] == init(s)),
-                            lambda s, t: z3.And(ts.trans(s, t), t[name] == step(s, t)))
+                            lambda s, t: z3.And(ts.trans(s, t), t[name] == step(s, t)), ts.fairness)
+
+
+def fair_loop(ts: TransitionSystem, loop: list[State]) -> z3.BoolRef:
+    """The states ``loop`` (s_j .. s_{n-1} of a lasso whose s_n equals s_j),
+    repeated forever, meet every fairness constraint of ``ts``: for each,
+    ``enabled`` at no state of the loop or ``taken`` at one of them."""
+    return z3.And(*[z3.Implies(z3.Or(*[f.enabled(s) for s in loop]), z3.Or(*[f.taken(s) for s in loop]))
+                    for f in ts.fairness]) if ts.fairness else z3.BoolVal(True)

@@ -32,6 +32,7 @@ from ..base import NodeTarget, Stopwatch, make_evidence
 from .check import NodeResult, check_trace
 from .config import ConfigError, MonitorConfig, load_mapping
 from .deadlines import check_deadlines, deadline_status, has_deadlines
+from .periods import has_periods, with_periods
 from .rml import Spec, rml_id, translate
 
 NAME = "monitors"
@@ -214,6 +215,15 @@ class MonitorsBackend:
             except Exception as exc:  # as above: the record's error, never a crash
                 return evidence("error", f"the deadlines could not be checked: {type(exc).__name__}: {exc}",
                                 log=str(exc))
+        if has_periods(target.node):  # periodic outputs on the same run (periods.py)
+            try:
+                status, explanation, more = with_periods(
+                    target.node, read_trace(target.root / trace, [target.root / d for d in cfg.msg_dirs]), trace,
+                    status, explanation)
+            except Exception as exc:  # as above: the record's error, never a crash
+                return evidence("error", f"the periods could not be checked: {type(exc).__name__}: {exc}",
+                                log=str(exc))
+            extra.update(more)
         return evidence(status, explanation, details={"monitoring": details, **extra},
                         artifacts=(str(obligation.data.get("rml", "")), str(obligation.data.get("config", ""))),
                         log=summary_line(res))

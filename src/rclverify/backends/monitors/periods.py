@@ -1,0 +1,127 @@
+"""Periodic outputs checked against message stamps (issue 40).
+
+A node's ``periodic( out.y, 100 ms )`` (docs/rcl-language.md, "Progress,
+initial values and periodic outputs") says the node refreshes ``out.y`` at
+least once per period: a rate, a watchdog's heartbeat.  On a recorded run
+the messages that carry ``out.y`` (the topic ``topics(...)`` binds to it,
+:func:`.deadlines.topic_bindings`) are stamped as the deadline monitor
+stamps them (:func:`.deadlines.event_stamp`: the header's stamp, else the
+trace's time), and:
+
+* every gap between two consecutive messages of ``out.y`` is at most the
+  period: ``true``; a longer gap is ``false``, with both stamps (gaps are
+  compared to the microsecond, :data:`TOLERANCE_S`: stamps read as floats
+  since the epoch are only that exact, and ``1.3 - 1.2`` is not ``0.1``);
+* after the last message, the run goes on (its last event of any topic) for
+  more than a period: ``false`` (the output stopped being refreshed);
+* no message of ``out.y`` at all: nothing was checked (``pending``); the
+  time before the first message is not judged (a recorded run may start
+  before the node does).
+
+A period in steps (``periodic( out.y, 3 steps )``) is a rule of the
+composed system (docs/requirements.md), not of a recorded run, which has no
+steps: it is not monitored.  Neither is ``progress( ... )`` (counted in
+steps) nor ``initially( ... )`` (a value before the first message, which a
+recorded run does not show); a bound in time is a guarantee's deadline
+(``triggered by in.x within 200 ms``, :mod:`.deadlines`).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any, Iterable
+
+from ...rcl.liveness import period_seconds
+from ...rcl.types import CheckedNode
+from ...traces.events import Event
+from .deadlines import event_stamp, topic_bindings
+
+
+#: The slack of a gap against its period (s): the resolution of an epoch stamp read as a float.
+TOLERANCE_S = 1e-6
+
+
+@dataclass
+class PeriodResult:
+    """One node's periodic outputs on one run: per output ``out.y``, the
+    messages seen and the first gap longer than its period (``None``:
+    none), as ``{"from": stamp, "to": stamp or None (the run's end),
+    "gap": s, "period": s, "where": the later message's place}``."""
+
+    node: str
+    periods: dict[str, float] = field(default_factory=dict)
+    messages: dict[str, int] = field(default_factory=dict)
+    late: dict[str, dict[str, Any]] = field(default_factory=dict)
+    end: float | None = None
+
+    def to_json(self) -> dict[str, Any]:
+        return {"node": self.node, "periods": dict(self.periods), "messages": dict(self.messages),
+                "late": dict(self.late), "end": self.end}
+
+
+def has_periods(node: CheckedNode) -> bool:
+    """Whether ``node`` declares a period in time (one a recorded run can check)."""
+    return any(period_seconds(p) is not None for p in node.node.periodic)
+
+
+def check_periods(node: CheckedNode, events: Iterable[Event]) -> PeriodResult:
+    """The periodic outputs of ``node`` (periods in time) over a recorded
+    run's ``events``, in order (module docstring)."""
+    res = PeriodResult(node.name)
+    for p in node.node.periodic:
+        s = period_seconds(p)
+        if s is not None:
+            res.periods[f"out.{p.output.name}"] = float(s)
+    topics: dict[str, list[str]] = {}
+    for topic, keys in topic_bindings(node).items():
+        outs = [k for k, _ in keys if k in res.periods]
+        if outs:
+            topics[topic] = outs
+    last: dict[str, tuple[float, str]] = {}
+    for ev in events:
+        stamp = event_stamp(ev)
+        res.end = stamp if res.end is None else max(res.end, stamp)
+        for key in topics.get(ev.topic.lstrip("/"), ()):
+            res.messages[key] = res.messages.get(key, 0) + 1
+            before = last.get(key)
+            if before is not None and key not in res.late and stamp - before[0] > res.periods[key] + TOLERANCE_S:
+                res.late[key] = {"from": before[0], "to": stamp, "gap": stamp - before[0],
+                                 "period": res.periods[key], "where": ev.where}
+            last[key] = (stamp, ev.where)
+    for key, (stamp, where) in last.items():
+        if key not in res.late and res.end is not None and res.end - stamp > res.periods[key] + TOLERANCE_S:
+            res.late[key] = {"from": stamp, "to": None, "gap": res.end - stamp, "period": res.periods[key],
+                             "where": where}
+    return res
+
+
+def period_status(res: PeriodResult, trace: str) -> tuple[str, str]:
+    """Evidence status and explanation of one node's periods on a run: a gap
+    longer than a period -> ``failed`` (named with its stamps); no message
+    of some periodic output -> ``pending``; else ``discharged``."""
+    for key, g in res.late.items():
+        after = (f"the next at {g['to']:.3f} s ({g['where']})" if g["to"] is not None
+                 else f"none after it although {trace} goes on to {res.end:.3f} s")
+        return "failed", (f"{res.node}.{key} is declared periodic every {_ms(g['period'])} but a message at "
+                          f"{g['from']:.3f} s has {after}: a gap of {_ms(g['gap'])}")
+    silent = [k for k in res.periods if not res.messages.get(k)]
+    if silent:
+        return "pending", f"{trace} has no message of {', '.join(f'{res.node}.{k}' for k in silent)}: its period was not checked"
+    return "discharged", ", ".join(f"{res.node}.{k}: {res.messages[k]} messages, no gap over {_ms(res.periods[k])}"
+                                   for k in res.periods)
+
+
+def with_periods(node: CheckedNode, events: Iterable[Event], trace: str, status: str,
+                 explanation: str) -> tuple[str, str, dict[str, Any]]:
+    """The monitor's verdict combined with the node's periods on the same run:
+    a failed period fails the evidence, otherwise the verdict stands (a
+    period that saw no message adds a note).  Returns ``(status,
+    explanation, {"periods": ...})``."""
+    res = check_periods(node, events)
+    pstatus, pexpl = period_status(res, trace)
+    if pstatus == "failed":
+        return "failed", f"periods: {pexpl}; {explanation}", {"periods": res.to_json()}
+    return status, f"{explanation}; periods: {pexpl}", {"periods": res.to_json()}
+
+
+def _ms(x: float) -> str:
+    return f"{x * 1000:.0f} ms" if abs(x) < 10 else f"{x:.3f} s"
