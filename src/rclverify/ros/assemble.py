@@ -118,6 +118,16 @@ class Assembly:
                                             f"its topics are unknown", "ROS-LAUNCH"))
         got = self.linked(prog) if prog is not None else Linked()
         g.notes.extend(got.notes)
+        if ln.name is None and len({n for n, _s, _ns in got.nodes}) > 1 and prog is not None:
+            # a ROS 2 process of several nodes, none renamed by the launch file: each node
+            # is itself, in the launch namespace, with its own endpoints (docs/ros.md)
+            for i, (name, _src, code_ns) in enumerate(got.nodes):
+                ns = ln.ns if ln.ns != "/" else names.join("/", code_ns or "")
+                mine = [e for e, o in got.endpoints if o == i]
+                full = names.normalise(name) if name.startswith("/") else names.join(ns, name)
+                add_node(full, names.split(full)[0], ln.pkg, ln.exe or None, _files(prog, got, mine, None),
+                         ln.src, mine, ln.remaps, "launch", ln.params)
+            return
         eps = [e for e, _o in got.endpoints]
         name = ln.name or (got.nodes[0][0] if got.nodes else (plugin.split("::")[-1] if plugin else ln.exe))
         if name.startswith("/"):

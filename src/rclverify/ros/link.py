@@ -38,6 +38,7 @@ from .cpp_types import action_type, message_type, service_type, split_template
 from .model import Endpoint, Note, Src
 from .link_values import MAX_DEPTH, MAX_VALUES, Values
 from .programs import PackageCode, Program
+from .unit_names import canonical
 
 __all__ = ["Linked", "Linker", "MAX_DEPTH", "MAX_VALUES"]
 _ACTIONLIB = {"SimpleActionServer": "action_servers", "ActionServer": "action_servers",
@@ -63,7 +64,7 @@ class Linker(Values):
 
     def __init__(self, prog: Program, code: PackageCode, known: Callable[[str], bool]) -> None:
         self.prog, self.code, self.known = prog, code, known
-        self.recs = {f: code.records[f] for f in prog.files if f in code.records}
+        self.recs = canonical({f: code.records[f] for f in prog.files if f in code.records})
         self.fns: dict[str, tuple[str, list[str], list[str], list[Any]]] = {}
         self.units: dict[str, dict[str, Any]] = {}
         self.fields: dict[tuple[str, str], list[Any]] = {}

@@ -206,7 +206,7 @@ class _File:
         self.out["consts"] = {k: v for k, v in ((k, s._one([s.value(x) if not isinstance(x, tuple) else x
                                                              for x in vs])) for k, vs in s.consts.items())
                               if v is not None}
-        self.out["ros2"] = self.ros2
+        self.out["ros2"], self.out["using_ns"] = self.ros2, s.using_ns
         return self.out
 
     def initializer(self, n: Any) -> None:
