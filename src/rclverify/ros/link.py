@@ -33,16 +33,15 @@ import re
 from dataclasses import dataclass, field
 from typing import Any, Callable
 
-from . import cpp_helpers, emit, symbols
-from .cpp_types import action_type, message_type, service_type, split_template
+from . import emit, symbols
+from .cpp_types import split_template
 from .model import Endpoint, Note, Src
+from .link_members import LinkMembers
 from .link_values import MAX_DEPTH, MAX_VALUES, Values
 from .programs import PackageCode, Program
 from .unit_names import canonical
 
 __all__ = ["Linked", "Linker", "MAX_DEPTH", "MAX_VALUES"]
-_ACTIONLIB = {"SimpleActionServer": "action_servers", "ActionServer": "action_servers",
-              "SimpleActionClient": "action_clients", "ActionClient": "action_clients"}
 _IDENT = re.compile(r"[A-Za-z_][\w:]*")
 
 
@@ -58,7 +57,7 @@ class Linked:
     files: list[str] = field(default_factory=list)
 
 
-class Linker(Values):
+class Linker(LinkMembers, Values):
     """Link one program of a package (see the module docstring); ``known(t)`` says
     whether the scan's type table defines message type ``t``."""
 
@@ -290,68 +289,6 @@ class Linker(Values):
         if got and t is None:
             note(emit.type_note(got[0]))
         return got
-
-    def cb_type(self, kind: str, cb: Any) -> str | None:
-        """The type a callback (C++: its name; Python: ``("cands", types)`` of a star
-        import) gives an endpoint of role ``kind``."""
-        if isinstance(cb, tuple) and cb and cb[0] == "cands":
-            known = [t for t in cb[1] if self.known(t)]
-            return known[0] if len(known) == 1 else None
-        if isinstance(cb, tuple) and cb and cb[0] == "type":
-            text: str | None = cb[1]
-            for _ in range(4):
-                text = self.aliases.get(text or "", self.aliases.get((text or "").split("::")[-1], text))
-        elif isinstance(cb, str):
-            text = self.callbacks.get(cb)
-            if text is None:  # written with another qualification than declared
-                hits = sorted({v for k, v in self.callbacks.items() if k.endswith("::" + cb) or cb.endswith("::" + k)})
-                text = hits[0] if len(hits) == 1 else self.callbacks.get(cb.split("::")[-1])
-        else:
-            return None
-        if kind in ("pub", "sub"):
-            return message_type(text, self.aliases)
-        return service_type(text) if kind.startswith("service") else action_type(text)
-
-    def members(self, r: dict[str, Any]) -> list[Endpoint]:
-        """Pending endpoints of helper objects held as members (their class found in
-        the program's declarations): made in a constructor's initialiser list, or
-        by default where none initialises them; and of their methods' calls."""
-        out: list[Endpoint] = []
-        for unit, m, ty, src in r.get("member_decls", []):
-            if not self.runs(unit, None):
-                continue
-            inits = [c for c in self.calls if c[0] == "member" and c[1] == m and c[4] == unit]
-            for c in inits or [None]:
-                args = c[2] if c else []
-                at, fkey = (c[5], c[3]) if c else (src, None)
-                for kind, nv, t, hv in self.helper(ty, args) or []:
-                    out.append(Endpoint(kind, "", t, at, None, (), unit,
-                                        (nv, hv, None, fkey, symbols.text(nv) or m, at), fkey))
-        for unit, m, meth, args, texts, src, fkey in r.get("member_calls", []):
-            if not self.runs(unit, fkey):
-                continue
-            ty = self.units.get(unit, {}).get("members", {}).get(m)
-            for b in self.units.get(unit, {}).get("bases", []):
-                cls = self.match(b, unit)
-                ty = ty or (self.units.get(cls, {}).get("members", {}).get(m) if cls else None)
-            specs = cpp_helpers.method(ty, meth, args, [], lambda x: x, None) if ty else None
-            for kind, nv, t, hv in specs or []:
-                k = 1 if kind == "sub" and meth == "subscribe" else 0
-                out.append(Endpoint(kind, "", t, src, None, (), unit,
-                                    (nv, hv, None, fkey, texts[k] if k < len(texts) else m, src), fkey))
-        return out
-
-    def helper(self, ty: str, args: list[Any]) -> list[cpp_helpers.Spec] | None:
-        head, targs = split_template(ty.replace(" ", ""))
-        last = head.split("::")[-1]
-        if last in _ACTIONLIB and targs:
-            if not args:
-                return []
-            first = args[0]
-            if len(args) >= 2 and first is not None and first[0] in ("nh", "field", "arg"):
-                return [(_ACTIONLIB[last], args[1], action_type(targs[0]), first)]
-            return [(_ACTIONLIB[last], first, action_type(targs[0]), None)]
-        return cpp_helpers.constructed(ty, args, lambda x: x, False)
 
     def owners(self, units: list[str | None], eps: list[Endpoint]) -> list[int]:
         """Each endpoint's node (an index in the named nodes; -1 when none)."""

@@ -36,6 +36,7 @@ from __future__ import annotations
 from typing import Any
 
 from . import cpp_helpers, emit, symbols, treesitter
+from .cpp_members import MemberReader
 from .cpp_prep import REGISTER, prepare
 from .cpp_scope import base_name, callee_parts, namespaces_of
 from .cpp_values import CppValues
@@ -55,7 +56,7 @@ _LIBRARY = ("std::", "ros::", "rclcpp::", "boost::", "RCLCPP_", "ROS_", "tf2::",
 _T = treesitter.text
 
 
-class _File:
+class _File(MemberReader):
     def __init__(self, data: bytes, shown: str) -> None:
         self.shown = shown
         self.vex_at: Any = None
@@ -195,6 +196,8 @@ class _File:
                 self.declaration(n)
             elif t == "field_declaration":
                 self.member(n)
+            elif t in ("class_specifier", "struct_specifier"):
+                self.bases(n)
             elif t == "call_expression":
                 self.call(n)
         s = self.scope
@@ -255,18 +258,6 @@ class _File:
         finally:
             self.scope.override, self.vex_at = None, None
 
-    def member(self, n: Any) -> None:
-        ty = _T(n.child_by_field_name("type"))
-        head, targs = split_template(ty.replace(" ", ""))
-        last = head.split("::")[-1]
-        fn_cls = self.scope.fn_of(n)
-        if fn_cls is not None or not (last in _ACTIONLIB or last in cpp_helpers.CONSTRUCTED):
-            return
-        nss, cls = namespaces_of(n)
-        for d in n.children_by_field_name("declarator"):
-            if d.type == "field_identifier":  # a value member (a pointer is made elsewhere)
-                self.out["member_decls"].append(("::".join(nss + cls), _T(d), ty, self.src(n)))
-
     def call(self, n: Any) -> None:
         fn = n.child_by_field_name("function")
         a = n.child_by_field_name("arguments")
@@ -317,6 +308,8 @@ class _File:
             ta = targs[0] if targs else None
             self.emit(kind, args[1], self.msg(ta) if ta else None, n, s.value(args[0]))
             return
+        if len(args) == 1 and last in ("subscribe", "advertise", "advertiseService") and "::" in full and recv is None:
+            return  # a static method of some class (T::subscribe(rate)), not a node handle's
         if len(args) == 1 and last in ("subscribe", "advertise", "advertiseService"):
             ops = s.value(args[0])
             if ops is not None and ops[0] == "ops":
@@ -350,30 +343,6 @@ class _File:
         if msg_type is None and cb is None and ta:
             cb = ("type", ta)  # an alias of another file (a header's using/typedef): read by the linker
         self.emit(kind, args[0], msg_type, n, handle, cb if msg_type is None else None)
-
-    def deferred_method(self, recv: Any, method: str, args: list[Any], at: Any) -> bool:
-        """A helper method on a member whose class this file does not declare
-        (``it_.advertise("image", 1)``, ``sub_.subscribe(nh, "t", 1)``): left to
-        the linker, which knows the member's type from the program's other files."""
-        r = recv.child_by_field_name("field") if recv.type == "field_expression" else recv
-        fn = self.scope.fn_of(at)
-        if fn is None or not fn.in_class or r is None or r.type not in ("identifier", "field_identifier"):
-            return False
-        self.out["member_calls"].append((fn.unit, _T(r), method, [self.scope.value(x) for x in args],
-                                         [_T(x) for x in args], self.src(at), fn.key))
-        return True
-
-    def helper_form(self, method: str, args: list[Any]) -> bool:
-        """Whether a call without template arguments has the form of a helper's method
-        only (never of a node handle's): ``advertise(name, n)``, the camera forms,
-        message_filters' ``subscribe(h, name, ...)``, ``on_parameter_event(cb)``."""
-        from .cpp_params import string_value
-        if method in ("advertiseCamera", "subscribeCamera", "on_parameter_event"):
-            return True
-        if method == "advertise":
-            return len(args) >= 2
-        return method == "subscribe" and len(args) >= 2 and (
-            self.scope.is_handle(args[0]) or (string_value(args[0]) is None and string_value(args[1]) is not None))
 
     def action2(self, last: str, targs: list[str], args: list[Any], n: Any) -> None:
         kind = "action_servers" if last == "create_server" else "action_clients"

@@ -287,6 +287,8 @@ def extract(mod: PyModule, shown: str) -> dict[str, Any]:
             spec = _METHODS[last]
         if spec is None:
             helped = py_helpers.helper(f, c, ros2) if f and "." in f else None
+            for m in mod.star if helped is None and f and "." not in f and f not in mod.imports else ():
+                helped = helped or py_helpers.helper(f"{m}.{f}", c, ros2)  # from interactive_markers... import *
             if helped is not None:
                 for kind, name, typ in helped:
                     add(kind, name, typ, c)
