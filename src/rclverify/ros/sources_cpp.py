@@ -38,6 +38,7 @@ from typing import Any
 from . import cpp_helpers, emit, symbols, treesitter
 from .cpp_members import MemberReader
 from .cpp_prep import REGISTER, prepare
+from .nodelets import registered
 from .cpp_scope import base_name, callee_parts, namespaces_of
 from .cpp_values import CppValues
 from .cpp_types import action_type, callback_name, message_type, service_type, split_template
@@ -66,6 +67,7 @@ class _File(MemberReader):
         for m in REGISTER.finditer(data):
             line = data.count(b"\n", 0, m.start()) + 1
             self.out["components"].append((m.group(1).decode().lstrip(":"), Src(shown, line, 1)))
+        self.out["nodelets"] = registered(data, shown)
         data = prepare(data)
         self.ros2 = b"rclcpp" in data
         root = treesitter.parser("cpp").parse(data).root_node
@@ -74,6 +76,7 @@ class _File(MemberReader):
         for n in self.nodes:
             self._index(n)
         self.scope = CppValues(self.nodes)
+        self.scope.nodelet = b"nodelet" in data and b"Nodelet" in data
         if root.has_error:
             err = next((n for n in self.nodes if n.type == "ERROR" or n.is_missing), root)
             self.out["notes"].append(Note(self.src(err), "C++ source has syntax errors; read what tree-sitter "
