@@ -127,6 +127,7 @@ class Linker(LinkMembers, Values):
         self.reach = self._reach({f"U:{u}" for u in self.entry})
         self._memo: dict[str, list[dict[int, Any]]] = {}
         self._stack: set[str] = set()
+        self.pins: dict[str, int] = {}
 
     # -- program structure
     def match(self, name: str, caller: str | None) -> str | None:
@@ -223,51 +224,75 @@ class Linker(LinkMembers, Values):
     def run(self) -> Linked:
         out = Linked()
         said: set[tuple[Src, str]] = set()
-        eps: list[Endpoint] = []
 
         def note(n: Note) -> None:
             if (n.src, n.message) not in said:
                 said.add((n.src, n.message))
                 out.notes.append(n)
 
-        def take(f: str, e: Endpoint) -> None:
-            if e.unit is None and e.func is None and f not in self.prog.entry:
-                return
-            if (e.unit is not None or e.func is not None) and not self.runs(e.unit, e.func):
-                return
-            for x in self.resolve(e, note):
-                if x not in eps:
-                    eps.append(x)
-                    if f not in out.files:
-                        out.files.append(f)
-
+        raw: list[tuple[str, Endpoint]] = []
         for f, r in self.recs.items():
-            for e in r.get("endpoints", []):
-                take(f, e)
-            for e in self.members(r):
-                take(f, e)
-        named: list[tuple[str, Src, str | None, str | None]] = []
+            for e in list(r.get("endpoints", [])) + self.members(r):
+                if e.unit is None and e.func is None and f not in self.prog.entry:
+                    continue
+                if (e.unit is not None or e.func is not None) and not self.runs(e.unit, e.func):
+                    continue
+                raw.append((f, e))
+        named = self.named(note, out)
+        out.nodes = [(n, s, ns) for n, s, ns, _u, _p in named]
+        units = [u for _n, _s, _ns, u, _p in named]
+        got: list[tuple[Endpoint, int]] = []
+        for (f, e), own in zip(raw, self.owners(units, [e for _f, e in raw])):
+            # one class made as several nodes (each call site its own name): each instance
+            # reads the endpoint with the arguments of its own call site (docs/ros.md)
+            group = [j for j, it in enumerate(named) if own >= 0 and it[3] == units[own] and it[4]]
+            for j in group if len(group) > 1 else [own]:
+                self.pin(named[j][4] if len(group) > 1 else {})
+                for x in self.resolve(e, note):
+                    if (x, j) not in got:
+                        got.append((x, j))
+                        if f not in out.files:
+                            out.files.append(f)
+        self.pin({})
+        out.endpoints = got
+        return out
+
+    def named(self, note: Callable[[Note], None], out: Linked) -> list[tuple[str, Src, str | None, str | None,
+                                                                          dict[str, int]]]:
+        """The program's nodes: ``[(name, where named, namespace, unit, pins)]``; a node
+        name read from the arguments of a function called at several sites (a node
+        class constructed twice) is read site by site, ``pins`` naming the site."""
+        named: list[tuple[str, Src, str | None, str | None, dict[str, int]]] = []
         for f, r in self.recs.items():
             for v, src, unit, fkey, ns in r.get("node_names", []):
                 if (unit is not None or fkey is not None) and not self.runs(unit, fkey) \
                         or unit is None and fkey is None and f not in self.prog.entry:
                     continue
-                for env in self.contexts(fkey):
-                    for name in self.eval(v, env, fkey):
-                        t = symbols.text(name) if name is not None and name[0] in ("str", "cat") else None
-                        if t is None:
-                            note(Note(src, "node name is not a string literal: not resolved statically"))
-                            continue
-                        nsv = self.eval(ns, env, fkey)[0] if ns is not None else None
-                        item = (t, src, symbols.text(nsv) if nsv is not None else None, unit)
-                        if not any(x[0] == t and x[2] == item[2] for x in named):
-                            named.append(item)
-                        if f not in out.files:
-                            out.files.append(f)
-        out.nodes = [(n, s, ns) for n, s, ns, _u in named]
-        owners = self.owners([u for *_x, u in named], eps)
-        out.endpoints = list(zip(eps, owners))
-        return out
+                live = [i for i, (_a, _k, caller) in enumerate(self.sites.get(fkey or "", []))
+                        if caller is None or self.runs(None, caller)]
+                pinned = len(live) > 1 and not symbols.is_concrete(v)
+                for pins in [{fkey: i} for i in live] if pinned and fkey else [{}]:
+                    self.pin(pins)
+                    for env in self.contexts(fkey):
+                        for name in self.eval(v, env, fkey):
+                            t = symbols.text(name) if name is not None and name[0] in ("str", "cat") else None
+                            if t is None:
+                                note(Note(src, "node name is not a string literal: not resolved statically"))
+                                continue
+                            nsv = self.eval(ns, env, fkey)[0] if ns is not None else None
+                            item = (t, src, symbols.text(nsv) if nsv is not None else None, unit, pins)
+                            if not any(x[0] == t and x[2] == item[2] for x in named):
+                                named.append(item)
+                            if f not in out.files:
+                                out.files.append(f)
+        self.pin({})
+        return named
+
+    def pin(self, pins: dict[str, int]) -> None:
+        """Read function ``k``'s parameters from its call site ``pins[k]`` only."""
+        if pins != self.pins:
+            self.pins = pins
+            self._memo.clear()
 
     def resolve(self, e: Endpoint, note: Callable[[Note], None]) -> list[Endpoint]:
         """The concrete endpoints a (possibly pending) endpoint stands for."""
