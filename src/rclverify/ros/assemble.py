@@ -128,7 +128,8 @@ class Assembly:
                     eps = [e for e, o in got.endpoints if o == i]
                     full = names.join(names.join("/", ns or ""), name)
                     files = _files(prog, got, eps, src.file)
-                    add_node(full, names.split(full)[0], pkg, prog.exe, files, src, eps, [], "source")
+                    add_node(full, names.split(full)[0], pkg, prog.exe, files, src, eps, [], "source",
+                             lifecycle=got.kinds[i] == "lifecycle" if i < len(got.kinds) else False)
 
     def launch_node(self, ln: LaunchNode, add_node: Callable[..., None], g: Graph) -> None:
         """The node launch element ``ln`` starts (see the module docstring)."""
@@ -175,7 +176,8 @@ class Assembly:
                 mine = [e for e, o in got.endpoints if o == i]
                 full = names.normalise(name) if name.startswith("/") else names.join(ns, name)
                 add_node(full, names.split(full)[0], ln.pkg, ln.exe or None, _files(prog, got, mine, None),
-                         ln.src, mine, ln.remaps, "launch", ln.params)
+                         ln.src, mine, ln.remaps, "launch", ln.params,
+                         lifecycle=i < len(got.kinds) and got.kinds[i] == "lifecycle")
             return
         eps = [e for e, _o in got.endpoints]
         name = ln.name or (got.nodes[0][0] if got.nodes else (plugin.split("::")[-1] if plugin else ln.exe))
@@ -185,7 +187,8 @@ class Assembly:
         else:
             full, ns = names.join(ln.ns, name), ln.ns
         files = _files(prog, got, eps, None) if prog is not None else []
-        add_node(full, ns, ln.pkg, ln.exe or None, files, ln.src, eps, ln.remaps, "launch", ln.params)
+        add_node(full, ns, ln.pkg, ln.exe or None, files, ln.src, eps, ln.remaps, "launch", ln.params,
+                 lifecycle="lifecycle" in got.kinds)
 
 
 def _files(prog: Program, got: Linked, eps: list[Endpoint], named_in: str | None) -> list[str]:

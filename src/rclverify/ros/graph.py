@@ -216,12 +216,13 @@ def _scan(paths: Sequence[Path], launch: Sequence[Path], launch_args: dict[str, 
 
     def add_node(full: str, ns: str, pkg: str | None, exe: str | None, files: list[str], declared: Src,
                  eps: list[Endpoint], remaps: list[tuple[str, str, Src]], origin: str,
-                 params: dict[str, tuple[str, Src]] | None = None) -> None:
-        node = GraphNode(full, ns, pkg, exe, files, declared, origin=origin)
+                 params: dict[str, tuple[str, Src]] | None = None, lifecycle: bool = False) -> None:
+        node = GraphNode(full, ns, pkg, exe, files, declared, origin=origin, lifecycle=lifecycle)
         if full in g.nodes and origin == "source" and g.nodes[full].origin == "source":
             # no launch file starts them: several programs that take the same
             # name are one node of the graph with all their endpoints (docs/ros.md)
             node = g.nodes[full]
+            node.lifecycle = node.lifecycle or lifecycle
             g.notes.append(Note(declared, f"node {full} is also named at {node.declared_at}; no launch file "
                                           f"starts these programs: shown as one node with the endpoints of "
                                           f"all of them", "ROS-LAUNCH"))

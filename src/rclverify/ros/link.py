@@ -47,11 +47,12 @@ _IDENT = re.compile(r"[A-Za-z_][\w:]*")
 
 @dataclass
 class Linked:
-    """A linked program: ``nodes`` ``[(name, where named, namespace or None)]``,
-    ``endpoints`` ``[(Endpoint, index of its node in nodes, or -1)]``, ``notes``
+    """A linked program: ``nodes`` ``[(name, where named, namespace or None)]`` (``kinds``:
+    each one's kind, ``"lifecycle"`` for a managed node, else ``None``), ``endpoints`` ``[(Endpoint, index of its node in nodes, or -1)]``, ``notes``
     and the ``files`` that gave any of them."""
 
     nodes: list[tuple[str, Src, str | None]] = field(default_factory=list)
+    kinds: list[str | None] = field(default_factory=list)  # per node: "lifecycle" or None
     endpoints: list[tuple[Endpoint, int]] = field(default_factory=list)
     notes: list[Note] = field(default_factory=list)
     files: list[str] = field(default_factory=list)
@@ -264,7 +265,7 @@ class Linker(LinkMembers, Values):
         class constructed twice) is read site by site, ``pins`` naming the site."""
         named: list[tuple[str, Src, str | None, str | None, dict[str, int]]] = []
         for f, r in self.recs.items():
-            for v, src, unit, fkey, ns in r.get("node_names", []):
+            for v, src, unit, fkey, ns, *kind in r.get("node_names", []):
                 if (unit is not None or fkey is not None) and not self.runs(unit, fkey) \
                         or unit is None and fkey is None and f not in self.prog.entry:
                     continue
@@ -283,6 +284,7 @@ class Linker(LinkMembers, Values):
                             item = (t, src, symbols.text(nsv) if nsv is not None else None, unit, pins)
                             if not any(x[0] == t and x[2] == item[2] for x in named):
                                 named.append(item)
+                                out.kinds.append(kind[0] if kind else None)
                             if f not in out.files:
                                 out.files.append(f)
         self.pin({})

@@ -122,6 +122,9 @@ class GraphNode:
     service_clients: list[GraphEdge] = field(default_factory=list)
     action_servers: list[GraphEdge] = field(default_factory=list)
     action_clients: list[GraphEdge] = field(default_factory=list)
+    # a managed (lifecycle) node: rclcpp_lifecycle / rclpy.lifecycle make its management
+    # services and transition events (:mod:`lifecycle`), which are not edges of its code
+    lifecycle: bool = False
 
     def edges_of(self, kind: str) -> list[GraphEdge]:
         """The list an :class:`Endpoint` of ``kind`` ("pub", "sub" or one of ``SERVICE_ROLES``)
@@ -145,6 +148,8 @@ class GraphNode:
         }
         for role in SERVICE_ROLES:
             d[role] = [e.to_json() for e in sorted(getattr(self, role), key=_ek)]
+        if self.lifecycle:
+            d["lifecycle"] = True
         return d
 
 

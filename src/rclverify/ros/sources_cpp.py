@@ -144,7 +144,7 @@ class _File(MemberReader):
         for kind, v, t, h in specs:
             self.emit(kind, None, t, at, h, name=v)
 
-    def node(self, v: symbols.Val, at: Any, ns: symbols.Val = None) -> None:
+    def node(self, v: symbols.Val, at: Any, ns: symbols.Val = None, kind: str | None = None) -> None:
         fn = self.scope.fn_of(at)
         unit = fn.unit if fn is not None else None
         t = symbols.text(v)
@@ -153,7 +153,7 @@ class _File(MemberReader):
             if fn is not None and fn.in_class:
                 self.out["classes"].setdefault(fn.unit, {"nodes": [], "endpoints": []})["nodes"].append(
                     (t, self.src(at)))
-        self.out["node_names"].append((v, self.src(at), unit, fn.key if fn else None, ns))
+        self.out["node_names"].append((v, self.src(at), unit, fn.key if fn else None, ns, kind))
 
     def record(self, kind: str, callee: str, args: list[Any], at: Any) -> None:
         fn = self.scope.fn_of(at)
@@ -166,7 +166,8 @@ class _File(MemberReader):
         head, targs = split_template(type_text.replace("typename", "").strip())
         base = head.split("::")[-1]
         if base in _NODE_TYPES and ("rclcpp" in head or head == base) and args:
-            self.node(self.scope.value(args[0]), at, self.scope.value(args[1]) if len(args) > 1 else None)
+            self.node(self.scope.value(args[0]), at, self.scope.value(args[1]) if len(args) > 1 else None,
+                      "lifecycle" if base == "LifecycleNode" else None)
             return
         if base in _ACTIONLIB and targs and "actionlib" in head + type_text:
             self.actionlib(_ACTIONLIB[base], targs[0], args, at)
@@ -224,7 +225,8 @@ class _File(MemberReader):
         if h.split("<")[0].split("::")[-1] in _NODE_TYPES and ("rclcpp" in h or "::" not in h) and args.named_children:
             a = args.named_children
             self.node(self.scope.value(a[0]), n, self.scope.value(a[1]) if len(a) > 1 and
-                      self.scope.value(a[1]) is not None and self.scope.value(a[1])[0] == "str" else None)
+                      self.scope.value(a[1]) is not None and self.scope.value(a[1])[0] == "str" else None,
+                      "lifecycle" if "LifecycleNode" in h else None)
             return
         self.record("member", h, list(args.named_children), n)
 
@@ -277,7 +279,8 @@ class _File(MemberReader):
             self.construct(targs[0], args, n)
             return
         if full.endswith("Node::make_shared") and args:
-            self.node(s.value(args[0]), n, s.value(args[1]) if len(args) > 1 else None)
+            self.node(s.value(args[0]), n, s.value(args[1]) if len(args) > 1 else None,
+                      "lifecycle" if "LifecycleNode" in full else None)
             return
         if full.endswith("Options::create") or (last == "init" and recv is not None and targs):
             return  # options: read where subscribe(ops) / advertise(ops) uses them

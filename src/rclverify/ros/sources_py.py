@@ -62,6 +62,7 @@ _CTORS = {
     "rclpy.ActionClient": ("action_clients", 2, "action_name", 1, "action_type"),
 }
 _METHODS = {"create_publisher": ("pub", 1, "topic", 0, "msg_type"),
+            "create_lifecycle_publisher": ("pub", 1, "topic", 0, "msg_type"),
             "create_subscription": ("sub", 1, "topic", 0, "msg_type"),
             "create_service": ("service_servers", 1, "srv_name", 0, "srv_type"),
             "create_client": ("service_clients", 1, "srv_name", 0, "srv_type")}
@@ -276,7 +277,8 @@ def extract(mod: PyModule, shown: str) -> dict[str, Any]:
                 if c.func != "super().__init__":
                     out["notes"].append(Note(v.src, "node name is not a string literal: not resolved statically"))
                 continue
-            out["node_names"].append((val, c.src, unit, sc.fn_key(c.src.line), None))
+            life = "lifecycle" if _node_class(mod, sc.class_at(c.src.line), lifecycle=sc.full) else None
+            out["node_names"].append((val, c.src, unit, sc.fn_key(c.src.line), None, life))
             continue
         spec = _CTORS.get(f)
         if spec is None and "actionlib" in f and last in _CTORS:
@@ -328,13 +330,19 @@ def _typed(dotted: str, kind: str) -> str | None:
     return t if t and parts[-2] == "msg" else None
 
 
-def _node_class(mod: PyModule, cls: str | None, depth: int = 0) -> bool:
+def _node_class(mod: PyModule, cls: str | None, depth: int = 0, lifecycle: Any = None) -> bool:
     """Whether class ``cls`` of the file derives from rclpy's ``Node`` (directly or
-    through a class of the same file)."""
+    through a class of the same file); with ``lifecycle`` (the file's import
+    resolver), whether from a lifecycle node (``rclpy.lifecycle.Node``,
+    ``LifecycleNode``)."""
     if cls is None or depth > 5:
         return False
     for b in mod.bases.get(cls.split(".")[-1], []):
-        if b.split(".")[-1] in ("Node", "LifecycleNode") or _node_class(mod, b, depth + 1):
+        if lifecycle is not None and (b.split(".")[-1] == "LifecycleNode" or ".lifecycle." in lifecycle(b) + "."
+                                      and b.split(".")[-1] == "Node"):
+            return True
+        if lifecycle is None and b.split(".")[-1] in ("Node", "LifecycleNode") or \
+                _node_class(mod, b, depth + 1, lifecycle):
             return True
     return False
 
