@@ -10,6 +10,9 @@ A helper member is made where the constructor's initialiser list names it
 (its arguments, its location), else by default at its declaration; a helper
 base class likewise, by the initialiser naming the base, else by default at
 the base clause (``class Diagnostics : private diagnostic_updater::Updater``).
+A helper constructed through a ``typedef`` that another file of the program
+declares (``new ReconfigureServer(private_nh)``) is read through the
+program's aliases.
 """
 from __future__ import annotations
 
@@ -79,6 +82,14 @@ class LinkMembers:
                 for kind, nv, t, hv in self.helper(ty, args) or []:
                     out.append(Endpoint(kind, "", t, at, None, (), unit,
                                         (nv, hv, None, fkey, symbols.text(nv) or last, at), fkey))
+        for kind0, callee, args, fkey, unit, at, *_kw in r.get("calls", []):
+            # a helper made through a typedef another file declares (new Srv(nh), Srv s(nh))
+            alias = self.aliases.get(callee) if kind0 == "ctor" and "::" not in callee else None
+            if alias is None or not self.runs(unit, fkey):
+                continue
+            for kind, nv, t, hv in self.helper(alias, args) or []:
+                out.append(Endpoint(kind, "", t, at, None, (), unit,
+                                    (nv, hv, None, fkey, symbols.text(nv) or callee, at), fkey))
         for unit, m, meth, args, texts, src, fkey in r.get("member_calls", []):
             if not self.runs(unit, fkey):
                 continue
