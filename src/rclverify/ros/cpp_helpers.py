@@ -20,6 +20,7 @@ documented API and source):
 | ``dynamic_reconfigure::Server<Config>([mutex,] [h])`` | through ``h`` (default ``~``): serves ``set_parameters`` (``dynamic_reconfigure/srv/Reconfigure``), publishes ``parameter_descriptions`` (``dynamic_reconfigure/msg/ConfigDescription``) and ``parameter_updates`` (``dynamic_reconfigure/msg/Config``) |
 | ``dynamic_reconfigure::Client<Config>(name, ...)`` | calls ``name/set_parameters``, subscribes ``name/parameter_descriptions`` and ``name/parameter_updates`` |
 | ``self_test::TestRunner([h, [ph]])`` | serves ``self_test`` (``diagnostic_msgs/srv/SelfTest``) through ``ph`` (default ``~``) |
+| ``realtime_tools::RealtimePublisher<T>(h, name, ...)`` / ``.init(h, name, ...)`` (ROS 1) | publishes ``name`` (``T``) through ``h``; ROS 2's ``RealtimePublisher<T>(publisher)`` wraps a publisher already read |
 
 Each spec is ``(role, name value, type, handle value)``; a handle is the
 node handle the helper was given (its namespace applies to the name).
@@ -47,11 +48,11 @@ RECONF = "dynamic_reconfigure/"
 #: helper classes whose construction creates endpoints, by last name part
 CONSTRUCTED = {"TransformBroadcaster", "StaticTransformBroadcaster", "TransformListener", "Subscriber",
                "InteractiveMarkerServer", "ParameterEventHandler", "CameraPublisher", "CameraSubscriber",
-               "Updater", "Server", "Client", "TestRunner"}
+               "Updater", "Server", "Client", "TestRunner", "RealtimePublisher"}
 #: helper methods that create endpoints, by the receiver's class (last name part)
 METHODS = {"ImageTransport": {"advertise", "subscribe", "advertiseCamera", "subscribeCamera"},
            "Subscriber": {"subscribe"}, "AsyncParametersClient": {"on_parameter_event"},
-           "SyncParametersClient": {"on_parameter_event"}}
+           "SyncParametersClient": {"on_parameter_event"}, "RealtimePublisher": {"init"}}
 
 
 def info_topic(image: symbols.Val) -> symbols.Val:
@@ -100,6 +101,8 @@ def constructed(type_text: str, args: list[Any], val: Value, ros2: bool,
         return None
     if last in ("Updater", "Server", "Client", "TestRunner"):
         return _ros1_tools(head, last, [val(a) for a in args])
+    if last == "RealtimePublisher":
+        return _realtime(head, targs, args, val, aliases)
     if last == "TransformBroadcaster" and ("tf" in head or not head.count("::")):
         return [("pub", symbols.lit("/tf"), TF, None)]
     if last == "StaticTransformBroadcaster":
@@ -135,6 +138,18 @@ def _ros1_tools(head: str, last: str, vals: list[symbols.Val]) -> list[Spec] | N
     return None
 
 
+def _realtime(head: str, targs: list[str], args: list[Any], val: Value,
+              aliases: dict[str, str] | None) -> list[Spec] | None:
+    """``realtime_tools::RealtimePublisher<T>(h, name, queue[, latched])`` (ROS 1), or its
+    ``init`` with the same arguments; made with one argument (ROS 2: an existing
+    publisher) or none, it creates nothing of its own."""
+    if "realtime_tools" not in head and "::" in head:
+        return None
+    if len(args) < 2 or not targs:
+        return []
+    return [("pub", val(args[1]), message_type(targs[0], aliases), val(args[0]))]
+
+
 def reconfigure_server(h: symbols.Val) -> list[Spec]:
     """A dynamic_reconfigure server's endpoints through handle ``h``."""
     return [("service_servers", symbols.lit("set_parameters"), RECONF + "srv/Reconfigure", h),
@@ -156,9 +171,15 @@ def method(recv_type: str, name: str, args: list[Any], targs: list[str], val: Va
     """The endpoints a helper's method call creates (receiver of class ``recv_type``,
     made with node handle ``handle``); ``None`` when it is none of :data:`METHODS`."""
     head, rtargs = split_template(recv_type.replace(" ", "").replace("&", "").replace("*", ""))
+    while head.split("::")[-1] in ("shared_ptr", "unique_ptr") and rtargs:  # a helper held by pointer
+        head, rtargs = split_template(rtargs[0].replace("const", ""))
+    for ptr in ("::SharedPtr", "::UniquePtr", "::Ptr", "::ConstSharedPtr"):
+        head = head[: -len(ptr)] if head.endswith(ptr) else head
     last = head.split("::")[-1]
     if name not in METHODS.get(last, ()):
         return None
+    if last == "RealtimePublisher":
+        return _realtime(head, rtargs, args, val, aliases)
     if last == "ImageTransport" and args:
         kind = "pub" if name.startswith("advertise") else "sub"
         return _image(kind, name.endswith("Camera"), val(args[0]), handle)

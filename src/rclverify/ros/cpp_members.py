@@ -86,10 +86,13 @@ class MemberReader:
     def helper_form(self, method: str, args: list[Any]) -> bool:
         """Whether a call without template arguments has the form of a helper's method
         only (never of a node handle's): ``advertise(name, n)``, the camera forms,
-        message_filters' ``subscribe(h, name, ...)``, ``on_parameter_event(cb)``."""
+        message_filters' ``subscribe(h, name, ...)``, ``on_parameter_event(cb)``,
+        a realtime publisher's ``init(h, name, n)``."""
         from .cpp_params import string_value
         if method in ("advertiseCamera", "subscribeCamera", "on_parameter_event"):
             return True
+        if method == "init":  # realtime_tools' pub.init(nh, "topic", 1)
+            return len(args) >= 2 and string_value(args[1]) is not None
         if method == "advertise":
             return len(args) >= 2
         return method == "subscribe" and len(args) >= 2 and (

@@ -289,7 +289,8 @@ class _File(MemberReader):
             rt = s.type_of(recv)
             if rt is not None:
                 specs = cpp_helpers.method(rt, last, args, targs, s.value, s.value(recv), self.aliases)
-            elif not targs and self.helper_form(last, args) and self.deferred_method(recv, last, args, n):
+            elif not targs and self.helper_form(last, args) and self.deferred_method(recv, last, args, n) \
+                    and last != "init":  # obj.init(...) may also be a method of the program's own class
                 return
         if specs is not None:
             self.specs(specs, n)
