@@ -203,3 +203,15 @@ def test_qt_access_specifiers_are_no_syntax_error() -> None:
            b"signals:\n  void changed();\n public Q_SLOTS:\n  void f();\n};\n"
     assert len(prepare(code)) == len(code)
     assert scan_cpp(code, "w.cpp")["notes"] == []
+
+
+@pytest.mark.skipif(not Path("/usr/share/std_srvs/srv").is_dir(), reason="Debian's ros-std-srvs is not installed")
+def test_a_ros2_scan_knows_std_srvs_but_keeps_ros2_messages(tmp_path: Path) -> None:
+    _pkg(tmp_path, "p", {"CMakeLists.txt": "project(p)\nadd_executable(n src/n.cpp)\n",
+                         "src/n.cpp": "class N : public rclcpp::Node {\n public:\n  N() : Node(\"n\") {\n"
+                                      "    create_service<std_srvs::srv::SetBool>(\"enable\", cb);\n  }\n};\n"},
+         ros2=True)
+    res = scan([tmp_path], base=tmp_path)
+    assert res.table.get("std_srvs/srv/SetBool_Request") is not None
+    header = res.table.get("std_msgs/msg/Header")
+    assert header is not None and "seq" not in [f[0] for f in header.fields]  # ROS 2's Header

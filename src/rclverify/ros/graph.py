@@ -169,6 +169,8 @@ def _scan(paths: Sequence[Path], launch: Sequence[Path], launch_args: dict[str, 
     # rosbags' ROS 2 store instead (docs/ros.md).
     if standard and (not pkgs or any(p.ros == 1 for p in pkgs.values())):
         table.add_debian_standard(cache)
+    elif standard:  # rosbags' ROS 2 store has messages only: services of message-less packages (std_srvs)
+        table.add_debian_standard(cache, services_only=True)
     for tname, fname, missing in table.unknown_refs():
         info = table.types[tname]
         g.notes.append(Note(Src(info.file or tname, info.lines.get(fname, 1)),
