@@ -243,13 +243,18 @@ class Linker(LinkMembers, Values):
         out.nodes = [(n, s, ns) for n, s, ns, _u, _p in named]
         units = [u for _n, _s, _ns, u, _p in named]
         got: list[tuple[Endpoint, int]] = []
+        # a header no program of the package includes: its classes are for other packages to
+        # make, with the names they give; what they leave open is not this package's to say
+        unused = self.prog.exe is None and self.prog.units is None and not named and \
+            all(f.rsplit(".", 1)[-1] in ("h", "hh", "hpp", "hxx") for f in self.prog.entry)
+        say = (lambda n: None) if unused else note
         for (f, e), own in zip(raw, self.owners(units, [e for _f, e in raw])):
             # one class made as several nodes (each call site its own name): each instance
             # reads the endpoint with the arguments of its own call site (docs/ros.md)
             group = [j for j, it in enumerate(named) if own >= 0 and it[3] == units[own] and it[4]]
             for j in group if len(group) > 1 else [own]:
                 self.pin(named[j][4] if len(group) > 1 else {})
-                for x in self.resolve(e, note):
+                for x in self.resolve(e, say):
                     if (x, j) not in got:
                         got.append((x, j))
                         if f not in out.files:
