@@ -215,3 +215,19 @@ def test_a_ros2_scan_knows_std_srvs_but_keeps_ros2_messages(tmp_path: Path) -> N
     assert res.table.get("std_srvs/srv/SetBool_Request") is not None
     header = res.table.get("std_msgs/msg/Header")
     assert header is not None and "seq" not in [f[0] for f in header.fields]  # ROS 2's Header
+
+
+def test_camera_info_manager_serves_set_camera_info_through_its_handle() -> None:
+    r = scan_cpp(b'void f() {\n  ros::NodeHandle pnh("~");\n'
+                 b'  camera_info_manager::CameraInfoManager cim(pnh, "cam", "file:///c.yaml");\n}\n', "x.cpp")
+    assert _eps(r) == {("service_servers", "set_camera_info", "sensor_msgs/srv/SetCameraInfo", ("~",))}
+
+
+def test_a_header_no_program_includes_is_not_reported_for_its_callers_names(tmp_path: Path) -> None:
+    _pkg(tmp_path, "lib", {
+        "CMakeLists.txt": "project(lib)\nadd_executable(n src/n.cpp)\n",
+        "src/n.cpp": "int main(int argc, char** argv) {\n  ros::init(argc, argv, \"n\");\n}\n",
+        "include/lib/relay.hpp": "class Relay {\n public:\n  Relay(ros::NodeHandle nh, const std::string& topic)\n"
+                                 "  { pub_ = nh.advertise<std_msgs::String>(topic, 1); }\n  ros::Publisher pub_;\n};\n"})
+    g = scan([tmp_path], base=tmp_path, standard=False).graph
+    assert not [n for n in g.notes if "not a string literal" in n.message] and _edges(g) == set()

@@ -20,6 +20,7 @@ documented API and source):
 | ``dynamic_reconfigure::Server<Config>([mutex,] [h])`` | through ``h`` (default ``~``): serves ``set_parameters`` (``dynamic_reconfigure/srv/Reconfigure``), publishes ``parameter_descriptions`` (``dynamic_reconfigure/msg/ConfigDescription``) and ``parameter_updates`` (``dynamic_reconfigure/msg/Config``) |
 | ``dynamic_reconfigure::Client<Config>(name, ...)`` | calls ``name/set_parameters``, subscribes ``name/parameter_descriptions`` and ``name/parameter_updates`` |
 | ``self_test::TestRunner([h, [ph]])`` | serves ``self_test`` (``diagnostic_msgs/srv/SelfTest``) through ``ph`` (default ``~``) |
+| ``camera_info_manager::CameraInfoManager(h, ...)`` | serves ``set_camera_info`` (``sensor_msgs/srv/SetCameraInfo``) through ``h`` |
 | ``realtime_tools::RealtimePublisher<T>(h, name, ...)`` / ``.init(h, name, ...)`` (ROS 1) | publishes ``name`` (``T``) through ``h``; ROS 2's ``RealtimePublisher<T>(publisher)`` wraps a publisher already read |
 
 Each spec is ``(role, name value, type, handle value)``; a handle is the
@@ -48,7 +49,7 @@ RECONF = "dynamic_reconfigure/"
 #: helper classes whose construction creates endpoints, by last name part
 CONSTRUCTED = {"TransformBroadcaster", "StaticTransformBroadcaster", "TransformListener", "Subscriber",
                "InteractiveMarkerServer", "ParameterEventHandler", "CameraPublisher", "CameraSubscriber",
-               "Updater", "Server", "Client", "TestRunner", "RealtimePublisher"}
+               "Updater", "Server", "Client", "TestRunner", "RealtimePublisher", "CameraInfoManager"}
 #: helper methods that create endpoints, by the receiver's class (last name part)
 METHODS = {"ImageTransport": {"advertise", "subscribe", "advertiseCamera", "subscribeCamera"},
            "Subscriber": {"subscribe"}, "AsyncParametersClient": {"on_parameter_event"},
@@ -103,6 +104,10 @@ def constructed(type_text: str, args: list[Any], val: Value, ros2: bool,
         return _ros1_tools(head, last, [val(a) for a in args])
     if last == "RealtimePublisher":
         return _realtime(head, targs, args, val, aliases)
+    if last == "CameraInfoManager" and head.startswith("camera_info_manager") and args:
+        h = val(args[0])
+        return [("service_servers", symbols.lit("set_camera_info"), "sensor_msgs/srv/SetCameraInfo",
+                 h if h is not None and h[0] == "nh" else None)]
     if last == "TransformBroadcaster" and ("tf" in head or not head.count("::")):
         return [("pub", symbols.lit("/tf"), TF, None)]
     if last == "StaticTransformBroadcaster":
