@@ -231,3 +231,16 @@ def test_a_header_no_program_includes_is_not_reported_for_its_callers_names(tmp_
                                  "  { pub_ = nh.advertise<std_msgs::String>(topic, 1); }\n  ros::Publisher pub_;\n};\n"})
     g = scan([tmp_path], base=tmp_path, standard=False).graph
     assert not [n for n in g.notes if "not a string literal" in n.message] and _edges(g) == set()
+
+
+@pytest.mark.parametrize("py2", [False, True])
+def test_percent_formatting_of_read_names_in_both_python_readers(py2: bool) -> None:
+    src = ("print 'legacy'\n" if py2 else "") + (
+        "import rospy\nROBOT = 'rover'\nrospy.init_node('n')\n"
+        "a = rospy.Publisher('/%s/cmd_vel' % ROBOT, T)\n"
+        "b = rospy.Publisher('%s/%s/scan' % (ROBOT, 'front'), T)\n"
+        "c = rospy.Publisher('%d/x' % 3, T)\n"
+        "d = rospy.Publisher('/%s/pose' % rospy.get_param('~turtle'), T)\n")
+    r = scan_python(src, "x.py")
+    assert [e.topic for e in r["endpoints"]] == ["/rover/cmd_vel", "rover/front/scan"]
+    assert len([n for n in r["notes"] if "not a string literal" in n.message]) == 2

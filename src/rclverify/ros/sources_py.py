@@ -45,7 +45,7 @@ from . import emit, py_helpers, symbols
 from .cpp_types import action_type, service_type
 from .model import Endpoint, Note, Src, canon_type
 from .pyconst import PyScope
-from .pyrecords import PyCall, PyModule, PyVal
+from .pyrecords import PyCall, PyModule, PyVal, percent
 
 
 # (role, index and keyword of the name, index and keyword of the type), by callee
@@ -106,6 +106,10 @@ def _ast_module(tree: ast.AST, shown: str) -> PyModule:
             return PyVal("name", d, loc(e))
         if isinstance(e, ast.BinOp) and isinstance(e.op, ast.Add):
             return PyVal("cat", ast.unparse(e), loc(e), parts=[val(e.left), val(e.right)])
+        if isinstance(e, ast.BinOp) and isinstance(e.op, ast.Mod) and isinstance(e.left, ast.Constant) \
+                and isinstance(e.left.value, str):  # '/%s/pose' % name
+            args = e.right.elts if isinstance(e.right, ast.Tuple) else [e.right]
+            return percent(e.left.value, [val(a) for a in args], ast.unparse(e), loc(e))
         if isinstance(e, ast.JoinedStr):
             parts = [val(x.value) if isinstance(x, ast.FormattedValue) and x.conversion == -1 and x.format_spec is None
                      else val(x) if isinstance(x, ast.Constant) else PyVal("other", ast.unparse(x), loc(e))
