@@ -242,5 +242,26 @@ def test_percent_formatting_of_read_names_in_both_python_readers(py2: bool) -> N
         "c = rospy.Publisher('%d/x' % 3, T)\n"
         "d = rospy.Publisher('/%s/pose' % rospy.get_param('~turtle'), T)\n")
     r = scan_python(src, "x.py")
-    assert [e.topic for e in r["endpoints"]] == ["/rover/cmd_vel", "rover/front/scan"]
-    assert len([n for n in r["notes"] if "not a string literal" in n.message]) == 2
+    assert [e.topic for e in r["endpoints"]] == ["/rover/cmd_vel", "rover/front/scan", ""]
+    assert r["endpoints"][2].param == "~turtle" and r["endpoints"][2].affix == ("/", "/pose")
+    assert len([n for n in r["notes"] if "not a string literal" in n.message]) == 1
+
+
+def test_a_name_built_around_a_parameter_takes_each_launch_value(tmp_path: Path) -> None:
+    _pkg(tmp_path, "tt", {
+        "CMakeLists.txt": "project(tt)\ncatkin_install_python(PROGRAMS nodes/follow.py DESTINATION bin)\n",
+        "nodes/follow.py": "import rospy\nfrom turtlesim.msg import Pose\nrospy.init_node('follow')\n"
+                           "name = rospy.get_param('~turtle')\n"
+                           "rospy.Subscriber('/%s/pose' % name, Pose, cb)\n"
+                           "rospy.Publisher(rospy.get_param('~leader', 'turtle1') + '/cmd_vel', Pose)\n",
+        "launch/two.launch": '<launch>\n<node pkg="tt" type="follow.py" name="a"><param name="turtle" value="t1"/>'
+                             '</node>\n<node pkg="tt" type="follow.py" name="b"><param name="turtle" value="t2"/>'
+                             '<param name="leader" value="t1"/></node>\n</launch>\n'})
+    g = scan([tmp_path], [tmp_path / "tt" / "launch" / "two.launch"], base=tmp_path, standard=False).graph
+    # the code's default alone is not taken for a name built around the parameter
+    assert {(n, t) for n, _r, t, _ty, _at in _edges(g)} == {("/a", "/t1/pose"), ("/b", "/t2/pose"),
+                                                           ("/b", "/t1/cmd_vel")}
+    assert [e.param for e in g.nodes["/b"].subscribes] == ["/b/turtle"]
+    assert [n.message for n in g.notes if n.src.line == 6] == [
+        "publisher topic name is 'rospy.get_param('~leader', 'turtle1') + '/cmd_vel'', not a string literal: "
+        "not resolved statically"]

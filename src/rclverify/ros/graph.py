@@ -239,7 +239,10 @@ def _scan(paths: Sequence[Path], launch: Sequence[Path], launch_args: dict[str, 
                 pname = names.resolve(e.param, ns, full)
                 got = mine.get(pname) or launch_params.get(pname)
                 if got is not None:
-                    written, set_at = got
+                    written, set_at = e.affix[0] + got[0] + e.affix[1], got[1]
+                elif e.unread is not None:
+                    g.notes.append(e.unread)
+                    continue
                 elif not e.topic:
                     g.notes.append(Note(e.src, f"name of {e.kind} comes from parameter {pname}, which has no "
                                                f"default in the code and no value in the launch files: "
