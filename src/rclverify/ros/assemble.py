@@ -93,7 +93,7 @@ class Assembly:
         pkg, _, last = lookup.partition("/")
         progs = [p for p in self.progs.get(pkg, []) if p.nodelet is not None]
         exact = [p for p in progs if p.nodelet == lookup]
-        near = [p for p in progs if p.nodelet.split("/")[-1].split("::")[-1] == last.split("::")[-1]]
+        near = [p for p in progs if (p.nodelet or "").split("/")[-1].split("::")[-1] == last.split("::")[-1]]
         hit = exact or near
         return hit[0] if len(hit) == 1 else None
 
@@ -108,7 +108,8 @@ class Assembly:
                     if all(e.src in named for e, _o in got.endpoints):
                         continue  # the nodelet's code is a node executable's too (its node wrapper)
                     name = prog.nodelet.split("/")[-1].split("::")[-1]
-                    at = self.registered_at(prog) or min(e.src for e, _o in got.endpoints)
+                    at = self.registered_at(prog) or min((e.src for e, _o in got.endpoints),
+                                                         key=lambda x: (x.file, x.line, x.col))
                     g.notes.append(Note(at, f"nodelet {prog.nodelet} is loaded by no launch file: shown as node "
                                             f"/{name} (a launch file gives its name)", "ROS-LAUNCH"))
                     g.notes.extend(got.notes)

@@ -169,14 +169,16 @@ def programs(code: PackageCode, t: Targets) -> list[Program]:
                 plugins[cls] = lib or f"file:{f}"
                 lookups.setdefault(cls, lookup or cls)
     for cls, target in sorted(plugins.items()):
-        srcs = [show(p) for p in t.libraries.get(target, []) + t.executables.get(target, [])] or \
+        lib_srcs = [show(p) for p in t.libraries.get(target, []) + t.executables.get(target, [])] or \
             ([target[5:]] if target.startswith("file:") else [])
-        files = _closure(code, srcs + linked(target, {target}), listed if not target.startswith("file:") else set())
-        exes = [e for e, (c, _l) in t.components.items() if c == cls]
-        for exe in exes or [None]:
-            if exe is not None and exe in t.executables:
+        files = _closure(code, lib_srcs + linked(target, {target}),
+                         listed if not target.startswith("file:") else set())
+        exes: list[str | None] = [e for e, (c, _l) in t.components.items() if c == cls]
+        for comp_exe in exes or [None]:
+            if comp_exe is not None and comp_exe in t.executables:
                 continue
-            out.append(Program(code.name, exe, srcs, files, {_class_named(code, cls)}, nodelet=lookups.get(cls)))
+            out.append(Program(code.name, comp_exe, lib_srcs, files, {_class_named(code, cls)},
+                               nodelet=lookups.get(cls)))
         held.update(files)
     scripts: dict[str, list[str]] = {}
     for exe, paths in t.programs.items():
