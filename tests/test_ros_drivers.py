@@ -265,3 +265,17 @@ def test_a_name_built_around_a_parameter_takes_each_launch_value(tmp_path: Path)
     assert [n.message for n in g.notes if n.src.line == 6] == [
         "publisher topic name is 'rospy.get_param('~leader', 'turtle1') + '/cmd_vel'', not a string literal: "
         "not resolved statically"]
+
+
+def test_a_node_class_made_through_a_factory_is_each_node_with_the_class_endpoints(tmp_path: Path) -> None:
+    _pkg(tmp_path, "fac", {"CMakeLists.txt": "project(fac)\nadd_executable(f src/main.cpp)\n",
+                           "src/main.cpp": "class Wheel : public rclcpp::Node {\n public:\n"
+                                           "  explicit Wheel(const std::string & name) : Node(name) {\n"
+                                           "    create_publisher<std_msgs::msg::Float64>(\"~/speed\", 10);\n  }\n};\n"
+                                           "std::shared_ptr<Wheel> make(const std::string & n) "
+                                           "{ return std::make_shared<Wheel>(n); }\n"
+                                           "int main() {\n  auto a = make(\"left\");\n  auto b = make(\"right\");\n}\n"},
+         ros2=True)
+    g = scan([tmp_path], base=tmp_path, standard=False).graph
+    assert _edges(g) == {("/left", "pub", "/left/speed", "std_msgs/msg/Float64", "main.cpp:4"),
+                         ("/right", "pub", "/right/speed", "std_msgs/msg/Float64", "main.cpp:4")}

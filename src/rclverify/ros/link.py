@@ -251,7 +251,7 @@ class Linker(LinkMembers, Values):
         for (f, e), own in zip(raw, self.owners(units, [e for _f, e in raw])):
             # one class made as several nodes (each call site its own name): each instance
             # reads the endpoint with the arguments of its own call site (docs/ros.md)
-            group = [j for j, it in enumerate(named) if own >= 0 and it[3] == units[own] and it[4]]
+            group = [j for j, it in enumerate(named) if own >= 0 and it[3] == units[own] and it[1] == named[own][1]]
             for j in group if len(group) > 1 else [own]:
                 self.pin(named[j][4] if len(group) > 1 else {})
                 for x in self.resolve(e, say):
