@@ -279,3 +279,14 @@ def test_a_node_class_made_through_a_factory_is_each_node_with_the_class_endpoin
     g = scan([tmp_path], base=tmp_path, standard=False).graph
     assert _edges(g) == {("/left", "pub", "/left/speed", "std_msgs/msg/Float64", "main.cpp:4"),
                          ("/right", "pub", "/right/speed", "std_msgs/msg/Float64", "main.cpp:4")}
+
+
+def test_an_actionlib_client_through_a_typedef_under_using_namespace(tmp_path: Path) -> None:
+    _pkg(tmp_path, "at", {"CMakeLists.txt": "project(at)\nadd_executable(c src/c.cpp)\n",
+                          "src/c.cpp": "#include <actionlib/client/simple_action_client.h>\nusing namespace std;\n"
+                                       "using namespace at_msgs;\n"
+                                       "typedef actionlib::SimpleActionClient<DockAction> Client;\n"
+                                       "int main(int argc, char** argv) {\n  ros::init(argc, argv, \"docker\");\n"
+                                       "  Client ac(\"dock\", true);\n}\n"})
+    g = scan([tmp_path], base=tmp_path, standard=False).graph
+    assert _edges(g) == {("/docker", "action_clients", "/dock", "at_msgs/action/Dock", "c.cpp:7")}

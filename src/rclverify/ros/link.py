@@ -71,6 +71,7 @@ class Linker(LinkMembers, Values):
         self.callbacks: dict[str, str] = {}
         self.aliases: dict[str, str] = {}
         self.calls: list[tuple[Any, ...]] = []
+        self.using_ns = sorted({ns for r in self.recs.values() for ns in r.get("using_ns", [])})
         entry_units: set[str] = set()
         for f, r in self.recs.items():
             for k, (unit, params, ptypes, defaults) in r.get("fns", {}).items():

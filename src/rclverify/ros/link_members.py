@@ -19,7 +19,7 @@ from __future__ import annotations
 from typing import Any, Callable
 
 from . import cpp_helpers, symbols
-from .cpp_types import action_type, message_type, service_type, split_template
+from .cpp_types import action_type, action_type_in, message_type, service_type, split_template
 from .model import Endpoint
 
 _ACTIONLIB = {"SimpleActionServer": "action_servers", "ActionServer": "action_servers",
@@ -34,6 +34,7 @@ class LinkMembers:
     callbacks: dict[str, str]
     aliases: dict[str, str]
     known: Callable[[str], bool]
+    using_ns: list[str]  # the program's ``using namespace`` directives
 
     def runs(self, unit: str | None, fkey: str | None, reach: set[str] | None = None) -> bool:  # pragma: no cover
         raise NotImplementedError
@@ -115,7 +116,8 @@ class LinkMembers:
             if not args:
                 return []
             first = args[0]
+            t = action_type_in(targs[0], self.using_ns)
             if len(args) >= 2 and first is not None and first[0] in ("nh", "field", "arg"):
-                return [(_ACTIONLIB[last], args[1], action_type(targs[0]), first)]
-            return [(_ACTIONLIB[last], first, action_type(targs[0]), None)]
+                return [(_ACTIONLIB[last], args[1], t, first)]
+            return [(_ACTIONLIB[last], first, t, None)]
         return cpp_helpers.constructed(ty, args, lambda x: x, False, self.aliases)

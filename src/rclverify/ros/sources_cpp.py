@@ -41,7 +41,7 @@ from .cpp_prep import REGISTER, prepare
 from .nodelets import registered
 from .cpp_scope import base_name, callee_parts, namespaces_of
 from .cpp_values import CppValues
-from .cpp_types import action_type, callback_name, message_type, service_type, split_template
+from .cpp_types import action_type, action_type_in, callback_name, message_type, service_type, split_template
 from .model import Note, Src, canon_type
 
 __all__ = ["scan_cpp", "action_type", "service_type"]
@@ -185,7 +185,7 @@ class _File(MemberReader):
         first_handle = len(args) >= 2 and self.scope.is_handle(args[0])
         name_arg = args[1] if first_handle else args[0]
         h = self.scope.value(args[0]) if first_handle else None
-        self.emit(kind, name_arg, action_type(self.aliases.get(ty, ty)), at, h)
+        self.emit(kind, name_arg, action_type_in(self.aliases.get(ty, ty), self.scope.using_ns), at, h)
 
     # -- the walk
     def run(self) -> dict[str, Any]:
