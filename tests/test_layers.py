@@ -71,6 +71,10 @@ LAYERS: list[tuple[str, tuple[str, ...]]] = [
     # assemble.py) that uses them: programs.py, link.py, link_values.py,
     # symbols.py, emit.py, cpp_scope.py, cpp_values.py, cpp_types.py,
     # cpp_prep.py, cpp_helpers.py, py_helpers.py, pyconst.py, namespaces.py;
+    # and the drivers' idioms: unit_names.py (classes defined out of line through
+    # using/typedef), cpp_members.py and link_members.py (helpers held as members
+    # and base classes), nodelets.py (ROS 1 nodelets), lifecycle.py (the
+    # management interface of lifecycle nodes, for the grounding);
     # they import only ros/ modules, the standard library and tree-sitter.
     # ros/dds.py, ros/dds_qos.py, ros/dds_discovery.py, ros/diff_dds.py: ROS 2's
     # conventions on DDS (names, the participant and node announcements, QoS

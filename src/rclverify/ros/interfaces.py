@@ -156,16 +156,22 @@ class TypeTable:
                     if f.suffix in (".msg", ".srv", ".action", ".idl") and f.is_file():
                         self.add_file(f, pkg, show(f), origin, cache, files)
 
-    def add_debian_standard(self, cache: ParseCache | None, share: Path = DEBIAN_SHARE) -> list[str]:
+    def add_debian_standard(self, cache: ParseCache | None, share: Path = DEBIAN_SHARE,
+                            services_only: bool = False) -> list[str]:
         """Register the interface packages Debian installed (``/usr/share/<pkg>/msg``,
         ``srv`` and ``action`` for a ``<pkg>`` with a ``package.xml`` or named ``*_msgs``
-        or ``*_srvs``, e.g. ``std_srvs``, which has no message); returns their names."""
+        or ``*_srvs``, e.g. ``std_srvs``, which has no message); returns their names.
+        ``services_only``: only packages that define no message (``std_srvs``), whose
+        services read the same in ROS 1 and ROS 2 (any message they use comes from
+        the ROS 2 store), for a scan of ROS 2 packages only (docs/ros.md)."""
         found: list[str] = []
         if not share.is_dir():
             return found
         roots = {p.parent for sub in ("msg", "srv", "action") for p in share.glob(f"*/{sub}")}
         for root in sorted(roots):
             if not ((root / "package.xml").is_file() or root.name.endswith(("_msgs", "_srvs"))):
+                continue
+            if services_only and (root / "msg").is_dir():
                 continue
             if root.name not in {p.split("/")[0] for p in self.types}:
                 self.add_package_dir(root, root.name, lambda f: f"{root.name}/{f.parent.name}/{f.name}",
