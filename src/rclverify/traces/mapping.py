@@ -152,7 +152,17 @@ class RuleError(ValueError):
         self.path = path
 
 
-def load_rules(raw: Any) -> dict[str, TopicRule]:
+class RuleSet(dict):  # type: ignore[type-arg]
+    """The mapping file's topic rules (topic -> :class:`TopicRule`) and its
+    ``tolerance`` of recorded numbers (``None``: none declared; else a
+    :class:`rclverify.logic.floatsem.Tolerance`, set by the mapping's loader),
+    which every monitor given these rules applies (docs/monitors.md,
+    "Numbers on the wire")."""
+
+    tolerance: Any = None
+
+
+def load_rules(raw: Any) -> RuleSet:
     """Topic rules from the plan's ``topics`` mapping (``{topic: {fields, update, default, state}}``):
     ``fields`` a list of field names, ``update`` ``accumulate`` or ``replace``,
     ``state`` a boolean (default false).
@@ -161,7 +171,7 @@ def load_rules(raw: Any) -> dict[str, TopicRule]:
     key at fault for a malformed rule (``topics`` not a mapping, ``fields``
     not a list of names, an unknown ``update``).
     """
-    out: dict[str, TopicRule] = {}
+    out = RuleSet()
     if raw is not None and not isinstance(raw, Mapping):
         raise RuleError(f"topics must map each topic to its rule, not {raw!r}", "topics")
     for topic, spec in (raw or {}).items():
