@@ -72,12 +72,18 @@ LAYERS: list[tuple[str, tuple[str, ...]]] = [
     # symbols.py, emit.py, cpp_scope.py, cpp_values.py, cpp_types.py,
     # cpp_prep.py, cpp_helpers.py, py_helpers.py, pyconst.py, namespaces.py;
     # they import only ros/ modules, the standard library and tree-sitter.
+    # logic/floatsem.py (issue 40): a formula judged on recorded values in
+    # exact, IEEE-754 double or tolerant arithmetic, built on the evaluator
+    # and Z3's concrete check beside it; the monitors (backends) call it.
     ("system/logic", ("rclverify.system", "rclverify.logic", "rclverify.ros")),
     # requirements/: formal requirements decided from the composed contracts
     # (check.py, beside the calculus it builds on) and their roll-up with the
     # evidence (rollup.py); its stage (stage.py) sits with the workspace it
     # writes into, its terminal listing (show.py) with the commands.
     ("calculus/health", ("rclverify.calculus", "rclverify.health", "rclverify.requirements")),
+    # backends/monitors/fieldpaths.py (issue 40): a mapping's field paths
+    # checked against the message definitions through ros/interfaces.py (the
+    # grounding's reader, a lower layer); entry_checks.py calls it.
     ("backends", ("rclverify.backends",)),
     # diagnosis/: each problem of the report explained and repairs checked by
     # re-running the calculus, health checks and Hoare triples on edited text
