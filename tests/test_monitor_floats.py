@@ -272,3 +272,36 @@ def test_judge_equals_the_semantics_read_directly(f: Any, r: float, d: float, to
     else:
         assert j.truth is True, (text, v, j)
         assert j.semantics == expected, (text, v, j)  # exact first, then double, then the tolerance
+
+
+def test_the_evidence_and_the_report_name_the_semantics(tmp_path: Path) -> None:
+    """``rclverify verify`` on a workspace whose recorded run needs double
+    arithmetic (Scale) and a declared tolerance (Clamp, plan entry)."""
+    from rclverify.cli import main
+    ws = tmp_path / "ws"
+    (ws / "contracts").mkdir(parents=True)
+    (ws / "contracts" / "scale.rcl").write_text(SCALE)
+    runs = ws / "runs"
+    runs.mkdir()
+    _log(runs, RUN[:4] + RUN[-1:])
+    (runs / "clamp.jsonl").write_text("".join(json.dumps(x) + "\n" for x in (
+        {"topic": "a", "time": 0.0, "data": 1.0}, {"topic": "x", "time": 0.1, "data": 30.000000000000004},
+        {"topic": "a", "time": 9.0, "data": 2.0}, {"topic": "x", "time": 9.1, "data": 3.0})))
+    (ws / "contracts" / "plan.yaml").write_text(
+        "name: floats\ncontracts: [contracts/scale.rcl]\nnodes:\n"
+        "  Scale:\n    evidence:\n      - backend: monitors\n        traces: [runs/run.jsonl]\n"
+        "  Clamp:\n    evidence:\n      - backend: monitors\n        tolerance: {abs: 1.0e-9}\n"
+        "        traces: [runs/clamp.jsonl]\n")
+    main(["verify", "-w", str(ws)])
+    ev = json.loads((ws / "artifacts" / "evidence" / "Scale.g0.monitors.run_jsonl.json").read_text())
+    assert ev["status"] == "discharged", ev["explanation"]
+    m = ev["details"]["monitoring"]
+    assert m["semantics"] == {"exact": 0, "double": 2, "tolerance": 0} and m["first_inexact"]["semantics"] == "double"
+    assert m["assumption"]["verdict"] == "held" and m["tolerance"] is None
+    assert "2 only in the node's double arithmetic" in ev["explanation"]
+    assert ev["details"]["deadlines"]["counts"]["true"] == 2
+    clamp = json.loads((ws / "artifacts" / "evidence" / "Clamp.g0.monitors.clamp_jsonl.json").read_text())
+    assert clamp["status"] == "discharged" and clamp["details"]["monitoring"]["semantics"]["tolerance"] == 1
+    assert clamp["details"]["monitoring"]["tolerance"] == {"abs": 1e-9, "rel": 0.0, "ulps": 0}
+    md = (ws / "reports" / "assurance.md").read_text()
+    assert "held only in the node's double arithmetic" in md and "held only within the tolerance" in md

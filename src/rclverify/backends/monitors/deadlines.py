@@ -51,6 +51,7 @@ from typing import Any, Callable, Iterable, Mapping
 
 from ...logic.floatsem import Tolerance, judge
 from ...rcl import ast
+from ...rcl.printer import expr_to_rcl
 from ...rcl.timing import seconds
 from ...rcl.types import Checked, CheckedNode
 from ...rcl.walk import subexpressions
@@ -243,7 +244,6 @@ class DeadlineMonitor:
     def _refused(self, inputs: Mapping[str, Any]) -> tuple[str, str] | None:
         """Why the node's assumption does not accept ``inputs`` (``(kind,
         reason)``, kind one of :data:`UNACCEPTED`), ``None`` when it does."""
-        from ...rcl.printer import expr_to_rcl
         for formula in self.assumption:
             j = judge(formula, self.checked, self.node, inputs, self.tolerance)
             if j.truth is True:
