@@ -132,7 +132,7 @@ def ulp_distance(a: float, b: float) -> int:
         return 1 << 64
 
     def ordered(x: float) -> int:
-        i = struct.unpack("<q", struct.pack("<d", x))[0]
+        i: int = struct.unpack("<q", struct.pack("<d", x))[0]
         return i if i >= 0 else -(i & 0x7FFFFFFFFFFFFFFF)
     return abs(ordered(a) - ordered(b))
 
@@ -273,7 +273,7 @@ class _Double(Evaluator):
         return x / y
 
     def compare(self, e: ast.Compare, b: Mapping[str, Any], op: str, x: Any, y: Any) -> bool:
-        return _CMP[op](_double(x), _double(y))
+        return bool(_CMP[op](_double(x), _double(y)))
 
     def quant(self, e: ast.Quant, b: Mapping[str, Any]) -> bool:
         return _enumerate(self, e, b)
@@ -288,7 +288,7 @@ class _Tolerant(Evaluator):
 
     def compare(self, e: ast.Compare, b: Mapping[str, Any], op: str, x: Any, y: Any) -> bool:
         if not (_number(x) and _number(y)) or not _reads_io(e, b, self.io_names):
-            return _CMP[op](x, y)
+            return bool(_CMP[op](x, y))
         close = self.tolerance.close(x, y)
         if op == "==":
             return close
