@@ -74,7 +74,8 @@ LAYERS: list[tuple[str, tuple[str, ...]]] = [
     # they import only ros/ modules, the standard library and tree-sitter.
     # logic/floatsem.py (issue 40): a formula judged on recorded values in
     # exact, IEEE-754 double or tolerant arithmetic, built on the evaluator
-    # and Z3's concrete check beside it; the monitors (backends) call it.
+    # and Z3's concrete check beside it, with logic/floatsens.py (which
+    # formulas those semantics can change); the monitors (backends) call it.
     ("system/logic", ("rclverify.system", "rclverify.logic", "rclverify.ros")),
     # requirements/: formal requirements decided from the composed contracts
     # (check.py, beside the calculus it builds on) and their roll-up with the
