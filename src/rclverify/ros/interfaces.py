@@ -230,7 +230,7 @@ class TypeTable:
 
 
 def field_path(table: TypeTable, msg_type: str, path: str) -> tuple[str | None, str | None, bool]:
-    """Follow ``path`` (``a.b[2].c``, ``a.b[].c``, ``a.b``) through ``msg_type``.
+    """Follow ``path`` (``a.b[2].c``, ``a.b[-1].c``, ``a.b[].c``, ``a.b``) through ``msg_type``.
 
     Returns ``(ros_type, error, is_array)``: the field's ROS type (``float32``,
     ``pkg/msg/T``) and whether the final field is an array, or an error text
@@ -239,7 +239,7 @@ def field_path(table: TypeTable, msg_type: str, path: str) -> tuple[str | None, 
     cur = msg_type
     is_array = False
     for seg in path.split("."):
-        m = re.fullmatch(r"([A-Za-z_][A-Za-z0-9_]*)((?:\[\d*\])*)", seg)
+        m = re.fullmatch(r"([A-Za-z_][A-Za-z0-9_]*)((?:\[-?\d*\])*)", seg)
         if not m:
             return None, f"'{seg}' is not a field name", False
         fname, index = m.group(1), m.group(2)
