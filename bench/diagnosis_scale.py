@@ -43,7 +43,7 @@ from typing import Sequence
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from _reference import reference_cpu  # noqa: E402
+from _reference import ITERATIONS, reference_cpu  # noqa: E402
 
 SRC = Path(__file__).resolve().parents[1] / "src"
 
@@ -117,7 +117,8 @@ def main(argv: Sequence[str] | None = None) -> int:
             if root.exists():
                 shutil.rmtree(root)
             write_workspace(root, n)
-            ref = reference_cpu()
+            # smoke: a tenth of the loop, scaled (an estimate; the figures of a smoke run are not compared)
+            ref = reference_cpu(ITERATIONS // 10) * 10 if a.smoke else reference_cpu()
             r = verify(root, Path(a.src) if a.src else SRC)
             if not (root / "reports" / "assurance.json").is_file():
                 print(f"{n:>6}  verify wrote no report (exit {r['rc']}):\n{r['out']}")
