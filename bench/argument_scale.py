@@ -16,6 +16,7 @@ asserted.
 Usage::
 
     PYTHONPATH=src python3 bench/argument_scale.py [--sizes 4,16,64]
+    PYTHONPATH=src python3 bench/argument_scale.py --smoke    # N = 2, 4: a few seconds
 """
 from __future__ import annotations
 
@@ -67,7 +68,9 @@ def cpu(fn: Any) -> tuple[float, Any]:
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--sizes", default="4,16,64")
-    sizes = [int(x) for x in ap.parse_args().sizes.split(",")]
+    ap.add_argument("--smoke", action="store_true", help="N = 2 and 4 only: a few seconds (CI)")
+    args = ap.parse_args()
+    sizes = [2, 4] if args.smoke else [int(x) for x in args.sizes.split(",")]
     print(f"{'nodes':>6} {'elements':>9} {'build s':>8} {'yaml s':>7} {'dot-text s':>10} {'dot layout s':>12}")
     for n in sizes:
         rep = synthetic_report(n)

@@ -12,6 +12,7 @@ it).  Figures are printed, not asserted; expect +-25% on a shared machine.
 Usage::
 
     PYTHONPATH=src python3 bench/gwendolen_explore.py [--repeat 3] [--after move|action] [--max-states N]
+    PYTHONPATH=src python3 bench/gwendolen_explore.py --smoke    # one run: a few seconds
 """
 from __future__ import annotations
 
@@ -32,7 +33,10 @@ def main() -> None:
     ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--after", default="move", help="'move' (the case study) or 'action' (every action)")
     ap.add_argument("--max-states", type=int, default=100_000)
+    ap.add_argument("--smoke", action="store_true", help="one run of the case study's graph (CI)")
     args = ap.parse_args()
+    if args.smoke:
+        args.repeat, args.after = 1, "move"
     after = "action" if args.after == "action" else [args.after]
     env = environment_from_plan({"percepts": PERCEPTS, "after": after, "at_most": 1})
     best = float("inf")

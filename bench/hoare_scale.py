@@ -20,6 +20,7 @@ Usage::
 
     python bench/hoare_scale.py --nodes 1000
     python bench/hoare_scale.py --workspace DIR --profile hoare.prof
+    python bench/hoare_scale.py --smoke                 # 3 nodes: a few seconds
 """
 from __future__ import annotations
 
@@ -52,7 +53,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     ap.add_argument("--nodes", type=int, default=1000, help="nodes of the generated system (default 1000)")
     ap.add_argument("--workspace", help="an existing workspace to use instead of generating one")
     ap.add_argument("--profile", help="write a cProfile of the export and run stages to this file")
+    ap.add_argument("--smoke", action="store_true", help="3 nodes only: a few seconds (CI)")
     args = ap.parse_args(argv)
+    if args.smoke:
+        args.nodes = 3
     tmp = None
     if args.workspace:
         root = Path(args.workspace)

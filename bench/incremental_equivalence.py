@@ -11,6 +11,7 @@ mismatches (0 expected) and the time taken::
 
     python3 bench/incremental_equivalence.py                 # 200 sequences, 2 at a time
     python3 bench/incremental_equivalence.py --sequences 20 --jobs 1 --seed 3
+    python3 bench/incremental_equivalence.py --smoke     # one sequence of one edit (CI)
 """
 from __future__ import annotations
 
@@ -54,7 +55,10 @@ def main() -> int:
     ap.add_argument("--length", type=int, default=2, help="most edits in one sequence")
     ap.add_argument("--jobs", type=int, default=2)
     ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--smoke", action="store_true", help="one sequence of one edit, in this process's pool of one (CI)")
     args = ap.parse_args()
+    if args.smoke:
+        args.sequences, args.length, args.jobs = 1, 1, 1
     t0 = time.perf_counter()
     with tempfile.TemporaryDirectory(prefix="rclverify-incremental-") as tmp:
         base = inc.make_workspace(Path(tmp) / "base" / "ws")

@@ -12,6 +12,7 @@ at the end.
 Usage::
 
     python3 bench/monitor_fuzz.py [--lines 1000000] [--damage 0.05]
+    python3 bench/monitor_fuzz.py --smoke      # 2,000 lines: a few seconds
 """
 from __future__ import annotations
 
@@ -62,7 +63,10 @@ def main() -> int:
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--lines", type=int, default=1_000_000)
     p.add_argument("--damage", type=float, default=0.05)
+    p.add_argument("--smoke", action="store_true", help="2,000 lines only: a few seconds (CI)")
     a = p.parse_args()
+    if a.smoke:
+        a.lines = 2_000
     from rclverify.backends.monitors.check import check_trace
     from rclverify.backends.monitors.config import load_mapping
     from rclverify.rcl.typecheck import load

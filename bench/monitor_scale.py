@@ -28,6 +28,7 @@ a one-million-event bag in under 60 s.  The figures are printed, not
 asserted.  Usage::
 
     python3 bench/monitor_scale.py [--events 50000] [--bag --bag-events 1000000 --bag-nodes RadiationSensor]
+    python3 bench/monitor_scale.py --smoke     # 1,000 events and a bag of 1,000: a few seconds
 """
 from __future__ import annotations
 
@@ -99,7 +100,10 @@ def main() -> int:
     ap.add_argument("--bag-nodes", nargs="*", default=None)
     ap.add_argument("--no-cache", action="store_true",
                     help="evaluate every formula afresh (the synthetic run repeats states, which the cache exploits)")
+    ap.add_argument("--smoke", action="store_true", help="1,000 events, a bag of 1,000 messages (CI)")
     args = ap.parse_args()
+    if args.smoke:
+        args.events, args.bag, args.bag_events = 1_000, True, 1_000
     if args.no_cache:
         from rclverify.backends.monitors.check import NodeMonitor
         NodeMonitor.cache_size = 0

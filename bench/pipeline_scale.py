@@ -35,6 +35,17 @@ Usage::
     python bench/pipeline_scale.py --sizes 10,100 -n 2 # quick run, doit -n 2
     python bench/pipeline_scale.py --keep DIR          # keep the workspaces under DIR
     python bench/pipeline_scale.py --hoare 0 --property-tests 0   # calculus and health only
+    python bench/pipeline_scale.py --smoke             # N = 2, no property tests: a few seconds
+    python bench/pipeline_scale.py --case-study [--compare OLD_SRC] [--repeat K]
+
+``--case-study`` measures instead a cold ``doit verify`` of the bundled case
+study (its contracts, plan, backends' inputs and ``dodo.py`` copied to a
+temporary directory), CPU seconds of doit and its children (SPIN, gcc,
+Dafny, ...), and, in the same process just before each run, a fixed
+pure-Python reference loop (``bench/_reference.py``): the CPU as a multiple
+of the loop is the figure comparable across machines and loads (issue 44).
+With ``--compare OLD_SRC`` each code runs on its own copy, alternating, and
+the ratio new/old of the multiples is printed.
 
 The figures are printed, not asserted.
 """
@@ -54,6 +65,12 @@ from pathlib import Path
 from typing import Sequence
 
 import yaml
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+from _reference import reference_cpu  # noqa: E402
+
+REPO = Path(__file__).resolve().parents[1]
 
 CLAMP = """\
 // A clamp: y is x when x is not negative, else 0.  The synthetic nodes of
@@ -255,8 +272,15 @@ def main(argv: Sequence[str] | None = None) -> int:
     ap.add_argument("--src", metavar="NEW_SRC", help="the source tree to measure (default: the installed rclverify)")
     ap.add_argument("--repeat", type=int, default=1, metavar="K",
                     help="with --compare: K no-op runs and K edits (the constant toggled) per code, alternating; "
-                         "the medians are printed (default 1)")
+                         "the medians are printed (default 1); with --case-study: K cold runs per code")
+    ap.add_argument("--smoke", action="store_true", help="N = 2 without property tests: a few seconds (CI)")
+    ap.add_argument("--case-study", action="store_true",
+                    help="a cold `doit verify` of the bundled case study, as a multiple of the reference loop")
     args = ap.parse_args(argv)
+    if args.case_study:
+        return case_study(args)
+    if args.smoke:
+        args.sizes, args.property_tests = ["2"], 0
     sizes = _sizes(args.sizes)
     if args.compare:
         return compare(sizes, args)
@@ -291,6 +315,65 @@ def main(argv: Sequence[str] | None = None) -> int:
             shutil.rmtree(base, ignore_errors=True)
     print("cold/no-op/edit: wall-clock seconds of one `doit verify`; (cpu): CPU seconds (user+sys) of doit and its "
           "children; MB: peak RSS of the largest process; ran: tasks the no-op run executed (0 expected).")
+    return 0
+
+
+#: What a copy of the case study needs to run `doit verify` (workspace-relative).
+CASE_STUDY = ("dodo.py", "contracts", "backends", "ros")
+
+
+def copy_case_study(dest: Path) -> None:
+    """The bundled case study's inputs under ``dest`` (new), without artifacts or reports."""
+    for rel in CASE_STUDY:
+        src = REPO / rel
+        if src.is_dir():
+            shutil.copytree(src, dest / rel, symlinks=True)
+        elif src.exists():
+            dest.mkdir(parents=True, exist_ok=True)
+            shutil.copy2(src, dest / rel)
+    for rel in ("artifacts", "reports"):
+        (dest / rel).mkdir(parents=True, exist_ok=True)
+
+
+def case_study(args: argparse.Namespace) -> int:
+    """Cold `doit verify` of the case study: CPU seconds and their multiple of the reference loop,
+    for this tree (``--src`` or the installed one) and, with ``--compare``, the old one, alternating."""
+    trees = {"new": args.src} if not args.compare else {"old": args.compare, "new": args.src}
+    base = Path(args.keep) if args.keep else Path(tempfile.mkdtemp(prefix="rclverify-casestudy-"))
+    print(f"case study, cold `doit verify`, {os.cpu_count()} CPU(s); "
+          + ", ".join(f"{k}: {v or 'installed'}" for k, v in trees.items()))
+    print(f"{'code':>5} {'run':>3} {'cpu s':>7} {'ref s':>6} {'cpu/ref':>8} {'wall s':>7}  overall")
+    ratios: dict[str, list[float]] = {k: [] for k in trees}
+    order = list(trees)
+    try:
+        for k in range(max(1, args.repeat)):
+            for name in order:
+                root = base / f"{name}{k}"
+                if root.exists():
+                    shutil.rmtree(root)
+                copy_case_study(root)
+                ref = reference_cpu()
+                r = doit_verify(root, args.jobs, trees[name])
+                overall = next((ln.strip() for ln in r.output.splitlines() if "overall" in ln), f"exit {r.rc}")
+                if not (root / "reports" / "assurance.json").is_file():
+                    print(f"{name:>5} {k:>3}  no report (exit {r.rc}):\n{r.output[-3000:]}")
+                    return 1
+                ratios[name].append(r.cpu / ref)
+                print(f"{name:>5} {k:>3} {r.cpu:>7.1f} {ref:>6.2f} {r.cpu / ref:>8.1f} {r.seconds:>7.1f}  {overall[:60]}",
+                      flush=True)
+                if not args.keep:
+                    shutil.rmtree(root, ignore_errors=True)
+            order.reverse()
+    finally:
+        if not args.keep:
+            shutil.rmtree(base, ignore_errors=True)
+    med = {name: sorted(v)[(len(v) - 1) // 2] for name, v in ratios.items()}
+    for name, m in med.items():
+        print(f"median cpu/ref ({name}): {m:.1f}")
+    if "old" in med:
+        print(f"new/old: {med['new'] / med['old']:.2f} (the issue's aim: at most 0.50)")
+    print("cpu s: CPU seconds (user+sys) of doit and its children; ref s: the reference loop (bench/_reference.py) "
+          "in this process just before the run; cpu/ref: the figure comparable across machines and loads.")
     return 0
 
 

@@ -24,6 +24,7 @@ may be shared; CPU seconds do not count other processes' load).
 Usage::
 
     python bench/property_tests.py [--examples 200] [--root .]
+    python bench/property_tests.py --smoke     # 5 examples: a few seconds
 """
 from __future__ import annotations
 
@@ -42,7 +43,10 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--examples", type=int, default=200)
     ap.add_argument("--root", type=Path, default=Path(__file__).resolve().parents[1])
+    ap.add_argument("--smoke", action="store_true", help="5 examples per guarantee: a few seconds (CI)")
     args = ap.parse_args()
+    if args.smoke:
+        args.examples = 5
     ws = Workspace(args.root)
     print(f"{'node':<16} {'guarantee':>9} {'mode':>8} {'status':>12} {'checked':>8} {'failing':>8} "
           f"{'seconds':>8} {'ex/s':>8} {'cpu_s':>8} {'ex/cpu_s':>8}")

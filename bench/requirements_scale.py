@@ -29,6 +29,7 @@ Usage::
 
     python bench/requirements_scale.py                       # 100 chains x 10 = 1000 nodes
     python bench/requirements_scale.py --chains 5 --depth 4  # a quick run
+    python bench/requirements_scale.py --smoke               # 2 chains of 3: a few seconds
 
 Wall-clock and CPU seconds are printed, not asserted.
 """
@@ -99,7 +100,10 @@ def main() -> int:
     ap.add_argument("--keep", help="write the workspace here and keep it")
     ap.add_argument("--temporal", action="store_true",
                     help="temporal requirements instead (always ..., a cone of 5-10 nodes each; docs/requirements.md)")
+    ap.add_argument("--smoke", action="store_true", help="2 chains of depth 3: a few seconds (CI)")
     a = ap.parse_args()
+    if a.smoke:
+        a.chains, a.depth = 2, 3
     root = Path(a.keep) if a.keep else Path(tempfile.mkdtemp(prefix="reqscale-")) / "ws"
     if root.exists():
         shutil.rmtree(root)

@@ -28,6 +28,11 @@ graph nodes with a source in the scanned directories).
 Usage::
 
     PYTHONPATH=src python3 bench/ros_real.py CHECKOUT --truth bench/data/ros_real_X.json [CHECKOUT --truth ...]
+    PYTHONPATH=src python3 bench/ros_real.py --smoke    # a two-node package written here, its truth known
+
+``--smoke`` needs no checkout: it writes a catkin package of two rospy
+nodes (a publisher with a name computed at run time, a service server and
+a subscriber) and measures it against the call sites it was written with.
 
 Figures are printed, not asserted.
 """
@@ -35,6 +40,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import tempfile
 from pathlib import Path
 
 from rclverify.ros.graph import scan
@@ -97,14 +103,54 @@ def _row(label: str, what: str, e: int, f: int, m: int, right: int | None = None
     return f"{label:<40} {what:<14} {e:>8} {f:>6} {m:>7} {rec:>7} {prec:>9}"
 
 
+SMOKE_FILES = {
+    "package.xml": '<?xml version="1.0"?>\n<package format="2"><name>smoke_pkg</name><version>0.1.0</version>'
+                   '<description>bench smoke</description><maintainer email="dev@example.org">dev</maintainer>'
+                   '<license>MIT</license><buildtool_depend>catkin</buildtool_depend><depend>rospy</depend>'
+                   '<depend>std_msgs</depend><depend>std_srvs</depend></package>\n',
+    "CMakeLists.txt": "cmake_minimum_required(VERSION 3.0.2)\nproject(smoke_pkg)\nfind_package(catkin REQUIRED)\n"
+                      "catkin_package()\ncatkin_install_python(PROGRAMS scripts/talker.py scripts/listener.py\n"
+                      "  DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})\n",
+    "scripts/talker.py": "#!/usr/bin/env python3\nimport sys\nimport rospy\nfrom std_msgs.msg import String\n"
+                         "from std_srvs.srv import Trigger\n\n"
+                         "if __name__ == '__main__':\n"
+                         "    rospy.init_node('talker')\n"
+                         "    pub = rospy.Publisher('chatter', String, queue_size=1)\n"
+                         "    extra = rospy.Publisher(sys.argv[1], String, queue_size=1)\n"
+                         "    srv = rospy.Service('reset', Trigger, lambda req: None)\n"
+                         "    rospy.spin()\n",
+    "scripts/listener.py": "#!/usr/bin/env python3\nimport rospy\nfrom std_msgs.msg import String\n\n"
+                           "if __name__ == '__main__':\n"
+                           "    rospy.init_node('listener')\n"
+                           "    rospy.Subscriber('chatter', String, lambda m: None)\n"
+                           "    rospy.spin()\n",
+}
+#: The call sites the smoke package was written with (the module docstring's shape).
+SMOKE_TRUTH = {"repository": "smoke_pkg (written by --smoke)", "scan": ["."], "launch": [], "nodes": [],
+               "sites": [["scripts/talker.py", 9, "/talker", "pub", "/chatter", "std_msgs/msg/String"],
+                         ["scripts/talker.py", 10, "/talker", "pub", None, "std_msgs/msg/String"],
+                         ["scripts/talker.py", 11, "/talker", "service_servers", "/reset", "std_srvs/srv/Trigger"],
+                         ["scripts/listener.py", 7, "/listener", "sub", "/chatter", "std_msgs/msg/String"]]}
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("items", nargs="+", help="CHECKOUT --truth FILE pairs")
-    ap.add_argument("--truth", action="append", type=Path, required=True, help="ground-truth JSON (one per checkout)")
+    ap.add_argument("items", nargs="*", help="CHECKOUT --truth FILE pairs")
+    ap.add_argument("--truth", action="append", type=Path, default=[], help="ground-truth JSON (one per checkout)")
+    ap.add_argument("--smoke", action="store_true", help="a package written here against its known call sites (CI)")
     a = ap.parse_intermixed_args()
-    if len(a.items) != len(a.truth):
+    if not a.smoke and (not a.items or len(a.items) != len(a.truth)):
         ap.error("give one --truth per checkout")
     print(f"{'repository':<40} {'what':<14} {'expected':>8} {'found':>6} {'matched':>7} {'recall':>7} {'precision':>9}")
+    if a.smoke:
+        with tempfile.TemporaryDirectory(prefix="rclverify-rosreal-") as d:
+            root = Path(d) / "smoke_pkg"
+            for rel, text in SMOKE_FILES.items():
+                (root / rel).parent.mkdir(parents=True, exist_ok=True)
+                (root / rel).write_text(text, encoding="utf-8")
+            for what, figures in measure(root, SMOKE_TRUTH).items():
+                print(_row(str(SMOKE_TRUTH["repository"]), what, *figures))
+        return
     for root, tpath in zip(a.items, a.truth):
         truth = json.loads(tpath.read_text())
         for what, figures in measure(Path(root), truth).items():

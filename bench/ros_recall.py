@@ -25,6 +25,7 @@ are printed, not asserted.
 Usage::
 
     PYTHONPATH=src python3 bench/ros_recall.py [--corpus tests/data/ros_corpus] [--verbose]
+    PYTHONPATH=src python3 bench/ros_recall.py --smoke      # two cases of the corpus: a few seconds
 """
 from __future__ import annotations
 
@@ -79,11 +80,12 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--corpus", type=Path, default=Path(__file__).parents[1] / "tests" / "data" / "ros_corpus")
     ap.add_argument("--verbose", action="store_true", help="list every missed and every extra item")
+    ap.add_argument("--smoke", action="store_true", help="the first two cases of the corpus only (CI)")
     a = ap.parse_args()
     # per package: group -> [expected, found, matched]
     table: dict[str, dict[str, list[int]]] = defaultdict(lambda: defaultdict(lambda: [0, 0, 0]))
     where = [0, 0]  # expected call sites, located
-    for case in sorted((a.corpus / "expected").glob("*.json")):
+    for case in sorted((a.corpus / "expected").glob("*.json"))[:2 if a.smoke else None]:
         exp = json.loads(case.read_text())
         ws = a.corpus / exp["workspace"]
         g = scan([ws], [ws / lf for lf in exp["launch"]], base=a.corpus, standard=False).graph

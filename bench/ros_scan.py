@@ -22,6 +22,7 @@ asserted; expect +-25% on a shared machine.
 Usage::
 
     PYTHONPATH=src python3 bench/ros_scan.py [--packages 200 --nodes 1000 --messages 400]
+    PYTHONPATH=src python3 bench/ros_scan.py --smoke    # 2 packages, 4 nodes, 4 types: a few seconds
 """
 from __future__ import annotations
 
@@ -130,7 +131,10 @@ def main() -> None:
     ap.add_argument("--packages", type=int, default=200)
     ap.add_argument("--nodes", type=int, default=1000)
     ap.add_argument("--messages", type=int, default=400)
+    ap.add_argument("--smoke", action="store_true", help="2 packages, 4 nodes, 4 message types (CI)")
     a = ap.parse_args()
+    if a.smoke:
+        a.packages, a.nodes, a.messages = 2, 4, 4
     with tempfile.TemporaryDirectory() as d:
         root = Path(d)
         top = build(root, a.packages, a.nodes, a.messages)

@@ -47,8 +47,9 @@ MAX_HEIGHT = 31_600
 #: The system diagram starts within the first two and a half screens (CSS px): "What needs attention"
 #: above it now has nine rows (the model checker's instances are rows of their own, not members of the
 #: guarantee-3 row), which put the diagram at 2,081 px; eleven since the Radiation Sensor's recorded runs
-#: are inconclusive (one row for the three), at 2,262 px.
-MAX_DIAGRAM_TOP = 2_300
+#: are inconclusive (one row for the three), at 2,262 px; twelve since the Agent's contract is found
+#: unrealizable (a row of its own), at 2,353 px. Still within two and a half screens of 1,000 px.
+MAX_DIAGRAM_TOP = 2_450
 #: The browser flags: no sandbox (containers), no GPU, nothing fetched from the network.
 FLAGS = ("--headless=new", "--no-sandbox", "--disable-gpu", "--disable-background-networking",
          "--disable-component-update", "--no-first-run", "--disable-sync", "--window-size=1400,1000")

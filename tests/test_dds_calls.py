@@ -150,6 +150,9 @@ def test_a_recorded_bag_reads_back_with_the_live_times(storage: str, tmp_path: P
     direct = [Event(k, t / 1e9, tp, {"data": v}, f"m{k}") for k, ((tp, v), t) in enumerate(zip(sent, times))]
     _, from_bag = check_trace(CHECKED, [CHECKED.nodes["Limiter"]], events, {}, 1.0)
     _, from_live = check_trace(CHECKED, [CHECKED.nodes["Limiter"]], direct, {}, 1.0)
-    assert from_bag[0].counts == from_live[0].counts and from_bag[0].counts["satisfied"] == 2
+    # the second limit's answer (2.5) fails it, and the run ends within the horizon: still open (another
+    # answer may come), the same read from the bag as from the messages themselves
+    assert from_bag[0].counts == from_live[0].counts
+    assert from_bag[0].counts["satisfied"] == 1 and from_bag[0].counts["open"] == 1
     with pytest.raises(BagError, match="exists"):
         BagRecorder(tmp_path / "run", storage, {}, [])

@@ -153,8 +153,30 @@ def test_no_finite_table_witness_leaves_consistency_to_the_general_query():
 
 def test_case_study_agent_guarantee_3_can_fire(agent_findings):
     """Guarantee 3 of the Agent can fire (its premise holds whenever i has no
-    successor waypoint), decided by the general query in the node task's Z3
-    state; asking the consistency witness in a context of its own leaves
-    that state as it was (health/witness.py)."""
+    successor waypoint).  The general query does not decide it in its first
+    budget nor any instance in the scan's first look; no instance being
+    vacuous, a witness of finite tables decides it (issue 44: decide first
+    with what decides), in a context of its own.  The witness, read back
+    from its RCL text, meets the assumption, every guarantee, every fact
+    and the premise at its ``i``, by direct evaluation (not Z3)."""
+    from rclverify.logic.evaluate import Evaluator, evaluate
+    from rclverify.rcl import ast
     g3 = agent_findings["Agent.g3.non-vacuous"]
-    assert g3.status == "ok" and g3.model is not None
+    assert g3.status == "ok" and g3.model is not None and g3.instances is None
+    assert g3.model["Agent.in.wayP"].startswith("{(0, 0) -> ")
+    plan = load_plan(ROOT)
+    checked = load([ROOT / p for p in plan.contracts])
+    resolve(plan, checked)
+    node = checked.nodes["Agent"]
+    model = {k: v for k, v in g3.model.items() if k.startswith("Agent.")}
+    values = _witness_values(model, "Agent")
+    formulas = [a.formula for a in node.node.assumes] + [g.formula for g in node.node.guarantees] \
+        + [f.expr for f in plan.facts["Agent"]]
+    assert [evaluate(f, checked, node, values) for f in formulas] == [True] * len(formulas)
+    g = node.node.guarantees[2].formula
+    while isinstance(g, ast.Quant) and g.kind == "forall":
+        g = g.body
+    assert isinstance(g, ast.Binary) and g.op == "->"
+    i = int(g3.model["i (witness for guarantee 3)"])
+    assert Evaluator(checked, node, values).eval(g.left, {"i": i}) is True  # the premise at the witness's i
+    assert "(declare-fun Agent.in.wayP (Real Real) Int)" in g3.smt2  # the statement is the general query's

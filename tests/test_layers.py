@@ -71,7 +71,15 @@ LAYERS: list[tuple[str, tuple[str, ...]]] = [
     # assemble.py) that uses them: programs.py, link.py, link_values.py,
     # symbols.py, emit.py, cpp_scope.py, cpp_values.py, cpp_types.py,
     # cpp_prep.py, cpp_helpers.py, py_helpers.py, pyconst.py, namespaces.py;
+    # and the drivers' idioms: unit_names.py (classes defined out of line through
+    # using/typedef), cpp_members.py and link_members.py (helpers held as members
+    # and base classes), nodelets.py (ROS 1 nodelets), lifecycle.py (the
+    # management interface of lifecycle nodes, for the grounding);
     # they import only ros/ modules, the standard library and tree-sitter.
+    # logic/floatsem.py (issue 40): a formula judged on recorded values in
+    # exact, IEEE-754 double or tolerant arithmetic, built on the evaluator
+    # and Z3's concrete check beside it, with logic/floatsens.py (which
+    # formulas those semantics can change); the monitors (backends) call it.
     # ros/dds.py, ros/dds_qos.py, ros/dds_discovery.py, ros/diff_dds.py: ROS 2's
     # conventions on DDS (names, the participant and node announcements, QoS
     # matching) and the running ROS 2 graph; read by ``ros diff --ros2`` here and
@@ -88,6 +96,9 @@ LAYERS: list[tuple[str, tuple[str, ...]]] = [
     # calculus and requirements/check.py, so they sit in this layer too;
     # health/realizable.py is a peer of the other health checks.
     ("calculus/health", ("rclverify.calculus", "rclverify.health", "rclverify.requirements")),
+    # backends/monitors/fieldpaths.py (issue 40): a mapping's field paths
+    # checked against the message definitions through ros/interfaces.py (the
+    # grounding's reader, a lower layer); entry_checks.py calls it.
     # backends/monitors/dds_*.py: the live monitor over DDS (types made from
     # the .msg files, the bus and its readers, calls checked one by one with
     # the monitors' engine, --enforce, the bag recorder); monitors' code,

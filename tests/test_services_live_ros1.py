@@ -138,3 +138,13 @@ def test_the_action_feedback_arrives_in_time(live_log: dict[str, Any]) -> None:
     assert "deadlines: 1 call(s) or goal(s) missed their deadline" in live_log["out"]
     published = live_log["echo"]
     assert '\\"kind\\": \\"deadline\\"' in published and '\\"verdict\\": \\"false\\"' in published, published[-2000:]
+
+
+def test_the_calls_reach_the_node_monitors_live(live_log: dict[str, Any]) -> None:
+    """The proxy hands each call and action message to the live engine too
+    (issue 40): the untimed monitors check the server's responses against
+    its guarantees as the offline check does."""
+    nodes = {n["node"]: n for n in live_log["record"]["nodes"]}
+    assert nodes["Base"]["counts"]["satisfied"] == 2, nodes["Base"]  # both estop calls answered as guaranteed
+    assert nodes["Mover"]["counts"]["satisfied"] == 1, nodes["Mover"]  # the goal, by its feedback and result
+    assert nodes["Base"]["status"] == nodes["Mover"]["status"] == "discharged"

@@ -175,7 +175,8 @@ def replacement_finding(ws: Workspace, node: str) -> Finding:
         raise RclError([error(loc, f"{rel} has no node {name!r}; it has {', '.join(other.nodes) or 'none'}", "E-plan")])
     return refinement_finding(node, spec, check_refinement(ws.checked.nodes[node], other.nodes[name],
                                                            merge_envs(ws.checked, other),
-                                                           facts=[f.expr for f in ws.plan.facts.get(node, ())]))
+                                                           facts=[f.expr for f in ws.plan.facts.get(node, ())],
+                                                           instances=ws.plan.instances.get(node)))
 
 
 def stage_export(ws: Workspace, node: str) -> list[dict[str, Any]]:

@@ -55,7 +55,7 @@ def check_entries(plan: Plan, checked: Checked) -> list[Diagnostic]:
                     from .review.backend import read_record
                     read_record(plan.root, e.config, loc)
                 else:
-                    _check_monitors(plan, e.config, loc)
+                    _check_monitors(plan, e.config, loc, checked)
             except PlanError as exc:  # once each: entries sharing a mapping file share its errors
                 out.extend(d for d in exc.diagnostics if d not in out)
     return out
@@ -80,19 +80,32 @@ def _one_ajpf_entry(plan: Plan, node: str, entries: Any) -> list[Diagnostic]:
     return out
 
 
-def _check_monitors(plan: Plan, config: Any, loc: Any) -> None:
-    """Read the monitors entry's trace mapping when it exists (its YAML and
-    its ``msg_dirs``, which must lie inside the workspace).  A missing
+def _check_monitors(plan: Plan, config: Any, loc: Any, checked: Checked | None = None) -> None:
+    """Read the monitors entry's trace mapping when it exists (its YAML, its
+    ``msg_dirs``, which must lie inside the workspace, and its field paths
+    against the message definitions the contracts' topics name,
+    :mod:`.monitors.fieldpaths`) and the entry's ``tolerance``.  A missing
     mapping or trace is left to the export stage (a workspace may record its
     traces after writing the plan).  Raises :class:`PlanError`."""
+    from ..logic.floatsem import ToleranceError, parse_tolerance
     from .monitors.config import DEFAULT_MAPPING, ConfigError, load_mapping
     rel = config.get("mapping")
     if not isinstance(rel, (str, type(None))) or not (plan.root / (rel or DEFAULT_MAPPING)).is_file():
+        try:
+            parse_tolerance(config.get("tolerance"))
+        except ToleranceError as exc:
+            l = loc("tolerance", *exc.key)
+            raise plan_error(l.file, l.line, l.col, str(exc)) from None
         return
     try:
-        load_mapping(plan.root, rel, config.get("horizon"), ())
+        cfg = load_mapping(plan.root, rel, config.get("horizon"), (), config.get("tolerance"))
     except ConfigError as exc:
         if exc.located:  # an error inside the mapping file: located there
             raise plan_error(*exc.located) from None
         l = loc(*exc.path)
         raise plan_error(l.file, l.line, l.col, str(exc)) from None
+    if checked is not None and cfg.mapping:
+        from .monitors.fieldpaths import check_field_paths
+        diags = check_field_paths(plan.root, cfg.mapping, cfg.msg_dirs, checked)
+        if diags:
+            raise PlanError(diags)

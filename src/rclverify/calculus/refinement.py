@@ -37,10 +37,11 @@ from __future__ import annotations
 
 import sys
 from dataclasses import dataclass
-from typing import Any, Mapping, Sequence, TextIO
+from typing import Any, Callable, Mapping, Sequence, TextIO
 
 import z3
 
+from ..health.witness import finite_witness, has_tables, points_for
 from ..logic.encode import EncodingError, Encoder
 from ..logic.query import DEFAULT_TIMEOUT_MS, QueryResult, prove
 from ..rcl import ast
@@ -193,6 +194,15 @@ def _decl_locs(c: Checked) -> dict[str, ast.Loc]:
 # The check
 # ---------------------------------------------------------------------------
 
+#: Budget of each side's first attempt (milliseconds' worth of Z3 resource steps,
+#: :data:`rclverify.logic.query.STEPS_PER_MS`): the case study's assumption side
+#: takes a few hundred steps; a side this does not decide goes up the ladder of
+#: :func:`rclverify.logic.retry.retry_order`.
+FIRST_MS = 250
+#: Budget of the finite-table counterexample looked for when the first attempt
+#: does not decide (the case study's guarantee side: 0.6 of it).
+WITNESS_MS = 1_000
+
 def _conj(clauses: tuple[ast.Clause, ...]) -> str:
     return " and ".join(f"({expr_to_rcl(c.formula)})" for c in clauses) or "TRUE"
 
@@ -204,9 +214,18 @@ def _rename(model: Mapping[str, str] | None, node: str) -> dict[str, str] | None
     return {(k[len(prefix):] if k.startswith(prefix) else k): v for k, v in model.items()}
 
 
+def _has_table_counterexample(enc: Encoder, formulas: Sequence[z3.BoolRef], points: int) -> Callable[[], bool]:
+    """A function telling whether ``formulas`` (a side's hypotheses and its
+    negated goal) have a model in which every function-typed input is a
+    finite table of ``points`` points (:func:`rclverify.health.witness.finite_witness`):
+    then the side is refuted, and only a strategy that builds models can
+    say so.  Asked only when the side's first small attempt did not decide."""
+    return lambda: has_tables(enc) and finite_witness(enc, formulas, points, WITNESS_MS).status == "sat"
+
+
 def check_refinement(a: CheckedNode, b: CheckedNode, env: Env, *,
                      timeout_ms: int = DEFAULT_TIMEOUT_MS, facts: Sequence[ast.Expr] = (),
-                     conditions: Sequence[ast.Expr] = ()) -> RefinementResult:
+                     conditions: Sequence[ast.Expr] = (), instances: tuple[int, int] | None = None) -> RefinementResult:
     """Decide whether contract ``b`` may replace contract ``a`` (module docstring).
 
     ``env`` must resolve both nodes' names (see :func:`merge_envs` for nodes
@@ -214,12 +233,18 @@ def check_refinement(a: CheckedNode, b: CheckedNode, env: Env, *,
     the plan's environment facts of ``a``'s node (formulas over ``a``'s
     inputs and outputs); ``conditions``: formulas over ``b``'s inputs (those
     ``a`` lacks included), which allow ``b`` extra inputs.  Both are
-    hypotheses of both sides and are listed in the result.  Raises
+    hypotheses of both sides and are listed in the result.  ``instances``:
+    the plan's ``instances: [lo, hi]`` of ``a``'s node, the size of the
+    finite tables a counterexample is first looked for with
+    (:func:`rclverify.health.witness.points_for`; the first attempt of each
+    side has :data:`FIRST_MS`, see :func:`rclverify.logic.query.prove`).
+    The verdict does not depend on them.  Raises
     :class:`RclError` for an interface mismatch and for formulas the Z3
     encoding does not support (located).
     """
     extra = [n for n in b.inputs if n not in a.inputs]
     check_interface(a, b, extra_inputs_ok=bool(conditions) or bool(facts))
+    points = points_for(instances)
     enc = Encoder(env)
     shared: dict[str, Any] = {}
     for prefix, group in (("in", a.inputs), ("out", a.outputs)):
@@ -241,9 +266,14 @@ def check_refinement(a: CheckedNode, b: CheckedNode, env: Env, *,
         raise RclError([error(_io_loc(b, "in", extra[0]), f"input {extra[0]!r} of {b.name} is not an input of {a.name} "
                                                           "and no condition mentions it; give one with --assume",
                               "E-refines-interface")])
-    q1 = prove(ab, [aa, *hyps], enc, timeout_ms=timeout_ms, deterministic=True,
+    # decide first with what decides (issue 44): each side's first attempt gets a small budget; when it
+    # cannot decide, a finite-table counterexample (health/witness.py) says the side is refuted, and MBQI,
+    # which builds models, is asked before the strategies that look for a proof
+    q1 = prove(ab, [aa, *hyps], enc, timeout_ms=timeout_ms, deterministic=True, first_ms=FIRST_MS,
+               likely_sat=_has_table_counterexample(enc, [aa, *hyps, z3.Not(ab)], points),
                comment=f"refinement, assumption side: A_{a.name} => A_{b.name}\nunsat: B assumes no more than A")
-    q2 = prove(ga, [aa, gb, *hyps], enc, timeout_ms=timeout_ms, deterministic=True,
+    q2 = prove(ga, [aa, gb, *hyps], enc, timeout_ms=timeout_ms, deterministic=True, first_ms=FIRST_MS,
+               likely_sat=_has_table_counterexample(enc, [aa, gb, *hyps, z3.Not(ga)], points),
                comment=f"refinement, guarantee side: A_{a.name} and G_{b.name} => G_{a.name}\n"
                        "unsat: B guarantees at least what A does")
 

@@ -26,6 +26,7 @@ from ..rcl.typecheck import check
 from ..rcl.types import Checked
 from ..system.model import SystemModel, build
 from .edits import Edit
+from .splice import FULL, spliced_system
 
 
 def source_text(ws: Any, rel: str) -> str:
@@ -35,7 +36,17 @@ def source_text(ws: Any, rel: str) -> str:
 
 def edited_system(ws: Any, edit: Edit) -> tuple[Checked, SystemModel] | None:
     """The type-checked system and its model with ``edit`` made to one
-    contract file; ``None`` when the edited text does not parse or check."""
+    contract file; ``None`` when the edited text does not parse or check.
+    An edit inside one node's clauses re-reads that node only
+    (:func:`.splice.spliced_system`: the cost of a candidate does not grow
+    with the system); any other edit parses and checks every file again."""
+    if edit.file in ws.plan.contracts:
+        try:
+            quick = spliced_system(ws, edit, source_text(ws, edit.file))
+        except (KeyError, ValueError):
+            quick = FULL  # the full path below says what is wrong
+        if quick is not FULL:
+            return quick  # type: ignore[return-value]
     specs = []
     try:
         for rel in ws.plan.contracts:

@@ -48,6 +48,13 @@ HEALTH_TIMEOUT_MS = 5_000
 #: instances in a row (with no vacuous one found) end the scan.
 INSTANCE_TIMEOUT_MS = 2_000
 GIVE_UP_AFTER = 3
+#: With an instance range, the first budgets of the general non-vacuity query
+#: and of each instance (issue 44, "decide first with what decides"; see
+#: :func:`_non_vacuity`).  The case study's instances each take about 25,000
+#: Z3 steps (0.2 of :data:`INSTANCE_FIRST_MS`); its guarantee 1's general
+#: query takes its whole budget and decides nothing.
+SCAN_FIRST_MS = 250
+INSTANCE_FIRST_MS = 100
 
 
 def _where(l: ast.Loc) -> str:
@@ -204,25 +211,28 @@ def check_node(checked: Checked, node: str, facts: Sequence[tuple[ast.Expr, ast.
     return out
 
 
-def _table_witness(h: _NodeHealth, comment: str) -> QueryResult | None:
-    """A witness of the consistency query in which each function-typed
-    input is a finite table (:mod:`.witness`), asked before the general
-    query when the contract has such inputs: Z3 finds one in a fraction of
-    the time it takes to find a model with uninterpreted functions (the
-    case study's Agent: 0.1-0.3 s instead of 3 s).  Its ``sat`` is a model of
-    the general query, so the finding is the same (``ok``), with the
-    general query's SMT-LIB2 text as its statement; anything else (None)
-    leaves the question to the general query.  Not used for non-vacuity:
-    there, an undecided general query is what starts the instance scan
-    that finds a guarantee vacuous for some instances only (the Agent's
-    guarantee 1), and a witness at one instance would hide that."""
+def _table_witness(h: _NodeHealth, comment: str,
+                   extra: Sequence[tuple[str, z3.BoolRef]] = ()) -> QueryResult | None:
+    """A witness of the consistency query (with ``extra``: of a
+    non-vacuity query) in which each function-typed input is a finite
+    table (:mod:`.witness`), asked before the general query when the
+    contract has such inputs: Z3 finds one in a fraction of the time it
+    takes to find a model with uninterpreted functions (the case study's
+    Agent: 0.1-0.3 s instead of 3 s).  Its ``sat`` is a model of the
+    general query, so the finding is the same (``ok``), with the general
+    query's SMT-LIB2 text as its statement; anything else (None) leaves the
+    question to the general query.  For non-vacuity it is asked only after
+    the instance scan's first look found no instance vacuous
+    (:func:`_non_vacuity`): a witness at one instance would hide a
+    guarantee vacuous at others (the Agent's guarantee 1), which the scan
+    reports."""
     if not has_tables(h.enc):
         return None
     t0 = time.perf_counter()
-    w = finite_witness(h.enc, [f for _, f in h.labelled()], points_for(h.instances))
+    w = finite_witness(h.enc, [f for _, f in h.labelled(extra)], points_for(h.instances))
     if w.status != "sat":
         return None
-    return QueryResult("sat", h.statement([], comment=comment), round(time.perf_counter() - t0, 4), model=w.model)
+    return QueryResult("sat", h.statement(extra, comment=comment), round(time.perf_counter() - t0, 4), model=w.model)
 
 
 def _noted(f: Finding, r: QueryResult) -> Finding:
@@ -237,14 +247,54 @@ def _non_vacuity(h: _NodeHealth, n: str, k: int) -> Finding | None:
     if prem is None:
         return None  # not forall ... (premise -> conclusion): no premise to examine
     extra, ptext = prem
-    # with an instance range the scan is the fallback of an undecided general query, so the retries of
-    # logic/retry.py are not tried first (the Agent's guarantee 1: 4 CPU s of retries that all give up)
-    scan = bool(h.instances and h.natural_vars(k))
-    r = h.sat(extra, comment=f"health {n}: can the premise of guarantee {k} hold? {ptext}", retry=not scan)
+    comment = f"health {n}: can the premise of guarantee {k} hold? {ptext}"
+    if not (h.instances and h.natural_vars(k)):
+        r = h.sat(extra, comment=comment, retry=True)
+        return _noted(replace(_premise_finding(h, n, k, r, ptext), smt2=r.smt2), r)
+    # With an instance range the scan decides where the general query cannot; the retries of
+    # logic/retry.py are not tried (the Agent's guarantee 1: 4 CPU s of retries that all give up).
+    # Decide first with what decides (issue 44): the general query with a small budget (what it decides
+    # there, its whole budget decides the same way), then each instance with a small budget; the general
+    # query gets its whole budget only when no instance was found vacuous.
+    r = h.sat(extra, comment=comment, retry=False, timeout_ms=min(h.timeout, SCAN_FIRST_MS))
+    if r.status == "inconclusive":
+        quick = _scan(h, n, k, min(h.timeout, INSTANCE_FIRST_MS))
+        if not any(x.status == "unsat" for x in quick.values()):
+            # no instance shown vacuous: a finite-table witness of the general query (its sat is the
+            # general query's), else the general query with its whole budget
+            r = _table_witness(h, comment, extra) or h.sat(extra, comment=comment, retry=False)
+        if r.status == "inconclusive":
+            return replace(_scan_finding(h, n, k, r, ptext, quick), smt2=r.smt2)
     return _noted(replace(_premise_finding(h, n, k, r, ptext), smt2=r.smt2), r)
 
 
+def _scan(h: _NodeHealth, n: str, k: int, budget_ms: int,
+          known: dict[int, QueryResult] | None = None) -> dict[int, QueryResult]:
+    """Guarantee ``k``'s premise asked at each instance ``lo..hi`` of its
+    first NATURAL variable, in order, with ``budget_ms`` each (an instance
+    ``known`` decided is not asked again), until :data:`GIVE_UP_AFTER`
+    instances in a row are undecided with none found vacuous before."""
+    assert h.instances is not None
+    v = h.natural_vars(k)[0]
+    lo, hi = h.instances
+    out: dict[int, QueryResult] = {}
+    streak = 0
+    for x in range(lo, hi + 1):
+        got = (known or {}).get(x)
+        if got is None or got.status == "inconclusive":
+            pe = h.premise(k, {v: x})
+            assert pe is not None
+            got = h.sat(pe[0], comment=f"health {n}: premise of guarantee {k} at {v}={x}", timeout_ms=budget_ms)
+        out[x] = got
+        streak = streak + 1 if got.status == "inconclusive" else 0
+        if streak >= GIVE_UP_AFTER and not any(y.status == "unsat" for y in out.values()):
+            break
+    return out
+
+
 def _premise_finding(h: _NodeHealth, n: str, k: int, r: QueryResult, ptext: str) -> Finding:
+    """The finding of a general non-vacuity query that decided, or of one
+    that did not when there is no instance range to scan."""
     fid, check = f"{n}.g{k}.non-vacuous", "non-vacuous"
     if r.status == "sat":
         return Finding(fid, n, check, k, "ok", f"The premise of guarantee {k} of {n} can hold: the guarantee can fire.",
@@ -256,34 +306,35 @@ def _premise_finding(h: _NodeHealth, n: str, k: int, r: QueryResult, ptext: str)
                        "guarantees and the environment facts, so it promises nothing.",
                        f"Premise: {ptext}. The unsat core names the clauses that exclude it.", None, list(r.core or []),
                        r.duration_s)
-    nat = h.natural_vars(k)
-    if not (h.instances and nat):
-        return Finding(fid, n, check, k, "inconclusive", f"Z3 could not decide whether guarantee {k} of {n} can fire ({r.reason}).",
-                       f"Premise: {ptext}. Give the plan an 'instances' range for {n} to examine it instance by instance.",
-                       duration_s=r.duration_s)
-    v = nat[0]
+    return Finding(fid, n, check, k, "inconclusive", f"Z3 could not decide whether guarantee {k} of {n} can fire ({r.reason}).",
+                   f"Premise: {ptext}. Give the plan an 'instances' range for {n} to examine it instance by instance.",
+                   duration_s=r.duration_s)
+
+
+def _scan_finding(h: _NodeHealth, n: str, k: int, r: QueryResult, ptext: str,
+                  quick: dict[int, QueryResult]) -> Finding:
+    """The finding of guarantee ``k`` examined instance by instance, the
+    general query ``r`` undecided: each instance the ``quick`` look did not
+    decide is asked with :data:`INSTANCE_TIMEOUT_MS` (the scan of
+    :func:`_scan`, in order, with its give-up rule)."""
+    fid, check = f"{n}.g{k}.non-vacuous", "non-vacuous"
+    assert h.instances is not None
+    v = h.natural_vars(k)[0]
     lo, hi = h.instances
+    full = _scan(h, n, k, min(h.timeout, INSTANCE_TIMEOUT_MS), quick)
     per: dict[str, str] = {}
     cores: dict[str, list[str]] = {}
-    total = r.duration_s
-    streak = 0
-    for x in range(lo, hi + 1):
-        pe = h.premise(k, {v: x})
-        assert pe is not None
-        ri = h.sat(pe[0], comment=f"health {n}: premise of guarantee {k} at {v}={x}",
-                   timeout_ms=min(h.timeout, INSTANCE_TIMEOUT_MS))
-        total += ri.duration_s
-        streak = streak + 1 if ri.status == "inconclusive" else 0
-        if streak >= GIVE_UP_AFTER and not any(s == "vacuous" for s in per.values()):
-            per[str(x)] = "inconclusive"
-            per.update({str(y): "not examined" for y in range(x + 1, hi + 1)})
-            break
+    total = r.duration_s + sum(x.duration_s for x in quick.values()) + sum(
+        x.duration_s for y, x in full.items() if x is not quick.get(y))
+    for x, ri in full.items():
         per[str(x)] = {"sat": "can fire", "unsat": "vacuous", "inconclusive": "inconclusive"}[ri.status]
         if ri.status == "unsat":
             cores[str(x)] = list(ri.core or [])
-    vac = [x for x, s in per.items() if s == "vacuous"]
-    fires = [x for x, s in per.items() if s == "can fire"]
-    unk = [x for x, s in per.items() if s in ("inconclusive", "not examined")]
+    if len(full) < hi - lo + 1:  # the scan gave up
+        per.update({str(y): "not examined" for y in range(lo + len(full), hi + 1)})
+    vac = [x for x, st in per.items() if st == "vacuous"]
+    fires = [x for x, st in per.items() if st == "can fire"]
+    unk = [x for x, st in per.items() if st in ("inconclusive", "not examined")]
     if vac:
         sample = cores[vac[0]]
         msg = (f"Guarantee {k} of {n} is vacuous for {v} in {_ranges(vac)}: its premise contradicts the node's other "

@@ -74,12 +74,18 @@ class _Query:
         self.given += [enc.formula(f, cn) for f, _ in facts if not outputs_mentioned(f, cn)]
         self.out_facts = [enc.formula(f, cn) for f, _ in facts if outputs_mentioned(f, cn)]
         self.guarantees = [enc.formula(g.formula, cn) for g in cn.node.guarantees]
-        self.outs = [enc.io_symbol(cn, "out", v) for v in cn.outputs]
+        # the outputs the guarantees or facts constrain: another (one a skeleton declares of the empty
+        # type `{}`, say) can take any value, so quantifying over it changes nothing
+        named: set[str] = set()
+        for f in [g.formula for g in cn.node.guarantees] + [f for f, _ in facts]:
+            named |= outputs_mentioned(f, cn)
+        constrained = [v for v in cn.outputs if v in named]
+        self.outs = [enc.io_symbol(cn, "out", v) for v in constrained]
         typed = Encoder(checked.env)  # the outputs' typing axioms, and only theirs
-        for v in cn.outputs:
+        for v in constrained:
             typed.io_symbol(cn, "out", v)
         self.typing = typed.axioms()
-        out_names = {typed.symbol_name(cn.name, "out", v) for v in cn.outputs}
+        out_names = {typed.symbol_name(cn.name, "out", v) for v in constrained}
         for name in out_names:  # bound below: not free symbols of the query (models show the inputs)
             enc.symbols.pop(name, None)
 
@@ -140,6 +146,8 @@ def realizability_findings(checked: Checked, node: str, facts: Sequence[tuple[as
     if not n.guarantees or not n.outputs:
         return []
     q = _Query(checked, node, facts, instances)
+    if not q.outs:
+        return []  # no guarantee constrains an output: any output answers (the shape checks say so)
     if any(isinstance(o, z3.FuncDeclRef) for o in q.outs):
         return []  # forall over a function-typed output: not first-order, not checked
     every = list(range(len(n.guarantees)))

@@ -295,6 +295,11 @@ class Evaluator:
     reference the tests compare the closures with."""
 
     compiled = True
+    #: ``None``: exact arithmetic (the compiled closures of this class); a
+    #: subclass with other number semantics names them here (its expressions
+    #: are compiled apart, calling :meth:`literal`, :meth:`arith` and
+    #: :meth:`compare`)
+    mode: str | None = None
 
     def __init__(self, checked: Checked, node: CheckedNode, values: Mapping[str, Any]) -> None:
         self.env = checked.env
@@ -344,12 +349,14 @@ class Evaluator:
         do what :meth:`interpret` does, node for node (:func:`_compile`)."""
         if not self.compiled:
             return self.interpret(e, b)
-        key = (id(e), id(self.node), id(self.env))
+        mode = self.mode
+        key: tuple[Any, ...] = (id(e), id(self.node), id(self.env)) if mode is None else \
+            (id(e), id(self.node), id(self.env), mode)
         hit = _COMPILED.get(key)
         if hit is None or hit[0] is not e or hit[1] is not self.node or hit[2] is not self.env:
             if len(_COMPILED) >= COMPILED_SIZE:
                 _COMPILED.clear()
-            hit = _COMPILED[key] = (e, self.node, self.env, _compile(e, self.env, self.node))
+            hit = _COMPILED[key] = (e, self.node, self.env, _compile(e, self.env, self.node, mode))
         return hit[3](self, b)
 
     def interpret(self, e: ast.Expr, b: Mapping[str, Any]) -> Any:
@@ -359,11 +366,7 @@ class Evaluator:
         if isinstance(e, ast.BoolLit):
             return e.value
         if isinstance(e, ast.NumLit):
-            lit = _LIT.get(e.text)
-            if lit is None:
-                v = e.value
-                lit = _LIT[e.text] = int(v) if v.denominator == 1 else v
-            return lit
+            return self.literal(e)
         if isinstance(e, ast.Var):
             return self.var(e, b)
         if isinstance(e, ast.Apply):
@@ -381,7 +384,7 @@ class Evaluator:
             return self.binary(e, b)
         if isinstance(e, ast.Compare):
             vals = [self.eval(o, b) for o in e.operands]
-            return all(_CMP[op](x, y) for op, x, y in zip(e.ops, vals, vals[1:]))
+            return all(self.compare(e, b, op, x, y) for op, x, y in zip(e.ops, vals, vals[1:]))
         if isinstance(e, ast.Member):
             x = self.eval(e.elem, b)
             carrier = self.carrier(e.collection, b)
@@ -425,7 +428,26 @@ class Evaluator:
             return (not self.eval(e.left, b)) or bool(self.eval(e.right, b))
         if op == "<=>":
             return bool(self.eval(e.left, b)) == bool(self.eval(e.right, b))
-        return arithmetic(op, self.eval(e.left, b), self.eval(e.right, b))
+        return self.arith(op, self.eval(e.left, b), self.eval(e.right, b))
+
+    # -- the semantics of numbers: exact here (REAL as rationals); the
+    # float-faithful semantics of recorded runs (logic/floatsem.py) override
+    # these three and set ``mode``, under which expressions are compiled apart
+    def literal(self, e: ast.NumLit) -> Any:
+        """The value of a numeric literal: its exact rational (an ``int`` when whole)."""
+        lit = _LIT.get(e.text)
+        if lit is None:
+            v = e.value
+            lit = _LIT[e.text] = int(v) if v.denominator == 1 else v
+        return lit
+
+    def arith(self, op: str, x: Any, y: Any) -> Any:
+        """``x op y`` (:func:`arithmetic`: exact)."""
+        return arithmetic(op, x, y)
+
+    def compare(self, e: ast.Compare, b: Mapping[str, Any], op: str, x: Any, y: Any) -> bool:
+        """One comparison ``x op y`` of ``e`` under bound variables ``b`` (exact)."""
+        return _CMP[op](x, y)
 
     # -- quantifiers -------------------------------------------------------------
     def domain(self, binding: ast.Binding, name: str, body: ast.Expr, b: Mapping[str, Any],
@@ -966,14 +988,28 @@ _Fn = Callable[["Evaluator", Mapping[str, Any]], Any]
 _COMPILED: dict[tuple[int, int, int], tuple[Any, Any, Any, _Fn]] = {}
 
 
-def _compile(e: Any, env: Any, node: CheckedNode) -> _Fn:
+def _compile(e: Any, env: Any, node: CheckedNode, mode: str | None = None) -> _Fn:
     """``e`` as a closure ``fn(evaluator, bound) -> value`` doing exactly what
     :meth:`Evaluator.interpret` does for it (same order of evaluation, same
     values, same exceptions), with the tree walk and the name resolution
     that does not depend on the bound variables done once.  Membership,
-    set/tuple literals and quantifiers are handed to the evaluator."""
+    set/tuple literals and quantifiers are handed to the evaluator.  With a
+    ``mode`` (an evaluator of other number semantics) literals, arithmetic
+    and comparisons call the evaluator's :meth:`~Evaluator.literal`,
+    :meth:`~Evaluator.arith` and :meth:`~Evaluator.compare`."""
     if isinstance(e, ast.Var):
-        return _compile_var(e, env, node)
+        return _compile_var(e, env, node, mode)
+    if mode is not None:
+        if isinstance(e, ast.NumLit):
+            return lambda ev, b: ev.literal(e)
+        if isinstance(e, ast.Compare):
+            parts = tuple(_compile(o, env, node, mode) for o in e.operands)
+            ops = e.ops
+
+            def compare_in_mode(ev: Evaluator, b: Mapping[str, Any]) -> Any:
+                vals = [o(ev, b) for o in parts]
+                return all(ev.compare(e, b, op, x, y) for op, x, y in zip(ops, vals, vals[1:]))
+            return compare_in_mode
     if isinstance(e, ast.NumLit):
         lit = _LIT.get(e.text)
         if lit is None:
@@ -985,11 +1021,11 @@ def _compile(e: Any, env: Any, node: CheckedNode) -> _Fn:
         truth = e.value
         return lambda ev, b: truth
     if isinstance(e, ast.Apply):
-        args = tuple(_compile(a, env, node) for a in e.args)
+        args = tuple(_compile(a, env, node, mode) for a in e.args)
         func = e.func
         fname, qualified = func.name, func.qualified
         ctor = func.prefix is None and fname in env.ctors
-        fvar = _compile_var(func, env, node)
+        fvar = _compile_var(func, env, node, mode)
 
         def apply(ev: Evaluator, b: Mapping[str, Any]) -> Any:
             vals = tuple([a(ev, b) for a in args])
@@ -1001,12 +1037,12 @@ def _compile(e: Any, env: Any, node: CheckedNode) -> _Fn:
             return f(*vals)
         return apply
     if isinstance(e, ast.Unary):
-        operand = _compile(e.operand, env, node)
+        operand = _compile(e.operand, env, node, mode)
         if e.op == "not":
             return lambda ev, b: not operand(ev, b)
         return lambda ev, b: -operand(ev, b)
     if isinstance(e, ast.Binary):
-        return _compile_binary(e, env, node)
+        return _compile_binary(e, env, node, mode)
     if isinstance(e, ast.Compare):
         operands = tuple(_compile(o, env, node) for o in e.operands)
         cmps = tuple(_CMP[op] for op in e.ops)
@@ -1022,7 +1058,7 @@ def _compile(e: Any, env: Any, node: CheckedNode) -> _Fn:
     return lambda ev, b: ev.interpret(e, b)
 
 
-def _compile_var(v: ast.Var, env: Any, node: CheckedNode) -> _Fn:
+def _compile_var(v: ast.Var, env: Any, node: CheckedNode, mode: str | None = None) -> _Fn:
     """:meth:`Evaluator.var` for ``v``: a bound variable first, then (fixed by
     the context) an enumeration value, a constant, a constructor, else the
     I/O value (:meth:`Evaluator.io`)."""
@@ -1042,17 +1078,17 @@ def _compile_var(v: ast.Var, env: Any, node: CheckedNode) -> _Fn:
     if name in env.enum_values:
         return lambda ev, b: b.get(name, name)
     if name in env.constants:
-        const = _compile(env.constants[name][1], env, node)
+        const = _compile(env.constants[name][1], env, node, mode)
         return lambda ev, b: b[name] if name in b else const(ev, {})
     if name in env.ctors:
         return lambda ev, b: b[name] if name in b else Term(name, ())
     return lambda ev, b: b[name] if name in b else io(ev, b)
 
 
-def _compile_binary(e: ast.Binary, env: Any, node: CheckedNode) -> _Fn:
+def _compile_binary(e: ast.Binary, env: Any, node: CheckedNode, mode: str | None = None) -> _Fn:
     """:meth:`Evaluator.binary` for ``e``."""
     op = e.op
-    left, right = _compile(e.left, env, node), _compile(e.right, env, node)
+    left, right = _compile(e.left, env, node, mode), _compile(e.right, env, node, mode)
     if op == "and":
         return lambda ev, b: bool(left(ev, b)) and bool(right(ev, b))
     if op == "or":
@@ -1061,7 +1097,8 @@ def _compile_binary(e: ast.Binary, env: Any, node: CheckedNode) -> _Fn:
         return lambda ev, b: (not left(ev, b)) or bool(right(ev, b))
     if op == "<=>":
         return lambda ev, b: bool(left(ev, b)) == bool(right(ev, b))
-
+    if mode is not None:
+        return lambda ev, b: ev.arith(op, left(ev, b), right(ev, b))
     return lambda ev, b: arithmetic(op, left(ev, b), right(ev, b))
 
 

@@ -27,7 +27,8 @@ import z3
 
 from .encode import Encoder, term_to_rcl, value_to_rcl
 from .functable import finite_table
-from .retry import attempts, bounded_solver, load_canonical, variants
+from .retry import (DEFAULT, attempts, bounded_solver, load_canonical, reasons_text, retry_order, strategy_solver,
+                    variants)
 
 DEFAULT_TIMEOUT_MS = 10_000
 
@@ -74,14 +75,20 @@ STEPS_PER_MS = 2_000
 SAFETY_FACTOR = 10
 
 
-def budgeted_solver(timeout_ms: int, ctx: z3.Context | None = None) -> z3.Solver:
+def steps(budget_ms: float) -> int:
+    """The Z3 resource limit of a budget of ``budget_ms`` milliseconds
+    (:data:`STEPS_PER_MS`), at least one step (Z3 reads 0 as no limit)."""
+    return max(1, int(budget_ms * STEPS_PER_MS))
+
+
+def budgeted_solver(timeout_ms: float, ctx: z3.Context | None = None) -> z3.Solver:
     """A solver in ``ctx`` (default: the process's main context) whose
     budget is ``timeout_ms`` milliseconds' worth of Z3 resource steps
-    (:data:`STEPS_PER_MS`), with a wall-clock safety net
-    :data:`SAFETY_FACTOR` times longer."""
+    (:func:`steps`), with a wall-clock safety net :data:`SAFETY_FACTOR`
+    times longer (at least a millisecond)."""
     s = z3.Solver(ctx=ctx)
-    s.set("rlimit", int(timeout_ms) * STEPS_PER_MS)
-    s.set("timeout", int(timeout_ms) * SAFETY_FACTOR)
+    s.set("rlimit", steps(timeout_ms))
+    s.set("timeout", max(1, int(timeout_ms * SAFETY_FACTOR)))
     return s
 
 
@@ -189,7 +196,8 @@ def smtlib_benchmark(formulas: Sequence[z3.BoolRef], ctx: z3.Context | None = No
 
 
 def prove(goal: z3.BoolRef, hypotheses: Sequence[z3.BoolRef], enc: Encoder | None = None, *,
-          timeout_ms: int = DEFAULT_TIMEOUT_MS, comment: str = "", deterministic: bool = False) -> QueryResult:
+          timeout_ms: int = DEFAULT_TIMEOUT_MS, comment: str = "", deterministic: bool = False,
+          first_ms: float | None = None, likely_sat: Callable[[], bool] | None = None) -> QueryResult:
     """Is ``hypotheses => goal`` valid?  Checks ``hypotheses and not goal``.
 
     ``enc`` (when given) renders a refuting model in RCL terms and adds its
@@ -201,36 +209,65 @@ def prove(goal: z3.BoolRef, hypotheses: Sequence[z3.BoolRef], enc: Encoder | Non
     the calling process's Z3 term ids reach the solver; the model is read
     back through ``enc``'s symbol names, which the text keeps.  Never raises
     on solver trouble: an unknown answer is ``inconclusive`` with Z3's reason.
+
+    ``first_ms`` (decide first with what decides, issue 44): the first
+    attempt gets only this budget (milliseconds' worth of resource steps);
+    a query it decides gets the answer the whole budget would give (a
+    resource-bounded search with a smaller bound is a prefix of the same
+    search).  Undecided, the strategies follow in the laddered order of
+    :func:`.retry.retry_order` (finite instantiation first, then the
+    default with its whole budget, then MBQI), each with its whole budget;
+    ``likely_sat`` (called only then, e.g. "a finite-table witness of the
+    refutation exists") puts the model-building MBQI first.  Not used
+    inside a :func:`solver_session` unless ``deterministic`` (a session's
+    first attempt is part of its history).
     """
     hyps = list(hypotheses) + (enc.axioms() if enc else [])
     formulas = hyps + [z3.Not(goal)]
-    with ExitStack() as scope:
+    script = smt2_script(formulas, comment or "validity query: unsat means the goal follows from the hypotheses")
+    ladder = first_ms is not None and (deterministic or not _SESSIONS)
+    t0 = time.perf_counter()
+
+    def answered(s: z3.Solver, r: z3.CheckSatResult, strategy: str = "") -> QueryResult | None:
+        dt = round(time.perf_counter() - t0, 4)
+        if r == z3.unsat:
+            return QueryResult("proved", script, dt, strategy=strategy)
+        if r == z3.sat:
+            return QueryResult("refuted", script, dt, model=render_model(s.model(), enc), strategy=strategy)
+        return None
+
+    def default(budget_ms: float | None) -> z3.Solver:
+        """The first attempt's solver with the query in it (``None``: its whole budget)."""
         if deterministic:
-            s = bounded_solver()
+            s = bounded_solver() if budget_ms is None else bounded_solver(rlimit=steps(budget_ms))
             load_canonical(s, formulas)
+        else:
+            s = budgeted_solver(budget_ms if budget_ms is not None else timeout_ms)
+            s.add(*formulas)
+        return s
+
+    with ExitStack() as scope:
+        if ladder or deterministic:
+            s = default(first_ms if ladder else None)
         else:
             s = scope.enter_context(query_solver(timeout_ms))
             s.add(*formulas)
-        t0 = time.perf_counter()
-        r = s.check()
-        dt = round(time.perf_counter() - t0, 4)
-        script = smt2_script(formulas, comment or "validity query: unsat means the goal follows from the hypotheses")
-        if r == z3.unsat:
-            return QueryResult("proved", script, dt)
-        if r == z3.sat:
-            return QueryResult("refuted", script, dt, model=render_model(s.model(), enc))
-        reasons = [f"default: {s.reason_unknown()}"]
-        for name0, s0, rewrite in attempts(formulas, timeout_ms):
-            for name, s2 in variants(name0, s0):
+        got = answered(s, s.check())
+        if got is not None:
+            return got
+        reasons = {DEFAULT: s.reason_unknown()}
+        models_first = bool(ladder and likely_sat is not None and likely_sat())
+        for name in retry_order(formulas, ladder=ladder, models_first=models_first):
+            if name == DEFAULT:
+                s2 = default(None)
+            else:
+                s2, rewrite = strategy_solver(name)
                 load_canonical(s2, [rewrite(f) for f in formulas])
-                r = s2.check()
-                dt = round(time.perf_counter() - t0, 4)
-                if r == z3.unsat:
-                    return QueryResult("proved", script, dt, strategy=name)
-                if r == z3.sat:
-                    return QueryResult("refuted", script, dt, model=render_model(s2.model(), enc), strategy=name)
-                reasons.append(f"{name}: {s2.reason_unknown()}")
-        return QueryResult("inconclusive", script, dt, reason="; ".join(reasons) if len(reasons) > 1 else s.reason_unknown())
+            got = answered(s2, s2.check(), "" if name == DEFAULT else name)
+            if got is not None:
+                return got
+            reasons[name] = s2.reason_unknown()
+        return QueryResult("inconclusive", script, round(time.perf_counter() - t0, 4), reason=reasons_text(reasons))
 
 
 def satisfiable(labelled: Sequence[tuple[str, z3.BoolRef]], enc: Encoder | None = None, *,

@@ -144,14 +144,15 @@ def _has_quantifier(e: z3.ExprRef) -> bool:
     return False
 
 
-def bounded_solver(*tactics: str) -> z3.Solver:
+def bounded_solver(*tactics: str, rlimit: int = RETRY_RLIMIT) -> z3.Solver:
     """A solver in a fresh Z3 context (so the answer does not depend on what
-    the process encoded before) bounded by :data:`RETRY_RLIMIT`; with
-    ``tactics`` (Z3 tactic names, e.g. ``"simplify", "smt"``), the solver
-    runs them in sequence (models are mapped back to the query's symbols)."""
+    the process encoded before) bounded by ``rlimit`` resource steps
+    (default :data:`RETRY_RLIMIT`); with ``tactics`` (Z3 tactic names, e.g.
+    ``"simplify", "smt"``), the solver runs them in sequence (models are
+    mapped back to the query's symbols)."""
     ctx = z3.Context()
     s = z3.Then(*tactics, ctx=ctx).solver() if len(tactics) > 1 else z3.Solver(ctx=ctx)
-    s.set("rlimit", RETRY_RLIMIT)
+    s.set("rlimit", rlimit)
     s.set("timeout", SAFETY_TIMEOUT_MS)
     return s
 
@@ -210,3 +211,67 @@ def variants(name: str, s: z3.Solver) -> list[tuple[str, z3.Solver]]:
         s2.set("smt.ematching", False)
         out.append((MBQI_SIMPLIFIED, s2))
     return out
+
+
+#: The name of Z3's default strategy (the first attempt) in a retry order.
+DEFAULT = "default"
+#: Every strategy, in the order their reasons for giving up are reported.
+REPORTED = (DEFAULT, FINITE, MBQI, MBQI_SIMPLIFIED)
+
+
+def retry_order(formulas: Sequence[z3.BoolRef], *, ladder: bool, models_first: bool = False) -> list[str]:
+    """The strategies to try, in order, after a first attempt at
+    ``formulas`` answered ``unknown``.
+
+    Without ``ladder`` (the first attempt had the query's whole budget):
+    the retries of the module docstring, finite instantiation (when a
+    quantifier has a finite sort to write out) then the two MBQI variants
+    (when there is a quantifier).
+
+    With ``ladder`` (the first attempt had only a small first budget:
+    decide first with what decides, issue 44): finite instantiation first,
+    an equivalent query over the finite domains written out; then the
+    default strategy with its whole budget (:data:`DEFAULT`); then MBQI.
+    ``models_first`` (the caller knows the query is satisfiable, e.g. a
+    finite-table witness exists): the two MBQI variants, which build
+    models, come before both, the one after simplification first; e-matching, the default's first resort,
+    finds instances that refute, never a model of a universally quantified
+    formula over an infinite sort.  Every strategy of the unladdered order
+    is in the laddered one, so a query one of them decides is still
+    decided; only which one answers first (and so a model) can differ."""
+    quantified = any(_has_quantifier(f) for f in formulas)
+    finite = quantified and any(not expand_finite(f).eq(f) for f in formulas)
+    fin = [FINITE] if finite else []
+    models = [MBQI, MBQI_SIMPLIFIED] if quantified else []
+    if not ladder:
+        return fin + models
+    # models first: after simplification first, the smaller query (the case study's replacement check:
+    # plain MBQI runs out of its budget, after simplification it answers in 60 % of it)
+    return models[::-1] + fin + [DEFAULT] if models_first else fin + [DEFAULT] + models
+
+
+def strategy_solver(name: str) -> tuple[z3.Solver, Callable[[z3.BoolRef], z3.BoolRef]]:
+    """The solver (a fresh, resource-bounded context: :func:`bounded_solver`)
+    and the rewrite of each formula for the retry ``name`` (not
+    :data:`DEFAULT`, whose solver is the caller's first attempt with its
+    whole budget).  Load the rewritten formulas with :func:`load_canonical`."""
+    if name == FINITE:
+        return bounded_solver(), lambda f: cast(z3.BoolRef, expand_finite(f))
+    if name == MBQI:
+        s = bounded_solver()
+    elif name == MBQI_SIMPLIFIED:
+        s = bounded_solver("simplify", "smt")
+    else:
+        raise ValueError(f"no retry strategy {name!r}")
+    s.set("smt.ematching", False)
+    return s, lambda f: f
+
+
+def reasons_text(reasons: dict[str, str]) -> str:
+    """Why every strategy tried gave up, ``"default: canceled; finite
+    instantiation: canceled; ..."`` in the order of :data:`REPORTED`
+    whatever order they ran in; the default's reason alone when nothing
+    else ran."""
+    if set(reasons) <= {DEFAULT}:
+        return reasons.get(DEFAULT, "")
+    return "; ".join(f"{n}: {reasons[n]}" for n in REPORTED if n in reasons)

@@ -58,7 +58,7 @@ SCHEMAS: dict[str, EntrySchema] = {s.name: s for s in (
                                "timeout_ms"),
                 path_keys=frozenset({"summary", "data"})),
     EntrySchema("review", ("record",), path_keys=frozenset({"record"})),
-    EntrySchema("monitors", ("traces", "mapping", "horizon"), path_keys=frozenset({"traces", "mapping"})),
+    EntrySchema("monitors", ("traces", "mapping", "horizon", "tolerance"), path_keys=frozenset({"traces", "mapping"})),
 )}
 
 #: The backends a plan may name, in registry order.

@@ -503,6 +503,25 @@ def check(specs: Sequence[ast.Spec], interface_only: Iterable[str] = ()) -> Chec
     return Checked(c.env, nodes, tuple(specs))
 
 
+def check_node_again(specs: Sequence[ast.Spec], n: ast.Node) -> CheckedNode:
+    """Type-check the one node ``n`` as :func:`check` would check it among
+    ``specs`` (the files of a checked system, ``n`` in place of the node of
+    the same name): ``specs``' contexts are resolved again (they do not
+    depend on nodes), then ``n`` alone.  For an edit inside one node's
+    clauses (the diagnosis's repair checks), whose other nodes the caller
+    already holds checked: the cost is that of the contexts and one node,
+    not of the system.  Raises :class:`RclError` as :func:`check`
+    does for ``n``'s errors."""
+    c = _Checker()
+    c.with_units = any(getattr(s, "has_units", True) for s in specs)
+    c.contexts(specs)
+    cn = c.node(n)
+    if c.diags or cn is None:
+        unique = list(dict.fromkeys(c.diags))
+        raise RclError(sorted(unique, key=lambda d: (d.loc.file, d.loc.line, d.loc.col)))
+    return cn
+
+
 def load(paths: Iterable[str | Path]) -> Checked:
     """Parse and type-check RCL files.  Raises :class:`RclError`."""
     return check(parse_files(paths))

@@ -16,13 +16,14 @@ The caller's ``add_node`` resolves the names (namespaces, remaps, parameters).
 from __future__ import annotations
 
 from pathlib import Path
+import dataclasses
 from typing import Any, Callable
 
-from . import names
+from . import names, nodelets
 from .executables import Targets
 from .launch import LaunchNode
 from .link import Linked, Linker
-from .model import Endpoint, Graph, Note
+from .model import Endpoint, Graph, Note, Src
 from .packages import Package
 from .programs import PackageCode, Program, programs
 
@@ -77,11 +78,44 @@ class Assembly:
             self.progs[pk].append(prog)
         return prog, cls
 
+    def registered_at(self, prog: Program) -> Src | None:
+        """Where a nodelet program's class is registered (``PLUGINLIB_EXPORT_CLASS``)."""
+        cls = next(iter(prog.units or ()), "")
+        for f in prog.files:
+            for written, _lookup, at in self.codes[prog.package].records.get(f, {}).get("nodelets", []):
+                if cls == written or cls.endswith("::" + written.split("::")[-1]):
+                    return at  # type: ignore[no-any-return]
+        return None
+
+    def nodelet_program(self, lookup: str) -> Program | None:
+        """The program of the nodelet a launch file loads as ``pkg/Type`` (its plugin
+        description's lookup name, else a registered class named ``Type``)."""
+        pkg, _, last = lookup.partition("/")
+        progs = [p for p in self.progs.get(pkg, []) if p.nodelet is not None]
+        exact = [p for p in progs if p.nodelet == lookup]
+        near = [p for p in progs if (p.nodelet or "").split("/")[-1].split("::")[-1] == last.split("::")[-1]]
+        hit = exact or near
+        return hit[0] if len(hit) == 1 else None
+
     def source_nodes(self, add_node: Callable[..., None], g: Graph) -> None:
         """Without launch files: every program's nodes (see the module docstring)."""
         for pkg in sorted(self.progs):
+            named = {e.src for prog in self.progs[pkg] if self.linked(prog).nodes
+                     for e, _o in self.linked(prog).endpoints}
             for prog in self.progs[pkg]:
                 got = self.linked(prog)
+                if not got.nodes and prog.nodelet is not None and got.endpoints:
+                    if all(e.src in named for e, _o in got.endpoints):
+                        continue  # the nodelet's code is a node executable's too (its node wrapper)
+                    name = prog.nodelet.split("/")[-1].split("::")[-1]
+                    at = self.registered_at(prog) or min((e.src for e, _o in got.endpoints),
+                                                         key=lambda x: (x.file, x.line, x.col))
+                    g.notes.append(Note(at, f"nodelet {prog.nodelet} is loaded by no launch file: shown as node "
+                                            f"/{name} (a launch file gives its name)", "ROS-LAUNCH"))
+                    g.notes.extend(got.notes)
+                    eps = [e for e, _o in got.endpoints]
+                    add_node("/" + name, "/", pkg, prog.nodelet, _files(prog, got, eps, None), at, eps, [], "source")
+                    continue
                 if not got.nodes:
                     if got.endpoints:
                         first = min((e for e, _o in got.endpoints), key=lambda e: (e.src.file, e.src.line))
@@ -95,14 +129,31 @@ class Assembly:
                     eps = [e for e, o in got.endpoints if o == i]
                     full = names.join(names.join("/", ns or ""), name)
                     files = _files(prog, got, eps, src.file)
-                    add_node(full, names.split(full)[0], pkg, prog.exe, files, src, eps, [], "source")
+                    add_node(full, names.split(full)[0], pkg, prog.exe, files, src, eps, [], "source",
+                             lifecycle=got.kinds[i] == "lifecycle" if i < len(got.kinds) else False)
 
     def launch_node(self, ln: LaunchNode, add_node: Callable[..., None], g: Graph) -> None:
         """The node launch element ``ln`` starts (see the module docstring)."""
         comp = self.targets.get(ln.pkg, Targets()).components.get(ln.exe) if ln.exe else None
         plugin = ln.plugin or (comp[0] if comp else None)
         prog: Program | None = None
-        if plugin:
+        if ln.pkg == "nodelet" and ln.exe == "nodelet":
+            what = nodelets.launch_args(ln.args)
+            if what is None or what[1] is None:  # a manager: a container, not a node (docs/ros.md)
+                if what is None:
+                    g.notes.append(Note(ln.src, f"nodelet args '{ln.args or ''}' are not 'manager', 'load "
+                                                f"pkg/Type manager' or 'standalone pkg/Type': not read", "ROS-LAUNCH"))
+                return
+            lookup = what[1]
+            pkg = lookup.split("/")[0]
+            prog = self.nodelet_program(lookup)
+            if prog is None:
+                where = "is not in the scanned workspaces" if pkg not in self.pkgs else \
+                    "has no nodelet of that name (plugin description, PLUGINLIB_EXPORT_CLASS)"
+                g.notes.append(Note(ln.src, f"nodelet '{lookup}': package '{pkg}' {where}; its topics are unknown",
+                                    "ROS-LAUNCH"))
+            ln = dataclasses.replace(ln, pkg=pkg, exe=lookup, name=ln.name or lookup.split("/")[-1])
+        elif plugin:
             prog, _cls = self.class_program(plugin, ln.pkg)
             if prog is None:
                 g.notes.append(Note(ln.src, f"component class '{plugin}' of package '{ln.pkg}' is not found in the "
@@ -118,6 +169,17 @@ class Assembly:
                                             f"its topics are unknown", "ROS-LAUNCH"))
         got = self.linked(prog) if prog is not None else Linked()
         g.notes.extend(got.notes)
+        if ln.name is None and len({n for n, _s, _ns in got.nodes}) > 1 and prog is not None:
+            # a ROS 2 process of several nodes, none renamed by the launch file: each node
+            # is itself, in the launch namespace, with its own endpoints (docs/ros.md)
+            for i, (name, _src, code_ns) in enumerate(got.nodes):
+                ns = ln.ns if ln.ns != "/" else names.join("/", code_ns or "")
+                mine = [e for e, o in got.endpoints if o == i]
+                full = names.normalise(name) if name.startswith("/") else names.join(ns, name)
+                add_node(full, names.split(full)[0], ln.pkg, ln.exe or None, _files(prog, got, mine, None),
+                         ln.src, mine, ln.remaps, "launch", ln.params,
+                         lifecycle=i < len(got.kinds) and got.kinds[i] == "lifecycle")
+            return
         eps = [e for e, _o in got.endpoints]
         name = ln.name or (got.nodes[0][0] if got.nodes else (plugin.split("::")[-1] if plugin else ln.exe))
         if name.startswith("/"):
@@ -126,7 +188,8 @@ class Assembly:
         else:
             full, ns = names.join(ln.ns, name), ln.ns
         files = _files(prog, got, eps, None) if prog is not None else []
-        add_node(full, ns, ln.pkg, ln.exe or None, files, ln.src, eps, ln.remaps, "launch", ln.params)
+        add_node(full, ns, ln.pkg, ln.exe or None, files, ln.src, eps, ln.remaps, "launch", ln.params,
+                 lifecycle="lifecycle" in got.kinds)
 
 
 def _files(prog: Program, got: Linked, eps: list[Endpoint], named_in: str | None) -> list[str]:

@@ -16,6 +16,12 @@ documented API and source):
 | ``rclcpp::ParameterEventHandler``, ``on_parameter_event`` | subscribes ``/parameter_events`` (``rcl_interfaces/msg/ParameterEvent``) |
 | ``ros::topic::waitForMessage<T>(name, ...)`` | subscribes ``name`` |
 | ``rclcpp::create_publisher<T>(node, name, ...)`` / ``create_subscription<T>`` (free functions) | ``name`` |
+| ``diagnostic_updater::Updater`` (ROS 1 and 2) | publishes ``/diagnostics`` (``diagnostic_msgs/msg/DiagnosticArray``) |
+| ``dynamic_reconfigure::Server<Config>([mutex,] [h])`` | through ``h`` (default ``~``): serves ``set_parameters`` (``dynamic_reconfigure/srv/Reconfigure``), publishes ``parameter_descriptions`` (``dynamic_reconfigure/msg/ConfigDescription``) and ``parameter_updates`` (``dynamic_reconfigure/msg/Config``) |
+| ``dynamic_reconfigure::Client<Config>(name, ...)`` | calls ``name/set_parameters``, subscribes ``name/parameter_descriptions`` and ``name/parameter_updates`` |
+| ``self_test::TestRunner([h, [ph]])`` | serves ``self_test`` (``diagnostic_msgs/srv/SelfTest``) through ``ph`` (default ``~``) |
+| ``camera_info_manager::CameraInfoManager(h, ...)`` | serves ``set_camera_info`` (``sensor_msgs/srv/SetCameraInfo``) through ``h`` |
+| ``realtime_tools::RealtimePublisher<T>(h, name, ...)`` / ``.init(h, name, ...)`` (ROS 1) | publishes ``name`` (``T``) through ``h``; ROS 2's ``RealtimePublisher<T>(publisher)`` wraps a publisher already read |
 
 Each spec is ``(role, name value, type, handle value)``; a handle is the
 node handle the helper was given (its namespace applies to the name).
@@ -36,13 +42,18 @@ INFO = "sensor_msgs/msg/CameraInfo"
 VIS = "visualization_msgs/msg/"
 EVENTS = ("sub", symbols.lit("/parameter_events"), "rcl_interfaces/msg/ParameterEvent", None)
 
+DIAGNOSTICS = ("pub", symbols.lit("/diagnostics"), "diagnostic_msgs/msg/DiagnosticArray", None)
+PRIVATE: symbols.Val = ("nh", (("ns", symbols.lit("~")),))
+RECONF = "dynamic_reconfigure/"
+
 #: helper classes whose construction creates endpoints, by last name part
 CONSTRUCTED = {"TransformBroadcaster", "StaticTransformBroadcaster", "TransformListener", "Subscriber",
-               "InteractiveMarkerServer", "ParameterEventHandler", "CameraPublisher", "CameraSubscriber"}
+               "InteractiveMarkerServer", "ParameterEventHandler", "CameraPublisher", "CameraSubscriber",
+               "Updater", "Server", "Client", "TestRunner", "RealtimePublisher", "CameraInfoManager"}
 #: helper methods that create endpoints, by the receiver's class (last name part)
 METHODS = {"ImageTransport": {"advertise", "subscribe", "advertiseCamera", "subscribeCamera"},
            "Subscriber": {"subscribe"}, "AsyncParametersClient": {"on_parameter_event"},
-           "SyncParametersClient": {"on_parameter_event"}}
+           "SyncParametersClient": {"on_parameter_event"}, "RealtimePublisher": {"init"}}
 
 
 def info_topic(image: symbols.Val) -> symbols.Val:
@@ -80,10 +91,23 @@ def constructed(type_text: str, args: list[Any], val: Value, ros2: bool,
     """The endpoints a helper of class ``type_text`` creates when made with
     ``args`` (syntax nodes; ``val`` gives their values); ``None`` when the class
     is no endpoint-creating helper."""
-    head, targs = split_template(type_text.replace(" ", ""))
+    t = type_text.replace(" ", "").replace("\n", "")
+    if ">" in t and "::" in t[t.rindex(">"):]:
+        return None  # a nested type of a helper (Server<C>::CallbackType), not the helper
+    head, targs = split_template(t)
+    if aliases and "::" not in head and head in aliases:  # typedef dynamic_reconfigure::Server<C> Srv;
+        head, targs = split_template(aliases[head].replace(" ", ""))
     last = head.split("::")[-1]
     if last not in CONSTRUCTED:
         return None
+    if last in ("Updater", "Server", "Client", "TestRunner"):
+        return _ros1_tools(head, last, [val(a) for a in args])
+    if last == "RealtimePublisher":
+        return _realtime(head, targs, args, val, aliases)
+    if last == "CameraInfoManager" and head.startswith("camera_info_manager") and args:
+        h = val(args[0])
+        return [("service_servers", symbols.lit("set_camera_info"), "sensor_msgs/srv/SetCameraInfo",
+                 h if h is not None and h[0] == "nh" else None)]
     if last == "TransformBroadcaster" and ("tf" in head or not head.count("::")):
         return [("pub", symbols.lit("/tf"), TF, None)]
     if last == "StaticTransformBroadcaster":
@@ -103,14 +127,64 @@ def constructed(type_text: str, args: list[Any], val: Value, ros2: bool,
     return None
 
 
+def _ros1_tools(head: str, last: str, vals: list[symbols.Val]) -> list[Spec] | None:
+    """diagnostic_updater, dynamic_reconfigure and self_test helpers made with
+    argument values ``vals`` (see the module table)."""
+    handles = [v for v in vals if v is not None and v[0] == "nh"]
+    if last == "Updater" and head.startswith("diagnostic_updater"):
+        return [DIAGNOSTICS]
+    if last == "Server" and head.startswith("dynamic_reconfigure"):
+        return reconfigure_server(handles[-1] if handles else PRIVATE)
+    if last == "Client" and head.startswith("dynamic_reconfigure") and vals:
+        return reconfigure_client(vals[0], handles[-1] if handles else None)
+    if last == "TestRunner" and head.startswith("self_test"):
+        return [("service_servers", symbols.lit("self_test"), "diagnostic_msgs/srv/SelfTest",
+                 handles[1] if len(handles) >= 2 else PRIVATE)]
+    return None
+
+
+def _realtime(head: str, targs: list[str], args: list[Any], val: Value,
+              aliases: dict[str, str] | None) -> list[Spec] | None:
+    """``realtime_tools::RealtimePublisher<T>(h, name, queue[, latched])`` (ROS 1), or its
+    ``init`` with the same arguments; made with one argument (ROS 2: an existing
+    publisher) or none, it creates nothing of its own."""
+    if "realtime_tools" not in head and "::" in head:
+        return None
+    if len(args) < 2 or not targs:
+        return []
+    return [("pub", val(args[1]), message_type(targs[0], aliases), val(args[0]))]
+
+
+def reconfigure_server(h: symbols.Val) -> list[Spec]:
+    """A dynamic_reconfigure server's endpoints through handle ``h``."""
+    return [("service_servers", symbols.lit("set_parameters"), RECONF + "srv/Reconfigure", h),
+            ("pub", symbols.lit("parameter_descriptions"), RECONF + "msg/ConfigDescription", h),
+            ("pub", symbols.lit("parameter_updates"), RECONF + "msg/Config", h)]
+
+
+def reconfigure_client(name: symbols.Val, h: symbols.Val) -> list[Spec]:
+    """A dynamic_reconfigure client's endpoints for the server named ``name``."""
+    def under(s: str) -> symbols.Val:
+        return symbols.cat([name, symbols.lit("/" + s)]) if name is not None else None
+    return [("service_clients", under("set_parameters"), RECONF + "srv/Reconfigure", h),
+            ("sub", under("parameter_descriptions"), RECONF + "msg/ConfigDescription", h),
+            ("sub", under("parameter_updates"), RECONF + "msg/Config", h)]
+
+
 def method(recv_type: str, name: str, args: list[Any], targs: list[str], val: Value, handle: symbols.Val,
            aliases: dict[str, str] | None = None) -> list[Spec] | None:
     """The endpoints a helper's method call creates (receiver of class ``recv_type``,
     made with node handle ``handle``); ``None`` when it is none of :data:`METHODS`."""
     head, rtargs = split_template(recv_type.replace(" ", "").replace("&", "").replace("*", ""))
+    while head.split("::")[-1] in ("shared_ptr", "unique_ptr") and rtargs:  # a helper held by pointer
+        head, rtargs = split_template(rtargs[0].replace("const", ""))
+    for ptr in ("::SharedPtr", "::UniquePtr", "::Ptr", "::ConstSharedPtr"):
+        head = head[: -len(ptr)] if head.endswith(ptr) else head
     last = head.split("::")[-1]
     if name not in METHODS.get(last, ()):
         return None
+    if last == "RealtimePublisher":
+        return _realtime(head, rtargs, args, val, aliases)
     if last == "ImageTransport" and args:
         kind = "pub" if name.startswith("advertise") else "sub"
         return _image(kind, name.endswith("Camera"), val(args[0]), handle)

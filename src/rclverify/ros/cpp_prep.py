@@ -15,6 +15,9 @@ keeps every byte offset (same length, newlines kept), so locations stay.
 * ``#ifdef __cplusplus`` / ``#if defined(__cplusplus)`` blocks that only
   open ``extern "C" {`` or close its ``}`` (a C header made includable from
   C++) are blanked, both of them, so the braces balance;
+* Qt's access specifiers ``private slots:`` / ``public Q_SLOTS:`` lose the
+  ``slots`` word, ``signals:`` / ``Q_SIGNALS:`` become ``public:`` (Qt's moc,
+  not the compiler, reads them);
 * a statement or member that is only an upper-case macro, with no
   semicolon (``PLUGINLIB_EXPORT_CLASS(a::B, nodelet::Nodelet)``,
   ``EIGEN_MAKE_ALIGNED_OPERATOR_NEW``), starting where a statement may start
@@ -40,6 +43,8 @@ _PASTED = re.compile(rb"(?<=[(,])([ \t\r\n]*)([A-Z][A-Z0-9_]*(?:[ \t\r\n]+[A-Z][
 _WORD = re.compile(rb"[A-Z][A-Z0-9_]*")
 _BARE = re.compile(rb"^[ \t]*([A-Z][A-Z0-9_]{2,})[ \t]*(\((?:[^()]|\((?:[^()]|\([^()]*\))*\))*\))?[ \t]*(//[^\n]*)?$",
                    re.M)
+_QT_ACCESS = re.compile(rb"\b(?:public|protected|private)([ \t]+(?:slots|Q_SLOTS))(?=[ \t]*:)")
+_QT_SIGNALS = re.compile(rb"^([ \t]*)(signals|Q_SIGNALS)(?=[ \t]*:)", re.M)
 REGISTER = re.compile(rb"\bRCLCPP_COMPONENTS_REGISTER_NODE\s*\(\s*([A-Za-z_][\w:]*)\s*\)")
 
 
@@ -104,6 +109,9 @@ def prepare(data: bytes) -> bytes:
                                                         if len(w.group(0)) >= 2 else w.group(0), m.group(2)), data)
     if b"__cplusplus" in data:
         data = _CPLUSPLUS.sub(lambda m: _spaces(m.group(0)), data)
+    if b"slots" in data or b"signals" in data or b"Q_S" in data:  # Qt's access specifiers
+        data = _QT_ACCESS.sub(lambda m: m.group(0)[: m.start(1) - m.start(0)] + _spaces(m.group(1)), data)
+        data = _QT_SIGNALS.sub(lambda m: m.group(1) + b"public" + b" " * (len(m.group(2)) - 6), data)
     if b"RCLCPP_COMPONENTS_REGISTER_NODE" in data:
         data = REGISTER.sub(lambda m: b" " * len(m.group(0)), data)
     return _bare(data)

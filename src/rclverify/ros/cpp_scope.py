@@ -23,6 +23,10 @@ from . import symbols, treesitter
 from .cpp_params import param_read
 
 _HANDLE_TYPES = ("NodeHandle",)
+#: what changes a string variable in place: C writers (their first argument) and std::string methods
+_C_WRITERS = {"sprintf", "snprintf", "strcpy", "strncpy", "strcat", "strncat", "memcpy", "sscanf", "vsnprintf"}
+_MUTATORS = {"append", "insert", "replace", "assign", "push_back", "erase", "resize", "clear", "pop_back"}
+UNKNOWN = ("unknown",)  # a binding whose value is not read statically
 _T = treesitter.text
 MAX_DEPTH = 12
 
@@ -129,9 +133,9 @@ class CppScope:
         for n in nodes:
             if n.type == "declaration":
                 self._declaration(n)
-            elif n.type == "assignment_expression" and n.child_by_field_name("operator") is not None \
-                    and _T(n.child_by_field_name("operator")) == "=":
-                self._assign(n.child_by_field_name("left"), n.child_by_field_name("right"), n)
+            elif n.type == "assignment_expression" and n.child_by_field_name("operator") is not None:
+                op = _T(n.child_by_field_name("operator"))
+                self._assign(n.child_by_field_name("left"), n.child_by_field_name("right") if op == "=" else None, n)
             elif n.type == "field_initializer":
                 fn = self.fn_of(n)
                 head = n.named_children[0] if n.named_children else None
@@ -145,6 +149,7 @@ class CppScope:
                 if r is not None and r[2] is not None:
                     self._bind(r[2], ("read", n), n)
                 f = n.child_by_field_name("function")
+                self._mutation(n, f)
                 if f is not None and f.type == "field_expression" and f.child_by_field_name("field") is not None \
                         and f.child_by_field_name("field").type == "template_method" \
                         and _T(f.child_by_field_name("field").child_by_field_name("name")) == "init":
@@ -254,8 +259,21 @@ class CppScope:
                 self.locals.setdefault(key, [])
 
     def _assign(self, left: Any, right: Any, at: Any) -> None:
-        if left is not None and right is not None:
-            self._bind(left, right, at)
+        """``left = right``; ``right`` is ``None`` for a compound assignment (``+=``): a value
+        no longer known statically."""
+        if left is not None:
+            self._bind(left, right if right is not None else UNKNOWN, at)
+
+    def _mutation(self, n: Any, f: Any) -> None:
+        """A call that changes a string in place (``snprintf(buf, ...)``, ``strcat``,
+        ``topic.append(...)``): its variable no longer holds what it was initialised with."""
+        if f is None:
+            return
+        a = n.child_by_field_name("arguments")
+        if f.type == "field_expression" and _T(f.child_by_field_name("field")) in _MUTATORS:
+            self._bind(f.child_by_field_name("argument"), UNKNOWN, n)
+        elif _T(f).split("::")[-1] in _C_WRITERS and a is not None and a.named_children:
+            self._bind(a.named_children[0], UNKNOWN, n)
 
     def _bind(self, target: Any, what: Any, at: Any) -> None:
         fn = self.fn_of(at)

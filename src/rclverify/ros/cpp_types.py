@@ -127,6 +127,19 @@ def action_type(name: str | None) -> str | None:
     return f"{pkg}/{mid}/{last}" if mid == "action" else None
 
 
+_NOT_PACKAGES = ("std", "ros", "boost", "actionlib", "Eigen", "rclcpp", "cv", "tf", "tf2", "tf2_ros")
+
+
+def action_type_in(name: str | None, using_ns: list[str]) -> str | None:
+    """:func:`action_type`, and for a bare ``XAction`` under one ``using namespace
+    pkg;`` of a package (not ``std``, ``ros``, ``boost`` ...), ``pkg/action/X``."""
+    t = action_type(name)
+    if t is not None or not name or "::" in name or not name.strip().endswith("Action"):
+        return t
+    pkgs = sorted({ns.strip(":") for ns in using_ns if ns and ns.strip(":").split("::")[0] not in _NOT_PACKAGES})
+    return action_type(f"{pkgs[0]}::{name.strip()}") if len(pkgs) == 1 else None
+
+
 def service_type(name: str | None) -> str | None:
     """``pkg::Srv``, ``pkg::srv::Srv``, ``pkg::Srv::Request`` (also as a
     ``SharedPtr`` or reference) -> ``pkg/srv/Srv``."""

@@ -42,7 +42,10 @@ def _options(ftext: str, fn: Any, args: list[Any]) -> tuple[str, str] | None:
 
 
 class CppValues(CppScope):
-    """A file's scopes with the values of its expressions."""
+    """A file's scopes with the values of its expressions; ``nodelet``: whether the
+    file is a nodelet's (``getName()`` is then the node's own name)."""
+
+    nodelet = False
 
     def value(self, n: Any, depth: int = 0) -> symbols.Val:
         """The :mod:`symbols` value of expression ``n`` (``None``: not read statically)."""
@@ -75,6 +78,8 @@ class CppValues(CppScope):
         ftext = _T(fn)
         last = ftext.split("::")[-1].split(".")[-1].split(">")[-1]
         if ftext.endswith("this_node::getName") or last == "get_fully_qualified_name":
+            return symbols.NODE
+        if ftext == "getName" and not args and self.nodelet:  # nodelet::Nodelet::getName(): the node's name
             return symbols.NODE
         if ftext in ("std::string", "string", "std::string_view") and len(args) == 1:
             return self.value(args[0], depth + 1)
@@ -176,6 +181,8 @@ class CppValues(CppScope):
 
     def _bound(self, fn: Fn | None, b: Any, depth: int) -> symbols.Val:
         if isinstance(b, tuple):
+            if b[0] == "unknown":  # changed in place (snprintf, +=, append): not read
+                return None
             if b[0] == "nhargs":
                 return self.handle(b[1], depth + 1)
             if b[0] in ("read", "ops"):

@@ -30,6 +30,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from .cmake import expand
+from .nodelets import plugin_classes
 
 _ENTRY = re.compile(r"^\s*([A-Za-z0-9_.\-]+)\s*=\s*([A-Za-z0-9_.]+)\s*:\s*[A-Za-z0-9_]+\s*$")
 _EXE = {"add_executable", "ament_auto_add_executable", "cs_add_executable"}
@@ -43,8 +44,10 @@ class Targets:
     """A package's build targets: ``executables`` and ``libraries`` ``{name: [source
     files that exist]}``, ``links`` ``{target: [linked target names]}``,
     ``components`` ``{executable: (class, CMakeLists line)}``, ``plugins``
-    ``{class: target}`` (every registered component class), ``programs``
-    ``{executable: [Python file]}`` (installed scripts, entry points)."""
+    ``{class: target}`` (every registered component class, and every nodelet
+    class its plugin description puts in a library of the package),
+    ``programs`` ``{executable: [Python file]}`` (installed scripts, entry
+    points), ``nodelets`` ``{lookup name: (class, library)}`` (:mod:`nodelets`)."""
 
     executables: dict[str, list[Path]] = field(default_factory=dict)
     libraries: dict[str, list[Path]] = field(default_factory=dict)
@@ -52,6 +55,7 @@ class Targets:
     components: dict[str, tuple[str, int]] = field(default_factory=dict)
     plugins: dict[str, str] = field(default_factory=dict)
     programs: dict[str, list[Path]] = field(default_factory=dict)
+    nodelets: dict[str, tuple[str, str | None]] = field(default_factory=dict)
 
 
 MAX_GLOB_DIRS = 2000  # directories one file(GLOB) pattern may visit
@@ -102,6 +106,10 @@ def targets(root: Path, pkg: str) -> Targets:
         _read(cmds, here, t, auto_libs, todo)
     for exe, srcs in setup_py_executables(root).items():
         t.programs.setdefault(exe, srcs)
+    t.nodelets = plugin_classes(root)
+    for cls, lib in t.nodelets.values():
+        if lib in t.libraries:
+            t.plugins.setdefault(cls, lib)
     return t
 
 

@@ -169,6 +169,8 @@ def _scan(paths: Sequence[Path], launch: Sequence[Path], launch_args: dict[str, 
     # rosbags' ROS 2 store instead (docs/ros.md).
     if standard and (not pkgs or any(p.ros == 1 for p in pkgs.values())):
         table.add_debian_standard(cache)
+    elif standard:  # rosbags' ROS 2 store has messages only: services of message-less packages (std_srvs)
+        table.add_debian_standard(cache, services_only=True)
     for tname, fname, missing in table.unknown_refs():
         info = table.types[tname]
         g.notes.append(Note(Src(info.file or tname, info.lines.get(fname, 1)),
@@ -216,12 +218,13 @@ def _scan(paths: Sequence[Path], launch: Sequence[Path], launch_args: dict[str, 
 
     def add_node(full: str, ns: str, pkg: str | None, exe: str | None, files: list[str], declared: Src,
                  eps: list[Endpoint], remaps: list[tuple[str, str, Src]], origin: str,
-                 params: dict[str, tuple[str, Src]] | None = None) -> None:
-        node = GraphNode(full, ns, pkg, exe, files, declared, origin=origin)
+                 params: dict[str, tuple[str, Src]] | None = None, lifecycle: bool = False) -> None:
+        node = GraphNode(full, ns, pkg, exe, files, declared, origin=origin, lifecycle=lifecycle)
         if full in g.nodes and origin == "source" and g.nodes[full].origin == "source":
             # no launch file starts them: several programs that take the same
             # name are one node of the graph with all their endpoints (docs/ros.md)
             node = g.nodes[full]
+            node.lifecycle = node.lifecycle or lifecycle
             g.notes.append(Note(declared, f"node {full} is also named at {node.declared_at}; no launch file "
                                           f"starts these programs: shown as one node with the endpoints of "
                                           f"all of them", "ROS-LAUNCH"))
@@ -236,7 +239,10 @@ def _scan(paths: Sequence[Path], launch: Sequence[Path], launch_args: dict[str, 
                 pname = names.resolve(e.param, ns, full)
                 got = mine.get(pname) or launch_params.get(pname)
                 if got is not None:
-                    written, set_at = got
+                    written, set_at = e.affix[0] + got[0] + e.affix[1], got[1]
+                elif e.unread is not None:
+                    g.notes.append(e.unread)
+                    continue
                 elif not e.topic:
                     g.notes.append(Note(e.src, f"name of {e.kind} comes from parameter {pname}, which has no "
                                                f"default in the code and no value in the launch files: "

@@ -45,6 +45,7 @@ from .ground_services import RULES as SERVICE_RULES
 from .ground_services import folded, ground_links
 from .interfaces import BASE_TYPES, TypeTable, field_path
 from .model import GraphEdge, GraphNode, Src, canon_type, short_type
+from .lifecycle import implicit
 
 _INT = {"int8", "int16", "int32", "int64", "uint8", "uint16", "uint32", "uint64", "byte", "char", "octet"}
 _FLOAT = {"float32", "float64"}
@@ -166,7 +167,7 @@ class Grounder:
         pairs = match_nodes(self.checked.nodes, graph_nodes, explicit)
         publishers: dict[str, list[tuple[str, GraphEdge]]] = {t: [] for t in external}
         for n in graph_nodes.values():
-            for e in n.publishes:
+            for e in n.publishes + implicit(n, "pub"):  # a lifecycle node's transition events too
                 publishers.setdefault(e.topic, []).append((n.name, e))
         all_topics = sorted(set(publishers) | {e.topic for n in graph_nodes.values() for e in n.subscribes})
         self.recorded: dict[str, list[tuple[str, str | None]]] = {}

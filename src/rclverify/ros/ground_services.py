@@ -29,6 +29,7 @@ from ..rcl import ast
 from . import names
 from .interfaces import TypeTable
 from .model import Graph, GraphEdge, GraphNode, Src, canon_type, short_type
+from .lifecycle import implicit
 
 #: rule id -> (severity, description), merged into ``ground.RULES`` (SARIF rules)
 RULES: dict[str, tuple[str, str]] = {}
@@ -70,10 +71,11 @@ def _own(edges: list[GraphEdge], name: str, gn: GraphNode) -> GraphEdge | None:
 
 def servers(graph_nodes: Mapping[str, GraphNode], kind: str) -> dict[str, list[tuple[str, GraphEdge]]]:
     """``{resolved name: [(node, server edge)]}`` of every service (``kind="service"``)
-    or action (``"action"``) served in ``graph_nodes``."""
+    or action (``"action"``) served in ``graph_nodes`` (with the management services
+    of lifecycle nodes, :mod:`lifecycle`)."""
     out: dict[str, list[tuple[str, GraphEdge]]] = {}
     for n in sorted(graph_nodes.values(), key=lambda n: n.name):
-        for e in n.edges_of(f"{kind}_servers"):
+        for e in n.edges_of(f"{kind}_servers") + implicit(n, f"{kind}_servers"):
             out.setdefault(e.topic, []).append((n.name, e))
     return out
 

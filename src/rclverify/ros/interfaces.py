@@ -156,16 +156,22 @@ class TypeTable:
                     if f.suffix in (".msg", ".srv", ".action", ".idl") and f.is_file():
                         self.add_file(f, pkg, show(f), origin, cache, files)
 
-    def add_debian_standard(self, cache: ParseCache | None, share: Path = DEBIAN_SHARE) -> list[str]:
+    def add_debian_standard(self, cache: ParseCache | None, share: Path = DEBIAN_SHARE,
+                            services_only: bool = False) -> list[str]:
         """Register the interface packages Debian installed (``/usr/share/<pkg>/msg``,
         ``srv`` and ``action`` for a ``<pkg>`` with a ``package.xml`` or named ``*_msgs``
-        or ``*_srvs``, e.g. ``std_srvs``, which has no message); returns their names."""
+        or ``*_srvs``, e.g. ``std_srvs``, which has no message); returns their names.
+        ``services_only``: only packages that define no message (``std_srvs``), whose
+        services read the same in ROS 1 and ROS 2 (any message they use comes from
+        the ROS 2 store), for a scan of ROS 2 packages only (docs/ros.md)."""
         found: list[str] = []
         if not share.is_dir():
             return found
         roots = {p.parent for sub in ("msg", "srv", "action") for p in share.glob(f"*/{sub}")}
         for root in sorted(roots):
             if not ((root / "package.xml").is_file() or root.name.endswith(("_msgs", "_srvs"))):
+                continue
+            if services_only and (root / "msg").is_dir():
                 continue
             if root.name not in {p.split("/")[0] for p in self.types}:
                 self.add_package_dir(root, root.name, lambda f: f"{root.name}/{f.parent.name}/{f.name}",
@@ -224,7 +230,7 @@ class TypeTable:
 
 
 def field_path(table: TypeTable, msg_type: str, path: str) -> tuple[str | None, str | None, bool]:
-    """Follow ``path`` (``a.b[2].c``, ``a.b[].c``, ``a.b``) through ``msg_type``.
+    """Follow ``path`` (``a.b[2].c``, ``a.b[-1].c``, ``a.b[].c``, ``a.b``) through ``msg_type``.
 
     Returns ``(ros_type, error, is_array)``: the field's ROS type (``float32``,
     ``pkg/msg/T``) and whether the final field is an array, or an error text
@@ -233,7 +239,7 @@ def field_path(table: TypeTable, msg_type: str, path: str) -> tuple[str | None, 
     cur = msg_type
     is_array = False
     for seg in path.split("."):
-        m = re.fullmatch(r"([A-Za-z_][A-Za-z0-9_]*)((?:\[\d*\])*)", seg)
+        m = re.fullmatch(r"([A-Za-z_][A-Za-z0-9_]*)((?:\[-?\d*\])*)", seg)
         if not m:
             return None, f"'{seg}' is not a field name", False
         fname, index = m.group(1), m.group(2)

@@ -58,6 +58,7 @@ class LaunchNode:
     plugin: str | None = None  # a composable node's class (``ns::Class``); ``exe`` is then ""
     # the node's private parameters the launch file sets: ``~name`` -> (value, where set)
     params: dict[str, tuple[str, Src]] = field(default_factory=dict)
+    args: str | None = None  # the node's command-line ``args`` (a nodelet's ``load pkg/Type manager``)
 
 
 @dataclass
@@ -275,7 +276,8 @@ class Interpreter:
             ns = self._attr(el, "ns", scope, path) or self._attr(el, "namespace", scope, path)
             node_ns = names.join(scope.ns, ns) if ns else scope.ns
             remaps, params = self._node_children(el, scope, path, node_ns, name)
-            self.nodes.append(LaunchNode(pkg, exe, name, node_ns, remaps, el.src, None, params))
+            self.nodes.append(LaunchNode(pkg, exe, name, node_ns, remaps, el.src, None, params,
+                                         self._attr(el, "args", scope, path) if pkg == "nodelet" else None))
         elif t == "include":
             f = self._attr(el, "file", scope, path)
             if not f:

@@ -36,6 +36,9 @@ def _callee(c: ast.Call) -> str:
 
 #: the variables ``generate_launch_description()`` assigns, while one file is read
 _ENV: dict[str, ast.AST] = {}
+#: the variables it assigns more than once (chosen at run time): name -> lines
+_TWICE: dict[str, list[int]] = {}
+_HERE = [""]  # the launch file's name
 
 
 def _value(e: ast.AST, depth: int = 0) -> str:
@@ -43,6 +46,9 @@ def _value(e: ast.AST, depth: int = 0) -> str:
         return str(e.value).lower() if isinstance(e.value, bool) else str(e.value)
     if isinstance(e, ast.Name) and e.id in _ENV and depth < 8:
         return _value(_ENV[e.id], depth + 1)
+    if isinstance(e, ast.Name) and e.id in _TWICE:
+        raise _Unres(f"variable '{e.id}' (assigned {len(_TWICE[e.id])} times, lines "
+                     f"{', '.join(map(str, _TWICE[e.id]))}: chosen at run time)")
     if isinstance(e, ast.Name):
         raise _Unres(f"variable '{e.id}' (not assigned in generate_launch_description())")
     if isinstance(e, ast.Call):
@@ -51,6 +57,8 @@ def _value(e: ast.AST, depth: int = 0) -> str:
             var = _value(e.args[0], depth + 1)
             d = _kw(e, "default")
             return f"$(var-default {var} {_value(d, depth + 1)})" if d is not None else f"$(var {var})"
+        if name in ("ThisLaunchFileDir", "ThisLaunchFile") and not e.args:
+            return "$(dirname)" if name == "ThisLaunchFileDir" else "$(dirname)/" + _HERE[0]
         args = [_value(a, depth + 1) for a in e.args]
         if name in ("get_package_share_directory", "FindPackageShare") and len(args) == 1:
             return f"$(find-pkg-share {args[0]})"
@@ -210,10 +218,13 @@ def read_python(path: Path, shown: str) -> tuple[El | None, list[Note]]:
     notes: list[Note] = []
     fn = next((f for f in tree.body if isinstance(f, ast.FunctionDef) and f.name == "generate_launch_description"), None)
     _ENV.clear()
+    _TWICE.clear()
+    _HERE[0] = path.name
     try:
         return _read(fn, shown, notes)
     finally:
         _ENV.clear()
+        _TWICE.clear()
 
 
 def _read(fn: ast.FunctionDef | None, shown: str, notes: list[Note]) -> tuple[El | None, list[Note]]:
@@ -221,14 +232,15 @@ def _read(fn: ast.FunctionDef | None, shown: str, notes: list[Note]) -> tuple[El
         return None, [Note(Src(shown), "no generate_launch_description() function", "ROS-PARSE", "error")]
     kids: list[El] = []
     assigned: dict[str, ast.AST] = {}
-    counts: dict[str, int] = {}
+    counts: dict[str, list[int]] = {}
     for st in ast.walk(fn):
         if isinstance(st, ast.Assign) and len(st.targets) == 1 and isinstance(st.targets[0], ast.Name):
-            counts[st.targets[0].id] = counts.get(st.targets[0].id, 0) + 1
+            counts.setdefault(st.targets[0].id, []).append(st.lineno)
             _ENV[st.targets[0].id] = st.value
-    for name, k in counts.items():
-        if k > 1:
+    for name, lines in counts.items():
+        if len(lines) > 1:
             _ENV.pop(name)  # assigned twice: not one value
+            _TWICE[name] = sorted(lines)
     for st in ast.walk(fn):
         if isinstance(st, ast.Assign) and len(st.targets) == 1 and isinstance(st.targets[0], ast.Name):
             assigned[st.targets[0].id] = st.value

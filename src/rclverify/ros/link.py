@@ -33,43 +33,45 @@ import re
 from dataclasses import dataclass, field
 from typing import Any, Callable
 
-from . import cpp_helpers, emit, symbols
-from .cpp_types import action_type, message_type, service_type, split_template
+from . import emit, symbols
+from .cpp_types import split_template
 from .model import Endpoint, Note, Src
+from .link_members import LinkMembers
 from .link_values import MAX_DEPTH, MAX_VALUES, Values
 from .programs import PackageCode, Program
+from .unit_names import canonical
 
 __all__ = ["Linked", "Linker", "MAX_DEPTH", "MAX_VALUES"]
-_ACTIONLIB = {"SimpleActionServer": "action_servers", "ActionServer": "action_servers",
-              "SimpleActionClient": "action_clients", "ActionClient": "action_clients"}
 _IDENT = re.compile(r"[A-Za-z_][\w:]*")
 
 
 @dataclass
 class Linked:
-    """A linked program: ``nodes`` ``[(name, where named, namespace or None)]``,
-    ``endpoints`` ``[(Endpoint, index of its node in nodes, or -1)]``, ``notes``
+    """A linked program: ``nodes`` ``[(name, where named, namespace or None)]`` (``kinds``:
+    each one's kind, ``"lifecycle"`` for a managed node, else ``None``), ``endpoints`` ``[(Endpoint, index of its node in nodes, or -1)]``, ``notes``
     and the ``files`` that gave any of them."""
 
     nodes: list[tuple[str, Src, str | None]] = field(default_factory=list)
+    kinds: list[str | None] = field(default_factory=list)  # per node: "lifecycle" or None
     endpoints: list[tuple[Endpoint, int]] = field(default_factory=list)
     notes: list[Note] = field(default_factory=list)
     files: list[str] = field(default_factory=list)
 
 
-class Linker(Values):
+class Linker(LinkMembers, Values):
     """Link one program of a package (see the module docstring); ``known(t)`` says
     whether the scan's type table defines message type ``t``."""
 
     def __init__(self, prog: Program, code: PackageCode, known: Callable[[str], bool]) -> None:
         self.prog, self.code, self.known = prog, code, known
-        self.recs = {f: code.records[f] for f in prog.files if f in code.records}
+        self.recs = canonical({f: code.records[f] for f in prog.files if f in code.records})
         self.fns: dict[str, tuple[str, list[str], list[str], list[Any]]] = {}
         self.units: dict[str, dict[str, Any]] = {}
         self.fields: dict[tuple[str, str], list[Any]] = {}
         self.callbacks: dict[str, str] = {}
         self.aliases: dict[str, str] = {}
         self.calls: list[tuple[Any, ...]] = []
+        self.using_ns = sorted({ns for r in self.recs.values() for ns in r.get("using_ns", [])})
         entry_units: set[str] = set()
         for f, r in self.recs.items():
             for k, (unit, params, ptypes, defaults) in r.get("fns", {}).items():
@@ -127,6 +129,7 @@ class Linker(Values):
         self.reach = self._reach({f"U:{u}" for u in self.entry})
         self._memo: dict[str, list[dict[int, Any]]] = {}
         self._stack: set[str] = set()
+        self.pins: dict[str, int] = {}
 
     # -- program structure
     def match(self, name: str, caller: str | None) -> str | None:
@@ -223,51 +226,81 @@ class Linker(Values):
     def run(self) -> Linked:
         out = Linked()
         said: set[tuple[Src, str]] = set()
-        eps: list[Endpoint] = []
 
         def note(n: Note) -> None:
             if (n.src, n.message) not in said:
                 said.add((n.src, n.message))
                 out.notes.append(n)
 
-        def take(f: str, e: Endpoint) -> None:
-            if e.unit is None and e.func is None and f not in self.prog.entry:
-                return
-            if (e.unit is not None or e.func is not None) and not self.runs(e.unit, e.func):
-                return
-            for x in self.resolve(e, note):
-                if x not in eps:
-                    eps.append(x)
-                    if f not in out.files:
-                        out.files.append(f)
+        raw: list[tuple[str, Endpoint]] = []
+        for f, r in self.recs.items():
+            for e in list(r.get("endpoints", [])) + self.members(r):
+                if e.unit is None and e.func is None and f not in self.prog.entry:
+                    continue
+                if (e.unit is not None or e.func is not None) and not self.runs(e.unit, e.func):
+                    continue
+                raw.append((f, e))
+        named = self.named(note, out)
+        out.nodes = [(n, s, ns) for n, s, ns, _u, _p in named]
+        units = [u for _n, _s, _ns, u, _p in named]
+        got: list[tuple[Endpoint, int]] = []
+        # a header no program of the package includes: its classes are for other packages to
+        # make, with the names they give; what they leave open is not this package's to say
+        unused = self.prog.exe is None and self.prog.units is None and not named and \
+            all(f.rsplit(".", 1)[-1] in ("h", "hh", "hpp", "hxx") for f in self.prog.entry)
+        say = (lambda n: None) if unused else note
+        for (f, e), own in zip(raw, self.owners(units, [e for _f, e in raw])):
+            # one class made as several nodes (each call site its own name): each instance
+            # reads the endpoint with the arguments of its own call site (docs/ros.md)
+            group = [j for j, it in enumerate(named) if own >= 0 and it[3] == units[own] and it[1] == named[own][1]]
+            for j in group if len(group) > 1 else [own]:
+                self.pin(named[j][4] if len(group) > 1 else {})
+                for x in self.resolve(e, say):
+                    if (x, j) not in got:
+                        got.append((x, j))
+                        if f not in out.files:
+                            out.files.append(f)
+        self.pin({})
+        out.endpoints = got
+        return out
 
+    def named(self, note: Callable[[Note], None], out: Linked) -> list[tuple[str, Src, str | None, str | None,
+                                                                          dict[str, int]]]:
+        """The program's nodes: ``[(name, where named, namespace, unit, pins)]``; a node
+        name read from the arguments of a function called at several sites (a node
+        class constructed twice) is read site by site, ``pins`` naming the site."""
+        named: list[tuple[str, Src, str | None, str | None, dict[str, int]]] = []
         for f, r in self.recs.items():
-            for e in r.get("endpoints", []):
-                take(f, e)
-            for e in self.members(r):
-                take(f, e)
-        named: list[tuple[str, Src, str | None, str | None]] = []
-        for f, r in self.recs.items():
-            for v, src, unit, fkey, ns in r.get("node_names", []):
+            for v, src, unit, fkey, ns, *kind in r.get("node_names", []):
                 if (unit is not None or fkey is not None) and not self.runs(unit, fkey) \
                         or unit is None and fkey is None and f not in self.prog.entry:
                     continue
-                for env in self.contexts(fkey):
-                    for name in self.eval(v, env, fkey):
-                        t = symbols.text(name) if name is not None and name[0] in ("str", "cat") else None
-                        if t is None:
-                            note(Note(src, "node name is not a string literal: not resolved statically"))
-                            continue
-                        nsv = self.eval(ns, env, fkey)[0] if ns is not None else None
-                        item = (t, src, symbols.text(nsv) if nsv is not None else None, unit)
-                        if not any(x[0] == t and x[2] == item[2] for x in named):
-                            named.append(item)
-                        if f not in out.files:
-                            out.files.append(f)
-        out.nodes = [(n, s, ns) for n, s, ns, _u in named]
-        owners = self.owners([u for *_x, u in named], eps)
-        out.endpoints = list(zip(eps, owners))
-        return out
+                live = [i for i, (_a, _k, caller) in enumerate(self.sites.get(fkey or "", []))
+                        if caller is None or self.runs(None, caller)]
+                pinned = len(live) > 1 and not symbols.is_concrete(v)
+                for pins in [{fkey: i} for i in live] if pinned and fkey else [{}]:
+                    self.pin(pins)
+                    for env in self.contexts(fkey):
+                        for name in self.eval(v, env, fkey):
+                            t = symbols.text(name) if name is not None and name[0] in ("str", "cat") else None
+                            if t is None:
+                                note(Note(src, "node name is not a string literal: not resolved statically"))
+                                continue
+                            nsv = self.eval(ns, env, fkey)[0] if ns is not None else None
+                            item = (t, src, symbols.text(nsv) if nsv is not None else None, unit, pins)
+                            if not any(x[0] == t and x[2] == item[2] for x in named):
+                                named.append(item)
+                                out.kinds.append(kind[0] if kind else None)
+                            if f not in out.files:
+                                out.files.append(f)
+        self.pin({})
+        return named
+
+    def pin(self, pins: dict[str, int]) -> None:
+        """Read function ``k``'s parameters from its call site ``pins[k]`` only."""
+        if pins != self.pins:
+            self.pins = pins
+            self._memo.clear()
 
     def resolve(self, e: Endpoint, note: Callable[[Note], None]) -> list[Endpoint]:
         """The concrete endpoints a (possibly pending) endpoint stands for."""
@@ -289,68 +322,6 @@ class Linker(Values):
         if got and t is None:
             note(emit.type_note(got[0]))
         return got
-
-    def cb_type(self, kind: str, cb: Any) -> str | None:
-        """The type a callback (C++: its name; Python: ``("cands", types)`` of a star
-        import) gives an endpoint of role ``kind``."""
-        if isinstance(cb, tuple) and cb and cb[0] == "cands":
-            known = [t for t in cb[1] if self.known(t)]
-            return known[0] if len(known) == 1 else None
-        if isinstance(cb, tuple) and cb and cb[0] == "type":
-            text: str | None = cb[1]
-            for _ in range(4):
-                text = self.aliases.get(text or "", self.aliases.get((text or "").split("::")[-1], text))
-        elif isinstance(cb, str):
-            text = self.callbacks.get(cb)
-            if text is None:  # written with another qualification than declared
-                hits = sorted({v for k, v in self.callbacks.items() if k.endswith("::" + cb) or cb.endswith("::" + k)})
-                text = hits[0] if len(hits) == 1 else self.callbacks.get(cb.split("::")[-1])
-        else:
-            return None
-        if kind in ("pub", "sub"):
-            return message_type(text, self.aliases)
-        return service_type(text) if kind.startswith("service") else action_type(text)
-
-    def members(self, r: dict[str, Any]) -> list[Endpoint]:
-        """Pending endpoints of helper objects held as members (their class found in
-        the program's declarations): made in a constructor's initialiser list, or
-        by default where none initialises them; and of their methods' calls."""
-        out: list[Endpoint] = []
-        for unit, m, ty, src in r.get("member_decls", []):
-            if not self.runs(unit, None):
-                continue
-            inits = [c for c in self.calls if c[0] == "member" and c[1] == m and c[4] == unit]
-            for c in inits or [None]:
-                args = c[2] if c else []
-                at, fkey = (c[5], c[3]) if c else (src, None)
-                for kind, nv, t, hv in self.helper(ty, args) or []:
-                    out.append(Endpoint(kind, "", t, at, None, (), unit,
-                                        (nv, hv, None, fkey, symbols.text(nv) or m, at), fkey))
-        for unit, m, meth, args, texts, src, fkey in r.get("member_calls", []):
-            if not self.runs(unit, fkey):
-                continue
-            ty = self.units.get(unit, {}).get("members", {}).get(m)
-            for b in self.units.get(unit, {}).get("bases", []):
-                cls = self.match(b, unit)
-                ty = ty or (self.units.get(cls, {}).get("members", {}).get(m) if cls else None)
-            specs = cpp_helpers.method(ty, meth, args, [], lambda x: x, None) if ty else None
-            for kind, nv, t, hv in specs or []:
-                k = 1 if kind == "sub" and meth == "subscribe" else 0
-                out.append(Endpoint(kind, "", t, src, None, (), unit,
-                                    (nv, hv, None, fkey, texts[k] if k < len(texts) else m, src), fkey))
-        return out
-
-    def helper(self, ty: str, args: list[Any]) -> list[cpp_helpers.Spec] | None:
-        head, targs = split_template(ty.replace(" ", ""))
-        last = head.split("::")[-1]
-        if last in _ACTIONLIB and targs:
-            if not args:
-                return []
-            first = args[0]
-            if len(args) >= 2 and first is not None and first[0] in ("nh", "field", "arg"):
-                return [(_ACTIONLIB[last], args[1], action_type(targs[0]), first)]
-            return [(_ACTIONLIB[last], first, action_type(targs[0]), None)]
-        return cpp_helpers.constructed(ty, args, lambda x: x, False)
 
     def owners(self, units: list[str | None], eps: list[Endpoint]) -> list[int]:
         """Each endpoint's node (an index in the named nodes; -1 when none)."""

@@ -45,6 +45,7 @@ class Values:
     code: Any
     _memo: dict[str, list[dict[int, Any]]]
     _stack: set[str]
+    pins: dict[str, int]  # function key -> the one call site whose arguments are read
 
     def runs(self, unit: str | None, fkey: str | None, reach: set[str] | None = None) -> bool:  # pragma: no cover
         raise NotImplementedError
@@ -63,7 +64,8 @@ class Values:
         self._stack.add(fkey)
         params = self.fns[fkey][1]
         envs: list[dict[int, Any]] = []
-        for args, kwargs, caller in self.sites.get(fkey, []):
+        sites = self.sites.get(fkey, [])
+        for args, kwargs, caller in sites[self.pins[fkey]:self.pins[fkey] + 1] if fkey in self.pins else sites:
             if caller is not None and not self.runs(None, caller):
                 continue
             for cenv in self.contexts(caller, depth + 1):

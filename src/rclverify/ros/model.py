@@ -37,7 +37,10 @@ class Endpoint:
     name as ROS resolves it for the node (``~topic`` private, ``topic``
     relative, ``/topic`` global; ROS 2 parameters are always ``~name``), and
     ``topic`` is then the code's default (``""`` when it gives none); the
-    launch file's value for the parameter wins (docs/ros.md, "Reading real code").
+    launch file's value for the parameter wins (docs/ros.md, "Reading real code");
+    ``affix``: the literal text before and after the parameter's value when the
+    name is built around it (``'/%s/pose' % get_param('~turtle')``), read only
+    where a launch file sets the parameter, else ``unread`` (a :class:`Note`) is given.
 
     ``handle``: the namespaces of the node handle the name is created through
     (``("~",)`` for a private ``ros::NodeHandle``, ``("left",)``; resolved, and
@@ -55,6 +58,8 @@ class Endpoint:
     unit: str | None = None
     pending: Any = None
     func: str | None = None
+    affix: tuple[str, str] = ("", "")  # text around the parameter's value ('/' + value + '/pose')
+    unread: Any = None  # the located note to give when no launch file sets that parameter
 
 
 # The four service/action roles an :class:`Endpoint` may have besides "pub"/"sub", each the
@@ -122,6 +127,9 @@ class GraphNode:
     service_clients: list[GraphEdge] = field(default_factory=list)
     action_servers: list[GraphEdge] = field(default_factory=list)
     action_clients: list[GraphEdge] = field(default_factory=list)
+    # a managed (lifecycle) node: rclcpp_lifecycle / rclpy.lifecycle make its management
+    # services and transition events (:mod:`lifecycle`), which are not edges of its code
+    lifecycle: bool = False
 
     def edges_of(self, kind: str) -> list[GraphEdge]:
         """The list an :class:`Endpoint` of ``kind`` ("pub", "sub" or one of ``SERVICE_ROLES``)
@@ -145,6 +153,8 @@ class GraphNode:
         }
         for role in SERVICE_ROLES:
             d[role] = [e.to_json() for e in sorted(getattr(self, role), key=_ek)]
+        if self.lifecycle:
+            d["lifecycle"] = True
         return d
 
 

@@ -34,8 +34,9 @@ class Program:
     """One program: ``package``, ``exe`` (the executable's name; ``None`` for a
     component class registered without one, or a loose file), ``entry`` (the
     files whose units start it), ``files`` (every file it runs, shown paths),
-    ``units`` (explicit entry units: a component's class) and ``aliases``
-    (other names of the executable: a script's stem)."""
+    ``units`` (explicit entry units: a component's or nodelet's class),
+    ``aliases`` (other names of the executable: a script's stem) and
+    ``nodelet`` (for a nodelet class: its lookup name, :mod:`nodelets`)."""
 
     package: str
     exe: str | None
@@ -43,6 +44,7 @@ class Program:
     files: list[str]
     units: set[str] | None = None
     aliases: list[str] = field(default_factory=list)
+    nodelet: str | None = None  # a nodelet class's lookup name (``pkg/Type``), or its class when none is known
 
 
 def module_names(shown: str, pkg_shown: str) -> list[str]:
@@ -124,6 +126,19 @@ def _closure(code: PackageCode, start: list[str], listed: set[str]) -> list[str]
     return seen
 
 
+def _class_named(code: PackageCode, cls: str) -> str:
+    """The class of the package's C++ records that ``cls`` (as a build file or
+    plugin description writes it) names: itself, else the one class whose
+    qualified name ends with it."""
+    cls = cls.strip().lstrip(":")
+    units = {u for r in code.records.values() if r.get("lang") != "py" for u in r.get("units", {})}
+    if cls in units:
+        return cls
+    ends = sorted(u for u in units if u.endswith("::" + cls.split("::")[-1]) and
+                  (u.endswith("::" + cls) or "::" not in cls))
+    return ends[0] if len(ends) == 1 else cls
+
+
 def programs(code: PackageCode, t: Targets) -> list[Program]:
     """Every program of the package (see the module docstring)."""
     show = code.show
@@ -145,14 +160,25 @@ def programs(code: PackageCode, t: Targets) -> list[Program]:
         comp = t.components.get(exe)
         out.append(Program(code.name, exe, own, files, {comp[0]} if comp else None))
         held.update(files)
-    for cls, target in sorted(t.plugins.items()):
-        srcs = [show(p) for p in t.libraries.get(target, []) + t.executables.get(target, [])]
-        files = _closure(code, srcs + linked(target, {target}), listed)
-        exes = [e for e, (c, _l) in t.components.items() if c == cls]
-        for exe in exes or [None]:
-            if exe is not None and exe in t.executables:
+    lookups = {c: k for k, (c, _lib) in t.nodelets.items()}
+    plugins = dict(t.plugins)
+    for f, r in sorted(code.records.items()):  # nodelets registered in code, with no plugin description read
+        for cls, lookup, _at in r.get("nodelets", []):
+            if _class_named(code, cls) not in {_class_named(code, c) for c in plugins}:
+                lib = next((n for n, ps in sorted(t.libraries.items()) if f in {show(p) for p in ps}), None)
+                plugins[cls] = lib or f"file:{f}"
+                lookups.setdefault(cls, lookup or cls)
+    for cls, target in sorted(plugins.items()):
+        lib_srcs = [show(p) for p in t.libraries.get(target, []) + t.executables.get(target, [])] or \
+            ([target[5:]] if target.startswith("file:") else [])
+        files = _closure(code, lib_srcs + linked(target, {target}),
+                         listed if not target.startswith("file:") else set())
+        exes: list[str | None] = [e for e, (c, _l) in t.components.items() if c == cls]
+        for comp_exe in exes or [None]:
+            if comp_exe is not None and comp_exe in t.executables:
                 continue
-            out.append(Program(code.name, exe, srcs, files, {cls}))
+            out.append(Program(code.name, comp_exe, lib_srcs, files, {_class_named(code, cls)},
+                               nodelet=lookups.get(cls)))
         held.update(files)
     scripts: dict[str, list[str]] = {}
     for exe, paths in t.programs.items():

@@ -11,6 +11,9 @@ documented API):
 | ``rospy.wait_for_message(name, T)`` / rclpy ``wait_for_message(T, node, name)`` | subscribes ``name`` |
 | ``InteractiveMarkerServer(ns)`` (ROS 1) / ``(node, ns)`` (ROS 2) | as the C++ server (:mod:`cpp_helpers`) |
 | rclpy ``ParameterEventHandler(node)`` | subscribes ``/parameter_events`` |
+| ``diagnostic_updater.Updater()`` (ROS 1) / ``Updater(node)`` (ROS 2) | publishes ``/diagnostics`` |
+| ``dynamic_reconfigure.server.Server(Config, cb[, namespace])`` | serves ``set_parameters``, publishes ``parameter_descriptions``, ``parameter_updates`` in ``~`` (a relative ``namespace`` is under ``~``) |
+| ``dynamic_reconfigure.client.Client(name, ...)`` | calls ``name/set_parameters``, subscribes ``name/parameter_descriptions``, ``name/parameter_updates`` |
 
 A spec is ``(role, name value or the argument holding it, type argument,
 handle)``; :mod:`sources_py` reads the arguments.
@@ -20,7 +23,7 @@ from __future__ import annotations
 from typing import Any
 
 from . import symbols
-from .cpp_helpers import EVENTS, TF, VIS
+from .cpp_helpers import DIAGNOSTICS, EVENTS, RECONF, TF, VIS
 from .pyrecords import PyCall, PyVal
 
 _BROADCASTERS = {"TransformBroadcaster": "/tf", "StaticTransformBroadcaster": "/tf_static"}
@@ -58,4 +61,25 @@ def helper(origin: str, c: PyCall, ros2: bool) -> list[tuple[str, Any, Any]] | N
         return out
     if top == "rclpy" and last == "ParameterEventHandler":
         return [(EVENTS[0], EVENTS[1], EVENTS[2])]
+    if top == "diagnostic_updater" and last == "Updater":
+        return [(DIAGNOSTICS[0], DIAGNOSTICS[1], DIAGNOSTICS[2])]
+    if top == "dynamic_reconfigure" and last in ("Server", "Client"):
+        return _reconfigure(last, c)
     return None
+
+
+def _reconfigure(last: str, c: PyCall) -> list[tuple[str, Any, Any]]:
+    """dynamic_reconfigure's Python server (its namespace: ``~`` by default, a
+    relative one under ``~``) or client (the server's name)."""
+    parts = (("set_parameters", RECONF + "srv/Reconfigure"), ("parameter_descriptions", RECONF + "msg/ConfigDescription"),
+             ("parameter_updates", RECONF + "msg/Config"))
+    if last == "Client":
+        name = _arg(c, 0, "name")
+        return [(role, ("under", name, n), t) for role, (n, t) in zip(("service_clients", "sub", "sub"), parts)]
+    ns = _arg(c, 2, "namespace")
+    if ns is not None and ns.kind != "str":  # relative or not is known only at run time: not guessed
+        return [(role, ("under", None, n), t) for role, (n, t) in zip(("service_servers", "pub", "pub"), parts)]
+    text = ns.text if ns is not None else ""
+    prefix = "~" if not text else (text if text[0] in "/~" else "~" + text).rstrip("/") + "/"
+    return [(role, symbols.lit((prefix + n).replace("~/", "~")), t)
+            for role, (n, t) in zip(("service_servers", "pub", "pub"), parts)]

@@ -3,9 +3,12 @@
 calls with their arguments, and assignments; :func:`sources_py.extract` reads it."""
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass, field
 
 from .model import Src
+
+_SPEC = re.compile(r"%(?:\([^)]*\))?[-#0 +]*(?:\d+|\*)?(?:\.\d+)?[a-zA-Z%]")
 
 
 @dataclass
@@ -58,3 +61,23 @@ class PyModule:
         self.import_lines.setdefault(local, []).append((origin, line))
         first = min(self.import_lines[local], key=lambda x: x[1])
         self.imports[local] = first[0]
+
+
+def percent(fmt: str, args: list[PyVal], text: str, src: Src) -> PyVal:
+    """``'fmt' % args`` (``text`` the source) as a concatenation when every
+    specifier is ``%s`` (``%%`` a percent sign) and there is one argument per
+    specifier; anything else is ``"other"`` (not read)."""
+    parts: list[PyVal] = []
+    at, k = 0, 0
+    for m in _SPEC.finditer(fmt):
+        if m.group(0) not in ("%s", "%%") or (m.group(0) == "%s" and k >= len(args)):
+            return PyVal("other", text, src)
+        parts.append(PyVal("str", fmt[at:m.start()] + ("%" if m.group(0) == "%%" else ""), src))
+        if m.group(0) == "%s":
+            parts.append(args[k])
+            k += 1
+        at = m.end()
+    if k != len(args):
+        return PyVal("other", text, src)
+    parts.append(PyVal("str", fmt[at:], src))
+    return PyVal("cat", text, src, parts=parts)

@@ -36,10 +36,12 @@ from __future__ import annotations
 from typing import Any
 
 from . import cpp_helpers, emit, symbols, treesitter
+from .cpp_members import MemberReader
 from .cpp_prep import REGISTER, prepare
+from .nodelets import registered
 from .cpp_scope import base_name, callee_parts, namespaces_of
 from .cpp_values import CppValues
-from .cpp_types import action_type, callback_name, message_type, service_type, split_template
+from .cpp_types import action_type, action_type_in, callback_name, message_type, service_type, split_template
 from .model import Note, Src, canon_type
 
 __all__ = ["scan_cpp", "action_type", "service_type"]
@@ -55,7 +57,7 @@ _LIBRARY = ("std::", "ros::", "rclcpp::", "boost::", "RCLCPP_", "ROS_", "tf2::",
 _T = treesitter.text
 
 
-class _File:
+class _File(MemberReader):
     def __init__(self, data: bytes, shown: str) -> None:
         self.shown = shown
         self.vex_at: Any = None
@@ -65,6 +67,7 @@ class _File:
         for m in REGISTER.finditer(data):
             line = data.count(b"\n", 0, m.start()) + 1
             self.out["components"].append((m.group(1).decode().lstrip(":"), Src(shown, line, 1)))
+        self.out["nodelets"] = registered(data, shown)
         data = prepare(data)
         self.ros2 = b"rclcpp" in data
         root = treesitter.parser("cpp").parse(data).root_node
@@ -73,6 +76,7 @@ class _File:
         for n in self.nodes:
             self._index(n)
         self.scope = CppValues(self.nodes)
+        self.scope.nodelet = b"nodelet" in data and b"Nodelet" in data
         if root.has_error:
             err = next((n for n in self.nodes if n.type == "ERROR" or n.is_missing), root)
             self.out["notes"].append(Note(self.src(err), "C++ source has syntax errors; read what tree-sitter "
@@ -140,7 +144,7 @@ class _File:
         for kind, v, t, h in specs:
             self.emit(kind, None, t, at, h, name=v)
 
-    def node(self, v: symbols.Val, at: Any, ns: symbols.Val = None) -> None:
+    def node(self, v: symbols.Val, at: Any, ns: symbols.Val = None, kind: str | None = None) -> None:
         fn = self.scope.fn_of(at)
         unit = fn.unit if fn is not None else None
         t = symbols.text(v)
@@ -149,7 +153,7 @@ class _File:
             if fn is not None and fn.in_class:
                 self.out["classes"].setdefault(fn.unit, {"nodes": [], "endpoints": []})["nodes"].append(
                     (t, self.src(at)))
-        self.out["node_names"].append((v, self.src(at), unit, fn.key if fn else None, ns))
+        self.out["node_names"].append((v, self.src(at), unit, fn.key if fn else None, ns, kind))
 
     def record(self, kind: str, callee: str, args: list[Any], at: Any) -> None:
         fn = self.scope.fn_of(at)
@@ -162,7 +166,8 @@ class _File:
         head, targs = split_template(type_text.replace("typename", "").strip())
         base = head.split("::")[-1]
         if base in _NODE_TYPES and ("rclcpp" in head or head == base) and args:
-            self.node(self.scope.value(args[0]), at, self.scope.value(args[1]) if len(args) > 1 else None)
+            self.node(self.scope.value(args[0]), at, self.scope.value(args[1]) if len(args) > 1 else None,
+                      "lifecycle" if base == "LifecycleNode" else None)
             return
         if base in _ACTIONLIB and targs and "actionlib" in head + type_text:
             self.actionlib(_ACTIONLIB[base], targs[0], args, at)
@@ -180,7 +185,7 @@ class _File:
         first_handle = len(args) >= 2 and self.scope.is_handle(args[0])
         name_arg = args[1] if first_handle else args[0]
         h = self.scope.value(args[0]) if first_handle else None
-        self.emit(kind, name_arg, action_type(self.aliases.get(ty, ty)), at, h)
+        self.emit(kind, name_arg, action_type_in(self.aliases.get(ty, ty), self.scope.using_ns), at, h)
 
     # -- the walk
     def run(self) -> dict[str, Any]:
@@ -195,6 +200,8 @@ class _File:
                 self.declaration(n)
             elif t == "field_declaration":
                 self.member(n)
+            elif t in ("class_specifier", "struct_specifier"):
+                self.bases(n)
             elif t == "call_expression":
                 self.call(n)
         s = self.scope
@@ -206,7 +213,7 @@ class _File:
         self.out["consts"] = {k: v for k, v in ((k, s._one([s.value(x) if not isinstance(x, tuple) else x
                                                              for x in vs])) for k, vs in s.consts.items())
                               if v is not None}
-        self.out["ros2"] = self.ros2
+        self.out["ros2"], self.out["using_ns"] = self.ros2, s.using_ns
         return self.out
 
     def initializer(self, n: Any) -> None:
@@ -218,7 +225,8 @@ class _File:
         if h.split("<")[0].split("::")[-1] in _NODE_TYPES and ("rclcpp" in h or "::" not in h) and args.named_children:
             a = args.named_children
             self.node(self.scope.value(a[0]), n, self.scope.value(a[1]) if len(a) > 1 and
-                      self.scope.value(a[1]) is not None and self.scope.value(a[1])[0] == "str" else None)
+                      self.scope.value(a[1]) is not None and self.scope.value(a[1])[0] == "str" else None,
+                      "lifecycle" if "LifecycleNode" in h else None)
             return
         self.record("member", h, list(args.named_children), n)
 
@@ -255,18 +263,6 @@ class _File:
         finally:
             self.scope.override, self.vex_at = None, None
 
-    def member(self, n: Any) -> None:
-        ty = _T(n.child_by_field_name("type"))
-        head, targs = split_template(ty.replace(" ", ""))
-        last = head.split("::")[-1]
-        fn_cls = self.scope.fn_of(n)
-        if fn_cls is not None or not (last in _ACTIONLIB or last in cpp_helpers.CONSTRUCTED):
-            return
-        nss, cls = namespaces_of(n)
-        for d in n.children_by_field_name("declarator"):
-            if d.type == "field_identifier":  # a value member (a pointer is made elsewhere)
-                self.out["member_decls"].append(("::".join(nss + cls), _T(d), ty, self.src(n)))
-
     def call(self, n: Any) -> None:
         fn = n.child_by_field_name("function")
         a = n.child_by_field_name("arguments")
@@ -283,7 +279,8 @@ class _File:
             self.construct(targs[0], args, n)
             return
         if full.endswith("Node::make_shared") and args:
-            self.node(s.value(args[0]), n, s.value(args[1]) if len(args) > 1 else None)
+            self.node(s.value(args[0]), n, s.value(args[1]) if len(args) > 1 else None,
+                      "lifecycle" if "LifecycleNode" in full else None)
             return
         if full.endswith("Options::create") or (last == "init" and recv is not None and targs):
             return  # options: read where subscribe(ops) / advertise(ops) uses them
@@ -292,7 +289,8 @@ class _File:
             rt = s.type_of(recv)
             if rt is not None:
                 specs = cpp_helpers.method(rt, last, args, targs, s.value, s.value(recv), self.aliases)
-            elif not targs and self.helper_form(last, args) and self.deferred_method(recv, last, args, n):
+            elif not targs and self.helper_form(last, args) and self.deferred_method(recv, last, args, n) \
+                    and last != "init":  # obj.init(...) may also be a method of the program's own class
                 return
         if specs is not None:
             self.specs(specs, n)
@@ -317,6 +315,8 @@ class _File:
             ta = targs[0] if targs else None
             self.emit(kind, args[1], self.msg(ta) if ta else None, n, s.value(args[0]))
             return
+        if len(args) == 1 and last in ("subscribe", "advertise", "advertiseService") and "::" in full and recv is None:
+            return  # a static method of some class (T::subscribe(rate)), not a node handle's
         if len(args) == 1 and last in ("subscribe", "advertise", "advertiseService"):
             ops = s.value(args[0])
             if ops is not None and ops[0] == "ops":
@@ -350,30 +350,6 @@ class _File:
         if msg_type is None and cb is None and ta:
             cb = ("type", ta)  # an alias of another file (a header's using/typedef): read by the linker
         self.emit(kind, args[0], msg_type, n, handle, cb if msg_type is None else None)
-
-    def deferred_method(self, recv: Any, method: str, args: list[Any], at: Any) -> bool:
-        """A helper method on a member whose class this file does not declare
-        (``it_.advertise("image", 1)``, ``sub_.subscribe(nh, "t", 1)``): left to
-        the linker, which knows the member's type from the program's other files."""
-        r = recv.child_by_field_name("field") if recv.type == "field_expression" else recv
-        fn = self.scope.fn_of(at)
-        if fn is None or not fn.in_class or r is None or r.type not in ("identifier", "field_identifier"):
-            return False
-        self.out["member_calls"].append((fn.unit, _T(r), method, [self.scope.value(x) for x in args],
-                                         [_T(x) for x in args], self.src(at), fn.key))
-        return True
-
-    def helper_form(self, method: str, args: list[Any]) -> bool:
-        """Whether a call without template arguments has the form of a helper's method
-        only (never of a node handle's): ``advertise(name, n)``, the camera forms,
-        message_filters' ``subscribe(h, name, ...)``, ``on_parameter_event(cb)``."""
-        from .cpp_params import string_value
-        if method in ("advertiseCamera", "subscribeCamera", "on_parameter_event"):
-            return True
-        if method == "advertise":
-            return len(args) >= 2
-        return method == "subscribe" and len(args) >= 2 and (
-            self.scope.is_handle(args[0]) or (string_value(args[0]) is None and string_value(args[1]) is not None))
 
     def action2(self, last: str, targs: list[str], args: list[Any], n: Any) -> None:
         kind = "action_servers" if last == "create_server" else "action_clients"

@@ -45,7 +45,7 @@ from . import emit, py_helpers, symbols
 from .cpp_types import action_type, service_type
 from .model import Endpoint, Note, Src, canon_type
 from .pyconst import PyScope
-from .pyrecords import PyCall, PyModule, PyVal
+from .pyrecords import PyCall, PyModule, PyVal, percent
 
 
 # (role, index and keyword of the name, index and keyword of the type), by callee
@@ -62,6 +62,7 @@ _CTORS = {
     "rclpy.ActionClient": ("action_clients", 2, "action_name", 1, "action_type"),
 }
 _METHODS = {"create_publisher": ("pub", 1, "topic", 0, "msg_type"),
+            "create_lifecycle_publisher": ("pub", 1, "topic", 0, "msg_type"),
             "create_subscription": ("sub", 1, "topic", 0, "msg_type"),
             "create_service": ("service_servers", 1, "srv_name", 0, "srv_type"),
             "create_client": ("service_clients", 1, "srv_name", 0, "srv_type")}
@@ -105,6 +106,10 @@ def _ast_module(tree: ast.AST, shown: str) -> PyModule:
             return PyVal("name", d, loc(e))
         if isinstance(e, ast.BinOp) and isinstance(e.op, ast.Add):
             return PyVal("cat", ast.unparse(e), loc(e), parts=[val(e.left), val(e.right)])
+        if isinstance(e, ast.BinOp) and isinstance(e.op, ast.Mod) and isinstance(e.left, ast.Constant) \
+                and isinstance(e.left.value, str):  # '/%s/pose' % name
+            args = e.right.elts if isinstance(e.right, ast.Tuple) else [e.right]
+            return percent(e.left.value, [val(a) for a in args], ast.unparse(e), loc(e))
         if isinstance(e, ast.JoinedStr):
             parts = [val(x.value) if isinstance(x, ast.FormattedValue) and x.conversion == -1 and x.format_spec is None
                      else val(x) if isinstance(x, ast.Constant) else PyVal("other", ast.unparse(x), loc(e))
@@ -276,7 +281,8 @@ def extract(mod: PyModule, shown: str) -> dict[str, Any]:
                 if c.func != "super().__init__":
                     out["notes"].append(Note(v.src, "node name is not a string literal: not resolved statically"))
                 continue
-            out["node_names"].append((val, c.src, unit, sc.fn_key(c.src.line), None))
+            life = "lifecycle" if _node_class(mod, sc.class_at(c.src.line), lifecycle=sc.full) else None
+            out["node_names"].append((val, c.src, unit, sc.fn_key(c.src.line), None, life))
             continue
         spec = _CTORS.get(f)
         if spec is None and "actionlib" in f and last in _CTORS:
@@ -287,6 +293,8 @@ def extract(mod: PyModule, shown: str) -> dict[str, Any]:
             spec = _METHODS[last]
         if spec is None:
             helped = py_helpers.helper(f, c, ros2) if f and "." in f else None
+            for m in mod.star if helped is None and f and "." not in f and f not in mod.imports else ():
+                helped = helped or py_helpers.helper(f"{m}.{f}", c, ros2)  # from interactive_markers... import *
             if helped is not None:
                 for kind, name, typ in helped:
                     add(kind, name, typ, c)
@@ -326,13 +334,19 @@ def _typed(dotted: str, kind: str) -> str | None:
     return t if t and parts[-2] == "msg" else None
 
 
-def _node_class(mod: PyModule, cls: str | None, depth: int = 0) -> bool:
+def _node_class(mod: PyModule, cls: str | None, depth: int = 0, lifecycle: Any = None) -> bool:
     """Whether class ``cls`` of the file derives from rclpy's ``Node`` (directly or
-    through a class of the same file)."""
+    through a class of the same file); with ``lifecycle`` (the file's import
+    resolver), whether from a lifecycle node (``rclpy.lifecycle.Node``,
+    ``LifecycleNode``)."""
     if cls is None or depth > 5:
         return False
     for b in mod.bases.get(cls.split(".")[-1], []):
-        if b.split(".")[-1] in ("Node", "LifecycleNode") or _node_class(mod, b, depth + 1):
+        if lifecycle is not None and (b.split(".")[-1] == "LifecycleNode" or ".lifecycle." in lifecycle(b) + "."
+                                      and b.split(".")[-1] == "Node"):
+            return True
+        if lifecycle is None and b.split(".")[-1] in ("Node", "LifecycleNode") or \
+                _node_class(mod, b, depth + 1, lifecycle):
             return True
     return False
 

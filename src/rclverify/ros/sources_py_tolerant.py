@@ -16,7 +16,7 @@ from typing import Any
 
 from . import treesitter
 from .model import Src
-from .pyrecords import PyCall, PyModule, PyVal
+from .pyrecords import PyCall, PyModule, PyVal, percent
 
 MAX_DEPTH = 100  # nesting read; deeper expressions are left as text
 
@@ -93,6 +93,13 @@ def tolerant_module(text: str, shown: str) -> tuple[Any, str]:
                         plain = e is not None and len(c.named_children) == 1
                         parts.append(val(e, depth + 1) if plain else PyVal("other", treesitter.text(c), loc(c)))
                 return PyVal("cat", treesitter.text(n), loc(n), parts=parts)
+        left = n.child_by_field_name("left") if n.type == "binary_operator" else None
+        if left is not None and treesitter.text(n.child_by_field_name("operator")) == "%" and depth <= MAX_DEPTH:
+            fmt = val(left, depth + 1)  # '/%s/pose' % name
+            right = n.child_by_field_name("right")
+            args = [x for x in right.named_children if x.type != "comment"] if right.type == "tuple" else [right]
+            if fmt.kind == "str":
+                return percent(fmt.text, [val(a, depth + 1) for a in args], treesitter.text(n), loc(n))
         if n.type == "binary_operator" and treesitter.text(n.child_by_field_name("operator")) == "+" \
                 and depth <= MAX_DEPTH:
             return PyVal("cat", treesitter.text(n), loc(n), parts=[val(n.child_by_field_name("left"), depth + 1),

@@ -41,18 +41,25 @@ def typestore(msg_dirs: Sequence[Path]) -> Any:
 
 def flatten(msg: Any) -> dict[str, Any]:
     """A deserialised message as a dict of its fields (nested messages as dicts,
-    arrays as lists)."""
+    arrays as lists, an array of messages as a list of dicts), so a mapping's
+    field path (``pose.pose.position.x``, ``poses[0].position.x``) reads a
+    bag as it reads a log."""
     out: dict[str, Any] = {}
     for name in getattr(msg, "__dataclass_fields__", {}):
         if name == "__msgtype__":
             continue
-        v = getattr(msg, name)
-        if hasattr(v, "__dataclass_fields__"):
-            v = flatten(v)
-        elif hasattr(v, "tolist"):
-            v = v.tolist()
-        out[name] = v
+        out[name] = _value(getattr(msg, name))
     return out
+
+
+def _value(v: Any) -> Any:
+    if hasattr(v, "__dataclass_fields__"):
+        return flatten(v)
+    if hasattr(v, "tolist"):
+        return v.tolist()
+    if isinstance(v, (list, tuple)):
+        return [_value(x) for x in v]
+    return v
 
 
 def read_bag(path: Path, msg_dirs: Sequence[Path] = ()) -> Iterator[Event]:

@@ -23,8 +23,11 @@ Which rule applies depends on the RCL variable's type:
   the argument types, in order.
 
 Which fields a topic's messages contribute, and in which order, is the
-plan's ``fields`` list for the topic (all fields in message order
-otherwise): bespoke rules in the paper's sense.
+plan's ``fields`` list for the topic (all top-level fields in message order
+otherwise): bespoke rules in the paper's sense.  A field may be a **path**
+into nested messages and arrays, as the ROS grounding reads them
+(``linear.x`` of a ``geometry_msgs/Twist``, ``pose.pose.position.x``,
+``ranges[0]``, ``ranges[-1]`` the last element): :func:`field_value`.
 
 A topic may be declared a **state** (``state: true``, e.g. a latched pose):
 only then may a node's output on it that was current before an input event
@@ -34,6 +37,7 @@ after its question").
 from __future__ import annotations
 
 import math
+import re
 from dataclasses import dataclass, field
 from fractions import Fraction
 from typing import Any, Mapping, Sequence
@@ -99,13 +103,81 @@ def _scalar(v: Any, t: T.Type) -> Any:
     return _NO
 
 
+_NAME = r"[A-Za-z_][A-Za-z0-9_]*"
+_PATH = re.compile(rf"{_NAME}(?:\[-?\d+\])*(?:\.{_NAME}(?:\[-?\d+\])*)*")
+_INDEX = re.compile(r"\[(-?\d+)\]")
+
+
+def is_path(name: str) -> bool:
+    """Whether a ``fields`` entry is written as a path (has ``.`` or ``[``)."""
+    return "." in name or "[" in name or "]" in name
+
+
+def parse_path(text: str) -> tuple[str | int, ...] | None:
+    """``pose.pose.position.x`` -> ``("pose", "pose", "position", "x")``,
+    ``ranges[-1]`` -> ``("ranges", -1)``; ``None`` when ``text`` is not a
+    path (field names joined by ``.``, each followed by any number of
+    integer indexes ``[k]``, negative counting from the end)."""
+    if not _PATH.fullmatch(text):
+        return None
+    steps: list[str | int] = []
+    for part in text.split("."):
+        steps.append(part.split("[", 1)[0])
+        steps.extend(int(k) for k in _INDEX.findall(part))
+    return tuple(steps)
+
+
+def field_value(fields: Mapping[str, Any], name: str) -> Any:
+    """The value of field ``name`` of a message (its fields as a dict, nested
+    messages as dicts, arrays as lists): a top-level key as it is (also one
+    that is literally ``a.b``, as some loggers flatten), else the path
+    :func:`parse_path` reads.  Raises :class:`MappingError` naming the
+    step that does not exist (with the fields there are) or the index out
+    of range."""
+    if name in fields:
+        return fields[name]
+    steps = parse_path(name) if is_path(name) else None
+    if steps is None:
+        raise MappingError(f"the message has no field {name}")
+    cur: Any = fields
+    done = ""
+    for step in steps:
+        if isinstance(step, int):
+            if not isinstance(cur, (list, tuple, bytes, bytearray)):
+                raise MappingError(f"the message has no field {name}: {done} is not an array")
+            if not -len(cur) <= step < len(cur):
+                raise MappingError(f"the message has no field {name}: index {step} is out of range "
+                                   f"({done} has {len(cur)} element(s))")
+            cur = cur[step]
+            done += f"[{step}]"
+            continue
+        if not isinstance(cur, Mapping):
+            raise MappingError(f"the message has no field {name}: {done} is not a message with fields")
+        if step not in cur:
+            have = ", ".join(str(k) for k in cur) or "no fields"
+            where = repr(done) if done else "the message"
+            raise MappingError(f"the message has no field {name}: {where} has no field {step!r} (it has: {have})")
+        cur = cur[step]
+        done = f"{done}.{step}" if done else step
+    return cur
+
+
 def field_items(fields: Mapping[str, Any], rule: TopicRule) -> list[tuple[str, Any]]:
-    """The message fields the rule reads, in order."""
+    """The message fields the rule reads, in order (:func:`field_value` for
+    each named field; the top-level fields without a ``fields`` list)."""
     if rule.fields:
-        missing = [f for f in rule.fields if f not in fields]
+        out: list[tuple[str, Any]] = []
+        missing: list[str] = []
+        why = ""
+        for f in rule.fields:
+            try:
+                out.append((f, field_value(fields, f)))
+            except MappingError as exc:
+                missing.append(f)
+                why = why or (str(exc) if is_path(f) else "")
         if missing:
-            raise MappingError(f"the message has no field {', '.join(missing)}")
-        return [(f, fields[f]) for f in rule.fields]
+            raise MappingError(why if why and len(missing) == 1 else f"the message has no field {', '.join(missing)}")
+        return out
     return list(fields.items())
 
 
@@ -152,16 +224,26 @@ class RuleError(ValueError):
         self.path = path
 
 
-def load_rules(raw: Any) -> dict[str, TopicRule]:
+class RuleSet(dict):  # type: ignore[type-arg]
+    """The mapping file's topic rules (topic -> :class:`TopicRule`) and its
+    ``tolerance`` of recorded numbers (``None``: none declared; else a
+    :class:`rclverify.logic.floatsem.Tolerance`, set by the mapping's loader),
+    which every monitor given these rules applies (docs/monitors.md,
+    "Numbers on the wire")."""
+
+    tolerance: Any = None
+
+
+def load_rules(raw: Any) -> RuleSet:
     """Topic rules from the plan's ``topics`` mapping (``{topic: {fields, update, default, state}}``):
-    ``fields`` a list of field names, ``update`` ``accumulate`` or ``replace``,
-    ``state`` a boolean (default false).
+    ``fields`` a list of field names or paths (:func:`parse_path`), ``update``
+    ``accumulate`` or ``replace``, ``state`` a boolean (default false).
 
     Raises :class:`RuleError` (a ``ValueError``) naming the topic and the
     key at fault for a malformed rule (``topics`` not a mapping, ``fields``
-    not a list of names, an unknown ``update``).
+    not a list of names, a malformed path, an unknown ``update``).
     """
-    out: dict[str, TopicRule] = {}
+    out = RuleSet()
     if raw is not None and not isinstance(raw, Mapping):
         raise RuleError(f"topics must map each topic to its rule, not {raw!r}", "topics")
     for topic, spec in (raw or {}).items():
@@ -173,6 +255,11 @@ def load_rules(raw: Any) -> dict[str, TopicRule]:
                                                             for f in fields):
             raise RuleError(f"topic {topic}: fields must be a list of message field names, not {fields!r}",
                             "topics", topic, "fields")
+        for k, f in enumerate(fields):
+            if isinstance(f, str) and is_path(f) and parse_path(f) is None:
+                raise RuleError(f"topic {topic}: {f!r} is not a field path (write names joined by '.', each "
+                                f"with optional integer indexes: linear.x, pose.pose.position.x, ranges[0], "
+                                f"ranges[-1])", "topics", topic, "fields", k)
         update = spec.get("update", "accumulate")
         if update not in ("accumulate", "replace"):
             raise RuleError(f"topic {topic}: update must be accumulate or replace, not {update!r}",

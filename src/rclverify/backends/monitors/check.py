@@ -50,19 +50,22 @@ from collections import deque
 from dataclasses import dataclass, field
 from typing import Any, Callable, Iterable, Mapping
 
-import z3
-
-from ...logic.concrete import check_concrete
-from ...logic.encode import EncodingError
-from ...logic.evaluate import evaluate, why_undecided
+from ...logic.floatsem import Judgement, Tolerance, judge
 from ...rcl import ast
 from ...rcl.printer import expr_to_rcl
 from ...rcl.types import Checked, CheckedNode
+from ...system.services import peers
 from ...traces.events import Event
 from ...traces.mapping import MappingError, TopicRule, initial_value, map_value
 from ...values import render
 
 VERDICTS = ("satisfied", "violated", "open", "assumption violated", "inconclusive", "incomplete input")
+#: Topic suffixes of a service's or action's parts, in the order of ``Link.parts``
+#: (a service ``s`` is observed as ``s/request`` and ``s/response`` events, an
+#: action ``a`` as actionlib's ``a/goal``, ``a/feedback`` and ``a/result``).
+LINK_TOPICS = {"service": ("request", "response"), "action": ("goal", "feedback", "result")}
+#: How far a semantics is from exact arithmetic (the weakest one a verdict rests on is shown).
+_WEAK = {"exact": 0, "double": 1, "tolerance": 2}
 
 
 def _reads(e: Any, out: set[str]) -> None:
@@ -102,7 +105,11 @@ class Verdict:
     output event); ``guarantee`` the 1-based guarantee that failed (0 when
     none or for the assumption); ``decided_at`` the time (s, trace clock)
     when it was decided; ``values`` the rendered values of the first failure
-    (inputs and the outputs that failed), ``reason`` one sentence.
+    (inputs and the outputs that failed), ``reason`` one sentence;
+    ``semantics`` the arithmetic that decided it (:mod:`rclverify.logic.floatsem`):
+    ``exact``, ``double`` or ``tolerance`` for a ``satisfied`` (the weakest
+    its assumption and guarantees needed), the semantics that all agreed for
+    a ``violated`` or ``assumption violated`` (``exact, double``), else ``""``.
     """
 
     node: str
@@ -115,12 +122,14 @@ class Verdict:
     guarantee: int = 0
     values: Mapping[str, str] = field(default_factory=dict)
     reason: str = ""
+    semantics: str = ""
 
     def to_json(self) -> dict[str, Any]:
         """A JSON-ready dict (the live monitor's verdict message)."""
         return {"node": self.node, "verdict": self.verdict, "event": self.event, "time": self.time,
                 "where": self.where, "topic": self.topic, "decided_at": self.decided_at,
-                "guarantee": self.guarantee, "values": dict(self.values), "reason": self.reason}
+                "guarantee": self.guarantee, "values": dict(self.values), "reason": self.reason,
+                "semantics": self.semantics}
 
 
 @dataclass
@@ -143,6 +152,9 @@ class _Group:
     superseded: Event | None = None
     #: a partial answer: (output event, guarantee, why it waits, the outputs that came)
     waiting: tuple[Event, int, str, dict[str, Any]] | None = None
+    #: the semantics the inputs' assumption held in, and those that agreed on ``last``'s failure
+    accepted: str = "exact"
+    last_semantics: str = ""
 
 
 @dataclass
@@ -152,7 +164,11 @@ class NodeResult:
     ``counts`` verdict -> number of input events; ``first_violation`` and
     ``first_assumption_violation`` are dicts (event index, time, where,
     guarantee, formula, values, reason) or ``None``; ``events`` is the
-    number of events on the node's topics.
+    number of events on the node's topics; ``accepted`` the input events
+    whose assumption held; ``semantics`` the ``satisfied`` verdicts per the
+    arithmetic that decided them (``exact``, ``double``, ``tolerance``);
+    ``first_inexact`` the first formula that held only in double arithmetic
+    or within the tolerance (event, where, time, semantics, formula, values).
     """
 
     node: str
@@ -161,40 +177,78 @@ class NodeResult:
     first_violation: dict[str, Any] | None = None
     first_assumption_violation: dict[str, Any] | None = None
     first_inconclusive: dict[str, Any] | None = None
+    accepted: int = 0
+    semantics: dict[str, int] = field(default_factory=lambda: {"exact": 0, "double": 0, "tolerance": 0})
+    first_inexact: dict[str, Any] | None = None
+
+    @property
+    def assumption(self) -> dict[str, Any]:
+        """The assumption monitor's verdict on the run: ``violated`` when an
+        input event violated it (the node is not at fault: the blame names the
+        producer), ``held`` when every evaluated input event met it, ``not
+        evaluated`` when none was evaluated."""
+        n = self.counts["assumption violated"]
+        verdict = "violated" if n else "held" if self.accepted else "not evaluated"
+        return {"verdict": verdict, "violations": n, "accepted": self.accepted,
+                "first": self.first_assumption_violation}
 
     def to_json(self) -> dict[str, Any]:
         return {"node": self.node, "counts": dict(self.counts), "events": self.events,
                 "first_violation": self.first_violation,
                 "first_assumption_violation": self.first_assumption_violation,
-                "first_inconclusive": self.first_inconclusive}
+                "first_inconclusive": self.first_inconclusive, "accepted": self.accepted,
+                "semantics": dict(self.semantics), "first_inexact": self.first_inexact}
 
 
 def producers(checked: Checked, node: CheckedNode, var: str) -> list[str]:
-    """Other nodes whose output has the input's name or is matched to the input's topic."""
+    """Other nodes whose output has the input's name or is matched to the
+    input's topic, or feeds it through a service or action link (rule S1,
+    :func:`rclverify.system.services.peers`: a client's response comes from
+    the server, a server's request from its clients)."""
     topics = {t.field for t in node.node.topics if t.match is not None and t.match.name == var}
-    out = []
+    out = {m for m, _ in peers(checked, node.name, var)} if node.node.links else set()
     for other in checked.nodes.values():
         if other.name == node.name:
             continue
         if var in other.outputs or any(t.field in topics and t.match is not None and t.match.name in other.outputs
                                        for t in other.node.topics):
-            out.append(other.name)
+            out.add(other.name)
     return sorted(out)
+
+
+def link_of(node: CheckedNode, var: str) -> str:
+    """``service estop`` when input ``var`` of ``node`` is a part of a service
+    or action link (its response, feedback, result, or a server's request),
+    else ``""``."""
+    for lk in node.node.links:
+        if any(v.prefix == "in" and v.name == var for v in lk.parts):
+            return f"{lk.kind} {lk.name}"
+    return ""
 
 
 class NodeMonitor:
     """Streams events through one node's contract; :meth:`finish` gives the result.
 
-    ``rules`` maps topic names to :class:`TopicRule`; ``horizon`` is in seconds.
+    ``rules`` maps topic names to :class:`TopicRule`; ``horizon`` is in
+    seconds; ``tolerance`` the declared tolerance of recorded numbers
+    (:class:`~rclverify.logic.floatsem.Tolerance`; default: the ``tolerance``
+    attribute of ``rules`` when it has one, as the mapping file's rules do,
+    else none).  Every formula is judged by
+    :func:`rclverify.logic.floatsem.judge` (exact, double, tolerance).  The
+    node's topics are its ``topics(...)`` and the parts of its service and
+    action links (:data:`LINK_TOPICS`; an action's part is the message's
+    ``goal``/``feedback``/``result`` field).
     """
 
     #: Evaluations remembered per (formula, inputs, outputs); 0 turns the cache off.
     cache_size = 4096
 
     def __init__(self, checked: Checked, node: CheckedNode, rules: Mapping[str, TopicRule],
-                 horizon: float, on_verdict: Callable[[Verdict], None] | None = None) -> None:
+                 horizon: float, on_verdict: Callable[[Verdict], None] | None = None,
+                 tolerance: Tolerance | None = None) -> None:
         self.checked, self.node, self.horizon = checked, node, horizon
         self.rules = rules
+        self.tolerance = tolerance if tolerance is not None else getattr(rules, "tolerance", None)
         self.on_verdict = on_verdict
         self.now = float("-inf")
         self.result = NodeResult(node.name)
@@ -208,6 +262,17 @@ class NodeMonitor:
             is_input = t.match.prefix == "in" or (t.match.prefix is None and t.match.name in node.inputs)
             key = ("in." if is_input else "out.") + t.match.name
             self.topics.setdefault(t.field.lstrip("/"), []).append((key, typ, is_input))
+        #: (topic, key) -> the part of an actionlib message that maps to the variable
+        self._parts: dict[tuple[str, str], str] = {}
+        for lk in node.node.links:
+            for suffix, v in zip(LINK_TOPICS.get(lk.kind, ()), lk.parts):
+                typ = node.io_type(v)
+                if typ is None or v.prefix not in ("in", "out"):
+                    continue
+                topic, key = f"{lk.name.lstrip('/')}/{suffix}", f"{v.prefix}.{v.name}"
+                self.topics.setdefault(topic, []).append((key, typ, v.prefix == "in"))
+                if lk.kind == "action":
+                    self._parts[(topic, key)] = suffix
         self.has_inputs = any(i for vs in self.topics.values() for _, _, i in vs)
         self.values: dict[str, Any] = {}
         for topic, vs in self.topics.items():
@@ -243,30 +308,29 @@ class NodeMonitor:
             self._deps[k] = tuple(v for v in sorted(self.values) if v in mentioned or v.split(".", 1)[1] in mentioned)
         self.pending: dict[Any, _Group] = {}
         self._due = float("inf")  # the earliest horizon among the pending obligations (s)
-        self._cache: dict[tuple[Any, tuple[Any, ...]], tuple[bool | None, str]] = {}
+        self._cache: dict[tuple[Any, tuple[Any, ...]], Judgement] = {}
 
     # -- evaluation --------------------------------------------------------------
-    def _truth(self, k: Any, formula: ast.Expr, values: Mapping[str, Any]) -> tuple[bool | None, str]:
-        """(truth, reason) of guarantee ``k`` (``("A", j)``: assumption ``j``)
-        on ``values``; remembered per (formula, values of the variables it reads)."""
+    def _judge(self, k: Any, formula: ast.Expr, values: Mapping[str, Any]) -> Judgement:
+        """The judgement of guarantee ``k`` (``("A", j)``: assumption ``j``) on
+        ``values`` (:func:`~rclverify.logic.floatsem.judge`: exact, then the
+        node's double arithmetic, then the tolerance); remembered per
+        (formula, values of the variables it reads)."""
         ck = (k, tuple([values.get(d) for d in self._deps[k]]))
         hit = self._cache.get(ck)
         if hit is not None:
             return hit
-        v = evaluate(formula, self.checked, self.node, values)
-        reason = ""
-        if v is None:
-            reason = why_undecided(formula, self.checked, self.node, values)
-            if "no value for" not in reason:  # undecided directly: Z3 on the concrete values
-                try:
-                    v, reason = check_concrete(formula, self.checked, self.node, values)
-                except (ValueError, TypeError, KeyError, EncodingError, z3.Z3Exception) as exc:  # a value Z3 cannot take: undecided, with the reason
-                    v, reason = None, f"{reason}; Z3 on concrete values failed: {exc}"
+        j = judge(formula, self.checked, self.node, values, self.tolerance)
         if self.cache_size:
             if len(self._cache) >= self.cache_size:
                 self._cache.clear()
-            self._cache[ck] = (v, reason)
-        return v, reason
+            self._cache[ck] = j
+        return j
+
+    def _truth(self, k: Any, formula: ast.Expr, values: Mapping[str, Any]) -> tuple[bool | None, str]:
+        """(truth, reason) of :meth:`_judge`."""
+        j = self._judge(k, formula, values)
+        return j.truth, j.reason
 
 
     def _rendered(self, values: Mapping[str, Any]) -> dict[str, str]:
@@ -290,11 +354,13 @@ class NodeMonitor:
         return {k: values[k] for k in self._keys[prefix] if values[k] is not None}
 
     def _verdict(self, verdict: str, ev: Event, guarantee: int = 0, values: Mapping[str, str] | None = None,
-                 reason: str = "", n: int = 1) -> None:
+                 reason: str = "", n: int = 1, semantics: str = "") -> None:
         self.result.counts[verdict] += n
+        if verdict == "satisfied" and semantics in self.result.semantics:
+            self.result.semantics[semantics] += n
         if self.on_verdict is not None:
             v = Verdict(self.node.name, verdict, ev.index, ev.time, ev.where, ev.topic, max(self.now, ev.time),
-                        guarantee, dict(values or {}), reason)
+                        guarantee, dict(values or {}), reason, semantics)
             for _ in range(n):
                 self.on_verdict(v)
 
@@ -312,8 +378,14 @@ class NodeMonitor:
         is_input = False
         changed: list[str] = []
         for key, typ, inp in vs:
+            fields: Any = ev.fields
+            part = self._parts.get((ev.topic, key)) if self._parts else None
             try:
-                self.values[key] = map_value(typ, ev.fields, self.rules.get(ev.topic, TopicRule()),
+                if part:
+                    fields = fields.get(part)
+                    if not isinstance(fields, Mapping):
+                        raise MappingError(f"the actionlib message has no {part!r} part")
+                self.values[key] = map_value(typ, fields, self.rules.get(ev.topic, TopicRule()),
                                              self.values.get(key))
             except MappingError as exc:
                 self._note_inconclusive(ev, 0, f"{key}: {exc}")
@@ -341,29 +413,41 @@ class NodeMonitor:
         if missing:
             self._verdict("incomplete input", ev, reason="no value yet for " + ", ".join(missing))
             return
+        accepted = "exact"
         for j, formula in enumerate(self.assumption):
-            ok, reason = self._truth(("A", j), formula, inputs)
+            judged = self._judge(("A", j), formula, inputs)
+            ok, reason = judged.truth, judged.reason
             if ok is False:
                 mentioned: set[str] = set()
                 _names(formula, mentioned)
-                blamed = sorted({p for k in inputs if k in mentioned or k[3:] in mentioned
-                                 for p in producers(self.checked, self.node, k[3:])})
+                reads = [k for k in inputs if k in mentioned or k[3:] in mentioned]
+                blamed = sorted({p for k in reads for p in producers(self.checked, self.node, k[3:])})
+                links = sorted({link_of(self.node, k[3:]) for k in reads} - {""})
                 blame = ("upstream node(s) " + ", ".join(blamed)) if blamed else "environment"
+                if blamed and links:
+                    blame += f" (through {', '.join(links)})"
                 if self.result.first_assumption_violation is None:
                     self.result.first_assumption_violation = {
                         "event": ev.index, "time": ev.time, "where": ev.where, "assumption": expr_to_rcl(formula),
-                        "values": self._rendered(inputs), "blame": blame}
+                        "values": self._rendered(inputs), "blame": blame, "semantics": judged.semantics}
                 self._verdict("assumption violated", ev, values=self._rendered(inputs),
-                              reason=f"assumption {expr_to_rcl(formula)} is false; blamed on the {blame}")
+                              reason=f"assumption {expr_to_rcl(formula)} is false; blamed on the {blame}",
+                              semantics=judged.semantics)
                 return
             if ok is None:
                 self._note_inconclusive(ev, 0, f"assumption undecided: {reason}")
                 return
+            if _WEAK.get(judged.semantics, 0) > _WEAK[accepted]:
+                accepted = judged.semantics
+                self._note_inexact(ev, judged, f"assumption {expr_to_rcl(formula)}", inputs)
+        self.result.accepted += 1
         ikey = tuple(inputs.items())
         key = (ikey, ())  # no answer yet: only a group that has none either is the same obligation
         group = self.pending.get(key)
         if group is None:
-            group = self.pending[key] = _Group(inputs, ikey=ikey)
+            group = self.pending[key] = _Group(inputs, ikey=ikey, accepted=accepted)
+        elif _WEAK[accepted] > _WEAK[group.accepted]:
+            group.accepted = accepted
         group.events.append(ev)
         group.ref = max(group.ref, ev.stamped)
         group.superseded = None  # the same question asked again: the answer to come answers both
@@ -404,11 +488,19 @@ class NodeMonitor:
         values.update(g.outs)
         failed: int | None = None
         undecided = ""
+        weakest = g.accepted
+        inexact: list[tuple[int, Judgement]] = []
+        failed_semantics = ""
         for k, formula in enumerate(self.guarantees, 1):
-            ok, reason = self._truth(k, formula, values)
+            judged = self._judge(k, formula, values)
+            ok, reason = judged.truth, judged.reason
             if ok is False:
-                failed = k
+                failed, failed_semantics = k, judged.semantics
                 break
+            if ok and judged.semantics != "exact":
+                inexact.append((k, judged))
+                if _WEAK.get(judged.semantics, 0) > _WEAK[weakest]:
+                    weakest = judged.semantics
             if ok is None:
                 if reason.startswith("no value for out."):  # no answer on that output yet: wait for it
                     if g.outs and g.last is None:  # a partial answer: shown if nothing completes it
@@ -417,11 +509,14 @@ class NodeMonitor:
                 undecided = f"guarantee {k}: {reason}"
                 break
         if failed is None and not undecided:
+            for k, judged in inexact[:1]:
+                self._note_inexact(g.events[0], judged, f"guarantee {k} ({self._texts[k]})", values)
             for trigger in g.events:
-                self._verdict("satisfied", trigger)
+                self._verdict("satisfied", trigger, semantics=weakest)
             done.append(key)
         elif failed is not None and (g.last is None or not g.answered):
             g.last, g.undecided = (ev, failed, {k: v for k, v in values.items() if k.startswith("out.")}), ""
+            g.last_semantics = failed_semantics
         else:
             g.undecided = undecided
 
@@ -442,6 +537,10 @@ class NodeMonitor:
             h.undecided = h.undecided or g.undecided
             h.answered = h.answered and g.answered
             h.superseded = h.superseded if g.superseded is not None else None
+            if _WEAK[g.accepted] > _WEAK[h.accepted]:
+                h.accepted = g.accepted
+            if h.last is g.last:  # h took g's failure: and the semantics it was decided in
+                h.last_semantics = g.last_semantics
         self.pending = merged
 
     def advance(self, now: float) -> None:
@@ -502,11 +601,21 @@ class NodeMonitor:
                 "trigger_time": trigger.time, "trigger_where": trigger.where,
                 "values": self._rendered({**g.inputs, **outputs}),
                 "reason": f"guarantee {k} is false on the output at {out.where} answering the input at "
-                          f"{trigger.where}, and no output within {self.horizon} s satisfied it"}
+                          f"{trigger.where}{_in_all(g.last_semantics)}, and no output within {self.horizon} s "
+                          f"satisfied it",
+                "semantics": g.last_semantics}
         if self.result.first_violation is None:
             self.result.first_violation = first
         self._verdict("violated", trigger, guarantee=first["guarantee"] or 0, values=first["values"],
-                      reason=first["reason"])
+                      reason=first["reason"], semantics=first.get("semantics", ""))
+
+    def _note_inexact(self, ev: Event, judged: Judgement, what: str, values: Mapping[str, Any]) -> None:
+        """Remember the first formula that held only in double arithmetic or
+        within the tolerance (the evidence names the semantics that decided)."""
+        if self.result.first_inexact is None:
+            self.result.first_inexact = {"event": ev.index, "time": ev.time, "where": ev.where,
+                                         "semantics": judged.semantics, "formula": what,
+                                         "values": self._rendered(values), "reason": judged.reason}
 
     def _note_inconclusive(self, ev: Event, k: int, reason: str) -> None:
         self._first_inconclusive(ev, reason)
@@ -526,9 +635,23 @@ class NodeMonitor:
         return self.result
 
 
+def _in_all(semantics: str) -> str:
+    """`` (false in exact and double arithmetic)`` for a failure that every
+    float semantics agreed on, ``""`` when only exact arithmetic applied."""
+    names = [s for s in semantics.split(", ") if s]
+    if len(names) < 2:
+        return ""
+    words = {"exact": "exact", "double": "double", "tolerance": "within the tolerance"}
+    said = [words.get(n, n) for n in names]
+    arith = [w for w in said if w in ("exact", "double")]
+    text = " and ".join(arith) + " arithmetic" + (" and " + said[-1] if "within the tolerance" in said else "")
+    return f" (false in {text})"
+
+
 def check_trace(checked: Checked, nodes: Iterable[CheckedNode], events: Iterable[Event],
                 rules: Mapping[str, TopicRule], horizon: float,
                 on_verdict: Callable[[Verdict], None] | None = None,
+                tolerance: Tolerance | None = None,
                 end: float | None = None) -> tuple[int, list[NodeResult]]:
     """Stream ``events`` through a monitor per node; returns (events read, results).
 
@@ -536,11 +659,12 @@ def check_trace(checked: Checked, nodes: Iterable[CheckedNode], events: Iterable
     event is fed in order, the clock advanced to the last event's time at the
     end (or to ``end``, seconds, when the run is known to have gone on after
     its last event: a live run's log, whose monitor kept its clock), then
-    every monitor finished.  ``on_verdict`` receives every event's
-    verdict as it is decided.  Raises whatever the event source raises
-    (:class:`TraceError`) after the events before it were processed.
+    every monitor finished.  ``on_verdict`` receives every event's verdict
+    as it is decided; ``tolerance`` as for :class:`NodeMonitor`.  Raises
+    whatever the event source raises (:class:`TraceError`) after the events
+    before it were processed.
     """
-    monitors = [NodeMonitor(checked, n, rules, horizon, on_verdict) for n in nodes]
+    monitors = [NodeMonitor(checked, n, rules, horizon, on_verdict, tolerance) for n in nodes]
     count = 0
     last_time = 0.0
     for ev in events:

@@ -58,7 +58,7 @@ def monitor_command(args: argparse.Namespace, checked: Checked) -> int:
     for trace in args.traces:
         path = Path(trace)
         # one pass over the run feeds both checks (a log named here may be a stream, read once)
-        dmons = [DeadlineMonitor(checked, n, cfg.rules, horizon=cfg.horizon) for n in timed]
+        dmons = [DeadlineMonitor(checked, n, cfg.rules, horizon=cfg.horizon, tolerance=cfg.tolerance) for n in timed]
 
         def tap(events: Iterable[Any]) -> Iterator[Any]:
             for ev in events:
@@ -69,7 +69,7 @@ def monitor_command(args: argparse.Namespace, checked: Checked) -> int:
             events, results = check_trace(checked, list(checked.nodes.values()),
                                           tap(read_trace(path, [root / d for d in cfg.msg_dirs], streams=True,
                                                          on_warning=lambda w: print(w, file=sys.stderr))),
-                                          cfg.rules, cfg.horizon)
+                                          cfg.rules, cfg.horizon, tolerance=cfg.tolerance)
             dres = [m.finish() for m in dmons]
         except TraceError as exc:
             _emit(report, args.json)
@@ -83,7 +83,7 @@ def monitor_command(args: argparse.Namespace, checked: Checked) -> int:
             status, explanation = verdict_status(res, trace)
             violated = violated or status == "failed"
             entry = {"node": res.node, "status": status, "explanation": explanation,
-                     **monitoring_details(res, trace, events, "", tool_versions(), cfg.horizon)}
+                     **monitoring_details(res, trace, events, "", tool_versions(), cfg.horizon, cfg.tolerance)}
             entry.pop("sha256")
             report.append(entry)
             if not args.json:
@@ -96,7 +96,9 @@ def monitor_command(args: argparse.Namespace, checked: Checked) -> int:
                            "deadlines": d.to_json()})
             if not args.json:
                 print(f"{trace}: {d.node} deadlines: " + (", ".join(f"{n} {v}" for v, n in d.counts.items() if n)
-                                                            or "no trigger event"))
+                                                            or "no trigger event")
+                      + ("; no verdict: " + ", ".join(f"{n} {v}" for v, n in d.unaccepted.items() if n)
+                         if any(d.unaccepted.values()) else ""))
                 print(f"  {status}: {explanation}")
     _emit(report, args.json)
     return 1 if violated else 0

@@ -5,11 +5,14 @@ Plan entry (``nodes.<Node>.evidence[k]``)::
     - backend: monitors
       mapping: backends/monitors/mapping.yaml   # topic rules, .msg dirs
       horizon: 2.0                              # seconds (default 5.0)
+      tolerance: {abs: 1.0e-6}                  # optional, overrides the mapping's
       traces: [backends/monitors/traces/nominal.jsonl, ...]
 
 Mapping file: ``msg_dirs`` (directories holding ``<pkg>/msg/<Type>.msg``),
 ``topics`` (:func:`rclverify.traces.mapping.load_rules`), optional
-``ros_version`` (``ros1``/``ros2``, default ``ros2``), ``horizon`` and
+``ros_version`` (``ros1``/``ros2``, default ``ros2``), ``horizon``,
+``tolerance`` (``{abs, rel, ulps}``: recorded numbers this close are equal
+to the comparisons, :class:`rclverify.logic.floatsem.Tolerance`) and
 ``ros_nodes`` (contract node -> ``{name, package, path}`` of the ROS node
 to instrument, as ROSMonitoring's configuration lists it)::
 
@@ -26,6 +29,7 @@ from typing import Any, Mapping
 
 import yaml
 
+from ...logic.floatsem import Tolerance, ToleranceError, parse_tolerance
 from ...traces.mapping import RuleError, TopicRule, load_rules
 from ...plan.yamlguard import read_yaml_text, safe_load_guarded
 
@@ -53,7 +57,10 @@ class ConfigError(Exception):
 @dataclass(frozen=True)
 class MonitorConfig:
     """Resolved options: workspace-relative ``mapping`` file, ``rules`` per topic,
-    ``msg_dirs`` (relative), ``horizon`` in seconds, ``ros_version``, ``traces``."""
+    ``msg_dirs`` (relative), ``horizon`` in seconds, ``ros_version``, ``traces``,
+    ``tolerance`` of recorded numbers (the plan entry's, else the mapping
+    file's; ``None``: none; ``rules.tolerance`` holds it too, so a monitor
+    given the rules applies it)."""
 
     mapping: str
     rules: Mapping[str, TopicRule]
@@ -62,6 +69,7 @@ class MonitorConfig:
     ros_version: str
     traces: tuple[str, ...] = ()
     ros_nodes: Mapping[str, Mapping[str, str]] = field(default_factory=dict)
+    tolerance: Tolerance | None = None
 
     def msg_files(self, root: Path) -> list[str]:
         """Workspace-relative ``.msg`` files under the message directories, sorted
@@ -78,8 +86,10 @@ def is_seconds(value: Any) -> bool:
             and value >= 0)
 
 
-def load_mapping(root: Path, rel: str | None, horizon: Any = None, traces: Any = ()) -> MonitorConfig:
+def load_mapping(root: Path, rel: str | None, horizon: Any = None, traces: Any = (),
+                 tolerance: Any = None) -> MonitorConfig:
     """Read the mapping file (``rel`` or the default; absent default -> no rules).
+    ``horizon`` and ``tolerance`` (the plan entry's, raw) override the file's.
 
     Raises :class:`ConfigError` for an unreadable file or malformed options.
     """
@@ -111,6 +121,17 @@ def load_mapping(root: Path, rel: str | None, horizon: Any = None, traces: Any =
     for k, t in enumerate(traces):
         if not (root / str(t)).exists():
             raise ConfigError(f"no such trace: {t}", "traces", k)
+    try:
+        tol = parse_tolerance(tolerance)
+    except ToleranceError as exc:  # the plan entry's: located by the caller
+        raise ConfigError(str(exc), "tolerance", *exc.key) from None
+    if tolerance is None:
+        try:
+            tol = parse_tolerance(raw.get("tolerance"))
+        except ToleranceError as exc:
+            raise ConfigError(f"{rel or DEFAULT_MAPPING}:{_at(path, rel or DEFAULT_MAPPING, ('tolerance', *exc.key))}: "
+                              f"error: {exc}") from None
+    rules.tolerance = tol
     ros = str(raw.get("ros_version", "ros2"))
     msg_dirs = raw.get("msg_dirs", ()) or ()
     if not isinstance(msg_dirs, (list, tuple)):
@@ -127,7 +148,7 @@ def load_mapping(root: Path, rel: str | None, horizon: Any = None, traces: Any =
     return MonitorConfig(rel or DEFAULT_MAPPING if path.is_file() else "", rules,
                          tuple(str(d) for d in raw.get("msg_dirs", ()) or ()), float(h), ros,
                          tuple(str(t) for t in traces),
-                         {str(k): {f: str(x) for f, x in v.items()} for k, v in ros_nodes.items()})
+                         {str(k): {f: str(x) for f, x in v.items()} for k, v in ros_nodes.items()}, tol)
 
 
 def _at(path: Path, rel: str, keys: tuple[Any, ...]) -> str:

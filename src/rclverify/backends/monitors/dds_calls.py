@@ -62,7 +62,10 @@ def link_view(node: CheckedNode, link: ast.Link) -> CheckedNode:
     topics = tuple(ast.Topic(link.ros_type, f"{link.name.strip('/')}/{part}", var, link.loc)
                    for part, var in zip(LINK_TOPICS[link.kind], link.parts))
     guarantees = node.node.guarantees if link.role == "serves" else ()
-    return CheckedNode(dataclasses.replace(node.node, topics=topics, guarantees=guarantees), node.inputs,
+    # links=(): the view's topics already bind the link's parts to its variables, and a DDS call's parts
+    # arrive unwrapped (the goal's fields, not an actionlib ActionGoal holding them), so the engine's own
+    # reading of the node's links (actionlib's wrapped parts) must not apply a second time
+    return CheckedNode(dataclasses.replace(node.node, topics=topics, guarantees=guarantees, links=()), node.inputs,
                        node.outputs)
 
 

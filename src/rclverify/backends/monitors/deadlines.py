@@ -16,6 +16,16 @@ ROSMonitoring's terms:
 * ``currently_false``: not answered yet and the deadline not yet expired (a
   run that ends then, or a live query before the deadline).
 
+**Only accepted inputs are obligations** (issue 40): the node's assumption
+is judged on the trigger's inputs; a trigger whose inputs violate it (or
+whose inputs are not all observed yet, or whose assumption cannot be
+decided) gets no deadline verdict and is counted apart
+(:attr:`DeadlineResult.unaccepted`): a node is not obliged to answer an
+input its contract does not accept, so a ``true`` there would be evidence
+of nothing and a ``false`` a false alarm.  Formulas are judged as the
+untimed monitor judges them (:func:`rclverify.logic.floatsem.judge`: exact,
+the node's double arithmetic, a declared tolerance).
+
 A ``triggered by`` without ``within`` is checked the same way with the
 monitor's ``horizon`` as its bound (offline; the live proxy has none, so
 it checks only guarantees with a deadline).
@@ -39,18 +49,20 @@ from collections import deque
 from dataclasses import dataclass, field
 from typing import Any, Callable, Iterable, Mapping
 
-from ...logic.evaluate import evaluate
+from ...logic.floatsem import Tolerance, judge
 from ...rcl import ast
+from ...rcl.printer import expr_to_rcl
 from ...rcl.timing import seconds
 from ...rcl.types import Checked, CheckedNode
 from ...rcl.walk import subexpressions
 from ...traces.events import Event
 from ...traces.mapping import MappingError, TopicRule, map_value
+from .check import LINK_TOPICS
 from .online import header_stamp
 
 DEADLINE_VERDICTS = ("true", "currently_false", "false")
-#: Topic suffixes of a link's parts, in the order of ``Link.parts``.
-LINK_TOPICS = {"service": ("request", "response"), "action": ("goal", "feedback", "result")}
+#: Why a trigger got no deadline verdict (:attr:`DeadlineResult.unaccepted`).
+UNACCEPTED = ("assumption violated", "incomplete input", "undecided")
 
 
 @dataclass(frozen=True)
@@ -69,12 +81,14 @@ class DeadlineVerdict:
     reason: str = ""
     #: the late answer of a trigger already judged ``false`` when its deadline expired (not a new verdict)
     update: bool = False
+    #: the arithmetic the answer's formula held in (``exact``, ``double``, ``tolerance``; ``""``: no answer)
+    semantics: str = ""
 
     def to_json(self) -> dict[str, Any]:
         return {"node": self.node, "guarantee": self.guarantee, "verdict": self.verdict,
                 "trigger_where": self.trigger_where, "trigger_stamp": self.trigger_stamp, "due": self.due,
                 "answer": self.answer, "answer_where": self.answer_where, "reason": self.reason,
-                "update": self.update}
+                "update": self.update, "semantics": self.semantics}
 
 
 @dataclass
@@ -86,19 +100,27 @@ class _Pending:
     inputs: dict[str, Any]
     #: the outputs published after the trigger (stamp at or after it): only they answer it
     outs: dict[str, Any] = field(default_factory=dict)
+    #: the last output after the trigger that did not satisfy the guarantee (where, why)
+    rejected: str = ""
 
 
 @dataclass
 class DeadlineResult:
-    """Counts per verdict and the first ``false`` of one node on one run."""
+    """Counts per verdict and the first ``false`` of one node on one run;
+    ``unaccepted`` the (trigger, guarantee) pairs given no verdict, per reason
+    (:data:`UNACCEPTED`), and the first of them (``first_unaccepted``:
+    where, stamp, guarantee, reason)."""
 
     node: str
     counts: dict[str, int] = field(default_factory=lambda: {v: 0 for v in DEADLINE_VERDICTS})
     first_false: DeadlineVerdict | None = None
+    unaccepted: dict[str, int] = field(default_factory=lambda: {v: 0 for v in UNACCEPTED})
+    first_unaccepted: dict[str, Any] | None = None
 
     def to_json(self) -> dict[str, Any]:
         return {"node": self.node, "counts": dict(self.counts),
-                "first_false": None if self.first_false is None else self.first_false.to_json()}
+                "first_false": None if self.first_false is None else self.first_false.to_json(),
+                "unaccepted": dict(self.unaccepted), "first_unaccepted": self.first_unaccepted}
 
 
 def event_stamp(ev: Event) -> float:
@@ -128,11 +150,16 @@ class DeadlineMonitor:
 
     ``feed(ev)`` one event; ``advance(now)`` the clock (expires deadlines);
     ``pending_verdicts()`` the ``currently_false`` obligations now;
-    ``finish()`` the result.  ``on_verdict`` gets every decided verdict."""
+    ``finish()`` the result.  ``on_verdict`` gets every decided verdict.
+    ``tolerance`` as for :class:`~.check.NodeMonitor` (default: ``rules``'
+    ``tolerance`` attribute when it has one)."""
 
     def __init__(self, checked: Checked, node: CheckedNode, rules: Mapping[str, TopicRule],
-                 on_verdict: Callable[[DeadlineVerdict], None] | None = None, horizon: float | None = None) -> None:
+                 on_verdict: Callable[[DeadlineVerdict], None] | None = None, horizon: float | None = None,
+                 tolerance: Tolerance | None = None) -> None:
         self.checked, self.node, self.rules, self.on_verdict = checked, node, rules, on_verdict
+        self.tolerance = tolerance if tolerance is not None else getattr(rules, "tolerance", None)
+        self.assumption = tuple(c.formula for c in node.node.assumes)
         self.bindings = topic_bindings(node)
         self.timed: list[tuple[int, ast.Clause, str, frozenset[str], float]] = []
         for k, cl in enumerate(node.node.guarantees, 1):
@@ -199,10 +226,34 @@ class DeadlineMonitor:
                     p.outs.update(fresh)
             self._answer(ev, stamp, outs)
         self.advance(stamp)
-        for k, cl, trig, _, d in self.timed:
-            if trig in changed:
-                inputs = {key: v for key, v in self.values.items() if key.startswith("in.")}
+        triggered = [t for t in self.timed if t[2] in changed]
+        if not triggered:
+            return
+        inputs = {key: v for key, v in self.values.items() if key.startswith("in.")}
+        refused = self._refused(inputs)
+        for k, cl, trig, _, d in triggered:
+            if refused is None:
                 self.pending.append(_Pending(k, ev, stamp, stamp + d, inputs))
+                continue
+            why, reason = refused
+            self.result.unaccepted[why] += 1
+            if self.result.first_unaccepted is None:
+                self.result.first_unaccepted = {"guarantee": k, "where": ev.where, "stamp": stamp, "why": why,
+                                                "reason": reason}
+
+    def _refused(self, inputs: Mapping[str, Any]) -> tuple[str, str] | None:
+        """Why the node's assumption does not accept ``inputs`` (``(kind,
+        reason)``, kind one of :data:`UNACCEPTED`), ``None`` when it does."""
+        for formula in self.assumption:
+            j = judge(formula, self.checked, self.node, inputs, self.tolerance)
+            if j.truth is True:
+                continue
+            if j.truth is False:
+                return "assumption violated", f"assumption {expr_to_rcl(formula)} is false of the trigger's inputs"
+            if j.reason.startswith("no value for"):
+                return "incomplete input", j.reason
+            return "undecided", f"assumption {expr_to_rcl(formula)} undecided: {j.reason}"
+        return None
 
     def _answer(self, ev: Event, stamp: float, outs: set[str]) -> None:
         for p in list(self.expired):
@@ -218,16 +269,22 @@ class DeadlineMonitor:
             if not (gouts & outs) or stamp < p.stamp:
                 keep.append(p)
                 continue
-            if evaluate(cl.formula, self.checked, self.node, self._visible(p)) is not True:
+            j = judge(cl.formula, self.checked, self.node, self._visible(p), self.tolerance)
+            if j.truth is not True:
+                p.rejected = f"the output at {ev.where} did not satisfy guarantee {k}" + (
+                    f" (false in {j.semantics} arithmetic)" if j.truth is False and "double" in j.semantics else
+                    f" ({j.reason})" if j.truth is None and j.reason else "")
                 keep.append(p)
                 continue
             if stamp <= p.due:
                 self._emit(DeadlineVerdict(self.node.name, p.k, "true", p.trigger.where, p.stamp, p.due, stamp,
-                                           ev.where, f"answered after {_ms(stamp - p.stamp)} (deadline {_ms(d)})"))
+                                           ev.where, f"answered after {_ms(stamp - p.stamp)} (deadline {_ms(d)})",
+                                           semantics=j.semantics))
             else:
                 self._emit(DeadlineVerdict(self.node.name, p.k, "false", p.trigger.where, p.stamp, p.due, stamp,
                                            ev.where, f"answered after {_ms(stamp - p.stamp)}, "
-                                           f"{_ms(stamp - p.due)} past the deadline of {_ms(d)}"))
+                                           f"{_ms(stamp - p.due)} past the deadline of {_ms(d)}",
+                                           semantics=j.semantics))
         self.pending = keep
 
     def _answers(self, p: _Pending, stamp: float, outs: set[str]) -> bool:
@@ -235,7 +292,7 @@ class DeadlineMonitor:
         _, cl, _, gouts, _ = next(t for t in self.timed if t[0] == p.k)
         if not (gouts & outs) or stamp < p.stamp:
             return False
-        return evaluate(cl.formula, self.checked, self.node, self._visible(p)) is True
+        return judge(cl.formula, self.checked, self.node, self._visible(p), self.tolerance).truth is True
 
     def _visible(self, p: _Pending) -> dict[str, Any]:
         """What obligation ``p`` is judged on: its trigger's inputs, the state
@@ -255,7 +312,8 @@ class DeadlineMonitor:
             if p.due < now:
                 d = p.due - p.stamp
                 self._emit(DeadlineVerdict(self.node.name, p.k, "false", p.trigger.where, p.stamp, p.due, None, "",
-                                           f"no answer within the deadline of {_ms(d)} (clock at {now:.3f} s)"))
+                                           f"no answer within the deadline of {_ms(d)} (clock at {now:.3f} s)"
+                                           + (f"; {p.rejected}" if p.rejected else "")))
                 self.expired.append(p)
             else:
                 keep.append(p)
@@ -276,10 +334,11 @@ class DeadlineMonitor:
 
 def check_deadlines(checked: Checked, nodes: Iterable[CheckedNode], events: Iterable[Event],
                     rules: Mapping[str, TopicRule], on_verdict: Callable[[DeadlineVerdict], None] | None = None,
-                    horizon: float | None = None) -> list[DeadlineResult]:
+                    horizon: float | None = None, tolerance: Tolerance | None = None) -> list[DeadlineResult]:
     """The deadline monitors of ``nodes`` run over a recorded trace, in
-    order; ``horizon`` (s) bounds a ``triggered by`` without ``within``."""
-    monitors = [DeadlineMonitor(checked, n, rules, on_verdict, horizon) for n in nodes]
+    order; ``horizon`` (s) bounds a ``triggered by`` without ``within``;
+    ``tolerance`` as for :class:`DeadlineMonitor`."""
+    monitors = [DeadlineMonitor(checked, n, rules, on_verdict, horizon, tolerance) for n in nodes]
     for ev in events:
         for m in monitors:
             m.feed(ev)
@@ -302,16 +361,29 @@ def deadline_status(res: DeadlineResult, trace: str) -> tuple[str, str]:
     ``pending`` when no trigger event was seen."""
     c = res.counts
     f = res.first_false
+    u = res.unaccepted
+    refused = ""
+    if any(u.values()):
+        first = res.first_unaccepted or {}
+        words = {"assumption violated": "whose inputs violated the assumption",
+                 "incomplete input": "with inputs not all observed yet", "undecided": "whose assumption was undecided"}
+        refused = ("; no deadline verdict for " + ", ".join(f"{n} trigger event(s) {words[k]}"
+                                                            for k, n in u.items() if n)
+                   + f" (first at {first.get('where')}: {first.get('reason')})")
     if c["false"] and f is not None:
-        late = (f"answered at {f.answer:.3f} s ({f.answer_where})" if f.answer is not None else "never answered")
+        late = (f"answered at {f.answer:.3f} s ({f.answer_where})" if f.answer is not None else
+                "never answered as guaranteed" if "did not satisfy" in f.reason else "never answered")
         return "failed", (f"{c['false']} trigger event(s) of {trace} missed {res.node}'s deadline; the first: "
                           f"guarantee {f.guarantee}, triggered at {f.trigger_where} (stamp {f.trigger_stamp:.3f} s), "
-                          f"due {f.due:.3f} s, {late}: {f.reason}")
+                          f"due {f.due:.3f} s, {late}: {f.reason}{refused}")
+    if u["undecided"]:
+        return "inconclusive", (f"{u['undecided']} trigger event(s) could not be judged against the assumption"
+                                f"{refused}")
     if c["currently_false"] and not c["true"]:
         return "inconclusive", (f"{c['currently_false']} trigger event(s) were unanswered and within their "
-                                f"deadline when {trace} ended")
+                                f"deadline when {trace} ended{refused}")
     if not c["true"]:
-        return "pending", f"{trace} has no trigger event of {res.node}'s timed guarantees: nothing was checked"
+        return "pending", f"{trace} has no accepted trigger event of {res.node}'s timed guarantees: nothing was checked{refused}"
     extra = (f"; {c['currently_false']} more still within their deadline when the run ended"
              if c["currently_false"] else "")
-    return "discharged", f"all {c['true']} trigger event(s) were answered within their deadline{extra}"
+    return "discharged", f"all {c['true']} accepted trigger event(s) were answered within their deadline{extra}{refused}"

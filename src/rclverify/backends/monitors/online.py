@@ -31,6 +31,7 @@ import math
 from dataclasses import dataclass, field
 from typing import Any, Callable, Iterable, Mapping
 
+from ...logic.floatsem import Tolerance
 from ...rcl.types import Checked, CheckedNode
 from ...traces.events import Event
 from ...traces.mapping import TopicRule
@@ -95,6 +96,8 @@ class OnlineEngine:
     on_verdict: Callable[[Verdict], None] | None = None
     on_silence: Callable[[str, float, bool], None] | None = None
     on_event: Callable[[Event], None] | None = None
+    #: the declared tolerance of recorded numbers (default: ``rules.tolerance``, see :class:`NodeMonitor`)
+    tolerance: Tolerance | None = None
     monitors: list[NodeMonitor] = field(init=False)
     topics: dict[str, TopicStatus] = field(init=False)
     late: int = field(init=False, default=0)
@@ -105,7 +108,7 @@ class OnlineEngine:
     _clock: float = field(init=False, default=-math.inf)
 
     def __post_init__(self) -> None:
-        self.monitors = [NodeMonitor(self.checked, n, self.rules, self.horizon, self.on_verdict)
+        self.monitors = [NodeMonitor(self.checked, n, self.rules, self.horizon, self.on_verdict, self.tolerance)
                          for n in self.nodes]
         self.topics = {t: TopicStatus() for m in self.monitors for t in m.topics}
 

@@ -50,16 +50,21 @@ class ProxyRun:
     ``log``: the JSON-lines file to write (this module's own command); or
     ``write(obj)``, a sink for each line's object (``rclverify monitor
     --live``: the live monitor's log) and ``publish(text)`` for each
-    deadline verdict as JSON text (its verdict topic)."""
+    deadline verdict as JSON text (its verdict topic); ``forward(topic,
+    fields, stamp)`` receives every observed message too (``rclverify
+    monitor --live``: the live engine, whose node monitors then check each
+    call's response against the server's guarantees and the client's
+    assumption, issue 40)."""
 
     def __init__(self, monitors: list[DeadlineMonitor], log: Path | None = None, *,
                  write: Callable[[dict[str, Any]], None] | None = None,
-                 publish: Callable[[str], None] | None = None) -> None:
+                 publish: Callable[[str], None] | None = None,
+                 forward: Callable[[str, dict[str, Any], float], None] | None = None) -> None:
         self.monitors, self.lock, self.index, self.false = monitors, threading.Lock(), 0, 0
         for m in monitors:
             m.on_verdict = self._verdict
         self.fh = log.open("w", encoding="utf-8") if log is not None else None
-        self.sink, self.publish = write, publish
+        self.sink, self.publish, self.forward = write, publish, forward
 
     def _write(self, obj: dict[str, Any]) -> None:
         if self.sink is not None:
@@ -85,6 +90,8 @@ class ProxyRun:
             self._write({"kind": "event", "index": ev.index, "topic": topic, "time": stamp, "fields": fields})
             for m in self.monitors:
                 m.feed(ev)
+            if self.forward is not None:
+                self.forward(topic, fields, stamp)
 
     def tick(self, now: float) -> None:
         with self.lock:
@@ -180,8 +187,9 @@ def proxy_factory(checked: Any, nodes: Sequence[Any], forward: Sequence[str],
     timed = {n.name for n in deadline_nodes(checked)}
 
     def start(rospy: Any, live: Any, publish: Callable[[str], None]) -> ProxyRun:
-        run = ProxyRun([DeadlineMonitor(checked, n, {}) for n in nodes if n.name in timed], write=live.note,
-                       publish=publish)
+        rules = getattr(live.engine, "rules", {})  # the mapping's rules (and tolerance) of the live run
+        run = ProxyRun([DeadlineMonitor(checked, n, rules) for n in nodes if n.name in timed], write=live.note,
+                       publish=publish, forward=live.push)
         run.handles = start_proxy(rospy, checked, forwards, dirs, run,  # type: ignore[attr-defined]
                                   lambda: rospy.Time.now().to_sec())
         return run

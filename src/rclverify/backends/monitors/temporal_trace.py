@@ -20,10 +20,12 @@ are found by Z3 on the concrete values, and used only when the formula
 defines exactly one value (else the variable has no value from there on,
 and what reads it is undecided).
 
-**Operands** are decided at each step by the one evaluator
-(:func:`rclverify.logic.decide.decide`: direct evaluation, Z3 on concrete
-values when it cannot); a variable not observed yet has no value, so an
-operand reading it is undecided at that step.
+**Operands** are decided at each step by the judgement of the node monitors
+(:func:`rclverify.logic.floatsem.judge`: direct evaluation, Z3 on concrete
+values when it cannot, then the nodes' double arithmetic and the mapping's
+tolerance, docs/monitors.md "Numbers on the wire"; a witness of an operand
+that held only there names the semantics); a variable not observed yet has
+no value, so an operand reading it is undecided at that step.
 
 **Finite-trace verdicts** (docs/requirements.md, "Temporal requirements"):
 
@@ -54,7 +56,7 @@ from typing import Any, Iterable, Mapping
 import z3
 
 from ...logic.concrete import finite_interpretation, to_z3
-from ...logic.decide import decide
+from ...logic.floatsem import judge
 from ...logic.encode import EncodingError, Encoder
 from ...plan.formal import Formal
 from ...plan.state import StateFormula, StateVar, parse_state_formula, state_type
@@ -289,13 +291,21 @@ class TraceStates:
         return out
 
 
-def _truth(f: Formal, checked: Checked, values: Mapping[str, Any]) -> bool | None:
+def _truth(f: Formal, checked: Checked, values: Mapping[str, Any], tolerance: Any = None,
+           semantics: dict[int, str] | None = None) -> bool | None:
+    """Operand ``f``'s truth on the step's values, judged as the node monitors
+    judge (:func:`rclverify.logic.floatsem.judge`: exact, then the nodes'
+    double arithmetic, then a declared ``tolerance``); the semantics that
+    decided goes to ``semantics[id(f)]``."""
     mine = {k: v for k, v in values.items() if k.partition(".")[2] in f.scope.inputs or
             k.partition(".")[2] in f.scope.outputs}
     try:
-        return decide(f.expr, checked, f.scope, mine)[0]
+        j = judge(f.expr, checked, f.scope, mine, tolerance)
     except (KeyError, ValueError, TypeError, EncodingError, z3.Z3Exception):
         return None
+    if semantics is not None:
+        semantics[id(f)] = j.semantics
+    return j.truth
 
 
 def _shown(f: Formal, values: Mapping[str, Any]) -> dict[str, str]:
@@ -319,6 +329,8 @@ def check_temporal_trace(t: Temporal, checked: Checked, states: tuple[StateVar, 
     for sv in states:
         state_type(sv, checked)
     st = TraceStates(checked, nodes, states, rules)
+    tol = getattr(rules, "tolerance", None)  # the mapping's tolerance of recorded numbers
+    sems: dict[int, str] = {}
     undecided: dict[str, Any] | None = None
     i = -1
     last: Event | None = None
@@ -329,15 +341,18 @@ def check_temporal_trace(t: Temporal, checked: Checked, states: tuple[StateVar, 
         vals = st.values()
 
         def wit(f: Formal, holds: bool | None) -> dict[str, Any]:
-            return {"step": i, "time": ev.time, "where": ev.where, "operand": f.expr and _text(f),
-                    "holds": holds, "values": _shown(f, vals)}
+            out = {"step": i, "time": ev.time, "where": ev.where, "operand": f.expr and _text(f),
+                   "holds": holds, "values": _shown(f, vals)}
+            if holds and sems.get(id(f), "exact") != "exact":  # held only in double arithmetic or the tolerance
+                out["semantics"] = sems[id(f)]
+            return out
 
         def at(verdict: str, why: str, w: list[dict[str, Any]]) -> TraceVerdict:
             return TraceVerdict(verdict, i + 1, why, i, ev.time, ev.where, w)
         if kind in ("always", "always next"):
             if kind == "always next" and i == 0:
                 continue
-            h = _truth(ops[0], checked, vals)
+            h = _truth(ops[0], checked, vals, tol, sems)
             if h is False:
                 return at("false", f"{_text(ops[0])} is false at step {i} ({ev.where}, t = {ev.time} s)",
                           [wit(ops[0], False)])
@@ -345,11 +360,11 @@ def check_temporal_trace(t: Temporal, checked: Checked, states: tuple[StateVar, 
                 undecided = wit(ops[0], None)
         elif kind == "next":
             if i == 1:
-                h = _truth(ops[0], checked, vals)
+                h = _truth(ops[0], checked, vals, tol, sems)
                 v = {True: "true", False: "false", None: "inconclusive"}[h]
                 return at(v, f"{_text(ops[0])} is {v if h is not None else 'undecided'} at step 1", [wit(ops[0], h)])
         elif kind == "eventually":
-            h = _truth(ops[0], checked, vals)
+            h = _truth(ops[0], checked, vals, tol, sems)
             if h is True:
                 return at("true", f"{_text(ops[0])} holds at step {i} ({ev.where}, t = {ev.time} s)",
                           [wit(ops[0], True)])
@@ -362,14 +377,14 @@ def check_temporal_trace(t: Temporal, checked: Checked, states: tuple[StateVar, 
                 return at("false", f"{_text(ops[0])} does not hold at any step 0..{t.bound}: the bound passed "
                                    f"at step {i} ({ev.where}, t = {ev.time} s)", [wit(ops[0], False)])
         else:  # until
-            g = _truth(ops[1], checked, vals)
+            g = _truth(ops[1], checked, vals, tol, sems)
             if g is True and undecided is None:
                 return at("true", f"{_text(ops[1])} holds at step {i}, {_text(ops[0])} at every step before",
                           [wit(ops[1], True)])
             if g is None and undecided is None:
                 undecided = wit(ops[1], None)
             if g is not True:
-                f = _truth(ops[0], checked, vals)
+                f = _truth(ops[0], checked, vals, tol, sems)
                 if f is False and undecided is None:
                     return at("false", f"{_text(ops[0])} is false at step {i} before {_text(ops[1])} held",
                               [wit(ops[0], False)])

@@ -1,0 +1,111 @@
+"""Check-time validation of a mapping file's field paths against the message definitions.
+
+A topic rule's ``fields`` may name nested fields and array elements
+(``linear.x``, ``pose.pose.position.x``, ``ranges[0]``, ``ranges[-1]``:
+:func:`rclverify.traces.mapping.parse_path`).  Where the contracts give the
+topic's ROS type (``topics(geometry_msgs/Twist cmd_vel matches(...))``, a
+service's request and response, an action's goal, feedback and result) and
+the type is known (the mapping's ``msg_dirs``, or the standard types of
+rosbags' store, which the bag reader uses too), every entry is followed
+through the definitions (:func:`rclverify.ros.interfaces.field_path`, the
+ROS grounding's reader): a field that does not exist, a message where a
+number is read, or an array read without an index is one located error at
+the entry in the mapping file (``mapping.yaml:7:22: error: topic cmd_vel:
+field 'linar.x' of geometry_msgs/Twist: ...``), before any run is read.
+An unknown type is left to the run (its events are then ``inconclusive``
+with the reason when a field is missing).
+"""
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any, Mapping, Sequence
+
+from ...plan.errors import plan_error
+from ...plan.yamlguard import load_located, read_yaml_text
+from ...rcl.errors import Diagnostic
+from ...rcl.types import Checked
+from ...ros.interfaces import BASE_TYPES, TypeTable, field_path
+from ...ros.model import canon_type, short_type
+from .check import LINK_TOPICS
+
+
+def topic_types(checked: Checked) -> dict[str, str]:
+    """topic (no leading ``/``) -> the canonical ROS type of what its rule
+    maps (``pkg/msg/Type``; for a link's topic the part's type,
+    ``std_srvs/srv/SetBool_Request``, ``pkg/action/Move_Goal``); the first
+    node naming a topic wins."""
+    out: dict[str, str] = {}
+    for node in checked.nodes.values():
+        for t in node.node.topics:
+            typ = canon_type(t.msg_type)
+            if typ:
+                out.setdefault(t.field.lstrip("/"), typ)
+        for lk in node.node.links:
+            base = canon_type(lk.ros_type, "srv" if lk.kind == "service" else "action")
+            if not base:
+                continue
+            suffixes = {"request": "_Request", "response": "_Response", "goal": "_Goal", "feedback": "_Feedback",
+                        "result": "_Result"}
+            for part in LINK_TOPICS.get(lk.kind, ()):
+                out.setdefault(f"{lk.name.lstrip('/')}/{part}", base + suffixes[part])
+    return out
+
+
+def _table(root: Path, msg_dirs: Sequence[str]) -> TypeTable:
+    """The workspace's interface files under ``msg_dirs`` (``<pkg>/msg/*.msg``,
+    also ``srv``/``action``), standard types from rosbags' store on demand."""
+    table = TypeTable()
+    for d in msg_dirs:
+        base = root / d
+        if not base.is_dir():
+            continue
+        for f in sorted(p for ext in ("msg", "srv", "action") for p in base.rglob(f"*.{ext}")):
+            if f.is_file() and f.parent.name == f.suffix.lstrip("."):
+                table.add_file(f, f.parent.parent.name, f.relative_to(root).as_posix(), "workspace", None)
+    return table
+
+
+def check_field_paths(root: Path, rel: str, msg_dirs: Sequence[str], checked: Checked) -> list[Diagnostic]:
+    """Located errors for the ``fields`` entries of mapping file ``rel`` that
+    do not name a number, string or boolean field of their topic's known
+    type (module docstring); empty when every known one does."""
+    path = root / rel
+    raw, locs = load_located(read_yaml_text(path, rel), rel)
+    topics = raw.get("topics") if isinstance(raw, Mapping) else None
+    if not isinstance(topics, Mapping):
+        return []
+    types = topic_types(checked)
+    table: TypeTable | None = None
+    out: list[Diagnostic] = []
+    for topic, spec in topics.items():
+        fields: Any = spec.get("fields") if isinstance(spec, Mapping) else None
+        typ = types.get(str(topic).lstrip("/"))
+        if typ is None or not isinstance(fields, (list, tuple)) or not fields:
+            continue
+        if table is None:
+            table = _table(root, msg_dirs)
+        if table.get(typ) is None:
+            continue  # a type this workspace does not define: the run decides
+        for k, f in enumerate(fields):
+            why = _why(table, typ, str(f))
+            if why is None:
+                continue
+            at = locs.get(("topics", topic, "fields", k)) or locs.get(("topics", topic, "fields"))
+            line, col = (at.line, at.col) if at is not None else (1, 1)
+            out.extend(plan_error(rel, line, col, f"topic {topic}: field {str(f)!r} of {short_type(typ)}: {why}",
+                                  "E-field").diagnostics)
+    return out
+
+
+def _why(table: TypeTable, typ: str, name: str) -> str | None:
+    rt, err, arr = field_path(table, typ, name)
+    if err is not None:
+        return err
+    if arr:
+        return f"an array ({short_type(rt)}[]) cannot fill a single value; index it ({name}[0], {name}[-1])"
+    if (rt or "").split("<=")[0] not in BASE_TYPES:
+        return f"a message ({short_type(rt)}); name one of its fields ({name}.<field>)"
+    return None
+
+
+__all__ = ["check_field_paths", "topic_types"]
