@@ -312,7 +312,9 @@ def verdict_status(res: NodeResult, trace: str) -> tuple[str, str]:
         return "inconclusive", (f"{c['inconclusive']} event(s) could not be decided; first at {i.get('where')}: "
                                 f"{i.get('reason')}{blame}")
     if c["open"]:
-        return "inconclusive", f"{c['open']} input event(s) were still unanswered when the trace ended{blame}"
+        i = res.first_inconclusive or {}
+        why = f"; first at {i.get('where')}: {i.get('reason')}" if i else ""
+        return "inconclusive", f"{c['open']} input event(s) were still unanswered when the trace ended{why}{blame}"
     if not c["satisfied"]:
         return "pending", (f"{trace} has no input event of {res.node} meeting its assumption "
                            f"({c['assumption violated']} violated it): nothing was checked")
