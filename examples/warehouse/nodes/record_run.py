@@ -31,7 +31,9 @@ from planner import planner  # noqa: E402
 
 #: s: how long each node takes from receiving a message to publishing its answer
 LATENCY = {"LidarDriver": 0.008, "Localiser": 0.010, "BatteryMonitor": 0.005, "MissionManager": 0.004,
-           "Planner": 0.020, "Controller": 0.015, "Base": 0.040}
+           "Planner": 0.020, "Controller": 0.015, "Base": 0.040,
+           # the service calls: the Controller's request, the Base's answer
+           "Controller/get_limits": 0.002, "Base/get_limits": 0.005}
 #: (time s, topic, message): what the environment and the operator send
 SCENARIO: list[tuple[float, str, dict[str, Any]]] = [
     (0.000, "battery_charge", {"data": 80.0}),
@@ -128,15 +130,18 @@ class Robot:
         self._control(t)
 
     def on_speed_cmd(self, t: float, msg: dict[str, Any]) -> None:
+        # a new speed command: ask the base for its limit first, follow the command with the answer
         self.ctl["speed_cmd"] = msg["data"]
-        self._control(t)
+        query = controller(0.0, 0.0, 1.0)["query"]
+        self.publish("Controller/get_limits", t, "get_limits/request", {"query": query})
 
     def on_get_limits_request(self, t: float, msg: dict[str, Any]) -> None:
         out = base(cmd_vel=0.0, query=msg["query"])
-        self.publish("Base", t, "get_limits/response", {"max_speed": out["max_speed"]})
+        self.publish("Base/get_limits", t, "get_limits/response", {"max_speed": out["max_speed"]})
 
     def on_get_limits_response(self, t: float, msg: dict[str, Any]) -> None:
         self.ctl["max_speed"] = msg["max_speed"]
+        self._control(t)
 
     def _control(self, t: float) -> None:
         if None in self.ctl.values():
@@ -149,8 +154,6 @@ class Robot:
         self.publish("Base", t, "odom", twist(out["wheel_speed"]))
 
     def run(self) -> list[dict[str, Any]]:
-        # the Controller asks the base for its speed limit when it starts
-        self.publish("Controller", 0.035, "get_limits/request", {"query": controller(0.0, 0.0, 1.0)["query"]})
         for k, (t, topic, msg) in enumerate(SCENARIO):
             heapq.heappush(self.queue, (t, -1000 + k, topic, msg))
         while self.queue and self.queue[0][0] <= END:
