@@ -229,6 +229,14 @@ node Base {
   guarantee( out.limit <= 2 ) triggered by in.query
 }
 
+node Caller {
+  inputs( button : BOOL, ack : BOOL )
+  outputs( req : BOOL )
+  topics( pkg/Button button matches(in.button), pkg/Ack ack matches(in.ack), pkg/Req req matches(out.req) )
+  assume( TRUE )
+  guarantee( out.req == in.button ) triggered by in.button
+}
+
 node Mission {
   inputs( order : REAL, low : BOOL )
   outputs( dock : BOOL )
@@ -264,6 +272,18 @@ def test_a_triggered_guarantee_is_owed_only_to_its_triggers_events(tmp_path: Pat
     got, res = _channels(tmp_path, "Base", rows, end=5.0)
     assert {k: v.verdict for k, v in got.items()} == {0: "satisfied", 2: "violated", 4: "satisfied"}
     assert got[2].guarantee == 2
+
+
+def test_an_event_no_guarantee_answers_gets_no_verdict(tmp_path: Path) -> None:
+    """A service client's response (``in.ack``) is an input event, but its only guarantee answers the
+    button: nothing is owed to the response, so no verdict (before, it waited for a request and was
+    violated after the horizon: the safety-stop example's Teleop), and it is counted as such, never as
+    satisfied."""
+    rows = [(0.0, "button", {"b": True}), (0.01, "req", {"b": True}), (0.05, "ack", {"b": True})]
+    got, res = _channels(tmp_path, "Caller", rows, end=5.0)
+    assert {k: v.verdict for k, v in got.items()} == {0: "satisfied"} and res.unowed == 1
+    from rclverify.backends.monitors.backend import summary_line
+    assert summary_line(res) == "Caller: 1 satisfied, 1 owed no answer (its guarantees answer other inputs)"
 
 
 def test_an_input_no_topic_carries_is_named_when_its_obligations_wait(tmp_path: Path) -> None:

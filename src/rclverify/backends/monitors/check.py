@@ -170,7 +170,10 @@ class NodeResult:
     whose assumption held; ``semantics`` the ``satisfied`` verdicts per the
     arithmetic that decided them (``exact``, ``double``, ``tolerance``);
     ``first_inexact`` the first formula that held only in double arithmetic
-    or within the tolerance (event, where, time, semantics, formula, values).
+    or within the tolerance (event, where, time, semantics, formula, values);
+    ``unowed`` the input events that met the assumption and that no
+    guarantee answers (each is ``triggered by`` another input): no verdict,
+    nothing was checked for them.
     """
 
     node: str
@@ -182,6 +185,7 @@ class NodeResult:
     accepted: int = 0
     semantics: dict[str, int] = field(default_factory=lambda: {"exact": 0, "double": 0, "tolerance": 0})
     first_inexact: dict[str, Any] | None = None
+    unowed: int = 0
 
     @property
     def assumption(self) -> dict[str, Any]:
@@ -199,7 +203,7 @@ class NodeResult:
                 "first_violation": self.first_violation,
                 "first_assumption_violation": self.first_assumption_violation,
                 "first_inconclusive": self.first_inconclusive, "accepted": self.accepted,
-                "semantics": dict(self.semantics), "first_inexact": self.first_inexact}
+                "semantics": dict(self.semantics), "first_inexact": self.first_inexact, "unowed": self.unowed}
 
 
 def producers(checked: Checked, node: CheckedNode, var: str) -> list[str]:
@@ -285,6 +289,7 @@ class NodeMonitor:
         #: guarantee k -> ``in.x`` for ``triggered by in.x``: it answers the events of that input only
         self._trigger = {k: f"in.{c.trigger.name}" for k, c in enumerate(node.node.guarantees, 1)
                          if c.trigger is not None}
+        self._triggers = frozenset(self._trigger.values())
         self._texts = {k: expr_to_rcl(f) for k, f in enumerate(self.guarantees, 1)}  # printed once, not per verdict
         self._renders: dict[int, tuple[Any, str]] = {}
         needed: set[str] = set()
@@ -452,7 +457,13 @@ class NodeMonitor:
                 accepted = judged.semantics
                 self._note_inexact(ev, judged, f"assumption {expr_to_rcl(formula)}", inputs)
         self.result.accepted += 1
-        # the question: the inputs, and which of them this event set (what a triggered guarantee answers)
+        if self._triggers and all(k in self._trigger and self._trigger[k] not in trig
+                                  for k in range(1, len(self.guarantees) + 1)):
+            self.result.unowed += 1  # every guarantee answers another input: nothing is owed to this event
+            return
+        # the question: the inputs, and which triggers of the node's guarantees this event set (a node
+        # without triggered guarantees groups its events by their inputs alone, as before)
+        trig = trig & self._triggers
         ikey = (tuple(inputs.items()), trig)
         key = (ikey, ())  # no answer yet: only a group that has none either is the same obligation
         group = self.pending.get(key)
