@@ -6,7 +6,7 @@ once on a copy of the seeded workspace, then once per fix of
 recorded again from the fixed node code, ``nodes/record_run.py``; the
 previous fix undone first), then with all five applied: each run is an
 incremental ``doit`` run of the same copy, which must equal a clean one
-(docs/scale.md).  About 17 s of CPU in all: seven pipeline runs, six of
+(docs/integrity.md).  About 17 s of CPU in all: seven pipeline runs, six of
 them incremental.
 
 (a) each defect is its own problem row with the right culprit and a safe

@@ -85,7 +85,9 @@ def progress_repairs(ws: Any, q: Mapping[str, Any], temporal: Mapping[str, Any])
             continue
         for k in BOUNDS:
             edit = _declaration_edit(ws, cn.node, k)
-            system = recheck.edited_system(ws, edit) if edit is not None else None
+            if edit is None:
+                break
+            system = recheck.edited_system(ws, edit)
             if system is None:
                 break
             world.fresh()

@@ -184,7 +184,7 @@ def _strengthen(ws: Any, sc: Mapping[str, Any], p: str, new_g: str, cost_of: Any
         not_shown=f"that {p} can be made to meet `{new_g}`: its evidence must establish it")]
 
 
-def _normal(c: ast.Expr, prefix: str, name: str) -> tuple[str, ast.NumLit] | None:
+def _normal(c: ast.Expr, prefix: str | None, name: str) -> tuple[str, ast.NumLit] | None:
     """``(op, literal)`` when ``c`` is ``<prefix>.<name> op N`` (or ``N op
     <prefix>.<name>``, mirrored) with an ordering ``op``."""
     if not (isinstance(c, ast.Compare) and len(c.ops) == 1 and c.ops[0] in _UPPER):
