@@ -30,6 +30,7 @@ from typing import Any
 from rclverify.argument.build import build_argument
 from rclverify.argument.export import to_dot, to_gsn_yaml
 from rclverify.bundle.archive import verify_bundle, write_bundle
+from rclverify.evidence.store import SEAL, seal_of
 from rclverify.plan.load import load_plan
 from rclverify.report.diagram import render_dot
 
@@ -93,8 +94,10 @@ def main() -> None:
             (ws / "reports" / "assurance.json").write_text(json.dumps({"summary": {"status": "pending", "headline": ""}}))
             ev = ws / "artifacts" / "evidence"
             ev.mkdir(parents=True)
-            for i in range(n * 12):
-                (ev / f"o{i}.json").write_text(json.dumps({"log": f"{i}" * 4096}))
+            for i in range(n * 12):  # sealed as rclverify writes them: the bundle packs only intact records
+                rec: dict[str, Any] = {"log": f"{i}" * 4096}
+                rec[SEAL] = seal_of(rec)
+                (ev / f"o{i}.json").write_text(json.dumps(rec))
             size = sum(p.stat().st_size for p in ws.rglob("*") if p.is_file()) / 2**20
             out = ws.parent / (ws.name + ".tar.gz")
             tools = {"rclverify": "bench"}

@@ -33,7 +33,8 @@ from rclverify.traces import read_trace
 REPO = Path(__file__).resolve().parents[1]
 SCRIPT = REPO / "scripts" / "ros1_case_study.py"
 HORIZON = 1.0
-RATE = 16.0
+RATE = 4.0  # the recorded times divided by 4: a loaded machine (CI runs two test workers) still lets
+#            the sensor answer a reading before the next one arrives (an answer comes after its question)
 
 try:
     import_rospy()

@@ -87,7 +87,8 @@ def cmd_check(args: argparse.Namespace) -> int:
             (errors if d.severity == "error" else warnings).append(d)
         if scope.why == "the plan's system" or (grouped.plan and len(grouped.scopes) == 1):
             # the plan's statements (formal:, deadline:, ...) against the system they name (docs/requirements.md)
-            found, note = plan_diagnostics(scope.files, checked, args.workspace, args.plan)
+            from .backends.entry_checks import check_entries  # the evidence entries too (docs/plan.md)
+            found, note = plan_diagnostics(scope.files, checked, args.workspace, args.plan, check_entries)
             errors += [d for d in found if getattr(d, "severity", "error") == "error"]
             if note:
                 print(note, file=sys.stderr)

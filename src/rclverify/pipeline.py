@@ -186,9 +186,19 @@ def stage_export(ws: Workspace, node: str) -> list[dict[str, Any]]:
     obligations = []
     shared = set(ws.plan.contracts) | {ws.plan.file}
     snapshot = ws.snapshot(node)
+    first_entry: dict[str, Any] = {}  # obligation id -> the entry that gave it
     for entry in ws.plan.evidence.get(node, ()):
         backend = get_backend(entry.backend)
         for o in backend.export(ws.target(node, entry.index)):
+            if o.id in first_entry and first_entry[o.id] is not entry:
+                from .plan.errors import plan_error
+                here = ws.plan.locs.get(("nodes", node, "evidence", entry.index, "backend"), entry.loc)
+                there = first_entry[o.id]
+                raise plan_error(here.file, here.line, here.col,
+                                 f"this {entry.backend} entry of {node} gives obligation {o.id}, which the entry at "
+                                 f"{there.loc.file}:{there.loc.line}:{there.loc.col} gives too (the obligations of an "
+                                 "entry are named by its file's name): rename one file or keep one entry")
+            first_entry[o.id] = entry
             # Evidence about a node depends on that node's contract, the shared
             # context and its plan entries -- exactly its snapshot -- not on the
             # whole contract and plan files, which other nodes share.

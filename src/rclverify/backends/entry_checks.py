@@ -36,6 +36,7 @@ def check_entries(plan: Plan, checked: Checked) -> list[Diagnostic]:
         if node not in checked.nodes:
             continue
         out.extend(_one_ajpf_entry(plan, node, entries))
+        out.extend(_no_repeated_entry(plan, node, entries))
         for e in entries:
             if e.backend not in ("experiment", "review", "monitors"):
                 continue
@@ -77,6 +78,31 @@ def _one_ajpf_entry(plan: Plan, node: str, entries: Any) -> list[Diagnostic]:
                               f"node {node} has a second ajpf entry (the first is at {first.file}:{first.line}:"
                               f"{first.col}): both would give the same obligations and write artifacts/ajpf/{node}/; "
                               "keep one entry and list further property files under its 'properties'").diagnostics[0])
+    return out
+
+
+def _no_repeated_entry(plan: Plan, node: str, entries: Any) -> list[Diagnostic]:
+    """An error at the ``backend`` key of an entry of ``node`` that repeats an
+    earlier one (same backend, same configuration): it would give the same
+    obligations, which doit refuses as duplicated task names.  (Entries that
+    differ but still name their obligations alike are caught when the
+    obligations are exported, :func:`rclverify.pipeline.stage_export`.)"""
+    import json
+    seen: dict[str, ast.Loc] = {}
+    out = []
+    for e in entries:
+        if e.backend == "ajpf":
+            continue  # _one_ajpf_entry
+        key = e.backend + json.dumps(e.config, sort_keys=True, default=str)
+        loc = plan.locs.get(("nodes", node, "evidence", e.index, "backend"), e.loc)
+        if key in seen:
+            first = seen[key]
+            out.append(plan_error(loc.file, loc.line, loc.col,
+                                  f"node {node} has this {e.backend} entry twice (the first is at {first.file}:"
+                                  f"{first.line}:{first.col}): both would give the same obligations; keep one"
+                                  ).diagnostics[0])
+        else:
+            seen[key] = loc
     return out
 
 

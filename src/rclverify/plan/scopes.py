@@ -32,7 +32,7 @@ from __future__ import annotations
 import os
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Sequence
+from typing import Any, Callable, Sequence
 
 from ..rcl.errors import RclError
 
@@ -109,14 +109,17 @@ def group_files(files: Sequence[str], workspace: str = ".", plan_rel: str = "con
 
 
 def plan_diagnostics(files: Sequence[str], checked: object, workspace: str = ".",
-                     plan_rel: str = "contracts/plan.yaml") -> tuple[list[object], str]:
+                     plan_rel: str = "contracts/plan.yaml",
+                     entries: Callable[[Any, Any], list[Any]] | None = None) -> tuple[list[object], str]:
     """The located errors of the plan that groups ``files`` (see
     :func:`find_plan`), read and resolved against ``checked``, the checked
     system of ``files`` (:func:`rclverify.plan.load.resolve`: every
     statement of the plan that names the contracts).  Returns
     ``(diagnostics, note)``: ``note`` is ``""`` when the plan was checked,
     else why not (no plan, or ``files`` are not the plan's whole system, so
-    its node names could not be checked)."""
+    its node names could not be checked).  ``entries(plan, checked)``, when
+    given, adds the diagnostics of the plan's evidence entries (the
+    backends' check-time validation, a layer above this one)."""
     found = find_plan(files, workspace, plan_rel)
     if found is None:
         return [], ""
@@ -136,4 +139,4 @@ def plan_diagnostics(files: Sequence[str], checked: object, workspace: str = "."
         resolve(plan, checked)  # type: ignore[arg-type]
     except RclError as exc:
         return list(exc.diagnostics), ""
-    return [], ""
+    return (list(entries(plan, checked)) if entries is not None else []), ""
