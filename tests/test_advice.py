@@ -164,6 +164,62 @@ def test_a_coefficient_is_never_rewritten_as_a_bound(tmp_path: Path) -> None:
     assert "no single strengthening Z3 tried proves it" in mm["sentence"]
 
 
+THRESHOLDS = """// Off-by-one at a threshold: the battery is low below 20 %, the requirement says at 20 % or less;
+// the overheat flag is raised at 80 degrees, the requirement says only above 80.
+node Battery {
+  inputs( charge : REAL )
+  outputs( low : BOOL )
+  assume( 0 <= in.charge and in.charge <= 100 )
+  guarantee( out.low <=> in.charge < 20 )
+}
+
+node Mission {
+  inputs( low : BOOL )
+  outputs( dock : BOOL )
+  assume( TRUE )
+  guarantee( out.dock <=> in.low )
+}
+
+node Thermo {
+  inputs( temp : REAL )
+  outputs( hot : BOOL )
+  assume( 0 <= in.temp and in.temp <= 150 )
+  guarantee( out.hot <=> in.temp >= 80 )
+}
+"""
+
+
+def test_an_off_by_one_at_a_threshold_names_the_threshold_and_moves_it(tmp_path: Path) -> None:
+    """A requirement that includes its threshold (``<= 20``) against a guarantee that excludes it (``< 20``):
+    no bound of the cone to tighten (the numbers are equal), yet the culprit is the threshold guarantee and
+    the repair its strictness, checked by Z3; the other way round (``>= 80`` where the requirement says
+    ``> 80``) the threshold is excluded.  Before, no culprit was named ("no single strengthening Z3 tried
+    proves it")."""
+    ws = tmp_path / "t"
+    (ws / "contracts").mkdir(parents=True)
+    (ws / "contracts" / "t.rcl").write_text(THRESHOLDS, encoding="utf-8")
+    (ws / "contracts" / "plan.yaml").write_text(
+        "contracts: [contracts/t.rcl]\nrequirements:\n"
+        "  - {id: DOCK, text: dock at 20 % or less, formal: \"Battery.in.charge <= 20 -> Mission.out.dock\"}\n"
+        "  - {id: HOT, text: hot only above 80, formal: \"Thermo.out.hot -> Thermo.in.temp > 80\"}\n",
+        encoding="utf-8")
+    assert main(["verify", "-w", str(ws)]) == 0
+    report = json.loads((ws / "reports" / "assurance.json").read_text(encoding="utf-8"))
+    dock, hot = _diag(report, "DOCK"), _diag(report, "HOT")
+    assert [c["source"] for c in dock["culprits"]] == ["contracts/t.rcl:7:3"]
+    assert "its threshold `in.charge < 20` has the other strictness than DOCK's" in dock["sentence"]
+    [r] = dock["repairs"]
+    assert r["kind"] == "move-threshold" and (r["edit"]["deleted"], r["edit"]["inserted"]) == ("<", "<=")
+    assert "Make the threshold of guarantee 1 of Battery (contracts/t.rcl:7:3) include 20 itself" in r["summary"]
+    assert "-  guarantee( out.low <=> in.charge < 20 )\n+  guarantee( out.low <=> in.charge <= 20 )" in r["diff"]
+    assert r["checks"][0] == {"check": "DOCK", "status": "proved (Z3: unsat)"}
+    [h] = hot["repairs"]
+    assert (h["kind"], h["edit"]["deleted"], h["edit"]["inserted"]) == ("move-threshold", ">=", ">")
+    assert "exclude 80 itself" in h["summary"] and [c["source"] for c in hot["culprits"]] == ["contracts/t.rcl:21:3"]
+    rows = {tuple(g["key"]): [m["id"] for m in g["members"]] for g in report["problems"]}
+    assert rows[("guarantee:Battery:1",)] == ["DOCK"] and rows[("guarantee:Thermo:1",)] == ["HOT"]
+
+
 BAD_PLAN = """name: deadline chain
 contracts:
   - contracts/chain.rcl

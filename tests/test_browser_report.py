@@ -138,11 +138,11 @@ def test_the_html_report_renders_in_chromium(tmp_path: Path, driver: Any) -> Non
     row = driver.find_element("xpath", "//table[contains(@class,'problems')]//tr[.//code[text()='Controller.sc2']]")
     repair = row.find_element("css selector", "details.repair")
     repair.find_element("tag name", "summary").click()
-    assert "guarantee( out.speed <= 1.5 )" in repair.text
+    assert "guarantee( 0 <= out.speed and out.speed <= 1.5 )" in repair.text
     row.find_element("css selector", "details.found > summary").click()
     details = driver.find_element("id", "diagnosis-Controller-sc2")
     details.find_element("tag name", "summary").click()
-    assert "guarantee( out.speed <= 1.5 )" in details.text
+    assert "guarantee( 0 <= out.speed and out.speed <= 1.5 )" in details.text
     # the dashboard: one row per node, and Controller's side conditions cell is failed
     cell = driver.find_element("xpath", "//table[contains(@class,'matrix')]//tr[th/a[text()='Controller']]/td[2]")
     assert "failed" in cell.text

@@ -144,7 +144,13 @@ def test_newcomer_speed_mismatch_gets_side_condition_repairs(newcomer: Path) -> 
     assert {"node": "Planner", "variable": "out.speed", "value": "2", "table": None} in d["counterexample"]
     kinds = {r["kind"]: r for r in d["repairs"]}
     assert set(kinds) == {"strengthen-producer", "weaken-consumer"}
-    assert "+  guarantee( out.speed <= 1.5 )" in kinds["strengthen-producer"]["diff"]
+    # the producer's bound tightened in place: the same contract as an added `out.speed <= 1.5`, without
+    # leaving the old bound redundant (a health warning that --strict fails on)
+    sp = kinds["strengthen-producer"]
+    assert ("-  guarantee( 0 <= out.speed and out.speed <= 2.0 )\n"
+            "+  guarantee( 0 <= out.speed and out.speed <= 1.5 )") in sp["diff"]
+    assert "tighten the bound of its guarantee 1 in place" in sp["summary"]
+    assert not any("redundant" in c["check"] for c in sp["cost"])
     assert "+  assume( 0 <= in.speed and in.speed <= 2.0 )" in kinds["weaken-consumer"]["diff"]
     for r in d["repairs"]:
         assert {"check": "Controller.sc2", "before": "failed", "after": "discharged"} in r["cost"]
@@ -156,8 +162,8 @@ def test_newcomer_speed_mismatch_gets_side_condition_repairs(newcomer: Path) -> 
     fix = res["fixes"][0]["artifactChanges"][0]
     assert fix["artifactLocation"]["uri"] == "contracts/rover.rcl"
     rep = fix["replacements"][0]
-    assert rep["insertedContent"]["text"] == "\n  guarantee( out.speed <= 1.5 )"
-    assert rep["deletedRegion"] == {"startLine": 9, "startColumn": 51, "endLine": 9, "endColumn": 51}
+    assert rep["insertedContent"]["text"] == "1.5"
+    assert rep["deletedRegion"] == {"startLine": 9, "startColumn": 46, "endLine": 9, "endColumn": 49}
 
 
 def test_a_broken_checker_shows_no_repair(newcomer: Path, monkeypatch: pytest.MonkeyPatch) -> None:
@@ -297,8 +303,9 @@ def test_explain_and_status_read_the_last_run(newcomer: Path, capsys: pytest.Cap
     from rclverify.pipeline import stage_report
     stage_report(ws, report=report)
     html = (newcomer / "reports" / "assurance.html").read_text(encoding="utf-8")
-    assert 'id="diagnosis-Controller-sc2"' in html and "+  guarantee( out.speed &lt;= 1.5 )" in html
-    assert "+  guarantee( out.speed <= 1.5 )" in (newcomer / "reports" / "assurance.md").read_text(encoding="utf-8")
+    assert 'id="diagnosis-Controller-sc2"' in html and "+  guarantee( 0 &lt;= out.speed and out.speed &lt;= 1.5 )" in html
+    assert ("+  guarantee( 0 <= out.speed and out.speed <= 1.5 )"
+            in (newcomer / "reports" / "assurance.md").read_text(encoding="utf-8"))
     assert json.loads((newcomer / "reports" / "assurance.json").read_text())["diagnoses"][0]["id"] == "Controller.sc2"
     assert main(["status", "-w", str(newcomer)]) == 0
     out = capsys.readouterr().out

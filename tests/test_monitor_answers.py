@@ -216,6 +216,86 @@ def test_the_mapping_checks_the_state_flag() -> None:
     assert "unknown key 'latched'" in str(e.value)
 
 
+# -- a guarantee triggered by one input answers that input's events only -----------
+
+CHANNELS = """
+node Base {
+  inputs( cmd : REAL, query : BOOL )
+  outputs( wheel : REAL, limit : REAL )
+  topics( pkg/Cmd cmd matches(in.cmd), pkg/Query query matches(in.query),
+          pkg/Wheel wheel matches(out.wheel), pkg/Limit limit matches(out.limit) )
+  assume( 0 <= in.cmd )
+  guarantee( out.wheel <= in.cmd ) triggered by in.cmd
+  guarantee( out.limit <= 2 ) triggered by in.query
+}
+
+node Caller {
+  inputs( button : BOOL, ack : BOOL )
+  outputs( req : BOOL )
+  topics( pkg/Button button matches(in.button), pkg/Ack ack matches(in.ack), pkg/Req req matches(out.req) )
+  assume( TRUE )
+  guarantee( out.req == in.button ) triggered by in.button
+}
+
+node Mission {
+  inputs( order : REAL, low : BOOL )
+  outputs( dock : BOOL )
+  topics( pkg/Order order matches(in.order), pkg/Dock dock matches(out.dock) )
+  assume( TRUE )
+  guarantee( out.dock <=> in.low )
+}
+"""
+
+
+def _channels(tmp: Path, node: str, rows: list[tuple[float, str, dict[str, Any]]], end: float) -> tuple[dict, Any]:
+    p = tmp / "channels.rcl"
+    p.write_text(CHANNELS)
+    checked = load([p])
+    got: list[Any] = []
+    evs = [Event(k, t, topic, f, f"run.jsonl:{k + 1}") for k, (t, topic, f) in enumerate(rows)]
+    _, [res] = check_trace(checked, [checked.nodes[node]], evs, {}, 1.0, got.append, end=end)
+    return {v.event: v for v in got}, res
+
+
+def test_a_triggered_guarantee_is_owed_only_to_its_triggers_events(tmp_path: Path) -> None:
+    """A base that follows velocity commands and answers a limit query (a
+    service) on another channel: ``triggered by in.query`` says the limit
+    answers the query, so a velocity command is not owed a limit message
+    (before, every command waited for one and was violated after the
+    horizon: a false alarm on a correct node), and a wrong limit fails the
+    query's event only."""
+    rows = [(0.0, "cmd", {"v": 1.0}), (0.05, "wheel", {"v": 1.0}), (0.5, "query", {"b": True}),
+            (0.55, "limit", {"v": 1.5}), (1.0, "cmd", {"v": 0.5}), (1.05, "wheel", {"v": 0.5})]
+    got, res = _channels(tmp_path, "Base", rows, end=5.0)
+    assert {k: v.verdict for k, v in got.items()} == {0: "satisfied", 2: "satisfied", 4: "satisfied"}
+    rows[3] = (0.55, "limit", {"v": 2.5})
+    got, res = _channels(tmp_path, "Base", rows, end=5.0)
+    assert {k: v.verdict for k, v in got.items()} == {0: "satisfied", 2: "violated", 4: "satisfied"}
+    assert got[2].guarantee == 2
+
+
+def test_an_event_no_guarantee_answers_gets_no_verdict(tmp_path: Path) -> None:
+    """A service client's response (``in.ack``) is an input event, but its only guarantee answers the
+    button: nothing is owed to the response, so no verdict (before, it waited for a request and was
+    violated after the horizon: the safety-stop example's Teleop), and it is counted as such, never as
+    satisfied."""
+    rows = [(0.0, "button", {"b": True}), (0.01, "req", {"b": True}), (0.05, "ack", {"b": True})]
+    got, res = _channels(tmp_path, "Caller", rows, end=5.0)
+    assert {k: v.verdict for k, v in got.items()} == {0: "satisfied"} and res.unowed == 1
+    from rclverify.backends.monitors.backend import summary_line
+    assert summary_line(res) == "Caller: 1 satisfied, 1 owed no answer (its guarantees answer other inputs)"
+
+
+def test_an_input_no_topic_carries_is_named_when_its_obligations_wait(tmp_path: Path) -> None:
+    """``in.low`` of Mission is bound to no topic: no run can give it a value, so
+    guarantee 1 waits for ever; the verdict and the evidence say why instead of
+    only "unanswered"."""
+    got, res = _channels(tmp_path, "Mission", [(0.0, "order", {"v": 3.0}), (0.1, "dock", {"b": False})], end=0.5)
+    assert got[0].verdict == "open"
+    assert "in.low of Mission is carried by no topic or link part" in got[0].reason
+    assert "carried by no topic" in res.first_inconclusive["reason"]
+
+
 # -- oracle: the streaming engine against a direct reading of the rule ------------
 
 def reference(checked: Any, rows: list[tuple[float, str, Any]], horizon: float, state: frozenset[str]) -> dict[int, str]:

@@ -94,6 +94,19 @@ def test_without_progress_the_lasso_names_the_node_that_never_answers(tmp_path: 
     assert row["key"] == ["contract:Base"] and "Base never answers" in row["sentence"]
     # SARIF and the terminal's explanation say the same
     assert "Base never answers" in (ws / "reports/assurance.md").read_text()
+    # the repair: the weakest progress bound tried with which the requirement check proves ARRIVE, checked on
+    # the edited contracts; applied, the requirement is proved (declared, not verified: evidence outstanding)
+    [rep] = d["repairs"]
+    assert rep["kind"] == "declare-progress" and rep["edit"]["inserted"] == "  progress( within 3 steps )\n"
+    assert rep["checks"] == [{"check": "ARRIVE", "status": "proved (temporal check: bounded)"}]
+    assert "which no backend checks yet" in rep["not_shown"] and row["repairs"]
+    from rclverify.diagnosis.edits import Edit
+    e = rep["edit"]
+    path = ws / e["file"]
+    path.write_text(Edit(e["file"], e["line"], e["col"], e["end_line"], e["end_col"], e["inserted"])
+                    .apply(path.read_text()))
+    fixed = _records(ws)["ARRIVE"]
+    assert fixed["check"]["temporal"]["status"] == "proved" and fixed["verdict"] == "proved, evidence outstanding"
 
 
 def test_with_progress_declared_the_same_requirement_is_proved(tmp_path: Path) -> None:

@@ -40,7 +40,7 @@ from ..logic import world
 from ..rcl import ast
 from ..rcl.printer import expr_to_rcl
 from . import realize, recheck
-from .bounds import bound_literals
+from .bounds import FLIP, bound_literals, thresholds, value
 from .edits import Edit
 from .repairs import _link_pairs, _numbers, _peel, _rename
 
@@ -125,10 +125,34 @@ def _implementable(ws: Any, system: Any, node: str) -> str:
     return "" if status == "refuted" else status
 
 
+def threshold_edit(ws: Any, cmp: ast.Compare) -> tuple[Edit, str, str] | None:
+    """``(edit, old, new)``: the edit giving the comparison ``cmp`` (of
+    :func:`.bounds.thresholds`) the other strictness (``<`` -> ``<=``),
+    and the comparison's text before and after; ``None`` without exact
+    locations.  Only the operator is replaced, whatever spacing surrounds it."""
+    a, b, whole = _span(cmp.operands[0]), _span(cmp.operands[1]), _span(cmp)
+    if a is None or b is None or whole is None:
+        return None
+    source = recheck.source_text(ws, cmp.loc.file)
+    between = Edit(cmp.loc.file, a[2], a[3], b[0], b[1], "").deleted(source)
+    op = cmp.ops[0]
+    at = between.find(op)
+    if at < 0 or between[:at].strip() or between[at + len(op):].strip():
+        return None
+    line, col = a[2], a[3]  # the operator's position (columns count characters)
+    for ch in between[:at]:
+        line, col = (line + 1, 1) if ch == "\n" else (line, col + 1)
+    edit = Edit(cmp.loc.file, line, col, line, col + len(op), FLIP[op])
+    f = cmp.loc.file
+    left, rest = Edit(f, whole[0], whole[1], a[2], a[3], "").deleted(source), Edit(f, b[0], b[1], whole[2], whole[3], "")
+    new = left + between[:at] + FLIP[op] + between[at + len(op):] + rest.deleted(source)
+    return edit, Edit(f, *whole, "").deleted(source), new
+
+
 def requirement_culprits(ws: Any, req_id: str, cone: Sequence[str]) -> list[dict[str, Any]]:
     """The guarantees of ``cone`` (node names) to blame for the refuted
     requirement ``req_id`` (module docstring), each ``{"node", "guarantee",
-    "edit": Edit, "how": "bound" | "conclusion", "old", "new"}`` with the
+    "edit": Edit, "how": "bound" | "threshold" | "conclusion", "old", "new"}`` with the
     strengthening Z3 checked and ``"implementable"`` (``proved`` or
     ``inconclusive``).  ``[]`` when no single strengthening proves it."""
     from ..plan.load import all_requirements
@@ -142,8 +166,25 @@ def requirement_culprits(ws: Any, req_id: str, cone: Sequence[str]) -> list[dict
     consts = list(dict.fromkeys(n.text for n in _numbers(formal.expr)))
     found: list[dict[str, Any]] = []
     trials = 0
+    values = {value(c) for c in consts} - {None}
     for n in cone:
         for k, g in enumerate(ws.checked.nodes[n].node.guarantees, 1):
+            hit = False
+            for cmp, lit in thresholds(g.formula):  # the statement's own number with the other strictness
+                flip = threshold_edit(ws, cmp) if value(lit.text) in values and trials < MAX_TRIALS else None
+                if flip is None:
+                    continue
+                trials += 1
+                system = recheck.edited_system(ws, flip[0])
+                impl = _implementable(ws, system, n) if system is not None and _proved(req, system, ws.plan) else ""
+                if impl:
+                    found.append({"node": n, "guarantee": k, "edit": flip[0], "how": "threshold",
+                                  "old": flip[1], "new": flip[2], "implementable": impl, "threshold": lit.text,
+                                  "inclusive": flip[0].text in ("<=", ">=")})
+                    hit = True
+                    break
+            if hit:
+                continue
             for lit in bound_literals(g.formula):  # bounds only: a coefficient is no bound to tighten
                 span = _span(lit)
                 for c in consts:

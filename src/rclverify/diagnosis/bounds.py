@@ -11,6 +11,12 @@ is a direct operand of an ordering comparison (``<``, ``<=``, ``>``,
 ``>=``); a coefficient when it is a direct operand of ``*`` or ``/``.
 Every other literal (an index ``f(3)``, a summand ``x + 1``, a value
 ``out.mode == 2``) is neither.
+
+A *threshold* is a bound in a comparison of two terms (``in.charge < 20``):
+its strictness may be wrong by one value, an off-by-one at the threshold,
+when the requirement names the same number with the other strictness
+(``<= 20``).  :func:`thresholds` lists them and :data:`FLIP` the other
+strictness.
 """
 from __future__ import annotations
 
@@ -44,6 +50,24 @@ def bound_literals(e: ast.Expr) -> list[ast.NumLit]:
     out = [lit for lit, parent in _direct_literals(e)
            if isinstance(parent, ast.Compare) and any(op in _ORDERING for op in parent.ops)]
     return sorted(out, key=lambda n: (n.loc.line, n.loc.col))
+
+
+#: The other strictness of an ordering comparison (an off-by-one at a threshold).
+FLIP = {"<": "<=", "<=": "<", ">": ">=", ">=": ">"}
+
+
+def thresholds(e: ast.Expr) -> list[tuple[ast.Compare, ast.NumLit]]:
+    """``(comparison, its literal)`` for the comparisons of ``e`` of two
+    terms, one a numeric literal, by an ordering operator (``in.charge <
+    20``, ``30 >= out.d``; not a chain ``0 <= x <= 1``), in source order:
+    the places where an off-by-one at a threshold is written."""
+    out = []
+    for x in subexpressions(e):
+        if isinstance(x, ast.Compare) and len(x.ops) == 1 and x.ops[0] in FLIP:
+            lits = [o for o in x.operands if isinstance(o, ast.NumLit)]
+            if len(lits) == 1:
+                out.append((x, lits[0]))
+    return sorted(out, key=lambda p: (p[1].loc.line, p[1].loc.col))
 
 
 def coefficient_literals(e: ast.Expr) -> list[tuple[ast.NumLit, ast.Binary]]:

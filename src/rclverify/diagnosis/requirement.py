@@ -12,7 +12,11 @@ from typing import Any
 
 from . import blame, recheck
 from .liveness import liveness_culprits
+from .progress_repair import progress_repairs
 from .repairs import _record as _repair
+
+#: The repair kind of each way a culprit was found (:func:`blame.requirement_culprits`).
+_KIND = {"bound": "tighten-bound", "threshold": "move-threshold", "conclusion": "strengthen-guarantee"}
 
 
 def requirement_record(ws: Any, report: Mapping[str, Any], q: Mapping[str, Any], cache: Any,
@@ -28,7 +32,9 @@ def requirement_record(ws: Any, report: Mapping[str, Any], q: Mapping[str, Any],
     check = q.get("check") or {}
     cone = [str(n) for n in check.get("cone") or []]
     if check.get("temporal"):
-        return _temporal_record(q, check)
+        return _temporal_record(q, check, lambda: cache.get(
+            ["progress-repair", q["id"], check.get("formal"), cone],
+            lambda: progress_repairs(ws, q, check["temporal"])) or [])
 
     def find() -> list[dict[str, Any]]:
         rows = []
@@ -39,12 +45,18 @@ def requirement_record(ws: Any, report: Mapping[str, Any], q: Mapping[str, Any],
             if f["how"] == "bound":
                 summary = (f"Tighten the bound of {what} ({src}): {f['old']} becomes {f['new']}; Z3 proves "
                            f"{q['id']} from consistent premises. {f['node']}'s evidence must then establish it.")
+            elif f["how"] == "threshold":
+                summary = (f"Make the threshold of {what} ({src}) {'include' if f['inclusive'] else 'exclude'} "
+                           f"{f['threshold']} itself: `{f['old']}` becomes `{f['new']}`, as {q['id']} states it "
+                           "(an off-by-one at the threshold); Z3 "
+                           f"proves {q['id']} from consistent premises. {f['node']}'s implementation and evidence "
+                           "must then decide the threshold value itself the same way.")
             else:
                 summary = (f"Strengthen {what} ({src}) by `{f['new']}`; Z3 proves {q['id']} from consistent premises. "
                            f"{f['node']}'s evidence must then establish it.")
             rows.append({"node": f["node"], "guarantee": f["guarantee"], "how": f["how"], "old": f["old"],
                          "new": f["new"], "text": text, "source": src,
-                         "repair": _repair("tighten-bound" if f["how"] == "bound" else "strengthen-guarantee",
+                         "repair": _repair(_KIND[f["how"]],
                                            summary, f["edit"], source,
                                            [{"check": str(q["id"]), "status": "proved (Z3: unsat)"},
                                             {"check": f"{f['node']} implementable",
@@ -54,8 +66,11 @@ def requirement_record(ws: Any, report: Mapping[str, Any], q: Mapping[str, Any],
                                            blame.cost(ws, report, f["node"], f["edit"]),
                                            proves=f"{q['id']} follows from the edited contracts, from consistent "
                                                   "premises",
-                                           not_shown=f"that {f['node']} can meet the stronger guarantee: its "
-                                                     "evidence must establish it")})
+                                           not_shown=(f"that {f['node']} can meet the stronger guarantee: its "
+                                                      "evidence must establish it" if f["how"] != "threshold" else
+                                                      f"that the threshold {q['id']} states is the right one for "
+                                                      f"the robot, and that {f['node']} meets it: its evidence "
+                                                      "must establish it"))})
         return rows
     found = cache.get(["requirement", q["id"], check.get("formal"), cone], find) or []
     cul = [{"what": f"guarantee {f['guarantee']} of {f['node']}: `{f['text']}`", "source": f["source"],
@@ -71,7 +86,10 @@ def requirement_record(ws: Any, report: Mapping[str, Any], q: Mapping[str, Any],
     if found:
         f = found[0]
         how = (f"its bound {f['old']} lets the counterexample through; with {f['new']} Z3 proves {q['id']}"
-               if f["how"] == "bound" else f"strengthened by `{f['new']}` it lets Z3 prove {q['id']}")
+               if f["how"] == "bound" else
+               f"its threshold `{f['old']}` has the other strictness than {q['id']}'s (an off-by-one at the "
+               f"threshold); with `{f['new']}` Z3 proves {q['id']}" if f["how"] == "threshold" else
+               f"strengthened by `{f['new']}` it lets Z3 prove {q['id']}")
         sentence = (f"Requirement {q['id']} (`{check.get('formal')}`, {check.get('source')}) is refuted because of "
                     f"guarantee {f['guarantee']} of {f['node']} ({f['source']}) `{f['text']}`: {how}"
                     + (f". Z3's counterexample: {cex}" if cex else "") + ".")
@@ -106,12 +124,15 @@ def _between(report: Mapping[str, Any], sources: set[str], sinks: set[str]) -> s
     return (reach(sources, down) & reach(sinks, up)) - sources - sinks
 
 
-def _temporal_record(q: Mapping[str, Any], check: Mapping[str, Any]) -> dict[str, Any]:
+def _temporal_record(q: Mapping[str, Any], check: Mapping[str, Any],
+                     repairs: Callable[[], list[dict[str, Any]]]) -> dict[str, Any]:
     """The diagnosis of a refuted temporal requirement: its counterexample
     run (docs/requirements.md, "Temporal requirements"), the state it loops
     through shown node by node.  A lasso that rests on a node that never
     answers (or on a loop stuck on values from before the run) names that
-    node, through :func:`.liveness.liveness_culprits`; otherwise no culprit
+    node, through :func:`.liveness.liveness_culprits`; for a node that never
+    answers, ``repairs()`` gives the progress declarations with which the
+    requirement is proved (:mod:`.progress_repair`); otherwise no culprit
     is named: the run meets every contract, and no strengthening is searched
     for a temporal statement (docs/diagnosis.md: only what Z3 showed is
     named)."""
@@ -133,5 +154,6 @@ def _temporal_record(q: Mapping[str, Any], check: Mapping[str, Any]) -> dict[str
                     f"meets every contract of its cone ({t.get('method')}; {t.get('detail')}). "
                     f"The state it repeats: {cex}. No guarantee of the cone prevents it: "
                     "a guarantee that forces progress, or an assuming: that excludes the run, is needed.")
+    fixes = repairs() if t.get("missing_progress") else []
     return {"id": str(q["id"]), "kind": "requirement", "node": node, "status": "failed", "sentence": sentence,
-            "culprits": culprits, "counterexample": table, "repairs": [], "guarantee": None}
+            "culprits": culprits, "counterexample": table, "repairs": fixes, "guarantee": None}

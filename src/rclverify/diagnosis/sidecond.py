@@ -4,7 +4,15 @@
 
 1. ``strengthen-producer``: ``c`` (in ``P``'s output names) becomes a new
    guarantee of ``P``, the weakest strengthening of ``G_p`` that entails
-   ``c``.  Offered only when ``P`` stays *implementable* (every input its
+   ``c``.  When a guarantee of ``P`` already bounds the output the same
+   way at its top level (``out.max_speed <= 2.0`` against ``in.max_speed
+   <= 1.5``), its bound is tightened in place instead (``2.0`` becomes
+   ``1.5``): the same contract as the added guarantee, without leaving the
+   old bound redundant (a health warning ``--strict`` fails on), its
+   trigger and deadline kept.  Otherwise, when every guarantee of ``P`` on the linked output answers one
+   input (``triggered by in.query``: a service's response), the new one
+   answers it too, so it is owed to that input's events only, as theirs are
+   (docs/monitors.md).  Offered only when ``P`` stays *implementable* (every input its
    assumption allows still has an answer, :func:`.realize.implementable`):
    adding ``out.d <= 30`` to ``out.d == 1000 * in.r`` is consistent but
    answers only ``in.r <= 0.03``; that is said (``not_offered``), not
@@ -35,6 +43,7 @@ from typing import Any, Mapping, Sequence
 from ..calculus.compose import conjuncts
 from ..rcl import ast
 from ..rcl.printer import expr_to_rcl
+from ..rcl.walk import subexpressions
 from . import realize, recheck
 from .bounds import coefficient_literals, number_text, power_of_ten, value
 from .edits import Edit
@@ -119,7 +128,7 @@ def side_condition_repairs(ws: Any, sc: Mapping[str, Any], before_sc: Mapping[st
 
     if single:
         out["repairs"] += _strengthen(ws, sc, producers[0], _rename(str(sc["conjunct"]), to_producer), cost_of,
-                                      discharged, out["not_offered"])
+                                      discharged, out["not_offered"], _inplace(ws, producers[0], pairs[0][1], target))
         if scale is not None and extreme is not None:
             out["repairs"] += _rescale(ws, sc, producers[0], pairs[0][1], scale, extreme, cost_of, discharged)
     out["repairs"] += _weaken(ws, sc, target, shape, extreme, scale, producers, to_consumer, cost_of, discharged,
@@ -128,18 +137,28 @@ def side_condition_repairs(ws: Any, sc: Mapping[str, Any], before_sc: Mapping[st
 
 
 def _strengthen(ws: Any, sc: Mapping[str, Any], p: str, new_g: str, cost_of: Any, discharged: dict[str, str],
-                not_offered: list[str]) -> list[dict[str, Any]]:
-    """1. the consumer's conjunct as a new guarantee of ``p`` (module docstring)."""
+                not_offered: list[str], inplace: tuple[Edit, int, str] | None = None) -> list[dict[str, Any]]:
+    """1. the consumer's conjunct as a new guarantee of ``p``, or a bound of
+    ``p`` tightened to it in place (``inplace``: :func:`_inplace`; module docstring)."""
     pn = ws.checked.nodes[p].node
     last = pn.guarantees[-1] if pn.guarantees else None
     if last is None or not last.loc.end_line:
         return []
+    trigger = _trigger_of(pn, {ov for q, ov, _, _ in _link_pairs(sc) if q == p})
+    suffix = f" triggered by {trigger}" if trigger else ""
+    answers = f" ({suffix.strip()}, as {p}'s guarantees on that output)" if trigger else ""
     rel = last.loc.file
     source = recheck.source_text(ws, rel)
     line = source.splitlines()[last.loc.line - 1]
     indent = line[:len(line) - len(line.lstrip())]
     edit = Edit(rel, last.loc.end_line, last.loc.end_col, last.loc.end_line, last.loc.end_col,
-                f"\n{indent}guarantee( {new_g} )")
+                f"\n{indent}guarantee( {new_g} ){suffix}")
+    how = f"add the guarantee `{new_g}`{answers}"
+    if inplace is not None:
+        edit, k, old = inplace
+        rel = edit.file
+        how = (f"tighten the bound of its guarantee {k} in place, `{old}` becoming `{new_g}` (the same as adding "
+               f"`{new_g}`, without leaving the old bound redundant)")
     system = recheck.edited_system(ws, edit)
     if system is None:
         return []
@@ -156,13 +175,65 @@ def _strengthen(ws: Any, sc: Mapping[str, Any], p: str, new_g: str, cost_of: Any
     undecided = " (Z3 could not decide whether it stays implementable)" if impl != "proved" else ""
     return [_record(
         "strengthen-producer",
-        f"Strengthen {p}: add the guarantee `{new_g}`, the weakest strengthening of {p}'s guarantees that entails "
-        f"{sc['node']}'s assumption `{sc['conjunct']}`; {p} stays consistent{' and implementable' if not undecided else ''}"
+        f"Strengthen {p}: {how}, the weakest strengthening of {p}'s guarantees that "
+        f"entails {sc['node']}'s assumption `{sc['conjunct']}`; {p} stays consistent{' and implementable' if not undecided else ''}"
         f"{undecided}. {p}'s evidence must then establish the new guarantee.",
         edit, recheck.source_text(ws, rel),
         [discharged, {"check": f"{p}.contract-consistent", "status": "ok (Z3: sat)"}, _implementable_check(impl, p)],
         cost, proves=f"{sc['id']} follows from the edited contracts",
         not_shown=f"that {p} can be made to meet `{new_g}`: its evidence must establish it")]
+
+
+def _normal(c: ast.Expr, prefix: str | None, name: str) -> tuple[str, ast.NumLit] | None:
+    """``(op, literal)`` when ``c`` is ``<prefix>.<name> op N`` (or ``N op
+    <prefix>.<name>``, mirrored) with an ordering ``op``."""
+    if not (isinstance(c, ast.Compare) and len(c.ops) == 1 and c.ops[0] in _UPPER):
+        return None
+    a, b = c.operands
+    op: str = c.ops[0]
+    if isinstance(b, ast.Var) and isinstance(a, ast.NumLit):
+        a, b, op = b, a, _MIRROR[op]
+    if isinstance(a, ast.Var) and a.prefix == prefix and a.name == name and isinstance(b, ast.NumLit):
+        return op, b
+    return None
+
+
+def _inplace(ws: Any, p: str, ov: str, target: ast.Expr) -> tuple[Edit, int, str] | None:
+    """``(edit, guarantee index, old conjunct text)``: the top-level conjunct
+    ``out.ov op N`` of a guarantee of ``p`` with the operator of the
+    consumer's conjunct ``target`` (``in.w op B``) and a weaker ``N``, its
+    literal replaced by ``B``; ``None`` when there is none."""
+    mine = next((_normal(target, pre, v.name) for pre in ("in", None) for v in subexpressions(target)
+                 if isinstance(v, ast.Var) and v.prefix == pre and _normal(target, pre, v.name)), None)
+    if mine is None:
+        return None
+    op, lit = mine
+    want = value(lit.text)
+    for k, g in enumerate(ws.checked.nodes[p].node.guarantees, 1):
+        for c in conjuncts(g.formula):
+            got = _normal(c, "out", ov)
+            if got is None or got[0] != op or not got[1].loc.line:
+                continue
+            old = value(got[1].text)
+            if old is None or want is None or not (old > want if _UPPER[op] else old < want):
+                continue
+            n = got[1]
+            return (Edit(n.loc.file, n.loc.line, n.loc.col, n.loc.line, n.loc.col + len(n.text), lit.text), k,
+                    expr_to_rcl(c))
+    return None
+
+
+def _trigger_of(node: ast.Node, outs: set[str]) -> str:
+    """``in.x`` when every guarantee of ``node`` that mentions one of the
+    outputs ``outs`` is ``triggered by in.x`` (the same input), else ``""``."""
+    found = set()
+    for g in node.guarantees:
+        text = expr_to_rcl(g.formula)
+        if any(re.search(rf"(?<![\w.])out\.{re.escape(ov)}(?!\w)", text) for ov in outs):
+            found.add(g.trigger.name if g.trigger is not None else None)
+    if len(found) == 1 and None not in found:
+        return f"in.{found.pop()}"
+    return ""
 
 
 def _rescale(ws: Any, sc: Mapping[str, Any], p: str, ov: str, k: int, extreme: Fraction, cost_of: Any,

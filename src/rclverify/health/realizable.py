@@ -21,7 +21,12 @@ only / mentioning an output; ``typing``: an output of a NATURAL type, or a
 constructor's NATURAL field, is ``>= 0``).  With function-typed inputs it
 first asks for such an input in which every function is a finite table
 (:mod:`.witness`), which Z3 finds in a fraction of the general query's time;
-a table witness is a genuine input.  Then it names the guarantees that
+a table witness is a genuine input.  Without function-typed inputs the
+query is first given to Z3's quantifier elimination (the ``qe`` tactic,
+complete for linear arithmetic, as the deadlock check of
+:mod:`rclverify.requirements.deadlock` does): the quantifier over the
+outputs is what the general solver struggles with (a Planner of four linear
+guarantees went undecided in 5.6 s that ``qe`` decides in 0.02 s).  Then it names the guarantees that
 conflict: the smallest set of them (single guarantees, then pairs) that
 already has no answer for some input.
 
@@ -40,7 +45,7 @@ from typing import Sequence
 import z3
 
 from ..logic.encode import Encoder
-from ..logic.query import satisfiable, smt2_script
+from ..logic.query import STEPS_PER_MS, SAFETY_FACTOR, render_model, satisfiable, smt2_script
 from ..rcl import ast
 from ..rcl.types import Checked
 from .finding import Finding
@@ -104,9 +109,30 @@ class _Query:
                 return "sat", w.model, round(time.perf_counter() - t0, 4), text
             if not general:
                 return "inconclusive", None, round(time.perf_counter() - t0, 4), ""
+        else:
+            status, model = self._eliminated(f)
+            if status in ("sat", "unsat"):
+                text = smt2_script(self.enc.axioms() + [f], comment)() if status == "sat" else ""
+                return status, model, round(time.perf_counter() - t0, 4), text
         r = satisfiable([("no output for this input", f)], self.enc, timeout_ms=REALIZABLE_TIMEOUT_MS,
                         comment=comment, retry=False)
         return r.status, r.model, round(time.perf_counter() - t0, 4), r.smt2 if r.status == "sat" else ""
+
+    def _eliminated(self, f: z3.BoolRef) -> tuple[str, dict[str, str] | None]:
+        """``(sat|unsat|unknown, input model)`` of ``f`` asked of Z3's
+        quantifier elimination then its SMT solver, within the query's budget
+        (resource steps, as :func:`rclverify.logic.query.budgeted_solver`)."""
+        s = z3.Then("qe", "smt").solver()
+        s.set("rlimit", REALIZABLE_TIMEOUT_MS * STEPS_PER_MS)
+        s.set("timeout", REALIZABLE_TIMEOUT_MS * SAFETY_FACTOR)
+        s.add(*self.enc.axioms(), f)
+        try:
+            r = s.check()
+        except z3.Z3Exception:  # a tactic that refuses the query: undecided here, the general query follows
+            return "unknown", None
+        if r == z3.sat:
+            return "sat", render_model(s.model(), self.enc)
+        return ("unsat", None) if r == z3.unsat else ("unknown", None)
 
 
 def realizability_findings(checked: Checked, node: str, facts: Sequence[tuple[ast.Expr, ast.Loc]] = (),

@@ -48,7 +48,9 @@ double) is not evaluated again (:func:`float_sensitive`).
 
 One function (:func:`judge`) decides, for the monitors of recorded and live
 runs (``backends/monitors``: ``check.py``, ``deadlines.py``, and through them
-``online.py``, the ROS 1/2 live monitors and the oracle).
+``online.py``, the ROS 1/2 live monitors and the oracle), and for the
+guarantee checks of the property tests (``backends/property_tests/harness.py``:
+a Python implementation computes in doubles too).
 """
 from __future__ import annotations
 

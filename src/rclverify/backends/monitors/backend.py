@@ -270,6 +270,8 @@ def monitoring_details(res: NodeResult, trace: str, events: int, sha: str, versi
 def summary_line(res: NodeResult) -> str:
     """``Node: 3 satisfied, 1 violated, ...`` (non-zero counts only)."""
     parts = [f"{n} {v}" for v, n in res.counts.items() if n]
+    if res.unowed:
+        parts.append(f"{res.unowed} owed no answer (its guarantees answer other inputs)")
     return f"{res.node}: " + (", ".join(parts) if parts else "no event on its topics")
 
 
@@ -312,10 +314,14 @@ def verdict_status(res: NodeResult, trace: str) -> tuple[str, str]:
         return "inconclusive", (f"{c['inconclusive']} event(s) could not be decided; first at {i.get('where')}: "
                                 f"{i.get('reason')}{blame}")
     if c["open"]:
-        return "inconclusive", f"{c['open']} input event(s) were still unanswered when the trace ended{blame}"
+        i = res.first_inconclusive or {}
+        why = f"; first at {i.get('where')}: {i.get('reason')}" if i else ""
+        return "inconclusive", f"{c['open']} input event(s) were still unanswered when the trace ended{why}{blame}"
     if not c["satisfied"]:
-        return "pending", (f"{trace} has no input event of {res.node} meeting its assumption "
-                           f"({c['assumption violated']} violated it): nothing was checked")
+        unowed = (f"; {res.unowed} met it but no guarantee answers them (each is triggered by another input)"
+                  if res.unowed else "")
+        return "pending", (f"{trace} has no input event of {res.node} that meets its assumption and that a "
+                           f"guarantee answers ({c['assumption violated']} violated it{unowed}): nothing was checked")
     return "discharged", f"all {c['satisfied']} input event(s) meeting the assumption were answered as guaranteed{blame}"
 
 

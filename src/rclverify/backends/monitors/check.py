@@ -155,6 +155,8 @@ class _Group:
     #: the semantics the inputs' assumption held in, and those that agreed on ``last``'s failure
     accepted: str = "exact"
     last_semantics: str = ""
+    #: the inputs the events set (``in.x``): a guarantee ``triggered by`` another input is no answer to them
+    triggers: frozenset[str] = frozenset()
 
 
 @dataclass
@@ -168,7 +170,10 @@ class NodeResult:
     whose assumption held; ``semantics`` the ``satisfied`` verdicts per the
     arithmetic that decided them (``exact``, ``double``, ``tolerance``);
     ``first_inexact`` the first formula that held only in double arithmetic
-    or within the tolerance (event, where, time, semantics, formula, values).
+    or within the tolerance (event, where, time, semantics, formula, values);
+    ``unowed`` the input events that met the assumption and that no
+    guarantee answers (each is ``triggered by`` another input): no verdict,
+    nothing was checked for them.
     """
 
     node: str
@@ -180,6 +185,7 @@ class NodeResult:
     accepted: int = 0
     semantics: dict[str, int] = field(default_factory=lambda: {"exact": 0, "double": 0, "tolerance": 0})
     first_inexact: dict[str, Any] | None = None
+    unowed: int = 0
 
     @property
     def assumption(self) -> dict[str, Any]:
@@ -197,7 +203,7 @@ class NodeResult:
                 "first_violation": self.first_violation,
                 "first_assumption_violation": self.first_assumption_violation,
                 "first_inconclusive": self.first_inconclusive, "accepted": self.accepted,
-                "semantics": dict(self.semantics), "first_inexact": self.first_inexact}
+                "semantics": dict(self.semantics), "first_inexact": self.first_inexact, "unowed": self.unowed}
 
 
 def producers(checked: Checked, node: CheckedNode, var: str) -> list[str]:
@@ -280,6 +286,10 @@ class NodeMonitor:
                 self.values[key] = initial_value(typ, rules.get(topic, TopicRule()))
         self.assumption = tuple(c.formula for c in node.node.assumes)
         self.guarantees = tuple(c.formula for c in node.node.guarantees)
+        #: guarantee k -> ``in.x`` for ``triggered by in.x``: it answers the events of that input only
+        self._trigger = {k: f"in.{c.trigger.name}" for k, c in enumerate(node.node.guarantees, 1)
+                         if c.trigger is not None}
+        self._triggers = frozenset(self._trigger.values())
         self._texts = {k: expr_to_rcl(f) for k, f in enumerate(self.guarantees, 1)}  # printed once, not per verdict
         self._renders: dict[int, tuple[Any, str]] = {}
         needed: set[str] = set()
@@ -287,6 +297,9 @@ class NodeMonitor:
             _names(f, needed)
         self.needed_inputs = sorted(k for k in self.values if k.startswith("in.") and
                                     (k in needed or k[3:] in needed))
+        #: variables the contract reads that no topic or link part carries: no run gives them a value
+        self.unbound = sorted(f"{p}.{v}" for p, names in (("in", node.inputs), ("out", node.outputs))
+                              for v in names if f"{p}.{v}" not in self.values and (v in needed or f"{p}.{v}" in needed))
         self._outputs = sorted(k for k in self.values if k.startswith("out."))
         # outputs whose every topic the mapping declares a state: their current
         # value may stand in for an answer; any other output answers only the
@@ -377,6 +390,7 @@ class NodeMonitor:
         self.result.events += 1
         is_input = False
         changed: list[str] = []
+        trig: set[str] = set()
         for key, typ, inp in vs:
             fields: Any = ev.fields
             part = self._parts.get((ev.topic, key)) if self._parts else None
@@ -391,19 +405,21 @@ class NodeMonitor:
                 self._note_inconclusive(ev, 0, f"{key}: {exc}")
                 return
             is_input = is_input or inp
-            if not inp:
+            if inp:
+                trig.add(key)
+            else:
                 changed.append(key)
         if changed:
             self._output(ev, changed)
         if is_input or (changed and not self.has_inputs):
-            self._input(ev)
+            self._input(ev, frozenset(trig))
 
     def _state(self) -> dict[str, Any]:
         """The outputs on state topics as they stand (observed ones only)."""
         values = self.values
         return {k: values[k] for k in self._state_outs if values[k] is not None}
 
-    def _input(self, ev: Event) -> None:
+    def _input(self, ev: Event, trig: frozenset[str] = frozenset()) -> None:
         for g in self.pending.values():
             g.answered = True
             if not g.outs and g.superseded is None:
@@ -441,11 +457,18 @@ class NodeMonitor:
                 accepted = judged.semantics
                 self._note_inexact(ev, judged, f"assumption {expr_to_rcl(formula)}", inputs)
         self.result.accepted += 1
-        ikey = tuple(inputs.items())
+        if self._triggers and all(k in self._trigger and self._trigger[k] not in trig
+                                  for k in range(1, len(self.guarantees) + 1)):
+            self.result.unowed += 1  # every guarantee answers another input: nothing is owed to this event
+            return
+        # the question: the inputs, and which triggers of the node's guarantees this event set (a node
+        # without triggered guarantees groups its events by their inputs alone, as before)
+        trig = trig & self._triggers
+        ikey = (tuple(inputs.items()), trig)
         key = (ikey, ())  # no answer yet: only a group that has none either is the same obligation
         group = self.pending.get(key)
         if group is None:
-            group = self.pending[key] = _Group(inputs, ikey=ikey, accepted=accepted)
+            group = self.pending[key] = _Group(inputs, ikey=ikey, accepted=accepted, triggers=trig)
         elif _WEAK[accepted] > _WEAK[group.accepted]:
             group.accepted = accepted
         group.events.append(ev)
@@ -492,6 +515,8 @@ class NodeMonitor:
         inexact: list[tuple[int, Judgement]] = []
         failed_semantics = ""
         for k, formula in enumerate(self.guarantees, 1):
+            if k in self._trigger and self._trigger[k] not in g.triggers:
+                continue  # triggered by another input: no answer to these events is owed (docs/monitors.md)
             judged = self._judge(k, formula, values)
             ok, reason = judged.truth, judged.reason
             if ok is False:
@@ -506,7 +531,7 @@ class NodeMonitor:
                     if g.outs and g.last is None:  # a partial answer: shown if nothing completes it
                         g.waiting = (ev, k, reason, dict(g.outs))
                     return
-                undecided = f"guarantee {k}: {reason}"
+                undecided = f"guarantee {k}: {reason}" + self._unbound_note(reason)
                 break
         if failed is None and not undecided:
             for k, judged in inexact[:1]:
@@ -519,6 +544,16 @@ class NodeMonitor:
             g.last_semantics = failed_semantics
         else:
             g.undecided = undecided
+
+    def _unbound_note(self, reason: str) -> str:
+        """A note for an undecided ``reason`` that waits on a variable no topic
+        carries (a contract whose ``topics(...)`` leave an input out): no run
+        will ever give it a value."""
+        names = [v for v in self.unbound if f"no value for {v}" in reason]
+        if not names:
+            return ""
+        return (f" ({', '.join(names)} of {self.node.name} is carried by no topic or link part: its topics(...) "
+                "and services(...)/actions(...) name none, so no run gives it a value)")
 
     def _rekey(self) -> None:
         """Regroup the pending obligations by (inputs, answers so far): two groups
@@ -629,8 +664,11 @@ class NodeMonitor:
     def finish(self) -> NodeResult:
         """Close the run: obligations past their horizon are violated, the rest open."""
         for g in self.pending.values():
+            why = f" ({g.undecided})" if g.undecided else ""
+            if g.undecided and g.events:  # why it waited: named in the evidence (backend.verdict_status)
+                self._first_inconclusive(g.events[0], f"unanswered when the run ended: {g.undecided}")
             for trigger in g.events:
-                self._verdict("open", trigger, reason=f"unanswered when the run ended, within {self.horizon} s")
+                self._verdict("open", trigger, reason=f"unanswered when the run ended, within {self.horizon} s{why}")
         self.pending.clear()
         return self.result
 

@@ -10,9 +10,12 @@ node's assumption holds on them (a filter, so Hypothesis's
 implementation is called with one keyword argument per input; its outputs
 must be a mapping with exactly the node's output names, each value of its
 RCL type (:func:`rclverify.values.conforms`); then every top-level conjunct
-of the guarantee is checked on the inputs and outputs
-(:func:`rclverify.logic.decide.decide`: direct evaluation, Z3 only where it
-cannot decide).  A violation is shrunk by Hypothesis; Z3's ``unknown``
+of the guarantee is checked on the inputs and outputs as the implementation
+computed them (:func:`rclverify.logic.floatsem.judge`: exact arithmetic by
+direct evaluation, Z3 only where it cannot decide, then the IEEE-754 double
+arithmetic a Python implementation computes in, as the monitors judge a
+recorded run; docs/property-tests.md, "Numbers as the implementation
+computes them").  A violation is shrunk by Hypothesis; Z3's ``unknown``
 counts as inconclusive, never as passed.  The reported counterexample is
 confirmed by Z3 (:func:`rclverify.logic.concrete.check_concrete`): the facts
 hold on its inputs and its outputs violate the conjunct.
@@ -36,6 +39,7 @@ from hypothesis.errors import FailedHealthCheck, Unsatisfiable
 
 from ...logic.concrete import check_concrete
 from ...logic.decide import decide
+from ...logic.floatsem import judge
 from ...logic.encode import EncodingError
 from ...rcl import ast
 from ...rcl.printer import expr_to_rcl
@@ -149,12 +153,17 @@ class Counts:
     failures: int = 0
     inconclusive: int = 0
     steps: int = 0
+    #: conjunct checks that held only in the implementation's double arithmetic (false as exact rationals)
+    double: int = 0
 
     def as_dict(self) -> dict[str, int]:
-        return {"run": self.drawn, "valid": self.valid, "rejected": self.rejected,
-                "rejected_by_facts": self.rejected_by_facts,
-                "assumption_unknown": self.assumption_unknown, "failures": self.failures,
-                "inconclusive": self.inconclusive, "steps_checked": self.steps}
+        out = {"run": self.drawn, "valid": self.valid, "rejected": self.rejected,
+               "rejected_by_facts": self.rejected_by_facts,
+               "assumption_unknown": self.assumption_unknown, "failures": self.failures,
+               "inconclusive": self.inconclusive, "steps_checked": self.steps}
+        if self.double:
+            out["double"] = self.double
+        return out
 
 
 @dataclass
@@ -204,6 +213,8 @@ class GuaranteeRun:
     #: the values, outputs and conjunct of ``last_failure`` (for the Z3 confirmation)
     last_values: tuple[dict[str, Any], dict[str, Any] | None, ast.Expr | None] | None = None
     unknown: set[str] = field(default_factory=set)
+    #: the first check that held only in double arithmetic: (conjunct text, rendered values)
+    first_double: tuple[str, str] | None = None
     _used_facts: tuple[ast.Expr, ...] | None = field(default=None, repr=False)
 
     @property
@@ -300,7 +311,12 @@ class GuaranteeRun:
         values = {**inputs, **{f"out.{k}": v for k, v in outputs.items()}}
         g = self.node.node.guarantees[self.guarantee - 1]
         for c in conjuncts(g.formula):
-            ok, why = decide(c, self.checked, self.node, values)
+            judged = judge(c, self.checked, self.node, values)
+            ok, why = judged.truth, judged.reason
+            if ok and judged.semantics == "double":
+                self.counts.double += 1
+                if self.first_double is None:
+                    self.first_double = (expr_to_rcl(c), ", ".join(f"{k} = {render(v)}" for k, v in sorted(values.items())))
             if ok is None:
                 self.counts.inconclusive += 1
                 self.unknown.add(why)
@@ -391,8 +407,13 @@ class GuaranteeRun:
         if self.counts.inconclusive:
             return Outcome("inconclusive", f"no violation, but Z3 answered unknown on {self.counts.inconclusive} "
                            f"example(s) ({', '.join(sorted(self.unknown))})", self.counts, None, sorted(self.unknown))
-        return Outcome("discharged", f"all {self.counts.valid} valid example(s) met guarantee {self.guarantee}",
-                       self.counts, None, [])
+        inexact = ""
+        if self.first_double is not None:
+            inexact = (f"; {self.counts.double} check(s) held only in the implementation's IEEE-754 double "
+                       f"arithmetic, false as exact rationals (first: {self.first_double[0]} with "
+                       f"{self.first_double[1]})")
+        return Outcome("discharged", f"all {self.counts.valid} valid example(s) met guarantee {self.guarantee}"
+                       + inexact, self.counts, None, [])
 
 
 @contextmanager
