@@ -180,4 +180,42 @@ def check_concrete(formula: ast.Expr, checked: Checked, node: CheckedNode, value
     return None, s.reason_unknown() or "unknown"
 
 
-__all__ = ["ConcreteValueError", "check_concrete", "finite_interpretation", "to_z3"]
+def false_whatever_the_rest(formula: ast.Expr, checked: Checked, node: CheckedNode, values: Mapping[str, Any], *,
+                            timeout_ms: int = SAFETY_TIMEOUT_MS, rlimit: int = CHECK_RLIMIT) -> bool:
+    """Is ``formula`` false for these values of some of ``node``'s inputs and
+    outputs whatever values the others take (within their types)?  ``values``
+    as for :func:`check_concrete`, but the I/O variables it leaves out are
+    free.  ``True`` only when Z3 shows the formula unsatisfiable with them
+    (a monitor may then call an answer missing an output false: no value of
+    that output could have made it hold); ``False`` when it is satisfiable or
+    Z3 cannot say.  Raises as :func:`check_concrete`."""
+    for q in values:
+        _io_type(node, q)
+    enc = Encoder(checked.env)
+    phi = enc.formula(formula, node)
+    consts: list[tuple[z3.ExprRef, z3.ExprRef]] = []
+    funcs: list[tuple[z3.FuncDeclRef, z3.ExprRef]] = []
+    for sym in list(enc.symbols.values()):
+        q = sym.z3name.split(".", 1)[1]
+        if q not in values:
+            continue
+        t, v = _io_type(node, q), values[q]
+        if isinstance(t, FuncT):
+            if not isinstance(v, FiniteFunction):
+                raise ConcreteValueError(f"{q}: {v!r} is not a finite function ({t})")
+            funcs.append((sym.decl, finite_interpretation(v, t, enc)))
+        else:
+            consts.append((sym.decl, to_z3(v, t, enc)))
+    body = z3.And(phi, *enc.axioms())  # the free outputs range over their types (NATURAL >= 0, ...)
+    if consts:
+        body = z3.substitute(body, *consts)
+    if funcs:
+        body = z3.substitute_funs(body, *funcs)
+    s = z3.Solver()
+    s.set("rlimit", int(rlimit))
+    s.set("timeout", int(timeout_ms))
+    s.add(body)
+    return s.check() == z3.unsat
+
+
+__all__ = ["ConcreteValueError", "check_concrete", "false_whatever_the_rest", "finite_interpretation", "to_z3"]

@@ -81,33 +81,45 @@ Tables = Callable[[Formal, TemporalVerdict, TransitionSystem], TemporalVerdict]
 def decide(t: Temporal, sys: ComposedSystem, pred: Callable[[Formal], Callable[[Any], Any]], *,
            bound: int = DEFAULT_BOUND, timeout_ms: int = 10_000, tables: Tables | None = None,
            ranking: Callable[[Any], Any] | None = None, invariant: Callable[[Any], Any] | None = None,
-           checked: Checked | None = None, gaps: dict[str, Any] | None = None) -> TemporalVerdict:
+           checked: Checked | None = None, gaps: dict[str, Any] | None = None,
+           tables_first: bool = False) -> TemporalVerdict:
     """Decide statement ``t`` over ``sys`` (module table); ``pred(F)`` is
     F as a predicate over one state.  ``tables(F, v, ts)`` is asked when the
     verdict ``v`` on an unbounded ``eventually F`` over ``ts`` is
     inconclusive (the finite-table lasso search of :func:`check_temporal`);
+    with ``tables_first`` (the system has function-typed variables, over
+    which Z3's general bounded query seldom decides: issue 44, "decide first
+    with what decides") it is asked first, on the system in which every node
+    answers what it accepts, and a confirmed lasso there is the verdict
+    without the general query;
     ``ranking`` and ``invariant`` (over one state) are the plan's, for that
     ``eventually``.  A lasso in which a node never answers what it accepts
     is explained (:func:`.progress_gap.explain_idle`, with ``checked``): what
     is missing is put in ``gaps`` (``missing_progress``, ``missing_initially``).  A verdict ``proved`` stands
     only if no run of the system stops (:func:`.deadlock.runs_go_on`)."""
     return runs_go_on(sys.ts, _decide(t, sys, pred, bound, timeout_ms, tables, ranking, invariant, checked,
-                                      gaps if gaps is not None else {}),
+                                      gaps if gaps is not None else {}, tables_first),
                       max_k=bound, timeout_ms=timeout_ms)
 
 
 def _decide(t: Temporal, sys: ComposedSystem, pred: Callable[[Formal], Callable[[Any], Any]], bound: int,
             timeout_ms: int, tables: Tables | None,
             ranking: Callable[[Any], Any] | None, invariant: Callable[[Any], Any] | None,
-            checked: Checked | None, gaps: dict[str, Any]) -> TemporalVerdict:
+            checked: Checked | None, gaps: dict[str, Any], tables_first: bool = False) -> TemporalVerdict:
     kind = shape(t, None)
     ts = sys.ts
 
     def eventually(g: Formal) -> TemporalVerdict:
+        tried_sync = False
+        if tables_first and tables is not None and checked is not None and not sys.eager:
+            w = tables(g, TemporalVerdict("inconclusive", "bounded"), sys.synchronous(ts))
+            if w.status == "refuted":  # a confirmed lasso of the declared system: the general query cannot undo it
+                return TemporalVerdict(w.status, w.method, k=w.k, bound=w.bound, trace=w.trace, loop=w.loop,
+                                       deadlock=w.deadlock, detail=f"{w.detail}; {EVEN_SO}")
+            tried_sync = True
         v = check_eventually(ts, pred(g), ranking=ranking, invariant=invariant, bound=bound, timeout_ms=timeout_ms)
         by_tables = tables is not None and v.status == "inconclusive"
-        tried_sync = False
-        if by_tables and checked is not None and not sys.eager:
+        if by_tables and checked is not None and not sys.eager and not tried_sync:
             # every node answering what it accepts at once: the query Z3 decides best, and a lasso there is one
             # of the declared system that rests on no missing progress (.progress_gap)
             w = tables(g, v, sys.synchronous(ts))  # type: ignore[misc]
@@ -218,8 +230,10 @@ def check_temporal(req: Requirement, checked: Checked, model: SystemModel, plan:
                                       f"trace's values)")
     ranking = (lambda s: enc.term(rank.expr, rank.scope, sys.statement_symbols(s))) if rank is not None else None
     missing: dict[str, Any] = {}
+    from ..rcl.types import FuncT
     v = decide(t, sys, pred, bound=bound, timeout_ms=timeout_ms, tables=tables, ranking=ranking,
-               invariant=pred(inv) if inv is not None else None, checked=checked, gaps=missing)
+               invariant=pred(inv) if inv is not None else None, checked=checked, gaps=missing,
+               tables_first=any(isinstance(ty, FuncT) for ty in types.values()))
     lasso = v.status == "refuted" and "lasso" in v.method.split(" + ")
     gaps = missing.get("missing_progress", []) if lasso else []
     stuck = missing.get("missing_initially", []) if lasso else []

@@ -614,16 +614,34 @@ class NodeMonitor:
             return
         first: dict[str, Any]
         if g.last is None and g.waiting is not None:
+            # a partial answer (some outputs published after the input, another never): the guarantee cannot be
+            # judged, which is not the same as false. An output that keeps its value without being published
+            # again (a latched topic) is declared `state: true` in the mapping (docs/monitors.md)
             out, k, why, outs = g.waiting
-            first = {
-                "event": out.index, "time": out.time, "where": out.where, "guarantee": k,
-                "formula": self._texts[k], "trigger": trigger.index,
-                "trigger_time": trigger.time, "trigger_where": trigger.where,
-                "values": self._rendered({**g.inputs, **outs}),
-                "reason": f"guarantee {k} is undecided on the outputs published after the input at "
-                          f"{trigger.where} (the last at {out.where}): {why}, and no output within "
-                          f"{self.horizon} s completed the answer"}
-        elif g.last is None:
+            if self._false_whatever_missing(k, {**g.inputs, **outs}):
+                # no value of the missing output could make it hold: false on what was answered
+                first = {
+                    "event": out.index, "time": out.time, "where": out.where, "guarantee": k,
+                    "formula": self._texts[k], "trigger": trigger.index,
+                    "trigger_time": trigger.time, "trigger_where": trigger.where,
+                    "values": self._rendered({**g.inputs, **outs}),
+                    "reason": f"guarantee {k} is false on the outputs published after the input at {trigger.where} "
+                              f"(the last at {out.where}) whatever the value of the outputs not published after "
+                              f"it ({why})"}
+                if self.result.first_violation is None:
+                    self.result.first_violation = first
+                self._verdict("violated", trigger, guarantee=k, values=first["values"], reason=first["reason"])
+                return
+            missing = why.split(" ", 3)[-1].split(",")[0] if why.startswith("no value for ") else why
+            reason = (f"guarantee {k} is undecided on the outputs published after the input at {trigger.where} "
+                      f"(the last at {out.where}): {why}; nothing published within {self.horizon} s completed "
+                      f"the answer (if {missing} keeps its value between messages, declare its topic "
+                      "`state: true` in the mapping)")
+            self._first_inconclusive(trigger, reason)
+            self._verdict("inconclusive", trigger, guarantee=k, values=self._rendered({**g.inputs, **outs}),
+                          reason=reason)
+            return
+        if g.last is None:
             first = {
                 "event": trigger.index, "time": trigger.time, "where": trigger.where, "guarantee": None,
                 "formula": "", "values": self._rendered(g.inputs),
@@ -643,6 +661,18 @@ class NodeMonitor:
             self.result.first_violation = first
         self._verdict("violated", trigger, guarantee=first["guarantee"] or 0, values=first["values"],
                       reason=first["reason"], semantics=first.get("semantics", ""))
+
+    def _false_whatever_missing(self, k: int, values: Mapping[str, Any]) -> bool:
+        """Is guarantee ``k`` false on ``values`` (a partial answer) whatever the
+        outputs missing from it are (Z3, :func:`~...logic.concrete.false_whatever_the_rest`)?"""
+        import z3
+
+        from ...logic.concrete import false_whatever_the_rest
+        known = {q: v for q, v in values.items() if v is not None}
+        try:
+            return false_whatever_the_rest(self.guarantees[k - 1], self.checked, self.node, known)
+        except (KeyError, ValueError, z3.Z3Exception):
+            return False  # cannot be shown false: the partial answer stays undecided
 
     def _note_inexact(self, ev: Event, judged: Judgement, what: str, values: Mapping[str, Any]) -> None:
         """Remember the first formula that held only in double arithmetic or
