@@ -613,50 +613,42 @@ class NodeMonitor:
             self._verdict("inconclusive", trigger, guarantee=g.last[1], reason=reason)
             return
         first: dict[str, Any]
+
+        def on_answer(out: Event, k: int, outputs: Mapping[str, Any], reason: str, semantics: str = "") -> dict[str, Any]:
+            return {"event": out.index, "time": out.time, "where": out.where, "guarantee": k,
+                    "formula": self._texts[k], "trigger": trigger.index, "trigger_time": trigger.time,
+                    "trigger_where": trigger.where, "values": self._rendered({**g.inputs, **outputs}),
+                    "reason": reason, **({"semantics": semantics} if semantics else {})}
         if g.last is None and g.waiting is not None:
-            # a partial answer (some outputs published after the input, another never): the guarantee cannot be
-            # judged, which is not the same as false. An output that keeps its value without being published
-            # again (a latched topic) is declared `state: true` in the mapping (docs/monitors.md)
             out, k, why, outs = g.waiting
-            if self._false_whatever_missing(k, {**g.inputs, **outs}):
-                # no value of the missing output could make it hold: false on what was answered
-                first = {
-                    "event": out.index, "time": out.time, "where": out.where, "guarantee": k,
-                    "formula": self._texts[k], "trigger": trigger.index,
-                    "trigger_time": trigger.time, "trigger_where": trigger.where,
-                    "values": self._rendered({**g.inputs, **outs}),
-                    "reason": f"guarantee {k} is false on the outputs published after the input at {trigger.where} "
-                              f"(the last at {out.where}) whatever the value of the outputs not published after "
-                              f"it ({why})"}
-                if self.result.first_violation is None:
-                    self.result.first_violation = first
-                self._verdict("violated", trigger, guarantee=k, values=first["values"], reason=first["reason"])
+            if not self._false_whatever_missing(k, {**g.inputs, **outs}):
+                # a partial answer (some outputs published after the input, another never): the guarantee cannot
+                # be judged, which is not the same as false. An output that keeps its value without being published
+                # again (a latched topic) is declared `state: true` in the mapping (docs/monitors.md)
+                missing = why.split(" ", 3)[-1].split(",")[0] if why.startswith("no value for ") else why
+                reason = (f"guarantee {k} is undecided on the outputs published after the input at {trigger.where} "
+                          f"(the last at {out.where}): {why}; nothing published within {self.horizon} s completed "
+                          f"the answer (if {missing} keeps its value between messages, declare its topic "
+                          "`state: true` in the mapping)")
+                self._first_inconclusive(trigger, reason)
+                self._verdict("inconclusive", trigger, guarantee=k, values=self._rendered({**g.inputs, **outs}),
+                              reason=reason)
                 return
-            missing = why.split(" ", 3)[-1].split(",")[0] if why.startswith("no value for ") else why
-            reason = (f"guarantee {k} is undecided on the outputs published after the input at {trigger.where} "
-                      f"(the last at {out.where}): {why}; nothing published within {self.horizon} s completed "
-                      f"the answer (if {missing} keeps its value between messages, declare its topic "
-                      "`state: true` in the mapping)")
-            self._first_inconclusive(trigger, reason)
-            self._verdict("inconclusive", trigger, guarantee=k, values=self._rendered({**g.inputs, **outs}),
-                          reason=reason)
-            return
-        if g.last is None:
+            # no value of the missing outputs could make it hold: false on what was answered
+            first = on_answer(out, k, outs, f"guarantee {k} is false on the outputs published after the input at "
+                              f"{trigger.where} (the last at {out.where}) whatever the value of the outputs not "
+                              f"published after it ({why})")
+        elif g.last is None:
             first = {
                 "event": trigger.index, "time": trigger.time, "where": trigger.where, "guarantee": None,
                 "formula": "", "values": self._rendered(g.inputs),
                 "reason": f"no output satisfying the guarantees within {self.horizon} s of the input event"}
         else:
             out, k, outputs = g.last
-            first = {
-                "event": out.index, "time": out.time, "where": out.where, "guarantee": k,
-                "formula": self._texts[k], "trigger": trigger.index,
-                "trigger_time": trigger.time, "trigger_where": trigger.where,
-                "values": self._rendered({**g.inputs, **outputs}),
-                "reason": f"guarantee {k} is false on the output at {out.where} answering the input at "
-                          f"{trigger.where}{_in_all(g.last_semantics)}, and no output within {self.horizon} s "
-                          f"satisfied it",
-                "semantics": g.last_semantics}
+            first = on_answer(out, k, outputs, f"guarantee {k} is false on the output at {out.where} answering the "
+                              f"input at {trigger.where}{_in_all(g.last_semantics)}, and no output within "
+                              f"{self.horizon} s satisfied it", g.last_semantics)
+            first.setdefault("semantics", g.last_semantics)
         if self.result.first_violation is None:
             self.result.first_violation = first
         self._verdict("violated", trigger, guarantee=first["guarantee"] or 0, values=first["values"],
