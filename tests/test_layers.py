@@ -80,6 +80,9 @@ LAYERS: list[tuple[str, tuple[str, ...]]] = [
     # job (issue 44): evaluator.py (context, names, expressions), eval_values.py,
     # eval_shapes.py, eval_search.py, eval_quant.py, eval_closures.py; each imports
     # only the parts below it (values <- shapes <- search <- quant <- evaluator).
+    # logic/straightline.py (a formula compiled into straight-line Python for the
+    # monitors) builds on the evaluator's values; logic/judges.py puts it before
+    # floatsem.judge (issue 44).
     # logic/encode.py likewise holds the Encoder over sorts.py (sorts, coercions,
     # operators), symbols.py (the error, symbol names), translate.py (formulas
     # node by node) and modeltext.py (Z3 values as RCL text).

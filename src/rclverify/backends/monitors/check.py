@@ -51,6 +51,7 @@ from dataclasses import dataclass, field
 from typing import Any, Callable, Iterable, Mapping
 
 from ...logic.floatsem import Judgement, Tolerance, judge
+from ...logic.judges import FormulaJudge
 from ...rcl import ast
 from ...rcl.printer import expr_to_rcl
 from ...rcl.types import Checked, CheckedNode
@@ -309,13 +310,22 @@ class NodeMonitor:
         self.pending: dict[Any, _Group] = {}
         self._due = float("inf")  # the earliest horizon among the pending obligations (s)
         self._cache: dict[tuple[Any, tuple[Any, ...]], Judgement] = {}
+        # each formula compiled once (logic/judges.py): straight-line code decides what it can, judge() the rest
+        self._judges = {k: FormulaJudge(f, checked, node, self.tolerance)
+                        for k, f in [(("A", j), f) for j, f in enumerate(self.assumption)]
+                        + list(enumerate(self.guarantees, 1))}
 
     # -- evaluation --------------------------------------------------------------
     def _judge(self, k: Any, formula: ast.Expr, values: Mapping[str, Any]) -> Judgement:
         """The judgement of guarantee ``k`` (``("A", j)``: assumption ``j``) on
         ``values`` (:func:`~rclverify.logic.floatsem.judge`: exact, then the
-        node's double arithmetic, then the tolerance); remembered per
-        (formula, values of the variables it reads)."""
+        node's double arithmetic, then the tolerance).  The formula's compiled
+        judge answers first where it can alone (:class:`FormulaJudge`); what
+        it leaves to ``judge`` is remembered per (formula, values of the
+        variables it reads)."""
+        hit = self._judges[k].quick(values)
+        if hit is not None:
+            return hit
         ck = (k, tuple([values.get(d) for d in self._deps[k]]))
         hit = self._cache.get(ck)
         if hit is not None:
