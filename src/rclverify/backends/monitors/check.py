@@ -56,7 +56,7 @@ from ...rcl import ast
 from ...rcl.printer import expr_to_rcl
 from ...rcl.types import Checked, CheckedNode
 from ...traces.events import Event
-from ...traces.mapping import MappingError, TopicRule, initial_value, map_value
+from ...traces.mapping import MappingError, TopicRule, initial_value, value_mapper
 from ...values import render
 from .verdicts import _WEAK, VERDICTS, NodeResult, Verdict, _in_all, link_of, producers
 
@@ -64,6 +64,7 @@ from .verdicts import _WEAK, VERDICTS, NodeResult, Verdict, _in_all, link_of, pr
 #: (a service ``s`` is observed as ``s/request`` and ``s/response`` events, an
 #: action ``a`` as actionlib's ``a/goal``, ``a/feedback`` and ``a/result``).
 LINK_TOPICS = {"service": ("request", "response"), "action": ("goal", "feedback", "result")}
+_NO_RULE = TopicRule()  # the rule of a topic the mapping does not name
 
 
 def _reads(e: Any, out: set[str]) -> None:
@@ -94,7 +95,7 @@ def _names(e: Any, out: set[str]) -> None:
             _names(x, out)
 
 
-@dataclass
+@dataclass(slots=True)
 class _Group:
     """Pending input events with equal inputs and equal answers so far: their
     events, the event outputs published since them (``outs``: only those may
@@ -168,6 +169,9 @@ class NodeMonitor:
                 if lk.kind == "action":
                     self._parts[(topic, key)] = suffix
         self.has_inputs = any(i for vs in self.topics.values() for _, _, i in vs)
+        #: per topic, what its message sets, made once: (variable, its mapper, input?, actionlib part)
+        self._feeds = {topic: [(key, value_mapper(typ, rules.get(topic, _NO_RULE)), inp, self._parts.get((topic, key), ""))
+                               for key, typ, inp in vs] for topic, vs in self.topics.items()}
         self.values: dict[str, Any] = {}
         for topic, vs in self.topics.items():
             for key, typ, _ in vs:
@@ -204,9 +208,10 @@ class NodeMonitor:
         self._due = float("inf")  # the earliest horizon among the pending obligations (s)
         self._cache: dict[tuple[Any, tuple[Any, ...]], Judgement] = {}
         # each formula compiled once (logic/judges.py): straight-line code decides what it can, judge() the rest
-        self._judges = {k: FormulaJudge(f, checked, node, self.tolerance)
-                        for k, f in [(("A", j), f) for j, f in enumerate(self.assumption)]
-                        + list(enumerate(self.guarantees, 1))}
+        self._assumed = [(("A", j), f) for j, f in enumerate(self.assumption)]
+        self._guaranteed = list(enumerate(self.guarantees, 1))
+        self._judges = {k: FormulaJudge(f, checked, node, self.tolerance) for k, f in self._assumed + self._guaranteed}
+        self._in_keys = self._keys["in."]
 
     # -- evaluation --------------------------------------------------------------
     def _judge(self, k: Any, formula: ast.Expr, values: Mapping[str, Any]) -> Judgement:
@@ -273,28 +278,32 @@ class NodeMonitor:
         past their horizon); only events on the node's topics change its state.
         An event's outputs answer the obligations opened before it, then its
         inputs open a new one (an answer comes after its question)."""
-        self.advance(ev.time)
-        vs = self.topics.get(ev.topic)
+        t = ev.time  # the clock first (advance(), inline: this runs for every event)
+        if t > self.now:
+            self.now = t
+        if self.pending and self.now > self._due:
+            self._expire(self.now)
+        vs = self._feeds.get(ev.topic)
         if vs is None:
             return
         self.result.events += 1
         is_input = False
         changed: list[str] = []
-        for key, typ, inp in vs:
+        values = self.values
+        for key, mapper, inp, part in vs:
             fields: Any = ev.fields
-            part = self._parts.get((ev.topic, key)) if self._parts else None
             try:
                 if part:
                     fields = fields.get(part)
                     if not isinstance(fields, Mapping):
                         raise MappingError(f"the actionlib message has no {part!r} part")
-                self.values[key] = map_value(typ, fields, self.rules.get(ev.topic, TopicRule()),
-                                             self.values.get(key))
+                values[key] = mapper(fields, values.get(key))
             except MappingError as exc:
                 self._note_inconclusive(ev, 0, f"{key}: {exc}")
                 return
-            is_input = is_input or inp
-            if not inp:
+            if inp:
+                is_input = True
+            else:
                 changed.append(key)
         if changed:
             self._output(ev, changed)
@@ -311,14 +320,16 @@ class NodeMonitor:
             g.answered = True
             if not g.outs and g.superseded is None:
                 g.superseded = ev
-        inputs = self._observed("in.")
-        missing = [k for k in self.needed_inputs if k not in inputs]
-        if missing:
-            self._verdict("incomplete input", ev, reason="no value yet for " + ", ".join(missing))
-            return
+        values = self.values
+        inputs = {k: values[k] for k in self._in_keys if values[k] is not None}
+        if len(inputs) < len(self._in_keys):
+            missing = [k for k in self.needed_inputs if k not in inputs]
+            if missing:
+                self._verdict("incomplete input", ev, reason="no value yet for " + ", ".join(missing))
+                return
         accepted = "exact"
-        for j, formula in enumerate(self.assumption):
-            judged = self._judge(("A", j), formula, inputs)
+        for aj, formula in self._assumed:
+            judged = self._judge(aj, formula, inputs)
             ok, reason = judged.truth, judged.reason
             if ok is False:
                 mentioned: set[str] = set()
@@ -340,7 +351,7 @@ class NodeMonitor:
             if ok is None:
                 self._note_inconclusive(ev, 0, f"assumption undecided: {reason}")
                 return
-            if _WEAK.get(judged.semantics, 0) > _WEAK[accepted]:
+            if judged.semantics != "exact" and _WEAK.get(judged.semantics, 0) > _WEAK[accepted]:
                 accepted = judged.semantics
                 self._note_inexact(ev, judged, f"assumption {expr_to_rcl(formula)}", inputs)
         self.result.accepted += 1
@@ -352,12 +363,16 @@ class NodeMonitor:
         elif _WEAK[accepted] > _WEAK[group.accepted]:
             group.accepted = accepted
         group.events.append(ev)
-        group.ref = max(group.ref, ev.stamped)
+        stamped = ev.stamped
+        if stamped > group.ref:
+            group.ref = stamped
         group.superseded = None  # the same question asked again: the answer to come answers both
-        self._due = min(self._due, ev.time + self.horizon)
+        due = ev.time + self.horizon
+        if due < self._due:
+            self._due = due
         if len(group.events) == 1:
             done: list[Any] = []
-            self._evaluate(key, group, ev, self._state(), done)
+            self._evaluate(key, group, ev, self._state() if self._state_outs else {}, done)
             for k in done:
                 del self.pending[k]
 
@@ -366,13 +381,19 @@ class NodeMonitor:
         obligation whose question is not stamped after ``ev``; a state output's
         new value is seen by every obligation."""
         values = self.values
-        fresh = {k: values[k] for k in changed if k not in self._state_set and values[k] is not None}
-        state_changed = any(k in self._state_set for k in changed)
-        state = self._state()
+        states = self._state_set
+        if states:
+            fresh = {k: values[k] for k in changed if k not in states and values[k] is not None}
+            state_changed = any(k in states for k in changed)
+            state = self._state()
+        else:
+            fresh = {k: values[k] for k in changed if values[k] is not None}
+            state_changed, state = False, {}
         done: list[Any] = []
         rekey = False
+        stamped = ev.stamped
         for key, g in self.pending.items():
-            answered = bool(fresh) and ev.stamped >= g.ref
+            answered = bool(fresh) and stamped >= g.ref
             if answered:
                 g.outs.update(fresh)
                 rekey = True
@@ -380,21 +401,24 @@ class NodeMonitor:
                 self._evaluate(key, g, ev, state, done)
         for key in done:
             del self.pending[key]
-        if rekey:
+        if rekey and self.pending:
             self._rekey()
 
     def _evaluate(self, key: Any, g: _Group, ev: Event, state: Mapping[str, Any], done: list[Any]) -> None:
         """Evaluate group ``g``'s guarantees on its inputs, the state outputs and
         the outputs that answered it; satisfied -> verdicts and ``key`` in ``done``."""
-        values = dict(g.inputs)
-        values.update(state)
-        values.update(g.outs)
+        if state or g.outs:
+            values = dict(g.inputs)
+            values.update(state)
+            values.update(g.outs)
+        else:  # only read below: no copy needed
+            values = g.inputs
         failed: int | None = None
         undecided = ""
         weakest = g.accepted
         inexact: list[tuple[int, Judgement]] = []
         failed_semantics = ""
-        for k, formula in enumerate(self.guarantees, 1):
+        for k, formula in self._guaranteed:
             judged = self._judge(k, formula, values)
             ok, reason = judged.truth, judged.reason
             if ok is False:
@@ -557,13 +581,20 @@ def check_trace(checked: Checked, nodes: Iterable[CheckedNode], events: Iterable
     monitors = [NodeMonitor(checked, n, rules, horizon, on_verdict, tolerance) for n in nodes]
     count = 0
     last_time = 0.0
-    for ev in events:
-        count += 1
-        last_time = ev.time
-        for m in monitors:  # the clock first (as a live monitor's timer would), then the message
-            m.advance(ev.time)
-        for m in monitors:
-            m.feed(ev)
+    if len(monitors) == 1:  # feed() moves the clock first itself
+        feed = monitors[0].feed
+        for ev in events:
+            count += 1
+            last_time = ev.time
+            feed(ev)
+    else:
+        for ev in events:
+            count += 1
+            last_time = ev.time
+            for m in monitors:  # every clock first (as a live monitor's timer would), then the message
+                m.advance(ev.time)
+            for m in monitors:
+                m.feed(ev)
     for m in monitors:
         m.advance(max(last_time, end) if end is not None else last_time)
     return count, [m.finish() for m in monitors]
