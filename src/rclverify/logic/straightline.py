@@ -59,14 +59,14 @@ CACHE_SIZE = 10_000
 
 
 class Missing(Exception):
-    """The formula needs the value of I/O variable ``key`` (``"out.status"``),
-    which has none yet: the evaluator's ``no value for out.status``."""
+    """The formula needs the value of I/O variable ``key`` (``"out.status"``,
+    the exception's one argument), which has none yet: the evaluator's
+    ``no value for out.status``.  (No ``__init__`` of its own: raised at
+    every input event of a node whose answer has not come yet.)"""
 
-    __slots__ = ("key",)
-
-    def __init__(self, key: str) -> None:
-        super().__init__(key)
-        self.key = key
+    @property
+    def key(self) -> str:
+        return str(self.args[0])
 
 
 @dataclass(frozen=True)

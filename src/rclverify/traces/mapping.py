@@ -221,11 +221,18 @@ def value_mapper(typ: T.Type, rule: TopicRule) -> Any:
     real = isinstance(typ, T.Scalar) and typ.name == "REAL"
     if not (real or isinstance(typ, T.EnumT)):
         return lambda fields, previous: map_value(typ, fields, rule, previous)
-    named = bool(rule.fields)
+    names = rule.fields
     isfinite = math.isfinite
 
     def mapper(fields: Mapping[str, Any], previous: Any) -> Any:
-        for name, v in (field_items(fields, rule) if named else fields.items()):
+        if names:
+            try:  # the named fields as top-level keys (field_value reads such a key first)
+                items: Any = [(f, fields[f]) for f in names]
+            except (KeyError, TypeError, IndexError):  # a path, a missing field: the general reading and its errors
+                items = field_items(fields, rule)
+        else:
+            items = fields.items()
+        for name, v in items:
             if isinstance(v, float) and not isfinite(v):
                 raise MappingError(f"field {name!r} is {v!r}, not a finite number, for the value of type {typ}")
             if real:

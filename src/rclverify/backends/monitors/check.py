@@ -65,6 +65,7 @@ from .verdicts import _WEAK, VERDICTS, NodeResult, Verdict, _in_all, link_of, pr
 #: action ``a`` as actionlib's ``a/goal``, ``a/feedback`` and ``a/result``).
 LINK_TOPICS = {"service": ("request", "response"), "action": ("goal", "feedback", "result")}
 _NO_RULE = TopicRule()  # the rule of a topic the mapping does not name
+_NEVER = float("inf")
 
 
 def _reads(e: Any, out: set[str]) -> None:
@@ -375,6 +376,8 @@ class NodeMonitor:
             self._evaluate(key, group, ev, self._state() if self._state_outs else {}, done)
             for k in done:
                 del self.pending[k]
+            if not self.pending:
+                self._due = _NEVER  # no obligation left: no horizon to watch
 
     def _output(self, ev: Event, changed: list[str]) -> None:
         """Outputs ``changed`` were just set by ``ev``: they answer every pending
@@ -401,7 +404,9 @@ class NodeMonitor:
                 self._evaluate(key, g, ev, state, done)
         for key in done:
             del self.pending[key]
-        if rekey and self.pending:
+        if not self.pending:
+            self._due = _NEVER  # no obligation left: no horizon to watch
+        elif rekey:
             self._rekey()
 
     def _evaluate(self, key: Any, g: _Group, ev: Event, state: Mapping[str, Any], done: list[Any]) -> None:

@@ -66,9 +66,9 @@ def monitor_command(args: argparse.Namespace, checked: Checked) -> int:
                     m.feed(ev)
                 yield ev
         try:
-            events, results = check_trace(checked, list(checked.nodes.values()),
-                                          tap(read_trace(path, [root / d for d in cfg.msg_dirs], streams=True,
-                                                         on_warning=lambda w: print(w, file=sys.stderr))),
+            run = read_trace(path, [root / d for d in cfg.msg_dirs], streams=True,
+                             on_warning=lambda w: print(w, file=sys.stderr))
+            events, results = check_trace(checked, list(checked.nodes.values()), tap(run) if dmons else run,
                                           cfg.rules, cfg.horizon, tolerance=cfg.tolerance)
             dres = [m.finish() for m in dmons]
         except TraceError as exc:
