@@ -236,11 +236,6 @@ class NodeMonitor:
             self._cache[ck] = j
         return j
 
-    def _truth(self, k: Any, formula: ast.Expr, values: Mapping[str, Any]) -> tuple[bool | None, str]:
-        """(truth, reason) of :meth:`_judge`."""
-        j = self._judge(k, formula, values)
-        return j.truth, j.reason
-
 
     def _rendered(self, values: Mapping[str, Any]) -> dict[str, str]:
         return {k: self._render(v) for k, v in sorted(values.items()) if v is not None}
@@ -256,11 +251,6 @@ class NodeMonitor:
         text = render(v)
         self._renders[id(v)] = (v, text)
         return text
-
-    def _observed(self, prefix: str) -> dict[str, Any]:
-        """The values with ``prefix`` observed so far (an unobserved variable has no entry)."""
-        values = self.values
-        return {k: values[k] for k in self._keys[prefix] if values[k] is not None}
 
     def _verdict(self, verdict: str, ev: Event, guarantee: int = 0, values: Mapping[str, str] | None = None,
                  reason: str = "", n: int = 1, semantics: str = "") -> None:
