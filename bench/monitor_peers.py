@@ -128,7 +128,9 @@ def _rclverify_engine(n: int, rs: array, st: bytes, verdicts: bool) -> tuple[flo
     t0 = time.process_time()
     _, (res,) = check_trace(checked, [checked.nodes["Classifier"]], events(), rules, HORIZON,
                             seen if verdicts else None)
-    return time.process_time() - t0, bytes(out), dict(res.counts)
+    counts = dict(res.counts)
+    counts["evaluation"] = getattr(res, "evaluation", {})  # how the formulas ran (an older tree has no such field)
+    return time.process_time() - t0, bytes(out), counts
 
 
 def _rtamt(n: int, rs: array, st: bytes) -> tuple[float, bytes]:
@@ -278,8 +280,10 @@ def main() -> int:
         key = name.split("(")[-1].rstrip(")") if name.startswith("rclverify engine") else name
         agree = _agree(verdicts[key], verdicts["new"]) if key in verdicts else "-"
         print(f"{name:<28} {n / r['cpu']:>11.0f} {engine / r['cpu']:>9.2f} {r['rss']:>13.1f}  {agree}")
-    counts = rows["rclverify engine (new)"]["counts"]
-    print("rclverify engine verdicts: " + ", ".join(f"{v} {k}" for k, v in counts.items() if v))
+    counts = dict(rows["rclverify engine (new)"]["counts"])
+    evaluation = counts.pop("evaluation", {})
+    print("rclverify engine verdicts: " + ", ".join(f"{v} {k}" for k, v in counts.items() if v)
+          + "; formulas: " + ", ".join(f"{k} {v}" for k, v in evaluation.items()))
     cmd = rows["rclverify monitor (new)"]
     short = " (the command's start-up dominates a run this short)" if n < 100_000 else ""
     print(f"rclverify monitor / engine CPU: {cmd['cpu'] / engine:.2f} (aim: at most 1.5){short}; the command "

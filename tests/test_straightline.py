@@ -302,3 +302,11 @@ def test_a_classifier_run_with_wrong_answers_gets_the_same_verdicts(tmp_path: Pa
     assert fast == slow
     counts = fast[1][1][0]["counts"]
     assert counts["violated"] == 3 and counts["assumption violated"] == 1 and counts["satisfied"] == 7, counts
+    # the debug field says how each formula ran (not in the evidence record)
+    _, (res,) = check_trace(checked, nodes, read_trace(tmp_path / "run.jsonl"), {}, 2.0)
+    assert res.evaluation == {"assumption 1": "compiled", "guarantee 1": "compiled"}
+    assert "evaluation" not in res.to_json()
+    case = load([REPO / "contracts/remote_inspection.rcl"])
+    _, (sensor,) = check_trace(case, [case.nodes["RadiationSensor"]], iter(()), {}, 2.0)
+    assert sensor.evaluation == {"assumption 1": "compiled", "guarantee 1": "evaluated by the interpreter: a quantifier "
+                                                                            "(forall) is not compiled"}

@@ -17,7 +17,7 @@ from .events import Event, TraceError
 #: JSON's scanner with :func:`json.loads`'s defaults: one object read without the
 #: general entry point's checks, which :func:`read_jsonl` leaves to ``json.loads``
 #: for any line the scanner does not read whole (so every error is worded as before)
-_SCAN = json.JSONDecoder().scan_once
+_SCAN = json.JSONDecoder().scan_once  # type: ignore[attr-defined]  # set by JSONDecoder.__init__, not in the stubs
 _JSON_SPACE = " \t\n\r"
 
 

@@ -212,6 +212,8 @@ class NodeMonitor:
         self._assumed = [(("A", j), f) for j, f in enumerate(self.assumption)]
         self._guaranteed = list(enumerate(self.guarantees, 1))
         self._judges = {k: FormulaJudge(f, checked, node, self.tolerance) for k, f in self._assumed + self._guaranteed}
+        self.result.evaluation = {(f"assumption {k[1] + 1}" if isinstance(k, tuple) else f"guarantee {k}"):
+                                  (j.fallback or "compiled") for k, j in self._judges.items()}
         self._in_keys = self._keys["in."]
 
     # -- evaluation --------------------------------------------------------------

@@ -85,6 +85,7 @@ def monitor_command(args: argparse.Namespace, checked: Checked) -> int:
             entry = {"node": res.node, "status": status, "explanation": explanation,
                      **monitoring_details(res, trace, events, "", tool_versions(), cfg.horizon, cfg.tolerance)}
             entry.pop("sha256")
+            entry["evaluation"] = dict(res.evaluation)  # debug: which formulas ran as compiled code
             report.append(entry)
             if not args.json:
                 print(f"{trace}: {summary_line(res)}")

@@ -64,7 +64,8 @@ class NodeResult:
     whose assumption held; ``semantics`` the ``satisfied`` verdicts per the
     arithmetic that decided them (``exact``, ``double``, ``tolerance``);
     ``first_inexact`` the first formula that held only in double arithmetic
-    or within the tolerance (event, where, time, semantics, formula, values).
+    or within the tolerance (event, where, time, semantics, formula, values);
+    ``evaluation`` how each formula was evaluated (debug; not in :meth:`to_json`).
     """
 
     node: str
@@ -76,6 +77,10 @@ class NodeResult:
     accepted: int = 0
     semantics: dict[str, int] = field(default_factory=lambda: {"exact": 0, "double": 0, "tolerance": 0})
     first_inexact: dict[str, Any] | None = None
+    #: a debug field, in no evidence record: how each formula was evaluated
+    #: (``assumption 1`` / ``guarantee 2`` -> ``compiled``, or why the
+    #: straight-line code left it to the evaluator; logic/judges.py)
+    evaluation: dict[str, str] = field(default_factory=dict, compare=False)
 
     @property
     def assumption(self) -> dict[str, Any]:
