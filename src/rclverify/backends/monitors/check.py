@@ -55,15 +55,18 @@ from ...logic.judges import FormulaJudge
 from ...rcl import ast
 from ...rcl.printer import expr_to_rcl
 from ...rcl.types import Checked, CheckedNode
+from ...system.services import peers
 from ...traces.events import Event
 from ...traces.mapping import MappingError, TopicRule, initial_value, value_mapper
 from ...values import render
-from .verdicts import _WEAK, VERDICTS, NodeResult, Verdict, _in_all, link_of, producers
 
+VERDICTS = ("satisfied", "violated", "open", "assumption violated", "inconclusive", "incomplete input")
 #: Topic suffixes of a service's or action's parts, in the order of ``Link.parts``
 #: (a service ``s`` is observed as ``s/request`` and ``s/response`` events, an
 #: action ``a`` as actionlib's ``a/goal``, ``a/feedback`` and ``a/result``).
 LINK_TOPICS = {"service": ("request", "response"), "action": ("goal", "feedback", "result")}
+#: How far a semantics is from exact arithmetic (the weakest one a verdict rests on is shown).
+_WEAK = {"exact": 0, "double": 1, "tolerance": 2}
 _NO_RULE = TopicRule()  # the rule of a topic the mapping does not name
 _NEVER = float("inf")
 
@@ -96,6 +99,42 @@ def _names(e: Any, out: set[str]) -> None:
             _names(x, out)
 
 
+@dataclass(frozen=True)
+class Verdict:
+    """The verdict of one event of one node, as soon as it is decided.
+
+    ``verdict`` one of :data:`VERDICTS`; ``event``/``time``/``where``/``topic``
+    identify the input event it is about (for a node without inputs, the
+    output event); ``guarantee`` the 1-based guarantee that failed (0 when
+    none or for the assumption); ``decided_at`` the time (s, trace clock)
+    when it was decided; ``values`` the rendered values of the first failure
+    (inputs and the outputs that failed), ``reason`` one sentence;
+    ``semantics`` the arithmetic that decided it (:mod:`rclverify.logic.floatsem`):
+    ``exact``, ``double`` or ``tolerance`` for a ``satisfied`` (the weakest
+    its assumption and guarantees needed), the semantics that all agreed for
+    a ``violated`` or ``assumption violated`` (``exact, double``), else ``""``.
+    """
+
+    node: str
+    verdict: str
+    event: int
+    time: float
+    where: str
+    topic: str
+    decided_at: float
+    guarantee: int = 0
+    values: Mapping[str, str] = field(default_factory=dict)
+    reason: str = ""
+    semantics: str = ""
+
+    def to_json(self) -> dict[str, Any]:
+        """A JSON-ready dict (the live monitor's verdict message)."""
+        return {"node": self.node, "verdict": self.verdict, "event": self.event, "time": self.time,
+                "where": self.where, "topic": self.topic, "decided_at": self.decided_at,
+                "guarantee": self.guarantee, "values": dict(self.values), "reason": self.reason,
+                "semantics": self.semantics}
+
+
 @dataclass(slots=True)
 class _Group:
     """Pending input events with equal inputs and equal answers so far: their
@@ -120,6 +159,79 @@ class _Group:
     accepted: str = "exact"
     last_semantics: str = ""
 
+
+@dataclass
+class NodeResult:
+    """Verdicts of one node on one trace.
+
+    ``counts`` verdict -> number of input events; ``first_violation`` and
+    ``first_assumption_violation`` are dicts (event index, time, where,
+    guarantee, formula, values, reason) or ``None``; ``events`` is the
+    number of events on the node's topics; ``accepted`` the input events
+    whose assumption held; ``semantics`` the ``satisfied`` verdicts per the
+    arithmetic that decided them (``exact``, ``double``, ``tolerance``);
+    ``first_inexact`` the first formula that held only in double arithmetic
+    or within the tolerance (event, where, time, semantics, formula, values);
+    ``evaluation`` how each formula was evaluated (debug; not in :meth:`to_json`).
+    """
+
+    node: str
+    counts: dict[str, int] = field(default_factory=lambda: {v: 0 for v in VERDICTS})
+    events: int = 0
+    first_violation: dict[str, Any] | None = None
+    first_assumption_violation: dict[str, Any] | None = None
+    first_inconclusive: dict[str, Any] | None = None
+    accepted: int = 0
+    semantics: dict[str, int] = field(default_factory=lambda: {"exact": 0, "double": 0, "tolerance": 0})
+    first_inexact: dict[str, Any] | None = None
+    #: a debug field, in no evidence record: how each formula was evaluated
+    #: (``assumption 1`` / ``guarantee 2`` -> ``compiled``, or why the
+    #: straight-line code left it to the evaluator; logic/judges.py)
+    evaluation: dict[str, str] = field(default_factory=dict, compare=False)
+
+    @property
+    def assumption(self) -> dict[str, Any]:
+        """The assumption monitor's verdict on the run: ``violated`` when an
+        input event violated it (the node is not at fault: the blame names the
+        producer), ``held`` when every evaluated input event met it, ``not
+        evaluated`` when none was evaluated."""
+        n = self.counts["assumption violated"]
+        verdict = "violated" if n else "held" if self.accepted else "not evaluated"
+        return {"verdict": verdict, "violations": n, "accepted": self.accepted,
+                "first": self.first_assumption_violation}
+
+    def to_json(self) -> dict[str, Any]:
+        return {"node": self.node, "counts": dict(self.counts), "events": self.events,
+                "first_violation": self.first_violation,
+                "first_assumption_violation": self.first_assumption_violation,
+                "first_inconclusive": self.first_inconclusive, "accepted": self.accepted,
+                "semantics": dict(self.semantics), "first_inexact": self.first_inexact}
+
+
+def producers(checked: Checked, node: CheckedNode, var: str) -> list[str]:
+    """Other nodes whose output has the input's name or is matched to the
+    input's topic, or feeds it through a service or action link (rule S1,
+    :func:`rclverify.system.services.peers`: a client's response comes from
+    the server, a server's request from its clients)."""
+    topics = {t.field for t in node.node.topics if t.match is not None and t.match.name == var}
+    out = {m for m, _ in peers(checked, node.name, var)} if node.node.links else set()
+    for other in checked.nodes.values():
+        if other.name == node.name:
+            continue
+        if var in other.outputs or any(t.field in topics and t.match is not None and t.match.name in other.outputs
+                                       for t in other.node.topics):
+            out.add(other.name)
+    return sorted(out)
+
+
+def link_of(node: CheckedNode, var: str) -> str:
+    """``service estop`` when input ``var`` of ``node`` is a part of a service
+    or action link (its response, feedback, result, or a server's request),
+    else ``""``."""
+    for lk in node.node.links:
+        if any(v.prefix == "in" and v.name == var for v in lk.parts):
+            return f"{lk.kind} {lk.name}"
+    return ""
 
 
 class NodeMonitor:
@@ -171,8 +283,9 @@ class NodeMonitor:
                     self._parts[(topic, key)] = suffix
         self.has_inputs = any(i for vs in self.topics.values() for _, _, i in vs)
         #: per topic, what its message sets, made once: (variable, its mapper, input?, actionlib part)
-        self._feeds = {topic: [(key, value_mapper(typ, rules.get(topic, _NO_RULE)), inp, self._parts.get((topic, key), ""))
-                               for key, typ, inp in vs] for topic, vs in self.topics.items()}
+        self._feeds = {topic: [(key, value_mapper(typ, rules.get(topic, _NO_RULE)), inp,
+                                self._parts.get((topic, key), "")) for key, typ, inp in vs]
+                       for topic, vs in self.topics.items()}
         self.values: dict[str, Any] = {}
         for topic, vs in self.topics.items():
             for key, typ, _ in vs:
@@ -557,6 +670,19 @@ class NodeMonitor:
                 self._verdict("open", trigger, reason=f"unanswered when the run ended, within {self.horizon} s")
         self.pending.clear()
         return self.result
+
+
+def _in_all(semantics: str) -> str:
+    """`` (false in exact and double arithmetic)`` for a failure that every
+    float semantics agreed on, ``""`` when only exact arithmetic applied."""
+    names = [s for s in semantics.split(", ") if s]
+    if len(names) < 2:
+        return ""
+    words = {"exact": "exact", "double": "double", "tolerance": "within the tolerance"}
+    said = [words.get(n, n) for n in names]
+    arith = [w for w in said if w in ("exact", "double")]
+    text = " and ".join(arith) + " arithmetic" + (" and " + said[-1] if "within the tolerance" in said else "")
+    return f" (false in {text})"
 
 
 def check_trace(checked: Checked, nodes: Iterable[CheckedNode], events: Iterable[Event],
