@@ -270,6 +270,8 @@ class RuleSet(dict):  # type: ignore[type-arg]
     "Numbers on the wire")."""
 
     tolerance: Any = None
+    #: the transport skew in seconds (``None``: none; backends/monitors/skew.py)
+    skew: float | None = None
 
 
 def load_rules(raw: Any) -> RuleSet:

@@ -59,6 +59,7 @@ from ...system.services import peers
 from ...traces.events import Event
 from ...traces.mapping import MappingError, TopicRule, initial_value, value_mapper
 from ...values import render
+from .skew import EarlyOutputs, early_reason
 
 VERDICTS = ("satisfied", "violated", "open", "assumption violated", "inconclusive", "incomplete input")
 #: Topic suffixes of a service's or action's parts, in the order of ``Link.parts``
@@ -160,6 +161,8 @@ class _Group:
     last_semantics: str = ""
     #: the inputs the events set (``in.x``): a guarantee ``triggered by`` another input is no answer to them
     triggers: frozenset[str] = frozenset()
+    #: trigger event index -> the outputs received within the transport skew before it (skew.py)
+    early: dict[int, tuple[Event, dict[str, Any]]] = field(default_factory=dict)
 
 
 @dataclass
@@ -332,6 +335,9 @@ class NodeMonitor:
             _reads(f, mentioned)
             self._deps[k] = tuple(v for v in sorted(self.values) if v in mentioned or v.split(".", 1)[1] in mentioned)
         self.pending: dict[Any, _Group] = {}
+        skew = getattr(rules, "skew", None)
+        #: the outputs of the last ``skew`` seconds: an answer received just before its question (skew.py)
+        self._early = EarlyOutputs(skew) if skew and self.has_inputs else None
         self._due = float("inf")  # the earliest horizon among the pending obligations (s)
         self._cache: dict[tuple[Any, tuple[Any, ...]], Judgement] = {}
         # each formula compiled once (logic/judges.py): straight-line code decides what it can, judge() the rest
@@ -492,6 +498,10 @@ class NodeMonitor:
             group.accepted = accepted
         group.events.append(ev)
         stamped = ev.stamped
+        if self._early is not None:
+            early = self._early.before(stamped)
+            if early is not None:
+                group.early[ev.index] = early
         if stamped > group.ref:
             group.ref = stamped
         group.superseded = None  # the same question asked again: the answer to come answers both
@@ -519,6 +529,8 @@ class NodeMonitor:
         else:
             fresh = {k: values[k] for k in changed if values[k] is not None}
             state_changed, state = False, {}
+        if fresh and self._early is not None:
+            self._early.remember(ev, fresh)
         done: list[Any] = []
         rekey = False
         stamped = ev.stamped
@@ -608,6 +620,7 @@ class NodeMonitor:
             h.undecided = h.undecided or g.undecided
             h.answered = h.answered and g.answered
             h.superseded = h.superseded if g.superseded is not None else None
+            h.early.update(g.early)
             if _WEAK[g.accepted] > _WEAK[h.accepted]:
                 h.accepted = g.accepted
             if h.last is g.last:  # h took g's failure: and the semantics it was decided in
@@ -674,6 +687,15 @@ class NodeMonitor:
             first = on_answer(out, k, outs, f"guarantee {k} is false on the outputs published after the input at "
                               f"{trigger.where} (the last at {out.where}) whatever the value of the outputs not "
                               f"published after it ({why})")
+        elif g.last is None and self._early is not None and trigger.index in g.early:
+            out, outs = g.early[trigger.index]
+            k, semantics = self._early_failure(g, outs)
+            reason = early_reason(k, out, trigger, self._early.skew, self.horizon)
+            if k is None:  # the early output meets the guarantees: an answer or a stale output, not told apart
+                self._first_inconclusive(trigger, reason)
+                self._verdict("inconclusive", trigger, values=self._rendered({**g.inputs, **outs}), reason=reason)
+                return
+            first = on_answer(out, k, outs, reason, semantics)
         elif g.last is None:
             first = {
                 "event": trigger.index, "time": trigger.time, "where": trigger.where, "guarantee": None,
@@ -689,6 +711,19 @@ class NodeMonitor:
             self.result.first_violation = first
         self._verdict("violated", trigger, guarantee=first["guarantee"] or 0, values=first["values"],
                       reason=first["reason"], semantics=first.get("semantics", ""))
+
+    def _early_failure(self, g: _Group, outs: Mapping[str, Any]) -> tuple[int | None, str]:
+        """The first guarantee owed to ``g`` that is false on its inputs, the
+        state outputs and the early outputs ``outs``, with the semantics that
+        agreed, or ``(None, "")`` when none is (all hold, or one is undecided)."""
+        values = {**g.inputs, **self._state(), **outs}
+        for k, formula in self._guaranteed:
+            if k in self._trigger and self._trigger[k] not in g.triggers:
+                continue
+            judged = self._judge(k, formula, values)
+            if judged.truth is False:
+                return k, judged.semantics
+        return None, ""
 
     def _false_whatever_missing(self, k: int, values: Mapping[str, Any]) -> bool:
         """Is guarantee ``k`` false on ``values`` (a partial answer) whatever the

@@ -12,7 +12,9 @@ Mapping file: ``msg_dirs`` (directories holding ``<pkg>/msg/<Type>.msg``),
 ``topics`` (:func:`rclverify.traces.mapping.load_rules`), optional
 ``ros_version`` (``ros1``/``ros2``, default ``ros2``), ``horizon``,
 ``tolerance`` (``{abs, rel, ulps}``: recorded numbers this close are equal
-to the comparisons, :class:`rclverify.logic.floatsem.Tolerance`) and
+to the comparisons, :class:`rclverify.logic.floatsem.Tolerance`), ``skew``
+(seconds, default 0.02: how far apart two messages on different topics may be
+stamped in the other order than they were published, :mod:`.skew`) and
 ``ros_nodes`` (contract node -> ``{name, package, path}`` of the ROS node
 to instrument, as ROSMonitoring's configuration lists it)::
 
@@ -32,6 +34,7 @@ import yaml
 from ...logic.floatsem import Tolerance, ToleranceError, parse_tolerance
 from ...traces.mapping import RuleError, TopicRule, load_rules
 from ...plan.yamlguard import read_yaml_text, safe_load_guarded
+from .skew import DEFAULT_SKEW_S, parse_skew
 
 DEFAULT_MAPPING = "backends/monitors/mapping.yaml"
 DEFAULT_HORIZON = 5.0
@@ -132,6 +135,11 @@ def load_mapping(root: Path, rel: str | None, horizon: Any = None, traces: Any =
             raise ConfigError(f"{rel or DEFAULT_MAPPING}:{_at(path, rel or DEFAULT_MAPPING, ('tolerance', *exc.key))}: "
                               f"error: {exc}") from None
     rules.tolerance = tol
+    sk = parse_skew(raw.get("skew", DEFAULT_SKEW_S))
+    if sk is None:
+        raise ConfigError(f"{rel or DEFAULT_MAPPING}:{_at(path, rel or DEFAULT_MAPPING, ('skew',))}: error: skew must "
+                          f"be a finite number of seconds >= 0, not {raw.get('skew')!r}")
+    rules.skew = sk
     ros = str(raw.get("ros_version", "ros2"))
     msg_dirs = raw.get("msg_dirs", ()) or ()
     if not isinstance(msg_dirs, (list, tuple)):
