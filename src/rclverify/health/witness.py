@@ -183,6 +183,30 @@ def _found(model: z3.ModelRef, enc: Any, ctx: z3.Context, tables: dict[str, tupl
     return _Found(ctx, funcs, consts)
 
 
+def _fixed_left(formulas: Sequence[z3.ExprRef], f: _Found) -> bool:
+    """Is a symbol the witness fixes still free in ``formulas`` after the
+    substitutions (a function not replaced by its table, a variable not by
+    its value: a declaration the translation did not map onto the
+    witness's)?  Then the query would search it too, and its answer would
+    not be an extension of the witness."""
+    fixed = {d.name() for d, _ in f.funcs} | {c.decl().name() for c, _ in f.consts}
+    seen: set[int] = set()
+    todo = list(formulas)
+    while todo:
+        e = todo.pop()
+        if e.get_id() in seen:
+            continue
+        seen.add(e.get_id())
+        if z3.is_quantifier(e):
+            todo.append(e.body())
+        elif z3.is_app(e):
+            d = e.decl()
+            if d.kind() == z3.Z3_OP_UNINTERPRETED and d.name() in fixed:
+                return True
+            todo.extend(e.children())
+    return False
+
+
 def extend(w: Witness, enc: Any, formulas: Sequence[z3.BoolRef], budget_ms: int = EXTEND_TIMEOUT_MS) -> Witness:
     """Does the model of ``w`` (a :func:`finite_witness` answer ``sat`` for
     formulas ``F`` over ``enc``) extend to a model of ``F`` and
@@ -205,6 +229,8 @@ def extend(w: Witness, enc: Any, formulas: Sequence[z3.BoolRef], budget_ms: int 
         new = [z3.substitute_funs(x, *f.funcs) for x in new]
     if f.consts:
         new = [z3.substitute(x, *f.consts) for x in new]
+    if _fixed_left(new, f):
+        return Witness("inconclusive")
     s = budgeted_solver(budget_ms, f.ctx)
     if s.check(*new) != z3.sat:
         return Witness("inconclusive")
