@@ -228,7 +228,7 @@ def _table_counterexample(enc: Encoder, formulas: Sequence[z3.BoolRef],
     def find() -> dict[str, str] | None:
         if not has_tables(enc):
             return None
-        w = finite_witness(enc, formulas, points, WITNESS_MS, deterministic=True)
+        w = finite_witness(enc, formulas, points, WITNESS_MS, deterministic=True, simplified=True)
         return w.model if w.status == "sat" else None
     return find
 

@@ -1,4 +1,8 @@
-"""Extending a finite-table witness (health/witness.py ``extend``) against brute force.
+"""Finite-table witnesses (health/witness.py) against brute force.
+
+A witness asked of the ``simplify``/``qe-light`` tactics first
+(``simplified=True``) meets the contract, evaluated here on its tables, and
+is found whenever the default strategy finds one.
 
 A witness of a contract's consistency fixes every function-typed input to a
 table and every variable to a value; ``extend`` asks whether a premise over
@@ -11,6 +15,7 @@ from __future__ import annotations
 
 import random
 import re
+from typing import Any
 
 import pytest
 
@@ -24,14 +29,26 @@ CONTEXT = "context { T : INTEGER --> INTEGER ; }\n"
 
 
 def _contract(rng: random.Random) -> tuple[str, int]:
+    return _parts(rng)[:2]  # type: ignore[return-value]
+
+
+def _parts(rng: random.Random) -> tuple[str, int, Any]:
+    """A random contract's text, the bound ``a`` of guarantee 1's premise, and
+    the contract as a Python predicate on ``(f table, x, y)``."""
     a, b, c = rng.randint(-3, 3), rng.randint(-2, 2), rng.randint(-2, 4)
+    x0, k, op, v = rng.randint(-2, 2), rng.randint(0, 3), rng.choice(['<', '>=', '==']), rng.randint(-3, 3)
     text = (CONTEXT + "node n { inputs( f : T, x : INTEGER ) outputs( y : INTEGER )\n"
-            f"  assume( in.x >= {rng.randint(-2, 2)} )\n"
+            f"  assume( in.x >= {x0} )\n"
             f"  guarantee( forall(i in INTEGER | 0 <= i and i <= 3 and in.f(i) >= {a} -> out.y >= in.f(i) + {b}) )\n"
             f"  guarantee( out.y <= {c} )\n"
-            f"  guarantee( in.f({rng.randint(0, 3)}) {rng.choice(['<', '>=', '=='])} {rng.randint(-3, 3)} )\n"
+            f"  guarantee( in.f({k}) {op} {v} )\n"
             "}\n")
-    return text, a
+    compare = {"<": lambda p, q: p < q, ">=": lambda p, q: p >= q, "==": lambda p, q: p == q}[op]
+
+    def holds(f: dict[int, int], x: int, y: int) -> bool:
+        return (x >= x0 and all(y >= f[i] + b for i in range(4) if f[i] >= a) and y <= c
+                and compare(f[k], v))
+    return text, a, holds
 
 
 def _table(text: str) -> dict[int, int]:
@@ -80,3 +97,22 @@ def test_a_witness_with_an_untabled_function_is_not_extended() -> None:
     premise = h.premise(1)
     assert premise is not None
     assert extend(w, h.enc, [x for _, x in premise[0]]).status == "inconclusive"
+
+
+@pytest.mark.parametrize("seed", range(30))
+def test_a_simplified_witness_meets_the_contract_and_loses_none(seed: int) -> None:
+    rng = random.Random(seed)
+    text, _, holds = _parts(rng)
+    checked = check([parse_text(text, "w.rcl")])
+    found = {}
+    for simplified in (False, True):
+        world.fresh()
+        h = _NodeHealth(checked, checked.nodes["n"], (), None, 2000)
+        found[simplified] = finite_witness(h.enc, [f for _, f in h.labelled()], points_for(None),
+                                           simplified=simplified)
+    if found[False].status == "sat":
+        assert found[True].status == "sat"
+    w = found[True]
+    if w.status == "sat":
+        assert w.model is not None
+        assert holds(_table(w.model["n.in.f"]), int(w.model["n.in.x"]), int(w.model["n.out.y"])), (text, w.model)
