@@ -76,6 +76,16 @@ LAYERS: list[tuple[str, tuple[str, ...]]] = [
     # and base classes), nodelets.py (ROS 1 nodelets), lifecycle.py (the
     # management interface of lifecycle nodes, for the grounding);
     # they import only ros/ modules, the standard library and tree-sitter.
+    # logic/evaluate.py is the direct evaluator's entry point over its parts by
+    # job (issue 44): evaluator.py (context, names, expressions), eval_values.py,
+    # eval_shapes.py, eval_search.py, eval_quant.py, eval_closures.py; each imports
+    # only the parts below it (values <- shapes <- search <- quant <- evaluator).
+    # logic/straightline.py (a formula compiled into straight-line Python for the
+    # monitors) builds on the evaluator's values; logic/judges.py puts it before
+    # floatsem.judge (issue 44).
+    # logic/encode.py likewise holds the Encoder over sorts.py (sorts, coercions,
+    # operators), symbols.py (the error, symbol names), translate.py (formulas
+    # node by node) and modeltext.py (Z3 values as RCL text).
     # logic/floatsem.py (issue 40): a formula judged on recorded values in
     # exact, IEEE-754 double or tolerant arithmetic, built on the evaluator
     # and Z3's concrete check beside it, with logic/floatsens.py (which

@@ -124,3 +124,100 @@ def test_mcap_and_ros1_bags_carry_the_same_events(tmp_path: Path, form: str) -> 
     bag = list(read_trace(path, MSG))
     assert [(e.topic, dict(e.fields)) for e in bag] == [(e.topic, dict(e.fields)) for e in log]
     assert [e.time - bag[0].time for e in bag] == pytest.approx([e.time for e in log])
+
+
+def _reference_jsonl(path: Path) -> tuple[list[tuple[object, ...]], str]:
+    """The log reader as it was before its fast path (issue 44): every line
+    through ``json.loads``; the events read and the error ('' when none)."""
+    import math
+    out: list[tuple[object, ...]] = []
+    index = 0
+    with path.open(encoding="utf-8") as fh:
+        for lineno, line in enumerate(fh, 1):
+            if not line.strip():
+                continue
+            try:
+                obj = json.loads(line)
+            except json.JSONDecodeError as exc:
+                return out, f"{path}:{lineno}:{exc.colno}: error: malformed JSON: {exc.msg}"
+            if not isinstance(obj, dict):
+                return out, f"{path}:{lineno}:1: error: expected a JSON object, got {type(obj).__name__}"
+            topic, time = obj.get("topic"), obj.get("time")
+            if not isinstance(topic, str):
+                return out, f"{path}:{lineno}:1: error: the event has no string 'topic'"
+            if isinstance(time, bool) or not isinstance(time, (int, float)):
+                return out, f"{path}:{lineno}:1: error: the event has no numeric 'time'"
+            if not math.isfinite(time):
+                return out, f"{path}:{lineno}:1: error: the event's 'time' is {time!r}, not a finite number"
+            fields = {k: v for k, v in obj.items() if k not in ("topic", "time")}
+            out.append((index, float(time), topic.lstrip("/"), fields, f"{path.name}:{lineno}", None))
+            index += 1
+    return out, ""
+
+
+LINES = ['{"topic": "r", "time": 1.5, "value": 3}', '{"topic": "/s", "time": 2, "a": {"b": [1, 2.5]}, "c": "x"}',
+         '{"time": 3.0, "topic": "r", "value": NaN}', '   {"topic": "r", "time": 4}', '{"topic": "r", "time": 5} ',
+         '{"topic": "r", "time": 6}\t', '{"topic": "r", "time": 7}\x0b', '{"topic": "r", "time": 8} x',
+         '{"topic": "r", "time": 9}, {"topic": "r", "time": 10}', '{"topic": "r", "time": [1',
+         '{"topic": "r", "time": true}', '{"topic": 5, "time": 1}', '{"topic": "r", "time": Infinity}',
+         '{"topic": "r"}', '[1, 2]', '"text"', '', '   ', '{', '{"topic": "r", "time": 1, "topic": "q"}',
+         '{"topic": "r", "time": 1e400}', '{"topic": "r", "time": 12, "v": "\\u00e9\\n"}', '\ufeff{"topic": "r", "time": 1}']
+
+
+def test_the_log_readers_fast_path_reads_and_reports_as_json_loads(tmp_path: Path) -> None:
+    """Random logs of good, odd and bad lines (whitespace around an object,
+    JSON's whitespace and other whitespace after it, two objects on a line,
+    a truncated object, non-objects, NaN and Infinity, a BOM, CRLF ends):
+    the same events and the same located error as reading every line with
+    ``json.loads``."""
+    from hypothesis import HealthCheck, given, settings
+    from hypothesis import strategies as st
+
+    @settings(max_examples=150, deadline=None, database=None, derandomize=True,
+              suppress_health_check=list(HealthCheck))
+    @given(st.lists(st.sampled_from(LINES), max_size=8), st.sampled_from(["\n", "\r\n"]), st.booleans())
+    def check(lines: list[str], end: str, last_newline: bool) -> None:
+        p = tmp_path / "run.jsonl"
+        p.write_bytes((end.join(lines) + (end if last_newline else "")).encode("utf-8"))
+        want, error = _reference_jsonl(p)
+        got: list[tuple[object, ...]] = []
+        try:
+            for ev in read_trace(p):
+                got.append((ev.index, ev.time, ev.topic, dict(ev.fields), ev.where, ev.stamp))
+            said = ""
+        except TraceError as exc:
+            said = str(exc)
+        assert (got, said) == (want, error)
+    check()
+
+
+def test_the_scalar_mapper_maps_as_map_value() -> None:
+    """``value_mapper`` (the monitors' per-topic mapper, issue 44) against
+    ``map_value`` on random messages: the same value, or the same error."""
+    from fractions import Fraction
+
+    from hypothesis import HealthCheck, given, settings
+    from hypothesis import strategies as st
+
+    from rclverify.traces.mapping import value_mapper
+    scalar = st.sampled_from([1, 0, -2, 2.5, float("nan"), float("inf"), True, "green", "x", None, Fraction(1, 3),
+                              [1.5, 2], {"x": 4.0, "y": "red"}])
+    messages = st.dictionaries(st.sampled_from(["data", "a", "b", "a.x", "level"]), scalar, max_size=4)
+    rules = st.sampled_from([TopicRule(), TopicRule(fields=("data",)), TopicRule(fields=("a", "data")),
+                             TopicRule(fields=("a.x",)), TopicRule(fields=("b[1]",)), TopicRule(fields=("a[0]",))])
+    types = st.sampled_from([T.Scalar("REAL"), T.EnumT("Band", ("green", "red")), T.Scalar("NATURAL")])
+
+    def outcome(f: object) -> object:
+        try:
+            return ("value", f())  # type: ignore[operator]
+        except MappingError as exc:
+            return ("error", str(exc))
+
+    @settings(max_examples=300, deadline=None, database=None, derandomize=True,
+              suppress_health_check=list(HealthCheck))
+    @given(types, rules, messages)
+    def check(typ: T.Type, rule: TopicRule, fields: dict[str, object]) -> None:
+        fast = outcome(lambda: value_mapper(typ, rule)(fields, None))
+        slow = outcome(lambda: map_value(typ, fields, rule, None))
+        assert repr(fast) == repr(slow)  # repr: NaN is not equal to itself
+    check()

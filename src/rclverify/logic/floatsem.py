@@ -68,7 +68,8 @@ from ..rcl import types as T
 from ..rcl.types import Checked, CheckedNode
 from .concrete import check_concrete
 from .encode import EncodingError
-from .evaluate import MAX_RANGE, Evaluator, Undecided, _integer_range, _unused, evaluate, why_undecided
+from .eval_shapes import MAX_RANGE, _integer_range, _unused
+from .evaluate import Evaluator, Undecided, evaluate, why_undecided
 from .floatsens import float_sensitive
 
 #: The semantics a verdict may be decided in, in the order they are tried.

@@ -18,7 +18,7 @@ which gives ``out`` (the file's record), ``scope`` (:mod:`cpp_values`) and
 """
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from . import cpp_helpers, treesitter
 from .cpp_scope import namespaces_of
@@ -43,8 +43,9 @@ class MemberReader:
     out: dict[str, Any]
     scope: Any
 
-    def src(self, n: Any) -> Src:  # pragma: no cover - provided by the reader
-        raise NotImplementedError
+    if TYPE_CHECKING:  # provided by the class that mixes this one in
+        def src(self, n: Any) -> Src:
+            ...
 
     def member(self, n: Any) -> None:
         """A field declaration ``n`` of a class body: a helper held by value is recorded."""

@@ -93,12 +93,15 @@ def check_uri(uri: str) -> None:
         raise MasterError(f"{uri!r} is not a master URI (http://HOST:PORT)")
 
 
-def within(seconds: float, what: str, fn: Callable[[], Any]) -> Any:
-    """``fn()`` run in a daemon thread, waited for at most ``seconds``:
-    its value, or its exception re-raised; :class:`MasterError` naming
-    ``what`` and the limit when it has not finished in time (the thread is
-    left to end on its own socket timeout; being a daemon it never keeps
-    the process alive)."""
+def in_thread(fn: Callable[[], Any], seconds: float, name: str,
+              stop: threading.Event | None = None) -> tuple[str, Any]:
+    """``fn()`` run in a daemon thread named ``name``, waited for at most
+    ``seconds`` (in steps of 50 ms when a ``stop`` event may end the wait
+    early): ``("value", v)``, ``("error", exc)``, ``("timeout", None)`` or
+    ``("stopped", None)``.  A thread still running is left to end on its own
+    (a daemon: it never keeps the process alive).  The one way every call
+    to a ROS 1 master is bounded (``within``, the live monitor's
+    registration and shutdown)."""
     box: dict[str, Any] = {}
 
     def run() -> None:
@@ -107,14 +110,30 @@ def within(seconds: float, what: str, fn: Callable[[], Any]) -> Any:
         except BaseException as exc:  # noqa: BLE001 - handed to the caller
             box["error"] = exc
 
-    t = threading.Thread(target=run, name=f"rclverify-{what[:40]}", daemon=True)
+    t = threading.Thread(target=run, name=name, daemon=True)
     t.start()
-    t.join(seconds)
+    if stop is None:
+        t.join(seconds)
+    else:
+        deadline = time.monotonic() + seconds
+        while t.is_alive() and not stop.is_set() and time.monotonic() <= deadline:
+            t.join(0.05)
     if t.is_alive():
+        return ("stopped", None) if stop is not None and stop.is_set() else ("timeout", None)
+    return ("error", box["error"]) if "error" in box else ("value", box.get("value"))
+
+
+def within(seconds: float, what: str, fn: Callable[[], Any]) -> Any:
+    """``fn()`` run in a daemon thread, waited for at most ``seconds``
+    (:func:`in_thread`): its value, or its exception re-raised;
+    :class:`MasterError` naming ``what`` and the limit when it has not
+    finished in time."""
+    state, got = in_thread(fn, seconds, f"rclverify-{what[:40]}")
+    if state == "timeout":
         raise MasterError(f"{what}: no answer within the time limit of {seconds:g} s")
-    if "error" in box:
-        raise box["error"]
-    return box.get("value")
+    if state == "error":
+        raise got
+    return got
 
 
 def call(uri: str, method: str, *args: Any, timeout: float = MASTER_TIMEOUT_S) -> Any:

@@ -10,7 +10,7 @@ class TraceError(Exception):
     log, ``file: message N (offset B): error: ...`` for a bag."""
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, init=False)
 class Event:
     """A message as a monitor sees it.
 
@@ -32,6 +32,14 @@ class Event:
     fields: Mapping[str, Any]
     where: str
     stamp: float | None = None
+
+    def __init__(self, index: int, time: float, topic: str, fields: Mapping[str, Any], where: str,
+                 stamp: float | None = None) -> None:
+        # Frozen: each attribute is set once, here, in the instance's dict (the dataclass's own
+        # __init__ goes through object.__setattr__ per field, twice as slow, and a run has
+        # millions of events: issue 44)
+        d = self.__dict__
+        d["index"], d["time"], d["topic"], d["fields"], d["where"], d["stamp"] = index, time, topic, fields, where, stamp
 
     @property
     def stamped(self) -> float:

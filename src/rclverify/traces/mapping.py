@@ -206,6 +206,44 @@ def map_value(typ: T.Type, fields: Mapping[str, Any], rule: TopicRule, previous:
     raise MappingError(f"no mapping rule for a variable of type {typ}")
 
 
+_NUMBER = (int, float, Fraction)
+
+
+def value_mapper(typ: T.Type, rule: TopicRule) -> Any:
+    """:func:`map_value` for one variable's type and rule, made once:
+    ``mapper(fields, previous) -> value`` (raises :class:`MappingError`).
+
+    For a ``REAL`` or an enumeration it is the scalar rule's loop without
+    the general machinery (the monitors call it for every message): the
+    first field of a matching type, a non-finite float met before it an
+    error, the same values and the same messages as :func:`map_value`; for
+    any other type it is :func:`map_value` itself."""
+    real = isinstance(typ, T.Scalar) and typ.name == "REAL"
+    if not (real or isinstance(typ, T.EnumT)):
+        return lambda fields, previous: map_value(typ, fields, rule, previous)
+    names = rule.fields
+    isfinite = math.isfinite
+
+    def mapper(fields: Mapping[str, Any], previous: Any) -> Any:
+        if names:
+            try:  # the named fields as top-level keys (field_value reads such a key first)
+                items: Any = [(f, fields[f]) for f in names]
+            except (KeyError, TypeError, IndexError):  # a path, a missing field: the general reading and its errors
+                items = field_items(fields, rule)
+        else:
+            items = fields.items()
+        for name, v in items:
+            if isinstance(v, float) and not isfinite(v):
+                raise MappingError(f"field {name!r} is {v!r}, not a finite number, for the value of type {typ}")
+            if real:
+                if isinstance(v, _NUMBER) and not isinstance(v, bool):
+                    return v
+            elif isinstance(v, str):
+                return v
+        raise MappingError(f"no field left for the value of type {typ}")
+    return mapper
+
+
 def initial_value(typ: T.Type, rule: TopicRule) -> Any:
     """The value before any message: an empty table for a function, else ``None`` (unknown)."""
     if isinstance(typ, T.FuncT):

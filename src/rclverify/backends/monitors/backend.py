@@ -18,7 +18,7 @@ from __future__ import annotations
 import hashlib
 from importlib.metadata import PackageNotFoundError, version
 from pathlib import Path
-from typing import Any, Mapping
+from typing import Any, Callable, Iterable, Iterator, Mapping
 
 import jinja2
 
@@ -31,8 +31,8 @@ from ...traces.bag import custom_types
 from ..base import NodeTarget, Stopwatch, make_evidence
 from .check import NodeResult, check_trace
 from .config import ConfigError, MonitorConfig, load_mapping
-from .deadlines import check_deadlines, deadline_status, has_deadlines
-from .periods import has_periods, with_periods
+from .deadlines import DeadlineMonitor, DeadlineResult, deadline_status, has_deadlines
+from .periods import PeriodMonitor, has_periods, with_periods
 from .rml import Spec, rml_id, translate
 
 NAME = "monitors"
@@ -201,10 +201,17 @@ class MonitorsBackend:
         except Exception as exc:
             return evidence("error", f"the plan entry no longer loads: {exc}")
         trace = str(obligation.data.get("trace", ""))
+        # one read of the run feeds the untimed check, the deadlines and the periods
+        beside = _Beside()
+        if has_deadlines(target.node):
+            beside.add("deadlines", lambda: DeadlineMonitor(target.checked, target.node, cfg.rules,
+                                                            horizon=cfg.horizon, tolerance=cfg.tolerance))
+        if has_periods(target.node):  # periodic outputs on the same run (periods.py)
+            beside.add("periods", lambda: PeriodMonitor(target.node))
         try:
-            events, results = check_trace(target.checked, [target.node],
-                                          read_trace(target.root / trace, [target.root / d for d in cfg.msg_dirs]),
-                                          cfg.rules, cfg.horizon, tolerance=cfg.tolerance)
+            events, results = check_trace(target.checked, [target.node], beside.tap(
+                read_trace(target.root / trace, [target.root / d for d in cfg.msg_dirs])),
+                cfg.rules, cfg.horizon, tolerance=cfg.tolerance)
         except TraceError as exc:
             return evidence("error", f"the trace could not be read: {exc}", log=str(exc))
         except Exception as exc:  # a recorded run is user input: whatever the checker meets is this record's error
@@ -214,34 +221,69 @@ class MonitorsBackend:
                                      cfg.tolerance)
         status, explanation = verdict_status(res, trace)
         extra: dict[str, Any] = {}
-        if has_deadlines(target.node):
-            try:
-                status, explanation, extra = with_deadlines(target, cfg, trace, status, explanation)
-            except Exception as exc:  # as above: the record's error, never a crash
-                return evidence("error", f"the deadlines could not be checked: {type(exc).__name__}: {exc}",
-                                log=str(exc))
-        if has_periods(target.node):  # periodic outputs on the same run (periods.py)
-            try:
-                status, explanation, more = with_periods(
-                    target.node, read_trace(target.root / trace, [target.root / d for d in cfg.msg_dirs]), trace,
-                    status, explanation)
-            except Exception as exc:  # as above: the record's error, never a crash
-                return evidence("error", f"the periods could not be checked: {type(exc).__name__}: {exc}",
-                                log=str(exc))
+        finished = beside.finish()
+        for name in ("deadlines", "periods"):  # as above: the record's error, never a crash
+            err = beside.errors.get(name)
+            if err is not None:
+                return evidence("error", f"the {name} could not be checked: {type(err).__name__}: {err}",
+                                log=str(err))
+        if "deadlines" in finished:
+            status, explanation, extra = with_deadlines(target, finished["deadlines"], trace, status, explanation)
+        if "periods" in finished:
+            status, explanation, more = with_periods(finished["periods"], trace, status, explanation)
             extra.update(more)
         return evidence(status, explanation, details={"monitoring": details, **extra},
                         artifacts=(str(obligation.data.get("rml", "")), str(obligation.data.get("config", ""))),
                         log=summary_line(res))
 
 
-def with_deadlines(target: NodeTarget, cfg: MonitorConfig, trace: str, status: str,
+class _Beside:
+    """The deadline and period monitors of a node fed from the untimed
+    check's read of a run (:meth:`tap`), so a run is read once.  An error of
+    one of them is kept under its name (its evidence's error, as when it read
+    the run itself) and that monitor is fed no more; the read goes on."""
+
+    def __init__(self) -> None:
+        self.monitors: dict[str, Any] = {}
+        self.errors: dict[str, Exception] = {}
+
+    def add(self, name: str, make: Callable[[], Any]) -> None:
+        """The monitor ``make()`` makes, fed under ``name`` (its error kept)."""
+        try:
+            self.monitors[name] = make()
+        except Exception as exc:  # noqa: BLE001 - reported as that check's error
+            self.errors[name] = exc
+
+    def tap(self, events: Iterable[Any]) -> Iterator[Any]:
+        """``events`` unchanged, each fed to the monitors first."""
+        if not self.monitors:
+            yield from events
+            return
+        for ev in events:
+            for name, m in list(self.monitors.items()):
+                try:
+                    m.feed(ev)
+                except Exception as exc:  # noqa: BLE001 - reported as that check's error
+                    self.errors[name] = exc
+                    del self.monitors[name]
+            yield ev
+
+    def finish(self) -> dict[str, Any]:
+        """Each monitor's result (after the run), by name; a failing finish is an error too."""
+        out: dict[str, Any] = {}
+        for name, m in self.monitors.items():
+            try:
+                out[name] = m.finish()
+            except Exception as exc:  # noqa: BLE001
+                self.errors[name] = exc
+        return out
+
+
+def with_deadlines(target: NodeTarget, res: DeadlineResult, trace: str, status: str,
                    explanation: str) -> tuple[str, str, dict[str, Any]]:
-    """The untimed verdict combined with the node's deadline verdicts on the
-    same trace (:mod:`.deadlines`): the worse status wins; returns
+    """The untimed verdict combined with the node's deadline verdicts ``res``
+    on the same trace (:mod:`.deadlines`): the worse status wins; returns
     ``(status, explanation, {"deadlines": ...})``."""
-    res = check_deadlines(target.checked, [target.node],
-                          read_trace(target.root / trace, [target.root / d for d in cfg.msg_dirs]), cfg.rules,
-                          horizon=cfg.horizon, tolerance=cfg.tolerance)[0]
     dstatus, dexpl = deadline_status(res, trace)
     rank = {"discharged": 0, "pending": 1, "inconclusive": 2, "failed": 3}
     # An untimed check that saw nothing (pending) leaves the verdict to the deadline monitor only when every

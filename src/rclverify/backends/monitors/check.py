@@ -51,12 +51,13 @@ from dataclasses import dataclass, field
 from typing import Any, Callable, Iterable, Mapping
 
 from ...logic.floatsem import Judgement, Tolerance, judge
+from ...logic.judges import FormulaJudge
 from ...rcl import ast
 from ...rcl.printer import expr_to_rcl
 from ...rcl.types import Checked, CheckedNode
 from ...system.services import peers
 from ...traces.events import Event
-from ...traces.mapping import MappingError, TopicRule, initial_value, map_value
+from ...traces.mapping import MappingError, TopicRule, initial_value, value_mapper
 from ...values import render
 
 VERDICTS = ("satisfied", "violated", "open", "assumption violated", "inconclusive", "incomplete input")
@@ -66,6 +67,8 @@ VERDICTS = ("satisfied", "violated", "open", "assumption violated", "inconclusiv
 LINK_TOPICS = {"service": ("request", "response"), "action": ("goal", "feedback", "result")}
 #: How far a semantics is from exact arithmetic (the weakest one a verdict rests on is shown).
 _WEAK = {"exact": 0, "double": 1, "tolerance": 2}
+_NO_RULE = TopicRule()  # the rule of a topic the mapping does not name
+_NEVER = float("inf")
 
 
 def _reads(e: Any, out: set[str]) -> None:
@@ -132,7 +135,7 @@ class Verdict:
                 "semantics": self.semantics}
 
 
-@dataclass
+@dataclass(slots=True)
 class _Group:
     """Pending input events with equal inputs and equal answers so far: their
     events, the event outputs published since them (``outs``: only those may
@@ -174,6 +177,7 @@ class NodeResult:
     ``unowed`` the input events that met the assumption and that no
     guarantee answers (each is ``triggered by`` another input): no verdict,
     nothing was checked for them.
+    ``evaluation`` how each formula was evaluated (debug; not in :meth:`to_json`).
     """
 
     node: str
@@ -186,6 +190,10 @@ class NodeResult:
     semantics: dict[str, int] = field(default_factory=lambda: {"exact": 0, "double": 0, "tolerance": 0})
     first_inexact: dict[str, Any] | None = None
     unowed: int = 0
+    #: a debug field, in no evidence record: how each formula was evaluated
+    #: (``assumption 1`` / ``guarantee 2`` -> ``compiled``, or why the
+    #: straight-line code left it to the evaluator; logic/judges.py)
+    evaluation: dict[str, str] = field(default_factory=dict, compare=False)
 
     @property
     def assumption(self) -> dict[str, Any]:
@@ -280,6 +288,10 @@ class NodeMonitor:
                 if lk.kind == "action":
                     self._parts[(topic, key)] = suffix
         self.has_inputs = any(i for vs in self.topics.values() for _, _, i in vs)
+        #: per topic, what its message sets, made once: (variable, its mapper, input?, actionlib part)
+        self._feeds = {topic: [(key, value_mapper(typ, rules.get(topic, _NO_RULE)), inp,
+                                self._parts.get((topic, key), "")) for key, typ, inp in vs]
+                       for topic, vs in self.topics.items()}
         self.values: dict[str, Any] = {}
         for topic, vs in self.topics.items():
             for key, typ, _ in vs:
@@ -322,13 +334,25 @@ class NodeMonitor:
         self.pending: dict[Any, _Group] = {}
         self._due = float("inf")  # the earliest horizon among the pending obligations (s)
         self._cache: dict[tuple[Any, tuple[Any, ...]], Judgement] = {}
+        # each formula compiled once (logic/judges.py): straight-line code decides what it can, judge() the rest
+        self._assumed = [(("A", j), f) for j, f in enumerate(self.assumption)]
+        self._guaranteed = list(enumerate(self.guarantees, 1))
+        self._judges = {k: FormulaJudge(f, checked, node, self.tolerance) for k, f in self._assumed + self._guaranteed}
+        self.result.evaluation = {(f"assumption {k[1] + 1}" if isinstance(k, tuple) else f"guarantee {k}"):
+                                  (j.fallback or "compiled") for k, j in self._judges.items()}
+        self._in_keys = self._keys["in."]
 
     # -- evaluation --------------------------------------------------------------
     def _judge(self, k: Any, formula: ast.Expr, values: Mapping[str, Any]) -> Judgement:
         """The judgement of guarantee ``k`` (``("A", j)``: assumption ``j``) on
         ``values`` (:func:`~rclverify.logic.floatsem.judge`: exact, then the
-        node's double arithmetic, then the tolerance); remembered per
-        (formula, values of the variables it reads)."""
+        node's double arithmetic, then the tolerance).  The formula's compiled
+        judge answers first where it can alone (:class:`FormulaJudge`); what
+        it leaves to ``judge`` is remembered per (formula, values of the
+        variables it reads)."""
+        hit = self._judges[k].quick(values)
+        if hit is not None:
+            return hit
         ck = (k, tuple([values.get(d) for d in self._deps[k]]))
         hit = self._cache.get(ck)
         if hit is not None:
@@ -339,11 +363,6 @@ class NodeMonitor:
                 self._cache.clear()
             self._cache[ck] = j
         return j
-
-    def _truth(self, k: Any, formula: ast.Expr, values: Mapping[str, Any]) -> tuple[bool | None, str]:
-        """(truth, reason) of :meth:`_judge`."""
-        j = self._judge(k, formula, values)
-        return j.truth, j.reason
 
 
     def _rendered(self, values: Mapping[str, Any]) -> dict[str, str]:
@@ -360,11 +379,6 @@ class NodeMonitor:
         text = render(v)
         self._renders[id(v)] = (v, text)
         return text
-
-    def _observed(self, prefix: str) -> dict[str, Any]:
-        """The values with ``prefix`` observed so far (an unobserved variable has no entry)."""
-        values = self.values
-        return {k: values[k] for k in self._keys[prefix] if values[k] is not None}
 
     def _verdict(self, verdict: str, ev: Event, guarantee: int = 0, values: Mapping[str, str] | None = None,
                  reason: str = "", n: int = 1, semantics: str = "") -> None:
@@ -383,29 +397,32 @@ class NodeMonitor:
         past their horizon); only events on the node's topics change its state.
         An event's outputs answer the obligations opened before it, then its
         inputs open a new one (an answer comes after its question)."""
-        self.advance(ev.time)
-        vs = self.topics.get(ev.topic)
+        t = ev.time  # the clock first (advance(), inline: this runs for every event)
+        if t > self.now:
+            self.now = t
+        if self.pending and self.now > self._due:
+            self._expire(self.now)
+        vs = self._feeds.get(ev.topic)
         if vs is None:
             return
         self.result.events += 1
         is_input = False
         changed: list[str] = []
         trig: set[str] = set()
-        for key, typ, inp in vs:
+        values = self.values
+        for key, mapper, inp, part in vs:
             fields: Any = ev.fields
-            part = self._parts.get((ev.topic, key)) if self._parts else None
             try:
                 if part:
                     fields = fields.get(part)
                     if not isinstance(fields, Mapping):
                         raise MappingError(f"the actionlib message has no {part!r} part")
-                self.values[key] = map_value(typ, fields, self.rules.get(ev.topic, TopicRule()),
-                                             self.values.get(key))
+                values[key] = mapper(fields, values.get(key))
             except MappingError as exc:
                 self._note_inconclusive(ev, 0, f"{key}: {exc}")
                 return
-            is_input = is_input or inp
             if inp:
+                is_input = True
                 trig.add(key)
             else:
                 changed.append(key)
@@ -424,14 +441,16 @@ class NodeMonitor:
             g.answered = True
             if not g.outs and g.superseded is None:
                 g.superseded = ev
-        inputs = self._observed("in.")
-        missing = [k for k in self.needed_inputs if k not in inputs]
-        if missing:
-            self._verdict("incomplete input", ev, reason="no value yet for " + ", ".join(missing))
-            return
+        values = self.values
+        inputs = {k: values[k] for k in self._in_keys if values[k] is not None}
+        if len(inputs) < len(self._in_keys):
+            missing = [k for k in self.needed_inputs if k not in inputs]
+            if missing:
+                self._verdict("incomplete input", ev, reason="no value yet for " + ", ".join(missing))
+                return
         accepted = "exact"
-        for j, formula in enumerate(self.assumption):
-            judged = self._judge(("A", j), formula, inputs)
+        for aj, formula in self._assumed:
+            judged = self._judge(aj, formula, inputs)
             ok, reason = judged.truth, judged.reason
             if ok is False:
                 mentioned: set[str] = set()
@@ -453,7 +472,7 @@ class NodeMonitor:
             if ok is None:
                 self._note_inconclusive(ev, 0, f"assumption undecided: {reason}")
                 return
-            if _WEAK.get(judged.semantics, 0) > _WEAK[accepted]:
+            if judged.semantics != "exact" and _WEAK.get(judged.semantics, 0) > _WEAK[accepted]:
                 accepted = judged.semantics
                 self._note_inexact(ev, judged, f"assumption {expr_to_rcl(formula)}", inputs)
         self.result.accepted += 1
@@ -472,27 +491,39 @@ class NodeMonitor:
         elif _WEAK[accepted] > _WEAK[group.accepted]:
             group.accepted = accepted
         group.events.append(ev)
-        group.ref = max(group.ref, ev.stamped)
+        stamped = ev.stamped
+        if stamped > group.ref:
+            group.ref = stamped
         group.superseded = None  # the same question asked again: the answer to come answers both
-        self._due = min(self._due, ev.time + self.horizon)
+        due = ev.time + self.horizon
+        if due < self._due:
+            self._due = due
         if len(group.events) == 1:
             done: list[Any] = []
-            self._evaluate(key, group, ev, self._state(), done)
+            self._evaluate(key, group, ev, self._state() if self._state_outs else {}, done)
             for k in done:
                 del self.pending[k]
+            if not self.pending:
+                self._due = _NEVER  # no obligation left: no horizon to watch
 
     def _output(self, ev: Event, changed: list[str]) -> None:
         """Outputs ``changed`` were just set by ``ev``: they answer every pending
         obligation whose question is not stamped after ``ev``; a state output's
         new value is seen by every obligation."""
         values = self.values
-        fresh = {k: values[k] for k in changed if k not in self._state_set and values[k] is not None}
-        state_changed = any(k in self._state_set for k in changed)
-        state = self._state()
+        states = self._state_set
+        if states:
+            fresh = {k: values[k] for k in changed if k not in states and values[k] is not None}
+            state_changed = any(k in states for k in changed)
+            state = self._state()
+        else:
+            fresh = {k: values[k] for k in changed if values[k] is not None}
+            state_changed, state = False, {}
         done: list[Any] = []
         rekey = False
+        stamped = ev.stamped
         for key, g in self.pending.items():
-            answered = bool(fresh) and ev.stamped >= g.ref
+            answered = bool(fresh) and stamped >= g.ref
             if answered:
                 g.outs.update(fresh)
                 rekey = True
@@ -500,21 +531,26 @@ class NodeMonitor:
                 self._evaluate(key, g, ev, state, done)
         for key in done:
             del self.pending[key]
-        if rekey:
+        if not self.pending:
+            self._due = _NEVER  # no obligation left: no horizon to watch
+        elif rekey:
             self._rekey()
 
     def _evaluate(self, key: Any, g: _Group, ev: Event, state: Mapping[str, Any], done: list[Any]) -> None:
         """Evaluate group ``g``'s guarantees on its inputs, the state outputs and
         the outputs that answered it; satisfied -> verdicts and ``key`` in ``done``."""
-        values = dict(g.inputs)
-        values.update(state)
-        values.update(g.outs)
+        if state or g.outs:
+            values = dict(g.inputs)
+            values.update(state)
+            values.update(g.outs)
+        else:  # only read below: no copy needed
+            values = g.inputs
         failed: int | None = None
         undecided = ""
         weakest = g.accepted
         inexact: list[tuple[int, Judgement]] = []
         failed_semantics = ""
-        for k, formula in enumerate(self.guarantees, 1):
+        for k, formula in self._guaranteed:
             if k in self._trigger and self._trigger[k] not in g.triggers:
                 continue  # triggered by another input: no answer to these events is owed (docs/monitors.md)
             judged = self._judge(k, formula, values)
@@ -613,50 +649,42 @@ class NodeMonitor:
             self._verdict("inconclusive", trigger, guarantee=g.last[1], reason=reason)
             return
         first: dict[str, Any]
+
+        def on_answer(out: Event, k: int, outputs: Mapping[str, Any], reason: str, semantics: str = "") -> dict[str, Any]:
+            return {"event": out.index, "time": out.time, "where": out.where, "guarantee": k,
+                    "formula": self._texts[k], "trigger": trigger.index, "trigger_time": trigger.time,
+                    "trigger_where": trigger.where, "values": self._rendered({**g.inputs, **outputs}),
+                    "reason": reason, **({"semantics": semantics} if semantics else {})}
         if g.last is None and g.waiting is not None:
-            # a partial answer (some outputs published after the input, another never): the guarantee cannot be
-            # judged, which is not the same as false. An output that keeps its value without being published
-            # again (a latched topic) is declared `state: true` in the mapping (docs/monitors.md)
             out, k, why, outs = g.waiting
-            if self._false_whatever_missing(k, {**g.inputs, **outs}):
-                # no value of the missing output could make it hold: false on what was answered
-                first = {
-                    "event": out.index, "time": out.time, "where": out.where, "guarantee": k,
-                    "formula": self._texts[k], "trigger": trigger.index,
-                    "trigger_time": trigger.time, "trigger_where": trigger.where,
-                    "values": self._rendered({**g.inputs, **outs}),
-                    "reason": f"guarantee {k} is false on the outputs published after the input at {trigger.where} "
-                              f"(the last at {out.where}) whatever the value of the outputs not published after "
-                              f"it ({why})"}
-                if self.result.first_violation is None:
-                    self.result.first_violation = first
-                self._verdict("violated", trigger, guarantee=k, values=first["values"], reason=first["reason"])
+            if not self._false_whatever_missing(k, {**g.inputs, **outs}):
+                # a partial answer (some outputs published after the input, another never): the guarantee cannot
+                # be judged, which is not the same as false. An output that keeps its value without being published
+                # again (a latched topic) is declared `state: true` in the mapping (docs/monitors.md)
+                missing = why.split(" ", 3)[-1].split(",")[0] if why.startswith("no value for ") else why
+                reason = (f"guarantee {k} is undecided on the outputs published after the input at {trigger.where} "
+                          f"(the last at {out.where}): {why}; nothing published within {self.horizon} s completed "
+                          f"the answer (if {missing} keeps its value between messages, declare its topic "
+                          "`state: true` in the mapping)")
+                self._first_inconclusive(trigger, reason)
+                self._verdict("inconclusive", trigger, guarantee=k, values=self._rendered({**g.inputs, **outs}),
+                              reason=reason)
                 return
-            missing = why.split(" ", 3)[-1].split(",")[0] if why.startswith("no value for ") else why
-            reason = (f"guarantee {k} is undecided on the outputs published after the input at {trigger.where} "
-                      f"(the last at {out.where}): {why}; nothing published within {self.horizon} s completed "
-                      f"the answer (if {missing} keeps its value between messages, declare its topic "
-                      "`state: true` in the mapping)")
-            self._first_inconclusive(trigger, reason)
-            self._verdict("inconclusive", trigger, guarantee=k, values=self._rendered({**g.inputs, **outs}),
-                          reason=reason)
-            return
-        if g.last is None:
+            # no value of the missing outputs could make it hold: false on what was answered
+            first = on_answer(out, k, outs, f"guarantee {k} is false on the outputs published after the input at "
+                              f"{trigger.where} (the last at {out.where}) whatever the value of the outputs not "
+                              f"published after it ({why})")
+        elif g.last is None:
             first = {
                 "event": trigger.index, "time": trigger.time, "where": trigger.where, "guarantee": None,
                 "formula": "", "values": self._rendered(g.inputs),
                 "reason": f"no output satisfying the guarantees within {self.horizon} s of the input event"}
         else:
             out, k, outputs = g.last
-            first = {
-                "event": out.index, "time": out.time, "where": out.where, "guarantee": k,
-                "formula": self._texts[k], "trigger": trigger.index,
-                "trigger_time": trigger.time, "trigger_where": trigger.where,
-                "values": self._rendered({**g.inputs, **outputs}),
-                "reason": f"guarantee {k} is false on the output at {out.where} answering the input at "
-                          f"{trigger.where}{_in_all(g.last_semantics)}, and no output within {self.horizon} s "
-                          f"satisfied it",
-                "semantics": g.last_semantics}
+            first = on_answer(out, k, outputs, f"guarantee {k} is false on the output at {out.where} answering the "
+                              f"input at {trigger.where}{_in_all(g.last_semantics)}, and no output within "
+                              f"{self.horizon} s satisfied it", g.last_semantics)
+            first.setdefault("semantics", g.last_semantics)
         if self.result.first_violation is None:
             self.result.first_violation = first
         self._verdict("violated", trigger, guarantee=first["guarantee"] or 0, values=first["values"],
@@ -735,13 +763,23 @@ def check_trace(checked: Checked, nodes: Iterable[CheckedNode], events: Iterable
     monitors = [NodeMonitor(checked, n, rules, horizon, on_verdict, tolerance) for n in nodes]
     count = 0
     last_time = 0.0
-    for ev in events:
-        count += 1
-        last_time = ev.time
-        for m in monitors:  # the clock first (as a live monitor's timer would), then the message
-            m.advance(ev.time)
-        for m in monitors:
-            m.feed(ev)
+    if len(monitors) == 1:  # feed() moves the clock first itself
+        feed = monitors[0].feed
+        for ev in events:
+            count += 1
+            last_time = ev.time
+            feed(ev)
+    else:
+        for ev in events:
+            count += 1
+            last_time = ev.time
+            for m in monitors:  # every clock first (as a live monitor's timer would), then the message
+                m.advance(ev.time)
+            for m in monitors:
+                m.feed(ev)
     for m in monitors:
         m.advance(max(last_time, end) if end is not None else last_time)
     return count, [m.finish() for m in monitors]
+
+
+__all__ = ["LINK_TOPICS", "VERDICTS", "NodeMonitor", "NodeResult", "Verdict", "check_trace", "link_of", "producers"]

@@ -66,9 +66,9 @@ def monitor_command(args: argparse.Namespace, checked: Checked) -> int:
                     m.feed(ev)
                 yield ev
         try:
-            events, results = check_trace(checked, list(checked.nodes.values()),
-                                          tap(read_trace(path, [root / d for d in cfg.msg_dirs], streams=True,
-                                                         on_warning=lambda w: print(w, file=sys.stderr))),
+            run = read_trace(path, [root / d for d in cfg.msg_dirs], streams=True,
+                             on_warning=lambda w: print(w, file=sys.stderr))
+            events, results = check_trace(checked, list(checked.nodes.values()), tap(run) if dmons else run,
                                           cfg.rules, cfg.horizon, tolerance=cfg.tolerance)
             dres = [m.finish() for m in dmons]
         except TraceError as exc:
@@ -85,6 +85,7 @@ def monitor_command(args: argparse.Namespace, checked: Checked) -> int:
             entry = {"node": res.node, "status": status, "explanation": explanation,
                      **monitoring_details(res, trace, events, "", tool_versions(), cfg.horizon, cfg.tolerance)}
             entry.pop("sha256")
+            entry["evaluation"] = dict(res.evaluation)  # debug: which formulas ran as compiled code
             report.append(entry)
             if not args.json:
                 print(f"{trace}: {summary_line(res)}")

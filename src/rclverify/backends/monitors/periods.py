@@ -63,35 +63,53 @@ def has_periods(node: CheckedNode) -> bool:
     return any(period_seconds(p) is not None for p in node.node.periodic)
 
 
-def check_periods(node: CheckedNode, events: Iterable[Event]) -> PeriodResult:
-    """The periodic outputs of ``node`` (periods in time) over a recorded
-    run's ``events``, in order (module docstring)."""
-    res = PeriodResult(node.name)
-    for p in node.node.periodic:
-        s = period_seconds(p)
-        if s is not None:
-            res.periods[f"out.{p.output.name}"] = float(s)
-    topics: dict[str, list[str]] = {}
-    for topic, keys in topic_bindings(node).items():
-        outs = [k for k, _ in keys if k in res.periods]
-        if outs:
-            topics[topic] = outs
-    last: dict[str, tuple[float, str]] = {}
-    for ev in events:
+class PeriodMonitor:
+    """The periodic outputs of ``node`` (periods in time) checked one event
+    at a time (module docstring): :meth:`feed` every event of the run in
+    order, then :meth:`finish` for the :class:`PeriodResult`; so the untimed,
+    deadline and period checks of a run share one read of it."""
+
+    def __init__(self, node: CheckedNode) -> None:
+        self.result = res = PeriodResult(node.name)
+        for p in node.node.periodic:
+            s = period_seconds(p)
+            if s is not None:
+                res.periods[f"out.{p.output.name}"] = float(s)
+        self.topics: dict[str, list[str]] = {}
+        for topic, keys in topic_bindings(node).items():
+            outs = [k for k, _ in keys if k in res.periods]
+            if outs:
+                self.topics[topic] = outs
+        self.last: dict[str, tuple[float, str]] = {}
+
+    def feed(self, ev: Event) -> None:
+        res = self.result
         stamp = event_stamp(ev)
         res.end = stamp if res.end is None else max(res.end, stamp)
-        for key in topics.get(ev.topic.lstrip("/"), ()):
+        for key in self.topics.get(ev.topic.lstrip("/"), ()):
             res.messages[key] = res.messages.get(key, 0) + 1
-            before = last.get(key)
+            before = self.last.get(key)
             if before is not None and key not in res.late and stamp - before[0] > res.periods[key] + TOLERANCE_S:
                 res.late[key] = {"from": before[0], "to": stamp, "gap": stamp - before[0],
                                  "period": res.periods[key], "where": ev.where}
-            last[key] = (stamp, ev.where)
-    for key, (stamp, where) in last.items():
-        if key not in res.late and res.end is not None and res.end - stamp > res.periods[key] + TOLERANCE_S:
-            res.late[key] = {"from": stamp, "to": None, "gap": res.end - stamp, "period": res.periods[key],
-                             "where": where}
-    return res
+            self.last[key] = (stamp, ev.where)
+
+    def finish(self) -> PeriodResult:
+        res = self.result
+        for key, (stamp, where) in self.last.items():
+            if key not in res.late and res.end is not None and res.end - stamp > res.periods[key] + TOLERANCE_S:
+                res.late[key] = {"from": stamp, "to": None, "gap": res.end - stamp, "period": res.periods[key],
+                                 "where": where}
+        return res
+
+
+def check_periods(node: CheckedNode, events: Iterable[Event]) -> PeriodResult:
+    """The periodic outputs of ``node`` (periods in time) over a recorded
+    run's ``events``, in order (module docstring; :class:`PeriodMonitor`)."""
+    m = PeriodMonitor(node)
+    for ev in events:
+        m.feed(ev)
+    return m.finish()
 
 
 def period_status(res: PeriodResult, trace: str) -> tuple[str, str]:
@@ -110,13 +128,11 @@ def period_status(res: PeriodResult, trace: str) -> tuple[str, str]:
                                    for k in res.periods)
 
 
-def with_periods(node: CheckedNode, events: Iterable[Event], trace: str, status: str,
-                 explanation: str) -> tuple[str, str, dict[str, Any]]:
-    """The monitor's verdict combined with the node's periods on the same run:
-    a failed period fails the evidence, otherwise the verdict stands (a
-    period that saw no message adds a note).  Returns ``(status,
-    explanation, {"periods": ...})``."""
-    res = check_periods(node, events)
+def with_periods(res: PeriodResult, trace: str, status: str, explanation: str) -> tuple[str, str, dict[str, Any]]:
+    """The monitor's verdict combined with the node's periods on the same run
+    (``res``, :class:`PeriodMonitor`): a failed period fails the evidence,
+    otherwise the verdict stands (a period that saw no message adds a note).
+    Returns ``(status, explanation, {"periods": ...})``."""
     pstatus, pexpl = period_status(res, trace)
     if pstatus == "failed":
         return "failed", f"periods: {pexpl}; {explanation}", {"periods": res.to_json()}

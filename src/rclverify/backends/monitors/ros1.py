@@ -90,30 +90,18 @@ def bound_master_calls(rospy: Any, uri: str, timeout: float) -> bool:
 
 
 def run_bounded(stop: threading.Event, limit: float, what: str, fn: Callable[[], Any]) -> Any:
-    """``fn()`` in a daemon thread, waited for in steps of 50 ms: its value
-    (or its exception); :class:`RosStopped` as soon as ``stop`` is set (a
-    signal); :class:`RosUnavailable` once ``limit`` seconds passed.  The
-    thread is left behind on abort (a daemon: it never keeps the process)."""
-    box: dict[str, Any] = {}
-
-    def run() -> None:
-        try:
-            box["value"] = fn()
-        except BaseException as exc:  # noqa: BLE001 - handed to the caller
-            box["error"] = exc
-
-    t = threading.Thread(target=run, name="rclverify-ros1-register", daemon=True)
-    t.start()
-    deadline = time.monotonic() + limit
-    while t.is_alive():
-        if stop.is_set():
-            raise RosStopped(f"stopped by a signal while {what}; nothing was monitored")
-        if time.monotonic() > deadline:
-            raise RosUnavailable(f"{what} did not finish within its time limit of {limit:g} s; nothing was monitored")
-        t.join(0.05)
-    if "error" in box:
-        raise box["error"]
-    return box.get("value")
+    """``fn()`` in a daemon thread (:func:`~...ros.master_rpc.in_thread`):
+    its value (or its exception); :class:`RosStopped` as soon as ``stop`` is
+    set (a signal); :class:`RosUnavailable` once ``limit`` seconds passed."""
+    from ...ros.master_rpc import in_thread
+    state, got = in_thread(fn, limit, "rclverify-ros1-register", stop)
+    if state == "stopped":
+        raise RosStopped(f"stopped by a signal while {what}; nothing was monitored")
+    if state == "timeout":
+        raise RosUnavailable(f"{what} did not finish within its time limit of {limit:g} s; nothing was monitored")
+    if state == "error":
+        raise got
+    return got
 
 
 def finish_within(fn: Callable[[], Any], limit: float = SHUTDOWN_TIMEOUT_S) -> bool:
@@ -121,15 +109,8 @@ def finish_within(fn: Callable[[], Any], limit: float = SHUTDOWN_TIMEOUT_S) -> b
     master) in a daemon thread, waited for at most ``limit`` seconds, so a
     master that hangs cannot hold the exit.  Returns whether it finished
     (its exception, if any, is dropped: the run is ending)."""
-    def run() -> None:
-        try:
-            fn()
-        except Exception:  # noqa: BLE001 - a shutdown step that fails leaves nothing to do
-            pass
-    t = threading.Thread(target=run, name="rclverify-ros1-shutdown", daemon=True)
-    t.start()
-    t.join(limit)
-    return not t.is_alive()
+    from ...ros.master_rpc import in_thread
+    return in_thread(fn, limit, "rclverify-ros1-shutdown")[0] != "timeout"
 
 
 def import_rospy() -> Any:

@@ -1,0 +1,300 @@
+"""Offline monitoring against its peers: rclverify, RTAMT and Reelay on the same trace and property.
+
+The property is a three-band classifier (the case study's Radiation Sensor
+without its command): a reading ``r`` is answered by a status, ``green``
+below 120, ``orange`` from 120 to below 250, ``red`` from 250 on.  The trace
+has ``--samples`` samples, 10 ms apart; a sample is one reading (uniform in
+[0, 400), full double precision) and the status that answers it, wrong with
+probability ``--wrong`` (another band), so there are violations to agree on.
+
+Each tool checks every sample, each in a process of its own on the same
+samples (made from ``--seed``), the monitoring loop timed in CPU seconds:
+
+* **rclverify engine** (monitor only): the contract below through
+  ``check_trace`` (the offline verdict engine), the events made as it reads
+  them, the mapping's rules, horizon 5 ms: the reading is the input event,
+  the status (same stamp, logged after it) its answer (docs/monitors.md); a
+  sample's verdict is its input event's (``satisfied`` or ``violated``).
+  The horizon is half the sample period, so only a reading's own status can
+  answer it (a later status fitting its band would satisfy it within a
+  longer horizon), as each peer judges a sample on its own.  A last event
+  past every horizon ends the run so no obligation is left open;
+* **rclverify monitor**: the command on a workspace holding the contract,
+  the mapping and the trace as a ROSMonitoring log (two lines a sample):
+  the whole process's CPU (start, reading the log, checking, printing);
+* **RTAMT** 0.4.10 (``pip install rtamt==0.4.10``): the discrete-time STL
+  specification of the same property, updated sample by sample
+  (robustness >= 0 is satisfied; statuses as 0, 1, 2);
+* **Reelay** 25.0.0 (``pip install reelay==25.0.0``, C++ core): the same
+  property in its rye syntax, a discrete monitor updated sample by sample.
+
+Printed: samples per CPU second, each as a ratio to the rclverify engine,
+the command's CPU over the engine's (issue 44's aim: at most 1.5), peak
+resident memory, and whether each tool's verdict on every sample agrees
+with the rclverify engine's (the verdicts are collected in a second,
+untimed run of the engine, so collecting them costs the timing nothing).
+A peer that is not installed is skipped with the reason: the peers are
+optional bench dependencies (``pip install '.[bench]'``), never rclverify's.
+
+``--compare OLD_SRC`` also runs the rclverify engine and command from an
+older source tree (e.g. ``git worktree add /tmp/old <commit>``, then
+``OLD_SRC=/tmp/old/src``) alternately with this one, and prints old, new
+and new/old: issue 44's "at least 3x today's samples/s" is that ratio, in
+one run on one machine.
+
+Usage::
+
+    python3 bench/monitor_peers.py [--samples 1000000] [--wrong 0.001] [--compare OLD_SRC]
+    python3 bench/monitor_peers.py --smoke     # 2,000 samples: a few seconds
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import random
+import resource
+import subprocess
+import sys
+import tempfile
+import time
+from array import array
+from pathlib import Path
+from typing import Any, Iterator
+
+ROOT = Path(__file__).resolve().parents[1]
+BANDS = ("green", "orange", "red")
+CONTRACT = """\
+context { Band : {green, orange, red} ; }
+node Classifier {
+  inputs( r : REAL )
+  outputs( status : Band )
+  topics( std_msgs/Float64 reading matches(in.r), std_msgs/String status matches(out.status) )
+  assume( 0 <= in.r )
+  guarantee( (in.r < 120 -> out.status == green)
+         and (120 <= in.r and in.r < 250 -> out.status == orange)
+         and (250 <= in.r -> out.status == red) )
+}
+"""
+MAPPING = "horizon: 0.005\ntopics:\n  reading: {fields: [data]}\n  status: {fields: [data]}\n"
+PLAN = "name: classifier\ncontracts: [contracts/classifier.rcl]\nnodes:\n  Classifier:\n    evidence: []\n"
+RTAMT_SPEC = ("((r < 120) -> (status == 0)) and (((r >= 120) and (r < 250)) -> (status == 1)) "
+              "and ((r >= 250) -> (status == 2))")
+REELAY_SPEC = ("({r < 120} -> {status: green}) and ({r >= 120, r < 250} -> {status: orange}) "
+               "and ({r >= 250} -> {status: red})")
+PERIOD = 0.01  # s between samples
+HORIZON = 0.005  # s: half the sample period, so a reading is answered by its own status only
+
+
+def samples(n: int, seed: int, wrong: float) -> tuple[array, bytes]:
+    """The readings (doubles) and the status answering each (0 green, 1 orange, 2 red)."""
+    rnd = random.Random(seed)
+    rs = array("d")
+    st = bytearray()
+    for _ in range(n):
+        r = rnd.uniform(0.0, 400.0)
+        band = 0 if r < 120 else 1 if r < 250 else 2
+        if rnd.random() < wrong:
+            band = (band + rnd.choice((1, 2))) % 3
+        rs.append(r)
+        st.append(band)
+    return rs, bytes(st)
+
+
+# -- children: one tool each, timed in their own process --------------------------------------------
+
+def _rclverify_engine(n: int, rs: array, st: bytes, verdicts: bool) -> tuple[float, bytes, dict[str, int]]:
+    from rclverify.backends.monitors.check import check_trace
+    from rclverify.rcl.typecheck import load
+    from rclverify.traces.events import Event
+    from rclverify.traces.mapping import load_rules
+    with tempfile.TemporaryDirectory() as tmp:
+        (Path(tmp) / "classifier.rcl").write_text(CONTRACT)
+        checked = load([Path(tmp) / "classifier.rcl"])
+    rules = load_rules({"reading": {"fields": ["data"]}, "status": {"fields": ["data"]}})
+
+    def events() -> Iterator[Any]:
+        k = 0
+        for i in range(n):
+            t = i * PERIOD
+            yield Event(k, t, "reading", {"data": rs[i]}, "synthetic")
+            yield Event(k + 1, t, "status", {"data": BANDS[st[i]]}, "synthetic")
+            k += 2
+        yield Event(k, n * PERIOD + 10 * HORIZON, "tick", {}, "synthetic")  # past every horizon
+    out = bytearray(b"\x02" * n)
+
+    def seen(v: Any) -> None:
+        out[v.event // 2] = {"satisfied": 1, "violated": 0}.get(v.verdict, 2)
+    t0 = time.process_time()
+    _, (res,) = check_trace(checked, [checked.nodes["Classifier"]], events(), rules, HORIZON,
+                            seen if verdicts else None)
+    counts = dict(res.counts)
+    counts["evaluation"] = getattr(res, "evaluation", {})  # how the formulas ran (an older tree has no such field)
+    return time.process_time() - t0, bytes(out), counts
+
+
+def _rtamt(n: int, rs: array, st: bytes) -> tuple[float, bytes]:
+    import rtamt  # type: ignore[import-not-found]
+    spec = rtamt.StlDiscreteTimeSpecification()
+    spec.declare_var("r", "float")
+    spec.declare_var("status", "float")
+    spec.spec = RTAMT_SPEC
+    spec.parse()
+    out = bytearray(n)
+    update = spec.update
+    codes = (0.0, 1.0, 2.0)
+    t0 = time.process_time()
+    for i in range(n):
+        out[i] = update(i, [("r", rs[i]), ("status", codes[st[i]])]) >= 0
+    return time.process_time() - t0, bytes(out)
+
+
+def _reelay(n: int, rs: array, st: bytes) -> tuple[float, bytes]:
+    import reelay  # type: ignore[import-not-found]
+    m = reelay.discrete_timed_monitor(pattern=REELAY_SPEC, condense=False)
+    out = bytearray(n)
+    update = m.update
+    t0 = time.process_time()
+    for i in range(n):
+        out[i] = update({"time": i, "r": rs[i], "status": BANDS[st[i]]})["value"]
+    return time.process_time() - t0, bytes(out)
+
+
+def child(args: argparse.Namespace) -> int:
+    """Run one tool (``--child``) and print its figures as one JSON line."""
+    if args.src:
+        sys.path.insert(0, args.src)
+    rs, st = samples(args.samples, args.seed, args.wrong)
+    report: dict[str, Any] = {}
+    try:
+        if args.child == "rclverify":
+            cpu, _, counts = _rclverify_engine(args.samples, rs, st, verdicts=False)
+            report["counts"] = counts
+            rss = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+            if args.verdicts:
+                _, out, counts2 = _rclverify_engine(args.samples, rs, st, verdicts=True)
+                assert counts2 == counts, (counts, counts2)
+                Path(args.verdicts).write_bytes(out)
+        else:
+            cpu, out = (_rtamt if args.child == "rtamt" else _reelay)(args.samples, rs, st)
+            rss = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+            if args.verdicts:
+                Path(args.verdicts).write_bytes(out)
+    except ImportError as exc:
+        print(json.dumps({"skipped": f"{args.child} is not installed ({exc}); pip install '.[bench]'"}))
+        return 0
+    print(json.dumps({"cpu": cpu, "rss": rss, **report}))
+    return 0
+
+
+# -- the parent: runs the children, the command, and compares -----------------------------------------
+
+def _run_child(tool: str, args: argparse.Namespace, verdicts: Path | None, src: str | None) -> dict[str, Any]:
+    cmd = [sys.executable, str(Path(__file__).resolve()), "--child", tool, "--samples", str(args.samples),
+           "--seed", str(args.seed), "--wrong", str(args.wrong), "--src", src or str(ROOT / "src")]
+    if verdicts is not None:
+        cmd += ["--verdicts", str(verdicts)]
+    p = subprocess.run(cmd, capture_output=True, text=True)
+    if p.returncode != 0:
+        raise SystemExit(f"{tool}: exited {p.returncode}:\n{p.stderr[-3000:]}")
+    return dict(json.loads(p.stdout.strip().splitlines()[-1]))
+
+
+def _workspace(tmp: Path, args: argparse.Namespace) -> Path:
+    (tmp / "contracts").mkdir()
+    (tmp / "backends/monitors").mkdir(parents=True)
+    (tmp / "contracts/classifier.rcl").write_text(CONTRACT)
+    (tmp / "contracts/plan.yaml").write_text(PLAN)
+    (tmp / "backends/monitors/mapping.yaml").write_text(MAPPING)
+    rs, st = samples(args.samples, args.seed, args.wrong)
+    with (tmp / "run.jsonl").open("w") as f:
+        for i in range(args.samples):
+            t = round(i * PERIOD, 6)
+            f.write(f'{{"topic": "reading", "time": {t!r}, "data": {rs[i]!r}}}\n'
+                    f'{{"topic": "status", "time": {t!r}, "data": "{BANDS[st[i]]}"}}\n')
+        f.write(f'{{"topic": "tick", "time": {args.samples * PERIOD + 10 * HORIZON!r}}}\n')
+    return tmp
+
+
+def _run_command(ws: Path, src: str) -> dict[str, Any]:
+    """``rclverify monitor`` on the workspace's log: the child's CPU (user +
+    system) and peak RSS, from the rusage of the waited child."""
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join([src] + ([os.environ["PYTHONPATH"]]
+                                                                if os.environ.get("PYTHONPATH") else []))}
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
+    p = subprocess.run([sys.executable, "-c", "import sys; from rclverify.cli import main; sys.exit(main())",
+                        "monitor", "-w", str(ws), str(ws / "run.jsonl")], capture_output=True, text=True, env=env)
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    if p.returncode not in (0, 1):
+        raise SystemExit(f"rclverify monitor exited {p.returncode}:\n{p.stderr[-3000:]}")
+    cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
+    return {"cpu": cpu, "rss": after.ru_maxrss / 1024, "out": p.stdout.strip().splitlines()[0] if p.stdout else ""}
+
+
+def _agree(a: bytes, b: bytes) -> str:
+    same = sum(1 for x, y in zip(a, b) if x == y)
+    first = next((i for i, (x, y) in enumerate(zip(a, b)) if x != y), None)
+    return f"{same}/{len(a)}" + ("" if first is None else f" (first difference at sample {first})")
+
+
+def main() -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--samples", type=int, default=1_000_000)
+    ap.add_argument("--wrong", type=float, default=0.001, help="probability of a wrong status (a violation)")
+    ap.add_argument("--seed", type=int, default=44)
+    ap.add_argument("--compare", metavar="OLD_SRC", help="also run the engine and the command from this source tree")
+    ap.add_argument("--smoke", action="store_true", help="2,000 samples (CI)")
+    ap.add_argument("--child", choices=("rclverify", "rtamt", "reelay"), help=argparse.SUPPRESS)
+    ap.add_argument("--src", help=argparse.SUPPRESS)
+    ap.add_argument("--verdicts", help=argparse.SUPPRESS)
+    args = ap.parse_args()
+    if args.child:
+        return child(args)
+    if args.smoke:
+        args.samples = 2_000
+    n = args.samples
+    trees = [("new", str(ROOT / "src"))] + ([("old", str(Path(args.compare).resolve()))] if args.compare else [])
+    print(f"{n} samples (a reading and its answer each), {args.wrong:g} of the answers wrong, seed {args.seed}")
+    with tempfile.TemporaryDirectory() as tmp:
+        base = Path(tmp)
+        (base / "ws").mkdir()
+        ws = _workspace(base / "ws", args)
+        rows: dict[str, dict[str, Any]] = {}
+        verdicts: dict[str, bytes] = {}
+        for label, src in trees:  # alternately: the machine's load moves both alike
+            r = _run_child("rclverify", args, base / f"v-{label}", src)
+            rows[f"rclverify engine ({label})"] = r
+            verdicts[label] = (base / f"v-{label}").read_bytes()
+            rows[f"rclverify monitor ({label})"] = _run_command(ws, src)
+        for tool in ("rtamt", "reelay"):
+            r = _run_child(tool, args, base / f"v-{tool}", None)
+            rows[tool] = r
+            if "skipped" not in r:
+                verdicts[tool] = (base / f"v-{tool}").read_bytes()
+    engine = rows["rclverify engine (new)"]["cpu"]
+    print(f"{'tool':<28} {'samples/s':>11} {'x engine':>9} {'peak RSS MiB':>13}  verdicts agree with the engine")
+    for name, r in rows.items():
+        if "skipped" in r:
+            print(f"{name:<28} skipped: {r['skipped']}")
+            continue
+        key = name.split("(")[-1].rstrip(")") if name.startswith("rclverify engine") else name
+        agree = _agree(verdicts[key], verdicts["new"]) if key in verdicts else "-"
+        print(f"{name:<28} {n / r['cpu']:>11.0f} {engine / r['cpu']:>9.2f} {r['rss']:>13.1f}  {agree}")
+    counts = dict(rows["rclverify engine (new)"]["counts"])
+    evaluation = counts.pop("evaluation", {})
+    print("rclverify engine verdicts: " + ", ".join(f"{v} {k}" for k, v in counts.items() if v)
+          + "; formulas: " + ", ".join(f"{k} {v}" for k, v in evaluation.items()))
+    cmd = rows["rclverify monitor (new)"]
+    short = " (the command's start-up dominates a run this short)" if n < 100_000 else ""
+    print(f"rclverify monitor / engine CPU: {cmd['cpu'] / engine:.2f} (aim: at most 1.5){short}; the command "
+          f"printed: {cmd['out']}")
+    if args.compare:
+        old = rows["rclverify engine (old)"]["cpu"]
+        old_cmd = rows["rclverify monitor (old)"]["cpu"]
+        print(f"engine samples/s new/old: {old / engine:.2f} (aim: at least 3); "
+              f"command new/old: {old_cmd / cmd['cpu']:.2f}; old command / old engine: {old_cmd / old:.2f}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
