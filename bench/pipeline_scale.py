@@ -36,7 +36,7 @@ Usage::
     python bench/pipeline_scale.py --keep DIR          # keep the workspaces under DIR
     python bench/pipeline_scale.py --hoare 0 --property-tests 0   # calculus and health only
     python bench/pipeline_scale.py --smoke             # N = 2, no property tests: a few seconds
-    python bench/pipeline_scale.py --case-study [--compare OLD_SRC] [--repeat K]
+    python bench/pipeline_scale.py --case-study [--compare OLD_SRC] [--repeat K] [--no-compile]
 
 ``--case-study`` measures instead a cold ``doit verify`` of the bundled case
 study (its contracts, plan, backends' inputs and ``dodo.py`` copied to a
@@ -45,7 +45,11 @@ Dafny, ...), and, in the same process just before each run, a fixed
 pure-Python reference loop (``bench/_reference.py``): the CPU as a multiple
 of the loop is the figure comparable across machines and loads (issue 44).
 With ``--compare OLD_SRC`` each code runs on its own copy, alternating, and
-the ratio new/old of the multiples is printed.
+the ratio new/old of the multiples is printed.  Each tree's bytecode is
+written first (``compileall``, as ``scripts/setup.sh`` does for the
+installed package), so that no run spends its CPU compiling modules, which
+it would in a tree never imported or with ``PYTHONDONTWRITEBYTECODE`` set
+(``--no-compile``: as the trees are).
 
 The figures are printed, not asserted.
 """
@@ -276,6 +280,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     ap.add_argument("--smoke", action="store_true", help="N = 2 without property tests: a few seconds (CI)")
     ap.add_argument("--case-study", action="store_true",
                     help="a cold `doit verify` of the bundled case study, as a multiple of the reference loop")
+    ap.add_argument("--no-compile", action="store_true",
+                    help="with --case-study: do not write each tree's bytecode first (then a tree without it, "
+                         "or PYTHONDONTWRITEBYTECODE, makes every run compile the modules it imports)")
     args = ap.parse_args(argv)
     if args.case_study:
         return case_study(args)
@@ -335,13 +342,32 @@ def copy_case_study(dest: Path) -> None:
         (dest / rel).mkdir(parents=True, exist_ok=True)
 
 
+def compile_tree(src: str | None) -> None:
+    """Write the bytecode of the rclverify source tree ``src`` (default: the
+    installed package), as ``scripts/setup.sh`` does for the installed one:
+    with ``PYTHONDONTWRITEBYTECODE`` set (or a tree never imported), every
+    ``doit`` process would otherwise compile each module it imports, about
+    0.3 CPU s of a cold run that is no work of the code measured.  Python
+    reads the files whatever that variable says."""
+    env = dict(os.environ)
+    if src:
+        env["PYTHONPATH"] = os.pathsep.join([str(Path(src).resolve())] + ([env["PYTHONPATH"]] if env.get("PYTHONPATH") else []))
+    subprocess.run([sys.executable, "-c", "import compileall, os, rclverify; "
+                    "compileall.compile_dir(os.path.dirname(rclverify.__file__), quiet=1)"],
+                   env=env, check=True, capture_output=True)
+
+
 def case_study(args: argparse.Namespace) -> int:
     """Cold `doit verify` of the case study: CPU seconds and their multiple of the reference loop,
     for this tree (``--src`` or the installed one) and, with ``--compare``, the old one, alternating."""
     trees = {"new": args.src} if not args.compare else {"old": args.compare, "new": args.src}
     base = Path(args.keep) if args.keep else Path(tempfile.mkdtemp(prefix="rclverify-casestudy-"))
+    if not args.no_compile:
+        for src in trees.values():
+            compile_tree(src)
     print(f"case study, cold `doit verify`, {os.cpu_count()} CPU(s); "
-          + ", ".join(f"{k}: {v or 'installed'}" for k, v in trees.items()))
+          + ", ".join(f"{k}: {v or 'installed'}" for k, v in trees.items())
+          + ("; bytecode as the trees have it" if args.no_compile else "; each tree's bytecode written first"))
     print(f"{'code':>5} {'run':>3} {'cpu s':>7} {'ref s':>6} {'cpu/ref':>8} {'wall s':>7}  overall")
     ratios: dict[str, list[float]] = {k: [] for k in trees}
     order = list(trees)

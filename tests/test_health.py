@@ -155,8 +155,10 @@ def test_case_study_agent_guarantee_3_can_fire(agent_findings):
     """Guarantee 3 of the Agent can fire (its premise holds whenever i has no
     successor waypoint).  The general query does not decide it in its first
     budget nor any instance in the scan's first look; no instance being
-    vacuous, a witness of finite tables decides it (issue 44: decide first
-    with what decides), in a context of its own.  The witness, read back
+    vacuous, the consistency check's witness of finite tables, extended to
+    the premise's variables, decides it (issue 44: decide first with what
+    decides; a new witness of finite tables if it did not), in a context of
+    its own.  The witness, read back
     from its RCL text, meets the assumption, every guarantee, every fact
     and the premise at its ``i``, by direct evaluation (not Z3)."""
     from rclverify.logic.evaluate import Evaluator, evaluate

@@ -17,7 +17,7 @@ import z3
 
 from rclverify.logic import world
 from rclverify.logic.query import prove
-from rclverify.logic.retry import DEFAULT, FINITE, MBQI, MBQI_SIMPLIFIED, reasons_text, retry_order
+from rclverify.logic.retry import DEFAULT, FINITE, MBQI, MBQI_SIMPLIFIED, TABLES, reasons_text, retry_order
 
 DOMAIN = (0, 1, 2)
 
@@ -125,6 +125,29 @@ def test_an_undecided_first_attempt_hands_over_in_the_laddered_order() -> None:
     assert (r.status, r.strategy, asked) == ("proved", "", [])  # decided at once: the hint is never asked
 
 
+def test_a_counterexample_search_refutes_when_the_first_look_does_not_decide() -> None:
+    """``prove``'s ``counterexample``: asked only when the first look did not
+    decide; its model refutes the query at once (strategy TABLES); ``None``
+    hands the query to the ladder, which decides it as before."""
+    def ask(goal_holds: bool, **kw: Any) -> Any:
+        world.fresh()
+        sort, _ = z3.EnumSort("Ecex", ["e0", "e1", "e2"])
+        v = z3.Const("v", sort)
+        p = z3.Function("p", sort, z3.BoolSort())
+        hyp = z3.ForAll([v], p(v)) if goal_holds else z3.Exists([v], p(v))
+        return prove(p(z3.Const("k", sort)), [hyp], timeout_ms=2000, deterministic=True, **kw)
+    asked: list[bool] = []
+    r = ask(False, first_ms=0.001, counterexample=lambda: asked.append(True) or {"k": "e1", "p": "{else -> FALSE}"})
+    assert (r.status, r.strategy, r.model, asked) == ("refuted", TABLES, {"k": "e1", "p": "{else -> FALSE}"}, [True])
+    r = ask(False, first_ms=0.001, counterexample=lambda: None)
+    assert r.status == "refuted" and r.strategy != TABLES
+    r = ask(True, first_ms=0.001, counterexample=lambda: None)
+    assert (r.status, r.strategy) == ("proved", FINITE)
+    asked.clear()
+    r = ask(False, first_ms=1000, counterexample=lambda: asked.append(True) or {})
+    assert r.status == "refuted" and r.strategy == "" and asked == []  # decided at once: never asked
+
+
 def test_retry_order_and_reasons() -> None:
     world.fresh()
     sort, _ = z3.EnumSort("Eorder", ["a", "b"])
@@ -138,7 +161,7 @@ def test_retry_order_and_reasons() -> None:
     assert retry_order(quantified_finite, ladder=False) == [FINITE, MBQI, MBQI_SIMPLIFIED]
     assert retry_order(quantified_infinite, ladder=False) == [MBQI, MBQI_SIMPLIFIED]
     assert retry_order(ground, ladder=False) == []
-    assert retry_order(quantified_finite, ladder=True) == [FINITE, DEFAULT, MBQI, MBQI_SIMPLIFIED]
+    assert retry_order(quantified_finite, ladder=True) == [FINITE, MBQI, MBQI_SIMPLIFIED, DEFAULT]
     assert retry_order(quantified_finite, ladder=True, models_first=True) == [MBQI_SIMPLIFIED, MBQI, FINITE, DEFAULT]
     assert retry_order(ground, ladder=True) == [DEFAULT]
     assert reasons_text({DEFAULT: "canceled"}) == "canceled"

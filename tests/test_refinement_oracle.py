@@ -1,6 +1,6 @@
 """The refinement check against brute force (issue 44 changed the order in
-which it asks Z3: a small first budget, then, a finite-table counterexample
-found, MBQI first).  Random contracts over an enumeration, a Boolean and a
+which it asks Z3: a small first budget, then a finite-table counterexample,
+which refutes the side with its model; each such model is evaluated here).  Random contracts over an enumeration, a Boolean and a
 function-typed input read at two points, whose every valuation can be
 enumerated: "B refines A" holds exactly when ``A_A => A_B`` and
 ``A_A and G_B => G_A`` hold in every valuation.  Asked as the pipeline asks
@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import itertools
 import random
+import re
 from typing import Any
 
 import pytest
@@ -17,6 +18,7 @@ import pytest
 from rclverify.calculus import refinement
 from rclverify.calculus.refinement import check_refinement
 from rclverify.logic import world
+from rclverify.logic.retry import TABLES
 from rclverify.rcl.parser import parse_text
 from rclverify.rcl.typecheck import check
 
@@ -87,3 +89,19 @@ def test_refinement_agrees_with_brute_force(seed: int, monkeypatch: pytest.Monke
         got = (r.assumption.status, r.guarantee.status)
         assert got == want, (seed, first_ms, ta, tb, r)
         assert r.verdict == ("refines" if want == ("proved", "proved") else "does not refine")
+        for side, hyps, goal in ((r.assumption, aa, ab), (r.guarantee, aa + gb, ga)):
+            if side.strategy == TABLES:  # a finite-table counterexample: it must refute the side
+                assert side.model is not None
+                v = _valuation(side.model)
+                assert all(f(v) for f in hyps) and not all(f(v) for f in goal), (seed, side.model)
+
+
+def _valuation(model: dict[str, str]) -> dict[str, Any]:
+    """A counterexample as the report prints it, as a valuation of :func:`_valuations`'s shape
+    (a variable the model leaves out may take any value: the first)."""
+    def table_at(text: str, k: int) -> str:
+        rows = dict(re.findall(r"\((-?\d+)\) -> (\w+)", text))
+        return rows.get(str(k), re.search(r"else -> (\w+)", text).group(1))  # type: ignore[union-attr]
+    return {"x": model.get("in.x", COLORS[0]), "y": model.get("out.y", COLORS[0]),
+            "b": model.get("out.b", "FALSE") == "TRUE",
+            "f": tuple(table_at(model["in.f"], k) if "in.f" in model else COLORS[0] for k in (0, 1))}

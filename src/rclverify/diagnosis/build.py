@@ -360,7 +360,9 @@ def _hoare(ws: Any, report: Mapping[str, Any], e: Mapping[str, Any], o: Mapping[
                 f"program gives {outputs or 'another output'}, which the conjunct `{conj}` ({conj_src}) rules out.")
     before = {ob["id"]: ob["status"] for ob in report["obligations"]
               if ob["node"] == node and ob["backend"] == "hoare" and ob["instance"].split(".c")[0] == e["obligation"].split(".hoare.", 1)[-1].split(".c")[0]}
-    reps = cache.get(["hoare", e["obligation"], program, before],
+    # keyed by what the repair is computed from (not the obligation: every failed triple of one program
+    # entry and guarantee gets the same repair, searched once; the case study's c2 and c3)
+    reps = cache.get(["hoare", node, k, program, before],
                      lambda: hoare_repair(ws, node, k, program, before), extra_file=program)
     return _record(e["obligation"], "hoare", node, e["status"], sentence,
                    culprits=[{"what": f"{program} line {c.split(':')[1]}", "source": c.rsplit(':', 1)[0], "text": c.rsplit(': ', 1)[1]}

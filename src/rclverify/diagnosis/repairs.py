@@ -46,6 +46,9 @@ from .edits import Edit
 MAX_CANDIDATES = 12
 #: Most atoms in a guard.
 MAX_GUARD_ATOMS = 3
+#: The first budget of each "does guard g imply guard h" query (milliseconds' worth of
+#: Z3 resource steps; :func:`rclverify.logic.query.prove`'s ``first_ms``).
+FIRST_LOOK_MS = 100
 
 
 def _peel(e: ast.Expr) -> tuple[list[str], ast.Expr]:
@@ -181,7 +184,11 @@ def _weakest_first(ws: Any, node: str, guards: list[str], var_types: Mapping[str
             except (RclError, KeyError, ValueError, z3.Z3Exception):
                 implies[(g, h)] = False
                 continue
-            implies[(g, h)] = prove(goal, facts, enc, timeout_ms=INSTANCE_TIMEOUT_MS,
+            # a small first look, then the retries in the laddered order (finite instantiation first:
+            # the case study's `i + 1 <= 12` -> `exists(.. wayP(x, y) == i + 1)`, which the default strategy
+            # spent its whole budget on); every strategy still gets its whole budget, so what is proved is
+            # the same (logic/query.py, prove's first_ms)
+            implies[(g, h)] = prove(goal, facts, enc, timeout_ms=INSTANCE_TIMEOUT_MS, first_ms=FIRST_LOOK_MS,
                                     comment=f"repair: does `{g}` imply `{h}`?").status == "proved"
     todo, order = sorted(guards, key=lambda g: "exists(" in g or "forall(" in g), []
     while todo:
@@ -259,7 +266,9 @@ def guard_repair(ws: Any, node: str, culprit: int, victims: Sequence[tuple[int, 
                 break
         if any(v != "sat" for v in fired.values()):
             continue
-        if recheck.consistent(ws, checked, node) != "sat":
+        # a premise query holds the assumption, every guarantee and the facts: a victim's witness is one of
+        # consistency too, which is asked only when there is no victim
+        if not victims and recheck.consistent(ws, checked, node) != "sat":
             continue
         # the checks just answered are not asked again
         known = {**{k: "ok" for k in fired}, f"{node}.contract-consistent": "ok"}

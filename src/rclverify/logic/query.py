@@ -27,8 +27,8 @@ import z3
 
 from .encode import Encoder, term_to_rcl, value_to_rcl
 from .functable import finite_table
-from .retry import (DEFAULT, attempts, bounded_solver, load_canonical, reasons_text, retry_order, strategy_solver,
-                    variants)
+from .retry import (DEFAULT, TABLES, attempts, bounded_solver, load_canonical, reasons_text, retry_order,
+                    strategy_solver, variants)
 
 DEFAULT_TIMEOUT_MS = 10_000
 
@@ -197,7 +197,8 @@ def smtlib_benchmark(formulas: Sequence[z3.BoolRef], ctx: z3.Context | None = No
 
 def prove(goal: z3.BoolRef, hypotheses: Sequence[z3.BoolRef], enc: Encoder | None = None, *,
           timeout_ms: int = DEFAULT_TIMEOUT_MS, comment: str = "", deterministic: bool = False,
-          first_ms: float | None = None, likely_sat: Callable[[], bool] | None = None) -> QueryResult:
+          first_ms: float | None = None, likely_sat: Callable[[], bool] | None = None,
+          counterexample: Callable[[], dict[str, str] | None] | None = None) -> QueryResult:
     """Is ``hypotheses => goal`` valid?  Checks ``hypotheses and not goal``.
 
     ``enc`` (when given) renders a refuting model in RCL terms and adds its
@@ -221,6 +222,15 @@ def prove(goal: z3.BoolRef, hypotheses: Sequence[z3.BoolRef], enc: Encoder | Non
     refutation exists") puts the model-building MBQI first.  Not used
     inside a :func:`solver_session` unless ``deterministic`` (a session's
     first attempt is part of its history).
+
+    ``counterexample`` (with ``first_ms``; called only when the first
+    attempt did not decide): a more specific search for a refuting model,
+    e.g. one in which every function-typed input is a finite table
+    (:func:`rclverify.health.witness.finite_witness`).  Its model (RCL name
+    -> value text) must satisfy the hypotheses and the negated goal, so the
+    query is ``refuted`` with that model (strategy :data:`.retry.TABLES`)
+    without the retries; ``None`` leaves the query to the ladder, in the
+    order ``likely_sat`` gives (not asked again when it is the same search).
     """
     hyps = list(hypotheses) + (enc.axioms() if enc else [])
     formulas = hyps + [z3.Not(goal)]
@@ -256,6 +266,11 @@ def prove(goal: z3.BoolRef, hypotheses: Sequence[z3.BoolRef], enc: Encoder | Non
         if got is not None:
             return got
         reasons = {DEFAULT: s.reason_unknown()}
+        if ladder and counterexample is not None:
+            model = counterexample()
+            if model is not None:
+                return QueryResult("refuted", script, round(time.perf_counter() - t0, 4), model=model,
+                                   strategy=TABLES)
         models_first = bool(ladder and likely_sat is not None and likely_sat())
         for name in retry_order(formulas, ladder=ladder, models_first=models_first):
             if name == DEFAULT:

@@ -44,13 +44,16 @@ from __future__ import annotations
 
 import hashlib
 import json
+import time
+from dataclasses import replace
 from typing import Any, Sequence
 
 import z3
 
 from ..calculus.compose import split_assumption
 from ..logic.encode import Encoder
-from ..logic.query import DEFAULT_TIMEOUT_MS, satisfiable, solver_session
+from ..health.witness import finite_witness, has_tables, points_for
+from ..logic.query import DEFAULT_TIMEOUT_MS, QueryResult, satisfiable, solver_session
 from ..plan.formal import Formal, parse_formal
 from ..plan.load import Plan, Requirement
 from ..rcl import ast
@@ -66,6 +69,13 @@ NEGATED = "negated requirement"
 #: :mod:`rclverify.logic.retry` (finite instantiation, MBQI) often do; a short
 #: first attempt hands over to them sooner (an unknown is never upgraded).
 MODEL_TIMEOUT_MS = 1_000
+#: The budget of the general query's first look at the consistency and
+#: vacuity queries (decide first with what decides, issue 44): an unsat
+#: answer (a vacuous requirement, an inconsistent proof) comes at once;
+#: what it does not decide goes to a finite-table witness (function-typed
+#: inputs), then to the general query with :data:`MODEL_TIMEOUT_MS` and its
+#: retries, as before.
+FIRST_LOOK_MS = 50
 
 
 def _where(l: ast.Loc) -> str:
@@ -232,8 +242,8 @@ def check_requirement(req: Requirement, checked: Checked, model: SystemModel, pl
         if NEGATED not in (r.core or []):
             out.update(consistency="inconsistent", inconsistent_core=used, consistency_duration_s=0.0)
         else:
-            r2 = satisfiable([(lbl, f) for lbl, f in labelled if lbl in core], enc, timeout_ms=model_ms,
-                             comment=f"rclverify requirement {req.id}: are the premises its proof used consistent?")
+            r2 = _model_query([(lbl, f) for lbl, f in labelled if lbl in core], enc, model_ms, _points(plan, cone),
+                              f"rclverify requirement {req.id}: are the premises its proof used consistent?")
             out["consistency_duration_s"] = r2.duration_s
             if r2.status == "unsat":
                 out.update(consistency="inconsistent", inconsistent_core=[by_label[c] for c in (r2.core or [])])
@@ -243,10 +253,10 @@ def check_requirement(req: Requirement, checked: Checked, model: SystemModel, pl
                 out.update(consistency="undecided", consistency_reason=r2.reason)
         premise = _premise(formal.expr)
         if out["consistency"] == "consistent" and premise is not None:
-            r3 = satisfiable([(lbl, f) for lbl, f in labelled if lbl != NEGATED]
-                             + [("requirement premise", enc.formula(premise, formal.scope, symbols))], enc,
-                             timeout_ms=model_ms,
-                             comment=f"rclverify requirement {req.id}: can its premise hold with every premise of the cone?")
+            r3 = _model_query([(lbl, f) for lbl, f in labelled if lbl != NEGATED]
+                              + [("requirement premise", enc.formula(premise, formal.scope, symbols))], enc,
+                              model_ms, _points(plan, cone),
+                              f"rclverify requirement {req.id}: can its premise hold with every premise of the cone?")
             out["vacuity_duration_s"] = r3.duration_s
             if r3.status == "unsat":
                 out.update(vacuity="vacuous", vacuity_core=[by_label[c] for c in (r3.core or []) if c in by_label])
@@ -263,6 +273,41 @@ def check_requirement(req: Requirement, checked: Checked, model: SystemModel, pl
         return out
     out.update(verdict="inconclusive", reason=r.reason or "unknown")
     return out
+
+
+def _points(plan: Plan, cone: Sequence[str]) -> int:
+    """The size of the witness tables for a query over ``cone``: every
+    instance of every node of the cone gets a point of its own
+    (:func:`rclverify.health.witness.points_for`; the plan's instance ranges
+    are part of the cone's snapshots, hence of the record's fingerprint)."""
+    return max([points_for(plan.instances.get(n)) for n in cone] or [points_for(None)])
+
+
+def _model_query(labelled: list[tuple[str, z3.BoolRef]], enc: Encoder, model_ms: int, points: int,
+                 comment: str) -> QueryResult:
+    """Can ``labelled`` hold together?  The consistency and vacuity queries,
+    which look for a model: first the general query with
+    :data:`FIRST_LOOK_MS` (what it decides, its whole budget decides the
+    same way: a resource-bounded search with a smaller bound is a prefix of
+    the same search), then, with function-typed inputs, a witness in which
+    each is a finite table of ``points`` points
+    (:func:`rclverify.health.witness.finite_witness`: its model is a model
+    of the query; the case study's REQ2 and REQ3: 0.1-0.3 s where the
+    general query ran out of its budget before a retry found a model), then
+    the general query with ``model_ms`` and the retries of
+    :mod:`rclverify.logic.retry`.  Returns the :class:`QueryResult` of
+    whichever decided (``sat`` with a model, ``unsat`` with a core), else
+    the last one's ``inconclusive``."""
+    t0 = time.perf_counter()
+    r = satisfiable(labelled, enc, timeout_ms=min(model_ms, FIRST_LOOK_MS), comment=comment, retry=False)
+    if r.status != "inconclusive":
+        return r
+    if has_tables(enc):
+        w = finite_witness(enc, [f for _, f in labelled], points)
+        if w.status == "sat":
+            return QueryResult("sat", r.script, round(time.perf_counter() - t0, 4), model=w.model)
+    r = satisfiable(labelled, enc, timeout_ms=model_ms, comment=comment)
+    return replace(r, duration_s=round(time.perf_counter() - t0, 4))
 
 
 def _premise(e: ast.Expr) -> ast.Expr | None:

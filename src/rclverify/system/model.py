@@ -208,19 +208,16 @@ class SystemModel:
         each as its node sequence starting at its first node in source order
         and following existing connections only; the closing edge goes from
         the last node back to the first.  Sorted by length, then by sequence.
-        Found with networkx's ``simple_cycles`` (Johnson's algorithm), once
-        per model: the check stage and the report both show them."""
+        Found with Johnson's algorithm (:mod:`.cycles`), once per model: the
+        check stage and the report both show them."""
         return [list(c) for c in self._cycles]
 
     @cached_property
     def _cycles(self) -> tuple[tuple[str, ...], ...]:
-        import networkx as nx  # type: ignore[import-untyped]  # here: importing it is 0.15 s of every doit run
-        g = nx.DiGraph()
-        g.add_nodes_from(self.nodes)
-        g.add_edges_from((l.from_node, l.to_node) for l in self.links)
+        from .cycles import elementary_cycles
         order = {n: k for k, n in enumerate(self.nodes)}
         out = []
-        for c in nx.simple_cycles(g):
+        for c in elementary_cycles(self.nodes, [(l.from_node, l.to_node) for l in self.links]):
             k = min(range(len(c)), key=lambda j: order[c[j]])
             out.append(c[k:] + c[:k])
         return tuple(tuple(c) for c in sorted(out, key=lambda c: (len(c), [order[n] for n in c])))

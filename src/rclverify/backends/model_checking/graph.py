@@ -90,6 +90,9 @@ class StateGraph:
     depth: int = 0
     identifiers: str = ""
     derived: dict[int, frozenset[psl.Term]] = field(default_factory=dict, compare=False)
+    #: ``(state, modality) -> {term head: terms}`` of the pools ``holds`` searched (filled on use).
+    _heads: dict[tuple[int, str], dict[tuple[object, ...], tuple[psl.Term, ...]]] = field(
+        default_factory=dict, compare=False, repr=False)
 
     def holds(self, state: int, atom: psl.Modal | psl.Percept) -> bool:
         """Whether the atom holds in state ``state``.
@@ -99,25 +102,53 @@ class StateGraph:
         for the state (Gwendolen's Prolog-style rules).  An atom about another
         agent than :attr:`agent` is false.
         """
-        ms = self.states[state]
-        if isinstance(atom, psl.Percept):
-            return any(matches(atom.term, t) for t in ms.percepts)
-        if atom.agent != self.agent:
+        op = "P" if isinstance(atom, psl.Percept) else atom.op
+        if not isinstance(atom, psl.Percept) and atom.agent != self.agent:
             return False
+        heads = self._heads.get((state, op))
+        if heads is None:
+            heads = self._heads[(state, op)] = _by_head(self._pool(state, op))
+        if isinstance(atom.term, psl.Wild):
+            return any(heads.values())
+        # matches() is false on terms of another head, so only those of the pattern's head are tried
+        return any(matches(atom.term, t) for t in heads.get(_head(atom.term), ()))
+
+    def _pool(self, state: int, op: str) -> frozenset[psl.Term]:
+        """The terms an atom of modality ``op`` (``P`` for a percept) is matched against in ``state``."""
+        ms = self.states[state]
         pool: frozenset[psl.Term]
-        if atom.op == "B":
+        if op == "P":
+            pool = ms.percepts
+        elif op == "B":
             pool = ms.beliefs | self.derived.get(state, frozenset())
-        elif atom.op == "G":
+        elif op == "G":
             pool = ms.goals
-        elif atom.op == "D":
+        elif op == "D":
             pool = frozenset() if ms.last_action is None else frozenset({ms.last_action})
-        elif atom.op == "I":
+        elif op == "I":
             pool = ms.intentions
-        elif atom.op == "ItD":
+        elif op == "ItD":
             pool = ms.intended_actions
         else:  # pragma: no cover - psl.MODALITIES is closed
-            raise ValueError(f"unknown modality {atom.op}")
-        return any(matches(atom.term, t) for t in pool)
+            raise ValueError(f"unknown modality {op}")
+        return pool
+
+
+def _head(t: psl.Term) -> tuple[object, ...]:
+    """What :func:`matches` compares first: the kind of term, and a symbol's name or a
+    compound's name and arity (every number has the same head)."""
+    if isinstance(t, psl.Compound):
+        return ("compound", t.name, len(t.args))
+    if isinstance(t, psl.Sym):
+        return ("symbol", t.name)
+    return (type(t).__name__,)
+
+
+def _by_head(pool: frozenset[psl.Term]) -> dict[tuple[object, ...], tuple[psl.Term, ...]]:
+    out: dict[tuple[object, ...], list[psl.Term]] = {}
+    for t in pool:
+        out.setdefault(_head(t), []).append(t)
+    return {k: tuple(v) for k, v in out.items()}
 
 
 def matches(pattern: psl.Term, term: psl.Term) -> bool:
