@@ -24,6 +24,7 @@ from typing import Mapping, Sequence
 
 import z3
 
+from ..logic.retry import has_quantifier
 from ..values import decimal_text
 
 #: At most this many clauses are examined one by one (beyond: printed as ``qe`` left them).
@@ -43,21 +44,7 @@ def eliminate(f: z3.BoolRef) -> z3.BoolRef | None:
     except z3.Z3Exception:
         return None
     out = r.as_expr()
-    return None if _has_quantifier(out) else out
-
-
-def _has_quantifier(e: z3.ExprRef) -> bool:
-    todo, seen = [e], set()
-    while todo:
-        x = todo.pop()
-        if x.get_id() in seen:
-            continue
-        seen.add(x.get_id())
-        if z3.is_quantifier(x):
-            return True
-        if z3.is_app(x):
-            todo.extend(x.children())
-    return False
+    return None if has_quantifier(out) else out
 
 
 def _nnf_clauses(e: z3.BoolRef) -> list[list[z3.BoolRef]] | None:

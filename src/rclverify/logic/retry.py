@@ -49,7 +49,8 @@ MBQI_SIMPLIFIED = "model-based quantifier instantiation after simplification"
 MAX_INSTANCES = 256
 
 
-def _finite_values(s: z3.SortRef) -> list[z3.ExprRef] | None:
+def finite_values(s: z3.SortRef) -> list[z3.ExprRef] | None:
+    """Every value of a finite sort (BOOL, an enumeration), else ``None``."""
     if s.kind() == z3.Z3_BOOL_SORT:
         return [z3.BoolVal(False), z3.BoolVal(True)]
     if isinstance(s, z3.DatatypeSortRef):
@@ -66,7 +67,7 @@ def _cases(v: z3.ExprRef, tag: str) -> list[tuple[z3.ExprRef, list[z3.ExprRef]]]
     variables for its arguments (every value of a datatype is some
     constructor applied to arguments); other sorts give ``None``."""
     s = v.sort()
-    values = _finite_values(s)
+    values = finite_values(s)
     if values is not None:
         return [(x, []) for x in values]
     if isinstance(s, z3.DatatypeSortRef) and s.num_constructors() > 0:
@@ -130,7 +131,8 @@ def expand_finite(e: z3.ExprRef, depth: int = 0) -> z3.ExprRef:
     return e
 
 
-def _has_quantifier(e: z3.ExprRef) -> bool:
+def has_quantifier(e: z3.ExprRef) -> bool:
+    """Does ``e`` hold a quantifier anywhere (shared subterms visited once)?"""
     todo, seen = [e], set()
     while todo:
         x = todo.pop()
@@ -187,7 +189,7 @@ def attempts(formulas: Sequence[z3.BoolRef], timeout_ms: int
     solver with :func:`load_canonical`.
     ``timeout_ms`` (the first attempt's) is not used: retries are bounded by
     :data:`RETRY_RLIMIT` so that their answers are reproducible."""
-    if not any(_has_quantifier(f) for f in formulas):
+    if not any(has_quantifier(f) for f in formulas):
         return []
     out: list[tuple[str, z3.Solver, Callable[[z3.BoolRef], z3.BoolRef]]] = []
     changed = [expand_finite(f) for f in formulas]
@@ -247,7 +249,7 @@ def retry_order(formulas: Sequence[z3.BoolRef], *, ladder: bool, models_first: b
     is in the laddered one, each with its whole budget, so a query one of
     them decides is still decided; only which one answers first (and so a
     model) can differ."""
-    quantified = any(_has_quantifier(f) for f in formulas)
+    quantified = any(has_quantifier(f) for f in formulas)
     finite = quantified and any(not expand_finite(f).eq(f) for f in formulas)
     fin = [FINITE] if finite else []
     models = [MBQI, MBQI_SIMPLIFIED] if quantified else []

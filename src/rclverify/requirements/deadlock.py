@@ -43,7 +43,7 @@ from typing import Sequence
 
 import z3
 
-from ..logic.retry import MAX_INSTANCES, expand_finite
+from ..logic.retry import MAX_INSTANCES, expand_finite, finite_values
 from .tsys import Pred, State, TemporalVerdict, TransitionSystem, distinct, trace_of, unroll
 
 #: The step-by-step search of :func:`find_deadlock` stops (``inconclusive``)
@@ -51,17 +51,6 @@ from .tsys import Pred, State, TemporalVerdict, TransitionSystem, distinct, trac
 SEARCH_BUDGET = 30
 STOPS = ("no next state satisfies the contracts, the environment facts, the state declarations and the "
          "requirement's assumptions")
-
-
-def _finite(s: z3.SortRef) -> list[z3.ExprRef] | None:
-    """Every value of a finite sort (BOOL, an enumeration), else ``None``."""
-    if s.kind() == z3.Z3_BOOL_SORT:
-        return [z3.BoolVal(False), z3.BoolVal(True)]
-    if isinstance(s, z3.DatatypeSortRef):
-        cons = [s.constructor(k) for k in range(s.num_constructors())]
-        if cons and all(c.arity() == 0 for c in cons):
-            return [c() for c in cons]
-    return None
 
 
 def successor_exists(ts: TransitionSystem, s: State) -> z3.BoolRef:
@@ -73,9 +62,9 @@ def successor_exists(ts: TransitionSystem, s: State) -> z3.BoolRef:
     the other variables stay bound by ``exists``."""
     t = {n: z3.Const(f"{n}@succ", srt) for n, srt in ts.sorts.items()}  # bound: no clash with a step's
     body = ts.trans(s, t)
-    if any(_finite(srt) is not None or isinstance(srt, z3.DatatypeSortRef) for srt in ts.sorts.values()):
+    if any(finite_values(srt) is not None or isinstance(srt, z3.DatatypeSortRef) for srt in ts.sorts.values()):
         body = expand_finite(body)
-    finite = {n: vs for n, vs in ((n, _finite(srt)) for n, srt in ts.sorts.items()) if vs is not None}
+    finite = {n: vs for n, vs in ((n, finite_values(srt)) for n, srt in ts.sorts.items()) if vs is not None}
     rest = [t[n] for n in ts.sorts if n not in finite]
     combos = list(itertools.islice(itertools.product(*finite.values()), MAX_INSTANCES + 1))
     if not t:
