@@ -112,6 +112,8 @@ def _rclverify_engine(n: int, rs: array, st: bytes, verdicts: bool) -> tuple[flo
         (Path(tmp) / "classifier.rcl").write_text(CONTRACT)
         checked = load([Path(tmp) / "classifier.rcl"])
     rules = load_rules({"reading": {"fields": ["data"]}, "status": {"fields": ["data"]}})
+    if type(rules) is not dict:  # an older tree's rules are a plain dict, with no skew
+        rules.skew = 0.02  # the mapping's default transport skew, as the command runs it
 
     def events() -> Iterator[Any]:
         k = 0

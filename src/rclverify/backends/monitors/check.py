@@ -161,8 +161,6 @@ class _Group:
     last_semantics: str = ""
     #: the inputs the events set (``in.x``): a guarantee ``triggered by`` another input is no answer to them
     triggers: frozenset[str] = frozenset()
-    #: trigger event index -> the outputs received within the transport skew before it (skew.py)
-    early: dict[int, tuple[Event, dict[str, Any]]] = field(default_factory=dict)
 
 
 @dataclass
@@ -498,10 +496,6 @@ class NodeMonitor:
             group.accepted = accepted
         group.events.append(ev)
         stamped = ev.stamped
-        if self._early is not None:
-            early = self._early.before(stamped)
-            if early is not None:
-                group.early[ev.index] = early
         if stamped > group.ref:
             group.ref = stamped
         group.superseded = None  # the same question asked again: the answer to come answers both
@@ -530,7 +524,7 @@ class NodeMonitor:
             fresh = {k: values[k] for k in changed if values[k] is not None}
             state_changed, state = False, {}
         if fresh and self._early is not None:
-            self._early.remember(ev, fresh)
+            self._early.remember((ev, fresh))
         done: list[Any] = []
         rekey = False
         stamped = ev.stamped
@@ -620,7 +614,6 @@ class NodeMonitor:
             h.undecided = h.undecided or g.undecided
             h.answered = h.answered and g.answered
             h.superseded = h.superseded if g.superseded is not None else None
-            h.early.update(g.early)
             if _WEAK[g.accepted] > _WEAK[h.accepted]:
                 h.accepted = g.accepted
             if h.last is g.last:  # h took g's failure: and the semantics it was decided in
@@ -687,8 +680,8 @@ class NodeMonitor:
             first = on_answer(out, k, outs, f"guarantee {k} is false on the outputs published after the input at "
                               f"{trigger.where} (the last at {out.where}) whatever the value of the outputs not "
                               f"published after it ({why})")
-        elif g.last is None and self._early is not None and trigger.index in g.early:
-            out, outs = g.early[trigger.index]
+        elif g.last is None and self._early is not None and (early := self._early.before(trigger.stamped)):
+            out, outs = early
             k, semantics = self._early_failure(g, outs)
             reason = early_reason(k, out, trigger, self._early.skew, self.horizon)
             if k is None:  # the early output meets the guarantees: an answer or a stale output, not told apart

@@ -51,36 +51,47 @@ def parse_skew(value: Any) -> float | None:
 
 
 class EarlyOutputs:
-    """The outputs a node published within the last ``skew`` seconds.
+    """The outputs a node published lately, for the questions that got none.
 
-    :meth:`remember` is called for each output event (``fresh``: the event
-    outputs it set, ``out.x`` -> value); :meth:`before` gives the early
-    candidate of a question stamped at ``stamped`` (s): the outputs received
-    at most ``skew`` before it, merged in order (a later one overrides), with
-    the first such event, or ``None``."""
+    ``remember((event, fresh))`` is called for each output event (``fresh``:
+    the event outputs it set, ``out.x`` -> value, a dict the caller no
+    longer changes): one append, nothing else on the monitor's hot path.
+    :meth:`before` is asked only when a question's horizon passed with no
+    output after it; since every output stamped at or after a question
+    answers it, the outputs remembered since that question are none (or
+    stamped before it), and its early candidates are still at the end of
+    the queue.  At most :data:`KEPT` outputs are kept, so memory stays flat
+    at any rate."""
 
-    __slots__ = ("skew", "_recent")
+    __slots__ = ("skew", "_recent", "remember")
+
+    #: Outputs kept at most (older ones are forgotten as new ones come).
+    KEPT = 256
 
     def __init__(self, skew: float) -> None:
         self.skew = skew
-        self._recent: deque[tuple[Event, dict[str, Any]]] = deque()
-
-    def remember(self, ev: Event, fresh: Mapping[str, Any]) -> None:
-        recent = self._recent
-        recent.append((ev, dict(fresh)))
-        floor = ev.stamped - self.skew
-        while recent and recent[0][0].stamped < floor:
-            recent.popleft()
+        self._recent: deque[tuple[Event, Mapping[str, Any]]] = deque(maxlen=self.KEPT)
+        self.remember = self._recent.append
 
     def before(self, stamped: float) -> tuple[Event, dict[str, Any]] | None:
-        first: Event | None = None
+        """The early candidate of a question stamped at ``stamped`` (s): the
+        outputs stamped at most ``skew`` before it (or at its stamp, logged
+        before it), merged in order (a later one overrides), with the first
+        such event; ``None`` when there is none."""
+        floor = stamped - self.skew
+        found: list[tuple[Event, Mapping[str, Any]]] = []
+        for ev, fresh in reversed(self._recent):
+            at = ev.stamped
+            if at < floor:
+                break
+            if at <= stamped:
+                found.append((ev, fresh))
+        if not found:
+            return None
         outs: dict[str, Any] = {}
-        for ev, fresh in self._recent:
-            if stamped - self.skew <= ev.stamped <= stamped:
-                if first is None:
-                    first = ev
-                outs.update(fresh)
-        return None if first is None else (first, outs)
+        for _, fresh in reversed(found):
+            outs.update(fresh)
+        return found[-1][0], outs
 
 
 def early_reason(k: int | None, out: Event, trigger: Event, skew: float, horizon: float) -> str:
