@@ -28,7 +28,7 @@ a requirement's consistency and vacuity queries
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any, Sequence
+from typing import Any, Iterator, Sequence
 
 import z3
 
@@ -198,22 +198,10 @@ def _confirmed(formulas: Sequence[z3.BoolRef], model: z3.ModelRef) -> bool:
     quantified formulas are left to check, on fixed values (a few thousand
     steps on the case study; the budget of :data:`EXTEND_TIMEOUT_MS`)."""
     consts: dict[int, z3.ExprRef] = {}
-    seen: set[int] = set()
-    todo: list[z3.ExprRef] = list(formulas)
-    while todo:
-        e = todo.pop()
-        if e.get_id() in seen:
-            continue
-        seen.add(e.get_id())
-        if z3.is_quantifier(e):
-            todo.append(e.body())
-        elif z3.is_app(e):
-            d = e.decl()
-            if d.kind() == z3.Z3_OP_UNINTERPRETED:
-                if d.arity() > 0:
-                    return False
-                consts[e.get_id()] = e
-            todo.extend(e.children())
+    for e in _uninterpreted(formulas):
+        if e.decl().arity() > 0:
+            return False
+        consts[e.get_id()] = e
     subs = [(c, model.eval(c, model_completion=True)) for c in consts.values()]
     fixed = [z3.substitute(f, *subs) for f in formulas] if subs else list(formulas)
     s = budgeted_solver(EXTEND_TIMEOUT_MS, model.ctx)
@@ -253,6 +241,12 @@ def _fixed_left(formulas: Sequence[z3.ExprRef], f: _Found) -> bool:
     witness's)?  Then the query would search it too, and its answer would
     not be an extension of the witness."""
     fixed = {d.name() for d, _ in f.funcs} | {c.decl().name() for c, _ in f.consts}
+    return any(e.decl().name() in fixed for e in _uninterpreted(formulas))
+
+
+def _uninterpreted(formulas: Sequence[z3.ExprRef]) -> Iterator[z3.ExprRef]:
+    """The applications of uninterpreted symbols (constants and functions)
+    in ``formulas``, quantifier bodies included, each shared term once."""
     seen: set[int] = set()
     todo = list(formulas)
     while todo:
@@ -263,11 +257,9 @@ def _fixed_left(formulas: Sequence[z3.ExprRef], f: _Found) -> bool:
         if z3.is_quantifier(e):
             todo.append(e.body())
         elif z3.is_app(e):
-            d = e.decl()
-            if d.kind() == z3.Z3_OP_UNINTERPRETED and d.name() in fixed:
-                return True
+            if e.decl().kind() == z3.Z3_OP_UNINTERPRETED:
+                yield e
             todo.extend(e.children())
-    return False
 
 
 def extend(w: Witness, enc: Any, formulas: Sequence[z3.BoolRef], budget_ms: int = EXTEND_TIMEOUT_MS) -> Witness:
