@@ -62,6 +62,9 @@ from typing import Any
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "src"))
+sys.path.insert(0, str(ROOT / "bench"))
+from _pace import paced  # noqa: E402
+
 RUN = ROOT / "backends" / "monitors" / "traces" / "nominal.jsonl"
 
 
@@ -92,19 +95,7 @@ def publisher(rate: float, seconds: float, out: Path, wait_for: int, nodes: list
         time.sleep(0.05)
     time.sleep(0.5)
     msgs = [(e["topic"], build_message(Snapshot, e)) for e in lines]
-    n = int(rate * seconds)
-    sent: list[tuple[str, float]] = []
-    start = time.monotonic()
-    for k in range(n):
-        due = start + k / rate
-        wait = due - time.monotonic()
-        if wait > 0:
-            time.sleep(wait)
-        topic, msg = msgs[k % len(msgs)]
-        t = time.time()
-        pubs[topic].publish(msg)
-        sent.append((topic, t))
-    elapsed = time.monotonic() - start
+    sent, elapsed = paced(msgs, rate, seconds, lambda topic, msg: pubs[topic].publish(msg))
     out.write_text(json.dumps({"sent": sent, "elapsed": elapsed}))
     time.sleep(1.0)
     return 0

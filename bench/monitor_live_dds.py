@@ -40,6 +40,8 @@ from typing import Any
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "src"))
 sys.path.insert(0, str(ROOT / "bench"))
+from _pace import paced  # noqa: E402
+
 MSG = ROOT / "backends" / "monitors" / "msg"
 CONFIG = """<?xml version="1.0" encoding="UTF-8"?>
 <CycloneDDS xmlns="https://cdds.io/config"><Domain Id="any">
@@ -88,19 +90,7 @@ def publisher(rate: float, seconds: float, out: Path, nodes: list[str]) -> int:
         time.sleep(0.05)
     time.sleep(0.5)
     msgs = [(e["topic"], book.build(Snapshot, e)) for e in lines]
-    n = int(rate * seconds)
-    sent: list[tuple[str, float]] = []
-    start = time.monotonic()
-    for k in range(n):
-        due = start + k / rate
-        wait = due - time.monotonic()
-        if wait > 0:
-            time.sleep(wait)
-        topic, msg = msgs[k % len(msgs)]
-        t = time.time()
-        pubs[topic].write(msg)
-        sent.append((topic, t))
-    elapsed = time.monotonic() - start
+    sent, elapsed = paced(msgs, rate, seconds, lambda topic, msg: pubs[topic].write(msg))
     out.write_text(json.dumps({"sent": sent, "elapsed": elapsed}))
     time.sleep(1.0)
     return 0
