@@ -241,7 +241,24 @@ def value_mapper(typ: T.Type, rule: TopicRule) -> Any:
             elif isinstance(v, str):
                 return v
         raise MappingError(f"no field left for the value of type {typ}")
-    return mapper
+    if names is None or len(names) != 1:
+        return mapper
+    only = names[0]
+
+    def one_field(fields: Mapping[str, Any], previous: Any) -> Any:
+        # one named field (the common rule) holding a finite float or a string: the value itself; anything
+        # else (a path, a missing field, another type, NaN) goes the general way above, with its errors
+        try:
+            v = fields[only]
+        except (KeyError, TypeError, IndexError):
+            return mapper(fields, previous)
+        if real:
+            if type(v) is float and isfinite(v):
+                return v
+        elif type(v) is str:
+            return v
+        return mapper(fields, previous)
+    return one_field
 
 
 def initial_value(typ: T.Type, rule: TopicRule) -> Any:

@@ -59,6 +59,7 @@ from ...system.services import peers
 from ...traces.events import Event
 from ...traces.mapping import MappingError, TopicRule, initial_value, value_mapper
 from ...values import render
+from .needs_answer import answer_decides
 from .skew import EarlyOutputs, early_reason
 
 VERDICTS = ("satisfied", "violated", "open", "assumption violated", "inconclusive", "incomplete input")
@@ -70,6 +71,7 @@ LINK_TOPICS = {"service": ("request", "response"), "action": ("goal", "feedback"
 _WEAK = {"exact": 0, "double": 1, "tolerance": 2}
 _NO_RULE = TopicRule()  # the rule of a topic the mapping does not name
 _NEVER = float("inf")
+_NO_TRIGGERS: frozenset[str] = frozenset()
 
 
 def _reads(e: Any, out: set[str]) -> None:
@@ -293,6 +295,9 @@ class NodeMonitor:
         self._feeds = {topic: [(key, value_mapper(typ, rules.get(topic, _NO_RULE)), inp,
                                 self._parts.get((topic, key), "")) for key, typ, inp in vs]
                        for topic, vs in self.topics.items()}
+        #: per topic, the inputs it sets (the triggers of its events) and the outputs, made once
+        self._topic_io = {topic: (frozenset(k for k, _, inp in vs if inp), [k for k, _, inp in vs if not inp])
+                          for topic, vs in self.topics.items()}
         self.values: dict[str, Any] = {}
         for topic, vs in self.topics.items():
             for key, typ, _ in vs:
@@ -345,6 +350,10 @@ class NodeMonitor:
         self.result.evaluation = {(f"assumption {k[1] + 1}" if isinstance(k, tuple) else f"guarantee {k}"):
                                   (j.fallback or "compiled") for k, j in self._judges.items()}
         self._in_keys = self._keys["in."]
+        # a question's guarantees evaluated when it comes, unless Z3 showed that only an answer decides them
+        # (needs_answer.py: a speed fact; the value mappers refuse a NaN or infinite REAL, Z3's reals have none)
+        self._ask_at_question = not (self.has_inputs and not self._state_outs and not self._trigger
+                                     and answer_decides(checked, node, self.guarantees))
 
     # -- evaluation --------------------------------------------------------------
     def _judge(self, k: Any, formula: ast.Expr, values: Mapping[str, Any]) -> Judgement:
@@ -410,11 +419,8 @@ class NodeMonitor:
         if vs is None:
             return
         self.result.events += 1
-        is_input = False
-        changed: list[str] = []
-        trig: set[str] = set()
         values = self.values
-        for key, mapper, inp, part in vs:
+        for key, mapper, _inp, part in vs:
             fields: Any = ev.fields
             try:
                 if part:
@@ -425,15 +431,11 @@ class NodeMonitor:
             except MappingError as exc:
                 self._note_inconclusive(ev, 0, f"{key}: {exc}")
                 return
-            if inp:
-                is_input = True
-                trig.add(key)
-            else:
-                changed.append(key)
+        trig, changed = self._topic_io[ev.topic]  # every variable of the topic was set: made once, not per event
         if changed:
             self._output(ev, changed)
-        if is_input or (changed and not self.has_inputs):
-            self._input(ev, frozenset(trig))
+        if trig or (changed and not self.has_inputs):
+            self._input(ev, trig)
 
     def _state(self) -> dict[str, Any]:
         """The outputs on state topics as they stand (observed ones only)."""
@@ -453,8 +455,9 @@ class NodeMonitor:
                 self._verdict("incomplete input", ev, reason="no value yet for " + ", ".join(missing))
                 return
         accepted = "exact"
+        judges = self._judges
         for aj, formula in self._assumed:
-            judged = self._judge(aj, formula, inputs)
+            judged = judges[aj].quick(inputs) or self._judge(aj, formula, inputs)  # the compiled code first
             ok, reason = judged.truth, judged.reason
             if ok is False:
                 mentioned: set[str] = set()
@@ -486,7 +489,7 @@ class NodeMonitor:
             return
         # the question: the inputs, and which triggers of the node's guarantees this event set (a node
         # without triggered guarantees groups its events by their inputs alone, as before)
-        trig = trig & self._triggers
+        trig = trig & self._triggers if self._triggers else _NO_TRIGGERS
         ikey = (tuple(inputs.items()), trig)
         key = (ikey, ())  # no answer yet: only a group that has none either is the same obligation
         group = self.pending.get(key)
@@ -495,14 +498,14 @@ class NodeMonitor:
         elif _WEAK[accepted] > _WEAK[group.accepted]:
             group.accepted = accepted
         group.events.append(ev)
-        stamped = ev.stamped
+        stamped = ev.time if ev.stamp is None else ev.stamp  # ev.stamped, inline: this runs for every input
         if stamped > group.ref:
             group.ref = stamped
         group.superseded = None  # the same question asked again: the answer to come answers both
         due = ev.time + self.horizon
         if due < self._due:
             self._due = due
-        if len(group.events) == 1:
+        if len(group.events) == 1 and self._ask_at_question:
             done: list[Any] = []
             self._evaluate(key, group, ev, self._state() if self._state_outs else {}, done)
             for k in done:
@@ -527,9 +530,10 @@ class NodeMonitor:
             self._early.remember((ev, fresh))
         done: list[Any] = []
         rekey = False
-        stamped = ev.stamped
+        stamped = ev.time if ev.stamp is None else ev.stamp  # ev.stamped, inline
+        has_fresh = bool(fresh)
         for key, g in self.pending.items():
-            answered = bool(fresh) and stamped >= g.ref
+            answered = has_fresh and stamped >= g.ref
             if answered:
                 g.outs.update(fresh)
                 rekey = True
@@ -556,10 +560,11 @@ class NodeMonitor:
         weakest = g.accepted
         inexact: list[tuple[int, Judgement]] = []
         failed_semantics = ""
+        judges, trigger = self._judges, self._trigger
         for k, formula in self._guaranteed:
-            if k in self._trigger and self._trigger[k] not in g.triggers:
+            if trigger and k in trigger and trigger[k] not in g.triggers:
                 continue  # triggered by another input: no answer to these events is owed (docs/monitors.md)
-            judged = self._judge(k, formula, values)
+            judged = judges[k].quick(values) or self._judge(k, formula, values)  # the compiled code first
             ok, reason = judged.truth, judged.reason
             if ok is False:
                 failed, failed_semantics = k, judged.semantics

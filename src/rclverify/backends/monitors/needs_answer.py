@@ -1,0 +1,111 @@
+"""Which guarantees only an answer can decide (a speed fact, never a verdict).
+
+The monitor evaluates a question's guarantees when the question comes
+(docs/monitors.md, "An answer comes after its question"), on its inputs and
+the state outputs, before any answer: a guarantee whose inputs alone decide
+it (``in.on -> ...`` with ``in.on`` false) is ``satisfied`` or failed there.
+For most guarantees the evaluation only meets a missing output, and that
+costs about a fifth of the engine's time on a classifier (issue 44).
+
+:func:`answer_decides` asks Z3 once per node whether **no** value of the
+inputs decides a guarantee without the outputs: neither ``forall out. G``
+nor ``forall out. not G`` holds for any value of the inputs.  Then an
+evaluation on the inputs alone can only meet a missing output (a value
+computed without reading an output would be the same for every output, so
+one of the two would hold), and the monitor skips it.  The argument needs
+the recorded values to lie in Z3's domains, so it is made only where they
+do:
+
+* every formula of the node is quantifier-free, over inputs of type REAL,
+  BOOL or an enumeration (a recorded INTEGER could be 2.5), scalar
+  outputs, numbers, enumeration
+  values and ``+ - *``, comparisons and the connectives: no division, no
+  function, no set or sequence (nothing that can raise while evaluating);
+* the node has no state outputs (all its outputs are missing at the
+  question) and no ``triggered by`` guarantee;
+* a REAL input's recorded value is a finite number: the value mappers
+  refuse NaN and the infinities (``traces/mapping.py``; that event is
+  ``inconclusive``), which Z3's reals do not have.
+
+Anything else, and any ``unknown`` from Z3, answers ``False``: evaluate as
+before.  Skipping never changes a verdict, its guarantee, its reason or when
+it is decided; ``tests/test_monitor_needs_answer.py`` checks the verdicts
+with and without on random traces.
+"""
+from __future__ import annotations
+
+from typing import Any, Iterable, Mapping
+
+import z3
+
+from ...logic.encode import Encoder
+from ...rcl import ast
+from ...rcl.types import BOOL, INTEGER, NATURAL, REAL, Checked, CheckedNode, EnumT
+
+#: Z3's budget for each of the two queries of a guarantee (ms).
+QUERY_MS = 500
+_SCALARS = (REAL, INTEGER, NATURAL, BOOL)
+_OPS = ("<=>", "->", "or", "and", "+", "-", "*")
+#: (id of the checked system, node, ids of the formulas) -> (the system, the answer)
+_CACHE: dict[tuple[Any, ...], tuple[Checked, bool]] = {}
+
+
+def _plain(e: ast.Expr) -> bool:
+    """Quantifier-free, division-free, function-free scalar formula?"""
+    if isinstance(e, (ast.BoolLit, ast.NumLit, ast.Var)):
+        return True
+    if isinstance(e, ast.Unary):
+        return _plain(e.operand)
+    if isinstance(e, ast.Binary):
+        return e.op in _OPS and _plain(e.left) and _plain(e.right)
+    if isinstance(e, ast.Compare):
+        return all(_plain(x) for x in e.operands)
+    return False
+
+
+def _scalar(t: Any) -> bool:
+    return t in _SCALARS or isinstance(t, EnumT)
+
+
+def answer_decides(checked: Checked, node: CheckedNode, formulas: Iterable[ast.Expr]) -> bool:
+    """``True`` when Z3 shows that no value of ``node``'s inputs decides any
+    of ``formulas`` (its guarantees) without its outputs; ``False`` when a
+    value may, when a formula is outside the fragment above, or when Z3
+    cannot say within :data:`QUERY_MS` per query.  Raises nothing."""
+    formulas = list(formulas)
+    if not formulas or not all(_plain(f) for f in formulas):
+        return False
+    if not all(t in (REAL, BOOL) or isinstance(t, EnumT) for t in node.inputs.values()):
+        return False
+    if not all(_scalar(t) for t in node.outputs.values()):
+        return False
+    key = (id(checked), node.name, tuple(map(id, formulas)))
+    hit = _CACHE.get(key)
+    if hit is not None and hit[0] is checked:
+        return hit[1]
+    answer = _decides(checked, node, formulas)
+    if len(_CACHE) >= 64:
+        _CACHE.clear()
+    _CACHE[key] = (checked, answer)
+    return answer
+
+
+def _decides(checked: Checked, node: CheckedNode, formulas: list[ast.Expr]) -> bool:
+    try:
+        enc = Encoder(checked.env)
+        outs = [enc.io_symbol(node, "out", v) for v in sorted(node.outputs)]
+        encoded = [enc.formula(f, node) for f in formulas]
+        typed = z3.And(*enc.axioms()) if enc.axioms() else z3.BoolVal(True)
+        for g in encoded:
+            for goal in (g, z3.Not(g)):
+                s = z3.Solver()
+                s.set("timeout", QUERY_MS)
+                s.add(z3.ForAll(outs, z3.Implies(typed, goal)) if outs else goal)
+                if s.check() != z3.unsat:  # a value of the inputs decides it (or Z3 cannot say)
+                    return False
+    except Exception:  # noqa: BLE001 - a speed fact: anything unexpected keeps the evaluation
+        return False
+    return True
+
+
+__all__ = ["QUERY_MS", "answer_decides"]
