@@ -241,7 +241,7 @@ def value_mapper(typ: T.Type, rule: TopicRule) -> Any:
             elif isinstance(v, str):
                 return v
         raise MappingError(f"no field left for the value of type {typ}")
-    if names is None or len(names) != 1:
+    if len(names) != 1:
         return mapper
     only = names[0]
 

@@ -291,9 +291,9 @@ class NodeMonitor:
                 if lk.kind == "action":
                     self._parts[(topic, key)] = suffix
         self.has_inputs = any(i for vs in self.topics.values() for _, _, i in vs)
-        #: per topic, what its message sets, made once: (variable, its mapper, input?, actionlib part)
-        self._feeds = {topic: [(key, value_mapper(typ, rules.get(topic, _NO_RULE)), inp,
-                                self._parts.get((topic, key), "")) for key, typ, inp in vs]
+        #: per topic, what its message sets, made once: (variable, its mapper, actionlib part)
+        self._feeds = {topic: [(key, value_mapper(typ, rules.get(topic, _NO_RULE)),
+                                self._parts.get((topic, key), "")) for key, typ, _ in vs]
                        for topic, vs in self.topics.items()}
         #: per topic, the inputs it sets (the triggers of its events) and the outputs, made once
         self._topic_io = {topic: (frozenset(k for k, _, inp in vs if inp), [k for k, _, inp in vs if not inp])
@@ -420,7 +420,7 @@ class NodeMonitor:
             return
         self.result.events += 1
         values = self.values
-        for key, mapper, _inp, part in vs:
+        for key, mapper, part in vs:
             fields: Any = ev.fields
             try:
                 if part:
