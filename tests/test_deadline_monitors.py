@@ -108,9 +108,10 @@ def test_monitors_evidence_carries_the_deadlines(tmp_path: Path) -> None:
     assert base["details"]["deadlines"]["first_false"]["answer"] == 3.35
     mover = json.loads((ws / "artifacts" / "evidence" / "Mover.g0.monitors.nominal_jsonl.json").read_text())
     # the action's goal, feedback and result are the untimed check's events too (issue 40): the goal is
-    # answered by the feedback and the result, so guarantee 2 (untimed) is checked and holds
+    # answered by the feedback and the result, each judged (issue 47), so guarantee 2 (untimed) is checked
+    # on both and holds
     assert mover["status"] == "discharged" and mover["details"]["deadlines"]["counts"]["true"] == 1
-    assert mover["details"]["monitoring"]["counts"]["satisfied"] == 1
+    assert mover["details"]["monitoring"]["counts"]["satisfied"] == 2
 
 
 def test_a_trigger_without_deadline_is_bounded_by_the_horizon() -> None:

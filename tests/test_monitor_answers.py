@@ -1,14 +1,14 @@
-"""An answer comes after its question (docs/monitors.md, "An answer comes
-after its question"): on a recorded or live run an input event is answered
-only by outputs published after it (in trace order, stamped at or after
-it); the output current before it answered an earlier input.  Only a topic
-the mapping declares a ``state`` stands in with its current value.
+"""The one stream model (docs/semantics.md): every output message is judged
+against the question it answers (the latest at its stamp), a question
+superseded before any answer is owed nothing, an unanswered question is
+inconclusive, nothing holds before its first message.  Only a topic the
+mapping declares a ``state`` stands in with its current value.
 
-The oracle at the end checks the streaming engine (groups of pending
-obligations, merged and re-keyed as answers come) against a direct,
-quadratic reading of the rule on random traces."""
+The oracle at the end checks the streaming engine against a direct,
+quadratic reading of docs/semantics.md on random traces."""
 from __future__ import annotations
 
+from collections import Counter
 from pathlib import Path
 from typing import Any
 
@@ -73,9 +73,10 @@ def events(rows: list[tuple[float, str, Any]]) -> list[Event]:
 
 
 def run(checked: Any, rows: list[tuple[float, str, Any]], horizon: float = 1.0,
-        rules: Any = None) -> tuple[list[Any], Any]:
+        rules: Any = None, end: float | None = None) -> tuple[list[Any], Any]:
     got: list[Any] = []
-    _, [res] = check_trace(checked, [checked.nodes["Sensor"]], events(rows), rules or {}, horizon, got.append)
+    _, [res] = check_trace(checked, [checked.nodes["Sensor"]], events(rows), rules or {}, horizon, got.append,
+                           end=end)
     return sorted(got, key=lambda v: v.event), res
 
 
@@ -83,68 +84,91 @@ def by_event(verdicts: list[Any]) -> dict[int, str]:
     return {v.event: v.verdict for v in verdicts}
 
 
-# -- the issue's case ------------------------------------------------------------
+# -- answers -----------------------------------------------------------------------
 
 def test_a_stale_green_does_not_answer_a_later_reading(simple: Any) -> None:
     """r = 50 is answered green; r = 110 is answered red (wrong: < 120 is green).
-    The green still current when 110 arrives answered 50, not 110."""
+    The green still current when 110 arrives answered 50, not 110; each output
+    is judged against the question it answers."""
     got, res = run(simple, [(0.0, "r", 50.0), (0.1, "status", "green"), (1.0, "r", 110.0),
                             (1.1, "status", "red"), (5.0, "r", 60.0), (5.1, "status", "green")])
-    assert by_event(got) == {0: "satisfied", 2: "violated", 4: "satisfied"}
-    v = next(x for x in got if x.event == 2)
-    assert v.guarantee == 1 and v.values["out.status"] == "red" and "run.jsonl:4" in v.reason
-    assert res.first_violation["where"] == "run.jsonl:4"
+    assert by_event(got) == {1: "satisfied", 3: "violated", 5: "satisfied"}
+    v = next(x for x in got if x.event == 3)
+    assert v.guarantee == 1 and v.values["out.status"] == "red" and v.question == "run.jsonl:3"
+    assert res.first_violation["where"] == "run.jsonl:4" and res.first_violation["trigger_where"] == "run.jsonl:3"
 
 
-def test_an_unanswered_reading_is_violated_after_the_horizon_and_open_at_the_end(simple: Any) -> None:
-    got, _ = run(simple, [(0.0, "r", 50.0), (0.1, "status", "green"), (1.0, "r", 100.0), (3.0, "r", 90.0)])
-    assert by_event(got) == {0: "satisfied", 2: "violated", 3: "open"}
-    assert "no output" in next(v for v in got if v.event == 2).reason
+def test_every_output_is_judged_not_only_the_first_answer(simple: Any) -> None:
+    """Issue 47: after one right answer the later outputs for the same question
+    were never judged ("1 satisfied", discharged).  Each is judged now."""
+    got, res = run(simple, [(0.0, "r", 130.0), (0.1, "status", "red"), (0.2, "status", "green"),
+                            (0.3, "status", "red"), (0.4, "status", "green")])
+    assert by_event(got) == {1: "satisfied", 2: "violated", 3: "satisfied", 4: "violated"}
+    assert [v["where"] for v in res.violations] == ["run.jsonl:3", "run.jsonl:5"]
+
+
+def test_a_later_questions_answer_is_not_taken_for_an_earlier_one(simple: Any) -> None:
+    """Issue 47: red to r = 110 (wrong), then r = 300 red, then r = 100 green: the
+    green 1.5 s later answers r = 100, not r = 110 (the horizon is 5 s)."""
+    got, _ = run(simple, [(0.0, "r", 110.0), (0.1, "status", "red"), (0.5, "r", 300.0),
+                          (0.6, "status", "red"), (1.5, "r", 100.0), (1.6, "status", "green")], horizon=5.0)
+    assert by_event(got) == {1: "violated", 3: "satisfied", 5: "satisfied"}
+
+
+def test_an_unanswered_question_is_inconclusive_after_the_horizon_and_open_at_the_end(simple: Any) -> None:
+    got, res = run(simple, [(0.0, "r", 50.0), (0.1, "status", "green"), (1.0, "r", 100.0)], end=3.0)
+    assert by_event(got) == {1: "satisfied", 2: "inconclusive"}
+    assert "unanswered" in next(v for v in got if v.event == 2).reason
+    got, _ = run(simple, [(0.0, "r", 50.0), (0.1, "status", "green"), (1.0, "r", 100.0)], end=1.5)
+    assert by_event(got) == {1: "satisfied", 2: "open"}
 
 
 def test_equal_stamps_are_ordered_by_the_trace(simple: Any) -> None:
     """Same stamp: an output logged after the input answers it (one callback);
-    one logged before it was current before the question."""
+    one logged before it answers no question (it was current before)."""
     got, _ = run(simple, [(1.0, "r", 50.0), (1.0, "status", "green")])
-    assert by_event(got) == {0: "satisfied"}
-    got, _ = run(simple, [(1.0, "status", "green"), (1.0, "r", 50.0), (3.0, "r", 130.0)])
-    assert by_event(got)[1] == "violated"
+    assert by_event(got) == {1: "satisfied"}
+    got, res = run(simple, [(1.0, "status", "green"), (1.0, "r", 50.0), (3.0, "r", 130.0)])
+    assert by_event(got) == {1: "inconclusive", 2: "open"} and res.unasked == 1
 
 
 def test_an_output_stamped_before_the_input_is_no_answer(simple: Any) -> None:
     """Logged after the input but stamped before it: computed before the question."""
-    got, _ = run(simple, [(1.0, "r", 50.0), (0.9, "status", "green"), (3.0, "r", 130.0)])
-    assert by_event(got)[0] == "violated"
+    got, res = run(simple, [(1.0, "r", 50.0), (0.9, "status", "red")], end=3.0)
+    assert by_event(got) == {0: "inconclusive"} and res.unasked == 1
 
 
 def test_a_state_topic_stands_in_with_its_current_value(simple: Any) -> None:
     rows = [(0.0, "r", 50.0), (0.1, "status", "green"), (1.0, "r", 60.0), (3.0, "r", 130.0)]
     got, _ = run(simple, rows)
-    assert by_event(got)[2] == "violated"
-    got, _ = run(simple, rows, rules=load_rules({"status": {"state": True}}))
-    assert by_event(got)[2] == "satisfied"
+    assert by_event(got) == {1: "satisfied", 2: "inconclusive", 3: "open"}
+    got, _ = run(simple, rows, rules=load_rules({"status": {"state": True}}), end=5.0)
+    assert by_event(got) == {1: "satisfied", 2: "satisfied", 3: "violated"}
 
 
-def test_a_question_superseded_before_any_answer_is_inconclusive_not_violated(simple: Any) -> None:
-    """Two readings before the sensor answers: its answer (red, right for 130)
-    answers the inputs as they stood then; whether it ever answered 50 cannot
-    be told: inconclusive with the reason, never satisfied."""
+def test_a_question_superseded_before_any_answer_is_owed_nothing(simple: Any) -> None:
+    """Two readings before the sensor answers: the node owes the latest one an
+    answer (the paper's one-in, one-out streams); the first is superseded,
+    neither a failure nor inconclusive, and counted."""
     got, res = run(simple, [(0.0, "r", 50.0), (0.1, "r", 130.0), (0.2, "status", "red"), (5.0, "r", 10.0)])
-    assert by_event(got) == {0: "inconclusive", 1: "satisfied", 3: "open"}
-    assert "came before any output answered" in res.first_inconclusive["reason"]
+    assert by_event(got) == {0: "superseded", 2: "satisfied", 3: "open"}
+    assert res.counts["superseded"] == 1 and res.first_inconclusive is None
 
 
-def test_a_node_that_never_answers_is_violated(simple: Any) -> None:
-    got, _ = run(simple, [(float(t), "r", 50.0 + t) for t in range(6)])
-    assert [v.verdict for v in got][:4] == ["violated"] * 4
+def test_a_node_that_never_answers_is_never_discharged(simple: Any) -> None:
+    from rclverify.backends.monitors.backend import verdict_status
+    got, res = run(simple, [(float(t), "r", 50.0 + t) for t in range(6)], end=9.0)
+    assert [v.verdict for v in got] == ["superseded"] * 5 + ["inconclusive"]
+    assert verdict_status(res, "run.jsonl")[0] == "inconclusive"
 
 
 def test_a_partial_answer_names_the_output_it_waits_for(sensor: Any) -> None:
     got, res = run(sensor, [(0.0, "on", True), (0.1, "r", 50.0), (0.2, "status", "green"), (3.0, "r", 60.0)])
-    v = next(x for x in got if x.event == 1)
+    assert [v.verdict for v in got if v.event == 2] == ["satisfied", "inconclusive"]
+    v = next(x for x in got if x.guarantee == 2)
     # level never published after the reading: some level would satisfy guarantee 2, so it is undecided, not
     # false (a false alarm on a node whose level is latched); the reason says how to declare that
-    assert v.verdict == "inconclusive" and v.guarantee == 2 and "out.level" in v.reason
+    assert v.verdict == "inconclusive" and "out.level" in v.reason and v.question == "run.jsonl:2"
     assert "state: true" in v.reason and v.values["out.status"] == "green"
     assert res.first_violation is None
 
@@ -157,7 +181,7 @@ def test_the_online_engine_applies_the_same_rule(simple: Any) -> None:
     eng.push("r", {"value": 110.0}, 2.0)
     eng.push("status", {"level": "red"}, 2.1)
     eng.tick(3.0)
-    assert [(v.event, v.verdict) for v in got] == [(0, "satisfied"), (2, "violated")]
+    assert [(v.event, v.verdict) for v in got] == [(1, "satisfied"), (3, "violated")]
 
 
 def test_a_late_output_live_is_judged_by_its_own_stamp(simple: Any) -> None:
@@ -169,7 +193,7 @@ def test_a_late_output_live_is_judged_by_its_own_stamp(simple: Any) -> None:
     eng.push("r", {"header": {"stamp": {"secs": 2, "nsecs": 0}}, "value": 110.0}, 2.0)
     eng.push("status", {"header": {"stamp": {"secs": 1, "nsecs": 900_000_000}}, "level": "green"}, 2.05)
     eng.tick(3.0)
-    assert eng.late == 1 and [v.verdict for v in got] == ["violated"]
+    assert eng.late == 1 and [v.verdict for v in got] == ["inconclusive"] and "unanswered" in got[0].reason
 
 
 def test_the_deadline_monitor_applies_the_same_rule(tmp_path: Path) -> None:
@@ -270,11 +294,21 @@ def test_a_triggered_guarantee_is_owed_only_to_its_triggers_events(tmp_path: Pat
     rows = [(0.0, "cmd", {"v": 1.0}), (0.05, "wheel", {"v": 1.0}), (0.5, "query", {"b": True}),
             (0.55, "limit", {"v": 1.5}), (1.0, "cmd", {"v": 0.5}), (1.05, "wheel", {"v": 0.5})]
     got, res = _channels(tmp_path, "Base", rows, end=5.0)
-    assert {k: v.verdict for k, v in got.items()} == {0: "satisfied", 2: "satisfied", 4: "satisfied"}
+    assert {k: v.verdict for k, v in got.items()} == {1: "satisfied", 3: "satisfied", 5: "satisfied"}
     rows[3] = (0.55, "limit", {"v": 2.5})
     got, res = _channels(tmp_path, "Base", rows, end=5.0)
-    assert {k: v.verdict for k, v in got.items()} == {0: "satisfied", 2: "violated", 4: "satisfied"}
-    assert got[2].guarantee == 2
+    assert {k: v.verdict for k, v in got.items()} == {1: "satisfied", 3: "violated", 5: "satisfied"}
+    assert got[3].guarantee == 2
+
+
+def test_a_trigger_superseded_before_its_answer_is_still_owed(tmp_path: Path) -> None:
+    """Issue 47: a button pressed 20 us before an acknowledgement changes: the
+    button's question is superseded, and the question that superseded it
+    carries the button, so the request that answers it is judged (a wrong
+    request is violated, not skipped)."""
+    rows = [(0.0, "button", {"b": True}), (0.00002, "ack", {"b": False}), (0.01, "req", {"b": False})]
+    got, res = _channels(tmp_path, "Caller", rows, end=5.0)
+    assert {k: v.verdict for k, v in got.items()} == {0: "superseded", 2: "violated"}
 
 
 def test_an_event_no_guarantee_answers_gets_no_verdict(tmp_path: Path) -> None:
@@ -284,7 +318,7 @@ def test_an_event_no_guarantee_answers_gets_no_verdict(tmp_path: Path) -> None:
     satisfied."""
     rows = [(0.0, "button", {"b": True}), (0.01, "req", {"b": True}), (0.05, "ack", {"b": True})]
     got, res = _channels(tmp_path, "Caller", rows, end=5.0)
-    assert {k: v.verdict for k, v in got.items()} == {0: "satisfied"} and res.unowed == 1
+    assert {k: v.verdict for k, v in got.items()} == {1: "satisfied"} and res.unowed == 1
     from rclverify.backends.monitors.backend import summary_line
     assert summary_line(res) == "Caller: 1 satisfied, 1 owed no answer (its guarantees answer other inputs)"
 
@@ -294,71 +328,127 @@ def test_an_input_no_topic_carries_is_named_when_its_obligations_wait(tmp_path: 
     guarantee 1 waits for ever; the verdict and the evidence say why instead of
     only "unanswered"."""
     got, res = _channels(tmp_path, "Mission", [(0.0, "order", {"v": 3.0}), (0.1, "dock", {"b": False})], end=0.5)
-    assert got[0].verdict == "open"
-    assert "in.low of Mission is carried by no topic or link part" in got[0].reason
+    assert got[1].verdict == "inconclusive"
+    assert "in.low of Mission is carried by no topic or link part" in got[1].reason
     assert "carried by no topic" in res.first_inconclusive["reason"]
 
 
-# -- oracle: the streaming engine against a direct reading of the rule ------------
+# -- oracle
 
-def reference(checked: Any, rows: list[tuple[float, str, Any]], horizon: float, state: frozenset[str]) -> dict[int, str]:
-    """Per input event, from the definition: satisfied iff at the event or at
-    some later message within the horizon, every guarantee is true on the
-    event's inputs, the state outputs as they stand and the other outputs
-    set by messages after the event (an output before it is no answer).
-    Unsatisfied: ``open`` when the run ends within the horizon, else
-    ``closed`` (violated or inconclusive: both say "not met")."""
+def reference(checked: Any, rows: list[tuple[float, str, Any]], horizon: float,
+              state: frozenset[str]) -> Counter[tuple[int, str]]:
+    """The verdicts docs/semantics.md gives the Sensor contract on ``rows``
+    (times never decrease, no skew, the run ends at its last message), read
+    directly and quadratically: questions, supersession, every output judged
+    against the latest question before it on the outputs published since,
+    unanswered and partial questions closed when the run passes their horizon
+    (what a question's answer left out is owed to a newer question asked
+    within its horizon, not to it)."""
     node = checked.nodes["Sensor"]
+    g = {1: node.node.guarantees[0].formula, 2: node.node.guarantees[1].formula}
+    touches = {"status": 1, "level": 2}
+    out_key, in_key = {"status": "out.status", "level": "out.level"}, {"r": "in.r", "on": "in.on"}
     evs = events(rows)
-    out_key = {"status": "out.status", "level": "out.level"}
-    in_key = {"r": "in.r", "on": "in.on"}
-    inputs: dict[str, Any] = {}
-    verdicts: dict[int, str] = {}
-    last = evs[-1].time
+    end = evs[-1].time
+    got: Counter[tuple[int, str]] = Counter()
 
     def value(ev: Event) -> Any:
         return next(iter(ev.fields.values()))
 
+    def holds(k: int, values: dict[str, Any]) -> bool | None:
+        v = evaluate(g[k], checked, node, values)
+        return v if isinstance(v, bool) else None
+
+    def state_before(i: int) -> dict[str, Any]:  # the state outputs set by the messages before index i
+        return {out_key[e.topic]: value(e) for e in evs[:i] if e.topic in state}
+
+    inputs: dict[str, Any] = {}
+    questions: list[dict[str, Any]] = []
     for k, ev in enumerate(evs):
         if ev.topic not in in_key:
             continue
         inputs[in_key[ev.topic]] = value(ev)
         if len(inputs) < 2:
-            verdicts[k] = "incomplete input"
+            got[(k, "incomplete input")] += 1
             continue
-        if not inputs["in.r"] >= 0:
-            verdicts[k] = "assumption violated"
+        q = {"k": k, "t": ev.time, "inputs": dict(inputs), "owed": inputs["in.r"] >= 0, "decided": set()}
+        questions.append(q)
+        if not q["owed"]:
+            got[(k, "assumption violated")] += 1
             continue
-        current = {out_key[e.topic]: value(e) for e in evs[:k] if e.topic in out_key and e.topic in state}
-        fresh: dict[str, Any] = {}
-        points = [dict(inputs, **current)]
-        for e in evs[k + 1:]:
-            if e.time > ev.time + horizon:
-                break
-            if e.topic in out_key:
-                if e.topic in state:
-                    current[out_key[e.topic]] = value(e)
-                elif e.time >= ev.time:
-                    fresh[out_key[e.topic]] = value(e)
-                points.append({**inputs, **current, **fresh})
-        ok = any(all(evaluate(c.formula, checked, node, p) is True for c in node.node.guarantees) for p in points)
-        verdicts[k] = "satisfied" if ok else ("open" if ev.time + horizon >= last else "closed")
-    return verdicts
+        at_q = {i: holds(i, {**inputs, **state_before(k)}) for i in g}
+        q["decided"] = {i for i, v in at_q.items() if v is True}
+        q["settled"] = all(v is True for v in at_q.values())
+        if q["settled"]:
+            got[(k, "satisfied")] += 1
+    for m, ev in enumerate(evs):
+        if ev.topic not in out_key:
+            continue
+        before = [q for q in questions if q["k"] < m]
+        if not before or not before[-1]["owed"]:
+            continue
+        q = before[-1]
+        answer = {out_key[e.topic]: value(e) for e in evs[q["k"] + 1:m + 1]
+                  if e.topic in out_key and e.topic not in state}
+        i = touches[ev.topic]
+        v = holds(i, {**q["inputs"], **state_before(m + 1), **answer})
+        q.setdefault("judged", []).append((m, i, v))
+        if v is not None:
+            got[(m, "violated" if v is False else "satisfied")] += 1
+    for n, q in enumerate(questions):
+        if not q["owed"] or q["settled"]:
+            continue
+        k = q["k"]
+        nxt = questions[n + 1]["k"] if n + 1 < len(questions) else len(evs)
+        closed = end > q["t"] + horizon
+        cut = next((i for i, e in enumerate(evs) if e.time > q["t"] + horizon), len(evs))
+        later = [m for m in range(k + 1, min(nxt, cut)) if evs[m].topic in out_key]  # outputs before its horizon
+        answered = bool(later)
+        if nxt < min(cut, len(evs)) and not answered:
+            got[(k, "superseded")] += 1
+            continue
+        answer = {out_key[evs[m].topic]: value(evs[m]) for m in later if evs[m].topic not in state}
+        verdicts = []
+        decided, waiting = set(q["decided"]), {}
+        for m, i, v in q.get("judged", []):  # what the outputs before its horizon decided
+            if m in later:
+                if v is None:
+                    waiting[i] = m
+                else:
+                    decided.add(i)
+                    waiting.pop(i, None)
+        followed = nxt < min(cut, len(evs))  # a newer question within its horizon owes what is missing
+        if (answered or state) and not followed:
+            for i in g:
+                if i in decided:
+                    continue
+                at = waiting.get(i, later[-1] if later else k)
+                v = holds(i, {**q["inputs"], **state_before(cut), **answer})
+                if v is True:
+                    continue
+                verdicts.append((at, "violated" if v is False else "inconclusive" if closed else "open"))
+        for p in verdicts:
+            got[p] += 1
+        if not answered and not verdicts:
+            got[(k, "inconclusive" if closed else "open")] += 1
+    return got
 
 
 ROW = st.one_of(
-    st.tuples(st.just("r"), st.sampled_from([50.0, 110.0, 130.0])),
+    st.tuples(st.just("r"), st.sampled_from([50.0, 110.0, 130.0, -1.0])),
     st.tuples(st.just("on"), st.booleans()),
     st.tuples(st.just("status"), st.sampled_from(["green", "red"])),
     st.tuples(st.just("level"), st.sampled_from([50.0, 110.0, 130.0])),
 )
 
 
-@settings(max_examples=60, deadline=None)
+@settings(max_examples=150, deadline=None)
 @given(st.lists(st.tuples(st.sampled_from([0.0, 0.0, 0.3, 0.6, 1.2]), ROW), min_size=1, max_size=14),
        st.sampled_from([frozenset(), frozenset({"level"}), frozenset({"status", "level"})]))
-def test_the_engine_agrees_with_a_direct_reading_of_the_rule(sensor: Any, steps: list[Any],
-                                                             state: frozenset[str]) -> None:
+def test_the_engine_agrees_with_a_direct_reading_of_the_model(sensor: Any, steps: list[Any],
+                                                              state: frozenset[str]) -> None:
+    """Issue 47's oracle: every verdict of the engine, per message, equals the
+    brute-force judge written from docs/semantics.md."""
     t = 0.0
     rows = []
     for dt, (topic, v) in steps:  # stamps never decrease; equal stamps are common
@@ -366,7 +456,5 @@ def test_the_engine_agrees_with_a_direct_reading_of_the_rule(sensor: Any, steps:
         rows.append((t, topic, v))
     rules = load_rules({s: {"state": True} for s in state})
     got, _ = run(sensor, rows, horizon=1.0, rules=rules)
-    want = reference(sensor, rows, 1.0, state)
-    mine = {v.event: ("closed" if v.verdict in ("violated", "inconclusive") else v.verdict) for v in got}
-    assert mine == want
-
+    mine = Counter((v.event, v.verdict) for v in got)
+    assert mine == reference(sensor, rows, 1.0, state)

@@ -75,8 +75,9 @@ def test_a_twist_field_and_the_last_range_are_mapped_from_a_log(drive: Any, tmp_
     log = tmp_path / "run.jsonl"
     log.write_text("".join(json.dumps({"topic": tp, "time": t, **f}) + "\n" for t, tp, f in RUN))
     got = _verdicts(drive, read_trace(log))
-    # the scan alone is a complete input (the contract never reads the goal); the 1.5 m/s answer violates
-    assert got == [("satisfied", "1"), ("satisfied", "2"), ("satisfied", "4"), ("violated", "6"), ("open", "8")]
+    # the scan alone is a complete input (the contract never reads the goal), superseded by the goal before any
+    # answer; each command is judged against the question it answers, and the 1.5 m/s one violates
+    assert got == [("superseded", "1"), ("satisfied", "3"), ("satisfied", "5"), ("violated", "7"), ("open", "8")]
 
 
 def test_the_same_paths_read_a_ros2_bag(drive: Any, tmp_path: Path) -> None:
@@ -102,7 +103,7 @@ def test_the_same_paths_read_a_ros2_bag(drive: Any, tmp_path: Path) -> None:
                 msg = F64(f["data"])
             w.write(conns[tp], int(t * 1e9), store.serialize_cdr(msg, kinds[tp]))
     got = _verdicts(drive, read_trace(bag))
-    assert [v for v, _ in got] == ["satisfied", "satisfied", "satisfied", "violated", "open"]
+    assert [v for v, _ in got] == ["superseded", "satisfied", "satisfied", "violated", "open"]
 
 
 def test_a_missing_step_is_inconclusive_with_the_fields_there_are(drive: Any, tmp_path: Path) -> None:

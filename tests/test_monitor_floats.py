@@ -95,7 +95,7 @@ def test_the_evidence_says_which_semantics_decided(checked: Any, tmp_path: Path)
     _, (res,) = check_trace(checked, [checked.nodes["Scale"]], read_trace(_log(tmp_path, RUN[:4] + RUN[-1:])), {}, 5.0)
     status, text = verdict_status(res, "run.jsonl")
     assert status == "discharged"
-    assert "2 only in the node's double arithmetic (first at run.jsonl:1: guarantee 1 (out.d == 1000 * in.r))" in text
+    assert "2 only in the node's double arithmetic (first at run.jsonl:2: guarantee 1 (out.d == 1000 * in.r))" in text
 
 
 def test_an_output_over_a_bound_is_a_violation_unless_a_tolerance_is_declared(checked: Any, tmp_path: Path) -> None:

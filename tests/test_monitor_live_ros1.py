@@ -128,7 +128,7 @@ def test_live_verdicts_equal_the_offline_verdicts_for_the_same_messages(live_run
     assert sorted(map(_key, live)) == sorted(_key(v.to_json()) for v in offline)
 
 
-def test_the_injected_fault_is_reported_online_within_the_response_time(live_run: dict[str, Any]) -> None:
+def test_the_injected_fault_is_reported_online_at_once(live_run: dict[str, Any]) -> None:
     got = [json.loads(line) for line in (live_run["tmp"] / "topic.jsonl").read_text().splitlines()]
     bad = [g for g in got if g["data"]["node"] == "RadiationSensor" and g["data"]["verdict"] == "violated"]
     assert bad, got[-5:]
@@ -139,9 +139,10 @@ def test_the_injected_fault_is_reported_online_within_the_response_time(live_run
     first = fault[0]
     assert first["data"]["guarantee"] == 1
     assert first["data"]["values"]["out.radiationStatus"] == "orange"
-    # reported by the timer once the response time passed, not at the next message or at the end
+    # a wrong answer is violated whatever comes later (docs/semantics.md): reported once the transport skew
+    # passed, well within the response time, not at the next message or at the end
     delay = first["received"] - first["data"]["time"]
-    assert HORIZON <= delay < HORIZON + 1.0, delay
+    assert 0 <= delay < HORIZON, delay
     # every verdict the log records was published on the topic
     assert len(got) == len(_live_verdicts(live_run["tmp"] / "live.jsonl"))
 

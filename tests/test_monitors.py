@@ -108,15 +108,14 @@ def test_sensor_fault_is_flagged_at_the_wrong_status_with_guarantee_1(checked: A
 
 
 def test_nominal_run_does_not_fail_the_sensor(checked: Any, cfg: Any) -> None:
-    """No violation; the commands inspect(3) and inspect(5) reach the sensor
-    with the previous waypoint's reading, and the reading that follows comes
-    before any answer, so the answer (right for the new reading) cannot be
-    told apart: inconclusive, not satisfied by the status still current from
-    the last waypoint (docs/monitors.md, "An answer comes after its question")."""
+    """No violation, nothing undecided (issue 47): each command ``inspect(i)``
+    reaches the sensor with the previous waypoint's reading, and the reading
+    that follows comes before any answer, so the command's question is
+    superseded (the sensor owes the latest one an answer) and the answer is
+    judged against the new reading (docs/semantics.md)."""
     res = verdicts(checked, cfg, "nominal.jsonl")
-    assert res.counts["violated"] == 0 and res.counts["satisfied"] == 13
-    assert res.counts["inconclusive"] == 2 and res.counts["open"] == 1
-    assert res.first_inconclusive["where"] == "nominal.jsonl:36"
+    assert res.counts["violated"] == 0 and res.counts["satisfied"] == 11
+    assert res.counts["inconclusive"] == 0 and res.counts["open"] == 0 and res.counts["superseded"] == 5
     assert res.first_violation is None and res.first_assumption_violation is None
 
 
@@ -234,9 +233,9 @@ def test_backend_evidence_for_the_bundled_runs(exported: Path) -> None:
     obs = b.export(t)
     assert [o.instance for o in obs] == ["nominal_jsonl", "sensor_fault_jsonl", "env_fault_jsonl"]
     evs = {o.instance: b.run(o, t) for o in obs}
-    assert evs["nominal_jsonl"].status == "inconclusive"
+    assert evs["nominal_jsonl"].status == "discharged"
     assert evs["sensor_fault_jsonl"].status == "failed"
-    assert evs["env_fault_jsonl"].status == "inconclusive"
+    assert evs["env_fault_jsonl"].status == "discharged"  # the environment is blamed, not the sensor
     m = evs["sensor_fault_jsonl"].details["monitoring"]
     assert m["first_violation"]["guarantee"] == 1 and len(m["sha256"]) == 64 and m["events_read"] > 50
     assert "rosbags" in evs["nominal_jsonl"].tool_version
@@ -263,7 +262,7 @@ def test_cli_reports_verdicts_then_a_located_error(exported: Path, capsys: pytes
     assert err.strip().startswith(f"{bad}:2:") and "error:" in err
     rc = main(["monitor", "-w", str(exported), "--horizon", "2", str(TRACES / "nominal.jsonl")])
     out, _ = capsys.readouterr()
-    assert "RadiationSensor: 13 satisfied, 1 open, 2 inconclusive" in out
+    assert "RadiationSensor: 11 satisfied, 2 incomplete input, 5 superseded" in out
     assert rc == 1  # the published Agent and Navigation contracts are violated by any run
 
 

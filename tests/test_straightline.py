@@ -301,7 +301,9 @@ def test_a_classifier_run_with_wrong_answers_gets_the_same_verdicts(tmp_path: Pa
         slow = _verdicts(checked, nodes, read_trace(tmp_path / "run.jsonl"), {}, 2.0)
     assert fast == slow
     counts = fast[1][1][0]["counts"]
-    assert counts["violated"] == 3 and counts["assumption violated"] == 1 and counts["satisfied"] == 7, counts
+    # two wrong answers violated, the reading without an answer unanswered (inconclusive)
+    assert counts["violated"] == 2 and counts["inconclusive"] == 1, counts
+    assert counts["assumption violated"] == 1 and counts["satisfied"] == 7, counts
     # the debug field says how each formula ran (not in the evidence record)
     _, (res,) = check_trace(checked, nodes, read_trace(tmp_path / "run.jsonl"), {}, 2.0)
     assert res.evaluation == {"assumption 1": "compiled", "guarantee 1": "compiled"}

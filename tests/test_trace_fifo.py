@@ -123,7 +123,7 @@ def test_the_monitors_backend_records_an_error(tmp_path: Path) -> None:
     assert r.returncode == 0, r.stderr
     got = json.loads(r.stdout)
     assert got["nominal_bag"][0] == "error" and "metadata.yaml: error: a FIFO" in got["nominal_bag"][1]
-    assert got["nominal_jsonl"][0] == "inconclusive"
+    assert got["nominal_jsonl"][0] == "discharged"
 
 
 def test_a_fifo_message_definition_is_refused_not_read(tmp_path: Path) -> None:

@@ -57,8 +57,9 @@ from ...rcl.types import Checked, CheckedNode
 from ...rcl.walk import subexpressions
 from ...traces.events import Event
 from ...traces.mapping import MappingError, TopicRule, map_value
-from .check import LINK_TOPICS
+from ...traces.questions import Question, QuestionStream
 from .online import header_stamp
+from .verdicts import LINK_TOPICS, names
 
 DEADLINE_VERDICTS = ("true", "currently_false", "false")
 #: Why a trigger got no deadline verdict (:attr:`DeadlineResult.unaccepted`).
@@ -178,6 +179,13 @@ class DeadlineMonitor:
                       if key.startswith("out.") and (part or not rules.get(topic, TopicRule()).state)}
         self.state_outs = frozenset(key for keys in self.bindings.values() for key, _ in keys
                                     if key.startswith("out.") and key not in event_outs)
+        mentioned: set[str] = set()
+        for f in self.assumption + tuple(c.formula for c in node.node.guarantees):
+            names(f, mentioned)
+        #: every input the contract reads: a trigger before all have a value raises no question (docs/semantics.md)
+        self.needed = sorted(f"in.{v}" for v in node.inputs if v in mentioned or f"in.{v}" in mentioned)
+        #: the node's questions: an answer is judged on the latest at its stamp (a superseded trigger is carried)
+        self.stream = QuestionStream()
         self.values: dict[str, Any] = {}
         self.pending: list[_Pending] = []
         self.expired: deque[_Pending] = deque(maxlen=256)  # judged false, waiting for a late answer to show
@@ -226,11 +234,17 @@ class DeadlineMonitor:
                     p.outs.update(fresh)
             self._answer(ev, stamp, outs)
         self.advance(stamp)
+        if not any(c.startswith("in.") for c in changed):
+            return
+        inputs = {key: v for key, v in self.values.items() if key.startswith("in.")}
+        missing = [k for k in self.needed if k not in inputs]
+        refused = (("incomplete input", "no value yet for " + ", ".join(missing)) if missing else
+                   self._refused(inputs))
+        if not missing:
+            self.stream.ask(Question(ev, stamp, inputs, owed=refused is None))
         triggered = [t for t in self.timed if t[2] in changed]
         if not triggered:
             return
-        inputs = {key: v for key, v in self.values.items() if key.startswith("in.")}
-        refused = self._refused(inputs)
         for k, cl, trig, _, d in triggered:
             if refused is None:
                 self.pending.append(_Pending(k, ev, stamp, stamp + d, inputs))
@@ -269,7 +283,7 @@ class DeadlineMonitor:
             if not (gouts & outs) or stamp < p.stamp:
                 keep.append(p)
                 continue
-            j = judge(cl.formula, self.checked, self.node, self._visible(p), self.tolerance)
+            j = judge(cl.formula, self.checked, self.node, self._visible(p, stamp), self.tolerance)
             if j.truth is not True:
                 p.rejected = f"the output at {ev.where} did not satisfy guarantee {k}" + (
                     f" (false in {j.semantics} arithmetic)" if j.truth is False and "double" in j.semantics else
@@ -292,12 +306,15 @@ class DeadlineMonitor:
         _, cl, _, gouts, _ = next(t for t in self.timed if t[0] == p.k)
         if not (gouts & outs) or stamp < p.stamp:
             return False
-        return judge(cl.formula, self.checked, self.node, self._visible(p), self.tolerance).truth is True
+        return judge(cl.formula, self.checked, self.node, self._visible(p, stamp), self.tolerance).truth is True
 
-    def _visible(self, p: _Pending) -> dict[str, Any]:
-        """What obligation ``p`` is judged on: its trigger's inputs, the state
+    def _visible(self, p: _Pending, stamp: float | None = None) -> dict[str, Any]:
+        """What obligation ``p`` is judged on for an output stamped ``stamp``:
+        the inputs of the latest question at that stamp (the trigger's own, or
+        the accepted question that superseded it: docs/semantics.md), the state
         outputs as they stand and the outputs published since its trigger."""
-        values = dict(p.inputs)
+        q = self.stream.at(stamp) if stamp is not None else None
+        values = dict(q.inputs if q is not None and q.owed and q.stamp >= p.stamp else p.inputs)
         values.update({key: v for key, v in self.values.items() if key in self.state_outs and v is not None})
         values.update(p.outs)
         return values

@@ -1,0 +1,597 @@
+"""The verdict engine: one node's contract judged on a stream of messages.
+
+The stream model is docs/semantics.md's, asked of
+:mod:`rclverify.traces.questions` (paper lines 462-495 for the contract,
+1866-1869 for the one-in/one-out stream assumption, 791-980 for the
+monitors).  Per node:
+
+* a topic has no value until its first message, then its latest message;
+* an input message raises a **question** (the inputs as they stand) once
+  every input the contract reads has a value (before: ``incomplete
+  input``); its assumption false: ``assumption violated`` (blamed on the
+  producer), and the node owes it nothing; a question followed by another
+  before any output is ``superseded`` (neither a failure nor inconclusive);
+* **every output message is judged**: the guarantees that read an input
+  against the question it answers (the latest at its stamp, and those
+  within the transport skew after it, where both readings must agree), on
+  the outputs published since that question (a topic the mapping declares a
+  ``state`` with its current value); the guarantees over outputs only on
+  the outputs as they stand.  False: ``violated``, whatever comes later;
+  all that it decides true: ``satisfied``; undecided: ``inconclusive``.  A
+  guarantee that reads an output not published since the question waits
+  for it (a partial answer, judged when the horizon passes);
+* a question whose owed guarantees its inputs alone decide is ``satisfied``
+  (or ``violated``) at once; one with no output within the horizon is
+  unanswered, ``inconclusive`` (a deadline, :mod:`.deadlines`, fails it);
+  ``open`` when the run ends first.
+
+:meth:`NodeMonitor.feed` takes one event, :meth:`NodeMonitor.advance` moves
+the clock (a live monitor's timer), every verdict goes to ``on_verdict``
+as it is decided.  Memory holds the values, the recent questions, the
+outputs waiting for the skew to pass and a bounded evaluation cache.
+"""
+from __future__ import annotations
+
+from collections import deque
+from typing import Any, Callable, Mapping
+
+from ...logic.floatsem import Judgement, Tolerance, judge
+from ...logic.judges import FormulaJudge
+from ...rcl import ast
+from ...rcl.printer import expr_to_rcl
+from ...rcl.types import Checked, CheckedNode
+from ...traces.events import Event
+from ...traces.mapping import MappingError, TopicRule, initial_value, value_mapper
+from ...traces.questions import Question, QuestionStream
+from ...values import render
+from .needs_answer import answer_decides
+from .outcome import Outcome, combine, skew_reason
+from .verdicts import LINK_TOPICS, NodeResult, Verdict, in_all, link_of, names, producers, reads
+
+#: How far a semantics is from exact arithmetic (the weakest one a verdict rests on is shown).
+_WEAK = {"exact": 0, "double": 1, "tolerance": 2}
+_NO_RULE = TopicRule()  # the rule of a topic the mapping does not name
+_NEVER = float("inf")
+
+
+class NodeMonitor:
+    """Streams events through one node's contract; :meth:`finish` gives the result.
+
+    ``rules`` maps topic names to :class:`TopicRule` (its ``tolerance`` and
+    ``skew`` attributes, when it has them, as the mapping file's rules do,
+    are the declared tolerance and the transport skew in seconds);
+    ``horizon`` is in seconds; ``tolerance`` overrides the rules'.  Every
+    formula is judged by :func:`rclverify.logic.floatsem.judge` (exact,
+    double, tolerance).  The node's topics are its ``topics(...)`` and the
+    parts of its service and action links (:data:`LINK_TOPICS`)."""
+
+    #: Evaluations remembered per (formula, inputs, outputs); 0 turns the cache off.
+    cache_size = 4096
+
+    def __init__(self, checked: Checked, node: CheckedNode, rules: Mapping[str, TopicRule],
+                 horizon: float, on_verdict: Callable[[Verdict], None] | None = None,
+                 tolerance: Tolerance | None = None) -> None:
+        self.checked, self.node, self.horizon = checked, node, horizon
+        self.rules = rules
+        self.tolerance = tolerance if tolerance is not None else getattr(rules, "tolerance", None)
+        self.on_verdict = on_verdict
+        self.now = float("-inf")
+        self.result = NodeResult(node.name)
+        self.topics: dict[str, list[tuple[str, Any, bool]]] = {}
+        for t in node.node.topics:
+            if t.match is None:
+                continue
+            typ = node.io_type(t.match)
+            if typ is None:
+                continue
+            is_input = t.match.prefix == "in" or (t.match.prefix is None and t.match.name in node.inputs)
+            key = ("in." if is_input else "out.") + t.match.name
+            self.topics.setdefault(t.field.lstrip("/"), []).append((key, typ, is_input))
+        parts: dict[tuple[str, str], str] = {}  # (topic, key) -> the actionlib part that maps to the variable
+        for lk in node.node.links:
+            for suffix, v in zip(LINK_TOPICS.get(lk.kind, ()), lk.parts):
+                typ = node.io_type(v)
+                if typ is None or v.prefix not in ("in", "out"):
+                    continue
+                topic, key = f"{lk.name.lstrip('/')}/{suffix}", f"{v.prefix}.{v.name}"
+                self.topics.setdefault(topic, []).append((key, typ, v.prefix == "in"))
+                if lk.kind == "action":
+                    parts[(topic, key)] = suffix
+        self.has_inputs = any(i for vs in self.topics.values() for _, _, i in vs)
+        self._feeds = {topic: [(key, value_mapper(typ, rules.get(topic, _NO_RULE)), parts.get((topic, key), ""))
+                               for key, typ, _ in vs] for topic, vs in self.topics.items()}
+        self._topic_io = {topic: (frozenset(k for k, _, inp in vs if inp), [k for k, _, inp in vs if not inp])
+                          for topic, vs in self.topics.items()}
+        self.values: dict[str, Any] = {}
+        for topic, vs in self.topics.items():
+            for key, typ, _ in vs:
+                self.values[key] = initial_value(typ, rules.get(topic, _NO_RULE))
+        self.assumption = tuple(c.formula for c in node.node.assumes)
+        self.guarantees = tuple(c.formula for c in node.node.guarantees)
+        #: guarantee k -> ``in.x`` for ``triggered by in.x``: it answers the messages of that input only
+        self._trigger = {k: f"in.{c.trigger.name}" for k, c in enumerate(node.node.guarantees, 1)
+                         if c.trigger is not None}
+        self._triggers = frozenset(self._trigger.values())
+        self._texts = {k: expr_to_rcl(f) for k, f in enumerate(self.guarantees, 1)}
+        self._renders: dict[int, tuple[Any, str]] = {}
+        needed: set[str] = set()
+        for f in self.assumption + self.guarantees:
+            names(f, needed)
+        self.needed_inputs = sorted(k for k in self.values if k.startswith("in.") and
+                                    (k in needed or k[3:] in needed))
+        #: variables the contract reads that no topic or link part carries: no run gives them a value
+        self.unbound = sorted(f"{p}.{v}" for p, names_ in (("in", node.inputs), ("out", node.outputs))
+                              for v in names_ if f"{p}.{v}" not in self.values and (v in needed or f"{p}.{v}" in needed))
+        outputs = sorted(k for k in self.values if k.startswith("out."))
+        event_outs = {key for topic, vs in self.topics.items() for key, _, inp in vs
+                      if not inp and not rules.get(topic, _NO_RULE).state}
+        #: outputs on state topics: their current value stands in for every question
+        self._state_outs = [k for k in outputs if k not in event_outs]
+        self._state_set = frozenset(self._state_outs)
+        self._in_keys = [k for k in self.values if k.startswith("in.")]
+        self._deps: dict[Any, tuple[str, ...]] = {}
+        for k, f in [(("A", j), f) for j, f in enumerate(self.assumption)] + list(enumerate(self.guarantees, 1)):
+            mentioned: set[str] = set()
+            reads(f, mentioned)
+            self._deps[k] = tuple(v for v in sorted(self.values) if v in mentioned or v.split(".", 1)[1] in mentioned)
+        ks = range(1, len(self.guarantees) + 1)
+        #: guarantees judged against a question (they read an input or answer a trigger) and those judged alone
+        self._asked = [k for k in ks if self.has_inputs and (k in self._trigger or
+                                                            any(d.startswith("in.") for d in self._deps[k]))]
+        self._alone = [k for k in ks if k not in self._asked]
+        gouts = {k: {d for d in self._deps[k] if d.startswith("out.")} for k in ks}
+        #: per topic: the guarantees a message on it touches (they read an output it sets)
+        self._touch = {topic: ([k for k in self._asked if gouts[k] & set(outs)],
+                               [k for k in self._alone if gouts[k] & set(outs)])
+                       for topic, (_, outs) in self._topic_io.items()}
+        self._reads_out = {k: bool(gouts[k]) for k in ks}
+        skew = getattr(rules, "skew", None) or 0.0
+        self.stream = QuestionStream(skew if self.has_inputs else 0.0, horizon)
+        #: outputs waiting for the skew to pass: (event, stamp, the question it answered when it came,
+        #: outputs of the answer, state outputs)
+        self._held: deque[tuple[Event, float, Question | None, dict[str, Any], dict[str, Any]]] = deque()
+        #: questions whose horizon is watched, in order of their due time
+        self._watch: deque[Question] = deque()
+        self._due = _NEVER
+        self._cache: dict[tuple[Any, tuple[Any, ...]], Judgement] = {}
+        self._assumed = [(("A", j), f) for j, f in enumerate(self.assumption)]
+        self._guaranteed = dict(enumerate(self.guarantees, 1))
+        self._judges = {k: FormulaJudge(f, checked, node, self.tolerance)
+                        for k, f in self._assumed + list(self._guaranteed.items())}
+        self.result.evaluation = {(f"assumption {k[1] + 1}" if isinstance(k, tuple) else f"guarantee {k}"):
+                                  (j.fallback or "compiled") for k, j in self._judges.items()}
+        # a question's guarantees evaluated when it comes, unless Z3 showed that only an answer decides them
+        self._ask_at_question = any(not self._reads_out[k] for k in self._asked) or not (
+            self.has_inputs and not self._state_outs and not self._trigger
+            and answer_decides(checked, node, self.guarantees))
+
+    # -- evaluation --------------------------------------------------------------
+    def _judge(self, k: Any, values: Mapping[str, Any]) -> Judgement:
+        """The judgement of guarantee ``k`` (``("A", j)``: assumption ``j``) on
+        ``values``: the compiled code where it decides alone, else
+        :func:`~rclverify.logic.floatsem.judge`, remembered per (formula,
+        values of the variables it reads)."""
+        hit = self._judges[k].quick(values)
+        if hit is not None:
+            return hit
+        ck = (k, tuple([values.get(d) for d in self._deps[k]]))
+        hit = self._cache.get(ck)
+        if hit is not None:
+            return hit
+        formula = self._guaranteed[k] if isinstance(k, int) else self.assumption[k[1]]
+        j = judge(formula, self.checked, self.node, values, self.tolerance)
+        if self.cache_size:
+            if len(self._cache) >= self.cache_size:
+                self._cache.clear()
+            self._cache[ck] = j
+        return j
+
+    def _rendered(self, values: Mapping[str, Any]) -> dict[str, str]:
+        out = {}
+        for k, v in sorted(values.items()):
+            if v is None:
+                continue
+            hit = self._renders.get(id(v))
+            if hit is None or hit[0] is not v:
+                if len(self._renders) >= 256:
+                    self._renders.clear()
+                hit = self._renders[id(v)] = (v, render(v))
+            out[k] = hit[1]
+        return out
+
+    def _verdict(self, verdict: str, ev: Event, guarantee: int = 0, values: Mapping[str, str] | None = None,
+                 reason: str = "", semantics: str = "", question: str = "") -> None:
+        self.result.counts[verdict] += 1
+        if verdict == "satisfied" and semantics in self.result.semantics:
+            self.result.semantics[semantics] += 1
+        if verdict == "inconclusive" and self.result.first_inconclusive is None:
+            self.result.first_inconclusive = {"event": ev.index, "time": ev.time, "where": ev.where,
+                                              "reason": reason}
+        if self.on_verdict is not None:
+            self.on_verdict(Verdict(self.node.name, verdict, ev.index, ev.time, ev.where, ev.topic,
+                                    max(self.now, ev.time), guarantee, dict(values or {}), reason, semantics,
+                                    question))
+
+    def _note_inexact(self, ev: Event, judged: Judgement, what: str, values: Mapping[str, Any]) -> None:
+        if self.result.first_inexact is None:
+            self.result.first_inexact = {"event": ev.index, "time": ev.time, "where": ev.where,
+                                         "semantics": judged.semantics, "formula": what,
+                                         "values": self._rendered(values), "reason": judged.reason}
+
+    # -- streaming ---------------------------------------------------------------
+    def feed(self, ev: Event) -> None:
+        """Process one event: every event moves the clock (releasing outputs
+        past the skew, closing questions past their horizon); only events on
+        the node's topics change its state.  A message's outputs are judged
+        before its inputs raise a question (an answer comes after its question)."""
+        t = ev.time
+        if t > self.now:
+            self.now = t
+        if self._held and self.now > self._held[0][1] + self.stream.skew:
+            self._release(self.now)
+        if self.now > self._due:
+            self._expire(self.now)
+        vs = self._feeds.get(ev.topic)
+        if vs is None:
+            return
+        self.result.events += 1
+        values = self.values
+        for key, mapper, part in vs:
+            fields: Any = ev.fields
+            try:
+                if part:
+                    fields = fields.get(part)
+                    if not isinstance(fields, Mapping):
+                        raise MappingError(f"the actionlib message has no {part!r} part")
+                values[key] = mapper(fields, values.get(key))
+            except MappingError as exc:
+                self._verdict("inconclusive", ev, reason=f"{key}: {exc}")
+                return
+        trig, changed = self._topic_io[ev.topic]
+        if changed:
+            self._output(ev, changed)
+        if trig:
+            self._input(ev, trig)
+
+    def advance(self, now: float) -> None:
+        """Move the clock to ``now`` (s): outputs past the skew are judged,
+        questions past their horizon closed.  A time before the clock is ignored."""
+        if now > self.now:
+            self.now = now
+        if self._held:
+            self._release(self.now)
+        self._expire(self.now)
+
+    @property
+    def pending(self) -> bool:
+        """Whether a question still waits for its answer (owed, unanswered or
+        partly answered, within its horizon) or an output for the skew to pass."""
+        return bool(self._held) or any(q.waiting or not (q.answered or q.settled or q.reported) for q in self._watch)
+
+    def _state(self) -> dict[str, Any]:
+        values = self.values
+        return {k: values[k] for k in self._state_outs if values[k] is not None}
+
+    def _input(self, ev: Event, trig: frozenset[str]) -> None:
+        values = self.values
+        inputs = {k: values[k] for k in self._in_keys if values[k] is not None}
+        if len(inputs) < len(self._in_keys):
+            missing = [k for k in self.needed_inputs if k not in inputs]
+            if missing:  # not a question yet: nothing before the first message
+                self._verdict("incomplete input", ev, reason="no value yet for " + ", ".join(missing))
+                return
+        accepted, owed, refusal = "exact", True, ""
+        for aj, formula in self._assumed:
+            judged = self._judge(aj, inputs)
+            if judged.truth is False:
+                owed = False
+                self._assumption_violated(ev, formula, inputs, judged)
+                break
+            if judged.truth is None:
+                owed, refusal = False, f"assumption undecided: {judged.reason}"
+                break
+            if judged.semantics != "exact" and _WEAK.get(judged.semantics, 0) > _WEAK[accepted]:
+                accepted = judged.semantics
+                self._note_inexact(ev, judged, f"assumption {expr_to_rcl(formula)}", inputs)
+        q = Question(ev, ev.stamped, inputs, owed=owed, info=accepted)
+        old = self.stream.ask(q, trig & self._triggers)
+        if old is not None:
+            old.reported = True
+            self._verdict("superseded", old.event, reason=f"the input at {ev.where} came before any output "
+                          f"answered the question raised at {old.event.where}: the node owes the latest one an answer")
+        if refusal:
+            self._verdict("inconclusive", ev, reason=refusal)
+        if not owed:
+            return
+        self.result.accepted += 1
+        if not any(self._owes(q, k) for k in self._asked) and self._asked and not self._alone:
+            self.result.unowed += 1  # every guarantee answers another input: nothing is owed to this question
+            q.settled = True
+            return
+        q.info, q.due = (accepted, ev.time + self.horizon), ev.time + self.horizon
+        self._watch.append(q)
+        if self._due == _NEVER:
+            self._due = q.due
+        if self._ask_at_question:
+            self._at_question(q)
+
+    def _assumption_violated(self, ev: Event, formula: ast.Expr, inputs: Mapping[str, Any], judged: Judgement) -> None:
+        mentioned: set[str] = set()
+        names(formula, mentioned)
+        read = [k for k in inputs if k in mentioned or k[3:] in mentioned]
+        blamed = sorted({p for k in read for p in producers(self.checked, self.node, k[3:])})
+        links = sorted({link_of(self.node, k[3:]) for k in read} - {""})
+        blame = ("upstream node(s) " + ", ".join(blamed)) if blamed else "environment"
+        if blamed and links:
+            blame += f" (through {', '.join(links)})"
+        if self.result.first_assumption_violation is None:
+            self.result.first_assumption_violation = {
+                "event": ev.index, "time": ev.time, "where": ev.where, "assumption": expr_to_rcl(formula),
+                "values": self._rendered(inputs), "blame": blame, "semantics": judged.semantics}
+        self._verdict("assumption violated", ev, values=self._rendered(inputs),
+                      reason=f"assumption {expr_to_rcl(formula)} is false; blamed on the {blame}",
+                      semantics=judged.semantics)
+
+    def _owes(self, q: Question, k: int) -> bool:
+        trig = self._trigger.get(k)
+        return trig is None or trig in q.triggers
+
+    def _at_question(self, q: Question) -> None:
+        """The owed guarantees on the question's inputs and the state outputs:
+        one that reads no output false -> ``violated``; all true ->
+        ``satisfied`` at once (no answer needed); anything else waits for an
+        answer."""
+        values = {**q.inputs, **self._state()}
+        weakest = q.info[0]
+        waits = False
+        for k in self._asked:
+            if not self._owes(q, k):
+                continue
+            judged = self._judge(k, values)
+            if judged.truth is True:
+                q.decided.add(k)
+                if _WEAK.get(judged.semantics, 0) > _WEAK[weakest]:
+                    weakest = judged.semantics
+                continue
+            if judged.truth is False and not self._reads_out[k]:
+                q.settled = True
+                self._violation(q.event, k, values, f"guarantee {k} is false on the inputs of the question at "
+                                f"{q.event.where}{in_all(judged.semantics)}", judged.semantics, q.event)
+                return
+            waits = True
+        if not waits:
+            q.settled = True
+            self._verdict("satisfied", q.event, semantics=weakest)
+
+    def _output(self, ev: Event, changed: list[str]) -> None:
+        values = self.values
+        fresh = {k: values[k] for k in changed if values[k] is not None}
+        asked, alone = self._touch[ev.topic]
+        if not self.has_inputs:
+            self._decide(ev, None, [], self._alone_outcome(ev, alone), {})
+            return
+        stamped = ev.stamped
+        q = self.stream.at(stamped)
+        if q is not None:
+            mine = {k: v for k, v in fresh.items() if k not in self._state_set}
+            if ev.time <= q.due:  # an output after the horizon is judged, but is no part of the question's answer
+                q.answered = True
+                q.last_out = ev
+                q.answer.update(mine)
+                for k in asked:  # the triggers its guarantees answer are answered (carried no further)
+                    if k in self._trigger and self._owes(q, k):
+                        q.answered_triggers.add(self._trigger[k])
+                outs = dict(q.answer)
+            else:
+                outs = {**q.answer, **mine}
+        else:
+            outs = {k: v for k, v in fresh.items() if k not in self._state_set}
+        if self.stream.skew:
+            self._held.append((ev, stamped, q, outs, self._state()))
+            return
+        self._decide(ev, q, [], self._alone_outcome(ev, alone), outs, self._state())
+
+    def _release(self, now: float) -> None:
+        """Judge the held outputs whose skew has passed (all of them at the end)."""
+        skew = self.stream.skew
+        held = self._held
+        while held and held[0][1] + skew < now:
+            ev, stamped, q, outs, state = held.popleft()
+            others = self.stream.within_skew(stamped, q)  # it may answer them too: judged under both readings
+            self._decide(ev, q, others, self._alone_outcome(ev, self._touch[ev.topic][1]), outs, state)
+
+    def _alone_outcome(self, ev: Event, ks: list[int]) -> Outcome:
+        """The guarantees over outputs only that ``ev`` touches, on the outputs as they stand."""
+        if not ks:
+            return Outcome("none")
+        values = {k: v for k, v in self.values.items() if v is not None}
+        return self._outcome(ks, values, lambda k: True, None, ev)
+
+    def _outcome(self, ks: list[int], values: Mapping[str, Any], owed: Callable[[int], bool],
+                 q: Question | None, ev: Event, weakest: str = "exact") -> Outcome:
+        """Guarantees ``ks`` (those ``owed``) judged on ``values``: the first
+        false one, else undecided, else satisfied, else ``none``."""
+        decided, undecided = False, None
+        if q is not None and ev.time > q.due:
+            q = None  # judged against it, but past its horizon: no part of its answer
+        first_inexact = None
+        for k in ks:
+            if not owed(k):
+                continue
+            if q is not None and k in self._trigger:
+                q.answered_triggers.add(self._trigger[k])
+            judged = self._judge(k, values)
+            if judged.truth is False:
+                if q is not None:
+                    q.waiting.pop(k, None)
+                    q.decided.add(k)
+                return Outcome("violated", k, judged.semantics, values=dict(values))
+            if judged.truth is None:
+                if judged.reason.startswith("no value for out."):  # waits for that output
+                    if q is not None:
+                        q.waiting[k] = (ev, judged.reason, {x: v for x, v in values.items() if x.startswith("out.")})
+                    continue
+                undecided = undecided or (k, judged.reason)
+                continue
+            if q is not None:
+                q.waiting.pop(k, None)
+                q.decided.add(k)
+            decided = True
+            if judged.semantics != "exact":
+                first_inexact = first_inexact or (k, judged)
+                if _WEAK.get(judged.semantics, 0) > _WEAK[weakest]:
+                    weakest = judged.semantics
+        if undecided is not None:
+            k, why = undecided
+            return Outcome("inconclusive", k, reason=f"guarantee {k}: {why}" + self._unbound_note(why))
+        if decided:
+            if first_inexact is not None:
+                k, judged = first_inexact
+                self._note_inexact(ev, judged, f"guarantee {k} ({self._texts[k]})", values)
+            return Outcome("satisfied", semantics=weakest)
+        return Outcome("none")
+
+    def _question_outcome(self, q: Question | None, ev: Event, ks: list[int], outs: Mapping[str, Any],
+                          state: Mapping[str, Any], keep: bool = True) -> Outcome:
+        """Output ``ev`` judged against question ``q``; ``keep``: it is the
+        question ``ev`` answered (not another reading within the skew), whose
+        decided and waiting guarantees it updates."""
+        if q is None:
+            return Outcome("unasked")
+        if not q.owed:
+            return Outcome("none")
+        values = {**q.inputs, **state, **outs}
+        return self._outcome(ks, values, lambda k: self._owes(q, k), q if keep else None, ev,
+                             q.info[0] if isinstance(q.info, tuple) else "exact")
+
+    def _decide(self, ev: Event, q: Question | None, others: list[Question], alone: Outcome,
+                outs: Mapping[str, Any], state: Mapping[str, Any] | None = None) -> None:
+        """One output message's verdict: its output-only guarantees (``alone``)
+        and the question(s) it may answer, combined (:func:`.outcome.combine`)."""
+        ks = self._touch[ev.topic][0]
+        readings = [self._question_outcome(x, ev, ks, outs, state or {}, x is q) for x in [q, *others]] \
+            if self.has_inputs else []
+        if readings and readings[0].kind == "unasked" and all(r.kind == "unasked" for r in readings):
+            if ks:
+                self.result.unasked += 1
+        outcome = combine(alone, readings)
+        question = q if q is not None else (others[0] if others else None)
+        qwhere = question.event.where if question is not None else ""
+        if outcome.kind == "violated":
+            k = outcome.guarantee
+            reason = (f"guarantee {k} is false on the output at {ev.where}" +
+                      (f" answering the question at {qwhere}" if qwhere else "") + in_all(outcome.semantics))
+            if len(readings) > 1:
+                reason += f" (and on every question it may answer within the transport skew of {self.stream.skew:g} s)"
+            self._violation(ev, k, outcome.values, reason, outcome.semantics, question.event if question else None)
+        elif outcome.kind == "inconclusive":
+            reason = outcome.reason if len(readings) < 2 or outcome.reason else skew_reason(ev, q, others,
+                                                                                           self.stream.skew)
+            self._verdict("inconclusive", ev, guarantee=outcome.guarantee, reason=reason, question=qwhere)
+        elif outcome.kind == "satisfied":
+            self._verdict("satisfied", ev, semantics=outcome.semantics, question=qwhere)
+
+    def _violation(self, ev: Event, k: int, values: Mapping[str, Any], reason: str, semantics: str,
+                   trigger: Event | None) -> None:
+        record: dict[str, Any] = {"event": ev.index, "time": ev.time, "where": ev.where, "guarantee": k,
+                                  "formula": self._texts.get(k, ""), "values": self._rendered(values),
+                                  "reason": reason, "semantics": semantics}
+        if trigger is not None:
+            record.update({"trigger": trigger.index, "trigger_time": trigger.time, "trigger_where": trigger.where})
+        self.result.add_violation(record)
+        self._verdict("violated", ev, guarantee=k, values=record["values"], reason=reason, semantics=semantics,
+                      question=trigger.where if trigger is not None and trigger is not ev else "")
+
+    def _unbound_note(self, reason: str) -> str:
+        found = [v for v in self.unbound if f"no value for {v}" in reason]
+        if not found:
+            return ""
+        return (f" ({', '.join(found)} of {self.node.name} is carried by no topic or link part: its topics(...) "
+                "and services(...)/actions(...) name none, so no run gives it a value)")
+
+    def _expire(self, now: float) -> None:
+        """Close the watched questions whose horizon passed before ``now``."""
+        watch, skew = self._watch, self.stream.skew  # closed once the outputs within the skew were judged
+        if skew:
+            for q in watch:  # the state outputs as they stood when its horizon passed
+                if q.due >= now:
+                    break
+                if q.state_at_due is None:
+                    q.state_at_due = self._state()
+        while watch and watch[0].due + skew < now:
+            self._close(watch.popleft())
+        self._due = watch[0].due if watch else _NEVER
+
+    def _close(self, q: Question, end: bool = False) -> None:
+        """Question ``q``'s horizon passed (``end``: the run ended first):
+        its partial answers are judged (an owed guarantee no output decided
+        waits for the outputs it reads), and an unanswered one is inconclusive
+        (``open`` at the end)."""
+        state = q.state_at_due if q.state_at_due is not None else self._state()
+        if q.followed:  # a newer question came within its horizon: the node owes that one what is missing here
+            q.waiting.clear()
+        elif (q.answered or self._state_outs) and q.owed and not q.settled and not q.reported:
+            values = {**q.inputs, **state, **q.answer}
+            for k in self._asked:
+                if k in q.decided or k in q.waiting or not self._reads_out[k] or not self._owes(q, k) or \
+                        self._trigger.get(k) in q.passed:
+                    continue
+                judged = self._judge(k, values)
+                if judged.truth is not True:
+                    q.waiting[k] = (q.last_out or q.event, judged.reason or f"guarantee {k} is false",
+                                    {x: v for x, v in values.items() if x.startswith("out.")})
+        for k in [k for k in q.waiting if self._trigger.get(k) in q.passed]:
+            del q.waiting[k]  # the next question owes it now
+        judged_now = bool(q.waiting)
+        for k, (ev, why, outs) in sorted(q.waiting.items()):
+            self._partial(q, k, ev, why, {**state, **outs}, end)
+        q.waiting.clear()
+        was, q.reported = q.reported, True  # closed: superseded no more
+        if q.answered or q.settled or was or judged_now:
+            return
+        if end:
+            self._verdict("open", q.event, reason=f"unanswered when the run ended, within {self.horizon} s")
+            return
+        self._verdict("inconclusive", q.event, reason=f"unanswered: no output within {self.horizon} s of the "
+                      f"question at {q.event.where} (a finite run cannot show the answer never comes; a deadline "
+                      "`triggered by ... within` would fail)")
+
+    def _partial(self, q: Question, k: int, ev: Event, why: str, outs: Mapping[str, Any], end: bool) -> None:
+        """A partial answer: guarantee ``k`` waited for an output that never came
+        after the question; false whatever it is -> ``violated``, else undecided."""
+        values = {**q.inputs, **outs}  # outs: the state outputs at its horizon and the answer
+        if self._false_whatever_missing(k, values):
+            self._violation(ev, k, values, f"guarantee {k} is false on the outputs published after the question "
+                            f"at {q.event.where} (the last at {ev.where}) whatever the value of the outputs not "
+                            f"published after it ({why})", "", q.event)
+            return
+        missing = why.split(" ", 3)[-1].split(",")[0] if why.startswith("no value for ") else why
+        reason = (f"guarantee {k} is undecided on the outputs published after the question at {q.event.where} "
+                  f"(the last at {ev.where}): {why}; nothing published within {self.horizon} s completed the answer "
+                  f"(if {missing} keeps its value between messages, declare its topic `state: true` in the mapping)")
+        self._verdict("open" if end else "inconclusive", ev, guarantee=k, values=self._rendered(values),
+                      reason=reason, question=q.event.where)
+
+    def _false_whatever_missing(self, k: int, values: Mapping[str, Any]) -> bool:
+        import z3
+
+        from ...logic.concrete import false_whatever_the_rest
+        known = {q: v for q, v in values.items() if v is not None}
+        try:
+            return false_whatever_the_rest(self.guarantees[k - 1], self.checked, self.node, known)
+        except (KeyError, ValueError, z3.Z3Exception):
+            return False
+
+    def finish(self) -> NodeResult:
+        """Close the run: held outputs are judged, questions past their horizon
+        closed, the rest ``open``."""
+        if self._held:
+            self._release(_NEVER)
+        while self._watch:  # every output judged: a question past its horizon is closed, the rest open
+            q = self._watch.popleft()
+            self._close(q, end=not self.now > q.due)
+        self._due = _NEVER
+        return self.result
+
+
+__all__ = ["NodeMonitor"]

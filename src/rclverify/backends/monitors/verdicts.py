@@ -1,0 +1,210 @@
+"""The monitor's records: one verdict, one node's result on one run, who is blamed.
+
+Kept apart from the engine (:mod:`.engine`) so that every transport and the
+evidence builder read them without the engine; docs/monitors.md,
+"Semantics and verdicts", and docs/semantics.md give what they mean.
+"""
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass, field
+from typing import Any, Mapping
+
+from ...rcl import ast
+from ...rcl.types import Checked, CheckedNode
+from ...system.services import peers
+
+#: Verdicts of one node's events: per output message (``satisfied``,
+#: ``violated``, ``inconclusive``), per question (``assumption violated``,
+#: ``incomplete input``, ``superseded``, ``inconclusive`` when unanswered
+#: within the horizon, ``open`` when the run ended first; ``satisfied`` or
+#: ``violated`` when its inputs alone decide the guarantees).
+VERDICTS = ("satisfied", "violated", "open", "assumption violated", "inconclusive", "incomplete input",
+            "superseded")
+#: Topic suffixes of a service's or action's parts, in the order of ``Link.parts``
+#: (a service ``s`` is observed as ``s/request`` and ``s/response`` events, an
+#: action ``a`` as actionlib's ``a/goal``, ``a/feedback`` and ``a/result``).
+#: Violations kept per node and run (each a few hundred bytes; the count is exact beyond it).
+KEPT_VIOLATIONS = 200
+LINK_TOPICS = {"service": ("request", "response"), "action": ("goal", "feedback", "result")}
+
+
+def reads(e: Any, out: set[str]) -> None:
+    """Every name a formula mentions: each :class:`ast.Var`'s qualified and bare
+    name, anywhere in the tree (quantifier domains included); a superset of
+    the I/O variables it reads."""
+    if isinstance(e, ast.Var):
+        out.add(e.qualified)
+        out.add(e.name)
+        return
+    if isinstance(e, tuple):
+        for x in e:
+            reads(x, out)
+        return
+    if dataclasses.is_dataclass(e) and not isinstance(e, (type, ast.Loc)):
+        for f in dataclasses.fields(e):
+            reads(getattr(e, f.name), out)
+
+
+def names(e: Any, out: set[str]) -> None:
+    if isinstance(e, ast.Var):
+        out.add(e.qualified)
+    for name in ("args", "operand", "left", "right", "operands", "elem", "collection", "items", "body", "func"):
+        c = getattr(e, name, None)
+        if c is None:
+            continue
+        for x in (c if isinstance(c, tuple) else (c,)):
+            names(x, out)
+
+
+@dataclass(frozen=True)
+class Verdict:
+    """The verdict of one event of one node, as soon as it is decided.
+
+    ``verdict`` one of :data:`VERDICTS`; ``event``/``time``/``where``/``topic``
+    identify the message it is about: the output message for a verdict on
+    an output, the input message that raised the question otherwise; ``guarantee`` the 1-based guarantee that failed (0 when
+    none or for the assumption); ``decided_at`` the time (s, trace clock)
+    when it was decided; ``values`` the rendered values of the first failure
+    (inputs and the outputs that failed), ``reason`` one sentence;
+    ``semantics`` the arithmetic that decided it (:mod:`rclverify.logic.floatsem`):
+    ``exact``, ``double`` or ``tolerance`` for a ``satisfied`` (the weakest
+    its assumption and guarantees needed), the semantics that all agreed for
+    a ``violated`` or ``assumption violated`` (``exact, double``), else ``""``;
+    ``question`` where the question an output verdict answers was raised
+    (``""`` for a verdict on a question itself or on a node without inputs).
+    """
+
+    node: str
+    verdict: str
+    event: int
+    time: float
+    where: str
+    topic: str
+    decided_at: float
+    guarantee: int = 0
+    values: Mapping[str, str] = field(default_factory=dict)
+    reason: str = ""
+    semantics: str = ""
+    question: str = ""
+
+    def to_json(self) -> dict[str, Any]:
+        """A JSON-ready dict (the live monitor's verdict message)."""
+        return {"node": self.node, "verdict": self.verdict, "event": self.event, "time": self.time,
+                "where": self.where, "topic": self.topic, "decided_at": self.decided_at,
+                "guarantee": self.guarantee, "values": dict(self.values), "reason": self.reason,
+                "semantics": self.semantics, **({"question": self.question} if self.question else {})}
+
+
+@dataclass
+class NodeResult:
+    """Verdicts of one node on one trace.
+
+    ``counts`` verdict -> number of verdicts (on output messages and on
+    questions, :data:`VERDICTS`); ``first_violation`` and
+    ``first_assumption_violation`` are dicts (event index, time, where,
+    guarantee, formula, values, reason) or ``None``; ``events`` is the
+    number of events on the node's topics; ``accepted`` the input events
+    whose assumption held; ``semantics`` the ``satisfied`` verdicts per the
+    arithmetic that decided them (``exact``, ``double``, ``tolerance``);
+    ``first_inexact`` the first formula that held only in double arithmetic
+    or within the tolerance (event, where, time, semantics, formula, values);
+    ``unowed`` the input events that met the assumption and that no
+    guarantee answers (each is ``triggered by`` another input): no verdict,
+    nothing was checked for them; ``unasked`` the output messages published
+    before the node had any question (only their output-only guarantees are
+    judged); ``violations`` every ``violated`` verdict of the run (the first
+    :data:`KEPT_VIOLATIONS`, in the order decided; ``violations_dropped``
+    counts the rest), each as ``first_violation`` is.
+    ``evaluation`` how each formula was evaluated (debug; not in :meth:`to_json`).
+    """
+
+    node: str
+    counts: dict[str, int] = field(default_factory=lambda: {v: 0 for v in VERDICTS})
+    events: int = 0
+    first_violation: dict[str, Any] | None = None
+    first_assumption_violation: dict[str, Any] | None = None
+    first_inconclusive: dict[str, Any] | None = None
+    accepted: int = 0
+    semantics: dict[str, int] = field(default_factory=lambda: {"exact": 0, "double": 0, "tolerance": 0})
+    first_inexact: dict[str, Any] | None = None
+    unowed: int = 0
+    unasked: int = 0
+    violations: list[dict[str, Any]] = field(default_factory=list)
+    violations_dropped: int = 0
+    #: a debug field, in no evidence record: how each formula was evaluated
+    #: (``assumption 1`` / ``guarantee 2`` -> ``compiled``, or why the
+    #: straight-line code left it to the evaluator; logic/judges.py)
+    evaluation: dict[str, str] = field(default_factory=dict, compare=False)
+
+    @property
+    def assumption(self) -> dict[str, Any]:
+        """The assumption monitor's verdict on the run: ``violated`` when an
+        input event violated it (the node is not at fault: the blame names the
+        producer), ``held`` when every evaluated input event met it, ``not
+        evaluated`` when none was evaluated."""
+        n = self.counts["assumption violated"]
+        verdict = "violated" if n else "held" if self.accepted else "not evaluated"
+        return {"verdict": verdict, "violations": n, "accepted": self.accepted,
+                "first": self.first_assumption_violation}
+
+    def to_json(self) -> dict[str, Any]:
+        return {"node": self.node, "counts": dict(self.counts), "events": self.events,
+                "first_violation": self.first_violation,
+                "first_assumption_violation": self.first_assumption_violation,
+                "first_inconclusive": self.first_inconclusive, "accepted": self.accepted,
+                "semantics": dict(self.semantics), "first_inexact": self.first_inexact, "unowed": self.unowed,
+                "unasked": self.unasked, "violations": list(self.violations),
+                "violations_dropped": self.violations_dropped}
+
+    def add_violation(self, record: dict[str, Any]) -> None:
+        """Keep ``record`` (one ``violated`` verdict) in :attr:`violations`
+        (bounded) and as :attr:`first_violation` when it is the first."""
+        if self.first_violation is None:
+            self.first_violation = record
+        if len(self.violations) < KEPT_VIOLATIONS:
+            self.violations.append(record)
+        else:
+            self.violations_dropped += 1
+
+
+def producers(checked: Checked, node: CheckedNode, var: str) -> list[str]:
+    """Other nodes whose output has the input's name or is matched to the
+    input's topic, or feeds it through a service or action link (rule S1,
+    :func:`rclverify.system.services.peers`: a client's response comes from
+    the server, a server's request from its clients)."""
+    topics = {t.field for t in node.node.topics if t.match is not None and t.match.name == var}
+    out = {m for m, _ in peers(checked, node.name, var)} if node.node.links else set()
+    for other in checked.nodes.values():
+        if other.name == node.name:
+            continue
+        if var in other.outputs or any(t.field in topics and t.match is not None and t.match.name in other.outputs
+                                       for t in other.node.topics):
+            out.add(other.name)
+    return sorted(out)
+
+
+def link_of(node: CheckedNode, var: str) -> str:
+    """``service estop`` when input ``var`` of ``node`` is a part of a service
+    or action link (its response, feedback, result, or a server's request),
+    else ``""``."""
+    for lk in node.node.links:
+        if any(v.prefix == "in" and v.name == var for v in lk.parts):
+            return f"{lk.kind} {lk.name}"
+    return ""
+
+
+def in_all(semantics: str) -> str:
+    """`` (false in exact and double arithmetic)`` for a failure that every
+    float semantics agreed on, ``""`` when only exact arithmetic applied."""
+    names = [s for s in semantics.split(", ") if s]
+    if len(names) < 2:
+        return ""
+    words = {"exact": "exact", "double": "double", "tolerance": "within the tolerance"}
+    said = [words.get(n, n) for n in names]
+    arith = [w for w in said if w in ("exact", "double")]
+    text = " and ".join(arith) + " arithmetic" + (" and " + said[-1] if "within the tolerance" in said else "")
+    return f" (false in {text})"
+
+
+__all__ = ["KEPT_VIOLATIONS", "LINK_TOPICS", "VERDICTS", "NodeResult", "Verdict", "in_all", "link_of", "producers", "reads", "names"]

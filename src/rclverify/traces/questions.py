@@ -1,0 +1,163 @@
+"""Which message answers which: the one stream model of every stage that judges messages.
+
+docs/semantics.md states the model; this module is its one implementation
+(the offline and live monitors, bags, the enforcement gate and the deadline
+checks ask it).  From the paper's stream assumption (lines 1866-1869: a
+contract consumes one element of its input stream and produces at most one
+element of its output stream) and rule R3's persistence:
+
+* a topic has no value until its first message; after it, its value is its
+  latest message (the engines keep the values; this module keeps questions);
+* a **question** is a node's inputs as they stand after an input message,
+  once every input the node reads has a value (:meth:`QuestionStream.ask`);
+* a question followed by another question before any output answered it is
+  **superseded**: the node owes an answer to the latest question only.  The
+  inputs a ``triggered by`` guarantee answers (``triggers``) are carried to
+  the superseding question until an output of that guarantee answers them;
+* an output message answers the **latest question at its stamp**
+  (:meth:`QuestionStream.at`); a question stamped after the output but
+  within the transport skew (:meth:`QuestionStream.within_skew`) may be the
+  one it answers too, and the judge must give the same verdict under both
+  readings to give one at all (backends/monitors/skew.py);
+* the horizon is the time an answer may take, never licence to take a later
+  question's answer: a question with no output before it is unanswered.
+
+Everything here is stamps and bookkeeping; nothing evaluates a formula.
+Times are seconds on the run's clock (header stamps where the messages have
+them).
+"""
+from __future__ import annotations
+
+import bisect
+from collections import deque
+from dataclasses import dataclass, field
+from typing import Any
+
+from .events import Event
+
+#: Questions remembered for stamp look-ups (an output stamped before the latest question).
+KEPT = 64
+
+
+@dataclass(slots=True, eq=False)
+class Question:
+    """One question of one node.
+
+    ``event`` the input message that raised it; ``stamp`` its time (s);
+    ``inputs`` the inputs as they stood (``in.x`` -> value, every input the
+    node reads present); ``triggers`` the inputs whose messages are owed an
+    answer by a ``triggered by`` guarantee, each with the first such message
+    not answered yet (carried from superseded questions); ``owed`` whether
+    the node owes this question an answer at all (its assumption held);
+    ``answered`` whether an output message answered it; ``settled`` whether
+    it needed no answer (every owed guarantee held on the inputs alone);
+    ``reported`` whether its own verdict was given (superseded, or closed
+    unanswered: it is then superseded no more);
+    ``answer`` the outputs published since it (``out.y`` -> value);
+    ``info`` the engine's own data (the semantics its assumption held in).
+    """
+
+    event: Event
+    stamp: float
+    inputs: dict[str, Any]
+    triggers: dict[str, Event] = field(default_factory=dict)
+    owed: bool = True
+    answered: bool = False
+    settled: bool = False
+    reported: bool = False
+    answer: dict[str, Any] = field(default_factory=dict)
+    answered_triggers: set[str] = field(default_factory=set)
+    #: triggers carried on to the next question: that one owes their answer now
+    passed: set[str] = field(default_factory=set)
+    #: another question came within its horizon: what its answer left out is owed to that one now
+    followed: bool = False
+    #: guarantee -> (output event, reason, outputs): a partial answer waiting for another output
+    waiting: dict[int, tuple[Event, str, dict[str, Any]]] = field(default_factory=dict)
+    #: guarantees decided (true or false) on this question so far, and the last output that answered it
+    decided: set[int] = field(default_factory=set)
+    last_out: Event | None = None
+    #: the time (s, the run's clock) its horizon passes, and the state outputs then (kept for its closing)
+    due: float = float("inf")
+    state_at_due: dict[str, Any] | None = None
+    info: Any = None
+
+
+class QuestionStream:
+    """The questions of one node, in stamp order, and which one a message answers.
+
+    ``skew`` (s, >= 0) is the transport skew: how far apart two messages
+    may be stamped in the other order than they were published; ``horizon``
+    (s) the time an answer may take: a question asked after it passed does
+    not supersede the one before (that one is unanswered)."""
+
+    __slots__ = ("skew", "horizon", "latest", "_stamps", "_questions", "superseded")
+
+    def __init__(self, skew: float = 0.0, horizon: float = float("inf")) -> None:
+        self.skew = skew
+        self.horizon = horizon
+        self.latest: Question | None = None
+        self._stamps: deque[float] = deque()
+        self._questions: deque[Question] = deque()
+        #: how many questions were superseded (no answer before the next question)
+        self.superseded = 0
+
+    def ask(self, q: Question, triggers: frozenset[str] = frozenset()) -> Question | None:
+        """Raise question ``q`` (its message set the inputs ``triggers``).
+
+        Returns the question it supersedes (the previous one, owed, not
+        answered, and ``q`` asked within its horizon), else ``None``.  Triggers the previous question's outputs
+        have not answered are carried to ``q`` (the earliest message of each
+        kept), then ``q``'s own are added; a question the node is not owed
+        (``q.owed`` false) carries none."""
+        prev = self.latest
+        superseded = None
+        if prev is not None and q.event.time <= prev.event.time + self.horizon:
+            prev.followed = True
+            if (prev.owed and not prev.answered and not prev.settled and not prev.reported
+                    and q.event.time <= prev.event.time + self.horizon):
+                superseded = prev
+                self.superseded += 1
+            if q.owed:
+                for t, ev in prev.triggers.items():
+                    if t not in prev.answered_triggers:
+                        q.triggers.setdefault(t, ev)
+                        prev.passed.add(t)
+        if q.owed:
+            for t in triggers:
+                q.triggers.setdefault(t, q.event)
+        self.latest = q
+        stamps, qs = self._stamps, self._questions
+        if not stamps or q.stamp >= stamps[-1]:
+            stamps.append(q.stamp)
+            qs.append(q)
+        else:  # stamped before an earlier question: keep the stamp order
+            i = bisect.bisect_right(stamps, q.stamp)
+            stamps.insert(i, q.stamp)
+            qs.insert(i, q)
+        if len(stamps) > KEPT:
+            stamps.popleft()
+            qs.popleft()
+        return superseded
+
+    def at(self, stamp: float) -> Question | None:
+        """The latest question stamped at or before ``stamp`` (s), ``None`` when none is."""
+        stamps = self._stamps
+        if stamps and stamp >= stamps[-1]:
+            return self._questions[-1]
+        i = bisect.bisect_right(stamps, stamp)
+        return self._questions[i - 1] if i else None
+
+    def within_skew(self, stamp: float, answered: Question | None) -> list[Question]:
+        """The questions an output stamped ``stamp`` may answer besides
+        ``answered`` (the latest question at its stamp when it came): those
+        stamped within the skew after it, or at its stamp but asked after it."""
+        if not self.skew:
+            return []
+        qs = list(self._questions)
+        i = qs.index(answered) + 1 if answered is not None and answered in qs else \
+            bisect.bisect_left(self._stamps, stamp)
+        j = bisect.bisect_right(self._stamps, stamp + self.skew)
+        return [q for q in qs[i:j] if q.stamp >= stamp]
+
+
+__all__ = ["KEPT", "Question", "QuestionStream"]
