@@ -48,6 +48,7 @@ from ..rcl import ast
 from ..rcl.errors import Diagnostic, RclError, error
 from ..rcl.parser import parse_formula
 from .compose import free_io
+from .refine_timing import timing_side
 from ..rcl.printer import expr_to_rcl
 from ..rcl.typecheck import load
 from ..rcl.types import Checked, CheckedNode, Env
@@ -91,10 +92,12 @@ class RefinementResult:
     assumption: SideResult
     guarantee: SideResult
     conditions: tuple[str, ...] = ()
+    #: the timing side (calculus/refine_timing.py): A's triggered guarantees kept as fast; None when A has none
+    timing: SideResult | None = None
 
     @property
     def verdict(self) -> str:
-        sides = (self.assumption.status, self.guarantee.status)
+        sides = (self.assumption.status, self.guarantee.status) + ((self.timing.status,) if self.timing else ())
         if all(s == "proved" for s in sides):
             return "refines"
         if "refuted" in sides:
@@ -107,7 +110,7 @@ class RefinementResult:
                     "reason": s.reason, "duration_s": s.duration_s}
         return {"a": self.a, "b": self.b, "verdict": self.verdict,
                 "assumption": side(self.assumption), "guarantee": side(self.guarantee),
-                "conditions": list(self.conditions)}
+                "conditions": list(self.conditions), **({"timing": side(self.timing)} if self.timing else {})}
 
 
 # ---------------------------------------------------------------------------
@@ -268,6 +271,7 @@ def check_refinement(a: CheckedNode, b: CheckedNode, env: Env, *,
         aa, ga = conj(a, a.node.assumes), conj(a, a.node.guarantees)
         ab, gb = conj(b, b.node.assumes), conj(b, b.node.guarantees)
         hyps = [enc.formula(f, a, shared) for f in facts] + [enc.formula(c, b, shared) for c in conditions]
+        timed = timing_side(a, b, enc, shared, hyps, aa, timeout_ms=timeout_ms)
     except EncodingError as exc:
         raise RclError([error(exc.loc, str(exc).split(": error: ", 1)[-1], "E-encoding")]) from None
     s_assume = f"{_conj(a.node.assumes)} -> {_conj(b.node.assumes)}"
@@ -293,7 +297,13 @@ def check_refinement(a: CheckedNode, b: CheckedNode, env: Env, *,
 
     conds = tuple(f"{expr_to_rcl(f)}  [environment fact]" for f in facts) + tuple(
         f"{expr_to_rcl(c)}  [condition]" for c in conditions)
-    return RefinementResult(a.name, b.name, side("assumption", s_assume, q1), side("guarantee", s_guar, q2), conds)
+    timing = None
+    if timed is not None:
+        stmt, status, tq, why = timed
+        timing = (side("timing", stmt, tq) if tq is not None and status == tq.status else
+                  SideResult("timing", stmt, status, reason=why))
+    return RefinementResult(a.name, b.name, side("assumption", s_assume, q1), side("guarantee", s_guar, q2), conds,
+                            timing)
 
 
 def _io_names(e: ast.Expr) -> set[tuple[str | None, str]]:
@@ -336,8 +346,10 @@ def load_node(spec: str) -> tuple[Checked, CheckedNode]:
 def render(result: RefinementResult, spec_a: str, spec_b: str) -> str:
     """The verdict as text (what ``rclverify refines`` prints)."""
     lines = [f"Does {spec_b} refine {spec_a}?  (may {result.b} replace {result.a})"]
-    for s, label in ((result.assumption, "assumption (A_A -> A_B)"),
-                     (result.guarantee, "guarantee  (A_A and G_B -> G_A)")):
+    sides = [(result.assumption, "assumption (A_A -> A_B)"), (result.guarantee, "guarantee  (A_A and G_B -> G_A)")]
+    if result.timing is not None:
+        sides.append((result.timing, "timing     (A's deadlines kept as fast)"))
+    for s, label in sides:
         lines.append(f"  {label}: {s.status}" + (f" (by {s.strategy})" if s.strategy else ""))
         lines.append(f"      {s.statement}")
         if s.status == "refuted" and s.model is not None:
@@ -345,6 +357,8 @@ def render(result: RefinementResult, spec_a: str, spec_b: str) -> str:
             lines += [f"        {k} = {v}" for k, v in sorted(s.model.items())]
         if s.status == "inconclusive" and s.reason:
             lines.append(f"      solver: {s.reason}")
+        if s.status == "refuted" and s.model is None and s.reason:
+            lines.append(f"      {s.reason}")
     verdict = {"refines": f"yes: {result.b} ({spec_b}) refines {result.a} ({spec_a})",
                "does not refine": f"no: {result.b} ({spec_b}) does not refine {result.a} ({spec_a})",
                "inconclusive": "inconclusive: the solver could not decide every side"}[result.verdict]
