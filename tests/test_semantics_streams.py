@@ -117,3 +117,34 @@ def test_two_inputs_changing_20_us_apart_are_no_inconclusive(tmp_path: Path) -> 
                                         (1.00002, "estop_active", True), (1.01, "wheel_cmd", 0.0)], horizon=1.0)
     assert [v.verdict for v in got] == ["incomplete input", "superseded", "satisfied"]
     assert verdict_status(res, "run.mcap")[0] == "discharged"
+
+
+CHAIN = """node Source {
+  inputs( )
+  outputs( v : REAL )
+  guarantee( 0 <= out.v and out.v <= 1.0 )
+}
+node Motor {
+  inputs( v : REAL )
+  outputs( w : REAL )
+  assume( 0 <= in.v and in.v <= 1.5 )
+  guarantee( out.w == in.v )
+}
+"""
+
+
+def test_always_on_a_correct_chain_is_not_refuted_by_a_value_nobody_published(tmp_path: Path) -> None:
+    """Before: refuted at step 0 by a state in which Motor.in.v = 2 "from before the run"."""
+    import json
+    from rclverify.pipeline import Workspace
+    from rclverify.requirements.check import check_requirement
+    (tmp_path / "contracts").mkdir()
+    (tmp_path / "contracts/c.rcl").write_text(CHAIN)
+    reqs = {"SAFE": "always Motor.out.w <= 1.5", "SOME": "eventually Motor.out.w <= 1.0"}
+    (tmp_path / "contracts/plan.yaml").write_text("contracts: [contracts/c.rcl]\nrequirements:\n" + "".join(
+        f"  - id: {k}\n    text: {k}\n    formal: {json.dumps(f)}\n" for k, f in reqs.items()))
+    w = Workspace(tmp_path)
+    got = {r.id: check_requirement(r, w.checked, w.model, w.plan)["temporal"] for r in w.plan.requirements}
+    assert got["SAFE"]["status"] == "proved"
+    # eventually needs a published value: without progress the Motor may never answer, and the lasso says so
+    assert got["SOME"]["status"] == "refuted" and got["SOME"]["missing_progress"]

@@ -73,18 +73,18 @@ def test_table_lasso_refutes_and_is_confirmed(system) -> None:
     # the run never reaches the goal, and every level f takes is at most 9
     assert all(st["Hold.out.last"] != 7 for st in found.values)
     assert all(v <= 9 for st in found.values for v in [*st["Pick.in.f"].table.values(), st["Pick.in.f"].default])
-    assert confirm_lasso(found.values, found.loop, cone, sys.variables, types, checked, model, plan, goal, []) is None
+    assert confirm_lasso(found.values, found.loop, cone, sys.variables, types, checked, model, plan, goal, [], pub=sys.pub) is None
     # a corrupted trace is not confirmed: Pick's output is a level its table does not take
     bad = [dict(st) for st in found.values]
     for st in bad:
         st["Pick.in.f"] = FiniteFunction({}, 3, 1)
         st["Pick.out.k"] = 5
-    why = confirm_lasso(bad, found.loop, cone, sys.variables, types, checked, model, plan, goal, [])
+    why = confirm_lasso(bad, found.loop, cone, sys.variables, types, checked, model, plan, goal, [], pub=sys.pub)
     assert why is not None and "Pick's guarantee 1 does not hold" in why
     # a trace whose goal holds is not a counterexample
     hit = [dict(st, **{"Hold.in.k": 7, "Hold.out.last": 7, "Pick.out.k": 7, "Pick.in.f": FiniteFunction({}, 7, 1)})
            for st in found.values]
-    assert "the goal holds" in confirm_lasso(hit, found.loop, cone, sys.variables, types, checked, model, plan, goal, [])
+    assert "the goal holds" in confirm_lasso(hit, found.loop, cone, sys.variables, types, checked, model, plan, goal, [], pub=sys.pub)
 
 
 def test_requirement_record_is_refuted_by_a_lasso(system) -> None:

@@ -130,8 +130,8 @@ def test_with_progress_declared_the_same_requirement_is_proved(tmp_path: Path) -
 
 
 def test_initial_values_unstick_the_loop_and_are_used_by_safety(tmp_path: Path) -> None:
-    """(3) Without initial values the loop is stuck: each node reads a value
-    from before the run that its assumption refuses, so neither ever
+    """(3) Without initial values the loop is stuck: each node waits for a
+    value the other never publishes (docs/semantics.md), so neither ever
     answers, whatever progress both declare; the producers are named.  With
     Base's initial pose the same system proves ARRIVE, and ``always next``
     reads the initial value."""
@@ -142,9 +142,10 @@ def test_initial_values_unstick_the_loop_and_are_used_by_safety(tmp_path: Path) 
     assert stuck["ARRIVE"]["verdict"] == "refuted" and t["method"] == "lasso" and t["missing_progress"] == []
     assert {(g["node"], g["consumer"]) for g in t["missing_initially"]} >= {("Base", "Planner.in.pose")}
     loop = t["trace"][t["loop"]]
-    assert _node(loop, "Planner")["accepts"] in ("False", "FALSE") and _node(loop, "Base")["answers"] in ("False", "FALSE")
+    assert _node(loop, "Planner")["heard.pose"] in ("False", "FALSE") and _node(loop, "Base")["answers"] in ("False", "FALSE")
     assert "initially(" in stuck["ARRIVE"]["note"]
-    assert stuck["SAFE"]["verdict"] == "refuted"  # Base's first pose is free
+    # no pose is ever published: nothing for SAFE to judge (before issue 47 a pose "from before the run" refuted it)
+    assert stuck["SAFE"]["check"]["temporal"]["status"] == "proved"
     fixed = _records(_ws(tmp_path / "fixed", "progress( within 0 steps )",
                          "initially( out.pose == 0 )\n  progress( within 1 steps )", [ARRIVE, safe]))
     assert fixed["ARRIVE"]["check"]["temporal"]["status"] == "proved"
@@ -167,16 +168,26 @@ def test_a_table_lasso_that_breaks_fairness_is_not_confirmed(tmp_path: Path) -> 
     goal = operands(statement(req, checked, plan))[0]
     sys = build_system(list(model.nodes), checked, model, plan)
     types = variable_types(sys, checked, plan)
-    st = {"Planner.in.goal": 7, "Planner.in.pose": 0, "Planner.out.target": 7, "Planner.answers": True,
-          "Planner.accepts": True, "Base.in.target": 7, "Base.out.pose": 0, "Base.answers": False, "Base.accepts": True}
+    common = {"Planner.in.goal": 7, "Planner.in.pose": 0, "Planner.out.target": 7, "Planner.accepts": True,
+              "Base.in.target": 7, "Base.out.pose": 0, "Base.answers": False, "Base.accepts": True,
+              "Base.published": True}  # Base's initial pose is published from the start
+    # step 0: Planner has not heard the pose yet; step 1: it has and answers; step 2: Base has heard the target
+    st0 = {**common, "Planner.answers": False, "Planner.published": False, "Planner.heard.pose": False,
+           "Base.heard.target": False}
+    st1 = {**st0, "Planner.answers": True, "Planner.published": True, "Planner.heard.pose": True}
+    st = {**st1, "Base.heard.target": True}
     assuming = [parse_formal(a, checked, "ARRIVE assuming") for a in req.assuming]
     args = (list(model.nodes), sys.variables, types, checked, model, plan, goal, assuming)
-    assert confirm_lasso([st, dict(st)], 0, *args) is None  # a run of the declared system: Base may stay idle
-    why = confirm_lasso([st, dict(st)], 0, *args, ["Base"])
+    assert confirm_lasso([st0, st1, st, dict(st)], 2, *args, pub=sys.pub) is None  # Base may stay idle
+    why = confirm_lasso([st0, st1, st, dict(st)], 2, *args, ["Base"], sys.pub)
     assert why is not None and "Base accepts its input in the loop but never answers" in why
     lazy = {**st, "Planner.answers": False}
-    why = confirm_lasso([lazy, dict(lazy)], 0, *args)
+    why = confirm_lasso([st0, lazy, dict(lazy)], 1, *args, pub=sys.pub)
     assert why is not None and "Planner accepts its input but does not answer" in why
+    # the published-value flags are checked too: a node answering before it heard its input is no run
+    early = {**st0, "Planner.answers": True, "Planner.published": True}
+    why = confirm_lasso([early, st1, st, dict(st)], 2, *args, pub=sys.pub)
+    assert why is not None and "before every input it reads was published" in why
 
 
 @pytest.mark.parametrize("clause, words", [

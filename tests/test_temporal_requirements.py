@@ -13,14 +13,17 @@ from rclverify.pipeline import Workspace, stage_check, stage_requirements
 from rclverify.plan.errors import PlanError
 
 # Inc adds one to what Fwd hands back, up to 10; Fwd forwards it: a loop
-# (Inc.out.b -> Fwd.in.b, Fwd.out.a -> Inc.in.a).  Inc's state n counts its
-# steps up to 10.  Both answer at every step (progress within 0 steps: the
-# synchronous reading; tests/test_temporal_progress.py has nodes without it).
+# (Inc.out.b -> Fwd.in.b, Fwd.out.a -> Inc.in.a) that Fwd's initial value 0
+# starts (docs/semantics.md: without it neither node ever has an input).
+# Inc's state n counts its steps up to 10.  Both answer at every step they
+# have a question (progress within 0 steps: the synchronous reading;
+# tests/test_temporal_progress.py has nodes without it).
 RCL = """node Inc { inputs( a : NATURAL ) outputs( b : NATURAL )
   guarantee( (in.a < 10 -> out.b == in.a + 1) and (in.a >= 10 -> out.b == in.a) )
   progress( within 0 steps ) }
 node Fwd { inputs( b : NATURAL ) outputs( a : NATURAL )
   guarantee( out.a == in.b )
+  initially( out.a == 0 )
   progress( within 0 steps ) }
 """
 STATE = """state:
@@ -56,10 +59,10 @@ def loop(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, dict[str, dict
         "always Inc.state.n <= 6",                        # T2 refuted at step 7
         "eventually[<= 5] Inc.state.n >= 5",              # T3 met within its bound
         "eventually[<= 4] Inc.state.n >= 5",              # T4 refuted beyond it
-        "always Fwd.out.a <= 1000",                       # T5 refuted: the first input element is free
+        "always Fwd.out.a <= 10",                         # T5 proved: only published values count
         "eventually Inc.state.n == 20",                   # T6 never; no lasso within 10 steps
         "always next Fwd.in.b >= 1",                      # T7 the connection, from step 1 on
-        "always Fwd.in.b >= 1",                           # T8 refuted at step 0
+        "always Fwd.in.b >= 1",                           # T8 proved: nothing before Inc's first answer
     ])
     return ws, _check(ws)
 
@@ -89,28 +92,36 @@ def test_bounded_eventually_met_within_its_bound_refuted_beyond(loop) -> None:
     assert short["verdict"] == "refuted" and len(short["check"]["temporal"]["trace"]) == 5
 
 
-def test_the_first_input_element_is_free(loop) -> None:
-    r = loop[1]["T5"]
-    assert r["verdict"] == "refuted" and r["check"]["temporal"]["bound"] == 0
-    fwd = next(x for x in r["check"]["temporal"]["trace"][0]["nodes"] if x["node"] == "Fwd")
-    assert int(fwd["values"]["out.a"]) > 1000
+def test_a_value_nobody_published_is_absent_not_arbitrary(loop, tmp_path: Path) -> None:
+    """Issue 47: an input before its producer's first answer held any value "from
+    before the run", and `always Fwd.out.a <= 1000` was refuted at step 0."""
+    assert loop[1]["T5"]["check"]["temporal"]["status"] == "proved"
+    assert loop[1]["T8"]["check"]["temporal"]["status"] == "proved"
+    # without Fwd's initial value the loop never starts: nothing is ever published, the goal is missed, and
+    # the verdict names the initial value to declare
+    ws = _ws(tmp_path, ["eventually Fwd.out.a == 5"], state="")
+    (ws / "contracts/n.rcl").write_text(RCL.replace("  initially( out.a == 0 )\n", ""))
+    t = _check(ws)["T1"]["check"]["temporal"]
+    assert t["status"] == "refuted" and t["missing_initially"], t
+    assert {r["node"] for r in t["missing_initially"]} <= {"Inc", "Fwd"}
+    assert "never publishes" in t["detail"] and "initially" in t["detail"]
 
 
 def test_unbounded_eventually_never_met_on_a_bound(loop, tmp_path: Path) -> None:
     # n stops at 10: no run of 10 steps reaches 20, but no state repeats within 10 steps either
     r = loop[1]["T6"]
     assert r["verdict"] == "inconclusive" and r["check"]["temporal"]["bound"] == 10
-    # without the counter, a run whose Fwd.out.a stays at 11 is a lasso: refuted
+    # without the counter, a run whose Fwd.out.a stays at 10 (its initial value) is a lasso: refuted
     ws = _ws(tmp_path, ["eventually Fwd.out.a == 20"], state="")
+    (ws / "contracts/n.rcl").write_text(RCL.replace("initially( out.a == 0 )", "initially( out.a == 10 )"))
     t = _check(ws)["T1"]["check"]["temporal"]
     assert (t["status"], t["method"]) == ("refuted", "lasso") and t["loop"] is not None
     assert t["trace"][-1]["nodes"] == t["trace"][t["loop"]]["nodes"]
     assert all(next(x for x in st["nodes"] if x["node"] == "Fwd")["values"]["out.a"] != "20" for st in t["trace"])
 
 
-def test_always_next_reads_the_connection_a_first_input_is_free(loop) -> None:
+def test_always_next_reads_the_connection(loop) -> None:
     assert loop[1]["T7"]["check"]["temporal"]["status"] == "proved"
-    assert loop[1]["T8"]["verdict"] == "refuted" and loop[1]["T8"]["check"]["temporal"]["bound"] == 0
 
 
 def test_incremental_equals_clean_and_a_state_edit_rechecks(loop, tmp_path: Path) -> None:
@@ -156,7 +167,7 @@ def test_report_and_sarif_show_the_refuted_trace(loop) -> None:
     sarif = sarif_log(report)
     res = next(r for r in sarif["runs"][0]["results"] if r.get("properties", {}).get("requirement") == "T2")
     msg = res["message"]["text"]
-    assert "Temporal check: refuted by bmc, 7 steps checked" in msg and "step 7: Inc (answers = True, in.a = " in msg
+    assert "Temporal check: refuted by bmc, 7 steps checked" in msg and "step 7: Inc (answers = True, heard.a = True, in.a = " in msg
     loc = res["locations"][0]["physicalLocation"]
     assert loc["artifactLocation"]["uri"] == "contracts/plan.yaml" and loc["region"]["startLine"] == 8
     md = render_markdown(report)

@@ -1,5 +1,7 @@
 """An independent oracle for the composed system of a temporal requirement
-(issue 40): answers, progress, initial values and fairness.
+(issues 40 and 47): answers, progress, initial values, fairness and
+published values (a value no node has published is absent: B's input
+before A's first answer, a state formula over an output not yet published).
 
 Small random two-node workspaces over a three-value enumeration: A reads an
 environment input ``x`` (its assumption keeps it in a random set) and
@@ -81,8 +83,9 @@ def cases(draw: Any) -> Case:
 
 
 # --- the explicit system ------------------------------------------------------------------------
-# a state: (x, y (A's output), A answers, A waiting, y' (B's input), z, B answers, B waiting)
-State = tuple[str, str, bool, int, str, str, bool, int]
+# a state: (x, y (A's output), A answers, A waiting, y' (B's input), z, B answers, B waiting,
+#          A published, B published, B heard y) -- the published-value reading of docs/semantics.md
+State = tuple[str, str, bool, int, str, str, bool, int, bool, bool, bool]
 
 
 def _waiting(n: Node, accepted: bool, answers: bool, before: int | None) -> list[int]:
@@ -95,10 +98,12 @@ def _waiting(n: Node, accepted: bool, answers: bool, before: int | None) -> list
     return [w] if w <= n.bound else []
 
 
-def _node_steps(n: Node, inp: str, out_before: str | None, w_before: int | None) -> list[tuple[str, bool, int]]:
+def _node_steps(n: Node, inp: str, out_before: str | None, w_before: int | None,
+                ready: bool = True) -> list[tuple[str, bool, int]]:
     """(output, answers, waiting) a node may take given its input now and its output and waiting before
-    (``None``: step 0, the output then free or its initial value)."""
-    accepted = inp in n.accept
+    (``None``: step 0, the output then free or its initial value); ``ready``: its input was published (a
+    node owes an answer, and may give one, only then)."""
+    accepted = ready and inp in n.accept
     res = []
     for answers in (False, True):
         if answers:
@@ -122,9 +127,13 @@ def explicit(c: Case) -> tuple[set[State], dict[State, frozenset[State]]]:
         for x in sorted(c.a.accept):
             ya = _node_steps(c.a, x, prev[1] if prev else None, prev[3] if prev else None)
             yins = [prev[1]] if prev else list(V)  # B's input is A's output before; at step 0 it is free
+            heard = bool(prev and prev[8])  # ... but absent until A has published
             for yin in yins:
-                zb = _node_steps(c.b, yin, prev[5] if prev else None, prev[7] if prev else None)
-                out += [(x, y, ay, wa, yin, z, bz, wb) for (y, ay, wa), (z, bz, wb) in itertools.product(ya, zb)]
+                zb = _node_steps(c.b, yin, prev[5] if prev else None, prev[7] if prev else None, heard)
+                for (y, ay, wa), (z, bz, wb) in itertools.product(ya, zb):
+                    pa = (ay or c.a.initially is not None) if prev is None else (prev[8] or ay)
+                    pb = (bz or c.b.initially is not None) if prev is None else (prev[9] or bz)
+                    out.append((x, y, ay, wa, yin, z, bz, wb, pa, pb, heard))
         return out
     init = set(states_from(None))
     succ: dict[State, frozenset[State]] = {}
@@ -141,11 +150,13 @@ def explicit(c: Case) -> tuple[set[State], dict[State, frozenset[State]]]:
 def truth(c: Case, init: set[State], succ: dict[State, frozenset[State]]) -> dict[str, bool]:
     reach = _closure(init, succ)
     dead = {s for s in reach if not succ[s]}
-    fair = tuple((frozenset(s for s in reach if s[4 if k else 0] in n.accept), frozenset(s for s in reach if s[6 if k else 2]))
+    fair = tuple((frozenset(s for s in reach if s[4 if k else 0] in n.accept and (s[10] or not k)),
+                  frozenset(s for s in reach if s[6 if k else 2]))
                  for k, n in enumerate((c.a, c.b)) if n.progress)
-    missing = _closure(init, succ, lambda s: s[5] != c.goal)
+    missing = _closure(init, succ, lambda s: not (s[9] and s[5] == c.goal))  # reached on a published z only
     misses = bool(missing & dead) or _fair_cycle(missing, succ, fair)
-    return {"eventually": not misses and not dead, "always": all(s[5] != c.avoid for s in reach) and not dead}
+    return {"eventually": not misses and not dead,
+            "always": all(not s[9] or s[5] != c.avoid for s in reach) and not dead}
 
 
 def _row(values: dict[str, str], key: str) -> str:
@@ -156,7 +167,8 @@ def as_state(step: dict[str, Any]) -> State:
     a = next(x["values"] for x in step["nodes"] if x["node"] == "A")
     b = next(x["values"] for x in step["nodes"] if x["node"] == "B")
     return (a["in.x"], a["out.y"], _row(a, "answers") == "true", int(a.get("waiting", 0)), b["in.y"], b["out.z"],
-            _row(b, "answers") == "true", int(b.get("waiting", 0)))
+            _row(b, "answers") == "true", int(b.get("waiting", 0)), _row(a, "published") == "true",
+            _row(b, "published") == "true", _row(b, "heard.y") == "true")
 
 
 COUNTS: Counter[str] = Counter()
@@ -202,7 +214,7 @@ def test_composed_verdicts_agree_with_the_explicit_runs(c: Case, tmp_path_factor
                 assert path[-1] == path[t["loop"]]
                 for k, n in enumerate((c.a, c.b)):
                     if n.progress:  # a fair loop: accepted somewhere -> answers somewhere
-                        acc = any(s[4 if k else 0] in n.accept for s in ring)
+                        acc = any(s[4 if k else 0] in n.accept and (s[10] or not k) for s in ring)
                         assert not acc or any(s[6 if k else 2] for s in ring), (c, t)
         else:
             assert t["status"] == "inconclusive", t

@@ -9,9 +9,9 @@ a refuting lasso rests on:
   nothing says these nodes answer.  The culprit is each such node, at its
   contract's header (a declaration is missing from it, not a guarantee
   wrong), and the fix is ``progress( ... )`` on it if the node does answer;
-* ``missing_initially``: a loop no node of which ever accepts its input,
-  because an input keeps the value its producer's output had before the
-  run.  The culprit is each such producer, at its header, and the fix an
+* ``missing_initially``: a loop no node of which ever has a question it
+  owes an answer, because an input its producer never publishes has no
+  value (docs/semantics.md), or keeps a value its reader refuses.  The culprit is each such producer, at its header, and the fix an
   ``initially( ... )`` with a value its readers accept.
 
 Neither names the node whose variables the goal reads (that node meets its
@@ -53,7 +53,9 @@ def liveness_culprits(temporal: Mapping[str, Any]) -> tuple[str, list[dict[str, 
         culprits = [{"what": f"the contract of {n}: no initial value declared",
                      "source": next(str(r["source"]) for r in stuck if r["node"] == n),
                      "text": "declares no initially(...)"} for n in producers]
-        reads = "; ".join(f"{r['consumer']} keeps {r['node']}.{r['output']} = {r['value']} from before the run"
+        reads = "; ".join(f"{r['consumer']} never has a value: {r['node']} never publishes {r['node']}.{r['output']}"
+                          if str(r["value"]).startswith("none") else
+                          f"{r['consumer']} keeps {r['node']}.{r['output']} = {r['value']} from before the run"
                           for r in stuck)
         sentence = (f"no node of the loop ever accepts its input ({reads}), so none ever answers. Declare the "
                     f"initial value of the outputs of {', '.join(producers)} (initially( ... ), a value the readers' "

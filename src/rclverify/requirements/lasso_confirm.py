@@ -43,6 +43,7 @@ from ..rcl.liveness import step_bound
 from ..rcl.printer import expr_to_rcl
 from ..rcl.types import Checked, CheckedNode, Type
 from ..system.model import SystemModel
+from .published import Publication, confirm_flags
 from ..values import conforms
 
 #: Z3's budget per formula when direct evaluation cannot decide it (ms, a safety net).
@@ -67,15 +68,20 @@ def _holds(e: ast.Expr, checked: Checked, scope: CheckedNode, values: Mapping[st
 
 def confirm_lasso(trace: Sequence[Mapping[str, Any]], loop: int, cone: Sequence[str], variables: Mapping[str, tuple[str, str, str]],
                   types: Mapping[str, Type], checked: Checked, model: SystemModel, plan: Plan,
-                  goal: Formal, assuming: Sequence[Formal], fair: Sequence[str] = ()) -> str | None:
+                  goal: Formal, assuming: Sequence[Formal], fair: Sequence[str] = (),
+                  pub: Publication | None = None) -> str | None:
     """Check the lasso ``trace`` (one ``{variable: value}`` per step, the
     last equal to step ``loop``) against every rule of the module docstring.
     ``goal`` is ``F`` of ``eventually F``; ``fair`` the nodes held to
-    fairness in the loop.  Returns ``None`` when every check holds, else a
+    fairness in the loop; ``pub`` the system's published-value flags
+    (:mod:`.published`: they follow their rules, a node answers only when
+    every input it reads was published, the goal counts only on published
+    values).  Returns ``None`` when every check holds, else a
     sentence naming the first check that failed or was not decided.  Never
     raises."""
+    pub = pub or Publication()
     try:
-        _confirm(trace, loop, cone, variables, types, checked, model, plan, goal, assuming, fair)
+        _confirm(trace, loop, cone, variables, types, checked, model, plan, goal, assuming, fair, pub)
     except _Unconfirmed as exc:
         return str(exc)
     return None
@@ -106,14 +112,15 @@ def _node_values(state: Mapping[str, Any], node: str) -> dict[str, Any]:
 
 def _confirm(trace: Sequence[Mapping[str, Any]], loop: int, cone: Sequence[str], variables: Mapping[str, tuple[str, str, str]],
              types: Mapping[str, Type], checked: Checked, model: SystemModel, plan: Plan,
-             goal: Formal, assuming: Sequence[Formal], fair: Sequence[str]) -> None:
+             goal: Formal, assuming: Sequence[Formal], fair: Sequence[str], pub: Publication) -> None:
     if not trace or not 0 <= loop < len(trace) - 1:
         raise _Unconfirmed("the trace is not a lasso")
     if dict(trace[-1]) != dict(trace[loop]):
         raise _Unconfirmed(f"the last state differs from the loop state {loop}")
     for n in fair:
         ring = trace[loop:-1]
-        accepted = [st.get(f"{n}.accepts", True) is True for st in ring]
+        accepted = [st.get(f"{n}.accepts", True) is True and all(st.get(f) is True for f in pub.fed.get(n, ()))
+                    for st in ring]
         if any(accepted) and not any(st[f"{n}.answers"] is True for st in ring):
             raise _Unconfirmed(f"{n} accepts its input in the loop but never answers there (its progress)")
     states = [sv for sv in plan.states if sv.node in cone]
@@ -136,6 +143,7 @@ def _confirm(trace: Sequence[Mapping[str, Any]], loop: int, cone: Sequence[str],
                 if not _holds(e, checked, cn, vals, f"step {i}: {n} environment assumption/fact {expr_to_rcl(e)}"):
                     raise _Unconfirmed(f"step {i}: {n}'s environment assumption or fact {k} does not hold")
             accepts = all(_holds(a, checked, cn, vals, f"step {i}: {n} assumption") for a in internal)
+            ready = all(st.get(f) is True for f in pub.fed.get(n, ()))
             if f"{n}.accepts" in variables and st[f"{n}.accepts"] is not accepts:
                 raise _Unconfirmed(f"step {i}: {n}.accepts is {st[f'{n}.accepts']} but its assumption "
                                    f"{'holds' if accepts else 'fails'}")
@@ -147,7 +155,7 @@ def _confirm(trace: Sequence[Mapping[str, Any]], loop: int, cone: Sequence[str],
                     if not _holds(g.formula, checked, cn, vals, f"step {i}: {n} guarantee {k}"):
                         raise _Unconfirmed(f"step {i}: {n}'s guarantee {k} does not hold")
             if f"{n}.answers" in variables:
-                _check_waiting(n, cn, trace, i, accepts, answers)
+                _check_waiting(n, cn, trace, i, accepts and ready, answers)
             if i == 0 and f"{n}.answers" in variables and not answers:
                 for k, ini in enumerate(cn.node.initially, 1):
                     if not _holds(ini.formula, checked, cn, vals, f"step 0: {n} initially {k}"):
@@ -156,10 +164,15 @@ def _confirm(trace: Sequence[Mapping[str, Any]], loop: int, cone: Sequence[str],
         pseudo = {f"{'out' if variables[name][1] == 'out' else 'in'}.{name}": v
                   for name, v in st.items() if name in variables}
         for k, a in enumerate(assuming, 1):
-            if not _holds(a.expr, checked, a.scope, pseudo, f"step {i}: assuming {k}"):
+            if all(st.get(f) is True for f in pub.flags_of(a.mentions)) and \
+                    not _holds(a.expr, checked, a.scope, pseudo, f"step {i}: assuming {k}"):
                 raise _Unconfirmed(f"step {i}: the requirement's assuming {k} does not hold")
-        if _holds(goal.expr, checked, goal.scope, pseudo, f"step {i}: the goal"):
+        published = all(st.get(f) is True for f in pub.flags_of(goal.mentions))
+        if published and _holds(goal.expr, checked, goal.scope, pseudo, f"step {i}: the goal"):
             raise _Unconfirmed(f"step {i}: the goal holds")
+    bad_flag = confirm_flags(trace, pub, lambda st, n: st.get(f"{n}.answers") is True)
+    if bad_flag:
+        raise _Unconfirmed(bad_flag)
     for sv in states:
         vals = {f"in.state.{o.name}": trace[0][f"{o.node}.state.{o.name}"] for o in states if o.node == sv.node}
         f = parsed[sv][0]

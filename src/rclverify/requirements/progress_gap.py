@@ -59,7 +59,8 @@ def idle_in_loop(trace: Sequence[Mapping[str, str]], loop: int | None, sys: Comp
     for n in sys.cone:
         if f"{n}.answers" not in sys.variables:
             continue
-        accepted = [i for i in ring if str(trace[i].get(f"{n}.accepts", "True")) in _TRUE]
+        accepted = [i for i in ring if str(trace[i].get(f"{n}.accepts", "True")) in _TRUE
+                    and all(str(trace[i].get(f)) in _TRUE for f in sys.pub.fed.get(n, ()))]
         if accepted and not any(str(trace[i].get(f"{n}.answers")) in _TRUE for i in ring):
             out.append({"node": n, "accepted_at": accepted})
     return out
@@ -76,8 +77,11 @@ def stuck_in_loop(trace: Sequence[Mapping[str, str]], loop: int | None, sys: Com
     if loop is None or not trace:
         return []
     ring = range(loop, len(trace) - 1) or range(loop, loop + 1)
-    stuck = {n for n in sys.cone if f"{n}.accepts" in sys.variables
-             and not any(str(trace[i].get(f"{n}.accepts")) in _TRUE for i in ring)}
+    def enabled(n: str, i: int) -> bool:  # its assumption holds on inputs that were all published
+        return (str(trace[i].get(f"{n}.accepts", "True")) in _TRUE
+                and all(str(trace[i].get(f)) in _TRUE for f in sys.pub.fed.get(n, ())))
+    stuck = {n for n in sys.cone if (f"{n}.accepts" in sys.variables or sys.pub.fed.get(n))
+             and not any(enabled(n, i) for i in ring)}
     out: list[dict[str, Any]] = []
     seen: set[str] = set()
     for consumer, producer in sys.links:
@@ -88,8 +92,11 @@ def stuck_in_loop(trace: Sequence[Mapping[str, str]], loop: int | None, sys: Com
         if node.initially or any(str(st.get(f"{p_node}.answers")) in _TRUE for st in trace):
             continue
         seen.add(producer)
+        heard = sys.pub.heard.get(consumer)
+        absent = heard is not None and not any(str(st.get(heard)) in _TRUE for st in trace)
         out.append({"node": p_node, "source": f"{node.loc.file}:{node.loc.line}:{node.loc.col}",
-                    "output": producer.split(".", 1)[1], "value": str(trace[-1].get(producer, "?")),
+                    "output": producer.split(".", 1)[1],
+                    "value": "none: never published" if absent else str(trace[-1].get(producer, "?")),
                     "consumer": consumer})
     order = {n: k for k, n in enumerate(sys.cone)}
     return sorted(out, key=lambda r: order.get(r["node"], 0))
@@ -97,10 +104,12 @@ def stuck_in_loop(trace: Sequence[Mapping[str, str]], loop: int | None, sys: Com
 
 def stuck_words(stuck: Sequence[Mapping[str, Any]]) -> str:
     """The stuck lasso in one sentence, naming each producer's initial value to declare."""
-    parts = [f"{r['consumer']} keeps the value {r['node']}.{r['output']} had before the run ({r['value']}), "
-             f"outside its assumption, and {r['node']} never answers" for r in stuck]
+    parts = [(f"{r['consumer']} never has a value: {r['node']} never publishes {r['node']}.{r['output']}"
+              if r["value"].startswith("none") else
+              f"{r['consumer']} keeps the value {r['node']}.{r['output']} had before the run ({r['value']}), "
+              f"outside its assumption, and {r['node']} never answers") for r in stuck]
     names = list(dict.fromkeys(r["node"] for r in stuck))
-    return ("no node waiting on it ever accepts its input in the loop: " + "; ".join(parts)
+    return ("no node waiting on it ever has a question it owes an answer in the loop: " + "; ".join(parts)
             + f": declare the initial value of the outputs of {', '.join(names)} "
               "(initially( out.y == ... ), a value its readers accept) if the node has one before its first answer")
 

@@ -86,9 +86,12 @@ def roll_up(record: Mapping[str, Any] | None, g_status: Callable[[str, int], str
     stuck = (record.get("temporal") or {}).get("missing_initially") or []
     if v == "refuted" and stuck:
         names = ", ".join(dict.fromkeys(r["node"] for r in stuck))
-        return "refuted", "failed", (f"a run that never reaches it, in which no node waiting on {names} ever accepts "
-                                     f"its input: {stuck[0]['consumer']} keeps the value {stuck[0]['node']}."
-                                     f"{stuck[0]['output']} had before the run, and no initial value is declared "
+        first = stuck[0]
+        why = (f"{first['consumer']} never has a value: {first['node']} never publishes {first['node']}.{first['output']}"
+               if str(first["value"]).startswith("none") else
+               f"{first['consumer']} keeps the value {first['node']}.{first['output']} had before the run")
+        return "refuted", "failed", (f"a run that never reaches it, in which no node waiting on {names} ever has a "
+                                     f"question it owes an answer: {why}, and no initial value is declared "
                                      f"(declare initially( ... ) on {names})")
     if v == "refuted":
         who = ", ".join(p["label"] for p in record.get("failed_to_prevent", [])) or "no guarantee of the cone"

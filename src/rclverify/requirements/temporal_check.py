@@ -51,7 +51,7 @@ from .temporal import (TemporalVerdict, TransitionSystem, check_always, check_ev
                        check_eventually_within, check_next, check_until, find_lasso, with_flag)
 from .lasso import find_table_lasso
 from .lasso_confirm import confirm_lasso
-from .progress_gap import EVEN_SO, explain_idle
+from .progress_gap import EVEN_SO, explain_idle, stuck_in_loop, stuck_words
 from .transition import ComposedSystem, build_system, variable_types
 
 #: The bound of BMC for an unbounded ``eventually`` and of k-induction's k.
@@ -82,9 +82,13 @@ def decide(t: Temporal, sys: ComposedSystem, pred: Callable[[Formal], Callable[[
            bound: int = DEFAULT_BOUND, timeout_ms: int = 10_000, tables: Tables | None = None,
            ranking: Callable[[Any], Any] | None = None, invariant: Callable[[Any], Any] | None = None,
            checked: Checked | None = None, gaps: dict[str, Any] | None = None,
-           tables_first: bool = False) -> TemporalVerdict:
+           tables_first: bool = False, reach: Callable[[Formal], Callable[[Any], Any]] | None = None
+           ) -> TemporalVerdict:
     """Decide statement ``t`` over ``sys`` (module table); ``pred(F)`` is
-    F as a predicate over one state.  ``tables(F, v, ts)`` is asked when the
+    F as a predicate over one state where F must hold (under ``always``,
+    the left of ``until``), ``reach(F)`` (default ``pred``) where F must be
+    reached (under ``eventually`` and ``next``, the right of ``until``): on
+    published values, :mod:`.published`.  ``tables(F, v, ts)`` is asked when the
     verdict ``v`` on an unbounded ``eventually F`` over ``ts`` is
     inconclusive (the finite-table lasso search of :func:`check_temporal`);
     with ``tables_first`` (the system has function-typed variables, over
@@ -98,34 +102,43 @@ def decide(t: Temporal, sys: ComposedSystem, pred: Callable[[Formal], Callable[[
     is missing is put in ``gaps`` (``missing_progress``, ``missing_initially``).  A verdict ``proved`` stands
     only if no run of the system stops (:func:`.deadlock.runs_go_on`)."""
     return runs_go_on(sys.ts, _decide(t, sys, pred, bound, timeout_ms, tables, ranking, invariant, checked,
-                                      gaps if gaps is not None else {}, tables_first),
+                                      gaps if gaps is not None else {}, tables_first, reach or pred),
                       max_k=bound, timeout_ms=timeout_ms)
 
 
 def _decide(t: Temporal, sys: ComposedSystem, pred: Callable[[Formal], Callable[[Any], Any]], bound: int,
             timeout_ms: int, tables: Tables | None,
             ranking: Callable[[Any], Any] | None, invariant: Callable[[Any], Any] | None,
-            checked: Checked | None, gaps: dict[str, Any], tables_first: bool = False) -> TemporalVerdict:
+            checked: Checked | None, gaps: dict[str, Any], tables_first: bool = False,
+            reach: Callable[[Formal], Callable[[Any], Any]] | None = None) -> TemporalVerdict:
     kind = shape(t, None)
+    got = reach or pred
     ts = sys.ts
+
+    def even_so(w: TemporalVerdict) -> TemporalVerdict:
+        """A lasso of the synchronous system: the goal is missed even with progress, unless the loop
+        never starts for want of a published value (then the initial values to declare are named)."""
+        stuck = stuck_in_loop(w.trace, w.loop, sys, checked) if checked is not None else []
+        gaps["missing_initially"] = stuck
+        said = stuck_words(stuck) if stuck else EVEN_SO
+        return TemporalVerdict(w.status, w.method, k=w.k, bound=w.bound, trace=w.trace, loop=w.loop,
+                               deadlock=w.deadlock, detail=f"{w.detail}; {said}")
 
     def eventually(g: Formal) -> TemporalVerdict:
         tried_sync = False
         if tables_first and tables is not None and checked is not None and not sys.eager:
             w = tables(g, TemporalVerdict("inconclusive", "bounded"), sys.synchronous(ts))
             if w.status == "refuted":  # a confirmed lasso of the declared system: the general query cannot undo it
-                return TemporalVerdict(w.status, w.method, k=w.k, bound=w.bound, trace=w.trace, loop=w.loop,
-                                       deadlock=w.deadlock, detail=f"{w.detail}; {EVEN_SO}")
+                return even_so(w)
             tried_sync = True
-        v = check_eventually(ts, pred(g), ranking=ranking, invariant=invariant, bound=bound, timeout_ms=timeout_ms)
+        v = check_eventually(ts, got(g), ranking=ranking, invariant=invariant, bound=bound, timeout_ms=timeout_ms)
         by_tables = tables is not None and v.status == "inconclusive"
         if by_tables and checked is not None and not sys.eager and not tried_sync:
             # every node answering what it accepts at once: the query Z3 decides best, and a lasso there is one
             # of the declared system that rests on no missing progress (.progress_gap)
             w = tables(g, v, sys.synchronous(ts))  # type: ignore[misc]
             if w.status == "refuted":
-                return TemporalVerdict(w.status, w.method, k=w.k, bound=w.bound, trace=w.trace, loop=w.loop,
-                                       deadlock=w.deadlock, detail=f"{w.detail}; {EVEN_SO}")
+                return even_so(w)
             tried_sync = True
         if by_tables:
             v = tables(g, v, ts)  # type: ignore[misc]
@@ -136,7 +149,7 @@ def _decide(t: Temporal, sys: ComposedSystem, pred: Callable[[Formal], Callable[
             if by_tables:
                 w = tables(g, TemporalVerdict("inconclusive", "lasso"), ts2)  # type: ignore[misc]
                 return w if w.status == "refuted" else None
-            return find_lasso(ts2, pred(g), bound, timeout_ms=timeout_ms)
+            return find_lasso(ts2, got(g), bound, timeout_ms=timeout_ms)
         v, found = explain_idle(v, sys, ts, checked, search, tried_sync=tried_sync)
         gaps.update(found)
         return v
@@ -147,15 +160,15 @@ def _decide(t: Temporal, sys: ComposedSystem, pred: Callable[[Formal], Callable[
         ts2 = with_flag(ts, "<started>", lambda s: z3.BoolVal(False), lambda s, u: z3.BoolVal(True))
         return check_always(ts2, lambda s: z3.Or(z3.Not(s["<started>"]), f(s)), max_k=bound, timeout_ms=timeout_ms)
     if kind == "next":
-        return check_next(ts, pred(t.args[0]), timeout_ms=timeout_ms)
+        return check_next(ts, got(t.args[0]), timeout_ms=timeout_ms)
     if kind == "eventually":
-        f = pred(t.args[0])
+        f = got(t.args[0])
         if t.bound is not None:
             v = check_eventually_within(ts, f, t.bound, timeout_ms=timeout_ms)
             return TemporalVerdict("proved", v.method, bound=v.bound, detail=v.detail,
                                    deadlock=v.deadlock) if v.status == "met" else v
         return eventually(t.args[0])  # type: ignore[arg-type]
-    return check_until(ts, pred(t.args[0]), pred(t.args[1]), eventually=lambda: eventually(t.args[1]),  # type: ignore[arg-type]
+    return check_until(ts, pred(t.args[0]), got(t.args[1]), eventually=lambda: eventually(t.args[1]),  # type: ignore[arg-type]
                        max_k=bound, timeout_ms=timeout_ms)
 
 
@@ -191,8 +204,14 @@ def check_temporal(req: Requirement, checked: Checked, model: SystemModel, plan:
     sys = build_system(cone, checked, model, plan)
     enc = Encoder(checked.env)
 
-    def pred(f: Formal) -> Callable[[Any], Any]:
+    def raw(f: Formal) -> Callable[[Any], Any]:
         return lambda s: enc.formula(f.expr, f.scope, sys.statement_symbols(s))
+
+    def pred(f: Formal) -> Callable[[Any], Any]:  # must hold: only where its values are published
+        return lambda s: z3.Implies(sys.pub.defined(f.mentions, s), raw(f)(s))
+
+    def reach(f: Formal) -> Callable[[Any], Any]:  # must be reached: on published values
+        return lambda s: z3.And(sys.pub.defined(f.mentions, s), raw(f)(s))
     if assuming:  # the requirement's own assumptions hold in every state
         holds = [pred(a) for a in assuming]
         ts = sys.ts
@@ -210,14 +229,14 @@ def check_temporal(req: Requirement, checked: Checked, model: SystemModel, plan:
         if any(isinstance(ty, EmptyT) for ty in types.values()):
             return v
         try:
-            found = find_table_lasso(ts, pred(goal), types, bound=bound, points=points)
+            found = find_table_lasso(ts, reach(goal), types, bound=bound, points=points)
         except (ValueError, z3.Z3Exception) as exc:
             found = f"the finite-table search failed ({exc})"
         if isinstance(found, str):
             return TemporalVerdict(v.status, v.method, k=v.k, bound=v.bound, trace=v.trace, loop=v.loop,
                                    detail=f"{v.detail}; {found}")
         why = confirm_lasso(found.values, found.loop, cone, sys.variables, types, checked, model, plan, goal, assuming,
-                            [f.label for f in ts.fairness])
+                            [f.label for f in ts.fairness], sys.pub)
         if why is not None:
             return TemporalVerdict(v.status, v.method, k=v.k, bound=v.bound, trace=v.trace, loop=v.loop,
                                    detail=f"{v.detail}; a lasso with {points}-point tables was found but not "
@@ -229,11 +248,12 @@ def check_temporal(req: Requirement, checked: Checked, model: SystemModel, plan:
                                       f"(found with every function a {points}-point table, confirmed on the "
                                       f"trace's values)")
     ranking = (lambda s: enc.term(rank.expr, rank.scope, sys.statement_symbols(s))) if rank is not None else None
+    inv_pred = raw(inv) if inv is not None else None
     missing: dict[str, Any] = {}
     from ..rcl.types import FuncT
     v = decide(t, sys, pred, bound=bound, timeout_ms=timeout_ms, tables=tables, ranking=ranking,
-               invariant=pred(inv) if inv is not None else None, checked=checked, gaps=missing,
-               tables_first=any(isinstance(ty, FuncT) for ty in types.values()))
+               invariant=inv_pred, checked=checked, gaps=missing,
+               tables_first=any(isinstance(ty, FuncT) for ty in types.values()), reach=reach)
     lasso = v.status == "refuted" and "lasso" in v.method.split(" + ")
     gaps = missing.get("missing_progress", []) if lasso else []
     stuck = missing.get("missing_initially", []) if lasso else []
@@ -251,10 +271,10 @@ def check_temporal(req: Requirement, checked: Checked, model: SystemModel, plan:
         out.update(verdict="proved", used=used)
         # an initial value no output meets forces its node to answer at step 0: it removes runs, as a contradiction
         bad, why = sys.initial_values_unsatisfiable(timeout_ms)
-        if r == z3.unsat:
-            out.update(consistency="inconsistent", inconsistent_core=used)
-        elif bad:
+        if bad:  # the initial values no output meets: the precise core (they alone may leave no run)
             out.update(consistency="inconsistent", inconsistent_core=bad)
+        elif r == z3.unsat:
+            out.update(consistency="inconsistent", inconsistent_core=used)
         elif r == z3.sat and not why:
             out.update(consistency="consistent")
         else:

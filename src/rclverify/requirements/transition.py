@@ -33,8 +33,12 @@ transition relation"):
   node answers infinitely often);
 * **initial states**: every declared state variable satisfies its
   ``init``; a node that does not answer at step 0 has outputs satisfying its
-  ``initially`` (free without one); the first input elements are otherwise
-  unconstrained (they come from before the run).
+  ``initially`` (free without one);
+* **published values** (:mod:`.published`, docs/semantics.md): an output
+  holds a value only once its node has answered (or from the start, with
+  ``initially``); a node answers only once every input another node feeds
+  it has been published, and a requirement's state formula is evaluated on
+  published values only.
 """
 from __future__ import annotations
 
@@ -51,6 +55,8 @@ from ..rcl.liveness import STEP_WORDS, fair, progress_words, step_bound
 from ..rcl.printer import expr_to_rcl
 from ..rcl.types import BOOL, INTEGER, NATURAL, Checked, DataT, EmptyT, FuncT, Type
 from ..system.model import SystemModel
+from ..calculus.compose import free_io
+from .published import Publication, publication
 from .temporal import State, TransitionSystem
 from .tsys import Fairness
 
@@ -110,6 +116,8 @@ class ComposedSystem:
     bounds: dict[str, int | None] = field(default_factory=dict)
     #: per node that declares ``initially``: its outputs' types and initial values over one state
     initial: dict[str, Any] = field(default_factory=dict)
+    #: which values are published at each step (:mod:`.published`; docs/semantics.md)
+    pub: Publication = field(default_factory=Publication)
 
     def initial_values_unsatisfiable(self, timeout_ms: int) -> tuple[list[dict[str, Any]], str]:
         """The premises of the initial values that no output satisfies (a
@@ -249,6 +257,15 @@ def build_system(cone: Sequence[str], checked: Checked, model: SystemModel, plan
                              "node": sv.node, "index": 0, "text": " ".join(src.text.split()),
                              "source": f"{src.file}:{src.loc.line}:{src.loc.col}"})
 
+    alias = model.alias()
+    links = [(f"{c}.in.{v}", producer) for (c, p, v), producer in alias.items()
+             if c in cone and producer in sorts]
+    reads = {n: {v for f in [*internal[n], *env[n], *guarantees[n]] for p, v in free_io(f)
+                 if p in ("in", None) and v in checked.nodes[n].inputs} for n in cone}
+    pub = publication(answering, links, reads, [n for n in answering if initially[n]])
+    for name, var in pub.variables():
+        sorts[name], types[name], variables[name] = z3.BoolSort(), BOOL, var
+
     def node_symbols(n: str, s: State) -> dict[str, Any]:
         cn = checked.nodes[n]
         return {**{f"in.{v}": s[f"{n}.in.{v}"] for v in cn.inputs if f"{n}.in.{v}" in s},
@@ -279,6 +296,13 @@ def build_system(cone: Sequence[str], checked: Checked, model: SystemModel, plan
         """The node's assumption holds on ``s``'s input (its ``accepts`` variable, TRUE without one)."""
         return s[f"{n}.accepts"] if f"{n}.accepts" in s else z3.BoolVal(True)
 
+    def enabled(n: str, s: State) -> z3.BoolRef:
+        """The node has a question it owes an answer: every input it reads published, its assumption holding."""
+        return z3.And(accepted(n, s), pub.ready(n, s))
+
+    def answers_in(n: str, s: State) -> z3.BoolRef:
+        return s[f"{n}.answers"]
+
     def _valid(s: State) -> z3.BoolRef:
         parts = [c for c in (_typing(s[name], types[name]) for name in sorts) if c is not None]
         for n in cone:
@@ -291,18 +315,14 @@ def build_system(cone: Sequence[str], checked: Checked, model: SystemModel, plan
                     parts.append(z3.Implies(assumed(n, s), promise))
                 continue
             answers = s[f"{n}.answers"]
-            parts.append(z3.Implies(answers, z3.And(accepted(n, s), promise)))
+            parts.append(z3.Implies(answers, z3.And(enabled(n, s), promise)))
             k = bounds[n]
             if k == 0:
-                parts.append(z3.Implies(accepted(n, s), answers))
+                parts.append(z3.Implies(enabled(n, s), answers))
             elif k:
                 w = s[f"{n}.waiting"]
-                parts.append(z3.If(z3.Or(answers, z3.Not(accepted(n, s))), w == 0, z3.And(w >= 1, w <= k)))
+                parts.append(z3.If(z3.Or(answers, z3.Not(enabled(n, s))), w == 0, z3.And(w >= 1, w <= k)))
         return z3.And(*parts)
-
-    alias = model.alias()
-    links = [(f"{c}.in.{v}", producer) for (c, p, v), producer in alias.items()
-             if c in cone and producer in sorts]
 
     def state_syms(sv: Any, s: State, t: State | None) -> dict[str, Any]:
         out = node_symbols(sv.node, s) if t is not None else {}
@@ -314,8 +334,8 @@ def build_system(cone: Sequence[str], checked: Checked, model: SystemModel, plan
         return out
 
     def init(s: State) -> z3.BoolRef:
-        parts = [valid(s), *[enc.formula(parsed[sv][0].expr, parsed[sv][0].scope, state_syms(sv, s, None))
-                             for sv in states]]
+        parts = [valid(s), pub.init(s, answers_in),
+                 *[enc.formula(parsed[sv][0].expr, parsed[sv][0].scope, state_syms(sv, s, None)) for sv in states]]
         for n in answering:
             if initially[n]:
                 parts.append(z3.Implies(z3.Not(s[f"{n}.answers"]), z3.And(*[holds(n, f, s) for f in initially[n]])))
@@ -327,12 +347,12 @@ def build_system(cone: Sequence[str], checked: Checked, model: SystemModel, plan
         return cached(1, (s, t), lambda: _trans(s, t))
 
     def _trans(s: State, t: State) -> z3.BoolRef:
-        parts = [valid(s), valid(t)] + [t[c] == s[p] for c, p in links]
+        parts = [valid(s), valid(t), pub.trans(s, t, answers_in)] + [t[c] == s[p] for c, p in links]
         for n in answering:
             outs = [t[f"{n}.out.{v}"] == s[f"{n}.out.{v}"] for v in checked.nodes[n].outputs if f"{n}.out.{v}" in s]
             parts.append(z3.Implies(z3.Not(t[f"{n}.answers"]), z3.And(*outs)))
             if bounds[n]:
-                parts.append(z3.Implies(z3.And(z3.Not(t[f"{n}.answers"]), accepted(n, t)),
+                parts.append(z3.Implies(z3.And(z3.Not(t[f"{n}.answers"]), enabled(n, t)),
                                         t[f"{n}.waiting"] == s[f"{n}.waiting"] + 1))
         parts += [enc.formula(parsed[sv][1].expr, parsed[sv][1].scope, state_syms(sv, s, t)) for sv in states]
         return z3.And(*parts)
@@ -343,8 +363,8 @@ def build_system(cone: Sequence[str], checked: Checked, model: SystemModel, plan
                                 *[holds(n, f, s) for f in initially[n]])
 
     def progress_of(n: str) -> Fairness:
-        return Fairness(n, lambda s: accepted(n, s), lambda s: s[f"{n}.answers"])
+        return Fairness(n, lambda s: enabled(n, s), lambda s: s[f"{n}.answers"])
     declared = tuple(progress_of(n) for n in answering if fair(checked.nodes[n].node))
     everyone = tuple(progress_of(n) for n in answering)
     return ComposedSystem(TransitionSystem(sorts, init, trans, declared), list(cone), variables, premises, everyone,
-                          links, bounds, {n: initial_of(n) for n in answering if initially[n]})
+                          links, bounds, {n: initial_of(n) for n in answering if initially[n]}, pub)
