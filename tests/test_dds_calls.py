@@ -131,6 +131,28 @@ def test_the_gate_releases_only_what_is_shown_to_hold() -> None:
             parse_enforce([bad])
 
 
+def test_the_gate_fails_closed_on_an_input_it_cannot_judge_against() -> None:
+    """Issue 47: 0.9 was released after ``limit = NaN`` (judged against the stale
+    1.0), 5.0 after ``limit = +inf`` blocked as violated with ``in.limit: 1.0``.
+    Both are held back as inconclusive now, naming the input; a valid limit
+    after it is judged again; ``@open`` releases what cannot be decided."""
+    from rclverify.backends.monitors.dds_enforce import fail_open
+    eng = _engine()
+    ev = lambda k, topic, v: Event(k, float(k), topic, {"data": v}, f"m{k}")  # noqa: E731
+    eng.push("limit", {"data": 1.0}, 1.0)
+    for k, bad in ((2, float("nan")), (4, float("inf"))):
+        eng.push("limit", {"data": bad}, float(k))
+        for v in (0.9, 5.0):
+            ok, why = judge(eng.monitors, CHECKED, ev(k + 1, "speed", v), {})
+            assert not ok and why["verdict"] == "inconclusive", (bad, v, why)
+            assert "in.limit" in why["reason"] and "stale" in why["reason"]
+    eng.push("limit", {"data": 2.0}, 6.0)
+    assert judge(eng.monitors, CHECKED, ev(7, "speed", 0.9), {})[0] is True
+    assert judge(eng.monitors, CHECKED, ev(7, "speed", 5.0), {})[1]["verdict"] == "violated"
+    assert fail_open(["/speed@open", "/cmd:=/cmd_raw"]) == {"speed"}
+    assert parse_enforce(["/speed@open"]) == {"speed": "/speed_unchecked"}
+
+
 @pytest.mark.parametrize("storage", ["sqlite3", "mcap"])
 def test_a_recorded_bag_reads_back_with_the_live_times(storage: str, tmp_path: Path) -> None:
     pytest.importorskip("cyclonedds", reason="the cyclonedds binding is not installed")

@@ -202,7 +202,8 @@ def test_enforce_drops_exactly_the_violating_messages(run: dict[str, Any]) -> No
     blocked = [x for x in run["log"] if x.get("kind") == "blocked"]
     assert [b["verdict"]["values"]["out.speed"] for b in blocked] == ["1.5", "2.0"]
     assert all(b["verdict"]["verdict"] == "violated" and b["verdict"]["guarantee"] == 1 for b in blocked)
-    assert run["record"]["enforce"] == {"speed": {"private": "/speed_unchecked", "released": 2, "blocked": 2}}
+    assert run["record"]["enforce"] == {"speed": {"private": "/speed_unchecked", "released": 2, "blocked": 2,
+                                                  "policy": "closed"}}
 
 
 def test_a_best_effort_publisher_is_heard(run: dict[str, Any]) -> None:

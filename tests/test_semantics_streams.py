@@ -148,3 +148,22 @@ def test_always_on_a_correct_chain_is_not_refuted_by_a_value_nobody_published(tm
     assert got["SAFE"]["status"] == "proved"
     # eventually needs a published value: without progress the Motor may never answer, and the lasso says so
     assert got["SOME"]["status"] == "refuted" and got["SOME"]["missing_progress"]
+
+
+TWINS = """node Scale {
+  inputs( r : REAL )
+  outputs( d : REAL )
+  topics( std_msgs/Float64 r matches(in.r), std_msgs/Float64 d matches(out.d) )
+  guarantee( out.d == 1000 * in.r )
+  guarantee( out.d != 1000 * in.r )
+}
+"""
+
+
+def test_one_arithmetic_per_message_for_the_whole_contract(tmp_path: Path) -> None:
+    """Before: two contradictory guarantees were both "satisfied", one in exact
+    arithmetic, the other in the node's double arithmetic."""
+    checked = _checked(tmp_path, TWINS)
+    got, res = _run(checked, "Scale", [(0.0, "r", 1.2), (0.1, "d", 1000 * 1.2)])
+    assert [v.verdict for v in got] == ["violated"]
+    assert "no one arithmetic" in got[0].reason and res.counts["satisfied"] == 0

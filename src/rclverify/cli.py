@@ -628,9 +628,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     lv.add_argument("--ros", choices=("1", "2"), help="ROS version (default: $ROS_VERSION, else 1)")
     lv.add_argument("--ros2", dest="ros", action="store_const", const="2",
                     help="ROS 2 over DDS (Cyclone DDS; ROS_DOMAIN_ID, CYCLONEDDS_URI): same as --ros 2")
-    lv.add_argument("--enforce", action="append", default=[], metavar="TOPIC[:=PRIVATE]",
+    lv.add_argument("--enforce", action="append", default=[], metavar="TOPIC[:=PRIVATE][@open]",
                     help="ROS 2: republish TOPIC only when the guarantee holds; the node publishes on PRIVATE "
-                         "(default TOPIC_unchecked) (repeatable)")
+                         "(default TOPIC_unchecked); TOPIC@open also releases what cannot be decided, which is "
+                         "held back by default (repeatable)")
     lv.add_argument("--record", metavar="BAG", help="ROS 2: record the contract topics to a new ROS 2 bag")
     lv.add_argument("--record-storage", choices=("sqlite3", "mcap"),
                     help="the bag's storage (default: mcap for a BAG ending .mcap, else sqlite3)")

@@ -240,6 +240,23 @@ def judge(formula: ast.Expr, checked: Checked, node: CheckedNode, values: Mappin
     return Judgement(None, "", reason)
 
 
+def holds_in(semantics: str, formula: ast.Expr, checked: Checked, node: CheckedNode, values: Mapping[str, Any],
+             tolerance: Tolerance | None = None) -> bool | None:
+    """Does ``formula`` hold of ``values`` in the one arithmetic ``semantics``
+    (``exact``, ``double``, ``tolerance``), ``None`` when undecided there?
+    The monitor judges every guarantee of one message in one arithmetic
+    (issue 47, docs/monitors.md "Numbers on the wire"): a message whose
+    guarantees hold only in different arithmetics holds in none."""
+    if semantics == "exact":
+        j = judge(formula, checked, node, values)
+        return j.truth if j.semantics.startswith("exact") or j.truth is not True else False
+    if semantics == "double":
+        return _run(_Double(checked, node, values), formula)[0]
+    ev = _Tolerant(checked, node, values)
+    ev.tolerance = tolerance or Tolerance()
+    return _run(ev, formula)[0]
+
+
 def _run(ev: Evaluator, formula: ast.Expr) -> tuple[bool | None, str]:
     try:
         return bool(ev.eval(formula, {})), ""
@@ -401,5 +418,5 @@ def _finite_domain(ev: Evaluator, e: ast.Quant, bd: ast.Binding, name: str, b: M
     raise Undecided(f"quantifier over {type(dom).__name__} is not finite")
 
 
-__all__ = ["Judgement", "SEMANTICS", "Tolerance", "ToleranceError", "float_sensitive", "judge", "parse_tolerance",
+__all__ = ["Judgement", "SEMANTICS", "Tolerance", "ToleranceError", "float_sensitive", "holds_in", "judge", "parse_tolerance",
            "ulp_distance"]

@@ -213,12 +213,15 @@ class _ToAst(Transformer[Token, Any]):
 
     def _unit(self, tok: Token | None) -> ast.UnitAnn | None:
         """The :class:`~rclverify.rcl.ast.UnitAnn` of a ``UNIT`` token
-        (``None`` for an absent one): its text without the brackets and
-        blanks, located at the opening bracket."""
+        (``None`` for an absent one): its text without the brackets, as
+        :func:`~rclverify.rcl.units.normal_text` writes it (a blank between
+        two symbols is a product, ``[m s]`` is ``m*s``, never ``ms``),
+        located at the opening bracket."""
         if tok is None:
             return None
         self.units_seen = True
-        return ast.UnitAnn("".join(str(tok)[1:-1].split()), self._span([tok]))
+        from .units import normal_text
+        return ast.UnitAnn(normal_text(str(tok)[1:-1]), self._span([tok]))
 
     def node_clause(self, c: list[Any]) -> ast.Node:
         v = _vals(c)

@@ -152,6 +152,21 @@ def chain_operands(e: ast.Binary) -> list[ast.Expr]:
 EXACT_CHAIN_MAX = 64
 
 
+#: Longest program-built chain whose printed parentheses are checked for minimality by reading the
+#: text back (a few parses of a short text; longer chains keep every same-operator pair).
+MINIMAL_CHAIN_MAX = 12
+
+
+def _reads_back(text: str, e: ast.Expr) -> bool:
+    """Whether ``text`` parses to ``e`` (AST equality ignores parentheses and locations)."""
+    from .errors import RclError
+    from .parser import parse_formula
+    try:
+        return parse_formula(text) == e
+    except (RclError, RecursionError):
+        return False
+
+
 def _opens(x: ast.Expr, op: str) -> bool:
     return isinstance(x, ast.Binary) and x.op == op and not x.parenthesised
 
@@ -247,7 +262,17 @@ def _expr(p: _Printer, e: ast.Expr) -> str:
         lf = _opens(e.left, e.op) or (p.explicit and clarifying_parens(e, e.left))
         rf = _opens(e.right, e.op) or (p.explicit and clarifying_parens(e, e.right))
         lmin, rmin = operand_levels(e)
-        return f"{p.wrap(e.left, lmin, lf)} {e.op} {p.wrap(e.right, rmin, rf)}"
+        text = f"{p.wrap(e.left, lmin, lf)} {e.op} {p.wrap(e.right, rmin, rf)}"
+        if len(ops) <= MINIMAL_CHAIN_MAX and not p.explicit:
+            # a pair the parser does not need goes (the printed text is minimal): the flat text of a
+            # same-operator operand may balance back into exactly this tree ((a or (a or a)) or a)
+            for drop_left in (True, False):
+                if (lf if drop_left else rf):
+                    bare = (f"{p.wrap(e.left, lmin, False)} {e.op} {p.wrap(e.right, rmin, rf)}" if drop_left else
+                            f"{p.wrap(e.left, lmin, lf)} {e.op} {p.wrap(e.right, rmin, False)}")
+                    if _reads_back(bare, e):
+                        return bare
+        return text
     if isinstance(e, ast.Binary):
         lmin, rmin = operand_levels(e)
         lf = p.explicit and clarifying_parens(e, e.left)

@@ -34,6 +34,8 @@ candela, ``h`` the hour).
 """
 from __future__ import annotations
 
+import re
+
 import difflib
 import math
 from dataclasses import dataclass
@@ -227,8 +229,12 @@ def parse_unit(text: str) -> Unit:
 
 
 def normal_text(text: str) -> str:
-    """``text`` with its blanks removed: how a unit is printed back (``m / s^2`` -> ``m/s^2``)."""
-    return "".join(text.split())
+    """``text`` as a unit is printed back: blanks beside an operator removed
+    (``m / s^2`` -> ``m/s^2``), a blank between two factors a product
+    (``N m`` -> ``N*m``, never the symbol ``Nm``)."""
+    tight = re.sub(r"\s*([*/^()])\s*", r"\1", text.strip())
+    tight = re.sub(r"\^([+-])\s+", r"^\1", tight)
+    return re.sub(r"\s+", "*", tight)
 
 
 class _Reader:
@@ -253,16 +259,27 @@ class _Reader:
 
     def unit(self) -> Unit:
         u = self.term()
-        while self.peek() in ("*", "/"):
-            op = self.text[self.i]
-            self.i += 1
-            v = self.term()
-            u = u.times(v) if op == "*" else u.over(v)
-        return u
+        while True:
+            before = self.i
+            c = self.peek()
+            if c in ("*", "/"):
+                op_at = self.i
+                self.i += 1
+                v = self.term()
+                u = u.times(v) if c == "*" else u.over(v)
+            elif c and self.i > before and (c.isalnum() or c in "(%"):
+                op_at = before  # a blank between two factors is a product (N m), never glued into one symbol
+                u = u.times(self.term())
+            else:
+                return u
+            if max((abs(d) for d in u.dims), default=0) > MAX_EXPONENT:  # m/s/s/... as much as s^-13
+                raise UnitError(f"exponent out of range (at most {MAX_EXPONENT} in magnitude)", op_at)
 
     def term(self) -> Unit:
         u = self.factor()
+        after = self.i
         if self.peek() != "^":
+            self.i = after  # the blanks after it are the caller's (a blank may be a product)
             return u
         self.i += 1
         self.skip()

@@ -143,9 +143,10 @@ def live_command(args: argparse.Namespace, checked: Any, cfg: Any, root: Path) -
     run_class: Any = LiveRun
     extra: dict[str, Any] = {}
     if enforce_items:
-        from .dds_enforce import EnforceUsage, EnforcingRun, parse_enforce
+        from .dds_enforce import EnforceUsage, EnforcingRun, fail_open, parse_enforce
         try:
             extra["guarded"] = parse_enforce(enforce_items)
+            extra["open_topics"] = fail_open(enforce_items)
         except EnforceUsage as exc:
             print(f"rclverify monitor --live: error: {exc}", file=sys.stderr)
             return 2

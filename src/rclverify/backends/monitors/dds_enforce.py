@@ -15,9 +15,15 @@ has it then: the latest inputs, the outputs with this message's value
 cannot decide).  It is released only when every guarantee that reads the
 topic's variable is true; ``false`` blocks it (``violated``, with the
 guarantee and the values), and so does a guarantee that cannot be decided
-or an input the guarantee reads that has not been received yet
-(``inconclusive``, ``incomplete input``): a filter lets through what is
-shown to hold, not what is not shown to fail.  The assumption is not
+or an input the guarantee reads that has not been received yet, or whose
+latest message did not map (a NaN or an infinity, which no guarantee can
+be judged on: the value in force before it is stale, and judging against
+it released 0.9 after ``limit = NaN`` before issue 47) (``inconclusive``,
+``incomplete input``): a filter lets through what is shown to hold, not what
+is not shown to fail (it fails closed).  The policy is per topic:
+``--enforce /cmd@open`` releases what cannot be decided (it still blocks
+what is false), for a consumer that must not starve; the evidence counts
+those releases apart (``released_undecided``).  The assumption is not
 consulted: a message that breaks the guarantee is held back even when the
 inputs broke the assumption.
 
@@ -56,7 +62,7 @@ def parse_enforce(items: Sequence[str]) -> dict[str, str]:
     equal to the real one."""
     out: dict[str, str] = {}
     for it in items:
-        real, sep, private = it.partition(":=")
+        real, sep, private = it.strip().removesuffix("@open").partition(":=")
         real = real.strip().strip("/")
         private = "/" + (private.strip().strip("/") if sep else real + "_unchecked")
         if not real or private == "/":
@@ -65,6 +71,13 @@ def parse_enforce(items: Sequence[str]) -> dict[str, str]:
             raise EnforceUsage(f"--enforce {it!r}: the private name must differ from the topic it guards")
         out[real] = private
     return out
+
+
+def fail_open(items: Sequence[str]) -> frozenset[str]:
+    """The guarded topics (without ``/``) written ``TOPIC@open`` (module
+    docstring): undecided messages are released there."""
+    return frozenset(it.split(":=", 1)[0].strip().removesuffix("@open").strip("/") for it in items
+                     if it.strip().endswith("@open"))
 
 
 def _reads(formula: ast.Expr) -> set[str]:
@@ -102,6 +115,12 @@ def judge(monitors: Sequence[Any], checked: Any, ev: Event,
             judged = True
             shown = {n: render(v) for n, v in sorted(values.items()) if n in reads or n.split(".", 1)[1] in reads}
             missing = sorted(n for n in m.needed_inputs if n not in values and (n in reads or n[3:] in reads))
+            stale = sorted(n for n in getattr(m, "invalid", {}) if n.startswith("in.") and (n in reads or n[3:] in reads))
+            if stale:
+                return False, {"node": m.node.name, "verdict": "inconclusive", "guarantee": k,
+                               "formula": expr_to_rcl(formula), "values": shown,
+                               "reason": f"{stale[0]}: {m.invalid[stale[0]]}; the value in force is stale, so "
+                                         f"guarantee {k} cannot be judged (held back: the gate fails closed)"}
             if missing:
                 return False, {"node": m.node.name, "verdict": "incomplete input", "guarantee": k,
                                "formula": expr_to_rcl(formula), "values": shown,
@@ -128,11 +147,13 @@ class EnforcingRun(LiveRun):
     name.  :meth:`stash` keeps a message's bytes until the engine releases it."""
 
     def __init__(self, *args: Any, guarded: Mapping[str, str], release: Callable[[str, bytes], None],
-                 **kw: Any) -> None:
+                 open_topics: frozenset[str] = frozenset(), **kw: Any) -> None:
         self.guarded, self.release = dict(guarded), release
+        self.open_topics = open_topics
         self._raw: dict[int, bytes] = {}
-        self.gate_counts: dict[str, dict[str, Any]] = {t: {"private": p, "released": 0, "blocked": 0}
-                                                        for t, p in self.guarded.items()}
+        self.gate_counts: dict[str, dict[str, Any]] = {
+            t: {"private": p, "released": 0, "blocked": 0, "policy": "open" if t in open_topics else "closed",
+                **({"released_undecided": 0} if t in open_topics else {})} for t, p in self.guarded.items()}
         super().__init__(*args, **kw)
 
     def stash(self, fields: Any, raw: bytes) -> None:
@@ -147,9 +168,12 @@ class EnforcingRun(LiveRun):
         raw = self._raw.pop(id(ev.fields), None)
         ok, verdict = judge(self.engine.monitors, self.engine.checked, ev, self.engine.rules)
         counts = self.gate_counts[ev.topic]
-        if ok and raw is not None:
+        undecided = not ok and verdict.get("verdict") in ("inconclusive", "incomplete input")
+        if raw is not None and (ok or (undecided and ev.topic in self.open_topics)):
             self.release(ev.topic, raw)
             counts["released"] += 1
+            if not ok:
+                counts["released_undecided"] += 1
             return
         counts["blocked"] += 1
         why: dict[str, Any] = verdict or {"verdict": "inconclusive", "reason": "its bytes were lost"}
@@ -159,4 +183,4 @@ class EnforcingRun(LiveRun):
             self.publish(dumps({"kind": "blocked", "topic": ev.topic, "where": ev.where, "time": ev.time, **why}))
 
 
-__all__ = ["BLOCKED_LOG_TOPIC", "EnforceUsage", "EnforcingRun", "judge", "parse_enforce"]
+__all__ = ["BLOCKED_LOG_TOPIC", "EnforceUsage", "EnforcingRun", "fail_open", "judge", "parse_enforce"]

@@ -35,7 +35,7 @@ from __future__ import annotations
 from collections import deque
 from typing import Any, Callable, Mapping
 
-from ...logic.floatsem import Judgement, Tolerance, judge
+from ...logic.floatsem import Judgement, Tolerance, holds_in, judge
 from ...logic.judges import FormulaJudge
 from ...rcl import ast
 from ...rcl.printer import expr_to_rcl
@@ -103,6 +103,8 @@ class NodeMonitor:
         self._topic_io = {topic: (frozenset(k for k, _, inp in vs if inp), [k for k, _, inp in vs if not inp])
                           for topic, vs in self.topics.items()}
         self.values: dict[str, Any] = {}
+        #: variables whose latest message did not map (NaN, infinity, a missing field): key -> why
+        self.invalid: dict[str, str] = {}
         for topic, vs in self.topics.items():
             for key, typ, _ in vs:
                 self.values[key] = initial_value(typ, rules.get(topic, _NO_RULE))
@@ -245,8 +247,12 @@ class NodeMonitor:
                         raise MappingError(f"the actionlib message has no {part!r} part")
                 values[key] = mapper(fields, values.get(key))
             except MappingError as exc:
+                # the value in force is stale now: a gate holds back what reads it (dds_enforce.py)
+                self.invalid[key] = f"the latest message at {ev.where} does not map ({exc})"
                 self._verdict("inconclusive", ev, reason=f"{key}: {exc}")
                 return
+            if self.invalid:
+                self.invalid.pop(key, None)
         trig, changed = self._topic_io[ev.topic]
         if changed:
             self._output(ev, changed)
@@ -412,6 +418,7 @@ class NodeMonitor:
         """Guarantees ``ks`` (those ``owed``) judged on ``values``: the first
         false one, else undecided, else satisfied, else ``none``."""
         decided, undecided = False, None
+        held: list[tuple[int, str]] = []
         if q is not None and ev.time > q.due:
             q = None  # judged against it, but past its horizon: no part of its answer
         first_inexact = None
@@ -437,6 +444,7 @@ class NodeMonitor:
                 q.waiting.pop(k, None)
                 q.decided.add(k)
             decided = True
+            held.append((k, judged.semantics))
             if judged.semantics != "exact":
                 first_inexact = first_inexact or (k, judged)
                 if _WEAK.get(judged.semantics, 0) > _WEAK[weakest]:
@@ -444,6 +452,15 @@ class NodeMonitor:
         if undecided is not None:
             k, why = undecided
             return Outcome("inconclusive", k, reason=f"guarantee {k}: {why}" + self._unbound_note(why))
+        if decided and weakest != "exact":  # one arithmetic per message for the whole contract
+            for k, sem in held:
+                if _WEAK.get(sem, 0) < _WEAK[weakest] and holds_in(weakest, self._guaranteed[k], self.checked,
+                                                                  self.node, values, self.tolerance) is False:
+                    other = next(j for j, s2 in held if s2 == weakest)
+                    return Outcome("violated", k, weakest, values=dict(values),
+                                   reason=f"guarantee {other} holds only in {weakest} arithmetic and guarantee {k} "
+                                          f"is false in it: no one arithmetic makes the node's guarantees hold on "
+                                          f"the message")
         if decided:
             if first_inexact is not None:
                 k, judged = first_inexact
@@ -480,7 +497,8 @@ class NodeMonitor:
         if outcome.kind == "violated":
             k = outcome.guarantee
             reason = (f"guarantee {k} is false on the output at {ev.where}" +
-                      (f" answering the question at {qwhere}" if qwhere else "") + in_all(outcome.semantics))
+                      (f" answering the question at {qwhere}" if qwhere else "") +
+                      (f": {outcome.reason}" if outcome.reason else in_all(outcome.semantics)))
             if len(readings) > 1:
                 reason += f" (and on every question it may answer within the transport skew of {self.stream.skew:g} s)"
             self._violation(ev, k, outcome.values, reason, outcome.semantics, question.event if question else None)
