@@ -30,17 +30,15 @@ def skewed(skew: float, state: frozenset[str] = frozenset()) -> Any:
     return rules
 
 
-def test_a_right_answer_received_just_before_its_question_is_no_false_alarm(simple: Any) -> None:
-    """Green received 0.1 ms before the reading 50 it answers: without a skew it
-    answers no question; with one it may answer the reading, and it is right
-    under both readings: satisfied.  The reading itself got no answer after it:
-    unanswered (inconclusive), never discharged on an early output."""
+def test_an_output_before_any_question_answers_none_with_or_without_skew(simple: Any) -> None:
+    """Green received 0.1 ms before the first reading: it answers no question
+    (nothing was asked before it), so it gets no verdict either way; the
+    reading got no answer after it: unanswered (inconclusive), never
+    discharged on an early output."""
     rows = [(1.0, "status", "green"), (1.0001, "r", 50.0), (5.0, "r", 60.0)]
-    got, res = run(simple, rows, skewed(0.0))
-    assert [(v.event, v.verdict) for v in got] == [(1, "inconclusive"), (2, "open")] and res.unasked == 1
-    got, res = run(simple, rows, rules=skewed(DEFAULT_SKEW_S))
-    assert [(v.event, v.verdict) for v in got] == [(0, "satisfied"), (1, "inconclusive"), (2, "open")]
-    assert got[0].question == "run.jsonl:2" and res.first_violation is None
+    for skew in (0.0, DEFAULT_SKEW_S):
+        got, res = run(simple, rows, skewed(skew))
+        assert [(v.event, v.verdict) for v in got] == [(1, "inconclusive"), (2, "open")] and res.unasked == 1
 
 
 def test_a_wrong_answer_from_the_previous_question_is_no_false_alarm(simple: Any) -> None:
@@ -75,7 +73,7 @@ def test_an_answer_after_the_question_is_judged_as_before(simple: Any) -> None:
     """The early output does not hide the real answer: red after r = 130 satisfies it."""
     got, _ = run(simple, [(1.0, "status", "green"), (1.001, "r", 130.0), (1.1, "status", "red"), (5.0, "r", 1.0)],
                  rules=skewed(DEFAULT_SKEW_S))
-    assert {v.event: v.verdict for v in got} == {0: "inconclusive", 2: "satisfied", 3: "open"}
+    assert {v.event: v.verdict for v in got} == {2: "satisfied", 3: "open"}
 
 
 def test_the_mapping_sets_the_skew_and_refuses_a_bad_one(tmp_path: Path) -> None:

@@ -30,16 +30,17 @@ from __future__ import annotations
 
 import bisect
 from collections import deque
-from dataclasses import dataclass, field
 from typing import Any
 
 from .events import Event
 
-#: Questions remembered for stamp look-ups (an output stamped before the latest question).
+#: Questions remembered for stamp look-ups (an output stamped before the latest question): at least
+#: this many, at most twice as many.
 KEPT = 64
+#: The empty set a question's rarely used sets start as (never mutated: Question.mark replaces it).
+_NO_SET: Any = frozenset()
 
 
-@dataclass(slots=True, eq=False)
 class Question:
     """One question of one node.
 
@@ -57,29 +58,39 @@ class Question:
     ``info`` the engine's own data (the semantics its assumption held in).
     """
 
-    event: Event
-    stamp: float
-    inputs: dict[str, Any]
-    triggers: dict[str, Event] = field(default_factory=dict)
-    owed: bool = True
-    answered: bool = False
-    settled: bool = False
-    reported: bool = False
-    answer: dict[str, Any] = field(default_factory=dict)
-    answered_triggers: set[str] = field(default_factory=set)
-    #: triggers carried on to the next question: that one owes their answer now
-    passed: set[str] = field(default_factory=set)
-    #: another question came within its horizon: what its answer left out is owed to that one now
-    followed: bool = False
-    #: guarantee -> (output event, reason, outputs): a partial answer waiting for another output
-    waiting: dict[int, tuple[Event, str, dict[str, Any]]] = field(default_factory=dict)
-    #: guarantees decided (true or false) on this question so far, and the last output that answered it
-    decided: set[int] = field(default_factory=set)
-    last_out: Event | None = None
-    #: the time (s, the run's clock) its horizon passes, and the state outputs then (kept for its closing)
-    due: float = float("inf")
-    state_at_due: dict[str, Any] | None = None
-    info: Any = None
+    __slots__ = ("event", "stamp", "inputs", "triggers", "owed", "answered", "settled", "reported", "answer",
+                 "answered_triggers", "passed", "followed", "waiting", "decided", "last_out", "view", "due", "info")
+
+    def __init__(self, event: Event, stamp: float, inputs: dict[str, Any], owed: bool = True,
+                 info: Any = None) -> None:
+        self.event, self.stamp, self.inputs, self.owed, self.info = event, stamp, inputs, owed, info
+        #: inputs -> the first message of each not answered yet (``triggered by``), carried when superseded
+        self.triggers: dict[str, Event] = {}
+        self.answered = self.settled = self.reported = False
+        #: another question came within its horizon: what its answer left out is owed to that one now
+        self.followed = False
+        self.answer: dict[str, Any] = {}
+        #: triggers an output of their guarantee answered, and those carried on to the next question
+        #: (made when first needed: most nodes have no trigger)
+        self.answered_triggers: set[str] = _NO_SET
+        self.passed: set[str] = _NO_SET
+        #: guarantee -> (output event, reason, outputs): a partial answer waiting for another output
+        self.waiting: dict[int, tuple[Event, str, dict[str, Any]]] = {}
+        #: guarantees decided (true or false) on this question so far, and the last output that answered it
+        self.decided: set[int] = set()
+        self.last_out: Event | None = None
+        #: its inputs and answer in one dict, kept up to date as the answer grows (the judge's values)
+        self.view: dict[str, Any] | None = None
+        #: the time (s, the run's clock) its horizon passes
+        self.due = float("inf")
+
+    def mark(self, which: str, trigger: str) -> None:
+        """Add ``trigger`` to the set ``which`` (``answered_triggers`` or ``passed``)."""
+        got = getattr(self, which)
+        if got is _NO_SET:
+            got = set()
+            setattr(self, which, got)
+        got.add(trigger)
 
 
 class QuestionStream:
@@ -96,8 +107,8 @@ class QuestionStream:
         self.skew = skew
         self.horizon = horizon
         self.latest: Question | None = None
-        self._stamps: deque[float] = deque()
-        self._questions: deque[Question] = deque()
+        self._stamps: list[float] = []
+        self._questions: list[Question] = []
         #: how many questions were superseded (no answer before the next question)
         self.superseded = 0
 
@@ -111,18 +122,18 @@ class QuestionStream:
         (``q.owed`` false) carries none."""
         prev = self.latest
         superseded = None
-        if prev is not None and q.event.time <= prev.event.time + self.horizon:
-            prev.followed = True
-            if (prev.owed and not prev.answered and not prev.settled and not prev.reported
-                    and q.event.time <= prev.event.time + self.horizon):
-                superseded = prev
-                self.superseded += 1
-            if q.owed:
+        if prev is not None:
+            if q.event.time <= prev.event.time + self.horizon:
+                prev.followed = True
+                if prev.owed and not prev.answered and not prev.settled and not prev.reported:
+                    superseded = prev
+                    self.superseded += 1
+            if q.owed and prev.triggers:
                 for t, ev in prev.triggers.items():
                     if t not in prev.answered_triggers:
                         q.triggers.setdefault(t, ev)
-                        prev.passed.add(t)
-        if q.owed:
+                        prev.mark("passed", t)
+        if q.owed and triggers:
             for t in triggers:
                 q.triggers.setdefault(t, q.event)
         self.latest = q
@@ -134,9 +145,9 @@ class QuestionStream:
             i = bisect.bisect_right(stamps, q.stamp)
             stamps.insert(i, q.stamp)
             qs.insert(i, q)
-        if len(stamps) > KEPT:
-            stamps.popleft()
-            qs.popleft()
+        if len(stamps) > 2 * KEPT:  # forget the oldest, a batch at a time (amortised O(1))
+            del stamps[:KEPT]
+            del qs[:KEPT]
         return superseded
 
     def at(self, stamp: float) -> Question | None:
@@ -153,7 +164,7 @@ class QuestionStream:
         stamped within the skew after it, or at its stamp but asked after it."""
         if not self.skew:
             return []
-        qs = list(self._questions)
+        qs = self._questions
         i = qs.index(answered) + 1 if answered is not None and answered in qs else \
             bisect.bisect_left(self._stamps, stamp)
         j = bisect.bisect_right(self._stamps, stamp + self.skew)

@@ -52,6 +52,13 @@ from .verdicts import LINK_TOPICS, NodeResult, Verdict, in_all, link_of, names, 
 _WEAK = {"exact": 0, "double": 1, "tolerance": 2}
 _NO_RULE = TopicRule()  # the rule of a topic the mapping does not name
 _NEVER = float("inf")
+_NO_TRIGGERS: frozenset[str] = frozenset()
+_NONE = Outcome("none")
+_SATISFIED = {sem: Outcome("satisfied", semantics=sem) for sem in ("exact", "double", "tolerance")}
+
+
+def _always(k: int) -> bool:
+    return True
 
 
 class NodeMonitor:
@@ -147,13 +154,16 @@ class NodeMonitor:
                                [k for k in self._alone if gouts[k] & set(outs)])
                        for topic, (_, outs) in self._topic_io.items()}
         self._reads_out = {k: bool(gouts[k]) for k in ks}
+        #: the guarantees an answered question must see decided (they read an output)
+        self._need = [k for k in self._asked if gouts[k]]
         skew = getattr(rules, "skew", None) or 0.0
         self.stream = QuestionStream(skew if self.has_inputs else 0.0, horizon)
-        #: outputs waiting for the skew to pass: (event, stamp, the question it answered when it came,
-        #: outputs of the answer, state outputs)
-        self._held: deque[tuple[Event, float, Question | None, dict[str, Any], dict[str, Any]]] = deque()
-        #: questions whose horizon is watched, in order of their due time
-        self._watch: deque[Question] = deque()
+        #: outputs false for the question at their stamp, waiting for the questions within the skew after them:
+        #: (event, stamp, that question, outputs of the answer, state outputs, output-only outcome, its reading)
+        self._held: deque[tuple[Any, ...]] = deque()
+        #: the one question whose horizon is watched: the latest owed one (an earlier one was followed by a
+        #: newer question within its horizon, which owes what it lacks, or was closed when its horizon passed)
+        self._open: Question | None = None
         self._due = _NEVER
         self._cache: dict[tuple[Any, tuple[Any, ...]], Judgement] = {}
         self._assumed = [(("A", j), f) for j, f in enumerate(self.assumption)]
@@ -272,7 +282,8 @@ class NodeMonitor:
     def pending(self) -> bool:
         """Whether a question still waits for its answer (owed, unanswered or
         partly answered, within its horizon) or an output for the skew to pass."""
-        return bool(self._held) or any(q.waiting or not (q.answered or q.settled or q.reported) for q in self._watch)
+        q = self._open
+        return bool(self._held) or (q is not None and bool(q.waiting or not (q.answered or q.settled or q.reported)))
 
     def _state(self) -> dict[str, Any]:
         values = self.values
@@ -287,8 +298,9 @@ class NodeMonitor:
                 self._verdict("incomplete input", ev, reason="no value yet for " + ", ".join(missing))
                 return
         accepted, owed, refusal = "exact", True, ""
+        judges = self._judges
         for aj, formula in self._assumed:
-            judged = self._judge(aj, inputs)
+            judged = judges[aj].quick(inputs) or self._judge(aj, inputs)  # the compiled code first, inline
             if judged.truth is False:
                 owed = False
                 self._assumption_violated(ev, formula, inputs, judged)
@@ -299,8 +311,10 @@ class NodeMonitor:
             if judged.semantics != "exact" and _WEAK.get(judged.semantics, 0) > _WEAK[accepted]:
                 accepted = judged.semantics
                 self._note_inexact(ev, judged, f"assumption {expr_to_rcl(formula)}", inputs)
-        q = Question(ev, ev.stamped, inputs, owed=owed, info=accepted)
-        old = self.stream.ask(q, trig & self._triggers)
+        q = Question(ev, ev.time if ev.stamp is None else ev.stamp, inputs, owed=owed, info=accepted)
+        old = self.stream.ask(q, trig & self._triggers if self._triggers else trig & _NO_TRIGGERS)
+        if self._open is not None and self._open.followed:  # it owes nothing more: the new question does
+            self._open, self._due = None, _NEVER
         if old is not None:
             old.reported = True
             self._verdict("superseded", old.event, reason=f"the input at {ev.where} came before any output "
@@ -310,14 +324,12 @@ class NodeMonitor:
         if not owed:
             return
         self.result.accepted += 1
-        if not any(self._owes(q, k) for k in self._asked) and self._asked and not self._alone:
+        if self._trigger and self._asked and not self._alone and not any(self._owes(q, k) for k in self._asked):
             self.result.unowed += 1  # every guarantee answers another input: nothing is owed to this question
             q.settled = True
             return
         q.info, q.due = (accepted, ev.time + self.horizon), ev.time + self.horizon
-        self._watch.append(q)
-        if self._due == _NEVER:
-            self._due = q.due
+        self._open, self._due = q, q.due
         if self._ask_at_question:
             self._at_question(q)
 
@@ -371,40 +383,59 @@ class NodeMonitor:
 
     def _output(self, ev: Event, changed: list[str]) -> None:
         values = self.values
-        fresh = {k: values[k] for k in changed if values[k] is not None}
         asked, alone = self._touch[ev.topic]
         if not self.has_inputs:
             self._decide(ev, None, [], self._alone_outcome(ev, alone), {})
             return
-        stamped = ev.stamped
+        states = self._state_set
+        mine = {k: values[k] for k in changed if values[k] is not None and k not in states}
+        stamped = ev.time if ev.stamp is None else ev.stamp
         q = self.stream.at(stamped)
         if q is not None:
-            mine = {k: v for k, v in fresh.items() if k not in self._state_set}
             if ev.time <= q.due:  # an output after the horizon is judged, but is no part of the question's answer
                 q.answered = True
                 q.last_out = ev
-                q.answer.update(mine)
-                for k in asked:  # the triggers its guarantees answer are answered (carried no further)
-                    if k in self._trigger and self._owes(q, k):
-                        q.answered_triggers.add(self._trigger[k])
-                outs = dict(q.answer)
+                answer = q.answer
+                answer.update(mine)
+                view = q.view
+                if view is None:
+                    view = q.view = dict(q.inputs)
+                view.update(mine)
+                if self._trigger:
+                    for k in asked:  # the triggers its guarantees answer are answered (carried no further)
+                        if k in self._trigger and self._owes(q, k):
+                            q.mark("answered_triggers", self._trigger[k])
+                outs = answer
             else:
                 outs = {**q.answer, **mine}
         else:
-            outs = {k: v for k, v in fresh.items() if k not in self._state_set}
-        if self.stream.skew:
-            self._held.append((ev, stamped, q, outs, self._state()))
+            outs = mine
+        state = self._state() if self._state_outs else {}
+        first = self._question_outcome(q, ev, asked, outs, state)
+        alone_now = self._alone_outcome(ev, alone) if alone else _NONE
+        if first.kind == "violated" and self.stream.skew:
+            # false for the question at its stamp: it may be the right answer to a question stamped within the
+            # skew after it that gets no answer of its own; judged once that is known (docs/semantics.md)
+            self._held.append((ev, stamped, q, dict(outs), state, alone_now, first))
             return
-        self._decide(ev, q, [], self._alone_outcome(ev, alone), outs, self._state())
+        if alone_now is _NONE and first.kind == "satisfied":  # the common case, without combining
+            self._verdict("satisfied", ev, semantics=first.semantics, question=q.event.where if q else "")
+            return
+        self._decide(ev, q, [], alone_now, outs, first)
 
-    def _release(self, now: float) -> None:
-        """Judge the held outputs whose skew has passed (all of them at the end)."""
+    def _release(self, now: float, end: bool = False) -> None:
+        """Judge the held outputs whose skew has passed and whose questions within
+        the skew are settled (answered by outputs of their own, closed, or past
+        their horizon); all of them at the ``end``."""
         skew = self.stream.skew
         held = self._held
-        while held and held[0][1] + skew < now:
-            ev, stamped, q, outs, state = held.popleft()
-            others = self.stream.within_skew(stamped, q)  # it may answer them too: judged under both readings
-            self._decide(ev, q, others, self._alone_outcome(ev, self._touch[ev.topic][1]), outs, state)
+        while held and (end or held[0][1] + skew < now):
+            ev, stamped, q, outs, state, alone, first = held[0]
+            others = [o for o in self.stream.within_skew(stamped, q) if not o.answered]
+            if not end and any(not o.reported and now <= o.due for o in others):
+                return  # a question it may answer has no answer of its own yet: wait
+            held.popleft()
+            self._decide(ev, q, others, alone, outs, first, state)
 
     def _alone_outcome(self, ev: Event, ks: list[int]) -> Outcome:
         """The guarantees over outputs only that ``ev`` touches, on the outputs as they stand."""
@@ -426,7 +457,7 @@ class NodeMonitor:
             if not owed(k):
                 continue
             if q is not None and k in self._trigger:
-                q.answered_triggers.add(self._trigger[k])
+                q.mark("answered_triggers", self._trigger[k])
             judged = self._judge(k, values)
             if judged.truth is False:
                 if q is not None:
@@ -477,20 +508,40 @@ class NodeMonitor:
             return Outcome("unasked")
         if not q.owed:
             return Outcome("none")
-        values = {**q.inputs, **state, **outs}
-        return self._outcome(ks, values, lambda k: self._owes(q, k), q if keep else None, ev,
+        if not state and outs is q.answer and q.view is not None:
+            values = q.view  # inputs and answer, kept by _output: no copy
+        else:
+            values = dict(q.inputs)
+            if state:
+                values.update(state)
+            values.update(outs)
+        if keep and len(ks) == 1 and not self._trigger and ev.time <= q.due:  # one guarantee: the common case
+            k = ks[0]
+            judged = self._judges[k].quick(values) or self._judge(k, values)
+            if judged.truth is True and judged.semantics == "exact":
+                q.waiting.pop(k, None)
+                q.decided.add(k)
+                return _SATISFIED[q.info[0] if isinstance(q.info, tuple) else "exact"]
+        return self._outcome(ks, values, self._owes_fn(q), q if keep else None, ev,
                              q.info[0] if isinstance(q.info, tuple) else "exact")
 
+    def _owes_fn(self, q: Question) -> Callable[[int], bool]:
+        """Which guarantees ``q`` is owed (all of them when none has a trigger)."""
+        if not self._trigger:
+            return _always
+        return lambda k: self._owes(q, k)
+
     def _decide(self, ev: Event, q: Question | None, others: list[Question], alone: Outcome,
-                outs: Mapping[str, Any], state: Mapping[str, Any] | None = None) -> None:
+                outs: Mapping[str, Any], first: Outcome | None = None, state: Mapping[str, Any] | None = None) -> None:
         """One output message's verdict: its output-only guarantees (``alone``)
-        and the question(s) it may answer, combined (:func:`.outcome.combine`)."""
+        and the question(s) it may answer (``first``: the reading of ``q``,
+        the question at its stamp; ``others``: those within the skew after
+        it that got no answer of their own), combined (:func:`.outcome.combine`)."""
         ks = self._touch[ev.topic][0]
-        readings = [self._question_outcome(x, ev, ks, outs, state or {}, x is q) for x in [q, *others]] \
-            if self.has_inputs else []
-        if readings and readings[0].kind == "unasked" and all(r.kind == "unasked" for r in readings):
-            if ks:
-                self.result.unasked += 1
+        readings = ([first] if first is not None else []) + [
+            self._question_outcome(x, ev, ks, outs, state or {}, False) for x in others]
+        if first is not None and first.kind == "unasked" and not others and ks:
+            self.result.unasked += 1
         outcome = combine(alone, readings)
         question = q if q is not None else (others[0] if others else None)
         qwhere = question.event.where if question is not None else ""
@@ -528,24 +579,21 @@ class NodeMonitor:
                 "and services(...)/actions(...) name none, so no run gives it a value)")
 
     def _expire(self, now: float) -> None:
-        """Close the watched questions whose horizon passed before ``now``."""
-        watch, skew = self._watch, self.stream.skew  # closed once the outputs within the skew were judged
-        if skew:
-            for q in watch:  # the state outputs as they stood when its horizon passed
-                if q.due >= now:
-                    break
-                if q.state_at_due is None:
-                    q.state_at_due = self._state()
-        while watch and watch[0].due + skew < now:
-            self._close(watch.popleft())
-        self._due = watch[0].due if watch else _NEVER
+        """Close the watched question when its horizon passed before ``now``."""
+        q = self._open
+        if q is not None and q.due < now:
+            self._open, self._due = None, _NEVER
+            self._close(q)
 
     def _close(self, q: Question, end: bool = False) -> None:
         """Question ``q``'s horizon passed (``end``: the run ended first):
         its partial answers are judged (an owed guarantee no output decided
         waits for the outputs it reads), and an unanswered one is inconclusive
         (``open`` at the end)."""
-        state = q.state_at_due if q.state_at_due is not None else self._state()
+        if q.answered and not q.waiting and (q.followed or q.decided.issuperset(self._need)):
+            q.reported = True  # answered in full (the common case)
+            return
+        state = self._state()
         if q.followed:  # a newer question came within its horizon: the node owes that one what is missing here
             q.waiting.clear()
         elif (q.answered or self._state_outs) and q.owed and not q.settled and not q.reported:
@@ -604,9 +652,10 @@ class NodeMonitor:
         """Close the run: held outputs are judged, questions past their horizon
         closed, the rest ``open``."""
         if self._held:
-            self._release(_NEVER)
-        while self._watch:  # every output judged: a question past its horizon is closed, the rest open
-            q = self._watch.popleft()
+            self._release(self.now, end=True)
+        q = self._open
+        if q is not None:  # every output judged: a question past its horizon is closed, else open
+            self._open = None
             self._close(q, end=not self.now > q.due)
         self._due = _NEVER
         return self.result
