@@ -54,6 +54,14 @@ WS = Path(__file__).parent / "data" / "dds_ws"
 SPEEDS = [(1.0, 0.5), (1.1, 1.5), (1.2, 0.8), (1.3, 2.0)]  # (limit, speed): the 2nd and 4th exceed their limit
 
 
+def _other_layout() -> type:
+    """``std_msgs::msg::dds_::Float64_`` whose ``data`` is a string: the contract's type name, another
+    layout (a cyclonedds IDL class made with ``type()``, so its annotation is the type itself)."""
+    import cyclonedds.idl as idl
+    return type("Float64_", (idl.IdlStruct,), {"__annotations__": {"data": str}, "__module__": __name__,
+                                                "__idl_typename__": "std_msgs::msg::dds_::Float64_"})
+
+
 def _stop(p: subprocess.Popen[bytes], sig: int = signal.SIGINT) -> None:
     if p.poll() is None:
         os.killpg(p.pid, sig)
@@ -102,6 +110,11 @@ def run(tmp_path_factory: pytest.TempPathFactory) -> Iterator[dict[str, Any]]:
         # another participant publishes /range with another type: its messages cannot be heard, and that is said
         other = Ros2Participant(types, domain_of(env))
         imposter = other.publisher(other.node("imposter"), "/range", "std_msgs/Float64")
+        # and a node that was not remapped writes the guarded /speed beside the gate (issue 47): said, and the
+        # evidence of what reads /speed cannot be discharged while it does
+        rogue = other.publisher(other.node("rogue"), "/speed", "std_msgs/Float64")
+        # and one publishes /limit with the contract's type name but another layout: named, never heard
+        other.writer(other.node("mislaid"), "rt/limit", _other_layout(), QosProfile(reliable=True, depth=10))
         other.announce()
         ros.announce()
         # the monitor's readers are made when it discovers a publisher: wait until they are matched
@@ -212,10 +225,29 @@ def test_a_best_effort_publisher_is_heard(run: dict[str, Any]) -> None:
     ranger = next(n for n in run["record"]["nodes"] if n["node"] == "Ranger")
     assert ranger["counts"]["satisfied"] == 4
     # a publisher of another type on the topic: a located warning, never silence
-    warnings = run["record"]["warnings"]
+    warnings = [w for w in run["record"]["warnings"] if "/imposter" in w]
     assert len(warnings) == 1 and warnings[0].startswith("contracts/dds.rcl:20:11: warning: range: node /imposter ")
     assert "publishes std_msgs::msg::dds_::Float64_" in warnings[0] and "not heard" in warnings[0]
     assert run["imposter"] == 0 and warnings[0] in run["out"]
+
+
+def test_another_writer_on_a_guarded_topic_is_named_and_keeps_the_evidence_from_discharged(run: dict) -> None:
+    """Issue 47: a node that was not remapped writes /speed beside the gate."""
+    rogue = [w for w in run["record"]["warnings"] if "/rogue" in w]
+    assert len(rogue) == 1 and ": warning: /speed: node /rogue writes on the guarded topic" in rogue[0]
+    assert rogue[0].startswith("contracts/dds.rcl:") and rogue[0] in run["out"]
+    assert run["record"]["bypass"] == {"speed": ["node /rogue"]}
+    limiter = next(n for n in run["record"]["nodes"] if n["node"] == "Limiter")
+    assert any("/rogue also wrote on the guarded topic /speed" in t for t in limiter["trust"])
+    assert limiter["status"] != "discharged"
+
+
+def test_a_publisher_of_the_same_type_name_with_another_layout_is_named_not_heard(run: dict) -> None:
+    """Issue 47: the layout is compared by the type identifier DDS discovery carries."""
+    mislaid = [w for w in run["record"]["warnings"] if "/mislaid" in w]
+    assert len(mislaid) == 1 and ": warning: limit: node /mislaid publishes std_msgs::msg::dds_::Float64_ with " \
+        "another layout" in mislaid[0]
+    assert run["record"]["qos"]["limit"]["publishers_heard"] == 1
 
 
 def test_verdicts_are_on_the_bus(run: dict[str, Any]) -> None:

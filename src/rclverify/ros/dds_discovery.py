@@ -32,6 +32,8 @@ class EndpointInfo:
     topic: str
     type_name: str
     qos: QosProfile
+    #: the XTypes type identifier discovery carries (a hash of the type's layout; None when not sent)
+    type_id: Any = None
 
     @property
     def label(self) -> str:
@@ -85,7 +87,8 @@ class Discovery:
                 part = e.participant_key.bytes
                 if part in self.own:
                     continue
-                table[key] = EndpointInfo(key, part, e.topic_name, e.type_name, from_dds(e.qos))
+                table[key] = EndpointInfo(key, part, e.topic_name, e.type_name, from_dds(e.qos),
+                                          getattr(e, "type_id", None))
                 changed = True
         for raw, info in take_raw(self._info, 1000):
             try:

@@ -14,6 +14,12 @@ located warning, once per publisher and reason, never silence:
 * a publisher of another type on the topic (its samples are not the
   contract's type): ``FILE:LINE:COL: warning: /scan: node /lidar publishes
   sensor_msgs::msg::dds_::Imu_, the contract's type is ...; not heard``;
+* a publisher of a type with the contract's type name but another layout
+  (the XTypes type identifier discovery carries differs; issue 47): named,
+  never counted as heard;
+* another participant writing a topic only the monitor should write (a
+  guarded topic beside the gate, the verdict topic: :meth:`Bus.watch_writers`,
+  :mod:`.dds_trust`);
 * a publisher whose QoS no one reader matches together with the others
   (exclusive ownership beside shared, partitions): the policy and both
   sides' QoS.
@@ -89,12 +95,22 @@ class Bus:
         #: first sight (monotonic s) of each publication not yet named by ros_discovery_info: its warning
         #: waits up to NAME_GRACE_S for the node's announcement, which may come after the endpoint's
         self._unnamed: dict[bytes, float] = {}
+        #: topics only the monitor should write (dds_topic -> key, where, role) and the others found writing them
+        self.watched: dict[str, tuple[str, str, str]] = {}
+        self.bypass: dict[str, set[str]] = {}
 
     def tap(self, key: str, dds_topic: str, struct: type, where: str) -> Tap:
         """Ask to hear ``dds_topic`` (call before :meth:`start`)."""
         t = Tap(key, dds_topic, struct, where)
         self.taps.append(t)
         return t
+
+    def watch_writers(self, dds_topic: str, key: str, where: str, role: str) -> None:
+        """Warn about every other participant's writer on ``dds_topic`` (a topic
+        only the monitor should write: a guarded topic, the verdict topic) and
+        record it in :attr:`bypass` under ``key`` (:mod:`.dds_trust`)."""
+        self.watched[dds_topic] = (key, where, role)
+        self.bypass.setdefault(key, set())
 
     def writer(self, dds_topic: str, struct: type, qos: QosProfile, user_data: bytes = b"") -> Any:
         """A writer of the monitor on ``dds_topic``."""
@@ -154,11 +170,18 @@ class Bus:
         for t in self.taps:
             pubs = disc.publishers(t.dds_topic)
             want = t.struct.__idl_typename__  # type: ignore[attr-defined]
-            same = [p for p in pubs if p.type_name == want]
+            layout = _type_id(t.struct)
+            same = [p for p in pubs if p.type_name == want and not _other_layout(p, layout)]
             for p in pubs:
                 if p.type_name != want and (p.guid, "type") not in t.warned and self._named(p.guid):
                     self._warn_once(t, p.guid, "type", f"{t.where}: warning: {t.key}: {disc.who(p)} publishes "
                                     f"{p.type_name}, the contract's type is {want}; its messages are not heard")
+                elif p.type_name == want and _other_layout(p, layout) and (p.guid, "layout") not in t.warned \
+                        and self._named(p.guid):
+                    self._warn_once(t, p.guid, "layout", f"{t.where}: warning: {t.key}: {disc.who(p)} publishes "
+                                    f"{p.type_name} with another layout than the contract's type (its type "
+                                    "identifier, from DDS discovery, differs: other fields or field types); its "
+                                    "messages are not heard")
             if not same:
                 continue
             req, left = reader_for([p.qos for p in same])
@@ -185,6 +208,19 @@ class Bus:
             t.heard = {p.guid for k, p in enumerate(same) if k not in left}
             if self.on_reader is not None:
                 self.on_reader(t, same)
+        if self.watched:
+            self._foreign()
+
+    def _foreign(self) -> None:
+        """The writers discovery reports on the watched topics (never the monitor's own)."""
+        for dds_topic, (key, where, role) in self.watched.items():
+            for p in self.discovery.publishers(dds_topic):
+                who = self.discovery.who(p)
+                if who in self.bypass[key] or not self._named(p.guid):
+                    continue
+                self.bypass[key].add(who)
+                self.warn(f"{where}: warning: /{key}: {who} writes on the {role} beside the monitor; what it "
+                          "writes is not checked, and the evidence is not discharged while it does")
 
     def _drain_one(self, t: Tap) -> None:
         got = take_raw(t.reader, 100000)
@@ -216,6 +252,20 @@ class Bus:
             if t.reader is not None:
                 t.reader.__del__()
         self.discovery.close()
+
+
+def _type_id(struct: type) -> Any:
+    """The XTypes type identifier of the contract's struct (``None`` when it cannot be made)."""
+    try:
+        return struct.__idl__.get_type_id()  # type: ignore[attr-defined]
+    except Exception:  # noqa: BLE001 - no identifier: the layout is not compared
+        return None
+
+
+def _other_layout(p: Any, layout: Any) -> bool:
+    """Whether publication ``p`` announces a layout other than ``layout`` (both
+    identifiers known and different; a publisher that sends none is taken at its name)."""
+    return layout is not None and getattr(p, "type_id", None) is not None and p.type_id != layout
 
 
 __all__ = ["Bus", "Tap"]

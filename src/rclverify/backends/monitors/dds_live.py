@@ -133,6 +133,7 @@ def run_dds(run_factory: Callable[..., LiveRun], checked: Checked, nodes: list[C
         out(text)
 
     from .dds_bus import Bus
+    from .dds_trust import VERDICT_KEY, downgrade
     worker_box: list[EngineWorker] = []
     republish: dict[str, Any] = {}
 
@@ -177,6 +178,9 @@ def run_dds(run_factory: Callable[..., LiveRun], checked: Checked, nodes: list[C
         calls = CallTaps(book, types, links)
     for t, struct in structs.items():
         bus.tap(t, topic_name(enforce.get(t, t)), struct, where.get(t, t))
+    for t in enforce:  # only the gate may write a guarded topic, only the monitor the verdict topic (dds_trust.py)
+        bus.watch_writers(topic_name(t), t, where.get(t, t), "guarded topic")
+    bus.watch_writers(topic_name(verdict_topic), VERDICT_KEY, "--verdict-topic", "verdict topic")
     for key, dds_topic, struct, loc in (calls.plan if calls is not None else ()):
         bus.tap(key, dds_topic, struct, loc)
 
@@ -240,6 +244,11 @@ def run_dds(run_factory: Callable[..., LiveRun], checked: Checked, nodes: list[C
             record_["deadlines"] = {"results": summary["deadlines"], "false": summary["false"]}
         if enforce:
             record_["enforce"] = live.gate_counts  # type: ignore[attr-defined]
+        bypass = {k: sorted(v) for k, v in bus.bypass.items() if v}
+        if bypass:
+            record_["bypass"] = bypass
+        downgrade(record_["nodes"], {n.name: [t.field.strip("/") for t in n.node.topics] for n in nodes}, bypass,
+                  {t.key: t.reader_changes for t in bus.taps})
         if recorder is not None:
             record_["bag"] = recorder.close()
         if evidence is not None:
