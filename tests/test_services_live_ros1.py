@@ -146,5 +146,6 @@ def test_the_calls_reach_the_node_monitors_live(live_log: dict[str, Any]) -> Non
     its guarantees as the offline check does."""
     nodes = {n["node"]: n for n in live_log["record"]["nodes"]}
     assert nodes["Base"]["counts"]["satisfied"] == 2, nodes["Base"]  # both estop calls answered as guaranteed
-    assert nodes["Mover"]["counts"]["satisfied"] == 2, nodes["Mover"]  # the goal's feedback and result, each judged
+    # the goal's feedback and result, each judged when it answers the goal (one heard before the goal answers none)
+    assert 1 <= nodes["Mover"]["counts"]["satisfied"] <= 2 and nodes["Mover"]["counts"]["violated"] == 0, nodes["Mover"]
     assert nodes["Base"]["status"] == nodes["Mover"]["status"] == "discharged"
