@@ -24,8 +24,12 @@ and what reads it is undecided).
 (:func:`rclverify.logic.floatsem.judge`: direct evaluation, Z3 on concrete
 values when it cannot, then the nodes' double arithmetic and the mapping's
 tolerance, docs/monitors.md "Numbers on the wire"; a witness of an operand
-that held only there names the semantics); a variable not observed yet has
-no value, so an operand reading it is undecided at that step.
+that held only there names the semantics).  A variable not observed yet has
+no value, and an operand reading one is not evaluated at that step (the one
+stream model, docs/semantics.md, issue 47): ``always F`` constrains
+published values only, ``eventually F`` (``next``, the right of ``until``)
+needs ``F`` on published values; a declared state variable without a value
+leaves what reads it undecided.
 
 **Finite-trace verdicts** (docs/requirements.md, "Temporal requirements"):
 
@@ -308,6 +312,17 @@ def _truth(f: Formal, checked: Checked, values: Mapping[str, Any], tolerance: An
     return j.truth
 
 
+def _published(f: Formal, values: Mapping[str, Any]) -> bool:
+    """Whether every input and output operand ``f`` mentions has been
+    published on this trace (docs/semantics.md: a state formula over a value
+    never published is not evaluated; a state variable without a value stays
+    undecided instead)."""
+    for n, p, v in f.mentions:
+        if p in ("in", "out") and f"{p}.{n}.{p}.{v}" not in values:
+            return False
+    return True
+
+
 def _shown(f: Formal, values: Mapping[str, Any]) -> dict[str, str]:
     names = {f"{n}.{p}.{v}" for n, p, v in f.mentions}
     return {k.partition(".")[2]: render(v) for k, v in sorted(values.items()) if k.partition(".")[2] in names}
@@ -352,6 +367,8 @@ def check_temporal_trace(t: Temporal, checked: Checked, states: tuple[StateVar, 
         if kind in ("always", "always next"):
             if kind == "always next" and i == 0:
                 continue
+            if not _published(ops[0], vals):
+                continue  # a value it reads was never published: not evaluated (docs/semantics.md)
             h = _truth(ops[0], checked, vals, tol, sems)
             if h is False:
                 return at("false", f"{_text(ops[0])} is false at step {i} ({ev.where}, t = {ev.time} s)",
@@ -360,11 +377,11 @@ def check_temporal_trace(t: Temporal, checked: Checked, states: tuple[StateVar, 
                 undecided = wit(ops[0], None)
         elif kind == "next":
             if i == 1:
-                h = _truth(ops[0], checked, vals, tol, sems)
+                h = _truth(ops[0], checked, vals, tol, sems) if _published(ops[0], vals) else False
                 v = {True: "true", False: "false", None: "inconclusive"}[h]
                 return at(v, f"{_text(ops[0])} is {v if h is not None else 'undecided'} at step 1", [wit(ops[0], h)])
-        elif kind == "eventually":
-            h = _truth(ops[0], checked, vals, tol, sems)
+        elif kind == "eventually":  # reached only on published values
+            h = _truth(ops[0], checked, vals, tol, sems) if _published(ops[0], vals) else False
             if h is True:
                 return at("true", f"{_text(ops[0])} holds at step {i} ({ev.where}, t = {ev.time} s)",
                           [wit(ops[0], True)])
@@ -377,14 +394,14 @@ def check_temporal_trace(t: Temporal, checked: Checked, states: tuple[StateVar, 
                 return at("false", f"{_text(ops[0])} does not hold at any step 0..{t.bound}: the bound passed "
                                    f"at step {i} ({ev.where}, t = {ev.time} s)", [wit(ops[0], False)])
         else:  # until
-            g = _truth(ops[1], checked, vals, tol, sems)
+            g = _truth(ops[1], checked, vals, tol, sems) if _published(ops[1], vals) else False
             if g is True and undecided is None:
                 return at("true", f"{_text(ops[1])} holds at step {i}, {_text(ops[0])} at every step before",
                           [wit(ops[1], True)])
             if g is None and undecided is None:
                 undecided = wit(ops[1], None)
             if g is not True:
-                f = _truth(ops[0], checked, vals, tol, sems)
+                f = _truth(ops[0], checked, vals, tol, sems) if _published(ops[0], vals) else True
                 if f is False and undecided is None:
                     return at("false", f"{_text(ops[0])} is false at step {i} before {_text(ops[1])} held",
                               [wit(ops[0], False)])
