@@ -372,3 +372,20 @@ def test_editing_one_contract_reruns_that_node_its_consumers_and_the_report(work
     finally:
         rcl.write_text(original)
         assert _doit(workspace, "verify").returncode == 0
+
+
+def test_every_violation_of_a_run_is_kept_and_explained_one_by_one(workspace: Path, report: dict,
+                                                                   capsys: pytest.CaptureFixture[str]) -> None:
+    """Issue 47/48: a run keeps every violation (time, message, guarantee, values, the question
+    answered), not only the first; `rclverify explain OBLIGATION#N` reaches each."""
+    from rclverify.cli import main
+    ev = next(e for e in report["evidence"] if e["obligation"] == "Agent.g0.monitors.nominal_jsonl")
+    vs = ev["monitoring"]["violations"]
+    assert len(vs) == ev["monitoring"]["counts"]["violated"] == 12
+    assert vs[0] == ev["monitoring"]["first_violation"] and all(v["guarantee"] == 3 for v in vs)
+    assert main(["explain", "-w", str(workspace), "Agent.g0.monitors.nominal_jsonl#2"]) == 0
+    out = capsys.readouterr().out
+    assert out.startswith(f"violation Agent.g0.monitors.nominal_jsonl#2 of 12 on backends/monitors/traces/nominal.jsonl: "
+                          f"{vs[1]['where']}") and "answering the question at" in out and "out.command = " in out
+    assert main(["explain", "-w", str(workspace), "Agent.g0.monitors.nominal_jsonl"]) == 0
+    assert "Agent.g0.monitors.nominal_jsonl#12" in capsys.readouterr().out

@@ -310,7 +310,7 @@ def _evidence(ws: Any, report: Mapping[str, Any], e: Mapping[str, Any], o: Mappi
         gtext, gsrc = _guarantee_source(report, node, gk) if gk else ("", "")
         sentence = (f"In {mon.get('trace', 'the trace')}, the output at {fv.get('where')} (t = {fv.get('time')} s) "
                     f"answering the input at {fv.get('trigger_where')} violates guarantee {gk} of {node} ({gsrc})"
-                    f"; {mon.get('counts', {}).get('violated', '?')} input event(s) of the run violate the contract.")
+                    f"; {mon.get('counts', {}).get('violated', '?')} message(s) of the run violate the contract (each: `rclverify explain OBLIGATION#N`).")
         return _record(e["obligation"], "monitor", node, e["status"], sentence,
                        culprits=[{"what": f"event {fv.get('where')}", "source": fv.get("where", ""), "text": ""},
                                  {"what": f"guarantee {gk} of {node}", "source": gsrc, "text": gtext}],

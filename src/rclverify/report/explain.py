@@ -107,6 +107,8 @@ class _Index:
         out = list(self.requirements) + list(self.nodes)
         out += [f"{n}.g{g['index']}" for n, node in self.nodes.items() for g in node.get("guarantees") or []]
         out += list(self.diagnoses) + list(self.items) + list(self.rules) + list(self.results)
+        out += [f"{ob}#{k}" for ob, e in self.evidence.items() if ob
+                for k in range(1, len(((e.get("monitoring") or {}).get("violations") or [])) + 1)]
         out += [c for c in self.ros if c] + [c for c in self.lint if c] + list(self.argument)
         return list(dict.fromkeys(out))
 
@@ -114,7 +116,7 @@ class _Index:
     def find(self, wanted: str) -> list[str] | None:
         for exact in (True, False):
             for finder in (self._requirement, self._node, self._guarantee, self._item, self._problem,
-                           self._rule, self._argument):
+                           self._rule, self._argument, self._violation):
                 lines = finder(wanted, exact)
                 if lines is not None:
                     return lines
@@ -158,7 +160,7 @@ class _Index:
     def _item(self, wanted: str, exact: bool) -> list[str] | None:
         key = self._match(wanted, self.diagnoses, exact)  # a diagnosis says all an item row says, and more
         if key is not None:
-            return diagnosis_lines(self.diagnoses[key])
+            return diagnosis_lines(self.diagnoses[key]) + self._violation_ids(key)
         key = self._match(wanted, self.items, exact)
         return None if key is None else self.item_lines(key)
 
@@ -223,8 +225,39 @@ class _Index:
         if x.get("model"):  # a health check's model when it holds is a witness, otherwise a counterexample
             label = "witness" if x["status"] in ("discharged", "ok", "warning") else "counterexample"
             out += [f"  {label}:"] + table_lines(counterexample_table(x["model"], x["node"]), "    ")
+        if kind == "obligation":
+            out += self._violation_ids(key)
         if x["status"] in ("discharged", "ok", "warning") and key not in self.diagnoses:
             out.append("  no problem to diagnose")
+        return out
+
+    def _violation_ids(self, key: str) -> list[str]:
+        """The lines naming every violation a monitored run of obligation ``key`` kept."""
+        m = (self.evidence.get(key) or {}).get("monitoring") or {}
+        vs = m.get("violations") or []
+        out = [f"  violation {key}#{k}: {v.get('where')} (t = {v.get('time')} s), guarantee {v.get('guarantee')}"
+               for k, v in enumerate(vs, 1)]
+        if m.get("violations_dropped"):
+            out.append(f"  and {m['violations_dropped']} more violation(s), counted, not kept")
+        return (["", "violations (each: `rclverify explain ID`):"] + out) if out else []
+
+    def _violation(self, wanted: str, exact: bool) -> list[str] | None:
+        """``OBLIGATION#N``: the N-th violation a monitored run kept (1-based)."""
+        ob, sep, n = wanted.strip().rpartition("#")
+        if not sep or not n.isdigit():
+            return None
+        key = self._match(ob, self.evidence, exact)
+        m = ((self.evidence.get(key) or {}).get("monitoring") or {}) if key else {}
+        vs = m.get("violations") or []
+        if not 1 <= int(n) <= len(vs):
+            return None
+        v = vs[int(n) - 1]
+        out = [f"violation {key}#{n} of {len(vs)} on {m.get('trace')}: {v.get('where')} (t = {v.get('time')} s)",
+               f"  guarantee {v.get('guarantee')}: {v.get('formula', '')}"]
+        if v.get("trigger_where"):
+            out.append(f"  answering the question at {v['trigger_where']} (t = {v.get('trigger_time')} s)")
+        out.append(f"  {v.get('reason', '')}")
+        out += [f"    {name} = {value}" for name, value in sorted((v.get("values") or {}).items())]
         return out
 
     def guarantee_lines(self, node: str, g: Mapping[str, Any], indent: str = "") -> list[str]:

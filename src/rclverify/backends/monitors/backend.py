@@ -300,13 +300,19 @@ def monitoring_details(res: NodeResult, trace: str, events: int, sha: str, versi
     (``assumption``), the ``satisfied`` verdicts per semantics that decided
     them (``semantics``: exact, double, tolerance), the first formula that
     held only outside exact arithmetic (``first_inexact``) and the declared
-    ``tolerance`` (``None``: none)."""
+    ``tolerance`` (``None``: none), and every violation of the run
+    (``violations``: the first :data:`~.verdicts.KEPT_VIOLATIONS`, each with
+    its time, message, guarantee, values and the question it answered;
+    ``violations_dropped`` the count beyond them), which ``rclverify explain
+    OBLIGATION#N`` prints one by one."""
     return {"trace": trace, "sha256": sha, "events_read": events, "node_events": res.events,
             "horizon_s": horizon, "counts": dict(res.counts), "first_violation": res.first_violation,
             "first_assumption_violation": res.first_assumption_violation,
             "first_inconclusive": res.first_inconclusive, "assumption": res.assumption,
             "semantics": dict(res.semantics), "first_inexact": res.first_inexact,
-            "tolerance": tolerance.to_json() if tolerance else None, "tools": versions}
+            "tolerance": tolerance.to_json() if tolerance else None, "tools": versions,
+            "violations": list(res.violations), "violations_dropped": res.violations_dropped,
+            "unasked": res.unasked}
 
 
 def summary_line(res: NodeResult) -> str:
@@ -342,15 +348,17 @@ def verdict_status(res: NodeResult, trace: str) -> tuple[str, str]:
     blame = ""
     if c["assumption violated"]:
         a = res.first_assumption_violation or {}
-        blame = (f"; the assumption monitor's verdict is violated: {c['assumption violated']} input event(s) "
+        blame = (f"; the assumption monitor's verdict is violated: {c['assumption violated']} question(s) "
                  f"violated the assumption (first at {a.get('where')}, blamed on the {a.get('blame')}), so the node "
                  f"is not at fault for them")
     blame += semantics_note(res)
     if c["violated"]:
         v: Mapping[str, Any] = res.first_violation or {}
         which = f"guarantee {v['guarantee']} ({v.get('formula', '')})" if v.get("guarantee") else "the guarantees"
-        return "failed", (f"{c['violated']} input event(s) of {trace} violated {res.node}'s contract; the first "
-                          f"violation is at {v.get('where')} (t = {v.get('time')} s): {which}: {v.get('reason')}")
+        return "failed", (f"{c['violated']} message(s) of {trace} violated {res.node}'s contract; the first "
+                          f"violation is at {v.get('where')} (t = {v.get('time')} s): {which}: {v.get('reason')}"
+                          + (f" (every violation: `rclverify explain OBLIGATION#N`, N = 1..{len(res.violations)})"
+                             if len(res.violations) > 1 else ""))
     if c["inconclusive"]:
         i = res.first_inconclusive or {}
         return "inconclusive", (f"{c['inconclusive']} event(s) could not be decided; first at {i.get('where')}: "
@@ -358,13 +366,13 @@ def verdict_status(res: NodeResult, trace: str) -> tuple[str, str]:
     if c["open"]:
         i = res.first_inconclusive or {}
         why = f"; first at {i.get('where')}: {i.get('reason')}" if i else ""
-        return "inconclusive", f"{c['open']} input event(s) were still unanswered when the trace ended{why}{blame}"
+        return "inconclusive", f"{c['open']} question(s) were still unanswered when the trace ended{why}{blame}"
     if not c["satisfied"]:
         unowed = (f"; {res.unowed} met it but no guarantee answers them (each is triggered by another input)"
                   if res.unowed else "")
         return "pending", (f"{trace} has no input event of {res.node} that meets its assumption and that a "
                            f"guarantee answers ({c['assumption violated']} violated it{unowed}): nothing was checked")
-    return "discharged", f"all {c['satisfied']} input event(s) meeting the assumption were answered as guaranteed{blame}"
+    return "discharged", f"all {c['satisfied']} judged answer(s) met the guarantees{blame}"
 
 
 def _rel(target: NodeTarget, file: str) -> str:
