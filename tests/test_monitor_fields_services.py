@@ -210,7 +210,7 @@ def test_a_service_response_outside_the_clients_assumption_is_violated(service: 
     assert planner.assumption["verdict"] == "violated" and planner.assumption["violations"] == 1
     assert planner.counts["satisfied"] == 1  # the second response (5) is accepted and answered
     status, text = verdict_status(planner, "calls.jsonl")
-    assert "the assumption monitor's verdict is violated: 1 input event(s) violated the assumption (first at " \
+    assert "the assumption monitor's verdict is violated: 1 question(s) violated the assumption (first at " \
            "calls.jsonl:2, blamed on the upstream node(s) Ranger (through service range))" in text
     # the deadlines: no `true` for the response the client's contract does not accept
     dplanner, dranger = check_deadlines(service, nodes, read_trace(log), {})
