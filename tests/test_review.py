@@ -142,3 +142,16 @@ def test_an_alias_bomb_in_a_review_record_is_refused_before_expansion() -> None:
         for k in range(8))
     with pytest.raises(PlanError, match="alias bomb"):
         parse_record(bomb, "backends/review/bomb.yaml")
+
+
+def test_review_writes_the_record_the_plan_names_when_it_is_missing(ws: Workspace, capsys) -> None:
+    """Issue 48: once the plan named FILE, `rclverify review NODE -o FILE` refused to run (the plan's
+    check wanted FILE), and its error said to run that same command."""
+    (ws.root / RECORD).unlink()
+    rc = main(["review", "Localisation", "-w", str(ws.root), "-o", str(ws.root / RECORD)])
+    assert rc == 0 and (ws.root / RECORD).is_file()
+    assert parse_record((ws.root / RECORD).read_text(encoding="utf-8"), RECORD).node == "Localisation"
+    # any other command still refuses the plan while the record is missing
+    (ws.root / RECORD).unlink()
+    assert main(["review", "Localisation", "-w", str(ws.root), "-o", str(ws.root / "other.yaml")]) != 0
+    assert "does not exist" in capsys.readouterr().err

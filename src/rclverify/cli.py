@@ -471,7 +471,15 @@ def cmd_bundle(args: argparse.Namespace) -> int:
 def cmd_review(args: argparse.Namespace) -> int:
     from .backends.review.blank import blank_record
     from .evidence.store import atomic_write_text
-    ws = _ws(args)
+    from .pipeline import Workspace
+    root = Path(args.workspace)
+    out_rel = ""
+    if args.output:  # the record this command writes may be the one the plan names and misses (issue 48)
+        try:
+            out_rel = Path(args.output).resolve().relative_to(root.resolve()).as_posix()
+        except ValueError:
+            out_rel = ""
+    ws = Workspace(root, args.plan, missing_ok=(out_rel,) if out_rel else ())
     if args.node not in ws.checked.nodes:
         print(f"error: no node named {args.node!r}; nodes: {', '.join(ws.node_names())}", file=sys.stderr)
         return 2
