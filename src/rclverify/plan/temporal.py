@@ -127,10 +127,21 @@ def _parse(src: Source, start: int, end: int, checked: Checked, what: str,
     try:
         return parse_formal(leaf, checked, what, states)
     except RclError as exc:
+        nested = _NESTED.search(text, start, end)
+        if nested is not None:  # `always (P -> eventually Q)`: an operator inside a state formula
+            raise RclError([error(_loc_at(src, nested.start(1)), f"{what}: {nested.group(1)!r} inside a state "
+                                  "formula is not decided (the response pattern always (P -> eventually Q) and "
+                                  "its bounded and next forms among them); write always F, always next F, "
+                                  "eventually F, eventually[<= N] F, next F or F until G with F, G state "
+                                  "formulas (docs/requirements.md, Temporal requirements)", "E-temporal")]) from None
         slip = _misspelled(src, start, end, checked, what)
         if slip is None:
             raise
         raise RclError([slip]) from None
+
+
+#: A temporal operator standing as a word inside what should be a state formula.
+_NESTED = re.compile(r"(?<![\w.'])(always|eventually|next|previous|until)(?![\w.'(])")
 
 
 #: The temporal operators, for the suggestion of a misspelled one.
