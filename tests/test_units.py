@@ -425,3 +425,19 @@ def test_fmt_command_round_trip_and_literal_units_alone(tmp_path, capsys):
     [(line, col, code, _)] = _errors("node A { inputs( r : REAL ) outputs( d : REAL )\n"
                                      "  guarantee( out.d > 0 and 2 [m] < 3 [s] ) }")
     assert (line, col, code) == (2, 36, "E-unit-dimension")
+
+
+@pytest.mark.parametrize("producer, consumer, factor, units", [
+    ("out.d == 180 / 3.141592653589793 * in.r / 5", "0 <= in.d and in.d <= 6.2832 / 5 * 30 / 6.2832", "180/pi",
+     ("[deg] read as [rad]")),
+    ("out.d == 3.6 * in.r", "0 <= in.d and in.d <= 30", "3.6", "[km/h] read as [m/s]"),
+    ("out.d == in.r / 0.3048", "0 <= in.d and in.d <= 30", "1/0.3048", "[ft] read as [m]"),
+])
+def test_the_usual_conversions_are_named(producer, consumer, factor, units):
+    """Issue 48: the scale hint knew powers of ten only (not 180/pi, 3.6, 0.3048)."""
+    [sc] = _pair(producer, consumer)[1:]
+    assert sc.status == "failed"
+    [m] = sc.scale
+    assert m["factor"] == factor and f"as a value in {units} would" in m["message"], m["message"]
+    [f] = scale_findings([sc.to_json("x.smt2")])
+    assert f"differ by a factor of {factor}" in f["explanation"]

@@ -23,7 +23,11 @@ not both declare a unit (declared units are checked exactly,
   with ``2 <= |k| <= 12``, and the producer's range divided by ``10^k`` lies
   inside the consumer's (with the same 2 % slack): read in the other unit,
   the producer's values would fit.  A factor of 10 is left out: ``<= 1``
-  against ``<= 10`` is an ordinary margin far more often than a unit.
+  against ``<= 10`` is an ordinary margin far more often than a unit;
+* else, the same rule with one of the usual conversions that are no power
+  of ten (:data:`CONVERSIONS`, issue 48: degrees and radians, 180/pi; km/h
+  and m/s, 3.6; feet and metres, 0.3048; mph and m/s, 0.44704; miles and
+  kilometres, 1.609344; inches and centimetres, 2.54), within 0.5 %.
 
 An unbounded range, an optimiser that cannot answer in its budget, or a
 non-numeric input gives nothing: the finding is a warning that points at a
@@ -132,6 +136,44 @@ def scale_power(producer: tuple[Fraction | None, Fraction | None],
     return None
 
 
+#: The usual conversions that are no power of ten: (factor the producer's values are of the consumer's,
+#: its text, the producer's unit, the consumer's unit), both directions.
+_BASE_CONVERSIONS = [(Fraction(180) / Fraction(3.141592653589793), "180/pi", "deg", "rad"),
+                     (Fraction(36, 10), "3.6", "km/h", "m/s"),
+                     (1 / Fraction(3048, 10000), "1/0.3048", "ft", "m"),
+                     (1 / Fraction(44704, 100000), "1/0.44704", "mph", "m/s"),
+                     (1 / Fraction(1609344, 1000000), "1/1.609344", "mi", "km"),
+                     (Fraction(254, 100), "2.54", "cm", "in")]
+CONVERSIONS = _BASE_CONVERSIONS + [(1 / f, (t[2:] if t.startswith("1/") else f"1/{t}"), c, p)
+                                   for f, t, p, c in _BASE_CONVERSIONS]
+#: Relative slack when a bound ratio is compared with a named conversion (tighter than a power of ten's).
+NAMED_SLACK = Fraction(5, 1000)
+
+
+def named_conversion(producer: tuple[Fraction | None, Fraction | None],
+                     consumer: tuple[Fraction | None, Fraction | None]) -> tuple[Fraction, str, str, str] | None:
+    """The usual conversion (:data:`CONVERSIONS`) by which the producer's range
+    is the consumer's read in another unit, as :func:`scale_power` does for
+    powers of ten: ``(factor, its text, the producer's unit, the consumer's
+    unit)``, or ``None``."""
+    for f, text, pu, cu in CONVERSIONS:
+        ratio_ok = False
+        for p, c in zip(producer, consumer):
+            if p is None or c is None or p == 0 or c == 0 or (p > 0) != (c > 0):
+                continue
+            if abs(p / c - f) <= NAMED_SLACK * f:
+                ratio_ok = True
+        if not ratio_ok:
+            continue
+        lo_p, hi_p = producer
+        lo_c, hi_c = consumer
+        lo_ok = lo_c is None or (lo_p is not None and lo_p / f >= lo_c - NAMED_SLACK * abs(lo_c))
+        hi_ok = hi_c is None or (hi_p is not None and hi_p / f <= hi_c + NAMED_SLACK * abs(hi_c))
+        if lo_ok and hi_ok:
+            return f, text, pu, cu
+    return None
+
+
 def probable_mismatches(checked: Checked, links: Iterable[Any], enc: Any, node: str,
                         conjunct: ast.Expr) -> tuple[dict[str, Any], ...]:
     """The probable scale mismatches behind one side condition of ``node``:
@@ -143,7 +185,8 @@ def probable_mismatches(checked: Checked, links: Iterable[Any], enc: Any, node: 
     Returns one record per mismatched input: ``{"producer":
     "Lidar.out.d", "consumer": "Controller.in.d", "producer_range": [lo,
     hi], "consumer_range": [lo, hi]`` (texts, ``-oo``/``+oo`` when
-    unbounded), ``"power": k, "factor": "1000", "message": the sentence}``.
+    unbounded), ``"power": k`` (0 for a named conversion), ``"factor":
+    "1000"`` or ``"180/pi"``, ``"message": the sentence}``.
     Never raises for solver trouble (nothing is found then)."""
     cn = checked.nodes[node]
     read = _inputs_read(conjunct, cn)
@@ -169,13 +212,18 @@ def probable_mismatches(checked: Checked, links: Iterable[Any], enc: Any, node: 
         if p_range is None or c_range is None:
             continue
         k = scale_power(p_range, c_range)
-        if k is None:
-            continue
+        if k is not None:
+            factor = str(10 ** k) if k > 0 else f"1/{10 ** -k}"
+            pu, cu = _EXAMPLES.get(k, ("..", ".."))
+        else:
+            named = named_conversion(p_range, c_range)
+            if named is None:
+                continue
+            k = 0
+            _, factor, pu, cu = named
         writer, reader = f"{l.from_node}.out.{l.from_var}", f"{node}.in.{l.to_var}"
         pr = [_show(p_range[0], "-oo"), _show(p_range[1], "+oo")]
         cr = [_show(c_range[0], "-oo"), _show(c_range[1], "+oo")]
-        factor = str(10 ** k) if k > 0 else f"1/{10 ** -k}"
-        pu, cu = _EXAMPLES.get(k, ("..", ".."))
         said = expr_to_rcl(own[0]) if len(own) == 1 else " and ".join(expr_to_rcl(c) for c in own[:3])
         msg = (f"probable scale mismatch: {writer} ranges over [{pr[0]}, {pr[1]}] ({l.from_node}'s guarantees and "
                f"assumptions) and {reader} over [{cr[0]}, {cr[1]}] ({node} assumes {said}): they differ by a "
@@ -204,7 +252,7 @@ def scale_findings(side_conditions: Iterable[Mapping[str, Any]]) -> list[dict[st
                         "check": "probable-scale-mismatch", "guarantee": None, "status": "warning",
                         "message": f"side condition {sc['id']}: {m['message']}",
                         "explanation": (f"Side condition {sc['id']} ({sc.get('conjunct', '')}) is {sc['status']}; "
-                                        f"the ranges of its two ends differ by a factor of {10 ** abs(m['power'])}, "
+                                        f"the ranges of its two ends differ by a factor of {m['factor']}, "
                                         "which a unit mismatch explains better than a range problem."),
                         "model": None, "core": None, "duration_s": 0.0, "instances": None})
     return out
