@@ -55,7 +55,8 @@ class Question:
     ``reported`` whether its own verdict was given (superseded, or closed
     unanswered: it is then superseded no more);
     ``answer`` the outputs published since it (``out.y`` -> value);
-    ``info`` the engine's own data (the semantics its assumption held in).
+    ``info`` the engine's own data (the arithmetic its assumption held in:
+    ``exact``, ``double`` or ``tolerance``).
     """
 
     __slots__ = ("event", "stamp", "inputs", "triggers", "owed", "answered", "settled", "reported", "answer",

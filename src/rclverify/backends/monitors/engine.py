@@ -154,6 +154,10 @@ class NodeMonitor:
                                [k for k in self._alone if gouts[k] & set(outs)])
                        for topic, (_, outs) in self._topic_io.items()}
         self._reads_out = {k: bool(gouts[k]) for k in ks}
+        #: per topic, the one guarantee a message on it touches when that is all there is to judge (no
+        #: trigger, no output-only guarantee): the engine's fast path (0: none)
+        self._single = {topic: (asked[0] if len(asked) == 1 and not alone and not self._trigger else 0)
+                        for topic, (asked, alone) in self._touch.items()}
         #: the guarantees an answered question must see decided (they read an output)
         self._need = [k for k in self._asked if gouts[k]]
         skew = getattr(rules, "skew", None) or 0.0
@@ -311,8 +315,8 @@ class NodeMonitor:
             if judged.semantics != "exact" and _WEAK.get(judged.semantics, 0) > _WEAK[accepted]:
                 accepted = judged.semantics
                 self._note_inexact(ev, judged, f"assumption {expr_to_rcl(formula)}", inputs)
-        q = Question(ev, ev.time if ev.stamp is None else ev.stamp, inputs, owed=owed, info=accepted)
-        old = self.stream.ask(q, trig & self._triggers if self._triggers else trig & _NO_TRIGGERS)
+        q = Question(ev, ev.time if ev.stamp is None else ev.stamp, inputs, owed, accepted)
+        old = self.stream.ask(q, trig & self._triggers if self._triggers else _NO_TRIGGERS)
         if self._open is not None and self._open.followed:  # it owes nothing more: the new question does
             self._open, self._due = None, _NEVER
         if old is not None:
@@ -328,7 +332,7 @@ class NodeMonitor:
             self.result.unowed += 1  # every guarantee answers another input: nothing is owed to this question
             q.settled = True
             return
-        q.info, q.due = (accepted, ev.time + self.horizon), ev.time + self.horizon
+        q.due = ev.time + self.horizon
         self._open, self._due = q, q.due
         if self._ask_at_question:
             self._at_question(q)
@@ -360,7 +364,7 @@ class NodeMonitor:
         ``satisfied`` at once (no answer needed); anything else waits for an
         answer."""
         values = {**q.inputs, **self._state()}
-        weakest = q.info[0]
+        weakest = q.info
         waits = False
         for k in self._asked:
             if not self._owes(q, k):
@@ -410,6 +414,22 @@ class NodeMonitor:
                 outs = {**q.answer, **mine}
         else:
             outs = mine
+        k = self._single.get(ev.topic, 0)
+        if k and q is not None and q.owed and q.view is not None and outs is q.answer and not self._state_outs:
+            # the common case inline: one guarantee, no trigger, no state, no output-only guarantee
+            view = q.view
+            judged = self._judges[k].quick(view) or self._judge(k, view)
+            if judged.truth is True and judged.semantics == "exact":
+                if q.waiting:
+                    q.waiting.pop(k, None)
+                q.decided.add(k)
+                result = self.result
+                result.counts["satisfied"] += 1
+                result.semantics[q.info] += 1
+                if self.on_verdict is not None:
+                    self.on_verdict(Verdict(self.node.name, "satisfied", ev.index, ev.time, ev.where, ev.topic,
+                                            max(self.now, ev.time), 0, {}, "", q.info, q.event.where))
+                return
         state = self._state() if self._state_outs else {}
         first = self._question_outcome(q, ev, asked, outs, state)
         alone_now = self._alone_outcome(ev, alone) if alone else _NONE
@@ -521,9 +541,9 @@ class NodeMonitor:
             if judged.truth is True and judged.semantics == "exact":
                 q.waiting.pop(k, None)
                 q.decided.add(k)
-                return _SATISFIED[q.info[0] if isinstance(q.info, tuple) else "exact"]
+                return _SATISFIED[q.info]
         return self._outcome(ks, values, self._owes_fn(q), q if keep else None, ev,
-                             q.info[0] if isinstance(q.info, tuple) else "exact")
+                             q.info)
 
     def _owes_fn(self, q: Question) -> Callable[[int], bool]:
         """Which guarantees ``q`` is owed (all of them when none has a trigger)."""
@@ -583,6 +603,9 @@ class NodeMonitor:
         q = self._open
         if q is not None and q.due < now:
             self._open, self._due = None, _NEVER
+            if q.answered and not q.waiting and (q.followed or q.decided.issuperset(self._need)):
+                q.reported = True  # answered in full: nothing to say (the common case, inline)
+                return
             self._close(q)
 
     def _close(self, q: Question, end: bool = False) -> None:
