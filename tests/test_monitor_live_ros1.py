@@ -130,10 +130,17 @@ def test_live_verdicts_equal_the_offline_verdicts_for_the_same_messages(live_run
 
 def test_the_injected_fault_is_reported_online_at_once(live_run: dict[str, Any]) -> None:
     got = [json.loads(line) for line in (live_run["tmp"] / "topic.jsonl").read_text().splitlines()]
+    # the injected fault (r = 300 classified orange); on a loaded machine the live sensor may also
+    # answer another reading after the response time, which the monitor rightly reports as well.  When the
+    # answer's callback ran before the reading's (a race of two TCPROS links: docs/semantics.md, "Transport
+    # skew"), the answer is right for the reading before and wrong for 300: inconclusive, never left green
+    raced = [g for g in got if g["data"]["node"] == "RadiationSensor" and g["data"]["verdict"] == "inconclusive"
+             and g["data"]["values"].get("in.r") == "300.0" and "transport skew" in g["data"]["reason"]]
+    if raced:
+        assert raced[0]["data"]["values"]["out.radiationStatus"] == "orange"
+        return
     bad = [g for g in got if g["data"]["node"] == "RadiationSensor" and g["data"]["verdict"] == "violated"]
     assert bad, got[-5:]
-    # the injected fault (r = 300 classified orange); on a loaded machine the live sensor may also
-    # answer another reading after the response time, which the monitor rightly reports as well
     fault = [g for g in bad if g["data"]["values"].get("in.r") == "300.0"]
     assert fault, [g["data"]["values"] for g in bad]
     first = fault[0]
@@ -151,12 +158,14 @@ def test_the_last_verdict_is_latched_and_the_stop_writes_evidence(live_run: dict
                                                                   capsys: pytest.CaptureFixture[str]) -> None:
     [last] = [json.loads(line) for line in (live_run["tmp"] / "last.jsonl").read_text().splitlines()]
     assert last["data"]["node"] == "RadiationSensor"
-    assert live_run["rc"] == 1  # a contract was violated
+    assert live_run["rc"] == 1  # a contract was violated (the Agent's, whatever the race)
     ev = json.loads((live_run["tmp"] / "evidence.json").read_text())
     log = live_run["tmp"] / "live.jsonl"
     assert ev["sha256"] == hashlib.sha256(log.read_bytes()).hexdigest()
     sensor = {n["node"]: n for n in ev["nodes"]}["RadiationSensor"]
-    assert sensor["status"] == "failed" and sensor["first_violation"]["guarantee"] == 1
+    # failed; inconclusive when the fault's answer raced its reading (the test above), never discharged
+    assert sensor["status"] == "failed" and sensor["first_violation"]["guarantee"] == 1 or (
+        sensor["status"] == "inconclusive" and "transport skew" in json.dumps(sensor))
     assert ev["late_events"] == 0 and ev["decode_errors"] == {}
     assert "RadiationSensor:" in live_run["monitor_out"]  # the status line
     # the log re-checks offline with the command

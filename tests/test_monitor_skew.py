@@ -55,6 +55,24 @@ def test_a_wrong_answer_from_the_previous_question_is_no_false_alarm(simple: Any
     assert res.first_violation is None
 
 
+def test_an_answer_right_before_but_wrong_for_the_question_just_after_is_never_left_green(simple: Any) -> None:
+    """The live case study's race: the sensor answers r = 300 with orange, and the
+    answer is stamped 0.3 ms before the reading; against the reading before it
+    (130) orange is right.  The reading gets no answer of its own, so the two
+    readings disagree: the output's satisfied is followed by an inconclusive,
+    and the run is never discharged on it (before, it read discharged)."""
+    from rclverify.backends.monitors.backend import verdict_status
+    rows = [(0.0, "r", 130.0), (0.01, "status", "red"), (1.0, "status", "red"), (1.0003, "r", 50.0),
+            (1.5, "r", 60.0), (1.51, "status", "green")]
+    got, res = run(simple, rows, skewed(DEFAULT_SKEW_S))
+    at2 = [v for v in got if v.event == 2]
+    assert [v.verdict for v in at2] == ["satisfied", "inconclusive"]
+    assert "0.30 ms before the question at run.jsonl:4" in at2[1].reason and at2[1].question == "run.jsonl:4"
+    assert verdict_status(res, "run.jsonl")[0] == "inconclusive"
+    got, res = run(simple, rows, skewed(0.0))  # without a skew: the reading is superseded, the run discharged
+    assert verdict_status(res, "run.jsonl")[0] == "discharged"
+
+
 def test_a_wrong_answer_under_every_reading_is_violated(simple: Any) -> None:
     rows = [(0.0, "r", 50.0), (0.01, "status", "green"), (1.0, "status", "red"), (1.0001, "r", 60.0)]
     got, res = run(simple, rows, rules=skewed(DEFAULT_SKEW_S))

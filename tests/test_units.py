@@ -365,7 +365,8 @@ def test_scale_power_against_its_definition(lo, width, k):
     producer = (consumer[0] * f, consumer[1] * f)
     assert scale_power(producer, consumer) == k
     assert scale_power(consumer, consumer) is None  # one scale: nothing to say
-    shifted = (producer[0] + f * width, producer[1] + f * width)  # right scale, wrong place: does not fit
+    s = width + Fraction(abs(lo) + width, 10) + 1  # past the 2 % slack whatever the bounds' magnitude
+    shifted = (producer[0] + f * s, producer[1] + f * s)  # right scale, wrong place: does not fit
     assert scale_power(shifted, consumer) is None
 
 

@@ -54,6 +54,7 @@ _NO_RULE = TopicRule()  # the rule of a topic the mapping does not name
 _NEVER = float("inf")
 _NO_TRIGGERS: frozenset[str] = frozenset()
 _NONE = Outcome("none")
+_EMPTY: Mapping[str, Any] = {}
 _SATISFIED = {sem: Outcome("satisfied", semantics=sem) for sem in ("exact", "double", "tolerance")}
 
 
@@ -162,6 +163,8 @@ class NodeMonitor:
         self._need = [k for k in self._asked if gouts[k]]
         skew = getattr(rules, "skew", None) or 0.0
         self.stream = QuestionStream(skew if self.has_inputs else 0.0, horizon)
+        #: outputs judged at once, for a question within the skew after them that gets no answer of its own
+        self._recent: deque[tuple[Event, float, dict[str, Any], Mapping[str, Any]]] = deque(maxlen=64)
         #: outputs false for the question at their stamp, waiting for the questions within the skew after them:
         #: (event, stamp, that question, outputs of the answer, state outputs, output-only outcome, its reading)
         self._held: deque[tuple[Any, ...]] = deque()
@@ -321,6 +324,8 @@ class NodeMonitor:
             self._open, self._due = None, _NEVER
         if old is not None:
             old.reported = True
+            if self._recent:
+                self._early_answer(old)
             self._verdict("superseded", old.event, reason=f"the input at {ev.where} came before any output "
                           f"answered the question raised at {old.event.where}: the node owes the latest one an answer")
         if refusal:
@@ -414,6 +419,8 @@ class NodeMonitor:
                 outs = {**q.answer, **mine}
         else:
             outs = mine
+        if self.stream.skew:  # judged at once: reconsidered if a question within the skew after it gets no answer
+            self._recent.append((ev, stamped, mine, self._state() if self._state_outs else _EMPTY))
         k = self._single.get(ev.topic, 0)
         if k and q is not None and q.owed and q.view is not None and outs is q.answer and not self._state_outs:
             # the common case inline: one guarantee, no trigger, no state, no output-only guarantee
@@ -436,6 +443,7 @@ class NodeMonitor:
         if first.kind == "violated" and self.stream.skew:
             # false for the question at its stamp: it may be the right answer to a question stamped within the
             # skew after it that gets no answer of its own; judged once that is known (docs/semantics.md)
+            self._recent.pop()  # judged with both readings when released, not reconsidered
             self._held.append((ev, stamped, q, dict(outs), state, alone_now, first))
             return
         if alone_now is _NONE and first.kind == "satisfied":  # the common case, without combining
@@ -456,6 +464,36 @@ class NodeMonitor:
                 return  # a question it may answer has no answer of its own yet: wait
             held.popleft()
             self._decide(ev, q, others, alone, outs, first, state)
+
+    def _early_answer(self, qb: Question) -> None:
+        """Question ``qb`` got no answer of its own: the outputs judged at once
+        that were stamped within the skew before it may have been its answer
+        (docs/semantics.md, "Transport skew").  Where they are false for it, the
+        two readings disagree: an ``inconclusive`` verdict follows the one given
+        at once (never a ``satisfied`` left standing for a wrong answer)."""
+        if not qb.owed:
+            return
+        floor = qb.stamp - self.stream.skew
+        cands = [r for r in self._recent if floor <= r[1] <= qb.stamp and r[0].index < qb.event.index]
+        if not cands:
+            return
+        outs: dict[str, Any] = {}
+        ks: list[int] = []
+        for ev, _, mine, _ in cands:
+            outs.update(mine)
+            ks += [k for k in self._touch[ev.topic][0] if k not in ks]
+        ev, stamped, _, state = cands[-1]
+        reading = self._question_outcome(qb, ev, sorted(ks), outs, state, False)
+        if reading.kind != "violated":
+            return
+        self._recent = deque((r for r in self._recent if r not in cands), maxlen=self._recent.maxlen)
+        gap = max(qb.stamp - stamped, 0.0) * 1000
+        self._verdict("inconclusive", ev, guarantee=reading.guarantee, values=self._rendered(reading.values),
+                      reason=f"the output at {ev.where} met the question at its stamp, but it was stamped {gap:.2f} ms "
+                             f"before the question at {qb.event.where}, within the transport skew of "
+                             f"{self.stream.skew:g} s, and that question got no answer of its own: as its answer, "
+                             f"guarantee {reading.guarantee} is false; the two readings disagree (docs/semantics.md, "
+                             f"\"Transport skew\")", question=qb.event.where)
 
     def _alone_outcome(self, ev: Event, ks: list[int]) -> Outcome:
         """The guarantees over outputs only that ``ev`` touches, on the outputs as they stand."""
@@ -638,6 +676,8 @@ class NodeMonitor:
         was, q.reported = q.reported, True  # closed: superseded no more
         if q.answered or q.settled or was or judged_now:
             return
+        if self._recent:
+            self._early_answer(q)
         if end:
             self._verdict("open", q.event, reason=f"unanswered when the run ended, within {self.horizon} s")
             return
