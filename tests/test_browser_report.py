@@ -290,3 +290,25 @@ def test_the_case_study_report_reads_well(tmp_path: Path, driver: Any) -> None:
     assert driver.execute_script("return document.documentElement.scrollWidth <= window.innerWidth")
     driver.execute_script("document.getElementById('argument').scrollIntoView()")
     _screenshot(driver, tmp_path, "assurance-case-study-argument.png")
+
+
+def test_the_first_screen_says_what_to_fix(tmp_path: Path, driver: Any) -> None:
+    """Issue 48: at 1400x900 the first screen holds the overall status with the refuted
+    requirements counted and the first problem to fix with its culprit (before, the
+    node-by-technique dashboard pushed the problems below the fold)."""
+    with gzip.open(REPO / "tests" / "data" / "case-study-report.json.gz", "rt", encoding="utf-8") as f:
+        report = json.load(f)
+    report.pop("problems", None)
+    out = tmp_path / "reports"
+    out.mkdir()
+    render_files(report, out, ("assurance.html",))
+    driver.set_window_size(1400, 900)
+    driver.get((out / "assurance.html").as_uri())
+    height = driver.execute_script("return window.innerHeight")
+    lead = driver.find_element("css selector", "header p.lead").get_attribute("textContent")
+    assert "1 requirement refuted (REQ4)" in lead and "problems to fix" in lead
+    first = driver.find_element("css selector", "#problem-1")
+    bottom = driver.execute_script("return arguments[0].getBoundingClientRect().bottom", first)
+    assert bottom <= height, (bottom, height)
+    assert "contracts/remote_inspection.rcl:72:3" in first.get_attribute("textContent")  # its culprit
+    _screenshot(driver, tmp_path, "assurance-first-screen.png")

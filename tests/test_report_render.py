@@ -414,7 +414,8 @@ def test_dashboard_cells_are_the_worst_status_of_each_technique_and_link_to_it()
     html = render.render_html(rep, rendering=NO_DOT)
     dashboard = _section(html, 'id="dashboard"', "</section>")
     assert 'href="#ev-Sensor.g1.hoare"' in dashboard and "REQ1" in dashboard
-    assert html.index('id="dashboard"') < html.index('id="attention"') < html.index('id="system"')
+    # the first screen leads with what to fix (issue 48), then the dashboard, then the diagram
+    assert html.index('id="attention"') < html.index('id="dashboard"') < html.index('id="system"')
     md = render.render_markdown(rep)
     assert "## Dashboard" in md and "(#ev-Sensor.g1.hoare)" in md
 
