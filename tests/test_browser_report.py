@@ -311,4 +311,8 @@ def test_the_first_screen_says_what_to_fix(tmp_path: Path, driver: Any) -> None:
     bottom = driver.execute_script("return arguments[0].getBoundingClientRect().bottom", first)
     assert bottom <= height, (bottom, height)
     assert "contracts/remote_inspection.rcl:72:3" in first.get_attribute("textContent")  # its culprit
+    # the culprit nodes are marked in the dashboard (a guarantee or the contract of each is a culprit)
+    marked = driver.execute_script("return [...document.querySelectorAll('table.matrix th span.culprit')]"
+                                   ".map(s => s.closest('th').querySelector('a').textContent)")
+    assert "Agent" in marked and "Localisation" not in marked, marked
     _screenshot(driver, tmp_path, "assurance-first-screen.png")

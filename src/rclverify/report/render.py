@@ -19,7 +19,7 @@ import re
 from collections import defaultdict
 from functools import lru_cache
 from pathlib import Path
-from typing import Any, Callable, Mapping, Sequence, TypeVar
+from typing import Any, Callable, Iterable, Mapping, Sequence, TypeVar
 from urllib.parse import quote
 
 import jinja2
@@ -420,7 +420,8 @@ TECHNIQUES: tuple[str, ...] = ("health", "side conditions", "hoare", "dafny", "a
 _HEALTH_AS: Mapping[str, str] = {"ok": "discharged", "problem": "failed", "unknown": "inconclusive"}
 
 
-def dashboard(report: Mapping[str, Any], evidence_of: Mapping[str, Sequence[tuple[str, Any]]]) -> dict[str, Any]:
+def dashboard(report: Mapping[str, Any], evidence_of: Mapping[str, Sequence[tuple[str, Any]]],
+              groups: Sequence[Mapping[str, Any]] | None = None) -> dict[str, Any]:
     """The dashboard's matrix of nodes (rows) against techniques (columns).
 
     Each cell is the WORST status of the node's items of that technique
@@ -439,7 +440,8 @@ def dashboard(report: Mapping[str, Any], evidence_of: Mapping[str, Sequence[tupl
     of the first item with the worst status (its first evidence record,
     else its obligation row; the health finding; the side condition).
     Returns ``{"columns": [technique], "rows": [{"node", "status",
-    "cells": [cell]}]}``."""
+    "cells": [cell], "culprit" (a problem's culprit is its guarantee or
+    contract, :func:`culprit_nodes`)}]}``."""
     items: dict[tuple[str, str], list[tuple[str, str]]] = defaultdict(list)
     for o in report["obligations"]:
         evs = evidence_of.get(str(o["id"]), [])
@@ -452,6 +454,7 @@ def dashboard(report: Mapping[str, Any], evidence_of: Mapping[str, Sequence[tupl
         items[(str(sc["node"]), "side conditions")].append((str(sc["status"]), anchor("sc", sc["id"])))
     for u in report.get("unverified") or ():  # no obligation at all: a column of its own, after the techniques
         items[(str(u["node"]), "no evidence")].append((str(u["status"]), anchor("g", u["node"], u["guarantee"])))
+    culprits = culprit_nodes(groups if groups is not None else report.get("problems") or ())
     extra = sorted({b for _, b in items} - set(TECHNIQUES) - {"no evidence"})
     extra += ["no evidence"] if any(b == "no evidence" for _, b in items) else []
     columns = [*TECHNIQUES, *extra]
@@ -472,8 +475,22 @@ def dashboard(report: Mapping[str, Any], evidence_of: Mapping[str, Sequence[tupl
             counts = sorted(tally.items(), key=lambda kv: (-rank(kv[0]), kv[0]))
             cells.append({"status": first[0], "worst": tally[first[0]], "total": len(got), "counts": counts,
                           "anchor": first[1]})
-        rows.append({"node": name, "status": n["status"], "cells": cells})
+        rows.append({"node": name, "status": n["status"], "cells": cells, "culprit": name in culprits})
     return {"columns": columns, "rows": rows}
+
+
+def culprit_nodes(groups: Iterable[Any]) -> set[str]:
+    """The nodes a problem's culprit (``groups``: the problems by root cause)
+    is a guarantee or the contract of (``guarantee:Node:k``,
+    ``contract:Node``; issue 48: the dashboard marks them, so that the first
+    screen blames the culprit, not its victims)."""
+    out = set()
+    for g in groups:
+        for c in g.get("culprits") or () if isinstance(g, Mapping) else ():
+            kind, _, rest = str(c.get("id", "")).partition(":")
+            if kind in ("guarantee", "contract") and rest:
+                out.add(rest.split(":", 1)[0])
+    return out
 
 
 def view(report: Mapping[str, Any]) -> dict[str, Any]:
@@ -553,7 +570,7 @@ def view(report: Mapping[str, Any]) -> dict[str, Any]:
     groups = (list(report["problems"]) if report.get("problems") is not None
               else group_problems(report, problems, anchor))
     return {
-        "dashboard": dashboard(report, evidence_of), "problem_groups": groups,
+        "dashboard": dashboard(report, evidence_of, groups), "problem_groups": groups,
         "diagnosis": {str(d["id"]): d for d in report.get("diagnoses") or []},
         "counts": counts, "problems": problems, "outstanding": outstanding, "outstanding_groups": outstanding_groups,
         "pending_groups": list(pending_groups.values()),
