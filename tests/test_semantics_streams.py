@@ -167,3 +167,24 @@ def test_one_arithmetic_per_message_for_the_whole_contract(tmp_path: Path) -> No
     got, res = _run(checked, "Scale", [(0.0, "r", 1.2), (0.1, "d", 1000 * 1.2)])
     assert [v.verdict for v in got] == ["violated"]
     assert "no one arithmetic" in got[0].reason and res.counts["satisfied"] == 0
+
+
+def test_a_split_answer_false_whatever_the_rest_is_violated_when_a_newer_question_follows() -> None:
+    """The live case study's other race (issue 47): the sensor publishes inspected(4) for the
+    command, then the reading 300 arrives, then orange (wrong: 300 is red) with the reading's
+    stamp, then the next command.  The reading's answer lacks inspected (owed to the next
+    question), but orange is false whatever inspected is: violated, never a silent green."""
+    from rclverify.backends.monitors.config import load_mapping
+    repo = Path(__file__).resolve().parents[1]
+    checked = load([repo / "contracts" / "remote_inspection.rcl"])
+    cfg = load_mapping(repo, "backends/monitors/mapping.yaml", 2.0)
+    cmd = {"command": "inspect", "posx": 0.0, "posy": 0.0, "id": 4}
+    rows = [(0.0, "r", {"value": 130.0}), (0.5, "command", cmd), (0.52, "inspected", {"id": 4}),
+            (0.5202, "r", {"value": 300.0}), (0.5202, "radiationStatus", {"level": "orange"}),
+            (0.75, "command", {"command": "move", "posx": 9.0, "posy": 6.5, "id": 0})]
+    evs = [Event(k, t, topic, f, f"live: message {k}") for k, (t, topic, f) in enumerate(rows)]
+    got: list[Any] = []
+    _, [res] = check_trace(checked, [checked.nodes["RadiationSensor"]], evs, cfg.rules, 2.0, got.append)
+    bad = [v for v in got if v.verdict == "violated"]
+    assert bad and bad[0].values["in.r"] == "300.0" and bad[0].values["out.radiationStatus"] == "orange"
+    assert verdict_status(res, "live")[0] == "failed"

@@ -321,7 +321,9 @@ class NodeMonitor:
         q = Question(ev, ev.time if ev.stamp is None else ev.stamp, inputs, owed, accepted)
         old = self.stream.ask(q, trig & self._triggers if self._triggers else _NO_TRIGGERS)
         if self._open is not None and self._open.followed:  # it owes nothing more: the new question does
-            self._open, self._due = None, _NEVER
+            followed, self._open, self._due = self._open, None, _NEVER
+            if followed.waiting:
+                self._wrong_whatever(followed)
         if old is not None:
             old.reported = True
             if self._recent:
@@ -656,7 +658,7 @@ class NodeMonitor:
             return
         state = self._state()
         if q.followed:  # a newer question came within its horizon: the node owes that one what is missing here
-            q.waiting.clear()
+            self._wrong_whatever(q)
         elif (q.answered or self._state_outs) and q.owed and not q.settled and not q.reported:
             values = {**q.inputs, **state, **q.answer}
             for k in self._asked:
@@ -684,6 +686,21 @@ class NodeMonitor:
         self._verdict("inconclusive", q.event, reason=f"unanswered: no output within {self.horizon} s of the "
                       f"question at {q.event.where} (a finite run cannot show the answer never comes; a deadline "
                       "`triggered by ... within` would fail)")
+
+    def _wrong_whatever(self, q: Question) -> None:
+        """Question ``q`` was followed by a newer one within its horizon, with
+        guarantees still waiting for outputs: what is missing is owed to the
+        newer question, but an answer already false whatever the missing
+        outputs are is ``violated`` now (the sensor's ``orange`` for a reading
+        of 300 fails whatever ``inspected`` is)."""
+        state = self._state()
+        for k, (ev, why, outs) in sorted(q.waiting.items()):
+            values = {**q.inputs, **state, **outs}
+            if self._false_whatever_missing(k, values):
+                self._violation(ev, k, values, f"guarantee {k} is false on the outputs published after the question "
+                                f"at {q.event.where} (the last at {ev.where}) whatever the value of the outputs not "
+                                f"published before the next question ({why})", "", q.event)
+        q.waiting.clear()
 
     def _partial(self, q: Question, k: int, ev: Event, why: str, outs: Mapping[str, Any], end: bool) -> None:
         """A partial answer: guarantee ``k`` waited for an output that never came
