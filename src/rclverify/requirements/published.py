@@ -80,12 +80,7 @@ class Publication:
         """The values a statement mentions (``(node, "in"|"out"|"state", var)``)
         all published in ``s``: each output's node has published, each fed input
         has been heard; environment inputs and state variables always have one."""
-        flags: list[str] = []
-        for n, kind, var in mentions:
-            name = (self.published.get(n) if kind == "out" else
-                    self.heard.get(f"{n}.in.{var}") if kind == "in" else None)
-            if name is not None and name not in flags:
-                flags.append(name)
+        flags = self.flags_of(mentions)
         return z3.And(*[s[f] for f in flags]) if flags else z3.BoolVal(True)
 
     def flags_of(self, mentions: Iterable[tuple[str, str, str]]) -> list[str]:
