@@ -246,7 +246,7 @@ class _Index:
         ob, sep, n = wanted.strip().rpartition("#")
         if not sep or not n.isdigit():
             return None
-        key = self._match(ob, self.evidence, exact)
+        key = self._match(ob, [str(e) for e in self.evidence if e], exact)
         m = ((self.evidence.get(key) or {}).get("monitoring") or {}) if key else {}
         vs = m.get("violations") or []
         if not 1 <= int(n) <= len(vs):

@@ -1,0 +1,193 @@
+"""How a question ends, for the verdict engine (:mod:`.engine`): the parts that run once per question
+or less, kept apart from the per-message hot path.
+
+* :meth:`Closing._assumption_violated`: a question the assumption refuses, blamed on the producer;
+* :meth:`Closing._at_question`: the owed guarantees its inputs alone decide;
+* :meth:`Closing._close`: its horizon passed (or the run ended): partial answers judged, an unanswered
+  question ``inconclusive`` (``open`` at the end);
+* :meth:`Closing._wrong_whatever`: a newer question followed it with guarantees still waiting: an
+  answer false whatever its missing outputs is ``violated``;
+* :meth:`Closing._early_answer`: it got no answer of its own: outputs judged at once within the
+  transport skew before it are reconsidered.
+
+The rules are docs/semantics.md's; the mixin reads the engine's state and calls its judge (the
+methods it expects are declared for the type checker only).
+"""
+from __future__ import annotations
+
+from collections import deque
+from typing import TYPE_CHECKING, Any, Mapping
+
+from ...logic.floatsem import Judgement
+from ...rcl import ast
+from ...rcl.printer import expr_to_rcl
+from ...traces.events import Event
+from ...traces.questions import Question
+from .verdicts import in_all, link_of, names, producers
+
+_WEAK = {"exact": 0, "double": 1, "tolerance": 2}
+
+class Closing:
+    """The once-per-question parts of :class:`~.engine.NodeMonitor` (module docstring)."""
+
+    if TYPE_CHECKING:  # the engine's state and helpers the mixin reads, declared for the type checker only
+        _recent: deque[tuple[Event, float, dict[str, Any], Mapping[str, Any]]]
+
+        def __getattr__(self, name: str) -> Any: ...
+
+    def _assumption_violated(self, ev: Event, formula: ast.Expr, inputs: Mapping[str, Any], judged: Judgement) -> None:
+        mentioned: set[str] = set()
+        names(formula, mentioned)
+        read = [k for k in inputs if k in mentioned or k[3:] in mentioned]
+        blamed = sorted({p for k in read for p in producers(self.checked, self.node, k[3:])})
+        links = sorted({link_of(self.node, k[3:]) for k in read} - {""})
+        blame = ("upstream node(s) " + ", ".join(blamed)) if blamed else "environment"
+        if blamed and links:
+            blame += f" (through {', '.join(links)})"
+        if self.result.first_assumption_violation is None:
+            self.result.first_assumption_violation = {
+                "event": ev.index, "time": ev.time, "where": ev.where, "assumption": expr_to_rcl(formula),
+                "values": self._rendered(inputs), "blame": blame, "semantics": judged.semantics}
+        self._verdict("assumption violated", ev, values=self._rendered(inputs),
+                      reason=f"assumption {expr_to_rcl(formula)} is false; blamed on the {blame}",
+                      semantics=judged.semantics)
+
+    def _at_question(self, q: Question) -> None:
+        """The owed guarantees on the question's inputs and the state outputs:
+        one that reads no output false -> ``violated``; all true ->
+        ``satisfied`` at once (no answer needed); anything else waits for an
+        answer."""
+        values = {**q.inputs, **self._state()}
+        weakest = q.info
+        waits = False
+        for k in self._asked:
+            if not self._owes(q, k):
+                continue
+            judged = self._judge(k, values)
+            if judged.truth is True:
+                q.decided.add(k)
+                if _WEAK.get(judged.semantics, 0) > _WEAK[weakest]:
+                    weakest = judged.semantics
+                continue
+            if judged.truth is False and not self._reads_out[k]:
+                q.settled = True
+                self._violation(q.event, k, values, f"guarantee {k} is false on the inputs of the question at "
+                                f"{q.event.where}{in_all(judged.semantics)}", judged.semantics, q.event)
+                return
+            waits = True
+        if not waits:
+            q.settled = True
+            self._verdict("satisfied", q.event, semantics=weakest)
+
+    def _early_answer(self, qb: Question) -> None:
+        """Question ``qb`` got no answer of its own: the outputs judged at once
+        that were stamped within the skew before it may have been its answer
+        (docs/semantics.md, "Transport skew").  Where they are false for it, the
+        two readings disagree: an ``inconclusive`` verdict follows the one given
+        at once (never a ``satisfied`` left standing for a wrong answer)."""
+        if not qb.owed:
+            return
+        floor = qb.stamp - self.stream.skew
+        cands = [r for r in self._recent if floor <= r[1] <= qb.stamp and r[0].index < qb.event.index]
+        if not cands:
+            return
+        outs: dict[str, Any] = {}
+        ks: list[int] = []
+        for ev, _, mine, _ in cands:
+            outs.update(mine)
+            ks += [k for k in self._touch[ev.topic][0] if k not in ks]
+        ev, stamped, _, state = cands[-1]
+        reading = self._question_outcome(qb, ev, sorted(ks), outs, state, False)
+        if reading.kind != "violated":
+            return
+        self._recent = deque((r for r in self._recent if r not in cands), maxlen=self._recent.maxlen)
+        gap = max(qb.stamp - stamped, 0.0) * 1000
+        self._verdict("inconclusive", ev, guarantee=reading.guarantee, values=self._rendered(reading.values),
+                      reason=f"the output at {ev.where} met the question at its stamp, but it was stamped {gap:.2f} ms "
+                             f"before the question at {qb.event.where}, within the transport skew of "
+                             f"{self.stream.skew:g} s, and that question got no answer of its own: as its answer, "
+                             f"guarantee {reading.guarantee} is false; the two readings disagree (docs/semantics.md, "
+                             f"\"Transport skew\")", question=qb.event.where)
+
+    def _close(self, q: Question, end: bool = False) -> None:
+        """Question ``q``'s horizon passed (``end``: the run ended first):
+        its partial answers are judged (an owed guarantee no output decided
+        waits for the outputs it reads), and an unanswered one is inconclusive
+        (``open`` at the end)."""
+        if q.answered and not q.waiting and (q.followed or q.decided.issuperset(self._need)):
+            q.reported = True  # answered in full (the common case)
+            return
+        state = self._state()
+        if q.followed:  # a newer question came within its horizon: the node owes that one what is missing here
+            self._wrong_whatever(q)
+        elif (q.answered or self._state_outs) and q.owed and not q.settled and not q.reported:
+            values = {**q.inputs, **state, **q.answer}
+            for k in self._asked:
+                if k in q.decided or k in q.waiting or not self._reads_out[k] or not self._owes(q, k) or \
+                        self._trigger.get(k) in q.passed:
+                    continue
+                judged = self._judge(k, values)
+                if judged.truth is not True:
+                    q.waiting[k] = (q.last_out or q.event, judged.reason or f"guarantee {k} is false",
+                                    {x: v for x, v in values.items() if x.startswith("out.")})
+        for k in [k for k in q.waiting if self._trigger.get(k) in q.passed]:
+            del q.waiting[k]  # the next question owes it now
+        judged_now = bool(q.waiting)
+        for k, (ev, why, outs) in sorted(q.waiting.items()):
+            self._partial(q, k, ev, why, {**state, **outs}, end)
+        q.waiting.clear()
+        was, q.reported = q.reported, True  # closed: superseded no more
+        if q.answered or q.settled or was or judged_now:
+            return
+        if self._recent:
+            self._early_answer(q)
+        if end:
+            self._verdict("open", q.event, reason=f"unanswered when the run ended, within {self.horizon} s")
+            return
+        self._verdict("inconclusive", q.event, reason=f"unanswered: no output within {self.horizon} s of the "
+                      f"question at {q.event.where} (a finite run cannot show the answer never comes; a deadline "
+                      "`triggered by ... within` would fail)")
+
+    def _wrong_whatever(self, q: Question) -> None:
+        """Question ``q`` was followed by a newer one within its horizon, with
+        guarantees still waiting for outputs: what is missing is owed to the
+        newer question, but an answer already false whatever the missing
+        outputs are is ``violated`` now (the sensor's ``orange`` for a reading
+        of 300 fails whatever ``inspected`` is)."""
+        state = self._state()
+        for k, (ev, why, outs) in sorted(q.waiting.items()):
+            values = {**q.inputs, **state, **outs}
+            if self._false_whatever_missing(k, values):
+                self._violation(ev, k, values, f"guarantee {k} is false on the outputs published after the question "
+                                f"at {q.event.where} (the last at {ev.where}) whatever the value of the outputs not "
+                                f"published before the next question ({why})", "", q.event)
+        q.waiting.clear()
+
+    def _partial(self, q: Question, k: int, ev: Event, why: str, outs: Mapping[str, Any], end: bool) -> None:
+        """A partial answer: guarantee ``k`` waited for an output that never came
+        after the question; false whatever it is -> ``violated``, else undecided."""
+        values = {**q.inputs, **outs}  # outs: the state outputs at its horizon and the answer
+        if self._false_whatever_missing(k, values):
+            self._violation(ev, k, values, f"guarantee {k} is false on the outputs published after the question "
+                            f"at {q.event.where} (the last at {ev.where}) whatever the value of the outputs not "
+                            f"published after it ({why})", "", q.event)
+            return
+        missing = why.split(" ", 3)[-1].split(",")[0] if why.startswith("no value for ") else why
+        reason = (f"guarantee {k} is undecided on the outputs published after the question at {q.event.where} "
+                  f"(the last at {ev.where}): {why}; nothing published within {self.horizon} s completed the answer "
+                  f"(if {missing} keeps its value between messages, declare its topic `state: true` in the mapping)")
+        self._verdict("open" if end else "inconclusive", ev, guarantee=k, values=self._rendered(values),
+                      reason=reason, question=q.event.where)
+
+    def _false_whatever_missing(self, k: int, values: Mapping[str, Any]) -> bool:
+        import z3
+
+        from ...logic.concrete import false_whatever_the_rest
+        known = {q: v for q, v in values.items() if v is not None}
+        try:
+            return false_whatever_the_rest(self.guarantees[k - 1], self.checked, self.node, known)
+        except (KeyError, ValueError, z3.Z3Exception):
+            return False
+
+
+__all__ = ["Closing"]
