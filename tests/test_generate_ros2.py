@@ -170,7 +170,7 @@ def test_ros_scan_of_the_generated_tree_is_the_contracts_graph(tmp_path: Path, c
         assert len(want) == 30
     _parse_all(out)  # every interface file parses
     pys = sorted(out.rglob("*.py"))
-    assert len(pys) == 4 * len(want) + 1  # per node: __init__, node, logic, setup; one launch file
+    assert len(pys) == 5 * len(want) + 1  # per node: __init__, node, contract, logic, setup; one launch file
     for p in pys:
         py_compile.compile(str(p), cfile=str(tmp_path / "c.pyc"), doraise=True)
         first = p.read_text().splitlines()[0]

@@ -35,7 +35,8 @@ def cmd_ros2(args: argparse.Namespace) -> int:
     system = args.system or ws.resolve().name
     out = Path(args.output)
     try:
-        res = write_tree(out, checked, system)
+        sources = {sp.file: (ws / sp.file).read_text(encoding="utf-8") for sp in checked.specs}
+        res = write_tree(out, checked, system, sources)
     except (OSError, ValueError) as exc:
         print(f"{out}: error: {exc}", file=sys.stderr)
         return 1

@@ -9,6 +9,7 @@ changed: those are the files to read again (docs/generate.md).
 """
 from __future__ import annotations
 
+import json
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -42,12 +43,13 @@ class Result:
     stale_logic: list[str] = field(default_factory=list)
 
 
-def render_tree(checked: Checked, system: str) -> tuple[dict[str, str], dict[str, str], dict[str, list[str]]]:
+def render_tree(checked: Checked, system: str, sources: dict[str, str] | None = None) -> tuple[dict[str, str], dict[str, str], dict[str, list[str]]]:
     """The generated tree of ``checked`` for system ``system`` (a ROS package name prefix).
 
     Returns ``(generated, once, interface_of)``: relative path -> text for generated files and
     for created-once files, and logic file -> the generated files describing its node's interface
-    (its node file and the interface files its ends use).  Raises ``ValueError`` for a contract
+    (its node file and the interface files its ends use).  ``sources`` (contract file -> text)
+    is embedded in each node's contract layer (``contract.py``).  Raises ``ValueError`` for a contract
     the mapping cannot express (docs/generate.md)."""
     gen: dict[str, str] = {}
     once: dict[str, str] = {}
@@ -68,6 +70,8 @@ def render_tree(checked: Checked, system: str) -> tuple[dict[str, str], dict[str
         ctx = dict(marker=GENERATED, np=np, cls=camel(np.ros_name) + "Node", qos_depth=QOS_DEPTH)
         gen[f"{d}/{d}/node.py"] = _ENV.get_template("node.py.j2").render(ctx)
         gen[f"{d}/{d}/__init__.py"] = f"# {GENERATED}\n"
+        gen[f"{d}/{d}/contract.py"] = _ENV.get_template("contract.py.j2").render(
+            ctx, sources_json=json.dumps(sources or {}, sort_keys=True))
         gen[f"{d}/setup.py"] = _ENV.get_template("setup.py.j2").render(ctx)
         gen[f"{d}/setup.cfg"] = _ENV.get_template("setup.cfg.j2").render(ctx)
         gen[f"{d}/package.xml"] = _ENV.get_template("node_package.xml.j2").render(ctx)
@@ -85,11 +89,11 @@ def render_tree(checked: Checked, system: str) -> tuple[dict[str, str], dict[str
     return gen, once, interface_of
 
 
-def write_tree(out: Path, checked: Checked, system: str) -> Result:
+def write_tree(out: Path, checked: Checked, system: str, sources: dict[str, str] | None = None) -> Result:
     """Write the tree of :func:`render_tree` under ``out``; see :class:`Result`.
 
     Raises ``OSError`` when a file cannot be written and ``ValueError`` as :func:`render_tree`."""
-    gen, once, interface_of = render_tree(checked, snake(system))
+    gen, once, interface_of = render_tree(checked, snake(system), sources)
     res = Result()
     for rel, text in sorted(gen.items()):
         p = out / rel
