@@ -204,3 +204,15 @@ def test_a_contract_error_is_located_and_no_tree_is_written(tmp_path: Path, caps
     err = capsys.readouterr().err
     assert "contracts/sys.rcl:1:" in err and "error" in err and "Traceback" not in err
     assert not (tmp_path / "out").exists()
+
+
+def test_a_hand_written_file_at_a_generated_path_is_never_overwritten(tmp_path: Path, capsys) -> None:
+    ws = _ws(tmp_path, _chain_system(2))
+    out = tmp_path / "out"
+    (out / "n0" / "n0").mkdir(parents=True)
+    (out / "n0" / "n0" / "node.py").write_text("# mine\n")
+    assert main(["generate", "ros2", "-w", str(ws), "-o", str(out)]) == 1
+    err = capsys.readouterr().err
+    assert "n0/n0/node.py: error: exists and is not a generated file" in err and "Traceback" not in err
+    assert (out / "n0" / "n0" / "node.py").read_text() == "# mine\n"
+    assert not (out / "n1").exists()  # nothing written

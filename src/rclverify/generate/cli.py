@@ -29,7 +29,7 @@ def add_parsers(sub: Any) -> None:
 def cmd_ros2(args: argparse.Namespace) -> int:
     """Check the workspace's contracts and write the tree; prints what changed and the logic files to read."""
     from ..pipeline import Workspace
-    from .writer import write_tree
+    from .writer import GenerateError, write_tree
     ws = Path(args.workspace)
     checked = Workspace(ws, args.plan).checked  # raises RclError, printed located by main
     system = args.system or ws.resolve().name
@@ -37,6 +37,9 @@ def cmd_ros2(args: argparse.Namespace) -> int:
     try:
         sources = {sp.file: (ws / sp.file).read_text(encoding="utf-8") for sp in checked.specs}
         res = write_tree(out, checked, system, sources)
+    except GenerateError as exc:
+        print(exc, file=sys.stderr)
+        return 1
     except (OSError, ValueError) as exc:
         print(f"{out}: error: {exc}", file=sys.stderr)
         return 1

@@ -28,6 +28,14 @@ _ENV = jinja2.Environment(loader=jinja2.PackageLoader("rclverify.generate", "tem
                           keep_trailing_newline=True, autoescape=False, undefined=jinja2.StrictUndefined)
 
 
+class GenerateError(ValueError):
+    """A file of the output directory the run refuses to touch; printed ``path: error: message``."""
+
+    def __init__(self, path: Path, message: str) -> None:
+        super().__init__(f"{path}: error: {message}")
+        self.path = path
+
+
 @dataclass
 class Result:
     """What a run did (paths relative to the output directory).
@@ -89,12 +97,23 @@ def render_tree(checked: Checked, system: str, sources: dict[str, str] | None = 
     return gen, once, interface_of
 
 
+def _is_generated(text: str) -> bool:
+    """The file's header (its first three lines) marks it generated-every-time."""
+    return any(GENERATED in line for line in text.split("\n", 3)[:3])
+
+
 def write_tree(out: Path, checked: Checked, system: str, sources: dict[str, str] | None = None) -> Result:
     """Write the tree of :func:`render_tree` under ``out``; see :class:`Result`.
 
-    Raises ``OSError`` when a file cannot be written and ``ValueError`` as :func:`render_tree`."""
+    Raises ``OSError`` when a file cannot be written, ``ValueError`` as :func:`render_tree` and
+    when a file at a generated path lacks the generated header (a hand-written file is never
+    overwritten); nothing is written then."""
     gen, once, interface_of = render_tree(checked, snake(system), sources)
     res = Result()
+    for rel, text in sorted(gen.items()):  # every conflict refused before anything is written
+        p = out / rel
+        if text and p.is_file() and not _is_generated(p.read_text(encoding="utf-8", errors="replace")):
+            raise GenerateError(p, "exists and is not a generated file (no generated header): not overwritten")
     for rel, text in sorted(gen.items()):
         p = out / rel
         if p.is_file() and p.read_text(encoding="utf-8") == text:
