@@ -168,6 +168,9 @@ def test_ros_scan_of_the_generated_tree_is_the_contracts_graph(tmp_path: Path, c
     assert _graph_of_scan(out, tmp_path) == want
     if case == "chain30":
         assert len(want) == 30
+    if case == "warehouse":  # units and the assumption's bounds as comments, from every user of the field
+        nav = (out / "warehouse_msgs/action/Navigate.action").read_text()
+        assert "float64 goal_x  # [m]; RCL REAL; Planner assumes 0 <= goal_x <= 100\n" in nav
     _parse_all(out)  # every interface file parses
     pys = sorted(out.rglob("*.py"))
     assert len(pys) == 5 * len(want) + 1  # per node: __init__, node, contract, logic, setup; one launch file

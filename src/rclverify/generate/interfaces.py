@@ -14,7 +14,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from ..rcl.types import Checked, CheckedNode
-from .typemap import STANDARD_PACKAGES, Section, TypeMapper
+from .typemap import STANDARD_PACKAGES, Section, TypeMapper, snake
 
 
 @dataclass
@@ -73,8 +73,18 @@ def is_standard(ros_type: str) -> bool:
 
 
 def _unit(node: CheckedNode, prefix: str, var: str) -> str:
+    """The field's comment head: its unit (``[m/s]``) and, for an input, the bounds the node's
+    assumption puts on it by top-level conjuncts (``assumed 0 <= charge <= 100``)."""
     u = node.unit_of(prefix, var)
-    return str(u) if u is not None else ""
+    parts = [str(u)] if u is not None else []
+    if prefix == "in":
+        from ..backends.property_tests.strategies import assumption_bounds
+        bd = assumption_bounds(node).get(var)
+        if bd is not None and (bd.lo is not None or bd.hi is not None):
+            lo = f"{bd.lo} {'<' if bd.lo_strict else '<='} " if bd.lo is not None else ""
+            hi = f" {'<' if bd.hi_strict else '<='} {bd.hi}" if bd.hi is not None else ""
+            parts.append(f"{node.name} assumes {lo}{snake(var)}{hi}")
+    return "; ".join(parts)
 
 
 def _add_var(pkgs: dict[str, InterfacePackage], pkg: str, section: Section, node: CheckedNode,

@@ -81,7 +81,9 @@ class Section:
         """Add ``f`` unless a field of that name is there (same type: shared; another type: suffixed)."""
         for old in self.fields:
             if old.name == f.name:
-                if old.ros_type == f.ros_type:
+                if old.ros_type == f.ros_type:  # shared: keep what each user's comment adds
+                    extra = [c for c in f.comment.split("; ") if c and c not in old.comment.split("; ")]
+                    old.comment = "; ".join([c for c in old.comment.split("; ") if c] + extra)
                     return
                 f = Field(f.ros_type, f"{f.name}_{len(self.fields)}", f.comment)
         self.fields.append(f)
