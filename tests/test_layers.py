@@ -147,7 +147,7 @@ LAYERS: list[tuple[str, tuple[str, ...]]] = [
     # an archive of the evidence with its manifest), ``rclverify ros ...``
     # (ros/cli.py) and ``init --from-ros`` (ros/skeleton.py, on scaffold's
     # templates).
-    ("cli", ("rclverify.cli", "rclverify.requirements.show", "rclverify.scaffold", "rclverify.bundle", "rclverify.ros.cli",
+    ("cli", ("rclverify.cli", "rclverify.requirements.show", "rclverify.scaffold", "rclverify.generate", "rclverify.bundle", "rclverify.ros.cli",
              "rclverify.ros.skeleton")),
 ]
 

@@ -610,6 +610,8 @@ def main(argv: Sequence[str] | None = None) -> int:
 
     from .ros.cli import add_parsers as add_ros_parsers
     add_ros_parsers(sub)
+    from .generate.cli import add_parsers as add_generate_parsers
+    add_generate_parsers(sub)
     m = add("monitor", cmd_monitor, "check recorded runs (ROSMonitoring logs, ROS bags) against every "
             "node's contract", True)
     m.add_argument("traces", nargs="*", metavar="TRACE", help="a .jsonl log, a .bag, a ROS 2 bag directory or .mcap")

@@ -1,0 +1,10 @@
+"""``rclverify generate``: from checked RCL contracts to ROS 2 packages (docs/generate.md).
+
+The paper's reversed workflow (Luckcuck et al., lines 1864-1866): write and
+check the contracts first, then produce the message type definitions and the
+node skeletons from them.  Modules by job: :mod:`.typemap` (RCL types to ROS
+interface fields), :mod:`.interfaces` (the interface packages),
+:mod:`.nodes` (one ament_python package per node and the launch files),
+:mod:`.writer` (rendering and writing, generated-every-time versus
+generated-once files), :mod:`.cli` (the command).
+"""

@@ -1,0 +1,137 @@
+"""The interface packages of a system: ``.msg``, ``.srv`` and ``.action`` from the contracts.
+
+Every ROS type a contract names in ``topics(...)``, ``services(...)`` or
+``actions(...)`` (docs/rcl-language.md) whose package is not a standard one
+(:data:`.typemap.STANDARD_PACKAGES`) is defined here: a message type gets one
+field per contract variable that ``matches`` it (the union over all nodes),
+a service its request and response variables, an action its goal, result and
+feedback variables (the ``.action`` order; the contract writes goal,
+feedback, result).  Units of measure are comments in REP 103 style
+(``# [m/s]``).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from ..rcl.types import Checked, CheckedNode
+from .typemap import STANDARD_PACKAGES, Section, TypeMapper, snake
+
+
+@dataclass
+class Interface:
+    """One interface file: ``kind`` ``msg``/``srv``/``action``, its sections in file order."""
+
+    pkg: str
+    name: str
+    kind: str
+    sections: list[Section]
+    users: set[str] = field(default_factory=set)
+
+    @property
+    def path(self) -> str:
+        """Path inside the package: ``msg/Name.msg``."""
+        return f"{self.kind}/{self.name}.{self.kind}"
+
+    @property
+    def ros_name(self) -> str:
+        """``pkg/msg/Name`` (the full interface name rosbags and rosidl use)."""
+        return f"{self.pkg}/{self.kind}/{self.name}"
+
+
+@dataclass
+class InterfacePackage:
+    """A generated interface package: its interfaces and the packages they depend on."""
+
+    name: str
+    interfaces: dict[str, Interface] = field(default_factory=dict)
+    mapper: TypeMapper | None = None
+
+    def all_interfaces(self) -> list[Interface]:
+        """Declared interfaces, then the nested messages the mapping made (sorted by path)."""
+        out = dict(self.interfaces)
+        assert self.mapper is not None
+        for n, s in self.mapper.nested.items():
+            out.setdefault(f"msg/{n}", Interface(self.name, n, "msg", [s]))
+        return sorted(out.values(), key=lambda i: i.path)
+
+    def depends(self) -> list[str]:
+        """Other packages whose types the fields use (``std_msgs`` for ``{}``)."""
+        deps = {f.ros_type.split("/")[0] for i in self.all_interfaces() for s in i.sections for f in s.fields
+                if "/" in f.ros_type}
+        return sorted(deps - {self.name})
+
+
+def split_type(ros_type: str) -> tuple[str, str]:
+    """``pkg/Name`` or ``pkg/msg/Name`` -> ``(pkg, Name)``."""
+    parts = ros_type.split("/")
+    return parts[0], parts[-1]
+
+
+def is_standard(ros_type: str) -> bool:
+    """The type belongs to a package every ROS 2 distribution ships."""
+    return split_type(ros_type)[0] in STANDARD_PACKAGES
+
+
+def _unit(node: CheckedNode, prefix: str, var: str) -> str:
+    """The field's comment head: its unit (``[m/s]``) and, for an input, the bounds the node's
+    assumption puts on it by top-level conjuncts (``assumed 0 <= charge <= 100``)."""
+    u = node.unit_of(prefix, var)
+    parts = [str(u)] if u is not None else []
+    if prefix == "in":
+        from ..backends.property_tests.strategies import assumption_bounds
+        bd = assumption_bounds(node).get(var)
+        if bd is not None and (bd.lo is not None or bd.hi is not None):
+            lo = f"{bd.lo} {'<' if bd.lo_strict else '<='} " if bd.lo is not None else ""
+            hi = f" {'<' if bd.hi_strict else '<='} {bd.hi}" if bd.hi is not None else ""
+            parts.append(f"{node.name} assumes {lo}{snake(var)}{hi}")
+    return "; ".join(parts)
+
+
+def _add_var(pkgs: dict[str, InterfacePackage], pkg: str, section: Section, node: CheckedNode,
+             prefix: str, var: str) -> None:
+    table = node.inputs if prefix == "in" else node.outputs
+    decls = node.node.inputs if prefix == "in" else node.node.outputs
+    texpr = next((d.type for d in decls if d.name == var), None)
+    mapper = pkgs[pkg].mapper
+    assert mapper is not None
+    mapper.field(section, var, table[var], texpr, _unit(node, prefix, var))
+
+
+def interface_packages(checked: Checked) -> dict[str, InterfacePackage]:
+    """The interface packages the contracts of ``checked`` need, by package name.
+
+    Returns ``{pkg: InterfacePackage}``; standard packages are absent.  A variable without a
+    ``matches`` clause adds no field.  Raises ``ValueError`` for an RCL type with no ROS field."""
+    pkgs: dict[str, InterfacePackage] = {}
+
+    def package(name: str) -> InterfacePackage:
+        if name not in pkgs:
+            pkgs[name] = InterfacePackage(name, mapper=TypeMapper(name))
+        return pkgs[name]
+
+    for cn in checked.nodes.values():
+        for t in cn.node.topics:
+            if is_standard(t.msg_type):
+                continue
+            pkg, name = split_type(t.msg_type)
+            ip = package(pkg)
+            iface = ip.interfaces.setdefault(f"msg/{name}", Interface(pkg, name, "msg", [Section()]))
+            iface.users.add(cn.name)
+            if t.match is not None and t.match.prefix in ("in", "out"):
+                _add_var(pkgs, pkg, iface.sections[0], cn, t.match.prefix, t.match.name)
+        for link in cn.node.links:
+            if is_standard(link.ros_type):
+                continue
+            pkg, name = split_type(link.ros_type)
+            ip = package(pkg)
+            kind = "srv" if link.kind == "service" else "action"
+            n_sections = 2 if kind == "srv" else 3
+            iface = ip.interfaces.setdefault(f"{kind}/{name}",
+                                             Interface(pkg, name, kind, [Section() for _ in range(n_sections)]))
+            iface.users.add(cn.name)
+            # contract order: request, response / goal, feedback, result; file order: goal, result, feedback
+            order = (0, 1) if kind == "srv" else (0, 2, 1)
+            for part, where in zip(link.parts, order):
+                if part.prefix in ("in", "out"):
+                    _add_var(pkgs, pkg, iface.sections[where], cn, part.prefix, part.name)
+    return pkgs

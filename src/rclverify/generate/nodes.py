@@ -1,0 +1,109 @@
+"""One ament_python package per node of the contracts, and the launch files of the system.
+
+The node's ROS interface is read from its contract (docs/rcl-language.md):
+a ``topics(...)`` entry matching an input is a subscription, one matching an
+output a publication (the topic's name is the entry's name, its type the
+entry's type); ``services(...)`` ``serves`` is a service server, ``calls`` a
+client; ``actions(...)`` the same with action servers and clients.  The
+ROS node name is the contract's node name.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from ..rcl.types import Checked, CheckedNode
+from .interfaces import split_type
+from .typemap import snake
+
+#: Default QoS depth of the generated publishers and subscriptions (rclpy's keep-last history).
+QOS_DEPTH = 10
+
+
+@dataclass(frozen=True)
+class Endpoint:
+    """A publisher, subscription, service or action end of a node.
+
+    ``role`` is ``pub``/``sub``/``service_server``/``service_client``/``action_server``/
+    ``action_client``; ``ros_type`` is ``pkg/Name``; ``var`` the contract variable (``in.x``)."""
+
+    role: str
+    name: str
+    ros_type: str
+    var: str
+
+    @property
+    def pkg(self) -> str:
+        """The interface package of the type."""
+        return split_type(self.ros_type)[0]
+
+    @property
+    def cls(self) -> str:
+        """The Python class of the type."""
+        return split_type(self.ros_type)[1]
+
+    @property
+    def kind(self) -> str:
+        """``msg``, ``srv`` or ``action`` (the Python module the class is imported from)."""
+        return "msg" if self.role in ("pub", "sub") else "srv" if self.role.startswith("service") else "action"
+
+    @property
+    def attr(self) -> str:
+        """The attribute of the node object holding the end."""
+        return f"{self.role}_{snake(self.name)}"
+
+
+@dataclass
+class NodePackage:
+    """A node's package: ``package`` (Python package name), ``ros_name`` and its ends."""
+
+    ros_name: str
+    package: str
+    endpoints: list[Endpoint] = field(default_factory=list)
+    contract_file: str = ""
+
+    def imports(self) -> list[tuple[str, str, list[str]]]:
+        """``(pkg, kind, [classes])`` for the ``from pkg.kind import ...`` lines, sorted."""
+        by: dict[tuple[str, str], set[str]] = {}
+        for e in self.endpoints:
+            by.setdefault((e.pkg, e.kind), set()).add(e.cls)
+        return [(p, k, sorted(c)) for (p, k), c in sorted(by.items())]
+
+    def depends(self) -> list[str]:
+        """Interface packages the node uses."""
+        return sorted({e.pkg for e in self.endpoints})
+
+    def has(self, *roles: str) -> bool:
+        """Whether some end has one of ``roles``."""
+        return any(e.role in roles for e in self.endpoints)
+
+
+def node_package(cn: CheckedNode) -> NodePackage:
+    """The package of node ``cn`` (one end per topic entry with a ``matches`` clause and per link)."""
+    np = NodePackage(cn.name, snake(cn.name), contract_file=cn.node.loc.file)
+    seen: set[tuple[str, str]] = set()
+    for t in cn.node.topics:
+        if t.match is None or t.match.prefix not in ("in", "out"):
+            continue
+        role = "sub" if t.match.prefix == "in" else "pub"
+        if (role, t.field) in seen:
+            continue
+        seen.add((role, t.field))
+        np.endpoints.append(Endpoint(role, t.field, t.msg_type, f"{t.match.prefix}.{t.match.name}"))
+    for link in cn.node.links:
+        role = f"{link.kind}_{'server' if link.role == 'serves' else 'client'}"
+        if (role, link.name) in seen:
+            continue
+        seen.add((role, link.name))
+        np.endpoints.append(Endpoint(role, link.name, link.ros_type,
+                                     ", ".join(f"{p.prefix}.{p.name}" for p in link.parts)))
+    return np
+
+
+def node_packages(checked: Checked) -> list[NodePackage]:
+    """One package per node, in source order; raises ``ValueError`` when two nodes share a package name."""
+    out = [node_package(cn) for cn in checked.nodes.values()]
+    names = [p.package for p in out]
+    dup = sorted({n for n in names if names.count(n) > 1})
+    if dup:
+        raise ValueError(f"two nodes give the same package name {dup[0]!r}")
+    return out

@@ -1,0 +1,162 @@
+"""RCL types to ROS 2 interface field types (docs/generate.md, "Type mapping").
+
+Scalars: ``REAL`` float64, ``INTEGER`` int64, ``NATURAL`` uint64, ``BOOL``
+bool, ``STRING`` string.  An enumeration is a ``uint8`` with one named
+constant per value in the message that holds the field.  A constructor set,
+a tuple and a function table become nested messages of the interface
+package; sets and sequences become unbounded arrays (an array of arrays is
+wrapped in a nested message, which ROS 2 requires).  The empty type ``{}``
+is ``std_msgs/Empty``.  Field and constant names follow the ROS 2 interface
+rules (design article "Interface definition", rosidl): fields lower
+snake_case, constants upper case, message names CamelCase.
+"""
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass, field
+
+from ..rcl import ast
+from ..rcl.types import DataT, EmptyT, EnumT, FuncT, Scalar, SeqT, SetT, TupleT, Type
+
+#: RCL scalar name -> ROS 2 primitive type
+SCALARS: dict[str, str] = {"REAL": "float64", "INTEGER": "int64", "NATURAL": "uint64", "BOOL": "bool",
+                           "STRING": "string"}
+
+#: Interface packages every ROS 2 distribution ships: their types are used, never generated.
+STANDARD_PACKAGES = frozenset({
+    "std_msgs", "geometry_msgs", "sensor_msgs", "nav_msgs", "builtin_interfaces", "action_msgs", "std_srvs",
+    "diagnostic_msgs", "shape_msgs", "stereo_msgs", "trajectory_msgs", "visualization_msgs", "tf2_msgs",
+    "example_interfaces", "unique_identifier_msgs", "rcl_interfaces", "lifecycle_msgs", "statistics_msgs"})
+
+
+def snake(name: str) -> str:
+    """A ROS 2 field name from an RCL identifier: ``radiationStatus`` -> ``radiation_status``,
+    ``wayP`` -> ``way_p``, ``x'`` -> ``x_p``.  The result matches ``[a-z][a-z0-9_]*`` with no
+    double or trailing underscore (rosidl's field-name rule)."""
+    s = name.replace("'", "_p")
+    s = re.sub(r"(?<=[a-z0-9])([A-Z])", r"_\1", s).lower()
+    s = re.sub(r"[^a-z0-9_]", "_", s)
+    s = re.sub(r"_+", "_", s).strip("_")
+    if not s or not s[0].isalpha():
+        s = "f_" + s
+    return s
+
+
+def camel(name: str) -> str:
+    """A ROS 2 message name from an RCL identifier (``RadStat`` stays, ``way_p`` -> ``WayP``)."""
+    parts = re.split(r"[^A-Za-z0-9]+", name.replace("'", "P"))
+    s = "".join(p[:1].upper() + p[1:] for p in parts if p)
+    if not s or not s[0].isalpha():
+        s = "T" + s
+    return s
+
+
+@dataclass
+class Field:
+    """One line ``<ros_type> <name>  # comment`` of an interface definition."""
+
+    ros_type: str
+    name: str
+    comment: str = ""
+
+
+@dataclass
+class Constant:
+    """``uint8 NAME=value  # comment``."""
+
+    ros_type: str
+    name: str
+    value: int
+    comment: str = ""
+
+
+@dataclass
+class Section:
+    """The fields and constants of a message, or one part of a service or action."""
+
+    fields: list[Field] = field(default_factory=list)
+    constants: list[Constant] = field(default_factory=list)
+
+    def add_field(self, f: Field) -> None:
+        """Add ``f`` unless a field of that name is there (same type: shared; another type: suffixed)."""
+        for old in self.fields:
+            if old.name == f.name:
+                if old.ros_type == f.ros_type:  # shared: keep what each user's comment adds
+                    extra = [c for c in f.comment.split("; ") if c and c not in old.comment.split("; ")]
+                    old.comment = "; ".join([c for c in old.comment.split("; ") if c] + extra)
+                    return
+                f = Field(f.ros_type, f"{f.name}_{len(self.fields)}", f.comment)
+        self.fields.append(f)
+
+    def add_constant(self, c: Constant) -> None:
+        """Add ``c`` unless a constant of that name is there."""
+        if all(old.name != c.name for old in self.constants):
+            self.constants.append(c)
+
+
+class TypeMapper:
+    """Maps resolved RCL types to ROS 2 field types of interface package ``pkg``.
+
+    ``nested`` collects the nested messages made on the way (name -> section),
+    to be written as ``msg/<Name>.msg`` of ``pkg``.
+    """
+
+    def __init__(self, pkg: str) -> None:
+        self.pkg = pkg
+        self.nested: dict[str, Section] = {}
+
+    def field(self, section: Section, name: str, t: Type, texpr: ast.TypeExpr | None = None,
+              comment: str = "") -> None:
+        """Add the field for RCL variable ``name`` of type ``t`` (declared as ``texpr``) to ``section``."""
+        hint = texpr.name if isinstance(texpr, ast.TName) else camel(name)
+        ros_type = self.ros_type(t, hint, section)
+        note = f"RCL {texpr.name} = {t}" if isinstance(texpr, ast.TName) else f"RCL {t}"
+        section.add_field(Field(ros_type, snake(name), "; ".join(x for x in (comment, note) if x)))
+
+    def ros_type(self, t: Type, hint: str, holder: Section) -> str:
+        """The ROS 2 type of a field of RCL type ``t``; enumeration constants go to ``holder``.
+
+        ``hint`` names the nested message a structured type needs.  Raises ``ValueError`` for a
+        type no interface field can hold (none exists among RCL's resolved types today)."""
+        if isinstance(t, Scalar):
+            return SCALARS[t.name]
+        if isinstance(t, EnumT):
+            prefix = snake(t.name).upper()
+            for i, v in enumerate(t.values):
+                holder.add_constant(Constant("uint8", f"{prefix}_{snake(v).upper()}", i, f"{t.name} value {v}"))
+            return "uint8"
+        if isinstance(t, EmptyT):
+            return "std_msgs/Empty"
+        if isinstance(t, (SetT, SeqT)):
+            inner = self.ros_type(t.elem, hint + "Item", holder)
+            if inner.endswith("[]"):  # ROS 2 has no array of arrays: wrap the inner array
+                inner = self._nested(hint + "Item", lambda s: s.add_field(Field(inner, "elems")))
+            return inner + "[]"
+        if isinstance(t, TupleT):
+            def fill(s: Section) -> None:
+                for k, e in enumerate(t.elems):
+                    s.add_field(Field(self.ros_type(e, f"{hint}E{k}", s), f"e{k}", f"RCL {e}"))
+            return self._nested(camel(hint) if camel(hint) != hint else hint, fill)
+        if isinstance(t, DataT):
+            def fill_data(s: Section) -> None:
+                s.add_field(Field("uint8", "ctor", "which constructor"))
+                for i, (cname, args) in enumerate(t.ctors):
+                    s.add_constant(Constant("uint8", snake(cname).upper(), i, f"constructor {cname}"))
+                    for k, a in enumerate(args):
+                        s.add_field(Field(self.ros_type(a, f"{t.name}{camel(cname)}{k}", s),
+                                          f"{snake(cname)}_{k}", f"argument {k + 1} of {cname}, RCL {a}"))
+            return self._nested(camel(t.name), fill_data)
+        if isinstance(t, FuncT):
+            def fill_fn(s: Section) -> None:
+                for k, a in enumerate(t.args):
+                    s.add_field(Field(self.ros_type(a, f"{hint}Arg{k}", s), f"arg{k}", f"RCL {a}"))
+                s.add_field(Field(self.ros_type(t.result, f"{hint}Value", s), "value", f"RCL {t.result}"))
+            return self._nested(camel(hint) + "Entry", fill_fn) + "[]"
+        raise ValueError(f"no ROS 2 field type for RCL type {t}")
+
+    def _nested(self, name: str, fill) -> str:  # type: ignore[no-untyped-def]
+        if name not in self.nested:
+            s = Section()
+            self.nested[name] = s  # registered first: a recursive reference ends here
+            fill(s)
+        return f"{self.pkg}/{name}"

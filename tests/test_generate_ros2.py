@@ -1,0 +1,221 @@
+"""``rclverify generate ros2``: interfaces parse with rosbags' type system with the mapped field
+types, every generated Python file compiles, ``ros scan`` of the generated tree gives back the
+contracts' graph exactly, and regeneration keeps logic files (docs/generate.md)."""
+from __future__ import annotations
+
+import json
+import py_compile
+import shutil
+from pathlib import Path
+
+import pytest
+from rosbags.typesys import get_types_from_msg
+from rosbags.interfaces import Nodetype
+
+from rclverify.cli import main
+from rclverify.generate.writer import GENERATED, ONCE
+from rclverify.pipeline import Workspace
+
+ROOT = Path(__file__).resolve().parents[1]
+
+ALL_TYPES = """
+context {
+  Color : {red, green} ;
+  Cmd : { go(REAL, NATURAL), turn(INTEGER) } ;
+  Tab : NATURAL --> REAL ;
+  Pair : (REAL, INTEGER) ;
+  Nothing : {} ;
+}
+node Probe {
+  inputs( r : REAL [m], i : INTEGER, n : NATURAL, b : BOOL, s : STRING, c : Color, k : Cmd, f : Tab,
+          p : Pair, e : Nothing, q : seq(REAL), z : set(NATURAL), qq : seq(seq(BOOL)) )
+  outputs( o : BOOL )
+  topics( probe_msgs/All r matches(in.r), probe_msgs/All i matches(in.i), probe_msgs/All n matches(in.n),
+          probe_msgs/All b matches(in.b), probe_msgs/All s matches(in.s), probe_msgs/All c matches(in.c),
+          probe_msgs/All k matches(in.k), probe_msgs/All f matches(in.f), probe_msgs/All p matches(in.p),
+          probe_msgs/All e matches(in.e), probe_msgs/All q matches(in.q), probe_msgs/All z matches(in.z),
+          probe_msgs/All qq matches(in.qq), std_msgs/Bool o matches(out.o) )
+  assume( TRUE )
+  guarantee( out.o == in.b )
+}
+"""
+
+# field -> the type rosbags reads (BASE name, NAME type, or ('seq', inner))
+EXPECTED = {
+    "r": "float64", "i": "int64", "n": "uint64", "b": "bool", "s": "string", "c": "uint8",
+    "k": "probe_msgs/msg/Cmd", "f": ("seq", "probe_msgs/msg/TabEntry"), "p": "probe_msgs/msg/Pair",
+    "e": "std_msgs/msg/Empty", "q": ("seq", "float64"), "z": ("seq", "uint64"),
+    "qq": ("seq", "probe_msgs/msg/QqItem"),
+}
+
+
+def _ws(tmp: Path, rcl: str) -> Path:
+    ws = tmp / "ws"
+    (ws / "contracts").mkdir(parents=True)
+    (ws / "contracts" / "sys.rcl").write_text(rcl)
+    (ws / "contracts" / "plan.yaml").write_text("contracts: [contracts/sys.rcl]\n")
+    return ws
+
+
+def _simple(t: tuple) -> object:
+    kind, arg = t
+    if kind == Nodetype.BASE:
+        return arg[0]
+    if kind == Nodetype.NAME:
+        return arg
+    assert kind == Nodetype.SEQUENCE
+    return ("seq", _simple(arg[0]))
+
+
+def _parse_all(out: Path) -> dict[str, tuple]:
+    """Every interface file parsed with rosbags: full type name -> (constants, fields)."""
+    types: dict[str, tuple] = {}
+    for f in sorted(out.glob("*/msg/*.msg")) + sorted(out.glob("*/srv/*.srv")) + sorted(out.glob("*/action/*.action")):
+        pkg, kind, name = f.parent.parent.name, f.parent.name, f.stem
+        parts = f.read_text().split("\n---\n")
+        suffixes = {"msg": [""], "srv": ["_Request", "_Response"], "action": ["_Goal", "_Result", "_Feedback"]}[kind]
+        assert len(parts) == len(suffixes), f
+        for text, suf in zip(parts, suffixes):
+            types.update(get_types_from_msg(text, f"{pkg}/{kind}/{name}{suf}"))
+    return types
+
+
+def test_every_rcl_type_maps_to_the_documented_ros_field(tmp_path: Path) -> None:
+    ws = _ws(tmp_path, ALL_TYPES)
+    assert main(["generate", "ros2", "-w", str(ws), "-o", str(tmp_path / "out")]) == 0
+    types = _parse_all(tmp_path / "out")
+    consts, fields = types["probe_msgs/msg/All"]
+    got = {n: _simple(t) for n, t in fields}
+    assert got == EXPECTED
+    assert ("COLOR_RED", "uint8", 0) in consts and ("COLOR_GREEN", "uint8", 1) in consts
+    cmd_consts, cmd_fields = types["probe_msgs/msg/Cmd"]
+    assert [c[0] for c in cmd_consts] == ["GO", "TURN"]
+    assert {n: _simple(t) for n, t in cmd_fields} == {"ctor": "uint8", "go_0": "float64", "go_1": "uint64",
+                                                      "turn_0": "int64"}
+    assert {n: _simple(t) for n, t in types["probe_msgs/msg/TabEntry"][1]} == {"arg0": "uint64", "value": "float64"}
+    assert {n: _simple(t) for n, t in types["probe_msgs/msg/QqItem"][1]} == {"elems": ("seq", "bool")}
+    assert "# [m]" in (tmp_path / "out/probe_msgs/msg/All.msg").read_text()
+    assert not (tmp_path / "out/std_msgs").exists()  # standard types are used, not generated
+
+
+def _graph_of_contracts(ws: Path) -> dict[str, set]:
+    checked = Workspace(ws, "contracts/plan.yaml").checked
+    g: dict[str, set] = {}
+    for cn in checked.nodes.values():
+        ends = set()
+        for t in cn.node.topics:
+            if t.match is not None and t.match.prefix in ("in", "out"):
+                pkg, name = t.msg_type.split("/")[0], t.msg_type.split("/")[-1]
+                ends.add(("subscribes" if t.match.prefix == "in" else "publishes", "/" + t.field, f"{pkg}/msg/{name}"))
+        for ln in cn.node.links:
+            pkg, name = ln.ros_type.split("/")[0], ln.ros_type.split("/")[-1]
+            kind = "srv" if ln.kind == "service" else "action"
+            ends.add((f"{ln.kind}_{'servers' if ln.role == 'serves' else 'clients'}", "/" + ln.name,
+                      f"{pkg}/{kind}/{name}"))
+        g["/" + cn.name] = ends
+    return g
+
+
+def _graph_of_scan(out: Path, tmp: Path) -> dict[str, set]:
+    js = tmp / "graph.json"
+    assert main(["ros", "scan", str(out), "--json", str(js)]) == 0
+    scan = json.loads(js.read_text())
+    g: dict[str, set] = {}
+    for n in scan["nodes"]:
+        ends = set()
+        for role in ("publishes", "subscribes", "service_servers", "service_clients", "action_servers",
+                     "action_clients"):
+            ends |= {(role, e["topic"], e["type"]) for e in n[role]}
+        g[n["name"]] = ends
+    assert not scan["unresolved"]
+    return g
+
+
+def _chain_system(n: int) -> str:
+    """``n`` nodes in a chain over std_msgs topics; node 0 serves a service and an action the last calls."""
+    lines = ["context { Mode : {idle, busy} ; }"]
+    for k in range(n):
+        links = ""
+        if k == 0:
+            links = ("  services( chain_msgs/Ask ask serves(in.q, out.a) )\n"
+                     "  actions( chain_msgs/Go go serves(in.g, out.fb, out.res) )\n")
+            io = "inputs( q : BOOL, g : REAL [m] ) outputs( x0 : REAL, a : Mode, fb : REAL, res : BOOL )"
+            topics = "topics( std_msgs/Float64 t0 matches(out.x0) )"
+        else:
+            extra_in = ", a : Mode, fb : REAL, res : BOOL" if k == n - 1 else ""
+            extra_out = ", q : BOOL, g : REAL [m]" if k == n - 1 else ""
+            if k == n - 1:
+                links = ("  services( chain_msgs/Ask ask calls(out.q, in.a) )\n"
+                         "  actions( chain_msgs/Go go calls(out.g, in.fb, in.res) )\n")
+            io = f"inputs( x{k - 1} : REAL{extra_in} ) outputs( x{k} : REAL{extra_out} )"
+            topics = f"topics( std_msgs/Float64 t{k - 1} matches(in.x{k - 1}), std_msgs/Float64 t{k} matches(out.x{k}) )"
+        lines.append(f"node N{k} {{\n  {io}\n  {topics}\n{links}  assume( TRUE )\n"
+                     f"  guarantee( out.x{k} >= 0 )\n}}")
+    return "\n".join(lines)
+
+
+@pytest.mark.parametrize("case", ["case_study", "warehouse", "chain30"])
+def test_ros_scan_of_the_generated_tree_is_the_contracts_graph(tmp_path: Path, case: str) -> None:
+    if case == "case_study":
+        ws = ROOT
+    elif case == "warehouse":
+        ws = ROOT / "examples" / "warehouse"
+    else:
+        ws = _ws(tmp_path, _chain_system(30))
+    out = tmp_path / "out"
+    assert main(["generate", "ros2", "-w", str(ws), "-o", str(out), "--system", "sys"]) == 0
+    want = _graph_of_contracts(ws)
+    assert _graph_of_scan(out, tmp_path) == want
+    if case == "chain30":
+        assert len(want) == 30
+    if case == "warehouse":  # units and the assumption's bounds as comments, from every user of the field
+        nav = (out / "warehouse_msgs/action/Navigate.action").read_text()
+        assert "float64 goal_x  # [m]; RCL REAL; Planner assumes 0 <= goal_x <= 100\n" in nav
+    _parse_all(out)  # every interface file parses
+    pys = sorted(out.rglob("*.py"))
+    assert len(pys) == 5 * len(want) + 1  # per node: __init__, node, contract, logic, setup; one launch file
+    for p in pys:
+        py_compile.compile(str(p), cfile=str(tmp_path / "c.pyc"), doraise=True)
+        first = p.read_text().splitlines()[0]
+        assert first in (f"# {GENERATED}", f"# {ONCE}"), p
+
+
+def test_regeneration_keeps_logic_and_names_the_logic_files_to_read(tmp_path: Path, capsys) -> None:
+    ws = _ws(tmp_path, _chain_system(3))
+    out = tmp_path / "out"
+    assert main(["generate", "ros2", "-w", str(ws), "-o", str(out)]) == 0
+    logic = out / "n1/n1/logic.py"
+    logic.write_text(logic.read_text() + "\n# hand-written\n")
+    capsys.readouterr()
+    assert main(["generate", "ros2", "-w", str(ws), "-o", str(out)]) == 0
+    msg = capsys.readouterr().out
+    assert "0 generated file(s) written" in msg and "warning" not in msg
+    # the interface of N2 changes (new topic); N1's does not
+    rcl = (ws / "contracts/sys.rcl").read_text().replace(
+        "std_msgs/Float64 t2 matches(out.x2)", "std_msgs/Float64 t2b matches(out.x2)")
+    (ws / "contracts/sys.rcl").write_text(rcl)
+    assert main(["generate", "ros2", "-w", str(ws), "-o", str(out)]) == 0
+    msg = capsys.readouterr().out
+    assert "n2/n2/logic.py: warning" in msg and "n1/n1/logic.py" not in msg
+    assert logic.read_text().endswith("# hand-written\n")
+    assert "'t2b'" in (out / "n2/n2/node.py").read_text()
+
+
+def test_a_contract_error_is_located_and_no_tree_is_written(tmp_path: Path, capsys) -> None:
+    ws = _ws(tmp_path, "node A { inputs( x : REAL ) outputs( y : REAL ) topics( ) assume( TRUE ) guarantee( out.z > 0 ) }")
+    assert main(["generate", "ros2", "-w", str(ws), "-o", str(tmp_path / "out")]) == 1
+    err = capsys.readouterr().err
+    assert "contracts/sys.rcl:1:" in err and "error" in err and "Traceback" not in err
+    assert not (tmp_path / "out").exists()
+
+
+def test_a_hand_written_file_at_a_generated_path_is_never_overwritten(tmp_path: Path, capsys) -> None:
+    ws = _ws(tmp_path, _chain_system(2))
+    out = tmp_path / "out"
+    (out / "n0" / "n0").mkdir(parents=True)
+    (out / "n0" / "n0" / "node.py").write_text("# mine\n")
+    assert main(["generate", "ros2", "-w", str(ws), "-o", str(out)]) == 1
+    err = capsys.readouterr().err
+    assert "n0/n0/node.py: error: exists and is not a generated file" in err and "Traceback" not in err
+    assert (out / "n0" / "n0" / "node.py").read_text() == "# mine\n"
+    assert not (out / "n1").exists()  # nothing written
