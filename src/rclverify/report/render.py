@@ -31,6 +31,7 @@ from ..evidence.store import dumps
 from ..cache.memo import last_call
 from . import diagram
 from .fragments import FragmentCache, cached_dumps
+from .culprits import culprit_nodes
 from .problems import group_problems
 from . import htmlfilters
 from .textfmt import FOLD_CHARS, breakable, formula_html, formula_lines, natural_key, natural_sorted, natural_within
@@ -479,18 +480,6 @@ def dashboard(report: Mapping[str, Any], evidence_of: Mapping[str, Sequence[tupl
     return {"columns": columns, "rows": rows}
 
 
-def culprit_nodes(groups: Iterable[Any]) -> set[str]:
-    """The nodes a problem's culprit (``groups``: the problems by root cause)
-    is a guarantee or the contract of (``guarantee:Node:k``,
-    ``contract:Node``; issue 48: the dashboard marks them, so that the first
-    screen blames the culprit, not its victims)."""
-    out = set()
-    for g in groups:
-        for c in g.get("culprits") or () if isinstance(g, Mapping) else ():
-            kind, _, rest = str(c.get("id", "")).partition(":")
-            if kind in ("guarantee", "contract") and rest:
-                out.add(rest.split(":", 1)[0])
-    return out
 
 
 def view(report: Mapping[str, Any]) -> dict[str, Any]:

@@ -31,7 +31,8 @@ def node_rows(report: Mapping[str, Any]) -> list[dict[str, Any]]:
     """One row per node of ``report``: ``{"node", "status", "obligations"
     (status -> count), "sc_proved", "sc_total", "health_problems",
     "health_open", "health_total", "health_warnings", "unverified" (``["g<k>"]``: the node's
-    guarantees no obligation covers)}``, worst status first, then report order."""
+    guarantees no obligation covers), "culprit" (its guarantee or contract is a problem's culprit,
+    :mod:`.culprits`)}``, worst status first, then report order."""
     def by_node(items: list[Mapping[str, Any]]) -> dict[Any, list[Mapping[str, Any]]]:
         # one pass per kind: a scan of every item per node was quadratic in the system size
         out: dict[Any, list[Mapping[str, Any]]] = {}
@@ -40,6 +41,8 @@ def node_rows(report: Mapping[str, Any]) -> list[dict[str, Any]]:
         return out
     obligations, sides, findings = (by_node(report[k]) for k in ("obligations", "side_conditions", "findings"))
     unverified = by_node(list(report.get("unverified") or ()))
+    from .culprits import culprit_nodes
+    blamed = culprit_nodes(report.get("problems") or ())
     rows = []
     for k, n in enumerate(report["nodes"]):
         name = n["name"]
@@ -53,7 +56,8 @@ def node_rows(report: Mapping[str, Any]) -> list[dict[str, Any]]:
                      "health_problems": sum(f["status"] in ("problem", "error") for f in fs),
                      "health_open": sum(f["status"] == "inconclusive" for f in fs), "health_total": len(fs),
                      "health_warnings": sum(f["status"] == "warning" for f in fs),
-                     "unverified": [f"g{u['guarantee']}" for u in unverified.get(name, [])]})
+                     "unverified": [f"g{u['guarantee']}" for u in unverified.get(name, [])],
+                     "culprit": name in blamed})
     rows.sort(key=lambda r: (-_rank(r["status"]), r["order"]))
     return rows
 
@@ -255,7 +259,8 @@ def summary_table(report: Mapping[str, Any], colour: bool, rows: list[dict[str, 
         table.add_column(head, footer=foot, overflow="fold", no_wrap=head in ("node", "status"))
     for r in shown:
         st = f"[{_COLOUR.get(r['status'], 'red')}]{r['status']}[/]" if colour else r["status"]
-        cells = [r["node"], st, _counts(r["obligations"], colour),
+        # a node whose guarantee or contract is a problem's culprit: where the repair goes (issue 48)
+        cells = [r["node"] + (" (culprit)" if r.get("culprit") else ""), st, _counts(r["obligations"], colour),
                  f"{r['sc_proved']}/{r['sc_total']} proved" if r["sc_total"] else "-", _health(r)]
         if gaps:
             own = r.get("unverified", [])
