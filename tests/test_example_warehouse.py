@@ -250,3 +250,15 @@ def test_declaring_the_units_makes_it_a_located_error_at_both_ends(tmp_path: Pat
     assert any("lidar_driver.rcl:9:12: error:" in x for x in lines)
     assert any("controller.rcl:10:11: error:" in x for x in lines)
     assert all("a factor of 1000" in x for x in lines)
+
+
+def test_sarif_puts_a_failed_side_condition_at_the_guarantee_to_repair(runs: dict[str, Any]) -> None:
+    """Issue 48: the CI annotation of a failed side condition landed on the innocent consumer."""
+    from rclverify.report.sarif import sarif_log
+    results = sarif_log(runs["seeded"])["runs"][0]["results"]
+    sc = next(r for r in results if r["ruleId"] == "RCL-SC-REFUTED"
+              and r["properties"]["sideCondition"] == "Controller.sc2")
+    assert sc["locations"][0]["physicalLocation"]["artifactLocation"]["uri"] == "contracts/lidar_driver.rcl"
+    rel = sc["relatedLocations"][0]
+    assert rel["physicalLocation"]["artifactLocation"]["uri"] == "contracts/controller.rcl"
+    assert rel["message"]["text"] == "the assumption it fails"

@@ -367,12 +367,35 @@ def _attach_diagnoses(report: Mapping[str, Any], results: Sequence[dict[str, Any
         if d is None:
             continue
         res["properties"]["diagnosis"] = d["sentence"]
+        if res["partialFingerprints"]["rclverifyItem/v1"].startswith("side-condition:"):
+            _at_the_culprit(res, d)
         # what Z3 showed and what it did not, with each fix: "checked by Z3" is no safety claim (docs/diagnosis.md)
         fixes = [sarif_fix(f"{r['summary']} Z3 shows: {r.get('proves') or 'the problem no longer follows'}; not shown: "
                            f"{r.get('not_shown') or 'that the change is safe'}.", r["edit"])
                  for r in d.get("repairs", []) if r.get("edit")]
         if fixes:
             res["fixes"] = fixes
+
+
+def _at_the_culprit(res: dict[str, Any], d: Mapping[str, Any]) -> None:
+    """A failed side condition is located at the guarantee its diagnosis blames
+    (a producer that publishes what the consumer does not accept), so that a CI
+    annotation lands on the node to repair; the consumer's assumption it fails
+    becomes a related location (issue 48; SARIF 2.1.0 §3.27.22)."""
+    guarantee = next((c for c in d.get("culprits") or () if isinstance(c, Mapping)
+                      and str(c.get("what", "")).startswith("guarantee") and c.get("source")), None)
+    if guarantee is None:
+        return
+    at = _location(str(guarantee["source"]))
+    if not at:
+        return
+    rel = res.get("locations") or []
+    res["locations"] = at
+    for i, loc in enumerate(rel):
+        loc["id"] = i
+        loc["message"] = {"text": "the assumption it fails"}
+    if rel:
+        res["relatedLocations"] = rel
 
 
 def _descriptor(r: Rule) -> dict[str, Any]:
