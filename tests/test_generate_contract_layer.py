@@ -27,16 +27,7 @@ def _load(path: Path, name: str):  # type: ignore[no-untyped-def]
 
 
 def _z3_verdict(node_name: str, values: dict) -> tuple[str, int]:
-    node = CHECKED.nodes[node_name]
-    for c in node.node.assumes:
-        ok, _ = check_concrete(c.formula, CHECKED, node, values)
-        if ok is not True:
-            return ("assumption violated" if ok is False else "inconclusive", 0)
-    for k, c in enumerate(node.node.guarantees, 1):
-        ok, _ = check_concrete(c.formula, CHECKED, node, values)
-        if ok is not True:
-            return ("violated" if ok is False else "inconclusive", k)
-    return ("satisfied", 0)
+    return _z3_verdict_of(CHECKED, node_name, values)
 
 
 _REAL = st.one_of(st.integers(-30, 130).map(float), st.floats(-1e4, 1e4, allow_nan=False),

@@ -29,7 +29,6 @@ them).
 from __future__ import annotations
 
 import bisect
-from collections import deque
 from typing import Any
 
 from .events import Event

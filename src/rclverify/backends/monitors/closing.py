@@ -23,9 +23,8 @@ from ...rcl import ast
 from ...rcl.printer import expr_to_rcl
 from ...traces.events import Event
 from ...traces.questions import Question
-from .verdicts import in_all, link_of, names, producers
+from .verdicts import WEAK as _WEAK, in_all, link_of, names, producers
 
-_WEAK = {"exact": 0, "double": 1, "tolerance": 2}
 
 class Closing:
     """The once-per-question parts of :class:`~.engine.NodeMonitor` (module docstring)."""

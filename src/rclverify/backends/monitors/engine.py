@@ -46,10 +46,8 @@ from ...values import render
 from .closing import Closing
 from .needs_answer import answer_decides
 from .outcome import Outcome, combine, skew_reason
-from .verdicts import LINK_TOPICS, NodeResult, Verdict, in_all, names, reads
+from .verdicts import WEAK as _WEAK, LINK_TOPICS, NodeResult, Verdict, in_all, names, reads
 
-#: How far a semantics is from exact arithmetic (the weakest one a verdict rests on is shown).
-_WEAK = {"exact": 0, "double": 1, "tolerance": 2}
 _NO_RULE = TopicRule()  # the rule of a topic the mapping does not name
 _NEVER = float("inf")
 _NO_TRIGGERS: frozenset[str] = frozenset()
@@ -501,13 +499,6 @@ class NodeMonitor(Closing):
             if state:
                 values.update(state)
             values.update(outs)
-        if keep and len(ks) == 1 and not self._trigger and ev.time <= q.due:  # one guarantee: the common case
-            k = ks[0]
-            judged = self._judges[k].quick(values) or self._judge(k, values)
-            if judged.truth is True and judged.semantics == "exact":
-                q.waiting.pop(k, None)
-                q.decided.add(k)
-                return _SATISFIED[q.info]
         return self._outcome(ks, values, self._owes_fn(q), q if keep else None, ev,
                              q.info)
 

@@ -24,6 +24,8 @@ VERDICTS = ("satisfied", "violated", "open", "assumption violated", "inconclusiv
 #: Topic suffixes of a service's or action's parts, in the order of ``Link.parts``
 #: (a service ``s`` is observed as ``s/request`` and ``s/response`` events, an
 #: action ``a`` as actionlib's ``a/goal``, ``a/feedback`` and ``a/result``).
+#: How far an arithmetic is from exact (the weakest one a verdict rests on is shown; logic/floatsem.py).
+WEAK = {"exact": 0, "double": 1, "tolerance": 2}
 #: Violations kept per node and run (each a few hundred bytes; the count is exact beyond it).
 KEPT_VIOLATIONS = 200
 LINK_TOPICS = {"service": ("request", "response"), "action": ("goal", "feedback", "result")}
@@ -207,4 +209,4 @@ def in_all(semantics: str) -> str:
     return f" (false in {text})"
 
 
-__all__ = ["KEPT_VIOLATIONS", "LINK_TOPICS", "VERDICTS", "NodeResult", "Verdict", "in_all", "link_of", "producers", "reads", "names"]
+__all__ = ["KEPT_VIOLATIONS", "LINK_TOPICS", "WEAK", "VERDICTS", "NodeResult", "Verdict", "in_all", "link_of", "producers", "reads", "names"]
