@@ -126,7 +126,10 @@ LAYERS: list[tuple[str, tuple[str, ...]]] = [
     # the stages and the commands; it imports the layers below only.
     # The deadlines stage (calculus/deadline_stage.py) writes and reads its sealed record
     # in the workspace, as the requirements stage does.
-    ("workspace", ("rclverify.workspace", "rclverify.requirements.stage", "rclverify.calculus.deadline_stage")),
+    # crosscheck/ (issue 50): the second solver's stage reads the stages' sealed records and re-decides their
+    # queries with cvc5; the report folds its verdicts in, so it sits with the workspace's stages.
+    ("workspace", ("rclverify.workspace", "rclverify.requirements.stage", "rclverify.calculus.deadline_stage",
+                   "rclverify.crosscheck")),
     # report/ and argument/ render the results; contract_texts.py makes the
     # texts of the contracts the report shows (RCL, LaTeX, lint), so it
     # belongs with the report.

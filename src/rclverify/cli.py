@@ -437,6 +437,8 @@ def cmd_bundle(args: argparse.Namespace) -> int:
     """Write the assessor's bundle, or (``--verify FILE``) check one against its manifest."""
     from .bundle.archive import verify_bundle, write_bundle
     from .bundle.manifest import BundleError
+    if args.recheck:
+        return _bundle_recheck(args.recheck)
     if args.verify:
         try:
             manifest = verify_bundle(Path(args.verify))
@@ -465,6 +467,28 @@ def cmd_bundle(args: argparse.Namespace) -> int:
     for m in manifest["missing"]:
         print(f"warning: {m}: named by the plan but does not exist; not in the bundle", file=sys.stderr)
     print(f"{out}: {len(manifest['files'])} file(s) and MANIFEST.json; check with: rclverify bundle --verify {out}")
+    return 0
+
+
+def _bundle_recheck(archive: str) -> int:
+    """``bundle --recheck``: re-decide every stored query of ``archive`` with both solvers (docs/second-solver.md)."""
+    from .bundle.archive import read_members
+    from .bundle.manifest import BundleError
+    from .crosscheck.recheck import recheck_members
+    try:
+        out = recheck_members(read_members(Path(archive)))
+    except BundleError as exc:
+        for problem in exc.problems:
+            print(f"{archive}: error: {problem}", file=sys.stderr)
+        return 1
+    for n in out.notes:
+        print(f"{archive}: note: {n}", file=sys.stderr)
+    for p in out.problems:
+        print(f"{archive}: error: {p}", file=sys.stderr)
+    if out.problems:
+        return 1
+    print(f"{archive}: {out.checked} discharging quer{'y' if out.checked == 1 else 'ies'} re-decided from the "
+          "bundle alone; every answer agrees with its record")
     return 0
 
 
@@ -590,6 +614,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     bnd = add("bundle", cmd_bundle, "write the assessor's bundle (reports, artifacts, plan, contracts, manifest)", True)
     bnd.add_argument("-o", "--output", help="archive to write (.tar.gz or .zip; default: <workspace name>-bundle.tar.gz)")
     bnd.add_argument("--verify", metavar="FILE", help="check the archive FILE against its manifest instead")
+    bnd.add_argument("--recheck", metavar="FILE",
+                     help="re-decide every stored query of the archive FILE with Z3 and cvc5 from the bundle "
+                          "alone and compare with the recorded verdicts instead")
     for sp in (rep, bnd):
         sp.add_argument("--no-wait", action="store_true",
                         help="exit 1 instead of waiting when a run is in progress in the workspace "

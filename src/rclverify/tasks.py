@@ -256,6 +256,19 @@ def act_deadlines(root: str) -> Any:
     return None
 
 
+def act_crosscheck(root: str, nodes: list[str]) -> Any:
+    """Decide every discharging query again with cvc5 (:mod:`rclverify.crosscheck.stage`, issue 50)."""
+    from .crosscheck.stage import stage_crosscheck
+    try:
+        index = stage_crosscheck(Path(root), nodes)
+    except OSError as exc:
+        return _io_fail(exc, root)
+    counts = index.get("counts", {})
+    print("second solver: " + (", ".join(f"{v} {k}" for k, v in counts.items()) or "nothing to re-decide")
+          + ("" if index.get("solver") else " (cvc5 is not installed)"))
+    return None
+
+
 def act_ground(root: str) -> Any:
     """The grounding stage (docs/ros.md): scan the plan's ``ros:`` section,
     hold the contracts against it; findings go to the report, never to a verdict."""
@@ -692,6 +705,16 @@ def _build_tasks(root: str | Path, plan_file: str) -> dict[str, Callable[[], Any
 
     ros_section = dict(index.ros) if index is not None else {}  # from the index: a no-op run loads no contract
 
+    def task_crosscheck() -> dict[str, Any]:
+        """Decide every discharging Z3 query again with cvc5 from its SMT-LIB2 text (docs/second-solver.md)."""
+        from .crosscheck.stage import INDEX as CROSS
+        deps = [at(ws.calculus(n)) for n in nodes] + [at(ws.health(n)) for n in nodes]
+        deps.append(at("artifacts/requirements/index.json"))
+        if deadline_nodes:
+            deps.append(at("artifacts/deadlines/index.json"))
+        return {"actions": [(act_crosscheck, [r, list(nodes)])], "file_dep": deps,
+                "targets": [at(CROSS)], "uptodate": [code, sealed], "verbosity": 2, "clean": True}
+
     def task_ground() -> dict[str, Any]:
         """Ground the contracts in the ROS software of the plan's ros: section (docs/ros.md)."""
         return {"actions": [(act_ground, [r])], "file_dep": [str(rootp / plan_file)] + contract_deps,
@@ -715,6 +738,7 @@ def _build_tasks(root: str | Path, plan_file: str) -> dict[str, Callable[[], Any
             deps.append(at("artifacts/ros/grounding.json"))
         if deadline_nodes:
             deps.append(at("artifacts/deadlines/index.json"))  # the deadlines task's target
+        deps.append(at("artifacts/crosscheck/index.json"))  # the second solver's verdicts
         for part, files in REPORT_PARTS.items():
             yield {"name": part, "doc": "reports/" + ", ".join(files), "actions": [(act_report, [r, part])],
                    "file_dep": deps, "uptodate": [code, sealed],
@@ -726,7 +750,8 @@ def _build_tasks(root: str | Path, plan_file: str) -> dict[str, Callable[[], Any
         """The whole pipeline: check, compose, health, export, run, report.  --strict fails on any open evidence."""
         # `requirements` (and `ground`) before `report`: reached only through the report's file dependencies,
         # they would make report:html wait and report:text run first (their fragment caches expect html first)
-        before = ["requirements"] + (["deadlines"] if deadline_nodes else []) + (["ground"] if ros_section else [])
+        before = (["requirements"] + (["deadlines"] if deadline_nodes else []) + ["crosscheck"]
+                  + (["ground"] if ros_section else []))
         return {"actions": [(act_verify, [r])], "task_dep": ["check", *before, "report"] if ok else ["check"],
                 "file_dep": [str(rootp / REPORTS[2])] if ok else [],
                 "params": [{"name": "strict", "long": "strict", "type": bool, "default": False,
@@ -736,7 +761,8 @@ def _build_tasks(root: str | Path, plan_file: str) -> dict[str, Callable[[], Any
     creators: dict[str, Callable[[], Any]] = {"task_check": task_check, "task_verify": task_verify}
     if ok:
         creators.update({"task_graph": task_graph, "task_node": task_node, "task_requirements": task_requirements,
-                         "task_evidence": task_evidence, "task_report": task_report})
+                         "task_evidence": task_evidence, "task_report": task_report,
+                         "task_crosscheck": task_crosscheck})
         if ros_section:
             creators["task_ground"] = task_ground
         if deadline_nodes:

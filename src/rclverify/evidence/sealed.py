@@ -31,7 +31,7 @@ from .store import SEAL, _sealed_text, seal_of, write_json
 
 #: Workspace-relative directories and files whose JSON records are sealed (:func:`is_sealed_path`).
 SEALED_DIRS = ("artifacts/requirements/", "artifacts/health/", "artifacts/calculus/", "artifacts/provenance/",
-               "artifacts/obligations/", "artifacts/deadlines/")
+               "artifacts/obligations/", "artifacts/deadlines/", "artifacts/crosscheck/")
 SEALED_FILES = ("artifacts/check/diagnostics.json", "artifacts/report/summary.json", "artifacts/ros/grounding.json",
                 "artifacts/check/index.json")
 

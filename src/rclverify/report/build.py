@@ -219,6 +219,12 @@ def build_report(ws: Workspace) -> dict[str, Any]:
             health[n] = [f if f["status"] == "error" else
                          {**f, "status": "stale", "message": note + f["status"] + ". " + f["message"]}
                          for f in health[n]]
+    from ..crosscheck.apply import load as load_second_solver
+    second = load_second_solver(ws.root)  # cvc5's verdicts: a proof the two solvers do not agree on is inconclusive
+    for n in checked.nodes:
+        comps[n] = {**comps[n], "side_conditions": [second.side_condition(sc)
+                                                    for sc in comps[n].get("side_conditions", [])]}
+        health[n] = [second.finding(f) for f in health[n]]
     # a counterexample shows the nodes involved only: the consumer and the producers of the linked variables
     side_conditions = [involved_model(sc) for n in checked.nodes for sc in comps[n].get("side_conditions", [])]
     sc_status = {n: worst([sc["status"] for sc in comps[n].get("side_conditions", [])], empty="discharged")
@@ -279,6 +285,7 @@ def build_report(ws: Workspace) -> dict[str, Any]:
     from ..plan.load import all_requirements
     from ..requirements.stage import read_records
     checks = read_records(ws, hashes)  # sealed and hashed: altered -> error, other inputs -> stale
+    checks = {k: second.requirement(v) or v for k, v in checks.items()}
     for r in all_requirements(plan):
         support: list[dict[str, Any]] = []
         for s in r.support:
@@ -292,7 +299,7 @@ def build_report(ws: Workspace) -> dict[str, Any]:
                              **requirement_check(current_record(r, checks.get(r.id)), st, g_status, sc_status)})
 
     from .deadlines import deadline_rows, fold_into, strict_ok as deadlines_ok
-    deadlines = deadline_rows(ws, hashes, g_status, ob_rows)  # rule D3, rolled into each requirement
+    deadlines = deadline_rows(ws, hashes, g_status, ob_rows, second)  # rule D3, rolled into each requirement
     fold_into(requirements, deadlines)
 
     derived = []
@@ -421,6 +428,7 @@ def involved_model(sc: Mapping[str, Any]) -> Mapping[str, Any]:
 #: The fields of a requirement's check record (requirements/check.py) the report carries.
 _CHECK_FIELDS = ("origin", "source", "formal", "assuming", "cone", "used", "traced_not_needed", "consistency",
                  "inconsistent_core", "vacuity", "vacuity_core", "counterexample", "failed_to_prevent", "reason", "smt2", "explanation",
+                 "solvers",  # the second solver's agreement (crosscheck/apply.py)
                  "temporal",  # a temporal requirement's verdict, k, bound and trace (requirements/temporal_check.py)
                  "traces",  # its recorded runs' verdicts (backends/monitors/temporal_evidence.py)
                  "duration_s")

@@ -58,12 +58,14 @@ def _spec_of(rec: Mapping[str, Any], spec: Any) -> bool:
 
 
 def deadline_rows(ws: Workspace, current: Mapping[str, str], g_status: Callable[[str, int], str],
-                  ob_rows: Sequence[Mapping[str, Any]]) -> list[dict[str, Any]]:
+                  ob_rows: Sequence[Mapping[str, Any]], second: Any = None) -> list[dict[str, Any]]:
     """One row per ``deadline:`` of ``ws``'s plan, in plan order (module
     docstring).  ``current``: path -> sha256 of the current snapshots and
     model (:func:`rclverify.workspace.current_snapshot_hashes`);
     ``g_status(node, k)``: a guarantee's evidence status; ``ob_rows``: the
     report's obligation rows (``id``, ``node``, ``backend``, ``status``).
+    ``second``: the second solver's verdicts (:class:`rclverify.crosscheck.apply.SecondSolver`),
+    which make a proved deadline they do not agree on inconclusive.
     Returns ``[]`` for a plan without deadlines."""
     from ..calculus.deadline_stage import INDEX, read_deadlines
     from ..calculus.deadlines import show_seconds as _show
@@ -86,6 +88,8 @@ def deadline_rows(ws: Workspace, current: Mapping[str, str], g_status: Callable[
             rows.append({**base, "verdict": "pending",
                          "reason": f"not decided yet for this path and bound ({INDEX}): run `doit verify`"})
             continue
+        if second is not None:
+            rec = second.deadline(rec)
         chain = [{**h, "status": g_status(str(h["node"]), int(h["guarantee"])),
                   "monitors": monitors.get(str(h["node"]), [])} for h in rec.get("chain") or []]
         verdict = str(rec.get("status"))
@@ -94,7 +98,7 @@ def deadline_rows(ws: Workspace, current: Mapping[str, str], g_status: Callable[
             reason = f"STALE: {reason}; recorded verdict {rec.get('recorded_status')}"
         rows.append({**base, "verdict": verdict if verdict in STATUS_OF else "error", "reason": reason,
                      "chain": chain, "total": rec.get("total"), "stamps": list(rec.get("stamps") or []),
-                     "smt2": str(rec.get("smt2") or "")})
+                     "smt2": str(rec.get("smt2") or ""), "solvers": rec.get("solvers")})
     for row in rows:
         # the timed guarantees the decision rests on: their evidence (the monitors check the stamps)
         row["evidence_status"] = worst([h["status"] for h in row["chain"]], empty="pending")

@@ -96,6 +96,9 @@ def roll_up(record: Mapping[str, Any] | None, g_status: Callable[[str, int], str
     if v == "refuted":
         who = ", ".join(p["label"] for p in record.get("failed_to_prevent", [])) or "no guarantee of the cone"
         return "refuted", "failed", f"Z3 found a counterexample that every premise allows; it is not prevented by: {who}"
+    if v != "proved" and record.get("recorded_verdict") == "proved" and isinstance(record.get("solvers"), dict):
+        return "inconclusive", "inconclusive", (f"Z3 proved it, but the second solver does not confirm it "
+                                                f"({record['solvers'].get('why')}): not proved (docs/second-solver.md)")
     if v != "proved":
         return "inconclusive", "inconclusive", f"Z3 could not decide it ({record.get('reason', 'unknown')}); not proved"
     if record.get("consistency") == "inconsistent":

@@ -1,0 +1,99 @@
+"""The second solver's verdicts folded into what the report shows.
+
+Every side condition, health finding and requirement record the report
+reads gets ``solvers``: ``{"agreement", "why", "cvc5", "proof", "smt2"}``
+from the sealed ``artifacts/crosscheck/index.json``
+(:mod:`.stage`).  Where the two solvers disagree, or cvc5 answered
+``unknown`` to what Z3 proved, the item reads ``inconclusive`` with both
+answers, never discharged or proved (issue 50; docs/second-solver.md).
+An item the stage did not see (it ran before the item was decided, or its
+record is altered) reads ``one solver`` with the reason.
+"""
+from __future__ import annotations
+
+from typing import Any, Mapping
+
+from .stage import DOWNGRADES
+
+_STAGE_MISSING = "the second-solver stage has not decided it (run `doit verify`)"
+
+
+class SecondSolver:
+    """The stage's rows by ``(kind, id)`` and the record's problem ('' when
+    its seal holds or it does not exist yet)."""
+
+    def __init__(self, rows: Mapping[tuple[str, str], dict[str, Any]], problem: str = "") -> None:
+        self.rows = dict(rows)
+        self.problem = problem
+
+    def solvers(self, kind: str, item_id: str, smt2: str | None = None) -> dict[str, Any]:
+        """The ``solvers`` object of one item (module docstring).  A row
+        whose query text is not the one the item names now (another
+        ``smt2`` path) is not believed."""
+        r = self.rows.get((kind, item_id))
+        if r is None or (smt2 is not None and r.get("smt2") != smt2):
+            why = f"second-solver record: {self.problem}" if self.problem else _STAGE_MISSING
+            return {"agreement": "one solver", "why": why, "cvc5": None, "proof": "", "smt2": smt2 or ""}
+        c = r.get("cvc5") if isinstance(r.get("cvc5"), dict) else None
+        return {"agreement": str(r.get("agreement")), "why": str(r.get("why", "")),
+                "cvc5": None if c is None else {k: c.get(k) for k in ("answer", "reason", "version", "proof_checked")},
+                "proof": (c or {}).get("proof", ""), "smt2": str(r.get("smt2", ""))}
+
+    def side_condition(self, sc: dict[str, Any]) -> dict[str, Any]:
+        """``sc`` (a side-condition row) with ``solvers``; a discharged one
+        the solvers do not agree on is ``inconclusive``."""
+        if sc.get("status") != "discharged":
+            return sc
+        s = self.solvers("side-condition", str(sc.get("id")), sc.get("smt2"))
+        if s["agreement"] in DOWNGRADES:
+            return {**sc, "status": "inconclusive", "solvers": s,
+                    "explanation": f"Not discharged: {s['why']} (second solver). Z3 alone: "
+                                   + str(sc.get("explanation", ""))}
+        return {**sc, "solvers": s}
+
+    def finding(self, f: dict[str, Any]) -> dict[str, Any]:
+        """A health finding with ``solvers``; an ``ok`` one the solvers do
+        not agree on is ``inconclusive``."""
+        if f.get("status") != "ok":
+            return f
+        s = self.solvers("health", str(f.get("id")), f.get("smt2"))
+        if s["agreement"] in DOWNGRADES:
+            return {**f, "status": "inconclusive", "solvers": s,
+                    "message": f"{f.get('message', '')} Not confirmed: {s['why']} (second solver)."}
+        return {**f, "solvers": s}
+
+    def requirement(self, rec: dict[str, Any] | None) -> dict[str, Any] | None:
+        """A requirement record with ``solvers``; a ``proved`` one the
+        solvers do not agree on has verdict ``inconclusive`` and the reason."""
+        if rec is None or rec.get("verdict") != "proved":
+            return rec
+        s = self.solvers("requirement", str(rec.get("id")), rec.get("smt2"))
+        if s["agreement"] in DOWNGRADES:
+            return {**rec, "verdict": "inconclusive", "recorded_verdict": "proved", "solvers": s,
+                    "reason": f"second solver: {s['why']}"}
+        return {**rec, "solvers": s}
+
+    def deadline(self, d: dict[str, Any]) -> dict[str, Any]:
+        """A deadline record with ``solvers``; a ``proved`` one the solvers
+        do not agree on is ``inconclusive``."""
+        if d.get("status") != "proved":
+            return d
+        s = self.solvers("deadline", str(d.get("requirement")), d.get("smt2"))
+        if s["agreement"] in DOWNGRADES:
+            return {**d, "status": "inconclusive", "solvers": s, "reason": f"second solver: {s['why']}"}
+        return {**d, "solvers": s}
+
+    def counts(self) -> dict[str, int]:
+        """How many items each agreement has (the report's headline)."""
+        out: dict[str, int] = {}
+        for r in self.rows.values():
+            a = str(r.get("agreement"))
+            out[a] = out.get(a, 0) + 1
+        return dict(sorted(out.items()))
+
+
+def load(root: Any) -> SecondSolver:
+    """The :class:`SecondSolver` of the workspace at ``root`` (a ``Path``)."""
+    from .stage import read_crosscheck
+    rows, problem = read_crosscheck(root)
+    return SecondSolver(rows, problem)

@@ -1,0 +1,113 @@
+"""Decide an SMT-LIB2 script with cvc5, from its text alone.
+
+The script is the one rclverify keeps for every Z3 query (``*.smt2`` under
+``artifacts/``, written by Z3's printer, :func:`rclverify.logic.query.smtlib_benchmark`).
+cvc5 (PyPI ``cvc5``, the solver's own Python API) parses it with its
+SMT-LIB 2.6 front end (``cvc5.InputParser``) and runs its commands; nothing
+of rclverify's model is used, so the answer is independent of the encoder
+that wrote the text.
+
+Rules (SMT-LIB 2.6 standard, section 4.2; cvc5 options reference):
+
+* a script without ``set-logic`` is run under ``ALL`` (Z3 writes none);
+* a script with several ``check-sat`` commands (a query and its retry
+  joined by ``(reset)``) is answered by its last one, the query the
+  recorded verdict rests on;
+* the budget is cvc5's deterministic resource limit per check
+  (``rlimit-per``, :data:`RLIMIT`), so the answer does not depend on the
+  machine's load; a wall-clock limit (:data:`WALL_S`) is only a safety net;
+* on ``unsat``, the proof is produced (``produce-proofs``) in cvc5's CPC
+  format and re-checked step by step by cvc5's internal proof checker
+  (``check-proofs``): a proof that does not check raises inside cvc5 and
+  is reported as ``error``, never as ``unsat``.
+"""
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+
+#: cvc5 resource units per check: some 150k units a second on the case
+#: study's heaviest quantified query, so about 10 s of work, the Z3 budget.
+RLIMIT = 1_500_000
+#: Wall-clock safety net per check, in milliseconds.
+WALL_MS = 60_000
+
+
+@dataclass(frozen=True)
+class Decision:
+    """cvc5's answer to one script.
+
+    ``answer``   ``sat`` / ``unsat`` / ``unknown`` / ``error`` (cvc5 rejected
+                 the script or its proof did not check);
+    ``reason``   cvc5's reason for ``unknown`` (``INCOMPLETE``,
+                 ``RESOURCEOUT``, ...) or the error message; '' otherwise;
+    ``proof``    the checked proof (CPC text) on ``unsat``, else '';
+    ``proof_checked`` the proof was re-checked by cvc5's proof checker;
+    ``version``  cvc5's version; ``duration_s`` wall time in seconds.
+    """
+
+    answer: str
+    reason: str
+    proof: str
+    proof_checked: bool
+    version: str
+    duration_s: float
+
+
+def version() -> str:
+    """cvc5's version string, '' when the package is not installed."""
+    try:
+        import cvc5
+    except ImportError:
+        return ""
+    return str(getattr(cvc5, "__version__", "")) or "unknown"
+
+
+def decide(text: str, name: str = "query.smt2", *, rlimit: int = RLIMIT, proofs: bool = True) -> Decision:
+    """Run the SMT-LIB2 script ``text`` in a fresh cvc5 solver.
+
+    ``name`` labels cvc5's messages; ``rlimit`` is the resource budget per
+    check; ``proofs`` asks for the checked proof of an ``unsat`` answer.
+    Returns a :class:`Decision`; never raises for a bad script (``error``
+    with cvc5's message).  Raises ``ImportError`` when cvc5 is missing.
+    """
+    import cvc5
+    t0 = time.perf_counter()
+    ver = version()
+    tm = cvc5.TermManager()
+    s = cvc5.Solver(tm)
+    try:
+        s.setOption("rlimit-per", str(int(rlimit)))
+        s.setOption("tlimit-per", str(WALL_MS))
+        if proofs:
+            s.setOption("produce-proofs", "true")
+            s.setOption("check-proofs", "true")
+            s.setOption("proof-format-mode", "cpc")
+        sm = cvc5.SymbolManager(tm)
+        parser = cvc5.InputParser(s, sm)
+        script = text if "(set-logic" in text else "(set-logic ALL)\n" + text
+        parser.setStringInput(cvc5.InputLanguage.SMT_LIB_2_6, script, name)
+        last = ""
+        while True:
+            cmd = parser.nextCommand()
+            if cmd.isNull():
+                break
+            out = str(cmd.invoke(s, sm) or "").strip()
+            if out.startswith("(error"):
+                return Decision("error", out, "", False, ver, time.perf_counter() - t0)
+            if out.split(" ", 1)[0] in ("sat", "unsat", "unknown"):
+                last = out
+        if not last:
+            return Decision("error", "the script has no check-sat", "", False, ver, time.perf_counter() - t0)
+        answer, _, why = last.partition(" ")
+        proof = ""
+        if answer == "unsat" and proofs:
+            proof = "\n".join(_text(s.proofToString(p)) for p in s.getProof())
+        return Decision(answer, why.strip("() "), proof, bool(proof), ver, time.perf_counter() - t0)
+    except Exception as e:  # noqa: BLE001 - cvc5's API raises its own exception type for what it rejects
+        return Decision("error", str(e).strip().splitlines()[0][:300] if str(e).strip() else type(e).__name__,
+                        "", False, ver, time.perf_counter() - t0)
+
+
+def _text(b: bytes | str) -> str:
+    return b.decode("utf-8", "replace") if isinstance(b, bytes) else b

@@ -1,0 +1,84 @@
+"""The items a second solver re-decides, read from the sealed stage records.
+
+An item is one recorded Z3 answer that discharges something, with the
+SMT-LIB2 file it was decided from:
+
+=================  ======================================  =========  ========
+kind               record                                  verdict    expects
+=================  ======================================  =========  ========
+``side-condition`` ``artifacts/calculus/<Node>.json``      discharged unsat
+``requirement``    ``artifacts/requirements/<ID>.json``    proved     unsat
+``deadline``       ``artifacts/deadlines/index.json``      proved     unsat
+``health``         ``artifacts/health/<Node>.json``        ok         sat/unsat
+=================  ======================================  =========  ========
+
+A health check reads ``ok`` on a satisfiable query (an assumption that can
+be met, a consistent contract, a guarantee that can fire: Z3's witness is
+its certificate) except the replacement check, which reads ``ok`` on a
+proof.  A record whose seal does not hold gives no item: the report already
+shows it ``error``.  Hoare triples and Dafny proofs are not items yet
+(docs/second-solver.md says so).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any, Iterable
+
+from ..evidence.sealed import read_sealed
+from ..requirements.stage import record_path
+
+#: Health checks whose ``ok`` is an ``unsat`` answer (a proof); every other
+#: check's ``ok`` is a satisfiable answer with Z3's witness.
+PROOF_CHECKS = frozenset({"replacement-refines"})
+
+
+@dataclass(frozen=True)
+class Item:
+    """One discharging answer: ``kind`` (table above), ``id`` (the side
+    condition's, requirement's or finding's id), ``smt2`` (workspace-relative
+    path of its script), ``verdict`` (the recorded one), ``expects``
+    (``unsat`` or ``sat``: Z3's answer that gave the verdict)."""
+
+    kind: str
+    id: str
+    smt2: str
+    verdict: str
+    expects: str
+
+
+def discharging_items(root: Any, nodes: Iterable[str]) -> list[Item]:
+    """Every :class:`Item` of the workspace at ``root`` (a ``Path``) for
+    ``nodes``, in a fixed order (node order, then requirements and
+    deadlines by id).  Reads sealed records only; never raises for a
+    missing or altered record (it gives no item)."""
+    out: list[Item] = []
+    for n in nodes:
+        body, why = read_sealed(root / f"artifacts/calculus/{n}.json", "side-condition record")
+        for sc in _rows(body, why, "side_conditions"):
+            if sc.get("status") == "discharged" and _path(sc.get("smt2")):
+                out.append(Item("side-condition", str(sc.get("id")), sc["smt2"], "discharged", "unsat"))
+        body, why = read_sealed(root / f"artifacts/health/{n}.json", "contract health record")
+        for f in _rows(body, why, "findings"):
+            if f.get("status") == "ok" and _path(f.get("smt2")):
+                expects = "unsat" if f.get("check") in PROOF_CHECKS else "sat"
+                out.append(Item("health", str(f.get("id")), f["smt2"], "ok", expects))
+    index, why = read_sealed(root / "artifacts/requirements/index.json", "requirement index")
+    records = index.get("records") if isinstance(index, dict) and not why else None
+    for rid in sorted(records) if isinstance(records, dict) else []:
+        rec, why = read_sealed(root / record_path(rid), "requirement record")
+        if rec and not why and rec.get("verdict") == "proved" and _path(rec.get("smt2")):
+            out.append(Item("requirement", rid, rec["smt2"], "proved", "unsat"))
+    body, why = read_sealed(root / "artifacts/deadlines/index.json", "deadline record")
+    for d in sorted(_rows(body, why, "results"), key=lambda d: str(d.get("requirement"))):
+        if d.get("status") == "proved" and _path(d.get("smt2")):
+            out.append(Item("deadline", str(d.get("requirement")), d["smt2"], "proved", "unsat"))
+    return out
+
+
+def _rows(body: Any, why: str, key: str) -> list[dict[str, Any]]:
+    rows = body.get(key) if isinstance(body, dict) and not why else None
+    return [r for r in rows if isinstance(r, dict)] if isinstance(rows, list) else []
+
+
+def _path(p: Any) -> bool:
+    return isinstance(p, str) and p.startswith("artifacts/") and p.endswith(".smt2") and ".." not in p

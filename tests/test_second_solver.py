@@ -1,0 +1,121 @@
+"""The second solver (issue 50): every discharging Z3 query decided again by
+cvc5 from its SMT-LIB2 text, with a checked proof; a disagreement is never
+proved; ``bundle --recheck`` re-decides a bundle's queries from it alone."""
+from __future__ import annotations
+
+import io
+import json
+import tarfile
+from pathlib import Path
+
+import pytest
+
+pytest.importorskip("cvc5", reason="cvc5 (PyPI) is a dependency of rclverify; CI installs it")
+
+from rclverify.cli import main
+from rclverify.crosscheck.cvc5_decide import decide
+from rclverify.crosscheck.stage import agreement, stage_crosscheck
+
+SAT_SCRIPT = "(declare-fun x () Real)\n(assert (> x 1.0))\n(check-sat)\n"
+
+
+@pytest.fixture(scope="module")
+def ws(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    root = tmp_path_factory.mktemp("second") / "ws"
+    assert main(["init", str(root)]) == 0
+    assert main(["verify", "-w", str(root)]) in (0, 1)
+    return root
+
+
+def _report(root: Path) -> dict:
+    return json.loads((root / "reports/assurance.json").read_text())
+
+
+def test_every_proof_has_both_solvers_and_a_checked_proof(ws: Path) -> None:
+    r = _report(ws)
+    scs = [sc for sc in r["side_conditions"] if sc["status"] == "discharged"]
+    reqs = [q for q in r["requirements"] if q.get("check", q).get("solvers")]
+    assert scs and len(reqs) == 2
+    for s in [sc["solvers"] for sc in scs] + [q["check"]["solvers"] for q in reqs]:
+        assert s["agreement"] == "two solvers", s
+        assert s["cvc5"]["answer"] == "unsat" and s["cvc5"]["proof_checked"] is True
+        proof = (ws / s["proof"]).read_text()
+        assert proof.strip().startswith("(") and len(proof) > 100
+    index = json.loads((ws / "artifacts/crosscheck/index.json").read_text())
+    assert index["solver"]["name"] == "cvc5" and index["counts"] == {"two solvers": len(index["items"])}
+
+
+def test_a_planted_wrong_proof_reads_inconclusive(ws: Path, tmp_path: Path) -> None:
+    import shutil
+    root = tmp_path / "ws"
+    shutil.copytree(ws, root)
+    # the record says Z3 proved REQ1 and discharged Actuator.sc1; their queries are in fact satisfiable
+    (root / "artifacts/requirements/REQ1.smt2").write_text(SAT_SCRIPT)
+    (root / "artifacts/calculus/Actuator.sc1.smt2").write_text(SAT_SCRIPT)
+    stage_crosscheck(root, ["Sensor", "Controller", "Actuator"])
+    assert main(["report", "-w", str(root)]) in (0, 1)
+    r = _report(root)
+    sc = next(sc for sc in r["side_conditions"] if sc["id"] == "Actuator.sc1")
+    assert sc["status"] == "inconclusive" and sc["solvers"]["agreement"] == "disagree"
+    assert "Z3 answered unsat, cvc5 sat" in sc["explanation"]
+    req = next(q for q in r["requirements"] if q["id"] == "REQ1")
+    assert req["verdict"] == "inconclusive", req["verdict"]
+    assert "second solver does not confirm it" in req["note"]
+    assert main(["verify", "-w", str(root), "--strict"]) == 1
+
+
+def test_cvc5_unknown_on_a_proof_is_inconclusive() -> None:
+    hard = ("(declare-fun x () Int)(declare-fun y () Int)(declare-fun z () Int)"
+            "(assert (and (> x 0) (> y 0) (> z 0) (= (+ (* x x x) (* y y y)) (* z z z))))(check-sat)")
+    d = decide(hard, rlimit=2_000)
+    assert d.answer == "unknown"
+    row = {"answer": d.answer, "reason": d.reason, "proof_checked": d.proof_checked, "version": d.version}
+    assert agreement("unsat", row)[0] == "inconclusive"
+    assert agreement("sat", row)[0] == "one solver"  # a witness of Z3's stands alone
+    assert agreement("unsat", {"answer": "error", "reason": "x"})[0] == "one solver"
+    assert agreement("unsat", {"answer": "unsat", "proof_checked": False})[0] == "disagree"
+    assert agreement("unsat", None)[0] == "one solver"
+
+
+def test_a_rejected_script_is_an_error_never_an_answer() -> None:
+    assert decide("(assert (> x 0))(check-sat)").answer == "error"
+    assert decide("(declare-fun x () Int)").answer == "error"
+    d = decide("(declare-fun x () Int)(assert (and (> x 0) (< x 0)))(check-sat)")
+    assert d.answer == "unsat" and d.proof_checked and d.proof
+
+
+def _rewrite(archive: Path, out: Path, name: str, edit) -> None:
+    with tarfile.open(archive) as t:
+        members = [(m, t.extractfile(m).read() if m.isfile() else None) for m in t.getmembers()]
+    with tarfile.open(out, "w:gz") as t:
+        for m, data in members:
+            if m.name == name:
+                data = edit(data)
+                m.size = len(data)
+            t.addfile(m, io.BytesIO(data) if data is not None else None)
+
+
+def test_bundle_recheck(ws: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    archive = tmp_path / "b.tar.gz"
+    assert main(["bundle", "-w", str(ws), "-o", str(archive)]) == 0
+    capsys.readouterr()
+    assert main(["bundle", "--recheck", str(archive)]) == 0
+    assert "every answer agrees" in capsys.readouterr().out
+    edited = tmp_path / "edited.tar.gz"  # a bound of the stored query changed: 100 -> 1000 in a premise
+    _rewrite(archive, edited, "artifacts/requirements/REQ1.smt2",
+             lambda b: b.replace(b"(<= Actuator.out.actuator_value (to_real 100))",
+                                 b"(<= Actuator.out.actuator_value (to_real 1000))", 1))
+    assert main(["bundle", "--recheck", str(edited)]) == 1
+    err = capsys.readouterr().err
+    assert "requirement REQ1: its query artifacts/requirements/REQ1.smt2 was edited" in err
+
+
+def test_bundle_recheck_names_an_edited_verdict(ws: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    archive = tmp_path / "b.tar.gz"
+    assert main(["bundle", "-w", str(ws), "-o", str(archive)]) == 0
+    edited = tmp_path / "edited.tar.gz"
+    _rewrite(archive, edited, "artifacts/requirements/REQ2.json",
+             lambda b: b.replace(b'"proved"', b'"refuted"', 1))
+    capsys.readouterr()
+    assert main(["bundle", "--recheck", str(edited)]) == 1
+    assert "artifacts/requirements/REQ2.json: record" in capsys.readouterr().err
