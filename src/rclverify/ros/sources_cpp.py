@@ -36,6 +36,7 @@ from __future__ import annotations
 from typing import Any
 
 from . import cpp_helpers, emit, symbols, treesitter
+from .cpp_bases import node_base
 from .cpp_members import MemberReader
 from .cpp_prep import REGISTER, prepare
 from .nodelets import registered
@@ -222,11 +223,14 @@ class _File(MemberReader):
         if head is None or args is None:
             return
         h = _T(head)
-        if h.split("<")[0].split("::")[-1] in _NODE_TYPES and ("rclcpp" in h or "::" not in h) and args.named_children:
+        kind = node_base(h, self.ros2)
+        if kind is not None and args.named_children:
             a = args.named_children
             self.node(self.scope.value(a[0]), n, self.scope.value(a[1]) if len(a) > 1 and
                       self.scope.value(a[1]) is not None and self.scope.value(a[1])[0] == "str" else None,
-                      "lifecycle" if "LifecycleNode" in h else None)
+                      "lifecycle" if kind == "lifecycle" else None)
+            if "::" in h and "rclcpp" not in h:  # a workspace base (pkg_util::LifecycleNode): the linker runs it too
+                self.record("member", h, list(args.named_children), n)
             return
         self.record("member", h, list(args.named_children), n)
 

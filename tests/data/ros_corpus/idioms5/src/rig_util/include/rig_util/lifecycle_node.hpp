@@ -1,0 +1,25 @@
+#ifndef RIG_UTIL__LIFECYCLE_NODE_HPP_
+#define RIG_UTIL__LIFECYCLE_NODE_HPP_
+
+#include <string>
+
+#include "rclcpp/rclcpp.hpp"
+#include "rclcpp_lifecycle/lifecycle_node.hpp"
+
+namespace rig_util
+{
+
+// The base every node of the rig derives from.
+class LifecycleNode : public rclcpp_lifecycle::LifecycleNode
+{
+public:
+  LifecycleNode(
+    const std::string & node_name,
+    const std::string & ns = "",
+    const rclcpp::NodeOptions & options = rclcpp::NodeOptions());
+  virtual ~LifecycleNode();
+};
+
+}  // namespace rig_util
+
+#endif  // RIG_UTIL__LIFECYCLE_NODE_HPP_
