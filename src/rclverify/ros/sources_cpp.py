@@ -42,7 +42,7 @@ from .cpp_prep import REGISTER, prepare
 from .nodelets import registered
 from .cpp_scope import base_name, callee_parts, namespaces_of
 from .cpp_values import CppValues
-from .cpp_types import action_type, action_type_in, callback_name, message_type, service_type, split_template
+from .cpp_types import adapted, action_type, action_type_in, callback_name, message_type, service_type, split_template
 from .model import Note, Src, canon_type
 
 __all__ = ["scan_cpp", "action_type", "service_type"]
@@ -69,11 +69,12 @@ class _File(MemberReader):
             line = data.count(b"\n", 0, m.start()) + 1
             self.out["components"].append((m.group(1).decode().lstrip(":"), Src(shown, line, 1)))
         self.out["nodelets"] = registered(data, shown)
+        adapters = adapted(data)
         data = prepare(data)
         self.ros2 = b"rclcpp" in data
         root = treesitter.parser("cpp").parse(data).root_node
         self.nodes = list(treesitter.walk(root))
-        self.aliases: dict[str, str] = {}
+        self.aliases: dict[str, str] = adapters
         for n in self.nodes:
             self._index(n)
         self.scope = CppValues(self.nodes)

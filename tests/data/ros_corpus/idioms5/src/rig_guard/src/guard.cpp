@@ -22,6 +22,13 @@ Guard::CallbackReturn Guard::on_configure(const rclcpp_lifecycle::State &)
   return CallbackReturn::SUCCESS;
 }
 
+Guard::CallbackReturn Guard::on_activate(const rclcpp_lifecycle::State &)
+{
+  stop_pub_->on_activate();
+  createBond();
+  return CallbackReturn::SUCCESS;
+}
+
 void Guard::scanCallback(sensor_msgs::msg::LaserScan::ConstSharedPtr)
 {
 }

@@ -28,6 +28,12 @@ public:
     return CallbackReturn::SUCCESS;
   }
 
+  CallbackReturn on_activate(const rclcpp_lifecycle::State &) override
+  {
+    createBond();
+    return CallbackReturn::SUCCESS;
+  }
+
 private:
   void onCommand(geometry_msgs::msg::Twist::SharedPtr)
   {

@@ -15,4 +15,17 @@ LifecycleNode::~LifecycleNode()
 {
 }
 
+void LifecycleNode::createBond()
+{
+  bond_ = std::make_unique<bond::Bond>(
+    std::string("bond"), this->get_name(), shared_from_this());
+  bond_->setHeartbeatPeriod(0.1);
+  bond_->start();
+}
+
+void LifecycleNode::destroyBond()
+{
+  bond_.reset();
+}
+
 }  // namespace rig_util

@@ -20,6 +20,7 @@ public:
 
 protected:
   CallbackReturn on_configure(const rclcpp_lifecycle::State & state) override;
+  CallbackReturn on_activate(const rclcpp_lifecycle::State & state) override;
   void scanCallback(sensor_msgs::msg::LaserScan::ConstSharedPtr msg);
 
   rclcpp::Subscription<sensor_msgs::msg::LaserScan>::SharedPtr scan_sub_;

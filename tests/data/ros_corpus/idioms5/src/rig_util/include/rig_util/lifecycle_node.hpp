@@ -1,8 +1,10 @@
 #ifndef RIG_UTIL__LIFECYCLE_NODE_HPP_
 #define RIG_UTIL__LIFECYCLE_NODE_HPP_
 
+#include <memory>
 #include <string>
 
+#include "bondcpp/bond.hpp"
 #include "rclcpp/rclcpp.hpp"
 #include "rclcpp_lifecycle/lifecycle_node.hpp"
 
@@ -18,6 +20,13 @@ public:
     const std::string & ns = "",
     const rclcpp::NodeOptions & options = rclcpp::NodeOptions());
   virtual ~LifecycleNode();
+
+protected:
+  // The heartbeat a lifecycle manager watches.
+  void createBond();
+  void destroyBond();
+
+  std::unique_ptr<bond::Bond> bond_;
 };
 
 }  // namespace rig_util
