@@ -115,3 +115,36 @@ def test_whole_workspace_is_the_hand_written_graph_and_run_time_names_are_locate
         assert _edges(graph, node) == _want(node), node
     notes = {f"{n.src.file}:{n.src.line}" for n in graph.notes if n.code == "ROS-UNRESOLVED"}
     assert notes == set(EXPECTED["unresolved"])
+
+
+def test_a_stacks_free_factory_taking_the_node_first() -> None:
+    # pkg::interfaces::create_service<T>(shared_from_this(), get_name() + "/is_active", cb)
+    r = scan_cpp(b'#include "rclcpp/rclcpp.hpp"\n#include "std_srvs/srv/trigger.hpp"\n'
+                 b'class M : public rclcpp::Node {\n public:\n  M() : Node("m") {}\n  void start() {\n'
+                 b'    srv_ = rig::interfaces::create_service<std_srvs::srv::Trigger>(\n'
+                 b'      shared_from_this(), get_name() + std::string("/is_active"), cb_);\n  }\n};\n', "m.cpp")
+    assert [(e.kind, e.topic, e.msg_type, e.src.line) for e in r["endpoints"]] == [
+        ("service_servers", "~is_active", "std_srvs/srv/Trigger", 7)]
+
+
+def test_one_node_named_by_an_executable_and_its_component_is_said_once(tmp_path: Path) -> None:
+    pkg = tmp_path / "ws" / "mon"
+    (pkg / "src").mkdir(parents=True)
+    (pkg / "package.xml").write_text('<package format="3"><name>mon</name><version>0.0.0</version>'
+                                     '<description>d</description><maintainer email="dev@example.org">m'
+                                     '</maintainer><license>MIT</license><buildtool_depend>ament_cmake'
+                                     '</buildtool_depend><export><build_type>ament_cmake</build_type></export>'
+                                     '</package>')
+    (pkg / "CMakeLists.txt").write_text('project(mon)\nadd_library(mon_core SHARED src/mon.cpp)\n'
+                                        'add_executable(mon src/main.cpp)\ntarget_link_libraries(mon mon_core)\n'
+                                        'rclcpp_components_register_nodes(mon_core "mon::Monitor")\n')
+    (pkg / "src" / "mon.cpp").write_text('#include "rclcpp/rclcpp.hpp"\n#include "std_msgs/msg/bool.hpp"\n'
+                                         'namespace mon {\nclass Monitor : public rclcpp::Node {\n public:\n'
+                                         '  Monitor() : Node("monitor") {\n'
+                                         '    p_ = create_publisher<std_msgs::msg::Bool>("alarm", 1);\n  }\n};\n}\n')
+    (pkg / "src" / "main.cpp").write_text('#include "rclcpp/rclcpp.hpp"\nint main(int argc, char ** argv) {\n'
+                                          '  rclcpp::init(argc, argv);\n'
+                                          '  rclcpp::spin(std::make_shared<mon::Monitor>());\n}\n')
+    g = scan([tmp_path / "ws"], [], base=tmp_path, standard=False).graph
+    assert [(e.topic, e.src.line) for e in g.nodes["/monitor"].publishes] == [("/alarm", 7)]
+    assert not [n for n in g.notes if "also named" in n.message]

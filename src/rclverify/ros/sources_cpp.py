@@ -314,6 +314,8 @@ class _File(MemberReader):
         if last == "create_server":
             return
         handle = s.value(recv) if recv is not None else None
+        if recv is None and "::" in full and last.startswith("create_") and len(args) >= 2 and s.is_handle(args[0]):
+            handle, args = s.value(args[0]), args[1:]  # a stack's factory: ns::create_service<T>(node, name, ...)
         if last in ("advertise", "subscribe") and len(args) >= 2 and s.is_handle(args[0]):
             # advertise(nh, topic, n) / subscribe(nh, topic, n) of an object given the handle
             # (topic_tools::ShapeShifter, a message_filters subscriber of a class this file does not know)
