@@ -19,7 +19,7 @@ from pathlib import Path
 import dataclasses
 from typing import Any, Callable
 
-from . import names, nodelets
+from . import cross_package, names, nodelets
 from .executables import Targets
 from .launch import LaunchNode
 from .link import Linked, Linker
@@ -42,12 +42,24 @@ class Assembly:
         self.progs = {p: programs(self.codes[p], targets[p]) for p in sorted(pkgs)}
         self.targets = targets
         self._linked: dict[int, Linked] = {}
+        # a program's code in the workspace's other packages (helper libraries, issue 53)
+        self._views: dict[int, PackageCode] = {}
+        used: dict[str, set[str]] = {}
+        for pk in sorted(self.progs):
+            for prog in self.progs[pk]:
+                added = cross_package.extend(prog, self.codes)
+                if added:
+                    self._views[id(prog)] = cross_package.view(prog, self.codes, added)
+                    for f, other in added.items():
+                        used.setdefault(other, set()).add(f)
+        cross_package.library_programs(self.progs, used, self.codes)
 
     def linked(self, prog: Program) -> Linked:
         """``prog`` linked (once)."""
         got = self._linked.get(id(prog))
         if got is None:
-            got = self._linked[id(prog)] = Linker(prog, self.codes[prog.package], self.known).run()
+            code = self._views.get(id(prog), self.codes[prog.package])
+            got = self._linked[id(prog)] = Linker(prog, code, self.known).run()
         return got
 
     def program(self, pkg: str, exe: str) -> Program | None:
@@ -75,6 +87,9 @@ class Assembly:
             files = sorted({h[2] for h in hits if h[1] == cls})
             from .programs import _closure
             prog = Program(pk, None, files, _closure(self.codes[pk], files, set()), {cls})
+            added = cross_package.extend(prog, self.codes)
+            if added:
+                self._views[id(prog)] = cross_package.view(prog, self.codes, added)
             self.progs[pk].append(prog)
         return prog, cls
 

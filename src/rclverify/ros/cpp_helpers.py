@@ -21,6 +21,7 @@ documented API and source):
 | ``dynamic_reconfigure::Client<Config>(name, ...)`` | calls ``name/set_parameters``, subscribes ``name/parameter_descriptions`` and ``name/parameter_updates`` |
 | ``self_test::TestRunner([h, [ph]])`` | serves ``self_test`` (``diagnostic_msgs/srv/SelfTest``) through ``ph`` (default ``~``) |
 | ``camera_info_manager::CameraInfoManager(h, ...)`` | serves ``set_camera_info`` (``sensor_msgs/srv/SetCameraInfo``) through ``h`` |
+| ``bond::Bond(topic, id, ...)`` (bondcpp, ROS 1 and 2) | publishes and subscribes ``topic`` (``bond/msg/Status``): the heartbeat |
 | ``realtime_tools::RealtimePublisher<T>(h, name, ...)`` / ``.init(h, name, ...)`` (ROS 1) | publishes ``name`` (``T``) through ``h``; ROS 2's ``RealtimePublisher<T>(publisher)`` wraps a publisher already read |
 
 Each spec is ``(role, name value, type, handle value)``; a handle is the
@@ -40,6 +41,7 @@ TF = "tf2_msgs/msg/TFMessage"
 IMAGE = "sensor_msgs/msg/Image"
 INFO = "sensor_msgs/msg/CameraInfo"
 VIS = "visualization_msgs/msg/"
+BOND = "bond/msg/Status"
 EVENTS = ("sub", symbols.lit("/parameter_events"), "rcl_interfaces/msg/ParameterEvent", None)
 
 DIAGNOSTICS = ("pub", symbols.lit("/diagnostics"), "diagnostic_msgs/msg/DiagnosticArray", None)
@@ -49,7 +51,7 @@ RECONF = "dynamic_reconfigure/"
 #: helper classes whose construction creates endpoints, by last name part
 CONSTRUCTED = {"TransformBroadcaster", "StaticTransformBroadcaster", "TransformListener", "Subscriber",
                "InteractiveMarkerServer", "ParameterEventHandler", "CameraPublisher", "CameraSubscriber",
-               "Updater", "Server", "Client", "TestRunner", "RealtimePublisher", "CameraInfoManager"}
+               "Updater", "Server", "Client", "TestRunner", "RealtimePublisher", "CameraInfoManager", "Bond"}
 #: helper methods that create endpoints, by the receiver's class (last name part)
 METHODS = {"ImageTransport": {"advertise", "subscribe", "advertiseCamera", "subscribeCamera"},
            "Subscriber": {"subscribe"}, "AsyncParametersClient": {"on_parameter_event"},
@@ -108,6 +110,8 @@ def constructed(type_text: str, args: list[Any], val: Value, ros2: bool,
         h = val(args[0])
         return [("service_servers", symbols.lit("set_camera_info"), "sensor_msgs/srv/SetCameraInfo",
                  h if h is not None and h[0] == "nh" else None)]
+    if last == "Bond" and head.startswith("bond") and args:  # bondcpp: Bond(topic, id, [node, ...])
+        return [("pub", val(args[0]), BOND, None), ("sub", val(args[0]), BOND, None)]
     if last == "TransformBroadcaster" and ("tf" in head or not head.count("::")):
         return [("pub", symbols.lit("/tf"), TF, None)]
     if last == "StaticTransformBroadcaster":

@@ -10,7 +10,12 @@
 * rclcpp: ``declare_parameter("n", default)`` / ``declare_parameter<T>(...)``,
   ``get_parameter("n").as_string()``, ``get_parameter("n", var)``,
   ``get_parameter_or("n", var, default)``; ROS 2 parameters belong to their
-  node, so each is the private ``~n``, its default the declared one.
+  node, so each is the private ``~n``, its default the declared one (a string,
+  or ``rclcpp::ParameterValue("x")``; also through a stack's
+  ``declare_parameter_if_not_declared(node, "n", value)``).  A ROS 2 key
+  computed in the code (``source_name_ + ".topic"``) is known by its text
+  (:func:`key_text`) and read by its value where the program gives it
+  (:mod:`cpp_values`, :mod:`link_values`; issue 53).
 
 Source of the name rules: ROS 1 wiki "Names" and "Parameter Server"; ROS 2
 design "Parameters".
@@ -23,6 +28,24 @@ from . import treesitter
 
 _ROS1 = {"param", "getParam", "getParamCached"}
 _ROS2 = {"declare_parameter", "get_parameter", "get_parameter_or"}
+_IF_NOT_DECLARED = "declare_parameter_if_not_declared"  # a helper of real stacks: (node, name, value)
+KEY = "~{"  # the prefix of a computed ROS 2 parameter key's text: ``~{source_name_+".topic"}``
+
+
+def key_text(n: Any) -> str:
+    """The text a computed parameter key is known by in its file (``~{...}``, blanks
+    dropped), the same at its ``declare_parameter`` and its ``get_parameter``."""
+    return KEY + "".join(treesitter.text(n).split()) + "}"
+
+
+def default_value(n: Any) -> str | None:
+    """A declared default: a string (:func:`string_value`), also wrapped as
+    ``rclcpp::ParameterValue("x")`` (rclcpp's ``ParameterValue`` API)."""
+    if n is not None and n.type == "call_expression" and \
+            treesitter.text(n.child_by_field_name("function")).split("::")[-1] == "ParameterValue":
+        a = n.child_by_field_name("arguments")
+        return string_value(a.named_children[0]) if a is not None and len(a.named_children) == 1 else None
+    return string_value(n)
 
 
 def string_value(n: Any) -> str | None:
@@ -60,9 +83,13 @@ def param_read(n: Any) -> tuple[str, str | None, Any, Any, bool] | None:
     if f is not None and f.type in ("template_method", "template_function"):
         f = f.child_by_field_name("name")
     last = treesitter.text(f).split("::")[-1]
+    if last == _IF_NOT_DECLARED and len(args) >= 2:  # pkg_util::declare_parameter_if_not_declared(node, n, v)
+        last, args = "declare_parameter", args[1:]
     if last not in _ROS1 and last not in _ROS2 and last not in ("get",):
         return None
     pname = string_value(args[0])
+    if pname is None and last in _ROS2:  # a computed key (source_name_ + ".topic"): read by its value
+        pname = key_text(args[0])
     if pname is None:
         return None
     full = treesitter.text(fn)
@@ -82,7 +109,7 @@ def param_read(n: Any) -> tuple[str, str | None, Any, Any, bool] | None:
     if last in _ROS2:
         p = pname if pname.startswith("~") else f"~{pname}"
         if last == "declare_parameter":
-            return p, string_value(args[1]) if len(args) >= 2 else None, None, None, True
+            return p, default_value(args[1]) if len(args) >= 2 else None, None, None, True
         if last == "get_parameter":
             return (p, None, args[1], None, True) if len(args) >= 2 else (p, None, None, None, True)
         return (p, string_value(args[2]) if len(args) >= 3 else None, args[1], None, True) if len(args) >= 2 else None

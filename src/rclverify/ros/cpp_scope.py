@@ -39,6 +39,7 @@ class Fn:
         self.key, self.unit, self.in_class, self.nid = key, unit, in_class, nid
         self.params: list[str] = []
         self.ptypes: list[str] = []
+        self.pconst: list[bool] = []  # per parameter: declared const
         self.defaults: list[Any] = []
 
 
@@ -130,6 +131,7 @@ class CppScope:
                     self.consts.setdefault(_T(n.child_by_field_name("name")), []).append(symbols.lit(v[1:-1]))
             elif t == "using_declaration" and any(c.type == "namespace" for c in n.children):
                 self.using_ns.append(_T(n.named_children[-1]) if n.named_children else "")
+        calls: list[Any] = []
         for n in nodes:
             if n.type == "declaration":
                 self._declaration(n)
@@ -143,6 +145,7 @@ class CppScope:
                 if fn is not None and head is not None and a is not None and fn.in_class:
                     self.fields.setdefault((fn.unit, _T(head)), []).append((fn, ("init", list(a.named_children), _T(head))))
             elif n.type == "call_expression":
+                calls.append(n)
                 r = param_read(n)
                 if r is not None and r[4] and "declare_parameter" in _T(n.child_by_field_name("function")):
                     self.declared.setdefault(r[0], r[1])
@@ -155,7 +158,36 @@ class CppScope:
                         and _T(f.child_by_field_name("field").child_by_field_name("name")) == "init":
                     self._bind(f.child_by_field_name("argument"), ("ops", n), n)
 
+        for n in calls:
+            self._out_args(n)
+
     # -- indexing
+    def _out_args(self, n: Any) -> None:
+        """``getParameters(topic)`` where this file's ``getParameters(std::string & t)``
+        reads a parameter into ``t``: the caller's local ``topic`` holds what ``t`` is
+        given (an out-parameter; issue 53)."""
+        f = n.child_by_field_name("function")
+        a = n.child_by_field_name("arguments")
+        fn = self.fn_of(n)
+        if f is None or a is None or fn is None or not a.named_children:
+            return
+        if f.type == "field_expression":
+            if _T(f.child_by_field_name("argument")) != "this":
+                return
+            f = f.child_by_field_name("field")
+        if f is None or f.type != "identifier" and f.type != "field_identifier":
+            return
+        name = _T(f)
+        keys = {f"{fn.unit}::{name}", name} if fn.in_class else {name}
+        callee = next((c for c in self.fns.values() if c.key in keys and c.nid != fn.nid), None)
+        if callee is None:
+            return
+        for i, x in enumerate(a.named_children[:len(callee.params)]):
+            ty = callee.ptypes[i]
+            if x.type == "identifier" and (fn.nid, _T(x)) in self.ltypes and ty.endswith("&") and \
+                    not callee.pconst[i] and self.locals.get((callee.nid, callee.params[i])):
+                self.locals.setdefault((fn.nid, _T(x)), []).append(("out", callee, callee.params[i]))
+
     def _function(self, n: Any) -> None:
         fd = n.child_by_field_name("declarator")
         while fd is not None and fd.type != "function_declarator":
@@ -183,6 +215,7 @@ class CppScope:
             fn.params.append(_T(d) if d is not None else "")
             fn.ptypes.append(_T(p.child_by_field_name("type")) + (
                 " &" if "&" in _T(p.child_by_field_name("declarator") or p) else ""))
+            fn.pconst.append(any(c.type == "type_qualifier" and _T(c) == "const" for c in p.children))
             fn.defaults.append(p.child_by_field_name("default_value"))
         self.fns[n.id] = fn
 

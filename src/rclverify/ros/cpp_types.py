@@ -16,6 +16,11 @@ through:
   ``rclcpp::adapt_type<Custom>::as<pkg::msg::T>``: the ROS type, the second
   argument (rclcpp's type adaptation, REP 2007).
 
+* ``RCLCPP_USING_CUSTOM_TYPE_AS_ROS_MESSAGE_TYPE(Custom, pkg::msg::T)``
+  (:func:`adapted`): ``Custom`` is then ``pkg::msg::T`` wherever the program
+  writes it (``create_publisher<Custom>``); a type of a namespace that holds
+  no messages (``cv::Mat``, ``std::string``) is never read as one.
+
 Sources: roscpp's message generator (``genpy``/``gencpp`` typedefs), rclcpp
 ``type_adapter.hpp``.
 """
@@ -109,8 +114,8 @@ def message_type(text: str | None, aliases: dict[str, str] | None = None) -> str
     """``pkg/msg/T`` for a C++ message type's text (see :func:`plain`), or ``None``
     when it does not name a message of a package."""
     p = plain(text, aliases)
-    if p is None or "<" in p or "::" not in p:
-        return None
+    if p is None or "<" in p or "::" not in p or p.split("::")[0] in _NOT_PACKAGES:
+        return None  # cv::Mat, std::string: a custom type no adapter names is no message
     t = canon_type(p)
     return t if t and t.count("/") == 2 and t.split("/")[1] == "msg" else None
 
@@ -161,3 +166,19 @@ def callback_name(text: str) -> str:
     if "(" in t and "&" in t:  # a bind expression: its first argument
         t = t[t.index("(") + 1:].split(",")[0]
     return t.strip().lstrip("&").strip()
+
+
+_ADAPTED = re.compile(rb"RCLCPP_USING_CUSTOM_TYPE_AS_ROS_MESSAGE_TYPE\s*\(\s*([\w:]+)\s*,\s*([\w:]+)\s*\)")
+
+
+def adapted(data: bytes) -> dict[str, str]:
+    """``{custom type: "rclcpp::TypeAdapter<custom, ros type>"}`` for each
+    ``RCLCPP_USING_CUSTOM_TYPE_AS_ROS_MESSAGE_TYPE(custom, ros type)`` of a file's
+    bytes (rclcpp ``type_adapter.hpp``: the macro makes ``custom`` an implicit
+    type adapter of the ROS type), read before the macro is blanked as an
+    upper-case statement (:mod:`cpp_prep`)."""
+    out: dict[str, str] = {}
+    for m in _ADAPTED.finditer(data):
+        c, r = m.group(1).decode(), m.group(2).decode()
+        out[c.lstrip(":")] = f"rclcpp::TypeAdapter<{c},{r}>"
+    return out

@@ -8,7 +8,8 @@ a member of its class (``("field", class, name)``, bound where the program
 constructs it), a ROS parameter read (:mod:`cpp_params`), a node handle
 (``ros::NodeHandle nh("~")``, ``ros::NodeHandle(parent, "ns")``, rclcpp
 ``create_sub_node("ns")``, a nodelet's ``getPrivateNodeHandle()``), the node's
-own name (``ros::this_node::getName()``, ``get_fully_qualified_name()``),
+own name (``ros::this_node::getName()``, ``get_fully_qualified_name()``,
+rclcpp's ``get_name()``), a parameter read with a computed key,
 roscpp options (``ros::SubscribeOptions::create<T>(name, ...)``,
 ``ops.init<T>(name, ...)``).  A name bound twice to different values is not
 read (``None``).
@@ -18,7 +19,7 @@ from __future__ import annotations
 from typing import Any
 
 from . import symbols, treesitter
-from .cpp_params import param_read, string_value
+from .cpp_params import KEY, param_read, string_value
 from .cpp_scope import _HANDLE_TYPES, MAX_DEPTH, CppScope, Fn, base_name, is_node_type
 
 _T = treesitter.text
@@ -81,6 +82,11 @@ class CppValues(CppScope):
             return symbols.NODE
         if ftext == "getName" and not args and self.nodelet:  # nodelet::Nodelet::getName(): the node's name
             return symbols.NODE
+        if last == "get_name" and not args and (fn.type != "field_expression" or self.is_handle(
+                fn.child_by_field_name("argument"))):
+            # rclcpp's Node::get_name(): the node's name without its namespace; a name
+            # made from it (get_name() + "/x") is relative, so it resolves as ~/x
+            return symbols.NODE
         if ftext in ("std::string", "string", "std::string_view") and len(args) == 1:
             return self.value(args[0], depth + 1)
         if base_name(ftext) in _HANDLE_TYPES:
@@ -116,6 +122,12 @@ class CppValues(CppScope):
             pname, default, _ref, recv, ros2 = r
             if default is None and ros2:
                 default = self.declared.get(pname)
+            if pname.startswith(KEY):  # a computed key: its value, read here or by the linker
+                key = self.value(args[0], depth + 1)
+                text = symbols.text(key) if key is not None and symbols.is_concrete(key) else None
+                if key is None or key[0] in ("node", "param") or text is not None and text.startswith("~"):
+                    return None
+                return ("param", "~" + text if text is not None else key, default, None)
             return ("param", pname, default, self.value(recv, depth + 1) if recv is not None and not ros2 else None)
         return None
 
@@ -183,6 +195,10 @@ class CppValues(CppScope):
         if isinstance(b, tuple):
             if b[0] == "unknown":  # changed in place (snprintf, +=, append): not read
                 return None
+            if b[0] == "out":  # given to a function that writes its parameter b[2] (an out-parameter)
+                callee = b[1]
+                return self._one([self._bound(callee, x, depth + 1)
+                                  for x in self.locals.get((callee.nid, b[2]), [])]) if depth < MAX_DEPTH else None
             if b[0] == "nhargs":
                 return self.handle(b[1], depth + 1)
             if b[0] in ("read", "ops"):

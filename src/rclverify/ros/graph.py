@@ -225,9 +225,10 @@ def _scan(paths: Sequence[Path], launch: Sequence[Path], launch_args: dict[str, 
             # name are one node of the graph with all their endpoints (docs/ros.md)
             node = g.nodes[full]
             node.lifecycle = node.lifecycle or lifecycle
-            g.notes.append(Note(declared, f"node {full} is also named at {node.declared_at}; no launch file "
-                                          f"starts these programs: shown as one node with the endpoints of "
-                                          f"all of them", "ROS-LAUNCH"))
+            if declared != node.declared_at:  # one code named twice (an executable and its component): one node
+                g.notes.append(Note(declared, f"node {full} is also named at {node.declared_at}; no launch file "
+                                              f"starts these programs: shown as one node with the endpoints of "
+                                              f"all of them", "ROS-LAUNCH"))
             node.sources.extend(f for f in files if f not in node.sources)
         elif full in g.nodes:
             g.notes.append(Note(declared, f"node {full} is started twice (first at {g.nodes[full].declared_at}); "

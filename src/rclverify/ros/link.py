@@ -287,7 +287,8 @@ class Linker(LinkMembers, Values):
                                 note(Note(src, "node name is not a string literal: not resolved statically"))
                                 continue
                             nsv = self.eval(ns, env, fkey)[0] if ns is not None else None
-                            item = (t, src, symbols.text(nsv) if nsv is not None else None, unit, pins)
+                            # "" and no namespace are the same (a base's default ns = "")
+                            item = (t, src, (symbols.text(nsv) or None) if nsv is not None else None, unit, pins)
                             if not any(x[0] == t and x[2] == item[2] for x in named):
                                 named.append(item)
                                 out.kinds.append(kind[0] if kind else None)

@@ -113,7 +113,11 @@ class Values:
             c = rec.get("consts", {}).get(hit[1]) if hit else None
             return self.eval(c, {}, None, depth + 1) if c is not None else [None]
         if k == "param":
-            return [("param", v[1], v[2], h) for h in (self.eval(v[3], env, fkey, depth + 1) if v[3] else [None])]
+            keys = [v[1]] if isinstance(v[1], str) else [
+                "~" + t if t is not None and not t.startswith("~") else None
+                for t in (symbols.text(x) for x in self.eval(v[1], env, fkey, depth + 1))]  # a computed key
+            return limit([("param", key, v[2], h) if key is not None else None for key in keys
+                          for h in (self.eval(v[3], env, fkey, depth + 1) if v[3] else [None])])
         if k == "nh":
             segs: list[tuple[Any, ...]] = [()]
             for kind, x in v[1]:
@@ -169,7 +173,7 @@ def _homes(v: Any) -> set[str]:
     if v[0] == "nh":
         return set().union(*(_homes(x) for _k, x in v[1]))
     if v[0] == "param":
-        return _homes(v[3])
+        return _homes(v[3]) | (_homes(v[1]) if isinstance(v[1], tuple) else set())
     if v[0] == "ops":
         return _homes(v[2])
     return set()

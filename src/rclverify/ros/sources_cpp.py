@@ -36,12 +36,13 @@ from __future__ import annotations
 from typing import Any
 
 from . import cpp_helpers, emit, symbols, treesitter
+from .cpp_bases import node_base
 from .cpp_members import MemberReader
 from .cpp_prep import REGISTER, prepare
 from .nodelets import registered
 from .cpp_scope import base_name, callee_parts, namespaces_of
 from .cpp_values import CppValues
-from .cpp_types import action_type, action_type_in, callback_name, message_type, service_type, split_template
+from .cpp_types import adapted, action_type, action_type_in, callback_name, message_type, service_type, split_template
 from .model import Note, Src, canon_type
 
 __all__ = ["scan_cpp", "action_type", "service_type"]
@@ -68,11 +69,12 @@ class _File(MemberReader):
             line = data.count(b"\n", 0, m.start()) + 1
             self.out["components"].append((m.group(1).decode().lstrip(":"), Src(shown, line, 1)))
         self.out["nodelets"] = registered(data, shown)
+        adapters = adapted(data)
         data = prepare(data)
         self.ros2 = b"rclcpp" in data
         root = treesitter.parser("cpp").parse(data).root_node
         self.nodes = list(treesitter.walk(root))
-        self.aliases: dict[str, str] = {}
+        self.aliases: dict[str, str] = adapters
         for n in self.nodes:
             self._index(n)
         self.scope = CppValues(self.nodes)
@@ -222,11 +224,14 @@ class _File(MemberReader):
         if head is None or args is None:
             return
         h = _T(head)
-        if h.split("<")[0].split("::")[-1] in _NODE_TYPES and ("rclcpp" in h or "::" not in h) and args.named_children:
+        kind = node_base(h, self.ros2)
+        if kind is not None and args.named_children:
             a = args.named_children
             self.node(self.scope.value(a[0]), n, self.scope.value(a[1]) if len(a) > 1 and
                       self.scope.value(a[1]) is not None and self.scope.value(a[1])[0] == "str" else None,
-                      "lifecycle" if "LifecycleNode" in h else None)
+                      "lifecycle" if kind == "lifecycle" else None)
+            if "::" in h and "rclcpp" not in h:  # a workspace base (pkg_util::LifecycleNode): the linker runs it too
+                self.record("member", h, list(args.named_children), n)
             return
         self.record("member", h, list(args.named_children), n)
 
@@ -309,6 +314,8 @@ class _File(MemberReader):
         if last == "create_server":
             return
         handle = s.value(recv) if recv is not None else None
+        if recv is None and "::" in full and last.startswith("create_") and len(args) >= 2 and s.is_handle(args[0]):
+            handle, args = s.value(args[0]), args[1:]  # a stack's factory: ns::create_service<T>(node, name, ...)
         if last in ("advertise", "subscribe") and len(args) >= 2 and s.is_handle(args[0]):
             # advertise(nh, topic, n) / subscribe(nh, topic, n) of an object given the handle
             # (topic_tools::ShapeShifter, a message_filters subscriber of a class this file does not know)

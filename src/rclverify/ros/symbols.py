@@ -10,7 +10,8 @@ A value is a tuple (hashable, picklable, so it lives in the parse cache):
   constructor (``callable`` its key), bound where the program calls it;
 * ``("field", unit, name)``: a member of class ``unit`` (C++ member,
   Python ``self.name``), bound in the class's constructor or methods;
-* ``("param", name, default, handle)``: a ROS parameter read (``default`` a
+* ``("param", name, default, handle)``: a ROS parameter read (``name`` a string,
+  or the value of a ROS 2 key computed in the code, without its ``~``; ``default`` a
   string or ``None``; ``handle`` the node handle it is read through, a value
   or ``None``; the parameter's name resolves against that handle's namespace);
 * ``("nh", segments)``: a node handle (roscpp ``ros::NodeHandle``, an rclcpp
@@ -70,7 +71,7 @@ def is_concrete(v: Val) -> bool:
     if k in ("arg", "field", "ext"):
         return False
     if k == "param":
-        return is_concrete(v[3])
+        return is_concrete(v[3]) and (isinstance(v[1], str) or is_concrete(v[1]))
     if k == "nh":
         return all(is_concrete(x) for _kind, x in v[1])
     if k == "cat":
