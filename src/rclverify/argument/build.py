@@ -114,7 +114,9 @@ def _requirement_goal(b: "_Builder", r: Mapping[str, Any], guarantee_goal: Mappi
               + (f" ({', '.join(p['label'] for p in c.get('used') or [])})" if c.get("used") else "")
               + ". " + ENTAILMENT),
         supported_by=tuple(dict.fromkeys(kids)), in_context_of=tuple(ctx), ref=rid))
-    return b.add(Element(ident("G", rid), "goal", _clip(f"{rid}: {r['text']}"), supported_by=(strategy,), ref=rid))
+    conf = (f" [confidence {r['confidence']:.4g}: {r['limited_by']['sentence']}]"
+            if r.get("confidence") is not None and r.get("limited_by") else "")
+    return b.add(Element(ident("G", rid), "goal", _clip(f"{rid}: {r['text']}{conf}"), supported_by=(strategy,), ref=rid))
 
 
 class _Builder:
@@ -200,7 +202,9 @@ def build_argument(report: Mapping[str, Any]) -> Argument:
             tool = f"{ev['tool']} {ev['tool_version']}".strip()
             kids.append(b.add(Element(
                 ident("Sn", "ev", oid), "solution",
-                _clip(f"{ev['kind']} evidence ({ev['backend']}, {tool}) for {oid}: {ev['status']}. {ev['explanation']}"),
+                _clip(f"{ev['kind']} evidence ({ev['backend']}, {tool}) for {oid}: {ev['status']}"
+                      + (f" [strength: {ev['strength']['kind']}; {ev['strength']['detail']}]" if ev.get("strength") else "")
+                      + f". {ev['explanation']}"),
                 status=str(ev["status"]), ref=oid, url=f"artifacts/evidence/{oid}.json")))
         if not mine:
             kids.append(b.add(Element(ident("G", node, f"g{k}", "evidence"), "goal",
@@ -219,7 +223,9 @@ def build_argument(report: Mapping[str, Any]) -> Argument:
         sid = str(sc["id"])
         verdict = str(sc.get("verdict") or sc["status"])
         sn = b.add(Element(ident("Sn", "sc", sid), "solution",
-                           _clip(f"Z3 query {sc['smt2']}: {verdict}. {sc['explanation']}"),
+                           _clip(f"Z3 query {sc['smt2']}: {verdict}"
+                                 + (f" [{sc['solvers']['agreement']}]" if sc.get("solvers") else "")
+                                 + f". {sc['explanation']}"),
                            status=str(sc["status"]), ref=sid, url=str(sc["smt2"])))
         if verdict == "discharged in context":  # the claim is the weaker one the proof supports (docs/calculus.md)
             ctx = sc.get("context") or {}

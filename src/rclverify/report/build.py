@@ -393,6 +393,8 @@ def build_report(ws: Workspace) -> dict[str, Any]:
         "environment_assumptions": env_assumptions, "pending": pending, "lint": lint_rows,
         "expected_verdicts": expected, "grounding": grounding, "unverified": unverified, "deadlines": deadlines,
     }
+    from .confidence_rows import annotate  # evidence strength and confidence over the argument (issue 50)
+    annotate(report, [(l.from_node, l.to_node) for l in model.links])
     # one severity per finding (report/severity.py): --strict fails on every error and warning, health and lint
     # warnings included, as SARIF, JUnit and the terminal show them
     from .severity import blocking

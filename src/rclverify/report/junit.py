@@ -82,6 +82,13 @@ def _outcome(case: ET.Element, status: str, summary: str, detail: str, kind: str
     return "failures"
 
 
+def _properties(case: ET.Element, props: Mapping[str, str]) -> None:
+    """A test case's ``<properties>`` (the convention pytest's ``record_property`` writes)."""
+    el = ET.SubElement(case, "properties")
+    for k, v in props.items():
+        ET.SubElement(el, "property", {"name": k, "value": str(v)})
+
+
 def _lines(*parts: str) -> str:
     return "\n".join(p for p in parts if p)
 
@@ -135,6 +142,8 @@ def _requirements_suite(report: Mapping[str, Any]) -> tuple[ET.Element, dict[str
         prevent = "; ".join(f"{p['label']}: {p['text']} ({p['source']})" for p in c.get("failed_to_prevent") or [])
         counts["tests"] += 1
         time += secs
+        if r.get("confidence") is not None and r.get("limited_by"):
+            _properties(case, {"confidence": f"{r['confidence']:.6g}", "limited_by": r["limited_by"].get("sentence", "")})
         bumped = _outcome(case, str(r["status"]), f"{r['verdict']}: {r['note']}",
                           _lines(f"requirement {r['id']}: {r['text']}",
                                  f"formal: {c['formal']}" if c.get("formal") else "",
@@ -218,6 +227,8 @@ def _suite(node: Mapping[str, Any], data: Mapping[str, Any]) -> tuple[ET.Element
         case = _case(suite, f"{name}.obligation", str(o["id"]), str(o["source"]), secs)
         expl = str(ev["explanation"]) if ev is not None else reasons.get(str(o["id"]), "no evidence record yet")
         cex = model_text(ev.get("counterexample")) if ev is not None else ""
+        if ev is not None and ev.get("strength"):  # the evidence's kind (docs/confidence.md)
+            _properties(case, {"strength": ev["strength"]["kind"], "strength.detail": ev["strength"].get("detail", "")})
         tally(case, str(o["status"]), expl.splitlines()[0] if expl else str(o["status"]),
               _lines(f"obligation ({o['backend']}, {o['kind']}) of guarantee {o['guarantee']}: {o['statement']}",
                      f"source: {o['source']}", expl, f"counterexample: {cex}" if cex else ""), secs)
@@ -225,6 +236,8 @@ def _suite(node: Mapping[str, Any], data: Mapping[str, Any]) -> tuple[ET.Element
         case = _case(suite, f"{name}.side_condition", str(sc["id"]), str(sc["source"]), sc.get("duration_s"))
         model = model_text(sc.get("model"))
         verdict = str(sc.get("verdict") or sc["status"])
+        if sc.get("strength"):
+            _properties(case, {"strength": sc["strength"]["kind"], "solvers": str(sc["strength"].get("solvers", 1))})
         tally(case, str(sc["status"]), str(sc.get("explanation") or sc["status"]),
               _lines(f"side condition ({sc['rule']}): {sc['conjunct']}", f"source: {sc['source']}",
                      f"verdict: {verdict}", str(sc.get("explanation") or ""),

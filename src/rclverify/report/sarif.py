@@ -210,6 +210,8 @@ def _obligation_results(report: Mapping[str, Any]) -> list[dict[str, Any]]:
                  "status": o["status"]}
         if ev is not None and ev.get("counterexample"):
             props["counterexample"] = dict(ev["counterexample"])
+        if ev is not None and ev.get("strength"):  # the evidence's kind (docs/confidence.md)
+            props["strength"] = dict(ev["strength"])
         out.append(_result(rule, _level("obligation", str(o["status"])), " ".join(words), str(o["source"]),
                            f"obligation:{o['id']}", props))
     return out
@@ -241,6 +243,10 @@ def _side_condition_results(report: Mapping[str, Any]) -> list[dict[str, Any]]:
             words.append(f"Counterexample: {model_text(sc['model'])}.")
         props: dict[str, Any] = {"sideCondition": sc["id"], "node": sc["node"], "rule": sc["rule"], "status": status,
                                  "verdict": verdict}
+        if sc.get("strength"):
+            props["strength"] = dict(sc["strength"])
+        if sc.get("solvers"):
+            props["solvers"] = {k: sc["solvers"].get(k) for k in ("agreement", "why", "proof")}
         ctx = sc.get("context")
         if isinstance(ctx, Mapping):  # decided in context: the cone and the upstream premises used
             props["inContext"] = {"cone": ctx.get("cone"), "used": list(ctx.get("used") or []),

@@ -1,0 +1,111 @@
+"""Confidence over a mixed-method argument (issue 50; docs/confidence.md).
+
+The paper leaves open "the level of confidence we can have in a system
+that has been verified using a mixture of methods; particularly how
+confidence can be calculated for more complex systems with loops in the
+information flow" (lines 1876-1877).  This module answers it with one
+conservative calculus over doubts (``doubt = 1 - confidence``; each
+evidence kind's doubt is :data:`.strength.DOUBT`):
+
+C1  a guarantee's doubt is the least doubt of its discharged evidence (the
+    strongest leg; legs are not assumed independent, so several legs earn
+    no extra credit: Littlewood and Wright, IEEE TSE 33(5), 2007); 1 without
+    discharged evidence;
+C2  a claim resting on premises ``P`` has doubt ``min(1, sum of the
+    doubts of P)``: the Frechet (Boole) bound, which holds whatever the
+    dependence between the premises (Bishop, Bloomfield, Littlewood et al.,
+    IEEE TSE 37(5), 2011);
+C3  a node's claim rests on its guarantees and its side conditions;
+C4  a derived property of node ``n`` (rules R1-R3 compose it from the
+    nodes upstream) rests on the premises of every node of ``n``'s cone,
+    the least fixpoint of ``cone(n) = {n} + cone(p) for each producer p``;
+    around a loop (R4) the fixpoint is reached once the loop's nodes are
+    in, and each premise counts once;
+C5  a proved requirement rests on its own proof (one or two solvers), the
+    guarantees its proof used, their nodes' side conditions and the
+    declared premises it used (``assumed``); a requirement not proved has
+    doubt 1.
+
+The premise with the largest doubt is what *limits* a claim; the report
+names it ("REQ2 rests on tested-only evidence for Navigation guarantee 1").
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Iterable, Mapping, Sequence
+
+
+@dataclass(frozen=True)
+class Premise:
+    """One leaf of the argument: ``label`` (``"Navigation guarantee 1"``),
+    ``kind`` (a strength kind, :data:`.strength.KINDS`), ``doubt`` in [0, 1]."""
+
+    label: str
+    kind: str
+    doubt: float
+
+
+@dataclass(frozen=True)
+class Claim:
+    """A claim's ``doubt`` (C2 over its premises), its ``confidence``
+    (``1 - doubt``) and the premise that ``limits`` it (``None`` without
+    premises)."""
+
+    doubt: float
+    confidence: float
+    limits: Premise | None
+
+
+def guarantee_premise(label: str, legs: Sequence[tuple[str, float]]) -> Premise:
+    """C1: the premise of a guarantee from its evidence ``legs`` (``(kind,
+    doubt)`` each): the leg of least doubt; ``assumed`` with doubt 1
+    without legs."""
+    if not legs:
+        return Premise(label, "assumed", 1.0)
+    kind, doubt = min(legs, key=lambda kd: kd[1])
+    return Premise(label, kind, doubt)
+
+
+def claim(premises: Iterable[Premise]) -> Claim:
+    """C2: the claim resting on ``premises`` (each counted once, by label)."""
+    seen: dict[str, Premise] = {}
+    for p in premises:
+        seen.setdefault(p.label, p)
+    doubt = min(1.0, sum(p.doubt for p in seen.values()))
+    limits = max(seen.values(), key=lambda p: (p.doubt, p.label), default=None)
+    return Claim(round(doubt, 9), round(1.0 - doubt, 9), limits)
+
+
+def cones(producers: Mapping[str, Iterable[str]]) -> dict[str, frozenset[str]]:
+    """C4's cones: for every node of ``producers`` (node -> its producer
+    nodes), the least fixpoint ``cone(n) = {n} + cone(p)``, by iterating
+    until no cone grows (loops included)."""
+    nodes = set(producers) | {p for ps in producers.values() for p in ps}
+    cone = {n: {n} for n in nodes}
+    changed = True
+    while changed:
+        changed = False
+        for n in nodes:
+            for p in producers.get(n, ()):
+                if not cone[p] <= cone[n]:
+                    cone[n] |= cone[p]
+                    changed = True
+    return {n: frozenset(c) for n, c in cone.items()}
+
+
+def node_claims(own: Mapping[str, Sequence[Premise]]) -> dict[str, Claim]:
+    """C3: each node's claim from its ``own`` premises (guarantees and side conditions)."""
+    return {n: claim(ps) for n, ps in own.items()}
+
+
+def derived_claims(own: Mapping[str, Sequence[Premise]], producers: Mapping[str, Iterable[str]]) -> dict[str, Claim]:
+    """C4: each node's derived property, resting on the premises of its cone."""
+    cone = cones({n: list(producers.get(n, ())) for n in own})
+    return {n: claim(p for m in sorted(cone[n]) for p in own.get(m, ())) for n in own}
+
+
+def requirement_claim(proved: bool, proof: Premise, used: Sequence[Premise]) -> Claim:
+    """C5: a requirement's claim; doubt 1 (limited by its own proof) when not proved."""
+    if not proved:
+        return Claim(1.0, 0.0, Premise(proof.label, proof.kind, 1.0))
+    return claim([proof, *used])

@@ -1,0 +1,117 @@
+"""Typed evidence strength (issue 50; docs/confidence.md).
+
+Every evidence record and side condition of the report carries a
+``strength``: ``{"kind", "detail", "doubt"}``.
+
+=============  ==========================================================
+kind           what it rests on
+=============  ==========================================================
+``proof``      unbounded and decided by a solver or verifier (``solvers``: 2
+               when cvc5 agreed, 1 otherwise)
+``bounded``    exhaustive to a stated bound: SPIN or AJPF over an
+               abstraction or a partial mapping
+``statistical`` experiments: the sample size and the one-sided 95 % bound
+               the data give for the criterion
+``tested``     property tests: examples run against the assumption
+``observed``   monitored runs: questions answered, events read
+``reviewed``   a signed review record
+``assumed``    stated, not verified (environment assumptions, declared
+               progress and initial values)
+=============  ==========================================================
+
+``doubt`` is the probability, by convention, that a claim resting on this
+evidence alone is false (the complement of its confidence; the convention of
+conservative claims, Bishop, Bloomfield, Littlewood et al., IEEE TSE 37(5),
+2011): :data:`DOUBT`.  Only evidence whose status is ``discharged`` gives
+confidence; any other status has doubt 1.
+"""
+from __future__ import annotations
+
+import math
+from typing import Any, Mapping
+
+#: The kinds, strongest first (the report orders and compares by this).
+KINDS = ("proof", "bounded", "statistical", "tested", "observed", "reviewed", "assumed")
+
+#: Doubt of a discharged claim per kind (docs/confidence.md gives the reasons).  ``proof`` is split by
+#: how many independent solvers decided it; ``statistical`` uses its data's bound where there is one.
+DOUBT: Mapping[str, float] = {"proof2": 1e-4, "proof": 1e-3, "bounded": 1e-2, "statistical": 5e-2,
+                              "tested": 5e-2, "observed": 1e-1, "reviewed": 1e-1, "assumed": 2e-1}
+
+#: The strength of each backend's evidence (a test enumerates the backends of ``rclverify.backends``).
+BACKEND_KIND: Mapping[str, str] = {"hoare": "proof", "dafny": "proof", "ajpf": "bounded",
+                                   "model_checking": "bounded", "experiment": "statistical",
+                                   "property_tests": "tested", "monitors": "observed", "review": "reviewed"}
+
+
+def one_sided_bound(n: int, level: float = 0.95) -> float:
+    """The one-sided upper confidence bound, at ``level``, on the rate of
+    trials missing a criterion when ``n`` trials all met it: the exact
+    Clopper-Pearson bound for zero failures, ``1 - (1 - level) ** (1 / n)``
+    (about 3/n, the "rule of three").  ``1.0`` for ``n <= 0``."""
+    return 1.0 if n <= 0 else 1.0 - (1.0 - level) ** (1.0 / n)
+
+
+def _figure(row: Mapping[str, Any], name: str) -> str | None:
+    for pair in row.get("figures") or []:
+        if isinstance(pair, (list, tuple)) and len(pair) == 2 and pair[0] == name:
+            return str(pair[1])
+    return None
+
+
+def evidence_strength(row: Mapping[str, Any]) -> dict[str, Any]:
+    """The strength of one evidence row of the report (``backend``,
+    ``status``, and the backend's figures: ``examples``, ``monitoring``,
+    ``figures``).  Returns ``{"kind", "detail", "doubt"}``; an unknown
+    backend is ``assumed``."""
+    backend = str(row.get("backend", ""))
+    kind = BACKEND_KIND.get(backend, "assumed")
+    detail, doubt = "", DOUBT[kind]
+    if backend == "hoare":
+        detail = "Z3 on the verification conditions (one solver)"
+    elif backend == "dafny":
+        detail = "Dafny (Boogie and Z3; one solver)"
+    elif kind == "bounded":
+        partial = "PARTIAL COVERAGE" in str(row.get("explanation", ""))
+        detail = f"{row.get('tool') or backend} over an abstraction" + ("; partial coverage" if partial else "")
+    elif kind == "statistical":
+        n = _figure(row, "count")
+        k = int(n) if n and n.isdigit() else 0
+        bound = one_sided_bound(k)
+        detail = ("sample size not stated" if not k else f"{k} trials" if row.get("status") != "discharged" else
+                  f"{k} trials, all within the criterion: a one-sided 95 % bound of {bound:.1%} on the rate of trials "
+                  "missing it")
+        doubt = max(DOUBT["statistical"], bound) if k else 1.0
+    elif kind == "tested":
+        ex = row.get("examples") or {}
+        detail = f"{ex.get('valid', 0)} examples within the assumption (of {ex.get('run', 0)} run)"
+    elif kind == "observed":
+        m = row.get("monitoring") or {}
+        c = m.get("counts") or {}
+        answered = int(c.get("satisfied", 0) or 0) + int(c.get("violated", 0) or 0)
+        detail = f"{answered} questions answered, {m.get('events_read', 0)} events read"
+    elif kind == "reviewed":
+        who = (_figure(row, "reviewer") or "").split(";")[0].strip()
+        detail = f"review by {who[:60] or 'an unnamed reviewer'}"
+    if row.get("status") != "discharged":
+        doubt = 1.0
+    return {"kind": kind, "detail": detail, "doubt": doubt}
+
+
+def side_condition_strength(sc: Mapping[str, Any]) -> dict[str, Any]:
+    """The strength of a side-condition row: a ``proof`` by one or two
+    solvers (its ``solvers.agreement``), doubt 1 unless ``discharged``."""
+    two = (sc.get("solvers") or {}).get("agreement") == "two solvers"
+    doubt = DOUBT["proof2" if two else "proof"] if sc.get("status") == "discharged" else 1.0
+    return {"kind": "proof", "detail": "Z3 and cvc5" if two else "Z3 (one solver)", "solvers": 2 if two else 1,
+            "doubt": doubt}
+
+
+def stronger(a: str, b: str) -> str:
+    """The stronger of two kinds (:data:`KINDS` order)."""
+    return a if KINDS.index(a) <= KINDS.index(b) else b
+
+
+def confidence(doubt: float) -> float:
+    """The confidence of a doubt, ``1 - doubt`` clipped to ``[0, 1]``, rounded to 6 places."""
+    return round(min(1.0, max(0.0, 1.0 - doubt)), 6) if not math.isnan(doubt) else 0.0

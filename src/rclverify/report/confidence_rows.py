@@ -1,0 +1,102 @@
+"""Evidence strength and confidence on the report's rows (issue 50).
+
+Annotates the report model :func:`rclverify.report.build.build_report`
+makes, in place:
+
+* every evidence row and side condition gets ``strength``
+  (:mod:`rclverify.argument.strength`);
+* every node gets ``confidence`` (rule C3) and every derived property
+  ``confidence`` (C4, over its cone, loops by a fixpoint);
+* every requirement gets ``confidence`` (C5) and ``limited_by``: the
+  premise with the largest doubt and a sentence naming it;
+* ``summary.confidence``: the least confidence of the formal requirements.
+
+The rules and their sources: :mod:`rclverify.argument.confidence`, docs/confidence.md.
+"""
+from __future__ import annotations
+
+from typing import Any
+
+from ..argument.confidence import Premise, derived_claims, guarantee_premise, node_claims, requirement_claim
+from ..argument.strength import DOUBT, evidence_strength, side_condition_strength
+from ..requirements.rollup import MET, OUTSTANDING
+
+#: Requirement verdicts whose Z3 proof holds (the evidence it rests on may not be all discharged).
+_PROVED = (MET, OUTSTANDING)
+
+_WORDS = {"proof": "a proof by one solver", "bounded": "bounded evidence", "statistical": "statistical evidence",
+          "tested": "tested-only evidence", "observed": "observed-only evidence", "reviewed": "reviewed-only evidence",
+          "assumed": "an assumed premise"}
+
+
+def limit_sentence(req_id: str, p: Premise) -> str:
+    """"REQ2 rests on tested-only evidence for Navigation guarantee 1" (with the doubt)."""
+    if p.doubt >= 1.0:
+        return f"{req_id} rests on {p.label}, which nothing discharges"
+    return f"{req_id} rests on {_WORDS.get(p.kind, p.kind)} for {p.label} (doubt {p.doubt:g})"
+
+
+def annotate(report: dict[str, Any], links: list[tuple[str, str]]) -> None:
+    """Add strength and confidence to ``report`` (module docstring).
+    ``links``: ``(producer node, consumer node)`` of the system model."""
+    by_ob: dict[str, list[dict[str, Any]]] = {}
+    for e in report.get("evidence", []):
+        e["strength"] = evidence_strength(e)
+        by_ob.setdefault(str(e.get("obligation")), []).append(e["strength"])
+    for sc in report.get("side_conditions", []):
+        sc["strength"] = side_condition_strength(sc)
+    own: dict[str, list[Premise]] = {}
+    guarantee: dict[tuple[str, int], Premise] = {}
+    sc_premises: dict[str, list[Premise]] = {}
+    for sc in report.get("side_conditions", []):
+        sc_premises.setdefault(str(sc.get("node")), []).append(
+            Premise(f"side condition {sc['id']}", "proof", sc["strength"]["doubt"]))
+    for n in report.get("nodes", []):
+        name = n["name"]
+        ps: list[Premise] = []
+        for g in n.get("guarantees", []):
+            legs = [(s["kind"], s["doubt"]) for o in g.get("obligations", []) for s in by_ob.get(o, [])]
+            p = guarantee_premise(f"{name} guarantee {g['index']}", legs)
+            guarantee[(name, int(g["index"]))] = p
+            g["strength"] = {"kind": p.kind, "doubt": p.doubt}
+            ps.append(p)
+        own[name] = ps + sc_premises.get(name, [])
+    producers: dict[str, set[str]] = {n: set() for n in own}
+    for a, b in links:
+        if b in producers and a in own:
+            producers[b].add(a)
+    for name, c in node_claims(own).items():
+        _put(next(n for n in report["nodes"] if n["name"] == name), c)
+    derived = derived_claims(own, producers)
+    for d in report.get("derived_properties", []):
+        if d.get("node") in derived:
+            _put(d, derived[d["node"]])
+    lows: list[float] = []
+    for rq in report.get("requirements", []):
+        check = rq.get("check") or {}
+        if not check.get("formal"):
+            continue
+        two = (check.get("solvers") or {}).get("agreement") == "two solvers"
+        proof = Premise(f"the proof of {rq['id']}", "proof", DOUBT["proof2" if two else "proof"])
+        used: list[Premise] = []
+        for p in check.get("used") or []:
+            if p.get("kind") == "guarantee" and (p.get("node"), p.get("index")) in guarantee:
+                used.append(guarantee[(p["node"], p["index"])])
+                used.extend(sc_premises.get(p["node"], []))
+            else:
+                used.append(Premise(str(p.get("label", p.get("kind"))), "assumed", DOUBT["assumed"]))
+        c = requirement_claim(rq.get("verdict") in _PROVED, proof, used)
+        _put(rq, c)
+        if rq.get("verdict") not in _PROVED:
+            rq["limited_by"]["sentence"] = f"{rq['id']} is {rq.get('verdict')}: no confidence rests on it"
+        elif c.limits is not None:
+            rq["limited_by"]["sentence"] = limit_sentence(rq["id"], c.limits)
+        lows.append(c.confidence)
+    if lows:
+        report.setdefault("summary", {})["confidence"] = min(lows)
+
+
+def _put(row: dict[str, Any], c: Any) -> None:
+    row["confidence"] = c.confidence
+    row["limited_by"] = None if c.limits is None else {"label": c.limits.label, "kind": c.limits.kind,
+                                                       "doubt": c.limits.doubt}
