@@ -39,6 +39,8 @@ from .workspace import PLAN, LspWorkspace, Outside
 
 #: Seconds a check of the text as you type may take before it is abandoned.
 TIME_LIMIT = 5.0
+#: Seconds between two looks at the last run's SARIF log.
+POLL = 1.0
 
 
 class Refused(JsonRpcException):
@@ -61,6 +63,7 @@ class RclServer(LanguageServer):
         self._wanted: dict[tuple[str, ...], int] = {}
         self._running: set[tuple[str, ...]] = set()
         self._published: set[str] = set()
+        self.messages: Any = None
 
     # -- the workspace ---------------------------------------------------------------------------
     def set_root(self, root: Path, plan: str = PLAN) -> None:
@@ -132,6 +135,20 @@ class RclServer(LanguageServer):
             self.good[key] = a
         self.publish(a, texts)
 
+    async def watch_last_run(self) -> None:
+        """Publish again every analysed scope's diagnostics when a run wrote
+        a new SARIF log (checked every :data:`POLL` seconds), so that the
+        findings of a run that ends while the file is open appear without an edit."""
+        seen = self.last.written()
+        while True:
+            await asyncio.sleep(POLL)
+            now = self.last.written()
+            if now != seen:
+                seen = now
+                texts = self.open_texts()
+                for a in list(self.analyses.values()):
+                    self.publish(a, texts)
+
     def publish(self, a: Analysis, texts: dict[str, str]) -> None:
         """Publish ``a``'s diagnostics for every open file it concerns, with
         the last run's findings in each; clear the files published before
@@ -175,6 +192,11 @@ def _initialize(ls: RclServer, params: lsp.InitializeParams) -> None:
     plan = str(opts.get("plan") or PLAN)
     if root is not None and root.is_dir():
         ls.set_root(root, plan)
+
+
+@SERVER.feature(lsp.INITIALIZED)
+def _initialized(ls: RclServer, params: lsp.InitializedParams) -> None:
+    asyncio.ensure_future(ls.watch_last_run())
 
 
 def _notified(ls: RclServer, uri: str) -> str | None:
@@ -237,6 +259,51 @@ def _code_action(ls: RclServer, params: lsp.CodeActionParams) -> list[lsp.CodeAc
     from .actions import quick_fixes
     rel, _text = text_of(ls, params.text_document.uri)
     return quick_fixes(ls.ws, ls.open_texts(), rel, params, ls.last)
+
+
+def _symbol(ls: RclServer, uri: str, pos: lsp.Position) -> tuple[Any, Any] | None:
+    """``(analysis, symbol)`` at ``pos`` of ``uri``, ``None`` when nothing known stands there."""
+    from .index import symbol_at
+    rel, text = text_of(ls, uri)
+    a = ls.analysis(rel) or ls.analysis(rel, good=False)
+    if a is None:
+        return None
+    sym = symbol_at(a, rel, text, pos.line, pos.character, plan=rel == ls.ws.plan)
+    return (a, sym) if sym is not None else None
+
+
+@SERVER.feature(lsp.TEXT_DOCUMENT_HOVER)
+def _hover(ls: RclServer, params: lsp.HoverParams) -> lsp.Hover | None:
+    from .hover import hover
+    found = _symbol(ls, params.text_document.uri, params.position)
+    return hover(found[0], found[1], ls.last.report()) if found else None
+
+
+@SERVER.feature(lsp.TEXT_DOCUMENT_DEFINITION)
+def _definition(ls: RclServer, params: lsp.DefinitionParams) -> list[lsp.Location] | None:
+    from .navigate import definition
+    found = _symbol(ls, params.text_document.uri, params.position)
+    return definition(ls.ws, found[0], ls.open_texts(), found[1]) or None if found else None
+
+
+@SERVER.feature(lsp.TEXT_DOCUMENT_REFERENCES)
+def _references(ls: RclServer, params: lsp.ReferenceParams) -> list[lsp.Location] | None:
+    from .navigate import references
+    found = _symbol(ls, params.text_document.uri, params.position)
+    if not found:
+        return None
+    return references(ls.ws, found[0], ls.open_texts(), found[1], params.context.include_declaration) or None
+
+
+@SERVER.feature(lsp.TEXT_DOCUMENT_COMPLETION, lsp.CompletionOptions(trigger_characters=[".", "[", " "]))
+def _completion(ls: RclServer, params: lsp.CompletionParams) -> lsp.CompletionList:
+    from .complete import MessageTypes, completions
+    rel, text = text_of(ls, params.text_document.uri)
+    if ls.messages is None or ls.messages.root != ls.ws.root:
+        ls.messages = MessageTypes(ls.ws.root)
+    a = ls.analysis(rel) or ls.analysis(rel, good=False)
+    items = completions(a, rel, text, params.position.line, params.position.character, ls.messages)
+    return lsp.CompletionList(is_incomplete=False, items=items)
 
 
 def serve(root: Path | None = None, plan: str = PLAN) -> int:
