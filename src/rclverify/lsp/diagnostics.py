@@ -127,7 +127,7 @@ def utf16_col(line_text: str, col: int) -> int:
     """The LSP character offset (UTF-16 code units, 0-based) of the 0-based
     code-point column ``col`` of ``line_text`` (LSP 3.17, "Position")."""
     head = line_text[:max(col, 0)]
-    return len(head.encode("utf-16-le")) // 2
+    return len(head.encode("utf-16-le", "surrogatepass")) // 2
 
 
 def lsp_range(loc: ast.Loc, lines: list[str]) -> lsp.Range:

@@ -120,16 +120,20 @@ class RclServer(LanguageServer):
         first = key[0]
         loop = asyncio.get_running_loop()
         fut = loop.run_in_executor(self.thread_pool, analyse, self.ws, first, texts)
+        from ..rcl.ast import Loc
+        from ..rcl.errors import error
         try:
             a = await asyncio.wait_for(asyncio.shield(fut), TIME_LIMIT)
         except asyncio.TimeoutError:
-            from ..rcl.ast import Loc
-            from ..rcl.errors import error
             a = Analysis(first, key)
             for f in key:
                 if f in texts:
                     a.add([error(Loc(f, 1, 1), f"checking took longer than {TIME_LIMIT:g} s; not checked as you type "
                                  f"(run `rclverify check {f}`)", "E-lsp-time")])
+        except Exception as exc:  # a fault of the server, not of the text: said where the user looks
+            a = Analysis(first, key)
+            a.add([error(Loc(first, 1, 1), f"the language server could not check this text ({type(exc).__name__}: "
+                         f"{exc}); `rclverify check {first}` checks it", "E-lsp-internal")])
         self.analyses[key] = a
         if a.checked is not None:
             self.good[key] = a
@@ -150,15 +154,15 @@ class RclServer(LanguageServer):
                     self.publish(a, texts)
 
     def publish(self, a: Analysis, texts: dict[str, str]) -> None:
-        """Publish ``a``'s diagnostics for every open file it concerns, with
-        the last run's findings in each; clear the files published before
-        that have none now."""
-        files = set(texts) & (set(a.files) | set(a.diagnostics) | {self.ws.plan}) if a.files else set()
-        files |= {f for f in self._published if f in a.files or f in a.diagnostics}
+        """Publish ``a``'s diagnostics for every file it has some for and every
+        open file of its scope (and the plan), with the last run's findings
+        in each; clear the files published before that have none now."""
+        files = set(a.diagnostics) | (set(a.files) & set(texts)) | ({self.ws.plan} & set(texts))
+        files |= {f for f in self._published if f in a.files or f == self.ws.plan}
         for f in sorted(files):
             text = texts.get(f)
             if text is None:
-                text = self.ws.disk_text(f) or ""
+                text = self.ws.shown_text(f)
             lines = text.split("\n")
             diags = [to_lsp(d, lines) for d in a.diagnostics.get(f, [])]
             fresh = self.last.fresh(f, texts.get(f), self.ws.disk_text(f))

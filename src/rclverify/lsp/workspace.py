@@ -103,3 +103,13 @@ class LspWorkspace:
             return decode_text((self.root / rel).read_bytes(), rel)
         except (OSError, RclError):
             return None
+
+
+    def shown_text(self, rel: str) -> str:
+        """The saved text of ``rel`` as far as it reads (bytes that are not
+        UTF-8 replaced), for placing a diagnostic in a file that does not
+        decode; ``""`` when it cannot be read."""
+        try:
+            return (self.root / rel).read_bytes().decode("utf-8", "replace")
+        except OSError:
+            return ""
