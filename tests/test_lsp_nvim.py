@@ -78,3 +78,31 @@ def test_neovim_reads_the_located_diagnostic(tmp_path: Path) -> None:
     want = [(d.loc.line - 1, d.loc.col - 1, d.message, d.code) for d in exc.value.diagnostics]
     assert [(r["lnum"], r["col"], r["message"], r["code"]) for r in rows] == want
     assert all(r["severity"] == 1 for r in rows)  # vim.diagnostic.severity.ERROR
+
+
+def test_the_textmate_grammar_reads_rcl_lark_s_words() -> None:
+    """editors/rcl.tmLanguage.json: every pattern compiles, and each reserved word of rcl.lark (the words
+    its NAME terminal excludes) and each clause keyword is coloured as a keyword, not as a variable."""
+    import re
+    grammar = json.loads((REPO / "editors" / "rcl.tmLanguage.json").read_text(encoding="utf-8"))
+    patterns: list[tuple[str, str]] = []
+
+    def walk(x: object) -> None:
+        if isinstance(x, dict):
+            if "match" in x:
+                caps = x.get("captures") or {}
+                patterns.append((str(x.get("name") or (caps.get("1") or {}).get("name", "")), str(x["match"])))
+            for k, v in x.items():
+                if k in ("match", "begin", "end"):
+                    re.compile(str(v))
+                walk(v)
+        elif isinstance(x, list):
+            for v in x:
+                walk(v)
+    walk(grammar)
+    lark = (REPO / "src" / "rclverify" / "rcl" / "rcl.lark").read_text(encoding="utf-8")
+    reserved = re.search(r"NAME: /\(\?!\(([^)]*)\)", lark).group(1).split("|")
+    assert "forall" in reserved and "TRUE" in reserved
+    for word in reserved + ["context", "assume(", "guarantee(", "matches"]:
+        name = next(n for n, p in patterns if re.match(p, word))
+        assert not name.startswith("variable"), (word, name)
