@@ -1,10 +1,12 @@
 """``rclverify lsp``: the RCL language server over stdio (docs/editor.md).
 
-Exit codes: 0 when the client ends the session; 2 usage errors.
+Exit codes: 0 when the client ends the session; 2 usage errors (also a
+``-w`` that names no directory).
 """
 from __future__ import annotations
 
 import argparse
+import sys
 from pathlib import Path
 from typing import Any
 
@@ -24,6 +26,10 @@ def add_parsers(sub: Any) -> None:
 
 
 def cmd_lsp(args: argparse.Namespace) -> int:
-    """Serve the workspace until the client exits."""
+    """Serve the workspace until the client exits; exit 2 (one line) when
+    ``-w`` names no directory."""
+    if args.workspace and not Path(args.workspace).is_dir():
+        print(f"{args.workspace}: error: no such workspace directory", file=sys.stderr)
+        return 2
     from .server import serve
     return serve(Path(args.workspace) if args.workspace else None, args.plan)
