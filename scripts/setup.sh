@@ -20,6 +20,7 @@ as_root() {
 #   ROS 1 (ros-core ...)     a real ROS master and rospy nodes for the live monitor and the graph read
 #                            from a running system; message definitions for grounding
 #   chromium(-driver)        the browser test of the HTML report
+#   neovim                   the language server's test in a real editor (tests/test_lsp_nvim.py)
 DEBIAN_PACKAGES=(
   dafny graphviz spin gcc
   ros-core python3-rospy python3-rosbag python3-rosgraph python3-roslaunch python3-genpy python3-catkin-pkg
@@ -27,6 +28,7 @@ DEBIAN_PACKAGES=(
   python3-actionlib python3-actionlib-msgs ros-actionlib-msgs ros-std-srvs
   ros-std-msgs ros-geometry-msgs ros-sensor-msgs ros-nav-msgs
   chromium chromium-driver
+  neovim
 )
 if command -v apt-get >/dev/null 2>&1; then
   need=()

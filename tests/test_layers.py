@@ -149,8 +149,9 @@ LAYERS: list[tuple[str, tuple[str, ...]]] = [
     # init``: a new workspace from templates), bundle/ (``rclverify bundle``:
     # an archive of the evidence with its manifest), ``rclverify ros ...``
     # (ros/cli.py) and ``init --from-ros`` (ros/skeleton.py, on scaffold's
-    # templates).
-    ("cli", ("rclverify.cli", "rclverify.requirements.show", "rclverify.scaffold", "rclverify.generate", "rclverify.bundle", "rclverify.ros.cli",
+    # templates), and the language server (lsp/, ``rclverify lsp``: beside the CLI, it reads what
+    # every layer below gives and the last run's report files).
+    ("cli", ("rclverify.cli", "rclverify.lsp", "rclverify.requirements.show", "rclverify.scaffold", "rclverify.generate", "rclverify.bundle", "rclverify.ros.cli",
              "rclverify.ros.skeleton")),
 ]
 

@@ -19,6 +19,7 @@
 ``rclverify review NODE [-o FILE]``  write a review record to fill in
 ``rclverify ros scan PATH...``     the ROS computation graph from workspaces (docs/ros.md)
 ``rclverify ros check``            the plan's contracts against that graph
+``rclverify lsp``                  the RCL language server over stdio (docs/editor.md)
 
 Exit codes: 0 success, 1 errors in the input (or, for ``compose``/``verify
 --strict``, an obligation that does not hold), 2 usage errors.  A user's
@@ -639,6 +640,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     add_ros_parsers(sub)
     from .generate.cli import add_parsers as add_generate_parsers
     add_generate_parsers(sub)
+    from .lsp.cli import add_parsers as add_lsp_parsers
+    add_lsp_parsers(sub)
     m = add("monitor", cmd_monitor, "check recorded runs (ROSMonitoring logs, ROS bags) against every "
             "node's contract", True)
     m.add_argument("traces", nargs="*", metavar="TRACE", help="a .jsonl log, a .bag, a ROS 2 bag directory or .mcap")

@@ -1,0 +1,47 @@
+"""The case study's contracts as a small workspace for the language server's tests.
+
+The rover's contracts and the plan's environment facts (which the repair of
+the Agent's guarantee 3 needs: waypoints 0-12), with one requirement (REQ3), without the evidence
+entries and the ROS section, so that the real stages run in about
+four seconds: check, compose, health, requirements, the report with its diagnosis and SARIF
+log (rclverify.pipeline, as `doit verify` runs them).
+"""
+from __future__ import annotations
+
+import shutil
+from pathlib import Path
+
+import yaml
+
+REPO = Path(__file__).resolve().parents[1]
+RCL = "contracts/remote_inspection.rcl"
+PLAN = "contracts/plan.yaml"
+MSG = "ros/gazebo_radiation_plugin/msg/Snapshot.msg"
+
+
+def make_workspace(root: Path) -> Path:
+    """Write the workspace under ``root`` (a new directory); returns ``root``."""
+    (root / "contracts").mkdir(parents=True)
+    shutil.copy(REPO / RCL, root / RCL)
+    (root / MSG).parent.mkdir(parents=True)  # the message type the topics name (completion of its fields)
+    shutil.copy(REPO / MSG, root / MSG)
+    data = yaml.safe_load((REPO / PLAN).read_text(encoding="utf-8"))
+    data.update(requirements=[r for r in data["requirements"] if r["id"] == "REQ3"], nodes={})
+    for key in ("state", "ros"):
+        data.pop(key, None)
+    (root / PLAN).write_text(yaml.safe_dump(data, sort_keys=False), encoding="utf-8")
+    return root
+
+
+def run_pipeline(root: Path, nodes: tuple[str, ...] = ()) -> None:
+    """The stages of a run on ``root`` (every node's health, or ``nodes``'), then the report files."""
+    from rclverify.pipeline import Workspace, stage_check, stage_compose, stage_health, stage_report, stage_requirements
+    from rclverify.report.build import build_report
+    ws = Workspace(root)
+    stage_check(ws)
+    for n in ws.node_names():
+        stage_compose(ws, n)
+        if not nodes or n in nodes:
+            stage_health(ws, n)
+    stage_requirements(ws)
+    stage_report(ws, report=build_report(ws))
