@@ -7,7 +7,10 @@ information flow" (lines 1876-1877).  This module answers it with one
 conservative calculus over doubts (``doubt = 1 - confidence``; each
 evidence kind's doubt is :data:`.strength.DOUBT`):
 
-C1  a guarantee's doubt is the least doubt of its discharged evidence (the
+C0  a failed obligation is counter-evidence: it defeats its guarantee
+    (doubt 1), whatever else supports it;
+C1  a guarantee's doubt is the least doubt of its evidence legs (one leg per
+    evidence entry, its doubt the C2 sum over the entry's obligations; the
     strongest leg; legs are not assumed independent, so several legs earn
     no extra credit: Littlewood and Wright, IEEE TSE 33(5), 2007); 1 without
     discharged evidence;

@@ -40,7 +40,7 @@ DOUBT: Mapping[str, float] = {"proof2": 1e-4, "proof": 1e-3, "bounded": 1e-2, "s
 
 #: The strength of each backend's evidence (a test enumerates the backends of ``rclverify.backends``).
 BACKEND_KIND: Mapping[str, str] = {"hoare": "proof", "dafny": "proof", "ajpf": "bounded",
-                                   "model_checking": "bounded", "experiment": "statistical",
+                                   "experiment": "statistical",
                                    "property_tests": "tested", "monitors": "observed", "review": "reviewed"}
 
 

@@ -121,7 +121,8 @@ def load_plan(root: Path, plan_rel: str = "contracts/plan.yaml") -> Plan:
                                 tuple(x for x in srcs if x is not None),
                                 ranking=_source(("requirements", i, "ranking"), r, "ranking", locs, blocks, plan_rel),
                                 invariant=_source(("requirements", i, "invariant"), r, "invariant", locs, blocks,
-                                                  plan_rel)))
+                                                  plan_rel),
+                                strength=r.get("strength")))
     conns = []
     for i, c in enumerate(data.get("connections", []) or []):
         fn, fv = c["from"].split(".", 1)

@@ -35,7 +35,9 @@ class Requirement:
     ``Node.in.x``/``Node.out.y`` (:mod:`.formal`); ``origin`` is ``"plan"``
     or the Doorstop item's workspace-relative file; ``ranking`` and
     ``invariant`` the sources of a liveness statement's ranking function
-    and invariant (:mod:`.ranking`; ``None`` when not given).
+    and invariant (:mod:`.ranking`; ``None`` when not given); ``strength``
+    the least evidence strength the guarantees its proof uses must have
+    (:data:`rclverify.argument.strength.KINDS`; ``--strict`` enforces it).
     """
 
     id: str
@@ -47,6 +49,8 @@ class Requirement:
     origin: str = "plan"
     ranking: Source | None = None
     invariant: Source | None = None
+    #: the least evidence strength the guarantees its proof uses must have (docs/confidence.md), or ``None``
+    strength: str | None = None
 
 
 @dataclass(frozen=True)

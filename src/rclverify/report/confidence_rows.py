@@ -18,7 +18,7 @@ from __future__ import annotations
 from typing import Any
 
 from ..argument.confidence import Premise, derived_claims, guarantee_premise, node_claims, requirement_claim
-from ..argument.strength import DOUBT, evidence_strength, side_condition_strength
+from ..argument.strength import DOUBT, KINDS, evidence_strength, side_condition_strength
 from ..requirements.rollup import MET, OUTSTANDING
 
 #: Requirement verdicts whose Z3 proof holds (the evidence it rests on may not be all discharged).
@@ -36,13 +36,21 @@ def limit_sentence(req_id: str, p: Premise) -> str:
     return f"{req_id} rests on {_WORDS.get(p.kind, p.kind)} for {p.label} (doubt {p.doubt:g})"
 
 
-def annotate(report: dict[str, Any], links: list[tuple[str, str]]) -> None:
+def annotate(report: dict[str, Any], links: list[tuple[str, str]], required: dict[str, str] | None = None) -> bool:
     """Add strength and confidence to ``report`` (module docstring).
-    ``links``: ``(producer node, consumer node)`` of the system model."""
+    ``links``: ``(producer node, consumer node)`` of the system model;
+    ``required``: requirement id -> the least strength the plan asks of the
+    guarantees its proof uses.  Returns ``False`` when a requirement falls
+    short of its required strength (then ``--strict`` fails; each shortfall
+    is a problem of ``summary.problems`` and the requirement's
+    ``strength_shortfall``)."""
+    ok = True
+    required = required or {}
     by_ob: dict[str, list[dict[str, Any]]] = {}
     for e in report.get("evidence", []):
         e["strength"] = evidence_strength(e)
         by_ob.setdefault(str(e.get("obligation")), []).append(e["strength"])
+    status = {str(o.get("id")): str(o.get("status")) for o in report.get("obligations", [])}
     for sc in report.get("side_conditions", []):
         sc["strength"] = side_condition_strength(sc)
     own: dict[str, list[Premise]] = {}
@@ -55,8 +63,7 @@ def annotate(report: dict[str, Any], links: list[tuple[str, str]]) -> None:
         name = n["name"]
         ps: list[Premise] = []
         for g in n.get("guarantees", []):
-            legs = [(s["kind"], s["doubt"]) for o in g.get("obligations", []) for s in by_ob.get(o, [])]
-            p = guarantee_premise(f"{name} guarantee {g['index']}", legs)
+            p = guarantee_premise(f"{name} guarantee {g['index']}", _legs(g.get("obligations", []), by_ob, status))
             guarantee[(name, int(g["index"]))] = p
             g["strength"] = {"kind": p.kind, "doubt": p.doubt}
             ps.append(p)
@@ -79,13 +86,25 @@ def annotate(report: dict[str, Any], links: list[tuple[str, str]]) -> None:
         two = (check.get("solvers") or {}).get("agreement") == "two solvers"
         proof = Premise(f"the proof of {rq['id']}", "proof", DOUBT["proof2" if two else "proof"])
         used: list[Premise] = []
+        rests: list[Premise] = []  # the guarantees the proof used
         for p in check.get("used") or []:
             if p.get("kind") == "guarantee" and (p.get("node"), p.get("index")) in guarantee:
-                used.append(guarantee[(p["node"], p["index"])])
+                rests.append(guarantee[(p["node"], p["index"])])
+                used.append(rests[-1])
                 used.extend(sc_premises.get(p["node"], []))
             else:
                 used.append(Premise(str(p.get("label", p.get("kind"))), "assumed", DOUBT["assumed"]))
         c = requirement_claim(rq.get("verdict") in _PROVED, proof, used)
+        need = required.get(str(rq["id"]))
+        if need in KINDS:
+            short = [g for g in rests if g.doubt >= 1.0 or g.kind not in KINDS or KINDS.index(g.kind) > KINDS.index(need)]
+            rq["required_strength"] = need
+            rq["strength_shortfall"] = [f"{g.label} ({g.kind if g.doubt < 1.0 else 'nothing discharged'})" for g in short]
+            if short:
+                ok = False
+                report.setdefault("summary", {}).setdefault("problems", []).append(
+                    f"Requirement {rq['id']} requires {need} evidence; " + ", ".join(
+                        f"{g.label} rests on {g.kind if g.doubt < 1.0 else 'no discharged'} evidence" for g in short))
         _put(rq, c)
         if rq.get("verdict") not in _PROVED:
             rq["limited_by"]["sentence"] = f"{rq['id']} is {rq.get('verdict')}: no confidence rests on it"
@@ -94,6 +113,28 @@ def annotate(report: dict[str, Any], links: list[tuple[str, str]]) -> None:
         lows.append(c.confidence)
     if lows:
         report.setdefault("summary", {})["confidence"] = min(lows)
+    return ok
+
+
+#: Obligation statuses that are counter-evidence: the guarantee is defeated (docs/confidence.md, C0).
+_DEFEATING = ("failed", "error")
+
+
+def _legs(obligations: list[str], by_ob: dict[str, list[dict[str, Any]]],
+          status: dict[str, str]) -> list[tuple[str, float]]:
+    """A guarantee's legs (C1): its obligations grouped by evidence entry (the
+    obligation id up to its entry, ``Node.g1.hoare.prog``), each leg's doubt
+    the C2 sum over its obligations (conjuncts and instances are all needed).
+    One failed obligation defeats the guarantee (C0): a single leg of doubt 1."""
+    if any(status.get(o) in _DEFEATING for o in obligations):
+        return [("defeated", 1.0)]
+    legs: dict[str, list[tuple[str, float]]] = {}
+    for o in obligations:
+        parts = o.split(".")
+        leg = ".".join(parts[:4])
+        strengths = by_ob.get(o) or [{"kind": "assumed", "doubt": 1.0}]
+        legs.setdefault(leg, []).extend((s["kind"], s["doubt"]) for s in strengths)
+    return [(ps[0][0], min(1.0, sum(d for _, d in ps))) for ps in legs.values()]
 
 
 def _put(row: dict[str, Any], c: Any) -> None:

@@ -1,0 +1,131 @@
+"""Evidence strength and the confidence calculus (issue 50; docs/confidence.md)."""
+from __future__ import annotations
+
+import json
+import shutil
+from pathlib import Path
+
+import networkx as nx
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from rclverify.argument.confidence import Premise, claim, cones, derived_claims, requirement_claim
+from rclverify.argument.strength import BACKEND_KIND, KINDS, evidence_strength, one_sided_bound
+from rclverify.cli import main
+from rclverify.plan.entries import BACKEND_NAMES
+
+IDENTITY = "var x : REAL;\nvar y : REAL;\n\ny := x\n"
+EVIDENCE = """nodes:
+  Sensor:
+    evidence:
+      - {backend: hoare, program: backends/hoare/id.imp, binding: {in.reading: x, out.sensor_value: y}}
+  Controller:
+    evidence:
+      - {backend: hoare, program: backends/hoare/id.imp, binding: {in.sensor_value: x, out.controller_value: y}}
+  Actuator:
+    evidence:
+      - {backend: hoare, program: backends/hoare/id.imp, binding: {in.controller_value: x, out.actuator_value: y}}
+"""
+
+
+def test_every_backend_has_a_strength() -> None:
+    assert set(BACKEND_NAMES) == set(BACKEND_KIND)
+    assert set(BACKEND_KIND.values()) <= set(KINDS)
+    for b in BACKEND_NAMES:  # any status but discharged gives no confidence
+        assert evidence_strength({"backend": b, "status": "failed"})["doubt"] == 1.0
+        s = evidence_strength({"backend": b, "status": "discharged", "figures": [["count", "60"]]})
+        assert s["kind"] == BACKEND_KIND[b] and 0 < s["doubt"] < 1
+
+
+def test_the_experiment_bound_is_clopper_pearson_with_no_failure() -> None:
+    # 0.95 = 1 - (1 - p)^n at p = the bound: n trials all passing
+    for n in (1, 10, 47, 300):
+        p = one_sided_bound(n)
+        assert abs((1 - p) ** n - 0.05) < 1e-12
+    s = evidence_strength({"backend": "experiment", "status": "discharged", "figures": [["count", "10"]]})
+    assert s["doubt"] == pytest.approx(one_sided_bound(10)) and "10 trials" in s["detail"]
+
+
+# -- the oracle: random argument graphs with loops against a direct reading of the rules ----------------
+
+@st.composite
+def graphs(draw):
+    n = draw(st.integers(1, 5))
+    nodes = [f"N{i}" for i in range(n)]
+    edges = draw(st.lists(st.tuples(st.sampled_from(nodes), st.sampled_from(nodes)), max_size=8))
+    own = {v: [Premise(f"{v} p{j}", draw(st.sampled_from(KINDS)),
+                       draw(st.sampled_from([0.0, 1e-4, 1e-3, 0.01, 0.05, 0.2, 0.5, 1.0])))
+               for j in range(draw(st.integers(0, 3)))] for v in nodes}
+    return nodes, edges, own
+
+
+@settings(max_examples=200, deadline=None)
+@given(graphs())
+def test_confidence_equals_a_direct_evaluation_of_the_rules(g) -> None:
+    nodes, edges, own = g
+    producers = {v: [a for a, b in edges if b == v] for v in nodes}
+    dg = nx.DiGraph()
+    dg.add_nodes_from(nodes)
+    dg.add_edges_from(edges)
+    got = derived_claims(own, producers)
+    assert cones(producers) == {v: frozenset(nx.ancestors(dg, v) | {v}) for v in nodes}
+    for v in nodes:
+        # C4 read directly: every premise of every node that reaches v (v included), each once; C2: the sum, at most 1
+        premises = {p.label: p.doubt for u in nx.ancestors(dg, v) | {v} for p in own[u]}
+        doubt = min(1.0, sum(premises.values()))
+        assert got[v].doubt == pytest.approx(doubt, abs=1e-9)
+        assert got[v].confidence == pytest.approx(1 - doubt, abs=1e-9)
+        if premises:
+            assert got[v].limits.doubt == max(premises.values())
+    proof = Premise("proof", "proof", 1e-4)
+    assert requirement_claim(False, proof, own[nodes[0]]).confidence == 0.0
+    assert requirement_claim(True, proof, own[nodes[0]]) == claim([proof, *own[nodes[0]]])
+
+
+# -- on a verified workspace --------------------------------------------------------------------------
+
+@pytest.fixture(scope="module")
+def ws(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    root = tmp_path_factory.mktemp("confidence") / "ws"
+    assert main(["init", str(root)]) == 0
+    (root / "backends/hoare").mkdir(parents=True)
+    (root / "backends/hoare/id.imp").write_text(IDENTITY)
+    plan = root / "contracts/plan.yaml"
+    text = plan.read_text()
+    plan.write_text(text.replace("nodes:\n  Sensor: {}\n  Controller: {}\n  Actuator: {}\n", EVIDENCE)
+                    .replace("    text: The output of Actuator stays within 0..100.\n",
+                             "    text: The output of Actuator stays within 0..100.\n    strength: proof\n"))
+    assert main(["verify", "-w", str(root)]) == 0
+    return root
+
+
+def test_strength_and_confidence_in_every_format(ws: Path) -> None:
+    r = json.loads((ws / "reports/assurance.json").read_text())
+    assert r["evidence"] and all(e["strength"]["kind"] == "proof" and e["status"] == "discharged" for e in r["evidence"])
+    assert all(sc["strength"] == {"kind": "proof", "detail": "Z3 and cvc5", "solvers": 2, "doubt": 1e-4}
+               for sc in r["side_conditions"])
+    req = {q["id"]: q for q in r["requirements"]}
+    assert req["REQ1"]["verdict"] == "met" and 0.99 < req["REQ1"]["confidence"] < 1
+    assert req["REQ1"]["limited_by"]["sentence"].startswith("REQ1 rests on a proof by one solver for Actuator guarantee 1")
+    assert req["REQ1"]["strength_shortfall"] == []
+    assert r["summary"]["confidence"] == min(q["confidence"] for q in r["requirements"])
+    sarif = json.loads((ws / "reports/assurance.sarif").read_text())
+    assert sarif and "strength" in (ws / "reports/assurance.junit.xml").read_text()
+    assert "rests on a proof by one solver" in (ws / "reports/assurance.html").read_text()
+    assert "confidence" in (ws / "reports/argument.gsn.yaml").read_text()
+
+
+def test_a_required_strength_the_evidence_lacks_fails_strict(ws: Path, tmp_path: Path) -> None:
+    root = tmp_path / "ws"
+    shutil.copytree(ws, root)
+    plan = root / "contracts/plan.yaml"
+    # Actuator's only evidence goes: REQ1 (strength: proof) now rests on nothing discharged
+    plan.write_text(plan.read_text().replace(
+        "  Actuator:\n    evidence:\n      - {backend: hoare, program: backends/hoare/id.imp, binding: "
+        "{in.controller_value: x, out.actuator_value: y}}\n", "  Actuator: {}\n"))
+    assert main(["verify", "-w", str(root), "--strict"]) == 1
+    r = json.loads((root / "reports/assurance.json").read_text())
+    req = next(q for q in r["requirements"] if q["id"] == "REQ1")
+    assert req["confidence"] == 0.0 and req["strength_shortfall"] == ["Actuator guarantee 1 (nothing discharged)"]
+    assert any(p.startswith("Requirement REQ1 requires proof evidence") for p in r["summary"]["problems"])
