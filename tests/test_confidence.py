@@ -129,3 +129,23 @@ def test_a_required_strength_the_evidence_lacks_fails_strict(ws: Path, tmp_path:
     req = next(q for q in r["requirements"] if q["id"] == "REQ1")
     assert req["confidence"] == 0.0 and req["strength_shortfall"] == ["Actuator guarantee 1 (nothing discharged)"]
     assert any(p.startswith("Requirement REQ1 requires proof evidence") for p in r["summary"]["problems"])
+
+
+def test_hoare_conditions_are_decided_by_both_solvers(ws: Path, tmp_path: Path) -> None:
+    from rclverify.crosscheck.stage import stage_crosscheck
+    r = json.loads((ws / "reports/assurance.json").read_text())
+    hoare = [e for e in r["evidence"] if e["backend"] == "hoare"]
+    assert hoare and all(e["solvers"]["agreement"] == "two solvers" for e in hoare)
+    assert all(e["strength"]["detail"] == "Z3 and cvc5 on the verification conditions" for e in hoare)
+    root = tmp_path / "ws"
+    shutil.copytree(ws, root)
+    # a Hoare condition Z3 is recorded to have proved is in fact satisfiable: the evidence is not discharged
+    (root / "artifacts/hoare/Sensor/g2.id.c1.smt2").write_text(
+        "(push 1)\n(declare-fun x () Real)\n(assert (< x 0.0))\n(check-sat)\n(pop 1)\n")
+    stage_crosscheck(root, ["Sensor", "Controller", "Actuator"])
+    assert main(["report", "-w", str(root)]) in (0, 1)
+    r = json.loads((root / "reports/assurance.json").read_text())
+    ev = next(e for e in r["evidence"] if e["obligation"] == "Sensor.g2.hoare.id.c1")
+    assert ev["status"] == "inconclusive" and ev["solvers"]["agreement"] == "disagree"
+    assert ev["explanation"].startswith("Not discharged: Z3 answered unsat, cvc5 sat")
+    assert next(q for q in r["requirements"] if q["id"] == "REQ2")["verdict"] != "met"

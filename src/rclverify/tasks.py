@@ -705,10 +705,13 @@ def _build_tasks(root: str | Path, plan_file: str) -> dict[str, Callable[[], Any
 
     ros_section = dict(index.ros) if index is not None else {}  # from the index: a no-op run loads no contract
 
+    @create_after(executed="evidence")
     def task_crosscheck() -> dict[str, Any]:
         """Decide every discharging Z3 query again with cvc5 from its SMT-LIB2 text (docs/second-solver.md)."""
         from .crosscheck.stage import INDEX as CROSS
         deps = [at(ws.calculus(n)) for n in nodes] + [at(ws.health(n)) for n in nodes]
+        deps += [at(ws.obligations(n)) for n in nodes]
+        deps += [at(ws.evidence(o["id"])) for _, o in exported() if o.get("backend") == "hoare"]
         deps.append(at("artifacts/requirements/index.json"))
         if deadline_nodes:
             deps.append(at("artifacts/deadlines/index.json"))

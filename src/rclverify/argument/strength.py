@@ -68,7 +68,9 @@ def evidence_strength(row: Mapping[str, Any]) -> dict[str, Any]:
     kind = BACKEND_KIND.get(backend, "assumed")
     detail, doubt = "", DOUBT[kind]
     if backend == "hoare":
-        detail = "Z3 on the verification conditions (one solver)"
+        two = (row.get("solvers") or {}).get("agreement") == "two solvers"
+        detail = f"Z3{' and cvc5' if two else ' (one solver)'} on the verification conditions"
+        doubt = DOUBT["proof2" if two else "proof"]
     elif backend == "dafny":
         detail = "Dafny (Boogie and Z3; one solver)"
     elif kind == "bounded":

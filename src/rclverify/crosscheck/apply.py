@@ -83,6 +83,15 @@ class SecondSolver:
             return {**d, "status": "inconclusive", "solvers": s, "reason": f"second solver: {s['why']}"}
         return {**d, "solvers": s}
 
+    def evidence(self, obligation: str, backend: str, status: str) -> tuple[str, dict[str, Any] | None]:
+        """``(status, solvers)`` of an obligation's evidence: a discharged
+        Hoare triple the solvers do not agree on is ``inconclusive``
+        (``solvers`` is ``None`` for the other backends)."""
+        if backend != "hoare" or status != "discharged":
+            return status, None
+        s = self.solvers("hoare", obligation)
+        return ("inconclusive" if s["agreement"] in DOWNGRADES else status), s
+
     def counts(self) -> dict[str, int]:
         """How many items each agreement has (the report's headline)."""
         out: dict[str, int] = {}

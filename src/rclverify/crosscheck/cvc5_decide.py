@@ -63,13 +63,18 @@ def version() -> str:
     return str(getattr(cvc5, "__version__", "")) or "unknown"
 
 
-def decide(text: str, name: str = "query.smt2", *, rlimit: int = RLIMIT, proofs: bool = True) -> Decision:
+def decide(text: str, name: str = "query.smt2", *, rlimit: int = RLIMIT, proofs: bool = True,
+           every: bool = False) -> Decision:
     """Run the SMT-LIB2 script ``text`` in a fresh cvc5 solver.
 
     ``name`` labels cvc5's messages; ``rlimit`` is the resource budget per
     check; ``proofs`` asks for the checked proof of an ``unsat`` answer.
-    Returns a :class:`Decision`; never raises for a bad script (``error``
-    with cvc5's message).  Raises ``ImportError`` when cvc5 is missing.
+    ``every``: the answer is that of every ``check-sat`` of the script (a
+    Hoare triple's verification conditions, each in a ``push``/``pop``
+    scope): ``unsat`` only when all are, with each one's proof; otherwise
+    the last one's.  Returns a :class:`Decision`; never raises for a bad
+    script (``error`` with cvc5's message).  Raises ``ImportError`` when
+    cvc5 is missing.
     """
     import cvc5
     t0 = time.perf_counter()
@@ -87,7 +92,7 @@ def decide(text: str, name: str = "query.smt2", *, rlimit: int = RLIMIT, proofs:
         parser = cvc5.InputParser(s, sm)
         script = text if "(set-logic" in text else "(set-logic ALL)\n" + text
         parser.setStringInput(cvc5.InputLanguage.SMT_LIB_2_6, script, name)
-        last = ""
+        last, worst_, proof_parts = "", "", []
         while True:
             cmd = parser.nextCommand()
             if cmd.isNull():
@@ -97,12 +102,16 @@ def decide(text: str, name: str = "query.smt2", *, rlimit: int = RLIMIT, proofs:
                 return Decision("error", out, "", False, ver, time.perf_counter() - t0)
             if out.split(" ", 1)[0] in ("sat", "unsat", "unknown"):
                 last = out
+                if out == "unsat" and proofs:  # taken now: a later pop or reset discards it
+                    proof_parts.append("\n".join(_text(s.proofToString(p)) for p in s.getProof()))
+                elif out != "unsat" and not worst_:
+                    worst_ = out
         if not last:
             return Decision("error", "the script has no check-sat", "", False, ver, time.perf_counter() - t0)
-        answer, _, why = last.partition(" ")
+        answer, _, why = (worst_ if every and worst_ else last).partition(" ")
         proof = ""
         if answer == "unsat" and proofs:
-            proof = "\n".join(_text(s.proofToString(p)) for p in s.getProof())
+            proof = "\n".join(proof_parts if every else proof_parts[-1:])
         return Decision(answer, why.strip("() "), proof, bool(proof), ver, time.perf_counter() - t0)
     except Exception as e:  # noqa: BLE001 - cvc5's API raises its own exception type for what it rejects
         return Decision("error", str(e).strip().splitlines()[0][:300] if str(e).strip() else type(e).__name__,

@@ -10,14 +10,16 @@ kind               record                                  verdict    expects
 ``requirement``    ``artifacts/requirements/<ID>.json``    proved     unsat
 ``deadline``       ``artifacts/deadlines/index.json``      proved     unsat
 ``health``         ``artifacts/health/<Node>.json``        ok         sat/unsat
+``hoare``          ``artifacts/evidence/<Obligation>.json`` discharged unsat, each
 =================  ======================================  =========  ========
 
 A health check reads ``ok`` on a satisfiable query (an assumption that can
 be met, a consistent contract, a guarantee that can fire: Z3's witness is
 its certificate) except the replacement check, which reads ``ok`` on a
 proof.  A record whose seal does not hold gives no item: the report already
-shows it ``error``.  Hoare triples and Dafny proofs are not items yet
-(docs/second-solver.md says so).
+shows it ``error``.  A Hoare obligation's script holds one query per
+verification condition; all must be ``unsat``.  Dafny proofs are not
+items (Dafny's own Boogie/Z3 run is the evidence).
 """
 from __future__ import annotations
 
@@ -44,6 +46,8 @@ class Item:
     smt2: str
     verdict: str
     expects: str
+    #: the verdict rests on every check-sat of the script (a Hoare triple's conditions), not only its last
+    every: bool = False
 
 
 def discharging_items(root: Any, nodes: Iterable[str]) -> list[Item]:
@@ -68,6 +72,7 @@ def discharging_items(root: Any, nodes: Iterable[str]) -> list[Item]:
         rec, why = read_sealed(root / record_path(rid), "requirement record")
         if rec and not why and rec.get("verdict") == "proved" and _path(rec.get("smt2")):
             out.append(Item("requirement", rid, rec["smt2"], "proved", "unsat"))
+    out.extend(_hoare_items(root, nodes))
     body, why = read_sealed(root / "artifacts/deadlines/index.json", "deadline record")
     for d in sorted(_rows(body, why, "results"), key=lambda d: str(d.get("requirement"))):
         if d.get("status") == "proved" and _path(d.get("smt2")):
@@ -82,3 +87,24 @@ def _rows(body: Any, why: str, key: str) -> list[dict[str, Any]]:
 
 def _path(p: Any) -> bool:
     return isinstance(p, str) and p.startswith("artifacts/") and p.endswith(".smt2") and ".." not in p
+
+
+def _hoare_items(root: Any, nodes: Iterable[str]) -> list[Item]:
+    """A discharged Hoare obligation's verification conditions (its ``.smt2``
+    artifact: one ``push``/``pop`` scope per condition, all ``unsat``)."""
+    from ..evidence.sealed import obligation_list
+    from ..evidence.store import EvidenceStore
+    store = EvidenceStore(root)
+    out: list[Item] = []
+    for n in nodes:
+        records, problem = obligation_list(root / f"artifacts/obligations/{n}.json")
+        for o in records or [] if not problem else []:
+            if o.get("backend") != "hoare":
+                continue
+            ev, altered = store.read(str(o.get("id")))
+            if ev is None or altered or ev.status != "discharged":
+                continue
+            for a in ev.artifacts:
+                if _path(a):
+                    out.append(Item("hoare", ev.obligation, a, "discharged", "unsat", every=True))
+    return out

@@ -44,10 +44,16 @@ class Recheck:
     notes: list[str]
 
 
-def z3_answer(text: str) -> str:
+def z3_answer(text: str, every: bool = False) -> str:
     """Z3's answer (``sat``/``unsat``/``unknown``/``error``) to the last
     query of the SMT-LIB2 script ``text`` (queries are joined by
-    ``(reset)``), from the text alone in a fresh context."""
+    ``(reset)``), from the text alone in a fresh context; with ``every``,
+    to each ``(push 1)`` ... ``(pop 1)`` scope of it (a Hoare triple's
+    conditions): ``unsat`` when all are, else the first other answer."""
+    if every:
+        import re
+        answers = [z3_answer(b) for b in re.findall(r"\(push 1\)\n(.*?)\(pop 1\)", text, flags=re.S)]
+        return next((a for a in answers if a != "unsat"), "unsat" if answers else "error")
     import z3
     last = text.split("\n(reset)\n")[-1]
     ctx = z3.Context()
@@ -102,13 +108,13 @@ def recheck_members(members: dict[str, bytes]) -> Recheck:
                             f"(sha256 differs from {INDEX})")
             continue
         text = data.decode("utf-8", "replace")
-        z = z3_answer(text)
+        z = z3_answer(text, it.every)
         if z != it.expects:
             (notes if z in ("unknown", "error") else problems).append(
                 f"{label}: recorded {it.verdict} (Z3 {it.expects}); Z3 now answers {z} on {it.smt2}")
         recorded = (row.get("cvc5") or {}).get("answer")
         if has_cvc5 and recorded in ("sat", "unsat"):
-            c = decide(text, it.smt2, proofs=recorded == "unsat")
+            c = decide(text, it.smt2, proofs=recorded == "unsat", every=it.every)
             if c.answer != recorded:
                 (notes if c.answer in ("unknown", "error") else problems).append(
                     f"{label}: cvc5 recorded {recorded}, now answers {c.answer} on {it.smt2}")

@@ -98,14 +98,14 @@ def _row(root: Path, it: Item, ver: str, cache: dict[str, dict[str, Any]], keep:
                    why=f"{it.smt2} cannot be read ({exc.__class__.__name__}): the verdict has no query")
         return row
     sha = hashlib.sha256(text.encode("utf-8")).hexdigest()
-    key = f"{sha}:{ver}:{RLIMIT}"
+    key = f"{sha}:{ver}:{RLIMIT}" + (":every" if it.every else "")
     row.update(sha256=sha, key=key)
     proof_rel = f"{DIR}/proofs/{sha}.proof"
     d = cache.get(key) if ver else None
     if d is not None and d.get("proof") and not (root / proof_rel).is_file():
         d = None  # its proof is gone: decide again
     if d is None and ver:
-        dec: Decision = decide(text, it.smt2)
+        dec: Decision = decide(text, it.smt2, every=it.every)
         d = {"answer": dec.answer, "reason": dec.reason, "proof_checked": dec.proof_checked,
              "version": dec.version, "duration_s": round(dec.duration_s, 4), "proof": ""}
         if dec.proof:

@@ -169,6 +169,8 @@ def build_report(ws: Workspace) -> dict[str, Any]:
     hashes: dict[str, str] = current_snapshot_hashes(ws, texts)  # the model's too
     made_from, ev_inputs = dict(hashes), dict[str, Any]()  # what the report is built from (meta.inputs_sha256)
     stale = stale_stages(ws, hashes)  # calculus or health made from another contract text
+    from ..crosscheck.apply import load as load_second_solver
+    second = load_second_solver(ws.root)  # cvc5's verdicts: a proof the two solvers do not agree on is inconclusive
     for o in obligations:
         ev, altered = (None, altered_lists[o.id]) if o.id in altered_lists else store.read(o.id)
         ev_inputs[o.id] = dict(ev.input_hashes) if ev is not None else None
@@ -176,6 +178,7 @@ def build_report(ws: Workspace) -> dict[str, Any]:
             status = "error"
         else:
             status = store.current_status(ev, hashes) if ev else "pending"
+        status, solvers = second.evidence(o.id, o.backend, status)
         ob_status[o.id] = status
         ob_rows.append({"id": o.id, "node": o.node, "guarantee": o.guarantee, "backend": o.backend, "kind": o.kind,
                         "instance": o.instance, "statement": o.statement, "source": str(o.source),
@@ -189,6 +192,8 @@ def build_report(ws: Workspace) -> dict[str, Any]:
         expl = ev.explanation
         if altered:
             expl = f"{altered[0].upper()}{altered[1:]}. The record's own text follows, not to be believed: " + expl
+        if solvers is not None and status != ev.status:
+            expl = f"Not discharged: {solvers['why']} (second solver). Z3 alone: " + expl
         if status == "stale" and ev.status != "stale":
             expl = f"STALE: an input changed since this evidence was produced (recorded status {ev.status}). " + expl
         ev_rows.append({"obligation": ev.obligation, "backend": ev.backend, "kind": ev.kind, "status": status,
@@ -196,6 +201,8 @@ def build_report(ws: Workspace) -> dict[str, Any]:
                         "duration_s": ev.duration_s, "explanation": expl, "counterexample": ev.counterexample,
                         "artifacts": list(ev.artifacts), "log_excerpt": ev.log[-2000:],
                         **_evidence_extras(ws, ev.details)})
+        if solvers is not None:
+            ev_rows[-1]["solvers"] = solvers
         if isinstance(ev.details.get("examples"), dict):  # property tests: example counts and seed
             ev_rows[-1]["examples"] = {**ev.details["examples"], "seed": ev.details.get("seed"),
                                        "replay": ev.details.get("replay", ""),
@@ -219,8 +226,6 @@ def build_report(ws: Workspace) -> dict[str, Any]:
             health[n] = [f if f["status"] == "error" else
                          {**f, "status": "stale", "message": note + f["status"] + ". " + f["message"]}
                          for f in health[n]]
-    from ..crosscheck.apply import load as load_second_solver
-    second = load_second_solver(ws.root)  # cvc5's verdicts: a proof the two solvers do not agree on is inconclusive
     for n in checked.nodes:
         comps[n] = {**comps[n], "side_conditions": [second.side_condition(sc)
                                                     for sc in comps[n].get("side_conditions", [])]}
