@@ -119,3 +119,15 @@ def test_bundle_recheck_names_an_edited_verdict(ws: Path, tmp_path: Path, capsys
     capsys.readouterr()
     assert main(["bundle", "--recheck", str(edited)]) == 1
     assert "artifacts/requirements/REQ2.json: record" in capsys.readouterr().err
+
+
+def test_an_altered_second_solver_record_is_not_believed(ws: Path, tmp_path: Path) -> None:
+    import shutil
+    root = tmp_path / "ws"
+    shutil.copytree(ws, root)
+    index = root / "artifacts/crosscheck/index.json"
+    index.write_text(index.read_text().replace('"two solvers"', '"one solver"', 1))
+    assert main(["report", "-w", str(root)]) in (0, 1)
+    r = _report(root)
+    assert any(p.startswith("Second-solver record: second-solver record") for p in r["summary"]["problems"])
+    assert r["meta"]["strict_ok"] is False

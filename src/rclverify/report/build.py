@@ -399,12 +399,15 @@ def build_report(ws: Workspace) -> dict[str, Any]:
         "expected_verdicts": expected, "grounding": grounding, "unverified": unverified, "deadlines": deadlines,
     }
     from .confidence_rows import annotate  # evidence strength and confidence over the argument (issue 50)
+    report["summary"]["solvers"] = second.counts()  # how many items two solvers, one solver, ... (issue 50)
+    if second.problem:
+        report["summary"]["problems"].append(f"Second-solver record: {second.problem}")
     strength_ok = annotate(report, [(l.from_node, l.to_node) for l in model.links],
                            {r.id: r.strength for r in all_requirements(plan) if r.strength})
     # one severity per finding (report/severity.py): --strict fails on every error and warning, health and lint
     # warnings included, as SARIF, JUnit and the terminal show them
     from .severity import blocking
-    report["meta"]["strict_ok"] = bool(strict_ok) and strength_ok and not blocking(report)
+    report["meta"]["strict_ok"] = bool(strict_ok) and strength_ok and not second.problem and not blocking(report)
     # one diagnosis record per problem, with repairs checked by Z3 (docs/diagnosis.md)
     report["diagnoses"] = diagnose(ws, report)
     report["summary"]["diagnoses"] = [{"id": d["id"], "kind": d["kind"], "sentence": d["sentence"],
