@@ -61,6 +61,12 @@ def test_a_planted_wrong_proof_reads_inconclusive(ws: Path, tmp_path: Path) -> N
     req = next(q for q in r["requirements"] if q["id"] == "REQ1")
     assert req["verdict"] == "inconclusive", req["verdict"]
     assert "second solver does not confirm it" in req["note"]
+    # the argument shows the disagreement as a defeater (GSN dialectic extension) of the claims it undermines
+    arg = json.loads((root / "reports/argument.json").read_text())
+    els = {e["id"]: e for e in arg["elements"]}
+    assert els["CSn-solvers.Actuator.sc1"]["challenges"] == ["G-sc.Actuator.sc1"]
+    assert els["G-sc.Actuator.sc1"]["defeated"] is True and els["G-REQ1"]["defeated"] is True
+    assert "defeated: true" in (root / "reports/argument.gsn.yaml").read_text()
     assert main(["verify", "-w", str(root), "--strict"]) == 1
 
 

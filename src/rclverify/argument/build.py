@@ -300,6 +300,8 @@ def build_argument(report: Mapping[str, Any]) -> Argument:
     ids = ", ".join(str(r["id"]) for r in reqs) or "no requirement listed"
     b.els = {top: Element(top, "goal", f"The system {meta['workspace']} meets its requirements ({ids})",
                           supported_by=(s_reqs, s_contracts), in_context_of=top_ctx), **b.els}
+    from .defeaters import add_defeaters  # counter-evidence as the dialectic extension's defeaters (issue 50)
+    add_defeaters(b.els, report, ident)
     return propagate(Argument(top, b.els))
 
 

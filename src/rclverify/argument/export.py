@@ -45,7 +45,8 @@ from .model import Argument, Element
 FILES = ("argument.json", "argument.gsn.yaml", "argument.dot", "argument.svg")
 
 _SHAPES = {"goal": ("box", ""), "strategy": ("parallelogram", ""), "solution": ("ellipse", ""),
-           "context": ("box", "rounded,filled"), "assumption": ("oval", ""), "justification": ("oval", "")}
+           "context": ("box", "rounded,filled"), "assumption": ("oval", ""), "justification": ("oval", ""),
+           "counter_solution": ("ellipse", "dashed,filled")}
 
 
 def _yq(value: Any) -> str:
@@ -134,6 +135,7 @@ def to_gsn_yaml(arg: Argument, title: str = "assurance argument", link_prefix: s
     def element(e: Element) -> dict[str, Any]:
         return {"id": e.id, "text": _with_status(e), "supported_by": e.supported_by,
                 "in_context_of": e.in_context_of, "undeveloped": e.undeveloped,
+                "challenges": e.challenges, "defeated": e.defeated,
                 "url": link_prefix + e.url if e.url else ""}
     elements = _pieces(arg, fragments, "argument.gsn-elements.yaml.j2", link_prefix, element)
     return _environment().get_template("argument.gsn.yaml.j2").render(title=title.replace("\n", " "), elements=elements)
@@ -199,6 +201,8 @@ def to_dot(arg: Argument, title: str = "assurance argument", link_prefix: str = 
     def edges(e: Element) -> list[dict[str, Any]]:
         out = [{"src": diagram.dot_string(e.id), "dst": diagram.dot_string(x), "context": False} for x in e.supported_by]
         out += [{"src": diagram.dot_string(e.id), "dst": diagram.dot_string(x), "context": True} for x in e.in_context_of]
+        out += [{"src": diagram.dot_string(e.id), "dst": diagram.dot_string(x), "context": False, "challenges": True}
+                for x in e.challenges]
         return out
     return _environment().get_template("argument.dot.j2").render(
         title=title.replace("\n", " "), nodes=_pieces(arg, fragments, "argument.dot-nodes.j2", link_prefix, node),

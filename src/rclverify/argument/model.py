@@ -24,6 +24,8 @@ from ..evidence.records import SEVERITY, worst
 #: Element type -> GSN identifier prefix (gsn2x derives the type from it).
 PREFIX: Mapping[str, str] = {
     "goal": "G", "strategy": "S", "solution": "Sn", "context": "C", "assumption": "A", "justification": "J",
+    # the GSN Community Standard v3's dialectic extension: counter-evidence that challenges a claim
+    "counter_solution": "CSn",
 }
 #: Types that may appear in ``supported_by`` / ``in_context_of``.
 SUPPORT_TYPES = ("goal", "strategy", "solution")
@@ -59,17 +61,25 @@ class Element:
     undeveloped: bool = False
     ref: str = ""
     url: str = ""
+    #: a counter solution's targets (the dialectic extension's ``challenges``)
+    challenges: tuple[str, ...] = ()
+    #: the claim is defeated by counter-evidence (the dialectic extension's ``defeated``)
+    defeated: bool = False
 
     def to_json(self) -> dict[str, Any]:
-        return {"id": self.id, "type": self.type, "text": self.text, "status": self.status,
-                "supported_by": list(self.supported_by), "in_context_of": list(self.in_context_of),
-                "undeveloped": self.undeveloped, "ref": self.ref, "url": self.url}
+        out = {"id": self.id, "type": self.type, "text": self.text, "status": self.status,
+               "supported_by": list(self.supported_by), "in_context_of": list(self.in_context_of),
+               "undeveloped": self.undeveloped, "ref": self.ref, "url": self.url}
+        if self.challenges or self.defeated:
+            out.update(challenges=list(self.challenges), defeated=self.defeated)
+        return out
 
     @staticmethod
     def from_json(d: Mapping[str, Any]) -> "Element":
         return Element(id=d["id"], type=d["type"], text=d["text"], status=d.get("status"),
                        supported_by=tuple(d.get("supported_by", ())), in_context_of=tuple(d.get("in_context_of", ())),
-                       undeveloped=bool(d.get("undeveloped", False)), ref=d.get("ref", ""), url=d.get("url", ""))
+                       undeveloped=bool(d.get("undeveloped", False)), ref=d.get("ref", ""), url=d.get("url", ""),
+                       challenges=tuple(d.get("challenges", ())), defeated=bool(d.get("defeated", False)))
 
 
 @dataclass(frozen=True)
@@ -106,8 +116,13 @@ def validate(arg: Argument) -> None:
             raise ArgumentError(f"{e.id}: a {e.type} id must start with {PREFIX[e.type]!r}")
         if e.status is not None and e.status not in SEVERITY:
             raise ArgumentError(f"{e.id}: {e.status!r} is not an evidence status")
-        if e.type == "solution" and e.status is None:
+        if e.type in ("solution", "counter_solution") and e.status is None:
             raise ArgumentError(f"{e.id}: a solution needs the status of its evidence")
+        if e.challenges and e.type != "counter_solution":
+            raise ArgumentError(f"{e.id}: only a counter solution challenges other elements")
+        for x in e.challenges:
+            if x not in els or els[x].type not in ("goal", "solution"):
+                raise ArgumentError(f"{e.id}: challenges {x!r}, which is not a goal or solution of the structure")
         if e.supported_by and e.type not in ("goal", "strategy"):
             raise ArgumentError(f"{e.id}: only goals and strategies are supported by other elements")
         if e.undeveloped and e.supported_by:
@@ -151,7 +166,7 @@ def propagate(arg: Argument) -> Argument:
             return memo[i]
         e = els[i]
         s: str | None
-        if e.type == "solution":
+        if e.type in ("solution", "counter_solution"):
             s = e.status
         elif e.type in CONTEXT_TYPES:
             s = None
@@ -169,5 +184,5 @@ def propagate(arg: Argument) -> Argument:
         # most elements keep theirs (solutions); the constructor, not dataclasses.replace (4x slower)
         out[i] = e if s == e.status else Element(
             id=e.id, type=e.type, text=e.text, status=s, supported_by=e.supported_by, in_context_of=e.in_context_of,
-            undeveloped=e.undeveloped, ref=e.ref, url=e.url)
+            undeveloped=e.undeveloped, ref=e.ref, url=e.url, challenges=e.challenges, defeated=e.defeated)
     return Argument(arg.top, out)
