@@ -137,3 +137,11 @@ def test_an_altered_second_solver_record_is_not_believed(ws: Path, tmp_path: Pat
     r = _report(root)
     assert any(p.startswith("Second-solver record: second-solver record") for p in r["summary"]["problems"])
     assert r["meta"]["strict_ok"] is False
+
+
+def test_refines_is_confirmed_by_the_second_solver(capsys: pytest.CaptureFixture[str]) -> None:
+    from pathlib import Path as P
+    rcl = str(P(__file__).resolve().parents[1] / "contracts/remote_inspection.rcl")
+    assert main(["refines", f"{rcl}:RadiationSensor", f"{rcl}:RadiationSensor"]) == 0
+    out = capsys.readouterr().out
+    assert "second solver: assumption side: two solvers" in out and "guarantee side: two solvers" in out

@@ -372,11 +372,16 @@ def render(result: RefinementResult, spec_a: str, spec_b: str) -> str:
 
 
 def refines_main(spec_a: str, spec_b: str, *, out: TextIO | None = None, err: TextIO | None = None,
-                 assumes: Sequence[str] = ()) -> int:
+                 assumes: Sequence[str] = (), confirm: Any = None) -> int:
     """``rclverify refines A.rcl:Node B.rcl:Node``: print whether B refines A.
 
     ``assumes``: RCL formulas over B's inputs (``--assume``), conditions
     under which the replacement is checked (they let B read extra inputs).
+
+    ``confirm``: the second solver (issue 50), a callable from a side's
+    SMT-LIB2 text to ``(agreement, why)`` (:func:`rclverify.crosscheck.stage.agreement`
+    of cvc5's answer); a proved side it does not confirm makes the verdict
+    inconclusive (docs/second-solver.md).
 
     Returns the exit code: 0 when B refines A, 1 when it does not or the
     solver could not decide (the output says which), 2 on a user error
@@ -395,7 +400,15 @@ def refines_main(spec_a: str, spec_b: str, *, out: TextIO | None = None, err: Te
             print(d, file=err)
         return 2
     out.write(render(result, spec_a, spec_b))
-    return 0 if result.verdict == "refines" else 1
+    if confirm is None or result.verdict != "refines":
+        return 0 if result.verdict == "refines" else 1
+    sides = [s for s in (result.assumption, result.guarantee, result.timing) if s is not None and s.smt2]
+    said = [(s.name, *confirm(s.smt2)) for s in sides]
+    out.write("second solver: " + "; ".join(f"{name} side: {a} ({why})" for name, a, why in said) + "\n")
+    if any(a in ("disagree", "inconclusive") for _, a, _ in said):
+        out.write("verdict: inconclusive: the second solver does not confirm every side (docs/second-solver.md)\n")
+        return 1
+    return 0
 
 
 __all__ = ["RefinementResult", "SideResult", "check_interface", "check_refinement", "load_node", "merge_envs",
