@@ -5,7 +5,7 @@ requirement's ``formal:`` so that RCL's grammar and every contract keep
 their meaning::
 
     T ::= always T | eventually T | eventually[<= N] T
-        | next T | previous T | F until F | F
+        | next T | previous T | F until F | F -> T | F
 
 where ``F`` is a state formula read by :func:`rclverify.plan.formal.parse_formal`
 (``Node.in.x``/``Node.out.y``).  The operators bind like prefixes, ``until``
@@ -43,7 +43,8 @@ _UNTIL = re.compile(r"(?<![A-Za-z0-9_.'])until(?![A-Za-z0-9_'])")
 @dataclass(frozen=True)
 class Temporal:
     """A temporal statement: ``op`` is ``always`` | ``eventually`` |
-    ``next`` | ``previous`` | ``until``; ``args`` its one or two operands
+    ``next`` | ``previous`` | ``until`` | ``->`` (a state formula implying a
+    temporal statement: the response pattern); ``args`` its one or two operands
     (each a :class:`Temporal` or a :class:`Formal`); ``bound`` the step
     bound of ``eventually[<= N]`` (None: unbounded)."""
 
@@ -65,6 +66,19 @@ def _until_at(text: str, start: int, end: int) -> int | None:
         seg = text[start:m.start()]
         if sum(seg.count(c) for c in "([{") == sum(seg.count(c) for c in ")]}"):
             return m.start()
+    return None
+
+
+def _response_at(text: str, start: int, end: int) -> int | None:
+    """Offset of the first ``->`` in [start, end) outside brackets whose
+    right side begins with a temporal operator (the response pattern)."""
+    depth = 0
+    for k in range(start, end - 1):
+        depth += text[k] in "([{"
+        depth -= text[k] in ")]}"
+        if depth == 0 and text[k:k + 2] == "->" and (k == start or text[k - 1] != "<") \
+                and _PREFIX.match(text, k + 2, end) is not None:
+            return k
     return None
 
 
@@ -119,6 +133,16 @@ def _parse(src: Source, start: int, end: int, checked: Checked, what: str,
             if b:
                 bound, pos = _bound(src, b, what), b.end()
         return Temporal(op, (_parse(src, pos, end, checked, what, states),), bound)
+    imp = _response_at(text, start, end)
+    if imp is not None:  # `P -> eventually[<= N] Q` / `P -> next Q`: the response pattern (under always)
+        rhs = _parse(src, imp + 2, end, checked, what, states)
+        if isinstance(rhs, Temporal) and rhs.op == "eventually" and rhs.bound is None:
+            raise RclError([error(_loc_at(src, imp + 2 + len(text[imp + 2:end]) - len(text[imp + 2:end].lstrip())),
+                                  f"{what}: the unbounded response always (P -> eventually Q) is not decided; state "
+                                  "its bound in steps, always (P -> eventually[<= N] Q) (FRET's \"whenever P, within "
+                                  "N steps Q\"), or its next form always (P -> next Q) (docs/requirements.md, "
+                                  "Temporal requirements)", "E-temporal")])
+        return Temporal("->", (_parse(src, start, imp, checked, what, states), rhs))
     u = _until_at(text, start, end)
     if u is not None:
         return Temporal("until", (_parse(src, start, u, checked, what, states),
@@ -130,10 +154,10 @@ def _parse(src: Source, start: int, end: int, checked: Checked, what: str,
         nested = _NESTED.search(text, start, end)
         if nested is not None:  # `always (P -> eventually Q)`: an operator inside a state formula
             raise RclError([error(_loc_at(src, nested.start(1)), f"{what}: {nested.group(1)!r} inside a state "
-                                  "formula is not decided (the response pattern always (P -> eventually Q) and "
-                                  "its bounded and next forms among them); write always F, always next F, "
-                                  "eventually F, eventually[<= N] F, next F or F until G with F, G state "
-                                  "formulas (docs/requirements.md, Temporal requirements)", "E-temporal")]) from None
+                                  "formula is not decided; write always F, always next F, eventually F, "
+                                  "eventually[<= N] F, next F, F until G, always (F -> eventually[<= N] G) or "
+                                  "always (F -> next G) with F, G state formulas (docs/requirements.md, "
+                                  "Temporal requirements)", "E-temporal")]) from None
         slip = _misspelled(src, start, end, checked, what)
         if slip is None:
             raise
@@ -194,10 +218,17 @@ def _bound(src: Source, b: "re.Match[str]", what: str) -> int:
 
 def shape(t: Temporal | Formal, loc: Any) -> str:
     """The decided shape of a statement (module table): ``always``,
-    ``always next``, ``eventually``, ``next``, ``until``; raises
-    :class:`RclError` (``E-temporal`` at ``loc``) for another nesting."""
+    ``always next``, ``eventually``, ``next``, ``until``, ``response``
+    (``always (P -> eventually[<= N] Q)`` or ``always (P -> next Q)``: the
+    bounded response pattern, FRET's "whenever P, within N steps Q");
+    raises :class:`RclError` (``E-temporal`` at ``loc``) for another nesting."""
     if isinstance(t, Temporal):
         a = t.args[0]
+        if t.op == "always" and isinstance(a, Temporal) and a.op == "->" and isinstance(a.args[0], Formal):
+            r = a.args[1]
+            if isinstance(r, Temporal) and isinstance(r.args[0], Formal) and (
+                    r.op == "next" or (r.op == "eventually" and r.bound is not None)):
+                return "response"
         if t.op in ("always", "eventually", "next") and isinstance(a, Formal):
             return t.op
         if t.op == "always" and isinstance(a, Temporal) and a.op == "next" and isinstance(a.args[0], Formal):
@@ -205,5 +236,6 @@ def shape(t: Temporal | Formal, loc: Any) -> str:
         if t.op == "until" and all(isinstance(x, Formal) for x in t.args):
             return "until"
     raise RclError([error(loc, "this nesting of temporal operators is not decided; write always F, always next F, "
-                               "eventually F, eventually[<= N] F, next F or F until G with F, G state formulas "
+                               "eventually F, eventually[<= N] F, next F, F until G, always (F -> eventually[<= N] G) "
+                               "or always (F -> next G) with F, G state formulas "
                                "(docs/requirements.md, Temporal requirements)", "E-temporal")])

@@ -227,8 +227,9 @@ def build_report(ws: Workspace) -> dict[str, Any]:
                          {**f, "status": "stale", "message": note + f["status"] + ". " + f["message"]}
                          for f in health[n]]
     for n in checked.nodes:
-        comps[n] = {**comps[n], "side_conditions": [second.side_condition(sc)
-                                                    for sc in comps[n].get("side_conditions", [])]}
+        if comps[n]:  # {} before the calculus ran
+            comps[n] = {**comps[n], "side_conditions": [second.side_condition(sc)
+                                                        for sc in comps[n].get("side_conditions", [])]}
         health[n] = [second.finding(f) for f in health[n]]
     # a counterexample shows the nodes involved only: the consumer and the producers of the linked variables
     side_conditions = [involved_model(sc) for n in checked.nodes for sc in comps[n].get("side_conditions", [])]

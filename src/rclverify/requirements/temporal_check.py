@@ -17,6 +17,9 @@ statement                   decided by
                             bound checked: never met on a bound
 ``next F``                  one step (exact)
 ``F until G``               ``always (G seen or F)`` and ``eventually G``
+``always (P -> eventually   ``always`` of a monitor variable: the age of the
+[<= N] Q)``, ``always       oldest P not yet answered (BMC, k-induction;
+(P -> next Q)``             :mod:`.response`)
 ==========================  ===============================================
 
 Other nestings raise a located ``E-temporal`` error (the plan's
@@ -155,6 +158,12 @@ def _decide(t: Temporal, sys: ComposedSystem, pred: Callable[[Formal], Callable[
         return v
     if kind == "always":
         return check_always(ts, pred(t.args[0]), max_k=bound, timeout_ms=timeout_ms)
+    if kind == "response":  # always (P -> eventually[<= N] Q) / always (P -> next Q): requirements/response.py
+        from .response import check_response
+        p, r = t.args[0].args  # type: ignore[union-attr]
+        within = r.bound if r.op == "eventually" else None  # type: ignore[union-attr]
+        return check_response(ts, got(p), got(r.args[0]), within, max_k=bound,  # type: ignore[arg-type, union-attr]
+                              timeout_ms=timeout_ms)
     if kind == "always next":
         f = pred(t.args[0].args[0])  # type: ignore[union-attr]
         ts2 = with_flag(ts, "<started>", lambda s: z3.BoolVal(False), lambda s, u: z3.BoolVal(True))

@@ -65,6 +65,7 @@ from ...logic.encode import EncodingError, Encoder
 from ...plan.formal import Formal
 from ...plan.state import StateFormula, StateVar, parse_state_formula, state_type
 from ...plan.temporal import Temporal, shape
+from .response_trace import ResponseTracker
 from ...rcl.types import Checked, EnumT, FuncT, Scalar, Type
 from ...traces.events import Event
 from ...traces.mapping import MappingError, TopicRule, initial_value, map_value
@@ -336,8 +337,13 @@ def check_temporal_trace(t: Temporal, checked: Checked, states: tuple[StateVar, 
     shape that is not decided and whatever the event source raises
     (:class:`~rclverify.traces.TraceError`)."""
     kind = shape(t, None)
+    tracker: ResponseTracker | None = None
     if kind == "always next":
         ops: list[Formal] = [t.args[0].args[0]]  # type: ignore[union-attr]
+    elif kind == "response":  # always (P -> eventually[<= N] Q) / always (P -> next Q)
+        trig, resp = t.args[0].args  # type: ignore[union-attr]
+        ops = [trig, resp.args[0]]  # type: ignore[list-item, union-attr]
+        tracker = ResponseTracker(resp.bound if resp.op == "eventually" else None)  # type: ignore[union-attr]
     else:
         ops = list(t.args)  # type: ignore[arg-type]
     nodes = list(dict.fromkeys(n for f in ops for n in f.nodes))
@@ -375,6 +381,14 @@ def check_temporal_trace(t: Temporal, checked: Checked, states: tuple[StateVar, 
                           [wit(ops[0], False)])
             if h is None and undecided is None:
                 undecided = wit(ops[0], None)
+        elif tracker is not None:  # the response pattern (response_trace.py)
+            said = tracker.step(i, _truth(ops[0], checked, vals, tol, sems) if _published(ops[0], vals) else False,
+                                _truth(ops[1], checked, vals, tol, sems) if _published(ops[1], vals) else False)
+            if said is not None and said[0] == "false":
+                return at("false", f"{_text(ops[0])} held at step {said[1]} and {_text(ops[1])} did not hold in "
+                                   f"time, by step {i} ({ev.where}, t = {ev.time} s)", [wit(ops[1], False)])
+            if said is not None and undecided is None:
+                undecided = wit(ops[said[1]], None)
         elif kind == "next":
             if i == 1:
                 h = _truth(ops[0], checked, vals, tol, sems) if _published(ops[0], vals) else False
@@ -420,6 +434,14 @@ def check_temporal_trace(t: Temporal, checked: Checked, states: tuple[StateVar, 
     if kind in ("always", "always next"):
         return TraceVerdict("true", n, f"{_text(ops[0])} holds at every step of this trace ({n} steps): "
                                        "evidence for the requirement, not a proof", **end)
+    if tracker is not None and tracker.pending is None:
+        return TraceVerdict("true", n, f"every step where {_text(ops[0])} held was answered by {_text(ops[1])} in "
+                                       f"time in this trace ({n} steps): evidence for the requirement, not a proof",
+                            **end)
+    if tracker is not None:
+        return TraceVerdict("currently_false", n, f"{_text(ops[0])} held at step {tracker.pending} and {_text(ops[1])} has "
+                                                  f"not held since when the trace ended after {n} steps (a longer run "
+                                                  "may still answer it in time): inconclusive", **end)
     if kind == "next":
         return TraceVerdict("inconclusive", n, "the trace ended before step 1", **end)
     also = (f"; undecided at some steps, the first {undecided['step']} ({undecided['where']})"

@@ -1,0 +1,44 @@
+"""The bounded response pattern on a recorded run (issue 48).
+
+``always (P -> eventually[<= N] Q)`` and ``always (P -> next Q)`` read step
+by step, with the finite-trace verdicts of :mod:`.temporal_trace`: a
+trigger not answered in time is ``false`` at the step where the time ran
+out; a trigger still pending when the trace ends is ``currently_false`` (a
+longer run may answer it); otherwise ``true`` (evidence, not a proof).
+The rule is the composed system's (:mod:`rclverify.requirements.response`):
+a P at step i needs Q at some step i..i+N (``next``: Q at step i+1).
+"""
+from __future__ import annotations
+
+
+class ResponseTracker:
+    """The obligations of one run.  ``within``: N, or ``None`` for the next form."""
+
+    def __init__(self, within: int | None) -> None:
+        self.within = within
+        self.pending: int | None = None  # the step of the oldest trigger not yet answered
+        self.before: bool | None = False  # next form: the trigger's value at the step before
+
+    def step(self, i: int, p: bool | None, q: bool | None) -> tuple[str, int] | None:
+        """Read step ``i`` with the trigger's and the response's truth
+        (``None``: undecided there).  Returns ``("false", k)`` when the
+        trigger of step ``k`` is not answered in time, ``("undecided", 0)``
+        (the trigger) or ``("undecided", 1)`` (the response) when the
+        verdict depends on an undecided operand here, else ``None``."""
+        if self.within is None:
+            before, self.before = self.before, p
+            if before is True and q is False:
+                return "false", i - 1
+            if before is None:
+                return "undecided", 0
+            return ("undecided", 1) if before is True and q is None else None
+        if q is True:
+            self.pending = None
+            return None
+        if self.pending is None and p is True:
+            self.pending = i
+        if self.pending is not None and q is False and i - self.pending >= self.within:
+            return "false", self.pending
+        if p is None or q is None:
+            return "undecided", 0 if p is None else 1
+        return None

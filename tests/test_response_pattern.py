@@ -1,0 +1,122 @@
+"""The bounded response pattern (issue 48): ``always (P -> eventually[<= N] Q)``
+and ``always (P -> next Q)`` parsed, decided over the composed system and
+checked against a brute-force enumeration of small systems."""
+from __future__ import annotations
+
+import shutil
+from pathlib import Path
+
+import pytest
+import z3
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from rclverify.cli import main
+from rclverify.requirements.response import check_response
+from rclverify.requirements.tsys import TransitionSystem
+
+STATES = range(4)
+
+
+@st.composite
+def systems(draw):
+    init = draw(st.sets(st.sampled_from(STATES), min_size=1))
+    succ = {s: draw(st.sets(st.sampled_from(STATES), min_size=1)) for s in STATES}  # every state goes on
+    p = draw(st.sets(st.sampled_from(STATES)))
+    q = draw(st.sets(st.sampled_from(STATES)))
+    n = draw(st.sampled_from([None, 0, 1, 2]))
+    return init, succ, p, q, n
+
+
+def _brute(init, succ, p, q, n) -> bool:
+    """Whether every run meets the statement, by enumeration: the reachable
+    states; then a P not answered in time is a path from a reachable P-state."""
+    seen, todo = set(init), list(init)
+    while todo:
+        s = todo.pop()
+        for t in succ[s] - seen:
+            seen.add(t)
+            todo.append(t)
+    if n is None:  # always (P -> next Q): a reachable P-state with a successor outside Q
+        return not any(s in p and succ[s] - q for s in seen)
+
+    def misses(s, left: int) -> bool:  # a path from s of `left` more steps never in Q (s itself not in Q)
+        return s not in q and (left == 0 or any(misses(t, left - 1) for t in succ[s]))
+    return not any(s in p and misses(s, n) for s in seen)
+
+
+@settings(max_examples=150, deadline=None)
+@given(systems())
+def test_response_equals_enumeration(sys_) -> None:
+    init, succ, p, q, n = sys_
+    ts = TransitionSystem({"x": z3.IntSort()},
+                          lambda s: z3.Or(*[s["x"] == i for i in init]),
+                          lambda s, t: z3.Or(*[z3.And(s["x"] == a, t["x"] == b) for a in STATES for b in succ[a]]))
+    inside = lambda s, xs: z3.Or(*[s["x"] == i for i in xs]) if xs else z3.BoolVal(False)  # noqa: E731
+    v = check_response(ts, lambda s: inside(s, p), lambda s: inside(s, q), n, max_k=4 * ((n or 0) + 2) + 2,
+                       timeout_ms=5_000)
+    assert v.status == ("proved" if _brute(init, succ, p, q, n) else "refuted"), (v.status, v.detail)
+
+
+# -- in the plan, on a three-node chain -------------------------------------------------------------------
+
+def _with(root: Path, formal: str) -> None:
+    plan = root / "contracts/plan.yaml"
+    plan.write_text(plan.read_text().replace("requirements:\n", "requirements:\n  - id: RESP\n    text: answered\n"
+                                                                f"    formal: \"{formal}\"\n", 1))
+
+
+@pytest.fixture(scope="module")
+def chain(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    root = tmp_path_factory.mktemp("resp") / "ws"
+    assert main(["init", str(root)]) == 0
+    for f in ("sensor", "controller", "actuator"):  # each node answers at the step its assumption holds
+        p = root / f"contracts/{f}.rcl"
+        p.write_text(p.read_text().replace("\n  assume(", "\n  progress( within 0 steps )\n  assume(", 1))
+    return root
+
+
+@pytest.mark.parametrize("n, verdict", [(1, "refuted"), (2, "proved, evidence outstanding")])
+def test_a_chain_answers_within_its_length(chain: Path, tmp_path: Path, n: int, verdict: str,
+                                           capsys: pytest.CaptureFixture[str]) -> None:
+    root = tmp_path / "ws"
+    shutil.copytree(chain, root)
+    _with(root, f"always (Sensor.in.reading >= 90 -> eventually[<= {n}] Actuator.out.actuator_value >= 0)")
+    main(["requirements", "-w", str(root)])
+    assert f"RESP: {verdict}" in capsys.readouterr().out
+
+
+def test_the_unbounded_response_is_a_located_error(chain: Path, tmp_path: Path,
+                                                   capsys: pytest.CaptureFixture[str]) -> None:
+    root = tmp_path / "ws"
+    shutil.copytree(chain, root)
+    _with(root, "always (Sensor.in.reading >= 90 -> eventually Actuator.out.actuator_value >= 0)")
+    assert main(["requirements", "-w", str(root)]) != 0
+    err = capsys.readouterr().err
+    assert "contracts/plan.yaml:" in err and "E-temporal" not in err.split(":")[0]
+    assert "state its bound in steps, always (P -> eventually[<= N] Q)" in err
+
+
+# -- on a recorded run: the tracker of backends/monitors/response_trace.py against the definition ----------
+
+@settings(max_examples=300, deadline=None)
+@given(st.lists(st.tuples(st.booleans(), st.booleans()), max_size=12), st.sampled_from([None, 0, 1, 3]))
+def test_the_trace_tracker_equals_the_definition(run, n) -> None:
+    from rclverify.backends.monitors.response_trace import ResponseTracker
+    tr = ResponseTracker(n)
+    got = None
+    for i, (p, q) in enumerate(run):
+        said = tr.step(i, p, q)
+        if said is not None and said[0] == "false":
+            got = i
+            break
+    # the definition: the first step at which some trigger's window ran out without its response
+    if n is None:
+        fails = [i + 1 for i in range(len(run) - 1) if run[i][0] and not run[i + 1][1]]
+    else:
+        fails = [k + n for k in range(len(run)) if run[k][0] and k + n < len(run)
+                 and not any(run[j][1] for j in range(k, k + n + 1))]
+    assert got == (min(fails) if fails else None)
+    if got is None and n is not None:  # still pending at the end: a trigger whose window is not over
+        open_ = any(run[k][0] and not any(run[j][1] for j in range(k, len(run))) for k in range(len(run)))
+        assert (tr.pending is not None) == open_
