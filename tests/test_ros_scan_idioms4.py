@@ -78,7 +78,7 @@ def skeletons(tmp_path_factory):  # type: ignore[no-untyped-def]
 def test_skeletons_keep_programs_apart(skeletons) -> None:  # type: ignore[no-untyped-def]
     _ws, rcl = skeletons
     nodes = sorted(line.split()[1] for text in rcl.values() for line in text.splitlines() if line.startswith("node "))
-    assert nodes == ["Base", "TalkerChatCppTalker", "TalkerChatCppTalkerBestEffort", "TalkerChatPyTalker"]
+    assert nodes == ["Base", "RangeFusion", "TalkerChatCppTalker", "TalkerChatCppTalkerBestEffort", "TalkerChatPyTalker"]
     assert "outputs( chatter : STRING, dropped : NATURAL )" in rcl["talker_chat_cpp_talker_best_effort.rcl"]
 
 
@@ -104,3 +104,48 @@ def test_skeletons_of_a_driver_check_and_ground(skeletons, tmp_path: Path,  # ty
     # every contract is matched to its graph node (its enumerations read from the constants,
     # /parameter_events the library's): nothing but the two located ROS-LAUNCH notes
     assert sorted(f["code"] for f in got) == ["ROS-SCAN", "ROS-SCAN"]
+
+
+def test_the_packages_parameter_file_gives_values_and_lists_of_sources(graph) -> None:  # type: ignore[no-untyped-def]
+    assert _edges(graph, "/range_fusion") == _want("/range_fusion")
+    sets = {(e.topic, e.param, f"{e.param_set_at.file}:{e.param_set_at.line}")
+            for e in graph.nodes["/range_fusion"].publishes + graph.nodes["/range_fusion"].subscribes}
+    yaml = "idioms6/src/rig_sensing/config/range_fusion.yaml"
+    assert sets == {("/fused_range", "/range_fusion/output_topic", f"{yaml}:5"),
+                    ("/front/range", "/range_fusion/front.topic", f"{yaml}:8"),
+                    ("/rear/range", "/range_fusion/rear.topic", f"{yaml}:10")}
+    assert not [n for n in graph.notes if "range_fusion" in n.src.file]
+
+
+def test_without_the_parameter_file_the_code_default_and_a_located_note(tmp_path: Path) -> None:
+    import shutil
+    ws = tmp_path / "ws"
+    shutil.copytree(WS / "src" / "rig_sensing", ws / "rig_sensing")
+    shutil.rmtree(ws / "rig_sensing" / "config")
+    g = scan([ws], [], base=tmp_path, standard=False).graph
+    assert [e.topic for e in g.nodes["/range_fusion"].publishes] == ["/range"]
+    assert g.nodes["/range_fusion"].subscribes == []
+    [note] = [str(n) for n in g.notes]
+    assert note == ("ws/rig_sensing/src/range_fusion.cpp:26:23: warning: name of sub comes from parameter "
+                    "~<source>.topic of each source listed in parameter ~observation_sources, which has no list "
+                    "value in the launch files or the package's parameter files: not resolved statically")
+
+
+def test_parameter_files_two_files_disagreeing_and_wildcards(tmp_path: Path) -> None:
+    from rclverify.ros.param_yaml import PackageParams, matches, read_file
+    assert [matches(p, "/rig/range_fusion") for p in ("/**", "**", "/rig/range_fusion", "range_fusion",
+                                                      "/*/range_fusion", "/**/range_fusion", "/other")] == [
+        True, True, True, False, True, True, False]
+    got, notes = read_file("/**:\n  ros__parameters:\n    a: {b: x, n: 3}\n    l: [p, q]\n", "p.yaml")
+    assert (got, notes) == ([("/**", "~a.b", "x", got[0][3]), ("/**", "~l", ("p", "q"), got[1][3])], [])
+    assert read_file("a: [\n", "bad.yaml")[1][0].code == "ROS-PARSE"  # never raises
+    cfg = tmp_path / "pkg" / "config"
+    cfg.mkdir(parents=True)
+    (cfg / "a.yaml").write_text("n:\n  ros__parameters:\n    topic: one\n    same: s\n")
+    (cfg / "b.yaml").write_text("/n:\n  ros__parameters:\n    topic: two\n    same: s\n")
+    vals, said = PackageParams({"pkg": tmp_path / "pkg"}, lambda p: p.relative_to(tmp_path).as_posix()).for_node(
+        "pkg", "/n")
+    assert {k: v[0] for k, v in vals.items()} == {"/n/same": "s"}
+    assert [str(n) for n in said] == ["pkg/config/b.yaml:3:12: warning: parameter /n/topic has different values in "
+                                      "pkg/config/a.yaml:3:12 and pkg/config/b.yaml:3:12; which file runs is a "
+                                      "launch file's choice: not used"]

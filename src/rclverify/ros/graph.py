@@ -29,6 +29,7 @@ from .interfaces import TypeTable
 from .launch import El, Interpreter, read_xml, read_yaml
 from .launch_ros2 import read_python
 from .model import Endpoint, Graph, GraphEdge, GraphNode, Note, Src
+from .param_yaml import PackageParams, expand_each
 from .packages import Package, find_manifests, read_package
 from .sources_cpp import scan_cpp
 from .sources_py import scan_python
@@ -216,6 +217,8 @@ def _scan(paths: Sequence[Path], launch: Sequence[Path], launch_args: dict[str, 
         g.notes.append(Note(Src(bad), "name is not valid UTF-8: skipped", "ROS-PARSE"))
     asm = Assembly(pkgs, records, tgts, show, lambda t: table.get(t) is not None)
     launch_params: dict[str, tuple[str, Src]] = {}
+    pfiles = PackageParams({} if launch else {p: pkgs[p].root for p in pkgs}, show)
+    g.notes.extend(pfiles.notes)
     by_ros_name: dict[str, list[str]] = {}  # a ROS node name -> the graph nodes of the programs taking it
 
     def add_node(full: str, ns: str, pkg: str | None, exe: str | None, files: list[str], declared: Src,
@@ -249,12 +252,17 @@ def _scan(paths: Sequence[Path], launch: Sequence[Path], launch_args: dict[str, 
             g.notes.append(Note(declared, f"node {full} is started twice (first at {g.nodes[full].declared_at}); "
                                           f"ROS keeps only the last one", "ROS-LAUNCH"))
         mine = {names.resolve(k, ns, full): v for k, v in (params or {}).items()}
+        if origin == "source":  # no launch file: the package's parameter files (param_yaml)
+            from_files, said = pfiles.for_node(pkg, full)
+            g.notes.extend(said)
+            mine = {**from_files, **mine}
+        eps = expand_each(eps, lambda a: (mine.get(names.resolve(a, ns, full)) or (None,))[0], g.notes)
         for e in eps:
             written, pname, set_at = e.topic, None, None
             if e.param is not None:
                 pname = names.resolve(e.param, ns, full)
                 got = mine.get(pname) or launch_params.get(pname)
-                if got is not None:
+                if got is not None and isinstance(got[0], str):
                     written, set_at = e.affix[0] + got[0] + e.affix[1], got[1]
                 elif e.unread is not None:
                     g.notes.append(e.unread)
