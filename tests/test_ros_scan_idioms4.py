@@ -78,7 +78,8 @@ def skeletons(tmp_path_factory):  # type: ignore[no-untyped-def]
 def test_skeletons_keep_programs_apart(skeletons) -> None:  # type: ignore[no-untyped-def]
     _ws, rcl = skeletons
     nodes = sorted(line.split()[1] for text in rcl.values() for line in text.splitlines() if line.startswith("node "))
-    assert nodes == ["Base", "RangeFusion", "TalkerChatCppTalker", "TalkerChatCppTalkerBestEffort", "TalkerChatPyTalker"]
+    assert nodes == ["ArgvListener", "Base", "RangeFusion", "Relay", "TalkerChatCppTalker",
+                     "TalkerChatCppTalkerBestEffort", "TalkerChatPyTalker"]
     assert "outputs( chatter : STRING, dropped : NATURAL )" in rcl["talker_chat_cpp_talker_best_effort.rcl"]
 
 
@@ -102,8 +103,9 @@ def test_skeletons_of_a_driver_check_and_ground(skeletons, tmp_path: Path,  # ty
     findings = json.loads(out.read_text())
     got = findings["findings"] if isinstance(findings, dict) else findings
     # every contract is matched to its graph node (its enumerations read from the constants,
-    # /parameter_events the library's): nothing but the two located ROS-LAUNCH notes
-    assert sorted(f["code"] for f in got) == ["ROS-SCAN", "ROS-SCAN"]
+    # /parameter_events the library's): nothing but the scan's own located notes
+    assert {f["code"] for f in got} == {"ROS-SCAN"}
+    assert len(got) == 5  # two programs kept apart, three run-time names
 
 
 def test_the_packages_parameter_file_gives_values_and_lists_of_sources(graph) -> None:  # type: ignore[no-untyped-def]
@@ -149,3 +151,28 @@ def test_parameter_files_two_files_disagreeing_and_wildcards(tmp_path: Path) -> 
     assert [str(n) for n in said] == ["pkg/config/b.yaml:3:12: warning: parameter /n/topic has different values in "
                                       "pkg/config/a.yaml:3:12 and pkg/config/b.yaml:3:12; which file runs is a "
                                       "launch file's choice: not used"]
+
+
+def test_run_time_names_say_where_they_come_from(graph) -> None:  # type: ignore[no-untyped-def]
+    said = sorted(str(n) for n in graph.notes if n.code == "ROS-UNRESOLVED")
+    assert said == [
+        "idioms6/src/chat_cpp/src/listener_argv.cpp:12:5: warning: subscriber topic name is 'argv[1]', from argv: "
+        "not resolved statically",
+        "idioms6/src/chat_py/chat_py/relay.py:15:41: warning: publisher topic name is 'args.out_topic', from "
+        "argparse option --out-topic: not resolved statically",
+        "idioms6/src/chat_py/chat_py/relay.py:16:38: warning: subscriber topic name is 'sys.argv[1]', from argv: "
+        "not resolved statically"]
+    assert {f"{n.src.file}:{n.src.line}" for n in graph.notes if n.code == "ROS-UNRESOLVED"} == \
+        set(EXPECTED["unresolved"])
+    # round three's tools: a positional argparse argument, a name from the graph at run time
+    g5 = scan([CORPUS / "idioms5"], [], base=CORPUS, standard=False).graph
+    assert sorted(n.message for n in g5.notes if n.code == "ROS-UNRESOLVED") == [
+        "subscriber topic name is 'name', discovered at run time (get_topic_names_and_types()): not resolved "
+        "statically",
+        "subscriber topic name is 'topic', from argparse argument topic: not resolved statically"]
+
+
+def test_whole_workspace_is_the_hand_written_graph(graph) -> None:  # type: ignore[no-untyped-def]
+    assert set(graph.nodes) == set(EXPECTED["nodes"])
+    for node in EXPECTED["nodes"]:
+        assert _edges(graph, node) == _want(node), node

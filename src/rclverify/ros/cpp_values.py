@@ -70,6 +70,8 @@ class CppValues(CppScope):
             return ("nh", ())
         if t in ("identifier", "field_expression", "pointer_expression", "qualified_identifier"):
             return self._name_value(n, depth)
+        if t == "subscript_expression" and _T(n.child_by_field_name("argument")) == "argv":
+            return ("runtime", "from argv")  # main's argv[i]: the command line (symbols)
         return None
 
     def _call_value(self, n: Any, depth: int) -> symbols.Val:

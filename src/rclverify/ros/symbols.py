@@ -27,7 +27,11 @@ A value is a tuple (hashable, picklable, so it lives in the parse cache):
 * ``("each", param)``: one element of the string-array ROS 2 parameter
   ``param`` (``~observation_sources``), a C++ range-for's variable over it;
   its text is ``[~observation_sources]``, which the graph expands with the
-  parameter's value (:func:`rclverify.ros.param_yaml.expand`; issue 53).
+  parameter's value (:func:`rclverify.ros.param_yaml.expand_each`; issue 53);
+* ``("runtime", origin)``: a name only the running program knows, and where
+  it comes from (``from argv``, ``from argparse option --topic``,
+  ``discovered at run time (get_topic_names_and_types())``): never read, its
+  located note says the origin (issue 53).
 
 ``None`` is a value nobody can read statically (a computed string).
 Source of the naming rules: ROS 1 wiki "Names" and roscpp's ``NodeHandle``

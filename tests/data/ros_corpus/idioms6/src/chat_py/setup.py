@@ -12,6 +12,7 @@ setup(
     entry_points={
         'console_scripts': [
             'talker = chat_py.talker:main',
+            'relay = chat_py.relay:main',
         ],
     },
 )
