@@ -154,18 +154,22 @@ def test_yaml_launch_composable_node_with_parameter(tmp_path: Path) -> None:
     assert ("/y/yrelay", "action_servers", "/y/sweep", "corpus_interfaces/action/Sweep") in g.edges(True)
 
 
-def test_programs_taking_one_node_name_without_launch_are_one_node_with_all_endpoints() -> None:
+def test_programs_taking_one_node_name_without_launch_are_kept_apart() -> None:
     # Published packages ship several test scripts that call init_node with the
-    # same name; nothing starts them together, so none of them is dropped.
+    # same name; nothing starts them together, so each is a node of its own
+    # (issue 53: merged, they mixed into one contract), none dropped.
     _, g = _graph("loose_sources")
-    node = g.nodes["/rig_jogger"]
-    assert node.sources == ["loose/src/bench_tools/scripts/jog_linear.py",
-                            "loose/src/bench_tools/scripts/jog_spin.py"]
-    assert {e.topic for e in node.service_clients} == {"/rig/home", "/rig/stop"}
+    linear, spin = g.nodes["/rig_jogger@bench_tools.jog_linear.py"], g.nodes["/rig_jogger@bench_tools.jog_spin.py"]
+    assert "/rig_jogger" not in g.nodes
+    assert (linear.sources, spin.sources) == (["loose/src/bench_tools/scripts/jog_linear.py"],
+                                              ["loose/src/bench_tools/scripts/jog_spin.py"])
+    assert ({e.topic for e in linear.service_clients}, {e.topic for e in spin.service_clients}) == (
+        {"/rig/home"}, {"/rig/stop"})
     [note] = [n for n in g.notes if n.code == "ROS-LAUNCH"]
     assert str(note) == ("loose/src/bench_tools/scripts/jog_spin.py:7:1: warning: node /rig_jogger is also named "
                          "at loose/src/bench_tools/scripts/jog_linear.py:10:9; no launch file starts these "
-                         "programs: shown as one node with the endpoints of all of them")
+                         "programs together: kept apart as /rig_jogger@bench_tools.jog_spin.py (and "
+                         "/rig_jogger@bench_tools.jog_linear.py)")
 
 
 def test_nodes_named_alike_are_merged_only_without_launch_files() -> None:

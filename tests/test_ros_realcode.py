@@ -78,9 +78,9 @@ def test_constructor_arguments_and_namespaced_handles_across_files(tmp_path: Pat
     g = scan([tmp_path], base=tmp_path, standard=False).graph
     assert _edges(g) == {("/n", "pub", "/left/range", "std_msgs/msg/Float32", "sensor.cpp:3"),
                          ("/n", "pub", "/n/data", "std_msgs/msg/Float32", "sensor.cpp:3")}
-    # the third instance's name is computed at run time: said at the call, not guessed
-    assert [n.message for n in g.notes] == ["publisher topic name is 'topic', not a string literal: not resolved "
-                                            "statically"]
+    # the third instance's name is computed at run time: said at the call, not guessed, with
+    # where it comes from (issue 53)
+    assert [n.message for n in g.notes] == ["publisher topic name is 'topic', from argv: not resolved statically"]
 
 
 def test_a_static_method_called_does_not_construct_its_class(tmp_path: Path) -> None:

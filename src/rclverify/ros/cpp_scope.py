@@ -135,6 +135,11 @@ class CppScope:
         for n in nodes:
             if n.type == "declaration":
                 self._declaration(n)
+            elif n.type == "for_range_loop":  # for (auto & s : sources): s is each element (issue 53)
+                nm, fn = _declarator_name(n.child_by_field_name("declarator")), self.fn_of(n)
+                if nm is not None and fn is not None and n.child_by_field_name("right") is not None:
+                    self.ltypes[(fn.nid, _T(nm))] = _T(n.child_by_field_name("type"))
+                    self.locals.setdefault((fn.nid, _T(nm)), []).append(("each", n.child_by_field_name("right")))
             elif n.type == "assignment_expression" and n.child_by_field_name("operator") is not None:
                 op = _T(n.child_by_field_name("operator"))
                 self._assign(n.child_by_field_name("left"), n.child_by_field_name("right") if op == "=" else None, n)

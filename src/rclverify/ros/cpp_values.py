@@ -70,6 +70,8 @@ class CppValues(CppScope):
             return ("nh", ())
         if t in ("identifier", "field_expression", "pointer_expression", "qualified_identifier"):
             return self._name_value(n, depth)
+        if t == "subscript_expression" and _T(n.child_by_field_name("argument")) == "argv":
+            return ("runtime", "from argv")  # main's argv[i]: the command line (symbols)
         return None
 
     def _call_value(self, n: Any, depth: int) -> symbols.Val:
@@ -100,7 +102,7 @@ class CppValues(CppScope):
         if fn is not None and fn.type == "field_expression":
             method = _T(fn.child_by_field_name("field"))
             recv = fn.child_by_field_name("argument")
-            if method in ("c_str", "str", "data") and not args:
+            if method in ("c_str", "str", "data", "as_string_array") and not args:
                 return self.value(recv, depth + 1)
             if not args and recv is not None and recv.type == "call_expression":
                 inner = self.value(recv, depth + 1)  # get_parameter("t").as_string()
@@ -201,6 +203,10 @@ class CppValues(CppScope):
                                   for x in self.locals.get((callee.nid, b[2]), [])]) if depth < MAX_DEPTH else None
             if b[0] == "nhargs":
                 return self.handle(b[1], depth + 1)
+            if b[0] == "each":  # an element of a string-array parameter (symbols.each)
+                arr = self.value(b[1], depth + 1)
+                return ("each", arr[1]) if arr is not None and arr[0] == "param" and isinstance(arr[1], str) \
+                    and not arr[1].startswith(KEY) else None
             if b[0] in ("read", "ops"):
                 return self._call_value(b[1], depth + 1)
             if b[0] == "init":

@@ -4,8 +4,9 @@ workspaces, launch files, node sources and bags (docs/ros.md).
 Nodes come from the launch files given (``launch``); without any, each
 node source that names its node (``rospy.init_node('n')``,
 ``ros::init(.., "n")``, ``Node("n")`` ...) is one node in the root
-namespace (programs naming the same node are one node with all their
-endpoints; a Python file's node classes are one node each).  A node's topics are its sources' publishers and subscribers,
+namespace (programs naming the same node are kept apart, each a node
+``/name@package.executable``: :func:`apart_name`; a Python file's node
+classes are one node each).  A node's topics are its sources' publishers and subscribers,
 resolved in the node's namespace (ROS name rules, :mod:`names`) and then
 remapped by the launch file's ``remap`` elements (the last matching remap wins).
 """
@@ -28,6 +29,7 @@ from .interfaces import TypeTable
 from .launch import El, Interpreter, read_xml, read_yaml
 from .launch_ros2 import read_python
 from .model import Endpoint, Graph, GraphEdge, GraphNode, Note, Src
+from .param_yaml import PackageParams, expand_each
 from .packages import Package, find_manifests, read_package
 from .sources_cpp import scan_cpp
 from .sources_py import scan_python
@@ -215,31 +217,52 @@ def _scan(paths: Sequence[Path], launch: Sequence[Path], launch_args: dict[str, 
         g.notes.append(Note(Src(bad), "name is not valid UTF-8: skipped", "ROS-PARSE"))
     asm = Assembly(pkgs, records, tgts, show, lambda t: table.get(t) is not None)
     launch_params: dict[str, tuple[str, Src]] = {}
+    pfiles = PackageParams({} if launch else {p: pkgs[p].root for p in pkgs}, show)
+    g.notes.extend(pfiles.notes)
+    by_ros_name: dict[str, list[str]] = {}  # a ROS node name -> the graph nodes of the programs taking it
 
     def add_node(full: str, ns: str, pkg: str | None, exe: str | None, files: list[str], declared: Src,
                  eps: list[Endpoint], remaps: list[tuple[str, str, Src]], origin: str,
                  params: dict[str, tuple[str, Src]] | None = None, lifecycle: bool = False) -> None:
         node = GraphNode(full, ns, pkg, exe, files, declared, origin=origin, lifecycle=lifecycle)
-        if full in g.nodes and origin == "source" and g.nodes[full].origin == "source":
-            # no launch file starts them: several programs that take the same
-            # name are one node of the graph with all their endpoints (docs/ros.md)
-            node = g.nodes[full]
-            node.lifecycle = node.lifecycle or lifecycle
-            if declared != node.declared_at:  # one code named twice (an executable and its component): one node
-                g.notes.append(Note(declared, f"node {full} is also named at {node.declared_at}; no launch file "
-                                              f"starts these programs: shown as one node with the endpoints of "
-                                              f"all of them", "ROS-LAUNCH"))
-            node.sources.extend(f for f in files if f not in node.sources)
+        key = full
+        if origin == "source":
+            # no launch file starts them: each program taking a name is a node of its
+            # own, kept apart by its executable (docs/ros.md, "Programs without launch files")
+            keys = by_ros_name.setdefault(full, [])
+            same = next((k for k in keys if g.nodes[k].declared_at == declared), None)
+            if same is not None:  # one code named twice (an executable and its component): one node
+                node, key = g.nodes[same], same
+                node.lifecycle = node.lifecycle or lifecycle
+                node.sources.extend(f for f in files if f not in node.sources)
+            elif keys:
+                if keys == [full]:  # the first program taking the name is kept apart too
+                    first = g.nodes.pop(full)
+                    first.name = keys[0] = apart_name(full, first.package, first.executable, first.declared_at,
+                                                      g.nodes)
+                    g.nodes[first.name] = first
+                key = node.name = apart_name(full, pkg, exe, declared, g.nodes)
+                g.notes.append(Note(declared, f"node {full} is also named at {g.nodes[keys[0]].declared_at}; "
+                                              f"no launch file starts these programs together: kept apart as "
+                                              f"{key} (and {', '.join(keys)})", "ROS-LAUNCH"))
+                keys.append(key)
+            else:
+                keys.append(full)
         elif full in g.nodes:
             g.notes.append(Note(declared, f"node {full} is started twice (first at {g.nodes[full].declared_at}); "
                                           f"ROS keeps only the last one", "ROS-LAUNCH"))
         mine = {names.resolve(k, ns, full): v for k, v in (params or {}).items()}
+        if origin == "source":  # no launch file: the package's parameter files (param_yaml)
+            from_files, said = pfiles.for_node(pkg, full)
+            g.notes.extend(said)
+            mine = {**from_files, **mine}
+        eps = expand_each(eps, lambda a: (mine.get(names.resolve(a, ns, full)) or (None,))[0], g.notes)
         for e in eps:
             written, pname, set_at = e.topic, None, None
             if e.param is not None:
                 pname = names.resolve(e.param, ns, full)
                 got = mine.get(pname) or launch_params.get(pname)
-                if got is not None:
+                if got is not None and isinstance(got[0], str):
                     written, set_at = e.affix[0] + got[0] + e.affix[1], got[1]
                 elif e.unread is not None:
                     g.notes.append(e.unread)
@@ -255,7 +278,7 @@ def _scan(paths: Sequence[Path], launch: Sequence[Path], launch_args: dict[str, 
             # every call site keeps its own edge (the same name created twice is two edges)
             if not any(x.topic == edge.topic and x.msg_type == edge.msg_type and x.src == edge.src for x in lst):
                 lst.append(edge)
-        g.nodes[full] = node
+        g.nodes[key] = node
 
     if launch:
         interp = Interpreter(lambda p: pkgs[p].root.resolve() if p in pkgs else None,
@@ -290,3 +313,18 @@ def _scan(paths: Sequence[Path], launch: Sequence[Path], launch_args: dict[str, 
         cache.save()
         res.cache_hits, res.cache_misses = cache.hits, cache.misses
     return res
+
+
+def apart_name(full: str, pkg: str | None, exe: str | None, declared: Src | None, taken: dict[str, Any]) -> str:
+    """The graph name of one of several programs that take node name ``full`` with no
+    launch file starting them: ``/talker@demo_nodes_cpp.talker`` (``full@package.executable``;
+    the file's stem for a loose file; characters other than letters, digits, ``_``
+    and ``.`` as ``_``; ``.2``, ``.3`` ... appended while ``taken`` has it).  The
+    ``@`` makes it no ROS name, so it is never a running node's (docs/ros.md)."""
+    what = exe or (Path(declared.file).stem if declared is not None else "program")
+    tail = "".join(c if c.isalnum() or c in "_." else "_" for c in f"{pkg or 'loose'}.{what}")
+    out, k = f"{full}@{tail}", 1
+    while out in taken:
+        k += 1
+        out = f"{full}@{tail}.{k}"
+    return out

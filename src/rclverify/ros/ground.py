@@ -44,7 +44,7 @@ from .graph import ScanResult
 from .ground_services import RULES as SERVICE_RULES
 from .ground_services import folded, ground_links
 from .interfaces import BASE_TYPES, TypeTable, field_path
-from .model import GraphEdge, GraphNode, Src, canon_type, short_type
+from .model import LIBRARY_TOPICS, GraphEdge, GraphNode, Src, canon_type, short_type
 from .lifecycle import implicit
 
 _INT = {"int8", "int16", "int32", "int64", "uint8", "uint16", "uint32", "uint64", "byte", "char", "octet"}
@@ -94,7 +94,8 @@ class Finding:
 
 
 def _key(name: str) -> str:
-    return re.sub(r"[_\-]", "", names.split(name)[1] if name.startswith("/") else name).lower()
+    # ``@`` and ``.``: a program kept apart by its executable (``/talker@pkg.exe``, graph.apart_name)
+    return re.sub(r"[_\-@.]", "", names.split(name)[1] if name.startswith("/") else name).lower()
 
 
 def match_nodes(contract_nodes: Iterable[str], graph: Mapping[str, GraphNode],
@@ -199,7 +200,7 @@ class Grounder:
 
     def _own_edge(self, gn: GraphNode, kind: str, topic: str) -> GraphEdge | None:
         edges = gn.publishes if kind == "pub" else gn.subscribes
-        resolved = names.resolve(topic, gn.namespace, gn.name)
+        resolved = names.resolve(topic, gn.namespace, gn.name.split("@", 1)[0])  # a program kept apart: its ROS name
         return next((e for e in edges if e.written.lstrip("/") == topic or e.written == topic), None) or \
             next((e for e in edges if e.topic == resolved), None) or \
             next((e for e in edges if e.written.rstrip("/").rsplit("/", 1)[-1].lstrip("~") == topic), None) or \
@@ -268,7 +269,7 @@ class Grounder:
             if var is not None:
                 self._fields(cn, tp, var, ctype, rcl_loc)
         for e in gn.publishes + gn.subscribes:
-            if id(e) not in documented:
+            if id(e) not in documented and e.topic not in LIBRARY_TOPICS:  # the client library's, no contract's
                 what = "publishes" if e in gn.publishes else "subscribes to"
                 self.add("ROS-TOPIC-UNDOCUMENTED", f"{gn.name} {what} {e.topic} ({short_type(e.msg_type)}), which "
                          f"{node.name}'s contract leaves out of topics(...)", node.loc, e.src, node.name, e.written)
@@ -351,7 +352,9 @@ class Grounder:
                 consts = {n.lower() for n, t, _v in (oinfo.consts if oinfo else []) if t == rt}
                 if not consts:
                     return False, f"an integer field without constants cannot hold {w.name}'s values"
-                vals = {v.lower() for v in w.values}
+                # a value qualified with its type where two messages' constants clash (soundValueOn)
+                vals = {v.lower()[len(w.name):] if v.lower()[len(w.name):] in consts and
+                        v.lower().startswith(w.name.lower()) else v.lower() for v in w.values}
                 if vals != consts:
                     miss, extra = sorted(vals - consts), sorted(consts - vals)
                     return False, (f"its {rt} constants ({', '.join(sorted(consts)).upper()}) do not match "

@@ -86,7 +86,7 @@ class Values:
         if v is None or depth > MAX_DEPTH:
             return [None]
         k = v[0]
-        if k in ("str", "node"):
+        if k in ("str", "node", "each", "runtime"):
             return [v]
         homes = {h for h in _homes(v) if h != fkey and h in self.fns}
         if len(homes) == 1 and k != "arg":

@@ -13,6 +13,11 @@ from typing import Any
 SCHEMA_ID = "rclverify-ros-graph/1"
 
 
+#: topics every ROS 2 node's client library makes (rcl: ``/rosout`` for logging,
+#: ``/parameter_events`` for parameter changes; ROS 2 design "Parameters"): the
+#: library's, never a contract's inputs or outputs (docs/ros.md, issue 53)
+LIBRARY_TOPICS = frozenset({"/parameter_events", "/rosout"})
+
 @dataclass(frozen=True)
 class Src:
     """A location in a scanned file: path as given, 1-based line and column."""

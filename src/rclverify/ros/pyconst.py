@@ -22,8 +22,15 @@ Keys of units (what owns an endpoint): ``FILE::Cls`` for a class,
 """
 from __future__ import annotations
 
+import re
+from typing import Any
+
 from . import symbols
 from .pyrecords import PyCall, PyModule, PyVal
+
+#: rclpy/rospy calls whose results are the running graph's names (names found at run time)
+DISCOVERY = {"get_topic_names_and_types", "get_service_names_and_types", "get_node_names",
+             "get_node_names_and_namespaces", "get_published_topics", "get_topic_type"}
 
 _ROS = ("rospy", "rclpy", "std_msgs", "actionlib", "tf", "tf2_ros", "message_filters", "os", "sys", "math",
         "time", "threading", "numpy", "interactive_markers")
@@ -104,6 +111,8 @@ class PyScope:
             return symbols.cat([self.value(p, depth + 1) for p in v.parts])
         if v.kind == "name":
             return self._name(v.text, v.src.line, depth)
+        if v.kind == "other" and re.match(r"(sys\.)?argv\s*\[", v.text):
+            return ("runtime", "from argv")
         for c in ([v.call] if v.call else []) + v.calls:
             g = self.getter(c)
             if g is not None:
@@ -112,6 +121,8 @@ class PyScope:
             f = self.full(v.call.func)
             if f in ("rospy.get_name", "rospy.names.get_name") or v.call.func.endswith("get_fully_qualified_name"):
                 return symbols.NODE
+            if v.call.func.rsplit(".", 1)[-1] in DISCOVERY:
+                return ("runtime", f"discovered at run time ({v.call.func.rsplit('.', 1)[-1]}())")
             if f == "str" and len(v.call.args) == 1:
                 return self.value(v.call.args[0], depth + 1)
             if f == "os.path.join" and v.call.args:
@@ -131,12 +142,32 @@ class PyScope:
             if key in self.binds:
                 return self._one(self.binds[key], depth)
         head = name.split(".")[0]
+        parsed = self._argparse(head, name.partition(".")[2], f)
+        if parsed is not None:
+            return parsed
         if head in self.mod.imports:
             origin = self.full(name)
             if origin.split(".")[0] in _ROS:
                 return None
             return ("ext", origin)
         return None
+
+    def _argparse(self, head: str, attr: str, f: tuple[Any, ...] | None) -> symbols.Val:
+        """``("runtime", "from argparse option --topic")`` for ``args.topic`` where ``args``
+        is bound to an ``ArgumentParser``'s ``parse_args()`` / ``parse_known_args()``
+        (Python docs, argparse: an option's ``dest`` is its long name, ``-`` as ``_``)."""
+        if not attr or "." in attr:
+            return None
+        keys = ([("local", f[0], head)] if f is not None else []) + [("module", head)]
+        vals = [v for k in keys for v in self.binds.get(k, [])]
+        if not vals or not all(v.call is not None and v.call.func.rsplit(".", 1)[-1] in (
+                "parse_args", "parse_known_args") for v in vals):
+            return None
+        opts = [c.args[i].text for c in self.mod.calls if c.func.endswith(".add_argument")
+                for i in range(len(c.args)) if c.args[i].kind == "str"
+                and c.args[i].text.lstrip("-").replace("-", "_") == attr]
+        opt = opts[-1] if opts else attr
+        return ("runtime", f"from argparse {'option' if opt.startswith('-') else 'argument'} {opt}")
 
     def _one(self, vals: list[PyVal], depth: int) -> symbols.Val:
         got = {self.value(x, depth + 1) for x in vals}

@@ -33,7 +33,7 @@ import jinja2
 from ..evidence.store import atomic_write_text
 from .graph import ScanResult
 from .interfaces import TypeTable, elem_type
-from .model import GraphNode, short_type
+from .model import LIBRARY_TOPICS, GraphNode, short_type
 from .safecopy import copy_package
 
 _ENV = jinja2.Environment(loader=jinja2.PackageLoader("rclverify.ros", "templates"), autoescape=False,
@@ -44,7 +44,9 @@ _SIGNED = {"int8", "int16", "int32", "int64"}
 _RCL_WORDS = {"node", "context", "inputs", "outputs", "topics", "assume", "guarantee", "forall", "exists",
               "exists_unique", "and", "or", "not", "in", "out", "TRUE", "FALSE", "REAL", "INTEGER", "NATURAL",
               "BOOL", "STRING", "matches", "set", "seq"}
-_SKIP_FIELDS = {"header", "stamp"}
+# rosidl's placeholder of an empty message (``std_msgs/Empty``: ``uint8
+# structure_needs_at_least_one_member``, ROS 2 IDL mapping) is no field of it
+_SKIP_FIELDS = {"header", "stamp", "structure_needs_at_least_one_member"}
 #: the context declarations shared by every skeleton (one RCL type per message type)
 TYPES_FILE = "contracts/ros_types.rcl"
 
@@ -133,6 +135,19 @@ def _type_name(msg: str, taken: dict[str, str]) -> str:
     return name
 
 
+def _value(tname: str, const: str, taken: dict[str, str]) -> str:
+    """An enumeration value for constant ``const`` of type ``tname``: ``on`` for ``ON``,
+    qualified with the type (``soundValueOn``) when another enumeration has ``on``
+    already (RCL values are global: two messages' ``ON`` constants must not clash;
+    the grounding reads either form, :func:`rclverify.ros.ground`).  ``taken`` records
+    values as ``"=value"`` -> type name."""
+    v = ident(const.lower())
+    if taken.setdefault("=" + v, tname) != tname:
+        v = ident(f"{tname} {const.lower()}")
+        taken["=" + v] = tname
+    return v
+
+
 def _var_type(table: TypeTable, msg: str | None, var: str,
               taken: dict[str, str] | None = None) -> tuple[str, list[str], dict[str, str] | None]:
     """(RCL type text, field paths, context declaration or None); types are named
@@ -148,7 +163,7 @@ def _var_type(table: TypeTable, msg: str | None, var: str,
         consts = [n for n, ct, _ in info.consts if ct == t] if "." not in path else []
         if consts and t in _UNSIGNED | _SIGNED:
             tname = _type_name(msg, taken) + ident(path, camel=True)
-            return tname, [path], {"name": tname, "type": "{" + ", ".join(ident(c.lower()) for c in consts) + "}"}
+            return tname, [path], {"name": tname, "type": "{" + ", ".join(_value(tname, c, taken) for c in consts) + "}"}
         return rcl_scalar(t) or "{}", [path], None
     if not fields:
         return "{}", [], None
@@ -221,8 +236,10 @@ def build_skeletons(res: ScanResult) -> tuple[list[_Node], dict[str, list[str]],
         used_names.add(cname)
         n = _Node(cname, gname, gn.package, gn.executable, gn.sources, _contract_file(cname, nodes))
         seen: set[str] = set()
-        written = [e.written or e.topic for e in gn.publishes + gn.subscribes]
-        for kind, edges in (("in", gn.subscribes), ("out", gn.publishes)):
+        # the client library's own topics (/parameter_events, /rosout) are no contract's
+        pubs, subs = ([e for e in es if e.topic not in LIBRARY_TOPICS] for es in (gn.publishes, gn.subscribes))
+        written = [e.written or e.topic for e in pubs + subs]
+        for kind, edges in (("in", subs), ("out", pubs)):
             done: set[str] = set()
             for e in sorted(edges, key=lambda e: e.topic):
                 if e.topic in done:
@@ -244,7 +261,7 @@ def build_skeletons(res: ScanResult) -> tuple[list[_Node], dict[str, list[str]],
         _links(n, gn, table, taken, context, seen)
         nodes.append(n)
     published = {e.topic for n in g.nodes.values() for e in n.publishes}
-    external = sorted({e.topic for n in g.nodes.values() for e in n.subscribes} - published)
+    external = sorted({e.topic for n in g.nodes.values() for e in n.subscribes} - published - LIBRARY_TOPICS)
     return nodes, fields, external, list(context.values())
 
 

@@ -44,7 +44,7 @@ from typing import Any
 from . import emit, py_helpers, symbols
 from .cpp_types import action_type, service_type
 from .model import Endpoint, Note, Src, canon_type
-from .pyconst import PyScope
+from .pyconst import DISCOVERY, PyScope
 from .pyrecords import PyCall, PyModule, PyVal, percent
 
 
@@ -166,11 +166,20 @@ def _ast_module(tree: ast.AST, shown: str) -> PyModule:
         elif isinstance(n, ast.ClassDef):
             mod.classes.append((n.name, n.lineno, getattr(n, "end_lineno", None) or n.lineno))
             mod.bases[n.name] = [d for d in (_dotted(b) for b in n.bases) if d]
+        elif isinstance(n, ast.For) and isinstance(n.iter, ast.Call) and \
+                (_dotted(n.iter.func) or "").rsplit(".", 1)[-1] in DISCOVERY:
+            # for name, types in node.get_topic_names_and_types(): names found at run time (pyconst)
+            for t in (n.target.elts if isinstance(n.target, ast.Tuple) else [n.target]):
+                if isinstance(t, ast.Name):
+                    mod.assigns.append((t.id, val(n.iter)))
         elif isinstance(n, (ast.Assign, ast.AnnAssign)) and n.value is not None:
             for t in (n.targets if isinstance(n, ast.Assign) else [n.target]):
                 d = _dotted(t)
                 if d is not None:
                     mod.assigns.append((d, val(n.value)))
+                elif isinstance(t, ast.Tuple) and t.elts and isinstance(t.elts[0], ast.Name) and isinstance(
+                        n.value, ast.Call) and (_dotted(n.value.func) or "").endswith(".parse_known_args"):
+                    mod.assigns.append((t.elts[0].id, val(n.value)))  # args, rest = p.parse_known_args()
     if isinstance(tree, ast.Module):
         scopes(tree.body, "", False)
     mod.calls.sort(key=lambda c: (c.src.line, c.src.col))  # source order, as the tolerant reader gives

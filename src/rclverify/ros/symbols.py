@@ -23,7 +23,15 @@ A value is a tuple (hashable, picklable, so it lives in the parse cache):
   ``rospy.get_name()``), which ROS resolves like ``~``;
 * ``("cat", parts)``: the concatenation of ``parts``;
 * ``("ext", dotted)``: a Python name imported from another module of the
-  package (``from pkg.names import TOPIC``).
+  package (``from pkg.names import TOPIC``);
+* ``("each", param)``: one element of the string-array ROS 2 parameter
+  ``param`` (``~observation_sources``), a C++ range-for's variable over it;
+  its text is ``[~observation_sources]``, which the graph expands with the
+  parameter's value (:func:`rclverify.ros.param_yaml.expand_each`; issue 53);
+* ``("runtime", origin)``: a name only the running program knows, and where
+  it comes from (``from argv``, ``from argparse option --topic``,
+  ``discovered at run time (get_topic_names_and_types())``): never read, its
+  located note says the origin (issue 53).
 
 ``None`` is a value nobody can read statically (a computed string).
 Source of the naming rules: ROS 1 wiki "Names" and roscpp's ``NodeHandle``
@@ -88,6 +96,8 @@ def text(v: Val) -> str | None:
         return str(v[1])
     if v[0] == "node":
         return "~"
+    if v[0] == "each":
+        return f"[{v[1]}]"
     if v[0] == "cat":
         parts = [text(x) for x in v[1]]
         if any(p is None for p in parts):
