@@ -402,7 +402,9 @@ def factor_text(a: Unit, b: Unit) -> str:
     big, small = (a, b) if float(f) * math.pi ** pi >= 1 else (b, a)
     if (big, small) == (b, a):
         f, pi = 1 / f, -pi
-    n = _scale_text(f, pi)
+    from .unitconv import short_decimal  # 3.6, 0.3048: the usual conversions as people write them
+    n = short_decimal(f) if not pi else None
+    n = n or _scale_text(f, pi)
     return f"a factor of {n} (1 {_name(big)} = {n} {_name(small)})"
 
 
