@@ -54,6 +54,15 @@ def _targets() -> list[Unit]:
 TARGETS: tuple[Unit, ...] = tuple(_targets())
 
 
+_BY_KEY = {t.key: t for t in reversed(TARGETS)}
+
+
+def named(u: Unit) -> Unit:
+    """``u`` with the text of the unit of :data:`TARGETS` it is (``[m/s]``
+    for the unit the algebra makes of ``[m]/[s]``), else as it is."""
+    return u if u.text else _BY_KEY.get(u.key, u)
+
+
 def _magnitude(f: Fraction, pi: int) -> float:
     return float(f) * math.pi ** pi
 

@@ -41,7 +41,7 @@ from typing import Any, Iterable, Mapping
 from . import ast
 from .printer import expr_to_rcl
 from .types import Checked
-from .unitconv import convert_by
+from .unitconv import convert_by, named
 from .units import Unit
 
 #: ``(node, "in" | "out", variable)``.
@@ -149,7 +149,7 @@ def resolve(u: Unit, k: Fraction | None) -> tuple[Unit, Unit | None]:
     ``k``: the converted unit and ``u`` when ``k`` is a usual conversion,
     else ``(u, None)``."""
     t = convert_by(u, k) if k is not None else None
-    return (t, u) if t is not None else (u, None)
+    return (t, named(u)) if t is not None else (named(u), None)
 
 
 class _Terms:
