@@ -261,6 +261,24 @@ def test_the_conversion_is_the_first_repair_and_z3_checked_it(verified, tmp_path
         == "discharged"
 
 
+def test_a_mismatch_declared_at_both_ends_no_longer_stops_the_run(tmp_path):
+    """Before issue 48 the error stopped ``doit verify`` and no report was written."""
+    ws = tmp_path / "declared"
+    (ws / "contracts").mkdir(parents=True)
+    (ws / "contracts" / "robot.rcl").write_text(
+        ROBOT.replace("outputs( heading : REAL )", "outputs( heading : REAL [deg] )"), encoding="utf-8")
+    (ws / "contracts" / "plan.yaml").write_text(PLAN.split("nodes:")[0], encoding="utf-8")
+    assert main(["verify", "-w", str(ws)]) == 0
+    report = json.loads((ws / "reports" / "assurance.json").read_text(encoding="utf-8"))
+    # recorded once, at the producer's declaration (SARIF and the row on the producer, not the consumer)
+    assert [(x["code"], x["location"]) for x in report["lint"]] == [("E-unit-scale", "contracts/robot.rcl:3:12")]
+    [row] = [g for g in report["problems"] if "Gnss.out.heading.unit" in [m["id"] for m in g["members"]]]
+    assert {"Localiser.sc2", "contracts/robot.rcl:3:12"} <= {m["id"] for m in row["members"]}
+    assert [c["what"] for c in row["culprits"]] == ["the contract of Gnss"]
+    assert "Planner.contract-consistent" in {m["id"] for g in report["problems"] for m in g["members"]}
+    assert main(["verify", "-w", str(ws), "--strict"]) == 1
+
+
 # ---------------------------------------------------------------------------
 # Oracle: the inferred unit equals a brute-force propagation
 # ---------------------------------------------------------------------------

@@ -76,7 +76,6 @@ def unit_records(ws: Any, report: Mapping[str, Any], cached: Callable[[Any, Call
     [], "repairs", "guarantee", "joins": [ids], "lint": the location of its
     lint row}``.  ``cached(key, make)`` keeps the repairs between runs (the
     diagnosis cache).  Never raises for a system that type-checked."""
-    from .build import _record as record
     out = []
     for m in mismatches(ws.checked, ws.model.links):
         joined = _joins(report, m)
@@ -88,11 +87,11 @@ def unit_records(ws: Any, report: Mapping[str, Any], cached: Callable[[Any, Call
             culprit = {"what": f"output {m.writer[2]} of {p}", "source": _loc(m.writer_decl), "text": str(m.writer_unit)}
         key = ["unit", m.name, str(m.writer_unit), str(m.reader_unit), _loc(m.at)]
         reps = cached(key, lambda: conversion_repair(ws, m)) or []
-        rec = record(f"{'.'.join(m.writer)}.unit", "unit", p, "failed", _sentence(m, joined, report),
-                     culprits=[culprit], repairs=reps,
-                     guarantee=m.inferred.guarantee if m.inferred is not None else None)
-        rec["joins"], rec["lint"] = joined, _loc(m.at)
-        out.append(rec)
+        out.append({"id": f"{'.'.join(m.writer)}.unit", "kind": "unit", "node": p, "status": "failed",
+                    "sentence": _sentence(m, joined, report), "culprits": [culprit], "counterexample": [],
+                    "repairs": [r for r in reps if r],
+                    "guarantee": m.inferred.guarantee if m.inferred is not None else None,
+                    "joins": joined, "lint": _loc(m.at)})
     return out
 
 

@@ -25,7 +25,7 @@ from __future__ import annotations
 import math
 from fractions import Fraction
 
-from .units import _NAMES, Unit, parse_unit, ratio
+from .units import _NAMES, Unit, _scale_text, parse_unit, ratio, short_decimal  # noqa: F401 (short_decimal: re-exported)
 
 #: Compound units a contract may declare, besides the symbols and prefixed symbols of the table.
 _COMPOUND = ("m/s", "km/h", "mm/s", "cm/s", "m/s^2", "rad/s", "deg/s", "rad/s^2", "deg/s^2", "m/min", "km/s")
@@ -99,17 +99,5 @@ def factor_name(a: Unit, b: Unit) -> str:
             return USUAL[f]
         if 1 / f in USUAL:
             return f"1/{USUAL[1 / f]}"
-    from .units import _scale_text
     return _scale_text(f, pi)
 
-
-def short_decimal(f: Fraction) -> str | None:
-    """``"3.6"`` for 18/5: a non-integer with an exact decimal of at most 6
-    places, as the usual conversions are written (``0.3048``, ``1.609344``);
-    else ``None``."""
-    if f.denominator == 1:
-        return None
-    for k in range(1, 7):
-        if (f * 10**k).denominator == 1:
-            return f"{float(f):.{k}f}"
-    return None
