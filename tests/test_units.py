@@ -238,9 +238,8 @@ node Controller {
 
 def test_unit_mismatch_located_at_both_ends():
     checked = check([parse_text(_SYSTEM, "robot.rcl")])
-    with pytest.raises(RclError) as e:
-        build(checked)
-    diags = [d for d in e.value.diagnostics if d.code == "E-unit-scale"]
+    build(checked)  # a unit mismatch does not stop the build (issue 48): the diagnostics say it
+    diags = [d for d in unit_diagnostics(checked) if d.code == "E-unit-scale"]
     ends = {(d.loc.file, d.loc.line, d.loc.col) for d in diags}
     # the producer's output declaration `d : REAL [mm]` and the consumer's input declaration `d : REAL [m]`
     assert ends == {("robot.rcl", 3, 12), ("robot.rcl", 9, 11)}

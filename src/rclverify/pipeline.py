@@ -56,8 +56,10 @@ def stage_check(ws: Workspace) -> dict[str, Any]:
     checked, model = ws.checked, ws.model
     texts = ContractTexts(ws)  # each file's lint and each node's RCL text, kept by the file's sha256
     warnings = [w for s in checked.specs for w in texts.lint(s)]
-    from .system.units import connection_warnings  # one end of a connection declares a unit, the other none
-    warnings += [d.to_json() for d in connection_warnings(checked, model.links)]
+    # units across connections: a missing unit (warning), a mismatch (an error row at the producer's end, the run
+    # going on: issue 48)
+    from .system.units import producer_diagnostics
+    warnings += [d.to_json() for d in producer_diagnostics(checked, model.links)]
     from .system.services import unserved
     warnings += [d.to_json() for d in unserved(checked)]  # a call no node answers (W-unserved)
     write_sealed(ws.path(ws.DIAGNOSTICS), {"warnings": warnings})

@@ -7,7 +7,9 @@ and the workspace and returns ``[record, ...]``, each::
      "kind": "vacuity" | "inconsistency" | "unsatisfiable-assumption" | "refinement"
              | "side-condition" | "hoare" | "monitor" | "property-test" | "evidence"
              | "requirement" (a refuted one: diagnosis/requirement.py)
-             | "deadline" (a refuted or undecided end-to-end deadline: diagnosis/deadline.py),
+             | "deadline" (a refuted or undecided end-to-end deadline: diagnosis/deadline.py)
+             | "unit" (a unit mismatch on a connection, blaming the producer: diagnosis/units.py;
+                       with "joins", the ids of the findings it explains, and "lint"),
      "node": str, "status": str,
      "sentence": one sentence naming the culprit by source location,
      "culprits": [{"what": str, "source": "file:line:col", "text": str}],
@@ -159,6 +161,9 @@ def _diagnose(ws: Any, report: Mapping[str, Any]) -> list[dict[str, Any]]:
                                                                           health_by_node.get(node, {})))
         return found
 
+    # a unit mismatch on a connection first: it explains the side condition and the runs that follow from it
+    from .units import unit_records
+    out += unit_records(ws, report, cache.get)
     for f in report["findings"]:
         if f["status"] != "problem":
             continue

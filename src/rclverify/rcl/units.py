@@ -402,8 +402,21 @@ def factor_text(a: Unit, b: Unit) -> str:
     big, small = (a, b) if float(f) * math.pi ** pi >= 1 else (b, a)
     if (big, small) == (b, a):
         f, pi = 1 / f, -pi
-    n = _scale_text(f, pi)
+    n = short_decimal(f) if not pi else None  # 3.6, 0.3048: the usual conversions as people write them
+    n = n or _scale_text(f, pi)
     return f"a factor of {n} (1 {_name(big)} = {n} {_name(small)})"
+
+
+def short_decimal(f: Fraction) -> str | None:
+    """``"3.6"`` for 18/5: a non-integer with an exact decimal of at most 6
+    places, as the usual conversions are written (``0.3048``, ``1.609344``);
+    else ``None``."""
+    if f.denominator == 1:
+        return None
+    for k in range(1, 7):
+        if (f * 10**k).denominator == 1:
+            return f"{float(f):.{k}f}"
+    return None
 
 
 def power_of_ten(a: Unit, b: Unit) -> int | None:

@@ -69,6 +69,7 @@ from typing import Any
 
 from ..evidence.records import SEVERITY
 from . import problems_mc as mc
+from . import problems_units as pu
 
 #: Key prefix of a group of outstanding evidence on a node's whole contract from one backend (rule 5).
 OUTSTANDING_WHOLE = "outstanding-contract:"
@@ -79,7 +80,7 @@ _CONTRACT_DEFECTS = ("vacuity", "inconsistency")
 #: Diagnosis kinds whose sentence names the cause rather than the symptom, most telling first: a
 #: contract defect names the guarantees that exclude each other, a side condition producer and
 #: consumer, a Hoare refutation the constants; a test or a monitor names only the guarantee broken.
-_TELLING = {"vacuity": 0, "inconsistency": 0, "unsatisfiable-assumption": 0, "side-condition": 1, "hoare": 1,
+_TELLING = {"unit": 0, "vacuity": 0, "inconsistency": 0, "unsatisfiable-assumption": 0, "side-condition": 1, "hoare": 1,
             "deadline": 1, "refinement": 2, "monitor": 3}
 #: Rank of every other kind (a property test, other evidence, a requirement, an attention item).
 _LEAST_TELLING = 4
@@ -198,8 +199,15 @@ def group_problems(report: Mapping[str, Any], items: Sequence[Mapping[str, Any]]
     explains: dict[str, list[str]] = {}
     mc_obl = mc.mc_obligations(report)
     direct: set[str] = set()  # model-checking evidence: grouped only by the culprits it names (problems_mc)
+    unit_of, unit_roots = pu.joins(diagnoses), {}  # a unit mismatch's row takes what it explains (problems_units)
     for d in diagnoses:
         roots = _roots(d.get("culprits", []), places, victim_of(d.get("node"), d.get("guarantee")))
+        if d["kind"] == pu.KIND:
+            unit_roots[str(d["id"])] = roots = roots or [f"problem:{d['id']}"]
+            item_anchor.setdefault(str(d["id"]), item_anchor.get(str(d.get("lint")), ""))
+        if d["kind"] == pu.KIND or unit_of.get(str(d["id"])) in unit_roots:
+            roots = unit_roots[str(d["id"]) if d["kind"] == pu.KIND else unit_of[str(d["id"])]]
+            direct.add(str(d["id"]))
         if d["kind"] == "deadline":  # its own row, whatever else its hops' guarantees are found in (rule 5)
             roots = [f"{DEADLINE_PREFIX}{d.get('requirement')}"]
         if str(d["id"]) in mc_obl:
@@ -252,6 +260,9 @@ def group_problems(report: Mapping[str, Any], items: Sequence[Mapping[str, Any]]
         elif o is not None and not o.get("guarantee") and str(it["status"]) in ("inconclusive", "pending"):
             roots = [f"{OUTSTANDING_WHOLE}{o.get('backend')}:{o.get('node')}"]  # rule 5
             direct.add(ref)
+        if unit_of.get(ref) in unit_roots:  # explained by a unit mismatch: its row (problems_units)
+            roots = unit_roots[unit_of[ref]]
+            direct.add(ref)
         if it["kind"] == "derived property":
             ref = f"{ref}.derived"  # named fully: the derived property of the node, never the bare node name
             # not derived because a side condition of its cone is not discharged: that side condition's cause
@@ -262,6 +273,10 @@ def group_problems(report: Mapping[str, Any], items: Sequence[Mapping[str, Any]]
                          "sentence": str(it["message"]) + (f" `{it['formula']}`" if it.get("formula") else ""),
                          "anchor": str(it["anchor"]), "diagnosis": False}, roots))
         covered.add(ref)
+    for m, uid in pu.extra_members(report, diagnoses, covered, anchor):  # a lint warning, a health warning, a run
+        if uid in unit_roots:
+            direct.add(m["id"])
+            members.append((m, unit_roots[uid]))
 
     groups: dict[tuple[str, ...], dict[str, Any]] = {}
     for m, roots in members:

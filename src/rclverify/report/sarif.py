@@ -363,13 +363,17 @@ def _attach_diagnoses(report: Mapping[str, Any], results: Sequence[dict[str, Any
     from ..diagnosis.edits import sarif_fix
     by_key: dict[str, Mapping[str, Any]] = {}
     for d in report.get("diagnoses", []):
+        if d.get("kind") == "unit":  # a unit mismatch: the lint error at the producer (diagnosis/units.py)
+            by_key[f"unit:{d.get('lint')}"] = d
+            continue
         if d.get("kind") == "deadline":
             by_key[f"deadline:{d.get('requirement')}"] = d
             continue
         for prefix in ("health", "side-condition", "obligation", "requirement"):
             by_key[f"{prefix}:{d['id']}"] = d
     for res in results:
-        d = by_key.get(res["partialFingerprints"]["rclverifyItem/v1"])
+        fp = res["partialFingerprints"]["rclverifyItem/v1"]
+        d = by_key.get(fp) or (by_key.get("unit:" + fp[5:].split(":E-unit-")[0]) if ":E-unit-" in fp else None)
         if d is None:
             continue
         res["properties"]["diagnosis"] = d["sentence"]

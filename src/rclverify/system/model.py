@@ -30,7 +30,7 @@ from ..plan.load import Connection
 from ..rcl.errors import RclError, error
 from ..rcl.types import Checked, EmptyT
 from .services import peers as service_peers, side_conditions as service_conditions
-from .units import connection_diagnostics, connection_errors
+from .units import connection_diagnostics
 
 
 @dataclass(frozen=True)
@@ -247,11 +247,21 @@ def build(checked: Checked, connections: Sequence[Connection] = ()) -> SystemMod
     """Build the system model of the checked contracts.
 
     Raises :class:`RclError` (located at the input's declaration) when an
-    input could be fed by several nodes and the plan does not say which, and
-    (located at both declarations) when the two ends of a connection declare
-    different units of measure (:mod:`.units`).
+    input could be fed by several nodes and the plan does not say which.
+    A connection whose two ends disagree on the unit of measure does not
+    stop the build (issue 48): :func:`unit_diagnostics` and the check stage
+    report it (:mod:`.units`).
     """
     nodes = list(checked.nodes)
+    links, env, diags = _connect(checked, connections)
+    diags += service_conditions(checked)
+    if diags:
+        raise RclError(diags)
+    return SystemModel(tuple(nodes), tuple(links), tuple(env), _loops(nodes, links))
+
+
+def _connect(checked: Checked, connections: Sequence[Connection]) -> tuple[list[Link], list[tuple[str, str, str]], list[Any]]:
+    """The links, the environment inputs and the errors of :func:`build`'s connection search."""
     links: list[Link] = []
     env: list[tuple[str, str, str]] = []
     diags = []
@@ -283,11 +293,7 @@ def build(checked: Checked, connections: Sequence[Connection] = ()) -> SystemMod
                 links.append(Link(cands[0][0], cands[0][1], n, iv.name, via))
             else:
                 env.append((n, iv.name, str(t)))
-    diags += service_conditions(checked)
-    diags += connection_errors(checked, links)
-    if diags:
-        raise RclError(diags)
-    return SystemModel(tuple(nodes), tuple(links), tuple(env), _loops(nodes, links))
+    return links, env, diags
 
 
 def unit_diagnostics(checked: Checked, connections: Sequence[Connection] = ()) -> list[Any]:
@@ -295,11 +301,8 @@ def unit_diagnostics(checked: Checked, connections: Sequence[Connection] = ()) -
     (:func:`rclverify.system.units.connection_diagnostics`), also when the
     build fails for another reason (an ambiguous input): what ``rclverify
     check`` shows of a system's connections without running the calculus."""
-    try:
-        model = build(checked, connections)
-    except RclError as exc:
-        return [d for d in exc.diagnostics if d.code.startswith(("E-unit", "W-unit"))]
-    return connection_diagnostics(checked, model.links)
+    links, _, _ = _connect(checked, connections)  # the links found, whatever else fails the build
+    return connection_diagnostics(checked, links)
 
 
 def _by_topic(checked: Checked, node: str, var: str) -> list[tuple[str, str]]:

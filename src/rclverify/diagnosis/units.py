@@ -1,0 +1,183 @@
+"""One diagnosis per unit mismatch on a connection, joining what follows from it (issue 48).
+
+The driver publishes degrees where the localiser reads radians: the
+connection's unit mismatch (:func:`rclverify.system.units.mismatches`,
+declared at both ends or the driver's unit inferred from its guarantee,
+:mod:`rclverify.rcl.unitinfer`), the ``W-unit-missing`` warning on the
+driver's output, the side condition of the localiser that reads it, the
+calculus' probable scale mismatch on that side condition and the recorded
+runs in which the localiser's assumption is violated, blamed on the driver,
+are one defect.  :func:`unit_records` gives one record of kind ``unit`` for
+it (the shape of :mod:`.build`), blaming the **producer**: its culprit is
+the equation the unit was inferred from, or the producer's declaration;
+``joins`` lists the ids of the other findings (lint rows by their
+``file:line:col``, side conditions, findings, evidence), which
+:func:`rclverify.report.problems.group_problems` puts in the same row.
+
+The first repair is the conversion (:func:`conversion_repair`), offered only
+when Z3 and the unit check show it on the edited text.
+"""
+from __future__ import annotations
+
+import math
+import re
+from typing import Any, Callable, Mapping
+
+from ..rcl.unitconv import factor_name, short_decimal
+from ..rcl.units import Unit, ratio
+from ..system.units import Mismatch, mismatches
+from . import recheck
+from .edits import Edit
+from .repairs import _link_pairs, _record
+
+
+def _loc(loc: Any) -> str:
+    return f"{loc.file}:{loc.line}:{loc.col}"
+
+
+def _joins(report: Mapping[str, Any], m: Mismatch) -> list[str]:
+    """The ids of the report's findings that the mismatch ``m`` explains
+    (module docstring), in the report's order."""
+    (p, _, v), (c, _, w) = m.writer, m.reader
+    out = [_loc(m.at), _loc(m.writer_decl)]
+    out += [str(x["location"]) for x in report.get("lint") or () if str(x.get("code", "")).startswith("W-unit")
+            and x["location"] == _loc(m.reader_decl)]
+    scs = [sc for sc in report.get("side_conditions") or () if sc.get("status") != "discharged"
+           and (p, v, c, w) in _link_pairs(sc)]
+    out += [str(sc["id"]) for sc in scs]
+    out += [str(f["id"]) for f in report.get("findings") or () if f.get("check") == "probable-scale-mismatch"
+            and any(str(f["id"]).startswith(f"{sc['id']}.scale") for sc in scs)]
+    obligations = {str(o["id"]): o for o in report.get("obligations") or ()}
+    for e in report.get("evidence") or ():
+        first = (e.get("monitoring") or {}).get("first_assumption_violation") if isinstance(e.get("monitoring"), dict) else None
+        node = (obligations.get(str(e.get("obligation"))) or {}).get("node")
+        if first and node == c and re.search(rf"\b{re.escape(p)}\b", str(first.get("blame", ""))):
+            out.append(str(e["obligation"]))
+    return list(dict.fromkeys(out))
+
+
+def _sentence(m: Mismatch, joined: list[str], report: Mapping[str, Any]) -> str:
+    writer, reader = ".".join(m.writer), ".".join(m.reader)
+    p, c = m.writer[0], m.reader[0]
+    whence = (f"its unit inferred from guarantee {m.inferred.guarantee} `{m.inferred.clause}` ({_loc(m.inferred.loc)})"
+              if m.inferred is not None else f"as declared ({_loc(m.writer_decl)})")
+    factor = (f", a factor of {factor_name(m.reader_unit, m.writer_unit)}" if m.code == "E-unit-scale"
+              else f" ({m.reason})")
+    found = [j for j in joined if not re.match(r".*:\d+:\d+$", j)]
+    seen = f"; it explains {', '.join(found)}" if found else ""
+    return (f"Unit mismatch: {p} publishes {writer} in {m.writer_unit}, {whence}, where {c} reads {reader} in "
+            f"{m.reader_unit} ({_loc(m.reader_decl)}){factor}{seen}. Convert in {p}.")
+
+
+def unit_records(ws: Any, report: Mapping[str, Any], cached: Callable[[Any, Callable[[], Any]], Any]) -> list[dict[str, Any]]:
+    """One record per unit mismatch of the workspace ``ws`` (module
+    docstring), in link order: ``{"id": "<P>.out.<v>.unit", "kind": "unit",
+    "node": P, "status": "failed", "sentence", "culprits", "counterexample":
+    [], "repairs", "guarantee", "joins": [ids], "lint": the location of its
+    lint row}``.  ``cached(key, make)`` keeps the repairs between runs (the
+    diagnosis cache).  Never raises for a system that type-checked."""
+    out = []
+    for m in mismatches(ws.checked, ws.model.links):
+        joined = _joins(report, m)
+        p = m.writer[0]
+        if m.inferred is not None:
+            culprit = {"what": f"guarantee {m.inferred.guarantee} of {p}", "source": _loc(m.inferred.loc),
+                       "text": m.inferred.clause}
+        else:
+            culprit = {"what": f"output {m.writer[2]} of {p}", "source": _loc(m.writer_decl), "text": str(m.writer_unit)}
+        key = ["unit", m.name, str(m.writer_unit), str(m.reader_unit), _loc(m.at)]
+        reps = cached(key, lambda: conversion_repair(ws, m)) or []
+        out.append({"id": f"{'.'.join(m.writer)}.unit", "kind": "unit", "node": p, "status": "failed",
+                    "sentence": _sentence(m, joined, report), "culprits": [culprit], "counterexample": [],
+                    "repairs": [r for r in reps if r],
+                    "guarantee": m.inferred.guarantee if m.inferred is not None else None,
+                    "joins": joined, "lint": _loc(m.at)})
+    return out
+
+
+def _number(u: Unit, t: Unit) -> tuple[str, str]:
+    """``(operator, literal)`` that takes a number in ``u`` to ``t``:
+    ``("*", "0.017453292519943295")`` for deg to rad, ``("/", "3.6")`` for
+    km/h to m/s, the exact decimal when there is one."""
+    f, pi = ratio(u, t)  # how many t make one u
+    if pi == 0:
+        if f.denominator == 1:
+            return "*", str(f.numerator)
+        for op, x in (("*", f), ("/", 1 / f)):
+            if x.denominator == 1:
+                return op, str(x.numerator)
+            text = short_decimal(x)
+            if text:
+                return op, text
+    return "*", repr(float(f) * math.pi ** pi)
+
+
+def _wrap(text: str) -> str:
+    return f"({text})" if any(ch in text for ch in "*/") else text
+
+
+def conversion_repair(ws: Any, m: Mismatch) -> list[dict[str, Any]]:
+    """The conversion in the producer as a repair record
+    (:func:`rclverify.diagnosis.repairs._record`, kind ``convert-unit``):
+    the right side ``E`` of the equation the writer's unit was inferred
+    from becomes ``E * k [t/u]`` (the factor with its unit, so RCL's unit
+    algebra gives the reader's unit ``t`` exactly).  Returned only when the
+    edited contracts type-check, the connection's units agree, and Z3 shows
+    the producer consistent; the reader's side conditions are asked again
+    and their changes are the repair's ``cost``.  ``[]`` otherwise (a
+    declared mismatch: the fix changes two places of the producer; a unit
+    inferred through a conversion with another reading; dimensions apart)."""
+    got = m.inferred
+    if got is None or got.alternative is not None or m.code != "E-unit-scale" or got.from_key is not None:
+        return []
+    p, c = m.writer[0], m.reader[0]
+    cn = ws.checked.nodes[p]
+    eq = None
+    for g in cn.node.guarantees:
+        stack = [g.formula]
+        while stack:
+            e = stack.pop()
+            if getattr(e, "loc", None) == got.loc and hasattr(e, "operands"):
+                eq = e
+            stack += [x for x in (getattr(e, "left", None), getattr(e, "right", None)) if x is not None]
+    if eq is None:
+        return []
+    lhs, rhs = eq.operands
+    if not (getattr(lhs, "name", None) == m.writer[2]):
+        rhs = lhs
+    loc = rhs.loc
+    if not loc.end_line:
+        return []
+    source = recheck.source_text(ws, loc.file)
+    edit0 = Edit(loc.file, loc.line, loc.col, loc.end_line, loc.end_col, "")
+    old = edit0.deleted(source)
+    op, lit = _number(m.writer_unit, m.reader_unit)
+    unit = f"{_wrap(m.reader_unit.text or str(m.reader_unit)[1:-1])}/{_wrap(m.writer_unit.text or str(m.writer_unit)[1:-1])}"
+    from ..rcl.printer import level
+    body = old if level(rhs) >= 8 else f"({old})"
+    edit = Edit(loc.file, loc.line, loc.col, loc.end_line, loc.end_col, f"{body} {op} {lit} [{unit}]")
+    after = recheck.edited_system(ws, edit)
+    if after is None:
+        return []
+    checked, model = after
+    if any(x.writer == m.writer and x.reader == m.reader for x in mismatches(checked, model.links)):
+        return []
+    if recheck.consistent(ws, checked, p) != "sat":
+        return []
+    before = {k: v for k, v in recheck.side_conditions(ws.checked, ws.model, c, ws).items()}
+    now = recheck.side_conditions(checked, model, c, ws)
+    checks = [{"check": f"units of {m.name}", "status": f"agree: {m.reader_unit} at both ends"},
+              {"check": f"{p} consistent", "status": "yes (Z3: sat)"}]
+    checks += [{"check": k, "status": v} for k, v in sorted(now.items())]
+    fixed = [k for k, v in now.items() if v == "discharged" and before.get(k) != "discharged"]
+    still = [k for k, v in now.items() if v != "discharged"]
+    words = factor_name(m.writer_unit, m.reader_unit)  # how many of the reader's units make one of the writer's
+    from ..rcl.printer import expr_to_rcl
+    side = expr_to_rcl(lhs if rhs is not lhs else eq.operands[1])
+    summary = (f"Convert in {p}: write `{side} == {body} {op} {lit} [{unit}]` so that {p} publishes {m.reader_unit}, "
+               f"the unit {c} reads ({m.writer_unit} to {m.reader_unit}: multiply by {words})")
+    proves = (f"the units of {m.name} agree ({m.reader_unit} at both ends)"
+              + (f" and {', '.join(fixed)} follow{'s' if len(fixed) == 1 else ''} from the edited contracts" if fixed else ""))
+    not_shown = ("that the value's unit is really " + str(m.writer_unit) + " where it comes from"
+                 + (f"; {', '.join(still)} still not discharged" if still else ""))
+    return [_record("convert-unit", summary, edit, source, checks, recheck.changes(before, now), proves, not_shown)]
