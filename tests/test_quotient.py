@@ -71,9 +71,30 @@ def test_stdout_without_output_option_and_the_errors(tmp_path: Path) -> None:
     assert proc.returncode == 1 and "any contract serves" in proc.stderr
 
 
-def test_a_node_on_a_loop_is_refused_with_the_reason(tmp_path: Path) -> None:
-    proc = _rclverify(Path(__file__).resolve().parents[1], "quotient", "Agent")
-    assert proc.returncode == 1 and "lies on the loop" in proc.stderr and "R4" in proc.stderr
+LOOP = """node Ctl {
+  inputs( y : REAL )
+  outputs( u : REAL )
+  assume( 0 <= in.y and in.y <= 10 )
+  guarantee( 0 <= out.u and out.u <= 1 )
+}
+node Plant {
+  inputs( u : REAL )
+  outputs( y : REAL )
+  assume( 0 <= in.u and in.u <= 1 )
+  guarantee( 0 <= out.y and out.y <= 10 * in.u )
+}
+"""
+
+
+def test_a_node_on_a_loop_is_computed_with_the_loop_opened_by_r4(tmp_path: Path) -> None:
+    (tmp_path / "contracts").mkdir()
+    (tmp_path / "contracts/loop.rcl").write_text(LOOP)
+    (tmp_path / "contracts/plan.yaml").write_text("name: loop\ncontracts:\n  - contracts/loop.rcl\n")
+    proc = _rclverify(tmp_path, "quotient", "Plant")
+    assert proc.returncode == 0, proc.stderr
+    assert "lies on the loop {Ctl, Plant}" in proc.stdout or "lies on the loop {Plant, Ctl}" in proc.stdout
+    assert "R4" in proc.stdout and "Ctl.sc1 discharged; Ctl.sc2 discharged" in proc.stdout
+    assert "guarantee( 0 <= out.y and out.y <= 10 )" in proc.stdout
 
 
 ENUM = """

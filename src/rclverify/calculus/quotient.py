@@ -207,16 +207,19 @@ class _Beyond(Exception):
 def quotient(checked: Checked, model: SystemModel, plan: Any, node: str) -> Quotient:
     """The weakest contract of ``node`` (module docstring), re-checked.
 
-    Raises :class:`QuotientError` for an unknown node, a node on a loop, a
-    node with nothing to serve (no target), and a contract that does not
-    re-check."""
+    A node on a loop (every service client and server pair is one) is
+    computed with the loop opened as the calculus opens it (rule R4, paper
+    lines 717-768): its upstream premises are the loop's other guarantees,
+    each under its own node's assumption, the node's own outputs among the
+    hidden values; the contract is then re-checked with the loop composed,
+    where the in-context side conditions open the loop at its back edges
+    (:mod:`.context`), and a note says so.
+
+    Raises :class:`QuotientError` for an unknown node, a node with nothing
+    to serve (no target), and a contract that does not re-check."""
     if node not in checked.nodes:
         raise QuotientError(f"no node named {node!r}; nodes: {', '.join(checked.nodes)}")
     loop = model.loop_of(node)
-    if loop:
-        raise QuotientError(f"{node} lies on the loop {{{', '.join(loop)}}}: its assumption would depend on its own "
-                            "guarantee (rule R4 composes a loop from given contracts, paper lines 717-768); the quotient "
-                            "is computed for nodes on no loop")
     cn = checked.nodes[node]
     sysm = _System(checked, model, plan, node)
     tgts, notes = targets(sysm)
@@ -264,6 +267,10 @@ def quotient(checked: Checked, model: SystemModel, plan: Any, node: str) -> Quot
     if bad:
         raise QuotientError(f"the contract computed for {node} ({how}) does not re-check with Z3: "
                             + "; ".join(bad) + f"\n{block}")
+    if loop:
+        notes.append(f"{node} lies on the loop {{{', '.join(loop)}}}: computed with the loop opened as rule R4 opens it "
+                     "(the loop's other guarantees, each under its node's assumption, with this node's outputs "
+                     "hidden; paper lines 717-768) and re-checked with the loop composed")
     notes += _compare(cn, a_text, g_text, checked, model, plan)
     return Quotient(node, a_text, g_text, how.startswith("exact"), how,
                     tuple(f"{t.kind} {t.id}: {t.text}" for t in tgts), tuple(recheck), tuple(notes), block)
