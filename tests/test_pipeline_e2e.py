@@ -362,8 +362,9 @@ def test_editing_one_contract_reruns_that_node_its_consumers_and_the_report(work
         evidence = {t for t in ran if t.startswith("evidence:")}
         assert evidence and all(t.startswith("evidence:RadiationSensor.") for t in evidence)
         # `ground` too: the grounding of the plan's ros: section reads every contract (its file_dep)
+        # `crosscheck`: the second solver decides the changed side conditions and health checks again
         assert ran - evidence == {"check", "node:RadiationSensor", "node:Agent", "requirements", "ground",
-                                  "report:html", "report:text", "verify"}
+                                  "crosscheck", "report:html", "report:text", "verify"}
         # the formal requirements whose cone holds RadiationSensor: all four (the loop; REQ4 temporal over the same cone)
         assert "requirements: 4 of 4 checked (REQ1, REQ2, REQ3, REQ4)" in r.stdout
         # in the node tasks, only the stages whose own inputs changed: the consumer's side conditions

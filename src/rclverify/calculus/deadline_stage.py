@@ -44,7 +44,8 @@ def stage_deadlines(ws: "Workspace") -> tuple[list[DeadlineResult], list[dict[st
     Returns ``(results, records)`` in plan order.  Raises ``RclError`` for
     contracts or a plan that do not check, ``OSError`` when a file cannot
     be written."""
-    results = decide_plan(ws.plan, ws.checked, ws.model)
+    from .worst_path import with_worst_path  # the slowest other path may refute a deadline (issue 48)
+    results = [with_worst_path(r, ws.checked, ws.model) for r in decide_plan(ws.plan, ws.checked, ws.model)]
     model_hash = hashlib.sha256(dumps(ws.model.to_json()).encode("utf-8")).hexdigest()  # as the report takes it
     records: list[dict[str, Any]] = []
     keep = {"index.json"}

@@ -65,6 +65,8 @@ class DeadlineResult:
     stamps: tuple[tuple[str, Fraction], ...] = ()
     smt2: str = field(default="", compare=False)
     loc: ast.Loc = field(default_factory=ast.Loc, compare=False)
+    #: the slowest other path from the first node to the last, when slower than ``path`` (:mod:`.worst_path`)
+    worst_path: tuple[str, ...] = ()
 
     def to_json(self) -> dict[str, Any]:
         """The result as JSON: times exact (``within_s``, ``total_s``: a
@@ -81,6 +83,7 @@ class DeadlineResult:
                 "total_s": None if self.total is None else str(self.total),
                 "total": None if self.total is None else _show(self.total),
                 "stamps": [{"event": e, "t_s": str(t)} for e, t in self.stamps],
+                "worst_path": list(self.worst_path),
                 "loc": f"{self.loc.file}:{self.loc.line}:{self.loc.col}"}
 
 

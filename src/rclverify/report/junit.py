@@ -82,11 +82,19 @@ def _outcome(case: ET.Element, status: str, summary: str, detail: str, kind: str
     return "failures"
 
 
-def _properties(case: ET.Element, props: Mapping[str, str]) -> None:
-    """A test case's ``<properties>`` (the convention pytest's ``record_property`` writes)."""
-    el = ET.SubElement(case, "properties")
-    for k, v in props.items():
-        ET.SubElement(el, "property", {"name": k, "value": str(v)})
+def _properties(rows: list[tuple[str, str]], case: str, props: Mapping[str, str]) -> None:
+    """Add ``props`` of test case ``case`` to ``rows``, named ``<case>.<property>``:
+    the JUnit XML schema has properties per suite, not per test case."""
+    rows.extend((f"{case}.{k}", str(v)) for k, v in props.items())
+
+
+def _put_properties(suite: ET.Element, rows: list[tuple[str, str]]) -> None:
+    """``rows`` as the suite's ``<properties>``, its first child (JUnit XML schema)."""
+    if rows:
+        el = ET.Element("properties")
+        for k, v in rows:
+            ET.SubElement(el, "property", {"name": k, "value": v})
+        suite.insert(0, el)
 
 
 def _lines(*parts: str) -> str:
@@ -131,6 +139,7 @@ def _requirements_suite(report: Mapping[str, Any]) -> tuple[ET.Element, dict[str
         return None
     suite = ET.Element("testsuite", {"name": "requirements"})
     counts = {"tests": 0, "failures": 0, "errors": 0, "skipped": 0}
+    props: list[tuple[str, str]] = []  # the test cases' strength and confidence (docs/confidence.md)
     time = 0.0
     for r in reqs:
         c = r.get("check") or {}
@@ -143,7 +152,8 @@ def _requirements_suite(report: Mapping[str, Any]) -> tuple[ET.Element, dict[str
         counts["tests"] += 1
         time += secs
         if r.get("confidence") is not None and r.get("limited_by"):
-            _properties(case, {"confidence": f"{r['confidence']:.6g}", "limited_by": r["limited_by"].get("sentence", "")})
+            _properties(props, str(r["id"]), {"confidence": f"{r['confidence']:.6g}",
+                                              "limited_by": r["limited_by"].get("sentence", "")})
         bumped = _outcome(case, str(r["status"]), f"{r['verdict']}: {r['note']}",
                           _lines(f"requirement {r['id']}: {r['text']}",
                                  f"formal: {c['formal']}" if c.get("formal") else "",
@@ -155,6 +165,7 @@ def _requirements_suite(report: Mapping[str, Any]) -> tuple[ET.Element, dict[str
     for k, v in counts.items():
         suite.set(k, str(v))
     suite.set("time", f"{time:.3f}")
+    _put_properties(suite, props)
     return suite, counts, time
 
 
@@ -211,6 +222,7 @@ def _suite(node: Mapping[str, Any], data: Mapping[str, Any]) -> tuple[ET.Element
     items, evidence, reasons = data["items"], data["evidence"], data["reasons"]
     suite = ET.Element("testsuite", {"name": name})
     counts = {"tests": 0, "failures": 0, "errors": 0, "skipped": 0}
+    props: list[tuple[str, str]] = []  # the test cases' strength and confidence (docs/confidence.md)
     time = 0.0
 
     def tally(case: ET.Element, status: str, summary: str, detail: str, seconds: Any) -> None:
@@ -228,7 +240,8 @@ def _suite(node: Mapping[str, Any], data: Mapping[str, Any]) -> tuple[ET.Element
         expl = str(ev["explanation"]) if ev is not None else reasons.get(str(o["id"]), "no evidence record yet")
         cex = model_text(ev.get("counterexample")) if ev is not None else ""
         if ev is not None and ev.get("strength"):  # the evidence's kind (docs/confidence.md)
-            _properties(case, {"strength": ev["strength"]["kind"], "strength.detail": ev["strength"].get("detail", "")})
+            _properties(props, str(o["id"]), {"strength": ev["strength"]["kind"],
+                                              "strength.detail": ev["strength"].get("detail", "")})
         tally(case, str(o["status"]), expl.splitlines()[0] if expl else str(o["status"]),
               _lines(f"obligation ({o['backend']}, {o['kind']}) of guarantee {o['guarantee']}: {o['statement']}",
                      f"source: {o['source']}", expl, f"counterexample: {cex}" if cex else ""), secs)
@@ -237,7 +250,8 @@ def _suite(node: Mapping[str, Any], data: Mapping[str, Any]) -> tuple[ET.Element
         model = model_text(sc.get("model"))
         verdict = str(sc.get("verdict") or sc["status"])
         if sc.get("strength"):
-            _properties(case, {"strength": sc["strength"]["kind"], "solvers": str(sc["strength"].get("solvers", 1))})
+            _properties(props, str(sc["id"]), {"strength": sc["strength"]["kind"],
+                                               "solvers": str(sc["strength"].get("solvers", 1))})
         tally(case, str(sc["status"]), str(sc.get("explanation") or sc["status"]),
               _lines(f"side condition ({sc['rule']}): {sc['conjunct']}", f"source: {sc['source']}",
                      f"verdict: {verdict}", str(sc.get("explanation") or ""),
@@ -261,6 +275,7 @@ def _suite(node: Mapping[str, Any], data: Mapping[str, Any]) -> tuple[ET.Element
     for k, v in counts.items():
         suite.set(k, str(v))
     suite.set("time", f"{time:.3f}")
+    _put_properties(suite, props)
     return suite, counts, time
 
 

@@ -1,0 +1,76 @@
+"""The worst timing path of an end-to-end deadline (issue 48).
+
+A requirement's ``deadline: {path: [A, ..., B], within: d}`` names one path
+of nodes; rule D3 (:mod:`.deadlines`) sums the timed guarantees along it.
+But B's output may also be answered through another path from A (a branch
+that joins again), and its answer may come later.  As AGREE's latency
+analysis does, every simple path of the system model from A to B whose
+timed guarantees chain (each hop triggered by an output of the one before,
+D2) is decided too, and the slowest one, when it is not the named one, is
+reported: it refutes the deadline when its sum exceeds ``d``, and it is
+named in the record either way.
+
+Paths are enumerated up to :data:`MAX_PATHS` (networkx's simple-path
+enumeration, loops never repeated); beyond it the record says the search was
+cut.
+"""
+from __future__ import annotations
+
+from dataclasses import replace
+from fractions import Fraction
+from typing import Any, Sequence
+
+from ..rcl.types import Checked
+from ..system.model import SystemModel
+from .deadlines import PROVED, REFUTED, _show, chains, decide
+
+#: The largest number of paths from A to B examined.
+MAX_PATHS = 200
+
+
+def other_paths(model: SystemModel, path: Sequence[str]) -> tuple[list[tuple[str, ...]], bool]:
+    """``(paths, cut)``: the simple paths of ``model`` from ``path[0]`` to
+    ``path[-1]`` other than ``path`` (at most :data:`MAX_PATHS`; ``cut``
+    when there were more)."""
+    import itertools
+
+    import networkx as nx
+    g = nx.DiGraph()
+    g.add_nodes_from(model.nodes)
+    g.add_edges_from((lk.from_node, lk.to_node) for lk in model.links)
+    if path[0] not in g or path[-1] not in g or len(path) < 2:
+        return [], False
+    it = nx.all_simple_paths(g, path[0], path[-1])
+    found = [tuple(p) for p in itertools.islice(it, MAX_PATHS + 1)]
+    cut = len(found) > MAX_PATHS
+    return [p for p in found[:MAX_PATHS] if p != tuple(path)], cut
+
+
+def with_worst_path(result: Any, checked: Checked, model: SystemModel) -> Any:
+    """``result`` (a :class:`.deadlines.DeadlineResult` of the named path)
+    with the slowest other path considered: refuted by it when its chain's
+    sum exceeds the bound (its chain, sum and stamps then shown, the named
+    path kept as the record's ``path``), and ``worst_path`` naming it when
+    it is slower than the named one."""
+    worst: tuple[tuple[str, ...], Fraction] | None = None
+    paths, cut = other_paths(model, result.path)
+    for p in paths:
+        found, _ = chains(checked, model, p)
+        if not found:
+            continue  # no chain of timed guarantees along it: not a timing path
+        tight = min(sum((h.bound for h in c), Fraction(0)) for c in found)
+        if worst is None or tight > worst[1]:
+            worst = (p, tight)
+    note = " (more than 200 paths: the search was cut)" if cut else ""
+    if worst is None or (result.total is not None and worst[1] <= result.total):
+        return replace(result, reason=result.reason + note) if note else result
+    p, total = worst
+    named = " -> ".join(result.path)
+    if result.status == PROVED and total > result.within:
+        other = decide(checked, model, result.requirement, p, result.within, result.loc)
+        if other.status == REFUTED:
+            return replace(other, path=result.path, worst_path=p,
+                           reason=f"another path from {p[0]} to {p[-1]} is slower than the one named ({named}): "
+                                  f"{other.reason}" + note)
+    return replace(result, worst_path=p, reason=f"{result.reason}; the slowest path from {p[0]} to {p[-1]} is "
+                                                f"{' -> '.join(p)}, {_show(total)}, not the one named{note}")

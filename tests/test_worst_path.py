@@ -1,0 +1,73 @@
+"""The worst timing path of a deadline (issue 48; calculus/worst_path.py):
+another path from the same first node to the same last one, slower than the
+named path, is found and named, and refutes the deadline when its sum
+exceeds the bound; its verdict equals a brute-force search over the paths."""
+from __future__ import annotations
+
+import itertools
+import random
+from fractions import Fraction
+
+from rclverify.calculus.deadlines import PROVED, REFUTED, decide
+from rclverify.calculus.worst_path import with_worst_path
+from rclverify.rcl.parser import parse_text
+from rclverify.rcl.typecheck import check
+from rclverify.system.model import build
+
+DIAMOND = """\
+node A {
+  inputs( a : REAL )
+  outputs( b : REAL, c : REAL )
+  guarantee( out.b == in.a and out.c == in.a ) triggered by in.a within 10 ms
+}
+node Fast {
+  inputs( b : REAL )
+  outputs( d1 : REAL )
+  guarantee( out.d1 == in.b ) triggered by in.b within 20 ms
+}
+node Slow {
+  inputs( c : REAL )
+  outputs( d2 : REAL )
+  guarantee( out.d2 == in.c ) triggered by in.c within 400 ms
+}
+node D {
+  inputs( d1 : REAL, d2 : REAL )
+  outputs( e : REAL )
+  guarantee( out.e == in.d1 ) triggered by in.d1 within 30 ms
+  guarantee( out.e == in.d2 ) triggered by in.d2 within 30 ms
+}
+"""
+
+
+def _decided(text: str, path: list[str], within: Fraction):  # type: ignore[no-untyped-def]
+    checked = check([parse_text(text, "s.rcl")])
+    model = build(checked)
+    return with_worst_path(decide(checked, model, "R", path, within), checked, model)
+
+
+def test_a_slower_branch_refutes_the_deadline_named_along_the_fast_one() -> None:
+    r = _decided(DIAMOND, ["A", "Fast", "D"], Fraction(1, 10))
+    assert r.status == REFUTED and r.path == ("A", "Fast", "D") and r.worst_path == ("A", "Slow", "D")
+    assert r.reason.startswith("another path from A to D is slower than the one named (A -> Fast -> D)")
+    assert r.total == Fraction(44, 100) and [h.node for h in r.chain] == ["A", "Slow", "D"]
+    ok = _decided(DIAMOND, ["A", "Fast", "D"], Fraction(1, 2))  # both within: proved, the slow one named
+    assert ok.status == PROVED and ok.worst_path == ("A", "Slow", "D")
+    assert "the slowest path from A to D is A -> Slow -> D, 440 ms, not the one named" in ok.reason
+    named_slow = _decided(DIAMOND, ["A", "Slow", "D"], Fraction(1, 2))  # the named one is the slowest
+    assert named_slow.status == PROVED and named_slow.worst_path == ()
+
+
+def test_worst_path_equals_brute_force_on_random_diamonds() -> None:
+    rnd = random.Random(48)
+    for _ in range(25):
+        ms = [rnd.choice([5, 10, 50, 100, 300]) for _ in range(5)]
+        text = (DIAMOND.replace("within 10 ms", f"within {ms[0]} ms").replace("within 20 ms", f"within {ms[1]} ms")
+                .replace("within 400 ms", f"within {ms[2]} ms")
+                .replace("in.d1 within 30 ms", f"in.d1 within {ms[3]} ms")
+                .replace("in.d2 within 30 ms", f"in.d2 within {ms[4]} ms"))
+        bound = Fraction(rnd.choice([50, 100, 200, 400, 800]), 1000)
+        sums = {("A", "Fast", "D"): ms[0] + ms[1] + ms[3], ("A", "Slow", "D"): ms[0] + ms[2] + ms[4]}
+        for named in itertools.permutations(sums, 1):
+            r = _decided(text, list(named[0]), bound)
+            expected = REFUTED if max(sums.values()) > bound * 1000 else PROVED
+            assert r.status == expected, (ms, bound, named, r.reason)
