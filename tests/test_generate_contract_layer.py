@@ -1,6 +1,8 @@
-"""The generated Python contract layer (``<node>/contract.py``) against Z3: on random values
-(Hypothesis) its verdict is the one Z3 gives clause by clause on the same values, for every node
-of examples/warehouse (docs/generate.md, "The contract layer")."""
+"""The generated Python contract layer (``<node>/contract.py``) against Z3 and against the monitor
+engine: on random values (Hypothesis) its verdict is the one Z3 gives clause by clause on the same
+values (exact arithmetic; a step the layer accepts only in the node's double arithmetic, as the
+monitor does, is false to Z3), and the one the monitor engine gives a question and its answer
+(docs/generate.md, "The contract layer")."""
 from __future__ import annotations
 
 import importlib.util
@@ -52,7 +54,11 @@ def test_generated_checks_agree_with_z3_on_every_warehouse_node(tmp_path: Path) 
         @given(strat)
         def agree(values: dict) -> None:
             got = layer.judge(values)
-            assert (got["verdict"], got["guarantee"]) == _z3_verdict(node_name, values), values
+            want = _z3_verdict(node_name, values)
+            if got["semantics"] in ("double", "tolerance"):  # holds only as the node computes: false to Z3
+                assert got["verdict"] == "satisfied" and want[0] != "satisfied", (values, want)
+                return
+            assert (got["verdict"], got["guarantee"]) == want, values
             seen.add(got["verdict"])
 
         agree()
@@ -90,7 +96,7 @@ def test_generated_checks_agree_with_z3_on_the_case_study_where_both_decide(tmp_
             nonlocal compared
             got = layer.judge(values)
             want = _z3_verdict_of(checked, node_name, values)
-            if "inconclusive" in (got["verdict"], want[0]):
+            if "inconclusive" in (got["verdict"], want[0]) or got["semantics"] in ("double", "tolerance"):
                 return
             assert (got["verdict"], got["guarantee"]) == want, values
             compared += 1

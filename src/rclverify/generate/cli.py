@@ -7,6 +7,7 @@ the mapping or a write failed (``DIR: error: ...``); 2 usage errors.
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 from pathlib import Path
 from typing import Any
@@ -40,7 +41,8 @@ def cmd_ros2(args: argparse.Namespace) -> int:
     try:
         sources = {sp.file: (ws / sp.file).read_text(encoding="utf-8") for sp in checked.specs}
         rules, tolerance = monitor_rules(ws, args.plan)
-        res = write_tree(out, checked, system, sources, args.lang, rules, tolerance)
+        prefix = Path(os.path.relpath(out.resolve(), ws.resolve())).as_posix()
+        res = write_tree(out, checked, system, sources, args.lang, rules, tolerance, prefix)
     except (GenerateError, ConfigError) as exc:
         print(exc, file=sys.stderr)
         return 1
@@ -57,14 +59,17 @@ def cmd_ros2(args: argparse.Namespace) -> int:
 def monitor_rules(ws: Path, plan: str) -> tuple[Any, Any]:
     """The monitors' mapping rules by topic and declared tolerance of workspace ``ws``: from the
     first ``monitors`` evidence entry of the plan naming a ``mapping`` (its ``tolerance``
-    overriding the file's), else the default mapping file (``backends/monitors/mapping.yaml``,
+    overriding the file's; not the ``rclverify_mapping.yaml`` this command writes), else the default mapping file (``backends/monitors/mapping.yaml``,
     absent: no rules).  Raises ``ConfigError`` (located) for a malformed mapping file."""
     from ..backends.monitors.config import load_mapping
     from ..plan.load import load_plan
     rel, tol = None, None
     p = load_plan(ws, plan)
     for e in (e for es in p.evidence.values() for e in es if e.backend == "monitors"):
-        if e.config.get("mapping") or e.config.get("tolerance") is not None:
+        mapping = e.config.get("mapping")
+        if mapping and Path(str(mapping)).name == "rclverify_mapping.yaml":
+            continue  # the one this command writes (the plan fragment's): it reads the rules, not them
+        if mapping or e.config.get("tolerance") is not None:
             rel, tol = e.config.get("mapping"), e.config.get("tolerance")
             break
     cfg = load_mapping(ws, rel, tolerance=tol)

@@ -38,6 +38,12 @@ class Wire:
     part: str
     path: str
 
+    def var_topic(self, np: NodePackage) -> str:
+        """The topic the monitors read this variable on: the end's name, ``name/request`` and
+        so on for a service's or action's part (the monitors' LINK_TOPICS)."""
+        end = next(e for e in np.endpoints if e.attr == self.attr)
+        return end.name.lstrip("/") if self.part == "msg" else f"{end.name.lstrip('/')}/{self.part}"
+
     @property
     def side(self) -> str:
         """``in`` or ``out``."""

@@ -22,6 +22,7 @@ from ..rcl.types import Checked
 from .interfaces import interface_packages
 from .cpp import cpp_package
 from .nodes import QOS_DEPTH, NodePackage, node_packages
+from .planfrag import plan_fragment
 from .wiring import wires
 from .typemap import camel, snake
 
@@ -57,7 +58,8 @@ class Result:
 
 def render_tree(checked: Checked, system: str, sources: dict[str, str] | None = None, lang: str = "python",
                 rules: Mapping[str, Any] | None = None,
-                tolerance: Tolerance | None = None) -> tuple[dict[str, str], dict[str, str], dict[str, list[str]]]:
+                tolerance: Tolerance | None = None,
+                prefix: str = ".") -> tuple[dict[str, str], dict[str, str], dict[str, list[str]]]:
     """The generated tree of ``checked`` for system ``system`` (a ROS package name prefix).
 
     Returns ``(generated, once, interface_of)``: relative path -> text for generated files and
@@ -110,6 +112,7 @@ def render_tree(checked: Checked, system: str, sources: dict[str, str] | None = 
     gen[f"{b}/CMakeLists.txt"] = _ENV.get_template("bringup_CMakeLists.txt.j2").render(ctx2)
     gen[f"{b}/launch/{system}.launch.py"] = _ENV.get_template("launch.py.j2").render(ctx2)
     gen[f"{b}/launch/{system}.launch.xml"] = _ENV.get_template("launch.xml.j2").render(ctx2)
+    gen.update(plan_fragment(nodes, prefix, lang, rules, _ENV, GENERATED))
     return gen, once, interface_of
 
 
@@ -125,13 +128,13 @@ def _is_generated(text: str) -> bool:
 
 def write_tree(out: Path, checked: Checked, system: str, sources: dict[str, str] | None = None,
                lang: str = "python", rules: Mapping[str, Any] | None = None,
-               tolerance: Tolerance | None = None) -> Result:
+               tolerance: Tolerance | None = None, prefix: str = ".") -> Result:
     """Write the tree of :func:`render_tree` under ``out``; see :class:`Result`.
 
     Raises ``OSError`` when a file cannot be written, ``ValueError`` as :func:`render_tree` and
     when a file at a generated path lacks the generated header (a hand-written file is never
     overwritten); nothing is written then."""
-    gen, once, interface_of = render_tree(checked, snake(system), sources, lang, rules, tolerance)
+    gen, once, interface_of = render_tree(checked, snake(system), sources, lang, rules, tolerance, prefix)
     res = Result()
     for rel, text in sorted(gen.items()):  # every conflict refused before anything is written
         p = out / rel
