@@ -184,3 +184,23 @@ def test_the_driver_reads_as_the_node_computes(built: dict) -> None:
     got = _run(built["exe"], pkg, ["in.range=0.1 out.obstacle=100.0", "in.range=2 out.obstacle=2",
                                    "in.range=-1 out.obstacle=-1000"])
     assert got == [("satisfied", 0, "TT"), ("violated", 1, "TF"), ("assumption violated", 0, "FT")]
+
+
+def test_a_declared_tolerance_is_the_headers_second_reading(tmp_path: Path) -> None:
+    """The plan's monitors entry declares a tolerance: numbers within it are equal to the checks,
+    as to the monitor (docs/monitors.md, "Numbers on the wire")."""
+    ws = tmp_path / "ws"
+    shutil.copytree(ROOT / "examples" / "contracts_first" / "contracts", ws / "contracts")
+    plan = (ws / "contracts" / "plan.yaml").read_text()
+    (ws / "contracts" / "plan.yaml").write_text(plan.replace(
+        "mapping: gen/rclverify_mapping.yaml", "mapping: m.yaml\n        tolerance: {abs: 1.0e-9}"))
+    (ws / "m.yaml").write_text("topics: {}\n")
+    assert main(["generate", "ros2", "-w", str(ws), "-o", str(ws / "gen"), "--lang", "cpp"]) == 0
+    inc = ws / "gen" / "temp_sensor" / "include"
+    assert "kTolerance{1e-09, 0.0, 0}" in (inc / "temp_sensor" / "contract_checks.hpp").read_text()
+    src = tmp_path / "d.cpp"
+    src.write_text('#include "temp_sensor/contract_driver.hpp"\n#include <iostream>\n'
+                   "int main() { return temp_sensor::drive(std::cin, std::cout); }\n")
+    subprocess.run(CXX + [f"-I{inc}", str(src), "-o", str(tmp_path / "d")], check=True, capture_output=True)
+    got = _run(tmp_path / "d", "", ["in.kelvin=300 out.celsius=26.850000000001", "in.kelvin=300 out.celsius=26.86"])
+    assert got == [("satisfied", 0, "TT"), ("violated", 1, "TF")]
