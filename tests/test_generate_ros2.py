@@ -15,6 +15,7 @@ from rosbags.interfaces import Nodetype
 from rclverify.cli import main
 from rclverify.generate.writer import GENERATED, ONCE
 from rclverify.pipeline import Workspace
+from rclverify.ros.treesitter import parser, walk
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -154,8 +155,12 @@ def _chain_system(n: int) -> str:
     return "\n".join(lines)
 
 
+VERDICT_END = ("publishes", "/rclverify/verdict", "std_msgs/msg/String")
+
+
+@pytest.mark.parametrize("lang", ["python", "cpp"])
 @pytest.mark.parametrize("case", ["case_study", "warehouse", "chain30"])
-def test_ros_scan_of_the_generated_tree_is_the_contracts_graph(tmp_path: Path, case: str) -> None:
+def test_ros_scan_of_the_generated_tree_is_the_contracts_graph(tmp_path: Path, case: str, lang: str) -> None:
     if case == "case_study":
         ws = ROOT
     elif case == "warehouse":
@@ -163,9 +168,10 @@ def test_ros_scan_of_the_generated_tree_is_the_contracts_graph(tmp_path: Path, c
     else:
         ws = _ws(tmp_path, _chain_system(30))
     out = tmp_path / "out"
-    assert main(["generate", "ros2", "-w", str(ws), "-o", str(out), "--system", "sys"]) == 0
+    assert main(["generate", "ros2", "-w", str(ws), "-o", str(out), "--system", "sys", "--lang", lang]) == 0
     want = _graph_of_contracts(ws)
-    assert _graph_of_scan(out, tmp_path) == want
+    # the contracts' graph, and each node's verdict publisher (its contract layer's violations)
+    assert _graph_of_scan(out, tmp_path) == {n: ends | {VERDICT_END} for n, ends in want.items()}
     if case == "chain30":
         assert len(want) == 30
     if case == "warehouse":  # units and the assumption's bounds as comments, from every user of the field
@@ -173,7 +179,18 @@ def test_ros_scan_of_the_generated_tree_is_the_contracts_graph(tmp_path: Path, c
         assert "float64 goal_x  # [m]; RCL REAL; Planner assumes 0 <= goal_x <= 100\n" in nav
     _parse_all(out)  # every interface file parses
     pys = sorted(out.rglob("*.py"))
-    assert len(pys) == 5 * len(want) + 1  # per node: __init__, node, contract, logic, setup; one launch file
+    if lang == "python":
+        assert len(pys) == 5 * len(want) + 1  # per node: __init__, node, contract, logic, setup; one launch file
+    else:
+        assert len(pys) == 1  # the launch file
+        cpps = sorted(out.rglob("*.cpp")) + sorted(out.rglob("*.hpp"))
+        assert len(cpps) == 6 * len(want)  # node, logic .cpp/.hpp, checks, driver .hpp/.cpp
+        for p in cpps:  # tree-sitter-cpp reads every C++ file without an error node
+            tree = parser("cpp").parse(p.read_bytes())
+            bad = [n for n in walk(tree.root_node) if n.type == "ERROR" or n.is_missing]
+            assert not bad, (p, bad[0].start_point)
+            first = p.read_text().splitlines()[0]
+            assert first in (f"// {GENERATED}", f"// {ONCE}"), p
     for p in pys:
         py_compile.compile(str(p), cfile=str(tmp_path / "c.pyc"), doraise=True)
         first = p.read_text().splitlines()[0]

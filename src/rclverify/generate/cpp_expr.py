@@ -1,0 +1,195 @@
+"""RCL formulas as C++17 expressions over a node's ``Inputs``/``Outputs`` structs (docs/generate.md).
+
+The generated check header (``contract_checks.hpp``, no ROS dependency) evaluates
+each assumption and guarantee clause the way rclverify's monitor reads a
+recorded value in its *double* semantics (``logic/floatsem.py`` ``_Double``,
+docs/monitors.md "Numbers on the wire"): every non-integer literal is the
+nearest double (the C++ compiler rounds a decimal literal to nearest), every
+``+ - * /`` is a binary64 operation, left to right as written, integers stay
+integers (``std::int64_t``), comparisons on the doubles.  With a declared
+tolerance a second reading compares numbers that read a recorded value up to
+the tolerance (``rclverify_rt::close``), in double arithmetic too.
+
+Plain C++ has no exact rational arithmetic: the monitor's first reading,
+*exact* (the values as rationals, literals as the decimals they spell), is
+not made.  A formula exact arithmetic finds true and double arithmetic
+false is therefore false here and true to the monitor (no case in the
+examples; the oracle test counts them).  Integer arithmetic overflows at
+2**63 where Python's does not, and an integer compared with a double is
+converted to the double (exact below 2**53).
+
+Translated: ``REAL``/``INTEGER``/``NATURAL``/``BOOL`` and enumeration
+variables (``in.x``, ``out.y``, bare I/O names), numeric and boolean
+literals, enumeration values, context constants, ``not``, unary ``-``,
+``and or -> <=>``, ``+ - * /`` (``/`` by zero is undecided, as in
+rclverify), chained comparisons, and membership in a literal set.
+Anything else (quantifiers, functions, constructor terms, sets, sequences,
+tuples, strings) raises :class:`Untranslatable`: the clause's check then
+answers *undecided* (the monitor's ``inconclusive``), never a guess.
+"""
+from __future__ import annotations
+
+from ..rcl import ast
+from ..rcl.types import Checked, CheckedNode, EnumT, Scalar, Type
+from .typemap import snake
+
+#: RCL scalar -> C++ type of the struct field
+CPP_SCALARS = {"REAL": "double", "INTEGER": "std::int64_t", "NATURAL": "std::uint64_t", "BOOL": "bool"}
+
+
+class Untranslatable(ValueError):
+    """A formula (part) outside the translated fragment; the message says which construct."""
+
+
+def cpp_type(t: Type) -> str | None:
+    """The C++ field type of an RCL type, ``None`` when the header cannot hold it."""
+    if isinstance(t, Scalar):
+        return CPP_SCALARS.get(t.name)
+    if isinstance(t, EnumT):
+        return "std::uint8_t"
+    return None
+
+
+def enum_const(t: EnumT, value: str) -> str:
+    """The C++ constant of an enumeration value: ``kRadStatRed``."""
+    return "k" + _camel(t.name) + _camel(value)
+
+
+def _camel(s: str) -> str:
+    return "".join(p[:1].upper() + p[1:] for p in snake(s).split("_"))
+
+
+class CppTranslator:
+    """Translates the formulas of one node; ``mode`` is ``double`` or ``tolerance``.
+
+    ``translate(formula)`` returns a C++ expression of type ``bool`` reading ``in``
+    and ``out`` (``const Inputs&``, ``const Outputs&``) that may throw
+    ``rclverify_rt::Undecided``; raises :class:`Untranslatable`."""
+
+    def __init__(self, checked: Checked, node: CheckedNode, mode: str = "double") -> None:
+        self.env, self.node, self.mode = checked.env, node, mode
+
+    def translate(self, e: ast.Expr) -> str:
+        code, kind = self.expr(e)
+        if kind != "bool":
+            raise Untranslatable(f"a clause of type {kind}")
+        return code
+
+    # -- expressions: (code, kind) with kind bool / int / double / enum:<Name> ------------
+    def expr(self, e: ast.Expr) -> tuple[str, str]:
+        if isinstance(e, ast.BoolLit):
+            return ("true" if e.value else "false"), "bool"
+        if isinstance(e, ast.NumLit):
+            if e.is_integral:
+                return f"std::int64_t{{{int(e.value)}}}", "int"
+            return f"double{{{e.text}}}", "double"
+        if isinstance(e, ast.Var):
+            return self.var(e)
+        if isinstance(e, ast.Unary):
+            code, kind = self.expr(e.operand)
+            if e.op == "not":
+                return f"(!{self._bool(code, kind)})", "bool"
+            if kind not in ("int", "double"):
+                raise Untranslatable(f"unary minus on {kind}")
+            return f"(-{code})", kind
+        if isinstance(e, ast.Binary):
+            return self.binary(e)
+        if isinstance(e, ast.Compare):
+            return self.compare(e)
+        if isinstance(e, ast.Member):
+            return self.member(e)
+        raise Untranslatable(_CONSTRUCTS.get(type(e).__name__, type(e).__name__))
+
+    def var(self, v: ast.Var) -> tuple[str, str]:
+        if v.prefix is None and v.name in self.env.enum_values:
+            t = self.env.enum_values[v.name]
+            return enum_const(t, v.name), f"enum:{t.name}"
+        if v.prefix is None and v.name in self.env.constants:
+            code, kind = self.expr(self.env.constants[v.name][1])
+            return f"({code})", kind
+        if v.prefix in ("in", "out"):
+            side, name = v.prefix, v.name
+        elif v.prefix is None and (v.name in self.node.inputs or v.name in self.node.outputs):
+            side, name = ("in" if v.name in self.node.inputs else "out"), v.name
+        else:
+            raise Untranslatable(f"variable {v.name}")
+        t = (self.node.inputs if side == "in" else self.node.outputs).get(name)
+        field = f"{side}.{snake(name)}"
+        if isinstance(t, Scalar) and t.name == "REAL":
+            return field, "double"
+        if isinstance(t, Scalar) and t.name == "INTEGER":
+            return field, "int"
+        if isinstance(t, Scalar) and t.name == "NATURAL":
+            return f"static_cast<std::int64_t>({field})", "int"
+        if isinstance(t, Scalar) and t.name == "BOOL":
+            return field, "bool"
+        if isinstance(t, EnumT):
+            return field, f"enum:{t.name}"
+        raise Untranslatable(f"{side}.{name} of type {t}")
+
+    def binary(self, e: ast.Binary) -> tuple[str, str]:
+        (lc, lk), (rc, rk) = self.expr(e.left), self.expr(e.right)
+        if e.op in ("and", "or", "->", "<=>"):
+            lb, rb = self._bool(lc, lk), self._bool(rc, rk)
+            op = {"and": "&&", "or": "||", "<=>": "=="}.get(e.op)
+            return (f"(!{lb} || {rb})" if e.op == "->" else f"({lb} {op} {rb})"), "bool"
+        if lk not in ("int", "double") or rk not in ("int", "double"):
+            raise Untranslatable(f"arithmetic on {lk}, {rk}")
+        if e.op == "/":
+            return f"rclverify_rt::div({lc}, {rc})", "double"
+        kind = "int" if lk == rk == "int" else "double"
+        return f"({lc} {e.op} {rc})", kind
+
+    def compare(self, e: ast.Compare) -> tuple[str, str]:
+        parts = [self.expr(x) for x in e.operands]
+        reads = [_reads_io(x, self.node) for x in e.operands]
+        out = []
+        for k, op in enumerate(e.ops):
+            (lc, lk), (rc, rk) = parts[k], parts[k + 1]
+            numeric = lk in ("int", "double") and rk in ("int", "double")
+            if not numeric and (lk != rk or op not in ("==", "!=")):
+                raise Untranslatable(f"comparison {op} of {lk} and {rk}")
+            if numeric and self.mode == "tolerance" and (reads[k] or reads[k + 1]):
+                out.append(f"rclverify_rt::tol_cmp(rclverify_rt::Cmp::{_CMP_NAMES[op]}, "
+                           f"static_cast<double>({lc}), static_cast<double>({rc}), kTolerance)")
+            elif numeric and lk != rk:  # int against double: compared as doubles
+                out.append(f"(static_cast<double>({lc}) {op} static_cast<double>({rc}))")
+            else:
+                out.append(f"({lc} {op} {rc})")
+        return (out[0] if len(out) == 1 else "(" + " && ".join(out) + ")"), "bool"
+
+    def member(self, e: ast.Member) -> tuple[str, str]:
+        if not isinstance(e.collection, ast.SetLit):
+            raise Untranslatable("membership in a set that is not a literal")
+        code, kind = self.expr(e.elem)
+        tests = []
+        for item in e.collection.items:
+            ic, ik = self.expr(item)
+            if ik != kind or kind == "double" or kind == "int":
+                raise Untranslatable(f"membership of {kind} in a set of {ik}")
+            tests.append(f"{code} == {ic}")
+        body = "(" + (" || ".join(tests) or "false") + ")"
+        return (f"(!{body})" if e.negated else body), "bool"
+
+    @staticmethod
+    def _bool(code: str, kind: str) -> str:
+        if kind != "bool":
+            raise Untranslatable(f"a connective on {kind}")
+        return code
+
+
+_CONSTRUCTS = {"Quant": "a quantifier", "TupleQuant": "a quantifier", "Apply": "a function or constructor term",
+               "SetLit": "a set", "SeqLit": "a sequence", "TupleLit": "a tuple", "StrLit": "a string",
+               "SeqRange": "a sequence range"}
+_CMP_NAMES = {"==": "kEq", "!=": "kNe", "<": "kLt", "<=": "kLe", ">": "kGt", ">=": "kGe"}
+
+
+def _reads_io(e: ast.Expr, node: CheckedNode) -> bool:
+    """Does ``e`` read an input or output (the tolerance applies to such comparisons only)?"""
+    if isinstance(e, ast.Var):
+        return e.prefix in ("in", "out") or (e.prefix is None and (e.name in node.inputs or e.name in node.outputs))
+    if isinstance(e, ast.Unary):
+        return _reads_io(e.operand, node)
+    if isinstance(e, ast.Binary):
+        return _reads_io(e.left, node) or _reads_io(e.right, node)
+    return False

@@ -1,0 +1,206 @@
+"""``generate ros2 --lang cpp``: the ROS-free contract checks compile with g++ (``-Wall -Wextra
+-Werror``, syntax only and a real build), and the compiled checks agree with rclverify's own
+judgement on random values (Hypothesis) for every node of examples/warehouse and of the case
+study (docs/generate.md, "C++ nodes").
+
+The oracle, per clause: the C++ truth is rclverify's double reading
+(``floatsem.holds_in("double")``) wherever the clause is translated, and ``U`` (undecided) where
+the header says it is not.  Per step: the C++ verdict is the monitor's judgement (the generated
+Python contract layer, ``floatsem.judge``) unless a clause differs for one of the two documented
+reasons (not translated; true in exact arithmetic only), which the test names and counts."""
+from __future__ import annotations
+
+import importlib.util
+import shutil
+import subprocess
+from pathlib import Path
+
+import pytest
+from hypothesis import given, settings, strategies as st
+
+from rclverify.cli import main
+from rclverify.logic.floatsem import holds_in
+from rclverify.pipeline import Workspace
+from rclverify.rcl.types import BOOL, EmptyT, EnumT, FuncT, Scalar
+
+ROOT = Path(__file__).resolve().parents[1]
+CASES = {"warehouse": ROOT / "examples" / "warehouse", "case_study": ROOT}
+CXX = ["g++", "-std=c++17", "-Wall", "-Wextra", "-Werror"]
+
+pytestmark = pytest.mark.skipif(shutil.which("g++") is None, reason="g++ is not installed")
+
+
+@pytest.fixture(scope="module")
+def built(tmp_path_factory: pytest.TempPathFactory) -> dict:
+    """Both workspaces generated with --lang cpp, every node's driver linked into one binary
+    (dispatching on the package name) with every node's logic.cpp; compiled once."""
+    tmp = tmp_path_factory.mktemp("cpp")
+    pkgs: dict[str, tuple[str, Path]] = {}  # node -> (package, output dir)
+    for case, ws in CASES.items():
+        out = tmp / case
+        assert main(["generate", "ros2", "-w", str(ws), "-o", str(out), "--lang", "cpp"]) == 0
+        for h in sorted(out.glob("*/include/*/contract_checks.hpp")):
+            node = next(line.split('"')[1] for line in h.read_text().splitlines() if "kNode = " in line)
+            pkgs[node] = (h.parent.name, out)
+    incs = [f"-I{out / pkg / 'include'}" for pkg, out in pkgs.values()]
+    headers = [str(out / pkg / "include" / pkg / "contract_checks.hpp") for pkg, out in pkgs.values()]
+    # a check header alone is a translation unit: self-contained, no ROS, no warning (every header
+    # comes from one template with the same includes; one is compiled alone, all in the build below)
+    subprocess.run(CXX + ["-fsyntax-only", "-x", "c++", headers[0]], check=True, capture_output=True, text=True)
+    main_cpp = tmp / "drivers.cpp"  # one translation unit: every driver, every logic.cpp, a dispatch
+    main_cpp.write_text("".join(f'#include "{pkg}/contract_driver.hpp"\n' for pkg, _ in pkgs.values())
+                        + "".join(f'#include "{out / pkg / "src" / "logic.cpp"}"\n' for pkg, out in pkgs.values())
+                        + "#include <iostream>\n#include <string>\nint main(int argc, char ** argv)\n{\n"
+                        + "  const std::string n = argc > 1 ? argv[1] : \"\";\n"
+                        + "".join(f'  if (n == "{pkg}") {{ return {pkg}::drive(std::cin, std::cout); }}\n'
+                                  for pkg, _ in pkgs.values())
+                        + "  return 2;\n}\n")
+    exe = tmp / "drivers"
+    subprocess.run(CXX + ["-O1", *incs, str(main_cpp), "-o", str(exe)], check=True, capture_output=True, text=True)
+    return {"pkgs": pkgs, "exe": exe}
+
+
+def _load(path: Path, name: str):  # type: ignore[no-untyped-def]
+    spec = importlib.util.spec_from_file_location(name, path)
+    assert spec is not None and spec.loader is not None
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    return mod
+
+
+def _text(q: str, v: object, t: object) -> str:
+    if isinstance(v, bool):
+        return f"{q}={int(v)}"
+    if isinstance(t, Scalar) and t.name == "REAL":
+        return f"{q}={float(v)!r}"
+    return f"{q}={v}"
+
+
+_REAL = st.one_of(st.integers(-30, 130).map(float), st.floats(-1e4, 1e4, allow_nan=False),
+                  st.sampled_from([0.0, 0.5, 1.5, 2.0, 20.0, 30.0, 100.0, 120.0, 250.0, 0.1, 1e-9]))
+
+
+def _run(exe: Path, pkg: str, steps: list[str]) -> list[tuple[str, int, str]]:
+    res = subprocess.run([str(exe), pkg], input="".join(s + "\n" for s in steps), capture_output=True, text=True,
+                         check=True)
+    rows = [line.split("|") for line in res.stdout.splitlines()]
+    return [(v, int(g), t) for v, g, t in rows]
+
+
+@pytest.mark.parametrize("case", sorted(CASES))
+def test_compiled_checks_agree_with_rclverify(built: dict, tmp_path: Path, case: str) -> None:
+    from rclverify.backends.property_tests.strategies import input_space
+    ws = CASES[case]
+    checked = Workspace(ws, "contracts/plan.yaml").checked
+    layer_out = tmp_path / "py"
+    assert main(["generate", "ros2", "-w", str(ws), "-o", str(layer_out)]) == 0
+    stats = {"steps": 0, "agree": 0, "untranslated": 0, "exact_only": 0, "verdicts": set()}
+    for node_name, cn in checked.nodes.items():
+        pkg, out = built["pkgs"][node_name]
+        header = (out / pkg / "include" / pkg / "contract_checks.hpp").read_text()
+        layer = _load(layer_out / pkg / pkg / "contract.py", f"cpp_oracle_{case}_{pkg}")
+        clauses = list(cn.node.assumes) + list(cn.node.guarantees)
+        names = [f"assumption_{k}" for k in range(1, len(cn.node.assumes) + 1)] + \
+                [f"guarantee_{k}" for k in range(1, len(cn.node.guarantees) + 1)]
+        untranslated = [f"inline Truth {n}(" in header and
+                        "// not translated" in header.split(f"inline Truth {n}(")[1].split("\n}\n")[0]
+                        for n in names]
+        io = {f"in.{k}": t for k, t in cn.inputs.items()} | {f"out.{k}": t for k, t in cn.outputs.items()}
+        space = input_space(cn, {})
+
+        @st.composite
+        def values(draw, io=io, space=space):  # type: ignore[no-untyped-def]
+            space.pools = {}
+            out = {}
+            for q, t in io.items():
+                if isinstance(t, EmptyT):
+                    continue
+                if t == BOOL:
+                    out[q] = draw(st.booleans())
+                elif isinstance(t, Scalar) and t.name == "REAL":
+                    out[q] = draw(_REAL)
+                elif isinstance(t, FuncT):
+                    out[q] = space.table(draw, t)
+                else:
+                    out[q] = draw(space.value(t))
+            return out
+
+        size = 30 if case == "warehouse" else 8
+
+        @settings(max_examples=3, deadline=None, database=None)
+        @given(st.lists(values(), min_size=size, max_size=size))
+        def agree(batch: list) -> None:
+            held = lambda q, t: isinstance(t, EnumT) or (isinstance(t, Scalar) and t.name != "STRING")  # noqa: E731
+            steps = [" ".join(_text(q, v, io[q]) for q, v in vals.items() if held(q, io[q])) for vals in batch]
+            for vals, (verdict, g, truths) in zip(batch, _run(built["exe"], pkg, steps)):
+                stats["steps"] += 1
+                differs = False
+                for k, (clause, u) in enumerate(zip(clauses, untranslated)):
+                    if u:
+                        assert truths[k] == "U", (node_name, names[k], vals)
+                        differs = True
+                        continue
+                    want = holds_in("double", clause.formula, checked, cn, vals)
+                    assert truths[k] == {True: "T", False: "F", None: "U"}[want], (node_name, names[k], vals)
+                    if want is not True and holds_in("exact", clause.formula, checked, cn, vals) is True:
+                        stats["exact_only"] += 1
+                        differs = True
+                assert (verdict, g) == _aggregate(truths, len(cn.node.assumes)), (node_name, vals)
+                monitor = layer.judge(vals)
+                if not differs or monitor["verdict"] == "assumption violated" == verdict:
+                    assert (verdict, g) == (monitor["verdict"], monitor["guarantee"]), (node_name, vals)
+                    stats["agree"] += 1
+                    stats["verdicts"].add(verdict)
+                else:
+                    stats["untranslated"] += any(untranslated)
+
+        agree()
+    if case == "warehouse":  # every clause translated; the random values reach every verdict
+        assert stats["untranslated"] == 0 and stats["agree"] >= 150, stats
+        assert {"satisfied", "violated", "assumption violated"} <= stats["verdicts"], stats
+    else:  # the guarantees quantify over functions: not translated, inconclusive in C++; the
+        # assumptions are, and a broken one is the monitor's verdict too
+        assert stats["untranslated"] > 0 and stats["agree"] >= 1, stats
+
+
+def _aggregate(truths: str, n_assumes: int) -> tuple[str, int]:
+    """The verdict the monitor engine's rule gives these clause truths (docs/generate.md)."""
+    for t in truths[:n_assumes]:
+        if t != "T":
+            return ("assumption violated" if t == "F" else "inconclusive", 0)
+    gs = truths[n_assumes:]
+    if "F" in gs:
+        return ("violated", gs.index("F") + 1)
+    if "U" in gs:
+        return ("inconclusive", gs.index("U") + 1)
+    return ("satisfied", 0)
+
+
+def test_the_driver_reads_as_the_node_computes(built: dict) -> None:
+    """The LidarDriver's check on values written by hand: the SDK's 1000 * range holds in double
+    arithmetic (1000 * 0.1 is 100.0 as the node computes; as exact rationals the double nearest 0.1
+    times 1000 is not 100), a wrong output is violated, a range below 0 breaks the assumption."""
+    pkg, _ = built["pkgs"]["LidarDriver"]
+    got = _run(built["exe"], pkg, ["in.range=0.1 out.obstacle=100.0", "in.range=2 out.obstacle=2",
+                                   "in.range=-1 out.obstacle=-1000"])
+    assert got == [("satisfied", 0, "TT"), ("violated", 1, "TF"), ("assumption violated", 0, "FT")]
+
+
+def test_a_declared_tolerance_is_the_headers_second_reading(tmp_path: Path) -> None:
+    """The plan's monitors entry declares a tolerance: numbers within it are equal to the checks,
+    as to the monitor (docs/monitors.md, "Numbers on the wire")."""
+    ws = tmp_path / "ws"
+    shutil.copytree(ROOT / "examples" / "contracts_first" / "contracts", ws / "contracts")
+    plan = (ws / "contracts" / "plan.yaml").read_text()
+    (ws / "contracts" / "plan.yaml").write_text(plan.replace(
+        "mapping: gen/rclverify_mapping.yaml", "mapping: m.yaml\n        tolerance: {abs: 1.0e-9}"))
+    (ws / "m.yaml").write_text("topics: {}\n")
+    assert main(["generate", "ros2", "-w", str(ws), "-o", str(ws / "gen"), "--lang", "cpp"]) == 0
+    inc = ws / "gen" / "temp_sensor" / "include"
+    assert "kTolerance{1e-09, 0.0, 0}" in (inc / "temp_sensor" / "contract_checks.hpp").read_text()
+    src = tmp_path / "d.cpp"
+    src.write_text('#include "temp_sensor/contract_driver.hpp"\n#include <iostream>\n'
+                   "int main() { return temp_sensor::drive(std::cin, std::cout); }\n")
+    subprocess.run(CXX + [f"-I{inc}", str(src), "-o", str(tmp_path / "d")], check=True, capture_output=True)
+    got = _run(tmp_path / "d", "", ["in.kelvin=300 out.celsius=26.850000000001", "in.kelvin=300 out.celsius=26.86"])
+    assert got == [("satisfied", 0, "TT"), ("violated", 1, "TF")]
