@@ -315,4 +315,8 @@ def test_the_first_screen_says_what_to_fix(tmp_path: Path, driver: Any) -> None:
     marked = driver.execute_script("return [...document.querySelectorAll('table.matrix th span.culprit')]"
                                    ".map(s => s.closest('th').querySelector('a').textContent)")
     assert "Agent" in marked and "Localisation" not in marked, marked
+    # and in the system diagram: the culprit's box has a thick red border and says so
+    drawn = driver.execute_script("return [...document.querySelectorAll('svg g.node.culprit title')]"
+                                  ".map(t => t.textContent)")
+    assert "Agent" in drawn and "Localisation" not in drawn, drawn
     _screenshot(driver, tmp_path, "assurance-first-screen.png")

@@ -509,3 +509,21 @@ def test_long_formulas_are_folded_and_broken_at_connectives() -> None:
     assert "  -> exists(y in REAL |" in lines and "    and out.c == move(y)))" in lines
     assert " ".join(x.strip() for x in lines) == long
     assert render.breakable("a/b_c.d") == "a/<wbr>b_<wbr>c.<wbr>d"
+
+
+def test_the_diagram_marks_the_culprit_and_the_failing_edge() -> None:
+    """Issue 48: the system diagram blames the culprit, not only its red victims."""
+    from rclverify.report.diagram import system_dot
+    system = {"nodes": [{"name": "Gnss", "status": "discharged"}, {"name": "Loc", "status": "failed"},
+                        {"name": "Plan", "status": "failed"}],
+              "connections": [{"from_node": "Gnss", "from_var": "h", "to_node": "Loc", "to_var": "h", "via": ""},
+                              {"from_node": "Loc", "from_var": "p", "to_node": "Plan", "to_var": "p", "via": ""}],
+              "environment_inputs": [], "loops": []}
+    dot = system_dot(system, culprits={"Gnss"}, failing={("Gnss", "Loc")})
+    lines = dot.splitlines()
+    gnss = next(l for l in lines if l.strip().startswith('"Gnss" ['))
+    assert 'class="culprit"' in gnss and "culprit" in gnss.split("label=")[1]
+    assert not any('class="culprit"' in l for l in lines if l.strip().startswith(('"Loc" [', '"Plan" [')))
+    edge = next(l for l in lines if '"Gnss" -> "Loc"' in l)
+    assert 'class="failing"' in edge and 'class="failing"' not in next(l for l in lines if '"Loc" -> "Plan"' in l)
+    assert system_dot(system) == system_dot(system, culprits=(), failing=())  # nothing marked by default

@@ -16,7 +16,7 @@ import shutil
 import subprocess
 from dataclasses import dataclass
 from functools import lru_cache
-from typing import Any, Mapping, Sequence
+from typing import Any, Iterable, Mapping, Sequence
 
 import jinja2
 
@@ -86,7 +86,8 @@ def _loop_edges(loops: Sequence[Sequence[str]]) -> set[tuple[str, str]]:
     return pairs
 
 
-def system_dot(system: Mapping[str, Any], title: str = "system model") -> str:
+def system_dot(system: Mapping[str, Any], title: str = "system model", culprits: Iterable[str] = (),
+               failing: Iterable[tuple[str, str]] = ()) -> str:
     """Graphviz DOT text of the system model.
 
     ``system`` is ``report["system"]``: ``nodes`` (``[{"name", "status"}]``),
@@ -99,9 +100,15 @@ def system_dot(system: Mapping[str, Any], title: str = "system model") -> str:
     by it; edges are labelled with the variable (``out -> in`` when the two
     names differ); environment inputs are plain-text sources ``env: <var>``
     with a dashed edge; connections on a loop (R4, paper lines 714-768) are
-    bold.  Everything is sorted, so equal inputs give byte-equal output.
+    bold.  A node in ``culprits`` (a problem blames its guarantee or
+    contract, :mod:`.culprits`) has a thick red border and "culprit" in its
+    label; a connection in ``failing`` (``(producer, consumer)`` of a side
+    condition that is not discharged) is drawn red and dashed: the failing
+    edge (issue 48: the diagram blames the culprit, not only its victims).
+    Everything is sorted, so equal inputs give byte-equal output.
     Raises ``KeyError`` when a required key is missing.
     """
+    blamed, bad = set(culprits), set(failing)
     loop_pairs = _loop_edges(system["loops"])
     names = {n["name"] for n in system["nodes"]}
     status = {n["name"]: n["status"] for n in system["nodes"]}
@@ -114,8 +121,9 @@ def system_dot(system: Mapping[str, Any], title: str = "system model") -> str:
     for name in sorted(names):
         st = status.get(name)
         fill, border = _NODE_COLOURS.get(st or "", _OTHER_COLOURS)
-        label = dot_string(name, st) if st else dot_string(name)
-        nodes.append({"id": dot_string(name), "label": label, "fill": fill, "border": border})
+        label = dot_string(name, *([st] if st else []), *(["\u2691 culprit"] if name in blamed else []))
+        nodes.append({"id": dot_string(name), "label": label, "fill": fill, "border": border,
+                      "culprit": name in blamed})
 
     edges = []
     conns = sorted(
@@ -132,6 +140,7 @@ def system_dot(system: Mapping[str, Any], title: str = "system model") -> str:
             "label": dot_string(var),
             "tooltip": dot_string(tip),
             "loop": (c["from_node"], c["to_node"]) in loop_pairs,
+            "failing": (c["from_node"], c["to_node"]) in bad,
         })
 
     sources = []
