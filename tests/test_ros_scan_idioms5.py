@@ -2,7 +2,7 @@
 names given through rclcpp's own name resolution, a camera subscription on a
 member holding such a name (its camera_info beside it), image_transport
 subscriber filters, a message_filters member typed through a
-using-declaration in its header; and pluginlib plugins of ROS 2.
+using-declaration in its header.
 
 The workspace is the project's own (tests/data/ros_corpus/idioms7), its
 expected graph written by hand (expected/idioms7_sources.json); each test
