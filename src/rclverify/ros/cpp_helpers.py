@@ -11,6 +11,7 @@ documented API and source):
 | ``tf2_ros::StaticTransformBroadcaster`` | publishes ``/tf_static`` |
 | ``tf2_ros::TransformListener`` / ``tf::TransformListener`` | subscribes ``/tf`` and ``/tf_static`` |
 | ``message_filters::Subscriber<T>(h, name, ...)`` / ``.subscribe(h, name, ...)`` | subscribes ``name`` (``T``) |
+| ``image_transport::SubscriberFilter(h, name, ...)`` / ``.subscribe(h, name, ...)`` | subscribes ``name`` (``sensor_msgs/msg/Image``) |
 | ``image_transport::ImageTransport`` ``advertise``/``subscribe``; ROS 2 ``image_transport::create_publisher``/``create_subscription`` | ``name`` (``sensor_msgs/msg/Image``); the ``Camera`` forms add ``camera_info`` beside it (``sensor_msgs/msg/CameraInfo``) |
 | ``interactive_markers::InteractiveMarkerServer(ns, ...)`` | ROS 1: publishes ``ns/update``, ``ns/update_full``, subscribes ``ns/feedback``; ROS 2: publishes ``ns/update``, subscribes ``ns/feedback``, serves ``ns/get_interactive_markers`` |
 | ``rclcpp::ParameterEventHandler``, ``on_parameter_event`` | subscribes ``/parameter_events`` (``rcl_interfaces/msg/ParameterEvent``) |
@@ -51,21 +52,17 @@ RECONF = "dynamic_reconfigure/"
 #: helper classes whose construction creates endpoints, by last name part
 CONSTRUCTED = {"TransformBroadcaster", "StaticTransformBroadcaster", "TransformListener", "Subscriber",
                "InteractiveMarkerServer", "ParameterEventHandler", "CameraPublisher", "CameraSubscriber",
-               "Updater", "Server", "Client", "TestRunner", "RealtimePublisher", "CameraInfoManager", "Bond"}
+               "Updater", "Server", "Client", "TestRunner", "RealtimePublisher", "CameraInfoManager", "Bond",
+               "SubscriberFilter"}
 #: helper methods that create endpoints, by the receiver's class (last name part)
 METHODS = {"ImageTransport": {"advertise", "subscribe", "advertiseCamera", "subscribeCamera"},
-           "Subscriber": {"subscribe"}, "AsyncParametersClient": {"on_parameter_event"},
+           "Subscriber": {"subscribe"}, "SubscriberFilter": {"subscribe"}, "AsyncParametersClient": {"on_parameter_event"},
            "SyncParametersClient": {"on_parameter_event"}, "RealtimePublisher": {"init"}}
 
 
 def info_topic(image: symbols.Val) -> symbols.Val:
-    """The ``camera_info`` topic beside image topic ``image`` (image_transport's
-    ``getCameraInfoTopic``: the image topic's namespace + ``camera_info``)."""
-    t = symbols.text(image)
-    if t is None:
-        return None
-    head = t.rsplit("/", 1)[0] + "/" if "/" in t else ("~" if t.startswith("~") else "")
-    return symbols.lit(head + "camera_info")
+    """The ``camera_info`` topic beside image topic ``image`` (:func:`symbols.camera_info`)."""
+    return symbols.camera_info(image)
 
 
 def _image(kind: str, camera: bool, name: symbols.Val, h: symbols.Val) -> list[Spec]:
@@ -128,6 +125,8 @@ def constructed(type_text: str, args: list[Any], val: Value, ros2: bool,
         return [EVENTS]
     if last in ("CameraPublisher", "CameraSubscriber") and head.startswith("image_transport") and len(args) >= 2:
         return _image("pub" if last == "CameraPublisher" else "sub", True, val(args[1]), val(args[0]))
+    if last == "SubscriberFilter" and head.startswith("image_transport"):
+        return _image("sub", False, val(args[1]), val(args[0])) if len(args) >= 2 else []
     return None
 
 
@@ -194,6 +193,8 @@ def method(recv_type: str, name: str, args: list[Any], targs: list[str], val: Va
         return _image(kind, name.endswith("Camera"), val(args[0]), handle)
     if last == "Subscriber" and head.startswith("message_filters") and len(args) >= 2:
         return [("sub", val(args[1]), message_type(rtargs[0], aliases) if rtargs else None, val(args[0]))]
+    if last == "SubscriberFilter" and head.startswith("image_transport") and len(args) >= 2:
+        return _image("sub", False, val(args[1]), val(args[0]))
     if name == "on_parameter_event":
         return [EVENTS]
     return []

@@ -9,7 +9,12 @@ constructs it), a ROS parameter read (:mod:`cpp_params`), a node handle
 (``ros::NodeHandle nh("~")``, ``ros::NodeHandle(parent, "ns")``, rclcpp
 ``create_sub_node("ns")``, a nodelet's ``getPrivateNodeHandle()``), the node's
 own name (``ros::this_node::getName()``, ``get_fully_qualified_name()``,
-rclcpp's ``get_name()``), a parameter read with a computed key,
+rclcpp's ``get_name()``), a parameter read with a computed key, a name
+resolved or expanded by rclcpp for the node (``node_base->
+resolve_topic_or_service_name("image", false)``,
+``rclcpp::expand_topic_or_service_name(name, get_name(), get_namespace())``:
+the name as written, which the graph resolves as ROS does; one that is
+relative and follows other text in a concatenation is not read),
 roscpp options (``ros::SubscribeOptions::create<T>(name, ...)``,
 ``ops.init<T>(name, ...)``).  A name bound twice to different values is not
 read (``None``).
@@ -24,6 +29,10 @@ from .cpp_scope import _HANDLE_TYPES, MAX_DEPTH, CppScope, Fn, base_name, is_nod
 
 _T = treesitter.text
 
+
+#: rclcpp's name resolution for a node: ``NodeBaseInterface::resolve_topic_or_service_name``
+#: (rclcpp >= Humble) and ``rclcpp::expand_topic_or_service_name`` (name, node name, namespace).
+_RESOLVERS = ("resolve_topic_or_service_name", "expand_topic_or_service_name")
 
 _OPTIONS = {"SubscribeOptions": "sub", "AdvertiseOptions": "pub", "AdvertiseServiceOptions": "service_servers"}
 
@@ -62,6 +71,8 @@ class CppValues(CppScope):
         if t in ("parenthesized_expression",) and n.named_children:
             return self.value(n.named_children[0], depth + 1)
         if t == "binary_expression" and _T(n.child_by_field_name("operator")) == "+":
+            if self._resolved_relative(n.child_by_field_name("right"), depth):
+                return None  # "ns" + resolve("x"): the node's namespace in the middle of a name
             return symbols.cat([self.value(n.child_by_field_name("left"), depth + 1),
                                 self.value(n.child_by_field_name("right"), depth + 1)])
         if t == "call_expression":
@@ -90,6 +101,9 @@ class CppValues(CppScope):
             # made from it (get_name() + "/x") is relative, so it resolves as ~/x
             return symbols.NODE
         if ftext in ("std::string", "string", "std::string_view") and len(args) == 1:
+            return self.value(args[0], depth + 1)
+        if last in _RESOLVERS and args:
+            # rclcpp resolves (remaps) the name against the node: what the graph does with it as written
             return self.value(args[0], depth + 1)
         if base_name(ftext) in _HANDLE_TYPES:
             return self.handle(args, depth)
@@ -159,6 +173,24 @@ class CppValues(CppScope):
         if t in ("identifier", "field_expression", "pointer_expression"):
             return is_node_type(self.type_of(n) or "")
         return False
+
+    def _resolved_relative(self, n: Any, depth: int) -> bool:
+        """Whether expression ``n`` is (or is a local bound only to) an rclcpp name
+        resolution (:data:`_RESOLVERS`) of a name that is not absolute: the node's
+        namespace then comes first in its text, which no written form can say."""
+        if n is None or depth > MAX_DEPTH:
+            return False
+        if n.type == "call_expression":
+            fn = n.child_by_field_name("function")
+            last = _T(fn).split("::")[-1].split(".")[-1].split(">")[-1]
+            a = n.child_by_field_name("arguments")
+            if last in _RESOLVERS and a is not None and a.named_children:
+                txt = symbols.text(self.value(a.named_children[0], depth + 1))
+                return not (txt or "").startswith("/")
+            return False
+        f = self.fn_of(n) if n.type == "identifier" else None
+        binds = self.locals.get((f.nid, _T(n)), []) if f is not None else []
+        return any(not isinstance(b, tuple) and self._resolved_relative(b, depth + 1) for b in binds)
 
     def _name_value(self, n: Any, depth: int) -> symbols.Val:
         fn = self.fn_of(n)

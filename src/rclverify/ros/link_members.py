@@ -99,7 +99,7 @@ class LinkMembers:
             for b in self.units.get(unit, {}).get("bases", []):
                 cls = self.match(b, unit)
                 ty = ty or (self.units.get(cls, {}).get("members", {}).get(m) if cls else None)
-            specs = cpp_helpers.method(ty, meth, args, [], lambda x: x, None) if ty else None
+            specs = cpp_helpers.method(ty, meth, args, [], lambda x: x, None, self.aliases) if ty else None
             for kind, nv, t, hv in specs or []:
                 k = 1 if kind == "sub" and meth == "subscribe" else 0
                 out.append(Endpoint(kind, "", t, src, None, (), unit,

@@ -131,6 +131,9 @@ class Values:
             for x in v[1]:
                 parts = limit([p + [y] for p in parts for y in self.eval(x, env, fkey, depth + 1)])
             return limit([symbols.cat(p) for p in parts])
+        if k == "info":  # image_transport's camera_info beside an image topic read here
+            return limit([symbols.camera_info(x) if x is not None and symbols.is_concrete(x) else None
+                          for x in self.eval(v[1], env, fkey, depth + 1)])
         if k == "ops":
             return [("ops", v[1], n, v[3], v[4]) for n in self.eval(v[2], env, fkey, depth + 1)]
         return [None]
@@ -176,4 +179,6 @@ def _homes(v: Any) -> set[str]:
         return _homes(v[3]) | (_homes(v[1]) if isinstance(v[1], tuple) else set())
     if v[0] == "ops":
         return _homes(v[2])
+    if v[0] == "info":
+        return _homes(v[1])
     return set()

@@ -28,6 +28,9 @@ A value is a tuple (hashable, picklable, so it lives in the parse cache):
   ``param`` (``~observation_sources``), a C++ range-for's variable over it;
   its text is ``[~observation_sources]``, which the graph expands with the
   parameter's value (:func:`rclverify.ros.param_yaml.expand_each`; issue 53);
+* ``("info", image)``: the ``camera_info`` topic image_transport pairs with
+  image topic ``image`` (its namespace + ``camera_info``), for an image topic
+  only the linker can read (a member, a parameter of the function);
 * ``("runtime", origin)``: a name only the running program knows, and where
   it comes from (``from argv``, ``from argparse option --topic``,
   ``discovered at run time (get_topic_names_and_types())``): never read, its
@@ -70,6 +73,18 @@ def cat(parts: list[Val]) -> Val:
     return out[0] if len(out) == 1 else ("cat", tuple(out))
 
 
+def camera_info(image: Val) -> Val:
+    """The ``camera_info`` topic beside image topic ``image`` (image_transport's
+    ``getCameraInfoTopic``: the image topic's namespace + ``camera_info``): a
+    literal when ``image``'s text is known, ``("info", image)`` while it needs
+    the program's context, ``None`` when it cannot be read."""
+    t = text(image)
+    if t is None:
+        return ("info", image) if image is not None and not is_concrete(image) else None
+    head = t.rsplit("/", 1)[0] + "/" if "/" in t else ("~" if t.startswith("~") else "")
+    return lit(head + "camera_info")
+
+
 def is_concrete(v: Val) -> bool:
     """Whether ``v`` needs no program context (no ``arg``, ``field`` or ``ext``
     part): it can be read, or be found unreadable, in its file alone."""
@@ -78,6 +93,8 @@ def is_concrete(v: Val) -> bool:
     k = v[0]
     if k in ("arg", "field", "ext"):
         return False
+    if k == "info":
+        return is_concrete(v[1])
     if k == "param":
         return is_concrete(v[3]) and (isinstance(v[1], str) or is_concrete(v[1]))
     if k == "nh":
