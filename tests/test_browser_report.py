@@ -320,3 +320,40 @@ def test_the_first_screen_says_what_to_fix(tmp_path: Path, driver: Any) -> None:
                                   ".map(t => t.textContent)")
     assert "Agent" in drawn and "Localisation" not in drawn, drawn
     _screenshot(driver, tmp_path, "assurance-first-screen.png")
+
+
+def test_the_warehouse_first_screen_says_what_to_fix(tmp_path: Path, driver: Any) -> None:
+    """Issue 48, on examples/warehouse (``tests/data/warehouse-report.json.gz``: its
+    ``reports/assurance.json`` after ``doit verify``, gzipped): at 1400x900 the first screen
+    holds the overall status with the refuted requirements and deadline counted, and the
+    first problem with its culprit and its first repair; the culprit node is marked in the
+    dashboard and the system diagram, a node no problem blames is not."""
+    with gzip.open(REPO / "tests" / "data" / "warehouse-report.json.gz", "rt", encoding="utf-8") as f:
+        report = json.load(f)
+    out = tmp_path / "reports"
+    out.mkdir()
+    render_files(report, out, ("assurance.html",))
+    driver.set_window_size(1400, 900)
+    driver.get((out / "assurance.html").as_uri())
+    height = driver.execute_script("return window.innerHeight")
+    status = driver.find_element("css selector", "header p.banner")
+    assert "failed" in status.get_attribute("textContent")
+    lead = driver.find_element("css selector", "header p.lead").get_attribute("textContent")
+    assert "3 requirements refuted (STOP, DOCK, ARRIVE)" in lead and "1 end-to-end deadline refuted" in lead, lead
+    first = driver.find_element("css selector", "#problem-1")
+    text = first.get_attribute("textContent")
+    assert "contracts/lidar_driver.rcl:15:3" in text  # the culprit: LidarDriver's guarantee, not the consumer
+    assert "rescale-producer" in text  # its first repair
+    top = driver.execute_script("return arguments[0].getBoundingClientRect().top", first)
+    assert top < height, (top, height)  # the first problem starts on the first screen
+    marked = driver.execute_script("return [...document.querySelectorAll('table.matrix th span.culprit')]"
+                                   ".map(s => s.closest('th').querySelector('a').textContent)")
+    assert "LidarDriver" in marked, marked
+    drawn = driver.execute_script("return [...document.querySelectorAll('svg g.node.culprit title')]"
+                                  ".map(t => t.textContent)")
+    # the deadline's chain blames Controller's guarantee 1 too; Localiser and MissionManager are no culprit
+    assert "LidarDriver" in drawn and "Localiser" not in drawn and "MissionManager" not in drawn, drawn
+    failing = driver.execute_script("return [...document.querySelectorAll('svg g.edge.failing title')]"
+                                    ".map(t => t.textContent)")
+    assert any("LidarDriver" in t and "Controller" in t for t in failing), failing
+    _screenshot(driver, tmp_path, "assurance-warehouse-first-screen.png")
