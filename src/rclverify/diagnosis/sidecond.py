@@ -184,17 +184,35 @@ def _strengthen(ws: Any, sc: Mapping[str, Any], p: str, new_g: str, cost_of: Any
         not_shown=f"that {p} can be made to meet `{new_g}`: its evidence must establish it")]
 
 
-def _normal(c: ast.Expr, prefix: str | None, name: str) -> tuple[str, ast.NumLit] | None:
-    """``(op, literal)`` when ``c`` is ``<prefix>.<name> op N`` (or ``N op
-    <prefix>.<name>``, mirrored) with an ordering ``op``."""
+def _normal(c: ast.Expr, prefix: str | None, name: str,
+            constants: Mapping[str, Any] | None = None) -> tuple[str, ast.Expr] | None:
+    """``(op, bound)`` when ``c`` is ``<prefix>.<name> op N`` (or ``N op
+    <prefix>.<name>``, mirrored) with an ordering ``op``; ``N`` a numeral,
+    or, with ``constants`` (the context's, name -> (type, defining
+    expression)), a named constant whose value is a numeral (issue 48: one
+    first repair also when the bound is a named constant)."""
     if not (isinstance(c, ast.Compare) and len(c.ops) == 1 and c.ops[0] in _UPPER):
         return None
     a, b = c.operands
     op: str = c.ops[0]
-    if isinstance(b, ast.Var) and isinstance(a, ast.NumLit):
+
+    def bound(e: ast.Expr) -> bool:
+        return isinstance(e, ast.NumLit) or (constants is not None and isinstance(e, ast.Var) and e.prefix is None
+                                             and e.name in constants and _const_value(e, constants) is not None)
+    if bound(a) and isinstance(b, ast.Var) and not bound(b):
         a, b, op = b, a, _MIRROR[op]
-    if isinstance(a, ast.Var) and a.prefix == prefix and a.name == name and isinstance(b, ast.NumLit):
+    if isinstance(a, ast.Var) and a.prefix == prefix and a.name == name and bound(b):
         return op, b
+    return None
+
+
+def _const_value(e: ast.Expr, constants: Mapping[str, Any] | None) -> Fraction | None:
+    """The value of a numeral, or of a named constant defined by one."""
+    if isinstance(e, ast.NumLit):
+        return value(e.text)
+    if isinstance(e, ast.Var) and constants is not None and e.name in constants:
+        defining = constants[e.name][1]
+        return value(defining.text) if isinstance(defining, ast.NumLit) else None
     return None
 
 
@@ -203,22 +221,25 @@ def _inplace(ws: Any, p: str, ov: str, target: ast.Expr) -> tuple[Edit, int, str
     ``out.ov op N`` of a guarantee of ``p`` with the operator of the
     consumer's conjunct ``target`` (``in.w op B``) and a weaker ``N``, its
     literal replaced by ``B``; ``None`` when there is none."""
-    mine = next((_normal(target, pre, v.name) for pre in ("in", None) for v in subexpressions(target)
-                 if isinstance(v, ast.Var) and v.prefix == pre and _normal(target, pre, v.name)), None)
+    consts = ws.checked.env.constants
+    mine = next((_normal(target, pre, v.name, consts) for pre in ("in", None) for v in subexpressions(target)
+                 if isinstance(v, ast.Var) and v.prefix == pre and v.name not in consts
+                 and _normal(target, pre, v.name, consts)), None)
     if mine is None:
         return None
     op, lit = mine
-    want = value(lit.text)
+    want = _const_value(lit, consts)
     for k, g in enumerate(ws.checked.nodes[p].node.guarantees, 1):
         for c in conjuncts(g.formula):
             got = _normal(c, "out", ov)
             if got is None or got[0] != op or not got[1].loc.line:
                 continue
-            old = value(got[1].text)
+            old = _const_value(got[1], consts) if isinstance(got[1], ast.NumLit) else None
             if old is None or want is None or not (old > want if _UPPER[op] else old < want):
                 continue
             n = got[1]
-            return (Edit(n.loc.file, n.loc.line, n.loc.col, n.loc.line, n.loc.col + len(n.text), lit.text), k,
+            assert isinstance(n, ast.NumLit)
+            return (Edit(n.loc.file, n.loc.line, n.loc.col, n.loc.line, n.loc.col + len(n.text), expr_to_rcl(lit)), k,
                     expr_to_rcl(c))
     return None
 

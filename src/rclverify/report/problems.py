@@ -148,6 +148,22 @@ class _Places:
         return rows[i][1] if i >= 0 else None
 
 
+def _join_requirements_to_side_conditions(members: list[tuple[dict[str, Any], list[str]]]) -> None:
+    """A refuted requirement whose culprits are all culprits of one failed
+    side condition has that side condition's root cause: both rows read one
+    problem, with one first repair (issue 48: a service answering up to 64
+    waypoints to a client whose buffer holds ``RouteBuffer = 50`` gave a
+    side-condition row and a requirement row with two different first
+    repairs).  Changes ``members`` (``(member, roots)``) in place."""
+    sides = [set(r) for m, r in members if m["kind"] == "side-condition" and r]
+    for i, (m, roots) in enumerate(members):
+        if m["kind"] != "requirement" or not roots:
+            continue
+        home = next((s for s in sides if set(roots) <= s), None)
+        if home is not None:
+            members[i] = (m, sorted(home))
+
+
 def _roots(culprits: Sequence[Mapping[str, Any]], places: _Places, victim: str | None) -> list[str]:
     """Root culprit ids of one problem (rules 1 and 2 of the module docstring)."""
     roots: list[str] = []
@@ -235,6 +251,7 @@ def group_problems(report: Mapping[str, Any], items: Sequence[Mapping[str, Any]]
         members.append(({"id": str(q["id"]), "kind": "requirement", "status": str(q["status"]),
                          "sentence": f"Requirement {q['id']} is {q['verdict']}" + (f": {note}" if note else "") + ".",
                          "anchor": anchor("req", q["id"]), "diagnosis": False}, roots))
+    _join_requirements_to_side_conditions(members)
     covered = {m["id"] for m, _ in members}
     obligation = {str(o["id"]): o for o in report.get("obligations", [])}
     unverified = {str(u["id"]): u for u in report.get("unverified") or ()}
