@@ -1,12 +1,14 @@
-"""ROS 2 pluginlib plugins (issue 53, idiom 5): a class exported in a plugin
-description that package.xml's <export> names, whose endpoints are made on the
-handle its loader gives it, belongs to the node whose parameter file lists it;
-a plugin no node is found to load is a located note, never an edge.
+"""ROS 2 pluginlib plugins (issue 53, idiom 5), and field paths kept per
+contract (the grounding bug docs/ros.md notes in "Held-out recall").
 
-The workspace is the project's own (tests/data/ros_corpus/idioms8), its
-expected graph written by hand (expected/idioms8_sources.json); each scan
-test below failed before pluginlib plugins were read (the plugins' endpoints
-were lost, with a note about a file naming no node)."""
+A class exported in a plugin description that package.xml's <export> names,
+whose endpoints are made on the handle its loader gives it, belongs to the
+node whose parameter file lists it; a plugin no node is found to load is a
+located note, never an edge.  The workspace is the project's own
+(tests/data/ros_corpus/idioms8), its expected graph written by hand
+(expected/idioms8_sources.json); each test below failed on main 9637a4d (the
+plugins' endpoints were lost, with a note about a file naming no node; the
+skeleton wrote one topic's field paths for two message types)."""
 from __future__ import annotations
 
 import json
@@ -142,3 +144,52 @@ def test_instances_follow_the_nodes_list() -> None:
     found, notes = instances(values, "/m", classes)
     assert [(i, c.type) for i, c in found] == [("a", "rig_layers::RangeLayer"), ("b", "rig_layers::BumperLayer")]
     assert notes == []  # "not a class" is some other parameter called plugin
+
+
+def _pkg(root: Path, name: str, build: str, extra: str = "") -> Path:
+    (root / name).mkdir(parents=True)
+    (root / name / "package.xml").write_text(
+        f'<?xml version="1.0"?>\n<package format="3"><name>{name}</name><version>0.1.0</version>'
+        f'<description>d</description><maintainer email="dev@example.org">dev</maintainer><license>MIT</license>'
+        f'<buildtool_depend>{build}</buildtool_depend>{extra}<export><build_type>{build}</build_type></export>'
+        f'</package>\n')
+    return root / name
+
+
+def test_field_paths_are_kept_per_contract_when_one_topic_carries_two_types(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    # the grounding bug of docs/ros.md "Held-out recall": one topic name, a message in one
+    # node and an array of it in another; the first contract's field paths were written
+    # under the topic's name and looked up in the other contract's array type
+    from rclverify.cli import main
+    src = tmp_path / "pads" / "src"
+    msgs = _pkg(src, "pad_msgs", "ament_cmake", "<member_of_group>rosidl_interface_packages</member_of_group>")
+    (msgs / "msg").mkdir()
+    (msgs / "msg" / "Feedback.msg").write_text("uint8 kind\nfloat32 intensity\n")
+    (msgs / "msg" / "FeedbackArray.msg").write_text("Feedback[] array\n")
+    (msgs / "CMakeLists.txt").write_text('cmake_minimum_required(VERSION 3.8)\nproject(pad_msgs)\n'
+                                         'rosidl_generate_interfaces(${PROJECT_NAME} "msg/Feedback.msg" '
+                                         '"msg/FeedbackArray.msg")\nament_package()\n')
+    nodes = _pkg(src, "pad_nodes", "ament_python")
+    (nodes / "scripts").mkdir()
+    (nodes / "scripts" / "pad.py").write_text(
+        "import rclpy\nfrom pad_msgs.msg import Feedback\nrclpy.init()\nn = rclpy.create_node('pad')\n"
+        "n.create_subscription(Feedback, 'set_feedback', lambda m: None, 1)\n")
+    (nodes / "scripts" / "rumble.py").write_text(
+        "import rclpy\nfrom pad_msgs.msg import FeedbackArray\nrclpy.init()\nn = rclpy.create_node('rumble')\n"
+        "n.create_publisher(FeedbackArray, 'set_feedback', 1)\n")
+    ws = tmp_path / "ws"
+    assert main(["init", str(ws), "--from-ros", str(tmp_path / "pads")]) == 0
+    plan = (ws / "contracts/plan.yaml").read_text()
+    assert "    Pad.set_feedback: [kind, intensity]\n" in plan and "    set_feedback:" not in plan
+    capsys.readouterr()
+    out = tmp_path / "ground.json"
+    main(["ros", "check", "-w", str(ws), "--json", str(out)])
+    codes = [f["code"] for f in json.loads(out.read_text())["findings"]]
+    assert "ROS-FIELD-MISSING" not in codes and "ROS-FIELD-TYPE" not in codes
+    assert "ROS-TYPE-DIFFERS" in codes  # the code disagrees with itself: that stays said
+    # the grounding reads the contract's own entry (Contract.topic): a path Rumble's array lacks
+    (ws / "contracts/plan.yaml").write_text(plan + "    Rumble.set_feedback: [kind]\n")
+    main(["ros", "check", "-w", str(ws), "--json", str(out)])
+    missing = [f for f in json.loads(out.read_text())["findings"] if f["code"] == "ROS-FIELD-MISSING"]
+    assert [(f["node"], f["topic"]) for f in missing] == [("Rumble", "set_feedback")]
