@@ -83,7 +83,8 @@ def test_a_layer_the_list_leaves_out_is_not_loaded(tmp_path: Path) -> None:
 
 def test_initialize_with_a_node_handle_and_an_unknown_plugin_class(tmp_path: Path) -> None:
     # another base (initialize(rclcpp::Node::SharedPtr node)), a lookup name given by
-    # <class name=...> in <class_libraries>, and a plugin: value no package exports
+    # <class name=...> in <class_libraries>, a plugin: value no package exports, and an
+    # exported class no source defines
     ws = tmp_path / "idioms8"
     shutil.copytree(WS, ws)
     pkg = ws / "src" / "rig_layers"
@@ -95,6 +96,7 @@ def test_initialize_with_a_node_handle_and_an_unknown_plugin_class(tmp_path: Pat
     (pkg / "checks.xml").write_text(
         '<class_libraries><library path="lib/librig_checks">\n'
         '  <class name="rig_layers/Probe" type="rig_layers::Probe" base_class_type="rig_core::Check"/>\n'
+        '  <class type="rig_layers::Missing" base_class_type="rig_core::Check"/>\n'
         '</library></class_libraries>\n')
     manifest = pkg / "package.xml"
     manifest.write_text(manifest.read_text().replace(
@@ -104,8 +106,9 @@ def test_initialize_with_a_node_handle_and_an_unknown_plugin_class(tmp_path: Pat
     cmake.write_text(cmake.read_text().replace("pluginlib_export", "add_library(rig_checks SHARED src/probe.cpp)\n"
                                                                   "pluginlib_export"))
     cfg = ws / "src" / "rig_mapper" / "config" / "mapper.yaml"
-    cfg.write_text(cfg.read_text().replace('"bumper"]', '"bumper", "probe", "ghost"]') +
-                   '    probe:\n      plugin: "rig_layers/Probe"\n    ghost:\n      plugin: "rig_layers::Ghost"\n')
+    cfg.write_text(cfg.read_text().replace('"bumper"]', '"bumper", "probe", "ghost", "missing"]') +
+                   '    probe:\n      plugin: "rig_layers/Probe"\n    ghost:\n      plugin: "rig_layers::Ghost"\n'
+                   '    missing:\n      plugin: "rig_layers::Missing"\n')
     g = scan([ws], [], base=tmp_path, standard=False).graph
     pubs = {(e.topic, f"{e.src.file}:{e.src.line}") for e in g.nodes["/mapper"].edges_of("pub")}
     assert ("/probe_state", "idioms8/src/rig_layers/src/probe.cpp:8") in pubs
@@ -113,6 +116,9 @@ def test_initialize_with_a_node_handle_and_an_unknown_plugin_class(tmp_path: Pat
     assert str(ghost.src) == "idioms8/src/rig_mapper/config/mapper.yaml:16:15"
     assert "parameter /mapper/ghost.plugin names plugin 'rig_layers::Ghost', which no scanned package exports" \
         in ghost.message
+    [missing] = [n for n in g.notes if "Missing" in n.message]  # exported, defined nowhere
+    assert str(missing.src) == "idioms8/src/rig_mapper/config/mapper.yaml:18:15"
+    assert "no scanned C++ source defines the class: its endpoints are unknown" in missing.message
 
 
 def test_descriptions_read_from_the_export_and_nodelets_left_to_their_reader(tmp_path: Path) -> None:
@@ -139,10 +145,10 @@ def test_instances_follow_the_nodes_list() -> None:
               "/m/b.plugin": ("rig_layers::BumperLayer", at), "/m/c.plugin": ("not a class", at),
               "/other/d.plugin": ("rig_layers::SonarLayer", at)}
     found, notes = instances(values, "/m", classes)
-    assert [(i, c.type) for i, c in found] == [("a", "rig_layers::RangeLayer")] and notes == []
+    assert [(i, c.type) for i, c, _at in found] == [("a", "rig_layers::RangeLayer")] and notes == []
     del values["/m/layers"]  # no list: every plugin entry of the node is its (the code's default list)
     found, notes = instances(values, "/m", classes)
-    assert [(i, c.type) for i, c in found] == [("a", "rig_layers::RangeLayer"), ("b", "rig_layers::BumperLayer")]
+    assert [(i, c.type) for i, c, _at in found] == [("a", "rig_layers::RangeLayer"), ("b", "rig_layers::BumperLayer")]
     assert notes == []  # "not a class" is some other parameter called plugin
 
 

@@ -126,9 +126,11 @@ class Assembly:
         found, notes = plugins.instances(values, full, self.plugin_classes)
         eps: list[Endpoint] = []
         files: list[str] = []
-        for inst, pc in found:
+        for inst, pc, at in found:
             base = self.plugin_progs.get(pc.type)
             if base is None:
+                notes.append(Note(at, f"plugin {pc.type} (instance {inst} of {full}) is exported, but no scanned C++ "
+                                      f"source defines the class: its endpoints are unknown"))
                 continue
             prog = self._instances.get((pc.type, inst))
             if prog is None:

@@ -36,8 +36,8 @@ plugin declares.  Endpoints made on the handle the plugin is given (a weak
 pointer's ``lock()``, ``initialize(rclcpp::Node::SharedPtr node)``) belong to
 the loading node.  A plugin class no node is found to load gives no edge: each
 of its endpoints is a located note naming the class (:func:`unloaded_note`);
-a ``plugin:`` value naming a class no scanned package exports is a located
-note at the parameter file's line.
+a ``plugin:`` value naming a class no scanned package exports, or one no
+scanned C++ source defines, is a located note at the parameter file's line.
 """
 from __future__ import annotations
 
@@ -133,8 +133,8 @@ def entry_sites(fns: dict[str, tuple[str, list[str], list[str], list[Any]]], ent
 
 
 def instances(values: dict[str, tuple[Any, Src]], full: str, classes: dict[str, PluginClass]
-              ) -> tuple[list[tuple[str, PluginClass]], list[Note]]:
-    """``([(instance name, plugin)], notes)``: the plugins node ``full`` loads, read
+              ) -> tuple[list[tuple[str, PluginClass, Src]], list[Note]]:
+    """``([(instance name, plugin, where the file names it)], notes)``: the plugins node ``full`` loads, read
     from its parameter values ``values`` (``{"/node/key": (value, where)}``, strings
     and string tuples; :meth:`param_yaml.PackageParams.for_node`).  ``classes``: the
     exported plugins by type and by lookup name.  A ``plugin`` value that looks
@@ -146,14 +146,14 @@ def instances(values: dict[str, tuple[Any, Src]], full: str, classes: dict[str, 
         if k.startswith(pre) and k.endswith(".plugin") and isinstance(v, str) and len(k) > len(pre) + 7:
             named[k[len(pre):-len(".plugin")]] = (v.strip().lstrip(":"), at)
     listed = {x for k, (v, _at) in values.items() if k.startswith(pre) and isinstance(v, tuple) for x in v}
-    out: list[tuple[str, PluginClass]] = []
+    out: list[tuple[str, PluginClass, Src]] = []
     notes: list[Note] = []
     for inst, (v, at) in named.items():
         if listed & set(named) and inst not in listed:
             continue  # the node's list names other plugins: this one is not loaded
         pc = classes.get(v)
         if pc is not None:
-            out.append((inst, pc))
+            out.append((inst, pc, at))
         elif _CLASSY.match(v):
             notes.append(Note(at, f"parameter {pre}{inst}.plugin names plugin '{v}', which no scanned package "
                                   f"exports (package.xml <export> naming a plugin description): its endpoints "

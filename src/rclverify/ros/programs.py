@@ -189,12 +189,12 @@ def programs(code: PackageCode, t: Targets) -> list[Program]:
         cls = _class_named(code, pc.type)
         srcs = [show(p) for p in t.libraries.get(pc.library or "", [])] or sorted(
             f for f, r in code.records.items() if r.get("lang") != "py" and cls in r.get("units", {}))
-        if srcs:
+        if srcs and any(cls in r.get("units", {}) for r in code.records.values() if r.get("lang") != "py"):
             target = pc.library if pc.library in t.libraries else None
             files = _closure(code, srcs + (linked(target, {target}) if target else []),
                              listed if target else set())
             out.append(Program(code.name, None, srcs, files, {cls}, plugin=pc.type))
-            held.update(files)
+            held.update(f for f in files if not code.records.get(f, {}).get("node_names"))
     scripts: dict[str, list[str]] = {}
     for exe, paths in t.programs.items():
         scripts.setdefault(show(paths[0]), []).append(exe)
