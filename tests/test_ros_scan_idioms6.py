@@ -199,3 +199,19 @@ def test_field_paths_are_kept_per_contract_when_one_topic_carries_two_types(
     main(["ros", "check", "-w", str(ws), "--json", str(out)])
     missing = [f for f in json.loads(out.read_text())["findings"] if f["code"] == "ROS-FIELD-MISSING"]
     assert [(f["node"], f["topic"]) for f in missing] == [("Rumble", "set_feedback")]
+
+
+def test_a_node_in_a_plugin_library_is_still_a_node(tmp_path: Path) -> None:
+    ws = tmp_path / "idioms8"
+    shutil.copytree(WS, ws)
+    pkg = ws / "src" / "rig_layers"
+    (pkg / "src" / "probe_node.cpp").write_text(
+        '#include "rclcpp/rclcpp.hpp"\n#include "std_msgs/msg/bool.hpp"\n'
+        'class ProbeNode : public rclcpp::Node {\npublic:\n  ProbeNode() : Node("layer_probe")\n'
+        '  {\n    pub_ = create_publisher<std_msgs::msg::Bool>("probe", 1);\n  }\n'
+        '  rclcpp::Publisher<std_msgs::msg::Bool>::SharedPtr pub_;\n};\n')
+    cmake = pkg / "CMakeLists.txt"
+    cmake.write_text(cmake.read_text().replace("src/sonar_layer.cpp)", "src/sonar_layer.cpp src/probe_node.cpp)"))
+    g = scan([ws], [], base=tmp_path, standard=False).graph
+    assert set(g.nodes) == {"/mapper", "/layer_probe"}
+    assert [e.topic for e in g.nodes["/layer_probe"].publishes] == ["/probe"]
