@@ -6,7 +6,8 @@ The corpus (``tests/data/ros_corpus``) is the project's own small ROS 1
 published code (a Python 2 rospy script, a C++ class node with private
 handles and parameters, rclcpp components with an export macro registered
 through a CMake wrapper function and started as launch composable nodes,
-rclpy with parameters, every service and action API).  ``expected/*.json``
+rclpy with parameters, every service and action API, ROS 2 pluginlib plugins
+whose endpoints are the node whose parameter file loads them: ``idioms8``).  ``expected/*.json``
 holds, per entry launch file, the graph written by hand from reading the
 code: each node with its publishers, subscribers, service servers/clients and
 action servers/clients, resolved names and types, and (``[name, type,

@@ -19,7 +19,7 @@ from pathlib import Path
 import dataclasses
 from typing import Any, Callable
 
-from . import cross_package, names, nodelets
+from . import cross_package, names, nodelets, plugins
 from .executables import Targets
 from .launch import LaunchNode
 from .link import Linked, Linker
@@ -53,6 +53,12 @@ class Assembly:
                     for f, other in added.items():
                         used.setdefault(other, set()).add(f)
         cross_package.library_programs(self.progs, used, self.codes)
+        # ROS 2 pluginlib classes by type and lookup name, their programs, the instances loaded
+        self.plugin_classes = {k: pc for pk in sorted(targets) for pc in targets[pk].pluginlib
+                               for k in (pc.type, pc.lookup)}
+        self.plugin_progs = {p.plugin: p for pk in sorted(self.progs) for p in self.progs[pk] if p.plugin}
+        self.plugins_loaded: set[str] = set()
+        self._instances: dict[tuple[str, str], Program] = {}
 
     def linked(self, prog: Program) -> Linked:
         """``prog`` linked (once)."""
@@ -112,12 +118,61 @@ class Assembly:
         hit = exact or near
         return hit[0] if len(hit) == 1 else None
 
+    def plugin_endpoints(self, full: str, values: dict[str, tuple[Any, Src]]
+                         ) -> tuple[list[Endpoint], list[str], list[Note]]:
+        """``(endpoints, files, notes)`` of the plugins node ``full`` loads, found in its
+        parameter values ``values`` (:func:`plugins.instances`): each instance's program
+        linked with the instance's name (:mod:`plugins`)."""
+        found, notes = plugins.instances(values, full, self.plugin_classes)
+        eps: list[Endpoint] = []
+        files: list[str] = []
+        for inst, pc, at in found:
+            base = self.plugin_progs.get(pc.type)
+            if base is None:
+                notes.append(Note(at, f"plugin {pc.type} (instance {inst} of {full}) is exported, but no scanned C++ "
+                                      f"source defines the class: its endpoints are unknown"))
+                continue
+            prog = self._instances.get((pc.type, inst))
+            if prog is None:
+                prog = self._instances[(pc.type, inst)] = dataclasses.replace(base, files=list(base.files),
+                                                                              instance=inst)
+                if id(base) in self._views:
+                    self._views[id(prog)] = self._views[id(base)]
+            self.plugins_loaded.add(pc.type)
+            got = self.linked(prog)
+            notes.extend(got.notes)
+            eps += [e for e, _o in got.endpoints]
+            files += [f for f in got.files if f not in files]
+        return eps, files, notes
+
+    def unloaded_plugins(self) -> list[Note]:
+        """A located note for each endpoint of each plugin class no node was found to load
+        (:func:`plugins.unloaded_note`), and what the plugin descriptions could not say."""
+        out: list[Note] = []
+        for pk in sorted(self.targets):
+            root = self.pkgs[pk].root if pk in self.pkgs else None
+            for n in self.targets[pk].plugin_notes:
+                shown = self.codes[pk].show(root / n.src.file) if root is not None else n.src.file
+                out.append(dataclasses.replace(n, src=Src(shown, n.src.line, n.src.col)))
+        for t, prog in sorted(self.plugin_progs.items()):
+            if t in self.plugins_loaded:
+                continue
+            pc = self.plugin_classes[t]
+            lk = Linker(prog, self._views.get(id(prog), self.codes[prog.package]), self.known)
+            eps = {e.src: e for r in lk.recs.values() for e in list(r.get("endpoints", [])) + lk.members(r)
+                   if (e.unit is not None or e.func is not None) and lk.runs(e.unit, e.func)}
+            out += [plugins.unloaded_note(e, pc, self.codes[prog.package].show(pc.xml))
+                    for _s, e in sorted(eps.items(), key=lambda x: (x[0].file, x[0].line, x[0].col))]
+        return out
+
     def source_nodes(self, add_node: Callable[..., None], g: Graph) -> None:
         """Without launch files: every program's nodes (see the module docstring)."""
         for pkg in sorted(self.progs):
             named = {e.src for prog in self.progs[pkg] if self.linked(prog).nodes
                      for e, _o in self.linked(prog).endpoints}
             for prog in self.progs[pkg]:
+                if prog.plugin is not None:
+                    continue  # a pluginlib class: its endpoints are its loading node's (plugin_endpoints)
                 got = self.linked(prog)
                 if not got.nodes and prog.nodelet is not None and got.endpoints:
                     if all(e.src in named for e, _o in got.endpoints):

@@ -30,7 +30,9 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from .cmake import expand
+from .model import Note
 from .nodelets import plugin_classes
+from .plugins import PluginClass, described
 
 _ENTRY = re.compile(r"^\s*([A-Za-z0-9_.\-]+)\s*=\s*([A-Za-z0-9_.]+)\s*:\s*[A-Za-z0-9_]+\s*$")
 _EXE = {"add_executable", "ament_auto_add_executable", "cs_add_executable"}
@@ -47,7 +49,9 @@ class Targets:
     ``{class: target}`` (every registered component class, and every nodelet
     class its plugin description puts in a library of the package),
     ``programs`` ``{executable: [Python file]}`` (installed scripts, entry
-    points), ``nodelets`` ``{lookup name: (class, library)}`` (:mod:`nodelets`)."""
+    points), ``nodelets`` ``{lookup name: (class, library)}`` (:mod:`nodelets`),
+    ``pluginlib`` the ROS 2 plugin classes it exports and ``plugin_notes`` what
+    could not be read of their descriptions (:mod:`plugins`)."""
 
     executables: dict[str, list[Path]] = field(default_factory=dict)
     libraries: dict[str, list[Path]] = field(default_factory=dict)
@@ -56,6 +60,8 @@ class Targets:
     plugins: dict[str, str] = field(default_factory=dict)
     programs: dict[str, list[Path]] = field(default_factory=dict)
     nodelets: dict[str, tuple[str, str | None]] = field(default_factory=dict)
+    pluginlib: list[PluginClass] = field(default_factory=list)
+    plugin_notes: list[Note] = field(default_factory=list)
 
 
 MAX_GLOB_DIRS = 2000  # directories one file(GLOB) pattern may visit
@@ -107,6 +113,7 @@ def targets(root: Path, pkg: str) -> Targets:
     for exe, srcs in setup_py_executables(root).items():
         t.programs.setdefault(exe, srcs)
     t.nodelets = plugin_classes(root)
+    t.pluginlib, t.plugin_notes = described(root)
     for cls, lib in t.nodelets.values():
         if lib in t.libraries:
             t.plugins.setdefault(cls, lib)

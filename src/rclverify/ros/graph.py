@@ -256,6 +256,10 @@ def _scan(paths: Sequence[Path], launch: Sequence[Path], launch_args: dict[str, 
             from_files, said = pfiles.for_node(pkg, full)
             g.notes.extend(said)
             mine = {**from_files, **mine}
+            more, more_files, said = asm.plugin_endpoints(full, mine)  # pluginlib plugins it loads
+            g.notes.extend(said)
+            eps = eps + more
+            node.sources.extend(f for f in more_files if f not in node.sources)
         eps = expand_each(eps, lambda a: (mine.get(names.resolve(a, ns, full)) or (None,))[0], g.notes)
         for e in eps:
             written, pname, set_at = e.topic, None, None
@@ -296,6 +300,7 @@ def _scan(paths: Sequence[Path], launch: Sequence[Path], launch_args: dict[str, 
             asm.launch_node(ln, add_node, g)
     else:
         asm.source_nodes(add_node, g)
+    g.notes.extend(asm.unloaded_plugins())
     for shown, r in sorted(res.sources.items()):
         g.notes.extend(r["notes"])
     g.notes = list(dict.fromkeys(g.notes))  # a note given by several programs (a shared header) once

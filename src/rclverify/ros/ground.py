@@ -16,7 +16,9 @@ How a contract names ROS things (decisions written in docs/ros.md):
   so remapping at launch keeps the contract valid, and the resolved name
   is what other nodes must publish;
 * the fields a topic's variable is read from are the plan's
-  ``ros.fields[T]``, else the monitor mapping's ``fields`` list for ``T``
+  ``ros.fields[C.T]`` (contract ``C``'s own topic ``T``: one name may carry
+  different message types in different contracts), else ``ros.fields[T]``,
+  else the monitor mapping's ``fields`` list for ``T``
   (``backends/monitors/mapping.yaml``, docs/monitors.md), else the message's
   fields in order; paths may be nested (``pose.position.x``) and index
   arrays (``readings[0].value``, ``readings[].value``).
@@ -282,7 +284,9 @@ class Grounder:
         typ = cn.io_type(var)
         if typ is None:
             return
-        paths = list(self.fields.get(tp.field, []))
+        # the contract's own entry (Contract.topic) first: the same topic name may carry
+        # another message type in another contract (skeleton.py writes both forms)
+        paths = list(self.fields.get(f"{cn.name}.{tp.field}", self.fields.get(tp.field, [])))
         resolved: list[tuple[str, str, bool, Src]] = []
         for p in paths:
             rt, err, arr = field_path(self.table, ctype, p)

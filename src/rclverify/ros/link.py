@@ -33,7 +33,7 @@ import re
 from dataclasses import dataclass, field
 from typing import Any, Callable
 
-from . import emit, symbols
+from . import emit, plugins, symbols
 from .cpp_types import split_template
 from .model import Endpoint, Note, Src
 from .link_members import LinkMembers
@@ -120,6 +120,9 @@ class Linker(LinkMembers, Values):
                 self._edge(here, f"F:{ck}")
             if ck is not None:
                 self.sites.setdefault(ck, []).append((args, kwargs, fkey))
+        if prog.instance is not None:  # a plugin's methods its loader calls, given the instance's name
+            for k, got in plugins.entry_sites(self.fns, set(prog.units or ()), set(self.sites), prog.instance).items():
+                self.sites[k] = list(got)
         for u, info in self.units.items():
             for ty in list(info["members"].values()) + info["bases"]:
                 for ident in _IDENT.findall(ty):

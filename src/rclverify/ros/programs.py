@@ -35,8 +35,11 @@ class Program:
     component class registered without one, or a loose file), ``entry`` (the
     files whose units start it), ``files`` (every file it runs, shown paths),
     ``units`` (explicit entry units: a component's or nodelet's class),
-    ``aliases`` (other names of the executable: a script's stem) and
-    ``nodelet`` (for a nodelet class: its lookup name, :mod:`nodelets`)."""
+    ``aliases`` (other names of the executable: a script's stem),
+    ``nodelet`` (for a nodelet class: its lookup name, :mod:`nodelets`),
+    ``plugin`` (for a ROS 2 pluginlib class: its type, :mod:`plugins`; such a
+    program is no node, its endpoints are the loading node's) and
+    ``instance`` (the name a loader gives one instance of that plugin)."""
 
     package: str
     exe: str | None
@@ -45,6 +48,8 @@ class Program:
     units: set[str] | None = None
     aliases: list[str] = field(default_factory=list)
     nodelet: str | None = None  # a nodelet class's lookup name (``pkg/Type``), or its class when none is known
+    plugin: str | None = None  # a ROS 2 pluginlib class (``pkg::Plugin``)
+    instance: str | None = None  # the instance name a plugin's loader gives it
 
 
 def module_names(shown: str, pkg_shown: str) -> list[str]:
@@ -180,6 +185,16 @@ def programs(code: PackageCode, t: Targets) -> list[Program]:
             out.append(Program(code.name, comp_exe, lib_srcs, files, {_class_named(code, cls)},
                                nodelet=lookups.get(cls)))
         held.update(files)
+    for pc in t.pluginlib:  # ROS 2 pluginlib classes: run from their class, loaded by a node (plugins)
+        cls = _class_named(code, pc.type)
+        srcs = [show(p) for p in t.libraries.get(pc.library or "", [])] or sorted(
+            f for f, r in code.records.items() if r.get("lang") != "py" and cls in r.get("units", {}))
+        if srcs and any(cls in r.get("units", {}) for r in code.records.values() if r.get("lang") != "py"):
+            target = pc.library if pc.library in t.libraries else None
+            files = _closure(code, srcs + (linked(target, {target}) if target else []),
+                             listed if target else set())
+            out.append(Program(code.name, None, srcs, files, {cls}, plugin=pc.type))
+            held.update(f for f in files if not code.records.get(f, {}).get("node_names"))
     scripts: dict[str, list[str]] = {}
     for exe, paths in t.programs.items():
         scripts.setdefault(show(paths[0]), []).append(exe)

@@ -16,7 +16,9 @@ rules, lines 535-548), for a topic's message:
 * no base field: the empty type ``{}``.
 
 The fields chosen are written to the plan's ``ros.fields`` so the grounding
-check and the reader agree.  Every guarantee is ``TRUE``, a placeholder the
+check and the reader agree: keyed by the topic's field name when every
+contract using that name reads one message type, else by
+``Contract.topic`` for each contract (the types differ, so do the paths).  Every guarantee is ``TRUE``, a placeholder the
 health check reports (a tautology promises nothing) and the argument shows
 undeveloped (no evidence).
 """
@@ -227,6 +229,7 @@ def build_skeletons(res: ScanResult) -> tuple[list[_Node], dict[str, list[str]],
     context: dict[str, dict[str, str]] = {}
     nodes: list[_Node] = []
     fields: dict[str, list[str]] = {}
+    uses: dict[str, list[tuple[str, str | None, list[str]]]] = {}  # topic field -> (contract, type, paths)
     used_names: set[str] = set()
     for gname in sorted(g.nodes):
         gn: GraphNode = g.nodes[gname]
@@ -256,10 +259,16 @@ def build_skeletons(res: ScanResult) -> tuple[list[_Node], dict[str, list[str]],
                 (n.inputs if kind == "in" else n.outputs).append(f"{var} : {typ}")
                 n.topics.append(f"{short_type(e.msg_type) if e.msg_type else 'std_msgs/Empty'} {topic_name} "
                                 f"matches({kind}.{var})")
-                if paths:
-                    fields.setdefault(topic_name, paths)
+                uses.setdefault(topic_name, []).append((cname, e.msg_type, paths))
         _links(n, gn, table, taken, context, seen)
         nodes.append(n)
+    for topic_name, got in uses.items():
+        # one message type wherever the name is used: one entry by the topic's name; types
+        # that differ (JoyFeedback and JoyFeedbackArray on set_feedback): one per contract
+        shared = len({t for _c, t, _p in got}) == 1
+        for cname, _t, paths in got:
+            if paths:
+                fields.setdefault(topic_name if shared else f"{cname}.{topic_name}", paths)
     published = {e.topic for n in g.nodes.values() for e in n.publishes}
     external = sorted({e.topic for n in g.nodes.values() for e in n.subscribes} - published - LIBRARY_TOPICS)
     return nodes, fields, external, list(context.values())
