@@ -63,15 +63,16 @@ def _near(v: Any, named: Iterable[Fraction]) -> list[Fraction]:
     return sorted(cands, key=lambda c: (abs(c - x), c))
 
 
-def boundary_example(run: Any, inputs: Mapping[str, Any]) -> tuple[dict[str, Any], list[str]] | None:
+def boundary_example(run: Any, inputs: Mapping[str, Any],
+                     violation: type[BaseException]) -> tuple[dict[str, Any], list[str]] | None:
     """``(inputs, at_boundary)``: ``inputs`` (a failing example of ``run``, a
     :class:`.harness.GuaranteeRun` of a function) with each numeric input
     moved to a value the contract names or a short value where the example
     still fails (module docstring), and the inputs whose value the contract
     names; ``None`` when no input moved.  The failure of the returned
     example is left in ``run.last_failure``/``run.last_values`` (the
-    caller's example's when ``None``)."""
-    from .harness import Counts, _Violation
+    caller's example's when ``None``).  ``violation`` the exception
+    :meth:`.harness.GuaranteeRun.check_step` raises on a violation."""
     named = contract_numbers(run.node)
     best = dict(inputs)
     saved = (run.last_failure, run.last_values)
@@ -87,13 +88,13 @@ def boundary_example(run: Any, inputs: Mapping[str, Any]) -> tuple[dict[str, Any
                 continue
             tries += 1
             trial = {**best, name: new}
-            probe = dataclasses.replace(run, counts=Counts(), last_failure=None, last_values=None, unknown=set(),
+            probe = dataclasses.replace(run, counts=type(run.counts)(), last_failure=None, last_values=None, unknown=set(),
                                         stop_at_failure=True, first_double=None)
             if not probe.assumption_holds(trial):
                 continue
             try:
                 probe.check_step(run.impl, trial, None)
-            except _Violation:
+            except violation:
                 if _same_guarantee(probe.last_failure, saved[0]):
                     best, found = trial, (probe.last_failure, probe.last_values)
                     break

@@ -386,7 +386,7 @@ class GuaranteeRun:
         except _Violation:
             assert self.last_failure is not None
             from .readable import readable_failure  # the boundary value first, the implementation's line (issue 48)
-            moved = readable_failure(self)
+            moved = readable_failure(self, _Violation)
             unconfirmed = self._unconfirmed()
             if unconfirmed is not None:
                 return unconfirmed

@@ -9,20 +9,21 @@ from .boundary import boundary_example, boundary_first
 from .cause import cause_line
 
 
-def readable_failure(run: Any) -> bool:
+def readable_failure(run: Any, violation: type[BaseException]) -> bool:
     """Rewrite ``run.last_failure`` (a :class:`.harness.GuaranteeRun` that
     stopped at a failure): for a function, the example moved to the
     contract's boundary when it still fails there, its inputs at a named
     value first; for both a function and a class, ``cause``: the
     implementation's ``file:line`` the example takes last
     (:func:`.cause.cause_line`, the file as the plan names it).  Returns
-    whether the example moved.  Never raises for the implementation's
+    whether the example moved.  ``violation`` the exception ``check_step``
+    raises on a violation.  Never raises for the implementation's
     failures."""
     moved = False
     inputs = run.last_values[0] if run.last_values is not None else None
     example: Any = run.last_example
     if not run.stateful and inputs is not None:
-        got = boundary_example(run, inputs)
+        got = boundary_example(run, inputs, violation)
         if got is not None:
             example, at = got
             cex = run.last_failure
