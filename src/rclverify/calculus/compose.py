@@ -57,7 +57,10 @@ import dataclasses
 from dataclasses import dataclass
 from typing import Any, Mapping, Sequence
 
+import z3
+
 from ..logic.encode import Encoder
+from ..logic.nicemodel import nicer_model
 from .context import ConeContext, ContextResult
 from ..logic.query import DEFAULT_TIMEOUT_MS, prove, solver_session
 from ..rcl import ast
@@ -326,8 +329,12 @@ def compose_node(checked: Checked, model: SystemModel, node: str, *,
         if r.strategy:
             expl += f" Z3's default strategy gave up; answered with {r.strategy}."
         duration = round(first.duration_s + (r.duration_s if r is not first else 0.0), 4)
+        shown = r.model  # integers and short decimals where Z3 finds them, re-checked (logic/nicemodel.py)
+        if status == "failed" and r.model:
+            asked = hyps + (prod_assumptions if variant == VARIANT_WITH_ASSUMPTIONS else [])
+            shown = nicer_model([*asked, z3.Not(goal)], enc, r.model).model
         sc = SideCondition(f"{node}.sc{k}", node, rule, expr_to_rcl(c), _loc(c.loc), used_text,
-                           status, duration, r.smt2, r.model, expl, variant, tuple(links), status)
+                           status, duration, r.smt2, shown, expl, variant, tuple(links), status)
         if status != "discharged":  # context before blame (docs/calculus.md)
             if cone_ctx is None:
                 cone_ctx = ConeContext(checked, model, node, lambda m: environment_conjuncts(checked, model, m), facts)

@@ -53,6 +53,7 @@ from typing import Any, Callable, Mapping, Sequence
 import z3
 
 from ..logic.encode import Encoder
+from ..logic.nicemodel import nicer_model
 from ..logic.query import query_solver, render_model, satisfiable, smt2_script, smtlib_benchmark
 from ..rcl import ast
 from ..rcl.printer import expr_to_rcl
@@ -383,6 +384,9 @@ class ConeContext:
                     shown = render_model(m, self.enc)
                     violated = tuple(n for n, d in zip(self.flag_nodes, self.definitions)
                                      if z3.is_false(m.eval(d.arg(0), model_completion=True)))
+                # short values where Z3 finds them, the same nodes' assumptions violated, re-checked (issue 48)
+                same = [d.arg(0) == z3.BoolVal(n not in violated, d.ctx) for n, d in zip(self.flag_nodes, self.definitions)]
+                shown = nicer_model([*background, *tracked, *literals, *same], self.enc, shown).model
                 return ContextResult("refuted", script(), dt, model=shown, violated=violated)
         if core is not None:
             return self._proved(core, script, dt, consistency=consistency)

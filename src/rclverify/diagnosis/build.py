@@ -51,7 +51,7 @@ CACHE = "artifacts/cache/diagnosis.pickle"
 LOCK = "artifacts/diagnosis.lock"
 #: Most entries the cache keeps.
 KEEP = 200
-_META_KEYS = {"conjunct", "facts", "guarantee", "reason", "replay", "source"}
+_META_KEYS = {"conjunct", "facts", "guarantee", "reason", "replay", "source", "cause", "boundary"}
 
 
 class _Cache:
@@ -323,8 +323,10 @@ def _evidence(ws: Any, report: Mapping[str, Any], e: Mapping[str, Any], o: Mappi
     if backend == "property_tests" and isinstance(e.get("counterexample"), dict):
         cex = {kk: v for kk, v in e["counterexample"].items() if kk not in _META_KEYS}
         impl = _obligation_record(ws, node, e["obligation"]).get("data", {}).get("implementation", "the implementation")
+        cause = e["counterexample"].get("cause")  # the implementation line the example takes (issue 48)
         sentence = (f"Hypothesis found inputs on which {impl} "
-                    f"violates {where}; replay: `{e['counterexample'].get('replay', '')}`.")
+                    f"violates {where}" + (f"; the example's last line run in the implementation is {cause}"
+                                           if cause else "") + f"; replay: `{e['counterexample'].get('replay', '')}`.")
         return _record(e["obligation"], "property-test", node, e["status"], sentence,
                        culprits=[{"what": where, "source": src, "text": text}],
                        counterexample=counterexample_table(cex, node), guarantee=k)
@@ -339,6 +341,7 @@ def _evidence(ws: Any, report: Mapping[str, Any], e: Mapping[str, Any], o: Mappi
 
 def _hoare(ws: Any, report: Mapping[str, Any], e: Mapping[str, Any], o: Mapping[str, Any], cache: _Cache) -> dict[str, Any]:
     from ..backends.hoare import lang
+    from ..backends.hoare.culprit_lines import compared_constants
     node, k = o["node"], o["guarantee"]
     rec = _obligation_record(ws, node, e["obligation"])
     data = rec.get("data", {})
@@ -347,8 +350,10 @@ def _hoare(ws: Any, report: Mapping[str, Any], e: Mapping[str, Any], o: Mapping[
     prog_consts: list[str] = []
     try:
         prog = lang.parse_program(ws.path(program).read_text(encoding="utf-8"), program)
-        prog_consts = [f"{program}:{n.loc.line}: {n.text}" for n in rep._numbers(prog.body)]
-        prog_texts = [n.text for n in rep._numbers(prog.body)]
+        # the thresholds its conditions compare with, in line order: no assigned constant's line (issue 48)
+        compared = compared_constants(prog)
+        prog_consts = [f"{program}:{n.loc.line}: {n.text}" for n in compared]
+        prog_texts = list(dict.fromkeys(n.text for n in compared))
     except Exception:  # noqa: BLE001 - a program that no longer parses: no constants named
         prog_texts = []
     # the guarantee's thresholds the program does not use (0, a sign bound, is no threshold)

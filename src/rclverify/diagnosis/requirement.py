@@ -137,7 +137,7 @@ def _temporal_record(q: Mapping[str, Any], check: Mapping[str, Any],
     for a temporal statement (docs/diagnosis.md: only what Z3 showed is
     named)."""
     t = check["temporal"]
-    trace = t.get("trace") or []
+    trace = t.get("shown") or t.get("trace") or []  # cut to what matters (report/cex_cone.py)
     loop = t.get("loop")
     shown = trace[loop] if loop is not None and 0 <= loop < len(trace) else (trace[-1] if trace else {"nodes": []})
     table = [{"node": r["node"], "variable": v, "value": x, "table": None}

@@ -422,24 +422,17 @@ def build_report(ws: Workspace) -> dict[str, Any]:
 
 def involved_model(sc: Mapping[str, Any]) -> Mapping[str, Any]:
     """``sc`` (a side-condition row of the calculus) with its Z3 ``model``
-    (``{"Node.in.x": value}``) cut to the nodes its conjunct involves: the
-    consumer and the producers of its ``links`` (``"P.out.v -> C.in.w
-    (...)"``).  The query holds every producer of the consumer (the drone's
-    Geofence with the battery mismatch), whose values say nothing about
-    this conjunct.  Unchanged without a model or links, and for a side
-    condition decided in context (its ``context`` record), whose
-    counterexample is that of the whole upstream cone."""
-    model = sc.get("model")
-    nodes = {str(sc.get("node", ""))} | {str(l).split(".", 1)[0] for l in sc.get("links") or ()}
-    if not isinstance(model, dict) or not sc.get("links") or sc.get("context"):
-        return sc  # decided in context: the calculus kept the cones of the producers read (docs/calculus.md)
-    kept = {k: v for k, v in model.items() if str(k).split(".", 1)[0] in nodes}
-    return {**sc, "model": kept} if kept and len(kept) < len(model) else sc
+    cut to the nodes its conjunct involves (:func:`.cex_cone.side_condition_view`:
+    the consumer, the producers of its links and, decided in context, the
+    nodes whose assumption the counterexample violates)."""
+    from .cex_cone import side_condition_view
+    return side_condition_view(sc)
 
 
 #: The fields of a requirement's check record (requirements/check.py) the report carries.
 _CHECK_FIELDS = ("origin", "source", "formal", "assuming", "cone", "used", "traced_not_needed", "consistency",
-                 "inconsistent_core", "vacuity", "vacuity_core", "counterexample", "failed_to_prevent", "reason", "smt2", "explanation",
+                 "inconsistent_core", "vacuity", "vacuity_core", "counterexample", "outside_assumptions",
+                 "counterexample_note", "failed_to_prevent", "reason", "smt2", "explanation",
                  "solvers",  # the second solver's agreement (crosscheck/apply.py)
                  "temporal",  # a temporal requirement's verdict, k, bound and trace (requirements/temporal_check.py)
                  "traces",  # its recorded runs' verdicts (backends/monitors/temporal_evidence.py)
@@ -471,7 +464,8 @@ def requirement_check(record: Mapping[str, Any] | None, traced_status: str, g_st
     ``note`` and the check's details (:mod:`rclverify.requirements.rollup`)."""
     from ..requirements.rollup import roll_up
     verdict, status, note = roll_up(record, g_status, sc_status, traced_status)
-    details = {k: (record or {}).get(k) for k in _CHECK_FIELDS}
+    from .cex_cone import with_trace_view  # a temporal trace cut to what matters (issue 48)
+    details = dict(with_trace_view({k: (record or {}).get(k) for k in _CHECK_FIELDS}))
     return {"status": status, "verdict": verdict, "note": note, "check": details}
 
 

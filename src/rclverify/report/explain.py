@@ -62,6 +62,8 @@ def requirement_lines(r: Mapping[str, Any]) -> list[str]:
             for p in c.get("vacuity_core") or []]
     for row in c.get("counterexample") or []:
         out.append(f"    counterexample {row['node']}: " + ", ".join(f"{k} = {v}" for k, v in row["values"].items()))
+    if c.get("counterexample_note"):
+        out.append(f"    {c['counterexample_note']}")
     out += [f"    did not prevent it: {p['label']}: {p['text']}  ({p['source']})" for p in c.get("failed_to_prevent") or []]
     return out
 

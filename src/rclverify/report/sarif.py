@@ -212,8 +212,18 @@ def _obligation_results(report: Mapping[str, Any]) -> list[dict[str, Any]]:
             props["counterexample"] = dict(ev["counterexample"])
         if ev is not None and ev.get("strength"):  # the evidence's kind (docs/confidence.md)
             props["strength"] = dict(ev["strength"])
-        out.append(_result(rule, _level("obligation", str(o["status"])), " ".join(words), str(o["source"]),
-                           f"obligation:{o['id']}", props))
+        res = _result(rule, _level("obligation", str(o["status"])), " ".join(words), str(o["source"]),
+                      f"obligation:{o['id']}", props)
+        cause = (ev.get("counterexample") or {}).get("cause") if ev is not None else None
+        if isinstance(cause, str) and _location(f"{cause}:0"):  # at the implementation's line (issue 48)
+            rel = _location(str(o["source"]))
+            for loc in rel:
+                loc.update(id=0, message={"text": "the guarantee the example violates"})
+            res["locations"] = _location(f"{cause}:0")
+            res["locations"][0]["message"] = {"text": "the implementation's last line the failing example runs"}
+            if rel:
+                res["relatedLocations"] = rel
+        out.append(res)
     return out
 
 

@@ -23,7 +23,7 @@ def temporal_words(t: Mapping[str, Any]) -> str:
     words = [head + "."]
     if t.get("trace"):
         steps = []
-        for st in t["trace"]:
+        for st in t.get("shown") or t["trace"]:  # cut to what matters (report/cex_cone.py)
             rows = ", ".join(f"{row['node']} (" + ", ".join(f"{k} = {v}" for k, v in row["values"].items()) + ")"
                              for row in st["nodes"])
             steps.append(f"step {st['step']}: {rows}")

@@ -268,8 +268,10 @@ def check_requirement(req: Requirement, checked: Checked, model: SystemModel, pl
         mentioned = {enc.symbol_name(n, p, v) for f in (formal,) for n, p, v in f.mentions}
         hit = [lbl for lbl, syms in g_symbols.items() if syms & mentioned]
         first = [l for l in hit if l in traced] or hit
-        out.update(verdict="refuted", counterexample=_counterexample(r.model or {}, cone, checked, enc),
-                   failed_to_prevent=[by_label[l] for l in first])
+        from .readable import readable_counterexample  # within the assumptions, short values (issue 48)
+        shown, note = readable_counterexample(labelled, r.model or {}, cone, checked, model, enc)
+        out.update(verdict="refuted", counterexample=_counterexample(shown, cone, checked, enc),
+                   failed_to_prevent=[by_label[l] for l in first], **note)
         return out
     out.update(verdict="inconclusive", reason=r.reason or "unknown")
     return out

@@ -215,6 +215,8 @@ class GuaranteeRun:
     unknown: set[str] = field(default_factory=set)
     #: the first check that held only in double arithmetic: (conjunct text, rendered values)
     first_double: tuple[str, str] | None = None
+    #: the example of the last body run (a function's inputs, a class's steps): replayed for the cause line
+    last_example: Any = None
     _used_facts: tuple[ast.Expr, ...] | None = field(default=None, repr=False)
 
     @property
@@ -327,6 +329,7 @@ class GuaranteeRun:
 
     def body(self, example: Any) -> None:
         self.counts.valid += 1
+        self.last_example = example
         if self.stateful:
             machine = self.impl()
             for k, inputs in enumerate(example, 1):
@@ -380,12 +383,17 @@ class GuaranteeRun:
         try:
             with _no_local_constants():
                 test()
-        except _Violation as exc:
+        except _Violation:
             assert self.last_failure is not None
+            from .readable import readable_failure  # the boundary value first, the implementation's line (issue 48)
+            moved = readable_failure(self, _Violation)
             unconfirmed = self._unconfirmed()
             if unconfirmed is not None:
                 return unconfirmed
-            return Outcome("failed", f"{exc} on the shrunk example {_example_text(self.last_failure)}",
+            cause = self.last_failure.get("cause")
+            return Outcome("failed", f"{self.last_failure['reason']} on the {'example' if moved else 'shrunk example'} "
+                           f"{_example_text(self.last_failure)}" + (f" (the implementation's last line run: {cause})"
+                                                                    if cause else ""),
                            self.counts, self.last_failure, sorted(self.unknown))
         except (FailedHealthCheck, Unsatisfiable) as exc:
             kind = "filter_too_much" if isinstance(exc, FailedHealthCheck) else "unsatisfiable"
