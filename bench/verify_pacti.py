@@ -8,7 +8,8 @@ holds in context (``x_i <= 50 + i``) and none locally; the requirement
 400):
 
 * **rclverify verify** in a fresh workspace, in a child process: CPU
-  seconds (user + system of it and its children), the side conditions
+  seconds (user + system of it and its children), of which ``cvc5 s`` the
+  second solver's own (the seconds cvc5 took per item, issue 50), the side conditions
   discharged locally / in context / otherwise, those in context proved from
   the producers' cone summaries (calculus/summary.py), and SYS's verdict;
 * **calculus only**: every node's composition in this process, with the
@@ -73,8 +74,13 @@ def verify(root: Path, src: Path) -> dict[str, Any]:
     context = sum(1 for s in scs if s.get("verdict") == "discharged in context")
     summaries = sum(1 for s in scs if (s.get("context") or {}).get("summaries"))
     sys_req = next((r for r in rep["requirements"] if r["id"] == "SYS"), {})
+    try:  # the second solver's share: cvc5's own seconds per item (issue 50's stage)
+        cross = json.loads((root / "artifacts" / "crosscheck" / "index.json").read_text(encoding="utf-8"))
+        cvc5 = sum(float((r.get("cvc5") or {}).get("duration_s") or 0) for r in cross.get("items", []))
+    except (OSError, ValueError):
+        cvc5 = 0.0
     return {"cpu": probe["cpu"], "rc": probe["rc"], "local": local, "context": context, "other": len(scs) - local - context,
-            "summaries": summaries, "SYS": str(sys_req.get("verdict") or sys_req.get("status"))}
+            "summaries": summaries, "SYS": str(sys_req.get("verdict") or sys_req.get("status")), "cvc5": cvc5}
 
 
 def calculus(root: Path, summaries: bool) -> float:
@@ -104,7 +110,7 @@ def main(argv: list[str] | None = None) -> int:
     pc = _pacti()
     sizes = [5] if args.smoke else [int(x) for x in args.sizes.split(",")]
     print(f"CPU seconds, medians of {args.repeat}; {os.cpu_count()} CPU(s); chain with every x_i <= {BOUND}")
-    head = f"{'N':>5} {'verify s':>9} {'local':>5} {'ctx':>5} {'summ':>5} {'SYS':>8}"
+    head = f"{'N':>5} {'verify s':>9} {'cvc5 s':>7} {'local':>5} {'ctx':>5} {'summ':>5} {'SYS':>8}"
     head += f" {'old s':>8}" if args.src else ""
     head += f" {'calc s':>7}" + (f" {'calc full':>9}" if args.full else "") + f" {'pacti s':>8} {'ratio':>6}"
     print(head)
@@ -129,7 +135,7 @@ def main(argv: list[str] | None = None) -> int:
                "old": statistics.median(old) if old else None, "full": statistics.median(full) if full else None,
                "pacti": statistics.median(pac) if pac else None}
         rows.append(row)
-        line = f"{n:5} {row['verify']:9.2f} {r['local']:5} {r['context']:5} {r['summaries']:5} {r['SYS'].split(',')[0]:>8}"
+        line = f"{n:5} {row['verify']:9.2f} {r['cvc5']:7.2f} {r['local']:5} {r['context']:5} {r['summaries']:5} {r['SYS'].split(',')[0]:>8}"
         line += f" {row['old']:8.2f}" if args.src else ""
         line += f" {row['calc']:7.2f}" + (f" {row['full']:9.2f}" if args.full else "")
         line += (f" {row['pacti']:8.2f} {row['verify'] / row['pacti']:6.2f}" if row["pacti"] else "  (Pacti not installed)")
