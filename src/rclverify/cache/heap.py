@@ -29,11 +29,10 @@ One thing here is about C's heap, not Python's: :func:`keep_freed_memory`
 (called with :func:`freeze_for_run` and :func:`freeze_inherited`).  Every
 node stage starts a fresh Z3 context (logic/world.py), and a context's
 tables are blocks large enough for glibc's ``malloc`` to map them with
-``mmap`` and hand them back with ``munmap`` (its threshold adapts, but not
-in a process whose heap a doit run has grown), so each context paid page
-faults for the memory it touched: 8 ms instead of 0.7 ms, and a quarter
-of ``rclverify verify``'s CPU seconds on a 200-node chain (issue 51;
-docs/scale.md).
+``mmap`` and hand them back with ``munmap`` (measured in a doit run of a
+200-node chain, not in a small process), so each context paid page faults
+for the memory it touched: 8 ms instead of 0.7 ms, and a quarter of
+``rclverify verify``'s CPU seconds there (issue 51; docs/scale.md).
 """
 from __future__ import annotations
 

@@ -74,7 +74,8 @@ class Summary:
                  the encoder's symbol names of the values of ``I(m)``);
     ``used``     ``((label, RCL text, order), ...)``: the cone's premises
                  the summary rests on (``order``: (node index, item index));
-    ``script``   the query that shows it implied (unsat), for the record."""
+    ``script``   the query that showed it implied (unsat); kept in memory
+                 (tests), not written."""
 
     node: str
     formula: str
@@ -125,11 +126,14 @@ def _naturals(checked: Checked, m: str, symbol: Mapping[tuple[str, str], str]) -
 def summary_of(checked: Checked, model: SystemModel, node: str,
                environment: Callable[[str], Sequence[ast.Expr]],
                facts: Mapping[str, Sequence[ast.Expr]] | None = None) -> Summary | None:
-    """The :class:`Summary` of ``node``'s upstream cone, or ``None`` when it
-    has none (module docstring).  ``environment(m)``: the environment
-    conjuncts of ``m``'s assumption; ``facts``: the plan's facts per node.
-    Computed producers first, each once per (checked, model, facts) and
-    process.  Never raises on solver trouble (``None``)."""
+    """The :class:`Summary` of ``node``'s upstream cone (rule R1's derived
+    property made exact, paper lines 564-590; module docstring), or
+    ``None`` when it has none.  ``checked``/``model``: the system;
+    ``environment(m)``: the environment conjuncts of ``m``'s assumption
+    (:func:`.compose.environment_conjuncts`); ``facts``: the plan's facts
+    per node (RCL formulas over its I/O).  Computed producers first, each
+    once per (checked, model, facts) and process.  Never raises on solver
+    trouble (``None``); a ``KeyError`` for a node not in ``model``."""
     facts = facts or {}
     memo = _memo(checked, model, facts)
     if node in memo:
@@ -275,11 +279,15 @@ def _implied(ctx: z3.Context, decls: str, premises: Sequence[tuple[str, str]], a
 def decide(checked: Checked, model: SystemModel, node: str, conjunct: ast.Expr,
            environment: Callable[[str], Sequence[ast.Expr]],
            facts: Mapping[str, Sequence[ast.Expr]] | None, comment: str, timeout_ms: int) -> ContextResult | None:
-    """The in-context verdict of ``conjunct`` (of ``node``'s assumption)
-    from the summaries of ``node``'s maximal producers and ``node``'s own
-    environment conjuncts and facts: a ``proved`` :class:`.ContextResult`
-    (``used`` the cone's premises it rests on, ``summaries`` the producers
-    whose summaries it read), or ``None``: decide over the full cone
+    """The in-context verdict of ``conjunct`` (an internal conjunct of
+    ``node``'s assumption, the premise of R1-R3, paper lines 564-690) from
+    the summaries of ``node``'s maximal producers and ``node``'s own
+    environment conjuncts and facts (arguments as :func:`summary_of`;
+    ``comment`` heads the script, ``timeout_ms`` budgets each check).
+    Returns a ``proved`` :class:`.ContextResult` (``used``: ``"label: RCL
+    text"`` of the cone's premises it rests on, in cone order;
+    ``summaries``: the producers whose summaries it read; ``smt2``: the
+    query over the summaries), or ``None``: decide over the whole cone
     (module docstring).  Never raises on solver trouble."""
     facts = facts or {}
     if model.loop_of(node):
@@ -343,8 +351,8 @@ def decide(checked: Checked, model: SystemModel, node: str, conjunct: ast.Expr,
     nodes = tuple(dict.fromkeys(node_of[u[0]] for u in used if " guarantee " in u[0]))
     joins = _multi_path(model, node, model.upstream(node), set()) if len(producers) > 1 or nodes else set()
     header = "".join(f"; {line}\n" for line in comment.splitlines())
-    script = (header + f"; premises: the summaries of the cones of {', '.join(top)} (each implied by its cone: "
-              "see its summary script) and the consumer's environment assumptions and facts\n"
+    script = (header + f"; premises: the summaries of the cones of {', '.join(top)} (each proved implied by its cone "
+              "by Z3 when made: calculus/summary.py) and the consumer's environment assumptions and facts\n"
               + decls + "".join(f"; {label}\n(assert {b})\n" for label, b in premises)
               + "".join(f"(assert {a})\n" for a in axioms) + f"; {NEGATED}\n(assert (not {goal}))\n(check-sat)\n")
     return ContextResult("proved", script, dt, used=tuple(f"{u[0]}: {u[1]}" for u in used), used_nodes=nodes,
