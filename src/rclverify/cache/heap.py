@@ -24,6 +24,15 @@ objects that cannot be garbage yet:
 * :func:`freeze_at_exit` -- nothing is collected while the process exits.
 
 Objects made after a freeze are collected as usual.
+
+One thing here is about C's heap, not Python's: :func:`keep_freed_memory`
+(called with :func:`freeze_for_run` and :func:`freeze_inherited`).  Every
+node stage starts a fresh Z3 context (logic/world.py), and a context's
+tables are blocks large enough for glibc's ``malloc`` to map them with
+``mmap`` and hand them back with ``munmap`` (measured in a doit run of a
+200-node chain, not in a small process), so each context paid page faults
+for the memory it touched: 8 ms instead of 0.7 ms, and a quarter of
+``rclverify verify``'s CPU seconds there (issue 51; docs/scale.md).
 """
 from __future__ import annotations
 
@@ -53,9 +62,42 @@ def no_collection() -> Iterator[None]:
 
 def freeze_for_run() -> None:
     """Freeze the heap of a process about to run doit's tasks (the loaded
-    workspace and the task definitions), until :func:`release_after_run`."""
+    workspace and the task definitions), until :func:`release_after_run`;
+    and :func:`keep_freed_memory`."""
     gc.freeze()
     _RUN[:] = [True]
+    keep_freed_memory()
+
+
+#: glibc's ``mallopt`` parameters (malloc.h) and the values set: blocks up to
+#: 32 MiB (glibc's largest mmap threshold on 64 bits) come from the heap, and
+#: up to 256 MiB freed at its top stay there for the next allocation.
+_M_TRIM_THRESHOLD, _M_MMAP_THRESHOLD = -1, -3
+_TRIM, _MMAP = 256 << 20, 32 << 20
+_MALLOPT: list[bool] = []
+
+
+def keep_freed_memory() -> bool:
+    """Tell glibc's ``malloc`` to keep memory freed by this process for
+    its next allocations instead of returning it to the system at once
+    (module docstring), once per process.  Returns whether it was set;
+    ``False`` (nothing done) on a C library without ``mallopt`` (macOS,
+    musl) or when it refuses the values: only the speed differs."""
+    if _MALLOPT:
+        return _MALLOPT[0]
+    ok = False
+    try:
+        import ctypes
+        import ctypes.util
+        name = ctypes.util.find_library("c")
+        libc = ctypes.CDLL(name) if name else None
+        mallopt = getattr(libc, "mallopt", None)
+        if mallopt is not None and "glibc" in (os.confstr("CS_GNU_LIBC_VERSION") or "").lower():
+            ok = bool(mallopt(_M_MMAP_THRESHOLD, _MMAP)) and bool(mallopt(_M_TRIM_THRESHOLD, _TRIM))
+    except (OSError, ValueError, AttributeError):
+        ok = False
+    _MALLOPT[:] = [ok]
+    return ok
 
 
 def release_after_run() -> None:
@@ -75,6 +117,7 @@ def freeze_inherited() -> None:
         return
     gc.freeze()
     _WORKER[:] = [pid]
+    keep_freed_memory()  # inherited from the parent with fork; set again where it was not
 
 
 def freeze_at_exit() -> None:

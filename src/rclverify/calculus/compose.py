@@ -62,6 +62,7 @@ import z3
 from ..logic.encode import Encoder
 from ..logic.nicemodel import nicer_model
 from .context import ConeContext, ContextResult
+from .summary import decide as decide_by_summaries
 from ..logic.query import DEFAULT_TIMEOUT_MS, prove, solver_session
 from ..rcl import ast
 from ..rcl.printer import expr_to_rcl
@@ -259,15 +260,19 @@ def environment_conjuncts(checked: Checked, model: SystemModel, node: str) -> tu
 @solver_session()
 def compose_node(checked: Checked, model: SystemModel, node: str, *,
                  facts: Mapping[str, Sequence[ast.Expr]] | None = None,
-                 timeout_ms: int = DEFAULT_TIMEOUT_MS) -> NodeComposition:
+                 timeout_ms: int = DEFAULT_TIMEOUT_MS, summaries: bool = True) -> NodeComposition:
     """Apply the calculus to ``node``: discharge its side conditions with Z3.
 
     ``facts`` are the plan's environment facts per node (RCL formulas over
     that node's inputs and outputs); only a side condition that fails
     locally reads them, with the rest of its upstream cone (:mod:`.context`).
     Returns a :class:`NodeComposition`.  Never raises on solver trouble
-    (an unknown answer is an ``inconclusive`` side condition).  The side
-    conditions share one solver session
+    (an unknown answer is an ``inconclusive`` side condition).  A side
+    condition decided in context is first tried from the summaries of the
+    producers' cones (:mod:`.summary`), then, unless that proves it, over
+    the whole cone; ``summaries=False`` reads the whole cone always (the
+    oracle test: the verdicts are the same).  The side conditions share one
+    solver session
     (:func:`~rclverify.logic.query.solver_session`), asked in a fixed order.
     """
     cn = checked.nodes[node]
@@ -336,14 +341,21 @@ def compose_node(checked: Checked, model: SystemModel, node: str, *,
         sc = SideCondition(f"{node}.sc{k}", node, rule, expr_to_rcl(c), _loc(c.loc), used_text,
                            status, duration, r.smt2, shown, expl, variant, tuple(links), status)
         if status != "discharged":  # context before blame (docs/calculus.md)
-            if cone_ctx is None:
-                cone_ctx = ConeContext(checked, model, node, lambda m: environment_conjuncts(checked, model, m), facts)
-            cr = cone_ctx.decide(c, head + "\nvariant: " + VARIANT_IN_CONTEXT + " (the upstream cone; "
-                                 "each guarantee under its node's assumption)", timeout_ms)
-            read_from = {x.split(".", 1)[0] for x in links}
-            keep: set[str] = ({node}.union(*(model.upstream(p) for p in read_from)) if read_from
-                              else set(cone_ctx.cone))
-            sc = in_context(sc, cr, cone_ctx, who, keep)
+            env_of = lambda m: environment_conjuncts(checked, model, m)  # noqa: E731
+            comment = head + "\nvariant: " + VARIANT_IN_CONTEXT
+            cr = (decide_by_summaries(checked, model, node, c, env_of, facts, comment + " (the summaries of the "
+                                      "producers' cones)", timeout_ms) if summaries else None)
+            if cr is not None:  # proved from the producers' summaries: the cone is not read (calculus/summary.py)
+                sc = in_context(sc, cr, ConeView(tuple(model.upstream(node)), ()), who)
+            else:
+                if cone_ctx is None:
+                    cone_ctx = ConeContext(checked, model, node, env_of, facts)
+                cr = cone_ctx.decide(c, comment + " (the upstream cone; each guarantee under its node's assumption)",
+                                     timeout_ms)
+                read_from = {x.split(".", 1)[0] for x in links}
+                keep: set[str] = ({node}.union(*(model.upstream(p) for p in read_from)) if read_from
+                                  else set(cone_ctx.cone))
+                sc = in_context(sc, cr, cone_ctx, who, keep)
         if sc.status != "discharged":  # neither locally nor in context: a power of ten between the ranges?
             scale = tuple(probable_mismatches(checked, model.links_into(node), enc, node, c))
             if scale:
@@ -380,7 +392,16 @@ def compose_node(checked: Checked, model: SystemModel, node: str, *,
                            cone_env, g_text)
 
 
-def in_context(sc: SideCondition, cr: ContextResult, ctx: ConeContext, who: str,
+@dataclass(frozen=True)
+class ConeView:
+    """What :func:`in_context` reads of a cone: its nodes and the links its
+    loops are opened at (a :class:`.ConeContext` has both)."""
+
+    cone: tuple[str, ...]
+    cut: tuple[str, ...]
+
+
+def in_context(sc: SideCondition, cr: ContextResult, ctx: ConeContext | ConeView, who: str,
                keep: set[str] | None = None) -> SideCondition:
     """``sc`` (decided locally, not discharged) with the verdict of its
     in-context check ``cr`` over the cone ``ctx`` (:mod:`.context`): the
@@ -395,7 +416,7 @@ def in_context(sc: SideCondition, cr: ContextResult, ctx: ConeContext, who: str,
     record: dict[str, Any] = {"cone": size, "used": [u.split(":", 1)[0] for u in cr.used],
                               "used_nodes": list(cr.used_nodes),
                               "opened": list(ctx.cut), "violated": list(cr.violated), "joins": list(cr.joins),
-                              "local": local}
+                              "local": local, **({"summaries": list(cr.summaries)} if cr.summaries else {})}
     opened = ("; the loop of its cone is opened at " + ", ".join(ctx.cut) + " (rule R4, paper lines 717-768: "
               "the value read there is taken as arbitrary, so no guarantee is used to discharge its own premise)"
               if ctx.cut else "")
@@ -412,6 +433,10 @@ def in_context(sc: SideCondition, cr: ContextResult, ctx: ConeContext, who: str,
                                               if len(labels) > NAMED else "") if labels else "no premise"
         expl = (f"Discharged in context. {local_words}, but {cone_words} does: Z3 proved it from {named}. Sound for "
                 f"the composed system as long as the environment assumptions of the cone hold.")
+        if cr.summaries:
+            expl += (f" The proof read the summaries of the cones of {', '.join(cr.summaries)} (what each cone "
+                     "establishes about the values read outside it, built producer by producer and each proved "
+                     "implied by its cone) instead of the cone itself; the premises named are those they rest on.")
         if cr.joins:
             expl += (f" The proof reads {', '.join(cr.joins)} along more than one path; like the requirement checks "
                      "it rests on R3's simplifying assumption that the outputs a join reads persist and are available "

@@ -81,7 +81,9 @@ class ContextResult:
     ``joins``    nodes of the cone read along more than one path that the
                  proof used (rests on R3's simplifying assumption, line 660);
     ``smt2``, ``duration_s`` (seconds), ``reason`` (Z3's, inconclusive),
-    ``strategy`` (the retry that answered, if any).
+    ``strategy`` (the retry that answered, if any);
+    ``summaries`` the producers whose cone summaries the proof read instead
+    of their cones (:mod:`.summary`; empty: the whole cone was read).
     """
 
     status: str
@@ -94,6 +96,7 @@ class ContextResult:
     joins: tuple[str, ...] = ()
     reason: str = ""
     strategy: str = ""
+    summaries: tuple[str, ...] = ()
 
 
 def opened_links(model: SystemModel, node: str) -> list[Link]:

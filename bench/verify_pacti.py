@@ -1,0 +1,150 @@
+"""`rclverify verify` of a chain beside Pacti composing the same chain (issue 51).
+
+The chain (tests/_chain.py) with every assumption widened to ``0 <= x_i <=
+1000``: node ``N<i>`` guarantees ``x_{i+1} <= x_i + 1`` and ``0 <=
+x_{i+1}``, the environment gives ``0 <= x0 <= 50``, so every assumption
+holds in context (``x_i <= 50 + i``) and none locally; the requirement
+``SYS: N<n-1>.out.x<n> <= 50 + n`` holds.  For each N (default 100, 200,
+400):
+
+* **rclverify verify** in a fresh workspace, in a child process: CPU
+  seconds (user + system of it and its children), of which ``cvc5 s`` the
+  second solver's own (the seconds cvc5 took per item, issue 50), the side conditions
+  discharged locally / in context / otherwise, those in context proved from
+  the producers' cone summaries (calculus/summary.py), and SYS's verdict;
+* **calculus only**: every node's composition in this process, with the
+  summaries and (``--full``) reading the whole cone, CPU seconds;
+* **Pacti** (the optional ``bench`` extra): the environment's contract
+  composed with ``N0``, ``N1``, ... (bench/compose_pacti.py), CPU seconds,
+  and whether it composes the whole chain (the same verdict).
+
+Then the growth per doubling of each column.  ``--src OLD_SRC`` runs
+``rclverify verify`` from another source tree as well (a ``git worktree``
+of the old code), ``--repeat K`` takes the median of K runs.
+
+    python bench/verify_pacti.py                         # N = 100, 200, 400
+    python bench/verify_pacti.py --sizes 100,200 --full  # and the calculus reading whole cones
+    python bench/verify_pacti.py --smoke                 # N = 5: seconds (CI)
+
+Figures are printed, not asserted; the exit status is 1 only when a
+verdict differs from the expected one (a side condition not discharged,
+SYS not proved, Pacti not composing the chain).
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+from typing import Any
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT / "src"))
+sys.path.insert(0, str(ROOT / "tests"))
+sys.path.insert(0, str(ROOT / "bench"))
+
+from _chain import write_chain  # noqa: E402
+
+BOUND = 1000
+#: The child process: runs its arguments and prints their CPU seconds (with their children).
+PROBE = ("import json, resource, subprocess, sys\n"
+         "r = subprocess.run(sys.argv[1:], capture_output=True, text=True)\n"
+         "u = resource.getrusage(resource.RUSAGE_CHILDREN)\n"
+         "print(json.dumps({'rc': r.returncode, 'out': r.stderr[-2000:], 'cpu': u.ru_utime + u.ru_stime}))\n")
+
+
+def workspace(root: Path, n: int) -> Path:
+    return write_chain(root, n, bound=BOUND, requirements=[("SYS", f"N{n - 1}.out.x{n} <= {50 + n}")])
+
+
+def verify(root: Path, src: Path) -> dict[str, Any]:
+    """``rclverify verify`` of ``root`` with the source tree ``src``: CPU and the verdicts."""
+    env = dict(os.environ, PYTHONPATH=str(src))
+    p = subprocess.run([sys.executable, "-c", PROBE, sys.executable, "-m", "rclverify.cli", "verify", "-w", str(root)],
+                       capture_output=True, text=True, env=env)
+    probe = json.loads(p.stdout)
+    rep = json.loads((root / "reports" / "assurance.json").read_text(encoding="utf-8"))
+    scs = rep["side_conditions"]
+    local = sum(1 for s in scs if s["status"] == "discharged" and s.get("verdict") != "discharged in context")
+    context = sum(1 for s in scs if s.get("verdict") == "discharged in context")
+    summaries = sum(1 for s in scs if (s.get("context") or {}).get("summaries"))
+    sys_req = next((r for r in rep["requirements"] if r["id"] == "SYS"), {})
+    try:  # the second solver's share: cvc5's own seconds per item (issue 50's stage)
+        cross = json.loads((root / "artifacts" / "crosscheck" / "index.json").read_text(encoding="utf-8"))
+        cvc5 = sum(float((r.get("cvc5") or {}).get("duration_s") or 0) for r in cross.get("items", []))
+    except (OSError, ValueError):
+        cvc5 = 0.0
+    return {"cpu": probe["cpu"], "rc": probe["rc"], "local": local, "context": context, "other": len(scs) - local - context,
+            "summaries": summaries, "SYS": str(sys_req.get("verdict") or sys_req.get("status")), "cvc5": cvc5}
+
+
+def calculus(root: Path, summaries: bool) -> float:
+    """CPU seconds of every node's composition of the workspace at ``root`` in this process."""
+    from rclverify.calculus.compose import compose_node
+    from rclverify.logic import world
+    from rclverify.workspace import Workspace
+    ws = Workspace(root)
+    checked, model = ws.checked, ws.model
+    facts = {m: [f.expr for f in fs] for m, fs in ws.plan.facts.items()}
+    t0 = time.process_time()
+    for node in checked.nodes:
+        world.fresh()
+        compose_node(checked, model, node, facts=facts, summaries=summaries)
+    return time.process_time() - t0
+
+
+def main(argv: list[str] | None = None) -> int:
+    p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    p.add_argument("--sizes", default="100,200,400", help="chain lengths (default 100,200,400)")
+    p.add_argument("--src", help="also run `rclverify verify` from this source tree (the old code)")
+    p.add_argument("--full", action="store_true", help="also time the calculus reading whole cones")
+    p.add_argument("--repeat", type=int, default=1, help="median of this many runs of each figure")
+    p.add_argument("--smoke", action="store_true", help="N = 5: seconds (CI)")
+    args = p.parse_args(argv)
+    from compose_pacti import _pacti, pacti_chain
+    pc = _pacti()
+    sizes = [5] if args.smoke else [int(x) for x in args.sizes.split(",")]
+    print(f"CPU seconds, medians of {args.repeat}; {os.cpu_count()} CPU(s); chain with every x_i <= {BOUND}")
+    head = f"{'N':>5} {'verify s':>9} {'cvc5 s':>7} {'local':>5} {'ctx':>5} {'summ':>5} {'SYS':>8}"
+    head += f" {'old s':>8}" if args.src else ""
+    head += f" {'calc s':>7}" + (f" {'calc full':>9}" if args.full else "") + f" {'pacti s':>8} {'ratio':>6}"
+    print(head)
+    ok, rows = True, []
+    for n in sizes:
+        runs, old, calc, full, pac = [], [], [], [], []
+        for _ in range(args.repeat):
+            with tempfile.TemporaryDirectory() as d:
+                runs.append(verify(workspace(Path(d) / "ws", n), ROOT / "src"))
+                if args.src:
+                    old.append(verify(workspace(Path(d) / "old", n), Path(args.src))["cpu"])
+                calc.append(calculus(Path(d) / "ws", True))
+                if args.full:
+                    full.append(calculus(Path(d) / "ws", False))
+            if pc is not None:
+                r = pacti_chain(pc, n, None, BOUND)
+                ok = ok and r["first"] is None
+                pac.append(r["seconds"])
+        r = runs[0]
+        ok = ok and r["rc"] == 0 and r["other"] == 0 and r["context"] == n - 1 and r["SYS"].startswith("proved")
+        row = {"n": n, "verify": statistics.median(x["cpu"] for x in runs), "calc": statistics.median(calc),
+               "old": statistics.median(old) if old else None, "full": statistics.median(full) if full else None,
+               "pacti": statistics.median(pac) if pac else None}
+        rows.append(row)
+        line = f"{n:5} {row['verify']:9.2f} {r['cvc5']:7.2f} {r['local']:5} {r['context']:5} {r['summaries']:5} {r['SYS'].split(',')[0]:>8}"
+        line += f" {row['old']:8.2f}" if args.src else ""
+        line += f" {row['calc']:7.2f}" + (f" {row['full']:9.2f}" if args.full else "")
+        line += (f" {row['pacti']:8.2f} {row['verify'] / row['pacti']:6.2f}" if row["pacti"] else "  (Pacti not installed)")
+        print(line, flush=True)
+    for a, b in zip(rows, rows[1:]):
+        growth = {k: b[k] / a[k] for k in ("verify", "old", "calc", "full", "pacti") if a.get(k) and b.get(k)}
+        print(f"growth {a['n']} -> {b['n']}: " + ", ".join(f"{k} {v:.2f}x" for k, v in growth.items()))
+    return 0 if ok else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,359 @@
+"""Cone summaries: a side condition decided in context without re-reading the cone.
+
+The in-context check (:mod:`.context`; docs/calculus.md, "Side conditions
+in context") decides a conjunct of node ``n``'s assumption against the
+premises ``P(n)`` of ``n``'s whole upstream cone.  Along a chain of N nodes
+the cones add up to N*N/2 contracts (issue 51).  Rule R1's derived
+property (paper lines 564-590) is what a node's cone establishes about its
+outputs; here it is made exact and finite: the **summary** of node ``m`` is
+
+    ``S_m = exists (the cone's other values). P(cone m)``
+
+projected onto ``I(m)``, the outputs of ``cone(m)`` that a node outside it
+reads.  It is built from the summaries of ``m``'s producers, never from the
+whole cone: ``S_m`` is Z3's quantifier elimination (``qe``:
+Loos-Weispfenning / Fourier-Motzkin for the reals, Cooper for the integers,
+exact for linear arithmetic) of the producers' summaries and ``m``'s own
+premises (each guarantee under ``m``'s assumption, the environment
+conjuncts of its assumption, its plan facts).  Then ``P(n) |= c`` iff
+``S_p1 and ... and S_pk and local(n) |= c`` for ``n``'s producers whose
+cones contain the others' (*maximal* producers), when those cones are
+pairwise disjoint: the values the projections hide are then independent.
+
+Soundness first:
+
+* a summary is used only once Z3 proved it implied by what it was built
+  from (:attr:`Summary.script`, unsat: the premises and ``not S_m``):
+  never stronger than its cone, whatever ``qe`` returned;
+* a node gets no summary (and nothing downstream of it one) when its cone
+  has a loop (rule R4 opens loops per consumer, lines 741-743), its
+  maximal producers' cones overlap (a reconverging join: the projection
+  would forget that the two branches share a value), a formula leaves
+  :mod:`.smttext`'s fragment, or ``qe`` fails within its budget;
+* :func:`decide` answers only ``proved``, and only when the query over the
+  summaries is unsat *and* its premises are satisfiable (exact summaries:
+  then so is ``P(n)``, and the full cone's verdict is ``proved`` too).
+  Anything else (a counterexample, unknown, contradictory premises) is
+  ``None``: the caller decides over the full cone as before, so a
+  counterexample is the whole cone's, traced back to its sources.
+
+The premises a proof rests on are named as before: each summary keeps the
+premises of its cone that Z3's unsat core used to establish it
+(:attr:`Summary.used`), and a proof's ``used`` is its own core with each
+summary replaced by those.  Everything kept is text (no Z3 object), made in
+a Z3 context of its own from text alone, so it is the same whichever node
+task of whichever process made it (incremental equals clean).
+"""
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+from typing import Any, Callable, Mapping, Sequence
+
+import z3
+
+from ..rcl import ast
+from ..rcl.printer import expr_to_rcl
+from ..rcl.types import NATURAL, Checked
+from ..system.model import SystemModel
+from .context import NEGATED, ContextResult, _multi_path, _node_premises
+from .smttext import SORTS, quote, to_smt
+
+#: Budget of each quantifier elimination and each check of a summary (milliseconds).
+QE_MS = 2_000
+#: A summary whose SMT-LIB text is longer is not kept (the full cone is read instead).
+MAX_TEXT = 20_000
+
+
+@dataclass(frozen=True)
+class Summary:
+    """What node ``node``'s upstream cone establishes about the values
+    read outside it.
+
+    ``formula``  SMT-LIB2 term over ``symbols`` (``((name, sort), ...)``,
+                 the encoder's symbol names of the values of ``I(m)``);
+    ``used``     ``((label, RCL text, order), ...)``: the cone's premises
+                 the summary rests on (``order``: (node index, item index));
+    ``script``   the query that showed it implied (unsat); kept in memory
+                 (tests), not written."""
+
+    node: str
+    formula: str
+    symbols: tuple[tuple[str, str], ...]
+    used: tuple[tuple[str, str, tuple[int, int]], ...]
+    script: str
+
+
+_MEMO: dict[str, Any] = {"key": None, "summaries": {}}
+
+
+def _memo(checked: Checked, model: SystemModel, facts: Mapping[str, Sequence[ast.Expr]]) -> dict[str, Any]:
+    """The summaries of the last (checked, model, facts) (summaries are
+    data: nothing of Z3 is kept)."""
+    fp = tuple((n, tuple(expr_to_rcl(f) for f in fs)) for n, fs in sorted(facts.items()))
+    key = _MEMO["key"]
+    if key is None or key[0] is not checked or key[1] is not model or key[2] != fp:
+        _MEMO["key"], _MEMO["summaries"] = (checked, model, fp), {}
+    return _MEMO["summaries"]
+
+
+def _maximal(model: SystemModel, producers: Sequence[str]) -> list[str] | None:
+    """The producers whose cone holds no other producer's, or ``None``
+    when two of their cones overlap (the summaries would not be exact)."""
+    masks = model.upstream_masks()
+    top = [p for p in producers if not any(q != p and masks[p] & ~masks[q] == 0 for q in producers)]
+    for i, p in enumerate(top):
+        for q in top[i + 1:]:
+            if masks[p] & masks[q]:
+                return None
+    return top
+
+
+def _symbols(checked: Checked, model: SystemModel, m: str) -> dict[tuple[str, str], str]:
+    cn = checked.nodes[m]
+    alias = model.alias()
+    return {(p, v): alias.get((m, p, v), f"{m}.{p}.{v}") for p, table in (("in", cn.inputs), ("out", cn.outputs))
+            for v in table}
+
+
+def _naturals(checked: Checked, m: str, symbol: Mapping[tuple[str, str], str]) -> list[str]:
+    """``(>= x 0)`` for each NATURAL input and output of ``m`` (the encoder's axiom)."""
+    cn = checked.nodes[m]
+    return [f"(>= {quote(symbol[(p, v)])} 0)" for p, table in (("in", cn.inputs), ("out", cn.outputs))
+            for v, t in table.items() if t == NATURAL and (p, v) in symbol]
+
+
+def summary_of(checked: Checked, model: SystemModel, node: str,
+               environment: Callable[[str], Sequence[ast.Expr]],
+               facts: Mapping[str, Sequence[ast.Expr]] | None = None) -> Summary | None:
+    """The :class:`Summary` of ``node``'s upstream cone (rule R1's derived
+    property made exact, paper lines 564-590; module docstring), or
+    ``None`` when it has none.  ``checked``/``model``: the system;
+    ``environment(m)``: the environment conjuncts of ``m``'s assumption
+    (:func:`.compose.environment_conjuncts`); ``facts``: the plan's facts
+    per node (RCL formulas over its I/O).  Computed producers first, each
+    once per (checked, model, facts) and process.  Never raises on solver
+    trouble (``None``); a ``KeyError`` for a node not in ``model``."""
+    facts = facts or {}
+    memo = _memo(checked, model, facts)
+    if node in memo:
+        return memo[node]
+    order: list[str] = []  # the cone's nodes without a summary yet, producers first (post-order)
+    stack, seen = [(node, iter(model.producers(node)))], {node}
+    while stack:
+        v, it = stack[-1]
+        for p in it:
+            if p not in seen and p not in memo:
+                seen.add(p)
+                stack.append((p, iter(model.producers(p))))
+                break
+        else:
+            stack.pop()
+            order.append(v)
+    for m in order:
+        memo[m] = _build(checked, model, m, environment, facts, memo)
+    return memo[node]
+
+
+def _build(checked: Checked, model: SystemModel, m: str, environment: Callable[[str], Sequence[ast.Expr]],
+           facts: Mapping[str, Sequence[ast.Expr]], memo: Mapping[str, Summary | None]) -> Summary | None:
+    if model.loop_of(m):
+        return None
+    producers = model.producers(m)
+    top = _maximal(model, producers)
+    if top is None or any(memo.get(p) is None for p in producers):
+        return None
+    symbol = _symbols(checked, model, m)
+    d = _node_premises(checked, model, m, False, environment(m), facts.get(m, ()), symbol)
+    if not d.smt:
+        return None
+    index = {n: i for i, n in enumerate(model.nodes)}
+    # I(m): outputs of the cone read by a node outside it
+    masks, bit = model.upstream_masks(), {n: 1 << i for i, n in enumerate(model.nodes)}
+    outside = ~masks[m]
+    keep: dict[str, str] = {}
+    for p in top:
+        for name, sort in memo[p].symbols:  # type: ignore[union-attr]
+            keep[name] = sort
+    sorts: dict[str, str] = dict(keep)
+    cn = checked.nodes[m]
+    for (p, v), name in symbol.items():
+        t = (cn.inputs if p == "in" else cn.outputs)[v]
+        if t not in SORTS:
+            return None
+        sorts[name] = SORTS[t]
+        if p == "out":
+            keep[name] = SORTS[t]
+    kept = {}
+    for name, sort in keep.items():  # an output symbol is named <node>.out.<var> (model.alias)
+        u, prefix, var = name.split(".", 2)
+        if prefix == "out" and any(bit[r] & outside for r in model.readers(u, var)):
+            kept[name] = sort
+    premises: list[tuple[str, str]] = [(f"{p} summary", memo[p].formula) for p in top]  # type: ignore[union-attr]
+    for label, _, kind, _, t in d.items:
+        body = f"(=> {d.assumption} {t})" if kind == "guarantee" and d.assumption is not None else t
+        premises.append((label, body or "true"))
+    axioms = _naturals(checked, m, symbol)
+    decls = "".join(f"(declare-fun {quote(n)} () {s})\n" for n, s in sorted(sorts.items()))
+    ctx = z3.Context()  # of its own: the text made depends on nothing this process did before
+    try:
+        formula = _eliminate(ctx, decls, [b for _, b in premises] + axioms, sorted(set(sorts) - set(kept)))
+        used = (_implied(ctx, decls, premises, axioms, formula)
+                if formula is not None and len(formula) <= MAX_TEXT else None)
+    except z3.Z3Exception:
+        used = None
+    if used is None or formula is None:
+        return None
+    own = {label: (text, k) for k, (label, text, _, _, _) in enumerate(d.items)}
+    out: dict[str, tuple[str, str, tuple[int, int]]] = {}
+    for label in used:
+        if label.endswith(" summary"):
+            for u in memo[label[:-len(" summary")]].used:  # type: ignore[union-attr]
+                out[u[0]] = u
+        else:
+            out[label] = (label, own[label][0], (index[m], own[label][1]))
+    script = (f"; rclverify summary of the upstream cone of {m}: its premises entail\n; {formula}\n"
+              f"; (summaries of {', '.join(top) or 'no producer'}; unsat means implied)\n"
+              + decls + "".join(f"; {label}\n(assert {body})\n" for label, body in premises)
+              + "".join(f"(assert {a})\n" for a in axioms) + f"(assert (not {formula}))\n(check-sat)\n")
+    return Summary(m, formula, tuple(sorted(kept.items())), tuple(sorted(out.values(), key=lambda u: u[2])), script)
+
+
+def _eliminate(ctx: z3.Context, decls: str, bodies: Sequence[str], hidden: Sequence[str]) -> str | None:
+    """``exists hidden. and(bodies)`` without the quantifier, as SMT-LIB
+    text (Z3 context ``ctx``); ``None`` when ``qe`` leaves a quantifier or
+    gives up."""
+    fs = z3.parse_smt2_string(decls + "".join(f"(assert {b})\n" for b in bodies), ctx=ctx)
+    body = z3.And(*fs) if len(fs) else z3.BoolVal(True, ctx)
+    if hidden:
+        consts = {str(c): c for f in fs for c in _constants(f)}
+        xs = [consts[h] for h in hidden if h in consts]
+        if xs:
+            body = z3.Exists(xs, body)
+    from ..logic.retry import has_quantifier
+    for qe in ("qe2", "qe"):  # model-based projection first: a clean conjunction, and faster (docs/calculus.md)
+        g = z3.Goal(ctx=ctx)
+        g.add(body)
+        try:
+            out = z3.TryFor(z3.Then("simplify", qe, "simplify", ctx=ctx), QE_MS, ctx=ctx)(g).as_expr()
+        except z3.Z3Exception:
+            continue
+        if not has_quantifier(out):
+            return " ".join(out.sexpr().split())  # one line: the scripts quote it in a comment
+    return None
+
+
+def _constants(f: z3.ExprRef) -> list[z3.ExprRef]:
+    out, todo, seen = [], [f], set()
+    while todo:
+        x = todo.pop()
+        if x.get_id() in seen:
+            continue
+        seen.add(x.get_id())
+        if z3.is_const(x) and x.decl().kind() == z3.Z3_OP_UNINTERPRETED:
+            out.append(x)
+        elif z3.is_app(x):
+            todo.extend(x.children())
+    return out
+
+
+def _implied(ctx: z3.Context, decls: str, premises: Sequence[tuple[str, str]], axioms: Sequence[str],
+             formula: str) -> list[str] | None:
+    """The labels of ``premises`` an unsat core of ``premises and axioms
+    and not formula`` uses (Z3 context ``ctx``), or ``None`` unless Z3
+    answers unsat."""
+    lits = "".join(f"(declare-fun |s!{k}| () Bool)\n" for k in range(len(premises)))
+    text = (decls + lits + "".join(f"(assert (=> |s!{k}| {b}))\n" for k, (_, b) in enumerate(premises))
+            + "".join(f"(assert {a})\n" for a in axioms) + f"(assert (not {formula}))\n")
+    s = z3.Solver(ctx=ctx)
+    s.set("timeout", QE_MS)
+    s.set("unsat_core", True)
+    s.add(z3.parse_smt2_string(text, ctx=ctx))
+    lit = [z3.Bool(f"s!{k}", ctx) for k in range(len(premises))]
+    if s.check(*lit) != z3.unsat:
+        return None
+    core = {str(c) for c in s.unsat_core()}
+    return [label for k, (label, _) in enumerate(premises) if f"s!{k}" in core]
+
+
+def decide(checked: Checked, model: SystemModel, node: str, conjunct: ast.Expr,
+           environment: Callable[[str], Sequence[ast.Expr]],
+           facts: Mapping[str, Sequence[ast.Expr]] | None, comment: str, timeout_ms: int) -> ContextResult | None:
+    """The in-context verdict of ``conjunct`` (an internal conjunct of
+    ``node``'s assumption, the premise of R1-R3, paper lines 564-690) from
+    the summaries of ``node``'s maximal producers and ``node``'s own
+    environment conjuncts and facts (arguments as :func:`summary_of`;
+    ``comment`` heads the script, ``timeout_ms`` budgets each check).
+    Returns a ``proved`` :class:`.ContextResult` (``used``: ``"label: RCL
+    text"`` of the cone's premises it rests on, in cone order;
+    ``summaries``: the producers whose summaries it read; ``smt2``: the
+    query over the summaries), or ``None``: decide over the whole cone
+    (module docstring).  Never raises on solver trouble."""
+    facts = facts or {}
+    if model.loop_of(node):
+        return None
+    producers = model.producers(node)
+    top = _maximal(model, producers)
+    if not producers or top is None:
+        return None
+    sums = [summary_of(checked, model, p, environment, facts) for p in top]
+    if any(s is None for s in sums):
+        return None
+    symbol = _symbols(checked, model, node)
+    d = _node_premises(checked, model, node, True, environment(node), facts.get(node, ()), symbol)
+    used_syms: dict[str, str] = {}
+    goal = to_smt(conjunct, checked.nodes[node], symbol, used_syms)
+    if not d.smt or goal is None:
+        return None
+    sorts: dict[str, str] = {n: s for sm in sums for n, s in sm.symbols}  # type: ignore[union-attr]
+    cn = checked.nodes[node]
+    for (p, v), name in symbol.items():
+        t = (cn.inputs if p == "in" else cn.outputs)[v]
+        if t not in SORTS:
+            return None
+        sorts[name] = SORTS[t]
+    premises = [(f"{p} summary", sm.formula) for p, sm in zip(top, sums)]  # type: ignore[union-attr]
+    premises += [(label, t or "true") for label, _, _, _, t in d.items]
+    axioms = _naturals(checked, node, symbol)
+    decls = "".join(f"(declare-fun {quote(n)} () {s})\n" for n, s in sorted(sorts.items()))
+    t0 = time.perf_counter()
+    lits = "".join(f"(declare-fun |l!{k}| () Bool)\n" for k in range(len(premises) + 1))
+    text = (decls + lits + "".join(f"(assert (=> |l!{k}| {b}))\n" for k, (_, b) in enumerate(premises))
+            + "".join(f"(assert {a})\n" for a in axioms) + f"(assert (=> |l!{len(premises)}| (not {goal})))\n")
+    ctx = z3.Context()  # of its own: a failure decided over the whole cone next gets today's model (same Z3 state)
+    try:
+        s = z3.Solver(ctx=ctx)
+        s.set("timeout", timeout_ms)
+        s.set("unsat_core", True)
+        s.add(z3.parse_smt2_string(text, ctx=ctx))
+        lit = [z3.Bool(f"l!{k}", ctx) for k in range(len(premises) + 1)]
+        if s.check(*lit) != z3.unsat:
+            return None  # a counterexample or unknown: the full cone decides (and traces the counterexample)
+        core = {str(c) for c in s.unsat_core()}
+        if f"l!{len(premises)}" not in core or s.check(*lit[:-1]) != z3.sat:
+            return None  # premises that may contradict each other: the full cone says what they prove
+    except z3.Z3Exception:
+        return None
+    dt = round(time.perf_counter() - t0, 4)
+    index = {n: i for i, n in enumerate(model.nodes)}
+    own = {label: (text_, k) for k, (label, text_, _, _, _) in enumerate(d.items)}
+    out: dict[str, tuple[str, str, tuple[int, int]]] = {}
+    for k, (label, _) in enumerate(premises):
+        if f"l!{k}" not in core:
+            continue
+        if label.endswith(" summary"):
+            for u in summary_of(checked, model, label[:-len(" summary")], environment, facts).used:  # type: ignore[union-attr]
+                out[u[0]] = u
+        else:
+            out[label] = (label, own[label][0], (index[node], own[label][1]))
+    used = sorted(out.values(), key=lambda u: u[2])
+    node_of = {u[0]: model.nodes[u[2][0]] for u in used}
+    nodes = tuple(dict.fromkeys(node_of[u[0]] for u in used if " guarantee " in u[0]))
+    joins = _multi_path(model, node, model.upstream(node), set()) if len(producers) > 1 or nodes else set()
+    header = "".join(f"; {line}\n" for line in comment.splitlines())
+    script = (header + f"; premises: the summaries of the cones of {', '.join(top)} (each proved implied by its cone "
+              "by Z3 when made: calculus/summary.py) and the consumer's environment assumptions and facts\n"
+              + decls + "".join(f"; {label}\n(assert {b})\n" for label, b in premises)
+              + "".join(f"(assert {a})\n" for a in axioms) + f"; {NEGATED}\n(assert (not {goal}))\n(check-sat)\n")
+    return ContextResult("proved", script, dt, used=tuple(f"{u[0]}: {u[1]}" for u in used), used_nodes=nodes,
+                         joins=tuple(n for n in nodes if n in joins), summaries=tuple(top))
