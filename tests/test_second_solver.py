@@ -88,6 +88,12 @@ def test_a_rejected_script_is_an_error_never_an_answer() -> None:
     assert decide("(declare-fun x () Int)").answer == "error"
     d = decide("(declare-fun x () Int)(assert (and (> x 0) (< x 0)))(check-sat)")
     assert d.answer == "unsat" and d.proof_checked and d.proof
+    # a side condition decided in context: its local query (sat), `(reset)`, then the query in context (unsat);
+    # the verdict rests on the last, which cvc5 decides with its proof (cvc5 stops proofs at a reset)
+    ctx = ("(declare-fun x () Real)\n(assert (> x 1.0))\n(check-sat)\n(reset)\n"
+           "(declare-fun x () Real)\n(assert (and (> x 1.0) (< x 0.0)))\n(check-sat)\n")
+    d = decide(ctx)
+    assert d.answer == "unsat" and d.proof_checked
 
 
 def _rewrite(archive: Path, out: Path, name: str, edit) -> None:

@@ -10,9 +10,10 @@ that wrote the text.
 Rules (SMT-LIB 2.6 standard, section 4.2; cvc5 options reference):
 
 * a script without ``set-logic`` is run under ``ALL`` (Z3 writes none);
-* a script with several ``check-sat`` commands (a query and its retry
-  joined by ``(reset)``) is answered by its last one, the query the
-  recorded verdict rests on;
+* a script with several queries joined by ``(reset)`` (a side condition's
+  local check and its check in context) is answered by its last one, the
+  query the recorded verdict rests on, which alone is given to cvc5 (cvc5
+  stops producing proofs at ``(reset)``);
 * the budget is cvc5's deterministic resource limit per check
   (``rlimit-per``, :data:`RLIMIT`), so the answer does not depend on the
   machine's load; a wall-clock limit (:data:`WALL_S`) is only a safety net;
@@ -90,6 +91,8 @@ def decide(text: str, name: str = "query.smt2", *, rlimit: int = RLIMIT, proofs:
             s.setOption("proof-format-mode", "cpc")
         sm = cvc5.SymbolManager(tm)
         parser = cvc5.InputParser(s, sm)
+        if not every:  # the verdict rests on the last query: cvc5 drops proof production at `(reset)`
+            text = text.split("\n(reset)\n")[-1]
         script = text if "(set-logic" in text else "(set-logic ALL)\n" + text
         parser.setStringInput(cvc5.InputLanguage.SMT_LIB_2_6, script, name)
         last, worst_, proof_parts = "", "", []
