@@ -6,9 +6,11 @@ holds every variable and flag of every node of its cone at every step, 34
 of them in the issue's delivery robot).  The report shows what a person
 needs to follow the failure:
 
-* a side condition decided in context: the values of the consumer, of the
-  producers it reads on the conjunct's links, and of the nodes whose
-  assumption the counterexample violates (:func:`side_condition_view`);
+* a side condition: the values of the consumer, of the producers it reads
+  on the conjunct's links, and of the nodes whose assumption the
+  counterexample violates (:func:`side_condition_view`); one that failed
+  in context keeps its whole cone (the counterexample traced back through
+  the premises that allow it);
 * a temporal trace (:func:`trace_view`): at every step, the variables the
   statement (or its ``assuming:``) names and those whose value changes along
   the run; of a node the lasso rests on (a missing progress or initial
@@ -95,9 +97,11 @@ def side_condition_view(sc: Mapping[str, Any]) -> Mapping[str, Any]:
     and, decided in context, the nodes whose assumption the counterexample
     violates (``context["violated"]``); ``model_hidden`` counts the values
     left out.  Unchanged without a model or links, or when nothing would be
-    left."""
+    left; unchanged, too, for a side condition that failed *in context*: its
+    counterexample is traced back through the upstream cone whose premises
+    allowed it (issue 51), every value of which is part of why it fails."""
     model = sc.get("model")
-    if not isinstance(model, dict) or not sc.get("links"):
+    if not isinstance(model, dict) or not sc.get("links") or sc.get("variant") == "in context":
         return sc
     nodes = {str(sc.get("node", ""))} | {str(l).split(".", 1)[0] for l in sc.get("links") or ()}
     ctx = sc.get("context")
