@@ -132,7 +132,7 @@ def _random_system(seed: int):  # type: ignore[no-untyped-def]
     return "\n".join(nodes), facts
 
 
-@settings(max_examples=60, deadline=None, derandomize=True)
+@settings(max_examples=25, deadline=None, derandomize=True)
 @given(seed=st.integers(0, 10**6))
 def test_verdicts_with_summaries_equal_the_whole_cones(seed: int) -> None:
     text, facts = _random_system(seed)

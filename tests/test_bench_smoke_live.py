@@ -1,0 +1,19 @@
+"""The heavier half of the bench smoke runs (tests/test_bench_smoke.py): the
+benches that start live services or run the pipeline several times, in a
+file of their own so that the two workers share the smoke runs."""
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from test_bench_smoke import BENCHES, HEAVY, run_smoke
+
+
+def test_every_heavy_bench_exists() -> None:
+    assert set(HEAVY) <= set(BENCHES), set(HEAVY) - set(BENCHES)
+
+
+@pytest.mark.parametrize("bench", [b for b in BENCHES if b in HEAVY])
+def test_heavy_bench_runs_in_smoke_mode(bench: str, tmp_path: Path) -> None:
+    run_smoke(bench, tmp_path)
