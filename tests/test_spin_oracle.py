@@ -96,7 +96,7 @@ def response_holds(graph: StateGraph, p: str, q: str) -> bool:
     return not any(state_holds(graph, k, p) for k in alive)
 
 
-@settings(max_examples=15, deadline=None, suppress_health_check=[HealthCheck.too_slow, HealthCheck.filter_too_much])
+@settings(max_examples=9, deadline=None, suppress_health_check=[HealthCheck.too_slow, HealthCheck.filter_too_much])
 @given(program=programs(), pairs=st.lists(st.tuples(st.sampled_from(ATOMS), st.sampled_from(ATOMS)),
                                           min_size=1, max_size=4, unique=True))
 def test_spin_agrees_with_a_direct_search_of_the_graph(program: str, pairs: list[tuple[str, str]]) -> None:
