@@ -185,7 +185,7 @@ def _fresh_z3_afterwards() -> Iterator[None]:
     world.fresh()
 
 
-@settings(max_examples=400, deadline=None, database=None, derandomize=True,
+@settings(max_examples=700, deadline=None, database=None, derandomize=True,
           suppress_health_check=list(HealthCheck))
 @given(formulas(), st.lists(values(), min_size=4, max_size=4))
 def _agree(text: str, value_sets: list[dict[str, Any]]) -> None:
