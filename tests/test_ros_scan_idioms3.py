@@ -9,18 +9,18 @@ expected graph written by hand (expected/idioms5_sources.json); each test
 below failed before issue 53's change and passes after."""
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
 import pytest
 
+import _idioms
+
 from rclverify.ros.graph import scan
 from rclverify.ros.sources_cpp import scan_cpp
 
-CORPUS = Path(__file__).parent / "data" / "ros_corpus"
+CORPUS, ROLES = _idioms.CORPUS, _idioms.ROLES
 WS = CORPUS / "idioms5"
-EXPECTED = json.loads((CORPUS / "expected" / "idioms5_sources.json").read_text())
-ROLES = ("pub", "sub", "service_servers", "service_clients", "action_servers", "action_clients")
+EXPECTED = _idioms.expected("idioms5")
 
 
 @pytest.fixture(scope="module")
@@ -29,13 +29,11 @@ def graph():  # type: ignore[no-untyped-def]
 
 
 def _edges(g, node: str) -> set[tuple[str, str, str | None, str]]:  # type: ignore[no-untyped-def]
-    n = g.nodes[node]
-    return {(role, e.topic, e.msg_type, f"{e.src.file}:{e.src.line}") for role in ROLES for e in n.edges_of(role)}
+    return _idioms.edges(g, node)
 
 
 def _want(node: str) -> set[tuple[str, str, str | None, str]]:
-    spec = EXPECTED["nodes"][node]
-    return {(role, name, typ, at) for role in ROLES for name, typ, at in spec.get(role, [])}
+    return _idioms.want(EXPECTED, node)
 
 
 def test_node_base_of_a_helper_package_written_with_its_namespace(graph) -> None:  # type: ignore[no-untyped-def]

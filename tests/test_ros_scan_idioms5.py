@@ -9,17 +9,17 @@ expected graph written by hand (expected/idioms7_sources.json); each test
 below failed before its change and passes after."""
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
 import pytest
 
+import _idioms
+
 from rclverify.ros.graph import scan
 
-CORPUS = Path(__file__).parent / "data" / "ros_corpus"
+CORPUS, ROLES = _idioms.CORPUS, _idioms.ROLES
 WS = CORPUS / "idioms7"
-EXPECTED = json.loads((CORPUS / "expected" / "idioms7_sources.json").read_text())
-ROLES = ("pub", "sub", "service_servers", "service_clients", "action_servers", "action_clients")
+EXPECTED = _idioms.expected("idioms7")
 
 
 @pytest.fixture(scope="module")
@@ -28,13 +28,11 @@ def graph():  # type: ignore[no-untyped-def]
 
 
 def _edges(g, node: str) -> set[tuple[str, str, str | None, str]]:  # type: ignore[no-untyped-def]
-    n = g.nodes[node]
-    return {(role, e.topic, e.msg_type, f"{e.src.file}:{e.src.line}") for role in ROLES for e in n.edges_of(role)}
+    return _idioms.edges(g, node)
 
 
 def _want(node: str) -> set[tuple[str, str, str | None, str]]:
-    spec = EXPECTED["nodes"][node]
-    return {(role, name, typ, at) for role in ROLES for name, typ, at in spec.get(role, [])}
+    return _idioms.want(EXPECTED, node)
 
 
 def test_names_resolved_by_rclcpp_and_a_lazy_camera_subscription_on_a_member(graph) -> None:  # type: ignore[no-untyped-def]
