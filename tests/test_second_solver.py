@@ -151,3 +151,15 @@ def test_refines_is_confirmed_by_the_second_solver(capsys: pytest.CaptureFixture
     assert main(["refines", f"{rcl}:RadiationSensor", f"{rcl}:RadiationSensor"]) == 0
     out = capsys.readouterr().out
     assert "second solver: assumption side: two solvers" in out and "guarantee side: two solvers" in out
+
+
+def test_every_part_of_a_reset_joined_proof_is_decided() -> None:
+    """A replacement check's two sides are joined by `(reset)`; both must be unsat for it to read ok."""
+    both = ("(declare-fun x () Real)\n(assert (and (> x 1.0) (< x 0.0)))\n(check-sat)\n(reset)\n"
+            "(declare-fun y () Real)\n(assert (and (> y 1.0) (< y 0.0)))\n(check-sat)\n")
+    first_sat = ("(declare-fun x () Real)\n(assert (> x 1.0))\n(check-sat)\n(reset)\n"
+                 "(declare-fun y () Real)\n(assert (and (> y 1.0) (< y 0.0)))\n(check-sat)\n")
+    d = decide(both, every=True)
+    assert d.answer == "unsat" and d.proof_checked
+    assert decide(first_sat, every=True).answer == "sat"
+    assert decide(first_sat).answer == "unsat"  # without `every`, only the last query counts (a side condition)

@@ -66,6 +66,25 @@ def version() -> str:
 
 def decide(text: str, name: str = "query.smt2", *, rlimit: int = RLIMIT, proofs: bool = True,
            every: bool = False) -> Decision:
+    """The script ``text`` decided by cvc5 (:func:`_decide_one`); with
+    ``every``, each part of it between ``(reset)`` commands in a fresh
+    solver (cvc5 stops producing proofs at a reset), the answer ``unsat``
+    only when every part's every ``check-sat`` is, else the first other
+    part's."""
+    parts = text.split("\n(reset)\n") if every else [text]
+    if len(parts) == 1:
+        return _decide_one(text, name, rlimit=rlimit, proofs=proofs, every=every)
+    t0 = time.perf_counter()
+    done = [_decide_one(p, name, rlimit=rlimit, proofs=proofs, every=True) for p in parts]
+    bad = next((d for d in done if d.answer != "unsat"), None)
+    if bad is not None:
+        return Decision(bad.answer, bad.reason, "", False, bad.version, time.perf_counter() - t0)
+    return Decision("unsat", "", "\n".join(d.proof for d in done), all(d.proof_checked for d in done),
+                    done[0].version, time.perf_counter() - t0)
+
+
+def _decide_one(text: str, name: str = "query.smt2", *, rlimit: int = RLIMIT, proofs: bool = True,
+                every: bool = False) -> Decision:
     """Run the SMT-LIB2 script ``text`` in a fresh cvc5 solver.
 
     ``name`` labels cvc5's messages; ``rlimit`` is the resource budget per

@@ -64,8 +64,8 @@ def discharging_items(root: Any, nodes: Iterable[str]) -> list[Item]:
         body, why = read_sealed(root / f"artifacts/health/{n}.json", "contract health record")
         for f in _rows(body, why, "findings"):
             if f.get("status") == "ok" and _path(f.get("smt2")):
-                expects = "unsat" if f.get("check") in PROOF_CHECKS else "sat"
-                out.append(Item("health", str(f.get("id")), f["smt2"], "ok", expects))
+                proof = f.get("check") in PROOF_CHECKS  # both sides of a replacement (joined by a reset) must hold
+                out.append(Item("health", str(f.get("id")), f["smt2"], "ok", "unsat" if proof else "sat", every=proof))
     index, why = read_sealed(root / "artifacts/requirements/index.json", "requirement index")
     records = index.get("records") if isinstance(index, dict) and not why else None
     for rid in sorted(records) if isinstance(records, dict) else []:

@@ -52,7 +52,8 @@ def z3_answer(text: str, every: bool = False) -> str:
     conditions): ``unsat`` when all are, else the first other answer."""
     if every:
         import re
-        answers = [z3_answer(b) for b in re.findall(r"\(push 1\)\n(.*?)\(pop 1\)", text, flags=re.S)]
+        blocks = re.findall(r"\(push 1\)\n(.*?)\(pop 1\)", text, flags=re.S) or text.split("\n(reset)\n")
+        answers = [z3_answer(b) for b in blocks]
         return next((a for a in answers if a != "unsat"), "unsat" if answers else "error")
     import z3
     last = text.split("\n(reset)\n")[-1]
