@@ -26,3 +26,15 @@ def want(exp: dict[str, Any], node: str) -> set[tuple[str, str, str | None, str]
     """The edges ``exp`` (an expected graph) lists for ``node``."""
     spec = exp["nodes"][node]
     return {(role, name, typ, at) for role in ROLES for name, typ, at in spec.get(role, [])}
+
+
+def graph_fixture(case: str) -> Any:
+    """A module-scoped pytest fixture ``graph``: the scan of corpus case ``case``."""
+    import pytest
+
+    from rclverify.ros.graph import scan
+
+    @pytest.fixture(scope="module")
+    def graph() -> Any:
+        return scan([CORPUS / case], [], base=CORPUS, standard=False).graph
+    return graph

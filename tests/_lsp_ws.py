@@ -45,3 +45,23 @@ def run_pipeline(root: Path, nodes: tuple[str, ...] = ()) -> None:
             stage_health(ws, n)
     stage_requirements(ws)
     stage_report(ws, report=build_report(ws))
+
+
+async def wait_diagnostics(client, u: str, want, timeout: float):  # type: ignore[no-untyped-def]
+    """The diagnostics of ``u`` once ``want(diagnostics)`` holds, waiting for the
+    server's publications up to ``timeout`` seconds (an assertion error past it)."""
+    import asyncio
+    import time
+
+    from lsprotocol import types as lsp
+    end = time.monotonic() + timeout
+    while True:
+        got = list(client.diagnostics.get(u, []))
+        if want(got):
+            return got
+        left = end - time.monotonic()
+        assert left > 0, f"no diagnostics as wanted within {timeout} s; last: {[(d.code, d.message[:80]) for d in got]}"
+        try:
+            await asyncio.wait_for(client.wait_for_notification(lsp.TEXT_DOCUMENT_PUBLISH_DIAGNOSTICS), left)
+        except asyncio.TimeoutError:
+            pass

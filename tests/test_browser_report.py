@@ -292,19 +292,26 @@ def test_the_case_study_report_reads_well(tmp_path: Path, driver: Any) -> None:
     _screenshot(driver, tmp_path, "assurance-case-study-argument.png")
 
 
-def test_the_first_screen_says_what_to_fix(tmp_path: Path, driver: Any) -> None:
-    """Issue 48: at 1400x900 the first screen holds the overall status with the refuted
-    requirements counted and the first problem to fix with its culprit (before, the
-    node-by-technique dashboard pushed the problems below the fold)."""
-    with gzip.open(REPO / "tests" / "data" / "case-study-report.json.gz", "rt", encoding="utf-8") as f:
+def _first_screen(driver: Any, tmp_path: Path, stored: str, regroup: bool = False) -> int:
+    """Open the HTML report of the stored report dict ``tests/data/<stored>`` at 1400x900 and return
+    the window's inner height; ``regroup``: its problems grouped again by the current code."""
+    with gzip.open(REPO / "tests" / "data" / stored, "rt", encoding="utf-8") as f:
         report = json.load(f)
-    report.pop("problems", None)
+    if regroup:
+        report.pop("problems", None)
     out = tmp_path / "reports"
     out.mkdir()
     render_files(report, out, ("assurance.html",))
     driver.set_window_size(1400, 900)
     driver.get((out / "assurance.html").as_uri())
-    height = driver.execute_script("return window.innerHeight")
+    return int(driver.execute_script("return window.innerHeight"))
+
+
+def test_the_first_screen_says_what_to_fix(tmp_path: Path, driver: Any) -> None:
+    """Issue 48: at 1400x900 the first screen holds the overall status with the refuted
+    requirements counted and the first problem to fix with its culprit (before, the
+    node-by-technique dashboard pushed the problems below the fold)."""
+    height = _first_screen(driver, tmp_path, "case-study-report.json.gz", regroup=True)
     lead = driver.find_element("css selector", "header p.lead").get_attribute("textContent")
     assert "1 requirement refuted (REQ4)" in lead and "problems to fix" in lead
     first = driver.find_element("css selector", "#problem-1")
@@ -328,14 +335,7 @@ def test_the_warehouse_first_screen_says_what_to_fix(tmp_path: Path, driver: Any
     holds the overall status with the refuted requirements and deadline counted, and the
     first problem with its culprit and its first repair; the culprit node is marked in the
     dashboard and the system diagram, a node no problem blames is not."""
-    with gzip.open(REPO / "tests" / "data" / "warehouse-report.json.gz", "rt", encoding="utf-8") as f:
-        report = json.load(f)
-    out = tmp_path / "reports"
-    out.mkdir()
-    render_files(report, out, ("assurance.html",))
-    driver.set_window_size(1400, 900)
-    driver.get((out / "assurance.html").as_uri())
-    height = driver.execute_script("return window.innerHeight")
+    height = _first_screen(driver, tmp_path, "warehouse-report.json.gz")
     status = driver.find_element("css selector", "header p.banner")
     assert "failed" in status.get_attribute("textContent")
     lead = driver.find_element("css selector", "header p.lead").get_attribute("textContent")

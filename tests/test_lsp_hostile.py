@@ -16,6 +16,8 @@ import pytest_lsp
 from lsprotocol import types as lsp
 from pytest_lsp import ClientServerConfig, LanguageClient
 
+from _lsp_ws import wait_diagnostics
+
 REPO = Path(__file__).resolve().parents[1]
 ENV = {**os.environ, "PYTHONPATH": str(REPO / "src") + os.pathsep + os.environ.get("PYTHONPATH", "")}
 pytestmark = pytest.mark.asyncio(loop_scope="module")
@@ -74,17 +76,7 @@ def change(client: LanguageClient, u: str, version: int, text: str) -> None:
 
 
 async def wait_for(client: LanguageClient, u: str, want, timeout: float = LIMIT) -> list[lsp.Diagnostic]:
-    end = time.monotonic() + timeout
-    while True:
-        got = list(client.diagnostics.get(u, []))
-        if want(got):
-            return got
-        left = end - time.monotonic()
-        assert left > 0, f"nothing as wanted within {timeout} s: {[(d.code, d.message[:80]) for d in got]}"
-        try:
-            await asyncio.wait_for(client.wait_for_notification(lsp.TEXT_DOCUMENT_PUBLISH_DIAGNOSTICS), left)
-        except asyncio.TimeoutError:
-            pass
+    return await wait_diagnostics(client, u, want, timeout)
 
 
 async def answers(client: LanguageClient, u: str) -> float:

@@ -6,10 +6,8 @@ One server for the module (started once); the tests run in order and the
 document's text is set by each test that edits it."""
 from __future__ import annotations
 
-import asyncio
 import os
 import sys
-import time
 from pathlib import Path
 
 import pytest
@@ -17,7 +15,7 @@ import pytest_lsp
 from lsprotocol import types as lsp
 from pytest_lsp import ClientServerConfig, LanguageClient
 
-from _lsp_ws import REPO, RCL, make_workspace, run_pipeline
+from _lsp_ws import REPO, RCL, make_workspace, run_pipeline, wait_diagnostics
 
 pytestmark = pytest.mark.asyncio(loop_scope="module")
 
@@ -47,17 +45,7 @@ def uri(ws: Path, rel: str = RCL) -> str:
 
 async def diagnostics(client: LanguageClient, u: str, want, timeout: float = 10.0) -> list[lsp.Diagnostic]:
     """The diagnostics of ``u`` once ``want(diagnostics)`` holds (waits for publications)."""
-    end = time.monotonic() + timeout
-    while True:
-        got = list(client.diagnostics.get(u, []))
-        if want(got):
-            return got
-        left = end - time.monotonic()
-        assert left > 0, f"no diagnostics as wanted within {timeout} s; last: {[(d.code, d.message) for d in got]}"
-        try:
-            await asyncio.wait_for(client.wait_for_notification(lsp.TEXT_DOCUMENT_PUBLISH_DIAGNOSTICS), left)
-        except asyncio.TimeoutError:
-            pass
+    return await wait_diagnostics(client, u, want, timeout)
 
 
 def change(client: LanguageClient, u: str, version: int, text: str) -> None:

@@ -11,8 +11,6 @@ from __future__ import annotations
 
 from pathlib import Path
 
-import pytest
-
 import _idioms
 
 from rclverify.ros.graph import scan
@@ -21,15 +19,8 @@ from rclverify.ros.sources_cpp import scan_cpp
 CORPUS, ROLES = _idioms.CORPUS, _idioms.ROLES
 WS = CORPUS / "idioms5"
 EXPECTED = _idioms.expected("idioms5")
-
-
-@pytest.fixture(scope="module")
-def graph():  # type: ignore[no-untyped-def]
-    return scan([WS], [], base=CORPUS, standard=False).graph
-
-
-def _edges(g, node: str) -> set[tuple[str, str, str | None, str]]:  # type: ignore[no-untyped-def]
-    return _idioms.edges(g, node)
+graph = _idioms.graph_fixture("idioms5")
+_edges = _idioms.edges
 
 
 def _want(node: str) -> set[tuple[str, str, str | None, str]]:

@@ -22,15 +22,8 @@ from rclverify.ros.graph import scan
 CORPUS, ROLES = _idioms.CORPUS, _idioms.ROLES
 WS = CORPUS / "idioms6"
 EXPECTED = _idioms.expected("idioms6")
-
-
-@pytest.fixture(scope="module")
-def graph():  # type: ignore[no-untyped-def]
-    return scan([WS], [], base=CORPUS, standard=False).graph
-
-
-def _edges(g, node: str) -> set[tuple[str, str, str | None, str]]:  # type: ignore[no-untyped-def]
-    return _idioms.edges(g, node)
+graph = _idioms.graph_fixture("idioms6")
+_edges = _idioms.edges
 
 
 def _want(node: str) -> set[tuple[str, str, str | None, str]]:

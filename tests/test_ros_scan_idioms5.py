@@ -9,26 +9,13 @@ expected graph written by hand (expected/idioms7_sources.json); each test
 below failed before its change and passes after."""
 from __future__ import annotations
 
-from pathlib import Path
-
-import pytest
-
 import _idioms
-
-from rclverify.ros.graph import scan
 
 CORPUS, ROLES = _idioms.CORPUS, _idioms.ROLES
 WS = CORPUS / "idioms7"
 EXPECTED = _idioms.expected("idioms7")
-
-
-@pytest.fixture(scope="module")
-def graph():  # type: ignore[no-untyped-def]
-    return scan([WS], [], base=CORPUS, standard=False).graph
-
-
-def _edges(g, node: str) -> set[tuple[str, str, str | None, str]]:  # type: ignore[no-untyped-def]
-    return _idioms.edges(g, node)
+graph = _idioms.graph_fixture("idioms7")
+_edges = _idioms.edges
 
 
 def _want(node: str) -> set[tuple[str, str, str | None, str]]:

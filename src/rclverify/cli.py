@@ -523,17 +523,9 @@ def cmd_review(args: argparse.Namespace) -> int:
 
 def cmd_refines(args: argparse.Namespace) -> int:
     from .calculus.refinement import refines_main
-    from .crosscheck.cvc5_decide import decide, version
-    from .crosscheck.stage import agreement
-
-    def confirm(text: str) -> tuple[str, str]:
-        """cvc5's agreement with Z3's proof of one side (docs/second-solver.md)."""
-        if not version():
-            return agreement("unsat", None)
-        d = decide(text)
-        return agreement("unsat", {"answer": d.answer, "reason": d.reason, "proof_checked": d.proof_checked,
-                                   "version": d.version})
-    return refines_main(args.original, args.replacement, assumes=getattr(args, "assume", None) or (), confirm=confirm)
+    from .crosscheck.stage import confirm_proof  # each proved side confirmed by cvc5 (docs/second-solver.md)
+    return refines_main(args.original, args.replacement, assumes=getattr(args, "assume", None) or (),
+                        confirm=confirm_proof)
 
 
 def cmd_quotient(args: argparse.Namespace) -> int:

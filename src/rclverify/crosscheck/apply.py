@@ -39,49 +39,41 @@ class SecondSolver:
                 "cvc5": None if c is None else {k: c.get(k) for k in ("answer", "reason", "version", "proof_checked")},
                 "proof": (c or {}).get("proof", ""), "smt2": str(r.get("smt2", ""))}
 
+    def _fold(self, row: dict[str, Any] | None, kind: str, id_key: str, status_key: str, good: str,
+              downgraded: Any) -> dict[str, Any] | None:
+        """``row`` with ``solvers`` when its ``status_key`` reads ``good``;
+        then, when the solvers do not agree, ``status_key`` set to
+        ``inconclusive`` and the fields ``downgraded(row, solvers)`` gives."""
+        if row is None or row.get(status_key) != good:
+            return row
+        s = self.solvers(kind, str(row.get(id_key)), row.get("smt2"))
+        if s["agreement"] in DOWNGRADES:
+            return {**row, status_key: "inconclusive", "solvers": s, **downgraded(row, s)}
+        return {**row, "solvers": s}
+
     def side_condition(self, sc: dict[str, Any]) -> dict[str, Any]:
         """``sc`` (a side-condition row) with ``solvers``; a discharged one
         the solvers do not agree on is ``inconclusive``."""
-        if sc.get("status") != "discharged":
-            return sc
-        s = self.solvers("side-condition", str(sc.get("id")), sc.get("smt2"))
-        if s["agreement"] in DOWNGRADES:
-            return {**sc, "status": "inconclusive", "solvers": s,
-                    "explanation": f"Not discharged: {s['why']} (second solver). Z3 alone: "
-                                   + str(sc.get("explanation", ""))}
-        return {**sc, "solvers": s}
+        return self._fold(sc, "side-condition", "id", "status", "discharged", lambda r, s: {
+            "explanation": f"Not discharged: {s['why']} (second solver). Z3 alone: {r.get('explanation', '')}"}) or sc
 
     def finding(self, f: dict[str, Any]) -> dict[str, Any]:
         """A health finding with ``solvers``; an ``ok`` one the solvers do
         not agree on is ``inconclusive``."""
-        if f.get("status") != "ok":
-            return f
-        s = self.solvers("health", str(f.get("id")), f.get("smt2"))
-        if s["agreement"] in DOWNGRADES:
-            return {**f, "status": "inconclusive", "solvers": s,
-                    "message": f"{f.get('message', '')} Not confirmed: {s['why']} (second solver)."}
-        return {**f, "solvers": s}
+        return self._fold(f, "health", "id", "status", "ok", lambda r, s: {
+            "message": f"{r.get('message', '')} Not confirmed: {s['why']} (second solver)."}) or f
 
     def requirement(self, rec: dict[str, Any] | None) -> dict[str, Any] | None:
         """A requirement record with ``solvers``; a ``proved`` one the
         solvers do not agree on has verdict ``inconclusive`` and the reason."""
-        if rec is None or rec.get("verdict") != "proved":
-            return rec
-        s = self.solvers("requirement", str(rec.get("id")), rec.get("smt2"))
-        if s["agreement"] in DOWNGRADES:
-            return {**rec, "verdict": "inconclusive", "recorded_verdict": "proved", "solvers": s,
-                    "reason": f"second solver: {s['why']}"}
-        return {**rec, "solvers": s}
+        return self._fold(rec, "requirement", "id", "verdict", "proved", lambda r, s: {
+            "recorded_verdict": "proved", "reason": f"second solver: {s['why']}"})
 
     def deadline(self, d: dict[str, Any]) -> dict[str, Any]:
         """A deadline record with ``solvers``; a ``proved`` one the solvers
         do not agree on is ``inconclusive``."""
-        if d.get("status") != "proved":
-            return d
-        s = self.solvers("deadline", str(d.get("requirement")), d.get("smt2"))
-        if s["agreement"] in DOWNGRADES:
-            return {**d, "status": "inconclusive", "solvers": s, "reason": f"second solver: {s['why']}"}
-        return {**d, "solvers": s}
+        return self._fold(d, "deadline", "requirement", "status", "proved", lambda r, s: {
+            "reason": f"second solver: {s['why']}"}) or d
 
     def evidence(self, obligation: str, backend: str, status: str) -> tuple[str, dict[str, Any] | None]:
         """``(status, solvers)`` of an obligation's evidence: a discharged

@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass
+from typing import Any
 
 #: cvc5 resource units per check: some 150k units a second on the case
 #: study's heaviest quantified query, so about 10 s of work, the Z3 budget.
@@ -53,6 +54,12 @@ class Decision:
     proof_checked: bool
     version: str
     duration_s: float
+
+    def row(self) -> dict[str, Any]:
+        """The decision as the second-solver record keeps it (the proof's
+        path, ``proof``, is the caller's to fill in)."""
+        return {"answer": self.answer, "reason": self.reason, "proof_checked": self.proof_checked,
+                "version": self.version, "duration_s": round(self.duration_s, 4), "proof": ""}
 
 
 def version() -> str:

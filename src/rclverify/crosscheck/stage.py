@@ -65,6 +65,12 @@ def agreement(expects: str, d: dict[str, Any] | None) -> tuple[str, str]:
     return "disagree", f"Z3 answered {expects}, cvc5 {ans}"
 
 
+def confirm_proof(text: str) -> tuple[str, str]:
+    """``(agreement, why)`` of cvc5 with a proof (Z3's ``unsat``) of the
+    SMT-LIB2 script ``text``, decided now (``rclverify refines``)."""
+    return agreement("unsat", decide(text).row() if version() else None)
+
+
 def stage_crosscheck(root: Path, nodes: Iterable[str]) -> dict[str, Any]:
     """Decide every discharging item of the workspace at ``root`` again
     with cvc5 and write the stage's record (module docstring); returns the
@@ -106,8 +112,7 @@ def _row(root: Path, it: Item, ver: str, cache: dict[str, dict[str, Any]], keep:
         d = None  # its proof is gone: decide again
     if d is None and ver:
         dec: Decision = decide(text, it.smt2, every=it.every)
-        d = {"answer": dec.answer, "reason": dec.reason, "proof_checked": dec.proof_checked,
-             "version": dec.version, "duration_s": round(dec.duration_s, 4), "proof": ""}
+        d = dec.row()
         if dec.proof:
             atomic_write_text(root / proof_rel, dec.proof)
             d["proof"] = proof_rel

@@ -42,7 +42,7 @@ from ..rcl.printer import expr_to_rcl
 from . import realize, recheck
 from .bounds import FLIP, bound_literals, thresholds, value
 from .edits import Edit
-from .repairs import _link_pairs, _numbers, _peel, _rename
+from .repairs import link_pairs, _numbers, _peel, _rename
 
 #: Most edited systems checked per problem (each costs a parse, a type check and a Z3 query).
 MAX_TRIALS = 24
@@ -82,7 +82,7 @@ def side_condition_culprits(ws: Any, sc: Mapping[str, Any]) -> tuple[list[tuple[
     conclusion, strengthened by the conjunct, makes Z3 discharge ``sc``
     (module docstring), and how many candidates could not be decided (Z3
     answered unknown, or the strengthened text does not type-check)."""
-    pairs = _link_pairs(sc)
+    pairs = link_pairs(sc)
     to_producer = [(f"in.{iv}", f"out.{ov}") for _, ov, _, iv in pairs]
     extra = _rename(str(sc["conjunct"]), to_producer)
     out: list[tuple[str, int]] = []

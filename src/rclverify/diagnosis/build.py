@@ -245,7 +245,7 @@ def _and(items: list[str]) -> str:
 
 def _side_condition(ws: Any, report: Mapping[str, Any], sc: Mapping[str, Any], cache: _Cache,
                     sc_before: Mapping[str, str]) -> dict[str, Any]:
-    pairs = rep._link_pairs(sc)
+    pairs = rep.link_pairs(sc)
     cul = [{"what": f"assumption of {sc['node']}: `{sc['conjunct']}`", "source": sc["source"], "text": sc["conjunct"]}]
     said = []
     # a producer guarantee is named only when strengthening it discharges the side condition (blame.py)

@@ -318,7 +318,7 @@ def _numeric_vars(ws: Any, cn: Any, formula: ast.Expr) -> dict[str, str]:
     return out
 
 
-def _link_pairs(sc: Mapping[str, Any]) -> list[tuple[str, str, str, str]]:
+def link_pairs(sc: Mapping[str, Any]) -> list[tuple[str, str, str, str]]:
     """``(producer, out var, consumer, in var)`` of a side condition's links
     (``Planner.out.speed -> Controller.in.speed (via name)``)."""
     out = []

@@ -47,7 +47,7 @@ from ..rcl.walk import subexpressions
 from . import realize, recheck
 from .bounds import coefficient_literals, number_text, power_of_ten, value
 from .edits import Edit
-from .repairs import MAX_CANDIDATES, _and_text, _link_pairs, _record, _rename
+from .repairs import MAX_CANDIDATES, _and_text, link_pairs, _record, _rename
 
 _UPPER = {"<=": True, "<": True, ">=": False, ">": False}
 _MIRROR = {"<=": ">=", "<": ">", ">=": "<=", ">": "<"}
@@ -83,7 +83,7 @@ def side_condition_repairs(ws: Any, sc: Mapping[str, Any], before_sc: Mapping[st
     names the consumer's evidence (``"Controller.g1.hoare.c1 (discharged)"``)
     that a weakened assumption invalidates."""
     out: dict[str, Any] = {"repairs": [], "not_offered": []}
-    pairs = _link_pairs(sc)
+    pairs = link_pairs(sc)
     if not pairs:
         return out
     consumer = str(sc["node"])
@@ -144,7 +144,7 @@ def _strengthen(ws: Any, sc: Mapping[str, Any], p: str, new_g: str, cost_of: Any
     last = pn.guarantees[-1] if pn.guarantees else None
     if last is None or not last.loc.end_line:
         return []
-    trigger = _trigger_of(pn, {ov for q, ov, _, _ in _link_pairs(sc) if q == p})
+    trigger = _trigger_of(pn, {ov for q, ov, _, _ in link_pairs(sc) if q == p})
     suffix = f" triggered by {trigger}" if trigger else ""
     answers = f" ({suffix.strip()}, as {p}'s guarantees on that output)" if trigger else ""
     rel = last.loc.file

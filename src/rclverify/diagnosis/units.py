@@ -28,7 +28,7 @@ from ..rcl.units import Unit, ratio
 from ..system.units import Mismatch, mismatches
 from . import recheck
 from .edits import Edit
-from .repairs import _link_pairs, _record
+from .repairs import link_pairs, _record
 
 
 def _loc(loc: Any) -> str:
@@ -43,7 +43,7 @@ def _joins(report: Mapping[str, Any], m: Mismatch) -> list[str]:
     out += [str(x["location"]) for x in report.get("lint") or () if str(x.get("code", "")).startswith("W-unit")
             and x["location"] == _loc(m.reader_decl)]
     scs = [sc for sc in report.get("side_conditions") or () if sc.get("status") != "discharged"
-           and (p, v, c, w) in _link_pairs(sc)]
+           and (p, v, c, w) in link_pairs(sc)]
     out += [str(sc["id"]) for sc in scs]
     out += [str(f["id"]) for f in report.get("findings") or () if f.get("check") == "probable-scale-mismatch"
             and any(str(f["id"]).startswith(f"{sc['id']}.scale") for sc in scs)]

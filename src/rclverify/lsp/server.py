@@ -211,25 +211,26 @@ def _notified(ls: RclServer, uri: str) -> str | None:
         return None
 
 
-@SERVER.feature(lsp.TEXT_DOCUMENT_DID_OPEN)
-async def _did_open(ls: RclServer, params: lsp.DidOpenTextDocumentParams) -> None:
-    rel = _notified(ls, params.text_document.uri)
+async def _check_uri(ls: RclServer, uri: str) -> None:
+    """Check the document ``uri`` again (opened, changed or saved) when it is in the workspace."""
+    rel = _notified(ls, uri)
     if rel is not None:
         await ls.check(rel)
+
+
+@SERVER.feature(lsp.TEXT_DOCUMENT_DID_OPEN)
+async def _did_open(ls: RclServer, params: lsp.DidOpenTextDocumentParams) -> None:
+    await _check_uri(ls, params.text_document.uri)
 
 
 @SERVER.feature(lsp.TEXT_DOCUMENT_DID_CHANGE)
 async def _did_change(ls: RclServer, params: lsp.DidChangeTextDocumentParams) -> None:
-    rel = _notified(ls, params.text_document.uri)
-    if rel is not None:
-        await ls.check(rel)
+    await _check_uri(ls, params.text_document.uri)
 
 
 @SERVER.feature(lsp.TEXT_DOCUMENT_DID_SAVE)
 async def _did_save(ls: RclServer, params: lsp.DidSaveTextDocumentParams) -> None:
-    rel = _notified(ls, params.text_document.uri)
-    if rel is not None:
-        await ls.check(rel)
+    await _check_uri(ls, params.text_document.uri)
 
 
 @SERVER.feature(lsp.TEXT_DOCUMENT_DID_CLOSE)

@@ -72,8 +72,9 @@ def annotate(report: dict[str, Any], links: list[tuple[str, str]], required: dic
     for a, b in links:
         if b in producers and a in own:
             producers[b].add(a)
-    for name, c in node_claims(own).items():
-        _put(next(n for n in report["nodes"] if n["name"] == name), c)
+    claims = node_claims(own)
+    for n in report.get("nodes", []):  # one pass: a search per node was quadratic in the system's size
+        _put(n, claims[n["name"]])
     derived = derived_claims(own, producers)
     for d in report.get("derived_properties", []):
         if d.get("node") in derived:

@@ -637,13 +637,9 @@ def _argument(report: Mapping[str, Any], rendering: diagram.Rendering | None,
 @last_call  # the HTML report's layout and page both show it
 def _system_dot(report: Mapping[str, Any]) -> str:
     """The system diagram with the problems' culprit nodes and the failing connections marked (issue 48)."""
-    failing = set()
-    for sc in report.get("side_conditions") or ():
-        if sc.get("status") in ("failed", "inconclusive", "error"):
-            for link in sc.get("links") or ():  # "P.out.x -> C.in.y (via ...)"
-                left, _, right = str(link).partition(" -> ")
-                if right:
-                    failing.add((left.split(".", 1)[0], right.split(".", 1)[0]))
+    from ..diagnosis.repairs import link_pairs
+    failing = {(p, c) for sc in report.get("side_conditions") or () if sc.get("status") in ("failed", "inconclusive", "error")
+               for p, _, c, _ in link_pairs(sc)}
     culprits = culprit_nodes(problem_groups(report))
     return diagram.system_dot(report["system"], title=f"system model of {report['meta']['workspace']}",
                               culprits=culprits, failing=failing)
