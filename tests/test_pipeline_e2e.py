@@ -10,6 +10,12 @@ from pathlib import Path
 
 import pytest
 
+from rclverify.evidence.store import dumps
+from rclverify.pipeline import Workspace
+from rclverify.report.build import build_report
+from rclverify.report.fragments import FragmentCache, cached_dumps
+from rclverify.report.parts import FRAGMENTS, PARTS, write_part
+
 ROOT = Path(__file__).resolve().parents[1]
 
 
@@ -350,7 +356,7 @@ def test_side_conditions_are_written_for_a_second_solver(report: dict, workspace
         assert s.check() == z3.unsat, sc["id"]
 
 
-def test_editing_one_contract_reruns_that_node_its_consumers_and_the_report(workspace: Path) -> None:
+def test_editing_one_contract_reruns_that_node_its_consumers_and_the_report(workspace: Path, tmp_path: Path) -> None:
     rcl = workspace / "contracts" / "remote_inspection.rcl"
     original = rcl.read_text()
     try:
@@ -370,6 +376,15 @@ def test_editing_one_contract_reruns_that_node_its_consumers_and_the_report(work
         # in the node tasks, only the stages whose own inputs changed: the consumer's side conditions
         assert "RadiationSensor: compose, health, export" in r.stdout
         assert re.search(r"Agent: compose(?!,)", r.stdout)
+        # its report tasks rendered with the previous run's pieces (report/fragments.py): the same
+        # bytes as a report rendered without any, and each task kept exactly its own files' pieces
+        assert _reports(workspace) == _render(workspace, tmp_path / "plain", None)
+        edited = build_report(Workspace(workspace))
+        for part, rel in FRAGMENTS.items():
+            kept = FragmentCache(workspace / rel)
+            write_part(edited, tmp_path / "warm", part, kept)
+            assert kept.misses == 0, part
+        assert _reports(tmp_path / "warm", "") == _reports(workspace)
     finally:
         rcl.write_text(original)
         assert _doit(workspace, "verify").returncode == 0
@@ -390,3 +405,53 @@ def test_every_violation_of_a_run_is_kept_and_explained_one_by_one(workspace: Pa
                           f"{vs[1]['where']}") and "answering the question at" in out and "out.command = " in out
     assert main(["explain", "-w", str(workspace), "Agent.g0.monitors.nominal_jsonl"]) == 0
     assert "Agent.g0.monitors.nominal_jsonl#12" in capsys.readouterr().out
+
+
+# --- the report's kept pieces (report/fragments.py) on this verified copy -------------------------
+
+#: Every file the report task writes (argument.svg only with Graphviz).
+FILES = ("assurance.html", "assurance.md", "assurance.json", "assurance.sarif", "assurance.junit.xml",
+         "argument.json", "argument.gsn.yaml", "argument.dot", "argument.svg")
+
+
+def _render(ws: Path, out: Path, fragments: FragmentCache | None) -> dict[str, bytes]:
+    """Every report file of ``ws`` rendered into ``out`` (as the report task does)."""
+    from rclverify.argument.export import write_argument
+    from rclverify.report.ci import write_ci_reports
+    from rclverify.report.render import render_all
+    report = build_report(Workspace(ws))
+    render_all(report, out, fragments=fragments)
+    write_ci_reports(report, out, fragments)
+    write_argument(report, out, fragments)
+    return {name: (out / name).read_bytes() for name in FILES if (out / name).exists()}
+
+
+def _reports(ws: Path, sub: str = "reports") -> dict[str, bytes]:
+    return {name: (ws / sub / name).read_bytes() for name in FILES if (ws / sub / name).exists()}
+
+
+def test_empty_and_warm_cache_give_the_uncached_report(workspace: Path, report: dict, tmp_path: Path) -> None:
+    plain = _render(workspace, tmp_path / "plain", None)
+    assert set(plain) >= set(FILES) - {"argument.svg"}
+    empty = FragmentCache(tmp_path / "cache.pickle")
+    assert _render(workspace, tmp_path / "empty", empty) == plain
+    assert empty.misses > 0 and empty.save()
+    warm = FragmentCache(tmp_path / "cache.pickle")
+    assert _render(workspace, tmp_path / "warm", warm) == plain
+    assert warm.misses == 0 and warm.hits == empty.hits + empty.misses
+    # what the doit run wrote with its own cache is the same text too
+    assert _reports(workspace) == plain
+    assert cached_dumps(report, FragmentCache()) == dumps(report)
+
+
+def test_the_report_parts_write_disjoint_files_that_together_are_the_whole_report(workspace: Path,
+                                                                                 tmp_path: Path) -> None:
+    plain = _render(workspace, tmp_path / "plain", None)
+    built = build_report(Workspace(workspace))
+    for part in reversed(PARTS):  # the order the two report tasks finish in does not matter
+        written = [p.name for p in write_part(built, tmp_path / part, part)]
+        assert set(written) <= set(PARTS[part]) and set(PARTS[part]) - set(written) <= {"argument.svg"}
+        assert sorted(p.name for p in (tmp_path / part).iterdir()) == sorted(written)
+    assert not set(PARTS["html"]) & set(PARTS["text"])
+    both = {**_reports(tmp_path, "html"), **_reports(tmp_path, "text")}
+    assert both == plain
