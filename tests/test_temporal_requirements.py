@@ -198,12 +198,13 @@ def test_an_operator_inside_a_state_formula_is_a_located_error_naming_the_shapes
     assert "always F, always next F" in d and "always (F -> eventually[<= N] G)" in d and "expected one of" not in d
 
 
-def test_the_unbounded_response_asks_for_its_bound(tmp_path: Path) -> None:
-    """The bounded response pattern is decided (tests/test_response_pattern.py); the unbounded one is not."""
-    formal = "always (Inc.out.b >= 1 -> eventually Inc.out.b >= 2)"
-    ws = _ws(tmp_path, [formal])
-    with pytest.raises(PlanError) as e:
-        Workspace(ws).checked
-    d = str(e.value.diagnostics[0])
-    assert d.startswith(f"contracts/plan.yaml:5:{13 + formal.index('eventually') + 1}: error: T1 formal:")
-    assert "always (P -> eventually[<= N] Q)" in d
+def test_the_unbounded_response_is_decided(tmp_path: Path) -> None:
+    """``always (P -> eventually Q)`` (requirements/response.py; the oracle is
+    tests/test_response_pattern.py): Inc's output, once at least 1, reaches 2
+    (proved through the bounded form); it never reaches 11, so that response
+    is never proved."""
+    recs = _check(_ws(tmp_path, ["always (Inc.out.b >= 1 -> eventually Inc.out.b >= 2)",
+                                 "always (Inc.out.b >= 1 -> eventually Inc.out.b >= 11)"]))
+    assert recs["T1"]["check"]["temporal"]["status"] == "proved", recs["T1"]["check"]["temporal"]
+    assert recs["T1"]["check"]["temporal"]["method"] == "bounded response"
+    assert recs["T2"]["check"]["temporal"]["status"] in ("refuted", "inconclusive"), recs["T2"]["check"]["temporal"]

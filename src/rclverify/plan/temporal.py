@@ -136,12 +136,6 @@ def _parse(src: Source, start: int, end: int, checked: Checked, what: str,
     imp = _response_at(text, start, end)
     if imp is not None:  # `P -> eventually[<= N] Q` / `P -> next Q`: the response pattern (under always)
         rhs = _parse(src, imp + 2, end, checked, what, states)
-        if isinstance(rhs, Temporal) and rhs.op == "eventually" and rhs.bound is None:
-            raise RclError([error(_loc_at(src, imp + 2 + len(text[imp + 2:end]) - len(text[imp + 2:end].lstrip())),
-                                  f"{what}: the unbounded response always (P -> eventually Q) is not decided; state "
-                                  "its bound in steps, always (P -> eventually[<= N] Q) (FRET's \"whenever P, within "
-                                  "N steps Q\"), or its next form always (P -> next Q) (docs/requirements.md, "
-                                  "Temporal requirements)", "E-temporal")])
         return Temporal("->", (_parse(src, start, imp, checked, what, states), rhs))
     u = _until_at(text, start, end)
     if u is not None:
@@ -219,15 +213,15 @@ def _bound(src: Source, b: "re.Match[str]", what: str) -> int:
 def shape(t: Temporal | Formal, loc: Any) -> str:
     """The decided shape of a statement (module table): ``always``,
     ``always next``, ``eventually``, ``next``, ``until``, ``response``
-    (``always (P -> eventually[<= N] Q)`` or ``always (P -> next Q)``: the
-    bounded response pattern, FRET's "whenever P, within N steps Q");
+    (``always (P -> eventually[<= N] Q)``, ``always (P -> eventually Q)``
+    or ``always (P -> next Q)``: the response pattern, FRET's "whenever P,
+    within N steps Q" and "whenever P, eventually Q");
     raises :class:`RclError` (``E-temporal`` at ``loc``) for another nesting."""
     if isinstance(t, Temporal):
         a = t.args[0]
         if t.op == "always" and isinstance(a, Temporal) and a.op == "->" and isinstance(a.args[0], Formal):
             r = a.args[1]
-            if isinstance(r, Temporal) and isinstance(r.args[0], Formal) and (
-                    r.op == "next" or (r.op == "eventually" and r.bound is not None)):
+            if isinstance(r, Temporal) and isinstance(r.args[0], Formal) and r.op in ("next", "eventually"):
                 return "response"
         if t.op in ("always", "eventually", "next") and isinstance(a, Formal):
             return t.op
@@ -236,6 +230,6 @@ def shape(t: Temporal | Formal, loc: Any) -> str:
         if t.op == "until" and all(isinstance(x, Formal) for x in t.args):
             return "until"
     raise RclError([error(loc, "this nesting of temporal operators is not decided; write always F, always next F, "
-                               "eventually F, eventually[<= N] F, next F, F until G, always (F -> eventually[<= N] G) "
-                               "or always (F -> next G) with F, G state formulas "
+                               "eventually F, eventually[<= N] F, next F, F until G, always (F -> eventually[<= N] G), "
+                               "always (F -> eventually G) or always (F -> next G) with F, G state formulas "
                                "(docs/requirements.md, Temporal requirements)", "E-temporal")])

@@ -23,13 +23,36 @@ P and Q are read on published values (docs/semantics.md): the caller's
 A run that stops with an obligation pending is found by the caller's
 check that no run stops (:func:`.deadlock.runs_go_on`), as for every
 liveness statement.
+
+The **unbounded** form ``always (P -> eventually Q)`` (FRET's "whenever P,
+eventually Q"; Dwyer, Avrunin and Corbett's response pattern, ICSE 1999)
+is liveness: a violation is an infinite run on which some P is never
+answered.  :func:`check_unbounded_response` adds a Boolean ``<pending>``
+(a P not yet answered: ``P and not Q`` initially, then ``(pending or P)
+and not Q``) and decides:
+
+* ``proved`` (method ``ranking``) by the plan's ranking function: in every
+  state of its invariant where a P is pending the rank is >= 0 and every
+  step decreases it (the rule of :func:`.temporal.check_eventually`);
+* ``proved`` (method ``bounded response``) when the bounded pattern holds
+  for some N in :data:`BOUNDS` (at most the search bound): every P is then
+  answered within N steps, so eventually;
+* ``refuted`` (method ``lasso``) by a run whose last state equals an
+  earlier one, the loop meeting the fairness constraints, with a P pending
+  in every state of the loop: repeated forever, that P is never answered;
+* else ``inconclusive``, naming what was tried.
 """
 from __future__ import annotations
 
 import z3
 
-from .temporal import check_always
-from .tsys import Pred, TemporalVerdict, TransitionSystem, with_flag
+from typing import Callable
+
+from .temporal import _ranking_fails, check_always
+from .tsys import Pred, TemporalVerdict, TransitionSystem, fair_loop, trace_of, unroll, with_flag
+
+#: The bounds N tried, in order, to prove the unbounded response from the bounded one.
+BOUNDS = (0, 1, 2, 4, 8)
 
 
 def with_counter(ts: TransitionSystem, name: str, init: "z3.ArithRef | object",
@@ -63,3 +86,54 @@ def check_response(ts: TransitionSystem, trigger: Pred, goal: Pred, within: int 
     ts2 = with_counter(ts, "<pending>", start, step)
     inv = lambda s: z3.And(s["<pending>"] >= -1, s["<pending>"] < n)  # noqa: E731
     return check_always(ts2, inv, max_k=max(max_k, n + 2), timeout_ms=timeout_ms)
+
+
+def check_unbounded_response(ts: TransitionSystem, trigger: Pred, goal: Pred, *, max_k: int = 10,
+                             timeout_ms: int = 10_000, ranking: Callable[[dict], z3.ArithRef] | None = None,
+                             invariant: Pred | None = None) -> TemporalVerdict:
+    """Decide ``always (trigger -> eventually goal)`` (module docstring):
+    ``proved`` by ``ranking`` (with ``invariant``, which the caller has
+    proved) or by the bounded pattern for an N of :data:`BOUNDS` up to
+    ``max_k``; ``refuted`` by a lasso of at most ``max_k`` steps with a
+    trigger pending around its loop; else ``inconclusive``.  ``timeout_ms``
+    bounds each solver call (milliseconds)."""
+    ts2 = with_flag(ts, "<pending>", lambda s: z3.And(trigger(s), z3.Not(goal(s))),
+                    lambda s, t: z3.And(z3.Or(s["<pending>"], trigger(t)), z3.Not(goal(t))))
+    why = "no ranking function"
+    if ranking is not None:
+        inv = invariant or (lambda st: z3.BoolVal(True))
+        failed = _ranking_fails(ts2, lambda st: z3.Not(st["<pending>"]), inv, ranking, timeout_ms)
+        if failed is None:
+            return TemporalVerdict("proved", "ranking", detail="in every state of the invariant where a trigger is "
+                                                               "pending, the ranking function is >= 0 and every step "
+                                                               "decreases it")
+        why = failed
+    tried = []
+    for n in (b for b in BOUNDS if b <= max_k):
+        v = check_response(ts, trigger, goal, n, max_k=max_k, timeout_ms=timeout_ms)
+        if v.status == "proved":
+            return TemporalVerdict("proved", "bounded response", k=v.k, bound=n,
+                                   detail=f"every trigger is answered within {n} steps (k-induction, k = {v.k})")
+        tried.append(f"within {n}: {v.status}")
+    for n in range(1, max_k + 1):
+        states, steps = unroll(ts2, n)
+        sv = z3.Solver()
+        sv.set("timeout", timeout_ms)
+        loops = [z3.And(*[states[n][v] == states[j][v] for v in ts2.sorts], fair_loop(ts2, states[j:n]),
+                        *[st["<pending>"] for st in states[j:n + 1]]) for j in range(n)]
+        sv.add(ts2.init(states[0]), *steps, z3.Or(*loops))
+        r = sv.check()
+        if r == z3.sat:
+            m = sv.model()
+            loop = next(j for j in range(n) if z3.is_true(m.eval(loops[j], model_completion=True)))
+            return TemporalVerdict("refuted", "lasso", bound=n, trace=trace_of(m, states), loop=loop,
+                                   detail=f"a run whose step {n} returns to step {loop} with a trigger pending at "
+                                          "every step of the loop: it is never answered")
+        if r == z3.unknown:
+            return TemporalVerdict("inconclusive", "lasso", bound=n - 1,
+                                   detail=f"{why}; not answered within {', '.join(tried)}; Z3 could not decide "
+                                          f"whether a run of {n} steps loops with a trigger pending "
+                                          f"({sv.reason_unknown()})")
+    return TemporalVerdict("inconclusive", "lasso", bound=max_k,
+                           detail=f"{why}; the bounded pattern tried {', '.join(tried) or 'no bound'}; no run of up "
+                                  f"to {max_k} steps loops with a trigger pending")

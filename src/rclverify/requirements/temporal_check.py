@@ -20,6 +20,10 @@ statement                   decided by
 ``always (P -> eventually   ``always`` of a monitor variable: the age of the
 [<= N] Q)``, ``always       oldest P not yet answered (BMC, k-induction;
 (P -> next Q)``             :mod:`.response`)
+``always (P -> eventually   a P pending: the plan's ranking function, or
+Q)``                        the bounded form for a small N (proved); a
+                            lasso with a P pending around its loop
+                            (refuted); else inconclusive (:mod:`.response`)
 ==========================  ===============================================
 
 Other nestings raise a located ``E-temporal`` error (the plan's
@@ -159,8 +163,11 @@ def _decide(t: Temporal, sys: ComposedSystem, pred: Callable[[Formal], Callable[
     if kind == "always":
         return check_always(ts, pred(t.args[0]), max_k=bound, timeout_ms=timeout_ms)
     if kind == "response":  # always (P -> eventually[<= N] Q) / always (P -> next Q): requirements/response.py
-        from .response import check_response
+        from .response import check_response, check_unbounded_response
         p, r = t.args[0].args  # type: ignore[union-attr]
+        if r.op == "eventually" and r.bound is None:  # type: ignore[union-attr]
+            return check_unbounded_response(ts, got(p), got(r.args[0]), max_k=bound,  # type: ignore[arg-type, union-attr]
+                                            timeout_ms=timeout_ms, ranking=ranking, invariant=invariant)
         within = r.bound if r.op == "eventually" else None  # type: ignore[union-attr]
         return check_response(ts, got(p), got(r.args[0]), within, max_k=bound,  # type: ignore[arg-type, union-attr]
                               timeout_ms=timeout_ms)

@@ -7,14 +7,17 @@ out; a trigger still pending when the trace ends is ``currently_false`` (a
 longer run may answer it); otherwise ``true`` (evidence, not a proof).
 The rule is the composed system's (:mod:`rclverify.requirements.response`):
 a P at step i needs Q at some step i..i+N (``next``: Q at step i+1).
+The unbounded ``always (P -> eventually Q)`` is N = infinity: never
+``false`` on a finite run, ``currently_false`` while a P waits.
 """
 from __future__ import annotations
 
 
 class ResponseTracker:
-    """The obligations of one run.  ``within``: N, or ``None`` for the next form."""
+    """The obligations of one run.  ``within``: N (``math.inf``: the
+    unbounded form), or ``None`` for the next form."""
 
-    def __init__(self, within: int | None) -> None:
+    def __init__(self, within: float | None) -> None:
         self.within = within
         self.pending: int | None = None  # the step of the oldest trigger not yet answered
         self.before: bool | None = False  # next form: the trigger's value at the step before

@@ -53,6 +53,8 @@ operand read there).
 """
 from __future__ import annotations
 
+import math
+
 from dataclasses import dataclass, field
 from fractions import Fraction
 from typing import Any, Iterable, Mapping
@@ -343,7 +345,8 @@ def check_temporal_trace(t: Temporal, checked: Checked, states: tuple[StateVar, 
     elif kind == "response":  # always (P -> eventually[<= N] Q) / always (P -> next Q)
         trig, resp = t.args[0].args  # type: ignore[union-attr]
         ops = [trig, resp.args[0]]  # type: ignore[list-item, union-attr]
-        tracker = ResponseTracker(resp.bound if resp.op == "eventually" else None)  # type: ignore[union-attr]
+        tracker = ResponseTracker((math.inf if resp.bound is None else resp.bound)  # type: ignore[union-attr]
+                                  if resp.op == "eventually" else None)  # type: ignore[union-attr]
     else:
         ops = list(t.args)  # type: ignore[arg-type]
     nodes = list(dict.fromkeys(n for f in ops for n in f.nodes))
