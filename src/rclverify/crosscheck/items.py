@@ -19,8 +19,8 @@ kind               record                                  verdict    expects
 
 A health check reads ``ok`` on a satisfiable query (an assumption that can
 be met, a consistent contract, a guarantee that can fire: Z3's witness is
-its certificate) except the replacement check, which reads ``ok`` on a
-proof.  A proved requirement's consistency and vacuity answers are items
+its certificate) except the replacement check and realizability, which
+read ``ok`` on a proof.  A proved requirement's consistency and vacuity answers are items
 too (its ``met`` rests on the satisfiable ones, its ``proved vacuously`` or
 ``from an inconsistency`` on the unsatisfiable ones).  A record whose seal does not hold gives no item: the report already
 shows it ``error``.  A Hoare obligation's script holds one query per
@@ -37,7 +37,7 @@ from ..requirements.stage import record_path
 
 #: Health checks whose ``ok`` is an ``unsat`` answer (a proof); every other
 #: check's ``ok`` is a satisfiable answer with Z3's witness.
-PROOF_CHECKS = frozenset({"replacement-refines"})
+PROOF_CHECKS = frozenset({"replacement-refines", "realizable"})
 
 #: A proved requirement's side queries (``requirements/check.py``): their decided verdicts and Z3's
 #: answer behind each.
