@@ -206,7 +206,8 @@ def build_report(ws: Workspace) -> dict[str, Any]:
         if isinstance(ev.details.get("examples"), dict):  # property tests: example counts and seed
             ev_rows[-1]["examples"] = {**ev.details["examples"], "seed": ev.details.get("seed"),
                                        "replay": ev.details.get("replay", ""),
-                                       "facts": ev.details.get("facts", [])}
+                                       "facts": ev.details.get("facts", []),
+                                       "coverage": ev.details.get("coverage") or {}}
         if isinstance(ev.details, dict) and ev.details.get("monitoring"):
             ev_rows[-1]["monitoring"] = ev.details["monitoring"]
         if status == "pending":
