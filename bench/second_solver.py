@@ -7,7 +7,8 @@ prints:
 
 * the CPU seconds of the cold run (Z3 and everything else);
 * the CPU seconds of the second-solver stage alone, and cvc5's own
-  seconds summed over the items, with the items' agreement counts;
+  seconds summed over the items, with the items' agreement counts, in
+  all and per kind of item;
 * the CPU seconds of `bundle --recheck` (both solvers, from the bundle alone).
 
 `--smoke` uses the generated three-node workspace of `rclverify init`
@@ -68,6 +69,12 @@ def main() -> int:
     print(f"second-solver stage (cvc5, {len(index['items'])} items):   {stage:7.2f} CPU s "
           f"({cvc5_s:.2f} s in cvc5; {stage / cold:.1%} of the cold run)")
     print(f"agreement: {index['counts']}")
+    kinds: dict[str, dict[str, int]] = {}
+    for r in index["items"]:
+        by = kinds.setdefault(r["kind"], {})
+        by[r["agreement"]] = by.get(r["agreement"], 0) + 1
+    for kind, by in sorted(kinds.items()):
+        print(f"  {kind}: {by}")
     print(f"`bundle --recheck` (Z3 and cvc5 from text): {recheck:7.2f} CPU s (rc {rc})")
     return 0
 

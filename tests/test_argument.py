@@ -187,7 +187,7 @@ def test_gsn2x_yaml_has_the_documented_shape() -> None:
     for eid, body in data.items():
         e = arg.elements[eid]
         assert eid.startswith(prefix[e.type]) and isinstance(body["text"], str)
-        assert set(body) <= {"text", "supportedBy", "inContextOf", "undeveloped", "url"}
+        assert set(body) <= {"text", "supportedBy", "inContextOf", "undeveloped", "url", "acp"}
         for x in body.get("supportedBy", []):
             assert data[x] is not None and arg.elements[x].type in ("goal", "strategy", "solution")
         for x in body.get("inContextOf", []):
@@ -257,3 +257,45 @@ def test_an_argument_too_large_to_draw_is_not_laid_out(tmp_path: Any, monkeypatc
     assert f"the argument has {n} elements" in section and '<a href="argument.dot">' in section
     assert "<pre>" not in section and 'href="argument.svg"' not in section
     assert "No diagram: the argument has" in render.render_markdown(_report())
+
+
+def _claim_points_obey_v09(data: dict[str, Any]) -> list[tuple[str, str]]:
+    """Every assurance claim point of a gsn2x YAML document, ``(element, ACP name)``, after checking gsn2x's V09
+    on it: it references only the element itself or the element's supportedBy / inContextOf targets."""
+    out = []
+    for eid, body in data.items():
+        for name, refs in (body.get("acp") or {}).items():
+            assert refs, (eid, name)
+            for x in refs:
+                assert x == eid or x in body.get("supportedBy", []) or x in body.get("inContextOf", []), (eid, name, x)
+            out.append((eid, name))
+    return out
+
+
+def test_assurance_claim_points_mark_where_confidence_is_argued() -> None:
+    from rclverify.report.confidence_rows import annotate
+    rep = _report()
+    rep["evidence"][0]["status"] = "failed"  # counter-evidence: a defeater of Sensor guarantee 1
+    rep["obligations"][0]["status"] = "failed"
+    rep["nodes"][0]["guarantees"][0]["obligations"] = ["Sensor.g1.hoare"]
+    rep["nodes"][0]["guarantees"][1]["obligations"] = ["Sensor.g2.review"]
+    annotate(rep, [("Sensor", "Planner")])
+    data = yaml.safe_load(to_gsn_yaml(build_argument(rep), "mini"))
+    points = dict(_claim_points_obey_v09(data))
+    # each requirement goal has one (these requirements are argued by the calculus: no confidence of their own)
+    assert points["G-REQ1"] == "ACP-REQ1" and points["G-REQ2"] == "ACP-REQ2"
+    # a node claim: on its link to the premise that limits it, with the confidence and rule C3
+    assert data["G-Sensor"]["acp"] == {"ACP-Sensor": ["G-Sensor.g1"]}
+    assert "[ACP-Sensor: confidence 0 by rule C3, limited by Sensor guarantee 1" in data["G-Sensor"]["text"]
+    assert "confidence 0.0001 by rule C4" not in data["G-Planner"]["text"]
+    assert "its derived property (rules R1-R4): confidence 0 by rule C4" in data["G-Planner"]["text"]
+    # where the defeater attaches
+    assert data["G-Sensor.g1"]["acp"] == {"ACP-Sensor.g1.challenged": ["G-Sensor.g1"]}
+    assert "challenged by CSn-ev.Sensor.g1.hoare (defeated): confidence 0 by rule C0" in data["G-Sensor.g1"]["text"]
+    # the model rejects a claim point gsn2x's V09 would reject
+    arg = build_argument(rep)
+    bad = dict(arg.elements)
+    bad["G-Sensor"] = dataclasses.replace(bad["G-Sensor"], acp=(("ACP-x", ("G-Planner.g1",)),))
+    with pytest.raises(ArgumentError, match="ACP-x references 'G-Planner.g1'"):
+        propagate(Argument(arg.top, bad))
+    assert Argument.from_json(arg.to_json()) == arg

@@ -107,13 +107,31 @@ def test_strength_and_confidence_in_every_format(ws: Path) -> None:
                for sc in r["side_conditions"])
     req = {q["id"]: q for q in r["requirements"]}
     assert req["REQ1"]["verdict"] == "met" and 0.99 < req["REQ1"]["confidence"] < 1
-    assert req["REQ1"]["limited_by"]["sentence"].startswith("REQ1 rests on a proof by one solver for Actuator guarantee 1")
+    assert req["REQ1"]["limited_by"]["sentence"].startswith("REQ1 rests on a proof for Actuator guarantee 1")
     assert req["REQ1"]["strength_shortfall"] == []
     assert r["summary"]["confidence"] == min(q["confidence"] for q in r["requirements"])
     sarif = json.loads((ws / "reports/assurance.sarif").read_text())
     assert sarif and "strength" in (ws / "reports/assurance.junit.xml").read_text()
-    assert "rests on a proof by one solver" in (ws / "reports/assurance.html").read_text()
+    assert "rests on a proof for Actuator guarantee 1" in (ws / "reports/assurance.html").read_text()
     assert "confidence" in (ws / "reports/argument.gsn.yaml").read_text()
+
+
+def test_every_requirement_goal_has_an_assurance_claim_point_gsn2x_accepts(ws: Path) -> None:
+    import yaml
+
+    from test_argument import _claim_points_obey_v09
+    data = yaml.safe_load((ws / "reports/argument.gsn.yaml").read_text())
+    points = _claim_points_obey_v09(data)
+    r = json.loads((ws / "reports/assurance.json").read_text())
+    for q in r["requirements"]:
+        assert (f"G-{q['id']}", f"ACP-{q['id']}") in points
+    req1 = data["G-REQ1"]
+    assert req1["acp"] == {"ACP-REQ1": ["S-REQ1"]}
+    conf = next(q["confidence"] for q in r["requirements"] if q["id"] == "REQ1")
+    assert f"[ACP-REQ1: confidence {conf:.4g} by rule C5; REQ1 rests on a proof for Actuator guarantee 1" in req1["text"]
+    # the strategy's link to the premise that limits REQ1 (the calculus names it)
+    assert data["S-REQ1"]["acp"] == {"ACP-REQ1.limit": ["G-Actuator.g1"]}
+    assert all((f"G-{n}", f"ACP-{n}") in points for n in ("Sensor", "Controller", "Actuator"))
 
 
 def test_a_required_strength_the_evidence_lacks_fails_strict(ws: Path, tmp_path: Path) -> None:

@@ -238,6 +238,12 @@ def test_backend_evidence_for_the_bundled_runs(exported: Path) -> None:
     assert evs["env_fault_jsonl"].status == "discharged"  # the environment is blamed, not the sensor
     m = evs["sensor_fault_jsonl"].details["monitoring"]
     assert m["first_violation"]["guarantee"] == 1 and len(m["sha256"]) == 64 and m["events_read"] > 50
+    # the run's duration in trace time: its first event to its last, as the file has them
+    import json as _json
+    times = [_json.loads(line)["time"] for line in
+             (exported / "backends/monitors/traces/nominal.jsonl").read_text().splitlines() if line.strip()]
+    nominal = evs["nominal_jsonl"].details["monitoring"]
+    assert nominal["duration_s"] == pytest.approx(max(times) - min(times)) and nominal["duration_s"] > 0
     assert "rosbags" in evs["nominal_jsonl"].tool_version
     assert "blamed on the environment" in evs["env_fault_jsonl"].explanation
 

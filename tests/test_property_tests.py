@@ -115,6 +115,21 @@ def test_correct_implementation_discharged(tmp_path: Path) -> None:
     ex = ev.details["examples"]
     assert ex["valid"] == 100 and ex["failures"] == 0 and ex["inconclusive"] == 0
     assert "impl.py" in ev.input_hashes
+    cov = ev.details["coverage"]  # r is bounded below only; a command is a term: not measured
+    assert cov["in.r"]["range"] == "[0, inf]" and cov["in.r"]["fraction"] is None and ".." in cov["in.r"]["drawn"]
+    assert cov["in.command"]["fraction"] is None and "not measured" in cov["in.command"]["range"]
+
+
+def test_the_coverage_of_a_bounded_range_is_the_buckets_the_examples_hit(tmp_path: Path) -> None:
+    from rclverify.argument.strength import evidence_strength
+    ev = run(workspace(tmp_path, GOOD, extra="        bounds: {in.r: [0, 500]}\n"))
+    c = ev.details["coverage"]["in.r"]
+    lo, hi = (float(x) for x in c["drawn"].split(".."))
+    assert c["range"] == "[0, 500]" and c["buckets"] == 10 and 0 <= lo <= hi <= 500
+    assert c["fraction"] == c["covered"] / 10 and 1 <= c["covered"] <= 10
+    row = {"backend": "property_tests", "status": ev.status, "examples": {**ev.details["examples"],
+                                                                         "coverage": ev.details["coverage"]}}
+    assert f"in.r {c['fraction']:.0%} of [0, 500] (drawn {c['drawn']})" in evidence_strength(row)["detail"]
 
 
 def test_off_by_one_threshold_caught_with_shrunk_counterexample(tmp_path: Path) -> None:

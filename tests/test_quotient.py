@@ -41,6 +41,9 @@ def test_the_middle_node_of_a_chain_gets_the_weakest_contract_which_puts_in_plac
     assert "assume( 0 <= in.x1 and in.x1 <= 51 )" in text
     assert "guarantee( 0 <= out.x2 and out.x2 <= 59 )" in text
     assert "exact" in text and "REQ proved" in text and "N2.sc2 discharged" in text
+    # every proved re-check decided again by cvc5 from its script (issue 50; docs/second-solver.md)
+    said = re.search(r"// Second solver \(cvc5\) on each proved re-check: (.*)\.\n", text)
+    assert said and "REQ two solvers" in said.group(1) and "N2.sc2 two solvers" in said.group(1), text
     # put in place by hand: every side condition discharged (compose exits 0), the requirement met
     rcl = ws / "contracts/chain.rcl"
     block = re.search(r"node N1 \{.*?\n\}\n", text, re.S).group(0)  # type: ignore[union-attr]
@@ -51,6 +54,19 @@ def test_the_middle_node_of_a_chain_gets_the_weakest_contract_which_puts_in_plac
     assert "[failed]" not in proc.stdout and "N1.sc2 [discharged in context]" in proc.stdout
     proc = _rclverify(ws, "requirements")
     assert proc.returncode == 0 and "REQ" in proc.stdout and "proved" in proc.stdout, proc.stdout + proc.stderr
+
+
+def test_a_re_check_the_second_solver_does_not_confirm_is_not_a_contract(tmp_path: Path) -> None:
+    """cvc5 given a satisfiable query for each proved re-check (a planted wrong script): it disagrees, and the
+    contract does not re-check."""
+    pytest.importorskip("cvc5")
+    from rclverify.crosscheck.stage import confirm_proof
+    ws = Workspace(write_chain(tmp_path / "ws", 3, missing=[1]), interface_only=("N1",))
+    with pytest.raises(QuotientError, match=r"does not re-check with Z3 and cvc5: .*inconclusive \(second solver: "
+                                            r"Z3 answered unsat, cvc5 sat\)"):
+        quotient(ws.checked, ws.model, ws.plan, "N1",
+                 confirm=lambda _: confirm_proof("(declare-fun x () Real)\n(assert (> x 1.0))\n(check-sat)\n"))
+    world.fresh()
 
 
 def test_stdout_without_output_option_and_the_errors(tmp_path: Path) -> None:

@@ -70,6 +70,28 @@ def test_a_planted_wrong_proof_reads_inconclusive(ws: Path, tmp_path: Path) -> N
     assert main(["verify", "-w", str(root), "--strict"]) == 1
 
 
+def test_a_requirements_side_queries_are_decided_by_both_and_a_disagreement_is_inconclusive(
+        ws: Path, tmp_path: Path) -> None:
+    import shutil
+    r = _report(ws)
+    req2 = next(q for q in r["requirements"] if q["id"] == "REQ2")["check"]
+    for side, answer in (("consistency", "sat"), ("vacuity", "sat")):
+        s = req2[f"{side}_solvers"]
+        assert s["agreement"] == "two solvers" and s["cvc5"]["answer"] == answer, (side, s)
+        assert s["smt2"] == f"artifacts/requirements/REQ2.{side}.smt2"
+    root = tmp_path / "ws"
+    shutil.copytree(ws, root)
+    # the record says Z3 found a model of REQ2's premise; its stored query is in fact unsatisfiable
+    (root / "artifacts/requirements/REQ2.vacuity.smt2").write_text(
+        "(declare-fun x () Real)\n(assert (and (> x 1.0) (< x 0.0)))\n(check-sat)\n")
+    stage_crosscheck(root, ["Sensor", "Controller", "Actuator"])
+    assert main(["report", "-w", str(root)]) in (0, 1)
+    req = next(q for q in _report(root)["requirements"] if q["id"] == "REQ2")
+    assert req["verdict"] == "inconclusive" and req["check"]["vacuity_solvers"]["agreement"] == "disagree"
+    assert "second solver does not agree: Z3 answered sat, cvc5 unsat" in req["note"]
+    assert "Vacuity (non-vacuous): disagree" in (root / "reports/assurance.md").read_text()
+
+
 def test_cvc5_unknown_on_a_proof_is_inconclusive() -> None:
     hard = ("(declare-fun x () Int)(declare-fun y () Int)(declare-fun z () Int)"
             "(assert (and (> x 0) (> y 0) (> z 0) (= (+ (* x x x) (* y y y)) (* z z z))))(check-sat)")

@@ -533,10 +533,11 @@ def cmd_quotient(args: argparse.Namespace) -> int:
     (:mod:`rclverify.calculus.quotient`); a contract that cannot be given is
     one ``error:`` line, exit 1."""
     from .calculus.quotient import QuotientError, quotient, render
+    from .crosscheck.stage import confirm_proof  # each proved re-check confirmed by cvc5 (docs/second-solver.md)
     from .pipeline import Workspace
     ws = Workspace(Path(args.workspace), args.plan, interface_only=(args.node,))
     try:
-        q = quotient(ws.checked, ws.model, ws.plan, args.node)
+        q = quotient(ws.checked, ws.model, ws.plan, args.node, confirm=confirm_proof)
     except QuotientError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 1

@@ -114,9 +114,8 @@ def _requirement_goal(b: "_Builder", r: Mapping[str, Any], guarantee_goal: Mappi
               + (f" ({', '.join(p['label'] for p in c.get('used') or [])})" if c.get("used") else "")
               + ". " + ENTAILMENT),
         supported_by=tuple(dict.fromkeys(kids)), in_context_of=tuple(ctx), ref=rid))
-    conf = (f" [confidence {r['confidence']:.4g}: {r['limited_by']['sentence']}]"
-            if r.get("confidence") is not None and r.get("limited_by") else "")
-    return b.add(Element(ident("G", rid), "goal", _clip(f"{rid}: {r['text']}{conf}"), supported_by=(strategy,), ref=rid))
+    # its confidence is stated at its assurance claim point (.claim_points)
+    return b.add(Element(ident("G", rid), "goal", _clip(f"{rid}: {r['text']}"), supported_by=(strategy,), ref=rid))
 
 
 class _Builder:
@@ -302,6 +301,8 @@ def build_argument(report: Mapping[str, Any]) -> Argument:
                           supported_by=(s_reqs, s_contracts), in_context_of=top_ctx), **b.els}
     from .defeaters import add_defeaters  # counter-evidence as the dialectic extension's defeaters (issue 50)
     add_defeaters(b.els, report, ident)
+    from .claim_points import add_claim_points  # where confidence is argued (issue 50)
+    add_claim_points(b.els, report, ident)
     return propagate(Argument(top, b.els))
 
 

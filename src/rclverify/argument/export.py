@@ -5,7 +5,9 @@
   "Syntax in YAML"): one top-level key per element whose prefix gives its
   type (``G``, ``S``, ``Sn``, ``C``, ``A``, ``J``), with ``text``, and
   optionally ``supportedBy``, ``inContextOf`` (lists of ids),
-  ``undeveloped: true`` and ``url``.  The status is appended to the text of
+  ``undeveloped: true`` and ``url``; the dialectic extension's
+  ``challenges`` and ``defeated`` and the confidence extension's ``acp``
+  (assurance claim points, :mod:`.claim_points`).  The status is appended to the text of
   goals, strategies and solutions (gsn2x has no status attribute).
 * DOT (:func:`to_dot`): GSN shapes (goal box, strategy parallelogram,
   solution ellipse, context rounded box, assumption and justification ovals
@@ -135,7 +137,7 @@ def to_gsn_yaml(arg: Argument, title: str = "assurance argument", link_prefix: s
     def element(e: Element) -> dict[str, Any]:
         return {"id": e.id, "text": _with_status(e), "supported_by": e.supported_by,
                 "in_context_of": e.in_context_of, "undeveloped": e.undeveloped,
-                "challenges": e.challenges, "defeated": e.defeated,
+                "challenges": e.challenges, "defeated": e.defeated, "acp": e.acp,
                 "url": link_prefix + e.url if e.url else ""}
     elements = _pieces(arg, fragments, "argument.gsn-elements.yaml.j2", link_prefix, element)
     return _environment().get_template("argument.gsn.yaml.j2").render(title=title.replace("\n", " "), elements=elements)

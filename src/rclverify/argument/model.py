@@ -65,6 +65,9 @@ class Element:
     challenges: tuple[str, ...] = ()
     #: the claim is defeated by counter-evidence (the dialectic extension's ``defeated``)
     defeated: bool = False
+    #: assurance claim points (the confidence extension's ``acp``): ``(name, references)`` each, a
+    #: reference being the element itself or one of its ``supported_by`` / ``in_context_of`` targets
+    acp: tuple[tuple[str, tuple[str, ...]], ...] = ()
 
     def to_json(self) -> dict[str, Any]:
         out = {"id": self.id, "type": self.type, "text": self.text, "status": self.status,
@@ -72,6 +75,8 @@ class Element:
                "undeveloped": self.undeveloped, "ref": self.ref, "url": self.url}
         if self.challenges or self.defeated:
             out.update(challenges=list(self.challenges), defeated=self.defeated)
+        if self.acp:
+            out["acp"] = {name: list(refs) for name, refs in self.acp}
         return out
 
     @staticmethod
@@ -79,7 +84,8 @@ class Element:
         return Element(id=d["id"], type=d["type"], text=d["text"], status=d.get("status"),
                        supported_by=tuple(d.get("supported_by", ())), in_context_of=tuple(d.get("in_context_of", ())),
                        undeveloped=bool(d.get("undeveloped", False)), ref=d.get("ref", ""), url=d.get("url", ""),
-                       challenges=tuple(d.get("challenges", ())), defeated=bool(d.get("defeated", False)))
+                       challenges=tuple(d.get("challenges", ())), defeated=bool(d.get("defeated", False)),
+                       acp=tuple((str(n), tuple(r)) for n, r in (d.get("acp") or {}).items()))
 
 
 @dataclass(frozen=True)
@@ -123,6 +129,11 @@ def validate(arg: Argument) -> None:
         for x in e.challenges:
             if x not in els or els[x].type not in ("goal", "solution"):
                 raise ArgumentError(f"{e.id}: challenges {x!r}, which is not a goal or solution of the structure")
+        for name, refs in e.acp:  # gsn2x V09: the element itself or an element directly related to it
+            for x in refs:
+                if x != e.id and x not in e.supported_by and x not in e.in_context_of:
+                    raise ArgumentError(f"{e.id}: assurance claim point {name} references {x!r}, which is neither "
+                                        "the element nor one of its supportedBy / inContextOf targets")
         if e.supported_by and e.type not in ("goal", "strategy"):
             raise ArgumentError(f"{e.id}: only goals and strategies are supported by other elements")
         if e.undeveloped and e.supported_by:
@@ -184,5 +195,6 @@ def propagate(arg: Argument) -> Argument:
         # most elements keep theirs (solutions); the constructor, not dataclasses.replace (4x slower)
         out[i] = e if s == e.status else Element(
             id=e.id, type=e.type, text=e.text, status=s, supported_by=e.supported_by, in_context_of=e.in_context_of,
-            undeveloped=e.undeveloped, ref=e.ref, url=e.url, challenges=e.challenges, defeated=e.defeated)
+            undeveloped=e.undeveloped, ref=e.ref, url=e.url, challenges=e.challenges, defeated=e.defeated,
+            acp=e.acp)
     return Argument(arg.top, out)

@@ -12,8 +12,10 @@ kind           what it rests on
                abstraction or a partial mapping
 ``statistical`` experiments: the sample size and the one-sided 95 % bound
                the data give for the criterion
-``tested``     property tests: examples run against the assumption
-``observed``   monitored runs: questions answered, events read
+``tested``     property tests: examples run against the assumption, and
+               their coverage of the assumption's ranges per input
+``observed``   monitored runs: questions answered, events read, the run's
+               duration in trace time
 ``reviewed``   a signed review record
 ``assumed``    stated, not verified (environment assumptions, declared
                progress and initial values)
@@ -87,17 +89,37 @@ def evidence_strength(row: Mapping[str, Any]) -> dict[str, Any]:
     elif kind == "tested":
         ex = row.get("examples") or {}
         detail = f"{ex.get('valid', 0)} examples within the assumption (of {ex.get('run', 0)} run)"
+        cov = coverage_text(ex.get("coverage") or {})
+        detail += f"; coverage of the assumption's ranges: {cov}" if cov else ""
     elif kind == "observed":
         m = row.get("monitoring") or {}
         c = m.get("counts") or {}
         answered = int(c.get("satisfied", 0) or 0) + int(c.get("violated", 0) or 0)
         detail = f"{answered} questions answered, {m.get('events_read', 0)} events read"
+        if isinstance(m.get("duration_s"), (int, float)):
+            detail += f" over {m['duration_s']:g} s of trace time"
     elif kind == "reviewed":
         who = (_figure(row, "reviewer") or "").split(";")[0].strip()
         detail = f"review by {who[:60] or 'an unnamed reviewer'}"
     if row.get("status") != "discharged":
         doubt = 1.0
     return {"kind": kind, "detail": detail, "doubt": doubt}
+
+
+def coverage_text(cov: Mapping[str, Any]) -> str:
+    """The property tests' coverage (backends/property_tests/coverage.py) in
+    one line: ``in.x 80% of [0, 100] (drawn 0..97)`` per measured input,
+    ``in.y drawn -3..41 of [-inf, inf] (unbounded)`` for an unbounded one;
+    inputs not measured (tables, sequences) are left out.  '' without any."""
+    parts = []
+    for key, c in cov.items():
+        if not isinstance(c, Mapping):
+            continue
+        if isinstance(c.get("fraction"), (int, float)):
+            parts.append(f"{key} {c['fraction']:.0%} of {c.get('range')} (drawn {c.get('drawn')})")
+        elif c.get("buckets") is None and c.get("drawn") and "not measured" not in str(c.get("range")):
+            parts.append(f"{key} drawn {c['drawn']} of {c.get('range')} (unbounded)")
+    return "; ".join(parts)
 
 
 def side_condition_strength(sc: Mapping[str, Any]) -> dict[str, Any]:

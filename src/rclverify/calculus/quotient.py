@@ -40,7 +40,7 @@ from __future__ import annotations
 
 import dataclasses
 from dataclasses import dataclass
-from typing import Any, Mapping, Sequence
+from typing import Any, Callable, Mapping, Sequence
 
 import z3
 
@@ -94,6 +94,8 @@ class Quotient:
     recheck: tuple[tuple[str, str], ...]
     notes: tuple[str, ...]
     node_text: str
+    #: the second solver on each proved re-check: ``(id, agreement, why)`` (empty without one)
+    solvers: tuple[tuple[str, str, str], ...] = ()
 
 
 def _conj(fs: Sequence[z3.BoolRef]) -> z3.BoolRef:
@@ -204,7 +206,14 @@ class _Beyond(Exception):
     """The computation leaves linear arithmetic."""
 
 
-def quotient(checked: Checked, model: SystemModel, plan: Any, node: str) -> Quotient:
+#: Re-check verdicts that rest on a proof (Z3's unsat), which a second solver confirms.
+PROVED = ("discharged", "discharged in context", "proved")
+#: Agreements of the second solver that make a proved re-check inconclusive (crosscheck/stage.py).
+NOT_CONFIRMED = ("disagree", "inconclusive")
+
+
+def quotient(checked: Checked, model: SystemModel, plan: Any, node: str,
+             confirm: Callable[[str], tuple[str, str]] | None = None) -> Quotient:
     """The weakest contract of ``node`` (module docstring), re-checked.
 
     A node on a loop (every service client and server pair is one) is
@@ -214,6 +223,11 @@ def quotient(checked: Checked, model: SystemModel, plan: Any, node: str) -> Quot
     hidden values; the contract is then re-checked with the loop composed,
     where the in-context side conditions open the loop at its back edges
     (:mod:`.context`), and a note says so.
+
+    ``confirm``: the second solver (issue 50; docs/second-solver.md), a
+    callable from a proved re-check's SMT-LIB2 script to ``(agreement,
+    why)``; a re-check it does not confirm (``disagree``,
+    ``inconclusive``) is not proved, so the contract does not re-check.
 
     Raises :class:`QuotientError` for an unknown node, a node with nothing
     to serve (no target), and a contract that does not re-check."""
@@ -262,18 +276,28 @@ def quotient(checked: Checked, model: SystemModel, plan: Any, node: str) -> Quot
         how = (f"a sound approximation, not the weakest contract ({why}): assumption TRUE; guarantee: what the "
                "direct consumers assume of its outputs")
     block = _node_block(cn.node, a_text, g_text)
-    recheck = _recheck(checked, plan, node, block, tgts)
-    bad = [f"{i} {v}" for i, v in recheck if v not in ("discharged", "discharged in context", "proved")]
+    decided = _recheck(checked, plan, node, block, tgts)
+    said: list[tuple[str, str, str]] = []
+    recheck: list[tuple[str, str]] = []
+    for i, v, script in decided:
+        if confirm is not None and v in PROVED and script:
+            agreement, why = confirm(script)
+            said.append((i, agreement, why))
+            if agreement in NOT_CONFIRMED:
+                v = f"inconclusive (second solver: {why})"
+        recheck.append((i, v))
+    bad = [f"{i} {v}" for i, v in recheck if v not in PROVED]
     if bad:
-        raise QuotientError(f"the contract computed for {node} ({how}) does not re-check with Z3: "
-                            + "; ".join(bad) + f"\n{block}")
+        raise QuotientError(f"the contract computed for {node} ({how}) does not re-check"
+                            f"{' with Z3 and cvc5' if confirm else ' with Z3'}: " + "; ".join(bad) + f"\n{block}")
     if loop:
         notes.append(f"{node} lies on the loop {{{', '.join(loop)}}}: computed with the loop opened as rule R4 opens it "
                      "(the loop's other guarantees, each under its node's assumption, with this node's outputs "
                      "hidden; paper lines 717-768) and re-checked with the loop composed")
     notes += _compare(cn, a_text, g_text, checked, model, plan)
     return Quotient(node, a_text, g_text, how.startswith("exact"), how,
-                    tuple(f"{t.kind} {t.id}: {t.text}" for t in tgts), tuple(recheck), tuple(notes), block)
+                    tuple(f"{t.kind} {t.id}: {t.text}" for t in tgts), tuple(recheck), tuple(notes), block,
+                    tuple(said))
 
 
 def render(q: Quotient, target_texts: Mapping[str, str] | None = None) -> str:
@@ -286,7 +310,8 @@ def render(q: Quotient, target_texts: Mapping[str, str] | None = None) -> str:
     texts = target_texts or {}
     return env.get_template("quotient.rcl.j2").render(
         q=q, targets=[texts.get(t, t) for t in q.targets],
-        recheck="; ".join(f"{i} {v}" for i, v in q.recheck))
+        recheck="; ".join(f"{i} {v}" for i, v in q.recheck),
+        solvers="; ".join(f"{i} {a}" for i, a, _ in q.solvers))
 
 
 def _no_answer(sysm: _System, a: z3.BoolRef, g: z3.BoolRef, outs: Sequence[z3.ExprRef],
@@ -364,8 +389,10 @@ def _node_block(n: ast.Node, a_text: str, g_text: str) -> str:
     return node_to_rcl(node)
 
 
-def _recheck(checked: Checked, plan: Any, node: str, block: str, tgts: Sequence[Target]) -> list[tuple[str, str]]:
-    """Every target's verdict with ``block`` in place of ``node`` (module docstring)."""
+def _recheck(checked: Checked, plan: Any, node: str, block: str,
+             tgts: Sequence[Target]) -> list[tuple[str, str, str]]:
+    """Every target's verdict with ``block`` in place of ``node`` (module
+    docstring): ``(id, verdict, the SMT-LIB2 script it was decided from)``."""
     from ..logic import world
     from ..rcl.typecheck import check
     from ..requirements.check import check_requirement
@@ -376,18 +403,18 @@ def _recheck(checked: Checked, plan: Any, node: str, block: str, tgts: Sequence[
     checked2 = check(specs)
     model2 = build(checked2, plan.connections)
     facts = {m: [f.expr for f in fs] for m, fs in plan.facts.items()}
-    out: list[tuple[str, str]] = []
+    out: list[tuple[str, str, str]] = []
     consumers = sorted({t.consumer for t in tgts if t.kind == "side condition"} | {node},
                        key=list(checked2.nodes).index)
-    verdicts: dict[str, str] = {}
+    verdicts: dict[str, tuple[str, str]] = {}
     for d in consumers:
         world.fresh()
         for sc in compose_node(checked2, model2, d, facts=facts).side_conditions:
-            verdicts[sc.id] = sc.verdict or sc.status
-    out += [(sid, v) for sid, v in verdicts.items() if sid.startswith(f"{node}.")]
+            verdicts[sc.id] = (sc.verdict or sc.status, sc.smt2 or "")
+    out += [(sid, v, smt2) for sid, (v, smt2) in verdicts.items() if sid.startswith(f"{node}.")]
     for t in tgts:
         if t.kind == "side condition":
-            out.append((t.id, verdicts.get(t.id, "absent")))
+            out.append((t.id, *verdicts.get(t.id, ("absent", ""))))
     from ..plan.load import all_requirements
     reqs = {r.id: r for r in all_requirements(plan)}
     for t in tgts:
@@ -397,7 +424,7 @@ def _recheck(checked: Checked, plan: Any, node: str, block: str, tgts: Sequence[
             v = str(rec.get("verdict"))
             if v == "proved" and rec.get("consistency") == "inconsistent":
                 v = "proved from an inconsistency"
-            out.append((t.id, v))
+            out.append((t.id, v, str(rec.get("smt2") or "")))
     world.fresh()
     return out
 

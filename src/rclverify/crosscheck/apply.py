@@ -65,9 +65,26 @@ class SecondSolver:
 
     def requirement(self, rec: dict[str, Any] | None) -> dict[str, Any] | None:
         """A requirement record with ``solvers``; a ``proved`` one the
-        solvers do not agree on has verdict ``inconclusive`` and the reason."""
-        return self._fold(rec, "requirement", "id", "verdict", "proved", lambda r, s: {
+        solvers do not agree on has verdict ``inconclusive`` and the reason.
+        A proved one's decided consistency and vacuity answers get
+        ``consistency_solvers`` and ``vacuity_solvers``; one the solvers do
+        not agree on reads ``undecided`` with the reason (the requirement is
+        then ``inconclusive``, requirements/rollup.py)."""
+        rec = self._fold(rec, "requirement", "id", "verdict", "proved", lambda r, s: {
             "recorded_verdict": "proved", "reason": f"second solver: {s['why']}"})
+        if rec is None or rec.get("verdict") != "proved":
+            return rec
+        from .items import SIDE_ANSWERS
+        for side, answers in SIDE_ANSWERS.items():
+            if rec.get(side) not in answers or not rec.get(f"{side}_smt2"):
+                continue
+            s = self.solvers(side, str(rec.get("id")), rec.get(f"{side}_smt2"))
+            rec = {**rec, f"{side}_solvers": s}
+            if s["agreement"] in DOWNGRADES:
+                rec.update({side: "undecided", f"recorded_{side}": rec[side],
+                            f"{side}_reason": f"Z3 found it {rec[side]}, but the second solver does not agree: "
+                                              f"{s['why']}"})
+        return rec
 
     def deadline(self, d: dict[str, Any]) -> dict[str, Any]:
         """A deadline record with ``solvers``; a ``proved`` one the solvers

@@ -8,6 +8,10 @@ kind               record                                  verdict    expects
 =================  ======================================  =========  ========
 ``side-condition`` ``artifacts/calculus/<Node>.json``      discharged unsat
 ``requirement``    ``artifacts/requirements/<ID>.json``    proved     unsat
+``consistency``    the same, ``consistency_smt2``          consistent sat
+                                                           inconsist. unsat
+``vacuity``        the same, ``vacuity_smt2``              non-vac.   sat
+                                                           vacuous    unsat
 ``deadline``       ``artifacts/deadlines/index.json``      proved     unsat
 ``health``         ``artifacts/health/<Node>.json``        ok         sat/unsat
 ``hoare``          ``artifacts/evidence/<Obligation>.json`` discharged unsat, each
@@ -15,8 +19,10 @@ kind               record                                  verdict    expects
 
 A health check reads ``ok`` on a satisfiable query (an assumption that can
 be met, a consistent contract, a guarantee that can fire: Z3's witness is
-its certificate) except the replacement check, which reads ``ok`` on a
-proof.  A record whose seal does not hold gives no item: the report already
+its certificate) except the replacement check and realizability, which
+read ``ok`` on a proof.  A proved requirement's consistency and vacuity answers are items
+too (its ``met`` rests on the satisfiable ones, its ``proved vacuously`` or
+``from an inconsistency`` on the unsatisfiable ones).  A record whose seal does not hold gives no item: the report already
 shows it ``error``.  A Hoare obligation's script holds one query per
 verification condition; all must be ``unsat``.  Dafny proofs are not
 items (Dafny's own Boogie/Z3 run is the evidence).
@@ -31,7 +37,12 @@ from ..requirements.stage import record_path
 
 #: Health checks whose ``ok`` is an ``unsat`` answer (a proof); every other
 #: check's ``ok`` is a satisfiable answer with Z3's witness.
-PROOF_CHECKS = frozenset({"replacement-refines"})
+PROOF_CHECKS = frozenset({"replacement-refines", "realizable"})
+
+#: A proved requirement's side queries (``requirements/check.py``): their decided verdicts and Z3's
+#: answer behind each.
+SIDE_ANSWERS = {"consistency": {"consistent": "sat", "inconsistent": "unsat"},
+                "vacuity": {"non-vacuous": "sat", "vacuous": "unsat"}}
 
 
 @dataclass(frozen=True)
@@ -72,6 +83,10 @@ def discharging_items(root: Any, nodes: Iterable[str]) -> list[Item]:
         rec, why = read_sealed(root / record_path(rid), "requirement record")
         if rec and not why and rec.get("verdict") == "proved" and _path(rec.get("smt2")):
             out.append(Item("requirement", rid, rec["smt2"], "proved", "unsat"))
+            for side, answers in SIDE_ANSWERS.items():
+                verdict = rec.get(side)
+                if verdict in answers and _path(rec.get(f"{side}_smt2")):
+                    out.append(Item(side, rid, rec[f"{side}_smt2"], str(verdict), answers[verdict]))
     out.extend(_hoare_items(root, nodes))
     body, why = read_sealed(root / "artifacts/deadlines/index.json", "deadline record")
     for d in sorted(_rows(body, why, "results"), key=lambda d: str(d.get("requirement"))):

@@ -30,9 +30,10 @@ guarantees went undecided in 5.6 s that ``qe`` decides in 0.02 s).  Then it name
 conflict: the smallest set of them (single guarantees, then pairs) that
 already has no answer for some input.
 
-Like the checks of :mod:`.shape` it reports only what it finds: a
-``problem`` finding (check ``realizable``) with the input that has no
-answer, and nothing when the contract is realizable, when Z3 cannot decide
+It reports a ``problem`` finding (check ``realizable``) with the input that
+has no answer, and an ``ok`` finding when Z3 proves the contract realizable
+(the query is unsat; its SMT-LIB2 text is kept, and a second solver decides
+it again: docs/second-solver.md).  Nothing is reported when Z3 cannot decide
 within the budget, or when an output is function-typed (``forall`` over a
 function is beyond first-order logic: not checked, docs/architecture.md).
 """
@@ -60,6 +61,12 @@ MAX_SUBSET_SEARCH = 5
 
 def _where(l: ast.Loc) -> str:
     return f"{l.file}:{l.line}:{l.col}"
+
+
+def _conj(fs: Sequence[z3.BoolRef]) -> z3.BoolRef:
+    """The conjunction of ``fs``: ``True`` when empty (Z3's printer writes an
+    empty ``And`` as a bare ``and``, which no SMT-LIB2 reader takes)."""
+    return z3.And(*fs) if len(fs) > 1 else fs[0] if fs else z3.BoolVal(True)
 
 
 class _Query:
@@ -92,8 +99,8 @@ class _Query:
     def formula(self, ks: Sequence[int]) -> z3.BoolRef:
         """The query with guarantees ``ks`` (0-based) only."""
         g = [self.guarantees[k] for k in ks]
-        body = z3.Implies(z3.And(*self.typing, *self.out_facts), z3.Not(z3.And(*g)))
-        return z3.And(*self.given, z3.ForAll(self.outs, body))
+        body = z3.Implies(_conj([*self.typing, *self.out_facts]), z3.Not(_conj(g)))
+        return _conj([*self.given, z3.ForAll(self.outs, body)])
 
     def answer(self, ks: Sequence[int], comment: str, general: bool = True
                ) -> tuple[str, dict[str, str] | None, float, str]:
@@ -112,11 +119,11 @@ class _Query:
         else:
             status, model = self._eliminated(f)
             if status in ("sat", "unsat"):
-                text = smt2_script(self.enc.axioms() + [f], comment)() if status == "sat" else ""
+                text = smt2_script(self.enc.axioms() + [f], comment)()
                 return status, model, round(time.perf_counter() - t0, 4), text
         r = satisfiable([("no output for this input", f)], self.enc, timeout_ms=REALIZABLE_TIMEOUT_MS,
                         comment=comment, retry=False)
-        return r.status, r.model, round(time.perf_counter() - t0, 4), r.smt2 if r.status == "sat" else ""
+        return r.status, r.model, round(time.perf_counter() - t0, 4), r.smt2 if r.status in ("sat", "unsat") else ""
 
     def _eliminated(self, f: z3.BoolRef) -> tuple[str, dict[str, str] | None]:
         """``(sat|unsat|unknown, input model)`` of ``f`` asked of Z3's
@@ -137,8 +144,9 @@ class _Query:
 
 def realizability_findings(checked: Checked, node: str, facts: Sequence[tuple[ast.Expr, ast.Loc]] = (),
                            instances: tuple[int, int] | None = None) -> list[Finding]:
-    """The ``realizable`` finding of ``node`` when its contract is not
-    realizable (module docstring), else ``[]``.  ``facts``: the plan's
+    """The ``realizable`` finding of ``node``: ``problem`` when its contract
+    is not realizable, ``ok`` when Z3 proves it is; ``[]`` when not decided
+    or not checked (module docstring).  ``facts``: the plan's
     environment facts of the node with their locations; ``instances``: its
     ``instances`` range (the tables' size).  Never raises on solver trouble."""
     cn = checked.nodes[node]
@@ -152,6 +160,13 @@ def realizability_findings(checked: Checked, node: str, facts: Sequence[tuple[as
         return []  # forall over a function-typed output: not first-order, not checked
     every = list(range(len(n.guarantees)))
     status, model, secs, smt2 = q.answer(every, f"health {node}: is there an input no output answers?")
+    if status == "unsat":
+        return [Finding(f"{node}.realizable", node, "realizable", None, "ok",
+                        f"The contract of {node} can be implemented: every input its assumption"
+                        + (" and the environment facts admit" if facts else " admits")
+                        + " has an output satisfying every guarantee.",
+                        "Realizability (forall in. A(in) -> exists out. G(in, out)): Z3 proved that no admissible "
+                        "input lacks an answer (the query below is unsat).", None, None, secs, smt2=smt2)]
     if status != "sat":
         return []
     conflict = every

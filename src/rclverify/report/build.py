@@ -206,7 +206,8 @@ def build_report(ws: Workspace) -> dict[str, Any]:
         if isinstance(ev.details.get("examples"), dict):  # property tests: example counts and seed
             ev_rows[-1]["examples"] = {**ev.details["examples"], "seed": ev.details.get("seed"),
                                        "replay": ev.details.get("replay", ""),
-                                       "facts": ev.details.get("facts", [])}
+                                       "facts": ev.details.get("facts", []),
+                                       "coverage": ev.details.get("coverage") or {}}
         if isinstance(ev.details, dict) and ev.details.get("monitoring"):
             ev_rows[-1]["monitoring"] = ev.details["monitoring"]
         if status == "pending":
@@ -434,6 +435,8 @@ _CHECK_FIELDS = ("origin", "source", "formal", "assuming", "cone", "used", "trac
                  "inconsistent_core", "vacuity", "vacuity_core", "counterexample", "outside_assumptions",
                  "counterexample_note", "failed_to_prevent", "reason", "smt2", "explanation",
                  "solvers",  # the second solver's agreement (crosscheck/apply.py)
+                 "consistency_smt2", "consistency_solvers", "recorded_consistency",  # and on the side queries
+                 "vacuity_smt2", "vacuity_solvers", "recorded_vacuity",
                  "temporal",  # a temporal requirement's verdict, k, bound and trace (requirements/temporal_check.py)
                  "traces",  # its recorded runs' verdicts (backends/monitors/temporal_evidence.py)
                  "duration_s")

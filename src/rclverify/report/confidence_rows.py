@@ -24,7 +24,7 @@ from ..requirements.rollup import MET, OUTSTANDING
 #: Requirement verdicts whose Z3 proof holds (the evidence it rests on may not be all discharged).
 _PROVED = (MET, OUTSTANDING)
 
-_WORDS = {"proof": "a proof by one solver", "bounded": "bounded evidence", "statistical": "statistical evidence",
+_WORDS = {"proof": "a proof", "bounded": "bounded evidence", "statistical": "statistical evidence",
           "tested": "tested-only evidence", "observed": "observed-only evidence", "reviewed": "reviewed-only evidence",
           "assumed": "an assumed premise"}
 

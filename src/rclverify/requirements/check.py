@@ -173,7 +173,9 @@ def check_requirement(req: Requirement, checked: Checked, model: SystemModel, pl
     ``vacuous``/``undecided``, proved implications only) with
     ``vacuity_core``, ``counterexample`` (``[{node, values:
     {var: value}}]``, refuted only), ``failed_to_prevent`` (premises), ``reason``
-    (Z3's, inconclusive only), ``smt2`` (the query's text), ``duration_s``.
+    (Z3's, inconclusive only), ``smt2`` (the query's text), ``duration_s``;
+    ``consistency_smt2`` and ``vacuity_smt2``: the text of the consistency
+    and vacuity queries when Z3 decided them (sat or unsat).
 
     ``timeout_ms`` is the validity query's budget, ``model_ms`` the first
     attempt's of the consistency and vacuity queries (:data:`MODEL_TIMEOUT_MS`).
@@ -245,6 +247,8 @@ def check_requirement(req: Requirement, checked: Checked, model: SystemModel, pl
             r2 = _model_query([(lbl, f) for lbl, f in labelled if lbl in core], enc, model_ms, _points(plan, cone),
                               f"rclverify requirement {req.id}: are the premises its proof used consistent?")
             out["consistency_duration_s"] = r2.duration_s
+            if r2.status in ("sat", "unsat"):  # decided: a second solver re-decides it (docs/second-solver.md)
+                out["consistency_smt2"] = r2.smt2
             if r2.status == "unsat":
                 out.update(consistency="inconsistent", inconsistent_core=[by_label[c] for c in (r2.core or [])])
             elif r2.status == "sat":
@@ -258,6 +262,8 @@ def check_requirement(req: Requirement, checked: Checked, model: SystemModel, pl
                               model_ms, _points(plan, cone),
                               f"rclverify requirement {req.id}: can its premise hold with every premise of the cone?")
             out["vacuity_duration_s"] = r3.duration_s
+            if r3.status in ("sat", "unsat"):
+                out["vacuity_smt2"] = r3.smt2
             if r3.status == "unsat":
                 out.update(vacuity="vacuous", vacuity_core=[by_label[c] for c in (r3.core or []) if c in by_label])
             else:

@@ -119,12 +119,13 @@ def roll_up(record: Mapping[str, Any] | None, g_status: Callable[[str, int], str
     ev = worst(list(statuses.values()), empty="discharged")
     if record.get("consistency") != "consistent":  # the worst of that and the evidence, as the argument has it
         return "inconclusive", worst(["inconclusive", ev]), (
-            "proved, but Z3 could not decide whether the premises it used are consistent "
+            "proved, but it is not decided whether the premises it used are consistent "
             f"({record.get('consistency_reason', 'unknown')})")
     if record.get("vacuity") not in (None, "non-vacuous"):  # undecided: never met (it may hold only vacuously)
         return "inconclusive", worst(["inconclusive", ev]), (
-            "proved, but Z3 could not decide whether the requirement's premise can ever hold together with the "
-            "premises of its cone: it may be proved only because it never applies (vacuity undecided)")
+            "proved, but it is not decided whether the requirement's premise can ever hold together with the "
+            "premises of its cone: it may be proved only because it never applies (vacuity undecided"
+            + (f": {record['vacuity_reason']})" if record.get("vacuity_reason") else ")"))
     if ev == "discharged":
         return MET, "discharged", "proved from the used premises, and all the evidence they rest on is discharged"
     open_ = ", ".join(f"{k} ({s})" for k, s in statuses.items() if s != "discharged")

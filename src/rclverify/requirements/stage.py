@@ -3,7 +3,9 @@
 Writes ``artifacts/requirements/<ID>.json`` (the record of
 :func:`.check.check_requirement` plus its ``fingerprint`` and ``inputs``,
 the sha256 of each contract snapshot of its cone and of the system model),
-``artifacts/requirements/<ID>.smt2`` (the query) and
+``artifacts/requirements/<ID>.smt2`` (the query), ``<ID>.consistency.smt2``
+and ``<ID>.vacuity.smt2`` (a proved requirement's side queries, when Z3
+decided them) and
 ``artifacts/requirements/index.json`` (``{"records": {id: sha256 of the
 record}}``, in requirement order: the report tasks depend on it).  Records
 and index are sealed (:mod:`rclverify.evidence.sealed`); a record whose seal
@@ -29,6 +31,11 @@ if TYPE_CHECKING:
 DIR = "artifacts/requirements"
 INDEX = f"{DIR}/index.json"
 _SAFE = re.compile(r"[^A-Za-z0-9_.-]+")
+
+
+#: The side queries of a proved requirement whose scripts are kept beside its record
+#: (``artifacts/requirements/<ID>.<side>.smt2``, ``<side>_smt2`` in the record).
+SIDE_QUERIES = ("consistency", "vacuity")
 
 
 def record_path(req_id: str) -> str:
@@ -91,6 +98,11 @@ def stage_requirements(ws: "Workspace", *, force: bool = False) -> list[tuple[di
                 rec["smt2"] = rel[:-5] + ".smt2"
                 atomic_write_text(ws.root / rec["smt2"], smt2)
                 keep.add(rec["smt2"].rsplit("/", 1)[1])
+            for side in SIDE_QUERIES:  # the consistency and vacuity queries, for the second solver
+                text = rec.pop(f"{side}_smt2", None)
+                if text is not None:
+                    rec[f"{side}_smt2"] = rel[:-5] + f".{side}.smt2"
+                    atomic_write_text(ws.root / rec[f"{side}_smt2"], text)
             rec["fingerprint"] = fp
             rec["inputs"] = input_hashes(ws, cone, snap, model_hash) if formal is not None else {}
             if traces:
@@ -98,8 +110,9 @@ def stage_requirements(ws: "Workspace", *, force: bool = False) -> list[tuple[di
                 rec["inputs"].update(th)
             write_sealed(ws.root / rel, rec)
             now = True
-        if rec.get("smt2"):
-            keep.add(rec["smt2"].rsplit("/", 1)[1])
+        for key in ("smt2", *(f"{side}_smt2" for side in SIDE_QUERIES)):
+            if rec.get(key):
+                keep.add(rec[key].rsplit("/", 1)[1])
         index[req.id] = hashlib.sha256((ws.root / rel).read_bytes()).hexdigest()
         out.append((rec, now))
     write_sealed(ws.root / INDEX, {"records": index})

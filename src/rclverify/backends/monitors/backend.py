@@ -209,8 +209,9 @@ class MonitorsBackend:
         if has_periods(target.node):  # periodic outputs on the same run (periods.py)
             beside.add("periods", lambda: PeriodMonitor(target.node))
         try:
-            events, results = check_trace(target.checked, [target.node], beside.tap(
-                read_trace(target.root / trace, [target.root / d for d in cfg.msg_dirs])),
+            span = TraceSpan()  # the run's duration in trace time (the strength's detail, docs/confidence.md)
+            events, results = check_trace(target.checked, [target.node], span.tap(beside.tap(
+                read_trace(target.root / trace, [target.root / d for d in cfg.msg_dirs]))),
                 cfg.rules, cfg.horizon, tolerance=cfg.tolerance)
         except TraceError as exc:
             return evidence("error", f"the trace could not be read: {exc}", log=str(exc))
@@ -218,7 +219,7 @@ class MonitorsBackend:
             return evidence("error", f"the trace could not be checked: {type(exc).__name__}: {exc}", log=str(exc))
         res = results[0]
         details = monitoring_details(res, trace, events, trace_sha256(target.root, trace), versions, cfg.horizon,
-                                     cfg.tolerance)
+                                     cfg.tolerance, duration_s=span.seconds)
         status, explanation = verdict_status(res, trace)
         extra: dict[str, Any] = {}
         finished = beside.finish()
@@ -293,8 +294,29 @@ def with_deadlines(target: NodeTarget, res: DeadlineResult, trace: str, status: 
     return worse, f"deadlines: {dexpl}; untimed: {explanation}", {"deadlines": res.to_json()}
 
 
+class TraceSpan:
+    """The span of a run in trace time: :meth:`tap` passes the events on and
+    notes the first and last event's ``time``; :attr:`seconds` is their
+    difference (``None`` before any event)."""
+
+    def __init__(self) -> None:
+        self.first: float | None = None
+        self.last: float | None = None
+
+    def tap(self, events: Any) -> Any:
+        for ev in events:
+            if self.first is None:
+                self.first = ev.time
+            self.last = ev.time
+            yield ev
+
+    @property
+    def seconds(self) -> float | None:
+        return None if self.first is None or self.last is None else round(self.last - self.first, 6)
+
+
 def monitoring_details(res: NodeResult, trace: str, events: int, sha: str, versions: str,
-                       horizon: float, tolerance: Any = None) -> dict[str, Any]:
+                       horizon: float, tolerance: Any = None, duration_s: float | None = None) -> dict[str, Any]:
     """The evidence ``details["monitoring"]`` block (also printed by ``rclverify monitor``):
     beside the counts and first violations, the assumption monitor's verdict
     (``assumption``), the ``satisfied`` verdicts per semantics that decided
@@ -304,7 +326,8 @@ def monitoring_details(res: NodeResult, trace: str, events: int, sha: str, versi
     (``violations``: the first :data:`~.verdicts.KEPT_VIOLATIONS`, each with
     its time, message, guarantee, values and the question it answered;
     ``violations_dropped`` the count beyond them), which ``rclverify explain
-    OBLIGATION#N`` prints one by one."""
+    OBLIGATION#N`` prints one by one; ``duration_s``: the run's span in trace
+    time, seconds from its first event to its last (``None``: not measured)."""
     return {"trace": trace, "sha256": sha, "events_read": events, "node_events": res.events,
             "horizon_s": horizon, "counts": dict(res.counts), "first_violation": res.first_violation,
             "first_assumption_violation": res.first_assumption_violation,
@@ -312,7 +335,7 @@ def monitoring_details(res: NodeResult, trace: str, events: int, sha: str, versi
             "semantics": dict(res.semantics), "first_inexact": res.first_inexact,
             "tolerance": tolerance.to_json() if tolerance else None, "tools": versions,
             "violations": list(res.violations), "violations_dropped": res.violations_dropped,
-            "unasked": res.unasked}
+            "unasked": res.unasked, "duration_s": duration_s}
 
 
 def summary_line(res: NodeResult) -> str:

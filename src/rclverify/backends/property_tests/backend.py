@@ -166,6 +166,8 @@ class PropertyTestsBackend:
         if unused:
             details["facts_not_used"] = [f"{expr_to_rcl(f)} ({_source(target, f.loc)}): names an output"
                                          for f in unused]
+        if outcome.coverage:  # the valid examples' coverage of the assumption's ranges (.coverage)
+            details["coverage"] = outcome.coverage
         if outcome.unknown_reasons:
             details["unknown_reasons"] = outcome.unknown_reasons
         if outcome.health:

@@ -46,6 +46,7 @@ from ...rcl.printer import expr_to_rcl
 from ...rcl.types import Checked, CheckedNode
 from ...values import conforms, render
 from .seeding import Seeder, split_facts
+from .coverage import Coverage
 from .strategies import conjuncts, input_space
 
 DEFAULT_MAX_EXAMPLES = 200
@@ -183,6 +184,8 @@ class Outcome:
     counterexample: dict[str, str] | None = None
     unknown_reasons: list[str] = field(default_factory=list)
     health: str = ""
+    #: per input, how much of the assumption's range the valid examples covered (:mod:`.coverage`)
+    coverage: dict[str, dict[str, Any]] = field(default_factory=dict)
 
 
 class _Violation(AssertionError):
@@ -218,6 +221,8 @@ class GuaranteeRun:
     #: the example of the last body run (a function's inputs, a class's steps): replayed for the cause line
     last_example: Any = None
     _used_facts: tuple[ast.Expr, ...] | None = field(default=None, repr=False)
+    #: the valid examples' coverage of the assumption's ranges (set up with the strategy)
+    coverage: Coverage | None = field(default=None, repr=False)
 
     @property
     def stateful(self) -> bool:
@@ -261,7 +266,9 @@ class GuaranteeRun:
         if self.used_facts:
             formulas = tuple(c.formula for c in self.node.node.assumes) + self.used_facts
             seed = Seeder(self.checked, self.node, formulas).base()
-        one = input_space(self.node, self.cfg.bounds, seed).inputs().filter(self.assumption_holds)
+        space = input_space(self.node, self.cfg.bounds, seed)
+        self.coverage = Coverage(self.node, space.bounds)
+        one = space.inputs().filter(self.assumption_holds)
         if self.stateful:
             return st.lists(one, min_size=1, max_size=self.cfg.steps)
         return one
@@ -290,6 +297,8 @@ class GuaranteeRun:
     def check_step(self, impl: Callable[..., Any], inputs: Mapping[str, Any], step: int | None) -> None:
         """Call the implementation on one input and check its outputs (raises on a violation)."""
         self.counts.steps += 1
+        if self.coverage is not None:
+            self.coverage.add(inputs)
         kwargs = {k.removeprefix("in."): v for k, v in inputs.items()}
         try:
             result = impl(**kwargs)
@@ -378,7 +387,14 @@ class GuaranteeRun:
         return Outcome("error", wrong, self.counts, None, sorted(self.unknown)) if wrong else None
 
     def run(self) -> Outcome:
-        """Run Hypothesis; never raises for a failing, inconclusive or starved run."""
+        """Run Hypothesis; never raises for a failing, inconclusive or starved run.
+        The outcome carries the valid examples' coverage of the assumption's ranges."""
+        outcome = self._run()
+        if self.coverage is not None:
+            outcome.coverage = self.coverage.as_dict()
+        return outcome
+
+    def _run(self) -> Outcome:
         test = hypothesis.seed(self.cfg.seed)(self.settings()(given(self.strategy())(self.body)))
         try:
             with _no_local_constants():
