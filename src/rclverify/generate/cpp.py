@@ -72,6 +72,8 @@ class Clause:
     double: str = ""
     tolerance: str = ""
     why: str = ""
+    #: why the translated check may answer undecided besides a division by zero (a quantifier)
+    notes: list[str] = field(default_factory=list)
 
     @property
     def title(self) -> str:
@@ -80,7 +82,7 @@ class Clause:
     @property
     def reason(self) -> str:
         """The inconclusive verdict's reason, a C++ string literal's contents."""
-        r = f"not translated to C++: {self.why}" if self.why else "division by zero"
+        r = f"not translated to C++: {self.why}" if self.why else "; ".join(self.notes + ["division by zero"])
         return r.replace("\\", "\\\\").replace('"', '\\"')
 
 
@@ -143,7 +145,9 @@ def checks_of(checked: Checked, cn: CheckedNode, namespace: str, tolerance: Tole
             fn = f"{'assumption' if kind == 'assume' else 'guarantee'}_{k}"
             cc = Clause(kind, k, _one_line(expr_to_rcl(cl.formula)), fn)
             try:
+                dbl.notes = []
                 cc.double = dbl.translate(cl.formula)
+                cc.notes = sorted(set(dbl.notes))
                 if tolerance:
                     cc.tolerance = tol.translate(cl.formula)
             except Untranslatable as exc:
