@@ -102,6 +102,8 @@ class Checks:
     clauses: list[Clause] = field(default_factory=list)
     tolerance: dict[str, Any] | None = None
     tolerance_text: str = ""
+    #: per guarantee (1-based, index 0 unused): the input of ``triggered by in.x``, "" none
+    triggers: list[str] = field(default_factory=list)
 
 
 @dataclass
@@ -135,6 +137,7 @@ def checks_of(checked: Checked, cn: CheckedNode, namespace: str, tolerance: Tole
         enums.setdefault(t.name, t)
     c.enums = [_Enum(t.name, snake(t.name), [(v, enum_const(t, v)) for v in t.values])
                for t in sorted(enums.values(), key=lambda t: t.name)]
+    c.triggers = [""] + [f"in.{g.trigger.name}" if g.trigger is not None else "" for g in cn.node.guarantees]
     dbl = CppTranslator(checked, cn, "double")
     tol = CppTranslator(checked, cn, "tolerance")
     if tolerance:
@@ -177,7 +180,7 @@ def node_context(checked: Checked, np: NodePackage, c: Checks, rules: Mapping[st
         kind = e.kind
         headers.add(_header(e.ros_type, kind))
         mine = [w for w in ws if w.attr == e.attr]
-        reads = [dict(field=held[w.var], path=w.path, part=w.part) for w in mine if w.side == "in"]
+        reads = [dict(field=held[w.var], path=w.path, part=w.part, var=w.var) for w in mine if w.side == "in"]
         writes = [dict(field=held[w.var], path=w.path, part=w.part) for w in mine if w.side == "out"]
         ends.append(dict(role=e.role, name=e.name, var=e.var, attr=e.attr, cpp=_cpp_type(e.ros_type, kind),
                          reads=reads, writes=writes))
