@@ -19,7 +19,8 @@ from typing import Any, Mapping
 from ..logic.floatsem import Tolerance
 from ..rcl.printer import expr_to_rcl
 from ..rcl.types import Checked, CheckedNode, EnumT
-from .cpp_expr import CppTranslator, Untranslatable, cpp_type, enum_const
+from .cpp_common import Untranslatable, enum_const
+from .cpp_expr import CppTranslator, cpp_type
 from .nodes import NodePackage
 from .typemap import camel, snake
 from .wiring import wires

@@ -33,15 +33,12 @@ from __future__ import annotations
 
 from ..rcl import ast
 from ..rcl.types import Checked, CheckedNode, EnumT, Scalar, Type
+from .cpp_common import Untranslatable, enum_const
 from .cpp_quant import quantifier
 from .typemap import snake
 
 #: RCL scalar -> C++ type of the struct field
 CPP_SCALARS = {"REAL": "double", "INTEGER": "std::int64_t", "NATURAL": "std::uint64_t", "BOOL": "bool"}
-
-
-class Untranslatable(ValueError):
-    """A formula (part) outside the translated fragment; the message says which construct."""
 
 
 def cpp_type(t: Type) -> str | None:
@@ -51,15 +48,6 @@ def cpp_type(t: Type) -> str | None:
     if isinstance(t, EnumT):
         return "std::uint8_t"
     return None
-
-
-def enum_const(t: EnumT, value: str) -> str:
-    """The C++ constant of an enumeration value: ``kRadStatRed``."""
-    return "k" + _camel(t.name) + _camel(value)
-
-
-def _camel(s: str) -> str:
-    return "".join(p[:1].upper() + p[1:] for p in snake(s).split("_"))
 
 
 class CppTranslator:

@@ -16,22 +16,20 @@ short cuts: ``forall`` stops at the first false body, ``exists`` at the first tr
 ``exists_unique`` at the second true one; an undecided body (division by zero) makes the
 whole clause undecided, as the Python reading's exception does.
 
-Not translated (:class:`.cpp_expr.Untranslatable`: the clause's check answers undecided):
+Not translated (:class:`.cpp_common.Untranslatable`: the clause's check answers undecided):
 a domain that is an input or output (sets and sequences are not held in the header), a set
 whose items are not literals, a tuple binder.
 """
 from __future__ import annotations
 
 from fractions import Fraction
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 from ..logic.eval_shapes import MAX_RANGE, _integer_range, _unused
 from ..logic.floatsem import MAX_ENUMERATION
 from ..rcl import ast
 from ..rcl.types import EnumT, Scalar
-
-if TYPE_CHECKING:
-    from .cpp_expr import CppTranslator
+from .cpp_common import Untranslatable, enum_const
 
 
 class _Undecided(Exception):
@@ -43,9 +41,10 @@ def cpp_ident(name: str) -> str:
     return "q_" + name.replace("'", "_p")
 
 
-def quantifier(tr: "CppTranslator", e: ast.Quant) -> tuple[str, str]:
-    """``(code, "bool")`` for quantifier ``e`` under translator ``tr`` (its bound variables in
-    ``tr.bound``); raises :class:`.cpp_expr.Untranslatable`."""
+def quantifier(tr: Any, e: ast.Quant) -> tuple[str, str]:
+    """``(code, "bool")`` for quantifier ``e`` under translator ``tr`` (a
+    :class:`.cpp_expr.CppTranslator`: its ``expr``, its bound variables in ``tr.bound``, its
+    ``notes``); raises :class:`.cpp_common.Untranslatable`."""
     loops: list[tuple[str, str, Any]] = []  # (C++ name, kind, domain: ("values", [code]) | ("range", lo, hi))
     size = 1
     try:
@@ -71,7 +70,6 @@ def quantifier(tr: "CppTranslator", e: ast.Quant) -> tuple[str, str]:
         tr.bound.clear()
         tr.bound.update(saved)
     if bkind != "bool":
-        from .cpp_expr import Untranslatable
         raise Untranslatable(f"a quantifier body of type {bkind}")
     if e.kind == "forall":
         step, end = "if (!(" + body + ")) { return false; }", "return true;"
@@ -100,10 +98,9 @@ def _count(spec: tuple[Any, ...]) -> int:
     return spec[2] - spec[1] + 1 if spec[0] == "range" else len(spec[1])
 
 
-def _domain(tr: "CppTranslator", e: ast.Quant, bd: ast.Binding, name: str) -> tuple[str, tuple[Any, ...]] | None:
+def _domain(tr: Any, e: ast.Quant, bd: ast.Binding, name: str) -> tuple[str, tuple[Any, ...]] | None:
     """``(kind, spec)`` of bound variable ``name``, ``None`` when the body does not read it
     (floatsem ``_finite_domain``'s cases, in its order); raises :class:`_Undecided`."""
-    from .cpp_expr import Untranslatable, enum_const
     dom = bd.domain
     env = tr.env
     if isinstance(dom, ast.TEnum):
@@ -139,12 +136,11 @@ def _domain(tr: "CppTranslator", e: ast.Quant, bd: ast.Binding, name: str) -> tu
     raise _Undecided(f"quantifier over {type(dom).__name__} is not finite")
 
 
-def _set_domain(tr: "CppTranslator", items: tuple[Any, ...]) -> tuple[str, tuple[Any, ...]]:
+def _set_domain(tr: Any, items: tuple[Any, ...]) -> tuple[str, tuple[Any, ...]]:
     """A set literal's items as loop values, once each, in the order the Python reading's set
     iterates them (numbers; enumeration values in the order written)."""
-    from .cpp_expr import Untranslatable
     codes: list[tuple[Any, str]] = []
-    kinds = set()
+    kinds: set[str] = set()
     for item in items:
         code, kind = tr.expr(item)
         lit = _literal(item, tr)
@@ -160,7 +156,7 @@ def _set_domain(tr: "CppTranslator", items: tuple[Any, ...]) -> tuple[str, tuple
     return kind, ("values", [order[v] for v in values])
 
 
-def _literal(item: Any, tr: "CppTranslator") -> Any:
+def _literal(item: Any, tr: Any) -> Any:
     if isinstance(item, ast.NumLit):
         v = item.value
         return int(v) if v.denominator == 1 else float(Fraction(v))
