@@ -159,13 +159,11 @@ def _messages(key: str, value, typ, rule) -> list[dict]:  # type: ignore[no-unty
 
 def _stream_and_engine(checked, cn, rules, layer, values: dict, order: list[str]) -> list:  # type: ignore[no-untyped-def]
     """Feed ``values`` as messages (inputs first, topics in ``order``) to the engine and to the
-    layer's Stream; returns [(kind, engine verdicts, layer verdict)] per message."""
-    from rclverify.backends.monitors.check import NodeMonitor, check_trace
-    from rclverify.traces.events import Event
-    from rclverify.traces.mapping import TopicRule, initial_value, map_value
+    layer's Stream; returns [(kind, engine verdicts, layer verdict, variable, its value after)] per
+    message (the value as the engine's mapping reads the message)."""
+    from rclverify.backends.monitors.check import NodeMonitor
+    from rclverify.traces.mapping import TopicRule
     topics = NodeMonitor(checked, cn, rules, 100.0).topics  # topic -> [(key, type, is input)]
-    links = {f"{lk.name.lstrip('/')}/{part}": part for lk in cn.node.links if lk.kind == "action"
-             for part in ("goal", "feedback", "result")}
     msgs = []
     for inp in (True, False):
         for topic in sorted(topics, key=lambda t: order.index(t) if t in order else -1):
@@ -195,7 +193,8 @@ def _run_both(checked, cn, rules, layer, topics, msgs) -> list:  # type: ignore[
     for k, (topic, key, typ, fields, inp) in enumerate(msgs):
         seen[key] = map_value(typ, fields, rules.get(topic, TopicRule()), seen.get(key))
         mine = stream.on_input({key: seen[key]}) if inp else stream.on_output({key: seen[key]})
-        rows.append(("in" if inp else "out", [(v.verdict, v.guarantee, v.reason) for v in got.get(k, [])], mine))
+        rows.append(("in" if inp else "out", [(v.verdict, v.guarantee, v.reason) for v in got.get(k, [])], mine,
+                     key, seen[key]))
     return rows
 
 
@@ -225,7 +224,7 @@ def test_a_triggered_guarantee_is_owed_by_its_trigger_only(tmp_path: Path) -> No
     seq = [(topic, key, typ, fields[0], inp) for topic, key, typ, fields, inp in seq]
     rows = _run_both(CHECKED, cn, rules, layer, topics, seq)
     _compare(rows, "Controller", set())
-    got = [(m["verdict"], m["guarantee"]) for k, _, m in rows if k == "out"]
+    got = [(m["verdict"], m["guarantee"]) for k, _, m, _, _ in rows if k == "out"]
     assert got == [("violated", 3), ("satisfied", 0), ("none", 0), ("satisfied", 0), ("satisfied", 0),
                    ("satisfied", 0)], got
     assert layer.judge({**layer.Stream().values, "in.obstacle": 4.0, "in.speed_cmd": 1.0, "in.max_speed": 1.5,
@@ -233,7 +232,7 @@ def test_a_triggered_guarantee_is_owed_by_its_trigger_only(tmp_path: Path) -> No
 
 
 def _compare(rows: list, where: object, seen: set) -> None:
-    for kind, engine, mine in rows:
+    for kind, engine, mine, _, _ in rows:
         if kind == "in":  # the question's assumption: refused by both or by neither
             refused = [(v, g, r) for v, g, r in engine if v == "assumption violated" or
                        (v == "inconclusive" and r.startswith("assumption undecided"))]
@@ -278,7 +277,7 @@ def test_the_stream_agrees_with_the_monitor_engine_on_every_warehouse_node(tmp_p
             rnd.shuffle(order)
             rows = _stream_and_engine(CHECKED, cn, rules, layer, values, order)
             _compare(rows, (node_name, values), seen)
-            semantics.update(m["semantics"] for k, _, m in rows if k == "out" and m["verdict"] == "satisfied")
+            semantics.update(m["semantics"] for k, _, m, _, _ in rows if k == "out" and m["verdict"] == "satisfied")
 
         agree()
         if node_name == "LidarDriver":  # 1000.0 * 0.1 is 100.0 in doubles only; the monitor reads it so

@@ -351,3 +351,80 @@ def test_triggered_guarantees_are_owed_as_the_python_stream_owes_them(built: dic
 
     agree()
     assert {"violated", "satisfied", "not owed"} <= seen, seen
+
+
+@pytest.mark.parametrize("case", sorted(CASES))
+def test_compiled_checks_agree_with_the_monitor_engine_on_every_node(built: dict, tmp_path: Path, case: str) -> None:
+    """Every node's compiled checks against the monitor engine itself (``check_trace``): random
+    values as the messages of a run (test_generate_contract_layer.py's ``_stream_and_engine``:
+    inputs, then every output), the step judged by C++ with ``heard=`` the inputs whose messages
+    raised or carried the question: a C++ verdict that decides (not ``inconclusive``) is the kind
+    of the engine's verdicts on the run's messages, and every guarantee the engine finds violated
+    is false in C++, unless a clause's double and exact readings differ (docs/generate.md)."""
+    from test_generate_contract_layer import _stream_and_engine  # the run both are fed
+
+    from rclverify.backends.monitors.config import load_mapping
+    from rclverify.backends.property_tests.strategies import input_space
+    ws = CASES[case]
+    checked = Workspace(ws, "contracts/plan.yaml").checked
+    out = tmp_path / "py"
+    assert main(["generate", "ros2", "-w", str(ws), "-o", str(out)]) == 0
+    rules = load_mapping(out if case == "warehouse" else ws,
+                         "rclverify_mapping.yaml" if case == "warehouse" else "backends/monitors/mapping.yaml").rules
+    stats = {"compared": 0, "inconclusive in C++": 0, "readings differ": 0}
+    kinds: set[str] = set()
+    for node_name, cn in checked.nodes.items():
+        pkg, _ = built["pkgs"][node_name]
+        layer = _load(out / pkg / pkg / "contract.py", f"engine_cpp_{case}_{pkg}")
+        io = {f"in.{k}": t for k, t in cn.inputs.items()} | {f"out.{k}": t for k, t in cn.outputs.items()}
+        space = input_space(cn, {})
+        clauses = list(cn.node.assumes) + list(cn.node.guarantees)
+        n = len(cn.node.assumes)
+
+        @st.composite
+        def values(draw, io=io, space=space):  # type: ignore[no-untyped-def]
+            space.pools = {}
+            return {q: (draw(st.booleans()) if t == BOOL else draw(_REAL | st.sampled_from([-1.0, -0.5])) if t == REAL else
+                        space.table(draw, t) if isinstance(t, FuncT) else draw(space.value(t)))
+                    for q, t in io.items() if not isinstance(t, EmptyT)}
+
+        @settings(max_examples=12 if case == "warehouse" else 8, deadline=None, database=None, derandomize=True,
+                  phases=[Phase.explicit, Phase.generate])
+        @given(values())
+        def agree(vals: dict) -> None:
+            rows = _stream_and_engine(checked, cn, rules, layer, vals, [])
+            final = {key: v for _, _, _, key, v in rows}
+            heard = [key for kind, engine, _, key, _ in rows
+                     if kind == "in" and not any(v == "incomplete input" for v, _, _ in engine)]
+            asked = [v for kind, engine, _, _, _ in rows if kind == "in" for v in engine
+                     if v[0] == "assumption violated" or (v[0] == "inconclusive" and v[2].startswith("assumption"))]
+            answers = [(v, g) for kind, engine, _, _, _ in rows if kind == "out" for v, g, r in engine
+                       if v in ("satisfied", "violated", "inconclusive") and "whatever the value" not in r
+                       and "undecided on the outputs published" not in r]
+            line = " ".join([f"heard={h}" for h in heard] + [_text(q, v, io[q]) for q, v in final.items()
+                            if isinstance(io[q], EnumT) or (isinstance(io[q], Scalar) and io[q].name != "STRING")])
+            (verdict, g, truths), = _run(built["exe"], pkg, [line])
+            if verdict == "inconclusive":
+                stats["inconclusive in C++"] += 1
+                return
+            if any(holds_in("double", c.formula, checked, cn, final) != holds_in("exact", c.formula, checked, cn, final)
+                   for c in clauses):
+                stats["readings differ"] += 1
+                return
+            if asked and asked[-1][0] == "assumption violated":  # the last question's, the one the step answers
+                assert verdict == "assumption violated", (node_name, line, asked)
+            else:
+                violated = {g2 for v, g2 in answers if v == "violated"}
+                want = "violated" if violated else "inconclusive" if any(v == "inconclusive" for v, _ in answers) \
+                    else "satisfied"
+                assert verdict == want, (node_name, line, truths, answers)
+                assert all(truths[n + k - 1] == "F" for k in violated), (node_name, line, truths, answers)
+            stats["compared"] += 1
+            kinds.add(verdict)
+
+        agree()
+    print(case, stats, sorted(kinds))
+    if case == "warehouse":
+        assert stats["compared"] >= 60 and {"satisfied", "violated", "assumption violated"} <= kinds, (stats, kinds)
+    else:  # the guarantees only exact arithmetic decides: inconclusive in C++; broken assumptions compared
+        assert stats["inconclusive in C++"] > 0 and "assumption violated" in kinds, (stats, kinds)
