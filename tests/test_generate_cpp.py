@@ -62,6 +62,15 @@ def built(tmp_path_factory: pytest.TempPathFactory) -> dict:
     return {"pkgs": pkgs, "exe": exe}
 
 
+@pytest.fixture(scope="module")
+def py_trees(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
+    """Both workspaces generated with --lang python (the contract layers), once."""
+    tmp = tmp_path_factory.mktemp("py")
+    for case, ws in CASES.items():
+        assert main(["generate", "ros2", "-w", str(ws), "-o", str(tmp / case)]) == 0
+    return {case: tmp / case for case in CASES}
+
+
 def _load(path: Path, name: str):  # type: ignore[no-untyped-def]
     spec = importlib.util.spec_from_file_location(name, path)
     assert spec is not None and spec.loader is not None
@@ -90,12 +99,11 @@ def _run(exe: Path, pkg: str, steps: list[str]) -> list[tuple[str, int, str]]:
 
 
 @pytest.mark.parametrize("case", sorted(CASES))
-def test_compiled_checks_agree_with_rclverify(built: dict, tmp_path: Path, case: str) -> None:
+def test_compiled_checks_agree_with_rclverify(built: dict, py_trees: dict, case: str) -> None:
     from rclverify.backends.property_tests.strategies import input_space
     ws = CASES[case]
     checked = Workspace(ws, "contracts/plan.yaml").checked
-    layer_out = tmp_path / "py"
-    assert main(["generate", "ros2", "-w", str(ws), "-o", str(layer_out)]) == 0
+    layer_out = py_trees[case]
     stats = {"steps": 0, "agree": 0, "untranslated": 0, "exact_only": 0, "exact_decides": 0, "differ": 0,
              "verdicts": set()}
     for node_name, cn in checked.nodes.items():
@@ -292,7 +300,7 @@ def test_bounded_quantifiers_are_loops_with_the_double_readings_verdict(tmp_path
 
 
 @pytest.mark.parametrize("node_name", ["Controller", "Planner"])
-def test_triggered_guarantees_are_owed_as_the_python_stream_owes_them(built: dict, tmp_path: Path,
+def test_triggered_guarantees_are_owed_as_the_python_stream_owes_them(built: dict, py_trees: dict,
                                                                       node_name: str) -> None:
     """A step of the C++ node answers the input message that made it (``Owed``: a guarantee
     ``triggered by in.x`` is judged only when that message is on in.x): on random runs (each step
@@ -304,8 +312,7 @@ def test_triggered_guarantees_are_owed_as_the_python_stream_owes_them(built: dic
     checked = Workspace(ws, "contracts/plan.yaml").checked
     cn = checked.nodes[node_name]
     pkg, _ = built["pkgs"][node_name]
-    out = tmp_path / "py"
-    assert main(["generate", "ros2", "-w", str(ws), "-o", str(out)]) == 0
+    out = py_trees["warehouse"]
     layer = _load(out / pkg / pkg / "contract.py", f"owed_{pkg}")
     ins, outs = [f"in.{k}" for k in cn.inputs], [f"out.{k}" for k in cn.outputs]
     real = st.sampled_from([0.0, 0.3, 1.0, 1.5, 2.0, 5.0, 40.0, 100.0]) | _REAL
@@ -354,7 +361,7 @@ def test_triggered_guarantees_are_owed_as_the_python_stream_owes_them(built: dic
 
 
 @pytest.mark.parametrize("case", sorted(CASES))
-def test_compiled_checks_agree_with_the_monitor_engine_on_every_node(built: dict, tmp_path: Path, case: str) -> None:
+def test_compiled_checks_agree_with_the_monitor_engine_on_every_node(built: dict, py_trees: dict, case: str) -> None:
     """Every node's compiled checks against the monitor engine itself (``check_trace``): random
     values as the messages of a run (test_generate_contract_layer.py's ``_stream_and_engine``:
     inputs, then every output), the step judged by C++ with ``heard=`` the inputs whose messages
@@ -367,8 +374,7 @@ def test_compiled_checks_agree_with_the_monitor_engine_on_every_node(built: dict
     from rclverify.backends.property_tests.strategies import input_space
     ws = CASES[case]
     checked = Workspace(ws, "contracts/plan.yaml").checked
-    out = tmp_path / "py"
-    assert main(["generate", "ros2", "-w", str(ws), "-o", str(out)]) == 0
+    out = py_trees[case]
     rules = load_mapping(out if case == "warehouse" else ws,
                          "rclverify_mapping.yaml" if case == "warehouse" else "backends/monitors/mapping.yaml").rules
     stats = {"compared": 0, "inconclusive in C++": 0, "readings differ": 0}
@@ -388,7 +394,7 @@ def test_compiled_checks_agree_with_the_monitor_engine_on_every_node(built: dict
                         space.table(draw, t) if isinstance(t, FuncT) else draw(space.value(t)))
                     for q, t in io.items() if not isinstance(t, EmptyT)}
 
-        @settings(max_examples=12 if case == "warehouse" else 8, deadline=None, database=None, derandomize=True,
+        @settings(max_examples=9 if case == "warehouse" else 8, deadline=None, database=None, derandomize=True,
                   phases=[Phase.explicit, Phase.generate])
         @given(values())
         def agree(vals: dict) -> None:
@@ -423,8 +429,7 @@ def test_compiled_checks_agree_with_the_monitor_engine_on_every_node(built: dict
             kinds.add(verdict)
 
         agree()
-    print(case, stats, sorted(kinds))
     if case == "warehouse":
-        assert stats["compared"] >= 60 and {"satisfied", "violated", "assumption violated"} <= kinds, (stats, kinds)
+        assert stats["compared"] >= 45 and {"satisfied", "violated", "assumption violated"} <= kinds, (stats, kinds)
     else:  # the guarantees only exact arithmetic decides: inconclusive in C++; broken assumptions compared
         assert stats["inconclusive in C++"] > 0 and "assumption violated" in kinds, (stats, kinds)
