@@ -8,6 +8,7 @@ from __future__ import annotations
 import importlib.util
 from pathlib import Path
 
+import pytest
 from hypothesis import given, settings, strategies as st
 
 from rclverify.cli import main
@@ -18,6 +19,15 @@ from rclverify.rcl.types import BOOL, EmptyT, FuncT, Scalar
 ROOT = Path(__file__).resolve().parents[1]
 WAREHOUSE = ROOT / "examples" / "warehouse"
 CHECKED = Workspace(WAREHOUSE, "contracts/plan.yaml").checked
+
+
+@pytest.fixture(scope="module")
+def trees(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
+    """Both workspaces generated (--lang python), once for the module."""
+    tmp = tmp_path_factory.mktemp("gen")
+    for name, ws in (("warehouse", WAREHOUSE), ("case_study", ROOT)):
+        assert main(["generate", "ros2", "-w", str(ws), "-o", str(tmp / name)]) == 0
+    return {"warehouse": tmp / "warehouse", "case_study": tmp / "case_study"}
 
 
 def _load(path: Path, name: str):  # type: ignore[no-untyped-def]
@@ -36,10 +46,9 @@ _REAL = st.one_of(st.integers(-30, 130).map(float), st.floats(-1e4, 1e4, allow_n
                   st.sampled_from([0.0, 1.5, 2.0, 20.0, 100.0, 1e-9]))
 
 
-def test_generated_checks_agree_with_z3_on_every_warehouse_node(tmp_path: Path) -> None:
-    out = tmp_path / "out"
+def test_generated_checks_agree_with_z3_on_every_warehouse_node(trees: dict) -> None:
+    out = trees["warehouse"]
     seen_all: set[str] = set()
-    assert main(["generate", "ros2", "-w", str(WAREHOUSE), "-o", str(out)]) == 0
     for node_name, cn in CHECKED.nodes.items():
         pkg = [p for p in out.iterdir() if (p / p.name / "contract.py").is_file()
                and f"NODE = \"{node_name}\"" in (p / p.name / "contract.py").read_text()]
@@ -68,13 +77,12 @@ def test_generated_checks_agree_with_z3_on_every_warehouse_node(tmp_path: Path) 
     assert {"satisfied", "violated", "assumption violated"} <= seen_all, seen_all
 
 
-def test_generated_checks_agree_with_z3_on_the_case_study_where_both_decide(tmp_path: Path) -> None:
+def test_generated_checks_agree_with_z3_on_the_case_study_where_both_decide(trees: dict) -> None:
     """The case study's values are finite function tables (the property tests' strategies draw
     them); where the evaluator or Z3 cannot decide a clause the example is not compared."""
     from rclverify.backends.property_tests.strategies import input_space
     checked = Workspace(ROOT, "contracts/plan.yaml").checked
-    out = tmp_path / "out"
-    assert main(["generate", "ros2", "-w", str(ROOT), "-o", str(out)]) == 0
+    out = trees["case_study"]
     compared = 0
     kinds: set[str] = set()
     for node_name, cn in checked.nodes.items():
@@ -198,15 +206,14 @@ def _run_both(checked, cn, rules, layer, topics, msgs) -> list:  # type: ignore[
     return rows
 
 
-def test_a_triggered_guarantee_is_owed_by_its_trigger_only(tmp_path: Path) -> None:
+def test_a_triggered_guarantee_is_owed_by_its_trigger_only(trees: dict) -> None:
     """Controller's guarantee 3, ``out.query triggered by in.speed_cmd``: a request without the
     query after a new speed command violates it; after an obstacle reading only (the speed
     command answered already) it is not owed, and the Stream, as the engine, says nothing, where
     the step's judgement (every guarantee) would call it violated (docs/semantics.md)."""
     from rclverify.backends.monitors.check import NodeMonitor
     from rclverify.backends.monitors.config import load_mapping
-    out = tmp_path / "out"
-    assert main(["generate", "ros2", "-w", str(WAREHOUSE), "-o", str(out)]) == 0
+    out = trees["warehouse"]
     rules = load_mapping(out, "rclverify_mapping.yaml").rules
     cn = CHECKED.nodes["Controller"]
     layer = _load(out / "controller" / "controller" / "contract.py", "trigger_contract")
@@ -252,10 +259,9 @@ def _compare(rows: list, where: object, seen: set) -> None:
             seen.add(f"compared {mine['node']}")
 
 
-def test_the_stream_agrees_with_the_monitor_engine_on_every_warehouse_node(tmp_path: Path) -> None:
+def test_the_stream_agrees_with_the_monitor_engine_on_every_warehouse_node(trees: dict) -> None:
     from rclverify.backends.monitors.config import load_mapping
-    out = tmp_path / "out"
-    assert main(["generate", "ros2", "-w", str(WAREHOUSE), "-o", str(out)]) == 0
+    out = trees["warehouse"]
     rules = load_mapping(out, "rclverify_mapping.yaml").rules
     seen: set[str] = set()
     semantics: set[str] = set()
@@ -289,13 +295,12 @@ def test_the_stream_agrees_with_the_monitor_engine_on_every_warehouse_node(tmp_p
     assert "double" in semantics, semantics  # the node's double arithmetic, as the monitor reads it
 
 
-def test_the_stream_agrees_with_the_monitor_engine_on_every_case_study_node(tmp_path: Path) -> None:
+def test_the_stream_agrees_with_the_monitor_engine_on_every_case_study_node(trees: dict) -> None:
     from rclverify.backends.monitors.config import load_mapping
     from rclverify.backends.property_tests.strategies import input_space
     checked = Workspace(ROOT, "contracts/plan.yaml").checked
     rules = load_mapping(ROOT, "backends/monitors/mapping.yaml").rules
-    out = tmp_path / "out"
-    assert main(["generate", "ros2", "-w", str(ROOT), "-o", str(out)]) == 0
+    out = trees["case_study"]
     seen: set[str] = set()
     for node_name, cn in checked.nodes.items():
         layer = _load(out / _snake(node_name) / _snake(node_name) / "contract.py", f"engine_cs_{node_name}")
@@ -324,14 +329,13 @@ def _snake(name: str) -> str:
     return snake(name)
 
 
-def test_the_verdict_message_is_the_monitors(tmp_path: Path) -> None:
+def test_the_verdict_message_is_the_monitors(trees: dict) -> None:
     """The generated layer's message for rclverify/verdict has the monitor's fields (Verdict.to_json)
     and JSON form (live.dumps); node.py publishes it for a violation only."""
     import json
     from rclverify.backends.monitors.live import dumps
     from rclverify.backends.monitors.verdicts import Verdict
-    out = tmp_path / "out"
-    assert main(["generate", "ros2", "-w", str(WAREHOUSE), "-o", str(out)]) == 0
+    out = trees["warehouse"]
     layer = _load(out / "lidar_driver/lidar_driver/contract.py", "msg_contract_lidar")
     msg = layer.verdict_message({"in.range": 2.0, "out.obstacle": 3.0}, 7, 1.5, "/obstacle")
     ref = Verdict("LidarDriver", "violated", 7, 1.5, "node LidarDriver", "/obstacle", 1.5, 1,
