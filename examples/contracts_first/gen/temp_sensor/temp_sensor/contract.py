@@ -46,7 +46,9 @@ def judge(values, owed=None, wait=False, assumptions=True):
     ``owed``: the 1-based guarantees to judge (``None``: all; :class:`Stream` gives those an
     output message answers); ``wait``: a guarantee reading an output with no value yet waits
     (is not judged) instead of being undecided, and a step that decides none is ``none`` (no
-    verdict), as the engine judges an output message (docs/semantics.md, "Answers")."""
+    verdict), as the engine judges an output message (docs/semantics.md, "Answers");
+    ``assumptions``: False judges the guarantees alone (those over outputs only, on the
+    outputs as they stand)."""
     from rclverify.logic.floatsem import holds_in, judge as floatjudge
     from rclverify.values import render
     checked, node = _node()
@@ -138,8 +140,8 @@ class Stream:
         if any(k not in self.values for k in self._ins):
             return None  # incomplete input: not a question yet
         inputs = {k: v for k, v in self.values.items() if k.startswith('in.')}
-        v = judge(inputs, owed=())
-        owed = v['verdict'] == 'none' or v['verdict'] == 'satisfied'
+        v = judge(inputs, owed=())  # the assumption alone
+        owed = v['verdict'] == 'satisfied'
         carried = (self.triggers - self.answered) if owed and self.question is not None else set()
         self.triggers = carried | ({k for k in changed if k in TRIGGERS.values()} if owed else set())
         self.answered = set()
@@ -156,7 +158,7 @@ class Stream:
         touched = [k for k, (_, outs) in sorted(self._per.items()) if outs & set(changed)]
         asked = [k for k in touched if self._ins and (k in TRIGGERS or self._per[k][0])]
         alone = [k for k in touched if k not in asked]
-        first = judge({}, owed=(), wait=True, assumptions=False)  # 'none'
+        first = dict(node=NODE, verdict='none', guarantee=0, values={}, reason='', semantics='')
         if asked and self.question is not None and self.question[1]:
             inputs, _ = self.question
             self.answer.update(changed)
