@@ -1,6 +1,8 @@
 """examples/contracts_first: the contracts, the tree `rclverify generate ros2` made from them and
-the hand-written logic; `doit verify` finds the seeded bug in TempSensor's logic and discharges
-HeaterControl's, and the fixed logic is discharged (docs/generate.md, "Contracts first: an example")."""
+the hand-written logic; `doit verify` finds the seeded bug in TempSensor's logic, by its property
+tests and by the monitor on the run record_run.py recorded from that logic, and discharges
+HeaterControl's; the fixed logic, its run recorded again, is discharged (docs/generate.md,
+"Contracts first: an example")."""
 from __future__ import annotations
 
 import json
@@ -29,11 +31,20 @@ def test_doit_verify_finds_the_seeded_bug_and_discharges_the_fix(tmp_path: Path,
     fragment = (ws / "gen" / "rclverify_plan.yaml").read_text().split("nodes:\n", 1)[1]
     plan = (ws / "contracts" / "plan.yaml").read_text().split("nodes:\n", 1)[1]
     strip = lambda t: [ln for ln in t.splitlines() if ln.strip() and not ln.strip().startswith("#")]  # noqa: E731
-    assert strip(plan) == strip(fragment)  # the plan's entries are the generated fragment's
+    # the plan's entries are the generated fragment's, with the recorded run under `traces`
+    assert strip(plan) == strip(fragment.replace("traces: []", "traces:\n          - runs/run.jsonl"))
+    # the committed run is the one record_run.py records from the committed logic
+    run = (ws / "runs" / "run.jsonl").read_text()
+    subprocess.run([sys.executable, "record_run.py"], cwd=ws, check=True, capture_output=True)
+    assert (ws / "runs" / "run.jsonl").read_text() == run
 
-    assert _verify(ws) == {"TempSensor.g1.property_tests.e0": "failed",
-                           "HeaterControl.g1.property_tests.e0": "discharged"}
+    assert _verify(ws) == {"TempSensor.g1.property_tests.e0": "failed", "TempSensor.g0.monitors.run_jsonl": "failed",
+                           "HeaterControl.g1.property_tests.e0": "discharged",
+                           "HeaterControl.g0.monitors.run_jsonl": "discharged"}
     logic = ws / "gen" / "temp_sensor" / "temp_sensor" / "logic.py"
     logic.write_text(logic.read_text().replace("kelvin - 273}", "kelvin - 273.15}"))
+    subprocess.run([sys.executable, "record_run.py"], cwd=ws, check=True, capture_output=True)
     assert _verify(ws) == {"TempSensor.g1.property_tests.e0": "discharged",
-                           "HeaterControl.g1.property_tests.e0": "discharged"}
+                           "TempSensor.g0.monitors.run_jsonl": "discharged",
+                           "HeaterControl.g1.property_tests.e0": "discharged",
+                           "HeaterControl.g0.monitors.run_jsonl": "discharged"}

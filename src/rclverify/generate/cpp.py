@@ -19,7 +19,8 @@ from typing import Any, Mapping
 from ..logic.floatsem import Tolerance
 from ..rcl.printer import expr_to_rcl
 from ..rcl.types import Checked, CheckedNode, EnumT
-from .cpp_expr import CppTranslator, Untranslatable, cpp_type, enum_const
+from .cpp_common import Untranslatable, enum_const
+from .cpp_expr import CppTranslator, cpp_type
 from .nodes import NodePackage
 from .typemap import camel, snake
 from .wiring import wires
@@ -72,6 +73,8 @@ class Clause:
     double: str = ""
     tolerance: str = ""
     why: str = ""
+    #: why the translated check may answer undecided besides a division by zero (a quantifier)
+    notes: list[str] = field(default_factory=list)
 
     @property
     def title(self) -> str:
@@ -80,7 +83,7 @@ class Clause:
     @property
     def reason(self) -> str:
         """The inconclusive verdict's reason, a C++ string literal's contents."""
-        r = f"not translated to C++: {self.why}" if self.why else "division by zero"
+        r = f"not translated to C++: {self.why}" if self.why else "; ".join(self.notes + ["division by zero"])
         return r.replace("\\", "\\\\").replace('"', '\\"')
 
 
@@ -100,6 +103,8 @@ class Checks:
     clauses: list[Clause] = field(default_factory=list)
     tolerance: dict[str, Any] | None = None
     tolerance_text: str = ""
+    #: per guarantee (1-based, index 0 unused): the input of ``triggered by in.x``, "" none
+    triggers: list[str] = field(default_factory=list)
 
 
 @dataclass
@@ -133,6 +138,7 @@ def checks_of(checked: Checked, cn: CheckedNode, namespace: str, tolerance: Tole
         enums.setdefault(t.name, t)
     c.enums = [_Enum(t.name, snake(t.name), [(v, enum_const(t, v)) for v in t.values])
                for t in sorted(enums.values(), key=lambda t: t.name)]
+    c.triggers = [""] + [f"in.{g.trigger.name}" if g.trigger is not None else "" for g in cn.node.guarantees]
     dbl = CppTranslator(checked, cn, "double")
     tol = CppTranslator(checked, cn, "tolerance")
     if tolerance:
@@ -143,7 +149,9 @@ def checks_of(checked: Checked, cn: CheckedNode, namespace: str, tolerance: Tole
             fn = f"{'assumption' if kind == 'assume' else 'guarantee'}_{k}"
             cc = Clause(kind, k, _one_line(expr_to_rcl(cl.formula)), fn)
             try:
+                dbl.notes = []
                 cc.double = dbl.translate(cl.formula)
+                cc.notes = sorted(set(dbl.notes))
                 if tolerance:
                     cc.tolerance = tol.translate(cl.formula)
             except Untranslatable as exc:
@@ -173,7 +181,7 @@ def node_context(checked: Checked, np: NodePackage, c: Checks, rules: Mapping[st
         kind = e.kind
         headers.add(_header(e.ros_type, kind))
         mine = [w for w in ws if w.attr == e.attr]
-        reads = [dict(field=held[w.var], path=w.path, part=w.part) for w in mine if w.side == "in"]
+        reads = [dict(field=held[w.var], path=w.path, part=w.part, var=w.var) for w in mine if w.side == "in"]
         writes = [dict(field=held[w.var], path=w.path, part=w.part) for w in mine if w.side == "out"]
         ends.append(dict(role=e.role, name=e.name, var=e.var, attr=e.attr, cpp=_cpp_type(e.ros_type, kind),
                          reads=reads, writes=writes))

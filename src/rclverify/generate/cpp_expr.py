@@ -22,8 +22,10 @@ Translated: ``REAL``/``INTEGER``/``NATURAL``/``BOOL`` and enumeration
 variables (``in.x``, ``out.y``, bare I/O names), numeric and boolean
 literals, enumeration values, context constants, ``not``, unary ``-``,
 ``and or -> <=>``, ``+ - * /`` (``/`` by zero is undecided, as in
-rclverify), chained comparisons, and membership in a literal set.
-Anything else (quantifiers, functions, constructor terms, sets, sequences,
+rclverify), chained comparisons, membership in a literal set, and
+quantifiers as the double reading enumerates them (:mod:`.cpp_quant`: loops
+over finite domains; an unbounded one undecided with its reason).
+Anything else (functions, constructor terms, sets and sequences as values,
 tuples, strings) raises :class:`Untranslatable`: the clause's check then
 answers *undecided* (the monitor's ``inconclusive``), never a guess.
 """
@@ -31,14 +33,12 @@ from __future__ import annotations
 
 from ..rcl import ast
 from ..rcl.types import Checked, CheckedNode, EnumT, Scalar, Type
+from .cpp_common import Untranslatable, enum_const
+from .cpp_quant import quantifier
 from .typemap import snake
 
 #: RCL scalar -> C++ type of the struct field
 CPP_SCALARS = {"REAL": "double", "INTEGER": "std::int64_t", "NATURAL": "std::uint64_t", "BOOL": "bool"}
-
-
-class Untranslatable(ValueError):
-    """A formula (part) outside the translated fragment; the message says which construct."""
 
 
 def cpp_type(t: Type) -> str | None:
@@ -50,15 +50,6 @@ def cpp_type(t: Type) -> str | None:
     return None
 
 
-def enum_const(t: EnumT, value: str) -> str:
-    """The C++ constant of an enumeration value: ``kRadStatRed``."""
-    return "k" + _camel(t.name) + _camel(value)
-
-
-def _camel(s: str) -> str:
-    return "".join(p[:1].upper() + p[1:] for p in snake(s).split("_"))
-
-
 class CppTranslator:
     """Translates the formulas of one node; ``mode`` is ``double`` or ``tolerance``.
 
@@ -68,6 +59,10 @@ class CppTranslator:
 
     def __init__(self, checked: Checked, node: CheckedNode, mode: str = "double") -> None:
         self.env, self.node, self.mode = checked.env, node, mode
+        #: the quantified variables in scope: RCL name -> (C++ name, kind) (:mod:`.cpp_quant`)
+        self.bound: dict[str, tuple[str, str]] = {}
+        #: why a translated formula may be undecided (a quantifier the double reading cannot enumerate)
+        self.notes: list[str] = []
 
     def translate(self, e: ast.Expr) -> str:
         code, kind = self.expr(e)
@@ -98,9 +93,13 @@ class CppTranslator:
             return self.compare(e)
         if isinstance(e, ast.Member):
             return self.member(e)
+        if isinstance(e, ast.Quant):
+            return quantifier(self, e)
         raise Untranslatable(_CONSTRUCTS.get(type(e).__name__, type(e).__name__))
 
     def var(self, v: ast.Var) -> tuple[str, str]:
+        if v.prefix is None and v.name in self.bound:  # a quantified variable first, as rclverify resolves names
+            return self.bound[v.name]
         if v.prefix is None and v.name in self.env.enum_values:
             t = self.env.enum_values[v.name]
             return enum_const(t, v.name), f"enum:{t.name}"
@@ -178,7 +177,7 @@ class CppTranslator:
         return code
 
 
-_CONSTRUCTS = {"Quant": "a quantifier", "TupleQuant": "a quantifier", "Apply": "a function or constructor term",
+_CONSTRUCTS = {"TupleQuant": "a quantifier with a tuple binder", "Apply": "a function or constructor term",
                "SetLit": "a set", "SeqLit": "a sequence", "TupleLit": "a tuple", "StrLit": "a string",
                "SeqRange": "a sequence range"}
 _CMP_NAMES = {"==": "kEq", "!=": "kNe", "<": "kLt", "<=": "kLe", ">": "kGt", ">=": "kGe"}

@@ -98,7 +98,9 @@ def render_tree(checked: Checked, system: str, sources: dict[str, str] | None = 
         gen[f"{d}/{d}/__init__.py"] = f"# {GENERATED}\n"
         gen[f"{d}/{d}/contract.py"] = _ENV.get_template("contract.py.j2").render(
             ctx, sources_json=json.dumps(sources or {}, sort_keys=True),
-            tolerance=tolerance.to_json() if tolerance else None)
+            tolerance=tolerance.to_json() if tolerance else None,
+            triggers=[(k, f"in.{c.trigger.name}") for k, c in
+                      enumerate(checked.nodes[np.ros_name].node.guarantees, 1) if c.trigger is not None])
         gen[f"{d}/setup.py"] = _ENV.get_template("setup.py.j2").render(ctx)
         gen[f"{d}/setup.cfg"] = _ENV.get_template("setup.cfg.j2").render(ctx)
         gen[f"{d}/package.xml"] = _ENV.get_template("node_package.xml.j2").render(ctx)

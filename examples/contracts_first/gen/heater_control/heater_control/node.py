@@ -21,7 +21,8 @@ class HeaterControlNode(Node):
 
     def __init__(self):
         super().__init__('HeaterControl')
-        self.values = {}
+        self.stream = contract.Stream()  # the messages as the monitor reads them (docs/semantics.md)
+        self.values = self.stream.values
         self.steps = 0
         self.verdict_pub = self.create_publisher(String, contract.VERDICT_TOPIC, QOS_DEPTH)
         # in.celsius
@@ -32,6 +33,7 @@ class HeaterControlNode(Node):
 
     def on_sub_temperature(self, msg):
         self.take('in.celsius', msg)
+        self.heard(['in.celsius'])
         logic.on_input(self, 'in.celsius', msg)
 
     def take(self, var, msg):
@@ -46,7 +48,7 @@ class HeaterControlNode(Node):
         attr = contract.FIELDS[var][0]
         self.take(var, msg)
         getattr(self, attr).publish(msg)
-        self.check(getattr(getattr(self, attr), 'topic_name', attr))
+        self.check(getattr(getattr(self, attr), 'topic_name', attr), [var])
 
     def fill(self, var, msg, value):
         """Set output ``var``'s field of ``msg`` to RCL value ``value`` and record it."""
@@ -66,11 +68,24 @@ class HeaterControlNode(Node):
         self.fill(var, msg, value)
         self.publish(var, msg)
 
-    def check(self, topic=''):
-        """Judge the step; a violation (``violated``, ``assumption violated``) goes to rclverify/verdict."""
+    def heard(self, inputs, topic=''):
+        """The inputs ``inputs`` came in one message: a question, whose broken assumption goes to
+        rclverify/verdict."""
+        v = self.stream.on_input({k: self.values[k] for k in inputs if k in self.values})
+        if v is not None:
+            self.report(v, topic)
+
+    def check(self, topic='', outputs=()):
+        """The outputs ``outputs`` went out in one message: judged as the monitor judges it (the
+        guarantees it answers, triggered ones only when their input's message is owed an answer);
+        a violation goes to rclverify/verdict."""
+        self.report(self.stream.on_output({k: self.values[k] for k in outputs if k in self.values}), topic)
+
+    def report(self, verdict, topic=''):
+        """Publish ``verdict`` (a contract.Stream verdict) on rclverify/verdict when it is a violation."""
         self.steps += 1
         now = self.get_clock().now().nanoseconds / 1e9
-        message = contract.verdict_message(self.values, self.steps, now, topic)
+        message = contract.verdict_message(self.values, self.steps, now, topic, verdict)
         if message['verdict'] in contract.VIOLATIONS:
             out = String()
             out.data = contract.dumps(message)

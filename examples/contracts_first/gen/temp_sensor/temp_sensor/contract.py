@@ -37,12 +37,18 @@ def _tolerance():
     return parse_tolerance(TOLERANCE)
 
 
-def judge(values):
+def judge(values, owed=None, wait=False, assumptions=True):
     """The verdict on one step, as the monitor engine judges a question and its answer
     (backends/monitors/engine.py): ``assumption violated`` (an assumption, in order, is false),
     ``inconclusive`` (an assumption undecided; or no guarantee false and one undecided),
     ``violated`` (the first false guarantee ``guarantee``, 1-based), else ``satisfied``;
-    ``semantics`` names the arithmetic that decided (docs/monitors.md, "Numbers on the wire")."""
+    ``semantics`` names the arithmetic that decided (docs/monitors.md, "Numbers on the wire").
+    ``owed``: the 1-based guarantees to judge (``None``: all; :class:`Stream` gives those an
+    output message answers); ``wait``: a guarantee reading an output with no value yet waits
+    (is not judged) instead of being undecided, and a step that decides none is ``none`` (no
+    verdict), as the engine judges an output message (docs/semantics.md, "Answers");
+    ``assumptions``: False judges the guarantees alone (those over outputs only, on the
+    outputs as they stand)."""
     from rclverify.logic.floatsem import holds_in, judge as floatjudge
     from rclverify.values import render
     checked, node = _node()
@@ -53,7 +59,7 @@ def judge(values):
 
     def verdict(name, g=0, reason='', semantics=''):
         return dict(node=NODE, verdict=name, guarantee=g, values=shown, reason=reason, semantics=semantics)
-    for clause in node.node.assumes:  # in order, as the monitor raises a question
+    for clause in (node.node.assumes if assumptions else ()):  # in order, as the monitor raises a question
         j = floatjudge(clause.formula, checked, node, values, tol)
         if j.truth is False:
             return verdict('assumption violated', 0, j.reason, j.semantics)
@@ -62,10 +68,14 @@ def judge(values):
         weakest = max(weakest, j.semantics, key=order.index)
     held, undecided = [], None
     for k, clause in enumerate(node.node.guarantees, 1):  # the first false one, else undecided, else satisfied
+        if owed is not None and k not in owed:
+            continue
         j = floatjudge(clause.formula, checked, node, values, tol)
         if j.truth is False:
             return verdict('violated', k, j.reason, j.semantics)
         if j.truth is None:
+            if wait and j.reason.startswith('no value for out.'):
+                continue  # waits for that output
             undecided = undecided or (k, j.reason)
             continue
         held.append((k, clause.formula, j.semantics))
@@ -77,7 +87,93 @@ def judge(values):
                                                                  tol) is False:
             return verdict('violated', k, f'no one arithmetic makes the guarantees hold: guarantee {k} is '
                            f'false in {weakest} arithmetic', weakest)
+    if wait and not held:
+        return verdict('none')
     return verdict('satisfied', 0, '', weakest)
+
+
+#: guarantee k (1-based) -> the input whose messages it answers (``triggered by in.x``)
+TRIGGERS = {
+}
+
+
+def _deps():
+    """(inputs the contract reads, per guarantee the inputs and the outputs it reads)."""
+    from rclverify.backends.monitors.verdicts import names, reads
+    _, node = _node()
+    needed = set()
+    for c in list(node.node.assumes) + list(node.node.guarantees):
+        names(c.formula, needed)
+    ins = [f'in.{n}' for n in node.inputs if f'in.{n}' in needed or n in needed]
+    per = {}
+    for k, c in enumerate(node.node.guarantees, 1):
+        got = set()
+        reads(c.formula, got)
+        per[k] = ({f'in.{n}' for n in node.inputs if f'in.{n}' in got or n in got},
+                  {f'out.{n}' for n in node.outputs if f'out.{n}' in got or n in got})
+    return ins, per
+
+
+class Stream:
+    """The node's messages read as rclverify's monitor reads a run (docs/semantics.md): an input
+    message raises a question once every input the contract reads has a value (its assumption
+    judged then); an output message answers the latest question, and only the guarantees that
+    read an output it sets are judged on it: those reading an input (or ``triggered by`` one) on
+    the question's inputs and the outputs published since it, the others on the outputs as they
+    stand; a guarantee ``triggered by in.x`` is owed only by a question that carries a message on
+    ``in.x`` not answered yet (carried on when a newer question supersedes it).  ``values`` holds
+    every variable's latest value."""
+
+    def __init__(self):
+        self.values = {}
+        self.question = None  # (inputs, owed)
+        self.answer = {}
+        self.triggers = set()
+        self.answered = set()
+        self._ins, self._per = _deps()
+
+    def on_input(self, changed):
+        """A message set the inputs ``changed`` ({'in.x': value}); returns the question's verdict
+        dict when its assumption is broken or undecided, ``None`` otherwise (no question yet, or
+        the node owes it an answer)."""
+        self.values.update(changed)
+        if any(k not in self.values for k in self._ins):
+            return None  # incomplete input: not a question yet
+        inputs = {k: v for k, v in self.values.items() if k.startswith('in.')}
+        v = judge(inputs, owed=())  # the assumption alone
+        owed = v['verdict'] == 'satisfied'
+        carried = (self.triggers - self.answered) if owed and self.question is not None else set()
+        self.triggers = carried | ({k for k in changed if k in TRIGGERS.values()} if owed else set())
+        self.answered = set()
+        self.question, self.answer = (inputs, owed), {}
+        return None if owed else v
+
+    def _owes(self, k):
+        return k not in TRIGGERS or TRIGGERS[k] in self.triggers
+
+    def on_output(self, changed):
+        """A message set the outputs ``changed`` ({'out.y': value}); returns its verdict dict
+        (``verdict`` ``none``: nothing decided on it, no verdict)."""
+        self.values.update(changed)
+        touched = [k for k, (_, outs) in sorted(self._per.items()) if outs & set(changed)]
+        asked = [k for k in touched if self._ins and (k in TRIGGERS or self._per[k][0])]
+        alone = [k for k in touched if k not in asked]
+        first = dict(node=NODE, verdict='none', guarantee=0, values={}, reason='', semantics='')
+        if asked and self.question is not None and self.question[1]:
+            inputs, _ = self.question
+            self.answer.update(changed)
+            owed = [k for k in asked if self._owes(k)]
+            self.answered |= {TRIGGERS[k] for k in owed if k in TRIGGERS}
+            first = judge({**inputs, **self.answer}, owed=owed, wait=True)
+        elif self.question is not None:
+            self.answer.update(changed)
+        second = judge({k: v for k, v in self.values.items() if k.startswith('out.')}, owed=alone, wait=True,
+                       assumptions=False) if alone else first
+        for kind in ('violated', 'inconclusive', 'satisfied'):  # the worse of the two (outcome.combine)
+            for v in (first, second):
+                if v['verdict'] == kind:
+                    return v
+        return first
 
 
 def value_of(var, raw):
@@ -118,11 +214,12 @@ def field_of(msg, path):
     return msg
 
 
-def verdict_message(values, event=0, time=0.0, topic=''):
+def verdict_message(values, event=0, time=0.0, topic='', verdict=None):
     """The monitor's verdict message for one step (``Verdict.to_json`` of
     backends/monitors/verdicts.py): node, verdict, event (the step's index), time and
-    decided_at (seconds), where, topic (the output's), guarantee, values, reason, semantics."""
-    v = judge(values)
+    decided_at (seconds), where, topic (the output's), guarantee, values, reason, semantics.
+    ``verdict``: a verdict dict already made (by :class:`Stream`), else ``judge(values)``."""
+    v = verdict if verdict is not None else judge(values)
     return {'node': NODE, 'verdict': v['verdict'], 'event': event, 'time': time, 'where': f'node {NODE}',
             'topic': topic, 'decided_at': time, 'guarantee': v['guarantee'], 'values': v['values'],
             'reason': v['reason'], 'semantics': v['semantics']}

@@ -1,0 +1,23 @@
+"""Names the C++ translation modules share (:mod:`.cpp_expr`, :mod:`.cpp_quant`): the error a
+formula outside the translated fragment raises and the C++ constant of an enumeration value."""
+from __future__ import annotations
+
+from ..rcl.types import EnumT
+from .typemap import snake
+
+
+class Untranslatable(ValueError):
+    """A formula (part) outside the translated fragment; the message says which construct."""
+
+
+def enum_const(t: EnumT, value: str) -> str:
+    """The C++ constant of an enumeration value: ``kRadStatRed``."""
+    return "k" + camel_words(t.name) + camel_words(value)
+
+
+def camel_words(s: str) -> str:
+    """``rad_stat``, ``RadStat`` -> ``RadStat`` (by rosidl's snake_case words)."""
+    return "".join(p[:1].upper() + p[1:] for p in snake(s).split("_"))
+
+
+__all__ = ["Untranslatable", "camel_words", "enum_const"]
