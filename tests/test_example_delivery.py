@@ -177,11 +177,13 @@ def test_each_defect_is_one_row_with_the_right_culprit(runs: dict[str, Any]) -> 
     # (c) the route longer than the buffer: one row for the side condition and the requirement
     route = ROWS["03-route-buffer.diff"]
     assert _members(report, route) == ["Navigator.sc4", "ROUTE"]
-    assert ("guarantee 1 of RouteServer", "contracts/route_server.rcl:13:3") in _culprits(report, route)
+    assert _culprits(report, route) == [("guarantee 1 of RouteServer", "contracts/route_server.rcl:13:3"),
+                                        ("assumption 3 of Navigator", "contracts/navigator.rcl:22:3")]
     # (d) the stop number off by one: one row for both consumers, the producer its culprit guarantee
     stop = ROWS["04-stop-number.diff"]
     assert _members(report, stop) == ["Navigator.sc1", "LockerController.sc1"]
-    assert [w for w, _ in _culprits(report, stop) if w.startswith("guarantee")] == ["guarantee 1 of MissionPlanner"]
+    assert [w for w, _ in _culprits(report, stop)] == [  # the producer first, then the assumptions it fails
+        "guarantee 1 of MissionPlanner", "assumption 1 of LockerController", "assumption 1 of Navigator"]
     from rclverify.report.culprits import culprit_nodes
     blamed = culprit_nodes(report["problems"])
     assert {"GnssDriver", "MissionPlanner", "RouteServer", "WheelController", "SpeedGovernor"} <= blamed

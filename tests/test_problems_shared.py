@@ -50,7 +50,8 @@ def test_consumers_of_one_loose_bound_are_one_row_with_one_first_repair(tmp_path
     assert ("Driver.sc1", "Locker.sc1") in rows  # one row for the dest bound, both victims its findings
     assert not [k for k in rows if k in (("Driver.sc1",), ("Locker.sc1",))]
     row = rows[("Driver.sc1", "Locker.sc1")]
-    assert "guarantee 1 of Planner" in [c["what"] for c in row["culprits"]]
+    assert [c["what"] for c in row["culprits"]] == ["guarantee 1 of Planner", "assumption 1 of Driver",
+                                                    "assumption 1 of Locker"]  # the producer first
     ref = row["repairs"][0]
     rep = next(d for d in report["diagnoses"] if d["id"] == ref["diagnosis"])["repairs"][ref["index"]]
     assert (rep["kind"], rep["edit"]["deleted"], rep["edit"]["inserted"]) == ("strengthen-producer", "501", "500")
@@ -74,3 +75,10 @@ def test_only_failed_side_conditions_with_the_same_first_repair_are_joined() -> 
     assert roots["C.sc1"] == ["assumption:C:1", "guarantee:P:1"]  # another first repair
     assert roots["D.sc1"] == ["assumption:D:1"] and roots["E.sc1"] == ["assumption:E:1"]  # no repair: never joined
     assert roots["R"] == ["guarantee:P:1"] and roots["F.sc1"] == ["assumption:F:1", "guarantee:P:1"]
+
+
+def test_the_producer_comes_before_the_assumptions_it_fails() -> None:
+    from rclverify.report.problems_shared import producer_first
+    assert producer_first(["assumption:B:1", "assumption:A:2", "guarantee:P:1", "contract:Q", "p.imp:9"]) == [
+        "guarantee:P:1", "contract:Q", "p.imp:9", "assumption:B:1", "assumption:A:2"]
+    assert producer_first([]) == []

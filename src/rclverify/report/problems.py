@@ -74,6 +74,7 @@ from typing import Any
 from ..evidence.records import SEVERITY
 from . import problems_mc as mc
 from . import problems_shared as ps
+from .problems_shared import producer_first
 from . import problems_units as pu
 from .textfmt import natural_sorted
 
@@ -315,8 +316,10 @@ def group_problems(report: Mapping[str, Any], items: Sequence[Mapping[str, Any]]
         g = groups.get(key)
         if g is None:
             g = groups[key] = {"key": list(key), "status": m["status"], "sentence": first_sentence(m["sentence"]),
-                               # in natural order: a program's line 9 before its line 13 (issue 48)
-                               "culprits": [_culprit(r, places, anchor) for r in natural_sorted(key) if r in places.info],
+                               # in natural order: a program's line 9 before its line 13 (issue 48); what
+                               # to repair before the assumptions it fails (the producer, then its victims)
+                               "culprits": [_culprit(r, places, anchor) for r in producer_first(natural_sorted(key))
+                                            if r in places.info],
                                "members": [], "repairs": []}
         g["members"].append(m)
         if _severity(m["status"]) > _severity(g["status"]):

@@ -13,6 +13,9 @@ problem, keyed by the union of their culprits, and that edit is its one
 first repair.  A side condition with no repair, or one whose first repair
 differs, keeps its own key.
 
+A row's culprits name the producer first (:func:`producer_first`): its
+guarantee is where the first repair goes; the consumers' assumptions follow.
+
 The rule is applied to the side-condition members only, before the
 requirements and derived properties take their keys from them, so a derived
 property behind both joins the same row.
@@ -56,3 +59,13 @@ def join_by_first_repair(members: list[tuple[dict[str, Any], list[str]]],
         for i in idx:
             members[i] = (members[i][0], list(union))
 
+
+
+def producer_first(roots: Sequence[str]) -> list[str]:
+    """``roots`` (root-culprit ids in their display order) with the
+    consumers' assumptions (``assumption:Node:k``) after everything else,
+    each part in its order: a failed side condition's row names the
+    producer's guarantee, the place of its first repair, before the
+    assumptions of the victims it fails (issue 48: the first screen blamed
+    the victims)."""
+    return [r for r in roots if not r.startswith("assumption:")] + [r for r in roots if r.startswith("assumption:")]
