@@ -6,8 +6,9 @@ runs once on a copy of the seeded workspace, then once per fix of
 ``examples/delivery/fixes/`` applied cumulatively (``git apply``; the run
 recorded again from the fixed node code, ``nodes/record_run.py``), the last
 one with ``--strict``: seven pipeline runs, six of them incremental ``doit``
-runs of the same copy (which must equal a clean one, docs/integrity.md: the
-last fix edits a hop off the deadline's named path).
+runs of the same copy (the last fix edits a hop off the deadline's named
+path, which the incremental run must decide again, as a clean one does:
+docs/integrity.md).
 
 (a) each defect is one problem row with the right culprit and, where the
     contract is at fault, a safe first repair that is the edit its fix
