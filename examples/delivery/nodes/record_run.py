@@ -1,6 +1,6 @@
 """Record a run of the delivery robot's node logic (the functions of this
-folder, one file per node) as a ROS 2 bag in MCAP storage, as ``ros2 bag
-record -s mcap`` writes it (rosbag2 format version 9, written by rosbags).
+folder, one file per node) as a ROS 2 bag in MCAP storage (a rosbag2
+directory, format version 9, written by rosbags' writer).
 
 The nodes are driven by a scripted scenario on a simulated clock: each
 node's callback runs the same function the property tests check and
