@@ -124,8 +124,8 @@ def test_each_defect_is_its_own_row_with_the_right_culprit(runs: dict[str, Any])
     assert "sums to 170 ms, 20 ms over the budget" in _diag(report, "STOP.deadline")["sentence"]
     # (2) the service: the server's response guarantee and the client's assumption on the response
     assert members[ROWS["02-service-range.diff"]] == ["Controller.sc6"]
-    assert culprits[ROWS["02-service-range.diff"]] == [("assumption 3 of Controller", "contracts/controller.rcl:20:3"),
-                                                        ("guarantee 2 of Base", "contracts/base.rcl:19:3")]
+    assert culprits[ROWS["02-service-range.diff"]] == [("guarantee 2 of Base", "contracts/base.rcl:19:3"),
+                                                        ("assumption 3 of Controller", "contracts/controller.rcl:20:3")]
     # (3) liveness: the node that should answer (Planner), not the one whose input the goal reads
     assert members[ROWS["03-progress.diff"]] == ["ARRIVE"]
     assert culprits[ROWS["03-progress.diff"]] == [("the contract of Planner", "contracts/planner.rcl:8:1")]

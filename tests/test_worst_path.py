@@ -71,3 +71,46 @@ def test_worst_path_equals_brute_force_on_random_diamonds() -> None:
             r = _decided(text, list(named[0]), bound)
             expected = REFUTED if max(sums.values()) > bound * 1000 else PROVED
             assert r.status == expected, (ms, bound, named, r.reason)
+
+
+def test_the_deadline_task_reads_every_node_between_the_ends() -> None:
+    """The deadlines task depends on the snapshots of these nodes: the slow branch's node is one of
+    them although the named path does not pass it; a node off every path is not."""
+    from rclverify.calculus.worst_path import nodes_between
+    text = DIAMOND + "node E {\n  inputs( a : REAL )\n  outputs( z : REAL )\n  guarantee( out.z == in.a )\n}\n"
+    model = build(check([parse_text(text, "s.rcl")]))
+    assert nodes_between(model, ["A", "Fast", "D"]) == ("A", "Fast", "D", "Slow")
+    assert nodes_between(model, ["A", "Slow", "D"]) == ("A", "Slow", "D", "Fast")
+
+
+def test_nodes_between_cover_every_simple_path_on_random_graphs() -> None:
+    """Oracle: every node of every simple path between the ends (brute force over node orders) is
+    named, and every node named lies on a walk from the first to the last."""
+    from types import SimpleNamespace
+
+    from rclverify.calculus.worst_path import nodes_between
+    rnd = random.Random(4848)
+    for _ in range(60):
+        names = [f"N{i}" for i in range(rnd.randint(2, 6))]
+        edges = {(a, b) for a in names for b in names if a != b and rnd.random() < 0.35}
+        model = SimpleNamespace(nodes=names, links=[SimpleNamespace(from_node=a, to_node=b) for a, b in edges])
+        a, b = names[0], names[-1]
+        on_paths: set[str] = set()
+        for k in range(len(names) - 1):
+            for mid in itertools.permutations([n for n in names if n not in (a, b)], k):
+                p = (a, *mid, b)
+                if all((x, y) in edges for x, y in zip(p, p[1:])):
+                    on_paths |= set(p)
+        got = set(nodes_between(model, [a, b]))  # type: ignore[arg-type]
+        assert on_paths <= got, (edges, on_paths, got)
+
+        def reach(x: str, y: str) -> bool:
+            seen, todo = {x}, [x]
+            while todo:
+                n = todo.pop()
+                for s, t in edges:
+                    if s == n and t not in seen:
+                        seen.add(t)
+                        todo.append(t)
+            return y in seen
+        assert all(n in (a, b) or (reach(a, n) and reach(n, b)) for n in got), (edges, got)

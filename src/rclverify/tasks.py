@@ -20,7 +20,7 @@ Stages and their real file dependencies, per node ``N``:
 ``requirements``   plan + model + contract snapshots (+ Doorstop files, recorded runs) ->
                    artifacts/requirements/<ID>.json; inside, only requirements whose
                    cone's snapshots or statements changed are checked again
-``deadlines``      plan + model + snapshots of the nodes on a deadline's path ->
+``deadlines``      plan + model + snapshots of the nodes between a deadline's ends ->
                    artifacts/deadlines/index.json (rule D3, every end-to-end deadline;
                    only when the plan has one)
 ``report:html``    every artifact above -> reports/assurance.{html,json}, the CI formats

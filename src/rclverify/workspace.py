@@ -64,7 +64,8 @@ class TaskIndex:
     requirement_dirs: tuple[str, ...] = ()
     #: The plan's ``ros:`` section (docs/ros.md): what the ``ground`` task reads; empty: no such task.
     ros: dict[str, Any] = dataclasses.field(default_factory=dict)
-    #: The nodes on the paths of the plan's end-to-end deadlines (rule D3): their snapshots are the
+    #: The nodes on the paths of the plan's end-to-end deadlines (rule D3) and every node between their
+    #: ends (the worst path, :func:`rclverify.calculus.worst_path.nodes_between`): their snapshots are the
     #: inputs of the ``deadlines`` task; empty: the plan has no deadline and there is no such task.
     deadline_nodes: tuple[str, ...] = ()
 
@@ -116,6 +117,7 @@ class Workspace:
     @cached_property
     def index(self) -> TaskIndex:
         """The :class:`TaskIndex` of the loaded workspace (raises like :attr:`model`)."""
+        from .calculus.worst_path import nodes_between
         plan, model = self.plan, self.model
         return TaskIndex(
             nodes=tuple(self.checked.nodes), producers={n: tuple(model.producers(n)) for n in self.checked.nodes},
@@ -123,7 +125,8 @@ class Workspace:
             entries={n: tuple(e.config for e in es) for n, es in plan.evidence.items()},
             requirement_dirs=tuple(d for d, _ in plan.requirements_from),
             ros=dict(getattr(plan, "ros", None) or {}),
-            deadline_nodes=tuple(dict.fromkeys(n for d in plan.deadlines for n in d.path)))
+            # every node between a deadline's ends: the slowest path may leave the named one (issue 48)
+            deadline_nodes=tuple(dict.fromkeys(n for d in plan.deadlines for n in nodes_between(model, d.path))))
 
     @cached_property
     def checked(self) -> Checked:

@@ -46,6 +46,25 @@ def other_paths(model: SystemModel, path: Sequence[str]) -> tuple[list[tuple[str
     return [p for p in found[:MAX_PATHS] if p != tuple(path)], cut
 
 
+def nodes_between(model: SystemModel, path: Sequence[str]) -> tuple[str, ...]:
+    """The nodes whose contracts the decision of a deadline along ``path``
+    reads: those of ``path``, then (in ``model.nodes`` order) every node
+    reachable from ``path[0]`` that reaches ``path[-1]`` in ``model``'s
+    links, a superset of the nodes on the simple paths
+    :func:`with_worst_path` may take as the slowest.  The ``deadlines`` task
+    depends on their snapshots: an edit of a hop off the named path changes
+    the verdict too (issue 48: an incremental run kept a deadline refuted
+    that a clean run proved)."""
+    import networkx as nx
+    g = nx.DiGraph()
+    g.add_nodes_from(model.nodes)
+    g.add_edges_from((lk.from_node, lk.to_node) for lk in model.links)
+    if len(path) < 2 or path[0] not in g or path[-1] not in g:
+        return tuple(path)
+    between = (nx.descendants(g, path[0]) | {path[0]}) & (nx.ancestors(g, path[-1]) | {path[-1]})
+    return tuple(dict.fromkeys([*path, *(n for n in model.nodes if n in between)]))
+
+
 def with_worst_path(result: Any, checked: Checked, model: SystemModel) -> Any:
     """``result`` (a :class:`.deadlines.DeadlineResult` of the named path)
     with the slowest other path considered: refuted by it when its chain's

@@ -46,6 +46,10 @@ its diagnosis record (:mod:`rclverify.diagnosis.build`, ``culprits``):
    hop's guarantee found wanting elsewhere (a monitor, a vacuity) is
    another problem: a deadline is about time, not about what is answered.
 
+Failed side conditions whose first repair is the same edit (one producer
+too loose for several consumers) are one group, keyed by the union of their
+culprits (:mod:`.problems_shared`).
+
 The culprits a diagnosis record names are the ones Z3 showed
 (:mod:`rclverify.diagnosis.blame`): strengthening each alone removes the
 counterexample, so unrelated bugs that only mention the same variable do
@@ -69,6 +73,8 @@ from typing import Any
 
 from ..evidence.records import SEVERITY
 from . import problems_mc as mc
+from . import problems_shared as ps
+from .problems_shared import producer_first
 from . import problems_units as pu
 from .textfmt import natural_sorted
 
@@ -238,6 +244,7 @@ def group_problems(report: Mapping[str, Any], items: Sequence[Mapping[str, Any]]
         if d["kind"] in _CONTRACT_DEFECTS and victim and roots and victim not in roots:
             explains.setdefault(victim, [])
             explains[victim] += [r for r in roots if r not in explains[victim]]
+    ps.join_by_first_repair(members, by_id)  # several consumers, one too loose producer: one row (issue 48)
     diagnosed = {str(d["id"]) for d in diagnoses}
     for q in report.get("requirements", []):
         if q.get("verdict") not in BAD_VERDICTS or str(q["id"]) in diagnosed:
@@ -309,8 +316,10 @@ def group_problems(report: Mapping[str, Any], items: Sequence[Mapping[str, Any]]
         g = groups.get(key)
         if g is None:
             g = groups[key] = {"key": list(key), "status": m["status"], "sentence": first_sentence(m["sentence"]),
-                               # in natural order: a program's line 9 before its line 13 (issue 48)
-                               "culprits": [_culprit(r, places, anchor) for r in natural_sorted(key) if r in places.info],
+                               # in natural order: a program's line 9 before its line 13 (issue 48); what
+                               # to repair before the assumptions it fails (the producer, then its victims)
+                               "culprits": [_culprit(r, places, anchor) for r in producer_first(natural_sorted(key))
+                                            if r in places.info],
                                "members": [], "repairs": []}
         g["members"].append(m)
         if _severity(m["status"]) > _severity(g["status"]):

@@ -1,0 +1,10 @@
+"""The Localiser node's logic: the function its ROS callback calls, and the
+implementation its property tests check (docs/property-tests.md: one keyword
+argument per RCL input, a mapping of output name to value returned).
+Plain floats, as the node computes them."""
+from __future__ import annotations
+
+
+def localiser(heading: float) -> dict[str, float]:
+    """The pose's yaw is the heading."""
+    return {"yaw": heading}

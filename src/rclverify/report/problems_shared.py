@@ -1,0 +1,71 @@
+"""Failed side conditions of several consumers with one first repair are one problem (issue 48).
+
+A producer whose guarantee is too loose for every node that reads its
+output (the MissionPlanner's ``out.dest_id <= 501`` read by a Navigator and
+a LockerController that both assume ``in.dest_id <= 500``) fails one side
+condition per consumer.  Each is keyed by its own culprits (the consumer's
+assumption and the producer's guarantee, :mod:`.problems` rule 1), so the
+report showed one row per *victim*, each with the same first repair: two
+rows for one root cause.  The cause is the edit that removes them: when the
+first repair of two failed side conditions is the same edit of the same
+text (the same diff, :mod:`rclverify.diagnosis.repairs`), they are one
+problem, keyed by the union of their culprits, and that edit is its one
+first repair.  A side condition with no repair, or one whose first repair
+differs, keeps its own key.
+
+A row's culprits name the producer first (:func:`producer_first`): its
+guarantee is where the first repair goes; the consumers' assumptions follow.
+
+The rule is applied to the side-condition members only, before the
+requirements and derived properties take their keys from them, so a derived
+property behind both joins the same row.
+"""
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from typing import Any
+
+
+def first_diff(diagnosis: Mapping[str, Any] | None) -> str | None:
+    """The unified diff of the first repair of ``diagnosis`` (a diagnosis
+    record: ``{"repairs": [{"diff": str, ...}, ...]}``), ``None`` when it
+    has none."""
+    reps = (diagnosis or {}).get("repairs") or ()
+    diff = reps[0].get("diff") if reps and isinstance(reps[0], Mapping) else None
+    return str(diff) if diff else None
+
+
+def join_by_first_repair(members: list[tuple[dict[str, Any], list[str]]],
+                         by_id: Mapping[str, Mapping[str, Any]]) -> None:
+    """Give the failed side conditions of ``members`` that share a first
+    repair one key: the union of their roots (module docstring).
+
+    ``members`` is the grouping's list of ``(member, roots)`` (member
+    ``{"id", "kind", "status", ...}``, roots the root-culprit ids), changed
+    in place; ``by_id`` maps a diagnosis id to its record.  Members of other
+    kinds, and side conditions whose first repair no other shares, are left
+    as they are."""
+    by_diff: dict[str, list[int]] = {}
+    for i, (m, roots) in enumerate(members):
+        if m.get("kind") != "side-condition" or not roots or m.get("status") != "failed":
+            continue
+        diff = first_diff(by_id.get(str(m["id"])))
+        if diff is not None:
+            by_diff.setdefault(diff, []).append(i)
+    for idx in by_diff.values():
+        if len(idx) < 2:
+            continue
+        union: list[str] = sorted({r for i in idx for r in members[i][1]})
+        for i in idx:
+            members[i] = (members[i][0], list(union))
+
+
+
+def producer_first(roots: Sequence[str]) -> list[str]:
+    """``roots`` (root-culprit ids in their display order) with the
+    consumers' assumptions (``assumption:Node:k``) after everything else,
+    each part in its order: a failed side condition's row names the
+    producer's guarantee, the place of its first repair, before the
+    assumptions of the victims it fails (issue 48: the first screen blamed
+    the victims)."""
+    return [r for r in roots if not r.startswith("assumption:")] + [r for r in roots if r.startswith("assumption:")]
