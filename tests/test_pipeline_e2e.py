@@ -86,6 +86,14 @@ def test_genuine_problems_of_the_case_study_are_shown(report: dict) -> None:
 
 
 
+def test_the_case_study_counterexamples_read_well(report: dict) -> None:
+    """Issue 48's readability check (tests/_readable.py) on the case study: REQ4's lasso among them."""
+    from _readable import assert_readable
+    assert assert_readable(report) >= 1
+    req4 = next(q for q in report["requirements"] if q["id"] == "REQ4")
+    assert req4["verdict"] == "refuted" and req4["check"]["temporal"]["trace"]
+
+
 def test_replacement_contract_is_checked_by_refinement(report: dict, workspace: Path) -> None:
     [f] = [f for f in report["findings"] if f["check"] == "replacement-refines"]
     # checked under the plan's 13-waypoint facts (the same facts the health checks use)
