@@ -33,6 +33,8 @@ The level table is shared with :mod:`rclverify.rcl.latex` through
 """
 from __future__ import annotations
 
+import itertools
+
 from typing import Union
 
 from . import ast
@@ -367,12 +369,11 @@ def node_to_rcl(n: ast.Node, explicit: bool = False) -> str:
     if n.topics:
         sep = ",\n          "
         lines.append(f"  topics( {sep.join(_topic(t) for t in n.topics)} )")
-    if n.links:
-        for kind in ("service", "action"):
-            group = [lk for lk in n.links if lk.kind == kind]
-            if group:
-                sep = ",\n          "
-                lines.append(f"  {kind}s( {sep.join(_link(lk) for lk in group)} )")
+    # one services(...) / actions(...) group per run of links of one kind, in the order written (the grammar
+    # takes any number of groups), so that the printed text parses back to the same links
+    sep = ",\n          "
+    for kind, run in itertools.groupby(n.links, key=lambda lk: lk.kind):
+        lines.append(f"  {kind}s( {sep.join(_link(lk) for lk in run)} )")
     lines += [f"  assume( {expr_to_rcl(c.formula, explicit)} )" for c in n.assumes]
     lines += [f"  guarantee( {expr_to_rcl(c.formula, explicit)} ){_timing(c)}" for c in n.guarantees]
     lines += [f"  initially( {expr_to_rcl(c.formula, explicit)} )" for c in n.initially]
