@@ -743,8 +743,11 @@ def _build_tasks(root: str | Path, plan_file: str) -> dict[str, Callable[[], Any
             deps.append(at("artifacts/deadlines/index.json"))  # the deadlines task's target
         deps.append(at("artifacts/crosscheck/index.json"))  # the second solver's verdicts
         for part, files in REPORT_PARTS.items():
+            # task_dep on crosscheck: both are created after `evidence`, and when the report's loader runs
+            # first doit does not yet know which task makes the second solver's index (its file_dep alone
+            # then let doit -n 2 render the report beside crosscheck, from no index)
             yield {"name": part, "doc": "reports/" + ", ".join(files), "actions": [(act_report, [r, part])],
-                   "file_dep": deps, "uptodate": [code, sealed],
+                   "file_dep": deps, "task_dep": ["crosscheck"], "uptodate": [code, sealed],
                    "targets": [at(f"reports/{f}") for f in files if f != "argument.svg"]
                    + ([at(ws.SUMMARY)] if part == "html" else []),
                    "verbosity": 2, "clean": True}
