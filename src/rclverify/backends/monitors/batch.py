@@ -105,11 +105,14 @@ def batch_plan(m: NodeMonitor, rules: Mapping[str, TopicRule]) -> BatchPlan | No
 
 def check_batch(checked: Checked, node: CheckedNode, events: Iterable[Event], rules: Mapping[str, TopicRule],
                 horizon: float, on_verdict: Callable[[Verdict], None] | None = None,
-                tolerance: Tolerance | None = None, end: float | None = None) -> tuple[int, NodeResult] | None:
+                tolerance: Tolerance | None = None, end: float | None = None, chunk: int = CHUNK,
+                stats: dict[str, int] | None = None) -> tuple[int, NodeResult] | None:
     """:func:`~.check.check_trace` for one node, in batches: (events read, the
     node's result), the same verdicts in the same order to ``on_verdict``;
     ``None`` before reading any event when the node is not eligible (module
-    docstring).  Raises what the event source raises."""
+    docstring).  ``chunk``: events read at once (>= 2); ``stats``, when given,
+    receives ``batched`` (answer pairs judged in batches) and ``streamed``
+    (events fed to the streaming engine).  Raises what the event source raises."""
     m = NodeMonitor(checked, node, rules, horizon, on_verdict, tolerance)
     plan = batch_plan(m, rules)
     if plan is None:
@@ -122,18 +125,21 @@ def check_batch(checked: Checked, node: CheckedNode, events: Iterable[Event], ru
     gc.disable()  # the chunk's events hold no cycles: refcounting frees them (the collector's passes cost 2x)
     try:
         while True:
-            chunk = carry + list(islice(it, CHUNK))
-            if len(chunk) == len(carry):
+            events_ = carry + list(islice(it, max(chunk, 2)))
+            if len(events_) == len(carry):
                 for ev in carry:
+                    run.streamed += 1
                     m.feed(ev)
                 break
-            count += len(chunk) - len(carry)
-            last_time = chunk[-1].time
-            carry = run.chunk(chunk)
+            count += len(events_) - len(carry)
+            last_time = events_[-1].time
+            carry = run.chunk(events_)
     finally:
         if was:
             gc.enable()
     m.advance(max(last_time, end) if end is not None else last_time)
+    if stats is not None:
+        stats.update(batched=run.batched, streamed=run.streamed)
     return count, m.finish()
 
 
@@ -144,6 +150,7 @@ class _Run:
         self.plan, self.m = plan, plan.m
         self.kinds = {t: j for j, t in enumerate(plan.inputs, 1)}
         self.kinds[plan.output[0]] = -1
+        self.batched = self.streamed = 0
 
     def chunk(self, chunk: list[Event]) -> list[Event]:
         """Judge ``chunk``; returns the events to carry to the next chunk (a last input whose answer may follow)."""
@@ -183,10 +190,12 @@ class _Run:
         i, k = 0, 0
         for e in ends.tolist():
             run = pairs[k:e + 1]
+            self.streamed += int(run[0]) - i
             for ev in chunk[i:int(run[0])]:  # not a pair: the engine
                 feed(ev)
             i = self._pairs(chunk, run, kind, times, cols)
             k = e + 1
+        self.streamed += max(n - i, 0)
         for ev in chunk[i:n]:
             feed(ev)
         return keep
@@ -227,11 +236,12 @@ class _Run:
         while p < total:
             b = int(bad[np.searchsorted(bad, p)]) if len(bad) and bad[-1] >= p else total
             if b > p and self._quiet(times[at[p]]):
-                self._satisfied(chunk, at[p:b], src)
+                self._satisfied(chunk, at[p:b], {k: v[p:b] for k, v in src.items()})
                 p = b
                 if p >= total:
                     break
             i = int(at[p])
+            self.streamed += 2
             feed(chunk[i])
             feed(chunk[i + 1])
             p += 1
@@ -257,6 +267,7 @@ class _Run:
         plan, m = self.plan, self.m
         h, okey, keys = m.horizon, plan.output[1], plan.keys
         n = len(at)
+        self.batched += n
         t_first = chunk[int(at[0])].time
         # the watched question: closed silently when its horizon passed, else followed by the first new question
         o = m._open
