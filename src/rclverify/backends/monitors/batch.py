@@ -128,8 +128,7 @@ def check_batch(checked: Checked, node: CheckedNode, events: Iterable[Event], ru
             events_ = carry + list(islice(it, max(chunk, 2)))
             if len(events_) == len(carry):
                 for ev in carry:
-                    run.streamed += 1
-                    m.feed(ev)
+                    run.feed(ev)
                 break
             count += len(events_) - len(carry)
             last_time = events_[-1].time
@@ -151,6 +150,34 @@ class _Run:
         self.kinds = {t: j for j, t in enumerate(plan.inputs, 1)}
         self.kinds[plan.output[0]] = -1
         self.batched = self.streamed = 0
+        #: runs of batch pairs whose older questions the stream keeps unmade (None), oldest first
+        self.ghosts: list[_Ghost] = []
+        self.fields = {key: field for key, field, _ in plan.inputs.values()}
+        self.node_topics = frozenset(self.kinds)
+
+    def feed(self, ev: Event) -> None:
+        """``ev`` to the engine, the kept questions made first when it may look one up (stamped before the latest)."""
+        self.streamed += 1
+        if self.ghosts and ev.topic in self.node_topics:
+            stamps = self.m.stream._stamps
+            if stamps and (ev.time if ev.stamp is None else ev.stamp) < stamps[-1]:
+                self._materialise()
+        self.m.feed(ev)
+
+    def _materialise(self) -> None:
+        """Make every question the stream keeps as ``None`` (the latest ghosts, in order)."""
+        qs = self.m.stream._questions
+        left = qs.count(None)
+        made: list[Question] = []
+        for g in reversed(self.ghosts):
+            if len(made) >= left:
+                break
+            made[:0] = [g.question(j, self) for j in range(max(0, len(g.at) - 1 - (left - len(made))),
+                                                           len(g.at) - 1)]
+        made = made[len(made) - left:]
+        it = iter(made)
+        self.m.stream._questions = [q if q is not None else next(it) for q in qs]
+        self.ghosts.clear()
 
     def chunk(self, chunk: list[Event]) -> list[Event]:
         """Judge ``chunk``; returns the events to carry to the next chunk (a last input whose answer may follow)."""
@@ -186,16 +213,14 @@ class _Run:
         # runs of pairs back to back, times in order: split where the next pair does not follow on
         link = (pairs[1:] == pairs[:-1] + 2) & (times[pairs[1:]] >= times[pairs[:-1] + 1])
         ends = np.append(np.flatnonzero(~link), len(pairs) - 1) if len(pairs) else np.zeros(0, dtype=np.int64)
-        feed = m.feed
+        feed = self.feed
         i, k = 0, 0
         for e in ends.tolist():
             run = pairs[k:e + 1]
-            self.streamed += int(run[0]) - i
             for ev in chunk[i:int(run[0])]:  # not a pair: the engine
                 feed(ev)
             i = self._pairs(chunk, run, kind, times, cols)
             k = e + 1
-        self.streamed += max(n - i, 0)
         for ev in chunk[i:n]:
             feed(ev)
         return keep
@@ -232,16 +257,15 @@ class _Run:
             sure &= np.broadcast_to(truth & certain, sure.shape)
         p, total = 0, len(at)
         bad = np.flatnonzero(~sure)
-        feed = m.feed
+        feed = self.feed
         while p < total:
             b = int(bad[np.searchsorted(bad, p)]) if len(bad) and bad[-1] >= p else total
             if b > p and self._quiet(times[at[p]]):
-                self._satisfied(chunk, at[p:b], {k: v[p:b] for k, v in src.items()})
+                self._satisfied(chunk, at[p:b], {k: v[p:b] for k, v in src.items()}, times)
                 p = b
                 if p >= total:
                     break
             i = int(at[p])
-            self.streamed += 2
             feed(chunk[i])
             feed(chunk[i + 1])
             p += 1
@@ -262,7 +286,7 @@ class _Run:
         stamps = m.stream._stamps
         return not stamps or stamps[-1] <= t
 
-    def _satisfied(self, chunk: list[Event], at: np.ndarray, src: dict[str, np.ndarray]) -> None:
+    def _satisfied(self, chunk: list[Event], at: np.ndarray, src: dict[str, np.ndarray], times: np.ndarray) -> None:
         """The pairs at ``at`` are surely satisfied: their verdicts, and the engine's state as feeding them sets it."""
         plan, m = self.plan, self.m
         h, okey, keys = m.horizon, plan.output[1], plan.keys
@@ -285,49 +309,32 @@ class _Run:
         result.semantics["exact"] += n
         result.accepted += n
         ofield = plan.output[2]
-        fields = {key: field for key, field, _ in plan.inputs.values()}
         if m.on_verdict is not None:
             name, emit = m.node.name, m.on_verdict
             for i in at.tolist():
                 qe, ev = chunk[i], chunk[i + 1]
                 emit(Verdict(name, "satisfied", ev.index, ev.time, ev.where, ev.topic, ev.time, 0, {}, "", "exact",
                              qe.where))
-        # the questions the stream keeps, and the outputs the engine remembers for the transport skew
+        # the questions the stream keeps (the newest made now, the older ones when the engine may look them
+        # up: _materialise), and the outputs the engine remembers for the transport skew
         stream = m.stream
         old = len(stream._questions)
         total = old + n
         keptn = total if total <= 2 * KEPT else KEPT + 1 + (total - 2 * KEPT - 1) % KEPT
-        tail = at[-min(n, keptn, 2 * KEPT):].tolist()
-        decided = sorted(plan.asked)
-        qs: list[Question] = []
-        off = len(at) - len(tail)
-        where = {k: src[k][off:].tolist() for k in keys}
-        for j, i in enumerate(tail):
-            qe, ev = chunk[i], chunk[i + 1]
-            # a mapped value is the message's field itself (value_mapper's one-field rule)
-            inputs = {k: chunk[where[k][j]].fields[fields[k]] if where[k][j] >= 0 else m.values[k]
-                      for k in m._in_keys}
-            q = Question(qe, qe.time, inputs, True, "exact")
-            q.answered = True
-            q.last_out = ev
-            mine = {okey: ev.fields[ofield]}
-            q.answer = mine
-            view = dict(inputs)
-            view.update(mine)
-            q.view = view
-            q.decided = set(decided)
-            q.due = qe.time + h
-            qs.append(q)
-        for a, b in zip(qs, qs[1:]):
-            if b.event.time <= a.event.time + h:
-                a.followed = True
-            else:
-                a.reported = True
-        newest = qs[-1]
-        drop = max(0, old + len(qs) - keptn)
-        stream._questions = (stream._questions + qs)[drop:]
-        stream._stamps = (stream._stamps + [q.stamp for q in qs])[drop:]
+        tail = at[-min(n, keptn, 2 * KEPT):]
+        where = {k: v[len(at) - len(tail):] for k, v in src.items()}
+        seed = {k: m.values[k] for k in m._in_keys}
+        ghost = _Ghost(chunk, tail, where, seed)
+        newest = ghost.question(len(tail) - 1, self)
+        drop = max(0, old + len(tail) - keptn)
+        stream._questions = (stream._questions + [None] * (len(tail) - 1) + [newest])[drop:]
+        stream._stamps = (stream._stamps + times[tail].tolist())[drop:]
         stream.latest = newest
+        if len(tail) > 1:
+            self.ghosts.append(ghost)
+            left = stream._questions.count(None)  # the ghosts the stream still keeps: the latest of them
+            while self.ghosts and sum(len(g.at) - 1 for g in self.ghosts[1:]) >= left:
+                del self.ghosts[0]
         if stream.skew:
             recent = m._recent
             for i in at[-recent.maxlen:].tolist():
@@ -343,6 +350,44 @@ class _Run:
         last_out = chunk[int(at[-1]) + 1]
         if last_out.time > m.now:
             m.now = last_out.time
+
+
+class _Ghost:
+    """The questions of a run of batch pairs the stream keeps but nothing has looked up yet: made on demand.
+
+    ``at`` the pairs' input positions in ``chunk``; ``where`` per input key the
+    position of the message that set it (< 0: ``seed``, its value before the run)."""
+
+    __slots__ = ("chunk", "at", "where", "seed")
+
+    def __init__(self, chunk: list[Event], at: np.ndarray, where: dict[str, np.ndarray], seed: dict[str, Any]) -> None:
+        self.chunk, self.at, self.where, self.seed = chunk, at, where, seed
+
+    def question(self, j: int, run: "_Run") -> Question:
+        """The ``j``-th pair's question as the engine leaves it once answered (questions.py's fields)."""
+        chunk, plan, h = self.chunk, run.plan, run.m.horizon
+        i = int(self.at[j])
+        qe, ev = chunk[i], chunk[i + 1]
+        inputs = {}
+        for k in run.m._in_keys:  # a mapped value is the message's field itself (value_mapper's one-field rule)
+            w = int(self.where[k][j])
+            inputs[k] = chunk[w].fields[run.fields[k]] if w >= 0 else self.seed[k]
+        q = Question(qe, qe.time, inputs, True, "exact")
+        q.answered = True
+        q.last_out = ev
+        mine = {plan.output[1]: ev.fields[plan.output[2]]}
+        q.answer = mine
+        view = dict(inputs)
+        view.update(mine)
+        q.view = view
+        q.decided = set(plan.asked)
+        q.due = qe.time + h
+        if j + 1 < len(self.at):  # the next question of the run followed it within its horizon, or it expired first
+            if chunk[int(self.at[j + 1])].time <= qe.time + h:
+                q.followed = True
+            else:
+                q.reported = True
+        return q
 
 
 def _seed(value: Any, codes: Mapping[str, int] | None) -> Any:
