@@ -181,19 +181,19 @@ def test_bench_samples_on_and_near_the_boundaries(checked: Any) -> None:
     """The bench's run shape (a reading, its status at the same stamp): long regular stretches, the
     boundary readings left to the engine, a wrong status now and then; one chunk and many."""
     rnd = random.Random(51)
-    rs = [rnd.choice(NEAR) if rnd.random() < 0.05 else rnd.uniform(0, 400) for _ in range(3000)]
+    rs = [rnd.choice(NEAR) if rnd.random() < 0.05 else rnd.uniform(0, 400) for _ in range(2000)]
     events: list[Event] = []
     for i, r in enumerate(rs):
         band = _band(r) if rnd.random() > 0.01 else rnd.choice(["green", "orange", "red"])
         events += [Event(2 * i, i * 0.01, "reading", {"data": r}, "s"), Event(2 * i + 1, i * 0.01, "status",
                                                                               {"data": band}, "s")]
-    events.append(Event(len(events), 3000 * 0.01 + 0.05, "tick", {}, "s"))
+    events.append(Event(len(events), 2000 * 0.01 + 0.05, "tick", {}, "s"))
     rules = load_rules(RULES)
     rules.skew = 0.02
-    for chunk in (7, 1000, 100000):
+    for chunk in (7, 100000):
         s, b, stats = _both(checked, "Classifier", events, rules, 0.005, None, chunk)
         assert b == s
-        assert stats["batched"] > 2800
+        assert stats["batched"] > 1800
 
 
 def test_certificates_agree_with_exact_judgement(checked: Any) -> None:
@@ -263,3 +263,21 @@ def test_bundled_runs_decline_or_agree() -> None:
                 n, (res,) = check_trace(checked, [node], read_trace(trace, msg), cfg.rules, cfg.horizon,
                                         seen_s.append, cfg.tolerance, batch=False)
                 assert (done[0], done[1], seen_b) == (n, res, seen_s), (rcl.name, name, trace.name)
+
+
+def test_a_source_error_midway_judges_the_events_before_it(checked: Any) -> None:
+    """check_trace's contract: what the event source raises propagates after the events before it were judged."""
+    events = [Event(k, k * 0.005, "reading" if k % 2 == 0 else "status",
+                    {"data": 10.0 if k % 2 == 0 else "green"}, "s") for k in range(41)]
+
+    def source() -> Any:
+        yield from events
+        raise ValueError("line 42: malformed")
+    rules = load_rules(RULES)
+    for batch in (False, True):
+        seen: list[Any] = []
+        with pytest.raises(ValueError, match="line 42"):
+            check_trace(checked, [checked.nodes["Classifier"]], source(), rules, 0.1, seen.append, batch=batch)
+        if not batch:
+            want = seen
+    assert seen == want and len(seen) == 20

@@ -35,7 +35,7 @@ from __future__ import annotations
 import gc
 from collections import deque
 from itertools import islice, repeat
-from operator import attrgetter, is_, itemgetter
+from operator import attrgetter, is_
 from typing import Any, Callable, Iterable, Mapping
 
 import numpy as np
@@ -45,7 +45,7 @@ from ...rcl.types import Checked, CheckedNode
 from ...traces.events import Event
 from ...traces.mapping import TopicRule
 from ...traces.questions import KEPT, Question
-from .columns import ColumnCompiler, Unsupported, io_kind
+from .columns import ColumnCompiler, Unsupported, column, field_values, io_kind, seed
 from .engine import NodeMonitor
 from .verdicts import NodeResult, Verdict
 
@@ -125,12 +125,19 @@ def check_batch(checked: Checked, node: CheckedNode, events: Iterable[Event], ru
     gc.disable()  # the chunk's events hold no cycles: refcounting frees them (the collector's passes cost 2x)
     try:
         while True:
-            events_ = carry + list(islice(it, max(chunk, 2)))
-            if len(events_) == len(carry):
+            events_, before = carry, len(carry)
+            try:
+                events_.extend(islice(it, max(chunk, 2)))  # what was read stays in the list if the source raises
+            except BaseException:
+                # the events before the error are judged, as the streaming engine judges them, then it propagates
+                for ev in run.chunk(events_) if len(events_) > before else events_:
+                    run.feed(ev)
+                raise
+            if len(events_) == before:
                 for ev in carry:
                     run.feed(ev)
                 break
-            count += len(events_) - len(carry)
+            count += len(events_) - before
             last_time = events_[-1].time
             carry = run.chunk(events_)
     finally:
@@ -194,7 +201,7 @@ class _Run:
         for topic, j, (key, field, kind_) in [(plan.output[0], -1, plan.output[1:])] + \
                 [(t, self.kinds[t], v) for t, v in plan.inputs.items()]:
             rows = np.flatnonzero(kind == j)
-            good, col = _column(_field(fields, rows, field), kind_, plan.enums.get(key, _EMPTY))
+            good, col = column(field_values(fields, rows, field), kind_, plan.enums.get(key, _EMPTY))
             ok[rows] &= good
             full = np.zeros(n, dtype=np.float64 if kind_ == "real" else np.int64)
             full[rows] = col
@@ -244,7 +251,7 @@ class _Run:
             col = cols[key][np.maximum(idx, 0)]
             if not mine.all():
                 before = idx < 0
-                first = _seed(m.values.get(key), plan.enums.get(key))
+                first = seed(m.values.get(key), plan.enums.get(key))
                 if first is None:  # no value yet, or one the columns do not hold: the engine judges those rows
                     seen &= ~before
                 else:
@@ -388,61 +395,6 @@ class _Ghost:
             else:
                 q.reported = True
         return q
-
-
-def _seed(value: Any, codes: Mapping[str, int] | None) -> Any:
-    """A value the engine holds as a column entry: a finite float, or the code of an
-    enumeration value; ``None`` for anything else."""
-    if codes is not None:
-        return codes.get(value) if type(value) is str else None
-    return value if type(value) is float and np.isfinite(value) else None
-
-
-def _field(fields: list[Any], rows: np.ndarray, name: str) -> list[Any]:
-    """Field ``name`` of the messages at ``rows`` (``None`` where a message has none)."""
-    if not len(rows):
-        return []
-    first, step = int(rows[0]), int(rows[1] - rows[0]) if len(rows) > 1 else 1
-    if step > 0 and int(rows[-1]) == first + step * (len(rows) - 1) and bool((np.diff(rows) == step).all()):
-        # evenly spaced (topics taking turns): a slice
-        picked = fields[first:int(rows[-1]) + 1:step]
-    else:
-        picked = itemgetter(*rows.tolist())(fields)
-    try:
-        return list(map(itemgetter(name), picked))
-    except (KeyError, TypeError, IndexError):
-        out = []
-        for f in picked:
-            try:
-                out.append(f[name])
-            except (KeyError, TypeError, IndexError):
-                out.append(None)
-        return out
-
-
-def _column(vals: list[Any], kind: str, codes: Mapping[str, int]) -> tuple[np.ndarray, np.ndarray]:
-    """(mapped as the engine's one-field rule maps, the column): a finite ``float``
-    for ``REAL``, a ``str`` of the enumeration for one."""
-    n = len(vals)
-    want = float if kind == "real" else str
-    types = set(map(type, vals))
-    if types == {want} or not types:
-        good = np.ones(n, dtype=bool)
-    else:
-        good = np.fromiter(map(is_, map(type, vals), repeat(want)), bool, n)
-    if kind == "real":
-        if types == {float}:
-            col = np.array(vals, dtype=np.float64)
-        else:
-            col = np.array([v if g else np.nan for v, g in zip(vals, good.tolist())], dtype=np.float64)
-        good &= np.isfinite(col)
-        return good, col
-    get = codes.get  # only a value of the variable's own enumeration has a code
-    if good.all():
-        col = np.fromiter(map(get, vals, repeat(-1)), np.int64, n)
-    else:
-        col = np.fromiter((get(v, -1) if g else -1 for v, g in zip(vals, good.tolist())), np.int64, n)
-    return good & (col >= 0), col
 
 
 __all__ = ["CHUNK", "BatchPlan", "batch_plan", "check_batch"]

@@ -24,13 +24,18 @@ the exact result; the bound used is ``2**-52``, twice that):
 
 A row whose every formula is surely true is decided; every other row
 (surely false, or not sure) is left to the streaming engine, whose judge
-decides it (exact, double, tolerance).  What is not compiled (division,
+decides it (exact, double, tolerance).  :func:`field_values`, :func:`column` and :func:`seed` read the recorded
+values into columns as the engine's one-field mapper reads them (a finite
+``float`` for ``REAL``, a ``str`` of the enumeration for one; anything else
+is marked, and left to the engine).  What is not compiled (division,
 functions, sets, quantifiers, integers, booleans as values) raises
 :class:`Unsupported`: the batch path then declines the whole node.
 """
 from __future__ import annotations
 
 from fractions import Fraction
+from itertools import repeat
+from operator import is_, itemgetter
 from typing import Any, Callable, Mapping
 
 import numpy as np
@@ -221,4 +226,59 @@ def _mul(a: tuple[Any, Any], b: tuple[Any, Any]) -> tuple[Any, Any]:
         return v, np.abs(va) * bb + np.abs(vb) * ba + ba * bb + np.abs(v) * _REL + _SLACK_ABS
 
 
-__all__ = ["ColumnCompiler", "Compiled", "Unsupported", "io_kind"]
+def seed(value: Any, codes: Mapping[str, int] | None) -> Any:
+    """A value the engine holds as a column entry: a finite float, or the code of an
+    enumeration value; ``None`` for anything else."""
+    if codes is not None:
+        return codes.get(value) if type(value) is str else None
+    return value if type(value) is float and np.isfinite(value) else None
+
+
+def field_values(fields: list[Any], rows: np.ndarray, name: str) -> list[Any]:
+    """Field ``name`` of the messages at ``rows`` (``None`` where a message has none)."""
+    if not len(rows):
+        return []
+    first, step = int(rows[0]), int(rows[1] - rows[0]) if len(rows) > 1 else 1
+    if step > 0 and int(rows[-1]) == first + step * (len(rows) - 1) and bool((np.diff(rows) == step).all()):
+        # evenly spaced (topics taking turns): a slice
+        picked = fields[first:int(rows[-1]) + 1:step]
+    else:
+        picked = itemgetter(*rows.tolist())(fields)
+    try:
+        return list(map(itemgetter(name), picked))
+    except (KeyError, TypeError, IndexError):
+        out = []
+        for f in picked:
+            try:
+                out.append(f[name])
+            except (KeyError, TypeError, IndexError):
+                out.append(None)
+        return out
+
+
+def column(vals: list[Any], kind: str, codes: Mapping[str, int]) -> tuple[np.ndarray, np.ndarray]:
+    """(mapped as the engine's one-field rule maps, the column): a finite ``float``
+    for ``REAL``, a ``str`` of the enumeration for one."""
+    n = len(vals)
+    want = float if kind == "real" else str
+    types = set(map(type, vals))
+    if types == {want} or not types:
+        good = np.ones(n, dtype=bool)
+    else:
+        good = np.fromiter(map(is_, map(type, vals), repeat(want)), bool, n)
+    if kind == "real":
+        if types == {float}:
+            col = np.array(vals, dtype=np.float64)
+        else:
+            col = np.array([v if g else np.nan for v, g in zip(vals, good.tolist())], dtype=np.float64)
+        good &= np.isfinite(col)
+        return good, col
+    get = codes.get  # only a value of the variable's own enumeration has a code
+    if good.all():
+        col = np.fromiter(map(get, vals, repeat(-1)), np.int64, n)
+    else:
+        col = np.fromiter((get(v, -1) if g else -1 for v, g in zip(vals, good.tolist())), np.int64, n)
+    return good & (col >= 0), col
+
+
+__all__ = ["ColumnCompiler", "Compiled", "Unsupported", "column", "field_values", "io_kind", "seed"]
