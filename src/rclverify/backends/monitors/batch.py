@@ -68,8 +68,9 @@ class BatchPlan:
             (key, typ, is_input), = vs
             rule = rules.get(topic)
             kind = io_kind(typ)
-            if rule is None or len(rule.fields) != 1 or rule.state or kind is None:
-                raise Unsupported(f"topic {topic}: not one REAL/enumeration field")
+            if rule is None or len(rule.fields) != 1 or not rule.fields[0].isidentifier() or rule.state or \
+                    kind is None:  # a field path is read by the general mapper: every message would be streamed
+                raise Unsupported(f"topic {topic}: not one REAL/enumeration field named at the top level")
             if is_input:
                 self.inputs[topic] = (key, rule.fields[0], kind)
             elif self.output[0]:
@@ -263,10 +264,14 @@ class _Run:
             truth, certain = f(columns)
             sure &= np.broadcast_to(truth & certain, sure.shape)
         p, total = 0, len(at)
+        m = self.m
         bad = np.flatnonzero(~sure)
         feed = self.feed
         while p < total:
             b = int(bad[np.searchsorted(bad, p)]) if len(bad) and bad[-1] >= p else total
+            if b > p and m._held:  # an output held for the skew: batch only up to the event that releases it
+                limit = m._held[0][1] + m.stream.skew
+                b = p + int(np.searchsorted(times[at[p:b] + 1], limit, side="right"))
             if b > p and self._quiet(times[at[p]]):
                 self._satisfied(chunk, at[p:b], {k: v[p:b] for k, v in src.items()}, times)
                 p = b
@@ -281,7 +286,7 @@ class _Run:
     def _quiet(self, t: float) -> bool:
         """Whether the engine would give no verdict of its own at an input at time ``t`` followed by its answer."""
         m = self.m
-        if m._held or m.now > t:
+        if m.now > t:
             return False
         o = m._open
         if o is not None and not (o.answered and not o.waiting and (o.followed or o.decided.issuperset(m._need))):
@@ -334,10 +339,12 @@ class _Run:
         ghost = _Ghost(chunk, tail, where, seed)
         newest = ghost.question(len(tail) - 1, self)
         drop = max(0, old + len(tail) - keptn)
-        stream._questions = (stream._questions + [None] * (len(tail) - 1) + [newest])[drop:]
+        # an output held for the skew: its release reads the questions within the skew after it, so they are made
+        made = [ghost.question(j, self) for j in range(len(tail) - 1)] if m._held else [None] * (len(tail) - 1)
+        stream._questions = (stream._questions + made + [newest])[drop:]
         stream._stamps = (stream._stamps + times[tail].tolist())[drop:]
         stream.latest = newest
-        if len(tail) > 1:
+        if len(tail) > 1 and not m._held:
             self.ghosts.append(ghost)
             left = stream._questions.count(None)  # the ghosts the stream still keeps: the latest of them
             while self.ghosts and sum(len(g.at) - 1 for g in self.ghosts[1:]) >= left:
