@@ -33,7 +33,6 @@ question comes); every formula compiled by :mod:`.columns`.
 from __future__ import annotations
 
 import gc
-from collections import deque
 from itertools import islice, repeat
 from operator import attrgetter, is_
 from typing import Any, Callable, Iterable, Mapping
@@ -45,6 +44,7 @@ from ...rcl.types import Checked, CheckedNode
 from ...traces.events import Event
 from ...traces.mapping import TopicRule
 from ...traces.questions import KEPT, Question
+from .answered import AnsweredRun
 from .columns import ColumnCompiler, Unsupported, column, field_values, io_kind, seed
 from .engine import NodeMonitor
 from .verdicts import NodeResult, Verdict
@@ -159,7 +159,7 @@ class _Run:
         self.kinds[plan.output[0]] = -1
         self.batched = self.streamed = 0
         #: runs of batch pairs whose older questions the stream keeps unmade (None), oldest first
-        self.ghosts: list[_Ghost] = []
+        self.ghosts: list[AnsweredRun] = []
         self.fields = {key: field for key, field, _ in plan.inputs.values()}
         self.node_topics = frozenset(self.kinds)
 
@@ -191,7 +191,7 @@ class _Run:
         """Judge ``chunk``; returns the events to carry to the next chunk (a last input whose answer may follow)."""
         plan, m = self.plan, self.m
         n = len(chunk)
-        kind = np.fromiter(map(self.kinds.get, map(_TOPIC, chunk), repeat(0)), np.int8, n)
+        kind = self._kind(list(map(_TOPIC, chunk)))
         times = np.fromiter(map(_TIME, chunk), np.float64, n)
         stamps = list(map(_STAMP, chunk))
         fields = list(map(_FIELDS, chunk))
@@ -232,6 +232,19 @@ class _Run:
         for ev in chunk[i:n]:
             feed(ev)
         return keep
+
+    def _kind(self, topics: list[str]) -> np.ndarray:
+        """Each event's topic as its column code: an input topic's number, -1 the output's, 0 another topic."""
+        n = len(topics)
+        if len(self.kinds) == 2 and n > 1:  # one input topic: a log where the two take turns is the common case
+            (a, ka), (b, kb) = self.kinds.items()
+            even, odd = topics[0::2], topics[1::2]
+            for x, kx, y, ky in ((a, ka, b, kb), (b, kb, a, ka)):
+                if even.count(x) == len(even) and odd.count(y) == len(odd):
+                    kind = np.empty(n, dtype=np.int8)
+                    kind[0::2], kind[1::2] = kx, ky
+                    return kind
+        return np.fromiter(map(self.kinds.get, topics, repeat(0)), np.int8, n)
 
     def _pairs(self, chunk: list[Event], at: np.ndarray, kind: np.ndarray, times: np.ndarray,
                cols: dict[str, np.ndarray]) -> int:
@@ -336,7 +349,7 @@ class _Run:
         tail = at[-min(n, keptn, 2 * KEPT):]
         where = {k: v[len(at) - len(tail):] for k, v in src.items()}
         seed = {k: m.values[k] for k in m._in_keys}
-        ghost = _Ghost(chunk, tail, where, seed)
+        ghost = AnsweredRun(chunk, tail, where, seed)
         newest = ghost.question(len(tail) - 1, self)
         drop = max(0, old + len(tail) - keptn)
         # an output held for the skew: its release reads the questions within the skew after it, so they are made
@@ -364,44 +377,6 @@ class _Run:
         last_out = chunk[int(at[-1]) + 1]
         if last_out.time > m.now:
             m.now = last_out.time
-
-
-class _Ghost:
-    """The questions of a run of batch pairs the stream keeps but nothing has looked up yet: made on demand.
-
-    ``at`` the pairs' input positions in ``chunk``; ``where`` per input key the
-    position of the message that set it (< 0: ``seed``, its value before the run)."""
-
-    __slots__ = ("chunk", "at", "where", "seed")
-
-    def __init__(self, chunk: list[Event], at: np.ndarray, where: dict[str, np.ndarray], seed: dict[str, Any]) -> None:
-        self.chunk, self.at, self.where, self.seed = chunk, at, where, seed
-
-    def question(self, j: int, run: "_Run") -> Question:
-        """The ``j``-th pair's question as the engine leaves it once answered (questions.py's fields)."""
-        chunk, plan, h = self.chunk, run.plan, run.m.horizon
-        i = int(self.at[j])
-        qe, ev = chunk[i], chunk[i + 1]
-        inputs = {}
-        for k in run.m._in_keys:  # a mapped value is the message's field itself (value_mapper's one-field rule)
-            w = int(self.where[k][j])
-            inputs[k] = chunk[w].fields[run.fields[k]] if w >= 0 else self.seed[k]
-        q = Question(qe, qe.time, inputs, True, "exact")
-        q.answered = True
-        q.last_out = ev
-        mine = {plan.output[1]: ev.fields[plan.output[2]]}
-        q.answer = mine
-        view = dict(inputs)
-        view.update(mine)
-        q.view = view
-        q.decided = set(plan.asked)
-        q.due = qe.time + h
-        if j + 1 < len(self.at):  # the next question of the run followed it within its horizon, or it expired first
-            if chunk[int(self.at[j + 1])].time <= qe.time + h:
-                q.followed = True
-            else:
-                q.reported = True
-        return q
 
 
 __all__ = ["CHUNK", "BatchPlan", "batch_plan", "check_batch"]
