@@ -245,7 +245,10 @@ for _ex in ("safety_stop", "warehouse"):
 
 
 def test_bundled_runs_decline_or_agree() -> None:
-    """Every node of the project's bundled runs: the batch path declines or gives the engine's verdicts."""
+    """Every node of the project's bundled runs: the batch path declines or gives the engine's verdicts, and
+    check_trace (which tries it first) gives the streaming result.  None is eligible today (quantifiers over
+    the waypoint table, several fields per topic, services, actions, triggers)."""
+    nodes = 0
     for rcl, root, mapping, traces, msg in RUNS:
         try:
             checked = load([rcl])
@@ -253,16 +256,28 @@ def test_bundled_runs_decline_or_agree() -> None:
         except Exception:  # noqa: BLE001 - a bundle of another shape (several files): not a run of this test
             continue
         for name, node in checked.nodes.items():
-            for trace in traces:
-                seen_b: list[Any] = []
-                done = check_batch(checked, node, read_trace(trace, msg), cfg.rules, cfg.horizon, seen_b.append,
-                                   cfg.tolerance, chunk=8)
-                if done is None:
-                    break
-                seen_s: list[Any] = []
+            nodes += 1
+            trace = traces[0]
+            seen_b: list[Any] = []
+            done = check_batch(checked, node, read_trace(trace, msg), cfg.rules, cfg.horizon, seen_b.append,
+                               cfg.tolerance, chunk=8)
+            runs = []
+            for batch in (False, True):
+                seen: list[Any] = []
                 n, (res,) = check_trace(checked, [node], read_trace(trace, msg), cfg.rules, cfg.horizon,
-                                        seen_s.append, cfg.tolerance, batch=False)
-                assert (done[0], done[1], seen_b) == (n, res, seen_s), (rcl.name, name, trace.name)
+                                        seen.append, cfg.tolerance, batch=batch)
+                runs.append((n, res, seen))
+            assert runs[1] == runs[0], (rcl.name, name, trace.name)
+            if done is not None:
+                assert (done[0], done[1], seen_b) == runs[0], (rcl.name, name, trace.name)
+            else:
+                assert name in DECLINED, f"{name} is eligible now: add its run's agreement to this test's figures"
+    assert nodes >= 4
+
+
+#: the bundled nodes the batch path declines (why: the test's docstring)
+DECLINED = {"Localisation", "Navigation", "Agent", "RadiationSensor", "Base", "BatteryMonitor", "Controller",
+            "LidarDriver", "Localiser", "MissionManager", "Planner", "Teleop", "Mission", "Mover"}
 
 
 def test_a_source_error_midway_judges_the_events_before_it(checked: Any) -> None:
