@@ -32,7 +32,7 @@ from rclverify.traces.mapping import load_rules
 
 REPO = Path(__file__).resolve().parents[1]
 CONTRACTS = """\
-context { Band : {green, orange, red} ; Level : {lo, hi} ; }
+context { Band : {green, orange, red} ; Level : {lo, hi} ; Gear : {slow, fast} ; EDGE : REAL = 119.99999999999999 ; }
 node Classifier {
   inputs( r : REAL )
   outputs( status : Band )
@@ -46,7 +46,15 @@ node Edge {
   inputs( r : REAL )
   outputs( s : Level )
   topics( std_msgs/Float64 reading matches(in.r), std_msgs/String level matches(out.s) )
-  guarantee( (in.r < 119.99999999999999 -> out.s == lo) and (in.r >= 119.99999999999999 -> out.s == hi) )
+  guarantee( (in.r < EDGE -> out.s == lo) and (in.r >= EDGE -> out.s == hi) )
+}
+node Shift {
+  inputs( gear : Gear, r : REAL )
+  outputs( s : Level )
+  topics( std_msgs/String gear matches(in.gear), std_msgs/Float64 reading matches(in.r),
+          std_msgs/String level matches(out.s) )
+  assume( in.r > -5 )
+  guarantee( (in.gear == fast and in.r >= 60 -> out.s == hi) and (not (in.gear == fast and in.r >= 60) -> out.s == lo) )
 }
 node Linear {
   inputs( a : REAL, b : REAL )
@@ -57,7 +65,7 @@ node Linear {
   guarantee( out.y >= in.a - 30 - in.b * 2 or out.y == 7 )
 }
 """
-RULES = {"reading": {"fields": ["data"]}, "status": {"fields": ["data"]}, "level": {"fields": ["data"]},
+RULES = {"reading": {"fields": ["data"]}, "gear": {"fields": ["data"]}, "status": {"fields": ["data"]}, "level": {"fields": ["data"]},
          "a": {"fields": ["data"]}, "b": {"fields": ["data"]}, "y": {"fields": ["data"]}}
 NEAR = [119.99999999999999, 120.0, 120.00000000000001, 119.99999999999997, 250.0, 249.99999999999997, 0.0, -0.0,
         5e-324]
@@ -88,6 +96,9 @@ SPECS: dict[str, tuple[dict[str, Callable[[random.Random], Any]], str, Callable[
     "Classifier": ({"reading": _reading}, "status", lambda v: _band(v["reading"]),
                    lambda rnd, v: rnd.choice(["green", "orange", "red"])),
     "Edge": ({"reading": _reading}, "level", lambda v: _level(v["reading"]), lambda rnd, v: rnd.choice(["lo", "hi"])),
+    "Shift": ({"gear": lambda rnd: rnd.choice(["slow", "fast"]), "reading": _reading}, "level",
+              lambda v: "hi" if v["gear"] == "fast" and v["reading"] >= 60 else "lo",
+              lambda rnd, v: "lo" if v["gear"] == "fast" and v["reading"] >= 60 else "hi"),
     "Linear": ({"a": lambda rnd: rnd.choice([rnd.uniform(-60, 60), 10.0, 0.1, 3.0]),
                 "b": lambda rnd: rnd.choice([rnd.uniform(-10, 110), 0.0, 1.0])},
                "y", lambda v: 0.1 * v["a"] + v["b"] - (0.0 if v["a"] % 2 < 0.5 else 0.5),
@@ -115,14 +126,14 @@ def _trace(rnd: random.Random, node: str, horizon: float) -> list[Event]:
         kind = "pair" if long_regular and rnd.random() < 0.97 else rnd.choices(
             ["pair", "lone", "dup", "late", "back", "stamped", "bad", "foreign", "orphan", "lookback"],
             [55, 6, 5, 5, 4, 4, 7, 4, 4, 6])[0]
-        topic = rnd.choice(list(inputs))
+        topic = rnd.choices(list(inputs), [3 if t == "reading" else 1 for t in inputs])[0]  # gear: now and then
         value = inputs[topic](rnd)
         if kind == "bad":
             value = rnd.choice(BAD)
         if kind in ("pair", "lone", "dup", "late", "bad", "stamped", "lookback"):
             add(topic, value, t, t - 0.003 if kind == "stamped" else None)
             asked.append(t)
-            if type(value) is float and math.isfinite(value):
+            if (type(value) is float and math.isfinite(value)) or value in ("slow", "fast"):
                 last[topic] = value
         answer = right(last) if rnd.random() < 0.85 else wrong(rnd, last)
         if kind == "bad" and rnd.random() < 0.5:
@@ -159,7 +170,7 @@ def _both(checked: Any, node: str, events: list[Event], rules: Any, horizon: flo
 def test_batch_equals_streaming_on_random_traces(checked: Any, node: str) -> None:
     rnd = random.Random(f"batch-{node}")
     batched = streamed = 0
-    for case in range(20 if node == "Linear" else 30):
+    for case in range(20 if node in ("Linear", "Shift") else 30):
         horizon = rnd.choice([0.005, 0.02, 0.1])
         rules = load_rules(RULES)
         rules.skew = rnd.choice([0.0, 0.02, 0.005])
