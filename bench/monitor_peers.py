@@ -19,6 +19,11 @@ samples (made from ``--seed``), the monitoring loop timed in CPU seconds:
   answer it (a later status fitting its band would satisfy it within a
   longer horizon), as each peer judges a sample on its own.  A last event
   past every horizon ends the run so no obligation is left open;
+* **rclverify batch**: the same through ``check_trace``'s offline batch
+  path (backends/monitors/batch.py: the answer pairs surely satisfied
+  judged over numpy columns, every other event by the engine), which the
+  command takes; its verdicts compared with the streaming engine's on
+  every sample (issue 51: at least Reelay's samples per second);
 * **rclverify monitor**: the command on a workspace holding the contract,
   the mapping and the trace as a ROSMonitoring log (two lines a sample):
   the whole process's CPU (start, reading the log, checking, printing);
@@ -28,8 +33,9 @@ samples (made from ``--seed``), the monitoring loop timed in CPU seconds:
 * **Reelay** 25.0.0 (``pip install reelay==25.0.0``, C++ core): the same
   property in its rye syntax, a discrete monitor updated sample by sample.
 
-Printed: samples per CPU second, each as a ratio to the rclverify engine,
-the command's CPU over the engine's (issue 44's aim: at most 1.5), peak
+Printed: samples per CPU second, each as a ratio to the rclverify streaming
+engine, the batch path's over Reelay's, the command's CPU over the batch
+path's and the streaming engine's (issue 44's aim: at most 1.5), peak
 resident memory, and whether each tool's verdict on every sample agrees
 with the rclverify engine's (the verdicts are collected in a second,
 untimed run of the engine, so collecting them costs the timing nothing).
