@@ -19,6 +19,11 @@ samples (made from ``--seed``), the monitoring loop timed in CPU seconds:
   answer it (a later status fitting its band would satisfy it within a
   longer horizon), as each peer judges a sample on its own.  A last event
   past every horizon ends the run so no obligation is left open;
+* **rclverify batch**: the same through ``check_trace``'s offline batch
+  path (backends/monitors/batch.py: the answer pairs surely satisfied
+  judged over numpy columns, every other event by the engine), which the
+  command takes; its verdicts compared with the streaming engine's on
+  every sample (issue 51: at least Reelay's samples per second);
 * **rclverify monitor**: the command on a workspace holding the contract,
   the mapping and the trace as a ROSMonitoring log (two lines a sample):
   the whole process's CPU (start, reading the log, checking, printing);
@@ -28,8 +33,9 @@ samples (made from ``--seed``), the monitoring loop timed in CPU seconds:
 * **Reelay** 25.0.0 (``pip install reelay==25.0.0``, C++ core): the same
   property in its rye syntax, a discrete monitor updated sample by sample.
 
-Printed: samples per CPU second, each as a ratio to the rclverify engine,
-the command's CPU over the engine's (issue 44's aim: at most 1.5), peak
+Printed: samples per CPU second, each as a ratio to the rclverify streaming
+engine, the batch path's over Reelay's, the command's CPU over the batch
+path's and the streaming engine's (issue 44's aim: at most 1.5), peak
 resident memory, and whether each tool's verdict on every sample agrees
 with the rclverify engine's (the verdicts are collected in a second,
 untimed run of the engine, so collecting them costs the timing nothing).
@@ -103,7 +109,8 @@ def samples(n: int, seed: int, wrong: float) -> tuple[array, bytes]:
 
 # -- children: one tool each, timed in their own process --------------------------------------------
 
-def _rclverify_engine(n: int, rs: array, st: bytes, verdicts: bool) -> tuple[float, bytes, dict[str, int]]:
+def _rclverify_engine(n: int, rs: array, st: bytes, verdicts: bool, batch: bool = False
+                      ) -> tuple[float, bytes, dict[str, int]]:
     from rclverify.backends.monitors.check import check_trace
     from rclverify.rcl.typecheck import load
     from rclverify.traces.events import Event
@@ -127,9 +134,12 @@ def _rclverify_engine(n: int, rs: array, st: bytes, verdicts: bool) -> tuple[flo
 
     def seen(v: Any) -> None:
         out[v.event // 2] = {"satisfied": 1, "violated": 0}.get(v.verdict, 2)
+    import inspect
+    # the streaming engine alone, or the batch path (an older tree has no batch path: always streaming)
+    extra = {"batch": batch} if "batch" in inspect.signature(check_trace).parameters else {}
     t0 = time.process_time()
     _, (res,) = check_trace(checked, [checked.nodes["Classifier"]], events(), rules, HORIZON,
-                            seen if verdicts else None)
+                            seen if verdicts else None, **extra)
     counts = dict(res.counts)
     counts["evaluation"] = getattr(res, "evaluation", {})  # how the formulas ran (an older tree has no such field)
     return time.process_time() - t0, bytes(out), counts
@@ -169,12 +179,13 @@ def child(args: argparse.Namespace) -> int:
     rs, st = samples(args.samples, args.seed, args.wrong)
     report: dict[str, Any] = {}
     try:
-        if args.child == "rclverify":
-            cpu, _, counts = _rclverify_engine(args.samples, rs, st, verdicts=False)
+        if args.child in ("rclverify", "batch"):
+            batch = args.child == "batch"
+            cpu, _, counts = _rclverify_engine(args.samples, rs, st, verdicts=False, batch=batch)
             report["counts"] = counts
             rss = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
             if args.verdicts:
-                _, out, counts2 = _rclverify_engine(args.samples, rs, st, verdicts=True)
+                _, out, counts2 = _rclverify_engine(args.samples, rs, st, verdicts=True, batch=batch)
                 assert counts2 == counts, (counts, counts2)
                 Path(args.verdicts).write_bytes(out)
         else:
@@ -246,7 +257,7 @@ def main() -> int:
     ap.add_argument("--seed", type=int, default=44)
     ap.add_argument("--compare", metavar="OLD_SRC", help="also run the engine and the command from this source tree")
     ap.add_argument("--smoke", action="store_true", help="2,000 samples (CI)")
-    ap.add_argument("--child", choices=("rclverify", "rtamt", "reelay"), help=argparse.SUPPRESS)
+    ap.add_argument("--child", choices=("rclverify", "batch", "rtamt", "reelay"), help=argparse.SUPPRESS)
     ap.add_argument("--src", help=argparse.SUPPRESS)
     ap.add_argument("--verdicts", help=argparse.SUPPRESS)
     args = ap.parse_args()
@@ -267,6 +278,9 @@ def main() -> int:
             r = _run_child("rclverify", args, base / f"v-{label}", src)
             rows[f"rclverify engine ({label})"] = r
             verdicts[label] = (base / f"v-{label}").read_bytes()
+            if label == "new":
+                rows["rclverify batch"] = _run_child("batch", args, base / "v-batch", src)
+                verdicts["rclverify batch"] = (base / "v-batch").read_bytes()
             rows[f"rclverify monitor ({label})"] = _run_command(ws, src)
         for tool in ("rtamt", "reelay"):
             r = _run_child(tool, args, base / f"v-{tool}", None)
@@ -274,7 +288,8 @@ def main() -> int:
             if "skipped" not in r:
                 verdicts[tool] = (base / f"v-{tool}").read_bytes()
     engine = rows["rclverify engine (new)"]["cpu"]
-    print(f"{'tool':<28} {'samples/s':>11} {'x engine':>9} {'peak RSS MiB':>13}  verdicts agree with the engine")
+    batch = rows["rclverify batch"]
+    print(f"{'tool':<28} {'samples/s':>11} {'x engine':>9} {'peak RSS MiB':>13}  verdicts agree with the streaming engine")
     for name, r in rows.items():
         if "skipped" in r:
             print(f"{name:<28} skipped: {r['skipped']}")
@@ -284,11 +299,17 @@ def main() -> int:
         print(f"{name:<28} {n / r['cpu']:>11.0f} {engine / r['cpu']:>9.2f} {r['rss']:>13.1f}  {agree}")
     counts = dict(rows["rclverify engine (new)"]["counts"])
     evaluation = counts.pop("evaluation", {})
+    bcounts = dict(batch["counts"])
+    bcounts.pop("evaluation", None)
     print("rclverify engine verdicts: " + ", ".join(f"{v} {k}" for k, v in counts.items() if v)
-          + "; formulas: " + ", ".join(f"{k} {v}" for k, v in evaluation.items()))
+          + "; formulas: " + ", ".join(f"{k} {v}" for k, v in evaluation.items())
+          + ("; the batch path's counts: the same" if bcounts == counts else f"; the batch path's DIFFER: {bcounts}"))
+    if "reelay" in rows and "skipped" not in rows["reelay"]:
+        print(f"rclverify batch / Reelay samples/s: {rows['reelay']['cpu'] / batch['cpu']:.2f} (aim: at least 1)")
     cmd = rows["rclverify monitor (new)"]
     short = " (the command's start-up dominates a run this short)" if n < 100_000 else ""
-    print(f"rclverify monitor / engine CPU: {cmd['cpu'] / engine:.2f} (aim: at most 1.5){short}; the command "
+    print(f"rclverify monitor / engine CPU: {cmd['cpu'] / batch['cpu']:.2f} against the batch path the command "
+          f"takes, {cmd['cpu'] / engine:.2f} against the streaming engine (aim: at most 1.5){short}; the command "
           f"printed: {cmd['out']}")
     if args.compare:
         old = rows["rclverify engine (old)"]["cpu"]

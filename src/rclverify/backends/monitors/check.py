@@ -15,6 +15,7 @@ from ...logic.floatsem import Tolerance
 from ...rcl.types import Checked, CheckedNode
 from ...traces.events import Event
 from ...traces.mapping import TopicRule
+from .batch import check_batch
 from .engine import NodeMonitor
 from .verdicts import LINK_TOPICS, VERDICTS, NodeResult, Verdict, link_of, producers
 
@@ -23,7 +24,7 @@ def check_trace(checked: Checked, nodes: Iterable[CheckedNode], events: Iterable
                 rules: Mapping[str, TopicRule], horizon: float,
                 on_verdict: Callable[[Verdict], None] | None = None,
                 tolerance: Tolerance | None = None,
-                end: float | None = None) -> tuple[int, list[NodeResult]]:
+                end: float | None = None, batch: bool = True) -> tuple[int, list[NodeResult]]:
     """Stream ``events`` through a monitor per node; returns (events read, results).
 
     The online engine (:class:`NodeMonitor`) run over a recorded trace: each
@@ -34,7 +35,18 @@ def check_trace(checked: Checked, nodes: Iterable[CheckedNode], events: Iterable
     as it is decided; ``tolerance`` as for :class:`NodeMonitor`.  Raises
     whatever the event source raises (:class:`TraceError`) after the events
     before it were processed.
+
+    One node whose contract the batch path takes (:mod:`.batch`: quantifier-free
+    REAL/enumeration contracts, one output topic, no state, trigger or link) is
+    judged by it, unless ``batch`` is false: the same verdicts, in the same
+    order, the same result (tests/test_monitor_batch.py).  A live monitor never
+    comes here: it feeds :class:`NodeMonitor` itself.
     """
+    nodes = list(nodes)
+    if len(nodes) == 1 and batch:
+        done = check_batch(checked, nodes[0], events, rules, horizon, on_verdict, tolerance, end)
+        if done is not None:  # eligible: the same verdicts, in batches (batch.py)
+            return done[0], [done[1]]
     monitors = [NodeMonitor(checked, n, rules, horizon, on_verdict, tolerance) for n in nodes]
     count = 0
     last_time = 0.0

@@ -1,0 +1,62 @@
+"""The questions of a run of answer pairs the batch path judged (backends/monitors/batch.py).
+
+After a run of pairs the stream of :mod:`rclverify.traces.questions` keeps the
+last 64 to 128 questions, each answered by its pair's output; the engine looks
+one up only for an event stamped before the latest question.  The batch path
+makes the newest at once and the others, from this record, only then: the
+fields are those the engine sets on a question answered by one output that
+decided every guarantee (``answered``, ``answer``, ``view``, ``decided``,
+``due``; ``followed`` when the next question came within its horizon, else
+``reported``: it was closed, answered in full, when its horizon passed).
+"""
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from ...traces.events import Event
+from ...traces.questions import Question
+
+
+class AnsweredRun:
+    """A run of answer pairs judged in batch, whose questions are made when asked for.
+
+    ``at`` the pairs' input positions in ``chunk``; ``where`` per input key the
+    position of the message that set it (< 0: ``seed``, its value before the run).
+    :meth:`question` takes the batch run (``run.m`` the engine, ``run.plan`` its
+    plan, ``run.fields`` each input key's field)."""
+
+    __slots__ = ("chunk", "at", "where", "seed")
+
+    def __init__(self, chunk: list[Event], at: np.ndarray, where: dict[str, np.ndarray], seed: dict[str, Any]) -> None:
+        self.chunk, self.at, self.where, self.seed = chunk, at, where, seed
+
+    def question(self, j: int, run: Any) -> Question:
+        """The ``j``-th pair's question as the engine leaves it once answered (questions.py's fields)."""
+        chunk, plan, h = self.chunk, run.plan, run.m.horizon
+        i = int(self.at[j])
+        qe, ev = chunk[i], chunk[i + 1]
+        inputs = {}
+        for k in run.m._in_keys:  # a mapped value is the message's field itself (value_mapper's one-field rule)
+            w = int(self.where[k][j])
+            inputs[k] = chunk[w].fields[run.fields[k]] if w >= 0 else self.seed[k]
+        q = Question(qe, qe.time, inputs, True, "exact")
+        q.answered = True
+        q.last_out = ev
+        mine = {plan.output[1]: ev.fields[plan.output[2]]}
+        q.answer = mine
+        view = dict(inputs)
+        view.update(mine)
+        q.view = view
+        q.decided = set(plan.asked)
+        q.due = qe.time + h
+        if j + 1 < len(self.at):  # the next question of the run followed it within its horizon, or it expired first
+            if chunk[int(self.at[j + 1])].time <= qe.time + h:
+                q.followed = True
+            else:
+                q.reported = True
+        return q
+
+
+__all__ = ["AnsweredRun"]

@@ -1,0 +1,382 @@
+"""The offline batch path: one node's contract judged on a whole recorded trace, column-wise.
+
+Offline, a run is a batch (issue 51): most of it is a node answering each
+input message with one output message, every formula far from its
+boundaries.  This module reads the trace in chunks (:data:`CHUNK` events),
+finds those rows (a **pair**: an input message and the output message that
+follows it, the output the answer the stream model gives it, docs/semantics.md),
+evaluates the assumptions and guarantees over the chunk's columns in
+float64 with a certificate per row (:mod:`.columns`), and gives the rows
+surely true in exact arithmetic their ``satisfied`` verdict directly.  Every
+other event (an input with no answer, a late or duplicated answer, a value
+that does not map, a formula false or near a boundary, a message of another
+topic) goes through the streaming engine (:class:`~.engine.NodeMonitor`,
+its ``feed``) exactly as :func:`~.check.check_trace` would feed it, so its
+verdict is the engine's by construction.
+
+The two share one engine: before a run of batch rows the engine must be
+**quiet** (no output held for the transport skew, the watched question
+answered in full, nothing a new question would supersede), so the rows'
+verdicts are the engine's fast path's (``satisfied``, ``exact``, no
+reason); after them the engine's small state is set as feeding them would
+have set it (the values, the clock, the counts, the last questions and
+recent outputs it keeps, the watched question).  Memory is the chunk's
+columns and that small state: flat in the trace's length.
+
+Eligible (:func:`batch_plan`), else the caller streams: one node; no
+service or action link, no ``triggered by``, no state topic; every topic
+carries one ``REAL`` or enumeration variable through a rule naming one
+field; one output topic; every guarantee reads an input and the output, and
+Z3 showed only an answer decides them (the engine evaluates nothing when a
+question comes); every formula compiled by :mod:`.columns`.
+"""
+from __future__ import annotations
+
+import gc
+from itertools import islice, repeat
+from operator import attrgetter, is_
+from typing import Any, Callable, Iterable, Mapping
+
+import numpy as np
+
+from ...logic.floatsem import Tolerance
+from ...rcl.types import Checked, CheckedNode
+from ...traces.events import Event
+from ...traces.mapping import TopicRule
+from ...traces.questions import KEPT, Question
+from .answered import AnsweredRun
+from .columns import ColumnCompiler, Unsupported, column, field_values, io_kind, seed
+from .engine import NodeMonitor
+from .verdicts import NodeResult, Verdict
+
+#: Events read per chunk: the columns held at once.
+CHUNK = 16384
+_TOPIC, _TIME, _STAMP, _FIELDS = attrgetter("topic"), attrgetter("time"), attrgetter("stamp"), attrgetter("fields")
+_EMPTY: Mapping[str, Any] = {}
+
+
+class BatchPlan:
+    """What the batch path needs of an eligible node's monitor ``m``: its input
+    topics (topic -> (key, field, kind)), its output topic and key, the
+    compiled assumptions and guarantees."""
+
+    def __init__(self, m: NodeMonitor, rules: Mapping[str, TopicRule], compiler: ColumnCompiler) -> None:
+        self.m = m
+        self.inputs: dict[str, tuple[str, str, str]] = {}
+        self.output: tuple[str, str, str, str] = ("", "", "", "")
+        for topic, vs in m.topics.items():
+            (key, typ, is_input), = vs
+            rule = rules.get(topic)
+            kind = io_kind(typ)
+            if rule is None or len(rule.fields) != 1 or not rule.fields[0].isidentifier() or rule.state or \
+                    kind is None:  # a field path is read by the general mapper: every message would be streamed
+                raise Unsupported(f"topic {topic}: not one REAL/enumeration field named at the top level")
+            if is_input:
+                self.inputs[topic] = (key, rule.fields[0], kind)
+            elif self.output[0]:
+                raise Unsupported("more than one output topic")
+            else:
+                self.output = (topic, key, rule.fields[0], kind)
+        self.keys = [k for k, _, _ in self.inputs.values()]
+        if not self.output[0] or not self.inputs or len(set(self.keys)) != len(self.keys) or \
+                sorted(self.keys) != sorted(m._in_keys) or sorted(m.needed_inputs) != sorted(self.keys):
+            raise Unsupported("inputs and output not one topic each")
+        #: enumeration-valued keys -> the code of each value of their type (a value of no other type)
+        self.enums = {key: {v: compiler.codes[v] for v in typ.values if v in compiler.codes}
+                      for vs in m.topics.values() for key, typ, _ in vs if io_kind(typ) == "enum"}
+        self.codes = compiler.codes
+        self.formulas = [compiler.compile(f) for f in m.assumption + m.guarantees]
+        self.asked = set(m._asked)
+
+
+def batch_plan(m: NodeMonitor, rules: Mapping[str, TopicRule]) -> BatchPlan | None:
+    """The batch plan of monitor ``m`` when its node is eligible (module docstring), else ``None``."""
+    node = m.node
+    ks = range(1, len(m.guarantees) + 1)
+    if node.node.links or m._trigger or m._state_outs or not m.has_inputs or m._alone or m.unbound or \
+            m._ask_at_question or any(len(vs) != 1 for vs in m.topics.values()) or \
+            any(not m._reads_out[k] for k in ks) or sorted(m._asked) != list(ks):
+        return None
+    try:
+        plan = BatchPlan(m, rules, ColumnCompiler(m.checked, node))
+    except (Unsupported, ValueError):
+        return None
+    return plan
+
+
+def check_batch(checked: Checked, node: CheckedNode, events: Iterable[Event], rules: Mapping[str, TopicRule],
+                horizon: float, on_verdict: Callable[[Verdict], None] | None = None,
+                tolerance: Tolerance | None = None, end: float | None = None, chunk: int = CHUNK,
+                stats: dict[str, int] | None = None) -> tuple[int, NodeResult] | None:
+    """:func:`~.check.check_trace` for one node, in batches: (events read, the
+    node's result), the same verdicts in the same order to ``on_verdict``;
+    ``None`` before reading any event when the node is not eligible (module
+    docstring).  ``chunk``: events read at once (>= 2); ``stats``, when given,
+    receives ``batched`` (answer pairs judged in batches) and ``streamed``
+    (events fed to the streaming engine).  Raises what the event source raises."""
+    m = NodeMonitor(checked, node, rules, horizon, on_verdict, tolerance)
+    plan = batch_plan(m, rules)
+    if plan is None:
+        return None
+    run = _Run(plan)
+    count, last_time = 0, 0.0
+    it = iter(events)
+    carry: list[Event] = []
+    was = gc.isenabled()
+    gc.disable()  # the chunk's events hold no cycles: refcounting frees them (the collector's passes cost 2x)
+    try:
+        while True:
+            events_, before = carry, len(carry)
+            try:
+                events_.extend(islice(it, max(chunk, 2)))  # what was read stays in the list if the source raises
+            except BaseException:
+                # the events before the error are judged, as the streaming engine judges them, then it propagates
+                for ev in run.chunk(events_) if len(events_) > before else events_:
+                    run.feed(ev)
+                raise
+            if len(events_) == before:
+                for ev in carry:
+                    run.feed(ev)
+                break
+            count += len(events_) - before
+            last_time = events_[-1].time
+            carry = run.chunk(events_)
+    finally:
+        if was:
+            gc.enable()
+    m.advance(max(last_time, end) if end is not None else last_time)
+    if stats is not None:
+        stats.update(batched=run.batched, streamed=run.streamed)
+    return count, m.finish()
+
+
+class _Run:
+    """The batch path over one trace: the shared engine and the chunk loop."""
+
+    def __init__(self, plan: BatchPlan) -> None:
+        self.plan, self.m = plan, plan.m
+        self.kinds = {t: j for j, t in enumerate(plan.inputs, 1)}
+        self.kinds[plan.output[0]] = -1
+        self.batched = self.streamed = 0
+        #: runs of batch pairs whose older questions the stream keeps unmade (None), oldest first
+        self.ghosts: list[AnsweredRun] = []
+        self.fields = {key: field for key, field, _ in plan.inputs.values()}
+        self.node_topics = frozenset(self.kinds)
+
+    def feed(self, ev: Event) -> None:
+        """``ev`` to the engine, the kept questions made first when it may look one up (stamped before the latest)."""
+        self.streamed += 1
+        if self.ghosts and ev.topic in self.node_topics:
+            stamps = self.m.stream._stamps
+            if stamps and (ev.time if ev.stamp is None else ev.stamp) < stamps[-1]:
+                self._materialise()
+        self.m.feed(ev)
+
+    def _materialise(self) -> None:
+        """Make every question the stream keeps as ``None`` (the latest ghosts, in order)."""
+        qs = self.m.stream._questions
+        left = qs.count(None)
+        made: list[Question] = []
+        for g in reversed(self.ghosts):
+            if len(made) >= left:
+                break
+            made[:0] = [g.question(j, self) for j in range(max(0, len(g.at) - 1 - (left - len(made))),
+                                                           len(g.at) - 1)]
+        made = made[len(made) - left:]
+        it = iter(made)
+        self.m.stream._questions = [q if q is not None else next(it) for q in qs]
+        self.ghosts.clear()
+
+    def chunk(self, chunk: list[Event]) -> list[Event]:
+        """Judge ``chunk``; returns the events to carry to the next chunk (a last input whose answer may follow)."""
+        plan, m = self.plan, self.m
+        n = len(chunk)
+        kind = self._kind(list(map(_TOPIC, chunk)))
+        times = np.fromiter(map(_TIME, chunk), np.float64, n)
+        stamps = list(map(_STAMP, chunk))
+        fields = list(map(_FIELDS, chunk))
+        ok = kind != 0
+        if stamps.count(None) != n:
+            ok &= np.fromiter(map(is_, stamps, repeat(None)), bool, n)
+        cols: dict[str, np.ndarray] = {}
+        for topic, j, (key, field, kind_) in [(plan.output[0], -1, plan.output[1:])] + \
+                [(t, self.kinds[t], v) for t, v in plan.inputs.items()]:
+            rows = np.flatnonzero(kind == j)
+            good, col = column(field_values(fields, rows, field), kind_, plan.enums.get(key, _EMPTY))
+            ok[rows] &= good
+            full = np.zeros(n, dtype=np.float64 if kind_ == "real" else np.int64)
+            full[rows] = col
+            cols[key] = full
+        # a pair: an input at i, its answer at i + 1, both mapped, stamped in order, the answer within the horizon
+        h = m.horizon
+        start = np.zeros(n, dtype=bool)
+        if n > 1:
+            t0, t1 = times[:-1], times[1:]
+            start[:-1] = (kind[:-1] > 0) & (kind[1:] == -1) & ok[:-1] & ok[1:] & (t0 <= t1) & (t1 <= t0 + h)
+        keep: list[Event] = []
+        if kind[-1] > 0 and ok[-1]:
+            keep = [chunk[-1]]  # its answer may be the next chunk's first event
+            n -= 1
+        pairs = np.flatnonzero(start[:n])
+        # runs of pairs back to back, times in order: split where the next pair does not follow on
+        link = (pairs[1:] == pairs[:-1] + 2) & (times[pairs[1:]] >= times[pairs[:-1] + 1])
+        ends = np.append(np.flatnonzero(~link), len(pairs) - 1) if len(pairs) else np.zeros(0, dtype=np.int64)
+        feed = self.feed
+        i, k = 0, 0
+        for e in ends.tolist():
+            run = pairs[k:e + 1]
+            for ev in chunk[i:int(run[0])]:  # not a pair: the engine
+                feed(ev)
+            i = self._pairs(chunk, run, kind, times, cols)
+            k = e + 1
+        for ev in chunk[i:n]:
+            feed(ev)
+        return keep
+
+    def _kind(self, topics: list[str]) -> np.ndarray:
+        """Each event's topic as its column code: an input topic's number, -1 the output's, 0 another topic."""
+        n = len(topics)
+        if len(self.kinds) == 2 and n > 1:  # one input topic: a log where the two take turns is the common case
+            (a, ka), (b, kb) = self.kinds.items()
+            even, odd = topics[0::2], topics[1::2]
+            for x, kx, y, ky in ((a, ka, b, kb), (b, kb, a, ka)):
+                if even.count(x) == len(even) and odd.count(y) == len(odd):
+                    kind = np.empty(n, dtype=np.int8)
+                    kind[0::2], kind[1::2] = kx, ky
+                    return kind
+        return np.fromiter(map(self.kinds.get, topics, repeat(0)), np.int8, n)
+
+    def _pairs(self, chunk: list[Event], at: np.ndarray, kind: np.ndarray, times: np.ndarray,
+               cols: dict[str, np.ndarray]) -> int:
+        """A run of pairs (their inputs at ``at``): the surely satisfied ones in
+        batches, the rest fed to the engine.  Returns the event after the run."""
+        plan, m = self.plan, self.m
+        okey = plan.output[1]
+        # every input as it stands at each pair: the pair's own, else the latest before it (else the engine's)
+        tkind = kind[at]
+        columns: dict[str, np.ndarray] = {okey: cols[okey][at + 1]}
+        seen = np.ones(len(at), dtype=bool)
+        src: dict[str, np.ndarray] = {}
+        for topic, (key, _, _) in plan.inputs.items():
+            mine = tkind == self.kinds[topic]
+            idx = np.where(mine, at, -1)
+            np.maximum.accumulate(idx, out=idx)
+            src[key] = idx
+            col = cols[key][np.maximum(idx, 0)]
+            if not mine.all():
+                before = idx < 0
+                first = seed(m.values.get(key), plan.enums.get(key))
+                if first is None:  # no value yet, or one the columns do not hold: the engine judges those rows
+                    seen &= ~before
+                else:
+                    col = col.copy()
+                    col[before] = first
+            columns[key] = col
+        sure = seen.copy()
+        for f in plan.formulas:
+            truth, certain = f(columns)
+            sure &= np.broadcast_to(truth & certain, sure.shape)
+        p, total = 0, len(at)
+        m = self.m
+        bad = np.flatnonzero(~sure)
+        feed = self.feed
+        while p < total:
+            b = int(bad[np.searchsorted(bad, p)]) if len(bad) and bad[-1] >= p else total
+            if b > p and m._held:  # an output held for the skew: batch only up to the event that releases it
+                limit = m._held[0][1] + m.stream.skew
+                b = p + int(np.searchsorted(times[at[p:b] + 1], limit, side="right"))
+            if b > p and self._quiet(times[at[p]]):
+                self._satisfied(chunk, at[p:b], {k: v[p:b] for k, v in src.items()}, times)
+                p = b
+                if p >= total:
+                    break
+            i = int(at[p])
+            feed(chunk[i])
+            feed(chunk[i + 1])
+            p += 1
+        return int(at[-1]) + 2
+
+    def _quiet(self, t: float) -> bool:
+        """Whether the engine would give no verdict of its own at an input at time ``t`` followed by its answer."""
+        m = self.m
+        if m.now > t:
+            return False
+        o = m._open
+        if o is not None and not (o.answered and not o.waiting and (o.followed or o.decided.issuperset(m._need))):
+            return False
+        last = m.stream.latest
+        if last is not None and last.owed and not (last.answered or last.settled or last.reported) and \
+                t <= last.event.time + m.horizon:
+            return False
+        stamps = m.stream._stamps
+        return not stamps or stamps[-1] <= t
+
+    def _satisfied(self, chunk: list[Event], at: np.ndarray, src: dict[str, np.ndarray], times: np.ndarray) -> None:
+        """The pairs at ``at`` are surely satisfied: their verdicts, and the engine's state as feeding them sets it."""
+        plan, m = self.plan, self.m
+        h, okey, keys = m.horizon, plan.output[1], plan.keys
+        n = len(at)
+        self.batched += n
+        t_first = chunk[int(at[0])].time
+        # the watched question: closed silently when its horizon passed, else followed by the first new question
+        o = m._open
+        if o is not None and t_first > m._due:
+            o.reported = True
+            m._open, m._due = None, float("inf")
+        last = m.stream.latest
+        if last is not None and t_first <= last.event.time + h:
+            last.followed = True
+        if m._open is not None and m._open.followed:
+            m._open, m._due = None, float("inf")
+        result = m.result
+        result.events += 2 * n
+        result.counts["satisfied"] += n
+        result.semantics["exact"] += n
+        result.accepted += n
+        ofield = plan.output[2]
+        if m.on_verdict is not None:
+            name, emit = m.node.name, m.on_verdict
+            for i in at.tolist():
+                qe, ev = chunk[i], chunk[i + 1]
+                emit(Verdict(name, "satisfied", ev.index, ev.time, ev.where, ev.topic, ev.time, 0, {}, "", "exact",
+                             qe.where))
+        # the questions the stream keeps (the newest made now, the older ones when the engine may look them
+        # up: _materialise), and the outputs the engine remembers for the transport skew
+        stream = m.stream
+        old = len(stream._questions)
+        total = old + n
+        keptn = total if total <= 2 * KEPT else KEPT + 1 + (total - 2 * KEPT - 1) % KEPT
+        tail = at[-min(n, keptn, 2 * KEPT):]
+        where = {k: v[len(at) - len(tail):] for k, v in src.items()}
+        seed = {k: m.values[k] for k in m._in_keys}
+        ghost = AnsweredRun(chunk, tail, where, seed)
+        newest = ghost.question(len(tail) - 1, self)
+        drop = max(0, old + len(tail) - keptn)
+        # an output held for the skew: its release reads the questions within the skew after it, so they are made
+        made = [ghost.question(j, self) for j in range(len(tail) - 1)] if m._held else [None] * (len(tail) - 1)
+        stream._questions = (stream._questions + made + [newest])[drop:]
+        stream._stamps = (stream._stamps + times[tail].tolist())[drop:]
+        stream.latest = newest
+        if len(tail) > 1 and not m._held:
+            self.ghosts.append(ghost)
+            left = stream._questions.count(None)  # the ghosts the stream still keeps: the latest of them
+            while self.ghosts and sum(len(g.at) - 1 for g in self.ghosts[1:]) >= left:
+                del self.ghosts[0]
+        if stream.skew:
+            recent = m._recent
+            for i in at[-recent.maxlen:].tolist():
+                ev = chunk[i + 1]
+                recent.append((ev, ev.time, {okey: ev.fields[ofield]}, _EMPTY))
+        values = m.values
+        for k in keys:
+            values[k] = newest.inputs[k]
+            m.invalid.pop(k, None)
+        values[okey] = newest.answer[okey]
+        m.invalid.pop(okey, None)
+        m._open, m._due = newest, newest.due
+        last_out = chunk[int(at[-1]) + 1]
+        if last_out.time > m.now:
+            m.now = last_out.time
+
+
+__all__ = ["CHUNK", "BatchPlan", "batch_plan", "check_batch"]
