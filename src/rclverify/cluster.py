@@ -24,6 +24,7 @@ from __future__ import annotations
 import hashlib
 import json
 import os
+import warnings
 from pathlib import Path
 from typing import Any
 
@@ -83,7 +84,12 @@ def remote_run(root: str, plan_file: str, key: str, node: str, obligation_id: st
         _WORKER_WORKSPACES[(root, plan_file, key)] = ws
     o = Obligation.from_json(read_json(ws.path(ws.obligation(node, obligation_id))))
     fresh_z3()  # as a local run does (pipeline.stage_run): the same Z3 state for every job
-    ev = get_backend(o.backend).run(o, ws.target(node, int(o.data.get("entry", 0))))
+    with warnings.catch_warnings():
+        # the worker's own threads (Dask's heartbeats) draw from `random` while a property test generates
+        # its examples, and Hypothesis takes that for a strategy using `random` (ours do not: a local run
+        # never warns); the warning would print the whole workspace's repr in the worker's log
+        warnings.filterwarnings("ignore", message="Do not use the `random` module inside strategies")
+        ev = get_backend(o.backend).run(o, ws.target(node, int(o.data.get("entry", 0))))
     return json.dumps(ev.to_json())
 
 
