@@ -42,7 +42,11 @@ double solutions).  Under double and tolerance a quantifier is therefore
 enumerated over a finite domain only: ``BOOL``, an enumeration, a finite
 set, an ``INTEGER``/``NATURAL`` variable bounded by literal guards
 (``k <= 12 -> ...``), or a numeric variable the body never mentions; any
-other quantifier is undecided there.  A formula whose evaluation cannot
+other quantifier is undecided there, except, under double, a ``REAL``/``INTEGER``/``NATURAL``
+variable whose body changes truth only at finitely many points computable from the values
+(table keys, the terms it is compared with): it is decided exactly at those candidate points
+and one point in each gap (:mod:`rclverify.logic.candidates`; a ``REAL`` ranges over the
+doubles there).  A formula whose evaluation cannot
 differ between exact and double (no rounding arithmetic, every literal a
 double) is not evaluated again (:func:`float_sensitive`).
 
@@ -66,6 +70,7 @@ import z3
 from ..rcl import ast
 from ..rcl import types as T
 from ..rcl.types import Checked, CheckedNode
+from .candidates import quantify
 from .concrete import check_concrete
 from .encode import EncodingError
 from .eval_shapes import MAX_RANGE, _integer_range, _unused
@@ -297,7 +302,8 @@ class _Double(Evaluator):
         return bool(_CMP[op](_double(x), _double(y)))
 
     def quant(self, e: ast.Quant, b: Mapping[str, Any]) -> bool:
-        return _enumerate(self, e, b)
+        got = quantify(self, e, b, _finite_domain, MAX_ENUMERATION)
+        return _enumerate(self, e, b) if got is None else got
 
 
 class _Tolerant(Evaluator):
