@@ -32,6 +32,8 @@ CLAUSES = [
     "exists(k in NATURAL | in.c == ins(k + 1))",
     "exists_unique(i in INTEGER | in.a < i and i < in.a + 2)",
     "exists_unique(i in INTEGER | i < in.n)",
+    "exists_unique(i in INTEGER | i > in.n)",
+    "exists_unique(x in REAL | x < in.a and in.f(x) == 0)",
     "forall(x in REAL | x in {0.5, 1, in.a} -> in.g(x, x) or in.f(x) > 0)",
     "forall(x, y in REAL | in.g(x, y) -> exists(z in REAL | in.g(y, z) and not in.g(z, x)))",
     "exists(i in INTEGER | forall(x in REAL | in.f(x) != i + 1) and in.h(i) == 0)",

@@ -25,10 +25,12 @@ from __future__ import annotations
 from fractions import Fraction
 from typing import Any
 
+from ..logic.candidates import NotInFragment, analyse
 from ..logic.eval_shapes import MAX_RANGE, _integer_range, _unused
 from ..logic.floatsem import MAX_ENUMERATION
 from ..rcl import ast
 from ..rcl.types import EnumT, Scalar
+from .cpp_candidates import candidate_code
 from .cpp_common import Untranslatable, enum_const
 
 
@@ -47,10 +49,17 @@ def quantifier(tr: Any, e: ast.Quant) -> tuple[str, str]:
     ``notes``); raises :class:`.cpp_common.Untranslatable`."""
     loops: list[tuple[str, str, Any]] = []  # (C++ name, kind, domain: ("values", [code]) | ("range", lo, hi))
     size = 1
+    names = [n for bd in e.bindings for n in bd.names]
+    k = 0
     try:
         for bd in e.bindings:
             for n in bd.names:
-                dom = _domain(tr, e, bd, n)
+                k += 1
+                try:
+                    dom = _domain(tr, e, bd, n)
+                except _Undecided as why:  # the double reading's candidate points, where they decide
+                    loops.append((n, *_candidates(tr, e, bd, n, names[k:], why)))
+                    continue
                 if dom is None:  # unused: the body's value is the same for every value of it
                     continue
                 kind, spec = dom
@@ -61,6 +70,8 @@ def quantifier(tr: Any, e: ast.Quant) -> tuple[str, str]:
     except _Undecided as why:
         tr.notes.append(str(why))
         return f"rclverify_rt::undecided({_c_string(str(why))})", "bool"
+    if any(kind.startswith("cand:") for _, kind, _ in loops):
+        return candidate_code(tr, e, loops, cpp_ident, _CTYPES)
     saved = dict(tr.bound)
     try:
         for n, kind, _ in loops:
@@ -92,6 +103,27 @@ def quantifier(tr: Any, e: ast.Quant) -> tuple[str, str]:
 
 
 _CTYPES = {"int": "std::int64_t", "bool": "bool", "enum": "std::uint8_t", "double": "double"}
+
+
+def _candidates(tr: Any, e: ast.Quant, bd: ast.Binding, name: str, later: list[str],
+                why: _Undecided) -> tuple[str, Any]:
+    """``("cand:<NUMERIC>", sources)`` of a variable over an unbounded numeric domain (double reading
+    only: the tolerance reading enumerates finite domains only); raises :class:`_Undecided`."""
+    numeric = _numeric(tr, bd.domain)
+    if tr.mode != "double" or numeric is None or "without a literal bound" not in str(why):
+        raise why
+    try:
+        return f"cand:{numeric}", analyse(e.body, name, numeric, frozenset(later), tr.env)
+    except NotInFragment as nf:
+        raise _Undecided(f"{why}, and not by candidate points: {nf}") from None
+
+
+def _numeric(tr: Any, dom: Any) -> str | None:
+    name = dom.name if isinstance(dom, ast.TBase) else None
+    if isinstance(dom, ast.TName):
+        t = tr.env.types.get(dom.name)
+        name = t.name if isinstance(t, Scalar) else None
+    return name if name in ("REAL", "INTEGER", "NATURAL") else None
 
 
 def _count(spec: tuple[Any, ...]) -> int:
