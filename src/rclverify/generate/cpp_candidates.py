@@ -62,8 +62,9 @@ def _level(tr: Any, kind_q: str, n: str, kind: str, spec: Any, inner: str, cpp_i
         real = numeric == "REAL"
         setup = f"std::vector<{'double' if real else 'std::int64_t'}> q_bp; " + "".join(
             _push(tr, s, real) for s in spec)
-        points = "rclverify_rt::real_points(q_bp)" if real else \
-            f"rclverify_rt::int_points(q_bp, {'true' if numeric == 'NATURAL' else 'false'})"
+        eq = "true" if all(s.eq for s in spec) else "false"
+        points = f"rclverify_rt::real_points(q_bp, {eq})" if real else \
+            f"rclverify_rt::int_points(q_bp, {'true' if numeric == 'NATURAL' else 'false'}, {eq})"
         ctype = "double" if real else "std::int64_t"
         loop = (f"for (const auto & q_pt : {points}) {{ const {ctype} {v} = q_pt.first; const int q_m = q_pt.second; "
                 f"static_cast<void>({v}); static_cast<void>(q_m); const int q_c = {inner}; {step} }}")

@@ -80,6 +80,9 @@ class Source:
     shift: int = 0
     #: ``expr`` reads variables bound inside the scope: a table application, its results count
     table: bool = False
+    #: the variable meets these points by equality only (a key, ``==``/``!=``, a constructor
+    #: argument, membership): off the points it is the same everywhere
+    eq: bool = True
 
 
 _PLANS: dict[tuple[int, str, frozenset[str]], tuple[Any, Any]] = {}
@@ -137,15 +140,16 @@ class _Scan:
             return None
         return s + c if e.op == "+" else s - c
 
-    def valued(self, t: Any, inner: frozenset[str], kind: str, pos: int = 0, ctor: str = "", shift: int = 0) -> None:
+    def valued(self, t: Any, inner: frozenset[str], kind: str, pos: int = 0, ctor: str = "", shift: int = 0,
+               eq: bool = True) -> None:
         """Breakpoints from the values of ``t`` (a term without ``v``)."""
         if self.mentions(t, inner):
             raise NotInFragment(f"{self.v} is compared with a term that reads it")
         if self.known(t, inner):
-            self.out.append(Source(kind, t, pos, ctor, shift))
+            self.out.append(Source(kind, t, pos, ctor, shift, eq=eq))
             return
         if kind != "elems" and isinstance(t, ast.Apply) and self._table(t) and self.known(t.func, inner):
-            self.out.append(Source(kind, t, pos, ctor, shift, table=True))
+            self.out.append(Source(kind, t, pos, ctor, shift, table=True, eq=eq))
             return
         raise NotInFragment(f"{self.v} is compared with a term of variables bound inside its scope")
 
@@ -214,7 +218,7 @@ class _Scan:
         for a, b in ((left, right), (right, left)):
             s = self.ident(a, inner)
             if s is not None:
-                self.valued(b, inner, "values", shift=s)
+                self.valued(b, inner, "values", shift=s, eq=op in ("==", "!="))
                 return
             if isinstance(a, ast.Apply) and not self._table(a) and self.mentions(a, inner):
                 if op not in ("==", "!="):
@@ -305,9 +309,15 @@ def _exact(x: Any, numeric: str) -> Any:
     return x
 
 
-def points(bps: list[Any], numeric: str) -> Iterator[tuple[Any, int]]:
+def points(bps: list[Any], numeric: str, eq: bool = False) -> Iterator[tuple[Any, int]]:
     """The candidate points, ascending, each with how many values of the domain it stands
-    for (1, or :data:`MANY` for two and more): the breakpoints and one point in each gap."""
+    for (1, or :data:`MANY` for two and more): the breakpoints and one point in each gap.
+    ``eq`` (every source an equality): the breakpoints, then one point above them (below when
+    there is no double above) standing for every other value (always many: the domain is
+    infinite, the breakpoints finite), where the body is the same everywhere."""
+    if eq:
+        yield from _eq_points(bps, numeric)
+        return
     if numeric == "REAL":
         ps = sorted({float(x) for x in bps})
         if any(not math.isfinite(p) for p in ps):
@@ -348,6 +358,25 @@ def points(bps: list[Any], numeric: str) -> Iterator[tuple[Any, int]]:
         if k + 1 < len(zs) and zs[k + 1] - z >= 2:
             yield z + 1, min(zs[k + 1] - z - 1, MANY)
     yield zs[-1] + 1, MANY
+
+
+def _eq_points(bps: list[Any], numeric: str) -> Iterator[tuple[Any, int]]:
+    if numeric == "REAL":
+        ps = sorted({float(x) for x in bps})
+        if any(not math.isfinite(p) for p in ps):
+            raise Undecided("a breakpoint is not a finite number")
+        yield from ((p, 1) for p in ps)
+        if not ps:
+            yield 0.0, MANY
+            return
+        hi = ps[-1] + 1.0 if ps[-1] + 1.0 > ps[-1] else math.nextafter(ps[-1], math.inf)
+        lo = ps[0] - 1.0 if ps[0] - 1.0 < ps[0] else math.nextafter(ps[0], -math.inf)
+        yield (hi if math.isfinite(hi) else lo), MANY
+        return
+    ints = {math.floor(x) for x in bps} | {math.ceil(x) for x in bps}
+    zs = sorted(z for z in ints if numeric == "INTEGER" or z >= 0)
+    yield from ((z, 1) for z in zs)
+    yield (zs[-1] + 1 if zs else 0), MANY
 
 
 def _between(a: float, b: float) -> int:
@@ -412,7 +441,7 @@ def quantify(ev: Any, e: ast.Quant, b: Mapping[str, Any], finite_domain: Any, ma
             return 1 if ev.eval(e.body, cur) else 0
         name, dom, cand = slots[j]
         items: Any = ((x, 1) for x in dom) if dom is not None else \
-            points(breakpoints(ev, cand[1], cur, cand[0]), cand[0])
+            points(breakpoints(ev, cand[1], cur, cand[0]), cand[0], all(s.eq for s in cand[1]))
         count = 0
         for x, mult in items:
             nxt = dict(cur)
