@@ -18,7 +18,7 @@ from typing import Any, Mapping
 
 from ..logic.floatsem import Tolerance
 from ..rcl.printer import expr_to_rcl
-from ..logic.candidates import MAX_CANDIDATE_STEPS
+from ..logic.candidate_points import MAX_CANDIDATE_STEPS
 from ..rcl.types import Checked, CheckedNode, DataT, EnumT, FuncT
 from .cpp_common import Untranslatable, enum_const
 from .cpp_expr import CppTranslator, cpp_type

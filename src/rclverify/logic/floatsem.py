@@ -45,7 +45,7 @@ set, an ``INTEGER``/``NATURAL`` variable bounded by literal guards
 other quantifier is undecided there, except, under double, a ``REAL``/``INTEGER``/``NATURAL``
 variable whose body changes truth only at finitely many points computable from the values
 (table keys, the terms it is compared with): it is decided exactly at those candidate points
-and one point in each gap (:mod:`rclverify.logic.candidates`; a ``REAL`` ranges over the
+and one point in each gap (:mod:`rclverify.logic.candidates`, :mod:`rclverify.logic.candidate_points`; a ``REAL`` ranges over the
 doubles there).  A formula whose evaluation cannot
 differ between exact and double (no rounding arithmetic, every literal a
 double) is not evaluated again (:func:`float_sensitive`).
@@ -70,7 +70,7 @@ import z3
 from ..rcl import ast
 from ..rcl import types as T
 from ..rcl.types import Checked, CheckedNode
-from .candidates import quantify
+from .candidate_points import quantify
 from .concrete import check_concrete
 from .encode import EncodingError
 from .eval_shapes import MAX_RANGE, _integer_range, _unused
