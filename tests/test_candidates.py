@@ -36,6 +36,8 @@ CLAUSES = [
     "exists_unique(i in INTEGER | i > in.n)",
     "exists_unique(x in REAL | x < in.a and in.f(x) == 0)",
     "exists_unique(i in INTEGER | in.h(i) == 2)",
+    "forall(b in BOOL, x in REAL | b -> in.f(x) <= in.n or in.g(x, in.a))",
+    "exists_unique(m in {0, 1}, x in REAL | in.f(x) == m + 1)",
     "forall(x in REAL | x in {0.5, 1, in.a} -> in.g(x, x) or in.f(x) > 0)",
     "forall(x, y in REAL | in.g(x, y) -> exists(z in REAL | in.g(y, z) and not in.g(z, x)))",
     "exists(i in INTEGER | forall(x in REAL | in.f(x) != i + 1) and in.h(i) == 0)",
@@ -62,7 +64,8 @@ class _Grid(floatsem._Double):
         for bd in e.bindings:
             for n in bd.names:
                 names.append(n)
-                doms.append(GRID[bd.domain.name])
+                doms.append(GRID[bd.domain.name] if isinstance(bd.domain, ast.TBase) and bd.domain.name != "BOOL"
+                            else [False, True] if isinstance(bd.domain, ast.TBase) else list(self.collection(bd.domain, b)))
         hits = 0
         for combo in itertools.product(*doms):
             holds = bool(self.eval(e.body, dict(b) | dict(zip(names, combo))))

@@ -30,7 +30,7 @@ def test_candidate_points_in_cpp_are_the_double_readings(tmp_path: Path) -> None
     out = ws / "gen"
     assert main(["generate", "ros2", "-w", str(ws), "-o", str(out), "--lang", "cpp"]) == 0
     header = (out / "q" / "include" / "q" / "contract_checks.hpp").read_text()
-    assert "// not translated" not in header and header.count("rclverify_rt::real_points(q_bp, ") >= 10, header
+    assert "// not translated" not in header and header.count("rclverify_rt::real_points(cand_bp, ") >= 10, header
     src = tmp_path / "q.cpp"
     src.write_text('#include "q/contract_driver.hpp"\n#include <iostream>\n'
                    "int main() { return q::drive(std::cin, std::cout); }\n")

@@ -37,63 +37,63 @@ def candidate_code(tr: Any, e: ast.Quant, loops: list[tuple[str, str, Any]], cpp
         body, bkind = tr.expr(e.body)
         if bkind != "bool":
             raise Untranslatable(f"a quantifier body of type {bkind}")
-        code = f"(rclverify_rt::candidate_step(q_steps) && ({body}) ? 1 : 0)"
+        code = f"(rclverify_rt::candidate_step(cand_steps) && ({body}) ? 1 : 0)"
         for n, kind, spec in reversed(loops):
             code = _level(tr, e.kind, n, kind, spec, code, cpp_ident, ctypes)
     finally:
         tr.bound.clear()
         tr.bound.update(saved)
-    return f"([&]() -> bool {{ std::int64_t q_steps = 0; return {code} == 1; }}())", "bool"
+    return f"([&]() -> bool {{ std::int64_t cand_steps = 0; return {code} == 1; }}())", "bool"
 
 
 def _level(tr: Any, kind_q: str, n: str, kind: str, spec: Any, inner: str, cpp_ident: Any,
            ctypes: dict[str, str]) -> str:
     v = cpp_ident(n)
     if kind_q == "forall":
-        step = "if (q_c == 0) { return 0; }"
+        step = "if (cand_c == 0) { return 0; }"
     elif kind_q == "exists":
-        step = "if (q_c != 0) { return 1; }"
+        step = "if (cand_c != 0) { return 1; }"
     else:
-        step = ("q_n = std::min(q_n + q_c * q_m, rclverify_rt::kMany); "
-                "if (q_n >= rclverify_rt::kMany) { return rclverify_rt::kMany; }")
-    end = "return 1;" if kind_q == "forall" else "return q_n;"
+        step = ("cand_n = std::min(cand_n + cand_c * cand_m, rclverify_rt::kMany); "
+                "if (cand_n >= rclverify_rt::kMany) { return rclverify_rt::kMany; }")
+    end = "return 1;" if kind_q == "forall" else "return cand_n;"
     if kind.startswith("cand:"):
         numeric = kind[5:]
         real = numeric == "REAL"
-        setup = f"std::vector<{'double' if real else 'std::int64_t'}> q_bp; " + "".join(
+        setup = f"std::vector<{'double' if real else 'std::int64_t'}> cand_bp; " + "".join(
             _push(tr, s, real) for s in spec)
         eq = "true" if all(s.eq for s in spec) else "false"
-        points = f"rclverify_rt::real_points(q_bp, {eq})" if real else \
-            f"rclverify_rt::int_points(q_bp, {'true' if numeric == 'NATURAL' else 'false'}, {eq})"
+        points = f"rclverify_rt::real_points(cand_bp, {eq})" if real else \
+            f"rclverify_rt::int_points(cand_bp, {'true' if numeric == 'NATURAL' else 'false'}, {eq})"
         ctype = "double" if real else "std::int64_t"
-        loop = (f"for (const auto & q_pt : {points}) {{ const {ctype} {v} = q_pt.first; const int q_m = q_pt.second; "
-                f"static_cast<void>({v}); static_cast<void>(q_m); const int q_c = {inner}; {step} }}")
+        loop = (f"for (const auto & cand_pt : {points}) {{ const {ctype} {v} = cand_pt.first; const int cand_m = cand_pt.second; "
+                f"static_cast<void>({v}); static_cast<void>(cand_m); const int cand_c = {inner}; {step} }}")
     else:
         setup = ""
         ctype = ctypes[kind.split(":")[0]]
-        body = f"const int q_m = 1; static_cast<void>(q_m); const int q_c = {inner}; {step}"
+        body = f"const int cand_m = 1; static_cast<void>(cand_m); const int cand_c = {inner}; {step}"
         if spec[0] == "range":
             loop = f"for ({ctype} {v} = {spec[1]}; {v} <= {spec[2]}; ++{v}) {{ {body} }}"
         elif spec[1]:
             loop = f"for (const {ctype} {v} : {{{', '.join(spec[1])}}}) {{ static_cast<void>({v}); {body} }}"
         else:
             loop = ""
-    return f"[&]() -> int {{ int q_n = 0; static_cast<void>(q_n); {setup}{loop} {end} }}()"
+    return f"[&]() -> int {{ int cand_n = 0; static_cast<void>(cand_n); {setup}{loop} {end} }}()"
 
 
 def _push(tr: Any, s: Source, real: bool) -> str:
-    """C++ statements adding source ``s``'s breakpoints to ``q_bp``."""
+    """C++ statements adding source ``s``'s breakpoints to ``cand_bp``."""
     def push(x: str, kind: str) -> str:
         if kind not in _NUMERIC:
             return ""
         if s.shift:
             x = f"({x}) - {s.shift}" if kind == "int" else f"({x}) - {float(s.shift)!r}"
-        return f"q_bp.push_back(static_cast<double>({x})); " if real else f"rclverify_rt::int_breakpoint(q_bp, {x}); "
+        return f"cand_bp.push_back(static_cast<double>({x})); " if real else f"rclverify_rt::int_breakpoint(cand_bp, {x}); "
 
     if s.kind == "keys":
         code, kind = tr.var(s.expr)
         t = _func_type(tr, s.expr)
-        return f"for (const auto & q_row : {code}.rows) {{ {push(f'std::get<{s.pos}>(q_row.first)', _kind(t.args[s.pos]))}}} "
+        return f"for (const auto & cand_row : {code}.rows) {{ {push(f'std::get<{s.pos}>(cand_row.first)', _kind(t.args[s.pos]))}}} "
     if s.kind == "elems":
         if not isinstance(s.expr, ast.SetLit):
             raise Untranslatable("a quantified variable's membership in a set that is not a literal")
@@ -108,7 +108,7 @@ def _push(tr: Any, s: Source, real: bool) -> str:
         rk = _kind(_func_type(tr, s.expr.func).result)
         if rk not in _NUMERIC:
             return ""
-        return (f"for (const auto & q_row : {code}.rows) {{ {push('q_row.second', rk)}}} "
+        return (f"for (const auto & cand_row : {code}.rows) {{ {push('cand_row.second', rk)}}} "
                 + push(f"{code}.otherwise", rk))
     # ctor: a known term; its argument at pos when it is that constructor
     if s.table:
@@ -119,8 +119,8 @@ def _push(tr: Any, s: Source, real: bool) -> str:
         return ""
     index = [n for n, _ in data.ctors].index(s.ctor)
     arg = _kind(dict(data.ctors)[s.ctor][s.pos])
-    return (f"{{ const auto & q_t = {code}; if (q_t.ctor == {index}) {{ "
-            f"{push(f'q_t.{snake(s.ctor)}_{s.pos}', arg)}}} }} ")
+    return (f"{{ const auto & cand_t = {code}; if (cand_t.ctor == {index}) {{ "
+            f"{push(f'cand_t.{snake(s.ctor)}_{s.pos}', arg)}}} }} ")
 
 
 def _func_type(tr: Any, f: ast.Var) -> Any:

@@ -87,7 +87,7 @@ def quantifier(tr: Any, e: ast.Quant) -> tuple[str, str]:
     elif e.kind == "exists":
         step, end = "if (" + body + ") { return true; }", "return false;"
     else:
-        step, end = "if ((" + body + ") && ++q_count > 1) { return false; }", "return q_count == 1;"
+        step, end = "if ((" + body + ") && ++cand_count > 1) { return false; }", "return cand_count == 1;"
     code = step
     for n, kind, spec in reversed(loops):
         ctype = _CTYPES[kind.split(":")[0]]
@@ -98,7 +98,7 @@ def quantifier(tr: Any, e: ast.Quant) -> tuple[str, str]:
             code = f"for (const {ctype} {v} : {{{', '.join(spec[1])}}}) {{ static_cast<void>({v}); {code} }}"
         else:  # an empty domain: no assignment
             code = ""
-    count = "int q_count = 0; " if e.kind == "exists_unique" else ""
+    count = "int cand_count = 0; " if e.kind == "exists_unique" else ""
     return f"([&]() -> bool {{ {count}{code} {end} }}())", "bool"
 
 

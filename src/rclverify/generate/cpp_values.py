@@ -87,12 +87,12 @@ def parse_code(t: Type, var: str) -> str:
 
 def table_parse(t: FuncT, target: str) -> str:
     """C++ statements filling table ``target`` from the driver's text ``v``."""
-    args = ", ".join(parse_code(a, f"q_args[{k}]") for k, a in enumerate(t.args))
+    args = ", ".join(parse_code(a, f"cand_args[{k}]") for k, a in enumerate(t.args))
     return (f"{target} = {{}};\n"
-            f"        rclverify_rt::read_table(v, {len(t.args)}, [&](const std::vector<std::string> & q_args, "
-            f"const std::string & q_res) {{\n"
-            f"          if (q_args.empty()) {{\n            {target}.otherwise = {parse_code(t.result, 'q_res')};\n"
-            f"          }} else {{\n            {target}.set(std::make_tuple({args}), {parse_code(t.result, 'q_res')});\n"
+            f"        rclverify_rt::read_table(v, {len(t.args)}, [&](const std::vector<std::string> & cand_args, "
+            f"const std::string & cand_res) {{\n"
+            f"          if (cand_args.empty()) {{\n            {target}.otherwise = {parse_code(t.result, 'cand_res')};\n"
+            f"          }} else {{\n            {target}.set(std::make_tuple({args}), {parse_code(t.result, 'cand_res')});\n"
             f"          }}\n        }});")
 
 
