@@ -101,11 +101,7 @@ def points(bps: list[Any], numeric: str, eq: bool = False) -> Iterator[tuple[Any
         if math.isfinite(hi):
             yield hi, _between(ps[-1], math.inf)
         return
-    ints: set[int] = set()
-    for x in bps:
-        ints.add(math.floor(x))
-        ints.add(math.ceil(x))
-    zs = sorted(z for z in ints if numeric == "INTEGER" or z >= 0)
+    zs = _integers(bps, numeric)
     if not zs:
         yield 0, MANY
         return
@@ -133,10 +129,24 @@ def _eq_points(bps: list[Any], numeric: str) -> Iterator[tuple[Any, int]]:
         lo = ps[0] - 1.0 if ps[0] - 1.0 < ps[0] else math.nextafter(ps[0], -math.inf)
         yield (hi if math.isfinite(hi) else lo), MANY
         return
-    ints = {math.floor(x) for x in bps} | {math.ceil(x) for x in bps}
-    zs = sorted(z for z in ints if numeric == "INTEGER" or z >= 0)
+    zs = _integers(bps, numeric)
     yield from ((z, 1) for z in zs)
     yield (zs[-1] + 1 if zs else 0), MANY
+
+
+#: integer breakpoints beyond this are left undecided (the C++ checks hold 64-bit integers)
+INT_LIMIT = 2 ** 62
+
+
+def _integers(bps: list[Any], numeric: str) -> list[int]:
+    """The floor and ceiling of each breakpoint, ascending (``NATURAL``: from 0)."""
+    ints: set[int] = set()
+    for x in bps:
+        if not (math.isfinite(x) and -INT_LIMIT < x < INT_LIMIT):
+            raise Undecided(f"the breakpoint {x} is beyond 2**62")
+        ints.add(math.floor(x))
+        ints.add(math.ceil(x))
+    return sorted(z for z in ints if numeric == "INTEGER" or z >= 0)
 
 
 def _between(a: float, b: float) -> int:
