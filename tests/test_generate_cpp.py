@@ -12,6 +12,7 @@ reasons (not translated; true in exact arithmetic only; decided in exact arithme
 the test names and counts."""
 from __future__ import annotations
 
+import dataclasses
 import importlib.util
 import shutil
 import subprocess
@@ -407,6 +408,9 @@ def test_compiled_checks_agree_with_the_monitor_engine_on_every_node(built: dict
     out = py_trees[case]
     rules = load_mapping(out if case == "warehouse" else ws,
                          "rclverify_mapping.yaml" if case == "warehouse" else "backends/monitors/mapping.yaml").rules
+    if case == "case_study":  # the mapping gives wayPNow no default (unknown off its entries), which a C++ table
+        # cannot hold: the runs here read it with the default 0 (a mapping's `default: 0`)
+        rules = {t: dataclasses.replace(r, default=0) if t == "wayPNow" else r for t, r in rules.items()}
     stats = {"compared": 0, "inconclusive in C++": 0, "readings differ": 0, "an output with no message": 0, "a table with no default": 0}
     kinds: set[str] = set()
     for node_name, cn in checked.nodes.items():
@@ -473,7 +477,7 @@ def test_compiled_checks_agree_with_the_monitor_engine_on_every_node(built: dict
     if case == "warehouse":
         assert stats["compared"] >= 45 and {"satisfied", "violated", "assumption violated"} <= kinds, (stats, kinds)
     else:  # the quantified guarantees decided at candidate points: C++ decides every run and agrees with
-        # the engine; the Agent's wayP is read with no default (the mapping's), which C++ cannot hold
+        # the engine
         print(case, stats, sorted(kinds))
-        assert stats["inconclusive in C++"] == 0 and stats["compared"] >= 20, (stats, kinds)
+        assert stats["inconclusive in C++"] == 0 and stats["compared"] == 32, (stats, kinds)
         assert {"satisfied", "violated", "assumption violated"} <= kinds, (stats, kinds)
