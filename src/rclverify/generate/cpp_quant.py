@@ -6,9 +6,12 @@ reading enumerates a quantifier over a finite domain only (floatsem's module doc
 variable bounded by literal guards (``forall(i in NATURAL | i <= 12 -> ...)``, the range
 ``eval_shapes._integer_range`` reads, at most ``MAX_RANGE`` values), or a numeric variable the
 body never mentions (``forall``/``exists`` only); at most ``MAX_ENUMERATION`` assignments in
-all.  Any other quantifier (a ``REAL`` variable the body reads, an unbounded integer) is
-*undecided* there, and so here: its code throws ``rclverify_rt::Undecided`` with the reason,
-before the body (the body is not translated: the reading never evaluates it).
+all.  A ``REAL``/``INTEGER``/``NATURAL`` variable with no literal bound is decided, in the double
+reading only, at its candidate points (``logic/candidates.py``; the loops are
+:mod:`.cpp_candidates`'s).  Any other quantifier (a variable in arithmetic, compared with a term
+of inner variables, ...) is *undecided* there, and so here: its code throws
+``rclverify_rt::Undecided`` with the reason, before the body (the body is not translated: the
+reading never evaluates it).
 
 Each translated quantifier is an immediately invoked lambda looping over the domains in
 binding order (the first name outermost, as ``itertools.product``), with the double reading's
