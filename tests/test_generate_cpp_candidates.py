@@ -43,7 +43,7 @@ def test_candidate_points_in_cpp_are_the_double_readings(tmp_path: Path) -> None
 
     @settings(max_examples=2, deadline=None, database=None, derandomize=True,
               phases=[Phase.explicit, Phase.generate])
-    @given(st.lists(_values(), min_size=40, max_size=40))
+    @given(st.lists(_values(), min_size=30, max_size=30))
     def agree(batch: list) -> None:
         batch = SHARP + batch
         lines = [" ".join(_text(q, v, io[q]) for q, v in vals.items()) for vals in batch]

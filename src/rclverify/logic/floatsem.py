@@ -277,14 +277,21 @@ def _double(x: Any) -> Any:
     return float(x) if type(x) is Fraction else x
 
 
+#: a literal's text -> its value in the double reading (parsed once)
+_DOUBLE_LITERALS: dict[str, Any] = {}
+
+
 class _Double(Evaluator):
     """The formula in IEEE-754 binary64 arithmetic (module docstring)."""
 
     mode = "double"
 
     def literal(self, e: ast.NumLit) -> Any:
-        v = e.value
-        return int(v) if v.denominator == 1 else float(v)
+        hit = _DOUBLE_LITERALS.get(e.text)
+        if hit is None:
+            v = e.value
+            hit = _DOUBLE_LITERALS[e.text] = int(v) if v.denominator == 1 else float(v)
+        return hit
 
     def arith(self, op: str, x: Any, y: Any) -> Any:
         x, y = _double(x), _double(y)
