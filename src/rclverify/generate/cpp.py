@@ -98,7 +98,9 @@ class Clause:
     @property
     def reason(self) -> str:
         """The inconclusive verdict's reason, a C++ string literal's contents."""
-        r = f"not translated to C++: {self.why}" if self.why else "; ".join(self.notes + ["division by zero"])
+        extra = [f"a candidate point out of range or more than {MAX_CANDIDATE_STEPS} candidate evaluations"] \
+            if "candidate_step" in self.double else []
+        r = f"not translated to C++: {self.why}" if self.why else "; ".join(self.notes + ["division by zero"] + extra)
         return r.replace("\\", "\\\\").replace('"', '\\"')
 
 
