@@ -18,9 +18,11 @@ from typing import Any, Mapping
 
 from ..logic.floatsem import Tolerance
 from ..rcl.printer import expr_to_rcl
-from ..rcl.types import Checked, CheckedNode, EnumT
+from ..logic.candidate_points import MAX_CANDIDATE_STEPS
+from ..rcl.types import Checked, CheckedNode, DataT, EnumT, FuncT
 from .cpp_common import Untranslatable, enum_const
 from .cpp_expr import CppTranslator, cpp_type
+from .cpp_values import data_types, parse_code, table_parse, term_fields
 from .nodes import NodePackage
 from .typemap import camel, snake
 from .wiring import wires
@@ -45,7 +47,20 @@ class CField:
             return f'({ref} ? "TRUE" : "FALSE")'
         if isinstance(self.t, EnumT):
             return f"static_cast<int>({ref})"
+        if isinstance(self.t, FuncT):
+            return f"rclverify_rt::show_table({ref})"
+        if isinstance(self.t, DataT):
+            return f"show_{snake(self.t.name)}({ref})"
         return ref
+
+    @property
+    def fill(self) -> str:
+        """C++ statements setting the field from the driver's text ``v``."""
+        if isinstance(self.t, FuncT):
+            return table_parse(self.t, f"{self.side}.{self.field}")
+        if isinstance(self.t, DataT):
+            return f"{self.side}.{self.field} = {parse_code(self.t, 'v')};"
+        return f"{self.side}.{self.field} = {self.parse};"
 
     @property
     def parse(self) -> str:
@@ -83,7 +98,9 @@ class Clause:
     @property
     def reason(self) -> str:
         """The inconclusive verdict's reason, a C++ string literal's contents."""
-        r = f"not translated to C++: {self.why}" if self.why else "; ".join(self.notes + ["division by zero"])
+        extra = [f"a candidate point out of range or more than {MAX_CANDIDATE_STEPS} candidate evaluations"] \
+            if "candidate_step" in self.double else []
+        r = f"not translated to C++: {self.why}" if self.why else "; ".join(self.notes + ["division by zero"] + extra)
         return r.replace("\\", "\\\\").replace('"', '\\"')
 
 
@@ -100,6 +117,8 @@ class Checks:
     skipped_in: list[str] = field(default_factory=list)
     skipped_out: list[str] = field(default_factory=list)
     enums: list[Any] = field(default_factory=list)
+    #: the constructor sets held as ``Term<Name>`` (:func:`.cpp_values.term_fields`)
+    terms: list[dict[str, Any]] = field(default_factory=list)
     clauses: list[Clause] = field(default_factory=list)
     tolerance: dict[str, Any] | None = None
     tolerance_text: str = ""
@@ -138,6 +157,10 @@ def checks_of(checked: Checked, cn: CheckedNode, namespace: str, tolerance: Tole
         enums.setdefault(t.name, t)
     c.enums = [_Enum(t.name, snake(t.name), [(v, enum_const(t, v)) for v in t.values])
                for t in sorted(enums.values(), key=lambda t: t.name)]
+    c.terms = [dict(term_fields(t), fn=snake(t.name),
+                    parse=[(k["name"], len(k["args"]), k["fn"],
+                            [parse_code(a, f"q_a[{j}]") for j, a in enumerate(dict(t.ctors)[k["name"]])])
+                           for k in term_fields(t)["ctors"]]) for t in data_types(checked)]
     c.triggers = [""] + [f"in.{g.trigger.name}" if g.trigger is not None else "" for g in cn.node.guarantees]
     dbl = CppTranslator(checked, cn, "double")
     tol = CppTranslator(checked, cn, "tolerance")
@@ -173,7 +196,8 @@ def _cpp_type(ros_type: str, kind: str) -> str:
 def node_context(checked: Checked, np: NodePackage, c: Checks, rules: Mapping[str, Any] | None) -> dict[str, Any]:
     """The template context of ``src/<pkg>_node.cpp``: ``ends`` (each end with its C++ type and the
     struct fields it reads into and writes from, by field path), ``headers``, ``deps``."""
-    held = {f"{f.side}.{f.var}": f.field for f in c.inputs + c.outputs}
+    # tables and terms are filled by the driver, not from messages (docs/generate.md)
+    held = {f"{f.side}.{f.var}": f.field for f in c.inputs + c.outputs if not isinstance(f.t, (FuncT, DataT))}
     ws = [w for w in wires(np, rules) if w.path and w.var in held]
     ends = []
     headers: set[str] = set()
@@ -197,7 +221,7 @@ def cpp_package(checked: Checked, cn: CheckedNode, np: NodePackage, env: Any, ma
     text, rendered with jinja2 environment ``env``."""
     d = np.package
     c = checks_of(checked, cn, d, tolerance)
-    ctx = dict(marker=marker, np=np, c=c, qos_depth=qos_depth, guard=c.guard.replace("__CONTRACT_CHECKS_HPP_", ""),
+    ctx = dict(marker=marker, np=np, c=c, qos_depth=qos_depth, max_candidate_steps=MAX_CANDIDATE_STEPS, guard=c.guard.replace("__CONTRACT_CHECKS_HPP_", ""),
                **node_context(checked, np, c, rules))
     gen = {
         f"{d}/include/{d}/contract_checks.hpp": env.get_template("cpp_checks.hpp.j2").render(ctx),

@@ -24,17 +24,20 @@ literals, enumeration values, context constants, ``not``, unary ``-``,
 ``and or -> <=>``, ``+ - * /`` (``/`` by zero is undecided, as in
 rclverify), chained comparisons, membership in a literal set, and
 quantifiers as the double reading enumerates them (:mod:`.cpp_quant`: loops
-over finite domains; an unbounded one undecided with its reason).
-Anything else (functions, constructor terms, sets and sequences as values,
+over finite domains and over candidate points; anything else undecided with its reason).
+Function tables and constructor terms of scalar and enumeration arguments
+(:mod:`.cpp_values`): a table applied, a term built and compared with ``==``/``!=``.
+Anything else (functions not applied, sets and sequences as values,
 tuples, strings) raises :class:`Untranslatable`: the clause's check then
 answers *undecided* (the monitor's ``inconclusive``), never a guess.
 """
 from __future__ import annotations
 
 from ..rcl import ast
-from ..rcl.types import Checked, CheckedNode, EnumT, Scalar, Type
+from ..rcl.types import Checked, CheckedNode, DataT, EnumT, FuncT, Scalar, Type
 from .cpp_common import Untranslatable, enum_const
 from .cpp_quant import quantifier
+from .cpp_values import kind_of, table_type, term_struct
 from .typemap import snake
 
 #: RCL scalar -> C++ type of the struct field
@@ -47,6 +50,10 @@ def cpp_type(t: Type) -> str | None:
         return CPP_SCALARS.get(t.name)
     if isinstance(t, EnumT):
         return "std::uint8_t"
+    if isinstance(t, FuncT):
+        return table_type(t)
+    if isinstance(t, DataT):
+        return term_struct(t)
     return None
 
 
@@ -95,6 +102,8 @@ class CppTranslator:
             return self.member(e)
         if isinstance(e, ast.Quant):
             return quantifier(self, e)
+        if isinstance(e, ast.Apply):
+            return self.apply(e)
         raise Untranslatable(_CONSTRUCTS.get(type(e).__name__, type(e).__name__))
 
     def var(self, v: ast.Var) -> tuple[str, str]:
@@ -106,6 +115,8 @@ class CppTranslator:
         if v.prefix is None and v.name in self.env.constants:
             code, kind = self.expr(self.env.constants[v.name][1])
             return f"({code})", kind
+        if v.prefix is None and v.name in self.env.ctors:
+            return self.apply(ast.Apply(v, (), v.loc))
         if v.prefix in ("in", "out"):
             side, name = v.prefix, v.name
         elif v.prefix is None and (v.name in self.node.inputs or v.name in self.node.outputs):
@@ -124,7 +135,44 @@ class CppTranslator:
             return field, "bool"
         if isinstance(t, EnumT):
             return field, f"enum:{t.name}"
+        if isinstance(t, DataT) and term_struct(t) is not None:
+            return field, f"term:{t.name}"
+        if isinstance(t, FuncT) and table_type(t) is not None:
+            return field, "table"
         raise Untranslatable(f"{side}.{name} of type {t}")
+
+    def apply(self, e: ast.Apply) -> tuple[str, str]:
+        """A constructor term (``TermX::make_<ctor>(args)``) or a table application
+        (``in.f(args)``), each argument converted to the declared type."""
+        f = e.func
+        if f.prefix is None and f.name in self.env.ctors and f.name not in self.bound:
+            t = self.env.ctors[f.name]
+            struct = term_struct(t)
+            if struct is None:
+                raise Untranslatable(f"a constructor term of {t.name} (an argument not held here)")
+            types = dict(t.ctors)[f.name]
+            args = [self._arg(a, at) for a, at in zip(e.args, types)]
+            return f"{struct}::make_{snake(f.name)}({', '.join(args)})", f"term:{t.name}"
+        code, kind = self.var(f)
+        if kind != "table":
+            raise Untranslatable(f"an application of {f.qualified}")
+        t = (self.node.inputs if (f.prefix == "in" or (f.prefix is None and f.name in self.node.inputs))
+             else self.node.outputs)[f.name]
+        rk = kind_of(t.result)
+        if rk is None:
+            raise Untranslatable(f"a function result of type {t.result}")
+        args = [self._arg(a, at) for a, at in zip(e.args, t.args)]
+        return f"{code}({', '.join(args)})", rk
+
+    def _arg(self, a: ast.Expr, t: Type) -> str:
+        """Argument ``a`` as the C++ type of declared type ``t``."""
+        code, kind = self.expr(a)
+        want = kind_of(t)
+        if want == kind:
+            return code
+        if want == "double" and kind == "int":
+            return f"static_cast<double>({code})"
+        raise Untranslatable(f"an argument of kind {kind} where {t} is declared")
 
     def binary(self, e: ast.Binary) -> tuple[str, str]:
         (lc, lk), (rc, rk) = self.expr(e.left), self.expr(e.right)
@@ -164,7 +212,11 @@ class CppTranslator:
         tests = []
         for item in e.collection.items:
             ic, ik = self.expr(item)
-            if ik != kind or kind == "double" or kind == "int":
+            if kind in ("int", "double") and ik in ("int", "double"):  # exact ==, as the set's (no tolerance)
+                tests.append(f"{code} == {ic}" if ik == kind else
+                             f"static_cast<double>({code}) == static_cast<double>({ic})")
+                continue
+            if ik != kind:
                 raise Untranslatable(f"membership of {kind} in a set of {ik}")
             tests.append(f"{code} == {ic}")
         body = "(" + (" || ".join(tests) or "false") + ")"

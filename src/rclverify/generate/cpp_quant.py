@@ -6,9 +6,12 @@ reading enumerates a quantifier over a finite domain only (floatsem's module doc
 variable bounded by literal guards (``forall(i in NATURAL | i <= 12 -> ...)``, the range
 ``eval_shapes._integer_range`` reads, at most ``MAX_RANGE`` values), or a numeric variable the
 body never mentions (``forall``/``exists`` only); at most ``MAX_ENUMERATION`` assignments in
-all.  Any other quantifier (a ``REAL`` variable the body reads, an unbounded integer) is
-*undecided* there, and so here: its code throws ``rclverify_rt::Undecided`` with the reason,
-before the body (the body is not translated: the reading never evaluates it).
+all.  A ``REAL``/``INTEGER``/``NATURAL`` variable with no literal bound is decided, in the double
+reading only, at its candidate points (``logic/candidates.py``; the loops are
+:mod:`.cpp_candidates`'s).  Any other quantifier (a variable in arithmetic, compared with a term
+of inner variables, ...) is *undecided* there, and so here: its code throws
+``rclverify_rt::Undecided`` with the reason, before the body (the body is not translated: the
+reading never evaluates it).
 
 Each translated quantifier is an immediately invoked lambda looping over the domains in
 binding order (the first name outermost, as ``itertools.product``), with the double reading's
@@ -25,10 +28,12 @@ from __future__ import annotations
 from fractions import Fraction
 from typing import Any
 
+from ..logic.candidates import NotInFragment, analyse
 from ..logic.eval_shapes import MAX_RANGE, _integer_range, _unused
 from ..logic.floatsem import MAX_ENUMERATION
 from ..rcl import ast
 from ..rcl.types import EnumT, Scalar
+from .cpp_candidates import candidate_code
 from .cpp_common import Untranslatable, enum_const
 
 
@@ -47,10 +52,17 @@ def quantifier(tr: Any, e: ast.Quant) -> tuple[str, str]:
     ``notes``); raises :class:`.cpp_common.Untranslatable`."""
     loops: list[tuple[str, str, Any]] = []  # (C++ name, kind, domain: ("values", [code]) | ("range", lo, hi))
     size = 1
+    names = [n for bd in e.bindings for n in bd.names]
+    k = 0
     try:
         for bd in e.bindings:
             for n in bd.names:
-                dom = _domain(tr, e, bd, n)
+                k += 1
+                try:
+                    dom = _domain(tr, e, bd, n)
+                except _Undecided as why:  # the double reading's candidate points, where they decide
+                    loops.append((n, *_candidates(tr, e, bd, n, names[k:], why)))
+                    continue
                 if dom is None:  # unused: the body's value is the same for every value of it
                     continue
                 kind, spec = dom
@@ -61,6 +73,8 @@ def quantifier(tr: Any, e: ast.Quant) -> tuple[str, str]:
     except _Undecided as why:
         tr.notes.append(str(why))
         return f"rclverify_rt::undecided({_c_string(str(why))})", "bool"
+    if any(kind.startswith("cand:") for _, kind, _ in loops):
+        return candidate_code(tr, e, loops, cpp_ident, _CTYPES)
     saved = dict(tr.bound)
     try:
         for n, kind, _ in loops:
@@ -76,7 +90,7 @@ def quantifier(tr: Any, e: ast.Quant) -> tuple[str, str]:
     elif e.kind == "exists":
         step, end = "if (" + body + ") { return true; }", "return false;"
     else:
-        step, end = "if ((" + body + ") && ++q_count > 1) { return false; }", "return q_count == 1;"
+        step, end = "if ((" + body + ") && ++cand_count > 1) { return false; }", "return cand_count == 1;"
     code = step
     for n, kind, spec in reversed(loops):
         ctype = _CTYPES[kind.split(":")[0]]
@@ -87,11 +101,32 @@ def quantifier(tr: Any, e: ast.Quant) -> tuple[str, str]:
             code = f"for (const {ctype} {v} : {{{', '.join(spec[1])}}}) {{ static_cast<void>({v}); {code} }}"
         else:  # an empty domain: no assignment
             code = ""
-    count = "int q_count = 0; " if e.kind == "exists_unique" else ""
+    count = "int cand_count = 0; " if e.kind == "exists_unique" else ""
     return f"([&]() -> bool {{ {count}{code} {end} }}())", "bool"
 
 
 _CTYPES = {"int": "std::int64_t", "bool": "bool", "enum": "std::uint8_t", "double": "double"}
+
+
+def _candidates(tr: Any, e: ast.Quant, bd: ast.Binding, name: str, later: list[str],
+                why: _Undecided) -> tuple[str, Any]:
+    """``("cand:<NUMERIC>", sources)`` of a variable over an unbounded numeric domain (double reading
+    only: the tolerance reading enumerates finite domains only); raises :class:`_Undecided`."""
+    numeric = _numeric(tr, bd.domain)
+    if tr.mode != "double" or numeric is None or "without a literal bound" not in str(why):
+        raise why
+    try:
+        return f"cand:{numeric}", analyse(e.body, name, numeric, frozenset(later), tr.env)
+    except NotInFragment as nf:
+        raise _Undecided(f"{why}, and not by candidate points: {nf}") from None
+
+
+def _numeric(tr: Any, dom: Any) -> str | None:
+    name = dom.name if isinstance(dom, ast.TBase) else None
+    if isinstance(dom, ast.TName):
+        t = tr.env.types.get(dom.name)
+        name = t.name if isinstance(t, Scalar) else None
+    return name if name in ("REAL", "INTEGER", "NATURAL") else None
 
 
 def _count(spec: tuple[Any, ...]) -> int:

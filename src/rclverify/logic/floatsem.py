@@ -42,7 +42,11 @@ double solutions).  Under double and tolerance a quantifier is therefore
 enumerated over a finite domain only: ``BOOL``, an enumeration, a finite
 set, an ``INTEGER``/``NATURAL`` variable bounded by literal guards
 (``k <= 12 -> ...``), or a numeric variable the body never mentions; any
-other quantifier is undecided there.  A formula whose evaluation cannot
+other quantifier is undecided there, except, under double, a ``REAL``/``INTEGER``/``NATURAL``
+variable whose body changes truth only at finitely many points computable from the values
+(table keys, the terms it is compared with): it is decided exactly at those candidate points
+and one point in each gap (:mod:`rclverify.logic.candidates`, :mod:`rclverify.logic.candidate_points`; a ``REAL`` ranges over the
+doubles there).  A formula whose evaluation cannot
 differ between exact and double (no rounding arithmetic, every literal a
 double) is not evaluated again (:func:`float_sensitive`).
 
@@ -66,6 +70,7 @@ import z3
 from ..rcl import ast
 from ..rcl import types as T
 from ..rcl.types import Checked, CheckedNode
+from .candidate_points import quantify
 from .concrete import check_concrete
 from .encode import EncodingError
 from .eval_shapes import MAX_RANGE, _integer_range, _unused
@@ -272,14 +277,21 @@ def _double(x: Any) -> Any:
     return float(x) if type(x) is Fraction else x
 
 
+#: a literal's text -> its value in the double reading (parsed once)
+_DOUBLE_LITERALS: dict[str, Any] = {}
+
+
 class _Double(Evaluator):
     """The formula in IEEE-754 binary64 arithmetic (module docstring)."""
 
     mode = "double"
 
     def literal(self, e: ast.NumLit) -> Any:
-        v = e.value
-        return int(v) if v.denominator == 1 else float(v)
+        hit = _DOUBLE_LITERALS.get(e.text)
+        if hit is None:
+            v = e.value
+            hit = _DOUBLE_LITERALS[e.text] = int(v) if v.denominator == 1 else float(v)
+        return hit
 
     def arith(self, op: str, x: Any, y: Any) -> Any:
         x, y = _double(x), _double(y)
@@ -297,7 +309,8 @@ class _Double(Evaluator):
         return bool(_CMP[op](_double(x), _double(y)))
 
     def quant(self, e: ast.Quant, b: Mapping[str, Any]) -> bool:
-        return _enumerate(self, e, b)
+        got = quantify(self, e, b, _finite_domain, MAX_ENUMERATION)
+        return _enumerate(self, e, b) if got is None else got
 
 
 class _Tolerant(Evaluator):
