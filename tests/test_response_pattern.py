@@ -135,3 +135,14 @@ def test_the_trace_tracker_equals_the_definition(run, n) -> None:
     if got is None and n is not None:  # still pending at the end: a trigger whose window is not over
         open_ = any(run[k][0] and not any(run[j][1] for j in range(k, len(run))) for k in range(len(run)))
         assert (tr.pending is not None) == open_
+
+
+
+def test_an_unproved_invariant_never_proves_the_unbounded_response() -> None:
+    """The ranking rule holds inside its invariant only: an invariant that is not proved must not let it
+    prove (x counts up from 0, the trigger at 0 is never answered; 10 - x is a ranking function only
+    inside the false invariant x <= 10)."""
+    ts = TransitionSystem({"x": z3.IntSort()}, lambda s: s["x"] == 0, lambda s, t: t["x"] == s["x"] + 1)
+    v = check_unbounded_response(ts, lambda s: s["x"] == 0, lambda s: s["x"] < 0, max_k=3, timeout_ms=5_000,
+                                 ranking=lambda s: 10 - s["x"], invariant=lambda s: s["x"] <= 10)
+    assert v.status == "inconclusive" and "invariant is not proved" in v.detail, (v.status, v.detail)
