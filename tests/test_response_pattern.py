@@ -146,3 +146,34 @@ def test_an_unproved_invariant_never_proves_the_unbounded_response() -> None:
     v = check_unbounded_response(ts, lambda s: s["x"] == 0, lambda s: s["x"] < 0, max_k=3, timeout_ms=5_000,
                                  ranking=lambda s: 10 - s["x"], invariant=lambda s: s["x"] <= 10)
     assert v.status == "inconclusive" and "invariant is not proved" in v.detail, (v.status, v.detail)
+
+
+@settings(max_examples=120, deadline=None)
+@given(st.lists(st.tuples(st.sampled_from([True, False, None]), st.sampled_from([True, False, None])), max_size=7),
+       st.sampled_from([None, 0, 1, 3, math.inf]))
+def test_the_trace_tracker_says_false_only_where_every_reading_fails(run, n) -> None:
+    """With undecided operands (``None``): ``false`` only when every way of deciding them fails the
+    definition (a response undecided in the window may have answered the trigger)."""
+    import itertools
+
+    from rclverify.backends.monitors.response_trace import ResponseTracker
+    tr = ResponseTracker(n)
+    got = None
+    for i, (p, q) in enumerate(run):
+        said = tr.step(i, p, q)
+        if said is not None and said[0] == "false":
+            got = i
+            break
+    if got is None:
+        return
+    holes = [(i, j) for i in range(got + 1) for j in (0, 1) if run[i][j] is None]
+    for fill in itertools.product([True, False], repeat=len(holes)):
+        r = [list(x) for x in run[:got + 1]]
+        for (i, j), b in zip(holes, fill):
+            r[i][j] = b
+        if n is None:
+            fails = any(r[i][0] and not r[i + 1][1] for i in range(len(r) - 1))
+        else:
+            fails = any(r[k][0] and k + n < len(r) and not any(r[j][1] for j in range(k, k + n + 1))
+                        for k in range(len(r)))
+        assert fails, (run, n, got, fill)
