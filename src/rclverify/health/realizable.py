@@ -47,15 +47,15 @@ from __future__ import annotations
 
 import itertools
 import time
-from typing import Any, Sequence
+from typing import Sequence
 
 import z3
 
 from ..logic.encode import Encoder
 from ..logic.query import STEPS_PER_MS, SAFETY_FACTOR, render_model, satisfiable, smt2_script
 from ..rcl import ast
-from ..logic.sorts import sort_of
-from ..rcl.types import NATURAL, Checked, DataT, FuncT, SeqT, SetT, TupleT, Type
+from ..logic.natural import natural_typing
+from ..rcl.types import Checked, FuncT
 from .finding import Finding
 from .shape import outputs_mentioned
 from .witness import finite_witness, has_tables, points_for
@@ -74,51 +74,6 @@ def _conj(fs: Sequence[z3.BoolRef]) -> z3.BoolRef:
     """The conjunction of ``fs``: ``True`` when empty (Z3's printer writes an
     empty ``And`` as a bare ``and``, which no SMT-LIB2 reader takes)."""
     return z3.And(*fs) if len(fs) > 1 else fs[0] if fs else z3.BoolVal(True)
-
-
-def natural_typing(term: z3.ExprRef, t: Type, depth: int = 0) -> tuple[list[z3.BoolRef], bool]:
-    """``(constraints, exact)``: that every NATURAL part of value ``term`` of
-    RCL type ``t`` is ``>= 0`` (the type's meaning, docs/architecture.md "Z3
-    encoding"): ``t`` itself, a constructor's fields (under its recogniser),
-    a tuple's components, at any depth (a constructor set nested in itself
-    followed 3 levels); ``exact`` is false when a NATURAL part is left
-    unconstrained: a sequence's or a set's elements (a quantified typing
-    left Z3 undecided for 20 s where the query without it takes 0.1 s), or
-    a nesting deeper than followed."""
-    if t == NATURAL:
-        return [term >= 0], True
-    if isinstance(t, (SeqT, SetT)):
-        return [], not _has_natural(t.elem, 0)
-    if not isinstance(t, (DataT, TupleT)):
-        return [], True
-    if depth > 3:
-        return [], not _has_natural(t, 0)
-    out: list[z3.BoolRef] = []
-    exact = True
-    s: Any = sort_of(t)
-    ctors = t.ctors if isinstance(t, DataT) else (("", t.elems),)
-    for k, (_, args) in enumerate(ctors):
-        parts: list[z3.BoolRef] = []
-        for i, a in enumerate(args):
-            cs, ok = natural_typing(s.accessor(k, i)(term), a, depth + 1)
-            parts += cs
-            exact = exact and ok
-        if parts:
-            out.append(z3.Implies(s.recognizer(k)(term), z3.And(*parts)) if isinstance(t, DataT) else z3.And(*parts))
-    return out, exact
-
-
-def _has_natural(t: Type, depth: int) -> bool:
-    """Whether type ``t`` has a NATURAL part (followed 6 levels; deeper: assumed so)."""
-    if t == NATURAL or depth > 6:
-        return t == NATURAL or isinstance(t, (DataT, TupleT, SeqT, SetT))
-    if isinstance(t, (SeqT, SetT)):
-        return _has_natural(t.elem, depth + 1)
-    if isinstance(t, TupleT):
-        return any(_has_natural(e, depth + 1) for e in t.elems)
-    if isinstance(t, DataT):
-        return any(_has_natural(a, depth + 1) for _, args in t.ctors for a in args)
-    return False
 
 
 class _Query:
