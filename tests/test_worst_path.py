@@ -114,3 +114,27 @@ def test_nodes_between_cover_every_simple_path_on_random_graphs() -> None:
                         todo.append(t)
             return y in seen
         assert all(n in (a, b) or (reach(a, n) and reach(n, b)) for n in got), (edges, got)
+
+
+def test_an_edit_off_the_named_path_makes_the_recorded_deadline_stale(tmp_path) -> None:  # type: ignore[no-untyped-def]
+    """The deadline record's inputs are the snapshots of every node between its ends, as the task's: a
+    slower hop off the named path refutes the deadline, so a proof recorded before the edit must read
+    ``stale`` in a report made without the stage (it read ``proved``)."""
+    from rclverify.calculus.deadline_stage import read_deadlines
+    from rclverify.contract_texts import ContractTexts
+    from rclverify.pipeline import stage_check, stage_deadlines
+    from rclverify.workspace import Workspace, current_snapshot_hashes
+    (tmp_path / "contracts").mkdir()
+    rcl = tmp_path / "contracts/s.rcl"
+    rcl.write_text(DIAMOND.replace("within 400 ms", "within 40 ms"))
+    (tmp_path / "contracts/plan.yaml").write_text(
+        "name: diamond\ncontracts:\n  - contracts/s.rcl\nrequirements:\n  - id: R\n    text: fast enough\n"
+        "    deadline: {path: [A, Fast, D], within: 100 ms}\nnodes: {}\n")
+    ws = Workspace(tmp_path)
+    stage_check(ws)
+    [rec] = stage_deadlines(ws)
+    assert rec["status"] == PROVED
+    rcl.write_text(DIAMOND)  # Slow: 400 ms, off the named path
+    ws = Workspace(tmp_path)
+    [now] = read_deadlines(ws, current_snapshot_hashes(ws, ContractTexts(ws)))[0] or []
+    assert now["status"] == "stale", now
