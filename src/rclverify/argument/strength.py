@@ -124,11 +124,17 @@ def coverage_text(cov: Mapping[str, Any]) -> str:
 
 def side_condition_strength(sc: Mapping[str, Any]) -> dict[str, Any]:
     """The strength of a side-condition row: a ``proof`` by one or two
-    solvers (its ``solvers.agreement``), doubt 1 unless ``discharged``."""
+    solvers (its ``solvers.agreement``), doubt 1 unless ``discharged``.  One
+    discharged from its producers' cone summaries (``context.summaries``,
+    calculus/summary.py) is one solver's: cvc5 decides the last query only,
+    the summaries were each proved implied by their cone by Z3 alone."""
     two = (sc.get("solvers") or {}).get("agreement") == "two solvers"
+    detail = "Z3 and cvc5" if two else "Z3 (one solver)"
+    if two and ((sc.get("context") or {}).get("summaries")):
+        # cvc5 decided the query over the cone summaries; each summary's own proof (implied by its cone) is Z3's
+        two, detail = False, "Z3 and cvc5 on the query over the cone summaries, the summaries by Z3 alone"
     doubt = DOUBT["proof2" if two else "proof"] if sc.get("status") == "discharged" else 1.0
-    return {"kind": "proof", "detail": "Z3 and cvc5" if two else "Z3 (one solver)", "solvers": 2 if two else 1,
-            "doubt": doubt}
+    return {"kind": "proof", "detail": detail, "solvers": 2 if two else 1, "doubt": doubt}
 
 
 def stronger(a: str, b: str) -> str:
