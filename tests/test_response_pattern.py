@@ -112,6 +112,28 @@ def test_the_unbounded_response_is_decided(chain: Path, tmp_path: Path, capsys: 
     assert rec["temporal"]["method"] == "bounded response" and rec["temporal"]["bound"] == 2
 
 
+
+def test_the_plans_ranking_and_invariant_are_read_for_the_unbounded_response(chain: Path, tmp_path: Path) -> None:
+    """docs/requirements.md: ``always (P -> eventually Q)`` is proved by the plan's ``ranking:`` (and
+    ``invariant:``); the plan refused both on it (E-temporal).  Neither proves what does not hold: a
+    constant rank does not decrease; an invariant that is not proved leaves the ranking unused."""
+    root = tmp_path / "ws"
+    shutil.copytree(chain, root)
+    for f in ("sensor", "controller", "actuator"):  # answering eventually: no bound proves it
+        p = root / f"contracts/{f}.rcl"
+        p.write_text(p.read_text().replace("progress( within 0 steps )", "progress( eventually )"))
+    _with(root, "always (Sensor.in.reading >= 90 -> eventually Actuator.out.actuator_value >= 0)")
+    plan = root / "contracts/plan.yaml"
+    text = plan.read_text()
+    for hints, said in (('    ranking: "0"\n', "does not decrease"),
+                        ('    ranking: "0"\n    invariant: "Sensor.in.reading >= 0 and Sensor.in.reading < 0"\n',
+                         "invariant is not proved")):
+        plan.write_text(text.replace("    text: answered\n", "    text: answered\n" + hints, 1))
+        assert main(["requirements", "-w", str(root)]) in (0, 1)
+        rec = json.loads((root / "artifacts/requirements/RESP.json").read_text())
+        assert rec["verdict"] == "inconclusive" and said in rec["reason"], rec.get("reason")
+
+
 # -- on a recorded run: the tracker of backends/monitors/response_trace.py against the definition ----------
 
 @settings(max_examples=300, deadline=None)
