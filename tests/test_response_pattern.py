@@ -199,3 +199,18 @@ def test_the_trace_tracker_says_false_only_where_every_reading_fails(run, n) -> 
             fails = any(r[k][0] and k + n < len(r) and not any(r[j][1] for j in range(k, k + n + 1))
                         for k in range(len(r)))
         assert fails, (run, n, got, fill)
+
+
+
+def test_a_run_that_stops_with_a_trigger_pending_refutes_the_unbounded_response() -> None:
+    """docs/requirements.md: a run that stops with a P pending is a counterexample (it is never
+    answered); it read inconclusive when the bounded pattern failed and no fair lasso exists (x stays 0,
+    an unfair loop, or steps to 1, where no step follows; the trigger at 0, no response anywhere)."""
+    from rclverify.requirements.deadlock import runs_go_on
+    from rclverify.requirements.tsys import Fairness
+    ts = TransitionSystem({"x": z3.IntSort()}, lambda s: s["x"] == 0,
+                          lambda s, t: z3.And(s["x"] == 0, z3.Or(t["x"] == 0, t["x"] == 1)),
+                          (Fairness("N", lambda s: s["x"] == 0, lambda s: s["x"] == 1),))
+    v = runs_go_on(ts, check_unbounded_response(ts, lambda s: s["x"] == 0, lambda s: s["x"] == 5, max_k=4,
+                                                timeout_ms=5_000), max_k=4, timeout_ms=5_000)
+    assert (v.status, v.method) == ("refuted", "deadlock"), (v.status, v.method, v.detail)

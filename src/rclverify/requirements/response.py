@@ -40,6 +40,8 @@ and not Q``) and decides:
 * ``refuted`` (method ``lasso``) by a run whose last state equals an
   earlier one, the loop meeting the fairness constraints, with a P pending
   in every state of the loop: repeated forever, that P is never answered;
+  or (method ``deadlock``) by a run that stops with a P pending (the
+  caller's check that no run stops refutes a proof only);
 * else ``inconclusive``, naming what was tried.
 """
 from __future__ import annotations
@@ -48,6 +50,7 @@ import z3
 
 from typing import Callable
 
+from .deadlock import find_deadlock
 from .temporal import _ranking_fails, check_always
 from .tsys import Pred, TemporalVerdict, TransitionSystem, fair_loop, trace_of, unroll, with_flag
 
@@ -141,6 +144,11 @@ def check_unbounded_response(ts: TransitionSystem, trigger: Pred, goal: Pred, *,
                                    detail=f"{why}; not answered within {', '.join(tried)}; Z3 could not decide "
                                           f"whether a run of {n} steps loops with a trigger pending "
                                           f"({sv.reason_unknown()})")
-    return TemporalVerdict("inconclusive", "lasso", bound=max_k,
+    # a run that stops with a trigger pending never answers it (docs/requirements.md, "Runs that stop")
+    stop = find_deadlock(ts2, max_k, ending=lambda st: st["<pending>"], timeout_ms=timeout_ms,
+                         what=" with a trigger pending")
+    if stop is not None and stop.status == "refuted":
+        return stop
+    return TemporalVerdict("inconclusive", "lasso", bound=max_k, deadlock=stop.deadlock if stop is not None else "",
                            detail=f"{why}; the bounded pattern tried {', '.join(tried) or 'no bound'}; no run of up "
                                   f"to {max_k} steps loops with a trigger pending")
