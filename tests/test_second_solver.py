@@ -207,3 +207,11 @@ def test_a_row_for_another_text_of_the_query_is_not_believed(tmp_path: Path) -> 
     (tmp_path / rel).write_text(SAT_SCRIPT.replace("1.0", "2.0"))
     s = load(tmp_path).solvers("requirement", "REQ1", rel)
     assert s["agreement"] == "one solver" and "another text" in s["why"], s
+
+
+def test_a_verdict_without_a_kept_query_says_so() -> None:
+    """A proved temporal requirement keeps no single query: one solver, and not "run doit verify"
+    (which would never give it a second one)."""
+    from rclverify.crosscheck.apply import SecondSolver
+    rec = SecondSolver({}).requirement({"id": "T1", "verdict": "proved", "temporal": {"method": "k-induction"}})
+    assert rec["solvers"]["agreement"] == "one solver" and "doit verify" not in rec["solvers"]["why"]

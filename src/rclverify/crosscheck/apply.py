@@ -16,6 +16,8 @@ from typing import Any, Mapping
 from .stage import DOWNGRADES
 
 _STAGE_MISSING = "the second-solver stage has not decided it (run `doit verify`)"
+_NO_QUERY = ("no single SMT-LIB2 query is kept for this verdict (a temporal proof by BMC, k-induction or a "
+             "ranking function; a scan instance by instance), so the second solver has none to decide")
 _OTHER_TEXT = ("the second solver decided another text of this query (its sha256 differs from the query's now): "
                "this one is Z3's alone until the second-solver stage runs again (run `doit verify`)")
 
@@ -51,6 +53,9 @@ class SecondSolver:
         ``inconclusive`` and the fields ``downgraded(row, solvers)`` gives."""
         if row is None or row.get(status_key) != good:
             return row
+        if not row.get("smt2"):  # no query kept (a temporal proof, a scan instance by instance): nothing to re-decide
+            return {**row, "solvers": {"agreement": "one solver", "why": _NO_QUERY, "cvc5": None, "proof": "",
+                                       "smt2": ""}}
         s = self.solvers(kind, str(row.get(id_key)), row.get("smt2"))
         if s["agreement"] in DOWNGRADES:
             return {**row, status_key: "inconclusive", "solvers": s, **downgraded(row, s)}
