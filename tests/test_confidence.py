@@ -179,3 +179,12 @@ def test_a_side_condition_read_from_cone_summaries_is_not_two_solvers() -> None:
     assert s["solvers"] == 1 and s["doubt"] == DOUBT["proof"] and "summaries" in s["detail"], s
     sc["context"] = {"summaries": []}
     assert side_condition_strength(sc)["doubt"] == DOUBT["proof2"]
+
+
+def test_the_observed_detail_counts_judged_messages_not_questions() -> None:
+    """The monitors count satisfied and violated per judged message (an output, or a question its inputs
+    alone decide; docs/semantics.md): a node without inputs has no question, yet its 5 outputs read
+    "5 questions answered"."""
+    row = {"backend": "monitors", "status": "discharged", "monitoring": {"counts": {"satisfied": 5}, "events_read": 5}}
+    d = evidence_strength(row)["detail"]
+    assert d.startswith("5 verdicts on messages (satisfied or violated)") and "question" not in d, d

@@ -14,7 +14,7 @@ kind           what it rests on
                the data give for the criterion
 ``tested``     property tests: examples run against the assumption, and
                their coverage of the assumption's ranges per input
-``observed``   monitored runs: questions answered, events read, the run's
+``observed``   monitored runs: messages judged, events read, the run's
                duration in trace time
 ``reviewed``   a signed review record
 ``assumed``    stated, not verified (environment assumptions, declared
@@ -95,7 +95,7 @@ def evidence_strength(row: Mapping[str, Any]) -> dict[str, Any]:
         m = row.get("monitoring") or {}
         c = m.get("counts") or {}
         answered = int(c.get("satisfied", 0) or 0) + int(c.get("violated", 0) or 0)
-        detail = f"{answered} questions answered, {m.get('events_read', 0)} events read"
+        detail = f"{answered} verdicts on messages (satisfied or violated), {m.get('events_read', 0)} events read"
         if isinstance(m.get("duration_s"), (int, float)):
             detail += f" over {m['duration_s']:g} s of trace time"
     elif kind == "reviewed":
