@@ -115,8 +115,9 @@ def coverage_text(cov: Mapping[str, Any]) -> str:
     for key, c in cov.items():
         if not isinstance(c, Mapping):
             continue
+        narrowed = f", the plan's bounds; the assumption admits {c['admitted']}" if c.get("admitted") else ""
         if isinstance(c.get("fraction"), (int, float)):
-            parts.append(f"{key} {c['fraction']:.0%} of {c.get('range')} (drawn {c.get('drawn')})")
+            parts.append(f"{key} {c['fraction']:.0%} of {c.get('range')} (drawn {c.get('drawn')}{narrowed})")
         elif c.get("buckets") is None and c.get("drawn") and "not measured" not in str(c.get("range")):
             parts.append(f"{key} drawn {c['drawn']} of {c.get('range')} (unbounded)")
     return "; ".join(parts)
