@@ -186,7 +186,7 @@ def test_case_study_agent_guarantee_3_can_fire(agent_findings):
 
 
 def test_the_natural_components_of_a_tuple_are_typed():
-    """A ``(NATURAL, NATURAL)`` is two integers to Z3: without their ``>= 0`` a guarantee only a negative
+    """A ``(NATURAL, NATURAL)`` is two integers to Z3 (a ``seq(NATURAL)`` a sequence of integers): without their ``>= 0`` a guarantee only a negative
     component meets read consistent, an assumption only one meets satisfiable (logic/natural.py)."""
     out = ("node C { inputs( x : INTEGER ) outputs( y : (NATURAL, NATURAL) ) assume( TRUE ) "
            "guarantee( exists(a, b in INTEGER | out.y == (a, b) and a < 0) ) }")
@@ -195,3 +195,7 @@ def test_the_natural_components_of_a_tuple_are_typed():
     inp = ("node C { inputs( x : (NATURAL, NATURAL) ) outputs( y : INTEGER ) "
            "assume( exists(a, b in INTEGER | in.x == (a, b) and b < 0) ) guarantee( out.y == 1 ) }")
     assert {f.check: f.status for f in _findings(inp, "C").values()}["assumption-satisfiable"] == "problem"
+    seq = ("node C { inputs( x : INTEGER ) outputs( y : seq(NATURAL) ) assume( TRUE ) "
+           "guarantee( exists(v in INTEGER | v in out.y and v < 0) ) }")  # a sequence's elements, by a quantifier
+    world.fresh()  # as the pipeline asks each node: in a fresh Z3 context
+    assert {f.check: f.status for f in _findings(seq, "C").values()}["contract-consistent"] != "ok"
