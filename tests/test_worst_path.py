@@ -138,3 +138,13 @@ def test_an_edit_off_the_named_path_makes_the_recorded_deadline_stale(tmp_path) 
     ws = Workspace(tmp_path)
     [now] = read_deadlines(ws, current_snapshot_hashes(ws, ContractTexts(ws)))[0] or []
     assert now["status"] == "stale", now
+
+
+def test_a_cut_path_search_never_proves(monkeypatch) -> None:  # type: ignore[no-untyped-def]
+    """Past MAX_PATHS simple paths the search is cut: a path not examined may be the slow one, so a
+    proof of the named path alone is inconclusive, not proved (here the cut leaves Slow, 400 ms, out)."""
+    import rclverify.calculus.worst_path as wp
+    monkeypatch.setattr(wp, "MAX_PATHS", 1)
+    text = DIAMOND.replace("node Slow", "node Aaa_slow")  # its path enumerated after the named one
+    r = _decided(text, ["A", "Fast", "D"], Fraction(1, 10))
+    assert r.status != PROVED, r.reason
