@@ -167,3 +167,24 @@ def test_hoare_conditions_are_decided_by_both_solvers(ws: Path, tmp_path: Path) 
     assert ev["status"] == "inconclusive" and ev["solvers"]["agreement"] == "disagree"
     assert ev["explanation"].startswith("Not discharged: Z3 answered unsat, cvc5 sat")
     assert next(q for q in r["requirements"] if q["id"] == "REQ2")["verdict"] != "met"
+
+
+def test_a_side_condition_read_from_cone_summaries_is_not_two_solvers() -> None:
+    """cvc5 decides only the last query of a side condition discharged from its producers' cone summaries
+    (calculus/summary.py): each summary was proved implied by its cone by Z3 alone, so the proof is not
+    one two solvers agreed on (its doubt must not be the two-solver one)."""
+    from rclverify.argument.strength import DOUBT, side_condition_strength
+    sc = {"status": "discharged", "solvers": {"agreement": "two solvers"}, "context": {"summaries": ["Planner"]}}
+    s = side_condition_strength(sc)
+    assert s["solvers"] == 1 and s["doubt"] == DOUBT["proof"] and "summaries" in s["detail"], s
+    sc["context"] = {"summaries": []}
+    assert side_condition_strength(sc)["doubt"] == DOUBT["proof2"]
+
+
+def test_the_observed_detail_counts_judged_messages_not_questions() -> None:
+    """The monitors count satisfied and violated per judged message (an output, or a question its inputs
+    alone decide; docs/semantics.md): a node without inputs has no question, yet its 5 outputs read
+    "5 questions answered"."""
+    row = {"backend": "monitors", "status": "discharged", "monitoring": {"counts": {"satisfied": 5}, "events_read": 5}}
+    d = evidence_strength(row)["detail"]
+    assert d.startswith("5 verdicts on messages (satisfied or violated)") and "question" not in d, d

@@ -183,3 +183,19 @@ def test_case_study_agent_guarantee_3_can_fire(agent_findings):
     i = int(g3.model["i (witness for guarantee 3)"])
     assert Evaluator(checked, node, values).eval(g.left, {"i": i}) is True  # the premise at the witness's i
     assert "(declare-fun Agent.in.wayP (Real Real) Int)" in g3.smt2  # the statement is the general query's
+
+
+def test_the_natural_components_of_a_tuple_are_typed():
+    """A ``(NATURAL, NATURAL)`` is two integers to Z3 (a ``seq(NATURAL)`` a sequence of integers): without their ``>= 0`` a guarantee only a negative
+    component meets read consistent, an assumption only one meets satisfiable (logic/natural.py)."""
+    out = ("node C { inputs( x : INTEGER ) outputs( y : (NATURAL, NATURAL) ) assume( TRUE ) "
+           "guarantee( exists(a, b in INTEGER | out.y == (a, b) and a < 0) ) }")
+    status = {f.check: f.status for f in _findings(out, "C").values()}
+    assert status["contract-consistent"] == "problem" and status.get("realizable") != "ok", status
+    inp = ("node C { inputs( x : (NATURAL, NATURAL) ) outputs( y : INTEGER ) "
+           "assume( exists(a, b in INTEGER | in.x == (a, b) and b < 0) ) guarantee( out.y == 1 ) }")
+    assert {f.check: f.status for f in _findings(inp, "C").values()}["assumption-satisfiable"] == "problem"
+    seq = ("node C { inputs( x : INTEGER ) outputs( y : seq(NATURAL) ) assume( TRUE ) "
+           "guarantee( exists(v in INTEGER | v in out.y and v < 0) ) }")  # a sequence's elements, by a quantifier
+    world.fresh()  # as the pipeline asks each node: in a fresh Z3 context
+    assert {f.check: f.status for f in _findings(seq, "C").values()}["contract-consistent"] != "ok"

@@ -129,7 +129,9 @@ def test_the_coverage_of_a_bounded_range_is_the_buckets_the_examples_hit(tmp_pat
     assert c["fraction"] == c["covered"] / 10 and 1 <= c["covered"] <= 10
     row = {"backend": "property_tests", "status": ev.status, "examples": {**ev.details["examples"],
                                                                          "coverage": ev.details["coverage"]}}
-    assert f"in.r {c['fraction']:.0%} of [0, 500] (drawn {c['drawn']})" in evidence_strength(row)["detail"]
+    # r's assumption bounds it below only: the fraction is of the plan's [0, 500], and the detail says so
+    assert (f"in.r {c['fraction']:.0%} of [0, 500] (drawn {c['drawn']}, the plan's bounds; the assumption admits "
+            "[0, inf])") in evidence_strength(row)["detail"]
 
 
 def test_off_by_one_threshold_caught_with_shrunk_counterexample(tmp_path: Path) -> None:

@@ -159,3 +159,17 @@ def test_linear_contracts_are_decided_by_quantifier_elimination() -> None:
     [f] = _findings(PLANNER.replace("0 <= out.speed and", "0.5 <= out.speed and"), "P")
     assert f.status == "problem" and f.core == ["guarantee 1 (c.rcl:7:3)", "guarantee 2 (c.rcl:8:3)"]
     assert f.model["P.in.pose"] == f.model["P.in.goal"]
+
+
+def test_an_output_whose_natural_parts_are_not_typed_is_never_proved_realizable() -> None:
+    """Only a NATURAL output and a constructor's NATURAL field get their ``>= 0`` (logic/encode.py): the
+    NATURAL elements of a tuple or a sequence are plain integers to Z3, so its ``unsat`` ranges over
+    outputs the type excludes.  Both contracts below have no answer (a NATURAL below 0); the ``ok``
+    must not be claimed (an input with no answer is still reported: that query is sound)."""
+    tup = ("node C { inputs( x : INTEGER ) outputs( y : (NATURAL, NATURAL) ) assume( TRUE ) "
+           "guarantee( exists(a, b in INTEGER | out.y == (a, b) and a < 0) ) }")
+    seq = ("node C { inputs( x : INTEGER ) outputs( y : seq(NATURAL) ) assume( TRUE ) "
+           "guarantee( exists(v in INTEGER | v in out.y and v < 0) ) }")
+    for text in (tup, seq):
+        assert not any(f.status == "ok" for f in _findings(text, "C")), text
+    assert _proved(_findings(tup.replace("a < 0", "a >= 0"), "C"))  # the tuple itself is not refused

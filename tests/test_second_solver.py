@@ -185,3 +185,33 @@ def test_every_part_of_a_reset_joined_proof_is_decided() -> None:
     assert d.answer == "unsat" and d.proof_checked
     assert decide(first_sat, every=True).answer == "sat"
     assert decide(first_sat).answer == "unsat"  # without `every`, only the last query counts (a side condition)
+
+
+def test_a_row_for_another_text_of_the_query_is_not_believed(tmp_path: Path) -> None:
+    """The second solver's row names the query's path and the sha256 of the text it decided; a query
+    re-written at the same path since (a stage run without the crosscheck, `rclverify requirements`
+    then `rclverify report`) was never seen by cvc5: it reads one solver, not the old agreement."""
+    import hashlib
+
+    from rclverify.crosscheck.apply import load
+    from rclverify.crosscheck.stage import INDEX
+    from rclverify.evidence.sealed import write_sealed
+    rel = "artifacts/requirements/REQ1.smt2"
+    (tmp_path / rel).parent.mkdir(parents=True)
+    (tmp_path / rel).write_text(SAT_SCRIPT)
+    row = {"kind": "requirement", "id": "REQ1", "smt2": rel, "verdict": "proved", "z3": "unsat",
+           "sha256": hashlib.sha256(SAT_SCRIPT.encode()).hexdigest(), "agreement": "two solvers", "why": "both",
+           "cvc5": {"answer": "unsat", "proof_checked": True, "version": "1", "reason": "", "proof": ""}}
+    write_sealed(tmp_path / INDEX, {"solver": None, "counts": {}, "items": [row]})
+    assert load(tmp_path).solvers("requirement", "REQ1", rel)["agreement"] == "two solvers"
+    (tmp_path / rel).write_text(SAT_SCRIPT.replace("1.0", "2.0"))
+    s = load(tmp_path).solvers("requirement", "REQ1", rel)
+    assert s["agreement"] == "one solver" and "another text" in s["why"], s
+
+
+def test_a_verdict_without_a_kept_query_says_so() -> None:
+    """A proved temporal requirement keeps no single query: one solver, and not "run doit verify"
+    (which would never give it a second one)."""
+    from rclverify.crosscheck.apply import SecondSolver
+    rec = SecondSolver({}).requirement({"id": "T1", "verdict": "proved", "temporal": {"method": "k-induction"}})
+    assert rec["solvers"]["agreement"] == "one solver" and "doit verify" not in rec["solvers"]["why"]

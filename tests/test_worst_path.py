@@ -114,3 +114,37 @@ def test_nodes_between_cover_every_simple_path_on_random_graphs() -> None:
                         todo.append(t)
             return y in seen
         assert all(n in (a, b) or (reach(a, n) and reach(n, b)) for n in got), (edges, got)
+
+
+def test_an_edit_off_the_named_path_makes_the_recorded_deadline_stale(tmp_path) -> None:  # type: ignore[no-untyped-def]
+    """The deadline record's inputs are the snapshots of every node between its ends, as the task's: a
+    slower hop off the named path refutes the deadline, so a proof recorded before the edit must read
+    ``stale`` in a report made without the stage (it read ``proved``)."""
+    from rclverify.calculus.deadline_stage import read_deadlines
+    from rclverify.contract_texts import ContractTexts
+    from rclverify.pipeline import stage_check, stage_deadlines
+    from rclverify.workspace import Workspace, current_snapshot_hashes
+    (tmp_path / "contracts").mkdir()
+    rcl = tmp_path / "contracts/s.rcl"
+    rcl.write_text(DIAMOND.replace("within 400 ms", "within 40 ms"))
+    (tmp_path / "contracts/plan.yaml").write_text(
+        "name: diamond\ncontracts:\n  - contracts/s.rcl\nrequirements:\n  - id: R\n    text: fast enough\n"
+        "    deadline: {path: [A, Fast, D], within: 100 ms}\nnodes: {}\n")
+    ws = Workspace(tmp_path)
+    stage_check(ws)
+    [rec] = stage_deadlines(ws)
+    assert rec["status"] == PROVED
+    rcl.write_text(DIAMOND)  # Slow: 400 ms, off the named path
+    ws = Workspace(tmp_path)
+    [now] = read_deadlines(ws, current_snapshot_hashes(ws, ContractTexts(ws)))[0] or []
+    assert now["status"] == "stale", now
+
+
+def test_a_cut_path_search_never_proves(monkeypatch) -> None:  # type: ignore[no-untyped-def]
+    """Past MAX_PATHS simple paths the search is cut: a path not examined may be the slow one, so a
+    proof of the named path alone is inconclusive, not proved (here the cut leaves Slow, 400 ms, out)."""
+    import rclverify.calculus.worst_path as wp
+    monkeypatch.setattr(wp, "MAX_PATHS", 1)
+    text = DIAMOND.replace("node Slow", "node Aaa_slow")  # its path enumerated after the named one
+    r = _decided(text, ["A", "Fast", "D"], Fraction(1, 10))
+    assert r.status != PROVED, r.reason

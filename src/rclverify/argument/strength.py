@@ -14,7 +14,7 @@ kind           what it rests on
                the data give for the criterion
 ``tested``     property tests: examples run against the assumption, and
                their coverage of the assumption's ranges per input
-``observed``   monitored runs: questions answered, events read, the run's
+``observed``   monitored runs: messages judged, events read, the run's
                duration in trace time
 ``reviewed``   a signed review record
 ``assumed``    stated, not verified (environment assumptions, declared
@@ -95,7 +95,7 @@ def evidence_strength(row: Mapping[str, Any]) -> dict[str, Any]:
         m = row.get("monitoring") or {}
         c = m.get("counts") or {}
         answered = int(c.get("satisfied", 0) or 0) + int(c.get("violated", 0) or 0)
-        detail = f"{answered} questions answered, {m.get('events_read', 0)} events read"
+        detail = f"{answered} verdicts on messages (satisfied or violated), {m.get('events_read', 0)} events read"
         if isinstance(m.get("duration_s"), (int, float)):
             detail += f" over {m['duration_s']:g} s of trace time"
     elif kind == "reviewed":
@@ -115,8 +115,9 @@ def coverage_text(cov: Mapping[str, Any]) -> str:
     for key, c in cov.items():
         if not isinstance(c, Mapping):
             continue
+        narrowed = f", the plan's bounds; the assumption admits {c['admitted']}" if c.get("admitted") else ""
         if isinstance(c.get("fraction"), (int, float)):
-            parts.append(f"{key} {c['fraction']:.0%} of {c.get('range')} (drawn {c.get('drawn')})")
+            parts.append(f"{key} {c['fraction']:.0%} of {c.get('range')} (drawn {c.get('drawn')}{narrowed})")
         elif c.get("buckets") is None and c.get("drawn") and "not measured" not in str(c.get("range")):
             parts.append(f"{key} drawn {c['drawn']} of {c.get('range')} (unbounded)")
     return "; ".join(parts)
@@ -124,11 +125,17 @@ def coverage_text(cov: Mapping[str, Any]) -> str:
 
 def side_condition_strength(sc: Mapping[str, Any]) -> dict[str, Any]:
     """The strength of a side-condition row: a ``proof`` by one or two
-    solvers (its ``solvers.agreement``), doubt 1 unless ``discharged``."""
+    solvers (its ``solvers.agreement``), doubt 1 unless ``discharged``.  One
+    discharged from its producers' cone summaries (``context.summaries``,
+    calculus/summary.py) is one solver's: cvc5 decides the last query only,
+    the summaries were each proved implied by their cone by Z3 alone."""
     two = (sc.get("solvers") or {}).get("agreement") == "two solvers"
+    detail = "Z3 and cvc5" if two else "Z3 (one solver)"
+    if two and ((sc.get("context") or {}).get("summaries")):
+        # cvc5 decided the query over the cone summaries; each summary's own proof (implied by its cone) is Z3's
+        two, detail = False, "Z3 and cvc5 on the query over the cone summaries, the summaries by Z3 alone"
     doubt = DOUBT["proof2" if two else "proof"] if sc.get("status") == "discharged" else 1.0
-    return {"kind": "proof", "detail": "Z3 and cvc5" if two else "Z3 (one solver)", "solvers": 2 if two else 1,
-            "doubt": doubt}
+    return {"kind": "proof", "detail": detail, "solvers": 2 if two else 1, "doubt": doubt}
 
 
 def stronger(a: str, b: str) -> str:

@@ -6,7 +6,10 @@ per ``deadline:`` of the plan, in plan order, each
 :meth:`~.deadlines.DeadlineResult.to_json` plus ``smt2`` (the query, saved
 as ``artifacts/deadlines/<ID>.smt2`` for re-checking with any SMT solver)
 and ``inputs`` (the sha256 of the contract snapshot of every node of the
-path and of the system model: what a chain is made from, rules D1 and D2).
+path and every node between its ends, :func:`.worst_path.nodes_between`,
+and of the system model: what a chain is made from, rules D1 and D2, and
+what the slowest other path is; with the named path's nodes only, an edit
+of a hop off it left a proof recorded before it unstale).
 The record is sealed (:mod:`rclverify.evidence.sealed`); a reader never
 believes one whose seal does not hold (:func:`read_deadlines`: ``error``),
 nor one made from other inputs than the current ones (``stale``).  Every
@@ -44,7 +47,7 @@ def stage_deadlines(ws: "Workspace") -> tuple[list[DeadlineResult], list[dict[st
     Returns ``(results, records)`` in plan order.  Raises ``RclError`` for
     contracts or a plan that do not check, ``OSError`` when a file cannot
     be written."""
-    from .worst_path import with_worst_path  # the slowest other path may refute a deadline (issue 48)
+    from .worst_path import nodes_between, with_worst_path  # the slowest other path may refute a deadline (issue 48)
     results = [with_worst_path(r, ws.checked, ws.model) for r in decide_plan(ws.plan, ws.checked, ws.model)]
     model_hash = hashlib.sha256(dumps(ws.model.to_json()).encode("utf-8")).hexdigest()  # as the report takes it
     records: list[dict[str, Any]] = []
@@ -57,7 +60,7 @@ def stage_deadlines(ws: "Workspace") -> tuple[list[DeadlineResult], list[dict[st
             atomic_write_text(ws.path(rec["smt2"]), r.smt2)
             keep.add(rec["smt2"].rsplit("/", 1)[1])
         inputs = {}
-        for n in dict.fromkeys(r.path):
+        for n in nodes_between(ws.model, r.path):  # every node the worst path may take, as the task's inputs
             p = ws.path(ws.snapshot(n))
             inputs[ws.snapshot(n)] = hashlib.sha256(p.read_bytes()).hexdigest() if p.is_file() else ""
         inputs[ws.MODEL] = model_hash

@@ -12,7 +12,8 @@ named in the record either way.
 
 Paths are enumerated up to :data:`MAX_PATHS` (networkx's simple-path
 enumeration, loops never repeated); beyond it the record says the search was
-cut.
+cut, and a deadline the paths examined do not refute is ``inconclusive``,
+never ``proved`` (a path not examined may be the slow one).
 """
 from __future__ import annotations
 
@@ -22,7 +23,7 @@ from typing import Any, Sequence
 
 from ..rcl.types import Checked
 from ..system.model import SystemModel
-from .deadlines import PROVED, REFUTED, _show, chains, decide
+from .deadlines import INCONCLUSIVE, PROVED, REFUTED, _show, chains, decide
 
 #: The largest number of paths from A to B examined.
 MAX_PATHS = 200
@@ -94,9 +95,9 @@ def with_worst_path(result: Any, checked: Checked, model: SystemModel) -> Any:
         tight = min(sum((h.bound for h in c), Fraction(0)) for c in found)
         if worst is None or tight > worst[1]:
             worst = (p, tight)
-    note = " (more than 200 paths: the search was cut)" if cut else ""
+    note = f" (more than {MAX_PATHS} paths: the search was cut)" if cut else ""
     if worst is None or (result.total is not None and worst[1] <= result.total):
-        return replace(result, reason=result.reason + note) if note else result
+        return _cut(replace(result, reason=result.reason + note) if note else result, cut)
     p, total = worst
     named = " -> ".join(result.path)
     if result.status == PROVED and total > result.within:
@@ -105,5 +106,16 @@ def with_worst_path(result: Any, checked: Checked, model: SystemModel) -> Any:
             return replace(other, path=result.path, worst_path=p,
                            reason=f"another path from {p[0]} to {p[-1]} is slower than the one named ({named}): "
                                   f"{other.reason}" + note)
-    return replace(result, worst_path=p, reason=f"{result.reason}; the slowest path from {p[0]} to {p[-1]} is "
-                                                f"{' -> '.join(p)}, {_show(total)}, not the one named{note}")
+    return _cut(replace(result, worst_path=p, reason=f"{result.reason}; the slowest path from {p[0]} to {p[-1]} is "
+                                                     f"{' -> '.join(p)}, {_show(total)}, not the one named{note}"), cut)
+
+
+def _cut(result: Any, cut: bool) -> Any:
+    """``result``, not ``proved`` when the path search was cut: a path not
+    examined may be slower than the bound, so the named path's proof does
+    not prove the deadline (``inconclusive``, saying so)."""
+    if not cut or result.status != PROVED:
+        return result
+    return replace(result, status=INCONCLUSIVE,
+                   reason=f"{result.reason}; not every path from {result.path[0]} to {result.path[-1]} was examined "
+                          f"(more than {MAX_PATHS}), and one not examined may be slower than the bound: not proved")

@@ -16,6 +16,10 @@ from typing import Any, Mapping
 from .stage import DOWNGRADES
 
 _STAGE_MISSING = "the second-solver stage has not decided it (run `doit verify`)"
+_NO_QUERY = ("no single SMT-LIB2 query is kept for this verdict (a temporal proof by BMC, k-induction or a "
+             "ranking function; a scan instance by instance), so the second solver has none to decide")
+_OTHER_TEXT = ("the second solver decided another text of this query (its sha256 differs from the query's now): "
+               "this one is Z3's alone until the second-solver stage runs again (run `doit verify`)")
 
 
 class SecondSolver:
@@ -34,6 +38,9 @@ class SecondSolver:
         if r is None or (smt2 is not None and r.get("smt2") != smt2):
             why = f"second-solver record: {self.problem}" if self.problem else _STAGE_MISSING
             return {"agreement": "one solver", "why": why, "cvc5": None, "proof": "", "smt2": smt2 or ""}
+        if r.get("other_text"):
+            return {"agreement": "one solver", "why": _OTHER_TEXT, "cvc5": None, "proof": "",
+                    "smt2": str(r.get("smt2", ""))}
         c = r.get("cvc5") if isinstance(r.get("cvc5"), dict) else None
         return {"agreement": str(r.get("agreement")), "why": str(r.get("why", "")),
                 "cvc5": None if c is None else {k: c.get(k) for k in ("answer", "reason", "version", "proof_checked")},
@@ -46,6 +53,9 @@ class SecondSolver:
         ``inconclusive`` and the fields ``downgraded(row, solvers)`` gives."""
         if row is None or row.get(status_key) != good:
             return row
+        if not row.get("smt2"):  # no query kept (a temporal proof, a scan instance by instance): nothing to re-decide
+            return {**row, "solvers": {"agreement": "one solver", "why": _NO_QUERY, "cvc5": None, "proof": "",
+                                       "smt2": ""}}
         s = self.solvers(kind, str(row.get(id_key)), row.get("smt2"))
         if s["agreement"] in DOWNGRADES:
             return {**row, status_key: "inconclusive", "solvers": s, **downgraded(row, s)}
@@ -105,13 +115,28 @@ class SecondSolver:
         """How many items each agreement has (the report's headline)."""
         out: dict[str, int] = {}
         for r in self.rows.values():
-            a = str(r.get("agreement"))
+            a = "one solver" if r.get("other_text") else str(r.get("agreement"))
             out[a] = out.get(a, 0) + 1
         return dict(sorted(out.items()))
 
 
 def load(root: Any) -> SecondSolver:
-    """The :class:`SecondSolver` of the workspace at ``root`` (a ``Path``)."""
+    """The :class:`SecondSolver` of the workspace at ``root`` (a ``Path``).
+    A row whose query file now holds another text than the one cvc5
+    decided (its ``sha256``; a stage re-wrote it since, the second-solver
+    stage not yet) is marked ``other_text``: its agreement is not carried
+    over to a query cvc5 never saw, whichever way it went."""
+    import hashlib
+
     from .stage import read_crosscheck
     rows, problem = read_crosscheck(root)
+    for key, r in list(rows.items()):
+        rel = r.get("smt2")
+        try:
+            text = (root / str(rel)).read_text(encoding="utf-8") if isinstance(rel, str) and rel else None
+            now = hashlib.sha256(text.encode("utf-8")).hexdigest() if text is not None else ""  # as the stage hashes
+        except (OSError, UnicodeDecodeError):
+            now = ""
+        if now != r.get("sha256"):
+            rows[key] = {**r, "other_text": True}
     return SecondSolver(rows, problem)

@@ -17,8 +17,14 @@ The check asks Z3 for an input with no answer::
     A(in) and F_in(in) and forall out. (typing(out) and F_out(in, out) -> not (G1 and ... and Gn))
 
 (``F_in``/``F_out``: the plan's environment facts of the node over its inputs
-only / mentioning an output; ``typing``: an output of a NATURAL type, or a
-constructor's NATURAL field, is ``>= 0``).  With function-typed inputs it
+only / mentioning an output; ``typing``: every NATURAL part of an output is
+``>= 0``: the output itself, a constructor's field, a tuple's component,
+at any depth, :func:`natural_typing`; the encoder's axioms cover the first
+two only, and an ``unsat`` over outputs the type excludes, a tuple ``(-1,
+0)`` of ``(NATURAL, NATURAL)``, proved contracts realizable that are not.
+A sequence's or a set's NATURAL elements are not typed: there a ``sat``
+is still an input with no answer, an ``unsat`` proves nothing and nothing
+is reported).  With function-typed inputs it
 first asks for such an input in which every function is a finite table
 (:mod:`.witness`), which Z3 finds in a fraction of the general query's time;
 a table witness is a genuine input.  Without function-typed inputs the
@@ -48,7 +54,8 @@ import z3
 from ..logic.encode import Encoder
 from ..logic.query import STEPS_PER_MS, SAFETY_FACTOR, render_model, satisfiable, smt2_script
 from ..rcl import ast
-from ..rcl.types import Checked
+from ..logic.natural import natural_typing
+from ..rcl.types import Checked, FuncT
 from .finding import Finding
 from .shape import outputs_mentioned
 from .witness import finite_witness, has_tables, points_for
@@ -88,10 +95,17 @@ class _Query:
             named |= outputs_mentioned(f, cn)
         constrained = [v for v in cn.outputs if v in named]
         self.outs = [enc.io_symbol(cn, "out", v) for v in constrained]
-        typed = Encoder(checked.env)  # the outputs' typing axioms, and only theirs
+        typed = Encoder(checked.env)  # the outputs' names, and only theirs
         for v in constrained:
             typed.io_symbol(cn, "out", v)
-        self.typing = typed.axioms()
+        self.typing: list[z3.BoolRef] = []
+        #: every NATURAL part of the outputs typed: without it an ``unsat`` is not a proof (module docstring)
+        self.exact = True
+        for v in constrained:
+            if not isinstance(cn.outputs[v], FuncT):
+                cs, ok = natural_typing(enc.io_symbol(cn, "out", v), cn.outputs[v])
+                self.typing += cs
+                self.exact = self.exact and ok
         out_names = {typed.symbol_name(cn.name, "out", v) for v in constrained}
         for name in out_names:  # bound below: not free symbols of the query (models show the inputs)
             enc.symbols.pop(name, None)
@@ -160,6 +174,8 @@ def realizability_findings(checked: Checked, node: str, facts: Sequence[tuple[as
         return []  # forall over a function-typed output: not first-order, not checked
     every = list(range(len(n.guarantees)))
     status, model, secs, smt2 = q.answer(every, f"health {node}: is there an input no output answers?")
+    if status == "unsat" and not q.exact:
+        return []  # proved over outputs the type excludes too (a negative element of a seq(NATURAL)): no proof
     if status == "unsat":
         return [Finding(f"{node}.realizable", node, "realizable", None, "ok",
                         f"The contract of {node} can be implemented: every input its assumption"

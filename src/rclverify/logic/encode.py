@@ -35,7 +35,8 @@ from typing import Any, Mapping
 import z3
 
 from ..rcl import ast
-from ..rcl.types import NATURAL, CheckedNode, DataT, Env, FuncT, Type
+from ..rcl.types import NATURAL, CheckedNode, DataT, Env, FuncT, SeqT, SetT, TupleT, Type
+from .natural import natural_typing
 from .modeltext import _render, _term_parts, _term_to_rcl_reference, _value_parts, term_to_rcl, value_to_rcl
 from .sorts import (_ctor, _join_sort, _recogniser, _tuple_fields, apply_operator, coerce, enum_const, sort_of,
                     tuple_sort, widen)
@@ -100,23 +101,23 @@ class Encoder:
         """Typing side constraints of every free symbol created so far.
 
         NATURAL constants are ``>= 0``; functions with a NATURAL result are
-        ``>= 0`` everywhere; constructor-set constants have NATURAL fields
-        ``>= 0``.
+        ``>= 0`` everywhere; constructor-set and tuple constants (and
+        function results) have their NATURAL parts ``>= 0`` at any depth
+        (:func:`.natural.natural_typing`), a sequence's or a set's NATURAL
+        elements by a quantified axiom.
         """
         out: list[z3.BoolRef] = []
         for sym in self.symbols.values():
             t = sym.type
-            if t == NATURAL:
-                out.append(sym.decl >= 0)
-            elif isinstance(t, FuncT) and t.result == NATURAL:
+            if isinstance(t, FuncT):
                 xs = [z3.Const(f"_a{k}", sort_of(a)) for k, a in enumerate(t.args)]
-                out.append(z3.ForAll(xs, sym.decl(*xs) >= 0) if xs else sym.decl() >= 0)
-            elif isinstance(t, DataT):
-                for cname, args in t.ctors:
-                    for k, a in enumerate(args):
-                        if a == NATURAL:
-                            acc = getattr(sort_of(t), f"{cname}_{k}")
-                            out.append(z3.Implies(_recogniser(t, cname)(sym.decl), acc(sym.decl) >= 0))
+                if t.result == NATURAL:
+                    out.append(z3.ForAll(xs, sym.decl(*xs) >= 0) if xs else sym.decl() >= 0)
+                elif xs and isinstance(t.result, (DataT, TupleT, SeqT, SetT)):
+                    cs, _ = natural_typing(sym.decl(*xs), t.result, quantified=True)
+                    out += [z3.ForAll(xs, c) for c in cs]
+            elif isinstance(t, (DataT, TupleT, SeqT, SetT)) or t == NATURAL:
+                out += natural_typing(sym.decl, t, quantified=True)[0]
         return out
 
     # -- formulas ----------------------------------------------------------------------------

@@ -17,7 +17,7 @@ every diagnostic lands on the plan's line and column.
 
 Errors (``E-type``: a ranking term that is not integer-valued;
 ``E-temporal``: either key on a requirement whose ``formal:`` is not an
-unbounded ``eventually`` or an ``until``; the name and type errors of
+unbounded ``eventually``, an ``until`` or an unbounded response; the name and type errors of
 :func:`.formal.read_expr`) are located :class:`RclError` diagnostics.
 """
 from __future__ import annotations
@@ -62,9 +62,15 @@ def parse_ranking(src: Source, checked: Checked, what: str,
 
 
 def is_liveness(t: "Temporal | Formal") -> bool:
-    """Whether statement ``t`` is an unbounded ``eventually F`` or an
-    ``F until G``: the statements a ranking function proves."""
-    return isinstance(t, Temporal) and ((t.op == "eventually" and t.bound is None) or t.op == "until")
+    """Whether statement ``t`` is an unbounded ``eventually F``, an ``F
+    until G`` or the unbounded response ``always (P -> eventually Q)``: the
+    statements a ranking function proves (docs/requirements.md)."""
+    if not isinstance(t, Temporal):
+        return False
+    if t.op == "always" and isinstance(t.args[0], Temporal) and t.args[0].op == "->":
+        r = t.args[0].args[1]
+        return isinstance(r, Temporal) and r.op == "eventually" and r.bound is None
+    return (t.op == "eventually" and t.bound is None) or t.op == "until"
 
 
 def parse_hints(ranking: Source | None, invariant: Source | None, statement: "Temporal | Formal",
@@ -82,7 +88,7 @@ def parse_hints(ranking: Source | None, invariant: Source | None, statement: "Te
             continue
         if not is_liveness(statement):
             diags.append(error(src.loc, f"{rid} {key}: {'a ranking function' if k == 0 else 'an invariant'} is read only for a liveness statement "
-                                        "(formal: eventually F without a bound, or F until G)", "E-temporal"))
+                                        "(formal: eventually F without a bound, F until G, or always (F -> eventually G))", "E-temporal"))
             continue
         try:
             out[k] = (parse_ranking(src, checked, f"{rid} ranking", states) if k == 0

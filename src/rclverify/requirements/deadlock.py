@@ -129,10 +129,11 @@ def _stopped(states: list[State], m: z3.ModelRef, k: int, what: str) -> Temporal
 
 
 def find_deadlock(ts: TransitionSystem, bound: int, *, staying: Pred | None = None,
-                  timeout_ms: int = 10_000, what: str = "") -> TemporalVerdict | None:
+                  timeout_ms: int = 10_000, what: str = "", ending: Pred | None = None) -> TemporalVerdict | None:
     """The shortest run ``s0 .. sk`` (``0 <= k < bound``) from an initial
     state whose states all satisfy ``staying`` (default: any) and whose last
-    state has no successor.
+    state has no successor (and satisfies ``ending``, default: any; the
+    unbounded response's "a trigger is pending when it stops").
 
     Returns ``refuted`` (method ``deadlock``, ``bound = k``, the run as the
     trace; ``what`` is appended to "the run stops at step k" in the
@@ -160,7 +161,8 @@ def find_deadlock(ts: TransitionSystem, bound: int, *, staying: Pred | None = No
             return TemporalVerdict("inconclusive", "deadlock", bound=k,
                                    detail=f"Z3 could not decide whether a run reaches step {k} ({why})",
                                    deadlock=f"undecided at step {k}")
-        r, m, why = _check(s, [no_successor(ts, states[k])], timeout_ms)
+        r, m, why = _check(s, [no_successor(ts, states[k]), *([ending(states[k])] if ending is not None else [])],
+                           timeout_ms)
         if r == z3.sat:
             assert m is not None
             return _stopped(states, m, k, what)

@@ -40,6 +40,8 @@ and not Q``) and decides:
 * ``refuted`` (method ``lasso``) by a run whose last state equals an
   earlier one, the loop meeting the fairness constraints, with a P pending
   in every state of the loop: repeated forever, that P is never answered;
+  or (method ``deadlock``) by a run that stops with a P pending (the
+  caller's check that no run stops refutes a proof only);
 * else ``inconclusive``, naming what was tried.
 """
 from __future__ import annotations
@@ -48,6 +50,7 @@ import z3
 
 from typing import Callable
 
+from .deadlock import find_deadlock
 from .temporal import _ranking_fails, check_always
 from .tsys import Pred, TemporalVerdict, TransitionSystem, fair_loop, trace_of, unroll, with_flag
 
@@ -92,8 +95,9 @@ def check_unbounded_response(ts: TransitionSystem, trigger: Pred, goal: Pred, *,
                              timeout_ms: int = 10_000, ranking: Callable[[dict], z3.ArithRef] | None = None,
                              invariant: Pred | None = None) -> TemporalVerdict:
     """Decide ``always (trigger -> eventually goal)`` (module docstring):
-    ``proved`` by ``ranking`` (with ``invariant``, which the caller has
-    proved) or by the bounded pattern for an N of :data:`BOUNDS` up to
+    ``proved`` by ``ranking`` (inside ``invariant``, itself proved here by
+    k-induction first: an invariant that is not proved leaves the ranking
+    function unused) or by the bounded pattern for an N of :data:`BOUNDS` up to
     ``max_k``; ``refuted`` by a lasso of at most ``max_k`` steps with a
     trigger pending around its loop; else ``inconclusive``.  ``timeout_ms``
     bounds each solver call (milliseconds)."""
@@ -102,12 +106,18 @@ def check_unbounded_response(ts: TransitionSystem, trigger: Pred, goal: Pred, *,
     why = "no ranking function"
     if ranking is not None:
         inv = invariant or (lambda st: z3.BoolVal(True))
-        failed = _ranking_fails(ts2, lambda st: z3.Not(st["<pending>"]), inv, ranking, timeout_ms)
-        if failed is None:
-            return TemporalVerdict("proved", "ranking", detail="in every state of the invariant where a trigger is "
-                                                               "pending, the ranking function is >= 0 and every step "
-                                                               "decreases it")
-        why = failed
+        # the rule holds only inside the invariant: an invariant that is not proved proves nothing
+        iv = check_always(ts, inv, max_k=max_k, timeout_ms=timeout_ms) if invariant is not None else None
+        if iv is not None and iv.status != "proved":
+            why = (f"ranking function not used: its invariant is not proved ({iv.status} by {iv.method}"
+                   + (f": {iv.detail}" if iv.detail else "") + ")")
+        else:
+            failed = _ranking_fails(ts2, lambda st: z3.Not(st["<pending>"]), inv, ranking, timeout_ms)
+            if failed is None:
+                return TemporalVerdict("proved", "ranking", k=iv.k if iv else None,
+                                       detail="in every state of the invariant where a trigger is pending, the "
+                                              "ranking function is >= 0 and every step decreases it")
+            why = failed
     tried = []
     for n in (b for b in BOUNDS if b <= max_k):
         v = check_response(ts, trigger, goal, n, max_k=max_k, timeout_ms=timeout_ms)
@@ -134,6 +144,11 @@ def check_unbounded_response(ts: TransitionSystem, trigger: Pred, goal: Pred, *,
                                    detail=f"{why}; not answered within {', '.join(tried)}; Z3 could not decide "
                                           f"whether a run of {n} steps loops with a trigger pending "
                                           f"({sv.reason_unknown()})")
-    return TemporalVerdict("inconclusive", "lasso", bound=max_k,
+    # a run that stops with a trigger pending never answers it (docs/requirements.md, "Runs that stop")
+    stop = find_deadlock(ts2, max_k, ending=lambda st: st["<pending>"], timeout_ms=timeout_ms,
+                         what=" with a trigger pending")
+    if stop is not None and stop.status == "refuted":
+        return stop
+    return TemporalVerdict("inconclusive", "lasso", bound=max_k, deadlock=stop.deadlock if stop is not None else "",
                            detail=f"{why}; the bounded pattern tried {', '.join(tried) or 'no bound'}; no run of up "
                                   f"to {max_k} steps loops with a trigger pending")

@@ -4,7 +4,9 @@
 by step, with the finite-trace verdicts of :mod:`.temporal_trace`: a
 trigger not answered in time is ``false`` at the step where the time ran
 out; a trigger still pending when the trace ends is ``currently_false`` (a
-longer run may answer it); otherwise ``true`` (evidence, not a proof).
+longer run may answer it); otherwise ``true`` (evidence, not a proof).  A
+response undecided at a step may answer every trigger pending there: none
+of them is ever ``false`` (the verdict is undecided at that step).
 The rule is the composed system's (:mod:`rclverify.requirements.response`):
 a P at step i needs Q at some step i..i+N (``next``: Q at step i+1).
 The unbounded ``always (P -> eventually Q)`` is N = infinity: never
@@ -38,10 +40,11 @@ class ResponseTracker:
         if q is True:
             self.pending = None
             return None
+        if q is None:  # the response may hold here: what is pending, and a trigger now, may be answered
+            self.pending = None
+            return "undecided", 1
         if self.pending is None and p is True:
             self.pending = i
         if self.pending is not None and q is False and i - self.pending >= self.within:
             return "false", self.pending
-        if p is None or q is None:
-            return "undecided", 0 if p is None else 1
-        return None
+        return ("undecided", 0) if p is None else None

@@ -19,7 +19,9 @@ assumption and the facts admitted, which the implementation ran on):
   measured, and said so.
 
 Returns, per input, ``{"range", "drawn", "buckets", "covered", "fraction"}``
-(``fraction`` ``None`` where not measured).
+(``fraction`` ``None`` where not measured), and ``admitted`` (the
+assumption's own range) where the plan's ``bounds:`` narrowed it: the
+fraction is of the range drawn from, not of all the assumption admits.
 """
 from __future__ import annotations
 
@@ -53,10 +55,20 @@ class Coverage:
     within ``bounds`` (input name -> :class:`~.strategies.Bound`, the
     strategy's own)."""
 
-    def __init__(self, node: CheckedNode, bounds: Mapping[str, Bound]) -> None:
+    def __init__(self, node: CheckedNode, bounds: Mapping[str, Bound],
+                 admitted: Mapping[str, Bound] | None = None) -> None:
         self.kinds: dict[str, tuple[str, Any]] = {}
+        #: per input, the assumption's own range where the plan's ``bounds:`` narrowed it (text)
+        self.admitted: dict[str, str] = {}
         for name, t in node.inputs.items():
             bd = bounds.get(name) or Bound()
+            if admitted is not None and isinstance(t, Scalar) and t.name in ("INTEGER", "NATURAL", "REAL"):
+                own = admitted.get(name) or Bound()
+                lo0 = own.lo if own.lo is not None else (Fraction(0) if t.name == "NATURAL" else None)
+                lo1 = bd.lo if bd.lo is not None else (Fraction(0) if t.name == "NATURAL" else None)
+                if (lo0, own.hi) != (lo1, bd.hi):
+                    self.admitted[name] = (f"[{'-inf' if lo0 is None else _text(lo0)}, "
+                                           f"{'inf' if own.hi is None else _text(own.hi)}]")
             if isinstance(t, Scalar) and t.name == "BOOL":
                 self.kinds[name] = ("finite", ("TRUE", "FALSE"))
             elif isinstance(t, EnumT):
@@ -125,6 +137,8 @@ class Coverage:
                     n = _count(spec)
                     out[key] = {"range": rng, "drawn": drawn, "buckets": n, "covered": len(self.seen[name]),
                                 "fraction": round(len(self.seen[name]) / n, 4)}
+                if name in self.admitted:
+                    out[key]["admitted"] = self.admitted[name]
             else:
                 out[key] = {"range": f"{spec} (not measured)", "drawn": "", "buckets": None, "covered": None,
                             "fraction": None}

@@ -47,7 +47,7 @@ from ...rcl.types import Checked, CheckedNode
 from ...values import conforms, render
 from .seeding import Seeder, split_facts
 from .coverage import Coverage
-from .strategies import conjuncts, input_space
+from .strategies import assumption_bounds, conjuncts, input_space
 
 DEFAULT_MAX_EXAMPLES = 200
 DEFAULT_SEED = 20260
@@ -267,7 +267,7 @@ class GuaranteeRun:
             formulas = tuple(c.formula for c in self.node.node.assumes) + self.used_facts
             seed = Seeder(self.checked, self.node, formulas).base()
         space = input_space(self.node, self.cfg.bounds, seed)
-        self.coverage = Coverage(self.node, space.bounds)
+        self.coverage = Coverage(self.node, space.bounds, assumption_bounds(self.node))
         one = space.inputs().filter(self.assumption_holds)
         if self.stateful:
             return st.lists(one, min_size=1, max_size=self.cfg.steps)
