@@ -45,7 +45,7 @@ VOCAB = ["(", ")", "{", "}", "<", ">", "<>", ",", ";", ":", "|", "=", "==", "!="
          "initially(", "progress(", "eventually", "within", "steps", "periodic(", "progress( within 2 steps )",
          "initially( out.o == 0 )", "periodic( out.o, 100 ms )"]
 
-FUZZ = settings(derandomize=True, deadline=None, database=None, max_examples=800,
+FUZZ = settings(derandomize=True, deadline=None, database=None, max_examples=500,
                 suppress_health_check=list(HealthCheck))
 
 
@@ -114,7 +114,7 @@ YAML_VOCAB = ["&a ", "*a", "&b ", "*b", "[", "]", "{", "}", ": ", "- ", "\n", " 
               "!!python/object:os.system", "!!binary", "? ", "|", ">", "#", ",", "%YAML 1.1\n", "---\n", "...\n"]
 
 
-@settings(derandomize=True, deadline=None, database=None, max_examples=800, suppress_health_check=list(HealthCheck))
+@settings(derandomize=True, deadline=None, database=None, max_examples=500, suppress_health_check=list(HealthCheck))
 @given(st.one_of(st.lists(mutation.map(lambda m: (m[0], m[1], m[2], YAML_VOCAB[hash(m[3]) % len(YAML_VOCAB)])),
                           min_size=1, max_size=6).map(lambda ops: mutate(PLAN, ops)),
                  st.lists(st.sampled_from(YAML_VOCAB), max_size=40).map("".join)))
