@@ -142,6 +142,25 @@ def implementation(k: int, producers: list[int]) -> str:
             f"    return {{'v{k}': {ins[0]} if {ins[0]} >= 0 else 0}}\n\n\n")
 
 
+def evidence(nodes: dict[str, object], impls: list[str], k: int, producers: list[int], hoare: bool,
+             property_tests: bool) -> None:
+    """Node ``N<k>``'s plan entries, added to ``nodes``: a ``hoare`` entry over
+    the clamp program (``hoare``), a ``property_tests`` entry of 25 examples
+    over its clamp in Python, whose text is appended to ``impls``
+    (``property_tests``)."""
+    ins = [f"v{p}" for p in producers] or ["e0"]
+    binding = {f"in.{ins[0]}": "x", f"out.v{k}": "y", **{f"in.{i}": "z" for i in ins[1:]}}
+    entries: list[dict[str, object]] = []
+    if hoare:
+        entries.append({"backend": "hoare", "program": "backends/hoare/clamp.imp", "binding": binding})
+    if property_tests:
+        impls.append(implementation(k, producers))
+        entries.append({"backend": "property_tests", "implementation": f"backends/property_tests/clamp.py:n{k}",
+                        "max_examples": 25})
+    if entries:
+        nodes[f"N{k}"] = {"evidence": entries}
+
+
 def generate(root: Path, n: int, property_tests: bool, pt_every: int = 10, hoare_every: int = 1) -> None:
     """Write an ``n``-node workspace under ``root`` (which must not exist);
     every ``hoare_every``-th node (0: none) gets a ``hoare`` entry over the
@@ -156,18 +175,8 @@ def generate(root: Path, n: int, property_tests: bool, pt_every: int = 10, hoare
     impls: list[str] = []
     for k in range(n):
         (root / "contracts" / f"n{k}.rcl").write_text(contract(k, prod[k]))
-        ins = [f"v{p}" for p in prod[k]] or ["e0"]
-        binding = {f"in.{ins[0]}": "x", f"out.v{k}": "y"}
-        binding.update({f"in.{i}": "z" for i in ins[1:]})
-        entries: list[dict[str, object]] = []
-        if hoare_every and k % hoare_every == 0:
-            entries.append({"backend": "hoare", "program": "backends/hoare/clamp.imp", "binding": binding})
-        if property_tests and k % pt_every == 0:
-            impls.append(implementation(k, prod[k]))
-            entries.append({"backend": "property_tests", "implementation": f"backends/property_tests/clamp.py:n{k}",
-                            "max_examples": 25})
-        if entries:
-            nodes[f"N{k}"] = {"evidence": entries}
+        evidence(nodes, impls, k, prod[k], bool(hoare_every) and k % hoare_every == 0,
+                 property_tests and k % pt_every == 0)
     if impls:
         (root / "backends" / "property_tests").mkdir(parents=True)
         (root / "backends" / "property_tests" / "clamp.py").write_text("".join(impls))

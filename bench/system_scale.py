@@ -51,7 +51,7 @@ import yaml
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from pipeline_scale import CLAMP, DODO, doit_verify, has_property_tests, implementation, topology  # noqa: E402
+from pipeline_scale import CLAMP, DODO, doit_verify, evidence, has_property_tests, topology  # noqa: E402
 
 #: Service calls and deadline requirements: every how many nodes (defaults).
 SERVICES_EVERY = 25
@@ -107,17 +107,8 @@ def generate(root: Path, n: int, *, services: int = SERVICES_EVERY, deadlines: i
     for k in range(n):
         (root / "contracts" / f"n{k}.rcl").write_text(
             contract(k, prod[k], k + 1 if k + 1 in clients else None, k in clients))
-        ins = [f"v{p}" for p in prod[k]] or ["e0"]
-        binding = {f"in.{ins[0]}": "x", f"out.v{k}": "y", **{f"in.{i}": "z" for i in ins[1:]}}
-        entries: list[dict[str, Any]] = []
-        if hoare and k % hoare == 0:
-            entries.append({"backend": "hoare", "program": "backends/hoare/clamp.imp", "binding": binding})
-        if pt and k % property_tests == 0 and k not in clients and k + 1 not in clients:
-            impls.append(implementation(k, prod[k]))
-            entries.append({"backend": "property_tests", "implementation": f"backends/property_tests/clamp.py:n{k}",
-                            "max_examples": 25})
-        if entries:
-            nodes[f"N{k}"] = {"evidence": entries}
+        evidence(nodes, impls, k, prod[k], bool(hoare) and k % hoare == 0,
+                 pt and k % property_tests == 0 and k not in clients and k + 1 not in clients)
     if impls:
         (root / "backends" / "property_tests").mkdir(parents=True)
         (root / "backends" / "property_tests" / "clamp.py").write_text("".join(impls))
