@@ -97,24 +97,33 @@ def _io_type(node: CheckedNode, qualified: str) -> Type:
     return table[name]
 
 
-_ENCODED: dict[tuple[int, str], tuple[ast.Expr, z3.BoolRef, dict[str, Any]]] = {}
+_ENCODED: dict[tuple[int, str], tuple[ast.Expr, z3.BoolRef, dict[str, Any], list[z3.BoolRef]]] = {}
 on_fresh(_ENCODED.clear)  # its formulas belong to the Z3 context they were made in
 
 
-def _encoded(formula: ast.Expr, checked: Checked, node: CheckedNode) -> tuple[z3.BoolRef, dict[str, Any]]:
+def _encoded_typed(formula: ast.Expr, checked: Checked,
+                   node: CheckedNode) -> tuple[z3.BoolRef, dict[str, Any], list[z3.BoolRef]]:
     """``formula`` encoded once over free I/O symbols (cached per formula object:
-    encoding costs more than the check), with those symbols by qualified name."""
+    encoding costs more than the check), with those symbols by qualified name
+    and the encoder's typing axioms over them (``NATURAL >= 0``, ...)."""
     key = (id(formula), node.name)
     hit = _ENCODED.get(key)
     if hit is not None and hit[0] is formula:
-        return hit[1], hit[2]
+        return hit[1], hit[2], hit[3]
     enc = Encoder(checked.env)
     phi = enc.formula(formula, node)
     free: dict[str, Any] = {}
     for sym in enc.symbols.values():
         q = sym.z3name.split(".", 1)[1]  # "<Node>.in.x" -> "in.x"
         free[q] = sym.decl
-    _ENCODED[key] = (formula, phi, free)
+    axioms = list(enc.axioms())
+    _ENCODED[key] = (formula, phi, free, axioms)
+    return phi, free, axioms
+
+
+def _encoded(formula: ast.Expr, checked: Checked, node: CheckedNode) -> tuple[z3.BoolRef, dict[str, Any]]:
+    """:func:`_encoded_typed` without the axioms."""
+    phi, free, _ = _encoded_typed(formula, checked, node)
     return phi, free
 
 
@@ -191,22 +200,21 @@ def false_whatever_the_rest(formula: ast.Expr, checked: Checked, node: CheckedNo
     Z3 cannot say.  Raises as :func:`check_concrete`."""
     for q in values:
         _io_type(node, q)
+    phi, free, axioms = _encoded_typed(formula, checked, node)  # encoded once per formula (a monitor asks often)
     enc = Encoder(checked.env)
-    phi = enc.formula(formula, node)
     consts: list[tuple[z3.ExprRef, z3.ExprRef]] = []
     funcs: list[tuple[z3.FuncDeclRef, z3.ExprRef]] = []
-    for sym in list(enc.symbols.values()):
-        q = sym.z3name.split(".", 1)[1]
+    for q, decl in free.items():
         if q not in values:
             continue
         t, v = _io_type(node, q), values[q]
         if isinstance(t, FuncT):
             if not isinstance(v, FiniteFunction):
                 raise ConcreteValueError(f"{q}: {v!r} is not a finite function ({t})")
-            funcs.append((sym.decl, finite_interpretation(v, t, enc)))
+            funcs.append((decl, finite_interpretation(v, t, enc)))
         else:
-            consts.append((sym.decl, to_z3(v, t, enc)))
-    body = z3.And(phi, *enc.axioms())  # the free outputs range over their types (NATURAL >= 0, ...)
+            consts.append((decl, to_z3(v, t, enc)))
+    body = z3.And(phi, *axioms)  # the free outputs range over their types (NATURAL >= 0, ...)
     if consts:
         body = z3.substitute(body, *consts)
     if funcs:
