@@ -92,6 +92,10 @@ def master(tmp_path_factory: pytest.TempPathFactory) -> Iterator[str]:
 
 def test_master_reads_services_and_actions(master: str) -> None:
     g = read_master(master)
+    for _ in range(2):  # a service's type is probed from the live node, within 5 s: on a machine whose cores
+        if not g.notes:  # other test workers hold, a probe may time out (a note says so); ask again, bounded
+            break
+        g = read_master(master)
     base = next(n for k, n in g.nodes.items() if k.startswith("/base"))
     assert [(e.topic, e.msg_type) for e in base.service_servers] == [("/estop", "std_srvs/srv/SetBool")]
     mover = next(n for k, n in g.nodes.items() if k.startswith("/mover"))
