@@ -1,9 +1,14 @@
 """Names the C++ translation modules share (:mod:`.cpp_expr`, :mod:`.cpp_quant`): the error a
-formula outside the translated fragment raises and the C++ constant of an enumeration value."""
+formula outside the translated fragment raises, the C++ constant of an enumeration value and the
+C++ type of an RCL scalar."""
 from __future__ import annotations
 
 from ..rcl.types import EnumT
 from .typemap import snake
+
+
+#: RCL scalar -> C++ type of a struct field (a table's or term's NATURAL is signed: :mod:`.cpp_values`)
+CPP_SCALARS = {"REAL": "double", "INTEGER": "std::int64_t", "NATURAL": "std::uint64_t", "BOOL": "bool"}
 
 
 class Untranslatable(ValueError):
@@ -20,4 +25,4 @@ def camel_words(s: str) -> str:
     return "".join(p[:1].upper() + p[1:] for p in snake(s).split("_"))
 
 
-__all__ = ["Untranslatable", "camel_words", "enum_const"]
+__all__ = ["CPP_SCALARS", "Untranslatable", "camel_words", "enum_const"]

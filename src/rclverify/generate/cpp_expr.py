@@ -35,14 +35,10 @@ from __future__ import annotations
 
 from ..rcl import ast
 from ..rcl.types import Checked, CheckedNode, DataT, EnumT, FuncT, Scalar, Type
-from .cpp_common import Untranslatable, enum_const
+from .cpp_common import CPP_SCALARS, Untranslatable, enum_const
 from .cpp_quant import quantifier
 from .cpp_values import kind_of, table_type, term_struct
 from .typemap import snake
-
-#: RCL scalar -> C++ type of the struct field
-CPP_SCALARS = {"REAL": "double", "INTEGER": "std::int64_t", "NATURAL": "std::uint64_t", "BOOL": "bool"}
-
 
 def cpp_type(t: Type) -> str | None:
     """The C++ field type of an RCL type, ``None`` when the header cannot hold it."""

@@ -18,11 +18,11 @@ from __future__ import annotations
 from typing import Any
 
 from ..rcl.types import DataT, EnumT, FuncT, Scalar, Type
-from .cpp_common import camel_words
+from .cpp_common import CPP_SCALARS, camel_words
 from .typemap import snake
 
-#: RCL scalar -> C++ type inside a table or a term
-_INNER = {"REAL": "double", "INTEGER": "std::int64_t", "NATURAL": "std::int64_t", "BOOL": "bool"}
+#: RCL scalar -> C++ type inside a table or a term: a field's, but INTEGER and NATURAL both std::int64_t (module docstring)
+_INNER = {**CPP_SCALARS, "NATURAL": "std::int64_t"}
 
 
 def inner_type(t: Type) -> str | None:
