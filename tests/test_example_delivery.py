@@ -43,6 +43,9 @@ from typing import Any
 
 import pytest
 
+from _example_report import changed as _changed, diag as _diag, first_repair as _first_repair, monitoring, \
+    rows as _rows, verify as _verify
+
 from rclverify.cli import main
 
 EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "delivery"
@@ -76,11 +79,6 @@ def _record(ws: Path) -> None:
         sys.path[:] = saved_path
 
 
-def _verify(ws: Path, *extra: str) -> tuple[int, dict[str, Any]]:
-    rc = main(["verify", "-w", str(ws), *extra])
-    return rc, json.loads((ws / "reports" / "assurance.json").read_text(encoding="utf-8"))
-
-
 def _events(ws: Path) -> list[tuple[float, str, dict[str, Any]]]:
     from rclverify.traces import read_trace
     return [(e.time, e.topic, dict(e.fields)) for e in read_trace(ws / RUN)]
@@ -111,26 +109,9 @@ def runs(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
     return out
 
 
-def _rows(report: dict[str, Any]) -> dict[tuple[str, ...], dict[str, Any]]:
-    return {tuple(g["key"]): g for g in report["problems"]}
-
-
 def _derived(report: dict[str, Any]) -> set[tuple[str, ...]]:
     """The row of the derived properties not derived (behind the failed side conditions)."""
     return {k for k, g in _rows(report).items() if all(m["id"].endswith(".derived") for m in g["members"])}
-
-
-def _diag(report: dict[str, Any], did: str) -> dict[str, Any]:
-    return next(d for d in report["diagnoses"] if d["id"] == did)
-
-
-def _first_repair(report: dict[str, Any], key: tuple[str, ...]) -> dict[str, Any]:
-    ref = _rows(report)[key]["repairs"][0]
-    return _diag(report, ref["diagnosis"])["repairs"][ref["index"]]
-
-
-def _changed(diff: str) -> list[str]:
-    return [x for x in diff.splitlines() if x[:1] in "+-" and not x.startswith(("+++", "---"))]
 
 
 def _members(report: dict[str, Any], key: tuple[str, ...]) -> list[str]:
@@ -265,11 +246,6 @@ def test_each_fix_removes_its_row_and_no_other_appears(runs: dict[str, Any]) -> 
         before = after
 
 
-def _monitoring(report: dict[str, Any], node: str) -> dict[str, Any]:
-    e = next(x for x in report["evidence"] if x["obligation"] == f"{node}.g0.monitors.run")
-    return {"status": e["status"], **e["monitoring"]}
-
-
 NODES = ["GnssDriver", "Localiser", "MissionPlanner", "RouteServer", "ObstacleDetector", "Navigator",
          "SpeedGovernor", "WheelController", "LockerController"]
 
@@ -309,3 +285,7 @@ def test_the_delivery_counterexamples_read_well(runs: dict[str, Any]) -> None:
     assert {q["id"] for q in refuted} == {"STOP", "ROUTE"}
     route = next(q for q in refuted if q["id"] == "ROUTE")["check"]  # 51 waypoints need an input outside Navigator
     assert "needs an input outside Navigator: in.n_waypoints <= RouteBuffer" in route["counterexample_note"]
+
+
+def _monitoring(report: dict[str, Any], node: str) -> dict[str, Any]:
+    return monitoring(report, node, "run")

@@ -33,6 +33,9 @@ from typing import Any
 
 import pytest
 
+from _example_report import changed as _changed, diag as _diag, first_repair as _first_repair, monitoring, \
+    rows as _rows, verify as _verify
+
 from rclverify.cli import main
 
 EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "warehouse"
@@ -62,15 +65,6 @@ def _apply(ws: Path, diff: Path, reverse: bool = False) -> None:
     _record(ws)
 
 
-def _verify(ws: Path, *extra: str) -> tuple[int, dict[str, Any]]:
-    rc = main(["verify", "-w", str(ws), *extra])
-    return rc, json.loads((ws / "reports" / "assurance.json").read_text(encoding="utf-8"))
-
-
-def _rows(report: dict[str, Any]) -> dict[tuple[str, ...], dict[str, Any]]:
-    return {tuple(g["key"]): g for g in report["problems"]}
-
-
 @pytest.fixture(scope="module")
 def runs(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
     ws = tmp_path_factory.mktemp("warehouse") / "ws"
@@ -88,19 +82,6 @@ def runs(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
         _apply(ws, diff)
     out["strict"] = _verify(ws, "--strict")
     return out
-
-
-def _diag(report: dict[str, Any], did: str) -> dict[str, Any]:
-    return next(d for d in report["diagnoses"] if d["id"] == did)
-
-
-def _first_repair(report: dict[str, Any], key: tuple[str, ...]) -> dict[str, Any]:
-    ref = _rows(report)[key]["repairs"][0]
-    return _diag(report, ref["diagnosis"])["repairs"][ref["index"]]
-
-
-def _changed(diff: str) -> list[str]:
-    return [x for x in diff.splitlines() if x[:1] in "+-" and not x.startswith(("+++", "---"))]
 
 
 def test_the_example_is_as_shipped(runs: dict[str, Any]) -> None:
@@ -187,11 +168,6 @@ def test_each_fix_removes_its_row_and_no_other_appears(runs: dict[str, Any], nam
                                               else set())
 
 
-def _monitoring(report: dict[str, Any], node: str) -> dict[str, Any]:
-    e = next(x for x in report["evidence"] if x["obligation"] == f"{node}.g0.monitors.run_jsonl")
-    return {"status": e["status"], **e["monitoring"]}
-
-
 def test_the_recorded_run_raises_no_false_alarm(runs: dict[str, Any]) -> None:
     report = runs["seeded"]
     nodes = ["LidarDriver", "Localiser", "BatteryMonitor", "MissionManager", "Planner", "Controller", "Base"]
@@ -262,3 +238,7 @@ def test_sarif_puts_a_failed_side_condition_at_the_guarantee_to_repair(runs: dic
     rel = sc["relatedLocations"][0]
     assert rel["physicalLocation"]["artifactLocation"]["uri"] == "contracts/controller.rcl"
     assert rel["message"]["text"] == "the assumption it fails"
+
+
+def _monitoring(report: dict[str, Any], node: str) -> dict[str, Any]:
+    return monitoring(report, node, "run_jsonl")
