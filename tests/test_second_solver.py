@@ -215,3 +215,24 @@ def test_a_verdict_without_a_kept_query_says_so() -> None:
     from rclverify.crosscheck.apply import SecondSolver
     rec = SecondSolver({}).requirement({"id": "T1", "verdict": "proved", "temporal": {"method": "k-induction"}})
     assert rec["solvers"]["agreement"] == "one solver" and "doit verify" not in rec["solvers"]["why"]
+
+
+def test_a_shared_session_answers_and_proves_as_fresh_solvers_do(ws: Path) -> None:
+    """One incremental solver for the quantifier-free scripts (the stage's
+    speed-up) gives each script the answer and the proof text a fresh
+    solver gives, whatever ran before it; quantified scripts are refused."""
+    from rclverify.crosscheck.cvc5_decide import RLIMIT, Session
+    index = json.loads((ws / "artifacts/crosscheck/index.json").read_text())
+    texts = [(ws / r["smt2"]).read_text() for r in index["items"] if not r["kind"] == "hoare"]
+    parts = [t.split("\n(reset)\n")[-1] for t in texts]
+    s = Session()
+    taken = [p for p in parts if s.takes(p, RLIMIT, True, False)]
+    refused = [p for p in parts if p not in taken]
+    assert taken and refused and all("forall" in p or "exists" in p for p in refused)
+    import re
+    name = next(m.group(1) for p in taken for m in [re.search(r"\(declare-fun (\S+) \(\) Real\)", p)] if m)
+    clash = f"(declare-fun {name} () Int)\n(assert (> {name} 2))\n(assert (< {name} 3))\n(check-sat)\n"
+    for p in taken + [clash] + taken[::-1]:  # a name declared again with another sort: scoped away
+        got, fresh = s.decide(p, "q", False), decide(p)
+        assert got is not None and (got.answer, got.proof) == (fresh.answer, fresh.proof)
+    assert decide(clash, session=s).answer == "unsat"

@@ -20,10 +20,18 @@ Rules (SMT-LIB 2.6 standard, section 4.2; cvc5 options reference):
 * on ``unsat``, the proof is produced (``produce-proofs``) in cvc5's CPC
   format and re-checked step by step by cvc5's internal proof checker
   (``check-proofs``): a proof that does not check raises inside cvc5 and
-  is reported as ``error``, never as ``unsat``.
+  is reported as ``error``, never as ``unsat``;
+* a :class:`Session` decides many quantifier-free scripts in one solver,
+  each in its own ``push``/``pop`` scope (docs/second-solver.md, "One
+  solver for many queries"): a proof-producing cvc5 solver costs about
+  8 ms to make (it loads its rewrite-rule database), a scoped query about
+  1.5 ms.  Quantified scripts, scripts that set the logic or options or
+  reset, and any answer other than ``sat``/``unsat`` go to a fresh solver,
+  so every recorded answer and proof is that of a fresh solver.
 """
 from __future__ import annotations
 
+import re
 import time
 from dataclasses import dataclass
 from typing import Any
@@ -72,22 +80,117 @@ def version() -> str:
 
 
 def decide(text: str, name: str = "query.smt2", *, rlimit: int = RLIMIT, proofs: bool = True,
-           every: bool = False) -> Decision:
-    """The script ``text`` decided by cvc5 (:func:`_decide_one`); with
+           every: bool = False, session: "Session | None" = None) -> Decision:
+    """The script ``text`` decided by cvc5 (:func:`_decide_one`, in
+    ``session`` where it takes the script: :meth:`Session.takes`); with
     ``every``, each part of it between ``(reset)`` commands in a fresh
     solver (cvc5 stops producing proofs at a reset), the answer ``unsat``
     only when every part's every ``check-sat`` is, else the first other
     part's."""
     parts = text.split("\n(reset)\n") if every else [text]
     if len(parts) == 1:
-        return _decide_one(text, name, rlimit=rlimit, proofs=proofs, every=every)
+        return _decide_part(text, name, rlimit, proofs, every, session)
     t0 = time.perf_counter()
-    done = [_decide_one(p, name, rlimit=rlimit, proofs=proofs, every=True) for p in parts]
+    done = [_decide_part(p, name, rlimit, proofs, True, session) for p in parts]
     bad = next((d for d in done if d.answer != "unsat"), None)
     if bad is not None:
         return Decision(bad.answer, bad.reason, "", False, bad.version, time.perf_counter() - t0)
     return Decision("unsat", "", "\n".join(d.proof for d in done), all(d.proof_checked for d in done),
                     done[0].version, time.perf_counter() - t0)
+
+
+def _decide_part(text: str, name: str, rlimit: int, proofs: bool, every: bool,
+                 session: "Session | None") -> Decision:
+    part = text if every else text.split("\n(reset)\n")[-1]  # the verdict rests on the last query
+    if session is not None and session.takes(part, rlimit, proofs, every):
+        d = session.decide(part, name, every)
+        if d is not None:
+            return d
+    return _decide_one(text, name, rlimit=rlimit, proofs=proofs, every=every)
+
+
+#: What keeps a script out of a shared solver: quantifiers (cvc5's
+#: instantiation may depend on terms an earlier query left behind, so the
+#: proof could differ from a fresh solver's) and commands that act on the
+#: solver beyond a scope.
+_UNSCOPED = re.compile(r"\((?:forall|exists|set-logic|set-option|reset|reset-assertions|exit|"
+                       r"declare-datatypes?|define-sort|declare-sort)\b")
+
+
+class Session:
+    """One incremental proof-producing cvc5 solver for many scripts.
+
+    :meth:`decide` runs a script between ``(push 1)`` and ``(pop 1)``, so
+    its declarations and assertions are gone after it; a fresh solver is
+    made after :data:`QUERIES` scripts (cvc5's term tables grow) and after
+    any answer other than ``sat``/``unsat``.  Only scripts :meth:`takes`
+    admits come here; the caller decides the rest in a fresh solver.
+    Answers and proofs equal a fresh solver's on the quantifier-free
+    scripts it admits (``tests/test_second_solver.py`` compares them).
+    Raises ``ImportError`` when cvc5 is missing.
+    """
+
+    QUERIES = 400
+
+    def __init__(self, rlimit: int = RLIMIT) -> None:
+        self.rlimit = rlimit
+        self._solver: Any = None
+        self._used = 0
+
+    def takes(self, text: str, rlimit: int, proofs: bool, every: bool) -> bool:
+        """Whether ``text`` may be decided here: proofs asked, the
+        session's budget, no quantifier and no solver-level command."""
+        return (proofs and rlimit == self.rlimit and _UNSCOPED.search(text) is None
+                and text.count("(push") == text.count("(pop"))
+
+    def _fresh(self) -> Any:
+        import cvc5
+        tm = cvc5.TermManager()
+        s = cvc5.Solver(tm)
+        for k, v in (("incremental", "true"), ("rlimit-per", str(int(self.rlimit))), ("tlimit-per", str(WALL_MS)),
+                     ("produce-proofs", "true"), ("check-proofs", "true"), ("proof-format-mode", "cpc")):
+            s.setOption(k, v)
+        s.setLogic("ALL")
+        self._solver, self._used = (tm, s, cvc5.SymbolManager(tm)), 0
+        return self._solver
+
+    def decide(self, text: str, name: str, every: bool) -> Decision | None:
+        """The script decided in the shared solver, or ``None`` (decide it
+        in a fresh solver) when its answer is not ``sat``/``unsat``."""
+        import cvc5
+        t0 = time.perf_counter()
+        if self._solver is None or self._used >= self.QUERIES:
+            self._fresh()
+        _tm, s, sm = self._solver
+        self._used += 1
+        answers: list[str] = []
+        proof_parts: list[str] = []
+        try:
+            parser = cvc5.InputParser(s, sm)
+            parser.setStringInput(cvc5.InputLanguage.SMT_LIB_2_6, "(push 1)\n" + text + "\n(pop 1)\n", name)
+            while True:
+                cmd = parser.nextCommand()
+                if cmd.isNull():
+                    break
+                out = str(cmd.invoke(s, sm) or "").strip()
+                if out.startswith("(error"):
+                    raise RuntimeError(out)
+                if out.split(" ", 1)[0] in ("sat", "unsat", "unknown"):
+                    answers.append(out)
+                    if out == "unsat":
+                        proof_parts.append("\n".join(_text(s.proofToString(p)) for p in s.getProof()))
+        except Exception:  # noqa: BLE001 - whatever went wrong, a fresh solver decides it
+            self._solver = None
+            return None
+        if not answers or any(a not in ("sat", "unsat") for a in answers):
+            self._solver = None
+            return None
+        ver = version()
+        bad = next((a for a in answers if a != "unsat"), None) if every else (answers[-1] if answers[-1] != "unsat" else None)
+        if bad is not None:
+            return Decision(bad, "", "", False, ver, time.perf_counter() - t0)
+        proof = "\n".join(proof_parts if every else proof_parts[-1:])
+        return Decision("unsat", "", proof, bool(proof), ver, time.perf_counter() - t0)
 
 
 def _decide_one(text: str, name: str = "query.smt2", *, rlimit: int = RLIMIT, proofs: bool = True,

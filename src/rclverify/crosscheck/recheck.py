@@ -26,7 +26,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from ..evidence.sealed import check_text, is_sealed_path
-from .cvc5_decide import decide, version
+from .cvc5_decide import Session, decide, version
 from .items import discharging_items
 from .stage import INDEX
 
@@ -94,6 +94,7 @@ def recheck_members(members: dict[str, bytes]) -> Recheck:
         nodes = sorted(p.stem for p in (root / "artifacts/calculus").glob("*.json"))
         items = discharging_items(root, nodes)
     has_cvc5 = bool(version())
+    session = Session() if has_cvc5 else None
     for it in items:
         label = f"{it.kind} {it.id}"
         row = rows.get((it.kind, it.id))
@@ -115,7 +116,7 @@ def recheck_members(members: dict[str, bytes]) -> Recheck:
                 f"{label}: recorded {it.verdict} (Z3 {it.expects}); Z3 now answers {z} on {it.smt2}")
         recorded = (row.get("cvc5") or {}).get("answer")
         if has_cvc5 and recorded in ("sat", "unsat"):
-            c = decide(text, it.smt2, proofs=recorded == "unsat", every=it.every)
+            c = decide(text, it.smt2, proofs=recorded == "unsat", every=it.every, session=session)
             if c.answer != recorded:
                 (notes if c.answer in ("unknown", "error") else problems).append(
                     f"{label}: cvc5 recorded {recorded}, now answers {c.answer} on {it.smt2}")

@@ -21,7 +21,7 @@ from typing import Any, Iterable
 
 from ..evidence.sealed import read_sealed, write_sealed
 from ..evidence.store import atomic_write_text
-from .cvc5_decide import RLIMIT, Decision, decide, version
+from .cvc5_decide import RLIMIT, Decision, Session, decide, version
 from .items import Item, discharging_items
 
 DIR = "artifacts/crosscheck"
@@ -82,8 +82,9 @@ def stage_crosscheck(root: Path, nodes: Iterable[str]) -> dict[str, Any]:
              and isinstance(r.get("cvc5"), dict) and isinstance(r.get("key"), str)}
     rows: list[dict[str, Any]] = []
     keep: set[str] = set()
+    session = Session() if ver else None
     for it in discharging_items(root, nodes):
-        rows.append(_row(root, it, ver, cache, keep))
+        rows.append(_row(root, it, ver, cache, keep, session))
     index = {"solver": {"name": "cvc5", "version": ver, "rlimit": RLIMIT} if ver else None,
              "counts": _counts(rows), "items": rows}
     write_sealed(root / INDEX, index)
@@ -94,7 +95,8 @@ def stage_crosscheck(root: Path, nodes: Iterable[str]) -> dict[str, Any]:
     return index
 
 
-def _row(root: Path, it: Item, ver: str, cache: dict[str, dict[str, Any]], keep: set[str]) -> dict[str, Any]:
+def _row(root: Path, it: Item, ver: str, cache: dict[str, dict[str, Any]], keep: set[str],
+         session: Session | None = None) -> dict[str, Any]:
     row: dict[str, Any] = {"kind": it.kind, "id": it.id, "smt2": it.smt2, "verdict": it.verdict,
                            "z3": it.expects}
     try:
@@ -111,7 +113,7 @@ def _row(root: Path, it: Item, ver: str, cache: dict[str, dict[str, Any]], keep:
     if d is not None and d.get("proof") and not (root / proof_rel).is_file():
         d = None  # its proof is gone: decide again
     if d is None and ver:
-        dec: Decision = decide(text, it.smt2, every=it.every)
+        dec: Decision = decide(text, it.smt2, every=it.every, session=session)
         d = dec.row()
         if dec.proof:
             atomic_write_text(root / proof_rel, dec.proof)
