@@ -147,7 +147,7 @@ def _reference_jsonl(path: Path) -> tuple[list[tuple[object, ...]], str]:
                 return out, f"{path}:{lineno}:1: error: the event has no string 'topic'"
             if isinstance(time, bool) or not isinstance(time, (int, float)):
                 return out, f"{path}:{lineno}:1: error: the event has no numeric 'time'"
-            if not math.isfinite(time):
+            if not -math.inf < time < math.inf or abs(time) > 1.7976931348623157e308:
                 return out, f"{path}:{lineno}:1: error: the event's 'time' is {time!r}, not a finite number"
             fields = {k: v for k, v in obj.items() if k not in ("topic", "time")}
             out.append((index, float(time), topic.lstrip("/"), fields, f"{path.name}:{lineno}", None))
@@ -161,7 +161,11 @@ LINES = ['{"topic": "r", "time": 1.5, "value": 3}', '{"topic": "/s", "time": 2, 
          '{"topic": "r", "time": 9}, {"topic": "r", "time": 10}', '{"topic": "r", "time": [1',
          '{"topic": "r", "time": true}', '{"topic": 5, "time": 1}', '{"topic": "r", "time": Infinity}',
          '{"topic": "r"}', '[1, 2]', '"text"', '', '   ', '{', '{"topic": "r", "time": 1, "topic": "q"}',
-         '{"topic": "r", "time": 1e400}', '{"topic": "r", "time": 12, "v": "\\u00e9\\n"}', '\ufeff{"topic": "r", "time": 1}']
+         '{"topic": "r", "time": 1e400}', '{"topic": "r", "time": 12, "v": "\\u00e9\\n"}', '\ufeff{"topic": "r", "time": 1}',
+         '{"topic": "r", "time": 13, "v": 123456789012345678901234567890, "w": [-9223372036854775809]}',
+         '{"topic": "r", "time": 14, "v": "\\ud800"}', '{"topic": "r", "time": 15, "v": {"w": 1E400}}',
+         '{"topic": "r", "time": 16, "v": 0.30000000000000004441, "w": 2.2250738585072011e-308}',
+         '{"topic": "r", "time": 1' + '0' * 400 + '}', '{"topic": "r", "time": -17, "v": -0.0, "w": 18446744073709551616}']
 
 
 def test_the_log_readers_fast_path_reads_and_reports_as_json_loads(tmp_path: Path) -> None:
@@ -189,6 +193,15 @@ def test_the_log_readers_fast_path_reads_and_reports_as_json_loads(tmp_path: Pat
             said = str(exc)
         assert (got, said) == (want, error)
     check()
+
+
+def test_bytes_that_are_not_utf8_are_a_located_error(tmp_path: Path) -> None:
+    p = tmp_path / "run.jsonl"
+    p.write_bytes(b'{"topic": "r", "time": 1, "v": 2}\n{"topic": "r", "time": 2, "v": "\xc3\xa9\xff"}\n')
+    got = []
+    with pytest.raises(TraceError, match=r"run.jsonl:2:34: error: the line is not UTF-8 text \(byte 0xff\)"):
+        got.extend(read_trace(p))
+    assert [e.time for e in got] == [1.0]
 
 
 def test_the_scalar_mapper_maps_as_map_value() -> None:
