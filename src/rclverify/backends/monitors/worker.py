@@ -78,6 +78,9 @@ class EngineWorker:
         self.error: BaseException | None = None
 
     def start(self) -> EngineWorker:
+        """Start the worker thread, the loaded heap frozen first (:func:`~rclverify.cache.heap.freeze_for_live`)."""
+        from ...cache.heap import freeze_for_live
+        freeze_for_live()
         self._thread.start()
         return self
 
