@@ -267,7 +267,7 @@ def test_a_client_that_sends_and_never_reads_is_throttled_then_dropped_and_its_s
         sock.settimeout(1)
         sent, pending, dropped_by = 0, b"", None
         deadline = time.monotonic() + 60
-        while time.monotonic() < deadline:  # send until the server drops us (bounded: 60 s)
+        while time.monotonic() < deadline and not stats.dropped:  # send until the server drops us (bounded: 60 s)
             if not pending:
                 proto.send_text(event)
                 pending = b"".join(proto.data_to_send())
@@ -279,7 +279,10 @@ def test_a_client_that_sends_and_never_reads_is_throttled_then_dropped_and_its_s
             except OSError as exc:  # reset or broken pipe: the server dropped the connection
                 dropped_by = exc
                 break
-        assert dropped_by is not None, f"{sent} events sent in 60 s, never dropped: {stats}"
+        # the client sees the reset, or (its receive buffer full, TCP backing off on loopback) the server says
+        # it dropped it: before the server looked for replies left unread in the socket's send queue, it
+        # waited forever for events that TCP no longer delivered
+        assert dropped_by is not None or stats.dropped == 1, f"{sent} events sent in 60 s, never dropped: {stats}"
         # the server held at most its limit of unanswered events, dropped the connection and freed it
         assert stats.peak_inbox <= limits.inbox, stats
         end = time.monotonic() + 20

@@ -181,6 +181,45 @@ async def _send_batch(ws: Any, replies: list[bytes]) -> None:
                     ws.transport.close()
 
 
+async def _woken(wake: asyncio.Event, ws: Any, stall_s: float) -> bool:
+    """Wait for ``wake``; ``False`` when replies already written wait in the
+    transport's buffer and none of them left it for ``stall_s`` seconds (the
+    client reads nothing).  websockets stops reading a connection whose
+    writes are paused, so such a client's events no longer arrive and the
+    wait for them would never end: the stall must be seen here, not only
+    while a batch is being sent."""
+    while True:
+        before = _unread(ws.transport)
+        try:
+            await asyncio.wait_for(wake.wait(), stall_s)
+            return True
+        except asyncio.TimeoutError:
+            now = _unread(ws.transport)
+            if now and now >= before:
+                return False
+
+
+def _unread(transport: Any) -> int:
+    """Bytes written to the connection that the client has not taken: the
+    transport's buffer and, where the system tells (Linux's ``TIOCOUTQ``),
+    the socket's send queue.  A client that reads nothing leaves its replies
+    in the kernel (a loopback socket's send buffer holds megabytes), and
+    TCP then backs off resending the client's own data, so no event arrives
+    either (seen: retransmission time-outs of 6.5 s with the client's
+    receive buffer full)."""
+    n = int(transport.get_write_buffer_size())
+    sock = transport.get_extra_info("socket")
+    try:
+        import fcntl
+        import struct
+        import termios
+        if sock is not None:
+            n += struct.unpack("i", fcntl.ioctl(sock.fileno(), termios.TIOCOUTQ, b"\0\0\0\0"))[0]
+    except (ImportError, AttributeError, OSError, ValueError):  # no such query here: the buffer alone
+        pass
+    return n
+
+
 def _answer(run: OracleRun, message: Any) -> dict[str, Any]:
     """``run.answer(message)``; an error the engine did not foresee is
     answered ``unknown`` with its reason instead of closing the connection."""
@@ -267,7 +306,10 @@ async def serve(checked: Checked, nodes: list[CheckedNode], rules: Mapping[str, 
         reader = asyncio.create_task(read())
         try:
             while True:
-                await wake.wait()
+                if not await _woken(wake, ws, lim.stall_s):  # replies unread for stall_s: drop it
+                    st.dropped += 1
+                    ws.transport.abort()
+                    return
                 wake.clear()
                 if inbox:
                     batch = inbox[:]
