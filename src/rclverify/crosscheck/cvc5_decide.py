@@ -157,28 +157,13 @@ class Session:
     def decide(self, text: str, name: str, every: bool) -> Decision | None:
         """The script decided in the shared solver, or ``None`` (decide it
         in a fresh solver) when its answer is not ``sat``/``unsat``."""
-        import cvc5
         t0 = time.perf_counter()
         if self._solver is None or self._used >= self.QUERIES:
             self._fresh()
         _tm, s, sm = self._solver
         self._used += 1
-        answers: list[str] = []
-        proof_parts: list[str] = []
         try:
-            parser = cvc5.InputParser(s, sm)
-            parser.setStringInput(cvc5.InputLanguage.SMT_LIB_2_6, "(push 1)\n" + text + "\n(pop 1)\n", name)
-            while True:
-                cmd = parser.nextCommand()
-                if cmd.isNull():
-                    break
-                out = str(cmd.invoke(s, sm) or "").strip()
-                if out.startswith("(error"):
-                    raise RuntimeError(out)
-                if out.split(" ", 1)[0] in ("sat", "unsat", "unknown"):
-                    answers.append(out)
-                    if out == "unsat":
-                        proof_parts.append("\n".join(_text(s.proofToString(p)) for p in s.getProof()))
+            answers, proof_parts = _run(s, sm, "(push 1)\n" + text + "\n(pop 1)\n", name, True)
         except Exception:  # noqa: BLE001 - whatever went wrong, a fresh solver decides it
             self._solver = None
             return None
@@ -219,25 +204,15 @@ def _decide_one(text: str, name: str = "query.smt2", *, rlimit: int = RLIMIT, pr
             s.setOption("check-proofs", "true")
             s.setOption("proof-format-mode", "cpc")
         sm = cvc5.SymbolManager(tm)
-        parser = cvc5.InputParser(s, sm)
         if not every:  # the verdict rests on the last query: cvc5 drops proof production at `(reset)`
             text = text.split("\n(reset)\n")[-1]
         script = text if "(set-logic" in text else "(set-logic ALL)\n" + text
-        parser.setStringInput(cvc5.InputLanguage.SMT_LIB_2_6, script, name)
-        last, worst_, proof_parts = "", "", []
-        while True:
-            cmd = parser.nextCommand()
-            if cmd.isNull():
-                break
-            out = str(cmd.invoke(s, sm) or "").strip()
-            if out.startswith("(error"):
-                return Decision("error", out, "", False, ver, time.perf_counter() - t0)
-            if out.split(" ", 1)[0] in ("sat", "unsat", "unknown"):
-                last = out
-                if out == "unsat" and proofs:  # taken now: a later pop or reset discards it
-                    proof_parts.append("\n".join(_text(s.proofToString(p)) for p in s.getProof()))
-                elif out != "unsat" and not worst_:
-                    worst_ = out
+        try:
+            answers, proof_parts = _run(s, sm, script, name, proofs)
+        except _ScriptError as e:
+            return Decision("error", str(e), "", False, ver, time.perf_counter() - t0)
+        last = answers[-1] if answers else ""
+        worst_ = next((a for a in answers if a != "unsat"), "")
         if not last:
             return Decision("error", "the script has no check-sat", "", False, ver, time.perf_counter() - t0)
         answer, _, why = (worst_ if every and worst_ else last).partition(" ")
@@ -248,6 +223,35 @@ def _decide_one(text: str, name: str = "query.smt2", *, rlimit: int = RLIMIT, pr
     except Exception as e:  # noqa: BLE001 - cvc5's API raises its own exception type for what it rejects
         return Decision("error", str(e).strip().splitlines()[0][:300] if str(e).strip() else type(e).__name__,
                         "", False, ver, time.perf_counter() - t0)
+
+
+class _ScriptError(Exception):
+    """cvc5 answered a command of the script with an ``(error ...)``."""
+
+
+def _run(s: Any, sm: Any, script: str, name: str, proofs: bool) -> tuple[list[str], list[str]]:
+    """Run the SMT-LIB2 ``script``'s commands in cvc5 solver ``s`` (symbol
+    manager ``sm``): the answers of its ``check-sat`` commands in order
+    (``sat``, ``unsat``, ``unknown (REASON)``) and, with ``proofs``, the
+    proof of each ``unsat`` in CPC text, taken at once (a later ``pop`` or
+    ``reset`` discards it).  Raises :class:`_ScriptError` with cvc5's error
+    output, and whatever cvc5's API raises for a script it rejects."""
+    import cvc5
+    parser = cvc5.InputParser(s, sm)
+    parser.setStringInput(cvc5.InputLanguage.SMT_LIB_2_6, script, name)
+    answers: list[str] = []
+    proof_parts: list[str] = []
+    while True:
+        cmd = parser.nextCommand()
+        if cmd.isNull():
+            return answers, proof_parts
+        out = str(cmd.invoke(s, sm) or "").strip()
+        if out.startswith("(error"):
+            raise _ScriptError(out)
+        if out.split(" ", 1)[0] in ("sat", "unsat", "unknown"):
+            answers.append(out)
+            if out == "unsat" and proofs:
+                proof_parts.append("\n".join(_text(s.proofToString(p)) for p in s.getProof()))
 
 
 def _text(b: bytes | str) -> str:
