@@ -171,7 +171,8 @@ LINES = ['{"topic": "r", "time": 1.5, "value": 3}', '{"topic": "/s", "time": 2, 
 def test_the_log_readers_fast_path_reads_and_reports_as_json_loads(tmp_path: Path) -> None:
     """Random logs of good, odd and bad lines (whitespace around an object,
     JSON's whitespace and other whitespace after it, two objects on a line,
-    a truncated object, non-objects, NaN and Infinity, a BOM, CRLF ends):
+    a truncated object, non-objects, NaN and Infinity, a BOM, CRLF and bare
+    CR ends):
     the same events and the same located error as reading every line with
     ``json.loads``."""
     from hypothesis import HealthCheck, given, settings
@@ -179,7 +180,7 @@ def test_the_log_readers_fast_path_reads_and_reports_as_json_loads(tmp_path: Pat
 
     @settings(max_examples=150, deadline=None, database=None, derandomize=True,
               suppress_health_check=list(HealthCheck))
-    @given(st.lists(st.sampled_from(LINES), max_size=8), st.sampled_from(["\n", "\r\n"]), st.booleans())
+    @given(st.lists(st.sampled_from(LINES), max_size=8), st.sampled_from(["\n", "\r\n", "\r"]), st.booleans())
     def check(lines: list[str], end: str, last_newline: bool) -> None:
         p = tmp_path / "run.jsonl"
         p.write_bytes((end.join(lines) + (end if last_newline else "")).encode("utf-8"))

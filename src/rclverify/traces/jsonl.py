@@ -9,7 +9,7 @@ four times JSON's scanner) when it can be: it reads every JSON text that
 Python's ``json`` reads to the same value (floats correctly rounded,
 integers of any size exact, duplicate keys the last, strings alike:
 compared on 300,000 random numbers and the corner cases of
-``tests/test_traces_jsonl.py``), and rejects what ``json`` reads beyond the
+``tests/test_traces.py``), and rejects what ``json`` reads beyond the
 standard (``NaN``, ``Infinity``, numbers that overflow to infinity, lone
 surrogates).  A line it rejects is read again by the scanner and
 ``json.loads`` path below, as before: the same events, the same errors.
@@ -50,8 +50,8 @@ def read_jsonl(path: Path) -> Iterator[Event]:
     ``time`` (JSON's ``NaN``/``Infinity``, which Python accepts, are refused);
     the events before it have already been yielded.
 
-    A line that starts with ``{`` is read by msgspec (module docstring);
-    one msgspec rejects goes to JSON's scanner (``json.loads``'s
+    Each line is read by msgspec (module docstring); a line msgspec
+    rejects goes to JSON's scanner (``json.loads``'s
     own checks cost twice the scan); any other line, or one the scanner
     does not read whole up to JSON whitespace, goes through ``json.loads``,
     which reads it, or reports it, as before.  Bytes that are not UTF-8
@@ -60,22 +60,25 @@ def read_jsonl(path: Path) -> Iterator[Event]:
     index = 0
     name = path.name
     fast, fast_error, slow, inf = _FAST, _FAST_ERROR, _slow, math.inf
+    lineno = 0
     with path.open("rb") as fh:
-        for lineno, raw in enumerate(fh, 1):
-            try:
-                obj: Any = fast(raw)
-            except fast_error:
-                obj = None
-            if type(obj) is not dict:  # what msgspec rejects, a blank line, or a value that is no object
-                obj = slow(path, lineno, raw)
-                if obj is None:
-                    continue
-            topic, time = obj.get("topic"), obj.get("time")
-            if not (type(time) is float and type(topic) is str and -inf < time < inf):
-                time = _checked(path, lineno, topic, time)
-            del obj["topic"], obj["time"]  # the message's fields, in their order (the object is this line's own)
-            yield Event(index, float(time), topic.lstrip("/"), obj, f"{name}:{lineno}")
-            index += 1
+        for chunk in fh:  # split at b"\n"; a bare b"\r" also ends a line (universal newlines, as text mode read it)
+            for raw in chunk.splitlines(True) if b"\r" in chunk else (chunk,):
+                lineno += 1
+                try:
+                    obj: Any = fast(raw)
+                except fast_error:
+                    obj = None
+                if type(obj) is not dict:  # what msgspec rejects, a blank line, or a value that is no object
+                    obj = slow(path, lineno, raw)
+                    if obj is None:
+                        continue
+                topic, time = obj.get("topic"), obj.get("time")
+                if not (type(time) is float and type(topic) is str and -inf < time < inf):
+                    time = _checked(path, lineno, topic, time)
+                del obj["topic"], obj["time"]  # the message's fields, in their order (the object is this line's own)
+                yield Event(index, float(time), topic.lstrip("/"), obj, f"{name}:{lineno}")
+                index += 1
 
 
 def _checked(path: Path, lineno: int, topic: Any, time: Any) -> float | int:
@@ -102,6 +105,8 @@ def _slow(path: Path, lineno: int, raw: bytes) -> dict[str, Any] | None:
         col = len(raw[:exc.start].decode("utf-8", "replace")) + 1
         raise TraceError(f"{path}:{lineno}:{col}: error: the line is not UTF-8 text "
                          f"(byte 0x{raw[exc.start]:02x})") from None
+    if line[-1:] == "\r" or line[-2:] == "\r\n":  # the line's end as text mode gave it: "\n" (errors' columns)
+        line = line.rstrip("\n")[:-1] + "\n"
     if line[:1] == "{":
         try:
             obj, end = _SCAN(line, 0)
