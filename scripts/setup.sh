@@ -4,7 +4,8 @@
 #     optional, their evidence is pending, the diagram replaced by DOT
 #     source, or the live tests skipped with the reason when missing;
 #   - the rclverify package itself with its Python dependencies and pytest (among them
-#     cyclonedds, whose wheel carries Cyclone DDS's C library: ROS 2 live, over DDS).
+#     cyclonedds, whose wheel carries Cyclone DDS's C library: ROS 2 live, over DDS);
+#   - with --tests, the test modules' bytecode as pytest rewrites it (below).
 # Safe to run again.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -51,3 +52,13 @@ echo "setup: installing rclverify and its Python dependencies"
 # The package's bytecode, compiled once here: an editable install compiles nothing, and a shell
 # with PYTHONDONTWRITEBYTECODE set would otherwise compile every module in every doit process.
 "$PY" -m compileall -q src/rclverify >/dev/null || true
+
+# --tests: the test modules' bytecode with pytest's assertion rewriting, written once here into
+# tests/__pycache__.  Where PYTHONDONTWRITEBYTECODE is set, pytest writes none, and each of the
+# suite's three workers rewrote every test module again (about 5 CPU s each); it reads what is
+# here whether or not it may write.
+if [ "${1:-}" = "--tests" ]; then
+  echo "setup: compiling the test modules"
+  env -u PYTHONDONTWRITEBYTECODE "$PY" -m pytest --collect-only -q -n 0 -p no:cacheprovider >/dev/null \
+    || echo "setup: the test modules did not all collect; pytest will say why"
+fi
