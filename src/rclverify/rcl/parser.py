@@ -67,7 +67,8 @@ def grammar_text() -> str:
 def lark_cache_file(name: str) -> str | bool:
     """Where lark keeps the analysed LALR tables of the grammar ``name``
     (lark's own ``cache`` option): ``$XDG_CACHE_HOME/rclverify`` or
-    ``~/.cache/rclverify``.  Building the RCL tables costs about 0.25 s, a
+    ``~/.cache/rclverify``; the RCL, Hoare and Gwendolen grammars use it.
+    Building the RCL tables costs about 0.25 s, a
     tenth of a doit run that re-parses one edited contract; loading them
     costs 0.02 s (docs/scale.md).  lark stores the sha256 of the grammar and
     options in the file and rebuilds (and rewrites) the tables when they

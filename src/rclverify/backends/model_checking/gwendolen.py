@@ -31,6 +31,7 @@ from lark.exceptions import UnexpectedCharacters, UnexpectedEOF, UnexpectedInput
 
 from ...rcl.ast import Loc
 from ...rcl.errors import RclError, error
+from ...rcl.parser import lark_cache_file
 from ...rcl.source import read_text
 from ..ajpf import psl
 
@@ -146,7 +147,8 @@ class Program:
 @lru_cache(maxsize=1)
 def _parser() -> Lark:
     grammar = (Path(__file__).with_name("gwendolen.lark")).read_text(encoding="utf-8")
-    return Lark(grammar, parser="lalr", propagate_positions=True, maybe_placeholders=False)
+    return Lark(grammar, parser="lalr", propagate_positions=True, maybe_placeholders=False,
+                cache=lark_cache_file("gwendolen"))  # the analysed tables kept by lark (rcl/parser.py)
 
 
 def parse_file(path: Path, source_name: str) -> Program:
