@@ -145,6 +145,9 @@ def stage_health(ws: Workspace, node: str) -> list[dict[str, Any]]:
         if f.smt2:
             j["smt2"] = f"artifacts/health/{f.id}.smt2"
             atomic_write_text(ws.path(j["smt2"]), f.smt2)
+        if f.witness_smt2:  # the quantifier-free query the second solver decides (health/realizer.py)
+            j["witness_smt2"] = f"artifacts/health/{f.id}.witness.smt2"
+            atomic_write_text(ws.path(j["witness_smt2"]), f.witness_smt2)
         findings.append(j)
     write_sealed(ws.path(ws.health(node)), {"node": node, "findings": findings})
     record_provenance(ws, node, "health", stage_inputs(ws, node, "health"))

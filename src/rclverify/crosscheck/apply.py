@@ -47,16 +47,18 @@ class SecondSolver:
                 "proof": (c or {}).get("proof", ""), "smt2": str(r.get("smt2", ""))}
 
     def _fold(self, row: dict[str, Any] | None, kind: str, id_key: str, status_key: str, good: str,
-              downgraded: Any) -> dict[str, Any] | None:
+              downgraded: Any, query: str | None = None) -> dict[str, Any] | None:
         """``row`` with ``solvers`` when its ``status_key`` reads ``good``;
         then, when the solvers do not agree, ``status_key`` set to
-        ``inconclusive`` and the fields ``downgraded(row, solvers)`` gives."""
+        ``inconclusive`` and the fields ``downgraded(row, solvers)`` gives.
+        ``query``: the script the second solver decides for it, when not
+        the row's ``smt2`` (a realizable contract's witness query)."""
         if row is None or row.get(status_key) != good:
             return row
         if not row.get("smt2"):  # no query kept (a temporal proof, a scan instance by instance): nothing to re-decide
             return {**row, "solvers": {"agreement": "one solver", "why": _NO_QUERY, "cvc5": None, "proof": "",
                                        "smt2": ""}}
-        s = self.solvers(kind, str(row.get(id_key)), row.get("smt2"))
+        s = self.solvers(kind, str(row.get(id_key)), query or row.get("smt2"))
         if s["agreement"] in DOWNGRADES:
             return {**row, status_key: "inconclusive", "solvers": s, **downgraded(row, s)}
         return {**row, "solvers": s}
@@ -70,8 +72,10 @@ class SecondSolver:
     def finding(self, f: dict[str, Any]) -> dict[str, Any]:
         """A health finding with ``solvers``; an ``ok`` one the solvers do
         not agree on is ``inconclusive``."""
+        witness = f.get("witness_smt2") if f.get("check") == "realizable" else None  # crosscheck/items.py
         return self._fold(f, "health", "id", "status", "ok", lambda r, s: {
-            "message": f"{r.get('message', '')} Not confirmed: {s['why']} (second solver)."}) or f
+            "message": f"{r.get('message', '')} Not confirmed: {s['why']} (second solver)."},
+            witness if isinstance(witness, str) and witness else None) or f
 
     def requirement(self, rec: dict[str, Any] | None) -> dict[str, Any] | None:
         """A requirement record with ``solvers``; a ``proved`` one the

@@ -20,7 +20,10 @@ kind               record                                  verdict    expects
 A health check reads ``ok`` on a satisfiable query (an assumption that can
 be met, a consistent contract, a guarantee that can fire: Z3's witness is
 its certificate) except the replacement check and realizability, which
-read ``ok`` on a proof.  A proved requirement's consistency and vacuity answers are items
+read ``ok`` on a proof.  A realizable contract with a witness (output
+terms answering every admissible input, :mod:`rclverify.health.realizer`)
+is decided from the witness's query instead (``witness_smt2``): it has no
+quantifier, and its unsat implies the realizability query's.  A proved requirement's consistency and vacuity answers are items
 too (its ``met`` rests on the satisfiable ones, its ``proved vacuously`` or
 ``from an inconsistency`` on the unsatisfiable ones).  A record whose seal does not hold gives no item: the report already
 shows it ``error``.  A Hoare obligation's script holds one query per
@@ -38,6 +41,9 @@ from ..requirements.stage import record_path
 #: Health checks whose ``ok`` is an ``unsat`` answer (a proof); every other
 #: check's ``ok`` is a satisfiable answer with Z3's witness.
 PROOF_CHECKS = frozenset({"replacement-refines", "realizable"})
+
+#: :attr:`Item.via` of a realizable contract decided from its witness.
+WITNESS = "witness"
 
 #: A proved requirement's side queries (``requirements/check.py``): their decided verdicts and Z3's
 #: answer behind each.
@@ -59,6 +65,9 @@ class Item:
     expects: str
     #: the verdict rests on every check-sat of the script (a Hoare triple's conditions), not only its last
     every: bool = False
+    #: what the script is when it is not the verdict's own query: ``witness`` (a realizable contract's
+    #: witness query, whose unsat implies the verdict's; health/realizer.py)
+    via: str = ""
 
 
 def discharging_items(root: Any, nodes: Iterable[str]) -> list[Item]:
@@ -74,7 +83,10 @@ def discharging_items(root: Any, nodes: Iterable[str]) -> list[Item]:
                 out.append(Item("side-condition", str(sc.get("id")), sc["smt2"], "discharged", "unsat"))
         body, why = read_sealed(root / f"artifacts/health/{n}.json", "contract health record")
         for f in _rows(body, why, "findings"):
-            if f.get("status") == "ok" and _path(f.get("smt2")):
+            if f.get("status") == "ok" and f.get("check") == "realizable" and _path(f.get("witness_smt2")):
+                # the witness's quantifier-free query, which implies realizability (health/realizer.py)
+                out.append(Item("health", str(f.get("id")), f["witness_smt2"], "ok", "unsat", every=True, via=WITNESS))
+            elif f.get("status") == "ok" and _path(f.get("smt2")):
                 proof = f.get("check") in PROOF_CHECKS  # both sides of a replacement (joined by a reset) must hold
                 out.append(Item("health", str(f.get("id")), f["smt2"], "ok", "unsat" if proof else "sat", every=proof))
     index, why = read_sealed(root / "artifacts/requirements/index.json", "requirement index")

@@ -22,7 +22,7 @@ from typing import Any, Iterable
 from ..evidence.sealed import read_sealed, write_sealed
 from ..evidence.store import atomic_write_text
 from .cvc5_decide import RLIMIT, Decision, Session, decide, version
-from .items import Item, discharging_items
+from .items import WITNESS, Item, discharging_items
 
 DIR = "artifacts/crosscheck"
 INDEX = f"{DIR}/index.json"
@@ -122,6 +122,10 @@ def _row(root: Path, it: Item, ver: str, cache: dict[str, dict[str, Any]], keep:
         keep.add(Path(d["proof"]).name)
     row["cvc5"] = d
     row["agreement"], row["why"] = agreement(it.expects, d)
+    if it.via == WITNESS:
+        row["via"] = WITNESS
+        row["why"] += (" on the witness query: the output terms written out answer every admissible input, which"
+                       " implies the contract is realizable")
     return row
 
 

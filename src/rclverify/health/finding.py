@@ -24,8 +24,11 @@ class Finding:
     ``core`` an unsat core (RCL clauses), ``instances`` per-instance verdicts
     of a quantified premise; ``duration_s`` is the solver's wall-clock time
     in seconds; ``smt2`` the query as SMT-LIB2 text (not compared, not in
-    :meth:`to_json`).  Checks: health/checks.py (consistency and vacuity,
-    paper lines 740-768) and health/shape.py.
+    :meth:`to_json`); ``witness`` (realizability ``ok`` only) output name ->
+    RCL term answering every admissible input, ``witness_smt2`` the query
+    showing it (health/realizer.py; not compared, not in :meth:`to_json`).
+    Checks: health/checks.py (consistency and vacuity, paper lines 740-768),
+    health/shape.py and health/realizable.py.
     """
 
     id: str
@@ -40,13 +43,19 @@ class Finding:
     duration_s: float = 0.0
     instances: dict[str, str] | None = None
     smt2: str = field(default="", compare=False)
+    witness: dict[str, str] | None = None
+    witness_smt2: str = field(default="", compare=False)
 
     def to_json(self) -> dict[str, Any]:
-        """The finding as a JSON object (every field but ``smt2``)."""
-        return {"id": self.id, "node": self.node, "check": self.check, "guarantee": self.guarantee,
-                "status": self.status, "message": self.message, "explanation": self.explanation,
-                "model": self.model, "core": self.core, "duration_s": self.duration_s,
-                "instances": self.instances}
+        """The finding as a JSON object (every field but the two scripts;
+        ``witness`` only when there is one)."""
+        out = {"id": self.id, "node": self.node, "check": self.check, "guarantee": self.guarantee,
+               "status": self.status, "message": self.message, "explanation": self.explanation,
+               "model": self.model, "core": self.core, "duration_s": self.duration_s,
+               "instances": self.instances}
+        if self.witness is not None:
+            out["witness"] = self.witness
+        return out
 
 
 __all__ = ["Finding"]

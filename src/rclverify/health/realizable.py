@@ -57,6 +57,7 @@ from ..rcl import ast
 from ..logic.natural import natural_typing
 from ..rcl.types import Checked, FuncT
 from .finding import Finding
+from .realizer import Witness, find_witness
 from .shape import outputs_mentioned
 from .witness import finite_witness, has_tables, points_for
 
@@ -139,6 +140,18 @@ class _Query:
                         comment=comment, retry=False)
         return r.status, r.model, round(time.perf_counter() - t0, 4), r.smt2 if r.status in ("sat", "unsat") else ""
 
+    def witness(self, node: str) -> Witness | None:
+        """Output terms that answer every admissible input (:mod:`.realizer`),
+        asked once Z3 proved the contract realizable; ``None`` with
+        function-typed inputs or none found."""
+        free = [s.decl for s in self.enc.symbols.values()]
+        if any(isinstance(d, z3.FuncDeclRef) for d in free):
+            return None
+        names = {str(d): str(d)[len(node) + 1:] if str(d).startswith(node + ".") else str(d)
+                 for d in [*free, *self.outs]}
+        body = _conj([*self.typing, *self.out_facts, *self.guarantees])
+        return find_witness(self.enc.axioms() + self.given, body, self.outs, free, names)
+
     def _eliminated(self, f: z3.BoolRef) -> tuple[str, dict[str, str] | None]:
         """``(sat|unsat|unknown, input model)`` of ``f`` asked of Z3's
         quantifier elimination then its SMT solver, within the query's budget
@@ -177,12 +190,19 @@ def realizability_findings(checked: Checked, node: str, facts: Sequence[tuple[as
     if status == "unsat" and not q.exact:
         return []  # proved over outputs the type excludes too (a negative element of a seq(NATURAL)): no proof
     if status == "unsat":
+        w = q.witness(node)
+        sketch = (f" For instance {w.text()} answers every one of them (Z3 checked it: the witness query is unsat)."
+                  if w is not None else "")
+        witness_smt2 = (smt2_script(list(w.query), f"health {node}: does the witness {w.text()} leave an admissible "
+                                                   "input unanswered? (unsat: it answers every one)")()
+                        if w is not None else "")
         return [Finding(f"{node}.realizable", node, "realizable", None, "ok",
                         f"The contract of {node} can be implemented: every input its assumption"
                         + (" and the environment facts admit" if facts else " admits")
-                        + " has an output satisfying every guarantee.",
+                        + " has an output satisfying every guarantee." + sketch,
                         "Realizability (forall in. A(in) -> exists out. G(in, out)): Z3 proved that no admissible "
-                        "input lacks an answer (the query below is unsat).", None, None, secs, smt2=smt2)]
+                        "input lacks an answer (the query below is unsat).", None, None, secs, smt2=smt2,
+                        witness=dict(w.terms) if w is not None else None, witness_smt2=witness_smt2)]
     if status != "sat":
         return []
     conflict = every
