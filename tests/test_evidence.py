@@ -110,3 +110,25 @@ def test_a_target_relates_artifact_paths_to_the_workspace_root(tmp_path: Path) -
     link.symlink_to(tmp_path)
     t2 = NodeTarget(root=link, checked=None, node=None, config={}, artifacts=link / "artifacts" / "x")  # type: ignore[arg-type]
     assert t2.rel(link / "artifacts" / "x" / "f.txt") == "artifacts/x/f.txt"
+
+
+# ---- the sealed text, encoded once (evidence/store.py: sealed_dumps) -------------------------------------
+
+from hypothesis import given, settings  # noqa: E402
+from hypothesis import strategies as st  # noqa: E402
+
+_KEYS = st.one_of(st.sampled_from(["a", "record", "record_sha25", "record_sha256x", "record_sha256 ", "z", "Ω",
+                                   "", '": ', '\\"', '\n  "x']), st.text(max_size=6))
+_VALUES = st.recursive(st.none() | st.booleans() | st.integers() | st.floats(allow_nan=False) | st.text(max_size=5),
+                       lambda c: st.lists(c, max_size=3) | st.dictionaries(_KEYS, c, max_size=3), max_leaves=8)
+
+
+@settings(max_examples=400, deadline=None)
+@given(st.dictionaries(_KEYS, _VALUES, max_size=6))
+def test_the_sealed_text_is_the_sealed_record_encoded(record: dict) -> None:
+    """The seal's line spliced into the one encoding equals encoding the record with its seal: keys
+    before and after the seal's, none after it, none at all, keys holding quotes, colons and the
+    indentation of a key line."""
+    from rclverify.evidence.store import SEAL, dumps, seal_of, sealed_dumps
+    record.pop(SEAL, None)
+    assert sealed_dumps(record) == dumps({**record, SEAL: seal_of(record)})

@@ -27,7 +27,7 @@ import os
 from pathlib import Path
 from typing import Any, Mapping
 
-from .store import SEAL, _sealed_text, seal_of, write_json
+from .store import SEAL, _sealed_text, atomic_write_text, seal_of, sealed_dumps
 
 #: Workspace-relative directories and files whose JSON records are sealed (:func:`is_sealed_path`).
 SEALED_DIRS = ("artifacts/requirements/", "artifacts/health/", "artifacts/calculus/", "artifacts/provenance/",
@@ -48,9 +48,10 @@ def sealed(record: Mapping[str, Any]) -> dict[str, Any]:
 
 
 def write_sealed(path: Path, record: Mapping[str, Any], *, durable: bool = False) -> bool:
-    """Write ``record`` sealed, atomically (:func:`.store.write_json`);
-    returns ``True`` when the file changed.  Raises ``OSError``."""
-    return write_json(path, sealed(record), durable=durable)
+    """Write ``record`` sealed, atomically (the text of :func:`.store.write_json`
+    of :func:`sealed`, encoded once: :func:`.store.sealed_dumps`); returns
+    ``True`` when the file changed.  Raises ``OSError``."""
+    return atomic_write_text(path, sealed_dumps(record), durable=durable)
 
 
 def check_text(text: str, what: str = "record") -> tuple[dict[str, Any] | None, str]:
