@@ -173,3 +173,34 @@ def test_recursive_constructor_sets_are_not_split() -> None:
     f = z3.Function("lf", Lst, z3.BoolSort())
     q = z3.ForAll([x], f(x))
     assert expand_finite(q).eq(q)
+
+
+def test_finite_expansion_of_shared_subterms_is_the_expansion_of_each() -> None:
+    """expand_finite expands each distinct subterm once (logic/retry.py): on formulas whose finite
+    quantifiers occur many times over (shared), the expansion of a conjunction is the conjunction of
+    the expansions, term for term, and the result is equivalent to the formula."""
+    import random
+
+    from rclverify.logic.retry import expand_finite
+    S, (a, b, _c) = z3.EnumSort("ShareS", ["sa", "sb", "sc"])
+    x = z3.Int("x")
+    rng = random.Random(7)
+
+    def formula(d: int) -> z3.BoolRef:
+        if d == 0:
+            return rng.choice([x > rng.randint(0, 3), z3.Bool("p")])
+        v = z3.Const(f"v{d}", S)
+        sub = formula(d - 1)
+        k = rng.randint(0, 2)
+        if k == 0:
+            return z3.ForAll([v], z3.Or(v == a, sub))
+        if k == 1:
+            return z3.Exists([v], z3.And(v != b, sub, sub))
+        return z3.And(sub, z3.Or(sub, formula(d - 1)))
+
+    for _ in range(60):
+        f, g = formula(rng.randint(1, 4)), formula(rng.randint(1, 4))
+        assert expand_finite(z3.And(f, g, f)).eq(z3.And(expand_finite(f), expand_finite(g), expand_finite(f)))
+        s = z3.Solver()
+        s.add(z3.Not(f == expand_finite(f)))
+        assert s.check() == z3.unsat

@@ -46,6 +46,7 @@ task of whichever process made it (incremental equals clean).
 """
 from __future__ import annotations
 
+import re
 import time
 from dataclasses import dataclass
 from typing import Any, Callable, Mapping, Sequence
@@ -197,7 +198,7 @@ def _build(checked: Checked, model: SystemModel, m: str, environment: Callable[[
     decls = "".join(f"(declare-fun {quote(n)} () {s})\n" for n, s in sorted(sorts.items()))
     ctx = z3.Context()  # of its own: the text made depends on nothing this process did before
     try:
-        formula = _eliminate(ctx, decls, [b for _, b in premises] + axioms, sorted(set(sorts) - set(kept)))
+        formula = _eliminate(ctx, decls, [b for _, b in premises] + axioms, sorted(set(sorts) - set(kept)), sorts)
         used = (_implied(ctx, decls, premises, axioms, formula)
                 if formula is not None and len(formula) <= MAX_TEXT else None)
     except z3.Z3Exception:
@@ -219,15 +220,17 @@ def _build(checked: Checked, model: SystemModel, m: str, environment: Callable[[
     return Summary(m, formula, tuple(sorted(kept.items())), tuple(sorted(out.values(), key=lambda u: u[2])), script)
 
 
-def _eliminate(ctx: z3.Context, decls: str, bodies: Sequence[str], hidden: Sequence[str]) -> str | None:
+def _eliminate(ctx: z3.Context, decls: str, bodies: Sequence[str], hidden: Sequence[str],
+               sorts: Mapping[str, str] | None = None) -> str | None:
     """``exists hidden. and(bodies)`` without the quantifier, as SMT-LIB
     text (Z3 context ``ctx``); ``None`` when ``qe`` leaves a quantifier or
-    gives up."""
+    gives up.  ``sorts``: each name's SMT-LIB sort (``Real``, ``Int``,
+    ``Bool``), so the names the bodies mention are bound without walking
+    the parsed formula (:func:`_bound`)."""
     fs = z3.parse_smt2_string(decls + "".join(f"(assert {b})\n" for b in bodies), ctx=ctx)
     body = z3.And(*fs) if len(fs) else z3.BoolVal(True, ctx)
     if hidden:
-        consts = {str(c): c for f in fs for c in _constants(f)}
-        xs = [consts[h] for h in hidden if h in consts]
+        xs = _bound(ctx, fs, bodies, hidden, sorts)
         if xs:
             body = z3.Exists(xs, body)
     from ..logic.retry import has_quantifier
@@ -241,6 +244,30 @@ def _eliminate(ctx: z3.Context, decls: str, bodies: Sequence[str], hidden: Seque
         if not has_quantifier(out):
             return " ".join(out.sexpr().split())  # one line: the scripts quote it in a comment
     return None
+
+
+#: The Z3 sort of each SMT-LIB sort name of :data:`.smttext.SORTS`.
+_Z3_SORTS = {"Real": z3.RealSort, "Int": z3.IntSort, "Bool": z3.BoolSort}
+
+
+def _bound(ctx: z3.Context, fs: Sequence[z3.ExprRef], bodies: Sequence[str], hidden: Sequence[str],
+           sorts: Mapping[str, str] | None) -> list[z3.ExprRef]:
+    """The constants of ``hidden`` that ``bodies`` mention, in ``hidden``'s
+    order: read off the text's tokens when every name is a simple SMT-LIB
+    symbol of a sort in ``sorts`` (the same constants Z3 parsed: a constant
+    is its name and sort), else found by walking the parsed ``fs`` (walking
+    the terms through Z3's Python objects was a tenth of a summary)."""
+    quoted = {h: quote(h) for h in hidden}
+    if sorts is not None and all(sorts.get(h) in _Z3_SORTS and not any(c in q for c in " \t\n()|")
+                                 for h, q in quoted.items()):
+        tokens = set(_TOKEN.findall(" ".join(bodies)))
+        return [z3.Const(h, _Z3_SORTS[sorts[h]](ctx)) for h in hidden if quoted[h] in tokens]
+    consts = {str(c): c for f in fs for c in _constants(f)}
+    return [consts[h] for h in hidden if h in consts]
+
+
+#: An SMT-LIB2 token that is not a parenthesis: a simple symbol, numeral or keyword.
+_TOKEN = re.compile(r"[^\s()]+")
 
 
 def _constants(f: z3.ExprRef) -> list[z3.ExprRef]:

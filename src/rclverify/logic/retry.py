@@ -35,6 +35,8 @@ from typing import Callable, Sequence, cast
 
 import z3
 
+from .subst import substitute
+
 #: Each retry is bounded by Z3's deterministic resource counter (``rlimit``),
 #: not by wall-clock time, so its answer does not depend on the machine's load
 #: (a serial and a parallel run agree).  About 2-5 s on one idle core; the
@@ -96,8 +98,29 @@ def expand_finite(e: z3.ExprRef, depth: int = 0) -> z3.ExprRef:
     counter would carry the process's history into the query).  ``depth`` is
     the number of enclosing binders (internal).  At most
     :data:`MAX_INSTANCES` instances are written per quantifier; beyond that
-    it is kept.
+    it is kept.  Each distinct subterm is expanded once per depth (a
+    transition relation shares its states' validity many times over; walked
+    as a tree, that was most of a deadlock check's time).
     """
+    return _expand(e, depth, {})
+
+
+#: The memo of one :func:`expand_finite` call: (term id, depth) -> (the term, its expansion).  It holds
+#: each term it is keyed by, so no id is reused for another term while the call runs (the bodies opened
+#: on the way are not subterms of the root).
+_Memo = dict[tuple[int, int], tuple[z3.ExprRef, z3.ExprRef]]
+
+
+def _expand(e: z3.ExprRef, depth: int, memo: _Memo) -> z3.ExprRef:
+    """:func:`expand_finite` of ``e`` at ``depth``, with ``memo``."""
+    key = (e.get_id(), depth)
+    hit = memo.get(key)
+    if hit is None:
+        hit = memo[key] = (e, _expand_once(e, depth, memo))
+    return hit[1]
+
+
+def _expand_once(e: z3.ExprRef, depth: int, memo: _Memo) -> z3.ExprRef:
     if z3.is_quantifier(e):
         q = e
         if q.is_lambda():
@@ -105,7 +128,7 @@ def expand_finite(e: z3.ExprRef, depth: int = 0) -> z3.ExprRef:
         names = [z3.Const(f"{q.var_name(k)}!q{depth}_{k}", q.var_sort(k)) for k in range(q.num_vars())]
         # de Bruijn: variable 0 is the last bound one
         opened = z3.substitute_vars(q.body(), *reversed(names))
-        body = expand_finite(opened, depth + 1)
+        body = _expand(opened, depth + 1, memo)
         cases = [_cases(v, f"{v}") for v in names]
         split = [k for k, c in enumerate(cases) if c is not None]
         if split:
@@ -114,19 +137,19 @@ def expand_finite(e: z3.ExprRef, depth: int = 0) -> z3.ExprRef:
                 kept = [v for k, v in enumerate(names) if cases[k] is None]
                 insts = []
                 for combo in combos:
-                    inst = z3.substitute(body, *[(names[k], val) for k, (val, _) in zip(split, combo)])
+                    inst = substitute(body, [(names[k], val) for k, (val, _) in zip(split, combo)])
                     bound = kept + [a for _, args in combo for a in args]
                     if not bound:
                         insts.append(inst)
                         continue
                     inner = z3.ForAll(bound, inst) if q.is_forall() else z3.Exists(bound, inst)
-                    insts.append(expand_finite(inner, depth + 1) if any(args for _, args in combo) else inner)
+                    insts.append(_expand(inner, depth + 1, memo) if any(args for _, args in combo) else inner)
                 return z3.And(*insts) if q.is_forall() else z3.Or(*insts)
         if body.eq(opened):
             return e
         return z3.ForAll(names, body) if q.is_forall() else z3.Exists(names, body)
     if z3.is_app(e) and e.num_args() > 0:
-        kids = [expand_finite(c, depth) for c in e.children()]
+        kids = [_expand(c, depth, memo) for c in e.children()]
         return e.decl()(*kids)
     return e
 

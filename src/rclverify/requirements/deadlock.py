@@ -44,6 +44,7 @@ from typing import Sequence
 import z3
 
 from ..logic.retry import MAX_INSTANCES, expand_finite, finite_values
+from ..logic.subst import substitute
 from .tsys import Pred, State, TemporalVerdict, TransitionSystem, distinct, trace_of, unroll
 
 #: The step-by-step search of :func:`find_deadlock` stops (``inconclusive``)
@@ -71,7 +72,7 @@ def successor_exists(ts: TransitionSystem, s: State) -> z3.BoolRef:
         return body
     if not finite or len(combos) > MAX_INSTANCES:
         return z3.Exists(list(t.values()), body)
-    cases = [z3.substitute(body, *[(t[n], v) for n, v in zip(finite, combo)]) for combo in combos]
+    cases = [substitute(body, [(t[n], v) for n, v in zip(finite, combo)]) for combo in combos]
     return z3.Or(*[z3.Exists(rest, c) if rest else c for c in cases])
 
 
