@@ -147,8 +147,8 @@ class _Query:
         free = [s.decl for s in self.enc.symbols.values()]
         if any(isinstance(d, z3.FuncDeclRef) for d in free):
             return None
-        names = {str(d): str(d)[len(node) + 1:] if str(d).startswith(node + ".") else str(d)
-                 for d in [*free, *self.outs]}
+        full = [d.decl().name() for d in [*free, *self.outs]]  # a constant's name (str() would print it)
+        names = {n: n[len(node) + 1:] if n.startswith(node + ".") else n for n in full}
         body = _conj([*self.typing, *self.out_facts, *self.guarantees])
         return find_witness(self.enc.axioms() + self.given, body, self.outs, free, names)
 

@@ -97,7 +97,7 @@ def find_witness(given: Sequence[z3.BoolRef], body: z3.BoolRef, outs: Sequence[z
             found = _cegis(params, terms, given, body, outs, inputs)
             if found is not None:
                 values, query = found
-                return Witness(tuple((names.get(str(o), str(o)), _text(t, values, names))
+                return Witness(tuple((_name(o, names), _text(t, values, names))
                                      for o, t in zip(outs, terms)), tuple(query))
     except z3.Z3Exception:
         return None
@@ -141,18 +141,19 @@ def _expr(t: _Term) -> z3.ExprRef:
 
 def _cegis(params: Sequence[z3.ExprRef], terms: Sequence[_Term], given: Sequence[z3.BoolRef], body: z3.BoolRef,
            outs: Sequence[z3.ExprRef], inputs: Sequence[z3.ExprRef]
-           ) -> tuple[dict[str, z3.ExprRef], list[z3.BoolRef]] | None:
-    """Parameters whose terms answer every admissible input, and the
-    verification query that showed it (unsat); ``None`` when the template
-    cannot, or the rounds or a check's budget run out."""
+           ) -> tuple[dict[int, z3.ExprRef], list[z3.BoolRef]] | None:
+    """The parameters' values (by term id; ``params`` keep the ids) whose
+    terms answer every admissible input, and the verification query that
+    showed it (unsat); ``None`` when the template cannot, or the rounds or
+    a check's budget run out."""
     answered = z3.substitute(body, *[(o, _expr(t)) for o, t in zip(outs, terms)])
     synth = budgeted_solver(CHECK_MS)
     for _ in range(ROUNDS):
         if synth.check() != z3.sat:
             return None
         m = synth.model()
-        values = {str(p): m.eval(p, model_completion=True) for p in params}
-        ws = [z3.simplify(z3.substitute(_expr(t), *[(p, values[str(p)]) for p in params])) for t in terms]
+        values = {p.get_id(): m.eval(p, model_completion=True) for p in params}
+        ws = [z3.simplify(z3.substitute(_expr(t), *[(p, values[p.get_id()]) for p in params])) for t in terms]
         query = [*given, z3.Not(z3.substitute(body, *zip(outs, ws)))]
         v = budgeted_solver(CHECK_MS)
         v.add(*query)
@@ -167,17 +168,22 @@ def _cegis(params: Sequence[z3.ExprRef], terms: Sequence[_Term], given: Sequence
     return None
 
 
-def _text(t: _Term, values: dict[str, z3.ExprRef], names: dict[str, str]) -> str:
+def _name(x: z3.ExprRef, names: dict[str, str]) -> str:
+    n = x.decl().name()
+    return names.get(n, n)
+
+
+def _text(t: _Term, values: dict[int, z3.ExprRef], names: dict[str, str]) -> str:
     """The term with its parameters' values in RCL notation: ``in.x + 1``, ``-2 * in.y``, ``green``."""
     c, coeffs = t
     parts = []
     for a, x in coeffs:
-        v = values[str(a)]
+        v = values[a.get_id()]
         if z3.is_rational_value(v) and v.numerator_as_long() == 0 or z3.is_int_value(v) and v.as_long() == 0:
             continue
         one = z3.is_int_value(v) and v.as_long() == 1 or z3.is_rational_value(v) and v.as_fraction() == 1
-        parts.append(names.get(str(x), str(x)) if one else f"{value_to_rcl(v)} * {names.get(str(x), str(x))}")
-    const = values[str(c)]
+        parts.append(_name(x, names) if one else f"{value_to_rcl(v)} * {_name(x, names)}")
+    const = values[c.get_id()]
     zero = (z3.is_int_value(const) and const.as_long() == 0
             or z3.is_rational_value(const) and const.numerator_as_long() == 0)
     if not parts or not zero:

@@ -155,17 +155,24 @@ def _expand_once(e: z3.ExprRef, depth: int, memo: _Memo) -> z3.ExprRef:
 
 
 def has_quantifier(e: z3.ExprRef) -> bool:
-    """Does ``e`` hold a quantifier anywhere (shared subterms visited once)?"""
-    todo, seen = [e], set()
+    """Does ``e`` hold a quantifier anywhere (shared subterms visited once)?
+    Walked with Z3's low-level API on the raw terms, as
+    :func:`rclverify.logic.modeltext.term_to_rcl` does: no Python wrapper
+    object per subterm."""
+    c = e.ctx.ref()
+    ast_id, kind, n_args, arg = z3.Z3_get_ast_id, z3.Z3_get_ast_kind, z3.Z3_get_app_num_args, z3.Z3_get_app_arg
+    todo, seen = [e.as_ast()], set()
     while todo:
-        x = todo.pop()
-        if x.get_id() in seen:
+        a = todo.pop()
+        i = ast_id(c, a)
+        if i in seen:
             continue
-        seen.add(x.get_id())
-        if z3.is_quantifier(x):
+        seen.add(i)
+        k = kind(c, a)
+        if k == z3.Z3_QUANTIFIER_AST:
             return True
-        if z3.is_app(x):
-            todo.extend(x.children())
+        if k == z3.Z3_APP_AST:
+            todo.extend(arg(c, a, j) for j in range(n_args(c, a)))
     return False
 
 
