@@ -43,7 +43,7 @@ from ...rcl.types import Checked, CheckedNode
 from ...traces.events import Event
 from ...traces.mapping import TopicRule
 from ...traces.questions import KEPT, Question
-from .answered import AnsweredRun
+from .answered import AnsweredRun, RecentOutput
 from .columns import ColumnCompiler, Unsupported, column, io_kind, seed
 from .engine import NodeMonitor
 from .rows import BlockRows, EventRows, chunks, rows_of
@@ -361,11 +361,11 @@ class _Run:
             left = stream._questions.count(None)  # the ghosts the stream still keeps: the latest of them
             while self.ghosts and sum(len(g.at) - 1 for g in self.ghosts[1:]) >= left:
                 del self.ghosts[0]
-        if stream.skew:
+        if stream.skew:  # the answers' entries, each event made if the engine reads it (answered.py)
             recent = m._recent
-            for i in at[-recent.maxlen:].tolist():
-                ev = chunk[i + 1]
-                recent.append((ev, ev.time, {okey: ev.fields[ofield]}, _EMPTY))
+            outs = at[-recent.maxlen:] + 1
+            recent.extend(map(RecentOutput, repeat(chunk), outs.tolist(), times[outs].tolist(), repeat(okey),
+                              repeat(ofield)))
         values = m.values
         for k in keys:
             values[k] = newest.inputs[k]
