@@ -11,8 +11,9 @@ lines as blocks instead, each either
   msgspec into a ``msgspec.Struct`` whose fields are the line's keys
   (``topic`` a string, every other value of any JSON type, read by the same
   decoder as :func:`~.jsonl.read_jsonl`'s first try), with its topics and
-  times as columns and an :class:`Event` made, by
-  :func:`~.jsonl.read_lines` itself, only for a row someone asks for; or
+  times as columns and an :class:`Event` made only for a row someone asks
+  for, by :func:`~.jsonl.line_event` (:func:`~.jsonl.read_lines`' own rule
+  for one line); or
 * a list of the events :func:`~.jsonl.read_lines` reads from the block's
   lines (the **exact path**), whenever the fast path cannot show that it
   reads the block as :func:`~.jsonl.read_jsonl` would.
@@ -176,8 +177,10 @@ class LogBlock:
     ``topics``: each row's topic (leading ``/`` removed, as the event's);
     ``times``: float64 seconds; :meth:`values`: a key's value per row;
     ``block[i]`` / ``block[i:j]``: the row's :class:`Event` (events), made by
-    :func:`~.jsonl.read_lines` from the row's line the first time it is asked
-    for, the same object after that."""
+    :func:`~.jsonl.line_event` from the row's line the first time it is asked
+    for, the same object after that.  Raises :class:`RuntimeError` should
+    the exact reader skip a row's line (a defect: the fast path takes only
+    lines with a string topic and a finite float time, which it reads)."""
 
     __slots__ = ("path", "name", "lines", "structs", "attr", "topics", "times", "lineno", "index", "_made")
 

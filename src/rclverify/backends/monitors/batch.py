@@ -2,8 +2,10 @@
 
 Offline, a run is a batch (issue 51): most of it is a node answering each
 input message with one output message, every formula far from its
-boundaries.  This module reads the trace in chunks (:data:`CHUNK` events),
-finds those rows (a **pair**: an input message and the output message that
+boundaries.  This module reads the trace in chunks (:data:`CHUNK` events;
+:mod:`.rows`: a list of events, or a block of a ROSMonitoring log read as
+columns, traces/jsonl_blocks.py, whose events are made only for the rows
+the engine or the batch path's state needs), finds those rows (a **pair**: an input message and the output message that
 follows it, the output the answer the stream model gives it, docs/semantics.md),
 evaluates the assumptions and guarantees over the chunk's columns in
 float64 with a certificate per row (:mod:`.columns`), and gives the rows
@@ -112,7 +114,7 @@ def check_batch(checked: Checked, node: CheckedNode, events: Iterable[Event], ru
     """:func:`~.check.check_trace` for one node, in batches: (events read, the
     node's result), the same verdicts in the same order to ``on_verdict``;
     ``None`` before reading any event when the node is not eligible (module
-    docstring).  ``chunk``: events read at once (>= 2); ``stats``, when given,
+    docstring).  ``chunk``: events (a log's lines) read at once (>= 2); ``stats``, when given,
     receives ``batched`` (answer pairs judged in batches) and ``streamed``
     (events fed to the streaming engine).  Raises what the event source raises."""
     m = NodeMonitor(checked, node, rules, horizon, on_verdict, tolerance)
