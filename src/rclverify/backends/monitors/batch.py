@@ -5,8 +5,9 @@ input message with one output message, every formula far from its
 boundaries.  This module reads the trace in chunks (:data:`CHUNK` events;
 :mod:`.rows`: a list of events, or a block of a ROSMonitoring log read as
 columns, traces/jsonl_blocks.py, whose events are made only for the rows
-the engine or the batch path's state needs), finds those rows (a **pair**: an input message and the output message that
-follows it, the output the answer the stream model gives it, docs/semantics.md),
+the engine or the batch path's state needs), finds those rows (a
+**pair**: an input message and the output message that follows it, the
+output the answer the stream model gives it, docs/semantics.md),
 evaluates the assumptions and guarantees over the chunk's columns in
 float64 with a certificate per row (:mod:`.columns`), and gives the rows
 surely true in exact arithmetic their ``satisfied`` verdict directly.  Every
@@ -312,7 +313,8 @@ class _Run:
         stamps = m.stream._stamps
         return not stamps or stamps[-1] <= t
 
-    def _satisfied(self, chunk: EventRows | BlockRows, at: np.ndarray, src: dict[str, np.ndarray], times: np.ndarray) -> None:
+    def _satisfied(self, chunk: EventRows | BlockRows, at: np.ndarray, src: dict[str, np.ndarray],
+                   times: np.ndarray) -> None:
         """The pairs at ``at`` are surely satisfied: their verdicts, and the engine's state as feeding them sets it."""
         plan, m = self.plan, self.m
         h, okey, keys = m.horizon, plan.output[1], plan.keys
