@@ -58,13 +58,13 @@ class JsonlLog:
         self.path = path
         self._events: Iterator[Event] | None = None
 
-    def __iter__(self) -> JsonlLog:
-        return self
+    def __iter__(self) -> Iterator[Event]:
+        if self._events is None:  # the reader's generator itself: a for loop pays no call of ours per event
+            self._events = read_jsonl(self.path)
+        return self._events
 
     def __next__(self) -> Event:
-        if self._events is None:
-            self._events = read_jsonl(self.path)
-        return next(self._events)
+        return next(iter(self))
 
     def blocks(self, fields: Sequence[str], rows: int) -> Iterator[LogBlock | list[Event]] | None:
         """The log's lines in blocks of at most ``rows`` lines: a :class:`LogBlock`
