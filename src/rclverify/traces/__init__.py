@@ -1,7 +1,8 @@
 """Recorded runs of a ROS system as streams of events.
 
 :mod:`.events` is the event record and the located error; :mod:`.jsonl`
-reads ROSMonitoring's JSON-lines logs, :mod:`.bag` ROS 1 and ROS 2 bags
+reads ROSMonitoring's JSON-lines logs (:mod:`.jsonl_blocks`: a block of
+lines at a time, as columns, for the offline batch path), :mod:`.bag` ROS 1 and ROS 2 bags
 (through ``rosbags``); :mod:`.mapping` turns messages into RCL values with
 the paper's mapping rules (lines 535-548).  :func:`read_trace` picks the
 reader by the file's form.
@@ -33,8 +34,8 @@ def read_trace(path: Path, msg_dirs: Sequence[Path] = (), *, streams: bool = Fal
         if on_warning is not None:
             on_warning(w)
     if not path.is_dir() and path.suffix in LOG_SUFFIXES:
-        from .jsonl import read_jsonl
-        return read_jsonl(path)
+        from .jsonl_blocks import JsonlLog
+        return JsonlLog(path)  # its events, as read_jsonl reads them, or its blocks for the batch path
     from .bag import read_bag
     return read_bag(path, msg_dirs)
 

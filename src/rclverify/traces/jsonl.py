@@ -23,7 +23,7 @@ import json
 import math
 import sys
 from pathlib import Path
-from typing import Any, Iterator
+from typing import Any, Iterable, Iterator
 
 import msgspec
 
@@ -57,12 +57,26 @@ def read_jsonl(path: Path) -> Iterator[Event]:
     which reads it, or reports it, as before.  Bytes that are not UTF-8
     raise a located :class:`TraceError`.
     """
-    index = 0
+    with path.open("rb") as fh:
+        yield from read_lines(path, fh)
+
+
+def read_lines(path: Path, chunks: Iterable[bytes], lineno: int = 0, index: int = 0,
+               end: list[int] | None = None) -> Iterator[Event]:
+    """The events of some lines of the log at ``path``, as :func:`read_jsonl` reads them.
+
+    ``chunks``: the log's bytes split after each ``b"\\n"`` (a file opened
+    ``"rb"``, or the lines of a block, :mod:`.jsonl_blocks`); a bare
+    ``b"\\r"`` inside a chunk also ends a line.  ``lineno``: the lines before
+    the first (1-based numbers follow it), ``index``: the events before it.
+    ``end``, when given, is set to ``[lineno, index]`` after the last line
+    read (also when a line raises).  Raises :class:`TraceError` as
+    :func:`read_jsonl`.
+    """
     name = path.name
     fast, fast_error, slow, inf = _FAST, _FAST_ERROR, _slow, math.inf
-    lineno = 0
-    with path.open("rb") as fh:
-        for chunk in fh:  # split at b"\n"; a bare b"\r" also ends a line (universal newlines, as text mode read it)
+    try:
+        for chunk in chunks:  # split at b"\n"; a bare b"\r" also ends a line (universal newlines, as text mode read it)
             for raw in chunk.splitlines(True) if b"\r" in chunk else (chunk,):
                 lineno += 1
                 try:
@@ -79,6 +93,28 @@ def read_jsonl(path: Path) -> Iterator[Event]:
                 del obj["topic"], obj["time"]  # the message's fields, in their order (the object is this line's own)
                 yield Event(index, float(time), topic.lstrip("/"), obj, f"{name}:{lineno}")
                 index += 1
+    finally:
+        if end is not None:
+            end[:] = [lineno, index]
+
+
+def line_event(path: Path, name: str, lineno: int, index: int, raw: bytes) -> Event | None:
+    """The event of line ``lineno`` (``raw``, its bytes) of the log at ``path``
+    (``name`` its file name), event ``index``: exactly what :func:`read_lines`
+    makes of it (its first branch, a line msgspec reads with a string topic
+    and a finite float time, repeated here; any other line is read by
+    :func:`read_lines` itself); ``None`` for a blank line.  Raises
+    :class:`TraceError` as :func:`read_lines`."""
+    try:
+        obj: Any = _FAST(raw)
+    except _FAST_ERROR:
+        obj = None
+    if type(obj) is dict:
+        topic, time = obj.get("topic"), obj.get("time")
+        if type(time) is float and type(topic) is str and -math.inf < time < math.inf:
+            del obj["topic"], obj["time"]
+            return Event(index, time, topic.lstrip("/"), obj, f"{name}:{lineno}")
+    return next(read_lines(path, (raw,), lineno - 1, index), None)
 
 
 def _checked(path: Path, lineno: int, topic: Any, time: Any) -> float | int:

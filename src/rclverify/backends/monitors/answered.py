@@ -8,10 +8,14 @@ fields are those the engine sets on a question answered by one output that
 decided every guarantee (``answered``, ``answer``, ``view``, ``decided``,
 ``due``; ``followed`` when the next question came within its horizon, else
 ``reported``: it was closed, answered in full, when its horizon passed).
+
+:class:`RecentOutput` is likewise one of the 64 answers the engine remembers
+for the transport skew (``NodeMonitor._recent``), its event made only if
+the engine reads it (a question left unanswered, ``closing.py``).
 """
 from __future__ import annotations
 
-from typing import Any
+from typing import Any, Iterator
 
 import numpy as np
 
@@ -59,4 +63,32 @@ class AnsweredRun:
         return q
 
 
-__all__ = ["AnsweredRun"]
+class RecentOutput:
+    """An entry of the engine's ``_recent`` outputs, ``(event, stamp, {key: value}, {})``
+    as ``engine.py`` appends it, for the answer at row ``i`` of a batch chunk
+    (``rows[i]`` its event, made when an item other than the stamp is read);
+    ``stamp`` its time (s), ``key``/``field`` the output's variable and field.
+    Compared by identity, as the engine's own entries (each a distinct event)."""
+
+    __slots__ = ("rows", "i", "stamp", "key", "field")
+
+    def __init__(self, rows: Any, i: int, stamp: float, key: str, field: str) -> None:
+        self.rows, self.i, self.stamp, self.key, self.field = rows, i, stamp, key, field
+
+    def __getitem__(self, k: int) -> Any:
+        return self.stamp if k == 1 else self._entry()[k]
+
+    def __iter__(self) -> Iterator[Any]:
+        return iter(self._entry())
+
+    def __len__(self) -> int:
+        return 4
+
+    def _entry(self) -> tuple[Event, float, dict[str, Any], dict[str, Any]]:
+        ev = self.rows[self.i]
+        return ev, self.stamp, {self.key: ev.fields[self.field]}, _EMPTY
+
+
+_EMPTY: dict[str, Any] = {}
+
+__all__ = ["AnsweredRun", "RecentOutput"]

@@ -2,9 +2,12 @@
 
 Offline, a run is a batch (issue 51): most of it is a node answering each
 input message with one output message, every formula far from its
-boundaries.  This module reads the trace in chunks (:data:`CHUNK` events),
-finds those rows (a **pair**: an input message and the output message that
-follows it, the output the answer the stream model gives it, docs/semantics.md),
+boundaries.  This module reads the trace in chunks (:data:`CHUNK` events;
+:mod:`.rows`: a list of events, or a block of a ROSMonitoring log read as
+columns, traces/jsonl_blocks.py, whose events are made only for the rows
+the engine or the batch path's state needs), finds those rows (a
+**pair**: an input message and the output message that follows it, the
+output the answer the stream model gives it, docs/semantics.md),
 evaluates the assumptions and guarantees over the chunk's columns in
 float64 with a certificate per row (:mod:`.columns`), and gives the rows
 surely true in exact arithmetic their ``satisfied`` verdict directly.  Every
@@ -33,8 +36,7 @@ question comes); every formula compiled by :mod:`.columns`.
 from __future__ import annotations
 
 import gc
-from itertools import islice, repeat
-from operator import attrgetter, is_
+from itertools import repeat
 from typing import Any, Callable, Iterable, Mapping
 
 import numpy as np
@@ -44,14 +46,14 @@ from ...rcl.types import Checked, CheckedNode
 from ...traces.events import Event
 from ...traces.mapping import TopicRule
 from ...traces.questions import KEPT, Question
-from .answered import AnsweredRun
-from .columns import ColumnCompiler, Unsupported, column, field_values, io_kind, seed
+from .answered import AnsweredRun, RecentOutput
+from .columns import ColumnCompiler, Unsupported, column, io_kind, seed
 from .engine import NodeMonitor
+from .rows import BlockRows, EventRows, chunks, rows_of
 from .verdicts import NodeResult, Verdict
 
 #: Events read per chunk: the columns held at once.
 CHUNK = 16384
-_TOPIC, _TIME, _STAMP, _FIELDS = attrgetter("topic"), attrgetter("time"), attrgetter("stamp"), attrgetter("fields")
 _EMPTY: Mapping[str, Any] = {}
 
 
@@ -78,6 +80,8 @@ class BatchPlan:
             else:
                 self.output = (topic, key, rule.fields[0], kind)
         self.keys = [k for k, _, _ in self.inputs.values()]
+        #: the message fields the columns read (a log read in blocks decodes them: rows.py)
+        self.fields = [f for _, f, _ in self.inputs.values()] + [self.output[2]]
         if not self.output[0] or not self.inputs or len(set(self.keys)) != len(self.keys) or \
                 sorted(self.keys) != sorted(m._in_keys) or sorted(m.needed_inputs) != sorted(self.keys):
             raise Unsupported("inputs and output not one topic each")
@@ -111,7 +115,7 @@ def check_batch(checked: Checked, node: CheckedNode, events: Iterable[Event], ru
     """:func:`~.check.check_trace` for one node, in batches: (events read, the
     node's result), the same verdicts in the same order to ``on_verdict``;
     ``None`` before reading any event when the node is not eligible (module
-    docstring).  ``chunk``: events read at once (>= 2); ``stats``, when given,
+    docstring).  ``chunk``: events (a log's lines) read at once (>= 2); ``stats``, when given,
     receives ``batched`` (answer pairs judged in batches) and ``streamed``
     (events fed to the streaming engine).  Raises what the event source raises."""
     m = NodeMonitor(checked, node, rules, horizon, on_verdict, tolerance)
@@ -120,27 +124,26 @@ def check_batch(checked: Checked, node: CheckedNode, events: Iterable[Event], ru
         return None
     run = _Run(plan)
     count, last_time = 0, 0.0
-    it = iter(events)
     carry: list[Event] = []
     was = gc.isenabled()
     gc.disable()  # the chunk's events hold no cycles: refcounting frees them (the collector's passes cost 2x)
+    source = chunks(events, max(chunk, 2), plan.fields)
     try:
         while True:
-            events_, before = carry, len(carry)
             try:
-                events_.extend(islice(it, max(chunk, 2)))  # what was read stays in the list if the source raises
-            except BaseException:
-                # the events before the error are judged, as the streaming engine judges them, then it propagates
-                for ev in run.chunk(events_) if len(events_) > before else events_:
-                    run.feed(ev)
-                raise
-            if len(events_) == before:
+                got = next(source)
+            except StopIteration:
+                break
+            except BaseException:  # the events before the source's error are judged as the engine judges them
                 for ev in carry:
                     run.feed(ev)
-                break
-            count += len(events_) - before
-            last_time = events_[-1].time
-            carry = run.chunk(events_)
+                raise
+            rows = rows_of(carry, got)
+            count += len(rows) - len(carry)
+            last_time = rows.last_time
+            carry = run.chunk(rows)
+        for ev in carry:
+            run.feed(ev)
     finally:
         if was:
             gc.enable()
@@ -187,22 +190,21 @@ class _Run:
         self.m.stream._questions = [q if q is not None else next(it) for q in qs]
         self.ghosts.clear()
 
-    def chunk(self, chunk: list[Event]) -> list[Event]:
+    def chunk(self, chunk: EventRows | BlockRows) -> list[Event]:
         """Judge ``chunk``; returns the events to carry to the next chunk (a last input whose answer may follow)."""
         plan, m = self.plan, self.m
         n = len(chunk)
-        kind = self._kind(list(map(_TOPIC, chunk)))
-        times = np.fromiter(map(_TIME, chunk), np.float64, n)
-        stamps = list(map(_STAMP, chunk))
-        fields = list(map(_FIELDS, chunk))
+        kind = self._kind(chunk.topics)
+        times = chunk.times
         ok = kind != 0
-        if stamps.count(None) != n:
-            ok &= np.fromiter(map(is_, stamps, repeat(None)), bool, n)
+        unstamped = chunk.unstamped()
+        if unstamped is not None:
+            ok &= unstamped
         cols: dict[str, np.ndarray] = {}
         for topic, j, (key, field, kind_) in [(plan.output[0], -1, plan.output[1:])] + \
                 [(t, self.kinds[t], v) for t, v in plan.inputs.items()]:
             rows = np.flatnonzero(kind == j)
-            good, col = column(field_values(fields, rows, field), kind_, plan.enums.get(key, _EMPTY))
+            good, col = column(chunk.values(rows, field), kind_, plan.enums.get(key, _EMPTY))
             ok[rows] &= good
             full = np.zeros(n, dtype=np.float64 if kind_ == "real" else np.int64)
             full[rows] = col
@@ -246,7 +248,7 @@ class _Run:
                     return kind
         return np.fromiter(map(self.kinds.get, topics, repeat(0)), np.int8, n)
 
-    def _pairs(self, chunk: list[Event], at: np.ndarray, kind: np.ndarray, times: np.ndarray,
+    def _pairs(self, chunk: EventRows | BlockRows, at: np.ndarray, kind: np.ndarray, times: np.ndarray,
                cols: dict[str, np.ndarray]) -> int:
         """A run of pairs (their inputs at ``at``): the surely satisfied ones in
         batches, the rest fed to the engine.  Returns the event after the run."""
@@ -311,7 +313,8 @@ class _Run:
         stamps = m.stream._stamps
         return not stamps or stamps[-1] <= t
 
-    def _satisfied(self, chunk: list[Event], at: np.ndarray, src: dict[str, np.ndarray], times: np.ndarray) -> None:
+    def _satisfied(self, chunk: EventRows | BlockRows, at: np.ndarray, src: dict[str, np.ndarray],
+                   times: np.ndarray) -> None:
         """The pairs at ``at`` are surely satisfied: their verdicts, and the engine's state as feeding them sets it."""
         plan, m = self.plan, self.m
         h, okey, keys = m.horizon, plan.output[1], plan.keys
@@ -362,11 +365,11 @@ class _Run:
             left = stream._questions.count(None)  # the ghosts the stream still keeps: the latest of them
             while self.ghosts and sum(len(g.at) - 1 for g in self.ghosts[1:]) >= left:
                 del self.ghosts[0]
-        if stream.skew:
+        if stream.skew:  # the answers' entries, each event made if the engine reads it (answered.py)
             recent = m._recent
-            for i in at[-recent.maxlen:].tolist():
-                ev = chunk[i + 1]
-                recent.append((ev, ev.time, {okey: ev.fields[ofield]}, _EMPTY))
+            outs = at[-recent.maxlen:] + 1
+            recent.extend(map(RecentOutput, repeat(chunk), outs.tolist(), times[outs].tolist(), repeat(okey),
+                              repeat(ofield)))
         values = m.values
         for k in keys:
             values[k] = newest.inputs[k]

@@ -18,7 +18,7 @@ from typing import Any, Iterable, Iterator
 from ...rcl.errors import RclError
 from ...rcl.types import Checked
 from ...traces import TraceError, read_trace
-from .backend import monitoring_details, summary_line, tool_versions, verdict_status
+from .summary import monitoring_details, summary_line, tool_versions, verdict_status
 from .check import check_trace
 from .deadlines import DeadlineMonitor, deadline_status, has_deadlines
 from .config import ConfigError, load_mapping

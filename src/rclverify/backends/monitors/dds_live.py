@@ -38,7 +38,7 @@ from ...evidence.store import atomic_write_text
 from ...rcl.types import Checked, CheckedNode
 from ...ros.dds import DdsUnavailable, domain_id, make_participant, topic_name, type_hash_user_data, write_raw
 from ...ros.dds_qos import writer_profile
-from .backend import verdict_status
+from .summary import verdict_status
 from .dds_bag import BagRecorder
 from .dds_calls import CallBook
 from .dds_services import CallTaps

@@ -33,7 +33,7 @@ from ...evidence.store import atomic_write_text
 from ...rcl.types import Checked, CheckedNode
 from ...traces.events import Event
 from ...traces.mapping import TopicRule
-from .backend import monitoring_details, summary_line, tool_versions, verdict_status
+from .summary import monitoring_details, summary_line, tool_versions, verdict_status
 from .check import NodeResult, Verdict
 from .online import OnlineEngine
 from .worker import EngineWorker
