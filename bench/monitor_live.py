@@ -299,7 +299,17 @@ def bench_oracle(n: int, node: str | None) -> None:
           f"core); load average {os.getloadavg()[0]:.1f} on {os.cpu_count()} core(s)")
 
 
+def _exit_on_sigterm() -> None:
+    """SIGTERM (``timeout``, a CI job's end) raises ``SystemExit`` in the
+    bench's own process, so the ``finally`` blocks stop the processes it
+    started (each in a session of its own): killed by the default handler,
+    the bench left a 10-minute publisher running."""
+    signal.signal(signal.SIGTERM, lambda *_: sys.exit(128 + signal.SIGTERM))
+
+
 def main() -> int:
+    if "--publisher" not in sys.argv[1:] and "--listener" not in sys.argv[1:]:
+        _exit_on_sigterm()  # the parent only: the publisher and the listener have handlers of their own
     if "--ros2" in sys.argv[1:]:  # ROS 2 over DDS: its own script (bench/monitor_live_dds.py)
         sys.path.insert(0, str(ROOT / "bench"))
         from monitor_live_dds import main as dds_main

@@ -265,4 +265,7 @@ def main(argv: list[str] | None = None) -> int:
 
 
 if __name__ == "__main__":
+    if "--publisher" not in sys.argv[1:] and "--listener" not in sys.argv[1:]:
+        from monitor_live import _exit_on_sigterm  # SIGTERM stops what the bench started (bench/monitor_live.py)
+        _exit_on_sigterm()
     sys.exit(main())
