@@ -69,19 +69,12 @@ from pathlib import Path
 from typing import Any, Iterator
 
 ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT / "tests"))
+
+from _classifier import CLASSIFIER  # noqa: E402
+
 BANDS = ("green", "orange", "red")
-CONTRACT = """\
-context { Band : {green, orange, red} ; }
-node Classifier {
-  inputs( r : REAL )
-  outputs( status : Band )
-  topics( std_msgs/Float64 reading matches(in.r), std_msgs/String status matches(out.status) )
-  assume( 0 <= in.r )
-  guarantee( (in.r < 120 -> out.status == green)
-         and (120 <= in.r and in.r < 250 -> out.status == orange)
-         and (250 <= in.r -> out.status == red) )
-}
-"""
+CONTRACT = CLASSIFIER  # tests/_classifier.py: the contract the batch path's tests check runs against
 MAPPING = "horizon: 0.005\ntopics:\n  reading: {fields: [data]}\n  status: {fields: [data]}\n"
 PLAN = "name: classifier\ncontracts: [contracts/classifier.rcl]\nnodes:\n  Classifier:\n    evidence: []\n"
 RTAMT_SPEC = ("((r < 120) -> (status == 0)) and (((r >= 120) and (r < 250)) -> (status == 1)) "

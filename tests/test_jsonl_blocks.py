@@ -25,6 +25,7 @@ from typing import Any
 import numpy as np
 import pytest
 
+from _classifier import CLASSIFIER
 from rclverify.traces import TraceError, read_trace
 from rclverify.traces import jsonl_blocks
 from rclverify.traces.jsonl import read_jsonl
@@ -135,18 +136,7 @@ def test_an_integer_time_keeps_its_block_exact(tmp_path: Path) -> None:
 
 # -- the command, with and without the fast path ------------------------------------------------------
 
-CONTRACT = """\
-context { Band : {green, orange, red} ; }
-node Classifier {
-  inputs( r : REAL )
-  outputs( status : Band )
-  topics( std_msgs/Float64 reading matches(in.r), std_msgs/String status matches(out.status) )
-  assume( 0 <= in.r )
-  guarantee( (in.r < 120 -> out.status == green)
-         and (120 <= in.r and in.r < 250 -> out.status == orange)
-         and (250 <= in.r -> out.status == red) )
-}
-"""
+CONTRACT = CLASSIFIER
 
 
 def _workspace(root: Path, skew: float) -> Any:

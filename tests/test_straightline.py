@@ -30,6 +30,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
+from _classifier import CLASSIFIER as _CLASSIFIER
 from rclverify.backends.monitors.check import check_trace
 from rclverify.backends.monitors.config import load_mapping
 from rclverify.logic.evaluator import Evaluator
@@ -237,18 +238,7 @@ def test_a_quantifier_is_left_to_the_evaluator_and_says_so() -> None:
 
 # -- whole runs: the same verdicts, event for event -------------------------------------------
 
-CLASSIFIER = """
-context { Band : {green, orange, red} ; }
-node Classifier {
-  inputs( r : REAL )
-  outputs( status : Band )
-  topics( std_msgs/Float64 reading matches(in.r), std_msgs/String status matches(out.status) )
-  assume( 0 <= in.r )
-  guarantee( (in.r < 120 -> out.status == green)
-         and (120 <= in.r and in.r < 250 -> out.status == orange)
-         and (250 <= in.r -> out.status == red) )
-}
-"""
+CLASSIFIER = "\n" + _CLASSIFIER  # tests/_classifier.py
 
 
 def _verdicts(checked: Any, nodes: list[Any], events: Any, rules: Any, horizon: float) -> tuple[Any, Any]:

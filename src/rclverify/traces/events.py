@@ -2,7 +2,8 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any, Mapping
+from itertools import islice
+from typing import Any, Iterable, Mapping
 
 
 class TraceError(Exception):
@@ -45,3 +46,16 @@ class Event:
     def stamped(self) -> float:
         """The message's own time (s): :attr:`stamp` when set, else :attr:`time`."""
         return self.time if self.stamp is None else self.stamp
+
+
+def taken(events: Iterable[Event], limit: int | None = None) -> tuple[list[Event], BaseException | None]:
+    """The events ``events`` gives (at most ``limit``), and what it raised
+    after them (``None`` when nothing): a reader's events before a bad line
+    are kept, and its error is raised by the caller after handing them on
+    (the log readers, :mod:`.jsonl_blocks` and the batch path's chunks)."""
+    got: list[Event] = []
+    try:
+        got.extend(islice(events, limit))  # what was read stays in the list if the source raises
+    except BaseException as exc:  # noqa: BLE001 - handed back to the caller, which raises it
+        return got, exc
+    return got, None

@@ -39,7 +39,7 @@ from typing import Any, Iterator, Sequence
 import msgspec
 import numpy as np
 
-from .events import Event
+from .events import Event, taken
 from .jsonl import line_event, read_jsonl, read_lines
 
 #: Bytes read from the log at once (a block is cut after its last whole line).
@@ -134,14 +134,8 @@ def _blocks(path: Path, fields: Sequence[str], rows: int) -> Iterator[LogBlock |
                 index += len(part)
                 yield block
                 continue
-            got: list[Event] = []
             end = [lineno, index]
-            try:
-                got.extend(read_lines(path, part, lineno, index, end))
-            except BaseException as exc:
-                error = exc
-            else:
-                error = None
+            got, error = taken(read_lines(path, part, lineno, index, end))
             if got:
                 yield got
             if error is not None:

@@ -15,13 +15,13 @@ message has none), and ``rows[i]`` / ``rows[i:j]``, the events themselves
 """
 from __future__ import annotations
 
-from itertools import islice, repeat
+from itertools import repeat
 from operator import attrgetter, is_
 from typing import Any, Iterable, Iterator, Sequence
 
 import numpy as np
 
-from ...traces.events import Event
+from ...traces.events import Event, taken
 from .columns import field_values
 
 _TOPIC, _TIME, _STAMP, _FIELDS = attrgetter("topic"), attrgetter("time"), attrgetter("stamp"), attrgetter("fields")
@@ -122,13 +122,7 @@ def chunks(events: Iterable[Event], size: int, fields: Sequence[str]) -> Iterato
             return
     it = iter(events)
     while True:
-        got: list[Event] = []
-        try:
-            got.extend(islice(it, size))  # what was read stays in the list if the source raises
-        except BaseException as exc:
-            error: BaseException | None = exc
-        else:
-            error = None
+        got, error = taken(it, size)
         if got:
             yield got
         if error is not None:
