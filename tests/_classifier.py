@@ -2,8 +2,8 @@
 the offline monitor's batch-path tests, its straight-line oracle and the log-reader tests check runs
 against."""
 
-CLASSIFIER = """\
-context { Band : {green, orange, red} ; }
+#: The node alone (a test with more nodes writes its own context line before it).
+CLASSIFIER_NODE = """\
 node Classifier {
   inputs( r : REAL )
   outputs( status : Band )
@@ -14,3 +14,4 @@ node Classifier {
          and (250 <= in.r -> out.status == red) )
 }
 """
+CLASSIFIER = "context { Band : {green, orange, red} ; }\n" + CLASSIFIER_NODE

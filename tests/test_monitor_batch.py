@@ -18,6 +18,7 @@ from typing import Any, Callable
 
 import pytest
 
+from _classifier import CLASSIFIER_NODE
 from rclverify.backends.monitors.batch import batch_plan, check_batch
 from rclverify.backends.monitors.check import check_trace
 from rclverify.backends.monitors.columns import ColumnCompiler
@@ -33,16 +34,7 @@ from rclverify.traces.mapping import load_rules
 REPO = Path(__file__).resolve().parents[1]
 CONTRACTS = """\
 context { Band : {green, orange, red} ; Level : {lo, hi} ; Gear : {slow, fast} ; EDGE : REAL = 119.99999999999999 ; }
-node Classifier {
-  inputs( r : REAL )
-  outputs( status : Band )
-  topics( std_msgs/Float64 reading matches(in.r), std_msgs/String status matches(out.status) )
-  assume( 0 <= in.r )
-  guarantee( (in.r < 120 -> out.status == green)
-         and (120 <= in.r and in.r < 250 -> out.status == orange)
-         and (250 <= in.r -> out.status == red) )
-}
-node Edge {
+""" + CLASSIFIER_NODE + """node Edge {
   inputs( r : REAL )
   outputs( s : Level )
   topics( std_msgs/Float64 reading matches(in.r), std_msgs/String level matches(out.s) )
