@@ -63,13 +63,10 @@ from typing import Any
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "src"))
 sys.path.insert(0, str(ROOT / "bench"))
+from _live import (cpu_seconds as _cpu_seconds, exit_on_sigterm as _exit_on_sigterm, messages as _lines,  # noqa: E402
+                   p99 as _p99, stop as _stop, wait_text as _wait_text)
 from _pace import paced  # noqa: E402
 
-RUN = ROOT / "backends" / "monitors" / "traces" / "nominal.jsonl"
-
-
-def _lines() -> list[dict[str, Any]]:
-    return [json.loads(line) for line in RUN.read_text().splitlines() if line.strip()]
 
 
 # -- processes the benchmark starts ------------------------------------------------------------
@@ -120,38 +117,6 @@ def listener(topic: str, out: Path) -> int:
 
 
 # -- live benchmark ------------------------------------------------------------------
-
-def _wait_text(path: Path, text: str, timeout: float) -> None:
-    deadline = time.monotonic() + timeout
-    while not (path.exists() and text in path.read_text(errors="replace")):
-        if time.monotonic() > deadline:
-            raise SystemExit(f"{path.name} never said {text!r}")
-        time.sleep(0.05)
-
-
-def _stop(p: subprocess.Popen[bytes], sig: int = signal.SIGTERM) -> None:
-    if p.poll() is None:
-        os.killpg(p.pid, sig)
-        try:
-            p.wait(20)
-        except subprocess.TimeoutExpired:
-            os.killpg(p.pid, signal.SIGKILL)
-            p.wait(5)
-
-
-def _cpu_seconds(pid: int) -> float | None:
-    """User + system CPU seconds of a process (Linux ``/proc``), or None."""
-    try:
-        fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
-        return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
-    except (OSError, IndexError, ValueError):
-        return None
-
-
-def _p99(xs: list[float]) -> float:
-    ys = sorted(xs)
-    return ys[min(len(ys) - 1, int(0.99 * len(ys)))]
-
 
 def bench_live(rate: float, seconds: float, nodes: list[str]) -> None:
     from rclverify.backends.monitors.ros1 import LocalMaster, RosUnavailable, import_rospy
@@ -297,14 +262,6 @@ def bench_oracle(n: int, node: str | None) -> None:
           f"({seq / n * 1e6:.0f} us round trip); pipelined {n / pipe:,.0f} events/s; oracle process CPU "
           f"{cpu / n * 1e6:.0f} us per event pipelined (about {n / cpu if cpu else 0:,.0f} events/s on one free "
           f"core); load average {os.getloadavg()[0]:.1f} on {os.cpu_count()} core(s)")
-
-
-def _exit_on_sigterm() -> None:
-    """SIGTERM (``timeout``, a CI job's end) raises ``SystemExit`` in the
-    bench's own process, so the ``finally`` blocks stop the processes it
-    started (each in a session of its own): killed by the default handler,
-    the bench left a 10-minute publisher running."""
-    signal.signal(signal.SIGTERM, lambda *_: sys.exit(128 + signal.SIGTERM))
 
 
 def main() -> int:

@@ -65,7 +65,7 @@ def _rss_kib(pid: int) -> int | None:
 
 def publisher(rate: float, seconds: float, out: Path, nodes: list[str]) -> int:
     """Publish the nominal run's messages on the monitored topics at ``rate``/s; write (topic, t_pub)."""
-    from monitor_live import _lines
+    from _live import messages as _lines
     from rclverify.backends.monitors.dds_types import TypeBook
     from rclverify.backends.monitors.ros1 import contract_topics
     from rclverify.rcl.typecheck import load
@@ -124,7 +124,7 @@ def listener(out: Path) -> int:
 
 def _run(tmp: Path, env: dict[str, str], rate: float, seconds: float, nodes: list[str],
          memory: bool) -> dict[str, Any]:
-    from monitor_live import _cpu_seconds, _stop, _wait_text
+    from _live import cpu_seconds as _cpu_seconds, stop as _stop, wait_text as _wait_text
     procs: list[subprocess.Popen[bytes]] = []
     tag = f"{int(rate)}{'m' if memory else ''}"
 
@@ -204,7 +204,7 @@ def bench_dds(rates: list[float], seconds: float, memory_s: float, nodes: list[s
     except ImportError as exc:
         print(f"ros2: skipped: {exc}")
         return
-    from monitor_live import _p99
+    from _live import p99 as _p99
     with tempfile.TemporaryDirectory() as d:
         tmp = Path(d)
         (tmp / "cyclonedds.xml").write_text(CONFIG)
@@ -266,6 +266,6 @@ def main(argv: list[str] | None = None) -> int:
 
 if __name__ == "__main__":
     if "--publisher" not in sys.argv[1:] and "--listener" not in sys.argv[1:]:
-        from monitor_live import _exit_on_sigterm  # SIGTERM stops what the bench started (bench/monitor_live.py)
-        _exit_on_sigterm()
+        from _live import exit_on_sigterm  # SIGTERM stops what the bench started (bench/_live.py)
+        exit_on_sigterm()
     sys.exit(main())
