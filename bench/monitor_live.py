@@ -68,7 +68,6 @@ from _live import (cpu_seconds as _cpu_seconds, exit_on_sigterm as _exit_on_sigt
 from _pace import paced  # noqa: E402
 
 
-
 # -- processes the benchmark starts ------------------------------------------------------------
 
 def publisher(rate: float, seconds: float, out: Path, wait_for: int, nodes: list[str]) -> int:
