@@ -135,3 +135,94 @@ def test_the_skew_never_turns_a_verdict_green_nor_red(sensor: Any, steps: list[A
         before, after = a.get(k, []), b.get(k, [])
         assert "violated" not in after or "violated" in before, (k, before, after)
         assert "satisfied" not in after or "satisfied" in before or not before, (k, before, after)
+
+
+TWO_OUTPUTS = """
+context { Stat : {red, orange, green} ; }
+node Sensor {
+  inputs( r : REAL )
+  outputs( status : Stat, done : BOOL )
+  topics( pkg/Reading r matches(in.r), pkg/Status status matches(out.status), pkg/Done done matches(out.done) )
+  assume( 0 <= in.r )
+  guarantee( out.done and (in.r < 120 -> out.status == green) and (120 <= in.r -> out.status == red) )
+}
+"""
+
+
+def test_a_partial_answer_received_early_is_never_dropped_green(tmp_path: Path) -> None:
+    """The live case study's race with an answer in two messages (the sensor's status and its
+    `inspected`): green for the reading 300 is received 0.2 ms before the reading, its `done` after
+    it, and the next reading follows.  Taken for the reading before (50), green is a partial answer
+    right so far; the reading 300's own answer lacks the status.  Before, both questions ended with
+    no verdict and the run read discharged; the early status completes the reading 300's answer
+    within the skew, false there: inconclusive, with both questions named."""
+    from rclverify.backends.monitors.backend import verdict_status
+    from rclverify.rcl.typecheck import load
+    from rclverify.traces.events import Event
+    p = tmp_path / "two.rcl"
+    p.write_text(TWO_OUTPUTS)
+    checked = load([p])
+    field = {"r": "value", "status": "level", "done": "flag"}
+    rows = [(0.0, "r", 50.0), (0.01, "status", "green"), (0.02, "done", True),  # answered in full
+            (0.9, "r", 50.0), (1.0, "status", "green"), (1.0002, "r", 300.0), (1.001, "done", True),
+            (1.5, "r", 60.0), (1.51, "status", "green"), (1.52, "done", True)]
+    evs = [Event(k, t, topic, {field[topic]: v}, f"run.jsonl:{k + 1}") for k, (t, topic, v) in enumerate(rows)]
+
+    def judged(skew: float) -> tuple[list[Any], Any]:
+        got: list[Any] = []
+        _, [res] = check_trace(checked, [checked.nodes["Sensor"]], iter(evs), skewed(skew), 1.0, got.append)
+        return got, res
+    got, res = judged(DEFAULT_SKEW_S)
+    [v] = [x for x in got if x.event == 4]
+    assert v.verdict == "inconclusive" and v.question == "run.jsonl:6" and "0.20 ms before" in v.reason
+    assert v.values["in.r"] == "300.0" and v.values["out.status"] == "green"
+    assert verdict_status(res, "run.jsonl")[0] == "inconclusive" and res.counts["satisfied"] == 2
+    # without a skew the messages are in the order they were published: the early status answered the
+    # reading before (50), the reading 300 got only its `done`, and the next reading superseded what it lacked
+    got, res = judged(0.0)
+    assert not [x for x in got if x.event in (4, 5, 6)] and verdict_status(res, "run.jsonl")[0] == "discharged"
+
+
+_TWO_ROW = st.one_of(st.tuples(st.just("r"), st.sampled_from([50.0, 130.0, 300.0])),
+                     st.tuples(st.just("status"), st.sampled_from(["green", "red", "orange"])),
+                     st.tuples(st.just("done"), st.booleans()))
+
+
+@settings(max_examples=80, deadline=None)
+@given(st.lists(st.tuples(st.sampled_from([0.0, 0.0, 0.0001, 0.1, 0.3, 1.2]), _TWO_ROW), min_size=1, max_size=14))
+def test_the_skew_never_turns_a_verdict_green_nor_red_with_answers_in_two_messages(tmp_path_factory: Any,
+                                                                                     steps: list[Any]) -> None:
+    """The property above on a guarantee that reads two outputs, so answers come in parts (partial
+    answers, followed by newer questions, completed within the skew): with a skew of 0.3 s a
+    question's verdicts are the same; an output's verdict is the same or became ``inconclusive``
+    (never ``satisfied`` nor ``violated`` where it was not, unless it answered no question without
+    the skew and is right for every question it may answer); and a run the skew leaves
+    ``discharged`` was ``discharged`` without it."""
+    from rclverify.backends.monitors.backend import verdict_status
+    from rclverify.rcl.typecheck import load
+    from rclverify.traces.events import Event
+    p = tmp_path_factory.mktemp("two") / "two.rcl"
+    p.write_text(TWO_OUTPUTS)
+    checked = load([p])
+    field = {"r": "value", "status": "level", "done": "flag"}
+    t, evs = 0.0, []
+    for k, (dt, (topic, v)) in enumerate(steps):
+        t += dt
+        evs.append(Event(k, t, topic, {field[topic]: v}, f"run.jsonl:{k + 1}"))
+
+    def judged(skew: float) -> tuple[dict[int, list[str]], str]:
+        got: list[Any] = []
+        _, [res] = check_trace(checked, [checked.nodes["Sensor"]], iter(evs), skewed(skew), 1.0, got.append)
+        out: dict[int, list[str]] = {}
+        for v in got:
+            out.setdefault(v.event, []).append(v.verdict)
+        return {k: sorted(x) for k, x in out.items()}, verdict_status(res, "run.jsonl")[0]
+    (a, plain), (b, skewed_status) = judged(0.0), judged(0.3)
+    for k in set(a) | set(b):
+        if evs[k].topic == "r":
+            assert a.get(k) == b.get(k), (k, a, b)
+            continue
+        before, after = a.get(k, []), b.get(k, [])
+        assert "violated" not in after or "violated" in before, (k, before, after)
+        assert "satisfied" not in after or "satisfied" in before or not before, (k, before, after)
+    assert skewed_status != "discharged" or plain == "discharged", (plain, skewed_status)

@@ -152,7 +152,9 @@ class Closing:
         guarantees still waiting for outputs: what is missing is owed to the
         newer question, but an answer already false whatever the missing
         outputs are is ``violated`` now (the sensor's ``orange`` for a reading
-        of 300 fails whatever ``inspected`` is)."""
+        of 300 fails whatever ``inspected`` is), and one false with the outputs
+        received within the transport skew before ``q`` is ``inconclusive``
+        (:meth:`_early_part`)."""
         state = self._state()
         for k, (ev, why, outs) in sorted(q.waiting.items()):
             values = {**q.inputs, **state, **outs}
@@ -160,7 +162,39 @@ class Closing:
                 self._violation(ev, k, values, f"guarantee {k} is false on the outputs published after the question "
                                 f"at {q.event.where} (the last at {ev.where}) whatever the value of the outputs not "
                                 f"published before the next question ({why})", "", q.event)
+            elif self._recent:
+                self._early_part(q, k, values)
         q.waiting.clear()
+
+    def _early_part(self, q: Question, k: int, values: Mapping[str, Any]) -> None:
+        """Guarantee ``k`` of question ``q`` waited for outputs ``q`` got no
+        message of before a newer question followed it.  Outputs stamped within
+        the transport skew before ``q`` were taken as (part of) the answer to the
+        question at their stamp, but they may be the missing part of ``q``'s:
+        the sensor's ``orange`` for the reading of 300, received 0.2 ms before
+        the reading, and its ``inspected`` after it.  Where ``k`` is false on
+        ``q``'s answer completed by them (its own outputs first), the two
+        readings disagree: ``inconclusive`` on the early output (docs/semantics.md,
+        "Transport skew"), never a question dropped with no verdict."""
+        floor = q.stamp - self.stream.skew
+        cands = [r for r in self._recent if floor <= r[1] <= q.stamp and r[0].index < q.event.index]
+        if not cands:
+            return
+        early: dict[str, Any] = {}
+        for _, _, mine, _ in cands:
+            early.update(mine)
+        completed = {**early, **values}  # its own answer first; the early outputs fill what it lacks
+        if not set(early).difference(values) or self._judge(k, completed).truth is not False:
+            return
+        ev, stamped = cands[-1][0], cands[-1][1]
+        self._recent = deque((r for r in self._recent if r not in cands), maxlen=self._recent.maxlen)
+        gap = max(q.stamp - stamped, 0.0) * 1000
+        self._verdict("inconclusive", ev, guarantee=k, values=self._rendered(completed),
+                      reason=f"the output at {ev.where} was stamped {gap:.2f} ms before the question at "
+                             f"{q.event.where}, within the transport skew of {self.stream.skew:g} s, and that "
+                             f"question's answer lacks what it published: as the rest of that answer, guarantee {k} "
+                             f"is false; taken for the question at its stamp, it left that answer incomplete; the "
+                             f"two readings disagree (docs/semantics.md, \"Transport skew\")", question=q.event.where)
 
     def _partial(self, q: Question, k: int, ev: Event, why: str, outs: Mapping[str, Any], end: bool) -> None:
         """A partial answer: guarantee ``k`` waited for an output that never came
