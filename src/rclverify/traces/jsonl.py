@@ -98,22 +98,10 @@ def read_lines(path: Path, chunks: Iterable[bytes], lineno: int = 0, index: int 
             end[:] = [lineno, index]
 
 
-def line_event(path: Path, name: str, lineno: int, index: int, raw: bytes) -> Event | None:
-    """The event of line ``lineno`` (``raw``, its bytes) of the log at ``path``
-    (``name`` its file name), event ``index``: exactly what :func:`read_lines`
-    makes of it (its first branch, a line msgspec reads with a string topic
-    and a finite float time, repeated here; any other line is read by
-    :func:`read_lines` itself); ``None`` for a blank line.  Raises
-    :class:`TraceError` as :func:`read_lines`."""
-    try:
-        obj: Any = _FAST(raw)
-    except _FAST_ERROR:
-        obj = None
-    if type(obj) is dict:
-        topic, time = obj.get("topic"), obj.get("time")
-        if type(time) is float and type(topic) is str and -math.inf < time < math.inf:
-            del obj["topic"], obj["time"]
-            return Event(index, time, topic.lstrip("/"), obj, f"{name}:{lineno}")
+def line_event(path: Path, lineno: int, index: int, raw: bytes) -> Event | None:
+    """The event of line ``lineno`` (``raw``, its bytes) of the log at ``path``,
+    event ``index``: what :func:`read_lines` makes of it, ``None`` for a
+    blank line.  Raises :class:`TraceError` as :func:`read_lines`."""
     return next(read_lines(path, (raw,), lineno - 1, index), None)
 
 

@@ -12,8 +12,8 @@ lines as blocks instead, each either
   (``topic`` a string, every other value of any JSON type, read by the same
   decoder as :func:`~.jsonl.read_jsonl`'s first try), with its topics and
   times as columns and an :class:`Event` made only for a row someone asks
-  for, by :func:`~.jsonl.line_event` (:func:`~.jsonl.read_lines`' own rule
-  for one line); or
+  for, by :func:`~.jsonl.line_event` (:func:`~.jsonl.read_lines` on that
+  one line); or
 * a list of the events :func:`~.jsonl.read_lines` reads from the block's
   lines (the **exact path**), whenever the fast path cannot show that it
   reads the block as :func:`~.jsonl.read_jsonl` would.
@@ -176,11 +176,11 @@ class LogBlock:
     the exact reader skip a row's line (a defect: the fast path takes only
     lines with a string topic and a finite float time, which it reads)."""
 
-    __slots__ = ("path", "name", "lines", "structs", "attr", "topics", "times", "lineno", "index", "_made")
+    __slots__ = ("path", "lines", "structs", "attr", "topics", "times", "lineno", "index", "_made")
 
     def __init__(self, path: Path, lines: list[bytes], structs: list[Any], attr: dict[str, str], topics: list[str],
                  times: np.ndarray, lineno: int, index: int) -> None:
-        self.path, self.name, self.lines, self.structs, self.attr = path, path.name, lines, structs, attr
+        self.path, self.lines, self.structs, self.attr = path, lines, structs, attr
         self.topics, self.times, self.lineno, self.index = topics, times, lineno, index
         self._made: dict[int, Event] = {}
 
@@ -208,7 +208,7 @@ class LogBlock:
             i += len(self.structs)
         ev = self._made.get(i)
         if ev is None:
-            ev = line_event(self.path, self.name, self.lineno + i + 1, self.index + i, self.lines[i])
+            ev = line_event(self.path, self.lineno + i + 1, self.index + i, self.lines[i])
             if ev is None:  # the fast path read a line the exact reader skips: a defect, never a silent gap
                 raise RuntimeError(f"{self.path}:{self.lineno + i + 1}: the log's two readers disagree")
             self._made[i] = ev
