@@ -26,7 +26,7 @@ from functools import cached_property
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Callable, Mapping, Sequence, cast
 
-from .evidence.store import dumps, write_json
+from .evidence.store import dumps
 from .rcl.errors import RclError
 
 if TYPE_CHECKING:
@@ -369,9 +369,9 @@ def write_check_index(ws: Workspace, hashes: dict[str, str]) -> None:
     sealed as evidence records are, in :attr:`Workspace.CHECK_INDEX`.
     Raises ``OSError``."""
     from .cache import code_stamp
-    from .evidence.store import SEAL, seal_of
+    from .evidence.store import atomic_write_text, sealed_dumps
     body = {"code": code_stamp(), "inputs": check_inputs(ws), "hashes": hashes}
-    write_json(ws.path(ws.CHECK_INDEX), {**body, SEAL: seal_of(body)})
+    atomic_write_text(ws.path(ws.CHECK_INDEX), sealed_dumps(body))
 
 
 def current_snapshot_hashes(ws: Workspace, texts: Any) -> dict[str, str]:
