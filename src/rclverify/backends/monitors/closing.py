@@ -86,8 +86,7 @@ class Closing:
         at once (never a ``satisfied`` left standing for a wrong answer)."""
         if not qb.owed:
             return
-        floor = qb.stamp - self.stream.skew
-        cands = [r for r in self._recent if floor <= r[1] <= qb.stamp and r[0].index < qb.event.index]
+        cands = self._early(qb)
         if not cands:
             return
         outs: dict[str, Any] = {}
@@ -99,7 +98,7 @@ class Closing:
         reading = self._question_outcome(qb, ev, sorted(ks), outs, state, False)
         if reading.kind != "violated":
             return
-        self._recent = deque((r for r in self._recent if r not in cands), maxlen=self._recent.maxlen)
+        self._forget(cands)
         gap = max(qb.stamp - stamped, 0.0) * 1000
         self._verdict("inconclusive", ev, guarantee=reading.guarantee, values=self._rendered(reading.values),
                       reason=f"the output at {ev.where} met the question at its stamp, but it was stamped {gap:.2f} ms "
@@ -107,6 +106,16 @@ class Closing:
                              f"{self.stream.skew:g} s, and that question got no answer of its own: as its answer, "
                              f"guarantee {reading.guarantee} is false; the two readings disagree (docs/semantics.md, "
                              f"\"Transport skew\")", question=qb.event.where)
+
+    def _early(self, q: Question) -> list[Any]:
+        """The outputs judged at once (``_recent``) that were received before
+        question ``q`` and stamped within the transport skew before it."""
+        floor = q.stamp - self.stream.skew
+        return [r for r in self._recent if floor <= r[1] <= q.stamp and r[0].index < q.event.index]
+
+    def _forget(self, used: list[Any]) -> None:
+        """Drop the outputs ``used`` from ``_recent``: their reconsideration is given."""
+        self._recent = deque((r for r in self._recent if r not in used), maxlen=self._recent.maxlen)
 
     def _close(self, q: Question, end: bool = False) -> None:
         """Question ``q``'s horizon passed (``end``: the run ended first):
@@ -176,8 +185,7 @@ class Closing:
         ``q``'s answer completed by them (its own outputs first), the two
         readings disagree: ``inconclusive`` on the early output (docs/semantics.md,
         "Transport skew"), never a question dropped with no verdict."""
-        floor = q.stamp - self.stream.skew
-        cands = [r for r in self._recent if floor <= r[1] <= q.stamp and r[0].index < q.event.index]
+        cands = self._early(q)
         if not cands:
             return
         early: dict[str, Any] = {}
@@ -187,7 +195,7 @@ class Closing:
         if not set(early).difference(values) or self._judge(k, completed).truth is not False:
             return
         ev, stamped = cands[-1][0], cands[-1][1]
-        self._recent = deque((r for r in self._recent if r not in cands), maxlen=self._recent.maxlen)
+        self._forget(cands)
         gap = max(q.stamp - stamped, 0.0) * 1000
         self._verdict("inconclusive", ev, guarantee=k, values=self._rendered(completed),
                       reason=f"the output at {ev.where} was stamped {gap:.2f} ms before the question at "
