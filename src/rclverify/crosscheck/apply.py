@@ -13,6 +13,7 @@ from __future__ import annotations
 
 from typing import Any, Mapping
 
+from .items import witness_query
 from .stage import DOWNGRADES
 
 _STAGE_MISSING = "the second-solver stage has not decided it (run `doit verify`)"
@@ -72,10 +73,8 @@ class SecondSolver:
     def finding(self, f: dict[str, Any]) -> dict[str, Any]:
         """A health finding with ``solvers``; an ``ok`` one the solvers do
         not agree on is ``inconclusive``."""
-        witness = f.get("witness_smt2") if f.get("check") == "realizable" else None  # crosscheck/items.py
         return self._fold(f, "health", "id", "status", "ok", lambda r, s: {
-            "message": f"{r.get('message', '')} Not confirmed: {s['why']} (second solver)."},
-            witness if isinstance(witness, str) and witness else None) or f
+            "message": f"{r.get('message', '')} Not confirmed: {s['why']} (second solver)."}, witness_query(f)) or f
 
     def requirement(self, rec: dict[str, Any] | None) -> dict[str, Any] | None:
         """A requirement record with ``solvers``; a ``proved`` one the

@@ -83,9 +83,10 @@ def discharging_items(root: Any, nodes: Iterable[str]) -> list[Item]:
                 out.append(Item("side-condition", str(sc.get("id")), sc["smt2"], "discharged", "unsat"))
         body, why = read_sealed(root / f"artifacts/health/{n}.json", "contract health record")
         for f in _rows(body, why, "findings"):
-            if f.get("status") == "ok" and f.get("check") == "realizable" and _path(f.get("witness_smt2")):
+            witness = witness_query(f)
+            if f.get("status") == "ok" and witness is not None:
                 # the witness's quantifier-free query, which implies realizability (health/realizer.py)
-                out.append(Item("health", str(f.get("id")), f["witness_smt2"], "ok", "unsat", every=True, via=WITNESS))
+                out.append(Item("health", str(f.get("id")), witness, "ok", "unsat", every=True, via=WITNESS))
             elif f.get("status") == "ok" and _path(f.get("smt2")):
                 proof = f.get("check") in PROOF_CHECKS  # both sides of a replacement (joined by a reset) must hold
                 out.append(Item("health", str(f.get("id")), f["smt2"], "ok", "unsat" if proof else "sat", every=proof))
@@ -105,6 +106,16 @@ def discharging_items(root: Any, nodes: Iterable[str]) -> list[Item]:
         if d.get("status") == "proved" and _path(d.get("smt2")):
             out.append(Item("deadline", str(d.get("requirement")), d["smt2"], "proved", "unsat"))
     return out
+
+
+def witness_query(finding: Any) -> str | None:
+    """The script the second solver decides for a health ``finding`` (a JSON
+    object) instead of its ``smt2``: a realizable contract's witness query
+    (``witness_smt2``), else ``None``."""
+    if not isinstance(finding, dict) or finding.get("check") != "realizable":
+        return None
+    path = finding.get("witness_smt2")
+    return path if _path(path) else None
 
 
 def _rows(body: Any, why: str, key: str) -> list[dict[str, Any]]:
