@@ -56,6 +56,7 @@ import z3
 from ..rcl import ast
 from ..rcl.printer import expr_to_rcl
 from ..rcl.types import NATURAL, Checked
+from ..logic.query import query_solver
 from ..system.model import SystemModel
 from .context import NEGATED, ContextResult, _multi_path, _node_premises
 from .smttext import SORTS, quote, to_smt
@@ -347,18 +348,18 @@ def decide(checked: Checked, model: SystemModel, node: str, conjunct: ast.Expr,
     lits = "".join(f"(declare-fun |l!{k}| () Bool)\n" for k in range(len(premises) + 1))
     text = (decls + lits + "".join(f"(assert (=> |l!{k}| {b}))\n" for k, (_, b) in enumerate(premises))
             + "".join(f"(assert {a})\n" for a in axioms) + f"(assert (=> |l!{len(premises)}| (not {goal})))\n")
-    ctx = z3.Context()  # of its own: a failure decided over the whole cone next gets today's model (same Z3 state)
     try:
-        s = z3.Solver(ctx=ctx)
-        s.set("timeout", timeout_ms)
-        s.set("unsat_core", True)
-        s.add(z3.parse_smt2_string(text, ctx=ctx))
-        lit = [z3.Bool(f"l!{k}", ctx) for k in range(len(premises) + 1)]
-        if s.check(*lit) != z3.unsat:
-            return None  # a counterexample or unknown: the full cone decides (and traces the counterexample)
-        core = {str(c) for c in s.unsat_core()}
-        if f"l!{len(premises)}" not in core or s.check(*lit[:-1]) != z3.sat:
-            return None  # premises that may contradict each other: the full cone says what they prove
+        # a scope of the caller's solver session (one node's calculus, logic/query.py): its queries follow
+        # from the stage's inputs alone, in a fixed order, so a failure then decided over the whole cone
+        # gets the same model in every run; a fresh Z3 context here cost as much as the query (docs/scale.md)
+        with query_solver(timeout_ms, cores=True) as s:
+            s.add(z3.parse_smt2_string(text))
+            lit = [z3.Bool(f"l!{k}") for k in range(len(premises) + 1)]
+            if s.check(*lit) != z3.unsat:
+                return None  # a counterexample or unknown: the full cone decides (and traces the counterexample)
+            core = {str(c) for c in s.unsat_core()}
+            if f"l!{len(premises)}" not in core or s.check(*lit[:-1]) != z3.sat:
+                return None  # premises that may contradict each other: the full cone says what they prove
     except z3.Z3Exception:
         return None
     dt = round(time.perf_counter() - t0, 4)
