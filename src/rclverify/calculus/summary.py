@@ -258,11 +258,10 @@ def _bound(ctx: z3.Context, fs: Sequence[z3.ExprRef], bodies: Sequence[str], hid
     symbol of a sort in ``sorts`` (the same constants Z3 parsed: a constant
     is its name and sort), else found by walking the parsed ``fs`` (walking
     the terms through Z3's Python objects was a tenth of a summary)."""
-    quoted = {h: quote(h) for h in hidden}
-    if sorts is not None and all(sorts.get(h) in _Z3_SORTS and not any(c in q for c in " \t\n()|")
-                                 for h, q in quoted.items()):
+    if sorts is not None and all(sorts.get(h) in _Z3_SORTS and not any(c in h for c in " \t\n()|") for h in hidden):
+        # a name is one token, bare (as Z3 prints it in a summary) or quoted (as smttext writes it)
         tokens = set(_TOKEN.findall(" ".join(bodies)))
-        return [z3.Const(h, _Z3_SORTS[sorts[h]](ctx)) for h in hidden if quoted[h] in tokens]
+        return [z3.Const(h, _Z3_SORTS[sorts[h]](ctx)) for h in hidden if h in tokens or quote(h) in tokens]
     consts = {str(c): c for f in fs for c in _constants(f)}
     return [consts[h] for h in hidden if h in consts]
 
