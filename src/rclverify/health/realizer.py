@@ -1,7 +1,8 @@
 """Contract health, realizability: an answer to every input, written out.
 
-When Z3 proves a contract realizable (:mod:`.realizable`: no admissible
-input lacks an output), this module looks for the answer itself: terms
+Before Z3 is asked whether a contract is realizable (:mod:`.realizable`:
+no admissible input lacks an output), this module looks for the answer
+itself: terms
 ``w(in)``, one per output, such that the quantifier-free query
 
     A(in) and F_in(in) and not (typing(w(in)) and F_out(in, w(in)) and G(in, w(in)))
@@ -9,7 +10,9 @@ input lacks an output), this module looks for the answer itself: terms
 is unsat: ``w`` answers every input the assumption and the facts admit
 (the names as in :mod:`.realizable`).  Such a ``w`` is an instance of the
 realizability statement's ``exists out``, so it proves the contract
-realizable on its own.  Two uses:
+realizable on its own, and the quantified query is not asked.  Three uses:
+
+* the proof: a quantifier-free query instead of a quantifier elimination;
 
 * the report shows it (``out.x = 0``, ``out.d = 1000 * in.r``): the first
   sketch of an implementation, or the hint that a guarantee says less than
