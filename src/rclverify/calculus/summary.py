@@ -42,7 +42,10 @@ premises of its cone that Z3's unsat core used to establish it
 (:attr:`Summary.used`), and a proof's ``used`` is its own core with each
 summary replaced by those.  Everything kept is text (no Z3 object), made in
 a Z3 context of its own from text alone, so it is the same whichever node
-task of whichever process made it (incremental equals clean).
+task of whichever process made it (incremental equals clean).  The query
+over the summaries (:func:`decide`) is a scope of the caller's solver
+session (one node's calculus, asked in a fixed order), not a context of
+its own: a context cost as much as the query.
 """
 from __future__ import annotations
 
