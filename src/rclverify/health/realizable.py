@@ -217,9 +217,8 @@ def realizability_findings(checked: Checked, node: str, facts: Sequence[tuple[as
                         + (" and the environment facts admit" if facts else " admits")
                         + " has an output satisfying every guarantee." + sketch,
                         "Realizability (forall in. A(in) -> exists out. G(in, out)): "
-                        + ("Z3 proved it with the answer above: no admissible input makes those output terms "
-                           "violate the contract (the witness query is unsat), so the query below, the statement "
-                           "itself, is unsat too." if w is not None else
+                        + ("it follows from the answer above, which Z3 proved answers every admissible input; "
+                           "the query below states it (unsat)." if w is not None else
                            "Z3 proved that no admissible input lacks an answer (the query below is unsat)."),
                         None, None, secs, smt2=smt2,
                         witness=dict(w.terms) if w is not None else None, witness_smt2=witness_smt2)]
