@@ -22,9 +22,20 @@ Then the growth per doubling of each column.  ``--src OLD_SRC`` runs
 ``rclverify verify`` from another source tree as well (a ``git worktree``
 of the old code), ``--repeat K`` takes the median of K runs.
 
+``--floor`` adds two what-if runs of ``rclverify verify`` (not
+configurations a user has: the bench patches the child process), to show
+where the rest of the distance to Pacti lies: ``no ctx`` without the
+fresh Z3 context of every node stage and cone summary (logic/world.py,
+calculus/summary.py: the integrity decision, docs/integrity.md), ``no ctx,
+no cvc5`` without cvc5 as well, as on a machine where it is not installed
+(the second solver of issue 50, added after issue 51's baseline: every
+discharging query decided again by cvc5 with a checked proof; each item
+then reads ``one solver``).  Their verdicts are not compared.
+
     python bench/verify_pacti.py                         # N = 100, 200, 400
     python bench/verify_pacti.py --sizes 100,200 --full  # and the calculus reading whole cones
-    python bench/verify_pacti.py --smoke                 # N = 5: seconds (CI)
+    python bench/verify_pacti.py --sizes 200 --floor     # and the two what-if runs
+    python bench/verify_pacti.py --smoke                 # N = 5, with --floor: seconds (CI)
 
 Figures are printed, not asserted; the exit status is 1 only when a
 verdict differs from the expected one (a side condition not discharged,
@@ -58,8 +69,40 @@ PROBE = ("import json, resource, subprocess, sys\n"
          "print(json.dumps({'rc': r.returncode, 'out': r.stderr[-2000:], 'cpu': u.ru_utime + u.ru_stime}))\n")
 
 
+#: The what-if child of ``--floor``: ``rclverify verify`` with the fresh Z3 contexts (``ctx``) and the
+#: second solver's stage (``cvc5``) switched off by patching, then its CPU seconds like :data:`PROBE`.
+WHATIF = ("import sys, types\n"
+          "off = sys.argv[1].split(',')\n"
+          "sys.argv = ['rclverify'] + sys.argv[2:]\n"
+          "import z3\n"
+          "if 'ctx' in off:\n"
+          "    import rclverify.logic.world as W, rclverify.pipeline as P, rclverify.calculus.summary as S\n"
+          "    assert P.fresh_z3 is W.fresh and S.z3 is z3, 'what-if: the names patched here moved'\n"
+          "    W.fresh = P.fresh_z3 = lambda: None\n"
+          "    S.z3 = types.SimpleNamespace(**{k: getattr(z3, k) for k in dir(z3) if not k.startswith('__')})\n"
+          "    S.z3.Context = z3.main_ctx\n"
+          "if 'cvc5' in off:\n"
+          "    sys.modules['cvc5'] = None  # as on a machine without cvc5: each item reads 'one solver'\n"
+          "    from rclverify.crosscheck.cvc5_decide import version\n"
+          "    assert version() == '', 'what-if: cvc5 still found'\n"
+          "from rclverify.cli import main\n"
+          "sys.exit(main())\n")
+
+
 def workspace(root: Path, n: int) -> Path:
     return write_chain(root, n, bound=BOUND, requirements=[("SYS", f"N{n - 1}.out.x{n} <= {50 + n}")])
+
+
+def whatif(root: Path, off: str) -> float:
+    """CPU seconds of ``rclverify verify`` of ``root`` with ``off`` (``ctx``,
+    ``ctx,cvc5``) switched off (:data:`WHATIF`); raises ``RuntimeError`` when it fails."""
+    env = dict(os.environ, PYTHONPATH=str(ROOT / "src"))
+    p = subprocess.run([sys.executable, "-c", PROBE, sys.executable, "-c", WHATIF, off, "verify", "-w", str(root)],
+                       capture_output=True, text=True, env=env)
+    probe = json.loads(p.stdout)
+    if probe["rc"] != 0:
+        raise RuntimeError(f"what-if {off}: exit {probe['rc']}: {probe['out'][-500:]}")
+    return float(probe["cpu"])
 
 
 def verify(root: Path, src: Path) -> dict[str, Any]:
@@ -104,19 +147,24 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--src", help="also run `rclverify verify` from this source tree (the old code)")
     p.add_argument("--full", action="store_true", help="also time the calculus reading whole cones")
     p.add_argument("--repeat", type=int, default=1, help="median of this many runs of each figure")
-    p.add_argument("--smoke", action="store_true", help="N = 5: seconds (CI)")
+    p.add_argument("--floor", action="store_true",
+                   help="also run verify without fresh Z3 contexts, and without them and the second solver (what-if)")
+    p.add_argument("--smoke", action="store_true", help="N = 5, with --floor: seconds (CI)")
     args = p.parse_args(argv)
+    args.floor = args.floor or args.smoke  # the what-if patches name internals: CI keeps them working
     from compose_pacti import _pacti, pacti_chain
     pc = _pacti()
     sizes = [5] if args.smoke else [int(x) for x in args.sizes.split(",")]
     print(f"CPU seconds, medians of {args.repeat}; {os.cpu_count()} CPU(s); chain with every x_i <= {BOUND}")
     head = f"{'N':>5} {'verify s':>9} {'cvc5 s':>7} {'local':>5} {'ctx':>5} {'summ':>5} {'SYS':>8}"
     head += f" {'old s':>8}" if args.src else ""
-    head += f" {'calc s':>7}" + (f" {'calc full':>9}" if args.full else "") + f" {'pacti s':>8} {'ratio':>6}"
+    head += f" {'calc s':>7}" + (f" {'calc full':>9}" if args.full else "")
+    head += f" {'no ctx':>7} {'no ctx,cvc5':>11}" if args.floor else ""
+    head += f" {'pacti s':>8} {'ratio':>6}"
     print(head)
     ok, rows = True, []
     for n in sizes:
-        runs, old, calc, full, pac = [], [], [], [], []
+        runs, old, calc, full, pac, noctx, bare = [], [], [], [], [], [], []
         for _ in range(args.repeat):
             with tempfile.TemporaryDirectory() as d:
                 runs.append(verify(workspace(Path(d) / "ws", n), ROOT / "src"))
@@ -125,6 +173,9 @@ def main(argv: list[str] | None = None) -> int:
                 calc.append(calculus(Path(d) / "ws", True))
                 if args.full:
                     full.append(calculus(Path(d) / "ws", False))
+                if args.floor:
+                    noctx.append(whatif(workspace(Path(d) / "noctx", n), "ctx"))
+                    bare.append(whatif(workspace(Path(d) / "bare", n), "ctx,cvc5"))
             if pc is not None:
                 r = pacti_chain(pc, n, None, BOUND)
                 ok = ok and r["first"] is None
@@ -133,15 +184,18 @@ def main(argv: list[str] | None = None) -> int:
         ok = ok and r["rc"] == 0 and r["other"] == 0 and r["context"] == n - 1 and r["SYS"].startswith("proved")
         row = {"n": n, "verify": statistics.median(x["cpu"] for x in runs), "calc": statistics.median(calc),
                "old": statistics.median(old) if old else None, "full": statistics.median(full) if full else None,
-               "pacti": statistics.median(pac) if pac else None}
+               "pacti": statistics.median(pac) if pac else None,
+               "noctx": statistics.median(noctx) if noctx else None, "bare": statistics.median(bare) if bare else None}
         rows.append(row)
         line = f"{n:5} {row['verify']:9.2f} {r['cvc5']:7.2f} {r['local']:5} {r['context']:5} {r['summaries']:5} {r['SYS'].split(',')[0]:>8}"
         line += f" {row['old']:8.2f}" if args.src else ""
         line += f" {row['calc']:7.2f}" + (f" {row['full']:9.2f}" if args.full else "")
+        line += f" {row['noctx']:7.2f} {row['bare']:11.2f}" if args.floor else ""
         line += (f" {row['pacti']:8.2f} {row['verify'] / row['pacti']:6.2f}" if row["pacti"] else "  (Pacti not installed)")
         print(line, flush=True)
     for a, b in zip(rows, rows[1:]):
-        growth = {k: b[k] / a[k] for k in ("verify", "old", "calc", "full", "pacti") if a.get(k) and b.get(k)}
+        growth = {k: b[k] / a[k] for k in ("verify", "old", "calc", "full", "noctx", "bare", "pacti")
+                  if a.get(k) and b.get(k)}
         print(f"growth {a['n']} -> {b['n']}: " + ", ".join(f"{k} {v:.2f}x" for k, v in growth.items()))
     return 0 if ok else 1
 
