@@ -74,6 +74,26 @@ def test_a_plan_edit_re_renders_the_report(verified: Path, tmp_path: Path) -> No
     assert "rover 9" in (ws / "reports/assurance.md").read_text(encoding="utf-8")
 
 
+def test_a_contract_edit_that_changes_no_snapshot_re_renders_the_report(verified: Path, tmp_path: Path) -> None:
+    """A comment after the last node changes the contract file and none of
+    the snapshots made from it; the report names the files' sha256
+    (``meta.inputs_sha256``), so it is rendered again, and the bundle takes
+    it (found by bench/incremental_equivalence.py: the report kept the old
+    sha256, `doit verify` called it up to date and the bundle refused it)."""
+    ws = _copy(verified, tmp_path)
+    proc = inc.verify(ws)  # in this directory first: doit's state names the workspace's files
+    assert proc.returncode == 0, proc.stdout + proc.stderr
+    snapshots = {p.name: p.read_bytes() for p in (ws / "artifacts/contracts").glob("*.json")}
+    rcl = ws / "contracts/remote_inspection.rcl"
+    rcl.write_text(rcl.read_text(encoding="utf-8") + "// a closing comment\n", encoding="utf-8")
+    proc = inc.verify(ws)
+    assert proc.returncode == 0, proc.stdout + proc.stderr
+    assert {p.name: p.read_bytes() for p in (ws / "artifacts/contracts").glob("*.json")} == snapshots
+    assert {"report:html", "report:text"} <= set(_ran(proc))
+    proc = _rclverify(ws, "bundle", "-o", str(tmp_path / "bundle.tar.gz"))
+    assert proc.returncode == 0, proc.stdout + proc.stderr
+
+
 def test_report_shows_evidence_of_an_edited_contract_as_stale(verified: Path, tmp_path: Path) -> None:
     ws = _copy(verified, tmp_path)
     before = {o["id"]: o["status"] for o in _report(ws)["obligations"]}

@@ -733,6 +733,13 @@ def _build_tasks(root: str | Path, plan_file: str) -> dict[str, Callable[[], Any
         # The plan itself: the report shows its name, requirements and their tracing, which no
         # other artifact holds (a plan edit that changes only those re-renders the report).
         deps = [str(rootp / plan_file)] + [at(p) for p in (ws.MODEL, ws.DIAGNOSTICS)] + list(snap.values())
+        # The files meta.inputs_sha256 hashes (workspace.check_inputs): the contract and replacement files
+        # themselves, not only the snapshots they give. An edit that changes none of the snapshots (a comment
+        # after the last node) left the report naming the old files' sha256, and the bundle then refused a
+        # report `doit verify` called up to date.
+        assert index is not None  # registered only when ok
+        deps += [d for d in check_deps if d not in deps]
+        deps += sorted({str(rootp / f) for f in index.replacement.values() if (rootp / f).is_file()} - set(deps))
         for n in nodes:
             deps += [at(ws.calculus(n)), at(ws.health(n)), at(ws.obligations(n))]
         deps += [at(ws.evidence(o["id"])) for _, o in exported()]
