@@ -4,7 +4,8 @@ From the verified cut-down case study (``tests/_incremental.py``), each
 sequence applies one to ``--length`` random edits (a requirement's text or
 tracing, the plan's name, a fact, a connection, a contract's formula or
 comment, a Hoare program, experiment data, a review record, a recorded run,
-a trace file or a contract file added or deleted), runs ``doit verify``
+a trace file or a contract file added or deleted, every edit so far
+undone), runs ``doit verify``
 after each edit, and compares every report file with a from-scratch run on
 a copy of the inputs.  Prints the sequences run, the edits applied, the
 mismatches (0 expected) and the time taken::

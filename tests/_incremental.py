@@ -9,7 +9,7 @@ entry of each cheap backend (review, experiment, Hoare, property tests,
 monitors).  Each edit is a change a user makes between two runs: a
 requirement's text or tracing, the plan's name, a fact, a connection, a
 contract's formula or comment, a backend input, a recorded run, a file
-deleted or added.
+deleted or added, every edit so far undone.
 
 After every edit ``doit verify`` runs in the workspace (incrementally, as a
 user's second run would), and a copy of its inputs alone is verified from
@@ -350,8 +350,23 @@ def edit_contract_file(root: Path, k: int) -> str:
     return "contracts/logger.rcl added"
 
 
+def edit_revert(root: Path, k: int) -> str:
+    """Undo every edit so far (a user's ``git checkout .``): the inputs as
+    :func:`make_workspace` wrote them, files added since deleted; what the
+    runs wrote is kept.  The one edit that may change nothing (on a
+    workspace not edited yet): then the run after it is a no-op run."""
+    for rel in FILES:
+        (root / rel).parent.mkdir(parents=True, exist_ok=True)
+        if not (root / rel).exists() or (root / rel).read_bytes() != (REPO / rel).read_bytes():
+            shutil.copyfile(REPO / rel, root / rel)
+    if _plan(root).read_text(encoding="utf-8") != PLAN:
+        _plan(root).write_text(PLAN, encoding="utf-8")
+    (root / "contracts/logger.rcl").unlink(missing_ok=True)
+    return f"every edit undone ({k})"
+
+
 EDITS: tuple[Edit, ...] = (
     edit_requirement_text, edit_requirement_tracing, edit_plan_name, edit_fact, edit_connection,
     edit_contract_formula, edit_contract_comment, edit_hoare_program, edit_experiment_data, edit_review_record,
-    edit_trace, edit_trace_file, edit_contract_file,
+    edit_trace, edit_trace_file, edit_contract_file, edit_revert,
 )
