@@ -35,6 +35,7 @@ from pathlib import Path
 from typing import Any, Iterator
 
 import pytest
+from _procs import stop
 
 pytest.importorskip("cyclonedds", reason="the cyclonedds binding is not installed (pip install cyclonedds)")
 
@@ -60,16 +61,6 @@ def _other_layout() -> type:
     import cyclonedds.idl as idl
     return type("Float64_", (idl.IdlStruct,), {"__annotations__": {"data": str}, "__module__": __name__,
                                                 "__idl_typename__": "std_msgs::msg::dds_::Float64_"})
-
-
-def _stop(p: subprocess.Popen[bytes], sig: int = signal.SIGINT) -> None:
-    if p.poll() is None:
-        os.killpg(p.pid, sig)
-        try:
-            p.wait(15)
-        except subprocess.TimeoutExpired:
-            os.killpg(p.pid, signal.SIGKILL)
-            p.wait(5)
 
 
 @pytest.fixture(scope="module")
@@ -148,13 +139,13 @@ def run(tmp_path_factory: pytest.TempPathFactory) -> Iterator[dict[str, Any]]:
                           QosProfile(reliable=True, durability="transient_local", depth=1))
         latched: list[Any] = []
         wait_until(lambda: latched.extend(late.take(N=4)) or bool(latched), 5, "the latched last verdict")
-        _stop(monitor)
+        stop(monitor, signal.SIGINT, grace=15)
         code = monitor.returncode
     except BaseException:
         print(out.read_text())
         raise
     finally:
-        _stop(monitor, signal.SIGKILL)
+        stop(monitor, signal.SIGKILL, grace=15)
         for p in (ros, other):
             if p is not None:
                 p.close()

@@ -21,6 +21,7 @@ from pathlib import Path
 from typing import Any
 
 import pytest
+from _procs import stop, wait_for
 
 from rclverify.backends.monitors.check import check_trace
 from rclverify.backends.monitors.config import load_mapping
@@ -49,25 +50,6 @@ def _start(args: list[str], env: dict[str, str], out: Path) -> subprocess.Popen[
                             stderr=subprocess.STDOUT, start_new_session=True)
 
 
-def _stop(p: subprocess.Popen[bytes], sig: int = signal.SIGTERM) -> None:
-    if p.poll() is None:
-        os.killpg(p.pid, sig)
-        try:
-            p.wait(10)
-        except subprocess.TimeoutExpired:
-            os.killpg(p.pid, signal.SIGKILL)
-            p.wait(5)
-
-
-def _wait_for(path: Path, text: str, timeout: float) -> None:
-    deadline = time.monotonic() + timeout
-    while time.monotonic() < deadline:
-        if path.exists() and text in path.read_text(errors="replace"):
-            return
-        time.sleep(0.05)
-    raise AssertionError(f"{path.name} never said {text!r}: {path.read_text(errors='replace')[-2000:]}")
-
-
 @pytest.fixture(scope="module")
 def live_run(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
     tmp = tmp_path_factory.mktemp("live")
@@ -87,7 +69,7 @@ def live_run(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
             procs.append(monitor)
             for p, name, text in ((listener, "listener.out", "listening"), (sensor, "sensor.out", "ready"),
                                   (monitor, "monitor.out", "monitoring")):
-                _wait_for(tmp / name, text, 20)
+                wait_for(tmp / name, text, 20)
             replay = subprocess.run([sys.executable, str(SCRIPT), "replay",
                                      str(REPO / "backends/monitors/traces/sensor_fault.jsonl"), "--rate", str(RATE),
                                      "--skip", "radiationStatus", "inspected", "--wait-for", "1",
@@ -100,11 +82,11 @@ def live_run(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
             procs.append(late)
             time.sleep(HORIZON + 0.5)
             assert late.wait(20) == 0
-            _stop(monitor, signal.SIGINT)  # the monitor's own stop: evidence written
+            stop(monitor, signal.SIGINT)  # the monitor's own stop: evidence written
             rc = monitor.returncode
         finally:
             for p in procs:
-                _stop(p)
+                stop(p)
     return {"tmp": tmp, "rc": rc, "monitor_out": (tmp / "monitor.out").read_text()}
 
 

@@ -21,6 +21,7 @@ from pathlib import Path
 from typing import Any
 
 import pytest
+from _procs import stop, wait_for
 
 from rclverify.backends.monitors.ros1 import LocalMaster, RosUnavailable, import_rospy
 
@@ -41,25 +42,6 @@ def _start(args: list[str], env: dict[str, str], out: Path) -> subprocess.Popen[
                             stderr=subprocess.STDOUT, start_new_session=True)
 
 
-def _stop(p: subprocess.Popen[bytes], sig: int = signal.SIGTERM) -> None:
-    if p.poll() is None:
-        os.killpg(p.pid, sig)
-        try:
-            p.wait(10)
-        except subprocess.TimeoutExpired:
-            os.killpg(p.pid, signal.SIGKILL)
-            p.wait(5)
-
-
-def _wait_for(path: Path, text: str, timeout: float) -> None:
-    end = time.monotonic() + timeout
-    while time.monotonic() < end:
-        if path.exists() and text in path.read_text(errors="replace"):
-            return
-        time.sleep(0.05)
-    raise AssertionError(f"{path.name} never said {text!r}: {path.read_text(errors='replace')[-2000:]}")
-
-
 @pytest.fixture(scope="module")
 def live_log(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
     tmp = tmp_path_factory.mktemp("svc")
@@ -72,14 +54,14 @@ def live_log(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
                           env, tmp / "base.out")
             mover = _start([str(NODES), "mover", "--feedback-after", "0.5"], env, tmp / "mover.out")
             procs += [base, mover]
-            _wait_for(tmp / "base.out", "ready", 60)
-            _wait_for(tmp / "mover.out", "ready", 60)
+            wait_for(tmp / "base.out", "ready", 60)
+            wait_for(tmp / "mover.out", "ready", 60)
             # the proxy inside the live monitor: one process, one log, one verdict topic
             monitor = _start(["-m", "rclverify.cli", "monitor", "-w", str(EXAMPLE), "--live", "--interfaces",
                               "interfaces", "--forward", "/estop=/estop_real", "--log", str(log),
                               "--evidence", str(tmp / "live.json"), "--duration", "60"], env, tmp / "monitor.out")
             procs.append(monitor)
-            _wait_for(tmp / "monitor.out", "monitoring ", 60)
+            wait_for(tmp / "monitor.out", "monitoring ", 60)
             # the deadline verdicts on the live monitor's verdict topic, as a subscriber sees them
             echo = subprocess.Popen(["rostopic", "echo", "/rclverify/verdict"], env=env, stdout=(tmp / "echo.out").open("wb"),
                                     stderr=subprocess.STDOUT, start_new_session=True)
@@ -91,12 +73,12 @@ def live_log(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
             procs += [teleop, mission]
             assert teleop.wait(60) == 0, (tmp / "teleop.out").read_text()
             assert mission.wait(60) == 0, (tmp / "mission.out").read_text()
-            _wait_for(log, '"node": "Mover"', 30)
-            _stop(monitor, signal.SIGINT)
+            wait_for(log, '"node": "Mover"', 30)
+            stop(monitor, signal.SIGINT)
             code = monitor.returncode
         finally:
             for p in reversed(procs):
-                _stop(p)
+                stop(p)
     # the proxy's lines ("kind": event, verdict, summary) among the live monitor's own
     lines = [x for x in map(json.loads, log.read_text().splitlines()) if "kind" in x]
     return {"lines": lines, "code": code, "tmp": tmp, "out": (tmp / "monitor.out").read_text(),

@@ -1,0 +1,33 @@
+"""Helpers of the live tests that start processes of their own (a ROS 1
+master, nodes, a monitor, each in a session of its own)."""
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import time
+from pathlib import Path
+
+
+def stop(p: subprocess.Popen[bytes], sig: int = signal.SIGTERM, grace: float = 10) -> None:
+    """Send ``sig`` to the process group of ``p`` (started with
+    ``start_new_session=True``) unless it has ended; SIGKILL after ``grace``
+    seconds, then wait up to 5 s more."""
+    if p.poll() is None:
+        os.killpg(p.pid, sig)
+        try:
+            p.wait(grace)
+        except subprocess.TimeoutExpired:
+            os.killpg(p.pid, signal.SIGKILL)
+            p.wait(5)
+
+
+def wait_for(path: Path, text: str, timeout: float) -> None:
+    """Wait until the file ``path`` holds ``text``; ``AssertionError`` with
+    the file's last 2000 characters after ``timeout`` seconds."""
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        if path.exists() and text in path.read_text(errors="replace"):
+            return
+        time.sleep(0.05)
+    raise AssertionError(f"{path.name} never said {text!r}: {path.read_text(errors='replace')[-2000:]}")
