@@ -65,6 +65,7 @@ from .cache import workspace as wscache
 from .pipeline import REPORT_PARTS, TaskIndex, Workspace
 from .plan.entries import TOOL_KEYS
 from .rcl.errors import RclError
+from .workspace import check_input_files
 
 _F = TypeVar("_F", bound=Callable[..., Any])
 
@@ -737,9 +738,7 @@ def _build_tasks(root: str | Path, plan_file: str) -> dict[str, Callable[[], Any
         # themselves, not only the snapshots they give. An edit that changes none of the snapshots (a comment
         # after the last node) left the report naming the old files' sha256, and the bundle then refused a
         # report `doit verify` called up to date.
-        assert index is not None  # registered only when ok
-        deps += [d for d in check_deps if d not in deps]
-        deps += sorted({str(rootp / f) for f in index.replacement.values() if (rootp / f).is_file()} - set(deps))
+        deps += [d for d in (at(f) for f in check_input_files(ws)) if d not in deps and os.path.isfile(d)]
         for n in nodes:
             deps += [at(ws.calculus(n)), at(ws.health(n)), at(ws.obligations(n))]
         deps += [at(ws.evidence(o["id"])) for _, o in exported()]

@@ -352,14 +352,18 @@ def cone_hashes(ws: Workspace, hashes: Mapping[str, str]) -> dict[str, str]:
     return {ws.cone(n): hashlib.sha256(t.encode("utf-8")).hexdigest() for n, t in texts.items()}
 
 
-def check_inputs(ws: Workspace) -> dict[str, str]:
-    """``{file: sha256}`` of every file the snapshots and the system model
-    are made from: the plan, its contract files and the replacement
-    contract files (what :attr:`Workspace.checked` reads)."""
-    from .cache import file_digest
+def check_input_files(ws: Workspace) -> list[str]:
+    """The workspace-relative files the snapshots and the system model are
+    made from: the plan, its contract files and the replacement contract
+    files (what :attr:`Workspace.checked` reads), in that order."""
     index = ws.index
-    files = [ws.plan_file, *index.contracts, *sorted(set(index.replacement.values()) - set(index.contracts))]
-    return {f: file_digest(ws.path(f)) for f in files}
+    return [ws.plan_file, *index.contracts, *sorted(set(index.replacement.values()) - set(index.contracts))]
+
+
+def check_inputs(ws: Workspace) -> dict[str, str]:
+    """``{file: sha256}`` of each of :func:`check_input_files`."""
+    from .cache import file_digest
+    return {f: file_digest(ws.path(f)) for f in check_input_files(ws)}
 
 
 def write_check_index(ws: Workspace, hashes: dict[str, str]) -> None:
