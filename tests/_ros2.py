@@ -1,0 +1,95 @@
+"""Helpers of the real-ROS 2 test tier: rclpy nodes on ROS 2's default
+middleware (rmw_fastrtps_cpp, Fast DDS), run in the ROS 2 Python that
+``scripts/setup.sh --tests`` installs beside the project (``.venv-ros2``,
+ROS 2's PyPI wheels; docs/ros2.md), or the one ``RCLVERIFY_ROS2_PYTHON``
+names (an apt installation's ``python3`` with its ``setup.bash`` sourced).
+
+Everything stays on loopback: ROS 2's own ``ROS_AUTOMATIC_DISCOVERY_RANGE=
+LOCALHOST`` for the rclpy nodes, Cyclone's loopback configuration
+(tests/dds_ros2.py) for the monitor, and a random ``ROS_DOMAIN_ID`` so that
+parallel test workers do not hear each other.  Every node is a process in a
+session of its own, stopped by :func:`_procs.stop` in the test's
+``finally``.
+"""
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+import textwrap
+from pathlib import Path
+from typing import Iterator
+
+import pytest
+
+from _procs import stop, wait_for
+from dds_ros2 import dds_env
+
+REPO = Path(__file__).resolve().parents[1]
+
+
+def ros2_python() -> Path:
+    """The ROS 2 Python to run rclpy nodes with; skips the test, with the
+    reason, where there is none (the wheels could not be installed)."""
+    named = os.environ.get("RCLVERIFY_ROS2_PYTHON")
+    exe = Path(named) if named else REPO / ".venv-ros2" / "bin" / "python"
+    if not exe.exists():
+        pytest.skip(f"no ROS 2 Python at {exe.name} (scripts/setup.sh --tests installs ROS 2's wheels into "
+                    ".venv-ros2; RCLVERIFY_ROS2_PYTHON names another)")
+    probe = subprocess.run([str(exe), "-c", "import rclpy, rmw_fastrtps_cpp"], capture_output=True, timeout=60)
+    if probe.returncode != 0:
+        pytest.skip(f"the ROS 2 Python cannot import rclpy and rmw_fastrtps_cpp: "
+                    f"{probe.stderr.decode(errors='replace').strip().splitlines()[-1:]}")
+    return exe
+
+
+def ros2_env(tmp: Path, rmw: str = "rmw_fastrtps_cpp") -> dict[str, str]:
+    """The environment of one test's ROS 2 system and monitor: this
+    process's, with a loopback Cyclone configuration and a random domain
+    (:func:`dds_ros2.dds_env`), discovery kept on the host, and ``rmw`` as
+    the nodes' middleware.  rclverify's own modules are not on the path."""
+    env = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "PYTHONSTARTUP")}
+    env.update(dds_env(tmp))
+    env.update(ROS_AUTOMATIC_DISCOVERY_RANGE="LOCALHOST", RMW_IMPLEMENTATION=rmw, PYTHONUNBUFFERED="1",
+               ROS_LOG_DIR=str(tmp / "ros_log"), RCUTILS_LOGGING_BUFFERED_STREAM="0")
+    return env
+
+
+def start_node(tmp: Path, name: str, source: str, env: dict[str, str], ready: str | None = "ready",
+               timeout: float = 30) -> subprocess.Popen[bytes]:
+    """Write ``source`` (dedented) to ``tmp/<name>.py`` and run it in the
+    ROS 2 Python, its output in ``tmp/<name>.log``; waits until the log
+    holds ``ready`` (skipped when ``None``).  The caller stops it with
+    :func:`_procs.stop`."""
+    script = tmp / f"{name}.py"
+    script.write_text(textwrap.dedent(source))
+    log = tmp / f"{name}.log"
+    with open(log, "wb") as fh:
+        p = subprocess.Popen([str(ros2_python()), str(script)], cwd=tmp, env=env, stdout=fh,
+                             stderr=subprocess.STDOUT, start_new_session=True)
+    if ready is not None:
+        try:
+            wait_for(log, ready, timeout)
+        except AssertionError:
+            stop(p)
+            raise
+    return p
+
+
+def rclverify(args: list[str], env: dict[str, str], cwd: Path, log: Path) -> subprocess.Popen[bytes]:
+    """Start ``rclverify ARGS`` (this Python, the project's sources) in a
+    session of its own, output in ``log``."""
+    env = dict(env, PYTHONPATH=str(REPO / "src"))
+    with open(log, "wb") as fh:
+        return subprocess.Popen([sys.executable, "-m", "rclverify.cli", *args], cwd=cwd, env=env, stdout=fh,
+                                stderr=subprocess.STDOUT, start_new_session=True)
+
+
+def stopping(*procs: subprocess.Popen[bytes]) -> Iterator[None]:
+    """A generator for ``contextlib.contextmanager``-style use in fixtures:
+    stops every process of ``procs`` when resumed."""
+    try:
+        yield
+    finally:
+        for p in procs:
+            stop(p)
