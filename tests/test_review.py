@@ -58,6 +58,7 @@ def test_checklist_has_one_question_per_conjunct_with_its_location(ws: Workspace
 
 def test_bundled_record_is_the_papers_review_and_stays_pending(ws: Workspace) -> None:
     rec = parse_record((ws.root / RECORD).read_text(encoding="utf-8"), RECORD)
+    assert rec.assumption == "TRUE" and rec.conjuncts == {"g1.c1": "exists_unique(x, y in REAL | out.position(x, y))"}
     assert rec.reviewer.startswith("not named in the paper") and rec.date == "not given in the paper"
     assert rec.answers == {"g1.c1": "yes"} and rec.verdict == "pass" and rec.files == ()
     ev = run(ws)
@@ -77,7 +78,8 @@ def test_all_yes_and_pass_with_files_is_discharged_and_editing_a_file_makes_it_s
 
 def test_a_no_answer_fails_naming_the_question(ws: Workspace) -> None:
     write_record(ws, files=[reviewed_file(ws)],
-                 checklist=[{"id": "g1.c1", "answer": "no", "note": "two estimates while converging"}])
+                 checklist=[{"id": "g1.c1", "answer": "no", "note": "two estimates while converging",
+                             "conjunct": "exists_unique(x, y in REAL | out.position(x, y))"}])
     ev = run(ws)
     assert ev.status == "failed"
     assert "answered no to g1.c1 (contracts/remote_inspection.rcl:37:14)" in ev.explanation
@@ -87,7 +89,7 @@ def test_a_no_answer_fails_naming_the_question(ws: Workspace) -> None:
 def test_verdict_fail_fails_and_unanswered_is_pending(ws: Workspace) -> None:
     write_record(ws, files=[reviewed_file(ws)], verdict="fail")
     assert run(ws).status == "failed"
-    write_record(ws, verdict="pass", checklist=[{"id": "g1.c1", "answer": None}])
+    write_record(ws, verdict="pass", checklist=[{"id": "g1.c1", "answer": None}])  # no text named: still pending
     ev = run(Workspace(ws.root))
     assert ev.status == "pending" and "g1.c1 not answered" in ev.explanation
 
@@ -155,3 +157,30 @@ def test_review_writes_the_record_the_plan_names_when_it_is_missing(ws: Workspac
     (ws.root / RECORD).unlink()
     assert main(["review", "Localisation", "-w", str(ws.root), "-o", str(ws.root / "other.yaml")]) != 0
     assert "does not exist" in capsys.readouterr().err
+
+
+def test_an_answer_binds_to_the_text_it_answered_not_the_guarantee_number(ws: Workspace) -> None:
+    """Issue 63, row 1: a review answered for one guarantee text does not
+    discharge the guarantee once its text changed (or the assumption did),
+    and a record that names no text discharges nothing."""
+    write_record(ws, files=[reviewed_file(ws)], reviewer="A. Reviewer", date="2026-01-02")
+    assert run(ws).status == "discharged"
+    rcl = ws.root / "contracts/remote_inspection.rcl"
+    text = rcl.read_text(encoding="utf-8")
+    assert text.count("exists_unique(x, y in REAL | out.position(x, y))") == 1
+    rcl.write_text(text.replace("exists_unique(x, y in REAL | out.position(x, y))",
+                                "exists_unique(x, y in REAL | out.position(x, y) and x >= 0.0)"), encoding="utf-8")
+    ev = run(Workspace(ws.root))
+    assert ev.status == "stale", ev.explanation
+    assert "answered g1.c1 for 'exists_unique(x, y in REAL | out.position(x, y))'" in ev.explanation
+    assert "remote_inspection.rcl:37:14 now reads" in ev.explanation
+    rcl.write_text(text, encoding="utf-8")
+    write_record(ws, assumption="in.x > 0.0")
+    ev = run(Workspace(ws.root))
+    assert ev.status == "stale" and "made under the assumption 'in.x > 0.0'" in ev.explanation
+    data = yaml.safe_load((ws.root / RECORD).read_text(encoding="utf-8"))
+    data.pop("assumption")
+    data["checklist"][0].pop("conjunct")
+    (ws.root / RECORD).write_text(yaml.safe_dump(data), encoding="utf-8")
+    ev = run(Workspace(ws.root))
+    assert ev.status == "stale" and "does not say which assumption" in ev.explanation

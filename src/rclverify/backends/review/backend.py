@@ -25,7 +25,7 @@ from ...plan.yamlguard import load_located, read_yaml_text
 from ...rcl import ast
 from ...rcl.errors import Diagnostic
 from ..base import NodeTarget, Stopwatch, make_evidence
-from .record import Question, RecordError, ReviewRecord, checklist, judge, parse_record
+from .record import Question, RecordError, ReviewRecord, assumption_text, checklist, judge, parse_record
 
 NAME = "review"
 KIND = "review"
@@ -111,7 +111,7 @@ class ReviewBackend:
             return make_evidence(target, obligation, "error", tool="review record", tool_version="-", clock=clock,
                                  explanation=f"the review record no longer checks: {exc}", log=str(exc))
         qs: list[Question] = [q for q in checklist(target.node) if q.guarantee == obligation.guarantee]
-        status, explanation, details = judge(rec, qs, target.root)
+        status, explanation, details = judge(rec, qs, target.root, assumption_text(target.node))
         details["record"] = rel
         details["figures_table"] = ([["reviewer", rec.reviewer], ["date", rec.date], ["scope", rec.scope],
                                      ["verdict", rec.verdict or "(none)"]]

@@ -7,7 +7,7 @@ from typing import Sequence
 import jinja2
 
 from ...rcl.types import CheckedNode
-from .record import checklist, sha256_of
+from .record import assumption_text, checklist, sha256_of
 
 
 def blank_record(node: CheckedNode, root: Path, files: Sequence[str] = ()) -> str:
@@ -25,4 +25,5 @@ def blank_record(node: CheckedNode, root: Path, files: Sequence[str] = ()) -> st
         listed.append({"path": f, "sha256": digest})
     env = jinja2.Environment(loader=jinja2.PackageLoader("rclverify.backends.review", "templates"),
                              undefined=jinja2.StrictUndefined, autoescape=False, keep_trailing_newline=True)
-    return env.get_template("record.yaml.j2").render(node=node.name, files=listed, questions=checklist(node))
+    return env.get_template("record.yaml.j2").render(node=node.name, files=listed, questions=checklist(node),
+                                                     assumption=assumption_text(node))

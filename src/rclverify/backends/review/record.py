@@ -8,18 +8,26 @@ Record (YAML)::
     scope: <what was reviewed, against what>
     files:                              # the reviewed files, workspace-relative
       - {path: src/localisation.py, sha256: <hex>}
+    assumption: <the node's assumption, as RCL, when the review was written>
     checklist:                          # one answer per generated question
-      - {id: g1.c1, answer: yes, note: <why>}   # yes | no | (empty: unanswered)
+      - {id: g1.c1, conjunct: <RCL>, answer: yes, note: <why>}   # yes | no | (empty: unanswered)
     verdict: pass                       # pass | fail | (empty: not decided)
 
 The checklist has one question per conjunct of each guarantee (top-level
 ``and`` split), with the conjunct's RCL location, so a reviewer knows what
 to check and the record says what was checked.
+
+An answer is bound to the **text** it answered, not to a guarantee's
+number: each entry names its conjunct and the record the assumption, both
+as :func:`~rclverify.rcl.printer.expr_to_rcl` prints them (whitespace
+aside).  When either differs from the contract's text now, the review
+answered another question and the evidence is ``stale`` (docs/integrity.md,
+"What makes evidence stale").
 """
 from __future__ import annotations
 
 import hashlib
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Mapping
 
@@ -56,7 +64,7 @@ def _conjuncts(e: ast.Expr) -> list[ast.Expr]:
 def checklist(node: CheckedNode) -> list[Question]:
     """The questions a review of ``node`` answers, guarantee by guarantee."""
     out = []
-    assume = " and ".join(expr_to_rcl(a.formula) for a in node.node.assumes) or "TRUE"
+    assume = assumption_text(node)
     for k, g in enumerate(node.node.guarantees, 1):
         for j, c in enumerate(_conjuncts(g.formula), 1):
             text = expr_to_rcl(c)
@@ -81,6 +89,8 @@ class ReviewRecord:
     answers: Mapping[str, str | None]
     notes: Mapping[str, str]
     verdict: str | None
+    conjuncts: Mapping[str, str] = field(default_factory=dict)
+    assumption: str | None = None
 
 
 def _answer(v: Any, where: str) -> str | None:
@@ -111,16 +121,56 @@ def parse_record(text: str, file: str) -> ReviewRecord:
         files.append((f["path"], f["sha256"].strip().lower()))
     answers: dict[str, str | None] = {}
     notes: dict[str, str] = {}
+    conjuncts: dict[str, str] = {}
     for i, q in enumerate(data["checklist"] or []):
         if not isinstance(q, dict) or "id" not in q:
             raise RecordError(f"{file}: checklist[{i}] needs an id")
         answers[str(q["id"])] = _answer(q.get("answer"), f"{file}: checklist {q['id']}")
         notes[str(q["id"])] = str(q.get("note") or "").strip()
+        if q.get("conjunct") is not None:
+            conjuncts[str(q["id"])] = str(q["conjunct"])
+    assumption = data.get("assumption")
     verdict = data["verdict"]
     if verdict not in (None, "", "pass", "fail"):
         raise RecordError(f"{file}: verdict must be pass, fail or empty, found {verdict!r}")
     return ReviewRecord(str(data["node"]), str(data["reviewer"] or "").strip(), str(data["date"] or "").strip(),
-                        str(data["scope"] or "").strip(), tuple(files), answers, notes, verdict or None)
+                        str(data["scope"] or "").strip(), tuple(files), answers, notes, verdict or None, conjuncts,
+                        None if assumption is None else str(assumption))
+
+
+def assumption_text(node: CheckedNode) -> str:
+    """The node's assumption as one RCL text (``TRUE`` when it has none): what a
+    record's ``assumption`` must read."""
+    return " and ".join(expr_to_rcl(a.formula) for a in node.node.assumes) or "TRUE"
+
+
+def _same_text(a: str, b: str) -> bool:
+    return " ".join(a.split()) == " ".join(b.split())
+
+
+def text_drift(record: ReviewRecord, questions: list[Question], assumption: str) -> str | None:
+    """Why the record's answers are not about the contract's text now, or
+    ``None`` when every answered question names its conjunct as it reads now
+    and the record names the assumption as it reads now."""
+    answered = [q for q in questions if record.answers.get(q.id) is not None]
+    if not answered:
+        return None  # nothing answered yet: pending, whatever text the record names
+    if record.assumption is None:
+        return ("the record does not say which assumption it was reviewed under (no `assumption:`); an answer binds "
+                "to the text it answered: regenerate the record with `rclverify review "
+                f"{record.node}` and review again")
+    if not _same_text(record.assumption, assumption):
+        return (f"the review was made under the assumption {record.assumption.strip()!r}; the contract now assumes "
+                f"{assumption!r}: review it again")
+    for q in answered:
+        said = record.conjuncts.get(q.id)
+        if said is None:
+            return (f"the record's answer to {q.id} does not say which text it answered (no `conjunct:`); "
+                    f"{q.location} now reads {q.conjunct!r}: review it again")
+        if not _same_text(said, q.conjunct):
+            return (f"the review answered {q.id} for {said.strip()!r}; {q.location} now reads {q.conjunct!r}: "
+                    "review it again")
+    return None
 
 
 def sha256_of(path: Path) -> str | None:
@@ -131,10 +181,14 @@ def sha256_of(path: Path) -> str | None:
         return None
 
 
-def judge(record: ReviewRecord, questions: list[Question], root: Path) -> tuple[str, str, dict[str, Any]]:
-    """(status, explanation, details) of ``record`` for the ``questions`` of one guarantee.
+def judge(record: ReviewRecord, questions: list[Question], root: Path,
+          assumption: str | None = None) -> tuple[str, str, dict[str, Any]]:
+    """(status, explanation, details) of ``record`` for the ``questions`` of one guarantee;
+    ``assumption``: the node's assumption text now (:func:`assumption_text`).
 
     * a listed file missing or with another sha256 -> ``stale``;
+    * an answer about another text than the conjunct's or the assumption's
+      now (:func:`text_drift`) -> ``stale``;
     * a question the record does not answer (the contract's checklist
       changed) -> ``stale`` (regenerate with ``rclverify review``);
     * an answer ``no`` or verdict ``fail`` -> ``failed`` naming the question;
@@ -156,6 +210,10 @@ def judge(record: ReviewRecord, questions: list[Question], root: Path) -> tuple[
         return "stale", (f"the record does not answer {', '.join(q.id for q in missing)} ({missing[0].location}: "
                          f"{missing[0].conjunct}); the contract's checklist changed: regenerate it with "
                          f"`rclverify review {record.node}`"), details
+    if assumption is not None:
+        drift = text_drift(record, questions, assumption)
+        if drift is not None:
+            return "stale", drift, details
     for q in questions:
         if record.answers.get(q.id) == "no":
             return "failed", (f"the reviewer answered no to {q.id} ({q.location}): {q.question}"
