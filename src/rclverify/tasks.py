@@ -388,7 +388,13 @@ def _inputs(config: Any, root: Path, seen: dict[str, tuple[str, ...]]) -> list[s
     def files(v: str) -> tuple[str, ...]:
         if v not in seen:
             p = root / v
-            if not p.exists():
+            py = v.rsplit(":", 1)[0] if ":" in v else v
+            if py.endswith(".py") and (root / py).is_file():
+                # a Python implementation (`file.py:callable`): the file and every workspace module it imports,
+                # so that a changed helper exports the obligations, and their inputs, again (issue 63, row 2)
+                from .backends.property_tests.closure import import_closure
+                seen[v] = tuple(import_closure(root, py)[0])
+            elif not p.exists():
                 seen[v] = ()
             elif p.is_dir():
                 seen[v] = tuple(os.path.relpath(f, root) for f in glob.glob(str(p / "**" / "*"), recursive=True)

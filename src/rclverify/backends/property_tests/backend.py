@@ -32,6 +32,7 @@ from ...plan.errors import PlanError
 from ...rcl.printer import expr_to_rcl
 from ..base import NodeTarget, Stopwatch, make_evidence
 from ..timelimit import TimeLimitExceeded, wall_clock_limit
+from .closure import import_closure, outside_versions
 from .seeding import split_facts
 from .harness import Config, ConfigError, Outcome, load_implementation, read_config, run_guarantee, versions
 
@@ -112,7 +113,9 @@ class PropertyTestsBackend:
         cfg = _config(target)
         path = test_file(target)
         atomic_write_text(path, render_tests(target, cfg, _is_class(target, cfg)))
-        inputs = tuple(sorted({cfg.file, *target.contract_files, target.plan_file}))
+        closure, outside = import_closure(target.root, cfg.file)  # every workspace module the code imports
+        inputs = tuple(sorted({cfg.file, *closure, *target.contract_files, target.plan_file}))
+        imported = outside_versions(outside)
         out = []
         for k, g in enumerate(target.node.node.guarantees, 1):
             out.append(Obligation(
@@ -122,6 +125,7 @@ class PropertyTestsBackend:
                           f"satisfying the assumption: {expr_to_rcl(g.formula)}",
                 source=_source(target, g.loc), instance=f"e{target.index}", artifact=target.rel(path),
                 inputs=inputs, data={"implementation": cfg.implementation, "max_examples": cfg.max_examples,
+                                     "imports_outside_workspace": imported,
                                      "seed": cfg.seed, "guarantee": k}))
         return out
 

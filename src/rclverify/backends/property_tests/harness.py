@@ -121,11 +121,19 @@ def read_config(raw: Mapping[str, Any], node: CheckedNode, root: Path) -> Config
 
 
 def load_implementation(root: Path, cfg: Config) -> Any:
-    """Import the implementation's file afresh and return the named callable or class.
+    """Import the implementation's file afresh, with every workspace module of
+    its import closure (:mod:`.closure`) that this process imported before,
+    and return the named callable or class.
 
     Raises :class:`ConfigError` when the file does not import or lacks the name.
     """
     path = (root / cfg.file).resolve()
+    from .closure import import_closure
+    closure = {(root / f).resolve() for f in import_closure(root, cfg.file)[0]}
+    for name, mod in list(sys.modules.items()):  # the workspace modules it imports, afresh too (a long-lived process)
+        where = getattr(mod, "__file__", None)
+        if where and Path(where).resolve() in closure:
+            del sys.modules[name]
     modname = f"rclverify_impl_{abs(hash(str(path)))}"
     spec = importlib.util.spec_from_file_location(modname, path)
     if spec is None or spec.loader is None:
