@@ -473,11 +473,13 @@ def cmd_bundle(args: argparse.Namespace) -> int:
 
 def _bundle_recheck(archive: str) -> int:
     """``bundle --recheck``: re-decide every stored query of ``archive`` with both solvers (docs/second-solver.md)."""
-    from .bundle.archive import read_members
+    from .bundle.archive import verify_bundle
     from .bundle.manifest import BundleError
     from .crosscheck.recheck import recheck_members
-    try:
-        out = recheck_members(read_members(Path(archive)))
+    records: dict[str, bytes] = {}
+    try:  # the archive verified first, streamed under --verify's limits; only its records kept (issue 63, row 8)
+        verify_bundle(Path(archive), records)
+        out = recheck_members(records)
     except BundleError as exc:
         for problem in exc.problems:
             print(f"{archive}: error: {problem}", file=sys.stderr)
@@ -651,6 +653,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     m.add_argument("--mapping", help="mapping file (default: backends/monitors/mapping.yaml if present)")
     m.add_argument("--horizon", type=seconds, help="seconds an input event may wait for its answer (default 5.0)")
     m.add_argument("--json", action="store_true", help="print the verdicts as JSON")
+    m.add_argument("--strict", action="store_true",
+                   help="exit 1 also when a node, topic, service, action or deadline of the contracts was not "
+                        "judged (nothing heard, not decoded, ...; docs/monitors.md, \"Silence is never green\")")
     lv = m.add_argument_group("live monitoring (ROS 1, ROS 2 over DDS; docs/monitors.md)")
     lv.add_argument("--live", action="store_true", help="monitor the running ROS system instead (ROS 1: "
                     "ROS_MASTER_URI; ROS 2: --ros2)")

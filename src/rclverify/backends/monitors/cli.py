@@ -5,7 +5,10 @@
 Exit status: 0 when no contract is violated, 1 when one is, 2 for a trace
 or configuration that cannot be read (a located message on stderr; the
 verdicts of the traces already checked are printed first) or when ROS 1
-or ROS 2's DDS domain cannot be reached in ``--live`` mode.
+or ROS 2's DDS domain cannot be reached in ``--live`` mode.  With
+``--strict``, 1 too when the run did not judge an item it was asked to
+check (a node, topic, service, action or deadline: :mod:`.judged`), as
+``doit verify --strict`` fails on what is not discharged.
 """
 from __future__ import annotations
 
@@ -22,6 +25,7 @@ from .summary import monitoring_details, summary_line, tool_versions, verdict_st
 from .check import check_trace
 from .deadlines import DeadlineMonitor, deadline_status, has_deadlines
 from .config import ConfigError, load_mapping
+from .judged import Heard, not_judged, strict_line
 
 
 
@@ -52,24 +56,30 @@ def monitor_command(args: argparse.Namespace, checked: Checked) -> int:
         print("rclverify monitor: error: name a TRACE to check, or --live to monitor the running system",
               file=sys.stderr)
         return 2
+    nodes = selected_nodes(checked, args.nodes, "monitor")
+    if nodes is None:
+        return 2
     violated = False
+    unjudged: list[dict[str, str]] = []
     report: list[dict[str, Any]] = []
-    timed = [n for n in checked.nodes.values() if has_deadlines(n)]
+    timed = [n for n in nodes if has_deadlines(n)]
     for trace in args.traces:
         path = Path(trace)
         # one pass over the run feeds both checks (a log named here may be a stream, read once)
         dmons = [DeadlineMonitor(checked, n, cfg.rules, horizon=cfg.horizon, tolerance=cfg.tolerance) for n in timed]
+        heard: dict[str, int] = {}
 
         def tap(events: Iterable[Any]) -> Iterator[Any]:
             for ev in events:
+                key = ev.topic.strip("/")
+                heard[key] = heard.get(key, 0) + 1
                 for m in dmons:
                     m.feed(ev)
                 yield ev
         try:
             run = read_trace(path, [root / d for d in cfg.msg_dirs], streams=True,
                              on_warning=lambda w: print(w, file=sys.stderr))
-            events, results = check_trace(checked, list(checked.nodes.values()), tap(run) if dmons else run,
-                                          cfg.rules, cfg.horizon, tolerance=cfg.tolerance)
+            events, results = check_trace(checked, nodes, tap(run), cfg.rules, cfg.horizon, tolerance=cfg.tolerance)
             dres = [m.finish() for m in dmons]
         except TraceError as exc:
             _emit(report, args.json)
@@ -79,6 +89,9 @@ def monitor_command(args: argparse.Namespace, checked: Checked) -> int:
             _emit(report, args.json)
             print(f"{trace}: error: the trace could not be checked: {type(exc).__name__}: {exc}", file=sys.stderr)
             return 2
+        statuses = {res.node: [verdict_status(res, trace)] for res in results}
+        items = not_judged(nodes, Heard(heard), statuses, {d.node: d.counts for d in dres}, f"in {trace}")
+        unjudged += items
         for res in results:
             status, explanation = verdict_status(res, trace)
             violated = violated or status == "failed"
@@ -86,6 +99,7 @@ def monitor_command(args: argparse.Namespace, checked: Checked) -> int:
                      **monitoring_details(res, trace, events, "", tool_versions(), cfg.horizon, cfg.tolerance)}
             entry.pop("sha256")
             entry["evaluation"] = dict(res.evaluation)  # debug: which formulas ran as compiled code
+            entry["not_judged"] = [i for i in items if i["node"] == res.node]
             report.append(entry)
             if not args.json:
                 print(f"{trace}: {summary_line(res)}")
@@ -101,8 +115,25 @@ def monitor_command(args: argparse.Namespace, checked: Checked) -> int:
                       + ("; no verdict: " + ", ".join(f"{n} {v}" for v, n in d.unaccepted.items() if n)
                          if any(d.unaccepted.values()) else ""))
                 print(f"  {status}: {explanation}")
+        if not args.json:
+            _print_not_judged(items, f"{trace}: ")
     _emit(report, args.json)
-    return 1 if violated else 0
+    return 1 if violated else _strict(args, unjudged)
+
+
+def _print_not_judged(items: list[dict[str, str]], prefix: str) -> None:
+    """One line per item the run did not judge (silence is never green: judged.py)."""
+    for i in items:
+        print(f"{prefix}not judged: {i['kind']} {i['name']} ({i['node']}): {i['reason']}: {i['detail']}")
+
+
+def _strict(args: argparse.Namespace, unjudged: list[dict[str, str]]) -> int:
+    """The exit code of a run with no violation: 1 under ``--strict`` when
+    an item went unjudged (``unjudged``, the first named on stderr), else 0."""
+    if not unjudged or not getattr(args, "strict", False):
+        return 0
+    print(strict_line(unjudged), file=sys.stderr)
+    return 1
 
 
 def live_command(args: argparse.Namespace, checked: Any, cfg: Any, root: Path) -> int:
@@ -187,14 +218,22 @@ def live_command(args: argparse.Namespace, checked: Any, cfg: Any, root: Path) -
     for n in record_.get("calls", {}).get("nodes", []):
         print(f"calls: {n['node']}: {n['status']}: {n['explanation']}")
     if "deadlines" in record_:
-        print(f"deadlines: {record_['deadlines']['false']} call(s) or goal(s) missed their deadline")
+        judged = sum(r["counts"]["true"] + r["counts"]["false"] for r in record_["deadlines"]["results"])
+        print(f"deadlines: {record_['deadlines']['false']} of {judged} judged call(s) or goal(s) missed their "
+              f"deadline")
+    for d in record_.get("topic_deadlines", []):
+        print(f"deadlines: {d['node']}: {d['status']}: {d['explanation']}")
     for topic, c in record_.get("enforce", {}).items():
         print(f"enforce /{topic}: {c['released']} released, {c['blocked']} blocked (read from {c['private']})")
     if "bag" in record_:
         print(f"recorded {record_['bag']['messages']} message(s) to {record_['bag']['path']}")
+    _print_not_judged(record_.get("not_judged", []), "")
     late = bool(record_.get("deadlines", {}).get("false"))
+    late = late or any(d["status"] == "failed" for d in record_.get("topic_deadlines", []))
     calls_failed = any(n["status"] == "failed" for n in record_.get("calls", {}).get("nodes", []))
-    return 1 if late or calls_failed or any(n["status"] == "failed" for n in record_["nodes"]) else 0
+    if late or calls_failed or any(n["status"] == "failed" for n in record_["nodes"]):
+        return 1
+    return _strict(args, list(record_.get("not_judged", [])))
 
 
 def oracle_command(args: argparse.Namespace, checked: Checked) -> int:

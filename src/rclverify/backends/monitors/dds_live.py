@@ -251,6 +251,7 @@ def run_dds(run_factory: Callable[..., LiveRun], checked: Checked, nodes: list[C
                   {t.key: t.reader_changes for t in bus.taps})
         if recorder is not None:
             record_["bag"] = recorder.close()
+        record_["not_judged"] = live.not_judged(record_)  # silence is never green (judged.py)
         if evidence is not None:
             atomic_write_text(evidence, json.dumps(record_, indent=2, sort_keys=True) + "\n")
         out(_status(live, call_counts))

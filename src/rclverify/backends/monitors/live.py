@@ -13,8 +13,17 @@ ROS 2 layer (:mod:`.ros2`) only move messages in and verdicts out.  It
   verdict to ``publish_last`` (a latched topic) at every timer tick where
   it changed;
 * keeps a one-line status per node (:meth:`status_line`);
+* runs each node's timed guarantees (``triggered by ... within ...``)
+  through the offline check's :class:`~.deadlines.DeadlineMonitor`, fed the
+  very events it writes to the log and its clock moved by the timer; each
+  deadline verdict is a log line (topic :data:`VERDICT_LOG_TOPIC`, ``kind:
+  "deadline"``, ``time`` the monitor's clock when it was decided, so the
+  offline check of the log moves its clock there too and gives the same
+  verdicts) and is published (``{"kind": "deadline", ...}``);
+* counts what it heard of every item of the contracts (:mod:`.judged`);
 * on :meth:`stop` writes a monitoring evidence record shaped like the
-  offline one (events, verdict counts, first violation, the log's sha256).
+  offline one (events, verdict counts, first violation, the log's sha256,
+  the deadlines as ``topic_deadlines``).
 
 docs/monitors.md ("Live monitoring") gives the decisions.
 """
@@ -35,6 +44,8 @@ from ...traces.events import Event
 from ...traces.mapping import TopicRule
 from .summary import monitoring_details, summary_line, tool_versions, verdict_status
 from .check import NodeResult, Verdict
+from .deadlines import DeadlineMonitor, DeadlineResult, DeadlineVerdict, deadline_status, has_deadlines
+from .judged import Heard, not_judged
 from .online import OnlineEngine
 from .worker import EngineWorker
 
@@ -81,8 +92,17 @@ class LiveRun:
         self.started = datetime.now(timezone.utc).isoformat(timespec="seconds")
         self.silences: list[dict[str, Any]] = []
         self.verdicts = 0
-        self.engine = OnlineEngine(checked, list(nodes), rules, horizon, reorder_window, silence_s,
+        nodes = list(nodes)
+        self.nodes = nodes
+        self.engine = OnlineEngine(checked, nodes, rules, horizon, reorder_window, silence_s,
                                    on_verdict=self._verdict, on_silence=self._silence, on_event=self._event)
+        #: the offline check's deadline monitors, fed the logged events (horizon: a trigger without `within`)
+        self.deadlines = [DeadlineMonitor(checked, n, rules, self._deadline, horizon=horizon)
+                          for n in nodes if has_deadlines(n)]
+        self.deadline_results: list[DeadlineResult] = []
+        #: link part ("estop/request") -> its call events heard (paired), and answers heard without their call
+        self.calls_heard: dict[str, int] = {}
+        self.orphans: dict[str, int] = {}
         self.results: list[NodeResult] | None = None
         self._last: dict[str, str] = {}  # node -> latest verdict not yet published as its last verdict
 
@@ -90,6 +110,16 @@ class LiveRun:
     def _event(self, ev: Event) -> None:
         self._log.write(dumps({"topic": ev.topic, "time": ev.time, **{k: v for k, v in ev.fields.items()
                                                                        if k not in ("topic", "time")}}) + "\n")
+        for d in self.deadlines:  # after its log line: a verdict it decides comes after it, as offline
+            d.feed(ev)
+
+    def _deadline(self, v: DeadlineVerdict) -> None:
+        now = max((d.now for d in self.deadlines if d.node.name == v.node), default=v.trigger_stamp)
+        t = now if now > float("-inf") else v.trigger_stamp
+        self._log.write(dumps({"topic": VERDICT_LOG_TOPIC, "time": t, "kind": "deadline", "verdict": v.to_json()})
+                        + "\n")
+        if self.publish is not None:
+            self.publish(dumps({"kind": "deadline", **v.to_json()}))
 
     def _verdict(self, v: Verdict) -> None:
         self.verdicts += 1
@@ -120,6 +150,8 @@ class LiveRun:
         with self.lock:
             if self.results is None:
                 self.engine.tick(now)
+                for d in self.deadlines:  # the monitors' clock: the timer less the reorder window
+                    d.advance(now - self.engine.reorder_window)
                 self._flush_last()
                 self._log.flush()
 
@@ -129,6 +161,19 @@ class LiveRun:
         with self.lock:
             if self.results is None:
                 self._log.write(dumps(dict(obj)) + "\n")
+                self._heard_call(obj)
+
+    def _heard_call(self, obj: Mapping[str, Any]) -> None:
+        """Count a call event of the log (the ROS 1 proxy's ``kind: "event"``
+        lines, the DDS call book's ``kind: "call"`` ones) for :mod:`.judged`."""
+        if obj.get("kind") == "event" and isinstance(obj.get("topic"), str):
+            key = str(obj["topic"]).strip("/")
+            self.calls_heard[key] = self.calls_heard.get(key, 0) + 1
+        elif obj.get("kind") == "call" and obj.get("link") is not None:
+            key = f"{str(obj['link']).strip('/')}/{obj.get('part')}"
+            book = self.calls_heard if "index" in obj else self.orphans if obj.get("orphan") else None
+            if book is not None:
+                book[key] = book.get(key, 0) + 1
 
     def _flush_last(self) -> None:
         """Publish each node's latest verdict (latched), once per timer tick
@@ -142,6 +187,8 @@ class LiveRun:
         """``Node: 3 satisfied, 1 violated | Node2: ...`` (a live per-node status)."""
         with self.lock:
             parts = [summary_line(m.result) for m in self.engine.monitors]
+            parts += [f"{d.node.name} deadlines: " + ", ".join(f"{n} {v}" for v, n in d.result.counts.items() if n)
+                      for d in self.deadlines if any(d.result.counts.values())]
         silent = [t for t, s in self.engine.topics.items() if s.silent]
         return " | ".join(parts) + (f" | silent: {', '.join(sorted(silent))}" if silent else "")
 
@@ -153,6 +200,7 @@ class LiveRun:
         with self.lock:
             if self.results is None:
                 self.results = self.engine.finish()
+                self.deadline_results = [d.finish() for d in self.deadlines]  # currently_false: logged
                 self._flush_last()
                 self._log.close()
         sha = hashlib.sha256(self.log_path.read_bytes()).hexdigest()
@@ -170,10 +218,37 @@ class LiveRun:
                   "events": self.engine.released, "late_events": self.engine.late,
                   "max_late_s": round(self.engine.max_late_s, 6),
                   "reorder_window_s": self.engine.reorder_window, "verdicts": self.verdicts,
-                  "silent_topics": self.silences, "nodes": nodes}
+                  "silent_topics": self.silences, "nodes": nodes,
+                  "topic_deadlines": [self._deadline_entry(d) for d in self.deadline_results]}
         if evidence is not None:
             atomic_write_text(evidence, json.dumps(record, indent=2, sort_keys=True) + "\n")
         return record
+
+
+    def _deadline_entry(self, res: DeadlineResult) -> dict[str, Any]:
+        """One node's deadline verdicts as the offline command reports them."""
+        status, explanation = deadline_status(res, self.log_path.name)
+        return {"node": res.node, "status": status, "explanation": explanation, "deadlines": res.to_json()}
+
+    def not_judged(self, record: Mapping[str, Any]) -> list[dict[str, str]]:
+        """The items of the monitored contracts this run did not judge
+        (:func:`~.judged.not_judged`), from what it heard and the finished
+        ``record`` (its ``nodes``, ``calls``, ``deadlines``,
+        ``topic_deadlines``, ``decode_errors``, ``warnings``, ``qos``)."""
+        heard = Heard({**{t: s.received for t, s in self.engine.topics.items()}, **self.calls_heard},
+                      dict(self.orphans), dict(record.get("decode_errors") or {}), list(record.get("warnings") or ()),
+                      {k: int(v.get("publishers_heard", 0)) for k, v in record["qos"].items()}
+                      if isinstance(record.get("qos"), dict) else None)
+        statuses: dict[str, list[tuple[str, str]]] = {}
+        for n in [*record["nodes"], *record.get("calls", {}).get("nodes", [])]:
+            statuses.setdefault(n["node"], []).append((n["status"], n["explanation"]))
+        counts: dict[str, dict[str, int]] = {}
+        results = [e["deadlines"] for e in record.get("topic_deadlines", [])]
+        for r in results + list(record.get("deadlines", {}).get("results", [])):
+            total = counts.setdefault(r["node"], {})
+            for v, k in r["counts"].items():
+                total[v] = total.get(v, 0) + k
+        return not_judged(self.nodes, heard, statuses, counts, "during the live run")
 
 
 def _no_delay(pub: Any) -> None:
@@ -314,6 +389,7 @@ def run_ros1(run_factory: Callable[..., LiveRun], checked: Checked, nodes: list[
         if deadlines is not None:
             record["deadlines"] = {"results": deadlines["results"], "false": deadlines["false"]}
         record["decode_errors"] = decode_errors
+        record["not_judged"] = live.not_judged(record)  # silence is never green (judged.py)
         if evidence is not None:
             atomic_write_text(evidence, json.dumps(record, indent=2, sort_keys=True) + "\n")
         out(live.status_line())

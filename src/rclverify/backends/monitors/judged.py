@@ -1,0 +1,178 @@
+"""What a monitoring run was asked to judge and did not (issue 62: silence is never green).
+
+``rclverify monitor`` (a recorded run or ``--live``) is asked to judge the
+monitored contracts' **items**: each node, each topic its ``topics(...)``
+names, each service and action its links name, and each node's timed
+guarantees (``triggered by ... within ...``, the deadlines).  A run that
+heard nothing of an item judged none of it: whatever its other verdicts,
+that item is neither satisfied nor violated, and a run whose every item
+went unheard is no evidence at all.  :func:`not_judged` lists those items,
+one record each (docs/monitors.md, "Silence is never green"):
+
+``{"kind": "node"|"topic"|"service"|"action"|"deadline", "name": ...,
+"node": <the contract node naming it>, "reason": <one of REASONS>,
+"detail": <one sentence>}``
+
+A reason is one of :data:`REASONS`: ``nothing heard`` (no message of it
+reached the monitor), ``type refused`` (a publisher of it was seen with a
+type or QoS the monitor's reader cannot take; the live bus's warning
+names it), ``not decoded`` (messages came but did not decode as the
+contract's type), ``not paired`` (answers of a service or action came
+whose request or goal was not heard or could not be matched to them),
+``no answer`` (calls or goals came, no reply or result), ``no verdict``
+(messages came but decided nothing: every input outside the assumption,
+or no accepted trigger event).  ``rclverify monitor --strict`` exits 1
+when the list is not empty.
+
+Standard library only, shared by the offline command (:mod:`.cli`) and
+the live runs (:mod:`.live`, :mod:`.dds_live`).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any, Iterable, Mapping
+
+from ...rcl.types import CheckedNode
+from .verdicts import LINK_TOPICS
+
+REASONS = ("nothing heard", "type refused", "not decoded", "not paired", "no answer", "no verdict")
+#: the parts of a link that open a call (a service's request, an action's goal) and that answer one
+_OPENS = ("request", "goal")
+_ANSWERS = ("response", "result")
+
+
+@dataclass
+class Heard:
+    """What a run heard, as counts.  ``messages``: topic or link part
+    (``"speed"``, ``"estop/request"``, no leading ``/``) -> messages heard
+    (for a link part: calls or answers paired to their call); ``orphans``:
+    link part -> answers heard whose call was not; ``decode_errors``: topic
+    (or a tap's key naming the link) -> messages that did not decode;
+    ``warnings``: the live bus's warning lines (a refused publisher names
+    its topic); ``publishers``: topic -> publishers the live reader matched
+    (``None`` offline)."""
+
+    messages: dict[str, int] = field(default_factory=dict)
+    orphans: dict[str, int] = field(default_factory=dict)
+    decode_errors: Mapping[str, int] = field(default_factory=dict)
+    warnings: Iterable[str] = ()
+    publishers: Mapping[str, int] | None = None
+
+
+def not_judged(nodes: Iterable[CheckedNode], heard: Heard, statuses: Mapping[str, Iterable[tuple[str, str]]],
+               deadlines: Mapping[str, Mapping[str, int]], where: str) -> list[dict[str, str]]:
+    """The items of ``nodes``' contracts the run did not judge (module docstring).
+
+    ``statuses``: node name -> its ``(status, explanation)`` pairs (the
+    untimed check's, the live calls'); a node is judged when one of them is
+    not ``pending``.  ``deadlines``: node name -> its deadline verdict counts
+    (``true``, ``false``, ``currently_false``, summed over the topic and the
+    call deadline monitors; a node absent has none); a node's deadlines are
+    judged when one trigger got ``true`` or ``false``.  ``where``: the run, as
+    the details say it (``"in run.jsonl"``, ``"during the live run"``).
+    Returns the records in contract order: nodes, then topics, links and
+    deadlines, each item once."""
+    nodes = list(nodes)
+    out: list[dict[str, str]] = []
+    warnings = list(heard.warnings)
+    for n in nodes:
+        pairs = list(statuses.get(n.name, ()))
+        if pairs and all(s == "pending" for s, _ in pairs):
+            silent = [t for t in _keys(n) if not heard.messages.get(t)]
+            reason = "nothing heard" if len(silent) == len(_keys(n)) else "no verdict"
+            out.append(_item("node", n.name, n.name, reason, pairs[0][1]))
+    seen: set[str] = set()
+    for n in nodes:
+        for t in n.node.topics:
+            key = t.field.strip("/")
+            if key in seen or heard.messages.get(key):
+                continue
+            seen.add(key)
+            reason, detail = _silent_topic(key, t.msg_type, heard, warnings, where)
+            out.append(_item("topic", "/" + key, n.name, reason, detail))
+    for n in nodes:
+        for lk in n.node.links:
+            key = lk.name.strip("/")
+            if key in seen:
+                continue
+            seen.add(key)
+            found = _silent_link(key, lk.kind, heard, where)
+            if found is not None:
+                out.append(_item(lk.kind, "/" + key, n.name, *found))
+    for n in nodes:
+        timed = [k for k, c in enumerate(n.node.guarantees, 1) if c.trigger is not None]
+        c = deadlines.get(n.name, {})
+        if not timed or c.get("true", 0) or c.get("false", 0):
+            continue
+        triggers = sorted({f"in.{g.trigger.name}" for g in n.node.guarantees if g.trigger is not None})
+        pending = c.get("currently_false", 0)
+        reason, detail = (("no verdict", f"{pending} trigger event(s) were still within their deadline {where}")
+                          if pending else
+                          ("no verdict", f"trigger events came but none was accepted (the assumption) {where}")
+                          if _heard_any(n, heard, triggers) else
+                          ("nothing heard", f"no event of its trigger(s) {', '.join(triggers)} {where}"))
+        out.append(_item("deadline", f"{n.name} guarantee(s) {', '.join(map(str, timed))}", n.name, reason, detail))
+    return out
+
+
+def _item(kind: str, name: str, node: str, reason: str, detail: str) -> dict[str, str]:
+    return {"kind": kind, "name": name, "node": node, "reason": reason, "detail": detail}
+
+
+def _keys(n: CheckedNode) -> list[str]:
+    """Every topic and link part a node's contract names (no leading ``/``)."""
+    keys = [t.field.strip("/") for t in n.node.topics]
+    for lk in n.node.links:
+        keys += [f"{lk.name.strip('/')}/{p}" for p in LINK_TOPICS[lk.kind]]
+    return keys
+
+
+def _heard_any(n: CheckedNode, heard: Heard, triggers: list[str]) -> bool:
+    """Whether a message carrying one of ``triggers`` (``in.x``) was heard."""
+    names = {t[3:] for t in triggers}
+    keys = [t.field.strip("/") for t in n.node.topics if t.match is not None and t.match.name in names]
+    for lk in n.node.links:
+        keys += [f"{lk.name.strip('/')}/{p}" for p, v in zip(LINK_TOPICS[lk.kind], lk.parts) if v.name in names]
+    return any(heard.messages.get(k) for k in keys)
+
+
+def _silent_topic(key: str, typ: str, heard: Heard, warnings: list[str], where: str) -> tuple[str, str]:
+    """Why topic ``key`` was not heard: ``(reason, detail)``."""
+    refused = [w for w in warnings if f": {key}: " in w and "not heard" in w]
+    if refused:
+        return "type refused", refused[0].split(": warning: ", 1)[-1]
+    bad = heard.decode_errors.get(key, 0)
+    if bad:
+        return "not decoded", f"{bad} message(s) on /{key} did not decode as {typ} {where}"
+    pubs = "" if heard.publishers is None else f" ({heard.publishers.get(key, 0)} publisher(s) matched)"
+    return "nothing heard", f"no message on /{key} {where}{pubs}"
+
+
+def _silent_link(key: str, kind: str, heard: Heard, where: str) -> tuple[str, str] | None:
+    """Why link ``key`` was not judged, ``None`` when a call of it was answered."""
+    parts = LINK_TOPICS[kind]
+    opened = sum(heard.messages.get(f"{key}/{p}", 0) for p in parts if p in _OPENS)
+    answered = sum(heard.messages.get(f"{key}/{p}", 0) for p in parts if p in _ANSWERS)
+    orphans = sum(heard.orphans.get(f"{key}/{p}", 0) for p in parts)
+    what = "call(s)" if kind == "service" else "goal(s)"
+    if opened and answered:
+        return None
+    bad = sum(n for k, n in heard.decode_errors.items() if key in k)
+    if bad and not opened:
+        return "not decoded", f"{bad} message(s) of /{key} did not decode {where}"
+    if orphans:
+        return "not paired", (f"{orphans} answer(s) of /{key} were heard but not paired to a {what[:-3]} "
+                              f"({opened} {what} heard) {where}")
+    if opened:
+        return "no answer", f"{opened} {what} of /{key} were heard, none answered {where}"
+    return "nothing heard", f"no {what[:-3]} of /{key} was heard {where}"
+
+
+def strict_line(items: list[dict[str, str]]) -> str:
+    """The one line ``--strict`` ends with when ``items`` is not empty."""
+    first = items[0]
+    return (f"rclverify monitor: --strict: {len(items)} item(s) were not judged; the first: {first['kind']} "
+            f"{first['name']}: {first['reason']}: {first['detail']}")
+
+
+__all__ = ["Heard", "REASONS", "not_judged", "strict_line"]
