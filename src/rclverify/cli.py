@@ -440,14 +440,29 @@ def cmd_bundle(args: argparse.Namespace) -> int:
     from .bundle.manifest import BundleError
     if args.recheck:
         return _bundle_recheck(args.recheck)
+    from .bundle import signature
+    if args.keygen:
+        try:
+            public = signature.write_key_pair(Path(args.keygen))
+        except BundleError as exc:
+            print(f"rclverify bundle: error: {exc.problems[0]}", file=sys.stderr)
+            return 1
+        print(f"{args.keygen}: private key (keep it); {public}: public key, fingerprint "
+              f"{signature.fingerprint(signature.load_public_key(public))} (give it to the assessor to pin)")
+        return 0
     if args.verify:
         try:
-            manifest = verify_bundle(Path(args.verify))
+            key = signature.load_public_key(Path(args.key)) if args.key else None
+            manifest = verify_bundle(Path(args.verify), key=key)
         except BundleError as exc:
             for problem in exc.problems:
                 print(f"{args.verify}: error: {problem}", file=sys.stderr)
             return 1
-        print(f"{args.verify}: {len(manifest['files'])} file(s) match MANIFEST.json; every record's seal holds")
+        signed = (f"; signed by the pinned key {manifest['signed']}" if manifest["signed"] else
+                  "; no key pinned (--key AUTHOR.pub): the seals prove the records unchanged since sealing, not "
+                  "who sealed them")
+        print(f"{args.verify}: {len(manifest['files'])} file(s) match MANIFEST.json; every record's seal holds"
+              + signed)
         return 0
     ws = _ws(args)
     with _run_lock(args):  # the report and the evidence it is checked against, as one run left them
@@ -460,7 +475,8 @@ def cmd_bundle(args: argparse.Namespace) -> int:
                        for c in (ws.plan.name or ws.root.resolve().name)).strip("-")
         out = Path(args.output) if args.output else Path(f"{name or 'workspace'}-bundle.tar.gz")
         try:
-            manifest = write_bundle(ws.root, ws.plan, out)
+            key = signature.load_private_key(Path(args.sign)) if args.sign else None
+            manifest = write_bundle(ws.root, ws.plan, out, key=key)
         except BundleError as exc:
             for problem in exc.problems:
                 print(f"{args.workspace}: error: {problem}", file=sys.stderr)
@@ -473,12 +489,12 @@ def cmd_bundle(args: argparse.Namespace) -> int:
 
 def _bundle_recheck(archive: str) -> int:
     """``bundle --recheck``: re-decide every stored query of ``archive`` with both solvers (docs/second-solver.md)."""
-    from .bundle.archive import verify_bundle
+    from .bundle.archive import scan_members
     from .bundle.manifest import BundleError
     from .crosscheck.recheck import recheck_members
     records: dict[str, bytes] = {}
-    try:  # the archive verified first, streamed under --verify's limits; only its records kept (issue 63, row 8)
-        verify_bundle(Path(archive), records)
+    try:  # streamed under --verify's limits and member-name rules; only the records kept (issue 63, row 8)
+        scan_members(Path(archive), None, records)
         out = recheck_members(records)
     except BundleError as exc:
         for problem in exc.problems:
@@ -620,6 +636,12 @@ def main(argv: Sequence[str] | None = None) -> int:
     bnd = add("bundle", cmd_bundle, "write the assessor's bundle (reports, artifacts, plan, contracts, manifest)", True)
     bnd.add_argument("-o", "--output", help="archive to write (.tar.gz or .zip; default: <workspace name>-bundle.tar.gz)")
     bnd.add_argument("--verify", metavar="FILE", help="check the archive FILE against its manifest instead")
+    bnd.add_argument("--sign", metavar="KEY",
+                     help="sign the manifest with the Ed25519 private key KEY (PEM; MANIFEST.sig in the archive)")
+    bnd.add_argument("--key", metavar="PUB",
+                     help="with --verify: the author's pinned Ed25519 public key (PEM); the signature must hold")
+    bnd.add_argument("--keygen", metavar="KEY",
+                     help="write a new Ed25519 key pair KEY and KEY.pub instead, for --sign and --key")
     bnd.add_argument("--recheck", metavar="FILE",
                      help="re-decide every stored query of the archive FILE with Z3 and cvc5 from the bundle "
                           "alone and compare with the recorded verdicts instead")

@@ -15,6 +15,7 @@ import gzip
 import hashlib
 import io
 import json
+import posixpath
 import tarfile
 import zipfile
 import zlib
@@ -57,8 +58,11 @@ def _zip_bytes(members: Mapping[str, bytes]) -> bytes:
     return raw.getvalue()
 
 
-def write_bundle(root: Path, plan: Plan, out: Path, tools: Mapping[str, str] | None = None) -> dict[str, Any]:
-    """Pack the workspace ``root`` (plan ``plan``) into the archive ``out``.
+def write_bundle(root: Path, plan: Plan, out: Path, tools: Mapping[str, str] | None = None,
+                 key: Any = None) -> dict[str, Any]:
+    """Pack the workspace ``root`` (plan ``plan``) into the archive ``out``;
+    with ``key`` (an Ed25519 private key, :mod:`.signature`) the member
+    ``MANIFEST.sig`` signs the manifest's bytes.
 
     ``tools`` overrides :func:`.manifest.tool_versions` (tests).  Returns the
     manifest.  Raises :class:`BundleError` when the report has not been
@@ -77,7 +81,11 @@ def write_bundle(root: Path, plan: Plan, out: Path, tools: Mapping[str, str] | N
     if broken:
         raise BundleError(broken)
     manifest = build_manifest(root, plan, files, missing, contents, tools if tools is not None else tool_versions())
-    members = {MANIFEST: dumps(manifest).encode("utf-8"), **contents}
+    members = {MANIFEST: dumps(manifest).encode("utf-8")}
+    if key is not None:
+        from .signature import SIGNATURE, sign
+        members[SIGNATURE] = sign(members[MANIFEST], key)
+    members.update(contents)
     out.parent.mkdir(parents=True, exist_ok=True)
     # durable, and 0644: an archive is for others to read
     atomic_write_bytes(out, _zip_bytes(members) if is_zip(out) else _tar_bytes(members), durable=True, mode=0o644)
@@ -85,8 +93,13 @@ def write_bundle(root: Path, plan: Plan, out: Path, tools: Mapping[str, str] | N
 
 
 def _unsafe(name: str) -> bool:
+    """Whether member ``name`` may not be believed as a path: absolute, with
+    ``..``, a backslash, or not in normal form (``./``, ``//``, a trailing
+    ``/``: ``artifacts/./requirements/R.json`` names the same file as a
+    listed member and would shadow it when unpacked; issue 63, row 6)."""
     p = PurePosixPath(name)
-    return p.is_absolute() or ".." in p.parts or "\\" in name
+    return p.is_absolute() or ".." in p.parts or "\\" in name or posixpath.normpath(name) != name \
+        or name.startswith("./")
 
 
 def _each_member(path: Path, problems: list[str]) -> Iterator[tuple[str, int, Any]]:
@@ -103,7 +116,7 @@ def _each_member(path: Path, problems: list[str]) -> Iterator[tuple[str, int, An
                 if info.is_dir():
                     continue
                 if _unsafe(info.filename) or info.filename in seen:
-                    problems.append(f"{info.filename}: unsafe or repeated member")
+                    problems.append(f"{info.filename}: unsafe, repeated or not a normalized member name")
                     continue
                 seen.add(info.filename)
                 with zf.open(info) as fh:
@@ -114,7 +127,7 @@ def _each_member(path: Path, problems: list[str]) -> Iterator[tuple[str, int, An
                 if m.isdir():
                     continue
                 if not m.isfile() or _unsafe(m.name) or m.name in seen:
-                    problems.append(f"{m.name}: unsafe, repeated or not a regular file")
+                    problems.append(f"{m.name}: unsafe, repeated, not a normalized member name or not a regular file")
                     continue
                 seen.add(m.name)
                 fh = tar.extractfile(m)
@@ -174,16 +187,16 @@ def must_be_sealed(name: str) -> bool:
         or is_sealed_path(name)
 
 
-def _hash_stream(name: str, fh: Any, limit: int) -> tuple[str, int, bytes | None]:
+def _hash_stream(name: str, fh: Any, limit: int, keep: bool = False) -> tuple[str, int, bytes | None]:
     """``(sha256 hex, size, bytes or None)`` of the stream ``fh`` read in
     chunks of :data:`_CHUNK`: memory stays bounded whatever the member's
     size.  The bytes are kept only for :data:`MANIFEST` and for records
-    (:func:`is_record`) of at most :data:`MAX_RECORD_BYTES`, whose seals are
-    checked.  Raises :class:`BundleError` when more than ``limit`` bytes
+    (:func:`is_record`, or any member when ``keep``) of at most
+    :data:`MAX_RECORD_BYTES`, whose seals are checked.  Raises :class:`BundleError` when more than ``limit`` bytes
     come out (a zip member whose header understates its size)."""
     h = hashlib.sha256()
     size = 0
-    kept: list[bytes] | None = [] if name == MANIFEST or is_record(name) else None
+    kept: list[bytes] | None = [] if name == MANIFEST or is_record(name) or keep else None
     while chunk := fh.read(_CHUNK):
         size += len(chunk)
         if size > limit:
@@ -196,12 +209,17 @@ def _hash_stream(name: str, fh: Any, limit: int) -> tuple[str, int, bytes | None
     return h.hexdigest(), size, b"".join(kept) if kept is not None else None
 
 
-def scan_members(path: Path, seals: list[str] | None = None) -> tuple[bytes | None, dict[str, tuple[str, int]]]:
+def scan_members(path: Path, seals: list[str] | None = None, kept: dict[str, bytes] | None = None,
+                 signature: dict[str, bytes] | None = None) -> tuple[bytes | None, dict[str, tuple[str, int]]]:
     """``(MANIFEST.json bytes or None, {member: (sha256, size)})`` of the
     archive at ``path`` (tar.gz or zip), every member streamed and hashed in
     chunks (bounded memory), nothing extracted to disk.  When ``seals`` is
     a list, every record member's seal is checked as it is read
-    (:func:`seal_problem`) and each problem appended to it.
+    (:func:`seal_problem`) and each problem appended to it.  When ``kept``
+    is a dict, the bytes of every member under ``artifacts/`` (records and
+    stored queries) of at most :data:`MAX_RECORD_BYTES` are put in it, by
+    name (``bundle --recheck``); ``signature``, when a dict, gets the
+    bytes of ``MANIFEST.sig`` (:mod:`.signature`) if the archive has it.
 
     Raises :class:`BundleError` for an unreadable or corrupt archive, for
     members that are links, devices, absolute or ``..`` paths, or repeated,
@@ -227,8 +245,13 @@ def scan_members(path: Path, seals: list[str] | None = None) -> tuple[bytes | No
 
     def record(name: str, fh: Any, limit: int) -> None:
         nonlocal manifest
-        digest, size, data = _hash_stream(name, fh, limit)
+        keep = (kept is not None and name.startswith("artifacts/")) or (signature is not None and name == "MANIFEST.sig")
+        digest, size, data = _hash_stream(name, fh, limit, keep)
         out[name] = (digest, size)
+        if name == "MANIFEST.sig" and signature is not None and data is not None:
+            signature[name] = data
+        elif keep and data is not None and kept is not None:
+            kept[name] = data
         if name == MANIFEST:
             manifest = data
         elif seals is not None and is_record(name):
@@ -267,7 +290,7 @@ def seal_problem(name: str, data: bytes | None) -> str:
     return f"{name}: seal broken: {problem}" if problem else ""
 
 
-def verify_bundle(path: Path) -> dict[str, Any]:
+def verify_bundle(path: Path, kept: dict[str, bytes] | None = None, key: Any = None) -> dict[str, Any]:
     """Check the archive at ``path`` against its ``MANIFEST.json``, and
     every record in it against its own seal.
 
@@ -279,13 +302,21 @@ def verify_bundle(path: Path) -> dict[str, Any]:
     edited to match, says what rclverify never recorded), and a missing or
     malformed manifest, and a member too large to check
     (:func:`scan_members`).  Members are streamed: memory stays bounded
-    whatever their size.
+    whatever their size.  ``kept``: as :func:`scan_members` (the records'
+    bytes, for ``--recheck``).  ``key``: the author's pinned Ed25519 public
+    key; then ``MANIFEST.sig`` must be its signature of the manifest
+    (:func:`.signature.check`), else it is a problem.  The returned
+    manifest has ``signed`` set to the key's fingerprint, ``None`` when no
+    key was given.
     """
+    from .signature import SIGNATURE, check, fingerprint
     seals: list[str] = []
-    manifest_bytes, members = scan_members(path, seals)
+    signature: dict[str, bytes] = {}
+    manifest_bytes, members = scan_members(path, seals, kept, signature)
     if manifest_bytes is None:
         raise BundleError([f"{MANIFEST}: missing from the archive"])
     members.pop(MANIFEST, None)
+    members.pop(SIGNATURE, None)  # over the manifest, so not in it
     try:
         manifest = json.loads(manifest_bytes.decode("utf-8"))
         listed = {str(k): str(v["sha256"]) for k, v in manifest["files"].items()}
@@ -299,6 +330,8 @@ def verify_bundle(path: Path) -> dict[str, Any]:
             problems.append(f"{name}: changed (sha256 {h}, manifest says {listed[name]})")
     problems += [f"{name}: in the archive but not in the manifest" for name in sorted(set(members) - set(listed))]
     problems += sorted(seals)
+    if key is not None and (why := check(manifest_bytes, signature.get(SIGNATURE), key)):
+        problems.append(why)
     if problems:
         raise BundleError(problems)
-    return dict(manifest)
+    return {**manifest, "signed": fingerprint(key) if key is not None else None}

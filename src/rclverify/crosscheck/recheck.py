@@ -69,7 +69,7 @@ def z3_answer(text: str, every: bool = False) -> str:
 
 def recheck_members(members: dict[str, bytes]) -> Recheck:
     """Re-decide the items of an archive's ``members`` (name -> bytes, as
-    :func:`rclverify.bundle.archive.read_members` gives them)."""
+    :func:`rclverify.bundle.archive.verify_bundle` keeps them)."""
     problems: list[str] = []
     notes: list[str] = []
     raw = members.get(INDEX)
