@@ -83,6 +83,9 @@ def read_lines(path: Path, chunks: Iterable[bytes], lineno: int = 0, index: int 
                     obj: Any = fast(raw)
                 except fast_error:
                     obj = None
+                except RecursionError:  # a value nested deeper than any reader goes (issue 63, row 12)
+                    raise TraceError(f"{path}:{lineno}:1: error: the line nests arrays or objects too deeply to "
+                                     "read (thousands of levels); no message is that deep") from None
                 if type(obj) is not dict:  # what msgspec rejects, a blank line, or a value that is no object
                     obj = slow(path, lineno, raw)
                     if obj is None:
@@ -134,7 +137,7 @@ def _slow(path: Path, lineno: int, raw: bytes) -> dict[str, Any] | None:
     if line[:1] == "{":
         try:
             obj, end = _SCAN(line, 0)
-        except (StopIteration, ValueError):
+        except (StopIteration, ValueError, RecursionError):
             pass
         else:
             rest = len(line) - end
@@ -146,6 +149,9 @@ def _slow(path: Path, lineno: int, raw: bytes) -> dict[str, Any] | None:
         obj = json.loads(line)
     except json.JSONDecodeError as exc:
         raise TraceError(f"{path}:{lineno}:{exc.colno}: error: malformed JSON: {exc.msg}") from None
+    except RecursionError:
+        raise TraceError(f"{path}:{lineno}:1: error: the line nests arrays or objects too deeply to read "
+                         "(thousands of levels); no message is that deep") from None
     if not isinstance(obj, dict):
         raise TraceError(f"{path}:{lineno}:1: error: expected a JSON object, got {type(obj).__name__}")
     return obj

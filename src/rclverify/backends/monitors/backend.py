@@ -149,8 +149,10 @@ class MonitorsBackend:
         atomic_write_text(rml, render_rml(target.checked, node, spec, source))
         atomic_write_text(target.artifacts.parent / "config.yaml", render_config(target.checked, cfg.ros_version, cfg.ros_nodes))
         out = []
+        names = [Path(t).name for t in cfg.traces]
         for trace in cfg.traces:
-            stem = Path(trace).name.replace(".", "_")
+            # the file's name, or its whole path where two traces share a name (issue 63, row 12)
+            stem = (Path(trace).name if names.count(Path(trace).name) == 1 else trace).replace(".", "_").replace("/", "_")
             oid = make_obligation_id(node.name, 0, NAME, stem)
             statement = (f"the run recorded in {trace} satisfies the contract of {node.name}: every input event "
                          f"meeting the assumption is answered within {cfg.horizon} s by outputs meeting every "

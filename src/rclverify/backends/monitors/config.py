@@ -24,6 +24,7 @@ to instrument, as ROSMonitoring's configuration lists it)::
 from __future__ import annotations
 
 import math
+import posixpath
 import re
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -121,9 +122,14 @@ def load_mapping(root: Path, rel: str | None, horizon: Any = None, traces: Any =
         raise ConfigError(f"{rel or DEFAULT_MAPPING}:{_at(path, rel or DEFAULT_MAPPING, ('horizon',))}: error: {msg}")
     if isinstance(traces, str) or not isinstance(traces, (list, tuple)):
         raise ConfigError("traces must be a list of files", "traces")
+    seen: dict[str, int] = {}
     for k, t in enumerate(traces):
         if not (root / str(t)).exists():
             raise ConfigError(f"no such trace: {t}", "traces", k)
+        norm = posixpath.normpath(str(t))
+        if norm in seen:  # one run, two obligations of one id: refused where it is written (issue 63, row 12)
+            raise ConfigError(f"trace {t} is listed twice (also as traces[{seen[norm]}])", "traces", k)
+        seen[norm] = k
     try:
         tol = parse_tolerance(tolerance)
     except ToleranceError as exc:  # the plan entry's: located by the caller
