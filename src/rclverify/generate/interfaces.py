@@ -7,13 +7,16 @@ field per contract variable that ``matches`` it (the union over all nodes),
 a service its request and response variables, an action its goal, result and
 feedback variables (the ``.action`` order; the contract writes goal,
 feedback, result).  Units of measure are comments in REP 103 style
-(``# [m/s]``).
+(``# [m/s]``); one interface carries each quantity in one unit (:func:`check_units`).
 """
 from __future__ import annotations
 
 from dataclasses import dataclass, field
 
+from ..rcl import ast
+from ..rcl.errors import RclError, error
 from ..rcl.types import Checked, CheckedNode
+from ..rcl.units import Unit
 from .typemap import STANDARD_PACKAGES, Section, TypeMapper, snake
 
 
@@ -26,6 +29,8 @@ class Interface:
     kind: str
     sections: list[Section]
     users: set[str] = field(default_factory=set)
+    #: per field the declared units of measure of the variables it carries, where declared
+    units: list[tuple[str, Unit, ast.Loc, str]] = field(default_factory=list)
 
     @property
     def path(self) -> str:
@@ -87,11 +92,16 @@ def _unit(node: CheckedNode, prefix: str, var: str) -> str:
     return "; ".join(parts)
 
 
-def _add_var(pkgs: dict[str, InterfacePackage], pkg: str, section: Section, node: CheckedNode,
+def _add_var(pkgs: dict[str, InterfacePackage], pkg: str, iface: Interface, section: Section, node: CheckedNode,
              prefix: str, var: str) -> None:
     table = node.inputs if prefix == "in" else node.outputs
     decls = node.node.inputs if prefix == "in" else node.node.outputs
-    texpr = next((d.type for d in decls if d.name == var), None)
+    decl = next((d for d in decls if d.name == var), None)
+    texpr = decl.type if decl is not None else None
+    u = node.unit_of(prefix, var)
+    if u is not None and decl is not None:
+        iface.units.append((snake(var), u, decl.unit.loc if decl.unit is not None else decl.loc,
+                            f"{node.name}'s {prefix}.{var}"))
     mapper = pkgs[pkg].mapper
     assert mapper is not None
     mapper.field(section, var, table[var], texpr, _unit(node, prefix, var))
@@ -118,7 +128,7 @@ def interface_packages(checked: Checked) -> dict[str, InterfacePackage]:
             iface = ip.interfaces.setdefault(f"msg/{name}", Interface(pkg, name, "msg", [Section()]))
             iface.users.add(cn.name)
             if t.match is not None and t.match.prefix in ("in", "out"):
-                _add_var(pkgs, pkg, iface.sections[0], cn, t.match.prefix, t.match.name)
+                _add_var(pkgs, pkg, iface, iface.sections[0], cn, t.match.prefix, t.match.name)
         for link in cn.node.links:
             if is_standard(link.ros_type):
                 continue
@@ -133,5 +143,29 @@ def interface_packages(checked: Checked) -> dict[str, InterfacePackage]:
             order = (0, 1) if kind == "srv" else (0, 2, 1)
             for part, where in zip(link.parts, order):
                 if part.prefix in ("in", "out"):
-                    _add_var(pkgs, pkg, iface.sections[where], cn, part.prefix, part.name)
+                    _add_var(pkgs, pkg, iface, iface.sections[where], cn, part.prefix, part.name)
+    check_units(pkgs)
     return pkgs
+
+
+def check_units(pkgs: dict[str, InterfacePackage]) -> None:
+    """Refuse an interface whose fields would carry one quantity in two units: two declared
+    units of one dimension (``[m]`` and ``[mm]``, ``[rad]`` and ``[deg]``) that differ in scale,
+    whether on one field (two nodes reading it differently) or on two fields of the same
+    ``.msg``/``.srv``/``.action``.  A ROS interface's fields are read by whoever uses it, with
+    the units its comments give (REP 103: SI units throughout); two scales of one quantity in one
+    definition is the mix-up a reader makes.  Raises :class:`RclError` with one located error per
+    clash, at the later declaration's unit, naming the earlier one."""
+    diags = []
+    for pkg in pkgs.values():
+        for iface in pkg.interfaces.values():
+            first: dict[tuple[int, ...], tuple[str, Unit, ast.Loc, str]] = {}
+            for fname, u, loc, who in iface.units:
+                seen = first.setdefault(u.dims, (fname, u, loc, who))
+                if seen[1] != u:
+                    diags.append(error(loc, f"{iface.ros_name}: field {fname} would carry {who} in {u}, and field "
+                                            f"{seen[0]} the same quantity in {seen[1]} ({seen[3]}, {seen[2]}): "
+                                            f"one unit per quantity in one interface (convert one of them)",
+                                       "generate-units"))
+    if diags:
+        raise RclError(diags)

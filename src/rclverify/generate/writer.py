@@ -10,6 +10,7 @@ changed: those are the files to read again (docs/generate.md).
 from __future__ import annotations
 
 import json
+import pprint
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Mapping
@@ -23,6 +24,7 @@ from .interfaces import interface_packages
 from .cpp import cpp_package
 from .nodes import QOS_DEPTH, NodePackage, node_packages
 from .planfrag import plan_fragment
+from .pycarry import carried
 from .wiring import wires
 from .typemap import camel, snake
 
@@ -96,8 +98,10 @@ def render_tree(checked: Checked, system: str, sources: dict[str, str] | None = 
                    wires=wires(np, rules), inputs=list(checked.nodes[np.ros_name].inputs))
         gen[f"{d}/{d}/node.py"] = _ENV.get_template("node.py.j2").render(ctx)
         gen[f"{d}/{d}/__init__.py"] = f"# {GENERATED}\n"
+        gen[f"{d}/{d}/contract_eval.py"] = _ENV.get_template("contract_eval.py.j2").render(ctx)
         gen[f"{d}/{d}/contract.py"] = _ENV.get_template("contract.py.j2").render(
             ctx, sources_json=json.dumps(sources or {}, sort_keys=True),
+            carried_py=pprint.pformat(carried(checked, checked.nodes[np.ros_name]), width=110, sort_dicts=True),
             tolerance=tolerance.to_json() if tolerance else None,
             triggers=[(k, f"in.{c.trigger.name}") for k, c in
                       enumerate(checked.nodes[np.ros_name].node.guarantees, 1) if c.trigger is not None])

@@ -5,8 +5,22 @@ Every end of the contract's interface is created here; what the node does
 is in logic.py (created once, yours to edit).  Each message an end carries
 updates the node's RCL values (``self.values``, by the field contract.FIELDS
 names); each output published through ``self.publish('out.x', msg)`` is
-checked against the contract (contract.py) and a violation is published on ``rclverify/verdict`` in the monitor's format."""
+checked against the contract (contract.py, which carries its own judgement: no
+rclverify needed) and a violation is published on the node's own ``~/contract_verdict``
+(``/<node>/contract_verdict``) in the monitor's format.
+
+Threads: the node spins in a MultiThreadedExecutor.  Subscriptions (and timers the logic
+makes in ``group_topics``) run one at a time, service and action servers in a group of their
+own, clients and action clients in a reentrant group: a callback may wait for an answer of
+another node's service, or of this node's own, without blocking the executor that must
+deliver it (``self.call``, with a timeout).  The node's RCL values are updated under
+``self.lock``.  SIGINT and SIGTERM stop it cleanly (rclpy shuts the context down; ``main``
+destroys the node and returns)."""
+import threading
+
 import rclpy
+from rclpy.callback_groups import MutuallyExclusiveCallbackGroup, ReentrantCallbackGroup
+from rclpy.executors import ExternalShutdownException, MultiThreadedExecutor
 from rclpy.node import Node
 from std_msgs.msg import String
 from std_msgs.msg import Bool, Float64
@@ -14,6 +28,8 @@ from std_msgs.msg import Bool, Float64
 from . import contract, logic
 
 QOS_DEPTH = 10
+#: executor threads: one per callback group and one to spare
+THREADS = 4
 
 
 class HeaterControlNode(Node):
@@ -24,45 +40,72 @@ class HeaterControlNode(Node):
         self.stream = contract.Stream()  # the messages as the monitor reads them (docs/semantics.md)
         self.values = self.stream.values
         self.steps = 0
+        self.lock = threading.RLock()
+        self.group_topics = MutuallyExclusiveCallbackGroup()
+        self.group_servers = MutuallyExclusiveCallbackGroup()
+        self.group_clients = ReentrantCallbackGroup()
         self.verdict_pub = self.create_publisher(String, contract.VERDICT_TOPIC, QOS_DEPTH)
         # in.celsius
-        self.sub_temperature = self.create_subscription(Float64, 'temperature', self.on_sub_temperature, QOS_DEPTH)
+        self.sub_temperature = self.create_subscription(Float64, 'temperature', self.on_sub_temperature, QOS_DEPTH,
+                                                     callback_group=self.group_topics)
         # out.heat
         self.pub_heat = self.create_publisher(Bool, 'heat', QOS_DEPTH)
         logic.setup(self)
+        self.get_logger().info(f'contract layer ready; verdicts on {self.verdict_pub.topic_name}')
 
     def on_sub_temperature(self, msg):
         self.take('in.celsius', msg)
         self.heard(['in.celsius'])
         logic.on_input(self, 'in.celsius', msg)
 
+    def call(self, attr, request, timeout_sec=5.0):
+        """Call the service client ``attr`` (``'service_client_get_limits'``) with ``request`` and
+        wait at most ``timeout_sec`` seconds for its response, from a callback too (the client's
+        group is reentrant, the executor has THREADS threads); ``None`` when no response came."""
+        client = getattr(self, attr)
+        if not client.wait_for_service(timeout_sec=timeout_sec):
+            self.get_logger().warning(f'{client.srv_name}: no server within {timeout_sec} s')
+            return None
+        done = threading.Event()
+        future = client.call_async(request)
+        future.add_done_callback(lambda _: done.set())
+        if not done.wait(timeout_sec):
+            client.remove_pending_request(future)
+            self.get_logger().warning(f'{client.srv_name}: no response within {timeout_sec} s')
+            return None
+        return future.result()
+
     def take(self, var, msg):
         """Record contract variable ``var`` from ``msg`` (its field in contract.FIELDS; none known: kept
         as the logic set it in ``self.values``)."""
         path = contract.FIELDS.get(var, ('', ''))[1]
         if path:
-            self.values[var] = contract.value_of(var, contract.field_of(msg, path))
+            with self.lock:
+                self.values[var] = contract.value_of(var, contract.field_of(msg, path))
 
     def publish(self, var, msg):
         """Publish ``msg`` for output ``var`` on its end and check the contract on the values."""
         attr = contract.FIELDS[var][0]
-        self.take(var, msg)
-        getattr(self, attr).publish(msg)
-        self.check(getattr(getattr(self, attr), 'topic_name', attr), [var])
+        with self.lock:
+            self.take(var, msg)
+            getattr(self, attr).publish(msg)
+            self.check(getattr(getattr(self, attr), 'topic_name', attr), [var])
 
     def fill(self, var, msg, value):
         """Set output ``var``'s field of ``msg`` to RCL value ``value`` and record it."""
         path = contract.FIELDS.get(var, ('', ''))[1]
         if path:
             contract.set_field(msg, path, contract.raw_of(var, value))
-        self.values[var] = value
+        with self.lock:
+            self.values[var] = value
 
     def publish_value(self, var, value):
         """Publish RCL value ``value`` of output ``var`` in a new message of its end's type
         (an output on a topic; one on a service or action is filled by ``fill``)."""
         attr = contract.FIELDS[var][0]
         if not attr.startswith('pub_'):
-            self.values[var] = value
+            with self.lock:
+                self.values[var] = value
             return
         msg = getattr(self, attr).msg_type()
         self.fill(var, msg, value)
@@ -70,19 +113,22 @@ class HeaterControlNode(Node):
 
     def heard(self, inputs, topic=''):
         """The inputs ``inputs`` came in one message: a question, whose broken assumption goes to
-        rclverify/verdict."""
-        v = self.stream.on_input({k: self.values[k] for k in inputs if k in self.values})
-        if v is not None:
-            self.report(v, topic)
+        the node's verdict topic."""
+        with self.lock:
+            v = self.stream.on_input({k: self.values[k] for k in inputs if k in self.values})
+            if v is not None:
+                self.report(v, topic)
 
     def check(self, topic='', outputs=()):
         """The outputs ``outputs`` went out in one message: judged as the monitor judges it (the
         guarantees it answers, triggered ones only when their input's message is owed an answer);
-        a violation goes to rclverify/verdict."""
-        self.report(self.stream.on_output({k: self.values[k] for k in outputs if k in self.values}), topic)
+        a violation goes to the node's verdict topic."""
+        with self.lock:
+            self.report(self.stream.on_output({k: self.values[k] for k in outputs if k in self.values}), topic)
 
     def report(self, verdict, topic=''):
-        """Publish ``verdict`` (a contract.Stream verdict) on rclverify/verdict when it is a violation."""
+        """Publish ``verdict`` (a contract.Stream verdict) on the node's verdict topic when it is a
+        violation."""
         self.steps += 1
         now = self.get_clock().now().nanoseconds / 1e9
         message = contract.verdict_message(self.values, self.steps, now, topic, verdict)
@@ -93,13 +139,23 @@ class HeaterControlNode(Node):
 
 
 def main(args=None):
+    """Run the node until SIGINT or SIGTERM (rclpy's signal handlers shut the context down and
+    the executor stops: ExternalShutdownException, or KeyboardInterrupt before they are
+    installed); exit status 0 then, no traceback."""
     rclpy.init(args=args)
-    node = HeaterControlNode()
+    node = None
+    executor = MultiThreadedExecutor(num_threads=THREADS)
     try:
-        rclpy.spin(node)
+        node = HeaterControlNode()
+        executor.add_node(node)
+        executor.spin()
+    except (KeyboardInterrupt, ExternalShutdownException):
+        pass
     finally:
-        node.destroy_node()
-        rclpy.shutdown()
+        executor.shutdown()
+        if node is not None:
+            node.destroy_node()
+        rclpy.try_shutdown()
 
 
 if __name__ == '__main__':
