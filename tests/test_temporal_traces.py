@@ -180,3 +180,20 @@ def test_recorded_runs_are_evidence_of_the_temporal_requirement_in_the_report(tm
     from rclverify.tasks import build_tasks
     assert str(tmp_path / "run.jsonl") in build_tasks(tmp_path)["task_requirements"]()["file_dep"]
 
+
+
+@pytest.mark.parametrize("bad", ['"six"', "NaN", "true"])
+def test_an_unreadable_value_never_stands_in_for_the_one_before(ws, bad: str) -> None:
+    """Issue 63, row 5: a message whose value cannot be read (a string, NaN,
+    a bool for a number) leaves what reads it undecided at that step; the
+    value before it does not stand in, so ``always`` is not true."""
+    p = ws.root / "unreadable.jsonl"
+    lines = [json.dumps({"topic": t, "time": round(0.1 * k, 1), "data": v}) for k, (t, v) in enumerate(RUN[:4])]
+    lines.append('{"topic": "b", "time": 0.4, "data": %s}' % bad)
+    p.write_text("\n".join(lines) + "\n")
+    v = _check(ws, "always Inc.out.b <= 3", p)
+    assert v.verdict == "inconclusive", v.reason
+    assert v.step == 4 and "could not be read" in v.reason and "unreadable.jsonl:5" in v.reason
+    # read again, the value is judged as usual
+    p.write_text("\n".join(lines + ['{"topic": "b", "time": 0.5, "data": 9}']) + "\n")
+    assert _check(ws, "always Inc.out.b <= 3", p).verdict == "false"

@@ -254,6 +254,9 @@ class TraceStates:
         self.state: dict[tuple[str, str], Any] = {}
         self.steps = 0
         self.problem = ""
+        #: scope keys (``"in.Node.in.x"``) whose last message could not be read (a string for a REAL, NaN, a
+        #: bool): no value, and what reads them is undecided, never judged on the value before (issue 63, row 5)
+        self.unreadable: dict[str, str] = {}
 
     def _node_values(self, n: str) -> dict[str, Any]:
         out = {k: v for k, v in self.io[n].items() if v is not None}
@@ -267,10 +270,13 @@ class TraceStates:
             return False
         before = {n: self._node_values(n) for n in {sv.node for sv in self.vars}} if self.steps else {}
         for n, key, typ in vs:
+            p, _, name = key.partition(".")
             try:
                 self.io[n][key] = map_value(typ, ev.fields, self.rules.get(ev.topic, TopicRule()), self.io[n].get(key))
+                self.unreadable.pop(f"{p}.{n}.{p}.{name}", None)
             except MappingError as exc:
                 self.io[n][key] = None
+                self.unreadable[f"{p}.{n}.{p}.{name}"] = f"{ev.where}: {n}.{key}: {exc}"
                 self.problem = self.problem or f"{ev.where}: {n}.{key}: {exc}"
         for sv in self.vars:
             init, nxt = self.formulas[(sv.node, sv.name)]
@@ -358,6 +364,13 @@ def check_temporal_trace(t: Temporal, checked: Checked, states: tuple[StateVar, 
     undecided: dict[str, Any] | None = None
     i = -1
     last: Event | None = None
+    def decide(f: Formal, unpublished: bool | None) -> bool | None:
+        """``f``'s truth at this step: undecided when a value it reads was unreadable in its last message,
+        ``unpublished`` when one was never published, else judged."""
+        if any(f"{p}.{n}.{p}.{v}" in st.unreadable for n, p, v in f.mentions):
+            return None
+        return _truth(f, checked, vals, tol, sems) if _published(f, vals) else unpublished
+
     for ev in events:
         if not st.feed(ev):
             continue
@@ -367,6 +380,9 @@ def check_temporal_trace(t: Temporal, checked: Checked, states: tuple[StateVar, 
         def wit(f: Formal, holds: bool | None) -> dict[str, Any]:
             out = {"step": i, "time": ev.time, "where": ev.where, "operand": f.expr and _text(f),
                    "holds": holds, "values": _shown(f, vals)}
+            bad = [st.unreadable[k] for n, p, v in f.mentions if (k := f"{p}.{n}.{p}.{v}") in st.unreadable]
+            if bad:
+                out["unreadable"] = bad
             if holds and sems.get(id(f), "exact") != "exact":  # held only in double arithmetic or the tolerance
                 out["semantics"] = sems[id(f)]
             return out
@@ -376,17 +392,14 @@ def check_temporal_trace(t: Temporal, checked: Checked, states: tuple[StateVar, 
         if kind in ("always", "always next"):
             if kind == "always next" and i == 0:
                 continue
-            if not _published(ops[0], vals):
-                continue  # a value it reads was never published: not evaluated (docs/semantics.md)
-            h = _truth(ops[0], checked, vals, tol, sems)
+            h = decide(ops[0], True)  # a value it reads never published: not evaluated (docs/semantics.md)
             if h is False:
                 return at("false", f"{_text(ops[0])} is false at step {i} ({ev.where}, t = {ev.time} s)",
                           [wit(ops[0], False)])
             if h is None and undecided is None:
                 undecided = wit(ops[0], None)
         elif tracker is not None:  # the response pattern (response_trace.py)
-            said = tracker.step(i, _truth(ops[0], checked, vals, tol, sems) if _published(ops[0], vals) else False,
-                                _truth(ops[1], checked, vals, tol, sems) if _published(ops[1], vals) else False)
+            said = tracker.step(i, decide(ops[0], False), decide(ops[1], False))
             if said is not None and said[0] == "false":
                 return at("false", f"{_text(ops[0])} held at step {said[1]} and {_text(ops[1])} did not hold in "
                                    f"time, by step {i} ({ev.where}, t = {ev.time} s)", [wit(ops[1], False)])
@@ -394,11 +407,11 @@ def check_temporal_trace(t: Temporal, checked: Checked, states: tuple[StateVar, 
                 undecided = wit(ops[said[1]], None)
         elif kind == "next":
             if i == 1:
-                h = _truth(ops[0], checked, vals, tol, sems) if _published(ops[0], vals) else False
+                h = decide(ops[0], False)
                 v = {True: "true", False: "false", None: "inconclusive"}[h]
                 return at(v, f"{_text(ops[0])} is {v if h is not None else 'undecided'} at step 1", [wit(ops[0], h)])
         elif kind == "eventually":  # reached only on published values
-            h = _truth(ops[0], checked, vals, tol, sems) if _published(ops[0], vals) else False
+            h = decide(ops[0], False)
             if h is True:
                 return at("true", f"{_text(ops[0])} holds at step {i} ({ev.where}, t = {ev.time} s)",
                           [wit(ops[0], True)])
@@ -411,14 +424,14 @@ def check_temporal_trace(t: Temporal, checked: Checked, states: tuple[StateVar, 
                 return at("false", f"{_text(ops[0])} does not hold at any step 0..{t.bound}: the bound passed "
                                    f"at step {i} ({ev.where}, t = {ev.time} s)", [wit(ops[0], False)])
         else:  # until
-            g = _truth(ops[1], checked, vals, tol, sems) if _published(ops[1], vals) else False
+            g = decide(ops[1], False)
             if g is True and undecided is None:
                 return at("true", f"{_text(ops[1])} holds at step {i}, {_text(ops[0])} at every step before",
                           [wit(ops[1], True)])
             if g is None and undecided is None:
                 undecided = wit(ops[1], None)
             if g is not True:
-                f = _truth(ops[0], checked, vals, tol, sems) if _published(ops[0], vals) else True
+                f = decide(ops[0], True)
                 if f is False and undecided is None:
                     return at("false", f"{_text(ops[0])} is false at step {i} before {_text(ops[1])} held",
                               [wit(ops[0], False)])
@@ -430,9 +443,10 @@ def check_temporal_trace(t: Temporal, checked: Checked, states: tuple[StateVar, 
         return TraceVerdict("inconclusive", 0, "the trace has no message on the topics of "
                                                f"{', '.join(nodes)}: nothing was checked")
     if undecided is not None and kind != "eventually":
+        why = (f"a value it reads could not be read ({undecided['unreadable'][0]}), and the value before never "
+               "stands in" if undecided.get("unreadable") else "a value it reads is not observed or not decidable there")
         return TraceVerdict("inconclusive", n, f"an operand is undecided at step {undecided['step']} "
-                                               f"({undecided['where']}): a value it reads is not observed or "
-                                               "not decidable there", undecided["step"], undecided["time"],
+                                               f"({undecided['where']}): {why}", undecided["step"], undecided["time"],
                             undecided["where"], [undecided])
     if kind in ("always", "always next"):
         return TraceVerdict("true", n, f"{_text(ops[0])} holds at every step of this trace ({n} steps): "
