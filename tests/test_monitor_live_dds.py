@@ -236,10 +236,12 @@ def test_another_writer_on_a_guarded_topic_is_named_and_keeps_the_evidence_from_
 
 
 def test_a_publisher_of_the_same_type_name_with_another_layout_is_named_not_heard(run: dict) -> None:
-    """Issue 47: the layout is compared by the type identifier DDS discovery carries."""
+    """Issue 47: the layout is compared member by member with the type object DDS discovery names (never the
+    bare type identifier, issue 62), and the field that differs is named."""
     mislaid = [w for w in run["record"]["warnings"] if "/mislaid" in w]
     assert len(mislaid) == 1 and ": warning: limit: node /mislaid publishes std_msgs::msg::dds_::Float64_ with " \
-        "another layout" in mislaid[0]
+        "another layout than the contract's type: field data: the publisher's is string, the contract's float64" \
+        in mislaid[0], mislaid
     assert run["record"]["qos"]["limit"]["publishers_heard"] == 1
 
 

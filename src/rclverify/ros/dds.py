@@ -87,15 +87,48 @@ def domain_id(env: Mapping[str, str] | None = None) -> int:
     return d
 
 
+#: What rclverify adds to the user's Cyclone configuration (read after it, so it wins on these two settings):
+#: * ``AllowInvalidTryConstruct``: Fast DDS 3 (ROS 2 Kilted's default middleware) announces XTypes type
+#:   objects whose sequence and array elements carry no try-construct flag, which DDS-XTypes 1.3
+#:   (7.3.4.4.4) requires and Cyclone otherwise refuses, printing ``ddsi_xt_type_init_impl with invalid type
+#:   object`` on stderr for each such type;
+#: * ``IgnoreTypeInformation`` for eProsima's vendor id (1.15, DDS-RTPS 2.5 9.3.1.5): Fast DDS's type lookup
+#:   service answers a request for a type's *minimal* identifier with its *complete* type object, so Cyclone
+#:   compares the monitor's minimal type with Fast DDS's complete one, never finds them identical, and refuses
+#:   every type that nests a struct in a sequence or array ("not delimited", DDS-XTypes 7.2.4.4.4.4).  Fast
+#:   DDS's endpoints are then matched on the type name, as ROS 2's middlewares match each other, and the
+#:   monitor compares the layout itself (the ROS 2 type hash its writers announce, :mod:`.dds_layout`).
+COMPATIBILITY = ("<Compatibility><AllowInvalidTryConstruct>true</AllowInvalidTryConstruct>"
+                 "<IgnoreTypeInformation>1.15</IgnoreTypeInformation></Compatibility>")
+_domains: dict[int, Any] = {}  # the domains this process configured (kept alive: a Domain entity ends with it)
+
+
+def _configure(d: int) -> None:
+    """Create domain ``d`` with the user's configuration (``CYCLONEDDS_URI``: files and XML fragments, comma
+    separated, as Cyclone reads it) followed by :data:`COMPATIBILITY`; a domain this process already has
+    (made here or by the caller) is left as it is."""
+    from cyclonedds.core import DDSException
+    from cyclonedds.domain import Domain
+    if d in _domains:
+        return
+    user = os.environ.get("CYCLONEDDS_URI", "").strip().strip(",")
+    try:
+        _domains[d] = Domain(d, f"{user},{COMPATIBILITY}" if user else COMPATIBILITY)
+    except DDSException as exc:
+        if exc.code != DDSException.DDS_RETCODE_PRECONDITION_NOT_MET:  # not "exists already": the config
+            raise
+
+
 def make_participant(domain: int | None = None) -> Any:
     """A DDS participant in ``domain`` (default :func:`domain_id`), configured
-    by ``CYCLONEDDS_URI``.  Raises :class:`DdsUnavailable` when Cyclone refuses
-    (a configuration file that does not parse, no usable interface)."""
+    by ``CYCLONEDDS_URI`` and :data:`COMPATIBILITY`.  Raises :class:`DdsUnavailable`
+    when Cyclone refuses (a configuration file that does not parse, no usable interface)."""
     import_cyclonedds()
     from cyclonedds.core import DDSException
     from cyclonedds.domain import DomainParticipant
     d = domain_id() if domain is None else domain
     try:
+        _configure(d)
         return DomainParticipant(d)
     except DDSException as exc:
         uri = os.environ.get("CYCLONEDDS_URI", "")
@@ -354,7 +387,20 @@ def type_hash_user_data(ros_type_name: str, store: Any = None) -> bytes:
         return b""
 
 
-__all__ = ["ACTION_INFIX", "ACTION_SERVICES", "ACTION_TOPICS", "DISCOVERY_TOPIC", "DISCOVERY_TYPE", "DdsUnavailable",
-           "MAX_DOMAIN_ID", "NodeInfo", "decode_participant_info", "discovery_struct", "domain_id", "dds_type",
-           "encode_participant_info", "import_cyclonedds", "make_participant", "reply_topic", "request_topic",
-           "ros_name", "ros_type", "service_type", "take_raw", "topic_name", "type_hash_user_data", "write_raw"]
+def announced_type_hash(user_data: bytes) -> str | None:
+    """The ROS 2 type hash (``RIHS01_<64 hex digits>``, REP-2011) an endpoint's
+    USER_DATA announces as ``typehash=...;`` (ROS 2 Iron and newer, every
+    middleware: rmw_dds_common ``encode_type_hash_for_user_data_qos``), or
+    ``None`` when it announces none (Humble and older, plain DDS)."""
+    for item in bytes(user_data).decode("utf-8", errors="replace").split(";"):
+        key, _, value = item.partition("=")
+        if key.strip() == "typehash" and value.startswith("RIHS01_"):
+            return value.strip()
+    return None
+
+
+__all__ = ["ACTION_INFIX", "ACTION_SERVICES", "ACTION_TOPICS", "COMPATIBILITY", "DISCOVERY_TOPIC", "DISCOVERY_TYPE",
+           "DdsUnavailable", "MAX_DOMAIN_ID", "NodeInfo", "announced_type_hash", "decode_participant_info",
+           "discovery_struct", "domain_id", "dds_type", "encode_participant_info", "import_cyclonedds",
+           "make_participant", "reply_topic", "request_topic", "ros_name", "ros_type", "service_type", "take_raw",
+           "topic_name", "type_hash_user_data", "write_raw"]

@@ -22,7 +22,7 @@ not slow a reliable publisher down (DDS flow control); it keeps the last
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 from fnmatch import fnmatchcase
 from typing import Any, Iterable
 
@@ -51,6 +51,8 @@ class QosProfile:
     exclusive: bool = False
     partitions: tuple[str, ...] = ()
     representations: tuple[int, ...] = (XCDR1,)
+    #: the endpoint's USER_DATA as discovery reports it (ROS 2's ``typehash=RIHS01_...;``); not a matching policy
+    user_data: bytes = field(default=b"", compare=False, repr=False)
 
     def describe(self) -> str:
         """``reliable, transient_local, keep_last(1)`` and any policy off its default."""
@@ -112,7 +114,8 @@ def from_dds(qos: Any) -> QosProfile:
         lease_ns=int(getattr(live, "lease_duration", INFINITE_NS)),
         exclusive=own is not None and _kind(own) == "Exclusive",
         partitions=tuple(getattr(part, "partitions", ()) or ()),
-        representations=tuple(reps) or (XCDR1,))
+        representations=tuple(reps) or (XCDR1,),
+        user_data=bytes(getattr(p.get("Userdata"), "data", b"") or b""))
 
 
 def to_dds(q: QosProfile, user_data: bytes = b"") -> Any:

@@ -15,8 +15,11 @@ located warning, once per publisher and reason, never silence:
   contract's type): ``FILE:LINE:COL: warning: /scan: node /lidar publishes
   sensor_msgs::msg::dds_::Imu_, the contract's type is ...; not heard``;
 * a publisher of a type with the contract's type name but another layout
-  (the XTypes type identifier discovery carries differs; issue 47): named,
-  never counted as heard;
+  (issue 47; :mod:`.dds_layout` compares the type objects, or the ROS 2 type
+  hashes, never the bare XTypes identifiers): named, with the field that
+  differs where its type object says it, never counted as heard, and its
+  samples dropped if they reach the reader (Fast DDS's writers are matched
+  on the type name: :data:`rclverify.ros.dds.COMPATIBILITY`);
 * another participant writing a topic only the monitor should write (a
   guarded topic beside the gate, the verdict topic: :meth:`Bus.watch_writers`,
   :mod:`.dds_trust`);
@@ -41,7 +44,8 @@ from typing import Any, Callable
 
 from ...ros.dds import take_raw
 from ...ros.dds_discovery import Discovery
-from ...ros.dds_qos import QosProfile, mismatches, reader_for, to_dds
+from ...ros.dds_qos import QosProfile, from_dds, mismatches, reader_for, to_dds
+from .dds_layout import OTHER, PENDING, LayoutJudge
 
 #: Seconds a warning about a publication waits for ros_discovery_info to name its node (a ROS 2 node
 #: announces itself after its endpoints are discovered); past it, the participant's id is named.
@@ -64,24 +68,32 @@ class Tap:
     samples: int = 0
     heard: set[bytes] = field(default_factory=set)  # writer GUIDs the current reader matches
     warned: set[tuple[bytes, str]] = field(default_factory=set)
+    #: per publication handle (sample info): whether its samples are the contract's layout
+    admitted: dict[int, bool] = field(default_factory=dict)
+    dropped: int = 0  # samples of a publisher of another layout, not handed on
 
     def to_json(self) -> dict[str, Any]:
         return {"topic": self.dds_topic, "samples": self.samples, "reader_changes": self.reader_changes,
-                "qos": self.qos.to_json() if self.qos is not None else None, "publishers_heard": len(self.heard)}
+                "qos": self.qos.to_json() if self.qos is not None else None, "publishers_heard": len(self.heard),
+                "other_layout_samples": self.dropped}
 
 
 class Bus:
     """Discovery, taps and the thread that reads them (module docstring).
     ``warn(text)`` receives each warning line; ``period_s`` bounds a wait;
     ``on_reader(tap, publishers)`` is told each time a tap's reader is made
-    (in the bus thread), with the publishers it was made for."""
+    (in the bus thread), with the publishers it was made for; ``type_hash(struct)``
+    the ROS 2 type hash of a contract struct (:meth:`.dds_types.TypeBook.type_hash`)."""
 
     def __init__(self, dp: Any, on_sample: Callable[[Tap, bytes, Any, int], None],
                  warn: Callable[[str], None], period_s: float = 0.05,
-                 on_reader: Callable[[Tap, list[Any]], None] | None = None) -> None:
+                 on_reader: Callable[[Tap, list[Any]], None] | None = None,
+                 type_hash: Callable[[type], str | None] | None = None) -> None:
         from cyclonedds.core import WaitSet
         self.dp, self.on_sample, self.warn, self.period_s = dp, on_sample, warn, period_s
         self.on_reader = on_reader
+        self.layouts = LayoutJudge(dp, type_hash or (lambda struct: None))
+        self._pending = False  # a publisher's type object not yet resolved: update again next period
         self.discovery = Discovery(dp)
         self.taps: list[Tap] = []
         self.waitset = WaitSet(dp)
@@ -139,7 +151,8 @@ class Bus:
                 now = time.monotonic()
                 if now >= next_poll:  # discovery at most every period, not at every sample
                     next_poll = now + self.period_s
-                    if self.discovery.poll() or any(now - t0 >= NAME_GRACE_S for t0 in self._unnamed.values()):
+                    if self.discovery.poll() or self._pending \
+                            or any(now - t0 >= NAME_GRACE_S for t0 in self._unnamed.values()):
                         self._update()
                 self._drain()
             self._drain(every=True)
@@ -154,10 +167,7 @@ class Bus:
                 got = take_raw(t.reader, 256)
                 if not got:
                     break
-                now = time.time_ns()
-                t.samples += len(got)
-                for raw, info in got:
-                    self.on_sample(t, raw, info, now)
+                self._hand_on(t, got)
                 if len(got) < 256:
                     break
 
@@ -167,21 +177,25 @@ class Bus:
         from cyclonedds.sub import DataReader
         from cyclonedds.topic import Topic
         disc = self.discovery
+        self._pending = False
         for t in self.taps:
             pubs = disc.publishers(t.dds_topic)
             want = t.struct.__idl_typename__  # type: ignore[attr-defined]
-            layout = _type_id(t.struct)
-            same = [p for p in pubs if p.type_name == want and not _other_layout(p, layout)]
+            same = []
             for p in pubs:
-                if p.type_name != want and (p.guid, "type") not in t.warned and self._named(p.guid):
-                    self._warn_once(t, p.guid, "type", f"{t.where}: warning: {t.key}: {disc.who(p)} publishes "
-                                    f"{p.type_name}, the contract's type is {want}; its messages are not heard")
-                elif p.type_name == want and _other_layout(p, layout) and (p.guid, "layout") not in t.warned \
-                        and self._named(p.guid):
+                if p.type_name != want:
+                    if (p.guid, "type") not in t.warned and self._named(p.guid):
+                        self._warn_once(t, p.guid, "type", f"{t.where}: warning: {t.key}: {disc.who(p)} publishes "
+                                        f"{p.type_name}, the contract's type is {want}; its messages are not heard")
+                    continue
+                verdict, why = self.layouts.judge(t.struct, p.type_id, p.qos.user_data)
+                self._pending = self._pending or verdict == PENDING
+                if verdict == OTHER and (p.guid, "layout") not in t.warned and self._named(p.guid):
                     self._warn_once(t, p.guid, "layout", f"{t.where}: warning: {t.key}: {disc.who(p)} publishes "
-                                    f"{p.type_name} with another layout than the contract's type (its type "
-                                    "identifier, from DDS discovery, differs: other fields or field types); its "
+                                    f"{p.type_name} with another layout than the contract's type: {why}; its "
                                     "messages are not heard")
+                if verdict != OTHER:
+                    same.append(p)
             if not same:
                 continue
             req, left = reader_for([p.qos for p in same])
@@ -223,11 +237,33 @@ class Bus:
                           "writes is not checked, and the evidence is not discharged while it does")
 
     def _drain_one(self, t: Tap) -> None:
-        got = take_raw(t.reader, 100000)
+        self._hand_on(t, take_raw(t.reader, 100000))
+
+    def _hand_on(self, t: Tap, got: list[tuple[bytes, Any]]) -> None:
+        """Hand each sample on, but those of a publisher of another layout (counted in ``dropped``)."""
         now = time.time_ns()
-        t.samples += len(got)
         for raw, info in got:
-            self.on_sample(t, raw, info, now)
+            ok = t.admitted.get(info.publication_handle)
+            if ok is None:
+                ok = t.admitted[info.publication_handle] = self._admit(t, info.publication_handle)
+            if ok:
+                t.samples += 1
+                self.on_sample(t, raw, info, now)
+            else:
+                t.dropped += 1
+
+    def _admit(self, t: Tap, handle: int) -> bool:
+        """Whether the writer of publication ``handle`` (matched by the tap's reader) has the contract's
+        layout; a writer discovery cannot describe any more is taken at its type name."""
+        try:
+            ep = t.reader.get_matched_publication_data(handle)
+        except Exception:  # noqa: BLE001 - gone already: nothing to compare
+            ep = None
+        if ep is None:
+            return True
+        verdict, _why = self.layouts.judge(t.struct, getattr(ep, "type_id", None),
+                                           from_dds(getattr(ep, "qos", None)).user_data)
+        return verdict != OTHER
 
     def _named(self, guid: bytes) -> bool:
         """May a warning about publication ``guid`` be said now: its node is known, or the grace for
@@ -252,20 +288,6 @@ class Bus:
             if t.reader is not None:
                 t.reader.__del__()
         self.discovery.close()
-
-
-def _type_id(struct: type) -> Any:
-    """The XTypes type identifier of the contract's struct (``None`` when it cannot be made)."""
-    try:
-        return struct.__idl__.get_type_id()  # type: ignore[attr-defined]
-    except Exception:  # noqa: BLE001 - no identifier: the layout is not compared
-        return None
-
-
-def _other_layout(p: Any, layout: Any) -> bool:
-    """Whether publication ``p`` announces a layout other than ``layout`` (both
-    identifiers known and different; a publisher that sends none is taken at its name)."""
-    return layout is not None and getattr(p, "type_id", None) is not None and p.type_id != layout
 
 
 __all__ = ["Bus", "Tap"]

@@ -144,7 +144,8 @@ def run_dds(run_factory: Callable[..., LiveRun], checked: Checked, nodes: list[C
         if tap.key in enforce and tap.key not in republish:
             republish[tap.key] = bus.writer(topic_name(tap.key), structs[tap.key], publishers[0].qos)
     bus = Bus(dp, lambda tap, raw, info, rns: worker_box[0].offer(tap.key, (raw, info.source_timestamp, rns),
-                                                                  rns / 1e9), warn, on_reader=on_reader)
+                                                                  rns / 1e9), warn, on_reader=on_reader,
+              type_hash=types.type_hash)
     user = type_hash_user_data("std_msgs/msg/String")
     pub = bus.writer(topic_name(verdict_topic), string, writer_profile(depth=1000), user)
     latched = writer_profile(transient_local=True, depth=1)

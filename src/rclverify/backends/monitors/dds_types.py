@@ -207,6 +207,25 @@ class TypeBook:
             feedback=self.struct(f"{base}_FeedbackMessage"),
             status=self.struct("action_msgs/msg/GoalStatusArray"))
 
+    def type_hash(self, cls: type) -> str | None:
+        """The ROS 2 type hash (``RIHS01_...``, REP-2011, :mod:`rclverify.ros.type_hash`)
+        of message struct ``cls`` from the definitions this book reads: what a
+        ROS 2 publisher of the same definition announces.  ``None`` for a
+        service part or request-header struct."""
+        from ...ros.dds import ros_type
+        from ...ros.type_hash import UnknownType, rihs01
+        name = ros_type(getattr(cls, "__idl_typename__", ""))
+        if name is None or "/msg/" not in name:
+            return None
+
+        def fields_of(t: str) -> Any:
+            info = self.table.get(t)
+            return None if info is None else info.fields
+        try:
+            return rihs01(name, fields_of)
+        except (UnknownType, KeyError, ValueError, TypeError):
+            return None
+
     # -- values ------------------------------------------------------------------------------
     def build(self, cls: type, data: Mapping[str, Any]) -> Any:
         """An instance of struct ``cls`` from a dict (nested dicts and lists of
