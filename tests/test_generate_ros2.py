@@ -238,3 +238,21 @@ def test_a_hand_written_file_at_a_generated_path_is_never_overwritten(tmp_path: 
     assert "n0/n0/node.py: error: exists and is not a generated file" in err and "Traceback" not in err
     assert (out / "n0" / "n0" / "node.py").read_text() == "# mine\n"
     assert not (out / "n1").exists()  # nothing written
+
+
+def test_one_quantity_in_two_units_in_one_interface_is_a_located_error(tmp_path: Path, capsys) -> None:
+    """A service whose request carries metres and whose response millimetres (issue 62): refused at
+    the later declaration's unit, naming the other, exit 1, nothing written; the same units on a
+    message's two fields, or one dimension in one unit, are fine."""
+    ws = _ws(tmp_path, "node Ranger {\n  inputs( target : REAL [m] )\n  outputs( dist : REAL [mm] )\n"
+                       "  services( range_msgs/Measure measure serves(in.target, out.dist) )\n"
+                       "  assume( TRUE )\n  guarantee( out.dist >= 0 )\n}\n")
+    assert main(["generate", "ros2", "-w", str(ws), "-o", str(tmp_path / "out")]) == 1
+    err = capsys.readouterr().err
+    assert "contracts/sys.rcl:3:24: error: range_msgs/srv/Measure: field dist would carry Ranger's out.dist " \
+           "in [mm], and field target the same quantity in [m] (Ranger's in.target, contracts/sys.rcl:2:25)" in err
+    assert "Traceback" not in err and not (tmp_path / "out").exists()
+    (ws / "contracts" / "sys.rcl").write_text((ws / "contracts" / "sys.rcl").read_text().replace("[mm]", "[m]"))
+    assert main(["generate", "ros2", "-w", str(ws), "-o", str(tmp_path / "out")]) == 0
+    srv = (tmp_path / "out" / "range_msgs" / "srv" / "Measure.srv").read_text()
+    assert "float64 target  # [m]" in srv and "float64 dist  # [m]" in srv

@@ -50,6 +50,8 @@ class HeaterControlNode(Node):
                                                      callback_group=self.group_topics)
         # out.heat
         self.pub_heat = self.create_publisher(Bool, 'heat', QOS_DEPTH)
+        #: each end's name -> the attribute holding it
+        self.ends = {'temperature': 'sub_temperature', 'heat': 'pub_heat'}
         logic.setup(self)
         self.get_logger().info(f'contract layer ready; verdicts on {self.verdict_pub.topic_name}')
 
@@ -74,6 +76,11 @@ class HeaterControlNode(Node):
             self.get_logger().warning(f'{client.srv_name}: no response within {timeout_sec} s')
             return None
         return future.result()
+
+    def carries(self, var, end):
+        """Whether contract variable ``var`` travels on the end named ``end`` (a topic, service or
+        action name): which outputs of a step go into a service's response."""
+        return contract.FIELDS.get(var, ('', ''))[0] == self.ends.get(end)
 
     def take(self, var, msg):
         """Record contract variable ``var`` from ``msg`` (its field in contract.FIELDS; none known: kept

@@ -51,6 +51,8 @@ class TempSensorNode(Node):
                                                      callback_group=self.group_topics)
         # out.celsius
         self.pub_temperature = self.create_publisher(Float64, 'temperature', QOS_DEPTH)
+        #: each end's name -> the attribute holding it
+        self.ends = {'probe': 'sub_probe', 'temperature': 'pub_temperature'}
         logic.setup(self)
         self.get_logger().info(f'contract layer ready; verdicts on {self.verdict_pub.topic_name}')
 
@@ -75,6 +77,11 @@ class TempSensorNode(Node):
             self.get_logger().warning(f'{client.srv_name}: no response within {timeout_sec} s')
             return None
         return future.result()
+
+    def carries(self, var, end):
+        """Whether contract variable ``var`` travels on the end named ``end`` (a topic, service or
+        action name): which outputs of a step go into a service's response."""
+        return contract.FIELDS.get(var, ('', ''))[0] == self.ends.get(end)
 
     def take(self, var, msg):
         """Record contract variable ``var`` from ``msg`` (its field in contract.FIELDS; none known: kept
