@@ -252,11 +252,15 @@ class Assembly:
             return
         eps = [e for e, _o in got.endpoints]
         name = ln.name or (got.nodes[0][0] if got.nodes else (plugin.split("::")[-1] if plugin else ln.exe))
+        # the code's namespace (Node(name, namespace=...), rclcpp::Node(name, ns)) holds unless the launch
+        # file gives one: launch_ros then remaps __ns, which replaces it (ROS 2 design "Topic and Service Names")
+        code_ns = got.nodes[0][2] if got.nodes else None
+        base = ln.ns if ln.ns != "/" or not code_ns else names.join("/", code_ns)
         if name.startswith("/"):
             full = names.normalise(name)
             ns = names.split(full)[0]
         else:
-            full, ns = names.join(ln.ns, name), ln.ns
+            full, ns = names.join(base, name), base
         files = _files(prog, got, eps, None) if prog is not None else []
         add_node(full, ns, ln.pkg, ln.exe or None, files, ln.src, eps, ln.remaps, "launch", ln.params,
                  lifecycle="lifecycle" in got.kinds)

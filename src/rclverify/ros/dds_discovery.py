@@ -110,6 +110,32 @@ class Discovery:
                                  for g in n.readers + n.writers}
         return changed
 
+    def pending(self) -> list[str]:
+        """What discovery has not yet told of the ROS 2 participants it knows,
+        one sentence each (empty when the graph is settled).  A ROS 2 participant
+        is one with a writer on ``ros_discovery_info`` (rmw_dds_common's graph
+        cache: every ROS 2 context has one, a plain DDS participant none); it is
+        settled when its node list has arrived, every endpoint of it is in one of
+        its nodes, and every endpoint its nodes list has been discovered.  Fast
+        DDS sends a newly matched reader the transient-local node list at its
+        next heartbeat, seconds later, so a reader polls until this is empty
+        (:func:`.diff_dds.read_dds_graph`)."""
+        ros = {w.participant for w in self.writers.values() if w.topic == DISCOVERY_TOPIC}
+        out = [f"participant {uuid.UUID(bytes=p)}: its node list (ros_discovery_info) has not arrived"
+               for p in sorted(ros - set(self.nodes))]
+        for table in (self.writers, self.readers):
+            for e in sorted(table.values(), key=lambda e: e.guid):
+                if e.participant in ros and e.participant in self.nodes and e.topic != DISCOVERY_TOPIC \
+                        and self.node_of(e.guid) is None:
+                    out.append(f"endpoint {e.label} on {e.topic}: no node of its participant lists it yet")
+        known = set(self.writers) | set(self.readers)
+        for p, nodes in sorted(self.nodes.items()):
+            for n in nodes:
+                lost = [g for g in n.readers + n.writers if g not in known]
+                if lost:
+                    out.append(f"node {n.full_name}: {len(lost)} of its endpoints not yet discovered")
+        return out
+
     def node_of(self, endpoint: bytes) -> str | None:
         """The ROS node (``/ns/name``) an endpoint GUID belongs to, or ``None``."""
         return self._by_endpoint.get(endpoint)

@@ -117,21 +117,42 @@ def qos_conflicts(disc: Discovery) -> list[tuple[str, EndpointInfo, EndpointInfo
     return out
 
 
-def read_dds_graph(wait_s: float = 2.0, domain: int | None = None) -> tuple[Graph, Discovery, str, Any]:
-    """Listen to the domain for ``wait_s`` seconds; returns the graph, the
-    discovery (for :func:`qos_conflicts`), the source label (``DDS domain
-    N``) and the participant (delete it when done).  Raises
-    :class:`~.dds.DdsUnavailable`."""
+#: seconds past ``--wait`` that :func:`read_dds_graph` keeps listening while a ROS 2 participant's node
+#: list or endpoints are still on their way (two of Fast DDS's 3-second heartbeat periods)
+SETTLE_S = 6.0
+#: seconds without news from discovery after which a settled graph is taken as complete
+QUIET_S = 0.5
+
+
+def read_dds_graph(wait_s: float = 2.0, domain: int | None = None,
+                   settle_s: float = SETTLE_S) -> tuple[Graph, Discovery, str, Any]:
+    """Listen to the domain for ``wait_s`` seconds, then on, up to ``settle_s``
+    seconds more, while discovery brought news in the last :data:`QUIET_S`
+    seconds or :meth:`.Discovery.pending` names a ROS 2 participant
+    whose node list or endpoints have not arrived (what is still pending then
+    is a ``ROS-DDS`` note of the graph: its nodes may be reported not running).
+    Returns the graph, the discovery (for :func:`qos_conflicts`), the source
+    label (``DDS domain N``) and the participant (delete it when done).
+    Raises :class:`~.dds.DdsUnavailable`."""
     d = domain_id() if domain is None else domain
     dp = make_participant(d)
     disc = Discovery(dp)
-    end = time.monotonic() + wait_s
-    while time.monotonic() < end:
-        disc.poll()
+    start = last = time.monotonic()
+    while True:
+        now = time.monotonic()
+        if disc.poll():
+            last = now
+        spent = now - start
+        quiet = now - last >= QUIET_S
+        if spent >= wait_s and (spent >= wait_s + settle_s or quiet and not disc.pending()):
+            break
         time.sleep(0.05)
-    disc.poll()
     source = f"DDS domain {d}"
-    return graph_of(disc, source), disc, source, dp
+    g = graph_of(disc, source)
+    for p in disc.pending():
+        g.notes.append(Note(Src(source, 1, 1), f"after {time.monotonic() - start:.1f} s of listening, {p}: the "
+                                               f"graph may be incomplete (give --wait longer)", "ROS-DDS"))
+    return g, disc, source, dp
 
 
 def diff_dds(static: Graph, running: Graph, source: str,

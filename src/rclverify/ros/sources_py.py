@@ -291,7 +291,8 @@ def extract(mod: PyModule, shown: str) -> dict[str, Any]:
                     out["notes"].append(Note(v.src, "node name is not a string literal: not resolved statically"))
                 continue
             life = "lifecycle" if _node_class(mod, sc.class_at(c.src.line), lifecycle=sc.full) else None
-            out["node_names"].append((val, c.src, unit, sc.fn_key(c.src.line), None, life))
+            ns = c.kwargs.get("namespace")  # rclpy: keyword-only (Node, create_node); rospy has none
+            out["node_names"].append((val, c.src, unit, sc.fn_key(c.src.line), sc.value(ns) if ns else None, life))
             continue
         spec = _CTORS.get(f)
         if spec is None and "actionlib" in f and last in _CTORS:
