@@ -1,0 +1,309 @@
+"""``rclverify ros diff --ros2`` against REAL rclpy nodes on Fast DDS
+(issue 62; docs/ros.md, "Expected against observed").
+
+The code side is a small ament_python workspace written into the test's
+directory: ``talker`` (publishes ``chatter``, subscribes to ``cmd``),
+``camera`` (``rclpy.create_node('camera', namespace='sensors')``: its
+namespace is in the code), ``viewer`` (subscribes reliably to
+``/sensors/image``) and ``planner`` (``Node.__init__(..., namespace='nav')``),
+started by a Python launch file that puts ``talker`` and ``planner`` under
+``/robot`` (launch_ros' namespace replaces the code's) and remaps
+``talker``'s ``cmd`` to ``/teleop/cmd``.
+
+The running side is rclpy on rmw_fastrtps_cpp in the ROS 2 Python
+(tests/_ros2.py), on loopback and a random domain: ``talker`` and ``viewer``
+run the workspace's own code with the arguments launch_ros gives them
+(``--ros-args -r __node:=... -r __ns:=... -r from:=to``); one more process
+runs a ``/sensors/camera`` that publishes ``/sensors/image`` best-effort
+(the reliable ``viewer`` gets nothing from it) and a ``/intruder`` the code
+does not have; ``planner`` is not started.  The diff must report exactly:
+``/robot/planner`` missing (at its launch line), ``/intruder`` extra, the
+QoS conflict on ``/sensors/image``, and nothing about the nodes that run as
+the code says; exit 1.
+
+The static tests beside it check the namespaces the scan gives, without
+ROS 2: code namespaces in Python and C++, launch namespaces in Python and
+XML launch files.
+"""
+from __future__ import annotations
+
+import json
+import subprocess
+import textwrap
+from pathlib import Path
+from typing import Any, Iterator
+
+import pytest
+
+from _procs import stop, wait_for
+from _ros2 import rclverify, ros2_env, start_node
+
+PKG = {
+    "package.xml": """\
+        <?xml version="1.0"?>
+        <package format="3">
+          <name>demo_pkg</name>
+          <version>0.1.0</version>
+          <description>the code side of the real ROS 2 diff test</description>
+          <maintainer email="dev@example.org">dev</maintainer>
+          <license>MIT</license>
+          <exec_depend>rclpy</exec_depend>
+          <exec_depend>std_msgs</exec_depend>
+          <export><build_type>ament_python</build_type></export>
+        </package>
+        """,
+    "setup.py": """\
+        from setuptools import setup
+        setup(name='demo_pkg', version='0.1.0', packages=['demo_pkg'],
+              entry_points={'console_scripts': ['talker = demo_pkg.talker:main', 'camera = demo_pkg.camera:main',
+                                                'viewer = demo_pkg.viewer:main',
+                                                'planner = demo_pkg.planner:main']})
+        """,
+    "resource/demo_pkg": "",
+    "demo_pkg/__init__.py": "",
+    "demo_pkg/talker.py": """\
+        import rclpy
+        from rclpy.node import Node
+        from std_msgs.msg import String
+
+
+        class Talker(Node):
+            def __init__(self):
+                super().__init__('talker')
+                self.pub = self.create_publisher(String, 'chatter', 10)
+                self.create_subscription(String, 'cmd', lambda m: None, 10)
+
+
+        def main():
+            rclpy.init()
+            rclpy.spin(Talker())
+        """,
+    "demo_pkg/camera.py": """\
+        import rclpy
+        from std_msgs.msg import String
+
+
+        def main():
+            rclpy.init()
+            node = rclpy.create_node('camera', namespace='sensors')
+            node.create_publisher(String, 'image', 10)
+            rclpy.spin(node)
+        """,
+    "demo_pkg/viewer.py": """\
+        import rclpy
+        from rclpy.node import Node
+        from std_msgs.msg import String
+
+
+        class Viewer(Node):
+            def __init__(self):
+                super().__init__('viewer')
+                self.create_subscription(String, '/sensors/image', self.show, 10)
+
+            def show(self, msg):
+                self.get_logger().info(msg.data)
+
+
+        def main():
+            rclpy.init()
+            rclpy.spin(Viewer())
+        """,
+    "demo_pkg/planner.py": """\
+        import rclpy
+        from rclpy.node import Node
+        from std_msgs.msg import String
+
+
+        class Planner(Node):
+            def __init__(self):
+                super().__init__('planner', namespace='nav')
+                self.create_subscription(String, '/sensors/image', lambda m: None, 10)
+                self.create_publisher(String, 'plan', 10)
+
+
+        def main():
+            rclpy.init()
+            rclpy.spin(Planner())
+        """,
+    "launch/demo.launch.py": """\
+        from launch import LaunchDescription
+        from launch_ros.actions import Node
+
+
+        def generate_launch_description():
+            return LaunchDescription([
+                Node(package='demo_pkg', executable='talker', name='talker', namespace='robot',
+                     remappings=[('cmd', '/teleop/cmd')]),
+                Node(package='demo_pkg', executable='camera', name='camera'),
+                Node(package='demo_pkg', executable='viewer', name='viewer'),
+                Node(package='demo_pkg', executable='planner', name='planner', namespace='robot'),
+            ])
+        """,
+}
+PLANNER_LINE = 11  # its Node(...) in launch/demo.launch.py
+
+#: runs one of the workspace's nodes as launch_ros starts it: its entry point, with ``--ros-args``
+RUN = """\
+    import importlib, sys
+    sys.path.insert(0, {pkg!r})
+    sys.argv = ['{mod}', '--ros-args'] + {remaps!r}
+    import rclpy
+    spin = rclpy.spin
+    def announced(node, *a, **k):
+        print('ready', flush=True)
+        spin(node, *a, **k)
+    rclpy.spin = announced
+    importlib.import_module('demo_pkg.{mod}').main()
+    """
+
+#: what runs besides the code: a best-effort camera (the viewer requests reliable) and a node the code lacks
+OTHERS = """\
+    import rclpy
+    from rclpy.executors import SingleThreadedExecutor
+    from rclpy.qos import QoSProfile, ReliabilityPolicy
+    from std_msgs.msg import String
+    rclpy.init()
+    camera = rclpy.create_node('camera', namespace='/sensors')
+    camera.create_publisher(String, 'image', QoSProfile(depth=5, reliability=ReliabilityPolicy.BEST_EFFORT))
+    intruder = rclpy.create_node('intruder')
+    intruder.create_publisher(String, '/debug', 10)
+    ex = SingleThreadedExecutor()
+    ex.add_node(camera)
+    ex.add_node(intruder)
+    print('ready', flush=True)
+    ex.spin()
+    """
+
+
+def write_ws(root: Path) -> Path:
+    """The workspace of the code side under ``root``; returns the package directory."""
+    pkg = root / "src" / "demo_pkg"
+    for rel, text in PKG.items():
+        (pkg / rel).parent.mkdir(parents=True, exist_ok=True)
+        (pkg / rel).write_text(textwrap.dedent(text))
+    return pkg
+
+
+def _run(pkg: Path, mod: str, node: str, ns: str | None = None, remaps: tuple[str, ...] = ()) -> str:
+    args = ["-r", f"__node:={node}"] + (["-r", f"__ns:={ns}"] if ns else [])
+    for r in remaps:
+        args += ["-r", r]
+    return RUN.format(pkg=str(pkg), mod=mod, remaps=args)
+
+
+@pytest.fixture(scope="module")
+def diff(tmp_path_factory: pytest.TempPathFactory) -> Iterator[dict[str, Any]]:
+    tmp = tmp_path_factory.mktemp("ros2diff")
+    pkg = write_ws(tmp / "ws")
+    env = ros2_env(tmp)
+    procs: list[subprocess.Popen[bytes]] = []
+    try:
+        for name, src in (("talker", _run(pkg, "talker", "talker", "/robot", ("cmd:=/teleop/cmd",))),
+                          ("viewer", _run(pkg, "viewer", "viewer")), ("others", OTHERS)):
+            procs.append(start_node(tmp, name, src, env, ready=None))  # started together, waited for below
+        for name in ("talker", "viewer", "others"):
+            wait_for(tmp / f"{name}.log", "ready", 30)
+        out, log = tmp / "diff.json", tmp / "diff.log"
+        p = rclverify(["ros", "diff", "src", "--launch", "src/demo_pkg/launch/demo.launch.py", "--ros2",
+                       "--wait", "2", "--json", str(out)], env, tmp / "ws", log)
+        procs.append(p)
+        code = p.wait(60)
+        yield {"code": code, "json": json.loads(out.read_text()), "log": log.read_text(), "domain": env["ROS_DOMAIN_ID"]}
+    finally:
+        for p in procs:
+            stop(p)
+
+
+def _items(d: dict[str, Any], side: str, category: str | None = None) -> list[dict[str, Any]]:
+    return [i for i in d["json"][side] if category is None or i["category"] == category]
+
+
+def test_the_node_not_started_is_missing_at_its_launch_line(diff: dict[str, Any]) -> None:
+    missing = _items(diff, "missing", "node")
+    assert [i["name"] for i in missing] == ["/robot/planner"], diff["log"]
+    assert missing[0]["at"]["file"].endswith("demo.launch.py") and missing[0]["at"]["line"] == PLANNER_LINE
+    assert diff["code"] == 1 and diff["json"]["observed"] == {"kind": "dds", "source": f"DDS domain {diff['domain']}"}
+
+
+def test_the_node_the_code_lacks_is_the_one_extra(diff: dict[str, Any]) -> None:
+    extra = _items(diff, "extra")
+    assert [(i["category"], i["name"]) for i in extra] == [("node", "/intruder")], diff["log"]
+    assert "publishes /debug" in extra[0]["message"]
+
+
+def test_the_qos_conflict_names_both_nodes(diff: dict[str, Any]) -> None:
+    qos = _items(diff, "missing", "qos")
+    assert len(qos) == 1 and qos[0]["name"] == "/sensors/image", diff["log"]
+    assert "node /viewer subscribes with reliable" in qos[0]["message"]
+    assert "node /sensors/camera publishes with best_effort" in qos[0]["message"]
+    assert len(diff["json"]["missing"]) == 2  # the planner and the conflict: nothing else
+
+
+def test_namespaced_nodes_are_found_with_their_namespace(diff: dict[str, Any]) -> None:
+    # /robot/talker (the launch file's namespace, cmd remapped to /teleop/cmd) and /sensors/camera (the
+    # code's namespace) run as the code has them: no item names them, and every endpoint found its node
+    everything = diff["json"]["missing"] + diff["json"]["extra"]
+    assert not [i for i in everything if i["node"] in ("/robot/talker", "/sensors/camera", "/viewer")]
+    assert not [i for i in everything if i["category"] == "node" and i["name"] != "/robot/planner"
+                and i["name"] != "/intruder"]
+    assert "in no ROS 2 node" not in diff["log"] and "may be incomplete" not in diff["log"], diff["log"]
+
+
+# -- the namespaces of the static scan (no ROS 2 needed) ---------------------------------------
+
+def _scan(ws: Path, *launch: str) -> dict[str, Any]:
+    from rclverify.ros.graph import scan
+    g = scan([ws / "src"], [ws / x for x in launch])
+    return {n.name: sorted(e.topic for e in n.publishes + n.subscribes) for n in g.graph.nodes.values()}
+
+
+def test_the_code_namespace_without_a_launch_file(tmp_path: Path) -> None:
+    write_ws(tmp_path)
+    assert _scan(tmp_path) == {"/talker": ["/chatter", "/cmd"], "/sensors/camera": ["/sensors/image"],
+                               "/viewer": ["/sensors/image"], "/nav/planner": ["/nav/plan", "/sensors/image"]}
+
+
+def test_the_launch_namespace_replaces_the_code_one(tmp_path: Path) -> None:
+    write_ws(tmp_path)
+    assert _scan(tmp_path, "src/demo_pkg/launch/demo.launch.py") == {
+        "/robot/talker": ["/robot/chatter", "/teleop/cmd"], "/sensors/camera": ["/sensors/image"],
+        "/viewer": ["/sensors/image"], "/robot/planner": ["/robot/plan", "/sensors/image"]}
+
+
+def test_xml_launch_and_rclcpp_namespaces(tmp_path: Path) -> None:
+    pkg = tmp_path / "src" / "cpp_pkg"
+    (pkg / "src").mkdir(parents=True)
+    (pkg / "launch").mkdir()
+    (pkg / "package.xml").write_text(
+        '<?xml version="1.0"?>\n<package format="3"><name>cpp_pkg</name><version>0.1.0</version>'
+        '<description>d</description><maintainer email="dev@example.org">dev</maintainer><license>MIT</license>'
+        '<depend>rclcpp</depend><depend>std_msgs</depend><export><build_type>ament_cmake</build_type></export>'
+        '</package>\n')
+    (pkg / "CMakeLists.txt").write_text("cmake_minimum_required(VERSION 3.8)\nproject(cpp_pkg)\n"
+                                        "add_executable(odom src/odom.cpp)\nadd_executable(lidar src/lidar.cpp)\n")
+    (pkg / "src" / "odom.cpp").write_text(textwrap.dedent("""\
+        #include <rclcpp/rclcpp.hpp>
+        #include <std_msgs/msg/string.hpp>
+        class Odom : public rclcpp::Node {
+        public:
+          Odom() : Node("odom", "base") { pub_ = create_publisher<std_msgs::msg::String>("odometry", 10); }
+          rclcpp::Publisher<std_msgs::msg::String>::SharedPtr pub_;
+        };
+        int main(int argc, char ** argv) { rclcpp::init(argc, argv); rclcpp::spin(std::make_shared<Odom>()); }
+        """))
+    (pkg / "src" / "lidar.cpp").write_text(textwrap.dedent("""\
+        #include <rclcpp/rclcpp.hpp>
+        #include <std_msgs/msg/string.hpp>
+        int main(int argc, char ** argv) {
+          rclcpp::init(argc, argv);
+          auto node = rclcpp::Node::make_shared("lidar", "sensors");
+          auto pub = node->create_publisher<std_msgs::msg::String>("scan", 10);
+          rclcpp::spin(node);
+        }
+        """))
+    (pkg / "launch" / "sys.launch.xml").write_text(
+        '<launch>\n  <node pkg="cpp_pkg" exec="odom" name="odom"/>\n'
+        '  <node pkg="cpp_pkg" exec="lidar" name="lidar" namespace="front"/>\n</launch>\n')
+    assert _scan(tmp_path) == {"/base/odom": ["/base/odometry"], "/sensors/lidar": ["/sensors/scan"]}
+    assert _scan(tmp_path, "src/cpp_pkg/launch/sys.launch.xml") == {"/base/odom": ["/base/odometry"],
+                                                                     "/front/lidar": ["/front/scan"]}
