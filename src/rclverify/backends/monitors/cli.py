@@ -26,6 +26,7 @@ from .check import check_trace
 from .deadlines import DeadlineMonitor, deadline_status, has_deadlines
 from .config import ConfigError, load_mapping
 from .judged import Heard, not_judged, strict_line
+from .periods import PeriodMonitor, has_periods, period_status
 
 
 
@@ -67,6 +68,7 @@ def monitor_command(args: argparse.Namespace, checked: Checked) -> int:
         path = Path(trace)
         # one pass over the run feeds both checks (a log named here may be a stream, read once)
         dmons = [DeadlineMonitor(checked, n, cfg.rules, horizon=cfg.horizon, tolerance=cfg.tolerance) for n in timed]
+        pmons = [PeriodMonitor(n) for n in nodes if has_periods(n)]
         heard: dict[str, int] = {}
 
         def tap(events: Iterable[Any]) -> Iterator[Any]:
@@ -75,12 +77,15 @@ def monitor_command(args: argparse.Namespace, checked: Checked) -> int:
                 heard[key] = heard.get(key, 0) + 1
                 for m in dmons:
                     m.feed(ev)
+                for p in pmons:
+                    p.feed(ev)
                 yield ev
         try:
             run = read_trace(path, [root / d for d in cfg.msg_dirs], streams=True,
                              on_warning=lambda w: print(w, file=sys.stderr))
             events, results = check_trace(checked, nodes, tap(run), cfg.rules, cfg.horizon, tolerance=cfg.tolerance)
             dres = [m.finish() for m in dmons]
+            pres = [p.finish() for p in pmons]
         except TraceError as exc:
             _emit(report, args.json)
             print(str(exc), file=sys.stderr)
@@ -115,6 +120,13 @@ def monitor_command(args: argparse.Namespace, checked: Checked) -> int:
                       + ("; no verdict: " + ", ".join(f"{n} {v}" for v, n in d.unaccepted.items() if n)
                          if any(d.unaccepted.values()) else ""))
                 print(f"  {status}: {explanation}")
+        for pr in pres:
+            status, explanation = period_status(pr, trace)
+            violated = violated or status == "failed"
+            report.append({"node": pr.node, "status": status, "explanation": explanation, "trace": trace,
+                           "periods": pr.to_json()})
+            if not args.json:
+                print(f"{trace}: {pr.node} periods: {status}: {explanation}")
         if not args.json:
             _print_not_judged(items, f"{trace}: ")
     _emit(report, args.json)
@@ -223,13 +235,15 @@ def live_command(args: argparse.Namespace, checked: Any, cfg: Any, root: Path) -
               f"deadline")
     for d in record_.get("topic_deadlines", []):
         print(f"deadlines: {d['node']}: {d['status']}: {d['explanation']}")
+    for d in record_.get("periods", []):
+        print(f"periods: {d['node']}: {d['status']}: {d['explanation']}")
     for topic, c in record_.get("enforce", {}).items():
         print(f"enforce /{topic}: {c['released']} released, {c['blocked']} blocked (read from {c['private']})")
     if "bag" in record_:
         print(f"recorded {record_['bag']['messages']} message(s) to {record_['bag']['path']}")
     _print_not_judged(record_.get("not_judged", []), "")
     late = bool(record_.get("deadlines", {}).get("false"))
-    late = late or any(d["status"] == "failed" for d in record_.get("topic_deadlines", []))
+    late = late or any(d["status"] == "failed" for d in record_.get("topic_deadlines", []) + record_.get("periods", []))
     calls_failed = any(n["status"] == "failed" for n in record_.get("calls", {}).get("nodes", []))
     if late or calls_failed or any(n["status"] == "failed" for n in record_["nodes"]):
         return 1

@@ -14,16 +14,15 @@ ROS 2 layer (:mod:`.ros2`) only move messages in and verdicts out.  It
   it changed;
 * keeps a one-line status per node (:meth:`status_line`);
 * runs each node's timed guarantees (``triggered by ... within ...``)
-  through the offline check's :class:`~.deadlines.DeadlineMonitor`, fed the
-  very events it writes to the log and its clock moved by the timer; each
-  deadline verdict is a log line (topic :data:`VERDICT_LOG_TOPIC`, ``kind:
-  "deadline"``, ``time`` the monitor's clock when it was decided, so the
-  offline check of the log moves its clock there too and gives the same
-  verdicts) and is published (``{"kind": "deadline", ...}``);
+  and periodic outputs through the offline check's monitors, fed the very
+  lines it writes to the log (:mod:`.logchecks`); each deadline verdict is
+  a log line (topic :data:`VERDICT_LOG_TOPIC`, ``kind: "deadline"``,
+  ``time`` the clock that decided it) and is published (``{"kind":
+  "deadline", ...}``);
 * counts what it heard of every item of the contracts (:mod:`.judged`);
 * on :meth:`stop` writes a monitoring evidence record shaped like the
   offline one (events, verdict counts, first violation, the log's sha256,
-  the deadlines as ``topic_deadlines``).
+  the deadlines as ``topic_deadlines``, the periods as ``periods``).
 
 docs/monitors.md ("Live monitoring") gives the decisions.
 """
@@ -44,8 +43,9 @@ from ...traces.events import Event
 from ...traces.mapping import TopicRule
 from .summary import monitoring_details, summary_line, tool_versions, verdict_status
 from .check import NodeResult, Verdict
-from .deadlines import DeadlineMonitor, DeadlineResult, DeadlineVerdict, deadline_status, has_deadlines
+from .deadlines import DeadlineVerdict
 from .judged import Heard, not_judged
+from .logchecks import LogChecks
 from .online import OnlineEngine
 from .worker import EngineWorker
 
@@ -96,10 +96,8 @@ class LiveRun:
         self.nodes = nodes
         self.engine = OnlineEngine(checked, nodes, rules, horizon, reorder_window, silence_s,
                                    on_verdict=self._verdict, on_silence=self._silence, on_event=self._event)
-        #: the offline check's deadline monitors, fed the logged events (horizon: a trigger without `within`)
-        self.deadlines = [DeadlineMonitor(checked, n, rules, self._deadline, horizon=horizon)
-                          for n in nodes if has_deadlines(n)]
-        self.deadline_results: list[DeadlineResult] = []
+        #: the offline check's deadline and period monitors, fed the log's lines (logchecks.py)
+        self.checks = LogChecks(checked, nodes, rules, horizon, self._deadline)
         #: link part ("estop/request") -> its call events heard (paired), and answers heard without their call
         self.calls_heard: dict[str, int] = {}
         self.orphans: dict[str, int] = {}
@@ -110,14 +108,12 @@ class LiveRun:
     def _event(self, ev: Event) -> None:
         self._log.write(dumps({"topic": ev.topic, "time": ev.time, **{k: v for k, v in ev.fields.items()
                                                                        if k not in ("topic", "time")}}) + "\n")
-        for d in self.deadlines:  # after its log line: a verdict it decides comes after it, as offline
-            d.feed(ev)
+        self.checks.event(ev)  # after its log line: a verdict it decides comes after it, as offline
 
-    def _deadline(self, v: DeadlineVerdict) -> None:
-        now = max((d.now for d in self.deadlines if d.node.name == v.node), default=v.trigger_stamp)
-        t = now if now > float("-inf") else v.trigger_stamp
-        self._log.write(dumps({"topic": VERDICT_LOG_TOPIC, "time": t, "kind": "deadline", "verdict": v.to_json()})
-                        + "\n")
+    def _deadline(self, v: DeadlineVerdict, t: float) -> None:
+        line = {"topic": VERDICT_LOG_TOPIC, "time": t, "kind": "deadline", "verdict": v.to_json()}
+        self._log.write(dumps(line) + "\n")
+        self.checks.line(line, deadline=True)
         if self.publish is not None:
             self.publish(dumps({"kind": "deadline", **v.to_json()}))
 
@@ -125,6 +121,8 @@ class LiveRun:
         self.verdicts += 1
         text = dumps(v.to_json())  # serialised once: the log line and the published message
         self._log.write(f'{{"topic": "{VERDICT_LOG_TOPIC}", "time": {v.decided_at!r}, "verdict": {text}}}\n')
+        if self.checks.active:
+            self.checks.line({"topic": VERDICT_LOG_TOPIC, "time": v.decided_at})
         if self.publish is not None:
             self.publish(text)
         self._last[v.node] = text
@@ -150,8 +148,7 @@ class LiveRun:
         with self.lock:
             if self.results is None:
                 self.engine.tick(now)
-                for d in self.deadlines:  # the monitors' clock: the timer less the reorder window
-                    d.advance(now - self.engine.reorder_window)
+                self.checks.advance(now - self.engine.reorder_window)  # the monitors' clock, as the engine's
                 self._flush_last()
                 self._log.flush()
 
@@ -161,6 +158,7 @@ class LiveRun:
         with self.lock:
             if self.results is None:
                 self._log.write(dumps(dict(obj)) + "\n")
+                self.checks.line(obj)
                 self._heard_call(obj)
 
     def _heard_call(self, obj: Mapping[str, Any]) -> None:
@@ -187,8 +185,7 @@ class LiveRun:
         """``Node: 3 satisfied, 1 violated | Node2: ...`` (a live per-node status)."""
         with self.lock:
             parts = [summary_line(m.result) for m in self.engine.monitors]
-            parts += [f"{d.node.name} deadlines: " + ", ".join(f"{n} {v}" for v, n in d.result.counts.items() if n)
-                      for d in self.deadlines if any(d.result.counts.values())]
+            parts += self.checks.status()
         silent = [t for t, s in self.engine.topics.items() if s.silent]
         return " | ".join(parts) + (f" | silent: {', '.join(sorted(silent))}" if silent else "")
 
@@ -200,7 +197,7 @@ class LiveRun:
         with self.lock:
             if self.results is None:
                 self.results = self.engine.finish()
-                self.deadline_results = [d.finish() for d in self.deadlines]  # currently_false: logged
+                self.checks.finish()  # currently_false deadlines: logged
                 self._flush_last()
                 self._log.close()
         sha = hashlib.sha256(self.log_path.read_bytes()).hexdigest()
@@ -218,17 +215,10 @@ class LiveRun:
                   "events": self.engine.released, "late_events": self.engine.late,
                   "max_late_s": round(self.engine.max_late_s, 6),
                   "reorder_window_s": self.engine.reorder_window, "verdicts": self.verdicts,
-                  "silent_topics": self.silences, "nodes": nodes,
-                  "topic_deadlines": [self._deadline_entry(d) for d in self.deadline_results]}
+                  "silent_topics": self.silences, "nodes": nodes, **self.checks.record(self.log_path.name)}
         if evidence is not None:
             atomic_write_text(evidence, json.dumps(record, indent=2, sort_keys=True) + "\n")
         return record
-
-
-    def _deadline_entry(self, res: DeadlineResult) -> dict[str, Any]:
-        """One node's deadline verdicts as the offline command reports them."""
-        status, explanation = deadline_status(res, self.log_path.name)
-        return {"node": res.node, "status": status, "explanation": explanation, "deadlines": res.to_json()}
 
     def not_judged(self, record: Mapping[str, Any]) -> list[dict[str, str]]:
         """The items of the monitored contracts this run did not judge

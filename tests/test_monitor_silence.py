@@ -1,0 +1,133 @@
+"""Silence is never green, and live = offline (issue 62), below the middleware.
+
+* the live run (:class:`LiveRun`) judges deadlines and periods as the
+  offline command judges its log: the same counts, the same statuses, even
+  for a trigger whose deadline only the live timer saw pass (the verdict's
+  log line carries that clock to the offline check);
+* :func:`judged.not_judged` names each item not judged with its reason;
+* ``doit verify``'s monitors evidence of a recorded run that holds no event
+  of its node is never ``discharged`` (pinned).
+
+The real-ROS 2 side is tests/test_ros2_silence_deadlines.py.
+"""
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from rclverify.backends.monitors.config import load_mapping
+from rclverify.backends.monitors.judged import Heard, not_judged
+from rclverify.backends.monitors.live import LiveRun
+from rclverify.cli import main
+from rclverify.rcl.parser import parse_text
+from rclverify.rcl.typecheck import check
+
+RCL = """\
+node Echo {
+  inputs( r : REAL )
+  outputs( y : REAL, beat : BOOL )
+  topics( std_msgs/Float64 r matches(in.r), std_msgs/Float64 out matches(out.y),
+          std_msgs/Bool beat matches(out.beat) )
+  assume( in.r >= 0 )
+  guarantee( out.y == in.r ) triggered by in.r within 100 ms
+  periodic( out.beat, 100 ms )
+}
+
+node Server {
+  inputs( req : BOOL )
+  outputs( ok : BOOL )
+  services( std_srvs/SetBool estop serves(in.req, out.ok) )
+  actions( rclverify_examples/Move move serves(in.req, out.ok, out.ok) )
+  assume( TRUE )
+  guarantee( in.req -> out.ok ) triggered by in.req within 1 s
+}
+"""
+
+
+def _ws(tmp: Path) -> Path:
+    ws = tmp / "ws"
+    (ws / "contracts").mkdir(parents=True)
+    (ws / "contracts/sys.rcl").write_text(RCL)
+    (ws / "contracts/plan.yaml").write_text("contracts: [contracts/sys.rcl]\n")
+    return ws
+
+
+def _checked() -> Any:
+    return check([parse_text(RCL, "sys.rcl")])
+
+
+def test_live_deadlines_and_periods_are_the_offline_checks_of_its_log(tmp_path: Path,
+                                                                       capsys: pytest.CaptureFixture[str]) -> None:
+    ws, checked = _ws(tmp_path), _checked()
+    cfg = load_mapping(ws, None, 1.0)
+    log = tmp_path / "live.jsonl"
+    published: list[str] = []
+    live = LiveRun(checked, [checked.nodes["Echo"]], cfg.rules, cfg.horizon, log, reorder_window=0.0,
+                   publish=published.append)
+    # (time, topic, value): answered in 20 ms; unanswered until 250 ms late; never answered; a beat gap of 250 ms
+    script = [(1.0, "r", 1.0), (1.0, "beat", True), (1.02, "out", 1.0), (1.1, "beat", True), (1.2, "beat", True),
+              (1.45, "beat", True), (1.5, "r", 2.0), (1.75, "out", 2.0), (1.8, "r", 3.0)]
+    for t, topic, v in script:
+        live.tick(t)
+        live.push(topic, {"data": v}, t)
+    live.tick(1.95)  # r = 3.0 is past its deadline: only the timer says so
+    assert "Echo deadlines: 1 true, 2 false" in live.status_line()
+    record = live.stop()
+    (dl,), (per,) = record["topic_deadlines"], record["periods"]
+    assert dl["deadlines"]["counts"] == {"true": 1, "false": 2, "currently_false": 0} and dl["status"] == "failed"
+    assert per["status"] == "failed" and "a gap of 250 ms" in per["explanation"]
+    assert sum(1 for m in map(json.loads, published) if m.get("kind") == "deadline") == 4  # and the late answer
+    capsys.readouterr()
+    rc = main(["monitor", "-w", str(ws), "--horizon", "1.0", "--node", "Echo", "--json", str(log)])
+    report = json.loads(capsys.readouterr().out)
+    off_dl = next(e for e in report if "deadlines" in e)
+    off_per = next(e for e in report if "periods" in e)
+    assert rc == 1
+    assert off_dl["deadlines"]["counts"] == dl["deadlines"]["counts"] and off_dl["status"] == dl["status"]
+    stamps = lambda late: {k: (g["from"], g["to"], g["gap"]) for k, g in late.items()}  # noqa: E731 (where: its own)
+    assert stamps(off_per["periods"]["late"]) == stamps(per["periods"]["late"]) and off_per["status"] == per["status"]
+    assert next(e for e in report if "counts" in e)["counts"] == record["nodes"][0]["counts"]
+
+
+def test_each_item_not_judged_has_its_reason() -> None:
+    checked = _checked()
+    nodes = list(checked.nodes.values())
+    heard = Heard({"r": 3, "out": 0, "estop/request": 2, "move/result": 0}, {"move/result": 1},
+                  {"out": 4}, ["sys.rcl:4:11: warning: beat: /imposter publishes std_msgs::msg::dds_::Float64_, "
+                               "the contract's type is std_msgs::msg::dds_::Bool_; its messages are not heard"])
+    statuses = {"Echo": [("pending", "nothing was checked")], "Server": [("pending", "x"), ("discharged", "y")]}
+    items = not_judged(nodes, heard, statuses, {"Echo": {"true": 0, "false": 0, "currently_false": 2}}, "in run")
+    got = {(i["kind"], i["name"]): (i["reason"], i["detail"]) for i in items}
+    assert got[("node", "Echo")][0] == "no verdict" and ("node", "Server") not in got  # the calls judged Server
+    assert got[("topic", "/out")] == ("not decoded", "4 message(s) on /out did not decode as std_msgs/Float64 in run")
+    assert got[("topic", "/beat")][0] == "type refused" and "/imposter publishes" in got[("topic", "/beat")][1]
+    assert got[("service", "/estop")] == ("no answer", "2 call(s) of /estop were heard, none answered in run")
+    assert got[("action", "/move")][0] == "not paired" and "1 answer(s) of /move" in got[("action", "/move")][1]
+    assert got[("deadline", "Echo guarantee(s) 1")] == ("no verdict", "2 trigger event(s) were still within their "
+                                                                      "deadline in run")
+    assert got[("deadline", "Server guarantee(s) 1")][0] == "no verdict"  # a request came, no accepted trigger
+    assert ("topic", "/r") not in got
+    silent = not_judged(nodes, Heard(), {}, {}, "in run")
+    assert {(i["kind"], i["reason"]) for i in silent} == {("topic", "nothing heard"), ("service", "nothing heard"),
+                                                         ("action", "nothing heard"), ("deadline", "nothing heard")}
+
+
+def test_a_recorded_run_without_the_nodes_events_is_never_discharged(tmp_path: Path) -> None:
+    """``doit verify``: the monitors evidence of a run that holds no event of
+    its node is pending (nothing was checked), in the record and the report."""
+    ws = _ws(tmp_path)
+    (ws / "traces").mkdir()
+    (ws / "traces/other.jsonl").write_text("".join(json.dumps({"topic": "unrelated", "time": 0.1 * k, "data": 1.0})
+                                                   + "\n" for k in range(5)))
+    (ws / "contracts/plan.yaml").write_text("contracts: [contracts/sys.rcl]\nnodes:\n  Echo:\n    evidence:\n"
+                                            "      - backend: monitors\n        traces: [traces/other.jsonl]\n")
+    assert main(["verify", "-w", str(ws)]) == 0
+    ev = json.loads((ws / "artifacts/evidence/Echo.g0.monitors.other_jsonl.json").read_text())
+    assert ev["status"] == "pending" and "nothing was checked" in ev["explanation"], ev["explanation"]
+    report = json.loads((ws / "reports/assurance.json").read_text())
+    statuses = {e["status"] for e in report["evidence"] if e["obligation"].startswith("Echo.g0.monitors")}
+    assert statuses == {"pending"}
+    assert main(["verify", "-w", str(ws), "--strict"]) == 1
