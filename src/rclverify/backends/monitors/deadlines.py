@@ -27,8 +27,9 @@ untimed monitor judges them (:func:`rclverify.logic.floatsem.judge`: exact,
 the node's double arithmetic, a declared tolerance).
 
 A ``triggered by`` without ``within`` is checked the same way with the
-monitor's ``horizon`` as its bound (offline; the live proxy has none, so
-it checks only guarantees with a deadline).
+monitor's ``horizon`` as its bound (offline, and live on the monitored
+topics, :mod:`.logchecks`; the per-call monitors of ROS 1's proxy and of
+DDS calls have none, so they check only guarantees with a deadline).
 
 **Clock.**  An event's time is its message's ``header.stamp`` when it has one
 (:func:`~.online.header_stamp`), else the time the trace gives it (the
