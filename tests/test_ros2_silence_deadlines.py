@@ -195,6 +195,8 @@ def test_a_run_that_heard_nothing_is_never_green(run: dict[str, Any]) -> None:
         rec = run["record"][name]
         (ghost,) = rec["nodes"]
         assert ghost["status"] == "pending" and rec["topic_deadlines"][0]["status"] == "pending", rec
+        assert "(not judged: nothing heard: no message on /ghost_in, /ghost_out during the live run)" in \
+            ghost["explanation"], ghost["explanation"]
         items = {(i["kind"], i["name"]): i["reason"] for i in rec["not_judged"]}
         assert items == {("node", "Ghost"): "nothing heard", ("topic", "/ghost_in"): "nothing heard",
                          ("topic", "/ghost_out"): "nothing heard",
@@ -222,6 +224,7 @@ def test_offline_a_trace_without_a_nodes_event_fails_strict(run: dict[str, Any],
     rc, report, err = _offline(run, capsys, "--node", "Ghost", "--strict")
     (ghost, _deadlines) = report
     assert rc == 1 and ghost["status"] == "pending" and "--strict: 4 item(s) were not judged" in err
+    assert "(not judged: nothing heard: no message on /ghost_in, /ghost_out in " in ghost["explanation"]
     assert {i["reason"] for i in ghost["not_judged"]} == {"nothing heard"} and len(ghost["not_judged"]) == 4
     rc, report, _ = _offline(run, capsys, "--node", "Ghost")
     assert rc == 0 and report[0]["status"] == "pending"

@@ -25,7 +25,7 @@ from .summary import monitoring_details, summary_line, tool_versions, verdict_st
 from .check import check_trace
 from .deadlines import DeadlineMonitor, deadline_status, has_deadlines
 from .config import ConfigError, load_mapping
-from .judged import Heard, not_judged, strict_line
+from .judged import Heard, explain, not_judged, strict_line
 from .periods import PeriodMonitor, has_periods, period_status
 
 
@@ -105,10 +105,11 @@ def monitor_command(args: argparse.Namespace, checked: Checked) -> int:
             entry.pop("sha256")
             entry["evaluation"] = dict(res.evaluation)  # debug: which formulas ran as compiled code
             entry["not_judged"] = [i for i in items if i["node"] == res.node]
+            explain(entry, items)
             report.append(entry)
             if not args.json:
                 print(f"{trace}: {summary_line(res)}")
-                print(f"  {status}: {explanation}")
+                print(f"  {status}: {entry['explanation']}")
         for d in dres:
             status, explanation = deadline_status(d, trace)
             violated = violated or status == "failed"

@@ -78,9 +78,12 @@ def not_judged(nodes: Iterable[CheckedNode], heard: Heard, statuses: Mapping[str
     for n in nodes:
         pairs = list(statuses.get(n.name, ()))
         if pairs and all(s == "pending" for s, _ in pairs):
-            silent = [t for t in _keys(n) if not heard.messages.get(t)]
-            reason = "nothing heard" if len(silent) == len(_keys(n)) else "no verdict"
-            out.append(_item("node", n.name, n.name, reason, pairs[0][1]))
+            keys = _keys(n)
+            if all(not heard.messages.get(t) for t in keys):
+                out.append(_item("node", n.name, n.name, "nothing heard",
+                                 f"no message on {', '.join('/' + t for t in keys) or 'its topics (none)'} {where}"))
+            else:
+                out.append(_item("node", n.name, n.name, "no verdict", pairs[0][1]))
     seen: set[str] = set()
     for n in nodes:
         for t in n.node.topics:
@@ -168,6 +171,15 @@ def _silent_link(key: str, kind: str, heard: Heard, where: str) -> tuple[str, st
     return "nothing heard", f"no {what[:-3]} of /{key} was heard {where}"
 
 
+def explain(entry: dict[str, Any], items: Iterable[Mapping[str, str]]) -> None:
+    """Add to a node's ``pending`` entry (``node``, ``status``,
+    ``explanation``) why it was not judged, from its ``node`` item of
+    ``items``: the status then says the reason itself."""
+    for i in items:
+        if i["kind"] == "node" and i["node"] == entry.get("node") and entry.get("status") == "pending":
+            entry["explanation"] = f"{entry['explanation']} (not judged: {i['reason']}: {i['detail']})"
+
+
 def strict_line(items: list[dict[str, str]]) -> str:
     """The one line ``--strict`` ends with when ``items`` is not empty."""
     first = items[0]
@@ -175,4 +187,4 @@ def strict_line(items: list[dict[str, str]]) -> str:
             f"{first['name']}: {first['reason']}: {first['detail']}")
 
 
-__all__ = ["Heard", "REASONS", "not_judged", "strict_line"]
+__all__ = ["Heard", "REASONS", "explain", "not_judged", "strict_line"]

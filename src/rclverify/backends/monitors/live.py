@@ -44,7 +44,7 @@ from ...traces.mapping import TopicRule
 from .summary import monitoring_details, summary_line, tool_versions, verdict_status
 from .check import NodeResult, Verdict
 from .deadlines import DeadlineVerdict
-from .judged import Heard, not_judged
+from .judged import Heard, explain, not_judged
 from .logchecks import LogChecks
 from .online import OnlineEngine
 from .worker import EngineWorker
@@ -224,7 +224,9 @@ class LiveRun:
         """The items of the monitored contracts this run did not judge
         (:func:`~.judged.not_judged`), from what it heard and the finished
         ``record`` (its ``nodes``, ``calls``, ``deadlines``,
-        ``topic_deadlines``, ``decode_errors``, ``warnings``, ``qos``)."""
+        ``topic_deadlines``, ``decode_errors``, ``warnings``, ``qos``); each
+        ``pending`` node of ``record["nodes"]`` gets the reason added to its
+        explanation."""
         heard = Heard({**{t: s.received for t, s in self.engine.topics.items()}, **self.calls_heard},
                       dict(self.orphans), dict(record.get("decode_errors") or {}), list(record.get("warnings") or ()),
                       {k: int(v.get("publishers_heard", 0)) for k, v in record["qos"].items()}
@@ -238,7 +240,10 @@ class LiveRun:
             total = counts.setdefault(r["node"], {})
             for v, k in r["counts"].items():
                 total[v] = total.get(v, 0) + k
-        return not_judged(self.nodes, heard, statuses, counts, "during the live run")
+        items = not_judged(self.nodes, heard, statuses, counts, "during the live run")
+        for entry in record["nodes"]:  # a pending node says why itself
+            explain(entry, items)
+        return items
 
 
 def _no_delay(pub: Any) -> None:
