@@ -103,7 +103,7 @@ COMPATIBILITY = ("<Compatibility><AllowInvalidTryConstruct>true</AllowInvalidTry
 _domains: dict[int, Any] = {}  # the domains this process configured (kept alive: a Domain entity ends with it)
 
 
-def _configure(d: int) -> None:
+def configure_domain(d: int) -> None:
     """Create domain ``d`` with the user's configuration (``CYCLONEDDS_URI``: files and XML fragments, comma
     separated, as Cyclone reads it) followed by :data:`COMPATIBILITY`; a domain this process already has
     (made here or by the caller) is left as it is."""
@@ -128,7 +128,7 @@ def make_participant(domain: int | None = None) -> Any:
     from cyclonedds.domain import DomainParticipant
     d = domain_id() if domain is None else domain
     try:
-        _configure(d)
+        configure_domain(d)
         return DomainParticipant(d)
     except DDSException as exc:
         uri = os.environ.get("CYCLONEDDS_URI", "")
@@ -400,7 +400,7 @@ def announced_type_hash(user_data: bytes) -> str | None:
 
 
 __all__ = ["ACTION_INFIX", "ACTION_SERVICES", "ACTION_TOPICS", "COMPATIBILITY", "DISCOVERY_TOPIC", "DISCOVERY_TYPE",
-           "DdsUnavailable", "MAX_DOMAIN_ID", "NodeInfo", "announced_type_hash", "decode_participant_info",
-           "discovery_struct", "domain_id", "dds_type", "encode_participant_info", "import_cyclonedds",
-           "make_participant", "reply_topic", "request_topic", "ros_name", "ros_type", "service_type", "take_raw",
-           "topic_name", "type_hash_user_data", "write_raw"]
+           "DdsUnavailable", "MAX_DOMAIN_ID", "NodeInfo", "announced_type_hash", "configure_domain",
+           "decode_participant_info", "discovery_struct", "domain_id", "dds_type", "encode_participant_info",
+           "import_cyclonedds", "make_participant", "reply_topic", "request_topic", "ros_name", "ros_type",
+           "service_type", "take_raw", "topic_name", "type_hash_user_data", "write_raw"]

@@ -94,6 +94,7 @@ class Bus:
         self.on_reader = on_reader
         self.layouts = LayoutJudge(dp, type_hash or (lambda struct: None))
         self._pending = False  # a publisher's type object not yet resolved: update again next period
+        self._final = False  # stopping: no warning waits any more
         self.discovery = Discovery(dp)
         self.taps: list[Tap] = []
         self.waitset = WaitSet(dp)
@@ -155,6 +156,8 @@ class Bus:
                             or any(now - t0 >= NAME_GRACE_S for t0 in self._unnamed.values()):
                         self._update()
                 self._drain()
+            self._final = True  # a warning still waiting for its node's name is said now, with the participant's
+            self._update()
             self._drain(every=True)
         except BaseException as exc:  # noqa: BLE001 - kept for stop(): a dead reader thread must be said
             self.error = exc
@@ -268,7 +271,7 @@ class Bus:
     def _named(self, guid: bytes) -> bool:
         """May a warning about publication ``guid`` be said now: its node is known, or the grace for
         ros_discovery_info to name it has passed (then it is said with the participant's id)."""
-        if self.discovery.node_of(guid):
+        if self.discovery.node_of(guid) or self._final:
             self._unnamed.pop(guid, None)
             return True
         first = self._unnamed.setdefault(guid, time.monotonic())
