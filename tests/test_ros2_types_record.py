@@ -156,8 +156,8 @@ def run(tmp_path_factory: pytest.TempPathFactory) -> Iterator[dict[str, Any]]:
     procs = {}
     system = cyclone = None
     mp = pytest.MonkeyPatch()
-    for k in ("CYCLONEDDS_URI", "ROS_DOMAIN_ID"):  # this process's Cyclone publisher: the same domain, loopback
-        mp.setenv(k, env[k])
+    for var in ("CYCLONEDDS_URI", "ROS_DOMAIN_ID"):  # this process's Cyclone publisher: the same domain, loopback
+        mp.setenv(var, env[var])
     try:
         for name, bag in bags.items():
             procs[name] = rclverify(
