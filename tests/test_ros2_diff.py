@@ -18,12 +18,14 @@ runs a ``/sensors/camera`` that publishes ``/sensors/image`` best-effort
 (the reliable ``viewer`` gets nothing from it) and a ``/intruder`` the code
 does not have; ``planner`` is not started.  The diff must report exactly:
 ``/robot/planner`` missing (at its launch line), ``/intruder`` extra, the
-QoS conflict on ``/sensors/image``, and nothing about the nodes that run as
-the code says; exit 1.
+QoS conflict on ``/sensors/image`` between the running viewer and camera,
+the camera running best-effort where its code asks for reliable (at its
+``create_publisher`` call), and nothing about the nodes that run as the
+code says; exit 1.
 
-The static tests beside it check the namespaces the scan gives, without
-ROS 2: code namespaces in Python and C++, launch namespaces in Python and
-XML launch files.
+The static tests beside it check, without ROS 2, the namespaces the scan
+gives (code namespaces in Python and C++, launch namespaces in Python and
+XML launch files) and the QoS read from the code (ros/code_qos.py).
 """
 from __future__ import annotations
 
@@ -232,18 +234,27 @@ def test_the_node_the_code_lacks_is_the_one_extra(diff: dict[str, Any]) -> None:
 
 
 def test_the_qos_conflict_names_both_nodes(diff: dict[str, Any]) -> None:
-    qos = _items(diff, "missing", "qos")
+    qos = [i for i in _items(diff, "missing", "qos") if i["at"] is None]  # between running endpoints
     assert len(qos) == 1 and qos[0]["name"] == "/sensors/image", diff["log"]
     assert "node /viewer subscribes with reliable" in qos[0]["message"]
     assert "node /sensors/camera publishes with best_effort" in qos[0]["message"]
-    assert len(diff["json"]["missing"]) == 2  # the planner and the conflict: nothing else
+    assert len(diff["json"]["missing"]) == 3  # the planner, the conflict and the camera's drift: nothing else
+
+
+def test_a_publisher_running_with_other_qos_than_its_code_is_located_at_the_call(diff: dict[str, Any]) -> None:
+    drift = [i for i in _items(diff, "missing", "qos") if i["at"] is not None]
+    assert [(i["node"], i["name"]) for i in drift] == [("/sensors/camera", "/sensors/image")], diff["log"]
+    assert drift[0]["at"]["file"].endswith("demo_pkg/camera.py") and drift[0]["at"]["line"] == 8
+    assert "reliability: reliable in the code, best_effort running" in drift[0]["message"]
+    assert any(c.startswith("the reliability and durability the code asks for") for c in diff["json"]["compared"])
 
 
 def test_namespaced_nodes_are_found_with_their_namespace(diff: dict[str, Any]) -> None:
     # /robot/talker (the launch file's namespace, cmd remapped to /teleop/cmd) and /sensors/camera (the
     # code's namespace) run as the code has them: no item names them, and every endpoint found its node
     everything = diff["json"]["missing"] + diff["json"]["extra"]
-    assert not [i for i in everything if i["node"] in ("/robot/talker", "/sensors/camera", "/viewer")]
+    assert not [i for i in everything if i["node"] in ("/robot/talker", "/viewer")]
+    assert [i["category"] for i in everything if i["node"] == "/sensors/camera"] == ["qos"]  # its drift only
     assert not [i for i in everything if i["category"] == "node" and i["name"] != "/robot/planner"
                 and i["name"] != "/intruder"]
     assert "in no ROS 2 node" not in diff["log"] and "may be incomplete" not in diff["log"], diff["log"]
@@ -307,3 +318,44 @@ def test_xml_launch_and_rclcpp_namespaces(tmp_path: Path) -> None:
     assert _scan(tmp_path) == {"/base/odom": ["/base/odometry"], "/sensors/lidar": ["/sensors/scan"]}
     assert _scan(tmp_path, "src/cpp_pkg/launch/sys.launch.xml") == {"/base/odom": ["/base/odometry"],
                                                                      "/front/lidar": ["/front/scan"]}
+
+
+def test_the_qos_the_code_asks_for(tmp_path: Path) -> None:
+    from rclverify.ros.code_qos import read
+    from rclverify.ros.model import Src
+    py = tmp_path / "n.py"
+    py.write_text(textwrap.dedent("""\
+        from rclpy.qos import QoSProfile, ReliabilityPolicy, DurabilityPolicy, qos_profile_sensor_data
+        import rclpy.qos
+        latched = QoSProfile(depth=1, durability=DurabilityPolicy.TRANSIENT_LOCAL)
+        n.create_publisher(String, 'a', 10)
+        n.create_publisher(String, 'b', qos_profile_sensor_data)
+        n.create_publisher(String, 'c', QoSProfile(depth=5, reliability=ReliabilityPolicy.BEST_EFFORT))
+        n.create_publisher(String, 'd', latched)
+        n.create_subscription(String, 'e', cb, rclpy.qos.qos_profile_system_default)
+        n.create_subscription(String, 'f', cb, qos_profile=QoSProfile(depth=1, reliability=pick()))
+        n.create_subscription(String, 'g', cb, 3)
+        """))
+    got = {line: read(Src(str(py), line, 1), "pub" if line < 8 else "sub") for line in range(4, 11)}
+    assert {k: (v.reliability, v.durability) if v else None for k, v in got.items()} == {
+        4: ("reliable", "volatile"), 5: ("best_effort", "volatile"), 6: ("best_effort", "volatile"),
+        7: ("reliable", "transient_local"), 8: (None, None), 9: (None, "volatile"), 10: ("reliable", "volatile")}
+    cpp = tmp_path / "n.cpp"
+    cpp.write_text(textwrap.dedent("""\
+        auto qos = rclcpp::QoS(rclcpp::KeepLast(1)).transient_local();
+        void f() {
+          a_ = create_publisher<std_msgs::msg::String>("a", 10);
+          b_ = node->create_publisher<std_msgs::msg::String>("b", rclcpp::SensorDataQoS());
+          c_ = create_publisher<std_msgs::msg::String>(
+              "c", rclcpp::QoS(5).best_effort());
+          d_ = create_publisher<std_msgs::msg::String>("d", qos);
+          e_ = create_subscription<std_msgs::msg::String>("e", rclcpp::SystemDefaultsQoS(),
+                                                          [this](const std_msgs::msg::String & m) { on(m, 1); });
+          g_ = create_subscription<std_msgs::msg::String>("g", rclcpp::QoS(1).reliability(
+              rclcpp::ReliabilityPolicy::BestEffort), std::bind(&N::cb, this, _1));
+        }
+        """))
+    got = {line: read(Src(str(cpp), line, 3), "pub" if line < 8 else "sub") for line in (3, 4, 5, 7, 8, 10)}
+    assert {k: (v.reliability, v.durability) if v else None for k, v in got.items()} == {
+        3: ("reliable", "volatile"), 4: ("best_effort", "volatile"), 5: ("best_effort", "volatile"),
+        7: ("reliable", "transient_local"), 8: (None, None), 10: ("best_effort", "volatile")}

@@ -32,6 +32,7 @@ from __future__ import annotations
 import time
 from typing import Any
 
+from . import code_qos
 from .dds import ACTION_INFIX, ACTION_SERVICES, DISCOVERY_TOPIC, domain_id, make_participant, ros_name, ros_type
 from .dds import service_type as _service_type
 from .dds_discovery import Discovery, EndpointInfo
@@ -161,11 +162,23 @@ def diff_dds(static: Graph, running: Graph, source: str,
     """Compare the code's graph with the running ROS 2 graph: what
     :func:`.diff.diff_master` compares, the service clients, and each QoS
     conflict as a ``qos`` item of the missing list (the connection the code
-    promises is not made).  Pure but for naming nodes through ``disc``."""
+    promises is not made).  With ``disc``, also the reliability and
+    durability each publisher and subscriber asks for in the code against
+    its running endpoint (:func:`code_qos_items`; reads the code's files,
+    relative to the current directory as the scan showed them)."""
     res = diff_master(static, running, source)
     res.kind = "dds"
     res.compared += ["service clients", "QoS of the publishers and subscribers of each topic"]
-    res.not_compared = ["the QoS the code asks for (the diff reports the running endpoints' conflicts)"]
+    res.not_compared = ["history depth (DDS discovery does not announce it)"]
+    if disc is not None:
+        items, unread = code_qos_items(static, disc, source)
+        res.missing += items
+        res.compared.append("the reliability and durability the code asks for, against the running endpoint")
+        if unread:
+            res.not_compared.append(f"the QoS of {len(unread)} publisher(s)/subscriber(s) the code does not say "
+                                    f"literally ({', '.join(unread[:3])}{', ...' if len(unread) > 3 else ''})")
+    else:
+        res.not_compared.append("the QoS the code asks for (the diff reports the running endpoints' conflicts)")
     for name in sorted(set(static.nodes) & set(running.nodes)):
         se, re_ = _first(static.nodes[name].edges_of("service_clients")), \
             _first(running.nodes[name].edges_of("service_clients"))
@@ -185,4 +198,42 @@ def diff_dds(static: Graph, running: Graph, source: str,
     return res
 
 
-__all__ = ["INFRA_SERVICE_SUFFIXES", "INFRA_TOPICS", "diff_dds", "graph_of", "qos_conflicts", "read_dds_graph"]
+def _policies(q: Any) -> tuple[str, str]:
+    return ("reliable" if q.reliable else "best_effort"), q.durability
+
+
+def code_qos_items(static: Graph, disc: Discovery, source: str) -> tuple[list[Item], list[str]]:
+    """``qos`` items (located at the code's call) for each publisher and
+    subscriber of a node running under its code's name whose running
+    endpoints on that topic all differ from the reliability or durability the
+    code asks for (:mod:`.code_qos`); and, as ``node topic``, those whose QoS
+    the code does not say literally (not compared).  Endpoints are given to
+    nodes by ``ros_discovery_info`` (:meth:`.Discovery.node_of`)."""
+    items: list[Item] = []
+    unread: list[str] = []
+    for name in sorted(static.nodes):
+        for kind, verb, side in (("pub", "publishes", disc.writers), ("sub", "subscribes to", disc.readers)):
+            for topic, e in sorted(_first(static.nodes[name].edges_of(kind)).items()):
+                run = [x for x in side.values() if disc.node_of(x.guid) == name and ros_name(x.topic) == ("topic", topic)]
+                if not run:
+                    continue
+                cq = code_qos.read(e.src, kind)
+                if cq is None or (cq.reliability is None and cq.durability is None):
+                    unread.append(f"{name} {topic}")
+                    continue
+                off = [x for x in run if (cq.reliability or _policies(x.qos)[0], cq.durability or _policies(x.qos)[1])
+                       != _policies(x.qos)]
+                if len(off) < len(run):
+                    continue
+                got = _policies(off[0].qos)
+                why = [f"{p}: {c} in the code, {r} running" for p, c, r in
+                       (("reliability", cq.reliability, got[0]), ("durability", cq.durability, got[1])) if c and c != r]
+                items.append(Item("qos", topic, name, e.msg_type, None, e.src, source,
+                                  f"{name} {verb} {topic}{_t(e.msg_type)} with {cq.text} ({cq.describe()}) in the "
+                                  f"code; its running {'publisher' if kind == 'pub' else 'subscriber'} has "
+                                  f"{', '.join(got)} ({'; '.join(why)})"))
+    return items, unread
+
+
+__all__ = ["INFRA_SERVICE_SUFFIXES", "INFRA_TOPICS", "code_qos_items", "diff_dds", "graph_of", "qos_conflicts",
+           "read_dds_graph"]
