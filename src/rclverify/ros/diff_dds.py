@@ -41,6 +41,8 @@ from .diff import DiffResult, Item, _first, _t, diff_master
 from .model import Graph, GraphEdge, GraphNode, Note, Src, short_type
 
 INFRA_TOPICS = {"/rosout", "/parameter_events"}
+#: the first character of a hidden node's name (rclpy ``HIDDEN_NODE_PREFIX``; ROS 2's command line tools name theirs so)
+HIDDEN_PREFIX = "_"
 #: the services every rclcpp/rclpy node offers about itself (its parameters, its types)
 INFRA_SERVICE_SUFFIXES = ("/describe_parameters", "/get_parameter_types", "/get_parameters", "/list_parameters",
                           "/set_parameters", "/set_parameters_atomically", "/get_type_description")
@@ -166,10 +168,16 @@ def diff_dds(static: Graph, running: Graph, source: str,
     durability each publisher and subscriber asks for in the code against
     its running endpoint (:func:`code_qos_items`; reads the code's files,
     relative to the current directory as the scan showed them)."""
+    hidden = sorted(n for n in running.nodes if n.rsplit("/", 1)[-1].startswith(HIDDEN_PREFIX) and n not in static.nodes)
+    if hidden:  # ROS 2's tools (the ros2cli daemon, ros2 topic echo): left out as `ros2 node list` leaves them out
+        running = Graph(nodes={k: v for k, v in running.nodes.items() if k not in hidden}, notes=running.notes)
     res = diff_master(static, running, source)
     res.kind = "dds"
     res.compared += ["service clients", "QoS of the publishers and subscribers of each topic"]
     res.not_compared = ["history depth (DDS discovery does not announce it)"]
+    if hidden:
+        res.not_compared.append(f"{len(hidden)} hidden node(s) the code does not have ({', '.join(hidden[:3])}"
+                                f"{', ...' if len(hidden) > 3 else ''}): a name starting with '_' is a ROS 2 tool's")
     if disc is not None:
         items, unread = code_qos_items(static, disc, source)
         res.missing += items
