@@ -27,8 +27,10 @@ Service name mapping to DDS"):
   DDS topic ``ros_discovery_info`` (reliable, transient-local, keep-last 1):
   its participant's GID and, per node, the namespace, the name and the GIDs
   of the node's readers and writers (a GID is the DDS GUID, 16 bytes; ROS 2
-  Humble and older send it in a 24-byte array padded with zeros, Jazzy and
-  newer in a 16-byte one: :func:`decode_participant_info` reads both).
+  Foxy, Galactic and Humble send it in a 24-byte array padded with zeros
+  (``Gid.msg``: ``char[24] data``), Iron and newer in a 16-byte one
+  (``char[16]`` since rmw_dds_common 2.0.0): :func:`decode_participant_info`
+  reads both, deciding by the sample: exactly one layout reads it whole).
 
 Raw access (:func:`take_raw`, :func:`write_raw`) goes one level under the
 binding's ``DataReader.take``/``DataWriter.write`` (its ``_clayer`` module,
@@ -327,10 +329,12 @@ def encode_participant_info(gid: bytes, nodes: Iterable[NodeInfo], gid_size: int
 
 
 def discovery_struct() -> Any:
-    """The ``ParticipantEntitiesInfo`` type (16-byte GIDs, Jazzy's layout) as
-    a cyclonedds struct: what the topic is created with (ROS 2's own
-    participants send no XTypes type information, so they match on the name;
-    the samples are read raw, in either layout)."""
+    """The ``ParticipantEntitiesInfo`` type (16-byte GIDs, Iron's and newer
+    layout) as a cyclonedds struct: what the topic is created with.  ROS 2's
+    participants match it on the name: rmw_cyclonedds sends no XTypes type
+    information, and Fast DDS's (Kilted: the same struct, but no try-construct
+    flag on its sequence and array elements) is ignored by the participant
+    (:data:`COMPATIBILITY`).  The samples are read raw, in either layout."""
     import_cyclonedds()
     from cyclonedds.idl import make_idl_struct
     from cyclonedds.idl import types as T
