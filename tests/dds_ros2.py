@@ -54,11 +54,14 @@ SERVICE_QOS = QosProfile(reliable=True, durability="volatile", depth=10)  # rmw_
 
 
 def dds_env(tmp: Path) -> dict[str, str]:
-    """``CYCLONEDDS_URI`` (a loopback-only configuration written in ``tmp``)
-    and a random ``ROS_DOMAIN_ID`` (1..230)."""
+    """``CYCLONEDDS_URI`` (a loopback-only configuration written in ``tmp``),
+    a random ``ROS_DOMAIN_ID`` (1..230) and ``RMW_IMPLEMENTATION=rmw_cyclonedds_cpp``
+    (the wire form of these participants' services, which the monitor reads by it)."""
     cfg = tmp / "cyclonedds.xml"
     cfg.write_text(CONFIG)
-    return {"CYCLONEDDS_URI": cfg.as_uri(), "ROS_DOMAIN_ID": str(random.SystemRandom().randint(1, 230))}
+    # the participants here speak rmw_cyclonedds' wire form: the monitor is told so as a user would
+    return {"CYCLONEDDS_URI": cfg.as_uri(), "ROS_DOMAIN_ID": str(random.SystemRandom().randint(1, 230)),
+            "RMW_IMPLEMENTATION": "rmw_cyclonedds_cpp"}
 
 
 def wait_until(cond: Callable[[], bool], timeout: float, what: str) -> None:

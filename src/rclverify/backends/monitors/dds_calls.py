@@ -47,7 +47,8 @@ from ...rcl.types import Checked, CheckedNode
 from ...traces.events import Event
 from ...traces.mapping import TopicRule
 from .check import NodeMonitor, NodeResult, Verdict
-from .deadlines import LINK_TOPICS, DeadlineMonitor, DeadlineResult, DeadlineVerdict
+from .deadlines import DeadlineMonitor, DeadlineResult, DeadlineVerdict
+from .verdicts import LINK_TOPICS
 
 #: the ``topic`` of a call's log lines: no contract names it, so ``rclverify monitor LOG`` skips them
 CALL_LOG_TOPIC = "rclverify/call"
@@ -85,6 +86,7 @@ class _Call:
     monitors: list[NodeMonitor]
     deadlines: list[DeadlineMonitor]
     answered: bool = False
+    first: int = -1  # the index of the request's (the goal's) event
 
 
 class CallBook:
@@ -116,7 +118,7 @@ class CallBook:
         self.emitted = 0  # verdicts given so far (a tick that gives one is logged, for the replay)
         self.now = float("-inf")
         self.counts = {"calls": 0, "goals": 0, "answered": 0, "unanswered": 0, "orphan_answers": 0, "evicted": 0,
-                       "rejected": 0}
+                       "rejected": 0, "unpaired": 0}
 
     # -- input -------------------------------------------------------------------------------
     def open(self, name: str, key: tuple[Any, ...], label: str, fields: Mapping[str, Any], stamp: float,
@@ -134,6 +136,7 @@ class CallBook:
         call = _Call(key, name, label, stamp, bound, monitors, deadlines)
         self.calls[key] = call
         self.counts["goals" if part == "goal" else "calls"] += 1
+        call.first = self.index
         self._feed(call, part, fields, stamp)
         while len(self.calls) > self.max_calls:
             self._close(next(iter(self.calls)), evicted=True)
@@ -163,6 +166,38 @@ class CallBook:
             self.counts["rejected"] += 1
             self._log({"link": self.calls[key].name, "part": "rejected", "time": stamp, "key": _key(key)})
             self._close(key)
+
+    def unpaired(self, key: tuple[Any, ...], stamp: float, reason: str) -> None:
+        """Call ``key`` may have been answered at ``stamp`` (s), but which answer
+        is its cannot be known (:mod:`.dds_order`): what was judged of it stays
+        (its request's assumption, deadlines already expired: each was decided
+        before any answer could have come), what waits for its answer is
+        ``inconclusive`` with ``reason`` (each node that serves or calls it),
+        its deadlines not yet due are left undecided (``unaccepted``)."""
+        call = self.calls.pop(key, None)
+        if call is None:
+            return
+        self.counts["unpaired"] += 1
+        self._log({"link": call.name, "part": "unpaired", "time": stamp, "key": _key(key), "reason": reason})
+        for m in call.monitors:
+            res = m.result
+            res.counts["inconclusive"] += 1
+            if res.first_inconclusive is None:
+                res.first_inconclusive = {"event": call.first, "time": call.opened, "where": f"{call.label} request",
+                                          "reason": reason}
+            self._verdict(Verdict(m.node.name, "inconclusive", call.first, call.opened, f"{call.label} request",
+                                  f"{call.name}/request", max(stamp, self.now), reason=reason))
+            _add(self.results.setdefault(m.node.name, NodeResult(m.node.name)), res)
+        for d in call.deadlines:
+            total = self.deadline_results.setdefault(d.result.node, DeadlineResult(d.result.node))
+            for v, n in d.result.counts.items():
+                total.counts[v] += n
+            total.first_false = total.first_false or d.result.first_false
+            total.unaccepted["undecided"] += len(d.pending)
+            if d.pending and total.first_unaccepted is None:
+                total.first_unaccepted = {"where": f"{call.label} request", "stamp": call.opened,
+                                          "guarantee": d.pending[0].k, "why": "undecided", "reason": reason}
+            d.pending = []
 
     def note(self, obj: dict[str, Any]) -> None:
         """A line for the log about a call (a status change) that no monitor reads."""
@@ -273,6 +308,8 @@ def replay(book: CallBook, lines: Iterable[Mapping[str, Any]]) -> dict[str, Any]
         part = str(x.get("part"))
         if part == "tick":
             book.tick(float(x["time"]))
+        elif part == "unpaired":
+            book.unpaired(tuple(x["key"]), float(x["time"]), str(x["reason"]))
         elif "index" in x:
             name, key = str(x["link"]), tuple(x["key"])
             if part in ("request", "goal"):

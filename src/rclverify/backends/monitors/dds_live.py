@@ -43,6 +43,7 @@ from .dds_bag import BagRecorder
 from .dds_calls import CallBook
 from .dds_services import CallTaps
 from .dds_types import DdsTypeError, TypeBook, to_fields
+from .dds_wire import WriterIds
 from .live import VERDICT_LOG_TOPIC, LiveRun, dumps, stop_and_record
 from .ros1 import contract_topics
 from .worker import EngineWorker
@@ -60,8 +61,7 @@ class _Sink:
     def tick(self, now: float) -> None:
         self.live.tick(now)
         if self.book is not None and self.taps is not None:
-            self.taps.tick(now)
-            self.book.tick(now - self.window)  # the topic engine's timer is as far behind (reorder window)
+            self.taps.tick(now, self.window)  # the book's clock as far behind as the topic engine's, or more
 
 
 def _status(live: LiveRun, calls: Mapping[tuple[str, str], int]) -> str:
@@ -143,8 +143,10 @@ def run_dds(run_factory: Callable[..., LiveRun], checked: Checked, nodes: list[C
         before the first message is released)."""
         if tap.key in enforce and tap.key not in republish:
             republish[tap.key] = bus.writer(topic_name(tap.key), structs[tap.key], publishers[0].qos)
-    bus = Bus(dp, lambda tap, raw, info, rns: worker_box[0].offer(tap.key, (raw, info.source_timestamp, rns),
-                                                                  rns / 1e9), warn, on_reader=on_reader,
+    writers = WriterIds()  # a service sample's writer tells its wire form (dds_wire.py)
+    bus = Bus(dp, lambda tap, raw, info, rns: worker_box[0].offer(tap.key, (
+        raw, info.source_timestamp, rns, writers.of(tap.reader, info) if tap.key.startswith("call:") else None),
+        rns / 1e9), warn, on_reader=on_reader,
               type_hash=types.type_hash)
     user = type_hash_user_data("std_msgs/msg/String")
     pub = bus.writer(topic_name(verdict_topic), string, writer_profile(depth=1000), user)
@@ -182,14 +184,14 @@ def run_dds(run_factory: Callable[..., LiveRun], checked: Checked, nodes: list[C
     for t in enforce:  # only the gate may write a guarded topic, only the monitor the verdict topic (dds_trust.py)
         bus.watch_writers(topic_name(t), t, where.get(t, t), "guarded topic")
     bus.watch_writers(topic_name(verdict_topic), VERDICT_KEY, "--verdict-topic", "verdict topic")
-    for key, dds_topic, struct, loc in (calls.plan if calls is not None else ()):
-        bus.tap(key, dds_topic, struct, loc)
+    if calls is not None:
+        calls.attach(bus)
 
     def decode(key: str, payload: Any) -> Mapping[str, Any] | None:
-        raw, source_ns, received_ns = payload
+        raw, source_ns, received_ns = payload[:3]
         try:
             if calls is not None and key.startswith("call:"):
-                calls.handle(key, raw, source_ns / 1e9, received_ns / 1e9)
+                calls.handle(key, raw, source_ns / 1e9, received_ns / 1e9, payload[3])
                 return None
             fields: Mapping[str, Any] = to_fields(structs[key].deserialize(raw))
         except Exception:  # bytes that are not the contract's type: counted, never a crash
@@ -228,7 +230,7 @@ def run_dds(run_factory: Callable[..., LiveRun], checked: Checked, nodes: list[C
             worker.stop()
         except Exception:  # noqa: BLE001 - stop_and_record stops it again and records the error
             pass
-        summary = book.finish() if book is not None else None  # while the log is open
+        summary = calls.finish() if calls is not None else None  # while the log is open
         record_ = stop_and_record(worker, live, None, out)
         if bus_error:
             record_["bus_error"] = bus_error
@@ -237,7 +239,8 @@ def run_dds(run_factory: Callable[..., LiveRun], checked: Checked, nodes: list[C
         record_.update(middleware=f"DDS domain {domain_id()} ({_version()})", warnings=warnings,
                        decode_errors=decode_errors, qos={t.key: t.to_json() for t in bus.taps})
         if summary is not None and book is not None:
-            record_["calls"] = {"counts": summary["counts"], "nodes": []}
+            record_["calls"] = {"counts": summary["counts"], "nodes": [],
+                                "samples": calls.counts if calls is not None else {}}
             for name, res in book.results.items():
                 status, explanation = verdict_status(res, "the live calls")
                 record_["calls"]["nodes"].append({"node": name, "status": status, "explanation": explanation,

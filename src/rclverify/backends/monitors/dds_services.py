@@ -1,43 +1,60 @@
-"""Services and actions heard on the DDS bus, paired by identity and fed to
-the :class:`~.dds_calls.CallBook`.
+"""Services and actions heard on the DDS bus, paired and fed to the
+:class:`~.dds_calls.CallBook`.
 
 For every link a monitored contract declares (``services(...)``,
 ``actions(...)``), :class:`CallTaps` asks the bus (:mod:`.dds_bus`) for:
 
 * a service ``/s`` of type ``pkg/T``: ``rq/sRequest`` and ``rr/sReply``
-  (``pkg::srv::dds_::T_Request_`` / ``T_Response_``, each with rmw_cyclonedds'
-  request header);
+  (``pkg::srv::dds_::T_Request_`` / ``T_Response_``) and its introspection
+  events ``rt/s/_service_event`` (:mod:`.dds_introspection`);
 * an action ``/a``: ``rq``/``rr`` of ``/a/_action/send_goal`` and
   ``/a/_action/get_result``, and ``rt/a/_action/feedback`` and
   ``rt/a/_action/status``.
 
-and turns each sample, in the engine thread, into a call event: a request
-opens its call under its identity (the client's writer handle and the
-sequence number), the reply with the same identity answers it; a goal opens
-its call under its ``goal_id``, the feedback messages and the get-result
-reply carrying that goal id answer it (the get-result request tells which
-goal its reply is about), a refused goal (``accepted`` false) closes it
-unjudged, status changes are logged.  Stamps are the samples' DDS source
-timestamps (s).  An answer whose request has not been taken yet (request
-and reply travel on different topics) waits up to :data:`EARLY_S` seconds
-for it before it counts as an answer without a call.
+The request and reply readers are of the wire form ``RMW_IMPLEMENTATION``
+names (:mod:`.dds_wire`); a sample whose writer is of the other vendor is
+counted, not decoded:
 
-Services between rmw_fastrtps nodes carry their identity in RTPS's
-related-sample-identity, not in the payload: such calls have no header and
-are not decoded (docs/monitors.md says so).
+* **with the request header** (rmw_cyclonedds): a request opens its call
+  under its identity (the client's writer handle and the sequence number),
+  the reply with the same identity answers it;
+* **without it** (rmw_fastrtps): the service's introspection events pair
+  request and reply exactly when the server (or every client) publishes
+  them; else the order pairs them where it is certain
+  (:mod:`.dds_order`), and says which calls it cannot pair;
+* **an action**: a goal opens its call under its ``goal_id``, the feedback
+  messages and the get-result reply carrying that goal id answer it (the
+  get-result request tells which goal its reply is about: by the header's
+  identity, or by the order), a refused goal (``accepted`` false) closes it
+  unjudged, status changes are logged.
+
+Samples are taken in the order of their DDS source timestamps: each waits
+:data:`SETTLE_S` seconds after its stamp (so that a request taken after its
+reply, the two travelling on different topics, still comes first), and the
+call book's clock runs that far behind.  An answer whose request has not been
+heard waits up to :data:`EARLY_S` seconds for it before it counts as an
+answer without a call.
 """
 from __future__ import annotations
 
+import heapq
 from typing import Any, Iterable
 
 from ...rcl import ast
 from ...rcl.types import CheckedNode
 from ...ros.dds import ACTION_INFIX, reply_topic, request_topic, topic_name
 from .dds_calls import CallBook
+from .dds_introspection import EVENT_SUFFIX, SIDES, event_key, event_side, event_struct
+from .dds_order import OrderPairer, Pending
 from .dds_types import TypeBook, request_id, to_fields
+from .dds_wire import framed_rmw, has_header
 
-#: seconds an answer waits for its request (or goal) to be taken
+#: seconds an answer waits for its request (or goal) to be heard
 EARLY_S = 2.0
+#: seconds a sample waits after its source stamp, so that samples are taken in the stamps' order
+SETTLE_S = 0.3
+#: seconds after its receipt a sample is taken whatever its stamp says (a writer whose clock runs ahead)
+LATE_S = 1.0
 #: action_msgs/msg/GoalStatus values (ROS 2 design "Actions")
 GOAL_STATUS = {0: "unknown", 1: "accepted", 2: "executing", 3: "canceling", 4: "succeeded", 5: "canceled",
                6: "aborted"}
@@ -52,10 +69,13 @@ class CallTaps:
     (module docstring).  Raises :class:`~.dds_types.DdsTypeError` (with the
     link's location) for a link type the interface files do not define."""
 
-    def __init__(self, book: CallBook, types: TypeBook, links: Iterable[tuple[CheckedNode, ast.Link]]) -> None:
+    def __init__(self, book: CallBook, types: TypeBook, links: Iterable[tuple[CheckedNode, ast.Link]],
+                 framed: bool | None = None) -> None:
         from .dds_types import DdsTypeError
         self.book, self.types = book, types
-        self.specs: dict[str, tuple[str, Any, str]] = {}  # tap key -> (link name, struct, part)
+        #: the services' samples carry rmw_cyclonedds' request header (default: by RMW_IMPLEMENTATION)
+        self.framed = framed_rmw() if framed is None else framed
+        self.specs: dict[str, tuple[str, Any, Any, str]] = {}  # tap key -> (link, struct read, header struct or None, part)
         self.plan: list[tuple[str, str, Any, str]] = []  # (tap key, dds topic, struct, where)
         seen: set[str] = set()
         for _node, lk in links:
@@ -64,52 +84,179 @@ class CallTaps:
                 continue
             seen.add(name)
             try:
-                if lk.kind == "service":
-                    req, rep = types.service(lk.ros_type)
-                    self._add(name, "request", request_topic(name), req, lk)
-                    self._add(name, "reply", reply_topic(name), rep, lk)
-                else:
-                    a = types.action(lk.ros_type)
-                    base = name + ACTION_INFIX
-                    self._add(name, "goal_request", request_topic(base + "send_goal"), a.send_goal[0], lk)
-                    self._add(name, "goal_reply", reply_topic(base + "send_goal"), a.send_goal[1], lk)
-                    self._add(name, "result_request", request_topic(base + "get_result"), a.get_result[0], lk)
-                    self._add(name, "result_reply", reply_topic(base + "get_result"), a.get_result[1], lk)
-                    self._add(name, "feedback", topic_name(base + "feedback"), a.feedback, lk)
-                    self._add(name, "status", topic_name(base + "status"), a.status, lk)
+                self._plan(name, lk)
             except DdsTypeError as exc:
                 raise DdsTypeError(f"{_where(lk)}: error: {lk.kind} {name} ({lk.ros_type}): {exc}") from None
+        self.taps: dict[str, Any] = {}  # tap key -> the bus's Tap (attach)
         self._goal_of: dict[tuple[int, int], str] = {}  # send-goal/get-result request id -> goal id
         self._status: dict[str, int] = {}
         self._early: dict[tuple[Any, ...], list[tuple[str, dict[str, Any], float, bool, float, str]]] = {}
+        self._queue: list[tuple[float, int, float, str, bytes, bytes | None]] = []
+        self._n = 0
+        self._pairers: dict[str, OrderPairer] = {}
+        self._asked: dict[bytes, int] = {}  # requests heard per writer without identity
+        self.last = float("-inf")  # the stamp of the last sample taken
+        #: samples taken after a later-stamped one (``late``), of a writer no longer known or of the other
+        #: wire form (:mod:`.dds_wire`), events without
+        #: contents, request/reply samples left to the introspection events, samples that did not decode
+        self.counts = {"late": 0, "unknown_writer": 0, "other_form": 0, "no_contents": 0, "introspected": 0,
+                       "undecodable": 0}
 
-    def _add(self, name: str, part: str, dds_topic: str, struct: Any, lk: ast.Link) -> None:
+    def _plan(self, name: str, lk: ast.Link) -> None:
+        t = self.types
+        if lk.kind == "service":
+            req, rep = t.service(lk.ros_type)
+            pkg, _, rest = lk.ros_type.replace("/srv/", "/").partition("/")
+            self._add(name, "request", request_topic(name), t.struct(f"{pkg}/srv/{rest}_Request"), req, lk)
+            self._add(name, "reply", reply_topic(name), t.struct(f"{pkg}/srv/{rest}_Response"), rep, lk)
+            self._add(name, "event", topic_name(name + EVENT_SUFFIX), event_struct(t, lk.ros_type), None, lk)
+            return
+        a = t.action(lk.ros_type)
+        pkg, _, rest = lk.ros_type.replace("/action/", "/").partition("/")
+        plain = f"{pkg}/action/{rest}"
+        base = name + ACTION_INFIX
+        for svc, part, (hreq, hrep) in (("send_goal", "goal", a.send_goal), ("get_result", "result", a.get_result)):
+            kind = "SendGoal" if svc == "send_goal" else "GetResult"
+            self._add(name, f"{part}_request", request_topic(base + svc), t.struct(f"{plain}_{kind}_Request"), hreq,
+                      lk)
+            self._add(name, f"{part}_reply", reply_topic(base + svc), t.struct(f"{plain}_{kind}_Response"), hrep, lk)
+        self._add(name, "feedback", topic_name(base + "feedback"), a.feedback, None, lk)
+        self._add(name, "status", topic_name(base + "status"), a.status, None, lk)
+
+    def _add(self, name: str, part: str, dds_topic: str, plain: Any, header: Any, lk: ast.Link) -> None:
         key = f"call:{name}:{part}"
-        self.specs[key] = (name, struct, part)
-        self.plan.append((key, dds_topic, struct, _where(lk)))
+        self.specs[key] = (name, header if self.framed and header is not None else plain, header, part)
+        self.plan.append((key, dds_topic, header if self.framed and header is not None else plain, _where(lk)))
+
+    def attach(self, bus: Any) -> None:
+        """Ask ``bus`` (a :class:`~.dds_bus.Bus`, before it starts) for every topic of the plan."""
+        for key, dds_topic, struct, where in self.plan:
+            self.taps[key] = bus.tap(key, dds_topic, struct, where)
 
     # -- samples (engine thread) -------------------------------------------------------------
-    def handle(self, key: str, raw: bytes, stamp: float, now: float) -> None:
-        """One sample of tap ``key`` (serialized, source stamp ``stamp``, received ``now``)."""
-        name, struct, part = self.specs[key]
+    def handle(self, key: str, raw: bytes, stamp: float, now: float, writer: bytes | None = None) -> None:
+        """One sample of tap ``key`` (serialized, source stamp ``stamp``, received
+        ``now``, written by ``writer``: its GUID), taken at a later :meth:`tick`."""
+        self._n += 1
+        heapq.heappush(self._queue, (stamp, self._n, now, key, raw, writer))
+
+    def tick(self, now: float, window: float = 0.0) -> None:
+        """Take the samples whose time has come, in their stamps' order; answers
+        that waited :data:`EARLY_S` s for their call count as answers without
+        one; the book's clock moves to ``now - max(window, SETTLE_S)``."""
+        self._take(lambda stamp, got: stamp <= now - SETTLE_S or got <= now - LATE_S)
+        for key in [k for k, xs in self._early.items() if now - xs[0][4] > EARLY_S]:
+            for part, fields, stamp, final, _t, name in self._early.pop(key):
+                self.book.answer(key, part, fields, stamp, final, name)
+        self.book.tick(now - max(window, SETTLE_S))
+
+    def finish(self) -> dict[str, Any]:
+        """Take every sample still waiting, then finish the book (its summary)."""
+        self._take(lambda stamp, got: True)
+        return self.book.finish()
+
+    def _take(self, due: Any) -> None:
+        while self._queue and due(self._queue[0][0], self._queue[0][2]):
+            stamp, _n, got, key, raw, writer = heapq.heappop(self._queue)
+            if stamp < self.last - 1e-9:
+                self.counts["late"] += 1
+            self.last = max(self.last, stamp)
+            try:
+                self._decode(key, raw, stamp, got, writer)
+            except Exception:  # noqa: BLE001 - bytes that are not the link's type: counted, never a crash
+                self.counts["undecodable"] += 1
+
+    def _decode(self, key: str, raw: bytes, stamp: float, now: float, writer: bytes | None) -> None:
+        name, struct, header, part = self.specs[key]
+        framed = header is not None and self.framed
+        if header is not None:
+            if writer is None:
+                self.counts["unknown_writer"] += 1
+                return
+            if has_header(writer) != framed:
+                self.counts["other_form"] += 1
+                return  # a writer of the other middleware: its bytes are not this reader's layout
         s = struct.deserialize(raw)
-        if part == "request":
+        if part == "event":
+            self._event(name, s, stamp, now)
+        elif part in ("request", "reply"):
+            if self._side(name) is not None:
+                self.counts["introspected"] += 1
+                return  # the introspection events pair this service's calls (and would count them again)
+            if part == "request":
+                self._request(name, s, stamp, framed, writer)
+            elif framed:
+                self._answer(request_id(s), "response", to_fields(s), stamp, True, name, now)
+            else:
+                self._ordered_reply(name, s, stamp, writer)
+        else:
+            self._action(name, part, s, stamp, now, framed, writer)
+
+    # -- services ------------------------------------------------------------------------------
+    def _request(self, name: str, s: Any, stamp: float, framed: bool, writer: bytes | None) -> None:
+        if framed:
             guid, seq = request_id(s)
             self._open(name, (guid, seq), f"{name.strip('/')} call {guid:016x}:{seq}", to_fields(s), stamp)
-        elif part == "reply":
-            self._answer(request_id(s), "response", to_fields(s), stamp, True, name, now)
-        elif part == "goal_request":
+            return
+        assert writer is not None
+        k = self._asked[writer] = self._asked.get(writer, 0) + 1
+        key, label = ("w", writer.hex(), k), f"{name.strip('/')} call {writer.hex()}#{k}"
+        self._open(name, key, label, to_fields(s), stamp)
+        self._pairer(name).request(Pending(key, stamp, label))
+
+    def _ordered_reply(self, name: str, s: Any, stamp: float, writer: bytes | None) -> None:
+        out = self._pairer(name).reply(stamp, writer)
+        if out.answers is not None:
+            self.book.answer(out.answers.key, "response", to_fields(s), stamp, True, name)
+        elif out.orphan:
+            self.book.answer(("w", "", 0), "response", to_fields(s), stamp, True, name)
+        for p in out.undecided:
+            self.book.unpaired(p.key, stamp, out.reason)
+
+    def _pairer(self, name: str) -> OrderPairer:
+        p = self._pairers.get(name)
+        if p is None:
+            p = self._pairers[name] = OrderPairer(name)
+        return p
+
+    def _side(self, name: str) -> str | None:
+        """Which side's introspection events pair the calls of service ``name`` (:func:`event_side`)."""
+        ev, rep, req = (self.taps.get(f"call:{name}:{p}") for p in ("event", "reply", "request"))
+        if ev is None or rep is None or req is None:
+            return None
+        return event_side(ev.heard, rep.heard, req.heard)
+
+    def _event(self, name: str, s: Any, stamp: float, now: float) -> None:
+        side = self._side(name)
+        if side is None:
+            return
+        asked, told = SIDES[side]
+        gid, seq = event_key(s)
+        key = ("ev", gid, seq)
+        kind = int(s.info.event_type)
+        if kind == asked:
+            if not s.request:
+                self.counts["no_contents"] += 1
+                return  # introspection without CONTENTS: nothing to judge (docs/ros2.md)
+            self._open(name, key, f"{name.strip('/')} call {gid}:{seq}", to_fields(s.request[0]), stamp)
+        elif kind == told and s.response:
+            self._answer(key, "response", to_fields(s.response[0]), stamp, True, name, now)
+
+    # -- actions -------------------------------------------------------------------------------
+    def _action(self, name: str, part: str, s: Any, stamp: float, now: float, framed: bool,
+                writer: bytes | None) -> None:
+        if part == "goal_request":
             gid = bytes(s.goal_id.uuid).hex()
-            self._remember(request_id(s), gid)
+            self._ask(name, "send_goal", s, gid, stamp, framed)
             self._open(name, (gid,), f"{name.strip('/')} goal {gid}", to_fields(s.goal), stamp, "goal")
-        elif part == "goal_reply":
-            gid = self._goal_of.pop(request_id(s), "")
-            if gid and not s.accepted:
-                self.book.reject((gid,), stamp)
         elif part == "result_request":
-            self._remember(request_id(s), bytes(s.goal_id.uuid).hex())
+            self._ask(name, "get_result", s, bytes(s.goal_id.uuid).hex(), stamp, framed)
+        elif part == "goal_reply":
+            self._goal_reply(name, s, stamp, framed, writer)
         elif part == "result_reply":
-            gid = self._goal_of.pop(request_id(s), "")
+            gid, undecided, why = self._told(name, "get_result", s, stamp, framed, writer)
+            for g in undecided:
+                self.book.unpaired((g,), stamp, f"its result cannot be told apart: {why}")
             if gid:
                 self._answer((gid,), "result", to_fields(s.result), stamp, True, name, now)
                 self._note_status(name, gid, int(s.status), stamp)
@@ -119,12 +266,40 @@ class CallTaps:
             for st in s.status_list:
                 self._note_status(name, bytes(st.goal_info.goal_id.uuid).hex(), int(st.status), stamp)
 
-    def _remember(self, rid: tuple[int, int], gid: str) -> None:
-        """Which goal the reply to request ``rid`` (send-goal or get-result) is about (bounded)."""
-        self._goal_of[rid] = gid
-        while len(self._goal_of) > 10_000:
-            self._goal_of.pop(next(iter(self._goal_of)))
+    def _ask(self, name: str, svc: str, s: Any, gid: str, stamp: float, framed: bool) -> None:
+        """A send-goal or get-result request about goal ``gid``: remember which goal its reply is about."""
+        if framed:
+            self._goal_of[request_id(s)] = gid
+            while len(self._goal_of) > 10_000:
+                self._goal_of.pop(next(iter(self._goal_of)))
+        else:
+            self._pairer(f"{name}/_action/{svc}").request(Pending((gid,), stamp, f"goal {gid}"))
 
+    def _told(self, name: str, svc: str, s: Any, stamp: float, framed: bool,
+              writer: bytes | None) -> tuple[str, list[str], str]:
+        """The goal a send-goal or get-result reply is about (``""``: unknown), the
+        goals it leaves undecided and why."""
+        if framed:
+            return self._goal_of.pop(request_id(s), ""), [], ""
+        pairer = self._pairer(f"{name}/_action/{svc}")
+        out = pairer.reply(stamp, writer)
+        return (str(out.answers.key[0]) if out.answers else "", [str(p.key[0]) for p in out.undecided],
+                out.reason)
+
+    def _goal_reply(self, name: str, s: Any, stamp: float, framed: bool, writer: bytes | None) -> None:
+        pool = [str(p.key[0]) for p in self._pairers[f"{name}/_action/send_goal"].pool] \
+            if f"{name}/_action/send_goal" in self._pairers else []
+        gid, undecided, why = self._told(name, "send_goal", s, stamp, framed, writer)
+        if s.accepted:
+            return
+        if gid:
+            self.book.reject((gid,), stamp)
+            return
+        for g in dict.fromkeys(undecided + pool):  # one of them was refused: none can be judged
+            self.book.unpaired((g,), stamp, f"a goal was refused and which one cannot be told: "
+                               f"{why or 'its request is one of several unanswered'}")
+
+    # -- the book --------------------------------------------------------------------------------
     def _open(self, name: str, key: tuple[Any, ...], label: str, fields: dict[str, Any], stamp: float,
               part: str = "request") -> None:
         self.book.open(name, key, label, fields, stamp, part)
@@ -147,11 +322,5 @@ class CallTaps:
         self.book.note({"link": name.strip("/"), "part": "status", "time": stamp, "key": [gid],
                         "status": GOAL_STATUS.get(status, str(status))})
 
-    def tick(self, now: float) -> None:
-        """Answers that waited :data:`EARLY_S` s for their call count as answers without one."""
-        for key in [k for k, xs in self._early.items() if now - xs[0][4] > EARLY_S]:
-            for part, fields, stamp, final, _t, name in self._early.pop(key):
-                self.book.answer(key, part, fields, stamp, final, name)
 
-
-__all__ = ["CallTaps", "EARLY_S", "GOAL_STATUS"]
+__all__ = ["CallTaps", "EARLY_S", "GOAL_STATUS", "LATE_S", "SETTLE_S"]
