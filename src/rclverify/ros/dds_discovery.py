@@ -4,7 +4,10 @@ GUID, participant, topic, type, QoS) and the node each belongs to (ROS 2's
 ``ros_discovery_info``, :mod:`.dds`).
 
 :class:`Discovery` only reads: it creates built-in readers and one reader
-of ``ros_discovery_info`` (reliable, transient-local, as ROS 2's own), and
+of ``ros_discovery_info`` (reliable, transient-local, keep-all: the QoS of
+rmw's own reader of it, rmw_fastrtps ``init_rmw_context_impl.cpp``; the
+writers keep the last one, but the topic has no key, so every participant's
+sample falls in one instance and a keep-last reader would lose some), and
 :meth:`Discovery.poll` takes what arrived, without blocking.  The live
 monitor polls it from its DDS thread; ``rclverify ros diff --ros2`` polls it
 for a settling time and reads the graph (:mod:`.diff_dds`).  An endpoint
