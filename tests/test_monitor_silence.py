@@ -131,3 +131,31 @@ def test_a_recorded_run_without_the_nodes_events_is_never_discharged(tmp_path: P
     statuses = {e["status"] for e in report["evidence"] if e["obligation"].startswith("Echo.g0.monitors")}
     assert statuses == {"pending"}
     assert main(["verify", "-w", str(ws), "--strict"]) == 1
+
+
+def test_counting_what_a_log_holds_keeps_the_batch_path(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """The offline command counts each topic's events for the not-judged
+    items without turning a log's columnar reading into events one by one."""
+    from rclverify.backends.monitors import batch
+    from rclverify.backends.monitors.batch import check_batch
+    kinds: list[str] = []
+    real = batch.rows_of
+    monkeypatch.setattr(batch, "rows_of", lambda head, chunk: kinds.append(type(chunk).__name__) or real(head, chunk))
+    from rclverify.backends.monitors.judged import Counted
+    from rclverify.traces import read_trace
+    from rclverify.traces.mapping import load_rules
+    rcl = ("node Lim {\n  inputs( r : REAL )\n  outputs( y : REAL )\n"
+           "  topics( std_msgs/Float64 r matches(in.r), std_msgs/Float64 out matches(out.y) )\n"
+           "  assume( in.r >= 0 )\n  guarantee( out.y <= in.r )\n}\n")
+    node = check([parse_text(rcl, "lim.rcl")])
+    log = tmp_path / "run.jsonl"
+    log.write_text("".join(json.dumps({"topic": t, "time": k + d, "data": v}) + "\n"
+                           for k in range(300) for t, d, v in (("r", 0.0, 1.0), ("out", 0.5, 0.5), ("noise", 0.7, 0))))
+    heard: dict[str, int] = {}
+    stats: dict[str, int] = {}
+    rules = load_rules({"r": {"fields": ["data"]}, "out": {"fields": ["data"]}})
+    got = check_batch(node, node.nodes["Lim"], Counted(read_trace(log, streams=True), heard), rules, 5.0,
+                      chunk=64, stats=stats)
+    assert got is not None and got[1].counts["satisfied"] == 300
+    assert stats["batched"] == 300 and heard == {"r": 300, "out": 300, "noise": 300}
+    assert kinds and set(kinds) == {"LogBlock"}, kinds  # the log's blocks, never events made one by one

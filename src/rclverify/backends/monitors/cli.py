@@ -25,7 +25,7 @@ from .summary import monitoring_details, summary_line, tool_versions, verdict_st
 from .check import check_trace
 from .deadlines import DeadlineMonitor, deadline_status, has_deadlines
 from .config import ConfigError, load_mapping
-from .judged import Heard, explain, not_judged, strict_line
+from .judged import Counted, Heard, explain, not_judged, strict_line
 from .periods import PeriodMonitor, has_periods, period_status
 
 
@@ -73,8 +73,6 @@ def monitor_command(args: argparse.Namespace, checked: Checked) -> int:
 
         def tap(events: Iterable[Any]) -> Iterator[Any]:
             for ev in events:
-                key = ev.topic.strip("/")
-                heard[key] = heard.get(key, 0) + 1
                 for m in dmons:
                     m.feed(ev)
                 for p in pmons:
@@ -83,7 +81,9 @@ def monitor_command(args: argparse.Namespace, checked: Checked) -> int:
         try:
             run = read_trace(path, [root / d for d in cfg.msg_dirs], streams=True,
                              on_warning=lambda w: print(w, file=sys.stderr))
-            events, results = check_trace(checked, nodes, tap(run), cfg.rules, cfg.horizon, tolerance=cfg.tolerance)
+            source = tap(run) if dmons or pmons else run  # untapped, a log keeps its columnar reading (batch path)
+            events, results = check_trace(checked, nodes, Counted(source, heard), cfg.rules, cfg.horizon,
+                                          tolerance=cfg.tolerance)
             dres = [m.finish() for m in dmons]
             pres = [p.finish() for p in pmons]
         except TraceError as exc:

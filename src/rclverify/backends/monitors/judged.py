@@ -29,8 +29,9 @@ the live runs (:mod:`.live`, :mod:`.dds_live`).
 """
 from __future__ import annotations
 
+from collections import Counter
 from dataclasses import dataclass, field
-from typing import Any, Iterable, Mapping
+from typing import Any, Iterable, Iterator, Mapping
 
 from ...rcl.types import CheckedNode
 from .verdicts import LINK_TOPICS
@@ -57,6 +58,39 @@ class Heard:
     decode_errors: Mapping[str, int] = field(default_factory=dict)
     warnings: Iterable[str] = ()
     publishers: Mapping[str, int] | None = None
+
+
+class Counted:
+    """A recorded run's events passed on unchanged, counted per topic into
+    ``heard`` (topic without ``/`` -> events) as they are read.  A log the
+    batch path reads in blocks (``events.blocks``, rows.py) keeps that path:
+    its blocks are passed on and counted by their ``topics`` column, so
+    counting never turns the columnar reading into one event at a time."""
+
+    def __init__(self, events: Iterable[Any], heard: dict[str, int]) -> None:
+        self.events, self.heard = events, heard
+
+    def __iter__(self) -> Iterator[Any]:
+        heard = self.heard
+        for ev in self.events:
+            key = ev.topic.strip("/")
+            heard[key] = heard.get(key, 0) + 1
+            yield ev
+
+    def blocks(self, fields: Any, rows: int) -> Iterator[Any] | None:
+        """The source's blocks (``None`` when it has none), counted."""
+        source = getattr(self.events, "blocks", None)
+        got = source(fields, rows) if source is not None else None
+        return None if got is None else self._counted(got)
+
+    def _counted(self, blocks: Iterator[Any]) -> Iterator[Any]:
+        heard = self.heard
+        for block in blocks:
+            topics = [ev.topic for ev in block] if isinstance(block, list) else block.topics
+            for key, n in Counter(topics).items():
+                key = key.strip("/")
+                heard[key] = heard.get(key, 0) + n
+            yield block
 
 
 def not_judged(nodes: Iterable[CheckedNode], heard: Heard, statuses: Mapping[str, Iterable[tuple[str, str]]],
@@ -187,4 +221,4 @@ def strict_line(items: list[dict[str, str]]) -> str:
             f"{first['name']}: {first['reason']}: {first['detail']}")
 
 
-__all__ = ["Heard", "REASONS", "explain", "not_judged", "strict_line"]
+__all__ = ["Counted", "Heard", "REASONS", "explain", "not_judged", "strict_line"]
