@@ -20,8 +20,8 @@ BENCHES = sorted(p.name for p in (REPO / "bench").glob("*.py") if not p.name.sta
 #: The benches that start live services (a ROS 1 master, DDS participants, a WebSocket oracle) or run
 #: the whole pipeline several times: run from tests/test_bench_smoke_live.py, so that pytest-xdist's
 #: one-file-per-worker distribution (--dist loadfile) gives the two halves to the two workers.
-HEAVY = ("monitor_live_dds.py", "monitor_live.py", "incremental_equivalence.py", "verify_pacti.py",
-         "diagnosis_scale.py", "pipeline_scale.py", "second_solver.py")
+HEAVY = ("monitor_live_dds.py", "monitor_live_rclpy.py", "monitor_live.py", "incremental_equivalence.py",
+         "verify_pacti.py", "diagnosis_scale.py", "pipeline_scale.py", "second_solver.py")
 
 
 def test_there_are_benches() -> None:
@@ -33,8 +33,9 @@ def test_bench_runs_in_smoke_mode(bench: str, tmp_path: Path) -> None:
     run_smoke(bench, tmp_path)
 
 
-def run_smoke(bench: str, tmp_path: Path) -> None:
-    """Run ``bench/<bench> --smoke`` as its own process and check it printed figures and exited 0."""
+def run_smoke(bench: str, tmp_path: Path) -> str:
+    """Run ``bench/<bench> --smoke`` as its own process and check it printed figures and exited 0; returns
+    what it printed."""
     env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(REPO / "src")] + (
         [os.environ["PYTHONPATH"]] if os.environ.get("PYTHONPATH") else [])),
            "TMPDIR": str(tmp_path), "XDG_CACHE_HOME": str(tmp_path / "cache")}
@@ -44,3 +45,4 @@ def run_smoke(bench: str, tmp_path: Path) -> None:
     assert p.returncode == 0, f"{bench} --smoke exited {p.returncode}:\n{out[-4000:]}"
     assert "Traceback" not in out, out[-4000:]
     assert p.stdout.strip(), f"{bench} --smoke printed no figures"
+    return p.stdout

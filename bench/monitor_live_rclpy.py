@@ -1,0 +1,207 @@
+"""How much the live monitor hears, and how fast it answers, from a real
+rclpy publisher on Fast DDS (ROS 2's default middleware; issue 62).
+
+The publisher is an rclpy node in the ROS 2 Python (``.venv-ros2``, ROS 2's
+PyPI wheels, or the one ``RCLVERIFY_ROS2_PYTHON`` names) on
+``rmw_fastrtps_cpp``; ``rclverify monitor --live --ros2`` watches three of
+its topics, each of another kind of type: ``/a`` ``std_msgs/Float64``,
+``/b`` ``sensor_msgs/JointState`` (sequences of strings and numbers, read
+at ``position[0]``), ``/c`` ``geometry_msgs/PoseWithCovarianceStamped`` (a
+nested fixed array, read at ``pose.pose.position.x``), reliable, keep-last
+1000, round-robin.  Everything on 127.0.0.1 (Cyclone's loopback
+configuration, ``ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST``), a random
+``ROS_DOMAIN_ID``.  Two runs, each with processes of its own:
+
+* **loss** at ``--total-rate`` messages/s over the three topics (default
+  5000) for ``--seconds`` s: messages published, heard (per topic) and
+  checked, and the difference;
+* **latency** at ``--latency-rate`` (default 1000/s): publication (the
+  rclpy ``publish`` call's wall-clock time) to the verdict received by a
+  listener on ``/rclverify/verdict`` (bench/monitor_live_dds.py's), p50 and
+  p99 in ms, over the verdicts decided on arrival.
+
+Prints the figures, the load average and the core count; asserts nothing.
+``--smoke`` (the test suite's): 1 s at 300 and 200 messages/s; without a
+ROS 2 Python it says why and exits 0.
+"""
+from __future__ import annotations
+
+import json
+import os
+import random
+import signal
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+from typing import Any
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT / "bench"))
+from monitor_live_dds import CONFIG, _latency  # noqa: E402  (the loopback config; verdicts decided on arrival)
+
+TOPICS = {"a": ("std_msgs/Float64", "data", "A"), "b": ("sensor_msgs/JointState", "position[0]", "B"),
+          "c": ("geometry_msgs/PoseWithCovarianceStamped", "pose.pose.position.x", "C")}
+PUBLISHER = """\
+import json, sys, time
+sys.path.insert(0, sys.argv[4])
+import rclpy
+from rclpy.node import Node
+from rclpy.qos import QoSProfile, ReliabilityPolicy
+from std_msgs.msg import Float64
+from sensor_msgs.msg import JointState
+from geometry_msgs.msg import PoseWithCovarianceStamped
+from _pace import paced
+rate, seconds, out = float(sys.argv[1]), float(sys.argv[2]), sys.argv[3]
+rclpy.init()
+node = Node("bench_talker")
+qos = QoSProfile(depth=1000, reliability=ReliabilityPolicy.RELIABLE)
+pubs = {"a": node.create_publisher(Float64, "a", qos), "b": node.create_publisher(JointState, "b", qos),
+        "c": node.create_publisher(PoseWithCovarianceStamped, "c", qos)}
+until = time.monotonic() + 30
+while min(p.get_subscription_count() for p in pubs.values()) < 1:
+    if time.monotonic() > until:
+        sys.exit("the monitor's readers did not match")
+    time.sleep(0.05)
+time.sleep(0.5)
+j = JointState(name=["shoulder", "elbow", "wrist"], position=[0.5, 1.0, 1.5], velocity=[0.0] * 3, effort=[2.0] * 3)
+p = PoseWithCovarianceStamped()
+p.pose.pose.position.x = 1.0
+p.pose.covariance[0] = 0.1
+msgs = [("a", Float64(data=1.0)), ("b", j), ("c", p)]
+sent, elapsed = paced(msgs, rate, seconds, lambda topic, msg: pubs[topic].publish(msg))
+with open(out, "w") as fh:
+    json.dump({"sent": sent, "elapsed": elapsed}, fh)
+print("published", len(sent), flush=True)
+time.sleep(1.0)
+"""
+
+
+def ros2_python() -> tuple[Path | None, str]:
+    """The ROS 2 Python and ``""``, or ``None`` and why there is none."""
+    named = os.environ.get("RCLVERIFY_ROS2_PYTHON")
+    exe = Path(named) if named else ROOT / ".venv-ros2" / "bin" / "python"
+    if not exe.exists():
+        return None, f"no ROS 2 Python at {exe} (scripts/setup.sh --tests installs ROS 2's wheels into .venv-ros2)"
+    probe = subprocess.run([str(exe), "-c", "import rclpy, rmw_fastrtps_cpp"], capture_output=True, text=True,
+                           timeout=60)
+    if probe.returncode != 0:
+        return None, f"the ROS 2 Python cannot import rclpy: {(probe.stderr.strip().splitlines() or [''])[-1]}"
+    return exe, ""
+
+
+def _workspace(ws: Path) -> None:
+    rcl = "\n".join(f"node {node} {{\n  inputs( )\n  outputs( v : REAL )\n  topics( {typ} {t} matches(out.v) )\n"
+                    f"  assume( TRUE )\n  guarantee( out.v >= 0 )\n}}\n" for t, (typ, _f, node) in TOPICS.items())
+    (ws / "contracts").mkdir(parents=True)
+    (ws / "contracts/bench.rcl").write_text(rcl)
+    (ws / "contracts/plan.yaml").write_text("contracts: [contracts/bench.rcl]\n")
+    (ws / "mapping.yaml").write_text("topics:\n" + "".join(f"  {t}: {{fields: ['{f}']}}\n"
+                                                           for t, (_typ, f, _n) in TOPICS.items()))
+
+
+def _run(tmp: Path, env: dict[str, str], ros2: Path, rate: float, seconds: float, latency: bool) -> dict[str, Any]:
+    from _live import cpu_seconds, stop, wait_text
+    tag = f"{'lat' if latency else 'loss'}{int(rate)}"
+    procs: list[subprocess.Popen[bytes]] = []
+
+    def start(args: list[str], name: str) -> subprocess.Popen[bytes]:
+        p = subprocess.Popen(args, env=env, cwd=tmp, stdout=(tmp / name).open("wb"), stderr=subprocess.STDOUT,
+                             start_new_session=True)
+        procs.append(p)
+        return p
+    try:
+        lis = None
+        if latency:
+            lis = start([sys.executable, str(ROOT / "bench" / "monitor_live_dds.py"), "--listener",
+                         str(tmp / f"verdicts{tag}.json")], f"listener{tag}.out")
+            wait_text(tmp / f"listener{tag}.out", "listening", 30)
+        mon = start([sys.executable, "-m", "rclverify.cli", "monitor", "--live", "--ros2", "-w", str(tmp / "ws"),
+                     "--mapping", "mapping.yaml", "--horizon", "1.0", "--reorder-window", "0", "--status", "0",
+                     "--log", str(tmp / f"live{tag}.jsonl"), "--evidence", str(tmp / f"evidence{tag}.json")],
+                    f"monitor{tag}.out")
+        wait_text(tmp / f"monitor{tag}.out", "monitoring", 30)
+        (tmp / "publisher.py").write_text(PUBLISHER)
+        pub = start([str(ros2), str(tmp / "publisher.py"), str(rate), str(seconds), str(tmp / f"sent{tag}.json"),
+                     str(ROOT / "bench")], f"publisher{tag}.out")
+        pub.wait(seconds * 3 + 60)
+        time.sleep(1.5)  # the last messages arrive and are judged
+        cpu = cpu_seconds(mon.pid)
+        stop(mon, signal.SIGINT)
+        if lis is not None:
+            stop(lis)
+    finally:
+        for p in procs:
+            stop(p)
+    if not (tmp / f"sent{tag}.json").exists():
+        raise SystemExit(f"the rclpy publisher failed:\n{(tmp / f'publisher{tag}.out').read_text()[-2000:]}")
+    res: dict[str, Any] = {"sent": json.loads((tmp / f"sent{tag}.json").read_text()), "cpu": cpu,
+                           "record": json.loads((tmp / f"evidence{tag}.json").read_text()),
+                           "log_topics": [json.loads(x)["topic"] for x in
+                                          (tmp / f"live{tag}.jsonl").read_text().splitlines()]}
+    if latency:
+        res["verdicts"] = json.loads((tmp / f"verdicts{tag}.json").read_text())
+    return res
+
+
+def bench(total_rate: float, latency_rate: float, seconds: float) -> None:
+    """The benchmark (module docstring)."""
+    ros2, why = ros2_python()
+    if ros2 is None:
+        print(f"rclpy: skipped: {why}")
+        return
+    from _live import p99
+    load = f"load average {os.getloadavg()[0]:.1f} on {os.cpu_count()} core(s)"
+    with tempfile.TemporaryDirectory() as d:
+        tmp = Path(d)
+        _workspace(tmp / "ws")
+        (tmp / "cyclonedds.xml").write_text(CONFIG)
+        env = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "PYTHONSTARTUP")}
+        env.update(PYTHONPATH=str(ROOT / "src"), CYCLONEDDS_URI=(tmp / "cyclonedds.xml").as_uri(),
+                   ROS_DOMAIN_ID=str(random.SystemRandom().randint(1, 230)), ROS_AUTOMATIC_DISCOVERY_RANGE="LOCALHOST",
+                   RMW_IMPLEMENTATION="rmw_fastrtps_cpp", ROS_LOG_DIR=str(tmp / "ros_log"), PYTHONUNBUFFERED="1")
+        res = _run(tmp, {**env, "PYTHONPATH": str(ROOT / "src")}, ros2, total_rate, seconds, latency=False)
+        sent, rec = res["sent"]["sent"], res["record"]
+        per = {t: sum(1 for topic, _t in sent if topic == t) for t in TOPICS}
+        heard = {t: rec["qos"][t]["samples"] for t in TOPICS}
+        lost = len(sent) - rec["events"]
+        print(f"rclpy: loss: {total_rate:.0f} msg/s asked over {len(TOPICS)} topics: published {len(sent)} in "
+              f"{res['sent']['elapsed']:.2f} s ({len(sent) / res['sent']['elapsed']:.0f} msg/s); heard "
+              f"{sum(heard.values())} ({', '.join(f'/{t} {heard[t]}/{per[t]}' for t in TOPICS)}); checked "
+              f"{rec['events']}; lost {lost}; decode errors {sum(rec['decode_errors'].values())}; {load}")
+        if res["cpu"] is not None:
+            print(f"rclpy: loss: monitor CPU {res['cpu'] / max(1, len(sent)) * 1e6:.0f} us per message "
+                  f"(start-up included), engine thread {rec.get('engine_cpu_us_per_message', 0):.0f} us")
+        res = _run(tmp, env, ros2, latency_rate, seconds, latency=True)
+        lat = _latency(res)
+        if lat:
+            print(f"rclpy: latency: {latency_rate:.0f} msg/s: publication -> verdict received over {len(lat)} "
+                  f"verdict(s) decided on arrival: p50 {statistics.median(lat):.2f} ms, p99 {p99(lat):.2f} ms, "
+                  f"max {lat[-1]:.2f} ms; checked {res['record']['events']} of {len(res['sent']['sent'])}; "
+                  f"load average {os.getloadavg()[0]:.1f}")
+        else:
+            print(f"rclpy: latency: {latency_rate:.0f} msg/s: no verdict decided on arrival was received "
+                  f"(checked {res['record']['events']} of {len(res['sent']['sent'])})")
+
+
+def main(argv: list[str] | None = None) -> int:
+    import argparse
+    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--total-rate", type=float, default=5000.0, help="messages/s over the three topics (loss run)")
+    p.add_argument("--latency-rate", type=float, default=1000.0, help="messages/s of the latency run")
+    p.add_argument("--seconds", type=float, default=5.0)
+    p.add_argument("--smoke", action="store_true", help="CI: 1 s at 300 and 200 messages/s")
+    a = p.parse_args(argv)
+    if a.smoke:
+        bench(300.0, 200.0, 1.0)
+    else:
+        bench(a.total_rate, a.latency_rate, a.seconds)
+    return 0
+
+
+if __name__ == "__main__":
+    from _live import exit_on_sigterm  # SIGTERM stops what the bench started (bench/_live.py)
+    exit_on_sigterm()
+    sys.exit(main())
