@@ -14,6 +14,11 @@
   printer keeps none); a clause with a comment inside is left as written.
   A text that does not parse is not formatted (the request fails with the
   syntax error, as ``rclverify fmt`` does).
+
+Line ends (:mod:`.lines`): positions are computed on the text with ``\n``
+line ends, which has the editor's lines and columns; the text an edit
+inserts is written with the document's own line end (:func:`.lines.eol_of`),
+so formatting a CRLF, CR or mixed file neither adds nor loses a line end.
 """
 from __future__ import annotations
 
@@ -21,11 +26,11 @@ import re
 from typing import Any, Mapping
 
 from lsprotocol import types as lsp
-from pygls.exceptions import JsonRpcException
-
 from ..rcl.errors import RclError
 from .diagnostics import utf16_col
 from .lastrun import LastRun
+from .lines import eol_of, for_parser, split_lines, with_eol
+from .rpc import Failed
 from .workspace import LspWorkspace, Outside
 
 _COMMENT = re.compile(r"//|/\*")
@@ -61,11 +66,11 @@ def fix_edit(ws: LspWorkspace, open_docs: Mapping[str, str], fix: Mapping[str, A
         text = open_docs.get(rel, disk)
         if text is None or text != disk:
             return None
-        lines = text.split("\n")
+        lines, eol = split_lines(text), eol_of(text)
         for rep in ch.get("replacements") or ():
             r = rep["deletedRegion"]
             rng = lsp.Range(_pos(lines, r["startLine"], r["startColumn"]), _pos(lines, r["endLine"], r["endColumn"]))
-            changes.setdefault(ws.uri(rel), []).append(lsp.TextEdit(rng, rep["insertedContent"]["text"]))
+            changes.setdefault(ws.uri(rel), []).append(lsp.TextEdit(rng, with_eol(rep["insertedContent"]["text"], eol)))
     return lsp.WorkspaceEdit(changes=changes) if changes else None
 
 
@@ -101,15 +106,18 @@ def quick_fixes(ws: LspWorkspace, open_docs: Mapping[str, str], rel: str,
 def format_edits(rel: str, text: str) -> list[lsp.TextEdit]:
     """The edits that bring ``text`` (the file ``rel``) to ``rclverify
     fmt``'s form clause by clause (see the module docstring); ``[]`` when it
-    is in that form.  Raises a JSON-RPC error with the located syntax
-    error when ``text`` does not parse."""
+    is in that form.  ``text`` may have any line ends; the inserted text
+    has the document's (module docstring).  Raises :class:`.rpc.Failed`
+    (LSP ``RequestFailed``) with the located syntax error when ``text``
+    does not parse."""
     from ..rcl.parser import parse_text
     from ..rcl.printer import context_to_rcl, node_to_rcl
+    eol, text = eol_of(text), for_parser(text)
     try:
         spec = parse_text(text, rel)
     except RclError as exc:
-        raise JsonRpcException(str(exc.diagnostics[0])) from None
-    lines = text.split("\n")
+        raise Failed(str(exc.diagnostics[0])) from None
+    lines = split_lines(text)
     edits = []
     clauses: list[Any] = [(c, context_to_rcl(c)) for c in spec.contexts] + [(n, node_to_rcl(n)) for n in spec.nodes]
     for clause, printed in clauses:
@@ -121,7 +129,7 @@ def format_edits(rel: str, text: str) -> list[lsp.TextEdit]:
         if old == printed or _COMMENT.search(old):
             continue
         edits.append(lsp.TextEdit(lsp.Range(_pos(lines, loc.line, loc.col), _pos(lines, loc.end_line, loc.end_col)),
-                                  printed))
+                                  with_eol(printed, eol)))
     return edits
 
 

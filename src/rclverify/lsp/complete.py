@@ -24,6 +24,7 @@ from lsprotocol import types as lsp
 
 from .diagnostics import Analysis
 from .index import all_nodes, code_point_col, declarations, node_at
+from .lines import split_lines
 
 #: The words of rcl.lark that are keywords somewhere (reserved or contextual).
 KEYWORDS = ("context", "node", "inputs", "outputs", "topics", "matches", "assume", "guarantee", "triggered", "by",
@@ -93,13 +94,13 @@ def completions(a: Analysis | None, rel: str, text: str, line: int, char16: int,
                 messages: MessageTypes | None = None) -> list[lsp.CompletionItem]:
     """The completion items at the LSP position of ``rel`` (whose text is
     ``text``) from the analysis ``a`` (``None``: keywords and units only)."""
-    lines = text.split("\n")
+    lines = split_lines(text)
     here = lines[line] if 0 <= line < len(lines) else ""
     before = here[:code_point_col(here, char16)]
     K = lsp.CompletionItemKind
     if _UNIT.search(before):
         from ..rcl.units import SYMBOLS
-        return [_item(name, K.Unit, sym.what) for name, sym in SYMBOLS.items()]
+        return [_item(name, K.Unit, sym.name) for name, sym in SYMBOLS.items()]  # Symbol.name: what the unit is
     node = node_at(a, rel, line + 1) if a is not None else None
     m = _IO.search(before)
     if m:

@@ -24,6 +24,7 @@ from lsprotocol import types as lsp
 
 from ..rcl import ast
 from ..rcl.errors import Diagnostic, RclError, error
+from .lines import for_parser
 from .workspace import LspWorkspace
 
 #: The longest text (characters) analysed as you type: some 40 times the
@@ -58,13 +59,15 @@ class Analysis:
 def analyse(ws: LspWorkspace, rel: str, open_docs: Mapping[str, str]) -> Analysis:
     """Check ``rel`` (root-relative) with the files of its scope, open
     documents from ``open_docs`` (root-relative path -> text), the others from
-    disk.  Returns the :class:`Analysis`; never raises for what a text holds
+    disk.  The texts are parsed, and kept in ``texts``, with ``\n`` line
+    ends (:func:`.lines.for_parser`), so the parser's lines are LSP's.
+    Returns the :class:`Analysis`; never raises for what a text holds
     (every problem is a diagnostic)."""
     files = ws.scope(rel)
     a = Analysis(rel, files)
     for f in files:
         try:
-            a.texts[f] = ws.text(f, open_docs)
+            a.texts[f] = for_parser(ws.text(f, open_docs))
         except RclError as exc:
             a.add(exc.diagnostics)
             continue

@@ -24,6 +24,7 @@ from typing import Any, Iterator
 
 from ..rcl import ast
 from .diagnostics import Analysis
+from .lines import normalize, split_lines
 
 _WORD = re.compile(r"(?<![\w.])(?:in|out|state)\.[A-Za-z_]\w*'*|[A-Za-z_]\w*(?:\.(?:in|out|state)\.[A-Za-z_]\w*'*)?'*")
 _COMMENTS = re.compile(r"//[^\n]*|/\*.*?(?:\*/|\Z)", re.S)
@@ -62,8 +63,11 @@ def comment_spans(text: str, yaml: bool = False) -> list[tuple[int, int]]:
 
 def word_at(text: str, line: int, char16: int, yaml: bool = False) -> tuple[str, int, int] | None:
     """``(word, start, end)`` (0-based code-point columns) of the name at
-    the LSP position, ``None`` on anything else or in a comment."""
-    lines = text.split("\n")
+    the LSP position, ``None`` on anything else or in a comment (a
+    position past the end of the document, ``None``; past the end of its
+    line, the line's end, as LSP 3.17 "Position" says)."""
+    text = normalize(text)
+    lines = split_lines(text)
     if not 0 <= line < len(lines):
         return None
     here = lines[line]
@@ -128,7 +132,7 @@ def symbol_at(a: Analysis, rel: str, text: str, line: int, char16: int, plan: bo
     word, start, end = found
     nodes = all_nodes(a)
     if plan:
-        return _plan_symbol(a, word, start, text.split("\n")[line], nodes)
+        return _plan_symbol(a, word, start, split_lines(text)[line], nodes)
     node = node_at(a, rel, line + 1)
     if "." in word and node is not None:
         prefix, _, var = word.partition(".")
@@ -168,11 +172,12 @@ def _plan_symbol(a: Analysis, word: str, start: int, line_text: str, nodes: dict
 
 def occurrences(text: str, name: str, yaml: bool = False) -> Iterator[tuple[int, int, int]]:
     """``(line, start, end)`` (0-based, code points) of every whole-word
-    occurrence of ``name`` in ``text`` outside comments."""
+    occurrence of ``name`` in ``text`` (any line ends, LSP's lines) outside comments."""
+    text = normalize(text)
     spans = comment_spans(text, yaml)
     pattern = re.compile(r"(?<![\w.'])" + re.escape(name) + r"(?![\w'])")
     starts = [0]
-    for line in text.split("\n"):
+    for line in split_lines(text):
         starts.append(starts[-1] + len(line) + 1)
     import bisect
     for m in pattern.finditer(text):

@@ -26,6 +26,7 @@ from lsprotocol import types as lsp
 
 from ..rcl.errors import RclError
 from .diagnostics import utf16_col
+from .lines import split_lines
 
 SARIF = "reports/assurance.sarif"
 REPORT = "reports/assurance.json"
@@ -99,7 +100,7 @@ class LastRun:
     def diagnostics(self, rel: str, text: str, fresh: bool) -> list[lsp.Diagnostic]:
         """The findings in ``rel`` as LSP diagnostics over ``text`` (code:
         the SARIF rule id; ``data``: the fixes, when ``fresh``)."""
-        lines = text.split("\n")
+        lines = split_lines(text)
         out = []
         for f in self.findings():
             if f.file != rel:

@@ -31,12 +31,13 @@ from lsprotocol import types as lsp
 from ..rcl import ast
 from .diagnostics import Analysis, lsp_range, utf16_col
 from .index import Symbol, all_nodes, declarations, occurrences
+from .lines import split_lines
 from .workspace import LspWorkspace
 
 
 def _loc(ws: LspWorkspace, texts: Mapping[str, str], loc: ast.Loc) -> lsp.Location:
     text = texts.get(loc.file) or ws.disk_text(loc.file) or ""
-    return lsp.Location(ws.uri(loc.file), lsp_range(loc, text.split("\n")))
+    return lsp.Location(ws.uri(loc.file), lsp_range(loc, split_lines(text)))
 
 
 def _io_decl(a: Analysis, node: str, prefix: str, var: str) -> ast.IOVar | None:
@@ -81,7 +82,9 @@ def definition(ws: LspWorkspace, a: Analysis, texts: Mapping[str, str], sym: Sym
             if r.id == sym.name:
                 for s in r.support:
                     n = nodes.get(s.node)
-                    for k in s.guarantees if n else ():
+                    if n is None:
+                        continue
+                    for k in s.guarantees:
                         if 1 <= k <= len(n.guarantees):
                             locs.append(n.guarantees[k - 1].loc)
     elif sym.kind == "guarantee":
@@ -131,13 +134,13 @@ def references(ws: LspWorkspace, a: Analysis, texts: Mapping[str, str], sym: Sym
             found = _in_node(files[n.loc.file], n, names, n.loc.file)
             decl = _io_decl(a, node, prefix, var)
             # the bare name counts only at its declaration (elsewhere it may be another thing)
-            hits += [h for h in found if h[2] + 1 == (decl.loc.col if decl else -1) and h[1] + 1 == decl.loc.line
-                     or files[h[0]].split("\n")[h[1]][h[2]:h[3]].startswith(prefix + ".")]
+            hits += [h for h in found if decl is not None and (h[1] + 1, h[2] + 1) == (decl.loc.line, decl.loc.col)
+                     or split_lines(files[h[0]])[h[1]][h[2]:h[3]].startswith(prefix + ".")]
             if ws.plan in files:
                 hits += [(ws.plan, line, s, e) for line, s, e in occurrences(files[ws.plan], f"{node}.{prefix}.{var}", yaml=True)]
     out = []
     for f, line, s, e in sorted(set(hits)):
-        here = files[f].split("\n")[line]
+        here = split_lines(files[f])[line]
         out.append(lsp.Location(ws.uri(f), lsp.Range(lsp.Position(line, utf16_col(here, s)),
                                                        lsp.Position(line, utf16_col(here, e)))))
     return out

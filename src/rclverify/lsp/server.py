@@ -15,10 +15,17 @@ this package (docs/editor.md).
   system type-checked.
 
 Every request for a document outside the workspace is refused
-(:class:`.workspace.Outside`: a JSON-RPC error whose message names the
-file); a notification about one is ignored with a log message.  An
-unexpected exception in a handler is answered as an error too and the
-server goes on (pygls catches it): no text can stop the server.
+(:class:`.workspace.Outside`: a JSON-RPC error -32602 whose message names
+the file); a notification about one is ignored with a log message.  Every
+request is answered (:mod:`.rpc`): one whose params do not have the
+protocol's types with -32602, an unexpected exception in a handler with a
+one-line -32603 error (no traceback), and the server goes on: no text and
+no request can stop it.  A position past the end of its line or of the
+document is answered as a position where nothing stands (hover ``null``,
+no definition, no references).
+
+Lines are LSP's (:mod:`.lines`: ``\r\n``, ``\r`` and ``\n`` end a line);
+texts go to the parser with ``\n`` line ends.
 """
 from __future__ import annotations
 
@@ -29,12 +36,13 @@ from typing import Any
 from urllib.parse import unquote, urlparse
 
 from lsprotocol import types as lsp
-from pygls.exceptions import JsonRpcException
 from pygls.lsp.server import LanguageServer
 
 from .. import __version__
 from .diagnostics import Analysis, analyse, to_lsp
 from .lastrun import LastRun
+from .lines import split_lines
+from .rpc import RclProtocol, Refused, guarded, log_one_line, one_line
 from .workspace import PLAN, LspWorkspace, Outside
 
 #: Seconds a check of the text as you type may take before it is abandoned.
@@ -43,19 +51,13 @@ TIME_LIMIT = 5.0
 POLL = 1.0
 
 
-class Refused(JsonRpcException):
-    """A request about a document outside the workspace (JSON-RPC error
-    -32602, invalid params), with the reason as its message."""
-
-    CODE = -32602
-
-
 class RclServer(LanguageServer):
     """The RCL language server of one workspace (rooted at the client's
     workspace folder, see :mod:`.workspace`)."""
 
     def __init__(self) -> None:
-        super().__init__("rclverify", __version__, text_document_sync_kind=lsp.TextDocumentSyncKind.Full)
+        super().__init__("rclverify", __version__, text_document_sync_kind=lsp.TextDocumentSyncKind.Full,
+                         protocol_cls=RclProtocol)
         self.ws = LspWorkspace(Path(os.getcwd()))
         self.last = LastRun(self.ws.root)
         self.analyses: dict[tuple[str, ...], Analysis] = {}
@@ -81,9 +83,9 @@ class RclServer(LanguageServer):
     def open_texts(self) -> dict[str, str]:
         """The editor's text of every open document of the workspace, by root-relative path."""
         out = {}
-        for uri, doc in list(self.workspace.text_documents.items()):
+        for doc in list(self.workspace.text_documents.values()):
             try:
-                out[self.ws.rel(uri)] = doc.source
+                out[self.ws.rel(doc.uri)] = doc.source
             except Outside:
                 continue
         return out
@@ -149,9 +151,13 @@ class RclServer(LanguageServer):
             now = self.last.written()
             if now != seen:
                 seen = now
-                texts = self.open_texts()
-                for a in list(self.analyses.values()):
-                    self.publish(a, texts)
+                try:
+                    texts = self.open_texts()
+                    for a in list(self.analyses.values()):
+                        self.publish(a, texts)
+                except Exception as exc:  # a fault of the server: said in one line, and the watch goes on
+                    self.window_log_message(lsp.LogMessageParams(
+                        lsp.MessageType.Error, one_line(f"publishing the last run's findings failed: {exc!r}")))
 
     def publish(self, a: Analysis, texts: dict[str, str]) -> None:
         """Publish ``a``'s diagnostics for every file it has some for and every
@@ -163,7 +169,7 @@ class RclServer(LanguageServer):
             text = texts.get(f)
             if text is None:
                 text = self.ws.shown_text(f)
-            lines = text.split("\n")
+            lines = split_lines(text)
             diags = [to_lsp(d, lines) for d in a.diagnostics.get(f, [])]
             fresh = self.last.fresh(f, texts.get(f), self.ws.disk_text(f))
             diags += self.last.diagnostics(f, text, fresh)
@@ -190,6 +196,7 @@ def _root_of(params: lsp.InitializeParams) -> Path | None:
 
 
 @SERVER.feature(lsp.INITIALIZE)
+@guarded(lsp.INITIALIZE)
 def _initialize(ls: RclServer, params: lsp.InitializeParams) -> None:
     root = _root_of(params)
     opts = params.initialization_options if isinstance(params.initialization_options, dict) else {}
@@ -199,6 +206,7 @@ def _initialize(ls: RclServer, params: lsp.InitializeParams) -> None:
 
 
 @SERVER.feature(lsp.INITIALIZED)
+@guarded(lsp.INITIALIZED, notification=True)
 def _initialized(ls: RclServer, params: lsp.InitializedParams) -> None:
     asyncio.ensure_future(ls.watch_last_run())
 
@@ -219,21 +227,25 @@ async def _check_uri(ls: RclServer, uri: str) -> None:
 
 
 @SERVER.feature(lsp.TEXT_DOCUMENT_DID_OPEN)
+@guarded(lsp.TEXT_DOCUMENT_DID_OPEN, notification=True)
 async def _did_open(ls: RclServer, params: lsp.DidOpenTextDocumentParams) -> None:
     await _check_uri(ls, params.text_document.uri)
 
 
 @SERVER.feature(lsp.TEXT_DOCUMENT_DID_CHANGE)
+@guarded(lsp.TEXT_DOCUMENT_DID_CHANGE, notification=True)
 async def _did_change(ls: RclServer, params: lsp.DidChangeTextDocumentParams) -> None:
     await _check_uri(ls, params.text_document.uri)
 
 
 @SERVER.feature(lsp.TEXT_DOCUMENT_DID_SAVE)
+@guarded(lsp.TEXT_DOCUMENT_DID_SAVE, notification=True)
 async def _did_save(ls: RclServer, params: lsp.DidSaveTextDocumentParams) -> None:
     await _check_uri(ls, params.text_document.uri)
 
 
 @SERVER.feature(lsp.TEXT_DOCUMENT_DID_CLOSE)
+@guarded(lsp.TEXT_DOCUMENT_DID_CLOSE, notification=True)
 def _did_close(ls: RclServer, params: lsp.DidCloseTextDocumentParams) -> None:
     rel = _notified(ls, params.text_document.uri)
     if rel is not None and rel in ls._published:
@@ -245,13 +257,14 @@ def text_of(ls: RclServer, uri: str) -> tuple[str, str]:
     """``(root-relative path, text)`` of the document ``uri`` (the editor's,
     else the saved one); raises :class:`Refused` outside the workspace."""
     rel = ls.rel(uri)
-    doc = ls.workspace.text_documents.get(uri)
+    doc = ls.workspace.text_documents.get(unquote(uri))  # pygls files open documents under the unquoted URI
     if doc is not None:
         return rel, doc.source
     return rel, ls.ws.disk_text(rel) or ""
 
 
 @SERVER.feature(lsp.TEXT_DOCUMENT_FORMATTING)
+@guarded(lsp.TEXT_DOCUMENT_FORMATTING)
 def _formatting(ls: RclServer, params: lsp.DocumentFormattingParams) -> list[lsp.TextEdit] | None:
     from .actions import format_edits
     rel, text = text_of(ls, params.text_document.uri)
@@ -260,6 +273,7 @@ def _formatting(ls: RclServer, params: lsp.DocumentFormattingParams) -> list[lsp
 
 @SERVER.feature(lsp.TEXT_DOCUMENT_CODE_ACTION,
                 lsp.CodeActionOptions(code_action_kinds=[lsp.CodeActionKind.QuickFix]))
+@guarded(lsp.TEXT_DOCUMENT_CODE_ACTION)
 def _code_action(ls: RclServer, params: lsp.CodeActionParams) -> list[lsp.CodeAction]:
     from .actions import quick_fixes
     rel, _text = text_of(ls, params.text_document.uri)
@@ -278,6 +292,7 @@ def _symbol(ls: RclServer, uri: str, pos: lsp.Position) -> tuple[Any, Any] | Non
 
 
 @SERVER.feature(lsp.TEXT_DOCUMENT_HOVER)
+@guarded(lsp.TEXT_DOCUMENT_HOVER)
 def _hover(ls: RclServer, params: lsp.HoverParams) -> lsp.Hover | None:
     from .hover import hover
     found = _symbol(ls, params.text_document.uri, params.position)
@@ -285,6 +300,7 @@ def _hover(ls: RclServer, params: lsp.HoverParams) -> lsp.Hover | None:
 
 
 @SERVER.feature(lsp.TEXT_DOCUMENT_DEFINITION)
+@guarded(lsp.TEXT_DOCUMENT_DEFINITION)
 def _definition(ls: RclServer, params: lsp.DefinitionParams) -> list[lsp.Location] | None:
     from .navigate import definition
     found = _symbol(ls, params.text_document.uri, params.position)
@@ -292,6 +308,7 @@ def _definition(ls: RclServer, params: lsp.DefinitionParams) -> list[lsp.Locatio
 
 
 @SERVER.feature(lsp.TEXT_DOCUMENT_REFERENCES)
+@guarded(lsp.TEXT_DOCUMENT_REFERENCES)
 def _references(ls: RclServer, params: lsp.ReferenceParams) -> list[lsp.Location] | None:
     from .navigate import references
     found = _symbol(ls, params.text_document.uri, params.position)
@@ -301,6 +318,7 @@ def _references(ls: RclServer, params: lsp.ReferenceParams) -> list[lsp.Location
 
 
 @SERVER.feature(lsp.TEXT_DOCUMENT_COMPLETION, lsp.CompletionOptions(trigger_characters=[".", "[", " "]))
+@guarded(lsp.TEXT_DOCUMENT_COMPLETION)
 def _completion(ls: RclServer, params: lsp.CompletionParams) -> lsp.CompletionList:
     from .complete import MessageTypes, completions
     rel, text = text_of(ls, params.text_document.uri)
@@ -316,5 +334,6 @@ def serve(root: Path | None = None, plan: str = PLAN) -> int:
     the client names none); returns the exit code 0."""
     if root is not None:
         SERVER.set_root(root, plan)
+    log_one_line()
     SERVER.start_io()
     return 0

@@ -36,6 +36,21 @@ class Outside(Exception):
     ``str()`` is the one-line reason the server answers with."""
 
 
+def _shown(text: str) -> str:
+    """``text`` as a message may show it: control characters escaped, at most 200 characters."""
+    out = "".join(c if c.isprintable() else repr(c)[1:-1] for c in text)
+    return out if len(out) <= 200 else out[:197] + "..."
+
+
+def _encodable(name: str) -> bool:
+    """Whether ``name`` is text a file name can hold (no lone surrogate)."""
+    try:
+        name.encode("utf-8")
+    except UnicodeEncodeError:
+        return False
+    return True
+
+
 class LspWorkspace:
     """The workspace rooted at ``root`` (a directory).
 
@@ -49,16 +64,29 @@ class LspWorkspace:
     def rel(self, uri: str) -> str:
         """The root-relative POSIX path of the document ``uri``
         (``file:///.../contracts/a.rcl`` -> ``contracts/a.rcl``).  Raises
-        :class:`Outside` for a URI of another scheme or a path that is not
-        inside the root (after resolving symbolic links and ``..``)."""
-        parsed = urlparse(uri)
+        :class:`Outside` for a URI of another scheme, a path with a NUL
+        character or a lone surrogate (no file can have that name), or a
+        path that is not inside the root (after resolving symbolic links
+        and ``..``); the reason shows the URI with its control characters
+        escaped."""
+        shown = _shown(uri)
+        try:
+            parsed = urlparse(uri)
+        except ValueError:  # e.g. a malformed IPv6 host
+            raise Outside(f"{shown}: refused: not a valid URI") from None
         if parsed.scheme != "file":
-            raise Outside(f"{uri}: refused: not a file of the workspace {self.root.name}")
-        path = Path(os.path.realpath(unquote(parsed.path)))
+            raise Outside(f"{shown}: refused: not a file of the workspace {self.root.name}")
+        name = unquote(parsed.path)
+        if "\x00" in name or not _encodable(name):
+            raise Outside(f"{shown}: refused: not a valid file name (it holds a NUL character or a lone surrogate)")
+        try:
+            path = Path(os.path.realpath(name))
+        except (OSError, ValueError) as exc:
+            raise Outside(f"{shown}: refused: the path cannot be resolved ({exc.__class__.__name__})") from None
         try:
             return path.relative_to(self.root).as_posix()
         except ValueError:
-            raise Outside(f"{path}: refused: outside the workspace {self.root} (the server reads "
+            raise Outside(f"{_shown(str(path))}: refused: outside the workspace {self.root} (the server reads "
                           "only the files of its workspace)") from None
 
     def uri(self, rel: str) -> str:
