@@ -364,3 +364,15 @@ def test_the_qos_the_code_asks_for(tmp_path: Path) -> None:
     assert {k: (v.reliability, v.durability) if v else None for k, v in got.items()} == {
         3: ("reliable", "volatile"), 4: ("best_effort", "volatile"), 5: ("best_effort", "volatile"),
         7: ("reliable", "transient_local"), 8: (None, None), 10: ("best_effort", "volatile")}
+
+
+def test_a_namespace_computed_at_run_time_is_a_located_warning(tmp_path: Path) -> None:
+    pkg = write_ws(tmp_path)
+    cam = pkg / "demo_pkg" / "camera.py"
+    cam.write_text(cam.read_text().replace("import rclpy\n", "import os\nimport rclpy\n")
+                   .replace("namespace='sensors'", "namespace=os.environ['ROBOT']"))
+    from rclverify.ros.graph import scan
+    g = scan([tmp_path / "src"], base=tmp_path)
+    notes = [str(n) for n in g.graph.notes if "namespace of node 'camera'" in n.message]
+    assert notes == ["src/demo_pkg/demo_pkg/camera.py:8:12: warning: namespace of node 'camera' is not a string "
+                     "literal: not resolved statically (the root namespace is shown unless a launch file gives one)"]

@@ -290,6 +290,11 @@ class Linker(LinkMembers, Values):
                                 note(Note(src, "node name is not a string literal: not resolved statically"))
                                 continue
                             nsv = self.eval(ns, env, fkey)[0] if ns is not None else None
+                            if ns is not None and (nsv is None or symbols.text(nsv) is None):
+                                note(Note(src, f"namespace of node '{t}' is not a string literal: not resolved "
+                                               f"statically (the root namespace is shown unless a launch file "
+                                               f"gives one)"))
+                                nsv = None
                             # "" and no namespace are the same (a base's default ns = "")
                             item = (t, src, (symbols.text(nsv) or None) if nsv is not None else None, unit, pins)
                             if not any(x[0] == t and x[2] == item[2] for x in named):

@@ -245,8 +245,8 @@ def extract(mod: PyModule, shown: str) -> dict[str, Any]:
                                             f"{mod.imports[head]}, the first (line {lines[0]})", "ROS-UNRESOLVED"))
         if head not in mod.imports and "." not in v.text and mod.star:
             want = "srv" if kind.startswith("service") else "action" if kind.startswith("action") else "msg"
-            cands = sorted({_typed(f"{m}.{v.text}", kind) for m in mod.star
-                            if m.split(".")[-1] == ("msg" if want == "action" else want)} - {None})
+            cands = sorted({t for m in mod.star if m.split(".")[-1] == ("msg" if want == "action" else want)
+                            for t in [_typed(f"{m}.{v.text}", kind)] if t is not None})
             if len(cands) == 1:
                 return cands[0], None
             return None, (("cands", tuple(cands)) if cands else None)
@@ -292,7 +292,8 @@ def extract(mod: PyModule, shown: str) -> dict[str, Any]:
                 continue
             life = "lifecycle" if _node_class(mod, sc.class_at(c.src.line), lifecycle=sc.full) else None
             ns = c.kwargs.get("namespace")  # rclpy: keyword-only (Node, create_node); rospy has none
-            out["node_names"].append((val, c.src, unit, sc.fn_key(c.src.line), sc.value(ns) if ns else None, life))
+            nsv = (sc.value(ns) or ("runtime", "computed at run time")) if ns else None
+            out["node_names"].append((val, c.src, unit, sc.fn_key(c.src.line), nsv, life))
             continue
         spec = _CTORS.get(f)
         if spec is None and "actionlib" in f and last in _CTORS:
