@@ -175,8 +175,15 @@ def test_a_late_answer_is_a_false_deadline_live_and_offline(run: dict[str, Any],
     rec = run["record"]["echo"]
     (dl,) = rec["topic_deadlines"]
     assert dl["node"] == "Echo" and dl["status"] == "failed", (dl, run["out"]["echo"])
-    assert dl["deadlines"]["counts"] == {"true": 9, "false": 1, "currently_false": 0}, dl
-    assert dl["deadlines"]["first_false"]["trigger_where"] and "100 ms" in dl["deadlines"]["first_false"]["reason"]
+    counts = dl["deadlines"]["counts"]
+    # every answer but the late one comes within 100 ms on an idle machine (9 true); a loaded one may be slower
+    assert counts["false"] >= 1 and counts["true"] + counts["false"] == 10 and counts["true"] >= 5, dl
+    assert "100 ms" in dl["deadlines"]["first_false"]["reason"]
+    log = [json.loads(x) for x in (run["tmp"] / "echo.jsonl").read_text().splitlines()]
+    messages = [x for x in log if not x["topic"].startswith("rclverify/")]  # "message N": the N-th released
+    late = [messages[int(x["verdict"]["trigger_where"].split()[-1])]["data"] for x in log
+            if x.get("kind") == "deadline" and x["verdict"]["verdict"] == "false" and not x["verdict"]["update"]]
+    assert 3.0 in late and len(late) == counts["false"], late
     assert run["codes"]["echo"] == 1 and "deadlines: Echo: failed" in run["out"]["echo"]
     echo = next(n for n in rec["nodes"] if n["node"] == "Echo")
     assert rec["not_judged"] == [] and echo["counts"]["satisfied"] == 10, (rec["not_judged"], echo)
