@@ -43,7 +43,8 @@ def add_parsers(sub: Any) -> None:
     d.add_argument("--ros2", action="store_true", help="the running ROS 2 system: its DDS domain (ROS_DOMAIN_ID, "
                    "CYCLONEDDS_URI), nodes from ros_discovery_info, endpoints and QoS from DDS discovery")
     d.add_argument("--wait", type=float, default=2.0, metavar="S",
-                   help="--ros2: seconds to listen to discovery before comparing (default 2)")
+                   help="--ros2: seconds to listen to discovery before comparing (default 2), then up to 6 s "
+                        "more while a ROS 2 participant's node list or endpoints are still on their way")
     d.add_argument("--bag", metavar="BAG", help="a recorded run: .bag, ROS 2 bag dir, .mcap (topics and types only)")
     d.add_argument("--json", metavar="FILE", help="write both lists as JSON (docs/ros.md)")
     d.set_defaults(fn=cmd_diff)
