@@ -255,6 +255,44 @@ async def formatting_lf(client: LanguageClient, ws: Path, text: str) -> list[lsp
         client.text_document_did_close(lsp.DidCloseTextDocumentParams(lsp.TextDocumentIdentifier(u)))
 
 
+async def test_a_quick_fix_inserts_the_documents_line_end(client: LanguageClient, ws: Path) -> None:
+    """A repair of the last run whose text spans two lines, offered in a CRLF file: its edit inserts CRLF.
+    The SARIF log is written here in the form the report writes (the fix by rclverify.diagnosis.edits.sarif_fix,
+    the run's own producer of it): a run of the pipeline offers no repair of two lines to test with."""
+    import json
+
+    from rclverify.diagnosis.edits import sarif_fix
+    rel = "contracts/c.rcl"
+    lf = CONTRACT.replace("Driver", "Third").replace("Brake", "Stop")
+    text = lf.replace("\n", "\r\n")
+    (ws / rel).write_bytes(text.encode("utf-8"))
+    line = lf.split("\n").index("  guarantee( out.stop -> in.speed <= vmax )") + 1
+    fix = sarif_fix("Split guarantee 1 of Stop. Z3 shows: nothing; not shown: anything.", {
+        "file": rel, "line": line, "col": 3, "end_line": line, "end_col": 44,
+        "inserted": "guarantee( out.stop -> in.speed <= vmax )\n  guarantee( in.speed >= 0 [m/s] )"})
+    result = {"ruleId": "RCL-TEST", "level": "warning", "message": {"text": "a finding"}, "fixes": [fix],
+              "locations": [{"physicalLocation": {"artifactLocation": {"uri": rel},
+                                                  "region": {"startLine": line, "startColumn": 3}}}]}
+    sarif = ws / "reports" / "assurance.sarif"
+    sarif.parent.mkdir(exist_ok=True)
+    sarif.write_text(json.dumps({"version": "2.1.0", "runs": [{"results": [result]}]}), encoding="utf-8")
+    stamp = (ws / rel).stat().st_mtime + 1
+    os.utime(sarif, (stamp, stamp))  # the run wrote its log after the file was saved: the finding is fresh
+    u = (ws / rel).as_uri()
+    open_doc(client, u, text)
+    got, err = await answer(client.text_document_code_action_async(lsp.CodeActionParams(
+        lsp.TextDocumentIdentifier(u), lsp.Range(lsp.Position(line - 1, 0), lsp.Position(line - 1, 5)),
+        lsp.CodeActionContext(diagnostics=[]))))
+    assert err is None and got, (err, got)
+    (edit,) = got[0].edit.changes[u]
+    assert "\r\n" in edit.new_text and "\n" not in edit.new_text.replace("\r\n", "")
+    fixed = apply_edits(text, [edit])
+    assert set(_BREAK.findall(fixed)) == {"\r\n"}
+    assert normalize(fixed) == lf.replace("  guarantee( out.stop -> in.speed <= vmax )",
+                                          "  guarantee( out.stop -> in.speed <= vmax )\n  guarantee( in.speed >= 0 [m/s] )")
+    client.text_document_did_close(lsp.DidCloseTextDocumentParams(lsp.TextDocumentIdentifier(u)))
+
+
 @pytest.mark.filterwarnings("ignore:The test <Function")
 def test_an_unexpected_exception_is_one_line() -> None:
     """The guard around every handler (in this process: no request makes the real server fail on purpose)."""
