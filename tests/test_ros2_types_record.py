@@ -263,3 +263,22 @@ def test_the_bag_checked_offline_gives_the_live_verdicts(run: dict[str, Any], st
                for e in report if "counts" in e}
     assert offline == _counts(run["record"][storage]) == EXPECTED, (offline, got.err)
     assert rc == 1, got.err  # violated guarantees: a failing exit, live and offline
+
+
+def test_a_contract_over_a_wstring_type_is_refused_at_its_topic(tmp_path: Path,
+                                                                 capsys: pytest.CaptureFixture[str]) -> None:
+    """``test_msgs/WStrings`` (ROS 2's own definition): one located error before the monitor joins the
+    domain, exit 2, never a traceback or a run that hears garbage (dds_types.py says why)."""
+    ws = tmp_path / "ws"
+    _workspace(ws)
+    (ws / "contracts/types.rcl").write_text("node W {\n  inputs( )\n  outputs( v : INTEGER )\n"
+                                            "  topics( test_msgs/WStrings ws matches(out.v) )\n  assume( TRUE )\n"
+                                            "  guarantee( out.v >= 0 )\n}\n")
+    (ws / "mapping.yaml").write_text("msg_dirs: [interfaces]\ntopics:\n  ws: {fields: [alignment_check]}\n")
+    capsys.readouterr()
+    rc = main(["monitor", "-w", str(ws), "--live", "--ros2", "--mapping", "mapping.yaml", "--duration", "1"])
+    err = capsys.readouterr().err
+    assert rc == 2 and err.startswith("contracts/types.rcl:4:11: error: topic /ws (test_msgs/WStrings): "
+                                      "test_msgs/msg/WStrings: field wstring_value is a wstring"), err
+    assert "Traceback" not in err
+

@@ -25,9 +25,13 @@ build step, no ROS installation.
   ``T_FeedbackMessage`` (``goal_id`` + ``feedback``), all in ``pkg::action``;
   status is ``action_msgs/msg/GoalStatusArray``.
 
-``wstring`` is refused with the type that uses it (Cyclone's Python binding
-has no wide string); every error is a :class:`DdsTypeError` naming the type
-and, for the workspace's files, the file.
+``wstring`` is refused with the type that uses it: Cyclone's Python binding
+has no wide string, the middlewares do not agree on its bytes (Fast DDS 3
+writes a ``uint32`` count of 4-byte code units in XCDR1, measured with
+``test_msgs/WStrings``; rmw_cyclonedds writes UTF-16, 2-byte units) and
+rosbags can neither describe nor decode one, so a bag could not hold it.
+Every error is a :class:`DdsTypeError` naming the type and, for the
+workspace's files, the file.
 """
 from __future__ import annotations
 
@@ -135,7 +139,9 @@ class TypeBook:
             raise DdsTypeError(f"{owner}: field {fname} has type {base}, which Cyclone's Python binding cannot carry")
         if kind == 2:
             if str(detail).endswith("/wstring"):
-                raise DdsTypeError(f"{owner}: field {fname} is a wstring, which Cyclone's Python binding cannot carry")
+                raise DdsTypeError(f"{owner}: field {fname} is a wstring, which the monitor does not decode (Cyclone's "
+                                   "Python binding has no wide string; Fast DDS sends 4-byte, rmw_cyclonedds 2-byte "
+                                   "code units; rosbags cannot store it)")
             cls = self.struct(str(detail), owner)
             return cls, cls
         elem, inner = self._field_type(detail[0], owner, fname)
