@@ -170,9 +170,10 @@ class CallBook:
     def unpaired(self, key: tuple[Any, ...], stamp: float, reason: str) -> None:
         """Call ``key`` may have been answered at ``stamp`` (s), but which answer
         is its cannot be known (:mod:`.dds_order`): what was judged of it stays
-        (its request's assumption, deadlines already expired: each was decided
-        before any answer could have come), what waits for its answer is
-        ``inconclusive`` with ``reason`` (each node that serves or calls it),
+        (its request's assumption, a guarantee its request alone decides,
+        deadlines already expired: each was decided before any answer could
+        have come), what waits for its answer is ``inconclusive`` with
+        ``reason`` (each node that serves or calls it),
         its deadlines not yet due are left undecided (``unaccepted``)."""
         call = self.calls.pop(key, None)
         if call is None:
@@ -181,6 +182,9 @@ class CallBook:
         self._log({"link": call.name, "part": "unpaired", "time": stamp, "key": _key(key), "reason": reason})
         for m in call.monitors:
             res = m.result
+            if not m.pending:  # decided on the request alone (an answer could not change it)
+                _add(self.results.setdefault(m.node.name, NodeResult(m.node.name)), res)
+                continue
             res.counts["inconclusive"] += 1
             if res.first_inconclusive is None:
                 res.first_inconclusive = {"event": call.first, "time": call.opened, "where": f"{call.label} request",

@@ -22,15 +22,15 @@ the server publishes them (they cover every client), else the clients'
 (REQUEST_SENT, RESPONSE_RECEIVED) when every client publishes them; never
 both (a call would be counted twice).  :func:`event_side` decides from the
 writers discovery reports on the event topic and on the service's reply and
-request topics (a participant's writers share its GUID prefix, the first 12
-bytes).  The event type is made here from the service's request and
+request topics, and the node each belongs to (a service's event writer is
+its server's node's, a client's its client's node's).  The event type is made here from the service's request and
 response structs (rosidl makes it the same way: ``rosidl_generator_type_description``
 adds ``<Srv>_Event`` to every service); ``ServiceEventInfo`` is defined here
 when the interface files do not define it (rosbags' store predates it).
 """
 from __future__ import annotations
 
-from typing import Any, Iterable
+from typing import Any, Callable, Iterable
 
 from .dds_types import TypeBook
 
@@ -58,17 +58,21 @@ def event_struct(types: TypeBook, srv_type: str) -> type:
     return types.struct(f"{base}_Event", srv_type)
 
 
-def event_side(event_writers: Iterable[bytes], reply_writers: Iterable[bytes],
-               request_writers: Iterable[bytes]) -> str | None:
+def event_side(event_writers: Iterable[bytes], reply_writers: Iterable[bytes], request_writers: Iterable[bytes],
+               owner: Callable[[bytes], str | None] = lambda g: None) -> str | None:
     """``"server"`` when a server of the service publishes introspection
-    events, ``"client"`` when every client does, else ``None`` (writer GUIDs,
-    16 bytes each)."""
-    pubs = {bytes(g[:12]) for g in event_writers}
+    events, ``"client"`` when every client does, else ``None``.  Arguments
+    are writer GUIDs (16 bytes each) and ``owner(guid)``: the ROS node a
+    writer belongs to (``ros_discovery_info``, ``None`` not known yet), else
+    its participant (the GUID prefix: every node of one process shares it)."""
+    def who(g: bytes) -> str:
+        return owner(bytes(g)) or bytes(g[:12]).hex()
+    pubs = {who(g) for g in event_writers}
     if not pubs:
         return None
-    if any(bytes(g[:12]) in pubs for g in reply_writers):
+    if any(who(g) in pubs for g in reply_writers):
         return "server"
-    clients = {bytes(g[:12]) for g in request_writers}
+    clients = {who(g) for g in request_writers}
     return "client" if clients and clients <= pubs else None
 
 

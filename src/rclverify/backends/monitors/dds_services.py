@@ -88,6 +88,7 @@ class CallTaps:
             except DdsTypeError as exc:
                 raise DdsTypeError(f"{_where(lk)}: error: {lk.kind} {name} ({lk.ros_type}): {exc}") from None
         self.taps: dict[str, Any] = {}  # tap key -> the bus's Tap (attach)
+        self._node_of: Any = lambda guid: None  # a writer's ROS node (the bus's discovery, attach)
         self._goal_of: dict[tuple[int, int], str] = {}  # send-goal/get-result request id -> goal id
         self._status: dict[str, int] = {}
         self._early: dict[tuple[Any, ...], list[tuple[str, dict[str, Any], float, bool, float, str]]] = {}
@@ -132,6 +133,7 @@ class CallTaps:
         """Ask ``bus`` (a :class:`~.dds_bus.Bus`, before it starts) for every topic of the plan."""
         for key, dds_topic, struct, where in self.plan:
             self.taps[key] = bus.tap(key, dds_topic, struct, where)
+        self._node_of = bus.discovery.node_of
 
     # -- samples (engine thread) -------------------------------------------------------------
     def handle(self, key: str, raw: bytes, stamp: float, now: float, writer: bytes | None = None) -> None:
@@ -224,7 +226,7 @@ class CallTaps:
         ev, rep, req = (self.taps.get(f"call:{name}:{p}") for p in ("event", "reply", "request"))
         if ev is None or rep is None or req is None:
             return None
-        return event_side(ev.heard, rep.heard, req.heard)
+        return event_side(ev.heard, rep.heard, req.heard, self._node_of)
 
     def _event(self, name: str, s: Any, stamp: float, now: float) -> None:
         side = self._side(name)

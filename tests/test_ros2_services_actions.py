@@ -1,0 +1,278 @@
+"""Services and actions of real rclpy nodes on Fast DDS, judged call by call
+(issue 62; docs/monitors.md, "Services and actions over DDS"; docs/ros2.md).
+
+rmw_fastrtps writes a service's requests and replies without the request
+header rmw_cyclonedds puts in the payload: a reply names its request only in
+RTPS inline QoS, which the monitor's DDS reader does not see.  One ROS 2
+system (one rclpy process, tests/_ros2.py) runs once for the module, and one
+monitor watches it:
+
+* ``base`` serves ``/estop`` (std_srvs/SetBool), answering the first call
+  right, the second wrong, the third right but 400 ms late (the contract's
+  deadline is 200 ms); ``teleop`` calls it three times, one call at a time:
+  each call is paired by order (one outstanding) and judged;
+* ``brake`` serves ``/brake`` and answers every call ``success: false``
+  after 200 ms; two clients call it at once (``data: true`` and ``data:
+  false``, two outstanding): which answer is whose cannot be known: the
+  ``data: true`` call is inconclusive with the reason, never guessed (by
+  order, the wrong answer would be blamed on one of them; the ``data:
+  false`` call holds whatever its answer);
+* ``lamp`` is ``brake`` again with service introspection enabled
+  (``configure_introspection(..., CONTENTS)``): the same two concurrent
+  calls are paired exactly by ``client_gid`` + ``sequence_number``: the
+  ``data: true`` call is violated, the ``data: false`` one satisfied;
+* ``fib`` serves the test_msgs/action/Fibonacci action; ``mission`` sends
+  two goals one after the other (order 3, then order 4, whose result the
+  server spoils with a negative last number): both goals are judged, the
+  second violated.
+"""
+from __future__ import annotations
+
+import json
+import signal
+import time
+from typing import Any, Iterator
+
+import pytest
+from _procs import stop, wait_for
+from _ros2 import rclverify, ros2_env, ros2_python, start_node
+
+from rclverify.backends.monitors.dds_calls import CallBook, replay
+from rclverify.rcl.typecheck import load
+
+RCL = """\
+node Base {
+  inputs( req : BOOL )
+  outputs( ok : BOOL )
+  services( std_srvs/SetBool estop serves(in.req, out.ok) )
+  assume( TRUE )
+  guarantee( in.req -> out.ok ) triggered by in.req within 200 ms
+}
+
+node Brake {
+  inputs( req : BOOL )
+  outputs( ok : BOOL )
+  services( std_srvs/SetBool brake serves(in.req, out.ok) )
+  assume( TRUE )
+  guarantee( in.req -> out.ok )
+}
+
+node Lamp {
+  inputs( req : BOOL )
+  outputs( ok : BOOL )
+  services( std_srvs/SetBool lamp serves(in.req, out.ok) )
+  assume( TRUE )
+  guarantee( in.req -> out.ok )
+}
+
+node Fib {
+  inputs( order : INTEGER )
+  outputs( last : INTEGER, final : INTEGER )
+  actions( test_msgs/Fibonacci fib serves(in.order, out.last, out.final) )
+  assume( in.order >= 1 )
+  guarantee( out.final >= 0 )
+}
+"""
+# the feedback's and the result's number: the last of the sequence (docs/monitors.md, "Field paths")
+MAPPING = """\
+topics:
+  fib/feedback: {fields: ["sequence[-1]"]}
+  fib/result: {fields: ["sequence[-1]"]}
+"""
+SETBOOL = "bool data\n---\nbool success\nstring message\n"
+FIBONACCI = "int32 order\n---\nint32[] sequence\n---\nint32[] sequence\n"
+
+SYSTEM = """\
+import time
+import rclpy
+from rclpy.action import ActionClient, ActionServer
+from rclpy.executors import SingleThreadedExecutor
+from rclpy.node import Node
+from rclpy.qos import qos_profile_services_default
+from rclpy.service_introspection import ServiceIntrospectionState
+from std_srvs.srv import SetBool
+from test_msgs.action import Fibonacci
+
+rclpy.init()
+nodes = {n: Node(n) for n in ("base", "teleop", "brake", "brake_a", "brake_b", "lamp", "lamp_a", "lamp_b",
+                              "fib", "mission", "watch")}
+calls = [0]
+
+def estop(req, resp):
+    calls[0] += 1
+    if calls[0] == 3:
+        time.sleep(0.4)  # right, but late: the deadline is 200 ms
+    resp.success = calls[0] != 2  # the second answer is wrong
+    return resp
+
+def stubborn(req, resp):
+    time.sleep(0.2)  # both calls are outstanding meanwhile
+    resp.success = False
+    return resp
+
+nodes["base"].create_service(SetBool, "estop", estop)
+nodes["brake"].create_service(SetBool, "brake", stubborn)
+lamp = nodes["lamp"].create_service(SetBool, "lamp", stubborn)
+lamp.configure_introspection(nodes["lamp"].get_clock(), qos_profile_services_default,
+                             ServiceIntrospectionState.CONTENTS)
+
+def execute(goal):
+    seq = [0, 1]
+    for i in range(1, goal.request.order):
+        seq.append(seq[i] + seq[i - 1])
+        goal.publish_feedback(Fibonacci.Feedback(sequence=seq))
+        time.sleep(0.02)
+    goal.succeed()
+    return Fibonacci.Result(sequence=seq if goal.request.order < 4 else seq + [-1])  # the second is spoilt
+
+ActionServer(nodes["fib"], Fibonacci, "fib", execute)
+ex = SingleThreadedExecutor()
+for n in nodes.values():
+    ex.add_node(n)
+
+def done(*futs, timeout=5.0):
+    until = time.monotonic() + timeout
+    while time.monotonic() < until and not all(f.done() for f in futs):
+        ex.spin_once(timeout_sec=0.01)
+    return [f.result() if f.done() else None for f in futs]
+
+teleop = nodes["teleop"].create_client(SetBool, "estop")
+pairs = {s: [nodes[f"{s}_{k}"].create_client(SetBool, s) for k in "ab"] for s in ("brake", "lamp")}
+mission = ActionClient(nodes["mission"], Fibonacci, "fib")
+print("ready", flush=True)
+# the monitor's readers are made once it discovers the endpoints: wait for its verdict topic, then a little
+until = time.monotonic() + 20
+while time.monotonic() < until and (nodes["watch"].count_publishers("/rclverify/verdict") < 1
+                                   or not all(c.service_is_ready() for c in [teleop, *pairs["brake"],
+                                                                             *pairs["lamp"]])
+                                   or not mission.server_is_ready()):
+    ex.spin_once(timeout_sec=0.05)
+until = time.monotonic() + 1.5
+while time.monotonic() < until:
+    ex.spin_once(timeout_sec=0.05)
+print("matched", flush=True)
+answers = [done(teleop.call_async(SetBool.Request(data=True)))[0].success for _ in range(3)]
+print("estop", answers, flush=True)
+for s in ("brake", "lamp"):
+    a, b = pairs[s]
+    got = done(a.call_async(SetBool.Request(data=True)), b.call_async(SetBool.Request(data=False)))
+    print(s, [r.success for r in got], flush=True)
+finals = []
+for order in (3, 4):
+    (handle,) = done(mission.send_goal_async(Fibonacci.Goal(order=order)))
+    (result,) = done(handle.get_result_async())
+    finals.append(list(result.result.sequence)[-1])
+print("fib", finals, flush=True)
+print("done", flush=True)
+while True:
+    ex.spin_once(timeout_sec=0.1)
+"""
+
+
+@pytest.fixture(scope="module")
+def run(tmp_path_factory: pytest.TempPathFactory) -> Iterator[dict[str, Any]]:
+    ros2_python()  # skips, with the reason, without a ROS 2 Python
+    tmp = tmp_path_factory.mktemp("calls")
+    ws = tmp / "ws"
+    (ws / "contracts").mkdir(parents=True)
+    (ws / "contracts/sys.rcl").write_text(RCL)
+    (ws / "contracts/plan.yaml").write_text("contracts: [contracts/sys.rcl]\n")
+    (ws / "mapping.yaml").write_text(MAPPING)
+    (ws / "interfaces/std_srvs/srv").mkdir(parents=True)
+    (ws / "interfaces/std_srvs/srv/SetBool.srv").write_text(SETBOOL)
+    (ws / "interfaces/test_msgs/action").mkdir(parents=True)
+    (ws / "interfaces/test_msgs/action/Fibonacci.action").write_text(FIBONACCI)
+    env = ros2_env(tmp)
+    monitor = system = None
+    try:
+        monitor = rclverify(["monitor", "-w", str(ws), "--live", "--ros2", "--interfaces", "interfaces", "--mapping",
+                             "mapping.yaml", "--horizon", "1.0", "--reorder-window", "0", "--status", "0",
+                             "--duration", "60", "--log", str(tmp / "live.jsonl"), "--evidence",
+                             str(tmp / "live.json")], env, tmp, tmp / "monitor.out")
+        wait_for(tmp / "monitor.out", "monitoring", 30)
+        system = start_node(tmp, "system", SYSTEM, env)
+        wait_for(tmp / "system.log", "done", 40)
+        time.sleep(1.6)  # the horizon (1 s) and the monitor's settle (0.3 s) pass: the last goal is judged
+        stop(monitor, signal.SIGINT)
+        code = monitor.returncode
+        yield {"tmp": tmp, "ws": ws, "code": code, "out": (tmp / "monitor.out").read_text(),
+               "system": (tmp / "system.log").read_text(),
+               "log": [json.loads(x) for x in (tmp / "live.jsonl").read_text().splitlines()],
+               "record": json.loads((tmp / "live.json").read_text())}
+    finally:
+        if system is not None:
+            stop(system)
+        if monitor is not None:
+            stop(monitor)
+
+
+def _verdicts(run: dict[str, Any], node: str) -> list[dict[str, Any]]:
+    return sorted((x["verdict"] for x in run["log"] if x.get("topic") == "rclverify/verdict" and "kind" not in x
+                   and x["verdict"].get("call") and x["verdict"]["node"] == node), key=lambda v: v["time"])
+
+
+def _calls(run: dict[str, Any]) -> dict[str, dict[str, Any]]:
+    return {n["node"]: n for n in run["record"]["calls"]["nodes"]}
+
+
+def test_sequential_calls_are_paired_by_order_and_judged(run: dict[str, Any]) -> None:
+    assert "estop [True, False, True]" in run["system"], run["system"]
+    base = _verdicts(run, "Base")
+    assert [v["verdict"] for v in base] == ["satisfied", "violated", "satisfied"], (base, run["out"])
+    assert base[1]["values"] == {"in.req": "TRUE", "out.ok": "FALSE"}
+    assert _calls(run)["Base"]["status"] == "failed"
+    dl = [x["verdict"] for x in run["log"] if x.get("kind") == "deadline" and x["verdict"]["node"] == "Base"
+          and not x["verdict"]["update"]]
+    assert [v["verdict"] for v in dl] == ["true", "false", "false"], dl
+    late = [x["verdict"] for x in run["log"] if x.get("kind") == "deadline" and x["verdict"]["update"]]
+    assert len(late) == 1 and late[0]["answer"] - late[0]["trigger_stamp"] >= 0.4  # the late one, with its stamp
+    assert run["record"]["deadlines"]["false"] == 2
+    assert run["code"] == 1, run["out"]
+
+
+def test_concurrent_calls_without_identity_are_inconclusive_not_guessed(run: dict[str, Any]) -> None:
+    assert "brake [False, False]" in run["system"], run["system"]
+    brake = _verdicts(run, "Brake")
+    # the data: false call holds whatever its answer (decided on its request); the data: true one waits for
+    # an answer that is one of two: inconclusive, with the reason (by order, the wrong answer is blamed)
+    assert sorted(v["verdict"] for v in brake) == ["inconclusive", "satisfied"], brake
+    (why,) = [v["reason"] for v in brake if v["verdict"] == "inconclusive"]
+    assert "2 requests of /brake were unanswered" in why and "introspection" in why, why
+    assert _calls(run)["Brake"]["counts"]["violated"] == 0 and _calls(run)["Brake"]["status"] != "discharged"
+    unpaired = [x for x in run["log"] if x.get("kind") == "call" and x.get("part") == "unpaired"]
+    assert {x["link"] for x in unpaired} == {"brake"} and len(unpaired) == 2
+
+
+def test_introspection_pairs_concurrent_calls_exactly(run: dict[str, Any]) -> None:
+    assert "lamp [False, False]" in run["system"], run["system"]
+    lamp = _verdicts(run, "Lamp")
+    # the data: false call holds (on its request, and on its answer), the data: true one is violated
+    assert {v["verdict"] for v in lamp} == {"satisfied", "violated"}, lamp
+    (bad,) = [v for v in lamp if v["verdict"] == "violated"]
+    assert bad["values"] == {"in.req": "TRUE", "out.ok": "FALSE"}  # the data: true call got the wrong answer
+    keys = [x["key"] for x in run["log"] if x.get("kind") == "call" and x.get("link") == "lamp" and "index" in x]
+    assert len(keys) == 4 and all(k[0] == "ev" for k in keys)  # paired by client gid and sequence number
+    assert run["record"]["calls"]["samples"]["introspected"] >= 4  # its request/reply samples left to the events
+
+
+def test_two_goals_of_a_fibonacci_action_are_judged(run: dict[str, Any]) -> None:
+    assert "fib [2, -1]" in run["system"], run["system"]
+    fib = [v for v in _verdicts(run, "Fib") if v["topic"] == "fib/result"]
+    assert [v["verdict"] for v in fib] == ["satisfied", "violated"], (_verdicts(run, "Fib"), run["out"])
+    assert fib[1]["values"]["out.final"] == "-1"
+    counts = run["record"]["calls"]["counts"]
+    assert counts["goals"] == 2 and counts["calls"] == 3 + 2 + 2 and counts["unpaired"] == 2, counts
+    parts = {x["part"] for x in run["log"] if x.get("kind") == "call" and x.get("link") == "fib"}
+    assert {"goal", "feedback", "result", "status"} <= parts
+
+
+def test_the_live_calls_replay_to_the_same_summary(run: dict[str, Any]) -> None:
+    checked = load([run["ws"] / "contracts" / "sys.rcl"])
+    from rclverify.backends.monitors.config import load_mapping
+    rules = load_mapping(run["ws"], "mapping.yaml", 1.0).rules
+    book = CallBook(checked, [(n, lk) for n in checked.nodes.values() for lk in n.node.links], rules, 1.0)
+    summary = replay(book, run["log"])
+    assert summary["counts"] == run["record"]["calls"]["counts"]
+    assert {r["node"]: r["counts"] for r in summary["nodes"]} == \
+        {n["node"]: n["counts"] for n in run["record"]["calls"]["nodes"]}
+    assert summary["false"] == run["record"]["deadlines"]["false"]
