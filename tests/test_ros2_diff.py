@@ -2,10 +2,11 @@
 (issue 62; docs/ros.md, "Expected against observed").
 
 The code side is a small ament_python workspace written into the test's
-directory: ``talker`` (publishes ``chatter``, subscribes to ``cmd``),
+directory: ``talker`` (publishes ``chatter``, subscribes to ``cmd``, serves
+``reset`` and the action ``count``),
 ``camera`` (``rclpy.create_node('camera', namespace='sensors')``: its
 namespace is in the code), ``viewer`` (subscribes reliably to
-``/sensors/image``) and ``planner`` (``Node.__init__(..., namespace='nav')``),
+``/sensors/image``, calls ``/robot/reset`` and the action ``/robot/count``) and ``planner`` (``Node.__init__(..., namespace='nav')``),
 started by a Python launch file that puts ``talker`` and ``planner`` under
 ``/robot`` (launch_ros' namespace replaces the code's) and remaps
 ``talker``'s ``cmd`` to ``/teleop/cmd``.
@@ -65,8 +66,11 @@ PKG = {
     "demo_pkg/__init__.py": "",
     "demo_pkg/talker.py": """\
         import rclpy
+        from rclpy.action import ActionServer
         from rclpy.node import Node
         from std_msgs.msg import String
+        from std_srvs.srv import Trigger
+        from test_msgs.action import Fibonacci
 
 
         class Talker(Node):
@@ -74,6 +78,16 @@ PKG = {
                 super().__init__('talker')
                 self.pub = self.create_publisher(String, 'chatter', 10)
                 self.create_subscription(String, 'cmd', lambda m: None, 10)
+                self.create_service(Trigger, 'reset', self.on_reset)
+                self.count = ActionServer(self, Fibonacci, 'count', self.execute)
+
+            def on_reset(self, request, response):
+                response.success = True
+                return response
+
+            def execute(self, goal):
+                goal.succeed()
+                return Fibonacci.Result()
 
 
         def main():
@@ -93,14 +107,19 @@ PKG = {
         """,
     "demo_pkg/viewer.py": """\
         import rclpy
+        from rclpy.action import ActionClient
         from rclpy.node import Node
         from std_msgs.msg import String
+        from std_srvs.srv import Trigger
+        from test_msgs.action import Fibonacci
 
 
         class Viewer(Node):
             def __init__(self):
                 super().__init__('viewer')
                 self.create_subscription(String, '/sensors/image', self.show, 10)
+                self.reset = self.create_client(Trigger, '/robot/reset')
+                self.count = ActionClient(self, Fibonacci, '/robot/count')
 
             def show(self, msg):
                 self.get_logger().info(msg.data)
@@ -284,6 +303,16 @@ def test_the_launch_namespace_replaces_the_code_one(tmp_path: Path) -> None:
     assert _scan(tmp_path, "src/demo_pkg/launch/demo.launch.py") == {
         "/robot/talker": ["/robot/chatter", "/teleop/cmd"], "/sensors/camera": ["/sensors/image"],
         "/viewer": ["/sensors/image"], "/robot/planner": ["/robot/plan", "/sensors/image"]}
+    # the services and actions the live test compares (no item about them there means the running side has them)
+    from rclverify.ros.graph import scan
+    g = scan([tmp_path / "src"], [tmp_path / "src/demo_pkg/launch/demo.launch.py"]).graph
+    kinds = ("service_servers", "service_clients", "action_servers", "action_clients")
+    assert {n: {k: [(e.topic, e.msg_type) for e in g.nodes[n].edges_of(k)] for k in kinds
+                if g.nodes[n].edges_of(k)} for n in ("/robot/talker", "/viewer")} == {
+        "/robot/talker": {"service_servers": [("/robot/reset", "std_srvs/srv/Trigger")],
+                          "action_servers": [("/robot/count", "test_msgs/action/Fibonacci")]},
+        "/viewer": {"service_clients": [("/robot/reset", "std_srvs/srv/Trigger")],
+                    "action_clients": [("/robot/count", "test_msgs/action/Fibonacci")]}}
 
 
 def test_xml_launch_and_rclcpp_namespaces(tmp_path: Path) -> None:
