@@ -3,11 +3,11 @@
 
 The code side is a small ament_python workspace written into the test's
 directory: ``talker`` (publishes ``chatter``, subscribes to ``cmd``, serves
-``reset`` and the action ``count``),
-``camera`` (``rclpy.create_node('camera', namespace='sensors')``: its
-namespace is in the code), ``viewer`` (subscribes reliably to
-``/sensors/image``, calls ``/robot/reset`` and the action ``/robot/count``) and ``planner`` (``Node.__init__(..., namespace='nav')``),
-started by a Python launch file that puts ``talker`` and ``planner`` under
+``reset`` and the action ``count``), ``camera``
+(``rclpy.create_node('camera', namespace='sensors')``: its namespace is in
+the code), ``viewer`` (subscribes reliably to ``/sensors/image``, calls
+``/robot/reset`` and the action ``/robot/count``) and ``planner``
+(``Node.__init__(..., namespace='nav')``), started by a Python launch file that puts ``talker`` and ``planner`` under
 ``/robot`` (launch_ros' namespace replaces the code's) and remaps
 ``talker``'s ``cmd`` to ``/teleop/cmd``.
 
