@@ -127,6 +127,9 @@ def test_a_recorded_run_without_the_nodes_events_is_never_discharged(tmp_path: P
     assert main(["verify", "-w", str(ws)]) == 0
     ev = json.loads((ws / "artifacts/evidence/Echo.g0.monitors.other_jsonl.json").read_text())
     assert ev["status"] == "pending" and "nothing was checked" in ev["explanation"], ev["explanation"]
+    assert "(not judged: nothing heard: no message on /r, /out, /beat in traces/other.jsonl)" in ev["explanation"]
+    assert {(i["kind"], i["reason"]) for i in ev["details"]["not_judged"]} == {
+        ("node", "nothing heard"), ("topic", "nothing heard"), ("deadline", "nothing heard")}
     report = json.loads((ws / "reports/assurance.json").read_text())
     statuses = {e["status"] for e in report["evidence"] if e["obligation"].startswith("Echo.g0.monitors")}
     assert statuses == {"pending"}

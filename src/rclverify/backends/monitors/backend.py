@@ -31,6 +31,7 @@ from ..base import NodeTarget, Stopwatch, make_evidence
 from .check import check_trace
 from .config import ConfigError, MonitorConfig, load_mapping
 from .deadlines import DeadlineMonitor, DeadlineResult, deadline_status, has_deadlines
+from .judged import Counted, Heard, explain, not_judged
 from .periods import PeriodMonitor, has_periods, with_periods
 from .rml import Spec, rml_id, translate
 from .summary import monitoring_details, summary_line, tool_versions, verdict_status
@@ -201,8 +202,9 @@ class MonitorsBackend:
             beside.add("periods", lambda: PeriodMonitor(target.node))
         try:
             span = TraceSpan()  # the run's duration in trace time (the strength's detail, docs/confidence.md)
-            events, results = check_trace(target.checked, [target.node], span.tap(beside.tap(
-                read_trace(target.root / trace, [target.root / d for d in cfg.msg_dirs]))),
+            heard: dict[str, int] = {}  # events per topic: what the run did not judge (judged.py)
+            events, results = check_trace(target.checked, [target.node], Counted(span.tap(beside.tap(
+                read_trace(target.root / trace, [target.root / d for d in cfg.msg_dirs]))), heard),
                 cfg.rules, cfg.horizon, tolerance=cfg.tolerance)
         except TraceError as exc:
             return evidence("error", f"the trace could not be read: {exc}", log=str(exc))
@@ -224,6 +226,13 @@ class MonitorsBackend:
         if "periods" in finished:
             status, explanation, more = with_periods(finished["periods"], trace, status, explanation)
             extra.update(more)
+        dl = finished.get("deadlines")
+        # silence is never green: what the run did not judge, with the reason, beside the status
+        extra["not_judged"] = items = not_judged([target.node], Heard(heard), {res.node: [(status, explanation)]},
+                                                 {dl.node: dl.counts} if dl is not None else {}, f"in {trace}")
+        entry = {"node": res.node, "status": status, "explanation": explanation}
+        explain(entry, items)  # a pending record says why itself
+        explanation = entry["explanation"]
         return evidence(status, explanation, details={"monitoring": details, **extra},
                         artifacts=(str(obligation.data.get("rml", "")), str(obligation.data.get("config", ""))),
                         log=summary_line(res))
