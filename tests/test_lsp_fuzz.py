@@ -293,6 +293,27 @@ async def test_a_quick_fix_inserts_the_documents_line_end(client: LanguageClient
     client.text_document_did_close(lsp.DidCloseTextDocumentParams(lsp.TextDocumentIdentifier(u)))
 
 
+async def test_formatting_a_text_over_the_size_limit_is_refused_at_once(client: LanguageClient, ws: Path) -> None:
+    from rclverify.lsp.diagnostics import MAX_CHARS
+    u = (ws / "contracts" / "b.rcl").as_uri()
+    open_doc(client, u, CONTRACT + "// padding\r\n" * (MAX_CHARS // 12 + 1))
+    t = time.monotonic()
+    got, err = await answer(client.text_document_formatting_async(lsp.DocumentFormattingParams(
+        lsp.TextDocumentIdentifier(u), lsp.FormattingOptions(tab_size=2, insert_spaces=True))))
+    assert err is not None and err.code == -32803 and "run `rclverify fmt contracts/b.rcl`" in err.message, (got, err)
+    one_sentence(err)
+    assert time.monotonic() - t < 2.0
+    client.text_document_did_close(lsp.DidCloseTextDocumentParams(lsp.TextDocumentIdentifier(u)))
+
+
+@pytest.mark.filterwarnings("ignore:The test <Function")
+def test_a_malformed_root_uri_leaves_the_working_directory_the_root() -> None:
+    from rclverify.lsp.server import _root_of
+    for bad in ("file://[::1/ws", "file:///srv/a%00b", "file:///srv/a\x00b"):
+        assert _root_of(lsp.InitializeParams(capabilities=lsp.ClientCapabilities(), root_uri=bad)) is None, bad
+    assert _root_of(lsp.InitializeParams(capabilities=lsp.ClientCapabilities(), root_uri="file:///srv/w%20s")) == Path("/srv/w s")
+
+
 @pytest.mark.filterwarnings("ignore:The test <Function")
 def test_an_unexpected_exception_is_one_line() -> None:
     """The guard around every handler (in this process: no request makes the real server fail on purpose)."""

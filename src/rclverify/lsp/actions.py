@@ -109,9 +109,14 @@ def format_edits(rel: str, text: str) -> list[lsp.TextEdit]:
     is in that form.  ``text`` may have any line ends; the inserted text
     has the document's (module docstring).  Raises :class:`.rpc.Failed`
     (LSP ``RequestFailed``) with the located syntax error when ``text``
-    does not parse."""
+    does not parse, or when it is longer than
+    :data:`.diagnostics.MAX_CHARS` (it is not parsed as you type either)."""
     from ..rcl.parser import parse_text
     from ..rcl.printer import context_to_rcl, node_to_rcl
+    from .diagnostics import MAX_CHARS
+    if len(text) > MAX_CHARS:
+        raise Failed(f"{rel}: not formatted in the editor: {len(text)} characters, over the limit of {MAX_CHARS} "
+                     f"(run `rclverify fmt {rel}`)")
     eol, text = eol_of(text), for_parser(text)
     try:
         spec = parse_text(text, rel)

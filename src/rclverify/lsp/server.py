@@ -186,13 +186,23 @@ def _root_of(params: lsp.InitializeParams) -> Path | None:
         uri = params.workspace_folders[0].uri
     elif params.root_uri:
         uri = params.root_uri
-    if uri:
-        parsed = urlparse(uri)
-        if parsed.scheme == "file":
-            return Path(unquote(parsed.path))
-    if params.root_path:
-        return Path(params.root_path)
+    try:
+        if uri:
+            parsed = urlparse(uri)
+            if parsed.scheme == "file" and "\x00" not in unquote(parsed.path):
+                return Path(unquote(parsed.path))
+        if params.root_path and "\x00" not in params.root_path:
+            return Path(params.root_path)
+    except ValueError:  # a malformed URI: the server's working directory stays the root
+        pass
     return None
+
+
+def _is_dir(p: Path) -> bool:
+    try:
+        return p.is_dir()
+    except (OSError, ValueError):
+        return False
 
 
 @SERVER.feature(lsp.INITIALIZE)
@@ -201,7 +211,7 @@ def _initialize(ls: RclServer, params: lsp.InitializeParams) -> None:
     root = _root_of(params)
     opts = params.initialization_options if isinstance(params.initialization_options, dict) else {}
     plan = str(opts.get("plan") or PLAN)
-    if root is not None and root.is_dir():
+    if root is not None and _is_dir(root):
         ls.set_root(root, plan)
 
 
