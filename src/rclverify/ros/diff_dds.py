@@ -201,9 +201,15 @@ def diff_dds(static: Graph, running: Graph, source: str,
         who_r = disc.who(r) if disc is not None else r.label
         res.missing.append(Item("qos", topic, None, ros_type(w.type_name), None, None, source,
                                 f"{topic} ({short_type(ros_type(w.type_name))}): {who_r} subscribes with "
-                                f"{r.qos.describe()}, {who_w} publishes with {w.qos.describe()}; DDS does not "
+                                f"{_announced(r.qos)}, {who_w} publishes with {_announced(w.qos)}; DDS does not "
                                 f"connect them ({'; '.join(why)}), so the subscriber receives nothing from it"))
     return res
+
+
+def _announced(q: Any) -> str:
+    """``q.describe()`` without the history, which discovery does not announce (the
+    reader fills in keep_last(1), DDS's default, whatever the endpoint keeps)."""
+    return ", ".join(p for p in q.describe().split(", ") if not p.startswith(("keep_last(", "keep_all")))
 
 
 def _policies(q: Any) -> tuple[str, str]:
