@@ -179,3 +179,116 @@ def test_a_recorded_bag_reads_back_with_the_live_times(storage: str, tmp_path: P
     assert from_bag[0].counts["satisfied"] == 1 and from_bag[0].counts["violated"] == 1
     with pytest.raises(BagError, match="exists"):
         BagRecorder(tmp_path / "run", storage, {}, [])
+
+
+# -- calls without identity (rmw_fastrtps: docs/monitors.md, "Services and actions over DDS") --------------
+
+def test_the_order_pairs_only_what_it_makes_certain() -> None:
+    from rclverify.backends.monitors.dds_order import OrderPairer, Pending
+    p = OrderPairer("/estop")
+    a, b, c, d = (Pending(("w", "a", k), t, f"call {k}") for k, t in ((1, 1.0), (2, 2.0), (3, 2.1), (4, 5.0)))
+    p.request(a)
+    assert p.reply(1.5, b"S").answers == a  # one outstanding: certain
+    assert p.reply(1.6, b"S").orphan  # nothing outstanding: an answer without a call
+    p.request(b)
+    p.request(c)
+    two = p.reply(2.5, b"S")  # two outstanding: which one it answers cannot be known
+    assert two.answers is None and two.undecided == (b, c) and "2 requests of /estop" in two.reason
+    p.request(d)
+    # one of b, c is still unanswered: this reply may be its, so d is undecided too, never paired by a guess
+    three = p.reply(5.5, b"S")
+    assert three.answers is None and three.undecided == (d,) and "could not be paired" in three.reason
+    assert p.reply(5.6, b"S") == type(three)()  # the last of the pool: nothing left to decide
+    p.request(Pending(("w", "a", 5), 6.0, "call 5"))
+    assert p.reply(6.5, b"S").answers is not None  # certain again once the pool is spent
+    p.request(Pending(("w", "a", 6), 7.0, "call 6"))
+    other = p.reply(7.5, b"T")  # a second server: each answers every request
+    assert other.answers is None and len(other.undecided) == 1 and "2 servers answer /estop" in other.reason
+
+
+def test_an_unpaired_call_is_inconclusive_and_replays() -> None:
+    lines: list[dict[str, Any]] = []
+    book = _book(lines)
+    book.open("/estop", ("w", "a", 1), "estop call a#1", {"data": True}, 10.0)
+    book.open("/estop", ("w", "b", 1), "estop call b#1", {"data": False}, 10.01)
+    book.tick(10.1)
+    book.unpaired(("w", "a", 1), 10.15, "two outstanding")
+    book.unpaired(("w", "b", 1), 10.15, "two outstanding")
+    book.tick(12.0)
+    summary = book.finish()
+    base = [x["verdict"] for x in lines if x.get("verdict", {}).get("node") == "Base" and "kind" not in x]
+    # the data: false call holds whatever its answer (decided on its request); the other waits: inconclusive
+    assert sorted(v["verdict"] for v in base) == ["inconclusive", "satisfied"]
+    assert [v["reason"] for v in base if v["verdict"] == "inconclusive"] == ["two outstanding"]
+    assert summary["counts"]["unpaired"] == 2 and summary["false"] == 0  # its deadline was not yet due: undecided
+    (dl,) = summary["deadlines"]
+    assert dl["unaccepted"]["undecided"] == 2 and dl["first_unaccepted"]["reason"] == "two outstanding"
+    assert replay(_book([]), lines) == summary
+
+
+def _taps(lines: list[dict[str, Any]]) -> tuple[Any, Any]:
+    pytest.importorskip("cyclonedds", reason="the cyclonedds binding is not installed")
+    from rclverify.backends.monitors.dds_services import CallTaps
+    from rclverify.backends.monitors.dds_types import TypeBook
+    types = TypeBook([WS / "interfaces"])
+    return CallTaps(_book(lines), types, LINKS, framed=False), types
+
+
+FAST = bytes.fromhex("010f78fd00000001000000000000") + b"\x14\x03"  # an eProsima writer GUID (vendor 0x010f)
+
+
+def test_plain_samples_are_taken_in_stamp_order_and_checked_by_vendor() -> None:
+    lines: list[dict[str, Any]] = []
+    taps, types = _taps(lines)
+    req = types.struct("std_srvs/srv/SetBool_Request")
+    rep = types.struct("std_srvs/srv/SetBool_Response")
+    assert taps.specs["call:/estop:request"][1] is req  # the plain layout: Fast DDS's
+    server, client = FAST[:-2] + b"\x13\x03", FAST
+    # the reply is handed on before its request (two topics, two readers): the stamps put them in order
+    taps.handle("call:/estop:reply", rep(success=False, message="").serialize(), 20.05, 20.06, server)
+    taps.handle("call:/estop:request", req(data=True).serialize(), 20.0, 20.07, client)
+    # a Cyclone writer's sample is of the other wire form: counted, never decoded as this one
+    taps.handle("call:/estop:request", req(data=True).serialize(), 20.1, 20.1, b"\x01\x10" + FAST[2:])
+    taps.tick(20.2)
+    assert not [x for x in lines if x.get("part") == "request"]  # still settling
+    taps.tick(22.0)
+    summary = taps.finish()
+    base = [x["verdict"]["verdict"] for x in lines if x.get("verdict", {}).get("node") == "Base"
+            and "kind" not in x]
+    assert base == ["violated"] and summary["counts"]["calls"] == 1 and taps.counts["other_form"] == 1
+    assert replay(_book([]), lines) == summary
+
+
+def test_introspection_events_pair_concurrent_calls_exactly() -> None:
+    from types import SimpleNamespace
+
+    from rclverify.backends.monitors.dds_introspection import event_side, event_struct
+    lines: list[dict[str, Any]] = []
+    taps, types = _taps(lines)
+    ev = event_struct(types, "std_srvs/SetBool")
+    server, client = FAST[:-2] + b"\x13\x03", b"\x01\x0f" + bytes(range(10)) + b"\x00\x00\x14\x03"
+    taps.taps = {"call:/estop:event": SimpleNamespace(heard={server[:-2] + b"\x15\x03"}),
+                 "call:/estop:reply": SimpleNamespace(heard={server}),
+                 "call:/estop:request": SimpleNamespace(heard={client})}
+
+    def event(kind: int, seq: int, stamp: float, **parts: Any) -> None:
+        s = types.build(ev, {"info": {"event_type": kind, "client_gid": list(client), "sequence_number": seq},
+                             **{k: [v] for k, v in parts.items()}})
+        taps.handle("call:/estop:event", s.serialize(), stamp, stamp, server)
+    # two calls outstanding at once, answered in the other order: the events name each call
+    event(1, 1, 30.00, request={"data": True})
+    event(1, 2, 30.01, request={"data": True})
+    event(2, 2, 30.05, response={"success": True, "message": ""})
+    event(2, 1, 30.10, response={"success": False, "message": ""})
+    event(3, 1, 30.11, response={"success": False, "message": ""})  # the client's own event: not read twice
+    # the request/reply samples of the same calls are left to the events
+    req = types.struct("std_srvs/srv/SetBool_Request")
+    taps.handle("call:/estop:request", req(data=True).serialize(), 30.0, 30.0, client)
+    taps.tick(32.0)
+    summary = taps.finish()
+    base = {x["verdict"]["where"]: x["verdict"]["verdict"] for x in lines
+            if x.get("verdict", {}).get("node") == "Base" and "kind" not in x}
+    gid = client.hex()
+    assert base == {f"estop call {gid}:1 response": "violated", f"estop call {gid}:2 response": "satisfied"}
+    assert summary["counts"]["calls"] == 2 and taps.counts["introspected"] == 1
+    assert event_side([client], [server], [client]) == "client" and event_side([], [server], [client]) is None

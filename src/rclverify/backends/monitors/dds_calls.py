@@ -167,19 +167,22 @@ class CallBook:
             self._log({"link": self.calls[key].name, "part": "rejected", "time": stamp, "key": _key(key)})
             self._close(key)
 
-    def unpaired(self, key: tuple[Any, ...], stamp: float, reason: str) -> None:
+    def unpaired(self, key: tuple[Any, ...], stamp: float, reason: str, part: str = "response") -> None:
         """Call ``key`` may have been answered at ``stamp`` (s), but which answer
         is its cannot be known (:mod:`.dds_order`): what was judged of it stays
         (its request's assumption, a guarantee its request alone decides,
         deadlines already expired: each was decided before any answer could
         have come), what waits for its answer is ``inconclusive`` with
         ``reason`` (each node that serves or calls it),
-        its deadlines not yet due are left undecided (``unaccepted``)."""
+        its deadlines not yet due are left undecided (``unaccepted``).  Its log
+        line (``unpaired``, ``orphan``: an answer heard and not paired) names
+        the answer's ``part`` (``response``, ``result``)."""
         call = self.calls.pop(key, None)
         if call is None:
             return
         self.counts["unpaired"] += 1
-        self._log({"link": call.name, "part": "unpaired", "time": stamp, "key": _key(key), "reason": reason})
+        self._log({"link": call.name, "part": part, "unpaired": True, "orphan": True, "time": stamp,
+                   "key": _key(key), "reason": reason})
         for m in call.monitors:
             res = m.result
             if not m.pending:  # decided on the request alone (an answer could not change it)
@@ -312,8 +315,8 @@ def replay(book: CallBook, lines: Iterable[Mapping[str, Any]]) -> dict[str, Any]
         part = str(x.get("part"))
         if part == "tick":
             book.tick(float(x["time"]))
-        elif part == "unpaired":
-            book.unpaired(tuple(x["key"]), float(x["time"]), str(x["reason"]))
+        elif x.get("unpaired"):
+            book.unpaired(tuple(x["key"]), float(x["time"]), str(x["reason"]), part)
         elif "index" in x:
             name, key = str(x["link"]), tuple(x["key"])
             if part in ("request", "goal"):

@@ -258,7 +258,7 @@ class CallTaps:
         elif part == "result_reply":
             gid, undecided, why = self._told(name, "get_result", s, stamp, framed, writer)
             for g in undecided:
-                self.book.unpaired((g,), stamp, f"its result cannot be told apart: {why}")
+                self.book.unpaired((g,), stamp, f"its result cannot be told apart: {why}", "result")
             if gid:
                 self._answer((gid,), "result", to_fields(s.result), stamp, True, name, now)
                 self._note_status(name, gid, int(s.status), stamp)
@@ -299,7 +299,7 @@ class CallTaps:
             return
         for g in dict.fromkeys(undecided + pool):  # one of them was refused: none can be judged
             self.book.unpaired((g,), stamp, f"a goal was refused and which one cannot be told: "
-                               f"{why or 'its request is one of several unanswered'}")
+                               f"{why or 'its request is one of several unanswered'}", "result")
 
     # -- the book --------------------------------------------------------------------------------
     def _open(self, name: str, key: tuple[Any, ...], label: str, fields: dict[str, Any], stamp: float,
