@@ -80,3 +80,31 @@ def test_a_qos_conflict_is_reported(diff: dict[str, Any]) -> None:
     assert len(qos) == 1 and qos[0]["name"] == "/range"
     assert "node /viewer subscribes with reliable" in qos[0]["message"]
     assert "node /sensor publishes with best_effort" in qos[0]["message"]
+
+
+def test_a_node_list_that_never_arrives_is_said_after_the_settling(tmp_path: Path,
+                                                                  monkeypatch: pytest.MonkeyPatch) -> None:
+    """A ROS 2 participant (it has a ros_discovery_info writer) whose node list
+    never comes: the reader listens past the wait for the settling time, then
+    says so; its endpoints are in no node, never silently in a wrong one."""
+    import time
+
+    from rclverify.ros.diff_dds import read_dds_graph
+    env = dds_env(tmp_path)
+    for k, v in env.items():
+        monkeypatch.setenv(k, v)
+    ros = Ros2Participant(TypeBook([]), domain_of(env))
+    try:
+        ros.publisher(ros.node("late"), "/scan", "std_msgs/Float32")  # announce() is never called
+        start = time.monotonic()
+        g, disc, _source, dp = read_dds_graph(0.5, domain_of(env), settle_s=1.0)
+        took = time.monotonic() - start
+        disc.close()
+        dp.__del__()
+    finally:
+        ros.close()
+    said = [n.message for n in g.notes]
+    assert [m for m in said if "its node list (ros_discovery_info) has not arrived" in m
+            and "the graph may be incomplete" in m], said
+    assert [m for m in said if "rt/scan" in m and "in no ROS 2 node" in m], said
+    assert not g.nodes and 1.4 <= took < 5, (g.nodes, took)
