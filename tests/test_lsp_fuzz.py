@@ -467,4 +467,40 @@ async def test_random_requests_are_answered_and_formatting_round_trips(client: L
     got, err = await answer(client.text_document_hover_async(lsp.HoverParams(lsp.TextDocumentIdentifier(a),
                                                                              lsp.Position(0, 0))))
     assert err is None  # the server still serves
-    assert not [m for m in client.messages if _LEAK.search(m.message)], client.messages
+    assert not client.messages, client.messages  # no pop-up: what a notification could not do is in the log
+    assert not [m for m in client.log_messages if _LEAK.search(m.message)], client.log_messages
+
+
+@pytest.mark.filterwarnings("ignore:The test <Function")
+def test_requests_after_shutdown_are_answered(tmp_path: Path) -> None:
+    """Over raw JSON-RPC (its own short-lived server): a notification pygls cannot read is logged in one line,
+    and a request after ``shutdown`` is answered -32600 (LSP 3.17 "Shutdown Request"), not dropped."""
+    import json
+    import subprocess
+
+    from _procs import stop
+    proc = subprocess.Popen([sys.executable, "-m", "rclverify.cli", "lsp", "-w", str(tmp_path)], env=ENV,
+                            stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=subprocess.PIPE, start_new_session=True)
+    try:
+        def send(msg: dict[str, Any]) -> None:
+            body = json.dumps(msg).encode()
+            proc.stdin.write(b"Content-Length: %d\r\n\r\n" % len(body) + body)  # type: ignore[union-attr]
+            proc.stdin.flush()  # type: ignore[union-attr]
+
+        send({"jsonrpc": "2.0", "id": 1, "method": "initialize", "params": {"capabilities": {}}})
+        send({"jsonrpc": "2.0", "method": "textDocument/didOpen", "params": {"textDocument": {"uri": 5}}})
+        send({"jsonrpc": "2.0", "id": 2, "method": "shutdown"})
+        send({"jsonrpc": "2.0", "id": 3, "method": "textDocument/hover",
+              "params": {"textDocument": {"uri": (tmp_path / "a.rcl").as_uri()}, "position": {"line": 0, "character": 0}}})
+        send({"jsonrpc": "2.0", "method": "exit"})
+        out, err = proc.communicate(timeout=BOUND * 2)
+    finally:
+        stop(proc)
+    msgs = [json.loads(part.split(b"\r\n\r\n", 1)[1]) for part in out.split(b"Content-Length: ")[1:]]
+    by_id = {m.get("id"): m for m in msgs if "id" in m}
+    assert set(by_id) == {1, 2, 3}, msgs
+    assert by_id[3]["error"] == {"code": -32600, "message": "textDocument/hover: the server is shutting down "
+                                                             "(it received `shutdown`)"}
+    logs = [m["params"]["message"] for m in msgs if m.get("method") == "window/logMessage"]
+    assert logs == ["the server could not handle a message (JsonRpcInvalidParams: Invalid Params)"], msgs
+    assert b"Traceback" not in err and all(len(line) <= 400 for line in err.splitlines()), err.decode()

@@ -7,7 +7,9 @@ type (a position whose line is 2^31 or negative: LSP's ``uinteger`` is
 logs the error and shows it out of band, and the request's id is lost: the
 client waits for ever.  :class:`RclProtocol` answers such a request with a
 JSON-RPC error -32602 (invalid params, JSON-RPC 2.0 section 5.1) whose
-message names the method and the fields at fault.
+message names the method and the fields at fault; a request after
+``shutdown`` (which pygls drops) with -32600 (LSP 3.17, "Shutdown
+Request").
 
 When a handler raises, pygls answers -32603 with the exception's text and
 its traceback in ``data``.  :func:`guarded` wraps every feature handler:
@@ -82,7 +84,9 @@ def invalid_params_message(method: str, exc: BaseException | None) -> str:
     except Exception:  # not a cattrs error: the message alone
         why = []
     detail = "; ".join(why) if why else "they do not have the protocol's types"
-    return one_line(f"{method}: invalid params ({detail}; LSP positions are integers 0..2147483647)")
+    if re.search(r"position|range|line|character", detail, re.I):
+        detail += "; LSP positions are integers 0..2147483647"
+    return one_line(f"{method}: invalid params ({detail})")
 
 
 class OneLineFormatter(logging.Formatter):
@@ -133,6 +137,12 @@ class RclProtocol(LanguageServerProtocol):
         if isinstance(message, _Invalid):
             log.warning("%s", message.message)
             self._send_response(message.id, error=lsp.ResponseError(Refused.CODE, message.message))
+            return
+        method = getattr(message, "method", None)
+        if self._shutdown and method not in (None, lsp.EXIT) and getattr(message, "id", None) is not None:
+            # LSP 3.17 "Shutdown Request": requests after it are answered InvalidRequest (pygls drops them)
+            self._send_response(message.id, error=lsp.ResponseError(
+                -32600, f"{method}: the server is shutting down (it received `shutdown`)"))
             return
         super().handle_message(message)
 

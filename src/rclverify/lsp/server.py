@@ -67,6 +67,17 @@ class RclServer(LanguageServer):
         self._published: set[str] = set()
         self.messages: Any = None
 
+    def report_server_error(self, error: Exception, source: Any) -> None:
+        """A fault outside a request (a notification pygls could not read or
+        apply, e.g. ``didChange`` of a document never opened): one line in
+        the editor's log (``window/logMessage``), not a pop-up; a request's
+        fault is in its answer (:mod:`.rpc`)."""
+        from pygls.exceptions import FeatureRequestError
+        if source is FeatureRequestError:
+            return
+        self.window_log_message(lsp.LogMessageParams(
+            lsp.MessageType.Error, one_line(f"the server could not handle a message ({type(error).__name__}: {error})")))
+
     # -- the workspace ---------------------------------------------------------------------------
     def set_root(self, root: Path, plan: str = PLAN) -> None:
         """Serve the workspace at ``root`` from now on."""
