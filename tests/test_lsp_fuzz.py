@@ -306,29 +306,6 @@ async def test_formatting_a_text_over_the_size_limit_is_refused_at_once(client: 
     client.text_document_did_close(lsp.DidCloseTextDocumentParams(lsp.TextDocumentIdentifier(u)))
 
 
-@pytest.mark.filterwarnings("ignore:The test <Function")
-def test_a_malformed_root_uri_leaves_the_working_directory_the_root() -> None:
-    from rclverify.lsp.server import _root_of
-    for bad in ("file://[::1/ws", "file:///srv/a%00b", "file:///srv/a\x00b"):
-        assert _root_of(lsp.InitializeParams(capabilities=lsp.ClientCapabilities(), root_uri=bad)) is None, bad
-    assert _root_of(lsp.InitializeParams(capabilities=lsp.ClientCapabilities(), root_uri="file:///srv/w%20s")) == Path("/srv/w s")
-
-
-@pytest.mark.filterwarnings("ignore:The test <Function")
-def test_an_unexpected_exception_is_one_line() -> None:
-    """The guard around every handler (in this process: no request makes the real server fail on purpose)."""
-    from rclverify.lsp.rpc import guarded
-
-    @guarded("textDocument/hover")
-    def broken(ls: Any, params: Any) -> None:
-        raise KeyError("a\nb")
-
-    with pytest.raises(JsonRpcException) as exc:
-        broken(None, None)
-    assert exc.value.code == -32603 and exc.value.data is None
-    assert exc.value.message == "textDocument/hover: internal error of the language server (KeyError: 'a\\nb'); it goes on serving"
-
-
 async def test_every_position_of_a_cr_document(client: LanguageClient, ws: Path) -> None:
     """Hover, completion, definition and references at every position of the contract with bare-CR line
     ends (and one past each line's end): every one answered, none an error; what hover finds on a name
@@ -469,38 +446,3 @@ async def test_random_requests_are_answered_and_formatting_round_trips(client: L
     assert err is None  # the server still serves
     assert not client.messages, client.messages  # no pop-up: what a notification could not do is in the log
     assert not [m for m in client.log_messages if _LEAK.search(m.message)], client.log_messages
-
-
-@pytest.mark.filterwarnings("ignore:The test <Function")
-def test_requests_after_shutdown_are_answered(tmp_path: Path) -> None:
-    """Over raw JSON-RPC (its own short-lived server): a notification pygls cannot read is logged in one line,
-    and a request after ``shutdown`` is answered -32600 (LSP 3.17 "Shutdown Request"), not dropped."""
-    import json
-    import subprocess
-
-    from _procs import stop
-    proc = subprocess.Popen([sys.executable, "-m", "rclverify.cli", "lsp", "-w", str(tmp_path)], env=ENV,
-                            stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=subprocess.PIPE, start_new_session=True)
-    try:
-        def send(msg: dict[str, Any]) -> None:
-            body = json.dumps(msg).encode()
-            proc.stdin.write(b"Content-Length: %d\r\n\r\n" % len(body) + body)  # type: ignore[union-attr]
-            proc.stdin.flush()  # type: ignore[union-attr]
-
-        send({"jsonrpc": "2.0", "id": 1, "method": "initialize", "params": {"capabilities": {}}})
-        send({"jsonrpc": "2.0", "method": "textDocument/didOpen", "params": {"textDocument": {"uri": 5}}})
-        send({"jsonrpc": "2.0", "id": 2, "method": "shutdown"})
-        send({"jsonrpc": "2.0", "id": 3, "method": "textDocument/hover",
-              "params": {"textDocument": {"uri": (tmp_path / "a.rcl").as_uri()}, "position": {"line": 0, "character": 0}}})
-        send({"jsonrpc": "2.0", "method": "exit"})
-        out, err = proc.communicate(timeout=BOUND * 2)
-    finally:
-        stop(proc)
-    msgs = [json.loads(part.split(b"\r\n\r\n", 1)[1]) for part in out.split(b"Content-Length: ")[1:]]
-    by_id = {m.get("id"): m for m in msgs if "id" in m}
-    assert set(by_id) == {1, 2, 3}, msgs
-    assert by_id[3]["error"] == {"code": -32600, "message": "textDocument/hover: the server is shutting down "
-                                                             "(it received `shutdown`)"}
-    logs = [m["params"]["message"] for m in msgs if m.get("method") == "window/logMessage"]
-    assert logs == ["the server could not handle a message (JsonRpcInvalidParams: Invalid Params)"], msgs
-    assert b"Traceback" not in err and all(len(line) <= 400 for line in err.splitlines()), err.decode()

@@ -13,5 +13,7 @@ checked together), :mod:`.diagnostics` (parse, type, unit and lint errors of
 the unsaved text), :mod:`.lastrun` (the last run's findings, stale once the
 text changes), :mod:`.index` (what is at a position), :mod:`.hover`,
 :mod:`.navigate` (definition, references), :mod:`.actions` (quick fixes,
-formatting), :mod:`.complete`, :mod:`.server` (the pygls handlers).
+formatting), :mod:`.complete`, :mod:`.lines` (LSP's lines: ``\r\n``, ``\r``,
+``\n``), :mod:`.rpc` (every request answered in one line), :mod:`.server`
+(the pygls handlers).
 """
