@@ -22,7 +22,10 @@ does not have; ``planner`` is not started.  The diff must report exactly:
 QoS conflict on ``/sensors/image`` between the running viewer and camera,
 the camera running best-effort where its code asks for reliable (at its
 ``create_publisher`` call), and nothing about the nodes that run as the
-code says; exit 1.
+code says; exit 1.  An independent oracle checks the reading itself: ROS 2's
+own graph API (rclpy in a process of its own) must list the same nodes,
+publishers, subscribers, service servers and clients, action servers and
+clients, with their types, as rclverify read from DDS.
 
 The static tests beside it check, without ROS 2, the namespaces the scan
 gives (code namespaces in Python and C++, launch namespaces in Python and
@@ -39,7 +42,7 @@ from typing import Any, Iterator
 import pytest
 
 from _procs import stop, wait_for
-from _ros2 import rclverify, ros2_env, start_node
+from _ros2 import rclverify, ros2_env, ros2_python, start_node
 
 PKG = {
     "package.xml": """\
@@ -199,6 +202,37 @@ OTHERS = """\
     """
 
 
+#: ROS 2's own view of the graph (rclpy's graph API over rmw_dds_common's graph cache), as JSON on stdout once
+#: every node of ``want`` is seen (at most 15 s): per node its publishers, subscribers, service servers and
+#: clients, action servers and clients, each ``[name, [types]]``
+PROBE = """\
+    import json, sys, time
+    import rclpy
+    from rclpy.action import get_action_client_names_and_types_by_node as aclients
+    from rclpy.action import get_action_server_names_and_types_by_node as aservers
+    want = set(sys.argv[1:])
+    rclpy.init()
+    me = rclpy.create_node('_graph_probe')
+    end = time.monotonic() + 15
+    while time.monotonic() < end:
+        rclpy.spin_once(me, timeout_sec=0.1)
+        nodes = [(n, ns) for n, ns in me.get_node_names_and_namespaces() if n != '_graph_probe']
+        if want <= {(ns.rstrip('/') + '/' + n) for n, ns in nodes}:
+            time.sleep(1.0)  # the endpoints after the nodes
+            rclpy.spin_once(me, timeout_sec=0.1)
+            break
+    out = {}
+    for n, ns in sorted(set(nodes)):
+        out[ns.rstrip('/') + '/' + n] = {
+            'pub': me.get_publisher_names_and_types_by_node(n, ns),
+            'sub': me.get_subscriber_names_and_types_by_node(n, ns),
+            'service_servers': me.get_service_names_and_types_by_node(n, ns),
+            'service_clients': me.get_client_names_and_types_by_node(n, ns),
+            'action_servers': aservers(me, n, ns), 'action_clients': aclients(me, n, ns)}
+    print(json.dumps(out), flush=True)
+    """
+
+
 def write_ws(root: Path) -> Path:
     """The workspace of the code side under ``root``; returns the package directory."""
     pkg = root / "src" / "demo_pkg"
@@ -232,10 +266,52 @@ def diff(tmp_path_factory: pytest.TempPathFactory) -> Iterator[dict[str, Any]]:
                        "--wait", "2", "--json", str(out)], env, tmp / "ws", log)
         procs.append(p)
         code = p.wait(60)
-        yield {"code": code, "json": json.loads(out.read_text()), "log": log.read_text(), "domain": env["ROS_DOMAIN_ID"]}
+        probe = subprocess.Popen([str(ros2_python()), "-c", textwrap.dedent(PROBE), *RUNNING], cwd=tmp, env=env,
+                                 stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, start_new_session=True)
+        procs.append(probe)
+        ours = _read_running(env)  # rclverify's reading of the same graph, meanwhile
+        seen = json.loads(probe.communicate(timeout=30)[0] or b"{}")
+        yield {"code": code, "json": json.loads(out.read_text()), "log": log.read_text(), "domain": env["ROS_DOMAIN_ID"],
+               "ros2": seen, "ours": ours}
     finally:
         for p in procs:
             stop(p)
+
+
+#: the nodes that run (their names as ROS 2 gives them)
+RUNNING = ("/robot/talker", "/viewer", "/sensors/camera", "/intruder", "/_ros2cli_probe")
+
+
+def _read_running(env: dict[str, str]) -> dict[str, dict[str, list[tuple[str, str | None]]]]:
+    """rclverify's graph of the running system (:func:`read_dds_graph`), per node and edge kind."""
+    from rclverify.ros.diff_dds import read_dds_graph
+    mp = pytest.MonkeyPatch()
+    mp.setenv("CYCLONEDDS_URI", env["CYCLONEDDS_URI"])
+    try:
+        g, disc, _s, dp = read_dds_graph(2.0, int(env["ROS_DOMAIN_ID"]))
+        disc.close()
+        dp.__del__()
+    finally:
+        mp.undo()
+    kinds = ("pub", "sub", "service_servers", "service_clients", "action_servers", "action_clients")
+    return {name: {k: sorted((e.topic, e.msg_type) for e in n.edges_of(k)) for k in kinds}
+            for name, n in g.nodes.items() if not name.endswith("/_graph_probe")}
+
+
+def _ros2_view(seen: dict[str, Any]) -> dict[str, dict[str, list[tuple[str, str | None]]]]:
+    """ROS 2's view with what docs/ros.md says the diff leaves out taken out: /rosout and
+    /parameter_events, each node's parameter and type-description services, an action's
+    hidden topics and services (its server and client are the action graph API's)."""
+    from rclverify.ros.diff_dds import INFRA_SERVICE_SUFFIXES, INFRA_TOPICS
+    out = {}
+    for name, kinds in seen.items():
+        if name.endswith("/_graph_probe"):
+            continue
+        out[name] = {k: sorted((t, types[0] if len(types) == 1 else None) for t, types in v
+                               if t not in INFRA_TOPICS and "/_action/" not in t
+                               and not (k.startswith("service") and t.endswith(INFRA_SERVICE_SUFFIXES)))
+                     for k, v in kinds.items()}
+    return out
 
 
 def _items(d: dict[str, Any], side: str, category: str | None = None) -> list[dict[str, Any]]:
@@ -282,6 +358,16 @@ def test_namespaced_nodes_are_found_with_their_namespace(diff: dict[str, Any]) -
     assert not [i for i in everything if i["category"] == "node" and i["name"] != "/robot/planner"
                 and i["name"] != "/intruder"]
     assert "in no ROS 2 node" not in diff["log"] and "may be incomplete" not in diff["log"], diff["log"]
+
+
+def test_the_running_graph_is_the_one_ros2_itself_sees(diff: dict[str, Any]) -> None:
+    """Oracle: rclpy's graph API (rmw_fastrtps, rmw_dds_common's graph cache) in
+    a process of its own; every node, publisher, subscriber, service server and
+    client, action server and client, with its type, must be what rclverify read."""
+    ros2 = _ros2_view(diff["ros2"])
+    assert set(ros2) == set(RUNNING), ros2  # the probe saw the whole system
+    assert diff["ours"] == ros2
+    assert ros2["/robot/talker"]["action_servers"] == [("/robot/count", "test_msgs/action/Fibonacci")]
 
 
 # -- the namespaces of the static scan (no ROS 2 needed) ---------------------------------------
