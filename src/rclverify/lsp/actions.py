@@ -26,6 +26,7 @@ import re
 from typing import Any, Mapping
 
 from lsprotocol import types as lsp
+
 from ..rcl.errors import RclError
 from .diagnostics import utf16_col
 from .lastrun import LastRun

@@ -70,7 +70,8 @@ def hover_text(a: Analysis, sym: Symbol, report: Mapping[str, Any] | None) -> st
         if not 1 <= sym.index <= len(n.guarantees):
             return None
         from ..rcl.printer import expr_to_rcl
-        g: Mapping[str, Any] = next((x for x in _report_node(report, sym.node).get("guarantees") or () if x.get("index") == sym.index), {})
+        g: Mapping[str, Any] = next((x for x in _report_node(report, sym.node).get("guarantees") or ()
+                                     if x.get("index") == sym.index), {})
         obligations = [o for o in (report or {}).get("obligations", ())
                        if o.get("node") == sym.node and o.get("guarantee") == sym.index]
         findings = [f for f in (report or {}).get("findings", ())

@@ -20,9 +20,10 @@ the file); a notification about one is ignored with a log message.  Every
 request is answered (:mod:`.rpc`): one whose params do not have the
 protocol's types with -32602, an unexpected exception in a handler with a
 one-line -32603 error (no traceback), and the server goes on: no text and
-no request can stop it.  A position past the end of its line or of the
-document is answered as a position where nothing stands (hover ``null``,
-no definition, no references).
+no request can stop it.  A position past the last line is answered as a
+place where nothing stands (hover ``null``, no definition, no
+references); past the end of its line it means the line's end (LSP 3.17,
+"Position").
 
 Lines are LSP's (:mod:`.lines`: ``\r\n``, ``\r`` and ``\n`` end a line);
 texts go to the parser with ``\n`` line ends.
