@@ -2,12 +2,15 @@
 
 A ROS 2 service call is a request and a reply that carry the same identity
 (rmw_cyclonedds' request header: the client's request-writer handle and a
-sequence number, :mod:`.dds_types`); an action goal is its ``goal_id`` (a
-UUID) on the send-goal request, the feedback messages and the get-result
-reply.  A third party on the bus sees every call of every client, so calls
-are paired by identity, never by their order, and each call (each goal) is
-checked as a trace of its own (docs/monitors.md, "Services and actions over
-DDS"):
+sequence number, :mod:`.dds_types`; or the call's ``client_gid`` and
+sequence number in the service's introspection events,
+:mod:`.dds_introspection`); an action goal is its ``goal_id`` (a UUID) on
+the send-goal request, the feedback messages and the get-result reply.  A
+third party on the bus sees every call of every client, so calls are paired
+by identity, and by their order only where the order leaves no doubt
+(:mod:`.dds_order`: a call it cannot pair is :meth:`CallBook.unpaired`), and
+each call (each goal) is checked as a trace of its own (docs/monitors.md,
+"Services and actions over DDS"):
 
 * **the server's guarantee**: the node that ``serves(...)`` the link, seen
   through the link (:func:`link_view`: its topics are the link's parts,
