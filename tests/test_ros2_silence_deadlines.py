@@ -5,9 +5,9 @@ One ROS 2 system runs once for the module: ``echo`` answers each ``/r``
 on ``/out`` at once, except the value 3.0, which it answers 301 ms late
 (the contract's deadline is 100 ms); ``driver`` sends ten values, each
 after the previous answer; ``base`` serves ``/estop`` (std_srvs/SetBool)
-and ``driver`` calls it twice once its client sees the server (within 2 s;
-Fast DDS does not always announce it that soon, and then there is no call:
-the service test holds either way).  Four monitors watch the same run, each as
+and ``driver`` calls it twice (without waiting for ``service_is_ready()``:
+rmw_fastrtps calls a server ready only when the request topic has as many
+readers as the reply topic has writers, which a monitor reading both breaks).  Four monitors watch the same run, each as
 its own process with its own verdict topic:
 
 * ``echo``: ``--node Echo --strict``: the late answer is a ``false``
@@ -104,13 +104,18 @@ for k in range(10):
     while len(answers) <= k and time.monotonic() < until:
         ex.spin_once(timeout_sec=0.01)
     time.sleep(0.03)
-until = time.monotonic() + 2
-while time.monotonic() < until and not client.service_is_ready():
+# while the monitor reads /estop's request and reply topics, rmw_fastrtps may never call the server ready (it
+# wants as many request readers as reply writers): wait a little, then call anyway (the server is there)
+until = time.monotonic() + 5  # the base monitor's reader of the requests, beside the server's (the raw DDS topic)
+while time.monotonic() < until and len(driver.get_subscriptions_info_by_topic("rq/estopRequest", True)) < 2:
     ex.spin_once(timeout_sec=0.05)
-print("service ready", client.service_is_ready(), flush=True)
-for k in range(2 if client.service_is_ready() else 0):
+replies = []
+for k in range(2):
     fut = client.call_async(SetBool.Request(data=True))
     ex.spin_until_future_complete(fut, timeout_sec=3)
+    replies.append(fut.done())
+print("service ready", client.service_is_ready(), "readers", len(driver.get_subscriptions_info_by_topic(
+    "rq/estopRequest", True)), "replies", replies, flush=True)
 print("done", len(answers), flush=True)
 while True:
     ex.spin_once(timeout_sec=0.1)
