@@ -26,8 +26,13 @@ workspace's, so the monitor names it in a warning and drops every one of
 its samples (counted), while the Cyclone publisher, whose XTypes type
 object has the contract's layout, is heard.
 
-Two live monitors watch the run, one recording to the default storage
-(SQLite 3), one to MCAP.  Checked: every message heard and decoded (the
+A ninth, ``ws``, carries ``test_msgs/WStrings`` (wide strings, their
+defaults, arrays and sequences of them), watched by a third monitor of its
+own (``--node W``, no bag: rosbags cannot describe a ``wstring``), whose
+guarantee compares the decoded text.
+
+Two live monitors watch the rest of the run, one recording to the default
+storage (SQLite 3), one to MCAP.  Checked: every message heard and decoded (the
 counts per topic, no decode error), the verdicts, no layout warning and no
 Cyclone ``invalid type object`` line on the monitor's output; each bag read
 back by rosbags (its ``metadata.yaml``, the message counts, a decoded
@@ -67,6 +72,8 @@ TOPICS: dict[str, tuple[str, str, str, str, tuple[int, int]]] = {
                "INTEGER", "v <= 16", (17, N - 17)),
 }
 EXPECTED = {**{name.capitalize(): want for name, (*_, want) in TOPICS.items()}, "Mislaid": (N, 0)}
+WIDE = "context {\n  Greeting = {hello, bye} ;\n}\nnode W {\n  inputs( )\n  outputs( v : Greeting )\n" \
+    "  topics( test_msgs/WStrings ws matches(out.v) )\n  assume( TRUE )\n  guarantee( out.v == hello )\n}\n"
 MISLAID = "node Mislaid {\n  inputs( )\n  outputs( v : REAL )\n  topics( test_msgs/Nested mislaid matches(out.v) )\n" \
     "  assume( TRUE )\n  guarantee( out.v >= 0 )\n}\n"
 
@@ -77,17 +84,18 @@ from rclpy.node import Node
 from std_msgs.msg import Float64MultiArray, MultiArrayDimension
 from sensor_msgs.msg import JointState
 from geometry_msgs.msg import PoseWithCovarianceStamped
-from test_msgs.msg import Arrays, BoundedSequences, MultiNested, Nested, UnboundedSequences
+from test_msgs.msg import Arrays, BoundedSequences, MultiNested, Nested, UnboundedSequences, WStrings
 
 rclpy.init()
 node = Node("talker")
 types = {{"arr": Float64MultiArray, "joints": JointState, "pose": PoseWithCovarianceStamped,
          "bounded": BoundedSequences, "unbounded": UnboundedSequences, "arrays": Arrays, "nested": MultiNested,
-         "mislaid": Nested}}
+         "mislaid": Nested, "ws": WStrings}}
 pubs = {{t: node.create_publisher(c, t, 50) for t, c in types.items()}}
 print("ready", flush=True)
 until = time.monotonic() + 20
-while time.monotonic() < until and min(p.get_subscription_count() for p in pubs.values()) < 2:
+while time.monotonic() < until and (min(p.get_subscription_count() for t, p in pubs.items() if t != "ws") < 2
+                                    or pubs["ws"].get_subscription_count() < 1):
     time.sleep(0.05)
 print("matched", {{t: p.get_subscription_count() for t, p in pubs.items()}}, flush=True)
 time.sleep(0.3)
@@ -110,6 +118,8 @@ for k in range({N}):
     pubs["nested"].publish(MultiNested(unbounded_sequence_of_unbounded_sequences=[
         UnboundedSequences(), UnboundedSequences(int32_values=[5, k], string_values=["n"])]))
     pubs["mislaid"].publish(Nested())
+    pubs["ws"].publish(WStrings(wstring_value="hello" if k < {N - 1} else "bye",
+                                array_of_wstrings=["a", "\u00fc", str(k)], unbounded_sequence_of_wstrings=["x"] * (k % 3)))
     time.sleep(0.02)
 print("done", flush=True)
 while True:
@@ -133,10 +143,11 @@ def _workspace(ws: Path) -> None:
                    f"  topics( {typ} {name} matches(out.v) )\n  assume( TRUE )\n"
                    f"  guarantee( {guarantee.replace('v', 'out.v')} )\n}}\n")
     (ws / "contracts").mkdir(parents=True)
-    (ws / "contracts/types.rcl").write_text("\n".join(rcl + [MISLAID]))
+    (ws / "contracts/types.rcl").write_text("\n".join(rcl + [MISLAID, WIDE]), encoding="utf-8")
     (ws / "contracts/plan.yaml").write_text("contracts: [contracts/types.rcl]\n")
     fields = "\n".join(f"  {name}: {{fields: ['{path}']}}" for name, (_t, path, *_r) in TOPICS.items())
-    (ws / "mapping.yaml").write_text(f"msg_dirs: [interfaces]\ntopics:\n{fields}\n  mislaid: {{fields: [x]}}\n")
+    (ws / "mapping.yaml").write_text(f"msg_dirs: [interfaces]\ntopics:\n{fields}\n  mislaid: {{fields: [x]}}\n"
+                                 "  ws: {fields: [wstring_value]}\n")
     share = Path(subprocess.run([str(ros2_python()), "-c", FIND_TEST_MSGS], capture_output=True, text=True,
                                 timeout=60, check=True).stdout.strip()) / "msg"
     (ws / "interfaces/test_msgs/msg").mkdir(parents=True)
@@ -159,13 +170,14 @@ def run(tmp_path_factory: pytest.TempPathFactory) -> Iterator[dict[str, Any]]:
     for var in ("CYCLONEDDS_URI", "ROS_DOMAIN_ID"):  # this process's Cyclone publisher: the same domain, loopback
         mp.setenv(var, env[var])
     try:
-        for name, bag in bags.items():
+        nodes = [x for n in [*EXPECTED] for x in ("--node", n)]
+        for name, extra in [*((n, ["--record", str(b), *nodes]) for n, b in bags.items()), ("wide", ["--node", "W"])]:
             procs[name] = rclverify(
                 ["monitor", "-w", str(ws), "--live", "--ros2", "--mapping", "mapping.yaml", "--horizon", "1.0",
                  "--reorder-window", "0", "--status", "0", "--duration", "60", "--verdict-topic", f"/{name}/verdict",
-                 "--record", str(bag), "--log", str(tmp / f"{name}.jsonl"), "--evidence", str(tmp / f"{name}.json")],
+                 "--log", str(tmp / f"{name}.jsonl"), "--evidence", str(tmp / f"{name}.json"), *extra],
                 env, tmp, tmp / f"{name}.out")
-        for name in bags:
+        for name in procs:
             wait_for(tmp / f"{name}.out", "monitoring", 30)
         configure_domain(domain_of(env))  # as the monitor's: Fast DDS's type information read without complaint
         cyclone = Ros2Participant(TypeBook([ws / "interfaces"]), domain_of(env))
@@ -182,8 +194,9 @@ def run(tmp_path_factory: pytest.TempPathFactory) -> Iterator[dict[str, Any]]:
         for p in procs.values():
             stop(p, signal.SIGINT)
         yield {"tmp": tmp, "ws": ws, "bags": {n: Path(str(b).removesuffix(".mcap")) for n, b in bags.items()},
-               "out": {n: (tmp / f"{n}.out").read_text() for n in bags},
-               "record": {n: json.loads((tmp / f"{n}.json").read_text()) for n in bags},
+               "out": {n: (tmp / f"{n}.out").read_text() for n in procs},
+               "record": {n: json.loads((tmp / f"{n}.json").read_text()) for n in procs},
+               "wide_log": [json.loads(x) for x in (tmp / "wide.jsonl").read_text().splitlines()],
                "system": (tmp / "system.log").read_text()}
     finally:
         if system is not None:
@@ -260,25 +273,31 @@ def test_the_bag_checked_offline_gives_the_live_verdicts(run: dict[str, Any], st
     got = capsys.readouterr()
     report = json.loads(got.out)
     offline = {e["node"]: (e["counts"].get("satisfied", 0), e["counts"].get("violated", 0))
-               for e in report if "counts" in e}
+               for e in report if "counts" in e and e["node"] != "W"}
     assert offline == _counts(run["record"][storage]) == EXPECTED, (offline, got.err)
     assert rc == 1, got.err  # violated guarantees: a failing exit, live and offline
 
 
-def test_a_contract_over_a_wstring_type_is_refused_at_its_topic(tmp_path: Path,
-                                                                 capsys: pytest.CaptureFixture[str]) -> None:
-    """``test_msgs/WStrings`` (ROS 2's own definition): one located error before the monitor joins the
-    domain, exit 2, never a traceback or a run that hears garbage (dds_types.py says why)."""
-    ws = tmp_path / "ws"
-    _workspace(ws)
-    (ws / "contracts/types.rcl").write_text("node W {\n  inputs( )\n  outputs( v : INTEGER )\n"
-                                            "  topics( test_msgs/WStrings ws matches(out.v) )\n  assume( TRUE )\n"
-                                            "  guarantee( out.v >= 0 )\n}\n")
-    (ws / "mapping.yaml").write_text("msg_dirs: [interfaces]\ntopics:\n  ws: {fields: [alignment_check]}\n")
-    capsys.readouterr()
-    rc = main(["monitor", "-w", str(ws), "--live", "--ros2", "--mapping", "mapping.yaml", "--duration", "1"])
-    err = capsys.readouterr().err
-    assert rc == 2 and err.startswith("contracts/types.rcl:4:11: error: topic /ws (test_msgs/WStrings): "
-                                      "test_msgs/msg/WStrings: field wstring_value is a wstring"), err
-    assert "Traceback" not in err
+def test_wide_strings_are_heard_and_decoded_to_their_text(run: dict[str, Any]) -> None:
+    rec, out = run["record"]["wide"], run["out"]["wide"]
+    assert rec["decode_errors"] == {} and rec["warnings"] == [] and rec["qos"]["ws"]["samples"] == N, (rec, out)
+    assert _counts(rec) == {"W": (N - 1, 1)}, (_counts(rec), out)  # the last one is another text
+    lines = [e for e in run["wide_log"] if e["topic"] == "ws"]
+    assert len(lines) == N and lines[0]["wstring_value"] == "hello", lines[:1]
+    last = lines[-1]
+    assert last["wstring_value"] == "bye" and last["array_of_wstrings"] == ["a", "\u00fc", str(N - 1)]
+    assert last["wstring_value_default3"] == "\u30cf\u30ed\u30fc\u30ef\u30fc\u30eb\u30c9"  # rosidl's default
+    assert last["unbounded_sequence_of_wstrings"] == ["x"] * ((N - 1) % 3)
 
+
+def test_recording_a_wstring_topic_is_refused_before_the_run(run: dict[str, Any],
+                                                              capsys: pytest.CaptureFixture[str]) -> None:
+    """rosbags cannot describe a wstring, so a bag could not hold the topic: one error, exit 2, no traceback,
+    before the monitor joins the domain, and nothing of a bag left behind."""
+    capsys.readouterr()
+    rc = main(["monitor", "-w", str(run["ws"]), "--live", "--ros2", "--mapping", "mapping.yaml", "--node", "W",
+               "--duration", "1", "--record", str(run["tmp"] / "wide.mcap")])
+    err = capsys.readouterr().err
+    assert rc == 2 and "wide: error: cannot record: topic /ws (test_msgs/WStrings): " in err, err
+    assert "a wstring cannot be stored" in err and "Traceback" not in err, err
+    assert not (run["tmp"] / "wide").exists()

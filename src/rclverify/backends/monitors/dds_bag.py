@@ -16,6 +16,7 @@ live run checked, at the same times, and gives the same verdicts
 from __future__ import annotations
 
 import queue
+import shutil
 import threading
 from pathlib import Path
 from typing import Any, Mapping, Sequence
@@ -70,6 +71,7 @@ class BagRecorder:
             raise BagError(f"{self.path}: error: cannot record: the bag was not opened within {open_timeout_s:g} s")
         if self.error:
             self._thread.join(open_timeout_s)
+            shutil.rmtree(self.path, ignore_errors=True)  # new (checked above): no half-made bag is left behind
             raise BagError(f"{self.path}: error: cannot record: {self.error}")
 
     def _open(self) -> tuple[Any, dict[str, Any]]:
@@ -78,13 +80,14 @@ class BagRecorder:
                         storage_plugin=StoragePlugin.MCAP if self.storage == "mcap" else StoragePlugin.SQLITE3)
         writer.open()
         connections: dict[str, Any] = {}
-        try:
-            for topic, msg_type in self.topics.items():
-                pkg, _, name = msg_type.replace("/msg/", "/").partition("/")
+        for topic, msg_type in self.topics.items():
+            pkg, _, name = msg_type.replace("/msg/", "/").partition("/")
+            try:
                 connections[topic] = writer.add_connection("/" + topic, f"{pkg}/msg/{name}", typestore=self._store)
-        except Exception:  # rosbags: a type its store cannot describe
-            writer.close()
-            raise
+            except Exception as exc:  # rosbags: a type its store cannot describe
+                writer.close()
+                wide = " (rosbags has no wide string: a wstring cannot be stored)" if "wstring" in str(exc) else ""
+                raise RuntimeError(f"topic /{topic} ({msg_type}): {exc}{wide}") from None
         return writer, connections
 
     def _run(self) -> None:

@@ -25,13 +25,15 @@ build step, no ROS installation.
   ``T_FeedbackMessage`` (``goal_id`` + ``feedback``), all in ``pkg::action``;
   status is ``action_msgs/msg/GoalStatusArray``.
 
-``wstring`` is refused with the type that uses it: Cyclone's Python binding
-has no wide string, the middlewares do not agree on its bytes (Fast DDS 3
-writes a ``uint32`` count of 4-byte code units in XCDR1, measured with
-``test_msgs/WStrings``; rmw_cyclonedds writes UTF-16, 2-byte units) and
-rosbags can neither describe nor decode one, so a bag could not hold it.
-Every error is a :class:`DdsTypeError` naming the type and, for the
-workspace's files, the file.
+A ``wstring`` (Cyclone's Python binding has no wide string) is carried as
+what ROS 2's middlewares put on the wire in plain CDR: a ``uint32`` count,
+then one 4-byte code unit per character (``wchar_t`` on Linux; rmw_fastrtps'
+``rosidl_typesupport_fastrtps`` and rmw_cyclonedds' legacy-CDR writer
+alike, measured with ``test_msgs/WStrings`` from Fast DDS 3), so the struct
+holds ``sequence<uint32>`` and :func:`to_fields` gives the text back;
+rosbags cannot describe a ``wstring``, so such a topic cannot be recorded
+(``--record`` says so).  Every error is a :class:`DdsTypeError` naming the
+type and, for the workspace's files, the file.
 """
 from __future__ import annotations
 
@@ -138,10 +140,8 @@ class TypeBook:
                 return (bool if base == "bool" else getattr(T, _BASE[base])), None
             raise DdsTypeError(f"{owner}: field {fname} has type {base}, which Cyclone's Python binding cannot carry")
         if kind == 2:
-            if str(detail).endswith("/wstring"):
-                raise DdsTypeError(f"{owner}: field {fname} is a wstring, which the monitor does not decode (Cyclone's "
-                                   "Python binding has no wide string; Fast DDS sends 4-byte, rmw_cyclonedds 2-byte "
-                                   "code units; rosbags cannot store it)")
+            if _wide_depth(desc) == 0:
+                return T.sequence[T.uint32], None  # type: ignore[misc]  # a wstring's wire form (module docstring)
             cls = self.struct(str(detail), owner)
             return cls, cls
         elem, inner = self._field_type(detail[0], owner, fname)
@@ -172,6 +172,9 @@ class TypeBook:
         if not info.fields:
             fields[_EMPTY] = T.uint8
         cls = make_idl_struct(name.rsplit("/", 1)[-1] + "_", dds_type(name), fields)
+        wide = {f: d for f, d in ((f, _wide_depth(desc)) for f, desc in info.fields) if d is not None}
+        if wide:
+            setattr(cls, WIDE, wide)
         self._structs[key] = cls
         self.nested[cls] = nested
         return cls
@@ -235,8 +238,9 @@ class TypeBook:
     # -- values ------------------------------------------------------------------------------
     def build(self, cls: type, data: Mapping[str, Any]) -> Any:
         """An instance of struct ``cls`` from a dict (nested dicts and lists of
-        dicts for nested messages; a field not given has its zero value)."""
+        dicts for nested messages, text for a wstring; a field not given has its zero value)."""
         nested = self.nested.get(cls, {})
+        wide = getattr(cls, WIDE, {})
         hints = self._hints.get(cls)
         if hints is None:
             hints = self._hints[cls] = typing.get_type_hints(cls, include_extras=True)
@@ -247,6 +251,8 @@ class TypeBook:
                 kw[fname] = self._zero(ann, inner)
                 continue
             v = data[fname]
+            if fname in wide:
+                v = _units(v, wide[fname])
             if inner is not None:
                 v = [self.build(inner, x) for x in v] if isinstance(v, (list, tuple)) else self.build(inner, v)
             kw[fname] = v
@@ -269,6 +275,35 @@ class TypeBook:
         return False if base is bool else 0.0 if base is float else 0
 
 
+#: the class attribute naming a struct's wstring fields: field -> how many arrays or sequences hold the text
+WIDE = "__rclverify_wstrings__"
+
+
+def _wide_depth(desc: Any) -> int | None:
+    """0 for a ``wstring`` field description, 1 for an array or sequence of them; ``None`` otherwise."""
+    kind, detail = int(desc[0]), desc[1]
+    if kind == 2:
+        return 0 if str(detail).endswith("/wstring") else None
+    if kind in (3, 4):
+        inner = _wide_depth(detail[0])
+        return None if inner is None else inner + 1
+    return None
+
+
+def _text(units: Any, depth: int) -> Any:
+    """A wstring's code units as text (``depth`` arrays or sequences of them: lists of text)."""
+    if depth:
+        return [_text(u, depth - 1) for u in units]
+    return "".join(chr(c) if 0 <= c <= 0x10FFFF and not 0xD800 <= c <= 0xDFFF else "\ufffd" for c in units)
+
+
+def _units(text: Any, depth: int) -> Any:
+    """The inverse of :func:`_text`."""
+    if depth:
+        return [_units(t, depth - 1) for t in text]
+    return [ord(c) for c in str(text)] if isinstance(text, str) else list(text)
+
+
 def to_fields(sample: Any) -> Any:
     """A received struct as JSON-ready data: a dict per struct (the request
     header and rosidl's placeholder member left out), lists for arrays and
@@ -276,7 +311,9 @@ def to_fields(sample: Any) -> Any:
     gives a ROS 2 bag's message (``traces/bag.py``)."""
     fs = getattr(sample, "__dataclass_fields__", None)
     if fs is not None:
-        return {k: to_fields(getattr(sample, k)) for k in fs if k not in HEADER_FIELDS and k != _EMPTY}
+        wide = getattr(type(sample), WIDE, {})
+        return {k: _text(getattr(sample, k), wide[k]) if k in wide else to_fields(getattr(sample, k))
+                for k in fs if k not in HEADER_FIELDS and k != _EMPTY}
     if isinstance(sample, (bytes, bytearray)):
         return list(sample)
     if isinstance(sample, (list, tuple)):
