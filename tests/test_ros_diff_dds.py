@@ -108,3 +108,11 @@ def test_a_node_list_that_never_arrives_is_said_after_the_settling(tmp_path: Pat
             and "the graph may be incomplete" in m], said
     assert [m for m in said if "rt/scan" in m and "in no ROS 2 node" in m], said
     assert not g.nodes and 1.4 <= took < 5, (g.nodes, took)
+    # a diff on such a reading is never "equal": nothing differs, but the running side was not read whole
+    from rclverify.ros.diff import render_text
+    from rclverify.ros.diff_dds import diff_dds
+    from rclverify.ros.model import Graph
+    res = diff_dds(Graph(), g, "DDS domain")
+    assert not res.missing and not res.extra and not res.equal and len(res.incomplete) == 1
+    assert res.to_json()["equal"] is False and res.to_json()["incomplete"] == res.incomplete
+    assert render_text(res)[-1].startswith("ros diff: 0 missing, 0 extra (incomplete, not equal)")

@@ -84,15 +84,18 @@ class DiffResult:
     extra: list[Item] = field(default_factory=list)
     compared: list[str] = field(default_factory=list)
     not_compared: list[str] = field(default_factory=list)
+    #: what the running side could not be read completely (a ROS 2 node list still on its way): never equal then
+    incomplete: list[str] = field(default_factory=list)
 
     @property
     def equal(self) -> bool:
-        return not self.missing and not self.extra
+        return not self.missing and not self.extra and not self.incomplete
 
     def to_json(self) -> dict[str, Any]:
         """The documented JSON shape (docs/ros.md, "Expected against observed")."""
         return {"schema": SCHEMA_ID, "observed": {"kind": self.kind, "source": self.source},
                 "equal": self.equal, "compared": list(self.compared), "not_compared": list(self.not_compared),
+                "incomplete": list(self.incomplete),
                 "missing": [i.to_json() for i in self.missing], "extra": [i.to_json() for i in self.extra]}
 
 
@@ -262,7 +265,9 @@ def render_text(res: DiffResult) -> list[str]:
         lines += [f"  {i}" for i in res.extra]
     for nc in res.not_compared:
         lines.append(f"not compared: {nc}")
-    verdict = "equal" if res.equal else "they differ"
+    for inc in res.incomplete:
+        lines.append(f"incomplete: {inc}")
+    verdict = "equal" if res.equal else "they differ" if res.missing or res.extra else "incomplete, not equal"
     lines.append(f"ros diff: {len(res.missing)} missing, {len(res.extra)} extra ({verdict}); compared "
                  f"{', '.join(res.compared)}")
     return lines

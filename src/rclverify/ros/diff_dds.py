@@ -2,9 +2,11 @@
 (docs/ros.md, "Expected against observed").
 
 :func:`read_dds_graph` joins the domain (``ROS_DOMAIN_ID``,
-``CYCLONEDDS_URI``), listens to discovery for ``wait_s`` seconds
-(:mod:`.dds_discovery`) and makes the same :class:`~.model.Graph` the ROS 1
-master reader makes (:mod:`.master`):
+``CYCLONEDDS_URI``), listens to discovery for ``wait_s`` seconds and on
+while the graph settles (every ROS 2 participant's node list and endpoints
+in: :meth:`.Discovery.pending`; Fast DDS sends its node list at its next
+heartbeat) and makes the same :class:`~.model.Graph` the ROS 1 master
+reader makes (:mod:`.master`):
 
 * a node per entry of ``ros_discovery_info`` (``/ns/name``), each endpoint
   given to the node that lists its GUID;
@@ -125,6 +127,8 @@ def qos_conflicts(disc: Discovery) -> list[tuple[str, EndpointInfo, EndpointInfo
 SETTLE_S = 6.0
 #: seconds without news from discovery after which a settled graph is taken as complete
 QUIET_S = 0.5
+#: the words of a note saying the running graph was not read completely (the diff is then never equal)
+INCOMPLETE = "the graph may be incomplete"
 
 
 def read_dds_graph(wait_s: float = 2.0, domain: int | None = None,
@@ -153,8 +157,8 @@ def read_dds_graph(wait_s: float = 2.0, domain: int | None = None,
     source = f"DDS domain {d}"
     g = graph_of(disc, source)
     for p in disc.pending():
-        g.notes.append(Note(Src(source, 1, 1), f"after {time.monotonic() - start:.1f} s of listening, {p}: the "
-                                               f"graph may be incomplete (give --wait longer)", "ROS-DDS"))
+        g.notes.append(Note(Src(source, 1, 1), f"after {time.monotonic() - start:.1f} s of listening, {p}: "
+                                               f"{INCOMPLETE} (give --wait longer)", "ROS-DDS"))
     return g, disc, source, dp
 
 
@@ -173,6 +177,7 @@ def diff_dds(static: Graph, running: Graph, source: str,
         running = Graph(nodes={k: v for k, v in running.nodes.items() if k not in hidden}, notes=running.notes)
     res = diff_master(static, running, source)
     res.kind = "dds"
+    res.incomplete = [n.message for n in running.notes if n.code == "ROS-DDS" and INCOMPLETE in n.message]
     res.compared += ["service clients", "QoS of the publishers and subscribers of each topic"]
     res.not_compared = ["history depth (DDS discovery does not announce it)"]
     if hidden:
