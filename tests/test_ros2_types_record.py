@@ -26,6 +26,11 @@ workspace's, so the monitor names it in a warning and drops every one of
 its samples (counted), while the Cyclone publisher, whose XTypes type
 object has the contract's layout, is heard.
 
+A tenth, ``keyed``, carries ``test_msgs/KeyedLong`` (``@key long key``,
+declared in ``.idl`` only), which the workspace describes with a ``.msg``
+of the same fields and no key: DDS never matches a keyless reader with a
+keyed writer, so the monitor says so and hears nothing of it.
+
 A ninth, ``ws``, carries ``test_msgs/WStrings`` (wide strings, their
 defaults, arrays and sequences of them), watched by a third monitor of its
 own (``--node W``, no bag: rosbags cannot describe a ``wstring``), whose
@@ -71,9 +76,11 @@ TOPICS: dict[str, tuple[str, str, str, str, tuple[int, int]]] = {
     "nested": ("test_msgs/MultiNested", "unbounded_sequence_of_unbounded_sequences[1].int32_values[-1]",
                "INTEGER", "v <= 16", (17, N - 17)),
 }
-EXPECTED = {**{name.capitalize(): want for name, (*_, want) in TOPICS.items()}, "Mislaid": (N, 0)}
+EXPECTED = {**{name.capitalize(): want for name, (*_, want) in TOPICS.items()}, "Mislaid": (N, 0), "Keyed": (0, 0)}
 WIDE = "context {\n  Greeting = {hello, bye} ;\n}\nnode W {\n  inputs( )\n  outputs( v : Greeting )\n" \
     "  topics( test_msgs/WStrings ws matches(out.v) )\n  assume( TRUE )\n  guarantee( out.v == hello )\n}\n"
+KEYED = "node Keyed {\n  inputs( )\n  outputs( v : INTEGER )\n  topics( test_msgs/KeyedLong keyed matches(out.v) )\n" \
+    "  assume( TRUE )\n  guarantee( out.v >= 0 )\n}\n"
 MISLAID = "node Mislaid {\n  inputs( )\n  outputs( v : REAL )\n  topics( test_msgs/Nested mislaid matches(out.v) )\n" \
     "  assume( TRUE )\n  guarantee( out.v >= 0 )\n}\n"
 
@@ -84,17 +91,17 @@ from rclpy.node import Node
 from std_msgs.msg import Float64MultiArray, MultiArrayDimension
 from sensor_msgs.msg import JointState
 from geometry_msgs.msg import PoseWithCovarianceStamped
-from test_msgs.msg import Arrays, BoundedSequences, MultiNested, Nested, UnboundedSequences, WStrings
+from test_msgs.msg import Arrays, BoundedSequences, KeyedLong, MultiNested, Nested, UnboundedSequences, WStrings
 
 rclpy.init()
 node = Node("talker")
 types = {{"arr": Float64MultiArray, "joints": JointState, "pose": PoseWithCovarianceStamped,
          "bounded": BoundedSequences, "unbounded": UnboundedSequences, "arrays": Arrays, "nested": MultiNested,
-         "mislaid": Nested, "ws": WStrings}}
+         "mislaid": Nested, "ws": WStrings, "keyed": KeyedLong}}
 pubs = {{t: node.create_publisher(c, t, 50) for t, c in types.items()}}
 print("ready", flush=True)
 until = time.monotonic() + 20
-while time.monotonic() < until and (min(p.get_subscription_count() for t, p in pubs.items() if t != "ws") < 2
+while time.monotonic() < until and (min(p.get_subscription_count() for t, p in pubs.items() if t not in ("ws", "keyed")) < 2
                                     or pubs["ws"].get_subscription_count() < 1):
     time.sleep(0.05)
 print("matched", {{t: p.get_subscription_count() for t, p in pubs.items()}}, flush=True)
@@ -118,6 +125,7 @@ for k in range({N}):
     pubs["nested"].publish(MultiNested(unbounded_sequence_of_unbounded_sequences=[
         UnboundedSequences(), UnboundedSequences(int32_values=[5, k], string_values=["n"])]))
     pubs["mislaid"].publish(Nested())
+    pubs["keyed"].publish(KeyedLong(key=k % 3, value=k))
     pubs["ws"].publish(WStrings(wstring_value="hello" if k < {N - 1} else "bye",
                                 array_of_wstrings=["a", "\u00fc", str(k)], unbounded_sequence_of_wstrings=["x"] * (k % 3)))
     time.sleep(0.02)
@@ -143,17 +151,18 @@ def _workspace(ws: Path) -> None:
                    f"  topics( {typ} {name} matches(out.v) )\n  assume( TRUE )\n"
                    f"  guarantee( {guarantee.replace('v', 'out.v')} )\n}}\n")
     (ws / "contracts").mkdir(parents=True)
-    (ws / "contracts/types.rcl").write_text("\n".join(rcl + [MISLAID, WIDE]), encoding="utf-8")
+    (ws / "contracts/types.rcl").write_text("\n".join(rcl + [MISLAID, KEYED, WIDE]), encoding="utf-8")
     (ws / "contracts/plan.yaml").write_text("contracts: [contracts/types.rcl]\n")
     fields = "\n".join(f"  {name}: {{fields: ['{path}']}}" for name, (_t, path, *_r) in TOPICS.items())
     (ws / "mapping.yaml").write_text(f"msg_dirs: [interfaces]\ntopics:\n{fields}\n  mislaid: {{fields: [x]}}\n"
-                                 "  ws: {fields: [wstring_value]}\n")
+                                 "  ws: {fields: [wstring_value]}\n  keyed: {fields: [value]}\n")
     share = Path(subprocess.run([str(ros2_python()), "-c", FIND_TEST_MSGS], capture_output=True, text=True,
                                 timeout=60, check=True).stdout.strip()) / "msg"
     (ws / "interfaces/test_msgs/msg").mkdir(parents=True)
     for f in share.glob("*.msg"):
         shutil.copy(f, ws / "interfaces/test_msgs/msg" / f.name)
     (ws / "interfaces/test_msgs/msg/Nested.msg").write_text("float64 x\n")  # not ROS 2's: another layout
+    (ws / "interfaces/test_msgs/msg/KeyedLong.msg").write_text("int32 key\nint32 value\n")  # ROS 2's has only .idl
 
 
 @pytest.fixture(scope="module")
@@ -217,9 +226,10 @@ def test_every_message_of_every_type_is_heard_decoded_and_judged(run: dict[str, 
     assert "matched" in run["system"] and "done" in run["system"], run["system"]
     rec, out = run["record"][storage], run["out"][storage]
     assert rec["decode_errors"] == {}, rec["decode_errors"]
-    assert {t: q["samples"] for t, q in rec["qos"].items()} == {**{t: N for t in TOPICS}, "mislaid": N}, rec["qos"]
+    assert {t: q["samples"] for t, q in rec["qos"].items()} == {**{t: N for t in TOPICS}, "mislaid": N,
+                                                                "keyed": 0}, rec["qos"]
     assert all(q["other_layout_samples"] == 0 and q["publishers_heard"] == 1 for t, q in rec["qos"].items()
-               if t != "mislaid")
+               if t not in ("mislaid", "keyed"))
     assert rec["events"] == N * (len(TOPICS) + 1), rec["events"]
     assert _counts(rec) == EXPECTED, (_counts(rec), out)
     # no vendor noise, and no layout refused but the one that differs
@@ -231,7 +241,7 @@ def test_every_message_of_every_type_is_heard_decoded_and_judged(run: dict[str, 
 def test_a_publisher_of_the_type_name_with_another_layout_is_named_and_never_heard(run: dict[str, Any],
                                                                                     storage: str) -> None:
     rec = run["record"][storage]
-    (warning,) = rec["warnings"]  # said before the monitor stops, named by its node or, not yet known, its participant
+    (warning,) = [w for w in rec["warnings"] if ": mislaid:" in w]  # said before the monitor stops, named by its node or, not yet known, its participant
     assert re.match(r"contracts/types\.rcl:\d+:\d+: warning: mislaid: (node /talker|participant [0-9a-f-]+) "
                     r"publishes test_msgs::msg::dds_::Nested_ with another layout than the contract's type: its ROS 2 "
                     r"type hash RIHS01_[0-9a-f]+\.\.\. differs from the contract's type's RIHS01_", warning), warning
@@ -276,6 +286,18 @@ def test_the_bag_checked_offline_gives_the_live_verdicts(run: dict[str, Any], st
                for e in report if "counts" in e and e["node"] != "W"}
     assert offline == _counts(run["record"][storage]) == EXPECTED, (offline, got.err)
     assert rc == 1, got.err  # violated guarantees: a failing exit, live and offline
+
+
+@pytest.mark.parametrize("storage", ["sqlite3", "mcap"])
+def test_a_keyed_topic_beside_a_keyless_contract_type_is_named_and_never_green(run: dict[str, Any],
+                                                                              storage: str) -> None:
+    rec = run["record"][storage]
+    (warning,) = [w for w in rec["warnings"] if ": keyed:" in w]
+    assert re.match(r"contracts/types\.rcl:\d+:\d+: warning: keyed: (node /talker|participant [0-9a-f-]+) "
+                    r"publishes test_msgs::msg::dds_::KeyedLong_ as a keyed topic", warning), warning
+    assert rec["qos"]["keyed"]["samples"] == 0 and rec["qos"]["keyed"]["publishers_heard"] == 0
+    (node,) = [n for n in rec["nodes"] if n["node"] == "Keyed"]
+    assert node["status"] == "pending", node
 
 
 def test_wide_strings_are_heard_and_decoded_to_their_text(run: dict[str, Any]) -> None:

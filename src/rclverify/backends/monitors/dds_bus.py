@@ -20,6 +20,8 @@ located warning, once per publisher and reason, never silence:
   differs where its type object says it, never counted as heard, and its
   samples dropped if they reach the reader (Fast DDS's writers are matched
   on the type name: :data:`rclverify.ros.dds.COMPATIBILITY`);
+* a keyed topic's writer (ROS 2 declares keys in ``.idl`` files only) when the
+  contract's type, from a ``.msg``, has none: DDS never matches the two;
 * another participant writing a topic only the monitor should write (a
   guarded topic beside the gate, the verdict topic: :meth:`Bus.watch_writers`,
   :mod:`.dds_trust`);
@@ -191,6 +193,13 @@ class Bus:
                         self._warn_once(t, p.guid, "type", f"{t.where}: warning: {t.key}: {disc.who(p)} publishes "
                                         f"{p.type_name}, the contract's type is {want}; its messages are not heard")
                     continue
+                if _keyed(p.guid) and _keyless(t.struct):
+                    if (p.guid, "key") not in t.warned and self._named(p.guid):
+                        self._warn_once(t, p.guid, "key", f"{t.where}: warning: {t.key}: {disc.who(p)} publishes "
+                                        f"{p.type_name} as a keyed topic (its writer's entity kind), the contract's "
+                                        "type has no key (a .msg cannot declare one; ROS 2 declares keys only in "
+                                        ".idl files, which the monitor does not read); its messages are not heard")
+                    continue
                 verdict, why = self.layouts.judge(t.struct, p.type_id, p.qos.user_data)
                 self._pending = self._pending or verdict == PENDING
                 if verdict == OTHER and (p.guid, "layout") not in t.warned and self._named(p.guid):
@@ -291,6 +300,19 @@ class Bus:
             if t.reader is not None:
                 t.reader.__del__()
         self.discovery.close()
+
+
+def _keyless(struct: type) -> bool:
+    """Whether a cyclonedds struct has no key member (the binding knows it once the type is populated)."""
+    idl = struct.__idl__  # type: ignore[attr-defined]
+    idl.populate()
+    return bool(idl.keyless)
+
+
+def _keyed(guid: bytes) -> bool:
+    """Whether a writer's GUID names a keyed topic's writer: entity kind 0x02 (user-defined writer with key;
+    0x03 is one without, DDS-RTPS 2.5, 9.3.1.2).  A keyless reader never matches it."""
+    return len(guid) == 16 and guid[15] == 0x02
 
 
 __all__ = ["Bus", "Tap"]
