@@ -25,10 +25,14 @@ monitor watches it:
   two goals one after the other (order 3, then order 4, whose result the
   server spoils with a negative last number): both goals are judged, the
   second violated.
+
+A second monitor, told the wrong middleware (``RMW_IMPLEMENTATION=rmw_cyclonedds_cpp``),
+names each Fast DDS writer of ``/estop`` whose calls it cannot read, and exits 1 under ``--strict``.
 """
 from __future__ import annotations
 
 import json
+import re
 import signal
 import time
 from typing import Any, Iterator
@@ -93,6 +97,7 @@ from rclpy.service_introspection import ServiceIntrospectionState
 from std_srvs.srv import SetBool
 from test_msgs.action import Fibonacci
 
+t0 = time.monotonic()
 rclpy.init()
 nodes = {n: Node(n) for n in ("base", "teleop", "brake", "brake_a", "brake_b", "lamp", "lamp_a", "lamp_b",
                               "fib", "mission", "watch")}
@@ -150,7 +155,7 @@ while time.monotonic() < until and (nodes["watch"].count_publishers("/rclverify/
 until = time.monotonic() + 1.5
 while time.monotonic() < until:
     ex.spin_once(timeout_sec=0.05)
-print("matched", flush=True)
+print("matched", round(time.monotonic() - t0, 2), flush=True)
 answers = [done(teleop.call_async(SetBool.Request(data=True)))[0].success for _ in range(3)]
 print("estop", answers, flush=True)
 for s in ("brake", "lamp"):
@@ -163,7 +168,7 @@ for order in (3, 4):
     (result,) = done(handle.get_result_async())
     finals.append(list(result.result.sequence)[-1])
 print("fib", finals, flush=True)
-print("done", flush=True)
+print("done", round(time.monotonic() - t0, 2), flush=True)
 while True:
     ex.spin_once(timeout_sec=0.1)
 """
@@ -183,27 +188,37 @@ def run(tmp_path_factory: pytest.TempPathFactory) -> Iterator[dict[str, Any]]:
     (ws / "interfaces/test_msgs/action").mkdir(parents=True)
     (ws / "interfaces/test_msgs/action/Fibonacci.action").write_text(FIBONACCI)
     env = ros2_env(tmp)
-    monitor = system = None
+    monitor = wrong = system = None
     try:
+        # a second monitor told the wrong middleware: it must say it cannot hear the calls, never stay silent
+        wrong = rclverify(["monitor", "-w", str(ws), "--live", "--ros2", "--interfaces", "interfaces", "--node", "Base",
+                           "--strict", "--horizon", "1.0", "--status", "0", "--duration", "60", "--verdict-topic",
+                           "/wrong/verdict", "--evidence", str(tmp / "wrong.json")],
+                          dict(env, RMW_IMPLEMENTATION="rmw_cyclonedds_cpp"), tmp, tmp / "wrong.out")
         monitor = rclverify(["monitor", "-w", str(ws), "--live", "--ros2", "--interfaces", "interfaces", "--mapping",
                              "mapping.yaml", "--horizon", "1.0", "--reorder-window", "0", "--status", "0",
                              "--duration", "60", "--log", str(tmp / "live.jsonl"), "--evidence",
                              str(tmp / "live.json")], env, tmp, tmp / "monitor.out")
         wait_for(tmp / "monitor.out", "monitoring", 30)
+        wait_for(tmp / "wrong.out", "monitoring", 30)
         system = start_node(tmp, "system", SYSTEM, env)
         wait_for(tmp / "system.log", "done", 40)
         time.sleep(1.6)  # the horizon (1 s) and the monitor's settle (0.3 s) pass: the last goal is judged
         stop(monitor, signal.SIGINT)
+        stop(wrong, signal.SIGINT)
         code = monitor.returncode
         yield {"tmp": tmp, "ws": ws, "code": code, "out": (tmp / "monitor.out").read_text(),
                "system": (tmp / "system.log").read_text(),
                "log": [json.loads(x) for x in (tmp / "live.jsonl").read_text().splitlines()],
-               "record": json.loads((tmp / "live.json").read_text())}
+               "record": json.loads((tmp / "live.json").read_text()),
+               "wrong": {"code": wrong.returncode, "out": (tmp / "wrong.out").read_text(),
+                         "record": json.loads((tmp / "wrong.json").read_text())}}
     finally:
         if system is not None:
             stop(system)
-        if monitor is not None:
-            stop(monitor)
+        for p in (monitor, wrong):
+            if p is not None:
+                stop(p)
 
 
 def _verdicts(run: dict[str, Any], node: str) -> list[dict[str, Any]]:
@@ -276,3 +291,16 @@ def test_the_live_calls_replay_to_the_same_summary(run: dict[str, Any]) -> None:
     assert {r["node"]: r["counts"] for r in summary["nodes"]} == \
         {n["node"]: n["counts"] for n in run["record"]["calls"]["nodes"]}
     assert summary["false"] == run["record"]["deadlines"]["false"]
+
+
+def test_a_monitor_told_the_wrong_middleware_says_so(run: dict[str, Any]) -> None:
+    """RMW_IMPLEMENTATION=rmw_cyclonedds_cpp beside Fast DDS nodes: the framed reader cannot take their
+    plain samples; each Fast DDS writer of the service is named, nothing is judged, --strict exits 1."""
+    wrong = run["wrong"]
+    # named by its node, or by its participant when Fast DDS's node list has not come yet (seconds later)
+    assert re.search(r"warning: /estop: (node /teleop|node /base|participant [-0-9a-f]+) is eProsima Fast DDS, "
+                     r"whose service samples come without rmw_cyclonedds' request header", wrong["out"]), wrong["out"]
+    assert "RMW_IMPLEMENTATION='rmw_cyclonedds_cpp'" in wrong["out"]
+    assert not wrong["record"]["calls"]["nodes"] and wrong["record"]["calls"]["counts"]["calls"] == 0
+    items = {i["name"]: i["reason"] for i in wrong["record"]["not_judged"] if i["kind"] == "service"}
+    assert set(items) == {"/estop"} and wrong["code"] == 1, (items, wrong["out"])

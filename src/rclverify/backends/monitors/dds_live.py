@@ -185,7 +185,7 @@ def run_dds(run_factory: Callable[..., LiveRun], checked: Checked, nodes: list[C
         bus.watch_writers(topic_name(t), t, where.get(t, t), "guarded topic")
     bus.watch_writers(topic_name(verdict_topic), VERDICT_KEY, "--verdict-topic", "verdict topic")
     if calls is not None:
-        calls.attach(bus)
+        calls.attach(bus, warn)
 
     def decode(key: str, payload: Any) -> Mapping[str, Any] | None:
         raw, source_ns, received_ns = payload[:3]

@@ -38,16 +38,18 @@ answer without a call.
 from __future__ import annotations
 
 import heapq
+import os
 from typing import Any, Iterable
 
 from ...rcl import ast
 from ...rcl.types import CheckedNode
 from ...ros.dds import ACTION_INFIX, reply_topic, request_topic, topic_name
+from .dds_bus import NAME_GRACE_S
 from .dds_calls import CallBook
 from .dds_introspection import EVENT_SUFFIX, SIDES, event_key, event_side, event_struct
 from .dds_order import OrderPairer, Pending
 from .dds_types import TypeBook, request_id, to_fields
-from .dds_wire import framed_rmw, has_header
+from .dds_wire import framed_rmw, has_header, vendor
 
 #: seconds an answer waits for its request (or goal) to be heard
 EARLY_S = 2.0
@@ -89,6 +91,12 @@ class CallTaps:
                 raise DdsTypeError(f"{_where(lk)}: error: {lk.kind} {name} ({lk.ros_type}): {exc}") from None
         self.taps: dict[str, Any] = {}  # tap key -> the bus's Tap (attach)
         self._node_of: Any = lambda guid: None  # a writer's ROS node (the bus's discovery, attach)
+        self._disc: Any = None
+        self._warn: Any = None
+        self._warned: set[bytes] = set()
+        self._seen: dict[bytes, float] = {}  # when a writer of the other form was first seen
+        self._said: set[str] = set()
+        self._checked = float("-inf")
         self._goal_of: dict[tuple[int, int], str] = {}  # send-goal/get-result request id -> goal id
         self._status: dict[str, int] = {}
         self._early: dict[tuple[Any, ...], list[tuple[str, dict[str, Any], float, bool, float, str]]] = {}
@@ -129,11 +137,45 @@ class CallTaps:
         self.specs[key] = (name, header if self.framed and header is not None else plain, header, part)
         self.plan.append((key, dds_topic, header if self.framed and header is not None else plain, _where(lk)))
 
-    def attach(self, bus: Any) -> None:
-        """Ask ``bus`` (a :class:`~.dds_bus.Bus`, before it starts) for every topic of the plan."""
+    def attach(self, bus: Any, warn: Any = None) -> None:
+        """Ask ``bus`` (a :class:`~.dds_bus.Bus`, before it starts) for every topic of the plan;
+        ``warn(line)`` is told of each writer of the other wire form (:meth:`check_forms`)."""
         for key, dds_topic, struct, where in self.plan:
             self.taps[key] = bus.tap(key, dds_topic, struct, where)
         self._node_of = bus.discovery.node_of
+        self._disc, self._warn = bus.discovery, warn
+
+    def check_forms(self, now: float) -> None:
+        """Warn once about each writer discovery shows on a request or reply
+        topic whose vendor writes the other wire form (:mod:`.dds_wire`): the
+        monitor's reader cannot take its samples (they do not have its
+        layout), so its calls would otherwise go unheard in silence.  A writer
+        is named by its node once ``ros_discovery_info`` tells it, or after
+        :data:`~.dds_bus.NAME_GRACE_S` seconds by its participant."""
+        if self._disc is None or self._warn is None:
+            return
+        for key, (name, _struct, header, _part) in self.specs.items():
+            if header is None:
+                continue
+            try:
+                pubs = self._disc.publishers(self.taps[key].dds_topic)
+            except RuntimeError:  # discovery changed under us (the DDS thread): next time
+                return
+            for e in pubs:
+                if has_header(e.guid) == self.framed or e.guid in self._warned:
+                    continue
+                first = self._seen.setdefault(e.guid, now)
+                if self._node_of(e.guid) is None and now - first < NAME_GRACE_S:
+                    continue
+                self._warned.add(e.guid)
+                mine, theirs = ("with", "without") if self.framed else ("without", "with")
+                line = (f"{self.taps[key].where}: warning: {name}: {self._disc.who(e)} is {vendor(e.guid)}, whose "
+                        f"service samples come {theirs} rmw_cyclonedds' request header; the monitor reads them {mine} "
+                        f"it (RMW_IMPLEMENTATION={os.environ.get('RMW_IMPLEMENTATION', '')!r}): its calls are not "
+                        "heard (set RMW_IMPLEMENTATION to the robot's middleware)")
+                if line not in self._said:  # a participant's request and reply writers, before its nodes are known
+                    self._said.add(line)
+                    self._warn(line)
 
     # -- samples (engine thread) -------------------------------------------------------------
     def handle(self, key: str, raw: bytes, stamp: float, now: float, writer: bytes | None = None) -> None:
@@ -147,6 +189,9 @@ class CallTaps:
         that waited :data:`EARLY_S` s for their call count as answers without
         one; the book's clock moves to ``now - max(window, SETTLE_S)``."""
         self._take(lambda stamp, got: stamp <= now - SETTLE_S or got <= now - LATE_S)
+        if now - self._checked >= 0.5:
+            self._checked = now
+            self.check_forms(now)
         for key in [k for k, xs in self._early.items() if now - xs[0][4] > EARLY_S]:
             for part, fields, stamp, final, _t, name in self._early.pop(key):
                 self.book.answer(key, part, fields, stamp, final, name)
