@@ -336,6 +336,28 @@ async def test_every_position_of_a_cr_document(client: LanguageClient, ws: Path)
     change(client, u, 51, lf)
 
 
+async def test_every_position_of_the_plan(client: LanguageClient, ws: Path) -> None:
+    """The plan open in the editor with names of every form (`in.x` alone, `Node.in.x`, `Node.out.y`, a node):
+    hover, definition and references at every position answered, none an error (a bare `in.x` raised)."""
+    u = (ws / "contracts" / "plan.yaml").as_uri()
+    text = PLAN + "notes: [in.speed, Driver.in.goal, Driver.out.speed, Brake, in.x.y, Brake.in]\r\n"
+    open_doc(client, u, text)
+    doc, requests = lsp.TextDocumentIdentifier(u), []
+    positions = [lsp.Position(k, c) for k, line in enumerate(_BREAK.split(text)) for c in range(len(line) + 2)]
+    for p in positions:
+        requests += [client.text_document_hover_async(lsp.HoverParams(doc, p)),
+                     client.text_document_definition_async(lsp.DefinitionParams(doc, p)),
+                     client.text_document_references_async(lsp.ReferenceParams(
+                         context=lsp.ReferenceContext(include_declaration=True), text_document=doc, position=p))]
+    got = await asyncio.wait_for(asyncio.gather(*requests, return_exceptions=True), BOUND * 4)
+    errors = [(positions[k // 3], g) for k, g in enumerate(got) if isinstance(g, BaseException)]
+    assert not errors, errors[:3]
+    line = len(_BREAK.split(PLAN)) - 1
+    driver = got[3 * positions.index(lsp.Position(line, text.split("\n")[line].index("Driver.in.goal") + 1))]
+    assert driver is not None and driver.contents.value.startswith("**in.goal** of Driver")
+    client.text_document_did_close(lsp.DidCloseTextDocumentParams(doc))
+
+
 # -- the fuzz run ------------------------------------------------------------------------------------
 
 def _document(rng: random.Random) -> str:

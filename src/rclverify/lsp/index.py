@@ -157,10 +157,11 @@ def symbol_at(a: Analysis, rel: str, text: str, line: int, char16: int, plan: bo
 
 
 def _plan_symbol(a: Analysis, word: str, start: int, line_text: str, nodes: dict[str, ast.Node]) -> Symbol | None:
-    if "." in word:
-        head, prefix, var = word.split(".", 2)
-        if head in nodes and prefix in ("in", "out"):
-            return Symbol("io", var, head, prefix)
+    if "." in word:  # `Agent.in.x`; a bare `in.x` (no node before it) names nothing in the plan
+        parts = word.split(".", 2)
+        head = parts[0]
+        if len(parts) == 3 and head in nodes and parts[1] in ("in", "out"):
+            return Symbol("io", parts[2], head, parts[1])
         return Symbol("node", head) if head in nodes else None
     plan = a.plan
     if plan is not None and any(r.id == word for r in plan.requirements):
