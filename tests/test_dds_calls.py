@@ -292,3 +292,24 @@ def test_introspection_events_pair_concurrent_calls_exactly() -> None:
     assert base == {f"estop call {gid}:1 response": "violated", f"estop call {gid}:2 response": "satisfied"}
     assert summary["counts"]["calls"] == 2 and taps.counts["introspected"] == 1
     assert event_side([client], [server], [client]) == "client" and event_side([], [server], [client]) is None
+
+
+def test_introspection_that_begins_mid_call_leaves_that_call_unpaired() -> None:
+    from types import SimpleNamespace
+    lines: list[dict[str, Any]] = []
+    taps, types = _taps(lines)
+    server = FAST[:-2] + b"\x13\x03"
+    event = SimpleNamespace(heard=set())
+    taps.taps = {"call:/estop:event": event, "call:/estop:reply": SimpleNamespace(heard={server}),
+                 "call:/estop:request": SimpleNamespace(heard={FAST})}
+    req = types.struct("std_srvs/srv/SetBool_Request")
+    taps.handle("call:/estop:request", req(data=True).serialize(), 40.0, 40.0, FAST)
+    taps.tick(41.0)
+    assert list(taps.book.calls) == [("w", FAST.hex(), 1)]  # opened by the order's source
+    event.heard = {server[:-2] + b"\x15\x03"}  # the server's event writer is discovered now
+    rep = types.struct("std_srvs/srv/SetBool_Response")
+    taps.handle("call:/estop:reply", rep(success=False, message="").serialize(), 41.1, 41.1, server)
+    taps.tick(42.0)
+    (line,) = [x for x in lines if x.get("unpaired")]
+    assert "introspection events began while this call was open" in line["reason"]
+    assert not taps.book.calls and taps.counts["introspected"] == 1  # the reply is left to the events

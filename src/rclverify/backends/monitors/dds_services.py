@@ -103,6 +103,7 @@ class CallTaps:
         self._queue: list[tuple[float, int, float, str, bytes, bytes | None]] = []
         self._n = 0
         self._pairers: dict[str, OrderPairer] = {}
+        self._sides: dict[str, str | None] = {}  # per service, the introspection side last used
         self._asked: dict[bytes, int] = {}  # requests heard per writer without identity
         self.last = float("-inf")  # the stamp of the last sample taken
         #: samples taken after a later-stamped one (``late``), of a writer no longer known or of the other
@@ -227,7 +228,7 @@ class CallTaps:
         if part == "event":
             self._event(name, s, stamp, now)
         elif part in ("request", "reply"):
-            if self._side(name) is not None:
+            if self._side(name, stamp) is not None:
                 self.counts["introspected"] += 1
                 return  # the introspection events pair this service's calls (and would count them again)
             if part == "request":
@@ -266,15 +267,27 @@ class CallTaps:
             p = self._pairers[name] = OrderPairer(name)
         return p
 
-    def _side(self, name: str) -> str | None:
-        """Which side's introspection events pair the calls of service ``name`` (:func:`event_side`)."""
+    def _side(self, name: str, stamp: float) -> str | None:
+        """Which side's introspection events pair the calls of service ``name``
+        (:func:`event_side`) at the sample stamped ``stamp``.  When that changes
+        (an event writer discovered after calls began, or gone), the calls the
+        other source opened can no longer be answered by it: they are unpaired."""
         ev, rep, req = (self.taps.get(f"call:{name}:{p}") for p in ("event", "reply", "request"))
-        if ev is None or rep is None or req is None:
-            return None
-        return event_side(ev.heard, rep.heard, req.heard, self._node_of)
+        side = None if ev is None or rep is None or req is None else \
+            event_side(ev.heard, rep.heard, req.heard, self._node_of)
+        if self._sides.setdefault(name, side) == side:
+            return side
+        was, self._sides[name] = self._sides[name], side
+        why = (f"{name}'s introspection events {'began' if was is None else 'changed or stopped'} while this call "
+               "was open: its answer may come through the other source, and the two cannot be matched")
+        keys = [k for k, c in self.book.calls.items() if c.name == name.strip("/") and k and k[0] in ("ev", "w")]
+        for k in keys:
+            self.book.unpaired(k, stamp, why)
+        self._pairers.pop(name, None)
+        return side
 
     def _event(self, name: str, s: Any, stamp: float, now: float) -> None:
-        side = self._side(name)
+        side = self._side(name, stamp)
         if side is None:
             return
         asked, told = SIDES[side]
