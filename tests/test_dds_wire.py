@@ -244,3 +244,96 @@ def test_ros_domain_id_is_checked() -> None:
     for bad in ("x", "233", "-1"):
         with pytest.raises(dds.DdsUnavailable, match="ROS_DOMAIN_ID"):
             dds.domain_id({"ROS_DOMAIN_ID": bad})
+
+
+# -- issue 62: layouts, type hashes, wide strings, the bag writer's thread -------------------------------
+
+#: hashes rosidl wrote into ROS 2 Kilted's share/<pkg>/msg/<T>.json (and that rclpy's publishers announce)
+ROSIDL_HASHES = {
+    "std_msgs/msg/Float64MultiArray": "RIHS01_1025ddc6b9552d191f89ef1a8d2f60f3d373e28b283d8891ddcc974e8c55397f",
+    "std_msgs/msg/Char": "RIHS01_3ad2d04dd29ba19d04b16659afa3ccaedd691914b02a64e82e252f2fa6a586a9",
+    "sensor_msgs/msg/JointState": "RIHS01_a13ee3a330e346c9d87b5aa18d24e11690752bd33a0350f11c5882bc9179260e",
+}
+
+
+@pytest.mark.parametrize("name", sorted(ROSIDL_HASHES))
+def test_the_type_hash_is_rosidls(name: str) -> None:
+    """REP-2011's hash as rosidl computes it (a .msg ``char`` hashed as ``uint8``, where rosbags' own hash
+    differs), from the definitions the type book reads."""
+    book = TypeBook([])
+    assert book.type_hash(book.message(name)) == ROSIDL_HASHES[name]
+    assert book.type_hash(book.message("std_msgs/String").__class__) is None  # not a message struct: no hash
+
+
+def test_the_announced_type_hash_is_read_from_user_data() -> None:
+    h = ROSIDL_HASHES["std_msgs/msg/Char"]
+    assert dds.announced_type_hash(f"typehash={h};".encode()) == h
+    assert dds.announced_type_hash(f"clientid=1.2;typehash={h};".encode()) == h
+    assert dds.announced_type_hash(b"") is None and dds.announced_type_hash(b"typehash=RIHS02_x;") is None
+
+
+def test_a_layout_difference_names_the_field() -> None:
+    from cyclonedds.idl import make_idl_struct
+    from cyclonedds.idl import types as T
+
+    from rclverify.backends.monitors.dds_layout import difference, shape
+    book = TypeBook([])
+    mine = shape(book.message("geometry_msgs/PoseWithCovarianceStamped"))
+    point = make_idl_struct("Point_", "x::Point_", {"x": T.float64, "y": T.float64, "z": str})
+    quat = make_idl_struct("Quaternion_", "x::Quaternion_", {"x": T.float64, "y": T.float64, "z": T.float64,
+                                                               "w": T.float64})
+    pose = make_idl_struct("Pose_", "x::Pose_", {"position": point, "orientation": quat})
+    cov = make_idl_struct("PoseWithCovariance_", "x::PoseWithCovariance_",
+                          {"pose": pose, "covariance": T.array[T.float64, 36]})  # type: ignore[misc]
+    assert difference(mine, shape(book.message("geometry_msgs/PoseWithCovarianceStamped"))) is None
+    theirs = ("struct", (mine[1][0], ("pose", shape(cov))))
+    assert difference(mine, theirs) == "field pose.pose.position.z: the publisher's is string, the contract's float64"
+    short = make_idl_struct("PoseWithCovariance_", "y::PoseWithCovariance_",
+                            {"pose": book.message("geometry_msgs/Pose"), "covariance": T.array[T.float64, 9]})  # type: ignore[misc]
+    assert difference(mine, ("struct", (mine[1][0], ("pose", shape(short))))) == \
+        "field pose.covariance: the publisher's is an array of 9 float64, the contract's an array of 36 float64"
+    fewer = ("struct", mine[1][:1])
+    assert difference(mine, fewer) == "field pose: the publisher's type has no such field"
+    assert difference(fewer, mine) == "field pose: the publisher's type has it, the contract's has not"
+    seq = shape(book.message("std_msgs/Float64MultiArray"))
+    bounded = ("struct", (seq[1][0], ("data", ("sequence", "float64"))))
+    assert difference(seq, bounded) is None  # a sequence's bound is not part of the layout (XCDR1 bytes alike)
+
+
+def test_a_wstring_is_its_wire_form_and_its_text(tmp_path: Path) -> None:
+    """Fast DDS's and rmw_cyclonedds' plain CDR: a uint32 count, then 4-byte code units (measured from
+    rclpy on Fast DDS with test_msgs/WStrings); decoded back to the text, in arrays too."""
+    pkg = tmp_path / "wide_msgs" / "msg"
+    pkg.mkdir(parents=True)
+    (pkg / "W.msg").write_text("wstring w\nwstring[2] ws\nint32 n\n")
+    book = TypeBook([tmp_path])
+    W = book.message("wide_msgs/W")
+    raw = book.build(W, {"w": "h\u00e9\u30cf", "ws": ["a", ""], "n": 7}).serialize(use_version_2=False)
+    assert raw[4:8] == struct.pack("<I", 3) and raw[8:20] == struct.pack("<3I", 0x68, 0xE9, 0x30CF)
+    assert to_fields(W.deserialize(raw)) == {"w": "h\u00e9\u30cf", "ws": ["a", ""], "n": 7}  # type: ignore[attr-defined]
+
+
+def test_the_bag_is_written_from_its_own_thread(tmp_path: Path) -> None:
+    """SQLite's objects live in the thread that made them: writes from another thread (the engine's) reach
+    the bag, bad input is counted and never written, and the bag reads back whole."""
+    import threading
+
+    from rosbags.highlevel import AnyReader
+
+    from rclverify.backends.monitors.dds_bag import BagRecorder
+    book = TypeBook([])
+    F = book.message("std_msgs/Float64")
+    rec = BagRecorder(tmp_path / "bag", "sqlite3", {"/x": "std_msgs/Float64"}, [])
+    def engine() -> None:
+        for k in range(50):
+            rec.write("x", 1_000 + k, F(data=float(k)).serialize(use_version_2=False))
+    t = threading.Thread(target=engine)
+    t.start()
+    t.join()
+    rec.write("x", 2_000, "not bytes")  # type: ignore[arg-type]
+    rec.write("elsewhere", 2_001, b"\x00\x01\x00\x00")
+    out = rec.close()
+    assert out["messages"] == 50 and out["failed"] == 1, out
+    with AnyReader([tmp_path / "bag"], default_typestore=typestore([])) as reader:
+        got = [getattr(reader.deserialize(raw, c.msgtype), "data") for c, _t, raw in reader.messages()]
+    assert got == [float(k) for k in range(50)]
