@@ -77,7 +77,8 @@ class CallTaps:
         self.book, self.types = book, types
         #: the services' samples carry rmw_cyclonedds' request header (default: by RMW_IMPLEMENTATION)
         self.framed = framed_rmw() if framed is None else framed
-        self.specs: dict[str, tuple[str, Any, Any, str]] = {}  # tap key -> (link, struct read, header struct or None, part)
+        #: tap key -> (link, the struct read, the header struct or None, part)
+        self.specs: dict[str, tuple[str, Any, Any, str]] = {}
         self.plan: list[tuple[str, str, Any, str]] = []  # (tap key, dds topic, struct, where)
         seen: set[str] = set()
         for _node, lk in links:
@@ -107,8 +108,8 @@ class CallTaps:
         self._asked: dict[bytes, int] = {}  # requests heard per writer without identity
         self.last = float("-inf")  # the stamp of the last sample taken
         #: samples taken after a later-stamped one (``late``), of a writer no longer known or of the other
-        #: wire form (:mod:`.dds_wire`), events without
-        #: contents, request/reply samples left to the introspection events, samples that did not decode
+        #: wire form (:mod:`.dds_wire`), events without contents, request/reply samples left to the
+        #: introspection events, samples that did not decode
         self.counts = {"late": 0, "unknown_writer": 0, "other_form": 0, "no_contents": 0, "introspected": 0,
                        "undecodable": 0}
 
