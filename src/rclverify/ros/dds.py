@@ -381,12 +381,18 @@ def _humble() -> Any:
 
 def type_hash_user_data(ros_type_name: str, store: Any = None) -> bytes:
     """``typehash=RIHS01_...;`` for an endpoint's USER_DATA, as ROS 2 Iron and
-    newer announce it (the REP-2011 type hash, computed by rosbags' type
-    store); empty when the store does not know the type."""
+    newer announce it (the REP-2011 type hash, :func:`.type_hash.rihs01`, over
+    the definitions of rosbags' type ``store``, ROS 2 Humble's by default);
+    empty when the store does not know the type."""
+    from .type_hash import rihs01
     if store is None:
         store = _humble()
+    defs = store.fielddefs
+
+    def fields_of(name: str) -> Any:
+        return defs[name][1] if name in defs else None
     try:
-        return f"typehash={store.hash_rihs01(ros_type_name)};".encode()
+        return f"typehash={rihs01(ros_type_name, fields_of)};".encode()
     except Exception:  # a type the store lacks: no hash, as ROS 2 Humble sends none
         return b""
 
