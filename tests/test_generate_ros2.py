@@ -256,3 +256,126 @@ def test_one_quantity_in_two_units_in_one_interface_is_a_located_error(tmp_path:
     assert main(["generate", "ros2", "-w", str(ws), "-o", str(tmp_path / "out")]) == 0
     srv = (tmp_path / "out" / "range_msgs" / "srv" / "Measure.srv").read_text()
     assert "float64 target  # [m]" in srv and "float64 dist  # [m]" in srv
+
+
+DIFF_CONTRACT = """\
+context {
+  Mode : {idle, run, halt} ;
+  Limit : REAL = 2.5 ;
+  Step : REAL = 0.1 ;
+}
+node Mixer {
+  inputs( a : REAL, b : REAL, k : INTEGER, m : Mode, f : BOOL )
+  outputs( s : REAL, q : REAL, ok : BOOL, n : NATURAL, mo : Mode )
+  topics( std_msgs/Float64 a matches(in.a), std_msgs/Float64 b matches(in.b), std_msgs/Int64 k matches(in.k),
+          std_msgs/Float64 s matches(out.s), std_msgs/Float64 q matches(out.q), std_msgs/Bool ok matches(out.ok) )
+  assume( -100 <= in.a and in.a <= 100 and in.m in {idle, run} )
+  guarantee( out.s == in.a + in.b * Step )
+  guarantee( out.q == in.a / in.b or in.b == 0 )
+  guarantee( out.ok <=> (in.f or in.a < Limit) )
+  guarantee( forall(i in INTEGER | 0 <= i and i <= 3 -> out.n + i >= in.k - 10) )
+  guarantee( exists(x in Mode | x == out.mo) and exists_unique(t in BOOL | t == in.f) )
+  guarantee( forall(v in {1, 2, 3} | out.s * v != 7.3 or out.ok) )
+  guarantee( in.k < 0 -> 0.1 + 0.2 == 0.3 )
+  guarantee( in.b * Step == 0.3 -> out.ok )
+  guarantee( out.q <= 20 or out.q >= 21 or in.f )
+}
+"""
+
+
+def _diff_values(cn):  # type: ignore[no-untyped-def]
+    """Values of node ``cn``'s inputs and outputs by their types, any subset of them (missing ones too)."""
+    from hypothesis import strategies as st
+
+    from rclverify.rcl.types import EnumT, Scalar
+    real = st.sampled_from([0.0, 0.1, 0.2, 0.3, 1.5, 2.5, 3, 7.3, -3.0, 19.999999999999996, 20.000000000000004,
+                          1e-9, 100.0]) | \
+        st.floats(-150, 150, allow_nan=False) | st.integers(-5, 5)
+    kinds = {"REAL": real, "INTEGER": st.integers(-20, 20), "NATURAL": st.integers(0, 30), "BOOL": st.booleans()}
+    io = {}
+    for side, table in (("in", cn.inputs), ("out", cn.outputs)):
+        for name, t in table.items():
+            if isinstance(t, Scalar) and t.name in kinds:
+                io[f"{side}.{name}"] = kinds[t.name]
+            elif isinstance(t, EnumT):
+                io[f"{side}.{name}"] = st.sampled_from(list(t.values))
+    return st.fixed_dictionaries({}, optional=io)
+
+
+@pytest.mark.parametrize("tolerance", [None, {"abs": 1e-9, "ulps": 4}])
+def test_the_carried_judgement_is_rclverifys(tmp_path: Path, tolerance: dict | None) -> None:
+    """Differential: the generated package's own judgement (contract_eval.py, no rclverify) gives,
+    clause by clause, the truth and the deciding arithmetic rclverify's monitor judgement
+    (``logic/floatsem.judge``) gives on the same values: exact, double and tolerance readings,
+    enumerations, constants, literal sets, quantifiers over bounded integers, an enumeration, BOOL
+    and a literal set, division by zero, missing values; and on every warehouse and
+    contracts-first node."""
+    import importlib.util
+
+    from hypothesis import given, settings
+
+    from rclverify.logic.floatsem import judge as floatjudge, parse_tolerance
+    from rclverify.pipeline import Workspace
+    ws = _ws(tmp_path, DIFF_CONTRACT)
+    if tolerance:
+        (ws / "contracts" / "plan.yaml").write_text(
+            "contracts: [contracts/sys.rcl]\nnodes:\n  Mixer:\n    evidence:\n      - backend: monitors\n"
+            f"        tolerance: {{abs: {tolerance['abs']}, ulps: {tolerance['ulps']}}}\n")
+    cases = [(ws, "Mixer")] + [(ROOT / "examples" / w, n) for w, ns in
+                               (("warehouse", ("Base", "BatteryMonitor", "Controller", "LidarDriver", "Localiser",
+                                               "MissionManager", "Planner")),
+                                ("contracts_first", ("TempSensor", "HeaterControl"))) for n in ns]
+    trees: dict[Path, Path] = {}
+    decided: dict[str, int] = {}
+    readings: set[tuple[bool | None, str]] = set()
+    for w, node in cases:
+        if w not in trees:
+            trees[w] = tmp_path / f"out{len(trees)}"
+            assert main(["generate", "ros2", "-w", str(w), "-o", str(trees[w])]) == 0
+        from rclverify.generate.typemap import snake
+        path = trees[w] / snake(node) / snake(node) / "contract.py"
+        spec = importlib.util.spec_from_file_location(f"diff_{node}_{bool(tolerance)}", path)
+        assert spec is not None and spec.loader is not None
+        layer = importlib.util.module_from_spec(spec)
+        spec.loader.exec_module(layer)
+        checked = Workspace(w, "contracts/plan.yaml").checked
+        cn = checked.nodes[node]
+        tol = parse_tolerance(tolerance) if w == ws else None
+        mine_tol = layer._TOL
+        assert (mine_tol is None) == (tol is None)
+        clauses = list(zip(list(cn.node.assumes) + list(cn.node.guarantees),
+                           layer.CARRIED["assumes"] + layer.CARRIED["guarantees"]))
+
+        @settings(max_examples=120 if node == "Mixer" else 15, deadline=None, database=None, derandomize=True)
+        @given(_diff_values(cn))
+        def agree(values: dict) -> None:
+            compare(values)
+
+        def compare(values: dict, node: str = node, clauses: list = clauses, cn=cn,  # type: ignore[no-untyped-def]
+                    checked=checked, tol=tol, layer=layer, mine_tol=mine_tol) -> None:
+            for c, carried in clauses:
+                want = floatjudge(c.formula, checked, cn, values, tol)
+                truth, sem, reason = layer.ev.judge(carried, values, mine_tol)
+                if truth is None and want.truth is not None:
+                    assert "not judged by the carried" in reason or "rclverify also asks Z3" in reason, \
+                        (node, c.formula, values, want, reason)
+                    continue
+                assert (truth, sem) == (want.truth, want.semantics), (node, values, want, reason)
+                if truth is None and want.reason.startswith("no value for"):  # the value a reading waits for
+                    assert reason == want.reason, (want.reason, reason)
+                elif truth is None:
+                    assert not reason.startswith("no value for"), (want.reason, reason)
+                decided[node] = decided.get(node, 0) + (truth is not None)
+                if node == "Mixer":
+                    readings.add((truth, sem))
+
+        agree()
+        if node == "Mixer":  # the readings random values meet rarely: double only, within the tolerance only
+            for values in ({"in.b": 3, "out.ok": False}, {"in.b": 3.0, "out.ok": True},
+                           {"out.q": 20.000000000000004, "in.f": False}, {"out.s": 0.1, "in.a": 0, "in.b": 1}):
+                compare(values)
+    assert decided.get("Mixer", 0) >= 200 and all(decided.get(n, 0) > 0 for _, n in cases), decided
+    want = {(True, "exact"), (True, "double"), (False, "exact"), (False, "exact, double"), (None, "")}
+    if tolerance:  # (every clause the double reading can change, the tolerance can too, here)
+        want = (want - {(False, "exact, double")}) | {(True, "tolerance"), (False, "exact, double, tolerance")}
+    assert want <= readings, readings

@@ -31,6 +31,8 @@ from . import contract, logic
 QOS_DEPTH = 10
 #: executor threads: one per callback group and one to spare
 THREADS = 4
+#: the longest the executor waits before the loop looks at the context again [s]
+SPIN_TIMEOUT = 0.5
 
 
 class TempSensorNode(Node):
@@ -149,14 +151,17 @@ class TempSensorNode(Node):
 def main(args=None):
     """Run the node until SIGINT or SIGTERM (rclpy's signal handlers shut the context down and
     the executor stops: ExternalShutdownException, or KeyboardInterrupt before they are
-    installed); exit status 0 then, no traceback."""
+    installed); exit status 0 then, no traceback.  The executor waits at most SPIN_TIMEOUT at a
+    time and the loop checks the context: a MultiThreadedExecutor's ``spin()`` on ROS 2's wheels
+    was seen to miss the signal's wake-up and wait forever (docs/generate.md)."""
     rclpy.init(args=args)
     node = None
     executor = MultiThreadedExecutor(num_threads=THREADS)
     try:
         node = TempSensorNode()
         executor.add_node(node)
-        executor.spin()
+        while rclpy.ok():
+            executor.spin_once(timeout_sec=SPIN_TIMEOUT)
     except (KeyboardInterrupt, ExternalShutdownException):
         pass
     finally:
