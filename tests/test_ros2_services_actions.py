@@ -22,9 +22,10 @@ monitor watches it:
   calls are paired exactly by ``client_gid`` + ``sequence_number``: the
   ``data: true`` call is violated, the ``data: false`` one satisfied;
 * ``fib`` serves the test_msgs/action/Fibonacci action; ``mission`` sends
-  two goals one after the other (order 3, then order 4, whose result the
-  server spoils with a negative last number): both goals are judged, the
-  second violated.
+  three goals one after the other (order 3; order 4, whose result the
+  server spoils with a negative last number; order 40, canceled while it
+  runs): each goal is judged, the second violated, and the cancel request
+  and reply are logged with the goal's id.
 
 A second monitor, told the wrong middleware (``RMW_IMPLEMENTATION=rmw_cyclonedds_cpp``),
 names each Fast DDS writer of ``/estop`` whose calls it cannot read, and exits 1 under ``--strict``.
@@ -89,8 +90,9 @@ FIBONACCI = "int32 order\n---\nint32[] sequence\n---\nint32[] sequence\n"
 SYSTEM = """\
 import time
 import rclpy
-from rclpy.action import ActionClient, ActionServer
-from rclpy.executors import SingleThreadedExecutor
+from rclpy.action import ActionClient, ActionServer, CancelResponse
+from rclpy.callback_groups import ReentrantCallbackGroup
+from rclpy.executors import MultiThreadedExecutor
 from rclpy.node import Node
 from rclpy.qos import qos_profile_services_default
 from rclpy.service_introspection import ServiceIntrospectionState
@@ -124,14 +126,19 @@ lamp.configure_introspection(nodes["lamp"].get_clock(), qos_profile_services_def
 def execute(goal):
     seq = [0, 1]
     for i in range(1, goal.request.order):
+        if goal.is_cancel_requested:
+            goal.canceled()
+            return Fibonacci.Result(sequence=seq)
         seq.append(seq[i] + seq[i - 1])
         goal.publish_feedback(Fibonacci.Feedback(sequence=seq))
         time.sleep(0.02)
     goal.succeed()
     return Fibonacci.Result(sequence=seq if goal.request.order < 4 else seq + [-1])  # the second is spoilt
 
-ActionServer(nodes["fib"], Fibonacci, "fib", execute)
-ex = SingleThreadedExecutor()
+# reentrant: a cancel request is taken while the goal runs (each other node's callbacks stay one at a time)
+ActionServer(nodes["fib"], Fibonacci, "fib", execute, cancel_callback=lambda goal: CancelResponse.ACCEPT,
+             callback_group=ReentrantCallbackGroup())
+ex = MultiThreadedExecutor(num_threads=4)
 for n in nodes.values():
     ex.add_node(n)
 
@@ -167,7 +174,14 @@ for order in (3, 4):
     (handle,) = done(mission.send_goal_async(Fibonacci.Goal(order=order)))
     (result,) = done(handle.get_result_async())
     finals.append(list(result.result.sequence)[-1])
-print("fib", finals, flush=True)
+(handle,) = done(mission.send_goal_async(Fibonacci.Goal(order=40)))  # a long one, canceled as it runs
+until = time.monotonic() + 0.15
+while time.monotonic() < until:
+    ex.spin_once(timeout_sec=0.01)
+(cancel,) = done(handle.cancel_goal_async())
+(result,) = done(handle.get_result_async())
+finals.append(result.status)
+print("fib", finals, len(cancel.goals_canceling), flush=True)
 print("done", round(time.monotonic() - t0, 2), flush=True)
 while True:
     ex.spin_once(timeout_sec=0.1)
@@ -270,15 +284,20 @@ def test_introspection_pairs_concurrent_calls_exactly(run: dict[str, Any]) -> No
     assert run["record"]["calls"]["samples"]["introspected"] >= 4  # its request/reply samples left to the events
 
 
-def test_two_goals_of_a_fibonacci_action_are_judged(run: dict[str, Any]) -> None:
-    assert "fib [2, -1]" in run["system"], run["system"]
+def test_goals_of_a_fibonacci_action_are_judged(run: dict[str, Any]) -> None:
+    assert "fib [2, -1, 5] 1" in run["system"], run["system"]  # the third canceled (status 5), one goal canceling
     fib = [v for v in _verdicts(run, "Fib") if v["topic"] == "fib/result"]
-    assert [v["verdict"] for v in fib] == ["satisfied", "violated"], (_verdicts(run, "Fib"), run["out"])
+    assert [v["verdict"] for v in fib] == ["satisfied", "violated", "satisfied"], (_verdicts(run, "Fib"), run["out"])
     assert fib[1]["values"]["out.final"] == "-1"
     counts = run["record"]["calls"]["counts"]
-    assert counts["goals"] == 2 and counts["calls"] == 3 + 2 + 2 and counts["unpaired"] == 2, counts
-    parts = {x["part"] for x in run["log"] if x.get("kind") == "call" and x.get("link") == "fib"}
-    assert {"goal", "feedback", "result", "status"} <= parts
+    assert counts["goals"] == 3 and counts["calls"] == 3 + 2 + 2 and counts["unpaired"] == 2, counts
+    lines = [x for x in run["log"] if x.get("kind") == "call" and x.get("link") == "fib"]
+    assert {"goal", "feedback", "result", "status", "cancel", "canceling"} <= {x["part"] for x in lines}
+    goals = [x["key"][0] for x in lines if x["part"] == "goal"]
+    (asked,) = [x["key"] for x in lines if x["part"] == "cancel"]
+    (told,) = [x["key"] for x in lines if x["part"] == "canceling"]
+    assert asked == told == [goals[2]]  # the cancel of the third goal, named by its goal id
+    assert [goals[2]] == [x["key"][0] for x in lines if x["part"] == "status" and x["status"] == "canceled"]
 
 
 def test_the_live_calls_replay_to_the_same_summary(run: dict[str, Any]) -> None:

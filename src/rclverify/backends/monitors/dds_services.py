@@ -7,9 +7,9 @@ For every link a monitored contract declares (``services(...)``,
 * a service ``/s`` of type ``pkg/T``: ``rq/sRequest`` and ``rr/sReply``
   (``pkg::srv::dds_::T_Request_`` / ``T_Response_``) and its introspection
   events ``rt/s/_service_event`` (:mod:`.dds_introspection`);
-* an action ``/a``: ``rq``/``rr`` of ``/a/_action/send_goal`` and
-  ``/a/_action/get_result``, and ``rt/a/_action/feedback`` and
-  ``rt/a/_action/status``.
+* an action ``/a``: ``rq``/``rr`` of ``/a/_action/send_goal``,
+  ``/a/_action/get_result`` and ``/a/_action/cancel_goal``, and
+  ``rt/a/_action/feedback`` and ``rt/a/_action/status``.
 
 The request and reply readers are of the wire form ``RMW_IMPLEMENTATION``
 names (:mod:`.dds_wire`); a sample whose writer is of the other vendor is
@@ -26,7 +26,8 @@ counted, not decoded:
   messages and the get-result reply carrying that goal id answer it (the
   get-result request tells which goal its reply is about: by the header's
   identity, or by the order), a refused goal (``accepted`` false) closes it
-  unjudged, status changes are logged.
+  unjudged; status changes, cancel requests and the goals a cancel reply
+  names (goal ids in both: no pairing needed) are logged.
 
 Samples are taken in the order of their DDS source timestamps: each waits
 :data:`SETTLE_S` seconds after its stamp (so that a request taken after its
@@ -60,6 +61,19 @@ LATE_S = 1.0
 #: action_msgs/msg/GoalStatus values (ROS 2 design "Actions")
 GOAL_STATUS = {0: "unknown", 1: "accepted", 2: "executing", 3: "canceling", 4: "succeeded", 5: "canceled",
                6: "aborted"}
+
+
+def _cancel_types(t: TypeBook) -> tuple[type, type, type, type]:
+    """The plain and the framed request and reply of ``action_msgs/srv/CancelGoal``
+    (ROS 2 design "Actions": the request a ``GoalInfo``, goal id and stamp;
+    the reply a return code and the ``GoalInfo`` of each goal now canceling),
+    defined here when the interface files do not (rosbags' store has no
+    services)."""
+    info = (2, "action_msgs/msg/GoalInfo")
+    req, rep = "action_msgs/srv/CancelGoal_Request", "action_msgs/srv/CancelGoal_Response"
+    t._synth(req, [("goal_info", info)])
+    t._synth(rep, [("return_code", (1, ("int8", 0))), ("goals_canceling", (4, (info, 0)))])
+    return t.struct(req), t.struct(rep), t.struct(req, header=True), t.struct(rep, header=True)
 
 
 def _where(link: ast.Link) -> str:
@@ -133,6 +147,9 @@ class CallTaps:
             self._add(name, f"{part}_reply", reply_topic(base + svc), t.struct(f"{plain}_{kind}_Response"), hrep, lk)
         self._add(name, "feedback", topic_name(base + "feedback"), a.feedback, None, lk)
         self._add(name, "status", topic_name(base + "status"), a.status, None, lk)
+        cq, cr, hq, hr = _cancel_types(t)
+        self._add(name, "cancel_request", request_topic(base + "cancel_goal"), cq, hq, lk)
+        self._add(name, "cancel_reply", reply_topic(base + "cancel_goal"), cr, hr, lk)
 
     def _add(self, name: str, part: str, dds_topic: str, plain: Any, header: Any, lk: ast.Link) -> None:
         key = f"call:{name}:{part}"
@@ -326,6 +343,12 @@ class CallTaps:
         elif part == "status":
             for st in s.status_list:
                 self._note_status(name, bytes(st.goal_info.goal_id.uuid).hex(), int(st.status), stamp)
+        elif part == "cancel_request":  # a zero goal id (and stamp) asks to cancel every goal (before it)
+            self.book.note({"link": name.strip("/"), "part": "cancel", "time": stamp,
+                            "key": [bytes(s.goal_info.goal_id.uuid).hex()]})
+        elif part == "cancel_reply":  # the goals the server accepted to cancel: their ids, no pairing needed
+            self.book.note({"link": name.strip("/"), "part": "canceling", "time": stamp, "return_code":
+                            int(s.return_code), "key": [bytes(g.goal_id.uuid).hex() for g in s.goals_canceling]})
 
     def _ask(self, name: str, svc: str, s: Any, gid: str, stamp: float, framed: bool) -> None:
         """A send-goal or get-result request about goal ``gid``: remember which goal its reply is about."""
