@@ -379,3 +379,31 @@ def test_the_carried_judgement_is_rclverifys(tmp_path: Path, tolerance: dict | N
     if tolerance:  # (every clause the double reading can change, the tolerance can too, here)
         want = (want - {(False, "exact, double")}) | {(True, "tolerance"), (False, "exact, double, tolerance")}
     assert want <= readings, readings
+
+
+def test_every_import_of_a_node_package_is_declared_and_none_is_rclverify(tmp_path: Path) -> None:
+    """A node package runs in a ROS 2 Python without rclverify (issue 62): each module its files
+    import is the standard library's, the package's own, or a package its package.xml names
+    (``exec_depend``); rclverify is never one."""
+    import ast as pyast
+    import re
+    import sys
+    for ws in (ROOT / "examples" / "warehouse", _ws(tmp_path, _chain_system(3))):
+        out = tmp_path / f"out_{ws.name}"
+        assert main(["generate", "ros2", "-w", str(ws), "-o", str(out)]) == 0
+        for xml in out.glob("*/package.xml"):
+            pkg = xml.parent
+            if not (pkg / "setup.py").is_file():
+                continue
+            declared = set(re.findall(r"<exec_depend>([\w]+)</exec_depend>", xml.read_text()))
+            used: set[str] = set()
+            for py in (pkg / pkg.name).glob("*.py"):
+                for n in pyast.walk(pyast.parse(py.read_text())):
+                    if isinstance(n, pyast.Import):
+                        used |= {a.name.split(".")[0] for a in n.names}
+                    elif isinstance(n, pyast.ImportFrom) and n.level == 0 and n.module:
+                        used.add(n.module.split(".")[0])
+            foreign = used - set(sys.stdlib_module_names) - {pkg.name}
+            assert "rclverify" not in used, pkg
+            assert foreign <= declared, (pkg.name, foreign - declared)
+            assert "std_msgs" in declared  # the verdict publisher's String
