@@ -185,29 +185,7 @@ class Bus:
         self._pending = False
         for t in self.taps:
             pubs = disc.publishers(t.dds_topic)
-            want = t.struct.__idl_typename__  # type: ignore[attr-defined]
-            same = []
-            for p in pubs:
-                if p.type_name != want:
-                    if (p.guid, "type") not in t.warned and self._named(p.guid):
-                        self._warn_once(t, p.guid, "type", f"{t.where}: warning: {t.key}: {disc.who(p)} publishes "
-                                        f"{p.type_name}, the contract's type is {want}; its messages are not heard")
-                    continue
-                if _keyed(p.guid) and _keyless(t.struct):
-                    if (p.guid, "key") not in t.warned and self._named(p.guid):
-                        self._warn_once(t, p.guid, "key", f"{t.where}: warning: {t.key}: {disc.who(p)} publishes "
-                                        f"{p.type_name} as a keyed topic (its writer's entity kind), the contract's "
-                                        "type has no key (a .msg cannot declare one; ROS 2 declares keys only in "
-                                        ".idl files, which the monitor does not read); its messages are not heard")
-                    continue
-                verdict, why = self.layouts.judge(t.struct, p.type_id, p.qos.user_data)
-                self._pending = self._pending or verdict == PENDING
-                if verdict == OTHER and (p.guid, "layout") not in t.warned and self._named(p.guid):
-                    self._warn_once(t, p.guid, "layout", f"{t.where}: warning: {t.key}: {disc.who(p)} publishes "
-                                    f"{p.type_name} with another layout than the contract's type: {why}; its "
-                                    "messages are not heard")
-                if verdict != OTHER:
-                    same.append(p)
+            same = self._heard_publishers(t, pubs)
             if not same:
                 continue
             req, left = reader_for([p.qos for p in same])
@@ -236,6 +214,35 @@ class Bus:
                 self.on_reader(t, same)
         if self.watched:
             self._foreign()
+
+    def _heard_publishers(self, t: Tap, pubs: list[Any]) -> list[Any]:
+        """The publishers of ``pubs`` whose samples are the contract's type (name, key, layout); a located
+        warning, once, for each of the others."""
+        disc = self.discovery
+        want = t.struct.__idl_typename__  # type: ignore[attr-defined]
+        same = []
+        for p in pubs:
+            if p.type_name != want:
+                if (p.guid, "type") not in t.warned and self._named(p.guid):
+                    self._warn_once(t, p.guid, "type", f"{t.where}: warning: {t.key}: {disc.who(p)} publishes "
+                                    f"{p.type_name}, the contract's type is {want}; its messages are not heard")
+                continue
+            if _keyed(p.guid) and _keyless(t.struct):
+                if (p.guid, "key") not in t.warned and self._named(p.guid):
+                    self._warn_once(t, p.guid, "key", f"{t.where}: warning: {t.key}: {disc.who(p)} publishes "
+                                    f"{p.type_name} as a keyed topic (its writer's entity kind), the contract's "
+                                    "type has no key (a .msg cannot declare one; ROS 2 declares keys only in "
+                                    ".idl files, which the monitor does not read); its messages are not heard")
+                continue
+            verdict, why = self.layouts.judge(t.struct, p.type_id, p.qos.user_data)
+            self._pending = self._pending or verdict == PENDING
+            if verdict == OTHER and (p.guid, "layout") not in t.warned and self._named(p.guid):
+                self._warn_once(t, p.guid, "layout", f"{t.where}: warning: {t.key}: {disc.who(p)} publishes "
+                                f"{p.type_name} with another layout than the contract's type: {why}; its "
+                                "messages are not heard")
+            if verdict != OTHER:
+                same.append(p)
+        return same
 
     def _foreign(self) -> None:
         """The writers discovery reports on the watched topics (never the monitor's own)."""
