@@ -49,6 +49,7 @@ from .dds_bus import NAME_GRACE_S
 from .dds_calls import CallBook
 from .dds_introspection import EVENT_SUFFIX, SIDES, event_key, event_side, event_struct
 from .dds_order import OrderPairer, Pending
+from .dds_shadow import REPLY_OF, Shadows
 from .dds_types import TypeBook, request_id, to_fields
 from .dds_wire import framed_rmw, has_header, vendor
 
@@ -112,6 +113,7 @@ class CallTaps:
         self._seen: dict[bytes, float] = {}  # when a writer of the other form was first seen
         self._said: set[str] = set()
         self._checked = float("-inf")
+        self.shadows: Shadows | None = None  # reply writers that keep services visible to clients (attach)
         self._goal_of: dict[tuple[int, int], str] = {}  # send-goal/get-result request id -> goal id
         self._status: dict[str, int] = {}
         self._early: dict[tuple[Any, ...], list[tuple[str, dict[str, Any], float, bool, float, str]]] = {}
@@ -158,11 +160,14 @@ class CallTaps:
 
     def attach(self, bus: Any, warn: Any = None) -> None:
         """Ask ``bus`` (a :class:`~.dds_bus.Bus`, before it starts) for every topic of the plan;
-        ``warn(line)`` is told of each writer of the other wire form (:meth:`check_forms`)."""
+        ``warn(line)`` is told of each writer of the other wire form (:meth:`check_forms`); the
+        request readers get their shadow reply writers (:mod:`.dds_shadow`)."""
         for key, dds_topic, struct, where in self.plan:
             self.taps[key] = bus.tap(key, dds_topic, struct, where)
         self._node_of = bus.discovery.node_of
         self._disc, self._warn = bus.discovery, warn
+        self.shadows = Shadows(bus, [(self.taps[k], self.taps[k.rsplit(":", 1)[0] + ":" + REPLY_OF[part]])
+                                     for k, (_n, _s, _h, part) in self.specs.items() if part in REPLY_OF])
 
     def check_forms(self, now: float) -> None:
         """Warn once about each writer discovery shows on a request or reply
@@ -211,6 +216,8 @@ class CallTaps:
         if now - self._checked >= 0.5:
             self._checked = now
             self.check_forms(now)
+            if self.shadows is not None:
+                self.shadows.update()
         for key in [k for k, xs in self._early.items() if now - xs[0][4] > EARLY_S]:
             for part, fields, stamp, final, _t, name in self._early.pop(key):
                 self.book.answer(key, part, fields, stamp, final, name)
