@@ -313,3 +313,35 @@ def test_introspection_that_begins_mid_call_leaves_that_call_unpaired() -> None:
     (line,) = [x for x in lines if x.get("unpaired")]
     assert "introspection events began while this call was open" in line["reason"]
     assert not taps.book.calls and taps.counts["introspected"] == 1  # the reply is left to the events
+
+
+def test_a_shadow_reply_writer_exists_only_while_a_real_server_does() -> None:
+    """dds_shadow.py: the monitor's request reader must not hide a service from rmw_fastrtps clients (one
+    more reader than reply writers), nor may its shadow fake a server when none is there."""
+    from types import SimpleNamespace
+
+    from rclverify.backends.monitors.dds_shadow import SHADOW, Shadows
+    made: list[str] = []
+    dropped: list[str] = []
+    servers: list[Any] = []
+
+    class Writer:
+        def __init__(self, topic: str) -> None:
+            self.topic = topic
+
+        def __del__(self) -> None:
+            dropped.append(self.topic)
+    bus = SimpleNamespace(discovery=SimpleNamespace(publishers=lambda topic: list(servers)),
+                          writer=lambda topic, struct, qos, user: made.append(topic) or Writer(topic))
+    rq, rr = SimpleNamespace(reader=None, dds_topic="rq/sRequest"), SimpleNamespace(dds_topic="rr/sReply", struct=int)
+    sh = Shadows(bus, [(rq, rr)])
+    servers.append(SimpleNamespace(qos=SimpleNamespace(user_data=b"")))
+    sh.update()
+    assert made == []  # the monitor reads no request yet: nothing to balance
+    rq.reader = object()
+    sh.update()
+    sh.update()
+    assert made == ["rr/sReply"] and list(sh.writers) == ["rr/sReply"]
+    servers[:] = [SimpleNamespace(qos=SimpleNamespace(user_data=SHADOW))]  # only another monitor's shadow left
+    sh.update()
+    assert sh.writers == {} and "rr/sReply" in dropped  # no server: no shadow to fake one
