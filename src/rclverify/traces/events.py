@@ -1,6 +1,7 @@
 """One observed message and the error a bad trace raises."""
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from itertools import islice
 from typing import Any, Iterable, Mapping
@@ -46,6 +47,17 @@ class Event:
     def stamped(self) -> float:
         """The message's own time (s): :attr:`stamp` when set, else :attr:`time`."""
         return self.time if self.stamp is None else self.stamp
+
+
+def to_ns(seconds: float) -> int:
+    """``seconds`` (a finite float or int) as integer nanoseconds, the nearest.
+
+    The whole seconds are split off first, so a stamp near the epoch's
+    1.7e9 s keeps its fraction's nanoseconds (``1.7e9 * 1e9`` in doubles is
+    off by up to 128 ns).  Deadlines are compared in these integers, never in
+    sums of doubles (docs/semantics.md, "Deadlines")."""
+    whole = math.floor(seconds)
+    return int(whole) * 1_000_000_000 + round((seconds - whole) * 1e9)
 
 
 def taken(events: Iterable[Event], limit: int | None = None) -> tuple[list[Event], BaseException | None]:

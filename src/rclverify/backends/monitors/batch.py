@@ -301,7 +301,7 @@ class _Run:
     def _quiet(self, t: float) -> bool:
         """Whether the engine would give no verdict of its own at an input at time ``t`` followed by its answer."""
         m = self.m
-        if m.now > t:
+        if m.now > t or m.invalid:  # an unreadable input makes the next questions undecided: the engine's
             return False
         o = m._open
         if o is not None and not (o.answered and not o.waiting and (o.followed or o.decided.issuperset(m._need))):

@@ -56,10 +56,10 @@ from ...rcl.printer import expr_to_rcl
 from ...rcl.timing import seconds
 from ...rcl.types import Checked, CheckedNode
 from ...rcl.walk import subexpressions
-from ...traces.events import Event
+from ...traces.events import Event, to_ns
 from ...traces.mapping import MappingError, TopicRule, map_value
 from ...traces.questions import Question, QuestionStream
-from .online import header_stamp
+from .online import header_stamp, header_stamp_ns
 from .verdicts import LINK_TOPICS, names
 
 DEADLINE_VERDICTS = ("true", "currently_false", "false")
@@ -104,6 +104,9 @@ class _Pending:
     outs: dict[str, Any] = field(default_factory=dict)
     #: the last output after the trigger that did not satisfy the guarantee (where, why)
     rejected: str = ""
+    #: the trigger's stamp and its deadline in integer nanoseconds: what the deadline is compared in
+    stamp_ns: int = 0
+    due_ns: int = 0
 
 
 @dataclass
@@ -129,6 +132,17 @@ def event_stamp(ev: Event) -> float:
     """The event's time on the stamps' clock (module docstring, "Clock")."""
     s = header_stamp(ev.fields)
     return ev.time if s is None else s
+
+
+def event_stamp_ns(ev: Event) -> int:
+    """The event's time on the stamps' clock in integer nanoseconds: a header's
+    ``secs``/``nsecs`` (ROS 1) or ``sec``/``nanosec`` (ROS 2, builtin_interfaces/Time)
+    exactly, else :func:`~rclverify.traces.events.to_ns` of the time the trace gives it.
+    Deadlines are compared in these integers (docs/semantics.md, "Deadlines"):
+    ``0.7 + 0.2`` in doubles is ``0.8999999999999999``, and an answer stamped at
+    0.9 s was reported "0 ms past the deadline"."""
+    s = header_stamp_ns(ev.fields)
+    return to_ns(ev.time) if s is None else s
 
 
 def topic_bindings(node: CheckedNode) -> dict[str, list[tuple[str, str]]]:
@@ -164,6 +178,8 @@ class DeadlineMonitor:
         self.assumption = tuple(c.formula for c in node.node.assumes)
         self.bindings = topic_bindings(node)
         self.timed: list[tuple[int, ast.Clause, str, frozenset[str], float]] = []
+        #: guarantee -> its bound in integer nanoseconds (what deadlines are compared in)
+        self.bounds_ns: dict[int, int] = {}
         for k, cl in enumerate(node.node.guarantees, 1):
             if cl.trigger is None:
                 continue
@@ -174,6 +190,7 @@ class DeadlineMonitor:
             outs = frozenset(f"out.{e.name}" for e in subexpressions(cl.formula)
                              if isinstance(e, ast.Var) and e.prefix == "out")
             self.timed.append((k, cl, f"in.{cl.trigger.name}", outs, float(bound)))
+            self.bounds_ns[k] = round(bound * 1_000_000_000)  # exact: `within 200 ms` is 200_000_000 ns
         # an output whose every topic the mapping declares a state may stand in
         # with its current value; any other answers only triggers before it
         event_outs = {key for topic, keys in self.bindings.items() for key, part in keys
@@ -188,9 +205,13 @@ class DeadlineMonitor:
         #: the node's questions: an answer is judged on the latest at its stamp (a superseded trigger is carried)
         self.stream = QuestionStream()
         self.values: dict[str, Any] = {}
+        #: keys whose latest message did not map (NaN, a missing field): key -> why; their stale value never
+        #: stands in (docs/semantics.md, "Values")
+        self.invalid: dict[str, str] = {}
         self.pending: list[_Pending] = []
         self.expired: deque[_Pending] = deque(maxlen=256)  # judged false, waiting for a late answer to show
         self.now = float("-inf")
+        self.now_ns: int | None = None
         self.result = DeadlineResult(node.name)
 
     def _emit(self, v: DeadlineVerdict) -> None:
@@ -208,10 +229,11 @@ class DeadlineMonitor:
 
     def feed(self, ev: Event) -> None:
         """Process one event (any topic; only the node's move its state)."""
-        stamp = event_stamp(ev)
+        ns = event_stamp_ns(ev)
+        stamp = ns / 1e9
         keys = self.bindings.get(ev.topic.lstrip("/"))
         if not keys or not self.timed:
-            self.advance(stamp)
+            self._advance_ns(ns)
             return
         changed: list[str] = []
         for key, part in keys:
@@ -224,23 +246,29 @@ class DeadlineMonitor:
                 continue
             try:
                 self.values[key] = map_value(typ, fields, self.rules.get(ev.topic, TopicRule()), self.values.get(key))
-            except MappingError:
+            except MappingError as exc:
+                # never the value before it: what reads this input is undecided until a message maps again
+                self.invalid[key] = f"{key}: the latest message at {ev.where} does not map ({exc})"
+                if key.startswith("in."):
+                    changed.append(key)
                 continue
+            self.invalid.pop(key, None)
             changed.append(key)
         outs = {c for c in changed if c.startswith("out.")}
         if outs:
             fresh = {c: self.values[c] for c in outs if c not in self.state_outs}
             for p in (*self.pending, *self.expired):
-                if stamp >= p.stamp:
+                if ns >= p.stamp_ns:
                     p.outs.update(fresh)
-            self._answer(ev, stamp, outs)
-        self.advance(stamp)
+            self._answer(ev, ns, outs)
+        self._advance_ns(ns)
         if not any(c.startswith("in.") for c in changed):
             return
         inputs = {key: v for key, v in self.values.items() if key.startswith("in.")}
         missing = [k for k in self.needed if k not in inputs]
+        unread = [why for k, why in self.invalid.items() if k in self.needed]
         refused = (("incomplete input", "no value yet for " + ", ".join(missing)) if missing else
-                   self._refused(inputs))
+                   ("undecided", unread[0]) if unread else self._refused(inputs))
         if not missing:
             self.stream.ask(Question(ev, stamp, inputs, owed=refused is None))
         triggered = [t for t in self.timed if t[2] in changed]
@@ -248,7 +276,8 @@ class DeadlineMonitor:
             return
         for k, cl, trig, _, d in triggered:
             if refused is None:
-                self.pending.append(_Pending(k, ev, stamp, stamp + d, inputs))
+                d_ns = self.bounds_ns[k]
+                self.pending.append(_Pending(k, ev, stamp, (ns + d_ns) / 1e9, inputs, stamp_ns=ns, due_ns=ns + d_ns))
                 continue
             why, reason = refused
             self.result.unaccepted[why] += 1
@@ -270,18 +299,19 @@ class DeadlineMonitor:
             return "undecided", f"assumption {expr_to_rcl(formula)} undecided: {j.reason}"
         return None
 
-    def _answer(self, ev: Event, stamp: float, outs: set[str]) -> None:
+    def _answer(self, ev: Event, ns: int, outs: set[str]) -> None:
+        stamp = ns / 1e9
         for p in list(self.expired):
-            if self._answers(p, stamp, outs):
+            if self._answers(p, ns, outs):
                 self.expired.remove(p)
                 self._emit(DeadlineVerdict(self.node.name, p.k, "false", p.trigger.where, p.stamp, p.due, stamp,
-                                           ev.where, f"answered after {_ms(stamp - p.stamp)}, "
-                                           f"{_ms(stamp - p.due)} past the deadline of {_ms(p.due - p.stamp)}",
-                                           update=True))
+                                           ev.where, f"answered after {_ms_ns(ns - p.stamp_ns)}, "
+                                           f"{_ms_ns(ns - p.due_ns)} past the deadline of "
+                                           f"{_ms_ns(p.due_ns - p.stamp_ns)}", update=True))
         keep: list[_Pending] = []
         for p in self.pending:
             k, cl, _, gouts, d = next(t for t in self.timed if t[0] == p.k)
-            if not (gouts & outs) or stamp < p.stamp:
+            if not (gouts & outs) or ns < p.stamp_ns:
                 keep.append(p)
                 continue
             j = judge(cl.formula, self.checked, self.node, self._visible(p, stamp), self.tolerance)
@@ -291,47 +321,57 @@ class DeadlineMonitor:
                     f" ({j.reason})" if j.truth is None and j.reason else "")
                 keep.append(p)
                 continue
-            if stamp <= p.due:
+            if ns <= p.due_ns:  # "within": at the deadline is in time (integer ns, no rounding)
                 self._emit(DeadlineVerdict(self.node.name, p.k, "true", p.trigger.where, p.stamp, p.due, stamp,
-                                           ev.where, f"answered after {_ms(stamp - p.stamp)} (deadline {_ms(d)})",
+                                           ev.where, f"answered after {_ms_ns(ns - p.stamp_ns)} (deadline {_ms(d)})",
                                            semantics=j.semantics))
             else:
                 self._emit(DeadlineVerdict(self.node.name, p.k, "false", p.trigger.where, p.stamp, p.due, stamp,
-                                           ev.where, f"answered after {_ms(stamp - p.stamp)}, "
-                                           f"{_ms(stamp - p.due)} past the deadline of {_ms(d)}",
+                                           ev.where, f"answered after {_ms_ns(ns - p.stamp_ns)}, "
+                                           f"{_ms_ns(ns - p.due_ns)} past the deadline of {_ms(d)}",
                                            semantics=j.semantics))
         self.pending = keep
 
-    def _answers(self, p: _Pending, stamp: float, outs: set[str]) -> bool:
-        """Whether outputs ``outs`` now (stamp ``stamp``) answer obligation ``p``."""
+    def _answers(self, p: _Pending, ns: int, outs: set[str]) -> bool:
+        """Whether outputs ``outs`` now (stamp ``ns``, integer ns) answer obligation ``p``."""
         _, cl, _, gouts, _ = next(t for t in self.timed if t[0] == p.k)
-        if not (gouts & outs) or stamp < p.stamp:
+        if not (gouts & outs) or ns < p.stamp_ns:
             return False
-        return judge(cl.formula, self.checked, self.node, self._visible(p, stamp), self.tolerance).truth is True
+        return judge(cl.formula, self.checked, self.node, self._visible(p, ns / 1e9), self.tolerance).truth is True
 
     def _visible(self, p: _Pending, stamp: float | None = None) -> dict[str, Any]:
         """What obligation ``p`` is judged on for an output stamped ``stamp``:
         the inputs of the latest question at that stamp (the trigger's own, or
-        the accepted question that superseded it: docs/semantics.md), the state
-        outputs as they stand and the outputs published since its trigger."""
+        the accepted question that superseded it: docs/semantics.md), with the
+        trigger input's value as the trigger message set it (a press released
+        before its answer still demands the press's answer: an output computed
+        from the release does not answer it), the state outputs as they stand
+        and the outputs published since its trigger."""
         q = self.stream.at(stamp) if stamp is not None else None
         values = dict(q.inputs if q is not None and q.owed and q.stamp >= p.stamp else p.inputs)
+        trig = next(t[2] for t in self.timed if t[0] == p.k)
+        if trig in p.inputs:
+            values[trig] = p.inputs[trig]
         values.update({key: v for key, v in self.values.items() if key in self.state_outs and v is not None})
         values.update(p.outs)
         return values
 
     def advance(self, now: float) -> None:
         """Move the clock to ``now`` (s); obligations due before it are ``false``."""
-        if now <= self.now:
+        self._advance_ns(to_ns(now))
+
+    def _advance_ns(self, now_ns: int) -> None:
+        """Move the clock to ``now_ns`` (integer ns); obligations due strictly before it are ``false``."""
+        if self.now_ns is not None and now_ns <= self.now_ns:
             return
-        self.now = now
+        self.now_ns = now_ns
+        now = self.now = now_ns / 1e9
         keep = []
         for p in self.pending:
-            if p.due < now:
-                d = p.due - p.stamp
+            if p.due_ns < now_ns:
                 self._emit(DeadlineVerdict(self.node.name, p.k, "false", p.trigger.where, p.stamp, p.due, None, "",
-                                           f"no answer within the deadline of {_ms(d)} (clock at {now:.3f} s)"
-                                           + (f"; {p.rejected}" if p.rejected else "")))
+                                           f"no answer within the deadline of {_ms_ns(p.due_ns - p.stamp_ns)} "
+                                           f"(clock at {now:.3f} s)" + (f"; {p.rejected}" if p.rejected else "")))
                 self.expired.append(p)
             else:
                 keep.append(p)
@@ -340,7 +380,8 @@ class DeadlineMonitor:
     def pending_verdicts(self) -> list[DeadlineVerdict]:
         """The obligations not answered whose deadline has not expired yet."""
         return [DeadlineVerdict(self.node.name, p.k, "currently_false", p.trigger.where, p.stamp, p.due, None, "",
-                                f"not answered yet; {_ms(p.due - self.now)} left") for p in self.pending]
+                                f"not answered yet; {_ms_ns(p.due_ns - (self.now_ns or 0))} left")
+                for p in self.pending]
 
     def finish(self) -> DeadlineResult:
         """End of the run: obligations still within their deadline are ``currently_false``."""
@@ -370,6 +411,15 @@ def has_deadlines(node: CheckedNode) -> bool:
 
 def _ms(x: float) -> str:
     return f"{x * 1000:.0f} ms" if abs(x) < 10 else f"{x:.3f} s"
+
+
+def _ms_ns(ns: int) -> str:
+    """A duration of ``ns`` integer nanoseconds as :func:`_ms` shows it; a late
+    answer less than half a millisecond past shows its microseconds (never
+    "0 ms past the deadline")."""
+    if 0 < abs(ns) < 500_000:
+        return f"{ns / 1000:.0f} us" if abs(ns) >= 500 else f"{ns} ns"
+    return _ms(ns / 1e9)
 
 
 def deadline_status(res: DeadlineResult, trace: str) -> tuple[str, str]:

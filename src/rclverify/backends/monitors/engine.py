@@ -304,7 +304,12 @@ class NodeMonitor(Closing):
                 return
         accepted, owed, refusal = "exact", True, ""
         judges = self._judges
-        for aj, formula in self._assumed:
+        if self.invalid and any(k in self.invalid for k in inputs):
+            # an input whose latest message did not map (a NaN): the value before it never stands in, so the
+            # question is undecided until that input maps again (docs/semantics.md, "Values")
+            unread = next(f"{k}: {why}" for k, why in self.invalid.items() if k in inputs)
+            owed, refusal = False, f"undecided: {unread}"
+        for aj, formula in (self._assumed if owed else ()):
             judged = judges[aj].quick(inputs) or self._judge(aj, inputs)  # the compiled code first, inline
             if judged.truth is False:
                 owed = False

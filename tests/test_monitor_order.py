@@ -1,0 +1,186 @@
+"""Each answer judged against the question in force at its stamp (issue 63, rows 3, 4 and 9).
+
+Small workspaces written here, JSON-lines runs checked by ``rclverify
+monitor`` (the batch path where the node takes it, the event path else),
+the streaming engine with the batch path off, and the live engine
+(:class:`OnlineEngine`) fed the same messages in the order they were heard:
+
+* row 3: a question heard late (a later line) with an earlier stamp (the
+  line's ``time`` or its header stamp) is the question an answer stamped
+  after it answers; it is never judged against the question before it;
+* row 4: a press released 10 ms later is answered by a stop, not by an
+  output computed from the release (docs/semantics.md, "Deadlines");
+* row 9: (a) an input whose latest message is a NaN makes what reads it
+  undecided, never the value before the NaN; (b) a deadline is compared in
+  integer nanoseconds, an answer at exactly ``t + d`` is in time.
+"""
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from rclverify.backends.monitors.check import check_trace
+from rclverify.backends.monitors.deadlines import check_deadlines
+from rclverify.backends.monitors.online import OnlineEngine
+from rclverify.cli import main
+from rclverify.rcl.typecheck import load
+from rclverify.traces import read_trace
+
+SENSOR = """
+context { Stat : {red, orange, green} ; }
+node Sensor {
+  inputs( r : REAL, on : BOOL )
+  outputs( status : Stat )
+  topics( pkg/Reading r matches(in.r), pkg/Switch on matches(in.on), pkg/Status status matches(out.status) )
+  assume( 0 <= in.r )
+  guarantee( in.on -> ((in.r < 120 -> out.status == green) and (120 <= in.r -> out.status == red)) )
+}
+"""
+
+BAND = """
+context { Stat : {red, orange, green} ; }
+node Band {
+  inputs( r : REAL )
+  outputs( status : Stat )
+  topics( pkg/Reading r matches(in.r), pkg/Status status matches(out.status) )
+  assume( 0 <= in.r )
+  guarantee( (in.r < 120 -> out.status == green) and (120 <= in.r -> out.status == red) )
+}
+"""
+
+STOPPER = """
+node Stopper {
+  inputs( b : BOOL )
+  outputs( stop : BOOL )
+  topics( std_msgs/Bool b matches(in.b), std_msgs/Bool stop matches(out.stop) )
+  assume( TRUE )
+  guarantee( in.b -> out.stop ) triggered by in.b within 200 ms
+}
+"""
+
+MAPPING = "topics:\n  r: {fields: [value]}\n  on: {fields: [flag]}\n  status: {fields: [level]}\n" \
+          "  b: {fields: [data]}\n  stop: {fields: [data]}\n"
+
+
+def _workspace(tmp: Path, rcl: str, lines: list[dict[str, Any]], skew: float | None = None) -> tuple[Path, Path]:
+    (tmp / "contracts").mkdir(exist_ok=True)
+    (tmp / "contracts" / "c.rcl").write_text(rcl)
+    (tmp / "contracts" / "plan.yaml").write_text("contracts: [contracts/c.rcl]\n")
+    (tmp / "mapping.yaml").write_text(MAPPING + (f"skew: {skew}\n" if skew is not None else ""))
+    run = tmp / "run.jsonl"
+    run.write_text("".join(json.dumps(x) + "\n" for x in lines))
+    return tmp, run
+
+
+def _monitor(ws: Path, run: Path, capsys: pytest.CaptureFixture[str], horizon: str = "2") -> tuple[int, str]:
+    rc = main(["monitor", "-w", str(ws), "--mapping", "mapping.yaml", "--horizon", horizon, str(run)])
+    return rc, capsys.readouterr().out
+
+
+def _engines(ws: Path, run: Path, node: str, horizon: float = 2.0) -> dict[str, list[tuple[int, str]]]:
+    """The verdicts (event, verdict) of the batch path, the event path and the live engine on ``run``."""
+    from rclverify.backends.monitors.config import load_mapping
+    checked = load([ws / "contracts" / "c.rcl"])
+    rules = load_mapping(ws, "mapping.yaml").rules
+    out: dict[str, list[tuple[int, str]]] = {}
+    for name, batch in (("batch", True), ("events", False)):
+        got: list[Any] = []
+        check_trace(checked, [checked.nodes[node]], read_trace(run), rules, horizon, got.append, batch=batch)
+        out[name] = sorted((v.event, v.verdict) for v in got)
+    got = []
+    eng = OnlineEngine(checked, [checked.nodes[node]], rules, horizon, reorder_window=0.0, on_verdict=got.append)
+    for ev in read_trace(run):  # heard in the log's order, each at its own time (or header stamp)
+        eng.push(ev.topic, dict(ev.fields), ev.time, ev.where)
+    eng.finish()
+    out["live"] = sorted((v.event, v.verdict) for v in got)
+    return out
+
+
+# -- row 4 ---------------------------------------------------------------------------
+
+def test_a_press_released_before_its_answer_is_not_answered_by_a_non_stop(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """Row 4: in.b true (a press), in.b false 10 ms later (its release), then
+    stop false: the press's deadline demands a stop; an output computed from
+    the release does not answer it.  Before: "answered", rc 0."""
+    ws, run = _workspace(tmp_path, STOPPER, [
+        {"topic": "b", "time": 1.0, "data": True}, {"topic": "b", "time": 1.01, "data": False},
+        {"topic": "stop", "time": 1.05, "data": False}, {"topic": "b", "time": 2.0, "data": False}])
+    checked = load([ws / "contracts" / "c.rcl"])
+    got: list[Any] = []
+    [res] = check_deadlines(checked, [checked.nodes["Stopper"]], read_trace(run), {}, got.append)
+    assert [(v.trigger_where, v.verdict) for v in got if not v.update] == [
+        ("run.jsonl:2", "true"), ("run.jsonl:1", "false"), ("run.jsonl:4", "currently_false")]
+    first = res.first_false
+    assert first is not None and first.trigger_where == "run.jsonl:1"
+    assert "the output at run.jsonl:3 did not satisfy guarantee 1" in first.reason
+    rc, out = _monitor(ws, run, capsys)
+    assert rc == 1 and "missed Stopper's deadline" in out
+    # a stop within the 200 ms answers the press (and the release: in.b false holds it too)
+    ws, run = _workspace(tmp_path, STOPPER, [
+        {"topic": "b", "time": 1.0, "data": True}, {"topic": "b", "time": 1.01, "data": False},
+        {"topic": "stop", "time": 1.05, "data": True}])
+    got.clear()
+    [res] = check_deadlines(checked, [checked.nodes["Stopper"]], read_trace(run), {}, got.append)
+    assert res.counts == {"true": 2, "currently_false": 0, "false": 0}
+
+
+# -- row 9 ---------------------------------------------------------------------------
+
+def test_an_answer_at_exactly_the_deadline_is_in_time(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """Row 9b: pressed at 0.7 s, stopped at 0.9 s, `within 200 ms`: 0.7 + 0.2 is
+    0.8999999999999999 in doubles, and the stop was "0 ms past the deadline".
+    In integer nanoseconds it is at the deadline: in time.  One nanosecond
+    later is late, and said so in microseconds, not "0 ms"."""
+    ws, run = _workspace(tmp_path, STOPPER, [
+        {"topic": "b", "time": 0.7, "data": True}, {"topic": "stop", "time": 0.9, "data": True}])
+    checked = load([ws / "contracts" / "c.rcl"])
+    [res] = check_deadlines(checked, [checked.nodes["Stopper"]], read_trace(run), {})
+    assert res.counts == {"true": 1, "currently_false": 0, "false": 0}
+    rc, out = _monitor(ws, run, capsys)
+    assert rc == 0 and "missed" not in out
+    # header stamps (ROS 2's sec/nanosec) are read exactly: 0.9 s + 1 ns is late, and said to be
+    got: list[Any] = []
+    ws, run = _workspace(tmp_path, STOPPER, [
+        {"topic": "b", "time": 5.0, "header": {"stamp": {"sec": 1700000000, "nanosec": 700_000_000}}, "data": True},
+        {"topic": "stop", "time": 5.0, "header": {"stamp": {"sec": 1700000000, "nanosec": 900_000_001}},
+         "data": True}])
+    [res] = check_deadlines(checked, [checked.nodes["Stopper"]], read_trace(run), {}, got.append)
+    assert res.counts["false"] == 1 and got[0].reason == "answered after 200 ms, 1 ns past the deadline of 200 ms"
+    run.write_text(run.read_text().replace("900000001", "900000000"))
+    [res] = check_deadlines(checked, [checked.nodes["Stopper"]], read_trace(run), {})
+    assert res.counts["true"] == 1
+
+
+def test_an_input_after_a_nan_is_not_judged_against_the_stale_value(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """Row 9a: r = 50 answered green; r = NaN (unreadable); the switch comes
+    on again and the sensor answers red (it read 300).  The value before the
+    NaN (50) no longer stands: the switch's question is undecided, not a
+    violation of "< 120 -> green"; the next readable r is judged."""
+    lines = [{"topic": "on", "time": 0.0, "flag": True}, {"topic": "r", "time": 0.1, "value": 50.0},
+             {"topic": "status", "time": 0.15, "level": "green"}, {"topic": "r", "time": 0.2, "value": "NaN"},
+             {"topic": "on", "time": 0.3, "flag": True}, {"topic": "status", "time": 0.35, "level": "red"},
+             {"topic": "r", "time": 0.4, "value": 300.0}, {"topic": "status", "time": 0.45, "level": "red"}]
+    ws, run = _workspace(tmp_path, SENSOR, lines)
+    run.write_text(run.read_text().replace('"NaN"', "NaN"))
+    got = _engines(ws, run, "Sensor")
+    assert got["events"] == got["batch"] == got["live"]
+    verdicts = dict(got["events"])
+    assert verdicts[2] == "satisfied" and verdicts[3] == "inconclusive" and verdicts[4] == "inconclusive"
+    assert 5 not in verdicts and verdicts[7] == "satisfied"  # owed nothing while r is unreadable; then judged
+    rc, out = _monitor(ws, run, capsys)
+    assert rc == 0 and "violated" not in out
+    # the deadline monitor: a trigger while the input is unreadable gets no deadline verdict (undecided)
+    timed = SENSOR.replace(
+        "out.status == red)) )", "out.status == red)) ) triggered by in.on within 100 ms")
+    (ws / "contracts" / "c.rcl").write_text(timed)
+    checked = load([ws / "contracts" / "c.rcl"])
+    from rclverify.backends.monitors.config import load_mapping
+    rules = load_mapping(ws, "mapping.yaml").rules
+    [res] = check_deadlines(checked, [checked.nodes["Sensor"]], read_trace(run), rules)
+    assert res.counts["false"] == 0 and res.unaccepted == {"assumption violated": 0, "incomplete input": 1,
+                                                           "undecided": 1}
