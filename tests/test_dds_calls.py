@@ -345,3 +345,36 @@ def test_a_shadow_reply_writer_exists_only_while_a_real_server_does() -> None:
     servers[:] = [SimpleNamespace(qos=SimpleNamespace(user_data=SHADOW))]  # only another monitor's shadow left
     sh.update()
     assert sh.writers == {} and "rr/sReply" in dropped  # no server: no shadow to fake one
+
+
+def test_results_of_concurrent_goals_without_identity_are_undecided_feedback_still_judged() -> None:
+    """rmw_fastrtps: a get-result reply names no goal; with two get-result requests outstanding, neither
+    goal's result can be told apart (their feedback, which carries the goal id, is still judged)."""
+    lines: list[dict[str, Any]] = []
+    taps, types = _taps(lines)
+    base = "rclverify_examples/action/Move"
+    goal_rq, goal_rr = types.struct(f"{base}_SendGoal_Request"), types.struct(f"{base}_SendGoal_Response")
+    res_rq, res_rr = types.struct(f"{base}_GetResult_Request"), types.struct(f"{base}_GetResult_Response")
+    fb = types.struct(f"{base}_FeedbackMessage")
+    server, client = FAST[:-2] + b"\x13\x03", FAST
+    uuid = lambda k: {"uuid": [k] * 16}  # noqa: E731
+    feed = [("goal_request", types.build(goal_rq, {"goal_id": uuid(1), "goal": {"target": 1.0}}), 50.0, client),
+            ("goal_request", types.build(goal_rq, {"goal_id": uuid(2), "goal": {"target": 2.0}}), 50.01, client),
+            ("goal_reply", types.build(goal_rr, {"accepted": True}), 50.02, server),
+            ("goal_reply", types.build(goal_rr, {"accepted": True}), 50.03, server),
+            ("result_request", types.build(res_rq, {"goal_id": uuid(1)}), 50.04, client),
+            ("result_request", types.build(res_rq, {"goal_id": uuid(2)}), 50.05, client),
+            ("feedback", types.build(fb, {"goal_id": uuid(2), "feedback": {"progress": -0.5}}), 50.1, server),
+            ("result_reply", types.build(res_rr, {"status": 4, "result": {"arrived": True}}), 50.3, server),
+            ("result_reply", types.build(res_rr, {"status": 4, "result": {"arrived": True}}), 50.4, server)]
+    for part, s, stamp, writer in feed:
+        taps.handle(f"call:/move:{part}", s.serialize(), stamp, stamp, writer)
+    taps.tick(53.0)
+    summary = taps.finish()
+    mover = [x["verdict"] for x in lines if x.get("verdict", {}).get("node") == "Mover" and "kind" not in x]
+    assert [v["verdict"] for v in mover if v["topic"] == "move/feedback"] == ["violated"]  # by its goal id
+    # goal 1 waits for its result: inconclusive, with the reason; goal 2 was already decided by its feedback
+    (undecided,) = [v for v in mover if v["verdict"] == "inconclusive"]
+    assert "its result cannot be told apart" in undecided["reason"] and undecided["where"].startswith("move goal 01")
+    assert summary["counts"]["goals"] == 2 and summary["counts"]["unpaired"] == 2
+    assert replay(_book([]), lines) == summary
