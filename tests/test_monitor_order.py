@@ -184,3 +184,75 @@ def test_an_input_after_a_nan_is_not_judged_against_the_stale_value(
     [res] = check_deadlines(checked, [checked.nodes["Sensor"]], read_trace(run), rules)
     assert res.counts["false"] == 0 and res.unaccepted == {"assumption violated": 0, "incomplete input": 1,
                                                            "undecided": 1}
+
+
+# -- row 3 ---------------------------------------------------------------------------
+
+def _stamped(t: float, epoch: int = 1700000000) -> dict[str, Any]:
+    sec = int(t)
+    return {"header": {"stamp": {"sec": epoch + sec, "nanosec": round((t - sec) * 1e9)}}}
+
+
+@pytest.mark.parametrize("skew", [None, 0])
+@pytest.mark.parametrize("headers", [False, True])
+def test_a_question_heard_late_is_the_one_an_answer_stamped_after_it_answers(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str], skew: float | None, headers: bool) -> None:
+    """Row 3: r = 50 at 1.0 s answered green; a green stamped 1.5 s; then, on a
+    later line, r = 130 stamped 1.2 s.  In force at 1.5 s is r = 130: the green
+    is false for it.  Before: judged against r = 50, "2 satisfied", rc 0.
+    With header stamps the lines' times are in order and the stamps are not."""
+    rows = [("r", 1.0, 50.0), ("status", 1.1, "green"), ("status", 1.5, "green"), ("r", 1.2, 130.0),
+            ("status", 1.6, "red")]
+    lines = []
+    for k, (topic, t, v) in enumerate(rows):
+        key = "value" if topic == "r" else "level"
+        lines.append({"topic": topic, "time": 1.0 + k / 10 if headers else t, key: v,
+                      **(_stamped(t) if headers else {})})
+    ws, run = _workspace(tmp_path, BAND, lines, skew)
+    got = _engines(ws, run, "Band")
+    assert got["events"] == got["batch"] == got["live"]
+    assert got["events"] == [(1, "satisfied"), (2, "satisfied"), (2, "violated"), (4, "satisfied")]
+    rc, out = _monitor(ws, run, capsys)
+    assert rc == 1 and "answering the question at run.jsonl:4" in out and "heard after it" in out
+
+
+def test_a_late_input_that_changes_a_later_question_is_judged_with_it(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """Two inputs: the switch at 1.3 s raised a question with r = 50, answered
+    green; r = 130 stamped 1.2 s is heard after both.  In force at the switch's
+    question is r = 130: the green is false for it (the question is judged
+    again on the inputs in force at its stamp)."""
+    lines = [{"topic": "on", "time": 0.0, "flag": True}, {"topic": "r", "time": 0.1, "value": 50.0},
+             {"topic": "status", "time": 0.2, "level": "green"}, {"topic": "on", "time": 1.3, "flag": True},
+             {"topic": "status", "time": 1.4, "level": "green"}, {"topic": "r", "time": 1.2, "value": 130.0},
+             {"topic": "status", "time": 1.5, "level": "red"}]
+    ws, run = _workspace(tmp_path, SENSOR, lines)
+    got = _engines(ws, run, "Sensor")
+    assert got["events"] == got["batch"] == got["live"]
+    assert [v for v in got["events"] if v[0] == 4] == [(4, "satisfied"), (4, "violated")]
+    assert (6, "satisfied") in got["events"]  # the red after it: r = 130, on: right
+    rc, out = _monitor(ws, run, capsys)
+    assert rc == 1 and "changes an input that question reads" in out
+
+
+def test_live_the_reorder_window_and_a_message_later_than_it_agree(tmp_path: Path) -> None:
+    """Live: within the reorder window the reading is put before the green by
+    its stamp (one verdict, violated); later than the window it is judged at
+    its stamp when it comes (the green's satisfied, then violated).  Neither
+    leaves the green satisfied alone."""
+    ws, run = _workspace(tmp_path, BAND, [])
+    from rclverify.backends.monitors.config import load_mapping
+    checked = load([ws / "contracts" / "c.rcl"])
+    rules = load_mapping(ws, "mapping.yaml").rules
+    for window, want in ((0.5, [(1, "satisfied"), (3, "violated")]),
+                         (0.1, [(1, "satisfied"), (2, "satisfied"), (2, "violated")])):
+        got: list[Any] = []
+        eng = OnlineEngine(checked, [checked.nodes["Band"]], rules, 2.0, reorder_window=window, on_verdict=got.append)
+        heard = [("r", 1.0, 50.0, 1.0), ("status", 1.1, "green", 1.1), ("status", 1.5, "green", 1.5),
+                 ("r", 1.2, 130.0, 1.75)]
+        for topic, t, v, when in heard:
+            eng.tick(when)
+            eng.push(topic, {**_stamped(t, 0), ("value" if topic == "r" else "level"): v}, when)
+        eng.tick(2.0)
+        eng.finish()
+        assert sorted((v.event, v.verdict) for v in got) == want, window

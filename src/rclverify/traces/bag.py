@@ -9,7 +9,7 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any, Iterator, Sequence
 
-from .events import Event, TraceError
+from .events import Event, TraceError, header_stamp
 
 
 def custom_types(msg_dirs: Sequence[Path]) -> dict[str, Any]:
@@ -93,7 +93,9 @@ def read_bag(path: Path, msg_dirs: Sequence[Path] = ()) -> Iterator[Event]:
             except Exception as exc:
                 raise TraceError(f"{path}: message {index} (topic {conn.topic}, {len(raw)} bytes): error: "
                                  f"cannot decode {conn.msgtype}: {exc}") from None
-            yield Event(index, stamp / 1e9, conn.topic.lstrip("/"), flatten(msg), f"{path.name}: message {index}")
+            fields = flatten(msg)  # its header's stamp, when it has one, is its own time (docs/semantics.md)
+            yield Event(index, stamp / 1e9, conn.topic.lstrip("/"), fields, f"{path.name}: message {index}",
+                        header_stamp(fields) if "header" in fields else None)
             index += 1
     finally:
         try:

@@ -27,7 +27,7 @@ from typing import Any, Iterable, Iterator
 
 import msgspec
 
-from .events import Event, TraceError
+from .events import FLAT_STAMPS, Event, TraceError, header_stamp
 
 
 #: JSON's scanner with :func:`json.loads`'s defaults: one object read without the
@@ -74,7 +74,7 @@ def read_lines(path: Path, chunks: Iterable[bytes], lineno: int = 0, index: int 
     :func:`read_jsonl`.
     """
     name = path.name
-    fast, fast_error, slow, inf = _FAST, _FAST_ERROR, _slow, math.inf
+    fast, fast_error, slow, inf, flat = _FAST, _FAST_ERROR, _slow, math.inf, FLAT_STAMPS
     try:
         for chunk in chunks:  # split at b"\n"; a bare b"\r" also ends a line (universal newlines, as text mode read it)
             for raw in chunk.splitlines(True) if b"\r" in chunk else (chunk,):
@@ -94,7 +94,9 @@ def read_lines(path: Path, chunks: Iterable[bytes], lineno: int = 0, index: int 
                 if not (type(time) is float and type(topic) is str and -inf < time < inf):
                     time = _checked(path, lineno, topic, time)
                 del obj["topic"], obj["time"]  # the message's fields, in their order (the object is this line's own)
-                yield Event(index, float(time), topic.lstrip("/"), obj, f"{name}:{lineno}")
+                # a header's stamp is the message's own time: what it answers is decided by it (docs/semantics.md)
+                stamp = header_stamp(obj) if "header" in obj or flat[0] in obj or flat[1] in obj else None
+                yield Event(index, float(time), topic.lstrip("/"), obj, f"{name}:{lineno}", stamp)
                 index += 1
     finally:
         if end is not None:

@@ -39,7 +39,7 @@ from typing import Any, Iterator, Sequence
 import msgspec
 import numpy as np
 
-from .events import Event, taken
+from .events import FLAT_STAMPS, Event, taken
 from .jsonl import line_event, read_jsonl, read_lines
 
 #: Bytes read from the log at once (a block is cut after its last whole line).
@@ -146,6 +146,8 @@ def _blocks(path: Path, fields: Sequence[str], rows: int) -> Iterator[LogBlock |
 
 def _fast(path: Path, dec: _Decoder, lines: list[bytes], lineno: int, index: int) -> LogBlock | None:
     """The block of ``lines`` when the fast path reads it as the exact one would (module docstring), else ``None``."""
+    if "header" in dec.attr or any(k in dec.attr for k in FLAT_STAMPS):
+        return None  # a message's own stamp is read by the exact reader (its event's ``stamp``)
     try:
         structs = list(map(dec.decode, lines))
     except Exception:  # noqa: BLE001 - whatever msgspec refuses (a blank line, a new key, bad bytes, depth): exact path

@@ -101,7 +101,7 @@ class QuestionStream:
     (s) the time an answer may take: a question asked after it passed does
     not supersede the one before (that one is unanswered)."""
 
-    __slots__ = ("skew", "horizon", "latest", "_stamps", "_questions", "superseded")
+    __slots__ = ("skew", "horizon", "latest", "_stamps", "_questions", "superseded", "forgot")
 
     def __init__(self, skew: float = 0.0, horizon: float = float("inf")) -> None:
         self.skew = skew
@@ -111,6 +111,8 @@ class QuestionStream:
         self._questions: list[Question] = []
         #: how many questions were superseded (no answer before the next question)
         self.superseded = 0
+        #: whether older questions were forgotten (a look-up before the oldest kept cannot be answered)
+        self.forgot = False
 
     def ask(self, q: Question, triggers: frozenset[str] = frozenset()) -> Question | None:
         """Raise question ``q`` (its message set the inputs ``triggers``).
@@ -148,7 +150,21 @@ class QuestionStream:
         if len(stamps) > 2 * KEPT:  # forget the oldest, a batch at a time (amortised O(1))
             del stamps[:KEPT]
             del qs[:KEPT]
+            self.forgot = True
         return superseded
+
+    def insert(self, q: Question) -> None:
+        """Keep question ``q``, heard after a question stamped later than it, at
+        its place in stamp order (after those stamped at or before it): it
+        supersedes nothing and is not the latest (an output stamped after the
+        later question answers that one); its own triggers are owed to it."""
+        i = bisect.bisect_right(self._stamps, q.stamp)
+        self._stamps.insert(i, q.stamp)
+        self._questions.insert(i, q)
+
+    def after(self, stamp: float) -> list[Question]:
+        """The questions kept stamped after ``stamp`` (s), in stamp order."""
+        return self._questions[bisect.bisect_right(self._stamps, stamp):]
 
     def at(self, stamp: float) -> Question | None:
         """The latest question stamped at or before ``stamp`` (s), ``None`` when none is."""

@@ -359,17 +359,19 @@ class _Run:
         made = [ghost.question(j, self) for j in range(len(tail) - 1)] if m._held else [None] * (len(tail) - 1)
         stream._questions = (stream._questions + made + [newest])[drop:]
         stream._stamps = (stream._stamps + times[tail].tolist())[drop:]
+        if drop or len(tail) < n:
+            stream.forgot = True
         stream.latest = newest
         if len(tail) > 1 and not m._held:
             self.ghosts.append(ghost)
             left = stream._questions.count(None)  # the ghosts the stream still keeps: the latest of them
             while self.ghosts and sum(len(g.at) - 1 for g in self.ghosts[1:]) >= left:
                 del self.ghosts[0]
-        if stream.skew:  # the answers' entries, each event made if the engine reads it (answered.py)
-            recent = m._recent
-            outs = at[-recent.maxlen:] + 1
-            recent.extend(map(RecentOutput, repeat(chunk), outs.tolist(), times[outs].tolist(), repeat(okey),
-                              repeat(ofield)))
+        # the answers' entries (the skew's, late.py's), each event made if the engine reads it (answered.py)
+        recent = m._recent
+        outs = at[-recent.maxlen:] + 1
+        recent.extend(map(RecentOutput, repeat(chunk), outs.tolist(), times[outs].tolist(), repeat(okey),
+                          repeat(ofield)))
         values = m.values
         for k in keys:
             values[k] = newest.inputs[k]
@@ -380,6 +382,8 @@ class _Run:
         last_out = chunk[int(at[-1]) + 1]
         if last_out.time > m.now:
             m.now = last_out.time
+        if last_out.time > m._hi:  # the latest stamp judged (a pair's rows have no stamp of their own)
+            m._hi = last_out.time
 
 
 __all__ = ["CHUNK", "BatchPlan", "batch_plan", "check_batch"]

@@ -1,6 +1,7 @@
 """How a question ends, for the verdict engine (:mod:`.engine`): the parts that run once per question
 or less, kept apart from the per-message hot path.
 
+* :meth:`Closing._accept`: whether the node owes a question an answer (an unreadable input: undecided);
 * :meth:`Closing._assumption_violated`: a question the assumption refuses, blamed on the producer;
 * :meth:`Closing._at_question`: the owed guarantees its inputs alone decide;
 * :meth:`Closing._close`: its horizon passed (or the run ended): partial answers judged, an unanswered
@@ -50,6 +51,31 @@ class Closing:
         self._verdict("assumption violated", ev, values=self._rendered(inputs),
                       reason=f"assumption {expr_to_rcl(formula)} is false; blamed on the {blame}",
                       semantics=judged.semantics)
+
+    def _accept(self, ev: Event, inputs: dict[str, Any]) -> tuple[bool, str, str]:
+        """Whether the node owes question ``inputs`` (raised by ``ev``) an answer:
+        (owed, the arithmetic its assumption held in, why it is undecided or ``""``);
+        a false assumption is reported ``assumption violated`` here."""
+        accepted, owed, refusal = "exact", True, ""
+        judges = self._judges
+        if self.invalid and any(k in self.invalid for k in inputs):
+            # an input whose latest message did not map (a NaN): the value before it never stands in, so the
+            # question is undecided until that input maps again (docs/semantics.md, "Values")
+            unread = next(f"{k}: {why}" for k, why in self.invalid.items() if k in inputs)
+            owed, refusal = False, f"undecided: {unread}"
+        for aj, formula in (self._assumed if owed else ()):
+            judged = judges[aj].quick(inputs) or self._judge(aj, inputs)  # the compiled code first, inline
+            if judged.truth is False:
+                owed = False
+                self._assumption_violated(ev, formula, inputs, judged)
+                break
+            if judged.truth is None:
+                owed, refusal = False, f"assumption undecided: {judged.reason}"
+                break
+            if judged.semantics != "exact" and _WEAK.get(judged.semantics, 0) > _WEAK[accepted]:
+                accepted = judged.semantics
+                self._note_inexact(ev, judged, f"assumption {expr_to_rcl(formula)}", inputs)
+        return owed, accepted, refusal
 
     def _at_question(self, q: Question) -> None:
         """The owed guarantees on the question's inputs and the state outputs:
@@ -147,7 +173,7 @@ class Closing:
         was, q.reported = q.reported, True  # closed: superseded no more
         if q.answered or q.settled or was or judged_now:
             return
-        if self._recent:
+        if self.stream.skew and self._recent:
             self._early_answer(q)
         if end:
             self._verdict("open", q.event, reason=f"unanswered when the run ended, within {self.horizon} s")
@@ -171,7 +197,7 @@ class Closing:
                 self._violation(ev, k, values, f"guarantee {k} is false on the outputs published after the question "
                                 f"at {q.event.where} (the last at {ev.where}) whatever the value of the outputs not "
                                 f"published before the next question ({why})", "", q.event)
-            elif self._recent:
+            elif self.stream.skew and self._recent:
                 self._early_part(q, k, values)
         q.waiting.clear()
 

@@ -44,6 +44,7 @@ from ...traces.mapping import MappingError, TopicRule, initial_value, value_mapp
 from ...traces.questions import Question, QuestionStream
 from ...values import render
 from .closing import Closing
+from .late import Late
 from .needs_answer import answer_decides
 from .outcome import Outcome, combine, skew_reason
 from .verdicts import WEAK as _WEAK, LINK_TOPICS, NodeResult, Verdict, in_all, names, reads
@@ -60,7 +61,7 @@ def _always(k: int) -> bool:
     return True
 
 
-class NodeMonitor(Closing):
+class NodeMonitor(Closing, Late):
     """Streams events through one node's contract; :meth:`finish` gives the result.
 
     ``rules`` maps topic names to :class:`TopicRule` (its ``tolerance`` and
@@ -166,6 +167,8 @@ class NodeMonitor(Closing):
         #: outputs false for the question at their stamp, waiting for the questions within the skew after them:
         #: (event, stamp, that question, outputs of the answer, state outputs, output-only outcome, its reading)
         self._held: deque[tuple[Any, ...]] = deque()
+        #: the latest stamp (s) of the node's messages judged so far: an input stamped before it was heard late
+        self._hi = float("-inf")
         #: the one question whose horizon is watched: the latest owed one (an earlier one was followed by a
         #: newer question within its horizon, which owes what it lacks, or was closed when its horizon passed)
         self._open: Question | None = None
@@ -295,6 +298,11 @@ class NodeMonitor(Closing):
         return {k: values[k] for k in self._state_outs if values[k] is not None}
 
     def _input(self, ev: Event, trig: frozenset[str]) -> None:
+        stamp = ev.time if ev.stamp is None else ev.stamp
+        if stamp < self._hi:  # heard after a message stamped later: its place is found by its stamp (late.py)
+            self._late_input(ev, trig, stamp)
+            return
+        self._hi = stamp
         values = self.values
         inputs = {k: values[k] for k in self._in_keys if values[k] is not None}
         if len(inputs) < len(self._in_keys):
@@ -302,26 +310,13 @@ class NodeMonitor(Closing):
             if missing:  # not a question yet: nothing before the first message
                 self._verdict("incomplete input", ev, reason="no value yet for " + ", ".join(missing))
                 return
-        accepted, owed, refusal = "exact", True, ""
-        judges = self._judges
-        if self.invalid and any(k in self.invalid for k in inputs):
-            # an input whose latest message did not map (a NaN): the value before it never stands in, so the
-            # question is undecided until that input maps again (docs/semantics.md, "Values")
-            unread = next(f"{k}: {why}" for k, why in self.invalid.items() if k in inputs)
-            owed, refusal = False, f"undecided: {unread}"
-        for aj, formula in (self._assumed if owed else ()):
-            judged = judges[aj].quick(inputs) or self._judge(aj, inputs)  # the compiled code first, inline
-            if judged.truth is False:
-                owed = False
-                self._assumption_violated(ev, formula, inputs, judged)
-                break
-            if judged.truth is None:
-                owed, refusal = False, f"assumption undecided: {judged.reason}"
-                break
-            if judged.semantics != "exact" and _WEAK.get(judged.semantics, 0) > _WEAK[accepted]:
-                accepted = judged.semantics
-                self._note_inexact(ev, judged, f"assumption {expr_to_rcl(formula)}", inputs)
-        q = Question(ev, ev.time if ev.stamp is None else ev.stamp, inputs, owed, accepted)
+        owed, accepted, refusal = self._accept(ev, inputs)
+        self._raise(ev, Question(ev, stamp, inputs, owed, accepted), trig, refusal)
+
+    def _raise(self, ev: Event, q: Question, trig: frozenset[str], refusal: str) -> None:
+        """Question ``q``, raised by ``ev`` (its message set the inputs ``trig``), is the latest:
+        it supersedes the one before it (docs/semantics.md) and is watched for its horizon."""
+        owed = q.owed
         old = self.stream.ask(q, trig & self._triggers if self._triggers else _NO_TRIGGERS)
         if self._open is not None and self._open.followed:  # it owes nothing more: the new question does
             followed, self._open, self._due = self._open, None, _NEVER
@@ -329,7 +324,7 @@ class NodeMonitor(Closing):
                 self._wrong_whatever(followed)
         if old is not None:
             old.reported = True
-            if self._recent:
+            if self.stream.skew and self._recent:
                 self._early_answer(old)
             self._verdict("superseded", old.event, reason=f"the input at {ev.where} came before any output "
                           f"answered the question raised at {old.event.where}: the node owes the latest one an answer")
@@ -380,8 +375,11 @@ class NodeMonitor(Closing):
                 outs = {**q.answer, **mine}
         else:
             outs = mine
-        if self.stream.skew:  # judged at once: reconsidered if a question within the skew after it gets no answer
-            self._recent.append((ev, stamped, mine, self._state() if self._state_outs else _EMPTY))
+        if stamped > self._hi:
+            self._hi = stamped
+        # remembered: reconsidered if a question within the skew after it gets no answer, or a question stamped
+        # before it is heard after it (late.py)
+        self._recent.append((ev, stamped, mine, self._state() if self._state_outs else _EMPTY))
         k = self._single.get(ev.topic, 0)
         if k and q is not None and q.owed and q.view is not None and outs is q.answer and not self._state_outs:
             # the common case inline: one guarantee, no trigger, no state, no output-only guarantee

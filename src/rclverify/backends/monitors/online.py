@@ -33,56 +33,9 @@ from typing import Any, Callable, Iterable, Mapping
 
 from ...logic.floatsem import Tolerance
 from ...rcl.types import Checked, CheckedNode
-from ...traces.events import Event, to_ns
+from ...traces.events import Event, header_stamp, header_stamp_ns
 from ...traces.mapping import TopicRule
 from .check import NodeMonitor, NodeResult, Verdict
-
-
-def header_stamp(fields: Mapping[str, Any]) -> float | None:
-    """The message's ``header.stamp`` in seconds, or ``None`` when it has none.
-
-    Accepts a nested header (``{"header": {"stamp": {"secs": 1, "nsecs": 5}}}``,
-    ROS 1; ``sec``/``nanosec``, ROS 2), a stamp already in seconds, and
-    ROSMonitoring's flattened form (``"header.stamp.secs"``).  A stamp that
-    is not a finite non-negative number is ignored (``None``).
-    """
-    h = fields.get("header")
-    stamp: Any = h.get("stamp") if isinstance(h, Mapping) else None
-    if stamp is None and ("header.stamp.secs" in fields or "header.stamp.sec" in fields):
-        stamp = {k.rsplit(".", 1)[1]: v for k, v in fields.items() if k.startswith("header.stamp.")}
-    if isinstance(stamp, Mapping):
-        s = stamp.get("secs", stamp.get("sec"))
-        ns = stamp.get("nsecs", stamp.get("nanosec", 0))
-        if _num(s) and _num(ns):
-            t = float(s) + float(ns) / 1e9
-            return t if t > 0 else None  # a zero stamp is ROS's "not set"
-        return None
-    if _num(stamp) and float(stamp) > 0:
-        return float(stamp)
-    return None
-
-
-def header_stamp_ns(fields: Mapping[str, Any]) -> int | None:
-    """The message's ``header.stamp`` in integer nanoseconds, or ``None`` as for
-    :func:`header_stamp`: integer ``secs``/``nsecs`` (ROS 1's ``time``) or
-    ``sec``/``nanosec`` (ROS 2's ``builtin_interfaces/Time``) exactly, a stamp
-    given in seconds rounded to the nearest nanosecond (:func:`~rclverify.traces.events.to_ns`)."""
-    t = header_stamp(fields)
-    if t is None:
-        return None
-    h = fields.get("header")
-    stamp: Any = h.get("stamp") if isinstance(h, Mapping) else None
-    if stamp is None:
-        stamp = {k.rsplit(".", 1)[1]: v for k, v in fields.items() if k.startswith("header.stamp.")}
-    if isinstance(stamp, Mapping):
-        s, ns = stamp.get("secs", stamp.get("sec")), stamp.get("nsecs", stamp.get("nanosec", 0))
-        if type(s) is int and type(ns) is int:
-            return s * 1_000_000_000 + ns
-    return to_ns(t)
-
-
-def _num(x: Any) -> bool:
-    return isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x)
 
 
 @dataclass
