@@ -1,8 +1,9 @@
 """examples/contracts_first: the contracts, the tree `rclverify generate ros2` made from them and
 the hand-written logic; `doit verify` finds the seeded bug in TempSensor's logic, by its property
-tests and by the monitor on the run record_run.py recorded from that logic, and discharges
-HeaterControl's; the fixed logic, its run recorded again, is discharged (docs/generate.md,
-"Contracts first: an example")."""
+tests and by the monitor on the run recorded from that logic running as rclpy nodes on ROS 2
+(record_live.py: the committed run is the live monitor's log, checked here without re-recording),
+and discharges HeaterControl's; the fixed logic, its run rebuilt by the simulator record_run.py
+(no ROS 2 needed), is discharged (docs/generate.md, "Contracts first: an example")."""
 from __future__ import annotations
 
 import json
@@ -33,10 +34,6 @@ def test_doit_verify_finds_the_seeded_bug_and_discharges_the_fix(tmp_path: Path,
     strip = lambda t: [ln for ln in t.splitlines() if ln.strip() and not ln.strip().startswith("#")]  # noqa: E731
     # the plan's entries are the generated fragment's, with the recorded run under `traces`
     assert strip(plan) == strip(fragment.replace("traces: []", "traces:\n          - runs/run.jsonl"))
-    # the committed run is the one record_run.py records from the committed logic
-    run = (ws / "runs" / "run.jsonl").read_text()
-    subprocess.run([sys.executable, "record_run.py"], cwd=ws, check=True, capture_output=True)
-    assert (ws / "runs" / "run.jsonl").read_text() == run
 
     assert _verify(ws) == {"TempSensor.g1.property_tests.e0": "failed", "TempSensor.g0.monitors.run_jsonl": "failed",
                            "HeaterControl.g1.property_tests.e0": "discharged",
@@ -48,3 +45,31 @@ def test_doit_verify_finds_the_seeded_bug_and_discharges_the_fix(tmp_path: Path,
                            "TempSensor.g0.monitors.run_jsonl": "discharged",
                            "HeaterControl.g1.property_tests.e0": "discharged",
                            "HeaterControl.g0.monitors.run_jsonl": "discharged"}
+
+
+def _messages(path: Path) -> list[dict]:
+    return [json.loads(x) for x in path.read_text().splitlines() if x.strip()]
+
+
+def test_the_committed_run_was_recorded_by_the_live_monitor(tmp_path: Path) -> None:
+    """runs/run.jsonl is `rclverify monitor --live --ros2`'s log of the rclpy nodes (record_live.py), not the
+    simulator's: it carries the monitor's verdict lines and wall-clock receive times; its messages are the
+    ones the simulator computes from the same logic and readings, in the same order, each answer published
+    at least the node's latency after its input (the nodes wait it), and the live verdicts are the 14
+    violations of TempSensor's guarantee 1 and HeaterControl's 14 satisfied answers."""
+    live = _messages(EXAMPLE / "runs" / "run.jsonl")
+    verdicts = [x["verdict"] for x in live if x["topic"] == "rclverify/verdict"]
+    messages = [x for x in live if not x["topic"].startswith("rclverify/")]
+    assert len(messages) == 42 and all(x["time"] > 1.6e9 for x in messages)  # Unix time, not a simulated clock
+    assert sorted((v["node"], v["verdict"]) for v in verdicts) == \
+        [("HeaterControl", "satisfied")] * 14 + [("TempSensor", "violated")] * 14
+    ws = tmp_path / "ws"
+    shutil.copytree(EXAMPLE, ws, ignore=shutil.ignore_patterns("artifacts", "reports", ".doit.*", "__pycache__",
+                                                               ".ros2"))
+    subprocess.run([sys.executable, "record_run.py"], cwd=ws, check=True, capture_output=True, timeout=60)
+    simulated = _messages(ws / "runs" / "run.jsonl")
+    drop_time = lambda m: {k: v for k, v in m.items() if k != "time"}  # noqa: E731
+    assert [drop_time(m) for m in messages] == [drop_time(m) for m in simulated]
+    for k in range(0, 42, 3):  # probe, temperature, heat: 4 ms, then 2 ms at least
+        assert messages[k + 1]["time"] - messages[k]["time"] >= 0.004
+        assert messages[k + 2]["time"] - messages[k + 1]["time"] >= 0.002

@@ -1,4 +1,8 @@
-"""Record a run of the thermostat's hand-written logic (each node's ``step`` in
+"""THE SIMULATOR, to rebuild the run without ROS 2: the committed
+``runs/run.jsonl`` is a recording of real rclpy nodes by ``rclverify monitor
+--live --ros2`` (``record_live.py``, README.md), and this script overwrites it.
+
+Record a run of the thermostat's hand-written logic (each node's ``step`` in
 ``gen/<pkg>/<pkg>/logic.py``, as it stands) in the monitor's log format
 (ROSMonitoring JSON lines, one message per line: ``topic``, ``time`` in
 seconds, the message's fields; docs/monitors.md).
