@@ -24,6 +24,7 @@ from .cpp_common import Untranslatable, enum_const
 from .cpp_expr import CppTranslator, cpp_type
 from .cpp_values import data_types, parse_code, table_parse, term_fields
 from .nodes import NodePackage
+from . import names
 from .typemap import camel, snake
 from .wiring import wires
 
@@ -152,7 +153,7 @@ def checks_of(checked: Checked, cn: CheckedNode, namespace: str, tolerance: Tole
                 continue
             if isinstance(t, EnumT):
                 enums[t.name] = t
-            into.append(CField(side, var, snake(var), ct, str(t), t))
+            into.append(CField(side, var, names.field_name(var), ct, str(t), t))
     for t in checked.env.enum_values.values():
         enums.setdefault(t.name, t)
     c.enums = [_Enum(t.name, snake(t.name), [(v, enum_const(t, v)) for v in t.values])
@@ -184,8 +185,11 @@ def checks_of(checked: Checked, cn: CheckedNode, namespace: str, tolerance: Tole
 
 
 def _header(ros_type: str, kind: str) -> str:
+    """The header rosidl_generator_cpp writes for ``pkg/Name`` (its CamelCase to snake_case rule,
+    rosidl_pycommon: ``WayPEntry`` -> ``way_p_entry.hpp``)."""
     pkg, name = ros_type.split("/")[0], ros_type.split("/")[-1]
-    return f"{pkg}/{kind}/{snake(name)}.hpp"
+    lower = re.sub("([a-z0-9])([A-Z])", r"\1_\2", re.sub("(.)([A-Z][a-z]+)", r"\1_\2", name)).lower()
+    return f"{pkg}/{kind}/{lower}.hpp"
 
 
 def _cpp_type(ros_type: str, kind: str) -> str:

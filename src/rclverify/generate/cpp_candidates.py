@@ -19,7 +19,7 @@ from ..logic.candidates import Source
 from ..rcl import ast
 from .cpp_common import Untranslatable
 from .cpp_values import kind_of, term_struct
-from .typemap import snake
+from .names import ctor_field
 
 _NUMERIC = ("int", "double")
 
@@ -120,7 +120,7 @@ def _push(tr: Any, s: Source, real: bool) -> str:
     index = [n for n, _ in data.ctors].index(s.ctor)
     arg = _kind(dict(data.ctors)[s.ctor][s.pos])
     return (f"{{ const auto & cand_t = {code}; if (cand_t.ctor == {index}) {{ "
-            f"{push(f'cand_t.{snake(s.ctor)}_{s.pos}', arg)}}} }} ")
+            f"{push(f'cand_t.{ctor_field(s.ctor, s.pos)}', arg)}}} }} ")
 
 
 def _func_type(tr: Any, f: ast.Var) -> Any:

@@ -38,7 +38,7 @@ from ..rcl.types import Checked, CheckedNode, DataT, EnumT, FuncT, Scalar, Type
 from .cpp_common import CPP_SCALARS, Untranslatable, enum_const
 from .cpp_quant import quantifier
 from .cpp_values import kind_of, table_type, term_struct
-from .typemap import snake
+from .names import field_name, snake
 
 def cpp_type(t: Type) -> str | None:
     """The C++ field type of an RCL type, ``None`` when the header cannot hold it."""
@@ -120,7 +120,7 @@ class CppTranslator:
         else:
             raise Untranslatable(f"variable {v.name}")
         t = (self.node.inputs if side == "in" else self.node.outputs).get(name)
-        field = f"{side}.{snake(name)}"
+        field = f"{side}.{field_name(name)}"
         if isinstance(t, Scalar) and t.name == "REAL":
             return field, "double"
         if isinstance(t, Scalar) and t.name == "INTEGER":

@@ -34,6 +34,7 @@ from ..logic.floatsem import MAX_ENUMERATION
 from ..rcl import ast
 from ..rcl.types import EnumT, Scalar
 from .cpp_candidates import candidate_code
+from .names import cpp_local
 from .cpp_common import Untranslatable, enum_const
 
 
@@ -42,8 +43,8 @@ class _Undecided(Exception):
 
 
 def cpp_ident(name: str) -> str:
-    """The C++ name of a bound variable: ``x'`` -> ``q_x_p``."""
-    return "q_" + name.replace("'", "_p")
+    """The C++ name of a bound variable: ``x'`` -> ``qp_x`` (:func:`.names.cpp_local`)."""
+    return cpp_local(name)
 
 
 def quantifier(tr: Any, e: ast.Quant) -> tuple[str, str]:

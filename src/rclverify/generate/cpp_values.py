@@ -19,7 +19,7 @@ from typing import Any
 
 from ..rcl.types import DataT, EnumT, FuncT, Scalar, Type
 from .cpp_common import CPP_SCALARS, camel_words
-from .typemap import snake
+from .names import ctor_field, snake
 
 #: RCL scalar -> C++ type inside a table or a term: a field's, but INTEGER and NATURAL both std::int64_t (module docstring)
 _INNER = {**CPP_SCALARS, "NATURAL": "std::int64_t"}
@@ -66,7 +66,7 @@ def term_fields(t: DataT) -> dict[str, Any]:
     ctors = []
     for k, (name, args) in enumerate(t.ctors):
         ctors.append(dict(index=k, name=name, fn=snake(name),
-                          args=[dict(field=f"{snake(name)}_{j}", cpp=inner_type(a)) for j, a in enumerate(args)]))
+                          args=[dict(field=ctor_field(name, j), cpp=inner_type(a)) for j, a in enumerate(args)]))
     return dict(name=t.name, struct=term_struct(t), ctors=ctors)
 
 

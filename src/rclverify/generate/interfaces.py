@@ -17,7 +17,8 @@ from ..rcl import ast
 from ..rcl.errors import RclError, error
 from ..rcl.types import Checked, CheckedNode
 from ..rcl.units import Unit
-from .typemap import STANDARD_PACKAGES, Section, TypeMapper, snake
+from . import names
+from .typemap import STANDARD_PACKAGES, Section, TypeMapper
 
 
 @dataclass
@@ -31,6 +32,10 @@ class Interface:
     users: set[str] = field(default_factory=set)
     #: per field the declared units of measure of the variables it carries, where declared
     units: list[tuple[str, Unit, ast.Loc, str]] = field(default_factory=list)
+    #: per field name the RCL variable name it carries and where that is declared (one name per field)
+    carriers: dict[str, tuple[str, ast.Loc, str]] = field(default_factory=dict)
+    #: the contract entry that first names the interface
+    loc: ast.Loc = field(default_factory=ast.Loc)
 
     @property
     def path(self) -> str:
@@ -88,7 +93,7 @@ def _unit(node: CheckedNode, prefix: str, var: str) -> str:
         if bd is not None and (bd.lo is not None or bd.hi is not None):
             lo = f"{bd.lo} {'<' if bd.lo_strict else '<='} " if bd.lo is not None else ""
             hi = f" {'<' if bd.hi_strict else '<='} {bd.hi}" if bd.hi is not None else ""
-            parts.append(f"{node.name} assumes {lo}{snake(var)}{hi}")
+            parts.append(f"{node.name} assumes {lo}{names.field_name(var)}{hi}")
     return "; ".join(parts)
 
 
@@ -99,11 +104,18 @@ def _add_var(pkgs: dict[str, InterfacePackage], pkg: str, iface: Interface, sect
     decl = next((d for d in decls if d.name == var), None)
     texpr = decl.type if decl is not None else None
     u = node.unit_of(prefix, var)
+    fname, who = names.field_name(var), f"{node.name}'s {prefix}.{var}"
+    loc = decl.loc if decl is not None else node.node.loc
+    first = iface.carriers.setdefault(fname, (var, loc, who))
+    if first[0] != var:
+        raise RclError([error(loc, f"{iface.ros_name}: {who} and {first[2]} ({first[1]}) would both be field {fname} "
+                                   f"(docs/generate.md, \"Names\"): rename one of them", "generate-names")])
     if u is not None and decl is not None:
-        iface.units.append((snake(var), u, decl.unit.loc if decl.unit is not None else decl.loc,
+        iface.units.append((fname, u, decl.unit.loc if decl.unit is not None else decl.loc,
                             f"{node.name}'s {prefix}.{var}"))
     mapper = pkgs[pkg].mapper
     assert mapper is not None
+    mapper.loc, mapper.who = loc, who
     mapper.field(section, var, table[var], texpr, _unit(node, prefix, var))
 
 
@@ -125,7 +137,7 @@ def interface_packages(checked: Checked) -> dict[str, InterfacePackage]:
                 continue
             pkg, name = split_type(t.msg_type)
             ip = package(pkg)
-            iface = ip.interfaces.setdefault(f"msg/{name}", Interface(pkg, name, "msg", [Section()]))
+            iface = ip.interfaces.setdefault(f"msg/{name}", Interface(pkg, name, "msg", [Section()], loc=t.loc))
             iface.users.add(cn.name)
             if t.match is not None and t.match.prefix in ("in", "out"):
                 _add_var(pkgs, pkg, iface, iface.sections[0], cn, t.match.prefix, t.match.name)
@@ -137,7 +149,8 @@ def interface_packages(checked: Checked) -> dict[str, InterfacePackage]:
             kind = "srv" if link.kind == "service" else "action"
             n_sections = 2 if kind == "srv" else 3
             iface = ip.interfaces.setdefault(f"{kind}/{name}",
-                                             Interface(pkg, name, kind, [Section() for _ in range(n_sections)]))
+                                             Interface(pkg, name, kind, [Section() for _ in range(n_sections)],
+                                                       loc=link.loc))
             iface.users.add(cn.name)
             # contract order: request, response / goal, feedback, result; file order: goal, result, feedback
             order = (0, 1) if kind == "srv" else (0, 2, 1)
@@ -145,7 +158,25 @@ def interface_packages(checked: Checked) -> dict[str, InterfacePackage]:
                 if part.prefix in ("in", "out"):
                     _add_var(pkgs, pkg, iface, iface.sections[where], cn, part.prefix, part.name)
     check_units(pkgs)
+    _check_nested(pkgs)
     return pkgs
+
+
+def _check_nested(pkgs: dict[str, InterfacePackage]) -> None:
+    """Refuse a nested message the type mapping makes under the name of an interface a contract
+    declares (``pkg/PairItem`` on a topic, and a variable whose ``seq(seq(...))`` needs
+    ``PairItem``): one file, two definitions.  Located at the contract entry naming the interface."""
+    diags = []
+    for pkg in pkgs.values():
+        assert pkg.mapper is not None
+        for n, (t, who) in sorted(pkg.mapper.made.items()):
+            declared = pkg.interfaces.get(f"msg/{n}")
+            if declared is not None:
+                diags.append(error(declared.loc, f"{pkg.name}/msg/{n} is declared here and is also the nested message "
+                                                 f"the type mapping makes for RCL type {t} of {who} (docs/generate.md, "
+                                                 f"\"Type mapping\"): rename the interface", "generate-names"))
+    if diags:
+        raise RclError(diags)
 
 
 def check_units(pkgs: dict[str, InterfacePackage]) -> None:

@@ -13,7 +13,7 @@ from dataclasses import dataclass, field
 
 from ..rcl.types import Checked, CheckedNode
 from .interfaces import split_type
-from .typemap import snake
+from .names import package_name, py_name, snake
 
 #: Default QoS depth of the generated publishers and subscriptions (rclpy's keep-last history).
 QOS_DEPTH = 10
@@ -60,6 +60,14 @@ class NodePackage:
     package: str
     endpoints: list[Endpoint] = field(default_factory=list)
     contract_file: str = ""
+    #: ``step``'s parameter per input, RCL name -> Python name (``x'`` -> ``x_prime``: :func:`.names.py_name`)
+    params: dict[str, str] = field(default_factory=dict)
+
+    @property
+    def step(self) -> str:
+        """The function of ``logic.py`` the property tests call with the inputs' RCL names:
+        ``step``, or ``step_rcl`` (which renames them) when Python cannot spell one as a parameter."""
+        return "step" if all(k == v for k, v in self.params.items()) else "step_rcl"
 
     def imports(self) -> list[tuple[str, str, list[str]]]:
         """``(pkg, kind, [classes])`` for the ``from pkg.kind import ...`` lines, sorted."""
@@ -79,7 +87,8 @@ class NodePackage:
 
 def node_package(cn: CheckedNode) -> NodePackage:
     """The package of node ``cn`` (one end per topic entry with a ``matches`` clause and per link)."""
-    np = NodePackage(cn.name, snake(cn.name), contract_file=cn.node.loc.file)
+    np = NodePackage(cn.name, package_name(cn.name), contract_file=cn.node.loc.file,
+                     params={n: py_name(n) for n in cn.inputs})
     seen: set[tuple[str, str]] = set()
     for t in cn.node.topics:
         if t.match is None or t.match.prefix not in ("in", "out"):

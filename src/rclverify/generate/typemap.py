@@ -12,10 +12,11 @@ snake_case, constants upper case, message names CamelCase.
 """
 from __future__ import annotations
 
-import re
 from dataclasses import dataclass, field
 
 from ..rcl import ast
+from ..rcl.errors import RclError, error
+from . import names
 from ..rcl.types import DataT, EmptyT, EnumT, FuncT, Scalar, SeqT, SetT, TupleT, Type
 
 #: RCL scalar name -> ROS 2 primitive type
@@ -29,26 +30,9 @@ STANDARD_PACKAGES = frozenset({
     "example_interfaces", "unique_identifier_msgs", "rcl_interfaces", "lifecycle_msgs", "statistics_msgs"})
 
 
-def snake(name: str) -> str:
-    """A ROS 2 field name from an RCL identifier: ``radiationStatus`` -> ``radiation_status``,
-    ``wayP`` -> ``way_p``, ``x'`` -> ``x_p``.  The result matches ``[a-z][a-z0-9_]*`` with no
-    double or trailing underscore (rosidl's field-name rule)."""
-    s = name.replace("'", "_p")
-    s = re.sub(r"(?<=[a-z0-9])([A-Z])", r"_\1", s).lower()
-    s = re.sub(r"[^a-z0-9_]", "_", s)
-    s = re.sub(r"_+", "_", s).strip("_")
-    if not s or not s[0].isalpha():
-        s = "f_" + s
-    return s
-
-
-def camel(name: str) -> str:
-    """A ROS 2 message name from an RCL identifier (``RadStat`` stays, ``way_p`` -> ``WayP``)."""
-    parts = re.split(r"[^A-Za-z0-9]+", name.replace("'", "P"))
-    s = "".join(p[:1].upper() + p[1:] for p in parts if p)
-    if not s or not s[0].isalpha():
-        s = "T" + s
-    return s
+#: the name rules live in :mod:`.names` (one module for every generated name)
+snake = names.snake
+camel = names.msg_name
 
 
 @dataclass
@@ -104,6 +88,11 @@ class TypeMapper:
     def __init__(self, pkg: str) -> None:
         self.pkg = pkg
         self.nested: dict[str, Section] = {}
+        #: nested message -> (the RCL type it holds, who made it: ``Planner's in.goal``)
+        self.made: dict[str, tuple[Type, str]] = {}
+        #: where the field being mapped is declared, and whose it is (set by the caller)
+        self.loc: ast.Loc = ast.Loc("", 0, 0)
+        self.who = ""
 
     def field(self, section: Section, name: str, t: Type, texpr: ast.TypeExpr | None = None,
               comment: str = "") -> None:
@@ -111,7 +100,7 @@ class TypeMapper:
         hint = texpr.name if isinstance(texpr, ast.TName) else camel(name)
         ros_type = self.ros_type(t, hint, section)
         note = f"RCL {texpr.name} = {t}" if isinstance(texpr, ast.TName) else f"RCL {t}"
-        section.add_field(Field(ros_type, snake(name), "; ".join(x for x in (comment, note) if x)))
+        section.add_field(Field(ros_type, names.field_name(name), "; ".join(x for x in (comment, note) if x)))
 
     def ros_type(self, t: Type, hint: str, holder: Section) -> str:
         """The ROS 2 type of a field of RCL type ``t``; enumeration constants go to ``holder``.
@@ -121,42 +110,48 @@ class TypeMapper:
         if isinstance(t, Scalar):
             return SCALARS[t.name]
         if isinstance(t, EnumT):
-            prefix = snake(t.name).upper()
             for i, v in enumerate(t.values):
-                holder.add_constant(Constant("uint8", f"{prefix}_{snake(v).upper()}", i, f"{t.name} value {v}"))
+                holder.add_constant(Constant("uint8", names.constant_name(t.name, v), i, f"{t.name} value {v}"))
             return "uint8"
         if isinstance(t, EmptyT):
             return "std_msgs/Empty"
         if isinstance(t, (SetT, SeqT)):
             inner = self.ros_type(t.elem, hint + "Item", holder)
             if inner.endswith("[]"):  # ROS 2 has no array of arrays: wrap the inner array
-                inner = self._nested(hint + "Item", lambda s: s.add_field(Field(inner, "elems")))
+                inner = self._nested(camel(hint) + "Item", lambda s: s.add_field(Field(inner, "elems")), t)
             return inner + "[]"
         if isinstance(t, TupleT):
             def fill(s: Section) -> None:
                 for k, e in enumerate(t.elems):
                     s.add_field(Field(self.ros_type(e, f"{hint}E{k}", s), f"e{k}", f"RCL {e}"))
-            return self._nested(camel(hint) if camel(hint) != hint else hint, fill)
+            return self._nested(camel(hint), fill, t)
         if isinstance(t, DataT):
             def fill_data(s: Section) -> None:
                 s.add_field(Field("uint8", "ctor", "which constructor"))
                 for i, (cname, args) in enumerate(t.ctors):
-                    s.add_constant(Constant("uint8", snake(cname).upper(), i, f"constructor {cname}"))
+                    s.add_constant(Constant("uint8", names.constant_name(cname), i, f"constructor {cname}"))
                     for k, a in enumerate(args):
                         s.add_field(Field(self.ros_type(a, f"{t.name}{camel(cname)}{k}", s),
-                                          f"{snake(cname)}_{k}", f"argument {k + 1} of {cname}, RCL {a}"))
-            return self._nested(camel(t.name), fill_data)
+                                          names.ctor_field(cname, k), f"argument {k + 1} of {cname}, RCL {a}"))
+            return self._nested(camel(t.name), fill_data, t)
         if isinstance(t, FuncT):
             def fill_fn(s: Section) -> None:
                 for k, a in enumerate(t.args):
                     s.add_field(Field(self.ros_type(a, f"{hint}Arg{k}", s), f"arg{k}", f"RCL {a}"))
                 s.add_field(Field(self.ros_type(t.result, f"{hint}Value", s), "value", f"RCL {t.result}"))
-            return self._nested(camel(hint) + "Entry", fill_fn) + "[]"
+            return self._nested(camel(hint) + "Entry", fill_fn, t) + "[]"
         raise ValueError(f"no ROS 2 field type for RCL type {t}")
 
-    def _nested(self, name: str, fill) -> str:  # type: ignore[no-untyped-def]
+    def _nested(self, name: str, fill, t: Type) -> str:  # type: ignore[no-untyped-def]
+        """The nested message ``name`` holding RCL type ``t``, made once; another type under the
+        same name (``Pair`` and ``pair'``'s tuple, say) is refused at :attr:`loc`."""
         if name not in self.nested:
             s = Section()
             self.nested[name] = s  # registered first: a recursive reference ends here
+            self.made[name] = (t, self.who)
             fill(s)
+        elif self.made[name][0] != t:
+            raise RclError([error(self.loc, f"{self.pkg}/msg/{name} would hold RCL type {t} for {self.who} and "
+                                            f"{self.made[name][0]} for {self.made[name][1]}: two types, one message "
+                                            f"name (rename one of them)", "generate-names")])
         return f"{self.pkg}/{name}"

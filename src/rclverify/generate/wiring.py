@@ -5,7 +5,7 @@ A node's end (``nodes.Endpoint``) carries one variable (a topic) or several
 in the contract's order: paper lines 1864-1866 leave the field choice to the
 generator).  The field is
 
-* for a type generated from the contracts: the variable's field (``snake(name)``);
+* for a type generated from the contracts: the variable's field (``names.field_name(name)``);
 * for ``std_msgs``' one-value messages (``Float64``, ``Bool``, ...): ``data``;
 * for any other standard type: the one field the monitors' mapping gives the
   topic (``cmd_vel: {fields: [linear.x]}``, docs/monitors.md), else none: the
@@ -19,7 +19,7 @@ from typing import Any, Mapping
 
 from .interfaces import is_standard
 from .nodes import NodePackage
-from .typemap import snake
+from .names import field_name
 
 #: std_msgs messages holding one value in field ``data``
 STD_DATA = frozenset({"Bool", "Byte", "Char", "Float32", "Float64", "Int8", "Int16", "Int32", "Int64", "UInt8",
@@ -58,7 +58,7 @@ class Wire:
 def _path(ros_type: str, var: str, topic: str, rules: Mapping[str, Any]) -> str:
     pkg, cls = ros_type.split("/")[0], ros_type.split("/")[-1]
     if not is_standard(ros_type):
-        return snake(var.split(".", 1)[1])
+        return field_name(var.split(".", 1)[1])
     if pkg == "std_msgs" and cls in STD_DATA:
         return "data"
     fields = getattr(rules.get(topic.lstrip("/")), "fields", ())
