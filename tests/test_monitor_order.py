@@ -256,3 +256,85 @@ def test_live_the_reorder_window_and_a_message_later_than_it_agree(tmp_path: Pat
         eng.tick(2.0)
         eng.finish()
         assert sorted((v.event, v.verdict) for v in got) == want, window
+
+
+# -- the differential: a log heard out of order against the same log in stamp order ----------
+
+def _rows_events(rows: list[tuple[str, float, Any]]) -> list[Any]:
+    from rclverify.traces.events import Event
+    key = {"r": "value", "on": "flag", "status": "level"}
+    return [Event(k, t, topic, {key[topic]: v}, f"run.jsonl:{k + 1}") for k, (topic, t, v) in enumerate(rows)]
+
+
+@pytest.fixture(scope="module")
+def contracts(tmp_path_factory: pytest.TempPathFactory) -> Any:
+    d = tmp_path_factory.mktemp("order")
+    (d / "s.rcl").write_text(SENSOR)
+    (d / "b.rcl").write_text(BAND.replace("Stat :", "Stat2 :").replace(": Stat", ": Stat2").replace(
+        "{red, orange, green}", "{red2, orange2, green2}").replace("green)", "green2)").replace("red)", "red2)"))
+    return load([d / "s.rcl"]), load([d / "b.rcl"])
+
+
+def _verdicts(checked: Any, node: str, rows: list[tuple[str, float, Any]], rules: Any,
+              batch: bool = False, live: bool = False) -> dict[str, set[str]]:
+    """Per message (topic and stamp), the verdicts it got: offline (the event path, or the
+    batch path), or live (each message received at its stamp, in the order heard, no window)."""
+    got: list[Any] = []
+    if live:
+        key = {"r": "value", "on": "flag", "status": "level"}
+        eng = OnlineEngine(checked, [checked.nodes[node]], rules, 1.0, on_verdict=got.append)
+        for topic, t, v in rows:
+            eng.push(topic, {key[topic]: v}, t)
+        eng.finish()
+    else:
+        check_trace(checked, [checked.nodes[node]], _rows_events(rows), rules, 1.0, got.append, batch=batch)
+    out: dict[str, set[str]] = {}
+    for v in got:
+        stamp = rows[v.event][1]
+        out.setdefault(f"{v.topic}@{stamp:.3f}#{v.event}", set()).add(v.verdict)
+    return out
+
+
+def test_an_output_violated_in_stamp_order_is_never_green_alone_heard_out_of_order(contracts: Any) -> None:
+    """Random runs of both contracts, each heard with some inputs moved later in
+    the log (their stamps kept; equal stamps, late answers, inputs before every
+    input has a value among them): every output the run in stamp order (equal
+    stamps in the order heard, docs/semantics.md) finds violated is violated
+    (or inconclusive) heard out of order too, never satisfied alone; the batch
+    path gives the event path's verdicts."""
+    import random
+    from rclverify.traces.mapping import load_rules
+    sensor, band = contracts
+    rnd = random.Random(63)
+    for case in range(400):
+        two = case % 2 == 0
+        checked, node = (sensor, "Sensor") if two else (band, "Band")
+        green, red = ("green", "red") if two else ("green2", "red2")
+        rules = load_rules({"r": {"fields": ["value"]}, "on": {"fields": ["flag"]}, "status": {"fields": ["level"]}})
+        rules.skew = rnd.choice([0.0, 0.02])  # type: ignore[attr-defined]
+        t, rows = 0.0, []
+        if two:
+            rows.append(("on", 0.0, True))
+        for _ in range(rnd.randint(2, 12)):
+            t += rnd.choice([0.01, 0.05, 0.2])
+            kind = rnd.random()
+            if kind < 0.5 or not two:
+                rows.append(("r", t, rnd.choice([50.0, 130.0])))
+            else:
+                rows.append(("on", t, rnd.choice([True, False])))
+            t += rnd.choice([0.0, 0.003, 0.01, 0.05, 1.5])
+            rows.append(("status", t, rnd.choice([green, red])))
+        heard = list(rows)
+        for _ in range(rnd.randint(1, 3)):  # an input heard later than it was stamped, behind some outputs
+            i = rnd.choice([k for k, r in enumerate(heard) if r[0] != "status"])
+            row = heard.pop(i)
+            heard.insert(min(len(heard), i + rnd.randint(1, 9)), row)
+        order = sorted(range(len(heard)), key=lambda k: heard[k][1])  # stamp order, equal stamps as heard
+        ordered = {k.split("#")[0] + f"#{order[int(k.split('#')[1])]}": vs
+                   for k, vs in _verdicts(checked, node, [heard[k] for k in order], rules).items()}
+        late = _verdicts(checked, node, heard, rules)
+        assert late == _verdicts(checked, node, heard, rules, batch=True), (case, heard)
+        assert late == _verdicts(checked, node, heard, rules, live=True), (case, heard)
+        for where, vs in ordered.items():
+            if where.startswith("status") and vs == {"violated"}:
+                assert late.get(where, set()) & {"violated", "inconclusive"}, (case, where, rows, heard, late)

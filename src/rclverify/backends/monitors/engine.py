@@ -169,6 +169,8 @@ class NodeMonitor(Closing, Late):
         self._held: deque[tuple[Any, ...]] = deque()
         #: the latest stamp (s) of the node's messages judged so far: an input stamped before it was heard late
         self._hi = float("-inf")
+        #: before the first question: input -> the (stamp, value, event) of the messages that set it (the last 64)
+        self._in_force: dict[str, list[tuple[float, Any, Event]]] = {}
         #: the one question whose horizon is watched: the latest owed one (an earlier one was followed by a
         #: newer question within its horizon, which owes what it lacks, or was closed when its horizon passed)
         self._open: Question | None = None
@@ -308,6 +310,11 @@ class NodeMonitor(Closing, Late):
         if len(inputs) < len(self._in_keys):
             missing = [k for k in self.needed_inputs if k not in inputs]
             if missing:  # not a question yet: nothing before the first message
+                for k in trig:  # before the first question, what a message heard late finds in force (late.py)
+                    kept = self._in_force.setdefault(k, [])
+                    kept.append((stamp, values[k], ev))
+                    if len(kept) > 64:
+                        del kept[0]
                 self._verdict("incomplete input", ev, reason="no value yet for " + ", ".join(missing))
                 return
         owed, accepted, refusal = self._accept(ev, inputs)

@@ -34,6 +34,7 @@ on the wrong question.
 """
 from __future__ import annotations
 
+import bisect
 from typing import TYPE_CHECKING, Any
 
 from ...traces.events import Event
@@ -53,83 +54,151 @@ class Late:
         mine = {k: values[k] for k in trig}
         kept = stream._questions
         last = kept[-1] if kept else None
-        later = last is not None and last.stamp > stamp
-        if last is not None and later:  # an input message stamped after it set the values in force now
+        first = stream._stamps[0] if kept else float("inf")
+        hist = self._in_force
+        if stamp < first:  # before the first question: kept with the messages counted incomplete
             for k in trig:
+                hist.setdefault(k, []).append((stamp, mine[k], ev))
+        tainted, reset = self._tainted(ev, stamp, mine)
+        for k in trig:  # the values in force now: a message stamped after it may have set them
+            if last is not None and reset:
                 values[k] = last.inputs.get(k)
+            elif last is None:
+                values[k] = _at(hist.get(k, ()), float("inf"))
         before = stream.at(stamp)
         if before is None and stream.forgot:
             self._verdict("inconclusive", ev, reason=f"the input at {ev.where}, stamped {stamp:.9g} s, was heard "
                           "after messages stamped later, and the questions before its stamp are no longer kept: "
                           "it cannot be put in its place, and the outputs after it were judged without it")
             return
-        inputs = {k: v for k, v in (before.inputs if before is not None else {}).items()}
+        inputs = dict(before.inputs) if before is not None else self._inputs_at(stamp)
         inputs.update({k: v for k, v in mine.items() if v is not None})
-        tainted = self._tainted(ev, stamp, mine)
         missing = [k for k in self.needed_inputs if k not in inputs]
+        completed = self._completed(stamp, first) if stamp < first else []
+        upto = completed[0][:2] if completed else None
         if missing:
             self._verdict("incomplete input", ev, reason="no value yet for " + ", ".join(missing) +
                           " at its stamp (heard after messages stamped later)")
-            self._revise_tainted(ev, stamp, None, tainted)
-            return
+            self._revise_tainted(ev, stamp, None, tainted, upto)
+        else:
+            self._place(ev, stamp, inputs, trig, tainted, upto)
+        for j, (t, e, got, kinds) in enumerate(completed):  # each before the next is put (what it answers)
+            self._place(e, t, got, kinds, [], completed[j + 1][:2] if j + 1 < len(completed) else None)
+
+    def _inputs_at(self, stamp: float) -> dict[str, Any]:
+        """Before the first question: the inputs as the messages stamped at or before ``stamp`` set them."""
+        got = {k: _at(h, stamp) for k, h in self._in_force.items()}
+        return {k: v for k, v in got.items() if v is not None}
+
+    def _place(self, ev: Event, stamp: float, inputs: dict[str, Any], trig: frozenset[str],
+               tainted: list[Question], upto: tuple[float, Event] | None = None) -> None:
+        """The question ``ev`` raises at ``stamp`` with ``inputs`` (those in force at its
+        stamp): the latest when none is stamped after it, else kept at its place; the
+        outputs judged since that it is the question of are judged again against it
+        (those before ``upto``, the next question yet to be put, when given)."""
+        stream = self.stream
         owed, accepted, refusal = self._accept(ev, inputs)
         q = Question(ev, stamp, inputs, owed, accepted)
-        if later:
-            stream.insert(q)
-            if owed and self._triggers:
-                for t in trig & self._triggers:
-                    q.triggers.setdefault(t, ev)
-            if refusal:
-                self._verdict("inconclusive", ev, reason=refusal)
-            if owed:
-                self.result.accepted += 1
-        else:
+        nxt = stream.after(stamp)
+        if not nxt:
             self._raise(ev, q, trig, refusal)
-        self._revise_tainted(ev, stamp, q, tainted)
-        if later and owed:
-            q.reported = True  # only the latest question is watched for its horizon
-            nxt = stream.after(stamp)
-            if not q.answered and not q.settled and nxt:
-                gap = nxt[0].stamp - stamp
-                self._verdict("superseded" if gap <= self.horizon else "inconclusive", ev,
-                              reason=f"heard after messages stamped later; the question at {nxt[0].event.where} "
-                                     f"came {gap:.9g} s after it, before any output answered it" +
-                                     ("" if gap <= self.horizon else f" and after its horizon of {self.horizon} s"))
+            if self._open is q:  # its horizon runs from its stamp, however late it was heard (live: the clock)
+                q.due = self._due = stamp + self.horizon
+            self._revise_tainted(ev, stamp, q, tainted, upto)
+            return
+        stream.insert(q)
+        if owed and self._triggers:
+            for t in trig & self._triggers:
+                q.triggers.setdefault(t, ev)
+        if refusal:
+            self._verdict("inconclusive", ev, reason=refusal)
+        if not owed:
+            return
+        self.result.accepted += 1
+        self._revise_tainted(ev, stamp, q, tainted, upto)
+        q.reported = True  # only the latest question is watched for its horizon
+        if not q.answered and not q.settled:
+            gap = nxt[0].stamp - stamp
+            self._verdict("superseded" if gap <= self.horizon else "inconclusive", ev,
+                          reason=f"heard after messages stamped later; the question at {nxt[0].event.where} came "
+                                 f"{gap:.9g} s after it, before any output answered it" +
+                                 ("" if gap <= self.horizon else f" and after its horizon of {self.horizon} s"))
 
-    def _tainted(self, ev: Event, stamp: float, mine: dict[str, Any]) -> list[Question]:
+    def _completed(self, stamp: float, first: float) -> list[tuple[float, Event, dict[str, Any], frozenset[str]]]:
+        """A message stamped ``stamp``, before the first question (stamped ``first``),
+        was heard late.  The messages stamped after it and before that question,
+        counted ``incomplete input`` when heard, may have every input at their
+        stamps now: each raises the question it would have raised in stamp order.
+        Returns them in stamp order: (stamp, event, inputs, the inputs it set); the
+        outputs judged since stamped after each are judged against it (they were
+        ``unasked``) when it is put (:meth:`_place`)."""
+        later: dict[int, tuple[float, Event]] = {}
+        for h in self._in_force.values():
+            for t, _, e in h:
+                if stamp < t < first:
+                    later[id(e)] = (t, e)
+        out: list[tuple[float, Event, dict[str, Any], frozenset[str]]] = []
+        for t, e in sorted(later.values(), key=lambda x: (x[0], x[1].index)):
+            inputs = self._inputs_at(t)
+            if all(k in inputs for k in self.needed_inputs):
+                out.append((t, e, inputs, frozenset(k for k, h in self._in_force.items() if any(x[2] is e for x in h))))
+        return out
+
+    def _tainted(self, ev: Event, stamp: float, mine: dict[str, Any]) -> tuple[list[Question], bool]:
         """The kept questions stamped after ``stamp`` that read an input ``ev`` changes
-        (before the next message of ``ev``'s topic): they were raised without it."""
-        out = []
+        (before the next message of ``ev``'s topic): they were raised without it (their
+        inputs now take its values); and whether a question of ``ev``'s topic stamped
+        after it was heard (its values are then not in force now)."""
+        out: list[Question] = []
+        hist = self._in_force  # a message of it counted incomplete, stamped after it, set it again
+        again = min((e[0] for k in mine for e in hist.get(k, ()) if e[0] > stamp), default=float("inf"))
         for q in self.stream.after(stamp):
-            if q.event.topic == ev.topic:
-                break
+            if q.event.topic == ev.topic or q.stamp >= again:
+                return out, True
             if any(q.inputs.get(k) != v for k, v in mine.items() if v is not None):
                 out.append(q)
                 q.inputs.update({k: v for k, v in mine.items() if v is not None})  # what later outputs are judged on
                 q.view = None if not q.answer else {**q.inputs, **q.answer}
-        return out
+        return out, again < float("inf")
 
-    def _revise_tainted(self, ev: Event, stamp: float, q: Question | None, tainted: list[Question]) -> None:
-        """The outputs already judged stamped after ``stamp``: those whose question at
-        their stamp is now ``q`` are judged against it; those of a ``tainted`` question
-        are ``inconclusive`` (module docstring)."""
+    def _revise_tainted(self, ev: Event, stamp: float, q: Question | None, tainted: list[Question],
+                        upto: tuple[float, Event] | None = None) -> None:
+        """The outputs already judged stamped after ``stamp`` (and before ``upto``, the
+        next question yet to be put: its stamp and event): those whose question at their
+        stamp is now ``q`` are judged against it, those of a ``tainted`` question on the
+        inputs it has now (:meth:`_retold`); outputs held for the skew take the question
+        at their stamp."""
         recent = self._recent
         if len(recent) == recent.maxlen and recent[0][1] > stamp:
             self._verdict("inconclusive", ev, reason=f"the input at {ev.where} was heard after more outputs stamped "
                           f"after it than the monitor keeps ({recent.maxlen}): the oldest of them were judged "
                           "without it, and their verdicts cannot be revised")
-        for r in [r for r in recent if r[1] > stamp]:
+        for r in [r for r in recent if r[1] >= stamp]:
             out_ev, stamped, outs, state = r
-            qa = self.stream.at(stamped)
+            if stamped == stamp and out_ev.index < ev.index:
+                continue  # stamped with it but heard before it: no answer to it (equal stamps in the run's order)
+            if upto is not None and (stamped > upto[0] or (stamped == upto[0] and out_ev.index > upto[1].index)):
+                continue
+            qa = self._in_force_at(stamped, out_ev)
             if q is not None and qa is q:
                 self._answers_late(ev, q, out_ev, outs, state)
             elif qa is not None and qa in tainted:
                 self._retold(ev, qa, out_ev, outs, state)
         for j, h in enumerate(self._held):  # outputs held for the skew: judged against the question at their stamp
-            qa = self.stream.at(h[1])
+            qa = self._in_force_at(h[1], h[0])
             if qa is not h[2] and qa is not None:
                 self._held[j] = (h[0], h[1], qa, h[3], h[4], h[5],
                                  self._question_outcome(qa, h[0], self._touch[h[0].topic][0], h[3], h[4], False))
+
+    def _in_force_at(self, stamp: float, out_ev: Event) -> Question | None:
+        """The question output ``out_ev``, stamped ``stamp``, answers: the latest stamped at
+        or before it, but not one stamped at the same time and heard after it (equal
+        stamps are ordered by the run: docs/semantics.md)."""
+        stamps, qs = self.stream._stamps, self.stream._questions
+        i = bisect.bisect_right(stamps, stamp)
+        while i and stamps[i - 1] == stamp and qs[i - 1] is not None and qs[i - 1].event.index > out_ev.index:
+            i -= 1
+        return qs[i - 1] if i else None
 
     def _retold(self, ev: Event, qa: Question, out_ev: Event, outs: dict[str, Any], state: Any) -> None:
         """Output ``out_ev`` was judged against ``qa``, whose inputs lacked ``ev``'s
@@ -175,6 +244,15 @@ class Late:
         elif got.kind == "inconclusive":
             self._verdict("inconclusive", out_ev, guarantee=got.guarantee, reason=got.reason + why,
                           question=qe.where)
+
+
+def _at(entries: Any, stamp: float) -> Any:
+    """The value of the entry ``(stamp, value, event)`` stamped latest at or before ``stamp`` (``None``: none)."""
+    best = None
+    for e in entries:
+        if e[0] <= stamp and (best is None or e[0] >= best[0]):
+            best = e
+    return None if best is None else best[1]
 
 
 __all__ = ["Late"]
