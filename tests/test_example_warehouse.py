@@ -3,8 +3,8 @@
 A seven-node warehouse robot with five seeded defects.  The pipeline runs
 once on a copy of the seeded workspace, then once per fix of
 ``examples/warehouse/fixes/`` applied to the copy (``git apply``; the run
-recorded again from the fixed node code, ``nodes/record_run.py``; the
-previous fix undone first), then with all five applied: each run is an
+rebuilt from the fixed node code by the simulator ``nodes/record_run.py``,
+no ROS 2 needed; the previous fix undone first), then with all five applied: each run is an
 incremental ``doit`` run of the same copy, which must equal a clean one
 (docs/integrity.md).  About 17 s of CPU in all: seven pipeline runs, six of
 them incremental.
@@ -13,10 +13,16 @@ them incremental.
     first repair, which is the edit the fix makes;
 (b) each fix removes its row and no row appears;
 (c) the recorded run raises no false alarm: no node's run is failed, the
-    node computing ``1000 * 1.2`` and publishing ``1200.0`` is discharged
-    (double arithmetic), the Twist's ``linear.x`` is read, and a service
-    response outside the client's assumption is caught, blamed on the
-    server through the service;
+    node computing ``1000 * range`` is discharged (exactly on the committed
+    run, whose ``sensor_msgs/Range`` carries a float32; in double arithmetic
+    on the simulator's ``1.2``), the Twist's ``linear.x`` is read, and a
+    service response outside the client's assumption is caught, blamed on
+    the server through the service;
+(e) the committed run is the live monitor's recording of real rclpy nodes
+    (``nodes/record_live.py``; checked, not recorded again): the plan's
+    trace is what ``trace_of`` makes of the monitor's log, and its messages
+    are the simulator's, in the same order but for same-time ties, up to
+    the float32 of the ranges.
 (d) with all five fixed, no problem row is left and ``--strict`` fails only
     on ARRIVE, proved with evidence outstanding (the declared progress is a
     claim no backend checks yet).
@@ -24,6 +30,7 @@ Real Z3, Hypothesis and doit; nothing of the example is edited in place.
 """
 from __future__ import annotations
 
+import importlib.util
 import json
 import shutil
 import subprocess
@@ -70,10 +77,9 @@ def runs(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
     ws = tmp_path_factory.mktemp("warehouse") / "ws"
     shutil.copytree(EXAMPLE, ws, ignore=shutil.ignore_patterns("artifacts", "reports", ".doit*", "__pycache__"))
     out: dict[str, Any] = {"ws": ws}
-    recorded = (ws / "backends/monitors/traces/run.jsonl").read_text(encoding="utf-8")
+    out["seeded"] = _verify(ws)[1]  # on the committed run, recorded live
     _record(ws)
-    out["recorded_again"] = (ws / "backends/monitors/traces/run.jsonl").read_text(encoding="utf-8") == recorded
-    out["seeded"] = _verify(ws)[1]
+    out["simulated"] = _lines(ws / "backends/monitors/traces/run.jsonl")
     for diff in FIXES:
         _apply(ws, diff)
         out[diff.name] = _verify(ws)[1]
@@ -84,10 +90,52 @@ def runs(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
     return out
 
 
+def _lines(path: Path) -> list[dict[str, Any]]:
+    return [json.loads(x) for x in path.read_text(encoding="utf-8").splitlines() if x.strip()]
+
+
 def test_the_example_is_as_shipped(runs: dict[str, Any]) -> None:
-    """The committed run is what the node code records, and every fix is a patch of the seeded files."""
-    assert runs["recorded_again"]
+    """Every fix is a patch of the seeded files."""
     assert [f.name for f in FIXES] == sorted(ROWS)
+
+
+def _values(line: dict[str, Any]) -> list[Any]:
+    """The values a line carries for the plan, whatever else its message has (a Range's header)."""
+    if line["topic"] == "scan":
+        return [line["range"]]
+    if "linear" in line:
+        return [line["linear"]["x"]]
+    body = {k: v for k, v in line.items() if k not in ("topic", "time")}
+    return [v for b in body.values() for v in (b.values() if isinstance(b, dict) else [b])]
+
+
+def test_the_committed_run_was_recorded_live_from_rclpy_nodes(runs: dict[str, Any]) -> None:
+    spec = importlib.util.spec_from_file_location("warehouse_record_live", EXAMPLE / "nodes" / "record_live.py")
+    assert spec is not None and spec.loader is not None
+    record_live = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(record_live)
+    log = _lines(EXAMPLE / "backends/monitors/live/monitor.jsonl")
+    trace = _lines(EXAMPLE / "backends/monitors/traces/run.jsonl")
+    # the monitor's log: its verdicts, the calls it paired, wall-clock receive times
+    verdicts = [x["verdict"] for x in log if x["topic"] == "rclverify/verdict"]
+    calls = [x for x in log if x["topic"] == "rclverify/call" and "index" in x]
+    assert len(verdicts) >= 40 and {c["link"] for c in calls} == {"get_limits", "navigate"} and len(calls) == 14
+    assert all(x["time"] > 1.6e9 for x in log)
+    assert not any(v["verdict"] == "violated" for v in verdicts)
+    # the plan's trace is the program's reading of that log, nothing edited
+    assert trace == json.loads(json.dumps(record_live.trace_of(log, record_live.ACTIONS)))
+    # the simulator's messages, same topics and values (float32 ranges), same order but for same-time ties
+    sim = runs["simulated"]
+    assert sorted(x["topic"] for x in trace) == sorted(x["topic"] for x in sim) and len(trace) == 62
+    for topic in {x["topic"] for x in sim}:
+        live_values = [v for x in trace if x["topic"] == topic for v in _values(x)]
+        sim_values = [v for x in sim if x["topic"] == topic for v in _values(x)]
+        assert len(live_values) == len(sim_values) and all(
+            a == b if isinstance(b, bool) else abs(a - b) <= 1e-7 * abs(b) for a, b in zip(live_values, sim_values)), \
+            (topic, live_values, sim_values)
+    # each node waited its latency: the odometry 40 ms after each velocity command at least
+    cmd, odom = ([x["time"] for x in trace if x["topic"] == t] for t in ("cmd_vel", "odom"))
+    assert len(cmd) == len(odom) == 7 and all(0.040 <= b - a < 0.1 for a, b in zip(cmd, odom))
 
 
 def test_each_defect_is_its_own_row_with_the_right_culprit(runs: dict[str, Any]) -> None:
@@ -174,8 +222,13 @@ def test_the_recorded_run_raises_no_false_alarm(runs: dict[str, Any]) -> None:
     for node in nodes:
         m = _monitoring(report, node)
         assert m["counts"]["violated"] == 0 and m["status"] != "failed", (node, m)
-    # 1000 * 1.2 published as 1200.0: satisfied in the node's double arithmetic, said so
+    # the recorded sensor_msgs/Range carries a float32: 1000 * range is exact in double, satisfied exactly
     lidar = _monitoring(report, "LidarDriver")
+    assert lidar["status"] == "discharged" and lidar["counts"]["satisfied"] == 4
+    assert not lidar["semantics"].get("double") and not lidar.get("first_inexact"), lidar
+    # the simulator's 1.2 (fix 1 alone leaves the driver as seeded): 1000 * 1.2 published as 1200.0,
+    # satisfied in the node's double arithmetic, said so
+    lidar = _monitoring(runs["01-deadline.diff"], "LidarDriver")
     assert lidar["status"] == "discharged" and lidar["semantics"]["double"] >= 1
     inexact = lidar["first_inexact"]
     assert inexact["values"] == {"in.range": "1.2", "out.obstacle": "1200.0"} and inexact["semantics"] == "double"

@@ -1,4 +1,9 @@
-"""Record a run of the warehouse robot's node logic (the functions of this
+"""THE SIMULATOR, to rebuild the run without ROS 2: the committed
+``backends/monitors/traces/run.jsonl`` is made from a recording of real rclpy
+nodes by ``rclverify monitor --live --ros2`` (``nodes/record_live.py``,
+README.md), and this script overwrites it.
+
+Record a run of the warehouse robot's node logic (the functions of this
 folder, one file per node) in the
 form of the monitor's logs (ROSMonitoring JSON lines; services as
 ``<svc>/request`` and ``<svc>/response``, the action as actionlib's
