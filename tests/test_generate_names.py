@@ -236,12 +236,21 @@ REFUSED = [
      "  topics( my_msgs/R fooBar matches(in.x), my_msgs/R foo_bar matches(in.x), std_msgs/Float64 q matches(out.y) )\n"
      "  guarantee( out.y == in.x )\n}\n",
      "4:43", "foo_bar and fooBar (contracts/sys.rcl:4:11) would both be node a's end sub_foo_bar"),
+    ("node a {\n  inputs( x' : REAL )\n  outputs( y : REAL )\n"
+     "  topics( my_msgs/R p matches(in.x'), std_msgs/Float64 q matches(out.y) )\n  guarantee( out.y == in.x' )\n}\n"
+     "node b {\n  inputs( z : REAL )\n  outputs( x_prime : REAL )\n"
+     "  topics( std_msgs/Float64 q matches(in.z), my_msgs/R p matches(out.x_prime) )\n"
+     "  guarantee( out.x_prime == in.z )\n}\n",
+     "9:12", "my_msgs/msg/R: b's out.x_prime and a's in.x' (contracts/sys.rcl:2:11) would both be field x_prime"),
+    ("node c {\n  inputs( pair : REAL --> REAL )\n  outputs( w : REAL )\n"
+     "  topics( my_msgs/S s matches(in.pair), my_msgs/PairEntry t matches(out.w) )\n  guarantee( out.w == 1 )\n}\n",
+     "4:41", "my_msgs/msg/PairEntry is declared here and is also the nested message"),
 ]
 
 
 @pytest.mark.parametrize("rcl, where, message", REFUSED, ids=[
     "prime-node", "prime-topic", "prime-collision", "keyword-collision", "package-collision", "keyword-package",
-    "lowercase-type", "end-collision"])
+    "lowercase-type", "end-collision", "field-collision-across-nodes", "nested-message-collision"])
 def test_a_name_the_tree_cannot_carry_is_refused_located(tmp_path: Path, capsys, rcl: str, where: str,
                                                           message: str) -> None:
     ws = _ws(tmp_path, rcl)
