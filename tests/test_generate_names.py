@@ -242,6 +242,11 @@ REFUSED = [
      "  topics( std_msgs/Float64 q matches(in.z), my_msgs/R p matches(out.x_prime) )\n"
      "  guarantee( out.x_prime == in.z )\n}\n",
      "9:12", "my_msgs/msg/R: b's out.x_prime and a's in.x' (contracts/sys.rcl:2:11) would both be field x_prime"),
+    ("node a {\n  inputs( x : REAL )\n  outputs( y : REAL )\n"
+     "  topics( my_msgs/R p matches(in.x), std_msgs/Float64 q matches(out.y) )\n  guarantee( out.y == in.x )\n}\n"
+     "node b {\n  inputs( z : REAL )\n  outputs( x : BOOL )\n"
+     "  topics( std_msgs/Float64 q matches(in.z), my_msgs/R p matches(out.x) )\n  guarantee( out.x <=> in.z > 0 )\n}\n",
+     "9:12", "my_msgs/msg/R: field x would carry b's out.x of type BOOL and a's in.x (contracts/sys.rcl:2:11) of type REAL"),
     ("node c {\n  inputs( pair : REAL --> REAL )\n  outputs( w : REAL )\n"
      "  topics( my_msgs/S s matches(in.pair), my_msgs/PairEntry t matches(out.w) )\n  guarantee( out.w == 1 )\n}\n",
      "4:41", "my_msgs/msg/PairEntry is declared here and is also the nested message"),
@@ -250,7 +255,7 @@ REFUSED = [
 
 @pytest.mark.parametrize("rcl, where, message", REFUSED, ids=[
     "prime-node", "prime-topic", "prime-collision", "keyword-collision", "package-collision", "keyword-package",
-    "lowercase-type", "end-collision", "field-collision-across-nodes", "nested-message-collision"])
+    "lowercase-type", "end-collision", "field-collision-across-nodes", "field-of-two-types", "nested-message-collision"])
 def test_a_name_the_tree_cannot_carry_is_refused_located(tmp_path: Path, capsys, rcl: str, where: str,
                                                           message: str) -> None:
     ws = _ws(tmp_path, rcl)

@@ -15,7 +15,7 @@ from dataclasses import dataclass, field
 
 from ..rcl import ast
 from ..rcl.errors import RclError, error
-from ..rcl.types import Checked, CheckedNode
+from ..rcl.types import Checked, CheckedNode, Type
 from ..rcl.units import Unit
 from . import names
 from .typemap import STANDARD_PACKAGES, Section, TypeMapper
@@ -32,8 +32,8 @@ class Interface:
     users: set[str] = field(default_factory=set)
     #: per field the declared units of measure of the variables it carries, where declared
     units: list[tuple[str, Unit, ast.Loc, str]] = field(default_factory=list)
-    #: per field name the RCL variable name it carries and where that is declared (one name per field)
-    carriers: dict[str, tuple[str, ast.Loc, str]] = field(default_factory=dict)
+    #: per (section, field name) the RCL variable it carries, where and whose it is, its type (one per field)
+    carriers: dict[tuple[int, str], tuple[str, ast.Loc, str, Type]] = field(default_factory=dict)
     #: the contract entry that first names the interface
     loc: ast.Loc = field(default_factory=ast.Loc)
 
@@ -106,10 +106,15 @@ def _add_var(pkgs: dict[str, InterfacePackage], pkg: str, iface: Interface, sect
     u = node.unit_of(prefix, var)
     fname, who = names.field_name(var), f"{node.name}'s {prefix}.{var}"
     loc = decl.loc if decl is not None else node.node.loc
-    first = iface.carriers.setdefault(fname, (var, loc, who))
+    part = next(i for i, s in enumerate(iface.sections) if s is section)
+    first = iface.carriers.setdefault((part, fname), (var, loc, who, table[var]))
     if first[0] != var:
         raise RclError([error(loc, f"{iface.ros_name}: {who} and {first[2]} ({first[1]}) would both be field {fname} "
                                    f"(docs/generate.md, \"Names\"): rename one of them", "generate-names")])
+    if first[3] != table[var]:
+        raise RclError([error(loc, f"{iface.ros_name}: field {fname} would carry {who} of type {table[var]} and "
+                                   f"{first[2]} ({first[1]}) of type {first[3]}: one field, one type (docs/generate.md, "
+                                   f"\"Names\"): rename one of them or give them one type", "generate-names")])
     if u is not None and decl is not None:
         iface.units.append((fname, u, decl.unit.loc if decl.unit is not None else decl.loc,
                             f"{node.name}'s {prefix}.{var}"))
