@@ -52,9 +52,11 @@ node class {
              and in.None == on )
 }
 node lambda {
-  inputs( int : REAL )
-  outputs( self : REAL )
+  inputs( int : REAL, import : REAL, await'' : BOOL, try : INTEGER )
+  outputs( self : REAL, yield : BOOL, virtual : NATURAL )
   topics( hostile_msgs/Out new matches(in.int), std_msgs/Float64 template matches(out.self) )
+  services( hostile_msgs/Ask delete serves(in.import, out.yield) )
+  actions( hostile_msgs/Go operator calls(out.virtual, in.await'', in.try) )
   guarantee( out.self == in.int )
 }
 """
@@ -171,8 +173,9 @@ def test_hostile_python_compiles_and_its_step_takes_the_rcl_names(hostile: dict[
     logic = (out / "class_node" / "class_node" / "logic.py").read_text()
     assert "def step(x_prime, delete, lambda_, None_, namespace):" in logic
     assert _plan_steps(out) == {"class": "python/class_node/class_node/logic.py:step_rcl",
-                                "lambda": "python/lambda_node/lambda_node/logic.py:step"}
-    for node, inputs in (("class", ["x'", "delete", "lambda", "None", "namespace"]), ("lambda", ["int"])):
+                                "lambda": "python/lambda_node/lambda_node/logic.py:step_rcl"}
+    for node, inputs in (("class", ["x'", "delete", "lambda", "None", "namespace"]),
+                         ("lambda", ["int", "import", "await''", "try"])):
         impl = _plan_steps(out)[node]
         file, _, fn = impl.rpartition(":")
         assert getattr(_load(out.parent / file), fn)(**{n: 0 for n in inputs}) == {}
@@ -194,7 +197,9 @@ def test_hostile_cpp_compiles(hostile: dict[str, Path], tmp_path: Path) -> None:
 
 def test_hostile_interfaces_parse_with_rosidl_and_map_to_the_rcl_names(hostile: dict[str, Path]) -> None:
     out = hostile["python"]
-    assert len(_rosidl([out])) == 3  # Reading, Out, Cmd
+    assert len(_rosidl([out])) == 5  # Reading, Out, Cmd, Ask.srv, Go.action
+    assert (out / "hostile_msgs" / "srv" / "Ask.srv").read_text().split("---")[1].split()[0:2] == ["bool", "yield_field"]
+    assert "bool await_prime_prime" in (out / "hostile_msgs" / "action" / "Go.action").read_text()
     reading = (out / "hostile_msgs" / "msg" / "Reading.msg").read_text()
     for line in ("float64 x_prime", "int64 delete_field", "bool lambda_field", "uint8 none",
                  "hostile_msgs/Cmd namespace_field", "uint8 MODE_OFF_PRIME=1"):

@@ -161,9 +161,12 @@ def _verdict_end(node: str) -> tuple[str, str, str]:
 
 
 @pytest.mark.parametrize("lang", ["python", "cpp"])
-@pytest.mark.parametrize("case", ["case_study", "warehouse", "chain30"])
+@pytest.mark.parametrize("case", ["case_study", "warehouse", "chain30", "hostile"])
 def test_ros_scan_of_the_generated_tree_is_the_contracts_graph(tmp_path: Path, case: str, lang: str) -> None:
-    if case == "case_study":
+    if case == "hostile":  # keyword and primed names (test_generate_names.py): the same graph, by its RCL names
+        from test_generate_names import HOSTILE
+        ws = _ws(tmp_path, HOSTILE)
+    elif case == "case_study":
         ws = ROOT
     elif case == "warehouse":
         ws = ROOT / "examples" / "warehouse"
