@@ -420,3 +420,40 @@ def test_the_name_rules() -> None:
         f = field_name(w)
         assert rosidl.match(f) and not keyword.iskeyword(f), w
         assert py_name(w).isidentifier() and not keyword.iskeyword(py_name(w)), w
+
+
+PT_CONTRACT = """
+node class {
+  inputs( x' : REAL, lambda : BOOL )
+  outputs( delete : REAL )
+  topics( hostile_msgs/Reading reading matches(in.x'), std_msgs/Bool flag matches(in.lambda),
+          std_msgs/Float64 result matches(out.delete) )
+  assume( 0 <= in.x' and in.x' <= 10 )
+  guarantee( out.delete >= in.x' )
+}
+"""
+
+
+def test_verify_property_tests_the_renamed_step(tmp_path: Path, capsys) -> None:
+    """The plan fragment's entry (``logic.py:step_rcl``) copied into the plan: ``verify`` calls the
+    hand-written ``step(x_prime, lambda_)`` through it, finds a seeded bug and discharges the fix."""
+    ws = _ws(tmp_path, PT_CONTRACT)
+    assert main(["generate", "ros2", "-w", str(ws), "-o", str(ws / "gen")]) == 0
+    frag = yaml.safe_load((ws / "gen" / "rclverify_plan.yaml").read_text())
+    assert frag["nodes"]["class"]["evidence"][0]["implementation"] == "gen/class_node/class_node/logic.py:step_rcl"
+    (ws / "contracts" / "plan.yaml").write_text(yaml.safe_dump(
+        {"name": "names", "contracts": ["contracts/sys.rcl"], "connections": [], "environment": {},
+         "nodes": {"class": {"evidence": frag["nodes"]["class"]["evidence"][:1]}}}, sort_keys=False))
+    logic = ws / "gen" / "class_node" / "class_node" / "logic.py"
+    text = logic.read_text()
+    stub = "def step(x_prime, lambda_):\n    \"\"\"The outputs for these inputs (RCL values, docs/values.md): " \
+           "``{output name: value}``.\"\"\"\n    return {}\n"
+    assert stub in text
+    for body, want in (("x_prime - (1 if lambda_ else 0)", "failed"), ("x_prime + (1 if lambda_ else 0)", "discharged")):
+        logic.write_text(text.replace(stub, stub.replace("return {}", f"return {{'delete': {body}}}")))
+        capsys.readouterr()
+        main(["verify", "-w", str(ws)])
+        out = capsys.readouterr().out
+        assert f"overall: {want}" in out, out[-2000:]
+        if want == "failed":
+            assert "logic.py:step_rcl violates guarantee 1 of class" in out
