@@ -338,3 +338,23 @@ def test_an_output_violated_in_stamp_order_is_never_green_alone_heard_out_of_ord
         for where, vs in ordered.items():
             if where.startswith("status") and vs == {"violated"}:
                 assert late.get(where, set()) & {"violated", "inconclusive"}, (case, where, rows, heard, late)
+
+
+def test_a_trigger_heard_after_its_answer_is_answered_by_it(tmp_path: Path) -> None:
+    """Row 3 for deadlines: the press stamped 1.0 s is heard after the stop
+    stamped 1.05 s (another reader, a later line): the stop answers it in
+    50 ms.  Before: the press waited for a later stop and was "false" (no
+    answer within 200 ms), a false alarm.  A stop stamped with the press but
+    heard before it does not answer it (equal stamps in the order heard)."""
+    ws, run = _workspace(tmp_path, STOPPER, [
+        {"topic": "stop", "time": 1.05, "data": True}, {"topic": "b", "time": 1.0, "data": True},
+        {"topic": "b", "time": 2.0, "data": False}])
+    checked = load([ws / "contracts" / "c.rcl"])
+    got: list[Any] = []
+    [res] = check_deadlines(checked, [checked.nodes["Stopper"]], read_trace(run), {}, got.append)
+    assert [(v.trigger_where, v.verdict, v.answer_where) for v in got] == [
+        ("run.jsonl:2", "true", "run.jsonl:1"), ("run.jsonl:3", "currently_false", "")]
+    run.write_text('{"topic": "stop", "time": 1.0, "data": true}\n{"topic": "b", "time": 1.0, "data": true}\n'
+                   '{"topic": "b", "time": 2.0, "data": false}\n')
+    [res] = check_deadlines(checked, [checked.nodes["Stopper"]], read_trace(run), {})
+    assert res.counts["false"] == 1

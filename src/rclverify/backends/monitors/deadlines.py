@@ -210,6 +210,9 @@ class DeadlineMonitor:
         self.invalid: dict[str, str] = {}
         self.pending: list[_Pending] = []
         self.expired: deque[_Pending] = deque(maxlen=256)  # judged false, waiting for a late answer to show
+        #: the last outputs heard: (stamp ns, event, outputs it set, their values): a trigger heard after them
+        #: but stamped before them is answered by them
+        self.heard: deque[tuple[int, Event, set[str], dict[str, Any]]] = deque(maxlen=64)
         self.now = float("-inf")
         self.now_ns: int | None = None
         self.result = DeadlineResult(node.name)
@@ -277,7 +280,9 @@ class DeadlineMonitor:
         for k, cl, trig, _, d in triggered:
             if refused is None:
                 d_ns = self.bounds_ns[k]
-                self.pending.append(_Pending(k, ev, stamp, (ns + d_ns) / 1e9, inputs, stamp_ns=ns, due_ns=ns + d_ns))
+                p = _Pending(k, ev, stamp, (ns + d_ns) / 1e9, inputs, stamp_ns=ns, due_ns=ns + d_ns)
+                if not (self.now_ns is not None and ns < self.now_ns and self._heard_late(p)):
+                    self.pending.append(p)
                 continue
             why, reason = refused
             self.result.unaccepted[why] += 1
@@ -308,29 +313,43 @@ class DeadlineMonitor:
                                            ev.where, f"answered after {_ms_ns(ns - p.stamp_ns)}, "
                                            f"{_ms_ns(ns - p.due_ns)} past the deadline of "
                                            f"{_ms_ns(p.due_ns - p.stamp_ns)}", update=True))
-        keep: list[_Pending] = []
-        for p in self.pending:
-            k, cl, _, gouts, d = next(t for t in self.timed if t[0] == p.k)
-            if not (gouts & outs) or ns < p.stamp_ns:
-                keep.append(p)
-                continue
-            j = judge(cl.formula, self.checked, self.node, self._visible(p, stamp), self.tolerance)
-            if j.truth is not True:
-                p.rejected = f"the output at {ev.where} did not satisfy guarantee {k}" + (
-                    f" (false in {j.semantics} arithmetic)" if j.truth is False and "double" in j.semantics else
-                    f" ({j.reason})" if j.truth is None and j.reason else "")
-                keep.append(p)
-                continue
-            if ns <= p.due_ns:  # "within": at the deadline is in time (integer ns, no rounding)
-                self._emit(DeadlineVerdict(self.node.name, p.k, "true", p.trigger.where, p.stamp, p.due, stamp,
-                                           ev.where, f"answered after {_ms_ns(ns - p.stamp_ns)} (deadline {_ms(d)})",
-                                           semantics=j.semantics))
-            else:
-                self._emit(DeadlineVerdict(self.node.name, p.k, "false", p.trigger.where, p.stamp, p.due, stamp,
-                                           ev.where, f"answered after {_ms_ns(ns - p.stamp_ns)}, "
-                                           f"{_ms_ns(ns - p.due_ns)} past the deadline of {_ms(d)}",
-                                           semantics=j.semantics))
-        self.pending = keep
+        self.pending = [p for p in self.pending if not self._try(p, ev, ns, outs)]
+        self.heard.append((ns, ev, outs, {c: self.values[c] for c in outs if c not in self.state_outs}))
+
+    def _try(self, p: _Pending, ev: Event, ns: int, outs: set[str]) -> bool:
+        """Whether output ``ev`` (stamp ``ns``, setting ``outs``) answers obligation ``p``:
+        its verdict given (``true``, or ``false`` when late), else ``False`` (still pending)."""
+        k, cl, _, gouts, d = next(t for t in self.timed if t[0] == p.k)
+        if not (gouts & outs) or ns < p.stamp_ns:
+            return False
+        stamp = ns / 1e9
+        j = judge(cl.formula, self.checked, self.node, self._visible(p, stamp), self.tolerance)
+        if j.truth is not True:
+            p.rejected = f"the output at {ev.where} did not satisfy guarantee {k}" + (
+                f" (false in {j.semantics} arithmetic)" if j.truth is False and "double" in j.semantics else
+                f" ({j.reason})" if j.truth is None and j.reason else "")
+            return False
+        if ns <= p.due_ns:  # "within": at the deadline is in time (integer ns, no rounding)
+            self._emit(DeadlineVerdict(self.node.name, p.k, "true", p.trigger.where, p.stamp, p.due, stamp,
+                                       ev.where, f"answered after {_ms_ns(ns - p.stamp_ns)} (deadline {_ms(d)})",
+                                       semantics=j.semantics))
+        else:
+            self._emit(DeadlineVerdict(self.node.name, p.k, "false", p.trigger.where, p.stamp, p.due, stamp,
+                                       ev.where, f"answered after {_ms_ns(ns - p.stamp_ns)}, "
+                                       f"{_ms_ns(ns - p.due_ns)} past the deadline of {_ms(d)}",
+                                       semantics=j.semantics))
+        return True
+
+    def _heard_late(self, p: _Pending) -> bool:
+        """A trigger heard after outputs stamped after it (docs/semantics.md, "Answers"):
+        those outputs (the last 64 kept), in the order heard, answer it as they would
+        have had it been heard first.  Returns whether one did (its verdict given)."""
+        for ns, ev, outs, fresh in self.heard:
+            if ns > p.stamp_ns:  # equal stamps: heard before it, no answer to it (the run's order)
+                p.outs.update(fresh)
+                if self._try(p, ev, ns, outs):
+                    return True
+        return False
 
     def _answers(self, p: _Pending, ns: int, outs: set[str]) -> bool:
         """Whether outputs ``outs`` now (stamp ``ns``, integer ns) answer obligation ``p``."""
