@@ -24,13 +24,24 @@ input at its stamp:
   them, and the outputs judged against it are judged again on them (a
   ``violated`` follows where false; ``inconclusive`` where the assumption
   no longer holds of them, or undecided);
+* before the first question (every input not yet given a value), the
+  messages counted ``incomplete input`` are kept (:attr:`NodeMonitor._in_force`,
+  the last 64 per input): a message heard late finds the values in force at
+  its stamp there, and those stamped after it that it completes raise their
+  questions, in stamp order (:meth:`Late._completed`);
+* equal stamps keep the order heard: an output stamped with a question and
+  heard before it does not answer it;
+* its horizon runs from its stamp (live, a late message's time is the clock);
 * what cannot be placed (the question in force at its stamp forgotten, or
   more outputs after it than the engine remembers) is ``inconclusive`` with
   the reason, never judged against the wrong question.
 
 A verdict already given is not withdrawn: a ``violated`` given against the
 question before stays (the revision adds to it); the run is not discharged
-on the wrong question.
+on the wrong question, but an output right for the question heard late keeps
+a ``violated`` given against the one before (docs/semantics.md).  Every
+input message pays one comparison (its stamp against the latest stamp
+judged) for this; the rest runs only for a message heard late.
 """
 from __future__ import annotations
 

@@ -11,7 +11,9 @@ a running system adds (docs/monitors.md, "Live monitoring"):
   order (ties in arrival order).  A message older than the last one
   released arrives too late to be ordered: it is still checked (at the
   current clock, never dropped silently) and counted in ``late`` (the
-  largest lag in ``max_late_s``);
+  largest lag in ``max_late_s``); its own stamp decides what it answers, and
+  an input put at its stamp revises what was judged without it, as offline
+  (``late.py``, docs/semantics.md "Answers");
 * **time**: :meth:`tick` (a timer, e.g. every 50 ms) moves every monitor's
   clock to ``now - reorder_window``, so an obligation whose horizon (the
   contract's response time) has passed is resolved ``violated`` without
