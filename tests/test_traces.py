@@ -235,3 +235,33 @@ def test_the_scalar_mapper_maps_as_map_value() -> None:
         slow = outcome(lambda: map_value(typ, fields, rule, None))
         assert repr(fast) == repr(slow)  # repr: NaN is not equal to itself
     check()
+
+
+#: sensor_msgs/msg/Range as ROS 2 Jazzy and newer define it: ``variance`` was added after Humble, whose
+#: definitions rosbags' store holds
+NEWER_RANGE = ("std_msgs/Header header\nuint8 ULTRASOUND=0\nuint8 INFRARED=1\nuint8 radiation_type\n"
+               "float32 field_of_view\nfloat32 min_range\nfloat32 max_range\nfloat32 range\nfloat32 variance\n")
+
+
+def test_a_workspace_definition_of_a_standard_type_replaces_the_store_s(tmp_path: Path) -> None:
+    """A workspace carrying its distribution's newer sensor_msgs/Range: rosbags refused the second
+    definition (TypesysError), so no bag of that workspace could be read or recorded; now the
+    workspace's definition wins and the other standard types stay."""
+    from rosbags.rosbag2 import StoragePlugin, Writer
+
+    from rclverify.traces.bag import typestore
+    msgs = tmp_path / "interfaces" / "sensor_msgs" / "msg"
+    msgs.mkdir(parents=True)
+    (msgs / "Range.msg").write_text(NEWER_RANGE)
+    store = typestore([tmp_path / "interfaces"])
+    assert [n for n, _ in store.fielddefs["sensor_msgs/msg/Range"][1]][-1] == "variance"
+    assert "geometry_msgs/msg/Twist" in store.fielddefs and "std_msgs/msg/Header" in store.fielddefs
+    Range, Header, Time = (store.types[f"{p}/msg/{n}"] for p, n in
+                           (("sensor_msgs", "Range"), ("std_msgs", "Header"), ("builtin_interfaces", "Time")))
+    msg = Range(header=Header(stamp=Time(sec=3, nanosec=0), frame_id="lidar"), radiation_type=1, field_of_view=0.5,
+                min_range=0.0, max_range=40.0, range=1.5, variance=0.25)
+    with Writer(tmp_path / "bag", version=9, storage_plugin=StoragePlugin.MCAP) as w:
+        conn = w.add_connection("/scan", "sensor_msgs/msg/Range", typestore=store)
+        w.write(conn, 3_000_000_000, store.serialize_cdr(msg, "sensor_msgs/msg/Range"))
+    (ev,) = read_trace(tmp_path / "bag", [tmp_path / "interfaces"])
+    assert (ev.topic, ev.fields["range"], ev.fields["variance"]) == ("scan", 1.5, 0.25)

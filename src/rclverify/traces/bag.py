@@ -32,10 +32,23 @@ def custom_types(msg_dirs: Sequence[Path]) -> dict[str, Any]:
 
 
 def typestore(msg_dirs: Sequence[Path]) -> Any:
-    """A ``rosbags`` type store with the standard types plus the workspace's."""
+    """A ``rosbags`` type store with the standard types plus the workspace's.
+
+    A workspace ``.msg`` of a standard type that differs from rosbags' (ROS 2
+    Humble's) definition replaces it: the robot's distribution may have
+    changed it (``sensor_msgs/Range`` gained ``variance`` after Humble), and
+    rosbags refuses a second definition of a registered name
+    (``TypesysError``), which made every bag of such a workspace unreadable.
+    Raises :class:`TraceError` as :func:`custom_types` does.
+    """
     from rosbags.typesys import Stores, get_typestore
     store = get_typestore(Stores.ROS2_HUMBLE)
-    store.register(custom_types(msg_dirs))
+    own = custom_types(msg_dirs)
+    if any(store.fielddefs.get(name, fields) != fields for name, fields in own.items()):
+        standard = {name: fields for name, fields in store.fielddefs.items() if name not in own}
+        store = get_typestore(Stores.EMPTY)
+        store.register(standard)
+    store.register(own)
     return store
 
 
