@@ -358,3 +358,19 @@ def test_a_trigger_heard_after_its_answer_is_answered_by_it(tmp_path: Path) -> N
                    '{"topic": "b", "time": 2.0, "data": false}\n')
     [res] = check_deadlines(checked, [checked.nodes["Stopper"]], read_trace(run), {})
     assert res.counts["false"] == 1
+
+
+def test_an_answer_at_exactly_the_horizon_answers_its_question(tmp_path: Path) -> None:
+    """Row 9b for the untimed check: r = 50 at 0.7 s, green at 0.9 s, a horizon
+    of 0.2 s.  In doubles 0.7 + 0.2 is 0.8999999999999999, and the green was
+    judged but its question reported "unanswered: no output within 0.2 s".
+    At the horizon, in integer nanoseconds, is within it; a nanosecond past is not."""
+    lines = [{"topic": "r", "time": 0.7, "value": 50.0}, {"topic": "status", "time": 0.9, "level": "green"},
+             {"topic": "r", "time": 2.0, "value": 50.0}]
+    ws, run = _workspace(tmp_path, BAND, lines, skew=0)
+    got = _engines(ws, run, "Band", horizon=0.2)
+    assert got["events"] == got["batch"] == got["live"] == [(1, "satisfied"), (2, "open")]
+    lines[1]["time"] = 0.900000001
+    ws, run = _workspace(tmp_path, BAND, lines, skew=0)
+    got = _engines(ws, run, "Band", horizon=0.2)
+    assert got["events"] == got["batch"] == got["live"] == [(0, "inconclusive"), (1, "satisfied"), (2, "open")]

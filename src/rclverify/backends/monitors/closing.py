@@ -2,6 +2,8 @@
 or less, kept apart from the per-message hot path.
 
 * :meth:`Closing._accept`: whether the node owes a question an answer (an unreadable input: undecided);
+* :meth:`Closing._violation`: a violation recorded and reported; :meth:`Closing._at_due`: a time at a
+  question's horizon in integer nanoseconds;
 * :meth:`Closing._assumption_violated`: a question the assumption refuses, blamed on the producer;
 * :meth:`Closing._at_question`: the owed guarantees its inputs alone decide;
 * :meth:`Closing._close`: its horizon passed (or the run ended): partial answers judged, an unanswered
@@ -16,13 +18,14 @@ methods it expects are declared for the type checker only).
 """
 from __future__ import annotations
 
+import math
 from collections import deque
 from typing import TYPE_CHECKING, Any, Mapping
 
 from ...logic.floatsem import Judgement
 from ...rcl import ast
 from ...rcl.printer import expr_to_rcl
-from ...traces.events import Event
+from ...traces.events import Event, to_ns
 from ...traces.questions import Question
 from .verdicts import WEAK as _WEAK, in_all, link_of, names, producers
 
@@ -76,6 +79,34 @@ class Closing:
                 accepted = judged.semantics
                 self._note_inexact(ev, judged, f"assumption {expr_to_rcl(formula)}", inputs)
         return owed, accepted, refusal
+
+    def _violation(self, ev: Event, k: int, values: Mapping[str, Any], reason: str, semantics: str,
+                   trigger: Event | None) -> None:
+        record: dict[str, Any] = {"event": ev.index, "time": ev.time, "where": ev.where, "guarantee": k,
+                                  "formula": self._texts.get(k, ""), "values": self._rendered(values),
+                                  "reason": reason, "semantics": semantics}
+        if trigger is not None:
+            record.update({"trigger": trigger.index, "trigger_time": trigger.time, "trigger_where": trigger.where})
+        self.result.add_violation(record)
+        self._verdict("violated", ev, guarantee=k, values=record["values"], reason=reason, semantics=semantics,
+                      question=trigger.where if trigger is not None and trigger is not ev else "")
+
+    def _unbound_note(self, reason: str) -> str:
+        found = [v for v in self.unbound if f"no value for {v}" in reason]
+        if not found:
+            return ""
+        return (f" ({', '.join(found)} of {self.node.name} is carried by no topic or link part: its topics(...) "
+                "and services(...)/actions(...) name none, so no run gives it a value)")
+
+    def _at_due(self, t: float, due: float) -> bool:
+        """Whether time ``t`` (s), after ``due`` in doubles, is at it in integer nanoseconds
+        (``due`` is a question's time plus the horizon: 0.7 + 0.2 is 0.8999999999999999 in
+        doubles, and an answer at 0.9 s is within a horizon of 0.2 s).  Called only when the
+        double comparison says late, so the common path pays nothing."""
+        h = self.horizon
+        if not (t - due < 1e-6 and math.isfinite(due) and math.isfinite(h)):
+            return False
+        return to_ns(t) <= to_ns(due - h) + to_ns(h)
 
     def _at_question(self, q: Question) -> None:
         """The owed guarantees on the question's inputs and the state outputs:

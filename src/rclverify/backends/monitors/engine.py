@@ -364,7 +364,7 @@ class NodeMonitor(Closing, Late):
         stamped = ev.time if ev.stamp is None else ev.stamp
         q = self.stream.at(stamped)
         if q is not None:
-            if ev.time <= q.due:  # an output after the horizon is judged, but is no part of the question's answer
+            if ev.time <= q.due or self._at_due(ev.time, q.due):  # an output after the horizon is judged, but is no part of the question's answer
                 q.answered = True
                 q.last_out = ev
                 answer = q.answer
@@ -426,7 +426,7 @@ class NodeMonitor(Closing, Late):
         while held and (end or held[0][1] + skew < now):
             ev, stamped, q, outs, state, alone, first = held[0]
             others = [o for o in self.stream.within_skew(stamped, q) if not o.answered]
-            if not end and any(not o.reported and now <= o.due for o in others):
+            if not end and any(not o.reported and (now <= o.due or self._at_due(now, o.due)) for o in others):
                 return  # a question it may answer has no answer of its own yet: wait
             held.popleft()
             self._decide(ev, q, others, alone, outs, first, state)
@@ -444,7 +444,7 @@ class NodeMonitor(Closing, Late):
         false one, else undecided, else satisfied, else ``none``."""
         decided, undecided = False, None
         held: list[tuple[int, str]] = []
-        if q is not None and ev.time > q.due:
+        if q is not None and ev.time > q.due and not self._at_due(ev.time, q.due):
             q = None  # judged against it, but past its horizon: no part of its answer
         first_inexact = None
         for k in ks:
@@ -547,28 +547,10 @@ class NodeMonitor(Closing, Late):
         elif outcome.kind == "satisfied":
             self._verdict("satisfied", ev, semantics=outcome.semantics, question=qwhere)
 
-    def _violation(self, ev: Event, k: int, values: Mapping[str, Any], reason: str, semantics: str,
-                   trigger: Event | None) -> None:
-        record: dict[str, Any] = {"event": ev.index, "time": ev.time, "where": ev.where, "guarantee": k,
-                                  "formula": self._texts.get(k, ""), "values": self._rendered(values),
-                                  "reason": reason, "semantics": semantics}
-        if trigger is not None:
-            record.update({"trigger": trigger.index, "trigger_time": trigger.time, "trigger_where": trigger.where})
-        self.result.add_violation(record)
-        self._verdict("violated", ev, guarantee=k, values=record["values"], reason=reason, semantics=semantics,
-                      question=trigger.where if trigger is not None and trigger is not ev else "")
-
-    def _unbound_note(self, reason: str) -> str:
-        found = [v for v in self.unbound if f"no value for {v}" in reason]
-        if not found:
-            return ""
-        return (f" ({', '.join(found)} of {self.node.name} is carried by no topic or link part: its topics(...) "
-                "and services(...)/actions(...) name none, so no run gives it a value)")
-
     def _expire(self, now: float) -> None:
         """Close the watched question when its horizon passed before ``now``."""
         q = self._open
-        if q is not None and q.due < now:
+        if q is not None and q.due < now and not self._at_due(now, q.due):
             self._open, self._due = None, _NEVER
             if q.answered and not q.waiting and (q.followed or q.decided.issuperset(self._need)):
                 q.reported = True  # answered in full: nothing to say (the common case, inline)
@@ -583,7 +565,7 @@ class NodeMonitor(Closing, Late):
         q = self._open
         if q is not None:  # every output judged: a question past its horizon is closed, else open
             self._open = None
-            self._close(q, end=not self.now > q.due)
+            self._close(q, end=not (self.now > q.due and not self._at_due(self.now, q.due)))
         self._due = _NEVER
         return self.result
 
