@@ -29,12 +29,12 @@ def test_candidate_points_in_cpp_are_the_double_readings(tmp_path: Path) -> None
     (ws / "contracts" / "plan.yaml").write_text("contracts: [contracts/q.rcl]\n")
     out = ws / "gen"
     assert main(["generate", "ros2", "-w", str(ws), "-o", str(out), "--lang", "cpp"]) == 0
-    header = (out / "q" / "include" / "q" / "contract_checks.hpp").read_text()
+    header = (out / "q_node" / "include" / "q_node" / "contract_checks.hpp").read_text()  # node Q: REP 144
     assert "// not translated" not in header and header.count("rclverify_rt::real_points(cand_bp, ") >= 10, header
     src = tmp_path / "q.cpp"
-    src.write_text('#include "q/contract_driver.hpp"\n#include <iostream>\n'
-                   "int main() { return q::drive(std::cin, std::cout); }\n")
-    subprocess.run(CXX + ["-O1", f"-I{out / 'q' / 'include'}", str(src), "-o", str(tmp_path / "q")],
+    src.write_text('#include "q_node/contract_driver.hpp"\n#include <iostream>\n'
+                   "int main() { return q_node::drive(std::cin, std::cout); }\n")
+    subprocess.run(CXX + ["-O1", f"-I{out / 'q_node' / 'include'}", str(src), "-o", str(tmp_path / "q")],
                    check=True, capture_output=True, text=True)
     checked = Workspace(ws, "contracts/plan.yaml").checked
     cn = checked.nodes["Q"]

@@ -414,6 +414,7 @@ def test_the_name_rules() -> None:
     assert field_name("None") == "none" and field_name("x''") == "x_prime_prime" and field_name("_") == "f"
     assert py_name("class") == "class_" and py_name("x'") == "x_prime" and py_name("__debug__") == "__debug___"
     assert package_name("class") == "class_node" and package_name("string") == "string_node"
+    assert package_name("A") == "a_node" and package_name("RadiationSensor") == "radiation_sensor"
     assert msg_name("none") == "NoneMsg" and msg_name("T'") == "TPrime"
     rosidl = re.compile(r"^(?!.*__)(?!.*_$)[a-z][a-z0-9_]*$")
     for w in HOSTILE_WORDS + [w + "'" for w in HOSTILE_WORDS]:

@@ -21,7 +21,8 @@ in it:
 * :func:`cpp_local`: a quantified variable in C++: ``q`` + one ``p`` per
   prime + ``_`` + the name (``x'`` -> ``qp_x``): injective by construction.
 * :func:`package_name`: a ROS package name (REP 144, rosidl's package
-  pattern) of a node: its field-style words; a Python or C++ keyword, a
+  pattern, at least two characters) of a node: its field-style words; one
+  letter, a Python or C++ keyword, a
   Python standard module or a ROS package the generated code imports takes
   ``_node`` (``class`` -> ``class_node``: the name is also a Python package, a
   C++ namespace and an executable).
@@ -142,9 +143,10 @@ def cpp_local(name: str) -> str:
 
 def package_name(name: str) -> str:
     """The ROS package (Python package, C++ namespace, executable) of node ``name``:
-    ``RadiationSensor`` -> ``radiation_sensor``, ``class`` -> ``class_node``."""
+    ``RadiationSensor`` -> ``radiation_sensor``, ``class`` -> ``class_node``, ``A`` -> ``a_node``
+    (REP 144: at least two characters)."""
     s = snake(name)
-    return s + "_node" if s in PACKAGE_RESERVED else s
+    return s + "_node" if s in PACKAGE_RESERVED or len(s) < 2 else s
 
 
 def msg_name(name: str) -> str:
