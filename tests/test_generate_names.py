@@ -206,8 +206,7 @@ def test_hostile_interfaces_parse_with_rosidl_and_map_to_the_rcl_names(hostile: 
         assert line in reading
     assert "uint8 DELETE_VALUE=1" not in reading and "uint64 delete_0" in (out / "hostile_msgs/msg/Cmd.msg").read_text()
     mapping = yaml.safe_load((out / "rclverify_mapping.yaml").read_text())
-    fields = {t: r["fields"] for t, r in mapping.items()} if "topics" not in mapping else \
-        {t: r["fields"] for t, r in mapping["topics"].items()}
+    fields = {t: r["fields"] for t, r in mapping["topics"].items()}
     assert fields["reading"] == ["x_prime"] and fields["reading2"] == ["delete_field"] and fields["new"] == ["int_field"]
     contract = _load(out / "class_node" / "class_node" / "contract.py")
     assert contract.FIELDS["in.x'"] == ("sub_reading", "x_prime")
@@ -458,3 +457,17 @@ def test_verify_property_tests_the_renamed_step(tmp_path: Path, capsys) -> None:
         assert f"overall: {want}" in out, out[-2000:]
         if want == "failed":
             assert "logic.py:step_rcl violates guarantee 1 of class" in out
+
+
+def test_names_yaml_would_read_as_booleans_stay_strings(tmp_path: Path) -> None:
+    """A node ``True``, topics ``yes``/``off``, fields ``on``/``null``: plain YAML reads them as
+    booleans and null; the plan fragment and the mapping quote them, so they read back as names."""
+    ws = _ws(tmp_path, "node True {\n  inputs( on : REAL )\n  outputs( null : BOOL )\n"
+                       "  topics( my_msgs/R yes matches(in.on), my_msgs/S off matches(out.null) )\n"
+                       "  guarantee( out.null <=> in.on > 0 )\n}\n")
+    assert main(["generate", "ros2", "-w", str(ws), "-o", str(ws / "gen")]) == 0
+    mapping = yaml.safe_load((ws / "gen" / "rclverify_mapping.yaml").read_text())
+    assert mapping == {"topics": {"yes": {"fields": ["on"]}, "off": {"fields": ["null"]}}}
+    plan = yaml.safe_load((ws / "gen" / "rclverify_plan.yaml").read_text())
+    assert list(plan["nodes"]) == ["True"]
+    assert plan["nodes"]["True"]["evidence"][0]["implementation"] == "gen/true_node/true_node/logic.py:step"

@@ -16,6 +16,7 @@ from pathlib import Path
 from typing import Any, Mapping
 
 import jinja2
+import yaml
 
 from ..evidence.store import atomic_write_text
 from ..logic.floatsem import Tolerance
@@ -35,6 +36,19 @@ ONCE = "created once by rclverify generate: yours to edit, never overwritten"
 _ENV = jinja2.Environment(loader=jinja2.PackageLoader("rclverify.generate", "templates"),
                           keep_trailing_newline=True, autoescape=False, undefined=jinja2.StrictUndefined)
 _ENV.filters["py"] = repr  # a Python string literal of any RCL name (``'in.x'``, ``"in.x'"``)
+
+
+def _yaml_scalar(text: str) -> str:
+    """``text`` as a YAML scalar that reads back as this string: plain where YAML reads it so,
+    else double-quoted (a node ``True``, a topic ``on`` or a field ``null`` are no strings plain)."""
+    try:
+        plain = yaml.safe_load(text) == text and ":" not in text and "#" not in text
+    except yaml.YAMLError:
+        plain = False
+    return text if plain else json.dumps(text)
+
+
+_ENV.filters["yaml"] = _yaml_scalar
 
 
 class GenerateError(ValueError):
