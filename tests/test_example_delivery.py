@@ -4,8 +4,8 @@ A nine-node ROS 2 delivery robot (a service, an action, nested messages,
 units, deadlines, an MCAP recording) with six seeded defects.  The pipeline
 runs once on a copy of the seeded workspace, then once per fix of
 ``examples/delivery/fixes/`` applied cumulatively (``git apply``; the run
-recorded again from the fixed node code, ``nodes/record_run.py``), the last
-one with ``--strict``: seven pipeline runs, six of them incremental ``doit``
+rebuilt from the fixed node code by the simulator ``nodes/record_run.py``,
+no ROS 2 needed), the last one with ``--strict``: seven pipeline runs, six of them incremental ``doit``
 runs of the same copy (the last fix edits a hop off the deadline's named
 path, which the incremental run must decide again, as a clean one does:
 docs/integrity.md).
@@ -14,7 +14,7 @@ docs/integrity.md).
     contract is at fault, a safe first repair that is the edit its fix
     makes: the degrees for radians a unit problem with the factor 180/pi
     blaming the driver, the stale wheel command named at its time stamp
-    (1.513 s) with every violated event of the run listed, the route longer
+    (1.513 s into the run) with every violated event of the run listed, the route longer
     than the buffer tightened to the named constant ``RouteBuffer``, the
     stop number off by one blamed on the producer read by two consumers
     (one row, not one per victim), the property test's failure at the
@@ -25,12 +25,17 @@ docs/integrity.md).
     stale command's;
 (d) with all six fixed, ``--strict`` passes: nothing is left outstanding;
 (e) the counterexamples read well (inputs within their assumptions or the
-    note saying why not, short values, no more than the cone).
+    note saying why not, short values, no more than the cone);
+(f) the committed run is the live monitor's recording of real rclpy nodes
+    (``nodes/record_live.py``; checked, not recorded again): the plan's bag
+    is what ``make_trace`` makes of the monitor's bag and log, and its
+    messages are the simulator's, topic by topic.
 Real Z3, Hypothesis, rosbags and doit; nothing of the example is edited in place.
 """
 from __future__ import annotations
 
 import contextlib
+import importlib.util
 import io
 import json
 import runpy
@@ -87,18 +92,18 @@ def _events(ws: Path) -> list[tuple[float, str, dict[str, Any]]]:
 @pytest.fixture(scope="module")
 def runs(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
     ws = tmp_path_factory.mktemp("delivery") / "ws"
-    shutil.copytree(EXAMPLE, ws, ignore=shutil.ignore_patterns("artifacts", "reports", ".doit*", "__pycache__"))
+    shutil.copytree(EXAMPLE, ws, ignore=shutil.ignore_patterns("artifacts", "reports", ".doit*", "__pycache__",
+                                                               ".ros2"))
     out: dict[str, Any] = {"ws": ws}
-    recorded = (ws / RUN / "run.mcap").read_bytes()
-    _record(ws)
-    out["recorded_again"] = (ws / RUN / "run.mcap").read_bytes() == recorded
-    out["seeded_events"] = _events(ws)
+    out["seeded_events"] = _events(ws)  # the committed run, recorded live
     out["seeded"] = _verify(ws)[1]
     for n in (1, 10):  # `rclverify explain` reaches every violation of the run, the first and the last
         buf = io.StringIO()
         with contextlib.redirect_stdout(buf):
             out[f"explain#{n}"] = (main(["explain", "-w", str(ws), f"WheelController.g0.monitors.run#{n}"]),
                                    buf.getvalue())
+    _record(ws)
+    out["simulated_events"] = _events(ws)
     for diff in FIXES:
         subprocess.run(["git", "apply", str(diff)], cwd=ws, check=True, capture_output=True, timeout=60)
         if "+++ b/nodes/" in diff.read_text(encoding="utf-8"):  # the node code changed: record the run again
@@ -123,9 +128,8 @@ def _culprits(report: dict[str, Any], key: tuple[str, ...]) -> list[tuple[str, s
 
 
 def test_the_example_is_as_shipped(runs: dict[str, Any]) -> None:
-    """The committed MCAP bag is what the node code records, read with its nested messages and the
-    service's and action's parts; every fix is a patch of the seeded files."""
-    assert runs["recorded_again"]
+    """The committed MCAP bag is read with its nested messages and the service's and action's parts;
+    every fix is a patch of the seeded files."""
     assert [f.name for f in FIXES] == sorted(ROWS)
     events = runs["seeded_events"]
     assert (EXAMPLE / RUN / "run.mcap").is_file()
@@ -155,7 +159,8 @@ def test_each_defect_is_one_row_with_the_right_culprit(runs: dict[str, Any]) -> 
     # (b) the stale wheel command: the event at its time stamp, every violated event listed
     stale = ROWS["02-stale-command.diff"]
     assert _culprits(report, stale) == [("guarantee 1 of WheelController", "contracts/wheel_controller.rcl:14:3")]
-    assert "(t = 1.513 s)" in rows[stale]["sentence"]
+    t = float(rows[stale]["sentence"].split("(t = ", 1)[1].split(" s)")[0])
+    assert 1.50 <= t - runs["seeded_events"][0][0] <= 1.53  # the watchdog's tick 1.513 s into the run
     # (c) the route longer than the buffer: one row for the side condition and the requirement
     route = ROWS["03-route-buffer.diff"]
     assert _members(report, route) == ["Navigator.sc4", "ROUTE"]
@@ -196,10 +201,12 @@ def test_every_violation_of_the_run_is_listed_and_explained(runs: dict[str, Any]
     ev = next(e for e in report["evidence"] if e["obligation"] == "WheelController.g0.monitors.run")
     viol = ev["monitoring"]["violations"]
     assert ev["monitoring"]["counts"]["violated"] == len(viol) == 10 and ev["monitoring"]["violations_dropped"] == 0
-    assert viol[0]["time"] == 1.513 and viol[0]["values"] == {"in.safe_cmd": "0.0", "out.wheel_cmd": "0.8"}
+    assert 1.50 <= viol[0]["time"] - runs["seeded_events"][0][0] <= 1.53
+    assert viol[0]["values"] == {"in.safe_cmd": "0.0", "out.wheel_cmd": "0.8"}
     assert [v["time"] for v in viol] == sorted(v["time"] for v in viol)
     rc, text = runs["explain#1"]
-    assert rc == 0 and "violation WheelController.g0.monitors.run#1 of 10" in text and "(t = 1.513 s)" in text
+    assert rc == 0 and "violation WheelController.g0.monitors.run#1 of 10" in text
+    assert f"(t = {viol[0]['time']} s)" in text
     assert "out.wheel_cmd = 0.8" in text and "in.safe_cmd = 0.0" in text
     rc, text = runs["explain#10"]
     assert rc == 0 and "#10 of 10" in text and f"(t = {viol[-1]['time']} s)" in text
@@ -285,6 +292,38 @@ def test_the_delivery_counterexamples_read_well(runs: dict[str, Any]) -> None:
     assert {q["id"] for q in refuted} == {"STOP", "ROUTE"}
     route = next(q for q in refuted if q["id"] == "ROUTE")["check"]  # 51 waypoints need an input outside Navigator
     assert "needs an input outside Navigator: in.n_waypoints <= RouteBuffer" in route["counterexample_note"]
+
+
+def test_the_committed_run_was_recorded_live_from_rclpy_nodes(runs: dict[str, Any], tmp_path: Path) -> None:
+    """The plan's bag is made by program from what ``rclverify monitor --live --ros2 --record`` wrote of
+    real rclpy nodes (its bag: the topics; its log: verdicts and the calls, which it does not record in
+    a bag), and carries the simulator's messages; each node waited its latency."""
+    live = EXAMPLE / "backends/monitors/live"
+    log = [json.loads(x) for x in (live / "monitor.jsonl").read_text(encoding="utf-8").splitlines() if x.strip()]
+    verdicts = [x["verdict"] for x in log if x["topic"] == "rclverify/verdict"]
+    calls = [x for x in log if x["topic"] == "rclverify/call" and "index" in x]
+    assert sorted(c["part"] for c in calls) == ["feedback", "goal", "request", "response", "result"]
+    assert sum(v["verdict"] == "violated" and v["node"] == "WheelController" for v in verdicts) == 10
+    assert all(x["time"] > 1.6e9 for x in log)  # the monitor's clock, not a simulated one
+    spec = importlib.util.spec_from_file_location("delivery_record_live", EXAMPLE / "nodes" / "record_live.py")
+    assert spec is not None and spec.loader is not None
+    record_live = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(record_live)
+    saved = list(sys.path)
+    try:
+        record_live.make_trace(live / "run", log, tmp_path / "run")
+    finally:
+        sys.path[:] = saved
+        sys.modules.pop("record_run", None)
+    from rclverify.traces import read_trace
+    remade = [(e.time, e.topic, dict(e.fields)) for e in read_trace(tmp_path / "run", [EXAMPLE / "interfaces"])]
+    assert remade == runs["seeded_events"] and len(remade) == 90
+    strip = lambda f: {k: v for k, v in f.items() if k not in ("header", "goal_id")}  # noqa: E731
+    sim = runs["simulated_events"]
+    for topic in {t for _, t, _ in sim}:
+        assert [strip(f) for _, t, f in remade if t == topic] == [strip(f) for _, t, f in sim if t == topic], topic
+    safe, wheel = ([e for e in remade if e[1] == t] for t in ("safe_cmd", "wheel_cmd"))
+    assert all(any(0.025 <= w[0] - s[0] < 0.06 for w in wheel) for s in safe)  # answered after its 25 ms
 
 
 def _monitoring(report: dict[str, Any], node: str) -> dict[str, Any]:

@@ -75,7 +75,8 @@ def _apply(ws: Path, diff: Path, reverse: bool = False) -> None:
 @pytest.fixture(scope="module")
 def runs(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
     ws = tmp_path_factory.mktemp("warehouse") / "ws"
-    shutil.copytree(EXAMPLE, ws, ignore=shutil.ignore_patterns("artifacts", "reports", ".doit*", "__pycache__"))
+    shutil.copytree(EXAMPLE, ws, ignore=shutil.ignore_patterns("artifacts", "reports", ".doit*", "__pycache__",
+                                                               ".ros2"))
     out: dict[str, Any] = {"ws": ws}
     out["seeded"] = _verify(ws)[1]  # on the committed run, recorded live
     _record(ws)

@@ -25,7 +25,7 @@ def _verify(ws: Path) -> dict:
 
 def test_doit_verify_finds_the_seeded_bug_and_discharges_the_fix(tmp_path: Path, capsys) -> None:
     ws = tmp_path / "ws"
-    shutil.copytree(EXAMPLE, ws, ignore=shutil.ignore_patterns("artifacts", "reports", ".doit.*", "__pycache__"))
+    shutil.copytree(EXAMPLE, ws, ignore=shutil.ignore_patterns("artifacts", "reports", ".doit.*", "__pycache__", ".ros2"))
     # the committed tree is what the command writes today, and the hand-written logic is kept
     assert main(["generate", "ros2", "-w", str(ws), "-o", str(ws / "gen"), "--system", "contracts_first"]) == 0
     assert "0 generated file(s) written" in capsys.readouterr().out

@@ -1,4 +1,9 @@
-"""Record a run of the delivery robot's node logic (the functions of this
+"""THE SIMULATOR, to rebuild the run without ROS 2: the committed
+``backends/monitors/traces/run/`` is made from a recording of real rclpy
+nodes by ``rclverify monitor --live --ros2`` (``nodes/record_live.py``,
+README.md), and this script overwrites it.
+
+Record a run of the delivery robot's node logic (the functions of this
 folder, one file per node) as a ROS 2 bag in MCAP storage (a rosbag2
 directory, format version 9, written by rosbags' writer).
 
@@ -202,11 +207,18 @@ def twist(vx: float) -> dict[str, Any]:
 
 
 def _store() -> Any:
-    """rosbags' store of ROS 2's standard types, plus the parts of the
+    """rosbags' store of ROS 2's standard types, the workspace's ``.msg`` files
+    (``interfaces/sensor_msgs/msg/Range.msg``: Kilted's, with ``variance``, as
+    the real nodes publish it), plus the parts of the
     workspace's ``.srv`` and ``.action`` files as message types
     ``<pkg>/msg/<T>_Request``, ``<pkg>/msg/<T>_Goal``, ..."""
     from rosbags.typesys import Stores, get_types_from_msg, get_typestore
-    store = get_typestore(Stores.ROS2_HUMBLE)
+    own: dict[str, Any] = {}
+    for f in sorted((ROOT / "interfaces").glob("*/msg/*.msg")):  # sensor_msgs/Range as Kilted defines it
+        own.update(get_types_from_msg(f.read_text(encoding="utf-8"), f"{f.parent.parent.name}/msg/{f.stem}"))
+    standard = get_typestore(Stores.ROS2_HUMBLE).fielddefs
+    store = get_typestore(Stores.EMPTY)  # the workspace's definitions replace Humble's
+    store.register({**{k: v for k, v in standard.items() if k not in own}, **own})
     for f in sorted((ROOT / "interfaces").rglob("*")):
         parts = {".srv": ("Request", "Response"), ".action": ("Goal", "Result", "Feedback")}.get(f.suffix)
         if parts is None:
