@@ -459,6 +459,25 @@ def test_verify_property_tests_the_renamed_step(tmp_path: Path, capsys) -> None:
             assert "logic.py:step_rcl violates guarantee 1 of class" in out
 
 
+def test_a_type_named_like_a_name_node_py_uses_is_imported_under_an_alias(tmp_path: Path) -> None:
+    """``my_msgs/Node`` would rebind rclpy's Node, ``my_msgs/String`` the verdicts' String,
+    ``my_msgs/FooNode`` the node's class, ``my_msgs/Pose`` and ``geometry_msgs/Pose`` each other:
+    each is imported as ``pkg_kind_Class``."""
+    ws = _ws(tmp_path, "node Foo {\n  inputs( a : REAL, b : REAL, c : REAL )\n  outputs( d : BOOL, e : REAL )\n"
+                       "  topics( my_msgs/Node t1 matches(in.a), my_msgs/Pose t2 matches(in.b), "
+                       "geometry_msgs/Pose t3 matches(in.c), my_msgs/String t4 matches(out.d), "
+                       "my_msgs/FooNode t5 matches(out.e) )\n  guarantee( out.d <=> in.a > 0 )\n}\n")
+    assert main(["generate", "ros2", "-w", str(ws), "-o", str(ws / "gen")]) == 0
+    node = (ws / "gen" / "foo" / "foo" / "node.py").read_text()
+    compile(node, "node.py", "exec")
+    assert "from my_msgs.msg import FooNode as my_msgs_msg_FooNode, Node as my_msgs_msg_Node, " \
+           "Pose as my_msgs_msg_Pose, String as my_msgs_msg_String\n" in node
+    assert "from geometry_msgs.msg import Pose as geometry_msgs_msg_Pose\n" in node
+    assert "from rclpy.node import Node\n" in node and "class FooNode(Node):" in node
+    assert "self.create_subscription(geometry_msgs_msg_Pose, 't3'" in node
+    assert "self.create_publisher(String, contract.VERDICT_TOPIC" in node
+
+
 def test_names_yaml_would_read_as_booleans_stay_strings(tmp_path: Path) -> None:
     """A node ``True``, topics ``yes``/``off``, fields ``on``/``null``: plain YAML reads them as
     booleans and null; the plan fragment and the mapping quote them, so they read back as names."""

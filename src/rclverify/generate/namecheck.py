@@ -101,10 +101,11 @@ def _interface(diags: list[Diagnostic], packages: _Scope, ros_type: str, loc: as
     pkg, name = parts[0], parts[-1]
     if pkg in STANDARD_PACKAGES:
         return
-    if not _PKG.match(pkg) or pkg in names.FIELD_RESERVED or pkg in names.ROS_PACKAGES:
+    if not _PKG.match(pkg) or pkg in names.PACKAGE_RESERVED:
         diags.append(error(loc, f"interface package {pkg} of {ros_type} cannot be generated: a package is "
-                                f"[a-z][a-z0-9_]* without '__' or a trailing '_' (rosidl, REP 144) and no Python "
-                                f"or C++ keyword (it is imported as {pkg}.msg and {pkg}::msg); rename it", _CODE))
+                                f"[a-z][a-z0-9_]* without '__' or a trailing '_' (rosidl, REP 144), no Python or C++ "
+                                f"keyword and no Python standard module or ROS package (it is imported as {pkg}.msg "
+                                f"and {pkg}::msg); rename it", _CODE))
     if not _MSG.match(name) or name in names.MSG_RESERVED:
         diags.append(error(loc, f"interface {name} of {ros_type} cannot be generated: a message, service or action "
                                 f"name is CamelCase, ^[A-Z][A-Za-z0-9]*$ (rosidl), and not None/True/False "

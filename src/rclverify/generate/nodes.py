@@ -13,7 +13,12 @@ from dataclasses import dataclass, field
 
 from ..rcl.types import Checked, CheckedNode
 from .interfaces import split_type
-from .names import package_name, py_name, snake
+from .names import msg_name, package_name, py_name, snake
+
+#: names node.py defines or imports at module level (an interface class of such a name is aliased)
+NODE_PY_NAMES = frozenset({"threading", "rclpy", "MutuallyExclusiveCallbackGroup", "ReentrantCallbackGroup",
+                           "ExternalShutdownException", "MultiThreadedExecutor", "Node", "String", "ActionServer",
+                           "ActionClient", "contract", "logic", "QOS_DEPTH", "THREADS", "SPIN_TIMEOUT", "main"})
 
 #: Default QoS depth of the generated publishers and subscriptions (rclpy's keep-last history).
 QOS_DEPTH = 10
@@ -70,11 +75,24 @@ class NodePackage:
         return "step" if all(k == v for k, v in self.params.items()) else "step_rcl"
 
     def imports(self) -> list[tuple[str, str, list[str]]]:
-        """``(pkg, kind, [classes])`` for the ``from pkg.kind import ...`` lines, sorted."""
+        """``(pkg, kind, [classes])`` for the ``from pkg.kind import ...`` lines, sorted; a class
+        imported under another name is ``Name as alias`` (:meth:`py_class`)."""
         by: dict[tuple[str, str], set[str]] = {}
         for e in self.endpoints:
-            by.setdefault((e.pkg, e.kind), set()).add(e.cls)
+            alias = self.py_class(e)
+            by.setdefault((e.pkg, e.kind), set()).add(e.cls if alias == e.cls else f"{e.cls} as {alias}")
         return [(p, k, sorted(c)) for (p, k), c in sorted(by.items())]
+
+    def py_class(self, e: Endpoint) -> str:
+        """The name ``node.py`` gives the type of end ``e``: its class, or ``pkg_kind_Class`` when
+        two of the node's types share the class name (``geometry_msgs/Pose``, ``my_msgs/Pose``) or
+        the name is one ``node.py`` defines or imports itself (``Node``, ``String``, the node's
+        class): an import would rebind it.  Injective: the class has no ``_``, the kind is fixed."""
+        if (e.pkg, e.kind, e.cls) == ("std_msgs", "msg", "String"):
+            return e.cls  # node.py's own import of the verdicts' type
+        twins = {(o.pkg, o.kind) for o in self.endpoints if o.cls == e.cls}
+        taken = NODE_PY_NAMES | {msg_name(self.ros_name) + "Node"}
+        return f"{e.pkg}_{e.kind}_{e.cls}" if len(twins) > 1 or e.cls in taken else e.cls
 
     def depends(self) -> list[str]:
         """Interface packages the node uses."""
