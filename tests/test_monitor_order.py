@@ -374,3 +374,20 @@ def test_an_answer_at_exactly_the_horizon_answers_its_question(tmp_path: Path) -
     ws, run = _workspace(tmp_path, BAND, lines, skew=0)
     got = _engines(ws, run, "Band", horizon=0.2)
     assert got["events"] == got["batch"] == got["live"] == [(0, "inconclusive"), (1, "satisfied"), (2, "open")]
+
+
+def test_an_answer_heard_before_its_question_within_the_skew_is_no_false_alarm(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """The race of every live run: the reading r = 130 stamped 1.6 s is heard 5 ms
+    after its answer, red, stamped 1.605 s.  Red is false for the reading before
+    (50), so it is held for the transport skew (20 ms); the reading comes within
+    it and red is judged against it: satisfied, and the reading is answered.
+    Before: "violated" against r = 50, a false alarm (exit 1)."""
+    ws, run = _workspace(tmp_path, BAND, [
+        {"topic": "r", "time": 1.0, "value": 50.0}, {"topic": "status", "time": 1.1, "level": "green"},
+        {"topic": "status", "time": 1.605, "level": "red"}, {"topic": "r", "time": 1.6, "value": 130.0},
+        {"topic": "r", "time": 3.0, "value": 50.0}])
+    got = _engines(ws, run, "Band", horizon=1.0)
+    assert got["events"] == got["batch"] == got["live"] == [(1, "satisfied"), (2, "satisfied"), (4, "open")]
+    rc, out = _monitor(ws, run, capsys, horizon="1")
+    assert rc == 0 and "2 satisfied, 1 open" in out

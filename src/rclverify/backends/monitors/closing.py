@@ -171,7 +171,9 @@ class Closing:
         return [r for r in self._recent if floor <= r[1] <= q.stamp and r[0].index < q.event.index]
 
     def _forget(self, used: list[Any]) -> None:
-        """Drop the outputs ``used`` from ``_recent``: their reconsideration is given."""
+        """Drop the outputs ``used`` from ``_recent``: their reconsideration is given (an input
+        heard late may still be their question: kept with ``_released`` for late.py)."""
+        self._released.extend(used)
         self._recent = deque((r for r in self._recent if r not in used), maxlen=self._recent.maxlen)
 
     def _close(self, q: Question, end: bool = False) -> None:

@@ -167,6 +167,8 @@ class NodeMonitor(Closing, Late):
         #: outputs false for the question at their stamp, waiting for the questions within the skew after them:
         #: (event, stamp, that question, outputs of the answer, state outputs, output-only outcome, its reading)
         self._held: deque[tuple[Any, ...]] = deque()
+        #: outputs held for the skew and judged since, kept as ``_recent`` keeps those judged at once (late.py)
+        self._released: deque[tuple[Event, float, dict[str, Any], Mapping[str, Any]]] = deque(maxlen=64)
         #: the latest stamp (s) of the node's messages judged so far: an input stamped before it was heard late
         self._hi = float("-inf")
         #: before the first question: input -> the (stamp, value, event) of the messages that set it (the last 64)
@@ -430,6 +432,8 @@ class NodeMonitor(Closing, Late):
                 return  # a question it may answer has no answer of its own yet: wait
             held.popleft()
             self._decide(ev, q, others, alone, outs, first, state)
+            # judged now: an input heard later but stamped before it may still be its question (late.py)
+            self._released.append((ev, stamped, {k: outs[k] for k in self._topic_io[ev.topic][1] if k in outs}, state))
 
     def _alone_outcome(self, ev: Event, ks: list[int]) -> Outcome:
         """The guarantees over outputs only that ``ev`` touches, on the outputs as they stand."""

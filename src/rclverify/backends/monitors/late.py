@@ -184,7 +184,9 @@ class Late:
             self._verdict("inconclusive", ev, reason=f"the input at {ev.where} was heard after more outputs stamped "
                           f"after it than the monitor keeps ({recent.maxlen}): the oldest of them were judged "
                           "without it, and their verdicts cannot be revised")
-        for r in [r for r in recent if r[1] >= stamp]:
+        judged = [r for r in recent if r[1] >= stamp] + [r for r in self._released if r[1] >= stamp]
+        judged.sort(key=lambda r: r[0].index)  # in the order heard
+        for r in judged:
             out_ev, stamped, outs, state = r
             if stamped == stamp and out_ev.index < ev.index:
                 continue  # stamped with it but heard before it: no answer to it (equal stamps in the run's order)
@@ -196,10 +198,17 @@ class Late:
             elif qa is not None and qa in tainted:
                 self._retold(ev, qa, out_ev, outs, state)
         for j, h in enumerate(self._held):  # outputs held for the skew: judged against the question at their stamp
-            qa = self._in_force_at(h[1], h[0])
-            if qa is not h[2] and qa is not None:
-                self._held[j] = (h[0], h[1], qa, h[3], h[4], h[5],
-                                 self._question_outcome(qa, h[0], self._touch[h[0].topic][0], h[3], h[4], False))
+            qa, outs = self._in_force_at(h[1], h[0]), h[3]
+            if qa is None or (qa is h[2] and qa not in tainted):
+                continue
+            if qa is q and qa is not h[2]:  # its answer now: the output's own values, not the old question's answer
+                own = {k: outs[k] for k in self._topic_io[h[0].topic][1] if k in outs}
+                q.answered, q.last_out = True, h[0]
+                q.answer.update(own)
+                q.view = {**q.inputs, **q.answer}
+                outs = dict(q.answer)
+            self._held[j] = (h[0], h[1], qa, outs, h[4], h[5],
+                             self._question_outcome(qa, h[0], self._touch[h[0].topic][0], outs, h[4], False))
 
     def _in_force_at(self, stamp: float, out_ev: Event) -> Question | None:
         """The question output ``out_ev``, stamped ``stamp``, answers: the latest stamped at
