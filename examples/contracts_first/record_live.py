@@ -53,7 +53,10 @@ class Failed(Exception):
 
 def ros2_python(named: str | None) -> Path:
     if named or os.environ.get("RCLVERIFY_ROS2_PYTHON"):
-        return Path(named or os.environ["RCLVERIFY_ROS2_PYTHON"])
+        exe = Path(named or os.environ["RCLVERIFY_ROS2_PYTHON"])
+        if not exe.is_file():
+            raise Failed(f"no ROS 2 Python at {exe}")
+        return exe
     for d in HERE.parents:
         if (d / ".venv-ros2" / "bin" / "python").exists():
             return d / ".venv-ros2" / "bin" / "python"
@@ -148,13 +151,18 @@ def record(py: Path, tmp: Path, out: Path) -> dict[str, object]:
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--ros2-python", help="the ROS 2 Python (rclpy, rmw_fastrtps_cpp)")
+    ap.add_argument("--keep", help="keep the processes' outputs in this folder (else a temporary one)")
     ap.add_argument("--out", default="runs/run.jsonl", help="the log to write (relative to this folder)")
     args = ap.parse_args(argv)
     try:
         py = ros2_python(args.ros2_python)
-        with tempfile.TemporaryDirectory(prefix="record_live_") as tmp:
-            figures = record(py, Path(tmp), HERE / args.out)
-    except Failed as exc:
+        if args.keep:
+            Path(args.keep).mkdir(parents=True, exist_ok=True)
+            figures = record(py, Path(args.keep).resolve(), HERE / args.out)
+        else:
+            with tempfile.TemporaryDirectory(prefix="record_live_") as tmp:
+                figures = record(py, Path(tmp), HERE / args.out)
+    except (Failed, OSError, subprocess.SubprocessError) as exc:
         print(f"record_live.py: error: {exc}", file=sys.stderr)
         return 1
     print(f"{args.out}: {json.dumps(figures)}")

@@ -71,7 +71,10 @@ class Failed(Exception):
 
 def ros2_python(named: str | None) -> Path:
     if named or os.environ.get("RCLVERIFY_ROS2_PYTHON"):
-        return Path(named or os.environ["RCLVERIFY_ROS2_PYTHON"])
+        exe = Path(named or os.environ["RCLVERIFY_ROS2_PYTHON"])
+        if not exe.is_file():
+            raise Failed(f"no ROS 2 Python at {exe}")
+        return exe
     for d in HERE.parents:
         if (d / ".venv-ros2" / "bin" / "python").exists():
             return d / ".venv-ros2" / "bin" / "python"
@@ -253,7 +256,7 @@ def main(argv: list[str] | None = None) -> int:
             shutil.rmtree(tmp / "bag", ignore_errors=True)
             seconds = record(py, tmp)
             figures = install(tmp, HERE / args.live, HERE / args.out)
-    except Failed as exc:
+    except (Failed, OSError, subprocess.SubprocessError) as exc:
         print(f"record_live.py: error: {exc}", file=sys.stderr)
         return 1
     figures["seconds"] = round(seconds, 1)

@@ -66,7 +66,10 @@ class Failed(Exception):
 
 def ros2_python(named: str | None) -> Path:
     if named or os.environ.get("RCLVERIFY_ROS2_PYTHON"):
-        return Path(named or os.environ["RCLVERIFY_ROS2_PYTHON"])
+        exe = Path(named or os.environ["RCLVERIFY_ROS2_PYTHON"])
+        if not exe.is_file():
+            raise Failed(f"no ROS 2 Python at {exe}")
+        return exe
     for d in HERE.parents:
         if (d / ".venv-ros2" / "bin" / "python").exists():
             return d / ".venv-ros2" / "bin" / "python"
@@ -198,7 +201,7 @@ def main(argv: list[str] | None = None) -> int:
         else:
             with tempfile.TemporaryDirectory(prefix="record_live_") as tmp:
                 figures = record(py, Path(tmp), HERE / args.out, HERE / args.live_log)
-    except Failed as exc:
+    except (Failed, OSError, subprocess.SubprocessError) as exc:
         print(f"record_live.py: error: {exc}", file=sys.stderr)
         return 1
     print(f"{args.out}: {json.dumps(figures)}")
