@@ -113,8 +113,9 @@ def _add_var(pkgs: dict[str, InterfacePackage], pkg: str, iface: Interface, sect
                                    f"(docs/generate.md, \"Names\"): rename one of them", "generate-names")])
     if first[3] != table[var]:
         raise RclError([error(loc, f"{iface.ros_name}: field {fname} would carry {who} of type {table[var]} and "
-                                   f"{first[2]} ({first[1]}) of type {first[3]}: one field, one type (docs/generate.md, "
-                                   f"\"Names\"): rename one of them or give them one type", "generate-names")])
+                                   f"{first[2]} ({first[1]}) of type {first[3]}: one field, one type "
+                                   f"(docs/generate.md, \"Names\"): rename one of them or give them one type",
+                              "generate-names")])
     if u is not None and decl is not None:
         iface.units.append((fname, u, decl.unit.loc if decl.unit is not None else decl.loc,
                             f"{node.name}'s {prefix}.{var}"))
