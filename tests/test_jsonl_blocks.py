@@ -184,7 +184,7 @@ def _run_log(rnd: random.Random, n: int) -> bytes:
 
 def _command(checked: Any, root: Path, log: Path, as_json: bool) -> tuple[int, str, str]:
     from rclverify.backends.monitors.cli import monitor_command
-    args = argparse.Namespace(workspace=str(root), mapping=None, horizon=None, json=as_json, live=False,
+    args = argparse.Namespace(workspace=str(root), mapping=None, horizon=None, json=as_json, live=False, nodes=None,
                               traces=[str(log)])
     out, err = io.StringIO(), io.StringIO()
     with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
