@@ -319,7 +319,7 @@ def test_an_output_violated_in_stamp_order_is_never_green_alone_heard_out_of_ord
             t += rnd.choice([0.01, 0.05, 0.2])
             kind = rnd.random()
             if kind < 0.5 or not two:
-                rows.append(("r", t, rnd.choice([50.0, 130.0])))
+                rows.append(("r", t, rnd.choice([50.0, 130.0, 130.0, -1.0])))
             else:
                 rows.append(("on", t, rnd.choice([True, False])))
             t += rnd.choice([0.0, 0.003, 0.01, 0.05, 1.5])

@@ -123,10 +123,10 @@ class Late:
                 q.triggers.setdefault(t, ev)
         if refusal:
             self._verdict("inconclusive", ev, reason=refusal)
+        self._revise_tainted(ev, stamp, q, tainted, upto)  # an unowed q is no output's answer: only the tainted
         if not owed:
             return
         self.result.accepted += 1
-        self._revise_tainted(ev, stamp, q, tainted, upto)
         q.reported = True  # only the latest question is watched for its horizon
         if not q.answered and not q.settled:
             gap = nxt[0].stamp - stamp
@@ -161,6 +161,7 @@ class Late:
         inputs now take its values); and whether a question of ``ev``'s topic stamped
         after it was heard (its values are then not in force now)."""
         out: list[Question] = []
+        self._lost: set[int] = set()  # the questions owed an answer on the inputs they had, and no more
         hist = self._in_force  # a message of it counted incomplete, stamped after it, set it again
         again = min((e[0] for k in mine for e in hist.get(k, ()) if e[0] > stamp), default=float("inf"))
         for q in self.stream.after(stamp):
@@ -170,6 +171,10 @@ class Late:
                 out.append(q)
                 q.inputs.update({k: v for k, v in mine.items() if v is not None})  # what later outputs are judged on
                 q.view = None if not q.answer else {**q.inputs, **q.answer}
+                owed = all(self._judge(aj, q.inputs).truth is True for aj, _ in self._assumed)
+                if q.owed and not owed:
+                    self._lost.add(id(q))
+                q.owed = owed  # owed or not on the inputs in force at its stamp (its verdict given stays)
         return out, again < float("inf")
 
     def _revise_tainted(self, ev: Event, stamp: float, q: Question | None, tainted: list[Question],
@@ -224,18 +229,14 @@ class Late:
         """Output ``out_ev`` was judged against ``qa``, whose inputs lacked ``ev``'s
         values (now set): judged again on them where the assumption still holds
         of them, else ``inconclusive`` (the verdict given was on other inputs)."""
-        if not qa.owed:
-            return
         why = (f"; the input at {ev.where}, heard after it but stamped before the question at {qa.event.where}, "
                "changes an input that question reads: the log's order is not the stamps'")
-        for aj, _ in self._assumed:
-            judged = self._judge(aj, qa.inputs)
-            if judged.truth is not True:
+        if not qa.owed:
+            if id(qa) in self._lost:  # owed when it was judged; with the input heard late the assumption fails
                 self._verdict("inconclusive", out_ev, reason=f"the output at {out_ev.where} was judged against the "
                               f"question at {qa.event.where} without the input at {ev.where}; with it the assumption "
-                              f"is {'false' if judged.truth is False else 'undecided'}" + why,
-                              question=qa.event.where)
-                return
+                              "does not hold (false or undecided)" + why, question=qa.event.where)
+            return
         got = self._question_outcome(qa, out_ev, self._touch[out_ev.topic][0], outs, dict(state or {}), False)
         self._late_verdict(out_ev, qa.event, got, why)
 
