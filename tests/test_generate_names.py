@@ -6,8 +6,9 @@ of such a contract did not compile (``def step(x', class)``, ``double delete{};`
 command said 0.  Here:
 
 * a hand-written hostile contract, generated for Python and for C++: every Python file compiles
-  and ``logic.py``'s property-test entry takes the RCL names; the C++ checks, drivers and logic
-  compile with g++ in one translation unit; every interface file parses with rosidl's own
+  and ``logic.py``'s property-test entry takes the RCL names; the C++ checks, drivers, logic and
+  nodes compile with g++ in one translation unit (rclcpp and the message headers stubbed from
+  the generated interface files: _rclcpp_stub.py); every interface file parses with rosidl's own
   parser (rosidl_adapter to IDL, rosidl_parser), from ROS 2's wheels; the mapping still maps
   each topic's field to its RCL variable;
 * names a tree cannot carry are refused, located at the contract's name, exit 1, nothing written;
@@ -32,6 +33,7 @@ from _ros2 import ros2_python
 from rclverify.cli import main
 from rclverify.generate.names import field_name, msg_name, package_name, py_name
 from rclverify.ros.treesitter import parser, walk
+from _rclcpp_stub import write_stubs
 
 CXX = ["g++", "-std=c++17", "-Wall", "-Wextra", "-Werror", "-fsyntax-only"]
 
@@ -144,11 +146,15 @@ def _plan_steps(out: Path) -> dict[str, str]:
 
 
 def _cpp_unit(trees: list[Path], unit: Path) -> list[str]:
-    """One translation unit with every package's driver and logic.cpp; the g++ command for it."""
+    """One translation unit with every package's driver, logic.cpp and node (its ``main`` renamed;
+    rclcpp and the message headers stubbed: tests/_rclcpp_stub.py); the g++ command for it."""
     pkgs = [h.parent for t in trees for h in sorted(t.glob("*/include/*/contract_driver.hpp"))]
+    stubs = write_stubs(trees, unit.parent / "stubs")
     unit.write_text("".join(f'#include "{p.name}/contract_driver.hpp"\n' for p in pkgs)
-                    + "".join(f'#include "{p.parent.parent / "src" / "logic.cpp"}"\n' for p in pkgs))
-    return CXX + [f"-I{p.parent}" for p in pkgs] + [str(unit)]
+                    + "".join(f'#include "{p.parent.parent / "src" / "logic.cpp"}"\n' for p in pkgs)
+                    + "".join(f'#define main main_{p.name}\n#include "{p.parent.parent / "src" / (p.name + "_node.cpp")}"\n'
+                              f"#undef main\n" for p in pkgs))
+    return CXX + [f"-I{stubs}"] + [f"-I{p.parent}" for p in pkgs] + [str(unit)]
 
 
 def _node_cpp_parses(tree: Path) -> None:
@@ -307,7 +313,7 @@ def _name(rng: random.Random, used: set[str], primes: bool = True) -> str:
             return name
 
 
-def _contract(rng: random.Random, node_name: str) -> tuple[str, list[str]]:
+def _contract(rng: random.Random, node_name: str, pkg: str) -> tuple[str, list[str]]:
     """A random contract (one node ``node_name``) with hostile names everywhere a name stands;
     returns the text and the node's inputs."""
     used = {node_name}
@@ -324,18 +330,18 @@ def _contract(rng: random.Random, node_name: str) -> tuple[str, list[str]]:
     topics = []
     for side, vs, msg in (("in", ins, "Data"), ("out", outs, "Result")):
         for v, _ in vs:
-            topics.append(f"gen_msgs/{msg} {_name(rng, used, primes=False)} matches({side}.{v})")
+            topics.append(f"{pkg}/{msg} {_name(rng, used, primes=False)} matches({side}.{v})")
     links = []
     if rng.random() < 0.5:  # a service: request and response variables of their own
         req, resp = (_name(rng, used), "REAL"), (_name(rng, used), "BOOL")
         ins.append(req)
         outs.append(resp)
-        links.append(f"  services( gen_msgs/Ask {_name(rng, used, primes=False)} serves(in.{req[0]}, out.{resp[0]}) )\n")
+        links.append(f"  services( {pkg}/Ask {_name(rng, used, primes=False)} serves(in.{req[0]}, out.{resp[0]}) )\n")
     if rng.random() < 0.4:  # an action: goal, feedback, result
         goal, fb, res = (_name(rng, used), "REAL"), (_name(rng, used), "REAL"), (_name(rng, used), "BOOL")
         ins.append(goal)
         outs.extend([fb, res])
-        links.append(f"  actions( gen_msgs/Go {_name(rng, used, primes=False)} "
+        links.append(f"  actions( {pkg}/Go {_name(rng, used, primes=False)} "
                      f"serves(in.{goal[0]}, out.{fb[0]}, out.{res[0]}) )\n")
     real_in = next((v for v, t in ins if t == "REAL"), None)
     parts = [f"forall({q1} in BOOL | {q1} or not {q1})", f"exists({q2} in {enum} | {q2} == {e1})"]
@@ -369,10 +375,10 @@ def random_trees(tmp_path_factory: pytest.TempPathFactory) -> dict:
     packages: set[str] = set()
     for i in range(30):
         node = _name(rng, set(), primes=False)
-        while package_name(node) in packages or package_name(node) == "gen_msgs":
+        while package_name(node) in packages or package_name(node).startswith("gen"):
             node = f"{node}{i}"
         packages.add(package_name(node))
-        rcl, ins = _contract(rng, node)
+        rcl, ins = _contract(rng, node, f"gen{i}_msgs")  # one interface package per contract: one C++ unit
         ws = _ws(tmp / f"c{i}", rcl)
         results = {}
         for lang in ("python", "cpp"):
