@@ -31,7 +31,7 @@ import yaml
 
 from _ros2 import ros2_python
 from rclverify.cli import main
-from rclverify.generate.names import field_name, msg_name, package_name, py_name
+from rclverify.generate.names import constant_name, field_name, msg_name, package_name, py_name
 from rclverify.ros.treesitter import parser, walk
 from _rclcpp_stub import write_stubs
 
@@ -257,6 +257,12 @@ REFUSED = [
      "node b {\n  inputs( z : REAL )\n  outputs( x : BOOL )\n"
      "  topics( std_msgs/Float64 q matches(in.z), my_msgs/R p matches(out.x) )\n  guarantee( out.x <=> in.z > 0 )\n}\n",
      "9:12", "my_msgs/msg/R: field x would carry b's out.x of type BOOL and a's in.x (contracts/sys.rcl:2:11) of type REAL"),
+    ("context {\n  Mode : {a', a_prime};\n  Cmd : {go(REAL), go_(REAL)};\n}\n"
+     "node Foo {\n  inputs( m : Mode, c : Cmd )\n  outputs( y : REAL )\n"
+     "  topics( my_msgs/R p matches(in.m), my_msgs/R q matches(in.c), std_msgs/Float64 r matches(out.y) )\n"
+     "  guarantee( out.y == 1 )\n}\n",
+     "2:3", "Mode's value a_prime and Mode's value a' (contracts/sys.rcl:2:3) would both be the rosidl constant "
+            "MODE_A_PRIME"),
     ("node c {\n  inputs( pair : REAL --> REAL )\n  outputs( w : REAL )\n"
      "  topics( my_msgs/S s matches(in.pair), my_msgs/PairEntry t matches(out.w) )\n  guarantee( out.w == 1 )\n}\n",
      "4:41", "my_msgs/msg/PairEntry is declared here and is also the nested message"),
@@ -265,7 +271,8 @@ REFUSED = [
 
 @pytest.mark.parametrize("rcl, where, message", REFUSED, ids=[
     "prime-node", "prime-topic", "prime-collision", "keyword-collision", "package-collision", "keyword-package",
-    "lowercase-type", "end-collision", "field-collision-across-nodes", "field-of-two-types", "nested-message-collision"])
+    "lowercase-type", "end-collision", "field-collision-across-nodes", "field-of-two-types", "context-constant-collision",
+    "nested-message-collision"])
 def test_a_name_the_tree_cannot_carry_is_refused_located(tmp_path: Path, capsys, rcl: str, where: str,
                                                           message: str) -> None:
     ws = _ws(tmp_path, rcl)
@@ -433,6 +440,7 @@ def test_the_name_rules() -> None:
     assert package_name("class") == "class_node" and package_name("string") == "string_node"
     assert package_name("A") == "a_node" and package_name("RadiationSensor") == "radiation_sensor"
     assert msg_name("none") == "NoneMsg" and msg_name("T'") == "TPrime"
+    assert constant_name("null") == "NULL_VALUE" and constant_name("RadStat", "red'") == "RAD_STAT_RED_PRIME"
     rosidl = re.compile(r"^(?!.*__)(?!.*_$)[a-z][a-z0-9_]*$")
     for w in HOSTILE_WORDS + [w + "'" for w in HOSTILE_WORDS]:
         f = field_name(w)
