@@ -7,9 +7,10 @@ recorder starts one process per node); ``python ros2_nodes.py scenario`` is
 the sensors and the operator.  Each node's callback calls the same function
 of this folder that the property tests check (the WheelController its
 ``WheelControllerNode``, watchdog included) on the message it received, and
-publishes the outputs that node's latency later (the figures of the
-simulator ``record_run.py``, which drives the same scenario on a simulated
-clock), without holding up its next callback, as the simulator does.  The
+publishes the outputs that node's latency after the message was sent (its
+DDS source timestamp; the figures of the simulator ``record_run.py``, which
+drives the same scenario on a simulated clock where messages travel in no
+time), without holding up its next callback, as the simulator does.  The
 Navigator serves the ``deliver`` action and asks the RouteServer's
 ``get_route`` service for the goal's route; the MissionPlanner sends each
 order as a goal.  The WheelController's watchdog ticks every 100 ms, 13 ms
@@ -63,9 +64,14 @@ READERS = {"cog": 2, "heading": 2, "pose": 2, "scan": 2, "clearance": 3, "order"
 QOS = 10
 
 
-def later(node, fn):
-    """Run ``fn`` (the node's publications, in order) that node's latency from now, on a thread of its own."""
-    t = threading.Timer(LATENCY[node], fn)
+def later(node, fn, info=None):
+    """Run ``fn`` (the node's publications, in order) on a thread of its own, that node's latency after
+    the message it answers was sent (``info``: the message's rclpy MessageInfo, whose source timestamp
+    is its writer's clock, this host's), or from now: the simulator's messages travel in no time."""
+    delay = LATENCY[node]
+    if info is not None:
+        delay -= (time.time_ns() - info["source_timestamp"]) / 1e9
+    t = threading.Timer(max(0.0, delay), fn)
     t.daemon = True
     t.start()
 
@@ -79,36 +85,36 @@ def twist(vx):
 def gnss_driver_node(node):
     pub = node.create_publisher(Float64, "heading", QOS)
 
-    def on_cog(msg):
+    def on_cog(msg, info):
         out = Float64(data=float(gnss_driver(msg.data)["heading"]))
-        later("GnssDriver", lambda: pub.publish(out))
+        later("GnssDriver", lambda: pub.publish(out), info)
     node.create_subscription(Float64, "cog", on_cog, QOS)
 
 
 def localiser_node(node):
     pub = node.create_publisher(Pose2D, "pose", QOS)
 
-    def on_heading(msg):
+    def on_heading(msg, info):
         out = Pose2D(x=0.0, y=0.0, theta=float(localiser(msg.data)["yaw"]))
-        later("Localiser", lambda: pub.publish(out))
+        later("Localiser", lambda: pub.publish(out), info)
     node.create_subscription(Float64, "heading", on_heading, QOS)
 
 
 def obstacle_detector_node(node):
     pub = node.create_publisher(Float64, "clearance", QOS)
 
-    def on_scan(msg):
+    def on_scan(msg, info):
         out = Float64(data=float(obstacle_detector(msg.range)["clearance"]))
-        later("ObstacleDetector", lambda: pub.publish(out))
+        later("ObstacleDetector", lambda: pub.publish(out), info)
     node.create_subscription(Range, "scan", on_scan, QOS)
 
 
 def locker_controller_node(node):
     pub = node.create_publisher(UInt8, "compartment", QOS)
 
-    def on_dest(msg):
+    def on_dest(msg, info):
         out = UInt8(data=int(locker_controller(msg.data)["compartment"]))
-        later("LockerController", lambda: pub.publish(out))
+        later("LockerController", lambda: pub.publish(out), info)
     node.create_subscription(UInt32, "locker_dest", on_dest, QOS)
 
 
@@ -126,7 +132,7 @@ def mission_planner_node(node):
     def on_accepted(fut):
         fut.result().get_result_async().add_done_callback(on_result)
 
-    def on_order(msg):
+    def on_order(msg, info):
         mission["order_id"] = msg.data
         dest = int(mission_planner(**mission)["dest_id"])
 
@@ -134,7 +140,7 @@ def mission_planner_node(node):
             client.send_goal_async(Deliver.Goal(dest_id=dest), feedback_callback=on_feedback) \
                 .add_done_callback(on_accepted)
             pub.publish(UInt32(data=dest))
-        later("MissionPlanner", send)
+        later("MissionPlanner", send, info)
     node.create_subscription(UInt32, "order", on_order, QOS)
     return lambda: client.wait_for_server(timeout_sec=20)
 
@@ -154,7 +160,7 @@ def navigator_node(node):
     nav = {"dest_id": None, "yaw": None, "clearance": None, "n_waypoints": None}
     goal = {"handle": None, "arrived": threading.Event()}
 
-    def navigate(feedback=False):  # with the lock held
+    def navigate(feedback=False, info=None):  # with the lock held
         if None in nav.values():
             return
         out = navigator(**nav)
@@ -164,7 +170,7 @@ def navigator_node(node):
             pub.publish(twist(out["cmd_vel"]))
             if feedback and handle is not None:
                 handle.publish_feedback(Deliver.Feedback(remaining=float(out["remaining"])))
-        later("Navigator", send)
+        later("Navigator", send, info)
 
     def on_route(fut):
         with lock:
@@ -187,15 +193,15 @@ def navigator_node(node):
         handle.succeed()
         return Deliver.Result(delivered_id=int(out["delivered_id"]))
 
-    def on_pose(msg):
+    def on_pose(msg, info):
         with lock:
             nav["yaw"] = msg.theta
-            navigate()
+            navigate(info=info)
 
-    def on_clearance(msg):
+    def on_clearance(msg, info):
         with lock:
             nav["clearance"] = msg.data
-            navigate()
+            navigate(info=info)
     node.create_subscription(Pose2D, "pose", on_pose, QOS)
     node.create_subscription(Float64, "clearance", on_clearance, QOS)
     node.create_subscription(Empty, "arrived", lambda _msg: goal["arrived"].set(), QOS)
@@ -207,19 +213,19 @@ def speed_governor_node(node):
     pub = node.create_publisher(Twist, "safe_cmd", QOS)
     gov = {"clearance": None, "cmd_vel": None}
 
-    def govern():
+    def govern(info):
         if None in gov.values():
             return
         out = twist(speed_governor(**gov)["safe_cmd"])
-        later("SpeedGovernor", lambda: pub.publish(out))
+        later("SpeedGovernor", lambda: pub.publish(out), info)
 
-    def on_clearance(msg):
+    def on_clearance(msg, info):
         gov["clearance"] = msg.data
-        govern()
+        govern(info)
 
-    def on_cmd_vel(msg):
+    def on_cmd_vel(msg, info):
         gov["cmd_vel"] = msg.linear.x
-        govern()
+        govern(info)
     node.create_subscription(Float64, "clearance", on_clearance, QOS)
     node.create_subscription(Twist, "cmd_vel", on_cmd_vel, QOS)
 
@@ -229,10 +235,10 @@ def wheel_controller_node(node):
     wheels = WheelControllerNode()
     lock = threading.Lock()
 
-    def on_safe_cmd(msg):
+    def on_safe_cmd(msg, info):
         with lock:
             out = Float64(data=float(wheels.on_safe_cmd(msg.linear.x)))
-        later("WheelController", lambda: pub.publish(out))
+        later("WheelController", lambda: pub.publish(out), info)
 
     def on_watchdog():
         with lock:
