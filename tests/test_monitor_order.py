@@ -391,3 +391,22 @@ def test_an_answer_heard_before_its_question_within_the_skew_is_no_false_alarm(
     assert got["events"] == got["batch"] == got["live"] == [(1, "satisfied"), (2, "satisfied"), (4, "open")]
     rc, out = _monitor(ws, run, capsys, horizon="1")
     assert rc == 0 and "2 satisfied, 1 open" in out
+
+
+def test_a_readable_input_heard_late_does_not_end_a_nan_stamped_after_it(tmp_path: Path) -> None:
+    """Rows 3 and 9a together: r = NaN stamped 1.2 s, then r = 130 stamped 1.1 s
+    heard after it.  In force from 1.2 s is the NaN: the switch's question at
+    1.3 s is undecided (inconclusive), not judged on r = 130; the reading heard
+    late is judged at its stamp (its question answered by nothing: superseded)."""
+    lines = [{"topic": "on", "time": 0.0, "flag": True}, {"topic": "r", "time": 1.0, "value": 50.0},
+             {"topic": "status", "time": 1.05, "level": "green"}, {"topic": "r", "time": 1.2, "value": "NaN"},
+             {"topic": "r", "time": 1.1, "value": 130.0}, {"topic": "on", "time": 1.3, "flag": True},
+             {"topic": "status", "time": 1.35, "level": "green"}, {"topic": "r", "time": 1.4, "value": 50.0},
+             {"topic": "status", "time": 1.45, "level": "green"}]
+    ws, run = _workspace(tmp_path, SENSOR, lines)
+    run.write_text(run.read_text().replace('"NaN"', "NaN"))
+    got = _engines(ws, run, "Sensor")
+    assert got["events"] == got["batch"] == got["live"]
+    verdicts = dict(got["events"])
+    assert verdicts[3] == "inconclusive" and verdicts[5] == "inconclusive" and 6 not in verdicts
+    assert verdicts[8] == "satisfied" and "violated" not in verdicts.values()

@@ -169,6 +169,8 @@ class NodeMonitor(Closing, Late):
         self._held: deque[tuple[Any, ...]] = deque()
         #: outputs held for the skew and judged since, kept as ``_recent`` keeps those judged at once (late.py)
         self._released: deque[tuple[Event, float, dict[str, Any], Mapping[str, Any]]] = deque(maxlen=64)
+        #: input -> (stamp, why) of its latest unreadable message (a NaN) until a message stamped after it maps
+        self._unread: dict[str, tuple[float, str]] = {}
         #: the latest stamp (s) of the node's messages judged so far: an input stamped before it was heard late
         self._hi = float("-inf")
         #: before the first question: input -> the (stamp, value, event) of the messages that set it (the last 64)
@@ -271,6 +273,9 @@ class NodeMonitor(Closing, Late):
             except MappingError as exc:
                 # the value in force is stale now: a gate holds back what reads it (dds_enforce.py)
                 self.invalid[key] = f"the latest message at {ev.where} does not map ({exc})"
+                self._unread[key] = (ev.stamped, self.invalid[key])  # a message heard late does not clear it (late.py)
+                if ev.stamped > self._hi:
+                    self._hi = ev.stamped
                 self._verdict("inconclusive", ev, reason=f"{key}: {exc}")
                 return
             if self.invalid:
@@ -307,6 +312,9 @@ class NodeMonitor(Closing, Late):
             self._late_input(ev, trig, stamp)
             return
         self._hi = stamp
+        if self._unread:  # a message stamped after the unreadable one: readable values are in force again
+            for k in trig:
+                self._unread.pop(k, None)
         values = self.values
         inputs = {k: values[k] for k in self._in_keys if values[k] is not None}
         if len(inputs) < len(self._in_keys):

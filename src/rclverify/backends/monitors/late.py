@@ -63,6 +63,8 @@ class Late:
         message of the node stamped later: raised at its stamp (module docstring)."""
         stream, values = self.stream, self.values
         mine = {k: values[k] for k in trig}
+        # an unreadable message stamped after it is still the one in force: what reads it after is undecided
+        unread = {k: u[1] for k in trig for u in (self._unread.get(k),) if u is not None and u[0] > stamp}
         kept = stream._questions
         last = kept[-1] if kept else None
         first = stream._stamps[0] if kept else float("inf")
@@ -81,6 +83,7 @@ class Late:
             self._verdict("inconclusive", ev, reason=f"the input at {ev.where}, stamped {stamp:.9g} s, was heard "
                           "after messages stamped later, and the questions before its stamp are no longer kept: "
                           "it cannot be put in its place, and the outputs after it were judged without it")
+            self.invalid.update(unread)
             return
         inputs = dict(before.inputs) if before is not None else self._inputs_at(stamp)
         inputs.update({k: v for k, v in mine.items() if v is not None})
@@ -95,6 +98,7 @@ class Late:
             self._place(ev, stamp, inputs, trig, tainted, upto)
         for j, (t, e, got, kinds) in enumerate(completed):  # each before the next is put (what it answers)
             self._place(e, t, got, kinds, [], completed[j + 1][:2] if j + 1 < len(completed) else None)
+        self.invalid.update(unread)
 
     def _inputs_at(self, stamp: float) -> dict[str, Any]:
         """Before the first question: the inputs as the messages stamped at or before ``stamp`` set them."""
