@@ -61,7 +61,7 @@ def _path(ros_type: str, var: str, topic: str, rules: Mapping[str, Any]) -> str:
         return field_name(var.split(".", 1)[1])
     if pkg == "std_msgs" and cls in STD_DATA:
         return "data"
-    fields = getattr(rules.get(topic.lstrip("/")), "fields", ())
+    fields = list(getattr(rules.get(topic.lstrip("/")), "fields", ()))
     return fields[0] if len(fields) == 1 else ""
 
 
