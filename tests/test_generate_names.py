@@ -439,6 +439,7 @@ def test_the_name_rules() -> None:
     assert py_name("class") == "class_" and py_name("x'") == "x_prime" and py_name("__debug__") == "__debug___"
     assert package_name("class") == "class_node" and package_name("string") == "string_node"
     assert package_name("A") == "a_node" and package_name("RadiationSensor") == "radiation_sensor"
+    assert package_name("StdMsgs") == "std_msgs_node" and package_name("rclpy") == "rclpy_node"
     assert msg_name("none") == "NoneMsg" and msg_name("T'") == "TPrime"
     assert constant_name("null") == "NULL_VALUE" and constant_name("RadStat", "red'") == "RAD_STAT_RED_PRIME"
     rosidl = re.compile(r"^(?!.*__)(?!.*_$)[a-z][a-z0-9_]*$")

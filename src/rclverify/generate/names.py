@@ -80,9 +80,16 @@ SIGINT SIGTERM SIGKILL SIGABRT SIGSEGV SIGFPE SIGILL BIG_ENDIAN LITTLE_ENDIAN BY
 #: words no rosidl field (nor the C++ struct field of a node's Inputs/Outputs) may be
 FIELD_RESERVED = PY_RESERVED | CPP_KEYWORDS | C_KEYWORDS | C_MACROS_LOWER
 
+#: Interface packages every ROS 2 distribution ships: their types are used, never generated.
+STANDARD_PACKAGES = frozenset({
+    "std_msgs", "geometry_msgs", "sensor_msgs", "nav_msgs", "builtin_interfaces", "action_msgs", "std_srvs",
+    "diagnostic_msgs", "shape_msgs", "stereo_msgs", "trajectory_msgs", "visualization_msgs", "tf2_msgs",
+    "example_interfaces", "unique_identifier_msgs", "rcl_interfaces", "lifecycle_msgs", "statistics_msgs"})
+
 #: ROS packages the generated packages import or depend on, besides the standard interface packages
 ROS_PACKAGES = frozenset("rclpy rclcpp rclcpp_action launch launch_ros ament_cmake ament_index_python "
-                         "rosidl_default_generators rosidl_default_runtime setuptools resource".split())
+                         "rosidl_default_generators rosidl_default_runtime setuptools resource rclverify"
+                         .split()) | STANDARD_PACKAGES
 
 #: names a node's package cannot take: it is a Python package, a C++ namespace and an executable
 PACKAGE_RESERVED = FIELD_RESERVED | frozenset(sys.stdlib_module_names) | ROS_PACKAGES

@@ -23,11 +23,8 @@ from ..rcl.types import DataT, EmptyT, EnumT, FuncT, Scalar, SeqT, SetT, TupleT,
 SCALARS: dict[str, str] = {"REAL": "float64", "INTEGER": "int64", "NATURAL": "uint64", "BOOL": "bool",
                            "STRING": "string"}
 
-#: Interface packages every ROS 2 distribution ships: their types are used, never generated.
-STANDARD_PACKAGES = frozenset({
-    "std_msgs", "geometry_msgs", "sensor_msgs", "nav_msgs", "builtin_interfaces", "action_msgs", "std_srvs",
-    "diagnostic_msgs", "shape_msgs", "stereo_msgs", "trajectory_msgs", "visualization_msgs", "tf2_msgs",
-    "example_interfaces", "unique_identifier_msgs", "rcl_interfaces", "lifecycle_msgs", "statistics_msgs"})
+#: Interface packages every ROS 2 distribution ships (their types are used, never generated)
+STANDARD_PACKAGES = names.STANDARD_PACKAGES
 
 
 #: the name rules live in :mod:`.names` (one module for every generated name)
