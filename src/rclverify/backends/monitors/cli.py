@@ -26,6 +26,7 @@ from .check import check_trace
 from .deadlines import DeadlineMonitor, deadline_status, has_deadlines
 from .config import ConfigError, load_mapping
 from .judged import Counted, Heard, explain, not_judged, strict_line
+from .log_calls import LogCalls
 from .periods import PeriodMonitor, has_periods, period_status
 
 
@@ -69,6 +70,7 @@ def monitor_command(args: argparse.Namespace, checked: Checked) -> int:
         # one pass over the run feeds both checks (a log named here may be a stream, read once)
         dmons = [DeadlineMonitor(checked, n, cfg.rules, horizon=cfg.horizon, tolerance=cfg.tolerance) for n in timed]
         pmons = [PeriodMonitor(n) for n in nodes if has_periods(n)]
+        calls = LogCalls(checked, nodes, cfg.rules, cfg.horizon, trace)  # a live log's calls (log_calls.py)
         heard: dict[str, int] = {}
 
         def tap(events: Iterable[Any]) -> Iterator[Any]:
@@ -82,10 +84,12 @@ def monitor_command(args: argparse.Namespace, checked: Checked) -> int:
             run = read_trace(path, [root / d for d in cfg.msg_dirs], streams=True,
                              on_warning=lambda w: print(w, file=sys.stderr))
             source = tap(run) if dmons or pmons else run  # untapped, a log keeps its columnar reading (batch path)
+            source = calls.tap(source) if calls.active else source  # only nodes with links: never the batch path
             events, results = check_trace(checked, nodes, Counted(source, heard), cfg.rules, cfg.horizon,
                                           tolerance=cfg.tolerance)
             dres = [m.finish() for m in dmons]
             pres = [p.finish() for p in pmons]
+            summary = calls.finish()
         except TraceError as exc:
             _emit(report, args.json)
             print(str(exc), file=sys.stderr)
@@ -95,7 +99,16 @@ def monitor_command(args: argparse.Namespace, checked: Checked) -> int:
             print(f"{trace}: error: the trace could not be checked: {type(exc).__name__}: {exc}", file=sys.stderr)
             return 2
         statuses = {res.node: [verdict_status(res, trace)] for res in results}
-        items = not_judged(nodes, Heard(heard), statuses, {d.node: d.counts for d in dres}, f"in {trace}")
+        centries, dentries = calls.entries(), calls.deadline_entries()
+        for c in centries:
+            statuses.setdefault(c["node"], []).append((c["status"], c["explanation"]))
+        dcounts = {d.node: dict(d.counts) for d in dres}
+        for r in calls.deadlines():  # the topic and the call deadlines summed, as the live run does
+            total = dcounts.setdefault(r.node, {})
+            for v, k in r.counts.items():
+                total[v] = total.get(v, 0) + k
+        items = not_judged(nodes, Heard({**heard, **calls.messages}, dict(calls.orphans)), statuses, dcounts,
+                           f"in {trace}")
         unjudged += items
         for res in results:
             status, explanation = verdict_status(res, trace)
@@ -128,10 +141,30 @@ def monitor_command(args: argparse.Namespace, checked: Checked) -> int:
                            "periods": pr.to_json()})
             if not args.json:
                 print(f"{trace}: {pr.node} periods: {status}: {explanation}")
+        if summary is not None:
+            violated = _report_calls(report, centries + dentries, summary, calls.missed(), trace,
+                                     args.json) or violated
         if not args.json:
             _print_not_judged(items, f"{trace}: ")
     _emit(report, args.json)
     return 1 if violated else _strict(args, unjudged)
+
+
+def _report_calls(report: list[dict[str, Any]], entries: list[dict[str, Any]], summary: dict[str, Any],
+                  missed: tuple[int, int], trace: str, as_json: bool) -> bool:
+    """Add a live log's call verdicts per node and its call deadlines to
+    ``report`` and print them as the live run does; returns whether one
+    failed (a violated call, a missed call deadline)."""
+    failed = False
+    for e in entries:
+        e["call_counts"] = summary["counts"]
+        failed = failed or e["status"] == "failed"
+        report.append(e)
+        if not as_json and "calls" in e:
+            print(f"{trace}: calls: {e['node']}: {e['status']}: {e['explanation']}")
+    if not as_json:
+        print(f"{trace}: deadlines: {missed[0]} of {missed[1]} judged call(s) or goal(s) missed their deadline")
+    return failed or missed[0] > 0
 
 
 def _print_not_judged(items: list[dict[str, str]], prefix: str) -> None:

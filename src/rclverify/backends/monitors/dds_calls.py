@@ -53,7 +53,7 @@ from .check import NodeMonitor, NodeResult, Verdict
 from .deadlines import DeadlineMonitor, DeadlineResult, DeadlineVerdict
 from .verdicts import LINK_TOPICS
 
-#: the ``topic`` of a call's log lines: no contract names it, so ``rclverify monitor LOG`` skips them
+#: the ``topic`` of a call's log lines: no contract names it; ``rclverify monitor LOG`` replays them (:func:`replay`)
 CALL_LOG_TOPIC = "rclverify/call"
 #: seconds an unanswered call is kept after its horizon and deadlines passed (a late answer still shown)
 LINGER_S = 10.0
@@ -305,28 +305,45 @@ def _add(total: NodeResult, one: NodeResult) -> None:
     total.first_inconclusive = total.first_inconclusive or one.first_inconclusive
 
 
+def replay_line(book: CallBook, x: Mapping[str, Any]) -> None:
+    """Give ``book`` one line of a live log (a JSON object: ``topic``,
+    ``time`` in s, the line's keys), as the live call book wrote it: a line
+    that is not a call line (``kind`` ``"call"``) is ignored.  A line with an
+    ``index`` opens its call (a request or a goal) or answers it; a ``tick``
+    line (written where a live tick decided something) moves the clock as the
+    live timer did; an ``unpaired`` line leaves its call inconclusive with the
+    live reason; a ``rejected`` line closes its goal as the live book did; an
+    ``orphan`` answer (no call of its identity was open) is counted.  Raises
+    ``KeyError``, ``TypeError`` or ``ValueError`` for a call line missing its
+    keys (a log not written by the monitor)."""
+    if x.get("kind") != "call":
+        return
+    part = str(x.get("part"))
+    if part == "tick":
+        book.tick(float(x["time"]))
+    elif x.get("unpaired"):
+        book.unpaired(tuple(x["key"]), float(x["time"]), str(x["reason"]), part)
+    elif part == "rejected":
+        book.reject(tuple(x["key"]), float(x["time"]))
+    elif "index" in x:
+        name, key = str(x["link"]), tuple(x["key"])
+        if part in ("request", "goal"):
+            book.open(name, key, str(x["where"]).rsplit(" ", 1)[0], x["fields"], float(x["time"]), part)
+        else:
+            book.answer(key, part, x["fields"], float(x["time"]), part != "feedback", name)
+    elif x.get("orphan") and str(x.get("link", "")).strip("/") in book.links:
+        book.counts["orphan_answers"] += 1  # live, no call of its identity was open: nothing to feed
+
+
 def replay(book: CallBook, lines: Iterable[Mapping[str, Any]]) -> dict[str, Any]:
-    """Run ``book`` over a live log's call lines in order and finish it: the
-    offline check of a live run's calls.  A line with an ``index`` opens its
-    call (a request or a goal) or answers it; a ``tick`` line (written where
-    a live tick decided something) moves the clock as the live timer did, so
-    a deadline that expired before its late answer arrived expires here too,
-    with the same clock in its reason."""
+    """Run ``book`` over a live log's lines in order (:func:`replay_line`)
+    and finish it: the offline check of a live run's calls, its summary as
+    :meth:`CallBook.finish`.  A deadline that expired live before its late
+    answer arrived expires here too (the ``tick`` lines), with the same clock
+    in its reason."""
     for x in lines:
-        if x.get("kind") != "call":
-            continue
-        part = str(x.get("part"))
-        if part == "tick":
-            book.tick(float(x["time"]))
-        elif x.get("unpaired"):
-            book.unpaired(tuple(x["key"]), float(x["time"]), str(x["reason"]), part)
-        elif "index" in x:
-            name, key = str(x["link"]), tuple(x["key"])
-            if part in ("request", "goal"):
-                book.open(name, key, str(x["where"]).rsplit(" ", 1)[0], x["fields"], float(x["time"]), part)
-            else:
-                book.answer(key, part, x["fields"], float(x["time"]), part != "feedback", name)
+        replay_line(book, x)
     return book.finish()
 
 
-__all__ = ["CALL_LOG_TOPIC", "CallBook", "LINGER_S", "link_view", "replay"]
+__all__ = ["CALL_LOG_TOPIC", "CallBook", "LINGER_S", "link_view", "replay", "replay_line"]
