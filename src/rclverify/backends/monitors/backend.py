@@ -32,6 +32,7 @@ from .check import check_trace
 from .config import ConfigError, MonitorConfig, load_mapping
 from .deadlines import DeadlineMonitor, DeadlineResult, deadline_status, has_deadlines
 from .judged import Counted, Heard, explain, not_judged
+from .log_calls import LogCalls, merge_deadlines
 from .periods import PeriodMonitor, has_periods, with_periods
 from .rml import Spec, rml_id, translate
 from .summary import monitoring_details, summary_line, tool_versions, verdict_status
@@ -200,12 +201,16 @@ class MonitorsBackend:
                                                             horizon=cfg.horizon, tolerance=cfg.tolerance))
         if has_periods(target.node):  # periodic outputs on the same run (periods.py)
             beside.add("periods", lambda: PeriodMonitor(target.node))
+        # a live log's service calls and action goals, judged as the live run judged them (log_calls.py)
+        calls = LogCalls(target.checked, [target.node], cfg.rules, cfg.horizon, trace)
         try:
             span = TraceSpan()  # the run's duration in trace time (the strength's detail, docs/confidence.md)
             heard: dict[str, int] = {}  # events per topic: what the run did not judge (judged.py)
+            source = read_trace(target.root / trace, [target.root / d for d in cfg.msg_dirs])
             events, results = check_trace(target.checked, [target.node], Counted(span.tap(beside.tap(
-                read_trace(target.root / trace, [target.root / d for d in cfg.msg_dirs]))), heard),
-                cfg.rules, cfg.horizon, tolerance=cfg.tolerance)
+                calls.tap(source) if calls.active else source)), heard), cfg.rules, cfg.horizon,
+                tolerance=cfg.tolerance)
+            summary = calls.finish()
         except TraceError as exc:
             return evidence("error", f"the trace could not be read: {exc}", log=str(exc))
         except Exception as exc:  # a recorded run is user input: whatever the checker meets is this record's error
@@ -221,14 +226,23 @@ class MonitorsBackend:
             if err is not None:
                 return evidence("error", f"the {name} could not be checked: {type(err).__name__}: {err}",
                                 log=str(err))
+        if summary is not None:  # the node's calls beside its topics; their deadlines with its topics' ones
+            status, explanation, extra = with_calls(calls.entries(), summary, status, explanation)
+            (cdl,) = calls.deadlines() or (None,)
+            merged = merge_deadlines(finished.get("deadlines"), cdl)
+            if merged is not None:
+                finished["deadlines"] = merged
         if "deadlines" in finished:
-            status, explanation, extra = with_deadlines(target, finished["deadlines"], trace, status, explanation)
+            status, explanation, more = with_deadlines(target, finished["deadlines"], trace, status, explanation)
+            extra.update(more)
         if "periods" in finished:
             status, explanation, more = with_periods(finished["periods"], trace, status, explanation)
             extra.update(more)
         dl = finished.get("deadlines")
         # silence is never green: what the run did not judge, with the reason, beside the status
-        extra["not_judged"] = items = not_judged([target.node], Heard(heard), {res.node: [(status, explanation)]},
+        extra["not_judged"] = items = not_judged([target.node], Heard({**heard, **calls.messages},
+                                                                      dict(calls.orphans)),
+                                                 {res.node: [(status, explanation)]},
                                                  {dl.node: dl.counts} if dl is not None else {}, f"in {trace}")
         entry = {"node": res.node, "status": status, "explanation": explanation}
         explain(entry, items)  # a pending record says why itself
@@ -278,6 +292,23 @@ class _Beside:
             except Exception as exc:  # noqa: BLE001
                 self.errors[name] = exc
         return out
+
+
+def with_calls(entries: list[dict[str, Any]], summary: dict[str, Any], status: str,
+               explanation: str) -> tuple[str, str, dict[str, Any]]:
+    """The untimed verdict on the node's topics combined with its calls'
+    (``entries``: :meth:`~.log_calls.LogCalls.entries`, at most one for one
+    node): a ``pending`` side leaves the verdict to the other, else the worse
+    status wins; returns ``(status, explanation, {"calls": ...})`` (the
+    node's call result and the log's call counts)."""
+    if not entries:
+        return status, explanation, {"calls": {"counts": summary["counts"]}}
+    (e,) = entries
+    rank = {"discharged": 0, "pending": 1, "inconclusive": 2, "failed": 3}
+    worse = (e["status"] if status == "pending" else status if e["status"] == "pending" else
+             max(status, e["status"], key=lambda s: rank.get(s, 0)))
+    return worse, f"calls: {e['explanation']}; topics: {explanation}", {
+        "calls": {"counts": summary["counts"], **e["calls"], "status": e["status"]}}
 
 
 def with_deadlines(target: NodeTarget, res: DeadlineResult, trace: str, status: str,
