@@ -27,6 +27,9 @@ monitor watches it:
   runs): each goal is judged, the second violated, and the cancel request
   and reply are logged with the goal's id.
 
+The live log, read back by ``rclverify monitor LOG``, gives the same call verdicts, call deadlines, items
+not judged and exit code as the live run (issue 62: live = offline).
+
 A second monitor, told the wrong middleware (``RMW_IMPLEMENTATION=rmw_cyclonedds_cpp``),
 names each Fast DDS writer of ``/estop`` whose calls it cannot read, and exits 1 under ``--strict``.
 """
@@ -333,3 +336,48 @@ def test_a_monitor_told_the_wrong_middleware_says_so(run: dict[str, Any]) -> Non
     assert not wrong["record"]["calls"]["nodes"] and wrong["record"]["calls"]["counts"]["calls"] == 0
     items = {i["name"]: i["reason"] for i in wrong["record"]["not_judged"] if i["kind"] == "service"}
     assert set(items) == {"/estop"} and wrong["code"] == 1, (items, wrong["out"])
+
+
+def _offline(run: dict[str, Any], *extra: str) -> tuple[int, list[dict[str, Any]]]:
+    """``rclverify monitor LOG`` on the live run's log (in this process)."""
+    import contextlib
+    import io
+
+    from rclverify.cli import main
+    out = io.StringIO()
+    with contextlib.redirect_stdout(out):
+        code = main(["monitor", "-w", str(run["ws"]), "--mapping", "mapping.yaml", "--horizon", "1.0", "--json",
+                     *extra, str(run["tmp"] / "live.jsonl")])
+    return code, json.loads(out.getvalue())
+
+
+def test_the_offline_command_on_the_live_log_judges_the_calls_as_the_live_run(run: dict[str, Any]) -> None:
+    """Issue 62, live = offline, the converse: ``rclverify monitor LOG`` reads the live log's call lines
+    through the same call book: the same call verdicts per node, the same call deadlines, the same exit
+    code, the same items not judged (``--strict`` too)."""
+    record = run["record"]
+    code, report = _offline(run)
+    calls = {e["node"]: e for e in report if "calls" in e}
+    assert {n: e["calls"]["counts"] for n, e in calls.items()} == \
+        {n["node"]: n["counts"] for n in record["calls"]["nodes"]}
+    assert {n: e["status"] for n, e in calls.items()} == {n["node"]: n["status"] for n in record["calls"]["nodes"]}
+    assert all(e["call_counts"] == record["calls"]["counts"] for e in calls.values())
+    dls = {e["node"]: e["call_deadlines"] for e in report if "call_deadlines" in e}
+    assert {n: (d["counts"], d["unaccepted"]) for n, d in dls.items()} == \
+        {r["node"]: (r["counts"], r["unaccepted"]) for r in record["deadlines"]["results"]}
+    assert sum(d["counts"]["false"] for d in dls.values()) == record["deadlines"]["false"] == 2
+    # Brake's call that could not be paired stays inconclusive with the live reason
+    assert calls["Brake"]["calls"]["first_inconclusive"]["reason"] == \
+        next(n for n in record["calls"]["nodes"] if n["node"] == "Brake")["first_inconclusive"]["reason"]
+    assert code == run["code"] == 1
+    items = sorted((i["kind"], i["name"], i["reason"]) for e in report for i in e.get("not_judged", []))
+    live_items = sorted((i["kind"], i["name"], i["reason"]) for i in record["not_judged"])
+    assert sorted(set(items)) == live_items, (items, live_items)
+    # judged by their calls: no item names them; /brake's two concurrent calls are "not paired", as live
+    assert [i for i in items if i[1] in ("Base", "Brake", "Lamp", "Fib", "/estop", "/brake", "/lamp", "/fib")] == \
+        [("service", "/brake", "not paired")], items
+    assert _offline(run, "--strict")[0] == 1
+    # Brake alone: nothing violated (its unpaired call is inconclusive), so 0; --strict: 1 for its unpaired link
+    code, report = _offline(run, "--node", "Brake")
+    assert [e["status"] for e in report if "calls" in e] == ["inconclusive"] and code == 0, report
+    assert _offline(run, "--node", "Brake", "--strict")[0] == 1
