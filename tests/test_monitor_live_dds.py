@@ -285,3 +285,17 @@ def test_live_verdicts_equal_the_offline_engines(run: dict[str, Any], capsys: py
     assert {r["node"]: r["counts"] for r in summary["nodes"]} == \
         {n["node"]: n["counts"] for n in run["record"]["calls"]["nodes"]}
     assert summary["false"] == run["record"]["deadlines"]["false"]
+
+
+def test_the_offline_command_on_the_live_log_judges_its_calls_as_live(run: dict[str, Any],
+                                                                      capsys: pytest.CaptureFixture[str]) -> None:
+    """``rclverify monitor LOG`` replays the log's call lines through the call book (log_calls.py): the
+    live run's call verdicts, call deadlines and exit code."""
+    capsys.readouterr()
+    code = main(["monitor", "-w", str(WS), "--horizon", "1.0", "--json", str(run["tmp"] / "live.jsonl")])
+    report = json.loads(capsys.readouterr().out)
+    assert {e["node"]: e["calls"]["counts"] for e in report if "calls" in e} == \
+        {n["node"]: n["counts"] for n in run["record"]["calls"]["nodes"]}
+    assert {e["node"]: e["call_deadlines"]["counts"] for e in report if "call_deadlines" in e} == \
+        {r["node"]: r["counts"] for r in run["record"]["deadlines"]["results"]}
+    assert code == run["code"] == 1
