@@ -2,7 +2,12 @@
 ``rclverify monitor --live``: monitor the running ROS 1 system, or with
 ``--ros2`` the ROS 2 system over DDS (:mod:`.dds_live`).
 
-Exit status: 0 when no contract is violated, 1 when one is, 2 for a trace
+A live ROS 2 run's log named as a TRACE has its service calls and action
+goals judged as the live run judged them (its call lines replayed through
+the live call book, :mod:`.log_calls`).
+
+Exit status: 0 when no contract is violated, 1 when one is (a message, a
+call, a deadline), 2 for a trace
 or configuration that cannot be read (a located message on stderr; the
 verdicts of the traces already checked are printed first) or when ROS 1
 or ROS 2's DDS domain cannot be reached in ``--live`` mode.  With
