@@ -93,6 +93,20 @@ class Counted:
             yield block
 
 
+def count_call_line(obj: Mapping[str, Any], messages: dict[str, int], orphans: dict[str, int]) -> None:
+    """Count one call line of a live log (``kind`` ``"call"``, the DDS call
+    book's) as the live run counts what it heard: a paired part (a line with
+    an ``index``) into ``messages``, an answer heard without its call
+    (``orphan``) into ``orphans``, both keyed ``"<link>/<part>"`` (no leading
+    ``/``); other lines are not counted."""
+    if obj.get("kind") != "call" or obj.get("link") is None:
+        return
+    key = f"{str(obj['link']).strip('/')}/{obj.get('part')}"
+    book = messages if "index" in obj else orphans if obj.get("orphan") else None
+    if book is not None:
+        book[key] = book.get(key, 0) + 1
+
+
 def not_judged(nodes: Iterable[CheckedNode], heard: Heard, statuses: Mapping[str, Iterable[tuple[str, str]]],
                deadlines: Mapping[str, Mapping[str, int]], where: str) -> list[dict[str, str]]:
     """The items of ``nodes``' contracts the run did not judge (module docstring).
@@ -221,4 +235,4 @@ def strict_line(items: list[dict[str, str]]) -> str:
             f"{first['name']}: {first['reason']}: {first['detail']}")
 
 
-__all__ = ["Counted", "Heard", "REASONS", "explain", "not_judged", "strict_line"]
+__all__ = ["Counted", "Heard", "REASONS", "count_call_line", "explain", "not_judged", "strict_line"]

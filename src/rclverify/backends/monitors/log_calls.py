@@ -28,6 +28,7 @@ from ...traces.events import Event, TraceError
 from ...traces.mapping import TopicRule
 from .dds_calls import CALL_LOG_TOPIC, CallBook, replay_line
 from .deadlines import DeadlineResult, deadline_status
+from .judged import count_call_line
 from .summary import verdict_status
 from .verdicts import NodeResult
 
@@ -78,12 +79,7 @@ class LogCalls:
             raise TraceError(f"{self.trace}:{lineno}:1: error: a call line of the live monitor that cannot be "
                              f"replayed ({type(exc).__name__}: {exc})") from None
         self.lines += 1
-        link = line.get("link")
-        if link is not None:  # what the live run counted (live.py, judged.py)
-            key = f"{str(link).strip('/')}/{line.get('part')}"
-            book = self.messages if "index" in line else self.orphans if line.get("orphan") else None
-            if book is not None:
-                book[key] = book.get(key, 0) + 1
+        count_call_line(line, self.messages, self.orphans)  # what the live run counted as heard
 
     def finish(self) -> dict[str, Any] | None:
         """The book's summary (:meth:`~.dds_calls.CallBook.finish`), ``None``
