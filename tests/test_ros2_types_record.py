@@ -130,7 +130,7 @@ for k in range({N}):
                                 array_of_wstrings=["a", "\u00fc", str(k)], unbounded_sequence_of_wstrings=["x"] * (k % 3)))
     time.sleep(0.02)
 print("done", flush=True)
-while True:
+while rclpy.ok():  # rclpy's own SIGTERM handler shuts the context down: then this process ends
     time.sleep(0.1)
 """
 
