@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import importlib.util
 import inspect
+import os
 import sys
 from contextlib import contextmanager
 from dataclasses import dataclass, field
@@ -130,9 +131,11 @@ def load_implementation(root: Path, cfg: Config) -> Any:
     path = (root / cfg.file).resolve()
     from .closure import import_closure
     closure = {(root / f).resolve() for f in import_closure(root, cfg.file)[0]}
+    names = {p.name for p in closure}
     for name, mod in list(sys.modules.items()):  # the workspace modules it imports, afresh too (a long-lived process)
         where = getattr(mod, "__file__", None)
-        if where and Path(where).resolve() in closure:
+        # the file name first: resolving every loaded module's path cost seconds per run
+        if where and os.path.basename(where) in names and Path(where).resolve() in closure:
             del sys.modules[name]
     modname = f"rclverify_impl_{abs(hash(str(path)))}"
     spec = importlib.util.spec_from_file_location(modname, path)
