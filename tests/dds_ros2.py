@@ -53,14 +53,37 @@ CONFIG = """<?xml version="1.0" encoding="UTF-8"?>
 SERVICE_QOS = QosProfile(reliable=True, durability="volatile", depth=10)  # rmw_qos_profile_services_default
 
 
+_HELD: list[int] = []  # the lock files of the domains this process took, open until it exits
+
+
+def _free_domain() -> int:
+    """A ``ROS_DOMAIN_ID`` (1..230) that no other test process on this machine
+    holds and this one has not used before: each is taken with an exclusive
+    lock on a file of the temporary directory, held until the process exits
+    (two test workers that drew one domain heard each other's nodes)."""
+    import fcntl
+    import tempfile
+    for d in random.SystemRandom().sample(range(1, 231), 230):
+        fd = os.open(os.path.join(tempfile.gettempdir(), f"rclverify-test-dds-domain-{d}.lock"), os.O_CREAT | os.O_RDWR)
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError:
+            os.close(fd)
+            continue
+        _HELD.append(fd)
+        return d
+    raise RuntimeError("no free DDS domain for the test: all 230 are held")
+
+
 def dds_env(tmp: Path) -> dict[str, str]:
     """``CYCLONEDDS_URI`` (a loopback-only configuration written in ``tmp``),
-    a random ``ROS_DOMAIN_ID`` (1..230) and ``RMW_IMPLEMENTATION=rmw_cyclonedds_cpp``
-    (the wire form of these participants' services, which the monitor reads by it)."""
+    a ``ROS_DOMAIN_ID`` of its own (:func:`_free_domain`) and
+    ``RMW_IMPLEMENTATION=rmw_cyclonedds_cpp`` (the wire form of these
+    participants' services, which the monitor reads by it)."""
     cfg = tmp / "cyclonedds.xml"
     cfg.write_text(CONFIG)
     # the participants here speak rmw_cyclonedds' wire form: the monitor is told so as a user would
-    return {"CYCLONEDDS_URI": cfg.as_uri(), "ROS_DOMAIN_ID": str(random.SystemRandom().randint(1, 230)),
+    return {"CYCLONEDDS_URI": cfg.as_uri(), "ROS_DOMAIN_ID": str(_free_domain()),
             "RMW_IMPLEMENTATION": "rmw_cyclonedds_cpp"}
 
 
