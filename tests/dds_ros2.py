@@ -142,9 +142,9 @@ class Ros2Participant:
         self.entities.append(r)
         return r
 
-    def publisher(self, node: NodeInfo, topic: str, msg_type: str, reliable: bool = True) -> Any:
+    def publisher(self, node: NodeInfo, topic: str, msg_type: str, reliable: bool = True, depth: int = 10) -> Any:
         return self.writer(node, topic_name(topic), self.types.message(msg_type),
-                           QosProfile(reliable=reliable, depth=10))
+                           QosProfile(reliable=reliable, depth=depth))
 
     def subscriber(self, node: NodeInfo, topic: str, msg_type: str, reliable: bool = True) -> Any:
         return self.reader(node, topic_name(topic), self.types.message(msg_type), QosProfile(reliable=reliable,

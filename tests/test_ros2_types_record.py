@@ -190,13 +190,14 @@ def run(tmp_path_factory: pytest.TempPathFactory) -> Iterator[dict[str, Any]]:
             wait_for(tmp / f"{name}.out", "monitoring", 30)
         configure_domain(domain_of(env))  # as the monitor's: Fast DDS's type information read without complaint
         cyclone = Ros2Participant(TypeBook([ws / "interfaces"]), domain_of(env))
-        right = cyclone.publisher(cyclone.node("right"), "/mislaid", "test_msgs/Nested")
+        # a history as deep as the run: on a loaded machine a reader's acknowledgement can lag ten samples
+        right = cyclone.publisher(cyclone.node("right"), "/mislaid", "test_msgs/Nested", depth=N)
         cyclone.announce()
         wait_until(lambda: matched(right) >= 2, 20, "the monitors' readers of /mislaid matched")
         Nested = cyclone.types.message("test_msgs/Nested")
         for k in range(N):
             right.write(Nested(x=float(k)))
-            time.sleep(0.005)  # the writer keeps the last 10: paced, none is replaced before it is acknowledged
+            time.sleep(0.005)
         system = start_node(tmp, "system", SYSTEM, env)
         wait_for(tmp / "system.log", "done", 40)
         time.sleep(0.5)  # the last messages reach the monitors
