@@ -114,13 +114,19 @@ def test_mean_plus_two_std_is_exact() -> None:
     assert evaluate(_crit("mean + 2 * std <= tolerance"), fig, above).holds is True  # type: ignore[arg-type]
 
 
+#: the text of the Navigation's guarantee 1 (contracts/remote_inspection.rcl), as rclverify prints it
+NAVIGATION_G1 = ("forall(x, y in REAL | in.command == move(x, y) and in.position(x, y) == TRUE <=> "
+                 "out.at(x, y) == TRUE)")
+
+
 def test_per_trial_data_end_to_end_with_plot(ws: Workspace) -> None:
     root = ws.root
     (root / "backends/experiment/runs.csv").write_text("trial,error\n1,10\n2,12\n3,9\n", encoding="utf-8")
     replace_in_plan(root, "summary: backends/experiment/navigation.yaml\n        constants: {tolerance: 25 cm}\n"
                     "        criterion: \"worst <= tolerance\"",
                     "data: backends/experiment/runs.csv\n        column: error\n        unit: cm\n"
-                    "        constants: {tolerance: 25 cm}\n        criterion: \"error <= tolerance\"")
+                    "        constants: {tolerance: 25 cm}\n        criterion: \"error <= tolerance\"\n"
+                    f"        answers: \"{NAVIGATION_G1}\"")
     ev = run_navigation(Workspace(root))[E0]
     assert ev.status == "discharged", ev.explanation  # type: ignore[attr-defined]
     svg = root / ev.details["plot"]  # type: ignore[attr-defined]
@@ -172,3 +178,27 @@ def test_division_by_a_zero_figure_is_undecided_not_failed() -> None:
     fig = load_summary("count: 3\nmean: 0 cm\nstd: 0 cm\nbest: 0 cm\nworst: 0 cm\n", "z.yaml")
     v = evaluate(_crit("worst / mean <= 2"), fig, {})  # type: ignore[arg-type]
     assert v.holds is None
+
+
+def test_experiments_support_one_text_not_a_guarantee_number(ws: Workspace) -> None:
+    """Issue 63: an experiment judged good supports the guarantee text its
+    plan entry names (``answers:``); without one it discharges nothing, and
+    once the guarantee reads otherwise it is stale."""
+    root = ws.root
+    (root / "backends/experiment/runs.csv").write_text("trial,error\n1,10\n2,12\n3,9\n", encoding="utf-8")
+    data = ("data: backends/experiment/runs.csv\n        column: error\n        unit: cm\n"
+            "        constants: {tolerance: 25 cm}\n        criterion: \"error <= tolerance\"")
+    replace_in_plan(root, "summary: backends/experiment/navigation.yaml\n        constants: {tolerance: 25 cm}\n"
+                    "        criterion: \"worst <= tolerance\"", data)
+    ev = run_navigation(Workspace(root))[E0]
+    assert ev.status == "pending" and "does not say which text of guarantee 1" in ev.explanation  # type: ignore[attr-defined]
+    assert f'answers: "{NAVIGATION_G1}"' in ev.explanation  # type: ignore[attr-defined]
+    replace_in_plan(root, data, data + f'\n        answers: "{NAVIGATION_G1}"')
+    assert run_navigation(Workspace(root))[E0].status == "discharged"  # type: ignore[attr-defined]
+    rcl = root / "contracts/remote_inspection.rcl"
+    text = rcl.read_text(encoding="utf-8")
+    assert text.count("out.at(x, y) == TRUE)") == 1
+    rcl.write_text(text.replace("out.at(x, y) == TRUE)", "out.at(x, y) == TRUE and in.command == move(x, y))"),
+                   encoding="utf-8")
+    ev = run_navigation(Workspace(root))[E0]
+    assert ev.status == "stale" and "the experiments support 'forall(x, y in REAL" in ev.explanation  # type: ignore[attr-defined]

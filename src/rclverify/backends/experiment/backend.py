@@ -129,5 +129,13 @@ class ExperimentBackend:
         if flags:
             return evidence("inconclusive", f"the criterion {cfg.criterion_text} holds on the reported figures "
                             f"({figures}), but they establish nothing{flag_text}", **kw)
+        text = expr_to_rcl(target.node.node.guarantees[cfg.guarantee - 1].formula)
+        if cfg.answers is None:  # bound to a number only: the text may have changed under it (issue 63)
+            return evidence("pending", f"the criterion {cfg.criterion_text} holds on the data in {cfg.file} "
+                            f"({figures}), but the plan entry does not say which text of guarantee {cfg.guarantee} "
+                            f"the experiments support: add answers: \"{text}\" if they support it", **kw)
+        if " ".join(cfg.answers.split()) != " ".join(text.split()):
+            return evidence("stale", f"the experiments support {cfg.answers.strip()!r}; guarantee {cfg.guarantee} now "
+                            f"reads {text!r}: judge the experiments against it again and update answers", **kw)
         return evidence("discharged", f"the criterion {cfg.criterion_text} holds on the data in {cfg.file}: {figures}",
                         **kw)

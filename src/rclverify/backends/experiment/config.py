@@ -4,6 +4,7 @@
 
     - backend: experiment
       guarantee: 1                       # the guarantee the experiments support
+      answers: "<the guarantee's RCL>"   # the text they support: another text now -> stale
       summary: backends/experiment/navigation.yaml   # summary statistics, or
       # data: runs.csv + column: error + unit: cm    # one row per trial
       better: lower                      # per-trial data: lower is better (default)
@@ -43,6 +44,7 @@ class ExperimentConfig:
     criterion_text: str
     criterion: ast.Expr
     timeout_ms: int
+    answers: str | None = None  # the guarantee text the plan says the experiments support
 
 
 def _err(loc: ast.Loc, msg: str) -> PlanError:
@@ -115,4 +117,8 @@ def read_config(root: Path, config: Mapping[str, Any], guarantees: int, loc: Loc
     timeout = config.get("timeout_ms", 10000)
     if isinstance(timeout, bool) or not isinstance(timeout, int) or timeout <= 0:
         raise _err(loc("timeout_ms"), f"experiment: timeout_ms must be a positive whole number, found {timeout!r}")
-    return ExperimentConfig(g, rel, figures, constants, text_c.strip(), expr, timeout)
+    answers = config.get("answers")
+    if answers is not None and (not isinstance(answers, str) or not answers.strip()):
+        raise _err(loc("answers"), "experiment: answers is the text of the guarantee the experiments support, "
+                   "as RCL (a string)")
+    return ExperimentConfig(g, rel, figures, constants, text_c.strip(), expr, timeout, answers)
