@@ -85,6 +85,31 @@ def rclverify(args: list[str], env: dict[str, str], cwd: Path, log: Path) -> sub
                                 stderr=subprocess.STDOUT, start_new_session=True)
 
 
+def colcon_build(ws: Path, tmp: Path) -> tuple[float, bytes]:
+    """``colcon build`` the packages under ``ws/src`` in the ROS 2 Python
+    (its venv as the CMake and ament prefix); returns (seconds, colcon's
+    output).  Fails the test with colcon's last lines when the build fails."""
+    import time
+    py = ros2_python()
+    venv = py.parent.parent
+    env = ros2_env(tmp)
+    env.update(PATH=f"{py.parent}:{env['PATH']}", CMAKE_PREFIX_PATH=str(venv), AMENT_PREFIX_PATH=str(venv))
+    t0 = time.monotonic()
+    r = subprocess.run([str(py), "-m", "colcon", "build", "--base-paths", "src"], cwd=ws, env=env,
+                       capture_output=True, timeout=300)
+    seconds = time.monotonic() - t0
+    assert r.returncode == 0, r.stdout.decode()[-3000:] + r.stderr.decode()[-3000:]
+    return seconds, r.stdout + r.stderr
+
+
+def install_env(ws: Path, env: dict[str, str]) -> dict[str, str]:
+    """``env`` with what sourcing colcon's ``ws/install/setup.sh`` sets
+    (PYTHONPATH, LD_LIBRARY_PATH, AMENT_PREFIX_PATH, ...)."""
+    dump = subprocess.run(["bash", "-c", ". install/setup.sh && env -0"], cwd=ws, env=env, capture_output=True,
+                          timeout=60, check=True).stdout
+    return dict(kv.split("=", 1) for kv in dump.decode().split("\0") if "=" in kv)
+
+
 def stopping(*procs: subprocess.Popen[bytes]) -> Iterator[None]:
     """A generator for ``contextlib.contextmanager``-style use in fixtures:
     stops every process of ``procs`` when resumed."""

@@ -15,13 +15,11 @@ from __future__ import annotations
 
 import json
 import subprocess
-import time
-from pathlib import Path
 
 import pytest
 
 from _procs import stop, wait_for
-from _ros2 import ros2_env, ros2_python, start_node
+from _ros2 import colcon_build, install_env, ros2_env, ros2_python, start_node
 from rclverify.cli import main
 
 CONTRACT = """\
@@ -126,18 +124,10 @@ rclpy.try_shutdown()
 """
 
 
-def _install_env(ws: Path, env: dict[str, str]) -> dict[str, str]:
-    """``env`` with what sourcing colcon's ``install/setup.sh`` sets (PYTHONPATH, LD_LIBRARY_PATH,
-    AMENT_PREFIX_PATH, ...)."""
-    dump = subprocess.run(["bash", "-c", ". install/setup.sh && env -0"], cwd=ws, env=env, capture_output=True,
-                          timeout=60, check=True).stdout
-    return dict(kv.split("=", 1) for kv in dump.decode().split("\0") if "=" in kv)
-
-
 @pytest.fixture(scope="module")
 def built(tmp_path_factory: pytest.TempPathFactory) -> dict:
     """The contract generated, its logic written, and the tree colcon-built in the ROS 2 Python."""
-    py = ros2_python()
+    ros2_python()  # skips, with the reason, without a ROS 2 Python
     tmp = tmp_path_factory.mktemp("gen2")
     ws = tmp / "ws"
     (ws / "contracts").mkdir(parents=True)
@@ -145,16 +135,9 @@ def built(tmp_path_factory: pytest.TempPathFactory) -> dict:
     (ws / "contracts" / "plan.yaml").write_text("contracts: [contracts/demo.rcl]\n")
     assert main(["generate", "ros2", "-w", str(ws), "-o", str(ws / "src"), "--system", "demo"]) == 0
     (ws / "src" / "doubler" / "doubler" / "logic.py").write_text(LOGIC)
-    venv = py.parent.parent
-    env = ros2_env(tmp)
-    env.update(PATH=f"{py.parent}:{env['PATH']}", CMAKE_PREFIX_PATH=str(venv), AMENT_PREFIX_PATH=str(venv))
-    t0 = time.monotonic()
-    r = subprocess.run([str(py), "-m", "colcon", "build", "--base-paths", "src"], cwd=ws, env=env,
-                       capture_output=True, timeout=300)
-    seconds = time.monotonic() - t0
-    assert r.returncode == 0, r.stdout.decode()[-3000:] + r.stderr.decode()[-3000:]
+    seconds, _output = colcon_build(ws, tmp)
     print(f"colcon build of demo_msgs and doubler: {seconds:.1f} s")
-    return {"ws": ws, "tmp": tmp, "env": _install_env(ws, ros2_env(tmp)), "seconds": seconds}
+    return {"ws": ws, "tmp": tmp, "env": install_env(ws, ros2_env(tmp)), "seconds": seconds}
 
 
 def test_the_generated_package_needs_no_rclverify(built: dict) -> None:
