@@ -19,14 +19,13 @@ import time
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
+sys.path.insert(1, str(Path(__file__).resolve().parents[2]))  # examples/: ros2_recording.serve
 sys.dont_write_bytecode = True
 
-import rclpy  # noqa: E402
 from geometry_msgs.msg import Twist  # noqa: E402
 from rclpy.action import ActionClient, ActionServer  # noqa: E402
 from rclpy.callback_groups import MutuallyExclusiveCallbackGroup, ReentrantCallbackGroup  # noqa: E402
-from rclpy.executors import ExternalShutdownException, MultiThreadedExecutor  # noqa: E402
-from rclpy.node import Node  # noqa: E402
+from ros2_recording import serve  # noqa: E402
 from sensor_msgs.msg import Range  # noqa: E402
 from std_msgs.msg import Bool, Float64  # noqa: E402
 from warehouse_msgs.action import Navigate  # noqa: E402
@@ -245,40 +244,5 @@ def scenario(node, executor):
     return 0
 
 
-def main():
-    roles = sys.argv[1:]
-    rclpy.init()
-    executor = MultiThreadedExecutor(num_threads=4)
-    nodes = []
-    try:
-        if roles == ["scenario"]:
-            node = Node("scenario")
-            nodes.append(node)
-            executor.add_node(node)
-            return scenario(node, executor)
-        waits = []
-        for role in roles:
-            node = Node(role)
-            nodes.append(node)
-            waits.append(NODES[role](node))
-            executor.add_node(node)
-        spinner = threading.Thread(target=lambda: executor.spin(), daemon=True)
-        spinner.start()
-        if not all(w() for w in waits if w is not None):
-            print("the service or action server did not come", flush=True)
-            return 1
-        print("ready", *roles, flush=True)
-        while rclpy.ok():
-            time.sleep(0.2)
-    except (KeyboardInterrupt, ExternalShutdownException):
-        pass
-    finally:
-        executor.shutdown()
-        for node in nodes:
-            node.destroy_node()
-        rclpy.try_shutdown()
-    return 0
-
-
 if __name__ == "__main__":
-    sys.exit(main())
+    sys.exit(serve(NODES, scenario))
