@@ -44,7 +44,7 @@ from ...traces.mapping import TopicRule
 from .summary import monitoring_details, summary_line, tool_versions, verdict_status
 from .check import NodeResult, Verdict
 from .deadlines import DeadlineVerdict
-from .judged import Heard, explain, not_judged
+from .judged import Heard, count_call_line, explain, not_judged
 from .logchecks import LogChecks
 from .online import OnlineEngine
 from .worker import EngineWorker
@@ -167,11 +167,8 @@ class LiveRun:
         if obj.get("kind") == "event" and isinstance(obj.get("topic"), str):
             key = str(obj["topic"]).strip("/")
             self.calls_heard[key] = self.calls_heard.get(key, 0) + 1
-        elif obj.get("kind") == "call" and obj.get("link") is not None:
-            key = f"{str(obj['link']).strip('/')}/{obj.get('part')}"
-            book = self.calls_heard if "index" in obj else self.orphans if obj.get("orphan") else None
-            if book is not None:
-                book[key] = book.get(key, 0) + 1
+        else:
+            count_call_line(obj, self.calls_heard, self.orphans)
 
     def _flush_last(self) -> None:
         """Publish each node's latest verdict (latched), once per timer tick
