@@ -99,7 +99,7 @@ def test_seeded_field_type_mistakes(tmp_path: Path) -> None:
              [("radiation: [value]", "radiation: [header.frame_id]"),
               ("cmd_vel: [linear.x]", "cmd_vel: [linear]")])
     rc, fs = _check(ws)
-    assert rc == 0  # without --strict grounding errors do not fail the command
+    assert rc == 1  # a grounding error fails the command, --strict or not (issue 65)
     got = [(f[0], f[1], f[2], f[3]) for f in fs if f[0] != "ROS-SCAN"]
     assert got == [
         ("ROS-FIELD-TYPE", "contracts/rover.rcl:11", "src/rover_msgs/msg/Reading.msg:2",

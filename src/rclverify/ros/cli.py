@@ -2,7 +2,7 @@
 
 Exit codes: 0 the graph (or the findings) was written; 1 an input file could
 not be read (``ROS-PARSE`` error, the graph is still written from the rest),
-or for ``check --strict`` a grounding error; 2 usage errors.
+or for ``check`` any grounding error; 2 usage errors.
 """
 from __future__ import annotations
 
@@ -51,7 +51,7 @@ def add_parsers(sub: Any) -> None:
     c = rs.add_parser("check", help="check the plan's contracts against the graph of its ros: section")
     c.add_argument("-w", "--workspace", default=".", help="workspace root (default: .)")
     c.add_argument("--plan", default="contracts/plan.yaml", help="plan file, relative to the workspace")
-    c.add_argument("--strict", action="store_true", help="exit 1 when a grounding error is found")
+    c.add_argument("--strict", action="store_true", help="accepted for older command lines: ros check always exits 1 on a grounding error")
     c.add_argument("--json", metavar="FILE", help="write the findings as JSON")
     c.set_defaults(fn=cmd_check)
 

@@ -128,8 +128,10 @@ def stage_ground(ws: Any) -> dict[str, Any]:
 
 
 def run_check(root: Path, plan: str, strict: bool, json_out: str | None) -> int:
-    """``rclverify ros check``: print each finding, a count line; exit 1 on
-    ``--strict`` with a grounding error (or a plan/contract error), else 0."""
+    """``rclverify ros check``: print each finding, a count line; exit 1 when
+    any grounding error is found (or the plan/contract cannot be read), else 0.
+    ``strict`` is kept for older command lines and changes nothing: an error is
+    never a pass (issue 65: 26 errors with exit 0 was a wrong green)."""
     from ..evidence.store import atomic_write_text
     from ..workspace import Workspace
     ws = Workspace(root, plan)
@@ -146,4 +148,4 @@ def run_check(root: Path, plan: str, strict: bool, json_out: str | None) -> int:
         atomic_write_text(Path(json_out), json.dumps(data, indent=2) + "\n")
     c = data["counts"]
     print(f"grounding: {c['error']} error(s), {c['warning']} warning(s); graph in {GRAPH}")
-    return 1 if strict and c["error"] else 0
+    return 1 if c["error"] else 0
