@@ -13,6 +13,10 @@ contract adds no rows to the report):
 ``redundant`` (``warning``)
     a conjunct that Z3 proves from the node's assumption and the node's other
     guarantee conjuncts: it adds nothing (often a sign of a copy-paste slip).
+    A conjunct of a timed guarantee (``within 20 ms``) is only shown
+    redundant by guarantees as tight or tighter, and one of a triggered
+    guarantee (``triggered by in.x``) only by guarantees of the same trigger
+    (:func:`may_imply`): deleting it must lose no deadline and no trigger.
 
 An output that no guarantee mentions is not reported here: the lint's
 ``W-unconstrained-output`` (rcl/lint.py) is the one place that says it, so
@@ -33,6 +37,7 @@ from ..logic.encode import Encoder
 from ..logic.query import prove
 from ..rcl import ast
 from ..rcl.printer import expr_to_rcl
+from ..rcl.timing import seconds
 from ..rcl.types import Checked, CheckedNode
 from .finding import Finding
 
@@ -79,7 +84,8 @@ def shape_findings(checked: Checked, node: str, *, timeout_ms: int = SHAPE_TIMEO
         if isinstance(c, ast.BoolLit):
             continue
         if len(parts) > 1:
-            others = [enc.formula(x, cn) for kk, jj, x in parts if (kk, jj) != (k, j)]
+            others = [enc.formula(x, cn) for kk, jj, x in parts
+                      if (kk, jj) != (k, j) and may_imply(n.guarantees[kk - 1], n.guarantees[k - 1])]
             r = prove(enc.formula(c, cn), assume + others, enc, timeout_ms=timeout_ms,
                       comment=f"health {node}: is conjunct {j} of guarantee {k} implied by the others?")
             if r.status == "refuted":
@@ -96,6 +102,28 @@ def shape_findings(checked: Checked, node: str, *, timeout_ms: int = SHAPE_TIMEO
             out.append(valid)
     out += implied.values()
     return out
+
+
+def may_imply(source: ast.Clause, target: ast.Clause) -> bool:
+    """May a conjunct of guarantee ``source`` serve as a hypothesis showing a
+    conjunct of guarantee ``target`` redundant?  Only when deleting the
+    target loses nothing the source does not promise too: the same trigger
+    (``triggered by in.x`` answers one input, and a guarantee on every
+    message is not one on the responses to ``x``, nor the other way round),
+    and, when the target has a deadline (``within 20 ms``), a source whose
+    deadline is as tight or tighter (an untimed guarantee never implies a
+    timed one: deleting the timed one would lose the deadline).  A deadline
+    whose length cannot be read counts as no deadline on the source and as
+    the tightest one on the target (the analysis then says nothing).
+    Rule: docs/rcl-language.md, "Services, actions and deadlines"."""
+    st, tt = source.trigger, target.trigger
+    if (st is None) != (tt is None) or (st is not None and tt is not None and st.name != tt.name):
+        return False
+    if target.deadline is None:
+        return True
+    need = seconds(target.deadline)
+    have = seconds(source.deadline) if source.deadline is not None else None
+    return need is not None and have is not None and have <= need
 
 
 def _tautology(enc: Encoder, cn: CheckedNode, node: str, k: int, j: int, c: ast.Expr,
