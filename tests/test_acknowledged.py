@@ -42,3 +42,106 @@ def test_a_triggered_guarantee_is_implied_by_one_of_the_same_trigger_only():
     assert "Stopper.g3.c1.redundant" not in _redundant(text)
     untriggered = TIMED.replace("  guarantee( in.estop -> out.halt )\n", "  guarantee( in.estop -> out.halt and in.button -> out.halt )\n")
     assert "Stopper.g1.c1.redundant" not in _redundant(untriggered)
+
+
+# ---------------------------------------------------------------------------
+# Acknowledgements: one small workspace, verified with and without them
+# ---------------------------------------------------------------------------
+
+import json  # noqa: E402
+from pathlib import Path  # noqa: E402
+from typing import Any  # noqa: E402
+
+import pytest  # noqa: E402
+
+from rclverify.cli import main  # noqa: E402
+from rclverify.plan.acknowledged import digest  # noqa: E402
+
+GAIN = """node Gain {
+  inputs( x : INTEGER )
+  outputs( y : INTEGER )
+  assume( in.x >= 0 )
+  guarantee( out.y >= in.x and out.y >= 0 )
+  guarantee( forall(k in NATURAL | out.y <= in.x + 10) )
+}
+"""
+IMPL = "def gain(x: int) -> dict[str, int]:\n    return {'y': x + 1}\n"
+PLAN = """name: gain
+contracts: [contracts/gain.rcl]
+nodes:
+  Gain:
+    evidence:
+      - {backend: property_tests, implementation: impl/gain.py:gain, max_examples: 20}
+"""
+ACKS = """acknowledged:
+  - warning: Gain.g1.c2.redundant
+    text: "out.y >= 0"
+    reason: kept so that a reader sees the output is never negative
+  - warning: W-unused-bound
+    file: contracts/gain.rcl
+    text: "forall(k in NATURAL | out.y <= in.x + 10)"
+    reason: the bound variable stays until the per-step table of the next release
+"""
+
+
+def _verify(ws: Path, plan: str, strict: bool = False) -> tuple[int, dict[str, Any]]:
+    (ws / "contracts" / "plan.yaml").write_text(plan, encoding="utf-8")
+    rc = main(["verify", "-w", str(ws)] + (["--strict"] if strict else []))
+    return rc, json.loads((ws / "reports" / "assurance.json").read_text(encoding="utf-8"))
+
+
+@pytest.fixture(scope="module")
+def gain_ws(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    ws = tmp_path_factory.mktemp("ack") / "gain"
+    (ws / "contracts").mkdir(parents=True)
+    (ws / "impl").mkdir()
+    (ws / "contracts" / "gain.rcl").write_text(GAIN, encoding="utf-8")
+    (ws / "impl" / "gain.py").write_text(IMPL, encoding="utf-8")
+    return ws
+
+
+def test_unacknowledged_warnings_fail_strict_and_offer_the_entry(gain_ws):
+    rc, report = _verify(gain_ws, PLAN, strict=True)
+    assert rc == 1 and not report["meta"]["strict_ok"]
+    [f] = [f for f in report["findings"] if f["id"] == "Gain.g1.c2.redundant"]
+    assert f["status"] == "warning" and f["flagged"] == "out.y >= 0" and f["sha256"] == digest("out.y >= 0")
+    assert [x["code"] for x in report["lint"]] == ["W-unused-bound"]
+    html = (gain_ws / "reports" / "assurance.html").read_text(encoding="utf-8")
+    assert f"sha256: {f['sha256'][:16]}" in html  # the entry to paste, for a warning not yet answered
+
+
+def test_acknowledged_warnings_pass_strict_with_their_reasons_everywhere(gain_ws):
+    rc, report = _verify(gain_ws, PLAN + ACKS, strict=True)
+    assert rc == 0 and report["meta"]["strict_ok"]
+    assert [a["status"] for a in report["acknowledgements"]] == ["ok", "ok"]
+    [f] = [f for f in report["findings"] if f["id"] == "Gain.g1.c2.redundant"]
+    assert f["status"] == "warning" and f["acknowledged"]["at"] == "contracts/plan.yaml:8:5"
+    sarif = json.loads((gain_ws / "reports" / "assurance.sarif").read_text(encoding="utf-8"))
+    sup = {r["ruleId"]: r.get("suppressions") for r in sarif["runs"][0]["results"]}
+    assert sup["RCL-HEALTH-REDUNDANT"][0]["justification"].startswith("kept so that a reader")
+    assert sup["RCL-HEALTH-REDUNDANT"][0]["status"] == "accepted"
+    assert sup["RCL-LINT-UNUSED-BOUND"][0]["kind"] == "external"
+    md = (gain_ws / "reports" / "assurance.md").read_text(encoding="utf-8")
+    assert "**Accepted risk**" in md and "the per-step table of the next release" in md
+    argument = json.loads((gain_ws / "reports" / "argument.json").read_text(encoding="utf-8"))
+    risks = [e for e in argument["elements"] if str(e["id"]).startswith("A-accepted")]
+    assert len(risks) == 2 and all(e["type"] == "assumption" for e in risks)
+
+
+def test_a_changed_flagged_text_raises_the_warning_again(gain_ws):
+    (gain_ws / "contracts" / "gain.rcl").write_text(GAIN.replace("out.y >= 0 )", "out.y >= 0 - 1 )"),
+                                                    encoding="utf-8")
+    try:
+        rc, report = _verify(gain_ws, PLAN + ACKS + """  - warning: W-implication-precedence
+    text: "a -> b -> c"
+    reason: an old slip of the contract since repaired
+""", strict=True)
+    finally:
+        (gain_ws / "contracts" / "gain.rcl").write_text(GAIN, encoding="utf-8")
+    assert rc == 1
+    status = {a["warning"]: a["status"] for a in report["acknowledgements"]}
+    assert status == {"Gain.g1.c2.redundant": "stale", "W-unused-bound": "ok", "W-implication-precedence": "stale"}
+    [f] = [f for f in report["findings"] if f["id"] == "Gain.g1.c2.redundant"]
+    assert not f.get("acknowledged") and f["flagged"] == "out.y >= 0 - 1"
+    why = " ".join(report["summary"]["problems"])
+    assert "the text it acknowledged changed" in why and "matches no warning of this run" in why

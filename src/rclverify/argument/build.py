@@ -301,6 +301,8 @@ def build_argument(report: Mapping[str, Any]) -> Argument:
                           supported_by=(s_reqs, s_contracts), in_context_of=top_ctx), **b.els}
     from .defeaters import add_defeaters  # counter-evidence as the dialectic extension's defeaters (issue 50)
     add_defeaters(b.els, report, ident)
+    from .accepted import add_accepted_risks  # warnings acknowledged in the plan, as accepted risks (issue 64)
+    add_accepted_risks(b.els, report, ident, top)
     from .claim_points import add_claim_points  # where confidence is argued (issue 50)
     add_claim_points(b.els, report, ident)
     return propagate(Argument(top, b.els))

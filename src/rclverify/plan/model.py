@@ -12,6 +12,7 @@ from typing import Any, Mapping
 
 from ..rcl import ast
 from .formal import Source
+from .acknowledged import Acknowledgement
 from .state import StateVar
 
 Path_ = tuple[Any, ...]
@@ -124,3 +125,5 @@ class Plan:
     deadlines: tuple[DeadlineSpec, ...] = ()
     #: declared state variables of nodes (``state:``, :mod:`.state`), read by temporal requirements
     states: tuple[StateVar, ...] = ()
+    #: warnings answered with a reason (``acknowledged:``, :mod:`.acknowledged`)
+    acknowledged: tuple[Acknowledgement, ...] = ()

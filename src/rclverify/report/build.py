@@ -336,6 +336,8 @@ def build_report(ws: Workspace) -> dict[str, Any]:
     for f in findings:
         if f["status"] == "problem":
             problems.append(f"Contract health: {f['message']}")
+    from ..plan.acknowledged import apply_acknowledgements  # warnings answered in the plan (docs/plan.md, issue 64)
+    acknowledgements = apply_acknowledgements(plan.acknowledged, findings, lint_rows, checked)
         elif f["status"] == "error":
             problems.append(f"Contract health of {f['node']} is error: {f['message']}")
         elif f["status"] == "stale":
@@ -354,6 +356,8 @@ def build_report(ws: Workspace) -> dict[str, Any]:
         if e["status"] in ("failed", "error", "stale"):
             problems.append(f"Evidence {e['obligation']} is {e['status']}: {_brief(e['explanation'])}")
     for x in expected:
+    problems.extend(f"Acknowledgement {a['at']} is {a['status']}: {a['message']}" for a in acknowledgements
+                    if a["status"] != "ok")
         if x["outcome"] == "MISMATCH":
             problems.append(f"Expected verdict mismatch: {x['obligation']} is {x['actual']}, the plan expects "
                             f"{x['expected']} ({x['source']})" + (f": {x['reason']}" if x["reason"] else ""))
@@ -404,6 +408,7 @@ def build_report(ws: Workspace) -> dict[str, Any]:
     report["summary"]["solvers"] = second.counts()  # how many items two solvers, one solver, ... (issue 50)
     if second.problem:
         report["summary"]["problems"].append(f"Second-solver record: {second.problem}")
+        "acknowledgements": acknowledgements,
     strength_ok = annotate(report, [(l.from_node, l.to_node) for l in model.links],
                            {r.id: r.strength for r in all_requirements(plan) if r.strength})
     # one severity per finding (report/severity.py): --strict fails on every error and warning, health and lint

@@ -68,6 +68,9 @@ def _outcome(case: ET.Element, status: str, summary: str, detail: str, kind: str
     one severity, :func:`.severity.junit_outcome`); return the counter it
     bumps (``failures``, ``errors``, ``skipped``) or '' for a pass."""
     from .severity import junit_outcome
+    if status == "acknowledged":  # a warning accepted in the plan with a reason (plan/acknowledged.py)
+        ET.SubElement(case, "skipped", {"message": f"acknowledged warning: {summary}"}).text = detail or None
+        return "skipped"
     how = junit_outcome(kind, status)
     if how == "pass":
         return ""
@@ -183,7 +186,10 @@ def _lint_suite(report: Mapping[str, Any]) -> tuple[ET.Element, dict[str, int], 
         sev = str(x["severity"]).lower()
         case = _case(suite, "lint", f"{x.get('code') or 'lint'} {x['location']}", str(x["location"]), 0.0)
         counts["tests"] += 1
-        bumped = _outcome(case, sev, str(x["message"]), f"{x['location']}: {sev}: {x['message']}", kind="lint")
+        ack = x.get("acknowledged")
+        bumped = _outcome(case, "acknowledged" if ack else sev,
+                          str(x["message"]) + (f" (acknowledged at {ack['at']}: {ack['reason']})" if ack else ""),
+                          f"{x['location']}: {sev}: {x['message']}", kind="lint")
         if bumped:
             counts[bumped] += 1
     for k, v in counts.items():
@@ -264,7 +270,9 @@ def _suite(node: Mapping[str, Any], data: Mapping[str, Any]) -> tuple[ET.Element
         case = _case(suite, f"{name}.health", str(f["id"]), _source_of(node, f), f.get("duration_s"))
         core = "; ".join(str(c) for c in f.get("core") or [])
         model = model_text(f.get("model"))
-        tally(case, str(f["status"]), str(f["message"]),
+        ack = f.get("acknowledged")
+        tally(case, "acknowledged" if ack else str(f["status"]),
+              str(f["message"]) + (f" (acknowledged at {ack['at']}: {ack['reason']})" if ack else ""),
               _lines(str(f["message"]), str(f.get("explanation") or ""), f"unsat core: {core}" if core else "",
                      f"counterexample: {model}" if model else ""), f.get("duration_s"))
     for u in items.get("unverified", ()):

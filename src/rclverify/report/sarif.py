@@ -57,6 +57,9 @@ class Rule:
 #: The fixed rules, keyed by id.  Lint rules are derived from the lint codes
 #: (:func:`lint_rule_id`).
 RULES: Mapping[str, Rule] = {r.id: r for r in (
+    Rule("RCL-ACK-STALE", "AcknowledgementStale", "warning",
+         "A plan acknowledgement answers no warning of this run, or the text it acknowledged changed (the "
+         "warning is raised again), or it names an item that is not a warning."),
     Rule("RCL-OBL-FAILED", "ObligationFailed", "error",
          "A backend refuted a proof obligation of a node's guarantee (the evidence is failed)."),
     Rule("RCL-OBL-ERROR", "ObligationError", "error",
@@ -320,9 +323,28 @@ def _finding_results(report: Mapping[str, Any]) -> list[dict[str, Any]]:
         if f.get("model"):
             words.append(f"Counterexample: {model_text(f['model'])}.")
         props = {"finding": f["id"], "node": f["node"], "check": f["check"], "status": f["status"]}
-        out.append(_result(rule, _level("health", str(f["status"])), " ".join(words), _finding_location(report, f),
-                           f"health:{f['id']}", props))
+        out.append(_suppressed(_result(rule, _level("health", str(f["status"])), " ".join(words),
+                                       _finding_location(report, f), f"health:{f['id']}", props), f))
     return out
+
+
+def _suppressed(res: dict[str, Any], row: Mapping[str, Any]) -> dict[str, Any]:
+    """``res`` with a SARIF ``suppressions`` entry (kind ``external``, status
+    ``accepted``, the reason as ``justification``, SARIF 2.1.0 section
+    3.35) when the plan acknowledges the warning ``row`` (plan/acknowledged.py)."""
+    ack = row.get("acknowledged")
+    if ack:
+        res["suppressions"] = [{"kind": "external", "status": "accepted", "justification": str(ack["reason"]),
+                                "locations": _location(str(ack["at"]))}]
+    return res
+
+
+def _acknowledgement_results(report: Mapping[str, Any]) -> list[dict[str, Any]]:
+    """Stale or refused plan acknowledgements, at their plan entry."""
+    return [_result("RCL-ACK-STALE", _level("acknowledgement", str(a["status"])),
+                    f"Acknowledgement of {a['warning']} is {a['status']}: {a['message']}", str(a["at"]),
+                    f"ack:{a['at']}:{a['warning']}", {"status": a["status"]})
+            for a in report.get("acknowledgements") or () if a.get("status") != "ok"]
 
 
 def _lint_results(report: Mapping[str, Any]) -> tuple[list[dict[str, Any]], list[Rule]]:
@@ -333,8 +355,8 @@ def _lint_results(report: Mapping[str, Any]) -> tuple[list[dict[str, Any]], list
         level = _level("lint", str(d["severity"]))
         rules.setdefault(rid, Rule(rid, "Lint" + "".join(w.capitalize() for w in rid.split("-")[2:]), level,
                                    "RCL lint: a contract clause that is legal but probably not what was meant."))
-        out.append(_result(rid, level, str(d["message"]), str(d["location"]),
-                           f"lint:{d['location']}:{d.get('code', '')}:{k}", {"severity": d["severity"]}))
+        out.append(_suppressed(_result(rid, level, str(d["message"]), str(d["location"]),
+                                       f"lint:{d['location']}:{d.get('code', '')}:{k}", {"severity": d["severity"]}), d))
     return out, sorted(rules.values(), key=lambda r: r.id)
 
 
@@ -437,7 +459,7 @@ def sarif_log(report: Mapping[str, Any]) -> dict[str, Any]:
     ground, ground_rules = _grounding_results(report)
     from .deadlines import SARIF_RULES, sarif_results
     results = (_obligation_results(report) + _unverified_results(report) + _side_condition_results(report) + _finding_results(report) + lint + ground
-               + _requirement_results(report) + sarif_results(report, _result))
+               + _requirement_results(report) + sarif_results(report, _result) + _acknowledgement_results(report))
     _attach_diagnoses(report, results)
     rules: Sequence[Rule] = list(RULES.values()) + [Rule(*r) for r in SARIF_RULES] + lint_rules + ground_rules
     index = {r.id: i for i, r in enumerate(rules)}

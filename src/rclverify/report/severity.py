@@ -27,7 +27,13 @@ need not describe: a graph node without a contract) do not.
 
 Kinds: ``obligation``, ``guarantee`` (one no obligation covers),
 ``side-condition``, ``health``, ``requirement`` (by verdict), ``deadline``
-(by verdict), ``lint`` (by its severity word).
+(by verdict), ``lint`` (by its severity word), ``acknowledgement`` (a plan
+entry answering a warning: ``stale`` is a warning, ``error`` an error).
+
+A health or lint warning that a plan acknowledgement answers
+(plan/acknowledged.py) keeps its severity in every output (SARIF marks it
+suppressed, with the reason as justification) but does not fail
+``--strict`` (:func:`acknowledged`).
 """
 from __future__ import annotations
 
@@ -106,14 +112,26 @@ def items(report: Mapping[str, Any]) -> list[tuple[str, str, str, str]]:
         add("deadline", f"{d['requirement']}.deadline", str(d["verdict"]))
     for x in report.get("lint") or ():
         add("lint", f"{x['location']}:{x.get('code', '')}", str(x["severity"]))
+    for a in report.get("acknowledgements") or ():  # a stale or refused acknowledgement (plan/acknowledged.py)
+        add("acknowledgement", f"{a['at']}:{a['warning']}", str(a["status"]))
     return out
+
+
+def acknowledged(report: Mapping[str, Any]) -> set[tuple[str, str]]:
+    """The ``(kind, id)`` of :func:`items` that a plan acknowledgement
+    answers (a warning accepted as a risk with a reason, docs/plan.md): they
+    keep their severity in every output but do not fail ``--strict``."""
+    out = {("health", str(f["id"])) for f in report.get("findings") or () if f.get("acknowledged")}
+    return out | {("lint", f"{x['location']}:{x.get('code', '')}") for x in report.get("lint") or ()
+                  if x.get("acknowledged")}
 
 
 def blocking(report: Mapping[str, Any]) -> list[tuple[str, str, str, str]]:
     """The findings that fail ``--strict`` (severity ``error`` or
     ``warning``), as :func:`items` gives them, plus the ROS grounding
     errors (``("grounding", code, "error", "error")``) and a stale grounding."""
-    out = [x for x in items(report) if gates(x[3])]
+    answered = acknowledged(report)
+    out = [x for x in items(report) if gates(x[3]) and not (x[3] == WARNING and (x[0], x[1]) in answered)]
     g = report.get("grounding")
     if isinstance(g, Mapping):
         for f in g.get("findings") or ():

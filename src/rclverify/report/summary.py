@@ -186,14 +186,20 @@ def strict_reasons(report: Mapping[str, Any]) -> list[str]:
     fs = [f for f in report["findings"] if f["status"] not in ("ok", "warning")]
     if fs:
         out.append(f"{len(fs)} contract health check{'s' if len(fs) != 1 else ''} found a problem or could not decide")
-    warned = [str(f["id"]) for f in report["findings"] if f["status"] == "warning"]
+    warned = [str(f["id"]) for f in report["findings"] if f["status"] == "warning" and not f.get("acknowledged")]
     if warned:  # one severity per finding: a warning fails --strict as it is a warning everywhere (report/severity.py)
         out.append(f"{len(warned)} contract health warning{'s' if len(warned) != 1 else ''} ("
                    + ", ".join(warned[:4]) + (", ..." if len(warned) > 4 else "") + ")")
-    lint = [x for x in report.get("lint") or () if str(x.get("severity", "")).lower() in ("warning", "error")]
+    lint = [x for x in report.get("lint") or () if str(x.get("severity", "")).lower() in ("warning", "error")
+            and not x.get("acknowledged")]  # a warning answered in the plan passes (plan/acknowledged.py)
     if lint:
         out.append(f"{len(lint)} lint diagnostic{'s' if len(lint) != 1 else ''} (`rclverify check`: "
                    + ", ".join(str(x["location"]) for x in lint[:3]) + (", ..." if len(lint) > 3 else "") + ")")
+    acks = [a for a in report.get("acknowledgements") or () if a.get("status") != "ok"]
+    if acks:
+        out.append(f"{len(acks)} acknowledgement{'s' if len(acks) != 1 else ''} in the plan "
+                   f"{'are' if len(acks) != 1 else 'is'} stale or refused ("
+                   + ", ".join(str(a["at"]) for a in acks[:3]) + (", ..." if len(acks) > 3 else "") + ")")
     rq = [r["id"] for r in report.get("requirements", []) if r.get("verdict", "informal") not in ("met", "informal")]
     if rq:
         out.append(f"{len(rq)} formal requirement{'s are' if len(rq) != 1 else ' is'} not met ("
