@@ -162,6 +162,7 @@ def build_report(ws: Workspace) -> dict[str, Any]:
     ob_rows: list[dict[str, Any]] = []
     pending: list[dict[str, Any]] = []
     ob_status: dict[str, str] = {}
+    declared: dict[str, list[tuple[str, Any]]] = {}  # node -> (record status, declaration rows) per record
     problems_altered: list[str] = []  # records that cannot be read as rclverify wrote them
     # input sha256s, taken once per file: nothing changes while the report is built.  Each node's
     # snapshot is taken from the current contracts and plan, not from artifacts/contracts/, so
@@ -189,6 +190,8 @@ def build_report(ws: Workspace) -> dict[str, Any]:
                 continue
             pending.append({"obligation": o.id, "backend": o.backend, "reason": "no evidence record yet: run `doit verify`"})
             continue
+        if isinstance(ev.details.get("declarations"), list):  # a node's declarations judged (issue 64)
+            declared.setdefault(o.node, []).append((status, ev.details["declarations"]))
         expl = ev.explanation
         if altered:
             expl = f"{altered[0].upper()}{altered[1:]}. The record's own text follows, not to be believed: " + expl
@@ -291,6 +294,7 @@ def build_report(ws: Workspace) -> dict[str, Any]:
     requirements: list[dict[str, Any]] = []
     from ..plan.load import all_requirements
     from ..requirements.stage import read_records
+    from ..requirements.rollup import declaration_statuses
     checks = read_records(ws, hashes)  # sealed and hashed: altered -> error, other inputs -> stale
     checks = {k: second.requirement(v) or v for k, v in checks.items()}
     for r in all_requirements(plan):
@@ -303,7 +307,8 @@ def build_report(ws: Workspace) -> dict[str, Any]:
                                 "obligations": natural_sorted([o.id for o in obligations if applies(o, s.node, k)])})
         st = worst([x["status"] for x in support] + [sc_status[x["node"]] for x in support]) if support else "pending"
         requirements.append({"id": r.id, "text": r.text, "status": st, "support": support,
-                             **requirement_check(current_record(r, checks.get(r.id)), st, g_status, sc_status)})
+                             **requirement_check(current_record(r, checks.get(r.id)), st, g_status, sc_status,
+                                                 declaration_statuses(declared))})
 
     from .deadlines import deadline_rows, fold_into, strict_ok as deadlines_ok
     deadlines = deadline_rows(ws, hashes, g_status, ob_rows, second)  # rule D3, rolled into each requirement
@@ -465,13 +470,13 @@ def current_record(req: Any, record: Mapping[str, Any] | None) -> Mapping[str, A
 
 
 def requirement_check(record: Mapping[str, Any] | None, traced_status: str, g_status: Any,
-                      sc_status: Mapping[str, str]) -> dict[str, Any]:
+                      sc_status: Mapping[str, str], d_status: Any = None) -> dict[str, Any]:
     """The requirement row's fields from its Z3 check: ``verdict`` (met /
     proved, evidence outstanding / proved from an inconsistency / refuted /
     inconclusive / informal), ``status`` (only ``met`` is ``discharged``),
     ``note`` and the check's details (:mod:`rclverify.requirements.rollup`)."""
     from ..requirements.rollup import roll_up
-    verdict, status, note = roll_up(record, g_status, sc_status, traced_status)
+    verdict, status, note = roll_up(record, g_status, sc_status, traced_status, d_status)
     from .cex_cone import with_trace_view  # a temporal trace cut to what matters (issue 48)
     details = dict(with_trace_view({k: (record or {}).get(k) for k in _CHECK_FIELDS}))
     return {"status": status, "verdict": verdict, "note": note, "check": details}

@@ -8,8 +8,9 @@ verdict (``check``)                what the proof rests on      status shown (``
                                    conditions of its node
 ``proved``, premises consistent    some evidence not            ``proved, evidence outstanding`` /
                                    discharged, or a declared    the worst of that evidence
-                                   progress or initial value    (a declaration: ``pending``)
-                                   (temporal; not verified)
+                                   progress or initial value    (a declaration no run or test
+                                   whose evidence is not        judged: ``pending``)
+                                   discharged (temporal)
 ``proved``, premises inconsistent  (anything)                   ``proved from an inconsistency`` /
                                                                 ``failed``
 ``proved``, premise never holds    (anything)                   ``proved vacuously`` / ``failed``
@@ -27,6 +28,13 @@ node never answers                 progress is named)
 ``error`` (record altered)          (not shown)                  ``error`` / ``error``
 =================================  ==========================  ==================================
 
+A declaration the proof uses (``progress``, ``initially``, a period in
+steps) is evidenced like a guarantee (issue 64): the ``monitors`` backend
+judges it on every recorded run of its node and the ``property_tests``
+backend on the node's implementation, each record carrying a row per
+declaration (``details.declarations``, backends/monitors/declarations.py);
+:func:`declaration_statuses` rolls them up.
+
 Only ``met`` has the status ``discharged`` (the green tick of every report
 format).  An informal requirement is ``pending`` whatever its traced
 guarantees' evidence says (the note names their worst status, the
@@ -36,7 +44,7 @@ verified nor refuted, and its goal in the assurance argument is undeveloped
 """
 from __future__ import annotations
 
-from typing import Any, Callable, Mapping
+from typing import Any, Callable, Mapping, Sequence
 
 from ..evidence.records import worst
 
@@ -47,15 +55,54 @@ VACUOUS = "proved vacuously"
 VERDICTS = (MET, OUTSTANDING, INCONSISTENT, VACUOUS, "refuted", "inconclusive", "informal", "stale", "error")
 
 
+#: a declaration's status given the premise kind (``"progress"``, ``"initial value"``) and index, with words
+DeclStatus = Callable[[str, str, int], tuple[str, str]]
+#: how bad a declaration's verdict on one record is (a record judges it, whatever the other records say)
+_DECL_RANK = ("failed", "error", "stale", "discharged", "inconclusive", "pending")
+
+
+def declaration_statuses(records: Mapping[str, Sequence[tuple[str, Sequence[Mapping[str, Any]]]]]) -> DeclStatus:
+    """The status of a node's declarations from its evidence records.
+
+    ``records[node]`` lists ``(record status, rows)``: each evidence record
+    of the node with its ``details.declarations`` rows (``{"declaration",
+    "premise", "index", "status", ...}``).  Returns ``d(node, premise kind,
+    index) -> (status, words)``.  Per declaration, over the records: a
+    record that is ``stale`` or ``error`` gives its rows that status; then
+    any ``failed`` row fails it, else ``error``, ``stale``; else one
+    ``discharged`` row discharges it (a run that did not exercise a
+    declaration, ``pending`` or ``inconclusive``, showed nothing against it;
+    a run that did, showed it held); else ``inconclusive``, else
+    ``pending``.  The premise ``progress`` stands for every declaration the
+    requirement check reads as progress (``progress(...)`` and periods in
+    steps): the worst of them.  No row at all: ``("pending", "declared, not
+    verified")``."""
+    def status(node: str, kind: str, index: int) -> tuple[str, str]:
+        per: dict[str, list[str]] = {}
+        for rec_status, rows in records.get(node, ()):
+            for r in rows:
+                if r.get("premise") == kind and int(r.get("index", 0)) == index:
+                    s = rec_status if rec_status in ("stale", "error") else str(r.get("status", "pending"))
+                    per.setdefault(str(r.get("declaration")), []).append(s)
+        if not per:
+            return "pending", "declared, not verified"
+        each = [min(ss, key=lambda s: _DECL_RANK.index(s) if s in _DECL_RANK else 0) for ss in per.values()]
+        st = worst(each)
+        runs = sum(len(ss) for ss in per.values())
+        return st, f"declaration, {st} on {runs} record{'s' if runs != 1 else ''}"
+    return status
+
+
 def roll_up(record: Mapping[str, Any] | None, g_status: Callable[[str, int], str], sc_status: Mapping[str, str],
-            traced_status: str) -> tuple[str, str, str]:
+            traced_status: str, d_status: DeclStatus | None = None) -> tuple[str, str, str]:
     """``(verdict, status, note)`` of one requirement.
 
     ``record`` is the requirement's check record (:func:`.check.check_requirement`;
     ``None`` when not checked yet), ``g_status(node, k)`` a guarantee's
     evidence status, ``sc_status[node]`` the worst of a node's side
     conditions, ``traced_status`` the worst status of the traced guarantees
-    (the roll-up of an informal requirement).
+    (the roll-up of an informal requirement), ``d_status`` the status of a
+    declaration (:func:`declaration_statuses`; ``None``: none verified).
     """
     if record is None:
         return "inconclusive", "pending", "not checked yet: run `rclverify requirements` or `doit verify`"
@@ -114,8 +161,10 @@ def roll_up(record: Mapping[str, Any] | None, g_status: Callable[[str, int], str
         if p["kind"] == "guarantee":
             statuses[p["label"]] = g_status(p["node"], p["index"])
             statuses[f"side conditions of {p['node']}"] = sc_status.get(p["node"], "discharged")
-        elif p["kind"] in ("progress", "initial value"):  # declared of the implementation; no backend checks it yet
-            statuses[f"{p['label']} (declared, not verified)"] = "pending"
+        elif p["kind"] in ("progress", "initial value"):  # declared of the implementation: its own evidence
+            st, words = d_status(p["node"], p["kind"], int(p.get("index", 0))) if d_status is not None else (
+                "pending", "declared, not verified")
+            statuses[f"{p['label']} ({words})"] = st
     ev = worst(list(statuses.values()), empty="discharged")
     if record.get("consistency") != "consistent":  # the worst of that and the evidence, as the argument has it
         return "inconclusive", worst(["inconclusive", ev]), (

@@ -31,10 +31,12 @@ from ..base import NodeTarget, Stopwatch, make_evidence
 from .check import check_trace
 from .config import ConfigError, MonitorConfig, load_mapping
 from .deadlines import DeadlineMonitor, DeadlineResult, deadline_status, has_deadlines
+from .declarations import DeclarationMonitor, add_periods, has_declarations, with_declarations
 from .judged import Counted, Heard, explain, not_judged
 from .log_calls import LogCalls, merge_deadlines
 from .periods import PeriodMonitor, has_periods, with_periods
 from .rml import Spec, rml_id, translate
+from .runset import run_counts, run_runset, runset_obligations
 from .summary import monitoring_details, summary_line, tool_versions, verdict_status
 
 NAME = "monitors"
@@ -178,11 +180,13 @@ class MonitorsBackend:
                       "config": target.rel(target.artifacts.parent / "config.yaml"),
                       "not_expressible": [{"guarantee": t.guarantee, "part": t.part, "why": t.why}
                                           for t in spec.terms if not t.text]}))
-        return out
+        return out + runset_obligations(target, list(cfg.traces), out)  # a target: the run set's claim (runset.py)
 
     def run(self, obligation: Obligation, target: NodeTarget) -> Evidence:
         """Check the obligation's trace against the node's contract (never raises
         for a user-caused problem)."""
+        if obligation.data.get("run_set") is not None:  # the entry's target over all its runs (runset.py)
+            return run_runset(self.run, obligation, target, tool_versions())
         clock = Stopwatch()
         versions = tool_versions()
 
@@ -201,6 +205,9 @@ class MonitorsBackend:
                                                             horizon=cfg.horizon, tolerance=cfg.tolerance))
         if has_periods(target.node):  # periodic outputs on the same run (periods.py)
             beside.add("periods", lambda: PeriodMonitor(target.node))
+        if has_declarations(target.node):  # initially, progress, periodic judged on the same run (declarations.py)
+            beside.add("declarations", lambda: DeclarationMonitor(target.checked, target.node, cfg.rules,
+                                                                  tolerance=cfg.tolerance))
         # a live log's service calls and action goals, judged as the live run judged them (log_calls.py)
         calls = LogCalls(target.checked, [target.node], cfg.rules, cfg.horizon, trace)
         try:
@@ -221,7 +228,7 @@ class MonitorsBackend:
         status, explanation = verdict_status(res, trace)
         extra: dict[str, Any] = {}
         finished = beside.finish()
-        for name in ("deadlines", "periods"):  # as above: the record's error, never a crash
+        for name in ("deadlines", "periods", "declarations"):  # as above: the record's error, never a crash
             err = beside.errors.get(name)
             if err is not None:
                 return evidence("error", f"the {name} could not be checked: {type(err).__name__}: {err}",
@@ -238,6 +245,10 @@ class MonitorsBackend:
         if "periods" in finished:
             status, explanation, more = with_periods(finished["periods"], trace, status, explanation)
             extra.update(more)
+        if "declarations" in finished:
+            status, explanation, more = with_declarations(
+                add_periods(finished["declarations"], target.node, finished.get("periods")), trace, status, explanation)
+            extra.update(more)
         dl = finished.get("deadlines")
         # silence is never green: what the run did not judge, with the reason, beside the status
         extra["not_judged"] = items = not_judged([target.node], Heard({**heard, **calls.messages},
@@ -247,6 +258,7 @@ class MonitorsBackend:
         entry = {"node": res.node, "status": status, "explanation": explanation}
         explain(entry, items)  # a pending record says why itself
         explanation = entry["explanation"]
+        extra["statistics"] = run_counts(target.root, target.config, trace, details["sha256"], res, status, span.seconds)
         return evidence(status, explanation, details={"monitoring": details, **extra},
                         artifacts=(str(obligation.data.get("rml", "")), str(obligation.data.get("config", ""))),
                         log=summary_line(res))

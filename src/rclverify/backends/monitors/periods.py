@@ -18,12 +18,12 @@ trace's time), and:
   time before the first message is not judged (a recorded run may start
   before the node does).
 
-A period in steps (``periodic( out.y, 3 steps )``) is a rule of the
-composed system (docs/requirements.md), not of a recorded run, which has no
-steps: it is not monitored.  Neither is ``progress( ... )`` (counted in
-steps) nor ``initially( ... )`` (a value before the first message, which a
-recorded run does not show); a bound in time is a guarantee's deadline
-(``triggered by in.x within 200 ms``, :mod:`.deadlines`).
+A period in steps (``periodic( out.y, 3 steps )``), ``progress( ... )``
+and ``initially( ... )`` are judged on the same run by :mod:`.declarations`
+(a step of the node there is one of its input events), which also turns
+this module's result into the verdict row of each period in time; a bound
+in time is a guarantee's deadline (``triggered by in.x within 200 ms``,
+:mod:`.deadlines`).
 """
 from __future__ import annotations
 

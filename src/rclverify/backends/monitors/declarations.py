@@ -1,0 +1,326 @@
+"""A node's declarations judged on a recorded run (issue 64).
+
+A node's ``initially( F )``, ``progress( ... )`` and ``periodic( out.y, P )``
+(docs/rcl-language.md, "Progress, initial values and periodic outputs") are
+claims about the implementation like its guarantees; each gets a verdict on
+every recorded run of the node's ``monitors`` entry, a row of the record's
+``details.declarations`` (:meth:`DeclarationResult.rows`).  The run is read
+in the stream model of the paper (lines 462-495): a *step* of the node is
+one of its input events (a message on a topic ``topics(...)`` binds to an
+input, or a call part a link binds to one), and the node *answers* at that
+step when one of its output messages comes after it and before its next
+input event.  The assumption is judged on the inputs current at the event
+(:func:`rclverify.logic.floatsem.judge`, as the untimed monitor judges it);
+a step at which it holds is *accepted*.
+
+* ``initially( F )``: F judged on the first value each output it reads is
+  published with (a subscriber has no value of the output before its first
+  message; the value the node starts from is only observable as that
+  message).  ``true``/``false``; when F is false and the first message
+  came after an input the node had accepted, it may be the node's answer
+  rather than its initial value: ``inconclusive`` (never a false alarm);
+  no message of an output F reads: ``pending``.
+* ``progress( within K steps )``: never K + 1 accepted steps in a row
+  unanswered (a step whose input is not accepted ends the row, as the
+  composed system's ``waiting`` counter does, requirements/transition.py):
+  ``false`` at the input event that ends the (K + 1)-th unanswered step;
+  ``true`` when at least one accepted step was seen and none broke the
+  bound; no accepted step: ``pending`` (the run exercised nothing).
+* ``progress( eventually )``: ``true`` when every accepted step is answered
+  by a later output; the run ending with an accepted step still unanswered:
+  ``inconclusive`` (a finite run never refutes "eventually"); no accepted
+  step: ``pending``.
+* ``periodic( out.y, N steps )``: as ``progress( within N - 1 steps )``, with
+  only a message of ``out.y`` answering.
+* ``periodic( out.y, 100 ms )``: the gaps :mod:`.periods` measures: a late
+  gap ``false``; at least two messages and no late gap ``true``; a single
+  message and the run ending within the period ``inconclusive`` (too short
+  to show a gap); none ``pending``.
+
+The verdicts map to evidence statuses as the monitors' do (``true``
+discharged, ``false`` failed); each row names the declaration's source so
+a requirement resting on it (requirements/rollup.py) can read it.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any, Iterable, Mapping
+
+from ...logic.floatsem import Tolerance, judge
+from ...rcl import ast
+from ...rcl.liveness import _steps, period_seconds
+from ...rcl.printer import expr_to_rcl
+from ...rcl.types import Checked, CheckedNode
+from ...rcl.walk import subexpressions
+from ...traces.events import Event
+from ...traces.mapping import MappingError, TopicRule, map_value
+from .deadlines import event_stamp, topic_bindings
+from .periods import PeriodResult
+from .verdicts import names
+
+#: declaration verdict -> evidence status
+STATUS = {"true": "discharged", "false": "failed", "inconclusive": "inconclusive", "pending": "pending"}
+
+
+@dataclass
+class _Count:
+    """One bounded-answer obligation (``progress`` or ``periodic`` in steps):
+    ``bound`` K (``None``: eventually), ``outs`` the outputs that answer
+    (empty: any output of the node); the row of unanswered accepted steps."""
+
+    label: str
+    source: str
+    bound: int | None
+    outs: frozenset[str]
+    text: str
+    premise: str = "progress"
+    row: int = 0
+    first_open: str = ""
+    accepted: int = 0
+    answered: int = 0
+    broken: str = ""
+
+
+@dataclass
+class _Initial:
+    index: int
+    formula: ast.Expr
+    source: str
+    outs: frozenset[str]
+    verdict: str = ""
+    reason: str = ""
+
+
+@dataclass
+class DeclarationResult:
+    """The verdict rows of one node's declarations on one run."""
+
+    node: str
+    declarations: list[dict[str, Any]] = field(default_factory=list)
+
+    def rows(self) -> list[dict[str, Any]]:
+        """``[{"declaration", "premise", "index", "source", "verdict", "status", "reason"}]``:
+        ``premise`` the kind of premise the requirement check makes of it
+        (``"initial value"``, ``"progress"``, ``""`` for a period in time)."""
+        return [dict(r) for r in self.declarations]
+
+
+def has_declarations(node: CheckedNode) -> bool:
+    """Whether ``node`` declares an initial value, progress or a period."""
+    n = node.node
+    return bool(n.initially or n.progress or n.periodic)
+
+
+def _src(loc: ast.Loc) -> str:
+    return f"{loc.file}:{loc.line}:{loc.col}"
+
+
+class DeclarationMonitor:
+    """The declarations of ``node`` judged one event at a time (module
+    docstring): :meth:`feed` every event of the run in order, then
+    :meth:`finish` with the run's :class:`~.periods.PeriodResult` (or
+    ``None`` when the node declares no period in time)."""
+
+    def __init__(self, checked: Checked, node: CheckedNode, rules: Mapping[str, TopicRule],
+                 tolerance: Tolerance | None = None) -> None:
+        self.checked, self.node, self.rules = checked, node, rules
+        self.tolerance = tolerance if tolerance is not None else getattr(rules, "tolerance", None)
+        self.bindings = topic_bindings(node)
+        self.assumption = tuple(c.formula for c in node.node.assumes)
+        mentioned: set[str] = set()
+        for f in self.assumption:
+            names(f, mentioned)
+        self.needed = sorted(f"in.{v}" for v in node.inputs if v in mentioned or f"in.{v}" in mentioned)
+        self.values: dict[str, Any] = {}
+        self.first: dict[str, tuple[Any, str]] = {}
+        self.seen_accepted = ""  # where the first accepted input was (an initial message after it may be an answer)
+        self.initials = [_Initial(k, c.formula, _src(c.loc), frozenset(
+            f"out.{e.name}" for e in subexpressions(c.formula) if isinstance(e, ast.Var) and e.prefix in ("out", None)
+            and e.name in node.outputs)) for k, c in enumerate(node.node.initially, 1)]
+        self.counts: list[_Count] = []
+        for p in node.node.progress:
+            k = _steps(p.bound) if p.bound is not None else None
+            self.counts.append(_Count("progress", _src(p.loc), k, frozenset(),
+                                      f"progress( {'eventually' if p.bound is None else f'within {p.bound} steps'} )"))
+        for per in node.node.periodic:
+            n = _steps(per.amount) if per.unit in ("steps", "step") else None
+            if n:
+                self.counts.append(_Count(f"periodic out.{per.output.name}", _src(per.loc), n - 1,
+                                          frozenset({f"out.{per.output.name}"}),
+                                          f"periodic( out.{per.output.name}, {per.amount} {per.unit} )"))
+
+    def feed(self, ev: Event) -> None:
+        """Process one event (any topic; only the node's move its state)."""
+        keys = self.bindings.get(ev.topic.lstrip("/"))
+        if not keys:
+            return
+        changed = self._map(ev, keys)
+        outs = {c for c in changed if c.startswith("out.")}
+        for key in outs:
+            if key not in self.first:
+                self.first[key] = (self.values[key], ev.where)
+                self._initial(ev)
+        for c in self.counts:
+            if outs and (not c.outs or c.outs & outs):
+                c.answered += 1 if c.row else 0
+                c.row = 0
+        if any(k.startswith("in.") for k in changed):
+            self._step(ev)
+
+    def _map(self, ev: Event, keys: list[tuple[str, str]]) -> list[str]:
+        changed = []
+        for key, part in keys:
+            fields = ev.fields.get(part) if part else ev.fields
+            if not isinstance(fields, Mapping):
+                continue
+            fields = {k: v for k, v in fields.items() if k != "header"}
+            typ = self.node.inputs.get(key[3:]) if key.startswith("in.") else self.node.outputs.get(key[4:])
+            if typ is None:
+                continue
+            try:
+                self.values[key] = map_value(typ, fields, self.rules.get(ev.topic, TopicRule()), self.values.get(key))
+            except MappingError:
+                self.values.pop(key, None)  # never the value before it: undecided until a message maps again
+            changed.append(key)
+        return changed
+
+    def _step(self, ev: Event) -> None:
+        """An input event: the previous step ends (a row over its bound is
+        broken), and a new step starts, accepted or not."""
+        for c in self.counts:
+            if c.bound is not None and c.row > c.bound and not c.broken:
+                c.broken = (f"{c.row} accepted steps in a row unanswered (at most {c.bound} allowed): no "
+                            f"{self._answer_words(c)} came between the input at {c.first_open} and the input at "
+                            f"{ev.where}")
+        accepted = self._accepts()
+        if accepted and not self.seen_accepted:
+            self.seen_accepted = ev.where
+        for c in self.counts:
+            if accepted:
+                c.accepted += 1
+                if c.row == 0:
+                    c.first_open = ev.where
+                c.row += 1
+            else:
+                c.row = 0
+
+    def _accepts(self) -> bool:
+        inputs = {k: v for k, v in self.values.items() if k.startswith("in.")}
+        if any(k not in inputs for k in self.needed):
+            return False
+        return all(judge(f, self.checked, self.node, inputs, self.tolerance).truth is True for f in self.assumption)
+
+    def _answer_words(self, c: _Count) -> str:
+        return "message of " + ", ".join(sorted(c.outs)) if c.outs else "output of the node"
+
+    def _initial(self, ev: Event) -> None:
+        for ini in self.initials:
+            if ini.verdict or not all(o in self.first for o in ini.outs):
+                continue
+            vals = {o: self.first[o][0] for o in ini.outs}
+            j = judge(ini.formula, self.checked, self.node, vals, self.tolerance)
+            at = ", ".join(f"{o} = {self.first[o][0]!r} ({self.first[o][1]})" for o in sorted(ini.outs))
+            if j.truth is True:
+                ini.verdict, ini.reason = "true", f"the first published values satisfy it: {at}"
+            elif j.truth is False and self.seen_accepted:
+                ini.verdict, ini.reason = "inconclusive", (
+                    f"the first published values do not satisfy it ({at}), but they came after the accepted input "
+                    f"at {self.seen_accepted}: they may be its answer, not the initial value")
+            elif j.truth is False:
+                ini.verdict, ini.reason = "false", f"the first published values do not satisfy it: {at}"
+            else:
+                ini.verdict, ini.reason = "inconclusive", f"undecided on the first published values ({at}): {j.reason}"
+
+    def finish(self) -> DeclarationResult:
+        """The rows of every declaration after the run (module docstring)
+        but the periods in time (:func:`add_periods`)."""
+        res = DeclarationResult(self.node.name)
+        for ini in self.initials:
+            verdict, reason = (ini.verdict, ini.reason) if ini.verdict else (
+                "pending", "no message of " + ", ".join(sorted(o for o in ini.outs if o not in self.first) or ["an output"])
+                + ": its first value was not seen")
+            res.declarations.append(_row(f"initially {ini.index}", "initial value", ini.index, ini.source,
+                                              f"initially( {expr_to_rcl(ini.formula)} )", verdict, reason))
+        for c in self.counts:
+            res.declarations.append(_row(c.label, c.premise, 0, c.source, c.text, *self._count_verdict(c)))
+        return res
+
+    def _count_verdict(self, c: _Count) -> tuple[str, str]:
+        if c.broken:
+            return "false", c.broken
+        if not c.accepted:
+            return "pending", "no input event the node's assumption accepts: nothing to answer"
+        if c.bound is None and c.row:
+            return "inconclusive", (f"the run ends with the accepted input at {c.first_open} not answered yet "
+                                    f"(a finite run never refutes 'eventually')")
+        return "true", (f"{c.accepted} accepted input events, none left unanswered for more than "
+                        + (f"{c.bound} steps" if c.bound is not None else "the run"))
+
+
+def _row(label: str, premise: str, index: int, source: str, text: str, verdict: str, reason: str) -> dict[str, Any]:
+    return {"declaration": label, "premise": premise, "index": index, "source": source, "text": text,
+            "verdict": verdict, "status": STATUS[verdict], "reason": reason}
+
+
+def add_periods(res: DeclarationResult, node: CheckedNode, periods: PeriodResult | None) -> DeclarationResult:
+    """``res`` with a row per period in time of ``node``, from the run's
+    :class:`~.periods.PeriodResult` (``None``: not checked, ``pending``)."""
+    for per in node.node.periodic:
+        if period_seconds(per) is not None:
+            res.declarations.append(_row(
+                f"periodic out.{per.output.name}", "", 0, _src(per.loc),
+                f"periodic( out.{per.output.name}, {per.amount} {per.unit} )",
+                *_period_verdict(periods, f"out.{per.output.name}")))
+    return res
+
+
+def _period_verdict(res: PeriodResult | None, key: str) -> tuple[str, str]:
+    if res is None or key not in res.periods:
+        return "pending", "the period was not checked"
+    late = res.late.get(key)
+    n = res.messages.get(key, 0)
+    if late is not None:
+        return "false", (f"a gap of {late['gap'] * 1000:.0f} ms after the message at {late['from']:.3f} s "
+                         f"({late['where']}), over the period of {late['period'] * 1000:.0f} ms")
+    if n == 0:
+        return "pending", "no message of the output: its period was not checked"
+    if n == 1:
+        return "inconclusive", "a single message and the run ends within the period: too short to show a gap"
+    return "true", f"{n} messages, no gap over {res.periods[key] * 1000:.0f} ms"
+
+
+def declaration_status(res: DeclarationResult, trace: str) -> tuple[str, str]:
+    """The evidence status the declarations add to the node's record on
+    ``trace``: ``failed`` when one is false (named), else ``discharged`` with
+    a note listing the ones the run did not decide."""
+    # a late period fails the record through periods.py already: not said twice
+    bad = [r for r in res.declarations if r["verdict"] == "false" and r["premise"]]
+    if bad:
+        r = bad[0]
+        return "failed", f"{res.node} declares {r['text']} ({r['source']}) but in {trace}: {r['reason']}"
+    open_ = [f"{r['text']}: {r['verdict']} ({r['reason']})" for r in res.declarations
+             if r["verdict"] not in ("true", "false")]
+    done = [r["text"] for r in res.declarations if r["verdict"] == "true"]
+    words = (["held: " + ", ".join(done)] if done else []) + (["not decided: " + "; ".join(open_)] if open_ else [])
+    return "discharged", "; ".join(words) or "none"
+
+
+def with_declarations(res: DeclarationResult, trace: str, status: str,
+                      explanation: str) -> tuple[str, str, dict[str, Any]]:
+    """The monitor's verdict combined with the node's declarations on the
+    same run: a false declaration fails the evidence (it is a claim of the
+    node's contract), otherwise the verdict stands with a note.  Returns
+    ``(status, explanation, {"declarations": rows})``."""
+    dstatus, dexpl = declaration_status(res, trace)
+    if dstatus == "failed":
+        return "failed", f"declarations: {dexpl}; {explanation}", {"declarations": res.rows()}
+    return status, f"{explanation}; declarations: {dexpl}", {"declarations": res.rows()}
+
+
+def check_declarations(checked: Checked, node: CheckedNode, events: Iterable[Event],
+                       rules: Mapping[str, TopicRule], periods: PeriodResult | None = None) -> DeclarationResult:
+    """The declarations of ``node`` over a recorded run's ``events``, in order."""
+    m = DeclarationMonitor(checked, node, rules)
+    for ev in events:
+        m.feed(ev)
+    return add_periods(m.finish(), node, periods)
