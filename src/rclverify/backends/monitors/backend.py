@@ -36,7 +36,6 @@ from .judged import Counted, Heard, explain, not_judged
 from .log_calls import LogCalls, merge_deadlines
 from .periods import PeriodMonitor, has_periods, with_periods
 from .rml import Spec, rml_id, translate
-from .runset import run_counts, run_runset, runset_obligations
 from .summary import monitoring_details, summary_line, tool_versions, verdict_status
 
 NAME = "monitors"
@@ -180,13 +179,11 @@ class MonitorsBackend:
                       "config": target.rel(target.artifacts.parent / "config.yaml"),
                       "not_expressible": [{"guarantee": t.guarantee, "part": t.part, "why": t.why}
                                           for t in spec.terms if not t.text]}))
-        return out + runset_obligations(target, list(cfg.traces), out)  # a target: the run set's claim (runset.py)
+        return out
 
     def run(self, obligation: Obligation, target: NodeTarget) -> Evidence:
         """Check the obligation's trace against the node's contract (never raises
         for a user-caused problem)."""
-        if obligation.data.get("run_set") is not None:  # the entry's target over all its runs (runset.py)
-            return run_runset(self.run, obligation, target, tool_versions())
         clock = Stopwatch()
         versions = tool_versions()
 
@@ -258,7 +255,6 @@ class MonitorsBackend:
         entry = {"node": res.node, "status": status, "explanation": explanation}
         explain(entry, items)  # a pending record says why itself
         explanation = entry["explanation"]
-        extra["statistics"] = run_counts(target.root, target.config, trace, details["sha256"], res, status, span.seconds)
         return evidence(status, explanation, details={"monitoring": details, **extra},
                         artifacts=(str(obligation.data.get("rml", "")), str(obligation.data.get("config", ""))),
                         log=summary_line(res))
