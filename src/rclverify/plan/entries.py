@@ -55,10 +55,11 @@ SCHEMAS: dict[str, EntrySchema] = {s.name: s for s in (
                                    "timeout_s"),
                 path_keys=frozenset({"implementation"}), qualified_keys=frozenset({"implementation"})),
     EntrySchema("experiment", ("guarantee", "answers", "summary", "data", "column", "unit", "better", "constants",
-                               "criterion", "timeout_ms"),
+                               "criterion", "timeout_ms", "target", "environment"),
                 path_keys=frozenset({"summary", "data"})),
     EntrySchema("review", ("record",), path_keys=frozenset({"record"})),
-    EntrySchema("monitors", ("traces", "mapping", "horizon", "tolerance"), path_keys=frozenset({"traces", "mapping"})),
+    EntrySchema("monitors", ("traces", "mapping", "horizon", "tolerance", "target", "environment", "origin"),
+                path_keys=frozenset({"traces", "mapping"})),
 )}
 
 #: The backends a plan may name, in registry order.

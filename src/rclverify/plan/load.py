@@ -22,6 +22,7 @@ from ..rcl.errors import Diagnostic, RclError, error
 from ..rcl.types import BOOL, Checked
 from .errors import PlanError, plan_error
 from .formal import Source
+from .targets import check_targets, requirement_target
 from .yamlguard import KEY, Blocks, compose_guarded, read_yaml_text, to_data
 
 # The plan's values live in plan/model.py (below this loader and what it calls); re-exported here.
@@ -122,7 +123,8 @@ def load_plan(root: Path, plan_rel: str = "contracts/plan.yaml") -> Plan:
                                 ranking=_source(("requirements", i, "ranking"), r, "ranking", locs, blocks, plan_rel),
                                 invariant=_source(("requirements", i, "invariant"), r, "invariant", locs, blocks,
                                                   plan_rel),
-                                strength=r.get("strength")))
+                                strength=r.get("strength"),
+                                target=requirement_target(r.get("target"), loc("requirements", i, "target"))))
     conns = []
     for i, c in enumerate(data.get("connections", []) or []):
         fn, fv = c["from"].split(".", 1)
@@ -329,6 +331,7 @@ def resolve(plan: Plan, checked: Checked) -> None:
             for key, msg in unknown_key_messages(e.backend, e.config):
                 path = ("nodes", node, "evidence", e.index, key)
                 bad(plan.locs.get(path + (KEY,), plan.locs.get(path, e.loc)), msg)
+    diags.extend(check_targets(plan))  # statistical targets, environment tags, run origins (docs/statistics.md)
     # The backends' own check-time validation (experiment data and criteria,
     # review records, trace mappings) is run by the layer above both
     # (rclverify.pipeline.Workspace.checked calls backends.entry_checks), so

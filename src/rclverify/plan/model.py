@@ -10,6 +10,7 @@ from fractions import Fraction
 from pathlib import Path
 from typing import Any, Mapping
 
+from ..evidence.statistics import Target
 from ..rcl import ast
 from .formal import Source
 from .acknowledged import Acknowledgement
@@ -52,6 +53,8 @@ class Requirement:
     invariant: Source | None = None
     #: the least evidence strength the guarantees its proof uses must have (docs/confidence.md), or ``None``
     strength: str | None = None
+    #: the violation probability its recorded runs must bound (docs/statistics.md), or ``None``
+    target: Target | None = None
 
 
 @dataclass(frozen=True)

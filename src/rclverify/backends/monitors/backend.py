@@ -15,6 +15,7 @@
 """
 from __future__ import annotations
 
+import functools
 import hashlib
 from pathlib import Path
 from typing import Any, Callable, Iterable, Iterator, Mapping
@@ -36,6 +37,7 @@ from .judged import Counted, Heard, explain, not_judged
 from .log_calls import LogCalls, merge_deadlines
 from .periods import PeriodMonitor, has_periods, with_periods
 from .rml import Spec, rml_id, translate
+from .runset import run_counts, run_runset, runset_obligations
 from .summary import monitoring_details, summary_line, tool_versions, verdict_status
 
 NAME = "monitors"
@@ -45,6 +47,7 @@ KIND = "monitoring"
 REORDER_WINDOW_MS = 50
 
 
+@functools.lru_cache(maxsize=1)  # one environment: each template compiled once per process, not once per trace
 def _templates() -> jinja2.Environment:
     return jinja2.Environment(loader=jinja2.PackageLoader("rclverify.backends.monitors", "templates"),
                               undefined=jinja2.StrictUndefined, autoescape=False, keep_trailing_newline=True,
@@ -179,11 +182,13 @@ class MonitorsBackend:
                       "config": target.rel(target.artifacts.parent / "config.yaml"),
                       "not_expressible": [{"guarantee": t.guarantee, "part": t.part, "why": t.why}
                                           for t in spec.terms if not t.text]}))
-        return out
+        return out + runset_obligations(target, list(cfg.traces), out)  # a target: the run set's claim (runset.py)
 
     def run(self, obligation: Obligation, target: NodeTarget) -> Evidence:
         """Check the obligation's trace against the node's contract (never raises
         for a user-caused problem)."""
+        if obligation.data.get("run_set") is not None:  # the entry's target over all its runs (runset.py)
+            return run_runset(self.run, obligation, target, tool_versions())
         clock = Stopwatch()
         versions = tool_versions()
 
@@ -255,6 +260,7 @@ class MonitorsBackend:
         entry = {"node": res.node, "status": status, "explanation": explanation}
         explain(entry, items)  # a pending record says why itself
         explanation = entry["explanation"]
+        extra["statistics"] = run_counts(target.root, target.config, trace, details["sha256"], res, status, span.seconds)
         return evidence(status, explanation, details={"monitoring": details, **extra},
                         artifacts=(str(obligation.data.get("rml", "")), str(obligation.data.get("config", ""))),
                         log=summary_line(res))

@@ -1,0 +1,156 @@
+"""Monitored runs counted, and a plan's statistical target judged on them (issue 68; docs/statistics.md).
+
+* :func:`run_counts` - what one run's evidence saw (``details["statistics"]``
+  of every monitors record): the run's digest, how it was recorded
+  (``live``: a log ``rclverify monitor --live`` wrote, with its verdict
+  lines; ``bag``; ``log``: any other ROSMonitoring log), the entry's
+  ``environment`` and ``origin``, judged answers, violations, inconclusive
+  answers, the seconds observed and the violations per guarantee;
+* :func:`runset_obligations` - with a ``target:`` the entry exports one more
+  obligation, "the runs of the entry bound the violation probability under
+  its environment", whose inputs are all of its traces;
+* :func:`run_runset` - that obligation's evidence: every trace checked as
+  its own obligation is (the same verdicts), each distinct digest counted
+  once, and the target decided (:func:`rclverify.evidence.statistics.decide`).
+  Runs of ``origin: harness`` are listed and never counted.
+
+A run's own record stays what it was: a violation fails it (counter-evidence
+for the guarantee, docs/confidence.md C0), while the run set's record judges
+the separate, quantified claim.
+"""
+from __future__ import annotations
+
+import dataclasses
+import hashlib
+from pathlib import Path
+from typing import Any, Callable
+
+from ...evidence.records import Evidence, Obligation, make_obligation_id
+from ...evidence.statistics import count_runs, decide
+from ...plan.targets import entry_environment, entry_origin, entry_target
+from ..base import NodeTarget, Stopwatch, make_evidence
+from .verdicts import NodeResult
+
+#: The suffixes of a bag file (a directory is a ROS 2 bag too).
+BAG_SUFFIXES = (".bag", ".mcap", ".db3")
+#: The topic of a live log's verdict lines (live.VERDICT_LOG_TOPIC; not imported: live.py pulls the engine in).
+_LIVE_MARK = b'"rclverify/verdict"'
+
+
+def recorded_as(root: Path, trace: str) -> str:
+    """``bag``, ``live`` or ``log`` (module docstring)."""
+    p = root / trace
+    if p.is_dir() or p.suffix in BAG_SUFFIXES:
+        return "bag"
+    try:
+        with p.open("rb") as fh:
+            for block in iter(lambda: fh.read(1 << 20), b""):
+                if _LIVE_MARK in block:
+                    return "live"
+    except OSError:
+        return "log"
+    return "log"
+
+
+def run_digest(root: Path, trace: str) -> str:
+    """The run's identity: sha256 over its contents only (a bag directory's
+    files by their names inside it), so one run copied under two names is
+    one run."""
+    p = root / trace
+    h = hashlib.sha256()
+    files = sorted(f for f in p.rglob("*") if f.is_file()) if p.is_dir() else [p]
+    for f in files:
+        if p.is_dir():
+            h.update(f.relative_to(p).as_posix().encode() + b"\0")
+        with f.open("rb") as fh:
+            for block in iter(lambda: fh.read(1 << 20), b""):
+                h.update(block)
+    return h.hexdigest()
+
+
+def run_counts(root: Path, config: Any, trace: str, sha: str, res: NodeResult, status: str,
+               seconds: float | None) -> dict[str, Any]:
+    """One run's counts (module docstring).  A run that failed or stayed
+    inconclusive on its deadlines, periods or calls alone counts one
+    violation or one undecided answer, so the run's verdict and its counts
+    never disagree."""
+    c = res.counts
+    violations = int(c.get("violated", 0))
+    unsure = int(c.get("inconclusive", 0)) + int(c.get("open", 0))
+    if status == "failed" and not violations:
+        violations = 1
+    if status == "inconclusive" and not unsure and not violations:
+        unsure = 1
+    per_guarantee: dict[str, int] = {}
+    for v in res.violations:
+        key = str(v.get("guarantee") or 0)
+        per_guarantee[key] = per_guarantee.get(key, 0) + 1
+    return {"trace": trace, "sha256": run_digest(root, trace), "files_sha256": sha, "recorded": recorded_as(root, trace),
+            "environment": entry_environment(config), "origin": entry_origin(config), "status": status,
+            "answers": int(c.get("satisfied", 0)) + int(c.get("violated", 0)), "violations": violations,
+            "inconclusive": unsure, "seconds": seconds or 0.0, "violations_per_guarantee": per_guarantee,
+            "per_guarantee_complete": not res.violations_dropped}
+
+
+def runset_obligations(target: NodeTarget, traces: list[str], per_trace: list[Obligation]) -> list[Obligation]:
+    """The run-set obligation of an entry with a ``target:`` (``[]`` without one or without traces)."""
+    t = entry_target(target.config)
+    if t is None or not per_trace:
+        return []
+    env = entry_environment(target.config)
+    first = per_trace[0]
+    oid = make_obligation_id(target.node.name, 0, "monitors", f"runs_{env}_e{target.index}")
+    statement = (f"the runs of {target.node.name} recorded under {env} bound the probability that a "
+                 f"{t.per} violates its contract: {t.words()}")
+    inputs = sorted({i for o in per_trace for i in o.inputs})
+    return [dataclasses.replace(first, id=oid, statement=statement, instance=f"runs_{env}_e{target.index}",
+                                inputs=tuple(inputs), data={**first.data, "trace": "", "run_set": list(traces),
+                                                            "target": t.to_json(), "environment": env})]
+
+
+def run_runset(check_one: Callable[[Obligation, NodeTarget], Evidence], obligation: Obligation,
+               target: NodeTarget, versions: str) -> Evidence:
+    """The run-set obligation's evidence (module docstring); ``check_one``
+    is the backend's per-trace ``run``."""
+    clock = Stopwatch()
+    t = entry_target(target.config)
+    env, origin = entry_environment(target.config), entry_origin(target.config)
+
+    def evidence(status: str, explanation: str, **kw: Any) -> Evidence:
+        return make_evidence(target, obligation, status, tool="rclverify monitor", tool_version=versions,
+                             clock=clock, explanation=explanation, **kw)
+    if t is None:
+        return evidence("error", "the plan entry no longer states a target that reads")
+    rows = []
+    own = {k: v for k, v in obligation.data.items() if k not in ("run_set", "target", "environment")}
+    for trace in dict.fromkeys(str(x) for x in obligation.data.get("run_set", ())):
+        # its record is read for its verdict and counts only: no input hashed (the run set's record hashes them all)
+        # and its entry seen with this trace only (the entry's check of every trace is done once, at export)
+        one = dataclasses.replace(target, config={**target.config, "traces": [trace]})
+        ev = check_one(dataclasses.replace(obligation, data={**own, "trace": trace}, inputs=()), one)
+        stats = (ev.details or {}).get("statistics")
+        rows.append(stats if isinstance(stats, dict) else
+                    {"trace": trace, "sha256": f"unread:{trace}", "status": ev.status, "answers": 0,
+                     "violations": 0, "inconclusive": 0, "seconds": 0.0, "reason": ev.explanation})
+    counted = [] if origin == "harness" else rows
+    counts = count_runs(counted)
+    verdict = decide(counts, t)
+    status, explanation = verdict["status"], f"under {env}: {verdict['explanation']}"
+    if origin == "harness":
+        status, explanation = "pending", (f"the {len(rows)} run(s) under {env} were driven by a test harness "
+                                          f"(origin: harness): they are not operation and count toward no bound")
+    errors = [r for r in rows if r.get("status") == "error"]
+    if errors and status == "discharged":  # an unreadable run may have violated: no bound without it
+        status = "inconclusive"
+        explanation += (f"; but {len(errors)} run(s) could not be checked (first: {errors[0].get('trace')}): "
+                        f"the bound holds only if they were clean")
+    if counts["duplicates"]:
+        explanation += f"; {counts['duplicates']} run file(s) repeat a run already counted (same sha256)"
+    if origin == "simulation":
+        explanation += "; the runs are simulated (origin: simulation): the bound holds for the simulator's runs"
+    details = {"statistics": {"environment": env, "origin": origin, "target": t.to_json(), "counts": counts,
+                              "decision": verdict, "runs": rows}}
+    return evidence(status, explanation, details=details, log=explanation)
+
+
+__all__ = ["BAG_SUFFIXES", "recorded_as", "run_counts", "run_runset", "runset_obligations"]
