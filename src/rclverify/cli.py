@@ -576,6 +576,26 @@ def cmd_oracle(args: argparse.Namespace) -> int:
     return oracle_command(args, checked)
 
 
+#: Exit code when standard output's reader left (128 + SIGPIPE, what a
+#: command killed by SIGPIPE reports in a shell).
+BROKEN_PIPE_EXIT = 141
+
+
+def _reader_left() -> int:
+    """Standard output's pipe closed (``rclverify explain ID | head``): point
+    standard output at the null device, so that the interpreter's flush at exit
+    neither fails nor prints, and return :data:`BROKEN_PIPE_EXIT`.  Nothing
+    goes to standard error: the reader asked for no more (POSIX ``SIGPIPE``
+    semantics; the Python documentation of ``signal``, "Note on SIGPIPE")."""
+    try:
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+        os.close(devnull)
+    except (OSError, ValueError):  # no file descriptor behind sys.stdout (a test's capture)
+        pass
+    return BROKEN_PIPE_EXIT
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``rclverify`` console script; returns the exit code."""
     p = argparse.ArgumentParser(prog="rclverify", description="Compositional verification from RCL contracts.")
@@ -714,7 +734,11 @@ def main(argv: Sequence[str] | None = None) -> int:
     args = p.parse_args(argv)
     from .runlock import RunInProgress
     try:
-        return int(args.fn(args))
+        code = int(args.fn(args))
+        sys.stdout.flush()  # a closed pipe shows here, not at exit, where it could not be caught
+        return code
+    except BrokenPipeError:  # `rclverify explain ID | head`: the reader left; end quietly
+        return _reader_left()
     except RclError as exc:
         return _print_diags(exc)
     except RunInProgress as exc:  # report/bundle --no-wait while a run holds the workspace

@@ -16,7 +16,13 @@ guarantee)
 a solver disagreement                            the side condition's or          yes
                                                  requirement's goal
 a vacuous or inconsistent proof                  the requirement's goal           yes
+a problem's culprit, failed or error             the guarantee's or the node's    if failed
+(report/culprits.py)                             goal
 ==============================================  ===============================  ========
+
+A defeated claim is never better than what defeats it
+(:func:`.model.propagate`): a culprit guarantee whose own evidence holds
+reads the status of the problem it causes (issue 64).
 """
 from __future__ import annotations
 
@@ -62,6 +68,17 @@ def add_defeaters(els: dict[str, Element], report: Mapping[str, Any], ident: Any
             challenge(ident("CSn", "solvers", sc["id"]), ident("G", "sc", sc["id"]),
                       f"The second solver does not confirm {sc['id']}: {s.get('why', '')}", "inconclusive", True,
                       str(s.get("smt2") or ""))
+    for n in report.get("nodes", []):  # a problem's culprit (issue 64): its goal is never "discharged"
+        name = str(n["name"])
+        for g in [*n.get("guarantees", []), n]:
+            target = ident("G", name, f"g{g['index']}") if g is not n else ident("G", name)
+            for k, row in enumerate(g.get("culprit_of") or (), 1):
+                if row["status"] not in ("failed", "error"):
+                    continue  # outstanding evidence is no counter-evidence: the goal reads it already
+                what = f"guarantee {g['index']} of {name}" if g is not n else f"the contract of {name}"
+                challenge(ident("CSn", "culprit", target, k), target,
+                          f"Problem caused by {what}: {row['sentence']}", str(row["status"]),
+                          row["status"] == "failed")
     for r in report.get("requirements", []):
         rid, verdict = str(r["id"]), str(r.get("verdict"))
         s = (r.get("check") or {}).get("solvers") or {}

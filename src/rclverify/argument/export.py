@@ -40,6 +40,7 @@ from ..cache.memo import last_call
 from ..report import diagram
 from ..cache import fingerprint
 from ..report.fragments import FragmentCache
+from ..report.textfmt import plain
 from .build import build_argument
 from .model import Argument, Element
 
@@ -176,7 +177,8 @@ def _clip(text: str, limit: int) -> str:
 def _label(e: Element) -> str:
     head = e.id if e.type != "solution" else e.ref or e.id
     width = 28 if e.type == "solution" else 44
-    body = e.text if len(e.text) <= 180 else e.text[:177] + "..."
+    text = plain(e.text)  # an SVG shows no Markdown: code spans as their text
+    body = text if len(text) <= 180 else text[:177] + "..."
     lines = [head] + (textwrap.wrap(body, width) if e.type != "solution" else [])
     if e.type in ("assumption", "justification"):
         lines.append("A" if e.type == "assumption" else "J")
@@ -196,7 +198,7 @@ def to_dot(arg: Argument, title: str = "assurance argument", link_prefix: str = 
     def node(e: Element) -> dict[str, Any]:
         shape, style = _SHAPES[e.type]
         fill, border = diagram.NODE_COLOURS.get(e.status or "", diagram.OTHER_COLOURS)
-        return {"id": diagram.dot_string(e.id), "label": _label(e), "tooltip": diagram.dot_string(_clip(e.text, MAX_TOOLTIP_CHARS)),
+        return {"id": diagram.dot_string(e.id), "label": _label(e), "tooltip": diagram.dot_string(_clip(plain(e.text), MAX_TOOLTIP_CHARS)),
                 "shape": shape, "style": style, "fill": fill, "border": border,
                 "url": diagram.dot_string(link_prefix + e.url) if e.url else ""}
 

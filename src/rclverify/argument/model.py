@@ -165,12 +165,19 @@ def propagate(arg: Argument) -> Argument:
     marked so: the evidence of a guarantee no obligation covers); otherwise the worst status of its
     ``supported_by`` children (a goal with no children and not marked
     undeveloped is also ``pending``: nothing shows it).  Solutions keep
-    their status; contexts and assumptions get ``None``.  Raises
+    their status; contexts and assumptions get ``None``.  A goal marked
+    ``defeated`` is never better than the counter solutions that challenge
+    it (a culprit guarantee whose own evidence holds reads its problem's
+    status, issue 64).  Raises
     :class:`ArgumentError` via :func:`validate`.
     """
     validate(arg)
     els = arg.elements
     memo: dict[str, str | None] = {}
+    defeaters: dict[str, list[str]] = {}
+    for e in els.values():
+        for t in e.challenges:
+            defeaters.setdefault(t, []).append(e.id)
 
     def status(i: str) -> str | None:
         if i in memo:
@@ -187,6 +194,8 @@ def propagate(arg: Argument) -> Argument:
         else:
             kids = [status(x) for x in e.supported_by]
             s = worst([k for k in kids if k is not None], empty=UNDEVELOPED_STATUS)
+        if e.defeated and s is not None:  # never better than what defeats it (a problem's culprit: issue 64)
+            s = worst([s, *(str(els[c].status) for c in defeaters.get(i, ()) if els[c].status is not None)])
         memo[i] = s
         return s
     out = {}

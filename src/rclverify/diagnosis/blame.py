@@ -109,6 +109,26 @@ def side_condition_culprits(ws: Any, sc: Mapping[str, Any]) -> tuple[list[tuple[
     return out, undecided
 
 
+def fixed_side_condition(ws: Any, sc: Mapping[str, Any], producer: str, k: int) -> Edit | None:
+    """The edit that discharges the failed side condition ``sc`` through
+    guarantee ``k`` of ``producer`` (one of :func:`side_condition_culprits`):
+    its conclusion strengthened by the consumer's conjunct in the producer's
+    names; ``None`` without an exact location."""
+    to_producer = [(f"in.{iv}", f"out.{ov}") for _, ov, _, iv in link_pairs(sc)]
+    return conclusion_edit(ws, producer, k, _rename(str(sc["conjunct"]), to_producer))
+
+
+def proved_with(ws: Any, req_id: str, edit: Edit) -> bool:
+    """Does Z3 prove the requirement ``req_id`` from consistent premises,
+    non-vacuously, once ``edit`` is made (the pipeline's own requirement
+    check on an edited copy; nothing is written)?  ``False`` when the edited
+    text does not check or the requirement is not in the plan."""
+    from ..plan.load import all_requirements
+    req = next((r for r in all_requirements(ws.plan) if r.id == req_id), None)
+    system = recheck.edited_system(ws, edit)
+    return req is not None and system is not None and _proved(req, system, ws.plan)
+
+
 def _proved(req: Any, system: Any, plan: Any) -> bool:
     from ..requirements.check import check_requirement
     world.fresh()

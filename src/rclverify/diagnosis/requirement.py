@@ -36,6 +36,10 @@ def requirement_record(ws: Any, report: Mapping[str, Any], q: Mapping[str, Any],
             ["progress-repair", q["id"], check.get("formal"), cone],
             lambda: progress_repairs(ws, q, check["temporal"])) or [])
 
+    causes = _causes(ws, report, q, cone, cache)
+    if causes:  # refuted only because a side condition fails: that problem's row, its culprit (issue 64)
+        return _consequence_record(report, q, check, causes, guarantee_source)
+
     def find() -> list[dict[str, Any]]:
         rows = []
         for f in blame.requirement_culprits(ws, str(q["id"]), cone):
@@ -100,6 +104,66 @@ def requirement_record(ws: Any, report: Mapping[str, Any], q: Mapping[str, Any],
     return {"id": str(q["id"]), "kind": "requirement", "node": found[0]["node"] if found else "", "status": "failed",
             "sentence": sentence, "culprits": cul, "counterexample": table,
             "repairs": [f["repair"] for f in found], "guarantee": None}
+
+
+def _causes(ws: Any, report: Mapping[str, Any], q: Mapping[str, Any], cone: list[str],
+            cache: Any) -> list[tuple[Mapping[str, Any], str, int]]:
+    """``[(side condition row, producer, guarantee index)]``: the failed side
+    conditions of ``q``'s cone whose discharge alone proves ``q`` -- each
+    producer guarantee that discharges it when strengthened by the
+    consumer's conjunct (:func:`blame.side_condition_culprits`, the same
+    cache entry as the side condition's own record), with which Z3 then
+    proves ``q`` from consistent premises (:func:`blame.proved_with`).  The
+    requirement is then a consequence of that problem, not a problem of its
+    own (docs/diagnosis.md, "One row per cause")."""
+    out: list[tuple[Mapping[str, Any], str, int]] = []
+    check = q.get("check") or {}
+    for sc in report.get("side_conditions") or ():
+        if sc.get("status") != "failed" or str(sc.get("node")) not in cone:
+            continue
+        def producers(sc: Mapping[str, Any] = sc) -> dict[str, Any]:  # as diagnosis/build.py keeps them
+            found, undecided = blame.side_condition_culprits(ws, sc)
+            return {"culprits": [list(x) for x in found], "undecided": undecided}
+        shown = cache.get(["sc-culprits", sc["id"], sc["conjunct"]], producers) or {}
+        for p, k in shown.get("culprits") or ():
+            def proves(p: str = str(p), k: int = int(k), sc: Mapping[str, Any] = sc) -> bool:
+                edit = blame.fixed_side_condition(ws, sc, p, k)
+                return edit is not None and blame.proved_with(ws, str(q["id"]), edit)
+            if cache.get(["consequence", q["id"], check.get("formal"), cone, sc["id"], sc["conjunct"], p, k], proves):
+                out.append((sc, str(p), int(k)))
+    return out
+
+
+def _consequence_record(report: Mapping[str, Any], q: Mapping[str, Any], check: Mapping[str, Any],
+                        causes: list[tuple[Mapping[str, Any], str, int]],
+                        guarantee_source: Callable[[Mapping[str, Any], str, int], tuple[str, str]]) -> dict[str, Any]:
+    """The diagnosis record of a requirement refuted only because of the
+    failed side conditions ``causes`` (:func:`_causes`): its culprits are
+    theirs (the consumer's assumption and the producer's guarantee), its
+    ``consequence_of`` their ids; no repair of its own (the side condition's
+    repairs are the row's)."""
+    cul: list[dict[str, Any]] = []
+    said: list[str] = []
+    for sc, p, k in causes:
+        text, src = guarantee_source(report, p, k)
+        for c in ({"what": f"assumption of {sc['node']}: `{sc['conjunct']}`", "source": sc["source"],
+                   "text": sc["conjunct"]},
+                  {"what": f"guarantee {k} of {p}: `{text}`", "source": src, "text": text}):
+            if c not in cul:
+                cul.append(c)
+        said.append(f"side condition {sc['id']} ({sc['node']} assumes `{sc['conjunct']}`, {sc['source']}) fails "
+                    f"through guarantee {k} of {p} ({src}) `{text}`")
+    table = [{"node": r["node"], "variable": v, "value": x, "table": None}
+             for r in check.get("counterexample") or [] for v, x in r["values"].items()]
+    cex = ", ".join(f"{r['node']}.{r['variable']} = {r['value']}" for r in table)
+    ids = list(dict.fromkeys(str(sc["id"]) for sc, _, _ in causes))
+    sentence = (f"Requirement {q['id']} (`{check.get('formal')}`, {check.get('source')}) is refuted only because "
+                + "; and ".join(said) + f": with that side condition discharged Z3 proves {q['id']}, so its "
+                "counterexample passes through the failed side condition"
+                + (f". Z3's counterexample: {cex}" if cex else "") + ".")
+    return {"id": str(q["id"]), "kind": "requirement", "node": causes[0][1], "status": "failed",
+            "sentence": sentence, "culprits": cul, "counterexample": table, "repairs": [], "guarantee": None,
+            "consequence_of": ids}
 
 
 def _between(report: Mapping[str, Any], sources: set[str], sinks: set[str]) -> set[str]:

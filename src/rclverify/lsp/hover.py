@@ -46,7 +46,8 @@ def hover_text(a: Analysis, sym: Symbol, report: Mapping[str, Any] | None) -> st
     if sym.kind == "node" and sym.name in nodes:
         rn = _report_node(report, sym.name)
         model = a.model
-        return t.render(kind="node", name=sym.name, status=rn.get("status"), contract=node_to_rcl(nodes[sym.name]).rstrip(),
+        return t.render(kind="node", name=sym.name, status=rn.get("status"), culprit_of=rn.get("culprit_of") or [],
+                        contract=node_to_rcl(nodes[sym.name]).rstrip(),
                         guarantees=rn.get("guarantees") or [],
                         producers=model.producers(sym.name) if model else [],
                         consumers=model.consumers(sym.name) if model else [])
@@ -77,6 +78,7 @@ def hover_text(a: Analysis, sym: Symbol, report: Mapping[str, Any] | None) -> st
         findings = [f for f in (report or {}).get("findings", ())
                     if f.get("node") == sym.node and f.get("guarantee") == sym.index]
         return t.render(kind="guarantee", node=sym.node, index=sym.index, status=g.get("status"),
+                        culprit_of=g.get("culprit_of") or [],
                         text=expr_to_rcl(n.guarantees[sym.index - 1].formula), obligations=obligations, findings=findings)
     if sym.kind == "requirement":
         r = next((x for x in (report or {}).get("requirements", ()) if x.get("id") == sym.name), None)

@@ -428,6 +428,8 @@ def build_report(ws: Workspace) -> dict[str, Any]:
     from .problems import group_problems
     from .render import anchor, problem_items
     report["problems"] = group_problems(report, problem_items(report), anchor)
+    from .culprits import mark_culprits  # a culprit node reads its problem's status, never "discharged" (issue 64)
+    mark_culprits(report)
     return report
 
 

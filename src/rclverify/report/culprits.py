@@ -8,6 +8,8 @@ from __future__ import annotations
 
 from typing import Any, Iterable, Mapping
 
+from ..evidence.records import SEVERITY, worst
+
 
 def culprit_nodes(groups: Iterable[Any]) -> set[str]:
     """The nodes a problem's culprit (``groups``: the problems by root cause)
@@ -27,4 +29,43 @@ def culprit_nodes(groups: Iterable[Any]) -> set[str]:
     return out
 
 
-__all__ = ["culprit_nodes"]
+#: Status words of the problem rows that are not evidence statuses, as evidence statuses (report/problems.py).
+_AS_EVIDENCE = {"problem": "failed", "refuted": "failed", "unknown": "inconclusive", "warning": "pending"}
+
+
+def _status(word: Any) -> str | None:
+    s = _AS_EVIDENCE.get(str(word), str(word))
+    return s if s in SEVERITY else None
+
+
+def mark_culprits(report: dict[str, Any]) -> None:
+    """Give every node and guarantee a problem blames the status of that
+    problem (issue 64: a culprit never reads "discharged"; its own evidence
+    may all hold, the problem it causes does not).  For each row of
+    ``report["problems"]`` (:func:`rclverify.report.problems.group_problems`)
+    and each culprit ``guarantee:Node:k`` or ``contract:Node`` of it, the
+    node's ``status`` (and the guarantee's) becomes the worse of its own and
+    the row's, and ``culprit_of`` lists ``{"status", "sentence"}`` of the rows
+    that name it.  Changes ``report`` in place; a row without culprits, or
+    naming a node the report does not have, changes nothing."""
+    nodes = {str(n["name"]): n for n in report.get("nodes") or ()}
+    for g in report.get("problems") or ():
+        st = _status(g.get("status"))
+        if st is None or st == "discharged" or str((g.get("key") or [""])[0]).startswith("unverified:"):
+            continue  # an unverified guarantee's row: the guarantee reads "unverified" already
+        for c in g.get("culprits") or ():
+            kind, _, rest = str(c.get("id", "")).partition(":")
+            name, _, k = rest.partition(":")
+            n = nodes.get(name)
+            if kind not in ("guarantee", "contract") or n is None:
+                continue
+            targets = [n] + [x for x in n.get("guarantees") or () if kind == "guarantee" and str(x.get("index")) == k]
+            for t in targets:
+                t["status"] = worst([str(t.get("status") or "discharged"), st])
+                seen = t.setdefault("culprit_of", [])
+                row = {"status": st, "sentence": str(g.get("sentence", ""))}
+                if row not in seen:
+                    seen.append(row)
+
+
+__all__ = ["culprit_nodes", "mark_culprits"]

@@ -1,6 +1,7 @@
 """The HTML report's jinja2 filters and globals beyond those of render.py.
 
-``prose`` (Markdown code spans as ``<code>``), ``natsort`` (ids in natural
+``prose`` (Markdown code spans as ``<code>``), ``plain`` (code spans as
+their text, for attributes such as ``title``), ``natsort`` (ids in natural
 order): :mod:`.textfmt`; ``readable_svg`` (a large drawing at a size whose
 text can be read): :mod:`.svgfit`; ``reqbadges`` (a requirement's proof and
 evidence as two badges): :mod:`.badges`; ``tally`` (statuses counted,
@@ -18,7 +19,7 @@ import jinja2
 from ..rcl.latex import document_frame
 from .badges import requirement_badges
 from .svgfit import readable_svg
-from .textfmt import natural_sorted, prose
+from .textfmt import natural_sorted, plain, prose
 
 
 def _natsort(items: Iterable[Any], attribute: str | None = None) -> list[Any]:
@@ -37,6 +38,6 @@ def _tally(env: jinja2.Environment, statuses: Iterable[Any]) -> list[tuple[str, 
 
 def register(env: jinja2.Environment) -> None:
     """Add this module's filters and globals to ``env`` (the report's environment)."""
-    env.filters.update(prose=prose, natsort=_natsort, readable_svg=readable_svg, reqbadges=requirement_badges,
+    env.filters.update(prose=prose, plain=plain, natsort=_natsort, readable_svg=readable_svg, reqbadges=requirement_badges,
                        tally=_tally)
     env.globals.update(latex_frame=document_frame)

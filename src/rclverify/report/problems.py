@@ -155,6 +155,22 @@ class _Places:
         return rows[i][1] if i >= 0 else None
 
 
+def _join_consequences(members: list[tuple[dict[str, Any], list[str]]], by_id: Mapping[str, Any]) -> None:
+    """A problem whose diagnosis is ``consequence_of`` other problems (a
+    requirement refuted only because a side condition fails, Z3 proving it
+    once that side condition is discharged: diagnosis/requirement.py) takes
+    their root culprits and is marked ``consequence_of`` (issue 64: one row
+    per cause, its consequences listed under it).  Changes ``members``
+    (``(member, roots)``) in place; a cause that is not a member changes
+    nothing."""
+    roots_of = {m["id"]: roots for m, roots in members}
+    for i, (m, roots) in enumerate(members):
+        causes = [str(c) for c in (by_id.get(m["id"]) or {}).get("consequence_of") or () if str(c) in roots_of]
+        if causes and m["diagnosis"]:
+            m["consequence_of"] = causes
+            members[i] = (m, list(dict.fromkeys(r for c in causes for r in roots_of[c])) or roots)
+
+
 def _join_requirements_to_side_conditions(members: list[tuple[dict[str, Any], list[str]]]) -> None:
     """A refuted requirement whose culprits are all culprits of one failed
     side condition has that side condition's root cause: both rows read one
@@ -205,7 +221,8 @@ def group_problems(report: Mapping[str, Any], items: Sequence[Mapping[str, Any]]
                      the worst status: the most telling kind (_TELLING), then the shortest,
          "culprits": [{"id", "what", "source", "file", "anchor" (fragment id or "")}],
          "where": file:line:col of the first member that has one (shown when no culprit is named),
-         "members": [{"id", "kind", "status", "sentence", "anchor", "diagnosis": bool}],
+         "members": [{"id", "kind", "status", "sentence", "anchor", "diagnosis": bool,
+                      "consequence_of": [ids of the members it follows from] (only on a consequence)}],
          "repairs": [{"diagnosis": id, "index": n}]  (distinct diffs, each checked by Z3)}
 
     Raises ``KeyError`` for a report dict without ``nodes``.
@@ -245,6 +262,7 @@ def group_problems(report: Mapping[str, Any], items: Sequence[Mapping[str, Any]]
             explains.setdefault(victim, [])
             explains[victim] += [r for r in roots if r not in explains[victim]]
     ps.join_by_first_repair(members, by_id)  # several consumers, one too loose producer: one row (issue 48)
+    _join_consequences(members, by_id)  # refuted only because of another problem: that problem's row (issue 64)
     diagnosed = {str(d["id"]) for d in diagnoses}
     for q in report.get("requirements", []):
         if q.get("verdict") not in BAD_VERDICTS or str(q["id"]) in diagnosed:

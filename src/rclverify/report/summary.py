@@ -124,7 +124,10 @@ def summary_data(report: Mapping[str, Any]) -> dict[str, Any]:
                           for d in report.get("deadlines") or ()],
             "problems": [{"status": g["status"], "sentence": group_sentence(g),
                           "culprits": [_culprit(c) for c in g.get("culprits", [])], "where": g.get("where", ""),
-                          "members": [m["id"] for m in g.get("members", [])], "repairs": len(g.get("repairs", []))}
+                          # a consequence says of what (issue 64: one row per cause, its consequences under it)
+                          "members": [m["id"] + (f" (a consequence of {', '.join(m['consequence_of'])})"
+                                                 if m.get("consequence_of") else "") for m in g.get("members", [])],
+                          "repairs": len(g.get("repairs", []))}
                          for g in report.get("problems", ())],
             "grounding": _grounding(report.get("grounding")), "strict": strict_reasons(report)}
 

@@ -60,34 +60,47 @@ def natural_within(items: Sequence[_T], group: Callable[[_T], Any], ident: Calla
 _TICKS = re.compile(r"`+")
 
 
-def prose(text: Any) -> Markup:
-    """``text`` as HTML: escaped, each Markdown code span (text between two
-    backtick runs of equal length) as ``<code>`` without its backticks, a
-    space stripped from both ends of a span that has one at each (as
-    CommonMark does).  A backtick run that no equal run closes stays as
-    text.  Line breaks are kept as they are (HTML folds them)."""
+def code_spans(text: Any) -> list[tuple[bool, str]]:
+    """``text`` cut into ``[(is_code, piece)]``: each Markdown code span
+    (text between two backtick runs of equal length, CommonMark "Code
+    spans") without its backticks, a space stripped from both ends of a span
+    that has one at each; the prose between them as it is.  A backtick run
+    that no equal run closes stays in the prose."""
     s = str(text)
-    if "`" not in s:
-        return Markup(escape(s))
-    out: list[str] = []
+    out: list[tuple[bool, str]] = []
     pos = 0
-    while True:
+    while "`" in s:
         m = _TICKS.search(s, pos)
         if m is None:
             break
         close = next((c for c in _TICKS.finditer(s, m.end()) if len(c.group(0)) == len(m.group(0))), None)
         if close is None:  # no closing run: the backticks are text
-            out.append(escape(s[pos:m.end()]))
+            out.append((False, s[pos:m.end()]))
             pos = m.end()
             continue
         code = s[m.end():close.start()]
         if len(code) > 2 and code.startswith(" ") and code.endswith(" ") and code.strip():
             code = code[1:-1]
-        out.append(escape(s[pos:m.start()]))
-        out.append(Markup("<code>%s</code>") % code)
+        out += [(False, s[pos:m.start()]), (True, code)]
         pos = close.end()
-    out.append(escape(s[pos:]))
-    return Markup("").join(out)
+    out.append((False, s[pos:]))
+    return [(c, t) for c, t in out if t or c]
+
+
+def prose(text: Any) -> Markup:
+    """``text`` as HTML: escaped, each Markdown code span
+    (:func:`code_spans`) as ``<code>`` without its backticks.  A backtick
+    run that no equal run closes stays as text.  Line breaks are kept as they
+    are (HTML folds them)."""
+    return Markup("").join(Markup("<code>%s</code>") % t if c else escape(t) for c, t in code_spans(text))
+
+
+def plain(text: Any) -> str:
+    """``text`` without Markdown markup, for places that show no markup (an
+    SVG drawing's labels and tooltips): each code span's text without its
+    backticks (:func:`code_spans`), and a backtick run left open (a span cut
+    short by a length limit) dropped."""
+    return "".join(t if c else _TICKS.sub("", t) for c, t in code_spans(text))
 
 
 #: Formulas longer than this (characters) are folded in the HTML report: the

@@ -1,0 +1,92 @@
+"""One row per cause (issue 64): a requirement refuted only because a side
+condition fails joins that side condition's row, names its culprit (the
+supervisor's 45 N, not the correct gripper driver), and says it is a
+consequence; a culprit node or guarantee never reads "discharged" (report,
+terminal table, argument, editor hover)."""
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from rclverify.argument.model import Argument, Element, propagate
+from rclverify.cli import main
+from rclverify.report.culprits import mark_culprits
+
+from _grip_ws import make
+
+
+@pytest.fixture(scope="module")
+def report(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
+    ws = make(tmp_path_factory.mktemp("grip") / "ws")
+    assert main(["verify", "-w", str(ws)]) == 0
+    out: dict[str, Any] = json.loads((ws / "reports" / "assurance.json").read_text(encoding="utf-8"))
+    out["_ws"] = str(ws)
+    return out
+
+
+def _row_of(report: dict[str, Any], member: str) -> dict[str, Any]:
+    return next(g for g in report["problems"] if member in [m["id"] for m in g["members"]])
+
+
+def test_consequence_joins_the_side_condition_row(report: dict[str, Any]) -> None:
+    row = _row_of(report, "REQ-FORCE")
+    ids = [m["id"] for m in row["members"]]
+    assert "GripperDriver.sc2" in ids  # the cause and its consequence: one row
+    assert sorted(row["key"]) == ["assumption:GripperDriver:1", "guarantee:Supervisor:1"]
+    req = next(m for m in row["members"] if m["id"] == "REQ-FORCE")
+    assert req["consequence_of"] == ["GripperDriver.sc2"]
+    # the correct driver's guarantee is no culprit of it
+    assert "guarantee:GripperDriver:1" not in [c["id"] for c in row["culprits"]]
+    d = next(x for x in report["diagnoses"] if x["id"] == "REQ-FORCE")
+    assert d["consequence_of"] == ["GripperDriver.sc2"]
+    assert "refuted only because side condition GripperDriver.sc2" in d["sentence"]
+    assert not any("GripperDriver" in c["what"] and "guarantee" in c["what"] for c in d["culprits"])
+
+
+def test_no_culprit_reads_discharged(report: dict[str, Any]) -> None:
+    sup = next(n for n in report["nodes"] if n["name"] == "Supervisor")
+    assert sup["status"] == "failed"
+    assert sup["guarantees"][0]["status"] == "failed"
+    assert sup["culprit_of"] and sup["culprit_of"][0]["status"] == "failed"
+    md = (Path(report["_ws"]) / "reports" / "assurance.md").read_text(encoding="utf-8")
+    assert "REQ-FORCE`](#" in md and "(a consequence of GripperDriver.sc2)" in md
+    arg = json.loads((Path(report["_ws"]) / "reports" / "argument.json").read_text(encoding="utf-8"))
+    goal = next(e for e in arg["elements"] if e["id"] == "G-Supervisor.g1")
+    assert goal["status"] == "failed" and goal.get("defeated") is True
+
+
+def test_mark_culprits_raises_only_what_a_row_names() -> None:
+    rep: dict[str, Any] = {
+        "nodes": [{"name": "A", "status": "discharged", "guarantees": [{"index": 1, "status": "discharged"},
+                                                                      {"index": 2, "status": "discharged"}]},
+                  {"name": "B", "status": "discharged", "guarantees": [{"index": 1, "status": "discharged"}]}],
+        "problems": [{"status": "problem", "sentence": "s", "culprits": [{"id": "guarantee:A:2"}]},
+                     {"status": "inconclusive", "sentence": "t", "culprits": [{"id": "assumption:B:1"}]}]}
+    mark_culprits(rep)
+    a, b = rep["nodes"]
+    assert a["status"] == "failed" and a["guarantees"][1]["status"] == "failed"
+    assert a["guarantees"][0]["status"] == "discharged" and "culprit_of" not in a["guarantees"][0]
+    assert b["status"] == "discharged"  # an assumption is where the victim is, not a culprit node
+
+
+def test_a_defeated_goal_is_never_better_than_its_defeater() -> None:
+    els = {"G": Element("G", "goal", "g", supported_by=("Sn",), defeated=True),
+           "Sn": Element("Sn", "solution", "ok", status="discharged"),
+           "CSn": Element("CSn", "counter_solution", "culprit", status="failed", challenges=("G",)),
+           "G2": Element("G2", "goal", "h", supported_by=("Sn2",)),
+           "Sn2": Element("Sn2", "solution", "ok", status="discharged")}
+    out = propagate(Argument("G", els)).elements
+    assert out["G"].status == "failed"
+    assert out["G2"].status == "discharged"
+
+
+def test_hover_names_the_problem(report: dict[str, Any]) -> None:
+    from rclverify.lsp.hover import _ENV
+    text = _ENV.get_template("hover.md.j2").render(
+        kind="node", name="Supervisor", status="failed", culprit_of=[{"status": "failed", "sentence": "S allows 45."}],
+        contract="node Supervisor {}", guarantees=[], producers=[], consumers=[])
+    assert "last run: `failed`" in text and "culprit of a problem (`failed`): S allows 45." in text
+    assert "discharged" not in text
