@@ -83,7 +83,7 @@ def test_299_clean_runs_meet_a_one_percent_target_at_95(tmp_path: Path) -> None:
     assert ob.id == "Clamp.g0.monitors.runs_lab_e0"
 
 
-def test_100_runs_fall_short_with_the_runs_still_needed_and_a_violation_among_1000(tmp_path: Path) -> None:
+def test_100_runs_fall_short_with_the_runs_still_needed_and_one_violation_among_1000_answers(tmp_path: Path) -> None:
     ws = _ws(tmp_path / "a", [], {"runs": [False] * 100})
     (tmp_path / "a/contracts/plan.yaml").write_text(json.dumps({"contracts": ["contracts/sys.rcl"], "nodes": {
         "Clamp": {"evidence": [_entry(tmp_path / "a", "runs")]}}}))
@@ -91,19 +91,26 @@ def test_100_runs_fall_short_with_the_runs_still_needed_and_a_violation_among_10
     d = ev.details["statistics"]["decision"]
     assert ev.status == "pending" and d["runs_needed"] == 199 and "199 further clean run(s)" in ev.explanation
     assert d["sprt"]["decision"] == "continue"
-    flags = [False] * 1000
-    flags[417] = True
-    _ws(tmp_path / "b", [], {"runs": flags})
+    # one violation among 1000 judged answers, counted per answer: one long run of 1000 questions
+    lines = []
+    for j in range(1000):
+        lines.append({"topic": "a", "time": 5000.0 + 0.1 * j, "data": 1.0})
+        lines.append({"topic": "x", "time": 5000.0 + 0.1 * j + 0.01, "data": 31.0 if j == 417 else 20.0})
+    _ws(tmp_path / "b", [], {"long": []})
+    (tmp_path / "b/long/run.jsonl").write_text("".join(json.dumps(x) + "\n" for x in lines))
+    entry = {"backend": "monitors", "traces": ["long/run.jsonl"],
+             "target": "violation probability <= 1e-2 at 95 % per answer"}
     (tmp_path / "b/contracts/plan.yaml").write_text(json.dumps({"contracts": ["contracts/sys.rcl"], "nodes": {
-        "Clamp": {"evidence": [_entry(tmp_path / "b", "runs")]}}}))
+        "Clamp": {"evidence": [entry]}}}))
     ws = Workspace(tmp_path / "b")
     _, ev, obligations = _runset(ws)
     s = ev.details["statistics"]
-    assert ev.status == "discharged" and (s["counts"]["runs"], s["counts"]["violating_runs"]) == (1000, 1)
+    assert ev.status == "discharged", ev.explanation
+    assert (s["counts"]["runs"], s["counts"]["answers"], s["counts"]["violations"]) == (1, 1000, 1)
     assert s["decision"]["bound"] == pytest.approx(0.004735, abs=1e-6)
-    # the violating run's own record still fails: counter-evidence for the guarantee itself
-    bad = [o for o in obligations if o.data.get("trace", "").endswith("run0417.jsonl")]
-    assert MonitorsBackend().run(bad[0], ws.target("Clamp", 0)).status == "failed"
+    # the run's own record still fails: a violation is counter-evidence for the guarantee itself
+    (own,) = [o for o in obligations if o.data.get("run_set") is None]
+    assert MonitorsBackend().run(own, ws.target("Clamp", 0)).status == "failed"
 
 
 def test_two_environments_are_kept_apart_and_a_run_given_twice_counts_once(tmp_path: Path) -> None:
@@ -140,3 +147,25 @@ def test_harness_runs_never_count_and_bad_targets_are_located(tmp_path: Path) ->
         "    target: violation probability <= 1e-3 at 95 % per answer\n")
     with pytest.raises(PlanError, match=r"plan.yaml:5:13: error: a requirement's target counts per run"):
         _ = Workspace(tmp_path).plan
+
+
+def test_an_experiment_target_counts_trials_and_leaves_the_criterion_alone(tmp_path: Path) -> None:
+    from rclverify.backends.experiment.backend import ExperimentBackend
+    _ws(tmp_path, [], {})
+    rows = [18.0] * 120
+    rows[33] = 27.0  # one trial beyond the tolerance
+    (tmp_path / "trials.csv").write_text("trial,err\n" + "".join(f"{i},{v}\n" for i, v in enumerate(rows, 1)))
+    entry = {"backend": "experiment", "guarantee": 1, "data": "trials.csv", "column": "err", "unit": "cm",
+             "constants": {"tol": "25 cm"}, "criterion": "err <= tol", "answers": "out.x <= 30",
+             "environment": "track", "target": "violation probability <= 5 % at 95 %"}
+    (tmp_path / "contracts/plan.yaml").write_text(json.dumps({"contracts": ["contracts/sys.rcl"],
+                                                              "nodes": {"Clamp": {"evidence": [entry]}}}))
+    target, backend = Workspace(tmp_path).target("Clamp", 0), ExperimentBackend()
+    criterion, stat = backend.export(target)
+    assert stat.id == "Clamp.g1.experiment.e0_target" and "under track" in stat.statement
+    assert backend.run(criterion, target).status == "failed"  # trial 34 misses the criterion: a counterexample
+    ev = backend.run(stat, target)
+    c = ev.details["statistics"]["counts"]
+    assert (c["runs"], c["violating_runs"]) == (120, 1) and ev.details["statistics"]["failing_trials"] == [34]
+    # 1 of 120 gives an upper bound of 3.9 %: within 5 %
+    assert ev.status == "discharged" and ev.details["statistics"]["decision"]["bound"] == pytest.approx(0.0389, abs=1e-3)

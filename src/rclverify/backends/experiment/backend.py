@@ -35,6 +35,7 @@ from .consistency import check, figures_json
 from .criterion import evaluate
 from .figures import format_value
 from .plot import render_svg
+from .target import run_target, target_obligations
 
 NAME = "experiment"
 KIND = "experiment"
@@ -73,16 +74,17 @@ class ExperimentBackend:
         """One obligation for the entry.  Raises :class:`PlanError` (located)."""
         cfg = load(target)
         g = target.node.node.guarantees[cfg.guarantee - 1]
-        oid = make_obligation_id(target.node.name, cfg.guarantee, NAME, f"e{target.index}")
+        oid = make_obligation_id(target.node.name, cfg.guarantee, NAME, f"e{target.index}")  # a target: one more (target.py)
         statement = (f"criterion {cfg.criterion_text} holds on {cfg.file} "
                      f"(supports guarantee {cfg.guarantee}: {expr_to_rcl(g.formula)})")
-        return [Obligation(
+        ob = Obligation(
             id=oid, node=target.node.name, guarantee=cfg.guarantee, backend=NAME, kind=KIND, statement=statement,
             source=SourceRef(g.loc.file, g.loc.line, g.loc.col), instance=f"e{target.index}",
             artifact=target.rel(target.artifacts / f"{oid}.svg") if target.artifacts.is_absolute() else "",
             inputs=tuple(sorted({cfg.file, *target.contract_files, target.plan_file})),
             data={"criterion": cfg.criterion_text, "file": cfg.file,
-                  "constants": {k: q.show() for k, q in sorted(cfg.constants.items())}})]
+                  "constants": {k: q.show() for k, q in sorted(cfg.constants.items())}})
+        return [ob, *target_obligations(target, ob)]
 
     def run(self, obligation: Obligation, target: NodeTarget) -> Evidence:
         """Evaluate the criterion and return the evidence record (never raises
@@ -98,6 +100,8 @@ class ExperimentBackend:
         except PlanError as exc:
             return evidence("error", f"the experiment entry no longer checks: {exc}", log=str(exc))
         verdict = evaluate(cfg.criterion, cfg.figures, cfg.constants, cfg.timeout_ms)
+        if obligation.data.get("target") is not None:  # the entry's target over its trials (target.py)
+            return run_target(obligation, target, cfg, verdict, "z3", z3.get_version_string())
         flags = check(cfg.figures)
         svg_path = target.artifacts / f"{obligation.id}.svg"
         title = f"{target.node.name}: {cfg.criterion_text}"
