@@ -23,7 +23,11 @@ keeps every byte offset (same length, newlines kept), so locations stay.
   ``EIGEN_MAKE_ALIGNED_OPERATOR_NEW``), starting where a statement may start
   (after ``;``, ``{``, ``}``, ``:`` or a directive) and followed by no ``;``,
   is blanked; ``RCLCPP_COMPONENTS_REGISTER_NODE(ns::C)`` too, its class
-  recorded by the caller.
+  recorded by the caller;
+* explicit template instantiations (``template class Server<pkg::srv::T>;``,
+  ``extern template class ...;``; C++ standard [temp.explicit]), which the
+  grammar reads with a missing declarator: they make no object, so nothing
+  is lost (the template's types are read where its objects are made).
 
 Source: the C++ standard's preprocessing and ``<cinttypes>`` macros (C99 7.8.1).
 """
@@ -45,6 +49,7 @@ _BARE = re.compile(rb"^[ \t]*([A-Z][A-Z0-9_]{2,})[ \t]*(\((?:[^()]|\((?:[^()]|\(
                    re.M)
 _QT_ACCESS = re.compile(rb"\b(?:public|protected|private)([ \t]+(?:slots|Q_SLOTS))(?=[ \t]*:)")
 _QT_SIGNALS = re.compile(rb"^([ \t]*)(signals|Q_SIGNALS)(?=[ \t]*:)", re.M)
+_INSTANTIATION = re.compile(rb"^[ \t]*(?:extern[ \t]+)?template[ \t]+(?:class|struct)[ \t]+[^;{}<>]*<[^;{}]*>[ \t]*;", re.M)
 REGISTER = re.compile(rb"\bRCLCPP_COMPONENTS_REGISTER_NODE\s*\(\s*([A-Za-z_][\w:]*)\s*\)")
 
 
@@ -114,4 +119,6 @@ def prepare(data: bytes) -> bytes:
         data = _QT_SIGNALS.sub(lambda m: m.group(1) + b"public" + b" " * (len(m.group(2)) - 6), data)
     if b"RCLCPP_COMPONENTS_REGISTER_NODE" in data:
         data = REGISTER.sub(lambda m: b" " * len(m.group(0)), data)
+    if b"template" in data:
+        data = _INSTANTIATION.sub(lambda m: _spaces(m.group(0)), data)
     return _bare(data)

@@ -47,6 +47,8 @@ def callee_parts(fn: Any) -> tuple[str, str, list[str]]:
     """A call's function ``fn`` as ``(its text without template arguments, the last
     part of its name, the template arguments' texts)``."""
     f = fn.child_by_field_name("field") if fn.type == "field_expression" else fn
+    if f is not None and f.type == "dependent_name" and f.named_children:  # node->template create_service<T>
+        f = f.named_children[-1]
     while f is not None and f.type == "qualified_identifier" and f.child_by_field_name("name") is not None:
         f = f.child_by_field_name("name")
     targs: list[str] = []
@@ -56,7 +58,7 @@ def callee_parts(fn: Any) -> tuple[str, str, list[str]]:
         name = _T(f.child_by_field_name("name"))
     else:
         name = _T(f)
-    full = _T(fn)
+    full = _T(fn).replace("template ", "")
     head = full.split("<")[0].strip()
     if "<" in full and ">::" in full:  # rclcpp::Node::make_shared / X<T>::create
         head = head + full[full.rindex(">") + 1:]
@@ -222,12 +224,21 @@ class CppScope:
                 " &" if "&" in _T(p.child_by_field_name("declarator") or p) else ""))
             fn.pconst.append(any(c.type == "type_qualifier" and _T(c) == "const" for c in p.children))
             fn.defaults.append(p.child_by_field_name("default_value"))
+        if key.endswith("::" + unit.split("::")[-1]) and any(f.key == key and len(f.params) != len(fn.params)
+                                                                 for f in self.fns.values()):
+            # a constructor overload: keyed by its arity, the linker runs only the one called (issue 65)
+            fn.key = f"{key}#{len(fn.params)}"
         self.fns[n.id] = fn
 
     def _class(self, n: Any) -> None:
         nss, cls = namespaces_of(n)
         name = "::".join(nss + cls + [_T(n.child_by_field_name("name")).split("<")[0]])
         info = self.classes.setdefault(name, {"members": {}, "bases": []})
+        tpl = n.parent.child_by_field_name("parameters") if n.parent is not None and \
+            n.parent.type == "template_declaration" else None
+        if tpl is not None:  # template<typename ServiceT> class Caller: read where it is made (issue 65)
+            info["tparams"] = [_T(x.child_by_field_name("name") or next(
+                (c for c in x.named_children if c.type == "type_identifier"), x)) for x in tpl.named_children]
         for c in n.children:
             if c.type == "base_class_clause":
                 info["bases"].extend(_T(b) for b in c.named_children if b.type != "access_specifier")
@@ -370,5 +381,6 @@ class CppScope:
                 return self.ltypes[(fn.nid, name)]
             if name in fn.params:
                 return fn.ptypes[fn.params.index(name)]
-            return self.classes.get(fn.unit, {}).get("members", {}).get(name)
+            got: str | None = self.classes.get(fn.unit, {}).get("members", {}).get(name)
+            return got
         return None

@@ -33,7 +33,7 @@ import re
 from dataclasses import dataclass, field
 from typing import Any, Callable
 
-from . import emit, plugins, symbols
+from . import emit, names, plugins, symbols
 from .cpp_types import split_template
 from .model import Endpoint, Note, Src
 from .link_members import LinkMembers
@@ -85,6 +85,8 @@ class Linker(LinkMembers, Values):
                 cur = self.units.setdefault(u, {"bases": [], "members": {}})
                 cur["bases"] += [b for b in info["bases"] if b not in cur["bases"]]
                 cur["members"].update(info["members"])
+                if info.get("tparams"):
+                    cur["tparams"] = info["tparams"]
                 if f in prog.entry:
                     entry_units.add(u)
             for key, vals in r.get("fields", {}).items():
@@ -104,13 +106,13 @@ class Linker(LinkMembers, Values):
         # what runs what: "U:class" (constructed: all its methods run) and "F:function" (called)
         self.edges: dict[str, set[str]] = {}
         for k, (unit, *_rest) in self.fns.items():
-            if unit in self.units or unit == k:
+            if (unit in self.units or unit == k) and "#" not in k:
                 self._edge(f"U:{unit}", f"F:{k}")
             if unit == k:
                 self._edge(f"F:{k}", f"U:{unit}")
         for c in self.calls:
             kind, callee, args, fkey, unit, _src, kwargs = c
-            ck, cu = self.callee(kind, callee, unit)
+            ck, cu = self.callee(kind, callee, unit, len(args))
             here = f"F:{fkey}" if fkey else f"U:{unit}" if unit else None
             made = kind in ("ctor", "member") or (ck is not None and cu is not None and (
                 ck.endswith(".__init__") or ck == self._ctor(cu)))
@@ -120,6 +122,9 @@ class Linker(LinkMembers, Values):
                 self._edge(here, f"F:{ck}")
             if ck is not None:
                 self.sites.setdefault(ck, []).append((args, kwargs, fkey))
+        for k, (unit, *_rest) in self.fns.items():  # an overload's class made where no call is read: all run
+            if "#" in k and not any(s.split("#")[0] == k.split("#")[0] for s in self.sites):
+                self._edge(f"U:{unit}", f"F:{k}")
         if prog.instance is not None:  # a plugin's methods its loader calls, given the instance's name
             for k, got in plugins.entry_sites(self.fns, set(prog.units or ()), set(self.sites), prog.instance).items():
                 self.sites[k] = list(got)
@@ -149,8 +154,18 @@ class Linker(LinkMembers, Values):
             cands = near or cands
         return sorted(cands, key=len)[0]
 
-    def callee(self, kind: str, callee: str, unit: str | None) -> tuple[str | None, str | None]:
-        """``(callable key, unit)`` a call record names in this program."""
+    def callee(self, kind: str, callee: str, unit: str | None, nargs: int | None = None) -> tuple[str | None, str | None]:
+        """``(callable key, unit)`` a call record names in this program; of a
+        constructor's overloads (keys ``Cls::Cls#N``), the one whose parameters
+        take ``nargs`` arguments when exactly one does."""
+        ck, cu = self._callee(kind, callee, unit)
+        if ck is None or nargs is None:
+            return ck, cu
+        over = [k for k in self.fns if k == ck or k.startswith(ck + "#")]
+        fit = [k for k in over if sum(d is None for d in self.fns[k][3]) <= nargs <= len(self.fns[k][1])]
+        return (fit[0] if len(fit) == 1 else ck), cu
+
+    def _callee(self, kind: str, callee: str, unit: str | None) -> tuple[str | None, str | None]:
         if self.py:
             return self._py_callee(callee)
         if kind == "member":
@@ -159,8 +174,11 @@ class Linker(LinkMembers, Values):
             cls = self.match(_held(ty), unit) if ty else None
             if cls is not None and _held(ty) != split_template(ty.replace(" ", ""))[0].replace("*", "").strip():
                 return None, cls  # a pointer member: made by the new/make_shared it is given
-            if cls is None and any(b.split("<")[0].split("::")[-1] == callee.split("::")[-1] for b in info.get("bases", [])):
+            base = callee.split("<")[0].split("::")[-1]  # ClientBase<ServiceT>(node, name): a template base
+            if cls is None and any(b.split("<")[0].split("::")[-1] == base for b in info.get("bases", [])):
                 cls = self.match(callee, unit)
+            if cls is None and unit and base == unit.split("::")[-1]:  # a delegating constructor
+                cls = unit
             return (self._ctor(cls), cls) if cls else (None, None)
         if kind == "ctor":
             cls = self.match(callee, unit)
@@ -244,6 +262,7 @@ class Linker(LinkMembers, Values):
                     continue
                 raw.append((f, e))
         named = self.named(note, out)
+        self.user_creates(note)
         out.nodes = [(n, s, ns) for n, s, ns, _u, _p in named]
         units = [u for _n, _s, _ns, u, _p in named]
         got: list[tuple[Endpoint, int]] = []
@@ -289,6 +308,11 @@ class Linker(LinkMembers, Values):
                             if t is None:
                                 note(Note(src, "node name is not a string literal: not resolved statically"))
                                 continue
+                            bad = names.node_name_problem(t)
+                            if bad is not None:  # never the node '/' (issue 65): its endpoints stay off the graph
+                                note(Note(src, f"node name {bad}: not resolved statically; its endpoints are "
+                                               f"not in the graph"))
+                                continue
                             nsv = self.eval(ns, env, fkey)[0] if ns is not None else None
                             if ns is not None and (nsv is None or symbols.text(nsv) is None):
                                 note(Note(src, f"namespace of node '{t}' is not a string literal: not resolved "
@@ -305,6 +329,17 @@ class Linker(LinkMembers, Values):
         self.pin({})
         return named
 
+    def user_creates(self, note: Callable[[Note], None]) -> None:
+        """A located note at each call of a user's method named like rclcpp's
+        (``bus.create_publisher(node, "t")``, :mod:`sources_cpp`) whose body is
+        not in the program: it is not rclcpp's, so nothing is guessed from it."""
+        for r in self.recs.values():
+            for callee, unit, fkey, src in r.get("user_creates", []):
+                ck, _cu = self.callee("call", callee, unit)
+                if self.runs(unit, fkey) and (ck is None or ck not in self.fns):
+                    note(Note(src, f"{callee}(...) takes the node first, so it is no rclcpp method, and its body "
+                                   f"is not in the workspace: its endpoints are not read"))
+
     def pin(self, pins: dict[str, int]) -> None:
         """Read function ``k``'s parameters from its call site ``pins[k]`` only."""
         if pins != self.pins:
@@ -317,17 +352,22 @@ class Linker(LinkMembers, Values):
             return [e]
         name, handle, cb, fkey, written, nsrc = e.pending
         t = e.msg_type if e.msg_type is not None else self.cb_type(e.kind, cb)
+        types: list[str | None] = [t]
+        if t is None and isinstance(cb, tuple) and cb[:1] == ("type",):  # a class template's parameter
+            types = [self.cb_type(e.kind, ("type", x)) for x in self.template_types(e.unit, cb[1])] or [None]
+            t = types[0] if all(types) else None
         got: list[Endpoint] = []
         for env in self.contexts(fkey):
             for n in self.eval(name, env, fkey):
                 for h in self.eval(handle, env, fkey) if handle is not None else [None]:
                     if n is not None and n[0] == "ops":
                         n = n[2]
-                    x, bad = emit.resolve(e.kind, n, h, t, e.src, e.unit, written, nsrc, e.func)
-                    if bad is not None:
-                        note(bad)
-                    if x is not None and x not in got:
-                        got.append(x)
+                    for ty in types:
+                        x, bad = emit.resolve(e.kind, n, h, ty, e.src, e.unit, written, nsrc, e.func)
+                        if bad is not None:
+                            note(bad)
+                        if x is not None and x not in got:
+                            got.append(x)
         if got and t is None:
             note(emit.type_note(got[0]))
         return got

@@ -64,6 +64,26 @@ class LinkMembers:
             return message_type(text, self.aliases)
         return service_type(text) if kind.startswith("service") else action_type(text)
 
+    def template_types(self, unit: str | None, param: str, depth: int = 0) -> list[str]:
+        """The type texts template parameter ``param`` of class template ``unit``
+        stands for: the template argument of each construction of the class
+        (``make_unique<Caller<pkg::srv::T>>(...)``, a derived template's base
+        initialiser ``ClientBase<ServiceT>(...)`` followed to its own
+        constructions), in call order; ``[]`` when none is found (issue 65)."""
+        tps = self.units.get(unit or "", {}).get("tparams", [])
+        if param not in tps or depth > 4:
+            return []
+        i, out = tps.index(param), []
+        for kind, callee, _args, _fkey, cunit, *_rest in self.calls:
+            targs = split_template(callee.replace(" ", ""))[1] if kind in ("ctor", "member") else []
+            if len(targs) <= i or self.match(callee, cunit) != unit:
+                continue
+            own = self.units.get(cunit or "", {}).get("tparams", [])
+            for x in self.template_types(cunit, targs[i], depth + 1) if targs[i] in own else [targs[i]]:
+                if x not in out:
+                    out.append(x)
+        return out
+
     def members(self, r: dict[str, Any]) -> list[Endpoint]:
         """Pending endpoints of helper objects held as members or base classes (their
         class found in the program's declarations): made in a constructor's

@@ -4,6 +4,8 @@ Names"): relative names resolve against the node's namespace, private names
 """
 from __future__ import annotations
 
+import re
+
 
 def join(ns: str, name: str) -> str:
     """``join('/a', 'b/c')`` -> ``/a/b/c``; a global ``name`` is returned normalised."""
@@ -31,3 +33,20 @@ def split(full: str) -> tuple[str, str]:
     full = normalise(full)
     ns, _, base = full.rpartition("/")
     return (ns or "/", base)
+
+
+_NODE_NAME = re.compile(r"^/?(?:[A-Za-z_][A-Za-z0-9_]*/)*[A-Za-z_][A-Za-z0-9_]*$")
+
+
+def node_name_problem(name: str) -> str | None:
+    """Why ``name`` (a node name as the code gives it) names no node, or ``None``
+    when it can: ROS 2's node name rules ("Topic and Service name mapping",
+    node names: letters, digits and underscores, not starting with a digit,
+    never empty) and ROS 1's (names are tokens joined by ``/``; a node's own
+    name holds no ``~``).  An empty or ``~`` name would otherwise be read as
+    the node ``/`` (issue 65)."""
+    if not name.strip("/"):
+        return "is empty"
+    if not _NODE_NAME.match(name):
+        return f"'{name}' is no valid node name"
+    return None

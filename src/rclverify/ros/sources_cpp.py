@@ -35,7 +35,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from . import cpp_helpers, emit, symbols, treesitter
+from . import cpp_helpers, emit, names, symbols, treesitter
 from .cpp_bases import node_base
 from .cpp_members import MemberReader
 from .cpp_prep import REGISTER, prepare
@@ -150,7 +150,7 @@ class _File(MemberReader):
         fn = self.scope.fn_of(at)
         unit = fn.unit if fn is not None else None
         t = symbols.text(v)
-        if t is not None and symbols.is_concrete(v) and v[0] != "node":
+        if t is not None and symbols.is_concrete(v) and v[0] != "node" and names.node_name_problem(t) is None:
             self.out["nodes"].append((t, self.src(at)))
             if fn is not None and fn.in_class:
                 self.out["classes"].setdefault(fn.unit, {"nodes": [], "endpoints": []})["nodes"].append(
@@ -178,8 +178,8 @@ class _File(MemberReader):
         if specs is not None:
             self.specs(specs, at)
             return
-        if head and not head.startswith(_LIBRARY):
-            self.record("ctor", head, args, at)
+        if head and not head.startswith(_LIBRARY):  # with its template arguments (a template's types)
+            self.record("ctor", type_text.replace("typename", "").strip() if targs else head, args, at)
 
     def actionlib(self, kind: str, ty: str, args: list[Any], at: Any) -> None:
         if not args:
@@ -210,7 +210,8 @@ class _File(MemberReader):
         self.out["fns"] = {f.key: (f.unit, f.params, f.ptypes, [s.value(d) for d in f.defaults])
                            for f in list(s.decls.values()) + list(s.fns.values())}
         self.out["aliases"] = self.aliases
-        self.out["units"] = {c: {"bases": i["bases"], "members": i["members"]} for c, i in s.classes.items()}
+        self.out["units"] = {c: {"bases": i["bases"], "members": i["members"], "tparams": i.get("tparams", [])}
+                             for c, i in s.classes.items()}
         self.out["fields"] = s.field_values()
         self.out["consts"] = {k: v for k, v in ((k, s._one([s.value(x) if not isinstance(x, tuple) else x
                                                              for x in vs])) for k, vs in s.consts.items())
@@ -313,6 +314,14 @@ class _File(MemberReader):
             return
         if last == "create_server":
             return
+        if recv is not None and last.startswith("create_") and s.is_handle(args[0]):
+            # rclcpp's node methods never take a node first: a user's method of the same name
+            # (bus.create_publisher(node, "t")), followed by the linker into its body (issue 65)
+            self.record("call", full, args, n)
+            owner = s.fn_of(n)
+            self.out.setdefault("user_creates", []).append(
+                (full, owner.unit if owner else None, owner.key if owner else None, self.src(n)))
+            return
         handle = s.value(recv) if recv is not None else None
         if recv is None and "::" in full and last.startswith("create_") and len(args) >= 2 and s.is_handle(args[0]):
             handle, args = s.value(args[0]), args[1:]  # a stack's factory: ns::create_service<T>(node, name, ...)
@@ -328,11 +337,11 @@ class _File(MemberReader):
             ops = s.value(args[0])
             if ops is not None and ops[0] == "ops":
                 t = self.msg(ops[3]) if ops[1] in ("pub", "sub") else service_type(self.aliases.get(ops[3], ops[3]))
-                cb = callback_name(ops[4] or "") or None
-                if t is None and cb:
-                    ct = self.out["callbacks"].get(cb)
+                ocb = callback_name(ops[4] or "") or None
+                if t is None and ocb:
+                    ct = self.out["callbacks"].get(ocb)
                     t = self.msg(ct) if ops[1] in ("pub", "sub") else service_type(ct)
-                self.emit(ops[1], None, t, n, handle, cb if t is None else None, name=ops[2],
+                self.emit(ops[1], None, t, n, handle, ocb if t is None else None, name=ops[2],
                           written=ops[5] if len(ops) > 5 else None)
             else:
                 self.out["notes"].append(Note(self.src(n), f"{last}({_T(args[0])[:60]}): its options are not read "

@@ -41,7 +41,7 @@ from __future__ import annotations
 import ast
 from typing import Any
 
-from . import emit, py_helpers, symbols
+from . import emit, names, py_helpers, symbols
 from .cpp_types import action_type, service_type
 from .model import Endpoint, Note, Src, canon_type
 from .pyconst import DISCOVERY, PyScope
@@ -284,6 +284,10 @@ def extract(mod: PyModule, shown: str) -> dict[str, Any]:
             if c.func == "super().__init__" and v.kind != "str" and not _node_class(mod, sc.class_at(c.src.line)):
                 continue
             unit = sc.unit_at(c.src.line)
+            if val is not None and val[0] == "str" and names.node_name_problem(val[1]) is not None:
+                out["notes"].append(Note(v.src, f"node name {names.node_name_problem(val[1])}: not resolved "
+                                                f"statically; its endpoints are not in the graph"))
+                continue
             if val is not None and val[0] == "str":
                 out["nodes"].append((val[1], c.src))
             elif symbols.is_concrete(val):
