@@ -80,8 +80,8 @@ def test_the_failure_is_at_the_boundary_and_at_the_implementation_line(tmp_path:
     assert cex["in.clearance"] == "2.0" and float(cex["in.speed_request"]) > 0.5
     assert len(cex["in.speed_request"].split(".")[-1]) <= 3
     assert float(cex["out.speed"]) > 0.5  # still a failure: the harness confirmed it with Z3
-    assert cex["cause"] == "nodes/speed_governor.py:13"  # `return {"speed": speed}`: the branch taken
-    assert "nodes/speed_governor.py:13" in ev.explanation
+    assert cex["cause"] == "nodes/speed_governor.py:12"  # `speed = speed_request`: what computed the output (issue 64)
+    assert "nodes/speed_governor.py:12" in ev.explanation
 
 
 def test_a_class_is_replayed_to_its_failing_step(tmp_path: Path) -> None:
@@ -99,14 +99,14 @@ def test_sarif_and_report_put_the_failure_on_the_implementation_line(tmp_path: P
     sarif = json.loads((ws / "reports/assurance.sarif").read_text())
     res = next(r for r in sarif["runs"][0]["results"] if r["partialFingerprints"]["rclverifyItem/v1"].startswith("obligation:"))
     loc = res["locations"][0]["physicalLocation"]
-    assert (loc["artifactLocation"]["uri"], loc["region"]["startLine"]) == ("nodes/speed_governor.py", 13)
+    assert (loc["artifactLocation"]["uri"], loc["region"]["startLine"]) == ("nodes/speed_governor.py", 12)
     rel = res["relatedLocations"][0]["physicalLocation"]
     assert (rel["artifactLocation"]["uri"], rel["region"]["startLine"]) == ("contracts/speed_governor.rcl", 7)
     html = (ws / "reports/assurance.html").read_text()
-    assert "Where the implementation goes wrong" in html and "nodes/speed_governor.py:13" in html
+    assert "Where the implementation goes wrong" in html and "nodes/speed_governor.py:12" in html
     report = json.loads((ws / "reports/assurance.json").read_text())
     d = next(x for x in report["diagnoses"] if x["kind"] == "property-test")
-    assert "nodes/speed_governor.py:13" in d["sentence"]
+    assert "nodes/speed_governor.py:12" in d["sentence"]
 
 
 PROGRAM = """var x : REAL;

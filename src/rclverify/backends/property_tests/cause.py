@@ -4,9 +4,14 @@ A property-test failure is the implementation's, not the contract's: the
 place to look is the line of the implementation that produced the wrong
 output (the branch taken), not the guarantee it violates.  The failing
 example is run once more under :func:`sys.settrace`, tracing only the
-frames of the implementation's own file, and the last line of that file
-executed before the call returned (or raised) is the cause: for
-``return {"speed": 1.0}`` in the wrong branch, that ``return`` line.
+frames of the implementation's own file.  The cause is the statement that
+computed the value returned (issue 64): the tracer records, line by line,
+which local variable of the implementation's entry frame each executed line
+changed, and the line that last assigned a local the returned output
+carries (the same object, e.g. ``joint = index + 1`` for ``return
+{"joint": joint}``) is named.  When the output carries no local (``return
+{"speed": 1.0}`` in the wrong branch), or the call raised, it is the last
+line of that file executed: that ``return`` line.
 
 The run is a replay of a shrunk example the harness already ran: the
 implementation is pure for a function, and a class is replayed from a new
@@ -36,18 +41,40 @@ def implementation_file(impl: Any) -> str | None:
 
 
 def last_line(call: Callable[[], Any], file: str) -> int | None:
-    """Run ``call()`` with a tracer on the frames of ``file``; the line number
-    of the last line of ``file`` executed (``None`` when none was).  The
-    tracer in place before (a coverage tool's) is put back."""
+    """Run ``call()`` with a tracer on the frames of ``file``; the line of
+    ``file`` that computed the value the call returned (module docstring:
+    the statement that last assigned a local variable whose value the
+    returned output carries), else the last line of ``file`` executed
+    (``None`` when none was).  The tracer in place before (a coverage
+    tool's) is put back."""
     last: list[int] = []
+    outer: list[FrameType] = []  # the first frame of file: the implementation's entry (its return is the output)
+    seen: dict[int, tuple[int, dict[str, Any]]] = {}  # id(frame) -> (line running, locals before it)
+    assigned: dict[str, int] = {}  # local of the entry frame -> line that last changed it
+    returned: list[Any] = []
+
+    def changes(frame: FrameType) -> None:
+        line, before = seen.get(id(frame), (0, {}))
+        now = dict(frame.f_locals)
+        if frame is outer[0] and line:
+            for k, v in now.items():
+                if k not in before or before[k] is not v:
+                    assigned[k] = line
+        seen[id(frame)] = (frame.f_lineno, now)
 
     def local(frame: FrameType, event: str, arg: Any) -> Any:
         if event in ("line", "return", "exception"):
             last.append(frame.f_lineno)
+            changes(frame)
+        if event == "return" and frame is outer[0]:
+            returned.append(arg)
         return local
 
     def tracer(frame: FrameType, event: str, arg: Any) -> Any:
         if event == "call" and os.path.abspath(frame.f_code.co_filename) == file:
+            if not outer:
+                outer.append(frame)
+            seen[id(frame)] = (0, dict(frame.f_locals))
             return local
         return None
 
@@ -59,7 +86,34 @@ def last_line(call: Callable[[], Any], file: str) -> int | None:
         pass
     finally:
         sys.settrace(before)
-    return last[-1] if last else None
+    computed = _computing_line(returned[0], assigned, outer[0].f_locals) if returned and outer else None
+    return computed or (last[-1] if last else None)
+
+
+def _leaves(value: Any) -> list[Any]:
+    """The output values a returned value carries: a mapping's values, a
+    sequence's items, an object's attributes, recursively (depth 3)."""
+    out: list[Any] = []
+    todo = [(value, 0)]
+    while todo:
+        v, depth = todo.pop()
+        out.append(v)
+        if depth >= 3:
+            continue
+        kids = (list(v.values()) if isinstance(v, Mapping) else list(v) if isinstance(v, (list, tuple))
+                else list(vars(v).values()) if hasattr(v, "__dict__") and not callable(v) else [])
+        todo += [(k, depth + 1) for k in kids]
+    return out
+
+
+def _computing_line(value: Any, assigned: Mapping[str, int], final: Mapping[str, Any]) -> int | None:
+    """The line that last assigned a local (``assigned``: name -> line,
+    ``final``: the locals at the return) whose value is one the returned
+    ``value`` carries (the same object; a bare constant is no evidence);
+    the latest such line, ``None`` when no local is returned."""
+    leaves = [v for v in _leaves(value) if v is not None and not isinstance(v, bool)]
+    lines = [assigned[k] for k, v in final.items() if k in assigned and any(v is x for x in leaves)]
+    return max(lines) if lines else None
 
 
 def cause_line(impl: Any, example: Mapping[str, Any] | Sequence[Mapping[str, Any]], step: int | None,
