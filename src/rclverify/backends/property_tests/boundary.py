@@ -5,7 +5,9 @@ for a number is often one that draws the eye to rounding
 (``speed_request = 0.5000000000000001``) and away from the value that
 matters (``clearance = 2.0``, the threshold the contract names).  After a
 failure, :func:`boundary_example` tries, input by input, the numbers the
-node's contract names (its assumption's and guarantee's literals) and short
+node's contract names (its assumption's and guarantee's literals, the
+values of the named constants they use) or its code compares with
+(:mod:`.constants`) and short
 values near the shrunk one (the integers either side, one decimal place),
 nearest first, and keeps each replacement with which the example still
 satisfies the assumption (and the used facts) and still violates the same
@@ -23,6 +25,7 @@ from typing import Any, Iterable, Mapping
 
 from ...rcl import ast
 from ...rcl.walk import subexpressions
+from .constants import boundary_constants
 
 #: At most this many re-runs of the implementation per failure.
 MAX_TRIES = 48
@@ -73,7 +76,7 @@ def boundary_example(run: Any, inputs: Mapping[str, Any],
     example is left in ``run.last_failure``/``run.last_values`` (the
     caller's example's when ``None``).  ``violation`` the exception
     :meth:`.harness.GuaranteeRun.check_step` raises on a violation."""
-    named = contract_numbers(run.node)
+    named = boundary_constants(run.checked, run.node, run.impl, contract_numbers(run.node))
     best = dict(inputs)
     saved = (run.last_failure, run.last_values)
     found: tuple[Any, Any] | None = None

@@ -48,6 +48,7 @@ from ...rcl.types import Checked, CheckedNode
 from ...values import conforms, render
 from .seeding import Seeder, split_facts
 from .coverage import Coverage
+from .constants import boundary_constants
 from .strategies import assumption_bounds, conjuncts, input_space
 
 DEFAULT_MAX_EXAMPLES = 200
@@ -277,7 +278,8 @@ class GuaranteeRun:
         if self.used_facts:
             formulas = tuple(c.formula for c in self.node.node.assumes) + self.used_facts
             seed = Seeder(self.checked, self.node, formulas).base()
-        space = input_space(self.node, self.cfg.bounds, seed)
+        # every threshold the contract or the code compares with, drawn with its neighbours (.constants)
+        space = input_space(self.node, self.cfg.bounds, seed, boundary_constants(self.checked, self.node, self.impl))
         self.coverage = Coverage(self.node, space.bounds, assumption_bounds(self.node))
         one = space.inputs().filter(self.assumption_holds)
         if self.stateful:

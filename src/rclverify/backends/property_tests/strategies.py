@@ -5,9 +5,11 @@ constrained by the node's assumption (docs/property-tests.md, "Strategies").
   form ``c <= in.x``, ``in.x < c``, ``a <= in.x < b`` (numeric literals) bounds
   a numeric input; ``in.e in {v1, v2}`` restricts an enumeration input.  The
   plan's ``bounds: {in.x: [lo, hi]}`` narrows further (either end may be null).
-* Boundary values: the numeric literals of the node's contract (and, for
-  REAL, their float neighbours) are drawn alongside arbitrary values, so a
-  threshold that is off by one is hit.
+* Boundary values: the numeric literals of the node's contract, the values
+  of the context constants it names and the numbers its implementation
+  compares with (:mod:`.constants`), each with its neighbours (one ulp
+  either side for REAL, one either side for integers), are drawn alongside
+  arbitrary values, so a threshold that is off by one is hit.
 * Function-typed inputs are finite tables with a default
   (:class:`~rclverify.values.FiniteFunction`).  Their keys come from one pool
   of argument tuples per argument type, drawn once per example, so two
@@ -23,7 +25,7 @@ import math
 from functools import partial
 from dataclasses import dataclass, field
 from fractions import Fraction
-from typing import Any, Callable, Mapping, cast
+from typing import Any, Callable, Iterable, Mapping, cast
 
 from hypothesis import strategies as st
 
@@ -360,7 +362,7 @@ class InputSpace:
         key = ("index", n)
         if key not in self.misc_cache:
             self.misc_cache[key] = st.integers(min_value=0, max_value=n - 1)
-        return self.misc_cache[key]
+        return cast("st.SearchStrategy[int]", self.misc_cache[key])
 
     def _result(self, base: FiniteFunction, t: FuncT) -> st.SearchStrategy[Any]:
         """A new result for a seeded table: one of the model's results (and
@@ -373,11 +375,13 @@ class InputSpace:
 
 
 def input_space(node: CheckedNode, plan_bounds: Mapping[str, tuple[Fraction | None, Fraction | None]],
-                seed: Mapping[str, Any] | None = None) -> InputSpace:
+                seed: Mapping[str, Any] | None = None, constants: Iterable[Fraction] = ()) -> InputSpace:
     """The :class:`InputSpace` of ``node``; ``plan_bounds`` maps input names
     (without ``in.``) to the plan's ``[lo, hi]`` (closed); ``seed`` maps
     qualified input names to a Z3 model's values (function-typed ones are
-    varied per example, see :meth:`InputSpace.vary`)."""
+    varied per example, see :meth:`InputSpace.vary`); ``constants`` the
+    thresholds drawn beside the contract's literals, each with its
+    neighbours (the named constants and the code's, :mod:`.constants`)."""
     bounds = assumption_bounds(node)
     for name, (lo, hi) in plan_bounds.items():
         bd = bounds.setdefault(name, Bound())
@@ -385,4 +389,4 @@ def input_space(node: CheckedNode, plan_bounds: Mapping[str, tuple[Fraction | No
             bd.lower(lo, False)
         if hi is not None:
             bd.upper(hi, False)
-    return InputSpace(node, bounds, contract_constants(node), seed=seed)
+    return InputSpace(node, bounds, sorted({*contract_constants(node), *constants}), seed=seed)
