@@ -299,3 +299,78 @@ def test_a_source_error_midway_judges_the_events_before_it(checked: Any) -> None
         if not batch:
             want = seen
     assert seen == want and len(seen) == 20
+
+
+def _as_columns(events: list[Event]) -> Any:
+    """``events`` as a run held in columns (traces/table.py), or ``None`` when it is not one (a stamp of its own,
+    a topic whose messages do not all have the same fields): a topic's values as a float64 array when all are
+    floats, a string array when all are strings, else a list (the batch path's general reading)."""
+    import numpy as np
+    from rclverify.traces.table import ColumnTrace
+    if any(ev.stamp is not None for ev in events) or not events:
+        return None
+    keys: dict[str, set[tuple[str, ...]]] = {}
+    values: dict[str, dict[str, list[Any]]] = {}
+    for ev in events:
+        keys.setdefault(ev.topic, set()).add(tuple(ev.fields))
+        for f, v in ev.fields.items():
+            values.setdefault(ev.topic, {}).setdefault(f, []).append(v)
+    if any(len(k) != 1 for k in keys.values()):
+        return None
+
+    def col(vs: list[Any]) -> Any:
+        kinds = set(map(type, vs))
+        return np.array(vs, dtype=np.float64) if kinds == {float} else np.array(vs) if kinds == {str} else vs
+    fields = {t: {f: col(vs) for f, vs in fs.items()} for t, fs in values.items()}
+    return ColumnTrace([ev.topic for ev in events], [ev.time for ev in events], fields, "cols")
+
+
+@pytest.mark.parametrize("node", ["Classifier", "Shift"])
+def test_batch_on_columns_equals_streaming(checked: Any, node: str) -> None:
+    """A run held in columns (traces/table.py): its events are the run's, and the batch path reading its
+    arrays (``typed``: no Python value per row) gives the streaming engine's verdicts on those events."""
+    rnd = random.Random(f"columns-{node}")
+    cases = batched = 0
+    for case in range(40):
+        horizon = rnd.choice([0.005, 0.02, 0.1])
+        rules = load_rules(RULES)
+        rules.skew = rnd.choice([0.0, 0.02])
+        # no stamps of their own, a missing field as null: a run columns hold (else the case is skipped)
+        trace = _as_columns([Event(e.index, e.time, e.topic, e.fields or {"data": None}, e.where)
+                             for e in _trace(rnd, node, horizon)])
+        if trace is None:
+            continue
+        cases += 1
+        events = list(trace)
+        assert [(e.index, e.time, e.topic, dict(e.fields)) for e in events] == \
+            [(k, float(trace.times[k]), trace.names[trace.codes[k]], dict(e.fields)) for k, e in enumerate(events)]
+        chunk = rnd.choice([2, 5, 64, 4096])
+        seen_s: list[Any] = []
+        want = check_trace(checked, [checked.nodes[node]], iter(events), rules, horizon, seen_s.append, batch=False)
+        seen_b: list[Any] = []
+        stats: dict[str, int] = {}
+        done = check_batch(checked, checked.nodes[node], trace, rules, horizon, seen_b.append, chunk=chunk,
+                           stats=stats)
+        assert done is not None
+        assert seen_b == seen_s, f"case {case}, chunk {chunk}"
+        assert (done[0], done[1]) == (want[0], want[1][0]), f"case {case}"
+        batched += stats["batched"]
+    assert cases >= 30 and batched > 100
+
+
+def test_column_trace_refuses_bad_columns() -> None:
+    import numpy as np
+    from rclverify.traces.table import ColumnTrace
+    with pytest.raises(ValueError, match="2 topics but 1 times"):
+        ColumnTrace(["a", "b"], [0.0])
+    with pytest.raises(ValueError, match="not a finite"):
+        ColumnTrace(["a"], [math.nan])
+    with pytest.raises(ValueError, match="topic a has 2 rows but 1 values of x"):
+        ColumnTrace(["a", "a"], [0.0, 1.0], {"a": {"x": np.array([1.0])}})
+    with pytest.raises(ValueError, match="no rows: b"):
+        ColumnTrace(["a"], [0.0], {"b": {"x": [1]}})
+    with pytest.raises(ValueError, match="not an index"):
+        ColumnTrace(np.array([0, 3]), [0.0, 1.0], names=["a", "b"])
+    t = ColumnTrace(np.array([1, 0]), [0.0, 1.0], {"/a": {"x": ["s"]}, "b": {"x": np.array([2.5])}}, "r", ["b", "/a"])
+    assert [(e.topic, e.fields, e.where) for e in t] == [("a", {"x": "s"}, "r: row 0"), ("b", {"x": 2.5}, "r: row 1")]
+    assert type(list(t)[1].fields["x"]) is float

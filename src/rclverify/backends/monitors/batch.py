@@ -47,7 +47,7 @@ from ...traces.events import Event
 from ...traces.mapping import TopicRule
 from ...traces.questions import KEPT, Question
 from .answered import AnsweredRun, RecentOutput
-from .columns import ColumnCompiler, Unsupported, column, io_kind, seed
+from .columns import ColumnCompiler, Unsupported, io_kind, seed
 from .engine import NodeMonitor
 from .rows import BlockRows, EventRows, chunks, rows_of
 from .verdicts import NodeResult, Verdict
@@ -204,7 +204,7 @@ class _Run:
         for topic, j, (key, field, kind_) in [(plan.output[0], -1, plan.output[1:])] + \
                 [(t, self.kinds[t], v) for t, v in plan.inputs.items()]:
             rows = np.flatnonzero(kind == j)
-            good, col = column(chunk.values(rows, field), kind_, plan.enums.get(key, _EMPTY))
+            good, col = chunk.typed(rows, field, kind_, plan.enums.get(key, _EMPTY))
             ok[rows] &= good
             full = np.zeros(n, dtype=np.float64 if kind_ == "real" else np.int64)
             full[rows] = col

@@ -17,12 +17,12 @@ from __future__ import annotations
 
 from itertools import repeat
 from operator import attrgetter, is_
-from typing import Any, Iterable, Iterator, Sequence
+from typing import Any, Iterable, Iterator, Mapping, Sequence
 
 import numpy as np
 
 from ...traces.events import Event, taken
-from .columns import field_values
+from .columns import column, field_values
 
 _TOPIC, _TIME, _STAMP, _FIELDS = attrgetter("topic"), attrgetter("time"), attrgetter("stamp"), attrgetter("fields")
 
@@ -56,6 +56,10 @@ class EventRows:
         if self._fields is None:
             self._fields = list(map(_FIELDS, self.events))
         return field_values(self._fields, rows, field)
+
+    def typed(self, rows: np.ndarray, field: str, kind: str, codes: Mapping[str, int]) -> tuple[np.ndarray, np.ndarray]:
+        """Field ``field`` at ``rows`` as :func:`~.columns.column` reads it: (mapped, column)."""
+        return column(self.values(rows, field), kind, codes)
 
     @property
     def last_time(self) -> float:
@@ -102,6 +106,20 @@ class BlockRows:
         cut = int(np.searchsorted(rows, h))
         return field_values(list(map(_FIELDS, self.head)), rows[:cut], field) + \
             self.block.values(rows[cut:] - h, field)
+
+    def typed(self, rows: np.ndarray, field: str, kind: str, codes: Mapping[str, int]) -> tuple[np.ndarray, np.ndarray]:
+        """As :meth:`EventRows.typed`; a block that holds its values as arrays
+        (traces/table.py, ``typed``) hands them over without a Python value per row."""
+        typed = getattr(self.block, "typed", None)
+        h = len(self.head)
+        cut = int(np.searchsorted(rows, h)) if h else 0
+        got: tuple[np.ndarray, np.ndarray] | None = typed(rows[cut:] - h, field, kind, codes) if typed else None
+        if got is None:
+            return column(self.values(rows, field), kind, codes)
+        if not cut:
+            return got
+        good, col = column(field_values(list(map(_FIELDS, self.head)), rows[:cut], field), kind, codes)
+        return np.concatenate([good, got[0]]), np.concatenate([col, got[1]])
 
     @property
     def last_time(self) -> float:
