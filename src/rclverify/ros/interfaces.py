@@ -86,6 +86,34 @@ def _field_lines(text: str) -> dict[str, int]:
     return out
 
 
+def generated_interfaces(root: Path, pkg: str) -> list[Path]:
+    """The interface files ``rosidl_generate_interfaces(${PROJECT_NAME} ...)`` of
+    the package's ``CMakeLists.txt`` names (variables and ``foreach`` expanded,
+    :func:`cmake.expand`), those under ``root`` that exist; ``[]`` when the
+    file is absent or unreadable.  Source: rosidl_cmake's
+    ``rosidl_generate_interfaces`` (its arguments after the target are
+    interface files relative to the package, up to the first keyword)."""
+    from .cmake import expand
+    try:
+        text = safefs.read_bytes(root / "CMakeLists.txt").decode("utf-8", errors="replace")
+    except OSError:
+        return []
+    out: list[Path] = []
+    for name, args, _line in expand(text, pkg):
+        if name.lower() != "rosidl_generate_interfaces":
+            continue
+        for a in args[1:]:
+            if a.isupper() and a.isalpha() or a.startswith(("ADD_LINTER_TESTS", "DEPENDENCIES", "LIBRARY_NAME",
+                                                            "SKIP_INSTALL", "SKIP_GROUP_MEMBERSHIP_CHECK")):
+                break
+            base, sep, rel = a.partition(":")  # rosidl's "base_dir:relative/file.msg" form
+            f = root / (Path(base) / rel if sep else Path(a))
+            if f.suffix in (".msg", ".srv", ".action", ".idl") and f.is_file() and \
+                    f.resolve().is_relative_to(root.resolve()) and f.resolve() not in {x.resolve() for x in out}:
+                out.append(f)
+    return out
+
+
 def _parse_one(kind: str, text: str, name: str) -> dict[str, Any]:
     from rosbags.typesys import get_types_from_idl, get_types_from_msg
     if kind == "idl":
@@ -99,8 +127,10 @@ def _parse_one(kind: str, text: str, name: str) -> dict[str, Any]:
         raise ValueError(f"a .{kind} file has {len(suffixes)} parts separated by '---', this one has {len(parts)}")
     out: dict[str, Any] = {}
     for part, suf in zip(parts, suffixes):
-        for k, v in get_types_from_msg(part, f"{pkg}/{kind}/{base}{suf}").items():
-            out[k.replace(f"/{kind}/msg/", f"/{kind}/")] = v
+        # parsed as pkg/msg/...: a field type without a package is pkg/msg/T, the
+        # same package's message (rosidl's rule), never pkg/srv/msg/T (issue 65)
+        for k, v in get_types_from_msg(part, f"{pkg}/msg/{base}{suf}").items():
+            out[k.replace(f"{pkg}/msg/{base}{suf}", f"{pkg}/{kind}/{base}{suf}")] = v
     return out
 
 
@@ -138,7 +168,7 @@ class TypeTable:
                 msg = " ".join(str(exc).split())[:300]
                 return ("error", line, f"bad {kind} definition {name}: {msg}")
 
-        parsed = cache.get(f"iface-{kind}-{name}", sha, parse) if cache else parse()
+        parsed = cache.get(f"iface2-{kind}-{name}", sha, parse) if cache else parse()
         if isinstance(parsed, tuple):
             self.notes.append(Note(Src(shown, parsed[1]), parsed[2], "ROS-PARSE", "error"))
             return
@@ -149,12 +179,22 @@ class TypeTable:
 
     def add_package_dir(self, root: Path, pkg: str, show: Any, origin: str, cache: ParseCache | None,
                         files: dict[str, str] | None = None) -> None:
+        """Read the interface files of the package at ``root``: those in ``msg/``,
+        ``srv/``, ``action/`` and every path ``rosidl_generate_interfaces`` names
+        in its ``CMakeLists.txt`` (``srvs/Pause.srv``: rosidl takes any path
+        relative to the package; issue 65)."""
+        seen: set[Path] = set()
         for sub in ("msg", "srv", "action"):
             d = root / sub
             if d.is_dir():
                 for f in sorted(d.iterdir()):
                     if f.suffix in (".msg", ".srv", ".action", ".idl") and f.is_file():
+                        seen.add(f.resolve())
                         self.add_file(f, pkg, show(f), origin, cache, files)
+        for f in generated_interfaces(root, pkg) if origin == "workspace" else []:
+            if f.resolve() not in seen:
+                seen.add(f.resolve())
+                self.add_file(f, pkg, show(f), origin, cache, files)
 
     def add_debian_standard(self, cache: ParseCache | None, share: Path = DEBIAN_SHARE,
                             services_only: bool = False) -> list[str]:
