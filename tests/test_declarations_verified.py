@@ -276,3 +276,26 @@ def test_a_declaration_rolls_up_from_its_records(records: Any, status: str, verd
     assert v == verdict and (s == "discharged") == (verdict == "met"), note
     if not records:
         assert "Base progress (declared, not verified)" in note
+
+
+def test_an_input_no_clause_reads_is_not_a_step() -> None:
+    """An action client's feedback, which its contract never reads, obliges
+    no answer: ``within 0 steps`` holds on a run where the client answers
+    every order but not the feedback in between."""
+    c = check([parse_text("""node Client {
+  inputs( order : INTEGER, feedback : INTEGER )
+  outputs( goal : INTEGER )
+  topics( std_msgs/Int64 order matches(in.order), std_msgs/Int64 feedback matches(in.feedback),
+          std_msgs/Int64 goal matches(out.goal) )
+  assume( 0 <= in.order )
+  guarantee( out.goal == in.order )
+  progress( within 0 steps )
+}
+""", "c.rcl")])
+    topics = ["order", "goal", "feedback", "feedback", "order", "goal"]
+    evs = [Event(i, i * 0.01, t, {"data": 3}, f"run.jsonl:{i + 1}") for i, t in enumerate(topics)]
+    [row] = check_declarations(c, c.nodes["Client"], evs, {}).rows()
+    assert (row["verdict"], row["reason"]) == ("true", "2 accepted input events, none left unanswered for more than 0 steps")
+    late = evs[:1] + evs[2:]  # the first order never answered before the next
+    [row] = check_declarations(c, c.nodes["Client"], late, {}).rows()
+    assert row["verdict"] == "false" and "between the input at run.jsonl:1 and the input at run.jsonl:5" in row["reason"]

@@ -7,9 +7,11 @@ every recorded run of the node's ``monitors`` entry, a row of the record's
 ``details.declarations`` (:meth:`DeclarationResult.rows`).  The run is read
 in the stream model of the paper (lines 462-495): a *step* of the node is
 one of its input events (a message on a topic ``topics(...)`` binds to an
-input, or a call part a link binds to one), and the node *answers* at that
-step when one of its output messages comes after it and before its next
-input event.  The assumption is judged on the inputs current at the event
+input, or a call part a link binds to one) that carries an input its
+contract reads (its assumption or a guarantee: a message no clause reads
+cannot oblige an answer, e.g. an action's feedback to a client that only
+sends goals), and the node *answers* at that step when one of its output
+messages comes after it and before its next step.  The assumption is judged on the inputs current at the event
 (:func:`rclverify.logic.floatsem.judge`, as the untimed monitor judges it);
 a step at which it holds is *accepted*.
 
@@ -131,6 +133,10 @@ class DeclarationMonitor:
         for f in self.assumption:
             names(f, mentioned)
         self.needed = sorted(f"in.{v}" for v in node.inputs if v in mentioned or f"in.{v}" in mentioned)
+        for c in node.node.guarantees:
+            names(c.formula, mentioned)
+        #: the inputs the contract reads: an event carrying one of them is a step of the node
+        self.read = frozenset(f"in.{v}" for v in node.inputs if v in mentioned or f"in.{v}" in mentioned)
         self.values: dict[str, Any] = {}
         self.first: dict[str, tuple[Any, str]] = {}
         self.seen_accepted = ""  # where the first accepted input was (an initial message after it may be an answer)
@@ -164,7 +170,7 @@ class DeclarationMonitor:
             if outs and (not c.outs or c.outs & outs):
                 c.answered += 1 if c.row else 0
                 c.row = 0
-        if any(k.startswith("in.") for k in changed):
+        if any(k in self.read for k in changed):
             self._step(ev)
 
     def _map(self, ev: Event, keys: list[tuple[str, str]]) -> list[str]:
