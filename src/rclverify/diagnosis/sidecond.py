@@ -29,6 +29,15 @@
    power-of-ten mismatch it is said to be probably unsafe (``C`` would
    read millimetres as metres).
 
+The bound tightened in place is compared and written in its own unit
+(``45 [N]`` becomes ``40 [N]``; a bare number is read in its variable's
+declared unit), and when that edit is not shown the guarantee is added
+instead, so a unit never suppresses the safe repair.  When the consumer's
+assumption stems from a requirement (a formal statement reads the linked
+value, or names the constant of its bound), weakening it is never the first
+repair: alone, it is withdrawn into ``not_offered`` with the reason
+(issue 64).
+
 Every repair is returned only when Z3 discharged the side condition on the
 edited contracts and the edited node stays consistent; that is what its
 ``proves`` says, and ``not_shown`` what Z3 did not show.
@@ -127,13 +136,63 @@ def side_condition_repairs(ws: Any, sc: Mapping[str, Any], before_sc: Mapping[st
     discharged = {"check": str(sc["id"]), "status": "discharged (Z3: proved)"}
 
     if single:
-        out["repairs"] += _strengthen(ws, sc, producers[0], _rename(str(sc["conjunct"]), to_producer), cost_of,
-                                      discharged, out["not_offered"], _inplace(ws, producers[0], pairs[0][1], target))
+        new_g = _rename(str(sc["conjunct"]), to_producer)
+        inplace = _inplace(ws, producers[0], pairs[0][1], target)
+        tightened = _strengthen(ws, sc, producers[0], new_g, cost_of, discharged, [], inplace) if inplace else []
+        # the bound tightened in place, else (no such bound, or its edit not shown) the guarantee added
+        out["repairs"] += tightened or _strengthen(ws, sc, producers[0], new_g, cost_of, discharged, out["not_offered"])
         if scale is not None and extreme is not None:
             out["repairs"] += _rescale(ws, sc, producers[0], pairs[0][1], scale, extreme, cost_of, discharged)
     out["repairs"] += _weaken(ws, sc, target, shape, extreme, scale, producers, to_consumer, cost_of, discharged,
                               consumer_evidence)
+    _requirement_guard(out, sc, _stems_from(ws, sc, pairs, target))
     return out
+
+
+def _stems_from(ws: Any, sc: Mapping[str, Any], pairs: Sequence[tuple[str, str, str, str]],
+                target: ast.Expr) -> list[str]:
+    """The ids of the plan's requirements the consumer's assumption ``target``
+    stems from: a formal statement that reads the linked value
+    (``Gripper.in.force`` or ``Supervisor.out.force``) or names a constant
+    the assumption's bound is written with."""
+    from ..plan.errors import PlanError
+    from ..plan.load import all_requirements
+    try:
+        reqs = all_requirements(ws.plan)
+    except PlanError:  # a Doorstop tree that cannot be read: reported elsewhere; the plan's own requirements
+        reqs = ws.plan.requirements
+    names = {f"{c}.in.{w}" for _, _, c, w in pairs} | {f"{p}.out.{v}" for p, v, _, _ in pairs}
+    consts = {v.name for v in subexpressions(target) if isinstance(v, ast.Var) and v.prefix is None
+              and v.name in ws.checked.env.constants}
+    out = []
+    for r in reqs:
+        text = r.formal.text if r.formal else ""
+        if any(re.search(rf"(?<![\w.]){re.escape(n)}(?![\w'])", text) for n in names | consts):
+            out.append(r.id)
+    return out
+
+
+def _requirement_guard(out: dict[str, Any], sc: Mapping[str, Any], reqs: Sequence[str]) -> None:
+    """Weakening a consumer's assumption that stems from a requirement is
+    never the first repair (issue 64): when it would be the only one it is
+    withdrawn into ``not_offered`` with the reason; after a safe repair it
+    stays, saying which requirement its bound stems from."""
+    if not reqs:
+        return
+    ids = ", ".join(reqs)
+    weak = [r for r in out["repairs"] if r["kind"] == "weaken-consumer"]
+    if not weak:
+        return
+    if out["repairs"][0]["kind"] == "weaken-consumer":
+        out["repairs"] = [r for r in out["repairs"] if r["kind"] != "weaken-consumer"]
+        out["not_offered"].append(
+            f"Weakening {sc['node']}'s assumption `{sc['conjunct']}` is not offered: its bound stems from "
+            f"requirement {ids}, and no safe repair (tightening the producer) was shown, so widening it would "
+            f"trade the requirement for a green side condition. Repair the producer, or revise {ids} first.")
+        return
+    for r in weak:
+        r["summary"] += (f" Its bound stems from requirement {ids}: widening it changes what {ids} demands, so "
+                         "it is never the first repair.")
 
 
 def _strengthen(ws: Any, sc: Mapping[str, Any], p: str, new_g: str, cost_of: Any, discharged: dict[str, str],
@@ -220,27 +279,41 @@ def _inplace(ws: Any, p: str, ov: str, target: ast.Expr) -> tuple[Edit, int, str
     """``(edit, guarantee index, old conjunct text)``: the top-level conjunct
     ``out.ov op N`` of a guarantee of ``p`` with the operator of the
     consumer's conjunct ``target`` (``in.w op B``) and a weaker ``N``, its
-    literal replaced by ``B``; ``None`` when there is none."""
+    literal (with its unit, ``45 [N]``) replaced by ``B``; ``None`` when
+    there is none.  ``N`` and ``B`` are compared in one unit, each read in
+    the unit written after it or else in its variable's declared unit
+    (:func:`.units.literal_si`); ``B`` is written in ``N``'s unit, or as the
+    consumer's named constant (issue 64: a unit on the bound no longer
+    suppresses the safe repair)."""
+    from .units import declared_unit, literal_si, literal_in
     consts = ws.checked.env.constants
-    mine = next((_normal(target, pre, v.name, consts) for pre in ("in", None) for v in subexpressions(target)
+    mine = next(((v, _normal(target, pre, v.name, consts)) for pre in ("in", None) for v in subexpressions(target)
                  if isinstance(v, ast.Var) and v.prefix == pre and v.name not in consts
                  and _normal(target, pre, v.name, consts)), None)
-    if mine is None:
+    if mine is None or mine[1] is None:
         return None
-    op, lit = mine
-    want = _const_value(lit, consts)
-    for k, g in enumerate(ws.checked.nodes[p].node.guarantees, 1):
+    var, (op, lit) = mine[0], mine[1]
+    cons = next((n for n in ws.checked.nodes.values() if var.name in n.inputs
+                 and any(c is target for a in n.node.assumes for c in conjuncts(a.formula))), None)
+    want = literal_si(lit, consts, declared_unit(cons.node.inputs if cons else (), var.name))
+    pn = ws.checked.nodes[p].node
+    unit_p = declared_unit(pn.outputs, ov)
+    for k, g in enumerate(pn.guarantees, 1):
         for c in conjuncts(g.formula):
             got = _normal(c, "out", ov)
-            if got is None or got[0] != op or not got[1].loc.line:
-                continue
-            old = _const_value(got[1], consts) if isinstance(got[1], ast.NumLit) else None
-            if old is None or want is None or not (old > want if _UPPER[op] else old < want):
+            if got is None or got[0] != op or not got[1].loc.line or not isinstance(got[1], ast.NumLit):
                 continue
             n = got[1]
-            assert isinstance(n, ast.NumLit)
-            return (Edit(n.loc.file, n.loc.line, n.loc.col, n.loc.line, n.loc.col + len(n.text), expr_to_rcl(lit)), k,
-                    expr_to_rcl(c))
+            old = literal_si(n, consts, unit_p)
+            if old is None or want is None or None not in (old[1], want[1]) and old[1] != want[1]:
+                continue  # two dimensions (the unit check reports it), or a value not read
+            if not (old[0] > want[0] if _UPPER[op] else old[0] < want[0]):
+                continue
+            text = expr_to_rcl(lit) if isinstance(lit, ast.Var) else literal_in(want[0], n, unit_p)
+            if text is None:
+                continue
+            end = n.loc.end_col if n.loc.end_line == n.loc.line else n.loc.col + len(n.text)
+            return Edit(n.loc.file, n.loc.line, n.loc.col, n.loc.line, end, text), k, expr_to_rcl(c)
     return None
 
 

@@ -181,3 +181,69 @@ def conversion_repair(ws: Any, m: Mismatch) -> list[dict[str, Any]]:
     not_shown = ("that the value's unit is really " + str(m.writer_unit) + " where it comes from"
                  + (f"; {', '.join(still)} still not discharged" if still else ""))
     return [_record("convert-unit", summary, edit, source, checks, recheck.changes(before, now), proves, not_shown)]
+
+
+# ---------------------------------------------------------------------------
+# Bounds in one unit: the in-place tightening of a bound written with a unit
+# (``45 [N]`` tightened to ``40 [N]``, issue 64) compares and writes numbers
+# in a common unit
+# ---------------------------------------------------------------------------
+
+def declared_unit(decls: Any, name: str) -> Any:
+    """The ``UnitAnn`` declared for the input or output ``name`` among
+    ``decls`` (``IOVar``s, or a mapping of name to one), ``None`` when none is."""
+    from ..rcl import ast
+    items = decls.values() if isinstance(decls, Mapping) else decls
+    for v in items:
+        if isinstance(v, ast.IOVar) and v.name == name:
+            return v.unit
+    return None
+
+
+def _unit_of(ann: Any) -> Unit | None:
+    from ..rcl.units import UnitError, parse_unit
+    if ann is None:
+        return None
+    try:
+        u = parse_unit(str(ann.text))
+    except UnitError:
+        return None
+    return u if u.offset is None and u.pi == 0 else None  # affine (degC) and pi-scaled units: not compared
+
+
+def literal_si(lit: Any, constants: Mapping[str, Any], declared: Any) -> tuple[Any, Any] | None:
+    """``(value in the coherent SI unit, dimensions)`` of a bound: a numeral
+    read in the unit written after it (``45 [N]``), else in ``declared`` (the
+    compared variable's ``UnitAnn``: a bare number takes the unit of what it
+    is compared with, docs/rcl-language.md "Units of measure"); a named
+    constant defined by a numeral likewise.  Dimensions are ``None`` for a
+    number with no unit at all.  ``None`` when the value or unit cannot be
+    read (an affine or pi-scaled unit, a constant not defined by a numeral)."""
+    from fractions import Fraction
+    from ..rcl import ast
+    if isinstance(lit, ast.Var) and lit.name in constants:
+        lit = constants[lit.name][1]
+    if not isinstance(lit, ast.NumLit):
+        return None
+    v = Fraction(lit.text)
+    ann = lit.unit if lit.unit is not None else declared
+    if ann is None:
+        return v, None
+    u = _unit_of(ann)
+    return None if u is None else (v * u.factor, u.dims)
+
+
+def literal_in(si: Any, like: Any, declared: Any) -> str | None:
+    """The value ``si`` (coherent SI) as a numeral in the unit of the
+    literal ``like``: with ``like``'s unit written after it when it has one
+    (``40 [N]``), else bare in ``declared``'s unit; ``None`` when that is no
+    finite decimal."""
+    from .bounds import number_text
+    ann = like.unit if like.unit is not None else declared
+    u = _unit_of(ann)
+    if ann is not None and u is None:
+        return None
+    text = number_text(si / u.factor if u is not None else si)
+    if text is None:
+        return None
+    return f"{text} [{like.unit.text}]" if like.unit is not None else text
