@@ -67,3 +67,77 @@ def test_a_class_step_names_its_assignment(tmp_path: Path) -> None:
     arm = _load(tmp_path, "armc", CLASS, "Arm")
     steps = [{"in.index": 1}, {"in.index": 3}]
     assert cause_line(arm, steps, 2, "armc.py") == "armc.py:6"
+
+
+# ---- Hoare: the assignment whose value breaks the post-condition -------------------------------
+
+ARM_RCL = """\
+node Arm {
+  inputs( index : NATURAL )
+  outputs( joint : NATURAL )
+  assume( in.index <= 5 )
+  guarantee( out.joint <= 5 )
+}
+"""
+
+ARM_IMP = """\
+var i : NATURAL;
+var joint : NATURAL;
+var limit : NATURAL;
+
+limit := 5;
+if i < limit then
+  joint := i
+else
+  joint := 6
+end
+"""
+
+ARM_PLAN = """\
+name: "arm"
+contracts: [contracts/arm.rcl]
+requirements: []
+nodes:
+  Arm:
+    evidence:
+      - backend: hoare
+        program: backends/hoare/arm.imp
+        binding: {in.index: "i", out.joint: joint}
+"""
+
+
+def test_hoare_names_the_assignment_not_the_comparison(tmp_path: Path) -> None:
+    import json
+
+    from rclverify.cli import main
+    (tmp_path / "contracts").mkdir()
+    (tmp_path / "backends" / "hoare").mkdir(parents=True)
+    (tmp_path / "contracts" / "arm.rcl").write_text(ARM_RCL, encoding="utf-8")
+    (tmp_path / "contracts" / "plan.yaml").write_text(ARM_PLAN, encoding="utf-8")
+    (tmp_path / "backends" / "hoare" / "arm.imp").write_text(ARM_IMP, encoding="utf-8")
+    (tmp_path / "dodo.py").write_text("from pathlib import Path\nfrom rclverify.tasks import build_tasks, doit_config\n"
+                                      "DOIT_CONFIG = doit_config()\nglobals().update(build_tasks(Path(__file__).parent))\n",
+                                      encoding="utf-8")
+    assert main(["verify", "-w", str(tmp_path)]) == 0
+    report = json.loads((tmp_path / "reports" / "assurance.json").read_text(encoding="utf-8"))
+    d = next(x for x in report["diagnoses"] if x["kind"] == "hoare")
+    assert [c["source"] for c in d["culprits"]][0] == "backends/hoare/arm.imp:9"
+    assert d["culprits"][0]["text"] == "joint := 6"
+    assert "backends/hoare/arm.imp:6" not in [c["source"] for c in d["culprits"]]  # `if i < limit`: no culprit
+    row = next(g for g in report["problems"] if d["id"] in [m["id"] for m in g["members"]])
+    assert row["key"] == ["line:backends/hoare/arm.imp:9"]
+
+
+def test_the_run_names_nothing_it_cannot_replay() -> None:
+    from rclverify.backends.hoare import lang
+    from rclverify.backends.hoare.culprit_assign import breaking_assignments, run
+    prog = lang.parse_program(ARM_IMP, "arm.imp")
+    final, last = run(prog, {"i": 5})
+    assert final["joint"] == 6 and last["joint"].loc.line == 9
+    assert run(prog, {"i": 2})[1]["joint"].loc.line == 7
+    # Z3 said another final value: not this run, nothing named
+    assert breaking_assignments(prog, {"i": 5, "joint (final)": 7}, {"out.joint": "joint"}, ARM_IMP) == []
+    loop = lang.parse_program("var x : INTEGER;\nwhile x < 10 invariant TRUE do\n  x := x + 1\nend\n", "l.imp")
+    assert run(loop, {"x": 0})[0]["x"] == 10
+    ext = lang.parse_program("extern f : REAL --> REAL;\nvar x : REAL;\nvar y : REAL;\ny := f(x)\n", "e.imp")
+    assert breaking_assignments(ext, {"x": 1, "y (final)": 2}, {"out.y": "y"}, "") == []

@@ -291,6 +291,22 @@ def _side_condition(ws: Any, report: Mapping[str, Any], sc: Mapping[str, Any], c
     return rec
 
 
+def _breaking_assignments(ws: Any, program: str, cex: Mapping[str, Any], data: Mapping[str, Any],
+                          conj: str) -> list[Any]:
+    """The last assignments to the outputs ``conj`` reads in the program's
+    run on the counterexample (:func:`rclverify.backends.hoare.culprit_assign.breaking_assignments`);
+    ``[]`` when the program no longer reads or the run cannot be made."""
+    from ..backends.hoare import lang
+    from ..backends.hoare.culprit_assign import breaking_assignments
+    outs = {k: str(v) for k, v in (data.get("binding") or {}).items()
+            if k.startswith("out.") and re.search(rf"(?<![\w.]){re.escape(k)}(?!\w)", conj)}
+    try:
+        text = ws.path(program).read_text(encoding="utf-8")
+        return breaking_assignments(lang.parse_program(text, program), cex, outs, text)
+    except Exception:  # noqa: BLE001 - a program that no longer parses or reads: nothing named
+        return []
+
+
 def _obligation_record(ws: Any, node: str, oid: str) -> Mapping[str, Any]:
     from ..evidence.sealed import obligation_list
     records, _ = obligation_list(ws.path(ws.obligations(node)))  # [] when altered outside rclverify
@@ -368,6 +384,13 @@ def _hoare(ws: Any, report: Mapping[str, Any], e: Mapping[str, Any], o: Mapping[
                 f"compares with {'/'.join(prog_texts) or 'other constants'} (" + ", ".join(prog_consts) + ") where the "
                 f"guarantee uses {'/'.join(conj_nums) or 'other constants'}; on {inputs or 'the counterexample'} the "
                 f"program gives {outputs or 'another output'}, which the conjunct `{conj}` ({conj_src}) rules out.")
+    assigned = [] if (conj_nums and prog_consts) else _breaking_assignments(ws, program, cex, data, conj)
+    if assigned:  # no threshold disagrees: the assignment whose value breaks the conjunct (issue 64)
+        prog_consts = [f"{program}:{a.line}: {a.text}" for a in assigned]
+        sentence = (f"On {inputs or 'the counterexample'} {program} runs "
+                    + ", then ".join(f"`{a.text}` ({program}:{a.line})" for a in assigned)
+                    + f", giving {outputs or 'its output'}, which the conjunct `{conj}` ({conj_src}) of guarantee "
+                    f"{k} of {node} ({gsrc}) rules out: the value assigned there breaks the post-condition.")
     before = {ob["id"]: ob["status"] for ob in report["obligations"]
               if ob["node"] == node and ob["backend"] == "hoare" and ob["instance"].split(".c")[0] == e["obligation"].split(".hoare.", 1)[-1].split(".c")[0]}
     # keyed by what the repair is computed from (not the obligation: every failed triple of one program
@@ -375,6 +398,6 @@ def _hoare(ws: Any, report: Mapping[str, Any], e: Mapping[str, Any], o: Mapping[
     reps = cache.get(["hoare", node, k, program, before],
                      lambda: hoare_repair(ws, node, k, program, before), extra_file=program)
     return _record(e["obligation"], "hoare", node, e["status"], sentence,
-                   culprits=[{"what": f"{program} line {c.split(':')[1]}", "source": c.rsplit(':', 1)[0], "text": c.rsplit(': ', 1)[1]}
+                   culprits=[{"what": f"{program} line {c.split(':')[1]}", "source": c.split(': ', 1)[0], "text": c.split(': ', 1)[1]}
                              for c in prog_consts] + [{"what": f"conjunct of guarantee {k} of {node}", "source": conj_src, "text": conj}],
                    counterexample=table, repairs=[reps] if reps else [], guarantee=k)
