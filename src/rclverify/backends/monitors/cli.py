@@ -32,6 +32,7 @@ from .deadlines import DeadlineMonitor, deadline_status, has_deadlines
 from .config import ConfigError, load_mapping
 from .judged import Counted, Heard, explain, not_judged, strict_line
 from .log_calls import LogCalls
+from .declarations import DeclarationMonitor, add_periods, declaration_status, has_declarations
 from .periods import PeriodMonitor, has_periods, period_status
 
 
@@ -75,6 +76,8 @@ def monitor_command(args: argparse.Namespace, checked: Checked) -> int:
         # one pass over the run feeds both checks (a log named here may be a stream, read once)
         dmons = [DeadlineMonitor(checked, n, cfg.rules, horizon=cfg.horizon, tolerance=cfg.tolerance) for n in timed]
         pmons = [PeriodMonitor(n) for n in nodes if has_periods(n)]
+        decl = [DeclarationMonitor(checked, n, cfg.rules, tolerance=cfg.tolerance) for n in nodes
+                if has_declarations(n)]
         calls = LogCalls(checked, nodes, cfg.rules, cfg.horizon, trace)  # a live log's calls (log_calls.py)
         heard: dict[str, int] = {}
 
@@ -84,16 +87,20 @@ def monitor_command(args: argparse.Namespace, checked: Checked) -> int:
                     m.feed(ev)
                 for p in pmons:
                     p.feed(ev)
+                for dm in decl:
+                    dm.feed(ev)
                 yield ev
         try:
             run = read_trace(path, [root / d for d in cfg.msg_dirs], streams=True,
                              on_warning=lambda w: print(w, file=sys.stderr))
-            source = tap(run) if dmons or pmons else run  # untapped, a log keeps its columnar reading (batch path)
+            source = tap(run) if dmons or pmons or decl else run  # untapped, a log keeps its columnar reading (batch path)
             source = calls.tap(source) if calls.active else source  # only nodes with links: never the batch path
             events, results = check_trace(checked, nodes, Counted(source, heard), cfg.rules, cfg.horizon,
                                           tolerance=cfg.tolerance)
             dres = [m.finish() for m in dmons]
             pres = [p.finish() for p in pmons]
+            decl_res = [add_periods(dm.finish(), dm.node, next((p for p in pres if p.node == dm.node.name), None))
+                        for dm in decl]
             summary = calls.finish()
         except TraceError as exc:
             _emit(report, args.json)
@@ -146,6 +153,13 @@ def monitor_command(args: argparse.Namespace, checked: Checked) -> int:
                            "periods": pr.to_json()})
             if not args.json:
                 print(f"{trace}: {pr.node} periods: {status}: {explanation}")
+        for dr in decl_res:  # initially, progress, periods (declarations.py, issue 64)
+            status, explanation = declaration_status(dr, trace)
+            violated = violated or status == "failed"
+            report.append({"node": dr.node, "status": status, "explanation": explanation, "trace": trace,
+                           "declarations": dr.rows()})
+            if not args.json:
+                print(f"{trace}: {dr.node} declarations: {status}: {explanation}")
         if summary is not None:
             violated = _report_calls(report, centries + dentries, summary, calls.missed(), trace,
                                      args.json) or violated

@@ -2,8 +2,10 @@
 
 ``rclverify monitor LOG`` feeds every line of a log, in order, to the
 deadline monitors of the nodes with timed guarantees
-(:class:`~.deadlines.DeadlineMonitor`) and, for the nodes with periodic
-outputs, to the period monitors (:class:`~.periods.PeriodMonitor`): each
+(:class:`~.deadlines.DeadlineMonitor`), for the nodes with periodic
+outputs to the period monitors (:class:`~.periods.PeriodMonitor`) and for
+the nodes with declarations to their monitors
+(:class:`~.declarations.DeclarationMonitor`): each
 released message, and each verdict or call line too, whose ``time`` moves
 their clocks.  :class:`LogChecks` is fed by the live run
 (:class:`~.live.LiveRun`) with the same lines as it writes them, in the same
@@ -32,6 +34,7 @@ from ...rcl.types import Checked, CheckedNode
 from ...traces.events import Event
 from ...traces.mapping import TopicRule
 from .deadlines import DeadlineMonitor, DeadlineResult, DeadlineVerdict, deadline_status, has_deadlines
+from .declarations import DeclarationMonitor, DeclarationResult, add_periods, declaration_status, has_declarations
 from .periods import PeriodMonitor, PeriodResult, has_periods, period_status
 
 
@@ -48,9 +51,12 @@ class LogChecks:
         self.deadlines = [DeadlineMonitor(checked, n, rules, self._verdict, horizon=horizon)
                           for n in nodes if has_deadlines(n)]
         self.periods = [PeriodMonitor(n) for n in nodes if has_periods(n)]
-        self.active = bool(self.deadlines or self.periods)
+        #: initially, progress and periods judged as offline (declarations.py, issue 64)
+        self.declarations = [DeclarationMonitor(checked, n, rules) for n in nodes if has_declarations(n)]
+        self.active = bool(self.deadlines or self.periods or self.declarations)
         self.deadline_results: list[DeadlineResult] = []
         self.period_results: list[PeriodResult] = []
+        self.declaration_results: list[DeclarationResult] = []
         self._lines = 0
 
     def _verdict(self, v: DeadlineVerdict) -> None:
@@ -64,6 +70,8 @@ class LogChecks:
             d.feed(ev)
         for p in self.periods:
             p.feed(ev)
+        for m in self.declarations:
+            m.feed(ev)
 
     def line(self, obj: Mapping[str, Any], deadline: bool = False) -> None:
         """Any other log line (``topic``, ``time``, its fields) after it was
@@ -78,6 +86,8 @@ class LogChecks:
         if not deadline:
             for d in self.deadlines:
                 d.feed(ev)
+            for m in self.declarations:  # a call's request or response line is an event of its node
+                m.feed(ev)
         for p in self.periods:
             p.feed(ev)
 
@@ -90,6 +100,9 @@ class LogChecks:
         """End of the run: triggers within their deadline are ``currently_false`` (their lines written)."""
         self.deadline_results = [d.finish() for d in self.deadlines]
         self.period_results = [p.finish() for p in self.periods]
+        by_node = {p.node: p for p in self.period_results}
+        self.declaration_results = [add_periods(m.finish(), m.node, by_node.get(m.node.name))
+                                    for m in self.declarations]
 
     def status(self) -> list[str]:
         """``Node deadlines: 9 true, 1 false`` per node with a verdict."""
@@ -97,9 +110,9 @@ class LogChecks:
                 for d in self.deadlines if any(d.result.counts.values())]
 
     def record(self, log: str) -> dict[str, Any]:
-        """The record's ``topic_deadlines`` and ``periods``: per node its status,
+        """The record's ``topic_deadlines``, ``periods`` and ``declarations``: per node its status,
         explanation and result, as ``rclverify monitor LOG`` reports them."""
-        out: dict[str, Any] = {"topic_deadlines": [], "periods": []}
+        out: dict[str, Any] = {"topic_deadlines": [], "periods": [], "declarations": []}
         for res in self.deadline_results:
             status, explanation = deadline_status(res, log)
             out["topic_deadlines"].append({"node": res.node, "status": status, "explanation": explanation,
@@ -108,6 +121,10 @@ class LogChecks:
             status, explanation = period_status(pres, log)
             out["periods"].append({"node": pres.node, "status": status, "explanation": explanation,
                                    "periods": pres.to_json()})
+        for dres in self.declaration_results:
+            status, explanation = declaration_status(dres, log)
+            out["declarations"].append({"node": dres.node, "status": status, "explanation": explanation,
+                                        "declarations": dres.rows()})
         return out
 
 
