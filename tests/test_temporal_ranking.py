@@ -124,7 +124,8 @@ def test_an_edit_of_ranking_rechecks_that_requirement_only(countdown) -> None:
 @pytest.mark.parametrize("req, where, what", [
     ({"formal": C0, "ranking": "Cnt.state.c == 0"}, "plan.yaml:6:15:", "must be an INTEGER or NATURAL term, found BOOL"),
     ({"formal": "always Cnt.state.c <= 50", "ranking": "Cnt.state.c"}, "plan.yaml:6:15:", "only for a liveness"),
-    ({"formal": "eventually[<= 60] Cnt.state.c == 0", "invariant": "TRUE"}, "plan.yaml:6:17:", "only for a liveness"),
+    # issue 64: an invariant is read for every temporal statement, never for a state requirement
+    ({"formal": "Cnt.out.b >= 0", "invariant": "TRUE"}, "plan.yaml:6:17:", "only for a temporal statement"),
     ({"ranking": "Cnt.state.c"}, "plan.yaml:5:15:", "need a liveness statement in formal:"),
     ({"formal": C0, "ranking": "Cnt.state.q"}, "plan.yaml:6:15:", "Cnt.state.q is not a state variable"),
 ])

@@ -15,9 +15,15 @@ proved only through a ranking function the user supplies
 declared state variables, :mod:`.state`).  They are read like ``formal:``:
 every diagnostic lands on the plan's line and column.
 
+Since issue 64 ``invariant:`` is also read for every other temporal
+statement: it strengthens the k-induction that proves ``always F``, the
+response patterns and ``until``'s safety part (docs/requirements.md,
+"Proofs a user can finish").
+
 Errors (``E-type``: a ranking term that is not integer-valued;
-``E-temporal``: either key on a requirement whose ``formal:`` is not an
-unbounded ``eventually``, an ``until`` or an unbounded response; the name and type errors of
+``E-temporal``: ``ranking:`` on a requirement whose ``formal:`` is not an
+unbounded ``eventually``, an ``until`` or an unbounded response, ``invariant:``
+on a state requirement; the name and type errors of
 :func:`.formal.read_expr`) are located :class:`RclError` diagnostics.
 """
 from __future__ import annotations
@@ -78,17 +84,26 @@ def parse_hints(ranking: Source | None, invariant: Source | None, statement: "Te
                 ) -> tuple[Term | None, Formal | None]:
     """A requirement's ``(ranking, invariant)`` parsed (``None`` where
     absent); ``statement`` is its parsed ``formal:``.  Raises
-    :class:`RclError` with every located error: ``E-temporal`` at a key
-    given on a statement that is not liveness (:func:`is_liveness`), else
-    the errors of :func:`parse_ranking` and :func:`.formal.parse_formal`."""
+    :class:`RclError` with every located error: ``E-temporal`` at a
+    ``ranking:`` given on a statement that is not liveness (:func:`is_liveness`), else
+    the errors of :func:`parse_ranking` and :func:`.formal.parse_formal`.
+    An ``invariant:`` is read for every temporal statement (issue 64: it
+    strengthens the induction that proves a safety pattern, and is the
+    ranking function's domain for a liveness one), never for a state
+    requirement (``E-temporal``)."""
     diags = []
     out: list[Term | Formal | None] = [None, None]
     for k, (src, key) in enumerate(((ranking, "ranking"), (invariant, "invariant"))):
         if src is None:
             continue
-        if not is_liveness(statement):
-            diags.append(error(src.loc, f"{rid} {key}: {'a ranking function' if k == 0 else 'an invariant'} is read only for a liveness statement "
+        if k == 0 and not is_liveness(statement):
+            diags.append(error(src.loc, f"{rid} {key}: a ranking function is read only for a liveness statement "
                                         "(formal: eventually F without a bound, F until G, or always (F -> eventually G))", "E-temporal"))
+            continue
+        if k == 1 and not isinstance(statement, Temporal):
+            diags.append(error(src.loc, f"{rid} {key}: an invariant is read only for a temporal statement (a state "
+                                        "requirement is decided over one step, with no induction to strengthen)",
+                               "E-temporal"))
             continue
         try:
             out[k] = (parse_ranking(src, checked, f"{rid} ranking", states) if k == 0

@@ -247,7 +247,7 @@ def runs_go_on(ts: TransitionSystem, v: TemporalVerdict, *, max_k: int = 10,
     dl = check_deadlock_free(ts, max_k=max_k, timeout_ms=timeout_ms)
     if dl.status == "proved":
         return TemporalVerdict(v.status, v.method, k=v.k, bound=v.bound, trace=v.trace, detail=v.detail,
-                               loop=v.loop, deadlock=dl.deadlock)
+                               loop=v.loop, deadlock=dl.deadlock, certificate=v.certificate)
     if dl.status == "refuted":
         return TemporalVerdict("refuted", "deadlock", bound=dl.bound, trace=dl.trace,
                                detail=f"{dl.detail}; the statement itself was {v.status} by {v.method}, but only "

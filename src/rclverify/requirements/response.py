@@ -18,6 +18,10 @@ BMC and k-induction of :func:`.temporal.check_always`:
   now, as ``eventually[<= N]`` does), so an age of N, reached at step i+N
   with no Q since i, is the violation.
 
+What k-induction cannot prove (unreachable states that keep a P waiting)
+is proved by IC3/PDR or with the plan's ``invariant:`` (:func:`.safety.prove_always`;
+the monitor variable is part of the state Spacer's certificate speaks of).
+
 P and Q are read on published values (docs/semantics.md): the caller's
 ``trigger`` and ``goal`` are ``published and P`` and ``published and Q``.
 A run that stops with an obligation pending is found by the caller's
@@ -51,6 +55,7 @@ import z3
 from typing import Callable
 
 from .deadlock import find_deadlock
+from .safety import Hint, prove_always
 from .temporal import _ranking_fails, check_always
 from .tsys import Pred, TemporalVerdict, TransitionSystem, fair_loop, trace_of, unroll, with_flag
 
@@ -69,14 +74,20 @@ def with_counter(ts: TransitionSystem, name: str, init: "z3.ArithRef | object",
 
 
 def check_response(ts: TransitionSystem, trigger: Pred, goal: Pred, within: int | None, *, max_k: int = 10,
-                   timeout_ms: int = 10_000) -> TemporalVerdict:
+                   timeout_ms: int = 10_000, hint: Hint | None = None, deep: bool = True) -> TemporalVerdict:
     """Decide ``always (trigger -> eventually[<= within] goal)``, or
     ``always (trigger -> next goal)`` when ``within`` is ``None`` (module
-    docstring).  Returns the verdict of :func:`.temporal.check_always` on
-    the monitor variable, its trace naming the monitor's value per step."""
+    docstring).  Returns the verdict on the monitor variable, its trace
+    naming the monitor's value per step: of :func:`.safety.prove_always`
+    (k-induction, the plan's invariant ``hint``, IC3/PDR), or with
+    ``deep=False`` of :func:`.temporal.check_always` alone (k-induction)."""
+    def always(ts2: TransitionSystem, prop: Pred, monitor: str) -> TemporalVerdict:
+        if not deep:
+            return check_always(ts2, prop, max_k=max_k, timeout_ms=timeout_ms)
+        return prove_always(ts2, prop, max_k=max_k, timeout_ms=timeout_ms, hint=hint, monitor=monitor)
     if within is None:
         ts2 = with_flag(ts, "<P before>", lambda s: z3.BoolVal(False), lambda s, t: trigger(s))
-        return check_always(ts2, lambda s: z3.Implies(s["<P before>"], goal(s)), max_k=max_k, timeout_ms=timeout_ms)
+        return always(ts2, lambda s: z3.Implies(s["<P before>"], goal(s)), "<P before>: the trigger held one step before")
     n = int(within)
 
     def start(s: dict[str, z3.ExprRef]) -> z3.ArithRef:
@@ -88,11 +99,12 @@ def check_response(ts: TransitionSystem, trigger: Pred, goal: Pred, within: int 
         return z3.If(goal(t), z3.IntVal(-1), z3.If(age >= 0, grown, start(t)))
     ts2 = with_counter(ts, "<pending>", start, step)
     inv = lambda s: z3.And(s["<pending>"] >= -1, s["<pending>"] < n)  # noqa: E731
-    return check_always(ts2, inv, max_k=max(max_k, n + 2), timeout_ms=timeout_ms)
+    max_k = max(max_k, n + 2)
+    return always(ts2, inv, "<pending>: the age in steps of the oldest trigger not yet answered, -1 for none")
 
 
 def check_unbounded_response(ts: TransitionSystem, trigger: Pred, goal: Pred, *, max_k: int = 10,
-                             timeout_ms: int = 10_000, ranking: Callable[[dict], z3.ArithRef] | None = None,
+                             timeout_ms: int = 10_000, ranking: Callable[[dict[str, z3.ExprRef]], z3.ArithRef] | None = None,
                              invariant: Pred | None = None) -> TemporalVerdict:
     """Decide ``always (trigger -> eventually goal)`` (module docstring):
     ``proved`` by ``ranking`` (inside ``invariant``, itself proved here by
@@ -120,7 +132,7 @@ def check_unbounded_response(ts: TransitionSystem, trigger: Pred, goal: Pred, *,
             why = failed
     tried = []
     for n in (b for b in BOUNDS if b <= max_k):
-        v = check_response(ts, trigger, goal, n, max_k=max_k, timeout_ms=timeout_ms)
+        v = check_response(ts, trigger, goal, n, max_k=max_k, timeout_ms=timeout_ms, deep=False)
         if v.status == "proved":
             return TemporalVerdict("proved", "bounded response", k=v.k, bound=n,
                                    detail=f"every trigger is answered within {n} steps (k-induction, k = {v.k})")

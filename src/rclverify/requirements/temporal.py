@@ -145,16 +145,20 @@ def check_next(ts: TransitionSystem, prop: Pred, *, timeout_ms: int = 10_000) ->
 
 def check_until(ts: TransitionSystem, prop: Pred, goal: Pred, *,
                 eventually: Callable[[], TemporalVerdict] | None = None, max_k: int = 10,
-                timeout_ms: int = 10_000) -> TemporalVerdict:
+                timeout_ms: int = 10_000,
+                always: Callable[[TransitionSystem, Pred], TemporalVerdict] | None = None) -> TemporalVerdict:
     """Decide ``prop until goal``: every run reaches ``goal``, and ``prop``
     holds at every step before.  Decided as its safety part, ``always (goal
     seen or prop)`` over ``ts`` with a history flag (:func:`check_always`),
     and its liveness part ``eventually goal`` (``eventually()``; default
-    :func:`check_eventually` with ``bound = max_k``).  ``refuted`` when
+    :func:`check_eventually` with ``bound = max_k``; ``always(ts, prop)``
+    decides the safety part, default :func:`check_always`).  ``refuted`` when
     either part is; ``proved`` when both are; else ``inconclusive`` with
     both parts' statuses."""
     ts2 = with_flag(ts, "<G seen>", goal, lambda s, u: z3.Or(s["<G seen>"], goal(u)))
-    safe = check_always(ts2, lambda s: z3.Or(s["<G seen>"], prop(s)), max_k=max_k, timeout_ms=timeout_ms)
+    safe_prop = lambda s: z3.Or(s["<G seen>"], prop(s))  # noqa: E731
+    safe = always(ts2, safe_prop) if always is not None else check_always(ts2, safe_prop, max_k=max_k,
+                                                                           timeout_ms=timeout_ms)
     if safe.status == "refuted":
         return safe
     live = eventually() if eventually is not None else check_eventually(ts, goal, bound=max_k, timeout_ms=timeout_ms)

@@ -54,6 +54,7 @@ from ..rcl.types import Checked, EmptyT
 from ..values import render
 from ..system.model import SystemModel
 from .deadlock import runs_go_on
+from .safety import Hint, prove_always
 from .temporal import (TemporalVerdict, TransitionSystem, check_always, check_eventually,
                        check_eventually_within, check_next, check_until, find_lasso, with_flag)
 from .lasso import find_table_lasso
@@ -89,8 +90,8 @@ def decide(t: Temporal, sys: ComposedSystem, pred: Callable[[Formal], Callable[[
            bound: int = DEFAULT_BOUND, timeout_ms: int = 10_000, tables: Tables | None = None,
            ranking: Callable[[Any], Any] | None = None, invariant: Callable[[Any], Any] | None = None,
            checked: Checked | None = None, gaps: dict[str, Any] | None = None,
-           tables_first: bool = False, reach: Callable[[Formal], Callable[[Any], Any]] | None = None
-           ) -> TemporalVerdict:
+           tables_first: bool = False, reach: Callable[[Formal], Callable[[Any], Any]] | None = None,
+           hint_text: str = "") -> TemporalVerdict:
     """Decide statement ``t`` over ``sys`` (module table); ``pred(F)`` is
     F as a predicate over one state where F must hold (under ``always``,
     the left of ``until``), ``reach(F)`` (default ``pred``) where F must be
@@ -107,9 +108,12 @@ def decide(t: Temporal, sys: ComposedSystem, pred: Callable[[Formal], Callable[[
     ``eventually``.  A lasso in which a node never answers what it accepts
     is explained (:func:`.progress_gap.explain_idle`, with ``checked``): what
     is missing is put in ``gaps`` (``missing_progress``, ``missing_initially``).  A verdict ``proved`` stands
-    only if no run of the system stops (:func:`.deadlock.runs_go_on`)."""
+    only if no run of the system stops (:func:`.deadlock.runs_go_on`).  ``invariant`` (written ``hint_text``)
+    also strengthens the proof of a safety shape (``always``, ``always next``, the bounded and next
+    response, ``until``'s safety part: :func:`.safety.prove_always`, which tries IC3/PDR too)."""
+    hint = Hint(invariant, hint_text or "invariant:") if invariant is not None else None
     return runs_go_on(sys.ts, _decide(t, sys, pred, bound, timeout_ms, tables, ranking, invariant, checked,
-                                      gaps if gaps is not None else {}, tables_first, reach or pred),
+                                      gaps if gaps is not None else {}, tables_first, reach or pred, hint),
                       max_k=bound, timeout_ms=timeout_ms)
 
 
@@ -117,7 +121,7 @@ def _decide(t: Temporal, sys: ComposedSystem, pred: Callable[[Formal], Callable[
             timeout_ms: int, tables: Tables | None,
             ranking: Callable[[Any], Any] | None, invariant: Callable[[Any], Any] | None,
             checked: Checked | None, gaps: dict[str, Any], tables_first: bool = False,
-            reach: Callable[[Formal], Callable[[Any], Any]] | None = None) -> TemporalVerdict:
+            reach: Callable[[Formal], Callable[[Any], Any]] | None = None, hint: Hint | None = None) -> TemporalVerdict:
     kind = shape(t, None)
     got = reach or pred
     ts = sys.ts
@@ -161,7 +165,7 @@ def _decide(t: Temporal, sys: ComposedSystem, pred: Callable[[Formal], Callable[
         gaps.update(found)
         return v
     if kind == "always":
-        return check_always(ts, pred(t.args[0]), max_k=bound, timeout_ms=timeout_ms)
+        return prove_always(ts, pred(t.args[0]), max_k=bound, timeout_ms=timeout_ms, hint=hint)
     if kind == "response":  # always (P -> eventually[<= N] Q) / always (P -> next Q): requirements/response.py
         from .response import check_response, check_unbounded_response
         p, r = t.args[0].args  # type: ignore[union-attr]
@@ -170,22 +174,33 @@ def _decide(t: Temporal, sys: ComposedSystem, pred: Callable[[Formal], Callable[
                                             timeout_ms=timeout_ms, ranking=ranking, invariant=invariant)
         within = r.bound if r.op == "eventually" else None  # type: ignore[union-attr]
         return check_response(ts, got(p), got(r.args[0]), within, max_k=bound,  # type: ignore[arg-type, union-attr]
-                              timeout_ms=timeout_ms)
+                              timeout_ms=timeout_ms, hint=hint)
     if kind == "always next":
         f = pred(t.args[0].args[0])  # type: ignore[union-attr]
         ts2 = with_flag(ts, "<started>", lambda s: z3.BoolVal(False), lambda s, u: z3.BoolVal(True))
-        return check_always(ts2, lambda s: z3.Or(z3.Not(s["<started>"]), f(s)), max_k=bound, timeout_ms=timeout_ms)
+        return prove_always(ts2, lambda s: z3.Or(z3.Not(s["<started>"]), f(s)), max_k=bound, timeout_ms=timeout_ms,
+                            hint=hint)
     if kind == "next":
-        return check_next(ts, got(t.args[0]), timeout_ms=timeout_ms)
+        return _exact(check_next(ts, got(t.args[0]), timeout_ms=timeout_ms), hint)
     if kind == "eventually":
         f = got(t.args[0])
         if t.bound is not None:
             v = check_eventually_within(ts, f, t.bound, timeout_ms=timeout_ms)
-            return TemporalVerdict("proved", v.method, bound=v.bound, detail=v.detail,
-                                   deadlock=v.deadlock) if v.status == "met" else v
+            return _exact(TemporalVerdict("proved", v.method, bound=v.bound, detail=v.detail,
+                                          deadlock=v.deadlock) if v.status == "met" else v, hint)
         return eventually(t.args[0])  # type: ignore[arg-type]
     return check_until(ts, pred(t.args[0]), got(t.args[1]), eventually=lambda: eventually(t.args[1]),  # type: ignore[arg-type]
-                       max_k=bound, timeout_ms=timeout_ms)
+                       max_k=bound, timeout_ms=timeout_ms,
+                       always=lambda ts2, p: prove_always(ts2, p, max_k=bound, timeout_ms=timeout_ms, hint=hint))
+
+
+def _exact(v: TemporalVerdict, hint: Hint | None) -> TemporalVerdict:
+    """``v``, decided exactly by unrolling (``next F``, ``eventually[<= N] F``), with a note that the plan's
+    invariant was not needed."""
+    if hint is not None:
+        v.detail = "; ".join(x for x in (v.detail, f"the invariant {hint.text!r} is not needed: this statement is "
+                                                     "decided exactly by unrolling the steps it speaks of") if x)
+    return v
 
 
 def _steps(trace: list[dict[str, str]], sys: ComposedSystem) -> list[dict[str, Any]]:
@@ -269,7 +284,8 @@ def check_temporal(req: Requirement, checked: Checked, model: SystemModel, plan:
     from ..rcl.types import FuncT
     v = decide(t, sys, pred, bound=bound, timeout_ms=timeout_ms, tables=tables, ranking=ranking,
                invariant=inv_pred, checked=checked, gaps=missing,
-               tables_first=any(isinstance(ty, FuncT) for ty in types.values()), reach=reach)
+               tables_first=any(isinstance(ty, FuncT) for ty in types.values()), reach=reach,
+               hint_text=" ".join(req.invariant.text.split()) if req.invariant is not None else "")
     lasso = v.status == "refuted" and "lasso" in v.method.split(" + ")
     gaps = missing.get("missing_progress", []) if lasso else []
     stuck = missing.get("missing_initially", []) if lasso else []

@@ -70,7 +70,9 @@ class TemporalVerdict:
     successor); ``loop`` a lasso's loop step (the last state of ``trace``
     equals state ``loop``); ``deadlock`` what is known of runs that stop
     (``""`` when not asked; else a sentence: deadlock-free and how,
-    reachable at which step, or undecided and why).
+    reachable at which step, or undecided and why); ``certificate`` the
+    inductive invariant that proves it, as text, when one was found and
+    re-checked (method ``pdr``: :mod:`.safety`).
     """
 
     status: str
@@ -81,11 +83,12 @@ class TemporalVerdict:
     detail: str = ""
     loop: int | None = None
     deadlock: str = ""
+    certificate: str = ""
 
-    def to_json(self) -> dict:
+    def to_json(self) -> dict[str, Any]:
         """The record fields (a JSON-ready dict)."""
         return {"status": self.status, "method": self.method, "k": self.k, "bound": self.bound,
-                "trace": self.trace, "detail": self.detail, "loop": self.loop, "deadlock": self.deadlock}
+                "trace": self.trace, "detail": self.detail, "loop": self.loop, "deadlock": self.deadlock, "certificate": self.certificate}
 
 
 def unroll(ts: TransitionSystem, n: int, tag: str = "") -> tuple[list[State], list[z3.BoolRef]]:
