@@ -39,6 +39,7 @@ import re
 from typing import Any, Mapping
 
 from .deadlines import own_check, with_deadline
+from .statistics import with_statistics
 from .model import Argument, Element, propagate
 from ..report.textfmt import natural_key
 
@@ -268,7 +269,8 @@ def build_argument(report: Mapping[str, Any]) -> Argument:
         rid = str(r["id"])
         if "verdict" in r:  # checked by Z3 (docs/requirements.md): entailment, or undeveloped
             gid = _requirement_goal(b, own_check(r), guarantee_goal, sides, j_calc)
-            req_goals.append(with_deadline(b.els, gid, r, guarantee_goal))  # its end-to-end deadline (rule D3)
+            req_goals.append(with_statistics(b.els, with_deadline(b.els, gid, r, guarantee_goal), r))  # its deadline
+            # (rule D3) and its recorded runs' bounds and targets (statistics.py, issue 68)
             continue
         kids: list[str] = []
         nodes_used: list[str] = []

@@ -11,11 +11,13 @@ kind           what it rests on
 ``bounded``    exhaustive to a stated bound: SPIN or AJPF over an
                abstraction or a partial mapping
 ``statistical`` experiments: the sample size and the one-sided 95 % bound
-               the data give for the criterion
+               the data give for the criterion; a target's record (a run set
+               or an experiment's trials): its Clopper-Pearson bound
 ``tested``     property tests: examples run against the assumption, and
                their coverage of the assumption's ranges per input
 ``observed``   monitored runs: messages judged, events read, the run's
-               duration in trace time
+               duration in trace time; the doubt is the 95 % bound over the
+               runs of its node and environment where the report counted them
 ``reviewed``   a signed review record
 ``assumed``    stated, not verified (environment assumptions, declared
                progress and initial values)
@@ -69,6 +71,9 @@ def evidence_strength(row: Mapping[str, Any]) -> dict[str, Any]:
     backend = str(row.get("backend", ""))
     kind = BACKEND_KIND.get(backend, "assumed")
     detail, doubt = "", DOUBT[kind]
+    stats = row.get("statistics") if isinstance(row.get("statistics"), Mapping) else None
+    if stats is not None and "decision" in stats:  # a target's record: its bound is the doubt (issue 68)
+        return target_strength(row, stats)
     if backend == "hoare":
         two = (row.get("solvers") or {}).get("agreement") == "two solvers"
         detail = f"Z3{' and cvc5' if two else ' (one solver)'} on the verification conditions"
@@ -98,12 +103,36 @@ def evidence_strength(row: Mapping[str, Any]) -> dict[str, Any]:
         detail = f"{answered} verdicts on messages (satisfied or violated), {m.get('events_read', 0)} events read"
         if isinstance(m.get("duration_s"), (int, float)):
             detail += f" over {m['duration_s']:g} s of trace time"
+        group = stats.get("group") if stats is not None else None
+        if stats is not None and isinstance(group, Mapping) and isinstance(group.get("bound"), (int, float)):
+            # the runs of its node and environment, counted: their bound replaces the convention (issue 68)
+            doubt = float(group["bound"])
+            detail += (f"; {group.get('runs')} run(s) under {stats.get('environment')}: a one-sided "
+                       f"{float(group.get('level', 0.95)) * 100:g} % bound of {doubt:.3g} on the probability "
+                       f"that a run violates the contract")
     elif kind == "reviewed":
         who = (_figure(row, "reviewer") or "").split(";")[0].strip()
         detail = f"review by {who[:60] or 'an unnamed reviewer'}"
     if row.get("status") != "discharged":
         doubt = 1.0
     return {"kind": kind, "detail": detail, "doubt": doubt}
+
+
+def target_strength(row: Mapping[str, Any], stats: Mapping[str, Any]) -> dict[str, Any]:
+    """The strength of a target's record (a run set's or an experiment's,
+    docs/statistics.md): ``statistical``, its detail the counts and the
+    bound at the target's level, its doubt that bound when ``discharged``
+    (1 otherwise)."""
+    d = stats.get("decision") or {}
+    t = stats.get("target") or {}
+    bound = d.get("bound")
+    per = t.get("per", "run")
+    detail = (f"{d.get('n', 0)} {per}(s) under {stats.get('environment')}, {d.get('k', 0)} violating"
+              + (f", {d['undecided']} undecided" if d.get("undecided") else "")
+              + (f": a one-sided {float(d.get('level', 0.95)) * 100:g} % bound of {bound:.3g} on the probability "
+                 f"that a {per} violates it" if isinstance(bound, (int, float)) else ""))
+    doubt = float(bound) if row.get("status") == "discharged" and isinstance(bound, (int, float)) else 1.0
+    return {"kind": "statistical", "detail": detail, "doubt": doubt}
 
 
 def coverage_text(cov: Mapping[str, Any]) -> str:

@@ -41,6 +41,7 @@ from ..system.model import cycles_kept, names_of
 from ..diagnosis.build import diagnose
 from ..diagnosis.text import natural_sorted  # p1 < p2 < p10
 from .expected import expected_rows
+from .statistics import annotate_statistics, compact as compact_statistics
 from .records import diagnostics as read_diagnostics, grounding as read_grounding, inputs_sha256, node_obligations, \
     node_records
 
@@ -213,6 +214,8 @@ def build_report(ws: Workspace) -> dict[str, Any]:
                                        "coverage": ev.details.get("coverage") or {}}
         if isinstance(ev.details, dict) and ev.details.get("monitoring"):
             ev_rows[-1]["monitoring"] = ev.details["monitoring"]
+        if isinstance(ev.details, dict) and isinstance(ev.details.get("statistics"), dict):  # runs counted (issue 68)
+            ev_rows[-1]["statistics"] = compact_statistics(ev.details["statistics"])
         if status == "pending":
             pending.append({"obligation": o.id, "backend": o.backend, "reason": ev.explanation})
 
@@ -409,6 +412,8 @@ def build_report(ws: Workspace) -> dict[str, Any]:
         "environment_assumptions": env_assumptions, "pending": pending, "lint": lint_rows,
         "expected_verdicts": expected, "grounding": grounding, "unverified": unverified, "deadlines": deadlines,
     }
+    # runs counted by environment, bounds and targets (report/statistics.py, docs/statistics.md), before the confidence
+    report["statistics"] = annotate_statistics(report, plan, {r.id: r.target for r in all_requirements(plan)})
     from .confidence_rows import annotate  # evidence strength and confidence over the argument (issue 50)
     report["summary"]["solvers"] = second.counts()  # how many items two solvers, one solver, ... (issue 50)
     if second.problem:

@@ -1,0 +1,162 @@
+"""Statistical guarantees in the report (issue 68; docs/statistics.md).
+
+* :func:`compact` - an evidence record's ``details["statistics"]`` as the
+  report row carries it (the run set's list of runs left in the record);
+* :func:`annotate_statistics` - the report's ``statistics`` table: the
+  monitored runs grouped by node, environment tag and origin (each run
+  counted once, by its content digest; never a bound across two tags),
+  with the one-sided 95 % Clopper-Pearson bound on the probability that a
+  run violates the node's contract; beside them every target's row (the
+  run sets' and the experiments' records); and each requirement's runs
+  grouped by the tags of the entries that recorded them, decided against
+  its ``target`` when it states one.  Each per-run evidence row gets its
+  group's bound (``statistics.group``), which the confidence uses as the
+  doubt of that run evidence (:mod:`rclverify.argument.strength`).
+"""
+from __future__ import annotations
+
+from typing import Any, Iterable, Mapping
+
+from ..evidence.statistics import count_runs, decide, upper_bound
+from ..plan.model import Plan
+from ..plan.targets import UNSTATED, entry_environment, entry_origin
+
+#: The level of a bound drawn where the plan states no target.
+LEVEL = 0.95
+
+
+def compact(stats: Mapping[str, Any]) -> dict[str, Any]:
+    """The report's copy of a record's statistics: the run list summarised
+    (how many runs were recorded live, from bags, as other logs)."""
+    out = {k: v for k, v in stats.items() if k != "runs"}
+    if isinstance(stats.get("counts"), Mapping):
+        out["counts"] = {k: v for k, v in stats["counts"].items() if k != "digests"}
+    runs = stats.get("runs")
+    if isinstance(runs, list):
+        recorded: dict[str, int] = {}
+        for r in runs:
+            if isinstance(r, Mapping):
+                recorded[str(r.get("recorded", "unknown"))] = recorded.get(str(r.get("recorded", "unknown")), 0) + 1
+        out["recorded"] = recorded
+    return out
+
+
+def _node(obligation: str) -> str:
+    return obligation.split(".", 1)[0]
+
+
+def _group_row(node: str, env: str, origin: str, rows: list[Mapping[str, Any]]) -> dict[str, Any]:
+    counts = count_runs(rows)
+    recorded: dict[str, int] = {}
+    for r in rows:
+        recorded[str(r.get("recorded", "unknown"))] = recorded.get(str(r.get("recorded", "unknown")), 0) + 1
+    n, k = counts["runs"], counts["violating_runs"] + counts["undecided_runs"]
+    counted = origin != "harness" and n > 0
+    return {"node": node, "environment": env, "origin": origin, "kind": "runs",
+            "counts": {key: v for key, v in counts.items() if key != "digests"}, "recorded": recorded,
+            "level": LEVEL, "bound": upper_bound(k, n, LEVEL) if counted else None,
+            "note": "" if counted else ("driven by a test harness: not operation, no bound" if origin == "harness"
+                                        else "no judged run: no bound")}
+
+
+def _target_row(e: Mapping[str, Any]) -> dict[str, Any]:
+    s = e["statistics"]
+    d = s.get("decision") or {}
+    return {"node": _node(str(e.get("obligation"))), "environment": s.get("environment", UNSTATED),
+            "origin": s.get("origin", "operation"), "kind": "target", "obligation": e.get("obligation"),
+            "backend": e.get("backend"), "status": e.get("status"), "target": (s.get("target") or {}).get("text"),
+            "counts": s.get("counts"), "recorded": s.get("recorded", {}), "level": d.get("level"),
+            "bound": d.get("bound"), "runs_needed": d.get("runs_needed"),
+            "sprt": (d.get("sprt") or {}).get("decision")}
+
+
+def _trace_environments(plan: Plan) -> dict[str, tuple[str, str]]:
+    """Each monitored trace of the plan -> (environment, origin) of the first entry naming it."""
+    out: dict[str, tuple[str, str]] = {}
+    for entries in plan.evidence.values():
+        for e in entries:
+            if e.backend == "monitors":
+                for tr in e.config.get("traces", ()) or ():
+                    out.setdefault(str(tr), (entry_environment(e.config), entry_origin(e.config)))
+    return out
+
+
+def requirement_statistics(req: Mapping[str, Any], target: Any, where: Mapping[str, tuple[str, str]]) -> list[dict[str, Any]]:
+    """A requirement's runs (its record's ``traces``) grouped by environment
+    tag: one row each with the counts, the bound (at the target's level, else
+    95 %) and, with a ``target``, its decision."""
+    groups: dict[tuple[str, str], list[dict[str, Any]]] = {}
+    check = req.get("check") if isinstance(req.get("check"), Mapping) else {}
+    for t in (check or {}).get("traces") or req.get("traces") or []:
+        env, origin = where.get(str(t.get("trace")), (UNSTATED, "operation"))
+        status = str(t.get("status"))
+        groups.setdefault((env, origin), []).append({
+            "sha256": t.get("sha256"), "status": status, "violations": int(status == "failed"),
+            "inconclusive": int(status == "inconclusive"), "answers": 1})
+    out = []
+    for (env, origin), rows in sorted(groups.items()):
+        counts = count_runs([] if origin == "harness" else rows)
+        row: dict[str, Any] = {"environment": env, "origin": origin,
+                               "counts": {k: v for k, v in counts.items() if k != "digests"}}
+        level = target.level if target is not None else LEVEL
+        row["bound"] = upper_bound(counts["violating_runs"] + counts["undecided_runs"], counts["runs"], level)
+        row["level"] = level
+        if target is not None:
+            d = decide(counts, target)
+            row.update(target=target.text, status=d["status"], explanation=f"under {env}: {d['explanation']}",
+                       runs_needed=d["runs_needed"], sprt=d["sprt"]["decision"])
+        out.append(row)
+    return out
+
+
+def annotate_statistics(report: dict[str, Any], plan: Plan, targets: Mapping[str, Any]) -> list[dict[str, Any]]:
+    """The report's ``statistics`` table (module docstring); sets
+    ``statistics.group`` on each per-run evidence row and ``statistics`` on
+    each requirement with recorded runs.  ``targets``: requirement id -> its
+    :class:`~rclverify.evidence.statistics.Target` (or ``None``)."""
+    groups: dict[tuple[str, str, str], list[Mapping[str, Any]]] = {}
+    table: list[dict[str, Any]] = []
+    for e in report.get("evidence", []):
+        s = e.get("statistics")
+        if not isinstance(s, dict):
+            continue
+        if "decision" in s:
+            table.append(_target_row(e))
+        elif e.get("backend") == "monitors" and "sha256" in s:
+            key = (_node(str(e.get("obligation"))), str(s.get("environment", UNSTATED)), str(s.get("origin", "operation")))
+            groups.setdefault(key, []).append(s)
+    by_key = {key: _group_row(*key, rows) for key, rows in groups.items()}
+    for e in report.get("evidence", []):
+        s = e.get("statistics")
+        if isinstance(s, dict) and "decision" not in s and e.get("backend") == "monitors" and "sha256" in s:
+            g = by_key[(_node(str(e.get("obligation"))), str(s.get("environment", UNSTATED)),
+                        str(s.get("origin", "operation")))]
+            s["group"] = {"runs": g["counts"]["runs"], "bound": g["bound"], "level": LEVEL}
+    table = [by_key[k] for k in sorted(by_key)] + table
+    where = _trace_environments(plan)
+    for rq in report.get("requirements", []):
+        rows = requirement_statistics(rq, targets.get(str(rq.get("id"))), where)
+        if rows:
+            rq["statistics"] = rows
+            table.extend({"requirement": rq["id"], "kind": "requirement", **r} for r in rows)
+    return table
+
+
+def words(rows: Iterable[Mapping[str, Any]]) -> list[str]:
+    """One line per row of the table, for the terminal and the Markdown report."""
+    out = []
+    for r in rows:
+        c = r.get("counts") or {}
+        who = r.get("requirement") or r.get("node")
+        bound = r.get("bound")
+        b = "no bound" if bound is None else f"{float(r.get('level') or LEVEL) * 100:g} % upper bound {bound:.3g}"
+        line = f"{who} under {r.get('environment')}: {c.get('runs', 0)} run(s), {c.get('violating_runs', 0)} violating; {b}"
+        if r.get("target"):
+            line += f"; target {r['target']}: {r.get('status')}"
+            if r.get("status") != "discharged" and r.get("runs_needed") is not None:
+                line += f" ({r['runs_needed']} further clean run(s) needed, SPRT {r.get('sprt')})"
+        out.append(line)
+    return out
+
+
+__all__ = ["LEVEL", "annotate_statistics", "compact", "requirement_statistics", "words"]
