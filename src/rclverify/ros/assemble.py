@@ -145,6 +145,33 @@ class Assembly:
             files += [f for f in got.files if f not in files]
         return eps, files, notes
 
+    def controller_nodes(self, add_node: Callable[..., None], entries: dict[str, list[Any]], g: Graph) -> None:
+        """ros2_control controllers as nodes of their own (issue 65): each instance a
+        controller manager's parameter file names (:func:`plugins.controller_instances`)
+        is a lifecycle node of that name whose code is the controller class, linked
+        with the instance's name; a controller whose class no scanned source
+        defines is a located note at the file's line."""
+        found = plugins.controller_instances([x for pk in sorted(entries) for x in entries[pk]],
+                                             self.plugin_classes, g.notes)
+        for full, inst, pc, at in found:
+            base = self.plugin_progs.get(pc.type)
+            if base is None:
+                g.notes.append(Note(at, f"controller {inst} is a {pc.type}, exported, but no scanned C++ source "
+                                        f"defines the class: its endpoints are unknown"))
+                continue
+            prog = self._instances.get((pc.type, inst))
+            if prog is None:
+                prog = self._instances[(pc.type, inst)] = dataclasses.replace(base, files=list(base.files),
+                                                                              instance=inst)
+                if id(base) in self._views:
+                    self._views[id(prog)] = self._views[id(base)]
+            self.plugins_loaded.add(pc.type)
+            got = self.linked(prog)
+            g.notes.extend(got.notes)
+            eps = [e for e, _o in got.endpoints]
+            add_node(full, names.split(full)[0], base.package, pc.lookup, _files(prog, got, eps, None), at, eps,
+                     [], "source", lifecycle=True)
+
     def unloaded_plugins(self) -> list[Note]:
         """A located note for each endpoint of each plugin class no node was found to load
         (:func:`plugins.unloaded_note`), and what the plugin descriptions could not say."""

@@ -300,6 +300,7 @@ def _scan(paths: Sequence[Path], launch: Sequence[Path], launch_args: dict[str, 
             asm.launch_node(ln, add_node, g)
     else:
         asm.source_nodes(add_node, g)
+        asm.controller_nodes(add_node, pfiles.entries, g)  # ros2_control controllers (issue 65)
     g.notes.extend(asm.unloaded_plugins())
     for shown, r in sorted(res.sources.items()):
         g.notes.extend(r["notes"])

@@ -44,7 +44,7 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import Any, Iterable
 
 from . import safefs
 from .model import Endpoint, Note, Src
@@ -84,14 +84,15 @@ def described(root: Path) -> tuple[list[PluginClass], list[Note]]:
     manifest, _note = parse_xml(root / "package.xml", "package.xml")
     if manifest is None:
         return out, notes
-    refs = [(e.get("plugin", ""), line_of(e)) for ex in manifest.iter("export") for e in ex
+    refs = [(e.get("plugin", ""), "package.xml", line_of(e)) for ex in manifest.iter("export") for e in ex
             if isinstance(e.tag, str) and e.tag != "nodelet" and e.get("plugin")]
-    for ref, line in refs[:MAX_PLUGIN_FILES]:
+    refs += [r for r in cmake_described(root) if r[0] not in {x[0] for x in refs}]
+    for ref, where, line in refs[:MAX_PLUGIN_FILES]:
         rel = ref.replace("${prefix}", "").lstrip("/")
         path = root / rel
         if not rel or ".." in Path(rel).parts or not safefs.inside(path) or not path.is_file():
-            notes.append(Note(Src("package.xml", line, 1), f"plugin description '{ref}' is not a file of the "
-                                                            f"package: its plugins are not read", "ROS-PARSE"))
+            notes.append(Note(Src(where, line, 1), f"plugin description '{ref}' is not a file of the "
+                                                   f"package: its plugins are not read", "ROS-PARSE"))
             continue
         desc, bad = parse_xml(path, rel)
         if desc is None:
@@ -107,6 +108,21 @@ def described(root: Path) -> tuple[list[PluginClass], list[Note]]:
                     out.append(PluginClass(t, (c.get("base_class_type") or "").strip().lstrip(":"),
                                            (c.get("name") or t).strip(), target, path, line_of(c)))
     return out, notes
+
+
+def cmake_described(root: Path) -> list[tuple[str, str, int]]:
+    """``[(description file, "CMakeLists.txt", line)]``: the plugin descriptions the
+    package's ``CMakeLists.txt`` exports with
+    ``pluginlib_export_plugin_description_file(base_pkg file.xml)`` (pluginlib's
+    ament CMake macro, the ROS 2 way that ros2_control controllers use instead
+    of a ``package.xml`` export); ``[]`` when the file cannot be read."""
+    from .cmake import expand
+    try:
+        cmds = expand(safefs.read_text(root / "CMakeLists.txt"), root.name)
+    except (OSError, UnicodeDecodeError):
+        return []
+    return [(args[1], "CMakeLists.txt", line) for name, args, line in cmds
+            if name.lower() == "pluginlib_export_plugin_description_file" and len(args) >= 2]
 
 
 def is_string_type(t: str) -> bool:
@@ -161,9 +177,50 @@ def instances(values: dict[str, tuple[Any, Src]], full: str, classes: dict[str, 
     return out, notes
 
 
+#: base classes of ros2_control's controllers: each instance runs on a node of its own
+CONTROLLER_BASES = ("controller_interface::ControllerInterface", "controller_interface::ChainableControllerInterface")
+
+
+def is_controller(pc: PluginClass) -> bool:
+    """Whether plugin ``pc`` is a ros2_control controller (its base class is one of
+    :data:`CONTROLLER_BASES`, or another ``controller_interface::`` base)."""
+    return pc.base in CONTROLLER_BASES or pc.base.startswith("controller_interface::")
+
+
+def controller_instances(entries: Iterable[tuple[str, str, Any, Src]], classes: dict[str, PluginClass],
+                         notes: list[Note] | None = None) -> list[tuple[str, str, PluginClass, Src]]:
+    """``[(node name, instance, controller, where)]``: the controllers a controller
+    manager's parameter file names (ros2_control's controller manager, "Controller
+    manager" docs: ``controller_manager: ros__parameters: <name>: type: pkg/Class``),
+    each a node ``<name>`` in the manager's namespace (the manager makes one node per
+    controller, named after it).  ``entries``: :class:`param_yaml.PackageParams`
+    entries (``(node pattern, "~key", value, where)``); ``classes``: the exported
+    plugins by type and by lookup name.  A ``type`` naming no exported plugin under
+    a ``controller_manager`` key is a located note in ``notes`` (its endpoints are
+    unknown); a ``type`` naming a plugin that is no controller is left alone."""
+    out: list[tuple[str, str, PluginClass, Src]] = []
+    for pattern, key, value, at in entries:
+        inst = key[1:-len(".type")] if key.startswith("~") and key.endswith(".type") else ""
+        pc = classes.get(value.strip()) if isinstance(value, str) else None
+        if inst and "." not in inst and pc is None and isinstance(value, str) and _CLASSY.match(value.strip()) \
+                and pattern.rstrip("/").endswith("controller_manager") and notes is not None:
+            notes.append(Note(at, f"controller {inst} is a {value.strip()}, which no scanned package exports "
+                                  f"(pluginlib_export_plugin_description_file or a package.xml export): its "
+                                  f"endpoints are unknown"))
+        if not inst or "." in inst or pc is None or not is_controller(pc):
+            continue
+        ns = pattern.rsplit("/", 1)[0] if "*" not in pattern else ""
+        full = (ns.rstrip("/") + "/" + inst) if ns.startswith("/") else "/" + inst
+        if not any(x[0] == full and x[2] == pc for x in out):
+            out.append((full, inst, pc, at))
+    return out
+
+
 def unloaded_note(e: Endpoint, pc: PluginClass, xml_shown: str) -> Note:
     """The located note for endpoint ``e`` of plugin ``pc`` that no node is found to
     load (``xml_shown``: its description file as shown)."""
+    named = (f"no controller manager's parameter file names it ('<name>: type: {pc.lookup}'), so its node "
+             f"name is known only at run time") if is_controller(pc) else \
+        f"no node's parameter file names it ('<name>.plugin: {pc.type}')"
     return Note(e.src, f"{_KINDS.get(e.kind, e.kind)} of plugin {pc.type} (a {pc.base or 'plugin'} exported in "
-                       f"{xml_shown}:{pc.line}): the plugin is loaded at run time and no node's parameter file "
-                       f"names it ('<name>.plugin: {pc.type}'): not in the graph")
+                       f"{xml_shown}:{pc.line}): the plugin is loaded at run time and {named}: not in the graph")
