@@ -1,0 +1,10 @@
+"""doit tasks of the fleet trials example.  `doit verify` runs the whole
+pipeline; `doit list` shows the stages; `doit verify --strict` fails unless
+every obligation is discharged.  All logic lives in rclverify.tasks."""
+from pathlib import Path
+
+from rclverify.tasks import build_tasks, doit_config
+
+DOIT_CONFIG = doit_config()
+
+globals().update(build_tasks(Path(__file__).parent))

@@ -1,0 +1,66 @@
+"""examples/fleet_trials (issue 68; docs/statistics.md): two run sets of the speed governor, each with an
+environment tag and a target; verified on a copy, with what the report, the confidence and the argument say."""
+from __future__ import annotations
+
+import json
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from rclverify.cli import main
+
+EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "fleet_trials"
+
+
+@pytest.fixture(scope="module")
+def ws(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    root = tmp_path_factory.mktemp("fleet") / "fleet_trials"
+    shutil.copytree(EXAMPLE, root, ignore=shutil.ignore_patterns("artifacts", "reports", ".doit*", "__pycache__"))
+    assert main(["verify", "-w", str(root)]) == 0  # pending, not failed: the night's runs fall short
+    return root
+
+
+def _report(ws: Path) -> dict[str, Any]:
+    return json.loads((ws / "reports/assurance.json").read_text())
+
+
+def test_the_day_meets_the_target_and_the_night_says_how_many_runs_it_needs(ws: Path) -> None:
+    r = _report(ws)
+    targets = {s["environment"]: s for s in r["statistics"] if s["kind"] == "target"}
+    day, night = targets["warehouse_day"], targets["loading_dock_night"]
+    assert day["status"] == "discharged" and day["counts"]["runs"] == 60
+    assert day["bound"] == pytest.approx(1 - 0.05 ** (1 / 60))
+    assert night["status"] == "pending" and night["counts"]["runs"] == 25
+    assert (night["runs_needed"], night["sprt"]) == (34, "continue")
+    groups = {s["environment"]: s for s in r["statistics"] if s["kind"] == "runs"}
+    assert set(groups) == {"warehouse_day", "loading_dock_night"}  # never one bound over both
+    assert groups["warehouse_day"]["recorded"] == {"log": 60} and groups["warehouse_day"]["origin"] == "simulation"
+    (g1,) = [g for n in r["nodes"] for g in n["guarantees"]]
+    assert g1["strength"]["kind"] == "statistical" and g1["strength"]["doubt"] == pytest.approx(day["bound"])
+    (req,) = r["requirements"]
+    assert {s["environment"]: s["status"] for s in req["statistics"]} == {"warehouse_day": "discharged",
+                                                                          "loading_dock_night": "pending"}
+    md = (ws / "reports/assurance.md").read_text()
+    assert "### Runs counted and statistical guarantees" in md and "34 further clean run(s) needed" in md
+
+
+def test_the_argument_has_a_target_goal_per_environment(ws: Path) -> None:
+    a = json.loads((ws / "reports/argument.json").read_text())
+    el = {e["id"]: e for e in a["elements"]}
+    assert el["G-FLEET-SPEED.target.warehouse_day"]["status"] == "discharged"
+    assert el["G-FLEET-SPEED.target.loading_dock_night"]["status"] == "pending"
+    assert "J-statistics" in el["G-FLEET-SPEED.target.warehouse_day"]["in_context_of"]
+    assert el["G-FLEET-SPEED"]["status"] == "pending"
+
+
+def test_the_simulation_writes_the_committed_runs(tmp_path: Path) -> None:
+    subprocess.run([sys.executable, str(EXAMPLE / "simulate_runs.py"), str(tmp_path)], check=True,
+                   capture_output=True)
+    for env in ("warehouse_day", "loading_dock_night"):
+        ours = sorted(p.name for p in (EXAMPLE / "runs" / env).iterdir())
+        assert ours == sorted(p.name for p in (tmp_path / env).iterdir())
+        assert all((EXAMPLE / "runs" / env / n).read_bytes() == (tmp_path / env / n).read_bytes() for n in ours)
