@@ -55,6 +55,11 @@ def requirement_lines(r: Mapping[str, Any]) -> list[str]:
     out += [f"  assuming: {a}" for a in c.get("assuming") or []]
     if r.get("note"):
         out.append(f"  {r['note']}")
+    t = c.get("temporal") or {}
+    if t.get("method"):  # how a temporal statement was decided; an IC3/PDR proof's certificate (issue 64)
+        out.append(f"  temporal check: {t.get('status')} by {t['method']}" + (f"; {t['detail']}" if t.get("detail") else ""))
+        if t.get("certificate"):
+            out.append(f"    certificate (inductive invariant, re-checked): {t['certificate']}")
     out += [f"    used: {p['label']}: {p['text']}  ({p['source']})" for p in c.get("used") or []]
     out += [f"    traced, not needed: {p['label']}" for p in c.get("traced_not_needed") or []]
     out += [f"    contradictory: {p['label']}: {p['text']}  ({p['source']})" for p in c.get("inconsistent_core") or []]

@@ -133,7 +133,7 @@ def by_pdr(ts: TransitionSystem, prop: Pred, *, max_k: int, timeout_ms: int,
     """``always prop`` by Spacer (:mod:`.pdr`), the certificate re-checked
     before it proves anything; ``within`` a proved invariant of ``ts`` that
     the clauses may assume.  ``proved`` (method ``pdr``, ``certificate`` the
-    invariant's text), ``refuted`` (method ``bmc``, the shortest run found
+    invariant's text; ``pdr with invariant`` with ``within``), ``refuted`` (method ``bmc``, the shortest run found
     from ``max_k`` steps on) or ``inconclusive`` with the reason."""
     sys = ts if within is None else TransitionSystem(
         ts.sorts, lambda s: z3.And(ts.init(s), within(s)), lambda s, t: z3.And(ts.trans(s, t), within(s), within(t)),
@@ -147,10 +147,10 @@ def by_pdr(ts: TransitionSystem, prop: Pred, *, max_k: int, timeout_ms: int,
             return TemporalVerdict("inconclusive", "pdr", detail=f"IC3/PDR (Z3 Spacer) answered with an invariant, "
                                                                   f"but {bad}")
         text = shown(ans.invariant)
-        return TemporalVerdict("proved", "pdr", certificate=text,
-                               detail=f"IC3/PDR (Z3 Spacer) found an inductive invariant, re-checked by Z3 (every "
-                                      f"initial state satisfies it, every step keeps it, it implies the property): "
-                                      f"{text}")
+        return TemporalVerdict("proved", "pdr" if within is None else "pdr with invariant", certificate=text,
+                               detail="IC3/PDR (Z3 Spacer) found an inductive invariant, re-checked by Z3: every "
+                                      "initial state satisfies it, every step keeps it, it implies the property "
+                                      "(the certificate)")
     if ans.status == "reachable":
         found = shortest_violation(sys, prop, max_k, limit)
         if isinstance(found, str):
