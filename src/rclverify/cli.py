@@ -653,6 +653,9 @@ def main(argv: Sequence[str] | None = None) -> int:
                    help="one contract skeleton per node of the ROS workspace PATH (repeatable; docs/ros.md)")
     i.add_argument("--launch", action="append", default=[], metavar="FILE",
                    help="with --from-ros: entry launch file (repeatable)")
+    i.add_argument("--library-endpoints", action="store_true",
+                   help="with --from-ros: also make the libraries' endpoints (tf, bond, diagnostics, interactive "
+                        "markers) contract inputs and outputs; by default they are listed apart")
     bnd = add("bundle", cmd_bundle, "write the assessor's bundle (reports, artifacts, plan, contracts, manifest)", True)
     bnd.add_argument("-o", "--output", help="archive to write (.tar.gz or .zip; default: <workspace name>-bundle.tar.gz)")
     bnd.add_argument("--verify", metavar="FILE", help="check the archive FILE against its manifest instead")
