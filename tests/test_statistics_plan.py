@@ -169,3 +169,35 @@ def test_an_experiment_target_counts_trials_and_leaves_the_criterion_alone(tmp_p
     assert (c["runs"], c["violating_runs"]) == (120, 1) and ev.details["statistics"]["failing_trials"] == [34]
     # 1 of 120 gives an upper bound of 3.9 %: within 5 %
     assert ev.status == "discharged" and ev.details["statistics"]["decision"]["bound"] == pytest.approx(0.0389, abs=1e-3)
+
+
+def test_the_live_monitor_counts_as_it_goes_and_its_log_counts_as_a_live_run(tmp_path: Path) -> None:
+    from rclverify.backends.monitors.config import load_mapping
+    from rclverify.backends.monitors.live import LiveRun
+    ws = _ws(tmp_path, [], {})
+    cfg = load_mapping(tmp_path, None, 1.0)
+    log = tmp_path / "live/run.jsonl"
+    live = LiveRun(ws.checked, [ws.checked.nodes["Clamp"]], cfg.rules, cfg.horizon, log, reorder_window=0.0)
+    for j in range(40):
+        t = 1.0 + 0.1 * j
+        live.tick(t)
+        live.push("a", {"data": 1.0}, t)
+        live.push("x", {"data": 20.0}, t + 0.01)
+        if j == 19:  # half way: the counts so far, and their bound
+            assert "answer(s) counted, 95 % bound" in live.status_line()
+    live.tick(6.0)
+    record = live.stop()
+    (node,) = record["nodes"]
+    s = node["statistics"]
+    assert (s["recorded"], s["answers"], s["violations"]) == ("live", 40, 0) and s["sha256"] == record["sha256"]
+    assert "40 answer(s) counted, 95 % bound 0.0722 per answer" in live.status_line()
+    # the log in the plan: recorded live, counted once however often it is named
+    (tmp_path / "live/again.jsonl").write_bytes(log.read_bytes())
+    entry = {"backend": "monitors", "traces": ["live/run.jsonl", "live/again.jsonl"], "environment": "lab",
+             "target": "violation probability <= 1e-1 at 95 % per answer"}
+    (tmp_path / "contracts/plan.yaml").write_text(json.dumps({"contracts": ["contracts/sys.rcl"],
+                                                              "nodes": {"Clamp": {"evidence": [entry]}}}))
+    _, ev, _ = _runset(Workspace(tmp_path))
+    st = ev.details["statistics"]
+    assert ev.status == "discharged" and st["counts"]["runs"] == 1 and st["counts"]["duplicates"] == 1
+    assert {r["recorded"] for r in st["runs"]} == {"live"} and st["counts"]["answers"] == 40

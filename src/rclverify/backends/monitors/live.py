@@ -179,9 +179,10 @@ class LiveRun:
         self._last.clear()
 
     def status_line(self) -> str:
-        """``Node: 3 satisfied, 1 violated | Node2: ...`` (a live per-node status)."""
+        """``Node: 3 satisfied, 1 violated; 4 answer(s) counted, 95 % bound 0.75 per answer | Node2: ...``
+        (a live per-node status: the counts so far, docs/statistics.md)."""
         with self.lock:
-            parts = [summary_line(m.result) for m in self.engine.monitors]
+            parts = [summary_line(m.result) + running_bound(m.result) for m in self.engine.monitors]
             parts += self.checks.status()
         silent = [t for t, s in self.engine.topics.items() if s.silent]
         return " | ".join(parts) + (f" | silent: {', '.join(sorted(silent))}" if silent else "")
@@ -201,11 +202,12 @@ class LiveRun:
         versions = tool_versions()
         horizon = self.engine.horizon
         nodes = []
+        observed = (datetime.now(timezone.utc) - datetime.fromisoformat(self.started)).total_seconds()
         for res in self.results:
             status, explanation = verdict_status(res, self.log_path.name)
             nodes.append({"node": res.node, "status": status, "explanation": explanation,
                           **monitoring_details(res, self.log_path.name, self.engine.released, sha, versions,
-                                               horizon)})
+                                               horizon), "statistics": live_counts(res, sha, observed)})
         record = {"kind": "monitoring", "mode": "live", "log": self.log_path.name, "sha256": sha,
                   "started": self.started,
                   "stopped": datetime.now(timezone.utc).isoformat(timespec="seconds"),
@@ -241,6 +243,31 @@ class LiveRun:
         for entry in record["nodes"]:  # a pending node says why itself
             explain(entry, items)
         return items
+
+
+def running_bound(res: NodeResult) -> str:
+    """``; 40 answer(s) counted, 95 % bound 0.0722 per answer``: the one-sided
+    Clopper-Pearson bound on the probability that an answer violates the
+    contract, from the counts so far (undecided answers count as
+    violations; docs/statistics.md); ``""`` before the first answer."""
+    c = res.counts
+    n = c.get("satisfied", 0) + c.get("violated", 0) + c.get("inconclusive", 0)
+    if not n:
+        return ""
+    from ...evidence.statistics import upper_bound
+    return f"; {n} answer(s) counted, 95 % bound {upper_bound(n - c.get('satisfied', 0), n, 0.95):.3g} per answer"
+
+
+def live_counts(res: NodeResult, sha: str, seconds: float) -> dict[str, Any]:
+    """What a live run counted of one node, as a run's evidence counts it
+    (:func:`.runset.run_counts`): the log's content sha256 (its identity: the
+    same log named twice in a plan is one run), judged answers, violations,
+    undecided answers (inconclusive and still open) and the wall-clock seconds
+    observed; ``recorded`` is ``live``."""
+    c = res.counts
+    return {"recorded": "live", "sha256": sha, "answers": c.get("satisfied", 0) + c.get("violated", 0),
+            "violations": c.get("violated", 0), "inconclusive": c.get("inconclusive", 0) + c.get("open", 0),
+            "seconds": round(seconds, 3)}
 
 
 def _no_delay(pub: Any) -> None:
