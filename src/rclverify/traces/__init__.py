@@ -3,7 +3,9 @@
 :mod:`.events` is the event record and the located error; :mod:`.jsonl`
 reads ROSMonitoring's JSON-lines logs (:mod:`.jsonl_blocks`: a block of
 lines at a time, as columns, for the offline batch path), :mod:`.bag` ROS 1 and ROS 2 bags
-(through ``rosbags``); :mod:`.mapping` turns messages into RCL values with
+(through ``rosbags``; :mod:`.bag_blocks`: a ROS 2 bag's messages a block
+at a time, as columns, for the offline batch path); :mod:`.table` a run
+already held in columns; :mod:`.mapping` turns messages into RCL values with
 the paper's mapping rules (lines 535-548).  :func:`read_trace` picks the
 reader by the file's form.
 """
@@ -36,8 +38,8 @@ def read_trace(path: Path, msg_dirs: Sequence[Path] = (), *, streams: bool = Fal
     if not path.is_dir() and path.suffix in LOG_SUFFIXES:
         from .jsonl_blocks import JsonlLog
         return JsonlLog(path)  # its events, as read_jsonl reads them, or its blocks for the batch path
-    from .bag import read_bag
-    return read_bag(path, msg_dirs)
+    from .bag_blocks import BagTrace
+    return BagTrace(path, msg_dirs)  # read_bag's events, or its blocks for the batch path (a ROS 2 bag)
 
 
 __all__ = ["Event", "TraceError", "read_trace"]

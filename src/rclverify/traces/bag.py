@@ -82,14 +82,8 @@ def read_bag(path: Path, msg_dirs: Sequence[Path] = ()) -> Iterator[Event]:
     cannot be opened or a message cannot be read (a truncated file); the
     events before it have already been yielded.
     """
-    from rosbags.highlevel import AnyReader
-    store = typestore(msg_dirs)
+    reader = open_bag(path, typestore(msg_dirs))
     index = 0
-    try:
-        reader = AnyReader([path], default_typestore=store)
-        reader.open()
-    except Exception as exc:
-        raise TraceError(f"{path}: message 0: error: cannot open the bag: {exc}") from None
     try:
         messages = reader.messages()
         while True:
@@ -101,17 +95,34 @@ def read_bag(path: Path, msg_dirs: Sequence[Path] = ()) -> Iterator[Event]:
                 raise TraceError(f"{path}: message {index}: error: cannot read the bag "
                                  f"(truncated?): {exc}") from None
             conn, stamp, raw = item
-            try:
-                msg = reader.deserialize(raw, conn.msgtype)
-            except Exception as exc:
-                raise TraceError(f"{path}: message {index} (topic {conn.topic}, {len(raw)} bytes): error: "
-                                 f"cannot decode {conn.msgtype}: {exc}") from None
-            fields = flatten(msg)  # its header's stamp, when it has one, is its own time (docs/semantics.md)
-            yield Event(index, stamp / 1e9, conn.topic.lstrip("/"), fields, f"{path.name}: message {index}",
-                        header_stamp(fields) if "header" in fields else None)
+            yield bag_event(reader, path, index, conn, stamp, raw)
             index += 1
     finally:
         try:
             reader.close()
         except Exception:
             pass
+
+
+def open_bag(path: Path, store: Any) -> Any:
+    """An opened ``rosbags`` reader of the bag at ``path``; raises :class:`TraceError` as :func:`read_bag`."""
+    from rosbags.highlevel import AnyReader
+    try:
+        reader = AnyReader([path], default_typestore=store)
+        reader.open()
+    except Exception as exc:
+        raise TraceError(f"{path}: message 0: error: cannot open the bag: {exc}") from None
+    return reader
+
+
+def bag_event(reader: Any, path: Path, index: int, conn: Any, stamp: int, raw: bytes) -> Event:
+    """The event of message ``index`` of the bag (``stamp`` in ns, ``raw`` its bytes), as :func:`read_bag`
+    makes it; raises :class:`TraceError` (located) when the message cannot be decoded."""
+    try:
+        msg = reader.deserialize(raw, conn.msgtype)
+    except Exception as exc:
+        raise TraceError(f"{path}: message {index} (topic {conn.topic}, {len(raw)} bytes): error: "
+                         f"cannot decode {conn.msgtype}: {exc}") from None
+    fields = flatten(msg)  # its header's stamp, when it has one, is its own time (docs/semantics.md)
+    return Event(index, stamp / 1e9, conn.topic.lstrip("/"), fields, f"{path.name}: message {index}",
+                 header_stamp(fields) if "header" in fields else None)

@@ -1,0 +1,227 @@
+"""A ROS 2 bag (sqlite3 or MCAP) read a block of messages at a time, as columns (the offline batch path).
+
+:func:`~.bag.read_bag` decodes every message into a message object, a
+dict of its fields and an :class:`~.events.Event`; the offline batch path
+(backends/monitors/batch.py) needs, for most messages, only the topic, the
+time and one field.  :class:`BagTrace` is what
+:func:`~rclverify.traces.read_trace` returns for a bag: iterated, it gives
+:func:`~.bag.read_bag`'s events; :meth:`BagTrace.blocks` gives the same
+messages, in the same order (``rosbags``' own reader gives both their order
+and their bytes), as :class:`BagBlock`\\ s of at most ``rows`` messages.
+
+A block decodes the ``data`` field of the two message types a batch-path
+topic most often carries straight from their CDR bytes, for all the block's
+messages of the type at once: ``std_msgs/msg/Float64`` (little-endian CDR,
+exactly 12 bytes: the double at offset 4) and ``std_msgs/msg/String``
+(little-endian CDR: the length ``L`` at offset 4, then ``L - 1`` bytes of
+UTF-8 and the terminating zero, nothing after).  Those are the bytes
+``rosbags`` decodes to the same value (a ``float``; a ``str``, strictly
+UTF-8), so the column holds what the event would.  Every other message (of
+another type, big-endian, padded, not valid) is decoded at once by
+:func:`~.bag.bag_event`, as :func:`~.bag.read_bag` decodes it; one it
+cannot decode ends the block: the events before it are given as a list,
+then its located :class:`~.events.TraceError` is raised, as the stream
+raises it.  A message's event is made on demand by the same
+:func:`~.bag.bag_event`.  A ROS 1 bag, or a workspace whose own ``.msg``
+files redefine either type, is not read in blocks (``blocks`` gives
+``None``: the caller reads events).
+"""
+from __future__ import annotations
+
+import copy
+from pathlib import Path
+from typing import Any, Iterator, Mapping, Sequence
+
+import numpy as np
+
+from .bag import bag_event, open_bag, read_bag, typestore
+from .events import Event, TraceError
+
+FLOAT64, STRING = "std_msgs/msg/Float64", "std_msgs/msg/String"
+_LE = b"\x00\x01"  # CDR little-endian encapsulation (the two bytes rosbags reads; the options after it are not)
+
+
+class BagTrace:
+    """The events of the bag at ``path`` (an iterator, as :func:`~.bag.read_bag`),
+    or its blocks (:meth:`blocks`), one or the other."""
+
+    def __init__(self, path: Path, msg_dirs: Sequence[Path] = ()) -> None:
+        self.path, self.msg_dirs = path, msg_dirs
+        self._events: Iterator[Event] | None = None
+
+    def __iter__(self) -> Iterator[Event]:
+        if self._events is None:
+            self._events = read_bag(self.path, self.msg_dirs)
+        return self._events
+
+    def __next__(self) -> Event:
+        return next(iter(self))
+
+    def blocks(self, fields: Sequence[str], rows: int) -> Iterator[BagBlock | list[Event]] | None:
+        """The bag's messages in blocks of at most ``rows`` (module docstring); ``None``
+        once events were read, or for a bag not read in blocks.  Raises
+        :class:`~.events.TraceError` as :func:`~.bag.read_bag`, after yielding the
+        events before the message."""
+        if self._events is not None:
+            return None
+        store = typestore(self.msg_dirs)
+        from rosbags.typesys import Stores, get_typestore
+        standard = get_typestore(Stores.ROS2_HUMBLE).fielddefs
+        if any(store.fielddefs.get(t) != standard[t] for t in (FLOAT64, STRING)):
+            return None  # the workspace redefines one: its layout is not the one decoded here
+        reader = open_bag(self.path, store)
+        if not reader.is2:
+            reader.close()
+            return None
+        self._events = iter(())
+        return _blocks(self.path, reader, max(rows, 1))
+
+
+def _blocks(path: Path, reader: Any, rows: int) -> Iterator[BagBlock | list[Event]]:
+    index = 0
+    # the blocks make their events on demand, also after the last block closed the reader (which then empties
+    # its type store): a shallow copy keeps the open reader's type store and decodes as read_bag's reader does
+    decoder = copy.copy(reader)
+    try:
+        messages = reader.messages()
+        while True:
+            got: list[tuple[Any, int, bytes]] = []
+            error: TraceError | None = None
+            try:
+                for item in messages:
+                    got.append(item)
+                    if len(got) >= rows:
+                        break
+            except Exception as exc:  # noqa: BLE001 - read_bag's located error, after the messages before it
+                error = TraceError(f"{path}: message {index + len(got)}: error: cannot read the bag "
+                                   f"(truncated?): {exc}")
+            if got:
+                block, bad = BagBlock.make(path, decoder, got, index)
+                if bad is not None:  # the events before a message that cannot be decoded, then its error
+                    if block:
+                        yield block
+                    raise bad
+                yield block
+                index += len(got)
+            if error is not None:
+                raise error
+            if len(got) < rows:
+                return
+    finally:
+        try:
+            reader.close()
+        except Exception:  # noqa: BLE001 - as read_bag: closing never hides the run's own error
+            pass
+
+
+class BagBlock:
+    """Messages ``index ..`` of a bag as columns (module docstring): ``topics``, ``times``
+    (float64 s, the recording's stamps), :meth:`values`, :meth:`typed`, ``block[i]`` (events)."""
+
+    __slots__ = ("path", "reader", "items", "index", "topics", "times", "_made", "_floats", "_is_float",
+                 "_strings")
+
+    def __init__(self, path: Path, reader: Any, items: list[tuple[Any, int, bytes]], index: int) -> None:
+        self.path, self.reader, self.items, self.index = path, reader, items, index
+        names: dict[int, str] = {}  # per connection (a rosbags Connection is not hashable: by identity)
+        self.topics: list[str] = [names.get(id(c)) or names.setdefault(id(c), c.topic.lstrip("/"))
+                                  for c, _, _ in items]
+        self.times = np.array([t for _, t, _ in items], dtype=np.int64) / 1e9  # as stamp / 1e9, per message
+        self._made: dict[int, Event] = {}
+        self._floats = np.zeros(len(items), dtype=np.float64)
+        self._is_float = np.zeros(len(items), dtype=bool)
+        self._strings: dict[int, str] = {}
+
+    @classmethod
+    def make(cls, path: Path, reader: Any, items: list[tuple[Any, int, bytes]], index: int
+             ) -> tuple[BagBlock | list[Event], TraceError | None]:
+        """The block of ``items`` (messages ``index ..``), or the events before a message
+        that cannot be decoded and its error (module docstring)."""
+        block = cls(path, reader, items, index)
+        types = [c.msgtype for c, _, _ in items]
+        floats = [i for i, t in enumerate(types) if t == FLOAT64]
+        if floats:
+            raws = [items[i][2] for i in floats]
+            if set(map(len, raws)) == {12}:
+                cells = np.frombuffer(b"".join(raws), dtype=np.uint8).reshape(-1, 12)
+                ok = (cells[:, 0] == 0) & (cells[:, 1] == 1)
+                at = np.array(floats)[ok]
+                block._floats[at] = cells[ok, 4:12].copy().view("<f8").reshape(-1)
+                block._is_float[at] = True
+        for i, t in enumerate(types):
+            if t == STRING:
+                s = _string(items[i][2])
+                if s is not None:
+                    block._strings[i] = s
+                    continue
+            elif t == FLOAT64 and block._is_float[i]:
+                continue
+            try:  # any other message: decoded now, in order, as the stream decodes it
+                block._made[i] = bag_event(reader, path, index + i, *items[i])
+            except TraceError as exc:
+                return [block[j] for j in range(i)], exc
+        return block, None
+
+    def __len__(self) -> int:
+        return len(self.items)
+
+    def values(self, rows: np.ndarray, key: str) -> list[Any]:
+        """The value of ``key`` in the messages at ``rows`` (``None`` where a message has none)."""
+        out: list[Any] = []
+        for i in rows.tolist():
+            ev = self._made.get(i)
+            if ev is not None:
+                out.append(ev.fields.get(key))
+            elif key != "data":
+                out.append(None)
+            elif self._is_float[i]:
+                out.append(float(self._floats[i]))
+            else:
+                out.append(self._strings[i])
+        return out
+
+    def typed(self, rows: np.ndarray, key: str, kind: str, codes: Mapping[str, int]
+              ) -> tuple[np.ndarray, np.ndarray] | None:
+        """``key`` at ``rows`` as :func:`~rclverify.backends.monitors.columns.column` reads
+        it, from the decoded columns; ``None`` when a row's message was decoded whole."""
+        if key != "data" or (self._made and any(i in self._made for i in rows.tolist())):
+            return None
+        is_float = self._is_float[rows]
+        if kind == "real":
+            col = self._floats[rows]
+            return is_float & np.isfinite(col), col
+        code = np.full(len(rows), -1, dtype=np.int64)
+        strings = self._strings
+        texts = np.array([strings.get(i, "") for i in rows.tolist()])
+        for value, k in codes.items():
+            code[texts == value] = k
+        code[is_float] = -1
+        return code >= 0, code
+
+    def __getitem__(self, i: Any) -> Any:
+        if isinstance(i, slice):
+            return [self[j] for j in range(*i.indices(len(self.items)))]
+        i = int(i)
+        if i < 0:
+            i += len(self.items)
+        ev = self._made.get(i)
+        if ev is None:
+            ev = self._made[i] = bag_event(self.reader, self.path, self.index + i, *self.items[i])
+        return ev
+
+
+def _string(raw: bytes) -> str | None:
+    """The ``data`` of a ``std_msgs/msg/String`` in little-endian CDR with nothing after its terminator
+    (module docstring), else ``None``."""
+    if len(raw) < 9 or raw[:2] != _LE:
+        return None
+    n = int.from_bytes(raw[4:8], "little")
+    if n < 1 or len(raw) != 8 + n or raw[-1] != 0:
+        return None
+    try:
+        return raw[8:-1].decode()
+    except UnicodeDecodeError:
+        return None
+
+
+__all__ = ["BagBlock", "BagTrace"]
