@@ -63,11 +63,20 @@ nodes:
       - backend: monitors
         mapping: mapping.yaml
         traces: [traces/run.jsonl]
+      - backend: property_tests
+        implementation: nodes/base.py:base
+        max_examples: 30
 requirements:
   - id: ARRIVE
     text: the robot eventually arrives at the goal
     formal: "eventually Planner.in.pose == 7"
     assuming: "Planner.in.goal == 7"
+"""
+BASE = """def base(target: int) -> dict[str, int]:
+    return {"pose": target}
+
+
+base.initial = {"pose": 0}  # what it publishes when it starts
 """
 # the last target and pose stand in for the answers to the last questions of the loop (docs/monitors.md)
 MAPPING = "topics:\n  target: {fields: [data], state: true}\n  pose: {fields: [data], state: true}\n"
@@ -99,6 +108,8 @@ def _workspace(root: Path, variant: str) -> Path:
     (ws / "contracts/r.rcl").write_text(RCL)
     (ws / "contracts/plan.yaml").write_text(PLAN)
     (ws / "mapping.yaml").write_text(MAPPING)
+    (ws / "nodes").mkdir()
+    (ws / "nodes/base.py").write_text(BASE)
     (ws / "traces/run.jsonl").write_text("".join(json.dumps(r) + "\n" for r in _run(variant)))
     return ws
 
@@ -129,6 +140,10 @@ def test_a_correct_system_with_progress_and_periods_is_green_under_strict(verifi
                                                           "periodic out.pose": "true"}
     assert rows["initially 1"]["reason"].endswith("out.pose = 0 (run.jsonl:1)")
     assert rows["progress"]["source"].endswith("r.rcl:18:3")
+    tested = json.loads((ws / "artifacts/evidence/Base.g1.property_tests.e1.json").read_text())
+    assert tested["status"] == "discharged"
+    assert {r["declaration"]: r["verdict"] for r in tested["details"]["declarations"]} == {
+        "initially 1": "true", "progress": "true"}
     planner = _evidence(ws, "Planner")["details"]["declarations"]
     assert [(r["declaration"], r["verdict"]) for r in planner] == [("progress", "true")]
 
@@ -148,7 +163,7 @@ def test_a_late_answer_is_not_green_and_names_the_inputs(verified: Any) -> None:
     req = next(r for r in report["requirements"] if r["id"] == "ARRIVE")
     ev = _evidence(ws, "Base")
     assert rc == 1 and req["verdict"] == "proved, evidence outstanding" and req["status"] == "failed"
-    assert "Base progress (declaration, failed on 1 record)" in req["note"]
+    assert "Base progress (declaration, failed: 1 discharged, 1 failed of 2 records)" in req["note"]
     assert ev["status"] == "failed"
     assert ("Base declares progress( within 1 steps )" in ev["explanation"]
             and "between the input at run.jsonl:11 and the input at run.jsonl:15" in ev["explanation"])
@@ -323,3 +338,31 @@ def test_the_monitor_command_and_the_live_checks_judge_them_as_the_backend(verif
         for got in (rec["Base"]["declarations"], next(e for e in shown if e["node"] == "Base")["declarations"]):
             assert {r["declaration"]: r["verdict"] for r in got} == want
         assert rec["Base"]["status"] == ("failed" if variant == "late" else "discharged")
+
+
+# ---- the property tests ------------------------------------------------------------------------------------------
+
+def test_the_property_tests_judge_progress_and_the_initial_value(tmp_path: Path) -> None:
+    """An implementation that raises on an admissible input (target 10)
+    breaks the declared progress; a class whose ``initial()`` gives pose 5
+    breaks ``initially( out.pose == 0 )`` and fails the record of guarantee
+    1; one without ``initial`` leaves it pending."""
+    from rclverify.backends.property_tests.declared import declaration_rows
+    from rclverify.backends.property_tests.harness import load_implementation, read_config, run_guarantee
+    c = _checked("  initially( out.pose == 0 )\n  progress( within 0 steps )\n")
+    node = c.nodes["Base"]
+    (tmp_path / "impl.py").write_text(
+        "def base(target):\n    if target == 10:\n        raise ValueError('no path to the end of the aisle')\n"
+        "    return {'pose': target}\n\n\nclass Base:\n    def initial(self):\n        return {'pose': 5}\n\n"
+        "    def step(self, target):\n        return {'pose': target}\n\n\ndef plain(target):\n    return {'pose': target}\n")
+    rows = {}
+    for attr in ("base", "Base", "plain"):
+        cfg = read_config({"implementation": f"impl.py:{attr}", "max_examples": 50}, node, tmp_path)
+        out = run_guarantee(c, node, 1, cfg, tmp_path)
+        rows[attr] = {r["declaration"]: (r["verdict"], r["reason"]) for r in declaration_rows(
+            c, node, load_implementation(tmp_path, cfg), out.status, out.counterexample, out.counts.valid)}
+    assert rows["base"]["progress"][0] == "false" and "in.target = 10" in rows["base"]["progress"][1]
+    assert rows["Base"]["progress"][0] == "true" and rows["plain"]["progress"][0] == "true"
+    assert rows["Base"]["initially 1"] == ("false", "the implementation's initial outputs do not satisfy it: out.pose = 5")
+    assert rows["plain"]["initially 1"][0] == "pending" and "no initial attribute" in rows["plain"]["initially 1"][1]
+    assert rows["base"]["initially 1"][0] == "pending"

@@ -88,8 +88,13 @@ def declaration_statuses(records: Mapping[str, Sequence[tuple[str, Sequence[Mapp
             return "pending", "declared, not verified"
         each = [min(ss, key=lambda s: _DECL_RANK.index(s) if s in _DECL_RANK else 0) for ss in per.values()]
         st = worst(each)
-        runs = sum(len(ss) for ss in per.values())
-        return st, f"declaration, {st} on {runs} record{'s' if runs != 1 else ''}"
+        seen: dict[str, int] = {}
+        for ss in per.values():
+            for x in ss:
+                seen[x] = seen.get(x, 0) + 1
+        runs = sum(seen.values())
+        return st, (f"declaration, {st}: " + ", ".join(f"{n} {x}" for x, n in sorted(seen.items()))
+                    + f" of {runs} record{'s' if runs != 1 else ''}")
     return status
 
 

@@ -33,6 +33,7 @@ from ...rcl.printer import expr_to_rcl
 from ..base import NodeTarget, Stopwatch, make_evidence
 from ..timelimit import TimeLimitExceeded, wall_clock_limit
 from .closure import import_closure, outside_versions
+from .declared import declaration_rows, has_declarations
 from .seeding import split_facts
 from .harness import Config, ConfigError, Outcome, load_implementation, read_config, run_guarantee, versions
 
@@ -93,6 +94,24 @@ def _is_class(target: NodeTarget, cfg: Config) -> bool:
         return inspect.isclass(load_implementation(target.root, cfg))
     except ConfigError as exc:
         raise target.config_error(str(exc), *exc.path) from None
+
+
+def _declarations(outcome: Outcome, cfg: Config, target: NodeTarget, k: int) -> tuple[str, str, list[dict[str, Any]]]:
+    """The declaration rows of guarantee ``k``'s run and the record's status
+    and message with them: an initial value outside ``initially`` fails the
+    record of guarantee 1 (:mod:`.declared`)."""
+    try:
+        impl = load_implementation(target.root, cfg) if target.node.node.initially else None
+    except ConfigError:
+        impl = None
+    rows = declaration_rows(target.checked, target.node, impl, outcome.status, outcome.counterexample,
+                            outcome.counts.valid)
+    bad = [r for r in rows if r["verdict"] == "false" and r["premise"] == "initial value"]
+    if bad and k == 1 and outcome.status != "failed":
+        r = bad[0]
+        return "failed", f"{cfg.implementation} declares {r['text']} ({r['source']}) but {r['reason']}; {outcome.message}", rows
+    held = [r["text"] for r in rows if r["verdict"] == "true"]
+    return outcome.status, outcome.message + ("; declarations held: " + ", ".join(held) if held else ""), rows
 
 
 class PropertyTestsBackend:
@@ -180,5 +199,8 @@ class PropertyTestsBackend:
         cex = outcome.counterexample
         if cex is not None:
             cex = {**cex, "replay": replay}
-        return evidence(outcome.status, outcome.message, log=log, artifacts=(target.rel(path),),
+        status, message = outcome.status, outcome.message
+        if has_declarations(target.node):  # progress and initial values on the implementation (declared.py)
+            status, message, details["declarations"] = _declarations(outcome, cfg, target, k)
+        return evidence(status, message, log=log, artifacts=(target.rel(path),),
                         counterexample=cex, details=details)
