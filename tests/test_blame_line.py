@@ -141,3 +141,80 @@ def test_the_run_names_nothing_it_cannot_replay() -> None:
     assert run(loop, {"x": 0})[0]["x"] == 10
     ext = lang.parse_program("extern f : REAL --> REAL;\nvar x : REAL;\nvar y : REAL;\ny := f(x)\n", "e.imp")
     assert breaking_assignments(ext, {"x": 1, "y (final)": 2}, {"out.y": "y"}, "") == []
+
+
+# ---- a generated node: the handler of logic.py that published the violating message ------------
+
+GEN_RCL = """\
+node ArmDriver {
+  inputs( estop : BOOL, target : REAL )
+  outputs( command : REAL )
+  topics( std_msgs/Bool estop matches(in.estop),
+          std_msgs/Float64 target matches(in.target),
+          std_msgs/Float64 command matches(out.command) )
+  assume( 0 <= in.target and in.target <= 10 )
+  guarantee( in.estop -> out.command == 0 )
+}
+"""
+
+#: what the user wrote in logic.py: a correct step, and an e-stop handler that re-sends the last command
+STEP = '''def step(estop, target):
+    """The outputs for these inputs (RCL values, docs/values.md): ``{output name: value}``."""
+    return {"command": 0.0 if estop else target}
+'''
+ON_INPUT = '''def on_input(node, var, msg):
+    """A message for contract input ``var`` (``'in.x'``) arrived; publish the outputs it decides."""
+    if var == "in.estop":
+        node.publish_value("out.command", getattr(node, "last", 0.0))
+        return
+    for name, value in _run(node).items():
+        node.last = value
+        node.publish_value(f'out.{name}', value)
+'''
+
+RUN = "".join(line + "\n" for line in (
+    '{"topic": "target", "time": 1.0, "data": 5.0}',
+    '{"topic": "estop", "time": 1.5, "data": false}',
+    '{"topic": "command", "time": 1.51, "data": 5.0}',
+    '{"topic": "estop", "time": 2.0, "data": true}',
+    '{"topic": "command", "time": 2.01, "data": 5.0}'))
+
+
+def test_a_run_of_a_generated_node_names_its_handler(tmp_path: Path) -> None:
+    import json
+    import re
+
+    import yaml
+
+    from rclverify.cli import main
+    (tmp_path / "contracts").mkdir()
+    (tmp_path / "runs").mkdir()
+    (tmp_path / "contracts" / "arm.rcl").write_text(GEN_RCL, encoding="utf-8")
+    (tmp_path / "contracts" / "plan.yaml").write_text(
+        'name: "gen"\ncontracts: [contracts/arm.rcl]\nrequirements: []\nnodes:\n  ArmDriver: {}\n', encoding="utf-8")
+    (tmp_path / "dodo.py").write_text("from pathlib import Path\nfrom rclverify.tasks import build_tasks, doit_config\n"
+                                      "DOIT_CONFIG = doit_config()\nglobals().update(build_tasks(Path(__file__).parent))\n",
+                                      encoding="utf-8")
+    assert main(["generate", "ros2", "-w", str(tmp_path), "-o", str(tmp_path / "gen")]) == 0
+    logic = tmp_path / "gen" / "arm_driver" / "arm_driver" / "logic.py"
+    text = logic.read_text(encoding="utf-8")
+    text = re.sub(r"def step\(estop, target\):\n(?:    .*\n)+", STEP, text, count=1)
+    text = re.sub(r"def on_input\(node, var, msg\):\n(?:    .*\n)+", ON_INPUT, text, count=1)
+    logic.write_text(text, encoding="utf-8")
+    lines = text.splitlines()
+    handler_line = lines.index("def on_input(node, var, msg):") + 1
+    early = handler_line + 4  # the bare `return` after re-sending the last command
+    assert lines[early - 1].strip() == "return"
+    (tmp_path / "runs" / "run.jsonl").write_text(RUN, encoding="utf-8")
+    plan = yaml.safe_load((tmp_path / "contracts" / "plan.yaml").read_text(encoding="utf-8"))
+    plan["nodes"] = {"ArmDriver": {"evidence": [{"backend": "monitors", "mapping": "gen/rclverify_mapping.yaml",
+                                                 "traces": ["runs/run.jsonl"]}]}}
+    (tmp_path / "contracts" / "plan.yaml").write_text(yaml.safe_dump(plan), encoding="utf-8")
+    assert main(["verify", "-w", str(tmp_path)]) == 0
+    report = json.loads((tmp_path / "reports" / "assurance.json").read_text(encoding="utf-8"))
+    d = next(x for x in report["diagnoses"] if x["kind"] == "monitor")
+    where = f"gen/arm_driver/arm_driver/logic.py:{handler_line}"
+    assert d["culprits"][0]["source"] == where and d["culprits"][0]["text"] == "on_input"
+    assert f"returns early at line {early}" in d["sentence"] and "called for in.estop" in d["culprits"][0]["what"]
+    row = next(g for g in report["problems"] if d["id"] in [m["id"] for m in g["members"]])
+    assert row["key"] == [f"line:{where}"]  # the handler, not the contract

@@ -291,6 +291,15 @@ def _side_condition(ws: Any, report: Mapping[str, Any], sc: Mapping[str, Any], c
     return rec
 
 
+def _generated_handler(ws: Any, node: str, monitoring: Mapping[str, Any]) -> Any:
+    """The handler of ``node``'s generated logic.py that published the first
+    violating message (:func:`rclverify.diagnosis.handlers.violating_handler`),
+    ``None`` for a node without generated code or a run it cannot place."""
+    from .handlers import violating_handler
+    entries = [{"backend": x.backend, **dict(x.config)} for x in ws.plan.evidence.get(node, ())]
+    return violating_handler(ws.root, node, entries, monitoring)
+
+
 def _breaking_assignments(ws: Any, program: str, cex: Mapping[str, Any], data: Mapping[str, Any],
                           conj: str) -> list[Any]:
     """The last assignments to the outputs ``conj`` reads in the program's
@@ -332,9 +341,17 @@ def _evidence(ws: Any, report: Mapping[str, Any], e: Mapping[str, Any], o: Mappi
         sentence = (f"In {mon.get('trace', 'the trace')}, the output at {fv.get('where')} (t = {fv.get('time')} s) "
                     f"answering the input at {fv.get('trigger_where')} violates guarantee {gk} of {node} ({gsrc})"
                     f"; {mon.get('counts', {}).get('violated', '?')} message(s) of the run violate the contract (each: `rclverify explain OBLIGATION#N`).")
-        return _record(e["obligation"], "monitor", node, e["status"], sentence,
-                       culprits=[{"what": f"event {fv.get('where')}", "source": fv.get("where", ""), "text": ""},
-                                 {"what": f"guarantee {gk} of {node}", "source": gsrc, "text": gtext}],
+        cul = [{"what": f"event {fv.get('where')}", "source": fv.get("where", ""), "text": ""},
+               {"what": f"guarantee {gk} of {node}", "source": gsrc, "text": gtext}]
+        h = _generated_handler(ws, node, mon)  # generated code: the logic.py handler that published it (issue 64)
+        if h is not None:
+            said = "".join([f"; it returns early at line {', '.join(map(str, h.early))}" if h.early else "",
+                            f"; it publishes at line {', '.join(map(str, h.publishes))}" if h.publishes else ""])
+            sentence = (sentence + f" The message was published by the handler `{h.name}` of {h.file}:{h.line}, "
+                        f"which the generated node.py calls for {h.variable}{said}.")
+            cul.insert(0, {"what": f"handler {h.name} of {h.file} (called for {h.variable}{said})",
+                           "source": f"{h.file}:{h.line}", "text": h.name})
+        return _record(e["obligation"], "monitor", node, e["status"], sentence, culprits=cul,
                        counterexample=counterexample_table(fv.get("values"), node), guarantee=gk)
     if backend == "property_tests" and isinstance(e.get("counterexample"), dict):
         cex = {kk: v for kk, v in e["counterexample"].items() if kk not in _META_KEYS}

@@ -171,6 +171,24 @@ def _join_consequences(members: list[tuple[dict[str, Any], list[str]]], by_id: M
             members[i] = (m, list(dict.fromkeys(r for c in causes for r in roots_of[c])) or roots)
 
 
+def _join_implementation_findings(members: list[tuple[dict[str, Any], list[str]]], by_id: Mapping[str, Any]) -> None:
+    """A property test or run that names only the guarantee it found
+    violated joins the row of another such finding of the same guarantee
+    that names implementation lines (``line:...``: the handler of a
+    generated node's logic.py that published the message, issue 64): one
+    implementation defect, found by a test and by a run, is one row.
+    Changes ``members`` in place."""
+    def victim(mid: str) -> tuple[Any, Any]:
+        d = by_id.get(mid) or {}
+        return d.get("node"), d.get("guarantee")
+    placed = {victim(m["id"]): roots for m, roots in members if m["kind"] in ("monitor", "property-test")
+              and roots and all(r.startswith("line:") for r in roots) and victim(m["id"])[1]}
+    for i, (m, roots) in enumerate(members):
+        node, k = victim(m["id"])
+        if m["kind"] in ("monitor", "property-test") and (node, k) in placed and roots == [f"guarantee:{node}:{k}"]:
+            members[i] = (m, list(placed[(node, k)]))
+
+
 def _join_requirements_to_side_conditions(members: list[tuple[dict[str, Any], list[str]]]) -> None:
     """A refuted requirement whose culprits are all culprits of one failed
     side condition has that side condition's root cause: both rows read one
@@ -263,6 +281,7 @@ def group_problems(report: Mapping[str, Any], items: Sequence[Mapping[str, Any]]
             explains[victim] += [r for r in roots if r not in explains[victim]]
     ps.join_by_first_repair(members, by_id)  # several consumers, one too loose producer: one row (issue 48)
     _join_consequences(members, by_id)  # refuted only because of another problem: that problem's row (issue 64)
+    _join_implementation_findings(members, by_id)  # a test and a run of one guarantee: the handler's row (issue 64)
     diagnosed = {str(d["id"]) for d in diagnoses}
     for q in report.get("requirements", []):
         if q.get("verdict") not in BAD_VERDICTS or str(q["id"]) in diagnosed:
