@@ -81,7 +81,8 @@ def test_skeletons_of_a_driver_check_and_ground(skeletons, tmp_path: Path,  # ty
     py = rcl["talker_chat_py_talker.rcl"]
     assert "outputs( chatter : STRING, heartbeat : {} )" in py  # std_msgs/Empty: the empty type, not NATURAL
     base = rcl["base.rcl"]
-    assert "inputs( reset : {} )" in base and "parameter_events" not in base
+    assert "inputs( reset : {} )" in base and "parameter_events" not in base.split("node Base")[1]
+    assert "subscribes to /parameter_events (rcl_interfaces/ParameterEvent)" in base  # listed apart (issue 65)
     # two messages' ON/OFF constants: the later enumeration's values are qualified with its type
     assert "  MotorPowerState : {off, on} ;\n  SoundValue : {soundValueOff, soundValueOn, beep} ;" in \
         rcl["ros_types.rcl"]

@@ -216,7 +216,8 @@ def init_from_ros(args: argparse.Namespace) -> int:
               file=sys.stderr)
         return 1
     try:
-        written = write_from_ros(root, res, [Path(p) for p in args.from_ros], [Path(p) for p in args.launch])
+        written = write_from_ros(root, res, [Path(p) for p in args.from_ros], [Path(p) for p in args.launch],
+                                 bool(getattr(args, "library_endpoints", False)))
     except OSError as exc:
         print(f"{args.dir}: error: cannot write the workspace: {exc.strerror or exc}", file=sys.stderr)
         return 1

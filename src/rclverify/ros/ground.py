@@ -46,7 +46,7 @@ from .graph import ScanResult
 from .ground_services import RULES as SERVICE_RULES
 from .ground_services import folded, ground_links
 from .interfaces import BASE_TYPES, TypeTable, field_path
-from .model import LIBRARY_TOPICS, GraphEdge, GraphNode, Src, canon_type, short_type
+from .model import GraphEdge, GraphNode, Src, canon_type, library_of, short_type
 from .lifecycle import implicit
 
 _INT = {"int8", "int16", "int32", "int64", "uint8", "uint16", "uint32", "uint64", "byte", "char", "octet"}
@@ -183,6 +183,8 @@ class Grounder:
             gname = pairs.get(cname)
             if gname is None:
                 want = explicit.get(cname)
+                if self._ambiguous(cname, want, graph_nodes, node):
+                    continue
                 hint = (f"the plan's ros.nodes names {want}, which the graph does not have" if want else
                         "no graph node has its name (up to case and _); map it in the plan's ros.nodes")
                 close = difflib.get_close_matches(_key(cname), [_key(k) for k in graph_nodes], 1, 0.5)
@@ -199,6 +201,31 @@ class Grounder:
                 self.add("ROS-NODE-NO-CONTRACT", f"graph node {gname} ({gn.package or '?'}/{gn.executable or '?'}) "
                          f"has no contract", self.plan_loc, gn.declared_at, gname)
         return self.findings
+
+    def _ambiguous(self, cname: str, want: str | None, graph_nodes: Mapping[str, GraphNode], node: ast.Node) -> bool:
+        """When several programs of the graph bear the name the contract node
+        (or its ``ros.nodes`` entry ``want``) asks for (kept apart by their
+        executables, ``/gripper@pkg.exe``), add one finding naming every
+        candidate with its package, executable and where it is declared
+        (issue 64), and return ``True``; else ``False``."""
+        def base(g: str) -> str:
+            return g.split("@", 1)[0]
+        if want:
+            target = names.normalise(want)
+            cands = sorted(g for g in graph_nodes if base(g) == target or _key(base(g)) == _key(target))
+        else:
+            cands = sorted(g for g in graph_nodes if _key(base(g)) == _key(cname))
+        if len(cands) < 2:
+            return False
+        gns = [graph_nodes[g] for g in cands]
+        listed = "; ".join(f"{g} ({gn.package or '?'}/{gn.executable or '?'}"
+                           + (f", {gn.declared_at.file}:{gn.declared_at.line}" if gn.declared_at else "") + ")"
+                           for g, gn in zip(cands, gns))
+        asked = f"the plan's ros.nodes names {want}, and" if want else "its name is that of"
+        self.add("ROS-NODE-NOT-IN-GRAPH", f"contract node {cname} is ambiguous: {asked} {len(cands)} programs "
+                 f"of the graph: {listed}; name the one it describes in the plan's ros.nodes "
+                 f"({cname}: {cands[0]})", node.loc, gns[0].declared_at, cname)
+        return True
 
     def _own_edge(self, gn: GraphNode, kind: str, topic: str) -> GraphEdge | None:
         edges = gn.publishes if kind == "pub" else gn.subscribes
@@ -271,7 +298,8 @@ class Grounder:
             if var is not None:
                 self._fields(cn, tp, var, ctype, rcl_loc)
         for e in gn.publishes + gn.subscribes:
-            if id(e) not in documented and e.topic not in LIBRARY_TOPICS:  # the client library's, no contract's
+            # the client library's and other libraries' (tf, bond, diagnostics ...): no contract need name them
+            if id(e) not in documented and library_of(e.topic, e.msg_type) is None:
                 what = "publishes" if e in gn.publishes else "subscribes to"
                 self.add("ROS-TOPIC-UNDOCUMENTED", f"{gn.name} {what} {e.topic} ({short_type(e.msg_type)}), which "
                          f"{node.name}'s contract leaves out of topics(...)", node.loc, e.src, node.name, e.written)

@@ -18,6 +18,30 @@ SCHEMA_ID = "rclverify-ros-graph/1"
 #: library's, never a contract's inputs or outputs (docs/ros.md, issue 53)
 LIBRARY_TOPICS = frozenset({"/parameter_events", "/rosout"})
 
+#: message and service types that libraries' helpers, not a node's own code, put on
+#: the graph (tf2_ros broadcasters and listeners, bond, diagnostic_updater,
+#: interactive_markers, parameter and lifecycle events), by the library's name
+LIBRARY_TYPES = {
+    "tf2_msgs/msg/TFMessage": "tf", "bond/msg/Status": "bond",
+    "diagnostic_msgs/msg/DiagnosticArray": "diagnostics",
+    "visualization_msgs/msg/InteractiveMarkerUpdate": "interactive markers",
+    "visualization_msgs/msg/InteractiveMarkerFeedback": "interactive markers",
+    "visualization_msgs/msg/InteractiveMarkerInit": "interactive markers",
+    "visualization_msgs/srv/GetInteractiveMarkers": "interactive markers",
+    "rcl_interfaces/msg/ParameterEvent": "parameter events", "rcl_interfaces/msg/Log": "logging",
+    "lifecycle_msgs/msg/TransitionEvent": "lifecycle",
+}
+
+
+def library_of(topic: str, msg_type: str | None) -> str | None:
+    """The library an endpoint is made by (``tf``, ``bond``, ``diagnostics``, ...)
+    when its topic or type is one of :data:`LIBRARY_TOPICS`/:data:`LIBRARY_TYPES`,
+    else ``None``: such endpoints are listed apart from a skeleton's inputs and
+    outputs (issue 65) and a contract need not name them."""
+    if topic in LIBRARY_TOPICS:
+        return "client library"
+    return LIBRARY_TYPES.get(canon_type(msg_type) or "") if msg_type else None
+
 @dataclass(frozen=True)
 class Src:
     """A location in a scanned file: path as given, 1-based line and column."""

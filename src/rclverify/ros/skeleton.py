@@ -35,7 +35,7 @@ import jinja2
 from ..evidence.store import atomic_write_text
 from .graph import ScanResult
 from .interfaces import TypeTable, elem_type
-from .model import LIBRARY_TOPICS, GraphNode, short_type
+from .model import LIBRARY_TOPICS, GraphEdge, GraphNode, library_of, short_type
 from .safecopy import copy_package
 
 _ENV = jinja2.Environment(loader=jinja2.PackageLoader("rclverify.ros", "templates"), autoescape=False,
@@ -124,6 +124,42 @@ class _Node:
     context: list[dict[str, str]] = field(default_factory=list)
     services: list[str] = field(default_factory=list)
     actions: list[str] = field(default_factory=list)
+    apart: list[str] = field(default_factory=list)  # endpoints left out, each with its reason (issue 65)
+
+
+_ROLE_WORDS = {"pub": "publishes", "sub": "subscribes to", "service_servers": "serves",
+               "service_clients": "calls", "action_servers": "serves action", "action_clients": "calls action"}
+
+
+def _left_out(n: _Node, role: str, e: GraphEdge, reason: str) -> None:
+    """Record that endpoint ``e`` (of ``role``) is not in ``n``'s contract, and why."""
+    at = f" ({e.src.file}:{e.src.line})" if e.src else ""
+    line = f"{_ROLE_WORDS.get(role, role)} {e.topic} ({short_type(e.msg_type) if e.msg_type else 'type unknown'}){at}: " \
+           f"{reason}"
+    if line not in n.apart:
+        n.apart.append(line)
+
+
+def _kept(n: _Node, role: str, edges: list[GraphEdge], table: TypeTable, library: bool) -> list[GraphEdge]:
+    """The endpoints of ``edges`` the contract takes: its own, with a type the scan
+    read; a library's (tf, bond, diagnostics, ...; :func:`model.library_of`) only
+    with ``library``; each one left out is listed in ``n.apart`` with the reason."""
+    out = []
+    for e in edges:
+        lib = library_of(e.topic, e.msg_type)
+        if lib == "client library" or (lib is not None and not library):
+            _left_out(n, role, e, f"made by the {lib}{'' if lib == 'client library' else ' library'}, not the "
+                                  f"node's own code" + (
+                "" if lib == "client library" else " (`init --from-ros --library-endpoints` takes it in)"))
+        elif not e.msg_type:
+            _left_out(n, role, e, "its type is not read statically (the scan's note at that line says why)")
+        else:
+            if table.get(e.msg_type if role in ("pub", "sub") else f"{e.msg_type}_Request" if role.startswith(
+                    "service") else f"{e.msg_type}_Goal") is None:
+                _left_out(n, role, e, f"kept, but {short_type(e.msg_type)} is defined by no scanned or standard "
+                                      f"package: its values are {{}}")
+            out.append(e)
+    return out
 
 
 def _type_name(msg: str, taken: dict[str, str]) -> str:
@@ -188,7 +224,7 @@ def _identifier(written: str, others: list[str]) -> str:
 
 
 def _links(n: "_Node", gn: GraphNode, table: TypeTable, taken: dict[str, str], context: dict[str, dict[str, str]],
-           seen: set[str]) -> None:
+           seen: set[str], library: bool = False) -> None:
     """The node's service and action links (``services(...)``, ``actions(...)``): a
     server reads the request (goal) and writes the response (feedback, result), a
     client the mirror image; each part an input or output typed from the
@@ -196,7 +232,7 @@ def _links(n: "_Node", gn: GraphNode, table: TypeTable, taken: dict[str, str], c
     for kind, parts in (("service", (("Request", "Req"), ("Response", "Res"))),
                         ("action", (("Goal", "Goal"), ("Feedback", "Feedback"), ("Result", "Result")))):
         for role in ("servers", "clients"):
-            edges = gn.edges_of(f"{kind}_{role}")
+            edges = _kept(n, f"{kind}_{role}", gn.edges_of(f"{kind}_{role}"), table, library)
             written = [e.written or e.topic for e in edges]
             done: set[str] = set()
             for e in sorted(edges, key=lambda e: e.topic):
@@ -220,10 +256,13 @@ def _links(n: "_Node", gn: GraphNode, table: TypeTable, taken: dict[str, str], c
                 getattr(n, f"{kind}s").append(f"{short_type(e.msg_type)} {name} {verb}({', '.join(refs)})")
 
 
-def build_skeletons(res: ScanResult) -> tuple[list[_Node], dict[str, list[str]], list[str], list[dict[str, str]]]:
+def build_skeletons(res: ScanResult, library: bool = False
+                    ) -> tuple[list[_Node], dict[str, list[str]], list[str], list[dict[str, str]]]:
     """Contract skeletons (one per graph node), the plan's ``fields``, the ``external``
     topics and the shared context declarations (one per message type used).  A
-    topic the node's code creates at several call sites is one input or output."""
+    topic the node's code creates at several call sites is one input or output.
+    Library endpoints (:func:`model.library_of`) are inputs and outputs only with
+    ``library``; every endpoint left out is in the node's ``apart`` list with why."""
     g, table = res.graph, res.table
     taken: dict[str, str] = {}
     context: dict[str, dict[str, str]] = {}
@@ -240,7 +279,8 @@ def build_skeletons(res: ScanResult) -> tuple[list[_Node], dict[str, list[str]],
         n = _Node(cname, gname, gn.package, gn.executable, gn.sources, _contract_file(cname, nodes))
         seen: set[str] = set()
         # the client library's own topics (/parameter_events, /rosout) are no contract's
-        pubs, subs = ([e for e in es if e.topic not in LIBRARY_TOPICS] for es in (gn.publishes, gn.subscribes))
+        pubs, subs = (_kept(n, role, es, table, library) for role, es in (("pub", gn.publishes),
+                                                                            ("sub", gn.subscribes)))
         written = [e.written or e.topic for e in pubs + subs]
         for kind, edges in (("in", subs), ("out", pubs)):
             done: set[str] = set()
@@ -260,7 +300,7 @@ def build_skeletons(res: ScanResult) -> tuple[list[_Node], dict[str, list[str]],
                 n.topics.append(f"{short_type(e.msg_type) if e.msg_type else 'std_msgs/Empty'} {topic_name} "
                                 f"matches({kind}.{var})")
                 uses.setdefault(topic_name, []).append((cname, e.msg_type, paths))
-        _links(n, gn, table, taken, context, seen)
+        _links(n, gn, table, taken, context, seen, library)
         nodes.append(n)
     for topic_name, got in uses.items():
         # one message type wherever the name is used: one entry by the topic's name; types
@@ -270,16 +310,27 @@ def build_skeletons(res: ScanResult) -> tuple[list[_Node], dict[str, list[str]],
             if paths:
                 fields.setdefault(topic_name if shared else f"{cname}.{topic_name}", paths)
     published = {e.topic for n in g.nodes.values() for e in n.publishes}
-    external = sorted({e.topic for n in g.nodes.values() for e in n.subscribes} - published - LIBRARY_TOPICS)
+    external = sorted({e.topic for n in g.nodes.values() for e in n.subscribes
+                       if e.msg_type and (library and library_of(e.topic, e.msg_type) != "client library"
+                                          or library_of(e.topic, e.msg_type) is None)} - published - LIBRARY_TOPICS)
+    for kind in ("service", "action"):  # called, served by no scanned node: another system's (issue 65)
+        served = {e.topic for n in g.nodes.values() for e in n.edges_of(f"{kind}_servers")}
+        external += sorted({e.topic for n in g.nodes.values() for e in n.edges_of(f"{kind}_clients")
+                            if e.msg_type and library_of(e.topic, e.msg_type) is None} - served - set(external))
     return nodes, fields, external, list(context.values())
 
 
-def write_from_ros(root: Path, res: ScanResult, scanned: list[Path], launch: list[Path]) -> list[Path]:
+def write_from_ros(root: Path, res: ScanResult, scanned: list[Path], launch: list[Path],
+                   library: bool = False) -> list[Path]:
     """Write the workspace: ``dodo.py``, ``contracts/*.rcl``, ``contracts/plan.yaml``,
     ``ros/`` (a copy of each scanned package directory) and empty ``backends``,
-    ``artifacts``, ``reports``.  Returns the paths written.  Raises ``OSError``."""
+    ``artifacts``, ``reports``.  Returns the paths written.  Raises ``OSError``.
+    ``library``: library endpoints become inputs and outputs too (:func:`build_skeletons`)."""
     from ..scaffold import EMPTY_DIRS, _env as scaffold_env
-    nodes, fields, external, context = build_skeletons(res)
+    nodes, fields, external, context = build_skeletons(res, library)
+    for n in nodes:
+        for line in n.apart:
+            print(f"{n.file}: {line}", file=sys.stderr)
     written: list[Path] = []
     name = root.resolve().name or "workspace"
     ros_dir = root / "ros"
