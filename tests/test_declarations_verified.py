@@ -366,3 +366,57 @@ def test_the_property_tests_judge_progress_and_the_initial_value(tmp_path: Path)
     assert rows["Base"]["initially 1"] == ("false", "the implementation's initial outputs do not satisfy it: out.pose = 5")
     assert rows["plain"]["initially 1"][0] == "pending" and "no initial attribute" in rows["plain"]["initially 1"][1]
     assert rows["base"]["initially 1"][0] == "pending"
+
+
+# ---- declarations that follow from others ------------------------------------------------------------------------
+
+def test_an_initial_value_that_follows_from_another_rests_on_it() -> None:
+    from rclverify.requirements.declared_proof import initial_support
+    c = _checked("  initially( out.pose == 0 )\n  initially( out.pose <= 3 )\n  initially( out.pose * out.pose >= 0 )\n")
+    node = c.nodes["Base"]
+    assert initial_support(c, node, 2) == [1]  # pose == 0 entails pose <= 3
+    assert initial_support(c, node, 3) == []  # holds of every integer
+    assert initial_support(c, node, 1) is None  # pose <= 3 does not entail pose == 0
+    row = {"declaration": "initially 1", "premise": "initial value", "index": 1, "status": "discharged"}
+    d = declaration_statuses({"Base": [("discharged", [row])]}, c)
+    assert d("Base", "initial value", 2) == ("discharged", "follows from initially 1 (Z3)")
+    assert d("Base", "initial value", 3) == ("discharged", "holds of every value of its outputs' types (Z3)")
+    assert d("Base", "initial value", 1)[0] == "discharged"
+    pending = declaration_statuses({"Base": [("discharged", [{**row, "status": "inconclusive"}])]}, c)
+    assert pending("Base", "initial value", 2)[0] == "pending"  # what it rests on is not verified
+
+
+def test_entailment_of_initial_values_agrees_with_enumeration() -> None:
+    """Random clauses over an output bounded by clause 1: Z3's entailment
+    (initial_support) against the values -2..8 enumerated."""
+    from rclverify.requirements.declared_proof import initial_support
+    rnd = random.Random(640)
+    ops = {"<=": lambda x, a: x <= a, ">=": lambda x, a: x >= a, "==": lambda x, a: x == a,
+           "!=": lambda x, a: x != a, "<": lambda x, a: x < a}
+    for _ in range(40):
+        clauses = [("<=", 8), (">=", -2)] + [(rnd.choice(list(ops)), rnd.randint(-3, 9)) for _ in range(rnd.randint(1, 3))]
+        text = "  initially( -2 <= out.pose and out.pose <= 8 )\n" + "".join(
+            f"  initially( out.pose {op} {a} )\n" for op, a in clauses[2:])
+        c = _checked(text)
+        for goal in range(2, len(clauses)):
+            others = [cl for k, cl in enumerate(clauses[2:], 2) if k != goal]
+            domain = [x for x in range(-2, 9) if all(ops[op](x, a) for op, a in others)]
+            op, a = clauses[goal]
+            want = all(ops[op](x, a) for x in domain)
+            got = initial_support(c, c.nodes["Base"], goal)
+            assert (got is not None) == want, (text, goal)
+
+
+def test_the_progress_premise_rests_on_the_least_bound() -> None:
+    """``periodic( out.pose, 2 steps )`` (within 1 step) is the premise; the
+    weaker ``progress( within 3 steps )`` follows from it, so its pending
+    evidence does not hold the premise back; a failed one still fails it."""
+    c = _checked("  progress( within 3 steps )\n  periodic( out.pose, 2 steps )\n")
+    per = {"declaration": "periodic out.pose", "premise": "progress", "index": 0, "status": "discharged"}
+    prog = {"declaration": "progress", "premise": "progress", "index": 0, "status": "pending"}
+    d = declaration_statuses({"Base": [("discharged", [per, prog])]}, c)
+    st, words = d("Base", "progress", 0)
+    assert st == "discharged" and "progress follows from periodic out.pose" in words
+    assert declaration_statuses({"Base": [("discharged", [per, prog])]})("Base", "progress", 0)[0] == "pending"
+    failed = declaration_statuses({"Base": [("failed", [per, {**prog, "status": "failed"}])]}, c)
+    assert failed("Base", "progress", 0)[0] == "failed"

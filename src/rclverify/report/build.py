@@ -311,7 +311,7 @@ def build_report(ws: Workspace) -> dict[str, Any]:
         st = worst([x["status"] for x in support] + [sc_status[x["node"]] for x in support]) if support else "pending"
         requirements.append({"id": r.id, "text": r.text, "status": st, "support": support,
                              **requirement_check(current_record(r, checks.get(r.id)), st, g_status, sc_status,
-                                                 declaration_statuses(declared))})
+                                                 declaration_statuses(declared, checked))})
 
     from .deadlines import deadline_rows, fold_into, strict_ok as deadlines_ok
     deadlines = deadline_rows(ws, hashes, g_status, ob_rows, second)  # rule D3, rolled into each requirement

@@ -61,7 +61,22 @@ DeclStatus = Callable[[str, str, int], tuple[str, str]]
 _DECL_RANK = ("failed", "error", "stale", "discharged", "inconclusive", "pending")
 
 
-def declaration_statuses(records: Mapping[str, Sequence[tuple[str, Sequence[Mapping[str, Any]]]]]) -> DeclStatus:
+def _combined(ss: Sequence[str]) -> str:
+    """One declaration's status over its records' statuses (:func:`declaration_statuses`)."""
+    return min(ss, key=lambda s: _DECL_RANK.index(s) if s in _DECL_RANK else 0)
+
+
+def _counted(per: Mapping[str, Sequence[str]], labels: Sequence[str]) -> str:
+    seen: dict[str, int] = {}
+    for label in labels:
+        for x in per.get(label, ()):
+            seen[x] = seen.get(x, 0) + 1
+    runs = sum(seen.values())
+    return ", ".join(f"{n} {x}" for x, n in sorted(seen.items())) + f" of {runs} record{'s' if runs != 1 else ''}"
+
+
+def declaration_statuses(records: Mapping[str, Sequence[tuple[str, Sequence[Mapping[str, Any]]]]],
+                         checked: Any = None) -> DeclStatus:
     """The status of a node's declarations from its evidence records.
 
     ``records[node]`` lists ``(record status, rows)``: each evidence record
@@ -73,28 +88,53 @@ def declaration_statuses(records: Mapping[str, Sequence[tuple[str, Sequence[Mapp
     ``discharged`` row discharges it (a run that did not exercise a
     declaration, ``pending`` or ``inconclusive``, showed nothing against it;
     a run that did, showed it held); else ``inconclusive``, else
-    ``pending``.  The premise ``progress`` stands for every declaration the
-    requirement check reads as progress (``progress(...)`` and periods in
-    steps): the worst of them.  No row at all: ``("pending", "declared, not
-    verified")``."""
+    ``pending``.  With the checked system (``checked``), what follows from
+    other declarations rests on them (requirements/declared_proof.py): the
+    premise ``progress`` on the declarations of the least step bound (the
+    best of them; a failed declaration of the node fails it), an
+    ``initially`` on the other ``initially`` clauses Z3 shows entail it;
+    without it, ``progress`` is the worst of its declarations.  No row at
+    all: ``("pending", "declared, not verified")``."""
+    from .declared_proof import initial_support, node_of, progress_labels
+
     def status(node: str, kind: str, index: int) -> tuple[str, str]:
         per: dict[str, list[str]] = {}
         for rec_status, rows in records.get(node, ()):
             for r in rows:
-                if r.get("premise") == kind and int(r.get("index", 0)) == index:
+                if r.get("premise") == kind:
                     s = rec_status if rec_status in ("stale", "error") else str(r.get("status", "pending"))
                     per.setdefault(str(r.get("declaration")), []).append(s)
+        cn = node_of(checked, node)
+        if kind == "initial value":
+            return _initial(per, index, cn)
         if not per:
             return "pending", "declared, not verified"
-        each = [min(ss, key=lambda s: _DECL_RANK.index(s) if s in _DECL_RANK else 0) for ss in per.values()]
-        st = worst(each)
-        seen: dict[str, int] = {}
-        for ss in per.values():
-            for x in ss:
-                seen[x] = seen.get(x, 0) + 1
-        runs = sum(seen.values())
-        return st, (f"declaration, {st}: " + ", ".join(f"{n} {x}" for x, n in sorted(seen.items()))
-                    + f" of {runs} record{'s' if runs != 1 else ''}")
+        each = {label: _combined(ss) for label, ss in per.items()}
+        least = [label for label in (progress_labels(cn) if cn is not None else []) if label in each]
+        if "failed" in each.values() or not least:
+            st = worst(list(each.values()))
+            return st, f"declaration, {st}: {_counted(per, list(per))}"
+        st = min((each[label] for label in least), key=_DECL_RANK.index)
+        rest = [label for label in each if label not in least]
+        return st, (f"declaration, {st}: {_counted(per, least)}"
+                    + (f"; {', '.join(rest)} follow{'s' if len(rest) == 1 else ''} from {', '.join(least)}"
+                       if rest else ""))
+
+    def _initial(per: Mapping[str, Sequence[str]], index: int, cn: Any) -> tuple[str, str]:
+        label = f"initially {index}"
+        own = _combined(per[label]) if label in per else None
+        if own in ("failed", "error", "stale", "discharged"):
+            return str(own), f"declaration, {own}: {_counted(per, [label])}"
+        support = initial_support(checked, cn, index) if cn is not None else None
+        if support is not None:
+            rest = [_combined(per[f"initially {j}"]) if f"initially {j}" in per else "pending" for j in support]
+            st = worst(rest, empty="discharged")
+            if st == "discharged":
+                return st, ("follows from " + ", ".join(f"initially {j}" for j in support) + " (Z3)" if support
+                            else "holds of every value of its outputs' types (Z3)")
+        if own is None:
+            return "pending", "declared, not verified"
+        return own, f"declaration, {own}: {_counted(per, [label])}"
     return status
 
 
