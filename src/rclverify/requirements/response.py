@@ -108,7 +108,7 @@ def check_unbounded_response(ts: TransitionSystem, trigger: Pred, goal: Pred, *,
                              invariant: Pred | None = None) -> TemporalVerdict:
     """Decide ``always (trigger -> eventually goal)`` (module docstring):
     ``proved`` by ``ranking`` (inside ``invariant``, itself proved here by
-    k-induction first: an invariant that is not proved leaves the ranking
+    k-induction or IC3/PDR first, :func:`.safety.prove_always`: an invariant that is not proved leaves the ranking
     function unused) or by the bounded pattern for an N of :data:`BOUNDS` up to
     ``max_k``; ``refuted`` by a lasso of at most ``max_k`` steps with a
     trigger pending around its loop; else ``inconclusive``.  ``timeout_ms``
@@ -119,7 +119,7 @@ def check_unbounded_response(ts: TransitionSystem, trigger: Pred, goal: Pred, *,
     if ranking is not None:
         inv = invariant or (lambda st: z3.BoolVal(True))
         # the rule holds only inside the invariant: an invariant that is not proved proves nothing
-        iv = check_always(ts, inv, max_k=max_k, timeout_ms=timeout_ms) if invariant is not None else None
+        iv = prove_always(ts, inv, max_k=max_k, timeout_ms=timeout_ms) if invariant is not None else None
         if iv is not None and iv.status != "proved":
             why = (f"ranking function not used: its invariant is not proved ({iv.status} by {iv.method}"
                    + (f": {iv.detail}" if iv.detail else "") + ")")

@@ -173,7 +173,8 @@ def check_until(ts: TransitionSystem, prop: Pred, goal: Pred, *,
 def check_eventually(ts: TransitionSystem, prop: Pred, *,
                      ranking: Callable[[State], z3.ArithRef] | None = None,
                      invariant: Pred | None = None, bound: int = 10,
-                     timeout_ms: int = 10_000) -> TemporalVerdict:
+                     timeout_ms: int = 10_000,
+                     prove: Callable[[TransitionSystem, Pred], TemporalVerdict] | None = None) -> TemporalVerdict:
     """Decide unbounded ``eventually prop``: every run, infinite or one
     that stops, reaches ``prop``.
 
@@ -189,13 +190,17 @@ def check_eventually(ts: TransitionSystem, prop: Pred, *,
     before reaching it (method ``deadlock``) or by a lasso missing it
     (:func:`find_lasso`).  Otherwise ``inconclusive``: a run of ``bound``
     steps missing ``prop`` is not a counterexample to liveness (it is
-    reported as the trace).
+    reported as the trace).  ``prove(ts, invariant)`` proves the invariant
+    (default :func:`check_always`; the requirement check passes
+    :func:`.safety.prove_always`, which also tries IC3/PDR and names the step
+    that breaks a candidate).
     """
     inv = invariant or (lambda st: z3.BoolVal(True))
     outside = lambda st: z3.Not(prop(st))  # noqa: E731
     why: str | None = "no ranking function"
     if ranking is not None:
-        iv = check_always(ts, inv, max_k=bound, timeout_ms=timeout_ms) if invariant else None
+        iv = (prove(ts, inv) if prove is not None else check_always(ts, inv, max_k=bound, timeout_ms=timeout_ms)) \
+            if invariant else None
         if iv is not None and iv.status != "proved":
             why = (f"ranking function not used: its invariant is not proved ({iv.status} by {iv.method}"
                    + (f": {iv.detail}" if iv.detail else "") + ")")

@@ -142,7 +142,8 @@ def _decide(t: Temporal, sys: ComposedSystem, pred: Callable[[Formal], Callable[
             if w.status == "refuted":  # a confirmed lasso of the declared system: the general query cannot undo it
                 return even_so(w)
             tried_sync = True
-        v = check_eventually(ts, got(g), ranking=ranking, invariant=invariant, bound=bound, timeout_ms=timeout_ms)
+        v = check_eventually(ts, got(g), ranking=ranking, invariant=invariant, bound=bound, timeout_ms=timeout_ms,
+                             prove=lambda ts2, p: prove_always(ts2, p, max_k=bound, timeout_ms=timeout_ms))
         by_tables = tables is not None and v.status == "inconclusive"
         if by_tables and checked is not None and not sys.eager and not tried_sync:
             # every node answering what it accepts at once: the query Z3 decides best, and a lasso there is one
