@@ -32,6 +32,9 @@ samples (made from ``--seed``), the monitoring loop timed in CPU seconds:
 * **rclverify monitor**: the command on a workspace holding the contract,
   the mapping and the trace as a ROSMonitoring log (two lines a sample):
   the whole process's CPU (start, reading the log, checking, printing);
+  and (unless ``--no-bags``) on the same samples in a sqlite3 and an MCAP
+  ROS 2 bag (``std_msgs/msg/Float64`` readings, ``std_msgs/msg/String``
+  statuses; traces/bag_blocks.py), whose counts must be the log's;
 * **RTAMT** 0.4.10 (``pip install rtamt==0.4.10``): the discrete-time STL
   specification of the same property, updated sample by sample
   (robustness >= 0 is satisfied; statuses as 0, 1, 2);
@@ -67,7 +70,7 @@ one run on one machine.
 
 Usage::
 
-    python3 bench/monitor_peers.py [--samples 1000000] [--wrong 0.001] [--compare OLD_SRC]
+    python3 bench/monitor_peers.py [--samples 1000000] [--wrong 0.001] [--compare OLD_SRC] [--no-bags]
     python3 bench/monitor_peers.py --smoke     # 2,000 samples: a few seconds
 """
 from __future__ import annotations
@@ -280,14 +283,36 @@ def _workspace(tmp: Path, args: argparse.Namespace) -> Path:
     return tmp
 
 
-def _run_command(ws: Path, src: str) -> dict[str, Any]:
+def _bags(ws: Path, args: argparse.Namespace) -> None:
+    """The same samples as ROS 2 bags beside the log: ``run_sqlite3`` and ``run_mcap`` (rosbags' writer),
+    the readings ``std_msgs/msg/Float64``, the statuses ``std_msgs/msg/String`` (their CDR bytes made here),
+    the recording stamps the log's times in nanoseconds."""
+    import struct
+    from rosbags.rosbag2 import StoragePlugin, Writer
+    from rclverify.traces.bag import typestore
+    store = typestore([])
+    rs, st = samples(args.samples, args.seed, args.wrong)
+    status = [b"\x00\x01\x00\x00" + struct.pack("<I", len(b) + 1) + b.encode() + b"\x00" for b in BANDS]
+    for storage, plugin in (("sqlite3", StoragePlugin.SQLITE3), ("mcap", StoragePlugin.MCAP)):
+        with Writer(ws / f"run_{storage}", version=9, storage_plugin=plugin) as w:
+            cr = w.add_connection("/reading", "std_msgs/msg/Float64", typestore=store)
+            cs = w.add_connection("/status", "std_msgs/msg/String", typestore=store)
+            ct = w.add_connection("/tick", "std_msgs/msg/Float64", typestore=store)
+            for i in range(args.samples):
+                t = round(i * PERIOD * 1e9)
+                w.write(cr, t, struct.pack("<4sd", b"\x00\x01\x00\x00", rs[i]))
+                w.write(cs, t, status[st[i]])
+            w.write(ct, round((args.samples * PERIOD + 10 * HORIZON) * 1e9), struct.pack("<4sd", b"\x00\x01\x00\x00", 0.0))
+
+
+def _run_command(ws: Path, src: str, trace: str = "run.jsonl") -> dict[str, Any]:
     """``rclverify monitor`` on the workspace's log: the child's CPU (user +
     system) and peak RSS, from the rusage of the waited child."""
     env = {**os.environ, "PYTHONPATH": os.pathsep.join([src] + ([os.environ["PYTHONPATH"]]
                                                                 if os.environ.get("PYTHONPATH") else []))}
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
     p = subprocess.run([sys.executable, "-c", "import sys; from rclverify.cli import main; sys.exit(main())",
-                        "monitor", "-w", str(ws), str(ws / "run.jsonl")], capture_output=True, text=True, env=env)
+                        "monitor", "-w", str(ws), str(ws / trace)], capture_output=True, text=True, env=env)
     after = resource.getrusage(resource.RUSAGE_CHILDREN)
     if p.returncode not in (0, 1):
         raise SystemExit(f"rclverify monitor exited {p.returncode}:\n{p.stderr[-3000:]}")
@@ -308,6 +333,7 @@ def main() -> int:
     ap.add_argument("--seed", type=int, default=44)
     ap.add_argument("--compare", metavar="OLD_SRC", help="also run the engine and the command from this source tree")
     ap.add_argument("--smoke", action="store_true", help="2,000 samples (CI)")
+    ap.add_argument("--no-bags", action="store_true", help="leave out the command on the sqlite3 and MCAP bags")
     ap.add_argument("--child", choices=("rclverify", "batch", "columns", "rtamt", "reelay", "mstlo"), help=argparse.SUPPRESS)
     ap.add_argument("--src", help=argparse.SUPPRESS)
     ap.add_argument("--verdicts", help=argparse.SUPPRESS)
@@ -334,6 +360,10 @@ def main() -> int:
                     rows[row] = _run_child(kind, args, base / f"v-{kind}", src)
                     verdicts[row] = (base / f"v-{kind}").read_bytes()
             rows[f"rclverify monitor ({label})"] = _run_command(ws, src)
+            if label == "new" and not args.no_bags:  # the same samples in ROS 2 bags
+                _bags(ws, args)
+                for storage in ("sqlite3", "mcap"):
+                    rows[f"rclverify monitor, {storage}"] = _run_command(ws, src, f"run_{storage}")
             if label == "new":  # the command's start-up: the same command on a log of ten samples
                 tiny = argparse.Namespace(**{**vars(args), "samples": 10})
                 (base / "tiny").mkdir()
@@ -368,13 +398,19 @@ def main() -> int:
         if peer in rows and "skipped" not in rows[peer]:
             print(f"rclverify batch / {peer} samples/s: {rows[peer]['cpu'] / cols['cpu']:.2f} reading columns, "
                   f"{rows[peer]['cpu'] / batch['cpu']:.2f} reading events (aim: at least 2)")
-    cmd = rows["rclverify monitor (new)"]
     start = rows["rclverify monitor, 10 samples"]["cpu"]
-    print(f"rclverify monitor: {n / cmd['cpu']:.0f} samples per CPU second, the start-up ({start:.2f} s) "
-          f"included; {n / max(cmd['cpu'] - start, 1e-9):.0f} without it; command / batch path on columns: "
-          f"{cmd['cpu'] / cols['cpu']:.2f}, {(cmd['cpu'] - start) / cols['cpu']:.2f} without the start-up "
-          f"(aim: at most 1.2)")
-    print(f"the command printed: {cmd['out']}")
+    said = set()
+    for name in ("rclverify monitor (new)", "rclverify monitor, sqlite3", "rclverify monitor, mcap"):
+        if name not in rows:
+            continue
+        cmd = rows[name]
+        print(f"{name}: {n / cmd['cpu']:.0f} samples per CPU second, the start-up ({start:.2f} s) included; "
+              f"{n / max(cmd['cpu'] - start, 1e-3):.0f} without it; command / batch path on columns: "
+              f"{cmd['cpu'] / cols['cpu']:.2f}, {(cmd['cpu'] - start) / cols['cpu']:.2f} without the start-up "
+              f"(aim: at most 1.2); printed: {cmd['out']}")
+        said.add(cmd["out"].split(": ", 1)[-1])
+    if len(said) != 1:  # the log and the two bags hold the same samples: the same counts
+        raise SystemExit(f"the command's counts differ between the log and the bags: {sorted(said)}")
     wrong = [k for k, v in verdicts.items() if v != verdicts["new"]]
     if wrong:  # a figure of a tool that judged otherwise compares nothing
         raise SystemExit(f"verdicts differ from the streaming engine's: {', '.join(wrong)}")
