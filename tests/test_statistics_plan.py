@@ -136,6 +136,13 @@ def test_harness_runs_never_count_and_bad_targets_are_located(tmp_path: Path) ->
         "Clamp": {"evidence": [_entry(tmp_path, "runs", origin="harness")]}}}))
     _, ev, _ = _runset(Workspace(tmp_path))
     assert ev.status == "pending" and ev.details["statistics"]["counts"]["runs"] == 0 and "not operation" in ev.explanation
+    (tmp_path / "contracts/plan.yaml").write_text(json.dumps({"contracts": ["contracts/sys.rcl"], "nodes": {
+        "Clamp": {"evidence": [{"backend": "monitors", "traces": [], "target": TARGET}]}}}))
+    target = Workspace(tmp_path).target("Clamp", 0)
+    (ob,) = MonitorsBackend().export(target)  # a target without runs: its obligation, pending, never dropped
+    ev = MonitorsBackend().run(ob, target)
+    assert ev.status == "pending" and "no judged run yet: 299 clean run(s)" in ev.explanation
+    assert ob.source.file == "contracts/sys.rcl"
     plan = (f"contracts: [contracts/sys.rcl]\nnodes:\n  Clamp:\n    evidence:\n      - backend: monitors\n"
             f"        traces: [runs/run0000.jsonl]\n        target: violation probability <= 2 at 95 %\n"
             f"        environment: day\n")

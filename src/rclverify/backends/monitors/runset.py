@@ -25,7 +25,7 @@ import hashlib
 from pathlib import Path
 from typing import Any, Callable
 
-from ...evidence.records import Evidence, Obligation, make_obligation_id
+from ...evidence.records import Evidence, Obligation, SourceRef, make_obligation_id
 from ...evidence.statistics import count_runs, decide
 from ...plan.targets import entry_environment, entry_origin, entry_target
 from ..base import NodeTarget, Stopwatch, make_evidence
@@ -95,17 +95,25 @@ def run_counts(root: Path, config: Any, trace: str, sha: str, res: NodeResult, s
 def runset_obligations(target: NodeTarget, traces: list[str], per_trace: list[Obligation]) -> list[Obligation]:
     """The run-set obligation of an entry with a ``target:`` (``[]`` without one or without traces)."""
     t = entry_target(target.config)
-    if t is None or not per_trace:
+    if t is None:
         return []
     env = entry_environment(target.config)
-    first = per_trace[0]
     oid = make_obligation_id(target.node.name, 0, "monitors", f"runs_{env}_e{target.index}")
     statement = (f"the runs of {target.node.name} recorded under {env} bound the probability that a "
                  f"{t.per} violates its contract: {t.words()}")
+    data = {"trace": "", "run_set": list(traces), "target": t.to_json(), "environment": env}
+    if not per_trace:  # a target and no run: pending, never silently dropped
+        loc, f = target.node.node.loc, Path(target.node.node.loc.file)
+        if f.is_absolute() and f.resolve().is_relative_to(target.root.resolve()):
+            f = f.resolve().relative_to(target.root.resolve())
+        return [Obligation(id=oid, node=target.node.name, guarantee=0, backend="monitors", kind="monitoring",
+                           statement=statement, source=SourceRef(f.as_posix(), loc.line, loc.col),
+                           instance=f"runs_{env}_e{target.index}",
+                           inputs=tuple(sorted({*target.contract_files, target.plan_file})), data=data)]
+    first = per_trace[0]
     inputs = sorted({i for o in per_trace for i in o.inputs})
     return [dataclasses.replace(first, id=oid, statement=statement, instance=f"runs_{env}_e{target.index}",
-                                inputs=tuple(inputs), data={**first.data, "trace": "", "run_set": list(traces),
-                                                            "target": t.to_json(), "environment": env})]
+                                inputs=tuple(inputs), data={**first.data, **data})]
 
 
 def run_runset(check_one: Callable[[Obligation, NodeTarget], Evidence], obligation: Obligation,
