@@ -90,3 +90,51 @@ def test_hover_names_the_problem(report: dict[str, Any]) -> None:
         contract="node Supervisor {}", guarantees=[], producers=[], consumers=[])
     assert "last run: `failed`" in text and "culprit of a problem (`failed`): S allows 45." in text
     assert "discharged" not in text
+
+
+ARM = """\
+node Planner {
+  inputs( index : NATURAL )
+  outputs( joint : NATURAL )
+  assume( in.index <= 5 )
+  guarantee( out.joint == in.index + 1 )
+}
+
+node Arm {
+  inputs( joint : NATURAL )
+  outputs( cmd : NATURAL )
+  assume( in.joint <= 5 )
+  guarantee( out.cmd == in.joint )
+}
+"""
+
+ARM_PLAN = """\
+name: "joints"
+contracts: [contracts/arm.rcl]
+requirements:
+  - id: REQ-JOINT
+    text: The planner only ever names one of the arm's six joints.
+    formal: "always Planner.out.joint <= 5"
+    supported_by:
+      - {node: Planner, guarantees: [1]}
+nodes:
+  Planner: {}
+  Arm: {}
+"""
+
+
+def test_a_temporal_requirement_names_the_off_by_one(tmp_path: Path) -> None:
+    (tmp_path / "contracts").mkdir()
+    (tmp_path / "contracts" / "arm.rcl").write_text(ARM, encoding="utf-8")
+    (tmp_path / "contracts" / "plan.yaml").write_text(ARM_PLAN, encoding="utf-8")
+    (tmp_path / "dodo.py").write_text("from pathlib import Path\nfrom rclverify.tasks import build_tasks, doit_config\n"
+                                      "DOIT_CONFIG = doit_config()\nglobals().update(build_tasks(Path(__file__).parent))\n",
+                                      encoding="utf-8")
+    assert main(["verify", "-w", str(tmp_path)]) == 0
+    report = json.loads((tmp_path / "reports" / "assurance.json").read_text(encoding="utf-8"))
+    d = next(x for x in report["diagnoses"] if x["id"] == "REQ-JOINT")
+    assert d["node"] == "Planner" and d["culprits"][0]["source"] == "contracts/arm.rcl:5:3"
+    assert "with `1` as `0` (off by one)" in d["sentence"]
+    assert "in.index + 0" in d["repairs"][0]["diff"]
+    row = _row_of(report, "REQ-JOINT")  # the slip's row: the side condition it also breaks
+    assert "Arm.sc1" in [m["id"] for m in row["members"]] and "guarantee:Planner:1" in row["key"]

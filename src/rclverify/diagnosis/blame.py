@@ -239,6 +239,63 @@ def requirement_culprits(ws: Any, req_id: str, cone: Sequence[str]) -> list[dict
     return found
 
 
+def _summands(e: Any) -> list[ast.NumLit]:
+    """The integer literals under ``e`` that are a direct operand of ``+``
+    or ``-`` (an index offset: ``1`` in ``out.joint == in.index + 1``)."""
+    from ..rcl.walk import subexpressions
+    out: list[ast.NumLit] = []
+    for x in subexpressions(e):
+        if isinstance(x, ast.Binary) and x.op in ("+", "-"):
+            out += [o for o in (x.left, x.right) if isinstance(o, ast.NumLit) and o.text.isdigit()]
+    return out
+
+
+def temporal_culprits(ws: Any, req_id: str, cone: Sequence[str]) -> list[dict[str, Any]]:
+    """The guarantees of ``cone`` to blame for the refuted temporal
+    requirement ``req_id`` whose run meets every contract (issue 64: an
+    off-by-one names the node with the slip): a guarantee is named when one
+    edit of it by one value -- a threshold's strictness where the statement
+    names the threshold (as :func:`requirement_culprits`), or an index
+    offset (a summand ``+ 1``) moved by one either way -- lets Z3's temporal
+    check prove the requirement (the pipeline's own check, on an edited copy)
+    and the edited node stays implementable.  Each ``{"node", "guarantee",
+    "edit", "how": "threshold" | "offset", "old", "new", "implementable"}``;
+    ``[]`` when no such edit does it within :data:`MAX_TRIALS`."""
+    from ..plan.load import all_requirements
+    req = next((r for r in all_requirements(ws.plan) if r.id == req_id), None)
+    if req is None or req.formal is None:
+        return []
+    values = {value(t) for t in re.findall(r"(?<![\w.])\d+(?:\.\d+)?(?![\w.])", req.formal.text)} - {None}
+    found: list[dict[str, Any]] = []
+    trials = 0
+
+    def holds(edit: Edit, n: str) -> str:
+        system = recheck.edited_system(ws, edit)
+        return _implementable(ws, system, n) if system is not None and _proved(req, system, ws.plan) else ""
+    for n in cone:
+        for k, g in enumerate(ws.checked.nodes[n].node.guarantees, 1):
+            tries: list[tuple[str, Edit, str, str]] = []
+            for cmp, lit in thresholds(g.formula):
+                flip = threshold_edit(ws, cmp) if value(lit.text) in values else None
+                if flip is not None:
+                    tries.append(("threshold", flip[0], flip[1], flip[2]))
+            for lit in _summands(g.formula):
+                span = _span(lit)
+                if span is not None:
+                    tries += [("offset", Edit(g.loc.file, *span, str(v)), lit.text, str(v))
+                              for v in (int(lit.text) - 1, int(lit.text) + 1) if v >= 0]
+            for how, edit, old, new in tries:
+                if trials >= MAX_TRIALS:
+                    return found
+                trials += 1
+                impl = holds(edit, n)
+                if impl:
+                    found.append({"node": n, "guarantee": k, "edit": edit, "how": how, "old": old, "new": new,
+                                  "implementable": impl})
+                    break
+    return found
+
+
 def cost(ws: Any, report: Mapping[str, Any], node: str, edit: Edit) -> list[dict[str, str]]:
     """What else changes status when ``edit`` strengthens a guarantee of
     ``node``: the side conditions of the nodes it feeds and ``node``'s own

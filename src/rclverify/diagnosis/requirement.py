@@ -32,9 +32,15 @@ def requirement_record(ws: Any, report: Mapping[str, Any], q: Mapping[str, Any],
     check = q.get("check") or {}
     cone = [str(n) for n in check.get("cone") or []]
     if check.get("temporal"):
-        return _temporal_record(q, check, lambda: cache.get(
+        rec = _temporal_record(q, check, lambda: cache.get(
             ["progress-repair", q["id"], check.get("formal"), cone],
             lambda: progress_repairs(ws, q, check["temporal"])) or [])
+        if rec["culprits"]:
+            return rec
+        # a run that meets every contract: the guarantee an edit by one value fixes (an off-by-one; issue 64)
+        slips = cache.get(["temporal-culprits", q["id"], check.get("formal"), cone],
+                          lambda: _slips(ws, report, q, guarantee_source)) or []
+        return _with_slips(rec, q, check, slips) if slips else rec
 
     causes = _causes(ws, report, q, cone, cache)
     if causes:  # refuted only because a side condition fails: that problem's row, its culprit (issue 64)
@@ -164,6 +170,50 @@ def _consequence_record(report: Mapping[str, Any], q: Mapping[str, Any], check: 
     return {"id": str(q["id"]), "kind": "requirement", "node": causes[0][1], "status": "failed",
             "sentence": sentence, "culprits": cul, "counterexample": table, "repairs": [], "guarantee": None,
             "consequence_of": ids}
+
+
+def _slips(ws: Any, report: Mapping[str, Any], q: Mapping[str, Any],
+           guarantee_source: Callable[[Mapping[str, Any], str, int], tuple[str, str]]) -> list[dict[str, Any]]:
+    """The guarantees :func:`blame.temporal_culprits` names for the refuted
+    temporal requirement ``q``, each ``{"node", "guarantee", "how", "old",
+    "new", "text", "source", "repair"}`` (its edit as a repair Z3 checked)."""
+    check = q.get("check") or {}
+    rows = []
+    for f in blame.temporal_culprits(ws, str(q["id"]), [str(n) for n in check.get("cone") or []]):
+        text, src = guarantee_source(report, f["node"], f["guarantee"])
+        what = f"guarantee {f['guarantee']} of {f['node']}"
+        kind = "an index offset" if f["how"] == "offset" else "a threshold's strictness"
+        summary = (f"Change {kind} of {what} ({src}) by one: `{f['old']}` becomes `{f['new']}`; Z3's temporal check "
+                   f"proves {q['id']}. {f['node']}'s implementation and evidence must then do the same.")
+        rows.append({"node": f["node"], "guarantee": f["guarantee"], "how": f["how"], "old": f["old"],
+                     "new": f["new"], "text": text, "source": src,
+                     "repair": _repair("move-threshold" if f["how"] == "threshold" else "tighten-bound", summary,
+                                       f["edit"], recheck.source_text(ws, f["edit"].file),
+                                       [{"check": str(q["id"]), "status": "proved (temporal check)"},
+                                        {"check": f"{f['node']} implementable",
+                                         "status": "yes (Z3: proved)" if f.get("implementable") == "proved"
+                                         else "not decided (Z3 could not say in its budget)"}],
+                                       blame.cost(ws, report, f["node"], f["edit"]),
+                                       proves=f"{q['id']} holds on every run of the edited contracts",
+                                       not_shown=f"that the edited value is the one {f['node']} must compute: its "
+                                                 "evidence must establish it")})
+    return rows
+
+
+def _with_slips(rec: dict[str, Any], q: Mapping[str, Any], check: Mapping[str, Any],
+                slips: list[dict[str, Any]]) -> dict[str, Any]:
+    """``rec`` (a temporal record without a culprit) naming the guarantees of ``slips`` (:func:`_slips`)."""
+    f = slips[0]
+    head = rec["sentence"].split(" The state it repeats: ")[0].split(" that meets every contract")[0]
+    state = rec["sentence"].split(" The state it repeats: ", 1)[1].split(". No guarantee")[0] \
+        if " The state it repeats: " in rec["sentence"] else ""
+    sentence = (f"{head}, because of guarantee {f['guarantee']} of {f['node']} ({f['source']}) `{f['text']}`: "
+                f"with `{f['old']}` as `{f['new']}` (off by one) Z3's temporal check proves {q['id']}"
+                + (f". The state: {state}" if state else "") + ".")
+    return {**rec, "node": f["node"], "sentence": sentence,
+            "culprits": [{"what": f"guarantee {x['guarantee']} of {x['node']}: `{x['text']}`", "source": x["source"],
+                          "text": x["text"]} for x in slips],
+            "repairs": [x["repair"] for x in slips]}
 
 
 def _between(report: Mapping[str, Any], sources: set[str], sinks: set[str]) -> set[str]:
