@@ -13,7 +13,10 @@ Small self-written packages, one construct each, scanned once per module:
   template, its type from the template argument of the construction
   (``make_unique<Server<T>>``), also through a template base's initialiser;
 * a constructor overload nobody calls makes no endpoint; an explicit
-  instantiation ``template class Server<T>;`` is no syntax error.
+  instantiation ``template class Server<T>;`` is no syntax error;
+* a Python module's client cache reached through imported functions: each
+  caller's name and service type (a parameter of the helper) read together,
+  an argparse name one located note.
 """
 from __future__ import annotations
 
@@ -53,6 +56,10 @@ int main(int argc, char ** argv)
 }
 """
 
+PY_SERVICES = "from std_srvs.srv import Trigger, SetBool\n\n_clients = {}\n\n\ndef client(node, srv_type, name):\n    key = (srv_type, name)\n    if key not in _clients:\n        _clients[key] = node.create_client(srv_type, name)\n    return _clients[key]\n\n\ndef trigger(node, name):\n    return client(node, Trigger, name).call_async(Trigger.Request())\n\n\ndef enable(node, on):\n    req = SetBool.Request()\n    req.data = on\n    return client(node, SetBool, 'enable_drive').call_async(req)\n"
+PY_PANEL = "import argparse\n\nimport rclpy\nfrom rclpy.node import Node\n\nfrom hmi_py.services import enable, trigger\n\n\ndef main():\n    parser = argparse.ArgumentParser()\n    parser.add_argument('--service', default='dock')\n    args, _ = parser.parse_known_args()\n    rclpy.init()\n    node = Node('panel')\n    trigger(node, args.service)\n    trigger(node, 'undock')\n    enable(node, True)\n    rclpy.spin(node)\n"
+PY_SETUP = "from setuptools import setup\nsetup(name='hmi_py', packages=['hmi_py'],\n      entry_points={'console_scripts': ['panel = hmi_py.panel:main']})\n"
+
 
 def _package(root: Path, name: str, files: dict[str, str]) -> None:
     d = root / "src" / name
@@ -70,6 +77,12 @@ def graph(tmp_path_factory):  # type: ignore[no-untyped-def]
     _package(root, "hmi", {"src/panel.cpp": PANEL, "src/empty.cpp": EMPTY})
     _package(root, "dock", {"include/dock/helpers.hpp": HELPERS, "src/dock_node.cpp": DOCK})
     _package(root, "relay", {"src/relay.cpp": OPAQUE})
+    py = root / "src" / "hmi_py"
+    for rel, text in {"package.xml": PKG.format(name="hmi_py").replace("ament_cmake", "ament_python"),
+                      "setup.py": PY_SETUP, "resource/hmi_py": "", "hmi_py/__init__.py": "",
+                      "hmi_py/services.py": PY_SERVICES, "hmi_py/panel.py": PY_PANEL}.items():
+        (py / rel).parent.mkdir(parents=True, exist_ok=True)
+        (py / rel).write_text(text)
     return scan([root], [], base=root).graph
 
 
@@ -125,3 +138,11 @@ def test_an_overload_nobody_calls_makes_no_endpoint(graph) -> None:  # type: ign
 
 def test_an_explicit_instantiation_is_no_syntax_error(graph) -> None:  # type: ignore[no-untyped-def]
     assert _notes(graph, "helpers.hpp") == []
+
+
+def test_python_client_cache_through_imported_functions(graph) -> None:  # type: ignore[no-untyped-def]
+    assert _edges(graph, "/panel") == {
+        ("service_clients", "/undock", "std_srvs/srv/Trigger"),
+        ("service_clients", "/enable_drive", "std_srvs/srv/SetBool")}
+    assert _notes(graph, "hmi_py/services.py") == [
+        "9: service client name is 'name', from argparse option --service: not resolved statically"]

@@ -356,8 +356,12 @@ class Linker(LinkMembers, Values):
         if t is None and isinstance(cb, tuple) and cb[:1] == ("type",):  # a class template's parameter
             types = [self.cb_type(e.kind, ("type", x)) for x in self.template_types(e.unit, cb[1])] or [None]
             t = types[0] if all(types) else None
+        argtype = cb if isinstance(cb, tuple) and cb[:1] == ("argtype",) else None
         got: list[Endpoint] = []
         for env in self.contexts(fkey):
+            if argtype is not None:  # a Python helper's type parameter, read at each call site (issue 65)
+                types = [_py_typed(v, e.kind) for v in self.eval(("arg", argtype[1], argtype[2]), env, fkey)] or [None]
+                t = types[0] if all(types) else None
             for n in self.eval(name, env, fkey):
                 for h in self.eval(handle, env, fkey) if handle is not None else [None]:
                     if n is not None and n[0] == "ops":
@@ -388,6 +392,12 @@ class Linker(LinkMembers, Values):
                 own = next((i for i in reach if units[i] in self.units and self.runs(e.unit, e.func, reach[i])), loose)
             out.append(own)
         return out
+
+
+def _py_typed(v: Any, kind: str) -> str | None:
+    """The ROS type a Python value names (``("ext", "std_srvs.srv.Trigger")``) for role ``kind``."""
+    from .sources_py import _typed
+    return _typed(v[1], kind) if v is not None and v[0] == "ext" and isinstance(v[1], str) else None
 
 
 def _held(ty: str | None) -> str:

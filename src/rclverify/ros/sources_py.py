@@ -235,6 +235,9 @@ def extract(mod: PyModule, shown: str) -> dict[str, Any]:
             return type_of(v.call.args[0], kind)
         if v.kind != "name":
             return None, None
+        pv = sc.value(v)
+        if pv is not None and pv[0] == "arg" and "." not in v.text:  # a helper's parameter: the callers' types
+            return None, ("argtype", pv[1], pv[2])
         head = v.text.split(".")[0]
         chosen = {o for o, _ln in mod.import_lines.get(head, [])}
         if len(chosen) > 1 and head not in said:
