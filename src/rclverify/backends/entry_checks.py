@@ -57,6 +57,7 @@ def check_entries(plan: Plan, checked: Checked) -> list[Diagnostic]:
                     read_record(plan.root, e.config, loc)
                 else:
                     _check_monitors(plan, e.config, loc, checked)
+                    out.extend(d for d in _shared_topics(plan, e.config, checked, node) if d not in out)
             except PlanError as exc:  # once each: entries sharing a mapping file share its errors
                 out.extend(d for d in exc.diagnostics if d not in out)
     return out
@@ -104,6 +105,22 @@ def _no_repeated_entry(plan: Plan, node: str, entries: Any) -> list[Diagnostic]:
         else:
             seen[key] = loc
     return out
+
+
+def _shared_topics(plan: Plan, config: Any, checked: Checked, node: str) -> list[Diagnostic]:
+    """Located errors of ``node``'s variables that share a topic and would
+    read one field (:mod:`.monitors.shared_topics`), under the entry's
+    mapping file's rules (none when it does not exist yet)."""
+    from .monitors.config import DEFAULT_MAPPING, ConfigError, load_mapping
+    from .monitors.shared_topics import shared_topic_errors
+    rel = config.get("mapping")
+    rules: Any = {}
+    if isinstance(rel, (str, type(None))) and (plan.root / (rel or DEFAULT_MAPPING)).is_file():
+        try:
+            rules = load_mapping(plan.root, rel, config.get("horizon"), (), config.get("tolerance")).rules
+        except ConfigError:
+            return []  # the mapping's own error is reported by _check_monitors
+    return shared_topic_errors(checked, node, rules, rel or DEFAULT_MAPPING)
 
 
 def _check_monitors(plan: Plan, config: Any, loc: Any, checked: Checked | None = None) -> None:

@@ -67,6 +67,9 @@ class NodePackage:
     contract_file: str = ""
     #: ``step``'s parameter per input, RCL name -> Python name (``x'`` -> ``x_prime``: :func:`.names.py_name`)
     params: dict[str, str] = field(default_factory=dict)
+    #: ``(variable, topic)`` of each further variable on a topic an end already carries: the end carries its
+    #: first variable only; the generated mapping says so (planfrag.py, issue 64)
+    unwired: list[tuple[str, str]] = field(default_factory=list)
 
     @property
     def step(self) -> str:
@@ -113,6 +116,7 @@ def node_package(cn: CheckedNode) -> NodePackage:
             continue
         role = "sub" if t.match.prefix == "in" else "pub"
         if (role, t.field) in seen:
+            np.unwired.append((f"{t.match.prefix}.{t.match.name}", t.field.lstrip("/")))
             continue
         seen.add((role, t.field))
         np.endpoints.append(Endpoint(role, t.field, t.msg_type, f"{t.match.prefix}.{t.match.name}"))

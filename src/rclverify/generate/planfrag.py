@@ -26,13 +26,54 @@ def plan_fragment(nodes: list[NodePackage], prefix: str, lang: str, rules: Mappi
                   env: Any, marker: str) -> dict[str, str]:
     """``{path: text}`` of ``rclverify_plan.yaml`` and ``rclverify_mapping.yaml`` for the generated
     ``nodes``; ``prefix`` is the output directory relative to the workspace (``gen``)."""
-    topics: dict[str, str] = {}
-    for np in nodes:
-        for w in wires(np, rules):
-            if w.path:
-                topics.setdefault(w.var_topic(np), w.path)
+    topics, omitted = mapped_topics(nodes, rules)
     pre = prefix.rstrip("/") + "/" if prefix not in ("", ".") else ""
     ctx = dict(marker=marker, nodes=nodes, pre=pre, lang=lang, max_examples=MAX_EXAMPLES,
-               topics=sorted(topics.items()))
+               topics=sorted(topics.items()), omitted=omitted)
     return {"rclverify_plan.yaml": env.get_template("plan_fragment.yaml.j2").render(ctx),
             "rclverify_mapping.yaml": env.get_template("plan_mapping.yaml.j2").render(ctx)}
+
+
+def mapped_topics(nodes: list[NodePackage], rules: Mapping[str, Any] | None
+                  ) -> tuple[dict[str, Any], list[dict[str, str]]]:
+    """What the generated mapping says of each topic of ``nodes``: ``(topics,
+    omitted)``.  ``topics`` maps a topic to the one field path its variables
+    read (a string), or, when variables of different names share the topic,
+    to ``{variable name: path}`` (each variable its own field:
+    docs/monitors.md, "One topic, several variables").  ``omitted`` lists
+    ``{"topic", "type", "var", "why"}`` for each variable whose field the
+    generator cannot name: a standard message of several fields (a
+    ``geometry_msgs/Point``, a ``Twist``) that no mapping rule of the
+    workspace narrows to one field; the mapping file says so in a comment,
+    naming the entry to write (issue 64)."""
+    per: dict[str, dict[str, str]] = {}
+    omitted: list[dict[str, str]] = []
+    for np in nodes:
+        for w in wires(np, rules):
+            topic = w.var_topic(np)
+            if w.path:
+                per.setdefault(topic, {}).setdefault(w.name, w.path)
+                continue
+            end = next(e for e in np.endpoints if e.attr == w.attr)
+            why = (f"{end.ros_type} has several fields and no mapping rule names the one {np.ros_name}'s {w.var} "
+                   f"reads; the monitors would read its first top-level field of the variable's type, which "
+                   f"may be another quantity: name it in backends/monitors/mapping.yaml "
+                   f"('{topic}: {{fields: [<field>]}}') and generate again")
+            item = {"topic": topic, "type": end.ros_type, "var": f"{np.ros_name}.{w.var}", "why": why}
+            if item not in omitted:
+                omitted.append(item)
+        for var, topic in np.unwired:
+            from ..traces.mapping import rule_for
+            own = list(rule_for(rules, topic, var).fields) if rules else []
+            if len(own) == 1:  # the workspace's mapping names its field: the monitors read it (the node does not)
+                per.setdefault(topic, {}).setdefault(var.split(".", 1)[1], own[0])
+                continue
+            omitted.append({"topic": topic, "type": "", "var": f"{np.ros_name}.{var}", "why": (
+                f"the generated node has one end per topic, which carries its first variable only: {var} is left "
+                f"to the hand-written logic; to monitor it, name each variable's field in "
+                f"backends/monitors/mapping.yaml ('{topic}: {{fields: {{x: [<field>], y: [<field>]}}}}', "
+                f"docs/monitors.md \"One topic, several variables\")")})
+    topics: dict[str, Any] = {}
+    for topic, by_name in per.items():
+        topics[topic] = next(iter(by_name.values())) if len(by_name) == 1 else dict(sorted(by_name.items()))
+    return topics, sorted(omitted, key=lambda o: (o["topic"], o["var"]))

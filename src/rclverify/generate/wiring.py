@@ -61,7 +61,8 @@ def _path(ros_type: str, var: str, topic: str, rules: Mapping[str, Any]) -> str:
         return field_name(var.split(".", 1)[1])
     if pkg == "std_msgs" and cls in STD_DATA:
         return "data"
-    fields = list(getattr(rules.get(topic.lstrip("/")), "fields", ()))
+    from ..traces.mapping import rule_for  # a topic's rule, or its variable's own (several variables on one topic)
+    fields = list(rule_for(rules, topic.lstrip("/"), var).fields) if rules else []
     return fields[0] if len(fields) == 1 else ""
 
 

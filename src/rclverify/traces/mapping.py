@@ -289,11 +289,28 @@ class RuleSet(dict):  # type: ignore[type-arg]
     tolerance: Any = None
     #: the transport skew in seconds (``None``: none; backends/monitors/skew.py)
     skew: float | None = None
+    #: (topic, variable name) -> the rule of one variable of a topic that carries several
+    #: (``fields: {x: [x], y: [y]}``); read through :func:`rule_for`
+    by_var: Mapping[tuple[str, str], TopicRule] = {}
+
+
+def rule_for(rules: Mapping[str, TopicRule], topic: str, key: str, default: TopicRule | None = None) -> TopicRule:
+    """The rule that maps the variable ``key`` (``in.x``, ``out.y`` or a bare
+    name) from ``topic``: its own (``fields: {x: [...]}``, several variables
+    on one topic, docs/monitors.md "One topic, several variables") when the
+    mapping gives one, else the topic's, else ``default`` (an empty rule)."""
+    name = key.split(".", 1)[1] if key.startswith(("in.", "out.")) else key
+    mine = getattr(rules, "by_var", {}).get((topic.lstrip("/"), name))
+    if mine is not None:
+        return mine  # type: ignore[no-any-return]
+    return rules.get(topic, default if default is not None else TopicRule())
 
 
 def load_rules(raw: Any) -> RuleSet:
     """Topic rules from the plan's ``topics`` mapping (``{topic: {fields, update, default, state}}``):
-    ``fields`` a list of field names or paths (:func:`parse_path`), ``update``
+    ``fields`` a list of field names or paths (:func:`parse_path`), or a
+    mapping of each variable name to its list when one topic carries several
+    variables (kept in ``by_var``, read by :func:`rule_for`), ``update``
     ``accumulate`` or ``replace``, ``state`` a boolean (default false).
 
     Raises :class:`RuleError` (a ``ValueError``) naming the topic and the
@@ -308,15 +325,11 @@ def load_rules(raw: Any) -> RuleSet:
         if not isinstance(spec, Mapping):
             raise RuleError(f"topic {topic}: expected a mapping", "topics", topic)
         fields: Any = spec.get("fields", ()) or ()
-        if not isinstance(fields, (list, tuple)) or not all(isinstance(f, (str, int)) and not isinstance(f, bool)
-                                                            for f in fields):
-            raise RuleError(f"topic {topic}: fields must be a list of message field names, not {fields!r}",
-                            "topics", topic, "fields")
-        for k, f in enumerate(fields):
-            if isinstance(f, str) and is_path(f) and parse_path(f) is None:
-                raise RuleError(f"topic {topic}: {f!r} is not a field path (write names joined by '.', each "
-                                f"with optional integer indexes: linear.x, pose.pose.position.x, ranges[0], "
-                                f"ranges[-1])", "topics", topic, "fields", k)
+        per_var = dict(fields) if isinstance(fields, Mapping) else {}
+        for var, fs in (per_var or {None: fields}).items():
+            _check_fields(str(topic), fs, () if var is None else (var,))
+        if per_var:
+            fields = ()
         update = spec.get("update", "accumulate")
         if update not in ("accumulate", "replace"):
             raise RuleError(f"topic {topic}: update must be accumulate or replace, not {update!r}",
@@ -329,4 +342,22 @@ def load_rules(raw: Any) -> RuleSet:
             raise RuleError(f"topic {topic}: unknown key {unknown[0]!r} (expected fields, update, default, state)",
                             "topics", topic, unknown[0])
         out[str(topic).lstrip("/")] = TopicRule(tuple(str(f) for f in fields), update, spec.get("default"), state)
+        for var, fs in per_var.items():
+            out.by_var = {**out.by_var, (str(topic).lstrip("/"), str(var)):
+                          TopicRule(tuple(str(f) for f in fs), update, spec.get("default"), state)}
     return out
+
+
+def _check_fields(topic: str, fields: Any, var: tuple[Any, ...]) -> None:
+    """Raise :class:`RuleError` unless ``fields`` is a list of field names
+    or paths (``var``: the variable key of a per-variable list, ``()`` else)."""
+    whose = f" (variable {var[0]})" if var else ""
+    if not isinstance(fields, (list, tuple)) or not all(isinstance(f, (str, int)) and not isinstance(f, bool)
+                                                        for f in fields):
+        raise RuleError(f"topic {topic}{whose}: fields must be a list of message field names, or map each variable "
+                        f"to its list ({{x: [x], y: [y]}}), not {fields!r}", "topics", topic, "fields", *var)
+    for k, f in enumerate(fields):
+        if isinstance(f, str) and is_path(f) and parse_path(f) is None:
+            raise RuleError(f"topic {topic}{whose}: {f!r} is not a field path (write names joined by '.', each "
+                            f"with optional integer indexes: linear.x, pose.pose.position.x, ranges[0], "
+                            f"ranges[-1])", "topics", topic, "fields", *var, k)

@@ -58,6 +58,12 @@ def monitor_command(args: argparse.Namespace, checked: Checked) -> int:
     except ConfigError as exc:
         print(f"{exc}" if exc.located else f"{args.mapping or 'rclverify monitor'}: error: {exc}", file=sys.stderr)
         return 2
+    from .shared_topics import shared_topic_errors  # two variables on one topic read distinct fields (issue 64)
+    shared = [d for n in checked.nodes for d in shared_topic_errors(checked, n, cfg.rules, cfg.mapping or
+                                                                   "backends/monitors/mapping.yaml")]
+    if shared:
+        print("\n".join(map(str, shared)), file=sys.stderr)
+        return 2
     if getattr(args, "live", False):
         return live_command(args, checked, cfg, root)
     if not args.traces:

@@ -44,7 +44,7 @@ from ...rcl import ast
 from ...rcl.printer import expr_to_rcl
 from ...rcl.walk import subexpressions
 from ...traces.events import Event
-from ...traces.mapping import MappingError, TopicRule, map_value
+from ...traces.mapping import MappingError, TopicRule, map_value, rule_for
 from ...values import render
 from .live import LiveRun, dumps
 
@@ -103,7 +103,7 @@ def judge(monitors: Sequence[Any], checked: Any, ev: Event,
         values = {k: v for k, v in m.values.items() if v is not None}
         try:
             for key, typ in outs:
-                values[key] = map_value(typ, ev.fields, rules.get(ev.topic, TopicRule()), m.values.get(key))
+                values[key] = map_value(typ, ev.fields, rule_for(rules, ev.topic, key), m.values.get(key))
         except MappingError as exc:
             return False, {"node": m.node.name, "verdict": "inconclusive", "guarantee": 0, "formula": "",
                            "values": {}, "reason": f"the message does not map to {outs[0][0]}: {exc}"}

@@ -57,7 +57,7 @@ from ...rcl.timing import seconds
 from ...rcl.types import Checked, CheckedNode
 from ...rcl.walk import subexpressions
 from ...traces.events import Event, to_ns
-from ...traces.mapping import MappingError, TopicRule, map_value
+from ...traces.mapping import MappingError, TopicRule, map_value, rule_for
 from ...traces.questions import Question, QuestionStream
 from .online import header_stamp, header_stamp_ns
 from .verdicts import LINK_TOPICS, names
@@ -248,7 +248,7 @@ class DeadlineMonitor:
             if typ is None:
                 continue
             try:
-                self.values[key] = map_value(typ, fields, self.rules.get(ev.topic, TopicRule()), self.values.get(key))
+                self.values[key] = map_value(typ, fields, rule_for(self.rules, ev.topic, key), self.values.get(key))
             except MappingError as exc:
                 # never the value before it: what reads this input is undecided until a message maps again
                 self.invalid[key] = f"{key}: the latest message at {ev.where} does not map ({exc})"

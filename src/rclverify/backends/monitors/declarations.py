@@ -55,7 +55,7 @@ from ...rcl.printer import expr_to_rcl
 from ...rcl.types import Checked, CheckedNode
 from ...rcl.walk import subexpressions
 from ...traces.events import Event
-from ...traces.mapping import MappingError, TopicRule, map_value
+from ...traces.mapping import MappingError, TopicRule, map_value, rule_for
 from .deadlines import event_stamp, topic_bindings
 from .periods import PeriodResult
 from .verdicts import names
@@ -184,7 +184,7 @@ class DeclarationMonitor:
             if typ is None:
                 continue
             try:
-                self.values[key] = map_value(typ, fields, self.rules.get(ev.topic, TopicRule()), self.values.get(key))
+                self.values[key] = map_value(typ, fields, rule_for(self.rules, ev.topic, key), self.values.get(key))
             except MappingError:
                 self.values.pop(key, None)  # never the value before it: undecided until a message maps again
             changed.append(key)

@@ -40,7 +40,7 @@ from ...logic.judges import FormulaJudge
 from ...rcl.printer import expr_to_rcl
 from ...rcl.types import Checked, CheckedNode
 from ...traces.events import Event
-from ...traces.mapping import MappingError, TopicRule, initial_value, value_mapper
+from ...traces.mapping import MappingError, TopicRule, initial_value, rule_for, value_mapper
 from ...traces.questions import Question, QuestionStream
 from ...values import render
 from .closing import Closing
@@ -105,7 +105,7 @@ class NodeMonitor(Closing, Late):
                 if lk.kind == "action":
                     parts[(topic, key)] = suffix
         self.has_inputs = any(i for vs in self.topics.values() for _, _, i in vs)
-        self._feeds = {topic: [(key, value_mapper(typ, rules.get(topic, _NO_RULE)), parts.get((topic, key), ""))
+        self._feeds = {topic: [(key, value_mapper(typ, rule_for(rules, topic, key, _NO_RULE)), parts.get((topic, key), ""))
                                for key, typ, _ in vs] for topic, vs in self.topics.items()}
         self._topic_io = {topic: (frozenset(k for k, _, inp in vs if inp), [k for k, _, inp in vs if not inp])
                           for topic, vs in self.topics.items()}
@@ -114,7 +114,7 @@ class NodeMonitor(Closing, Late):
         self.invalid: dict[str, str] = {}
         for topic, vs in self.topics.items():
             for key, typ, _ in vs:
-                self.values[key] = initial_value(typ, rules.get(topic, _NO_RULE))
+                self.values[key] = initial_value(typ, rule_for(rules, topic, key, _NO_RULE))
         self.assumption = tuple(c.formula for c in node.node.assumes)
         self.guarantees = tuple(c.formula for c in node.node.guarantees)
         #: guarantee k -> ``in.x`` for ``triggered by in.x``: it answers the messages of that input only

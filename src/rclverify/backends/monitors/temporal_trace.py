@@ -70,7 +70,7 @@ from ...plan.temporal import Temporal, shape
 from .response_trace import ResponseTracker
 from ...rcl.types import Checked, EnumT, FuncT, Scalar, Type
 from ...traces.events import Event
-from ...traces.mapping import MappingError, TopicRule, initial_value, map_value
+from ...traces.mapping import MappingError, TopicRule, initial_value, map_value, rule_for
 from ...values import FiniteFunction, render
 
 VERDICTS = ("true", "false", "currently_false", "inconclusive")
@@ -247,7 +247,7 @@ class TraceStates:
                 key = ("in." if inp else "out.") + t.match.name
                 topic = t.field.lstrip("/")
                 self.topics.setdefault(topic, []).append((n, key, typ))
-                self.io[n][key] = initial_value(typ, rules.get(topic, TopicRule()))
+                self.io[n][key] = initial_value(typ, rule_for(rules, topic, key))
         self.vars = [sv for sv in states if sv.node in self.nodes]
         self.formulas = {(sv.node, sv.name): (parse_state_formula(sv, "init", checked, states),
                                               parse_state_formula(sv, "next", checked, states)) for sv in self.vars}
@@ -272,7 +272,7 @@ class TraceStates:
         for n, key, typ in vs:
             p, _, name = key.partition(".")
             try:
-                self.io[n][key] = map_value(typ, ev.fields, self.rules.get(ev.topic, TopicRule()), self.io[n].get(key))
+                self.io[n][key] = map_value(typ, ev.fields, rule_for(self.rules, ev.topic, key), self.io[n].get(key))
                 self.unreadable.pop(f"{p}.{n}.{p}.{name}", None)
             except MappingError as exc:
                 self.io[n][key] = None
