@@ -316,28 +316,32 @@ def test_an_input_no_clause_reads_is_not_a_step() -> None:
     assert row["verdict"] == "false" and "between the input at run.jsonl:1 and the input at run.jsonl:5" in row["reason"]
 
 
-def test_the_monitor_command_and_the_live_checks_judge_them_as_the_backend(verified: Any, capsys: Any) -> None:
+def test_the_monitor_command_and_the_live_run_judge_them_as_the_backend(verified: Any, tmp_path: Path,
+                                                                        capsys: Any) -> None:
     """``rclverify monitor TRACE`` (exit 1 on the late answer) and the live
-    run's checks (:class:`LogChecks`, fed the same lines) give the rows the
-    backend's record has."""
+    run (:class:`LiveRun`, the messages pushed as the middleware hands them
+    over) give the rows the backend's record has; the offline command on the
+    live run's log gives them again (live = offline)."""
     from rclverify.backends.monitors.config import load_mapping
-    from rclverify.backends.monitors.logchecks import LogChecks
-    from rclverify.traces import read_trace
+    from rclverify.backends.monitors.live import LiveRun
+    checked = check([parse_text(RCL, "r.rcl")])
     for variant, code in (("correct", 0), ("late", 1)):
         ws = verified[variant][2]
-        assert main(["monitor", "-w", str(ws), "--mapping", "mapping.yaml", "--json", str(ws / "traces/run.jsonl")]) == code
-        shown = [e for e in json.loads(capsys.readouterr().out) if "declarations" in e]
-        checked = check([parse_text(RCL, "r.rcl")])
-        cfg = load_mapping(ws, "mapping.yaml")
-        live = LogChecks(checked, checked.nodes.values(), cfg.rules, 5.0, lambda v, t: None)
-        for ev in read_trace(ws / "traces/run.jsonl", []):
-            live.event(ev)
-        live.finish()
-        rec = {e["node"]: e for e in live.record("run.jsonl")["declarations"]}
         want = {r["declaration"]: r["verdict"] for r in _evidence(ws, "Base")["details"]["declarations"]}
-        for got in (rec["Base"]["declarations"], next(e for e in shown if e["node"] == "Base")["declarations"]):
+        assert main(["monitor", "-w", str(ws), "--mapping", "mapping.yaml", "--json", str(ws / "traces/run.jsonl")]) == code
+        offline = next(e for e in json.loads(capsys.readouterr().out) if "declarations" in e and e["node"] == "Base")
+        cfg = load_mapping(ws, "mapping.yaml")
+        log = tmp_path / f"{variant}.jsonl"
+        live = LiveRun(checked, list(checked.nodes.values()), cfg.rules, cfg.horizon, log, reorder_window=0.0)
+        for row in _run(variant):
+            live.tick(row["time"])
+            live.push(row["topic"], {"data": row["data"]}, row["time"])
+        rec = {e["node"]: e for e in live.stop()["declarations"]}
+        assert main(["monitor", "-w", str(ws), "--mapping", "mapping.yaml", "--json", str(log)]) == code
+        again = next(e for e in json.loads(capsys.readouterr().out) if "declarations" in e and e["node"] == "Base")
+        for got in (rec["Base"]["declarations"], offline["declarations"], again["declarations"]):
             assert {r["declaration"]: r["verdict"] for r in got} == want
-        assert rec["Base"]["status"] == ("failed" if variant == "late" else "discharged")
+        assert rec["Base"]["status"] == offline["status"] == ("failed" if variant == "late" else "discharged")
 
 
 # ---- the property tests ------------------------------------------------------------------------------------------
