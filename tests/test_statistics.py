@@ -21,7 +21,7 @@ def oracle_upper(k: int, n: int, level: float) -> float:
     if k >= n:
         return 1.0
     lo, hi = 0.0, 1.0
-    for _ in range(200):
+    for _ in range(80):
         mid = (lo + hi) / 2
         if binom_cdf(k, n, mid) > 1 - level:
             lo = mid
@@ -35,7 +35,7 @@ def oracle_lower(k: int, n: int, level: float) -> float:
     if k <= 0:
         return 0.0
     lo, hi = 0.0, 1.0
-    for _ in range(200):
+    for _ in range(80):
         mid = (lo + hi) / 2
         if 1 - binom_cdf(k - 1, n, mid) < 1 - level:
             lo = mid
@@ -138,3 +138,18 @@ def test_the_same_run_twice_is_counted_once() -> None:
     assert (c["runs"], c["duplicates"], c["answers"], c["seconds"]) == (5, 2, 15, 7.5)
     c = count_runs([{"sha256": "x", "status": "pending"}])
     assert (c["runs"], c["unjudged_runs"]) == (0, 1)
+
+
+def test_decide_agrees_with_the_oracle_on_random_run_sets() -> None:
+    """A target is discharged exactly when the brute-force bound, undecided runs counted as violations, meets it."""
+    rng = random.Random(3)
+    target = parse_target("violation probability <= 0.2 at 90 % per run")
+    for _ in range(60):
+        n = rng.randint(0, 30)
+        k = rng.randint(0, min(n, 3))
+        u = rng.randint(0, min(n - k, 2))
+        d = decide(count_runs(_rows(n, violating=k, unsure=u)), target)
+        assert (d["status"] == "discharged") == (n > 0 and oracle_upper(k + u, n, 0.9) <= 0.2)
+        if d["status"] == "pending":
+            m = d["runs_needed"]
+            assert m > 0 and oracle_upper(k + u, n + m, 0.9) <= 0.2 < oracle_upper(k + u, n + m - 1, 0.9)
