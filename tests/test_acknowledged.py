@@ -117,10 +117,15 @@ def test_acknowledged_warnings_pass_strict_with_their_reasons_everywhere(gain_ws
     [f] = [f for f in report["findings"] if f["id"] == "Gain.g1.c2.redundant"]
     assert f["status"] == "warning" and f["acknowledged"]["at"] == "contracts/plan.yaml:8:5"
     sarif = json.loads((gain_ws / "reports" / "assurance.sarif").read_text(encoding="utf-8"))
+    import jsonschema
+    schema = Path(__file__).parent / "data" / "sarif-schema-2.1.0.json"
+    jsonschema.validate(sarif, json.loads(schema.read_text(encoding="utf-8")))
     sup = {r["ruleId"]: r.get("suppressions") for r in sarif["runs"][0]["results"]}
     assert sup["RCL-HEALTH-REDUNDANT"][0]["justification"].startswith("kept so that a reader")
     assert sup["RCL-HEALTH-REDUNDANT"][0]["status"] == "accepted"
     assert sup["RCL-LINT-UNUSED-BOUND"][0]["kind"] == "external"
+    region = sup["RCL-HEALTH-REDUNDANT"][0]["location"]["physicalLocation"]["region"]
+    assert region["startLine"] == 8  # the plan entry that accepted it
     md = (gain_ws / "reports" / "assurance.md").read_text(encoding="utf-8")
     assert "**Accepted risk**" in md and "the per-step table of the next release" in md
     argument = json.loads((gain_ws / "reports" / "argument.json").read_text(encoding="utf-8"))

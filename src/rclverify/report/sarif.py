@@ -334,8 +334,11 @@ def _suppressed(res: dict[str, Any], row: Mapping[str, Any]) -> dict[str, Any]:
     3.35) when the plan acknowledges the warning ``row`` (plan/acknowledged.py)."""
     ack = row.get("acknowledged")
     if ack:
-        res["suppressions"] = [{"kind": "external", "status": "accepted", "justification": str(ack["reason"]),
-                                "locations": _location(str(ack["at"]))}]
+        sup: dict[str, Any] = {"kind": "external", "status": "accepted", "justification": str(ack["reason"])}
+        where = _location(str(ack["at"]))
+        if where:
+            sup["location"] = where[0]  # the plan entry (SARIF 2.1.0 section 3.35.6: one location)
+        res["suppressions"] = [sup]
     return res
 
 
