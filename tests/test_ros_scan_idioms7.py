@@ -16,7 +16,10 @@ Small self-written packages, one construct each, scanned once per module:
   instantiation ``template class Server<T>;`` is no syntax error;
 * a Python module's client cache reached through imported functions: each
   caller's name and service type (a parameter of the helper) read together,
-  an argparse name one located note.
+  an argparse name one located note;
+* a parameter read into a variable that already holds a value
+  (``std::string t = "scan"; get_parameter("t", t);``): that value is the
+  parameter's default, never "no default".
 """
 from __future__ import annotations
 
@@ -55,6 +58,7 @@ int main(int argc, char ** argv)
   return 0;
 }
 """
+FILTER = '#include <rclcpp/rclcpp.hpp>\n#include <sensor_msgs/msg/laser_scan.hpp>\n\nclass Filter : public rclcpp::Node\n{\npublic:\n  Filter()\n  : rclcpp::Node("scan_filter")\n  {\n    std::string in_topic = "scan";\n    declare_parameter("in_topic", rclcpp::ParameterValue(in_topic));\n    get_parameter("in_topic", in_topic);\n    std::string out_topic;\n    out_topic = "scan_filtered";\n    this->get_parameter("out_topic", out_topic);\n    sub_ = create_subscription<sensor_msgs::msg::LaserScan>(in_topic, 10, [](sensor_msgs::msg::LaserScan::SharedPtr) {});\n    pub_ = create_publisher<sensor_msgs::msg::LaserScan>(out_topic, 10);\n  }\n  rclcpp::Subscription<sensor_msgs::msg::LaserScan>::SharedPtr sub_;\n  rclcpp::Publisher<sensor_msgs::msg::LaserScan>::SharedPtr pub_;\n};\n\nint main(int argc, char ** argv)\n{\n  rclcpp::init(argc, argv);\n  rclcpp::spin(std::make_shared<Filter>());\n  return 0;\n}\n'
 
 PY_SERVICES = "from std_srvs.srv import Trigger, SetBool\n\n_clients = {}\n\n\ndef client(node, srv_type, name):\n    key = (srv_type, name)\n    if key not in _clients:\n        _clients[key] = node.create_client(srv_type, name)\n    return _clients[key]\n\n\ndef trigger(node, name):\n    return client(node, Trigger, name).call_async(Trigger.Request())\n\n\ndef enable(node, on):\n    req = SetBool.Request()\n    req.data = on\n    return client(node, SetBool, 'enable_drive').call_async(req)\n"
 PY_PANEL = "import argparse\n\nimport rclpy\nfrom rclpy.node import Node\n\nfrom hmi_py.services import enable, trigger\n\n\ndef main():\n    parser = argparse.ArgumentParser()\n    parser.add_argument('--service', default='dock')\n    args, _ = parser.parse_known_args()\n    rclpy.init()\n    node = Node('panel')\n    trigger(node, args.service)\n    trigger(node, 'undock')\n    enable(node, True)\n    rclpy.spin(node)\n"
@@ -77,6 +81,7 @@ def graph(tmp_path_factory):  # type: ignore[no-untyped-def]
     _package(root, "hmi", {"src/panel.cpp": PANEL, "src/empty.cpp": EMPTY})
     _package(root, "dock", {"include/dock/helpers.hpp": HELPERS, "src/dock_node.cpp": DOCK})
     _package(root, "relay", {"src/relay.cpp": OPAQUE})
+    _package(root, "lidar", {"src/filter.cpp": FILTER})
     py = root / "src" / "hmi_py"
     for rel, text in {"package.xml": PKG.format(name="hmi_py").replace("ament_cmake", "ament_python"),
                       "setup.py": PY_SETUP, "resource/hmi_py": "", "hmi_py/__init__.py": "",
@@ -146,3 +151,10 @@ def test_python_client_cache_through_imported_functions(graph) -> None:  # type:
         ("service_clients", "/enable_drive", "std_srvs/srv/SetBool")}
     assert _notes(graph, "hmi_py/services.py") == [
         "9: service client name is 'name', from argparse option --service: not resolved statically"]
+
+
+def test_a_value_held_before_a_parameter_read_is_its_default(graph) -> None:  # type: ignore[no-untyped-def]
+    n = graph.nodes["/scan_filter"]
+    got = {(r, e.topic, e.param) for r in ("pub", "sub") for e in n.edges_of(r)}
+    assert got == {("sub", "/scan", "/scan_filter/in_topic"), ("pub", "/scan_filtered", "/scan_filter/out_topic")}
+    assert _notes(graph, "filter.cpp") == []

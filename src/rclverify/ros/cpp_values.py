@@ -213,12 +213,28 @@ class CppValues(CppScope):
                 return ("nh", (("h", v),)) if is_node_type(fn.ptypes[fn.params.index(name)]) else v
             key = (fn.nid, name)
             if key in self.ltypes or key in self.locals:
-                return self._one([self._bound(fn, b, depth) for b in self.locals.get(key, [])])
+                return self._local(fn, self.locals.get(key, []), depth)
             if fn.in_class and name not in self.consts:
                 return self._member(fn, name, depth)
         if name in self.consts:
             return self._one([self.value(v, depth + 1) if not isinstance(v, tuple) else v for v in self.consts[name]])
         return None
+
+    def _local(self, fn: Fn, binds: list[Any], depth: int) -> symbols.Val:
+        """A local variable's value from its bindings in order.  A parameter read
+        into it (``get_parameter("t", topic)``, ``getParam``) leaves it unchanged
+        when the parameter is not set: what it held before is the read's default
+        (issue 65: "no default" was said where the code assigns one first)."""
+        reads = [i for i, b in enumerate(binds) if isinstance(b, tuple) and b and b[0] == "read"]
+        if not reads or reads[-1] == 0:
+            return self._one([self._bound(fn, b, depth) for b in binds])
+        i = reads[-1]
+        v = self._bound(fn, binds[i], depth)
+        if v is not None and v[0] == "param" and v[2] is None:
+            prior = self._one([self._bound(fn, b, depth) for b in binds[:i]])
+            if prior is not None and prior[0] == "str":
+                v = (v[0], v[1], prior[1], *v[3:])
+        return self._one([v] + [self._bound(fn, b, depth) for b in binds[i + 1:]])
 
     def _member(self, fn: Fn, name: str, depth: int) -> symbols.Val:
         v = ("field", fn.unit, name)
