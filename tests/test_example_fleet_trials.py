@@ -37,13 +37,16 @@ def test_the_day_meets_the_target_and_the_night_says_how_many_runs_it_needs(ws: 
     assert night["status"] == "pending" and night["counts"]["runs"] == 25
     assert (night["runs_needed"], night["sprt"]) == (34, "continue")
     groups = {s["environment"]: s for s in r["statistics"] if s["kind"] == "runs"}
-    assert set(groups) == {"warehouse_day", "loading_dock_night"}  # never one bound over both
+    assert set(groups) == {"warehouse_day", "loading_dock_night", "lab_bench"}  # never one bound over two tags
     assert groups["warehouse_day"]["recorded"] == {"log": 60} and groups["warehouse_day"]["origin"] == "simulation"
+    bench = groups["lab_bench"]  # recorded live from real ROS 2 nodes (record_live.py): operation, no target
+    assert (bench["recorded"], bench["origin"], bench["counts"]["answers"]) == ({"live": 10}, "operation", 200)
+    assert bench["bound"] == pytest.approx(1 - 0.05 ** (1 / 10))
     (g1,) = [g for n in r["nodes"] for g in n["guarantees"]]
     assert g1["strength"]["kind"] == "statistical" and g1["strength"]["doubt"] == pytest.approx(day["bound"])
     (req,) = r["requirements"]
-    assert {s["environment"]: s["status"] for s in req["statistics"]} == {"warehouse_day": "discharged",
-                                                                          "loading_dock_night": "pending"}
+    assert {s["environment"]: s["status"] for s in req["statistics"]} == {
+        "warehouse_day": "discharged", "loading_dock_night": "pending", "lab_bench": "pending"}
     md = (ws / "reports/assurance.md").read_text()
     assert "### Runs counted and statistical guarantees" in md and "34 further clean run(s) needed" in md
 
