@@ -138,3 +138,18 @@ def test_a_temporal_requirement_names_the_off_by_one(tmp_path: Path) -> None:
     assert "in.index + 0" in d["repairs"][0]["diff"]
     row = _row_of(report, "REQ-JOINT")  # the slip's row: the side condition it also breaks
     assert "Arm.sc1" in [m["id"] for m in row["members"]] and "guarantee:Planner:1" in row["key"]
+
+
+def test_a_counterexample_through_a_refuted_side_condition_says_so(report: dict[str, Any]) -> None:
+    from rclverify.diagnosis.requirement import _passes_through
+    from rclverify.workspace import Workspace
+    ws = Workspace(Path(report["_ws"]), "contracts/plan.yaml")
+    cone = ["Supervisor", "GripperDriver"]
+
+    def q(force: str) -> dict[str, Any]:
+        return {"id": "R", "check": {"counterexample": [
+            {"node": "Supervisor", "values": {"in.request": "0", "out.force": force}},
+            {"node": "GripperDriver", "values": {"in.force": force, "out.applied": force}}]}}
+    assert [sc["id"] for sc in _passes_through(ws, report, q("41"), cone)] == ["GripperDriver.sc2"]
+    assert _passes_through(ws, report, q("35"), cone) == []  # the driver's assumption holds there
+    assert _passes_through(ws, report, q("4x"), cone) == []  # a value that does not read shows nothing

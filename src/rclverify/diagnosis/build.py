@@ -358,7 +358,7 @@ def _evidence(ws: Any, report: Mapping[str, Any], e: Mapping[str, Any], o: Mappi
         impl = _obligation_record(ws, node, e["obligation"]).get("data", {}).get("implementation", "the implementation")
         cause = e["counterexample"].get("cause")  # the implementation line the example takes (issue 48)
         sentence = (f"Hypothesis found inputs on which {impl} "
-                    f"violates {where}" + (f"; the example's last line run in the implementation is {cause}"
+                    f"violates {where}" + (f"; the implementation line that computed the failing output is {cause}"
                                            if cause else "") + f"; replay: `{e['counterexample'].get('replay', '')}`.")
         return _record(e["obligation"], "property-test", node, e["status"], sentence,
                        culprits=[{"what": where, "source": src, "text": text}],

@@ -107,9 +107,15 @@ def requirement_record(ws: Any, report: Mapping[str, Any], q: Mapping[str, Any],
         sentence = (f"Requirement {q['id']} (`{check.get('formal')}`, {check.get('source')}) is refuted: the guarantees "
                     "of its cone allow a counterexample, and no single strengthening Z3 tried proves it"
                     + (f". Z3's counterexample: {cex}" if cex else "") + ".")
+    through = _passes_through(ws, report, q, cone)
+    if through:  # the counterexample runs through another node's refuted side condition: say so (issue 64)
+        sentence += " Its counterexample passes through " + "; ".join(
+            f"the failed side condition {sc['id']} ({sc['node']}'s assumption `{sc['conjunct']}`, {sc['source']}, "
+            "is false there)" for sc in through) + "."
     return {"id": str(q["id"]), "kind": "requirement", "node": found[0]["node"] if found else "", "status": "failed",
             "sentence": sentence, "culprits": cul, "counterexample": table,
-            "repairs": [f["repair"] for f in found], "guarantee": None}
+            "repairs": [f["repair"] for f in found], "guarantee": None,
+            "passes_through": [str(sc["id"]) for sc in through]}
 
 
 def _causes(ws: Any, report: Mapping[str, Any], q: Mapping[str, Any], cone: list[str],
@@ -137,6 +143,47 @@ def _causes(ws: Any, report: Mapping[str, Any], q: Mapping[str, Any], cone: list
                 return edit is not None and blame.proved_with(ws, str(q["id"]), edit)
             if cache.get(["consequence", q["id"], check.get("formal"), cone, sc["id"], sc["conjunct"], p, k], proves):
                 out.append((sc, str(p), int(k)))
+    return out
+
+
+def _cex_value(text: Any) -> Any:
+    """A counterexample's value text as a value of :mod:`rclverify.values`
+    (a number or a boolean); ``None`` for anything else."""
+    from fractions import Fraction
+    t = str(text).strip()
+    if t in ("true", "false", "TRUE", "FALSE"):
+        return t.lower() == "true"
+    try:
+        return Fraction(t)
+    except (ValueError, ZeroDivisionError):
+        return None
+
+
+def _passes_through(ws: Any, report: Mapping[str, Any], q: Mapping[str, Any],
+                    cone: list[str]) -> list[Mapping[str, Any]]:
+    """The failed side conditions of ``q``'s cone whose conjunct is false on
+    the consumer's values in ``q``'s counterexample (decided by the
+    monitors' evaluator, :func:`rclverify.logic.decide.decide`): the
+    counterexample passes through them.  A value that does not read, or a
+    conjunct the evaluator cannot decide, counts as not passing."""
+    from ..logic.decide import decide
+    from ..rcl.printer import expr_to_rcl
+    from ..calculus.compose import conjuncts
+    rows = {str(r["node"]): r.get("values") or {} for r in (q.get("check") or {}).get("counterexample") or []}
+    out = []
+    for sc in report.get("side_conditions") or ():
+        node = str(sc.get("node"))
+        if sc.get("status") != "failed" or node not in cone or node not in rows:
+            continue
+        values = {k: _cex_value(v) for k, v in rows[node].items()}
+        try:
+            cn = ws.checked.nodes[node]
+            conj = next((c for a in cn.node.assumes for c in conjuncts(a.formula)
+                         if expr_to_rcl(c) == sc["conjunct"]), None)
+            if conj is not None and None not in values.values() and decide(conj, ws.checked, cn, values)[0] is False:
+                out.append(sc)
+        except Exception:  # noqa: BLE001 - a value or conjunct the evaluator cannot take: not shown to pass
+            continue
     return out
 
 
