@@ -17,10 +17,11 @@ from rclverify.cli import main
 EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "contracts_first"
 
 
-def _verify(ws: Path) -> dict:
-    subprocess.run([sys.executable, "-m", "doit", "verify"], cwd=ws, capture_output=True, text=True, timeout=600)
+def _verify(ws: Path, *extra: str) -> dict:
+    p = subprocess.run([sys.executable, "-m", "doit", "verify", *extra], cwd=ws, capture_output=True, text=True,
+                       timeout=600)
     report = json.loads((ws / "reports" / "assurance.json").read_text())
-    return {o["id"]: o["status"] for o in report["obligations"]}
+    return {**{o["id"]: o["status"] for o in report["obligations"]}, "exit": p.returncode}
 
 
 def test_doit_verify_finds_the_seeded_bug_and_discharges_the_fix(tmp_path: Path, capsys) -> None:
@@ -37,14 +38,15 @@ def test_doit_verify_finds_the_seeded_bug_and_discharges_the_fix(tmp_path: Path,
 
     assert _verify(ws) == {"TempSensor.g1.property_tests.e0": "failed", "TempSensor.g0.monitors.run_jsonl": "failed",
                            "HeaterControl.g1.property_tests.e0": "discharged",
-                           "HeaterControl.g0.monitors.run_jsonl": "discharged"}
+                           "HeaterControl.g0.monitors.run_jsonl": "discharged", "exit": 0}
     logic = ws / "gen" / "temp_sensor" / "temp_sensor" / "logic.py"
     logic.write_text(logic.read_text().replace("kelvin - 273}", "kelvin - 273.15}"))
     subprocess.run([sys.executable, "record_run.py"], cwd=ws, check=True, capture_output=True)
-    assert _verify(ws) == {"TempSensor.g1.property_tests.e0": "discharged",
-                           "TempSensor.g0.monitors.run_jsonl": "discharged",
-                           "HeaterControl.g1.property_tests.e0": "discharged",
-                           "HeaterControl.g0.monitors.run_jsonl": "discharged"}
+    # the fixed thermostat is a correct system: green under --strict (issue 64)
+    assert _verify(ws, "--strict") == {"TempSensor.g1.property_tests.e0": "discharged",
+                                       "TempSensor.g0.monitors.run_jsonl": "discharged",
+                                       "HeaterControl.g1.property_tests.e0": "discharged",
+                                       "HeaterControl.g0.monitors.run_jsonl": "discharged", "exit": 0}
 
 
 def _messages(path: Path) -> list[dict]:

@@ -31,7 +31,7 @@ def plan_fragment(nodes: list[NodePackage], prefix: str, lang: str, rules: Mappi
     ctx = dict(marker=marker, nodes=nodes, pre=pre, lang=lang, max_examples=MAX_EXAMPLES,
                topics=sorted(topics.items()), omitted=omitted)
     return {"rclverify_plan.yaml": env.get_template("plan_fragment.yaml.j2").render(ctx),
-            "rclverify_mapping.yaml": env.get_template("plan_mapping.yaml.j2").render(ctx)}
+            "rclverify_mapping.yaml": env.get_template("plan_mapping.yaml.j2").render(ctx).rstrip("\n") + "\n"}
 
 
 def mapped_topics(nodes: list[NodePackage], rules: Mapping[str, Any] | None
@@ -46,6 +46,7 @@ def mapped_topics(nodes: list[NodePackage], rules: Mapping[str, Any] | None
     ``geometry_msgs/Point``, a ``Twist``) that no mapping rule of the
     workspace narrows to one field; the mapping file says so in a comment,
     naming the entry to write (issue 64)."""
+    from ..traces.mapping import rule_for
     per: dict[str, dict[str, str]] = {}
     omitted: list[dict[str, str]] = []
     for np in nodes:
@@ -63,7 +64,6 @@ def mapped_topics(nodes: list[NodePackage], rules: Mapping[str, Any] | None
             if item not in omitted:
                 omitted.append(item)
         for var, topic in np.unwired:
-            from ..traces.mapping import rule_for
             own = list(rule_for(rules, topic, var).fields) if rules else []
             if len(own) == 1:  # the workspace's mapping names its field: the monitors read it (the node does not)
                 per.setdefault(topic, {}).setdefault(var.split(".", 1)[1], own[0])
