@@ -37,7 +37,7 @@ def test_own_endpoints_only_and_both_checks_pass(code: Path, tmp_path: Path,
     assert "//   publishes /tf (tf2_msgs/TFMessage) (" in limiter and "made by the tf library" in limiter
     assert "contracts/speed_limiter.rcl: publishes /tf (tf2_msgs/TFMessage)" in err
     plan = (ws / "contracts/plan.yaml").read_text()
-    assert "  external:\n    - /speed_limiter/cmd\n    - /undock\n" in plan
+    assert "  external:\n    - /speed_limiter/cmd\n    - /watched\n    - /undock\n" in plan
     assert main(["check", "-w", str(ws)] + sorted(str(p) for p in (ws / "contracts").glob("*.rcl"))) == 0
     assert main(["ros", "check", "-w", str(ws)]) == 0
     assert "grounding: 0 error(s)" in capsys.readouterr().out

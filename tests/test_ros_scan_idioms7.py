@@ -36,6 +36,31 @@ PANEL = '#include <rclcpp/rclcpp.hpp>\n#include <std_msgs/msg/string.hpp>\n#incl
 EMPTY = '#include <rclcpp/rclcpp.hpp>\n#include <std_msgs/msg/string.hpp>\n\nclass Board : public rclcpp::Node\n{\npublic:\n  explicit Board(const rclcpp::NodeOptions & options, const std::string & name = "")\n  : rclcpp::Node(name, options)\n  {\n    pub_ = create_publisher<std_msgs::msg::String>("~/board", 10);\n  }\n  rclcpp::Publisher<std_msgs::msg::String>::SharedPtr pub_;\n};\n\nint main(int argc, char ** argv)\n{\n  rclcpp::init(argc, argv);\n  rclcpp::spin(std::make_shared<Board>(rclcpp::NodeOptions()));\n  return 0;\n}\n'
 HELPERS = '#pragma once\n#include <rclcpp/rclcpp.hpp>\n#include <std_msgs/msg/string.hpp>\n#include <std_srvs/srv/trigger.hpp>\n#include <std_srvs/srv/set_bool.hpp>\n\nnamespace dock\n{\nstruct Bus\n{\n  rclcpp::Publisher<std_msgs::msg::String>::SharedPtr create_publisher(\n    rclcpp::Node * node, const std::string & topic)\n  {\n    return node->create_publisher<std_msgs::msg::String>(topic + "_out", 10);\n  }\n};\n\ntemplate<typename ServiceT>\nclass ClientBase\n{\npublic:\n  ClientBase(rclcpp::Node * node, const std::string & name)\n  {\n    client_ = node->template create_client<ServiceT>(name);\n  }\n  typename rclcpp::Client<ServiceT>::SharedPtr client_;\n};\n\ntemplate<typename ServiceT>\nclass Caller : public ClientBase<ServiceT>\n{\npublic:\n  Caller(rclcpp::Node * node, const std::string & name)\n  : ClientBase<ServiceT>(node, name)\n  {\n  }\n};\n\ntemplate<typename ServiceT>\nclass Server\n{\npublic:\n  template<typename NodeT>\n  Server(NodeT node, const std::string & name)\n  {\n    server_ = node->template create_service<ServiceT>(name, [](auto, auto) {});\n  }\n  Server(rclcpp::Node * node, const std::string & name, int unused)\n  {\n    server_ = node->template create_service<ServiceT>(name + "_never", [](auto, auto) {});\n  }\n  typename rclcpp::Service<ServiceT>::SharedPtr server_;\n};\n\ntemplate class Server<std_srvs::srv::SetBool>;\n}  // namespace dock\n'
 DOCK = '#include <dock/helpers.hpp>\n\nclass DockNode : public rclcpp::Node\n{\npublic:\n  DockNode()\n  : rclcpp::Node("dock_node")\n  {\n    alerts_ = bus_.create_publisher(this, "alerts");\n    undock_ = std::make_unique<dock::Caller<std_srvs::srv::Trigger>>(this, "undock");\n    enable_ = std::make_unique<dock::Server<std_srvs::srv::SetBool>>(this, "enable");\n  }\n  dock::Bus bus_;\n  rclcpp::Publisher<std_msgs::msg::String>::SharedPtr alerts_;\n  std::unique_ptr<dock::Caller<std_srvs::srv::Trigger>> undock_;\n  std::unique_ptr<dock::Server<std_srvs::srv::SetBool>> enable_;\n};\n\nint main(int argc, char ** argv)\n{\n  rclcpp::init(argc, argv);\n  rclcpp::spin(std::make_shared<DockNode>());\n  return 0;\n}\n'
+# two constructor overloads told apart by their number of arguments, the last parameter
+# of each defaulted with a value the scan does not read (rclcpp::SystemDefaultsQoS())
+WATCH = """class Watch
+{
+public:
+  template<typename CallbackT, typename OtherT>
+  Watch(rclcpp::Node * node, const std::string & name, CallbackT && cb, OtherT && other, int depth,
+    const rclcpp::QoS & qos = rclcpp::SystemDefaultsQoS())
+  {
+    sub_ = node->create_subscription<std_msgs::msg::String>(name + "_pair", qos, cb);
+  }
+  template<typename CallbackT>
+  Watch(rclcpp::Node * node, const std::string & name, CallbackT && cb,
+    const rclcpp::QoS & qos = rclcpp::SystemDefaultsQoS())
+  {
+    sub_ = node->create_subscription<std_msgs::msg::String>(name, qos, cb);
+  }
+  rclcpp::Subscription<std_msgs::msg::String>::SharedPtr sub_;
+};
+
+"""
+HELPERS = HELPERS.replace("template class Server", WATCH + "template class Server")
+DOCK = DOCK.replace("  dock::Bus bus_;\n", "  dock::Bus bus_;\n  std::unique_ptr<dock::Watch> watch_;\n").replace(
+    "    enable_ = std::make_unique", "    watch_ = std::make_unique<dock::Watch>(this, \"watched\", "
+    "[](std_msgs::msg::String::SharedPtr) {});\n    enable_ = std::make_unique")
 OPAQUE = """#include <rclcpp/rclcpp.hpp>
 #include <vendor/bus.hpp>
 
@@ -136,9 +161,10 @@ def test_template_types_and_dependent_calls(graph) -> None:  # type: ignore[no-u
 
 def test_an_overload_nobody_calls_makes_no_endpoint(graph) -> None:  # type: ignore[no-untyped-def]
     assert not any(t == "/enable_never" for _r, t, _ty in _edges(graph, "/dock_node"))
+    # three arguments: the overload whose last parameter has a default (its value unread) runs, not the other
     assert _edges(graph, "/dock_node") == {
         ("pub", "/alerts_out", "std_msgs/msg/String"), ("service_servers", "/enable", "std_srvs/srv/SetBool"),
-        ("service_clients", "/undock", "std_srvs/srv/Trigger")}
+        ("service_clients", "/undock", "std_srvs/srv/Trigger"), ("sub", "/watched", "std_msgs/msg/String")}
 
 
 def test_an_explicit_instantiation_is_no_syntax_error(graph) -> None:  # type: ignore[no-untyped-def]

@@ -73,6 +73,7 @@ class Linker(LinkMembers, Values):
         self.calls: list[tuple[Any, ...]] = []
         self.using_ns = sorted({ns for r in self.recs.values() for ns in r.get("using_ns", [])})
         entry_units: set[str] = set()
+        self.optional: dict[str, int] = {k: n for r in self.recs.values() for k, n in r.get("optional", {}).items()}
         for f, r in self.recs.items():
             for k, (unit, params, ptypes, defaults) in r.get("fns", {}).items():
                 old = self.fns.get(k)
@@ -105,25 +106,26 @@ class Linker(LinkMembers, Values):
         self.sites: dict[str, list[tuple[list[Any], dict[str, Any], str | None]]] = {}
         # what runs what: "U:class" (constructed: all its methods run) and "F:function" (called)
         self.edges: dict[str, set[str]] = {}
+        overloaded = {k.split("#")[0] for k in self.fns if "#" in k}  # constructors run only where called
         for k, (unit, *_rest) in self.fns.items():
-            if (unit in self.units or unit == k) and "#" not in k:
+            if (unit in self.units or unit == k) and "#" not in k and k not in overloaded:
                 self._edge(f"U:{unit}", f"F:{k}")
             if unit == k:
                 self._edge(f"F:{k}", f"U:{unit}")
         for c in self.calls:
             kind, callee, args, fkey, unit, _src, kwargs = c
-            ck, cu = self.callee(kind, callee, unit, len(args))
+            ck, cu = self._callee(kind, callee, unit)
             here = f"F:{fkey}" if fkey else f"U:{unit}" if unit else None
             made = kind in ("ctor", "member") or (ck is not None and cu is not None and (
                 ck.endswith(".__init__") or ck == self._ctor(cu)))
             if here is not None and cu is not None and made:
                 self._edge(here, f"U:{cu}")
-            if here is not None and ck is not None:
-                self._edge(here, f"F:{ck}")
-            if ck is not None:
-                self.sites.setdefault(ck, []).append((args, kwargs, fkey))
+            for k in self.overloads(ck, len(args)) if ck is not None else []:
+                if here is not None:
+                    self._edge(here, f"F:{k}")
+                self.sites.setdefault(k, []).append((args, kwargs, fkey))
         for k, (unit, *_rest) in self.fns.items():  # an overload's class made where no call is read: all run
-            if "#" in k and not any(s.split("#")[0] == k.split("#")[0] for s in self.sites):
+            if ("#" in k or k in overloaded) and not any(s.split("#")[0] == k.split("#")[0] for s in self.sites):
                 self._edge(f"U:{unit}", f"F:{k}")
         if prog.instance is not None:  # a plugin's methods its loader calls, given the instance's name
             for k, got in plugins.entry_sites(self.fns, set(prog.units or ()), set(self.sites), prog.instance).items():
@@ -161,9 +163,19 @@ class Linker(LinkMembers, Values):
         ck, cu = self._callee(kind, callee, unit)
         if ck is None or nargs is None:
             return ck, cu
-        over = [k for k in self.fns if k == ck or k.startswith(ck + "#")]
-        fit = [k for k in over if sum(d is None for d in self.fns[k][3]) <= nargs <= len(self.fns[k][1])]
+        fit = self.overloads(ck, nargs)
         return (fit[0] if len(fit) == 1 else ck), cu
+
+    def overloads(self, ck: str, nargs: int) -> list[str]:
+        """The keys of the overloads of ``ck`` (``Cls::Cls``, ``Cls::Cls#N``) a call with
+        ``nargs`` arguments may run: those whose parameters, less the defaulted ones,
+        take that many; when several do (their argument types would decide), all of
+        them; ``[ck]`` when none does or ``ck`` has no overload."""
+        over = [k for k in self.fns if k == ck or k.startswith(ck + "#")]
+        if len(over) <= 1:
+            return [ck]
+        fit = [k for k in over if len(self.fns[k][1]) - self.optional.get(k, 0) <= nargs <= len(self.fns[k][1])]
+        return fit or [ck]
 
     def _callee(self, kind: str, callee: str, unit: str | None) -> tuple[str | None, str | None]:
         if self.py:

@@ -207,6 +207,9 @@ class _File(MemberReader):
             elif t == "call_expression":
                 self.call(n)
         s = self.scope
+        # how many trailing parameters have a default (read or not): which overload a call picks
+        self.out["optional"] = {f.key: sum(d is not None for d in f.defaults)
+                                for f in list(s.decls.values()) + list(s.fns.values())}
         self.out["fns"] = {f.key: (f.unit, f.params, f.ptypes, [s.value(d) for d in f.defaults])
                            for f in list(s.decls.values()) + list(s.fns.values())}
         self.out["aliases"] = self.aliases
