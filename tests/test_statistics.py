@@ -7,8 +7,8 @@ import random
 
 import pytest
 
-from rclverify.evidence.statistics import (count_runs, decide, lower_bound, parse_target, runs_needed, sprt,
-                                           upper_bound)
+from rclverify.evidence.statistics import count_runs, decide, lower_bound, runs_needed, sprt, upper_bound
+from rclverify.plan.target_text import parse_target
 
 
 def binom_cdf(k: int, n: int, p: float) -> float:

@@ -15,8 +15,6 @@ probability that a run (or a judged answer) violates a guarantee:
   Mathematical Statistics 16(2), 1945) of "the rate is at most half the
   target" against "the rate is at least the target", which says when a
   campaign may stop because it has already failed (or passed with margin);
-* :class:`Target` and :func:`parse_target` - a plan's
-  ``violation probability <= 1e-3 at 95 % per run`` as a value;
 * :func:`count_runs` and :func:`decide` - run rows counted once per digest,
   and the target's verdict on them.
 
@@ -28,9 +26,8 @@ scipy only: this sits with the evidence records, below every stage.
 from __future__ import annotations
 
 import math
-import re
 from dataclasses import dataclass
-from typing import Any, Iterable, Mapping
+from typing import Any, Iterable, Mapping, Protocol
 
 #: What a target counts: a whole run with any violation, or one judged answer.
 PER = ("run", "answer")
@@ -130,48 +127,24 @@ def sprt(k: int, n: int, target: float, level: float) -> Sprt:
     return Sprt(llr, accept_at, reject_at, good, bad, decision, int(more))
 
 
-@dataclass(frozen=True)
-class Target:
-    """A plan's target: the violation probability ``bound`` (0 < bound < 1)
-    at confidence ``level`` (0 < level < 1), counted ``per`` run or per
-    judged answer; ``text`` as written."""
+class TargetLike(Protocol):
+    """What :func:`decide` reads of a target (the plan's
+    :class:`rclverify.plan.targets.Target`): the violation probability
+    ``bound``, the confidence ``level``, ``per`` run or answer, and its
+    words and JSON form."""
 
-    bound: float
-    level: float
-    per: str
-    text: str
+    @property
+    def bound(self) -> float: ...
 
-    def to_json(self) -> dict[str, Any]:
-        return {"bound": self.bound, "level": self.level, "per": self.per, "text": self.text}
+    @property
+    def level(self) -> float: ...
 
-    def words(self) -> str:
-        """``violation probability <= 0.001 at 95 % per run`` (normalised)."""
-        return f"violation probability <= {self.bound:g} at {self.level * 100:g} % per {self.per}"
+    @property
+    def per(self) -> str: ...
 
+    def words(self) -> str: ...
 
-_NUMBER = r"(?:\d+(?:\.\d*)?|\.\d+)(?:[eE][-+]?\d+)?"
-_TARGET = re.compile(rf"^\s*violation\s+probability\s*<=\s*({_NUMBER})\s*(%?)\s+at\s+({_NUMBER})\s*(%?)"
-                     rf"(?:\s+per\s+(\w+))?\s*$")
-
-
-def parse_target(text: str) -> Target:
-    """``violation probability <= 1e-3 at 95 % per run`` (``per answer``;
-    ``per run`` when left out; the bound and the level as a fraction or a
-    percentage with ``%``).  Raises ``ValueError`` with the reason."""
-    m = _TARGET.match(text) if isinstance(text, str) else None
-    if m is None:
-        raise ValueError(f"a target reads 'violation probability <= 1e-3 at 95 % per run' (or per answer), "
-                         f"not {text!r}")
-    bound = float(m.group(1)) / (100.0 if m.group(2) else 1.0)
-    level = float(m.group(3)) / (100.0 if m.group(4) else 1.0)
-    per = m.group(5) or "run"
-    if per not in PER:
-        raise ValueError(f"a target counts per run or per answer, not per {per!r}")
-    if not 0.0 < bound < 1.0:
-        raise ValueError(f"a target's violation probability is between 0 and 1 (exclusive), not {m.group(1)}{m.group(2)}")
-    if not 0.5 <= level < 1.0:
-        raise ValueError(f"a target's confidence level is at least 50 % and below 100 %, not {m.group(3)}{m.group(4)}")
-    return Target(bound, level, per, " ".join(text.split()))
+    def to_json(self) -> dict[str, Any]: ...
 
 
 #: The fields of one run row that :func:`count_runs` adds up.
@@ -225,7 +198,7 @@ def trials(counts: Mapping[str, Any], per: str) -> tuple[int, int, int]:
     return int(counts["runs"]), int(counts["violating_runs"]), int(counts["undecided_runs"])
 
 
-def decide(counts: Mapping[str, Any], target: Target) -> dict[str, Any]:
+def decide(counts: Mapping[str, Any], target: TargetLike) -> dict[str, Any]:
     """The target's verdict on ``counts`` (:func:`count_runs`).  Undecided
     runs or answers count as violations for the bound (never a guess in the
     target's favour).  Returns ``{"status", "explanation", "n", "k",
@@ -266,5 +239,5 @@ def decide(counts: Mapping[str, Any], target: Target) -> dict[str, Any]:
     return out
 
 
-__all__ = ["PER", "Sprt", "Target", "count_runs", "decide", "lower_bound", "parse_target", "runs_needed", "sprt",
-           "trials", "upper_bound"]
+__all__ = ["PER", "Sprt", "TargetLike", "count_runs", "decide", "lower_bound", "runs_needed", "sprt", "trials",
+           "upper_bound"]

@@ -10,7 +10,7 @@ from fractions import Fraction
 from pathlib import Path
 from typing import Any, Mapping
 
-from ..evidence.statistics import Target
+from .target_text import Target
 from ..rcl import ast
 from .formal import Source
 from .acknowledged import Acknowledgement

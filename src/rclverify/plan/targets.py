@@ -23,7 +23,7 @@ from __future__ import annotations
 import re
 from typing import Any, Mapping
 
-from ..evidence.statistics import Target, parse_target
+from .target_text import Target, parse_target
 from ..rcl import ast
 from ..rcl.errors import Diagnostic
 from .errors import plan_error
