@@ -15,7 +15,7 @@
 """
 from __future__ import annotations
 
-from typing import Any, Iterable, Mapping
+from typing import Any, Mapping
 
 from ..evidence.statistics import count_runs, decide, upper_bound
 from ..plan.model import Plan
@@ -142,21 +142,4 @@ def annotate_statistics(report: dict[str, Any], plan: Plan, targets: Mapping[str
     return table
 
 
-def words(rows: Iterable[Mapping[str, Any]]) -> list[str]:
-    """One line per row of the table, for the terminal and the Markdown report."""
-    out = []
-    for r in rows:
-        c = r.get("counts") or {}
-        who = r.get("requirement") or r.get("node")
-        bound = r.get("bound")
-        b = "no bound" if bound is None else f"{float(r.get('level') or LEVEL) * 100:g} % upper bound {bound:.3g}"
-        line = f"{who} under {r.get('environment')}: {c.get('runs', 0)} run(s), {c.get('violating_runs', 0)} violating; {b}"
-        if r.get("target"):
-            line += f"; target {r['target']}: {r.get('status')}"
-            if r.get("status") != "discharged" and r.get("runs_needed") is not None:
-                line += f" ({r['runs_needed']} further clean run(s) needed, SPRT {r.get('sprt')})"
-        out.append(line)
-    return out
-
-
-__all__ = ["LEVEL", "annotate_statistics", "compact", "requirement_statistics", "words"]
+__all__ = ["LEVEL", "annotate_statistics", "compact", "requirement_statistics"]
