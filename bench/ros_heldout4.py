@@ -4,7 +4,8 @@ scan (``bench/data/ros_heldout4_*.json``), a *train* split looked at while
 developing and a *held-out* split that was not.
 
 A truth file is ``ros_heldout.py``'s (repository, branch, commit, ``scan``)
-plus ``split`` (``train``/``heldout``), ``own`` (the directories whose nodes
+plus ``split`` (``train``, ``heldout``, ``heldout-b``: a second held-out split counted and
+measured after the development had ended), ``own`` (the directories whose nodes
 are judged) and ``library`` (names of endpoints the client library or a
 framework base class makes on every node, such as the lifecycle management
 services: neither counted as sites nor judged; a leading ``*`` matches any
@@ -25,7 +26,7 @@ scanned in < 2 s.  Figures are printed, not asserted.
 
 Usage::
 
-    PYTHONPATH=src python3 bench/ros_heldout4.py --root DIR [--split train|heldout] [--verbose]
+    PYTHONPATH=src python3 bench/ros_heldout4.py --root DIR [--split train|heldout|heldout-b] [--verbose]
 
 where ``DIR/NAME`` holds ``git archive COMMIT SCAN... | tar -x`` of the
 truth file ``ros_heldout4_NAME.json`` (no upstream code is kept here).
@@ -119,7 +120,7 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--root", type=Path, required=True, help="directory holding one extracted tree per truth file")
     ap.add_argument("--verbose", action="store_true", help="list every site missed and every wrong edge")
-    ap.add_argument("--split", choices=("train", "heldout"), help="measure only this split")
+    ap.add_argument("--split", choices=("train", "heldout", "heldout-b"), help="measure only this split")
     a = ap.parse_args()
     totals: dict[str, dict[str, float]] = {}
     for path in sorted(DATA.glob("ros_heldout4_*.json")):
