@@ -209,3 +209,16 @@ def test_the_live_monitor_counts_as_it_goes_and_its_log_counts_as_a_live_run(tmp
     st = ev.details["statistics"]
     assert ev.status == "discharged" and st["counts"]["runs"] == 1 and st["counts"]["duplicates"] == 1
     assert {r["recorded"] for r in st["runs"]} == {"live"} and st["counts"]["answers"] == 40
+
+
+def test_every_bad_key_of_a_counting_entry_is_one_located_error(tmp_path: Path) -> None:
+    _ws(tmp_path, [], {})
+    (tmp_path / "contracts/plan.yaml").write_text(
+        "contracts: [contracts/sys.rcl]\nnodes:\n  Clamp:\n    evidence:\n      - backend: monitors\n"
+        "        target: 0.05\n        environment: two words\n        origin: field\n")
+    with pytest.raises(PlanError) as exc:
+        _ = Workspace(tmp_path).checked
+    text = str(exc.value)
+    assert "plan.yaml:6:17: error: a target is a text such as" in text and "not 0.05" in text
+    assert "plan.yaml:7:22: error: an environment tag is a name" in text
+    assert "plan.yaml:8:17: error: a run set's origin is one of operation, simulation, harness, not 'field'" in text

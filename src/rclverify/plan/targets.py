@@ -88,10 +88,14 @@ def _entry_problems(e: EvidenceEntry, at: Any) -> list[Diagnostic]:
     if e.backend not in COUNTING:  # another backend's entry: its unknown keys are reported by the loader
         return out
     if "target" in c:
-        try:
-            parse_target(c["target"] if isinstance(c["target"], str) else "")
-        except ValueError as exc:
-            bad("target", str(exc))
+        if not isinstance(c["target"], str):
+            bad("target", f"a target is a text such as 'violation probability <= 1e-3 at 95 % per run', not "
+                          f"{c['target']!r}")
+        else:
+            try:
+                parse_target(c["target"])
+            except ValueError as exc:
+                bad("target", str(exc))
     if "environment" in c and not (isinstance(c["environment"], str) and _TAG.match(c["environment"])):
         bad("environment", f"an environment tag is a name of letters, digits, '_', '.' or '-' (at most 64), not "
                            f"{c['environment']!r}")
