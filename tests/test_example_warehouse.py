@@ -254,11 +254,13 @@ def test_with_all_five_fixed_only_the_unverified_progress_claim_remains(runs: di
     verdicts = {q["id"]: q["verdict"] for q in report["requirements"]}
     assert verdicts == {"STOP": "met", "DOCK": "met", "SPEED": "met", "ARRIVE": "proved, evidence outstanding"}
     arrive = next(q for q in report["requirements"] if q["id"] == "ARRIVE")
-    assert "Planner progress (declared, not verified)" in arrive["note"]
+    # the progress declarations are judged on the run now (issue 64); the Planner's initial result is not:
+    # its first result answers a goal, and nodes/planner.py gives no initial outputs to the property tests
+    assert "Planner initially 1 (declaration, inconclusive" in arrive["note"] and "progress" not in arrive["note"]
     assert all(o["status"] == "discharged" for o in report["obligations"])
     assert not [f for f in report["findings"] if f["status"] not in ("ok",)]
-    assert rc == 1  # --strict: ARRIVE is not met until a backend checks the declared progress
-    assert report["summary"]["status"] == "pending"
+    assert rc == 1  # --strict: ARRIVE is not met until a backend checks the declared initial result
+    assert report["summary"]["status"] == "inconclusive"  # the run could not judge it
     assert report["summary"]["headline"].startswith("21 obligations: 21 discharged; 12/12 side conditions discharged")
 
 
