@@ -24,8 +24,9 @@ them incremental.
     are the simulator's, in the same order but for same-time ties, up to
     the float32 of the ranges.
 (d) with all five fixed, no problem row is left and ``--strict`` fails only
-    on ARRIVE, proved with evidence outstanding (the declared progress is a
-    claim no backend checks yet).
+    on ARRIVE, proved with evidence outstanding (the Planner's declared
+    initial result is a claim its run cannot show, its first result
+    answering a goal, and its implementation gives no initial outputs).
 Real Z3, Hypothesis and doit; nothing of the example is edited in place.
 """
 from __future__ import annotations
