@@ -102,11 +102,14 @@ def test_targets_parse_and_bad_ones_say_why() -> None:
     t = parse_target("violation probability <= 1e-3 at 95 % per answer")
     assert (t.bound, t.level, t.per) == (0.001, 0.95, "answer")
     t = parse_target("violation probability <= 1% at 0.99")
-    assert (t.bound, t.level, t.per) == (0.01, 0.99, "run")
+    assert (t.bound, t.level, t.per, t.guarantee) == (0.01, 0.99, "run", 0)
+    t = parse_target("violation probability <= 2e-3 at 99 % per answer of guarantee 2")
+    assert (t.per, t.guarantee) == ("answer", 2) and t.words().endswith("per answer of guarantee 2")
     for bad, why in [("violation probability < 1e-3 at 95 %", "a target reads"),
                      ("violation probability <= 1e-3 at 95 % per hour", "per run or per answer"),
                      ("violation probability <= 0 at 95 %", "between 0 and 1"),
-                     ("violation probability <= 0.1 at 100 %", "below 100 %")]:
+                     ("violation probability <= 0.1 at 100 %", "below 100 %"),
+                     ("violation probability <= 0.1 at 95 % per run of guarantee 0", "1-based")]:
         with pytest.raises(ValueError, match=why):
             parse_target(bad)
 

@@ -222,3 +222,31 @@ def test_every_bad_key_of_a_counting_entry_is_one_located_error(tmp_path: Path) 
     assert "plan.yaml:6:17: error: a target is a text such as" in text and "not 0.05" in text
     assert "plan.yaml:7:22: error: an environment tag is a name" in text
     assert "plan.yaml:8:17: error: a run set's origin is one of operation, simulation, harness, not 'field'" in text
+
+
+def test_a_target_of_one_guarantee_counts_that_guarantee_alone(tmp_path: Path) -> None:
+    _ws(tmp_path, [], {})
+    (tmp_path / "contracts/sys.rcl").write_text(RCL.replace("guarantee( out.x <= 30 )",
+                                                            "guarantee( out.x <= 30 )\n  guarantee( out.x >= 0 )"))
+    (tmp_path / "runs").mkdir()
+    for i in range(60):
+        lines = [{"topic": "a", "time": 10.0 + i, "data": 1.0},
+                 {"topic": "x", "time": 10.01 + i, "data": -1.0 if i == 7 else 5.0}]  # run 7 breaks guarantee 2
+        (tmp_path / f"runs/r{i:02d}.jsonl").write_text("".join(json.dumps(x) + "\n" for x in lines))
+    traces = _traces(tmp_path, "runs")
+    five = "violation probability <= 5 % at 95 % per run"
+    entries = [{"backend": "monitors", "traces": traces, "environment": "e", "target": f"{five} of guarantee 1"},
+               {"backend": "monitors", "traces": traces, "environment": "f", "target": f"{five} of guarantee 2"}]
+    (tmp_path / "contracts/plan.yaml").write_text(json.dumps({"contracts": ["contracts/sys.rcl"],
+                                                              "nodes": {"Clamp": {"evidence": entries}}}))
+    ws = Workspace(tmp_path)
+    one, ev1, _ = _runset(ws, 0)
+    two, ev2, _ = _runset(ws, 1)
+    assert (one.id, one.guarantee, two.id) == ("Clamp.g1.monitors.runs_e_e0", 1, "Clamp.g2.monitors.runs_f_e1")
+    assert ev1.status == "discharged" and ev1.details["statistics"]["decision"]["k"] == 0
+    assert ev2.status == "pending" and ev2.details["statistics"]["decision"]["k"] == 1
+    entries[0]["target"] = f"{five} of guarantee 3"
+    (tmp_path / "contracts/plan.yaml").write_text(json.dumps({"contracts": ["contracts/sys.rcl"],
+                                                              "nodes": {"Clamp": {"evidence": entries}}}))
+    with pytest.raises(PlanError, match="Clamp has 2 guarantee.s.; there is no guarantee 3"):
+        _ = Workspace(tmp_path).checked

@@ -331,7 +331,7 @@ def resolve(plan: Plan, checked: Checked) -> None:
             for key, msg in unknown_key_messages(e.backend, e.config):
                 path = ("nodes", node, "evidence", e.index, key)
                 bad(plan.locs.get(path + (KEY,), plan.locs.get(path, e.loc)), msg)
-    diags.extend(check_targets(plan))  # statistical targets, environment tags, run origins (docs/statistics.md)
+    diags.extend(check_targets(plan, checked))  # statistical targets, environment tags, run origins (docs/statistics.md)
     # The backends' own check-time validation (experiment data and criteria,
     # review records, trace mappings) is run by the layer above both
     # (rclverify.pipeline.Workspace.checked calls backends.entry_checks), so

@@ -3,8 +3,9 @@
 A ``monitors`` or ``experiment`` evidence entry may state
 
 ``target``       ``violation probability <= 1e-3 at 95 % per run`` (or
-                 ``per answer``): the runs of the entry must bound the
-                 probability of a violation by it (:mod:`rclverify.evidence.statistics`);
+                 ``per answer``; ``of guarantee K`` for one guarantee): the
+                 runs of the entry must bound the probability of a violation
+                 by it (:mod:`rclverify.evidence.statistics`);
 ``environment``  the operating conditions its runs cover, a tag
                  (``warehouse_day``); runs under different tags are never
                  pooled into one bound;
@@ -26,6 +27,7 @@ from typing import Any, Mapping
 from .target_text import Target, parse_target
 from ..rcl import ast
 from ..rcl.errors import Diagnostic
+from ..rcl.types import Checked
 from .errors import plan_error
 from .model import EvidenceEntry, Plan
 
@@ -75,10 +77,13 @@ def requirement_target(text: Any, loc: ast.Loc) -> Target | None:
     if t.per != "run":
         raise plan_error(loc.file, loc.line, loc.col, "a requirement's target counts per run (a run gives the "
                                                       "requirement one verdict), not per answer")
+    if t.guarantee:
+        raise plan_error(loc.file, loc.line, loc.col, "a requirement's target is about the requirement: 'of "
+                                                      "guarantee K' belongs on a node's evidence entry")
     return t
 
 
-def _entry_problems(e: EvidenceEntry, at: Any) -> list[Diagnostic]:
+def _entry_problems(e: EvidenceEntry, at: Any, guarantees: int | None) -> list[Diagnostic]:
     out: list[Diagnostic] = []
 
     def bad(key: str, msg: str) -> None:
@@ -93,9 +98,15 @@ def _entry_problems(e: EvidenceEntry, at: Any) -> list[Diagnostic]:
                           f"{c['target']!r}")
         else:
             try:
-                parse_target(c["target"])
+                t = parse_target(c["target"])
             except ValueError as exc:
                 bad("target", str(exc))
+            else:
+                if e.backend == "experiment" and t.guarantee:
+                    bad("target", "an experiment entry's target is about the entry's guarantee: leave out "
+                                  "'of guarantee K'")
+                elif guarantees is not None and t.guarantee > guarantees:
+                    bad("target", f"{e.node} has {guarantees} guarantee(s); there is no guarantee {t.guarantee}")
     if "environment" in c and not (isinstance(c["environment"], str) and _TAG.match(c["environment"])):
         bad("environment", f"an environment tag is a name of letters, digits, '_', '.' or '-' (at most 64), not "
                            f"{c['environment']!r}")
@@ -104,15 +115,18 @@ def _entry_problems(e: EvidenceEntry, at: Any) -> list[Diagnostic]:
     return out
 
 
-def check_targets(plan: Plan) -> list[Diagnostic]:
+def check_targets(plan: Plan, checked: Checked | None = None) -> list[Diagnostic]:
     """Located errors for every evidence entry's ``target``,
-    ``environment`` and ``origin`` that does not read (module docstring)."""
+    ``environment`` and ``origin`` that does not read, and (with the
+    ``checked`` contracts) a target's guarantee the node does not have
+    (module docstring)."""
     out: list[Diagnostic] = []
     for node, entries in plan.evidence.items():
+        n = checked.nodes.get(node) if checked is not None else None
         for e in entries:
             def at(key: str, e: EvidenceEntry = e) -> ast.Loc:
                 return plan.locs.get(("nodes", node, "evidence", e.index, key), e.loc)
-            out.extend(_entry_problems(e, at))
+            out.extend(_entry_problems(e, at, len(n.node.guarantees) if n is not None else None))
     return out
 
 

@@ -92,28 +92,48 @@ def run_counts(root: Path, config: Any, trace: str, sha: str, res: NodeResult, s
             "per_guarantee_complete": not res.violations_dropped}
 
 
+def of_guarantee(row: dict[str, Any], k: int) -> dict[str, Any]:
+    """A run's counts for guarantee ``k`` alone: its violations of ``k``; a
+    violation the run did not attribute to one guarantee (a missed deadline
+    or period, a failed call, or one beyond the violations the record kept)
+    is an undecided answer of ``k``, never a clean one."""
+    per = row.get("violations_per_guarantee") or {}
+    attributed = sum(int(v) for v in per.values())
+    unattributed = max(0, int(row.get("violations") or 0) - attributed)
+    return {**row, "violations": int(per.get(str(k), 0)),
+            "inconclusive": int(row.get("inconclusive") or 0) + unattributed}
+
+
 def runset_obligations(target: NodeTarget, traces: list[str], per_trace: list[Obligation]) -> list[Obligation]:
     """The run-set obligation of an entry with a ``target:`` (``[]`` without one or without traces)."""
     t = entry_target(target.config)
     if t is None:
         return []
     env = entry_environment(target.config)
-    oid = make_obligation_id(target.node.name, 0, "monitors", f"runs_{env}_e{target.index}")
+    k = t.guarantee  # 0: the whole contract
+    oid = make_obligation_id(target.node.name, k, "monitors", f"runs_{env}_e{target.index}")
+    what = f"guarantee {k}" if k else "its contract"
     statement = (f"the runs of {target.node.name} recorded under {env} bound the probability that a "
-                 f"{t.per} violates its contract: {t.words()}")
+                 f"{t.per} violates {what}: {t.words()}")
     data = {"trace": "", "run_set": list(traces), "target": t.to_json(), "environment": env}
     if not per_trace:  # a target and no run: pending, never silently dropped
-        loc, f = target.node.node.loc, Path(target.node.node.loc.file)
+        loc = target.node.node.guarantees[k - 1].loc if k else target.node.node.loc
+        f = Path(loc.file)
         if f.is_absolute() and f.resolve().is_relative_to(target.root.resolve()):
             f = f.resolve().relative_to(target.root.resolve())
-        return [Obligation(id=oid, node=target.node.name, guarantee=0, backend="monitors", kind="monitoring",
+        return [Obligation(id=oid, node=target.node.name, guarantee=k, backend="monitors", kind="monitoring",
                            statement=statement, source=SourceRef(f.as_posix(), loc.line, loc.col),
                            instance=f"runs_{env}_e{target.index}",
                            inputs=tuple(sorted({*target.contract_files, target.plan_file})), data=data)]
     first = per_trace[0]
     inputs = sorted({i for o in per_trace for i in o.inputs})
-    return [dataclasses.replace(first, id=oid, statement=statement, instance=f"runs_{env}_e{target.index}",
-                                inputs=tuple(inputs), data={**first.data, **data})]
+    source = first.source
+    if k:
+        g = target.node.node.guarantees[k - 1].loc
+        source = SourceRef(first.source.file, g.line, g.col)
+    return [dataclasses.replace(first, id=oid, guarantee=k, source=source, statement=statement,
+                                instance=f"runs_{env}_e{target.index}", inputs=tuple(inputs),
+                                data={**first.data, **data})]
 
 
 def run_runset(check_one: Callable[[Obligation, NodeTarget], Evidence], obligation: Obligation,
@@ -140,7 +160,7 @@ def run_runset(check_one: Callable[[Obligation, NodeTarget], Evidence], obligati
         rows.append(stats if isinstance(stats, dict) else
                     {"trace": trace, "sha256": f"unread:{trace}", "status": ev.status, "answers": 0,
                      "violations": 0, "inconclusive": 0, "seconds": 0.0, "reason": ev.explanation})
-    counted = [] if origin == "harness" else rows
+    counted = [] if origin == "harness" else [of_guarantee(r, t.guarantee) for r in rows] if t.guarantee else rows
     counts = count_runs(counted)
     verdict = decide(counts, t)
     status, explanation = verdict["status"], f"under {env}: {verdict['explanation']}"
