@@ -110,9 +110,10 @@ def test_unacknowledged_warnings_fail_strict_and_offer_the_entry(gain_ws):
     assert f"sha256: {f['sha256'][:16]}" in html  # the entry to paste, for a warning not yet answered
 
 
-def test_acknowledged_warnings_pass_strict_with_their_reasons_everywhere(gain_ws):
+def test_acknowledged_warnings_pass_strict_with_their_reasons_everywhere(gain_ws, capfd):
     rc, report = _verify(gain_ws, PLAN + ACKS, strict=True)
     assert rc == 0 and report["meta"]["strict_ok"]
+    assert "accepted risks: 2 warnings acknowledged in the plan: Gain.g1.c2.redundant" in capfd.readouterr().out
     assert [a["status"] for a in report["acknowledgements"]] == ["ok", "ok"]
     [f] = [f for f in report["findings"] if f["id"] == "Gain.g1.c2.redundant"]
     assert f["status"] == "warning" and f["acknowledged"]["at"] == "contracts/plan.yaml:8:5"

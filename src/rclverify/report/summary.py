@@ -129,7 +129,10 @@ def summary_data(report: Mapping[str, Any]) -> dict[str, Any]:
                                                  if m.get("consequence_of") else "") for m in g.get("members", [])],
                           "repairs": len(g.get("repairs", []))}
                          for g in report.get("problems", ())],
-            "grounding": _grounding(report.get("grounding")), "strict": strict_reasons(report)}
+            "grounding": _grounding(report.get("grounding")), "strict": strict_reasons(report),
+            # warnings answered in the plan (plan/acknowledged.py): named, so an accepted risk is never silent
+            "acknowledged": [f"{m} ({a['at']}: {a['reason']})" for a in report.get("acknowledgements") or ()
+                             if a.get("status") == "ok" for m in a.get("matched") or ()]}
 
 
 def group_sentence(group: Mapping[str, Any]) -> str:
@@ -364,5 +367,9 @@ def print_last_run(root: Path) -> dict[str, Any]:
         print(requirements_line(data["requirements"]))
     if data.get("deadlines"):
         print(deadlines_line(data["deadlines"]))
+    acks = list(data.get("acknowledged") or [])
+    if acks:
+        print(f"accepted risks: {len(acks)} warning{'s' if len(acks) != 1 else ''} acknowledged in the plan: "
+              + "; ".join(acks[:3]) + ("; ..." if len(acks) > 3 else ""))
     print_summary(data, "reports/assurance.html", rows=data["rows"])
     return data
