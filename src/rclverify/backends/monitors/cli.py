@@ -296,13 +296,16 @@ def live_command(args: argparse.Namespace, checked: Any, cfg: Any, root: Path) -
         print(f"deadlines: {d['node']}: {d['status']}: {d['explanation']}")
     for d in record_.get("periods", []):
         print(f"periods: {d['node']}: {d['status']}: {d['explanation']}")
+    for d in record_.get("declarations", []):
+        print(f"declarations: {d['node']}: {d['status']}: {d['explanation']}")
     for topic, c in record_.get("enforce", {}).items():
         print(f"enforce /{topic}: {c['released']} released, {c['blocked']} blocked (read from {c['private']})")
     if "bag" in record_:
         print(f"recorded {record_['bag']['messages']} message(s) to {record_['bag']['path']}")
     _print_not_judged(record_.get("not_judged", []), "")
     late = bool(record_.get("deadlines", {}).get("false"))
-    late = late or any(d["status"] == "failed" for d in record_.get("topic_deadlines", []) + record_.get("periods", []))
+    late = late or any(d["status"] == "failed" for d in record_.get("topic_deadlines", []) + record_.get("periods", [])
+                       + record_.get("declarations", []))
     calls_failed = any(n["status"] == "failed" for n in record_.get("calls", {}).get("nodes", []))
     if late or calls_failed or any(n["status"] == "failed" for n in record_["nodes"]):
         return 1
