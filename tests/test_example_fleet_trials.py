@@ -67,3 +67,16 @@ def test_the_simulation_writes_the_committed_runs(tmp_path: Path) -> None:
         ours = sorted(p.name for p in (EXAMPLE / "runs" / env).iterdir())
         assert ours == sorted(p.name for p in (tmp_path / env).iterdir())
         assert all((EXAMPLE / "runs" / env / n).read_bytes() == (tmp_path / env / n).read_bytes() for n in ours)
+
+
+def test_an_edited_run_is_not_counted_until_checked_again(ws: Path) -> None:
+    """Last in this module: it edits a run of the copy.  The report reads that run's record as stale: its counts
+    leave the group's bound and the run set's record is stale too."""
+    run = ws / "runs/warehouse_day/warehouse_day_007.jsonl"
+    run.write_text(run.read_text() + '{"topic": "requested", "time": 1800007000.0, "data": 0.5}\n')
+    assert main(["report", "-w", str(ws)]) == 0
+    r = _report(ws)
+    day = next(s for s in r["statistics"] if s["kind"] == "runs" and s["environment"] == "warehouse_day")
+    assert day["counts"]["runs"] == 59
+    target = next(s for s in r["statistics"] if s["kind"] == "target" and s["environment"] == "warehouse_day")
+    assert target["status"] == "stale"

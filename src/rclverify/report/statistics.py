@@ -6,7 +6,8 @@
   monitored runs grouped by node, environment tag and origin (each run
   counted once, by its content digest; never a bound across two tags),
   with the one-sided 95 % Clopper-Pearson bound on the probability that a
-  run violates the node's contract; beside them every target's row (the
+  run violates the node's contract (a stale or altered record's counts
+  are left out); beside them every target's row (the
   run sets' and the experiments' records); and each requirement's runs
   grouped by the tags of the entries that recorded them, decided against
   its ``target`` when it states one.  Each per-run evidence row gets its
@@ -23,6 +24,8 @@ from ..plan.targets import UNSTATED, entry_environment, entry_origin
 
 #: The level of a bound drawn where the plan states no target.
 LEVEL = 0.95
+#: Report statuses whose record's counts are not believed: made from other inputs, or altered (docs/integrity.md).
+_UNBELIEVED = ("stale", "error")
 
 
 def compact(stats: Mapping[str, Any]) -> dict[str, Any]:
@@ -122,13 +125,14 @@ def annotate_statistics(report: dict[str, Any], plan: Plan, targets: Mapping[str
             continue
         if "decision" in s:
             table.append(_target_row(e))
-        elif e.get("backend") == "monitors" and "sha256" in s:
+        elif e.get("backend") == "monitors" and "sha256" in s and e.get("status") not in _UNBELIEVED:
             key = (_node(str(e.get("obligation"))), str(s.get("environment", UNSTATED)), str(s.get("origin", "operation")))
             groups.setdefault(key, []).append(s)
     by_key = {key: _group_row(*key, rows) for key, rows in groups.items()}
     for e in report.get("evidence", []):
         s = e.get("statistics")
-        if isinstance(s, dict) and "decision" not in s and e.get("backend") == "monitors" and "sha256" in s:
+        if isinstance(s, dict) and "decision" not in s and e.get("backend") == "monitors" and "sha256" in s \
+                and e.get("status") not in _UNBELIEVED:
             g = by_key[(_node(str(e.get("obligation"))), str(s.get("environment", UNSTATED)),
                         str(s.get("origin", "operation")))]
             s["group"] = {"runs": g["counts"]["runs"], "bound": g["bound"], "level": LEVEL}
