@@ -42,6 +42,8 @@ def test_the_day_meets_the_target_and_the_night_says_how_many_runs_it_needs(ws: 
     bench = groups["lab_bench"]  # recorded live from real ROS 2 nodes (record_live.py): operation, no target
     assert (bench["recorded"], bench["origin"], bench["counts"]["answers"]) == ({"live": 10}, "operation", 200)
     assert bench["bound"] == pytest.approx(1 - 0.05 ** (1 / 10))
+    run = next(e for e in r["evidence"] if e["obligation"].endswith("lab_bench_003_jsonl"))
+    assert run["strength"]["kind"] == "observed" and run["strength"]["doubt"] == pytest.approx(bench["bound"])
     (g1,) = [g for n in r["nodes"] for g in n["guarantees"]]
     assert g1["strength"]["kind"] == "statistical" and g1["strength"]["doubt"] == pytest.approx(day["bound"])
     (req,) = r["requirements"]
