@@ -218,3 +218,6 @@ def test_a_run_of_a_generated_node_names_its_handler(tmp_path: Path) -> None:
     assert f"returns early at line {early}" in d["sentence"] and "called for in.estop" in d["culprits"][0]["what"]
     row = next(g for g in report["problems"] if d["id"] in [m["id"] for m in g["members"]])
     assert row["key"] == [f"line:{where}"]  # the handler, not the contract
+    assert row["culprits"][0]["node"] == "ArmDriver"  # the node whose code it is: marked a culprit
+    from rclverify.report.culprits import culprit_nodes
+    assert culprit_nodes(report["problems"]) == {"ArmDriver"}

@@ -13,8 +13,8 @@ from ..evidence.records import SEVERITY, worst
 
 def culprit_nodes(groups: Iterable[Any]) -> set[str]:
     """The nodes a problem's culprit (``groups``: the problems by root cause)
-    is a guarantee or the contract of (``guarantee:Node:k``,
-    ``contract:Node``; issue 48: the dashboard marks them, so that the first
+    is a guarantee, the contract or a line of the code of (``guarantee:Node:k``,
+    ``contract:Node``, a ``line:`` with its ``node``; issue 48: the dashboard marks them, so that the first
     screen blames the culprit, not its victims)."""
     out = set()
     for g in groups:
@@ -26,6 +26,8 @@ def culprit_nodes(groups: Iterable[Any]) -> set[str]:
             kind, _, rest = str(c.get("id", "")).partition(":")
             if kind in ("guarantee", "contract") and rest:
                 out.add(rest.split(":", 1)[0])
+            elif kind == "line" and c.get("node"):  # a line of the node's code (problems.py)
+                out.add(str(c["node"]))
     return out
 
 
@@ -43,7 +45,8 @@ def mark_culprits(report: dict[str, Any]) -> None:
     problem (issue 64: a culprit never reads "discharged"; its own evidence
     may all hold, the problem it causes does not).  For each row of
     ``report["problems"]`` (:func:`rclverify.report.problems.group_problems`)
-    and each culprit ``guarantee:Node:k`` or ``contract:Node`` of it, the
+    and each culprit ``guarantee:Node:k`` or ``contract:Node`` of it (or a
+    program line with its ``node``), the
     node's ``status`` (and the guarantee's) becomes the worse of its own and
     the row's, and ``culprit_of`` lists ``{"status", "sentence"}`` of the rows
     that name it.  Changes ``report`` in place; a row without culprits, or
@@ -56,6 +59,8 @@ def mark_culprits(report: dict[str, Any]) -> None:
         for c in g.get("culprits") or ():
             kind, _, rest = str(c.get("id", "")).partition(":")
             name, _, k = rest.partition(":")
+            if kind == "line":  # a line of a node's code: the node, no guarantee (problems.py)
+                kind, name = "contract", str(c.get("node") or "")
             n = nodes.get(name)
             if kind not in ("guarantee", "contract") or n is None:
                 continue

@@ -237,7 +237,8 @@ def group_problems(report: Mapping[str, Any], items: Sequence[Mapping[str, Any]]
         {"key": [root culprit ids], "status": worst member status,
          "sentence": the first sentence (first_sentence) of the diagnosis of a member with
                      the worst status: the most telling kind (_TELLING), then the shortest,
-         "culprits": [{"id", "what", "source", "file", "anchor" (fragment id or "")}],
+         "culprits": [{"id", "what", "source", "file", "anchor" (fragment id or ""),
+                       "node" (a program line's: the node of every finding of the row, when one)}],
          "where": file:line:col of the first member that has one (shown when no culprit is named),
          "members": [{"id", "kind", "status", "sentence", "anchor", "diagnosis": bool,
                       "consequence_of": [ids of the members it follows from] (only on a consequence)}],
@@ -385,6 +386,12 @@ def group_problems(report: Mapping[str, Any], items: Sequence[Mapping[str, Any]]
         if key[0].startswith(mc.FAILED_PREFIX):
             lines = [places.locate(src) for m in g["members"] for src in mc.trail_sources(by_id.get(m["id"]))]
             g["culprits"] = [_culprit(r, places, anchor) for r in dict.fromkeys(lines) if r is not None]
+    for g in groups.values():  # a program line (a handler, an assignment) is the code of its findings' node
+        owners = {str((by_id.get(m["id"]) or {}).get("node") or "") for m in g["members"]}
+        if len(owners) == 1 and "" not in owners:
+            for c in g["culprits"]:
+                if str(c["id"]).startswith("line:"):
+                    c["node"] = next(iter(owners))
     where = _sources(report)
     for g in groups.values():  # where the problem is, for a row that names no culprit
         g["where"] = next((where[m["id"]] for m in g["members"] if where.get(m["id"])), "")
