@@ -339,13 +339,13 @@ def build_report(ws: Workspace) -> dict[str, Any]:
                   "code": d.get("code", "")}
                  for d in read_diagnostics(ws)]
     env_assumptions = [e for n in checked.nodes for e in comps[n].get("environment_assumptions", [])]
+    from ..plan.acknowledged import apply_acknowledgements  # warnings answered in the plan (docs/plan.md, issue 64)
+    acknowledgements = apply_acknowledgements(plan.acknowledged, findings, lint_rows, checked)
 
     problems = []
     for f in findings:
         if f["status"] == "problem":
             problems.append(f"Contract health: {f['message']}")
-    from ..plan.acknowledged import apply_acknowledgements  # warnings answered in the plan (docs/plan.md, issue 64)
-    acknowledgements = apply_acknowledgements(plan.acknowledged, findings, lint_rows, checked)
         elif f["status"] == "error":
             problems.append(f"Contract health of {f['node']} is error: {f['message']}")
         elif f["status"] == "stale":
@@ -359,13 +359,13 @@ def build_report(ws: Workspace) -> dict[str, Any]:
             where = " (checked in context too)" if sc.get("context") and sc["status"] != "stale" else ""
             problems.append(f"Side condition {sc['id']} is {sc['status']}{where}: {sc['conjunct']}")
     problems.extend(problems_altered)
+    problems.extend(f"Acknowledgement {a['at']} is {a['status']}: {a['message']}" for a in acknowledgements
+                    if a["status"] != "ok")
     problems.extend(u["message"] for u in unverified)
     for e in ev_rows:
         if e["status"] in ("failed", "error", "stale"):
             problems.append(f"Evidence {e['obligation']} is {e['status']}: {_brief(e['explanation'])}")
     for x in expected:
-    problems.extend(f"Acknowledgement {a['at']} is {a['status']}: {a['message']}" for a in acknowledgements
-                    if a["status"] != "ok")
         if x["outcome"] == "MISMATCH":
             problems.append(f"Expected verdict mismatch: {x['obligation']} is {x['actual']}, the plan expects "
                             f"{x['expected']} ({x['source']})" + (f": {x['reason']}" if x["reason"] else ""))
@@ -411,6 +411,7 @@ def build_report(ws: Workspace) -> dict[str, Any]:
         "derived_properties": derived, "findings": findings, "obligations": ob_rows, "evidence": ev_rows,
         "environment_assumptions": env_assumptions, "pending": pending, "lint": lint_rows,
         "expected_verdicts": expected, "grounding": grounding, "unverified": unverified, "deadlines": deadlines,
+        "acknowledgements": acknowledgements,
     }
     # runs counted by environment, bounds and targets (report/statistics.py, docs/statistics.md), before the confidence
     report["statistics"] = annotate_statistics(report, plan, {r.id: r.target for r in all_requirements(plan)})
@@ -418,7 +419,6 @@ def build_report(ws: Workspace) -> dict[str, Any]:
     report["summary"]["solvers"] = second.counts()  # how many items two solvers, one solver, ... (issue 50)
     if second.problem:
         report["summary"]["problems"].append(f"Second-solver record: {second.problem}")
-        "acknowledgements": acknowledgements,
     strength_ok = annotate(report, [(l.from_node, l.to_node) for l in model.links],
                            {r.id: r.strength for r in all_requirements(plan) if r.strength})
     # one severity per finding (report/severity.py): --strict fails on every error and warning, health and lint
