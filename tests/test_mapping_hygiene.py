@@ -82,16 +82,18 @@ def test_the_generated_mapping_names_each_field_or_says_why_not(reach, capsys):
     assert main(["generate", "ros2", "-w", str(reach), "-o", str(reach / "gen")]) == 0
     got = yaml.safe_load((reach / "gen" / "rclverify_mapping.yaml").read_text(encoding="utf-8"))
     assert got["topics"]["target"] == {"fields": {"x": ["x"], "y": ["y"]}}  # never one list for two variables
-    # a standard message of several fields that no rule narrows: omitted, with the reason
-    (reach / "contracts" / "reach.rcl").write_text(
-        REACH.replace("          geometry_msgs/Point target matches(in.y),\n", "")
-        .replace("topics( geometry_msgs/Point target matches(in.x)", "topics( geometry_msgs/Point target matches(in.x), "
-                 "std_msgs/Float64 ty matches(in.y)"), encoding="utf-8")
+    # a standard message of several fields that no rule narrows: the field of the variable's name,
+    # else omitted with the reason (never the first field of the type, which may be another quantity)
     (reach / "backends" / "monitors" / "mapping.yaml").unlink()
+    one = REACH.replace("          geometry_msgs/Point target matches(in.y),\n", "").replace(
+        "std_msgs/Bool ok", "geometry_msgs/Point dy matches(in.y), std_msgs/Bool ok")
+    (reach / "contracts" / "reach.rcl").write_text(one.replace("in.y", "in.gap").replace("y : REAL", "gap : REAL"),
+                                                   encoding="utf-8")
     assert main(["generate", "ros2", "-w", str(reach), "-o", str(reach / "gen")]) == 0
     text = (reach / "gen" / "rclverify_mapping.yaml").read_text(encoding="utf-8")
-    assert "target" not in yaml.safe_load(text)["topics"]
-    assert "#   target (Reach.in.x): geometry_msgs/Point has several fields and no mapping rule names the one" in text
+    topics = yaml.safe_load(text)["topics"]
+    assert topics["target"] == {"fields": ["x"]} and "dy" not in topics
+    assert "#   dy (Reach.in.gap): geometry_msgs/Point has several fields and no mapping rule names the one" in text
 
 
 def test_an_ambiguous_node_name_is_answered_with_the_candidates(tmp_path):

@@ -40,12 +40,12 @@ def mapped_topics(nodes: list[NodePackage], rules: Mapping[str, Any] | None
     omitted)``.  ``topics`` maps a topic to the one field path its variables
     read (a string), or, when variables of different names share the topic,
     to ``{variable name: path}`` (each variable its own field:
-    docs/monitors.md, "One topic, several variables").  ``omitted`` lists
-    ``{"topic", "type", "var", "why"}`` for each variable whose field the
-    generator cannot name: a standard message of several fields (a
-    ``geometry_msgs/Point``, a ``Twist``) that no mapping rule of the
-    workspace narrows to one field; the mapping file says so in a comment,
-    naming the entry to write (issue 64)."""
+    docs/monitors.md, "One topic, several variables").  A standard message
+    of several fields that no mapping rule of the workspace narrows is mapped
+    to the field of the variable's own name when it has one
+    (:func:`_field_named`); else ``omitted`` lists ``{"topic", "type",
+    "var", "why"}`` for the variable, and the mapping file says so in a
+    comment, naming the entry to write (issue 64)."""
     from ..traces.mapping import rule_for
     per: dict[str, dict[str, str]] = {}
     omitted: list[dict[str, str]] = []
@@ -56,6 +56,10 @@ def mapped_topics(nodes: list[NodePackage], rules: Mapping[str, Any] | None
                 per.setdefault(topic, {}).setdefault(w.name, w.path)
                 continue
             end = next(e for e in np.endpoints if e.attr == w.attr)
+            named = _field_named(end.ros_type, w.name)
+            if named:  # the standard message has a field of the variable's name: the one it carries
+                per.setdefault(topic, {}).setdefault(w.name, named)
+                continue
             why = (f"{end.ros_type} has several fields and no mapping rule names the one {np.ros_name}'s {w.var} "
                    f"reads; the monitors would read its first top-level field of the variable's type, which "
                    f"may be another quantity: name it in backends/monitors/mapping.yaml "
@@ -77,3 +81,17 @@ def mapped_topics(nodes: list[NodePackage], rules: Mapping[str, Any] | None
     for topic, by_name in per.items():
         topics[topic] = next(iter(by_name.values())) if len(by_name) == 1 else dict(sorted(by_name.items()))
     return topics, sorted(omitted, key=lambda o: (o["topic"], o["var"]))
+
+
+def _field_named(ros_type: str, var: str) -> str:
+    """``var`` when the standard message ``ros_type`` has a top-level field of
+    that name holding one value (``range`` of ``sensor_msgs/Range``, ``x`` of
+    ``geometry_msgs/Point``), else ``""``: a field named as the variable is
+    the one a reader takes it to carry; any other choice is a guess."""
+    from ..ros.interfaces import BASE_TYPES, TypeTable, field_path
+    from ..ros.model import canon_type
+    typ = canon_type(ros_type)
+    if not typ:
+        return ""
+    rt, err, arr = field_path(TypeTable(), typ, var)
+    return var if err is None and not arr and (rt or "").split("<=")[0] in BASE_TYPES else ""
