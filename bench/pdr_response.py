@@ -50,8 +50,11 @@ def planner(wrap: int) -> TransitionSystem:
 
 def one(w: int, start: int) -> str:
     """The three timings for wrap ``w`` (the trigger from ``c = start``), as one line."""
-    trigger = lambda s: z3.And(s["request"] >= 90, s["c"] >= start)  # noqa: E731
-    goal = lambda s: s["c"] == 0  # noqa: E731
+    def trigger(s: dict[str, z3.ExprRef]) -> z3.BoolRef:
+        return z3.And(s["request"] >= 90, s["c"] >= start)
+
+    def goal(s: dict[str, z3.ExprRef]) -> z3.BoolRef:
+        return s["c"] == 0
     t0 = time.perf_counter()
     kind = check_response(planner(w), trigger, goal, 6, deep=False, timeout_ms=2_000)
     t1 = time.perf_counter()
