@@ -60,6 +60,10 @@ from .deadlines import event_stamp, topic_bindings
 from .periods import PeriodResult
 from .verdicts import names
 
+#: a first value that did not map (a missing field, NaN): an ``initially`` on it is undecided
+_UNMAPPED = object()
+#: at most this many cached assumption verdicts (then the cache starts again)
+_CACHE = 4096
 #: declaration verdict -> evidence status
 STATUS = {"true": "discharged", "false": "failed", "inconclusive": "inconclusive", "pending": "pending"}
 
@@ -133,6 +137,9 @@ class DeclarationMonitor:
         for f in self.assumption:
             names(f, mentioned)
         self.needed = sorted(f"in.{v}" for v in node.inputs if v in mentioned or f"in.{v}" in mentioned)
+        self.needed_set = frozenset(self.needed)
+        #: the assumption's verdict per tuple of the inputs it reads (a run repeats its inputs)
+        self.accepted: dict[Any, bool] = {}
         for c in node.node.guarantees:
             names(c.formula, mentioned)
         #: the inputs the contract reads: an event carrying one of them is a step of the node
@@ -143,6 +150,8 @@ class DeclarationMonitor:
         self.initials = [_Initial(k, c.formula, _src(c.loc), frozenset(
             f"out.{e.name}" for e in subexpressions(c.formula) if isinstance(e, ast.Var) and e.prefix in ("out", None)
             and e.name in node.outputs)) for k, c in enumerate(node.node.initially, 1)]
+        #: the outputs whose first value an ``initially`` reads and that were not published yet
+        self.awaited = {o for ini in self.initials for o in ini.outs}
         self.counts: list[_Count] = []
         for p in node.node.progress:
             k = _steps(p.bound) if p.bound is not None else None
@@ -163,8 +172,9 @@ class DeclarationMonitor:
         changed = self._map(ev, keys)
         outs = {c for c in changed if c.startswith("out.")}
         for key in outs:
-            if key not in self.first:
-                self.first[key] = (self.values[key], ev.where)
+            if key in self.awaited:
+                self.awaited.discard(key)
+                self.first[key] = (self.values.get(key, _UNMAPPED), ev.where)
                 self._initial(ev)
         for c in self.counts:
             if outs and (not c.outs or c.outs & outs):
@@ -174,20 +184,23 @@ class DeclarationMonitor:
             self._step(ev)
 
     def _map(self, ev: Event, keys: list[tuple[str, str]]) -> list[str]:
+        """The keys ``ev`` carries; the values mapped only where a judgement
+        needs them (the assumption's inputs, an output whose first value an
+        ``initially`` waits for): a step or an answer needs only the event."""
         changed = []
         for key, part in keys:
             fields = ev.fields.get(part) if part else ev.fields
-            if not isinstance(fields, Mapping):
+            typ = self.node.inputs.get(key[3:]) if key.startswith("in.") else self.node.outputs.get(key[4:])
+            if not isinstance(fields, Mapping) or typ is None:  # an action message without this part
+                continue
+            changed.append(key)
+            if key not in self.needed_set and key not in self.awaited:
                 continue
             fields = {k: v for k, v in fields.items() if k != "header"}
-            typ = self.node.inputs.get(key[3:]) if key.startswith("in.") else self.node.outputs.get(key[4:])
-            if typ is None:
-                continue
             try:
                 self.values[key] = map_value(typ, fields, rule_for(self.rules, ev.topic, key), self.values.get(key))
             except MappingError:
                 self.values.pop(key, None)  # never the value before it: undecided until a message maps again
-            changed.append(key)
         return changed
 
     def _step(self, ev: Event) -> None:
@@ -211,10 +224,24 @@ class DeclarationMonitor:
                 c.row = 0
 
     def _accepts(self) -> bool:
-        inputs = {k: v for k, v in self.values.items() if k.startswith("in.")}
-        if any(k not in inputs for k in self.needed):
+        """Whether the assumption holds of the current inputs (judged once per
+        distinct tuple of the inputs it reads, kept while they repeat)."""
+        if any(k not in self.values for k in self.needed):
             return False
-        return all(judge(f, self.checked, self.node, inputs, self.tolerance).truth is True for f in self.assumption)
+        inputs = {k: self.values[k] for k in self.needed}
+        try:
+            key: Any = tuple(inputs.values())
+            hash(key)
+        except TypeError:  # a value that cannot be a key (a mutable one): judged every time
+            key = None
+        if key is not None and key in self.accepted:
+            return bool(self.accepted[key])
+        ok = all(judge(f, self.checked, self.node, inputs, self.tolerance).truth is True for f in self.assumption)
+        if key is not None:
+            if len(self.accepted) >= _CACHE:
+                self.accepted.clear()
+            self.accepted[key] = ok
+        return ok
 
     def _answer_words(self, c: _Count) -> str:
         return "message of " + ", ".join(sorted(c.outs)) if c.outs else "output of the node"
@@ -222,6 +249,11 @@ class DeclarationMonitor:
     def _initial(self, ev: Event) -> None:
         for ini in self.initials:
             if ini.verdict or not all(o in self.first for o in ini.outs):
+                continue
+            unmapped = [o for o in sorted(ini.outs) if self.first[o][0] is _UNMAPPED]
+            if unmapped:
+                ini.verdict, ini.reason = "inconclusive", (
+                    f"the first message of {unmapped[0]} ({self.first[unmapped[0]][1]}) does not map to a value")
                 continue
             vals = {o: self.first[o][0] for o in ini.outs}
             j = judge(ini.formula, self.checked, self.node, vals, self.tolerance)
