@@ -56,7 +56,7 @@ def _write(path: Path, storage: str, seed: int, bad_at: int | None = None) -> No
             w.write(reading, t, raw)
             band = BANDS[0 if r < 120 else 1 if r < 250 else 2] if rnd.random() < 0.9 else rnd.choice(
                 BANDS + ["purple", ""])
-            text = band.encode() + b"\x00"
+            text = band.encode() + (b"\x00" if rnd.random() < 0.97 else b"\x00\x00")  # a NUL in the text too
             sraw = b"\x00\x01\x00\x00" + struct.pack("<I", len(text)) + text
             kind = rnd.random()
             if kind < 0.03:
@@ -92,6 +92,8 @@ def bags(tmp_path_factory: Any) -> dict[str, Path]:
 def test_blocks_carry_read_bags_events_and_values(bags: dict[str, Path], storage: str) -> None:
     path = bags[storage]
     want = list(read_bag(path))
+    assert any(e.fields.get("data") == "red\x00" for e in want)
+    typed = 0
     for rows in (7, 4096):
         blocks = list(BagTrace(path).blocks(["data"], rows) or [])
         assert all(isinstance(b, BagBlock) for b in blocks)
@@ -105,12 +107,14 @@ def test_blocks_carry_read_bags_events_and_values(bags: dict[str, Path], storage
                 vals = b.values(at, "data")
                 assert repr(vals) == repr([want[k + i].fields.get("data") for i in at.tolist()])
                 got = b.typed(at, "data", kind, codes)
+                typed += got is not None
                 if got is not None:
                     ref = column(vals, kind, codes)
                     assert got[0].tolist() == ref[0].tolist()
                     assert got[1][ref[0]].tolist() == ref[1][ref[0]].tolist()
             k += len(b)
         assert k == len(want)
+    assert typed > 20  # the columns were read from the bytes, not only through the decoder
 
 
 @pytest.mark.parametrize("storage", ["sqlite3", "mcap"])
@@ -130,5 +134,5 @@ def test_batch_on_bag_blocks_equals_streaming(bags: dict[str, Path], storage: st
                 runs.append((None, None, seen, str(exc)))
         assert repr(runs[1]) == repr(runs[0]), name
         assert (runs[0][3] is not None) == name.endswith("bad")
-        assert len(runs[0][2]) > 50
+        assert len(runs[0][2]) > 20
     assert "cannot decode std_msgs/msg/" in str(runs[0][3])  # a string that is not UTF-8 comes first

@@ -29,6 +29,7 @@ files redefine either type, is not read in blocks (``blocks`` gives
 from __future__ import annotations
 
 import copy
+from itertools import islice
 from pathlib import Path
 from typing import Any, Iterator, Mapping, Sequence
 
@@ -82,21 +83,19 @@ def _blocks(path: Path, reader: Any, rows: int) -> Iterator[BagBlock | list[Even
     # the blocks make their events on demand, also after the last block closed the reader (which then empties
     # its type store): a shallow copy keeps the open reader's type store and decodes as read_bag's reader does
     decoder = copy.copy(reader)
+    memo: dict[bytes, Any] = {}
     try:
         messages = reader.messages()
         while True:
             got: list[tuple[Any, int, bytes]] = []
             error: TraceError | None = None
             try:
-                for item in messages:
-                    got.append(item)
-                    if len(got) >= rows:
-                        break
+                got.extend(islice(messages, rows))  # what was read stays in the list if the reader raises
             except Exception as exc:  # noqa: BLE001 - read_bag's located error, after the messages before it
                 error = TraceError(f"{path}: message {index + len(got)}: error: cannot read the bag "
                                    f"(truncated?): {exc}")
             if got:
-                block, bad = BagBlock.make(path, decoder, got, index)
+                block, bad = BagBlock.make(path, decoder, got, index, memo)
                 if bad is not None:  # the events before a message that cannot be decoded, then its error
                     if block:
                         yield block
@@ -119,43 +118,59 @@ class BagBlock:
     (float64 s, the recording's stamps), :meth:`values`, :meth:`typed`, ``block[i]`` (events)."""
 
     __slots__ = ("path", "reader", "items", "index", "topics", "times", "_made", "_floats", "_is_float",
-                 "_strings")
+                 "_strs", "_is_str")
 
     def __init__(self, path: Path, reader: Any, items: list[tuple[Any, int, bytes]], index: int) -> None:
         self.path, self.reader, self.items, self.index = path, reader, items, index
-        names: dict[int, str] = {}  # per connection (a rosbags Connection is not hashable: by identity)
-        self.topics: list[str] = [names.get(id(c)) or names.setdefault(id(c), c.topic.lstrip("/"))
-                                  for c, _, _ in items]
-        self.times = np.array([t for _, t, _ in items], dtype=np.int64) / 1e9  # as stamp / 1e9, per message
         self._made: dict[int, Event] = {}
-        self._floats = np.zeros(len(items), dtype=np.float64)
-        self._is_float = np.zeros(len(items), dtype=bool)
-        self._strings: dict[int, str] = {}
+        self.topics: list[str] = []
+        self.times = np.zeros(0)
+        n = len(items)
+        self._floats = np.zeros(n, dtype=np.float64)
+        self._is_float = np.zeros(n, dtype=bool)
+        self._is_str = np.zeros(n, dtype=bool)
+        self._strs = np.zeros(n, dtype="<U1")
 
     @classmethod
-    def make(cls, path: Path, reader: Any, items: list[tuple[Any, int, bytes]], index: int
-             ) -> tuple[BagBlock | list[Event], TraceError | None]:
+    def make(cls, path: Path, reader: Any, items: list[tuple[Any, int, bytes]], index: int,
+             memo: dict[bytes, Any]) -> tuple[BagBlock | list[Event], TraceError | None]:
         """The block of ``items`` (messages ``index ..``), or the events before a message
-        that cannot be decoded and its error (module docstring)."""
+        that cannot be decoded and its error (module docstring); ``memo``: String bytes
+        already decoded (a run's statuses repeat), kept across the blocks."""
         block = cls(path, reader, items, index)
-        types = [c.msgtype for c, _, _ in items]
-        floats = [i for i, t in enumerate(types) if t == FLOAT64]
-        if floats:
-            raws = [items[i][2] for i in floats]
-            if set(map(len, raws)) == {12}:
-                cells = np.frombuffer(b"".join(raws), dtype=np.uint8).reshape(-1, 12)
-                ok = (cells[:, 0] == 0) & (cells[:, 1] == 1)
-                at = np.array(floats)[ok]
-                block._floats[at] = cells[ok, 4:12].copy().view("<f8").reshape(-1)
-                block._is_float[at] = True
-        for i, t in enumerate(types):
-            if t == STRING:
-                s = _string(items[i][2])
-                if s is not None:
-                    block._strings[i] = s
-                    continue
-            elif t == FLOAT64 and block._is_float[i]:
-                continue
+        n = len(items)
+        conns, stamps, raws = zip(*items)
+        ids = list(map(id, conns))
+        first = dict(zip(ids, conns))  # a rosbags Connection is not hashable: by identity
+        kind = {i: {FLOAT64: 1, STRING: 2}.get(c.msgtype, 0) for i, c in first.items()}
+        names = {i: c.topic.lstrip("/") for i, c in first.items()}
+        block.topics = list(map(names.__getitem__, ids))
+        block.times = np.fromiter(stamps, np.int64, n) / 1e9  # as stamp / 1e9, per message
+        code = np.fromiter(map(kind.__getitem__, ids), np.int8, n)
+        at = np.flatnonzero(code == 1)
+        if len(at):
+            picked = [raws[i] for i in at.tolist()]
+            whole = np.fromiter(map(len, picked), np.int64, len(picked)) == 12
+            at = at[whole]
+            cells = np.frombuffer(b"".join([r for r, w in zip(picked, whole.tolist()) if w]), dtype=np.uint8)
+            cells = cells.reshape(-1, 12)
+            ok = (cells[:, 0] == 0) & (cells[:, 1] == 1)
+            block._floats[at[ok]] = cells[ok, 4:12].copy().view("<f8").reshape(-1)
+            block._is_float[at[ok]] = True
+        at = np.flatnonzero(code == 2)
+        if len(at):
+            picked = [raws[i] for i in at.tolist()]
+            texts = list(map(memo.get, picked))
+            for j, (raw, t) in enumerate(zip(picked, texts)):
+                if t is None:
+                    t = texts[j] = _string(raw)
+                    if len(memo) < 4096:
+                        memo[raw] = t
+            good = np.array([t is not False for t in texts], dtype=bool)
+            block._is_str[at[good]] = True
+            block._strs = np.zeros(n, dtype=np.array([t for t in texts if t is not False] or [""]).dtype)
+            block._strs[at[good]] = [t for t in texts if t is not False]
+        for i in np.flatnonzero(~(block._is_float | block._is_str)).tolist():
             try:  # any other message: decoded now, in order, as the stream decodes it
                 block._made[i] = bag_event(reader, path, index + i, *items[i])
             except TraceError as exc:
@@ -168,34 +183,31 @@ class BagBlock:
     def values(self, rows: np.ndarray, key: str) -> list[Any]:
         """The value of ``key`` in the messages at ``rows`` (``None`` where a message has none)."""
         out: list[Any] = []
+        floats, strs = self._floats, self._strs
+        is_float, is_str = self._is_float, self._is_str
         for i in rows.tolist():
-            ev = self._made.get(i)
-            if ev is not None:
-                out.append(ev.fields.get(key))
-            elif key != "data":
-                out.append(None)
-            elif self._is_float[i]:
-                out.append(float(self._floats[i]))
-            else:
-                out.append(self._strings[i])
+            if is_float[i]:
+                out.append(float(floats[i]) if key == "data" else None)
+            elif is_str[i]:
+                out.append(str(strs[i]) if key == "data" else None)
+            else:  # decoded whole
+                out.append(self[i].fields.get(key))
         return out
 
     def typed(self, rows: np.ndarray, key: str, kind: str, codes: Mapping[str, int]
               ) -> tuple[np.ndarray, np.ndarray] | None:
         """``key`` at ``rows`` as :func:`~rclverify.backends.monitors.columns.column` reads
         it, from the decoded columns; ``None`` when a row's message was decoded whole."""
-        if key != "data" or (self._made and any(i in self._made for i in rows.tolist())):
-            return None
-        is_float = self._is_float[rows]
+        if key != "data" or not (self._is_float[rows] | self._is_str[rows]).all():
+            return None  # a message decoded whole (its event's fields hold its value)
         if kind == "real":
             col = self._floats[rows]
-            return is_float & np.isfinite(col), col
+            return self._is_float[rows] & np.isfinite(col), col
         code = np.full(len(rows), -1, dtype=np.int64)
-        strings = self._strings
-        texts = np.array([strings.get(i, "") for i in rows.tolist()])
+        texts = self._strs[rows]
         for value, k in codes.items():
             code[texts == value] = k
-        code[is_float] = -1
+        code[~self._is_str[rows]] = -1
         return code >= 0, code
 
     def __getitem__(self, i: Any) -> Any:
@@ -210,18 +222,19 @@ class BagBlock:
         return ev
 
 
-def _string(raw: bytes) -> str | None:
+def _string(raw: bytes) -> str | bool:
     """The ``data`` of a ``std_msgs/msg/String`` in little-endian CDR with nothing after its terminator
-    (module docstring), else ``None``."""
+    (module docstring), else ``False``; also ``False`` for a text holding a NUL (a numpy string column
+    would drop a trailing one: the message decoder gives it)."""
     if len(raw) < 9 or raw[:2] != _LE:
-        return None
+        return False
     n = int.from_bytes(raw[4:8], "little")
-    if n < 1 or len(raw) != 8 + n or raw[-1] != 0:
-        return None
+    if n < 1 or len(raw) != 8 + n or raw[-1] != 0 or 0 in raw[8:-1]:
+        return False
     try:
         return raw[8:-1].decode()
     except UnicodeDecodeError:
-        return None
+        return False
 
 
 __all__ = ["BagBlock", "BagTrace"]
