@@ -314,7 +314,7 @@ def _run_command(ws: Path, src: str, trace: str = "run.jsonl") -> dict[str, Any]
     p = subprocess.run([sys.executable, "-c", "import sys; from rclverify.cli import main; sys.exit(main())",
                         "monitor", "-w", str(ws), str(ws / trace)], capture_output=True, text=True, env=env)
     after = resource.getrusage(resource.RUSAGE_CHILDREN)
-    if p.returncode not in (0, 1):
+    if p.returncode not in (0, 1) or not p.stdout:
         raise SystemExit(f"rclverify monitor exited {p.returncode}:\n{p.stderr[-3000:]}")
     cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
     return {"cpu": cpu, "rss": after.ru_maxrss / 1024, "out": p.stdout.strip().splitlines()[0] if p.stdout else ""}
