@@ -90,6 +90,15 @@ def _verify(ws: Path, plan: str, strict: bool = False) -> tuple[int, dict[str, A
     return rc, json.loads((ws / "reports" / "assurance.json").read_text(encoding="utf-8"))
 
 
+def _explain(ws: Path) -> str:
+    import subprocess
+    import sys
+    p = subprocess.run([sys.executable, "-m", "rclverify.cli", "explain", "-w", str(ws), "Gain.g1.c2.redundant"],
+                       capture_output=True, text=True, timeout=120)
+    assert p.returncode == 0, p.stderr
+    return p.stdout
+
+
 @pytest.fixture(scope="module")
 def gain_ws(tmp_path_factory: pytest.TempPathFactory) -> Path:
     ws = tmp_path_factory.mktemp("ack") / "gain"
@@ -108,12 +117,14 @@ def test_unacknowledged_warnings_fail_strict_and_offer_the_entry(gain_ws):
     assert [x["code"] for x in report["lint"]] == ["W-unused-bound"]
     html = (gain_ws / "reports" / "assurance.html").read_text(encoding="utf-8")
     assert f"sha256: {f['sha256'][:16]}" in html  # the entry to paste, for a warning not yet answered
+    assert f"{{warning: Gain.g1.c2.redundant, sha256: {f['sha256'][:16]}, reason: ...}}" in _explain(gain_ws)
 
 
 def test_acknowledged_warnings_pass_strict_with_their_reasons_everywhere(gain_ws, capfd):
     rc, report = _verify(gain_ws, PLAN + ACKS, strict=True)
     assert rc == 0 and report["meta"]["strict_ok"]
     assert "accepted risks: 2 warnings acknowledged in the plan: Gain.g1.c2.redundant" in capfd.readouterr().out
+    assert "accepted risk, acknowledged in the plan (contracts/plan.yaml:8:5): kept so that" in _explain(gain_ws)
     assert [a["status"] for a in report["acknowledgements"]] == ["ok", "ok"]
     [f] = [f for f in report["findings"] if f["id"] == "Gain.g1.c2.redundant"]
     assert f["status"] == "warning" and f["acknowledged"]["at"] == "contracts/plan.yaml:8:5"

@@ -227,6 +227,12 @@ class _Index:
             out.append(f"  backend: {x.get('backend')}" + (f"; {ev['explanation']}" if ev.get("explanation") else ""))
         elif x.get("explanation"):
             out.append(f"  {x['explanation']}")
+        ack = x.get("acknowledged")
+        if ack:  # a warning answered in the plan (plan/acknowledged.py)
+            out.append(f"  accepted risk, acknowledged in the plan ({ack['at']}): {ack['reason']}")
+        elif x.get("sha256"):
+            out.append(f"  to accept it, add under acknowledged: in the plan: "
+                       f"{{warning: {key}, sha256: {str(x['sha256'])[:16]}, reason: ...}}")
         out += [f"  hypothesis: {h}" for h in x.get("hypotheses") or []]
         out += [f"  core: {c}" for c in x.get("core") or []]
         if x.get("model"):  # a health check's model when it holds is a witness, otherwise a counterexample
