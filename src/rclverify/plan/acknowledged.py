@@ -176,6 +176,8 @@ def apply_acknowledgements(acks: Iterable[Acknowledgement], findings: Iterable[M
     rows: list[tuple[str, MutableMapping[str, Any]]] = (
         [("health", f) for f in findings] + [("lint", x) for x in lint_rows])
     for kind, r in rows:
+        for k in ("acknowledged", "flagged", "sha256"):  # rows kept between runs in one process start clean
+            r.pop(k, None)
         if _is_warning(kind, r):
             r["flagged"] = health_flagged(r, checked) if kind == "health" else lint_flagged(r, checked)
             r["sha256"] = digest(r["flagged"])
