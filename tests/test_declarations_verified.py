@@ -198,9 +198,10 @@ def _verdicts(decls: str, spec: str) -> dict[str, tuple[str, str]]:
 @pytest.mark.parametrize("spec, verdict, words", [
     ("p0 t7 p7", "true", "out.pose = 0 (run.jsonl:1)"),
     ("p5 t7 p7", "false", "do not satisfy it: out.pose = 5"),
-    ("t7 p7", "inconclusive", "may be its answer, not the initial value"),
+    ("t7 p7", "inconclusive", "came after the input at run.jsonl:1: they may be the node's answer to it"),
+    ("tx p0", "inconclusive", "came after the input at run.jsonl:1"),  # even true: an answer, not a start value
     ("t7 t7", "pending", "no message of out.pose"),
-], ids=["first-holds", "first-wrong", "after-input", "silent"])
+], ids=["first-holds", "first-wrong", "after-input", "after-input-true", "silent"])
 def test_initially_is_judged_on_the_first_published_value(spec: str, verdict: str, words: str) -> None:
     got, reason = _verdicts("  initially( out.pose == 0 )\n", spec)["initially 1"]
     assert got == verdict and words in reason, reason

@@ -16,12 +16,15 @@ messages comes after it and before its next step.  The assumption is judged on t
 a step at which it holds is *accepted*.
 
 * ``initially( F )``: F judged on the first value each output it reads is
-  published with (a subscriber has no value of the output before its first
-  message; the value the node starts from is only observable as that
-  message).  ``true``/``false``; when F is false and the first message
-  came after an input the node had accepted, it may be the node's answer
-  rather than its initial value: ``inconclusive`` (never a false alarm);
-  no message of an output F reads: ``pending``.
+  published with, when that comes before the node's first input event (a
+  subscriber has no value of the output before its first message; the value
+  the node starts from is observable only when the node publishes it as it
+  starts): ``true``/``false``.  A first message after an input may be the
+  node's answer, not its initial value: ``inconclusive`` whatever F says of
+  it (true there, it would not show that subscribers have F-values before
+  the first answer, which is what a proof from ``initially`` assumes;
+  false, it would blame a correct node); no message of an output F reads:
+  ``pending``.
 * ``progress( within K steps )``: never K + 1 accepted steps in a row
   unanswered (a step whose input is not accepted ends the row, as the
   composed system's ``waiting`` counter does, requirements/transition.py):
@@ -146,7 +149,7 @@ class DeclarationMonitor:
         self.read = frozenset(f"in.{v}" for v in node.inputs if v in mentioned or f"in.{v}" in mentioned)
         self.values: dict[str, Any] = {}
         self.first: dict[str, tuple[Any, str]] = {}
-        self.seen_accepted = ""  # where the first accepted input was (an initial message after it may be an answer)
+        self.first_input = ""  # where the first input event was (an output message after it may be an answer)
         self.initials = [_Initial(k, c.formula, _src(c.loc), frozenset(
             f"out.{e.name}" for e in subexpressions(c.formula) if isinstance(e, ast.Var) and e.prefix in ("out", None)
             and e.name in node.outputs)) for k, c in enumerate(node.node.initially, 1)]
@@ -182,6 +185,8 @@ class DeclarationMonitor:
                 c.row = 0
         if any(k in self.read for k in changed):
             self._step(ev)
+        if not self.first_input and any(k.startswith("in.") for k in changed):
+            self.first_input = ev.where
 
     def _map(self, ev: Event, keys: list[tuple[str, str]]) -> list[str]:
         """The keys ``ev`` carries; the values mapped only where a judgement
@@ -212,8 +217,6 @@ class DeclarationMonitor:
                             f"{self._answer_words(c)} came between the input at {c.first_open} and the input at "
                             f"{ev.where}")
         accepted = self._accepts()
-        if accepted and not self.seen_accepted:
-            self.seen_accepted = ev.where
         for c in self.counts:
             if accepted:
                 c.accepted += 1
@@ -255,15 +258,18 @@ class DeclarationMonitor:
                 ini.verdict, ini.reason = "inconclusive", (
                     f"the first message of {unmapped[0]} ({self.first[unmapped[0]][1]}) does not map to a value")
                 continue
+            at = ", ".join(f"{o} = {self.first[o][0]!r} ({self.first[o][1]})" for o in sorted(ini.outs))
+            if self.first_input:
+                ini.verdict, ini.reason = "inconclusive", (
+                    f"the first published values ({at}) came after the input at {self.first_input}: they may be "
+                    "the node's answer to it, not the value it starts from (a node publishes its initial value "
+                    "when it starts, before its first input; or its implementation gives its initial outputs to "
+                    "the property tests)")
+                continue
             vals = {o: self.first[o][0] for o in ini.outs}
             j = judge(ini.formula, self.checked, self.node, vals, self.tolerance)
-            at = ", ".join(f"{o} = {self.first[o][0]!r} ({self.first[o][1]})" for o in sorted(ini.outs))
             if j.truth is True:
                 ini.verdict, ini.reason = "true", f"the first published values satisfy it: {at}"
-            elif j.truth is False and self.seen_accepted:
-                ini.verdict, ini.reason = "inconclusive", (
-                    f"the first published values do not satisfy it ({at}), but they came after the accepted input "
-                    f"at {self.seen_accepted}: they may be its answer, not the initial value")
             elif j.truth is False:
                 ini.verdict, ini.reason = "false", f"the first published values do not satisfy it: {at}"
             else:
