@@ -191,6 +191,8 @@ def roll_up(record: Mapping[str, Any] | None, g_status: Callable[[str, int], str
     if v != "proved" and record.get("recorded_verdict") == "proved" and isinstance(record.get("solvers"), dict):
         return "inconclusive", "inconclusive", (f"Z3 proved it, but the second solver does not confirm it "
                                                 f"({record['solvers'].get('why')}): not proved (docs/second-solver.md)")
+    if v != "proved" and record.get("temporal"):  # the detail says what was tried and the next step (issue 64)
+        return "inconclusive", "inconclusive", f"not proved: {record.get('reason', 'undecided')}"
     if v != "proved":
         return "inconclusive", "inconclusive", f"Z3 could not decide it ({record.get('reason', 'unknown')}); not proved"
     if record.get("consistency") == "inconsistent":
