@@ -162,3 +162,22 @@ def test_a_changed_flagged_text_raises_the_warning_again(gain_ws):
     assert not f.get("acknowledged") and f["flagged"] == "out.y >= 0 - 1"
     why = " ".join(report["summary"]["problems"])
     assert "the text it acknowledged changed" in why and "matches no warning of this run" in why
+
+
+def test_only_a_warning_can_be_acknowledged_and_lint_binds_by_clause_text():
+    from rclverify.plan.acknowledged import Acknowledgement, apply_acknowledgements
+    from rclverify.rcl import ast
+    checked = check([parse_text(GAIN, "contracts/gain.rcl")])
+    problem = {"id": "Gain.g1.tautology", "status": "problem", "message": "always true"}
+    lint = {"location": "contracts/gain.rcl:6:21", "code": "W-unused-bound", "severity": "warning",
+            "message": "unused k"}
+    at = ast.Loc("contracts/plan.yaml", 3, 5)
+    acks = [Acknowledgement("Gain.g1.tautology", "it is meant", at, text="out.y >= in.x and out.y >= 0"),
+            Acknowledgement("W-unused-bound", "kept as written", at, text="forall(k in NATURAL | out.y <= in.x + 10)",
+                            file="contracts/other.rcl"),
+            Acknowledgement("W-unused-bound", "kept as written", at, text="forall(k in NATURAL |  out.y <= in.x + 10)")]
+    got = apply_acknowledgements(acks, [problem], [lint], checked)
+    assert [a["status"] for a in got] == ["error", "stale", "ok"]  # refused; another file; white space is no change
+    assert "not a warning" in got[0]["message"] and not problem.get("acknowledged")
+    assert lint["flagged"] == "forall(k in NATURAL | out.y <= in.x + 10)" and lint["acknowledged"]["at"] == \
+        "contracts/plan.yaml:3:5"
