@@ -425,3 +425,19 @@ def test_the_progress_premise_rests_on_the_least_bound() -> None:
     assert declaration_statuses({"Base": [("discharged", [per, prog])]})("Base", "progress", 0)[0] == "pending"
     failed = declaration_statuses({"Base": [("failed", [per, {**prog, "status": "failed"}])]}, c)
     assert failed("Base", "progress", 0)[0] == "failed"
+
+
+def test_a_wrong_initial_value_fails_the_first_property_test_record(tmp_path: Path) -> None:
+    ws = tmp_path / "ws"
+    (ws / "contracts").mkdir(parents=True)
+    (ws / "nodes").mkdir()
+    (ws / "contracts/r.rcl").write_text(RCL)
+    (ws / "nodes/base.py").write_text(BASE.replace('{"pose": 0}', '{"pose": 4}'))
+    (ws / "contracts/plan.yaml").write_text(
+        "contracts: [contracts/r.rcl]\nnodes:\n  Base:\n    evidence:\n      - backend: property_tests\n"
+        "        implementation: nodes/base.py:base\n        max_examples: 20\n")
+    main(["verify", "-w", str(ws)])
+    ev = json.loads((ws / "artifacts/evidence/Base.g1.property_tests.e0.json").read_text())
+    assert ev["status"] == "failed", ev["explanation"]
+    assert ev["explanation"].startswith("nodes/base.py:base declares initially( out.pose == 0 ) (")
+    assert "do not satisfy it: out.pose = 4" in ev["explanation"]
