@@ -166,7 +166,8 @@ def test_each_defect_is_its_own_row_with_the_right_culprit(runs: dict[str, Any])
     assert culprits[ROWS["04-threshold.diff"]] == [("guarantee 1 of BatteryMonitor",
                                                     "contracts/battery_monitor.rcl:14:3")]
     # (5) millimetres: the producer's scale, and the probable scale mismatch without declared units
-    assert members[ROWS["05-millimetres.diff"]] == ["Controller.sc2"]
+    # the Controller's run, whose assumption the millimetres violate (blamed on LidarDriver): a consequence (issue 64)
+    assert members[ROWS["05-millimetres.diff"]] == ["Controller.sc2", "Controller.g0.monitors.run_jsonl"]
     assert ("guarantee 1 of LidarDriver", "contracts/lidar_driver.rcl:15:3") in culprits[ROWS["05-millimetres.diff"]]
     [scale] = [f for f in report["findings"] if f["check"] == "probable-scale-mismatch"]
     assert (scale["id"], scale["status"]) == ("Controller.sc2.scale", "warning")

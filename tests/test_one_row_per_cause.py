@@ -153,3 +153,48 @@ def test_a_counterexample_through_a_refuted_side_condition_says_so(report: dict[
     assert [sc["id"] for sc in _passes_through(ws, report, q("41"), cone)] == ["GripperDriver.sc2"]
     assert _passes_through(ws, report, q("35"), cone) == []  # the driver's assumption holds there
     assert _passes_through(ws, report, q("4x"), cone) == []  # a value that does not read shows nothing
+
+
+MONITORED = """\
+node Supervisor {
+  inputs( request : REAL )
+  outputs( force : REAL )
+  topics( std_msgs/Float64 request matches(in.request),
+          std_msgs/Float64 force matches(out.force) )
+  assume( 0 <= in.request and in.request <= 100 )
+  guarantee( 0 <= out.force and out.force <= 45 )
+}
+
+node GripperDriver {
+  inputs( force : REAL )
+  outputs( applied : REAL )
+  topics( std_msgs/Float64 force matches(in.force),
+          std_msgs/Float64 applied matches(out.applied) )
+  assume( 0 <= in.force and in.force <= 40 )
+  guarantee( 0 <= out.applied and out.applied <= in.force )
+}
+"""
+
+
+def test_a_run_whose_assumption_the_side_condition_lets_fail_joins_its_row(tmp_path: Path) -> None:
+    (tmp_path / "contracts").mkdir()
+    (tmp_path / "runs").mkdir()
+    (tmp_path / "contracts" / "cell.rcl").write_text(MONITORED, encoding="utf-8")
+    (tmp_path / "mapping.yaml").write_text("topics:\n  request: {fields: [data]}\n  force: {fields: [data]}\n"
+                                           "  applied: {fields: [data]}\n", encoding="utf-8")
+    (tmp_path / "runs" / "run.jsonl").write_text(
+        '{"topic": "request", "time": 1.0, "data": 50.0}\n{"topic": "force", "time": 1.01, "data": 45.0}\n'
+        '{"topic": "applied", "time": 1.02, "data": 45.0}\n', encoding="utf-8")
+    entry = "      - {backend: monitors, mapping: mapping.yaml, traces: [runs/run.jsonl]}\n"
+    (tmp_path / "contracts" / "plan.yaml").write_text(
+        'name: "gripm"\ncontracts: [contracts/cell.rcl]\nrequirements: []\nnodes:\n'
+        f"  Supervisor:\n    evidence:\n{entry}  GripperDriver:\n    evidence:\n{entry}", encoding="utf-8")
+    (tmp_path / "dodo.py").write_text("from pathlib import Path\nfrom rclverify.tasks import build_tasks, doit_config\n"
+                                      "DOIT_CONFIG = doit_config()\nglobals().update(build_tasks(Path(__file__).parent))\n",
+                                      encoding="utf-8")
+    assert main(["verify", "-w", str(tmp_path)]) == 0
+    report = json.loads((tmp_path / "reports" / "assurance.json").read_text(encoding="utf-8"))
+    row = _row_of(report, "GripperDriver.sc2")
+    run = next(m for m in row["members"] if m["id"] == "GripperDriver.g0.monitors.run_jsonl")
+    assert run["consequence_of"] == ["GripperDriver.sc2"] and "blamed on the upstream node(s) Supervisor" in run["sentence"]
+    assert "guarantee:Supervisor:1" in row["key"]

@@ -72,6 +72,7 @@ from collections.abc import Callable, Mapping, Sequence
 from typing import Any
 
 from ..evidence.records import SEVERITY
+from . import problems_causes as pc
 from . import problems_mc as mc
 from . import problems_shared as ps
 from .problems_shared import producer_first
@@ -153,40 +154,6 @@ class _Places:
             return rid
         i = bisect.bisect_right([r[0] for r in rows], line) - 1
         return rows[i][1] if i >= 0 else None
-
-
-def _join_consequences(members: list[tuple[dict[str, Any], list[str]]], by_id: Mapping[str, Any]) -> None:
-    """A problem whose diagnosis is ``consequence_of`` other problems (a
-    requirement refuted only because a side condition fails, Z3 proving it
-    once that side condition is discharged: diagnosis/requirement.py) takes
-    their root culprits and is marked ``consequence_of`` (issue 64: one row
-    per cause, its consequences listed under it).  Changes ``members``
-    (``(member, roots)``) in place; a cause that is not a member changes
-    nothing."""
-    roots_of = {m["id"]: roots for m, roots in members}
-    for i, (m, roots) in enumerate(members):
-        causes = [str(c) for c in (by_id.get(m["id"]) or {}).get("consequence_of") or () if str(c) in roots_of]
-        if causes and m["diagnosis"]:
-            m["consequence_of"] = causes
-            members[i] = (m, list(dict.fromkeys(r for c in causes for r in roots_of[c])) or roots)
-
-
-def _join_implementation_findings(members: list[tuple[dict[str, Any], list[str]]], by_id: Mapping[str, Any]) -> None:
-    """A property test or run that names only the guarantee it found
-    violated joins the row of another such finding of the same guarantee
-    that names implementation lines (``line:...``: the handler of a
-    generated node's logic.py that published the message, issue 64): one
-    implementation defect, found by a test and by a run, is one row.
-    Changes ``members`` in place."""
-    def victim(mid: str) -> tuple[Any, Any]:
-        d = by_id.get(mid) or {}
-        return d.get("node"), d.get("guarantee")
-    placed = {victim(m["id"]): roots for m, roots in members if m["kind"] in ("monitor", "property-test")
-              and roots and all(r.startswith("line:") for r in roots) and victim(m["id"])[1]}
-    for i, (m, roots) in enumerate(members):
-        node, k = victim(m["id"])
-        if m["kind"] in ("monitor", "property-test") and (node, k) in placed and roots == [f"guarantee:{node}:{k}"]:
-            members[i] = (m, list(placed[(node, k)]))
 
 
 def _join_requirements_to_side_conditions(members: list[tuple[dict[str, Any], list[str]]]) -> None:
@@ -281,8 +248,8 @@ def group_problems(report: Mapping[str, Any], items: Sequence[Mapping[str, Any]]
             explains.setdefault(victim, [])
             explains[victim] += [r for r in roots if r not in explains[victim]]
     ps.join_by_first_repair(members, by_id)  # several consumers, one too loose producer: one row (issue 48)
-    _join_consequences(members, by_id)  # refuted only because of another problem: that problem's row (issue 64)
-    _join_implementation_findings(members, by_id)  # a test and a run of one guarantee: the handler's row (issue 64)
+    pc.join_consequences(members, by_id)  # refuted only because of another problem: that problem's row (issue 64)
+    pc.join_implementation_findings(members, by_id)  # a test and a run of one guarantee: the handler's row (issue 64)
     diagnosed = {str(d["id"]) for d in diagnoses}
     for q in report.get("requirements", []):
         if q.get("verdict") not in BAD_VERDICTS or str(q["id"]) in diagnosed:
@@ -336,6 +303,7 @@ def group_problems(report: Mapping[str, Any], items: Sequence[Mapping[str, Any]]
                          "sentence": str(it["message"]) + (f" `{it['formula']}`" if it.get("formula") else ""),
                          "anchor": str(it["anchor"]), "diagnosis": False}, roots))
         covered.add(ref)
+    pc.assumption_violations(report, members, anchor)  # a run's assumption violation a failed side condition explains
     for m, uid in pu.extra_members(report, diagnoses, covered, anchor):  # a lint warning, a health warning, a run
         if uid in unit_roots:
             direct.add(m["id"])
