@@ -226,10 +226,16 @@ def test_a_wrong_bounded_response_is_refuted_with_its_run(planners: Path, capsys
     assert t["trace"][12]["nodes"][0]["values"]["state.c"] == "12"
 
 
-def test_a_plan_invariant_is_read_for_the_bounded_response(planners: Path, capsys) -> None:
-    out, rec = _record(_planner(planners / "hint", 15, '    invariant: "Planner.state.c <= 15"\n'), capsys)
-    assert "RESTART: met [discharged]" in out and rec["temporal"]["method"] == "k-induction with invariant"
-    assert "the invariant 'Planner.state.c <= 15' and the property together are" in rec["temporal"]["detail"]
+def test_a_plan_invariant_that_fails_is_named_with_the_step_that_breaks_it(planners: Path, capsys) -> None:
+    """The plan's invariant is read for the bounded response; c <= 10 is false at step 11 of every run (a
+    run longer than the k-induction's, found through Spacer), which the detail names with its values; the
+    requirement is still proved by Spacer without it, and the report says the invariant was not used."""
+    out, rec = _record(_planner(planners / "hint", 15, '    invariant: "Planner.state.c <= 10"\n'), capsys)
+    t = rec["temporal"]
+    assert "RESTART: met [discharged]" in out and t["method"] == "pdr"
+    assert "the plan's invariant did not help: the invariant 'Planner.state.c <= 10' is false on a run of the " \
+           "system: at step 11, {" in t["detail"] and "Planner.state.c = 11" in t["detail"]
+    assert "next step: weaken it so that it holds there" in t["detail"]
 
 
 def test_an_invariant_is_refused_on_a_state_requirement_only(tmp_path: Path) -> None:
