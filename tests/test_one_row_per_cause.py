@@ -198,3 +198,11 @@ def test_a_run_whose_assumption_the_side_condition_lets_fail_joins_its_row(tmp_p
     run = next(m for m in row["members"] if m["id"] == "GripperDriver.g0.monitors.run_jsonl")
     assert run["consequence_of"] == ["GripperDriver.sc2"] and "blamed on the upstream node(s) Supervisor" in run["sentence"]
     assert "guarantee:Supervisor:1" in row["key"]
+
+
+def test_explain_names_what_a_culprit_causes(report: dict[str, Any], capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["explain", "-w", report["_ws"], "Supervisor"]) == 0
+    out = capsys.readouterr().out
+    assert out.startswith("Supervisor [failed]") and "Supervisor.g1 [failed]" in out
+    assert "culprit of a problem [failed]: GripperDriver assumes `in.force <= 40`" in out
+    assert "[discharged]" not in out

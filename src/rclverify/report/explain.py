@@ -277,6 +277,8 @@ class _Index:
         k = g["index"]
         obs = [x for kind, x in self.items.values() if kind == "obligation" and x["node"] == node and x.get("guarantee") == k]
         status = "unverified" if not obs and not g.get("obligations") else g["status"]  # no obligation covers it
+        if g.get("culprit_of"):  # a problem's culprit reads that problem's status (report/culprits.py, issue 64)
+            status = g["status"]
         out = [f"{indent}{node}.g{k} [{status}] (guarantee {k} of {node}, {g.get('source', '')})",
                f"{indent}  {g['text']}"]
         if not obs and not g.get("obligations"):
@@ -301,6 +303,8 @@ class _Index:
         problems = [d for d in natural_sorted(list(self.diagnoses)) if d.startswith(f"{node}.g{k}.")]
         if problems:
             out.append(f"{indent}  problems: {', '.join(problems)} (`rclverify explain ID`)")
+        out += [f"{indent}  culprit of a problem [{c['status']}]: {clause_cut(c['sentence'], 300)}"
+                for c in g.get("culprit_of") or ()]
         return out
 
     def node_lines(self, node: str) -> list[str]:
@@ -327,6 +331,8 @@ class _Index:
             out.append(f"  health: {len(health) - len(bad)}/{len(health)} ok" + "".join(f"; {x['id']} [{x['status']}]" for x in bad))
         problems = [d for d in natural_sorted(list(self.diagnoses)) if d.split(".", 1)[0] == node]
         out.append(f"  problems: {', '.join(problems)} (`rclverify explain ID`)" if problems else "  problems: none")
+        out += [f"  culprit of a problem [{c['status']}]: {clause_cut(c['sentence'], 300)}"
+                for c in n.get("culprit_of") or ()]  # report/culprits.py (issue 64)
         for f in (g for fs in self.ros.values() for g in fs):
             if f.get("node") == node:
                 out.append(f"  ROS grounding {f.get('severity')}: {f.get('message')} ({f.get('code')})")
