@@ -138,6 +138,21 @@ def declaration_statuses(records: Mapping[str, Sequence[tuple[str, Sequence[Mapp
     return status
 
 
+def _premise_statuses(record: Mapping[str, Any], g_status: Callable[[str, int], str], sc_status: Mapping[str, str],
+                      d_status: DeclStatus | None) -> dict[str, str]:
+    """The evidence status of each premise the proof used, by its words in the note."""
+    statuses: dict[str, str] = {}
+    for p in record.get("used", []):
+        if p["kind"] == "guarantee":
+            statuses[p["label"]] = g_status(p["node"], p["index"])
+            statuses[f"side conditions of {p['node']}"] = sc_status.get(p["node"], "discharged")
+        elif p["kind"] in ("progress", "initial value"):  # declared of the implementation: its own evidence
+            st, words = d_status(p["node"], p["kind"], int(p.get("index", 0))) if d_status is not None else (
+                "pending", "declared, not verified")
+            statuses[f"{p['label']} ({words})"] = st
+    return statuses
+
+
 def roll_up(record: Mapping[str, Any] | None, g_status: Callable[[str, int], str], sc_status: Mapping[str, str],
             traced_status: str, d_status: DeclStatus | None = None) -> tuple[str, str, str]:
     """``(verdict, status, note)`` of one requirement.
@@ -203,15 +218,7 @@ def roll_up(record: Mapping[str, Any] | None, g_status: Callable[[str, int], str
         core = ", ".join(p["label"] for p in record.get("vacuity_core", []))
         why = f"together with the premises of its cone ({core})" if core else "(it contradicts itself)"
         return VACUOUS, "failed", f"the requirement's premise can never hold {why}: it is proved only because it never applies"
-    statuses: dict[str, str] = {}
-    for p in record.get("used", []):
-        if p["kind"] == "guarantee":
-            statuses[p["label"]] = g_status(p["node"], p["index"])
-            statuses[f"side conditions of {p['node']}"] = sc_status.get(p["node"], "discharged")
-        elif p["kind"] in ("progress", "initial value"):  # declared of the implementation: its own evidence
-            st, words = d_status(p["node"], p["kind"], int(p.get("index", 0))) if d_status is not None else (
-                "pending", "declared, not verified")
-            statuses[f"{p['label']} ({words})"] = st
+    statuses = _premise_statuses(record, g_status, sc_status, d_status)
     ev = worst(list(statuses.values()), empty="discharged")
     if record.get("consistency") != "consistent":  # the worst of that and the evidence, as the argument has it
         return "inconclusive", worst(["inconclusive", ev]), (
