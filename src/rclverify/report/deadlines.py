@@ -28,7 +28,10 @@ whose deadline is not decided (inconclusive, pending) is at best
 ``inconclusive``; stale and error carry over.  A proved deadline leaves
 the requirement's own verdict (an informal requirement stays informal:
 its text is not checked).  ``--strict`` fails unless every deadline is
-proved (:func:`strict_ok`, :func:`strict_reason`).  SARIF
+proved from a chain whose evidence is discharged, each hop's deadline
+measured on a run (a hop whose guarantee only a property test or a proof
+covers is ``pending``: they check its formula, not its time; issue 64)
+(:func:`strict_ok`, :func:`strict_reason`).  SARIF
 (``RCL-DEADLINE-REFUTED``, ``RCL-DEADLINE-INCONCLUSIVE``) and JUnit (a
 ``deadlines`` test suite) are laid out here too.
 """
@@ -75,7 +78,7 @@ def deadline_rows(ws: Workspace, current: Mapping[str, str], g_status: Callable[
     records, why = read_deadlines(ws, current)
     by_req = {str(r.get("requirement")): r for r in records or []}
     monitors = _monitor_verdicts(ws, ob_rows, {n for s in specs for n in s.path})
-    rows = []
+    rows: list[dict[str, Any]] = []
     for spec in specs:
         base = {"requirement": spec.requirement, "path": list(spec.path), "within": _show(spec.within),
                 "source": f"{spec.loc.file}:{spec.loc.line}:{spec.loc.col}", "chain": [], "total": None,
@@ -100,11 +103,30 @@ def deadline_rows(ws: Workspace, current: Mapping[str, str], g_status: Callable[
                      "chain": chain, "total": rec.get("total"), "stamps": list(rec.get("stamps") or []),
                      "smt2": str(rec.get("smt2") or ""), "solvers": rec.get("solvers")})
     for row in rows:
+        for h in row["chain"]:
+            _timing_measured(h)
         # the timed guarantees the decision rests on: their evidence (the monitors check the stamps)
         row["evidence_status"] = worst([h["status"] for h in row["chain"]], empty="pending")
         # proved is a green tick only when every hop's guarantee is discharged (as a requirement's "met")
         row["status"] = row["evidence_status"] if row["verdict"] == "proved" else STATUS_OF[row["verdict"]]
     return rows
+
+
+def _timing_measured(hop: dict[str, Any]) -> None:
+    """A hop whose guarantee is discharged by evidence that checks only its
+    formula (a property test, a proof: backends/timing_scope.py) while no
+    run timed it (no monitors' deadline record of its node with a ``true``
+    verdict and no ``false`` one) is ``pending``: the deadline the sum rests
+    on was measured by nothing (issue 64: a proved deadline is no green tick
+    on an unmeasured hop).  ``hop["timing"]`` says so."""
+    if hop["status"] != "discharged":
+        return
+    timed = [m for m in hop.get("monitors") or () if m.get("status") == "discharged"
+             and int((m.get("counts") or {}).get("true", 0) or 0) > 0]
+    if not timed:
+        hop["status"] = "pending"
+        hop["timing"] = (f"its {hop.get('within', '')} deadline is measured by no run: its evidence checks the "
+                         "guarantee's formula only (a monitors entry on a recorded or live run times it)")
 
 
 def _monitor_verdicts(ws: Workspace, ob_rows: Sequence[Mapping[str, Any]],
@@ -162,20 +184,29 @@ def fold_into(requirements: list[dict[str, Any]], rows: Sequence[Mapping[str, An
 
 
 def strict_ok(rows: Sequence[Mapping[str, Any]]) -> bool:
-    """``--strict`` holds for the deadlines: every one is proved."""
-    return all(r["verdict"] == "proved" for r in rows)
+    """``--strict`` holds for the deadlines: every one is proved, and every
+    hop of its chain discharged with its deadline measured on a run
+    (:func:`_timing_measured`)."""
+    return all(r["verdict"] == "proved" and r.get("status", "discharged") == "discharged" for r in rows)
 
 
 def strict_reason(report: Mapping[str, Any]) -> list[str]:
     """The clause ``verify --strict`` names for deadlines that are not
     proved (``[]`` when every one is): "1 end-to-end deadline is refuted
     (STOP)"."""
-    bad = [r for r in report.get("deadlines") or () if r["verdict"] != "proved"]
-    if not bad:
-        return []
-    verdicts = sorted({str(r["verdict"]) for r in bad})
-    return [f"{len(bad)} end-to-end deadline{'s are' if len(bad) != 1 else ' is'} {' or '.join(verdicts)} ("
-            + ", ".join(str(r["requirement"]) for r in bad[:4]) + (", ..." if len(bad) > 4 else "") + ")"]
+    rows = list(report.get("deadlines") or ())
+    bad = [r for r in rows if r["verdict"] != "proved"]
+    out = []
+    if bad:
+        verdicts = sorted({str(r["verdict"]) for r in bad})
+        out.append(f"{len(bad)} end-to-end deadline{'s are' if len(bad) != 1 else ' is'} {' or '.join(verdicts)} ("
+                   + ", ".join(str(r["requirement"]) for r in bad[:4]) + (", ..." if len(bad) > 4 else "") + ")")
+    open_ = [r for r in rows if r["verdict"] == "proved" and r.get("status", "discharged") != "discharged"]
+    if open_:
+        out.append(f"{len(open_)} end-to-end deadline{'s are' if len(open_) != 1 else ' is'} proved from a chain "
+                   "whose evidence is outstanding (a hop unverified, or its deadline measured by no run: "
+                   + ", ".join(str(r["requirement"]) for r in open_[:4]) + (", ..." if len(open_) > 4 else "") + ")")
+    return out
 
 
 def _chain_text(row: Mapping[str, Any]) -> str:

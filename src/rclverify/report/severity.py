@@ -108,8 +108,9 @@ def items(report: Mapping[str, Any]) -> list[tuple[str, str, str, str]]:
         add("health", str(f["id"]), str(f["status"]))
     for r in report.get("requirements") or ():
         add("requirement", str(r["id"]), str(r.get("verdict", "informal")))
-    for d in report.get("deadlines") or ():
-        add("deadline", f"{d['requirement']}.deadline", str(d["verdict"]))
+    for d in report.get("deadlines") or ():  # proved from a chain whose evidence is outstanding: not a pass
+        open_ = d["verdict"] == "proved" and d.get("status", "discharged") != "discharged"
+        add("deadline", f"{d['requirement']}.deadline", "proved, evidence outstanding" if open_ else str(d["verdict"]))
     for x in report.get("lint") or ():
         add("lint", f"{x['location']}:{x.get('code', '')}", str(x["severity"]))
     for a in report.get("acknowledgements") or ():  # a stale or refused acknowledgement (plan/acknowledged.py)
