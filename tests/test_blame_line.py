@@ -221,3 +221,51 @@ def test_a_run_of_a_generated_node_names_its_handler(tmp_path: Path) -> None:
     assert row["culprits"][0]["node"] == "ArmDriver"  # the node whose code it is: marked a culprit
     from rclverify.report.culprits import culprit_nodes
     assert culprit_nodes(report["problems"]) == {"ArmDriver"}
+
+
+def _random_program(rng: Any) -> tuple[str, str]:
+    """A random program over x, y, z (assignments and nested ifs) as the Hoare
+    language's text and as Python that records the line of each assignment."""
+    imp = ["var x : INTEGER;", "var y : INTEGER;", "var z : INTEGER;"]
+    py = ["last = {}"]
+
+    def expr() -> str:
+        a, b = rng.choice("xyz"), rng.choice(["x", "y", "z", str(rng.randint(0, 9))])
+        return f"{a} {rng.choice('+-*')} {b}"
+
+    def block(depth: int, indent: int) -> None:
+        for _ in range(rng.randint(1, 3)):
+            if depth < 2 and rng.random() < 0.3:
+                cond = f"{rng.choice('xyz')} {rng.choice(['<', '<=', '==', '>'])} {rng.randint(-5, 15)}"
+                imp.append(" " * indent + f"if {cond} then")
+                py.append(" " * indent + f"if {cond}:")
+                block(depth + 1, indent + 2)
+                imp.append(" " * indent + "else")
+                py.append(" " * indent + "else:")
+                block(depth + 1, indent + 2)
+                imp.append(" " * indent + "end")
+                py.append(" " * indent + "pass")  # keeps the two texts line for line
+            else:
+                v, e = rng.choice("xyz"), expr()
+                imp.append(" " * indent + f"{v} := {e}")
+                py.append(" " * indent + f"{v} = {e}; last['{v}'] = {len(imp)}")
+    block(0, 0)
+    return "\n".join(imp) + "\n", "\n".join(py) + "\n"
+
+
+def test_the_program_run_agrees_with_python_on_random_programs() -> None:
+    """Oracle: each random program run by culprit_assign.run gives the final values and the line of
+    the last assignment to each variable that Python's own execution of the same program gives."""
+    import random
+
+    from rclverify.backends.hoare import lang
+    from rclverify.backends.hoare.culprit_assign import run
+    rng = random.Random(64)
+    for _ in range(60):
+        imp, py = _random_program(rng)
+        start = {"x": rng.randint(-3, 12), "y": rng.randint(-3, 12), "z": rng.randint(-3, 12)}
+        env: dict[str, Any] = dict(start)
+        exec(py, {}, env)  # noqa: S102 - the oracle: Python runs the program it was written as
+        final, last = run(lang.parse_program(imp, "r.imp"), start)
+        assert {v: final[v] for v in "xyz"} == {v: env[v] for v in "xyz"}, imp
+        assert {v: a.loc.line for v, a in last.items()} == env["last"], imp
