@@ -38,6 +38,7 @@ import json
 import time
 from fnmatch import fnmatch
 from pathlib import Path
+from typing import Any
 
 from rclverify.ros.graph import scan
 from rclverify.ros.model import SERVICE_ROLES
@@ -47,9 +48,9 @@ REACH = ("static", "call", "runtime")
 DATA = Path(__file__).resolve().parent / "data"
 
 
-def load_truth(path: Path) -> dict:
+def load_truth(path: Path) -> dict[str, Any]:
     """The truth file at ``path``, checked: ``ValueError`` naming the row when malformed."""
-    truth = json.loads(path.read_text(encoding="utf-8"))
+    truth: dict[str, Any] = json.loads(path.read_text(encoding="utf-8"))
     for key in ("repository", "commit", "scan", "split", "own", "sites"):
         if key not in truth:
             raise ValueError(f"{path.name}: no {key!r}")
@@ -63,7 +64,7 @@ def _library(name: str, pats: list[str]) -> bool:
     return any(fnmatch(name, p) for p in pats)
 
 
-def measure(root: Path, truth: dict, verbose: bool = False) -> dict[str, float]:
+def measure(root: Path, truth: dict[str, Any], verbose: bool = False) -> dict[str, float]:
     """Counts for the extracted tree ``root``: ``sites``, ``found``, per reach
     ``R``/``found_R``, ``edges``/``right`` (precision), ``missed``/``noted``,
     ``seconds`` (the scan's wall time) and ``lines`` (C++/Python lines scanned)."""
