@@ -5,9 +5,10 @@ place to look is the line of the implementation that produced the wrong
 output (the branch taken), not the guarantee it violates.  The failing
 example is run once more under :func:`sys.settrace`, tracing only the
 frames of the implementation's own file.  The cause is the statement that
-computed the value returned (issue 64): the tracer records, line by line,
-which local variable of the implementation's entry frame each executed line
-changed, and the line that last assigned a local the returned output
+computed the value returned (issue 64): the tracer follows the entry
+frame's bytecode (``f_trace_opcodes``) and records the line of each store
+of a local variable, and the line that last assigned a local the ``return``
+statement reads and the returned output
 carries (the same object, e.g. ``joint = index + 1`` for ``return
 {"joint": joint}``) is named.  When the output carries no local (``return
 {"speed": 1.0}`` in the wrong branch), or the call raised, it is the last
@@ -49,32 +50,27 @@ def last_line(call: Callable[[], Any], file: str) -> int | None:
     tool's) is put back."""
     last: list[int] = []
     outer: list[FrameType] = []  # the first frame of file: the implementation's entry (its return is the output)
-    seen: dict[int, tuple[int, dict[str, Any]]] = {}  # id(frame) -> (line running, locals before it)
-    assigned: dict[str, int] = {}  # local of the entry frame -> line that last changed it
+    stores: dict[int, str] = {}  # bytecode offset of the entry frame -> the local it stores
+    assigned: dict[str, int] = {}  # local of the entry frame -> line that last stored it
     returned: list[Any] = []
-
-    def changes(frame: FrameType) -> None:
-        line, before = seen.get(id(frame), (0, {}))
-        now = dict(frame.f_locals)
-        if frame is outer[0] and line:
-            for k, v in now.items():
-                if k not in before or before[k] is not v:
-                    assigned[k] = line
-        seen[id(frame)] = (frame.f_lineno, now)
+    names: set[str] = set()  # the names the return statement reads (empty: any local)
 
     def local(frame: FrameType, event: str, arg: Any) -> Any:
+        if event == "opcode" and frame is outer[0] and frame.f_lasti in stores:
+            assigned[stores[frame.f_lasti]] = frame.f_lineno  # a store about to run (a local's new value)
         if event in ("line", "return", "exception"):
             last.append(frame.f_lineno)
-            changes(frame)
         if event == "return" and frame is outer[0]:
             returned.append(arg)
+            names.update(_returned_names(frame.f_code.co_filename, frame.f_lineno))
         return local
 
     def tracer(frame: FrameType, event: str, arg: Any) -> Any:
         if event == "call" and os.path.abspath(frame.f_code.co_filename) == file:
             if not outer:
                 outer.append(frame)
-            seen[id(frame)] = (0, dict(frame.f_locals))
+                stores.update(_stores(frame.f_code))
+                frame.f_trace_opcodes = True
             return local
         return None
 
@@ -86,8 +82,37 @@ def last_line(call: Callable[[], Any], file: str) -> int | None:
         pass
     finally:
         sys.settrace(before)
-    computed = _computing_line(returned[0], assigned, outer[0].f_locals) if returned and outer else None
+    final = {k: v for k, v in outer[0].f_locals.items() if not names or k in names} if outer else {}
+    computed = _computing_line(returned[0], assigned, final) if returned and outer else None
     return computed or (last[-1] if last else None)
+
+
+def _stores(code: Any) -> dict[int, str]:
+    """``{bytecode offset: local name}`` of every instruction of ``code``
+    that stores a local variable (:mod:`dis`): which line assigned a local
+    is then known exactly, even when the new value is the same object as
+    the old one (a small int)."""
+    import dis
+    return {i.offset: str(i.argval) for i in dis.get_instructions(code)
+            if i.opname in ("STORE_FAST", "STORE_NAME", "STORE_DEREF", "STORE_GLOBAL")}
+
+
+def _returned_names(file: str, line: int) -> set[str]:
+    """The names the ``return`` statement at ``file``:``line`` reads (a
+    small int is one object wherever it is computed, so a local is a
+    candidate only when the return reads it); empty when the line is not a
+    whole ``return`` statement (one spread over lines: every local is a
+    candidate)."""
+    import ast
+    import linecache
+    text = linecache.getline(file, line).strip()
+    try:
+        tree = ast.parse(text)
+    except SyntaxError:
+        return set()
+    if not tree.body or not isinstance(tree.body[0], ast.Return):
+        return set()
+    return {n.id for n in ast.walk(tree) if isinstance(n, ast.Name)}
 
 
 def _leaves(value: Any) -> list[Any]:
