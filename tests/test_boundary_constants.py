@@ -133,3 +133,21 @@ def test_the_constants_and_their_neighbours(tmp_path: Path) -> None:
     for n in (6, 7, 8):  # an integer constant and one either side
         assert find(space.integer(space.bounds.get("seen"), True), lambda v, n=n: v == n,
                     settings=settings(database=None, max_examples=2000)) == n
+
+
+def test_a_named_constant_bounds_an_input_as_a_literal_does(tmp_path: Path) -> None:
+    """``in.separation <= MaxRange`` bounds the draws (before, the input was
+    any float and two draws in three were filtered out)."""
+    from rclverify.backends.property_tests.constants import constant_values
+    text = RCL.replace("{bound}", "ProtectiveDist").replace("in.separation <= 100 )", "in.separation <= MaxRange )")
+    text = text.replace("MaxCount : NATURAL = 7 ;", "MaxCount : NATURAL = 7 ;\n  MaxRange : REAL [m] = 30 ;")
+    checked = check([parse_text(text, "s.rcl")])
+    cn = checked.nodes["Stopper"]
+    named = constant_values(checked, cn)
+    assert named == {"MaxRange": 30, "ProtectiveDist": Fraction("1.2345")}
+    bd = input_space(cn, {}, None, (), named).bounds["separation"]
+    assert (bd.lo, bd.hi) == (0, 30)
+    (tmp_path / "impl.py").write_text(STOPPER.format(op="<="))
+    cfg = read_config({"implementation": "impl.py:stopper", "max_examples": 50}, cn, tmp_path)
+    out = run_guarantee(checked, cn, 1, cfg, tmp_path)
+    assert out.status == "discharged" and out.counts.rejected == 0, out.counts.as_dict()

@@ -53,26 +53,31 @@ def _number(v: Any) -> Fraction | None:
     return Fraction(v)
 
 
-def named_constants(checked: Checked, node: CheckedNode) -> list[Fraction]:
-    """The values of the context constants ``node``'s assumptions and
-    guarantees name, each once, in source order (a constant whose value is
-    not a number, or cannot be evaluated, is left out)."""
-    out: list[Fraction] = []
+def constant_values(checked: Checked, node: CheckedNode) -> dict[str, Fraction]:
+    """``{name: value}`` of the context constants ``node``'s assumptions and
+    guarantees name, in source order (a constant whose value is not a
+    number, or cannot be evaluated, is left out)."""
+    out: dict[str, Fraction] = {}
     seen: set[str] = set()
     for clause in (*node.node.assumes, *node.node.guarantees):
         for e in subexpressions(clause.formula):
             if not isinstance(e, ast.Var) or e.prefix is not None or e.name in seen:
                 continue
             seen.add(e.name)
-            if e.name not in checked.env.constants:
+            if e.name not in checked.env.constants or e.name in node.inputs or e.name in node.outputs:
                 continue
             try:
                 v = _number(Evaluator(checked, node, {}).eval(checked.env.constants[e.name][1], {}))
             except Exception:  # noqa: BLE001 - a constant the evaluator cannot take adds no boundary
                 v = None
-            if v is not None and v not in out:
-                out.append(v)
+            if v is not None:
+                out[e.name] = v
     return out
+
+
+def named_constants(checked: Checked, node: CheckedNode) -> list[Fraction]:
+    """The values of :func:`constant_values`, each once, in source order."""
+    return list(dict.fromkeys(constant_values(checked, node).values()))
 
 
 def _compared(tree: pyast.AST) -> tuple[list[Fraction], set[str]]:

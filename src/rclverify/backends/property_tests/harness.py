@@ -48,7 +48,7 @@ from ...rcl.types import Checked, CheckedNode
 from ...values import conforms, render
 from .seeding import Seeder, split_facts
 from .coverage import Coverage
-from .constants import boundary_constants
+from .constants import boundary_constants, constant_values
 from .strategies import assumption_bounds, conjuncts, input_space
 
 DEFAULT_MAX_EXAMPLES = 200
@@ -278,9 +278,12 @@ class GuaranteeRun:
         if self.used_facts:
             formulas = tuple(c.formula for c in self.node.node.assumes) + self.used_facts
             seed = Seeder(self.checked, self.node, formulas).base()
-        # every threshold the contract or the code compares with, drawn with its neighbours (.constants)
-        space = input_space(self.node, self.cfg.bounds, seed, boundary_constants(self.checked, self.node, self.impl))
-        self.coverage = Coverage(self.node, space.bounds, assumption_bounds(self.node))
+        # every threshold the contract or the code compares with, drawn with its neighbours (.constants);
+        # a named constant bounds an input as a literal does
+        named = constant_values(self.checked, self.node)
+        space = input_space(self.node, self.cfg.bounds, seed, boundary_constants(self.checked, self.node, self.impl),
+                            named)
+        self.coverage = Coverage(self.node, space.bounds, assumption_bounds(self.node, named))
         one = space.inputs().filter(self.assumption_holds)
         if self.stateful:
             return st.lists(one, min_size=1, max_size=self.cfg.steps)

@@ -2,7 +2,8 @@
 constrained by the node's assumption (docs/property-tests.md, "Strategies").
 
 * Bounds by construction: every top-level conjunct of the assumption of the
-  form ``c <= in.x``, ``in.x < c``, ``a <= in.x < b`` (numeric literals) bounds
+  form ``c <= in.x``, ``in.x < c``, ``a <= in.x < b`` (numeric literals or
+  named constants of the context) bounds
   a numeric input; ``in.e in {v1, v2}`` restricts an enumeration input.  The
   plan's ``bounds: {in.x: [lo, hi]}`` narrows further (either end may be null).
 * Boundary values: the numeric literals of the node's contract, the values
@@ -59,11 +60,15 @@ class Bound:
             self.hi, self.hi_strict = v, strict
 
 
-def _num(e: ast.Expr) -> Fraction | None:
+def _num(e: ast.Expr, named: Mapping[str, Fraction] | None = None) -> Fraction | None:
+    """A numeric literal's value, or a named constant's (``named``: name -> value), negated under ``-``."""
     if isinstance(e, ast.NumLit):
         return e.value
-    if isinstance(e, ast.Unary) and e.op == "-" and isinstance(e.operand, ast.NumLit):
-        return -e.operand.value
+    if isinstance(e, ast.Var) and e.prefix is None and named and e.name in named:
+        return named[e.name]
+    if isinstance(e, ast.Unary) and e.op == "-":
+        v = _num(e.operand, named)
+        return None if v is None else -v
     return None
 
 
@@ -87,17 +92,19 @@ def conjuncts(e: ast.Expr) -> list[ast.Expr]:
 _FLIP = {"<": ">", "<=": ">=", ">": "<", ">=": "<=", "==": "==", "!=": "!="}
 
 
-def assumption_bounds(node: CheckedNode) -> dict[str, Bound]:
-    """Bounds per input name found in the assumption's top-level conjuncts."""
+def assumption_bounds(node: CheckedNode, named: Mapping[str, Fraction] | None = None) -> dict[str, Bound]:
+    """Bounds per input name found in the assumption's top-level conjuncts
+    (against numeric literals, and against the context constants of
+    ``named``, name -> value: ``in.x <= MaxRange``)."""
     out: dict[str, Bound] = {}
     for clause in node.node.assumes:
         for c in conjuncts(clause.formula):
             if isinstance(c, ast.Compare):
                 for cop, a, b in zip(c.ops, c.operands, c.operands[1:]):
                     op: str = cop
-                    name, v = _input(a, node), _num(b)
+                    name, v = _input(a, node), _num(b, named)
                     if name is None:
-                        name, v, op = _input(b, node), _num(a), _FLIP[cop]
+                        name, v, op = _input(b, node), _num(a, named), _FLIP[cop]
                     if name is None or v is None:
                         continue
                     bd = out.setdefault(name, Bound())
@@ -375,14 +382,16 @@ class InputSpace:
 
 
 def input_space(node: CheckedNode, plan_bounds: Mapping[str, tuple[Fraction | None, Fraction | None]],
-                seed: Mapping[str, Any] | None = None, constants: Iterable[Fraction] = ()) -> InputSpace:
+                seed: Mapping[str, Any] | None = None, constants: Iterable[Fraction] = (),
+                named: Mapping[str, Fraction] | None = None) -> InputSpace:
     """The :class:`InputSpace` of ``node``; ``plan_bounds`` maps input names
     (without ``in.``) to the plan's ``[lo, hi]`` (closed); ``seed`` maps
     qualified input names to a Z3 model's values (function-typed ones are
     varied per example, see :meth:`InputSpace.vary`); ``constants`` the
     thresholds drawn beside the contract's literals, each with its
-    neighbours (the named constants and the code's, :mod:`.constants`)."""
-    bounds = assumption_bounds(node)
+    neighbours (the named constants and the code's, :mod:`.constants`);
+    ``named`` the context constants' values, which bound an input as literals do."""
+    bounds = assumption_bounds(node, named)
     for name, (lo, hi) in plan_bounds.items():
         bd = bounds.setdefault(name, Bound())
         if lo is not None:
