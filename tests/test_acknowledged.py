@@ -181,3 +181,21 @@ def test_only_a_warning_can_be_acknowledged_and_lint_binds_by_clause_text():
     assert "not a warning" in got[0]["message"] and not problem.get("acknowledged")
     assert lint["flagged"] == "forall(k in NATURAL | out.y <= in.x + 10)" and lint["acknowledged"]["at"] == \
         "contracts/plan.yaml:3:5"
+
+
+@pytest.mark.parametrize("entry, where, said", [
+    ("  - {warning: Gain.g1.c2.redundant, reason: kept for the reader of it}\n", "4:5", "give the flagged text"),
+    ("  - warning: W-unused-bound\n    text: forall(k in NATURAL | TRUE)\n    reason: '...'\n", "6:14",
+     "the reason must say why"),
+])
+def test_a_malformed_acknowledgement_is_one_located_error(tmp_path, entry, where, said):
+    from rclverify.plan.errors import PlanError
+    from rclverify.plan.load import load_plan
+    (tmp_path / "contracts").mkdir()
+    (tmp_path / "contracts" / "gain.rcl").write_text(GAIN, encoding="utf-8")
+    (tmp_path / "contracts" / "plan.yaml").write_text("name: gain\ncontracts: [contracts/gain.rcl]\nacknowledged:\n"
+                                                      + entry, encoding="utf-8")
+    with pytest.raises(PlanError) as e:
+        load_plan(tmp_path)
+    [d] = e.value.diagnostics
+    assert f"{d.loc.line}:{d.loc.col}" == where and said in d.message

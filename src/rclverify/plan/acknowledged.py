@@ -69,10 +69,24 @@ def digest(text: str) -> str:
 
 
 def read_acknowledgements(data: Mapping[str, Any], locs: Mapping[Any, ast.Loc], plan_rel: str) -> tuple[Acknowledgement, ...]:
-    """The plan's ``acknowledged:`` entries (already schema-checked: each has
-    ``warning`` and ``reason``, and ``text`` or ``sha256``)."""
+    """The plan's ``acknowledged:`` entries (schema-checked: each has
+    ``warning`` and ``reason``).  Raises :class:`~.errors.PlanError`, located
+    at the entry, for an entry that gives neither or both of ``text`` and
+    ``sha256``, or whose reason is no sentence (fewer than three words of
+    letters: ``reason: "..."`` says nothing a reviewer can weigh)."""
+    from .errors import plan_error
     out = []
     for i, a in enumerate(data.get("acknowledged") or ()):
+        at = locs.get(("acknowledged", i), ast.Loc(plan_rel, 1, 1))
+        if ("text" in a) == ("sha256" in a):
+            raise plan_error(plan_rel, at.line, at.col, f"acknowledged[{i}] ({a['warning']}): give the flagged text "
+                             "it accepts as text: or its digest as sha256: (one of the two; the report shows both "
+                             "for every warning)", "E-acknowledged")
+        if len(re.findall(r"[A-Za-z]{2,}", str(a["reason"]))) < 3:
+            r = locs.get(("acknowledged", i, "reason"), at)
+            raise plan_error(plan_rel, r.line, r.col, f"acknowledged[{i}] ({a['warning']}): the reason must say why "
+                             f"the warning is accepted, in words a reviewer can weigh, not {a['reason']!r}",
+                             "E-acknowledged")
         out.append(Acknowledgement(str(a["warning"]), normal(a["reason"]),
                                    locs.get(("acknowledged", i), ast.Loc(plan_rel, 1, 1)),
                                    a.get("text"), a.get("sha256"), a.get("file")))
