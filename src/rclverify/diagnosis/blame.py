@@ -46,6 +46,9 @@ from .repairs import link_pairs, _numbers, _peel, _rename
 
 #: Most edited systems checked per problem (each costs a parse, a type check and a Z3 query).
 MAX_TRIALS = 24
+#: Most edited systems checked per refuted temporal requirement (each costs a temporal check:
+#: bounded model checking and an induction, several Z3 queries).
+TEMPORAL_TRIALS = 12
 
 
 def _span(e: Any) -> tuple[int, int, int, int] | None:
@@ -260,7 +263,7 @@ def temporal_culprits(ws: Any, req_id: str, cone: Sequence[str]) -> list[dict[st
     check prove the requirement (the pipeline's own check, on an edited copy)
     and the edited node stays implementable.  Each ``{"node", "guarantee",
     "edit", "how": "threshold" | "offset", "old", "new", "implementable"}``;
-    ``[]`` when no such edit does it within :data:`MAX_TRIALS`."""
+    ``[]`` when no such edit does it within :data:`TEMPORAL_TRIALS`."""
     from ..plan.load import all_requirements
     req = next((r for r in all_requirements(ws.plan) if r.id == req_id), None)
     if req is None or req.formal is None:
@@ -285,7 +288,7 @@ def temporal_culprits(ws: Any, req_id: str, cone: Sequence[str]) -> list[dict[st
                     tries += [("offset", Edit(g.loc.file, *span, str(v)), lit.text, str(v))
                               for v in (int(lit.text) - 1, int(lit.text) + 1) if v >= 0]
             for how, edit, old, new in tries:
-                if trials >= MAX_TRIALS:
+                if trials >= TEMPORAL_TRIALS:
                     return found
                 trials += 1
                 impl = holds(edit, n)
