@@ -143,6 +143,8 @@ def test_acknowledged_warnings_pass_strict_with_their_reasons_everywhere(gain_ws
     assert region["startLine"] == 8  # the plan entry that accepted it
     md = (gain_ws / "reports" / "assurance.md").read_text(encoding="utf-8")
     assert "**Accepted risk**" in md and "the per-step table of the next release" in md
+    attention = md.split("## What needs attention", 1)[1].split("\n## ", 1)[0]
+    assert "Gain.g1.c2.redundant" not in attention  # accepted: listed with its reason, not as outstanding
     argument = json.loads((gain_ws / "reports" / "argument.json").read_text(encoding="utf-8"))
     risks = [e for e in argument["elements"] if str(e["id"]).startswith("A-accepted")]
     assert len(risks) == 2 and all(e["type"] == "assumption" for e in risks)
@@ -163,6 +165,9 @@ def test_a_changed_flagged_text_raises_the_warning_again(gain_ws):
     assert status == {"Gain.g1.c2.redundant": "stale", "W-unused-bound": "ok", "W-implication-precedence": "stale"}
     [f] = [f for f in report["findings"] if f["id"] == "Gain.g1.c2.redundant"]
     assert not f.get("acknowledged") and f["flagged"] == "out.y >= 0 - 1"
+    md = (gain_ws / "reports" / "assurance.md").read_text(encoding="utf-8")
+    attention = md.split("## What needs attention", 1)[1].split("\n## ", 1)[0]
+    assert "W-implication-precedence" in attention and "Gain.g1.c2.redundant" in attention
     why = " ".join(report["summary"]["problems"])
     assert "the text it acknowledged changed" in why and "matches no warning of this run" in why
 

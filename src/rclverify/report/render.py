@@ -337,7 +337,7 @@ def _attention(report: Mapping[str, Any], ev_anchor: Sequence[str]) -> tuple[lis
                 f"{sc['node']}, {sc['rule']}, {sc['source']}",
                 str(sc["explanation"]) or "Assumption conjunct not established:", str(sc["conjunct"]))
     for f in report["findings"]:
-        if rank(f["status"]) > 0:
+        if rank(f["status"]) > 0 and not f.get("acknowledged"):  # an accepted risk is listed with its reason
             where = str(f["node"]) + (f", guarantee {f['guarantee']}" if f["guarantee"] is not None else "")
             msg = str(f["message"]) + (f" {f['explanation']}" if f["explanation"] else "")
             add(f["status"], f"contract health: {f['check']}", f["id"], anchor("finding", f["id"]), where, msg)
@@ -346,6 +346,9 @@ def _attention(report: Mapping[str, Any], ev_anchor: Sequence[str]) -> tuple[lis
             add(d["status"], "derived property", d["node"], anchor("derived", d["node"]),
                 ", ".join(d["rules"]), f"Derived property {d.get('derivation', 'not established')} "
                 "(a side condition of its cone is not discharged):", str(d["property"]))
+    for a in report.get("acknowledgements") or ():  # a stale or refused acknowledgement (plan/acknowledged.py)
+        if a.get("status") != "ok":
+            add(str(a["status"]), "acknowledgement", str(a["warning"]), "acknowledged", str(a["at"]), str(a["message"]))
     for k, lint in enumerate(report["lint"]):
         if str(lint["severity"]).lower() == "error":
             add("error", "lint", str(lint["location"]), anchor("lint", k + 1), str(lint["location"]),
