@@ -441,3 +441,16 @@ def test_a_wrong_initial_value_fails_the_first_property_test_record(tmp_path: Pa
     assert ev["status"] == "failed", ev["explanation"]
     assert ev["explanation"].startswith("nodes/base.py:base declares initially( out.pose == 0 ) (")
     assert "do not satisfy it: out.pose = 4" in ev["explanation"]
+
+
+def test_the_argument_has_a_goal_per_declaration_under_its_requirement(verified: Any) -> None:
+    """Each declaration the proof used is a goal with its evidence, so the
+    requirement's goal is never better than the declarations it rests on."""
+    for variant, base_progress in (("correct", "discharged"), ("late", "failed")):
+        ws = verified[variant][2]
+        els = {e["id"]: e for e in json.loads((ws / "reports/argument.json").read_text())["elements"]}
+        goals = {i: e["status"] for i, e in els.items() if i.startswith("G-decl.")}
+        assert goals == {"G-decl.Planner_progress": "discharged", "G-decl.Base_initially_1": "discharged",
+                         "G-decl.Base_progress": base_progress}, goals
+        assert "G-decl.Base_progress" in els["S-ARRIVE"]["supported_by"]
+        assert els["G-ARRIVE"]["status"] == ("discharged" if variant == "correct" else "failed")

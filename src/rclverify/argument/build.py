@@ -106,6 +106,7 @@ def _requirement_goal(b: "_Builder", r: Mapping[str, Any], guarantee_goal: Mappi
                 nodes_used.append(str(p["node"]))
     for name in nodes_used:
         kids += [ident("G", "sc", sc["id"]) for sc in sides.get(name, [])]
+    kids += [_declaration_goal(b, d) for d in c.get("declarations") or []]
     ctx = [j_calc] + [b.add(Element(ident("A", rid, "assuming", k), "assumption",
                                     _clip(f"{rid} assumes: {a}"), ref=rid))
                       for k, a in enumerate(c.get("assuming") or [], 1)]
@@ -117,6 +118,20 @@ def _requirement_goal(b: "_Builder", r: Mapping[str, Any], guarantee_goal: Mappi
         supported_by=tuple(dict.fromkeys(kids)), in_context_of=tuple(ctx), ref=rid))
     # its confidence is stated at its assurance claim point (.claim_points)
     return b.add(Element(ident("G", rid), "goal", _clip(f"{rid}: {r['text']}"), supported_by=(strategy,), ref=rid))
+
+
+def _declaration_goal(b: "_Builder", d: Mapping[str, Any]) -> str:
+    """The goal that a declaration a proof used holds of its node's
+    implementation (issue 64), supported by its evidence as the roll-up
+    reads it (requirements/rollup.declaration_evidence): the monitors' runs,
+    the property tests, or the declarations it follows from."""
+    label = str(d["label"])
+    sn = b.add(Element(ident("Sn", "decl", label), "solution",
+                       _clip(f"Evidence of {label} ({d.get('source', '')}): {d['status']} ({d.get('words', '')})"),
+                       status=str(d["status"]), ref=label))
+    return b.add(Element(ident("G", "decl", label), "goal",
+                         _clip(f"{d['node']} keeps its declaration {d.get('text', '')}".rstrip()),
+                         supported_by=(sn,), ref=label))
 
 
 class _Builder:

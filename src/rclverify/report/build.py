@@ -486,6 +486,8 @@ def requirement_check(record: Mapping[str, Any] | None, traced_status: str, g_st
     verdict, status, note = roll_up(record, g_status, sc_status, traced_status, d_status)
     from .cex_cone import with_trace_view  # a temporal trace cut to what matters (issue 48)
     details = dict(with_trace_view({k: (record or {}).get(k) for k in _CHECK_FIELDS}))
+    from ..requirements.rollup import declaration_evidence  # the declarations it used, with their evidence (issue 64)
+    details["declarations"] = declaration_evidence(record, d_status)
     return {"status": status, "verdict": verdict, "note": note, "check": details}
 
 

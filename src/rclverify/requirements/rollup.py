@@ -153,6 +153,23 @@ def _premise_statuses(record: Mapping[str, Any], g_status: Callable[[str, int], 
     return statuses
 
 
+def declaration_evidence(record: Mapping[str, Any] | None, d_status: DeclStatus | None) -> list[dict[str, Any]]:
+    """The declarations a requirement's proof used, each with its evidence:
+    ``[{"label", "node", "kind", "index", "text", "source", "status",
+    "words"}]`` (``d_status`` as for :func:`roll_up`; ``[]`` without a
+    record).  The report carries them in the requirement's ``check`` and
+    the argument makes a goal of each (argument/build.py)."""
+    out = []
+    for p in (record or {}).get("used") or []:
+        if p.get("kind") in ("progress", "initial value"):
+            st, words = d_status(p["node"], p["kind"], int(p.get("index", 0))) if d_status is not None else (
+                "pending", "declared, not verified")
+            out.append({"label": p["label"], "node": p["node"], "kind": p["kind"], "index": int(p.get("index", 0)),
+                        "text": f"initially( {p.get('text', '')} )" if p["kind"] == "initial value" else p.get("text", ""),
+                        "source": p.get("source", ""), "status": st, "words": words})
+    return out
+
+
 def roll_up(record: Mapping[str, Any] | None, g_status: Callable[[str, int], str], sc_status: Mapping[str, str],
             traced_status: str, d_status: DeclStatus | None = None) -> tuple[str, str, str]:
     """``(verdict, status, note)`` of one requirement.
