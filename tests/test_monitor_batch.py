@@ -374,3 +374,11 @@ def test_column_trace_refuses_bad_columns() -> None:
     t = ColumnTrace(np.array([1, 0]), [0.0, 1.0], {"/a": {"x": ["s"]}, "b": {"x": np.array([2.5])}}, "r", ["b", "/a"])
     assert [(e.topic, e.fields, e.where) for e in t] == [("a", {"x": "s"}, "r: row 0"), ("b", {"x": 2.5}, "r: row 1")]
     assert type(list(t)[1].fields["x"]) is float
+
+
+def test_empty_column_trace_is_judged_as_no_events(checked: Any) -> None:
+    from rclverify.traces.table import ColumnTrace
+    rules = load_rules(RULES)
+    runs = [check_trace(checked, [checked.nodes["Classifier"]], src, rules, 0.1, batch=batch)
+            for src, batch in ((iter([]), False), (ColumnTrace([], []), True))]
+    assert runs[0] == runs[1] and runs[0][0] == 0
