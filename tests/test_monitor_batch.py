@@ -374,6 +374,8 @@ def test_column_trace_refuses_bad_columns() -> None:
     t = ColumnTrace(np.array([1, 0]), [0.0, 1.0], {"/a": {"x": ["s"]}, "b": {"x": np.array([2.5])}}, "r", ["b", "/a"])
     assert [(e.topic, e.fields, e.where) for e in t] == [("a", {"x": "s"}, "r: row 0"), ("b", {"x": 2.5}, "r: row 1")]
     assert type(list(t)[1].fields["x"]) is float
+    ints = ColumnTrace(["a"], [0.0], {"a": {"x": np.array([3], dtype=np.int64)}})
+    assert type(list(ints)[0].fields["x"]) is int  # a Python int, as a log's message holds it
 
 
 def test_empty_column_trace_is_judged_as_no_events(checked: Any) -> None:

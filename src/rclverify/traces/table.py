@@ -96,9 +96,13 @@ class ColumnTrace:
 
 
 def _column(values: Any) -> Any:
-    """A field's values as kept: a float64 or string array as given, anything else as a list."""
-    if isinstance(values, np.ndarray) and (values.dtype == np.float64 or values.dtype.kind == "U"):
-        return values.reshape(-1)
+    """A field's values as kept: a float64 or string array as given, anything else as a list
+    (another array's values as Python numbers, the type a log's message gives: an ``int64``
+    array's as ``int``, never a numpy scalar)."""
+    if isinstance(values, np.ndarray):
+        if values.dtype == np.float64 or values.dtype.kind == "U":
+            return values.reshape(-1)
+        return values.reshape(-1).tolist()
     return list(values)
 
 
