@@ -121,7 +121,7 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--root", type=Path, required=True, help="directory holding one extracted tree per truth file")
     ap.add_argument("--verbose", action="store_true", help="list every site missed and every wrong edge")
-    ap.add_argument("--split", choices=("train", "heldout", "heldout-b"), help="measure only this split")
+    ap.add_argument("--split", choices=("train", "heldout", "heldout-b", "heldout-c"), help="measure only this split")
     a = ap.parse_args()
     totals: dict[str, dict[str, float]] = {}
     for path in sorted(DATA.glob("ros_heldout4_*.json")):

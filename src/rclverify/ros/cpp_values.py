@@ -28,6 +28,8 @@ from .cpp_params import KEY, param_read, string_value
 from .cpp_scope import _HANDLE_TYPES, MAX_DEPTH, CppScope, Fn, base_name, is_node_type
 
 _T = treesitter.text
+#: namespaces of libraries whose functions the workspace does not define: their calls are not followed
+_LIBRARY = ("std::", "ros::", "rclcpp", "boost::", "tf2", "Eigen::", "rcutils_", "rcl_", "rmw_", "cv::", "pcl::")
 
 
 #: rclcpp's name resolution for a node: ``NodeBaseInterface::resolve_topic_or_service_name``
@@ -119,8 +121,8 @@ class CppValues(CppScope):
             if method in ("c_str", "str", "data", "as_string_array") and not args:
                 return self.value(recv, depth + 1)
             if not args and recv is not None and recv.type == "call_expression":
-                inner = self.value(recv, depth + 1)  # get_parameter("t").as_string()
-                if inner is not None and inner[0] == "param":
+                inner = self.value(recv, depth + 1)  # get_parameter("t").as_string(), wrapper(node, "t").get<T>()
+                if inner is not None and inner[0] in ("param", "ret"):
                     return inner
             if method == "create_sub_node" and len(args) == 1:
                 return ("nh", (("h", self.value(recv, depth + 1)), ("ns", self.value(args[0], depth + 1))))
@@ -138,6 +140,8 @@ class CppValues(CppScope):
             pname, default, _ref, recv, ros2 = r
             if default is None and ros2:
                 default = self.declared.get(pname)
+            if default is None and ros2 and ftext.split("<")[0].endswith("declare_parameter") and len(args) >= 2:
+                default = self._symbolic_default(args[1], depth)
             if pname.startswith(KEY):  # a computed key: its value, read here or by the linker
                 key = self.value(args[0], depth + 1)
                 text = symbols.text(key) if key is not None and symbols.is_concrete(key) else None
@@ -145,7 +149,42 @@ class CppValues(CppScope):
                     return None
                 return ("param", "~" + text if text is not None else key, default, None)
             return ("param", pname, default, self.value(recv, depth + 1) if recv is not None and not ros2 else None)
-        return None
+        return self._returned(n, fn, args, depth)
+
+    def _symbolic_default(self, n: Any, depth: int) -> symbols.Val:
+        """The default a ``declare_parameter(name, x)`` is given when ``x`` is no
+        literal but a value the linker may read (a parameter of a wrapper
+        function, also as ``rclcpp::ParameterValue(x)`` / ``ParameterValue{x}``);
+        ``None`` otherwise."""
+        if n.type in ("call_expression", "compound_literal_expression"):
+            head = _T(n.child_by_field_name("function") or n.child_by_field_name("type"))
+            a = n.child_by_field_name("arguments") or n.child_by_field_name("value")
+            if head.split("::")[-1] != "ParameterValue" or a is None or len(a.named_children) != 1:
+                return None
+            n = a.named_children[0]
+        v = self.value(n, depth + 1)
+        return v if v is not None and not symbols.is_concrete(v) else None
+
+    def _returned(self, n: Any, fn: Any, args: list[Any], depth: int) -> symbols.Val:
+        """``("ret", callee, unit, args)`` for a call of a function the workspace
+        may define (a free function, or a method of this object or of a node),
+        read by the linker from the callee's ``return`` statements; ``None`` for
+        a library's function or a method of another object."""
+        if fn is None:
+            return None
+        head = _T(fn).replace("template ", "").split("<")[0].strip()
+        if not head or head.startswith(_LIBRARY) or fn.type not in ("identifier", "qualified_identifier",
+                                                                   "template_function", "field_expression"):
+            return None
+        if fn.type == "field_expression":
+            recv = fn.child_by_field_name("argument")
+            if recv is None or not (recv.type == "this" or self.is_handle(recv)):
+                rv = self.value(recv, depth + 1) if recv is not None else None
+                if rv is None or rv[0] != "nh":  # auto node = shared_from_this(): a node too
+                    return None
+        owner = self.fn_of(n)
+        return ("ret", head, owner.unit if owner is not None else None,
+                tuple(self.value(a, depth + 1) for a in args))
 
     def handle(self, args: list[Any], depth: int = 0) -> symbols.Val:
         """A ``ros::NodeHandle`` made with constructor arguments ``args``: ``()``,

@@ -39,7 +39,7 @@ def resolve(kind: str, name: symbols.Val, handle: symbols.Val, msg_type: str | N
     what = WHAT[kind]
     if name is not None and name[0] == "runtime":  # argv, argparse, the graph at run time (symbols)
         return None, Note(name_src, f"{what} name is '{short(written)}', {name[1]}: not resolved statically")
-    if name is None or name[0] in ("arg", "field", "ext", "nh"):
+    if name is None or name[0] in ("arg", "field", "ext", "nh", "ret"):
         return None, Note(name_src, f"{what} name is '{short(written)}', not a string literal: not resolved statically")
     segs = symbols.segments(handle)
     if segs is None:

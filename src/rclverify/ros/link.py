@@ -37,6 +37,7 @@ from . import emit, names, plugins, symbols
 from .cpp_types import split_template
 from .model import Endpoint, Note, Src
 from .link_members import LinkMembers
+from .link_returns import Returns
 from .link_values import MAX_DEPTH, MAX_VALUES, Values
 from .programs import PackageCode, Program
 from .unit_names import canonical
@@ -58,7 +59,7 @@ class Linked:
     files: list[str] = field(default_factory=list)
 
 
-class Linker(LinkMembers, Values):
+class Linker(LinkMembers, Values, Returns):
     """Link one program of a package (see the module docstring); ``known(t)`` says
     whether the scan's type table defines message type ``t``."""
 
@@ -74,6 +75,15 @@ class Linker(LinkMembers, Values):
         self.using_ns = sorted({ns for r in self.recs.values() for ns in r.get("using_ns", [])})
         entry_units: set[str] = set()
         self.optional: dict[str, int] = {k: n for r in self.recs.values() for k, n in r.get("optional", {}).items()}
+        self.returns: dict[str, list[Any]] = {}
+        self.fn_tparams: dict[str, list[str]] = {}
+        self.call_targs: list[tuple[str, str | None, str | None, int, list[str]]] = []
+        for r in self.recs.values():  # a header read by several files: its definitions once
+            self.fn_tparams.update(r.get("fn_tparams", {}))
+            self.call_targs += [tuple(c) for c in r.get("call_targs", []) if tuple(c) not in self.call_targs]
+            for k, entries in r.get("returns", {}).items():
+                self.returns.setdefault(k, [])
+                self.returns[k] += [tuple(e) for e in entries if tuple(e) not in self.returns[k]]
         for f, r in self.recs.items():
             for k, (unit, params, ptypes, defaults) in r.get("fns", {}).items():
                 old = self.fns.get(k)
@@ -346,10 +356,11 @@ class Linker(LinkMembers, Values):
         (``bus.create_publisher(node, "t")``, :mod:`sources_cpp`) whose body is
         not in the program: it is not rclcpp's, so nothing is guessed from it."""
         for r in self.recs.values():
-            for callee, unit, fkey, src in r.get("user_creates", []):
+            for callee, unit, fkey, src, *why in r.get("user_creates", []):
                 ck, _cu = self.callee("call", callee, unit)
                 if self.runs(unit, fkey) and (ck is None or ck not in self.fns):
-                    note(Note(src, f"{callee}(...) takes the node first, so it is no rclcpp method, and its body "
+                    said = why[0] if why else "takes the node first"
+                    note(Note(src, f"{callee}(...) {said}, so it is no rclcpp method, and its body "
                                    f"is not in the workspace: its endpoints are not read"))
 
     def pin(self, pins: dict[str, int]) -> None:
@@ -366,7 +377,8 @@ class Linker(LinkMembers, Values):
         t = e.msg_type if e.msg_type is not None else self.cb_type(e.kind, cb)
         types: list[str | None] = [t]
         if t is None and isinstance(cb, tuple) and cb[:1] == ("type",):  # a class template's parameter
-            types = [self.cb_type(e.kind, ("type", x)) for x in self.template_types(e.unit, cb[1])] or [None]
+            types = [self.cb_type(e.kind, ("type", x)) for x in self.template_types(e.unit, cb[1])
+                     or self.fn_template_types(e.func, cb[1])] or [None]
             t = types[0] if all(types) else None
         argtype = cb if isinstance(cb, tuple) and cb[:1] == ("argtype",) else None
         got: list[Endpoint] = []

@@ -54,6 +54,9 @@ class Values:
         def match(self, name: str, caller: str | None) -> str | None:
             ...
 
+        def returned(self, v: Any, env: dict[int, Any], fkey: str | None, depth: int) -> list[Any]:
+            ...
+
     def contexts(self, fkey: str | None, depth: int = 0) -> list[dict[int, Any]]:
         """The parameter values each call site of ``fkey`` gives (``[{}]``: none known)."""
         if fkey is None or fkey not in self.fns:
@@ -119,8 +122,12 @@ class Values:
             keys = [v[1]] if isinstance(v[1], str) else [
                 "~" + t if t is not None and not t.startswith("~") else None
                 for t in (symbols.text(x) for x in self.eval(v[1], env, fkey, depth + 1))]  # a computed key
-            return limit([("param", key, v[2], h) if key is not None else None for key in keys
+            defaults = [v[2]] if not isinstance(v[2], tuple) else [  # a wrapper's default: its argument
+                symbols.text(x) for x in self.eval(v[2], env, fkey, depth + 1)]
+            return limit([("param", key, d, h) if key is not None else None for key in keys for d in defaults
                           for h in (self.eval(v[3], env, fkey, depth + 1) if v[3] else [None])])
+        if k == "ret":
+            return self.returned(v, env, fkey, depth)
         if k == "nh":
             segs: list[tuple[Any, ...]] = [()]
             for kind, x in v[1]:
@@ -179,7 +186,10 @@ def _homes(v: Any) -> set[str]:
     if v[0] == "nh":
         return set().union(*(_homes(x) for _k, x in v[1]))
     if v[0] == "param":
-        return _homes(v[3]) | (_homes(v[1]) if isinstance(v[1], tuple) else set())
+        return _homes(v[3]) | (_homes(v[1]) if isinstance(v[1], tuple) else set()) | \
+            (_homes(v[2]) if isinstance(v[2], tuple) else set())
+    if v[0] == "ret":
+        return set().union(*(_homes(x) for x in v[3]))
     if v[0] == "ops":
         return _homes(v[2])
     if v[0] == "info":

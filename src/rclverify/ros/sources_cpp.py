@@ -212,6 +212,10 @@ class _File(MemberReader):
                                 for f in list(s.decls.values()) + list(s.fns.values())}
         self.out["fns"] = {f.key: (f.unit, f.params, f.ptypes, [s.value(d) for d in f.defaults])
                            for f in list(s.decls.values()) + list(s.fns.values())}
+        self.out["returns"] = self.returns()
+        self.out["fn_tparams"] = {s.fns[n.id].key: _tparams(n.parent) for n in self.nodes
+                                  if n.type == "function_definition" and n.id in s.fns and n.parent is not None
+                                  and n.parent.type == "template_declaration"}
         self.out["aliases"] = self.aliases
         self.out["units"] = {c: {"bases": i["bases"], "members": i["members"], "tparams": i.get("tparams", [])}
                              for c, i in s.classes.items()}
@@ -221,6 +225,62 @@ class _File(MemberReader):
                               if v is not None}
         self.out["ros2"], self.out["using_ns"] = self.ros2, s.using_ns
         return self.out
+
+    def rclcpp_like(self, full: str, args: list[Any], n: Any) -> bool:
+        """Whether qualified call ``full(args)`` may be rclcpp's (a create/advertise
+        call): a factory given the node first, rclcpp's or roscpp's own name, or a
+        node class's method named through its class (``rclcpp::Node::create_publisher``,
+        the caller's own class or a base of it)."""
+        if not full.split("::")[-1].startswith("create_") or full.startswith(("rclcpp", "ros::")):
+            return True
+        if len(args) >= 2 and (self.scope.is_handle(args[0]) or self.generic_node(args[0])):
+            return True
+        qual = full.rsplit("::", 1)[0].split("::")[-1].split("<")[0]
+        owner = self.scope.fn_of(n)
+        bases = self.scope.classes.get(owner.unit, {}).get("bases", []) if owner is not None else []
+        return "Node" in qual or (owner is not None and qual == owner.unit.split("::")[-1]) or any(
+            b.split("<")[0].split("::")[-1] == qual for b in bases)
+
+    def generic_node(self, n: Any) -> bool:
+        """Whether expression ``n`` is declared with a template parameter of its
+        function or class (``template<typename NodeT> C(const NodeT & parent)``):
+        given first to a stack's ``ns::create_subscription<T>(parent, topic, ...)``,
+        it stands for the node of any kind the template is made with (issue 65)."""
+        t = self.scope.type_of(n) if n.type == "identifier" else None
+        if not t:
+            return False
+        base = t.replace("const", "").replace("&", "").replace("*", "").strip()
+        p = n.parent
+        while p is not None:
+            if p.type == "template_declaration":
+                ps = p.child_by_field_name("parameters")
+                if base in _tparams(p):
+                    return True
+            p = p.parent
+        return False
+
+    def returns(self) -> dict[str, list[tuple[int, int, list[symbols.Val], list[symbols.Val]]]]:
+        """Per function key, one ``(parameters, defaulted ones, default values,
+        values returned)`` per definition (overloads apart) that returns a value
+        the linker may read: a ``("ret", ...)`` call of it is read from these
+        (a ``declare_parameter`` wrapper; issue 65).  A lambda's ``return`` is not
+        its enclosing function's."""
+        s, got = self.scope, {}  # type: ignore[var-annotated]
+        for n in self.nodes:
+            if n.type != "return_statement" or not n.named_children:
+                continue
+            p = n.parent
+            while p is not None and p.type not in ("function_definition", "lambda_expression"):
+                p = p.parent
+            f = s.fns.get(p.id) if p is not None and p.type == "function_definition" else None
+            if f is not None:
+                got.setdefault(p.id, (f, []))[1].append(s.value(n.named_children[0]))
+        out: dict[str, list[tuple[int, int, list[symbols.Val], list[symbols.Val]]]] = {}
+        for f, vals in got.values():
+            if any(v is not None for v in vals):
+                out.setdefault(f.key, []).append((len(f.params), sum(d is not None for d in f.defaults),
+                                                  [s.value(d) for d in f.defaults], vals))
+        return out
 
     def initializer(self, n: Any) -> None:
         head = n.named_children[0] if n.named_children else None
@@ -314,6 +374,10 @@ class _File(MemberReader):
         if kind is None or not args:
             if not full.startswith(_LIBRARY):
                 self.record("call", full, args, n)
+                if targs:  # a function template's types, read in its body by the linker
+                    owner = s.fn_of(n)
+                    self.out.setdefault("call_targs", []).append(
+                        (full, owner.unit if owner else None, owner.key if owner else None, len(args), targs))
             return
         if last == "create_server":
             return
@@ -325,9 +389,20 @@ class _File(MemberReader):
             self.out.setdefault("user_creates", []).append(
                 (full, owner.unit if owner else None, owner.key if owner else None, self.src(n)))
             return
+        if recv is None and "::" in full and not self.rclcpp_like(full, args, n):
+            # ns::create_subscription<T>(topic, ...): no node is given and ns is no rclcpp class:
+            # a workspace's function, followed by the linker into its body, else a note (issue 65)
+            self.record("call", full, args, n)
+            owner = s.fn_of(n)
+            self.out.setdefault("user_creates", []).append(
+                (full, owner.unit if owner else None, owner.key if owner else None, self.src(n),
+                 "is a function of another namespace than rclcpp's, given no node"))
+            return
         handle = s.value(recv) if recv is not None else None
-        if recv is None and "::" in full and last.startswith("create_") and len(args) >= 2 and s.is_handle(args[0]):
-            handle, args = s.value(args[0]), args[1:]  # a stack's factory: ns::create_service<T>(node, name, ...)
+        if recv is None and last.startswith("create_") and len(args) >= 2 and (
+                s.is_handle(args[0]) or self.generic_node(args[0])):
+            # a stack's factory, qualified or not: ns::create_service<T>(node, name, ...), read at its call
+            handle, args = s.value(args[0]), args[1:]
         if last in ("advertise", "subscribe") and len(args) >= 2 and s.is_handle(args[0]):
             # advertise(nh, topic, n) / subscribe(nh, topic, n) of an object given the handle
             # (topic_tools::ShapeShifter, a message_filters subscriber of a class this file does not know)
@@ -378,6 +453,13 @@ class _File(MemberReader):
         t = action_type(self.aliases.get(targs[0], targs[0])) if targs else None
         self.emit(kind, args[k], t, n, self.scope.value(args[0]) if k == 1 else None,
                   ("type", targs[0]) if t is None and targs else None)
+
+
+def _tparams(decl: Any) -> list[str]:
+    """The type parameters' names of a ``template<...>`` declaration."""
+    ps = decl.child_by_field_name("parameters")
+    return [_T(x.child_by_field_name("name") or (x.named_children[-1] if x.named_children else x))
+            for x in (ps.named_children if ps is not None else []) if "type" in x.type]
 
 
 def scan_cpp(data: bytes, shown: str) -> dict[str, Any]:

@@ -12,8 +12,14 @@ A value is a tuple (hashable, picklable, so it lives in the parse cache):
   Python ``self.name``), bound in the class's constructor or methods;
 * ``("param", name, default, handle)``: a ROS parameter read (``name`` a string,
   or the value of a ROS 2 key computed in the code, without its ``~``; ``default`` a
-  string or ``None``; ``handle`` the node handle it is read through, a value
+  string or ``None``, or a value of the function's own parameters that the
+  linker reads to a string (a ``declare_parameter`` wrapper's default);
+  ``handle`` the node handle it is read through, a value
   or ``None``; the parameter's name resolves against that handle's namespace);
+* ``("ret", callee, unit, args)``: what a workspace function returns, called
+  as ``callee`` (its text as written) from unit ``unit`` with argument values
+  ``args``: the linker reads the callee's ``return`` statements with those
+  arguments (a wrapper of ``declare_parameter``; issue 65);
 * ``("nh", segments)``: a node handle (roscpp ``ros::NodeHandle``, an rclcpp
   node or sub-node): what it adds to the node's namespace, in order, each
   ``("ns", value)`` (a namespace: ``"~"`` private, ``"left"`` relative) or
@@ -91,12 +97,13 @@ def is_concrete(v: Val) -> bool:
     if v is None:
         return True
     k = v[0]
-    if k in ("arg", "field", "ext"):
+    if k in ("arg", "field", "ext", "ret"):
         return False
     if k == "info":
         return is_concrete(v[1])
     if k == "param":
-        return is_concrete(v[3]) and (isinstance(v[1], str) or is_concrete(v[1]))
+        return is_concrete(v[3]) and (isinstance(v[1], str) or is_concrete(v[1])) and \
+            (not isinstance(v[2], tuple) or is_concrete(v[2]))
     if k == "nh":
         return all(is_concrete(x) for _kind, x in v[1])
     if k == "cat":

@@ -31,7 +31,8 @@ from .model import Endpoint
 
 #: the parts of a file's record the linker reads units and function keys from
 _LINKED = ("fns", "units", "fields", "calls", "endpoints", "node_names", "member_decls", "member_calls",
-           "callbacks", "consts", "aliases", "user_creates", "optional")
+           "callbacks", "consts", "aliases", "user_creates", "optional", "returns",
+           "call_targs", "fn_tparams")
 
 
 def canonical(recs: dict[str, dict[str, Any]]) -> dict[str, dict[str, Any]]:
