@@ -1,0 +1,105 @@
+"""The suite's tiers, the order its modules are handed to the workers, and the
+Hypothesis profile of the tests (issues 66 and 67; docs/ci.md, "The test suite").
+
+Tiers.  Two markers are applied here, by module, so that a module's tier is
+read in one place:
+
+- ``live``: the module starts real outside processes and talks to them over
+  the network or a pipe and waits on them: a ROS 1 master, rclpy nodes or
+  DDS participants, a WebSocket oracle, Chromium, the language server;
+- ``slow``: the module costs more than about two CPU seconds, or runs the
+  whole pipeline (``doit verify`` or ``rclverify verify``) on a workspace.
+
+``python3 -m pytest -m "not slow and not live"`` is the inner tier (under a
+minute on two cores); plain ``python3 -m pytest`` runs everything, as CI does.
+
+Order.  With ``--dist loadfile`` each module goes to one worker whole, and a
+worker takes the next module when it is free.  pytest-xdist's default hands
+out the modules with the most tests first, which leaves the modules of one
+or two long tests (a colcon build, a live ROS system, a whole oracle run) to
+the end, where one worker runs them while the others have nothing left:
+the classic tail of list scheduling.  ``pyproject.toml`` turns that reordering
+off (``--no-loadscope-reorder``) and this file sorts the modules by the CPU
+seconds measured for them (:data:`SECONDS`, longest first; Graham's LPT rule),
+the modules not listed after them in their usual order.  The figures are
+serial CPU seconds of one module (``/usr/bin/time``, user + system, pytest's
+own start-up subtracted) on the 2-core development machine; only their order
+matters, so a rough figure is enough, and a module that grows past two
+seconds belongs in :data:`SLOW` and here.
+"""
+from __future__ import annotations
+
+import os
+
+import pytest
+from hypothesis import HealthCheck, settings
+
+#: Modules that start live systems or subprocesses they talk to (``live``).
+LIVE = frozenset({
+    "test_bench_smoke_live", "test_browser_report", "test_dds_wire", "test_generate_names_ros2",
+    "test_lsp_fuzz", "test_lsp_hostile", "test_lsp_invalid", "test_lsp_nvim", "test_lsp_server",
+    "test_monitor_live_dds", "test_monitor_live_hostile", "test_monitor_live_ros1", "test_monitor_oracle",
+    "test_ros2_diff", "test_ros2_generated", "test_ros2_services_actions", "test_ros2_silence_deadlines",
+    "test_ros2_types_record", "test_ros_diff_dds", "test_ros_diff_live", "test_ros_live",
+    "test_ros_master_hostile", "test_services_live_ros1",
+})
+
+#: Serial CPU seconds of each module that costs more than about two (pytest's start-up subtracted).
+SECONDS: dict[str, float] = {
+    "test_pipeline_e2e": 36.8, "test_bench_smoke_live": 28.9, "test_integrity": 33.5,
+    "test_inputs_faults": 16.8, "test_hardening_greens": 15.9, "test_ros2_generated": 14.3,
+    "test_generate_names_ros2": 14.2, "test_bench_smoke": 13.3, "test_example_delivery": 11.4,
+    "test_example_warehouse": 18.1, "test_lsp_server": 10.6, "test_monitor_fuzz": 5.5,
+    "test_hardening_misc": 8.9, "test_generate_names": 9.2, "test_generate_ros2": 8.1,
+    "test_temporal_semantics_oracle": 8.0, "test_solver_session": 7.8, "test_spin_no_wrong_green": 7.5,
+    "test_ros2_types_record": 7.4, "test_temporal_requirements": 7.2, "test_spin": 6.5,
+    "test_one_evaluator": 6.4, "test_response_pattern": 6.2, "test_generate_cpp": 6.1,
+    "test_summary_incremental": 6.1, "test_dafny": 5.9, "test_property_tests": 5.9,
+    "test_ros_hostile": 5.8, "test_temporal_progress": 5.7, "test_temporal_oracle": 5.6,
+    "test_report_problems_roots": 5.3, "test_health": 5.1, "test_cache_poison": 4.9,
+    "test_browser_report": 4.9, "test_rcl_printer": 4.8, "test_findings_context": 4.7,
+    "test_calculus_summary": 4.6, "test_property_tests_facts": 4.6, "test_lsp_fuzz": 4.6,
+    "test_cli_newuser": 4.8, "test_ros2_silence_deadlines": 4.4, "test_requirements": 4.3,
+    "test_query_ladder": 4.2, "test_spin_oracle": 4.1, "test_diagnosis": 4.1, "test_quotient": 4.0,
+    "test_temporal_ranking": 4.0, "test_rcl_fuzz": 3.7, "test_jsonl_blocks": 3.6,
+    "test_report_unverified": 3.6, "test_advice": 3.6, "test_monitor_live_ros1": 3.6,
+    "test_ros_diff_live": 3.4, "test_second_solver": 3.3, "test_ros2_services_actions": 3.2,
+    "test_cluster": 3.1, "test_services_live_ros1": 3.1, "test_ros2_diff": 3.1, "test_experiment": 3.0,
+    "test_monitor_batch": 2.9, "test_generate_cpp_candidates": 2.9, "test_rcl_language": 2.8,
+    "test_layers": 2.7, "test_realizable": 2.6, "test_bench_compose_pacti": 2.5,
+    "test_calculus_context": 2.5, "test_generate_contract_layer": 2.5, "test_init": 2.5,
+    "test_straightline": 2.5, "test_generate_example": 3.7, "test_ros_ground": 2.1,
+}
+
+#: Modules that run the whole pipeline although they cost less than two seconds: still ``slow``.
+PIPELINE = frozenset({
+    "test_confidence", "test_deadlines", "test_deadlines_report", "test_evidence_staleness",
+    "test_generate_example", "test_inputs_paths", "test_locations_cause",
+    "test_monitor_periods", "test_monitor_silence", "test_one_root_one_repair", "test_problems_shared",
+    "test_realizer", "test_ros_init", "test_temporal_deadlock", "test_temporal_progress",
+    "test_units_inferred", "test_deadline_monitors", "test_monitor_floats",
+})
+
+#: The ``slow`` tier: every module measured above two CPU seconds, and the pipeline runs.
+SLOW = frozenset({name for name, s in SECONDS.items() if s >= 2.0}) | PIPELINE
+
+
+def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
+    """Mark each item with its module's tiers and order the modules longest first (stable within a module)."""
+    first: dict[str, int] = {}
+    for k, item in enumerate(items):
+        module = item.path.stem
+        first.setdefault(module, k)
+        if module in LIVE:
+            item.add_marker(pytest.mark.live)
+        if module in SLOW:
+            item.add_marker(pytest.mark.slow)
+    items.sort(key=lambda item: (-SECONDS.get(item.path.stem, 0.0), first[item.path.stem]))
+
+
+# Hypothesis: no per-example deadline (a loaded 2-core machine makes a slow example a false alarm,
+# and the suite's speed is measured by bench/ scripts, not by timed tests) and no "too slow" health
+# check for the same reason.  The number of examples is each test's own setting or Hypothesis's.
+settings.register_profile("tests", deadline=None,
+                          suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
+settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "tests"))
