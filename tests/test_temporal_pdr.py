@@ -1,5 +1,6 @@
-"""Safety proofs a user can finish (issue 64): IC3/PDR with Z3's Spacer, its
-certificate re-checked, and the plan's ``invariant:`` for every temporal
+"""Safety proofs a user can finish (issue 64): k-induction with invariants
+generated from the system's constants (Houdini), IC3/PDR with Z3's Spacer,
+its certificate re-checked, and the plan's ``invariant:`` for every temporal
 pattern, with the step that breaks a candidate named.
 
 The oracle compares the verdicts with a brute-force reachability
@@ -21,6 +22,7 @@ from hypothesis import strategies as st
 from rclverify.cli import main
 from rclverify.pipeline import Workspace, stage_check, stage_export, stage_run
 from rclverify.plan.errors import PlanError
+from rclverify.requirements.houdini import generate
 from rclverify.requirements.pdr import recheck, spacer_invariant
 from rclverify.requirements.safety import Hint, by_pdr, hint_fails, prove_always
 from rclverify.requirements.tsys import TransitionSystem
@@ -60,7 +62,8 @@ def _system(init, succ) -> TransitionSystem:
 @given(systems())
 def test_pdr_equals_reachability(sys_) -> None:
     """Spacer's verdict, its certificate re-checked, and the run it leads to, against the enumeration: x is an
-    integer, so the states outside 0..3 (no successor, not initial) are there for Spacer to exclude."""
+    integer, so the states outside 0..3 (no successor, not initial) are there for Spacer to exclude; the whole
+    procedure (after 1-induction) agrees, and the invariant Houdini generates holds in every reachable state."""
     init, succ, bad = sys_
     ts = _system(init, succ)
     prop = lambda s: z3.Not(z3.Or(*[_is(s, b) for b in bad])) if bad else z3.BoolVal(True)  # noqa: E731
@@ -76,22 +79,39 @@ def test_pdr_equals_reachability(sys_) -> None:
         while not layer & bad:
             layer, n = {t for s in layer for t in succ[s]}, n + 1
         assert len(run) - 1 == n
-    w = prove_always(ts, prop, max_k=1, timeout_ms=5_000)  # 1-induction first, then Spacer
+    w = prove_always(ts, prop, max_k=1, timeout_ms=5_000)  # 1-induction, generated bounds, then Spacer
     assert w.status == v.status
+    generated = generate(ts, prop, 5_000, 10_000)  # Houdini's invariant holds in every reachable state
+    assert not isinstance(generated, str)
+    for x, b in _reachable(init, succ):
+        assert all(z3.is_true(z3.simplify(p({"x": z3.IntVal(x), "b": z3.BoolVal(b)}))) for _, p in generated)
 
 
 def _counter(top: int, extra: bool = False) -> TransitionSystem:
     """x counts 0..top and wraps; above top (no run gets there) it counts on.  ``extra``: an array copied
     by a quantified step, which Spacer refuses (a quantifier in a recursive rule)."""
-    sorts = {"x": z3.IntSort()}
+    return _counters(top, ("x",), extra)
+
+
+def _counters(top: int, names: tuple[str, ...], extra: bool = False) -> TransitionSystem:
+    """Counters that count 0..top in step, wrapping together (``_counter``'s, one per name)."""
+    sorts = {n: z3.IntSort() for n in names}
     if extra:
         sorts["a"] = z3.ArraySort(z3.IntSort(), z3.IntSort())
     i = z3.Int("i")
 
     def trans(s, t):
-        step = t["x"] == z3.If(s["x"] == top, 0, s["x"] + 1)
-        return z3.And(step, z3.ForAll([i], t["a"][i] == s["a"][i])) if extra else step
-    return TransitionSystem(sorts, lambda s: s["x"] == 0, trans)
+        steps = [t[n] == z3.If(s[n] == top, 0, s[n] + 1) for n in names]
+        return z3.And(*steps, z3.ForAll([i], t["a"][i] == s["a"][i])) if extra else z3.And(*steps)
+    def init(s):
+        return z3.And(*[s[n] == 0 for n in names], *([z3.ForAll([i], s["a"][i] == 0)] if extra else []))
+    return TransitionSystem(sorts, init, trans)
+
+
+#: two counters in step never read x = 0, y = 5; the invariant it needs, x == y, is no bound
+PAIR = lambda s: z3.Not(z3.And(s["x"] == 0, s["y"] == 5))  # noqa: E731
+#: the same, and the array's first element stays 0: the array, with its quantified step, is in the cone
+PAIR_A = lambda s: z3.And(PAIR(s), s["a"][0] == 0)  # noqa: E731
 
 
 def test_a_certificate_is_rechecked_before_it_proves_anything() -> None:
@@ -106,14 +126,24 @@ def test_a_certificate_is_rechecked_before_it_proves_anything() -> None:
     assert answer.status == "invariant" and recheck(ts, never7, answer.invariant, 2_000) is None
 
 
+def test_generated_bounds_finish_what_k_induction_cannot_and_pdr_finds_the_relation() -> None:
+    """x <= 100 comes from the system's constant; x == y is no bound: Spacer finds it (without the array)."""
+    v = prove_always(_counter(100, extra=True), lambda s: s["x"] != 150, max_k=3, timeout_ms=2_000)
+    assert (v.status, v.method) == ("proved", "k-induction with generated invariant")
+    assert "x >= 0 and x <= 100" in v.detail
+    w = prove_always(_counters(10, ("x", "y")), PAIR, max_k=3, timeout_ms=2_000)
+    assert (w.status, w.method) == ("proved", "pdr") and "is not 3-inductive either" not in w.detail
+    assert w.certificate
+
+
 def test_a_time_limit_or_a_refused_clause_is_inconclusive_with_the_reason() -> None:
-    ts = _counter(100, extra=True)
-    v = prove_always(ts, lambda s: s["x"] != 150, max_k=3, timeout_ms=2_000)
+    v = prove_always(_counters(100, ("x", "y"), extra=True), PAIR_A, max_k=3, timeout_ms=2_000)
     assert v.status == "inconclusive"
     assert "not 3-inductive" in v.detail and "IC3/PDR (Z3 Spacer) found no inductive invariant" in v.detail
-    assert "quantifier" in v.detail  # Spacer's own reason
+    assert "k-induction assuming the generated invariant (x >= 0 and x <= 100 and y >= 0 and y <= 100" in v.detail
+    assert "spacer: quantifier in a recursive rule)" in v.detail  # Spacer's own reason, its first line
     # the step that breaks induction, and what to do
-    assert "the step that breaks induction goes from {x = 149" in v.detail and "to {x = 150}" in v.detail
+    assert "the step that breaks induction goes from {" in v.detail and "to {x = 0, y = 5" in v.detail
     assert "next step: if the first state cannot be reached, give the requirement an invariant:" in v.detail
     never150 = lambda s: s["x"] != 150  # noqa: E731
     limited = spacer_invariant(_counter(100), never150, 1)  # 1 ms: stopped with the reason, or a valid answer
@@ -122,28 +152,28 @@ def test_a_time_limit_or_a_refused_clause_is_inconclusive_with_the_reason() -> N
 
 
 def test_the_users_invariant_finishes_the_proof_or_is_named_with_the_step_that_breaks_it() -> None:
-    ts = _counter(100, extra=True)  # Spacer cannot help: the hint must
-    prop = lambda s: s["x"] != 150  # noqa: E731
-    good = prove_always(ts, prop, max_k=3, timeout_ms=2_000, hint=Hint(lambda s: s["x"] <= 100, "x <= 100"))
+    ts = _counters(100, ("x", "y"), extra=True)  # neither Spacer nor the generated bounds can help: the hint must
+    good = prove_always(ts, PAIR_A, max_k=3, timeout_ms=2_000, hint=Hint(lambda s: s["x"] == s["y"], "x == y"))
     assert (good.status, good.method) == ("proved", "k-induction with invariant")
-    weak = prove_always(ts, prop, max_k=3, timeout_ms=2_000, hint=Hint(lambda s: s["x"] <= 200, "x <= 200"))
+    weak = prove_always(ts, PAIR_A, max_k=3, timeout_ms=2_000, hint=Hint(lambda s: s["x"] <= 100, "x <= 100"))
     assert weak.status == "inconclusive"
-    # Z3 picks the step: 149 -> 150 breaks the property, 200 -> 201 the invariant; either is named as such
-    assert "the invariant 'x <= 200' is not inductive with the property: from the state {x = " in weak.detail
-    d = weak.detail
-    assert ("from the state {x = 149" in d and "one step leads to {x = 150}, where the property fails" in d) or \
-           ("from the state {x = 200" in d and "one step leads to {x = 201}, where the invariant fails" in d)
-    assert "spacer: quantifier in a recursive rule)" in weak.detail
-    wrong = hint_fails(ts, prop, Hint(lambda s: s["x"] <= 50, "x <= 50"), max_k=3, timeout_ms=2_000)
+    assert "the invariant 'x <= 100' holds on every run (k-induction) but is not strong enough: it allows the " \
+           "state {" in weak.detail and "where the property fails; next step: add to the invariant a conjunct" in weak.detail
+    # false from step 51 on, which neither k-induction nor Spacer (the array is in its cone) can tell
+    wrong = hint_fails(ts, PAIR_A, Hint(lambda s: z3.And(s["x"] <= 50, s["a"][0] == 0), "x <= 50 and a[0] == 0"),
+                       max_k=3, timeout_ms=2_000)
     assert isinstance(wrong, tuple) and not wrong[1]
-    assert "from the state {x = 50" in wrong[0] and "one step leads to {x = 51}, where the invariant fails" in wrong[0]
+    # Z3 picks the step: one that leaves the invariant (50 -> 51) or one that breaks the property; named as such
+    assert "the invariant 'x <= 50 and a[0] == 0' is not inductive with the property: from the state {x = " in wrong[0]
+    assert "where the invariant fails" in wrong[0] or "where the property fails" in wrong[0]
     # Spacer refutes a hint that only a long run breaks: the step and its values are named
-    deep = hint_fails(_counter(100), prop, Hint(lambda s: s["x"] <= 50, "x <= 50"), max_k=3, timeout_ms=2_000)
+    deep = hint_fails(_counter(100), lambda s: s["x"] != 150, Hint(lambda s: s["x"] <= 50, "x <= 50"), max_k=3,
+                      timeout_ms=2_000)
     assert isinstance(deep, tuple) and "is false on a run of the system: at step 51, {x = 51}" in deep[0]
     assert "next step: weaken it" in deep[0]
 
 
-# -- in a workspace: a planner whose cycle counter wraps at W ------------------------------------------------
+# -- in a workspace: a planner whose cycle counter wraps at 11 ------------------------------------------------
 
 RCL = """node Planner {
   inputs( request : REAL )
@@ -152,105 +182,131 @@ RCL = """node Planner {
   guarantee( 0 <= out.plan_id and out.plan_id <= 100 )
 }
 """
-PLAN = """name: cycle
+LATE_REQUEST = "Planner.in.request >= 90 and Planner.state.c >= 9"
+PLAN = f"""name: cycle
 contracts:
   - contracts/planner.rcl
 requirements:
   - id: RESTART
     text: A late request is followed by a new planning cycle within 6 steps.
-    formal: "always (Planner.in.request >= 90 and Planner.state.c >= 12 -> eventually[<= 6] Planner.state.c == 0)"
+    formal: "always ({LATE_REQUEST} -> eventually[<= 6] Planner.state.c == 0)"
     supported_by:
-      - {node: Planner, guarantees: [1]}
+      - {{node: Planner, guarantees: [1]}}
+  - id: LATE
+    text: A late request is followed by a new planning cycle within 1 step (it is not).
+    formal: "always ({LATE_REQUEST} -> eventually[<= 1] Planner.state.c == 0)"
+  - id: CYCLE
+    text: A new cycle starts with all its steps left.
+    formal: "always (Planner.state.c == 0 -> Planner.state.left == 11)"
+  - id: HINTED
+    text: RESTART, with an invariant that does not hold.
+    formal: "always ({LATE_REQUEST} -> eventually[<= 6] Planner.state.c == 0)"
+    invariant: "Planner.state.c <= 7"
 state:
   Planner:
     c:
       type: NATURAL
       init: "state.c == 0"
-      next: "(state.c < W -> next.c == state.c + 1) and (state.c == W -> next.c == 0) and (state.c > W -> next.c == state.c + 1)"
+      next: "(state.c < 11 -> next.c == state.c + 1) and (state.c == 11 -> next.c == 0) and (state.c > 11 -> next.c == state.c + 1)"
+    left:
+      type: NATURAL
+      init: "state.left == 11"
+      next: "(state.left > 0 -> next.left == state.left - 1) and (state.left == 0 -> next.left == 11)"
 nodes:
   Planner:
     evidence:
       - backend: hoare
         program: backends/hoare/planner.imp
-        binding: {in.request: request, out.plan_id: plan_id}
+        binding: {{in.request: request, out.plan_id: plan_id}}
 """
 
 
-def _planner(root: Path, wrap: int, extra: str = "") -> Path:
+@pytest.fixture(scope="module")
+def planner(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, str]:
+    """The workspace, its Hoare evidence discharged and its requirements checked once: ``(root, output)``.
+    The counter's branch above 11 counts on for ever: no run takes it, and it keeps k-induction alone from
+    proving RESTART and CYCLE ("not 10-inductive")."""
+    root = tmp_path_factory.mktemp("pdr") / "ws"
     (root / "contracts").mkdir(parents=True)
     (root / "backends/hoare").mkdir(parents=True)
     (root / "contracts/planner.rcl").write_text(RCL)
-    (root / "contracts/plan.yaml").write_text(PLAN.replace("W", str(wrap)).replace("    supported_by:", extra + "    supported_by:", 1))
+    (root / "contracts/plan.yaml").write_text(PLAN)
     (root / "backends/hoare/planner.imp").write_text("var request : REAL;\nvar plan_id : REAL;\nplan_id := request\n")
     w = Workspace(root)
     stage_check(w)
     for o in stage_export(w, "Planner"):
         stage_run(w, "Planner", o["id"])
-    return root
+    import contextlib
+    import io
+    buf = io.StringIO()
+    with contextlib.redirect_stdout(buf):
+        main(["requirements", "-w", str(root)])
+        assert main(["report", "-w", str(root)]) == 0
+    return root, buf.getvalue()
 
 
-@pytest.fixture(scope="module")
-def planners(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    return tmp_path_factory.mktemp("pdr")
+def _temporal(root: Path, rid: str) -> dict:
+    return json.loads((root / f"artifacts/requirements/{rid}.json").read_text())["temporal"]
 
 
-def _record(root: Path, capsys: pytest.CaptureFixture[str]) -> tuple[str, dict]:
-    main(["requirements", "-w", str(root)])
-    return capsys.readouterr().out, json.loads((root / "artifacts/requirements/RESTART.json").read_text())
-
-
-def test_a_correct_bounded_response_is_proved_by_pdr_and_met(planners: Path, capsys) -> None:
-    """Wrapping at 15, a request at c >= 12 sees c == 0 within 4 steps; k-induction alone said "not
-    10-inductive" (the branch above 15 counts on for ever), Spacer's invariant bounds c and the pending age."""
-    out, rec = _record(_planner(planners / "ok", 15), capsys)
+def test_a_correct_bounded_response_is_proved_with_a_generated_invariant_and_met(planner) -> None:
+    """A request at c >= 9 sees c == 0 within 3 steps; in the states where c <= 11 (a bound from the
+    system's own constant, Houdini) the response is 7-inductive."""
+    root, out = planner
     assert "RESTART: met [discharged]" in out
-    t = rec["temporal"]
-    assert (t["status"], t["method"]) == ("proved", "pdr") and "Planner.state.c < 16" in t["certificate"]
+    t = _temporal(root, "RESTART")
+    assert (t["status"], t["method"]) == ("proved", "k-induction with generated invariant")
+    assert "Planner.state.c >= 0 and Planner.state.c <= 11" in t["detail"]
+
+
+def test_a_relation_is_proved_by_pdr_with_its_certificate_shown(planner, capsys) -> None:
+    """c == 0 -> left == 11 needs c + left == 11, no bound: Spacer's invariant, re-checked, is the
+    certificate, in the record, the report and the explanation."""
+    root, out = planner
+    assert "CYCLE: met [discharged]" in out
+    t = _temporal(root, "CYCLE")
+    assert (t["status"], t["method"]) == ("proved", "pdr") and "Planner.state.left" in t["certificate"]
     assert "re-checked by Z3" in t["detail"]
-    root = planners / "ok"  # the report and the explanation show the certificate
-    assert main(["report", "-w", str(root)]) == 0
     assert f"certificate (an inductive invariant, re-checked): `{t['certificate']}`" in \
         (root / "reports/assurance.md").read_text()
     capsys.readouterr()
-    assert main(["explain", "RESTART", "-w", str(root)]) == 0
+    assert main(["explain", "CYCLE", "-w", str(root)]) == 0
     assert f"certificate (inductive invariant, re-checked): {t['certificate']}" in capsys.readouterr().out
 
 
-def test_a_wrong_bounded_response_is_refuted_with_its_run(planners: Path, capsys) -> None:
-    """Wrapping at 20, a request at c == 12 waits 8 steps: refuted by the run of 18 steps (beyond the
-    k-induction's bound, found once Spacer said a run exists)."""
-    out, rec = _record(_planner(planners / "late", 20), capsys)
-    assert "RESTART: refuted" in out
-    t = rec["temporal"]
-    assert (t["status"], t["method"], t["bound"]) == ("refuted", "bmc", 18) and len(t["trace"]) == 19
-    assert t["trace"][12]["nodes"][0]["values"]["state.c"] == "12"
+def test_a_wrong_bounded_response_is_refuted_with_its_run(planner) -> None:
+    """Within 1 step it is not: the request at c == 9 (step 9) is still waiting at step 10, beyond the
+    k-induction's 9 steps; found once Spacer said a run exists."""
+    root, out = planner
+    assert "LATE: refuted" in out
+    t = _temporal(root, "LATE")
+    assert (t["status"], t["method"], t["bound"]) == ("refuted", "bmc", 10) and len(t["trace"]) == 11
+    assert t["trace"][9]["nodes"][0]["values"]["state.c"] == "9"
 
 
-def test_a_plan_invariant_that_fails_is_named_with_the_step_that_breaks_it(planners: Path, capsys) -> None:
-    """The plan's invariant is read for the bounded response; c <= 10 is false at step 11 of every run (a
-    run longer than the k-induction's, found through Spacer), which the detail names with its values; the
-    requirement is still proved by Spacer without it, and the report says the invariant was not used."""
-    out, rec = _record(_planner(planners / "hint", 15, '    invariant: "Planner.state.c <= 10"\n'), capsys)
-    t = rec["temporal"]
-    assert "RESTART: met [discharged]" in out and t["method"] == "pdr"
-    assert "the plan's invariant did not help: the invariant 'Planner.state.c <= 10' is false on a run of the " \
-           "system: at step 11, {" in t["detail"] and "Planner.state.c = 11" in t["detail"]
+def test_a_plan_invariant_that_fails_is_named_with_the_step_that_breaks_it(planner) -> None:
+    """c <= 7 is false at step 8 of every run, which the detail names with its values; the requirement is
+    still proved without it (by the generated bound), and the report says the invariant was not used."""
+    root, out = planner
+    t = _temporal(root, "HINTED")
+    assert "HINTED: met [discharged]" in out and t["method"] == "k-induction with generated invariant"
+    assert "the plan's invariant did not help: the invariant 'Planner.state.c <= 7' is false on a run of the " \
+           "system: at step 8, {" in t["detail"] and "Planner.state.c = 8" in t["detail"]
     assert "next step: weaken it so that it holds there" in t["detail"]
+    assert "the plan's invariant `Planner.state.c <= 7` (not used by the proof)" in \
+        (root / "reports/assurance.md").read_text()
 
 
 def test_an_invariant_is_refused_on_a_state_requirement_only(tmp_path: Path) -> None:
     root = tmp_path / "ws"
     (root / "contracts").mkdir(parents=True)
     (root / "contracts/planner.rcl").write_text(RCL)
-    plan = PLAN.split("nodes:")[0].replace("W", "15")
-    for formal in ("always Planner.state.c <= 15", "next Planner.state.c == 1", "eventually[<= 3] Planner.state.c == 3"):
-        (root / "contracts/plan.yaml").write_text(plan.replace(
-            '"always (Planner.in.request >= 90 and Planner.state.c >= 12 -> eventually[<= 6] Planner.state.c == 0)"',
-            f'"{formal}"\n    invariant: "Planner.state.c <= 15"'))
+    head = PLAN.split("requirements:")[0] + "requirements:\n  - id: R\n    text: t\n    formal: "
+    states = "state:" + PLAN.split("state:", 1)[1].split("nodes:")[0]
+    for formal in ("always Planner.state.c <= 11", "next Planner.state.c == 1", "eventually[<= 3] Planner.state.c == 3"):
+        (root / "contracts/plan.yaml").write_text(f'{head}"{formal}"\n    invariant: "Planner.state.c <= 11"\n{states}')
         assert Workspace(root).checked is not None
-    (root / "contracts/plan.yaml").write_text(plan.replace(
-        '"always (Planner.in.request >= 90 and Planner.state.c >= 12 -> eventually[<= 6] Planner.state.c == 0)"',
-        '"Planner.out.plan_id >= 0"\n    invariant: "TRUE"'))
+    (root / "contracts/plan.yaml").write_text(f'{head}"Planner.out.plan_id >= 0"\n    invariant: "TRUE"\n{states}')
     with pytest.raises(PlanError) as e:
         Workspace(root).checked
     assert "an invariant is read only for a temporal statement" in str(e.value.diagnostics[0])

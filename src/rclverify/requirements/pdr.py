@@ -57,13 +57,64 @@ def named_state(ts: TransitionSystem, prime: bool = False) -> dict[str, z3.ExprR
     return {n: z3.Const(n + ("'" if prime else ""), s) for n, s in ts.sorts.items()}
 
 
+def _conjuncts(e: z3.ExprRef) -> list[z3.ExprRef]:
+    """The conjuncts of ``e``, nested ``And`` flattened."""
+    if z3.is_and(e):
+        return [c for k in e.children() for c in _conjuncts(k)]
+    return [e]
+
+
+def _names(e: z3.ExprRef, known: dict[str, str]) -> set[str]:
+    """The state variables ``e`` mentions (``known``: constant name -> variable)."""
+    out, seen, todo = set(), set(), [e]
+    while todo:
+        x = todo.pop()
+        if x.get_id() in seen:
+            continue
+        seen.add(x.get_id())
+        if z3.is_const(x) and x.decl().name() in known:
+            out.add(known[x.decl().name()])
+        todo.extend(x.children() if z3.is_app(x) else [x.body()] if z3.is_quantifier(x) else [])
+    return out
+
+
+def cone_of_influence(ts: TransitionSystem, prop: Pred) -> tuple[list[str], list[z3.ExprRef], list[z3.ExprRef]]:
+    """The variables ``prop`` depends on through the step relation, and the
+    conjuncts of ``init`` and ``trans`` (over :func:`named_state`) that
+    mention them: every conjunct touching one of them brings in every
+    variable it mentions, to a fixpoint (Clarke, Grumberg, Peled, "Model
+    Checking", the cone of influence).  The conjuncts left out mention none
+    of these variables; leaving them out lets more runs through, so an
+    invariant of the reduced system is one of ``ts`` (the certificate is
+    re-checked on ``ts`` anyway) while a run of it is searched again on
+    ``ts``."""
+    a, b = named_state(ts), named_state(ts, prime=True)
+    known = {**{n: n for n in ts.sorts}, **{n + "'": n for n in ts.sorts}}
+    parts = [(c, _names(c, known)) for c in _conjuncts(ts.init(a)) + _conjuncts(ts.trans(a, b))]
+    cone = _names(prop(a), known)
+    grew = True
+    while grew:
+        grew = False
+        for _, vs in parts:
+            if vs & cone and not vs <= cone:
+                cone |= vs
+                grew = True
+    n_init = len(_conjuncts(ts.init(a)))
+    keep = [i for i, (_, vs) in enumerate(parts) if vs & cone]
+    return ([n for n in ts.sorts if n in cone], [parts[i][0] for i in keep if i < n_init],
+            [parts[i][0] for i in keep if i >= n_init])
+
+
 def spacer_invariant(ts: TransitionSystem, prop: Pred, timeout_ms: int) -> HornAnswer:
     """Ask Spacer for an inductive invariant of ``ts`` implying ``prop``
-    (module docstring).  ``timeout_ms`` bounds the query (milliseconds).
-    Never raises on solver trouble: a theory or quantifier Spacer refuses is
-    ``unknown`` with Z3's message."""
-    names = list(ts.sorts)
+    (module docstring), over the variables of its cone of influence
+    (:func:`cone_of_influence`).  ``timeout_ms`` bounds the query
+    (milliseconds).  Never raises on solver trouble: a theory or quantifier
+    Spacer refuses is ``unknown`` with Z3's message."""
+    names, init, trans = cone_of_influence(ts, prop)
     a, b = named_state(ts), named_state(ts, prime=True)
+    if not names:  # a property of no variable: the clauses over every variable (a relation needs one)
+        names, init, trans = list(ts.sorts), [ts.init(a)], [ts.trans(a, b)]
     rel = z3.Function("Inv", *[ts.sorts[n] for n in names], z3.BoolSort())
 
     def inv(s: dict[str, z3.ExprRef]) -> z3.BoolRef:
@@ -73,8 +124,8 @@ def spacer_invariant(ts: TransitionSystem, prop: Pred, timeout_ms: int) -> HornA
     try:
         h = z3.SolverFor("HORN")
         h.set("timeout", timeout_ms)
-        h.add(z3.ForAll(av, z3.Implies(ts.init(a), inv(a))))
-        h.add(z3.ForAll(av + bv, z3.Implies(z3.And(inv(a), ts.trans(a, b)), inv(b))))
+        h.add(z3.ForAll(av, z3.Implies(z3.And(*init), inv(a))))
+        h.add(z3.ForAll(av + bv, z3.Implies(z3.And(inv(a), *trans), inv(b))))
         h.add(z3.ForAll(av, z3.Implies(z3.And(inv(a), z3.Not(prop(a))), z3.BoolVal(False))))
         r = h.check()
         took = time.perf_counter() - t0

@@ -8,11 +8,14 @@ case finds such a path, the base case no run.  :func:`prove_always` then
    prop)`` by the same k-induction: I and the property strengthen each other
    (a candidate that is not invariant, or not strong enough, is named with
    the step that breaks it, :func:`hint_fails`);
-2. asks Z3's Spacer for an inductive invariant (:mod:`.pdr`; within the
+2. generates an invariant from the system's constants (:mod:`.houdini`)
+   and proves the property by k-induction in its states (method
+   ``k-induction with generated invariant``);
+3. asks Z3's Spacer for an inductive invariant (:mod:`.pdr`; within the
    proved hint, when there is one), re-checks the certificate with plain Z3
    queries and proves the property with it (method ``pdr``); a run Spacer
    says exists is searched by bounded model checking (method ``bmc``);
-3. else says ``inconclusive``, with what each step found and the next step
+4. else says ``inconclusive``, with what each step found and the next step
    for the user: the counterexample to induction, one step from a state
    where the property holds to one where it fails, which an ``invariant:``
    must exclude.
@@ -29,6 +32,7 @@ from dataclasses import dataclass
 
 import z3
 
+from .houdini import generate, within as assuming
 from .pdr import recheck, shortest_violation, shown, spacer_invariant
 from .temporal import check_always
 from .tsys import Pred, TemporalVerdict, TransitionSystem, trace_of
@@ -162,10 +166,32 @@ def by_pdr(ts: TransitionSystem, prop: Pred, *, max_k: int, timeout_ms: int,
                                                           f"{limit} ms ({ans.reason or 'unknown'})")
 
 
+def _generated(ts: TransitionSystem, prop: Pred, *, max_k: int, timeout_ms: int) -> TemporalVerdict | str:
+    """k-induction of ``prop`` assuming the invariant :func:`.houdini.generate`
+    finds: the verdict when it decides, else what was found (a sentence)."""
+    g = generate(ts, prop, timeout_ms, timeout_ms * PDR_FACTOR)
+    if isinstance(g, str):
+        return f"no invariant was generated ({g})"
+    if not g:
+        return "no bound of the system's constants is invariant"
+    text = " and ".join(t for t, _ in g)
+    shown_ = text if len(text) <= 300 else text[:297] + "..."
+    w = check_always(assuming(ts, g), prop, max_k=max_k, timeout_ms=timeout_ms)
+    if w.status == "proved":
+        return TemporalVerdict("proved", "k-induction with generated invariant", k=w.k, bound=w.bound,
+                               detail=f"{w.k}-inductive in the states of the invariant generated from the system's "
+                                      f"constants (Houdini; every initial state satisfies it and every step keeps "
+                                      f"it): {shown_}")
+    if w.status == "refuted":  # the same runs as the system's: a genuine counterexample
+        return w
+    return f"k-induction assuming the generated invariant ({shown_}) is not {max_k}-inductive either"
+
+
 def prove_always(ts: TransitionSystem, prop: Pred, *, max_k: int = 10, timeout_ms: int = 10_000,
                  hint: Hint | None = None, monitor: str = "") -> TemporalVerdict:
     """Decide ``always prop`` (module docstring): k-induction, then the
-    ``hint`` with the property, then IC3/PDR.  ``monitor`` names, for the
+    ``hint`` with the property, then k-induction with a generated invariant,
+    then IC3/PDR.  ``monitor`` names, for the
     messages, a history variable the property reads (the bounded response's
     pending age).  Returns a :class:`TemporalVerdict`; ``inconclusive``
     names what each step found and, when no hint was given, the step that
@@ -181,6 +207,12 @@ def prove_always(ts: TransitionSystem, prop: Pred, *, max_k: int = 10, timeout_m
             return h
         said.append(h[0])
         proved_hint = hint.pred if h[1] else None
+    g = _generated(ts, prop, max_k=max_k, timeout_ms=timeout_ms)
+    if isinstance(g, TemporalVerdict):
+        if hint is not None and g.status == "proved":
+            g.detail += f" (the plan's invariant did not help: {said[-1]})"
+        return g
+    said.append(g)
     p = by_pdr(ts, prop, max_k=max_k, timeout_ms=timeout_ms, within=proved_hint)
     if p.status != "inconclusive":
         if hint is not None and p.status == "proved":
