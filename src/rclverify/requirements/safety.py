@@ -158,8 +158,8 @@ def by_pdr(ts: TransitionSystem, prop: Pred, *, max_k: int, timeout_ms: int,
     if ans.status == "reachable":
         found = shortest_violation(sys, prop, max_k, limit)
         if isinstance(found, str):
-            return TemporalVerdict("inconclusive", "pdr", detail=f"IC3/PDR (Z3 Spacer) says a run violates it, but "
-                                                                  f"{found}")
+            return TemporalVerdict("inconclusive", "pdr", detail=f"IC3/PDR (Z3 Spacer) says a run of the property's "
+                                                                  f"cone of influence violates it, but {found}")
         n, trace = found
         return TemporalVerdict("refuted", "bmc", bound=n, trace=trace, detail=f"violated at step {n}")
     return TemporalVerdict("inconclusive", "pdr", detail=f"IC3/PDR (Z3 Spacer) found no inductive invariant within "
