@@ -15,6 +15,8 @@ seconds of:
 * **k-ind**: BMC and k-induction up to k = 10 (inconclusive);
 * **pdr**: Spacer's query and the independent re-check of its certificate
   (:func:`rclverify.requirements.safety.by_pdr`), and the verdict;
+* **whole**: what the requirement check runs (k-induction, then the
+  invariant generated from the constants, then Spacer), and its method;
 * **wrong**: the same with the wrap at ``W + 5`` (refuted by Spacer, then
   the shortest run found by BMC: its length is printed; Spacer's time
   limit, 6 s, is reached near W = 200: inconclusive, with the reason).
@@ -67,10 +69,13 @@ def one(w: int, start: int) -> str:
     t2 = time.perf_counter()
     late = check_response(planner(w + 5), trigger, goal, 6, timeout_ms=2_000)
     t3 = time.perf_counter()
+    full = check_response(planner(w), trigger, goal, 6, timeout_ms=2_000)
+    t4 = time.perf_counter()
     assert kind.status != "refuted"  # k-induction alone never refutes a correct one
     return (f"W = {w:5d}  k-ind {t1 - t0:6.2f} s ({kind.status})  pdr {t2 - t1:6.2f} s ({ok.status})  "
             f"wrong {t3 - t2:6.2f} s ({late.status}"
-            + (f", run of {late.bound} steps)" if late.status == "refuted" else f": {late.detail.split('; ')[2]})"))
+            + (f", run of {late.bound} steps)" if late.status == "refuted" else f": {next(x for x in late.detail.split('; ') if 'IC3/PDR' in x)})")
+            + f"  whole {t4 - t3:6.2f} s ({full.status} by {full.method})")
 
 
 def main() -> None:
