@@ -297,3 +297,16 @@ def test_the_traced_line_agrees_with_python_on_random_functions(tmp_path: Path) 
         exec("\n".join(twin) + "\n", scope)  # noqa: S102 - the oracle
         x = rng.randint(-3, 8)
         assert cause_line(step, {"in.x": x}, None, "s.py") == f"s.py:{scope['twin'](x)}", "\n".join(body)
+
+
+def test_a_run_and_a_property_test_of_one_step_name_the_line_that_computed_it() -> None:
+    from rclverify.diagnosis.build import _computed_line
+    report = {"obligations": [{"id": "T.g1.property_tests.e0", "node": "T", "guarantee": 1},
+                              {"id": "T.g2.property_tests.e0", "node": "T", "guarantee": 2}],
+              "evidence": [{"obligation": "T.g1.property_tests.e0", "backend": "property_tests", "status": "failed",
+                            "counterexample": {"cause": "gen/t/t/logic.py:18"}},
+                           {"obligation": "T.g2.property_tests.e0", "backend": "property_tests", "status": "failed",
+                            "counterexample": {"cause": "gen/t/t/other.py:3"}}]}
+    assert _computed_line(report, "T", 1, "gen/t/t/logic.py") == "gen/t/t/logic.py:18"
+    assert _computed_line(report, "T", 2, "gen/t/t/logic.py") == ""  # another file: not this handler's code
+    assert _computed_line(report, "U", 1, "gen/t/t/logic.py") == ""

@@ -291,6 +291,20 @@ def _side_condition(ws: Any, report: Mapping[str, Any], sc: Mapping[str, Any], c
     return rec
 
 
+def _computed_line(report: Mapping[str, Any], node: str, k: Any, file: str) -> str:
+    """``file:line`` a failed property test of guarantee ``k`` of ``node``
+    names as computing the failing output, when it is a line of ``file``
+    (the generated node's logic.py); ``""`` otherwise."""
+    obligations = {str(o["id"]): o for o in report.get("obligations") or ()}
+    for e in report.get("evidence") or ():
+        o = obligations.get(str(e["obligation"])) or {}
+        cause = str((e.get("counterexample") or {}).get("cause") or "") if isinstance(e.get("counterexample"), dict) else ""
+        if e.get("backend") == "property_tests" and e.get("status") == "failed" and o.get("node") == node \
+                and o.get("guarantee") == k and cause.rsplit(":", 1)[0] == file:
+            return cause
+    return ""
+
+
 def _generated_handler(ws: Any, node: str, monitoring: Mapping[str, Any]) -> Any:
     """The handler of ``node``'s generated logic.py that published the first
     violating message (:func:`rclverify.diagnosis.handlers.violating_handler`),
@@ -351,6 +365,12 @@ def _evidence(ws: Any, report: Mapping[str, Any], e: Mapping[str, Any], o: Mappi
                         f"which the generated node.py calls for {h.variable}{said}.")
             cul.insert(0, {"what": f"handler {h.name} of {h.file} (called for {h.variable}{said})",
                            "source": f"{h.file}:{h.line}", "text": h.name})
+            # the same guarantee's property test found the line of that logic.py computing the value: it first
+            computed = _computed_line(report, node, gk, h.file)
+            if computed:
+                sentence = sentence[:-1] + f"; the value it published is computed at {computed} (the property test)."
+                cul.insert(0, {"what": f"{computed}: the line that computed the failing output (property test)",
+                               "source": computed, "text": ""})
         return _record(e["obligation"], "monitor", node, e["status"], sentence, culprits=cul,
                        counterexample=counterexample_table(fv.get("values"), node), guarantee=gk)
     if backend == "property_tests" and isinstance(e.get("counterexample"), dict):
