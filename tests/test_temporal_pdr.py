@@ -134,6 +134,11 @@ def test_generated_bounds_finish_what_k_induction_cannot_and_pdr_finds_the_relat
     w = prove_always(_counters(10, ("x", "y")), PAIR, max_k=3, timeout_ms=2_000)
     assert (w.status, w.method) == ("proved", "pdr") and "is not 3-inductive either" not in w.detail
     assert w.certificate
+    # a plan invariant that is false (from step 6) is named in the proof that did without it
+    h = prove_always(_counters(10, ("x", "y")), PAIR, max_k=3, timeout_ms=2_000, hint=Hint(lambda s: s["x"] <= 5, "x <= 5"))
+    assert (h.status, h.method) == ("proved", "pdr")
+    assert "(the plan's invariant did not help: the invariant 'x <= 5' is false on a run of the system: at step 6, " \
+           "{x = 6, y = 6}" in h.detail
 
 
 def test_a_time_limit_or_a_refused_clause_is_inconclusive_with_the_reason() -> None:

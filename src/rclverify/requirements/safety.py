@@ -200,24 +200,25 @@ def prove_always(ts: TransitionSystem, prop: Pred, *, max_k: int = 10, timeout_m
     if v.status != "inconclusive" or v.method == "bmc":
         return v
     said = [v.detail]
-    proved_hint = None
+    proved_hint, hint_said = None, ""
     if hint is not None:
         h = hint_fails(ts, prop, hint, max_k=max_k, timeout_ms=timeout_ms)
         if isinstance(h, TemporalVerdict):
             return h
-        said.append(h[0])
+        hint_said = h[0]
+        said.append(hint_said)
         proved_hint = hint.pred if h[1] else None
     g = _generated(ts, prop, max_k=max_k, timeout_ms=timeout_ms)
     if isinstance(g, TemporalVerdict):
         if hint is not None and g.status == "proved":
-            g.detail += f" (the plan's invariant did not help: {said[-1]})"
+            g.detail += f" (the plan's invariant did not help: {hint_said})"
         return g
     said.append(g)
     p = by_pdr(ts, prop, max_k=max_k, timeout_ms=timeout_ms, within=proved_hint)
     if p.status != "inconclusive":
         if hint is not None and p.status == "proved":
             p.detail += (" (inside the plan's invariant, proved on its own)" if proved_hint else
-                         f" (the plan's invariant did not help: {said[-1]})")
+                         f" (the plan's invariant did not help: {hint_said})")
         return p
     said.append(p.detail)
     if hint is None:
