@@ -13,6 +13,10 @@ Small self-written packages, one construct each, scanned once per module:
   forwarding to the free function;
 * a wrapper whose paths return different values, or one the scan cannot read,
   names nothing: a located note, no edge (never a guess);
+* the same in Python: a helper module's ``param_or(node, "p", default)``
+  (two paths, one parameter) and ``make_pub(node, String, topic)``, the
+  message type a parameter read at the call; a helper returning one of two
+  names by a branch names nothing;
 * a stack's factory taking the node first, ``rigutil::make_sub<T>(parent,
   topic, cb)``, inside a helper constructor whose node parameter is a template
   parameter (``template<typename NodeT> Smoother(const NodeT & parent, ...)``),
@@ -170,6 +174,44 @@ int main(int argc, char ** argv)
 }
 """
 
+PY_UTIL = """def param_or(node, name, default):
+    if node.has_parameter(name):
+        return node.get_parameter(name).value
+    return node.declare_parameter(name, default).value
+
+
+def pick(node, left):
+    if left:
+        return 'left_topic'
+    return 'right_topic'
+
+
+def make_pub(node, msg_type, topic):
+    return node.create_publisher(msg_type, topic, 10)
+"""
+PY_WATCH = """import rclpy
+from rclpy.node import Node
+from std_msgs.msg import String
+
+from rig_py.util import make_pub, param_or, pick
+
+
+class Watch(Node):
+    def __init__(self):
+        super().__init__('watch')
+        topic = param_or(self, 'status_topic', 'status')
+        self.pub = make_pub(self, String, topic)
+        self.sub = self.create_subscription(String, param_or(self, 'in_topic', 'incoming'), print, 10)
+        self.side = self.create_publisher(String, pick(self, True), 10)
+
+
+def main():
+    rclpy.init()
+    rclpy.spin(Watch())
+"""
+PY_SETUP = ("from setuptools import setup\nsetup(name='rig_py', packages=['rig_py'],\n"
+            "      entry_points={'console_scripts': ['watch = rig_py.watch:main']})\n")
+
 
 def _package(root: Path, name: str, files: dict[str, str], deps: str = "") -> None:
     d = root / "src" / name
@@ -187,6 +229,12 @@ def graph(tmp_path_factory):  # type: ignore[no-untyped-def]
     _package(root, "rigutil", {"include/rigutil/params.hpp": PARAMS})
     _package(root, "rig_mapping", {"src/mapper.cpp": MAPPER, "src/tracker.cpp": TRACKER},
              "<depend>rigutil</depend>")
+    py = root / "src" / "rig_py"
+    for rel, text in {"package.xml": PKG.format(name="rig_py", deps="").replace("ament_cmake", "ament_python"),
+                      "setup.py": PY_SETUP, "resource/rig_py": "", "rig_py/__init__.py": "",
+                      "rig_py/util.py": PY_UTIL, "rig_py/watch.py": PY_WATCH}.items():
+        (py / rel).parent.mkdir(parents=True, exist_ok=True)
+        (py / rel).write_text(text)
     return scan([root], [], base=root).graph
 
 
@@ -239,3 +287,12 @@ def test_a_factory_given_a_string_first_is_no_node_factory(graph) -> None:  # ty
     assert "18: feeds::create_subscription(...) is a function of another namespace than rclcpp's, given no node, " \
         "so it is no rclcpp method, and its body is not in the workspace: its endpoints are not read" in \
         _notes(graph, "tracker.cpp")
+
+
+def test_a_python_wrapper_of_declare_parameter_and_a_factory(graph) -> None:  # type: ignore[no-untyped-def]
+    n = graph.nodes["/watch"]
+    got = {(r, e.topic, e.msg_type, e.param) for r in ("pub", "sub") for e in n.edges_of(r)}
+    assert got == {("pub", "/status", S, "/watch/status_topic"), ("sub", "/incoming", S, "/watch/in_topic")}
+    # pick() returns one of two names by a branch: not guessed
+    assert any(m.startswith("14: publisher topic name is 'pick(self, True)', not a string literal")
+               for m in _notes(graph, "rig_py/watch.py")), _notes(graph, "rig_py/watch.py")

@@ -117,6 +117,9 @@ class PyScope:
             g = self.getter(c)
             if g is not None:
                 return ("param", g[1], g[0], None)
+            computed = self.computed_read(c, depth)
+            if computed is not None:
+                return computed
         if v.call is not None:
             f = self.full(v.call.func)
             if f in ("rospy.get_name", "rospy.names.get_name") or v.call.func.endswith("get_fully_qualified_name"):
@@ -130,7 +133,41 @@ class PyScope:
                 for k, a in enumerate(v.call.args):
                     parts += ([symbols.lit("/")] if k else []) + [self.value(a, depth + 1)]
                 return symbols.cat(parts)
+            callee = self.callee(v.call) if not v.call.kwargs and not v.calls[1:] else None
+            if callee is not None:  # a function of the workspace: what it returns, read by the linker
+                return ("ret", callee, None, tuple(self.value(a, depth + 1) for a in v.call.args))
         return None
+
+    def computed_read(self, c: PyCall, depth: int) -> symbols.Val:
+        """A ROS 2 parameter read whose name is a parameter of the enclosing function
+        (a wrapper's ``node.declare_parameter(name, default).value``): ``("param",
+        name value, default value or None, None)``, read by the linker; else ``None``."""
+        last = c.func.rsplit(".", 1)[-1]
+        if last not in ("get_parameter", "declare_parameter", "get_parameter_or") or not c.args or \
+                c.args[0].kind == "str":
+            return None
+        key = self.value(c.args[0], depth + 1)
+        if key is None or key[0] != "arg":
+            return None
+        d = self.value(c.args[1], depth + 1) if last != "get_parameter" and len(c.args) > 1 else None
+        return ("param", key, d if d is not None and d[0] in ("str", "arg") else None, None)
+
+    def returns(self) -> dict[str, list[tuple[int, int, list[symbols.Val], list[symbols.Val]]]]:
+        """Per function key, ``[(parameters, defaulted ones, default values, values
+        returned)]`` for a function returning a value the linker may read (a
+        ``("ret", ...)`` call of it, :mod:`link_returns`)."""
+        got: dict[str, list[symbols.Val]] = {}
+        for line, pv in self.mod.returns:
+            f = self.fn_at(line)
+            if f is not None:
+                got.setdefault(f[0], []).append(self.value(pv))
+        out = {}
+        for f in self.fns:
+            vals = got.get(f[0], [])
+            if any(x is not None for x in vals):
+                out[f"{self.shown}::{f[0]}"] = [(len(f[3]), sum(d is not None for d in f[4]),
+                                                 [self.value(d) if d is not None else None for d in f[4]], vals)]
+        return out
 
     def _name(self, name: str, line: int, depth: int) -> symbols.Val:
         f = self.fn_at(line)
@@ -147,8 +184,8 @@ class PyScope:
             return parsed
         if head in self.mod.imports:
             origin = self.full(name)
-            if origin.split(".")[0] in _ROS:
-                return None
+            if origin.split(".")[0] in _ROS and not any(f".{k}." in origin for k in ("msg", "srv", "action")):
+                return None  # an interface class (std_msgs.msg.String) is a type a helper may be given
             return ("ext", origin)
         return None
 

@@ -45,7 +45,8 @@ class PyModule:
     (modules imported with ``*``), every call, the assignments ``(target as
     written, value)``, each class statement's ``(name, first line, last line)``
     and each function's ``(qualified name, first line, last line, parameters,
-    defaults)`` (a method's ``self``/``cls`` left out; ``Cls.f`` for a method)."""
+    defaults)`` (a method's ``self``/``cls`` left out; ``Cls.f`` for a method),
+    and each ``return`` statement's ``(line, value)``."""
 
     imports: dict[str, str] = field(default_factory=dict)
     calls: list[PyCall] = field(default_factory=list)
@@ -55,6 +56,7 @@ class PyModule:
     star: list[str] = field(default_factory=list)
     import_lines: dict[str, list[tuple[str, int]]] = field(default_factory=dict)
     bases: dict[str, list[str]] = field(default_factory=dict)  # class name -> base classes as written
+    returns: list[tuple[int, "PyVal"]] = field(default_factory=list)  # (line, value) of each ``return x``
 
     def bind_import(self, local: str, origin: str, line: int) -> None:
         """Record that ``local`` is bound to ``origin`` by an import at ``line``."""

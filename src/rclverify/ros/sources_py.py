@@ -163,6 +163,8 @@ def _ast_module(tree: ast.AST, shown: str) -> PyModule:
                                 n.lineno)
         elif isinstance(n, ast.Call):
             mod.calls.append(call(n))
+        elif isinstance(n, ast.Return) and n.value is not None:
+            mod.returns.append((n.lineno, val(n.value)))
         elif isinstance(n, ast.ClassDef):
             mod.classes.append((n.name, n.lineno, getattr(n, "end_lineno", None) or n.lineno))
             mod.bases[n.name] = [d for d in (_dotted(b) for b in n.bases) if d]
@@ -334,6 +336,7 @@ def extract(mod: PyModule, shown: str) -> dict[str, Any]:
                     for q, _a, _b in sc.cls}
     out["fields"] = sc.fields()
     out["consts"] = sc.consts()
+    out["returns"] = sc.returns()
     out["imports"] = sorted(set(mod.imports.values()) | set(mod.star))
     return out
 

@@ -121,7 +121,8 @@ def tolerant_module(text: str, shown: str) -> tuple[Any, str]:
         return PyVal("other", treesitter.text(n), loc(n), None, inner)
 
     def function(n: Any) -> None:
-        names, p = [], n.parent
+        names: list[str] = []
+        p = n.parent
         while p is not None:
             if p.type in ("class_definition", "function_definition") and p.child_by_field_name("name") is not None:
                 nm = treesitter.text(p.child_by_field_name("name"))
@@ -136,8 +137,9 @@ def tolerant_module(text: str, shown: str) -> tuple[Any, str]:
         ps = n.child_by_field_name("parameters")
         for x in ps.named_children if ps is not None else []:
             if x.type in ("identifier", "typed_parameter"):
-                nm = x if x.type == "identifier" else next((c for c in x.named_children if c.type == "identifier"), None)
-                params.append(treesitter.text(nm))
+                ident = x if x.type == "identifier" else next(
+                    (c for c in x.named_children if c.type == "identifier"), None)
+                params.append(treesitter.text(ident))
                 defaults.append(None)
             elif x.type in ("default_parameter", "typed_default_parameter"):
                 params.append(treesitter.text(x.child_by_field_name("name")))
@@ -178,6 +180,8 @@ def tolerant_module(text: str, shown: str) -> tuple[Any, str]:
             function(n)
         elif t == "call":
             mod.calls.append(call(n, 0))
+        elif t == "return_statement" and n.named_children:
+            mod.returns.append((line, val(n.named_children[0], 0)))
         elif t == "class_definition" and n.child_by_field_name("name") is not None:
             mod.classes.append((treesitter.text(n.child_by_field_name("name")), n.start_point[0] + 1, n.end_point[0] + 1))
             sup = n.child_by_field_name("superclasses")
