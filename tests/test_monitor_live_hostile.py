@@ -10,6 +10,7 @@ runs as its own process (its own process group), killed in ``finally``.
 Skipped, with the reason, where rospy cannot be imported."""
 from __future__ import annotations
 
+import functools
 import os
 import signal
 import socketserver
@@ -26,14 +27,20 @@ import pytest
 REPO = Path(__file__).resolve().parents[1]
 
 
+@functools.cache
 def _no_rospy() -> str | None:
+    """Why rospy cannot be imported, or None: asked once, when the module's tests run."""
     r = subprocess.run([sys.executable, "-c", "from rclverify.backends.monitors.ros1 import import_rospy; "
                         "import_rospy()"], capture_output=True, text=True,
                        env=dict(os.environ, PYTHONPATH=str(REPO / "src")))
     return None if r.returncode == 0 else f"rospy cannot be imported: {r.stderr.strip()[-200:]}"
 
 
-pytestmark = pytest.mark.skipif(_no_rospy() is not None, reason=str(_no_rospy()))
+@pytest.fixture(scope="module", autouse=True)
+def _rospy() -> None:
+    reason = _no_rospy()
+    if reason is not None:
+        pytest.skip(reason)
 
 
 class _Server(socketserver.ThreadingMixIn, xmlrpc.server.SimpleXMLRPCServer):

@@ -36,7 +36,12 @@ SCRIPTS = WS / "src" / "diff_demo" / "scripts"
 REPO = HERE.parent
 EXAMPLE = REPO / "examples" / "safety_stop"
 
-pytestmark = pytest.mark.skipif(_have_ros1() is not None, reason=str(_have_ros1()))
+@pytest.fixture(scope="module", autouse=True)
+def _ros1() -> None:
+    """Skips the module, with the reason, where ROS 1 cannot run (asked only when its tests run)."""
+    reason = _have_ros1()
+    if reason is not None:
+        pytest.skip(reason)
 
 
 def _settled(uri: str, deadline: float) -> None:

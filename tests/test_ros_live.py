@@ -4,6 +4,7 @@ tests/data/ros/live_ws; the graph read from the master through rosgraph
 equals the graph read from the nodes' sources (docs/ros.md)."""
 from __future__ import annotations
 
+import functools
 import os
 import shutil
 import signal
@@ -27,7 +28,10 @@ def _free_port() -> int:
         return int(s.getsockname()[1])
 
 
+@functools.cache
 def _have_ros1() -> str | None:
+    """Why ROS 1 cannot run here, or None.  Asked once per process, and only when a live test is about to
+    run: every pytest worker imports every test module, and this starts a Python of its own."""
     if shutil.which("roscore") is None:
         return "roscore is not installed (apt-get install ros-core)"
     if subprocess.run([SYSTEM_PY, "-c", "import rospy"], capture_output=True).returncode != 0:
@@ -49,8 +53,15 @@ def _stop(p: subprocess.Popen[bytes]) -> None:
             p.wait(timeout=5)
 
 
-@pytest.mark.skipif(_have_ros1() is not None, reason=str(_have_ros1()))
-def test_graph_from_master_equals_graph_from_sources(tmp_path: Path) -> None:
+@pytest.fixture()
+def ros1() -> None:
+    """Skips, with the reason, where ROS 1 cannot run."""
+    reason = _have_ros1()
+    if reason is not None:
+        pytest.skip(reason)
+
+
+def test_graph_from_master_equals_graph_from_sources(tmp_path: Path, ros1: None) -> None:
     port = _free_port()
     uri = f"http://127.0.0.1:{port}"
     env = dict(os.environ, ROS_MASTER_URI=uri, ROS_IP="127.0.0.1", ROS_HOSTNAME="127.0.0.1",
