@@ -342,9 +342,16 @@ def main() -> int:
         return child(args)
     if args.smoke:
         args.samples = 2_000
-    n = args.samples
+    print(f"{args.samples} samples (a reading and its answer each), {args.wrong:g} of the answers wrong, "
+          f"seed {args.seed}")
+    rows, verdicts = _measure(args)
+    _print(rows, verdicts, args)
+    return 0
+
+
+def _measure(args: argparse.Namespace) -> tuple[dict[str, dict[str, Any]], dict[str, bytes]]:
+    """Every tool's figures (row name -> the child's JSON) and verdicts (row -> a byte a sample)."""
     trees = [("new", str(ROOT / "src"))] + ([("old", str(Path(args.compare).resolve()))] if args.compare else [])
-    print(f"{n} samples (a reading and its answer each), {args.wrong:g} of the answers wrong, seed {args.seed}")
     with tempfile.TemporaryDirectory() as tmp:
         base = Path(tmp)
         (base / "ws").mkdir()
@@ -373,6 +380,12 @@ def main() -> int:
             rows[tool] = r
             if "skipped" not in r:
                 verdicts[tool] = (base / f"v-{tool}").read_bytes()
+    return rows, verdicts
+
+
+def _print(rows: dict[str, dict[str, Any]], verdicts: dict[str, bytes], args: argparse.Namespace) -> None:
+    """The table and the ratios; exits 1 (SystemExit) when a verdict or the command's counts differ."""
+    n = args.samples
     engine = rows["rclverify engine (new)"]["cpu"]
     batch = rows["rclverify batch"]
     print(f"{'tool':<28} {'samples/s':>11} {'x engine':>9} {'peak RSS MiB':>13}  verdicts agree with the streaming engine")
@@ -417,9 +430,9 @@ def main() -> int:
     if args.compare:
         old = rows["rclverify engine (old)"]["cpu"]
         old_cmd = rows["rclverify monitor (old)"]["cpu"]
+        new_cmd = rows["rclverify monitor (new)"]["cpu"]
         print(f"engine samples/s new/old: {old / engine:.2f} (aim: at least 3); "
-              f"command new/old: {old_cmd / cmd['cpu']:.2f}; old command / old engine: {old_cmd / old:.2f}")
-    return 0
+              f"command new/old: {old_cmd / new_cmd:.2f}; old command / old engine: {old_cmd / old:.2f}")
 
 
 if __name__ == "__main__":
