@@ -58,7 +58,7 @@ def _system(init, succ) -> TransitionSystem:
                             lambda s, t: z3.Or(*[z3.And(_is(s, a), _is(t, c)) for a in STATES for c in succ[a]]))
 
 
-@settings(max_examples=30, deadline=None)
+@settings(max_examples=25, deadline=None)
 @given(systems())
 def test_pdr_equals_reachability(sys_) -> None:
     """Spacer's verdict, its certificate re-checked, and the run it leads to, against the enumeration: x is an
