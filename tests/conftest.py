@@ -21,7 +21,8 @@ the end, where one worker runs them while the others have nothing left:
 the classic tail of list scheduling.  ``pyproject.toml`` turns that reordering
 off (``--no-loadscope-reorder``) and this file sorts the modules by the CPU
 seconds measured for them (:data:`SECONDS`, longest first; Graham's LPT rule),
-the modules not listed after them in their usual order.  The figures are
+the modules not listed after them in their usual order (a live module by its
+wall-clock seconds, :data:`WALL`, when they are longer).  The figures are
 serial CPU seconds of one module (``/usr/bin/time``, user + system, pytest's
 own start-up subtracted) on the 2-core development machine; only their order
 matters, so a rough figure is enough, and a module that grows past two
@@ -71,6 +72,19 @@ SECONDS: dict[str, float] = {
     "test_straightline": 2.5, "test_generate_example": 3.7, "test_ros_ground": 2.1,
 }
 
+#: Wall-clock seconds of the live modules, serial (they wait on masters, nodes, a browser: their CPU
+#: seconds understate how long they hold a worker).  Taken on a loaded machine, so rather long: which
+#: only hands them out earlier, where a long module belongs.
+WALL: dict[str, float] = {
+    "test_bench_smoke_live": 49.4, "test_ros2_generated": 48.2, "test_lsp_server": 27.2,
+    "test_ros2_types_record": 19.5, "test_monitor_live_ros1": 16.6, "test_generate_names_ros2": 15.9,
+    "test_monitor_live_hostile": 15.0, "test_ros2_diff": 13.4, "test_ros_diff_live": 12.9,
+    "test_lsp_fuzz": 11.9, "test_ros2_services_actions": 11.5, "test_browser_report": 10.5,
+    "test_services_live_ros1": 10.0, "test_ros2_silence_deadlines": 8.6, "test_ros_live": 6.7,
+    "test_monitor_live_dds": 6.1, "test_lsp_hostile": 5.0, "test_ros_master_hostile": 5.0,
+    "test_ros_diff_dds": 4.7, "test_lsp_invalid": 3.3, "test_lsp_nvim": 2.7, "test_monitor_oracle": 2.2,
+}
+
 #: Modules that run the whole pipeline although they cost less than two seconds: still ``slow``.
 PIPELINE = frozenset({
     "test_confidence", "test_deadlines", "test_deadlines_report", "test_evidence_staleness",
@@ -94,7 +108,12 @@ def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item
             item.add_marker(pytest.mark.live)
         if module in SLOW:
             item.add_marker(pytest.mark.slow)
-    items.sort(key=lambda item: (-SECONDS.get(item.path.stem, 0.0), first[item.path.stem]))
+    items.sort(key=lambda item: (-_weight(item.path.stem), first[item.path.stem]))
+
+
+def _weight(module: str) -> float:
+    """How long ``module`` holds a worker, in seconds: its CPU seconds, or its wall-clock seconds when longer."""
+    return max(SECONDS.get(module, 0.0), WALL.get(module, 0.0))
 
 
 # Hypothesis: no per-example deadline (a loaded 2-core machine makes a slow example a false alarm,
