@@ -30,11 +30,18 @@ import _incremental as inc
 
 
 @pytest.fixture(scope="module")
-def verified(tmp_path_factory: pytest.TempPathFactory) -> Path:
+def clean_run(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, subprocess.CompletedProcess[str]]:
+    """One clean ``doit verify`` of the workspace, made once for the module: the workspace and the run.
+    No test changes it (each works on a copy), so it is also the reference a resumed run must equal."""
     root = inc.make_workspace(tmp_path_factory.mktemp("base") / "ws")
     proc = inc.verify(root)
     assert proc.returncode == 0, proc.stdout + proc.stderr
-    return root
+    return root, proc
+
+
+@pytest.fixture(scope="module")
+def verified(clean_run: tuple[Path, subprocess.CompletedProcess[str]]) -> Path:
+    return clean_run[0]
 
 
 def _copy(verified: Path, tmp_path: Path) -> Path:
@@ -225,13 +232,13 @@ def _run_and_kill(ws: Path, at: str, timeout: float = 120) -> list[str]:
     return started
 
 
-def test_a_killed_run_resumes_where_it_stopped(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+def test_a_killed_run_resumes_where_it_stopped(tmp_path: Path, capsys: pytest.CaptureFixture[str],
+                                              clean_run: tuple[Path, subprocess.CompletedProcess[str]]) -> None:
     """SIGKILL at five points of one workspace's runs (each run resumes the
     last and is killed further on), then a run to the end: each run executes
-    only the tasks that had not finished, and the reports equal a clean run's."""
-    reference = inc.make_workspace(tmp_path / "ref" / "ws")
-    full = inc.verify(reference)
-    assert full.returncode == 0, full.stdout + full.stderr
+    only the tasks that had not finished, and the reports equal a clean run's
+    (the module's clean run, of a workspace made the same way)."""
+    reference, full = clean_run
     every = _ran(full)
     ws = inc.make_workspace(tmp_path / "killed" / "ws")
     finished: set[str] = set()
