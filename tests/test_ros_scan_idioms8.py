@@ -296,3 +296,42 @@ def test_a_python_wrapper_of_declare_parameter_and_a_factory(graph) -> None:  # 
     # pick() returns one of two names by a branch: not guessed
     assert any(m.startswith("14: publisher topic name is 'pick(self, True)', not a string literal")
                for m in _notes(graph, "rig_py/watch.py")), _notes(graph, "rig_py/watch.py")
+
+
+RECURSIVE = """#include <rclcpp/rclcpp.hpp>
+#include <std_msgs/msg/string.hpp>
+
+std::string deeper(const std::string & t, int n)
+{
+  if (n > 0) {
+    return deeper(t + "x", n - 1);
+  }
+  return t;
+}
+
+class Loop : public rclcpp::Node
+{
+public:
+  Loop()
+  : rclcpp::Node("loop")
+  {
+    pub_ = create_publisher<std_msgs::msg::String>(deeper("chatter", 3), 10);
+  }
+  rclcpp::Publisher<std_msgs::msg::String>::SharedPtr pub_;
+};
+
+int main(int argc, char ** argv)
+{
+  rclcpp::init(argc, argv);
+  rclcpp::spin(std::make_shared<Loop>());
+  return 0;
+}
+"""
+
+
+def test_a_recursive_function_names_nothing(tmp_path) -> None:  # type: ignore[no-untyped-def]
+    _package(tmp_path, "looping", {"src/loop.cpp": RECURSIVE})
+    g = scan([tmp_path], [], base=tmp_path).graph
+    assert _edges(g, "/loop") == set()  # deeper() returns 'chatter' or itself: never guessed
+    assert any(m.startswith("18: publisher topic name is 'deeper(\"chatter\", 3)', not a string literal")
+               for m in _notes(g, "loop.cpp")), _notes(g, "loop.cpp")

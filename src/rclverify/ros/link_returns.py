@@ -38,6 +38,7 @@ class Returns:
     """The reading of ``("ret", ...)`` values (mixed into the linker)."""
 
     returns: dict[str, list[Entry]]
+    reading: set[str]  # the functions whose returns are being read (a recursion reads nothing)
     units: dict[str, dict[str, Any]]
     fn_tparams: dict[str, list[str]]
     call_targs: list[tuple[str, str | None, str | None, int, list[str]]]
@@ -56,20 +57,25 @@ class Returns:
         """Every value call value ``v`` takes in function ``fkey`` called with ``env``."""
         _k, callee, unit, args = v
         entries = self.return_entries(callee, unit, len(args))
-        if not entries:
-            return [None]
+        busy = self.reading
+        if not entries or any(k in busy for k, _e in entries):
+            return [None]  # a function read within its own reading (recursion): not read
         vals = [self.eval(a, env, fkey, depth + 1) for a in args]
         out: list[Any] = []
-        for combo in list(product(*vals))[:MAX_COMBOS]:  # one call's arguments: its paths read together
-            got: list[Any] = []
-            for key, (nparams, _opt, defaults, rets) in entries:
-                cenv = dict(enumerate(combo[:nparams]))
-                cenv.update({i: d for i, d in enumerate(defaults) if i >= len(combo) and symbols.is_concrete(d)})
-                for r in rets:
-                    got += self.eval(r, cenv, key, depth + 1) if r is not None else [None]
-            for x in one_value(got):
-                if x not in out:
-                    out.append(x)
+        busy.update(k for k, _e in entries)
+        try:
+            for combo in list(product(*vals))[:MAX_COMBOS]:  # one call's arguments: its paths read together
+                got: list[Any] = []
+                for key, (nparams, _opt, defaults, rets) in entries:
+                    cenv = dict(enumerate(combo[:nparams]))
+                    cenv.update({i: d for i, d in enumerate(defaults) if i >= len(combo) and symbols.is_concrete(d)})
+                    for r in rets:
+                        got += self.eval(r, cenv, key, depth + 1) if r is not None else [None]
+                for x in one_value(got):
+                    if x not in out:
+                        out.append(x)
+        finally:
+            busy.difference_update(k for k, _e in entries)
         return out
 
     def return_entries(self, callee: str, unit: str | None, nargs: int) -> list[tuple[str, Entry]]:
