@@ -36,3 +36,19 @@ def test_every_relative_link_resolves() -> None:
             if "://" not in target and not (path.parent / target).exists():
                 missing.append(f"{page}: {target}")
     assert missing == []
+
+
+def test_the_command_reference_lists_every_command() -> None:
+    """docs/commands.md's block names every command `rclverify --help` offers."""
+    import contextlib
+    import io
+
+    from rclverify.cli import main
+    out = io.StringIO()
+    with contextlib.redirect_stdout(out), contextlib.suppress(SystemExit):
+        main(["--help"])
+    commands = re.search(r"\{([a-z0-9_,-]+)\}", out.getvalue())
+    assert commands is not None, out.getvalue()
+    block = (ROOT / "docs/commands.md").read_text(encoding="utf-8").split("## Command line", 1)[1].split("```", 2)[1]
+    missing = [c for c in commands.group(1).split(",") if f"rclverify {c}" not in block]
+    assert missing == []
