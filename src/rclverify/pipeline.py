@@ -41,6 +41,7 @@ from .workspace import (PLAN, REPORT_PARTS, TaskIndex, Workspace, cone_digests, 
 
 if TYPE_CHECKING:
     from .health.checks import Finding
+    from .report.schema_types import Report
 
 # The parser, type checker, calculus, health checks, lint and backends are
 # imported where a stage uses them: a doit run that reuses the cached
@@ -258,7 +259,7 @@ def stage_deadlines(ws: Workspace) -> list[dict[str, Any]]:
 
 
 def stage_report(ws: Workspace, parts: Sequence[str] = tuple(REPORT_PARTS),
-                 report: dict[str, Any] | None = None) -> tuple[dict[str, Any], list[Path]]:
+                 report: Report | None = None) -> tuple[Report, list[Path]]:
     """Build the report dict of ``ws`` (unless ``report`` gives it) and write
     the files of ``parts`` under ``reports/`` (:mod:`rclverify.report.parts`:
     ``html`` is ``assurance.{html,json}``, the CI formats and the argument's

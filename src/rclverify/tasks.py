@@ -54,7 +54,7 @@ import inspect
 import os
 import shutil
 from pathlib import Path
-from typing import Any, Callable, Iterator, Mapping, Sequence, TypeVar, cast
+from typing import TYPE_CHECKING, Any, Callable, Iterator, Mapping, Sequence, TypeVar, cast
 
 from doit import create_after as _create_after
 from doit.exceptions import TaskFailed
@@ -66,6 +66,9 @@ from .pipeline import REPORT_PARTS, TaskIndex, Workspace
 from .plan.entries import TOOL_KEYS
 from .rcl.errors import RclError
 from .workspace import check_input_files
+
+if TYPE_CHECKING:
+    from .report.schema_types import Report
 
 _F = TypeVar("_F", bound=Callable[..., Any])
 
@@ -205,7 +208,7 @@ def act_run(root: str, node: str, obligation_id: str) -> Any:
 
 #: The report dict built by the first report part of a run, for the other parts the same process
 #: runs (a serial run): keyed by workspace root, valid for the workspace object of that run.
-_REPORTS: dict[str, tuple[Workspace, dict[str, Any]]] = {}
+_REPORTS: dict[str, tuple[Workspace, Report]] = {}
 
 
 def act_report(root: str, part: str) -> Any:

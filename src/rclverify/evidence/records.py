@@ -17,6 +17,9 @@ Statuses, from best to worst (roll-up takes the worst child):
 
 Kinds of evidence: ``proof``, ``model checking``, ``testing``,
 ``experiment``, ``review``, ``monitoring``.
+
+Both sets, and ``unverified`` (a guarantee no obligation covers, never a
+record's status), are defined once in :mod:`rclverify.evidence.statuses`.
 """
 from __future__ import annotations
 
@@ -26,19 +29,9 @@ from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any, Mapping, Sequence
 
+#: Severity order used by every roll-up; larger is worse (defined with the vocabulary).
+from .statuses import SEVERITY as SEVERITY
 
-#: Severity order used by every roll-up; larger is worse.
-SEVERITY: Mapping[str, int] = {
-    "discharged": 0,
-    "pending": 1,
-    # a guarantee no obligation covers: nothing was planned to establish it (report/build.py);
-    # never an evidence record's status
-    "unverified": 2,
-    "inconclusive": 3,
-    "stale": 4,
-    "error": 5,
-    "failed": 6,
-}
 #: Roll-up status for a parent with no evidence at all.
 MISSING = "pending"
 

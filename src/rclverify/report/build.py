@@ -41,6 +41,7 @@ from ..system.model import cycles_kept, names_of
 from ..diagnosis.build import diagnose
 from ..diagnosis.text import natural_sorted  # p1 < p2 < p10
 from .expected import expected_rows
+from .schema_types import Report, as_report
 from .statistics import annotate_statistics, compact as compact_statistics
 from .records import diagnostics as read_diagnostics, grounding as read_grounding, inputs_sha256, node_obligations, \
     node_records
@@ -147,8 +148,9 @@ class ConeEvidence:
         return derivation, worst(list(counts)), "rests on " + "; ".join(parts)
 
 
-def build_report(ws: Workspace) -> dict[str, Any]:
-    """Read every artifact of ``ws`` and return the report dict (see render.py)."""
+def build_report(ws: Workspace) -> Report:
+    """Read every artifact of ``ws`` and return the report (see render.py): a
+    :class:`.schema_types.Report`, the shape docs/assurance.schema.json publishes."""
     checked, model, plan = ws.checked, ws.model, ws.plan
     texts = ContractTexts(ws)  # each node's RCL and LaTeX texts, kept by its file's sha256 (read only here)
     store = EvidenceStore(ws.root)
@@ -235,7 +237,7 @@ def build_report(ws: Workspace) -> dict[str, Any]:
                          for f in health[n]]
     for n in checked.nodes:
         if comps[n]:  # {} before the calculus ran
-            comps[n] = {**comps[n], "side_conditions": [second.side_condition(sc)
+            comps[n] = {**comps[n], "side_conditions": [_verdict_of_status(second.side_condition(sc))
                                                         for sc in comps[n].get("side_conditions", [])]}
         health[n] = [second.finding(f) for f in health[n]]
     # a counterexample shows the nodes involved only: the consumer and the producers of the linked variables
@@ -435,7 +437,19 @@ def build_report(ws: Workspace) -> dict[str, Any]:
     report["problems"] = group_problems(report, problem_items(report), anchor)
     from .culprits import mark_culprits  # a culprit node reads its problem's status, never "discharged" (issue 64)
     mark_culprits(report)
-    return report
+    return as_report(report)
+
+
+def _verdict_of_status(sc: dict[str, Any]) -> dict[str, Any]:
+    """``sc`` (a side-condition row) with a ``verdict`` that says its
+    ``status``: a discharged row keeps its verdict (``discharged`` or
+    ``discharged in context``); a row made stale here or downgraded by the
+    second solver had kept the verdict recorded before (``discharged``),
+    which contradicted its status (docs/reading-the-report.md, "The report's
+    schema")."""
+    if sc.get("status") == "discharged" or sc.get("verdict") == sc.get("status"):
+        return sc
+    return {**sc, "verdict": sc.get("status")}
 
 
 def involved_model(sc: Mapping[str, Any]) -> Mapping[str, Any]:
@@ -491,7 +505,7 @@ def requirement_check(record: Mapping[str, Any] | None, traced_status: str, g_st
     return {"status": status, "verdict": verdict, "note": note, "check": details}
 
 
-def _headline(ob_rows: list[dict[str, Any]], counts: dict[str, int], side_conditions: list[dict[str, Any]],
+def _headline(ob_rows: list[dict[str, Any]], counts: dict[str, int], side_conditions: Sequence[Mapping[str, Any]],
               findings: list[dict[str, Any]], unverified: Sequence[Mapping[str, Any]] = ()) -> str:
     """The one-line summary, without empty fragments: a kind with nothing
     in it is said in words ("no obligations"), never as "0 obligations: ;".

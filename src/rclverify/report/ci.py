@@ -6,18 +6,18 @@ by ``rclverify report`` and the doit ``report:html`` task.
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any, Mapping
 
 from ..evidence.published import write_published
 from .fragments import FragmentCache
 from .junit import render_junit
 from .sarif import render_sarif
+from .schema_types import Report
 
 #: File names written under ``reports/``, in the order :func:`write_ci_reports` returns them.
 CI_FILES: tuple[str, ...] = ("assurance.sarif", "assurance.junit.xml")
 
 
-def write_ci_reports(report: Mapping[str, Any], out_dir: Path, fragments: FragmentCache | None = None) -> list[Path]:
+def write_ci_reports(report: Report, out_dir: Path, fragments: FragmentCache | None = None) -> list[Path]:
     """Render ``report`` (the dict of ``build_report``) as SARIF 2.1.0 and JUnit
     XML and write both to ``out_dir``; ``fragments`` keeps the JUnit text of
     each node between runs (:func:`rclverify.report.junit.render_junit`).

@@ -53,6 +53,7 @@ from typing import Any, Mapping
 from .fragments import FragmentCache
 from .sarif import split_location
 from .render import model_text
+from .schema_types import Report
 
 
 def _case(suite: ET.Element, classname: str, name: str, where: str, seconds: Any) -> ET.Element:
@@ -104,7 +105,7 @@ def _lines(*parts: str) -> str:
     return "\n".join(p for p in parts if p)
 
 
-def junit_tree(report: Mapping[str, Any]) -> ET.Element:
+def junit_tree(report: Report) -> ET.Element:
     """The ``<testsuites>`` element of ``report`` (see the module docstring).
 
     Raises ``KeyError`` for a report dict without the keys ``nodes``,
@@ -297,7 +298,7 @@ def _source_of(node: Mapping[str, Any], finding: Mapping[str, Any]) -> str:
 _DECLARATION = '<?xml version="1.0" encoding="utf-8"?>\n'
 
 
-def render_junit(report: Mapping[str, Any], fragments: FragmentCache | None = None) -> str:
+def render_junit(report: Report, fragments: FragmentCache | None = None) -> str:
     """:func:`junit_tree` as indented UTF-8 XML text with a declaration.
 
     With ``fragments``, each node's ``<testsuite>`` (its indented text, its

@@ -23,7 +23,6 @@ from __future__ import annotations
 
 from functools import lru_cache
 from pathlib import Path
-from typing import Any, Mapping
 
 from ..argument.export import FILES as ARGUMENT_FILES
 from ..argument.export import argument_layout, write_argument
@@ -31,6 +30,7 @@ from ..workspace import REPORT_PARTS
 from .ci import CI_FILES, write_ci_reports
 from .fragments import FragmentCache
 from .render import REPORT_FILES, render_files
+from .schema_types import Report
 
 #: Each part's files under ``reports/`` (``argument.svg`` only when the argument is laid out).
 PARTS = REPORT_PARTS
@@ -39,7 +39,7 @@ PARTS = REPORT_PARTS
 FRAGMENTS = {part: f"artifacts/cache/report-fragments.{part}.pickle" for part in PARTS}
 
 
-def write_part(report: Mapping[str, Any], out_dir: Path, part: str, fragments: FragmentCache | None = None) -> list[Path]:
+def write_part(report: Report, out_dir: Path, part: str, fragments: FragmentCache | None = None) -> list[Path]:
     """Render and write the files of ``part`` (a key of :data:`PARTS`) for
     ``report`` into ``out_dir``; ``fragments`` keeps rendered pieces
     between runs (the caller saves it).  Returns the paths written: the

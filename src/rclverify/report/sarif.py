@@ -36,6 +36,7 @@ from typing import Any, Mapping, Sequence
 
 from ..evidence.store import dumps
 from .render import model_text
+from .schema_types import Report
 
 #: The SARIF version written and the schema it validates against.
 SARIF_VERSION = "2.1.0"
@@ -448,12 +449,13 @@ def _descriptor(r: Rule) -> dict[str, Any]:
             "defaultConfiguration": {"level": r.level}}
 
 
-def sarif_log(report: Mapping[str, Any]) -> dict[str, Any]:
+def sarif_log(report: Report) -> dict[str, Any]:
     """The SARIF 2.1.0 log (a JSON-serialisable dict) of ``report``.
 
-    ``report`` is the dict of :func:`~rclverify.report.build.build_report`
-    (keys ``meta``, ``obligations``, ``evidence``, ``pending``,
-    ``side_conditions``, ``findings``, ``nodes``, ``lint``).  Every rule of
+    ``report`` is the :class:`~rclverify.report.schema_types.Report` of
+    :func:`~rclverify.report.build.build_report` (it reads ``meta``,
+    ``obligations``, ``evidence``, ``pending``, ``side_conditions``,
+    ``findings``, ``nodes``, ``lint``).  Every rule of
     :data:`RULES` is listed in the driver (so ids stay stable whether or not
     they fire), results refer to their rule by ``ruleIndex`` too.  Raises
     ``KeyError`` for a report dict without those keys.
@@ -481,6 +483,6 @@ def sarif_log(report: Mapping[str, Any]) -> dict[str, Any]:
     return {"$schema": SARIF_SCHEMA, "version": SARIF_VERSION, "runs": [run]}
 
 
-def render_sarif(report: Mapping[str, Any]) -> str:
+def render_sarif(report: Report) -> str:
     """:func:`sarif_log` as deterministic JSON text (sorted keys, final newline)."""
     return dumps(sarif_log(report))

@@ -47,12 +47,14 @@ from __future__ import annotations
 from typing import Any, Callable, Mapping, Sequence
 
 from ..evidence.records import worst
+from ..evidence.statuses import REQUIREMENT_VERDICTS
 
 MET = "met"
 OUTSTANDING = "proved, evidence outstanding"
 INCONSISTENT = "proved from an inconsistency"
 VACUOUS = "proved vacuously"
-VERDICTS = (MET, OUTSTANDING, INCONSISTENT, VACUOUS, "refuted", "inconclusive", "informal", "stale", "error")
+#: Every verdict a requirement row may carry: the vocabulary's set (evidence/statuses.py).
+VERDICTS = REQUIREMENT_VERDICTS
 
 
 #: a declaration's status given the premise kind (``"progress"``, ``"initial value"``) and index, with words
