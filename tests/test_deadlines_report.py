@@ -113,3 +113,13 @@ def test_the_end_of_verify_names_each_deadline_and_its_sums(runs: dict[str, Any]
     rows = runs["refuted"]["summary"]["deadlines"]
     assert [r[:4] for r in rows] == [["STOP", "refuted", "250 ms", "200 ms"], ["MOVE-FEEDBACK", "proved", "2 s", "2 s"]]
     assert deadlines_line(rows).startswith("deadlines: STOP refuted (250 ms > 200 ms")
+
+
+def test_the_reports_match_the_published_schema(runs: dict[str, Any]) -> None:
+    """The deadline rows (proved, then refuted) against docs/assurance.schema.json and the status vocabulary
+    (tests/_report_schema.py)."""
+    from _report_schema import check_report
+    for label in ("proved", "refuted"):
+        check_report(runs[label]["json"], label)
+    assert {d["verdict"] for d in runs["proved"]["json"]["deadlines"]} == {"proved"}
+    assert "refuted" in {d["verdict"] for d in runs["refuted"]["json"]["deadlines"]}

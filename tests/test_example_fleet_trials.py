@@ -82,3 +82,10 @@ def test_an_edited_run_is_not_counted_until_checked_again(ws: Path) -> None:
     assert day["counts"]["runs"] == 59
     target = next(s for s in r["statistics"] if s["kind"] == "target" and s["environment"] == "warehouse_day")
     assert target["status"] == "stale"
+
+
+def test_the_report_matches_the_published_schema(ws: Path) -> None:
+    """The statistics rows and the rest of the report against docs/assurance.schema.json and the status
+    vocabulary (tests/_report_schema.py)."""
+    from _report_schema import check_report
+    check_report(_report(ws), "fleet_trials")
