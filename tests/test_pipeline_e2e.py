@@ -49,6 +49,13 @@ def test_report_has_the_traceability_keys(report: dict) -> None:
     assert report["meta"]["plan"] == "contracts/plan.yaml"
 
 
+def test_report_matches_the_published_schema(report: dict) -> None:
+    """The case study's reports/assurance.json against docs/assurance.schema.json and the status
+    vocabulary (tests/_report_schema.py)."""
+    from _report_schema import check_report
+    check_report(report, "case study")
+
+
 def test_calculus_reproduces_d1(report: dict) -> None:
     sc = {s["id"]: s for s in report["side_conditions"]}
     assert sc["Agent.sc1"]["status"] == "discharged"
