@@ -4,10 +4,13 @@ workspace's own functions.
 Small self-written packages, one construct each, scanned once per module:
 
 * a wrapper of ``declare_parameter`` in another package's header, a free
-  function template with overloads (``rigutil::param_or(node, "p", default)``
-  and its two-argument form), returning the parameter on two paths: the
-  topic it names is the parameter, its default the wrapper's argument (also
-  through a member set in another method);
+  function template with overloads (``rigutil::param_or(node, "p", default,
+  warn)`` forwarding to ``param_or(logger, params, "p", default)``, both
+  taking four arguments: a string literal never goes to the ``Logger`` or
+  parameters-interface parameter, so the call is not read as the parameter
+  ``~layers``), returning the parameter on two paths: the topic it names is
+  the parameter, its default the wrapper's argument (also through a member
+  set in another method); a recursive function names nothing;
 * the same wrapper as a method of the node's own base class
   (``node->param_or("p", default)`` with ``auto node = shared_from_this()``),
   forwarding to the free function;
@@ -50,14 +53,24 @@ T param_or(NodeT node, const std::string & name)
   return node->get_parameter(name).template get_value<T>();
 }
 
-template<typename T, typename NodeT>
-T param_or(NodeT node, const std::string & name, const T & fallback)
+template<typename T>
+T param_or(
+  const rclcpp::Logger & logger, rclcpp::node_interfaces::NodeParametersInterface::SharedPtr params,
+  const std::string & name, const T & fallback)
 {
-  if (node->has_parameter(name)) {
-    return node->get_parameter(name).template get_value<T>();
+  if (params->has_parameter(name)) {
+    rclcpp::Parameter p(name, fallback);
+    params->get_parameter(name, p);
+    return p.get_value<T>();
   }
-  auto got = node->declare_parameter(name, rclcpp::ParameterValue{fallback}).template get<T>();
+  auto got = params->declare_parameter(name, rclcpp::ParameterValue{fallback}).template get<T>();
   return got;
+}
+
+template<typename T, typename NodeT>
+T param_or(NodeT node, const std::string & name, const T & fallback, bool warn = false)
+{
+  return param_or(node->get_logger(), node->get_node_parameters_interface(), name, fallback);
 }
 
 template<typename NodeT>
@@ -128,7 +141,7 @@ public:
   void configure()
   {
     auto node = shared_from_this();
-    layer_topic_ = rigutil::param_or(node, "layer_topic", std::string{"layers"});
+    layer_topic_ = rigutil::param_or(node, "layer_topic", std::string{"layers"}, true);
     layer_pub_ = create_publisher<std_msgs::msg::String>(layer_topic_, 10);
   }
   std::string layer_topic_;

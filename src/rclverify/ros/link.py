@@ -76,7 +76,7 @@ class Linker(LinkMembers, Values, Returns):
         entry_units: set[str] = set()
         self.optional: dict[str, int] = {k: n for r in self.recs.values() for k, n in r.get("optional", {}).items()}
         self.returns: dict[str, list[Any]] = {}
-        self.reading: set[str] = set()
+        self.reading: set[tuple[str, int]] = set()
         self.fn_tparams: dict[str, list[str]] = {}
         self.call_targs: list[tuple[str, str | None, str | None, int, list[str]]] = []
         for r in self.recs.values():  # a header read by several files: its definitions once

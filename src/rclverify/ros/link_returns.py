@@ -11,8 +11,10 @@ the callee's ``return`` statements (:func:`sources_cpp` records them per
 definition, overloads apart) with the callee's parameters bound to the
 call's arguments (missing ones to their defaults).  Of a function's
 overloads, those whose parameter count admits the call's arguments are read
-(C++ overload resolution would also weigh argument types, which the scan
-does not know: each candidate is read).
+(C++ overload resolution also weighs argument types; the scan knows one
+case: a string literal does not go to a parameter declared with a type that
+is neither a string nor a template parameter, such as a
+``ParameterDescriptor``; the other candidates are each read).
 
 A wrapper of ``declare_parameter`` typically returns the parameter on
 several paths: its value when it is declared already (no default there),
@@ -30,7 +32,8 @@ from typing import TYPE_CHECKING, Any
 
 from . import symbols
 
-Entry = tuple[int, int, list[Any], list[Any]]  # parameters, defaulted ones, defaults, returned values
+Entry = tuple[int, int, list[Any], list[Any], list[bool]]  # parameters, defaulted ones, defaults, returned
+# values, per parameter whether it may take a string literal
 MAX_COMBOS = 16
 
 
@@ -38,7 +41,7 @@ class Returns:
     """The reading of ``("ret", ...)`` values (mixed into the linker)."""
 
     returns: dict[str, list[Entry]]
-    reading: set[str]  # the functions whose returns are being read (a recursion reads nothing)
+    reading: set[tuple[str, int]]  # the definitions whose returns are being read (a recursion reads nothing)
     units: dict[str, dict[str, Any]]
     fn_tparams: dict[str, list[str]]
     call_targs: list[tuple[str, str | None, str | None, int, list[str]]]
@@ -57,25 +60,32 @@ class Returns:
         """Every value call value ``v`` takes in function ``fkey`` called with ``env``."""
         _k, callee, unit, args = v
         entries = self.return_entries(callee, unit, len(args))
-        busy = self.reading
-        if not entries or any(k in busy for k, _e in entries):
-            return [None]  # a function read within its own reading (recursion): not read
+        if not entries:
+            return [None]
         vals = [self.eval(a, env, fkey, depth + 1) for a in args]
         out: list[Any] = []
-        busy.update(k for k, _e in entries)
-        try:
-            for combo in list(product(*vals))[:MAX_COMBOS]:  # one call's arguments: its paths read together
-                got: list[Any] = []
-                for key, (nparams, _opt, defaults, rets) in entries:
-                    cenv = dict(enumerate(combo[:nparams]))
-                    cenv.update({i: d for i, d in enumerate(defaults) if i >= len(combo) and symbols.is_concrete(d)})
+        for combo in list(product(*vals))[:MAX_COMBOS]:  # one call's arguments: its paths read together
+            got: list[Any] = []
+            for key, entry in entries:
+                nparams, _opt, defaults, rets, strings = entry
+                if any(x is not None and x[0] == "str" and i < len(strings) and not strings[i]
+                       for i, x in enumerate(combo[:nparams])):
+                    continue  # a string literal given to a parameter of another type: not this overload
+                mark = (key, id(entry))  # one definition (overloads of one arity share a key)
+                if mark in self.reading:  # read within its own reading (recursion): not read
+                    got.append(None)
+                    continue
+                cenv = dict(enumerate(combo[:nparams]))
+                cenv.update({i: d for i, d in enumerate(defaults) if i >= len(combo) and symbols.is_concrete(d)})
+                self.reading.add(mark)
+                try:
                     for r in rets:
                         got += self.eval(r, cenv, key, depth + 1) if r is not None else [None]
-                for x in one_value(got):
-                    if x not in out:
-                        out.append(x)
-        finally:
-            busy.difference_update(k for k, _e in entries)
+                finally:
+                    self.reading.discard(mark)
+            for x in one_value(got) if got else [None]:
+                if x not in out:
+                    out.append(x)
         return out
 
     def return_entries(self, callee: str, unit: str | None, nargs: int) -> list[tuple[str, Entry]]:

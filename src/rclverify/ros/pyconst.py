@@ -152,9 +152,9 @@ class PyScope:
         d = self.value(c.args[1], depth + 1) if last != "get_parameter" and len(c.args) > 1 else None
         return ("param", key, d if d is not None and d[0] in ("str", "arg") else None, None)
 
-    def returns(self) -> dict[str, list[tuple[int, int, list[symbols.Val], list[symbols.Val]]]]:
+    def returns(self) -> dict[str, list[tuple[int, int, list[symbols.Val], list[symbols.Val], list[bool]]]]:
         """Per function key, ``[(parameters, defaulted ones, default values, values
-        returned)]`` for a function returning a value the linker may read (a
+        returned, per parameter whether it may take a string: always)]`` for a function returning a value the linker may read (a
         ``("ret", ...)`` call of it, :mod:`link_returns`)."""
         got: dict[str, list[symbols.Val]] = {}
         for line, pv in self.mod.returns:
@@ -166,7 +166,8 @@ class PyScope:
             vals = got.get(f[0], [])
             if any(x is not None for x in vals):
                 out[f"{self.shown}::{f[0]}"] = [(len(f[3]), sum(d is not None for d in f[4]),
-                                                 [self.value(d) if d is not None else None for d in f[4]], vals)]
+                                                 [self.value(d) if d is not None else None for d in f[4]], vals,
+                                                 [True] * len(f[3]))]
         return out
 
     def _name(self, name: str, line: int, depth: int) -> symbols.Val:

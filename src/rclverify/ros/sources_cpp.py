@@ -259,13 +259,15 @@ class _File(MemberReader):
             p = p.parent
         return False
 
-    def returns(self) -> dict[str, list[tuple[int, int, list[symbols.Val], list[symbols.Val]]]]:
+    def returns(self) -> dict[str, list[tuple[int, int, list[symbols.Val], list[symbols.Val], list[bool]]]]:
         """Per function key, one ``(parameters, defaulted ones, default values,
-        values returned)`` per definition (overloads apart) that returns a value
+        values returned, per parameter: whether it may take a string literal)``
+        per definition (overloads apart) that returns a value
         the linker may read: a ``("ret", ...)`` call of it is read from these
         (a ``declare_parameter`` wrapper; issue 65).  A lambda's ``return`` is not
         its enclosing function's."""
         s, got = self.scope, {}  # type: ignore[var-annotated]
+        self.nodes_by_id = {n.id: n for n in self.nodes if n.type == "function_definition"}
         for n in self.nodes:
             if n.type != "return_statement" or not n.named_children:
                 continue
@@ -275,11 +277,14 @@ class _File(MemberReader):
             f = s.fns.get(p.id) if p is not None and p.type == "function_definition" else None
             if f is not None:
                 got.setdefault(p.id, (f, []))[1].append(s.value(n.named_children[0]))
-        out: dict[str, list[tuple[int, int, list[symbols.Val], list[symbols.Val]]]] = {}
+        out: dict[str, list[tuple[int, int, list[symbols.Val], list[symbols.Val], list[bool]]]] = {}
         for f, vals in got.values():
             if any(v is not None for v in vals):
+                tps = set(_tparams(self.nodes_by_id[f.nid].parent)) if self.nodes_by_id[f.nid].parent is not None \
+                    and self.nodes_by_id[f.nid].parent.type == "template_declaration" else set()
                 out.setdefault(f.key, []).append((len(f.params), sum(d is not None for d in f.defaults),
-                                                  [s.value(d) for d in f.defaults], vals))
+                                                  [s.value(d) for d in f.defaults], vals,
+                                                  [_takes_string(t, tps) for t in f.ptypes]))
         return out
 
     def initializer(self, n: Any) -> None:
@@ -453,6 +458,15 @@ class _File(MemberReader):
         t = action_type(self.aliases.get(targs[0], targs[0])) if targs else None
         self.emit(kind, args[k], t, n, self.scope.value(args[0]) if k == 1 else None,
                   ("type", targs[0]) if t is None and targs else None)
+
+
+def _takes_string(ptype: str, tparams: set[str]) -> bool:
+    """Whether a parameter declared ``ptype`` may be given a string literal: a
+    string or character type, ``auto``, or a template parameter of its function
+    (``const std::string &``, ``T``); not ``const ParameterDescriptor &``,
+    ``bool``, ``rclcpp::Logger`` (how a call's overload is told apart)."""
+    base = ptype.replace("const", "").replace("&", "").replace("*", "").strip()
+    return "string" in base.lower() or "char" in base or base in ("auto", "") or base in tparams
 
 
 def _tparams(decl: Any) -> list[str]:
