@@ -41,7 +41,7 @@ LIVE = frozenset({
     "test_lsp_fuzz", "test_lsp_hostile", "test_lsp_invalid", "test_lsp_nvim", "test_lsp_server",
     "test_monitor_live_dds", "test_monitor_live_hostile", "test_monitor_live_ros1", "test_monitor_oracle",
     "test_ros2_diff", "test_ros2_generated", "test_ros2_services_actions", "test_ros2_silence_deadlines",
-    "test_ros2_types_record", "test_ros_diff_dds", "test_ros_diff_live", "test_ros_live",
+    "test_ros2_declarations", "test_ros2_types_record", "test_ros_diff_dds", "test_ros_diff_live", "test_ros_live",
     "test_ros_master_hostile", "test_services_live_ros1",
 })
 
@@ -70,6 +70,8 @@ SECONDS: dict[str, float] = {
     "test_layers": 2.7, "test_realizable": 2.6, "test_bench_compose_pacti": 2.5,
     "test_calculus_context": 2.5, "test_generate_contract_layer": 2.5, "test_init": 2.5,
     "test_straightline": 2.5, "test_generate_example": 3.7, "test_ros_ground": 2.1,
+    "test_temporal_pdr": 6.7, "test_declarations_verified": 3.7, "test_statistics_plan": 3.7,
+    "test_ros2_declarations": 2.7,
 }
 
 #: Wall-clock seconds of the live modules, serial (they wait on masters, nodes, a browser: their CPU
@@ -81,8 +83,8 @@ WALL: dict[str, float] = {
     "test_monitor_live_hostile": 15.0, "test_ros2_diff": 13.4, "test_ros_diff_live": 12.9,
     "test_lsp_fuzz": 11.9, "test_ros2_services_actions": 11.5, "test_browser_report": 10.5,
     "test_services_live_ros1": 10.0, "test_ros2_silence_deadlines": 8.6, "test_ros_live": 6.7,
-    "test_monitor_live_dds": 6.1, "test_lsp_hostile": 5.0, "test_ros_master_hostile": 5.0,
-    "test_ros_diff_dds": 4.7, "test_lsp_invalid": 3.3, "test_lsp_nvim": 2.7, "test_monitor_oracle": 2.2,
+    "test_ros2_declarations": 25.4, "test_monitor_live_dds": 6.1, "test_lsp_hostile": 5.0,
+    "test_ros_master_hostile": 5.0, "test_ros_diff_dds": 4.7, "test_lsp_invalid": 3.3, "test_lsp_nvim": 2.7, "test_monitor_oracle": 2.2,
 }
 
 #: Modules that run the whole pipeline although they cost less than two seconds: still ``slow``.
@@ -91,7 +93,9 @@ PIPELINE = frozenset({
     "test_generate_example", "test_inputs_paths", "test_locations_cause",
     "test_monitor_periods", "test_monitor_silence", "test_one_root_one_repair", "test_problems_shared",
     "test_realizer", "test_ros_init", "test_temporal_deadlock", "test_temporal_progress",
-    "test_units_inferred", "test_deadline_monitors", "test_monitor_floats",
+    "test_units_inferred", "test_deadline_monitors", "test_monitor_floats", "test_acknowledged",
+    "test_blame_line", "test_deadline_timing_measured", "test_example_fleet_trials", "test_mapping_hygiene",
+    "test_one_row_per_cause", "test_repairs_units", "test_report_hygiene", "test_report_schema",
 })
 
 #: The ``slow`` tier: every module measured above two CPU seconds, and the pipeline runs.

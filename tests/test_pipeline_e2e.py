@@ -233,15 +233,22 @@ def test_bundle_of_the_case_study_verifies(workspace: Path, tmp_path: Path) -> N
     assert any(f.startswith("artifacts/evidence/") for f in manifest["files"])
 
 
-def test_second_run_executes_no_task(workspace: Path) -> None:
-    r = _doit(workspace, "verify")
+@pytest.fixture(scope="module")
+def second_run(workspace: Path) -> subprocess.CompletedProcess[str]:
+    """`doit verify` again on the verified workspace, nothing changed: one run read by the two tests below."""
+    return _doit(workspace, "verify")
+
+
+def test_second_run_executes_no_task(second_run: subprocess.CompletedProcess[str]) -> None:
+    r = second_run
     assert r.returncode == 0
     executed = [l for l in r.stdout.splitlines() if l.startswith(".  ")]
     assert executed == [], executed
 
 
-def test_a_run_with_nothing_to_do_still_prints_the_status_and_the_problems_by_root_cause(workspace: Path) -> None:
-    r = _doit(workspace, "verify")
+def test_a_run_with_nothing_to_do_still_prints_the_status_and_the_problems_by_root_cause(
+        second_run: subprocess.CompletedProcess[str]) -> None:
+    r = second_run
     assert r.returncode == 0
     assert "overall: failed" in r.stdout and "11 problems by root cause (54 findings)" in r.stdout, r.stdout
     # 7: the Agent's model-checking instances are rows of their own (report/problems_mc.py), not this one
