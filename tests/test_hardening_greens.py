@@ -163,7 +163,16 @@ def test_2_records_altered_outside_rclverify_are_error_and_made_again(tmp_path: 
 
 # 3 ---------------------------------------------------------------------------------------------
 
-def test_3_strict_fails_on_a_formal_requirement_not_met_and_not_on_an_informal_one(tmp_path: Path) -> None:
+@pytest.fixture(scope="module")
+def met(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, subprocess.CompletedProcess[str]]:
+    """The workspace as shipped (STOP, STILL, DIST met; SAFE informal) after `doit verify --strict`: one
+    run for the module; test 3 reads it, test 4 (after it) goes on from it."""
+    ws = _copy(tmp_path_factory.mktemp("met"))
+    return ws, _doit(ws, "verify", "--strict")
+
+
+def test_3_strict_fails_on_a_formal_requirement_not_met_and_not_on_an_informal_one(
+        tmp_path: Path, met: tuple[Path, subprocess.CompletedProcess[str]]) -> None:
     refuted = _copy(tmp_path, "0.3")
     r = _doit(refuted, "verify", "--strict")
     assert r.returncode != 0 and "1 formal requirement is not met (STOP)" in r.stdout + r.stderr
@@ -171,17 +180,16 @@ def test_3_strict_fails_on_a_formal_requirement_not_met_and_not_on_an_informal_o
     assert {o["status"] for o in _report(refuted)["obligations"]} == {"discharged"}
     assert _reqs(refuted)["STOP"]["verdict"] == "refuted"
 
-    met = _copy(tmp_path)  # STOP, STILL, DIST met; SAFE informal
-    r = _doit(met, "verify", "--strict")
+    ws, r = met
     assert r.returncode == 0, r.stdout + r.stderr
-    assert _reqs(met)["SAFE"]["verdict"] == "informal"
+    assert _reqs(ws)["SAFE"]["verdict"] == "informal"
 
 
 # 4 ---------------------------------------------------------------------------------------------
 
-def test_4_the_bundle_refuses_a_report_built_from_other_inputs(tmp_path: Path,
-                                                             capsys: pytest.CaptureFixture[str]) -> None:
-    ws = _copy(tmp_path)
+def test_4_the_bundle_refuses_a_report_built_from_other_inputs(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str], met: tuple[Path, subprocess.CompletedProcess[str]]) -> None:
+    ws = met[0]  # verified as shipped (nothing left to run: the plain run after --strict's does no task)
     assert _doit(ws, "verify").returncode == 0
     out = tmp_path / "b.tar.gz"
     assert main(["bundle", "-w", str(ws), "-o", str(out)]) == 0
