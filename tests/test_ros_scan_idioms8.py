@@ -348,3 +348,88 @@ def test_a_recursive_function_names_nothing(tmp_path) -> None:  # type: ignore[n
     assert _edges(g, "/loop") == set()  # deeper() returns 'chatter' or itself: never guessed
     assert any(m.startswith("18: publisher topic name is 'deeper(\"chatter\", 3)', not a string literal")
                for m in _notes(g, "loop.cpp")), _notes(g, "loop.cpp")
+
+
+HANDLE = """#pragma once
+#include <rclcpp/rclcpp.hpp>
+#include <std_msgs/msg/string.hpp>
+
+namespace muxer
+{
+class Handle
+{
+public:
+  Handle(rclcpp::Node * node, const std::string & topic)
+  {
+    sub_ = node->create_subscription<std_msgs::msg::String>(
+      topic, 10, [](std_msgs::msg::String::SharedPtr) {});
+  }
+  rclcpp::Subscription<std_msgs::msg::String>::SharedPtr sub_;
+};
+}  // namespace muxer
+"""
+MUX = """#include <muxer/handle.hpp>
+
+class Mux : public rclcpp::Node
+{
+public:
+  Mux()
+  : rclcpp::Node("mux")
+  {
+    handles_ = std::make_shared<Handles>();
+    fill(*handles_);
+  }
+  template<typename List>
+  void fill(List & list)
+  {
+    list.emplace_back(this, "in_a");
+  }
+  using Handles = std::list<muxer::Handle>;
+  std::shared_ptr<Handles> handles_;
+};
+
+int main(int argc, char ** argv)
+{
+  rclcpp::init(argc, argv);
+  rclcpp::spin(std::make_shared<Mux>());
+  return 0;
+}
+"""
+DIRECT = """#include <muxer/handle.hpp>
+
+class Direct : public rclcpp::Node
+{
+public:
+  Direct()
+  : rclcpp::Node("direct")
+  {
+    handle_ = std::make_unique<muxer::Handle>(this, "direct_in");
+  }
+  std::unique_ptr<muxer::Handle> handle_;
+};
+
+int main(int argc, char ** argv)
+{
+  rclcpp::init(argc, argv);
+  rclcpp::spin(std::make_shared<Direct>());
+  return 0;
+}
+"""
+UNBUILT = ("subscriber topic of class muxer::Handle: nothing this program runs is read to construct the class")
+
+
+def test_a_class_made_only_through_a_container_is_a_note_not_silence(tmp_path) -> None:  # type: ignore[no-untyped-def]
+    _package(tmp_path, "muxer", {"include/muxer/handle.hpp": HANDLE, "src/mux.cpp": MUX})
+    g = scan([tmp_path], [], base=tmp_path).graph
+    assert _edges(g, "/mux") == set()
+    assert [m for m in _notes(g, "handle.hpp") if UNBUILT in m] == [f"12: {UNBUILT} (a construction through a "
+                                                                    "container's emplace_back/push_back or a factory "
+                                                                    "the scan does not follow is not read): not in "
+                                                                    "the graph"]
+
+
+def test_a_class_another_program_makes_gets_no_note(tmp_path) -> None:  # type: ignore[no-untyped-def]
+    _package(tmp_path, "muxer", {"include/muxer/handle.hpp": HANDLE, "src/mux.cpp": MUX, "src/direct.cpp": DIRECT})
+    g = scan([tmp_path], [], base=tmp_path).graph
+    assert _edges(g, "/direct") == {("sub", "/direct_in", S)}
+    assert not any(UNBUILT in m for m in _notes(g, "handle.hpp"))  # the graph has the class's edge

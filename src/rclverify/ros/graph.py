@@ -15,6 +15,7 @@ from __future__ import annotations
 from . import safefs
 
 import dataclasses
+import functools
 import os
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -28,7 +29,8 @@ from .executables import Targets, targets
 from .interfaces import TypeTable
 from .launch import El, Interpreter, read_xml, read_yaml
 from .launch_ros2 import read_python
-from .model import Endpoint, Graph, GraphEdge, GraphNode, Note, Src
+from .link import UNBUILT
+from .model import SERVICE_ROLES, Endpoint, Graph, GraphEdge, GraphNode, Note, Src
 from .param_yaml import PackageParams, expand_each
 from .packages import Package, find_manifests, read_package
 from .sources_cpp import scan_cpp
@@ -206,8 +208,7 @@ def _scan(paths: Sequence[Path], launch: Sequence[Path], launch_args: dict[str, 
             shown = show(f)
             sha = ParseCache.digest(data)
             is_py = f not in cpp
-            fn = (lambda d=data, s=shown: scan_python(d.decode("utf-8", errors="replace"), s)) if is_py \
-                else (lambda d=data, s=shown: scan_cpp(d, s))
+            fn = functools.partial(_parse, data, shown, is_py)
             r = cache.get(f"{'py' if is_py else 'cpp'}:{shown}", sha, fn) if cache else fn()
             recs[shown] = r
             if r["nodes"] or r["endpoints"] or r["notes"] or r.get("node_names"):
@@ -251,7 +252,7 @@ def _scan(paths: Sequence[Path], launch: Sequence[Path], launch_args: dict[str, 
         elif full in g.nodes:
             g.notes.append(Note(declared, f"node {full} is started twice (first at {g.nodes[full].declared_at}); "
                                           f"ROS keeps only the last one", "ROS-LAUNCH"))
-        mine = {names.resolve(k, ns, full): v for k, v in (params or {}).items()}
+        mine: dict[str, Any] = {names.resolve(k, ns, full): v for k, v in (params or {}).items()}
         if origin == "source":  # no launch file: the package's parameter files (param_yaml)
             from_files, said = pfiles.for_node(pkg, full)
             g.notes.extend(said)
@@ -305,12 +306,14 @@ def _scan(paths: Sequence[Path], launch: Sequence[Path], launch_args: dict[str, 
     for shown, r in sorted(res.sources.items()):
         g.notes.extend(r["notes"])
     g.notes = list(dict.fromkeys(g.notes))  # a note given by several programs (a shared header) once
+    made = {e.src for n in g.nodes.values() for r in ("pub", "sub") + SERVICE_ROLES for e in n.edges_of(r)}
+    g.notes = [n for n in g.notes if not (n.message.endswith(UNBUILT) and n.src in made)]  # another program makes it
     for b in bags:
         from .bag import bag_topics
-        info, notes = bag_topics(Path(b), show(Path(b)))
+        recorded, notes = bag_topics(Path(b), show(Path(b)))
         g.notes.extend(notes)
-        if info is not None:
-            g.bags.append(info)
+        if recorded is not None:
+            g.bags.append(recorded)
     used = {e.msg_type for n in g.nodes.values() for e in n.publishes + n.subscribes if e.msg_type}
     used |= {t["type"] for b in g.bags for t in b["topics"] if t["type"]}
     used |= {k for k, v in table.types.items() if v.origin == "workspace"}
@@ -334,3 +337,8 @@ def apart_name(full: str, pkg: str | None, exe: str | None, declared: Src | None
         k += 1
         out = f"{full}@{tail}.{k}"
     return out
+
+
+def _parse(data: bytes, shown: str, is_py: bool) -> dict[str, Any]:
+    """The record of one source file (:func:`scan_python` or :func:`scan_cpp`)."""
+    return scan_python(data.decode("utf-8", errors="replace"), shown) if is_py else scan_cpp(data, shown)

@@ -59,6 +59,11 @@ class Linked:
     files: list[str] = field(default_factory=list)
 
 
+#: why an endpoint of a class nothing constructs is not in the graph (docs/ros.md; issue 65)
+UNBUILT = ("nothing this program runs is read to construct the class (a construction through a container's "
+           "emplace_back/push_back or a factory the scan does not follow is not read): not in the graph")
+
+
 class Linker(LinkMembers, Values, Returns):
     """Link one program of a package (see the module docstring); ``known(t)`` says
     whether the scan's type table defines message type ``t``."""
@@ -245,6 +250,15 @@ class Linker(LinkMembers, Values, Returns):
             return callee, self.fns[callee][0]
         return None, None
 
+    def never_made(self, e: Endpoint) -> bool:
+        """Whether endpoint ``e`` lies in a class of the program that nothing the program
+        runs constructs, and in none of its methods that run anyway (not an overload
+        nobody calls: that is left out by design)."""
+        u = e.unit
+        if u is None or u not in self.units or "#" in (e.func or "") or f"U:{u}" in self.reach:
+            return False
+        return not any(f"F:{k}" in self.reach for k, v in self.fns.items() if v[0] == u)
+
     def _edge(self, a: str, b: str) -> None:
         self.edges.setdefault(a, set()).add(b)
 
@@ -277,14 +291,20 @@ class Linker(LinkMembers, Values, Returns):
                 out.notes.append(n)
 
         raw: list[tuple[str, Endpoint]] = []
+        unbuilt: list[Endpoint] = []
         for f, r in self.recs.items():
             for e in list(r.get("endpoints", [])) + self.members(r):
                 if e.unit is None and e.func is None and f not in self.prog.entry:
                     continue
                 if (e.unit is not None or e.func is not None) and not self.runs(e.unit, e.func):
+                    root = self.code.root.rstrip("/")
+                    if (root in ("", ".") or f.startswith(root + "/")) and self.never_made(e):
+                        unbuilt.append(e)
                     continue
                 raw.append((f, e))
         named = self.named(note, out)
+        for e in unbuilt if named else []:
+            note(Note(e.src, f"{emit.WHAT[e.kind]} of class {e.unit}: {UNBUILT}"))
         self.user_creates(note)
         out.nodes = [(n, s, ns) for n, s, ns, _u, _p in named]
         units = [u for _n, _s, _ns, u, _p in named]
