@@ -300,3 +300,13 @@ def test_sarif_puts_a_failed_side_condition_at_the_guarantee_to_repair(runs: dic
 
 def _monitoring(report: dict[str, Any], node: str) -> dict[str, Any]:
     return monitoring(report, node, "run_jsonl")
+
+
+def test_every_report_of_the_example_matches_the_published_schema(runs: dict[str, Any]) -> None:
+    """Each report the fixture built (as shipped, after each fix, under --strict) against
+    docs/assurance.schema.json and the status vocabulary (tests/_report_schema.py)."""
+    from _report_schema import check_report
+    reports = {k: v for k, v in runs.items() if isinstance(v, dict) and "meta" in v}
+    assert len(reports) > 2, sorted(reports)
+    for label, report in {**reports, "strict": runs["strict"][1]}.items():
+        check_report(report, label)

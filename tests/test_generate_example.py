@@ -21,6 +21,8 @@ def _verify(ws: Path, *extra: str) -> dict:
     p = subprocess.run([sys.executable, "-m", "doit", "verify", *extra], cwd=ws, capture_output=True, text=True,
                        timeout=600)
     report = json.loads((ws / "reports" / "assurance.json").read_text())
+    from _report_schema import check_report
+    check_report(report, "contracts_first")  # docs/assurance.schema.json and the status vocabulary
     return {**{o["id"]: o["status"] for o in report["obligations"]}, "exit": p.returncode}
 
 
