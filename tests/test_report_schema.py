@@ -95,9 +95,23 @@ def reports(tmp_path_factory: pytest.TempPathFactory) -> dict[str, dict[str, Any
     return out
 
 
-def test_the_schema_is_a_draft_2020_12_schema() -> None:
+def _undescribed(x: Any, where: str = "") -> list[str]:
+    """The properties of the schema ``x`` without a description, as paths."""
+    out: list[str] = []
+    if isinstance(x, dict):
+        out += [f"{where}/{k}" for k, v in (x.get("properties") or {}).items() if not v.get("description")]
+        for k, v in x.items():
+            out += _undescribed(v, f"{where}/{k}")
+    elif isinstance(x, list):
+        for i, v in enumerate(x):
+            out += _undescribed(v, f"{where}/{i}")
+    return out
+
+
+def test_the_schema_is_a_draft_2020_12_schema_with_each_key_described() -> None:
     Draft202012Validator.check_schema(SCHEMA)
     assert SCHEMA["$schema"] == "https://json-schema.org/draft/2020-12/schema"
+    assert _undescribed(SCHEMA) == []
 
 
 def test_the_schema_enums_are_the_vocabulary() -> None:
