@@ -153,7 +153,14 @@ class FindingRow(TypedDict):
     explanation: NotRequired[str]
     duration_s: NotRequired[float]
     smt2: NotRequired[str]
+    core: NotRequired[list[str] | None]
+    instances: NotRequired[dict[str, Any] | None]
+    model: NotRequired[dict[str, Any] | None]
+    witness: NotRequired[dict[str, Any]]
+    witness_smt2: NotRequired[str]
     solvers: NotRequired[dict[str, Any]]
+    flagged: NotRequired[str]
+    sha256: NotRequired[str]
     acknowledged: NotRequired[dict[str, str]]
 
 
