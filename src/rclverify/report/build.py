@@ -35,6 +35,7 @@ import z3
 from .. import __version__
 from ..contract_texts import ContractTexts
 from ..evidence.records import SEVERITY, Obligation, worst
+from ..evidence.statuses import Derivation, EvidenceStatus, HealthStatus
 from ..evidence.store import EvidenceStore
 from ..workspace import Workspace, current_snapshot_hashes, stale_stages
 from ..system.model import cycles_kept, names_of
@@ -46,7 +47,7 @@ from .statistics import annotate_statistics, compact as compact_statistics
 from .records import diagnostics as read_diagnostics, grounding as read_grounding, inputs_sha256, node_obligations, \
     node_records
 
-_FINDING_AS = {"ok": "discharged", "problem": "failed", "inconclusive": "inconclusive",
+_FINDING_AS: dict[HealthStatus, EvidenceStatus] = {"ok": "discharged", "problem": "failed", "inconclusive": "inconclusive",
                # a health warning (health/shape.py) is shown but changes no status
                "warning": "discharged",
                # made from another contract text (pipeline.stale_stages)
@@ -82,7 +83,7 @@ def _evidence_extras(ws: Workspace, details: Any) -> dict[str, Any]:
     return out
 
 
-_DERIVATION = {"discharged": "derived", "failed": "not derived"}
+_DERIVATION: dict[str, Derivation] = {"discharged": "derived", "failed": "not derived"}
 #: Most node names a derived property's note lists per status ("3 pending node contracts: A, B, C");
 #: the rest are counted.  A property at the end of a 1000-node chain rests on 999 contracts: its
 #: note named them all, a quadratic amount of report text nobody reads (the cone itself is the

@@ -39,7 +39,10 @@ from __future__ import annotations
 
 from typing import Any, Mapping
 
-ERROR, WARNING, NOTE = "error", "warning", "note"
+from ..evidence.statuses import SEVERITIES
+
+#: The three severities (the vocabulary's set, evidence/statuses.py).
+ERROR, WARNING, NOTE = SEVERITIES
 #: Severities that fail ``--strict``.
 GATING = (ERROR, WARNING)
 
