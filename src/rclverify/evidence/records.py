@@ -30,7 +30,7 @@ from pathlib import Path
 from typing import Any, Mapping, Sequence
 
 #: Severity order used by every roll-up; larger is worse (defined with the vocabulary).
-from .statuses import SEVERITY as SEVERITY
+from .statuses import RECORD_STATUSES, SEVERITY as SEVERITY
 
 #: Roll-up status for a parent with no evidence at all.
 MISSING = "pending"
@@ -161,7 +161,7 @@ class Evidence:
         ``KeyError``/``ValueError`` for a missing field or an unknown status."""
         if not isinstance(d, Mapping):
             raise TypeError(f"an evidence record is a JSON object, not {type(d).__name__}")
-        if d.get("status") not in SEVERITY or d.get("status") == "unverified":
+        if d.get("status") not in RECORD_STATUSES:  # never ``unverified``: a guarantee's status only
             raise ValueError(f"unknown evidence status {d.get('status')!r}")
         return Evidence(
             obligation=d["obligation"], backend=d["backend"], kind=d["kind"], status=d["status"],
