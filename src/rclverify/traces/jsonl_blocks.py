@@ -29,12 +29,33 @@ gives the same events and raises the same located error after yielding the
 events before it.  The keys of an exactly read block join the struct (at
 most :data:`MAX_KEYS`) for the next blocks.  Lines are split as the exact
 reader splits them: after ``\\n``, and at a bare ``\\r``.
+
+Before that, a whole read (:data:`BLOCK_BYTES`, cut after its last
+``\\n``) is tried **at once** (issue 67): one msgspec ``decode_lines``
+call into a *flat* struct (the same keys, every value but the topic and
+the time a JSON scalar: string, number, boolean or null; the time a
+number), taken only when the read has no ``\\r``, every line begins with
+``{`` and ends with ``}`` (the bytes around each ``\\n``, found with numpy)
+and the call gives one object per line.  Then each line is one object and
+nothing else, so each object is the one that line decodes to alone:
+strings cannot hold a raw line end (JSON forbids control characters in
+them, msgspec refuses them), so a line's last ``}`` is outside any string;
+values being scalars, it closes the object its line's first ``{`` opened;
+no object spans two lines and no line holds two, as there are as many
+objects as lines.  (``decode_lines`` alone is lax: it reads two objects on
+one line, or one over two lines; a block read as one JSON array was refused
+for the same reason, docs/scale.md.)  As on the line-by-line fast path,
+every time must be a finite ``float``.
+Anything else (an integer time, a nested value, a new key, a ``\\r``, bad bytes, a line
+msgspec refuses) sends the read to the line-by-line paths above, which
+give the same events and the same located error.  No line is split off
+as a ``bytes`` object unless a row's event is asked for.
 """
 from __future__ import annotations
 
 from operator import attrgetter
 from pathlib import Path
-from typing import Any, Iterator, Sequence
+from typing import Any, Iterator, Sequence, Union
 
 import msgspec
 import numpy as np
@@ -47,6 +68,8 @@ BLOCK_BYTES = 1 << 20
 #: The most keys the fast path's struct names (a log with more distinct keys reads the rest exactly).
 MAX_KEYS = 64
 _TOPIC, _TIME = attrgetter("f0"), attrgetter("f1")
+#: A flat line's values (module docstring): a nested array or object is refused by the decoder.
+_SCALAR = Union[str, float, int, bool, None]
 
 
 class JsonlLog:
@@ -88,6 +111,11 @@ class _Decoder:
                                  rename={f"f{j}": k for j, k in enumerate(self.keys)},
                                  forbid_unknown_fields=True, gc=False)
         self.decode = msgspec.json.Decoder(line).decode
+        flat = msgspec.defstruct("FlatLine", [("f0", str), ("f1", Union[float, int])] + [(f"f{j}", _SCALAR, None)
+                                                                          for j in range(2, len(self.keys))],
+                                 rename={f"f{j}": k for j, k in enumerate(self.keys)},
+                                 forbid_unknown_fields=True, gc=False)
+        self.decode_lines = msgspec.json.Decoder(flat).decode_lines
 
     def learn(self, events: list[Event]) -> _Decoder:
         """This decoder, or one that also names the keys of ``events`` (up to :data:`MAX_KEYS`)."""
@@ -97,35 +125,43 @@ class _Decoder:
         return _Decoder(list(seen)) if MAX_KEYS >= len(seen) > len(self.keys) else self
 
 
-def _lines(path: Path) -> Iterator[list[bytes]]:
-    """The log's lines, some at a time, each with its end (``b"\\n"``, ``b"\\r\\n"``,
-    a bare ``b"\\r"``; the last line may have none), as :func:`~.jsonl.read_lines` splits them."""
+def _reads(path: Path) -> Iterator[bytes]:
+    """The log's bytes, a read at a time, each cut after its last ``b"\\n"`` (the
+    rest carried to the next read; the log's end as it is)."""
     with path.open("rb") as fh:
-        pending: list[bytes] = []  # a line not ended yet, in pieces (a line may be longer than a read)
+        pending: list[bytes] = []  # bytes after the last b"\n" read (a line may be longer than a read)
         while True:
             data = fh.read1(BLOCK_BYTES)
             if not data:
                 break
-            if pending and b"\n" not in data and b"\r" not in data:
+            cut = data.rfind(b"\n") + 1
+            if not cut:
                 pending.append(data)
                 continue
-            lines = data.splitlines(True)
-            if pending:  # the line begun before ends here; a b"\r" before the read's first b"\n" ends it there
-                pending.append(lines[0])
-                lines[0:1] = b"".join(pending).splitlines(True)
+            if pending:
+                pending.append(data[:cut])
+                yield b"".join(pending)
                 pending = []
-            if lines[-1][-1:] != b"\n":  # not ended, or ended by a b"\r" a b"\n" may follow
-                pending.append(lines.pop())
-            if lines:
-                yield lines
+            else:
+                yield data[:cut] if cut < len(data) else data
+            if cut < len(data):
+                pending.append(data[cut:])
         if pending:
-            yield b"".join(pending).splitlines(True)
+            yield b"".join(pending)
 
 
 def _blocks(path: Path, fields: Sequence[str], rows: int) -> Iterator[LogBlock | list[Event]]:
     dec = _Decoder(fields)
     lineno = index = 0
-    for lines in _lines(path):
+    for data in _reads(path):
+        flat = _flat(path, dec, data, lineno, index, rows)
+        if flat is not None:
+            for whole in flat:
+                lineno += len(whole)
+                index += len(whole)
+                yield whole
+            continue
+        lines = data.splitlines(True)
         for at in range(0, len(lines), rows):
             part = lines[at:at + rows] if at or len(lines) > rows else lines
             block = _fast(path, dec, part, lineno, index)
@@ -144,6 +180,70 @@ def _blocks(path: Path, fields: Sequence[str], rows: int) -> Iterator[LogBlock |
             dec = dec.learn(got)
 
 
+def _flat(path: Path, dec: _Decoder, data: bytes, lineno: int, index: int, rows: int) -> list[LogBlock] | None:
+    """The read ``data`` as blocks of at most ``rows`` lines when it is decoded at once (module docstring), else ``None``."""
+    if "header" in dec.attr or any(k in dec.attr for k in FLAT_STAMPS) or data[:1] != b"{" or \
+            data[-1:] != b"\n" or b"\r" in data:
+        return None
+    u = np.frombuffer(data, np.uint8)
+    ends = (u == 10).nonzero()[0]  # each line's b"\n"; a "}" before each, a "{" after each but the last
+    n = len(ends)
+    if not (u[ends - 1] == 125).all() or not (u[ends[:-1] + 1] == 123).all():
+        return None
+    try:
+        structs = dec.decode_lines(data)
+    except Exception:  # noqa: BLE001 - whatever msgspec refuses: the line-by-line paths say what
+        return None
+    if len(structs) != n:
+        return None
+    found = list(map(_TIME, structs))
+    if set(map(type, found)) != {float}:  # an integer time: the exact reader's (its float() is the event's)
+        return None
+    times = np.array(found, dtype=np.float64)
+    if not np.isfinite(times).all():
+        return None
+    topics = _topics(structs)
+    lines = _Lines(data, ends)
+    return [LogBlock(path, _Slice(lines, a), structs[a:a + rows], dec.attr, topics[a:a + rows], times[a:a + rows],
+                     lineno + a, index + a) for a in range(0, n, rows)]
+
+
+def _topics(structs: list[Any]) -> list[str]:
+    """Each struct's topic, without its leading ``/`` (as the event's)."""
+    topics = list(map(_TOPIC, structs))
+    distinct = set(topics)
+    if any(t[:1] == "/" for t in distinct):
+        strip = {t: t.lstrip("/") for t in distinct}
+        topics = list(map(strip.__getitem__, topics))
+    return topics
+
+
+class _Lines:
+    """The lines of a read decoded at once (``ends``: the offset of each one's ``b"\\n"``),
+    a line split off only when it is asked for."""
+
+    __slots__ = ("data", "ends")
+
+    def __init__(self, data: bytes, ends: np.ndarray) -> None:
+        self.data, self.ends = data, ends
+
+    def line(self, i: int) -> bytes:
+        """Line ``i`` (0-based) with its ``b"\\n"``."""
+        return self.data[int(self.ends[i - 1]) + 1 if i else 0:int(self.ends[i]) + 1]
+
+
+class _Slice:
+    """The lines of :class:`_Lines` from ``start`` on, indexed as a list."""
+
+    __slots__ = ("lines", "start")
+
+    def __init__(self, lines: _Lines, start: int) -> None:
+        self.lines, self.start = lines, start
+
+    def __getitem__(self, i: int) -> bytes:
+        return self.lines.line(self.start + i)
+
+
 def _fast(path: Path, dec: _Decoder, lines: list[bytes], lineno: int, index: int) -> LogBlock | None:
     """The block of ``lines`` when the fast path reads it as the exact one would (module docstring), else ``None``."""
     if "header" in dec.attr or any(k in dec.attr for k in FLAT_STAMPS):
@@ -158,12 +258,7 @@ def _fast(path: Path, dec: _Decoder, lines: list[bytes], lineno: int, index: int
     column = np.array(times, dtype=np.float64)
     if not np.isfinite(column).all():
         return None
-    topics = list(map(_TOPIC, structs))
-    distinct = set(topics)
-    if any(t[:1] == "/" for t in distinct):
-        strip = {t: t.lstrip("/") for t in distinct}
-        topics = list(map(strip.__getitem__, topics))
-    return LogBlock(path, lines, structs, dec.attr, topics, column, lineno, index)
+    return LogBlock(path, lines, structs, dec.attr, _topics(structs), column, lineno, index)
 
 
 class LogBlock:
@@ -180,7 +275,7 @@ class LogBlock:
 
     __slots__ = ("path", "lines", "structs", "attr", "topics", "times", "lineno", "index", "_made")
 
-    def __init__(self, path: Path, lines: list[bytes], structs: list[Any], attr: dict[str, str], topics: list[str],
+    def __init__(self, path: Path, lines: Sequence[bytes] | _Slice, structs: list[Any], attr: dict[str, str], topics: list[str],
                  times: np.ndarray, lineno: int, index: int) -> None:
         self.path, self.lines, self.structs, self.attr = path, lines, structs, attr
         self.topics, self.times, self.lineno, self.index = topics, times, lineno, index
