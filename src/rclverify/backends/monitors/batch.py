@@ -320,7 +320,7 @@ class _Run:
         h, okey, keys = m.horizon, plan.output[1], plan.keys
         n = len(at)
         self.batched += n
-        t_first = chunk[int(at[0])].time
+        t_first = float(times[at[0]])  # the chunk's time column holds each event's time: no event made for it
         # the watched question: closed silently when its horizon passed, else followed by the first new question
         o = m._open
         if o is not None and t_first > m._due:
@@ -379,11 +379,11 @@ class _Run:
         values[okey] = newest.answer[okey]
         m.invalid.pop(okey, None)
         m._open, m._due = newest, newest.due
-        last_out = chunk[int(at[-1]) + 1]
-        if last_out.time > m.now:
-            m.now = last_out.time
-        if last_out.time > m._hi:  # the latest stamp judged (a pair's rows have no stamp of their own)
-            m._hi = last_out.time
+        last_out = float(times[at[-1] + 1])
+        if last_out > m.now:
+            m.now = last_out
+        if last_out > m._hi:  # the latest stamp judged (a pair's rows have no stamp of their own)
+            m._hi = last_out
 
 
 __all__ = ["CHUNK", "BatchPlan", "batch_plan", "check_batch"]
