@@ -33,14 +33,16 @@ roll-up (:mod:`.rollup`) treats both alike, plus ``temporal``: ``{status,
 method, k, bound, loop, detail, trace}`` with ``trace`` one entry per step,
 ``{"step": i, "nodes": [{"node", "values": {"in.x": v}}]}``.  A proof uses
 every premise of the cone (there is no unsat core of an induction), so
-``met`` needs the evidence of every guarantee of the cone discharged; a
+``met`` needs the evidence of every guarantee of the cone discharged, with
+one exception: a node's ``initially`` that the proof also holds without
+(:mod:`.initial_needed`) is traced, not needed; a
 system with no run at all (its premises contradict each other) proves
 anything, and is reported ``consistency: inconsistent``.
 """
 from __future__ import annotations
 
 import time
-from typing import Any, Callable
+from typing import Any, Callable, Collection
 
 import z3
 
@@ -59,6 +61,7 @@ from .temporal import (TemporalVerdict, TransitionSystem, check_always, check_ev
                        check_eventually_within, check_next, check_until, find_lasso, with_flag)
 from .lasso import find_table_lasso
 from .lasso_confirm import confirm_lasso
+from .initial_needed import initially_not_needed
 from .progress_gap import EVEN_SO, explain_idle, stuck_in_loop, stuck_words
 from .transition import ComposedSystem, build_system, variable_types
 
@@ -233,60 +236,65 @@ def check_temporal(req: Requirement, checked: Checked, model: SystemModel, plan:
     hints = [h for h in (rank, inv) if h is not None]
     want = {u for f in (*ops, *assuming, *hints) for n in f.nodes for u in (model.upstream(n) or [n])}
     cone = [n for n in model.nodes if n in want]  # as requirements/check.cone_of
-    sys = build_system(cone, checked, model, plan)
-    enc = Encoder(checked.env)
 
-    def raw(f: Formal) -> Callable[[Any], Any]:
-        return lambda s: enc.formula(f.expr, f.scope, sys.statement_symbols(s))
+    def solve(without: Collection[str] = ()) -> tuple[ComposedSystem, TemporalVerdict, dict[str, Any]]:
+        """The system of the cone (the nodes of ``without`` built with no ``initially``) and its verdict."""
+        sys = build_system(cone, checked, model, plan, without_initially=without)
+        enc = Encoder(checked.env)
 
-    def pred(f: Formal) -> Callable[[Any], Any]:  # must hold: only where its values are published
-        return lambda s: z3.Implies(sys.pub.defined(f.mentions, s), raw(f)(s))
+        def raw(f: Formal) -> Callable[[Any], Any]:
+            return lambda s: enc.formula(f.expr, f.scope, sys.statement_symbols(s))
 
-    def reach(f: Formal) -> Callable[[Any], Any]:  # must be reached: on published values
-        return lambda s: z3.And(sys.pub.defined(f.mentions, s), raw(f)(s))
-    if assuming:  # the requirement's own assumptions hold in every state
-        holds = [pred(a) for a in assuming]
-        ts = sys.ts
-        sys.ts = TransitionSystem(ts.sorts, lambda s: z3.And(ts.init(s), *[h(s) for h in holds]),
-                                  lambda s, u: z3.And(ts.trans(s, u), *[h(s) for h in holds], *[h(u) for h in holds]),
-                                  ts.fairness)
-        for k, a in enumerate(assuming, 1):
-            sys.premises.append({"label": f"assuming {k}", "kind": "assuming", "node": None, "index": k,
-                                 "text": base["assuming"][k - 1], "source": base["source"]})
-    types = variable_types(sys, checked, plan)
-    points = max([points_for(plan.instances.get(n)) for n in cone] or [points_for(None)])
+        def pred(f: Formal) -> Callable[[Any], Any]:  # must hold: only where its values are published
+            return lambda s: z3.Implies(sys.pub.defined(f.mentions, s), raw(f)(s))
 
-    def tables(goal: Formal, v: TemporalVerdict, ts: TransitionSystem) -> TemporalVerdict:
-        """The finite-table lasso search over ``ts``, confirmed on the trace (:mod:`.lasso`)."""
-        if any(isinstance(ty, EmptyT) for ty in types.values()):
-            return v
-        try:
-            found = find_table_lasso(ts, reach(goal), types, bound=bound, points=points)
-        except (ValueError, z3.Z3Exception) as exc:
-            found = f"the finite-table search failed ({exc})"
-        if isinstance(found, str):
-            return TemporalVerdict(v.status, v.method, k=v.k, bound=v.bound, trace=v.trace, loop=v.loop,
-                                   detail=f"{v.detail}; {found}")
-        why = confirm_lasso(found.values, found.loop, cone, sys.variables, types, checked, model, plan, goal, assuming,
-                            [f.label for f in ts.fairness], sys.pub)
-        if why is not None:
-            return TemporalVerdict(v.status, v.method, k=v.k, bound=v.bound, trace=v.trace, loop=v.loop,
-                                   detail=f"{v.detail}; a lasso with {points}-point tables was found but not "
-                                          f"confirmed on its values ({why})")
-        n = len(found.values) - 1
-        return TemporalVerdict("refuted", "lasso", bound=n, loop=found.loop,
-                               trace=[{k: render(x) for k, x in st.items()} for st in found.values],
-                               detail=f"a run whose step {n} returns to step {found.loop} and never reaches it "
-                                      f"(found with every function a {points}-point table, confirmed on the "
-                                      f"trace's values)")
-    ranking = (lambda s: enc.term(rank.expr, rank.scope, sys.statement_symbols(s))) if rank is not None else None
-    inv_pred = raw(inv) if inv is not None else None
-    missing: dict[str, Any] = {}
-    from ..rcl.types import FuncT
-    v = decide(t, sys, pred, bound=bound, timeout_ms=timeout_ms, tables=tables, ranking=ranking,
-               invariant=inv_pred, checked=checked, gaps=missing,
-               tables_first=any(isinstance(ty, FuncT) for ty in types.values()), reach=reach,
-               hint_text=" ".join(req.invariant.text.split()) if req.invariant is not None else "")
+        def reach(f: Formal) -> Callable[[Any], Any]:  # must be reached: on published values
+            return lambda s: z3.And(sys.pub.defined(f.mentions, s), raw(f)(s))
+        if assuming:  # the requirement's own assumptions hold in every state
+            holds = [pred(a) for a in assuming]
+            ts = sys.ts
+            sys.ts = TransitionSystem(ts.sorts, lambda s: z3.And(ts.init(s), *[h(s) for h in holds]),
+                                      lambda s, u: z3.And(ts.trans(s, u), *[h(s) for h in holds], *[h(u) for h in holds]),
+                                      ts.fairness)
+            for k, a in enumerate(assuming, 1):
+                sys.premises.append({"label": f"assuming {k}", "kind": "assuming", "node": None, "index": k,
+                                     "text": base["assuming"][k - 1], "source": base["source"]})
+        types = variable_types(sys, checked, plan)
+        points = max([points_for(plan.instances.get(n)) for n in cone] or [points_for(None)])
+
+        def tables(goal: Formal, v: TemporalVerdict, ts: TransitionSystem) -> TemporalVerdict:
+            """The finite-table lasso search over ``ts``, confirmed on the trace (:mod:`.lasso`)."""
+            if any(isinstance(ty, EmptyT) for ty in types.values()):
+                return v
+            try:
+                found = find_table_lasso(ts, reach(goal), types, bound=bound, points=points)
+            except (ValueError, z3.Z3Exception) as exc:
+                found = f"the finite-table search failed ({exc})"
+            if isinstance(found, str):
+                return TemporalVerdict(v.status, v.method, k=v.k, bound=v.bound, trace=v.trace, loop=v.loop,
+                                       detail=f"{v.detail}; {found}")
+            why = confirm_lasso(found.values, found.loop, cone, sys.variables, types, checked, model, plan, goal, assuming,
+                                [f.label for f in ts.fairness], sys.pub)
+            if why is not None:
+                return TemporalVerdict(v.status, v.method, k=v.k, bound=v.bound, trace=v.trace, loop=v.loop,
+                                       detail=f"{v.detail}; a lasso with {points}-point tables was found but not "
+                                              f"confirmed on its values ({why})")
+            n = len(found.values) - 1
+            return TemporalVerdict("refuted", "lasso", bound=n, loop=found.loop,
+                                   trace=[{k: render(x) for k, x in st.items()} for st in found.values],
+                                   detail=f"a run whose step {n} returns to step {found.loop} and never reaches it "
+                                          f"(found with every function a {points}-point table, confirmed on the "
+                                          f"trace's values)")
+        ranking = (lambda s: enc.term(rank.expr, rank.scope, sys.statement_symbols(s))) if rank is not None else None
+        inv_pred = raw(inv) if inv is not None else None
+        missing: dict[str, Any] = {}
+        from ..rcl.types import FuncT
+        v = decide(t, sys, pred, bound=bound, timeout_ms=timeout_ms, tables=tables, ranking=ranking,
+                   invariant=inv_pred, checked=checked, gaps=missing,
+                   tables_first=any(isinstance(ty, FuncT) for ty in types.values()), reach=reach,
+                   hint_text=" ".join(req.invariant.text.split()) if req.invariant is not None else "")
+        return sys, v, missing
+    sys, v, missing = solve()
     lasso = v.status == "refuted" and "lasso" in v.method.split(" + ")
     gaps = missing.get("missing_progress", []) if lasso else []
     stuck = missing.get("missing_initially", []) if lasso else []
@@ -310,6 +318,9 @@ def check_temporal(req: Requirement, checked: Checked, model: SystemModel, plan:
             out.update(consistency="inconsistent", inconsistent_core=used)
         elif r == z3.sat and not why:
             out.update(consistency="consistent")
+            spare = initially_not_needed(sys.premises, lambda nodes: solve(nodes)[1].status in ("proved", "met"))
+            out.update(used=[p for p in used if not (p["kind"] == "initial value" and p["node"] in spare)],
+                       traced_not_needed=[p for p in used if p["kind"] == "initial value" and p["node"] in spare])
         else:
             out.update(consistency="undecided", consistency_reason=s.reason_unknown() if r != z3.sat else why)
     elif v.status == "refuted":

@@ -43,7 +43,7 @@ transition relation"):
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any, Sequence
+from typing import Any, Collection, Sequence
 
 import z3
 
@@ -183,8 +183,12 @@ def variable_types(sys: ComposedSystem, checked: Checked, plan: Plan) -> dict[st
     return out
 
 
-def build_system(cone: Sequence[str], checked: Checked, model: SystemModel, plan: Plan) -> ComposedSystem:
-    """The transition system of ``cone`` (module docstring).
+def build_system(cone: Sequence[str], checked: Checked, model: SystemModel, plan: Plan, *,
+                 without_initially: Collection[str] = ()) -> ComposedSystem:
+    """The transition system of ``cone`` (module docstring); the nodes of
+    ``without_initially`` are built as if they declared no ``initially``
+    (nothing published before their first answer), to ask whether a proof
+    needs their declarations (:mod:`.temporal_check`).
 
     Raises :class:`~rclverify.rcl.errors.RclError` for a state declaration
     that does not check (the plan's ``resolve`` reports those first).
@@ -231,7 +235,8 @@ def build_system(cone: Sequence[str], checked: Checked, model: SystemModel, plan
                              "index": k, "text": f.text, "source": where(f.expr)})
     # answering (module docstring): which nodes answer, accept, count their waiting
     bounds = {n: step_bound(checked.nodes[n].node) for n in cone}
-    initially = {n: [c.formula for c in checked.nodes[n].node.initially] for n in cone}
+    initially = {n: [c.formula for c in checked.nodes[n].node.initially] if n not in without_initially else []
+                 for n in cone}
     answering = [n for n in cone if any(f"{n}.out.{v}" in sorts for v in checked.nodes[n].outputs)]
     for n in answering:
         node = checked.nodes[n].node
@@ -240,7 +245,7 @@ def build_system(cone: Sequence[str], checked: Checked, model: SystemModel, plan
             sorts[f"{n}.accepts"], types[f"{n}.accepts"], variables[f"{n}.accepts"] = z3.BoolSort(), BOOL, (n, "run", "accepts")
         if bounds[n]:
             sorts[f"{n}.waiting"], types[f"{n}.waiting"], variables[f"{n}.waiting"] = z3.IntSort(), INTEGER, (n, "run", "waiting")
-        for k, c in enumerate(node.initially, 1):
+        for k, c in enumerate(node.initially if n not in without_initially else (), 1):
             premises.append({"label": f"{n} initially {k}", "kind": "initial value", "node": n, "index": k,
                              "text": expr_to_rcl(c.formula), "source": where(c)})
         if fair(node):
