@@ -130,7 +130,8 @@ def mission_manager_node(node):
 def planner_node(node):
     pub = node.create_publisher(Float64, "speed_cmd", QOS)
     lock = threading.Lock()
-    state = {"goal_x": None, "pose_x": None, "goal": None, "done": threading.Event(), "reached_x": 0.0}
+    state = {"goal_x": None, "pose_x": None, "goal": None, "done": threading.Event(),
+             "reached_x": planner.initial["reached_x"]}
 
     def plan():  # with the lock held
         if state["goal_x"] is None or state["pose_x"] is None or state["goal"] is None:
