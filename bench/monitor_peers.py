@@ -35,6 +35,10 @@ samples (made from ``--seed``), the monitoring loop timed in CPU seconds:
   and (unless ``--no-bags``) on the same samples in a sqlite3 and an MCAP
   ROS 2 bag (``std_msgs/msg/Float64`` readings, ``std_msgs/msg/String``
   statuses; traces/bag_blocks.py), whose counts must be the log's;
+* **reading the log** (figures only): the log's blocks as the batch path
+  takes them (traces/jsonl_blocks.py) and the ``data`` values of every
+  row, in a process of its own after a warm-up on ten samples, without
+  judging anything: the part of the command no monitor can skip (issue 67);
 * **RTAMT** 0.4.10 (``pip install rtamt==0.4.10``): the discrete-time STL
   specification of the same property, updated sample by sample
   (robustness >= 0 is satisfied; statuses as 0, 1, 2);
@@ -62,6 +66,11 @@ untimed run of the engine, so collecting them costs the timing nothing).
 A peer that is not installed is skipped with the reason: the peers are
 optional bench dependencies (``pip install '.[bench]'``), never rclverify's.
 
+``--repeat K`` runs the command on the log, its start-up, the reading of
+the log and the columns path K times each and keeps each one's least CPU
+(the run the machine's other load disturbed least; the ratios between them
+are taken from those).
+
 ``--compare OLD_SRC`` also runs the rclverify engine and command from an
 older source tree (e.g. ``git worktree add /tmp/old <commit>``, then
 ``OLD_SRC=/tmp/old/src``) alternately with this one, and prints old, new
@@ -70,7 +79,7 @@ one run on one machine.
 
 Usage::
 
-    python3 bench/monitor_peers.py [--samples 1000000] [--wrong 0.001] [--compare OLD_SRC] [--no-bags]
+    python3 bench/monitor_peers.py [--samples 1000000] [--wrong 0.001] [--compare OLD_SRC] [--no-bags] [--repeat K]
     python3 bench/monitor_peers.py --smoke     # 2,000 samples: a few seconds
 """
 from __future__ import annotations
@@ -233,6 +242,9 @@ def child(args: argparse.Namespace) -> int:
     rs, st = samples(args.samples, args.seed, args.wrong)
     report: dict[str, Any] = {}
     try:
+        if args.child == "read":
+            print(json.dumps({"cpu": _read_log(Path(args.log)), "rss": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024}))
+            return 0
         if args.child in ("rclverify", "batch", "columns"):
             batch, cols = args.child != "rclverify", args.child == "columns"
             cpu, _, counts = _rclverify_engine(args.samples, rs, st, verdicts=False, batch=batch, columns=cols)
@@ -254,11 +266,42 @@ def child(args: argparse.Namespace) -> int:
     return 0
 
 
+def _read_log(log: Path) -> float:
+    """CPU seconds to read the log at ``log`` as the batch path does (its blocks, a block's
+    ``data`` at every row), after the same on the log's first ten samples (the imports, outside)."""
+    import numpy as np
+    from rclverify.traces.jsonl_blocks import JsonlLog
+
+    def read(path: Path) -> int:
+        rows = 0
+        for block in JsonlLog(path).blocks(["data"], 16384) or ():
+            rows += len(block)
+            if not isinstance(block, list):
+                block.values(np.arange(len(block)), "data")
+        return rows
+    with tempfile.TemporaryDirectory() as tmp:
+        head = Path(tmp) / "head.jsonl"
+        with log.open("rb") as f:
+            head.write_bytes(b"".join(f.readline() for _ in range(20)))
+        read(head)
+    t0 = time.process_time()
+    read(log)
+    return time.process_time() - t0
+
+
 # -- the parent: runs the children, the command, and compares -----------------------------------------
 
-def _run_child(tool: str, args: argparse.Namespace, verdicts: Path | None, src: str | None) -> dict[str, Any]:
+def _best(k: int, run: Any) -> dict[str, Any]:
+    """The figures of ``run()`` (a child's) with the least CPU of ``k`` runs."""
+    return min((run() for _ in range(max(k, 1))), key=lambda r: float(r.get("cpu", 0.0)))
+
+
+def _run_child(tool: str, args: argparse.Namespace, verdicts: Path | None, src: str | None,
+               log: Path | None = None) -> dict[str, Any]:
     cmd = [sys.executable, str(Path(__file__).resolve()), "--child", tool, "--samples", str(args.samples),
            "--seed", str(args.seed), "--wrong", str(args.wrong), "--src", src or str(ROOT / "src")]
+    if log is not None:
+        cmd += ["--log", str(log)]
     if verdicts is not None:
         cmd += ["--verdicts", str(verdicts)]
     p = subprocess.run(cmd, capture_output=True, text=True)
@@ -334,7 +377,12 @@ def main() -> int:
     ap.add_argument("--compare", metavar="OLD_SRC", help="also run the engine and the command from this source tree")
     ap.add_argument("--smoke", action="store_true", help="2,000 samples (CI)")
     ap.add_argument("--no-bags", action="store_true", help="leave out the command on the sqlite3 and MCAP bags")
-    ap.add_argument("--child", choices=("rclverify", "batch", "columns", "rtamt", "reelay", "mstlo"), help=argparse.SUPPRESS)
+    ap.add_argument("--repeat", type=int, default=1, metavar="K",
+                    help="run the command on the log, its start-up, the reading and the columns path K times; keep "
+                         "each one's least CPU")
+    ap.add_argument("--child", choices=("rclverify", "batch", "columns", "read", "rtamt", "reelay", "mstlo"),
+                    help=argparse.SUPPRESS)
+    ap.add_argument("--log", help=argparse.SUPPRESS)
     ap.add_argument("--src", help=argparse.SUPPRESS)
     ap.add_argument("--verdicts", help=argparse.SUPPRESS)
     args = ap.parse_args()
@@ -366,7 +414,11 @@ def _measure(args: argparse.Namespace) -> tuple[dict[str, dict[str, Any]], dict[
                 for kind, row in (("batch", "rclverify batch"), ("columns", "rclverify batch, columns")):
                     rows[row] = _run_child(kind, args, base / f"v-{kind}", src)
                     verdicts[row] = (base / f"v-{kind}").read_bytes()
-            rows[f"rclverify monitor ({label})"] = _run_command(ws, src)
+                if args.repeat > 1:
+                    rows["rclverify batch, columns"] = _best(args.repeat, lambda: _run_child("columns", args, None, src))
+                rows["reading the log (new)"] = _best(args.repeat, lambda: _run_child("read", args, None, src,
+                                                                                      ws / "run.jsonl"))
+            rows[f"rclverify monitor ({label})"] = _best(args.repeat, lambda: _run_command(ws, src))
             if label == "new" and not args.no_bags:  # the same samples in ROS 2 bags
                 _bags(ws, args)
                 for storage in ("sqlite3", "mcap"):
@@ -374,7 +426,8 @@ def _measure(args: argparse.Namespace) -> tuple[dict[str, dict[str, Any]], dict[
             if label == "new":  # the command's start-up: the same command on a log of ten samples
                 tiny = argparse.Namespace(**{**vars(args), "samples": 10})
                 (base / "tiny").mkdir()
-                rows["rclverify monitor, 10 samples"] = _run_command(_workspace(base / "tiny", tiny), src)
+                small = _workspace(base / "tiny", tiny)
+                rows["rclverify monitor, 10 samples"] = _best(args.repeat, lambda: _run_command(small, src))
         for tool in ("rtamt", "reelay", "mstlo"):
             r = _run_child(tool, args, base / f"v-{tool}", None)
             rows[tool] = r
@@ -422,6 +475,10 @@ def _print(rows: dict[str, dict[str, Any]], verdicts: dict[str, bytes], args: ar
               f"{cmd['cpu'] / cols['cpu']:.2f}, {(cmd['cpu'] - start) / cols['cpu']:.2f} without the start-up "
               f"(aim: at most 1.2); printed: {cmd['out']}")
         said.add(cmd["out"].split(": ", 1)[-1])
+    if "reading the log (new)" in rows:
+        read = rows["reading the log (new)"]["cpu"]
+        print(f"reading the log alone (blocks and values, nothing judged): {read:.2f} CPU s, {read / cols['cpu']:.2f}x "
+              "the batch path on columns")
     if len(said) != 1:  # the log and the two bags hold the same samples: the same counts
         raise SystemExit(f"the command's counts differ between the log and the bags: {sorted(said)}")
     wrong = [k for k, v in verdicts.items() if v != verdicts["new"]]
