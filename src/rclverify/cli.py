@@ -738,7 +738,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     from .runlock import RunInProgress
     try:
         code = int(args.fn(args))
-        sys.stdout.flush()  # a closed pipe shows here, not at exit, where it could not be caught
+        if not sys.stdout.closed:  # the language server closes its stdout at `exit`
+            sys.stdout.flush()  # a closed pipe shows here, not at exit, where it could not be caught
         return code
     except BrokenPipeError:  # `rclverify explain ID | head`: the reader left; end quietly
         return _reader_left()
