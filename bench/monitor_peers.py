@@ -243,7 +243,8 @@ def child(args: argparse.Namespace) -> int:
     report: dict[str, Any] = {}
     try:
         if args.child == "read":
-            print(json.dumps({"cpu": _read_log(Path(args.log)), "rss": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024}))
+            cpu = _read_log(Path(args.log))
+            print(json.dumps({"cpu": cpu, "rss": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024}))
             return 0
         if args.child in ("rclverify", "batch", "columns"):
             batch, cols = args.child != "rclverify", args.child == "columns"
