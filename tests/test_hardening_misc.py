@@ -147,9 +147,12 @@ def _edit(path: Path, old: str, new: str) -> tuple[int, int]:
 
 @pytest.mark.parametrize("old, new, key, message", [
     ("  r: {fields: [value]}", "  r: {fields: 5}", "5", "topic r: fields must be a list of message field names, "
+                                                          "or map each variable to its list ({x: [x], y: [y]}), "
                                                           "not 5"),
-    ("  r: {fields: [value]}", "  r: {fields: {a: 1}}", "{a: 1}", "topic r: fields must be a list of message "
-                                                                   "field names, not {'a': 1}"),
+    # a mapping under fields: is one list per variable (two variables on one topic, docs/monitors.md)
+    ("  r: {fields: [value]}", "  r: {fields: {a: 1}}", "1", "topic r (variable a): fields must be a list of "
+                                                              "message field names, or map each variable to its "
+                                                              "list ({x: [x], y: [y]}), not 1"),
     ("  at: {fields: [posx, posy], update: replace}", "  at: {fields: [posx, posy], update: 3}", "3",
      "topic at: update must be accumulate or replace, not 3"),
     ("msg_dirs: [backends/monitors/msg]", "msg_dirs: 7", "7", "msg_dirs must be a list of directories, not 7"),
