@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import random
 from fractions import Fraction
+from typing import Any
 
 from hypothesis import given, settings
 from hypothesis import strategies as st
@@ -138,6 +139,15 @@ def _random_system(seed: int):  # type: ignore[no-untyped-def]
     return "\n".join(nodes), facts
 
 
+def _shape(context: Any) -> Any:
+    """The in-context check record with each counterexample model reduced to the variables it names."""
+    if isinstance(context, dict):
+        return {k: sorted(v) if k == "model" and isinstance(v, dict) else _shape(v) for k, v in context.items()}
+    if isinstance(context, list):
+        return [_shape(v) for v in context]
+    return context
+
+
 @settings(max_examples=25, deadline=None, derandomize=True)
 @given(seed=st.integers(0, 10**6))
 def test_verdicts_with_summaries_equal_the_whole_cones(seed: int) -> None:
@@ -149,8 +159,9 @@ def test_verdicts_with_summaries_equal_the_whole_cones(seed: int) -> None:
         a, b = fast[k], full[k]
         assert (a.status, a.verdict) == (b.status, b.verdict), (text, k, a.explanation, b.explanation)
         if a.verdict == "failed":  # a counterexample is the whole cone's, traced back as before (its numbers
-            # may differ: the summaries' query ran first in the node's solver session)
-            assert sorted(a.model or {}) == sorted(b.model or {}) and a.context == b.context
+            # may differ: the summaries' query ran first in the node's solver session, and a loaded machine
+            # can make Z3 finish by another tactic: so can the numbers of the in-context check's model)
+            assert sorted(a.model or {}) == sorted(b.model or {}) and _shape(a.context) == _shape(b.context)
     # every summary is implied by its cone: the whole cone's check proves it
     env = lambda m: environment_conjuncts(checked, model, m)  # noqa: E731
     for n in checked.nodes:
