@@ -166,10 +166,10 @@ def load_plan(root: Path, plan_rel: str = "contracts/plan.yaml") -> Plan:
     deadlines = _deadlines(data, loc, plan_rel)
     from .state import read_state
     states = read_state(data, locs, blocks, plan_rel)
+    from .acknowledged import read_acknowledgements
     return Plan(plan_rel, root, contracts, tuple(reqs), tuple(conns), facts, instances, evidence, replacements, locs,
                 str(data.get("name", "")), dict(data.get("ros") or {}), rfrom, deadlines, states,
                 read_acknowledgements(data, locs, plan_rel))
-    from .acknowledged import read_acknowledgements
 
 
 def _deadlines(data: Mapping[str, Any], loc: Any, plan_rel: str) -> tuple[DeadlineSpec, ...]:

@@ -12,8 +12,8 @@ from typing import Any, Mapping
 
 from .target_text import Target
 from ..rcl import ast
-from .formal import Source
 from .acknowledged import Acknowledgement
+from .formal import Source
 from .state import StateVar
 
 Path_ = tuple[Any, ...]
