@@ -76,6 +76,7 @@ def test_a_completed_run_freezes_the_heap_only_at_exit(monkeypatch: Any) -> None
     monkeypatch.setattr(atexit, "register", registered.append)
     monkeypatch.setattr(heap, "_EXIT", [])
     heap.release_after_run()  # the heap frozen by a build_tasks of an earlier test
+    gc.unfreeze()  # ... or by a live monitor an earlier test ran in this process (freeze_for_live: never undone)
     assert gc.get_freeze_count() == 0
     for _ in range(2):
         rep = ProgressReporter(io.StringIO(), {})
