@@ -132,18 +132,25 @@ class Assembly:
                 notes.append(Note(at, f"plugin {pc.type} (instance {inst} of {full}) is exported, but no scanned C++ "
                                       f"source defines the class: its endpoints are unknown"))
                 continue
-            prog = self._instances.get((pc.type, inst))
-            if prog is None:
-                prog = self._instances[(pc.type, inst)] = dataclasses.replace(base, files=list(base.files),
-                                                                              instance=inst)
-                if id(base) in self._views:
-                    self._views[id(prog)] = self._views[id(base)]
-            self.plugins_loaded.add(pc.type)
+            prog = self._instance(base, pc.type, inst)
             got = self.linked(prog)
             notes.extend(got.notes)
             eps += [e for e, _o in got.endpoints]
             files += [f for f in got.files if f not in files]
         return eps, files, notes
+
+    def _instance(self, base: Any, plugin_type: str, inst: str) -> Any:
+        """The program of one named instance of a plugin class (``base`` with the
+        instance's name), made once per (class, instance) and sharing the class's
+        views; the class is marked loaded."""
+        prog = self._instances.get((plugin_type, inst))
+        if prog is None:
+            prog = self._instances[(plugin_type, inst)] = dataclasses.replace(base, files=list(base.files),
+                                                                              instance=inst)
+            if id(base) in self._views:
+                self._views[id(prog)] = self._views[id(base)]
+        self.plugins_loaded.add(plugin_type)
+        return prog
 
     def controller_nodes(self, add_node: Callable[..., None], entries: dict[str, list[Any]], g: Graph) -> None:
         """ros2_control controllers as nodes of their own (issue 65): each instance a
@@ -159,13 +166,7 @@ class Assembly:
                 g.notes.append(Note(at, f"controller {inst} is a {pc.type}, exported, but no scanned C++ source "
                                         f"defines the class: its endpoints are unknown"))
                 continue
-            prog = self._instances.get((pc.type, inst))
-            if prog is None:
-                prog = self._instances[(pc.type, inst)] = dataclasses.replace(base, files=list(base.files),
-                                                                              instance=inst)
-                if id(base) in self._views:
-                    self._views[id(prog)] = self._views[id(base)]
-            self.plugins_loaded.add(pc.type)
+            prog = self._instance(base, pc.type, inst)
             got = self.linked(prog)
             g.notes.extend(got.notes)
             eps = [e for e, _o in got.endpoints]
