@@ -9,6 +9,15 @@ every sample's summary statistics obey), :mod:`.plot` (SVG plot with
 matplotlib), :mod:`.config` (the plan entry), :mod:`.backend`
 (:class:`ExperimentBackend`).
 """
-from .backend import ExperimentBackend
+from typing import Any
 
 __all__ = ["ExperimentBackend"]
+
+
+def __getattr__(name: str) -> Any:
+    """``ExperimentBackend`` loaded on first use (PEP 562): ``rclverify check``
+    enters the package only for :mod:`.config` (the plan entry's checks)."""
+    if name == "ExperimentBackend":
+        from .backend import ExperimentBackend
+        return ExperimentBackend
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

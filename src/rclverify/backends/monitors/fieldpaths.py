@@ -26,7 +26,7 @@ from ...rcl.errors import Diagnostic
 from ...rcl.types import Checked
 from ...ros.interfaces import BASE_TYPES, TypeTable, field_path
 from ...ros.model import canon_type, short_type
-from .check import LINK_TOPICS
+from .verdicts import LINK_TOPICS
 
 
 def topic_types(checked: Checked) -> dict[str, str]:
