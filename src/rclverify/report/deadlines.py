@@ -167,8 +167,11 @@ def fold_into(requirements: list[dict[str, Any]], rows: Sequence[Mapping[str, An
                 if rq.get("verdict") == "met":
                     rq["verdict"] = "proved, evidence outstanding"
                 rq["status"] = worst([str(rq.get("status", "pending")), st])
+                open_steps = [f"{c['node']} guarantee {c['guarantee']} ({c['status']})"
+                              for c in row.get("chain", []) if c.get("status") != "discharged"]
                 rq["note"] = (f"end-to-end deadline proved, evidence of its chain {st}"
-                              + (f"; {rq['note']}" if rq.get("note") else ""))
+                              + (f": {', '.join(open_steps)}" if open_steps else "")
+                              + (f"; without the deadline: {rq['note']}" if rq.get("note") else ""))
             continue
         said = f"end-to-end deadline {row['within']} along {' -> '.join(row['path'])} {v}: {row['reason']}"
         old = rq.get("verdict")
