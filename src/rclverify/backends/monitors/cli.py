@@ -152,20 +152,16 @@ def monitor_command(args: argparse.Namespace, checked: Checked) -> int:
                       + ("; no verdict: " + ", ".join(f"{n} {v}" for v, n in d.unaccepted.items() if n)
                          if any(d.unaccepted.values()) else ""))
                 print(f"  {status}: {explanation}")
-        for pr in pres:
-            status, explanation = period_status(pr, trace)
+        # periods, then the declarations (initially, progress, periods: declarations.py, issue 64): one row each
+        judged: list[tuple[str, Any, Any, Any]] = [("periods", pr, period_status(pr, trace), pr.to_json())
+                                                   for pr in pres]
+        judged += [("declarations", dr, declaration_status(dr, trace), dr.rows()) for dr in decl_res]
+        for label, res_, (status, explanation), part in judged:
             violated = violated or status == "failed"
-            report.append({"node": pr.node, "status": status, "explanation": explanation, "trace": trace,
-                           "periods": pr.to_json()})
+            report.append({"node": res_.node, "status": status, "explanation": explanation, "trace": trace,
+                           label: part})
             if not args.json:
-                print(f"{trace}: {pr.node} periods: {status}: {explanation}")
-        for dr in decl_res:  # initially, progress, periods (declarations.py, issue 64)
-            status, explanation = declaration_status(dr, trace)
-            violated = violated or status == "failed"
-            report.append({"node": dr.node, "status": status, "explanation": explanation, "trace": trace,
-                           "declarations": dr.rows()})
-            if not args.json:
-                print(f"{trace}: {dr.node} declarations: {status}: {explanation}")
+                print(f"{trace}: {res_.node} {label}: {status}: {explanation}")
         if summary is not None:
             violated = _report_calls(report, centries + dentries, summary, calls.missed(), trace,
                                      args.json) or violated
