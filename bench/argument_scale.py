@@ -4,7 +4,7 @@ Builds a synthetic report dict of N nodes (3 guarantees each, 4 obligations
 per guarantee with discharged evidence, one side condition per node, one
 requirement per node) and prints, per N: the number of GSN elements, the
 time to build and propagate the goal structure
-(``rclverify.argument.build.build_argument``), to render the gsn2x YAML and
+(``rclverify.report.argument.build.build_argument``), to render the gsn2x YAML and
 the DOT text, and to lay the diagram out with Graphviz ``dot`` (skipped when
 it is not installed).  It then writes a workspace of N evidence records of
 4 KiB each and times ``rclverify bundle`` and ``--verify`` on it.
@@ -27,11 +27,11 @@ import time
 from pathlib import Path
 from typing import Any
 
-from rclverify.argument.build import build_argument
-from rclverify.argument.export import to_dot, to_gsn_yaml
-from rclverify.bundle.archive import verify_bundle, write_bundle
-from rclverify.evidence.store import SEAL, seal_of
-from rclverify.plan.load import load_plan
+from rclverify.report.argument.build import build_argument
+from rclverify.report.argument.export import to_dot, to_gsn_yaml
+from rclverify.report.bundle.archive import verify_bundle, write_bundle
+from rclverify.records.store import SEAL, seal_of
+from rclverify.model.plan.load import load_plan
 from rclverify.report.diagram import render_dot
 
 

@@ -67,8 +67,8 @@ from _chain import write_chain  # noqa: E402
 def rclverify_chain(n: int, weak: dict[int, int] | None = None, bound: int = 100) -> dict[str, Any]:
     """Every side condition of the chain decided by rclverify's calculus."""
     from rclverify.calculus.compose import IN_CONTEXT, compose_node
-    from rclverify.logic import world
-    from rclverify.workspace import Workspace
+    from rclverify.semantics import world
+    from rclverify.stages.workspace import Workspace
     with tempfile.TemporaryDirectory() as d:
         ws = Workspace(write_chain(Path(d) / "ws", n, weak=weak, bound=bound))
         checked, model = ws.checked, ws.model
@@ -151,8 +151,8 @@ QUOTIENTS = [
 def quotient_case(pc: Any, n: int, missing: int, reqs: Any, top_spec: Any, divisor_nodes: Any) -> dict[str, Any]:
     """One quotient case by rclverify's quotient and, when installed, by Pacti's."""
     from rclverify.calculus.quotient import quotient
-    from rclverify.logic import world
-    from rclverify.workspace import Workspace
+    from rclverify.semantics import world
+    from rclverify.stages.workspace import Workspace
     with tempfile.TemporaryDirectory() as d:
         ws = Workspace(write_chain(Path(d) / "ws", n, missing=[missing], requirements=reqs),
                        interface_only=(f"N{missing}",))
@@ -191,10 +191,10 @@ def quotient_case(pc: Any, n: int, missing: int, reqs: Any, top_spec: Any, divis
 
 def _rcl_z3(text: str, names: dict[str, z3.ArithRef], k: int) -> z3.BoolRef:
     """An RCL formula of the quotient (linear, over in.x<k> / out.x<k+1>) in Z3, through rclverify's encoder."""
-    from rclverify.logic.encode import Encoder
-    from rclverify.rcl.parser import parse_formula
-    from rclverify.rcl.types import REAL, CheckedNode
-    from rclverify.rcl.typecheck import check
+    from rclverify.semantics.encode import Encoder
+    from rclverify.lang.parser import parse_formula
+    from rclverify.lang.types import REAL, CheckedNode
+    from rclverify.lang.typecheck import check
     checked = check([])
     node = CheckedNode(None, {f"x{k}": REAL}, {f"x{k + 1}": REAL})  # type: ignore[arg-type]
     return Encoder(checked.env).formula(parse_formula(text), node, symbols=names)

@@ -25,8 +25,8 @@ sys.path.insert(0, str(ROOT / "src"))
 from rclverify.backends.monitors.check import check_trace  # noqa: E402
 from rclverify.backends.monitors.declarations import check_declarations  # noqa: E402
 from rclverify.backends.monitors.periods import check_periods  # noqa: E402
-from rclverify.rcl.parser import parse_text  # noqa: E402
-from rclverify.rcl.typecheck import check  # noqa: E402
+from rclverify.lang.parser import parse_text  # noqa: E402
+from rclverify.lang.typecheck import check  # noqa: E402
 from rclverify.traces.events import Event  # noqa: E402
 from rclverify.traces.mapping import TopicRule  # noqa: E402
 

@@ -1,8 +1,8 @@
 """CPU of the ``hoare`` backend's export and run over a synthetic system, in one process.
 
 Calls the pipeline's stage functions directly, as one doit process does:
-:func:`rclverify.pipeline.stage_export` for every node, then
-:func:`rclverify.pipeline.stage_run` for every exported ``hoare`` obligation
+:func:`rclverify.app.pipeline.stage_export` for every node, then
+:func:`rclverify.app.pipeline.stage_run` for every exported ``hoare`` obligation
 (the other backends' obligations are exported but not run).  The workspace is
 the one of ``bench/pipeline_scale.py`` (N nodes, each with a ``hoare`` entry
 over one shared clamp program, two guarantees, so 2N triples), written to a
@@ -38,7 +38,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 from pipeline_scale import generate  # noqa: E402  (a sibling bench script)
 
-from rclverify.pipeline import Workspace, stage_export, stage_run  # noqa: E402
+from rclverify.app.pipeline import Workspace, stage_export, stage_run  # noqa: E402
 
 
 def timed(fn: Callable[[], int]) -> tuple[int, float, float]:

@@ -60,7 +60,7 @@ async def measure(n: int, repeat: int) -> tuple[int, list[float]]:
             got[current["version"]].set()
 
     env = {**os.environ, "PYTHONPATH": str(REPO / "src") + os.pathsep + os.environ.get("PYTHONPATH", "")}
-    await client.start_io(sys.executable, "-m", "rclverify.cli", "lsp", env=env, cwd=str(root))
+    await client.start_io(sys.executable, "-m", "rclverify.cli.commands", "lsp", env=env, cwd=str(root))
     await client.initialize_async(lsp.InitializeParams(capabilities=lsp.ClientCapabilities(), root_uri=root.as_uri()))
     client.initialized(lsp.InitializedParams())
     got[0] = asyncio.Event()

@@ -45,9 +45,9 @@ def main() -> int:
     if shutil.which("spin") is None or shutil.which("gcc") is None:
         print("model checking: skipped: spin or gcc is not installed (apt-get install spin gcc)")
         return 0
-    from rclverify.backends.ajpf.backend import AjpfBackend
+    from rclverify.backends.model_checking.ajpf.backend import AjpfBackend
     from rclverify.backends.model_checking import backend as mc
-    from rclverify.workspace import Workspace
+    from rclverify.stages.workspace import Workspace
     os.environ.pop("MCAPL_HOME", None)
     os.environ.pop("AJPF_HOME", None)
     plan = yaml.safe_load((REPO / "contracts/plan.yaml").read_text(encoding="utf-8"))

@@ -69,7 +69,7 @@ def main() -> int:
         a.lines = 2_000
     from rclverify.backends.monitors.check import check_trace
     from rclverify.backends.monitors.config import load_mapping
-    from rclverify.rcl.typecheck import load
+    from rclverify.lang.typecheck import load
     from rclverify.traces import TraceError
     from rclverify.traces.jsonl import read_jsonl
     checked = load([ROOT / "contracts" / "remote_inspection.rcl"])

@@ -73,8 +73,8 @@ from _pace import paced  # noqa: E402
 def publisher(rate: float, seconds: float, out: Path, wait_for: int, nodes: list[str]) -> int:
     """Publish the run's messages on the monitored nodes' topics round-robin at
     ``rate``/s; write (topic, t_pub) per message."""
-    from rclverify.backends.monitors.ros1 import build_message, contract_topics, import_rospy, message_class
-    from rclverify.rcl.typecheck import load
+    from rclverify.runtime.ros1 import build_message, contract_topics, import_rospy, message_class
+    from rclverify.lang.typecheck import load
     rospy = import_rospy()
     Snapshot = message_class("gazebo_radiation_plugin/Snapshot", [ROOT / "backends/monitors/msg"])
     checked = load([ROOT / "contracts" / "remote_inspection.rcl"])
@@ -99,7 +99,7 @@ def publisher(rate: float, seconds: float, out: Path, wait_for: int, nodes: list
 
 def listener(topic: str, out: Path) -> int:
     """Collect (received, verdict) until SIGTERM, then write them."""
-    from rclverify.backends.monitors.ros1 import import_rospy
+    from rclverify.runtime.ros1 import import_rospy
     rospy = import_rospy()
     from std_msgs.msg import String
     got: list[tuple[float, str]] = []
@@ -118,7 +118,7 @@ def listener(topic: str, out: Path) -> int:
 # -- live benchmark ------------------------------------------------------------------
 
 def bench_live(rate: float, seconds: float, nodes: list[str]) -> None:
-    from rclverify.backends.monitors.ros1 import LocalMaster, RosUnavailable, import_rospy
+    from rclverify.runtime.ros1 import LocalMaster, RosUnavailable, import_rospy
     try:
         import_rospy()
     except RosUnavailable as exc:
@@ -137,7 +137,7 @@ def bench_live(rate: float, seconds: float, nodes: list[str]) -> None:
                 return p
             try:
                 lis = start([__file__, "--listener", str(tmp / "verdicts.json")], "listener.out")
-                mon = start(["-m", "rclverify.cli", "monitor", "--live", "-w", str(ROOT), "--horizon", "2.0",
+                mon = start(["-m", "rclverify.cli.commands", "monitor", "--live", "-w", str(ROOT), "--horizon", "2.0",
                              "--reorder-window", "0", "--status", "0", "--log", str(tmp / "live.jsonl"),
                              "--evidence", str(tmp / "evidence.json"),
                              *[x for n in nodes for x in ("--node", n)]], "monitor.out")
@@ -221,11 +221,11 @@ def bench_oracle(n: int, node: str | None) -> None:
         print(f"oracle: skipped: websockets is not installed ({exc})")
         return
 
-    from rclverify.backends.monitors.ros1 import free_port
+    from rclverify.runtime.ros1 import free_port
     port = free_port()
     with tempfile.TemporaryDirectory() as d:
         out = Path(d) / "oracle.out"
-        proc = subprocess.Popen([sys.executable, "-m", "rclverify.cli", "oracle", "-w", str(ROOT), "--port", str(port),
+        proc = subprocess.Popen([sys.executable, "-m", "rclverify.cli.commands", "oracle", "-w", str(ROOT), "--port", str(port),
                                  *(["--node", node] if node else [])], cwd=ROOT, stdout=out.open("wb"),
                                 stderr=subprocess.STDOUT, start_new_session=True,
                                 env={**os.environ, "PYTHONPATH": str(ROOT / "src")})

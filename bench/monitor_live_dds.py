@@ -66,11 +66,11 @@ def _rss_kib(pid: int) -> int | None:
 def publisher(rate: float, seconds: float, out: Path, nodes: list[str]) -> int:
     """Publish the nominal run's messages on the monitored topics at ``rate``/s; write (topic, t_pub)."""
     from _live import messages as _lines
-    from rclverify.backends.monitors.dds_types import TypeBook
-    from rclverify.backends.monitors.ros1 import contract_topics
-    from rclverify.rcl.typecheck import load
-    from rclverify.ros.dds import make_participant, topic_name
-    from rclverify.ros.dds_qos import QosProfile, to_dds
+    from rclverify.runtime.dds.types import TypeBook
+    from rclverify.runtime.ros1 import contract_topics
+    from rclverify.lang.typecheck import load
+    from rclverify.ros.live.dds import make_participant, topic_name
+    from rclverify.ros.live.dds_qos import QosProfile, to_dds
     from cyclonedds.pub import DataWriter
     from cyclonedds.topic import Topic
     checked = load([ROOT / "contracts" / "remote_inspection.rcl"])
@@ -98,9 +98,9 @@ def publisher(rate: float, seconds: float, out: Path, nodes: list[str]) -> int:
 
 def listener(out: Path) -> int:
     """Collect (received, verdict) from ``rt/rclverify/verdict`` until SIGTERM, then write them."""
-    from rclverify.backends.monitors.dds_types import TypeBook
-    from rclverify.ros.dds import make_participant, take_raw
-    from rclverify.ros.dds_qos import QosProfile, to_dds
+    from rclverify.runtime.dds.types import TypeBook
+    from rclverify.ros.live.dds import make_participant, take_raw
+    from rclverify.ros.live.dds_qos import QosProfile, to_dds
     from cyclonedds.core import InstanceState, ReadCondition, SampleState, ViewState, WaitSet
     from cyclonedds.sub import DataReader
     from cyclonedds.topic import Topic
@@ -138,7 +138,7 @@ def _run(tmp: Path, env: dict[str, str], rate: float, seconds: float, nodes: lis
     try:
         if not memory:  # the memory run keeps no verdicts (10 minutes of them are hundreds of MB of JSON)
             lis = start([__file__, "--listener", str(tmp / f"verdicts{tag}.json")], f"listener{tag}.out")
-        mon = start(["-m", "rclverify.cli", "monitor", "--live", "--ros2", "-w", str(ROOT), "--horizon", "2.0",
+        mon = start(["-m", "rclverify.cli.commands", "monitor", "--live", "--ros2", "-w", str(ROOT), "--horizon", "2.0",
                      "--reorder-window", "0", "--status", "0", "--log", str(tmp / f"live{tag}.jsonl"),
                      "--evidence", str(tmp / f"evidence{tag}.json"), *[x for n in nodes for x in ("--node", n)]],
                     f"monitor{tag}.out")

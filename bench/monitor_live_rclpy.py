@@ -118,7 +118,7 @@ def _run(tmp: Path, env: dict[str, str], ros2: Path, rate: float, seconds: float
             lis = start([sys.executable, str(ROOT / "bench" / "monitor_live_dds.py"), "--listener",
                          str(tmp / f"verdicts{tag}.json")], f"listener{tag}.out")
             wait_text(tmp / f"listener{tag}.out", "listening", 30)
-        mon = start([sys.executable, "-m", "rclverify.cli", "monitor", "--live", "--ros2", "-w", str(tmp / "ws"),
+        mon = start([sys.executable, "-m", "rclverify.cli.commands", "monitor", "--live", "--ros2", "-w", str(tmp / "ws"),
                      "--mapping", "mapping.yaml", "--horizon", "1.0", "--reorder-window", "0", "--status", "0",
                      "--log", str(tmp / f"live{tag}.jsonl"), "--evidence", str(tmp / f"evidence{tag}.json")],
                     f"monitor{tag}.out")

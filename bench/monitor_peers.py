@@ -151,7 +151,7 @@ def _columns(n: int, rs: array, st: bytes) -> Any:
 def _rclverify_engine(n: int, rs: array, st: bytes, verdicts: bool, batch: bool = False, columns: bool = False
                       ) -> tuple[float, bytes, dict[str, int]]:
     from rclverify.backends.monitors.check import check_trace
-    from rclverify.rcl.typecheck import load
+    from rclverify.lang.typecheck import load
     from rclverify.traces.events import Event
     from rclverify.traces.mapping import load_rules
     with tempfile.TemporaryDirectory() as tmp:
@@ -355,7 +355,7 @@ def _run_command(ws: Path, src: str, trace: str = "run.jsonl") -> dict[str, Any]
     env = {**os.environ, "PYTHONPATH": os.pathsep.join([src] + ([os.environ["PYTHONPATH"]]
                                                                 if os.environ.get("PYTHONPATH") else []))}
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
-    p = subprocess.run([sys.executable, "-c", "import sys; from rclverify.cli import main; sys.exit(main())",
+    p = subprocess.run([sys.executable, "-c", "import sys; from rclverify.cli.commands import main; sys.exit(main())",
                         "monitor", "-w", str(ws), str(ws / trace)], capture_output=True, text=True, env=env)
     after = resource.getrusage(resource.RUSAGE_CHILDREN)
     if p.returncode not in (0, 1) or not p.stdout:

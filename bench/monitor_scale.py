@@ -46,7 +46,7 @@ sys.path.insert(0, str(ROOT / "src"))
 
 from rclverify.backends.monitors.check import check_trace  # noqa: E402
 from rclverify.backends.monitors.config import load_mapping  # noqa: E402
-from rclverify.rcl.typecheck import load  # noqa: E402
+from rclverify.lang.typecheck import load  # noqa: E402
 from rclverify.traces import read_trace  # noqa: E402
 from rclverify.traces.events import Event  # noqa: E402
 

@@ -7,9 +7,9 @@ outputs, an enumeration and a constructor set, chained comparisons,
 arithmetic and topics.  For each N it prints:
 
 * the file size,
-* the LALR(1) parse time, text to AST (``rclverify.rcl.parser.parse_text``;
+* the LALR(1) parse time, text to AST (``rclverify.lang.parser.parse_text``;
   best of ``--repeat`` runs for N <= 1000) and the time per node,
-* the type-check time (``rclverify.rcl.typecheck.check``; the column is
+* the type-check time (``rclverify.lang.typecheck.check``; the column is
   skipped with a note when the checker cannot be imported),
 * the peak Python memory of parse + check (tracemalloc, in a separate run so
   the tracing does not distort the times),
@@ -53,9 +53,9 @@ from typing import Any, Callable, Sequence, TypeVar
 
 from lark import Lark
 
-from rclverify.rcl import ast
-from rclverify.cache.heap import no_collection as gc_paused
-from rclverify.rcl.parser import ast_from_tree, grammar_text, parse_text
+from rclverify.lang import ast
+from rclverify.core.cache.heap import no_collection as gc_paused
+from rclverify.lang.parser import ast_from_tree, grammar_text, parse_text
 
 T = TypeVar("T")
 
@@ -101,7 +101,7 @@ BEFORE_FILES = ("__init__.py", "ast.py", "errors.py", "parser.py", "rcl.lark", "
 
 def before_front_end() -> tuple[Callable[[str, str], Any], Callable[[list[Any]], Any]] | None:
     """``(parse_text, check)`` of the front end before the full-language
-    work: ``src/rclverify/rcl/`` at commit ``BEFORE_COMMIT``, written by
+    work: ``src/rclverify/lang/`` at commit ``BEFORE_COMMIT``, written by
     ``git show`` into a temporary package ``before_issue11`` and imported
     (old AST, parser, checker and types), its parser reading the old grammar.
 
@@ -113,7 +113,7 @@ def before_front_end() -> tuple[Callable[[str, str], Any], Callable[[list[Any]],
     pkg.mkdir()
     for name in BEFORE_FILES:
         try:
-            text = subprocess.run(["git", "-C", str(repo), "show", f"{BEFORE_COMMIT}:src/rclverify/rcl/{name}"],
+            text = subprocess.run(["git", "-C", str(repo), "show", f"{BEFORE_COMMIT}:src/rclverify/lang/{name}"],
                                   check=True, capture_output=True, text=True).stdout
         except (OSError, subprocess.CalledProcessError) as exc:
             print(f"note: old front end columns skipped: it is read from the git history (commit "
@@ -187,7 +187,7 @@ def main(argv: Sequence[str] | None = None) -> int:
 
     check: Callable[[list[ast.Spec]], object] | None
     try:
-        from rclverify.rcl.typecheck import check
+        from rclverify.lang.typecheck import check
     except ImportError as exc:  # the checker is optional for this benchmark
         check = None
         print(f"note: type-check column skipped ({exc})")

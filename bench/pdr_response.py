@@ -14,7 +14,7 @@ seconds of:
 
 * **k-ind**: BMC and k-induction up to k = 10 (inconclusive);
 * **pdr**: Spacer's query and the independent re-check of its certificate
-  (:func:`rclverify.requirements.safety.by_pdr`), and the verdict;
+  (:func:`rclverify.calculus.requirements.safety.by_pdr`), and the verdict;
 * **whole**: what the requirement check runs (k-induction, then the
   invariant generated from the constants, then Spacer), and its method;
 * **wrong**: the same with the wrap at ``W + 5`` (refuted by Spacer, then
@@ -36,9 +36,9 @@ import time
 
 import z3
 
-from rclverify.requirements.response import check_response, with_counter
-from rclverify.requirements.safety import by_pdr
-from rclverify.requirements.tsys import TransitionSystem
+from rclverify.calculus.requirements.response import check_response, with_counter
+from rclverify.calculus.requirements.safety import by_pdr
+from rclverify.calculus.requirements.tsys import TransitionSystem
 
 
 def planner(wrap: int) -> TransitionSystem:

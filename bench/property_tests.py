@@ -34,7 +34,7 @@ from typing import Any
 from pathlib import Path
 
 from rclverify.backends.property_tests.harness import GuaranteeRun, load_implementation, read_config
-from rclverify.pipeline import Workspace
+from rclverify.app.pipeline import Workspace
 
 NODES = ("RadiationSensor", "Agent")
 

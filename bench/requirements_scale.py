@@ -45,7 +45,7 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "src"))
 
-from rclverify.pipeline import Workspace, stage_check, stage_requirements  # noqa: E402
+from rclverify.app.pipeline import Workspace, stage_check, stage_requirements  # noqa: E402
 
 
 def node_text(c: int, k: int, temporal: bool = False) -> str:

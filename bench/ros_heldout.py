@@ -38,8 +38,8 @@ import json
 import os
 from pathlib import Path
 
-from rclverify.ros.graph import scan
-from rclverify.ros.model import SERVICE_ROLES
+from rclverify.ros.graph.scan import scan
+from rclverify.ros.extract.model import SERVICE_ROLES
 
 ROLES = ("pub", "sub") + tuple(SERVICE_ROLES)
 KINDS = ("literal", "computed", "runtime")

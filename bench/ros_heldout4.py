@@ -43,8 +43,8 @@ from fnmatch import fnmatch
 from pathlib import Path
 from typing import Any
 
-from rclverify.ros.graph import scan
-from rclverify.ros.model import SERVICE_ROLES
+from rclverify.ros.graph.scan import scan
+from rclverify.ros.extract.model import SERVICE_ROLES
 
 ROLES = ("pub", "sub") + tuple(SERVICE_ROLES)
 REACH = ("static", "call", "runtime")

@@ -43,8 +43,8 @@ import json
 import tempfile
 from pathlib import Path
 
-from rclverify.ros.graph import scan
-from rclverify.ros.model import SERVICE_ROLES
+from rclverify.ros.graph.scan import scan
+from rclverify.ros.extract.model import SERVICE_ROLES
 
 ROLES = ("pub", "sub") + tuple(SERVICE_ROLES)
 GROUP = {"pub": "topics", "sub": "topics", "service_servers": "services", "service_clients": "services",

@@ -38,8 +38,8 @@ import json
 from collections import defaultdict
 from pathlib import Path
 
-from rclverify.ros.graph import scan
-from rclverify.ros.model import SERVICE_ROLES
+from rclverify.ros.graph.scan import scan
+from rclverify.ros.extract.model import SERVICE_ROLES
 
 GROUPS = {"pub": "topics", "sub": "topics", "service_servers": "services", "service_clients": "services",
           "action_servers": "actions", "action_clients": "actions"}

@@ -31,7 +31,7 @@ import tempfile
 import time
 from pathlib import Path
 
-from rclverify.ros.graph import scan
+from rclverify.ros.graph.scan import scan
 
 PKG_XML = """<?xml version="1.0"?>
 <package format="2"><name>{name}</name><version>1.0.{k}</version><description>synthetic</description>

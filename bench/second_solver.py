@@ -37,8 +37,8 @@ def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--smoke", action="store_true", help="a three-node workspace, a few seconds")
     args = ap.parse_args()
-    from rclverify.cli import main as cli
-    from rclverify.crosscheck.stage import INDEX, stage_crosscheck
+    from rclverify.cli.commands import main as cli
+    from rclverify.stages.crosscheck.stage import INDEX, stage_crosscheck
     with tempfile.TemporaryDirectory() as tmp:
         ws = Path(tmp) / "ws"
         if args.smoke:

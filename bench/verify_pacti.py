@@ -25,7 +25,7 @@ of the old code), ``--repeat K`` takes the median of K runs.
 ``--floor`` adds two what-if runs of ``rclverify verify`` (not
 configurations a user has: the bench patches the child process), to show
 where the rest of the distance to Pacti lies: ``no ctx`` without the
-fresh Z3 context of every node stage and cone summary (logic/world.py,
+fresh Z3 context of every node stage and cone summary (semantics/world.py,
 calculus/summary.py: the integrity decision, docs/integrity.md), ``no ctx,
 no cvc5`` without cvc5 as well, as on a machine where it is not installed
 (the second solver of issue 50, added after issue 51's baseline: every
@@ -76,16 +76,16 @@ WHATIF = ("import sys, types\n"
           "sys.argv = ['rclverify'] + sys.argv[2:]\n"
           "import z3\n"
           "if 'ctx' in off:\n"
-          "    import rclverify.logic.world as W, rclverify.pipeline as P, rclverify.calculus.summary as S\n"
+          "    import rclverify.semantics.world as W, rclverify.app.pipeline as P, rclverify.calculus.summary as S\n"
           "    assert P.fresh_z3 is W.fresh and S.z3 is z3, 'what-if: the names patched here moved'\n"
           "    W.fresh = P.fresh_z3 = lambda: None\n"
           "    S.z3 = types.SimpleNamespace(**{k: getattr(z3, k) for k in dir(z3) if not k.startswith('__')})\n"
           "    S.z3.Context = z3.main_ctx\n"
           "if 'cvc5' in off:\n"
           "    sys.modules['cvc5'] = None  # as on a machine without cvc5: each item reads 'one solver'\n"
-          "    from rclverify.crosscheck.cvc5_decide import version\n"
+          "    from rclverify.stages.crosscheck.cvc5_decide import version\n"
           "    assert version() == '', 'what-if: cvc5 still found'\n"
-          "from rclverify.cli import main\n"
+          "from rclverify.cli.commands import main\n"
           "sys.exit(main())\n")
 
 
@@ -108,7 +108,7 @@ def whatif(root: Path, off: str) -> float:
 def verify(root: Path, src: Path) -> dict[str, Any]:
     """``rclverify verify`` of ``root`` with the source tree ``src``: CPU and the verdicts."""
     env = dict(os.environ, PYTHONPATH=str(src))
-    p = subprocess.run([sys.executable, "-c", PROBE, sys.executable, "-m", "rclverify.cli", "verify", "-w", str(root)],
+    p = subprocess.run([sys.executable, "-c", PROBE, sys.executable, "-m", "rclverify.cli.commands", "verify", "-w", str(root)],
                        capture_output=True, text=True, env=env)
     probe = json.loads(p.stdout)
     rep = json.loads((root / "reports" / "assurance.json").read_text(encoding="utf-8"))
@@ -129,8 +129,8 @@ def verify(root: Path, src: Path) -> dict[str, Any]:
 def calculus(root: Path, summaries: bool) -> float:
     """CPU seconds of every node's composition of the workspace at ``root`` in this process."""
     from rclverify.calculus.compose import compose_node
-    from rclverify.logic import world
-    from rclverify.workspace import Workspace
+    from rclverify.semantics import world
+    from rclverify.stages.workspace import Workspace
     ws = Workspace(root)
     checked, model = ws.checked, ws.model
     facts = {m: [f.expr for f in fs] for m, fs in ws.plan.facts.items()}

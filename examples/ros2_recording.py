@@ -129,7 +129,7 @@ def record(here: Path, py: Path, tmp: Path, *, interfaces: list[str], nodes: lis
     nenv = build(py, env, here, interfaces)
     procs: list[subprocess.Popen[bytes]] = []
     try:
-        mon = start([sys.executable, "-m", "rclverify.cli", "monitor", "-w", ".", "--live", "--ros2", *monitor,
+        mon = start([sys.executable, "-m", "rclverify.cli.commands", "monitor", "-w", ".", "--live", "--ros2", *monitor,
                      "--reorder-window", "0", "--status", "0", "--silence", "0", "--duration", str(timeout),
                      "--log", str(tmp / "run.jsonl"), "--evidence", str(tmp / "evidence.json")],
                     env, tmp / "monitor.out", here)

@@ -45,8 +45,8 @@ def _sensor_function() -> Any:
 
 
 def sensor(misclassify: bool) -> int:
-    from rclverify.backends.monitors.ros1 import import_rospy, message_class
-    from rclverify.values import Term
+    from rclverify.runtime.ros1 import import_rospy, message_class
+    from rclverify.semantics.values import Term
     rospy = import_rospy()
     Snapshot = message_class(SNAPSHOT, MSG_DIRS)
     step = _sensor_function()
@@ -76,7 +76,7 @@ def sensor(misclassify: bool) -> int:
 
 
 def listen(topic: str, out: Path, count: int) -> int:
-    from rclverify.backends.monitors.ros1 import import_rospy
+    from rclverify.runtime.ros1 import import_rospy
     rospy = import_rospy()
     from std_msgs.msg import String
     rospy.init_node("verdict_listener", anonymous=True)
@@ -96,7 +96,7 @@ def listen(topic: str, out: Path, count: int) -> int:
 
 def replay(run: Path, rate: float, skip: set[str], wait_for: int, timeout: float,
            need: dict[str, int] | None = None) -> int:
-    from rclverify.backends.monitors.ros1 import build_message, import_rospy, message_class
+    from rclverify.runtime.ros1 import build_message, import_rospy, message_class
     rospy = import_rospy()
     Snapshot = message_class(SNAPSHOT, MSG_DIRS)
     events = [json.loads(line) for line in run.read_text().splitlines() if line.strip()]

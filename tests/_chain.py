@@ -13,7 +13,7 @@ from typing import Sequence
 
 DODO = '''from pathlib import Path
 
-from rclverify.tasks import build_tasks, doit_config
+from rclverify.app.tasks import build_tasks, doit_config
 
 DOIT_CONFIG = doit_config()
 

@@ -6,7 +6,7 @@ import shutil
 from pathlib import Path
 from typing import Any
 
-from rclverify.pipeline import (Workspace, stage_check, stage_compose, stage_export, stage_health, stage_report,
+from rclverify.app.pipeline import (Workspace, stage_check, stage_compose, stage_export, stage_health, stage_report,
                                 stage_requirements, stage_run)
 
 DATA = Path(__file__).resolve().parent / "data"

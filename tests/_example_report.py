@@ -7,7 +7,7 @@ import json
 from pathlib import Path
 from typing import Any
 
-from rclverify.cli import main
+from rclverify.cli.commands import main
 
 
 def verify(ws: Path, *extra: str) -> tuple[int, dict[str, Any]]:

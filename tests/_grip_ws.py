@@ -51,7 +51,7 @@ nodes:
 DODO = """\
 from pathlib import Path
 
-from rclverify.tasks import build_tasks, doit_config
+from rclverify.app.tasks import build_tasks, doit_config
 
 DOIT_CONFIG = doit_config()
 

@@ -32,7 +32,7 @@ def graph_fixture(case: str) -> Any:
     """A module-scoped pytest fixture ``graph``: the scan of corpus case ``case``."""
     import pytest
 
-    from rclverify.ros.graph import scan
+    from rclverify.ros.graph.scan import scan
 
     @pytest.fixture(scope="module")
     def graph() -> Any:

@@ -4,7 +4,7 @@ The rover's contracts and the plan's environment facts (which the repair of
 the Agent's guarantee 3 needs: waypoints 0-12), with one requirement (REQ3), without the evidence
 entries and the ROS section, so that the real stages run in about
 four seconds: check, compose, health, requirements, the report with its diagnosis and SARIF
-log (rclverify.pipeline, as `doit verify` runs them).
+log (rclverify.app.pipeline, as `doit verify` runs them).
 """
 from __future__ import annotations
 
@@ -35,7 +35,7 @@ def make_workspace(root: Path) -> Path:
 
 def run_pipeline(root: Path, nodes: tuple[str, ...] = ()) -> None:
     """The stages of a run on ``root`` (every node's health, or ``nodes``'), then the report files."""
-    from rclverify.pipeline import Workspace, stage_check, stage_compose, stage_health, stage_report, stage_requirements
+    from rclverify.app.pipeline import Workspace, stage_check, stage_compose, stage_health, stage_report, stage_requirements
     from rclverify.report.build import build_report
     ws = Workspace(root)
     stage_check(ws)

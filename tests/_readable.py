@@ -10,7 +10,7 @@ from __future__ import annotations
 from fractions import Fraction
 from typing import Any
 
-from rclverify.logic.nicemodel import short
+from rclverify.semantics.nicemodel import short
 from rclverify.report.cex_cone import side_condition_view
 
 

@@ -13,14 +13,14 @@ from typing import Any, Iterator
 
 from jsonschema import Draft202012Validator
 
-from rclverify.evidence.statuses import VOCABULARY
+from rclverify.records.statuses import VOCABULARY
 
 SCHEMA_PATH = Path(__file__).resolve().parents[1] / "docs" / "assurance.schema.json"
 SCHEMA: dict[str, Any] = json.loads(SCHEMA_PATH.read_text(encoding="utf-8"))
 VALIDATOR = Draft202012Validator(SCHEMA)
 
 #: Every status word of a report by where it sits (``[]``: each element of a list) and its set of
-#: :data:`rclverify.evidence.statuses.VOCABULARY`; ``*`` accepts a word of any set but the
+#: :data:`rclverify.records.statuses.VOCABULARY`; ``*`` accepts a word of any set but the
 #: agreements, lint severities and evidence kinds (a problem row's member keeps its item's own word).
 STATUS_FIELDS: tuple[tuple[str, str], ...] = (
     ("summary.status", "evidence_status"),

@@ -81,7 +81,7 @@ def rclverify(args: list[str], env: dict[str, str], cwd: Path, log: Path) -> sub
     session of its own, output in ``log``."""
     env = dict(env, PYTHONPATH=str(REPO / "src"))
     with open(log, "wb") as fh:
-        return subprocess.Popen([sys.executable, "-m", "rclverify.cli", *args], cwd=cwd, env=env, stdout=fh,
+        return subprocess.Popen([sys.executable, "-m", "rclverify.cli.commands", *args], cwd=cwd, env=env, stdout=fh,
                                 stderr=subprocess.STDOUT, start_new_session=True)
 
 

@@ -10,8 +10,8 @@ from __future__ import annotations
 
 from typing import Any
 
-from rclverify.logic.floatsem import Tolerance, holds_in, judge as floatjudge
-from rclverify.rcl.types import Checked, CheckedNode
+from rclverify.semantics.floatsem import Tolerance, holds_in, judge as floatjudge
+from rclverify.lang.types import Checked, CheckedNode
 
 ORDER = ("exact", "double", "tolerance")
 

@@ -2,7 +2,7 @@
 to ROS 2's wire conventions (no ROS 2 installation here: nothing of rclpy,
 rcl or an RMW runs).
 
-What "ROS 2-shaped" means, as rmw_cyclonedds does it (rclverify/ros/dds.py
+What "ROS 2-shaped" means, as rmw_cyclonedds does it (rclverify/ros/live/dds.py
 cites where): topics ``rt/<name>`` of type ``pkg::msg::dds_::T_`` in plain
 CDR; a service's requests on ``rq/<name>Request`` and replies on
 ``rr/<name>Reply``, each sample starting with the client's request-writer
@@ -30,10 +30,10 @@ import uuid
 from pathlib import Path
 from typing import Any, Callable
 
-from rclverify.backends.monitors.dds_types import TypeBook, request_id, to_fields
-from rclverify.ros.dds import (NodeInfo, discovery_struct, encode_participant_info, reply_topic, request_topic,
+from rclverify.runtime.dds.types import TypeBook, request_id, to_fields
+from rclverify.ros.live.dds import (NodeInfo, discovery_struct, encode_participant_info, reply_topic, request_topic,
                                topic_name, type_hash_user_data, write_raw)
-from rclverify.ros.dds_qos import QosProfile, to_dds
+from rclverify.ros.live.dds_qos import QosProfile, to_dds
 
 CONFIG = """<?xml version="1.0" encoding="UTF-8"?>
 <CycloneDDS xmlns="https://cdds.io/config">

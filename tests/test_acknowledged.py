@@ -2,9 +2,9 @@
 and triggers, and acknowledgements of lint and health warnings in the plan."""
 from __future__ import annotations
 
-from rclverify.health.shape import shape_findings
-from rclverify.rcl.parser import parse_text
-from rclverify.rcl.typecheck import check
+from rclverify.calculus.health.shape import shape_findings
+from rclverify.lang.parser import parse_text
+from rclverify.lang.typecheck import check
 
 TIMED = """
 node Stopper {
@@ -54,8 +54,8 @@ from typing import Any  # noqa: E402
 
 import pytest  # noqa: E402
 
-from rclverify.cli import main  # noqa: E402
-from rclverify.plan.acknowledged import digest  # noqa: E402
+from rclverify.cli.commands import main  # noqa: E402
+from rclverify.model.plan.acknowledged import digest  # noqa: E402
 
 GAIN = """node Gain {
   inputs( x : INTEGER )
@@ -93,7 +93,7 @@ def _verify(ws: Path, plan: str, strict: bool = False) -> tuple[int, dict[str, A
 def _explain(ws: Path) -> str:
     import subprocess
     import sys
-    p = subprocess.run([sys.executable, "-m", "rclverify.cli", "explain", "-w", str(ws), "Gain.g1.c2.redundant"],
+    p = subprocess.run([sys.executable, "-m", "rclverify.cli.commands", "explain", "-w", str(ws), "Gain.g1.c2.redundant"],
                        capture_output=True, text=True, timeout=120)
     assert p.returncode == 0, p.stderr
     return p.stdout
@@ -173,8 +173,8 @@ def test_a_changed_flagged_text_raises_the_warning_again(gain_ws):
 
 
 def test_only_a_warning_can_be_acknowledged_and_lint_binds_by_clause_text():
-    from rclverify.plan.acknowledged import Acknowledgement, apply_acknowledgements
-    from rclverify.rcl import ast
+    from rclverify.model.plan.acknowledged import Acknowledgement, apply_acknowledgements
+    from rclverify.lang import ast
     checked = check([parse_text(GAIN, "contracts/gain.rcl")])
     problem = {"id": "Gain.g1.tautology", "status": "problem", "message": "always true"}
     lint = {"location": "contracts/gain.rcl:6:21", "code": "W-unused-bound", "severity": "warning",
@@ -197,8 +197,8 @@ def test_only_a_warning_can_be_acknowledged_and_lint_binds_by_clause_text():
      "the reason must say why"),
 ])
 def test_a_malformed_acknowledgement_is_one_located_error(tmp_path, entry, where, said):
-    from rclverify.plan.errors import PlanError
-    from rclverify.plan.load import load_plan
+    from rclverify.model.plan.errors import PlanError
+    from rclverify.model.plan.load import load_plan
     (tmp_path / "contracts").mkdir()
     (tmp_path / "contracts" / "gain.rcl").write_text(GAIN, encoding="utf-8")
     (tmp_path / "contracts" / "plan.yaml").write_text("name: gain\ncontracts: [contracts/gain.rcl]\nacknowledged:\n"

@@ -19,7 +19,7 @@ from typing import Any
 
 import pytest
 
-from rclverify.cli import main
+from rclverify.cli.commands import main
 
 DATA = Path(__file__).parent / "data" / "advice"
 

@@ -8,18 +8,18 @@ from pathlib import Path
 from typing import Iterator
 
 import pytest
-from rclverify.pipeline import Workspace
+from rclverify.app.pipeline import Workspace
 
-from rclverify.backends.ajpf import psl
-from rclverify.backends.ajpf.backend import AjpfBackend
-from rclverify.backends.ajpf.instantiate import Translator
-from rclverify.backends.ajpf.mapping import Canon, Row, RowError, build_row, dnf
-from rclverify.backends.ajpf.results import parse_log
+from rclverify.backends.model_checking.ajpf import psl
+from rclverify.backends.model_checking.ajpf.backend import AjpfBackend
+from rclverify.backends.model_checking.ajpf.instantiate import Translator
+from rclverify.backends.model_checking.ajpf.mapping import Canon, Row, RowError, build_row, dnf
+from rclverify.backends.model_checking.ajpf.results import parse_log
 from rclverify.backends.base import NodeTarget
-from rclverify.evidence.records import Obligation
-from rclverify.evidence.store import EvidenceStore
-from rclverify.plan.errors import PlanError
-from rclverify.rcl.parser import parse_formula
+from rclverify.records.records import Obligation
+from rclverify.records.store import EvidenceStore
+from rclverify.model.plan.errors import PlanError
+from rclverify.lang.parser import parse_formula
 
 REPO = Path(__file__).resolve().parents[1]
 

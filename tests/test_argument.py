@@ -10,9 +10,9 @@ from typing import Any
 import pytest
 import yaml
 
-from rclverify.argument.build import build_argument
-from rclverify.argument.export import argument_view, to_dot, to_gsn_yaml, to_json_text, write_argument
-from rclverify.argument.model import Argument, ArgumentError, Element, propagate
+from rclverify.report.argument.build import build_argument
+from rclverify.report.argument.export import argument_view, to_dot, to_gsn_yaml, to_json_text, write_argument
+from rclverify.report.argument.model import Argument, ArgumentError, Element, propagate
 from rclverify.report import render
 from rclverify.report.diagram import Rendering
 
@@ -166,7 +166,7 @@ def test_json_round_trips_and_is_deterministic() -> None:
     text = to_json_text(arg)
     assert Argument.from_json(json.loads(text)) == arg
     assert to_json_text(build_argument(copy.deepcopy(_report()))) == text
-    from rclverify.evidence.store import dumps
+    from rclverify.records.store import dumps
     from rclverify.report.fragments import FragmentCache
     assert text == dumps(arg.to_json())
     cache = FragmentCache()
@@ -242,7 +242,7 @@ def test_a_long_element_text_is_clipped_in_the_tooltip_so_dot_accepts_it(tmp_pat
 
 
 def test_an_argument_too_large_to_draw_is_not_laid_out(tmp_path: Any, monkeypatch: pytest.MonkeyPatch) -> None:
-    from rclverify.argument import export
+    from rclverify.report.argument import export
     from rclverify.report import diagram
     n = len(build_argument(_report()).elements)
     monkeypatch.setattr(export, "MAX_LAYOUT_ELEMENTS", n - 1)

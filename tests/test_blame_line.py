@@ -109,13 +109,13 @@ nodes:
 def test_hoare_names_the_assignment_not_the_comparison(tmp_path: Path) -> None:
     import json
 
-    from rclverify.cli import main
+    from rclverify.cli.commands import main
     (tmp_path / "contracts").mkdir()
     (tmp_path / "backends" / "hoare").mkdir(parents=True)
     (tmp_path / "contracts" / "arm.rcl").write_text(ARM_RCL, encoding="utf-8")
     (tmp_path / "contracts" / "plan.yaml").write_text(ARM_PLAN, encoding="utf-8")
     (tmp_path / "backends" / "hoare" / "arm.imp").write_text(ARM_IMP, encoding="utf-8")
-    (tmp_path / "dodo.py").write_text("from pathlib import Path\nfrom rclverify.tasks import build_tasks, doit_config\n"
+    (tmp_path / "dodo.py").write_text("from pathlib import Path\nfrom rclverify.app.tasks import build_tasks, doit_config\n"
                                       "DOIT_CONFIG = doit_config()\nglobals().update(build_tasks(Path(__file__).parent))\n",
                                       encoding="utf-8")
     assert main(["verify", "-w", str(tmp_path)]) == 0
@@ -186,13 +186,13 @@ def test_a_run_of_a_generated_node_names_its_handler(tmp_path: Path) -> None:
 
     import yaml
 
-    from rclverify.cli import main
+    from rclverify.cli.commands import main
     (tmp_path / "contracts").mkdir()
     (tmp_path / "runs").mkdir()
     (tmp_path / "contracts" / "arm.rcl").write_text(GEN_RCL, encoding="utf-8")
     (tmp_path / "contracts" / "plan.yaml").write_text(
         'name: "gen"\ncontracts: [contracts/arm.rcl]\nrequirements: []\nnodes:\n  ArmDriver: {}\n', encoding="utf-8")
-    (tmp_path / "dodo.py").write_text("from pathlib import Path\nfrom rclverify.tasks import build_tasks, doit_config\n"
+    (tmp_path / "dodo.py").write_text("from pathlib import Path\nfrom rclverify.app.tasks import build_tasks, doit_config\n"
                                       "DOIT_CONFIG = doit_config()\nglobals().update(build_tasks(Path(__file__).parent))\n",
                                       encoding="utf-8")
     assert main(["generate", "ros2", "-w", str(tmp_path), "-o", str(tmp_path / "gen")]) == 0

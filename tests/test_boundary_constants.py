@@ -24,8 +24,8 @@ from rclverify.backends.property_tests import boundary, harness
 from rclverify.backends.property_tests.constants import boundary_constants, code_constants, named_constants
 from rclverify.backends.property_tests.harness import read_config, run_guarantee
 from rclverify.backends.property_tests.strategies import input_space
-from rclverify.rcl.parser import parse_text
-from rclverify.rcl.typecheck import check
+from rclverify.lang.parser import parse_text
+from rclverify.lang.typecheck import check
 
 RCL = """context {
   ProtectiveDist : REAL [m] = 1.2345 ;

@@ -31,7 +31,7 @@ from typing import Any
 
 import pytest
 
-from rclverify.pipeline import (
+from rclverify.app.pipeline import (
     Workspace,
     stage_check,
     stage_compose,

@@ -10,13 +10,13 @@ from pathlib import Path
 
 import pytest
 
-from rclverify.bundle.archive import read_members, verify_bundle, write_bundle
-from rclverify.bundle.manifest import MANIFEST, BundleError
-from rclverify.cli import main
-from rclverify.evidence.sealed import sealed
-from rclverify.evidence.store import dumps
-from rclverify.plan.errors import PlanError
-from rclverify.plan.load import load_plan
+from rclverify.report.bundle.archive import read_members, verify_bundle, write_bundle
+from rclverify.report.bundle.manifest import MANIFEST, BundleError
+from rclverify.cli.commands import main
+from rclverify.records.sealed import sealed
+from rclverify.records.store import dumps
+from rclverify.model.plan.errors import PlanError
+from rclverify.model.plan.load import load_plan
 
 TOOLS = {"rclverify": "0", "z3": "4", "dafny": "not installed", "hypothesis": "6", "python": "3"}
 
@@ -140,7 +140,7 @@ def test_zip_bundles_verify_too(tmp_path: Path) -> None:
 def test_cli_writes_and_checks_a_bundle(tmp_path: Path, capsys: pytest.CaptureFixture[str],
                                         monkeypatch: pytest.MonkeyPatch) -> None:
     ws = _workspace(tmp_path / "ws")
-    monkeypatch.setattr("rclverify.bundle.archive.tool_versions", lambda: TOOLS)
+    monkeypatch.setattr("rclverify.report.bundle.archive.tool_versions", lambda: TOOLS)
     out = tmp_path / "out.tar.gz"
     assert main(["bundle", "-w", str(ws), "-o", str(out)]) == 0
     captured = capsys.readouterr()

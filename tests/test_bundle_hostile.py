@@ -14,10 +14,10 @@ from pathlib import Path
 
 import pytest
 
-from rclverify.bundle import archive
-from rclverify.bundle.archive import verify_bundle
-from rclverify.bundle.manifest import BundleError
-from rclverify.cli import main
+from rclverify.report.bundle import archive
+from rclverify.report.bundle.archive import verify_bundle
+from rclverify.report.bundle.manifest import BundleError
+from rclverify.cli.commands import main
 
 RECORD = b'{"status": "met"}\n'
 
@@ -86,11 +86,11 @@ def test_a_signed_bundle_fails_verification_when_re_sealed_by_another_hand(tmp_p
     the author's Ed25519 signature over the manifest is not."""
     from test_bundle import TOOLS, _workspace
 
-    from rclverify.bundle.archive import write_bundle
-    from rclverify.bundle.signature import load_private_key
-    from rclverify.evidence.sealed import sealed
-    from rclverify.evidence.store import dumps
-    from rclverify.plan.load import load_plan
+    from rclverify.report.bundle.archive import write_bundle
+    from rclverify.report.bundle.signature import load_private_key
+    from rclverify.records.sealed import sealed
+    from rclverify.records.store import dumps
+    from rclverify.model.plan.load import load_plan
     ws = _workspace(tmp_path / "ws")
     key = tmp_path / "author.pem"
     assert main(["bundle", "--keygen", str(key)]) == 0

@@ -22,8 +22,8 @@ from pathlib import Path
 
 import pytest
 
-from rclverify.cache import safeload
-from rclverify.cache.safeload import SafeUnpickler, load, loads
+from rclverify.core.cache import safeload
+from rclverify.core.cache.safeload import SafeUnpickler, load, loads
 
 REPO = Path(__file__).resolve().parents[1]
 DATA = REPO / "tests" / "data" / "requirements" / "stop"
@@ -98,18 +98,18 @@ def _poison_templates(cache: Path, payload: bytes) -> int:
 
 def test_the_loader_refuses_every_callable_that_is_not_a_kept_value_class() -> None:
     for module, name in [("os", "system"), ("posix", "system"), ("builtins", "eval"), ("builtins", "open"),
-                         ("io", "open"), ("subprocess", "Popen"), ("rclverify.cli", "os.system"),
-                         ("rclverify.cli", "main"), ("rclverify.__main__", "main"),
-                         ("rclverify.cache.store", "Shelf"), ("rclverify.backends.monitors.oracle", "serve"),
-                         ("rclverify.rcl.errors", "RclError"), ("rclverify.nonexistent", "Thing"),
+                         ("io", "open"), ("subprocess", "Popen"), ("rclverify.cli.commands", "os.system"),
+                         ("rclverify.cli.commands", "main"), ("rclverify.__main__", "main"),
+                         ("rclverify.core.cache.store", "Shelf"), ("rclverify.runtime.oracle", "serve"),
+                         ("rclverify.lang.errors", "RclError"), ("rclverify.nonexistent", "Thing"),
                          ("copyreg", "_reconstructor"), ("pathlib", "Path.touch")]:
         with pytest.raises(pickle.UnpicklingError):
             loads(_global(module, name))
     with pytest.raises(pickle.UnpicklingError):
         loads(pickle.dumps(_Opens(Path("/nonexistent/never"))))
     # the values rclverify keeps still load, as themselves
-    from rclverify.rcl.ast import Loc
-    from rclverify.rcl.parser import parse_text
+    from rclverify.lang.ast import Loc
+    from rclverify.lang.parser import parse_text
     spec = parse_text("node N { inputs( x : REAL ) outputs( y : REAL )\n  guarantee( out.y >= in.x + 1/2 ) }\n",
                       "n.rcl")
     value = {"spec": spec, "loc": Loc("f", 1, 2, 3, 4), "path": Path("a/b"), "half": Fraction(1, 2),
@@ -120,7 +120,7 @@ def test_the_loader_refuses_every_callable_that_is_not_a_kept_value_class() -> N
     forged = b"\x80\x04cfractions\nFraction\n\x8c\x0b1e999999999\x85R."
     with pytest.raises(pickle.UnpicklingError):
         SafeUnpickler(io.BytesIO(forged)).load()
-    assert safeload.allowed("rclverify.rcl.ast", "Loc") is Loc
+    assert safeload.allowed("rclverify.lang.ast", "Loc") is Loc
 
 
 @pytest.fixture(scope="module")
@@ -162,12 +162,12 @@ def test_a_poisoned_cache_is_never_executed_by_any_command(verified: tuple[Path,
     assert _poison_templates(cache, payloads[0]) >= 5
     before = (ws / "reports/assurance.json").read_text()
 
-    r = _run(ws, tmp, sys.executable, "-m", "rclverify.cli", "report")
+    r = _run(ws, tmp, sys.executable, "-m", "rclverify.cli.commands", "report")
     assert r.returncode == 0 and "reports/assurance.html" in r.stdout, r.stdout + r.stderr
     assert not marker.exists()
-    r = _run(ws, tmp, sys.executable, "-m", "rclverify.cli", "status")
+    r = _run(ws, tmp, sys.executable, "-m", "rclverify.cli.commands", "status")
     assert r.returncode == 0 and "MotorDriver assumes `0.5 <= in.speed_cmd`" in r.stdout, r.stdout + r.stderr
-    r = _run(ws, tmp, sys.executable, "-m", "rclverify.cli", "explain", "MotorDriver.sc1")
+    r = _run(ws, tmp, sys.executable, "-m", "rclverify.cli.commands", "explain", "MotorDriver.sc1")
     assert r.returncode == 0 and "counterexample" in r.stdout.lower() and "repair" in r.stdout.lower(), r.stdout
     assert not marker.exists()
     workspace = cache / "workspace.pickle"  # poisoned again: `report` above may have rewritten it

@@ -1,4 +1,4 @@
-"""The cache layer (rclverify.cache): one keying function, one file format, one rule of what is
+"""The cache layer (rclverify.core.cache): one keying function, one file format, one rule of what is
 kept.  A kept file from other code, damaged or truncated reads as empty; a run keeps what it used."""
 from __future__ import annotations
 
@@ -9,8 +9,8 @@ from pathlib import Path
 
 import pytest
 
-from rclverify.cache import Blobs, Keyer, Shelf, kept_files, read_stream, salt, write_stream
-from rclverify.cache.keys import fingerprint
+from rclverify.core.cache import Blobs, Keyer, Shelf, kept_files, read_stream, salt, write_stream
+from rclverify.core.cache.keys import fingerprint
 
 
 def test_keys_differ_for_different_contents_kinds_and_salts() -> None:
@@ -106,12 +106,12 @@ def test_rclverify_cache_lists_and_clears(tmp_path: Path) -> None:
     rows = {r["file"]: r for r in kept_files(tmp_path)}
     assert rows["artifacts/cache/x.pickle"]["current"] and rows["artifacts/cache/x.pickle"]["kind"] == "x"
     assert rows["artifacts/cache/old.json"]["current"] is False
-    run = [sys.executable, "-m", "rclverify.cli", "cache", "-w", str(tmp_path)]
+    run = [sys.executable, "-m", "rclverify.cli.commands", "cache", "-w", str(tmp_path)]
     out = subprocess.run(run, capture_output=True, text=True, timeout=60)
     assert out.returncode == 0 and "x.pickle" in out.stdout and "other code: not used" in out.stdout
     out = subprocess.run(run + ["--clear"], capture_output=True, text=True, timeout=60)
     assert out.returncode == 0 and not (tmp_path / "artifacts" / "cache").exists()
-    missing = subprocess.run([sys.executable, "-m", "rclverify.cli", "cache", "-w", str(tmp_path / "nope")],
+    missing = subprocess.run([sys.executable, "-m", "rclverify.cli.commands", "cache", "-w", str(tmp_path / "nope")],
                              capture_output=True, text=True, timeout=60)
     assert missing.returncode == 1 and "no such workspace directory" in missing.stderr
     assert "Traceback" not in missing.stderr

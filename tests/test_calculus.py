@@ -7,9 +7,9 @@ from pathlib import Path
 import pytest
 
 from rclverify.calculus.compose import compose_node, conjuncts, split_assumption
-from rclverify.rcl.parser import parse_formula, parse_text
-from rclverify.rcl.typecheck import check, load
-from rclverify.system.model import build
+from rclverify.lang.parser import parse_formula, parse_text
+from rclverify.lang.typecheck import check, load
+from rclverify.model.system.model import build
 
 ROOT = Path(__file__).resolve().parents[1]
 ROVER = Path(__file__).parent / "data" / "rover_navigation.rcl"

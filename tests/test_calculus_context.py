@@ -15,10 +15,10 @@ from hypothesis import strategies as st
 from _chain import chain_rcl
 from rclverify.calculus.compose import IN_CONTEXT, compose_node, split_assumption
 from rclverify.calculus.context import ConeContext, opened_links
-from rclverify.logic import world
-from rclverify.rcl.parser import parse_formula, parse_text
-from rclverify.rcl.typecheck import check
-from rclverify.system.model import build
+from rclverify.semantics import world
+from rclverify.lang.parser import parse_formula, parse_text
+from rclverify.lang.typecheck import check
+from rclverify.model.system.model import build
 
 X0 = {"N0": [parse_formula("0 <= in.x0 and in.x0 <= 50")]}
 
@@ -217,7 +217,7 @@ def test_in_context_verdict_equals_brute_force_enumeration(seed: int) -> None:
         ctx = ConeContext(checked, model, n, lambda m: split_assumption(checked, model, m)[1], facts)
         by_text = {t: f for t, f in a}
         for c in internal:
-            from rclverify.rcl.printer import expr_to_rcl
+            from rclverify.lang.printer import expr_to_rcl
             goal = by_text[expr_to_rcl(c)]
             r = ctx.decide(c, "oracle", 5000)
             # the encoder's way (every formula through the Z3 API) decides the same

@@ -16,10 +16,10 @@ from _chain import chain_rcl
 from rclverify.calculus.compose import IN_CONTEXT, compose_node, environment_conjuncts
 from rclverify.calculus.context import ConeContext
 from rclverify.calculus.summary import summary_of
-from rclverify.logic import world
-from rclverify.rcl.parser import parse_formula, parse_text
-from rclverify.rcl.typecheck import check
-from rclverify.system.model import build
+from rclverify.semantics import world
+from rclverify.lang.parser import parse_formula, parse_text
+from rclverify.lang.typecheck import check
+from rclverify.model.system.model import build
 
 X0 = {"N0": [parse_formula("0 <= in.x0 and in.x0 <= 50")]}
 

@@ -1,4 +1,4 @@
-"""Candidate points (``logic/candidates.py``): the double reading's verdict on quantifiers over
+"""Candidate points (``semantics/candidates.py``): the double reading's verdict on quantifiers over
 unbounded ``REAL``/``INTEGER``/``NATURAL`` domains, against two independent oracles on small
 random tables: brute-force enumeration of each quantified variable over a dense explicit grid
 (every breakpoint here is a multiple of 1/2 in [-3, 3], so a grid of sixths over [-4, 4] has
@@ -13,12 +13,12 @@ from fractions import Fraction
 
 from hypothesis import example, given, settings, strategies as st
 
-from rclverify.logic import floatsem
-from rclverify.logic.concrete import check_concrete
-from rclverify.rcl import ast
-from rclverify.rcl.parser import parse_text
-from rclverify.rcl.typecheck import check
-from rclverify.values import FiniteFunction, Term
+from rclverify.semantics import floatsem
+from rclverify.semantics.concrete import check_concrete
+from rclverify.lang import ast
+from rclverify.lang.parser import parse_text
+from rclverify.lang.typecheck import check
+from rclverify.semantics.values import FiniteFunction, Term
 
 CLAUSES = [
     "forall(x in REAL | in.f(x) <= in.n)",
@@ -147,7 +147,7 @@ def test_the_double_reading_of_the_case_studys_recorded_runs_decides_more_and_ne
 
     from rclverify.backends.monitors.check import NodeMonitor
     from rclverify.backends.monitors.config import load_mapping
-    from rclverify.pipeline import Workspace
+    from rclverify.app.pipeline import Workspace
     from rclverify.traces import read_trace
 
     repo = Path(__file__).resolve().parents[1]

@@ -12,11 +12,11 @@ from pathlib import Path
 import pytest
 import z3
 
-from rclverify.logic import world
-from rclverify.logic.nicemodel import nicer_model, short
+from rclverify.semantics import world
+from rclverify.semantics.nicemodel import nicer_model, short
 from rclverify.report.cex_cone import side_condition_view, trace_view
-from rclverify.requirements.check import check_requirement as _check_requirement
-from rclverify.workspace import Workspace
+from rclverify.calculus.requirements.check import check_requirement as _check_requirement
+from rclverify.stages.workspace import Workspace
 
 REPO = Path(__file__).resolve().parents[1]
 
@@ -119,7 +119,7 @@ def robot(tmp_path_factory: pytest.TempPathFactory) -> dict[str, dict]:
 
 
 def check_requirement(*args: object, **kw: object) -> dict:
-    """As the requirements stage checks one (requirements/stage.py): in a fresh Z3 context, so the
+    """As the requirements stage checks one (stages/requirements.py): in a fresh Z3 context, so the
     counterexample is the one a run shows whichever test ran before in this process."""
     world.fresh()
     return _check_requirement(*args, **kw)  # type: ignore[arg-type]

@@ -9,8 +9,8 @@ from pathlib import Path
 
 import pytest
 
-from rclverify.cli import main
-from rclverify.rcl.parser import parse_file, parse_text
+from rclverify.cli.commands import main
+from rclverify.lang.parser import parse_file, parse_text
 
 ROOT = Path(__file__).resolve().parents[1]
 CASE_STUDY = ROOT / "contracts" / "remote_inspection.rcl"
@@ -154,7 +154,7 @@ def test_refines_is_wired(capsys: pytest.CaptureFixture[str]) -> None:
 # ---------------------------------------------------------------------------
 
 def test_console_script_prints_no_traceback() -> None:
-    proc = subprocess.run([sys.executable, "-m", "rclverify.cli", "check", str(BAD)],
+    proc = subprocess.run([sys.executable, "-m", "rclverify.cli.commands", "check", str(BAD)],
                           capture_output=True, text=True, timeout=120, cwd=ROOT)
     assert proc.returncode == 1
     assert "Traceback" not in proc.stderr and proc.stdout == ""

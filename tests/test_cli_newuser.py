@@ -16,7 +16,7 @@ from typing import Any
 
 import pytest
 
-from rclverify.cli import main
+from rclverify.cli.commands import main
 
 ROOT = Path(__file__).resolve().parents[1]
 SRC = ROOT / "src"
@@ -153,7 +153,7 @@ def test_a_broken_summary_ends_doit_verify_in_one_line_not_a_traceback(drone: Pa
     ws = tmp_path / "ws"
     shutil.copytree(drone, ws)
     (ws / "artifacts/report/summary.json").write_text("[]", encoding="utf-8")
-    r = _run(ws, "-m", "rclverify.cli", "status")
+    r = _run(ws, "-m", "rclverify.cli.commands", "status")
     assert r.returncode == 1 and "Traceback" not in r.stderr
     assert r.stderr.strip() == f"{Path('artifacts/report/summary.json')}:1:1: error: summary record is not a JSON " \
                                "object: altered outside rclverify; run `rclverify verify` (or `doit verify`) to write it again"
@@ -192,7 +192,7 @@ def test_strict_ends_in_one_sentence_naming_why(grounded: tuple[Path, subprocess
                     "BatteryMonitor.g1, BatteryMonitor.g2, Geofence.g1, Geofence.g2, ...; 2 formal requirements are "
                     "not met (SAFE-ALT, REQ2); 2 ROS grounding errors "
                     "(`rclverify ros check`) (reports/assurance.html)."), last
-    r2 = _run(ws, "-m", "rclverify.cli", "verify", "--strict")
+    r2 = _run(ws, "-m", "rclverify.cli.commands", "verify", "--strict")
     assert r2.returncode == 1 and r2.stdout.rstrip().splitlines()[-1] == last
     assert "TaskFailed" not in r2.stdout + r2.stderr
 
@@ -280,7 +280,7 @@ def test_a_no_op_run_prints_the_table_and_the_docs_say_so(drone: Path) -> None:
 def test_the_command_reference_lists_every_ros_command() -> None:
     import argparse
 
-    from rclverify.ros.cli import add_parsers
+    from rclverify.cli.ros import add_parsers
     sub = argparse.ArgumentParser().add_subparsers(dest="command")
     add_parsers(sub)
     ros = sub.choices["ros"]

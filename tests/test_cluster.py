@@ -64,7 +64,7 @@ def _workspace(path: Path) -> Path:
     (path / "backends" / "hoare" / "clamp.imp").write_text(CLAMP)
     # a review record not filled in yet: its two obligations are pending
     from rclverify.backends.review.blank import blank_record
-    from rclverify.rcl.typecheck import load
+    from rclverify.lang.typecheck import load
     (path / "backends" / "review").mkdir(parents=True)
     node = load([path / "contracts" / "system.rcl"]).nodes["N1"]
     (path / "backends" / "review" / "n1.yaml").write_text(blank_record(node, path))
@@ -73,7 +73,7 @@ def _workspace(path: Path) -> Path:
 
 def _verify(ws: Path, *extra: str) -> subprocess.CompletedProcess[str]:
     env = {k: v for k, v in os.environ.items() if k != "RCLVERIFY_CLUSTER"}
-    return subprocess.run([sys.executable, "-m", "rclverify.cli", "verify", "-w", str(ws), *extra],
+    return subprocess.run([sys.executable, "-m", "rclverify.cli.commands", "verify", "-w", str(ws), *extra],
                           capture_output=True, text=True, timeout=300, env=env)
 
 
@@ -100,7 +100,7 @@ def test_evidence_from_a_local_cluster_equals_the_local_run(tmp_path: Path) -> N
         r = _verify(remote, "--cluster", cluster.scheduler_address)
         assert r.returncode == 0, r.stdout + r.stderr
     # the jobs ran on the cluster's worker (a thread of this process): it loaded the copy
-    from rclverify import cluster as rc
+    from rclverify.app import cluster as rc
     assert any(key[0] == str(remote.resolve()) for key in rc._WORKER_WORKSPACES)
     got, want = _evidence(remote), _evidence(local)
     assert set(got) == set(want) and len(want) == 5
@@ -117,8 +117,8 @@ def test_evidence_from_a_local_cluster_equals_the_local_run(tmp_path: Path) -> N
 def test_unreachable_cluster_fails_the_job_with_one_message(tmp_path: Path) -> None:
     ws = _workspace(tmp_path / "ws")
     env = {**os.environ, "RCLVERIFY_CLUSTER": "tcp://127.0.0.1:9"}
-    code = ("import rclverify.cluster as c; c.CONNECT_TIMEOUT_S = 2; "
-            "from rclverify.cli import main; raise SystemExit(main(['verify', '-w', %r]))" % str(ws))
+    code = ("import rclverify.app.cluster as c; c.CONNECT_TIMEOUT_S = 2; "
+            "from rclverify.cli.commands import main; raise SystemExit(main(['verify', '-w', %r]))" % str(ws))
     r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300, env=env)
     assert r.returncode != 0
     assert "cannot reach the Dask scheduler at tcp://127.0.0.1:9" in r.stdout + r.stderr

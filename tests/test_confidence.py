@@ -10,10 +10,10 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from rclverify.argument.confidence import Premise, claim, cones, derived_claims, requirement_claim
-from rclverify.argument.strength import BACKEND_KIND, KINDS, evidence_strength, one_sided_bound
-from rclverify.cli import main
-from rclverify.plan.entries import BACKEND_NAMES
+from rclverify.report.argument.confidence import Premise, claim, cones, derived_claims, requirement_claim
+from rclverify.report.argument.strength import BACKEND_KIND, KINDS, evidence_strength, one_sided_bound
+from rclverify.cli.commands import main
+from rclverify.model.plan.entries import BACKEND_NAMES
 
 IDENTITY = "var x : REAL;\nvar y : REAL;\n\ny := x\n"
 EVIDENCE = """nodes:
@@ -150,7 +150,7 @@ def test_a_required_strength_the_evidence_lacks_fails_strict(ws: Path, tmp_path:
 
 
 def test_hoare_conditions_are_decided_by_both_solvers(ws: Path, tmp_path: Path) -> None:
-    from rclverify.crosscheck.stage import stage_crosscheck
+    from rclverify.stages.crosscheck.stage import stage_crosscheck
     r = json.loads((ws / "reports/assurance.json").read_text())
     hoare = [e for e in r["evidence"] if e["backend"] == "hoare"]
     assert hoare and all(e["solvers"]["agreement"] == "two solvers" for e in hoare)
@@ -173,7 +173,7 @@ def test_a_side_condition_read_from_cone_summaries_is_not_two_solvers() -> None:
     """cvc5 decides only the last query of a side condition discharged from its producers' cone summaries
     (calculus/summary.py): each summary was proved implied by its cone by Z3 alone, so the proof is not
     one two solvers agreed on (its doubt must not be the two-solver one)."""
-    from rclverify.argument.strength import DOUBT, side_condition_strength
+    from rclverify.report.argument.strength import DOUBT, side_condition_strength
     sc = {"status": "discharged", "solvers": {"agreement": "two solvers"}, "context": {"summaries": ["Planner"]}}
     s = side_condition_strength(sc)
     assert s["solvers"] == 1 and s["doubt"] == DOUBT["proof"] and "summaries" in s["detail"], s

@@ -10,8 +10,8 @@ from hypothesis import strategies as st
 
 from rclverify.backends.property_tests.coverage import BUCKETS, Coverage
 from rclverify.backends.property_tests.strategies import Bound
-from rclverify.rcl.parser import parse_text
-from rclverify.rcl.typecheck import check
+from rclverify.lang.parser import parse_text
+from rclverify.lang.typecheck import check
 
 NODE = check([parse_text("""
 context { Mode : {idle, run, stop} ; }

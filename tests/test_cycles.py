@@ -1,4 +1,4 @@
-"""Johnson's elementary cycles (system/cycles.py) against brute force and networkx."""
+"""Johnson's elementary cycles (model/system/cycles.py) against brute force and networkx."""
 from __future__ import annotations
 
 import itertools
@@ -6,7 +6,7 @@ import random
 
 import pytest
 
-from rclverify.system.cycles import elementary_cycles
+from rclverify.model.system.cycles import elementary_cycles
 
 
 def _canonical(cycles: list[list[int]]) -> list[tuple[int, ...]]:

@@ -18,9 +18,9 @@ from rclverify.backends.dafny.runner import find_dafny, parse_output, scan_imple
 from rclverify.backends.dafny.stubgen import clause_lines
 from rclverify.backends.dafny.translate import Translator, real_literal
 from rclverify.calculus.refinement import check_refinement, merge_envs, refines_main
-from rclverify.plan.errors import PlanError
-from rclverify.rcl.parser import parse_formula
-from rclverify.rcl.typecheck import load
+from rclverify.model.plan.errors import PlanError
+from rclverify.lang.parser import parse_formula
+from rclverify.lang.typecheck import load
 
 REPO = Path(__file__).resolve().parents[1]
 CASE_STUDY = REPO / "contracts" / "remote_inspection.rcl"
@@ -409,8 +409,8 @@ node n { inputs(a : INTEGER, p : (REAL, REAL)) outputs(o : <NATURAL>)
 def test_qualified_builtins_and_tuple_literals_translate_to_dafny_that_resolves(tmp_path: Path) -> None:
     import subprocess
 
-    from rclverify.rcl.parser import parse_text
-    from rclverify.rcl.typecheck import check
+    from rclverify.lang.parser import parse_text
+    from rclverify.lang.typecheck import check
     spec = parse_text(TUPLES)
     c = check([spec])
     tr = Translator(c.env, c.nodes["n"], {"in.a": "a", "in.p": "p", "out.o": "o"})
@@ -446,8 +446,8 @@ node n { inputs(a : INTEGER, p : set(Pair), c : STRING, r : REAL) outputs(o : <N
 def test_strings_ranges_and_tuple_binders_translate_to_dafny_that_resolves(tmp_path: Path) -> None:
     import subprocess
 
-    from rclverify.rcl.parser import parse_text
-    from rclverify.rcl.typecheck import check
+    from rclverify.lang.parser import parse_text
+    from rclverify.lang.typecheck import check
     spec = parse_text(LANGUAGE)
     c = check([spec])
     tr = Translator(c.env, c.nodes["n"], {"in.a": "a", "in.p": "p", "in.c": "c", "in.r": "r", "out.o": "o"})

@@ -17,9 +17,9 @@ import pytest
 
 from rclverify.backends.monitors.check import check_trace
 from rclverify.backends.monitors.dds_calls import CallBook, link_view, replay
-from rclverify.backends.monitors.dds_enforce import EnforceUsage, judge, parse_enforce
+from rclverify.runtime.enforce import EnforceUsage, judge, parse_enforce
 from rclverify.backends.monitors.online import OnlineEngine
-from rclverify.rcl.typecheck import load
+from rclverify.lang.typecheck import load
 from rclverify.traces import read_trace
 from rclverify.traces.events import Event
 
@@ -136,7 +136,7 @@ def test_the_gate_fails_closed_on_an_input_it_cannot_judge_against() -> None:
     1.0), 5.0 after ``limit = +inf`` blocked as violated with ``in.limit: 1.0``.
     Both are held back as inconclusive now, naming the input; a valid limit
     after it is judged again; ``@open`` releases what cannot be decided."""
-    from rclverify.backends.monitors.dds_enforce import fail_open
+    from rclverify.runtime.enforce import fail_open
     eng = _engine()
     ev = lambda k, topic, v: Event(k, float(k), topic, {"data": v}, f"m{k}")  # noqa: E731
     eng.push("limit", {"data": 1.0}, 1.0)
@@ -156,8 +156,8 @@ def test_the_gate_fails_closed_on_an_input_it_cannot_judge_against() -> None:
 @pytest.mark.parametrize("storage", ["sqlite3", "mcap"])
 def test_a_recorded_bag_reads_back_with_the_live_times(storage: str, tmp_path: Path) -> None:
     pytest.importorskip("cyclonedds", reason="the cyclonedds binding is not installed")
-    from rclverify.backends.monitors.dds_bag import BagError, BagRecorder
-    from rclverify.backends.monitors.dds_types import TypeBook
+    from rclverify.runtime.dds.bag import BagError, BagRecorder
+    from rclverify.runtime.dds.types import TypeBook
     book = TypeBook([])
     F64 = book.message("std_msgs/Float64")
     rec = BagRecorder(tmp_path / "run", storage, {"limit": "std_msgs/Float64", "speed": "std_msgs/Float64"}, [])
@@ -184,7 +184,7 @@ def test_a_recorded_bag_reads_back_with_the_live_times(storage: str, tmp_path: P
 # -- calls without identity (rmw_fastrtps: docs/monitors.md, "Services and actions over DDS") --------------
 
 def test_the_order_pairs_only_what_it_makes_certain() -> None:
-    from rclverify.backends.monitors.dds_order import OrderPairer, Pending
+    from rclverify.runtime.dds.order import OrderPairer, Pending
     p = OrderPairer("/estop")
     a, b, c, d = (Pending(("w", "a", k), t, f"call {k}") for k, t in ((1, 1.0), (2, 2.0), (3, 2.1), (4, 5.0)))
     p.request(a)
@@ -228,8 +228,8 @@ def test_an_unpaired_call_is_inconclusive_and_replays() -> None:
 
 def _taps(lines: list[dict[str, Any]]) -> tuple[Any, Any]:
     pytest.importorskip("cyclonedds", reason="the cyclonedds binding is not installed")
-    from rclverify.backends.monitors.dds_services import CallTaps
-    from rclverify.backends.monitors.dds_types import TypeBook
+    from rclverify.runtime.dds.services import CallTaps
+    from rclverify.runtime.dds.types import TypeBook
     types = TypeBook([WS / "interfaces"])
     return CallTaps(_book(lines), types, LINKS, framed=False), types
 
@@ -262,7 +262,7 @@ def test_plain_samples_are_taken_in_stamp_order_and_checked_by_vendor() -> None:
 def test_introspection_events_pair_concurrent_calls_exactly() -> None:
     from types import SimpleNamespace
 
-    from rclverify.backends.monitors.dds_introspection import event_side, event_struct
+    from rclverify.runtime.dds.introspection import event_side, event_struct
     lines: list[dict[str, Any]] = []
     taps, types = _taps(lines)
     ev = event_struct(types, "std_srvs/SetBool")
@@ -320,7 +320,7 @@ def test_a_shadow_reply_writer_exists_only_while_a_real_server_does() -> None:
     more reader than reply writers), nor may its shadow fake a server when none is there."""
     from types import SimpleNamespace
 
-    from rclverify.backends.monitors.dds_shadow import SHADOW, Shadows
+    from rclverify.runtime.dds.shadow import SHADOW, Shadows
     made: list[str] = []
     dropped: list[str] = []
     servers: list[Any] = []

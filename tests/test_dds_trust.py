@@ -1,8 +1,8 @@
 """What a live run cannot vouch for keeps its evidence from ``discharged``
-(backends/monitors/dds_trust.py, issue 47)."""
+(runtime/dds/trust.py, issue 47)."""
 from __future__ import annotations
 
-from rclverify.backends.monitors.dds_trust import VERDICT_KEY, downgrade, reasons_for
+from rclverify.runtime.dds.trust import VERDICT_KEY, downgrade, reasons_for
 
 
 def _nodes() -> list[dict]:

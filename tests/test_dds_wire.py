@@ -1,7 +1,7 @@
 """ROS 2's wire conventions as rclverify speaks them over DDS, each checked
 against an independent oracle (docs/monitors.md, "ROS 2 over DDS"):
 
-* the CDR of the structs made at run time (:mod:`rclverify.backends.monitors.dds_types`)
+* the CDR of the structs made at run time (:mod:`rclverify.runtime.dds.types`)
   equals rosbags' CDR, which rosbag2 stores, byte for byte, on random
   messages of standard and workspace types; rmw_cyclonedds' request header
   is the 16 bytes it writes before the request (``serdata.cpp``);
@@ -23,9 +23,9 @@ import pytest
 
 pytest.importorskip("cyclonedds", reason="the cyclonedds binding is not installed (pip install cyclonedds)")
 
-from rclverify.backends.monitors.dds_types import DdsTypeError, TypeBook, request_id, to_fields  # noqa: E402
-from rclverify.ros import dds  # noqa: E402
-from rclverify.ros.dds_qos import (DURABILITY, INFINITE_NS, LIVELINESS, XCDR1, XCDR2, QosProfile,  # noqa: E402
+from rclverify.runtime.dds.types import DdsTypeError, TypeBook, request_id, to_fields  # noqa: E402
+from rclverify.ros.live import dds  # noqa: E402
+from rclverify.ros.live.dds_qos import (DURABILITY, INFINITE_NS, LIVELINESS, XCDR1, XCDR2, QosProfile,  # noqa: E402
                                    from_dds, mismatches, reader_for, to_dds)
 from rclverify.traces.bag import typestore  # noqa: E402
 
@@ -276,7 +276,7 @@ def test_a_layout_difference_names_the_field() -> None:
     from cyclonedds.idl import make_idl_struct
     from cyclonedds.idl import types as T
 
-    from rclverify.backends.monitors.dds_layout import difference, shape
+    from rclverify.runtime.dds.layout import difference, shape
     book = TypeBook([])
     mine = shape(book.message("geometry_msgs/PoseWithCovarianceStamped"))
     point = make_idl_struct("Point_", "x::Point_", {"x": T.float64, "y": T.float64, "z": str})
@@ -320,7 +320,7 @@ def test_the_bag_is_written_from_its_own_thread(tmp_path: Path) -> None:
 
     from rosbags.highlevel import AnyReader
 
-    from rclverify.backends.monitors.dds_bag import BagRecorder
+    from rclverify.runtime.dds.bag import BagRecorder
     book = TypeBook([])
     F = book.message("std_msgs/Float64")
     rec = BagRecorder(tmp_path / "bag", "sqlite3", {"/x": "std_msgs/Float64"}, [])

@@ -10,9 +10,9 @@ from pathlib import Path
 import pytest
 
 from rclverify.backends.monitors.deadlines import DeadlineMonitor, check_deadlines, deadline_status
-from rclverify.cli import main
-from rclverify.rcl.parser import parse_text
-from rclverify.rcl.typecheck import check
+from rclverify.cli.commands import main
+from rclverify.lang.parser import parse_text
+from rclverify.lang.typecheck import check
 from rclverify.traces import read_trace
 from rclverify.traces.events import Event
 

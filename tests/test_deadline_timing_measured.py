@@ -10,7 +10,7 @@ from typing import Any
 
 import pytest
 
-from rclverify.cli import main
+from rclverify.cli.commands import main
 
 RELAY = """node Relay {
   inputs( x : BOOL )

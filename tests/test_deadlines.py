@@ -1,4 +1,4 @@
-"""Rules S1 and D1-D3 (docs/architecture.md, "Services, actions and
+"""Rules S1 and D1-D3 (docs/decisions.md, "Services, actions and
 deadlines"): service links in the system model, deadlines adding along a
 path, the end-to-end deadline decided by Z3 with the chain named."""
 from __future__ import annotations
@@ -11,11 +11,11 @@ from pathlib import Path
 import pytest
 
 from rclverify.calculus.deadlines import INCONCLUSIVE, PROVED, REFUTED, chains, decide
-from rclverify.cli import main
-from rclverify.rcl.errors import RclError
-from rclverify.rcl.parser import parse_text
-from rclverify.rcl.typecheck import check
-from rclverify.system.model import build
+from rclverify.cli.commands import main
+from rclverify.lang.errors import RclError
+from rclverify.lang.parser import parse_text
+from rclverify.lang.typecheck import check
+from rclverify.model.system.model import build
 
 REPO = Path(__file__).resolve().parents[1]
 EXAMPLE = REPO / "examples" / "safety_stop"

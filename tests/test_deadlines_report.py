@@ -13,7 +13,7 @@ from typing import Any
 
 import pytest
 
-from rclverify.cli import main
+from rclverify.cli.commands import main
 
 EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "safety_stop"
 

@@ -4,7 +4,7 @@
 the monitors (backends/monitors/declarations.py), the verdict rows are
 carried by the evidence records, and a requirement whose proof uses a
 declaration reads ``met`` once the declaration's evidence is discharged
-(requirements/rollup.py).  A two-node robot (Planner sends the goal on as
+(calculus/requirements/rollup.py).  A two-node robot (Planner sends the goal on as
 Base's target, Base drives there and reports its pose; Base publishes its
 initial pose, answers within one step and refreshes its pose every 100 ms)
 is green under ``rclverify verify --strict``; a run with a 260 ms gap in the
@@ -23,10 +23,10 @@ import pytest
 
 from rclverify.backends.monitors.declarations import check_declarations
 from rclverify.backends.monitors.periods import check_periods
-from rclverify.cli import main
-from rclverify.rcl.parser import parse_text
-from rclverify.rcl.typecheck import check
-from rclverify.requirements.rollup import declaration_statuses, roll_up
+from rclverify.cli.commands import main
+from rclverify.lang.parser import parse_text
+from rclverify.lang.typecheck import check
+from rclverify.calculus.requirements.rollup import declaration_statuses, roll_up
 from rclverify.traces.events import Event
 from rclverify.traces.mapping import TopicRule
 
@@ -324,7 +324,7 @@ def test_the_monitor_command_and_the_live_run_judge_them_as_the_backend(verified
     over) give the rows the backend's record has; the offline command on the
     live run's log gives them again (live = offline)."""
     from rclverify.backends.monitors.config import load_mapping
-    from rclverify.backends.monitors.live import LiveRun
+    from rclverify.runtime.live import LiveRun
     checked = check([parse_text(RCL, "r.rcl")])
     for variant, code in (("correct", 0), ("late", 1)):
         ws = verified[variant][2]
@@ -376,7 +376,7 @@ def test_the_property_tests_judge_progress_and_the_initial_value(tmp_path: Path)
 # ---- declarations that follow from others ------------------------------------------------------------------------
 
 def test_an_initial_value_that_follows_from_another_rests_on_it() -> None:
-    from rclverify.requirements.declared_proof import initial_support
+    from rclverify.calculus.requirements.declared_proof import initial_support
     c = _checked("  initially( out.pose == 0 )\n  initially( out.pose <= 3 )\n  initially( out.pose * out.pose >= 0 )\n")
     node = c.nodes["Base"]
     assert initial_support(c, node, 2) == [1]  # pose == 0 entails pose <= 3
@@ -394,7 +394,7 @@ def test_an_initial_value_that_follows_from_another_rests_on_it() -> None:
 def test_entailment_of_initial_values_agrees_with_enumeration() -> None:
     """Random clauses over an output bounded by clause 1: Z3's entailment
     (initial_support) against the values -2..8 enumerated."""
-    from rclverify.requirements.declared_proof import initial_support
+    from rclverify.calculus.requirements.declared_proof import initial_support
     rnd = random.Random(640)
     ops = {"<=": lambda x, a: x <= a, ">=": lambda x, a: x >= a, "==": lambda x, a: x == a,
            "!=": lambda x, a: x != a, "<": lambda x, a: x < a}

@@ -1,5 +1,5 @@
 """Deterministic queries: the answer depends on the query only, not on the
-Z3 work the process did before (logic/retry.py ``load_canonical``)."""
+Z3 work the process did before (semantics/retry.py ``load_canonical``)."""
 from __future__ import annotations
 
 import itertools
@@ -10,8 +10,8 @@ from pathlib import Path
 
 import z3
 
-from rclverify.logic.query import prove
-from rclverify.logic.retry import TABLES, canonical_smt2, expand_finite
+from rclverify.semantics.query import prove
+from rclverify.semantics.retry import TABLES, canonical_smt2, expand_finite
 
 ROOT = Path(__file__).resolve().parents[1]
 _NOISE = itertools.count()
@@ -19,7 +19,7 @@ _NOISE = itertools.count()
 _REPLACEMENT = """
 import json, sys
 from pathlib import Path
-from rclverify.pipeline import Workspace, replacement_finding
+from rclverify.app.pipeline import Workspace, replacement_finding
 f = replacement_finding(Workspace(Path(sys.argv[1])), "Agent")
 print(json.dumps({"status": f.status, "message": f.message, "model": f.model, "explanation": f.explanation},
                  sort_keys=True))
@@ -41,7 +41,7 @@ def _unrelated_z3_work() -> None:
 
 
 def _replacement_here() -> dict[str, object]:
-    from rclverify.pipeline import Workspace, replacement_finding
+    from rclverify.app.pipeline import Workspace, replacement_finding
     f = replacement_finding(Workspace(ROOT), "Agent")
     return {"status": f.status, "message": f.message, "model": f.model, "explanation": f.explanation}
 
@@ -176,12 +176,12 @@ def test_recursive_constructor_sets_are_not_split() -> None:
 
 
 def test_finite_expansion_of_shared_subterms_is_the_expansion_of_each() -> None:
-    """expand_finite expands each distinct subterm once (logic/retry.py): on formulas whose finite
+    """expand_finite expands each distinct subterm once (semantics/retry.py): on formulas whose finite
     quantifiers occur many times over (shared), the expansion of a conjunction is the conjunction of
     the expansions, term for term, and the result is equivalent to the formula."""
     import random
 
-    from rclverify.logic.retry import expand_finite
+    from rclverify.semantics.retry import expand_finite
     S, (a, b, _c) = z3.EnumSort("ShareS", ["sa", "sb", "sc"])
     x = z3.Int("x")
     rng = random.Random(7)

@@ -14,12 +14,12 @@ import jsonschema
 import pytest
 import z3
 
-from rclverify.cli import main
+from rclverify.cli.commands import main
 from rclverify.diagnosis.build import CACHE, diagnose
 from rclverify.diagnosis.table import counterexample_table, decimals, function_table
-from rclverify.values import decimal_text
+from rclverify.semantics.values import decimal_text
 from rclverify.diagnosis.text import natural_sorted
-from rclverify.pipeline import Workspace, stage_check, stage_compose, stage_export, stage_health, stage_run
+from rclverify.app.pipeline import Workspace, stage_check, stage_compose, stage_export, stage_health, stage_run
 from rclverify.report.build import build_report
 from rclverify.report.sarif import sarif_log
 
@@ -108,8 +108,8 @@ def test_rationals_are_decimals_where_exact() -> None:
     assert decimal_text(Fraction(1, 3)) is None
     assert decimals("move(1/5, 3/2) and 1/3") == "move(0.2, 1.5) and 1/3"
     # where models are printed: Z3 values and the Python values of traces and property tests
-    from rclverify.logic.encode import value_to_rcl
-    from rclverify.values import render
+    from rclverify.semantics.encode import value_to_rcl
+    from rclverify.semantics.values import render
     assert value_to_rcl(z3.RealVal("1/5")) == "0.2" and value_to_rcl(z3.RealVal("1/3")) == "1/3"
     assert render(Fraction(1, 5)) == "0.2" and render(Fraction(2, 3)) == "2/3"
 
@@ -300,7 +300,7 @@ def test_explain_and_status_read_the_last_run(newcomer: Path, capsys: pytest.Cap
     assert main(["status", "-w", str(newcomer)]) == 1  # no report yet: located error
     assert "no report yet" in capsys.readouterr().err
     ws, report = _run(newcomer)
-    from rclverify.pipeline import stage_report
+    from rclverify.app.pipeline import stage_report
     stage_report(ws, report=report)
     html = (newcomer / "reports" / "assurance.html").read_text(encoding="utf-8")
     assert 'id="diagnosis-Controller-sc2"' in html and "+  guarantee( 0 &lt;= out.speed and out.speed &lt;= 1.5 )" in html

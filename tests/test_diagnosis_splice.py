@@ -15,11 +15,11 @@ import pytest
 from rclverify.diagnosis import recheck
 from rclverify.diagnosis.edits import Edit
 from rclverify.diagnosis.splice import FULL, spliced_system
-from rclverify.rcl.errors import RclError
-from rclverify.rcl.parser import parse_text
-from rclverify.rcl.typecheck import check
-from rclverify.system.model import build
-from rclverify.workspace import Workspace
+from rclverify.lang.errors import RclError
+from rclverify.lang.parser import parse_text
+from rclverify.lang.typecheck import check
+from rclverify.model.system.model import build
+from rclverify.stages.workspace import Workspace
 
 A = """context {
   Mode : {idle, busy} ;

@@ -10,11 +10,11 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from rclverify.logic.concrete import check_concrete
-from rclverify.logic.evaluate import evaluate, why_undecided
-from rclverify.rcl.parser import parse_formula, parse_text
-from rclverify.rcl.typecheck import check
-from rclverify.values import FiniteFunction, Term
+from rclverify.semantics.concrete import check_concrete
+from rclverify.semantics.evaluate import evaluate, why_undecided
+from rclverify.lang.parser import parse_formula, parse_text
+from rclverify.lang.typecheck import check
+from rclverify.semantics.values import FiniteFunction, Term
 
 SIGNATURE = """
 context {
@@ -108,7 +108,7 @@ def formulas(draw: Any) -> str:
 
 
 def _outcome(f: Any, values: dict[str, Any], compiled: bool) -> Any:
-    from rclverify.logic.evaluate import Evaluator
+    from rclverify.semantics.evaluate import Evaluator
     ev = Evaluator(CHECKED, NODE, values)
     ev.compiled = compiled
     try:

@@ -6,9 +6,9 @@ from pathlib import Path
 
 import pytest
 
-from rclverify.evidence.records import SEVERITY, Evidence, Obligation, SourceRef, hash_inputs, \
+from rclverify.records.records import SEVERITY, Evidence, Obligation, SourceRef, hash_inputs, \
     make_obligation_id, worst
-from rclverify.evidence.store import EvidenceStore, atomic_write_text, read_obligations, write_obligations
+from rclverify.records.store import EvidenceStore, atomic_write_text, read_obligations, write_obligations
 
 
 def _obligation(**kw: object) -> Obligation:
@@ -112,7 +112,7 @@ def test_a_target_relates_artifact_paths_to_the_workspace_root(tmp_path: Path) -
     assert t2.rel(link / "artifacts" / "x" / "f.txt") == "artifacts/x/f.txt"
 
 
-# ---- the sealed text, encoded once (evidence/store.py: sealed_dumps) -------------------------------------
+# ---- the sealed text, encoded once (records/store.py: sealed_dumps) -------------------------------------
 
 from hypothesis import given, settings  # noqa: E402
 from hypothesis import strategies as st  # noqa: E402
@@ -129,6 +129,6 @@ def test_the_sealed_text_is_the_sealed_record_encoded(record: dict) -> None:
     """The seal's line spliced into the one encoding equals encoding the record with its seal: keys
     before and after the seal's, none after it, none at all, keys holding quotes, colons and the
     indentation of a key line."""
-    from rclverify.evidence.store import SEAL, dumps, seal_of, sealed_dumps
+    from rclverify.records.store import SEAL, dumps, seal_of, sealed_dumps
     record.pop(SEAL, None)
     assert sealed_dumps(record) == dumps({**record, SEAL: seal_of(record)})

@@ -28,7 +28,7 @@ nodes:
         max_examples: 30
 """
 DODO = """from pathlib import Path
-from rclverify.tasks import build_tasks, doit_config
+from rclverify.app.tasks import build_tasks, doit_config
 DOIT_CONFIG = doit_config()
 globals().update(build_tasks(Path(__file__).parent))
 """
@@ -55,7 +55,7 @@ def test_a_changed_helper_module_re_runs_the_property_tests(tmp_path: Path) -> N
     assert _verify(tmp_path) == ("discharged", "discharged")
     (tmp_path / "helper.py").write_text("def cap(x):\n    return 1000\n")  # the implementation itself untouched
     assert _verify(tmp_path) == ("failed", "failed")
-    from rclverify.evidence.store import read_obligations
+    from rclverify.records.store import read_obligations
     obligations = read_obligations(tmp_path / "artifacts/obligations/Agent.json")
     assert "helper.py" in obligations[0].inputs
 

@@ -51,7 +51,7 @@ import pytest
 from _example_report import changed as _changed, diag as _diag, first_repair as _first_repair, monitoring, \
     rows as _rows, verify as _verify
 
-from rclverify.cli import main
+from rclverify.cli.commands import main
 
 EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "delivery"
 FIXES = sorted((EXAMPLE / "fixes").glob("*.diff"))

@@ -11,11 +11,11 @@ from rclverify.backends.experiment.consistency import check
 from rclverify.backends.experiment.criterion import evaluate
 from rclverify.backends.experiment.figures import DataError, load_summary, load_trials, quantity
 from rclverify.backends.experiment.plot import render_svg
-from rclverify.evidence.store import EvidenceStore
-from rclverify.pipeline import Workspace, stage_check, stage_export, stage_run
-from rclverify.rcl.parser import parse_formula
+from rclverify.records.store import EvidenceStore
+from rclverify.app.pipeline import Workspace, stage_check, stage_export, stage_run
+from rclverify.lang.parser import parse_formula
 from rclverify.report.build import _evidence_extras
-from rclverify.tasks import act_check
+from rclverify.app.tasks import act_check
 
 from _evidence_ws import copy_workspace, plan_line, replace_in_plan
 

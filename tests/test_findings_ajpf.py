@@ -1,11 +1,11 @@
-"""Partial coverage of AJPF properties (backends/ajpf/coverage.py)."""
+"""Partial coverage of AJPF properties (backends/model_checking/ajpf/coverage.py)."""
 from __future__ import annotations
 
 from pathlib import Path
 
 import pytest
 
-from rclverify.backends.ajpf.backend import AjpfBackend
+from rclverify.backends.model_checking.ajpf.backend import AjpfBackend
 from test_ajpf import make_target
 
 

@@ -6,9 +6,9 @@ from fractions import Fraction
 
 from rclverify.calculus.compose import (VARIANT_AS_WRITTEN, VARIANT_WITH_ASSUMPTIONS, compose_node,
                                         instance_rule)
-from rclverify.rcl.parser import parse_text
-from rclverify.rcl.typecheck import check
-from rclverify.system.model import build
+from rclverify.lang.parser import parse_text
+from rclverify.lang.typecheck import check
+from rclverify.model.system.model import build
 
 PIPELINE = """
 node P {
@@ -122,7 +122,7 @@ def test_three_producers_feeding_one_node_give_an_r3_instance():
 
 def test_case_study_radiation_sensor_is_a_branch_of_the_agents_command():
     from pathlib import Path
-    from rclverify.rcl.typecheck import load
+    from rclverify.lang.typecheck import load
     checked = load([Path(__file__).resolve().parents[1] / "contracts" / "remote_inspection.rcl"])
     model = build(checked)
     assert compose_node(checked, model, "RadiationSensor").instances[0]["rule"] == "R2"

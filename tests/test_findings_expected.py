@@ -4,7 +4,7 @@ from __future__ import annotations
 from pathlib import Path
 from types import SimpleNamespace
 
-from rclverify.rcl.ast import Loc
+from rclverify.lang.ast import Loc
 from rclverify.report.expected import expected_rows
 
 

@@ -1,13 +1,13 @@
-"""Health findings about what guarantees constrain (health/shape.py)."""
+"""Health findings about what guarantees constrain (calculus/health/shape.py)."""
 from __future__ import annotations
 
 from pathlib import Path
 
-from rclverify.health.checks import check_node
-from rclverify.health.shape import shape_findings
-from rclverify.rcl.lint import lint
-from rclverify.rcl.parser import parse_text
-from rclverify.rcl.typecheck import check, load
+from rclverify.calculus.health.checks import check_node
+from rclverify.calculus.health.shape import shape_findings
+from rclverify.lang.lint import lint
+from rclverify.lang.parser import parse_text
+from rclverify.lang.typecheck import check, load
 
 TEXT = """
 node N {
@@ -81,7 +81,7 @@ def test_a_lone_tautological_conjunct_is_found():
 def test_validity_is_asked_only_of_a_conjunct_the_others_imply(monkeypatch):
     # a counterexample to "implied by the others" falsifies the conjunct alone too, so the
     # tautology query runs only for the conjuncts that are implied (or undecided)
-    from rclverify.health import shape
+    from rclverify.calculus.health import shape
     asked: list[str] = []
     real = shape.prove
 

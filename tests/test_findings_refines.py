@@ -7,9 +7,9 @@ from pathlib import Path
 import pytest
 
 from rclverify.calculus.refinement import check_refinement, merge_envs, refines_main
-from rclverify.rcl.errors import RclError
-from rclverify.rcl.parser import parse_formula, parse_text
-from rclverify.rcl.typecheck import check
+from rclverify.lang.errors import RclError
+from rclverify.lang.parser import parse_formula, parse_text
+from rclverify.lang.typecheck import check
 
 ORIGINAL = """
 node S {

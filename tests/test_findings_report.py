@@ -1,11 +1,11 @@
-"""Report summaries and the loop view (report/build.py, system/model.py)."""
+"""Report summaries and the loop view (report/build.py, model/system/model.py)."""
 from __future__ import annotations
 
 import random
 
-from rclverify.evidence.records import SEVERITY, worst
+from rclverify.records.records import SEVERITY, worst
 from rclverify.report.build import CONE_NAMES, ConeEvidence, _headline
-from rclverify.system.model import Link, SystemModel
+from rclverify.model.system.model import Link, SystemModel
 
 
 def test_headline_has_no_empty_fragments():

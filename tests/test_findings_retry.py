@@ -1,9 +1,9 @@
-"""Retries of unknown answers (logic/retry.py)."""
+"""Retries of unknown answers (semantics/retry.py)."""
 from __future__ import annotations
 
 import z3
 
-from rclverify.logic.retry import FINITE, MBQI, attempts, expand_finite
+from rclverify.semantics.retry import FINITE, MBQI, attempts, expand_finite
 
 
 def test_quantifiers_over_enumerations_are_written_out_equivalently():

@@ -11,11 +11,11 @@ from pathlib import Path
 import pytest
 from hypothesis import given, settings, strategies as st
 
-from rclverify.cli import main
-from rclverify.generate.pycarry import NOT_CARRIED
-from rclverify.logic.concrete import check_concrete
-from rclverify.pipeline import Workspace
-from rclverify.rcl.types import BOOL, EmptyT, FuncT, Scalar
+from rclverify.cli.commands import main
+from rclverify.tools.generate.pycarry import NOT_CARRIED
+from rclverify.semantics.concrete import check_concrete
+from rclverify.app.pipeline import Workspace
+from rclverify.lang.types import BOOL, EmptyT, FuncT, Scalar
 
 ROOT = Path(__file__).resolve().parents[1]
 WAREHOUSE = ROOT / "examples" / "warehouse"
@@ -151,8 +151,8 @@ _COMPUTED = {"LidarDriver": lambda v: {"out.obstacle": 1000.0 * v["in.range"]},
 
 def _messages(key: str, value, typ, rule) -> list[dict]:  # type: ignore[no-untyped-def]
     """The messages' fields carrying RCL ``value`` of ``typ`` under mapping ``rule``."""
-    from rclverify.rcl.types import DataT
-    from rclverify.values import FiniteFunction, Term
+    from rclverify.lang.types import DataT
+    from rclverify.semantics.values import FiniteFunction, Term
     fields = list(rule.fields) or ["data"]
     blank = dict.fromkeys(fields)  # a field the value does not use: None, which no rule takes
     if isinstance(value, Term):
@@ -339,7 +339,7 @@ def test_the_stream_agrees_with_the_monitor_engine_on_every_case_study_node(tree
 
 
 def _snake(name: str) -> str:
-    from rclverify.generate.typemap import snake
+    from rclverify.tools.generate.typemap import snake
     return snake(name)
 
 
@@ -347,7 +347,7 @@ def test_the_verdict_message_is_the_monitors(trees: dict) -> None:
     """The generated layer's message for rclverify/verdict has the monitor's fields (Verdict.to_json)
     and JSON form (live.dumps); node.py publishes it for a violation only."""
     import json
-    from rclverify.backends.monitors.live import dumps
+    from rclverify.runtime.live import dumps
     from rclverify.backends.monitors.verdicts import Verdict
     out = trees["warehouse"]
     layer = _load(out / "lidar_driver/lidar_driver/contract.py", "msg_contract_lidar")

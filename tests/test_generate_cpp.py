@@ -22,11 +22,11 @@ import pytest
 from hypothesis import Phase, example, given, settings, strategies as st
 
 from _step_judge import judge as step_judge
-from rclverify.cli import main
-from rclverify.logic.floatsem import holds_in
-from rclverify.pipeline import Workspace
-from rclverify.rcl.types import BOOL, REAL, DataT, EmptyT, EnumT, FuncT, Scalar
-from rclverify.values import FiniteFunction, Term
+from rclverify.cli.commands import main
+from rclverify.semantics.floatsem import holds_in
+from rclverify.app.pipeline import Workspace
+from rclverify.lang.types import BOOL, REAL, DataT, EmptyT, EnumT, FuncT, Scalar
+from rclverify.semantics.values import FiniteFunction, Term
 
 ROOT = Path(__file__).resolve().parents[1]
 CASES = {"warehouse": ROOT / "examples" / "warehouse", "case_study": ROOT}

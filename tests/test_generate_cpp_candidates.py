@@ -1,5 +1,5 @@
 """The generated C++ checks decide quantifiers over unbounded numeric domains at the same candidate
-points as rclverify's double reading (``logic/candidates.py``, ``generate/cpp_candidates.py``): the
+points as rclverify's double reading (``semantics/candidates.py``, ``tools/generate/cpp_candidates.py``): the
 contract of ``test_candidates.py`` (function tables, a constructor term, nested quantifiers,
 ``exists_unique`` over REAL, INTEGER and NATURAL, three clauses outside the fragment) compiled with
 ``g++ -std=c++17 -Wall -Wextra -Werror``, each clause's C++ truth on random tables equal to
@@ -15,9 +15,9 @@ from hypothesis import Phase, given, settings, strategies as st
 from test_candidates import CLAUSES, SHARP, TEXT, _values
 from test_generate_cpp import CXX, _run, _text
 
-from rclverify.cli import main
-from rclverify.logic.floatsem import holds_in
-from rclverify.pipeline import Workspace
+from rclverify.cli.commands import main
+from rclverify.semantics.floatsem import holds_in
+from rclverify.app.pipeline import Workspace
 
 pytestmark = pytest.mark.skipif(shutil.which("g++") is None, reason="g++ is not installed")
 

@@ -12,7 +12,7 @@ import subprocess
 import sys
 from pathlib import Path
 
-from rclverify.cli import main
+from rclverify.cli.commands import main
 
 EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "contracts_first"
 

@@ -1,7 +1,7 @@
 """``generate ros2`` and hostile RCL names (issue 63 row 10; docs/generate.md, "Names").
 
 An RCL identifier may end in primes (``x'``) and may be a Python or C++ keyword (``class``,
-``delete``, ``lambda``, ``None``, ``namespace``, ``int``).  Before generate/names.py the tree
+``delete``, ``lambda``, ``None``, ``namespace``, ``int``).  Before tools/generate/names.py the tree
 of such a contract did not compile (``def step(x', class)``, ``double delete{};``) and the
 command said 0.  Here:
 
@@ -30,9 +30,9 @@ import pytest
 import yaml
 
 from _ros2 import ros2_python
-from rclverify.cli import main
-from rclverify.generate.names import constant_name, field_name, msg_name, package_name, py_name
-from rclverify.ros.treesitter import parser, walk
+from rclverify.cli.commands import main
+from rclverify.tools.generate.names import constant_name, field_name, msg_name, package_name, py_name
+from rclverify.ros.extract.treesitter import parser, walk
 from _rclcpp_stub import write_stubs
 
 CXX = ["g++", "-std=c++17", "-Wall", "-Wextra", "-Werror", "-fsyntax-only"]

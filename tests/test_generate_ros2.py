@@ -12,10 +12,10 @@ import pytest
 from rosbags.typesys import get_types_from_msg
 from rosbags.interfaces import Nodetype
 
-from rclverify.cli import main
-from rclverify.generate.writer import GENERATED, ONCE
-from rclverify.pipeline import Workspace
-from rclverify.ros.treesitter import parser, walk
+from rclverify.cli.commands import main
+from rclverify.tools.generate.writer import GENERATED, ONCE
+from rclverify.app.pipeline import Workspace
+from rclverify.ros.extract.treesitter import parser, walk
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -290,7 +290,7 @@ def _diff_values(cn):  # type: ignore[no-untyped-def]
     """Values of node ``cn``'s inputs and outputs by their types, any subset of them (missing ones too)."""
     from hypothesis import strategies as st
 
-    from rclverify.rcl.types import EnumT, Scalar
+    from rclverify.lang.types import EnumT, Scalar
     real = st.sampled_from([0.0, 0.1, 0.2, 0.3, 1.5, 2.5, 3, 7.3, -3.0, 19.999999999999996, 20.000000000000004,
                           1e-9, 100.0]) | \
         st.floats(-150, 150, allow_nan=False) | st.integers(-5, 5)
@@ -317,8 +317,8 @@ def test_the_carried_judgement_is_rclverifys(tmp_path: Path, tolerance: dict | N
 
     from hypothesis import given, settings
 
-    from rclverify.logic.floatsem import judge as floatjudge, parse_tolerance
-    from rclverify.pipeline import Workspace
+    from rclverify.semantics.floatsem import judge as floatjudge, parse_tolerance
+    from rclverify.app.pipeline import Workspace
     ws = _ws(tmp_path, DIFF_CONTRACT)
     if tolerance:
         (ws / "contracts" / "plan.yaml").write_text(
@@ -335,7 +335,7 @@ def test_the_carried_judgement_is_rclverifys(tmp_path: Path, tolerance: dict | N
         if w not in trees:
             trees[w] = tmp_path / f"out{len(trees)}"
             assert main(["generate", "ros2", "-w", str(w), "-o", str(trees[w])]) == 0
-        from rclverify.generate.typemap import snake
+        from rclverify.tools.generate.typemap import snake
         path = trees[w] / snake(node) / snake(node) / "contract.py"
         spec = importlib.util.spec_from_file_location(f"diff_{node}_{bool(tolerance)}", path)
         assert spec is not None and spec.loader is not None

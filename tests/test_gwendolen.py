@@ -10,13 +10,13 @@ from pathlib import Path
 
 import pytest
 
-from rclverify.backends.ajpf import psl
+from rclverify.backends.model_checking.ajpf import psl
 from rclverify.backends.model_checking.environment import Environment, environment_from_plan
 from rclverify.backends.model_checking.explore import explore, explore_program
 from rclverify.backends.model_checking.graph import StateGraph
 from rclverify.backends.model_checking.gwendolen import GwendolenError, parse_file, parse_text
-from rclverify.plan.errors import PlanError
-from rclverify.rcl.ast import Loc
+from rclverify.model.plan.errors import PlanError
+from rclverify.lang.ast import Loc
 
 ROOT = Path(__file__).resolve().parents[1]
 DATA = ROOT / "tests" / "data" / "gwendolen"
@@ -334,7 +334,7 @@ def test_jackal_inspects_and_records_every_waypoint(jackal):
 DIGEST = """
 import hashlib, sys
 from pathlib import Path
-from rclverify.backends.ajpf import psl
+from rclverify.backends.model_checking.ajpf import psl
 from rclverify.backends.model_checking.environment import environment_from_plan
 from rclverify.backends.model_checking.explore import explore, explore_program
 g = explore(Path(sys.argv[1]), "jackal.gwen", environment_from_plan(%r))

@@ -28,12 +28,12 @@ from pathlib import Path
 
 import pytest
 
-from rclverify.bundle import archive
-from rclverify.bundle.archive import verify_bundle
-from rclverify.bundle.manifest import MANIFEST, BundleError, collect
-from rclverify.cli import main
-from rclverify.evidence.sealed import read_sealed
-from rclverify.plan.load import load_plan
+from rclverify.report.bundle import archive
+from rclverify.report.bundle.archive import verify_bundle
+from rclverify.report.bundle.manifest import MANIFEST, BundleError, collect
+from rclverify.cli.commands import main
+from rclverify.records.sealed import read_sealed
+from rclverify.model.plan.load import load_plan
 
 DATA = Path(__file__).parent / "data" / "requirements" / "stop"
 
@@ -299,8 +299,8 @@ def test_2_an_obligation_list_altered_outside_rclverify_is_error_and_exported_ag
 
 def test_2_a_grounding_altered_or_made_from_other_files_is_not_believed(tmp_path: Path) -> None:
     from rclverify.report.records import grounding
-    from rclverify.ros.stage import GROUNDING, stage_ground
-    from rclverify.workspace import Workspace
+    from rclverify.app.ros_stage import GROUNDING, stage_ground
+    from rclverify.stages.workspace import Workspace
     root = Path(__file__).parents[1]
     for item in ("contracts", "ros", "backends"):
         shutil.copytree(root / item, tmp_path / item)

@@ -25,7 +25,7 @@ from typing import Any, Iterator
 
 import pytest
 
-from rclverify.cli import main
+from rclverify.cli.commands import main
 
 REPO = Path(__file__).resolve().parents[1]
 STOP = REPO / "tests" / "data" / "requirements" / "stop"
@@ -174,7 +174,7 @@ def test_a_malformed_mapping_is_one_error_located_in_the_mapping_file(
 
 def test_an_evidence_record_holding_a_list_or_null_is_produced_again_not_a_crash(
         tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    from rclverify.evidence.store import EvidenceStore
+    from rclverify.records.store import EvidenceStore
     ws = tmp_path / "ws"
     shutil.copytree(STOP, ws)
     assert _doit(ws).returncode == 0
@@ -206,9 +206,9 @@ def _oracle(limits: Any = None) -> Iterator[tuple[int, Any]]:
     """The oracle over the case study's RadiationSensor, served on 127.0.0.1
     by a thread of this process (so the test reads its counters)."""
     from rclverify.backends.monitors.config import load_mapping
-    from rclverify.backends.monitors.oracle import OracleStats, serve
-    from rclverify.backends.monitors.ros1 import free_port
-    from rclverify.rcl.typecheck import load
+    from rclverify.runtime.oracle import OracleStats, serve
+    from rclverify.runtime.ros1 import free_port
+    from rclverify.lang.typecheck import load
     checked = load([REPO / "contracts" / "remote_inspection.rcl"])
     cfg = load_mapping(REPO, "backends/monitors/mapping.yaml", 2.0)
     stats, port = OracleStats(), free_port()
@@ -256,7 +256,7 @@ def test_a_client_that_sends_and_never_reads_is_throttled_then_dropped_and_its_s
     from websockets.sync.client import connect
     from websockets.uri import parse_uri
 
-    from rclverify.backends.monitors.oracle import OracleLimits
+    from rclverify.runtime.oracle import OracleLimits
     limits = OracleLimits(inbox=32, inbox_bytes=1 << 20, stall_s=1.0)
     with _oracle(limits) as (port, stats):
         sock = socket.create_connection(("127.0.0.1", port), timeout=10)
@@ -313,7 +313,7 @@ def test_a_horizon_that_is_not_a_finite_number_of_seconds_is_a_usage_error(rover
                                                                            command: str) -> None:
     # a subprocess, bounded in time: an oracle that accepted the horizon would serve until killed
     extra = [str(rover / "backends/monitors/traces/nominal.jsonl")] if command == "monitor" else ["--port", "0"]
-    r = subprocess.run([sys.executable, "-m", "rclverify.cli", command, "-w", str(rover), f"--horizon={value}",
+    r = subprocess.run([sys.executable, "-m", "rclverify.cli.commands", command, "-w", str(rover), f"--horizon={value}",
                         *extra], env=_env(), capture_output=True, text=True, timeout=60)
     assert r.returncode == 2, r.stdout + r.stderr
     assert f"rclverify {command}: error: argument --horizon: '{value}' is not a finite number of seconds >= 0" \

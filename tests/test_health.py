@@ -5,11 +5,11 @@ from pathlib import Path
 
 import pytest
 
-from rclverify.health.checks import check_node
-from rclverify.logic import world
-from rclverify.plan.load import load_plan, resolve
-from rclverify.rcl.parser import parse_text
-from rclverify.rcl.typecheck import check, load
+from rclverify.calculus.health.checks import check_node
+from rclverify.semantics import world
+from rclverify.model.plan.load import load_plan, resolve
+from rclverify.lang.parser import parse_text
+from rclverify.lang.typecheck import check, load
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -59,7 +59,7 @@ def agent_findings():
     checked = load([ROOT / c for c in plan.contracts])
     resolve(plan, checked)
     facts = [(f.expr, f.loc) for f in plan.facts["Agent"]]
-    world.fresh()  # the Z3 state of the node task (logic/world.py), whatever this worker ran before
+    world.fresh()  # the Z3 state of the node task (semantics/world.py), whatever this worker ran before
     return {f.id: f for f in check_node(checked, "Agent", facts, plan.instances["Agent"])}
 
 
@@ -88,7 +88,7 @@ def _rcl_value(text: str):
     enumeration value or a constructor term with numeric arguments."""
     import re
     from fractions import Fraction
-    from rclverify.values import Term
+    from rclverify.semantics.values import Term
     text = text.strip()
     if text in ("TRUE", "FALSE"):
         return text == "TRUE"
@@ -104,7 +104,7 @@ def _rcl_value(text: str):
 def _witness_values(model: dict[str, str], node: str) -> dict[str, object]:
     """The witness's values keyed ``in.x``/``out.y``, tables as FiniteFunction."""
     import re
-    from rclverify.values import FiniteFunction
+    from rclverify.semantics.values import FiniteFunction
     out: dict[str, object] = {}
     for name, text in model.items():
         key = name.removeprefix(f"{node}.")
@@ -121,11 +121,11 @@ def _witness_values(model: dict[str, str], node: str) -> dict[str, object]:
 
 def test_case_study_agent_consistency_witness_is_a_finite_table_that_meets_the_contract(agent_findings):
     """The Agent's consistency is decided by a witness of finite tables
-    (health/witness.py), asked before the general query: the reported
+    (calculus/health/witness.py), asked before the general query: the reported
     witness, read back from its RCL text, satisfies the assumption, every
     guarantee and every environment fact by direct evaluation (the monitors'
     engine, not Z3)."""
-    from rclverify.logic.evaluate import evaluate
+    from rclverify.semantics.evaluate import evaluate
     c = agent_findings["Agent.contract-consistent"]
     assert c.status == "ok" and c.model is not None and "finite table" in c.explanation
     assert c.model["Agent.in.wayP"].startswith("{(0, 0) -> ")
@@ -162,8 +162,8 @@ def test_case_study_agent_guarantee_3_can_fire(agent_findings):
     its own.  The witness, read back
     from its RCL text, meets the assumption, every guarantee, every fact
     and the premise at its ``i``, by direct evaluation (not Z3)."""
-    from rclverify.logic.evaluate import Evaluator, evaluate
-    from rclverify.rcl import ast
+    from rclverify.semantics.evaluate import Evaluator, evaluate
+    from rclverify.lang import ast
     g3 = agent_findings["Agent.g3.non-vacuous"]
     assert g3.status == "ok" and g3.model is not None and g3.instances is None
     assert g3.model["Agent.in.wayP"].startswith("{(0, 0) -> ")
@@ -187,7 +187,7 @@ def test_case_study_agent_guarantee_3_can_fire(agent_findings):
 
 def test_the_natural_components_of_a_tuple_are_typed():
     """A ``(NATURAL, NATURAL)`` is two integers to Z3 (a ``seq(NATURAL)`` a sequence of integers): without their ``>= 0`` a guarantee only a negative
-    component meets read consistent, an assumption only one meets satisfiable (logic/natural.py)."""
+    component meets read consistent, an assumption only one meets satisfiable (semantics/natural.py)."""
     out = ("node C { inputs( x : INTEGER ) outputs( y : (NATURAL, NATURAL) ) assume( TRUE ) "
            "guarantee( exists(a, b in INTEGER | out.y == (a, b) and a < 0) ) }")
     status = {f.check: f.status for f in _findings(out, "C").values()}

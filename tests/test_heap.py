@@ -7,7 +7,7 @@ import multiprocessing
 
 import pytest
 
-from rclverify.cache import heap
+from rclverify.core.cache import heap
 
 
 def test_loading_restores_the_collector_also_after_an_error() -> None:

@@ -17,11 +17,11 @@ from rclverify.backends.hoare.check import check_program
 from rclverify.backends.hoare.outline import render_outline, outline_text, z3_text
 from rclverify.backends.hoare.solve import check_all
 from rclverify.backends.hoare.wp import ProgramModel, main_vc, wp
-from rclverify.evidence.records import Obligation
-from rclverify.logic.encode import Encoder
-from rclverify.plan.errors import PlanError
-from rclverify.rcl.errors import RclError
-from rclverify.rcl.typecheck import load
+from rclverify.records.records import Obligation
+from rclverify.semantics.encode import Encoder
+from rclverify.model.plan.errors import PlanError
+from rclverify.lang.errors import RclError
+from rclverify.lang.typecheck import load
 
 REPO = Path(__file__).resolve().parents[1]
 RCL = "contracts/remote_inspection.rcl"
@@ -431,8 +431,8 @@ def test_premise_over_an_output_moves_to_the_postcondition(workspace: Path, prog
 
 def test_bad_binding_is_located_at_its_key_in_the_plan(tmp_path: Path) -> None:
     import shutil
-    from rclverify.pipeline import Workspace
-    from rclverify.plan.errors import PlanError
+    from rclverify.app.pipeline import Workspace
+    from rclverify.model.plan.errors import PlanError
     for item in ("contracts", "backends"):
         shutil.copytree(REPO / item, tmp_path / item)
     plan = tmp_path / "contracts" / "plan.yaml"

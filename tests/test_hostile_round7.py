@@ -10,9 +10,9 @@ from pathlib import Path
 
 import pytest
 
-from rclverify.cli import main
-from rclverify.pipeline import Workspace
-from rclverify.plan.errors import PlanError
+from rclverify.cli.commands import main
+from rclverify.app.pipeline import Workspace
+from rclverify.model.plan.errors import PlanError
 
 EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "safety_stop"
 

@@ -9,8 +9,8 @@ from pathlib import Path
 
 import pytest
 
-from rclverify.cli import main
-from rclverify.scaffold import plan_nodes
+from rclverify.cli.commands import main
+from rclverify.tools.scaffold import plan_nodes
 
 SRC = Path(__file__).resolve().parents[1] / "src"
 

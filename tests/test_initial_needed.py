@@ -19,8 +19,8 @@ from typing import Any
 
 import pytest
 
-from rclverify.pipeline import Workspace, stage_check, stage_requirements
-from rclverify.requirements.initial_needed import initially_not_needed
+from rclverify.app.pipeline import Workspace, stage_check, stage_requirements
+from rclverify.calculus.requirements.initial_needed import initially_not_needed
 
 
 def _maximal(family: set[frozenset[str]]) -> set[frozenset[str]]:

@@ -16,8 +16,8 @@ from typing import Iterator
 
 import pytest
 
-from rclverify.cli import main
-from rclverify.evidence.published import published_mode, write_published
+from rclverify.cli.commands import main
+from rclverify.records.published import published_mode, write_published
 
 SRC = Path(__file__).resolve().parents[1] / "src"
 ENV = {**os.environ, "PYTHONPATH": str(SRC), "RCLVERIFY_NO_WAIT": ""}
@@ -40,7 +40,7 @@ def fresh(tmp_path: Path) -> Path:
 @pytest.fixture()
 def ws(fresh: Path) -> Path:
     """A verified `rclverify init` workspace."""
-    r = run(fresh, "rclverify.cli", "verify")
+    r = run(fresh, "rclverify.cli.commands", "verify")
     assert r.returncode == 0, r.stdout + r.stderr
     return fresh
 
@@ -114,7 +114,7 @@ def assert_one_plain_error(r: subprocess.CompletedProcess[str], cause: str) -> N
     assert "the reports and evidence of the last run are unchanged" in out
 
 
-COMMANDS = [("rclverify.cli", "verify"), ("doit", "verify")]
+COMMANDS = [("rclverify.cli.commands", "verify"), ("doit", "verify")]
 
 
 def test_read_only_reports_is_one_plain_error_and_the_reports_stay(ws: Path) -> None:
@@ -158,7 +158,7 @@ def test_a_full_disk_under_the_whole_workspace_is_one_plain_error(tmp_path: Path
     try:
         ws = disk / "ws"
         assert main(["init", str(ws)]) == 0
-        assert run(ws, "rclverify.cli", "verify").returncode == 0
+        assert run(ws, "rclverify.cli.commands", "verify").returncode == 0
         before = digests(ws, "reports", "artifacts/evidence")
         edit_contract(ws, 4)
         with open(disk / "filler", "wb", buffering=0) as fh:
@@ -180,10 +180,10 @@ def test_a_full_disk_under_the_whole_workspace_is_one_plain_error(tmp_path: Path
 
 def test_missing_workspace_and_missing_plan_are_one_error_each(tmp_path: Path, fresh: Path) -> None:
     ws = fresh
-    r = run(tmp_path, "rclverify.cli", "verify", "-w", str(tmp_path / "nope"))
+    r = run(tmp_path, "rclverify.cli.commands", "verify", "-w", str(tmp_path / "nope"))
     assert r.returncode == 1 and r.stderr == f"{tmp_path / 'nope'}: error: no such workspace directory\n"
     assert not (tmp_path / "nope").exists()
-    r = run(ws, "rclverify.cli", "verify", "--plan", "contracts/nope.yaml")
+    r = run(ws, "rclverify.cli.commands", "verify", "--plan", "contracts/nope.yaml")
     out = r.stdout + r.stderr
     assert r.returncode == 1 and "Traceback" not in out and "DependencyError" not in out
     assert out.count("error:") == 1
@@ -234,7 +234,7 @@ def holder(ws: Path) -> Iterator[subprocess.Popen[str]]:
 def test_a_second_run_exits_with_no_wait(fresh: Path) -> None:
     ws = fresh
     with holder(ws) as h:
-        r = run(ws, "rclverify.cli", "verify", "--no-wait")
+        r = run(ws, "rclverify.cli.commands", "verify", "--no-wait")
         assert r.returncode == 1 and "Traceback" not in r.stderr
         assert f"error: not waiting for the run in progress (pid {h.pid})" in r.stderr
         r = run(ws, "doit", "verify", env={**ENV, "RCLVERIFY_NO_WAIT": "1"})
@@ -264,11 +264,11 @@ def test_report_and_bundle_wait_for_a_run_in_progress(ws: Path) -> None:
     before = digests(ws, "reports")
     with holder(ws) as h:
         for argv in (("report", "--no-wait"), ("bundle", "--no-wait", "-o", "b.tar.gz")):
-            r = run(ws, "rclverify.cli", *argv)
+            r = run(ws, "rclverify.cli.commands", *argv)
             assert r.returncode == 1 and "Traceback" not in r.stderr, r.stderr
             assert f"error: not waiting for the run in progress (pid {h.pid})" in r.stderr
         assert digests(ws, "reports") == before and not (ws / "b.tar.gz").exists()
-        p = subprocess.Popen([sys.executable, "-m", "rclverify.cli", "report"], cwd=ws, env=ENV,
+        p = subprocess.Popen([sys.executable, "-m", "rclverify.cli.commands", "report"], cwd=ws, env=ENV,
                              stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
         assert p.stderr is not None
         assert p.stderr.readline() == f"waiting for the run in progress (pid {h.pid})\n"
@@ -278,7 +278,7 @@ def test_report_and_bundle_wait_for_a_run_in_progress(ws: Path) -> None:
         out, err = p.communicate(timeout=120)
     assert p.returncode == 0, out + err
     assert "reports/assurance.html" in out
-    r = run(ws, "rclverify.cli", "bundle", "--no-wait", "-o", "b.tar.gz")
+    r = run(ws, "rclverify.cli.commands", "bundle", "--no-wait", "-o", "b.tar.gz")
     assert r.returncode == 0 and (ws / "b.tar.gz").is_file(), r.stderr
 
 
@@ -287,7 +287,7 @@ def test_report_and_bundle_of_a_missing_workspace_make_no_lock_file(tmp_path: Pa
     gives the command's own error and leaves no directory behind."""
     missing = tmp_path / "no-such-ws"
     for argv in (("report",), ("bundle", "-o", str(tmp_path / "b.tar.gz"))):
-        r = run(tmp_path, "rclverify.cli", *argv, "-w", str(missing))
+        r = run(tmp_path, "rclverify.cli.commands", *argv, "-w", str(missing))
         assert r.returncode == 1 and "Traceback" not in r.stderr, r.stderr
         assert not missing.exists()
 
@@ -295,14 +295,14 @@ def test_report_and_bundle_of_a_missing_workspace_make_no_lock_file(tmp_path: Pa
 def test_a_killed_run_leaves_no_stale_lock(fresh: Path) -> None:
     ws = fresh
     with holder(ws) as h:
-        p = subprocess.Popen([sys.executable, "-m", "rclverify.cli", "verify"], cwd=ws, env=ENV,
+        p = subprocess.Popen([sys.executable, "-m", "rclverify.cli.commands", "verify"], cwd=ws, env=ENV,
                              stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
         assert p.stderr is not None and p.stderr.readline().startswith("waiting for the run in progress")
         os.kill(h.pid, signal.SIGKILL)
         out, err = p.communicate(timeout=120)
     assert p.returncode == 0, out + err
     assert (ws / "artifacts/run.lock").exists()  # the file stays; the lock went with the process
-    assert run(ws, "rclverify.cli", "verify", "--no-wait").returncode == 0
+    assert run(ws, "rclverify.cli.commands", "verify", "--no-wait").returncode == 0
 
 
 def test_two_runs_started_together_never_run_a_task_twice(fresh: Path) -> None:
@@ -330,7 +330,7 @@ def test_an_implementation_that_hangs_is_stopped_by_the_entrys_timeout(fresh: Pa
         "  Sensor: {}\n", "  Sensor:\n    evidence:\n      - backend: property_tests\n"
         "        implementation: backends/property_tests/sensor.py:sensor\n        timeout_s: 0.5\n"), encoding="utf-8")
     t0 = time.monotonic()
-    r = run(ws, "rclverify.cli", "verify", "--strict")
+    r = run(ws, "rclverify.cli.commands", "verify", "--strict")
     assert time.monotonic() - t0 < 60
     out = r.stdout + r.stderr
     assert r.returncode == 1 and "Traceback" not in out, out
@@ -358,7 +358,7 @@ def test_timeout_s_is_checked_and_the_limit_fires(fresh: Path) -> None:
 
 def test_fault_messages_name_the_place_and_the_cause() -> None:
     import errno
-    from rclverify.faults import describe_os_error
+    from rclverify.core.faults import describe_os_error
     root = Path("/w")
     tmp = PermissionError(errno.EACCES, "Permission denied", "/w/reports/.assurance.html.x1.tmp")
     assert describe_os_error(tmp, root).startswith("error: cannot write reports/: Permission denied (make it writable")

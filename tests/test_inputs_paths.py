@@ -14,10 +14,10 @@ from pathlib import Path
 import pytest
 import yaml
 
-from rclverify.cli import main
-from rclverify.plan.errors import PlanError
-from rclverify.plan.load import load_plan
-from rclverify.tasks import _inputs, act_check
+from rclverify.cli.commands import main
+from rclverify.model.plan.errors import PlanError
+from rclverify.model.plan.load import load_plan
+from rclverify.app.tasks import _inputs, act_check
 
 from _evidence_ws import REPO, copy_workspace, plan_line
 
@@ -117,7 +117,7 @@ def test_a_tool_path_outside_the_workspace_is_allowed_and_no_file_dependency(tmp
     assert _inputs(config, ws, {}) == []
     # Before: doit's DependencyError on '<ws>//usr/bin/dafny'.  The implementation is missing,
     # so the entry is pending (Dafny is not run) and the run succeeds.
-    r = subprocess.run([sys.executable, "-m", "rclverify.cli", "verify", "-w", str(ws)], capture_output=True,
+    r = subprocess.run([sys.executable, "-m", "rclverify.cli.commands", "verify", "-w", str(ws)], capture_output=True,
                        text=True, timeout=300, env={"PYTHONPATH": str(SRC), "PATH": "/usr/bin:/bin"})
     assert r.returncode == 0, r.stdout + r.stderr
     assert "DependencyError" not in r.stdout + r.stderr and "1 pending" in r.stdout
@@ -141,7 +141,7 @@ def test_a_tool_named_by_a_path_that_is_missing_is_a_located_error(tmp_path: Pat
 
 
 def test_a_tool_named_by_a_command_not_on_path_stays_pending(tmp_path: Path) -> None:
-    from rclverify.pipeline import Workspace, stage_check, stage_export, stage_run
+    from rclverify.app.pipeline import Workspace, stage_check, stage_export, stage_run
     ws = init_ws(tmp_path, "      - backend: dafny\n        dafny: no-such-dafny-here\n")
     assert load_plan(ws).evidence["Sensor"][0].config["dafny"] == "no-such-dafny-here"
     impl = ws / "backends/dafny/sensor.dfy"

@@ -12,14 +12,14 @@ from pathlib import Path
 import pytest
 import yaml
 
-from rclverify.cli import main
-from rclverify.plan.errors import PlanError
-from rclverify.plan.load import load_plan
-from rclverify.plan.yamlguard import load_located, safe_load_guarded
-from rclverify.rcl.errors import RclError
-from rclverify.rcl.parser import parse_file
-from rclverify.rcl.source import decode_text
-from rclverify.tasks import act_check
+from rclverify.cli.commands import main
+from rclverify.model.plan.errors import PlanError
+from rclverify.model.plan.load import load_plan
+from rclverify.model.plan.yamlguard import load_located, safe_load_guarded
+from rclverify.lang.errors import RclError
+from rclverify.lang.parser import parse_file
+from rclverify.lang.source import decode_text
+from rclverify.app.tasks import act_check
 
 from _evidence_ws import REPO, copy_workspace, plan_line
 
@@ -168,7 +168,7 @@ def test_libyaml_composes_the_nodes_pyyaml_does() -> None:
     repository gives the same node graph (kinds, tags, values, styles and marks) either way."""
     import yaml
 
-    from rclverify.plan import yamlguard
+    from rclverify.model.plan import yamlguard
     if yamlguard._COMPOSER is yaml.SafeLoader:
         pytest.skip("PyYAML built without libyaml: only its own loader is used")
 

@@ -60,7 +60,7 @@ def _ran(proc: subprocess.CompletedProcess[str]) -> list[str]:
 
 
 def _rclverify(ws: Path, *args: str) -> subprocess.CompletedProcess[str]:
-    return subprocess.run([sys.executable, "-m", "rclverify.cli", *args, "-w", str(ws)], capture_output=True,
+    return subprocess.run([sys.executable, "-m", "rclverify.cli.commands", *args, "-w", str(ws)], capture_output=True,
                           text=True, timeout=300)
 
 
@@ -131,7 +131,7 @@ def test_a_check_index_that_does_not_match_its_seal_is_not_believed(verified: Pa
     """The report takes the snapshots' hashes from check's index only while the index is sealed and
     its inputs are the current files; an index edited to list the edited file's new hash is ignored,
     the snapshots are made again and the edited node's evidence is stale."""
-    from rclverify.cache import file_digest
+    from rclverify.core.cache import file_digest
     ws = _copy(verified, tmp_path)
     rcl = ws / "contracts/remote_inspection.rcl"
     rcl.write_text(rcl.read_text(encoding="utf-8").replace("(250 <= in.r -> out.radiationStatus == red)",

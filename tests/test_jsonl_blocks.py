@@ -140,7 +140,7 @@ CONTRACT = CLASSIFIER
 
 
 def _workspace(root: Path, skew: float) -> Any:
-    from rclverify.pipeline import Workspace
+    from rclverify.app.pipeline import Workspace
     (root / "contracts").mkdir(parents=True)
     (root / "backends/monitors").mkdir(parents=True)
     (root / "contracts/classifier.rcl").write_text(CONTRACT)
@@ -183,7 +183,7 @@ def _run_log(rnd: random.Random, n: int) -> bytes:
 
 
 def _command(checked: Any, root: Path, log: Path, as_json: bool) -> tuple[int, str, str]:
-    from rclverify.backends.monitors.cli import monitor_command
+    from rclverify.cli.monitor import monitor_command
     args = argparse.Namespace(workspace=str(root), mapping=None, horizon=None, json=as_json, live=False, nodes=None,
                               traces=[str(log)])
     out, err = io.StringIO(), io.StringIO()

@@ -8,11 +8,15 @@ module ``pkg.name`` when that is a module, else to ``pkg``.  Importing
 ``a.b.c`` also runs ``a/__init__`` and ``a/b/__init__``; those implicit
 edges are not counted, only the module named.
 
-Two rules, each a test:
+The rules, each a test:
 
+* the folders are the layers: every top-level folder of the package is one
+  layer of :data:`LAYERS` (ros/ one per sub-folder), and no module sits
+  outside a folder but the two named there;
 * no import runs from a lower layer to a higher one (:data:`LAYERS`, lowest
   first; modules of one layer may import each other);
-* the graph has no cycle (also not inside one layer).
+* the graph has no cycle (also not inside one layer), and neither has the
+  graph of folders (a module's folder importing another's).
 
 :data:`KNOWN_VIOLATIONS` lists edges allowed to break the rules; it is
 empty (issue 25's three import circles are gone), and every listed edge must
@@ -30,129 +34,32 @@ SRC = Path(__file__).resolve().parents[1] / "src"
 PACKAGE = "rclverify"
 
 #: The layers, lowest first: a module may import modules of its own layer and
-#: of the layers before it.  An entry names a module or a package (a package
-#: covers every module under it); the longest matching entry decides.  The
-#: named layers are issue 25's order, rcl -> plan -> system/logic ->
-#: calculus/health -> backends -> evidence -> report/argument ->
-#: pipeline/tasks -> cli; the other modules are placed by what they are and
-#: what they import:
+#: of the layers before it.  Each layer is a folder of src/rclverify (ros/ is
+#: four, one per sub-folder); an entry covers every module under it, and the
+#: longest matching entry decides.  The one rule per folder is in its
+#: ``__init__`` docstring and in docs/architecture.md.  Two modules sit outside
+#: the folders: the package's ``__init__`` (its version; layer core) and
+#: ``tasks`` (the import every workspace's dodo.py has; layer app).
 LAYERS: list[tuple[str, tuple[str, ...]]] = [
-    # Process-wide utilities that know nothing of RCL: the package's version
-    # (``rclverify/__init__``; this entry is that module only, not the
-    # package), machine faults worded as one line (faults.py).  They import
-    # no other module of the package.
-    ("foundation", ("rclverify", "rclverify.faults")),
-    # The evidence record format (records.py: obligations, evidence records,
-    # input hashes) and its atomic store (store.py).  Every stage writes
-    # these records and the report reads them, so the format sits below all
-    # of them; it imports nothing of the package.  The "evidence" step of
-    # the data flow (backends -> evidence -> report) is the pipeline's
-    # evidence stage, which lives in the pipeline layer.
-    ("evidence records", ("rclverify.evidence",)),
-    # cache/: everything kept between runs (one keying function, one file
-    # format, one rule of what is kept), the workspace's load among it
-    # (cache/workspace.py, which sees the workspace only through its
-    # attributes), when the garbage collector runs (cache/heap.py, used by
-    # the parser) and the one-entry result memo (cache/memo.py).  It writes
-    # through the evidence store's atomic writer and knows nothing of RCL.
-    ("cache", ("rclverify.cache",)),
-    ("rcl", ("rclverify.rcl",)),
-    # values.py: the Python convention for RCL values (built on rcl's types),
-    # shared by the logic (evaluation on concrete values), the traces and the
-    # backends.  traces/: reading recorded runs (JSONL, rosbag) into events of
-    # such values; it needs only rcl types and values.
-    ("values", ("rclverify.values", "rclverify.traces")),
-    ("plan", ("rclverify.plan",)),
-    # ros/: the ROS computation graph read from the robot's software and the
-    # contracts grounded in it, the system as its code shows it, beside the
-    # system model (system/); its stage, command and skeleton writer are
-    # placed below with the pipeline and the commands.  The readers of real
-    # code (issue 42) are in this layer too, below the graph (graph.py,
-    # assemble.py) that uses them: programs.py, link.py, link_values.py,
-    # symbols.py, emit.py, cpp_scope.py, cpp_values.py, cpp_types.py,
-    # cpp_prep.py, cpp_helpers.py, py_helpers.py, pyconst.py, namespaces.py;
-    # and the drivers' idioms: unit_names.py (classes defined out of line through
-    # using/typedef), cpp_members.py and link_members.py (helpers held as members
-    # and base classes), nodelets.py (ROS 1 nodelets), lifecycle.py (the
-    # management interface of lifecycle nodes, for the grounding);
-    # they import only ros/ modules, the standard library and tree-sitter.
-    # logic/evaluate.py is the direct evaluator's entry point over its parts by
-    # job (issue 44): evaluator.py (context, names, expressions), eval_values.py,
-    # eval_shapes.py, eval_search.py, eval_quant.py, eval_closures.py; each imports
-    # only the parts below it (values <- shapes <- search <- quant <- evaluator).
-    # logic/straightline.py (a formula compiled into straight-line Python for the
-    # monitors) builds on the evaluator's values; logic/judges.py puts it before
-    # floatsem.judge (issue 44).
-    # logic/encode.py likewise holds the Encoder over sorts.py (sorts, coercions,
-    # operators), symbols.py (the error, symbol names), translate.py (formulas
-    # node by node) and modeltext.py (Z3 values as RCL text).
-    # logic/floatsem.py (issue 40): a formula judged on recorded values in
-    # exact, IEEE-754 double or tolerant arithmetic, built on the evaluator
-    # and Z3's concrete check beside it, with logic/floatsens.py (which
-    # formulas those semantics can change); the monitors (backends) call it.
-    # ros/dds.py, ros/dds_qos.py, ros/dds_discovery.py, ros/diff_dds.py: ROS 2's
-    # conventions on DDS (names, the participant and node announcements, QoS
-    # matching) and the running ROS 2 graph; read by ``ros diff --ros2`` here and
-    # by the live monitor above (backends), so they sit with the graph they feed.
-    ("system/logic", ("rclverify.system", "rclverify.logic", "rclverify.ros", "rclverify.ros.dds",
-                      "rclverify.ros.dds_qos", "rclverify.ros.dds_discovery", "rclverify.ros.diff_dds")),
-    # requirements/: formal requirements decided from the composed contracts
-    # (check.py, beside the calculus it builds on) and their roll-up with the
-    # evidence (rollup.py); its stage (stage.py) sits with the workspace it
-    # writes into, its terminal listing (show.py) with the commands.
-    # calculus/context.py and calculus/smttext.py (side conditions in context)
-    # build on the system model and the logic only; calculus/quotient.py and
-    # calculus/linear.py (the weakest contract of a node) re-check with the
-    # calculus and requirements/check.py, so they sit in this layer too;
-    # health/realizable.py is a peer of the other health checks.
-    ("calculus/health", ("rclverify.calculus", "rclverify.health", "rclverify.requirements")),
-    # backends/monitors/fieldpaths.py (issue 40): a mapping's field paths
-    # checked against the message definitions through ros/interfaces.py (the
-    # grounding's reader, a lower layer); entry_checks.py calls it.
-    # backends/monitors/dds_*.py: the live monitor over DDS (types made from
-    # the .msg files, the bus and its readers, calls checked one by one with
-    # the monitors' engine, --enforce, the bag recorder); monitors' code,
-    # beside the ROS 1 glue (ros1.py, live.py).
-    ("backends", ("rclverify.backends", "rclverify.backends.monitors.dds_types", "rclverify.backends.monitors.dds_bus",
-                  "rclverify.backends.monitors.dds_calls", "rclverify.backends.monitors.dds_services",
-                  "rclverify.backends.monitors.dds_enforce", "rclverify.backends.monitors.dds_bag",
-                  "rclverify.backends.monitors.dds_live")),
-    # diagnosis/: each problem of the report explained and repairs checked by
-    # re-running the calculus, health checks and Hoare triples on edited text
-    # (so above the backends); the report shows the records.
+    ("core", ("rclverify", "rclverify.core")),
+    ("records", ("rclverify.records",)),
+    ("lang", ("rclverify.lang",)),
+    ("semantics", ("rclverify.semantics",)),
+    ("traces", ("rclverify.traces",)),
+    ("model", ("rclverify.model",)),
+    ("ros/extract", ("rclverify.ros", "rclverify.ros.extract")),
+    ("ros/graph", ("rclverify.ros.graph",)),
+    ("ros/live", ("rclverify.ros.live",)),
+    ("ros/ground", ("rclverify.ros.ground",)),
+    ("calculus", ("rclverify.calculus",)),
+    ("backends", ("rclverify.backends",)),
+    ("runtime", ("rclverify.runtime",)),
     ("diagnosis", ("rclverify.diagnosis",)),
-    # The workspace (workspace.py: the loaded plan and contracts, artifact
-    # paths, snapshots and what makes a result stale): read by the report,
-    # the stages and the commands; it imports the layers below only.
-    # The deadlines stage (calculus/deadline_stage.py) writes and reads its sealed record
-    # in the workspace, as the requirements stage does.
-    # crosscheck/ (issue 50): the second solver's stage reads the stages' sealed records and re-decides their
-    # queries with cvc5; the report folds its verdicts in, so it sits with the workspace's stages.
-    ("workspace", ("rclverify.workspace", "rclverify.requirements.stage", "rclverify.calculus.deadline_stage",
-                   "rclverify.crosscheck")),
-    # report/ and argument/ render the results; contract_texts.py makes the
-    # texts of the contracts the report shows (RCL, LaTeX, lint), so it
-    # belongs with the report.
-    ("report/argument", ("rclverify.report", "rclverify.argument", "rclverify.contract_texts")),
-    # The stages and their drivers: pipeline.py and tasks.py (doit), the Dask scheduler's jobs
-    # (cluster.py), the progress line over the report's summary
-    # (progress.py), doit's state saved after each task (doitstate.py), one
-    # run at a time (runlock.py), the ROS grounding stage (ros/stage.py), the
-    # replay of one property test from a workspace (replay.py, what generated
-    # pytest files call).
-    # conetask.py: the doit uptodate check that re-runs a node's calculus when the part of its upstream
-    # cone it read changed (beside tasks.py, which uses it; it reads the evidence layer's seals only).
-    ("pipeline/tasks", ("rclverify.pipeline", "rclverify.tasks", "rclverify.cluster",
-                        "rclverify.progress", "rclverify.doitstate", "rclverify.runlock", "rclverify.ros.stage",
-                        "rclverify.replay", "rclverify.conetask")),
-    # Commands: the CLI, and what only commands use: scaffold/ (``rclverify
-    # init``: a new workspace from templates), bundle/ (``rclverify bundle``:
-    # an archive of the evidence with its manifest), ``rclverify ros ...``
-    # (ros/cli.py) and ``init --from-ros`` (ros/skeleton.py, on scaffold's
-    # templates), and the language server (lsp/, ``rclverify lsp``: beside the CLI, it reads what
-    # every layer below gives and the last run's report files).
-    ("cli", ("rclverify.cli", "rclverify.lsp", "rclverify.requirements.show", "rclverify.scaffold", "rclverify.generate", "rclverify.bundle", "rclverify.ros.cli",
-             "rclverify.ros.skeleton")),
+    ("stages", ("rclverify.stages",)),
+    ("report", ("rclverify.report",)),
+    ("app", ("rclverify.app", "rclverify.tasks")),
+    ("tools", ("rclverify.tools",)),
+    ("cli", ("rclverify.cli",)),
 ]
 
 #: Edges (importer, imported) of import circles 1 and 2 of issue 25, being
@@ -161,9 +68,9 @@ LAYERS: list[tuple[str, tuple[str, ...]]] = [
 #: longer exists).
 KNOWN_VIOLATIONS: frozenset[tuple[str, str]] = frozenset({
     # Empty: circle 1 (the plan importing the backend registry) went with
-    # plan/entries.py, circle 2 (pipeline, report, contract texts and
+    # model/plan/entries.py, circle 2 (pipeline, report, contract texts and
     # workspace cache importing each other) with workspace.py, and the plan
-    # loader's own circles with plan/model.py.  Keep it empty.
+    # loader's own circles with model/plan/model.py.  Keep it empty.
 })
 
 
@@ -230,9 +137,9 @@ def graph() -> nx.DiGraph:
 
 def test_the_graph_is_read_from_the_source(graph: nx.DiGraph) -> None:
     """Known imports of both kinds are found: module level and inside a function."""
-    assert graph.has_edge("rclverify.logic.decide", "rclverify.logic.evaluate")  # module level, relative
-    assert graph.has_edge("rclverify.cli", "rclverify.pipeline")  # inside a function
-    assert graph.has_edge("rclverify.health.checks", "rclverify.health.finding")
+    assert graph.has_edge("rclverify.semantics.decide", "rclverify.semantics.evaluate")  # module level, relative
+    assert graph.has_edge("rclverify.cli.commands", "rclverify.app.pipeline")  # inside a function
+    assert graph.has_edge("rclverify.calculus.health.checks", "rclverify.calculus.health.finding")
     assert len(graph) > 60 and graph.number_of_edges() > 300
 
 
@@ -265,7 +172,38 @@ def test_known_violations_still_exist(graph: nx.DiGraph) -> None:
 def test_the_rules_catch_a_violation() -> None:
     """The checks are not vacuous: an upward edge and a cycle added to a copy are found."""
     g = import_graph()
-    g.add_edge("rclverify.rcl.ast", "rclverify.pipeline")
-    assert layer_of("rclverify.rcl.ast") < layer_of("rclverify.pipeline")
+    g.add_edge("rclverify.lang.ast", "rclverify.app.pipeline")
+    assert layer_of("rclverify.lang.ast") < layer_of("rclverify.app.pipeline")
     g.remove_edges_from(KNOWN_VIOLATIONS)
     assert any(len(c) > 1 for c in nx.strongly_connected_components(g))
+
+
+def test_the_folders_are_the_layers() -> None:
+    """Every top-level folder is a layer's entry, and the loose modules are the two named."""
+    pkg = SRC / PACKAGE
+    folders = {f"{PACKAGE}.{d.name}" for d in pkg.iterdir() if d.is_dir() and (d / "__init__.py").exists()}
+    folders.discard(f"{PACKAGE}.ros")
+    folders |= {f"{PACKAGE}.ros.{d.name}" for d in (pkg / "ros").iterdir() if (d / "__init__.py").exists()}
+    entries = {e for _, es in LAYERS for e in es}
+    assert folders <= entries, f"folders without a layer: {sorted(folders - entries)}"
+    loose = sorted(p.stem for p in pkg.glob("*.py"))
+    assert loose == ["__init__", "tasks"], f"modules outside the layer folders: {loose}"
+    ros_modules = sorted(p.name for p in (pkg / "ros").glob("*.py"))
+    assert ros_modules == ["__init__.py"], f"modules outside ros's four folders: {ros_modules}"
+
+
+def folder_of(module: str, mods: dict[str, tuple[Path, bool]]) -> str:
+    """The folder (package) a module lives in; a package's ``__init__`` is its own folder."""
+    return module if mods[module][1] else module.rsplit(".", 1)[0]
+
+
+def test_no_folder_cycle(graph: nx.DiGraph) -> None:
+    """Collapsed to folders (calculus/health, report/argument, ...), the imports form no cycle."""
+    folders = nx.DiGraph()
+    mods = modules()
+    for a, b in graph.edges:
+        fa, fb = folder_of(a, mods), folder_of(b, mods)
+        if fa != fb and not fa.startswith(fb + "."):  # a sub-folder may use its parent's modules
+            folders.add_edge(fa, fb)
+    cycles = [sorted(c) for c in nx.strongly_connected_components(folders) if len(c) > 1]
+    assert not cycles, f"folder cycles: {cycles}"

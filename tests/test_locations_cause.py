@@ -12,7 +12,7 @@ import pytest
 from rclverify.backends.hoare import lang
 from rclverify.backends.hoare.culprit_lines import compared_constants
 from rclverify.backends.property_tests.backend import PropertyTestsBackend
-from rclverify.pipeline import Workspace
+from rclverify.app.pipeline import Workspace
 
 RCL = """// The speed governor: slow near obstacles.
 node SpeedGovernor {
@@ -91,9 +91,9 @@ def test_a_class_is_replayed_to_its_failing_step(tmp_path: Path) -> None:
 
 
 def test_sarif_and_report_put_the_failure_on_the_implementation_line(tmp_path: Path) -> None:
-    from rclverify.cli import main
+    from rclverify.cli.commands import main
     ws = _ws(tmp_path)
-    (ws / "dodo.py").write_text("from pathlib import Path\nfrom rclverify.tasks import build_tasks, doit_config\n"
+    (ws / "dodo.py").write_text("from pathlib import Path\nfrom rclverify.app.tasks import build_tasks, doit_config\n"
                                 "DOIT_CONFIG = doit_config()\nglobals().update(build_tasks(Path(__file__).parent))\n")
     main(["verify", "-w", str(ws)])
     sarif = json.loads((ws / "reports/assurance.sarif").read_text())

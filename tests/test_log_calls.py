@@ -18,9 +18,9 @@ import pytest
 from rclverify.backends.base import NodeTarget
 from rclverify.backends.monitors.backend import MonitorsBackend
 from rclverify.backends.monitors.dds_calls import CallBook
-from rclverify.backends.monitors.live import dumps
-from rclverify.cli import main
-from rclverify.rcl.typecheck import load
+from rclverify.runtime.live import dumps
+from rclverify.cli.commands import main
+from rclverify.lang.typecheck import load
 
 WS = Path(__file__).parent / "data" / "dds_ws"
 CHECKED = load([WS / "contracts" / "dds.rcl"])

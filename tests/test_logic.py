@@ -8,11 +8,11 @@ from typing import Any, Sequence
 import pytest
 import z3
 
-from rclverify.logic.encode import Encoder, EncodingError, sort_of
-from rclverify.logic.query import QueryResult, prove, satisfiable
-from rclverify.rcl.parser import parse_formula, parse_text
-from rclverify.rcl.typecheck import check, load
-from rclverify.rcl.types import BOOL, INTEGER, NATURAL, REAL, Checked, EnumT, FuncT
+from rclverify.semantics.encode import Encoder, EncodingError, sort_of
+from rclverify.semantics.query import QueryResult, prove, satisfiable
+from rclverify.lang.parser import parse_formula, parse_text
+from rclverify.lang.typecheck import check, load
+from rclverify.lang.types import BOOL, INTEGER, NATURAL, REAL, Checked, EnumT, FuncT
 
 ROOT = Path(__file__).resolve().parents[1]
 CASE_STUDY = ROOT / "contracts" / "remote_inspection.rcl"
@@ -283,7 +283,7 @@ def test_query_budgets_are_resource_steps_not_wall_clock(monkeypatch: pytest.Mon
     # 50 ms net used to fire first ('timeout' instead of the step limit) and
     # the test failed on a busy machine.  What is asserted is the behaviour:
     # a query stops after its budget of steps, at the same step every time.
-    from rclverify.logic import query
+    from rclverify.semantics import query
     monkeypatch.setattr(query, "SAFETY_FACTOR", 10 ** 6)
     x, y = z3.Ints("x y")
 
@@ -311,7 +311,7 @@ def test_model_terms_of_any_depth_render_without_recursion() -> None:
 
     import z3
 
-    from rclverify.logic.encode import term_to_rcl, value_to_rcl
+    from rclverify.semantics.encode import term_to_rcl, value_to_rcl
     p = z3.Int("p1")
     depth = sys.getrecursionlimit() * 3
     term: z3.ExprRef = z3.IntVal(0)

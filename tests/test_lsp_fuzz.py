@@ -69,7 +69,7 @@ PLAN = ("name: fuzz\ncontracts: [contracts/a.rcl]\nrequirements: []\nconnections
 EOLS = ("\n", "\r\n", "\r")
 _BREAK = re.compile(r"\r\n|\r|\n")
 #: What an error message may not hold: a traceback, a file of the server's code.
-_LEAK = re.compile(r"Traceback|File \"|\.py\b|site-packages|rclverify/lsp/")
+_LEAK = re.compile(r"Traceback|File \"|\.py\b|site-packages|rclverify/tools/lsp/")
 
 
 # -- LSP's rules, written here (not the server's code) ----------------------------------------------
@@ -118,8 +118,8 @@ def normalize(text: str) -> str:
 
 def printed(text: str) -> str:
     """The contract of ``text`` as `rclverify fmt` prints it (what a formatting may not change)."""
-    from rclverify.rcl.parser import parse_text
-    from rclverify.rcl.printer import to_rcl
+    from rclverify.lang.parser import parse_text
+    from rclverify.lang.printer import to_rcl
     return to_rcl(parse_text(normalize(text).lstrip("\ufeff"), "a.rcl"))
 
 
@@ -137,7 +137,7 @@ def ws(tmp_path_factory: pytest.TempPathFactory) -> Path:
 
 
 @pytest_lsp.fixture(scope="module", config=ClientServerConfig(
-    server_command=[sys.executable, "-m", "rclverify.cli", "lsp"], server_env=ENV))
+    server_command=[sys.executable, "-m", "rclverify.cli.commands", "lsp"], server_env=ENV))
 async def client(lsp_client: LanguageClient, ws: Path):
     await lsp_client.initialize_session(lsp.InitializeParams(capabilities=lsp.ClientCapabilities(), root_uri=ws.as_uri()))
     yield
@@ -294,7 +294,7 @@ async def test_a_quick_fix_inserts_the_documents_line_end(client: LanguageClient
 
 
 async def test_formatting_a_text_over_the_size_limit_is_refused_at_once(client: LanguageClient, ws: Path) -> None:
-    from rclverify.lsp.diagnostics import MAX_CHARS
+    from rclverify.tools.lsp.diagnostics import MAX_CHARS
     u = (ws / "contracts" / "b.rcl").as_uri()
     open_doc(client, u, CONTRACT + "// padding\r\n" * (MAX_CHARS // 12 + 1))
     t = time.monotonic()
@@ -451,7 +451,7 @@ async def test_random_requests_are_answered_and_formatting_round_trips(client: L
             if len(eols) == 1:
                 assert result == _BREAK.sub(eols.pop(), result)
             assert printed(result) == printed(text)
-            from rclverify.lsp.actions import format_edits  # the \n text's formatting: no line end lost or added
+            from rclverify.tools.lsp.actions import format_edits  # the \n text's formatting: no line end lost or added
             lf = normalize(text)
             assert normalize(result) == apply_edits(lf, format_edits("a.rcl", lf))
             assert result.startswith("\ufeff") == text.startswith("\ufeff")

@@ -58,7 +58,7 @@ def ws(tmp_path_factory: pytest.TempPathFactory) -> Path:
 
 
 @pytest_lsp.fixture(scope="module", config=ClientServerConfig(
-    server_command=[sys.executable, "-m", "rclverify.cli", "lsp"], server_env=ENV))
+    server_command=[sys.executable, "-m", "rclverify.cli.commands", "lsp"], server_env=ENV))
 async def client(lsp_client: LanguageClient, ws: Path):
     await lsp_client.initialize_session(lsp.InitializeParams(capabilities=lsp.ClientCapabilities(), root_uri=ws.as_uri()))
     yield
@@ -91,8 +91,8 @@ async def test_bad_bytes_on_disk_are_one_located_error(client: LanguageClient, w
     u = (ws / "contracts" / "a.rcl").as_uri()
     open_doc(client, u, CONTRACT)
     got = await wait_for(client, (ws / "contracts" / "bad.rcl").as_uri(), lambda ds: bool(ds))
-    from rclverify.rcl.errors import RclError
-    from rclverify.rcl.source import read_text
+    from rclverify.lang.errors import RclError
+    from rclverify.lang.source import read_text
     with pytest.raises(RclError) as exc:  # what `rclverify check` says of the file
         read_text(ws / "contracts" / "bad.rcl", "contracts/bad.rcl")
     (d,) = exc.value.diagnostics
@@ -116,7 +116,7 @@ async def test_deep_nesting_and_strange_characters(client: LanguageClient, ws: P
 
 
 async def test_over_the_size_limit_and_the_server_still_answers(client: LanguageClient, ws: Path) -> None:
-    from rclverify.lsp.diagnostics import MAX_CHARS
+    from rclverify.tools.lsp.diagnostics import MAX_CHARS
     u = (ws / "contracts" / "a.rcl").as_uri()
     huge = CONTRACT + "// padding\n" * (MAX_CHARS // 11 + 1)
     change(client, u, 4, huge)
@@ -131,8 +131,8 @@ async def test_over_the_size_limit_and_the_server_still_answers(client: Language
 async def test_every_prefix_of_a_contract(client: LanguageClient, ws: Path) -> None:
     """Half-typed text: the checker on every prefix (in this process) gives located diagnostics and no
     exception; the server, sent every prefix in a burst, answers at once and ends on the full text."""
-    from rclverify.lsp.diagnostics import analyse, lsp_range
-    from rclverify.lsp.workspace import LspWorkspace
+    from rclverify.tools.lsp.diagnostics import analyse, lsp_range
+    from rclverify.tools.lsp.workspace import LspWorkspace
     lw = LspWorkspace(ws)
     for k in range(len(CONTRACT) + 1):
         a = analyse(lw, "contracts/a.rcl", {"contracts/a.rcl": CONTRACT[:k]})

@@ -21,7 +21,7 @@ BOUND = 10.0
 
 def test_an_unexpected_exception_is_one_line() -> None:
     """The guard around every handler (in this process: no request makes the real server fail on purpose)."""
-    from rclverify.lsp.rpc import guarded
+    from rclverify.tools.lsp.rpc import guarded
 
     @guarded("textDocument/hover")
     def broken(ls: Any, params: Any) -> None:
@@ -34,7 +34,7 @@ def test_an_unexpected_exception_is_one_line() -> None:
 
 
 def test_a_malformed_root_uri_leaves_the_working_directory_the_root() -> None:
-    from rclverify.lsp.server import _root_of
+    from rclverify.tools.lsp.server import _root_of
     for bad in ("file://[::1/ws", "file:///srv/a%00b", "file:///srv/a\x00b"):
         assert _root_of(lsp.InitializeParams(capabilities=lsp.ClientCapabilities(), root_uri=bad)) is None, bad
     assert _root_of(lsp.InitializeParams(capabilities=lsp.ClientCapabilities(), root_uri="file:///srv/w%20s")) == Path("/srv/w s")
@@ -46,7 +46,7 @@ def test_requests_after_shutdown_are_answered(tmp_path: Path) -> None:
     import subprocess
 
     from _procs import stop
-    proc = subprocess.Popen([sys.executable, "-m", "rclverify.cli", "lsp", "-w", str(tmp_path)], env=ENV,
+    proc = subprocess.Popen([sys.executable, "-m", "rclverify.cli.commands", "lsp", "-w", str(tmp_path)], env=ENV,
                             stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=subprocess.PIPE, start_new_session=True)
     try:
         def send(msg: dict[str, Any]) -> None:

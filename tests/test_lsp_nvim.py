@@ -32,7 +32,7 @@ LUA = """
 local root, file, out, python, src = unpack(_G.args)
 local id = vim.lsp.start_client({
   name = "rclverify",
-  cmd = { python, "-m", "rclverify.cli", "lsp" },
+  cmd = { python, "-m", "rclverify.cli.commands", "lsp" },
   cmd_env = { PYTHONPATH = src },
   root_dir = root,
 })
@@ -70,9 +70,9 @@ def test_neovim_reads_the_located_diagnostic(tmp_path: Path) -> None:
                        capture_output=True, text=True, timeout=60)
     assert out.is_file(), f"nvim wrote no diagnostics (exit {p.returncode}): {p.stdout[-2000:]} {p.stderr[-2000:]}"
     rows = json.loads(out.read_text(encoding="utf-8"))
-    from rclverify.rcl.errors import RclError
-    from rclverify.rcl.parser import parse_text
-    from rclverify.rcl.typecheck import check
+    from rclverify.lang.errors import RclError
+    from rclverify.lang.parser import parse_text
+    from rclverify.lang.typecheck import check
     with pytest.raises(RclError) as exc:
         check([parse_text(BAD, "contracts/planner.rcl")])
     want = [(d.loc.line - 1, d.loc.col - 1, d.message, d.code) for d in exc.value.diagnostics]
@@ -100,7 +100,7 @@ def test_the_textmate_grammar_reads_rcl_lark_s_words() -> None:
             for v in x:
                 walk(v)
     walk(grammar)
-    lark = (REPO / "src" / "rclverify" / "rcl" / "rcl.lark").read_text(encoding="utf-8")
+    lark = (REPO / "src" / "rclverify" / "lang" / "rcl.lark").read_text(encoding="utf-8")
     reserved = re.search(r"NAME: /\(\?!\(([^)]*)\)", lark).group(1).split("|")
     assert "forall" in reserved and "TRUE" in reserved
     for word in reserved + ["context", "assume(", "guarantee(", "matches"]:

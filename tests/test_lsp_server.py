@@ -30,7 +30,7 @@ def ws(tmp_path_factory: pytest.TempPathFactory) -> Path:
 
 
 @pytest_lsp.fixture(scope="module", config=ClientServerConfig(
-    server_command=[sys.executable, "-m", "rclverify.cli", "lsp"], server_env=ENV))
+    server_command=[sys.executable, "-m", "rclverify.cli.commands", "lsp"], server_env=ENV))
 async def client(lsp_client: LanguageClient, ws: Path):
     await lsp_client.initialize_session(lsp.InitializeParams(
         capabilities=lsp.ClientCapabilities(), root_uri=ws.as_uri(),
@@ -86,9 +86,9 @@ async def test_a_typed_error_is_located_and_the_findings_go_stale(client: Langua
     assert (err.range.start.line, err.range.start.character) == (at.line, at.character)
     assert err.range.end.line == at.line and err.range.end.character > at.character
     # the command line's message for the same text
-    from rclverify.rcl.parser import parse_text
-    from rclverify.rcl.typecheck import check
-    from rclverify.rcl.errors import RclError
+    from rclverify.lang.parser import parse_text
+    from rclverify.lang.typecheck import check
+    from rclverify.lang.errors import RclError
     with pytest.raises(RclError) as exc:
         check([parse_text(bad, RCL)])
     assert (err.message, err.code) == (exc.value.diagnostics[0].message, exc.value.diagnostics[0].code)
@@ -210,8 +210,8 @@ async def test_formatting_keeps_comments_between_clauses(client: LanguageClient,
         lines = (head + e.new_text + tail).split("\n")
     out = "\n".join(lines)
     assert out.count("//") == text.count("//")
-    from rclverify.rcl.parser import parse_text
-    from rclverify.rcl.printer import to_rcl
+    from rclverify.lang.parser import parse_text
+    from rclverify.lang.printer import to_rcl
     assert to_rcl(parse_text(out)) == to_rcl(parse_text(text))
     assert "  CommandSet : {move(REAL, REAL), inspect(NATURAL)} ;" in out
 

@@ -11,7 +11,7 @@ from pathlib import Path
 import pytest
 import yaml
 
-from rclverify.cli import main
+from rclverify.cli.commands import main
 from rclverify.traces.mapping import RuleError, load_rules, rule_for
 
 REACH = """node Reach {
@@ -51,7 +51,7 @@ def _run(*args: str) -> tuple[int, str]:
     """``rclverify ARGS`` in a process of its own: its messages as a user sees them."""
     import subprocess
     import sys
-    p = subprocess.run([sys.executable, "-m", "rclverify.cli", *args], capture_output=True, text=True, timeout=300)
+    p = subprocess.run([sys.executable, "-m", "rclverify.cli.commands", *args], capture_output=True, text=True, timeout=300)
     return p.returncode, p.stdout + p.stderr
 
 

@@ -2,7 +2,7 @@
 result, another object (even an equal one) or other arguments a new one."""
 from __future__ import annotations
 
-from rclverify.cache.memo import last_call
+from rclverify.core.cache.memo import last_call
 
 
 def test_last_call_keeps_one_result_for_the_same_object() -> None:

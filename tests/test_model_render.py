@@ -7,7 +7,7 @@ import random
 
 import z3
 
-from rclverify.logic.encode import _term_to_rcl_reference, term_to_rcl
+from rclverify.semantics.encode import _term_to_rcl_reference, term_to_rcl
 
 
 def _random_term(rng: random.Random, depth: int, p1: z3.ArithRef, p2: z3.ArithRef, shared: list[z3.BoolRef]) -> z3.ExprRef:
@@ -43,7 +43,7 @@ def test_deep_chain_beyond_the_recursion_limit() -> None:
 def test_a_function_model_names_its_arguments_in_order() -> None:
     """In a function interpretation Var(j) is argument j: f(x, y) = x - 2y is
     printed with p1 for x (it was printed transposed)."""
-    from rclverify.logic.query import render_model
+    from rclverify.semantics.query import render_model
     f = z3.Function("f", z3.IntSort(), z3.IntSort(), z3.IntSort())
     x, y = z3.Ints("x y")
     s = z3.Solver()
@@ -56,10 +56,10 @@ def test_a_function_model_names_its_arguments_in_order() -> None:
 def test_a_function_constant_off_a_grid_of_points_is_an_exact_table() -> None:
     """An interpretation whose conditions only compare arguments with numerals
     is printed as the points where it differs from its value elsewhere, and
-    that value (logic/functable.py). Z3 answers this one with a disjunctive
+    that value (semantics/functable.py). Z3 answers this one with a disjunctive
     first branch of value 1 and an unreachable last ``else`` of 2, which a
     reading of the text would have called the value elsewhere."""
-    from rclverify.logic.query import render_model
+    from rclverify.semantics.query import render_model
     g = z3.Function("g", z3.RealSort(), z3.RealSort(), z3.IntSort())
     a, b = z3.Reals("a b")
     s = z3.Solver()
@@ -77,7 +77,7 @@ def test_a_function_constant_off_a_grid_of_points_is_an_exact_table() -> None:
 def test_a_function_that_returns_its_argument_is_not_made_a_table() -> None:
     """f(x) = x except f(3) = 7 takes infinitely many values: it is printed as
     its term, never as a table with one value elsewhere."""
-    from rclverify.logic.query import render_model
+    from rclverify.semantics.query import render_model
     f = z3.Function("f", z3.IntSort(), z3.IntSort())
     x = z3.Int("x")
     s = z3.Solver()

@@ -18,9 +18,9 @@ from hypothesis import given, settings, strategies as st
 from rclverify.backends.monitors.check import check_trace
 from rclverify.backends.monitors.deadlines import check_deadlines
 from rclverify.backends.monitors.online import OnlineEngine
-from rclverify.cli import main
-from rclverify.logic.evaluate import evaluate
-from rclverify.rcl.typecheck import load
+from rclverify.cli.commands import main
+from rclverify.semantics.evaluate import evaluate
+from rclverify.lang.typecheck import load
 from rclverify.traces.events import Event
 from rclverify.traces.mapping import RuleError, load_rules
 

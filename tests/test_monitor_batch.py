@@ -24,9 +24,9 @@ from rclverify.backends.monitors.check import check_trace
 from rclverify.backends.monitors.columns import ColumnCompiler
 from rclverify.backends.monitors.config import load_mapping
 from rclverify.backends.monitors.engine import NodeMonitor
-from rclverify.logic.floatsem import judge, parse_tolerance
-from rclverify.rcl.parser import parse_formula
-from rclverify.rcl.typecheck import load
+from rclverify.semantics.floatsem import judge, parse_tolerance
+from rclverify.lang.parser import parse_formula
+from rclverify.lang.typecheck import load
 from rclverify.traces import read_trace
 from rclverify.traces.events import Event
 from rclverify.traces.mapping import load_rules

@@ -5,7 +5,7 @@ evidence names the semantics that decided.  A node computing ``1000 * 1.2``
 and publishing ``1200.0`` does not violate ``out.d == 1000 * in.r``; one
 publishing ``1201.0`` does, in every semantics.
 
-The oracle at the end compares :func:`rclverify.logic.floatsem.judge` with
+The oracle at the end compares :func:`rclverify.semantics.floatsem.judge` with
 a direct reading of the three semantics written here (Fractions, Python
 floats, the tolerance's definition) on random formulas and values."""
 from __future__ import annotations
@@ -23,9 +23,9 @@ from rclverify.backends.monitors.config import ConfigError, load_mapping
 from rclverify.backends.monitors.deadlines import check_deadlines, deadline_status
 from rclverify.backends.monitors.online import OnlineEngine
 from rclverify.backends.monitors.backend import verdict_status
-from rclverify.logic.floatsem import Tolerance, judge, parse_tolerance, ulp_distance
-from rclverify.rcl.parser import parse_text
-from rclverify.rcl.typecheck import check, load
+from rclverify.semantics.floatsem import Tolerance, judge, parse_tolerance, ulp_distance
+from rclverify.lang.parser import parse_text
+from rclverify.lang.typecheck import check, load
 from rclverify.traces import read_trace
 from rclverify.traces.events import Event
 from rclverify.traces.mapping import load_rules
@@ -277,7 +277,7 @@ def test_judge_equals_the_semantics_read_directly(f: Any, r: float, d: float, to
 def test_the_evidence_and_the_report_name_the_semantics(tmp_path: Path) -> None:
     """``rclverify verify`` on a workspace whose recorded run needs double
     arithmetic (Scale) and a declared tolerance (Clamp, plan entry)."""
-    from rclverify.cli import main
+    from rclverify.cli.commands import main
     ws = tmp_path / "ws"
     (ws / "contracts").mkdir(parents=True)
     (ws / "contracts" / "scale.rcl").write_text(SCALE)

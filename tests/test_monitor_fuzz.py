@@ -22,8 +22,8 @@ from hypothesis import strategies as st
 
 from rclverify.backends.monitors.check import NodeMonitor, check_trace
 from rclverify.backends.monitors.config import load_mapping
-from rclverify.cli import main
-from rclverify.rcl.typecheck import load
+from rclverify.cli.commands import main
+from rclverify.lang.typecheck import load
 from rclverify.traces import TraceError, read_trace
 from rclverify.traces.events import Event
 from rclverify.traces.mapping import TopicRule
@@ -228,7 +228,7 @@ def test_a_long_run_generated_lazily_is_checked_in_flat_memory(cruise_ws: Path) 
 
 
 def test_doit_verify_with_a_bad_trace_writes_the_report(cruise_ws: Path) -> None:
-    (cruise_ws / "dodo.py").write_text("from pathlib import Path\nfrom rclverify.tasks import build_tasks, "
+    (cruise_ws / "dodo.py").write_text("from pathlib import Path\nfrom rclverify.app.tasks import build_tasks, "
                                        "doit_config\nDOIT_CONFIG = doit_config()\n"
                                        "globals().update(build_tasks(Path(__file__).parent))\n")
     import os

@@ -41,13 +41,13 @@ pytest.importorskip("cyclonedds", reason="the cyclonedds binding is not installe
 
 from dds_ros2 import Ros2Participant, dds_env, domain_of, matched, wait_until  # noqa: E402
 
-from rclverify.ros.dds_qos import QosProfile  # noqa: E402
+from rclverify.ros.live.dds_qos import QosProfile  # noqa: E402
 
 from rclverify.backends.monitors.check import check_trace  # noqa: E402
 from rclverify.backends.monitors.dds_calls import CallBook, replay  # noqa: E402
-from rclverify.backends.monitors.dds_types import TypeBook  # noqa: E402
-from rclverify.cli import main  # noqa: E402
-from rclverify.rcl.typecheck import load  # noqa: E402
+from rclverify.runtime.dds.types import TypeBook  # noqa: E402
+from rclverify.cli.commands import main  # noqa: E402
+from rclverify.lang.typecheck import load  # noqa: E402
 from rclverify.traces.jsonl import read_jsonl  # noqa: E402
 
 REPO = Path(__file__).resolve().parents[1]
@@ -72,7 +72,7 @@ def run(tmp_path_factory: pytest.TempPathFactory) -> Iterator[dict[str, Any]]:
         mp.setenv(k, v)
     out = tmp / "monitor.out"
     monitor = subprocess.Popen(
-        [sys.executable, "-m", "rclverify.cli", "monitor", "-w", str(WS), "--live", "--ros2", "--interfaces",
+        [sys.executable, "-m", "rclverify.cli.commands", "monitor", "-w", str(WS), "--live", "--ros2", "--interfaces",
          "interfaces", "--enforce", "/speed", "--record", str(tmp / "run.mcap"), "--log", str(tmp / "live.jsonl"),
          "--evidence", str(tmp / "live.json"), "--horizon", "1.0", "--reorder-window", "0", "--status", "0",
          "--duration", "60"],

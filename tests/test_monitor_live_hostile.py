@@ -1,6 +1,6 @@
 """``rclverify monitor --live`` against a ROS 1 master that hangs on
 ``registerPublisher``: SIGTERM and SIGINT stop it within seconds, with one
-message and exit 2, not after minutes (backends/monitors/ros1.py, "A
+message and exit 2, not after minutes (runtime/ros1.py, "A
 master is an external peer").
 
 The master is a tiny threaded XML-RPC server on 127.0.0.1 and an ephemeral
@@ -30,7 +30,7 @@ REPO = Path(__file__).resolve().parents[1]
 @functools.cache
 def _no_rospy() -> str | None:
     """Why rospy cannot be imported, or None: asked once, when the module's tests run."""
-    r = subprocess.run([sys.executable, "-c", "from rclverify.backends.monitors.ros1 import import_rospy; "
+    r = subprocess.run([sys.executable, "-c", "from rclverify.runtime.ros1 import import_rospy; "
                         "import_rospy()"], capture_output=True, text=True,
                        env=dict(os.environ, PYTHONPATH=str(REPO / "src")))
     return None if r.returncode == 0 else f"rospy cannot be imported: {r.stderr.strip()[-200:]}"
@@ -96,7 +96,7 @@ def test_a_signal_stops_the_monitor_while_the_master_hangs(master: HangingMaster
     env = dict(os.environ, ROS_MASTER_URI=master.uri, ROS_IP="127.0.0.1", ROS_HOSTNAME="127.0.0.1",
                ROS_HOME=str(tmp_path / "ros_home"), ROS_LOG_DIR=str(tmp_path / "log"),
                PYTHONPATH=str(REPO / "src") + os.pathsep + os.environ.get("PYTHONPATH", ""))
-    p = subprocess.Popen([sys.executable, "-m", "rclverify.cli", "monitor", "--live", "-w", str(REPO),
+    p = subprocess.Popen([sys.executable, "-m", "rclverify.cli.commands", "monitor", "--live", "-w", str(REPO),
                           "--node", "RadiationSensor", "--log", str(tmp_path / "live.jsonl")],
                          env=env, cwd=tmp_path, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
                          start_new_session=True)

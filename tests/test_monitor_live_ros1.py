@@ -25,10 +25,10 @@ from _procs import stop, wait_for
 
 from rclverify.backends.monitors.check import check_trace
 from rclverify.backends.monitors.config import load_mapping
-from rclverify.backends.monitors.live import VERDICT_LOG_TOPIC
-from rclverify.backends.monitors.ros1 import LocalMaster, RosUnavailable, import_rospy
-from rclverify.cli import main
-from rclverify.rcl.typecheck import load
+from rclverify.runtime.live import VERDICT_LOG_TOPIC
+from rclverify.runtime.ros1 import LocalMaster, RosUnavailable, import_rospy
+from rclverify.cli.commands import main
+from rclverify.lang.typecheck import load
 from rclverify.traces import read_trace
 
 REPO = Path(__file__).resolve().parents[1]
@@ -63,7 +63,7 @@ def live_run(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
             procs.append(listener)
             sensor = _start([str(SCRIPT), "sensor", "--misclassify"], env, tmp / "sensor.out")
             procs.append(sensor)
-            monitor = _start(["-m", "rclverify.cli", "monitor", "--live", "-w", str(REPO), "--horizon", str(HORIZON),
+            monitor = _start(["-m", "rclverify.cli.commands", "monitor", "--live", "-w", str(REPO), "--horizon", str(HORIZON),
                               "--log", str(tmp / "live.jsonl"), "--evidence", str(tmp / "evidence.json"),
                               "--status", "0.5", "--duration", "60"], env, tmp / "monitor.out")
             procs.append(monitor)

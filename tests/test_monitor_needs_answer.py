@@ -13,7 +13,7 @@ from hypothesis import given, settings, strategies as st
 
 from rclverify.backends.monitors.check import NodeMonitor, check_trace
 from rclverify.backends.monitors.needs_answer import answer_decides
-from rclverify.rcl.typecheck import load
+from rclverify.lang.typecheck import load
 from rclverify.traces.events import Event
 from rclverify.traces.mapping import load_rules
 

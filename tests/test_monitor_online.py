@@ -11,7 +11,7 @@ import pytest
 from rclverify.backends.monitors.check import check_trace
 from rclverify.backends.monitors.config import load_mapping
 from rclverify.backends.monitors.online import OnlineEngine, header_stamp
-from rclverify.rcl.typecheck import load
+from rclverify.lang.typecheck import load
 from rclverify.traces import read_trace
 
 REPO = Path(__file__).resolve().parents[1]
@@ -119,7 +119,7 @@ def test_live_run_logs_publishes_and_writes_evidence_the_offline_check_agrees_wi
     import hashlib
     import json
 
-    from rclverify.backends.monitors.live import VERDICT_LOG_TOPIC, LiveRun
+    from rclverify.runtime.live import VERDICT_LOG_TOPIC, LiveRun
     checked, cfg = case_study
     published: list[str] = []
     last: dict[str, str] = {}
@@ -152,8 +152,8 @@ def _worker_run(checked: Any, cfg: Any, tmp_path: Path, run: str, *, before_star
     message; returns (verdict keys, evidence record)."""
     import json
 
-    from rclverify.backends.monitors.live import LiveRun
-    from rclverify.backends.monitors.worker import EngineWorker
+    from rclverify.runtime.live import LiveRun
+    from rclverify.runtime.worker import EngineWorker
     published: list[str] = []
     live = LiveRun(checked, list(checked.nodes.values()), cfg.rules, cfg.horizon, tmp_path / f"{run}.jsonl",
                    reorder_window=0.0, publish=published.append)
@@ -192,8 +192,8 @@ def test_the_engine_thread_gives_the_offline_verdicts_even_with_a_backlog(
 
 
 def test_an_error_in_the_engine_thread_is_raised_by_stop(case_study: tuple[Any, Any], tmp_path: Path) -> None:
-    from rclverify.backends.monitors.live import LiveRun
-    from rclverify.backends.monitors.worker import EngineWorker
+    from rclverify.runtime.live import LiveRun
+    from rclverify.runtime.worker import EngineWorker
     checked, cfg = case_study
     live = LiveRun(checked, list(checked.nodes.values()), cfg.rules, cfg.horizon, tmp_path / "x.jsonl")
 
@@ -207,8 +207,8 @@ def test_an_error_in_the_engine_thread_is_raised_by_stop(case_study: tuple[Any, 
 
 
 def test_a_full_queue_drops_and_counts_instead_of_growing(case_study: tuple[Any, Any], tmp_path: Path) -> None:
-    from rclverify.backends.monitors.live import LiveRun
-    from rclverify.backends.monitors.worker import EngineWorker
+    from rclverify.runtime.live import LiveRun
+    from rclverify.runtime.worker import EngineWorker
     checked, cfg = case_study
     live = LiveRun(checked, list(checked.nodes.values()), cfg.rules, cfg.horizon, tmp_path / "x.jsonl")
     worker = EngineWorker(live, lambda topic, fields: fields, lambda: 1.0, max_queue=5)
@@ -223,8 +223,8 @@ def test_the_evidence_of_a_run_that_dropped_messages_or_lost_its_engine_is_not_d
         case_study: tuple[Any, Any], tmp_path: Path) -> None:
     """stop_and_record (both ROS layers): verdicts that miss dropped messages prove nothing, so no node
     reads discharged or pending; an engine that died makes every node error, with the reason."""
-    from rclverify.backends.monitors.live import LiveRun, stop_and_record
-    from rclverify.backends.monitors.worker import EngineWorker
+    from rclverify.runtime.live import LiveRun, stop_and_record
+    from rclverify.runtime.worker import EngineWorker
     checked, cfg = case_study
     lines: list[str] = []
 
@@ -254,7 +254,7 @@ def test_verdict_connections_get_tcp_nodelay() -> None:
     import socket
     from types import SimpleNamespace
 
-    from rclverify.backends.monitors.live import _no_delay
+    from rclverify.runtime.live import _no_delay
     server = socket.create_server(("127.0.0.1", 0))
     client = socket.create_connection(server.getsockname())
     peer, _ = server.accept()

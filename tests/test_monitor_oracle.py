@@ -16,9 +16,9 @@ from websockets.sync.client import connect
 
 from rclverify.backends.monitors.check import check_trace
 from rclverify.backends.monitors.config import load_mapping
-from rclverify.backends.monitors.oracle import ORACLE_VERDICTS
-from rclverify.backends.monitors.ros1 import free_port
-from rclverify.rcl.typecheck import load
+from rclverify.runtime.oracle import ORACLE_VERDICTS
+from rclverify.runtime.ros1 import free_port
+from rclverify.lang.typecheck import load
 from rclverify.traces import read_trace
 
 REPO = Path(__file__).resolve().parents[1]
@@ -30,7 +30,7 @@ def oracle(tmp_path_factory: pytest.TempPathFactory) -> Any:
     port = free_port()
     out = tmp_path_factory.mktemp("oracle") / "oracle.out"
     env = dict(os.environ, PYTHONPATH=str(REPO / "src") + os.pathsep + os.environ.get("PYTHONPATH", ""))
-    p = subprocess.Popen([sys.executable, "-m", "rclverify.cli", "oracle", "-w", str(REPO), "--port", str(port),
+    p = subprocess.Popen([sys.executable, "-m", "rclverify.cli.commands", "oracle", "-w", str(REPO), "--port", str(port),
                           "--node", "RadiationSensor", "--horizon", "2.0"], env=env, cwd=REPO,
                          stdout=out.open("wb"), stderr=subprocess.STDOUT, start_new_session=True)
     try:
@@ -110,7 +110,7 @@ def test_malformed_events_are_unknown_with_the_reason_and_the_run_goes_on(oracle
 
 def test_a_busy_port_is_one_located_error(oracle: Any) -> None:
     _, port = oracle
-    r = subprocess.run([sys.executable, "-m", "rclverify.cli", "oracle", "-w", str(REPO), "--port", str(port)],
+    r = subprocess.run([sys.executable, "-m", "rclverify.cli.commands", "oracle", "-w", str(REPO), "--port", str(port)],
                        cwd=REPO, capture_output=True, text=True, timeout=60,
                        env=dict(os.environ, PYTHONPATH=str(REPO / "src")))
     assert r.returncode == 2 and "Traceback" not in r.stderr

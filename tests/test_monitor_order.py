@@ -25,8 +25,8 @@ import pytest
 from rclverify.backends.monitors.check import check_trace
 from rclverify.backends.monitors.deadlines import check_deadlines
 from rclverify.backends.monitors.online import OnlineEngine
-from rclverify.cli import main
-from rclverify.rcl.typecheck import load
+from rclverify.cli.commands import main
+from rclverify.lang.typecheck import load
 from rclverify.traces import read_trace
 
 SENSOR = """

@@ -11,9 +11,9 @@ from pathlib import Path
 import pytest
 
 from rclverify.backends.monitors.periods import check_periods, has_periods, period_status
-from rclverify.cli import main
-from rclverify.rcl.typecheck import check
-from rclverify.rcl.parser import parse_text
+from rclverify.cli.commands import main
+from rclverify.lang.typecheck import check
+from rclverify.lang.parser import parse_text
 from rclverify.traces.events import Event
 
 RCL = """node Watchdog {

@@ -20,10 +20,10 @@ import pytest
 
 from rclverify.backends.monitors.config import load_mapping
 from rclverify.backends.monitors.judged import Heard, not_judged
-from rclverify.backends.monitors.live import LiveRun
-from rclverify.cli import main
-from rclverify.rcl.parser import parse_text
-from rclverify.rcl.typecheck import check
+from rclverify.runtime.live import LiveRun
+from rclverify.cli.commands import main
+from rclverify.lang.parser import parse_text
+from rclverify.lang.typecheck import check
 
 RCL = """\
 node Echo {

@@ -157,7 +157,7 @@ def test_a_partial_answer_received_early_is_never_dropped_green(tmp_path: Path) 
     no verdict and the run read discharged; the early status completes the reading 300's answer
     within the skew, false there: inconclusive, with both questions named."""
     from rclverify.backends.monitors.backend import verdict_status
-    from rclverify.rcl.typecheck import load
+    from rclverify.lang.typecheck import load
     from rclverify.traces.events import Event
     p = tmp_path / "two.rcl"
     p.write_text(TWO_OUTPUTS)
@@ -199,7 +199,7 @@ def test_the_skew_never_turns_a_verdict_green_nor_red_with_answers_in_two_messag
     the skew and is right for every question it may answer); and a run the skew leaves
     ``discharged`` was ``discharged`` without it."""
     from rclverify.backends.monitors.backend import verdict_status
-    from rclverify.rcl.typecheck import load
+    from rclverify.lang.typecheck import load
     from rclverify.traces.events import Event
     p = tmp_path_factory.mktemp("two") / "two.rcl"
     p.write_text(TWO_OUTPUTS)

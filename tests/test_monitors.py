@@ -14,12 +14,12 @@ from rclverify.backends.base import NodeTarget
 from rclverify.backends.monitors.backend import MonitorsBackend, render_config
 from rclverify.backends.monitors.check import check_trace
 from rclverify.backends.monitors.config import load_mapping
-from rclverify.cli import main
-from rclverify.logic.evaluate import evaluate
-from rclverify.rcl.parser import parse_formula as parse_expr
-from rclverify.rcl.typecheck import load
+from rclverify.cli.commands import main
+from rclverify.semantics.evaluate import evaluate
+from rclverify.lang.parser import parse_formula as parse_expr
+from rclverify.lang.typecheck import load
 from rclverify.traces import read_trace
-from rclverify.values import FiniteFunction, Term
+from rclverify.semantics.values import FiniteFunction, Term
 
 REPO = Path(__file__).resolve().parents[1]
 RCL = "contracts/remote_inspection.rcl"

@@ -1,12 +1,12 @@
-"""Direct evaluation (logic/evaluate.py, the monitors' engine) and Z3 on
-concrete values (logic/concrete.py) agree wherever both decide.
+"""Direct evaluation (semantics/evaluate.py, the monitors' engine) and Z3 on
+concrete values (semantics/concrete.py) agree wherever both decide.
 
 Hypothesis draws well-typed RCL formulas over one small typed signature
 (numbers of the three numeric types, BOOL, an enumeration, a constructor
 set, two function types) with nested quantifiers of every kind, and values
 for every input and output; each formula is checked on several value sets
 by both engines.  Property tests trust direct evaluation wherever it decides
-(logic/decide.py, docs/property-tests.md), so a disagreement here is a wrong
+(semantics/decide.py, docs/property-tests.md), so a disagreement here is a wrong
 verdict there.
 """
 from __future__ import annotations
@@ -19,14 +19,14 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from rclverify.logic.concrete import check_concrete
-from rclverify.logic.decide import decide
-from rclverify.logic.encode import EncodingError
-from rclverify.logic import world
-from rclverify.logic.evaluate import evaluate
-from rclverify.rcl.parser import parse_formula, parse_text
-from rclverify.rcl.typecheck import check
-from rclverify.values import FiniteFunction, Term
+from rclverify.semantics.concrete import check_concrete
+from rclverify.semantics.decide import decide
+from rclverify.semantics.encode import EncodingError
+from rclverify.semantics import world
+from rclverify.semantics.evaluate import evaluate
+from rclverify.lang.parser import parse_formula, parse_text
+from rclverify.lang.typecheck import check
+from rclverify.semantics.values import FiniteFunction, Term
 
 SIGNATURE = """
 context {

@@ -11,7 +11,7 @@ from pathlib import Path
 
 import pytest
 
-from rclverify.cli import main
+from rclverify.cli.commands import main
 
 ROUTE = """context {
   RouteBuffer : NATURAL = 50 ;

@@ -11,8 +11,8 @@ from typing import Any
 
 import pytest
 
-from rclverify.argument.model import Argument, Element, propagate
-from rclverify.cli import main
+from rclverify.report.argument.model import Argument, Element, propagate
+from rclverify.cli.commands import main
 from rclverify.report.culprits import mark_culprits
 
 from _grip_ws import make
@@ -84,7 +84,7 @@ def test_a_defeated_goal_is_never_better_than_its_defeater() -> None:
 
 
 def test_hover_names_the_problem(report: dict[str, Any]) -> None:
-    from rclverify.lsp.hover import _ENV
+    from rclverify.tools.lsp.hover import _ENV
     text = _ENV.get_template("hover.md.j2").render(
         kind="node", name="Supervisor", status="failed", culprit_of=[{"status": "failed", "sentence": "S allows 45."}],
         contract="node Supervisor {}", guarantees=[], producers=[], consumers=[])
@@ -127,7 +127,7 @@ def test_a_temporal_requirement_names_the_off_by_one(tmp_path: Path) -> None:
     (tmp_path / "contracts").mkdir()
     (tmp_path / "contracts" / "arm.rcl").write_text(ARM, encoding="utf-8")
     (tmp_path / "contracts" / "plan.yaml").write_text(ARM_PLAN, encoding="utf-8")
-    (tmp_path / "dodo.py").write_text("from pathlib import Path\nfrom rclverify.tasks import build_tasks, doit_config\n"
+    (tmp_path / "dodo.py").write_text("from pathlib import Path\nfrom rclverify.app.tasks import build_tasks, doit_config\n"
                                       "DOIT_CONFIG = doit_config()\nglobals().update(build_tasks(Path(__file__).parent))\n",
                                       encoding="utf-8")
     assert main(["verify", "-w", str(tmp_path)]) == 0
@@ -142,7 +142,7 @@ def test_a_temporal_requirement_names_the_off_by_one(tmp_path: Path) -> None:
 
 def test_a_counterexample_through_a_refuted_side_condition_says_so(report: dict[str, Any]) -> None:
     from rclverify.diagnosis.requirement import _passes_through
-    from rclverify.workspace import Workspace
+    from rclverify.stages.workspace import Workspace
     ws = Workspace(Path(report["_ws"]), "contracts/plan.yaml")
     cone = ["Supervisor", "GripperDriver"]
 
@@ -189,7 +189,7 @@ def test_a_run_whose_assumption_the_side_condition_lets_fail_joins_its_row(tmp_p
     (tmp_path / "contracts" / "plan.yaml").write_text(
         'name: "gripm"\ncontracts: [contracts/cell.rcl]\nrequirements: []\nnodes:\n'
         f"  Supervisor:\n    evidence:\n{entry}  GripperDriver:\n    evidence:\n{entry}", encoding="utf-8")
-    (tmp_path / "dodo.py").write_text("from pathlib import Path\nfrom rclverify.tasks import build_tasks, doit_config\n"
+    (tmp_path / "dodo.py").write_text("from pathlib import Path\nfrom rclverify.app.tasks import build_tasks, doit_config\n"
                                       "DOIT_CONFIG = doit_config()\nglobals().update(build_tasks(Path(__file__).parent))\n",
                                       encoding="utf-8")
     assert main(["verify", "-w", str(tmp_path)]) == 0

@@ -10,8 +10,8 @@ from pathlib import Path
 
 import pytest
 
-from rclverify.evidence.store import dumps
-from rclverify.pipeline import Workspace
+from rclverify.records.store import dumps
+from rclverify.app.pipeline import Workspace
 from rclverify.report.build import build_report
 from rclverify.report.fragments import FragmentCache, cached_dumps
 from rclverify.report.parts import FRAGMENTS, PARTS, write_part
@@ -220,9 +220,9 @@ def test_the_argument_is_written_and_agrees_with_the_report(report: dict, worksp
 
 
 def test_bundle_of_the_case_study_verifies(workspace: Path, tmp_path: Path) -> None:
-    from rclverify.bundle.archive import verify_bundle
+    from rclverify.report.bundle.archive import verify_bundle
     out = tmp_path / "case-study.tar.gz"
-    r = subprocess.run([sys.executable, "-m", "rclverify.cli", "bundle", "-w", str(workspace), "-o", str(out)],
+    r = subprocess.run([sys.executable, "-m", "rclverify.cli.commands", "bundle", "-w", str(workspace), "-o", str(out)],
                        capture_output=True, text=True, timeout=300)
     assert r.returncode == 0, r.stderr
     manifest = verify_bundle(out)
@@ -282,7 +282,7 @@ def test_everything_kept_between_runs_is_in_the_cache_layer(workspace: Path) -> 
     """One cache layer (issue 25): every file a run keeps under artifacts/cache is in the cache
     layer's format, written by this code, and `rclverify cache` lists each one; only jinja2's own
     bytecode cache and the layout blobs are directories."""
-    from rclverify.cache import kept_files
+    from rclverify.core.cache import kept_files
     rows = kept_files(workspace)
     files = {r["file"].removeprefix("artifacts/cache/"): r for r in rows}
     expected = {"workspace.pickle", "contract-texts.pickle", "report-fragments.html.pickle",
@@ -295,7 +295,7 @@ def test_everything_kept_between_runs_is_in_the_cache_layer(workspace: Path) -> 
             assert name in ("layout/", "templates/"), name
         else:
             assert r["current"] and r["kind"], r
-    out = subprocess.run([sys.executable, "-m", "rclverify.cli", "cache", "-w", str(workspace)],
+    out = subprocess.run([sys.executable, "-m", "rclverify.cli.commands", "cache", "-w", str(workspace)],
                          capture_output=True, text=True, timeout=60)
     assert out.returncode == 0 and "report-fragments" in out.stdout and "other code" not in out.stdout, out.stdout
 
@@ -346,7 +346,7 @@ def test_staleness_follows_the_inputs_of_each_obligation(workspace: Path) -> Non
         assert not [e for e in report["evidence"] if e["status"] == "stale"]
         # a changed backend input makes its evidence stale until it is re-run
         program.write_text(program_text + "\n// reviewed\n")
-        r = subprocess.run([sys.executable, "-m", "rclverify.cli", "report", "-w", str(workspace)],
+        r = subprocess.run([sys.executable, "-m", "rclverify.cli.commands", "report", "-w", str(workspace)],
                            capture_output=True, text=True, timeout=300)
         assert r.returncode == 0, r.stderr
         report = json.loads((workspace / "reports" / "assurance.json").read_text())
@@ -422,7 +422,7 @@ def test_every_violation_of_a_run_is_kept_and_explained_one_by_one(workspace: Pa
                                                                    capsys: pytest.CaptureFixture[str]) -> None:
     """Issue 47/48: a run keeps every violation (time, message, guarantee, values, the question
     answered), not only the first; `rclverify explain OBLIGATION#N` reaches each."""
-    from rclverify.cli import main
+    from rclverify.cli.commands import main
     ev = next(e for e in report["evidence"] if e["obligation"] == "Agent.g0.monitors.nominal_jsonl")
     vs = ev["monitoring"]["violations"]
     assert len(vs) == ev["monitoring"]["counts"]["violated"] == 12
@@ -444,7 +444,7 @@ FILES = ("assurance.html", "assurance.md", "assurance.json", "assurance.sarif", 
 
 def _render(ws: Path, out: Path, fragments: FragmentCache | None) -> dict[str, bytes]:
     """Every report file of ``ws`` rendered into ``out`` (as the report task does)."""
-    from rclverify.argument.export import write_argument
+    from rclverify.report.argument.export import write_argument
     from rclverify.report.ci import write_ci_reports
     from rclverify.report.render import render_all
     report = build_report(Workspace(ws))

@@ -7,11 +7,11 @@ from pathlib import Path
 
 import pytest
 
-from rclverify.cli import main
-from rclverify.plan.errors import PlanError
-from rclverify.plan.load import load_plan, resolve
-from rclverify.rcl.errors import Diagnostic
-from rclverify.rcl.typecheck import load
+from rclverify.cli.commands import main
+from rclverify.model.plan.errors import PlanError
+from rclverify.model.plan.load import load_plan, resolve
+from rclverify.lang.errors import Diagnostic
+from rclverify.lang.typecheck import load
 
 ROOT = Path(__file__).resolve().parents[1]
 PLAN = "contracts/plan.yaml"

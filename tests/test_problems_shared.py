@@ -11,7 +11,7 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-from rclverify.cli import main
+from rclverify.cli.commands import main
 from rclverify.report.problems_shared import join_by_first_repair
 
 SYSTEM = """\

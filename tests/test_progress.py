@@ -5,7 +5,7 @@ import io
 from types import SimpleNamespace
 from typing import Any
 
-from rclverify.progress import ProgressReporter, backend_of
+from rclverify.app.progress import ProgressReporter, backend_of
 from rclverify.report.summary import MAX_ROWS, node_rows, print_summary
 
 
@@ -71,7 +71,7 @@ def test_a_completed_run_freezes_the_heap_only_at_exit(monkeypatch: Any) -> None
     import atexit
     import gc
 
-    from rclverify.cache import heap
+    from rclverify.core.cache import heap
     registered: list[Any] = []
     monkeypatch.setattr(atexit, "register", registered.append)
     monkeypatch.setattr(heap, "_EXIT", [])
@@ -93,9 +93,9 @@ def test_verify_prints_the_summary_written_with_the_report(tmp_path: Any, capsys
 
     from doit.exceptions import TaskFailed
 
-    from rclverify.pipeline import Workspace
+    from rclverify.app.pipeline import Workspace
     from rclverify.report.summary import summary_data
-    from rclverify.tasks import act_verify
+    from rclverify.app.tasks import act_verify
     report = _report(3)
     report["meta"]["strict_ok"] = False
     report["summary"] = {"status": "failed", "headline": "from the JSON report", "problems": ["N7 is bad"]}
@@ -109,7 +109,7 @@ def test_verify_prints_the_summary_written_with_the_report(tmp_path: Any, capsys
     data["summary"] = {**data["summary"], "headline": "from the summary file"}
     data["meta"]["strict_ok"] = True
     (tmp_path / Workspace.SUMMARY).parent.mkdir(parents=True)
-    from rclverify.evidence.sealed import write_sealed
+    from rclverify.records.sealed import write_sealed
     write_sealed(tmp_path / Workspace.SUMMARY, data)  # as the report task writes it: sealed
     assert act_verify(str(tmp_path), True) is None
     assert "overall: failed -- from the summary file" in capsys.readouterr().out

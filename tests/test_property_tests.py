@@ -1,5 +1,5 @@
 """Tests of the property_tests backend and of the Z3 check on concrete values
-(rclverify.logic.concrete): real Hypothesis runs on small workspaces."""
+(rclverify.semantics.concrete): real Hypothesis runs on small workspaces."""
 from __future__ import annotations
 
 import os
@@ -13,18 +13,18 @@ import pytest
 
 from rclverify.backends import get_backend
 from rclverify.backends.property_tests.backend import PropertyTestsBackend
-from rclverify.evidence.records import Evidence
-from rclverify.logic.concrete import check_concrete
-from rclverify.pipeline import Workspace
-from rclverify.plan.errors import PlanError
-from rclverify.rcl.typecheck import load
-from rclverify.values import FiniteFunction, Term
+from rclverify.records.records import Evidence
+from rclverify.semantics.concrete import check_concrete
+from rclverify.app.pipeline import Workspace
+from rclverify.model.plan.errors import PlanError
+from rclverify.lang.typecheck import load
+from rclverify.semantics.values import FiniteFunction, Term
 
 REPO = Path(__file__).resolve().parents[1]
 RCL = "contracts/remote_inspection.rcl"
 
 GOOD = '''
-from rclverify.values import FiniteFunction
+from rclverify.semantics.values import FiniteFunction
 
 def sensor(r, command):
     status = "green" if r < 120 else "orange" if r < 250 else "red"
@@ -35,7 +35,7 @@ OFF_BY_ONE = GOOD.replace("r < 120", "r <= 120")
 OUT_OF_TYPE = GOOD.replace('"red"', '"yellow"')
 RAISES = GOOD.replace("    status =", "    if r > 1000: raise ValueError('too hot')\n    status =")
 STATEFUL = '''
-from rclverify.values import FiniteFunction
+from rclverify.semantics.values import FiniteFunction
 
 class Sensor:
     """Remembers every inspected waypoint."""
@@ -121,7 +121,7 @@ def test_correct_implementation_discharged(tmp_path: Path) -> None:
 
 
 def test_the_coverage_of_a_bounded_range_is_the_buckets_the_examples_hit(tmp_path: Path) -> None:
-    from rclverify.argument.strength import evidence_strength
+    from rclverify.report.argument.strength import evidence_strength
     ev = run(workspace(tmp_path, GOOD, extra="        bounds: {in.r: [0, 500]}\n"))
     c = ev.details["coverage"]["in.r"]
     lo, hi = (float(x) for x in c["drawn"].split(".."))
@@ -242,7 +242,7 @@ def test_check_concrete_rejects_unknown_name(checked: Any) -> None:
 
 def test_z3_unknown_is_inconclusive_never_passed(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     from rclverify.backends.property_tests import harness
-    from rclverify.logic.floatsem import Judgement
+    from rclverify.semantics.floatsem import Judgement
 
     def unknown_on_guarantee(formula: Any, checked: Any, node: Any, values: Any, *a: Any, **kw: Any) -> Any:
         assert any(k.startswith("out.") for k in values)  # judge decides the guarantee checks only
@@ -259,7 +259,7 @@ def test_z3_unknown_is_inconclusive_never_passed(tmp_path: Path, monkeypatch: py
 
 def _count_z3(monkeypatch: pytest.MonkeyPatch) -> list[str]:
     from rclverify.backends.property_tests import harness
-    from rclverify.logic import decide as decide_module
+    from rclverify.semantics import decide as decide_module
     calls: list[str] = []
     for module in (decide_module, harness):
         real = module.check_concrete

@@ -13,8 +13,8 @@ from rclverify.backends.property_tests import seeding
 from rclverify.backends.property_tests.backend import PropertyTestsBackend
 from rclverify.backends.property_tests.harness import GuaranteeRun, load_implementation, read_config
 from rclverify.backends.base import NodeTarget
-from rclverify.logic.concrete import check_concrete
-from rclverify.pipeline import Workspace
+from rclverify.semantics.concrete import check_concrete
+from rclverify.app.pipeline import Workspace
 
 REPO = Path(__file__).resolve().parents[1]
 
@@ -167,7 +167,7 @@ def test_z3_model_does_not_depend_on_earlier_z3_work(tmp_path: Path, monkeypatch
 def test_table_sizes_that_cannot_hold_the_facts_are_skipped(monkeypatch: pytest.MonkeyPatch) -> None:
     """13 waypoints need 13 distinct results: tables under 12 entries (and a default) cannot, so
     Z3 is not asked about them; the first size tried that works is the one found before."""
-    from rclverify.rcl.parser import parse_formula
+    from rclverify.lang.parser import parse_formula
     facts = tuple(parse_formula(t, "plan.yaml", 1, 1) for t in (
         "forall(x, y in REAL | in.wayP(x, y) <= 12)",
         "forall(k in NATURAL | k <= 12 -> exists(x, y in REAL | in.wayP(x, y) == k))"))

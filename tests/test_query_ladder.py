@@ -1,5 +1,5 @@
 """Decide first with what decides (issue 44): a query's first attempt with a
-small budget, then the retries of logic/retry.py in the laddered order.
+small budget, then the retries of semantics/retry.py in the laddered order.
 
 The oracle: small random first-order formulas over a three-valued
 enumeration and one binary relation, decided by brute force over every
@@ -15,9 +15,9 @@ from typing import Any
 import pytest
 import z3
 
-from rclverify.logic import world
-from rclverify.logic.query import prove
-from rclverify.logic.retry import DEFAULT, FINITE, MBQI, MBQI_SIMPLIFIED, TABLES, reasons_text, retry_order
+from rclverify.semantics import world
+from rclverify.semantics.query import prove
+from rclverify.semantics.retry import DEFAULT, FINITE, MBQI, MBQI_SIMPLIFIED, TABLES, reasons_text, retry_order
 
 DOMAIN = (0, 1, 2)
 

@@ -17,11 +17,11 @@ from hypothesis import strategies as st
 
 from _chain import write_chain
 from rclverify.calculus.quotient import QuotientError, quotient
-from rclverify.cli import main
-from rclverify.logic import world
-from rclverify.logic.evaluate import evaluate
-from rclverify.rcl.parser import parse_formula
-from rclverify.workspace import Workspace
+from rclverify.cli.commands import main
+from rclverify.semantics import world
+from rclverify.semantics.evaluate import evaluate
+from rclverify.lang.parser import parse_formula
+from rclverify.stages.workspace import Workspace
 
 
 def _rclverify(ws: Path, *args: str) -> subprocess.CompletedProcess[str]:
@@ -60,7 +60,7 @@ def test_a_re_check_the_second_solver_does_not_confirm_is_not_a_contract(tmp_pat
     """cvc5 given a satisfiable query for each proved re-check (a planted wrong script): it disagrees, and the
     contract does not re-check."""
     pytest.importorskip("cvc5")
-    from rclverify.crosscheck.stage import confirm_proof
+    from rclverify.stages.crosscheck.stage import confirm_proof
     ws = Workspace(write_chain(tmp_path / "ws", 3, missing=[1]), interface_only=("N1",))
     with pytest.raises(QuotientError, match=r"does not re-check with Z3 and cvc5: .*inconclusive \(second solver: "
                                             r"Z3 answered unsat, cvc5 sat\)"):

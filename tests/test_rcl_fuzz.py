@@ -4,7 +4,7 @@ Hypothesis mutates the repository's RCL contracts and its plan, and
 generates RCL formulas and YAML from token vocabularies.  Every case runs the
 front end as ``rclverify check`` does (parse, type-check, file warnings,
 lint) plus the printers; the only exception allowed is
-:class:`~rclverify.rcl.errors.RclError` (which :class:`PlanError` extends),
+:class:`~rclverify.lang.errors.RclError` (which :class:`PlanError` extends),
 and every diagnostic it carries must be located (line >= 1).  A case that
 parses must also round-trip through ``fmt``.
 
@@ -19,15 +19,15 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from rclverify.logic.encode import Encoder, EncodingError
-from rclverify.plan.load import read_plan_data
-from rclverify.rcl.errors import RclError
-from rclverify.rcl.filewarn import file_warnings
-from rclverify.rcl.latex import to_latex
-from rclverify.rcl.lint import lint
-from rclverify.rcl.parser import parse_text
-from rclverify.rcl.printer import to_rcl
-from rclverify.rcl.typecheck import check
+from rclverify.semantics.encode import Encoder, EncodingError
+from rclverify.model.plan.load import read_plan_data
+from rclverify.lang.errors import RclError
+from rclverify.lang.filewarn import file_warnings
+from rclverify.lang.latex import to_latex
+from rclverify.lang.lint import lint
+from rclverify.lang.parser import parse_text
+from rclverify.lang.printer import to_rcl
+from rclverify.lang.typecheck import check
 
 ROOT = Path(__file__).resolve().parents[1]
 SEEDS = [p.read_text(encoding="utf-8") for p in sorted(ROOT.rglob("*.rcl")) if ".git" not in p.parts]

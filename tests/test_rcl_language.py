@@ -13,20 +13,20 @@ import pytest
 import z3
 
 from rclverify import __version__
-from rclverify.cli import main
-from rclverify.logic.encode import Encoder, EncodingError
-from rclverify.logic.evaluate import evaluate
-from rclverify.plan.errors import PlanError
-from rclverify.plan.load import load_plan
-from rclverify.rcl import ast
-from rclverify.rcl.errors import RclError
-from rclverify.rcl.latex import to_latex
-from rclverify.rcl.lint import lint
-from rclverify.rcl.parser import NESTING_LIMIT, parse_file, parse_text
-from rclverify.rcl.printer import to_rcl
-from rclverify.rcl.typecheck import check
-from rclverify.rcl.types import INTEGER, NATURAL, STRING, EnumT, SeqT, TupleT
-from rclverify.rcl.walk import free_names, subexpressions
+from rclverify.cli.commands import main
+from rclverify.semantics.encode import Encoder, EncodingError
+from rclverify.semantics.evaluate import evaluate
+from rclverify.model.plan.errors import PlanError
+from rclverify.model.plan.load import load_plan
+from rclverify.lang import ast
+from rclverify.lang.errors import RclError
+from rclverify.lang.latex import to_latex
+from rclverify.lang.lint import lint
+from rclverify.lang.parser import NESTING_LIMIT, parse_file, parse_text
+from rclverify.lang.printer import to_rcl
+from rclverify.lang.typecheck import check
+from rclverify.lang.types import INTEGER, NATURAL, STRING, EnumT, SeqT, TupleT
+from rclverify.lang.walk import free_names, subexpressions
 
 ROOT = Path(__file__).resolve().parents[1]
 ALL_CONTRACTS = sorted(p for p in ROOT.rglob("*.rcl") if ".git" not in p.parts)
@@ -275,7 +275,7 @@ def test_left_nested_chain_built_by_a_program_prints_and_encodes() -> None:
         f = ast.Binary("and", f, ast.Compare(("!=",), (ast.Var("b", "out"), ast.NumLit(str(i)))))
     spec = parse_text(node("guarantee(out.b != 0)", io="inputs() outputs(b : INTEGER)"))
     c = check([spec])
-    from rclverify.rcl.printer import expr_to_rcl
+    from rclverify.lang.printer import expr_to_rcl
     assert expr_to_rcl(f).count(" and ") == 2999
     Encoder(c.env).formula(f, c.nodes["n"])
 

@@ -5,9 +5,9 @@ import re
 from collections import Counter
 from pathlib import Path
 
-from rclverify.rcl.lint import lint
-from rclverify.rcl.walk import free_names
-from rclverify.rcl.parser import parse_file, parse_formula, parse_text
+from rclverify.lang.lint import lint
+from rclverify.lang.walk import free_names
+from rclverify.lang.parser import parse_file, parse_formula, parse_text
 
 ROOT = Path(__file__).resolve().parents[1]
 CASE_STUDY = ROOT / "contracts" / "remote_inspection.rcl"

@@ -6,9 +6,9 @@ from pathlib import Path
 import pytest
 from lark import Lark
 
-from rclverify.rcl import ast
-from rclverify.rcl.errors import RclError
-from rclverify.rcl.parser import ast_from_tree, grammar_text, parse_file, parse_formula, parse_text
+from rclverify.lang import ast
+from rclverify.lang.errors import RclError
+from rclverify.lang.parser import ast_from_tree, grammar_text, parse_file, parse_formula, parse_text
 
 ROOT = Path(__file__).resolve().parents[1]
 CASE_STUDY = ROOT / "contracts" / "remote_inspection.rcl"
@@ -421,7 +421,7 @@ def test_grammar_is_unambiguous_on_the_case_study() -> None:
 
 def test_the_lalr_tables_are_cached_per_user_and_rebuilt_from_the_cache(tmp_path: Path,
                                                                         monkeypatch: pytest.MonkeyPatch) -> None:
-    from rclverify.rcl.parser import _BUILDER, lark_cache_file
+    from rclverify.lang.parser import _BUILDER, lark_cache_file
     monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "cache"))
     where = lark_cache_file("rcl")
     assert isinstance(where, str) and where.startswith(str(tmp_path / "cache" / "rclverify"))

@@ -7,11 +7,11 @@ from pathlib import Path
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from rclverify.rcl import ast
-from rclverify.rcl.errors import RclError
-from rclverify.rcl.latex import expr_to_latex, to_latex, type_to_latex
-from rclverify.rcl.parser import parse_file, parse_formula, parse_text
-from rclverify.rcl.printer import expr_to_rcl, to_rcl, type_to_rcl
+from rclverify.lang import ast
+from rclverify.lang.errors import RclError
+from rclverify.lang.latex import expr_to_latex, to_latex, type_to_latex
+from rclverify.lang.parser import parse_file, parse_formula, parse_text
+from rclverify.lang.printer import expr_to_rcl, to_rcl, type_to_rcl
 
 ROOT = Path(__file__).resolve().parents[1]
 CASE_STUDY = ROOT / "contracts" / "remote_inspection.rcl"
@@ -329,7 +329,7 @@ def test_latex_of_random_formulas_is_balanced(e: ast.Expr) -> None:
 
 
 def test_a_nodes_latex_block_names_its_file_and_the_document_has_one_frame() -> None:
-    from rclverify.rcl.latex import document_frame, node_latex
+    from rclverify.lang.latex import document_frame, node_latex
     spec = parse_file(CASE_STUDY)
     blocks = [node_latex(n) for n in spec.nodes]
     for n, block in zip(spec.nodes, blocks):

@@ -7,14 +7,14 @@ from pathlib import Path
 
 import pytest
 
-from rclverify.cli import main
-from rclverify.rcl import ast
-from rclverify.rcl.errors import RclError
-from rclverify.rcl.latex import to_latex
-from rclverify.rcl.parser import parse_text
-from rclverify.rcl.printer import to_rcl
-from rclverify.rcl.timing import seconds
-from rclverify.rcl.typecheck import check
+from rclverify.cli.commands import main
+from rclverify.lang import ast
+from rclverify.lang.errors import RclError
+from rclverify.lang.latex import to_latex
+from rclverify.lang.parser import parse_text
+from rclverify.lang.printer import to_rcl
+from rclverify.lang.timing import seconds
+from rclverify.lang.typecheck import check
 
 REPO = Path(__file__).resolve().parents[1]
 

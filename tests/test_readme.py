@@ -43,7 +43,7 @@ def test_the_command_reference_lists_every_command() -> None:
     import contextlib
     import io
 
-    from rclverify.cli import main
+    from rclverify.cli.commands import main
     out = io.StringIO()
     with contextlib.redirect_stdout(out), contextlib.suppress(SystemExit):
         main(["--help"])

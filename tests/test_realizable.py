@@ -12,11 +12,11 @@ from pathlib import Path
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from rclverify.health.realizable import realizability_findings
-from rclverify.logic import world
-from rclverify.plan.load import load_plan
-from rclverify.rcl.parser import parse_formula, parse_text
-from rclverify.rcl.typecheck import check, load
+from rclverify.calculus.health.realizable import realizability_findings
+from rclverify.semantics import world
+from rclverify.model.plan.load import load_plan
+from rclverify.lang.parser import parse_formula, parse_text
+from rclverify.lang.typecheck import check, load
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -149,7 +149,7 @@ def test_linear_contracts_are_decided_by_quantifier_elimination() -> None:
     in the general solver's budget (5.6 s, nothing reported); Z3's ``qe``
     decides it: realizable.  With the speed bound below the stop the same
     shape is decided unrealizable, with the input."""
-    from rclverify.health.realizable import _Query
+    from rclverify.calculus.health.realizable import _Query
     checked = check([parse_text(PLANNER, "p.rcl")])
     world.fresh()
     q = _Query(checked, "P", (), None)
@@ -162,7 +162,7 @@ def test_linear_contracts_are_decided_by_quantifier_elimination() -> None:
 
 
 def test_an_output_whose_natural_parts_are_not_typed_is_never_proved_realizable() -> None:
-    """Only a NATURAL output and a constructor's NATURAL field get their ``>= 0`` (logic/encode.py): the
+    """Only a NATURAL output and a constructor's NATURAL field get their ``>= 0`` (semantics/encode.py): the
     NATURAL elements of a tuple or a sequence are plain integers to Z3, so its ``unsat`` ranges over
     outputs the type excludes.  Both contracts below have no answer (a NATURAL below 0); the ``ok``
     must not be claimed (an input with no answer is still reported: that query is sound)."""

@@ -1,7 +1,7 @@
-"""Realizability witnesses (health/realizer.py): output terms answering every
+"""Realizability witnesses (calculus/health/realizer.py): output terms answering every
 admissible input, checked against enumeration on small random contracts; the
 second solver decides the witness's quantifier-free query in its shared
-solver (crosscheck/items.py), and a contract without a witness keeps the
+solver (stages/crosscheck/items.py), and a contract without a witness keeps the
 realizability query."""
 from __future__ import annotations
 
@@ -13,10 +13,10 @@ from pathlib import Path
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from rclverify.health.realizable import realizability_findings
-from rclverify.logic import world
-from rclverify.rcl.parser import parse_formula, parse_text
-from rclverify.rcl.typecheck import check
+from rclverify.calculus.health.realizable import realizability_findings
+from rclverify.semantics import world
+from rclverify.lang.parser import parse_formula, parse_text
+from rclverify.lang.typecheck import check
 
 from test_realizable import D, _holds, _random_contract
 
@@ -101,7 +101,7 @@ def test_the_second_solver_decides_the_witness_query_and_the_report_believes_it(
     """A chain's realizable nodes are decided from their witness scripts (two solvers, a checked
     proof); a node without a witness keeps the realizability query; the report's findings carry the
     witness row's agreement."""
-    from rclverify.cli import main
+    from rclverify.cli.commands import main
     (tmp_path / "contracts").mkdir()
     (tmp_path / "contracts/c.rcl").write_text(
         "node P { inputs( x : REAL ) outputs( y : REAL ) topics( t/X x matches(in.x), t/Y y matches(out.y) ) "

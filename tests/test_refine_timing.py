@@ -10,7 +10,7 @@ from pathlib import Path
 from hypothesis import given, settings, strategies as st
 
 from rclverify.calculus.refinement import check_refinement, merge_envs, refines_main
-from rclverify.rcl.typecheck import load
+from rclverify.lang.typecheck import load
 
 NODE = """node Bridge {{
   inputs( v : REAL )

@@ -17,10 +17,10 @@ import pytest
 
 from rclverify.calculus import refinement
 from rclverify.calculus.refinement import check_refinement
-from rclverify.logic import world
-from rclverify.logic.retry import TABLES
-from rclverify.rcl.parser import parse_text
-from rclverify.rcl.typecheck import check
+from rclverify.semantics import world
+from rclverify.semantics.retry import TABLES
+from rclverify.lang.parser import parse_text
+from rclverify.lang.typecheck import check
 
 COLORS = ("red", "green", "blue")
 CONTEXT = "context { Color : {red, green, blue} ; Idx : INTEGER --> Color ; }\n"

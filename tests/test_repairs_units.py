@@ -10,9 +10,9 @@ from typing import Any
 
 import pytest
 
-from rclverify.cli import main
+from rclverify.cli.commands import main
 from rclverify.diagnosis.units import literal_in, literal_si
-from rclverify.rcl import ast
+from rclverify.lang import ast
 
 # four independent links, one variable each (links join an output to the input of its name)
 CELL = """node SupA { inputs( ra : REAL [N] ) outputs( fa : REAL [N] )

@@ -10,8 +10,8 @@ from pathlib import Path
 
 import pytest
 
-from rclverify.cli import main
-from rclverify.plan.errors import PlanError
+from rclverify.cli.commands import main
+from rclverify.model.plan.errors import PlanError
 
 REPO = Path(__file__).resolve().parents[1]
 HOARE = """      - backend: hoare
@@ -48,7 +48,7 @@ def test_entries_whose_obligations_share_names_are_refused_at_export(tmp_path: P
     ws = _copy(tmp_path, HOARE.replace("backends/hoare/radiation_sensor.imp", "backends/other/radiation_sensor.imp"))
     (ws / "backends" / "other").mkdir()
     shutil.copy(ws / "backends" / "hoare" / "radiation_sensor.imp", ws / "backends" / "other")
-    from rclverify.pipeline import Workspace, stage_export
+    from rclverify.app.pipeline import Workspace, stage_export
     with pytest.raises(PlanError) as e:
         stage_export(Workspace(ws), "RadiationSensor")
     text = str(e.value)

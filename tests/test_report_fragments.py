@@ -9,7 +9,7 @@ from pathlib import Path
 
 import pytest
 
-from rclverify.evidence.store import dumps
+from rclverify.records.store import dumps
 from rclverify.report.fragments import FragmentCache, cached_dumps, fingerprint
 
 def test_a_damaged_or_foreign_cache_file_is_an_empty_cache(tmp_path: Path) -> None:

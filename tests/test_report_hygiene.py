@@ -12,9 +12,9 @@ from pathlib import Path
 
 import pytest
 
-from rclverify.argument.export import to_dot
-from rclverify.argument.model import Argument, Element
-from rclverify.cli import BROKEN_PIPE_EXIT, main
+from rclverify.report.argument.export import to_dot
+from rclverify.report.argument.model import Argument, Element
+from rclverify.cli.commands import BROKEN_PIPE_EXIT, main
 from rclverify.report.textfmt import code_spans, plain, prose
 
 from _grip_ws import make
@@ -118,7 +118,7 @@ def _closed_pipe_run(args: list[str], cwd: Path) -> subprocess.CompletedProcess[
     r, w = os.pipe()
     os.close(r)  # the reader left before the first line
     try:
-        return subprocess.run([sys.executable, "-c", "import sys; from rclverify.cli import main; "
+        return subprocess.run([sys.executable, "-c", "import sys; from rclverify.cli.commands import main; "
                                "sys.exit(main(sys.argv[1:]))", *args], stdout=w, stderr=subprocess.PIPE,
                               cwd=cwd, timeout=120, check=False)
     finally:

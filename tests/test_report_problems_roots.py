@@ -121,7 +121,7 @@ def test_every_group_of_the_drone_has_a_location(tmp_path: Path) -> None:
 
 def test_explain_prints_findings_without_a_record_of_their_own(tmp_path: Path, capsys) -> None:
     """Every finding `status` lists can be explained: a derived property by its full name."""
-    from rclverify.cli import main
+    from rclverify.cli.commands import main
     root = copy(tmp_path, "drone")
     verify(root)
     capsys.readouterr()

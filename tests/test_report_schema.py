@@ -1,5 +1,5 @@
 """reports/assurance.json of a run against its published JSON Schema (docs/assurance.schema.json), the
-one status vocabulary (rclverify.evidence.statuses) and the report's TypedDicts (report/schema_types.py;
+one status vocabulary (rclverify.records.statuses) and the report's TypedDicts (records/report_schema.py;
 tests/test_report_vocabulary.py holds the three in step without a run).
 
 One small workspace written here is verified once and reported twice more: after a contract edit
@@ -16,8 +16,8 @@ from typing import Any
 import pytest
 
 from _report_schema import VALIDATOR, check_report, out_of_vocabulary, schema_errors, words_seen
-from rclverify.cli import main
-from rclverify.report import schema_types as st
+from rclverify.cli.commands import main
+from rclverify.records import report_schema as st
 
 RCL = """node Gain {
   inputs( x : INTEGER )

@@ -13,7 +13,7 @@ import jsonschema
 from _drone_ws import DATA, copy, set_nodes, verify
 from rclverify.diagnosis.text import status_lines
 from rclverify.report.summary import print_summary, summary_data
-from rclverify.tasks import act_verify
+from rclverify.app.tasks import act_verify
 
 HOARE_FC = """  FlightController:
     evidence:
@@ -128,7 +128,7 @@ def test_the_overall_status_is_never_better_than_unverified(tmp_path: Path) -> N
 
 
 def test_explain_prints_an_unverified_guarantee(tmp_path: Path, capsys) -> None:
-    from rclverify.cli import main
+    from rclverify.cli.commands import main
     root = _partly_covered(tmp_path)
     verify(root)
     capsys.readouterr()

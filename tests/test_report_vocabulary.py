@@ -1,5 +1,5 @@
 """The report's published JSON Schema (docs/assurance.schema.json), the one status vocabulary
-(rclverify.evidence.statuses) and the report's TypedDicts (report/schema_types.py) held in step, and
+(rclverify.records.statuses) and the report's TypedDicts (records/report_schema.py) held in step, and
 the stages' own status tables held to the vocabulary.  Nothing here runs the pipeline (the inner
 tier); tests/test_report_schema.py validates the reports of a run.
 """
@@ -11,8 +11,8 @@ from typing import Any
 from jsonschema import Draft202012Validator
 
 from _report_schema import SCHEMA
-from rclverify.evidence import records, statuses
-from rclverify.report import schema_types as st
+from rclverify.records import records, statuses
+from rclverify.records import report_schema as st
 
 
 def _undescribed(x: Any, where: str = "") -> list[str]:
@@ -43,13 +43,13 @@ def test_the_schema_enums_are_the_vocabulary() -> None:
 
 
 def test_the_stages_use_the_vocabulary() -> None:
-    from rclverify.crosscheck.stage import DOWNGRADES
-    from rclverify.plan.expected import VERDICTS as EXPECTED
-    from rclverify.rcl.errors import Severity as LintSeverity
+    from rclverify.stages.crosscheck.stage import DOWNGRADES
+    from rclverify.model.plan.expected import VERDICTS as EXPECTED
+    from rclverify.lang.errors import Severity as LintSeverity
     from rclverify.report import severity
     from rclverify.report.build import _DERIVATION, _FINDING_AS
     from rclverify.report.deadlines import STATUS_OF
-    from rclverify.requirements import rollup
+    from rclverify.calculus.requirements import rollup
     assert rollup.VERDICTS == statuses.REQUIREMENT_VERDICTS
     assert {rollup.MET, rollup.OUTSTANDING, rollup.INCONSISTENT, rollup.VACUOUS} <= set(statuses.REQUIREMENT_VERDICTS)
     assert set(_FINDING_AS) == set(statuses.HEALTH_STATUSES)

@@ -20,8 +20,8 @@ from pathlib import Path
 
 import pytest
 
-from rclverify.cli import main
-from rclverify.pipeline import Workspace, stage_check, stage_requirements
+from rclverify.cli.commands import main
+from rclverify.app.pipeline import Workspace, stage_check, stage_requirements
 
 DATA = Path(__file__).parent / "data" / "requirements" / "stop"
 
@@ -242,8 +242,8 @@ def test_mistakes_in_a_formal_statement_are_located_errors(tmp_path: Path, forma
 def test_the_bundle_carries_the_doorstop_tree_and_the_requirement_records(tmp_path: Path) -> None:
     ws = _copy(tmp_path)
     assert main(["requirements", "-w", str(ws), "--plan", "contracts/plan_doorstop.yaml"]) == 1
-    from rclverify.bundle.manifest import collect
-    from rclverify.plan.load import load_plan
+    from rclverify.report.bundle.manifest import collect
+    from rclverify.model.plan.load import load_plan
     files, missing = collect(ws, load_plan(ws, "contracts/plan_doorstop.yaml"))
     assert {"reqs/.doorstop.yml", "reqs/SYS001.yml", "artifacts/requirements/SYS002.json"} <= set(files)
     assert not missing

@@ -14,9 +14,9 @@ import z3
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from rclverify.cli import main
-from rclverify.requirements.response import check_response, check_unbounded_response
-from rclverify.requirements.tsys import TransitionSystem
+from rclverify.cli.commands import main
+from rclverify.calculus.requirements.response import check_response, check_unbounded_response
+from rclverify.calculus.requirements.tsys import TransitionSystem
 
 STATES = range(4)
 
@@ -205,8 +205,8 @@ def test_a_run_that_stops_with_a_trigger_pending_refutes_the_unbounded_response(
     """docs/requirements.md: a run that stops with a P pending is a counterexample (it is never
     answered); it read inconclusive when the bounded pattern failed and no fair lasso exists (x stays 0,
     an unfair loop, or steps to 1, where no step follows; the trigger at 0, no response anywhere)."""
-    from rclverify.requirements.deadlock import runs_go_on
-    from rclverify.requirements.tsys import Fairness
+    from rclverify.calculus.requirements.deadlock import runs_go_on
+    from rclverify.calculus.requirements.tsys import Fairness
     ts = TransitionSystem({"x": z3.IntSort()}, lambda s: s["x"] == 0,
                           lambda s, t: z3.And(s["x"] == 0, z3.Or(t["x"] == 0, t["x"] == 1)),
                           (Fairness("N", lambda s: s["x"] == 0, lambda s: s["x"] == 1),))

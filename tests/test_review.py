@@ -10,10 +10,10 @@ import pytest
 import yaml
 
 from rclverify.backends.review.record import checklist, parse_record
-from rclverify.cli import main
-from rclverify.evidence.store import EvidenceStore
-from rclverify.pipeline import Workspace, stage_check, stage_export, stage_run
-from rclverify.tasks import act_check
+from rclverify.cli.commands import main
+from rclverify.records.store import EvidenceStore
+from rclverify.app.pipeline import Workspace, stage_check, stage_export, stage_run
+from rclverify.app.tasks import act_check
 
 from _evidence_ws import copy_workspace, plan_line, replace_in_plan
 
@@ -129,7 +129,7 @@ def test_review_command_writes_a_record_to_fill_in(ws: Workspace, capsys: pytest
 
 def test_conjuncts_split_at_top_level_and_only() -> None:
     from rclverify.backends.review.record import _conjuncts
-    from rclverify.rcl.parser import parse_formula
+    from rclverify.lang.parser import parse_formula
     f = parse_formula("out.a == 1 and (out.b == 2 and out.c == 3) and (out.d == 1 or out.e == 2)", "x.rcl", 1, 1)
     parts = _conjuncts(f)
     assert len(parts) == 4 and [p.loc.col for p in parts][:2] == [1, 17]
@@ -137,7 +137,7 @@ def test_conjuncts_split_at_top_level_and_only() -> None:
 
 def test_an_alias_bomb_in_a_review_record_is_refused_before_expansion() -> None:
     from rclverify.backends.review.record import parse_record
-    from rclverify.plan.errors import PlanError
+    from rclverify.model.plan.errors import PlanError
     bomb = "a: &a [x, x, x, x, x, x, x, x, x, x]\n" + "".join(
         f"{chr(98 + k)}: &{chr(98 + k)} [*{chr(97 + k)}, *{chr(97 + k)}, *{chr(97 + k)}, *{chr(97 + k)}, "
         f"*{chr(97 + k)}, *{chr(97 + k)}, *{chr(97 + k)}, *{chr(97 + k)}, *{chr(97 + k)}, *{chr(97 + k)}]\n"

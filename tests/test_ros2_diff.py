@@ -29,7 +29,7 @@ clients, with their types, as rclverify read from DDS.
 
 The static tests beside it check, without ROS 2, the namespaces the scan
 gives (code namespaces in Python and C++, launch namespaces in Python and
-XML launch files) and the QoS read from the code (ros/code_qos.py).
+XML launch files) and the QoS read from the code (ros/extract/code_qos.py).
 """
 from __future__ import annotations
 
@@ -284,7 +284,7 @@ RUNNING = ("/robot/talker", "/viewer", "/sensors/camera", "/intruder", "/_ros2cl
 
 def _read_running(env: dict[str, str]) -> dict[str, dict[str, list[tuple[str, str | None]]]]:
     """rclverify's graph of the running system (:func:`read_dds_graph`), per node and edge kind."""
-    from rclverify.ros.diff_dds import read_dds_graph
+    from rclverify.ros.live.diff_dds import read_dds_graph
     mp = pytest.MonkeyPatch()
     mp.setenv("CYCLONEDDS_URI", env["CYCLONEDDS_URI"])
     try:
@@ -302,7 +302,7 @@ def _ros2_view(seen: dict[str, Any]) -> dict[str, dict[str, list[tuple[str, str 
     """ROS 2's view with what docs/ros.md says the diff leaves out taken out: /rosout and
     /parameter_events, each node's parameter and type-description services, an action's
     hidden topics and services (its server and client are the action graph API's)."""
-    from rclverify.ros.diff_dds import INFRA_SERVICE_SUFFIXES, INFRA_TOPICS
+    from rclverify.ros.live.diff_dds import INFRA_SERVICE_SUFFIXES, INFRA_TOPICS
     out = {}
     for name, kinds in seen.items():
         if name.endswith("/_graph_probe"):
@@ -373,7 +373,7 @@ def test_the_running_graph_is_the_one_ros2_itself_sees(diff: dict[str, Any]) -> 
 # -- the namespaces of the static scan (no ROS 2 needed) ---------------------------------------
 
 def _scan(ws: Path, *launch: str) -> dict[str, Any]:
-    from rclverify.ros.graph import scan
+    from rclverify.ros.graph.scan import scan
     g = scan([ws / "src"], [ws / x for x in launch])
     return {n.name: sorted(e.topic for e in n.publishes + n.subscribes) for n in g.graph.nodes.values()}
 
@@ -390,7 +390,7 @@ def test_the_launch_namespace_replaces_the_code_one(tmp_path: Path) -> None:
         "/robot/talker": ["/robot/chatter", "/teleop/cmd"], "/sensors/camera": ["/sensors/image"],
         "/viewer": ["/sensors/image"], "/robot/planner": ["/robot/plan", "/sensors/image"]}
     # the services and actions the live test compares (no item about them there means the running side has them)
-    from rclverify.ros.graph import scan
+    from rclverify.ros.graph.scan import scan
     g = scan([tmp_path / "src"], [tmp_path / "src/demo_pkg/launch/demo.launch.py"]).graph
     kinds = ("service_servers", "service_clients", "action_servers", "action_clients")
     assert {n: {k: [(e.topic, e.msg_type) for e in g.nodes[n].edges_of(k)] for k in kinds
@@ -441,8 +441,8 @@ def test_xml_launch_and_rclcpp_namespaces(tmp_path: Path) -> None:
 
 
 def test_the_qos_the_code_asks_for(tmp_path: Path) -> None:
-    from rclverify.ros.code_qos import read
-    from rclverify.ros.model import Src
+    from rclverify.ros.extract.code_qos import read
+    from rclverify.ros.extract.model import Src
     py = tmp_path / "n.py"
     py.write_text(textwrap.dedent("""\
         from rclpy.qos import QoSProfile, ReliabilityPolicy, DurabilityPolicy, qos_profile_sensor_data
@@ -486,7 +486,7 @@ def test_a_namespace_computed_at_run_time_is_a_located_warning(tmp_path: Path) -
     cam = pkg / "demo_pkg" / "camera.py"
     cam.write_text(cam.read_text().replace("import rclpy\n", "import os\nimport rclpy\n")
                    .replace("namespace='sensors'", "namespace=os.environ['ROBOT']"))
-    from rclverify.ros.graph import scan
+    from rclverify.ros.graph.scan import scan
     g = scan([tmp_path / "src"], base=tmp_path)
     notes = [str(n) for n in g.graph.notes if "namespace of node 'camera'" in n.message]
     assert notes == ["src/demo_pkg/demo_pkg/camera.py:8:12: warning: namespace of node 'camera' is not a string "

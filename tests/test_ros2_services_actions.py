@@ -46,7 +46,7 @@ from _procs import stop, wait_for
 from _ros2 import rclverify, ros2_env, ros2_python, start_node
 
 from rclverify.backends.monitors.dds_calls import CallBook, replay
-from rclverify.rcl.typecheck import load
+from rclverify.lang.typecheck import load
 
 RCL = """\
 node Base {
@@ -343,7 +343,7 @@ def _offline(run: dict[str, Any], *extra: str) -> tuple[int, list[dict[str, Any]
     import contextlib
     import io
 
-    from rclverify.cli import main
+    from rclverify.cli.commands import main
     out = io.StringIO()
     with contextlib.redirect_stdout(out):
         code = main(["monitor", "-w", str(run["ws"]), "--mapping", "mapping.yaml", "--horizon", "1.0", "--json",

@@ -37,7 +37,7 @@ import pytest
 from _procs import stop, wait_for
 from _ros2 import rclverify, ros2_env, ros2_python, start_node
 
-from rclverify.cli import main
+from rclverify.cli.commands import main
 
 RCL = """\
 node Echo {

@@ -20,7 +20,7 @@ the rclpy node while the workspace defines ``test_msgs/Nested`` with other
 fields (``float64 x``), and a Cyclone DDS publisher of the project's own
 (tests/dds_ros2.py) publishes the workspace's layout on it: the same type
 name, two layouts.  Fast DDS's writers are matched on the type name
-(``rclverify.ros.dds.COMPATIBILITY``), so the rclpy node's samples reach
+(``rclverify.ros.live.dds.COMPATIBILITY``), so the rclpy node's samples reach
 the monitor's reader; the ROS 2 type hash it announces differs from the
 workspace's, so the monitor names it in a warning and drops every one of
 its samples (counted), while the Cyclone publisher, whose XTypes type
@@ -59,10 +59,10 @@ from _procs import stop, wait_for
 from _ros2 import rclverify, ros2_env, ros2_python, start_node
 from dds_ros2 import Ros2Participant, domain_of, matched, wait_until
 
-from rclverify.backends.monitors.dds_types import TypeBook
-from rclverify.ros.dds import configure_domain
+from rclverify.runtime.dds.types import TypeBook
+from rclverify.ros.live.dds import configure_domain
 
-from rclverify.cli import main
+from rclverify.cli.commands import main
 
 N = 20  # messages per topic
 #: topic -> (type, field path, RCL type, guarantee over the value v, expected (satisfied, violated))

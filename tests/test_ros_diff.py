@@ -9,10 +9,10 @@ from pathlib import Path
 
 import pytest
 
-from rclverify.cli import main
-from rclverify.ros.diff import diff_bag, diff_master, render_text
-from rclverify.ros.master import fold_actions
-from rclverify.ros.model import Graph, GraphEdge, GraphNode, Src
+from rclverify.cli.commands import main
+from rclverify.ros.live.diff import diff_bag, diff_master, render_text
+from rclverify.ros.live.master import fold_actions
+from rclverify.ros.extract.model import Graph, GraphEdge, GraphNode, Src
 
 REPO = Path(__file__).resolve().parents[1]
 URI = "http://127.0.0.1:11311"

@@ -23,8 +23,8 @@ pytest.importorskip("cyclonedds", reason="the cyclonedds binding is not installe
 
 from dds_ros2 import Ros2Participant, dds_env, domain_of  # noqa: E402
 
-from rclverify.backends.monitors.dds_types import TypeBook  # noqa: E402
-from rclverify.cli import main  # noqa: E402
+from rclverify.runtime.dds.types import TypeBook  # noqa: E402
+from rclverify.cli.commands import main  # noqa: E402
 
 WS = Path(__file__).parent / "data" / "ros" / "dds_diff_ws"
 LAUNCH = WS / "src" / "dds_demo" / "launch" / "demo.launch.py"
@@ -89,7 +89,7 @@ def test_a_node_list_that_never_arrives_is_said_after_the_settling(tmp_path: Pat
     says so; its endpoints are in no node, never silently in a wrong one."""
     import time
 
-    from rclverify.ros.diff_dds import read_dds_graph
+    from rclverify.ros.live.diff_dds import read_dds_graph
     env = dds_env(tmp_path)
     for k, v in env.items():
         monkeypatch.setenv(k, v)
@@ -109,9 +109,9 @@ def test_a_node_list_that_never_arrives_is_said_after_the_settling(tmp_path: Pat
     assert [m for m in said if "rt/scan" in m and "in no ROS 2 node" in m], said
     assert not g.nodes and 1.4 <= took < 5, (g.nodes, took)
     # a diff on such a reading is never "equal": nothing differs, but the running side was not read whole
-    from rclverify.ros.diff import render_text
-    from rclverify.ros.diff_dds import diff_dds
-    from rclverify.ros.model import Graph
+    from rclverify.ros.live.diff import render_text
+    from rclverify.ros.live.diff_dds import diff_dds
+    from rclverify.ros.extract.model import Graph
     res = diff_dds(Graph(), g, "DDS domain")
     assert not res.missing and not res.extra and not res.equal and len(res.incomplete) == 1
     assert res.to_json()["equal"] is False and res.to_json()["incomplete"] == res.incomplete

@@ -24,8 +24,8 @@ from typing import Iterator
 
 import pytest
 
-from rclverify.cli import main
-from rclverify.ros.master import MasterError, read_master
+from rclverify.cli.commands import main
+from rclverify.ros.live.master import MasterError, read_master
 
 from test_ros_live import SYSTEM_PY, _free_port, _have_ros1, _stop
 

@@ -10,14 +10,14 @@ from pathlib import Path
 
 import pytest
 
-from rclverify.ros.cpp_prep import prepare
-from rclverify.ros.graph import scan
-from rclverify.ros.ground_services import servers
-from rclverify.ros.lifecycle import MANAGEMENT, implicit
-from rclverify.ros.model import GraphNode, Src
-from rclverify.ros.nodelets import launch_args, plugin_classes, registered
-from rclverify.ros.sources_cpp import scan_cpp
-from rclverify.ros.sources_py import scan_python
+from rclverify.ros.extract.cpp_prep import prepare
+from rclverify.ros.graph.scan import scan
+from rclverify.ros.ground.ground_services import servers
+from rclverify.ros.ground.lifecycle import MANAGEMENT, implicit
+from rclverify.ros.extract.model import GraphNode, Src
+from rclverify.ros.extract.nodelets import launch_args, plugin_classes, registered
+from rclverify.ros.extract.sources_cpp import scan_cpp
+from rclverify.ros.extract.sources_py import scan_python
 
 CORPUS = Path(__file__).parent / "data" / "ros_corpus"
 PKG = ('<package format="2"><name>{n}</name><version>1.0.0</version><description>d</description>'

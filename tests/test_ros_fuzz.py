@@ -9,8 +9,8 @@ from pathlib import Path
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from rclverify.cli import main
-from rclverify.ros.graph import scan
+from rclverify.cli.commands import main
+from rclverify.ros.graph.scan import scan
 
 WS = Path(__file__).parent / "data" / "ros" / "catkin_ws" / "src"
 TARGETS = ["rover_control/launch/rover.launch", "rover_control/launch/control.launch", "rover_msgs/package.xml",

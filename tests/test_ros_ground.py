@@ -9,7 +9,7 @@ from pathlib import Path
 
 import pytest
 
-from rclverify.cli import main
+from rclverify.cli.commands import main
 
 WS = Path(__file__).parent / "data" / "ros" / "catkin_ws"
 

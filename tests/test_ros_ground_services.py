@@ -9,14 +9,14 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
-from rclverify.rcl import ast
-from rclverify.rcl.parser import parse_text
-from rclverify.rcl.typecheck import check
-from rclverify.ros.draw import grounding_dot
-from rclverify.ros.graph import ScanResult
-from rclverify.ros.ground import RULES, ground
-from rclverify.ros.interfaces import TypeTable
-from rclverify.ros.model import Graph, GraphEdge, GraphNode, Src
+from rclverify.lang import ast
+from rclverify.lang.parser import parse_text
+from rclverify.lang.typecheck import check
+from rclverify.ros.graph.draw import grounding_dot
+from rclverify.ros.graph.scan import ScanResult
+from rclverify.ros.ground.ground import RULES, ground
+from rclverify.ros.extract.interfaces import TypeTable
+from rclverify.ros.extract.model import Graph, GraphEdge, GraphNode, Src
 
 REPO = Path(__file__).resolve().parents[1]
 EXAMPLE = REPO / "examples" / "safety_stop"

@@ -16,7 +16,7 @@ MARK = "OUTSIDE_MARKER_7f3a91"
 MANIFEST = ('<?xml version="1.0"?><package format="2"><name>p</name><version>0.0.1</version>'
             '<description>d</description><maintainer email="m@example.com">m</maintainer>'
             '<license>MIT</license></package>\n')
-CLI = "import sys; from rclverify.cli import main; sys.exit(main(sys.argv[1:]))"
+CLI = "import sys; from rclverify.cli.commands import main; sys.exit(main(sys.argv[1:]))"
 NODE = "import rospy\nrospy.init_node('n')\nrospy.Publisher('/t', String)\n"
 
 
@@ -66,7 +66,7 @@ def test_fifo_and_device_link_are_skipped_not_read(tmp_path: Path) -> None:
 
 def test_large_source_is_capped(tmp_path: Path) -> None:
     """Item 8: a source file over the 8 MiB cap is skipped with a warning."""
-    from rclverify.ros import safefs
+    from rclverify.ros.extract import safefs
     big = tmp_path / "big.py"
     big.write_bytes(b"#" * (safefs.MAX_FILE_BYTES + 1))
     with pytest.raises(safefs.Refused, match="larger than 8 MiB"):
@@ -121,7 +121,7 @@ def test_init_from_ros_copies_no_link_target_and_does_not_loop(tmp_path: Path) -
 
 def test_copy_package_is_bounded(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     """Item 7: the copy stops at its file bound and says so."""
-    from rclverify.ros import safecopy
+    from rclverify.tools.scaffold import safecopy
     src = tmp_path / "src"
     src.mkdir()
     for i in range(5):
@@ -138,7 +138,7 @@ def test_cache_in_copied_workspace_scans_the_copy(tmp_path: Path) -> None:
     and the cached scan equals a clean one."""
     import shutil
 
-    from rclverify.ros.graph import scan
+    from rclverify.ros.graph.scan import scan
     ws = tmp_path / "ws"
     p = _pkg(ws)
     (p / "scripts" / "good.py").write_text(NODE)

@@ -9,11 +9,11 @@ from pathlib import Path
 
 import pytest
 
-from rclverify.ros.cmake import expand
-from rclverify.ros.graph import scan
-from rclverify.ros.model import SERVICE_ROLES
-from rclverify.ros.sources_cpp import scan_cpp
-from rclverify.ros.sources_py import scan_python
+from rclverify.ros.extract.cmake import expand
+from rclverify.ros.graph.scan import scan
+from rclverify.ros.extract.model import SERVICE_ROLES
+from rclverify.ros.extract.sources_cpp import scan_cpp
+from rclverify.ros.extract.sources_py import scan_python
 
 CORPUS = Path(__file__).parent / "data" / "ros_corpus"
 CASES = sorted((CORPUS / "expected").glob("*.json"))

@@ -10,8 +10,8 @@ from pathlib import Path
 
 import pytest
 
-from rclverify.cli import main
-from rclverify.ros.skeleton import rcl_scalar
+from rclverify.cli.commands import main
+from rclverify.tools.scaffold.skeleton import rcl_scalar
 
 AMENT = Path(__file__).parent / "data" / "ros" / "ament_ws"
 

@@ -11,7 +11,7 @@ from pathlib import Path
 
 import pytest
 
-from rclverify.cli import main
+from rclverify.cli.commands import main
 
 import test_ros_controllers
 import test_ros_scan_idioms7 as idioms7

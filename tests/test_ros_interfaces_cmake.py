@@ -9,8 +9,8 @@ from pathlib import Path
 
 import pytest
 
-from rclverify.ros.graph import scan
-from rclverify.ros.interfaces import generated_interfaces
+from rclverify.ros.graph.scan import scan
+from rclverify.ros.extract.interfaces import generated_interfaces
 
 PKG = ('<?xml version="1.0"?>\n<package format="3"><name>rig_msgs</name><version>0.1.0</version>'
        '<description>d</description><maintainer email="dev@example.org">a</maintainer><license>MIT</license>'

@@ -15,8 +15,8 @@ from pathlib import Path
 
 import pytest
 
-from rclverify.ros.graph import scan
-from rclverify.ros.master import MasterError, import_rosgraph, read_master
+from rclverify.ros.graph.scan import scan
+from rclverify.ros.live.master import MasterError, import_rosgraph, read_master
 
 LIVE = Path(__file__).parent / "data" / "ros" / "live_ws"
 SYSTEM_PY = "/usr/bin/python3"  # Debian's python3-rospy is installed for Debian's interpreter

@@ -1,6 +1,6 @@
 """A hostile or broken ROS 1 master: ``ros diff`` and ``ros scan --master``
 end within a bounded time with one located message and a non-zero exit,
-never a traceback or a hang (ros/master_rpc.py).
+never a traceback or a hang (ros/live/master_rpc.py).
 
 The masters here are tiny XML-RPC servers in a thread on 127.0.0.1 and an
 ephemeral port: one answers malformed structures, one accepts and never
@@ -18,8 +18,8 @@ from typing import Any, Iterator
 
 import pytest
 
-from rclverify.ros.master import read_master
-from rclverify.ros.master_rpc import MasterError, call, probe_service_type
+from rclverify.ros.live.master import read_master
+from rclverify.ros.live.master_rpc import MasterError, call, probe_service_type
 
 REPO = Path(__file__).resolve().parents[1]
 WS = Path(__file__).parent / "data" / "ros" / "diff_ws"
@@ -86,7 +86,7 @@ def silent() -> Iterator[str]:
 
 
 def _diff(uri: str, *extra: str, timeout: float = 30) -> subprocess.CompletedProcess[str]:
-    return subprocess.run([sys.executable, "-m", "rclverify.cli", "ros", "diff", str(WS), "--master", uri, *extra],
+    return subprocess.run([sys.executable, "-m", "rclverify.cli.commands", "ros", "diff", str(WS), "--master", uri, *extra],
                           capture_output=True, text=True, timeout=timeout, cwd=REPO)
 
 

@@ -10,14 +10,14 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from rclverify.ros import names, namespaces, symbols
-from rclverify.ros.cmake import expand
-from rclverify.ros.cpp_prep import prepare
-from rclverify.ros.cpp_types import message_type, service_type
-from rclverify.ros.graph import scan
-from rclverify.ros.launch_ros2 import read_python
-from rclverify.ros.sources_cpp import scan_cpp
-from rclverify.ros.sources_py import scan_python
+from rclverify.ros.extract import names, namespaces, symbols
+from rclverify.ros.extract.cmake import expand
+from rclverify.ros.extract.cpp_prep import prepare
+from rclverify.ros.extract.cpp_types import message_type, service_type
+from rclverify.ros.graph.scan import scan
+from rclverify.ros.extract.launch_ros2 import read_python
+from rclverify.ros.extract.sources_cpp import scan_cpp
+from rclverify.ros.extract.sources_py import scan_python
 
 PKG = ('<package format="2"><name>{n}</name><version>1.0.0</version><description>d</description>'
        '<maintainer email="dev@example.org">m</maintainer><license>MIT</license>'
@@ -152,7 +152,7 @@ def test_cmake_foreach_over_a_macro_and_subdirectories(tmp_path: Path) -> None:
     g = scan([tmp_path / "v"], [], base=tmp_path, standard=False).graph
     assert g.nodes["/w"].executable == "w"
     # a glob or a subdirectory leaving the package reads nothing there
-    from rclverify.ros.executables import targets
+    from rclverify.ros.extract.executables import targets
     (tmp_path / "v" / "CMakeLists.txt").write_text("project(v)\nfile(GLOB_RECURSE S /*.cpp ../*.cpp)\n"
                                                    "add_executable(z ${S})\nadd_subdirectory(../v/src/nodes)\n")
     assert targets(tmp_path / "v", "v").executables == {"z": []}
@@ -217,7 +217,7 @@ def test_python_launch_variables_are_read_and_a_literal_is_never_called_not_a_li
         ("node", {"pkg": "p", "exec": "e", "namespace": "$(var ns)"})]
     assert [n.message for n in notes] == ["Node(...): variable 'undefined_name' (not assigned in "
                                           "generate_launch_description()) cannot be read statically; action skipped"]
-    from rclverify.ros.launch import Interpreter
+    from rclverify.ros.extract.launch import Interpreter
     it = Interpreter(lambda p: None, lambda p: read_python(p, p.name), lambda p: p.name)
     it.run(lf, {})
     assert [(n.exe, n.ns) for n in it.nodes] == [("e", "/robot"), ("g", "/")]  # an empty default is no namespace

@@ -7,12 +7,12 @@ from pathlib import Path
 
 import pytest
 
-from rclverify.cli import main
-from rclverify.ros.graph import scan
-from rclverify.ros.interfaces import field_path
-from rclverify.ros.launch import read_yaml
-from rclverify.ros.sources_cpp import scan_cpp
-from rclverify.ros.sources_py import scan_python
+from rclverify.cli.commands import main
+from rclverify.ros.graph.scan import scan
+from rclverify.ros.extract.interfaces import field_path
+from rclverify.ros.extract.launch import read_yaml
+from rclverify.ros.extract.sources_cpp import scan_cpp
+from rclverify.ros.extract.sources_py import scan_python
 
 DATA = Path(__file__).parent / "data" / "ros"
 CATKIN = DATA / "catkin_ws"

@@ -13,8 +13,8 @@ from pathlib import Path
 
 import _idioms
 
-from rclverify.ros.graph import scan
-from rclverify.ros.sources_cpp import scan_cpp
+from rclverify.ros.graph.scan import scan
+from rclverify.ros.extract.sources_cpp import scan_cpp
 
 CORPUS, ROLES = _idioms.CORPUS, _idioms.ROLES
 WS = CORPUS / "idioms5"

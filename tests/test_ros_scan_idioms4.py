@@ -16,8 +16,8 @@ import pytest
 
 import _idioms
 
-from rclverify.cli import main
-from rclverify.ros.graph import scan
+from rclverify.cli.commands import main
+from rclverify.ros.graph.scan import scan
 
 CORPUS, ROLES = _idioms.CORPUS, _idioms.ROLES
 WS = CORPUS / "idioms6"
@@ -127,7 +127,7 @@ def test_without_the_parameter_file_the_code_default_and_a_located_note(tmp_path
 
 
 def test_parameter_files_two_files_disagreeing_and_wildcards(tmp_path: Path) -> None:
-    from rclverify.ros.param_yaml import PackageParams, matches, read_file
+    from rclverify.ros.extract.param_yaml import PackageParams, matches, read_file
     assert [matches(p, "/rig/range_fusion") for p in ("/**", "**", "/rig/range_fusion", "range_fusion",
                                                       "/*/range_fusion", "/**/range_fusion", "/other")] == [
         True, True, True, False, True, True, False]

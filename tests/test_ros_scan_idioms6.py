@@ -19,9 +19,9 @@ import pytest
 
 import _idioms
 
-from rclverify.ros.graph import scan
-from rclverify.ros.model import Src
-from rclverify.ros.plugins import described, instances
+from rclverify.ros.graph.scan import scan
+from rclverify.ros.extract.model import Src
+from rclverify.ros.extract.plugins import described, instances
 
 CORPUS, ROLES = _idioms.CORPUS, _idioms.ROLES
 WS = CORPUS / "idioms8"
@@ -159,7 +159,7 @@ def test_field_paths_are_kept_per_contract_when_one_topic_carries_two_types(
     # the grounding bug of docs/ros.md "Held-out recall": one topic name, a message in one
     # node and an array of it in another; the first contract's field paths were written
     # under the topic's name and looked up in the other contract's array type
-    from rclverify.cli import main
+    from rclverify.cli.commands import main
     src = tmp_path / "pads" / "src"
     msgs = _pkg(src, "pad_msgs", "ament_cmake", "<member_of_group>rosidl_interface_packages</member_of_group>")
     (msgs / "msg").mkdir()

@@ -27,7 +27,7 @@ from pathlib import Path
 
 import pytest
 
-from rclverify.ros.graph import scan
+from rclverify.ros.graph.scan import scan
 
 PKG = '<?xml version="1.0"?>\n<package format="3"><name>{name}</name><version>0.1.0</version><description>d</description>\n<maintainer email="dev@example.org">a</maintainer><license>MIT</license>\n<buildtool_depend>ament_cmake</buildtool_depend><depend>rclcpp</depend><depend>std_msgs</depend><depend>std_srvs</depend>\n<export><build_type>ament_cmake</build_type></export></package>\n'
 CMAKE = "cmake_minimum_required(VERSION 3.8)\nproject({name})\nfind_package(rclcpp REQUIRED)\n{exes}"

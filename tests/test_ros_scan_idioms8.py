@@ -32,7 +32,7 @@ from pathlib import Path
 
 import pytest
 
-from rclverify.ros.graph import scan
+from rclverify.ros.graph.scan import scan
 
 PKG = ('<?xml version="1.0"?>\n<package format="3"><name>{name}</name><version>0.1.0</version>'
        '<description>d</description>\n<maintainer email="dev@example.org">a</maintainer><license>MIT</license>\n'

@@ -7,10 +7,10 @@ from pathlib import Path
 
 import pytest
 
-from rclverify.cache import Shelf
-from rclverify.cache import workspace as wscache
-from rclverify.pipeline import Workspace
-from rclverify.system.model import Link, SystemModel, _loops, cycles_kept
+from rclverify.core.cache import Shelf
+from rclverify.core.cache import workspace as wscache
+from rclverify.app.pipeline import Workspace
+from rclverify.model.system.model import Link, SystemModel, _loops, cycles_kept
 
 
 def _sccs_by_reachability(nodes: list[str], links: list[Link]) -> tuple[tuple[str, ...], ...]:
@@ -112,7 +112,7 @@ def test_workspace_cache_is_used_only_while_the_inputs_are_unchanged(tmp_path: P
     (tmp_path / "contracts" / "a.rcl").write_text(RCL.replace("0 <= out.v", "1 <= out.v"))
     edited = Workspace(tmp_path)
     assert not wscache.restore(edited)
-    from rclverify.rcl.printer import expr_to_rcl
+    from rclverify.lang.printer import expr_to_rcl
     assert expr_to_rcl(edited.checked.nodes["A"].node.guarantees[0].formula) == "1 <= out.v"  # parsed again
     (tmp_path / "contracts" / "a.rcl").write_text(RCL)
     (tmp_path / "contracts" / "plan.yaml").write_text("contracts: [contracts/a.rcl]\nname: x\n")
@@ -139,7 +139,7 @@ def test_a_damaged_cache_is_ignored(tmp_path: Path) -> None:
 
 
 def test_a_missing_contract_is_reported_even_with_a_cached_plan(tmp_path: Path) -> None:
-    from rclverify.plan.errors import PlanError
+    from rclverify.model.plan.errors import PlanError
     ws = _ws(tmp_path)
     ws.model
     wscache.save(ws)
@@ -166,7 +166,7 @@ def test_a_valid_cache_defers_the_checked_contracts_until_a_task_needs_them(tmp_
     # the task index is there at once; the plan and the parsed contracts are not unpickled yet
     assert again.index.nodes == ("A",) and again.index.contracts == ("contracts/a.rcl",)
     assert {"plan", "checked", "model"}.isdisjoint(again.__dict__) and again.deferred is not None
-    import rclverify.rcl.parser as parser
+    import rclverify.lang.parser as parser
 
     def no_parse(*args: object, **kwargs: object) -> None:
         raise AssertionError("parsed although the cache holds the parsed contracts")
@@ -177,12 +177,12 @@ def test_a_valid_cache_defers_the_checked_contracts_until_a_task_needs_them(tmp_
 def test_a_contract_edited_after_the_cache_was_read_is_loaded_from_the_file(tmp_path: Path) -> None:
     _, again = _cached_and_restored(tmp_path)
     (tmp_path / "contracts" / "a.rcl").write_text(RCL.replace("0 <= out.v", "2 <= out.v"))
-    from rclverify.rcl.printer import expr_to_rcl
+    from rclverify.lang.printer import expr_to_rcl
     assert expr_to_rcl(again.checked.nodes["A"].node.guarantees[0].formula) == "2 <= out.v"
 
 
 def test_a_node_task_runs_only_the_stages_whose_inputs_changed() -> None:
-    from rclverify.tasks import NODE_STAGES, stages_to_run
+    from rclverify.app.tasks import NODE_STAGES, stages_to_run
     deps = {"compose": ["/w/a/snap/N.json", "/w/a/snap/P.json", "/w/a/model.json"],
             "health": ["/w/a/snap/N.json"], "export": ["/w/a/snap/N.json", "/w/backends/prog.imp"]}
     assert stages_to_run(deps, ["/w/a/snap/N.json"]) == ["compose", "health", "export"]

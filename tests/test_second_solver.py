@@ -12,9 +12,9 @@ import pytest
 
 pytest.importorskip("cvc5", reason="cvc5 (PyPI) is a dependency of rclverify; CI installs it")
 
-from rclverify.cli import main
-from rclverify.crosscheck.cvc5_decide import decide
-from rclverify.crosscheck.stage import agreement, stage_crosscheck
+from rclverify.cli.commands import main
+from rclverify.stages.crosscheck.cvc5_decide import decide
+from rclverify.stages.crosscheck.stage import agreement, stage_crosscheck
 
 SAT_SCRIPT = "(declare-fun x () Real)\n(assert (> x 1.0))\n(check-sat)\n"
 
@@ -193,9 +193,9 @@ def test_a_row_for_another_text_of_the_query_is_not_believed(tmp_path: Path) -> 
     then `rclverify report`) was never seen by cvc5: it reads one solver, not the old agreement."""
     import hashlib
 
-    from rclverify.crosscheck.apply import load
-    from rclverify.crosscheck.stage import INDEX
-    from rclverify.evidence.sealed import write_sealed
+    from rclverify.stages.crosscheck.apply import load
+    from rclverify.stages.crosscheck.stage import INDEX
+    from rclverify.records.sealed import write_sealed
     rel = "artifacts/requirements/REQ1.smt2"
     (tmp_path / rel).parent.mkdir(parents=True)
     (tmp_path / rel).write_text(SAT_SCRIPT)
@@ -212,7 +212,7 @@ def test_a_row_for_another_text_of_the_query_is_not_believed(tmp_path: Path) -> 
 def test_a_verdict_without_a_kept_query_says_so() -> None:
     """A proved temporal requirement keeps no single query: one solver, and not "run doit verify"
     (which would never give it a second one)."""
-    from rclverify.crosscheck.apply import SecondSolver
+    from rclverify.stages.crosscheck.apply import SecondSolver
     rec = SecondSolver({}).requirement({"id": "T1", "verdict": "proved", "temporal": {"method": "k-induction"}})
     assert rec["solvers"]["agreement"] == "one solver" and "doit verify" not in rec["solvers"]["why"]
 
@@ -221,10 +221,10 @@ def test_a_shared_session_answers_and_proves_as_fresh_solvers_do(ws: Path) -> No
     """One incremental solver for the quantifier-free scripts (the stage's
     speed-up) gives each script the answer and the proof text a fresh
     solver gives, whatever ran before it; quantified scripts are refused."""
-    from rclverify.crosscheck.cvc5_decide import RLIMIT, Session
+    from rclverify.stages.crosscheck.cvc5_decide import RLIMIT, Session
     index = json.loads((ws / "artifacts/crosscheck/index.json").read_text())
     texts = [(ws / r["smt2"]).read_text() for r in index["items"]]
-    # the realizability queries (quantified; the stage decides their witness queries: health/realizer.py)
+    # the realizability queries (quantified; the stage decides their witness queries: calculus/health/realizer.py)
     parts = [t.split("\n(reset)\n")[-1] for t in texts] + [
         p.read_text() for p in sorted((ws / "artifacts/health").glob("*.realizable.smt2"))]
     s = Session()

@@ -9,7 +9,7 @@ from typing import Any
 from rclverify.backends.monitors.backend import verdict_status
 from rclverify.backends.monitors.check import check_trace
 from rclverify.backends.monitors.deadlines import check_deadlines
-from rclverify.rcl.typecheck import load
+from rclverify.lang.typecheck import load
 from rclverify.traces.events import Event
 
 RANGER = """node Ranger {
@@ -136,8 +136,8 @@ node Motor {
 def test_always_on_a_correct_chain_is_not_refuted_by_a_value_nobody_published(tmp_path: Path) -> None:
     """Before: refuted at step 0 by a state in which Motor.in.v = 2 "from before the run"."""
     import json
-    from rclverify.pipeline import Workspace
-    from rclverify.requirements.check import check_requirement
+    from rclverify.app.pipeline import Workspace
+    from rclverify.calculus.requirements.check import check_requirement
     (tmp_path / "contracts").mkdir()
     (tmp_path / "contracts/c.rcl").write_text(CHAIN)
     reqs = {"SAFE": "always Motor.out.w <= 1.5", "SOME": "eventually Motor.out.w <= 1.0"}

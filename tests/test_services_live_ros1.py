@@ -24,7 +24,7 @@ from typing import Any
 import pytest
 from _procs import stop, wait_for
 
-from rclverify.backends.monitors.ros1 import LocalMaster, RosUnavailable, import_rospy
+from rclverify.runtime.ros1 import LocalMaster, RosUnavailable, import_rospy
 
 REPO = Path(__file__).resolve().parents[1]
 EXAMPLE = REPO / "examples" / "safety_stop"
@@ -58,7 +58,7 @@ def live_log(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
             wait_for(tmp / "base.out", "ready", 60)
             wait_for(tmp / "mover.out", "ready", 60)
             # the proxy inside the live monitor: one process, one log, one verdict topic
-            monitor = _start(["-m", "rclverify.cli", "monitor", "-w", str(EXAMPLE), "--live", "--interfaces",
+            monitor = _start(["-m", "rclverify.cli.commands", "monitor", "-w", str(EXAMPLE), "--live", "--interfaces",
                               "interfaces", "--forward", "/estop=/estop_real", "--log", str(log),
                               "--evidence", str(tmp / "live.json"), "--duration", "60"], env, tmp / "monitor.out")
             procs.append(monitor)

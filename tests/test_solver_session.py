@@ -1,4 +1,4 @@
-"""Queries sharing one incremental solver (logic/query.py, ``solver_session``):
+"""Queries sharing one incremental solver (semantics/query.py, ``solver_session``):
 the same verdicts and cores as fresh solvers, nothing left behind by a
 query, and the same answers every time a unit of work is repeated."""
 from __future__ import annotations
@@ -8,13 +8,13 @@ from pathlib import Path
 import z3
 
 from rclverify.calculus.compose import compose_node
-from rclverify.health.checks import check_node
-from rclverify.logic import query
-from rclverify.logic.query import prove, satisfiable, solver_session
-from rclverify.logic.world import fresh as fresh_z3
-from rclverify.plan.load import load_plan
-from rclverify.rcl.typecheck import load
-from rclverify.system.model import build
+from rclverify.calculus.health.checks import check_node
+from rclverify.semantics import query
+from rclverify.semantics.query import prove, satisfiable, solver_session
+from rclverify.semantics.world import fresh as fresh_z3
+from rclverify.model.plan.load import load_plan
+from rclverify.lang.typecheck import load
+from rclverify.model.system.model import build
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -64,7 +64,7 @@ def _verdicts(findings: list) -> list:
 
 def test_a_node_checked_again_gives_the_same_verdicts_and_cores() -> None:
     # Witness values may differ between the two runs: a Z3 model depends on the term ids of
-    # the process's context, which the first run's garbage changes (docs/architecture.md,
+    # the process's context, which the first run's garbage changes (docs/decisions.md,
     # "Determinism").  Verdicts, cores and instance scans may not.
     plan = load_plan(ROOT)
     checked = load([ROOT / c for c in plan.contracts])

@@ -12,15 +12,15 @@ from pathlib import Path
 import pytest
 import yaml
 
-from rclverify.backends.ajpf import psl
+from rclverify.backends.model_checking.ajpf import psl
 from rclverify.backends.base import NodeTarget
 from rclverify.backends.model_checking import backend as mc
 from rclverify.backends.model_checking import spin
 from rclverify.backends.model_checking.graph import MentalState, StateGraph, Transition
 from rclverify.backends.model_checking.ltl import Propositions, parse_psl_text, to_spin
 from rclverify.backends.model_checking.promela import Claim, build_model
-from rclverify.evidence.records import Obligation, SourceRef
-from rclverify.plan.errors import PlanError
+from rclverify.records.records import Obligation, SourceRef
+from rclverify.model.plan.errors import PlanError
 
 REPO = Path(__file__).resolve().parents[1]
 HAVE_SPIN = shutil.which("spin") is not None and shutil.which("gcc") is not None
@@ -240,8 +240,8 @@ STAGE_ONE = importlib.util.find_spec("rclverify.backends.model_checking.explore"
 @needs_spin
 @pytest.mark.skipif(not STAGE_ONE, reason="stage one not present")
 def test_case_study_instances_all_decided(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
-    from rclverify.backends.ajpf.backend import AjpfBackend
-    from rclverify.workspace import Workspace
+    from rclverify.backends.model_checking.ajpf.backend import AjpfBackend
+    from rclverify.stages.workspace import Workspace
     monkeypatch.delenv("MCAPL_HOME", raising=False)
     monkeypatch.delenv("AJPF_HOME", raising=False)
     plan = yaml.safe_load((REPO / "contracts/plan.yaml").read_text())
@@ -309,7 +309,7 @@ nodes:
 
 
 def spin_workspace(root: Path, extra: str) -> NodeTarget:
-    from rclverify.workspace import Workspace
+    from rclverify.stages.workspace import Workspace
     (root / "contracts").mkdir(parents=True, exist_ok=True)
     (root / "backends/ajpf").mkdir(parents=True, exist_ok=True)
     shutil.copy(REPO / "contracts/remote_inspection.rcl", root / "contracts")
@@ -325,7 +325,7 @@ def spin_workspace(root: Path, extra: str) -> NodeTarget:
     ("        properties: [backends/ajpf/none.psl]\n", 10, "property file 'backends/ajpf/none.psl' does not exist"),
 ])
 def test_spin_keys_are_checked_with_located_errors(tmp_path: Path, extra: str, where: int, message: str) -> None:
-    from rclverify.backends.ajpf.backend import AjpfBackend
+    from rclverify.backends.model_checking.ajpf.backend import AjpfBackend
     target = spin_workspace(tmp_path, extra)
     with pytest.raises(PlanError) as e:
         AjpfBackend().export(target)
@@ -333,7 +333,7 @@ def test_spin_keys_are_checked_with_located_errors(tmp_path: Path, extra: str, w
 
 
 def test_property_files_give_obligations_of_their_own(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
-    from rclverify.backends.ajpf.backend import AjpfBackend
+    from rclverify.backends.model_checking.ajpf.backend import AjpfBackend
     monkeypatch.delenv("MCAPL_HOME", raising=False)
     monkeypatch.delenv("AJPF_HOME", raising=False)
     (tmp_path / "backends/ajpf").mkdir(parents=True)

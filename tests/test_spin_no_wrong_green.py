@@ -23,18 +23,18 @@ from typing import Any, Callable, Iterator
 import pytest
 import yaml
 
-from rclverify.backends.ajpf import psl
-from rclverify.backends.ajpf.backend import DEFAULT_TIMEOUT_S as AJPF_TIMEOUT_S
-from rclverify.backends.ajpf.backend import AjpfBackend
+from rclverify.backends.model_checking.ajpf import psl
+from rclverify.backends.model_checking.ajpf.backend import DEFAULT_TIMEOUT_S as AJPF_TIMEOUT_S
+from rclverify.backends.model_checking.ajpf.backend import AjpfBackend
 from rclverify.backends.bounded import ToolInterrupted, run_bounded
 from rclverify.backends.model_checking import backend as mc
 from rclverify.backends.model_checking import spin
 from rclverify.backends.model_checking.environment import environment_from_plan
 from rclverify.backends.model_checking.explore import explore
 from rclverify.backends.model_checking.gwendolen import GwendolenError
-from rclverify.evidence.records import Evidence, Obligation
-from rclverify.plan.errors import PlanError
-from rclverify.rcl.errors import RclError
+from rclverify.records.records import Evidence, Obligation
+from rclverify.model.plan.errors import PlanError
+from rclverify.lang.errors import RclError
 
 from test_spin import HAVE_SPIN
 
@@ -68,7 +68,7 @@ def workspace(root: Path, program: str | None = None, model: str = "backends/ajp
     """A workspace with the case study's Agent contract and ajpf entry (SPIN), ``program``
     (default: the case study's agent) at ``model``, ``properties`` files, the entry changed by
     ``changes``; returns the Agent's target of entry 0."""
-    from rclverify.workspace import Workspace
+    from rclverify.stages.workspace import Workspace
     (root / "contracts").mkdir(parents=True, exist_ok=True)
     (root / "contracts/remote_inspection.rcl").write_text((REPO / "contracts/remote_inspection.rcl").read_text())
     (root / model).parent.mkdir(parents=True, exist_ok=True)
@@ -289,7 +289,7 @@ RUN_ONE = """
 import sys
 from pathlib import Path
 from rclverify import pipeline
-from rclverify.rcl.errors import RclError
+from rclverify.lang.errors import RclError
 ws = pipeline.Workspace(Path(sys.argv[1]))
 try:
     ev = pipeline.stage_run(ws, "Agent", sys.argv[2])
@@ -302,7 +302,7 @@ print("recorded", ev.status)
 
 def _start_run(tmp_path: Path) -> tuple[subprocess.Popen[str], Path, Path, str]:
     """A process checking one case-study obligation with SPIN, in an empty verifier cache."""
-    from rclverify import pipeline
+    from rclverify.app import pipeline
     root = tmp_path / "ws"
     workspace(root)
     ws = pipeline.Workspace(root)
@@ -457,7 +457,7 @@ def test_two_ajpf_entries_on_one_node_are_refused_by_check(tmp_path: Path) -> No
 
 
 def test_build_products_are_never_bundled(tmp_path: Path) -> None:
-    from rclverify.bundle.manifest import build_product
+    from rclverify.report.bundle.manifest import build_product
     (tmp_path / "artifacts/ajpf/Agent/spin/build/ab").mkdir(parents=True)
     (tmp_path / "artifacts/ajpf/Agent/spin/build/ab/model.pml").write_text("x")
     (tmp_path / "artifacts/ajpf/Agent/spin/model.pml").write_text("x")

@@ -27,7 +27,7 @@ import pytest
 from hypothesis import HealthCheck, assume, given, settings
 from hypothesis import strategies as st
 
-from rclverify.backends.ajpf import psl
+from rclverify.backends.model_checking.ajpf import psl
 from rclverify.backends.model_checking import spin
 from rclverify.backends.model_checking.environment import environment_from_plan
 from rclverify.backends.model_checking.explore import explore_program

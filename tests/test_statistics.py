@@ -1,4 +1,4 @@
-"""The statistics of counted runs (evidence/statistics.py, issue 68): the Clopper-Pearson bound, the runs still
+"""The statistics of counted runs (records/statistics.py, issue 68): the Clopper-Pearson bound, the runs still
 needed and Wald's SPRT, each against an independent brute-force computation on small cases."""
 from __future__ import annotations
 
@@ -7,8 +7,8 @@ import random
 
 import pytest
 
-from rclverify.evidence.statistics import count_runs, decide, lower_bound, runs_needed, sprt, upper_bound
-from rclverify.plan.target_text import parse_target
+from rclverify.records.statistics import count_runs, decide, lower_bound, runs_needed, sprt, upper_bound
+from rclverify.model.plan.target_text import parse_target
 
 
 def binom_cdf(k: int, n: int, p: float) -> float:

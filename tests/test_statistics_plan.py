@@ -9,9 +9,9 @@ from typing import Any
 import pytest
 
 from rclverify.backends.monitors.backend import MonitorsBackend
-from rclverify.cli import main
-from rclverify.plan.errors import PlanError
-from rclverify.workspace import Workspace
+from rclverify.cli.commands import main
+from rclverify.model.plan.errors import PlanError
+from rclverify.stages.workspace import Workspace
 
 RCL = """
 node Clamp {
@@ -181,7 +181,7 @@ def test_an_experiment_target_counts_trials_and_leaves_the_criterion_alone(tmp_p
 
 def test_the_live_monitor_counts_as_it_goes_and_its_log_counts_as_a_live_run(tmp_path: Path) -> None:
     from rclverify.backends.monitors.config import load_mapping
-    from rclverify.backends.monitors.live import LiveRun
+    from rclverify.runtime.live import LiveRun
     ws = _ws(tmp_path, [], {})
     cfg = load_mapping(tmp_path, None, 1.0)
     log = tmp_path / "live/run.jsonl"

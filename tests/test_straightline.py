@@ -1,5 +1,5 @@
-"""The monitors' compiled formulas (issue 44: logic/straightline.py,
-logic/judges.py) against the evaluator they replace on the hot path.
+"""The monitors' compiled formulas (issue 44: semantics/straightline.py,
+semantics/judges.py) against the evaluator they replace on the hot path.
 
 Hypothesis draws well-typed formulas of the fragment the monitors evaluate
 (numbers of the three numeric types with exact and inexact literals,
@@ -33,15 +33,15 @@ from hypothesis import strategies as st
 from _classifier import CLASSIFIER as _CLASSIFIER
 from rclverify.backends.monitors.check import check_trace
 from rclverify.backends.monitors.config import load_mapping
-from rclverify.logic.evaluator import Evaluator
-from rclverify.logic.eval_values import Undecided
-from rclverify.logic.floatsem import Tolerance, judge
-from rclverify.logic.judges import FormulaJudge
-from rclverify.logic.straightline import Missing, compile_exact
-from rclverify.rcl.parser import parse_formula, parse_text
-from rclverify.rcl.typecheck import check, load
+from rclverify.semantics.evaluator import Evaluator
+from rclverify.semantics.eval_values import Undecided
+from rclverify.semantics.floatsem import Tolerance, judge
+from rclverify.semantics.judges import FormulaJudge
+from rclverify.semantics.straightline import Missing, compile_exact
+from rclverify.lang.parser import parse_formula, parse_text
+from rclverify.lang.typecheck import check, load
 from rclverify.traces import read_trace
-from rclverify.values import FiniteFunction, Term
+from rclverify.semantics.values import FiniteFunction, Term
 
 REPO = Path(__file__).resolve().parents[1]
 SIGNATURE = """

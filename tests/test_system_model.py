@@ -5,14 +5,14 @@ from pathlib import Path
 
 import pytest
 
-from rclverify.logic.encode import Encoder
-from rclverify.logic.query import prove
-from rclverify.plan.load import Connection
-from rclverify.rcl import ast
-from rclverify.rcl.errors import RclError
-from rclverify.rcl.parser import parse_text
-from rclverify.rcl.typecheck import check, load
-from rclverify.system.model import Link, SystemModel, build
+from rclverify.semantics.encode import Encoder
+from rclverify.semantics.query import prove
+from rclverify.model.plan.load import Connection
+from rclverify.lang import ast
+from rclverify.lang.errors import RclError
+from rclverify.lang.parser import parse_text
+from rclverify.lang.typecheck import check, load
+from rclverify.model.system.model import Link, SystemModel, build
 
 ROOT = Path(__file__).resolve().parents[1]
 CASE_STUDY = ROOT / "contracts" / "remote_inspection.rcl"
@@ -70,7 +70,7 @@ def test_alias_maps_inputs_to_producer_outputs(model: SystemModel) -> None:
 
 
 def test_alias_discharges_navigation_assumption_from_localisation() -> None:
-    from rclverify.logic import world
+    from rclverify.semantics import world
     world.fresh()  # Z3's answer on the quantifiers depends on the context's history: up to two 10 s time-outs
     checked = load([CASE_STUDY])
     loc, nav = checked.nodes["Localisation"], checked.nodes["Navigation"]

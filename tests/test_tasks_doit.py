@@ -1,4 +1,4 @@
-"""rclverify's replacement of doit's implicit-dependency scan (tasks.py) adds
+"""rclverify's replacement of doit's implicit-dependency scan (app/tasks.py) adds
 the same task dependencies in the same order as doit's own."""
 from __future__ import annotations
 
@@ -7,7 +7,7 @@ from types import SimpleNamespace
 
 from doit.control import TaskControl
 
-from rclverify import tasks
+from rclverify.app import tasks
 
 
 def test_the_linear_scan_adds_what_doits_own_adds() -> None:

@@ -4,8 +4,8 @@ response and ranking functions (docs/requirements.md, Temporal requirements)."""
 import pytest
 import z3
 
-from rclverify.logic.world import fresh
-from rclverify.requirements.temporal import (
+from rclverify.semantics.world import fresh
+from rclverify.calculus.requirements.temporal import (
     TransitionSystem, check_always, check_eventually, check_eventually_within)
 
 I = z3.IntSort()
@@ -14,7 +14,7 @@ I = z3.IntSort()
 @pytest.fixture(autouse=True)
 def _fresh_z3_world() -> None:
     """Each test builds its terms in a fresh Z3 context, as a pipeline unit of
-    work does (logic/world.py): a sort made in the context of an earlier test
+    work does (semantics/world.py): a sort made in the context of an earlier test
     cannot be mixed with the terms of a later one."""
     global I
     fresh()
@@ -96,14 +96,14 @@ def test_unbounded_eventually_never_reached_is_not_proved():
     assert (v.status, v.method, v.loop) == ("refuted", "lasso", 0)
 
 
-# --- the statement layer over RCL formulas (plan/temporal.py) ---------------
+# --- the statement layer over RCL formulas (model/plan/temporal.py) ---------------
 
 import pytest  # noqa: E402
 
-from rclverify.plan.formal import Formal, Source  # noqa: E402
-from rclverify.plan.temporal import Temporal, parse_temporal  # noqa: E402
-from rclverify.rcl.errors import RclError  # noqa: E402
-from rclverify.rcl.typecheck import load  # noqa: E402
+from rclverify.model.plan.formal import Formal, Source  # noqa: E402
+from rclverify.model.plan.temporal import Temporal, parse_temporal  # noqa: E402
+from rclverify.lang.errors import RclError  # noqa: E402
+from rclverify.lang.typecheck import load  # noqa: E402
 
 
 @pytest.fixture(scope="module")

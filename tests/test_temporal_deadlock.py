@@ -15,13 +15,13 @@ from pathlib import Path
 import pytest
 import z3
 
-from rclverify.cli import main
-from rclverify.logic.world import fresh
-from rclverify.pipeline import Workspace, stage_check, stage_requirements
-from rclverify.plan.errors import PlanError
-from rclverify.plan.temporal import MAX_BOUND
-from rclverify.requirements.deadlock import runs_go_on
-from rclverify.requirements.temporal import (
+from rclverify.cli.commands import main
+from rclverify.semantics.world import fresh
+from rclverify.app.pipeline import Workspace, stage_check, stage_requirements
+from rclverify.model.plan.errors import PlanError
+from rclverify.model.plan.temporal import MAX_BOUND
+from rclverify.calculus.requirements.deadlock import runs_go_on
+from rclverify.calculus.requirements.temporal import (
     TransitionSystem, check_always, check_eventually, check_eventually_within, check_next, check_until)
 
 
@@ -184,10 +184,10 @@ def test_a_bound_past_the_limit_or_not_in_ascii_digits_is_a_located_error(tmp_pa
 
 
 def test_the_limit_itself_and_leading_zeros_are_accepted(tmp_path: Path) -> None:
-    from rclverify.plan.temporal import Temporal
+    from rclverify.model.plan.temporal import Temporal
     ws = _ws(tmp_path, COUNTER, [{"formal": f"eventually[<= {MAX_BOUND}] Sensor.out.value == 1000"},
                                  {"formal": "eventually[<=  0012 ] Sensor.out.value == 1000"}])
-    from rclverify.requirements.temporal_check import statement
+    from rclverify.calculus.requirements.temporal_check import statement
     w = Workspace(ws)
     bounds = [statement(r, w.checked, w.plan) for r in w.plan.requirements]
     assert [t.bound for t in bounds if isinstance(t, Temporal)] == [MAX_BOUND, 12]

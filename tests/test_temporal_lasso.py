@@ -1,7 +1,7 @@
 """Lassos with finite-table functions refute an unbounded ``eventually``
-(issue 34): the search of requirements/lasso.py over a small system with a
+(issue 34): the search of calculus/requirements/lasso.py over a small system with a
 function-typed input, the confirmation of its trace on concrete values
-(requirements/lasso_confirm.py), and a corrupted trace that is not
+(calculus/requirements/lasso_confirm.py), and a corrupted trace that is not
 confirmed.  Real Z3."""
 from __future__ import annotations
 
@@ -11,16 +11,16 @@ from pathlib import Path
 
 import pytest
 
-from rclverify.pipeline import Workspace
-from rclverify.plan.formal import parse_formal
-from rclverify.plan.temporal import operands
-from rclverify.requirements.check import check_requirement
-from rclverify.requirements.lasso import find_table_lasso
-from rclverify.requirements.lasso_confirm import confirm_lasso
-from rclverify.requirements.temporal_check import statement
-from rclverify.requirements.transition import build_system, variable_types
-from rclverify.logic.encode import Encoder
-from rclverify.values import FiniteFunction
+from rclverify.app.pipeline import Workspace
+from rclverify.model.plan.formal import parse_formal
+from rclverify.model.plan.temporal import operands
+from rclverify.calculus.requirements.check import check_requirement
+from rclverify.calculus.requirements.lasso import find_table_lasso
+from rclverify.calculus.requirements.lasso_confirm import confirm_lasso
+from rclverify.calculus.requirements.temporal_check import statement
+from rclverify.calculus.requirements.transition import build_system, variable_types
+from rclverify.semantics.encode import Encoder
+from rclverify.semantics.values import FiniteFunction
 
 # Pick reads a table f of levels (the environment's, bounded by 9) and
 # outputs a level f takes; Hold keeps the last level it read.  Both answer

@@ -30,9 +30,9 @@ import pytest
 import z3
 from hypothesis import HealthCheck, given, settings, strategies as st
 
-from rclverify.logic.world import fresh
-from rclverify.requirements.deadlock import check_deadlock_free, runs_go_on
-from rclverify.requirements.temporal import (
+from rclverify.semantics.world import fresh
+from rclverify.calculus.requirements.deadlock import check_deadlock_free, runs_go_on
+from rclverify.calculus.requirements.temporal import (
     Fairness, TemporalVerdict, TransitionSystem, check_always, check_eventually, check_eventually_within, check_next,
     check_until, with_flag)
 

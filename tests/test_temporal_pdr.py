@@ -19,13 +19,13 @@ import z3
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from rclverify.cli import main
-from rclverify.pipeline import Workspace, stage_check, stage_export, stage_run
-from rclverify.plan.errors import PlanError
-from rclverify.requirements.houdini import generate
-from rclverify.requirements.pdr import recheck, spacer_invariant
-from rclverify.requirements.safety import Hint, by_pdr, hint_fails, prove_always
-from rclverify.requirements.tsys import TransitionSystem
+from rclverify.cli.commands import main
+from rclverify.app.pipeline import Workspace, stage_check, stage_export, stage_run
+from rclverify.model.plan.errors import PlanError
+from rclverify.calculus.requirements.houdini import generate
+from rclverify.calculus.requirements.pdr import recheck, spacer_invariant
+from rclverify.calculus.requirements.safety import Hint, by_pdr, hint_fails, prove_always
+from rclverify.calculus.requirements.tsys import TransitionSystem
 
 XS = range(4)
 STATES = [(x, b) for x in XS for b in (False, True)]

@@ -18,10 +18,10 @@ from pathlib import Path
 
 import pytest
 
-from rclverify.cli import main
-from rclverify.pipeline import Workspace, stage_check, stage_requirements
-from rclverify.plan.errors import PlanError
-from rclverify.rcl.errors import RclError
+from rclverify.cli.commands import main
+from rclverify.app.pipeline import Workspace, stage_check, stage_requirements
+from rclverify.model.plan.errors import PlanError
+from rclverify.lang.errors import RclError
 
 PLANNER = """node Planner {{
   inputs( goal : INTEGER, pose : INTEGER )
@@ -153,14 +153,14 @@ def test_initial_values_unstick_the_loop_and_are_used_by_safety(tmp_path: Path) 
 
 
 def test_a_table_lasso_that_breaks_fairness_is_not_confirmed(tmp_path: Path) -> None:
-    """The independent confirmation of a lasso (requirements/lasso_confirm.py)
+    """The independent confirmation of a lasso (calculus/requirements/lasso_confirm.py)
     checks the progress rules on the values: a Base that declares progress
     but never answers what it accepts in the loop is not a run."""
-    from rclverify.plan.temporal import operands
-    from rclverify.requirements.lasso_confirm import confirm_lasso
-    from rclverify.requirements.temporal_check import statement
-    from rclverify.requirements.transition import build_system, variable_types
-    from rclverify.plan.formal import parse_formal
+    from rclverify.model.plan.temporal import operands
+    from rclverify.calculus.requirements.lasso_confirm import confirm_lasso
+    from rclverify.calculus.requirements.temporal_check import statement
+    from rclverify.calculus.requirements.transition import build_system, variable_types
+    from rclverify.model.plan.formal import parse_formal
     ws = _ws(tmp_path, "progress( within 0 steps )", "initially( out.pose == 0 )")
     w = Workspace(ws)
     checked, model, plan = w.checked, w.model, w.plan
@@ -209,9 +209,9 @@ def test_declarations_are_checked_with_located_errors(tmp_path: Path, clause: st
 
 
 def test_fmt_and_latex_keep_the_declarations(tmp_path: Path) -> None:
-    from rclverify.rcl.latex import to_latex
-    from rclverify.rcl.parser import parse_text
-    from rclverify.rcl.printer import to_rcl
+    from rclverify.lang.latex import to_latex
+    from rclverify.lang.parser import parse_text
+    from rclverify.lang.printer import to_rcl
     text = PLANNER.format("progress( eventually )\n  periodic( out.target, 100 ms )") + BASE.format(
         "initially( out.pose == 0 )\n  progress( within 2 steps )")
     spec = parse_text(text, "r.rcl")

@@ -9,8 +9,8 @@ from pathlib import Path
 
 import pytest
 
-from rclverify.pipeline import Workspace, stage_check, stage_requirements
-from rclverify.plan.errors import PlanError
+from rclverify.app.pipeline import Workspace, stage_check, stage_requirements
+from rclverify.model.plan.errors import PlanError
 
 RCL = """node Cnt { inputs( a : NATURAL ) outputs( b : NATURAL )
   guarantee( out.b == in.a ) }

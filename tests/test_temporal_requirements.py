@@ -9,8 +9,8 @@ from pathlib import Path
 
 import pytest
 
-from rclverify.pipeline import Workspace, stage_check, stage_requirements
-from rclverify.plan.errors import PlanError
+from rclverify.app.pipeline import Workspace, stage_check, stage_requirements
+from rclverify.model.plan.errors import PlanError
 
 # Inc adds one to what Fwd hands back, up to 10; Fwd forwards it: a loop
 # (Inc.out.b -> Fwd.in.b, Fwd.out.a -> Inc.in.a) that Fwd's initial value 0
@@ -199,7 +199,7 @@ def test_an_operator_inside_a_state_formula_is_a_located_error_naming_the_shapes
 
 
 def test_the_unbounded_response_is_decided(tmp_path: Path) -> None:
-    """``always (P -> eventually Q)`` (requirements/response.py; the oracle is
+    """``always (P -> eventually Q)`` (calculus/requirements/response.py; the oracle is
     tests/test_response_pattern.py): Inc's output, once at least 1, reaches 2
     (proved through the bounded form); it never reaches 11, so that response
     is never proved."""

@@ -12,7 +12,7 @@ random no progress, ``progress( eventually )``, ``within 0 steps`` or
 docs/requirements.md ("The transition relation") are written out here in
 plain Python, the runs enumerated, and the verdicts of ``eventually z ==
 g`` and ``always z != h`` (with the rule that no run may stop) compared with
-the real check (requirements/temporal_check.py): ``proved`` must be true,
+the real check (calculus/requirements/temporal_check.py): ``proved`` must be true,
 ``refuted`` false with a trace that is a run of the explicit system (a
 lasso's loop fair); ``inconclusive`` is counted and kept rare.  Real Z3.
 """
@@ -30,9 +30,9 @@ import pytest
 from hypothesis import HealthCheck, given, settings, strategies as st
 
 from test_temporal_oracle import _closure, _fair_cycle
-from rclverify.logic.world import fresh
-from rclverify.pipeline import Workspace
-from rclverify.requirements.check import check_requirement
+from rclverify.semantics.world import fresh
+from rclverify.app.pipeline import Workspace
+from rclverify.calculus.requirements.check import check_requirement
 
 V = ("a", "b", "c")
 KINDS = ("", "progress( eventually )", "progress( within 0 steps )", "progress( within 1 steps )")

@@ -11,11 +11,11 @@ from pathlib import Path
 import pytest
 
 from rclverify.backends.monitors.temporal_trace import check_temporal_trace
-from rclverify.plan.state import state_types
-from rclverify.plan.temporal import parse_temporal
-from rclverify.plan.formal import Source
+from rclverify.model.plan.state import state_types
+from rclverify.model.plan.temporal import parse_temporal
+from rclverify.model.plan.formal import Source
 from rclverify.traces import read_trace
-from rclverify.workspace import Workspace
+from rclverify.stages.workspace import Workspace
 
 # Inc answers each a with b = a + 1; its state n counts the b it produced.
 RCL = """node Inc { inputs( a : NATURAL ) outputs( b : NATURAL )
@@ -126,7 +126,7 @@ def test_case_study_req4_on_the_nominal_run_is_currently_false() -> None:
 
 
 def test_state_edit_shows_the_requirement_record_stale_before_the_stage_ran(tmp_path: Path) -> None:
-    from rclverify.pipeline import stage_check, stage_requirements
+    from rclverify.app.pipeline import stage_check, stage_requirements
     from rclverify.report.build import build_report
     (tmp_path / "contracts").mkdir()
     (tmp_path / "contracts/n.rcl").write_text(RCL)
@@ -144,7 +144,7 @@ def test_state_edit_shows_the_requirement_record_stale_before_the_stage_ran(tmp_
 
 
 def test_recorded_runs_are_evidence_of_the_temporal_requirement_in_the_report(tmp_path: Path) -> None:
-    from rclverify.pipeline import stage_check, stage_requirements
+    from rclverify.app.pipeline import stage_check, stage_requirements
     from rclverify.report.build import build_report
     (tmp_path / "contracts").mkdir()
     (tmp_path / "contracts/n.rcl").write_text(RCL)
@@ -177,7 +177,7 @@ def test_recorded_runs_are_evidence_of_the_temporal_requirement_in_the_report(tm
     again = {r["id"]: r for r in build_report(Workspace(tmp_path))["requirements"]}
     assert again["T1"]["check"]["traces"][0]["verdict"]["verdict"] == "true"
     # doit re-runs the requirements stage when a recorded run changes
-    from rclverify.tasks import build_tasks
+    from rclverify.app.tasks import build_tasks
     assert str(tmp_path / "run.jsonl") in build_tasks(tmp_path)["task_requirements"]()["file_dep"]
 
 

@@ -24,7 +24,7 @@ pytestmark = pytest.mark.skipif(not hasattr(os, "mkfifo"), reason="needs FIFOs")
 
 REPO = Path(__file__).resolve().parents[1]
 BAG = "backends/monitors/traces/nominal_bag"
-CLI = "import sys; from rclverify.cli import main; sys.exit(main(sys.argv[1:]))"
+CLI = "import sys; from rclverify.cli.commands import main; sys.exit(main(sys.argv[1:]))"
 
 
 def _case(tmp_path: Path) -> Path:
@@ -101,7 +101,7 @@ import json
 from pathlib import Path
 from rclverify.backends.base import NodeTarget
 from rclverify.backends.monitors.backend import MonitorsBackend
-from rclverify.rcl.typecheck import load
+from rclverify.lang.typecheck import load
 root = Path(".")
 checked = load([root / "contracts/remote_inspection.rcl"])
 t = NodeTarget(root=root, checked=checked, node=checked.nodes["RadiationSensor"],

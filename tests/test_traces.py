@@ -7,10 +7,10 @@ from pathlib import Path
 
 import pytest
 
-from rclverify.rcl import types as T
+from rclverify.lang import types as T
 from rclverify.traces import TraceError, read_trace
 from rclverify.traces.mapping import MappingError, TopicRule, map_value
-from rclverify.values import FiniteFunction, Term
+from rclverify.semantics.values import FiniteFunction, Term
 
 REPO = Path(__file__).resolve().parents[1]
 TRACES = REPO / "backends" / "monitors" / "traces"

@@ -5,11 +5,11 @@ from pathlib import Path
 
 import pytest
 
-from rclverify.rcl import ast
-from rclverify.rcl.errors import Diagnostic, RclError
-from rclverify.rcl.parser import parse_formula, parse_text
-from rclverify.rcl.typecheck import check, domain_type, infer, load
-from rclverify.rcl.types import (BOOL, INTEGER, NATURAL, REAL, DataT, EmptyT, EnumT, FuncT, SetT)
+from rclverify.lang import ast
+from rclverify.lang.errors import Diagnostic, RclError
+from rclverify.lang.parser import parse_formula, parse_text
+from rclverify.lang.typecheck import check, domain_type, infer, load
+from rclverify.lang.types import (BOOL, INTEGER, NATURAL, REAL, DataT, EmptyT, EnumT, FuncT, SetT)
 
 ROOT = Path(__file__).resolve().parents[1]
 CASE_STUDY = ROOT / "contracts" / "remote_inspection.rcl"

@@ -13,16 +13,16 @@ from hypothesis import strategies as st
 
 from rclverify.calculus.compose import compose_node
 from rclverify.calculus.scale import _range, scale_findings, scale_power
-from rclverify.cli import main
-from rclverify.contract_texts import node_texts
-from rclverify.rcl.errors import RclError
-from rclverify.rcl.latex import to_latex
-from rclverify.rcl.parser import parse_text
-from rclverify.rcl.printer import to_rcl
-from rclverify.rcl.timing import parse_duration, seconds
-from rclverify.rcl.typecheck import check
-from rclverify.rcl.units import PREFIXES, SYMBOLS, UnitError, factor_text, parse_unit, power_of_ten
-from rclverify.system.model import build, unit_diagnostics
+from rclverify.cli.commands import main
+from rclverify.report.contract_texts import node_texts
+from rclverify.lang.errors import RclError
+from rclverify.lang.latex import to_latex
+from rclverify.lang.parser import parse_text
+from rclverify.lang.printer import to_rcl
+from rclverify.lang.timing import parse_duration, seconds
+from rclverify.lang.typecheck import check
+from rclverify.lang.units import PREFIXES, SYMBOLS, UnitError, factor_text, parse_unit, power_of_ten
+from rclverify.model.system.model import build, unit_diagnostics
 
 # ---------------------------------------------------------------------------
 # The algebra, against Python's own evaluator over exact generators
@@ -61,7 +61,7 @@ _FACTOR = st.tuples(_SYM, st.integers(-3, 3).filter(lambda k: k != 0))
 def _in_range(factors: list[tuple[str, int]], ops: list[str]) -> bool:
     """Whether every base exponent stays within MAX_EXPONENT while the product is read left to
     right (issue 47: the limit holds for repeated multiplication and division too)."""
-    from rclverify.rcl.units import MAX_EXPONENT
+    from rclverify.lang.units import MAX_EXPONENT
     acc = [0] * len(parse_unit("m").dims)
     for k, ((sym, e), op) in enumerate(zip(factors, ["*", *ops])):
         d = parse_unit(sym).dims
@@ -387,7 +387,7 @@ def test_snapshots_follow_units_incremental_equals_clean(tmp_path):
     kept its texts equals the one a clean workspace makes; the check stage
     lists a unit declared at one end only among its warnings."""
     import shutil
-    from rclverify.pipeline import Workspace, stage_check
+    from rclverify.app.pipeline import Workspace, stage_check
 
     def ws(root, text):
         (root / "contracts").mkdir(parents=True, exist_ok=True)

@@ -8,9 +8,9 @@ from pathlib import Path
 
 import pytest
 
-from rclverify.rcl.typecheck import load
-from rclverify.rcl.errors import RclError
-from rclverify.rcl.units import MAX_EXPONENT, UnitError, parse_unit
+from rclverify.lang.typecheck import load
+from rclverify.lang.errors import RclError
+from rclverify.lang.units import MAX_EXPONENT, UnitError, parse_unit
 
 
 def test_a_blank_between_two_symbols_is_a_product() -> None:

@@ -26,14 +26,14 @@ import pytest
 from hypothesis import HealthCheck, given, reject, settings
 from hypothesis import strategies as st
 
-from rclverify.cli import main
-from rclverify.rcl.errors import RclError
-from rclverify.rcl.parser import parse_text
-from rclverify.rcl.typecheck import check
-from rclverify.rcl.unitconv import TARGETS, factor_name
-from rclverify.rcl.unitinfer import infer_units
-from rclverify.rcl.units import Unit, factor_text, parse_unit
-from rclverify.system.model import build, unit_diagnostics
+from rclverify.cli.commands import main
+from rclverify.lang.errors import RclError
+from rclverify.lang.parser import parse_text
+from rclverify.lang.typecheck import check
+from rclverify.lang.unitconv import TARGETS, factor_name
+from rclverify.lang.unitinfer import infer_units
+from rclverify.lang.units import Unit, factor_text, parse_unit
+from rclverify.model.system.model import build, unit_diagnostics
 
 ROBOT = """\
 node Gnss {

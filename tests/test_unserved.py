@@ -1,6 +1,6 @@
 """A client that calls a service nobody serves (issue: no wrong green): a
 located warning, and no deadline chain through the call is proved
-(system/services.py ``unserved``; calculus/deadlines.py ``chains``)."""
+(model/system/services.py ``unserved``; calculus/deadlines.py ``chains``)."""
 from __future__ import annotations
 
 import json
@@ -11,11 +11,11 @@ from pathlib import Path
 import pytest
 
 from rclverify.calculus.deadlines import INCONCLUSIVE, PROVED, decide
-from rclverify.cli import main
-from rclverify.rcl.parser import parse_text
-from rclverify.rcl.typecheck import check
-from rclverify.system.model import build
-from rclverify.system.services import unserved
+from rclverify.cli.commands import main
+from rclverify.lang.parser import parse_text
+from rclverify.lang.typecheck import check
+from rclverify.model.system.model import build
+from rclverify.model.system.services import unserved
 
 REPO = Path(__file__).resolve().parents[1]
 EXAMPLE = REPO / "examples" / "safety_stop"

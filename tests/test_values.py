@@ -3,8 +3,8 @@ from fractions import Fraction
 
 import pytest
 
-from rclverify.rcl import types as T
-from rclverify.values import FiniteFunction, Term, conforms, exact, render
+from rclverify.lang import types as T
+from rclverify.semantics.values import FiniteFunction, Term, conforms, exact, render
 
 CMD = T.DataT("CommandSet", (("move", (T.REAL, T.REAL)), ("inspect", (T.NATURAL,))))
 RAD = T.EnumT("RadStat", ("red", "orange", "green"))

@@ -1,4 +1,4 @@
-"""Finite-table witnesses (health/witness.py) against brute force.
+"""Finite-table witnesses (calculus/health/witness.py) against brute force.
 
 A witness asked of the ``simplify``/``qe-light`` tactics first
 (``simplified=True``) meets the contract, evaluated here on its tables, and
@@ -19,11 +19,11 @@ from typing import Any
 
 import pytest
 
-from rclverify.health.checks import _NodeHealth
-from rclverify.health.witness import extend, finite_witness, points_for
-from rclverify.logic import world
-from rclverify.rcl.parser import parse_text
-from rclverify.rcl.typecheck import check
+from rclverify.calculus.health.checks import _NodeHealth
+from rclverify.calculus.health.witness import extend, finite_witness, points_for
+from rclverify.semantics import world
+from rclverify.lang.parser import parse_text
+from rclverify.lang.typecheck import check
 
 CONTEXT = "context { T : INTEGER --> INTEGER ; }\n"
 

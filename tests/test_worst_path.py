@@ -10,9 +10,9 @@ from fractions import Fraction
 
 from rclverify.calculus.deadlines import PROVED, REFUTED, decide
 from rclverify.calculus.worst_path import with_worst_path
-from rclverify.rcl.parser import parse_text
-from rclverify.rcl.typecheck import check
-from rclverify.system.model import build
+from rclverify.lang.parser import parse_text
+from rclverify.lang.typecheck import check
+from rclverify.model.system.model import build
 
 DIAMOND = """\
 node A {
@@ -120,10 +120,10 @@ def test_an_edit_off_the_named_path_makes_the_recorded_deadline_stale(tmp_path) 
     """The deadline record's inputs are the snapshots of every node between its ends, as the task's: a
     slower hop off the named path refutes the deadline, so a proof recorded before the edit must read
     ``stale`` in a report made without the stage (it read ``proved``)."""
-    from rclverify.calculus.deadline_stage import read_deadlines
-    from rclverify.contract_texts import ContractTexts
-    from rclverify.pipeline import stage_check, stage_deadlines
-    from rclverify.workspace import Workspace, current_snapshot_hashes
+    from rclverify.stages.deadlines import read_deadlines
+    from rclverify.report.contract_texts import ContractTexts
+    from rclverify.app.pipeline import stage_check, stage_deadlines
+    from rclverify.stages.workspace import Workspace, current_snapshot_hashes
     (tmp_path / "contracts").mkdir()
     rcl = tmp_path / "contracts/s.rcl"
     rcl.write_text(DIAMOND.replace("within 400 ms", "within 40 ms"))

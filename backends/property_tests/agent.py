@@ -13,7 +13,7 @@ One call decides the next command from the current inputs:
    (``next_location``), else back to waypoint 0.
 
 Waypoints are given as a finite table ``wayP`` from coordinates to ids with a
-default id for every other point (rclverify.values.FiniteFunction); the
+default id for every other point (rclverify.semantics.values.FiniteFunction); the
 position ``at`` likewise.  A waypoint's coordinates are the first table
 entry with that id, or, when only the default gives that id, the first
 point (0.0, 0.0), (1.0, 0.0), ... that is not in the table.
@@ -22,7 +22,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from rclverify.values import FiniteFunction, Term
+from rclverify.semantics.values import FiniteFunction, Term
 
 
 def _where(wayP: FiniteFunction, i: int) -> tuple[float, float] | None:

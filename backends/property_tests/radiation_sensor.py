@@ -13,7 +13,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from rclverify.values import FiniteFunction, Term
+from rclverify.semantics.values import FiniteFunction, Term
 
 
 def classify(r: float) -> str:

@@ -47,7 +47,7 @@ def record_one(py: Path, tmp: Path, seed: int, out: Path) -> dict[str, object]:
     procs: list[subprocess.Popen[bytes]] = []
     t0 = time.monotonic()
     try:
-        mon = start([sys.executable, "-m", "rclverify.cli", "monitor", "-w", ".", "--live", "--ros2",
+        mon = start([sys.executable, "-m", "rclverify.cli.commands", "monitor", "-w", ".", "--live", "--ros2",
                      "--reorder-window", "0", "--status", "0", "--silence", "0", "--duration", str(TIMEOUT),
                      "--log", str(tmp / "run.jsonl"), "--evidence", str(tmp / "evidence.json")],
                     env, tmp / "monitor.out", HERE)

@@ -1,9 +1,9 @@
 """doit tasks of the warehouse robot.  `doit verify` runs the whole
 pipeline; `doit list` shows the stages; `doit verify --strict` fails unless
-every obligation is discharged.  All logic lives in rclverify.tasks."""
+every obligation is discharged.  All logic lives in rclverify.app.tasks."""
 from pathlib import Path
 
-from rclverify.tasks import build_tasks, doit_config
+from rclverify.app.tasks import build_tasks, doit_config
 
 DOIT_CONFIG = doit_config()
 

@@ -1,9 +1,9 @@
 """rclverify: compositional verification of modular robotic systems.
 
-Data flows one way: RCL text -> AST (:mod:`rclverify.rcl`) -> typed contracts
--> system model (:mod:`rclverify.system`) -> calculus and health
-(:mod:`rclverify.calculus`, :mod:`rclverify.health`) -> obligations and
-evidence (:mod:`rclverify.backends`, :mod:`rclverify.evidence`) -> assurance
+Data flows one way: RCL text -> AST (:mod:`rclverify.lang`) -> typed contracts
+-> system model (:mod:`rclverify.model.system`) -> calculus and health
+(:mod:`rclverify.calculus`, :mod:`rclverify.calculus.health`) -> obligations and
+evidence (:mod:`rclverify.backends`, :mod:`rclverify.records`) -> assurance
 report (:mod:`rclverify.report`).
 """
 

@@ -26,8 +26,8 @@ sys.path.insert(0, str(HERE))
 
 from logic import base, mover  # noqa: E402
 
-from rclverify.backends.monitors.ros1 import import_rospy  # noqa: E402
-from rclverify.backends.monitors.ros1_interfaces import action_classes, service_class  # noqa: E402
+from rclverify.runtime.ros1 import import_rospy  # noqa: E402
+from rclverify.runtime.ros1_interfaces import action_classes, service_class  # noqa: E402
 
 INTERFACES = [HERE.parent / "interfaces"]
 

@@ -12,12 +12,12 @@ from importlib import import_module
 from typing import TYPE_CHECKING, cast
 
 if TYPE_CHECKING:
-    from .base import Backend
+    from rclverify.backends.base import Backend
 
 IMPLEMENTED = {
     "hoare": ("rclverify.backends.hoare.backend", "HoareBackend"),
     "dafny": ("rclverify.backends.dafny.backend", "DafnyBackend"),
-    "ajpf": ("rclverify.backends.ajpf.backend", "AjpfBackend"),
+    "ajpf": ("rclverify.backends.model_checking.ajpf.backend", "AjpfBackend"),
     "property_tests": ("rclverify.backends.property_tests.backend", "PropertyTestsBackend"),
     "experiment": ("rclverify.backends.experiment.backend", "ExperimentBackend"),
     "review": ("rclverify.backends.review.backend", "ReviewBackend"),

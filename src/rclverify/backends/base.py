@@ -25,11 +25,11 @@ from datetime import datetime, timezone
 from pathlib import Path
 from typing import Any, Mapping, Protocol
 
-from ..evidence.records import Evidence, Obligation, hash_inputs
-from ..plan.errors import PlanError, plan_error
-from ..plan.load import KEY
-from ..rcl import ast
-from ..rcl.types import Checked, CheckedNode
+from rclverify.records.records import Evidence, Obligation, hash_inputs
+from rclverify.model.plan.errors import PlanError, plan_error
+from rclverify.model.plan.load import KEY
+from rclverify.lang import ast
+from rclverify.lang.types import Checked, CheckedNode
 
 
 @dataclass(frozen=True)
@@ -110,7 +110,7 @@ class Backend(Protocol):
     def export(self, target: NodeTarget) -> list[Obligation]:
         """Render the node's obligations under ``target.artifacts`` and return them.
 
-        Raises :class:`rclverify.plan.errors.PlanError` for a configuration
+        Raises :class:`rclverify.model.plan.errors.PlanError` for a configuration
         the user got wrong (missing file, unmappable type ...).
         """
         ...
@@ -152,11 +152,11 @@ def make_evidence(
 ) -> Evidence:
     """Build an :class:`Evidence` record for ``obligation``, hashing its inputs now.
 
-    ``status`` must be one of the statuses in :mod:`rclverify.evidence.records`.
+    ``status`` must be one of the statuses in :mod:`rclverify.records.records`.
     For a timed guarantee a backend that does not check time says so in the
     explanation and ``details["timing"]`` (:mod:`.timing_scope`).
     """
-    from .timing_scope import scope
+    from rclverify.backends.timing_scope import scope
     explanation, details = scope(obligation.backend, target.node, obligation.guarantee, explanation, details or {})
     return Evidence(
         obligation=obligation.id, backend=obligation.backend, kind=obligation.kind, status=status,

@@ -23,7 +23,7 @@ Every external tool a backend starts (SPIN's ``spin -a``, ``gcc`` and
 A tool that ends by a signal rclverify did not send (``kill``, the OOM
 killer, a user stopping a run) was **interrupted**: that is not a result.
 :func:`run_bounded` raises :class:`ToolInterrupted` (a located
-:class:`~rclverify.rcl.errors.RclError`), so the evidence task fails
+:class:`~rclverify.lang.errors.RclError`), so the evidence task fails
 without writing a record and the next run checks the obligation again.  A
 tool that crashes (SIGSEGV, SIGABRT) returns its negative exit code: the
 caller reports it as an error.
@@ -44,8 +44,8 @@ import time
 from pathlib import Path
 from typing import Any, Iterator, Mapping
 
-from ..rcl.ast import Loc
-from ..rcl.errors import RclError, error
+from rclverify.lang.ast import Loc
+from rclverify.lang.errors import RclError, error
 
 #: Signals by which something outside rclverify stops a tool (not a crash of the tool).
 INTERRUPTS = frozenset(int(s) for s in (signal.SIGKILL, signal.SIGTERM, signal.SIGINT, signal.SIGHUP,

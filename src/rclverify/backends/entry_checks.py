@@ -1,7 +1,7 @@
 """Check-time validation of the plan's ``experiment``, ``review``, ``monitors`` and ``ajpf`` entries.
 
-Called by :attr:`rclverify.pipeline.Workspace.checked` right after
-:func:`rclverify.plan.load.resolve` (the layer above both the plan and the
+Called by :attr:`rclverify.app.pipeline.Workspace.checked` right after
+:func:`rclverify.model.plan.load.resolve` (the layer above both the plan and the
 backends: the plan imports no backend code), so ``rclverify``/``doit
 check`` reports a missing data or record file, a malformed record, a bad
 criterion, a reviewed file or message directory outside the workspace, or a
@@ -19,11 +19,11 @@ from __future__ import annotations
 
 from typing import Any
 
-from ..plan.errors import PlanError, plan_error
-from ..plan.load import KEY, Plan
-from ..rcl import ast
-from ..rcl.errors import Diagnostic
-from ..rcl.types import Checked
+from rclverify.model.plan.errors import PlanError, plan_error
+from rclverify.model.plan.load import KEY, Plan
+from rclverify.lang import ast
+from rclverify.lang.errors import Diagnostic
+from rclverify.lang.types import Checked
 
 
 def check_entries(plan: Plan, checked: Checked) -> list[Diagnostic]:
@@ -50,10 +50,10 @@ def check_entries(plan: Plan, checked: Checked) -> list[Diagnostic]:
                 return plan.locs.get(full, _e.loc)
             try:
                 if e.backend == "experiment":
-                    from .experiment.config import read_config
+                    from rclverify.backends.experiment.config import read_config
                     read_config(plan.root, e.config, len(checked.nodes[node].node.guarantees), loc)
                 elif e.backend == "review":
-                    from .review.backend import read_record
+                    from rclverify.backends.review.backend import read_record
                     read_record(plan.root, e.config, loc)
                 else:
                     _check_monitors(plan, e.config, loc, checked)
@@ -87,7 +87,7 @@ def _no_repeated_entry(plan: Plan, node: str, entries: Any) -> list[Diagnostic]:
     earlier one (same backend, same configuration): it would give the same
     obligations, which doit refuses as duplicated task names.  (Entries that
     differ but still name their obligations alike are caught when the
-    obligations are exported, :func:`rclverify.pipeline.stage_export`.)"""
+    obligations are exported, :func:`rclverify.app.pipeline.stage_export`.)"""
     import json
     seen: dict[str, ast.Loc] = {}
     out = []
@@ -111,8 +111,8 @@ def _shared_topics(plan: Plan, config: Any, checked: Checked, node: str) -> list
     """Located errors of ``node``'s variables that share a topic and would
     read one field (:mod:`.monitors.shared_topics`), under the entry's
     mapping file's rules (none when it does not exist yet)."""
-    from .monitors.config import DEFAULT_MAPPING, ConfigError, load_mapping
-    from .monitors.shared_topics import shared_topic_errors
+    from rclverify.backends.monitors.config import DEFAULT_MAPPING, ConfigError, load_mapping
+    from rclverify.backends.monitors.shared_topics import shared_topic_errors
     rel = config.get("mapping")
     rules: Any = {}
     if isinstance(rel, (str, type(None))) and (plan.root / (rel or DEFAULT_MAPPING)).is_file():
@@ -130,8 +130,8 @@ def _check_monitors(plan: Plan, config: Any, loc: Any, checked: Checked | None =
     :mod:`.monitors.fieldpaths`) and the entry's ``tolerance``.  A missing
     mapping or trace is left to the export stage (a workspace may record its
     traces after writing the plan).  Raises :class:`PlanError`."""
-    from ..logic.floatsem import ToleranceError, parse_tolerance
-    from .monitors.config import DEFAULT_MAPPING, ConfigError, load_mapping
+    from rclverify.semantics.floatsem import ToleranceError, parse_tolerance
+    from rclverify.backends.monitors.config import DEFAULT_MAPPING, ConfigError, load_mapping
     rel = config.get("mapping")
     if not isinstance(rel, (str, type(None))) or not (plan.root / (rel or DEFAULT_MAPPING)).is_file():
         try:
@@ -148,7 +148,7 @@ def _check_monitors(plan: Plan, config: Any, loc: Any, checked: Checked | None =
         l = loc(*exc.path)
         raise plan_error(l.file, l.line, l.col, str(exc)) from None
     if checked is not None and cfg.mapping:
-        from .monitors.fieldpaths import check_field_paths
+        from rclverify.backends.monitors.fieldpaths import check_field_paths
         diags = check_field_paths(plan.root, cfg.mapping, cfg.msg_dirs, checked)
         if diags:
             raise PlanError(diags)

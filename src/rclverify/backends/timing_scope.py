@@ -2,7 +2,7 @@
 
 A guarantee ``G(phi) triggered by in.x within d`` has an untimed part (``phi``
 at every step, what rules R1-R4 use) and a timing part (the output follows
-the trigger within ``d``; docs/architecture.md, rule D1).  Only a backend in
+the trigger within ``d``; docs/decisions.md, rule D1).  Only a backend in
 :data:`TIMED_BACKENDS` checks the timing part; every other backend's evidence
 for a timed guarantee says so in its explanation and in
 ``details["timing"]``, so nothing is dropped silently.
@@ -11,7 +11,7 @@ from __future__ import annotations
 
 from typing import Any, Mapping
 
-from ..rcl.types import CheckedNode
+from rclverify.lang.types import CheckedNode
 
 #: Backends whose evidence checks triggers and deadlines against time stamps.
 TIMED_BACKENDS: frozenset[str] = frozenset({"monitors"})

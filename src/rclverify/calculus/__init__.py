@@ -1,1 +1,8 @@
-"""calculus stage of rclverify."""
+"""Layer 8, calculus: the contracts composed (rules R1-R4, paper section 4)
+and judged.
+
+The composition and refinement checks with Z3 (``compose``, ``refinement``,
+``context``, ``quotient``, ``deadlines``), contract health (``health/``:
+vacuity, realizability, shape) and formal requirements decided from the
+composed contracts (``requirements/``).  Imports ``ros`` and below.
+"""

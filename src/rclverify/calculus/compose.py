@@ -22,7 +22,7 @@ A side condition is ``discharged`` (Z3 proved it), ``failed`` (Z3 found a
 model of the producers' guarantees violating the conjunct; the model is
 shown in RCL names) or ``inconclusive`` (unknown/timeout; never proved).
 
-Two variants, tried in order (docs/architecture.md, "Side conditions"):
+Two variants, tried in order (docs/decisions.md, "Side conditions"):
 
 ``as written``
     the producers' guarantees alone entail the conjunct (the premise of
@@ -59,17 +59,17 @@ from typing import Any, Mapping, Sequence
 
 import z3
 
-from ..logic.encode import Encoder
-from ..logic.nicemodel import nicer_model
-from .context import ConeContext, ContextResult
-from .summary import decide as decide_by_summaries
-from ..logic.query import DEFAULT_TIMEOUT_MS, prove, solver_session
-from ..rcl import ast
-from ..rcl.printer import expr_to_rcl
-from ..rcl.walk import free_names, subexpressions
-from ..rcl.types import Checked
-from ..system.model import SystemModel
-from .scale import probable_mismatches
+from rclverify.semantics.encode import Encoder
+from rclverify.semantics.nicemodel import nicer_model
+from rclverify.calculus.context import ConeContext, ContextResult
+from rclverify.calculus.summary import decide as decide_by_summaries
+from rclverify.semantics.query import DEFAULT_TIMEOUT_MS, prove, solver_session
+from rclverify.lang import ast
+from rclverify.lang.printer import expr_to_rcl
+from rclverify.lang.walk import free_names, subexpressions
+from rclverify.lang.types import Checked
+from rclverify.model.system.model import SystemModel
+from rclverify.calculus.scale import probable_mismatches
 
 STATUS = {"proved": "discharged", "refuted": "failed", "inconclusive": "inconclusive"}
 
@@ -273,7 +273,7 @@ def compose_node(checked: Checked, model: SystemModel, node: str, *,
     the whole cone; ``summaries=False`` reads the whole cone always (the
     oracle test: the verdicts are the same).  The side conditions share one
     solver session
-    (:func:`~rclverify.logic.query.solver_session`), asked in a fixed order.
+    (:func:`~rclverify.semantics.query.solver_session`), asked in a fixed order.
     """
     cn = checked.nodes[node]
     producers = model.producers(node)
@@ -334,7 +334,7 @@ def compose_node(checked: Checked, model: SystemModel, node: str, *,
         if r.strategy:
             expl += f" Z3's default strategy gave up; answered with {r.strategy}."
         duration = round(first.duration_s + (r.duration_s if r is not first else 0.0), 4)
-        shown = r.model  # integers and short decimals where Z3 finds them, re-checked (logic/nicemodel.py)
+        shown = r.model  # integers and short decimals where Z3 finds them, re-checked (semantics/nicemodel.py)
         if status == "failed" and r.model:
             asked = hyps + (prod_assumptions if variant == VARIANT_WITH_ASSUMPTIONS else [])
             shown = nicer_model([*asked, z3.Not(goal)], enc, r.model).model

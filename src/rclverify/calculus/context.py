@@ -52,15 +52,15 @@ from typing import Any, Callable, Mapping, Sequence
 
 import z3
 
-from ..logic.encode import Encoder
-from ..logic.nicemodel import nicer_model
-from ..logic.query import query_solver, render_model, satisfiable, smt2_script, smtlib_benchmark
-from ..rcl import ast
-from ..rcl.printer import expr_to_rcl
-from ..rcl.types import Checked
-from ..system.model import Link, SystemModel
-from ..values import decimal_text
-from .smttext import SORTS, quote, to_smt
+from rclverify.semantics.encode import Encoder
+from rclverify.semantics.nicemodel import nicer_model
+from rclverify.semantics.query import query_solver, render_model, satisfiable, smt2_script, smtlib_benchmark
+from rclverify.lang import ast
+from rclverify.lang.printer import expr_to_rcl
+from rclverify.lang.types import Checked
+from rclverify.model.system.model import Link, SystemModel
+from rclverify.semantics.values import decimal_text
+from rclverify.calculus.smttext import SORTS, quote, to_smt
 
 NEGATED = "negated side condition"
 #: Budget of the query that checks the premises of an in-context proof can hold together (milliseconds).
@@ -393,7 +393,7 @@ class ConeContext:
                 return ContextResult("refuted", script(), dt, model=shown, violated=violated)
         if core is not None:
             return self._proved(core, script, dt, consistency=consistency)
-        # unknown: the retries of logic/retry.py (fresh solvers), which answer without a Z3 model object
+        # unknown: the retries of semantics/retry.py (fresh solvers), which answer without a Z3 model object
         plain = [(lbl, z3.substitute(f, (lit, z3.BoolVal(True)))) for lbl, f, lit in zip(labels, tracked, literals)]
         if self.definitions:
             plain.append(("definitions", z3.And(*self.definitions)))
@@ -488,7 +488,7 @@ _DEFINE = re.compile(r"\(define-fun (\|[^|]*\||\S+) \(\) (Real|Int|Bool)\s+(.*?)
 
 def _number(text: str) -> str | None:
     """An SMT-LIB numeral of a model (``5``, ``101.0``, ``(- 5.0)``, ``(/ 1.0 3.0)``,
-    ``(- (/ 1.0 2.0))``) as :func:`rclverify.logic.encode.value_to_rcl` writes it; ``None`` otherwise."""
+    ``(- (/ 1.0 2.0))``) as :func:`rclverify.semantics.encode.value_to_rcl` writes it; ``None`` otherwise."""
     t = " ".join(text.split())
     sign = 1
     if t.startswith("(- ") and t.endswith(")"):

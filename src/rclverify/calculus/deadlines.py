@@ -1,5 +1,5 @@
 """Rules D1-D3: deadlines chained along a path, decided by Z3
-(docs/architecture.md, "Services, actions and deadlines").
+(docs/decisions.md, "Services, actions and deadlines").
 
 A *hop* is one timed guarantee ``G(phi) triggered by in.x within d`` of a
 node (D1).  Along a requirement's path ``[A, B, C]`` a *chain* is one hop per
@@ -20,11 +20,11 @@ from typing import Any, Mapping, Sequence
 
 import z3
 
-from ..rcl import ast
-from ..rcl.timing import seconds
-from ..rcl.types import Checked
-from ..rcl.walk import subexpressions
-from ..system.model import SystemModel
+from rclverify.lang import ast
+from rclverify.lang.timing import seconds
+from rclverify.lang.types import Checked
+from rclverify.lang.walk import subexpressions
+from rclverify.model.system.model import SystemModel
 
 #: Verdicts of an end-to-end deadline, as the requirements' statuses.
 PROVED, REFUTED, INCONCLUSIVE = "proved", "refuted", "inconclusive"
@@ -107,13 +107,13 @@ def chains(checked: Checked, model: SystemModel, path: Sequence[str]) -> tuple[l
     when there is none, the reason naming where the path breaks.
 
     A chain never goes through a service or action that a node ``calls``
-    and no node ``serves`` (:func:`rclverify.system.services.unserved_parts`):
+    and no node ``serves`` (:func:`rclverify.model.system.services.unserved_parts`):
     a request to it reaches no one (it feeds no hop, whatever name the
     system model matched it by), a response from it never comes (a hop
     triggered by it never fires), and a chain whose last hop answers with
     such a request ends nowhere.  When only such chains exist, the reason
     names the call."""
-    from ..system.services import unserved_parts
+    from rclverify.model.system.services import unserved_parts
     dead = unserved_parts(checked)
     found, why = _chains(checked, model, path, dead)
     if found or not dead:
@@ -207,7 +207,7 @@ show_seconds = _show
 
 def decide_plan(plan: Any, checked: Checked, model: SystemModel) -> list[DeadlineResult]:
     """Rule D3 for every ``deadline:`` of the plan's requirements
-    (:class:`~rclverify.plan.model.DeadlineSpec`), in plan order."""
+    (:class:`~rclverify.model.plan.model.DeadlineSpec`), in plan order."""
     return [decide(checked, model, d.requirement, d.path, d.within, d.loc) for d in plan.deadlines]
 
 

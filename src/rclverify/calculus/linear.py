@@ -24,8 +24,8 @@ from typing import Mapping, Sequence
 
 import z3
 
-from ..logic.retry import has_quantifier
-from ..values import decimal_text
+from rclverify.semantics.retry import has_quantifier
+from rclverify.semantics.values import decimal_text
 
 #: At most this many clauses are examined one by one (beyond: printed as ``qe`` left them).
 MAX_CLAUSES = 200

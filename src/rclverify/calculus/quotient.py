@@ -10,7 +10,7 @@ as it is:
 * the **targets**: every side condition of every node downstream of ``M``
   (a conjunct of its assumption over produced inputs, decided in context,
   :mod:`.context`) and every formal, non-temporal requirement whose cone
-  holds ``M`` (:mod:`rclverify.requirements.check`); each is judged on the
+  holds ``M`` (:mod:`rclverify.calculus.requirements.check`); each is judged on the
   premises its own check uses, ``M``'s contract aside (``P_t``);
 * the **assumption** ``A(i) = exists w. P_M(w, i)``, where ``P_M`` are the
   premises of ``M``'s upstream cone (each guarantee under its node's
@@ -33,7 +33,7 @@ said so: ``TRUE`` as the assumption and, as the guarantee, the targets of
 Either way nothing is printed before Z3 re-checks it: the contract is put in
 place, the whole system type-checked again, every target's side condition
 decided (:func:`.compose.compose_node`) and every target requirement checked
-(:func:`rclverify.requirements.check.check_requirement`); a target not
+(:func:`rclverify.calculus.requirements.check.check_requirement`); a target not
 discharged or not proved makes :class:`QuotientError`.
 """
 from __future__ import annotations
@@ -44,16 +44,16 @@ from typing import Any, Callable, Mapping, Sequence
 
 import z3
 
-from ..logic.encode import Encoder
-from ..logic.query import prove
-from ..rcl import ast
-from ..rcl.parser import parse_formula, parse_text
-from ..rcl.printer import expr_to_rcl, node_to_rcl
-from ..rcl.types import BOOL, INTEGER, NATURAL, REAL, Checked
-from ..system.model import SystemModel
-from .compose import compose_node, split_assumption
-from .context import opened_links
-from .linear import clauses_under, eliminate, to_rcl
+from rclverify.semantics.encode import Encoder
+from rclverify.semantics.query import prove
+from rclverify.lang import ast
+from rclverify.lang.parser import parse_formula, parse_text
+from rclverify.lang.printer import expr_to_rcl, node_to_rcl
+from rclverify.lang.types import BOOL, INTEGER, NATURAL, REAL, Checked
+from rclverify.model.system.model import SystemModel
+from rclverify.calculus.compose import compose_node, split_assumption
+from rclverify.calculus.context import opened_links
+from rclverify.calculus.linear import clauses_under, eliminate, to_rcl
 
 ARITH = (BOOL, INTEGER, NATURAL, REAL)
 
@@ -153,9 +153,9 @@ def targets(sysm: _System) -> tuple[list[Target], list[str]]:
         for k, c in enumerate(internal, 1):
             out.append(Target("side condition", f"{d}.sc{k}", expr_to_rcl(c), prem,
                               enc.formula(c, checked.nodes[d]), d, c))
-    from ..plan.load import all_requirements
-    from ..requirements.check import cone_of, formals_of
-    from ..requirements.temporal_check import is_temporal
+    from rclverify.model.plan.load import all_requirements
+    from rclverify.calculus.requirements.check import cone_of, formals_of
+    from rclverify.calculus.requirements.temporal_check import is_temporal
     for req in all_requirements(plan):
         if req.formal is None:
             continue
@@ -208,7 +208,7 @@ class _Beyond(Exception):
 
 #: Re-check verdicts that rest on a proof (Z3's unsat), which a second solver confirms.
 PROVED = ("discharged", "discharged in context", "proved")
-#: Agreements of the second solver that make a proved re-check inconclusive (crosscheck/stage.py).
+#: Agreements of the second solver that make a proved re-check inconclusive (stages/crosscheck/stage.py).
 NOT_CONFIRMED = ("disagree", "inconclusive")
 
 
@@ -319,7 +319,7 @@ def _no_answer(sysm: _System, a: z3.BoolRef, g: z3.BoolRef, outs: Sequence[z3.Ex
     """Raise :class:`QuotientError` when some input the assumption admits
     has no output meeting the guarantee (with the node's environment
     facts): then no implementation can serve the targets (the quotient is
-    unrealizable, :mod:`rclverify.health.realizable`), and the input is
+    unrealizable, :mod:`rclverify.calculus.health.realizable`), and the input is
     named."""
     facts = sysm.env(sysm.node, sysm.enc)
     body = _conj([g] + facts)
@@ -357,7 +357,7 @@ def _approximate(sysm: _System, tgts: Sequence[Target]) -> str:
 
 
 def _vars(e: ast.Expr) -> list[ast.Var]:
-    from ..rcl.walk import subexpressions
+    from rclverify.lang.walk import subexpressions
     return [v for v in subexpressions(e) if isinstance(v, ast.Var)]
 
 
@@ -393,10 +393,10 @@ def _recheck(checked: Checked, plan: Any, node: str, block: str,
              tgts: Sequence[Target]) -> list[tuple[str, str, str]]:
     """Every target's verdict with ``block`` in place of ``node`` (module
     docstring): ``(id, verdict, the SMT-LIB2 script it was decided from)``."""
-    from ..logic import world
-    from ..rcl.typecheck import check
-    from ..requirements.check import check_requirement
-    from ..system.model import build
+    from rclverify.semantics import world
+    from rclverify.lang.typecheck import check
+    from rclverify.calculus.requirements.check import check_requirement
+    from rclverify.model.system.model import build
     file = checked.nodes[node].node.loc.file
     [new] = parse_text(block, file).nodes
     specs = [ast.Spec(s.contexts, tuple(new if x.name == node else x for x in s.nodes), s.file) for s in checked.specs]
@@ -415,7 +415,7 @@ def _recheck(checked: Checked, plan: Any, node: str, block: str,
     for t in tgts:
         if t.kind == "side condition":
             out.append((t.id, *verdicts.get(t.id, ("absent", ""))))
-    from ..plan.load import all_requirements
+    from rclverify.model.plan.load import all_requirements
     reqs = {r.id: r for r in all_requirements(plan)}
     for t in tgts:
         if t.kind == "requirement":
@@ -436,7 +436,7 @@ def _compare(cn: Any, a_text: str, g_text: str, checked: Checked, model: SystemM
     n = cn.node
     if not n.assumes and not n.guarantees:
         return []
-    from ..logic import world
+    from rclverify.semantics import world
     world.fresh()
     enc = Encoder(checked.env, model.alias())
     a_new, g_new = enc.formula(parse_formula(a_text), cn), enc.formula(parse_formula(g_text), cn)

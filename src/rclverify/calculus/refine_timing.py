@@ -15,7 +15,7 @@ An untimed guarantee of B promises an answer eventually, never within a
 bound, so it does not count.  When no guarantee of B qualifies, the side is
 refuted without a solver ("B promises no answer to in.x within 500 ms").
 
-:func:`timing_side` decides it with Z3 (:func:`rclverify.logic.query.prove`)
+:func:`timing_side` decides it with Z3 (:func:`rclverify.semantics.query.prove`)
 and returns a :class:`~.refinement.SideResult`-shaped tuple, or ``None`` when
 A has no triggered guarantee (nothing to keep).
 """
@@ -27,12 +27,12 @@ from typing import Any, Mapping, Sequence
 
 import z3
 
-from ..logic.encode import Encoder
-from ..logic.query import DEFAULT_TIMEOUT_MS, QueryResult, prove
-from ..rcl import ast
-from ..rcl.printer import expr_to_rcl
-from ..rcl.timing import seconds
-from ..rcl.types import CheckedNode
+from rclverify.semantics.encode import Encoder
+from rclverify.semantics.query import DEFAULT_TIMEOUT_MS, QueryResult, prove
+from rclverify.lang import ast
+from rclverify.lang.printer import expr_to_rcl
+from rclverify.lang.timing import seconds
+from rclverify.lang.types import CheckedNode
 
 
 @dataclass(frozen=True)
@@ -82,7 +82,7 @@ def timing_side(a: CheckedNode, b: CheckedNode, enc: Encoder, shared: Mapping[st
     is ``proved``, ``refuted`` or ``inconclusive``; ``query`` the Z3 query of
     the last promise decided (``None`` when a promise had no candidate in
     B); ``reason`` why it was refuted without a solver.  ``None`` when A has
-    no triggered guarantee.  Raises :class:`~rclverify.logic.encode.EncodingError`
+    no triggered guarantee.  Raises :class:`~rclverify.semantics.encode.EncodingError`
     as the encoder does."""
     mine = promises(a)
     if not mine:

@@ -15,10 +15,10 @@ contracts, B may replace A in any system where A was used when
 ``A_X`` is the conjunction of node X's assume clauses (TRUE when it has
 none) and ``G_X`` the conjunction of its guarantee clauses.  Input and output
 variables of A and B are the same Z3 symbols.  Each side is decided by Z3
-(:func:`rclverify.logic.query.prove`): ``proved``, ``refuted`` with a model
+(:func:`rclverify.semantics.query.prove`): ``proved``, ``refuted`` with a model
 in RCL names, or ``inconclusive`` (unknown/timeout; never counted as proved).
 
-Conditions (docs/architecture.md, "Refinement"):
+Conditions (docs/decisions.md, "Refinement"):
 
 * the *environment facts* the plan states for the node (the same facts the
   health checks and side conditions use) are hypotheses of both sides: B
@@ -41,17 +41,17 @@ from typing import Any, Callable, Mapping, Sequence, TextIO
 
 import z3
 
-from ..health.witness import finite_witness, has_tables, points_for
-from ..logic.encode import EncodingError, Encoder
-from ..logic.query import DEFAULT_TIMEOUT_MS, QueryResult, prove
-from ..rcl import ast
-from ..rcl.errors import Diagnostic, RclError, error
-from ..rcl.parser import parse_formula
-from .compose import free_io
-from .refine_timing import timing_side
-from ..rcl.printer import expr_to_rcl
-from ..rcl.typecheck import load
-from ..rcl.types import Checked, CheckedNode, Env
+from rclverify.calculus.health.witness import finite_witness, has_tables, points_for
+from rclverify.semantics.encode import EncodingError, Encoder
+from rclverify.semantics.query import DEFAULT_TIMEOUT_MS, QueryResult, prove
+from rclverify.lang import ast
+from rclverify.lang.errors import Diagnostic, RclError, error
+from rclverify.lang.parser import parse_formula
+from rclverify.calculus.compose import free_io
+from rclverify.calculus.refine_timing import timing_side
+from rclverify.lang.printer import expr_to_rcl
+from rclverify.lang.typecheck import load
+from rclverify.lang.types import Checked, CheckedNode, Env
 
 
 @dataclass(frozen=True)
@@ -65,7 +65,7 @@ class SideResult:
                    for ``refuted``;
     ``reason``     Z3's reason for ``inconclusive``;
     ``smt2``       the query as SMT-LIB2; ``duration_s`` its wall time;
-    ``strategy``   the retry that decided it (logic/retry.py), '' when Z3's
+    ``strategy``   the retry that decided it (semantics/retry.py), '' when Z3's
                    first attempt did or nothing did.
     """
 
@@ -198,9 +198,9 @@ def _decl_locs(c: Checked) -> dict[str, ast.Loc]:
 # ---------------------------------------------------------------------------
 
 #: Budget of each side's first attempt (milliseconds' worth of Z3 resource steps,
-#: :data:`rclverify.logic.query.STEPS_PER_MS`): the case study's assumption side
+#: :data:`rclverify.semantics.query.STEPS_PER_MS`): the case study's assumption side
 #: takes a few hundred steps; a side this does not decide goes up the ladder of
-#: :func:`rclverify.logic.retry.retry_order`.
+#: :func:`rclverify.semantics.retry.retry_order`.
 FIRST_MS = 250
 #: Budget of the finite-table counterexample looked for when the first attempt
 #: does not decide (loaded from its canonical text, the case study's guarantee
@@ -222,7 +222,7 @@ def _table_counterexample(enc: Encoder, formulas: Sequence[z3.BoolRef],
                           points: int) -> Callable[[], dict[str, str] | None]:
     """A function looking for a model of ``formulas`` (a side's hypotheses
     and its negated goal) in which every function-typed input is a finite
-    table of ``points`` points (:func:`rclverify.health.witness.finite_witness`,
+    table of ``points`` points (:func:`rclverify.calculus.health.witness.finite_witness`,
     :data:`WITNESS_MS`, loaded from its canonical text as the sides are):
     such a model refutes the side, and is what the
     report shows (RCL names -> values, each table as its rows); ``None``
@@ -249,8 +249,8 @@ def check_refinement(a: CheckedNode, b: CheckedNode, env: Env, *,
     hypotheses of both sides and are listed in the result.  ``instances``:
     the plan's ``instances: [lo, hi]`` of ``a``'s node, the size of the
     finite tables a counterexample is first looked for with
-    (:func:`rclverify.health.witness.points_for`; the first attempt of each
-    side has :data:`FIRST_MS`, see :func:`rclverify.logic.query.prove`).
+    (:func:`rclverify.calculus.health.witness.points_for`; the first attempt of each
+    side has :data:`FIRST_MS`, see :func:`rclverify.semantics.query.prove`).
     The verdict does not depend on them.  Raises
     :class:`RclError` for an interface mismatch and for formulas the Z3
     encoding does not support (located).
@@ -281,9 +281,9 @@ def check_refinement(a: CheckedNode, b: CheckedNode, env: Env, *,
                                                           "and no condition mentions it; give one with --assume",
                               "E-refines-interface")])
     # decide first with what decides (issue 44): each side's first attempt gets a small budget; when it
-    # cannot decide, a finite-table counterexample (health/witness.py) refutes the side with that model
+    # cannot decide, a finite-table counterexample (calculus/health/witness.py) refutes the side with that model
     # (the case study's guarantee side: 0.2 s, where MBQI after simplification took 1.2 s to build a
-    # model whose wayP was a 200 kB if-then-else); else the retries of logic/retry.py
+    # model whose wayP was a 200 kB if-then-else); else the retries of semantics/retry.py
     q1 = prove(ab, [aa, *hyps], enc, timeout_ms=timeout_ms, deterministic=True, first_ms=FIRST_MS,
                counterexample=_table_counterexample(enc, [aa, *hyps, z3.Not(ab)], points),
                comment=f"refinement, assumption side: A_{a.name} => A_{b.name}\nunsat: B assumes no more than A")
@@ -379,7 +379,7 @@ def refines_main(spec_a: str, spec_b: str, *, out: TextIO | None = None, err: Te
     under which the replacement is checked (they let B read extra inputs).
 
     ``confirm``: the second solver (issue 50), a callable from a side's
-    SMT-LIB2 text to ``(agreement, why)`` (:func:`rclverify.crosscheck.stage.agreement`
+    SMT-LIB2 text to ``(agreement, why)`` (:func:`rclverify.stages.crosscheck.stage.agreement`
     of cvc5's answer); a proved side it does not confirm makes the verdict
     inconclusive (docs/second-solver.md).
 

@@ -10,7 +10,7 @@ calculus says what the numbers suggest.
 
 For each input the conjunct reads over a connection, where the two ends do
 not both declare a unit (declared units are checked exactly,
-:mod:`rclverify.system.units`) and the type is a number:
+:mod:`rclverify.model.system.units`) and the type is a number:
 
 * the **producer's range** of the output: its least and greatest value
   under the producer's guarantees and assumptions (the hypotheses of the
@@ -40,10 +40,10 @@ from typing import Any, Iterable, Mapping, Sequence
 
 import z3
 
-from ..rcl import ast
-from ..rcl.printer import expr_to_rcl
-from ..rcl.types import Checked, CheckedNode, is_numeric
-from ..rcl.walk import free_names, subexpressions
+from rclverify.lang import ast
+from rclverify.lang.printer import expr_to_rcl
+from rclverify.lang.types import Checked, CheckedNode, is_numeric
+from rclverify.lang.walk import free_names, subexpressions
 
 #: Budget of one optimisation, milliseconds.
 OPTIMIZE_MS = 1000
@@ -178,8 +178,8 @@ def probable_mismatches(checked: Checked, links: Iterable[Any], enc: Any, node: 
                         conjunct: ast.Expr) -> tuple[dict[str, Any], ...]:
     """The probable scale mismatches behind one side condition of ``node``:
     ``conjunct`` is the assumption conjunct, ``links`` the connections into
-    ``node`` (:meth:`~rclverify.system.model.SystemModel.links_into`),
-    ``enc`` the side condition's :class:`~rclverify.logic.encode.Encoder`
+    ``node`` (:meth:`~rclverify.model.system.model.SystemModel.links_into`),
+    ``enc`` the side condition's :class:`~rclverify.semantics.encode.Encoder`
     (its aliases make a consumer input the producer's output symbol).
 
     Returns one record per mismatched input: ``{"producer":
@@ -238,7 +238,7 @@ def probable_mismatches(checked: Checked, links: Iterable[Any], enc: Any, node: 
 
 def scale_findings(side_conditions: Iterable[Mapping[str, Any]]) -> list[dict[str, Any]]:
     """Report findings (the shape of a contract-health finding,
-    :class:`~rclverify.health.finding.Finding`, status ``warning``) for the
+    :class:`~rclverify.calculus.health.finding.Finding`, status ``warning``) for the
     probable scale mismatches recorded on side conditions that are failed
     or inconclusive (a stale or altered record gives none): check
     ``probable-scale-mismatch``, id ``<side condition>.scale``, the

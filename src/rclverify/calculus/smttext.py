@@ -3,7 +3,7 @@
 The in-context check of a side condition (:mod:`.context`) asserts the
 contracts of a node's whole upstream cone; along a chain of N nodes the
 cones add up to N*N/2 contracts, and building each through the Z3 Python
-API (:class:`~rclverify.logic.encode.Encoder`) cost some 0.2 ms per
+API (:class:`~rclverify.semantics.encode.Encoder`) cost some 0.2 ms per
 formula: 14 s for the side conditions of a 200-node chain, almost all of it
 in the API's wrappers.  Z3's own parser reads the same assertions from text
 in a few milliseconds.  This module writes that text for the fragment it
@@ -28,8 +28,8 @@ from __future__ import annotations
 
 from typing import Mapping
 
-from ..rcl import ast
-from ..rcl.types import BOOL, INTEGER, NATURAL, REAL, CheckedNode, Type
+from rclverify.lang import ast
+from rclverify.lang.types import BOOL, INTEGER, NATURAL, REAL, CheckedNode, Type
 
 #: The RCL types of the fragment and their SMT-LIB sorts.
 SORTS: Mapping[Type, str] = {BOOL: "Bool", INTEGER: "Int", NATURAL: "Int", REAL: "Real"}
@@ -74,7 +74,7 @@ def _io(v: ast.Var, node: CheckedNode, symbol: Mapping[tuple[str, str], str], us
 
 
 def _term(e: ast.Expr, node: CheckedNode, symbol: Mapping[tuple[str, str], str], used: dict[str, str]) -> str:
-    # an explicit stack would be needed for very deep formulas; the parser bounds nesting (rcl/parser.py)
+    # an explicit stack would be needed for very deep formulas; the parser bounds nesting (lang/parser.py)
     if isinstance(e, ast.BoolLit):
         return "true" if e.value else "false"
     if isinstance(e, ast.NumLit):

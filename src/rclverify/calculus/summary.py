@@ -56,13 +56,13 @@ from typing import Any, Callable, Mapping, Sequence
 
 import z3
 
-from ..rcl import ast
-from ..rcl.printer import expr_to_rcl
-from ..rcl.types import NATURAL, Checked
-from ..logic.query import query_solver
-from ..system.model import SystemModel
-from .context import NEGATED, ContextResult, _multi_path, _node_premises
-from .smttext import SORTS, quote, to_smt
+from rclverify.lang import ast
+from rclverify.lang.printer import expr_to_rcl
+from rclverify.lang.types import NATURAL, Checked
+from rclverify.semantics.query import query_solver
+from rclverify.model.system.model import SystemModel
+from rclverify.calculus.context import NEGATED, ContextResult, _multi_path, _node_premises
+from rclverify.calculus.smttext import SORTS, quote, to_smt
 
 #: Budget of each quantifier elimination and each check of a summary (milliseconds).
 QE_MS = 2_000
@@ -237,7 +237,7 @@ def _eliminate(ctx: z3.Context, decls: str, bodies: Sequence[str], hidden: Seque
         xs = _bound(ctx, fs, bodies, hidden, sorts)
         if xs:
             body = z3.Exists(xs, body)
-    from ..logic.retry import has_quantifier
+    from rclverify.semantics.retry import has_quantifier
     for qe in ("qe2", "qe"):  # model-based projection first: a clean conjunction, and faster (docs/calculus.md)
         g = z3.Goal(ctx=ctx)
         g.add(body)
@@ -351,7 +351,7 @@ def decide(checked: Checked, model: SystemModel, node: str, conjunct: ast.Expr,
     text = (decls + lits + "".join(f"(assert (=> |l!{k}| {b}))\n" for k, (_, b) in enumerate(premises))
             + "".join(f"(assert {a})\n" for a in axioms) + f"(assert (=> |l!{len(premises)}| (not {goal})))\n")
     try:
-        # a scope of the caller's solver session (one node's calculus, logic/query.py): its queries follow
+        # a scope of the caller's solver session (one node's calculus, semantics/query.py): its queries follow
         # from the stage's inputs alone, in a fixed order, so a failure then decided over the whole cone
         # gets the same model in every run; a fresh Z3 context here cost as much as the query (docs/scale.md)
         with query_solver(timeout_ms, cores=True) as s:

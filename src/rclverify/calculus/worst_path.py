@@ -21,9 +21,9 @@ from dataclasses import replace
 from fractions import Fraction
 from typing import Any, Sequence
 
-from ..rcl.types import Checked
-from ..system.model import SystemModel
-from .deadlines import INCONCLUSIVE, PROVED, REFUTED, _show, chains, decide
+from rclverify.lang.types import Checked
+from rclverify.model.system.model import SystemModel
+from rclverify.calculus.deadlines import INCONCLUSIVE, PROVED, REFUTED, _show, chains, decide
 
 #: The largest number of paths from A to B examined.
 MAX_PATHS = 200

@@ -23,8 +23,8 @@ from __future__ import annotations
 from fractions import Fraction
 from typing import Iterator
 
-from ..rcl import ast
-from ..rcl.walk import subexpressions
+from rclverify.lang import ast
+from rclverify.lang.walk import subexpressions
 
 _ORDERING = ("<", "<=", ">", ">=")
 
@@ -112,5 +112,5 @@ def power_of_ten(a: Fraction, b: Fraction) -> int | None:
 def number_text(x: Fraction) -> str | None:
     """``x`` as an exact RCL numeric literal (an integer or a finite decimal:
     ``3/2`` -> ``1.5``), ``None`` when it has no finite decimal."""
-    from ..values import decimal_text
+    from rclverify.semantics.values import decimal_text
     return decimal_text(x)

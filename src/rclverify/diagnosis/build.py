@@ -36,15 +36,15 @@ from typing import Any, Callable, Iterator, Mapping
 
 import z3
 
-from ..cache import Shelf, file_digest
-from ..rcl.errors import RclError
-from . import blame, repairs as rep
-from .constants import hoare_repair
-from .deadline import budget_repairs, deadline_record
-from .requirement import requirement_record
-from .sidecond import side_condition_repairs
-from .culprits import culprits, parse_core, plan_facts
-from .table import counterexample_table
+from rclverify.core.cache import Shelf, file_digest
+from rclverify.lang.errors import RclError
+from rclverify.diagnosis import blame, repairs as rep
+from rclverify.diagnosis.constants import hoare_repair
+from rclverify.diagnosis.deadline import budget_repairs, deadline_record
+from rclverify.diagnosis.requirement import requirement_record
+from rclverify.diagnosis.sidecond import side_condition_repairs
+from rclverify.diagnosis.culprits import culprits, parse_core, plan_facts
+from rclverify.diagnosis.table import counterexample_table
 
 CACHE = "artifacts/cache/diagnosis.pickle"
 #: Taken while diagnosing (:func:`_one_at_a_time`); beside the run lock, not a kept result.
@@ -56,7 +56,7 @@ _META_KEYS = {"conjunct", "facts", "guarantee", "reason", "replay", "source", "c
 
 class _Cache:
     """The repairs of this workspace's problems, kept between runs: a
-    :class:`~rclverify.cache.store.Shelf` of kind ``diagnosis`` (salted with
+    :class:`~rclverify.core.cache.store.Shelf` of kind ``diagnosis`` (salted with
     Z3's version besides the rclverify code), keyed by the contract and plan
     files' sha256 and the problem's own key.  Keeps what this report used
     and earlier entries up to :data:`KEEP` in all (an edit undone finds them
@@ -162,7 +162,7 @@ def _diagnose(ws: Any, report: Mapping[str, Any]) -> list[dict[str, Any]]:
         return found
 
     # a unit mismatch on a connection first: it explains the side condition and the runs that follow from it
-    from .units import unit_records
+    from rclverify.diagnosis.units import unit_records
     out += unit_records(ws, report, cache.get)
     for f in report["findings"]:
         if f["status"] != "problem":
@@ -309,7 +309,7 @@ def _generated_handler(ws: Any, node: str, monitoring: Mapping[str, Any]) -> Any
     """The handler of ``node``'s generated logic.py that published the first
     violating message (:func:`rclverify.diagnosis.handlers.violating_handler`),
     ``None`` for a node without generated code or a run it cannot place."""
-    from .handlers import violating_handler
+    from rclverify.diagnosis.handlers import violating_handler
     entries = [{"backend": x.backend, **dict(x.config)} for x in ws.plan.evidence.get(node, ())]
     return violating_handler(ws.root, node, entries, monitoring)
 
@@ -319,8 +319,8 @@ def _breaking_assignments(ws: Any, program: str, cex: Mapping[str, Any], data: M
     """The last assignments to the outputs ``conj`` reads in the program's
     run on the counterexample (:func:`rclverify.backends.hoare.culprit_assign.breaking_assignments`);
     ``[]`` when the program no longer reads or the run cannot be made."""
-    from ..backends.hoare import lang
-    from ..backends.hoare.culprit_assign import breaking_assignments
+    from rclverify.backends.hoare import lang
+    from rclverify.backends.hoare.culprit_assign import breaking_assignments
     outs = {k: str(v) for k, v in (data.get("binding") or {}).items()
             if k.startswith("out.") and re.search(rf"(?<![\w.]){re.escape(k)}(?!\w)", conj)}
     try:
@@ -331,7 +331,7 @@ def _breaking_assignments(ws: Any, program: str, cex: Mapping[str, Any], data: M
 
 
 def _obligation_record(ws: Any, node: str, oid: str) -> Mapping[str, Any]:
-    from ..evidence.sealed import obligation_list
+    from rclverify.records.sealed import obligation_list
     records, _ = obligation_list(ws.path(ws.obligations(node)))  # [] when altered outside rclverify
     for o in records or []:
         if isinstance(o, dict) and o.get("id") == oid:
@@ -393,8 +393,8 @@ def _evidence(ws: Any, report: Mapping[str, Any], e: Mapping[str, Any], o: Mappi
 
 
 def _hoare(ws: Any, report: Mapping[str, Any], e: Mapping[str, Any], o: Mapping[str, Any], cache: _Cache) -> dict[str, Any]:
-    from ..backends.hoare import lang
-    from ..backends.hoare.culprit_lines import compared_constants
+    from rclverify.backends.hoare import lang
+    from rclverify.backends.hoare.culprit_lines import compared_constants
     node, k = o["node"], o["guarantee"]
     rec = _obligation_record(ws, node, e["obligation"])
     data = rec.get("data", {})

@@ -1,6 +1,6 @@
 """The members of an unsat core as culprits with source locations.
 
-Core labels come from :mod:`rclverify.health.checks`: ``guarantee 3
+Core labels come from :mod:`rclverify.calculus.health.checks`: ``guarantee 3
 (contracts/remote_inspection.rcl:72:3) at i=13``, ``environment fact 1
 (contracts/plan.yaml:57:10)``, ``assumption 1 (...)``, ``premise of
 guarantee 2 at i=0``.  The *victim* of a vacuity finding is its own

@@ -24,12 +24,12 @@ from __future__ import annotations
 from fractions import Fraction
 from typing import Any, Mapping, Sequence
 
-from ..calculus.deadlines import chains, decide, show_seconds
-from ..rcl.timing import UNITS
-from . import recheck
-from .bounds import number_text
-from .edits import Edit
-from .repairs import _record
+from rclverify.calculus.deadlines import chains, decide, show_seconds
+from rclverify.lang.timing import UNITS
+from rclverify.diagnosis import recheck
+from rclverify.diagnosis.bounds import number_text
+from rclverify.diagnosis.edits import Edit
+from rclverify.diagnosis.repairs import _record
 
 #: Units tried, largest first, to write a new deadline as a whole number.
 _SMALLER = ("min", "s", "ms", "us", "ns")

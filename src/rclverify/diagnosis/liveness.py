@@ -1,6 +1,6 @@
 """Who is named when a liveness requirement is refuted by a lasso.
 
-The temporal check (:mod:`rclverify.requirements.progress_gap`) records what
+The temporal check (:mod:`rclverify.calculus.requirements.progress_gap`) records what
 a refuting lasso rests on:
 
 * ``missing_progress``: nodes that accept their input in the loop and never

@@ -4,12 +4,12 @@ never answers (docs/diagnosis.md, "Refuted temporal requirement").
 The temporal check names the nodes a refuting lasso rests on
 (``missing_progress``: they accept their input in the loop and never
 answer, while the same search with every node answering finds no lasso;
-:mod:`rclverify.requirements.progress_gap`).  The repair is the missing
+:mod:`rclverify.calculus.requirements.progress_gap`).  The repair is the missing
 declaration, ``progress( within K steps )`` on that node, added to its
 contract (or replacing its ``progress( eventually )``, which excludes the
 lasso but bounds nothing, so proves nothing); the requirement is checked
 again on the edited contracts by the requirement check itself
-(:func:`rclverify.requirements.check.check_requirement`) and the repair is
+(:func:`rclverify.calculus.requirements.check.check_requirement`) and the repair is
 offered only when it is then ``proved``.  The bounds are tried weakest
 first (:data:`BOUNDS`: a larger K asks less of the node) and the first that
 proves is offered: the claim the implementation must meet is the weakest
@@ -25,10 +25,10 @@ from __future__ import annotations
 from collections.abc import Mapping
 from typing import Any
 
-from ..logic import world
-from . import recheck
-from .edits import Edit
-from .repairs import _record
+from rclverify.semantics import world
+from rclverify.diagnosis import recheck
+from rclverify.diagnosis.edits import Edit
+from rclverify.diagnosis.repairs import _record
 
 #: The step bounds tried, weakest first (a larger K is a weaker claim).
 BOUNDS = (3, 1, 0)
@@ -73,8 +73,8 @@ def progress_repairs(ws: Any, q: Mapping[str, Any], temporal: Mapping[str, Any])
     proves ``q`` on the edited contracts.  ``[]`` when none does, when the
     requirement or a node cannot be found, or the edited text does not
     check."""
-    from ..plan.load import all_requirements
-    from ..requirements.check import check_requirement
+    from rclverify.model.plan.load import all_requirements
+    from rclverify.calculus.requirements.check import check_requirement
     req = next((r for r in all_requirements(ws.plan) if r.id == q["id"]), None)
     if req is None:
         return []

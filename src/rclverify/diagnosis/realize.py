@@ -28,12 +28,12 @@ from typing import Any
 
 import z3
 
-from ..calculus.compose import free_io
-from ..logic import world
-from ..logic.encode import Encoder, EncodingError
-from ..rcl import ast
-from ..rcl.types import Checked, FuncT
-from ..rcl.walk import subexpressions
+from rclverify.calculus.compose import free_io
+from rclverify.semantics import world
+from rclverify.semantics.encode import Encoder, EncodingError
+from rclverify.lang import ast
+from rclverify.lang.types import Checked, FuncT
+from rclverify.lang.walk import subexpressions
 
 #: Budget of each query (milliseconds).
 TIMEOUT_MS = 3000
@@ -49,7 +49,7 @@ def implementable(ws: Any, checked: Checked, node: str) -> tuple[str, dict[str, 
     input the assumption allows and no output answers, or
     ``("inconclusive", {})`` (a function-typed output, Z3 undecided, an
     encoding error)."""
-    from ..logic.query import prove
+    from rclverify.semantics.query import prove
     world.fresh()
     cn = checked.nodes[node]
     if any(isinstance(t, FuncT) for t in cn.outputs.values()):

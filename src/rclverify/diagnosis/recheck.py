@@ -4,7 +4,7 @@ checked again by the pipeline's own Z3 checks.
 Nothing here writes to the workspace: an edited contract file is parsed
 from text under its own name, an edited program is written to a temporary
 directory that stands in for the workspace root.  Every answer comes from
-the real checks (:func:`rclverify.health.checks.check_node`,
+the real checks (:func:`rclverify.calculus.health.checks.check_node`,
 :func:`rclverify.calculus.compose.compose_node`, the Hoare backend's
 :func:`~rclverify.backends.hoare.solve.check_all`).
 """
@@ -18,15 +18,15 @@ from typing import Any, Mapping
 
 import z3
 
-from ..health.witness import finite_witness as table_witness, points_for
-from ..logic import world
-from ..rcl.errors import RclError
-from ..rcl.parser import parse_text
-from ..rcl.typecheck import check
-from ..rcl.types import Checked
-from ..system.model import SystemModel, build
-from .edits import Edit
-from .splice import FULL, spliced_system
+from rclverify.calculus.health.witness import finite_witness as table_witness, points_for
+from rclverify.semantics import world
+from rclverify.lang.errors import RclError
+from rclverify.lang.parser import parse_text
+from rclverify.lang.typecheck import check
+from rclverify.lang.types import Checked
+from rclverify.model.system.model import SystemModel, build
+from rclverify.diagnosis.edits import Edit
+from rclverify.diagnosis.splice import FULL, spliced_system
 
 
 def source_text(ws: Any, rel: str) -> str:
@@ -70,12 +70,12 @@ def health(ws: Any, checked: Checked, node: str, instances: Mapping[int, int] | 
     ``inconclusive``; an ``unsat`` answer is a ``problem``.  The
     non-vacuity of guarantee ``k`` is asked at ``instances[k]`` when given
     (where it was vacuous before).  The shape findings
-    (:mod:`rclverify.health.shape`) are the stage's own.  The replacement
+    (:mod:`rclverify.calculus.health.shape`) are the stage's own.  The replacement
     check is not asked again.  ``known``: statuses of checks the caller has
     just asked Z3 on the same ``checked`` (``{"Agent.g1.non-vacuous":
     "ok"}``), taken as they are instead of being asked twice."""
-    from ..health.checks import INSTANCE_TIMEOUT_MS
-    from ..health.shape import shape_findings
+    from rclverify.calculus.health.checks import INSTANCE_TIMEOUT_MS
+    from rclverify.calculus.health.shape import shape_findings
     as_status = {"sat": "ok", "unsat": "problem"}
     known = known or {}
     h = _health(ws, checked, node)
@@ -96,7 +96,7 @@ def health(ws: Any, checked: Checked, node: str, instances: Mapping[int, int] | 
 
 
 def _health(ws: Any, checked: Checked, node: str) -> Any:
-    from ..health.checks import _NodeHealth, INSTANCE_TIMEOUT_MS
+    from rclverify.calculus.health.checks import _NodeHealth, INSTANCE_TIMEOUT_MS
     world.fresh()
     facts = [(f.expr, f.loc) for f in ws.plan.facts.get(node, ())]
     return _NodeHealth(checked, checked.nodes[node], facts, None, INSTANCE_TIMEOUT_MS)
@@ -105,7 +105,7 @@ def _health(ws: Any, checked: Checked, node: str) -> Any:
 def finite_witness(h: Any, extra: list[tuple[str, z3.BoolRef]], points: int) -> str:
     """``"sat"`` when Z3 finds a witness of ``h``'s assumption, guarantees,
     facts and ``extra`` in which every function-typed input is a finite
-    table of ``points`` points (:func:`rclverify.health.witness.finite_witness`),
+    table of ``points`` points (:func:`rclverify.calculus.health.witness.finite_witness`),
     else ``"inconclusive"`` (no witness of that shape, which is not a proof
     that there is none).  Asked of Z3's ``simplify`` and ``qe-light``
     tactics first (``simplified``: the case study's Agent, 0.1 s a witness
@@ -124,7 +124,7 @@ def premise_fires(ws: Any, checked: Checked, node: str, k: int, at: int | None =
     shape :func:`finite_witness` looks for (asked first), or for the query
     of the health check ``non-vacuous``; else that query's ``unsat`` or
     ``inconclusive``."""
-    from ..health.checks import INSTANCE_TIMEOUT_MS
+    from rclverify.calculus.health.checks import INSTANCE_TIMEOUT_MS
     h = _health(ws, checked, node)
     var = h.natural_vars(k)
     prem = h.premise(k, {var[0]: at} if at is not None and var else None)
@@ -143,7 +143,7 @@ def consistent(ws: Any, checked: Checked, node: str) -> str:
     """Can the assumption, every guarantee and the facts of ``node`` hold
     together?  ``sat`` (a witness: the general query or :func:`finite_witness`),
     ``unsat`` or ``inconclusive``."""
-    from ..health.checks import INSTANCE_TIMEOUT_MS
+    from rclverify.calculus.health.checks import INSTANCE_TIMEOUT_MS
     h = _health(ws, checked, node)
     if finite_witness(h, [], _points(ws, node)) == "sat":  # first, as in premise_fires
         return "sat"
@@ -155,7 +155,7 @@ def side_conditions(checked: Checked, model: SystemModel, node: str, ws: Any = N
     """``{side condition id: status}`` of ``node`` in the edited system (a fresh Z3 world), with the
     plan's environment facts of ``ws`` (the workspace) as the stage has them: a side condition that
     fails locally is checked in context with them (docs/calculus.md)."""
-    from ..calculus.compose import compose_node
+    from rclverify.calculus.compose import compose_node
     world.fresh()
     facts = {n: [f.expr for f in fs] for n, fs in ws.plan.facts.items()} if ws is not None else None
     return {sc.id: sc.status for sc in compose_node(checked, model, node, facts=facts).side_conditions}
@@ -166,8 +166,8 @@ def hoare_statuses(ws: Any, node: str, index: int, program: str, new_text: str) 
     ``index`` of ``node`` with its program replaced by ``new_text`` (written to
     a temporary copy of the program's path; the workspace is not touched).
     A pending triple is ``pending``; a triple Z3 cannot decide ``inconclusive``."""
-    from ..backends.hoare.backend import prepare
-    from ..backends.hoare.solve import check_all
+    from rclverify.backends.hoare.backend import prepare
+    from rclverify.backends.hoare.solve import check_all
     world.fresh()
     tmp = Path(tempfile.mkdtemp(prefix="rclverify-repair-"))
     try:

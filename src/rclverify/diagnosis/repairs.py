@@ -33,21 +33,21 @@ from typing import Any, Mapping, Sequence
 
 import z3
 
-from ..calculus.compose import conjuncts
-from ..rcl import ast
-from ..rcl.printer import expr_to_rcl
-from ..rcl.errors import RclError
-from ..rcl.walk import free_names, subexpressions
-from ..logic import world
-from . import recheck
-from .edits import Edit
+from rclverify.calculus.compose import conjuncts
+from rclverify.lang import ast
+from rclverify.lang.printer import expr_to_rcl
+from rclverify.lang.errors import RclError
+from rclverify.lang.walk import free_names, subexpressions
+from rclverify.semantics import world
+from rclverify.diagnosis import recheck
+from rclverify.diagnosis.edits import Edit
 
 #: Most candidates tried per problem (each costs Z3 queries).
 MAX_CANDIDATES = 12
 #: Most atoms in a guard.
 MAX_GUARD_ATOMS = 3
 #: The first budget of each "does guard g imply guard h" query (milliseconds' worth of
-#: Z3 resource steps; :func:`rclverify.logic.query.prove`'s ``first_ms``).
+#: Z3 resource steps; :func:`rclverify.semantics.query.prove`'s ``first_ms``).
 FIRST_LOOK_MS = 100
 
 
@@ -162,10 +162,10 @@ def _weakest_first(ws: Any, node: str, guards: list[str], var_types: Mapping[str
     strictly weaker than, one without quantifiers comes first (Z3 decides
     the checks of the guarded contract more easily; of two equivalent
     guards either is the weakest)."""
-    from ..health.checks import INSTANCE_TIMEOUT_MS
-    from ..logic.encode import Encoder
-    from ..logic.query import prove
-    from ..rcl.parser import parse_formula
+    from rclverify.calculus.health.checks import INSTANCE_TIMEOUT_MS
+    from rclverify.semantics.encode import Encoder
+    from rclverify.semantics.query import prove
+    from rclverify.lang.parser import parse_formula
     if len(guards) < 2:
         return guards, {g: [] for g in guards}
     checked = ws.checked
@@ -187,7 +187,7 @@ def _weakest_first(ws: Any, node: str, guards: list[str], var_types: Mapping[str
             # a small first look, then the retries in the laddered order (finite instantiation first:
             # the case study's `i + 1 <= 12` -> `exists(.. wayP(x, y) == i + 1)`, which the default strategy
             # spent its whole budget on); every strategy still gets its whole budget, so what is proved is
-            # the same (logic/query.py, prove's first_ms)
+            # the same (semantics/query.py, prove's first_ms)
             implies[(g, h)] = prove(goal, facts, enc, timeout_ms=INSTANCE_TIMEOUT_MS, first_ms=FIRST_LOOK_MS,
                                     comment=f"repair: does `{g}` imply `{h}`?").status == "proved"
     todo, order = sorted(guards, key=lambda g: "exists(" in g or "forall(" in g), []
@@ -305,8 +305,8 @@ def _and_text(xs: Sequence[str]) -> str:
 def _numeric_vars(ws: Any, cn: Any, formula: ast.Expr) -> dict[str, str]:
     """``{name: "NATURAL" | "INTEGER"}`` of the outer ``forall``'s bound
     variables of those types, in binding order."""
-    from ..rcl.typecheck import domain_type
-    from ..rcl.types import Scalar
+    from rclverify.lang.typecheck import domain_type
+    from rclverify.lang.types import Scalar
     out: dict[str, str] = {}
     e = formula
     while isinstance(e, ast.Quant) and e.kind == "forall":

@@ -10,10 +10,10 @@ import re
 from collections.abc import Callable, Mapping
 from typing import Any
 
-from . import blame, recheck
-from .liveness import liveness_culprits
-from .progress_repair import progress_repairs
-from .repairs import _record as _repair
+from rclverify.diagnosis import blame, recheck
+from rclverify.diagnosis.liveness import liveness_culprits
+from rclverify.diagnosis.progress_repair import progress_repairs
+from rclverify.diagnosis.repairs import _record as _repair
 
 #: The repair kind of each way a culprit was found (:func:`blame.requirement_culprits`).
 _KIND = {"bound": "tighten-bound", "threshold": "move-threshold", "conclusion": "strengthen-guarantee"}
@@ -147,7 +147,7 @@ def _causes(ws: Any, report: Mapping[str, Any], q: Mapping[str, Any], cone: list
 
 
 def _cex_value(text: Any) -> Any:
-    """A counterexample's value text as a value of :mod:`rclverify.values`
+    """A counterexample's value text as a value of :mod:`rclverify.semantics.values`
     (a number or a boolean); ``None`` for anything else."""
     from fractions import Fraction
     t = str(text).strip()
@@ -163,12 +163,12 @@ def _passes_through(ws: Any, report: Mapping[str, Any], q: Mapping[str, Any],
                     cone: list[str]) -> list[Mapping[str, Any]]:
     """The failed side conditions of ``q``'s cone whose conjunct is false on
     the consumer's values in ``q``'s counterexample (decided by the
-    monitors' evaluator, :func:`rclverify.logic.decide.decide`): the
+    monitors' evaluator, :func:`rclverify.semantics.decide.decide`): the
     counterexample passes through them.  A value that does not read, or a
     conjunct the evaluator cannot decide, counts as not passing."""
-    from ..logic.decide import decide
-    from ..rcl.printer import expr_to_rcl
-    from ..calculus.compose import conjuncts
+    from rclverify.semantics.decide import decide
+    from rclverify.lang.printer import expr_to_rcl
+    from rclverify.calculus.compose import conjuncts
     rows = {str(r["node"]): r.get("values") or {} for r in (q.get("check") or {}).get("counterexample") or []}
     out = []
     for sc in report.get("side_conditions") or ():

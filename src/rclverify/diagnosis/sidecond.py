@@ -49,14 +49,14 @@ import re
 from fractions import Fraction
 from typing import Any, Mapping, Sequence
 
-from ..calculus.compose import conjuncts
-from ..rcl import ast
-from ..rcl.printer import expr_to_rcl
-from ..rcl.walk import subexpressions
-from . import realize, recheck
-from .bounds import coefficient_literals, number_text, power_of_ten, value
-from .edits import Edit
-from .repairs import MAX_CANDIDATES, _and_text, link_pairs, _record, _rename
+from rclverify.calculus.compose import conjuncts
+from rclverify.lang import ast
+from rclverify.lang.printer import expr_to_rcl
+from rclverify.lang.walk import subexpressions
+from rclverify.diagnosis import realize, recheck
+from rclverify.diagnosis.bounds import coefficient_literals, number_text, power_of_ten, value
+from rclverify.diagnosis.edits import Edit
+from rclverify.diagnosis.repairs import MAX_CANDIDATES, _and_text, link_pairs, _record, _rename
 
 _UPPER = {"<=": True, "<": True, ">=": False, ">": False}
 _MIRROR = {"<=": ">=", "<": ">", ">=": "<=", ">": "<"}
@@ -155,8 +155,8 @@ def _stems_from(ws: Any, sc: Mapping[str, Any], pairs: Sequence[tuple[str, str, 
     stems from: a formal statement that reads the linked value
     (``Gripper.in.force`` or ``Supervisor.out.force``) or names a constant
     the assumption's bound is written with."""
-    from ..plan.errors import PlanError
-    from ..plan.load import all_requirements
+    from rclverify.model.plan.errors import PlanError
+    from rclverify.model.plan.load import all_requirements
     try:
         reqs = all_requirements(ws.plan)
     except PlanError:  # a Doorstop tree that cannot be read: reported elsewhere; the plan's own requirements
@@ -285,7 +285,7 @@ def _inplace(ws: Any, p: str, ov: str, target: ast.Expr) -> tuple[Edit, int, str
     (:func:`.units.literal_si`); ``B`` is written in ``N``'s unit, or as the
     consumer's named constant (issue 64: a unit on the bound no longer
     suppresses the safe repair)."""
-    from .units import declared_unit, literal_si, literal_in
+    from rclverify.diagnosis.units import declared_unit, literal_si, literal_in
     consts = ws.checked.env.constants
     mine = next(((v, _normal(target, pre, v.name, consts)) for pre in ("in", None) for v in subexpressions(target)
                  if isinstance(v, ast.Var) and v.prefix == pre and v.name not in consts

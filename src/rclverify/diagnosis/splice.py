@@ -17,11 +17,11 @@ one in that node's clauses only:
   service links (AST equality, locations aside); otherwise the full path
   decides;
 * it is type-checked alone against the system's contexts
-  (:func:`rclverify.rcl.typecheck.check_node_again`): type checking a node
+  (:func:`rclverify.lang.typecheck.check_node_again`): type checking a node
   reads the contexts and that node only;
 * the system model is the workspace's own: links, environment inputs and
   loops are made from interfaces, topics and service links, which the edit
-  did not change (:func:`rclverify.system.model.build`).
+  did not change (:func:`rclverify.model.system.model.build`).
 
 The other nodes are the checked ones, with their locations as they were:
 an edit that adds a line moves the nodes after it in the file, but nothing
@@ -39,13 +39,13 @@ from __future__ import annotations
 from dataclasses import replace
 from typing import Any
 
-from ..rcl import ast
-from ..rcl.errors import RclError
-from ..rcl.parser import parse_text
-from ..rcl.typecheck import check_node_again
-from ..rcl.types import Checked
-from ..system.model import SystemModel
-from .edits import Edit
+from rclverify.lang import ast
+from rclverify.lang.errors import RclError
+from rclverify.lang.parser import parse_text
+from rclverify.lang.typecheck import check_node_again
+from rclverify.lang.types import Checked
+from rclverify.model.system.model import SystemModel
+from rclverify.diagnosis.edits import Edit
 
 #: Returned when the edit is not inside one node's clauses: check the whole edited system.
 FULL = object()

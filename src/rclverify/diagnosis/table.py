@@ -1,6 +1,6 @@
 """Counterexamples and witnesses as small tables (variable, value, node).
 
-A Z3 model arrives in RCL names (:func:`rclverify.logic.query.render_model`):
+A Z3 model arrives in RCL names (:func:`rclverify.semantics.query.render_model`):
 ``{"Agent.in.wayP": "{(p1, p2) -> (if ((p2 == 2) and ...) then 1 else ...)}"}``.
 Function-typed values become their finite table: one row per point the
 interpretation names (the positive equalities of each ``if`` branch), then
@@ -17,7 +17,7 @@ import re
 from fractions import Fraction
 from typing import Any, Mapping
 
-from ..values import decimal_text
+from rclverify.semantics.values import decimal_text
 
 #: Most rows of one function table; the rest are counted ("... and 40 more points").
 MAX_ROWS = 8
@@ -94,7 +94,7 @@ def function_table(text: str, max_rows: int = MAX_ROWS) -> dict[str, Any] | None
     else -> w}`` or ``{(p1, p2) -> (if (...) then v else ...)}``: ``{"rows":
     [[args, value], ...], "more": n, "else": w}``; ``None`` when ``text`` is
     not a function value."""
-    t = text.strip().replace("|->", "->")  # the trace readers' convention (values.py) and Z3's
+    t = text.strip().replace("|->", "->")  # the trace readers' convention (semantics/values.py) and Z3's
     if not (t.startswith("{") and t.endswith("}") and "->" in t):
         return None
     inner = t[1:-1]

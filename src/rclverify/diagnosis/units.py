@@ -1,9 +1,9 @@
 """One diagnosis per unit mismatch on a connection, joining what follows from it (issue 48).
 
 The driver publishes degrees where the localiser reads radians: the
-connection's unit mismatch (:func:`rclverify.system.units.mismatches`,
+connection's unit mismatch (:func:`rclverify.model.system.units.mismatches`,
 declared at both ends or the driver's unit inferred from its guarantee,
-:mod:`rclverify.rcl.unitinfer`), the ``W-unit-missing`` warning on the
+:mod:`rclverify.lang.unitinfer`), the ``W-unit-missing`` warning on the
 driver's output, the side condition of the localiser that reads it, the
 calculus' probable scale mismatch on that side condition and the recorded
 runs in which the localiser's assumption is violated, blamed on the driver,
@@ -23,12 +23,12 @@ import math
 import re
 from typing import Any, Callable, Mapping
 
-from ..rcl.unitconv import factor_name, short_decimal
-from ..rcl.units import Unit, ratio
-from ..system.units import Mismatch, mismatches
-from . import recheck
-from .edits import Edit
-from .repairs import link_pairs, _record
+from rclverify.lang.unitconv import factor_name, short_decimal
+from rclverify.lang.units import Unit, ratio
+from rclverify.model.system.units import Mismatch, mismatches
+from rclverify.diagnosis import recheck
+from rclverify.diagnosis.edits import Edit
+from rclverify.diagnosis.repairs import link_pairs, _record
 
 
 def _loc(loc: Any) -> str:
@@ -153,7 +153,7 @@ def conversion_repair(ws: Any, m: Mismatch) -> list[dict[str, Any]]:
     old = edit0.deleted(source)
     op, lit = _number(m.writer_unit, m.reader_unit)
     unit = f"{_wrap(m.reader_unit.text or str(m.reader_unit)[1:-1])}/{_wrap(m.writer_unit.text or str(m.writer_unit)[1:-1])}"
-    from ..rcl.printer import level
+    from rclverify.lang.printer import level
     body = old if level(rhs) >= 8 else f"({old})"
     edit = Edit(loc.file, loc.line, loc.col, loc.end_line, loc.end_col, f"{body} {op} {lit} [{unit}]")
     after = recheck.edited_system(ws, edit)
@@ -172,7 +172,7 @@ def conversion_repair(ws: Any, m: Mismatch) -> list[dict[str, Any]]:
     fixed = [k for k, v in now.items() if v == "discharged" and before.get(k) != "discharged"]
     still = [k for k, v in now.items() if v != "discharged"]
     words = factor_name(m.writer_unit, m.reader_unit)  # how many of the reader's units make one of the writer's
-    from ..rcl.printer import expr_to_rcl
+    from rclverify.lang.printer import expr_to_rcl
     side = expr_to_rcl(lhs if rhs is not lhs else eq.operands[1])
     summary = (f"Convert in {p}: write `{side} == {body} {op} {lit} [{unit}]` so that {p} publishes {m.reader_unit}, "
                f"the unit {c} reads ({m.writer_unit} to {m.reader_unit}: multiply by {words})")
@@ -192,7 +192,7 @@ def conversion_repair(ws: Any, m: Mismatch) -> list[dict[str, Any]]:
 def declared_unit(decls: Any, name: str) -> Any:
     """The ``UnitAnn`` declared for the input or output ``name`` among
     ``decls`` (``IOVar``s, or a mapping of name to one), ``None`` when none is."""
-    from ..rcl import ast
+    from rclverify.lang import ast
     items = decls.values() if isinstance(decls, Mapping) else decls
     for v in items:
         if isinstance(v, ast.IOVar) and v.name == name:
@@ -201,7 +201,7 @@ def declared_unit(decls: Any, name: str) -> Any:
 
 
 def _unit_of(ann: Any) -> Unit | None:
-    from ..rcl.units import UnitError, parse_unit
+    from rclverify.lang.units import UnitError, parse_unit
     if ann is None:
         return None
     try:
@@ -220,7 +220,7 @@ def literal_si(lit: Any, constants: Mapping[str, Any], declared: Any) -> tuple[A
     number with no unit at all.  ``None`` when the value or unit cannot be
     read (an affine or pi-scaled unit, a constant not defined by a numeral)."""
     from fractions import Fraction
-    from ..rcl import ast
+    from rclverify.lang import ast
     if isinstance(lit, ast.Var) and lit.name in constants:
         lit = constants[lit.name][1]
     if not isinstance(lit, ast.NumLit):
@@ -238,7 +238,7 @@ def literal_in(si: Any, like: Any, declared: Any) -> str | None:
     literal ``like``: with ``like``'s unit written after it when it has one
     (``40 [N]``), else bare in ``declared``'s unit; ``None`` when that is no
     finite decimal."""
-    from .bounds import number_text
+    from rclverify.diagnosis.bounds import number_text
     ann = like.unit if like.unit is not None else declared
     u = _unit_of(ann)
     if ann is not None and u is None:

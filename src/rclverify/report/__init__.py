@@ -1,1 +1,6 @@
-"""report stage of rclverify."""
+"""Layer 13, report: the results rendered.
+
+The assurance report (``build``, HTML, SARIF, JUnit, CI summaries), the GSN
+argument (``argument/``) and the assessor's bundle (``bundle/``).  Imports
+``stages`` and below.
+"""

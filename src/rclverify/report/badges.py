@@ -1,6 +1,6 @@
 """A requirement's status in the HTML report as what was proved and what the evidence says.
 
-A requirement's status (:mod:`rclverify.requirements.rollup`) rolls its Z3
+A requirement's status (:mod:`rclverify.calculus.requirements.rollup`) rolls its Z3
 verdict up with the evidence its proof rests on, so one red ``failed``
 stood beside "proved vacuously" and beside "proved, evidence outstanding"
 alike (issue 30, item 6).  :func:`requirement_badges` shows the two apart:

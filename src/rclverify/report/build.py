@@ -2,7 +2,7 @@
 
 Traceability: requirement -> node -> guarantee -> obligation -> evidence.
 Roll-up takes the worst status of the children
-(:data:`rclverify.evidence.records.SEVERITY`); nothing is shown as verified
+(:data:`rclverify.records.records.SEVERITY`); nothing is shown as verified
 while any of its evidence is failed, pending, stale or missing:
 
 * obligation: its evidence's *current* status (``stale`` when an input's
@@ -32,23 +32,23 @@ from typing import Any, Iterable, Mapping, Sequence
 
 import z3
 
-from .. import __version__
-from ..contract_texts import ContractTexts
-from ..evidence.records import SEVERITY, Obligation, worst
-from ..evidence.statuses import Derivation, EvidenceStatus, HealthStatus
-from ..evidence.store import EvidenceStore
-from ..workspace import Workspace, current_snapshot_hashes, stale_stages
-from ..system.model import cycles_kept, names_of
-from ..diagnosis.build import diagnose
-from ..diagnosis.text import natural_sorted  # p1 < p2 < p10
-from .expected import expected_rows
-from .schema_types import Report, as_report
-from .statistics import annotate_statistics, compact as compact_statistics
-from .records import diagnostics as read_diagnostics, grounding as read_grounding, inputs_sha256, node_obligations, \
+from rclverify import __version__
+from rclverify.report.contract_texts import ContractTexts
+from rclverify.records.records import SEVERITY, Obligation, worst
+from rclverify.records.statuses import Derivation, EvidenceStatus, HealthStatus
+from rclverify.records.store import EvidenceStore
+from rclverify.stages.workspace import Workspace, current_snapshot_hashes, stale_stages
+from rclverify.model.system.model import cycles_kept, names_of
+from rclverify.diagnosis.build import diagnose
+from rclverify.diagnosis.text import natural_sorted  # p1 < p2 < p10
+from rclverify.report.expected import expected_rows
+from rclverify.records.report_schema import Report, as_report
+from rclverify.report.statistics import annotate_statistics, compact as compact_statistics
+from rclverify.report.records import diagnostics as read_diagnostics, grounding as read_grounding, inputs_sha256, node_obligations, \
     node_records
 
 _FINDING_AS: dict[HealthStatus, EvidenceStatus] = {"ok": "discharged", "problem": "failed", "inconclusive": "inconclusive",
-               # a health warning (health/shape.py) is shown but changes no status
+               # a health warning (calculus/health/shape.py) is shown but changes no status
                "warning": "discharged",
                # made from another contract text (pipeline.stale_stages)
                "stale": "stale",
@@ -100,7 +100,7 @@ class ConeEvidence:
     The cones of a 1000-node chain hold half a million names; grouping them
     name by name took 0.3-0.5 s of every report build (docs/scale.md,
     seventh round).  Here a cone is a bit mask over the system's nodes
-    (``order``; :meth:`rclverify.system.model.SystemModel.upstream_masks`)
+    (``order``; :meth:`rclverify.model.system.model.SystemModel.upstream_masks`)
     and so is each status, so a cone's count per status is a popcount and
     the first :data:`CONE_NAMES` names of a status are its lowest bits.
 
@@ -174,7 +174,7 @@ def build_report(ws: Workspace) -> Report:
     hashes: dict[str, str] = current_snapshot_hashes(ws, texts)  # the model's too
     made_from, ev_inputs = dict(hashes), dict[str, Any]()  # what the report is built from (meta.inputs_sha256)
     stale = stale_stages(ws, hashes)  # calculus or health made from another contract text
-    from ..crosscheck.apply import load as load_second_solver
+    from rclverify.stages.crosscheck.apply import load as load_second_solver
     second = load_second_solver(ws.root)  # cvc5's verdicts: a proof the two solvers do not agree on is inconclusive
     for o in obligations:
         ev, altered = (None, altered_lists[o.id]) if o.id in altered_lists else store.read(o.id)
@@ -294,13 +294,13 @@ def build_report(ws: Workspace) -> Report:
             "guarantees": guarantees, "latex": tx["latex"],
         })
 
-    from .unverified import unverified_guarantees
+    from rclverify.report.unverified import unverified_guarantees
     unverified = unverified_guarantees(plan, nodes)
 
     requirements: list[dict[str, Any]] = []
-    from ..plan.load import all_requirements
-    from ..requirements.stage import read_records
-    from ..requirements.rollup import declaration_statuses
+    from rclverify.model.plan.load import all_requirements
+    from rclverify.stages.requirements import read_records
+    from rclverify.calculus.requirements.rollup import declaration_statuses
     checks = read_records(ws, hashes)  # sealed and hashed: altered -> error, other inputs -> stale
     checks = {k: second.requirement(v) or v for k, v in checks.items()}
     for r in all_requirements(plan):
@@ -316,7 +316,7 @@ def build_report(ws: Workspace) -> Report:
                              **requirement_check(current_record(r, checks.get(r.id)), st, g_status, sc_status,
                                                  declaration_statuses(declared, checked))})
 
-    from .deadlines import deadline_rows, fold_into, strict_ok as deadlines_ok
+    from rclverify.report.deadlines import deadline_rows, fold_into, strict_ok as deadlines_ok
     deadlines = deadline_rows(ws, hashes, g_status, ob_rows, second)  # rule D3, rolled into each requirement
     fold_into(requirements, deadlines)
 
@@ -336,13 +336,13 @@ def build_report(ws: Workspace) -> Report:
                         "loop_assumption": c["loop_assumption"]})
 
     findings = [f for n in checked.nodes for f in health[n]]
-    from ..calculus.scale import scale_findings  # a side condition's ranges a power of ten apart (a warning)
+    from rclverify.calculus.scale import scale_findings  # a side condition's ranges a power of ten apart (a warning)
     findings += scale_findings(side_conditions)
     lint_rows = [{"severity": d["severity"], "location": f"{d['file']}:{d['line']}:{d['col']}", "message": d["message"],
                   "code": d.get("code", "")}
                  for d in read_diagnostics(ws)]
     env_assumptions = [e for n in checked.nodes for e in comps[n].get("environment_assumptions", [])]
-    from ..plan.acknowledged import apply_acknowledgements  # warnings answered in the plan (docs/plan.md, issue 64)
+    from rclverify.model.plan.acknowledged import apply_acknowledgements  # warnings answered in the plan (docs/plan.md, issue 64)
     acknowledgements = apply_acknowledgements(plan.acknowledged, findings, lint_rows, checked)
 
     problems = []
@@ -418,7 +418,7 @@ def build_report(ws: Workspace) -> Report:
     }
     # runs counted by environment, bounds and targets (report/statistics.py, docs/statistics.md), before the confidence
     report["statistics"] = annotate_statistics(report, plan, {r.id: r.target for r in all_requirements(plan)})
-    from .confidence_rows import annotate  # evidence strength and confidence over the argument (issue 50)
+    from rclverify.report.confidence_rows import annotate  # evidence strength and confidence over the argument (issue 50)
     report["summary"]["solvers"] = second.counts()  # how many items two solvers, one solver, ... (issue 50)
     if second.problem:
         report["summary"]["problems"].append(f"Second-solver record: {second.problem}")
@@ -426,17 +426,17 @@ def build_report(ws: Workspace) -> Report:
                            {r.id: r.strength for r in all_requirements(plan) if r.strength})
     # one severity per finding (report/severity.py): --strict fails on every error and warning, health and lint
     # warnings included, as SARIF, JUnit and the terminal show them
-    from .severity import blocking
+    from rclverify.report.severity import blocking
     report["meta"]["strict_ok"] = bool(strict_ok) and strength_ok and not second.problem and not blocking(report)
     # one diagnosis record per problem, with repairs checked by Z3 (docs/diagnosis.md)
     report["diagnoses"] = diagnose(ws, report)
     report["summary"]["diagnoses"] = [{"id": d["id"], "kind": d["kind"], "sentence": d["sentence"],
                                        "repairs": len(d["repairs"])} for d in report["diagnoses"]]
     # the problems grouped by root cause: one row per culprit (report/problems.py, docs/reading-the-report.md)
-    from .problems import group_problems
-    from .render import anchor, problem_items
+    from rclverify.report.problems import group_problems
+    from rclverify.report.render import anchor, problem_items
     report["problems"] = group_problems(report, problem_items(report), anchor)
-    from .culprits import mark_culprits  # a culprit node reads its problem's status, never "discharged" (issue 64)
+    from rclverify.report.culprits import mark_culprits  # a culprit node reads its problem's status, never "discharged" (issue 64)
     mark_culprits(report)
     return as_report(report)
 
@@ -458,18 +458,18 @@ def involved_model(sc: Mapping[str, Any]) -> Mapping[str, Any]:
     cut to the nodes its conjunct involves (:func:`.cex_cone.side_condition_view`:
     the consumer, the producers of its links and, decided in context, the
     nodes whose assumption the counterexample violates)."""
-    from .cex_cone import side_condition_view
+    from rclverify.report.cex_cone import side_condition_view
     return side_condition_view(sc)
 
 
-#: The fields of a requirement's check record (requirements/check.py) the report carries.
+#: The fields of a requirement's check record (calculus/requirements/check.py) the report carries.
 _CHECK_FIELDS = ("origin", "source", "formal", "assuming", "cone", "used", "traced_not_needed", "consistency",
                  "inconsistent_core", "vacuity", "vacuity_core", "counterexample", "outside_assumptions",
                  "counterexample_note", "failed_to_prevent", "reason", "smt2", "explanation",
-                 "solvers",  # the second solver's agreement (crosscheck/apply.py)
+                 "solvers",  # the second solver's agreement (stages/crosscheck/apply.py)
                  "consistency_smt2", "consistency_solvers", "recorded_consistency",  # and on the side queries
                  "vacuity_smt2", "vacuity_solvers", "recorded_vacuity",
-                 "temporal",  # a temporal requirement's verdict, k, bound and trace (requirements/temporal_check.py)
+                 "temporal",  # a temporal requirement's verdict, k, bound and trace (calculus/requirements/temporal_check.py)
                  "traces",  # its recorded runs' verdicts (backends/monitors/temporal_evidence.py)
                  "duration_s")
 
@@ -496,12 +496,12 @@ def requirement_check(record: Mapping[str, Any] | None, traced_status: str, g_st
     """The requirement row's fields from its Z3 check: ``verdict`` (met /
     proved, evidence outstanding / proved from an inconsistency / refuted /
     inconclusive / informal), ``status`` (only ``met`` is ``discharged``),
-    ``note`` and the check's details (:mod:`rclverify.requirements.rollup`)."""
-    from ..requirements.rollup import roll_up
+    ``note`` and the check's details (:mod:`rclverify.calculus.requirements.rollup`)."""
+    from rclverify.calculus.requirements.rollup import roll_up
     verdict, status, note = roll_up(record, g_status, sc_status, traced_status, d_status)
-    from .cex_cone import with_trace_view  # a temporal trace cut to what matters (issue 48)
+    from rclverify.report.cex_cone import with_trace_view  # a temporal trace cut to what matters (issue 48)
     details = dict(with_trace_view({k: (record or {}).get(k) for k in _CHECK_FIELDS}))
-    from ..requirements.rollup import declaration_evidence  # the declarations it used, with their evidence (issue 64)
+    from rclverify.calculus.requirements.rollup import declaration_evidence  # the declarations it used, with their evidence (issue 64)
     details["declarations"] = declaration_evidence(record, d_status)
     return {"status": status, "verdict": verdict, "note": note, "check": details}
 

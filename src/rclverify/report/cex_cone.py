@@ -27,7 +27,7 @@ import re
 from typing import Any, Mapping, Sequence
 
 _NAMED = re.compile(r"\b([A-Za-z_]\w*)\.(in|out|state)\.([A-Za-z_]\w*)")
-#: The flags of a node's run that say whether it answers (requirements/published.py).
+#: The flags of a node's run that say whether it answers (calculus/requirements/published.py).
 _ANSWER_FLAGS = ("accepts", "answers")
 
 

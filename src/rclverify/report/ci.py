@@ -7,11 +7,11 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from ..evidence.published import write_published
-from .fragments import FragmentCache
-from .junit import render_junit
-from .sarif import render_sarif
-from .schema_types import Report
+from rclverify.records.published import write_published
+from rclverify.report.fragments import FragmentCache
+from rclverify.report.junit import render_junit
+from rclverify.report.sarif import render_sarif
+from rclverify.records.report_schema import Report
 
 #: File names written under ``reports/``, in the order :func:`write_ci_reports` returns them.
 CI_FILES: tuple[str, ...] = ("assurance.sarif", "assurance.junit.xml")

@@ -4,22 +4,22 @@ Annotates the report model :func:`rclverify.report.build.build_report`
 makes, in place:
 
 * every evidence row and side condition gets ``strength``
-  (:mod:`rclverify.argument.strength`);
+  (:mod:`rclverify.report.argument.strength`);
 * every node gets ``confidence`` (rule C3) and every derived property
   ``confidence`` (C4, over its cone, loops by a fixpoint);
 * every requirement gets ``confidence`` (C5) and ``limited_by``: the
   premise with the largest doubt and a sentence naming it;
 * ``summary.confidence``: the least confidence of the formal requirements.
 
-The rules and their sources: :mod:`rclverify.argument.confidence`, docs/confidence.md.
+The rules and their sources: :mod:`rclverify.report.argument.confidence`, docs/confidence.md.
 """
 from __future__ import annotations
 
 from typing import Any
 
-from ..argument.confidence import Premise, derived_claims, guarantee_premise, node_claims, requirement_claim
-from ..argument.strength import DOUBT, KINDS, evidence_strength, side_condition_strength
-from ..requirements.rollup import MET, OUTSTANDING
+from rclverify.report.argument.confidence import Premise, derived_claims, guarantee_premise, node_claims, requirement_claim
+from rclverify.report.argument.strength import DOUBT, KINDS, evidence_strength, side_condition_strength
+from rclverify.calculus.requirements.rollup import MET, OUTSTANDING
 
 #: Requirement verdicts whose Z3 proof holds (the evidence it rests on may not be all discharged).
 _PROVED = (MET, OUTSTANDING)

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from typing import Any, Iterable, Mapping
 
-from ..evidence.records import SEVERITY, worst
+from rclverify.records.records import SEVERITY, worst
 
 
 def culprit_nodes(groups: Iterable[Any]) -> set[str]:

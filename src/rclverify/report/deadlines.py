@@ -1,7 +1,7 @@
 """End-to-end deadlines in the report (rule D3; docs/requirements.md,
 "End-to-end deadlines"; docs/reading-the-report.md).
 
-The ``deadlines`` stage (:mod:`rclverify.calculus.deadline_stage`) decides
+The ``deadlines`` stage (:mod:`rclverify.stages.deadlines`) decides
 each requirement's ``deadline:`` with Z3.  Here its sealed record becomes
 one row per deadline of the current plan (:func:`deadline_rows`):
 
@@ -40,8 +40,8 @@ from __future__ import annotations
 import xml.etree.ElementTree as ET
 from typing import Any, Callable, Mapping, Sequence
 
-from ..evidence.records import worst
-from ..workspace import Workspace
+from rclverify.records.records import worst
+from rclverify.stages.workspace import Workspace
 
 #: A deadline verdict as an evidence status (the report's badges and roll-up).
 STATUS_OF = {"proved": "discharged", "refuted": "failed", "inconclusive": "inconclusive", "pending": "pending",
@@ -64,14 +64,14 @@ def deadline_rows(ws: Workspace, current: Mapping[str, str], g_status: Callable[
                   ob_rows: Sequence[Mapping[str, Any]], second: Any = None) -> list[dict[str, Any]]:
     """One row per ``deadline:`` of ``ws``'s plan, in plan order (module
     docstring).  ``current``: path -> sha256 of the current snapshots and
-    model (:func:`rclverify.workspace.current_snapshot_hashes`);
+    model (:func:`rclverify.stages.workspace.current_snapshot_hashes`);
     ``g_status(node, k)``: a guarantee's evidence status; ``ob_rows``: the
     report's obligation rows (``id``, ``node``, ``backend``, ``status``).
-    ``second``: the second solver's verdicts (:class:`rclverify.crosscheck.apply.SecondSolver`),
+    ``second``: the second solver's verdicts (:class:`rclverify.stages.crosscheck.apply.SecondSolver`),
     which make a proved deadline they do not agree on inconclusive.
     Returns ``[]`` for a plan without deadlines."""
-    from ..calculus.deadline_stage import INDEX, read_deadlines
-    from ..calculus.deadlines import show_seconds as _show
+    from rclverify.stages.deadlines import INDEX, read_deadlines
+    from rclverify.calculus.deadlines import show_seconds as _show
     specs = list(ws.plan.deadlines)
     if not specs:
         return []
@@ -134,7 +134,7 @@ def _monitor_verdicts(ws: Workspace, ob_rows: Sequence[Mapping[str, Any]],
     """node -> the deadline verdicts of its monitors' evidence records
     (``details["deadlines"]``, backends/monitors/deadlines.py):
     ``[{"obligation", "status", "counts", "first_false"}]``."""
-    from ..evidence.store import EvidenceStore
+    from rclverify.records.store import EvidenceStore
     store = EvidenceStore(ws.root)
     out: dict[str, list[dict[str, Any]]] = {}
     for o in ob_rows:
@@ -159,7 +159,7 @@ def fold_into(requirements: list[dict[str, Any]], rows: Sequence[Mapping[str, An
         if row is None:
             continue
         rq["deadline"] = row
-        # the requirement as its own check left it: its own argument is built from it (argument/deadlines.py)
+        # the requirement as its own check left it: its own argument is built from it (report/argument/deadlines.py)
         rq["without_deadline"] = {k: rq.get(k) for k in ("verdict", "status", "note")}
         v, st = row["verdict"], row["status"]
         if v == "proved":
@@ -236,7 +236,7 @@ def sarif_results(report: Mapping[str, Any], result: Callable[..., dict[str, Any
     for r in report.get("deadlines") or ():
         if r["verdict"] == "proved":
             continue
-        from .severity import of
+        from rclverify.report.severity import of
         rule = "RCL-DEADLINE-REFUTED" if r["verdict"] == "refuted" else "RCL-DEADLINE-INCONCLUSIVE"
         level = of("deadline", str(r["verdict"])) or "note"  # one severity in every output (report/severity.py)
         words = [f"End-to-end deadline of {r['requirement']} ({r['within']} along {' -> '.join(r['path'])}) is "

@@ -20,7 +20,7 @@ from typing import Any, Iterable, Mapping, Sequence
 
 import jinja2
 
-from . import layoutcache
+from rclverify.report import layoutcache
 
 #: Fill and border colour of a node box, by (normalised) status.
 _NODE_COLOURS: Mapping[str, tuple[str, str]] = {

@@ -22,8 +22,8 @@ from __future__ import annotations
 
 from typing import Any, Mapping, Sequence
 
-from ..plan.expected import VERDICTS
-from ..plan.load import Plan
+from rclverify.model.plan.expected import VERDICTS
+from rclverify.model.plan.load import Plan
 
 
 def _loc(plan: Plan, node: str, index: int, k: int) -> str:

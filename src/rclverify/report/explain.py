@@ -19,10 +19,10 @@ import difflib
 import re
 from typing import Any, Iterable, Mapping, Sequence
 
-from ..diagnosis.table import counterexample_table
-from ..diagnosis.text import clause_cut, explain_lines as diagnosis_lines, natural_sorted, table_lines
-from ..evidence.records import SEVERITY
-from .summary import group_sentence
+from rclverify.diagnosis.table import counterexample_table
+from rclverify.diagnosis.text import clause_cut, explain_lines as diagnosis_lines, natural_sorted, table_lines
+from rclverify.records.records import SEVERITY
+from rclverify.report.summary import group_sentence
 
 #: At most this many obligations of one guarantee are listed one a line; more are counted.
 SHOWN_OBLIGATIONS = 6
@@ -228,7 +228,7 @@ class _Index:
         elif x.get("explanation"):
             out.append(f"  {x['explanation']}")
         ack = x.get("acknowledged")
-        if ack:  # a warning answered in the plan (plan/acknowledged.py)
+        if ack:  # a warning answered in the plan (model/plan/acknowledged.py)
             out.append(f"  accepted risk, acknowledged in the plan ({ack['at']}): {ack['reason']}")
         elif x.get("sha256"):
             out.append(f"  to accept it, add under acknowledged: in the plan: "

@@ -7,13 +7,13 @@ JSON report -- is the same text as last run.  Rendering them all again was
 most of such a run (docs/scale.md).  A piece is a pure function of the data
 it is rendered from, so its text can be reused when that data is equal.
 
-The pieces are a :class:`~rclverify.cache.store.Shelf` of kind
+The pieces are a :class:`~rclverify.core.cache.store.Shelf` of kind
 ``report-fragments`` (salted with the jinja2 version besides the rclverify
 code, which covers every template), one file per part of the report
 (``artifacts/cache/report-fragments.<part>.pickle``:
 :mod:`rclverify.report.parts`), keyed by the piece's kind and the
-:func:`~rclverify.cache.keys.fingerprint` of exactly the data it is
-rendered from (:func:`rclverify.cache.keys.Keyer`).
+:func:`~rclverify.core.cache.keys.fingerprint` of exactly the data it is
+rendered from (:func:`rclverify.core.cache.keys.Keyer`).
 :meth:`FragmentCache.text` returns the kept text for a key or renders it
 (the callable gets nothing else: whatever the piece shows must be in the
 data the key is computed from); :meth:`FragmentCache.save` keeps the pieces
@@ -28,7 +28,7 @@ import json
 from pathlib import Path
 from typing import Any, Callable
 
-from ..cache import Shelf, fingerprint
+from rclverify.core.cache import Shelf, fingerprint
 
 __all__ = ["FragmentCache", "cached_dumps", "fingerprint"]
 
@@ -57,7 +57,7 @@ class FragmentCache(Shelf):
 
     def text_of_fingerprint(self, kind: str, fingerprint_of_data: bytes, render: Callable[[], str]) -> str:
         """:meth:`text` for data already fingerprinted
-        (:func:`~rclverify.cache.keys.fingerprint`), for data that keys
+        (:func:`~rclverify.core.cache.keys.fingerprint`), for data that keys
         several kinds of piece."""
         k = self.key(kind, fingerprint_of_data)
         got: str | None = self.get(k)
@@ -79,7 +79,7 @@ class FragmentCache(Shelf):
 
 def cached_dumps(value: Any, cache: FragmentCache, depth: int = 2) -> str:
     """``json.dumps(value, sort_keys=True, indent=2, ensure_ascii=False) + "\\n"``
-    -- the text of :func:`rclverify.evidence.store.dumps` -- with every
+    -- the text of :func:`rclverify.records.store.dumps` -- with every
     container ``depth`` levels down (the elements of the report's top-level
     lists) taken from ``cache``.
 

@@ -7,7 +7,7 @@ text can be read): :mod:`.svgfit`; ``reqbadges`` (a requirement's proof and
 evidence as two badges): :mod:`.badges`; ``tally`` (statuses counted,
 worst first); the global ``latex_frame(sources)``
 (the LaTeX appendix's one preamble and its end):
-:func:`rclverify.rcl.latex.document_frame`.
+:func:`rclverify.lang.latex.document_frame`.
 """
 from __future__ import annotations
 
@@ -16,10 +16,10 @@ from typing import Any, Iterable
 
 import jinja2
 
-from ..rcl.latex import document_frame
-from .badges import requirement_badges
-from .svgfit import readable_svg
-from .textfmt import natural_sorted, plain, prose
+from rclverify.lang.latex import document_frame
+from rclverify.report.badges import requirement_badges
+from rclverify.report.svgfit import readable_svg
+from rclverify.report.textfmt import natural_sorted, plain, prose
 
 
 def _natsort(items: Iterable[Any], attribute: str | None = None) -> list[Any]:

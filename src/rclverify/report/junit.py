@@ -50,10 +50,10 @@ import json
 import xml.etree.ElementTree as ET
 from typing import Any, Mapping
 
-from .fragments import FragmentCache
-from .sarif import split_location
-from .render import model_text
-from .schema_types import Report
+from rclverify.report.fragments import FragmentCache
+from rclverify.report.sarif import split_location
+from rclverify.report.render import model_text
+from rclverify.records.report_schema import Report
 
 
 def _case(suite: ET.Element, classname: str, name: str, where: str, seconds: Any) -> ET.Element:
@@ -68,8 +68,8 @@ def _outcome(case: ET.Element, status: str, summary: str, detail: str, kind: str
     """Attach the child element for an item of ``kind`` with ``status`` (its
     one severity, :func:`.severity.junit_outcome`); return the counter it
     bumps (``failures``, ``errors``, ``skipped``) or '' for a pass."""
-    from .severity import junit_outcome
-    if status == "acknowledged":  # a warning accepted in the plan with a reason (plan/acknowledged.py)
+    from rclverify.report.severity import junit_outcome
+    if status == "acknowledged":  # a warning accepted in the plan with a reason (model/plan/acknowledged.py)
         ET.SubElement(case, "skipped", {"message": f"acknowledged warning: {summary}"}).text = detail or None
         return "skipped"
     how = junit_outcome(kind, status)
@@ -121,7 +121,7 @@ def junit_tree(report: Report) -> ET.Element:
         for k, v in counts.items():
             totals[k] += v
         total_time += time
-    from .deadlines import junit_suite
+    from rclverify.report.deadlines import junit_suite
     for req in (_requirements_suite(report), junit_suite(report, _case, _outcome), _lint_suite(report)):
         if req is None:
             continue
@@ -322,7 +322,7 @@ def render_junit(report: Report, fragments: FragmentCache | None = None) -> str:
         for k, v in piece["counts"].items():
             totals[k] += v
         total_time += piece["time"]
-    from .deadlines import junit_suite
+    from rclverify.report.deadlines import junit_suite
     for req in (_requirements_suite(report), junit_suite(report, _case, _outcome), _lint_suite(report)):
         if req is None:
             continue

@@ -15,8 +15,8 @@ import json
 from pathlib import Path
 from typing import Any
 
-from ..rcl.ast import Loc
-from ..rcl.errors import RclError, error
+from rclverify.lang.ast import Loc
+from rclverify.lang.errors import RclError, error
 
 #: What a consumer of the last run reads.  A spec is a type (or a tuple of
 #: types), ``{key: spec}`` for an object whose keys must be there (a key

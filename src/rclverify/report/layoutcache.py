@@ -8,7 +8,7 @@ usually the same as last time (a diagram shows statuses and connections,
 not constants).  ``dot`` is deterministic, so its SVG for a given DOT text
 and a given ``dot`` program can be reused byte for byte.
 
-The layouts are :class:`~rclverify.cache.store.Blobs` of kind ``layout``
+The layouts are :class:`~rclverify.core.cache.store.Blobs` of kind ``layout``
 (one file per layout, ``artifacts/cache/layout/<key>.svg``, since the two
 report processes may lay out at once), keyed by the DOT text together with
 the path, size and modification time of the ``dot`` executable (an
@@ -22,7 +22,7 @@ import os
 from pathlib import Path
 from typing import Callable
 
-from ..cache import Blobs
+from rclverify.core.cache import Blobs
 
 KIND = "layout"
 _blobs = Blobs(None, KIND, "svg")

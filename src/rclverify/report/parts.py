@@ -7,7 +7,7 @@ about 9 s after every backend had finished, with the second core idle
 (docs/scale.md, sixth round).  The files fall into two parts of about the
 same cost, which ``doit -n 2`` renders at once in two processes (each
 builds the report dict from the same artifacts; a serial run builds it
-once, :func:`rclverify.tasks.act_report`):
+once, :func:`rclverify.app.tasks.act_report`):
 
 ``html``  ``assurance.html`` (with the Graphviz layouts of the system and
           the argument), ``assurance.json``, the CI formats
@@ -24,13 +24,13 @@ from __future__ import annotations
 from functools import lru_cache
 from pathlib import Path
 
-from ..argument.export import FILES as ARGUMENT_FILES
-from ..argument.export import argument_layout, write_argument
-from ..workspace import REPORT_PARTS
-from .ci import CI_FILES, write_ci_reports
-from .fragments import FragmentCache
-from .render import REPORT_FILES, render_files
-from .schema_types import Report
+from rclverify.report.argument.export import FILES as ARGUMENT_FILES
+from rclverify.report.argument.export import argument_layout, write_argument
+from rclverify.stages.workspace import REPORT_PARTS
+from rclverify.report.ci import CI_FILES, write_ci_reports
+from rclverify.report.fragments import FragmentCache
+from rclverify.report.render import REPORT_FILES, render_files
+from rclverify.records.report_schema import Report
 
 #: Each part's files under ``reports/`` (``argument.svg`` only when the argument is laid out).
 PARTS = REPORT_PARTS
@@ -47,7 +47,7 @@ def write_part(report: Report, out_dir: Path, part: str, fragments: FragmentCach
     ``KeyError`` for an unknown part and what
     :func:`~rclverify.report.render.render_files`,
     :func:`~rclverify.report.ci.write_ci_reports` and
-    :func:`~rclverify.argument.export.write_argument` raise.
+    :func:`~rclverify.report.argument.export.write_argument` raise.
     """
     names = PARTS[part]
     argument = None

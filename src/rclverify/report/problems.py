@@ -71,13 +71,13 @@ import re
 from collections.abc import Callable, Mapping, Sequence
 from typing import Any
 
-from ..evidence.records import SEVERITY
-from . import problems_causes as pc
-from . import problems_mc as mc
-from . import problems_shared as ps
-from .problems_shared import producer_first
-from . import problems_units as pu
-from .textfmt import natural_sorted
+from rclverify.records.records import SEVERITY
+from rclverify.report import problems_causes as pc
+from rclverify.report import problems_mc as mc
+from rclverify.report import problems_shared as ps
+from rclverify.report.problems_shared import producer_first
+from rclverify.report import problems_units as pu
+from rclverify.report.textfmt import natural_sorted
 
 #: Key prefix of a group of outstanding evidence on a node's whole contract from one backend (rule 5).
 OUTSTANDING_WHOLE = "outstanding-contract:"

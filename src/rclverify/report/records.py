@@ -3,7 +3,7 @@
 Each node's side conditions (``artifacts/calculus/<Node>.json``) and
 contract health findings (``artifacts/health/<Node>.json``), the lint
 diagnostics and the grounding are sealed records
-(:mod:`rclverify.evidence.sealed`, docs/integrity.md).  A record whose seal
+(:mod:`rclverify.records.sealed`, docs/integrity.md).  A record whose seal
 does not hold is shown as ``error`` ("... altered outside rclverify"),
 never with the statuses it claims: its side conditions are each ``error``
 (one placeholder when it cannot be read at all), its findings are replaced
@@ -15,9 +15,9 @@ from __future__ import annotations
 import hashlib
 from typing import Any, Iterable, Mapping
 
-from ..evidence.records import Obligation, SourceRef
-from ..evidence.sealed import obligation_list, read_sealed
-from ..workspace import Workspace
+from rclverify.records.records import Obligation, SourceRef
+from rclverify.records.sealed import obligation_list, read_sealed
+from rclverify.stages.workspace import Workspace
 
 
 def _error_side_conditions(node: str, body: dict[str, Any] | None, why: str) -> dict[str, Any]:
@@ -95,8 +95,8 @@ def grounding(ws: Workspace, rel: str) -> dict[str, Any] | None:
                 "context": {"packages": [], "files": []}, "drawing": {"dot": "", "svg": None},
                 "graph": {"nodes": []}, "matched": {}}
     if body is not None:
-        from ..evidence.records import hash_inputs
-        from ..ros.inputs import input_files
+        from rclverify.records.records import hash_inputs
+        from rclverify.ros.graph.inputs import input_files
         made = body.get("inputs")
         now = input_files(ws)
         if not isinstance(made, dict) or set(made) != set(now) or hash_inputs(ws.root, now) != made:
@@ -109,7 +109,7 @@ def inputs_sha256(ws: Workspace, made_from: Mapping[str, str], evidence_inputs: 
                   checks: Mapping[str, Mapping[str, Any]]) -> str:
     """One sha256 over what a report is built from, recorded in its
     ``meta.inputs_sha256``: the sha256 of the plan, contract and replacement
-    files (:func:`rclverify.workspace.check_inputs`), of the contract
+    files (:func:`rclverify.stages.workspace.check_inputs`), of the contract
     snapshots and system model they give (``made_from``), the
     ``input_hashes`` of each obligation's evidence record
     (``evidence_inputs``: obligation id -> hashes, ``None`` without a
@@ -118,8 +118,8 @@ def inputs_sha256(ws: Workspace, made_from: Mapping[str, str], evidence_inputs: 
     run and a clean one give the same value.  The bundle compares it with
     the value of a report built now (docs/argument.md): a report written
     before the evidence was produced again is not packed."""
-    from ..evidence.store import dumps
-    from ..workspace import check_inputs
+    from rclverify.records.store import dumps
+    from rclverify.stages.workspace import check_inputs
     body = {"files": check_inputs(ws), "made_from": dict(made_from), "evidence": dict(evidence_inputs),
             "requirements": {k: [v.get("verdict"), v.get("fingerprint"), v.get("inputs")] for k, v in checks.items()}}
     return hashlib.sha256(dumps(body).encode("utf-8")).hexdigest()

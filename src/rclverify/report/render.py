@@ -25,16 +25,16 @@ from urllib.parse import quote
 import jinja2
 from markupsafe import Markup, escape
 
-from ..evidence.records import SEVERITY
-from ..evidence.published import write_published
-from ..evidence.store import dumps
-from ..cache.memo import last_call
-from . import diagram
-from .fragments import FragmentCache, cached_dumps
-from .culprits import culprit_nodes
-from .problems import group_problems
-from . import htmlfilters
-from .textfmt import FOLD_CHARS, breakable, formula_html, formula_lines, natural_key, natural_sorted, natural_within
+from rclverify.records.records import SEVERITY
+from rclverify.records.published import write_published
+from rclverify.records.store import dumps
+from rclverify.core.cache.memo import last_call
+from rclverify.report import diagram
+from rclverify.report.fragments import FragmentCache, cached_dumps
+from rclverify.report.culprits import culprit_nodes
+from rclverify.report.problems import group_problems
+from rclverify.report import htmlfilters
+from rclverify.report.textfmt import FOLD_CHARS, breakable, formula_html, formula_lines, natural_key, natural_sorted, natural_within
 
 _T = TypeVar("_T")
 
@@ -257,7 +257,7 @@ def use_bytecode_cache(directory: Path | None) -> None:
     ``None``: compile in memory only).  Compiling the report's templates is
     about 0.3 s of every report run.  The files are code: the report run
     keeps them in the user's cache, never in a workspace
-    (:func:`rclverify.cache.keys.user_cache_dir`).  Raises ``OSError`` when
+    (:func:`rclverify.core.cache.keys.user_cache_dir`).  Raises ``OSError`` when
     ``directory`` cannot be created."""
     if directory is None:
         environment().bytecode_cache = None
@@ -346,7 +346,7 @@ def _attention(report: Mapping[str, Any], ev_anchor: Sequence[str]) -> tuple[lis
             add(d["status"], "derived property", d["node"], anchor("derived", d["node"]),
                 ", ".join(d["rules"]), f"Derived property {d.get('derivation', 'not established')} "
                 "(a side condition of its cone is not discharged):", str(d["property"]))
-    for a in report.get("acknowledgements") or ():  # a stale or refused acknowledgement (plan/acknowledged.py)
+    for a in report.get("acknowledgements") or ():  # a stale or refused acknowledgement (model/plan/acknowledged.py)
         if a.get("status") != "ok":
             add(str(a["status"]), "acknowledgement", str(a["warning"]), "acknowledged", str(a["at"]), str(a["message"]))
     for k, lint in enumerate(report["lint"]):
@@ -430,7 +430,7 @@ def dashboard(report: Mapping[str, Any], evidence_of: Mapping[str, Sequence[tupl
 
     Each cell is the WORST status of the node's items of that technique
     (evidence severity: failed > error > stale > inconclusive > pending >
-    discharged, :data:`rclverify.evidence.records.SEVERITY`): for a backend,
+    discharged, :data:`rclverify.records.records.SEVERITY`): for a backend,
     the statuses of the node's obligations of that backend (an obligation's
     status is that of its evidence, pending when it has none); for
     ``no evidence`` (only when there is one), the node's guarantees no
@@ -631,16 +631,16 @@ _NO_LAYOUT = diagram.Rendering(None, "the Markdown report gives the argument as 
 def _argument(report: Mapping[str, Any], rendering: diagram.Rendering | None,
               fragments: FragmentCache | None) -> dict[str, Any]:
     """The assurance argument's view for the templates (GSN goal structure
-    built from ``report``, see :mod:`rclverify.argument`); ``rendering`` of
+    built from ``report``, see :mod:`rclverify.report.argument`); ``rendering`` of
     the system diagram, when given, stands in for its layout too."""
-    from ..argument.export import argument_view
+    from rclverify.report.argument.export import argument_view
     return argument_view(report, rendering, fragments)
 
 
 @last_call  # the HTML report's layout and page both show it
 def _system_dot(report: Mapping[str, Any]) -> str:
     """The system diagram with the problems' culprit nodes and the failing connections marked (issue 48)."""
-    from ..diagnosis.repairs import link_pairs
+    from rclverify.diagnosis.repairs import link_pairs
     failing = {(p, c) for sc in report.get("side_conditions") or () if sc.get("status") in ("failed", "inconclusive", "error")
                for p, _, c, _ in link_pairs(sc)}
     culprits = culprit_nodes(problem_groups(report))
@@ -725,14 +725,14 @@ def render_files(report: Mapping[str, Any], out_dir: Path, names: Sequence[str] 
     rendered pieces between runs (:mod:`rclverify.report.fragments`; the
     caller saves it); the files are the same with or without it.
     ``argument`` lays the argument out (default
-    :func:`rclverify.argument.export.argument_layout`).  Returns the paths
+    :func:`rclverify.report.argument.export.argument_layout`).  Returns the paths
     in :data:`REPORT_FILES` order.  Raises
     ``ValueError``/``TypeError``/``jinja2.UndefinedError`` for a malformed
     report and ``OSError`` when ``out_dir`` cannot be written.
     """
     from concurrent.futures import Future, ThreadPoolExecutor
 
-    from ..argument.export import argument_layout
+    from rclverify.report.argument.export import argument_layout
     texts = {}
     # The two Graphviz layouts (seconds each on a large system) run as subprocesses beside the
     # other rendering; a thread only waits for its `dot`, so the GIL is not in the way.

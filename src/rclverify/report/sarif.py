@@ -34,9 +34,9 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any, Mapping, Sequence
 
-from ..evidence.store import dumps
-from .render import model_text
-from .schema_types import Report
+from rclverify.records.store import dumps
+from rclverify.report.render import model_text
+from rclverify.records.report_schema import Report
 
 #: The SARIF version written and the schema it validates against.
 SARIF_VERSION = "2.1.0"
@@ -154,7 +154,7 @@ _OBLIGATION_RULE = {"failed": "RCL-OBL-FAILED", "error": "RCL-OBL-ERROR", "stale
 
 def _level(kind: str, status: str) -> str:
     """The SARIF level of an item: its one severity (:mod:`.severity`)."""
-    from .severity import of
+    from rclverify.report.severity import of
     return of(kind, status) or "note"
 
 
@@ -288,7 +288,7 @@ def _requirement_results(report: Mapping[str, Any]) -> list[dict[str, Any]]:
                 f"{row['node']}: " + ", ".join(f"{k} = {v}" for k, v in row["values"].items())
                 for row in c["counterexample"]) + ".")
         if c.get("temporal"):  # a temporal requirement: its method, bound and trace step by step
-            from .temporal import temporal_words
+            from rclverify.report.temporal import temporal_words
             words.append(temporal_words(c["temporal"]))
         for p in c.get("failed_to_prevent") or []:
             words.append(f"Not prevented by {p['label']} ({p['text']}, {p['source']}).")
@@ -332,7 +332,7 @@ def _finding_results(report: Mapping[str, Any]) -> list[dict[str, Any]]:
 def _suppressed(res: dict[str, Any], row: Mapping[str, Any]) -> dict[str, Any]:
     """``res`` with a SARIF ``suppressions`` entry (kind ``external``, status
     ``accepted``, the reason as ``justification``, SARIF 2.1.0 section
-    3.35) when the plan acknowledges the warning ``row`` (plan/acknowledged.py)."""
+    3.35) when the plan acknowledges the warning ``row`` (model/plan/acknowledged.py)."""
     ack = row.get("acknowledged")
     if ack:
         sup: dict[str, Any] = {"kind": "external", "status": "accepted", "justification": str(ack["reason"])}
@@ -370,7 +370,7 @@ def _grounding_results(report: Mapping[str, Any]) -> tuple[list[dict[str, Any]],
     g = report.get("grounding")
     if not g:
         return [], []
-    from ..ros.ground import RULES as ROS_RULES
+    from rclverify.ros.ground.ground import RULES as ROS_RULES
     rules = [Rule(code, "Ros" + "".join(w.capitalize() for w in code.split("-")[1:]),
                   "error" if sev == "error" else "warning", text) for code, (sev, text) in ROS_RULES.items()]
     out = []
@@ -396,7 +396,7 @@ def _attach_diagnoses(report: Mapping[str, Any], results: Sequence[dict[str, Any
     sentence naming the culprit) and its repairs as SARIF ``fix`` objects
     (§3.55; each repair was checked by Z3 before it entered the report,
     docs/diagnosis.md).  A report without ``diagnoses`` is left as it is."""
-    from ..diagnosis.edits import sarif_fix
+    from rclverify.diagnosis.edits import sarif_fix
     by_key: dict[str, Mapping[str, Any]] = {}
     for d in report.get("diagnoses", []):
         if d.get("kind") == "unit":  # a unit mismatch: the lint error at the producer (diagnosis/units.py)
@@ -452,7 +452,7 @@ def _descriptor(r: Rule) -> dict[str, Any]:
 def sarif_log(report: Report) -> dict[str, Any]:
     """The SARIF 2.1.0 log (a JSON-serialisable dict) of ``report``.
 
-    ``report`` is the :class:`~rclverify.report.schema_types.Report` of
+    ``report`` is the :class:`~rclverify.records.report_schema.Report` of
     :func:`~rclverify.report.build.build_report` (it reads ``meta``,
     ``obligations``, ``evidence``, ``pending``, ``side_conditions``,
     ``findings``, ``nodes``, ``lint``).  Every rule of
@@ -462,7 +462,7 @@ def sarif_log(report: Report) -> dict[str, Any]:
     """
     lint, lint_rules = _lint_results(report)
     ground, ground_rules = _grounding_results(report)
-    from .deadlines import SARIF_RULES, sarif_results
+    from rclverify.report.deadlines import SARIF_RULES, sarif_results
     results = (_obligation_results(report) + _unverified_results(report) + _side_condition_results(report) + _finding_results(report) + lint + ground
                + _requirement_results(report) + sarif_results(report, _result) + _acknowledgement_results(report))
     _attach_diagnoses(report, results)

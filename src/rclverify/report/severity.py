@@ -31,7 +31,7 @@ Kinds: ``obligation``, ``guarantee`` (one no obligation covers),
 entry answering a warning: ``stale`` is a warning, ``error`` an error).
 
 A health or lint warning that a plan acknowledgement answers
-(plan/acknowledged.py) keeps its severity in every output (SARIF marks it
+(model/plan/acknowledged.py) keeps its severity in every output (SARIF marks it
 suppressed, with the reason as justification) but does not fail
 ``--strict`` (:func:`acknowledged`).
 """
@@ -39,9 +39,9 @@ from __future__ import annotations
 
 from typing import Any, Mapping
 
-from ..evidence.statuses import SEVERITIES
+from rclverify.records.statuses import SEVERITIES
 
-#: The three severities (the vocabulary's set, evidence/statuses.py).
+#: The three severities (the vocabulary's set, records/statuses.py).
 ERROR, WARNING, NOTE = SEVERITIES
 #: Severities that fail ``--strict``.
 GATING = (ERROR, WARNING)
@@ -116,7 +116,7 @@ def items(report: Mapping[str, Any]) -> list[tuple[str, str, str, str]]:
         add("deadline", f"{d['requirement']}.deadline", "proved, evidence outstanding" if open_ else str(d["verdict"]))
     for x in report.get("lint") or ():
         add("lint", f"{x['location']}:{x.get('code', '')}", str(x["severity"]))
-    for a in report.get("acknowledgements") or ():  # a stale or refused acknowledgement (plan/acknowledged.py)
+    for a in report.get("acknowledgements") or ():  # a stale or refused acknowledgement (model/plan/acknowledged.py)
         add("acknowledgement", f"{a['at']}:{a['warning']}", str(a["status"]))
     return out
 

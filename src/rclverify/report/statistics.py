@@ -12,15 +12,15 @@
   grouped by the tags of the entries that recorded them, decided against
   its ``target`` when it states one.  Each per-run evidence row gets its
   group's bound (``statistics.group``), which the confidence uses as the
-  doubt of that run evidence (:mod:`rclverify.argument.strength`).
+  doubt of that run evidence (:mod:`rclverify.report.argument.strength`).
 """
 from __future__ import annotations
 
 from typing import Any, Mapping
 
-from ..evidence.statistics import count_runs, decide, upper_bound
-from ..plan.model import Plan
-from ..plan.targets import UNSTATED, entry_environment, entry_origin
+from rclverify.records.statistics import count_runs, decide, upper_bound
+from rclverify.model.plan.model import Plan
+from rclverify.model.plan.targets import UNSTATED, entry_environment, entry_origin
 
 #: The level of a bound drawn where the plan states no target.
 LEVEL = 0.95
@@ -116,7 +116,7 @@ def annotate_statistics(report: dict[str, Any], plan: Plan, targets: Mapping[str
     """The report's ``statistics`` table (module docstring); sets
     ``statistics.group`` on each per-run evidence row and ``statistics`` on
     each requirement with recorded runs.  ``targets``: requirement id -> its
-    :class:`~rclverify.evidence.statistics.Target` (or ``None``)."""
+    :class:`~rclverify.records.statistics.Target` (or ``None``)."""
     groups: dict[tuple[str, str, str], list[Mapping[str, Any]]] = {}
     table: list[dict[str, Any]] = []
     for e in report.get("evidence", []):

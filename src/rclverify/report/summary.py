@@ -14,7 +14,7 @@ from typing import IO, TYPE_CHECKING, Any, Mapping, Sequence
 
 if TYPE_CHECKING:  # rich is imported where a table is drawn: doit imports this module on every run
     from rich.table import Table
-from ..evidence.records import SEVERITY
+from rclverify.records.records import SEVERITY
 
 #: At most this many node rows (worst first); the rest are summed in one row.
 MAX_ROWS = 15
@@ -41,7 +41,7 @@ def node_rows(report: Mapping[str, Any]) -> list[dict[str, Any]]:
         return out
     obligations, sides, findings = (by_node(report[k]) for k in ("obligations", "side_conditions", "findings"))
     unverified = by_node(list(report.get("unverified") or ()))
-    from .culprits import culprit_nodes
+    from rclverify.report.culprits import culprit_nodes
     blamed = culprit_nodes(report.get("problems") or ())
     rows = []
     for k, n in enumerate(report["nodes"]):
@@ -130,7 +130,7 @@ def summary_data(report: Mapping[str, Any]) -> dict[str, Any]:
                           "repairs": len(g.get("repairs", []))}
                          for g in report.get("problems", ())],
             "grounding": _grounding(report.get("grounding")), "strict": strict_reasons(report),
-            # warnings answered in the plan (plan/acknowledged.py): named, so an accepted risk is never silent
+            # warnings answered in the plan (model/plan/acknowledged.py): named, so an accepted risk is never silent
             "acknowledged": [f"{m} ({a['at']}: {a['reason']})" for a in report.get("acknowledgements") or ()
                              if a.get("status") == "ok" for m in a.get("matched") or ()]}
 
@@ -139,7 +139,7 @@ def group_sentence(group: Mapping[str, Any]) -> str:
     """The first sentence of a problem group, whole: the report's row
     (report/problems.py) cuts it to a length; the terminal cuts it only at
     a clause boundary (:func:`rclverify.diagnosis.text.clause_cut`)."""
-    from ..diagnosis.text import whole_first_sentence
+    from rclverify.diagnosis.text import whole_first_sentence
     short = str(group.get("sentence", ""))
     stem = short[:-4] if short.endswith(" ...") else None
     for m in group.get("members", []):
@@ -197,7 +197,7 @@ def strict_reasons(report: Mapping[str, Any]) -> list[str]:
         out.append(f"{len(warned)} contract health warning{'s' if len(warned) != 1 else ''} ("
                    + ", ".join(warned[:4]) + (", ..." if len(warned) > 4 else "") + ")")
     lint = [x for x in report.get("lint") or () if str(x.get("severity", "")).lower() in ("warning", "error")
-            and not x.get("acknowledged")]  # a warning answered in the plan passes (plan/acknowledged.py)
+            and not x.get("acknowledged")]  # a warning answered in the plan passes (model/plan/acknowledged.py)
     if lint:
         out.append(f"{len(lint)} lint diagnostic{'s' if len(lint) != 1 else ''} (`rclverify check`: "
                    + ", ".join(str(x["location"]) for x in lint[:3]) + (", ..." if len(lint) > 3 else "") + ")")
@@ -210,7 +210,7 @@ def strict_reasons(report: Mapping[str, Any]) -> list[str]:
     if rq:
         out.append(f"{len(rq)} formal requirement{'s are' if len(rq) != 1 else ' is'} not met ("
                    + ", ".join(rq[:4]) + (", ..." if len(rq) > 4 else "") + ")")
-    from .deadlines import strict_reason
+    from rclverify.report.deadlines import strict_reason
     out += strict_reason(report)  # end-to-end deadlines not proved
     g = _grounding(report.get("grounding"))
     if g and g["error"]:
@@ -232,7 +232,7 @@ def status_text(data: Mapping[str, Any]) -> list[str]:
     (:func:`rclverify.diagnosis.text.status_lines`), with the ROS grounding
     errors: counted on the overall line and listed one a line (they change
     no verdict, docs/ros.md, but fail ``--strict``)."""
-    from ..diagnosis.text import status_lines
+    from rclverify.diagnosis.text import status_lines
     g = data.get("grounding") or {}
     errors = int(g.get("error", 0) or 0)
     if errors:  # listed below one a line, not as the report's one summary problem
@@ -331,11 +331,11 @@ def read_summary(root: Path) -> dict[str, Any]:
     ``artifacts/report/summary.json`` when it is there (of any shape: a
     broken one is an error, not silently replaced), else made from
     ``reports/assurance.json``.  Raises
-    :class:`~rclverify.rcl.errors.RclError` (one located line) as
+    :class:`~rclverify.lang.errors.RclError` (one located line) as
     :func:`rclverify.report.lastrun.read_checked` does."""
-    from ..workspace import Workspace
-    from .lastrun import SUMMARY_SHAPE, SUMMARY_SOURCE_SHAPE, located, read_checked
-    from ..evidence.sealed import read_sealed
+    from rclverify.stages.workspace import Workspace
+    from rclverify.report.lastrun import SUMMARY_SHAPE, SUMMARY_SOURCE_SHAPE, located, read_checked
+    from rclverify.records.sealed import read_sealed
     path = root / Workspace.SUMMARY
     if path.exists():
         # sealed: a summary altered outside rclverify is said so and never shown (docs/integrity.md)
@@ -358,7 +358,7 @@ def print_last_run(root: Path) -> dict[str, Any]:
     and the summary table.  Read from ``artifacts/report/summary.json``
     (written with the report), else from ``reports/assurance.json``.
     Returns the summary data (:func:`summary_data`).  Raises
-    :class:`~rclverify.rcl.errors.RclError` (one located line) when neither
+    :class:`~rclverify.lang.errors.RclError` (one located line) when neither
     file can be read or the one read is of another shape
     (:mod:`rclverify.report.lastrun`)."""
     data = read_summary(root)

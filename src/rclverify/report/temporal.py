@@ -1,6 +1,6 @@
 """A temporal requirement's verdict in words (SARIF message, terminal).
 
-The record's ``temporal`` field (:mod:`rclverify.requirements.temporal_check`)
+The record's ``temporal`` field (:mod:`rclverify.calculus.requirements.temporal_check`)
 as one sentence per part: how it was decided (method, k, steps checked) and,
 for a refuted one, its trace step by step and node by node.
 """

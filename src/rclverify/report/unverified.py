@@ -8,7 +8,7 @@ outputs still exports one, which stays ``pending``), nothing will ever
 vouch for it: the report says so for every such guarantee instead of
 counting only the obligations that exist ("5 obligations: 5 discharged"
 while five guarantees had none).  Status order:
-:data:`rclverify.evidence.records.SEVERITY` (pending < unverified <
+:data:`rclverify.records.records.SEVERITY` (pending < unverified <
 inconclusive); docs/reading-the-report.md, "Unverified guarantees".
 """
 from __future__ import annotations
@@ -37,7 +37,7 @@ def unverified_guarantees(plan: Any, nodes: Sequence[Mapping[str, Any]]) -> list
     node, or it does but none of its entries (named by backend) exports an
     obligation for this guarantee.  ``message`` is the one-line problem
     (summary ``problems``).  ``plan.evidence`` maps node names to their
-    entries (:class:`rclverify.plan.model.EvidenceEntry`)."""
+    entries (:class:`rclverify.model.plan.model.EvidenceEntry`)."""
     out: list[dict[str, Any]] = []
     for n in nodes:
         name = str(n["name"])

@@ -1,15 +1,9 @@
-"""The ROS computation graph read from a robot's software, and contracts
-grounded in it (issue 22; docs/ros.md).
+"""Layer 7, ros: the ROS computation graph read from a robot's software, and
+contracts grounded in it (issue 22; docs/ros.md).
 
-Modules, lowest first: ``model`` (graph values, JSON), ``names`` (ROS name
-resolution), ``xmlsrc`` (located XML through lxml), ``packages``
-(``package.xml`` via catkin_pkg), ``interfaces`` (``.msg/.srv/.action/.idl``
-via rosbags' type system), ``sources_py`` / ``sources_cpp`` (node sources via
-``ast`` and tree-sitter-cpp), ``executables`` (executable name -> source
-files), ``launch_ros1`` / ``launch_ros2`` (launch files read statically),
-``bag`` (recorded runs), ``master`` (a live ROS 1 master), ``cache``
-(per-file parse cache keyed by sha256), ``graph`` (the scan), ``check``
-(grounding findings; ``ground_services`` for services and actions),
-``diff`` (the code's graph against a master or a bag, ``ros diff``),
-``skeleton`` (``init --from-ros``).
+Four folders, lowest first, each importing only those before it:
+``extract/`` (code, launch files, packages read into graph records),
+``graph/`` (the computation graph assembled), ``live/`` (the running system:
+ROS 1 master, ROS 2 on DDS, ``ros diff``), ``ground/`` (contracts grounded
+in the graph).  Imports ``model`` and below.
 """

@@ -9,7 +9,7 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any, Iterator, Sequence
 
-from .events import Event, TraceError, header_stamp
+from rclverify.traces.events import Event, TraceError, header_stamp
 
 
 def custom_types(msg_dirs: Sequence[Path]) -> dict[str, Any]:

@@ -35,8 +35,8 @@ from typing import Any, Iterator, Mapping, Sequence
 
 import numpy as np
 
-from .bag import bag_event, open_bag, read_bag, typestore
-from .events import Event, TraceError
+from rclverify.traces.bag import bag_event, open_bag, read_bag, typestore
+from rclverify.traces.events import Event, TraceError
 
 FLOAT64, STRING = "std_msgs/msg/Float64", "std_msgs/msg/String"
 _LE = b"\x00\x01"  # CDR little-endian encapsulation (the two bytes rosbags reads; the options after it are not)

@@ -4,7 +4,7 @@ Opening a FIFO for reading blocks until someone writes to it, and a device
 may never end; a recorded run is user input and may hold either (a FIFO
 named ``metadata.yaml`` in a ROS 2 bag directory held ``ground``, ``ros
 check`` and ``monitor`` for ever).  So every reader of a trace or a bag
-asks :func:`check_trace_path` first (the rule of ``ros/safefs.py``, which
+asks :func:`check_trace_path` first (the rule of ``ros/extract/safefs.py``, which
 guards the ROS scan's source files, applied to recorded runs; it lives here
 because the trace readers sit below the ROS layer):
 
@@ -26,7 +26,7 @@ import os
 import stat
 from pathlib import Path
 
-from .events import TraceError
+from rclverify.traces.events import TraceError
 
 #: Suffixes of the files a ROS bag reader opens in a bag directory.
 BAG_FILE_SUFFIXES = (".yaml", ".db3", ".mcap")

@@ -27,7 +27,7 @@ from typing import Any, Iterable, Iterator
 
 import msgspec
 
-from .events import FLAT_STAMPS, Event, TraceError, header_stamp
+from rclverify.traces.events import FLAT_STAMPS, Event, TraceError, header_stamp
 
 
 #: JSON's scanner with :func:`json.loads`'s defaults: one object read without the

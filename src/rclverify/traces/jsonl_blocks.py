@@ -60,8 +60,8 @@ from typing import Any, Iterator, Sequence, Union
 import msgspec
 import numpy as np
 
-from .events import FLAT_STAMPS, Event, taken
-from .jsonl import line_event, read_jsonl, read_lines
+from rclverify.traces.events import FLAT_STAMPS, Event, taken
+from rclverify.traces.jsonl import line_event, read_jsonl, read_lines
 
 #: Bytes read from the log at once (a block is cut after its last whole line).
 BLOCK_BYTES = 1 << 20

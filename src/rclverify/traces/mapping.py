@@ -42,8 +42,8 @@ from dataclasses import dataclass, field
 from fractions import Fraction
 from typing import Any, Mapping, Sequence
 
-from ..rcl import types as T
-from ..values import FiniteFunction, Term
+from rclverify.lang import types as T
+from rclverify.semantics.values import FiniteFunction, Term
 
 
 class MappingError(Exception):
@@ -282,7 +282,7 @@ class RuleError(ValueError):
 class RuleSet(dict):  # type: ignore[type-arg]
     """The mapping file's topic rules (topic -> :class:`TopicRule`) and its
     ``tolerance`` of recorded numbers (``None``: none declared; else a
-    :class:`rclverify.logic.floatsem.Tolerance`, set by the mapping's loader),
+    :class:`rclverify.semantics.floatsem.Tolerance`, set by the mapping's loader),
     which every monitor given these rules applies (docs/monitors.md,
     "Numbers on the wire")."""
 

@@ -31,7 +31,7 @@ from __future__ import annotations
 import bisect
 from typing import Any
 
-from .events import Event
+from rclverify.traces.events import Event
 
 #: Questions remembered for stamp look-ups (an output stamped before the latest question): at least
 #: this many, at most twice as many.

@@ -29,7 +29,7 @@ from typing import Any, Iterator, Mapping, Sequence
 
 import numpy as np
 
-from .events import Event
+from rclverify.traces.events import Event
 
 
 class ColumnTrace:

@@ -8,6 +8,6 @@ contract stub), :mod:`.runner` (find, identify, run Dafny and read its
 output), :mod:`.backend` (:class:`DafnyBackend`, name ``dafny``, kind
 ``proof``).
 """
-from .backend import DafnyBackend
+from rclverify.backends.dafny.backend import DafnyBackend
 
 __all__ = ["DafnyBackend"]

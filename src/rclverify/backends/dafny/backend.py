@@ -43,14 +43,14 @@ from typing import Any, Mapping
 
 import jinja2
 
-from ...evidence.records import Evidence, Obligation, SourceRef, make_obligation_id
-from ...evidence.store import atomic_write_text
+from rclverify.records.records import Evidence, Obligation, SourceRef, make_obligation_id
+from rclverify.records.store import atomic_write_text
 
-from ...rcl.errors import RclError
-from ...rcl.printer import expr_to_rcl
-from ..base import NodeTarget, Stopwatch, make_evidence
-from . import runner
-from .stubgen import ClauseRef, Stub, build_stub, clause_lines, snake
+from rclverify.lang.errors import RclError
+from rclverify.lang.printer import expr_to_rcl
+from rclverify.backends.base import NodeTarget, Stopwatch, make_evidence
+from rclverify.backends.dafny import runner
+from rclverify.backends.dafny.stubgen import ClauseRef, Stub, build_stub, clause_lines, snake
 
 DEFAULT_TIME_LIMIT_S = 60
 DEFAULT_TIMEOUT_S = 600
@@ -111,7 +111,7 @@ class DafnyBackend:
         """Build the node's stub and write it (atomically, only when changed).
 
         Returns the stub and its absolute path.  Raises
-        :class:`~rclverify.plan.errors.PlanError` for a bad plan entry or a
+        :class:`~rclverify.model.plan.errors.PlanError` for a bad plan entry or a
         contract Dafny cannot express (located at the RCL construct).
         """
         cfg = _Config(target)
@@ -129,7 +129,7 @@ class DafnyBackend:
     def export(self, target: NodeTarget) -> list[Obligation]:
         """Render the stub and return the node's single obligation.
 
-        Raises :class:`~rclverify.plan.errors.PlanError` (see :meth:`render`).
+        Raises :class:`~rclverify.model.plan.errors.PlanError` (see :meth:`render`).
         """
         cfg = _Config(target)
         stub, path = self.render(target)

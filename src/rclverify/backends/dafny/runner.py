@@ -36,8 +36,8 @@ from functools import lru_cache
 from pathlib import Path
 from typing import Mapping, Sequence
 
-from ...rcl.ast import Loc
-from ..bounded import run_bounded
+from rclverify.lang.ast import Loc
+from rclverify.backends.bounded import run_bounded
 
 
 # ---------------------------------------------------------------------------

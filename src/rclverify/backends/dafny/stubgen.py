@@ -40,11 +40,11 @@ from functools import lru_cache
 
 import jinja2
 
-from ...rcl import ast
-from ...rcl.printer import expr_to_rcl
-from ...rcl.types import CheckedNode, DataT, EnumT, Env, Type
-from .translate import Translator
-from .types import dafny_ident, dafny_type, datatype_decl, datatypes_in
+from rclverify.lang import ast
+from rclverify.lang.printer import expr_to_rcl
+from rclverify.lang.types import CheckedNode, DataT, EnumT, Env, Type
+from rclverify.backends.dafny.translate import Translator
+from rclverify.backends.dafny.types import dafny_ident, dafny_type, datatype_decl, datatypes_in
 
 
 @dataclass(frozen=True)
@@ -141,7 +141,7 @@ def build_stub(env: Env, node: CheckedNode, *, ghost: bool = True, header: str =
     ``commands``       Dafny command lines shown in the stub's comment;
     ``implementation`` the workspace-relative implementation path shown there.
 
-    Raises :class:`~rclverify.plan.errors.PlanError` (located at the RCL
+    Raises :class:`~rclverify.model.plan.errors.PlanError` (located at the RCL
     construct) for types or formulas Dafny cannot express, e.g. an input of
     the empty type ``{}``.
     """

@@ -1,7 +1,7 @@
 """RCL formulas -> Dafny expressions (for ``requires``/``ensures`` clauses).
 
 The translation keeps the meaning the Z3 encoding gives a formula
-(:mod:`rclverify.logic.encode`, shared/DESIGN.md "Semantics"):
+(:mod:`rclverify.semantics.encode`, shared/DESIGN.md "Semantics"):
 
 * connectives: ``not`` -> ``!``, ``and`` -> ``&&``, ``or`` -> ``||``,
   ``->`` -> ``==>``, ``<=>`` -> ``<==>``; every compound sub-expression is
@@ -33,7 +33,7 @@ The translation keeps the meaning the Z3 encoding gives a formula
   value or constructor whose name is shadowed is qualified (``RadStat.red``).
 
 Quantifying over functions is rejected with a located
-:class:`~rclverify.plan.errors.PlanError`.
+:class:`~rclverify.model.plan.errors.PlanError`.
 """
 from __future__ import annotations
 
@@ -42,12 +42,12 @@ from dataclasses import dataclass, field
 from fractions import Fraction
 from typing import Any, Mapping, cast
 
-from ...plan.errors import PlanError
-from ...rcl import ast
-from ...rcl.errors import error
-from ...rcl.printer import is_type
-from ...rcl.typecheck import domain_type
-from ...rcl.types import (
+from rclverify.model.plan.errors import PlanError
+from rclverify.lang import ast
+from rclverify.lang.errors import error
+from rclverify.lang.printer import is_type
+from rclverify.lang.typecheck import domain_type
+from rclverify.lang.types import (
     BOOL,
     INTEGER,
     NATURAL,
@@ -66,8 +66,8 @@ from ...rcl.types import (
     numeric_join,
     qualified_base,
 )
-from ...values import decimal_text
-from .types import dafny_ident, dafny_type
+from rclverify.semantics.values import decimal_text
+from rclverify.backends.dafny.types import dafny_ident, dafny_type
 
 _BASE_NAMES = {"REAL": REAL, "INTEGER": INTEGER, "NATURAL": NATURAL, "BOOL": BOOL}
 _INT_LIT = re.compile(r"\A(\(?)(-?\d+)(\)?)\Z")

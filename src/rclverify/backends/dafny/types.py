@@ -27,18 +27,18 @@ A context type name used for an input or output becomes a Dafny type
 synonym (``type WayP = (real, real) -> nat``) so that the method signature
 reads like the RCL ``inputs(...)`` clause.
 
-Rejections are :class:`~rclverify.plan.errors.PlanError` (an
-:class:`~rclverify.rcl.errors.RclError`) located at the RCL construct.
+Rejections are :class:`~rclverify.model.plan.errors.PlanError` (an
+:class:`~rclverify.lang.errors.RclError`) located at the RCL construct.
 """
 from __future__ import annotations
 
 import re
 from typing import Iterable
 
-from ...plan.errors import PlanError
-from ...rcl import ast
-from ...rcl.errors import error
-from ...rcl.types import DataT, EmptyT, EnumT, FuncT, Scalar, SeqT, SetT, TupleT, Type
+from rclverify.model.plan.errors import PlanError
+from rclverify.lang import ast
+from rclverify.lang.errors import error
+from rclverify.lang.types import DataT, EmptyT, EnumT, FuncT, Scalar, SeqT, SetT, TupleT, Type
 
 #: Dafny keywords and built-in type names an RCL name must not collide with.
 RESERVED = frozenset("""

@@ -24,18 +24,18 @@ from typing import Any
 
 import z3
 
-from ...evidence.records import Evidence, Obligation, SourceRef, make_obligation_id
-from ...evidence.store import atomic_write_text
-from ...plan.errors import PlanError
-from ...rcl import ast
-from ...rcl.printer import expr_to_rcl
-from ..base import NodeTarget, Stopwatch, make_evidence
-from .config import ExperimentConfig, read_config
-from .consistency import check, figures_json
-from .criterion import evaluate
-from .figures import format_value
-from .plot import render_svg
-from .target import run_target, target_obligations
+from rclverify.records.records import Evidence, Obligation, SourceRef, make_obligation_id
+from rclverify.records.store import atomic_write_text
+from rclverify.model.plan.errors import PlanError
+from rclverify.lang import ast
+from rclverify.lang.printer import expr_to_rcl
+from rclverify.backends.base import NodeTarget, Stopwatch, make_evidence
+from rclverify.backends.experiment.config import ExperimentConfig, read_config
+from rclverify.backends.experiment.consistency import check, figures_json
+from rclverify.backends.experiment.criterion import evaluate
+from rclverify.backends.experiment.figures import format_value
+from rclverify.backends.experiment.plot import render_svg
+from rclverify.backends.experiment.target import run_target, target_obligations
 
 NAME = "experiment"
 KIND = "experiment"

@@ -12,7 +12,7 @@
       criterion: "worst <= tolerance"    # RCL expression over the figures
       timeout_ms: 10000                  # Z3 budget per evaluation
 
-Every mistake is a :class:`~rclverify.plan.errors.PlanError` located in the
+Every mistake is a :class:`~rclverify.model.plan.errors.PlanError` located in the
 plan (the criterion's own errors at the offending sub-expression).
 """
 from __future__ import annotations
@@ -21,14 +21,14 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Callable, Mapping
 
-from ...plan.errors import PlanError, plan_error
-from ...plan.yamlguard import read_yaml_text
-from ...rcl.source import read_text as read_source
-from ...rcl import ast
-from ...rcl.errors import RclError
-from ...rcl.parser import parse_formula
-from .criterion import CriterionError, allowed_dims, dimension
-from .figures import DataError, Figures, Quantity, load_summary, load_trials, quantity
+from rclverify.model.plan.errors import PlanError, plan_error
+from rclverify.model.plan.yamlguard import read_yaml_text
+from rclverify.lang.source import read_text as read_source
+from rclverify.lang import ast
+from rclverify.lang.errors import RclError
+from rclverify.lang.parser import parse_formula
+from rclverify.backends.experiment.criterion import CriterionError, allowed_dims, dimension
+from rclverify.backends.experiment.figures import DataError, Figures, Quantity, load_summary, load_trials, quantity
 
 Locate = Callable[..., ast.Loc]
 

@@ -1,6 +1,6 @@
 """The acceptance criterion: an RCL expression over an experiment's figures.
 
-The criterion is parsed with the RCL parser (:func:`rclverify.rcl.parser.parse_formula`),
+The criterion is parsed with the RCL parser (:func:`rclverify.lang.parser.parse_formula`),
 so its syntax and locations are those of any RCL formula in the plan.  Names
 it may use: the statistics ``count``, ``mean``, ``std``, ``best``,
 ``worst``; the plan entry's ``constants`` (``tolerance: 25 cm``); and, for
@@ -21,9 +21,9 @@ from typing import Mapping
 
 import z3
 
-from ...logic.query import budgeted_solver
-from ...rcl import ast
-from .figures import Figures, Quantity
+from rclverify.semantics.query import budgeted_solver
+from rclverify.lang import ast
+from rclverify.backends.experiment.figures import Figures, Quantity
 
 ARITH = {"+", "-", "*", "/"}
 LOGIC = {"and", "or", "->", "<=>"}

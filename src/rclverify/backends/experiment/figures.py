@@ -27,7 +27,7 @@ from dataclasses import dataclass
 from fractions import Fraction
 from typing import Any, Mapping
 
-from ...plan.yamlguard import safe_load_guarded
+from rclverify.model.plan.yamlguard import safe_load_guarded
 
 #: unit -> (dimension, factor to the base unit).  Base units: m, s.
 UNITS: Mapping[str, tuple[str, Fraction]] = {

@@ -9,7 +9,7 @@ import io
 import textwrap
 from typing import Mapping
 
-from .figures import BASE, Figures, Quantity
+from rclverify.backends.experiment.figures import BASE, Figures, Quantity
 
 
 def render_svg(fig: Figures, constants: Mapping[str, Quantity], title: str) -> str:

@@ -7,7 +7,7 @@ data file is one trial (one run and one answer: ``per run`` and ``per
 answer`` count the same); a trial missing the criterion is a violation.
 Its evidence counts the trials (each identified by the data file's sha256
 and its row, so one file named twice is counted once) and decides the
-target with :func:`rclverify.evidence.statistics.decide`.  A criterion over
+target with :func:`rclverify.records.statistics.decide`.  A criterion over
 summary statistics only says nothing of each trial: the target stays
 ``pending`` and says so.  The criterion's own obligation is unchanged: a
 trial that misses it still fails it.
@@ -18,10 +18,10 @@ import dataclasses
 import hashlib
 from typing import Any
 
-from ...evidence.records import Evidence, Obligation, make_obligation_id
-from ...evidence.statistics import count_runs, decide
-from ...plan.targets import entry_environment, entry_target
-from ..base import NodeTarget, Stopwatch, make_evidence
+from rclverify.records.records import Evidence, Obligation, make_obligation_id
+from rclverify.records.statistics import count_runs, decide
+from rclverify.model.plan.targets import entry_environment, entry_target
+from rclverify.backends.base import NodeTarget, Stopwatch, make_evidence
 
 
 def target_obligations(target: NodeTarget, criterion: Obligation) -> list[Obligation]:

@@ -8,6 +8,6 @@ Modules: :mod:`.lang` (language: AST, parser, printer; grammar ``imp.lark``),
 counterexamples), :mod:`.outline` (proof outlines), :mod:`.backend`
 (:class:`HoareBackend`).
 """
-from .backend import HoareBackend
+from rclverify.backends.hoare.backend import HoareBackend
 
 __all__ = ["HoareBackend"]

@@ -26,15 +26,15 @@ from typing import Any
 import jinja2
 import z3
 
-from ...evidence.records import Evidence, Obligation, SourceRef, make_obligation_id
-from ...evidence.store import atomic_write_text
-from ...logic.encode import EncodingError, Encoder
-from ...rcl.errors import RclError, error
-from ..base import NodeTarget, Stopwatch, make_evidence
-from .obligations import Conjunct, EncodedTriple, HoareConfig, conjuncts, encode_triple, load_program, statement
-from .outline import OutlineLine, outline_text, render_outline, term_printer
-from .solve import TripleResult, check_all
-from .wp import VC, WP, ProgramModel, main_vc, wp
+from rclverify.records.records import Evidence, Obligation, SourceRef, make_obligation_id
+from rclverify.records.store import atomic_write_text
+from rclverify.semantics.encode import EncodingError, Encoder
+from rclverify.lang.errors import RclError, error
+from rclverify.backends.base import NodeTarget, Stopwatch, make_evidence
+from rclverify.backends.hoare.obligations import Conjunct, EncodedTriple, HoareConfig, conjuncts, encode_triple, load_program, statement
+from rclverify.backends.hoare.outline import OutlineLine, outline_text, render_outline, term_printer
+from rclverify.backends.hoare.solve import TripleResult, check_all
+from rclverify.backends.hoare.wp import VC, WP, ProgramModel, main_vc, wp
 
 NAME = "hoare"
 KIND = "proof"
@@ -89,8 +89,8 @@ def prepare(target: NodeTarget, only: str | None = None) -> list[Prepared]:
     one with obligation id ``only`` when given: a run checks one triple and
     need not encode the others).
 
-    Raises :class:`~rclverify.plan.errors.PlanError` (bad entry) or
-    :class:`~rclverify.rcl.errors.RclError` (bad program, or a guarantee the
+    Raises :class:`~rclverify.model.plan.errors.PlanError` (bad entry) or
+    :class:`~rclverify.lang.errors.RclError` (bad program, or a guarantee the
     Z3 encoding cannot express, located in the RCL file).
     """
     cfg, program, types = load_program(target)
@@ -214,7 +214,7 @@ class HoareBackend:
             return make_evidence(target, obligation, status, tool="z3", tool_version=version, clock=clock,
                                  explanation=explanation, **kw)
 
-        # Rebuilt here, in the run's own fresh Z3 context (logic/world.py): a triple kept from the
+        # Rebuilt here, in the run's own fresh Z3 context (semantics/world.py): a triple kept from the
         # export would carry the Z3 state of another unit of work, and its counterexample could differ
         # between an incremental and a clean run.
         try:

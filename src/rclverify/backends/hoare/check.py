@@ -1,8 +1,8 @@
 """Static checking of a program of the hoare backend's language.
 
-Types are RCL's (:mod:`rclverify.rcl.types`): declarations name ``REAL``,
+Types are RCL's (:mod:`rclverify.lang.types`): declarations name ``REAL``,
 ``INTEGER``, ``NATURAL``, ``BOOL`` or a type of the RCL context, resolved
-through the checked :class:`~rclverify.rcl.types.Env`, so the program's
+through the checked :class:`~rclverify.lang.types.Env`, so the program's
 ``RadStat`` is the contract's ``RadStat`` (paper lines 1131-1140 declare it;
 lines 1482-1491 use its values).
 
@@ -29,12 +29,12 @@ import difflib
 from dataclasses import dataclass
 from typing import Iterable, Mapping
 
-from ...rcl import ast as rast
-from ...rcl.ast import Loc
-from ...rcl.errors import Diagnostic, RclError, error
-from ...rcl.types import (BOOL, INTEGER, NATURAL, REAL, DataT, EnumT, Env, FuncT, Scalar, Type, assignable,
+from rclverify.lang import ast as rast
+from rclverify.lang.ast import Loc
+from rclverify.lang.errors import Diagnostic, RclError, error
+from rclverify.lang.types import (BOOL, INTEGER, NATURAL, REAL, DataT, EnumT, Env, FuncT, Scalar, Type, assignable,
                           comparable, is_numeric, numeric_join)
-from . import lang
+from rclverify.backends.hoare import lang
 
 
 @dataclass(frozen=True)

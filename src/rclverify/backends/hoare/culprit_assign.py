@@ -20,7 +20,7 @@ from dataclasses import dataclass
 from fractions import Fraction
 from typing import Any, Mapping
 
-from .lang import Assign, Binary, BoolConst, If, Name, Num, Old, Program, Skip, Unary, While
+from rclverify.backends.hoare.lang import Assign, Binary, BoolConst, If, Name, Num, Old, Program, Skip, Unary, While
 
 #: Most statements executed in one run (a loop that runs longer names nothing).
 MAX_STEPS = 100_000

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from typing import Any, Sequence
 
-from .lang import If, Program, While
+from rclverify.backends.hoare.lang import If, Program, While
 
 
 def compared_constants(program: Program) -> list[Any]:

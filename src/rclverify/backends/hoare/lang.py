@@ -25,7 +25,7 @@ Public entry points
 ``parse_expression(text, file, line, col)`` -> :data:`Expr`
 ``to_text(program)`` -> ``str``; ``expr_text(expr)`` -> ``str``; ``stmt_header(stmt)`` -> ``str``
 
-Every parse error is an :class:`~rclverify.rcl.errors.RclError` located in the
+Every parse error is an :class:`~rclverify.lang.errors.RclError` located in the
 program file (``file:line:col``).
 """
 from __future__ import annotations
@@ -39,10 +39,10 @@ from typing import Any, Literal, Union
 from lark import Lark, Token, Transformer, v_args
 from lark.exceptions import UnexpectedCharacters, UnexpectedEOF, UnexpectedInput, UnexpectedToken, VisitError
 
-from ...rcl import ast as rast
-from ...rcl.ast import Loc
-from ...rcl.parser import describe_terminal, lark_cache_file
-from ...rcl.errors import RclError, error
+from rclverify.lang import ast as rast
+from rclverify.lang.ast import Loc
+from rclverify.lang.parser import describe_terminal, lark_cache_file
+from rclverify.lang.errors import RclError, error
 
 NOLOC = Loc()
 
@@ -216,7 +216,7 @@ _FRIENDLY = {"NAME": "a name", "NUMBER": "a number", "CMP_OP": "a comparison", "
 @lru_cache(maxsize=1)
 def _lark() -> Lark:
     grammar = resources.files("rclverify.backends.hoare").joinpath("imp.lark").read_text(encoding="utf-8")
-    # the analysed tables kept by lark as the RCL grammar's are (rcl/parser.py: lark_cache_file):
+    # the analysed tables kept by lark as the RCL grammar's are (lang/parser.py: lark_cache_file):
     # building them cost 0.11 s in every process that reads a Hoare program or diagnoses its triples
     return Lark(grammar, parser="lalr", start=["start", "expr"], propagate_positions=True,
                 maybe_placeholders=True, cache=lark_cache_file("hoare"))
@@ -464,7 +464,7 @@ def parse_program_file(path: str | Path, display: str | None = None) -> Program:
     path); defaults to ``str(path)``.  An unreadable file is an
     :class:`RclError` (code ``E-io``) located at line 1.
     """
-    from ...rcl.source import decode_text  # UTF-8 rules of every input (a BOM accepted, UTF-16/32 named)
+    from rclverify.lang.source import decode_text  # UTF-8 rules of every input (a BOM accepted, UTF-16/32 named)
     name = display if display is not None else str(path)
     try:
         data = Path(path).read_bytes()

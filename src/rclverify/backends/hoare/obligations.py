@@ -24,7 +24,7 @@ This module does that for any guarantee:
   triple *not checkable* by this backend: it is exported with a ``pending``
   reason and never discharged.
 
-Encoding uses the system's :class:`rclverify.logic.encode.Encoder`, so the
+Encoding uses the system's :class:`rclverify.semantics.encode.Encoder`, so the
 program's sorts and the contract's are the same Z3 sorts.
 """
 from __future__ import annotations
@@ -36,17 +36,17 @@ from typing import Any, Mapping
 
 import z3
 
-from ...logic.encode import Encoder
-from ...plan.errors import PlanError
-from ...rcl import ast
-from ...rcl.errors import RclError, error
-from ...rcl.printer import binding_to_rcl, expr_to_rcl
-from ...rcl.typecheck import domain_type
-from ...rcl.types import NATURAL, CheckedNode, FuncT, Type, assignable
-from ..base import NodeTarget
-from . import lang
-from .check import ProgramTypes, check_program, expr_type
-from .wp import ProgramModel
+from rclverify.semantics.encode import Encoder
+from rclverify.model.plan.errors import PlanError
+from rclverify.lang import ast
+from rclverify.lang.errors import RclError, error
+from rclverify.lang.printer import binding_to_rcl, expr_to_rcl
+from rclverify.lang.typecheck import domain_type
+from rclverify.lang.types import NATURAL, CheckedNode, FuncT, Type, assignable
+from rclverify.backends.base import NodeTarget
+from rclverify.backends.hoare import lang
+from rclverify.backends.hoare.check import ProgramTypes, check_program, expr_type
+from rclverify.backends.hoare.wp import ProgramModel
 
 
 DEFAULT_TIMEOUT_MS = 10_000

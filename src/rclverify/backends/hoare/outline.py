@@ -20,7 +20,7 @@ from typing import Callable, Mapping, Sequence
 
 import z3
 
-from .wp import OutlineItem
+from rclverify.backends.hoare.wp import OutlineItem
 
 _P_IMP, _P_OR, _P_AND, _P_NOT, _P_CMP, _P_SUM, _P_PROD, _P_NEG, _P_ATOM = range(1, 10)
 

@@ -21,10 +21,10 @@ from typing import Any, Mapping, Sequence
 
 import z3
 
-from ...logic.query import query_solver, solver_session
-from . import lang
-from .outline import z3_text
-from .wp import VC, ProgramModel, iter_terms
+from rclverify.semantics.query import query_solver, solver_session
+from rclverify.backends.hoare import lang
+from rclverify.backends.hoare.outline import z3_text
+from rclverify.backends.hoare.wp import VC, ProgramModel, iter_terms
 
 #: Statement executions allowed when replaying a counterexample (loops).
 MAX_STEPS = 100_000
@@ -206,7 +206,7 @@ def check_all(vcs: Sequence[VC], background: Sequence[z3.BoolRef], m: ProgramMod
               names: Mapping[str, str] | None = None) -> TripleResult:
     """Check every VC of a triple (``main`` first) and roll the answers up.
 
-    The VCs share one solver session (:func:`~rclverify.logic.query.solver_session`):
+    The VCs share one solver session (:func:`~rclverify.semantics.query.solver_session`):
     the same VCs in the same order wherever the triple is checked (a local
     run, a cluster worker), so the answers and counterexamples are too."""
     with solver_session():

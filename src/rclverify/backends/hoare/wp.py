@@ -22,7 +22,7 @@ partial correctness):
 Everything is a Z3 term: REAL -> Real, INTEGER/NATURAL -> Int, BOOL -> Bool,
 context enumerations and constructor sets -> the *same* Z3 sorts the RCL
 encoder uses (obtained through :class:`Sorts`, i.e.
-:class:`rclverify.logic.encode.Encoder`).  Variables are constants named after
+:class:`rclverify.semantics.encode.Encoder`).  Variables are constants named after
 them; ``old(x)`` is a constant named ``old(x)``; externs are uninterpreted
 functions.  Alongside the precondition the computation records a proof
 outline: the assertion that holds before every statement, as in the paper's
@@ -36,11 +36,11 @@ from typing import Any, Iterator, Literal, Protocol
 import z3
 from z3.z3 import _to_expr_ref  # the typed wrapper of a raw term (ArithRef, BoolRef ...)
 
-from ...logic.encode import apply_operator, widen
-from ...rcl.ast import Loc
-from ...rcl.types import NATURAL, Type
-from . import lang
-from .check import ProgramTypes, expr_type
+from rclverify.semantics.encode import apply_operator, widen
+from rclverify.lang.ast import Loc
+from rclverify.lang.types import NATURAL, Type
+from rclverify.backends.hoare import lang
+from rclverify.backends.hoare.check import ProgramTypes, expr_type
 
 
 class Sorts(Protocol):

@@ -1,6 +1,6 @@
 """The ``ajpf`` plan entry checked by SPIN on rclverify's exploration of the agent program.
 
-The ``ajpf`` backend (:mod:`rclverify.backends.ajpf.backend`) exports one
+The ``ajpf`` backend (:mod:`rclverify.backends.model_checking.ajpf.backend`) exports one
 obligation per guarantee instance and renders them as the numbered
 properties of ``agent.psl``; with ``model_checker: spin`` this module gives
 their evidence, in two stages as AJPF's own SPIN export does (paper lines
@@ -35,22 +35,22 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Mapping
 
-from ...evidence.records import Evidence, Obligation, SourceRef, make_obligation_id
-from ...evidence.store import atomic_write_text
-from ...rcl.ast import Loc
-from ...rcl.errors import RclError
-from ..ajpf import psl
-from ..base import NodeTarget, Stopwatch, make_evidence
-from . import spin
-from .graph import StateGraph
-from .identifiers import named_identifiers, numbers
-from .ltl import Propositions, parse_psl_text, read_psl_file
-from .promela import Claim, PromelaModel, build_model
-from .trail import counterexample, read_replay, summary
-from .vacuity import antecedents, check_vacuity, temporal_checks
+from rclverify.records.records import Evidence, Obligation, SourceRef, make_obligation_id
+from rclverify.records.store import atomic_write_text
+from rclverify.lang.ast import Loc
+from rclverify.lang.errors import RclError
+from rclverify.backends.model_checking.ajpf import psl
+from rclverify.backends.base import NodeTarget, Stopwatch, make_evidence
+from rclverify.backends.model_checking import spin
+from rclverify.backends.model_checking.graph import StateGraph
+from rclverify.backends.model_checking.identifiers import named_identifiers, numbers
+from rclverify.backends.model_checking.ltl import Propositions, parse_psl_text, read_psl_file
+from rclverify.backends.model_checking.promela import Claim, PromelaModel, build_model
+from rclverify.backends.model_checking.trail import counterexample, read_replay, summary
+from rclverify.backends.model_checking.vacuity import antecedents, check_vacuity, temporal_checks
 
 if TYPE_CHECKING:
-    from .environment import Environment
+    from rclverify.backends.model_checking.environment import Environment
 
 TOOL = "SPIN"
 CHECKERS = ("spin", "ajpf")
@@ -94,7 +94,7 @@ def read_spin_config(target: NodeTarget) -> SpinConfig:
     env = None
     if "environment" in cfg:
         try:
-            from .environment import environment_from_plan  # stage one
+            from rclverify.backends.model_checking.environment import environment_from_plan  # stage one
         except ImportError:  # an installation without stage one: its evidence says so (run_spin)
             environment_from_plan = None
         if environment_from_plan is not None:
@@ -178,7 +178,7 @@ def _graph(target: NodeTarget, model: str, cfg: SpinConfig, time_limit_s: float,
     key = hashlib.sha256(text + json.dumps([model, cfg.environment_raw, cfg.max_states, cfg.max_depth,
                                             time_limit_s, avoid], sort_keys=True, default=str).encode()).hexdigest()
     if key not in _GRAPHS:
-        from .explore import explore  # stage one
+        from rclverify.backends.model_checking.explore import explore  # stage one
         assert cfg.environment is not None  # run_spin checked it
         t0 = time.perf_counter()
         graph: StateGraph | RclError

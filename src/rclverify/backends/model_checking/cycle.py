@@ -28,11 +28,11 @@ import bisect
 from dataclasses import dataclass, replace
 from typing import Iterable, Iterator, NamedTuple
 
-from ..ajpf import psl
-from .environment import Environment
-from .gwendolen import MAX_TERM_DEPTH, Deed, Plan, Program, Term, as_psl, located
-from .identifiers import ALTERNATE, FRESH, fresh_identifier, numbers
-from .unify import Beliefs, BoundReached, Subst, ground, substitute, term_depth, unify
+from rclverify.backends.model_checking.ajpf import psl
+from rclverify.backends.model_checking.environment import Environment
+from rclverify.backends.model_checking.gwendolen import MAX_TERM_DEPTH, Deed, Plan, Program, Term, as_psl, located
+from rclverify.backends.model_checking.identifiers import ALTERNATE, FRESH, fresh_identifier, numbers
+from rclverify.backends.model_checking.unify import Beliefs, BoundReached, Subst, ground, substitute, term_depth, unify
 
 
 class TermSet(tuple[psl.Term, ...]):

@@ -37,9 +37,9 @@ from itertools import combinations
 from math import comb
 from typing import Any, Callable, Mapping
 
-from ...plan.errors import PlanError, plan_error
-from ...rcl.ast import Loc
-from ..ajpf import psl
+from rclverify.model.plan.errors import PlanError, plan_error
+from rclverify.lang.ast import Loc
+from rclverify.backends.model_checking.ajpf import psl
 
 KEYS = ("percepts", "after", "at_most", "at_least", "initial")
 #: Bound on the branches of one reaction (subsets of the declared percepts).
@@ -109,7 +109,7 @@ def environment_from_plan(raw: Mapping[str, Any], locate: Locate | None = None) 
     ``locate(*path)`` gives the plan location of the value at ``path`` inside
     the mapping (``locate("percepts", 1)``; ``locate()`` the mapping itself);
     without it messages are located at ``<environment>:1:1``.  Raises
-    :class:`~rclverify.plan.errors.PlanError` (``E-plan``) for an unknown
+    :class:`~rclverify.model.plan.errors.PlanError` (``E-plan``) for an unknown
     key, a missing or empty ``percepts``, a percept that is not a term, a
     variable in a percept, ``_`` in an initial percept, an ``after`` that is
     neither ``"action"`` nor a list of action names, an ``at_most`` that is

@@ -15,13 +15,13 @@ from collections import deque
 from pathlib import Path
 from typing import Iterable
 
-from ..ajpf import psl
-from .cycle import AgentState, Cycle, goals, initial_state
-from .environment import Environment
-from .graph import MentalState, StateGraph, Transition
-from .gwendolen import Program, as_psl, parse_file
-from .identifiers import ALTERNATE, FRESH, analyse, numbers
-from .unify import BoundReached
+from rclverify.backends.model_checking.ajpf import psl
+from rclverify.backends.model_checking.cycle import AgentState, Cycle, goals, initial_state
+from rclverify.backends.model_checking.environment import Environment
+from rclverify.backends.model_checking.graph import MentalState, StateGraph, Transition
+from rclverify.backends.model_checking.gwendolen import Program, as_psl, parse_file
+from rclverify.backends.model_checking.identifiers import ALTERNATE, FRESH, analyse, numbers
+from rclverify.backends.model_checking.unify import BoundReached
 
 
 def mental_state(state: AgentState) -> MentalState:

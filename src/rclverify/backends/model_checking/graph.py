@@ -5,7 +5,7 @@ Stage one (the Gwendolen interpreter and its explorer) produces a
 graph is a plain value: states, labelled transitions, and for each state the
 agent's mental state as ground terms, on which the property language's
 atoms (``B``, ``G``, ``D``, ``I``, ``ItD``, ``P``; see
-:mod:`rclverify.backends.ajpf.psl`) are evaluated by :meth:`StateGraph.holds`.
+:mod:`rclverify.backends.model_checking.ajpf.psl`) are evaluated by :meth:`StateGraph.holds`.
 
 Source of the atoms' meaning: AJPF's property specification language
 (paper lines 1366-1394): ``B(ag, f)`` the agent believes ``f``; ``G(ag, f)``
@@ -18,7 +18,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from ..ajpf import psl
+from rclverify.backends.model_checking.ajpf import psl
 
 
 @dataclass(frozen=True)

@@ -8,7 +8,7 @@ Source of the language: Dennis and Farwer, "Gwendolen: A BDI Language for
 Verifiable Agents" (2008), and the Gwendolen chapter of the MCAPL manual;
 docs/model-checking.md lists the subset this interpreter runs.
 
-Terms are :mod:`rclverify.backends.ajpf.psl` terms (``Sym``, ``Num``,
+Terms are :mod:`rclverify.backends.model_checking.ajpf.psl` terms (``Sym``, ``Num``,
 ``Compound``, ``Wild`` for ``_``) plus :class:`Var` for a variable; a string
 ``"text"`` is the symbol whose name is the quoted text.  A name with no
 arguments and the same name with ``()`` are one term (``Sym``).
@@ -29,11 +29,11 @@ from typing import Union, cast
 from lark import Lark, Token, Tree
 from lark.exceptions import UnexpectedCharacters, UnexpectedEOF, UnexpectedInput, UnexpectedToken
 
-from ...rcl.ast import Loc
-from ...rcl.errors import RclError, error
-from ...rcl.parser import lark_cache_file
-from ...rcl.source import read_text
-from ..ajpf import psl
+from rclverify.lang.ast import Loc
+from rclverify.lang.errors import RclError, error
+from rclverify.lang.parser import lark_cache_file
+from rclverify.lang.source import read_text
+from rclverify.backends.model_checking.ajpf import psl
 
 GOAL_TYPES = ("achieve", "perform")
 #: Deepest term the interpreter accepts in a program and builds while running
@@ -148,7 +148,7 @@ class Program:
 def _parser() -> Lark:
     grammar = (Path(__file__).with_name("gwendolen.lark")).read_text(encoding="utf-8")
     return Lark(grammar, parser="lalr", propagate_positions=True, maybe_placeholders=False,
-                cache=lark_cache_file("gwendolen"))  # the analysed tables kept by lark (rcl/parser.py)
+                cache=lark_cache_file("gwendolen"))  # the analysed tables kept by lark (lang/parser.py)
 
 
 def parse_file(path: Path, source_name: str) -> Program:
@@ -156,7 +156,7 @@ def parse_file(path: Path, source_name: str) -> Program:
 
     Raises :class:`GwendolenError` on a syntax error, an unsupported
     construct, an unknown goal type, a non-ground initial belief or goal;
-    :class:`~rclverify.rcl.errors.RclError` when the file cannot be read or
+    :class:`~rclverify.lang.errors.RclError` when the file cannot be read or
     is not UTF-8.
     """
     return parse_text(read_text(path, source_name), source_name)

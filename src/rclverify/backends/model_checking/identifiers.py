@@ -48,9 +48,9 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Iterable
 
-from ..ajpf import psl
-from .gwendolen import Program, Term, Var
-from .unify import unify
+from rclverify.backends.model_checking.ajpf import psl
+from rclverify.backends.model_checking.gwendolen import Program, Term, Var
+from rclverify.backends.model_checking.unify import unify
 
 ALTERNATE = "alternate"
 FRESH = "fresh"

@@ -1,6 +1,6 @@
 """AJPF property formulas as SPIN LTL, and property files read from disk.
 
-A :mod:`~rclverify.backends.ajpf.psl` formula becomes the text of a SPIN 6
+A :mod:`~rclverify.backends.model_checking.ajpf.psl` formula becomes the text of a SPIN 6
 ``ltl`` block (SPIN manual, "ltl": ``[]`` always, ``<>`` eventually, ``U``
 until, ``V`` release, ``!``, ``&&``, ``||``, ``->``, ``true``/``false``).
 Each proposition of the property language (``B(ag, f)``, ``G``, ``D``,
@@ -25,8 +25,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Iterable
 
-from ...plan.errors import plan_error
-from ..ajpf import psl
+from rclverify.model.plan.errors import plan_error
+from rclverify.backends.model_checking.ajpf import psl
 
 Atom = psl.Modal | psl.Percept
 

@@ -44,9 +44,9 @@ from typing import Any, Mapping, Sequence
 
 from jinja2 import Environment, PackageLoader, StrictUndefined
 
-from ..ajpf import psl
-from .graph import StateGraph
-from .ltl import Propositions, atom_text, to_spin
+from rclverify.backends.model_checking.ajpf import psl
+from rclverify.backends.model_checking.graph import StateGraph
+from rclverify.backends.model_checking.ltl import Propositions, atom_text, to_spin
 
 #: Most states of one ``if`` inside a transition's ``d_step``.
 LEAF = 16

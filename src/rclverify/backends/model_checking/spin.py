@@ -45,9 +45,9 @@ import time
 from dataclasses import dataclass
 from pathlib import Path
 
-from ...cache.keys import user_cache_dir
-from ...rcl.ast import Loc
-from ..bounded import forget_directory, register_directory, run_bounded, temporary_directory
+from rclverify.core.cache.keys import user_cache_dir
+from rclverify.lang.ast import Loc
+from rclverify.backends.bounded import forget_directory, register_directory, run_bounded, temporary_directory
 
 #: Install command shown when SPIN or gcc is missing (Debian/Ubuntu).
 INSTALL = "apt-get install spin gcc"

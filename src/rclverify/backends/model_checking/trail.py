@@ -17,8 +17,8 @@ import re
 from dataclasses import dataclass
 from typing import Any, Sequence
 
-from .graph import StateGraph
-from .ltl import Propositions, atom_text
+from rclverify.backends.model_checking.graph import StateGraph
+from rclverify.backends.model_checking.ltl import Propositions, atom_text
 
 _STEP = re.compile(r"^\s*@([TS])\s+(\d+)\s*$")
 CYCLE_MARK = "START OF CYCLE"

@@ -17,8 +17,8 @@ from __future__ import annotations
 
 from typing import Iterator, Sequence
 
-from ..ajpf import psl
-from .gwendolen import MAX_TERM_DEPTH, Rule, Term, Var, as_psl, located
+from rclverify.backends.model_checking.ajpf import psl
+from rclverify.backends.model_checking.gwendolen import MAX_TERM_DEPTH, Rule, Term, Var, as_psl, located
 
 #: How deep reasoning rules may call each other before the query is refused.
 MAX_RULE_DEPTH = 64

@@ -34,8 +34,8 @@ A vacuous pass is reported ``inconclusive`` (``vacuous``), never
 from __future__ import annotations
 
 from dataclasses import dataclass
-from ..ajpf import psl
-from .graph import StateGraph
+from rclverify.backends.model_checking.ajpf import psl
+from rclverify.backends.model_checking.graph import StateGraph
 
 _TEMPORAL = (psl.Always, psl.Eventually, psl.Until, psl.Release)
 

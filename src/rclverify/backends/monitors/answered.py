@@ -19,8 +19,8 @@ from typing import Any, Iterator
 
 import numpy as np
 
-from ...traces.events import Event
-from ...traces.questions import Question
+from rclverify.traces.events import Event
+from rclverify.traces.questions import Question
 
 
 class AnsweredRun:

@@ -22,23 +22,23 @@ from typing import Any, Callable, Iterable, Iterator, Mapping
 
 import jinja2
 
-from ...evidence.records import Evidence, Obligation, SourceRef, make_obligation_id
-from ...evidence.store import atomic_write_text
-from ...rcl.printer import expr_to_rcl
-from ...rcl.types import Checked, CheckedNode
-from ...traces import TraceError, read_trace
-from ...traces.bag import custom_types
-from ..base import NodeTarget, Stopwatch, make_evidence
-from .check import check_trace
-from .config import ConfigError, MonitorConfig, load_mapping
-from .deadlines import DeadlineMonitor, DeadlineResult, deadline_status, has_deadlines
-from .declarations import DeclarationMonitor, add_periods, has_declarations, with_declarations
-from .judged import Counted, Heard, explain, not_judged
-from .log_calls import LogCalls, merge_deadlines
-from .periods import PeriodMonitor, has_periods, with_periods
-from .rml import Spec, rml_id, translate
-from .runset import run_counts, run_runset, runset_obligations
-from .summary import monitoring_details, summary_line, tool_versions, verdict_status
+from rclverify.records.records import Evidence, Obligation, SourceRef, make_obligation_id
+from rclverify.records.store import atomic_write_text
+from rclverify.lang.printer import expr_to_rcl
+from rclverify.lang.types import Checked, CheckedNode
+from rclverify.traces import TraceError, read_trace
+from rclverify.traces.bag import custom_types
+from rclverify.backends.base import NodeTarget, Stopwatch, make_evidence
+from rclverify.backends.monitors.check import check_trace
+from rclverify.backends.monitors.config import ConfigError, MonitorConfig, load_mapping
+from rclverify.backends.monitors.deadlines import DeadlineMonitor, DeadlineResult, deadline_status, has_deadlines
+from rclverify.backends.monitors.declarations import DeclarationMonitor, add_periods, has_declarations, with_declarations
+from rclverify.backends.monitors.judged import Counted, Heard, explain, not_judged
+from rclverify.backends.monitors.log_calls import LogCalls, merge_deadlines
+from rclverify.backends.monitors.periods import PeriodMonitor, has_periods, with_periods
+from rclverify.backends.monitors.rml import Spec, rml_id, translate
+from rclverify.backends.monitors.runset import run_counts, run_runset, runset_obligations
+from rclverify.backends.monitors.summary import monitoring_details, summary_line, tool_versions, verdict_status
 
 NAME = "monitors"
 KIND = "monitoring"
@@ -133,7 +133,7 @@ class MonitorsBackend:
                                 c.get("tolerance"))
         except ConfigError as exc:
             if exc.located:  # an error inside the mapping file: located there
-                from ...plan.errors import plan_error
+                from rclverify.model.plan.errors import plan_error
                 raise plan_error(*exc.located) from None
             if exc.path:
                 raise target.config_error(str(exc), *exc.path) from None

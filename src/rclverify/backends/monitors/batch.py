@@ -41,16 +41,16 @@ from typing import Any, Callable, Iterable, Mapping
 
 import numpy as np
 
-from ...logic.floatsem import Tolerance
-from ...rcl.types import Checked, CheckedNode
-from ...traces.events import Event
-from ...traces.mapping import TopicRule
-from ...traces.questions import KEPT, Question
-from .answered import AnsweredRun, RecentOutput
-from .columns import ColumnCompiler, Unsupported, io_kind, seed
-from .engine import NodeMonitor
-from .rows import BlockRows, EventRows, chunks, rows_of
-from .verdicts import NodeResult, Verdict
+from rclverify.semantics.floatsem import Tolerance
+from rclverify.lang.types import Checked, CheckedNode
+from rclverify.traces.events import Event
+from rclverify.traces.mapping import TopicRule
+from rclverify.traces.questions import KEPT, Question
+from rclverify.backends.monitors.answered import AnsweredRun, RecentOutput
+from rclverify.backends.monitors.columns import ColumnCompiler, Unsupported, io_kind, seed
+from rclverify.backends.monitors.engine import NodeMonitor
+from rclverify.backends.monitors.rows import BlockRows, EventRows, chunks, rows_of
+from rclverify.backends.monitors.verdicts import NodeResult, Verdict
 
 #: Events read per chunk: the columns held at once.
 CHUNK = 16384

@@ -11,13 +11,13 @@ from __future__ import annotations
 
 from typing import Callable, Iterable, Mapping
 
-from ...logic.floatsem import Tolerance
-from ...rcl.types import Checked, CheckedNode
-from ...traces.events import Event
-from ...traces.mapping import TopicRule
-from .batch import check_batch
-from .engine import NodeMonitor
-from .verdicts import LINK_TOPICS, VERDICTS, NodeResult, Verdict, link_of, producers
+from rclverify.semantics.floatsem import Tolerance
+from rclverify.lang.types import Checked, CheckedNode
+from rclverify.traces.events import Event
+from rclverify.traces.mapping import TopicRule
+from rclverify.backends.monitors.batch import check_batch
+from rclverify.backends.monitors.engine import NodeMonitor
+from rclverify.backends.monitors.verdicts import LINK_TOPICS, VERDICTS, NodeResult, Verdict, link_of, producers
 
 
 def check_trace(checked: Checked, nodes: Iterable[CheckedNode], events: Iterable[Event],

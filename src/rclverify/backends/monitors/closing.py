@@ -22,12 +22,12 @@ import math
 from collections import deque
 from typing import TYPE_CHECKING, Any, Mapping
 
-from ...logic.floatsem import Judgement
-from ...rcl import ast
-from ...rcl.printer import expr_to_rcl
-from ...traces.events import Event, to_ns
-from ...traces.questions import Question
-from .verdicts import WEAK as _WEAK, in_all, link_of, names, producers
+from rclverify.semantics.floatsem import Judgement
+from rclverify.lang import ast
+from rclverify.lang.printer import expr_to_rcl
+from rclverify.traces.events import Event, to_ns
+from rclverify.traces.questions import Question
+from rclverify.backends.monitors.verdicts import WEAK as _WEAK, in_all, link_of, names, producers
 
 
 class Closing:
@@ -282,7 +282,7 @@ class Closing:
     def _false_whatever_missing(self, k: int, values: Mapping[str, Any]) -> bool:
         import z3
 
-        from ...logic.concrete import false_whatever_the_rest
+        from rclverify.semantics.concrete import false_whatever_the_rest
         known = {q: v for q, v in values.items() if v is not None}
         try:
             return false_whatever_the_rest(self.guarantees[k - 1], self.checked, self.node, known)

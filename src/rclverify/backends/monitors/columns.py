@@ -2,7 +2,7 @@
 
 The offline batch path (:mod:`.batch`) asks, for each row (one question and
 its answer), whether a quantifier-free formula holds **in exact
-arithmetic** (the first semantics of :func:`rclverify.logic.floatsem.judge`,
+arithmetic** (the first semantics of :func:`rclverify.semantics.floatsem.judge`,
 whose answer "true in exact arithmetic" is ``Judgement(True, "exact")``).
 It evaluates the formula in float64 with numpy and carries, for every
 numeric term, an upper bound of its distance to the exact rational value
@@ -40,9 +40,9 @@ from typing import Any, Callable, Mapping
 
 import numpy as np
 
-from ...rcl import ast
-from ...rcl import types as T
-from ...rcl.types import Checked, CheckedNode
+from rclverify.lang import ast
+from rclverify.lang import types as T
+from rclverify.lang.types import Checked, CheckedNode
 
 _REL = 2.0 ** -52  # relative bound of one rounding (twice the unit roundoff)
 _SLACK_REL = 2.0 ** -48

@@ -12,7 +12,7 @@ Mapping file: ``msg_dirs`` (directories holding ``<pkg>/msg/<Type>.msg``),
 ``topics`` (:func:`rclverify.traces.mapping.load_rules`), optional
 ``ros_version`` (``ros1``/``ros2``, default ``ros2``), ``horizon``,
 ``tolerance`` (``{abs, rel, ulps}``: recorded numbers this close are equal
-to the comparisons, :class:`rclverify.logic.floatsem.Tolerance`), ``skew``
+to the comparisons, :class:`rclverify.semantics.floatsem.Tolerance`), ``skew``
 (seconds, default 0.02: how far apart two messages on different topics may be
 stamped in the other order than they were published, :mod:`.skew`) and
 ``ros_nodes`` (contract node -> ``{name, package, path}`` of the ROS node
@@ -32,10 +32,10 @@ from typing import Any, Mapping
 
 import yaml
 
-from ...logic.floatsem import Tolerance, ToleranceError, parse_tolerance
-from ...traces.mapping import RuleError, TopicRule, load_rules
-from ...plan.yamlguard import read_yaml_text, safe_load_guarded
-from .skew import DEFAULT_SKEW_S, parse_skew
+from rclverify.semantics.floatsem import Tolerance, ToleranceError, parse_tolerance
+from rclverify.traces.mapping import RuleError, TopicRule, load_rules
+from rclverify.model.plan.yamlguard import read_yaml_text, safe_load_guarded
+from rclverify.backends.monitors.skew import DEFAULT_SKEW_S, parse_skew
 
 DEFAULT_MAPPING = "backends/monitors/mapping.yaml"
 DEFAULT_HORIZON = 5.0
@@ -168,8 +168,8 @@ def load_mapping(root: Path, rel: str | None, horizon: Any = None, traces: Any =
 def _at(path: Path, rel: str, keys: tuple[Any, ...]) -> str:
     """``line:col`` of the value at ``keys`` in the mapping file (``1:1``
     when it cannot be found)."""
-    from ...plan.errors import PlanError
-    from ...plan.yamlguard import load_located
+    from rclverify.model.plan.errors import PlanError
+    from rclverify.model.plan.yamlguard import load_located
     try:
         _, locs = load_located(read_yaml_text(path, rel), rel)
     except (PlanError, yaml.YAMLError):
@@ -182,13 +182,13 @@ def _at(path: Path, rel: str, keys: tuple[Any, ...]) -> str:
 
 def _check_msg_dirs(root: Path, rel: str, path: Path, dirs: list[str]) -> None:
     """Refuse message directories outside the workspace (the rules of
-    :mod:`rclverify.plan.paths`): the ``.msg`` files are inputs of the
+    :mod:`rclverify.model.plan.paths`): the ``.msg`` files are inputs of the
     evidence and belong in the assessor's bundle.  Raises ``PlanError``
     located at the directory in the mapping file."""
-    from ...plan.errors import PlanError, plan_error
-    from ...plan.paths import escape_reason
-    from ...plan.yamlguard import load_located
-    from ...rcl.errors import Diagnostic
+    from rclverify.model.plan.errors import PlanError, plan_error
+    from rclverify.model.plan.paths import escape_reason
+    from rclverify.model.plan.yamlguard import load_located
+    from rclverify.lang.errors import Diagnostic
     bad = [(i, d, why) for i, d in enumerate(dirs) for why in [escape_reason(root, d)] if why is not None]
     if not bad:
         return

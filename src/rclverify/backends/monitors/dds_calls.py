@@ -45,13 +45,13 @@ import dataclasses
 from collections import OrderedDict
 from typing import Any, Callable, Iterable, Mapping
 
-from ...rcl import ast
-from ...rcl.types import Checked, CheckedNode
-from ...traces.events import Event
-from ...traces.mapping import TopicRule
-from .check import NodeMonitor, NodeResult, Verdict
-from .deadlines import DeadlineMonitor, DeadlineResult, DeadlineVerdict
-from .verdicts import LINK_TOPICS
+from rclverify.lang import ast
+from rclverify.lang.types import Checked, CheckedNode
+from rclverify.traces.events import Event
+from rclverify.traces.mapping import TopicRule
+from rclverify.backends.monitors.check import NodeMonitor, NodeResult, Verdict
+from rclverify.backends.monitors.deadlines import DeadlineMonitor, DeadlineResult, DeadlineVerdict
+from rclverify.backends.monitors.verdicts import LINK_TOPICS
 
 #: the ``topic`` of a call's log lines: no contract names it; ``rclverify monitor LOG`` replays them (:func:`replay`)
 CALL_LOG_TOPIC = "rclverify/call"

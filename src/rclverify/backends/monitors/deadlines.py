@@ -1,7 +1,7 @@
 """Deadlines of timed guarantees checked against message stamps (issue 33).
 
 A guarantee ``G(phi) triggered by in.x within d`` (rule D1,
-docs/architecture.md) is monitored per trigger event: the event on ``in.x``
+docs/decisions.md) is monitored per trigger event: the event on ``in.x``
 with stamp ``t`` opens an obligation due at ``t + d``; the first later
 message on an output ``phi`` mentions, with ``phi`` true on the trigger's
 inputs and the outputs published since the trigger (an output current
@@ -23,7 +23,7 @@ decided) gets no deadline verdict and is counted apart
 (:attr:`DeadlineResult.unaccepted`): a node is not obliged to answer an
 input its contract does not accept, so a ``true`` there would be evidence
 of nothing and a ``false`` a false alarm.  Formulas are judged as the
-untimed monitor judges them (:func:`rclverify.logic.floatsem.judge`: exact,
+untimed monitor judges them (:func:`rclverify.semantics.floatsem.judge`: exact,
 the node's double arithmetic, a declared tolerance).
 
 A ``triggered by`` without ``within`` is checked the same way with the
@@ -50,17 +50,17 @@ from collections import deque
 from dataclasses import dataclass, field
 from typing import Any, Callable, Iterable, Mapping
 
-from ...logic.floatsem import Tolerance, judge
-from ...rcl import ast
-from ...rcl.printer import expr_to_rcl
-from ...rcl.timing import seconds
-from ...rcl.types import Checked, CheckedNode
-from ...rcl.walk import subexpressions
-from ...traces.events import Event, to_ns
-from ...traces.mapping import MappingError, TopicRule, map_value, rule_for
-from ...traces.questions import Question, QuestionStream
-from .online import header_stamp, header_stamp_ns
-from .verdicts import LINK_TOPICS, names
+from rclverify.semantics.floatsem import Tolerance, judge
+from rclverify.lang import ast
+from rclverify.lang.printer import expr_to_rcl
+from rclverify.lang.timing import seconds
+from rclverify.lang.types import Checked, CheckedNode
+from rclverify.lang.walk import subexpressions
+from rclverify.traces.events import Event, to_ns
+from rclverify.traces.mapping import MappingError, TopicRule, map_value, rule_for
+from rclverify.traces.questions import Question, QuestionStream
+from rclverify.backends.monitors.online import header_stamp, header_stamp_ns
+from rclverify.backends.monitors.verdicts import LINK_TOPICS, names
 
 DEADLINE_VERDICTS = ("true", "currently_false", "false")
 #: Why a trigger got no deadline verdict (:attr:`DeadlineResult.unaccepted`).

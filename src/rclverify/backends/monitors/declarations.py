@@ -12,7 +12,7 @@ contract reads (its assumption or a guarantee: a message no clause reads
 cannot oblige an answer, e.g. an action's feedback to a client that only
 sends goals), and the node *answers* at that step when one of its output
 messages comes after it and before its next step.  The assumption is judged on the inputs current at the event
-(:func:`rclverify.logic.floatsem.judge`, as the untimed monitor judges it);
+(:func:`rclverify.semantics.floatsem.judge`, as the untimed monitor judges it);
 a step at which it holds is *accepted*.
 
 * ``initially( F )``: F judged on the first value each output it reads is
@@ -27,7 +27,7 @@ a step at which it holds is *accepted*.
   ``pending``.
 * ``progress( within K steps )``: never K + 1 accepted steps in a row
   unanswered (a step whose input is not accepted ends the row, as the
-  composed system's ``waiting`` counter does, requirements/transition.py):
+  composed system's ``waiting`` counter does, calculus/requirements/transition.py):
   ``false`` at the input event that ends the (K + 1)-th unanswered step;
   ``true`` when at least one accepted step was seen and none broke the
   bound; no accepted step: ``pending`` (the run exercised nothing).
@@ -44,24 +44,24 @@ a step at which it holds is *accepted*.
 
 The verdicts map to evidence statuses as the monitors' do (``true``
 discharged, ``false`` failed); each row names the declaration's source so
-a requirement resting on it (requirements/rollup.py) can read it.
+a requirement resting on it (calculus/requirements/rollup.py) can read it.
 """
 from __future__ import annotations
 
 from dataclasses import dataclass, field
 from typing import Any, Iterable, Mapping
 
-from ...logic.floatsem import Tolerance, judge
-from ...rcl import ast
-from ...rcl.liveness import _steps, period_seconds
-from ...rcl.printer import expr_to_rcl
-from ...rcl.types import Checked, CheckedNode
-from ...rcl.walk import subexpressions
-from ...traces.events import Event
-from ...traces.mapping import MappingError, TopicRule, map_value, rule_for
-from .deadlines import event_stamp, topic_bindings
-from .periods import PeriodResult
-from .verdicts import names
+from rclverify.semantics.floatsem import Tolerance, judge
+from rclverify.lang import ast
+from rclverify.lang.liveness import _steps, period_seconds
+from rclverify.lang.printer import expr_to_rcl
+from rclverify.lang.types import Checked, CheckedNode
+from rclverify.lang.walk import subexpressions
+from rclverify.traces.events import Event
+from rclverify.traces.mapping import MappingError, TopicRule, map_value, rule_for
+from rclverify.backends.monitors.deadlines import event_stamp, topic_bindings
+from rclverify.backends.monitors.periods import PeriodResult
+from rclverify.backends.monitors.verdicts import names
 
 #: a first value that did not map (a missing field, NaN): an ``initially`` on it is undecided
 _UNMAPPED = object()

@@ -35,19 +35,19 @@ from __future__ import annotations
 from collections import deque
 from typing import Any, Callable, Mapping
 
-from ...logic.floatsem import Judgement, Tolerance, holds_in, judge
-from ...logic.judges import FormulaJudge
-from ...rcl.printer import expr_to_rcl
-from ...rcl.types import Checked, CheckedNode
-from ...traces.events import Event
-from ...traces.mapping import MappingError, TopicRule, initial_value, rule_for, value_mapper
-from ...traces.questions import Question, QuestionStream
-from ...values import render
-from .closing import Closing
-from .late import Late
-from .needs_answer import answer_decides
-from .outcome import Outcome, combine, skew_reason
-from .verdicts import WEAK as _WEAK, LINK_TOPICS, NodeResult, Verdict, in_all, names, reads
+from rclverify.semantics.floatsem import Judgement, Tolerance, holds_in, judge
+from rclverify.semantics.judges import FormulaJudge
+from rclverify.lang.printer import expr_to_rcl
+from rclverify.lang.types import Checked, CheckedNode
+from rclverify.traces.events import Event
+from rclverify.traces.mapping import MappingError, TopicRule, initial_value, rule_for, value_mapper
+from rclverify.traces.questions import Question, QuestionStream
+from rclverify.semantics.values import render
+from rclverify.backends.monitors.closing import Closing
+from rclverify.backends.monitors.late import Late
+from rclverify.backends.monitors.needs_answer import answer_decides
+from rclverify.backends.monitors.outcome import Outcome, combine, skew_reason
+from rclverify.backends.monitors.verdicts import WEAK as _WEAK, LINK_TOPICS, NodeResult, Verdict, in_all, names, reads
 
 _NO_RULE = TopicRule()  # the rule of a topic the mapping does not name
 _NEVER = float("inf")
@@ -68,7 +68,7 @@ class NodeMonitor(Closing, Late):
     ``skew`` attributes, when it has them, as the mapping file's rules do,
     are the declared tolerance and the transport skew in seconds);
     ``horizon`` is in seconds; ``tolerance`` overrides the rules'.  Every
-    formula is judged by :func:`rclverify.logic.floatsem.judge` (exact,
+    formula is judged by :func:`rclverify.semantics.floatsem.judge` (exact,
     double, tolerance).  The node's topics are its ``topics(...)`` and the
     parts of its service and action links (:data:`LINK_TOPICS`)."""
 
@@ -195,7 +195,7 @@ class NodeMonitor(Closing, Late):
     def _judge(self, k: Any, values: Mapping[str, Any]) -> Judgement:
         """The judgement of guarantee ``k`` (``("A", j)``: assumption ``j``) on
         ``values``: the compiled code where it decides alone, else
-        :func:`~rclverify.logic.floatsem.judge`, remembered per (formula,
+        :func:`~rclverify.semantics.floatsem.judge`, remembered per (formula,
         values of the variables it reads)."""
         hit = self._judges[k].quick(values)
         if hit is not None:

@@ -7,7 +7,7 @@ topic's ROS type (``topics(geometry_msgs/Twist cmd_vel matches(...))``, a
 service's request and response, an action's goal, feedback and result) and
 the type is known (the mapping's ``msg_dirs``, or the standard types of
 rosbags' store, which the bag reader uses too), every entry is followed
-through the definitions (:func:`rclverify.ros.interfaces.field_path`, the
+through the definitions (:func:`rclverify.ros.extract.interfaces.field_path`, the
 ROS grounding's reader): a field that does not exist, a message where a
 number is read, or an array read without an index is one located error at
 the entry in the mapping file (``mapping.yaml:7:22: error: topic cmd_vel:
@@ -20,13 +20,13 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any, Mapping, Sequence
 
-from ...plan.errors import plan_error
-from ...plan.yamlguard import load_located, read_yaml_text
-from ...rcl.errors import Diagnostic
-from ...rcl.types import Checked
-from ...ros.interfaces import BASE_TYPES, TypeTable, field_path
-from ...ros.model import canon_type, short_type
-from .verdicts import LINK_TOPICS
+from rclverify.model.plan.errors import plan_error
+from rclverify.model.plan.yamlguard import load_located, read_yaml_text
+from rclverify.lang.errors import Diagnostic
+from rclverify.lang.types import Checked
+from rclverify.ros.extract.interfaces import BASE_TYPES, TypeTable, field_path
+from rclverify.ros.extract.model import canon_type, short_type
+from rclverify.backends.monitors.verdicts import LINK_TOPICS
 
 
 def topic_types(checked: Checked) -> dict[str, str]:

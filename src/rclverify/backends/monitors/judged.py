@@ -33,8 +33,8 @@ from collections import Counter
 from dataclasses import dataclass, field
 from typing import Any, Iterable, Iterator, Mapping
 
-from ...rcl.types import CheckedNode
-from .verdicts import LINK_TOPICS
+from rclverify.lang.types import CheckedNode
+from rclverify.backends.monitors.verdicts import LINK_TOPICS
 
 REASONS = ("nothing heard", "type refused", "not decoded", "not paired", "no answer", "no verdict")
 #: the parts of a link that open a call (a service's request, an action's goal) and that answer one

@@ -48,8 +48,8 @@ from __future__ import annotations
 import bisect
 from typing import TYPE_CHECKING, Any
 
-from ...traces.events import Event
-from ...traces.questions import Question
+from rclverify.traces.events import Event
+from rclverify.traces.questions import Question
 
 
 class Late:

@@ -23,14 +23,14 @@ from __future__ import annotations
 
 from typing import Any, Iterable, Iterator, Mapping
 
-from ...rcl.types import Checked, CheckedNode
-from ...traces.events import Event, TraceError
-from ...traces.mapping import TopicRule
-from .dds_calls import CALL_LOG_TOPIC, CallBook, replay_line
-from .deadlines import DeadlineResult, deadline_status
-from .judged import count_call_line
-from .summary import verdict_status
-from .verdicts import NodeResult
+from rclverify.lang.types import Checked, CheckedNode
+from rclverify.traces.events import Event, TraceError
+from rclverify.traces.mapping import TopicRule
+from rclverify.backends.monitors.dds_calls import CALL_LOG_TOPIC, CallBook, replay_line
+from rclverify.backends.monitors.deadlines import DeadlineResult, deadline_status
+from rclverify.backends.monitors.judged import count_call_line
+from rclverify.backends.monitors.summary import verdict_status
+from rclverify.backends.monitors.verdicts import NodeResult
 
 
 class LogCalls:

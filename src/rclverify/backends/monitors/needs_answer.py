@@ -38,9 +38,9 @@ from typing import Any, Iterable, Mapping
 
 import z3
 
-from ...logic.encode import Encoder
-from ...rcl import ast
-from ...rcl.types import BOOL, INTEGER, NATURAL, REAL, Checked, CheckedNode, EnumT
+from rclverify.semantics.encode import Encoder
+from rclverify.lang import ast
+from rclverify.lang.types import BOOL, INTEGER, NATURAL, REAL, Checked, CheckedNode, EnumT
 
 #: Z3's budget for each of the two queries of a guarantee (ms).
 QUERY_MS = 500

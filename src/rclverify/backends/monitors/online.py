@@ -33,11 +33,11 @@ import math
 from dataclasses import dataclass, field
 from typing import Any, Callable, Iterable, Mapping
 
-from ...logic.floatsem import Tolerance
-from ...rcl.types import Checked, CheckedNode
-from ...traces.events import Event, header_stamp, header_stamp_ns
-from ...traces.mapping import TopicRule
-from .check import NodeMonitor, NodeResult, Verdict
+from rclverify.semantics.floatsem import Tolerance
+from rclverify.lang.types import Checked, CheckedNode
+from rclverify.traces.events import Event, header_stamp, header_stamp_ns
+from rclverify.traces.mapping import TopicRule
+from rclverify.backends.monitors.check import NodeMonitor, NodeResult, Verdict
 
 
 @dataclass

@@ -13,8 +13,8 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Any, Sequence
 
-from ...traces.events import Event
-from ...traces.questions import Question
+from rclverify.traces.events import Event
+from rclverify.traces.questions import Question
 
 #: What one reading found: ``violated`` (a guarantee false), ``inconclusive``
 #: (undecided), ``satisfied`` (every guarantee it decided true), ``none``

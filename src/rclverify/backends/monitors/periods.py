@@ -30,10 +30,10 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Any, Iterable
 
-from ...rcl.liveness import period_seconds
-from ...rcl.types import CheckedNode
-from ...traces.events import Event
-from .deadlines import event_stamp, topic_bindings
+from rclverify.lang.liveness import period_seconds
+from rclverify.lang.types import CheckedNode
+from rclverify.traces.events import Event
+from rclverify.backends.monitors.deadlines import event_stamp, topic_bindings
 
 
 #: The slack of a gap against its period (s): the resolution of an epoch stamp read as a float.

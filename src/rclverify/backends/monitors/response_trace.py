@@ -7,7 +7,7 @@ out; a trigger still pending when the trace ends is ``currently_false`` (a
 longer run may answer it); otherwise ``true`` (evidence, not a proof).  A
 response undecided at a step may answer every trigger pending there: none
 of them is ever ``false`` (the verdict is undecided at that step).
-The rule is the composed system's (:mod:`rclverify.requirements.response`):
+The rule is the composed system's (:mod:`rclverify.calculus.requirements.response`):
 a P at step i needs Q at some step i..i+N (``next``: Q at step i+1).
 The unbounded ``always (P -> eventually Q)`` is N = infinity: never
 ``false`` on a finite run, ``currently_false`` while a P waits.

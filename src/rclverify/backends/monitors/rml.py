@@ -35,11 +35,11 @@ import re
 from dataclasses import dataclass, field
 from typing import Any, Mapping
 
-from ...rcl import ast
-from ...rcl import types as T
-from ...rcl.printer import expr_to_rcl
-from ...rcl.types import Checked, CheckedNode
-from ...traces.mapping import TopicRule
+from rclverify.lang import ast
+from rclverify.lang import types as T
+from rclverify.lang.printer import expr_to_rcl
+from rclverify.lang.types import Checked, CheckedNode
+from rclverify.traces.mapping import TopicRule
 
 #: Words the RML grammar reserves (RML.g4 and its later versions).
 KEYWORDS = frozenset({"not", "matches", "with", "empty", "all", "let", "var", "if", "else", "abs", "true",

@@ -21,8 +21,8 @@ from typing import Any, Iterable, Iterator, Mapping, Sequence
 
 import numpy as np
 
-from ...traces.events import Event, taken
-from .columns import column, field_values
+from rclverify.traces.events import Event, taken
+from rclverify.backends.monitors.columns import column, field_values
 
 _TOPIC, _TIME, _STAMP, _FIELDS = attrgetter("topic"), attrgetter("time"), attrgetter("stamp"), attrgetter("fields")
 

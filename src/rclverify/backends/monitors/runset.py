@@ -11,7 +11,7 @@
   its environment", whose inputs are all of its traces;
 * :func:`run_runset` - that obligation's evidence: every trace checked as
   its own obligation is (the same verdicts), each distinct digest counted
-  once, and the target decided (:func:`rclverify.evidence.statistics.decide`).
+  once, and the target decided (:func:`rclverify.records.statistics.decide`).
   Runs of ``origin: harness`` are listed and never counted.
 
 A run's own record stays what it was: a violation fails it (counter-evidence
@@ -25,11 +25,11 @@ import hashlib
 from pathlib import Path
 from typing import Any, Callable
 
-from ...evidence.records import Evidence, Obligation, SourceRef, make_obligation_id
-from ...evidence.statistics import count_runs, decide
-from ...plan.targets import entry_environment, entry_origin, entry_target
-from ..base import NodeTarget, Stopwatch, make_evidence
-from .verdicts import NodeResult
+from rclverify.records.records import Evidence, Obligation, SourceRef, make_obligation_id
+from rclverify.records.statistics import count_runs, decide
+from rclverify.model.plan.targets import entry_environment, entry_origin, entry_target
+from rclverify.backends.base import NodeTarget, Stopwatch, make_evidence
+from rclverify.backends.monitors.verdicts import NodeResult
 
 #: The suffixes of a bag file (a directory is a ROS 2 bag too).
 BAG_SUFFIXES = (".bag", ".mcap", ".db3")

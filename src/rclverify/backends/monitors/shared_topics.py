@@ -20,11 +20,11 @@ from __future__ import annotations
 
 from typing import Any, Mapping
 
-from ...rcl import ast
-from ...rcl import types as T
-from ...rcl.errors import Diagnostic, error
-from ...rcl.types import Checked
-from ...traces.mapping import TopicRule, rule_for
+from rclverify.lang import ast
+from rclverify.lang import types as T
+from rclverify.lang.errors import Diagnostic, error
+from rclverify.lang.types import Checked
+from rclverify.traces.mapping import TopicRule, rule_for
 
 _NUMBERS = ("REAL", "INTEGER", "NATURAL")
 

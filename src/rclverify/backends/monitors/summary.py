@@ -11,7 +11,7 @@ from __future__ import annotations
 from importlib.metadata import PackageNotFoundError, version
 from typing import Any, Mapping
 
-from .verdicts import NodeResult
+from rclverify.backends.monitors.verdicts import NodeResult
 
 
 def tool_versions() -> str:

@@ -21,7 +21,7 @@ trace verdict       status         meaning for the requirement
 (unreadable trace)  ``error``      the located message
 ==================  =============  ===============================================
 
-The rows live in the requirement's sealed record (requirements/stage.py), so
+The rows live in the requirement's sealed record (stages/requirements.py), so
 they are sealed with it; the record's ``inputs`` hold each trace's sha256
 under ``trace:<path>`` (:func:`trace_hashes`), and its fingerprint holds
 them too: an edited trace re-checks the requirement in the stage and shows
@@ -32,15 +32,15 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
-from ...plan.load import Plan, Requirement
-from ...plan.state import state_types
-from ...plan.temporal import Temporal, operands, parse_temporal
-from ...rcl.errors import RclError
-from ...rcl.types import Checked
-from ...traces import TraceError, read_trace
-from .backend import trace_sha256
-from .config import ConfigError, load_mapping
-from .temporal_trace import check_temporal_trace
+from rclverify.model.plan.load import Plan, Requirement
+from rclverify.model.plan.state import state_types
+from rclverify.model.plan.temporal import Temporal, operands, parse_temporal
+from rclverify.lang.errors import RclError
+from rclverify.lang.types import Checked
+from rclverify.traces import TraceError, read_trace
+from rclverify.backends.monitors.backend import trace_sha256
+from rclverify.backends.monitors.config import ConfigError, load_mapping
+from rclverify.backends.monitors.temporal_trace import check_temporal_trace
 
 STATUS = {"false": "failed", "true": "discharged", "currently_false": "inconclusive", "inconclusive": "inconclusive"}
 

@@ -1,7 +1,7 @@
 """A temporal requirement checked on a recorded run (docs/monitors.md, "Temporal requirements on traces").
 
 The statement is one of the decided shapes of
-:func:`rclverify.plan.temporal.shape` (``always F``, ``always next F``,
+:func:`rclverify.model.plan.temporal.shape` (``always F``, ``always next F``,
 ``eventually F``, ``eventually[<= N] F``, ``next F``, ``F until G``) over
 ``Node.in.x``/``Node.out.y``/``Node.state.v``.
 
@@ -12,16 +12,16 @@ topics (:mod:`rclverify.traces.mapping`, as the node monitors of
 paper lines 462-495).  Every message on one of those topics is one *step*:
 step i is the state after the i-th such message (messages on other topics
 change nothing the statement reads and are no step).  A declared state
-variable (the plan's ``state:``, :mod:`rclverify.plan.state`) has at step 0
+variable (the plan's ``state:``, :mod:`rclverify.model.plan.state`) has at step 0
 the value its ``init`` defines and at step i+1 the value its ``next``
 defines from step i's state and the node's inputs and outputs at step i,
-as in the composed system (:mod:`rclverify.requirements.transition`).  Both
+as in the composed system (:mod:`rclverify.calculus.requirements.transition`).  Both
 are found by Z3 on the concrete values, and used only when the formula
 defines exactly one value (else the variable has no value from there on,
 and what reads it is undecided).
 
 **Operands** are decided at each step by the judgement of the node monitors
-(:func:`rclverify.logic.floatsem.judge`: direct evaluation, Z3 on concrete
+(:func:`rclverify.semantics.floatsem.judge`: direct evaluation, Z3 on concrete
 values when it cannot, then the nodes' double arithmetic and the mapping's
 tolerance, docs/monitors.md "Numbers on the wire"; a witness of an operand
 that held only there names the semantics).  A variable not observed yet has
@@ -61,17 +61,17 @@ from typing import Any, Iterable, Mapping
 
 import z3
 
-from ...logic.concrete import finite_interpretation, to_z3
-from ...logic.floatsem import judge
-from ...logic.encode import EncodingError, Encoder
-from ...plan.formal import Formal
-from ...plan.state import StateFormula, StateVar, parse_state_formula, state_type
-from ...plan.temporal import Temporal, shape
-from .response_trace import ResponseTracker
-from ...rcl.types import Checked, EnumT, FuncT, Scalar, Type
-from ...traces.events import Event
-from ...traces.mapping import MappingError, TopicRule, initial_value, map_value, rule_for
-from ...values import FiniteFunction, render
+from rclverify.semantics.concrete import finite_interpretation, to_z3
+from rclverify.semantics.floatsem import judge
+from rclverify.semantics.encode import EncodingError, Encoder
+from rclverify.model.plan.formal import Formal
+from rclverify.model.plan.state import StateFormula, StateVar, parse_state_formula, state_type
+from rclverify.model.plan.temporal import Temporal, shape
+from rclverify.backends.monitors.response_trace import ResponseTracker
+from rclverify.lang.types import Checked, EnumT, FuncT, Scalar, Type
+from rclverify.traces.events import Event
+from rclverify.traces.mapping import MappingError, TopicRule, initial_value, map_value, rule_for
+from rclverify.semantics.values import FiniteFunction, render
 
 VERDICTS = ("true", "false", "currently_false", "inconclusive")
 #: :func:`solve_value`'s answer when a value the formula reads is not observed yet.
@@ -104,7 +104,7 @@ class TraceVerdict:
 
 
 def _from_z3(v: z3.ExprRef, t: Type) -> Any:
-    """A Z3 model value as a value of :mod:`rclverify.values` (None if not a literal)."""
+    """A Z3 model value as a value of :mod:`rclverify.semantics.values` (None if not a literal)."""
     if isinstance(t, Scalar):
         if t.name == "BOOL":
             return True if z3.is_true(v) else False if z3.is_false(v) else None
@@ -307,7 +307,7 @@ class TraceStates:
 def _truth(f: Formal, checked: Checked, values: Mapping[str, Any], tolerance: Any = None,
            semantics: dict[int, str] | None = None) -> bool | None:
     """Operand ``f``'s truth on the step's values, judged as the node monitors
-    judge (:func:`rclverify.logic.floatsem.judge`: exact, then the nodes'
+    judge (:func:`rclverify.semantics.floatsem.judge`: exact, then the nodes'
     double arithmetic, then a declared ``tolerance``); the semantics that
     decided goes to ``semantics[id(f)]``."""
     mine = {k: v for k, v in values.items() if k.partition(".")[2] in f.scope.inputs or
@@ -341,7 +341,7 @@ def check_temporal_trace(t: Temporal, checked: Checked, states: tuple[StateVar, 
                          rules: Mapping[str, TopicRule]) -> TraceVerdict:
     """The verdict of statement ``t`` on the recorded run ``events`` (module
     docstring).  ``states`` the plan's state declarations, ``rules`` the
-    topic mapping.  Raises :class:`~rclverify.rcl.errors.RclError` for a
+    topic mapping.  Raises :class:`~rclverify.lang.errors.RclError` for a
     shape that is not decided and whatever the event source raises
     (:class:`~rclverify.traces.TraceError`)."""
     kind = shape(t, None)
@@ -469,7 +469,7 @@ def check_temporal_trace(t: Temporal, checked: Checked, states: tuple[StateVar, 
 
 
 def _text(f: Formal) -> str:
-    from ...rcl.printer import expr_to_rcl
+    from rclverify.lang.printer import expr_to_rcl
     return expr_to_rcl(f.expr)
 
 

@@ -10,9 +10,9 @@ import dataclasses
 from dataclasses import dataclass, field
 from typing import Any, Mapping
 
-from ...rcl import ast
-from ...rcl.types import Checked, CheckedNode
-from ...system.services import peers
+from rclverify.lang import ast
+from rclverify.lang.types import Checked, CheckedNode
+from rclverify.model.system.services import peers
 
 #: Verdicts of one node's events: per output message (``satisfied``,
 #: ``violated``, ``inconclusive``), per question (``assumption violated``,
@@ -24,7 +24,7 @@ VERDICTS = ("satisfied", "violated", "open", "assumption violated", "inconclusiv
 #: Topic suffixes of a service's or action's parts, in the order of ``Link.parts``
 #: (a service ``s`` is observed as ``s/request`` and ``s/response`` events, an
 #: action ``a`` as actionlib's ``a/goal``, ``a/feedback`` and ``a/result``).
-#: How far an arithmetic is from exact (the weakest one a verdict rests on is shown; logic/floatsem.py).
+#: How far an arithmetic is from exact (the weakest one a verdict rests on is shown; semantics/floatsem.py).
 WEAK = {"exact": 0, "double": 1, "tolerance": 2}
 #: Violations kept per node and run (each a few hundred bytes; the count is exact beyond it).
 KEPT_VIOLATIONS = 200
@@ -69,7 +69,7 @@ class Verdict:
     none or for the assumption); ``decided_at`` the time (s, trace clock)
     when it was decided; ``values`` the rendered values of the first failure
     (inputs and the outputs that failed), ``reason`` one sentence;
-    ``semantics`` the arithmetic that decided it (:mod:`rclverify.logic.floatsem`):
+    ``semantics`` the arithmetic that decided it (:mod:`rclverify.semantics.floatsem`):
     ``exact``, ``double`` or ``tolerance`` for a ``satisfied`` (the weakest
     its assumption and guarantees needed), the semantics that all agreed for
     a ``violated`` or ``assumption violated`` (``exact, double``), else ``""``;
@@ -136,7 +136,7 @@ class NodeResult:
     violations_dropped: int = 0
     #: a debug field, in no evidence record: how each formula was evaluated
     #: (``assumption 1`` / ``guarantee 2`` -> ``compiled``, or why the
-    #: straight-line code left it to the evaluator; logic/judges.py)
+    #: straight-line code left it to the evaluator; semantics/judges.py)
     evaluation: dict[str, str] = field(default_factory=dict, compare=False)
 
     @property
@@ -173,7 +173,7 @@ class NodeResult:
 def producers(checked: Checked, node: CheckedNode, var: str) -> list[str]:
     """Other nodes whose output has the input's name or is matched to the
     input's topic, or feeds it through a service or action link (rule S1,
-    :func:`rclverify.system.services.peers`: a client's response comes from
+    :func:`rclverify.model.system.services.peers`: a client's response comes from
     the server, a server's request from its clients)."""
     topics = {t.field for t in node.node.topics if t.match is not None and t.match.name == var}
     out = {m for m, _ in peers(checked, node.name, var)} if node.node.links else set()

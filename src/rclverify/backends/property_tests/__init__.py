@@ -13,10 +13,10 @@ __all__ = ["PropertyTestsBackend"]
 
 def __getattr__(name: str) -> Any:
     """``PropertyTestsBackend`` loaded on first use (PEP 562): the package is
-    also entered for :mod:`.closure` by every ``doit`` start (tasks.py, the
+    also entered for :mod:`.closure` by every ``doit`` start (app/tasks.py, the
     implementation's import closure), which must not pay for importing
     Hypothesis (about 0.3 s of a no-op run's 0.46 s)."""
     if name == "PropertyTestsBackend":
-        from .backend import PropertyTestsBackend
+        from rclverify.backends.property_tests.backend import PropertyTestsBackend
         return PropertyTestsBackend
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -26,16 +26,16 @@ from typing import Any, Callable
 
 import jinja2
 
-from ...evidence.records import Evidence, Obligation, SourceRef, make_obligation_id
-from ...evidence.store import atomic_write_text
-from ...plan.errors import PlanError
-from ...rcl.printer import expr_to_rcl
-from ..base import NodeTarget, Stopwatch, make_evidence
-from ..timelimit import TimeLimitExceeded, wall_clock_limit
-from .closure import import_closure, outside_versions
-from .declared import declaration_rows, has_declarations
-from .seeding import split_facts
-from .harness import Config, ConfigError, Outcome, load_implementation, read_config, run_guarantee, versions
+from rclverify.records.records import Evidence, Obligation, SourceRef, make_obligation_id
+from rclverify.records.store import atomic_write_text
+from rclverify.model.plan.errors import PlanError
+from rclverify.lang.printer import expr_to_rcl
+from rclverify.backends.base import NodeTarget, Stopwatch, make_evidence
+from rclverify.backends.timelimit import TimeLimitExceeded, wall_clock_limit
+from rclverify.backends.property_tests.closure import import_closure, outside_versions
+from rclverify.backends.property_tests.declared import declaration_rows, has_declarations
+from rclverify.backends.property_tests.seeding import split_facts
+from rclverify.backends.property_tests.harness import Config, ConfigError, Outcome, load_implementation, read_config, run_guarantee, versions
 
 NAME = "property_tests"
 KIND = "testing"
@@ -126,7 +126,7 @@ class PropertyTestsBackend:
     def export(self, target: NodeTarget) -> list[Obligation]:
         """Render the pytest file; return one obligation per guarantee.
 
-        Raises :class:`~rclverify.plan.errors.PlanError` (located in the plan)
+        Raises :class:`~rclverify.model.plan.errors.PlanError` (located in the plan)
         for a bad entry or an implementation that does not import.
         """
         cfg = _config(target)

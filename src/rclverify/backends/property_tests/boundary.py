@@ -23,9 +23,9 @@ import math
 from fractions import Fraction
 from typing import Any, Iterable, Mapping
 
-from ...rcl import ast
-from ...rcl.walk import subexpressions
-from .constants import boundary_constants
+from rclverify.lang import ast
+from rclverify.lang.walk import subexpressions
+from rclverify.backends.property_tests.constants import boundary_constants
 
 #: At most this many re-runs of the implementation per failure.
 MAX_TRIES = 48

@@ -33,10 +33,10 @@ import re
 from fractions import Fraction
 from typing import Any, Iterable
 
-from ...logic.evaluator import Evaluator
-from ...rcl import ast
-from ...rcl.types import Checked, CheckedNode
-from ...rcl.walk import subexpressions
+from rclverify.semantics.evaluator import Evaluator
+from rclverify.lang import ast
+from rclverify.lang.types import Checked, CheckedNode
+from rclverify.lang.walk import subexpressions
 
 #: A module-level name written as a constant (PEP 8: capitals, digits and underscores).
 _CONSTANT_NAME = re.compile(r"^_*[A-Z][A-Z0-9_]*$")

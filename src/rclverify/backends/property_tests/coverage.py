@@ -29,8 +29,8 @@ import math
 from fractions import Fraction
 from typing import Any, Mapping
 
-from ...rcl.types import CheckedNode, EnumT, Scalar
-from .strategies import Bound
+from rclverify.lang.types import CheckedNode, EnumT, Scalar
+from rclverify.backends.property_tests.strategies import Bound
 
 #: Buckets a bounded numeric range is cut into.
 BUCKETS = 10

@@ -7,7 +7,7 @@ the node's declared progress on those inputs: every admissible input tried
 got an answer.  Each property-test record carries one row per declaration
 in ``details.declarations`` (the shape of the monitors' rows,
 backends/monitors/declarations.py), read by the requirement roll-up
-(requirements/rollup.py):
+(calculus/requirements/rollup.py):
 
 * ``progress( ... )`` and a period in steps (``periodic( out.y, N steps )``:
   every answer refreshes every output): ``true`` when the run passed (its
@@ -35,12 +35,12 @@ from __future__ import annotations
 import inspect
 from typing import Any, Mapping
 
-from ...logic.floatsem import judge
-from ...rcl import ast
-from ...rcl.liveness import STEP_WORDS
-from ...rcl.printer import expr_to_rcl
-from ...rcl.types import Checked, CheckedNode
-from ...values import conforms, render
+from rclverify.semantics.floatsem import judge
+from rclverify.lang import ast
+from rclverify.lang.liveness import STEP_WORDS
+from rclverify.lang.printer import expr_to_rcl
+from rclverify.lang.types import Checked, CheckedNode
+from rclverify.semantics.values import conforms, render
 
 #: the words of a counterexample's reason that say the implementation gave no answer (harness.check_step)
 NO_ANSWER = ("the implementation raised", "the implementation returned", "the implementation's outputs do not match")

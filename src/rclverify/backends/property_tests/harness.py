@@ -9,15 +9,15 @@ node's assumption holds on them (a filter, so Hypothesis's
 ``filter_too_much`` health check watches the rejection rate); the
 implementation is called with one keyword argument per input; its outputs
 must be a mapping with exactly the node's output names, each value of its
-RCL type (:func:`rclverify.values.conforms`); then every top-level conjunct
+RCL type (:func:`rclverify.semantics.values.conforms`); then every top-level conjunct
 of the guarantee is checked on the inputs and outputs as the implementation
-computed them (:func:`rclverify.logic.floatsem.judge`: exact arithmetic by
+computed them (:func:`rclverify.semantics.floatsem.judge`: exact arithmetic by
 direct evaluation, Z3 only where it cannot decide, then the IEEE-754 double
 arithmetic a Python implementation computes in, as the monitors judge a
 recorded run; docs/property-tests.md, "Numbers as the implementation
 computes them").  A violation is shrunk by Hypothesis; Z3's ``unknown``
 counts as inconclusive, never as passed.  The reported counterexample is
-confirmed by Z3 (:func:`rclverify.logic.concrete.check_concrete`): the facts
+confirmed by Z3 (:func:`rclverify.semantics.concrete.check_concrete`): the facts
 hold on its inputs and its outputs violate the conjunct.
 """
 from __future__ import annotations
@@ -38,18 +38,18 @@ from hypothesis import HealthCheck, Phase, Verbosity, given, settings
 from hypothesis import strategies as st
 from hypothesis.errors import FailedHealthCheck, Unsatisfiable
 
-from ...logic.concrete import check_concrete
-from ...logic.decide import decide
-from ...logic.floatsem import judge
-from ...logic.encode import EncodingError
-from ...rcl import ast
-from ...rcl.printer import expr_to_rcl
-from ...rcl.types import Checked, CheckedNode
-from ...values import conforms, render
-from .seeding import Seeder, split_facts
-from .coverage import Coverage
-from .constants import boundary_constants, constant_values
-from .strategies import assumption_bounds, conjuncts, input_space
+from rclverify.semantics.concrete import check_concrete
+from rclverify.semantics.decide import decide
+from rclverify.semantics.floatsem import judge
+from rclverify.semantics.encode import EncodingError
+from rclverify.lang import ast
+from rclverify.lang.printer import expr_to_rcl
+from rclverify.lang.types import Checked, CheckedNode
+from rclverify.semantics.values import conforms, render
+from rclverify.backends.property_tests.seeding import Seeder, split_facts
+from rclverify.backends.property_tests.coverage import Coverage
+from rclverify.backends.property_tests.constants import boundary_constants, constant_values
+from rclverify.backends.property_tests.strategies import assumption_bounds, conjuncts, input_space
 
 DEFAULT_MAX_EXAMPLES = 200
 DEFAULT_SEED = 20260
@@ -130,7 +130,7 @@ def load_implementation(root: Path, cfg: Config) -> Any:
     Raises :class:`ConfigError` when the file does not import or lacks the name.
     """
     path = (root / cfg.file).resolve()
-    from .closure import import_closure
+    from rclverify.backends.property_tests.closure import import_closure
     closure = {(root / f).resolve() for f in import_closure(root, cfg.file)[0]}
     names = {p.name for p in closure}
     for name, mod in list(sys.modules.items()):  # the workspace modules it imports, afresh too (a long-lived process)
@@ -417,7 +417,7 @@ class GuaranteeRun:
                 test()
         except _Violation:
             assert self.last_failure is not None
-            from .readable import readable_failure  # the boundary value first, the implementation's line (issue 48)
+            from rclverify.backends.property_tests.readable import readable_failure  # the boundary value first, the implementation's line (issue 48)
             moved = readable_failure(self, _Violation)
             unconfirmed = self._unconfirmed()
             if unconfirmed is not None:

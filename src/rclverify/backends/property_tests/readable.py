@@ -5,8 +5,8 @@ from __future__ import annotations
 
 from typing import Any
 
-from .boundary import boundary_example, boundary_first
-from .cause import cause_line
+from rclverify.backends.property_tests.boundary import boundary_example, boundary_first
+from rclverify.backends.property_tests.cause import cause_line
 
 
 def readable_failure(run: Any, violation: type[BaseException]) -> bool:

@@ -12,7 +12,7 @@ holds on a random finite table.  So inputs are built from a Z3 model:
   plus usable facts) mention becomes a table of ``n`` entries at fixed
   distinct keys ``(0, 0), (1, 1), ...`` with unknown results and an unknown
   default; the table (``ite`` over the keys, as
-  :func:`rclverify.logic.concrete.finite_interpretation` builds for a
+  :func:`rclverify.semantics.concrete.finite_interpretation` builds for a
   concrete table) replaces the function symbol; Z3 (tactics ``simplify``,
   ``qe``, ``smt``) finds the results.  ``n`` is the first of
   :data:`EXTRA_SIZES` with a model.  Computed once per node and process, in
@@ -24,7 +24,7 @@ holds on a random finite table.  So inputs are built from a Z3 model:
   added or overriding).
 
 Every example is then checked by
-:func:`~rclverify.logic.concrete.check_concrete` (the harness's filter), so
+:func:`~rclverify.semantics.concrete.check_concrete` (the harness's filter), so
 the encoding here never decides validity on its own.  Facts that name an
 output cannot constrain inputs and are not used for drawing (reported).
 """
@@ -36,12 +36,12 @@ from typing import Any
 
 import z3
 
-from ...logic.concrete import to_z3
-from ...logic.encode import Encoder, EncodingError, sort_of
-from ...logic.retry import SAFETY_TIMEOUT_MS
-from ...rcl import ast
-from ...rcl.types import Checked, CheckedNode, DataT, EnumT, FuncT, Scalar, Type
-from ...values import FiniteFunction, Term
+from rclverify.semantics.concrete import to_z3
+from rclverify.semantics.encode import Encoder, EncodingError, sort_of
+from rclverify.semantics.retry import SAFETY_TIMEOUT_MS
+from rclverify.lang import ast
+from rclverify.lang.types import Checked, CheckedNode, DataT, EnumT, FuncT, Scalar, Type
+from rclverify.semantics.values import FiniteFunction, Term
 
 EXTRA_SIZES = (0, 1, 2, 4, 8, 16, 32, 64)
 #: Z3's resource budget for one table size (its ``rlimit``, about 2 s on an
@@ -69,7 +69,7 @@ def split_facts(facts: tuple[ast.Expr, ...], node: CheckedNode) -> tuple[tuple[a
 
 
 def _from_z3(v: z3.ExprRef, t: Type) -> Any:
-    """A model value as a value of :mod:`rclverify.values`; ``ValueError`` when it is not one."""
+    """A model value as a value of :mod:`rclverify.semantics.values`; ``ValueError`` when it is not one."""
     if isinstance(t, Scalar):
         if t.name == "BOOL":
             return z3.is_true(v)
@@ -143,9 +143,9 @@ def min_entries(formulas: tuple[ast.Expr, ...]) -> int:
 
 
 #: Base models by node, input types and formulas.  They hold plain values of
-#: rclverify.values, no Z3 object, and each is computed in a Z3 context of its
+#: rclverify.semantics.values, no Z3 object, and each is computed in a Z3 context of its
 #: own from the formulas' SMT-LIB text, so it does not depend on the process's
-#: Z3 state: it is kept across rclverify.logic.world.fresh() (a clean run and
+#: Z3 state: it is kept across rclverify.semantics.world.fresh() (a clean run and
 #: an incremental one draw from the same model; the Agent's three guarantees
 #: share one instead of solving it three times).
 _BASE: dict[tuple[Any, ...], dict[str, Any] | None] = {}

@@ -12,12 +12,12 @@ constrained by the node's assumption (docs/property-tests.md, "Strategies").
   either side for REAL, one either side for integers), are drawn alongside
   arbitrary values, so a threshold that is off by one is hit.
 * Function-typed inputs are finite tables with a default
-  (:class:`~rclverify.values.FiniteFunction`).  Their keys come from one pool
+  (:class:`~rclverify.semantics.values.FiniteFunction`).  Their keys come from one pool
   of argument tuples per argument type, drawn once per example, so two
   functions over the same domain (the Agent's ``at`` and ``wayP``) share
   their points; values inside tables are small (NATURAL 0..5, INTEGER -5..5).
 * What the bounds do not capture is enforced by filtering with the whole
-  assumption, checked by :func:`~rclverify.logic.decide.decide` (direct evaluation, Z3 where
+  assumption, checked by :func:`~rclverify.semantics.decide.decide` (direct evaluation, Z3 where
   it cannot decide).
 """
 from __future__ import annotations
@@ -30,9 +30,9 @@ from typing import Any, Callable, Iterable, Mapping, cast
 
 from hypothesis import strategies as st
 
-from ...rcl import ast
-from ...rcl.types import CheckedNode, DataT, EmptyT, EnumT, FuncT, Scalar, SeqT, SetT, TupleT, Type
-from ...values import FiniteFunction, Term
+from rclverify.lang import ast
+from rclverify.lang.types import CheckedNode, DataT, EmptyT, EnumT, FuncT, Scalar, SeqT, SetT, TupleT, Type
+from rclverify.semantics.values import FiniteFunction, Term
 
 SMALL_NAT = 5
 POOL_SIZE = 4

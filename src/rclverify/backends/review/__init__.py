@@ -5,6 +5,6 @@ Modules: :mod:`.record` (the checklist generated from the guarantees, the
 record format and its validation), :mod:`.backend` (:class:`ReviewBackend`),
 ``templates/record.yaml.j2`` (the blank record ``rclverify review NODE`` writes).
 """
-from .backend import ReviewBackend
+from rclverify.backends.review.backend import ReviewBackend
 
 __all__ = ["ReviewBackend"]

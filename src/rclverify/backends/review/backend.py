@@ -18,14 +18,14 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
-from ...evidence.records import Evidence, Obligation, SourceRef, make_obligation_id
-from ...plan.errors import PlanError, plan_error
-from ...plan.paths import escape_reason
-from ...plan.yamlguard import load_located, read_yaml_text
-from ...rcl import ast
-from ...rcl.errors import Diagnostic
-from ..base import NodeTarget, Stopwatch, make_evidence
-from .record import Question, RecordError, ReviewRecord, assumption_text, checklist, judge, parse_record
+from rclverify.records.records import Evidence, Obligation, SourceRef, make_obligation_id
+from rclverify.model.plan.errors import PlanError, plan_error
+from rclverify.model.plan.paths import escape_reason
+from rclverify.model.plan.yamlguard import load_located, read_yaml_text
+from rclverify.lang import ast
+from rclverify.lang.errors import Diagnostic
+from rclverify.backends.base import NodeTarget, Stopwatch, make_evidence
+from rclverify.backends.review.record import Question, RecordError, ReviewRecord, assumption_text, checklist, judge, parse_record
 
 NAME = "review"
 KIND = "review"
@@ -54,7 +54,7 @@ def read_record(root: Path, config: Any, loc: Any) -> tuple[str, ReviewRecord]:
 def check_reviewed_paths(root: Path, rel: str, text: str, record: ReviewRecord) -> None:
     """Refuse a record whose ``files:`` name a file outside the workspace
     (absolute, ``..``, a backslash, or a symbolic link leading out; the
-    rules of :mod:`rclverify.plan.paths`): the reviewed files are inputs of
+    rules of :mod:`rclverify.model.plan.paths`): the reviewed files are inputs of
     the evidence and must be in the assessor's bundle.  Raises
     :class:`PlanError` listing each, located at the path in the record
     (``rel:line:col``)."""

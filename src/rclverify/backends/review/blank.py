@@ -6,8 +6,8 @@ from typing import Sequence
 
 import jinja2
 
-from ...rcl.types import CheckedNode
-from .record import assumption_text, checklist, sha256_of
+from rclverify.lang.types import CheckedNode
+from rclverify.backends.review.record import assumption_text, checklist, sha256_of
 
 
 def blank_record(node: CheckedNode, root: Path, files: Sequence[str] = ()) -> str:

@@ -19,7 +19,7 @@ to check and the record says what was checked.
 
 An answer is bound to the **text** it answered, not to a guarantee's
 number: each entry names its conjunct and the record the assumption, both
-as :func:`~rclverify.rcl.printer.expr_to_rcl` prints them (whitespace
+as :func:`~rclverify.lang.printer.expr_to_rcl` prints them (whitespace
 aside).  When either differs from the contract's text now, the review
 answered another question and the evidence is ``stale`` (docs/integrity.md,
 "What makes evidence stale").
@@ -33,10 +33,10 @@ from typing import Any, Mapping
 
 import yaml
 
-from ...rcl import ast
-from ...rcl.printer import expr_to_rcl
-from ...rcl.types import CheckedNode
-from ...plan.yamlguard import safe_load_guarded
+from rclverify.lang import ast
+from rclverify.lang.printer import expr_to_rcl
+from rclverify.lang.types import CheckedNode
+from rclverify.model.plan.yamlguard import safe_load_guarded
 
 
 class RecordError(ValueError):

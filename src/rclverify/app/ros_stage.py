@@ -1,0 +1,151 @@
+"""The grounding stage over a workspace: scan what the plan's ``ros:``
+section names, ground the contracts in it, write
+``artifacts/ros/graph.json`` and ``artifacts/ros/grounding.json``
+(atomically), and ``rclverify ros check``.
+
+``ros:`` keys (docs/ros.md): ``workspaces`` (directories), ``launch``
+(entry launch files), ``args`` (launch arguments), ``bags``, ``mapping``
+(field lists; default ``backends/monitors/mapping.yaml`` when present),
+``fields`` (``{topic: [field paths]}``, overrides the mapping), ``nodes``
+(``{ContractNode: /graph/node}``), ``ignore`` (graph nodes left out).
+Every path is workspace-relative and must stay inside the workspace.
+"""
+from __future__ import annotations
+
+import json
+import sys
+from pathlib import Path, PurePosixPath
+from typing import Any
+
+from rclverify.lang import ast
+
+GRAPH = "artifacts/ros/graph.json"
+GROUNDING = "artifacts/ros/grounding.json"
+DOT = "artifacts/ros/grounding.dot"
+SVG = "artifacts/ros/grounding.svg"
+CACHE = "artifacts/cache/ros-scan.pickle"
+DEFAULT_MAPPING = "backends/monitors/mapping.yaml"
+
+
+def _paths(ws: Any, key: str, missing: list[Any] | None = None) -> list[Path]:
+    """The existing paths of ``ros.<key>``.  A path that leaves the workspace is
+    a plan error (raised); one that does not exist is appended to ``missing``
+    as ``(loc, message)``: a grounding error, which never stops the pipeline."""
+    from rclverify.model.plan.errors import plan_error
+    ros = ws.plan.ros
+    vals = ros.get(key, []) or []
+    out = []
+    for i, v in enumerate(vals):
+        loc = ws.plan.locs.get(("ros", key, i), ast.Loc(ws.plan.file, 1, 1))
+        p = PurePosixPath(str(v))
+        if p.is_absolute() or ".." in p.parts:
+            raise plan_error(ws.plan.file, loc.line, loc.col, f"ros.{key}: {v!r} leaves the workspace; "
+                                                              f"give a path inside it", "E-path")
+        if not (ws.root / p).exists():
+            if missing is None:
+                raise plan_error(ws.plan.file, loc.line, loc.col, f"ros.{key}: {v!r} does not exist", "E-io")
+            missing.append((loc, f"ros.{key}: {v!r} does not exist; nothing of it was scanned"))
+            continue
+        out.append(ws.root / p)
+    return out
+
+
+def _fields(ws: Any) -> dict[str, list[str]]:
+    import yaml
+    ros = ws.plan.ros
+    out: dict[str, list[str]] = {}
+    mapping = ros.get("mapping") or (DEFAULT_MAPPING if (ws.root / DEFAULT_MAPPING).is_file() else None)
+    if mapping:
+        try:
+            data = yaml.safe_load((ws.root / mapping).read_text(encoding="utf-8")) or {}
+            for t, spec in (data.get("topics") or {}).items():
+                if isinstance(spec, dict) and spec.get("fields"):
+                    out[str(t).lstrip("/")] = [str(f) for f in spec["fields"]]
+        except (OSError, yaml.YAMLError, AttributeError):
+            pass  # the monitors stage reports a bad mapping file, located
+    for t, fs in (ros.get("fields") or {}).items():
+        out[str(t).lstrip("/")] = [str(f) for f in fs]
+    return out
+
+
+def has_ros(ws: Any) -> bool:
+    return bool(ws.plan.ros)
+
+
+def stage_ground(ws: Any) -> dict[str, Any]:
+    """Scan, ground, write both artifacts; returns the grounding dict
+    (``findings``, ``counts``, ``context`` for the GSN argument)."""
+    from rclverify.records.store import atomic_write_text
+    from rclverify.ros.graph.scan import scan
+    from rclverify.ros.ground.ground import ground
+    ros = ws.plan.ros
+    missing: list[Any] = []
+    wss = _paths(ws, "workspaces", missing)
+    launch = _paths(ws, "launch", missing)
+    bags = _paths(ws, "bags", missing)
+    args = {str(k): (str(v).lower() if isinstance(v, bool) else str(v)) for k, v in (ros.get("args") or {}).items()}
+    res = scan(wss, launch, args, bags, ws.root / CACHE, base=ws.root)
+    plan_loc = ws.plan.locs.get(("ros",), ast.Loc(ws.plan.file, 1, 1))
+    from rclverify.ros.ground.ground import Finding
+    findings = [Finding("ROS-SCAN", "error", msg, loc, None) for loc, msg in missing]
+    findings += ground(res, ws.checked, ws.plan.file, ros, _fields(ws), plan_loc)
+    g = res.graph
+    graph_json = g.to_json()
+    counts = {"error": sum(f.severity == "error" for f in findings),
+              "warning": sum(f.severity == "warning" for f in findings)}
+    data = {
+        "findings": [f.to_json() for f in findings],
+        "counts": counts,
+        "graph": {"nodes": [{"name": n["name"], "publishes": [e["topic"] for e in n["publishes"]],
+                             "subscribes": [e["topic"] for e in n["subscribes"]]} for n in graph_json["nodes"]]},
+        "context": {
+            "packages": [{"name": p["name"], "version": p["version"]} for p in graph_json["packages"]],
+            "files": graph_json["files"],
+            "launch": [str(p.relative_to(ws.root)) for p in launch],
+        },
+    }
+    from rclverify.report.diagram import dot_to_svg
+    from rclverify.ros.graph.draw import grounding_dot
+    from rclverify.ros.ground.ground import match_nodes
+    from rclverify.ros.extract import names
+    ignore = {names.normalise(n) for n in ros.get("ignore", []) or []}
+    pairs = match_nodes(ws.checked.nodes, {k: v for k, v in g.nodes.items() if k not in ignore},
+                        dict(ros.get("nodes", {}) or {}))
+    dot = grounding_dot(ws.checked, graph_json, data["findings"], pairs)
+    svg = dot_to_svg(dot)
+    data["drawing"] = {"dot": DOT, "svg": SVG if svg is not None else None}
+    data["matched"] = dict(pairs)
+    atomic_write_text(ws.path(DOT), dot)
+    if svg is not None:
+        atomic_write_text(ws.path(SVG), svg)
+    atomic_write_text(ws.path(GRAPH), json.dumps(graph_json, indent=2) + "\n")
+    from rclverify.records.records import hash_inputs
+    from rclverify.records.sealed import write_sealed
+    from rclverify.ros.graph.inputs import input_files
+    data["inputs"] = hash_inputs(ws.root, input_files(ws))
+    write_sealed(ws.path(GROUNDING), data)  # sealed: the report reads it (records/sealed.py)
+    return data
+
+
+def run_check(root: Path, plan: str, strict: bool, json_out: str | None) -> int:
+    """``rclverify ros check``: print each finding, a count line; exit 1 when
+    any grounding error is found (or the plan/contract cannot be read), else 0.
+    ``strict`` is kept for older command lines and changes nothing: an error is
+    never a pass (issue 65: 26 errors with exit 0 was a wrong green)."""
+    from rclverify.records.store import atomic_write_text
+    from rclverify.stages.workspace import Workspace
+    ws = Workspace(root, plan)
+    if not has_ros(ws):
+        print(f"{ws.plan.file}:1:1: error: the plan has no ros: section (docs/ros.md)", file=sys.stderr)
+        return 1
+    data = stage_ground(ws)
+    for f in data["findings"]:
+        r, s = f["rcl"], f["ros"]
+        where = f"{r['file']}:{r['line']}:{r['col']}" if r else (f"{s['file']}:{s['line']}:{s['col']}" if s else "")
+        also = f" [{s['file']}:{s['line']}:{s['col']}]" if r and s else ""
+        print(f"{where}: {f['severity']}: {f['message']}{also} ({f['code']})")
+    if json_out:
+        atomic_write_text(Path(json_out), json.dumps(data, indent=2) + "\n")
+    c = data["counts"]
+    print(f"grounding: {c['error']} error(s), {c['warning']} warning(s); graph in {GRAPH}")
+    return 1 if c["error"] else 0

@@ -1,0 +1,791 @@
+"""doit task generators for a workspace (``dodo.py`` only calls :func:`build_tasks`).
+
+Stages and their real file dependencies, per node ``N``:
+
+``check``          contracts + plan -> artifacts/contracts/N.json (one snapshot per
+                   node, rewritten only when that node's text changes), artifacts/cones/N.sha256
+                   (a digest of N's upstream cone's snapshots), model, lint
+``graph``          model -> model.dot, model.svg (when graphviz is installed); not part of
+                   ``verify`` (the report lays out its own diagram, with statuses):
+                   ``doit graph`` runs it
+``node:N``         three stages, each run only when one of its own inputs changed:
+                   compose  snapshot of N and of N's producers + model -> calculus/N.json;
+                            run again too when the part of N's cone digest it read changed
+                            (app/conetask.py: the whole cone when a side condition was decided in
+                            context, the cone's environment assumptions otherwise)
+                   health   snapshot of N (+ replacement contract) -> health/N.json
+                   export   snapshot of N + the backend input files -> obligations/N.json
+``evidence:ID``     one obligation's record + the files it reads -> its evidence record
+                   (created after ``node`` ran, when the obligations are known)
+``requirements``   plan + model + contract snapshots (+ Doorstop files, recorded runs) ->
+                   artifacts/requirements/<ID>.json; inside, only requirements whose
+                   cone's snapshots or statements changed are checked again
+``deadlines``      plan + model + snapshots of the nodes between a deadline's ends ->
+                   artifacts/deadlines/index.json (rule D3, every end-to-end deadline;
+                   only when the plan has one)
+``report:html``    every artifact above -> reports/assurance.{html,json}, the CI formats
+                   reports/assurance.sarif, assurance.junit.xml, argument.svg
+``report:text``    every artifact above -> reports/assurance.md, argument.{json,gsn.yaml,dot}
+                   (two tasks rendered at once by ``doit -n 2``: report/parts.py)
+``verify``         the whole pipeline; ``doit verify --strict`` fails unless every
+                   obligation is discharged
+
+doit compares file contents (md5), so editing one node's contract changes
+only that node's snapshot: its node task (all three stages) and run tasks,
+its consumers' node tasks (the compose stage only: their side conditions), the
+node tasks downstream whose side conditions were decided in context against
+the cone (app/conetask.py)
+and the report re-run.  The three stages share one doit task per node
+because doit's own cost per task (defining it, checking its dependencies)
+was most of a no-op run of a large system (docs/scale.md); the task's
+action gets doit's list of changed dependencies and runs the stages that
+read one of them (:func:`stages_to_run`).
+Actions are module-level functions with plain arguments, so ``doit -n 2``
+(parallel processes) behaves like a serial run.
+
+With the environment variable ``RCLVERIFY_CLUSTER=ADDRESS`` the ``evidence``
+tasks send their backend jobs to that Dask scheduler (:mod:`rclverify.app.cluster`);
+the records are stored locally as in a local run.
+"""
+from __future__ import annotations
+
+import glob
+import inspect
+import os
+import shutil
+from pathlib import Path
+from typing import TYPE_CHECKING, Any, Callable, Iterator, Mapping, Sequence, TypeVar, cast
+
+from doit import create_after as _create_after
+from doit.exceptions import TaskFailed
+from doit.tools import config_changed
+
+from rclverify.core.cache import code_stamp, heap
+from rclverify.core.cache import workspace as wscache
+from rclverify.app.pipeline import REPORT_PARTS, TaskIndex, Workspace
+from rclverify.model.plan.entries import TOOL_KEYS
+from rclverify.lang.errors import RclError
+from rclverify.stages.workspace import check_input_files
+
+if TYPE_CHECKING:
+    from rclverify.records.report_schema import Report
+
+_F = TypeVar("_F", bound=Callable[..., Any])
+
+
+def create_after(executed: str) -> Callable[[_F], _F]:
+    """doit's ``create_after`` (delayed task creation), typed."""
+    return cast(Callable[[_F], _F], _create_after(executed=executed))
+
+
+REPORTS = ["reports/assurance.html", "reports/assurance.md", "reports/assurance.json"]
+
+
+_WORKSPACES: dict[str, Workspace] = {}
+
+
+def _ws(root: str, plan_file: str | None = None) -> Workspace:
+    """The workspace at ``root``, loaded once per doit run: every action would
+    otherwise parse and check the contracts again.
+
+    :func:`build_tasks` (called at the start of every run, also by
+    ``rclverify verify``) puts the workspace it loaded here, so the actions of
+    a run see the contracts and plan as they were when the run started -- the
+    state its ``check`` task snapshots and every later task depends on.  A
+    contract edited while a run is under way is therefore picked up by the
+    next run, whose ``check`` sees the changed file.  Without a seeded entry
+    (a worker process that did not inherit it) the workspace is loaded here,
+    with ``plan_file`` (the ``check`` task passes the run's plan file; the
+    default plan otherwise).
+    """
+    heap.freeze_inherited()  # a doit -n worker: its inherited heap stays live (rclverify.core.cache.heap)
+    ws = _WORKSPACES.get(root)
+    if ws is None or (plan_file is not None and ws.plan_file != plan_file):
+        ws = Workspace(Path(root), plan_file or "contracts/plan.yaml")
+        ws.model  # load now: raises RclError for bad input and then caches nothing
+        _WORKSPACES[root] = ws
+    return ws
+
+
+def _fail(exc: RclError) -> TaskFailed:
+    return TaskFailed("\n".join(str(d) for d in exc.diagnostics))
+
+
+def _io_fail(exc: OSError, root: str, place: str = "artifacts/") -> TaskFailed:
+    """A fault of the machine (read-only directory, full disk) as one plain line
+    (:mod:`rclverify.core.faults`; ``place``: where the action writes, for an
+    error without a file name): the writes are atomic, nothing recorded changed."""
+    from rclverify.core.faults import describe_os_error
+    return TaskFailed(describe_os_error(exc, Path(root), place=place))
+
+
+def act_check(root: str, plan_file: str = "contracts/plan.yaml") -> Any:
+    from rclverify.app.pipeline import stage_check
+    try:
+        out = stage_check(_ws(root, plan_file))
+    except RclError as exc:
+        return _fail(exc)
+    except OSError as exc:
+        return _io_fail(exc, root)
+    for w in out["warnings"]:
+        print(f"{w['file']}:{w['line']}:{w['col']}: warning: {w['message']}")
+    return None
+
+
+def act_graph(root: str) -> Any:
+    from rclverify.records.store import atomic_write_text
+    from rclverify.app.pipeline import stage_graph
+    from rclverify.report.diagram import dot_to_svg
+    try:
+        dot = stage_graph(_ws(root))
+        svg = dot_to_svg(dot)
+        if svg is None:
+            print(f"graphviz 'dot' not found: {Workspace.DOT} written, model.svg not drawn")
+            return None
+        atomic_write_text(Path(root) / "artifacts/system/model.svg", svg)
+    except RclError as exc:
+        return _fail(exc)
+    except OSError as exc:
+        return _io_fail(exc, root)
+    return None
+
+
+#: The stages of a ``node:<Node>`` task, in the order they run.
+NODE_STAGES = ("compose", "health", "export")
+
+
+def stages_to_run(deps: Mapping[str, Sequence[str]], changed: Sequence[str]) -> list[str]:
+    """The stages of a node task whose own file dependencies are among
+    ``changed`` (doit's ``dep_changed``), in :data:`NODE_STAGES` order.
+
+    ``deps`` maps each stage to its file dependencies.  An empty ``changed``
+    means doit gave no reason by file (a forced run, ``doit -a``, a changed
+    ``uptodate`` check): every stage runs.  A missing target makes doit list
+    every dependency as changed, so every stage runs then too.
+    """
+    if not changed:
+        return list(NODE_STAGES)
+    hit = set(changed)
+    return [stage for stage in NODE_STAGES if hit.intersection(deps[stage])]
+
+
+def act_node(root: str, node: str, deps: dict[str, list[str]], changed: list[str]) -> Any:
+    """Run the stages of ``node`` whose inputs changed (:func:`stages_to_run`).
+
+    ``changed`` is filled by doit (the task's file dependencies that changed
+    since its last successful run)."""
+    from rclverify.app import pipeline
+    stages = stages_to_run(deps, changed)
+    try:
+        for stage in stages:
+            getattr(pipeline, f"stage_{stage}")(_ws(root), node)
+    except RclError as exc:
+        return _fail(exc)
+    except OSError as exc:
+        return _io_fail(exc, root)
+    print(f"{node}: {', '.join(stages)}")
+    return None
+
+
+def act_run(root: str, node: str, obligation_id: str) -> Any:
+    from rclverify.app import cluster
+    from rclverify.app.pipeline import stage_run
+    addr = cluster.address()  # RCLVERIFY_CLUSTER: the backend job runs on that Dask cluster
+    try:
+        if addr is None:
+            ev = stage_run(_ws(root), node, obligation_id)
+        else:
+            ev = cluster.run_on_cluster(addr, _ws(root), node, obligation_id)
+    except RclError as exc:
+        return _fail(exc)
+    except cluster.ClusterError as exc:
+        return TaskFailed(f"error: {exc}")
+    except OSError as exc:
+        return _io_fail(exc, root, "artifacts/evidence/")
+    print(f"{ev.obligation}: {ev.status}")
+    return None
+
+
+#: The report dict built by the first report part of a run, for the other parts the same process
+#: runs (a serial run): keyed by workspace root, valid for the workspace object of that run.
+_REPORTS: dict[str, tuple[Workspace, Report]] = {}
+
+
+def act_report(root: str, part: str) -> Any:
+    """Write one part of the report (:mod:`rclverify.report.parts`).  The
+    parts run after every backend, from the same artifacts, so a process
+    that runs both (``doit`` without ``-n``) builds the report dict once:
+    it is kept for the workspace object of this run (:func:`_ws`), which
+    a later run (a new :func:`build_tasks`) replaces."""
+    from rclverify.app.pipeline import stage_report
+    try:
+        ws = _ws(root)
+        kept = _REPORTS.get(root)
+        report, _ = stage_report(ws, (part,), kept[1] if kept is not None and kept[0] is ws else None)
+    except RclError as exc:
+        return _fail(exc)
+    except OSError as exc:
+        return _io_fail(exc, root, "reports/")
+    _REPORTS[root] = (ws, report)
+    if part == "html":
+        print(f"report: reports/assurance.html  ({report['summary']['headline']})")
+    else:
+        print("report: reports/assurance.md, reports/argument.{json,gsn.yaml,dot}")
+    return None
+
+
+def act_requirements(root: str) -> Any:
+    """Check the requirements whose inputs changed (:mod:`rclverify.stages.requirements`)."""
+    from rclverify.app.pipeline import stage_requirements
+    try:
+        rows = stage_requirements(_ws(root))
+    except RclError as exc:
+        return _fail(exc)
+    again = [rec["id"] for rec, now in rows if now]
+    print(f"requirements: {len(again)} of {len(rows)} checked" + (f" ({', '.join(again[:10])}"
+                                                                  + (", ..." if len(again) > 10 else "") + ")" if again else ""))
+    return None
+
+
+def act_deadlines(root: str) -> Any:
+    """Decide the end-to-end deadlines (rule D3, :mod:`rclverify.stages.deadlines`)."""
+    from rclverify.app.pipeline import stage_deadlines
+    try:
+        records = stage_deadlines(_ws(root))
+    except RclError as exc:
+        return _fail(exc)
+    except OSError as exc:
+        return _io_fail(exc, root)
+    print("deadlines: " + ", ".join(f"{r['requirement']} {r['status']}" for r in records))
+    return None
+
+
+def act_crosscheck(root: str, nodes: list[str]) -> Any:
+    """Decide every discharging query again with cvc5 (:mod:`rclverify.stages.crosscheck.stage`, issue 50)."""
+    from rclverify.stages.crosscheck.stage import stage_crosscheck
+    try:
+        index = stage_crosscheck(Path(root), nodes)
+    except OSError as exc:
+        return _io_fail(exc, root)
+    counts = index.get("counts", {})
+    print("second solver: " + (", ".join(f"{v} {k}" for k, v in counts.items()) or "nothing to re-decide")
+          + ("" if index.get("solver") else " (cvc5 is not installed)"))
+    return None
+
+
+def act_ground(root: str) -> Any:
+    """The grounding stage (docs/ros.md): scan the plan's ``ros:`` section,
+    hold the contracts against it; findings go to the report, never to a verdict."""
+    from rclverify.app.ros_stage import stage_ground
+    try:
+        data = stage_ground(_ws(root))
+    except RclError as exc:
+        return _fail(exc)
+    c = data["counts"]
+    print(f"grounding: {c['error']} error(s), {c['warning']} warning(s) (rclverify ros check lists them)")
+    return None
+
+
+def ros_fingerprint(root: Path, ros: Mapping[str, Any]) -> list[tuple[str, int, int]]:
+    """(path, size, mtime_ns) of every file under the ``ros:`` section's paths:
+    the grounding task runs again when one changes (the scan's own cache then
+    re-parses only the changed files)."""
+    out: list[tuple[str, int, int]] = []
+    for key in ("workspaces", "launch", "bags"):
+        for rel in ros.get(key, []) or []:
+            top = root / str(rel)
+            files = [top] if top.is_file() else sorted(p for p in top.rglob("*") if p.is_file()) if top.is_dir() else []
+            for p in files:
+                try:
+                    st = p.stat()
+                except OSError:
+                    continue
+                out.append((str(p.relative_to(root)), st.st_size, st.st_mtime_ns))
+    for key in ("mapping",):
+        if ros.get(key):
+            p = root / str(ros[key])
+            if p.is_file():
+                st = p.stat()
+                out.append((str(ros[key]), st.st_size, st.st_mtime_ns))
+    return out
+
+
+def act_verify(root: str, strict: bool) -> Any:
+    """The ``verify`` task: print the run's status, problems and summary table
+    (:func:`rclverify.report.summary.print_last_run`); with ``strict``, fail
+    unless every item holds."""
+    from rclverify.app.progress import PlainFailure
+    from rclverify.lang.errors import RclError
+    from rclverify.report.summary import print_last_run, strict_sentence
+    try:
+        data = print_last_run(Path(root))
+    except RclError as exc:  # the last run's summary is missing or of another shape: one located line
+        return PlainFailure("\n".join(str(d) for d in exc.diagnostics))
+    if strict and not data["meta"]["strict_ok"]:
+        return PlainFailure(strict_sentence(data))  # one sentence naming why (issue 30)
+    return None
+
+
+class RecordIntact:
+    """doit ``uptodate`` check of an evidence task: its record is as rclverify
+    wrote it.  A record changed by anything else (a hand edit of its status)
+    makes the task run again, so ``doit verify`` produces the evidence anew
+    instead of believing it (the report of a run that does not re-run it,
+    ``rclverify report``, shows it as ``error``: evidence altered).
+
+    Cheap on a no-op run: after the task ran, the record's size and
+    modification time are saved with doit's task values; while they are the
+    same the record is not read.  Otherwise its seal is checked
+    (:meth:`rclverify.records.store.EvidenceStore.read`)."""
+
+    __signature__ = inspect.Signature([inspect.Parameter("task", inspect.Parameter.POSITIONAL_OR_KEYWORD),
+                                       inspect.Parameter("values", inspect.Parameter.POSITIONAL_OR_KEYWORD)])
+
+    def __call__(self, task: Any, values: Mapping[str, Any]) -> bool:
+        target = task.targets[0]
+
+        def stat() -> dict[str, Any]:
+            try:
+                st = os.stat(target)
+            except OSError:
+                return {}
+            return {"_record_stat": [st.st_mtime_ns, st.st_size]}
+        task.value_savers.append(stat)
+        now = stat()
+        if not now:
+            return False
+        if values.get("_record_stat") == now["_record_stat"]:
+            return True
+        from rclverify.records.store import EvidenceStore
+        root, _, name = target.rpartition("/artifacts/evidence/")
+        try:
+            ev, problem = EvidenceStore(Path(root)).read(name[:-len(".json")])
+        except Exception as exc:  # noqa: BLE001 - whatever the file holds, the task produces it again
+            ev, problem = None, f"evidence record unreadable ({exc.__class__.__name__}): altered outside rclverify"
+        if problem:
+            print(f"{os.path.relpath(target, root)}: {problem}: producing it again")
+            return False
+        return ev is not None
+
+
+def strict_uptodate(task: Any, values: Any) -> bool:
+    """``verify`` is up to date unless ``--strict`` asks for the check again."""
+    return not bool(task.options.get("strict"))
+
+
+def _inputs(config: Any, root: Path, seen: dict[str, tuple[str, ...]]) -> list[str]:
+    """Workspace files named in a plan evidence entry (strings that are existing paths).
+
+    The values of tool keys (``dafny: PATH``, ``mcapl_home``, ``options``:
+    :data:`rclverify.model.plan.entries.TOOL_KEYS`) name installed tools, not
+    workspace files, and are never file dependencies (an absolute tool path
+    joined to the workspace root was a dependency on a file that does not
+    exist, a doit DependencyError); nor is any absolute path (the plan check
+    refuses those everywhere else).
+
+    ``seen`` memoises the files of each path string across calls (the
+    entries of many nodes name the same program or directory: one stat or
+    directory walk per distinct string)."""
+    out: set[str] = set()
+
+    def files(v: str) -> tuple[str, ...]:
+        if v not in seen:
+            p = root / v
+            py = v.rsplit(":", 1)[0] if ":" in v else v
+            if py.endswith(".py") and (root / py).is_file():
+                # a Python implementation (`file.py:callable`): the file and every workspace module it imports,
+                # so that a changed helper exports the obligations, and their inputs, again (issue 63, row 2)
+                from rclverify.backends.property_tests.closure import import_closure
+                seen[v] = tuple(import_closure(root, py)[0])
+            elif not p.exists():
+                seen[v] = ()
+            elif p.is_dir():
+                seen[v] = tuple(os.path.relpath(f, root) for f in glob.glob(str(p / "**" / "*"), recursive=True)
+                                if os.path.isfile(f))
+            else:
+                seen[v] = (v,)
+        return seen[v]
+
+    def walk(v: Any) -> None:
+        if isinstance(v, str) and "/" in v and not os.path.isabs(v):
+            out.update(files(v))
+        elif isinstance(v, dict):
+            for k, x in v.items():
+                if k not in TOOL_KEYS:
+                    walk(x)
+        elif isinstance(v, list):
+            for x in v:
+                walk(x)
+    walk(dict(config))
+    return sorted(out)
+
+
+def _z3_version() -> str:
+    """The installed z3-solver's version (from its metadata: importing Z3 costs a no-op run
+    a fifth of a second).  Every verdict comes from Z3, so another version makes them again."""
+    from importlib.metadata import PackageNotFoundError, version
+    try:
+        return version("z3-solver")
+    except PackageNotFoundError:
+        return "-"
+
+
+def _tool_fingerprint() -> dict[str, Any]:
+    from rclverify import __version__
+    return {"rclverify": __version__, "dafny": shutil.which("dafny"), "mcapl": os.environ.get("MCAPL_HOME") or os.environ.get("AJPF_HOME"),
+            "dot": shutil.which("dot"), "spin": shutil.which("spin")}
+
+
+#: Where doit keeps the state of each task (its file_dep signatures), relative to the workspace.
+DEP_FILE = ".doit.sqlite"
+
+
+def doit_config(dep_file: str = DEP_FILE) -> dict[str, Any]:
+    """``DOIT_CONFIG`` of a workspace's ``dodo.py`` (and of ``rclverify verify``):
+    ``verify`` by default, the progress reporter, and doit's SQLite
+    dependency store in ``dep_file``.
+
+    SQLite rather than doit's default ``dbm`` store: with Python's fallback
+    ``dbm.dumb`` (no gdbm on many systems) opening the store parses one line
+    per task with ``ast.literal_eval``, about 0.3 CPU s of a 1000-node no-op
+    run when it had 5000 tasks (docs/scale.md).  A workspace that switches store runs
+    every task once, as doit knows no earlier state in the new file."""
+    from rclverify.app.progress import ProgressReporter
+    return {"default_tasks": ["verify"], "verbosity": 2, "dep_file": dep_file, "backend": "sqlite3",
+            "reporter": ProgressReporter}
+
+
+def _linear_implicit_task_dep(targets: dict[str, str], task: Any, deps_list: Sequence[str]) -> None:
+    """doit's ``TaskControl.add_implicit_task_dep`` with a set for the
+    membership test: the same task dependencies in the same order.  doit's
+    own tests ``name not in task.task_dep`` on a list, which is quadratic
+    for a task whose file dependencies are the targets of thousands of
+    tasks (each report task of a 1000-node system: 5,000 file dependencies
+    from 3,000 tasks, a seventh of a second per task per run)."""
+    have = set(task.task_dep)
+    for dep in deps_list:
+        name = targets.get(dep)
+        if name is not None and name not in have:
+            task.task_dep.append(name)
+            have.add(name)
+
+
+def _use_linear_implicit_task_dep() -> None:
+    """Install :func:`_linear_implicit_task_dep` in doit (idempotent), when
+    doit's own has the signature it replaces (``pyproject.toml`` pins the
+    doit versions it was checked against; ``tests/test_tasks_doit.py``
+    compares the two)."""
+    from doit.control import TaskControl
+    current = TaskControl.add_implicit_task_dep
+    if current is _linear_implicit_task_dep:
+        return
+    if list(inspect.signature(current).parameters) == ["targets", "task", "deps_list"]:
+        DOIT_IMPLICIT_TASK_DEP.append(current)
+        TaskControl.add_implicit_task_dep = staticmethod(_linear_implicit_task_dep)
+
+
+#: doit's own implicit-dependency scan, once replaced (for the test that compares the two).
+DOIT_IMPLICIT_TASK_DEP: list[Callable[..., None]] = []
+
+
+def _guard_dep_writes() -> None:
+    """Make a full disk (or a read-only workspace) while doit writes its task
+    state end the run with one plain line and exit code 1, instead of doit's
+    traceback (``sqlite3.OperationalError: database or disk is full``, exit
+    3).  Wraps the writing methods of ``doit.dependency.SqliteDB`` (the store
+    :func:`doit_config` selects: ``dump`` at the end of a run, ``remove`` when
+    a task fails) once per process; what the run wrote is complete (every
+    write is atomic), only doit's record of it is lost, so its tasks run
+    again next time.  ``SystemExit`` passes through doit's own handler."""
+    import sqlite3
+    import sys
+    from doit.dependency import SqliteDB
+
+    def guard(method: Callable[..., Any]) -> Callable[..., Any]:
+        def guarded(self: Any, *args: Any) -> Any:
+            try:
+                return method(self, *args)
+            except (sqlite3.Error, OSError) as exc:
+                print(f"error: cannot save doit's task state in {os.path.basename(self.name)}: {exc} (free some "
+                      "space or make the workspace writable, and run again); what this run wrote is complete, and "
+                      "its tasks run again next time", file=sys.stderr)
+                raise SystemExit(1) from None
+        guarded._rclverify_guarded = True  # type: ignore[attr-defined]
+        return guarded
+    for name in ("dump", "remove"):
+        method = getattr(SqliteDB, name)
+        if not getattr(method, "_rclverify_guarded", False):
+            setattr(SqliteDB, name, guard(method))
+
+
+def build_tasks(root: str | Path, plan_file: str = "contracts/plan.yaml", *,
+                wait: bool | None = None) -> dict[str, Callable[[], Any]]:
+    """The ``task_*`` functions for a dodo.py of the workspace at ``root``.
+
+    First takes the workspace's run lock (:mod:`rclverify.core.runlock`: one run
+    at a time; a second run waits with the message ``waiting for the run in
+    progress (pid N)``, or with ``wait=False`` / ``RCLVERIFY_NO_WAIT=1``
+    does not wait).  The lock is given back when doit completes the run
+    (the progress reporter) or the process ends.  When the lock cannot be
+    had without waiting, or its file cannot be created, prints one
+    ``error:`` line and raises ``SystemExit(1)`` (``dodo.py`` has no other
+    way to end a doit command cleanly).
+
+    The loaded workspace stays live for the run: it is loaded without
+    cyclic garbage collection and then frozen for the run
+    (:mod:`rclverify.core.cache.heap`; the progress reporter gives it back to the
+    collector when doit completes the run)."""
+    import sys
+    from rclverify.core import runlock
+    from rclverify.core.faults import describe_os_error
+    rootp = Path(root)
+    if not rootp.is_dir():
+        print(f"{root}: error: no such workspace directory", file=sys.stderr)
+        raise SystemExit(1)
+    try:
+        runlock.acquire(rootp, wait=wait)
+    except runlock.RunInProgress as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        raise SystemExit(1) from None
+    except OSError as exc:
+        print(describe_os_error(exc, rootp.resolve(), "cannot take the run lock in"), file=sys.stderr)
+        raise SystemExit(1) from None
+    with heap.no_collection():
+        creators = _build_tasks(root, plan_file)
+        heap.freeze_for_run()  # before collecting again: what was made while loading is not looked at
+    return creators
+
+
+def _build_tasks(root: str | Path, plan_file: str) -> dict[str, Callable[[], Any]]:
+    _use_linear_implicit_task_dep()
+    _guard_dep_writes()
+    rootp = Path(root).resolve()
+    r = str(rootp)
+    ws = Workspace(rootp, plan_file)
+    restored = wscache.restore(ws)  # the loaded workspace of an earlier run, when no input changed
+    index: TaskIndex | None
+    try:
+        index = ws.index  # from the cache (no-op runs) or the loaded plan and model
+    except RclError:
+        index = None
+    ok = index is not None
+    nodes = list(index.nodes) if index is not None else []
+    if ok:
+        _WORKSPACES[r] = ws
+        if not restored:
+            wscache.save_in_background(ws)
+    else:
+        _WORKSPACES.pop(r, None)
+    try:
+        contract_deps = [f"{r}/{c}" for c in (index.contracts if index is not None else ws.plan.contracts)]
+    except RclError:
+        contract_deps = []
+
+    def at(rel: str) -> str:
+        """The absolute path of a workspace-relative artifact path (string
+        joining: ``pathlib`` cost 0.3 s of a 1000-node no-op run)."""
+        return f"{r}/{rel}"
+
+    snap = {n: at(ws.snapshot(n)) for n in nodes}
+    # Every task that makes a result depends on the rclverify code that makes it: another version
+    # (an upgrade, a changed module) makes every result again, as a clean run would.
+    code_version = {"rclverify": code_stamp(), "z3": _z3_version()}
+    code = config_changed(code_version)
+    code.__signature__ = inspect.signature(code)  # answered at once by doit (see task_evidence)
+
+    # Only files that exist are file dependencies (doit refuses a missing one with a DependencyError):
+    # a missing plan or contract makes `check` run, and fail with the located message, every time.
+    named = [str(rootp / plan_file)] + contract_deps
+    check_deps = [d for d in named if os.path.isfile(d)]
+    from rclverify.records.sealed import TargetsSealed  # a sealed record altered outside rclverify is made again
+    sealed = TargetsSealed()
+    check_extra: dict[str, Any] = {"uptodate": [False] if len(check_deps) < len(named) or not ok else [code, sealed]}
+
+    def task_check() -> dict[str, Any]:
+        """Parse and type-check the contracts, check the plan, lint, build the system model."""
+        return {"actions": [(act_check, [r, plan_file])], "file_dep": check_deps,
+                "targets": list(snap.values()) + [at(ws.cone(n)) for n in nodes]
+                + [str(rootp / p) for p in (ws.MODEL, ws.DIAGNOSTICS)],
+                "verbosity": 2, "clean": True, **check_extra}
+
+    def task_graph() -> dict[str, Any]:
+        """Write the system model as DOT and, with graphviz, draw it as SVG (doit graph)."""
+        return {"actions": [(act_graph, [r])], "file_dep": [str(rootp / ws.MODEL)], "targets": [str(rootp / ws.DOT)],
+                "task_dep": ["check"], "uptodate": [config_changed(shutil.which("dot") or "")], "verbosity": 2}
+
+    def task_node() -> Iterator[dict[str, Any]]:
+        """One task per node: its calculus, health checks and exported obligations."""
+        from rclverify.app.conetask import ConeUnchanged
+        assert index is not None  # registered only when ok, i.e. the model was built
+        model_json, seen = at(ws.MODEL), dict[str, tuple[str, ...]]()
+        yield {"basename": "node", "name": None,
+               "doc": "Per node, each when its own inputs changed: apply the calculus (R1-R4, side conditions "
+                      "discharged with Z3), check contract health, export the guarantees as obligations."}
+        for n in nodes:
+            repl = index.replacement.get(n)
+            deps = {
+                "compose": [snap[n], *(snap[p] for p in index.producers[n]), model_json],
+                "health": [snap[n]] + ([str(rootp / repl)] if repl and (rootp / repl).is_file() else []),
+                "export": [snap[n]] + [at(f) for config in index.entries.get(n, ()) for f in _inputs(config, rootp, seen)],
+            }
+            # the upstream cone: a file the check writes, read by an uptodate check (app/conetask.py), not a
+            # file_dep: only a composition that read the cone runs again when the cone changes
+            cone = ConeUnchanged(at(ws.cone(n)), at(ws.provenance(n)), ws.cone(n))
+            yield {"name": n, "actions": [(act_node, [r, n, deps])],
+                   "file_dep": sorted({d for ds in deps.values() for d in ds}),
+                   "targets": [at(ws.calculus(n)), at(ws.health(n)), at(ws.obligations(n))],
+                   "uptodate": [code, sealed, cone], "verbosity": 2, "clean": True}
+
+    def task_requirements() -> dict[str, Any]:
+        """Check each requirement's formal statement with Z3 from the guarantees of its cone.  Defined before
+        the evidence and report tasks: doit orders tasks by where their creators are defined, and the
+        report parts must run in their usual order after it (their fragment caches, report/fragments.py)."""
+        assert index is not None
+        from rclverify.stages.requirements import INDEX
+        extra: list[str] = []
+        if index.requirement_dirs:
+            from rclverify.model.plan.doorstop import doorstop_files
+            for d in index.requirement_dirs:
+                extra += [str(rootp / f) for f in doorstop_files(rootp, d)]
+        for configs in index.entries.values():  # recorded runs checked against temporal requirements (docs/plan.md)
+            for c in configs:
+                if hasattr(c, "get") and c.get("traces") and isinstance(c.get("mapping"), str) \
+                        and (rootp / c["mapping"]).is_file():
+                    extra.append(str(rootp / c["mapping"]))
+            for tr in (t for c in configs if hasattr(c, "get") for t in c.get("traces") or () if isinstance(t, str)):
+                p = rootp / tr
+                extra += sorted(str(f) for f in p.rglob("*") if f.is_file()) if p.is_dir() else [str(p)] if p.is_file() else []
+        return {"actions": [(act_requirements, [r])],
+                "file_dep": [str(rootp / plan_file), at(ws.MODEL)] + list(snap.values()) + sorted(set(extra)),
+                "targets": [at(INDEX)], "uptodate": [code, sealed], "verbosity": 2, "clean": True}
+
+    deadline_nodes = list(index.deadline_nodes) if index is not None else []
+
+    def task_deadlines() -> dict[str, Any]:
+        """Decide each requirement's end-to-end deadline with Z3 (rule D3: deadlines add along its path)."""
+        from rclverify.stages.deadlines import INDEX as DEADLINES
+        return {"actions": [(act_deadlines, [r])],
+                "file_dep": [str(rootp / plan_file), at(ws.MODEL)] + [snap[n] for n in deadline_nodes if n in snap],
+                "targets": [at(DEADLINES)], "uptodate": [code, sealed], "task_dep": ["check"], "verbosity": 2,
+                "clean": True}
+
+    exported_memo: list[list[tuple[str, dict[str, Any]]]] = []
+
+    def exported() -> list[tuple[str, dict[str, Any]]]:
+        """(node, obligation JSON) of every exported obligation (read after export ran;
+        once per run: the evidence and report tasks are both created after it)."""
+        if not exported_memo:
+            exported_memo.append(read_exported())
+        return exported_memo[0]
+
+    def read_exported() -> list[tuple[str, dict[str, Any]]]:
+        from rclverify.records.sealed import obligation_list
+        out: list[tuple[str, dict[str, Any]]] = []
+        for n in nodes:
+            records, _ = obligation_list(at(ws.obligations(n)))  # sealed: an altered list is made again first
+            out.extend((n, o) for o in records or [])
+        return out
+
+    @create_after(executed="node")
+    def task_evidence() -> Iterator[dict[str, Any]]:
+        """Run the backends: one task per obligation, one evidence record each."""
+        yield {"basename": "evidence", "name": None, "doc": "Run each backend on its obligations and record evidence."}
+        # One check for every evidence task: the tools found on PATH (searched once, not per
+        # obligation).  doit inspects an uptodate callable's signature for every task on every run
+        # (2000 `inspect.signature` calls, a third of a second at 1000 nodes); a precomputed
+        # `__signature__` (PEP 362) answers it at once.
+        # One config_changed per task: doit saves every config_changed of a task under one key, so a
+        # second one would overwrite the first's value and the task would never be up to date.
+        tools_unchanged = config_changed({**_tool_fingerprint(), **code_version})
+        tools_unchanged.__signature__ = inspect.signature(tools_unchanged)
+        record_intact = RecordIntact()
+        input_file: dict[str, str | None] = {}  # input -> its absolute path when it is a file (one stat per input)
+
+        def input_dep(rel: str) -> str | None:
+            if rel not in input_file:
+                p = rel if os.path.isabs(rel) else at(rel)  # strings, not pathlib: 0.1 s of a 1000-node no-op
+                input_file[rel] = p if os.path.isfile(p) else None
+            return input_file[rel]
+        for n, o in exported():
+            deps = [at(ws.obligation(n, o["id"]))]
+            deps += [d for d in map(input_dep, o["inputs"]) if d is not None]
+            yield {"name": o["id"], "actions": [(act_run, [r, n, o["id"]])], "file_dep": sorted(set(deps)),
+                   "targets": [at(ws.evidence(o["id"]))], "uptodate": [tools_unchanged, record_intact],
+                   "verbosity": 2, "clean": True}
+
+    ros_section = dict(index.ros) if index is not None else {}  # from the index: a no-op run loads no contract
+
+    @create_after(executed="evidence")
+    def task_crosscheck() -> dict[str, Any]:
+        """Decide every discharging Z3 query again with cvc5 from its SMT-LIB2 text (docs/second-solver.md)."""
+        from rclverify.stages.crosscheck.stage import INDEX as CROSS
+        deps = [at(ws.calculus(n)) for n in nodes] + [at(ws.health(n)) for n in nodes]
+        deps += [at(ws.obligations(n)) for n in nodes]
+        deps += [at(ws.evidence(o["id"])) for _, o in exported() if o.get("backend") == "hoare"]
+        deps.append(at("artifacts/requirements/index.json"))
+        if deadline_nodes:
+            deps.append(at("artifacts/deadlines/index.json"))
+        return {"actions": [(act_crosscheck, [r, list(nodes)])], "file_dep": deps,
+                "targets": [at(CROSS)], "uptodate": [code, sealed], "verbosity": 2, "clean": True}
+
+    def task_ground() -> dict[str, Any]:
+        """Ground the contracts in the ROS software of the plan's ros: section (docs/ros.md)."""
+        return {"actions": [(act_ground, [r])], "file_dep": [str(rootp / plan_file)] + contract_deps,
+                "uptodate": [config_changed({"files": ros_fingerprint(rootp, ros_section)}), sealed],
+                "targets": [at("artifacts/ros/grounding.json"), at("artifacts/ros/graph.json")],
+                "task_dep": ["check"], "verbosity": 2, "clean": True}
+
+    @create_after(executed="evidence")
+    def task_report() -> Iterator[dict[str, Any]]:
+        """Roll everything up into the report files: two parts, rendered at once by doit -n 2."""
+        yield {"basename": "report", "name": None,
+               "doc": "Roll everything up into reports/ (assurance.{html,md,json}, the CI formats, the argument)."}
+        # The plan itself: the report shows its name, requirements and their tracing, which no
+        # other artifact holds (a plan edit that changes only those re-renders the report).
+        deps = [str(rootp / plan_file)] + [at(p) for p in (ws.MODEL, ws.DIAGNOSTICS)] + list(snap.values())
+        # The files meta.inputs_sha256 hashes (workspace.check_inputs): the contract and replacement files
+        # themselves, not only the snapshots they give. An edit that changes none of the snapshots (a comment
+        # after the last node) left the report naming the old files' sha256, and the bundle then refused a
+        # report `doit verify` called up to date.
+        deps += [d for d in (at(f) for f in check_input_files(ws)) if d not in deps and os.path.isfile(d)]
+        for n in nodes:
+            deps += [at(ws.calculus(n)), at(ws.health(n)), at(ws.obligations(n))]
+        deps += [at(ws.evidence(o["id"])) for _, o in exported()]
+        deps.append(at("artifacts/requirements/index.json"))  # the requirements task's target
+        if ros_section:
+            deps.append(at("artifacts/ros/grounding.json"))
+        if deadline_nodes:
+            deps.append(at("artifacts/deadlines/index.json"))  # the deadlines task's target
+        deps.append(at("artifacts/crosscheck/index.json"))  # the second solver's verdicts
+        for part, files in REPORT_PARTS.items():
+            # task_dep on crosscheck: both are created after `evidence`, and when the report's loader runs
+            # first doit does not yet know which task makes the second solver's index (its file_dep alone
+            # then let doit -n 2 render the report beside crosscheck, from no index)
+            yield {"name": part, "doc": "reports/" + ", ".join(files), "actions": [(act_report, [r, part])],
+                   "file_dep": deps, "task_dep": ["crosscheck"], "uptodate": [code, sealed],
+                   "targets": [at(f"reports/{f}") for f in files if f != "argument.svg"]
+                   + ([at(ws.SUMMARY)] if part == "html" else []),
+                   "verbosity": 2, "clean": True}
+
+    def task_verify() -> dict[str, Any]:
+        """The whole pipeline: check, compose, health, export, run, report.  --strict fails on any open evidence."""
+        # `requirements` (and `ground`) before `report`: reached only through the report's file dependencies,
+        # they would make report:html wait and report:text run first (their fragment caches expect html first)
+        before = (["requirements"] + (["deadlines"] if deadline_nodes else []) + ["crosscheck"]
+                  + (["ground"] if ros_section else []))
+        return {"actions": [(act_verify, [r])], "task_dep": ["check", *before, "report"] if ok else ["check"],
+                "file_dep": [str(rootp / REPORTS[2])] if ok else [],
+                "params": [{"name": "strict", "long": "strict", "type": bool, "default": False,
+                            "help": "fail unless every obligation, side condition, health check and formal requirement holds"}],
+                "uptodate": [strict_uptodate], "verbosity": 2}
+
+    creators: dict[str, Callable[[], Any]] = {"task_check": task_check, "task_verify": task_verify}
+    if ok:
+        creators.update({"task_graph": task_graph, "task_node": task_node, "task_requirements": task_requirements,
+                         "task_evidence": task_evidence, "task_report": task_report,
+                         "task_crosscheck": task_crosscheck})
+        if ros_section:
+            creators["task_ground"] = task_ground
+        if deadline_nodes:
+            creators["task_deadlines"] = task_deadlines
+    return creators

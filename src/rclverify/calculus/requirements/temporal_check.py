@@ -1,0 +1,334 @@
+"""Decide a temporal requirement over the composed system (docs/requirements.md).
+
+The statement (:mod:`rclverify.model.plan.temporal`) is decided over the
+transition system of its cone (:mod:`.transition`) by the engine of
+:mod:`.temporal`:
+
+==========================  ===============================================
+statement                   decided by
+==========================  ===============================================
+``always F``                BMC then k-induction (``proved`` with k)
+``always next F``           the same from step 1 on
+``eventually[<= N] F``      unrolling N steps (exact)
+``eventually F``            the plan's ``ranking:`` (and ``invariant:``)
+                            valid (proved, method ``ranking``); every run
+                            reaches F within the bound (proved); a lasso
+                            missing F (refuted); else inconclusive with the
+                            bound checked: never met on a bound
+``next F``                  one step (exact)
+``F until G``               ``always (G seen or F)`` and ``eventually G``
+``always (P -> eventually   ``always`` of a monitor variable: the age of the
+[<= N] Q)``, ``always       oldest P not yet answered (BMC, k-induction;
+(P -> next Q)``             :mod:`.response`)
+``always (P -> eventually   a P pending: the plan's ranking function, or
+Q)``                        the bounded form for a small N (proved); a
+                            lasso with a P pending around its loop
+                            (refuted); else inconclusive (:mod:`.response`)
+==========================  ===============================================
+
+Other nestings raise a located ``E-temporal`` error (the plan's
+``resolve`` reports it through :func:`shape`).  The record has the fields of
+a state requirement's (:func:`.check.check_requirement`) so that the
+roll-up (:mod:`.rollup`) treats both alike, plus ``temporal``: ``{status,
+method, k, bound, loop, detail, trace}`` with ``trace`` one entry per step,
+``{"step": i, "nodes": [{"node", "values": {"in.x": v}}]}``.  A proof uses
+every premise of the cone (there is no unsat core of an induction), so
+``met`` needs the evidence of every guarantee of the cone discharged, with
+one exception: a node's ``initially`` that the proof also holds without
+(:mod:`.initial_needed`) is traced, not needed; a
+system with no run at all (its premises contradict each other) proves
+anything, and is reported ``consistency: inconsistent``.
+"""
+from __future__ import annotations
+
+import time
+from typing import Any, Callable, Collection
+
+import z3
+
+from rclverify.model.plan.formal import Formal, parse_formal
+from rclverify.model.plan.load import Plan, Requirement
+from rclverify.model.plan.ranking import parse_hints
+from rclverify.model.plan.state import state_types
+from rclverify.model.plan.temporal import Temporal, operands, parse_temporal, shape
+from rclverify.calculus.health.witness import points_for
+from rclverify.lang.types import Checked, EmptyT
+from rclverify.semantics.values import render
+from rclverify.model.system.model import SystemModel
+from rclverify.calculus.requirements.deadlock import runs_go_on
+from rclverify.calculus.requirements.safety import Hint, prove_always
+from rclverify.calculus.requirements.temporal import (TemporalVerdict, TransitionSystem, check_always, check_eventually,
+                       check_eventually_within, check_next, check_until, find_lasso, with_flag)
+from rclverify.calculus.requirements.lasso import find_table_lasso
+from rclverify.calculus.requirements.lasso_confirm import confirm_lasso
+from rclverify.calculus.requirements.initial_needed import initially_not_needed
+from rclverify.calculus.requirements.progress_gap import EVEN_SO, explain_idle, stuck_in_loop, stuck_words
+from rclverify.calculus.requirements.transition import ComposedSystem, build_system, variable_types
+
+#: The bound of BMC for an unbounded ``eventually`` and of k-induction's k.
+DEFAULT_BOUND = 10
+#: Each Z3 query's budget (ms): an unknown is inconclusive, never upgraded.
+TIMEOUT_MS = 2_000
+
+
+def is_temporal(req: Requirement, checked: Checked, plan: Plan) -> bool:
+    """Whether ``req``'s formal statement has a temporal operator."""
+    if req.formal is None:
+        return False
+    return isinstance(parse_temporal(req.formal, checked, req.id, state_types(plan.states, checked)), Temporal)
+
+
+def statement(req: Requirement, checked: Checked, plan: Plan) -> Temporal:
+    """The parsed temporal statement of ``req`` (raises :class:`RclError`)."""
+    t = parse_temporal(req.formal, checked, f"{req.id} formal", state_types(plan.states, checked))
+    assert isinstance(t, Temporal)
+    return t
+
+
+#: A table search over a system: ``tables(F, v, ts)`` (:func:`check_temporal`).
+Tables = Callable[[Formal, TemporalVerdict, TransitionSystem], TemporalVerdict]
+
+
+def decide(t: Temporal, sys: ComposedSystem, pred: Callable[[Formal], Callable[[Any], Any]], *,
+           bound: int = DEFAULT_BOUND, timeout_ms: int = 10_000, tables: Tables | None = None,
+           ranking: Callable[[Any], Any] | None = None, invariant: Callable[[Any], Any] | None = None,
+           checked: Checked | None = None, gaps: dict[str, Any] | None = None,
+           tables_first: bool = False, reach: Callable[[Formal], Callable[[Any], Any]] | None = None,
+           hint_text: str = "") -> TemporalVerdict:
+    """Decide statement ``t`` over ``sys`` (module table); ``pred(F)`` is
+    F as a predicate over one state where F must hold (under ``always``,
+    the left of ``until``), ``reach(F)`` (default ``pred``) where F must be
+    reached (under ``eventually`` and ``next``, the right of ``until``): on
+    published values, :mod:`.published`.  ``tables(F, v, ts)`` is asked when the
+    verdict ``v`` on an unbounded ``eventually F`` over ``ts`` is
+    inconclusive (the finite-table lasso search of :func:`check_temporal`);
+    with ``tables_first`` (the system has function-typed variables, over
+    which Z3's general bounded query seldom decides: issue 44, "decide first
+    with what decides") it is asked first, on the system in which every node
+    answers what it accepts, and a confirmed lasso there is the verdict
+    without the general query;
+    ``ranking`` and ``invariant`` (over one state) are the plan's, for that
+    ``eventually``.  A lasso in which a node never answers what it accepts
+    is explained (:func:`.progress_gap.explain_idle`, with ``checked``): what
+    is missing is put in ``gaps`` (``missing_progress``, ``missing_initially``).  A verdict ``proved`` stands
+    only if no run of the system stops (:func:`.deadlock.runs_go_on`).  ``invariant`` (written ``hint_text``)
+    also strengthens the proof of a safety shape (``always``, ``always next``, the bounded and next
+    response, ``until``'s safety part: :func:`.safety.prove_always`, which tries IC3/PDR too)."""
+    hint = Hint(invariant, hint_text or "invariant:") if invariant is not None else None
+    return runs_go_on(sys.ts, _decide(t, sys, pred, bound, timeout_ms, tables, ranking, invariant, checked,
+                                      gaps if gaps is not None else {}, tables_first, reach or pred, hint),
+                      max_k=bound, timeout_ms=timeout_ms)
+
+
+def _decide(t: Temporal, sys: ComposedSystem, pred: Callable[[Formal], Callable[[Any], Any]], bound: int,
+            timeout_ms: int, tables: Tables | None,
+            ranking: Callable[[Any], Any] | None, invariant: Callable[[Any], Any] | None,
+            checked: Checked | None, gaps: dict[str, Any], tables_first: bool = False,
+            reach: Callable[[Formal], Callable[[Any], Any]] | None = None, hint: Hint | None = None) -> TemporalVerdict:
+    kind = shape(t, None)
+    got = reach or pred
+    ts = sys.ts
+
+    def even_so(w: TemporalVerdict) -> TemporalVerdict:
+        """A lasso of the synchronous system: the goal is missed even with progress, unless the loop
+        never starts for want of a published value (then the initial values to declare are named)."""
+        stuck = stuck_in_loop(w.trace, w.loop, sys, checked) if checked is not None else []
+        gaps["missing_initially"] = stuck
+        said = stuck_words(stuck) if stuck else EVEN_SO
+        return TemporalVerdict(w.status, w.method, k=w.k, bound=w.bound, trace=w.trace, loop=w.loop,
+                               deadlock=w.deadlock, detail=f"{w.detail}; {said}")
+
+    def eventually(g: Formal) -> TemporalVerdict:
+        tried_sync = False
+        if tables_first and tables is not None and checked is not None and not sys.eager:
+            w = tables(g, TemporalVerdict("inconclusive", "bounded"), sys.synchronous(ts))
+            if w.status == "refuted":  # a confirmed lasso of the declared system: the general query cannot undo it
+                return even_so(w)
+            tried_sync = True
+        v = check_eventually(ts, got(g), ranking=ranking, invariant=invariant, bound=bound, timeout_ms=timeout_ms,
+                             prove=lambda ts2, p: prove_always(ts2, p, max_k=bound, timeout_ms=timeout_ms))
+        by_tables = tables is not None and v.status == "inconclusive"
+        if by_tables and checked is not None and not sys.eager and not tried_sync:
+            # every node answering what it accepts at once: the query Z3 decides best, and a lasso there is one
+            # of the declared system that rests on no missing progress (.progress_gap)
+            w = tables(g, v, sys.synchronous(ts))  # type: ignore[misc]
+            if w.status == "refuted":
+                return even_so(w)
+            tried_sync = True
+        if by_tables:
+            v = tables(g, v, ts)  # type: ignore[misc]
+        if checked is None:
+            return v
+
+        def search(ts2: TransitionSystem) -> TemporalVerdict | None:
+            if by_tables:
+                w = tables(g, TemporalVerdict("inconclusive", "lasso"), ts2)  # type: ignore[misc]
+                return w if w.status == "refuted" else None
+            return find_lasso(ts2, got(g), bound, timeout_ms=timeout_ms)
+        v, found = explain_idle(v, sys, ts, checked, search, tried_sync=tried_sync)
+        gaps.update(found)
+        return v
+    if kind == "always":
+        return prove_always(ts, pred(t.args[0]), max_k=bound, timeout_ms=timeout_ms, hint=hint)
+    if kind == "response":  # always (P -> eventually[<= N] Q) / always (P -> next Q): calculus/requirements/response.py
+        from rclverify.calculus.requirements.response import check_response, check_unbounded_response
+        p, r = t.args[0].args  # type: ignore[union-attr]
+        if r.op == "eventually" and r.bound is None:  # type: ignore[union-attr]
+            return check_unbounded_response(ts, got(p), got(r.args[0]), max_k=bound,  # type: ignore[arg-type, union-attr]
+                                            timeout_ms=timeout_ms, ranking=ranking, invariant=invariant)
+        within = r.bound if r.op == "eventually" else None  # type: ignore[union-attr]
+        return check_response(ts, got(p), got(r.args[0]), within, max_k=bound,  # type: ignore[arg-type, union-attr]
+                              timeout_ms=timeout_ms, hint=hint)
+    if kind == "always next":
+        f = pred(t.args[0].args[0])  # type: ignore[union-attr]
+        ts2 = with_flag(ts, "<started>", lambda s: z3.BoolVal(False), lambda s, u: z3.BoolVal(True))
+        return prove_always(ts2, lambda s: z3.Or(z3.Not(s["<started>"]), f(s)), max_k=bound, timeout_ms=timeout_ms,
+                            hint=hint)
+    if kind == "next":
+        return _exact(check_next(ts, got(t.args[0]), timeout_ms=timeout_ms), hint)
+    if kind == "eventually":
+        f = got(t.args[0])
+        if t.bound is not None:
+            v = check_eventually_within(ts, f, t.bound, timeout_ms=timeout_ms)
+            return _exact(TemporalVerdict("proved", v.method, bound=v.bound, detail=v.detail,
+                                          deadlock=v.deadlock) if v.status == "met" else v, hint)
+        return eventually(t.args[0])  # type: ignore[arg-type]
+    return check_until(ts, pred(t.args[0]), got(t.args[1]), eventually=lambda: eventually(t.args[1]),  # type: ignore[arg-type]
+                       max_k=bound, timeout_ms=timeout_ms,
+                       always=lambda ts2, p: prove_always(ts2, p, max_k=bound, timeout_ms=timeout_ms, hint=hint))
+
+
+def _exact(v: TemporalVerdict, hint: Hint | None) -> TemporalVerdict:
+    """``v``, decided exactly by unrolling (``next F``, ``eventually[<= N] F``), with a note that the plan's
+    invariant was not needed."""
+    if hint is not None:
+        v.detail = "; ".join(x for x in (v.detail, f"the invariant {hint.text!r} is not needed: this statement is "
+                                                     "decided exactly by unrolling the steps it speaks of") if x)
+    return v
+
+
+def _steps(trace: list[dict[str, str]], sys: ComposedSystem) -> list[dict[str, Any]]:
+    """A trace as steps x nodes: ``[{"step": i, "nodes": [{"node", "values"}]}]``."""
+    out = []
+    for i, st in enumerate(trace):
+        rows: dict[str, dict[str, str]] = {}
+        for name, value in st.items():
+            if name in sys.variables:
+                n, p, v = sys.variables[name]
+                rows.setdefault(n, {})[v if p == "run" else f"{p}.{v}"] = " ".join(value.split())
+        out.append({"step": i, "nodes": [{"node": n, "values": rows[n]} for n in sys.cone if n in rows]})
+    return out
+
+
+def check_temporal(req: Requirement, checked: Checked, model: SystemModel, plan: Plan, base: dict[str, Any],
+                   *, bound: int = DEFAULT_BOUND, timeout_ms: int = TIMEOUT_MS) -> dict[str, Any]:
+    """The record of temporal requirement ``req`` (module docstring);
+    ``base`` the fields :func:`.check.check_requirement` fills for every
+    requirement.  Raises :class:`RclError` for a statement that does not
+    check; never raises on solver trouble."""
+    from rclverify.semantics.encode import Encoder
+    t0 = time.perf_counter()
+    t = statement(req, checked, plan)
+    shape(t, req.formal.loc if req.formal else req.loc)
+    assuming = [parse_formal(a, checked, f"{req.id} assuming") for a in req.assuming]
+    rank, inv = parse_hints(req.ranking, req.invariant, t, checked, req.id, state_types(plan.states, checked))
+    ops = operands(t)
+    hints = [h for h in (rank, inv) if h is not None]
+    want = {u for f in (*ops, *assuming, *hints) for n in f.nodes for u in (model.upstream(n) or [n])}
+    cone = [n for n in model.nodes if n in want]  # as requirements/check.cone_of
+
+    def solve(without: Collection[str] = ()) -> tuple[ComposedSystem, TemporalVerdict, dict[str, Any]]:
+        """The system of the cone (the nodes of ``without`` built with no ``initially``) and its verdict."""
+        sys = build_system(cone, checked, model, plan, without_initially=without)
+        enc = Encoder(checked.env)
+
+        def raw(f: Formal) -> Callable[[Any], Any]:
+            return lambda s: enc.formula(f.expr, f.scope, sys.statement_symbols(s))
+
+        def pred(f: Formal) -> Callable[[Any], Any]:  # must hold: only where its values are published
+            return lambda s: z3.Implies(sys.pub.defined(f.mentions, s), raw(f)(s))
+
+        def reach(f: Formal) -> Callable[[Any], Any]:  # must be reached: on published values
+            return lambda s: z3.And(sys.pub.defined(f.mentions, s), raw(f)(s))
+        if assuming:  # the requirement's own assumptions hold in every state
+            holds = [pred(a) for a in assuming]
+            ts = sys.ts
+            sys.ts = TransitionSystem(ts.sorts, lambda s: z3.And(ts.init(s), *[h(s) for h in holds]),
+                                      lambda s, u: z3.And(ts.trans(s, u), *[h(s) for h in holds], *[h(u) for h in holds]),
+                                      ts.fairness)
+            for k, a in enumerate(assuming, 1):
+                sys.premises.append({"label": f"assuming {k}", "kind": "assuming", "node": None, "index": k,
+                                     "text": base["assuming"][k - 1], "source": base["source"]})
+        types = variable_types(sys, checked, plan)
+        points = max([points_for(plan.instances.get(n)) for n in cone] or [points_for(None)])
+
+        def tables(goal: Formal, v: TemporalVerdict, ts: TransitionSystem) -> TemporalVerdict:
+            """The finite-table lasso search over ``ts``, confirmed on the trace (:mod:`.lasso`)."""
+            if any(isinstance(ty, EmptyT) for ty in types.values()):
+                return v
+            try:
+                found = find_table_lasso(ts, reach(goal), types, bound=bound, points=points)
+            except (ValueError, z3.Z3Exception) as exc:
+                found = f"the finite-table search failed ({exc})"
+            if isinstance(found, str):
+                return TemporalVerdict(v.status, v.method, k=v.k, bound=v.bound, trace=v.trace, loop=v.loop,
+                                       detail=f"{v.detail}; {found}")
+            why = confirm_lasso(found.values, found.loop, cone, sys.variables, types, checked, model, plan, goal, assuming,
+                                [f.label for f in ts.fairness], sys.pub)
+            if why is not None:
+                return TemporalVerdict(v.status, v.method, k=v.k, bound=v.bound, trace=v.trace, loop=v.loop,
+                                       detail=f"{v.detail}; a lasso with {points}-point tables was found but not "
+                                              f"confirmed on its values ({why})")
+            n = len(found.values) - 1
+            return TemporalVerdict("refuted", "lasso", bound=n, loop=found.loop,
+                                   trace=[{k: render(x) for k, x in st.items()} for st in found.values],
+                                   detail=f"a run whose step {n} returns to step {found.loop} and never reaches it "
+                                          f"(found with every function a {points}-point table, confirmed on the "
+                                          f"trace's values)")
+        ranking = (lambda s: enc.term(rank.expr, rank.scope, sys.statement_symbols(s))) if rank is not None else None
+        inv_pred = raw(inv) if inv is not None else None
+        missing: dict[str, Any] = {}
+        from rclverify.lang.types import FuncT
+        v = decide(t, sys, pred, bound=bound, timeout_ms=timeout_ms, tables=tables, ranking=ranking,
+                   invariant=inv_pred, checked=checked, gaps=missing,
+                   tables_first=any(isinstance(ty, FuncT) for ty in types.values()), reach=reach,
+                   hint_text=" ".join(req.invariant.text.split()) if req.invariant is not None else "")
+        return sys, v, missing
+    sys, v, missing = solve()
+    lasso = v.status == "refuted" and "lasso" in v.method.split(" + ")
+    gaps = missing.get("missing_progress", []) if lasso else []
+    stuck = missing.get("missing_initially", []) if lasso else []
+    out: dict[str, Any] = {**base, "cone": cone, "premises": len(sys.premises), "used": [], "traced_not_needed": [],
+                           "temporal": {**v.to_json(), "trace": _steps(v.trace, sys),
+                                        "ranking": base.get("ranking"), "invariant": base.get("invariant"),
+                                        "missing_progress": gaps, "missing_initially": stuck}}
+    if v.status in ("proved", "met"):
+        a, b = sys.ts.state(0), sys.ts.state(1)
+        s = z3.Solver()
+        s.set("timeout", timeout_ms)
+        s.add(sys.ts.init(a), sys.ts.trans(a, b))
+        r = s.check()
+        used = sys.premises
+        out.update(verdict="proved", used=used)
+        # an initial value no output meets forces its node to answer at step 0: it removes runs, as a contradiction
+        bad, why = sys.initial_values_unsatisfiable(timeout_ms)
+        if bad:  # the initial values no output meets: the precise core (they alone may leave no run)
+            out.update(consistency="inconsistent", inconsistent_core=bad)
+        elif r == z3.unsat:
+            out.update(consistency="inconsistent", inconsistent_core=used)
+        elif r == z3.sat and not why:
+            out.update(consistency="consistent")
+            spare = initially_not_needed(sys.premises, lambda nodes: solve(nodes)[1].status in ("proved", "met"))
+            out.update(used=[p for p in used if not (p["kind"] == "initial value" and p["node"] in spare)],
+                       traced_not_needed=[p for p in used if p["kind"] == "initial value" and p["node"] in spare])
+        else:
+            out.update(consistency="undecided", consistency_reason=s.reason_unknown() if r != z3.sat else why)
+    elif v.status == "refuted":
+        mentioned = {n for f in ops for n in f.nodes}
+        # a run that stops, or a lasso resting on a node that never answers, is not let through by a guarantee
+        out.update(verdict="refuted", failed_to_prevent=[] if "deadlock" in v.method.split(" + ") or gaps or stuck else [
+            p for p in sys.premises if p["kind"] == "guarantee" and p["node"] in mentioned])
+    else:
+        out.update(verdict="inconclusive", reason=v.detail or "undecided")
+    out["duration_s"] = round(time.perf_counter() - t0, 4)
+    return out

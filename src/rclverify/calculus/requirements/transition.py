@@ -1,0 +1,375 @@
+"""The composed contracts of a requirement's cone as a transition system.
+
+The paper's stream model (lines 462-495): each contract consumes one input
+element and produces at most one output element satisfying its guarantee,
+and outputs persist.  Read over steps (docs/requirements.md, "The
+transition relation"):
+
+* a **state** gives a value to every input and output of every node of the
+  cone (``Node.in.x``, ``Node.out.y``; a function-typed variable is a Z3
+  array), to every declared state variable (``Node.state.v``,
+  :mod:`rclverify.model.plan.state`) and, for every node with an output, to
+  ``Node.answers`` (whether the node answers in that step), ``Node.accepts``
+  (whether its assumption holds on that step's input; only for a node whose
+  assumption reads a produced input) and, for a node with a step bound,
+  ``Node.waiting`` (how many steps in a row its assumption has held
+  without an answer);
+* **in every state** the environment conjuncts of the cone's assumptions
+  and the plan's environment facts hold (what the environment is assumed
+  to do: every external input meets the assumptions of the nodes that read
+  it), and a node that answers has its assumption hold and an output
+  satisfying its guarantees over that input;
+* **one step** from ``s`` to ``t``: every connection feeds the next input
+  element, ``t[Consumer.in.x] == s[Producer.out.y]``; a node that does not
+  answer keeps its outputs (they persist); each state variable takes the
+  value its ``next`` formula gives from ``s``; the environment's inputs are
+  free;
+* **progress** (:mod:`rclverify.lang.liveness`): a node may answer late or
+  never, unless it declares ``progress( within K steps )`` (no K + 1
+  steps in a row at which its assumption holds without an answer; K = 0:
+  it answers at every such step) or ``progress( eventually )``; every
+  declared progress is also a fairness constraint (:class:`.tsys.Fairness`:
+  on an infinite run on which its assumption holds infinitely often the
+  node answers infinitely often);
+* **initial states**: every declared state variable satisfies its
+  ``init``; a node that does not answer at step 0 has outputs satisfying its
+  ``initially`` (free without one);
+* **published values** (:mod:`.published`, docs/semantics.md): an output
+  holds a value only once its node has answered (or from the start, with
+  ``initially``); a node answers only once every input another node feeds
+  it has been published, and a requirement's state formula is evaluated on
+  published values only.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any, Collection, Sequence
+
+import z3
+
+from rclverify.calculus.compose import split_assumption
+from rclverify.semantics.encode import Encoder, sort_of
+from rclverify.model.plan.load import Plan
+from rclverify.model.plan.state import parse_state_formula, state_type
+from rclverify.lang.liveness import STEP_WORDS, fair, progress_words, step_bound
+from rclverify.lang.printer import expr_to_rcl
+from rclverify.lang.types import BOOL, INTEGER, NATURAL, Checked, DataT, EmptyT, FuncT, Type
+from rclverify.model.system.model import SystemModel
+from rclverify.calculus.compose import free_io
+from rclverify.calculus.requirements.published import Publication, publication
+from rclverify.calculus.requirements.temporal import State, TransitionSystem
+from rclverify.calculus.requirements.tsys import Fairness
+
+
+def _sort(t: Type) -> z3.SortRef:
+    if isinstance(t, FuncT):
+        return z3.ArraySort(*[sort_of(a) for a in t.args], sort_of(t.result))
+    return sort_of(t)
+
+
+def _typing(v: z3.ExprRef, t: Type) -> z3.BoolRef | None:
+    """NATURAL values are >= 0 (the encoder's typing axioms, per step), also
+    a constructor's NATURAL argument (``inspect(NATURAL)``: a value kept
+    from before the run is still a value of its type)."""
+    if t == NATURAL:
+        return v >= 0
+    if isinstance(t, DataT):
+        ds = v.sort()
+        parts = []
+        for i in range(ds.num_constructors()):
+            args = t.ctor(ds.constructor(i).name()) or ()
+            parts += [z3.Implies(ds.recognizer(i)(v), ds.accessor(i, j)(v) >= 0)
+                      for j, a in enumerate(args) if a == NATURAL]
+        return z3.And(*parts) if parts else None
+    if isinstance(t, FuncT) and t.result == NATURAL:
+        xs = [z3.Const(f"_t{k}", sort_of(a)) for k, a in enumerate(t.args)]
+        return z3.ForAll(xs, z3.Select(v, *xs) >= 0)
+    return None
+
+
+@dataclass
+class ComposedSystem:
+    """The transition system of a cone and how to read it.
+
+    ``ts``        the :class:`~.temporal.TransitionSystem` (variables named
+                  ``Node.in.x`` / ``Node.out.y`` / ``Node.state.v``);
+    ``cone``      the nodes, in source order;
+    ``variables`` ``{name: (node, "in"|"out"|"state"|"run", var)}`` (``run``:
+                  ``answers``, ``accepts``, ``waiting``);
+    ``premises``  what the system is made of, for the record: ``{label,
+                  kind, node, index, text, source}`` per guarantee,
+                  assumption, fact, initial value, progress and state
+                  declaration;
+    ``everyone``  fairness for every node that answers (as if each
+                  declared ``progress( eventually )``): what the diagnosis
+                  of a lasso asks again (:func:`fair_everywhere`);
+    ``links``     the connections inside the cone, ``(consumer input,
+                  producer output)`` by variable name.
+    """
+
+    ts: TransitionSystem
+    cone: list[str]
+    variables: dict[str, tuple[str, str, str]]
+    premises: list[dict[str, Any]] = field(default_factory=list)
+    everyone: tuple[Fairness, ...] = ()
+    links: list[tuple[str, str]] = field(default_factory=list)
+    bounds: dict[str, int | None] = field(default_factory=dict)
+    #: per node that declares ``initially``: its outputs' types and initial values over one state
+    initial: dict[str, Any] = field(default_factory=dict)
+    #: which values are published at each step (:mod:`.published`; docs/semantics.md)
+    pub: Publication = field(default_factory=Publication)
+
+    def initial_values_unsatisfiable(self, timeout_ms: int) -> tuple[list[dict[str, Any]], str]:
+        """The premises of the initial values that no output satisfies (a
+        node that must then answer at step 0, which would silently remove
+        every run whose first input it cannot accept), and the solver's
+        reason for any it could not decide (``""``: none)."""
+        bad: list[dict[str, Any]] = []
+        why = ""
+        for n, holds in self.initial.items():
+            s = z3.Solver()
+            s.set("timeout", timeout_ms)
+            s.add(holds(self.ts.state(0, "initially")))
+            r = s.check()
+            if r == z3.unsat:
+                bad += [p for p in self.premises if p["kind"] == "initial value" and p["node"] == n]
+            elif r == z3.unknown:
+                why = why or f"whether {n}'s initial value can hold ({s.reason_unknown()})"
+        return bad, why
+
+    @property
+    def eager(self) -> bool:
+        """Whether every node that answers declares ``progress( within 0
+        steps )`` (then :meth:`synchronous` is the system itself)."""
+        return all(self.bounds.get(f.label) == 0 for f in self.everyone)
+
+    def fair_everywhere(self, ts: TransitionSystem) -> TransitionSystem:
+        """``ts`` (this system's, possibly restricted further) with every
+        node's fairness, declared or not."""
+        have = {f.label for f in ts.fairness}
+        return TransitionSystem(ts.sorts, ts.init, ts.trans,
+                                ts.fairness + tuple(f for f in self.everyone if f.label not in have))
+
+    def synchronous(self, ts: TransitionSystem) -> TransitionSystem:
+        """``ts`` in which every node answers at every step its assumption
+        holds (as if each declared ``progress( within 0 steps )``): a
+        subsystem of :meth:`fair_everywhere`'s, and the reading before
+        progress could be declared."""
+        def eager(s: State) -> z3.BoolRef:
+            return z3.And(*[z3.Implies(f.enabled(s), f.taken(s)) for f in self.everyone])
+        return TransitionSystem(ts.sorts, lambda s: z3.And(ts.init(s), eager(s)),
+                                lambda s, t: z3.And(ts.trans(s, t), eager(s), eager(t)), ts.fairness)
+
+    def statement_symbols(self, s: State) -> dict[str, Any]:
+        """The encoder's symbols of a requirement statement at state ``s``
+        (:mod:`rclverify.model.plan.formal` names ``Node.in.x`` an input of its
+        pseudo node, so the key is ``"in.Node.in.x"``)."""
+        out = {}
+        for name, (_, p, _) in self.variables.items():
+            out[f"{'out' if p == 'out' else 'in'}.{name}"] = s[name]
+        return out
+
+
+def variable_types(sys: ComposedSystem, checked: Checked, plan: Plan) -> dict[str, Type]:
+    """The RCL type of each variable of ``sys`` (``{name: type}``)."""
+    out: dict[str, Type] = {}
+    declared = {(sv.node, sv.name): sv for sv in plan.states}
+    for name, (n, p, v) in sys.variables.items():
+        cn = checked.nodes[n]
+        if p == "run":
+            out[name] = INTEGER if v == "waiting" else BOOL
+            continue
+        out[name] = state_type(declared[(n, v)], checked) if p == "state" else (cn.inputs if p == "in" else cn.outputs)[v]
+    return out
+
+
+def build_system(cone: Sequence[str], checked: Checked, model: SystemModel, plan: Plan, *,
+                 without_initially: Collection[str] = ()) -> ComposedSystem:
+    """The transition system of ``cone`` (module docstring); the nodes of
+    ``without_initially`` are built as if they declared no ``initially``
+    (nothing published before their first answer), to ask whether a proof
+    needs their declarations (:mod:`.temporal_check`).
+
+    Raises :class:`~rclverify.lang.errors.RclError` for a state declaration
+    that does not check (the plan's ``resolve`` reports those first).
+    """
+    enc = Encoder(checked.env)
+    sorts: dict[str, z3.SortRef] = {}
+    types: dict[str, Type] = {}
+    variables: dict[str, tuple[str, str, str]] = {}
+    premises: list[dict[str, Any]] = []
+    for n in cone:
+        cn = checked.nodes[n]
+        for p, table in (("in", cn.inputs), ("out", cn.outputs)):
+            for v, t in table.items():
+                if isinstance(t, EmptyT):  # no value to hold (the encoder refuses any formula using it)
+                    continue
+                name = f"{n}.{p}.{v}"
+                sorts[name], types[name], variables[name] = _sort(t), t, (n, p, v)
+    states = [sv for sv in plan.states if sv.node in cone]
+    for sv in states:
+        name = f"{sv.node}.state.{sv.name}"
+        t = state_type(sv, checked)
+        sorts[name], types[name], variables[name] = _sort(t), t, (sv.node, "state", sv.name)
+
+    def where(e: Any) -> str:
+        return f"{e.loc.file}:{e.loc.line}:{e.loc.col}"
+
+    guarantees, internal, env, facts = {}, {}, {}, {}
+    for n in cone:
+        cn = checked.nodes[n]
+        guarantees[n] = [g.formula for g in cn.node.guarantees]
+        internal[n], env[n] = split_assumption(checked, model, n)
+        facts[n] = [f.expr for f in plan.facts.get(n, ())]
+        for k, g in enumerate(guarantees[n], 1):
+            premises.append({"label": f"{n} guarantee {k}", "kind": "guarantee", "node": n, "index": k,
+                             "text": expr_to_rcl(g), "source": where(g)})
+        for k, a in enumerate(internal[n], 1):
+            premises.append({"label": f"{n} assumption {k}", "kind": "internal assumption", "node": n, "index": k,
+                             "text": expr_to_rcl(a), "source": where(a)})
+        for k, a in enumerate(env[n], 1):
+            premises.append({"label": f"{n} environment assumption {k}", "kind": "environment assumption", "node": n,
+                             "index": k, "text": expr_to_rcl(a), "source": where(a)})
+        for k, f in enumerate(plan.facts.get(n, ()), 1):
+            premises.append({"label": f"{n} environment fact {k}", "kind": "environment fact", "node": n,
+                             "index": k, "text": f.text, "source": where(f.expr)})
+    # answering (module docstring): which nodes answer, accept, count their waiting
+    bounds = {n: step_bound(checked.nodes[n].node) for n in cone}
+    initially = {n: [c.formula for c in checked.nodes[n].node.initially] if n not in without_initially else []
+                 for n in cone}
+    answering = [n for n in cone if any(f"{n}.out.{v}" in sorts for v in checked.nodes[n].outputs)]
+    for n in answering:
+        node = checked.nodes[n].node
+        sorts[f"{n}.answers"], types[f"{n}.answers"], variables[f"{n}.answers"] = z3.BoolSort(), BOOL, (n, "run", "answers")
+        if internal[n]:
+            sorts[f"{n}.accepts"], types[f"{n}.accepts"], variables[f"{n}.accepts"] = z3.BoolSort(), BOOL, (n, "run", "accepts")
+        if bounds[n]:
+            sorts[f"{n}.waiting"], types[f"{n}.waiting"], variables[f"{n}.waiting"] = z3.IntSort(), INTEGER, (n, "run", "waiting")
+        for k, c in enumerate(node.initially if n not in without_initially else (), 1):
+            premises.append({"label": f"{n} initially {k}", "kind": "initial value", "node": n, "index": k,
+                             "text": expr_to_rcl(c.formula), "source": where(c)})
+        if fair(node):
+            premises.append({"label": f"{n} progress", "kind": "progress", "node": n, "index": 0,
+                             "text": progress_words(node),
+                             "source": where(node.progress[0] if node.progress else
+                                             next(p for p in node.periodic if p.unit in STEP_WORDS))})
+    parsed = {}
+    for sv in states:
+        parsed[sv] = (parse_state_formula(sv, "init", checked, plan.states),
+                      parse_state_formula(sv, "next", checked, plan.states))
+        for which, src in (("init", sv.init), ("next", sv.next)):
+            premises.append({"label": f"{sv.node}.state.{sv.name} {which}", "kind": "state declaration",
+                             "node": sv.node, "index": 0, "text": " ".join(src.text.split()),
+                             "source": f"{src.file}:{src.loc.line}:{src.loc.col}"})
+
+    alias = model.alias()
+    links = [(f"{c}.in.{v}", producer) for (c, p, v), producer in alias.items()
+             if c in cone and producer in sorts]
+    reads = {n: {v for f in [*internal[n], *env[n], *guarantees[n]] for p, v in free_io(f)
+                 if p in ("in", None) and v in checked.nodes[n].inputs} for n in cone}
+    pub = publication(answering, links, reads, [n for n in answering if initially[n]])
+    for name, var in pub.variables():
+        sorts[name], types[name], variables[name] = z3.BoolSort(), BOOL, var
+
+    def node_symbols(n: str, s: State) -> dict[str, Any]:
+        cn = checked.nodes[n]
+        return {**{f"in.{v}": s[f"{n}.in.{v}"] for v in cn.inputs if f"{n}.in.{v}" in s},
+                **{f"out.{v}": s[f"{n}.out.{v}"] for v in cn.outputs if f"{n}.out.{v}" in s}}
+
+    def holds(n: str, e: Any, s: State) -> z3.BoolRef:
+        return enc.formula(e, checked.nodes[n], node_symbols(n, s))
+
+    def assumed(n: str, s: State) -> z3.BoolRef:
+        return z3.And(*[holds(n, a, s) for a in internal[n]]) if internal[n] else z3.BoolVal(True)
+
+    # what valid/trans encode is a function of the states' terms: encoded once per state (pair).  The
+    # cache keeps the terms it is keyed by alive, so their ids cannot be reused for other terms.
+    memo: dict[tuple[int, ...], tuple[list[z3.ExprRef], z3.BoolRef]] = {}
+
+    def cached(tag: int, states_: tuple[State, ...], make: Any) -> z3.BoolRef:
+        terms = [st[name] for st in states_ for name in sorts]
+        key = (tag, *[x.get_id() for x in terms])
+        hit = memo.get(key)
+        if hit is None:
+            hit = memo[key] = (terms, make())
+        return hit[1]
+
+    def valid(s: State) -> z3.BoolRef:
+        return cached(0, (s,), lambda: _valid(s))
+
+    def accepted(n: str, s: State) -> z3.BoolRef:
+        """The node's assumption holds on ``s``'s input (its ``accepts`` variable, TRUE without one)."""
+        return s[f"{n}.accepts"] if f"{n}.accepts" in s else z3.BoolVal(True)
+
+    def enabled(n: str, s: State) -> z3.BoolRef:
+        """The node has a question it owes an answer: every input it reads published, its assumption holding."""
+        return z3.And(accepted(n, s), pub.ready(n, s))
+
+    def answers_in(n: str, s: State) -> z3.BoolRef:
+        return s[f"{n}.answers"]
+
+    def _valid(s: State) -> z3.BoolRef:
+        parts = [c for c in (_typing(s[name], types[name]) for name in sorts) if c is not None]
+        for n in cone:
+            parts += [holds(n, a, s) for a in env[n]] + [holds(n, f, s) for f in facts[n]]
+            if f"{n}.accepts" in s:
+                parts.append(s[f"{n}.accepts"] == assumed(n, s))
+            promise = z3.And(*[holds(n, g, s) for g in guarantees[n]]) if guarantees[n] else z3.BoolVal(True)
+            if f"{n}.answers" not in s:  # no output to answer with: its guarantee holds where its assumption does
+                if guarantees[n]:
+                    parts.append(z3.Implies(assumed(n, s), promise))
+                continue
+            answers = s[f"{n}.answers"]
+            parts.append(z3.Implies(answers, z3.And(enabled(n, s), promise)))
+            k = bounds[n]
+            if k == 0:
+                parts.append(z3.Implies(enabled(n, s), answers))
+            elif k:
+                w = s[f"{n}.waiting"]
+                parts.append(z3.If(z3.Or(answers, z3.Not(enabled(n, s))), w == 0, z3.And(w >= 1, w <= k)))
+        return z3.And(*parts)
+
+    def state_syms(sv: Any, s: State, t: State | None) -> dict[str, Any]:
+        out = node_symbols(sv.node, s) if t is not None else {}
+        for o in states:
+            if o.node == sv.node:
+                out[f"in.state.{o.name}"] = s[f"{o.node}.state.{o.name}"]
+                if t is not None:
+                    out[f"in.next.{o.name}"] = t[f"{o.node}.state.{o.name}"]
+        return out
+
+    def init(s: State) -> z3.BoolRef:
+        parts = [valid(s), pub.init(s, answers_in),
+                 *[enc.formula(parsed[sv][0].expr, parsed[sv][0].scope, state_syms(sv, s, None)) for sv in states]]
+        for n in answering:
+            if initially[n]:
+                parts.append(z3.Implies(z3.Not(s[f"{n}.answers"]), z3.And(*[holds(n, f, s) for f in initially[n]])))
+            if bounds[n]:
+                parts.append(s[f"{n}.waiting"] <= 1)
+        return z3.And(*parts)
+
+    def trans(s: State, t: State) -> z3.BoolRef:
+        return cached(1, (s, t), lambda: _trans(s, t))
+
+    def _trans(s: State, t: State) -> z3.BoolRef:
+        parts = [valid(s), valid(t), pub.trans(s, t, answers_in)] + [t[c] == s[p] for c, p in links]
+        for n in answering:
+            outs = [t[f"{n}.out.{v}"] == s[f"{n}.out.{v}"] for v in checked.nodes[n].outputs if f"{n}.out.{v}" in s]
+            parts.append(z3.Implies(z3.Not(t[f"{n}.answers"]), z3.And(*outs)))
+            if bounds[n]:
+                parts.append(z3.Implies(z3.And(z3.Not(t[f"{n}.answers"]), enabled(n, t)),
+                                        t[f"{n}.waiting"] == s[f"{n}.waiting"] + 1))
+        parts += [enc.formula(parsed[sv][1].expr, parsed[sv][1].scope, state_syms(sv, s, t)) for sv in states]
+        return z3.And(*parts)
+
+    def initial_of(n: str) -> Any:
+        outs = [f"{n}.out.{v}" for v in checked.nodes[n].outputs if f"{n}.out.{v}" in sorts]
+        return lambda s: z3.And(*[c for c in (_typing(s[o], types[o]) for o in outs) if c is not None],
+                                *[holds(n, f, s) for f in initially[n]])
+
+    def progress_of(n: str) -> Fairness:
+        return Fairness(n, lambda s: enabled(n, s), lambda s: s[f"{n}.answers"])
+    declared = tuple(progress_of(n) for n in answering if fair(checked.nodes[n].node))
+    everyone = tuple(progress_of(n) for n in answering)
+    return ComposedSystem(TransitionSystem(sorts, init, trans, declared), list(cone), variables, premises, everyone,
+                          links, bounds, {n: initial_of(n) for n in answering if initially[n]}, pub)

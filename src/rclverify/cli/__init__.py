@@ -1,0 +1,15 @@
+"""Layer 16, cli: the ``rclverify`` command, parsing and printing only.
+
+``commands`` (the commands' table and the entry point), one module per
+command group (``monitor``, ``ros``, ``requirements``, ``generate``,
+``lsp``).  Imports every layer below.
+"""
+from __future__ import annotations
+
+
+def main(argv: list[str] | None = None) -> int:
+    """The ``rclverify`` command's entry point (pyproject's ``rclverify.cli:main``):
+    :func:`rclverify.cli.commands.main`, imported when called so that
+    importing a command group does not load every command."""
+    from rclverify.cli.commands import main as run
+    return run(argv)

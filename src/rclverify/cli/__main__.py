@@ -1,0 +1,6 @@
+"""``python -m rclverify.cli``: the ``rclverify`` command."""
+import sys
+
+from rclverify.cli import main
+
+sys.exit(main())

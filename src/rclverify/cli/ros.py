@@ -1,0 +1,232 @@
+"""``rclverify ros scan``, ``rclverify ros diff`` and ``rclverify ros check`` (docs/ros.md).
+
+Exit codes: 0 the graph (or the findings) was written; 1 an input file could
+not be read (``ROS-PARSE`` error, the graph is still written from the rest),
+or for ``check`` any grounding error; 2 usage errors.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+from typing import Any
+
+#: Seconds each call to a master may take by default (ros/live/master_rpc.py MASTER_TIMEOUT_S; not imported
+#: here, so that building the command line does not load the XML-RPC client)
+MASTER_TIMEOUT_S = 10.0
+
+
+def add_parsers(sub: Any) -> None:
+    """Add the ``ros`` command and its subcommands to ``rclverify``'s parser."""
+    r = sub.add_parser("ros", help="read the ROS computation graph from workspaces; check contracts against it",
+                       description="read the ROS computation graph from workspaces; check contracts against it")
+    rs = r.add_subparsers(dest="ros_command", required=True)
+    s = rs.add_parser("scan", help="recover the computation graph from ROS 1/ROS 2 workspaces, launch files, bags, a master")
+    _code_args(s)
+    s.add_argument("--bag", action="append", default=[], metavar="BAG", help="recorded run: .bag, ROS 2 bag dir, .mcap")
+    s.add_argument("--master", metavar="URI", help="also read the running ROS 1 master at URI (http://127.0.0.1:11311)")
+    s.add_argument("--timeout", type=_seconds, default=MASTER_TIMEOUT_S, metavar="S",
+                   help=f"seconds each call to the master may take (default {MASTER_TIMEOUT_S:g})")
+    s.add_argument("--json", metavar="FILE", help="write the graph as JSON (docs/ros-graph.schema.json)")
+    s.add_argument("--cache", metavar="DIR", help="per-file parse cache directory (e.g. artifacts/cache)")
+    s.set_defaults(fn=cmd_scan)
+    d = rs.add_parser("diff", help="the graph the code promises against a running ROS 1 master, a running ROS 2 "
+                                   "system or a recorded run",
+                      description="compare the static graph (PATH..., --launch, --arg) with a running ROS 1 "
+                                  "master (--master), the running ROS 2 system on its DDS domain (--ros2) or a bag "
+                                  "(--bag): exit 0 equal, 1 they differ, 2 usage")
+    _code_args(d)
+    d.add_argument("--master", metavar="URI", help="the running ROS 1 master (http://127.0.0.1:11311)")
+    d.add_argument("--timeout", type=_seconds, default=MASTER_TIMEOUT_S, metavar="S",
+                   help=f"seconds each call to the master may take (default {MASTER_TIMEOUT_S:g})")
+    d.add_argument("--ros2", action="store_true", help="the running ROS 2 system: its DDS domain (ROS_DOMAIN_ID, "
+                   "CYCLONEDDS_URI), nodes from ros_discovery_info, endpoints and QoS from DDS discovery")
+    d.add_argument("--wait", type=float, default=2.0, metavar="S",
+                   help="--ros2: seconds to listen to discovery before comparing (default 2), then up to 6 s "
+                        "more while a ROS 2 participant's node list or endpoints are still on their way")
+    d.add_argument("--bag", metavar="BAG", help="a recorded run: .bag, ROS 2 bag dir, .mcap (topics and types only)")
+    d.add_argument("--json", metavar="FILE", help="write both lists as JSON (docs/ros.md)")
+    d.set_defaults(fn=cmd_diff)
+    c = rs.add_parser("check", help="check the plan's contracts against the graph of its ros: section")
+    c.add_argument("-w", "--workspace", default=".", help="workspace root (default: .)")
+    c.add_argument("--plan", default="contracts/plan.yaml", help="plan file, relative to the workspace")
+    c.add_argument("--strict", action="store_true", help="accepted for older command lines: ros check always exits 1 on a grounding error")
+    c.add_argument("--json", metavar="FILE", help="write the findings as JSON")
+    c.set_defaults(fn=cmd_check)
+
+
+def _seconds(text: str) -> float:
+    """A time limit in seconds: a finite number > 0 (argparse type; a usage error otherwise)."""
+    import math
+    try:
+        x = float(text)
+    except ValueError:
+        x = math.nan
+    if not (math.isfinite(x) and x > 0):
+        raise argparse.ArgumentTypeError(f"expected a finite number of seconds > 0, not {text!r}")
+    return x
+
+
+def _launch_args(items: list[str]) -> dict[str, str]:
+    out = {}
+    for it in items:
+        k, sep, v = it.partition(":=")
+        if not sep or not k:
+            raise SystemExit(f"error: --arg {it!r}: expected NAME:=VALUE")
+        out[k] = v
+    return out
+
+
+def _code_args(p: argparse.ArgumentParser) -> None:
+    """The code side of ``ros scan`` and ``ros diff``: ``PATH...``, ``--launch``, ``--arg``."""
+    p.add_argument("paths", nargs="*", metavar="PATH", help="workspace (or package) directories")
+    p.add_argument("--launch", action="append", default=[], metavar="FILE", help="entry launch file (repeatable)")
+    p.add_argument("--arg", action="append", default=[], metavar="NAME:=VALUE", help="launch argument (repeatable)")
+
+
+def _scan_args(args: argparse.Namespace, bags: list[str], cache: Path | None,
+               also_exist: list[str] | None = None) -> Any:
+    """The scan of ``args.paths``/``args.launch``/``args.arg`` (and ``bags``) shared by
+    ``ros scan`` and ``ros diff``: ``graph.scan``'s result, or ``None`` after one
+    usage message on standard error (a path that does not exist, a bad ``--arg``)."""
+    from rclverify.ros.graph.scan import scan
+    for p in list(args.paths) + list(args.launch) + bags + list(also_exist or ()):
+        if not Path(p).exists():
+            print(f"{p}: error: no such file or directory", file=sys.stderr)
+            return None
+    try:
+        largs = _launch_args(args.arg)
+    except SystemExit as exc:
+        print(exc, file=sys.stderr)
+        return None
+    return scan([Path(p) for p in args.paths], [Path(p) for p in args.launch], largs, [Path(b) for b in bags], cache)
+
+
+def cmd_scan(args: argparse.Namespace) -> int:
+    from rclverify.records.store import atomic_write_text
+    from rclverify.ros.live.master import MasterError, read_master
+    res = _scan_args(args, list(args.bag), Path(args.cache) / "ros-scan.pickle" if args.cache else None)
+    if res is None:
+        return 2
+    g = res.graph
+    data: dict[str, Any] = g.to_json()
+    if args.master:
+        try:
+            mg = read_master(args.master, timeout=args.timeout)
+        except MasterError as exc:
+            print(f"{args.master}: error: {exc}", file=sys.stderr)
+            return 1
+        data["master"] = {"uri": args.master, "nodes": [n.to_json() for _, n in sorted(mg.nodes.items())]}
+        for n in mg.notes:  # a service whose type the probe could not read
+            print(f"{args.master}: {n.severity}: {n.message}", file=sys.stderr)
+    for n in g.notes:
+        print(n, file=sys.stderr)
+    if args.json:
+        atomic_write_text(Path(args.json), json.dumps(data, indent=2, sort_keys=False) + "\n")
+    else:
+        print(json.dumps(data, indent=2))
+    errors = sum(1 for n in g.notes if n.severity == "error")
+    print(f"{len(g.packages)} package(s), {len(g.nodes)} node(s), {len(data['topics'])} topic(s), "
+          f"{len(g.types)} message type(s); {errors} error(s), {len(g.notes) - errors} warning(s)",
+          file=sys.stderr)
+    return 1 if errors else 0
+
+
+def cmd_diff(args: argparse.Namespace) -> int:
+    """``rclverify ros diff``: print the missing and extra lists (docs/ros.md,
+    "Expected against observed"); exit 0 equal, 1 they differ (or the master or
+    the DDS domain cannot be read, or a scanned file cannot be), 2 usage."""
+    from rclverify.records.store import atomic_write_text
+    from rclverify.ros.graph.bag import bag_topics
+    from rclverify.ros.live.diff import diff_bag, diff_master, render_text
+    from rclverify.ros.live.master import MasterError, read_master
+    if sum((args.master is not None, args.bag is not None, bool(getattr(args, "ros2", False)))) != 1:
+        print("error: ros diff needs exactly one running side: --master URI, --ros2 or --bag BAG", file=sys.stderr)
+        return 2
+    if not args.paths and not args.launch:
+        print("error: ros diff needs the code: PATH... and/or --launch FILE", file=sys.stderr)
+        return 2
+    res = _scan_args(args, [], None, [args.bag] if args.bag else [])
+    if res is None:
+        return 2
+    for n in res.graph.notes:
+        print(n, file=sys.stderr)
+    if args.master:
+        try:
+            running = read_master(args.master, timeout=args.timeout)
+        except MasterError as exc:
+            print(f"{args.master}: error: {exc}", file=sys.stderr)
+            return 1
+        for n in running.notes:
+            print(f"{args.master}: {n.severity}: {n.message}", file=sys.stderr)
+        result = diff_master(res.graph, running, args.master)
+    elif getattr(args, "ros2", False):
+        from rclverify.ros.live.dds import DdsUnavailable
+        from rclverify.ros.live.diff_dds import diff_dds, qos_conflicts, read_dds_graph
+        try:
+            running, disc, source, dp = read_dds_graph(max(0.0, args.wait))
+        except DdsUnavailable as exc:
+            print(f"ros diff --ros2: error: {exc}", file=sys.stderr)
+            return 1
+        try:
+            for n in running.notes:
+                print(f"{source}: {n.severity}: {n.message}", file=sys.stderr)
+            result = diff_dds(res.graph, running, source, qos_conflicts(disc), disc)
+        finally:
+            disc.close()
+            dp.__del__()
+    else:
+        bag, notes = bag_topics(Path(args.bag), args.bag)
+        if bag is None:
+            for n in notes:
+                print(n, file=sys.stderr)
+            return 1
+        result = diff_bag(res.graph, bag)
+    for line in render_text(result):
+        print(line)
+    if args.json:
+        try:
+            atomic_write_text(Path(args.json), json.dumps(result.to_json(), indent=2) + "\n")
+        except OSError as exc:
+            print(f"{args.json}: error: cannot write: {exc.strerror or exc}", file=sys.stderr)
+            return 1
+    errors = any(n.severity == "error" for n in res.graph.notes)
+    return 0 if result.equal and not errors else 1
+
+
+def init_from_ros(args: argparse.Namespace) -> int:
+    """``rclverify init DIR --from-ros PATH [--launch FILE]``."""
+    from rclverify.ros.graph.scan import scan
+    from rclverify.tools.scaffold.skeleton import write_from_ros
+    root = Path(args.dir)
+    if root.exists() and (not root.is_dir() or any(root.iterdir())):
+        print(f"{args.dir}: error: exists and is not an empty directory; rclverify init writes only into a new "
+              f"or empty one", file=sys.stderr)
+        return 1
+    for p in list(args.from_ros) + list(args.launch):
+        if not Path(p).exists():
+            print(f"{p}: error: no such file or directory", file=sys.stderr)
+            return 2
+    res = scan([Path(p) for p in args.from_ros], [Path(p) for p in args.launch])
+    for n in res.graph.notes:
+        print(n, file=sys.stderr)
+    if not res.graph.nodes:
+        print(f"{args.from_ros[0]}: error: no ROS node found (no launch file node, no source naming its node)",
+              file=sys.stderr)
+        return 1
+    try:
+        written = write_from_ros(root, res, [Path(p) for p in args.from_ros], [Path(p) for p in args.launch],
+                                 bool(getattr(args, "library_endpoints", False)))
+    except OSError as exc:
+        print(f"{args.dir}: error: cannot write the workspace: {exc.strerror or exc}", file=sys.stderr)
+        return 1
+    for p in written:
+        print(p)
+    print(f"{len(res.graph.nodes)} contract skeleton(s) written; run `doit verify` in {args.dir}")
+    return 0
+
+
+def cmd_check(args: argparse.Namespace) -> int:
+    from rclverify.app.ros_stage import run_check
+    return run_check(Path(args.workspace), args.plan, args.strict, args.json)

@@ -1,0 +1,7 @@
+"""Layer 1, core: what every layer needs and that knows nothing of RCL.
+
+``faults`` (machine faults worded as one line), ``atomic`` (atomic file
+writes, deterministic JSON), ``runlock`` (one run of a workspace at a
+time), ``cache/`` (everything kept between runs: one keying function, one
+file format).  Imports only the standard library and third-party packages.
+"""

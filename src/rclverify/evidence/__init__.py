@@ -1,1 +1,0 @@
-"""evidence stage of rclverify."""

@@ -1,0 +1,93 @@
+"""Traversals of RCL expressions shared by every stage (lint, calculus, backends).
+
+``children(e)``       the direct subexpressions of ``e``;
+``subexpressions(e)`` ``e`` and everything inside it, pre-order;
+``free_names(e)``     the unprefixed names occurring free in ``e``.
+
+Quantifier domains that are terms (``x in {1, 2}``) are subexpressions;
+domains that are types are not (see :func:`rclverify.lang.printer.is_type`).
+"""
+from __future__ import annotations
+
+from typing import Iterator, Union
+
+from rclverify.lang import ast
+from rclverify.lang.printer import is_type
+
+
+def children(e: ast.Expr) -> Iterator[ast.Expr]:
+    """The direct subexpressions of ``e`` (an applied function's name included)."""
+    if isinstance(e, ast.Apply):
+        yield e.func
+        yield from e.args
+    elif isinstance(e, ast.Unary):
+        yield e.operand
+    elif isinstance(e, ast.Binary):
+        yield e.left
+        yield e.right
+    elif isinstance(e, ast.Compare):
+        yield from e.operands
+    elif isinstance(e, ast.Member):
+        yield e.elem
+        yield e.collection
+    elif isinstance(e, (ast.SetLit, ast.SeqLit, ast.TupleLit)):
+        yield from e.items
+    elif isinstance(e, ast.Quant):
+        for b in e.bindings:
+            if not is_type(b.domain):
+                yield b.domain  # type: ignore[misc]
+        yield e.body
+    elif isinstance(e, ast.SeqRange):
+        yield e.lo
+        yield e.hi
+    elif isinstance(e, ast.TupleQuant):
+        if not is_type(e.domain):
+            yield e.domain  # type: ignore[misc]
+        yield e.body
+
+
+def subexpressions(e: ast.Expr) -> Iterator[ast.Expr]:
+    """``e`` and every expression inside it, pre-order (including quantifier
+    domains that are terms and applied function names)."""
+    stack: list[ast.Expr] = [e]
+    while stack:
+        cur = stack.pop()
+        yield cur
+        stack.extend(reversed(list(children(cur))))
+
+
+def free_names(e: Union[ast.Expr, ast.TypeExpr], *, heads: bool = True, type_names: bool = True) -> set[str]:
+    """Unprefixed names occurring free in ``e`` (bound variables of inner
+    quantifiers excluded, shadowing respected; each binding's domain sees the
+    bindings before it).
+
+    ``heads``       count the name of an applied function or constructor
+                    (``at`` in ``at(x, y)``, ``move`` in ``move(x, y)``);
+    ``type_names``  count a quantifier domain written as a name (``x in s``
+                    may name an earlier bound variable or a set).
+    """
+    if isinstance(e, ast.TName):
+        return {e.name} if type_names else set()
+    if is_type(e):
+        return set()
+    if isinstance(e, ast.Var):
+        return {e.name} if e.prefix is None else set()
+    if isinstance(e, ast.Apply) and not heads:
+        out: set[str] = set()
+        for a in e.args:
+            out |= free_names(a, heads=heads, type_names=type_names)
+        return out
+    if isinstance(e, ast.Quant):
+        free: set[str] = set()
+        bound: set[str] = set()
+        for b in e.bindings:
+            free |= free_names(b.domain, heads=heads, type_names=type_names) - bound
+            bound |= set(b.names)
+        return free | (free_names(e.body, heads=heads, type_names=type_names) - bound)
+    if isinstance(e, ast.TupleQuant):
+        dom = free_names(e.domain, heads=heads, type_names=type_names)
+        return dom | (free_names(e.body, heads=heads, type_names=type_names) - set(e.names))
+    found: set[str] = set()
+    for c in children(e):  # type: ignore[arg-type]
+        found |= free_names(c, heads=heads, type_names=type_names)
+    return found

@@ -1,0 +1,230 @@
+"""Acknowledged warnings: a lint or health warning answered in the plan.
+
+A warning (a lint warning of ``rclverify check``, a contract health finding
+of status ``warning`` such as a redundant conjunct) may be acknowledged in
+``contracts/plan.yaml`` with a reason::
+
+    acknowledged:
+      - warning: Mover.g2.c1.redundant          # a health finding's id, or a lint code
+        text: "out.arrived -> out.progress >= 0"  # the flagged text (or sha256: its digest)
+        reason: kept for the reader of the action's contract
+
+The acknowledgement is bound to the *flagged text* (:func:`flagged_text`:
+the conjunct, guarantee or clause the warning is about), as a review answer
+is bound to its ``conjunct:`` text (docs/integrity.md): when that text
+changes, the warning is raised again and the acknowledgement is reported
+stale.  An acknowledgement that matches no warning is reported stale too,
+and one naming an error or a problem is refused (only warnings can be
+accepted as a risk).  ``--strict`` fails on unacknowledged warnings and on
+stale acknowledgements; an acknowledged warning is shown in every output
+with its reason (SARIF: a ``suppressions`` entry with the justification).
+Format and decisions: docs/plan.md, "Acknowledged warnings".
+"""
+from __future__ import annotations
+
+import hashlib
+import re
+from dataclasses import dataclass
+from typing import Any, Iterable, Mapping, MutableMapping
+
+from rclverify.lang import ast
+from rclverify.lang.types import Checked
+
+#: ``<Node>.g<k>[.c<j>].<check>`` or ``<Node>.<check>``: a health finding's id (calculus/health/finding.py).
+_HEALTH_ID = re.compile(r"^(?P<node>[A-Za-z_][A-Za-z0-9_]*)(?:\.g(?P<k>\d+)(?:\.c(?P<j>\d+))?)?\.(?P<check>[A-Za-z0-9_-]+)$")
+
+
+@dataclass(frozen=True)
+class Acknowledgement:
+    """One ``acknowledged:`` entry of the plan.
+
+    ``warning`` is a health finding's id (``Mover.g2.c1.redundant``) or a
+    lint code (``W-unused-bound``, optionally narrowed to ``file``);
+    ``text`` the flagged text as written, ``sha256`` its digest (hex, a
+    prefix of at least 12 digits; one of the two is given); ``reason`` the
+    user's justification; ``loc`` the entry's place in the plan."""
+
+    warning: str
+    reason: str
+    loc: ast.Loc
+    text: str | None = None
+    sha256: str | None = None
+    file: str | None = None
+
+    def binds(self, flagged: str) -> bool:
+        """Is this acknowledgement bound to ``flagged`` (the finding's flagged text now)?"""
+        if self.text is not None:
+            return normal(self.text) == normal(flagged)
+        return bool(self.sha256) and digest(flagged).startswith(str(self.sha256).lower())
+
+
+def normal(text: str) -> str:
+    """``text`` with its white space runs made one space (the form digested)."""
+    return " ".join(str(text).split())
+
+
+def digest(text: str) -> str:
+    """The sha256 (hex) of :func:`normal` ``text``: what an acknowledgement binds."""
+    return hashlib.sha256(normal(text).encode("utf-8")).hexdigest()
+
+
+def read_acknowledgements(data: Mapping[str, Any], locs: Mapping[Any, ast.Loc], plan_rel: str) -> tuple[Acknowledgement, ...]:
+    """The plan's ``acknowledged:`` entries (schema-checked: each has
+    ``warning`` and ``reason``).  Raises :class:`~.errors.PlanError`, located
+    at the entry, for an entry that gives neither or both of ``text`` and
+    ``sha256``, or whose reason is no sentence (fewer than three words of
+    letters: ``reason: "..."`` says nothing a reviewer can weigh)."""
+    from rclverify.model.plan.errors import plan_error
+    out = []
+    for i, a in enumerate(data.get("acknowledged") or ()):
+        at = locs.get(("acknowledged", i), ast.Loc(plan_rel, 1, 1))
+        if ("text" in a) == ("sha256" in a):
+            raise plan_error(plan_rel, at.line, at.col, f"acknowledged[{i}] ({a['warning']}): give the flagged text "
+                             "it accepts as text: or its digest as sha256: (one of the two; the report shows both "
+                             "for every warning)", "E-acknowledged")
+        if len(re.findall(r"[A-Za-z]{2,}", str(a["reason"]))) < 3:
+            r = locs.get(("acknowledged", i, "reason"), at)
+            raise plan_error(plan_rel, r.line, r.col, f"acknowledged[{i}] ({a['warning']}): the reason must say why "
+                             f"the warning is accepted, in words a reviewer can weigh, not {a['reason']!r}",
+                             "E-acknowledged")
+        out.append(Acknowledgement(str(a["warning"]), normal(a["reason"]),
+                                   locs.get(("acknowledged", i), ast.Loc(plan_rel, 1, 1)),
+                                   a.get("text"), a.get("sha256"), a.get("file")))
+    return tuple(out)
+
+
+def _within(loc: ast.Loc, line: int, col: int) -> bool:
+    end = (loc.end_line, loc.end_col) if loc.end_line else (loc.line, 10**9)
+    return (loc.line, loc.col) <= (line, col) < end or (loc.line, loc.col) == (line, col)
+
+
+def _node_text(node: ast.Node) -> str:
+    from rclverify.lang.printer import to_rcl
+    return to_rcl(ast.Spec((), (node,)))
+
+
+def lint_flagged(row: Mapping[str, Any], checked: Checked, source: str = "") -> str:
+    """The flagged text of a lint row (``file``/``line``/``col`` or
+    ``location``): the clause or constant whose span holds the location,
+    else the node's whole contract, else the source line ``source`` gives."""
+    from rclverify.lang.printer import expr_to_rcl
+    file, line, col = _where(row)
+    for spec in checked.specs:
+        if spec.file != file:
+            continue
+        for ctx in spec.contexts:
+            for d in ctx.decls:
+                if isinstance(d, ast.ConstDecl) and _within(d.loc, line, col):
+                    return f"{d.name} = {expr_to_rcl(d.value)}"
+        for n in spec.nodes:
+            if not _within(n.loc, line, col):
+                continue
+            for c in n.assumes + n.guarantees:
+                if _within(c.loc, line, col):
+                    return expr_to_rcl(c.formula)
+            return _node_text(n)
+    return source or str(row.get("message", ""))
+
+
+def conjuncts(e: ast.Expr) -> list[ast.Expr]:
+    """The top-level ``and`` operands of ``e``, as the health checks number
+    them (the plan sits below the calculus, so this is not imported)."""
+    if isinstance(e, ast.Binary) and e.op == "and":
+        return conjuncts(e.left) + conjuncts(e.right)
+    return [e]
+
+
+def _where(row: Mapping[str, Any]) -> tuple[str, int, int]:
+    if "file" in row:
+        return str(row["file"]), int(row.get("line", 0)), int(row.get("col", 0))
+    file, line, col = (str(row.get("location", "")).rsplit(":", 2) + ["0", "0"])[:3]
+    return file, int(line) if line.isdigit() else 0, int(col) if col.isdigit() else 0
+
+
+def health_flagged(finding: Mapping[str, Any], checked: Checked) -> str:
+    """The flagged text of a health finding: conjunct ``j`` of guarantee
+    ``k`` (``<Node>.g<k>.c<j>.<check>``), guarantee ``k``
+    (``<Node>.g<k>.<check>``), the node's contract (``<Node>.<check>``), or
+    the finding's message when its id names no node of ``checked``."""
+    from rclverify.lang.printer import expr_to_rcl
+    m = _HEALTH_ID.match(str(finding.get("id", "")))
+    cn = checked.nodes.get(m["node"]) if m else None
+    if m is None or cn is None:
+        return str(finding.get("message", ""))
+    node = cn.node
+    if m["k"] is None:
+        return _node_text(node)
+    k = int(m["k"])
+    if not 1 <= k <= len(node.guarantees):
+        return str(finding.get("message", ""))
+    g = node.guarantees[k - 1]
+    if m["j"] is None:
+        return expr_to_rcl(g.formula)
+    parts = conjuncts(g.formula)
+    j = int(m["j"])
+    return expr_to_rcl(parts[j - 1]) if 1 <= j <= len(parts) else expr_to_rcl(g.formula)
+
+
+def _is_warning(kind: str, row: Mapping[str, Any]) -> bool:
+    return str(row.get("status" if kind == "health" else "severity", "")).lower() == "warning"
+
+
+def _ident(kind: str, row: Mapping[str, Any]) -> str:
+    return str(row["id"]) if kind == "health" else f"{row.get('location', '')}:{row.get('code', '')}"
+
+
+def apply_acknowledgements(acks: Iterable[Acknowledgement], findings: Iterable[MutableMapping[str, Any]],
+                           lint_rows: Iterable[MutableMapping[str, Any]], checked: Checked) -> list[dict[str, Any]]:
+    """Match the plan's acknowledgements with this run's warnings.
+
+    ``findings`` are the report's health rows (``id``, ``status``,
+    ``message``), ``lint_rows`` its lint rows (``location``, ``code``,
+    ``severity``, ``message``).  Every warning row gets ``flagged`` (its
+    flagged text) and ``sha256`` (its digest), and, when an acknowledgement
+    binds it, ``acknowledged`` = ``{"reason", "at"}`` (``at``: the plan
+    entry's ``file:line:col``).  Returns one row per acknowledgement:
+    ``{"warning", "reason", "at", "status", "message", "matched"}`` with
+    ``status`` ``ok`` (it acknowledges the ``matched`` warnings), ``stale``
+    (it matches no warning, or the flagged text changed: the warning is
+    raised again) or ``error`` (it names an item that is not a warning)."""
+    rows: list[tuple[str, MutableMapping[str, Any]]] = (
+        [("health", f) for f in findings] + [("lint", x) for x in lint_rows])
+    for kind, r in rows:
+        for k in ("acknowledged", "flagged", "sha256"):  # rows kept between runs in one process start clean
+            r.pop(k, None)
+        if _is_warning(kind, r):
+            r["flagged"] = health_flagged(r, checked) if kind == "health" else lint_flagged(r, checked)
+            r["sha256"] = digest(r["flagged"])
+    out = []
+    for a in acks:
+        cands = [(k, r) for k, r in rows if (r.get("id") == a.warning if k == "health" else
+                                             str(r.get("code", "")) == a.warning
+                                             and (a.file is None or str(r.get("location", "")).startswith(a.file + ":")))]
+        warns = [(k, r) for k, r in cands if _is_warning(k, r)]
+        bound = [(k, r) for k, r in warns if a.binds(str(r["flagged"]))]
+        at = f"{a.loc.file}:{a.loc.line}:{a.loc.col}"
+        for _, r in bound:
+            r["acknowledged"] = {"reason": a.reason, "at": at}
+        if bound:
+            status, msg = "ok", f"acknowledges {', '.join(_ident(k, r) for k, r in bound)}: {a.reason}"
+        elif warns:
+            now = "; ".join(f"`{r['flagged']}` (sha256 {str(r['sha256'])[:16]})" for _, r in warns[:3])
+            status, msg = "stale", (f"the text it acknowledged changed: {a.warning} now flags {now}; the warning is "
+                                    "raised again (read it, then bind the acknowledgement to the new text or drop it)")
+        elif cands:
+            k, r = cands[0]
+            word = r.get("status" if k == "health" else "severity")
+            status, msg = "error", (f"{a.warning} is {word}, not a warning: only a warning can be acknowledged as an "
+                                    "accepted risk (an error or an undecided check must be answered by a fix or evidence)")
+        else:
+            status, msg = "stale", f"matches no warning of this run ({a.warning}): remove it from the plan"
+        out.append({"warning": a.warning, "reason": a.reason, "at": at, "status": status, "message": msg,
+                    "matched": [_ident(k, r) for k, r in bound]})
+    return out
+
+
+def hint(kind: str, row: Mapping[str, Any]) -> str:
+    """The plan entry that would acknowledge the warning ``row`` (one YAML
+    flow mapping; ``reason`` left for the user to write)."""
+    name = row["id"] if kind == "health" else row.get("code", "")
+    return f'- {{warning: {name}, sha256: {str(row.get("sha256", ""))[:16]}, reason: "..."}}'

@@ -1,1 +1,0 @@
-"""rcl stage of rclverify."""

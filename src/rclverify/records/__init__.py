@@ -1,0 +1,7 @@
+"""Layer 2, records: the formats every stage writes and the report reads.
+
+Obligations and evidence records (``records``), their atomic store
+(``store``), sealed stage records (``sealed``), published artifacts,
+run-based statistics, the one status vocabulary (``statuses``) and the
+assurance report's schema as types (``report_schema``).  Imports ``core``.
+"""

@@ -1,0 +1,295 @@
+"""The assurance report's shape as types: one TypedDict per row kind and :class:`Report`.
+
+These are the static reading of ``docs/assurance.schema.json`` (JSON Schema
+draft 2020-12), the published shape of ``reports/assurance.json``; the
+status words are the Literal types of :mod:`rclverify.records.statuses`.
+A key the schema lists as optional is ``NotRequired`` here.  Records whose
+inner shape belongs to a tool (a requirement's check record, a monitoring
+summary, a counterexample, the grounding) are ``dict[str, Any]``, as the
+schema leaves them open.
+
+:func:`as_report` is the one place a report dict built pass by pass
+(report/build.py) becomes a :class:`Report`: it checks the top-level keys
+and the summary status, so a renderer typed on :class:`Report` never reads
+a report that lacks a part.
+"""
+# No ``from __future__ import annotations``: Python 3.11 reads ``NotRequired`` only from evaluated
+# annotations (with string annotations every key would count as required).
+from typing import Any, Mapping, NotRequired, TypedDict, cast
+
+from rclverify.records.statuses import (AcknowledgementStatus, Derivation, EvidenceKind, EvidenceStatus, HealthStatus,
+                                 LintSeverity, RequirementVerdict, SideConditionVerdict, EVIDENCE_STATUSES)
+
+
+class Meta(TypedDict):
+    """Where the report comes from (``meta``)."""
+    tool: str
+    version: str
+    workspace: str
+    plan: str
+    contracts: list[str]
+    z3_version: str
+    strict_ok: bool
+    inputs_sha256: str
+
+
+class DiagnosisBrief(TypedDict):
+    """One diagnosis in short (``summary.diagnoses[]``); ``repairs``: how many repairs Z3 checked."""
+    id: str
+    kind: str
+    sentence: str
+    repairs: int
+
+
+class Summary(TypedDict):
+    """The one-screen summary (``summary``); ``counts``: obligations per status."""
+    status: EvidenceStatus
+    counts: dict[str, int]
+    headline: str
+    problems: list[str]
+    solvers: dict[str, int]
+    diagnoses: list[DiagnosisBrief]
+    confidence: NotRequired[float]
+
+
+class GuaranteeRow(TypedDict):
+    """A guarantee of a node (``nodes[].guarantees[]``); ``index`` is 1-based."""
+    index: int
+    text: str
+    source: str
+    status: EvidenceStatus
+    obligations: list[str]
+    strength: NotRequired[dict[str, Any]]
+    culprit_of: NotRequired[list[dict[str, Any]]]
+
+
+class NodeRow(TypedDict):
+    """A node's contract and status (``nodes[]``); ``source`` is file:line:col."""
+    name: str
+    source: str
+    status: EvidenceStatus
+    inputs: list[dict[str, Any]]
+    outputs: list[dict[str, Any]]
+    assumptions: list[dict[str, Any]]
+    guarantees: list[GuaranteeRow]
+    latex: str
+    confidence: NotRequired[float]
+    limited_by: NotRequired[dict[str, Any] | None]
+    culprit_of: NotRequired[list[dict[str, Any]]]
+
+
+class SupportRow(TypedDict):
+    """A guarantee a requirement is traced to (``requirements[].support[]``)."""
+    node: str
+    guarantee: int
+    text: str
+    source: str
+    status: EvidenceStatus
+    obligations: list[str]
+
+
+class RequirementRow(TypedDict):
+    """A requirement (``requirements[]``): only ``verdict`` ``met`` has ``status`` ``discharged``."""
+    id: str
+    text: str
+    verdict: RequirementVerdict
+    status: EvidenceStatus
+    note: str
+    support: list[SupportRow]
+    check: dict[str, Any]
+    deadline: NotRequired[dict[str, Any]]
+    without_deadline: NotRequired[dict[str, Any]]
+    statistics: NotRequired[list[dict[str, Any]]]
+    confidence: NotRequired[float]
+    limited_by: NotRequired[dict[str, Any] | None]
+
+
+class SideConditionRow(TypedDict):
+    """A side condition decided by Z3 (``side_conditions[]``); ``duration_s`` in seconds."""
+    id: str
+    node: str
+    rule: str
+    conjunct: str
+    source: str
+    hypotheses: list[str]
+    status: EvidenceStatus
+    verdict: SideConditionVerdict
+    duration_s: float
+    smt2: str
+    model: dict[str, Any] | None
+    explanation: str
+    variant: str
+    links: list[str]
+    context: dict[str, Any] | None
+    scale_mismatch: NotRequired[list[dict[str, Any]]]
+    solvers: NotRequired[dict[str, Any]]
+    strength: NotRequired[dict[str, Any]]
+
+
+class DerivedPropertyRow(TypedDict):
+    """A node's derived property with its derivation and evidence statuses (``derived_properties[]``)."""
+    node: str
+    rules: list[str]
+    instances: list[dict[str, Any]]
+    environment_assumptions: list[str]
+    property: str
+    status: EvidenceStatus
+    derivation: Derivation
+    evidence_status: EvidenceStatus
+    evidence_note: str
+    loop_assumption: str | None
+    confidence: NotRequired[float]
+    limited_by: NotRequired[dict[str, Any] | None]
+
+
+class FindingRow(TypedDict):
+    """A contract health finding (``findings[]``); ``guarantee`` ``None`` for the whole contract."""
+    id: str
+    node: str
+    check: str
+    status: HealthStatus
+    message: str
+    guarantee: NotRequired[int | None]
+    explanation: NotRequired[str]
+    duration_s: NotRequired[float]
+    smt2: NotRequired[str]
+    core: NotRequired[list[str] | None]
+    instances: NotRequired[dict[str, Any] | None]
+    model: NotRequired[dict[str, Any] | None]
+    witness: NotRequired[dict[str, Any]]
+    witness_smt2: NotRequired[str]
+    solvers: NotRequired[dict[str, Any]]
+    flagged: NotRequired[str]
+    sha256: NotRequired[str]
+    acknowledged: NotRequired[dict[str, str]]
+
+
+class ObligationRow(TypedDict):
+    """An obligation (``obligations[]``); ``guarantee`` 0 is the whole contract."""
+    id: str
+    node: str
+    guarantee: int
+    backend: str
+    kind: EvidenceKind
+    instance: str
+    statement: str
+    source: str
+    artifact: str
+    status: EvidenceStatus
+
+
+class EvidenceRow(TypedDict):
+    """An evidence record as the report shows it (``evidence[]``); ``started`` ISO 8601, ``duration_s`` seconds."""
+    obligation: str
+    backend: str
+    kind: EvidenceKind
+    status: EvidenceStatus
+    tool: str
+    tool_version: str
+    started: str
+    duration_s: float
+    explanation: str
+    counterexample: dict[str, Any] | None
+    artifacts: list[str]
+    log_excerpt: str
+    figures: NotRequired[list[list[str]]]
+    plot_svg: NotRequired[str]
+    solvers: NotRequired[dict[str, Any]]
+    examples: NotRequired[dict[str, Any]]
+    monitoring: NotRequired[dict[str, Any]]
+    statistics: NotRequired[dict[str, Any]]
+    strength: NotRequired[dict[str, Any]]
+
+
+class PendingRow(TypedDict):
+    """An obligation without a decided record (``pending[]``)."""
+    obligation: str
+    backend: str
+    reason: str
+
+
+class LintRow(TypedDict):
+    """A diagnostic of the contract or plan text (``lint[]``); ``location`` is file:line:col."""
+    severity: LintSeverity
+    location: str
+    message: str
+    code: str
+    flagged: NotRequired[str]
+    sha256: NotRequired[str]
+    acknowledged: NotRequired[dict[str, str]]
+
+
+class AcknowledgementRow(TypedDict):
+    """A plan acknowledgement of a warning (``acknowledgements[]``); ``at`` is file:line:col."""
+    warning: str
+    reason: str
+    at: str
+    status: AcknowledgementStatus
+    message: str
+    matched: list[str]
+
+
+class UnverifiedRow(TypedDict):
+    """A guarantee no obligation covers (``unverified[]``)."""
+    id: str
+    node: str
+    guarantee: int
+    text: str
+    source: str
+    status: EvidenceStatus
+    reason: str
+    message: str
+
+
+class ProblemRow(TypedDict):
+    """Problems grouped by one root cause (``problems[]``)."""
+    key: list[str]
+    sentence: str
+    status: EvidenceStatus
+    where: str
+    culprits: list[dict[str, Any]]
+    members: list[dict[str, Any]]
+    repairs: list[dict[str, Any]]
+
+
+class Report(TypedDict):
+    """``reports/assurance.json`` (docs/assurance.schema.json)."""
+    meta: Meta
+    summary: Summary
+    system: dict[str, Any]
+    requirements: list[RequirementRow]
+    nodes: list[NodeRow]
+    side_conditions: list[SideConditionRow]
+    derived_properties: list[DerivedPropertyRow]
+    findings: list[FindingRow]
+    obligations: list[ObligationRow]
+    evidence: list[EvidenceRow]
+    environment_assumptions: list[dict[str, str]]
+    pending: list[PendingRow]
+    lint: list[LintRow]
+    expected_verdicts: list[dict[str, Any]]
+    grounding: dict[str, Any] | None
+    unverified: list[UnverifiedRow]
+    deadlines: list[dict[str, Any]]
+    acknowledgements: list[AcknowledgementRow]
+    statistics: list[dict[str, Any]]
+    diagnoses: list[dict[str, Any]]
+    problems: list[ProblemRow]
+
+
+#: The report's top-level keys, in the order build_report writes them.
+REPORT_KEYS: tuple[str, ...] = tuple(Report.__annotations__)
+
+
+def as_report(report: Mapping[str, Any]) -> Report:
+    """``report`` (a report dict, e.g. what the passes of report/build.py
+    grew) as a :class:`Report`.  Raises ``ValueError`` naming the missing
+    top-level keys, or a ``summary.status`` outside the evidence statuses:
+    a report without a part is a bug of the build, never shown."""
+    missing = [k for k in REPORT_KEYS if k not in report]
+    if missing:
+        raise ValueError(f"report lacks {', '.join(missing)}")
+    status = report["summary"].get("status")
+    if status not in EVIDENCE_STATUSES:
+        raise ValueError(f"report summary status {status!r} is not an evidence status")
+    return cast(Report, report)

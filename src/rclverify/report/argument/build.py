@@ -1,0 +1,334 @@
+"""Build the GSN goal structure from the assurance report dict.
+
+The argument is built from the report dict of :func:`rclverify.report.build.build_report`
+(the same data the report shows), so it needs no other artifact and works
+with any backend and any evidence kind: a solution is one evidence record,
+whatever produced it.  Structure (docs/argument.md)::
+
+    G-system  the system meets REQ1..REQn            in context of C-plan
+      S-requirements  argument over each requirement
+        G-<REQ>  the requirement's text
+          S-<REQ>  argument over the composition calculus (rules R1-R4,
+                   paper lines 556-768)              in context of A-persist,
+                   the loop rule's assumption, J-calculus
+            G-<Node>.g<k>   each supporting guarantee
+            G-<Node>.sc<k>  each side condition of a supporting node
+      S-contracts  argument over the node contracts (the rules' premises)
+        G-<Node>  the node meets its contract        in context of C-<Node>,
+                                                     its environment assumptions
+          G-<Node>.g<k>, G-<Node>.sc<k>
+    G-<Node>.g<k>   supported by one solution per evidence record of an
+                    obligation on it (guarantee k, or 0 = the whole contract),
+                    one per contract health finding on it, and an undeveloped
+                    goal per obligation without a record, or when no
+                    obligation was exported at all
+    G-<Node>.sc<k>  supported by the Z3 query's solution
+    G-<REQ>.deadline  a requirement's end-to-end deadline, under its goal
+                    (:mod:`.deadlines`: Z3's decision, the chain's timed
+                    guarantees, the monitors' evidence)
+
+Statuses then propagate upward (:func:`.model.propagate`): with the
+report's own roll-up rules this gives every requirement, guarantee and node
+goal the status the report shows for it.
+"""
+from __future__ import annotations
+
+import hashlib
+
+import re
+from typing import Any, Mapping
+
+from rclverify.report.argument.deadlines import own_check, with_deadline
+from rclverify.report.argument.statistics import with_statistics
+from rclverify.report.argument.model import Argument, Element, propagate
+from rclverify.report.textfmt import natural_key
+
+_FINDING_AS = {"ok": "discharged", "problem": "failed", "inconclusive": "inconclusive", "stale": "stale"}
+_ID_BAD = re.compile(r"[^A-Za-z0-9_.\-]+")
+
+PERSIST = ("Outputs persist once produced, so the inputs a node receives from several producers are "
+           "available together (the calculus's simplifying assumption for R3, paper lines 658-660; "
+           "the user must ensure it).")
+CALCULUS = ("Rules R1 (sequence), R2 (branch), R3 (join) and R4 (loop) of the composition calculus "
+            "(paper lines 556-768): when each node meets its contract and every side condition is "
+            "discharged, each node's guarantee eventually holds in the composed system.")
+IN_CONTEXT = ("Side conditions in context (docs/calculus.md): a conjunct of a node's assumption that its producers' "
+              "guarantees alone do not entail is entailed by the guarantees of its upstream cone, each taken only "
+              "where its own node's assumption holds (the stream semantics, paper lines 462-495), with the "
+              "environment assumptions and facts of the cone; loops are opened as rule R4 composes them (paper "
+              "lines 717-768), so no guarantee discharges its own premise.")
+
+
+def ident(prefix: str, *parts: Any) -> str:
+    """A GSN id ``<prefix>-<parts joined by '.'>`` with unsafe characters replaced by ``_``."""
+    return prefix + "-" + _ID_BAD.sub("_", ".".join(str(p) for p in parts))
+
+
+def _clip(text: str, n: int = 400) -> str:
+    text = " ".join(str(text).split())
+    return text if len(text) <= n else text[: n - 3] + "..."
+
+
+ENTAILMENT = ("Z3 decides the requirement from the guarantees of the nodes it mentions and of every node upstream "
+              "of them, the environment assumptions and facts of those nodes and the requirement's own assumptions "
+              "(docs/requirements.md); the proof is only as good as the evidence of the guarantees it used and the "
+              "consistency of its premises.")
+_PROOF_STATUS = {"met": "discharged", "proved, evidence outstanding": "discharged",
+                 "proved from an inconsistency": "failed", "proved vacuously": "failed", "refuted": "failed", "inconclusive": "inconclusive",
+                 "stale": "stale", "error": "error"}
+
+
+def _requirement_goal(b: "_Builder", r: Mapping[str, Any], guarantee_goal: Mapping[tuple[str, int], str],
+                      sides: Mapping[str, list[Mapping[str, Any]]], j_calc: str) -> str:
+    """The goal of a requirement the report's requirement check decided
+    (its ``verdict``): an informal one is an undeveloped goal; a formal one is
+    supported by a formal-entailment strategy whose children are the Z3
+    proof (a solution with the check's verdict) and the goals of the
+    guarantees the proof used, with the side conditions of their nodes."""
+    rid = str(r["id"])
+    c = r.get("check") or {}
+    if r["verdict"] == "informal":
+        traced = ", ".join(f"{s['node']} guarantee {s['guarantee']}" for s in r["support"]) or "no guarantee"
+        return b.add(Element(ident("G", rid), "goal",
+                             _clip(f"{rid}: {r['text']} (informal: no formal statement; traced to {traced})"),
+                             undeveloped=True, ref=rid))
+    sn = b.add(Element(ident("Sn", "req", rid), "solution",
+                       _clip(f"Z3 {('proof' if r['verdict'] in ('met', 'proved, evidence outstanding') else 'check')} "
+                             f"of {rid} ({c.get('smt2') or _temporal_what(c) or 'not checked yet'}): {r['verdict']}. "
+                             f"{r['note']}"),
+                       status=_PROOF_STATUS.get(str(r["verdict"]), "pending"), ref=rid, url=str(c.get("smt2") or "")))
+    kids = [sn]
+    nodes_used: list[str] = []
+    for p in c.get("used") or []:
+        if p.get("kind") == "guarantee" and (str(p["node"]), int(p["index"])) in guarantee_goal:
+            kids.append(guarantee_goal[(str(p["node"]), int(p["index"]))])
+            if p["node"] not in nodes_used:
+                nodes_used.append(str(p["node"]))
+    for name in nodes_used:
+        kids += [ident("G", "sc", sc["id"]) for sc in sides.get(name, [])]
+    kids += [_declaration_goal(b, d) for d in c.get("declarations") or []]
+    ctx = [j_calc] + [b.add(Element(ident("A", rid, "assuming", k), "assumption",
+                                    _clip(f"{rid} assumes: {a}"), ref=rid))
+                      for k, a in enumerate(c.get("assuming") or [], 1)]
+    strategy = b.add(Element(
+        ident("S", rid), "strategy",
+        _clip(f"Argument by formal entailment: {c.get('formal')} follows from the premises Z3 used"
+              + (f" ({', '.join(p['label'] for p in c.get('used') or [])})" if c.get("used") else "")
+              + ". " + ENTAILMENT),
+        supported_by=tuple(dict.fromkeys(kids)), in_context_of=tuple(ctx), ref=rid))
+    # its confidence is stated at its assurance claim point (.claim_points)
+    return b.add(Element(ident("G", rid), "goal", _clip(f"{rid}: {r['text']}"), supported_by=(strategy,), ref=rid))
+
+
+def _declaration_goal(b: "_Builder", d: Mapping[str, Any]) -> str:
+    """The goal that a declaration a proof used holds of its node's
+    implementation (issue 64), supported by its evidence as the roll-up
+    reads it (requirements/rollup.declaration_evidence): the monitors' runs,
+    the property tests, or the declarations it follows from."""
+    label = str(d["label"])
+    sn = b.add(Element(ident("Sn", "decl", label), "solution",
+                       _clip(f"Evidence of {label} ({d.get('source', '')}): {d['status']} ({d.get('words', '')})"),
+                       status=str(d["status"]), ref=label))
+    return b.add(Element(ident("G", "decl", label), "goal",
+                         _clip(f"{d['node']} keeps its declaration {d.get('text', '')}".rstrip()),
+                         supported_by=(sn,), ref=label))
+
+
+class _Builder:
+    def __init__(self) -> None:
+        self.els: dict[str, Element] = {}
+
+    def add(self, e: Element) -> str:
+        if e.id not in self.els:
+            self.els[e.id] = e
+        return e.id
+
+
+def build_argument(report: Mapping[str, Any]) -> Argument:
+    """The goal structure of ``report`` (a report dict, see
+    :data:`rclverify.report.render.REPORT_KEYS`), statuses propagated.
+
+    Returns an :class:`Argument` whose element order is deterministic
+    (requirements and nodes in report order, obligations in natural order
+    of their ids: ``p1_i0 < p2_i1 < p10_i9``).
+    Raises ``KeyError`` for a missing report key and
+    :class:`.model.ArgumentError` if the result were malformed.
+    """
+    b = _Builder()
+    meta = report["meta"]
+    reqs = report["requirements"]
+    ev_of = {str(e["obligation"]): e for e in report["evidence"]}
+    obligations = sorted(report["obligations"], key=lambda o: natural_key(o["id"]))  # p1 < p2 < p10
+    obligations_of: dict[str, list[Mapping[str, Any]]] = {}  # by node, still sorted by id
+    for o in obligations:
+        obligations_of.setdefault(str(o["node"]), []).append(o)
+    sides: dict[str, list[Mapping[str, Any]]] = {}
+    for sc in report["side_conditions"]:
+        sides.setdefault(str(sc["node"]), []).append(sc)
+    findings: dict[str, list[Mapping[str, Any]]] = {}
+    for f in report["findings"]:
+        findings.setdefault(str(f["node"]), []).append(f)
+    env: dict[str, list[Mapping[str, Any]]] = {}
+    for a in report["environment_assumptions"]:
+        env.setdefault(str(a["node"]), []).append(a)
+
+    top = ident("G", "system")
+    c_plan = b.add(Element(ident("C", "plan"), "context",
+                           f"Verification plan {meta['plan']} and contracts {', '.join(map(str, meta['contracts']))} "
+                           f"of {meta['workspace']}", url=str(meta["plan"])))
+    a_persist = b.add(Element(ident("A", "persist"), "assumption", PERSIST))
+    grounding = report.get("grounding")
+    top_ctx: tuple[str, ...] = (c_plan,)
+    if grounding:  # docs/ros.md: which software version the contracts were grounded in
+        ctx = grounding["context"]
+        digest = hashlib.sha256("".join(f"{f['path']}\0{f['sha256']}\n" for f in ctx["files"]).encode()).hexdigest()
+        top_ctx += (b.add(Element(ident("C", "ros"), "context", _clip(
+            "Contracts grounded in the ROS software: "
+            + ", ".join(f"{p['name']} {p['version']}" for p in ctx["packages"])
+            + f"; {len(ctx['files'])} scanned files (sha256 of their sha256 list {digest[:16]}, each in "
+              f"artifacts/ros/graph.json); {grounding['counts']['error']} grounding error(s), "
+              f"{grounding['counts']['warning']} warning(s)"), url="artifacts/ros/graph.json")),)
+    loop_ids: dict[str, str] = {}  # R4's assumption text -> its element (one per loop)
+    loop_of: dict[str, str] = {}
+    for d in report["derived_properties"]:
+        text = d.get("loop_assumption")
+        if text:
+            if text not in loop_ids:
+                loop_ids[text] = b.add(Element(ident("A", "loop", len(loop_ids) + 1), "assumption", str(text)))
+            loop_of[str(d["node"])] = loop_ids[text]
+    loops = list(loop_ids.values())
+    j_calc = b.add(Element(ident("J", "calculus"), "justification", CALCULUS))
+    j_context = ident("J", "context")
+    if any(sc.get("verdict") == "discharged in context" for sc in report["side_conditions"]):
+        b.add(Element(j_context, "justification", IN_CONTEXT))
+
+    def evidence_goals(node: str, k: int) -> list[str]:
+        """Solutions and undeveloped goals under guarantee ``k`` of ``node``."""
+        kids: list[str] = []
+        mine = [o for o in obligations_of.get(node, []) if o["node"] == node and int(o["guarantee"]) in (k, 0)]
+        for o in mine:
+            oid = str(o["id"])
+            ev = ev_of.get(oid)
+            if ev is None:
+                kids.append(b.add(Element(ident("G", "ob", oid), "goal",
+                                          f"Obligation {oid} ({o['backend']}) is discharged: no evidence record yet",
+                                          undeveloped=True, ref=oid)))
+                continue
+            tool = f"{ev['tool']} {ev['tool_version']}".strip()
+            kids.append(b.add(Element(
+                ident("Sn", "ev", oid), "solution",
+                _clip(f"{ev['kind']} evidence ({ev['backend']}, {tool}) for {oid}: {ev['status']}"
+                      + (f" [strength: {ev['strength']['kind']}; {ev['strength']['detail']}]" if ev.get("strength") else "")
+                      + f". {ev['explanation']}"),
+                status=str(ev["status"]), ref=oid, url=f"artifacts/evidence/{oid}.json")))
+        if not mine:
+            kids.append(b.add(Element(ident("G", node, f"g{k}", "evidence"), "goal",
+                                      f"Evidence that {node} guarantee {k} holds: no obligation was exported for it",
+                                      undeveloped=True, ref=f"{node}.g{k}", status="unverified")))
+        for f in findings.get(node, []):
+            if f["guarantee"] in (None, k):
+                kids.append(b.add(Element(
+                    ident("Sn", "health", f["id"]), "solution",
+                    _clip(f"Contract health check {f['check']} (Z3): {f['status']}. {f['message']}"),
+                    status=_FINDING_AS.get(str(f["status"]), "error"), ref=str(f["id"]),
+                    url=str(f.get("smt2") or ""))))
+        return kids
+
+    def side_goal(sc: Mapping[str, Any]) -> str:
+        sid = str(sc["id"])
+        verdict = str(sc.get("verdict") or sc["status"])
+        sn = b.add(Element(ident("Sn", "sc", sid), "solution",
+                           _clip(f"Z3 query {sc['smt2']}: {verdict}"
+                                 + (f" [{sc['solvers']['agreement']}]" if sc.get("solvers") else "")
+                                 + f". {sc['explanation']}"),
+                           status=str(sc["status"]), ref=sid, url=str(sc["smt2"])))
+        if verdict == "discharged in context":  # the claim is the weaker one the proof supports (docs/calculus.md)
+            ctx = sc.get("context") or {}
+            used = sorted({str(u).split(" ", 1)[0] for u in ctx.get("used_nodes") or []})
+            return b.add(Element(ident("G", "sc", sid), "goal",
+                                 _clip(f"Side condition {sid} ({sc['rule']}, {sc['source']}): the conjunct "
+                                       f"{sc['conjunct']} of {sc['node']}'s assumption follows, in context, from the "
+                                       f"guarantees of its upstream cone ({', '.join(used) or 'none'}), each under its "
+                                       "own node's assumption, and the cone's environment assumptions and facts"),
+                                 supported_by=(sn,), in_context_of=(j_context,), ref=sid))
+        return b.add(Element(ident("G", "sc", sid), "goal",
+                             _clip(f"Side condition {sid} ({sc['rule']}, {sc['source']}): the conjunct "
+                                   f"{sc['conjunct']} of {sc['node']}'s assumption follows from its producers' guarantees"),
+                             supported_by=(sn,), ref=sid))
+
+    guarantee_goal: dict[tuple[str, int], str] = {}
+    contract_goals: list[str] = []
+    for n in report["nodes"]:
+        name = str(n["name"])
+        g_ids = []
+        for g in n["guarantees"]:
+            k = int(g["index"])
+            gid = b.add(Element(ident("G", name, f"g{k}"), "goal",
+                                _clip(f"{name} guarantee {k} holds ({g['source']}): {g['text']}"),
+                                supported_by=tuple(evidence_goals(name, k)), ref=f"{name}.g{k}"))
+            guarantee_goal[(name, k)] = gid
+            g_ids.append(gid)
+        sc_ids = [side_goal(sc) for sc in sides.get(name, [])]
+        c_node = b.add(Element(ident("C", name), "context", f"Contract of {name} ({n['source']})", ref=name))
+        ctx = [c_node] + [b.add(Element(ident("A", "env", name, i), "assumption",
+                                        _clip(f"Environment assumption of {name} ({a['source']}): {a['text']}"), ref=name))
+                          for i, a in enumerate(env.get(name, []), 1)]
+        contract_goals.append(b.add(Element(
+            ident("G", name), "goal",
+            f"{name} meets its contract in the composed system: for every input satisfying its assumption, "
+            f"eventually an output satisfying its guarantees (paper lines 462-495)",
+            supported_by=tuple(g_ids + sc_ids), in_context_of=tuple(ctx), ref=name)))
+
+    req_goals = []
+    for r in reqs:
+        rid = str(r["id"])
+        if "verdict" in r:  # checked by Z3 (docs/requirements.md): entailment, or undeveloped
+            gid = _requirement_goal(b, own_check(r), guarantee_goal, sides, j_calc)
+            req_goals.append(with_statistics(b.els, with_deadline(b.els, gid, r, guarantee_goal), r))  # its deadline
+            # (rule D3) and its recorded runs' bounds and targets (statistics.py, issue 68)
+            continue
+        kids: list[str] = []
+        nodes_used: list[str] = []
+        for s in r["support"]:
+            kids.append(guarantee_goal[(str(s["node"]), int(s["guarantee"]))])
+            if s["node"] not in nodes_used:
+                nodes_used.append(str(s["node"]))
+        for name in nodes_used:
+            kids += [ident("G", "sc", sc["id"]) for sc in sides.get(name, [])]
+        ctx = [a_persist] + sorted({loop_of[x] for x in nodes_used if x in loop_of}) + [j_calc]
+        strategy = b.add(Element(
+            ident("S", rid), "strategy",
+            f"Argument over the composition calculus: {rid} follows from the guarantees of "
+            f"{', '.join(nodes_used) or 'no node'} once the side conditions of their assumptions are discharged",
+            supported_by=tuple(dict.fromkeys(kids)), in_context_of=tuple(ctx), ref=rid))
+        if kids:
+            req_goals.append(b.add(Element(ident("G", rid), "goal", _clip(f"{rid}: {r['text']}"),
+                                           supported_by=(strategy,), ref=rid)))
+        else:  # no supporting guarantee listed: nothing argues for it
+            del b.els[strategy]
+            req_goals.append(b.add(Element(ident("G", rid), "goal", _clip(f"{rid}: {r['text']} (no supporting guarantee listed)"),
+                                           undeveloped=True, ref=rid)))
+    s_reqs = b.add(Element(ident("S", "requirements"), "strategy", "Argument over each requirement of the plan",
+                           supported_by=tuple(req_goals), undeveloped=not req_goals))
+    s_contracts = b.add(Element(ident("S", "contracts"), "strategy",
+                                "Argument over the node contracts: every node meets its contract (the premises of rules R1-R4)",
+                                supported_by=tuple(contract_goals), in_context_of=(a_persist, *loops)))
+    ids = ", ".join(str(r["id"]) for r in reqs) or "no requirement listed"
+    b.els = {top: Element(top, "goal", f"The system {meta['workspace']} meets its requirements ({ids})",
+                          supported_by=(s_reqs, s_contracts), in_context_of=top_ctx), **b.els}
+    from rclverify.report.argument.defeaters import add_defeaters  # counter-evidence as the dialectic extension's defeaters (issue 50)
+    add_defeaters(b.els, report, ident)
+    from rclverify.report.argument.accepted import add_accepted_risks  # warnings acknowledged in the plan, as accepted risks (issue 64)
+    add_accepted_risks(b.els, report, ident, top)
+    from rclverify.report.argument.claim_points import add_claim_points  # where confidence is argued (issue 50)
+    add_claim_points(b.els, report, ident)
+    return propagate(Argument(top, b.els))
+
+
+def _temporal_what(c: Mapping[str, Any]) -> str:
+    """How a temporal requirement was decided (calculus/requirements/temporal_check.py), for its solution's text."""
+    t = c.get("temporal")
+    if not isinstance(t, Mapping):
+        return ""
+    steps = "no step checked" if t.get("bound") is None else f"{t['bound']} steps checked"
+    return f"temporal, {t.get('method')}, {steps}"

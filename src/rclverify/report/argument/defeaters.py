@@ -1,0 +1,90 @@
+"""Counter-evidence in the argument (issue 50): defeaters as the GSN
+Community Standard v3's dialectic extension draws them (a counter solution
+``CSn`` that ``challenges`` a claim; the claim marked ``defeated`` where the
+counter-evidence refutes it), in the form gsn2x reads.
+
+What undermines a claim, and what it challenges:
+
+==============================================  ===============================  ========
+counter-evidence                                 challenges                       defeats
+==============================================  ===============================  ========
+failed evidence (a monitor violation, a test     the guarantee's goal             yes
+counterexample, a refuted triple)
+stale evidence                                   the guarantee's goal             no
+partial coverage (a mapping covering part of a   the guarantee's goal             no
+guarantee)
+a solver disagreement                            the side condition's or          yes
+                                                 requirement's goal
+a vacuous or inconsistent proof                  the requirement's goal           yes
+a problem's culprit, failed or error             the guarantee's or the node's    if failed
+(report/culprits.py)                             goal
+==============================================  ===============================  ========
+
+A defeated claim is never better than what defeats it
+(:func:`.model.propagate`): a culprit guarantee whose own evidence holds
+reads the status of the problem it causes (issue 64).
+"""
+from __future__ import annotations
+
+from dataclasses import replace
+from typing import Any, Mapping
+
+from rclverify.report.argument.model import Element
+
+
+def _clip(text: str, n: int = 300) -> str:
+    return text if len(text) <= n else text[:n - 3] + "..."
+
+
+def add_defeaters(els: dict[str, Element], report: Mapping[str, Any], ident: Any) -> None:
+    """Add a counter solution per piece of counter-evidence of ``report`` to
+    ``els`` (element id -> element, changed in place) and mark the claims
+    it defeats; ``ident`` makes element ids (:func:`.build.ident`).  A
+    target not in ``els`` (a claim the argument does not show) is skipped."""
+    def challenge(cid: str, target: str, text: str, status: str, defeats: bool, url: str = "") -> None:
+        if target not in els or cid in els:
+            return
+        els[cid] = Element(cid, "counter_solution", _clip(text), status=status, challenges=(target,), url=url)
+        if defeats:
+            els[target] = replace(els[target], defeated=True)
+
+    for ev in report.get("evidence", []):
+        oid, st = str(ev["obligation"]), str(ev["status"])
+        parts = oid.split(".")
+        target = ident("G", parts[0], parts[1]) if len(parts) > 1 and parts[1][1:].isdigit() else ""
+        url = f"artifacts/evidence/{oid}.json"
+        if st == "failed":
+            challenge(ident("CSn", "ev", oid), target, f"Counter-evidence {oid} ({ev['backend']}): "
+                      f"{ev.get('explanation', '')}", "failed", True, url)
+        elif st == "stale":
+            challenge(ident("CSn", "ev", oid), target, f"Stale evidence {oid}: an input changed since it was produced",
+                      "stale", False, url)
+        elif "PARTIAL COVERAGE" in str(ev.get("explanation", "")):
+            challenge(ident("CSn", "ev", oid), target, f"Partial coverage {oid}: {ev.get('explanation', '')}",
+                      st, False, url)
+    for sc in report.get("side_conditions", []):
+        s = sc.get("solvers") or {}
+        if s.get("agreement") in ("disagree", "inconclusive"):
+            challenge(ident("CSn", "solvers", sc["id"]), ident("G", "sc", sc["id"]),
+                      f"The second solver does not confirm {sc['id']}: {s.get('why', '')}", "inconclusive", True,
+                      str(s.get("smt2") or ""))
+    for n in report.get("nodes", []):  # a problem's culprit (issue 64): its goal is never "discharged"
+        name = str(n["name"])
+        for g in [*n.get("guarantees", []), n]:
+            target = ident("G", name, f"g{g['index']}") if g is not n else ident("G", name)
+            for k, row in enumerate(g.get("culprit_of") or (), 1):
+                if row["status"] not in ("failed", "error"):
+                    continue  # outstanding evidence is no counter-evidence: the goal reads it already
+                what = f"guarantee {g['index']} of {name}" if g is not n else f"the contract of {name}"
+                challenge(ident("CSn", "culprit", target, k), target,
+                          f"Problem caused by {what}: {row['sentence']}", str(row["status"]),
+                          row["status"] == "failed")
+    for r in report.get("requirements", []):
+        rid, verdict = str(r["id"]), str(r.get("verdict"))
+        s = (r.get("check") or {}).get("solvers") or {}
+        if s.get("agreement") in ("disagree", "inconclusive"):
+            challenge(ident("CSn", "solvers", rid), ident("G", rid),
+                      f"The second solver does not confirm {rid}: {s.get('why', '')}", "inconclusive", True)
+        if verdict in ("proved vacuously", "proved from an inconsistency"):
+            challenge(ident("CSn", "vacuous", rid), ident("G", rid), f"{rid} is {verdict}: {r.get('note', '')}",
+                      "failed", True)

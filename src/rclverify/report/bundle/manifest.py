@@ -1,0 +1,240 @@
+"""What goes into an assessor's bundle, and its manifest.
+
+Collected (workspace-relative POSIX paths, sorted):
+
+* every regular file under ``reports/`` and ``artifacts/`` (hidden files,
+  such as the temporary files of atomic writes, are left out, and so is
+  ``artifacts/cache/``: a machine-local speed-up holding pickled data, which
+  an assessor must never be handed to load, and the lock files
+  ``artifacts/run.lock`` and ``artifacts/diagnosis.lock``, which order runs
+  on one machine, and build products: compiled verifiers left under
+  ``artifacts/<backend>/<Node>/spin/build/`` by earlier versions, and any
+  compiled executable (ELF, Mach-O) under ``artifacts/`` -- rclverify
+  builds executables in the user's cache only, and an assessor is never
+  handed one to run);
+* the plan, its contract files and replacement contracts, and the
+  Doorstop folders it reads requirements from (``requirements_from``);
+* every file the plan's evidence entries name (a directory contributes the
+  files under it; the same paths :mod:`rclverify.model.plan.paths` checks), and
+  every input an evidence record was hashed over;
+* ``dodo.py`` when the workspace has one.
+
+A named file that does not exist is listed under ``missing`` in the
+manifest (the report says what its absence means for the evidence).  A file
+that resolves outside the workspace is refused (:class:`BundleError`).
+"""
+from __future__ import annotations
+
+import hashlib
+import json
+import platform
+import re
+import shutil
+import subprocess
+from pathlib import Path
+from typing import Any, Iterable, Mapping
+
+import z3
+
+from rclverify import __version__
+from rclverify.model.plan.load import Plan
+from rclverify.model.plan.paths import TOOL_KEYS, escape_reason, looks_like_path
+
+#: Format tag of the manifest.
+FORMAT = "rclverify-bundle/1"
+MANIFEST = "MANIFEST.json"
+#: Workspace folders packed whole.
+TREES = ("reports", "artifacts")
+#: Left out of the trees: the workspace cache (rclverify.core.cache), pickled, and the
+#: lock files that order runs on this machine (rclverify.core.runlock's run.lock, the
+#: diagnosis's diagnosis.lock: a process id, no evidence).
+EXCLUDED = ("artifacts/cache/", "artifacts/run.lock", "artifacts/diagnosis.lock")
+#: Build products under artifacts/ (a compiled SPIN verifier and its sources): never bundled.
+_BUILD = re.compile(r"^artifacts/[^/]+/[^/]+/spin/build/")
+#: The first bytes of a compiled executable: ELF, Mach-O (64 and 32 bit).
+_EXECUTABLE_MAGIC = (b"\x7fELF", b"\xcf\xfa\xed\xfe", b"\xce\xfa\xed\xfe")
+
+
+def build_product(root: Path, rel: str) -> bool:
+    """Whether the workspace file ``rel`` is a build product that must not be
+    bundled: under a ``spin/build/`` folder of ``artifacts/``, or a file
+    under ``artifacts/`` that starts like a compiled executable."""
+    if _BUILD.match(rel):
+        return True
+    if not rel.startswith("artifacts/"):
+        return False
+    try:
+        with open(root / rel, "rb") as f:
+            head = f.read(4)
+    except OSError:
+        return False
+    return head.startswith(_EXECUTABLE_MAGIC)
+
+
+class BundleError(Exception):
+    """A bundle cannot be written or does not verify; ``problems`` lists why,
+    one sentence each, naming the file concerned."""
+
+    def __init__(self, problems: Iterable[str]) -> None:
+        self.problems = list(problems)
+        super().__init__("; ".join(self.problems))
+
+
+def sha256_bytes(data: bytes) -> str:
+    """Hex sha256 of ``data``."""
+    return hashlib.sha256(data).hexdigest()
+
+
+def _named(plan: Plan) -> set[str]:
+    """Workspace-relative paths the plan names (contracts, replacements, evidence inputs)."""
+    out = {plan.file, *plan.contracts}
+    out.update(spec.rpartition(":")[0] for spec, _ in plan.replacements.values())
+    if plan.requirements_from:  # Doorstop trees: their items are requirements (with each .doorstop.yml)
+        from rclverify.model.plan.doorstop import doorstop_files
+        for folder, _ in plan.requirements_from:
+            out.update(doorstop_files(plan.root, folder) or [folder])
+
+    def walk(v: Any) -> None:
+        if isinstance(v, str) and looks_like_path(plan.root, v):
+            out.add(v)
+        elif isinstance(v, Mapping):
+            for k, x in v.items():
+                if k not in TOOL_KEYS:
+                    walk(x)
+        elif isinstance(v, list):
+            for x in v:
+                walk(x)
+    from rclverify.model.plan.entries import declared_paths
+    for entries in plan.evidence.values():
+        for e in entries:
+            # the backend's declared path keys, a "<file>:<callable>" value by its file part (model/plan/entries.py),
+            # as the plan check reads them; other strings that look like paths as they are
+            entry = {"backend": e.backend, **e.config}
+            declared = dict(declared_paths(entry))
+            out.update(declared.values())
+            keys = {p[0] for p in declared}
+            walk({k: v for k, v in e.config.items() if k != "backend" and k not in keys})
+    ros = getattr(plan, "ros", None) or {}  # the software the contracts are grounded in (docs/ros.md)
+    for key in ("workspaces", "launch", "bags"):
+        out.update(str(v) for v in ros.get(key, []) or [])
+    if ros.get("mapping"):
+        out.add(str(ros["mapping"]))
+    return out
+
+
+def _hashed_inputs(root: Path) -> set[str]:
+    """Every input path an evidence record was hashed over while it existed."""
+    out: set[str] = set()
+    for p in sorted((root / "artifacts" / "evidence").glob("*.json")):
+        try:
+            hashes = json.loads(p.read_text(encoding="utf-8")).get("input_hashes", {})
+            # an input recorded as "missing" (a result log not imported yet) was absent then too
+            out.update(str(k) for k, h in hashes.items() if h != "missing")
+        except (OSError, ValueError, AttributeError):
+            continue
+    return out
+
+
+def _files_under(root: Path, rel: str) -> list[str]:
+    base = root / rel
+    out = []
+    for p in base.rglob("*"):
+        r = p.relative_to(root)
+        if any(part.startswith(".") for part in r.parts) or not p.is_file() \
+                or r.as_posix().startswith(EXCLUDED) or build_product(root, r.as_posix()):
+            continue
+        out.append(r.as_posix())
+    return out
+
+
+def collect(root: Path, plan: Plan) -> tuple[list[str], list[str]]:
+    """``(files, missing)``: the sorted workspace-relative files of the bundle
+    and the sorted named paths that do not exist.
+
+    Raises :class:`BundleError` when a file would come from outside the
+    workspace (a symbolic link leading out, an absolute or ``..`` path).
+    """
+    files: set[str] = set()
+    missing: set[str] = set()
+    for rel in TREES:
+        if (root / rel).is_dir():
+            files.update(_files_under(root, rel))
+    if (root / "dodo.py").is_file():
+        files.add("dodo.py")
+    for rel in _named(plan) | _hashed_inputs(root):
+        p = root / rel
+        if p.is_dir():
+            files.update(_files_under(root, rel))
+        elif p.is_file():
+            files.add(Path(rel).as_posix())
+        else:
+            missing.add(rel)
+    problems = [f"{f}: {why}" for f in sorted(files) if (why := escape_reason(root, f)) is not None]
+    if problems:
+        raise BundleError(problems)
+    return sorted(files), sorted(missing)
+
+
+def _dafny_version() -> str:
+    from rclverify.backends.dafny.runner import detect, find_dafny
+    exe = find_dafny()
+    if exe is None:
+        return "not installed"
+    tool = detect(exe)
+    return tool.version if tool else f"unidentified ({exe})"
+
+
+def _dot_version() -> str:
+    exe = shutil.which("dot")
+    if exe is None:
+        return "not installed"
+    try:
+        p = subprocess.run([exe, "-V"], capture_output=True, text=True, timeout=30, check=False)
+    except (OSError, subprocess.TimeoutExpired):
+        return "unidentified"
+    return (p.stderr or p.stdout).strip() or "unidentified"
+
+
+def tool_versions() -> dict[str, str]:
+    """Versions of the tools the evidence depends on: rclverify, Z3, Dafny
+    (found and identified like the Dafny backend does), Hypothesis, Python,
+    Graphviz and doit.  A tool that is absent is ``"not installed"``."""
+    import doit
+    try:
+        import hypothesis
+        hyp = str(hypothesis.__version__)
+    except ImportError:
+        hyp = "not installed"
+    return {"rclverify": __version__, "z3": z3.get_version_string(), "dafny": _dafny_version(),
+            "hypothesis": hyp, "python": platform.python_version(), "graphviz": _dot_version(),
+            "doit": ".".join(map(str, doit.__version__))}
+
+
+def build_manifest(root: Path, plan: Plan, files: list[str], missing: list[str], contents: Mapping[str, bytes],
+                   tools: Mapping[str, str]) -> dict[str, Any]:
+    """The manifest (a JSON value, no timestamp).
+
+    ``contents`` maps each of ``files`` to its bytes.  Keys: ``format``,
+    ``workspace``, ``plan``, ``files`` (path -> ``{"sha256", "bytes"}``),
+    ``missing``, ``tools``, ``reproduce`` (the command to run in the
+    unpacked archive, and the one that checks it), ``verdict`` (the
+    report's overall status and headline, when the report exists).
+    """
+    verdict: dict[str, Any] = {}
+    if "reports/assurance.json" in contents:
+        try:
+            summary = json.loads(contents["reports/assurance.json"].decode("utf-8"))["summary"]
+            verdict = {"status": summary["status"], "headline": summary["headline"]}
+        except (ValueError, KeyError, TypeError):
+            verdict = {}
+    return {
+        "format": FORMAT,
+        "workspace": plan.name or root.resolve().name,
+        "plan": plan.file,
+        "files": {f: {"sha256": sha256_bytes(contents[f]), "bytes": len(contents[f])} for f in files},
+        "missing": list(missing),
+        "tools": dict(sorted(tools.items())),
+        "reproduce": {"verify": f"rclverify verify -w . --plan {plan.file}",
+                      "check_bundle": "rclverify bundle --verify <this archive>"},
+        "verdict": verdict,
+    }

@@ -1,0 +1,103 @@
+"""Texts made from each contract file's syntax tree, kept between runs.
+
+The check stage and the report print every node of the system again on
+every run: its RCL text (the snapshot), the RCL text of each assumption and
+guarantee, its LaTeX, and each file's lint warnings.  For a 1000-node
+system that was 0.2 s of the check task and 0.2-0.3 s of each report task
+after a one-contract edit (docs/scale.md, seventh round), although only the
+edited file's texts can differ.  They are pure functions of a file's text,
+so they are kept in ``artifacts/cache/contract-texts.pickle``, a
+:class:`~rclverify.core.cache.store.Shelf` of kind ``contract-texts``, per
+contract file, keyed by the file's name and the sha256 of the text that was
+parsed (``Workspace.parsed``; the kind's salt holds the rclverify code: a
+changed printer misses).
+
+The check task (:func:`rclverify.app.pipeline.stage_check`) fills and writes the
+file; the report tasks, which run after it, only read it and make what it
+lacks.  A damaged, missing or foreign file is an empty cache; the texts are
+the same with or without it (``tests/test_contract_texts.py``).
+"""
+from __future__ import annotations
+
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+from rclverify.core.cache import Shelf
+from rclverify.lang import ast
+
+if TYPE_CHECKING:
+    from rclverify.stages.workspace import Workspace
+
+CACHE = "artifacts/cache/contract-texts.pickle"
+
+
+def node_texts(node: ast.Node) -> dict[str, Any]:
+    """The texts of one node: ``{"rcl": the node as RCL (the snapshot's
+    text), "latex": its LaTeX block (:func:`rclverify.lang.latex.node_latex`:
+    no preamble, its real file name), "inputs"/"outputs": [[name, type as RCL with its unit, ``REAL [m]``],
+    ...], "assumptions"/"guarantees": [[formula as RCL, "file:line:col"],
+    ...]}`` (lists, in declaration order)."""
+    from rclverify.lang.latex import node_latex
+    from rclverify.lang.printer import expr_to_rcl, to_rcl, type_to_rcl, unit_to_rcl
+    return {
+        "rcl": to_rcl(ast.Spec((), (node,))), "latex": node_latex(node),
+        "inputs": [[v.name, type_to_rcl(v.type) + unit_to_rcl(v.unit)] for v in node.inputs],
+        "outputs": [[v.name, type_to_rcl(v.type) + unit_to_rcl(v.unit)] for v in node.outputs],
+        "assumptions": [[expr_to_rcl(a.formula), str(a.loc)] for a in node.assumes],
+        "guarantees": [[expr_to_rcl(g.formula), str(g.loc)] for g in node.guarantees],
+    }
+
+
+def lint_json(spec: ast.Spec) -> list[dict[str, Any]]:
+    """The lint warnings of one parsed file (:func:`rclverify.lang.lint.lint`) as JSON."""
+    from rclverify.lang.lint import lint
+    return [d.to_json() for d in lint(spec)]
+
+
+class ContractTexts:
+    """The texts of the contract files of ``ws`` (whose contracts check:
+    ``ws.checked`` is read), from the cache file when it has them.
+
+    :meth:`node` and :meth:`lint` make what the cache lacks; :meth:`save`
+    writes the texts of the workspace's current files when anything was
+    made.  Never raises for a bad cache file.
+    """
+
+    def __init__(self, ws: "Workspace") -> None:
+        self.ws = ws
+        ws.checked  # fills ws.parsed with the sha256 of each file's parsed text
+        self.path: Path = ws.path(CACHE)
+        self._shelf = Shelf(self.path, "contract-texts")
+        self._files: dict[str, dict[str, Any]] = {}
+        for rel, (sha, _) in ws.parsed.items():
+            self._files[rel] = self._shelf.get_or_make(self._shelf.key("file", rel, sha), lambda: {"nodes": {}})
+
+    def _entry(self, rel: str) -> dict[str, Any]:
+        entry = self._files.get(rel)
+        if entry is None:  # not a parsed file of the workspace: kept for this object only
+            entry = self._files[rel] = {"nodes": {}}
+        return entry
+
+    def node(self, node: ast.Node) -> dict[str, Any]:
+        """:func:`node_texts` of ``node`` (a node of ``ws.checked``)."""
+        got: dict[str, Any] | None = self._entry(node.loc.file)["nodes"].get(node.name)
+        if got is None:
+            got = self._entry(node.loc.file)["nodes"][node.name] = node_texts(node)
+            self._shelf.changed()
+        return got
+
+    def lint(self, spec: ast.Spec) -> list[dict[str, Any]]:
+        """:func:`lint_json` of ``spec`` (a file of ``ws.checked``)."""
+        entry = self._entry(spec.file)
+        got: list[dict[str, Any]] | None = entry.get("lint")
+        if got is None:
+            got = entry["lint"] = lint_json(spec)
+            self._shelf.changed()
+        return got
+
+    def save(self) -> bool:
+        """Write the texts of the workspace's parsed files atomically when
+        any were made (those of files no longer parsed are dropped).
+        Returns whether the file was written; raises ``OSError`` when the
+        cache directory cannot be written."""
+        return self._shelf.save()

@@ -1,0 +1,111 @@
+"""A C++ program's code in the workspace's other packages (docs/ros.md,
+"Reading real code"; issue 53).
+
+A node of one package is often built on a helper library of another package
+of the same workspace: its base class (``pkg_util::LifecycleNode``), a twist
+subscriber or publisher wrapper, an odometry smoother, a service client
+wrapper, each creating endpoints with the names its caller passes.  The
+linker (:mod:`link`) reads such names across a program's files; this module
+adds the files of the other packages that a program includes, so the
+linker follows calls into them as it does within one package.
+
+Rules (the ament layout of a C++ package, ROS 2 "Developer Guide: Code style
+and language versions", and REP 122's ``include/<package>/`` headers):
+
+* an ``#include "P/x.hpp"`` or ``<P/x.hpp>`` whose first path component is
+  another scanned package ``P`` (never the program's own), found at
+  ``P/include/P/x.hpp`` (or ``P/P/x.hpp``), is a file of the program;
+* with it, what it includes in ``P`` and, for each header, the source of the
+  same name in ``P`` (its implementation: ``src/x.cpp``), as within a package
+  (:func:`programs._closure`);
+* transitively, through the packages those files include (at most
+  :data:`MAX_FILES` files added per program).
+
+A loose program of ``P`` (a library file no executable of ``P`` runs, which
+names no node itself) whose files another package's program runs is a library
+for other packages: the endpoints it leaves to its callers' names are read at
+the callers, so it is not a program of its own (:func:`library_programs`).
+"""
+from __future__ import annotations
+
+from rclverify.ros.extract.programs import _SOURCE, PackageCode, Program, _closure
+
+MAX_FILES = 2000  # files of other packages one program may take in
+
+
+def _other(inc: str, own: str, codes: dict[str, PackageCode]) -> tuple[str, str] | None:
+    """``(package, file)`` an include of ``inc`` names in another scanned package."""
+    pkg = inc.split("/", 1)[0] if "/" in inc else None
+    code = codes.get(pkg) if pkg is not None and pkg != own else None
+    if code is None:
+        return None
+    for cand in (f"{code.root}/include/{inc}", f"{code.root}/{inc}"):
+        if cand in code.records:
+            return pkg, cand  # type: ignore[return-value]
+    return None
+
+
+def _implementations(code: PackageCode, header: str) -> list[str]:
+    """The sources of ``code``'s package named as ``header`` is (``x.hpp`` -> ``x.cpp``)."""
+    stem = header.rsplit("/", 1)[-1].rsplit(".", 1)[0]
+    return sorted(f for name, fs in code.by_name.items() if name.rsplit(".", 1)[0] == stem and
+                  "." + name.rsplit(".", 1)[-1] in _SOURCE for f in fs)
+
+
+def extend(prog: Program, codes: dict[str, PackageCode]) -> dict[str, str]:
+    """Add to C++ program ``prog`` (in place, to ``prog.files``) the files of other
+    packages it includes (see the module docstring).
+
+    ``codes``: every scanned package's code by name.  Returns ``{file: package}``
+    of the files added (empty for a Python program, or one that includes no other
+    package).  Never raises."""
+    own = codes.get(prog.package)
+    if own is None or any(own.records.get(f, {}).get("lang") == "py" for f in prog.entry):
+        return {}
+    added: dict[str, str] = {}
+    todo = list(prog.files)
+    seen = set(todo)
+    while todo and len(added) < MAX_FILES:
+        f = todo.pop(0)
+        pkg_of_f = added.get(f, prog.package)
+        rec = codes[pkg_of_f].records.get(f, {})
+        for inc in rec.get("includes", []):
+            hit = _other(inc, pkg_of_f, codes)
+            if hit is None or hit[0] == prog.package or hit[1] in seen:
+                continue
+            pkg, header = hit
+            for g in _closure(codes[pkg], [header] + _implementations(codes[pkg], header), set()):
+                if g not in seen:
+                    seen.add(g)
+                    added[g] = pkg
+                    todo.append(g)
+    prog.files.extend(added)
+    return added
+
+
+def view(prog: Program, codes: dict[str, PackageCode], added: dict[str, str]) -> PackageCode:
+    """The code the linker reads for ``prog``: its package's, with the records of
+    the other packages' files ``added`` to it (:func:`extend`)."""
+    own = codes[prog.package]
+    if not added:
+        return own
+    records = dict(own.records)
+    for f, pkg in added.items():
+        records[f] = codes[pkg].records[f]
+    return PackageCode(own.name, own.root, records, own.show)
+
+
+def library_programs(progs: dict[str, list[Program]], used: dict[str, set[str]],
+                     codes: dict[str, PackageCode]) -> None:
+    """Drop, in place, each package's loose programs (no executable, no class of
+    their own to start) whose entry files the programs of other packages run
+    (``used[pkg]``: those files) and which name no node with a literal name: a
+    library for other packages (see the module docstring)."""
+    for pkg, lst in progs.items():
+        files = used.get(pkg, set())
+        if not files:
+            continue
+        recs = codes[pkg].records
+        lst[:] = [p for p in lst if not (p.exe is None and p.units is None and p.entry and
+                                         all(f in files for f in p.entry) and
+                                         not any(recs.get(f, {}).get("nodes") for f in p.entry))]

@@ -1,0 +1,211 @@
+"""Which source files make up a package's executables (no CMake or setup.py
+is run; docs/ros.md, "Reading real code").
+
+* ``CMakeLists.txt`` (:mod:`cmake`: variables, ``foreach``, the file's own
+  ``function``/``macro`` wrappers, ``file(GLOB)``): ``add_executable(name src...)``
+  (also ament_cmake_auto's ``ament_auto_add_executable`` and catkin_simple's
+  ``cs_add_executable``), ``add_library`` (``ament_auto_add_library``,
+  ``cs_add_library``), ``target_sources``, ``target_link_libraries(target
+  libs...)`` (an ``ament_auto`` executable links every ``ament_auto`` library
+  added before it); ``catkin_install_python(PROGRAMS ...)`` and
+  ``install(PROGRAMS ...)`` name Python programs;
+* ROS 2 components: ``rclcpp_components_register_node(target PLUGIN "ns::C"
+  EXECUTABLE exe)`` makes ``exe`` a node of class ``ns::C`` (also through a
+  wrapper); ``rclcpp_components_register_nodes(target "ns::C" ...)`` registers
+  plugins only (started by a launch file's composable node);
+* ``setup.py`` (read with ``ast``): ``console_scripts`` entries
+  ``exe = module.path:func`` and ``scripts=[...]``;
+* a ROS 1 Python script is its own executable (``scripts/talker.py`` is
+  ``talker.py``; its stem is accepted too).
+"""
+from __future__ import annotations
+
+from rclverify.ros.extract import safefs
+
+import ast
+import fnmatch
+import os
+import re
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from rclverify.ros.extract.cmake import expand
+from rclverify.ros.extract.model import Note
+from rclverify.ros.extract.nodelets import plugin_classes
+from rclverify.ros.extract.plugins import PluginClass, described
+
+_ENTRY = re.compile(r"^\s*([A-Za-z0-9_.\-]+)\s*=\s*([A-Za-z0-9_.]+)\s*:\s*[A-Za-z0-9_]+\s*$")
+_EXE = {"add_executable", "ament_auto_add_executable", "cs_add_executable"}
+_LIB = {"add_library", "ament_auto_add_library", "cs_add_library"}
+_KEYWORDS = {"WIN32", "MACOSX_BUNDLE", "EXCLUDE_FROM_ALL", "STATIC", "SHARED", "MODULE", "OBJECT", "PRIVATE",
+             "PUBLIC", "INTERFACE", "NO_TARGET_LINK_LIBRARIES", "DIRECTORY", "NO_TARGET_LINK"}
+
+
+@dataclass
+class Targets:
+    """A package's build targets: ``executables`` and ``libraries`` ``{name: [source
+    files that exist]}``, ``links`` ``{target: [linked target names]}``,
+    ``components`` ``{executable: (class, CMakeLists line)}``, ``plugins``
+    ``{class: target}`` (every registered component class, and every nodelet
+    class its plugin description puts in a library of the package),
+    ``programs`` ``{executable: [Python file]}`` (installed scripts, entry
+    points), ``nodelets`` ``{lookup name: (class, library)}`` (:mod:`nodelets`),
+    ``pluginlib`` the ROS 2 plugin classes it exports and ``plugin_notes`` what
+    could not be read of their descriptions (:mod:`plugins`)."""
+
+    executables: dict[str, list[Path]] = field(default_factory=dict)
+    libraries: dict[str, list[Path]] = field(default_factory=dict)
+    links: dict[str, list[str]] = field(default_factory=dict)
+    components: dict[str, tuple[str, int]] = field(default_factory=dict)
+    plugins: dict[str, str] = field(default_factory=dict)
+    programs: dict[str, list[Path]] = field(default_factory=dict)
+    nodelets: dict[str, tuple[str, str | None]] = field(default_factory=dict)
+    pluginlib: list[PluginClass] = field(default_factory=list)
+    plugin_notes: list[Note] = field(default_factory=list)
+
+
+MAX_GLOB_DIRS = 2000  # directories one file(GLOB) pattern may visit
+
+
+def _glob(root: Path):  # type: ignore[no-untyped-def]
+    """``glob(pattern, recurse)`` for :func:`cmake.expand`: the package files a
+    ``file(GLOB ...)`` pattern matches, relative to ``root``; a pattern leaving the
+    package matches nothing (links are not followed; the walk is bounded)."""
+    real_root = os.path.realpath(root)
+
+    def g(pattern: str, recurse: bool) -> list[str]:
+        while pattern.startswith("./"):
+            pattern = pattern[2:]
+        base, _, pat = pattern.rpartition("/")
+        top = Path(base or "/") if pattern.startswith("/") else root / base if base else root
+        real = os.path.realpath(top)
+        if not (real == real_root or real.startswith(real_root + os.sep)):
+            return []
+        out: list[str] = []
+        for k, (dirpath, dirnames, filenames) in enumerate(os.walk(top)):
+            if k >= MAX_GLOB_DIRS or len(out) > 10_000:
+                break
+            dirnames[:] = sorted(d for d in dirnames if not d.startswith(".")) if recurse else []
+            rel = Path(dirpath).relative_to(root).as_posix()
+            out.extend(f"{rel}/{f}" if rel != "." else f for f in sorted(filenames) if fnmatch.fnmatch(f, pat))
+        return out
+    return g
+
+
+MAX_SUBDIRS = 32  # CMakeLists.txt files read per package (add_subdirectory)
+
+
+def targets(root: Path, pkg: str) -> Targets:
+    """The :class:`Targets` of the package at ``root`` named ``pkg`` (its
+    ``CMakeLists.txt`` and those its ``add_subdirectory`` calls name, each
+    with source paths relative to its own directory)."""
+    t = Targets()
+    todo, seen = [root], 0
+    auto_libs: list[str] = []
+    while todo and seen < MAX_SUBDIRS:
+        here = todo.pop(0)
+        seen += 1
+        try:
+            cmds = expand(safefs.read_text(here / "CMakeLists.txt"), pkg, _glob(here))
+        except OSError:
+            continue
+        _read(cmds, here, t, auto_libs, todo)
+    for exe, srcs in setup_py_executables(root).items():
+        t.programs.setdefault(exe, srcs)
+    t.nodelets = plugin_classes(root)
+    t.pluginlib, t.plugin_notes = described(root)
+    for cls, lib in t.nodelets.values():
+        if lib in t.libraries:
+            t.plugins.setdefault(cls, lib)
+    return t
+
+
+def _read(cmds: list[tuple[str, list[str], int]], root: Path, t: Targets, auto_libs: list[str],
+          subdirs: list[Path]) -> None:
+    """The targets the commands of one ``CMakeLists.txt`` (in ``root``) declare, into ``t``."""
+    def files(srcs: list[str]) -> list[Path]:
+        return [root / s for s in srcs if s not in _KEYWORDS and (root / s).is_file()]
+
+    for name, args, line in cmds:
+        if not args:
+            continue
+        if name == "add_subdirectory" and (root / args[0]).is_dir() and not args[0].startswith(("test", "..")) \
+                and ".." not in Path(args[0]).parts and not Path(args[0]).is_absolute():
+            subdirs.append(root / args[0])
+        elif name in _EXE and "IMPORTED" not in args and "ALIAS" not in args:
+            t.executables.setdefault(args[0], []).extend(files(args[1:]))
+            if name == "ament_auto_add_executable":
+                t.links.setdefault(args[0], []).extend(auto_libs)
+        elif name in _LIB and "IMPORTED" not in args and "ALIAS" not in args and "INTERFACE" not in args[1:2]:
+            t.libraries.setdefault(args[0], []).extend(files(args[1:]))
+            if name == "ament_auto_add_library":
+                auto_libs.append(args[0])
+        elif name == "target_sources":
+            bucket = t.executables if args[0] in t.executables else t.libraries
+            bucket.setdefault(args[0], []).extend(files(args[1:]))
+        elif name in ("target_link_libraries", "ament_target_dependencies"):
+            t.links.setdefault(args[0], []).extend(a for a in args[1:] if a not in _KEYWORDS)
+        elif name == "rclcpp_components_register_node" and "PLUGIN" in args:
+            k = args.index("PLUGIN")
+            if k + 1 < len(args):
+                cls = args[k + 1].lstrip(":")
+                t.plugins[cls] = args[0]
+                if "EXECUTABLE" in args and args.index("EXECUTABLE") + 1 < len(args):
+                    t.components[args[args.index("EXECUTABLE") + 1]] = (cls, line)
+        elif name == "rclcpp_components_register_nodes" and len(args) > 1:
+            for a in args[1:]:
+                if "::" in a:
+                    t.plugins[a.lstrip(":")] = args[0]
+        elif name in ("catkin_install_python", "install") and "PROGRAMS" in args:
+            k = args.index("PROGRAMS") + 1
+            while k < len(args) and args[k] not in ("DESTINATION", "PERMISSIONS", "CONFIGURATIONS", "COMPONENT",
+                                                      "OPTIONAL", "RENAME"):
+                f = root / args[k]
+                if f.is_file():
+                    t.programs.setdefault(f.name, [f])
+                    t.programs.setdefault(f.stem, [f])
+                k += 1
+
+
+def cmake_components(root: Path, pkg: str) -> tuple[dict[str, tuple[str, int]], list[str]]:
+    """``({executable: (class, CMakeLists line)}, [plugin classes])`` registered by
+    ``rclcpp_components_register_node(s)`` (rclcpp_components' CMake API)."""
+    t = targets(root, pkg)
+    return t.components, list(t.plugins)
+
+
+def setup_py_executables(root: Path) -> dict[str, list[Path]]:
+    """``{executable: [module file]}`` from ``setup.py``'s ``console_scripts`` entries
+    and ``scripts=[...]`` (read with ``ast``, never run)."""
+    f = root / "setup.py"
+    out: dict[str, list[Path]] = {}
+    try:
+        tree = ast.parse(safefs.read_text(f))
+    except (OSError, SyntaxError, ValueError, RecursionError):
+        return out
+    for n in ast.walk(tree):
+        if isinstance(n, ast.Constant) and isinstance(n.value, str):
+            m = _ENTRY.match(n.value)
+            if m:
+                mod = root / (m.group(2).replace(".", "/") + ".py")
+                if mod.is_file():
+                    out[m.group(1)] = [mod]
+        elif isinstance(n, ast.keyword) and n.arg == "scripts" and isinstance(n.value, (ast.List, ast.Tuple)):
+            for e in n.value.elts:
+                if isinstance(e, ast.Constant) and isinstance(e.value, str) and (root / e.value).is_file():
+                    p = root / e.value
+                    out.setdefault(p.name, [p])
+                    out.setdefault(p.stem, [p])
+    return out
+
+
+def executables(root: Path, pkg: str, py_nodes: list[Path]) -> dict[str, list[Path]]:
+    """``{executable: [source files]}`` of one package (the executables' own sources,
+    without the libraries they link)."""
+    t = targets(root, pkg)
+    out = dict(t.executables)
+    out.update(t.programs)
+    for p in py_nodes:
+        out.setdefault(p.name, [p])
+        out.setdefault(p.stem, [p])
+    return out

@@ -1,0 +1,488 @@
+"""Publishers, subscribers, services, actions and node names in C++ node
+sources, read with tree-sitter's C++ grammar (``tree-sitter``, ``tree-sitter-cpp``).
+
+Recognised (roscpp and actionlib, ROS 1; rclcpp and rclcpp_action, ROS 2):
+
+* ``<h>.advertise<T>(topic, ...)``, ``<h>.subscribe<T>(topic, ...)``,
+  ``<h>.subscribe(topic, n, cb)`` (the type from the callback's first
+  parameter, :mod:`cpp_types`, found in this file or, by the linker, in the
+  program's other files), ``subscribe(ops)``/``advertise(ops)`` with
+  ``ros::SubscribeOptions::create<T>(...)`` / ``ops.init<T>(...)``;
+  ``create_publisher<T>``, ``create_subscription<T>``,
+  ``create_generic_publisher(topic, "pkg/msg/T")`` with any receiver;
+* services: ``advertiseService(name, &cb)``, ``serviceClient<Srv>(name)``,
+  ``ros::service::call(name, srv)``, ``create_service<Srv>``, ``create_client<Srv>``;
+  actions: actionlib ``SimpleActionServer``/``SimpleActionClient`` (declared,
+  members initialised in a constructor, ``new``, ``make_shared``; a leading
+  node handle is skipped), ``rclcpp_action::create_server<T>`` /
+  ``create_client<T>`` (node, name) or (four node interfaces, name);
+* library helpers (:mod:`cpp_helpers`): tf, message_filters,
+  image_transport, interactive markers, parameter events, ``waitForMessage``;
+* names (:mod:`cpp_scope`): literals, constants, parameters (:mod:`cpp_params`),
+  and what only the program knows (a constructor argument, a member),
+  left to the linker (:mod:`link`); node handles' namespaces;
+* node names from ``ros::init(argc, argv, "n")``, ``Node("n"[, "ns"])``
+  initialisers, ``rclcpp::Node node("n")``, ``std::make_shared<rclcpp::Node>("n")``,
+  ``rclcpp::Node::make_shared("n")``;
+* for the linker: functions and their parameters, classes (members, bases),
+  calls and constructions with their argument values, member bindings,
+  quoted ``#include``\\ s; the classes registered as components.
+
+Text the grammar would misread is blanked first (:mod:`cpp_prep`).  A name
+that is not read statically is reported unresolved at its location.
+"""
+from __future__ import annotations
+
+from typing import Any
+
+from rclverify.ros.extract import cpp_helpers, emit, names, symbols, treesitter
+from rclverify.ros.extract.cpp_bases import node_base
+from rclverify.ros.extract.cpp_members import MemberReader
+from rclverify.ros.extract.cpp_prep import REGISTER, prepare
+from rclverify.ros.extract.nodelets import registered
+from rclverify.ros.extract.cpp_scope import base_name, callee_parts, namespaces_of
+from rclverify.ros.extract.cpp_values import CppValues
+from rclverify.ros.extract.cpp_types import adapted, action_type, action_type_in, callback_name, message_type, service_type, split_template
+from rclverify.ros.extract.model import Note, Src, canon_type
+
+__all__ = ["scan_cpp", "action_type", "service_type"]
+
+_CALLS = {"advertise": "pub", "subscribe": "sub", "create_publisher": "pub", "create_subscription": "sub",
+          "advertiseService": "service_servers", "serviceClient": "service_clients",
+          "create_service": "service_servers", "create_client": "service_clients",
+          "create_generic_publisher": "pub", "create_generic_subscription": "sub"}
+_ACTIONLIB = {"SimpleActionServer": "action_servers", "ActionServer": "action_servers",
+              "SimpleActionClient": "action_clients", "ActionClient": "action_clients"}
+_NODE_TYPES = {"Node", "LifecycleNode"}
+_LIBRARY = ("std::", "ros::", "rclcpp::", "boost::", "RCLCPP_", "ROS_", "tf2::", "Eigen::", "rcutils_", "rcl_")
+_T = treesitter.text
+
+
+class _File(MemberReader):
+    def __init__(self, data: bytes, shown: str) -> None:
+        self.shown = shown
+        self.vex_at: Any = None
+        self.out: dict[str, Any] = {"nodes": [], "endpoints": [], "notes": [], "classes": {}, "components": [],
+                                    "lang": "cpp", "calls": [], "node_names": [], "member_decls": [],
+                                    "member_calls": [], "includes": [], "callbacks": {}}
+        for m in REGISTER.finditer(data):
+            line = data.count(b"\n", 0, m.start()) + 1
+            self.out["components"].append((m.group(1).decode().lstrip(":"), Src(shown, line, 1)))
+        self.out["nodelets"] = registered(data, shown)
+        adapters = adapted(data)
+        data = prepare(data)
+        self.ros2 = b"rclcpp" in data
+        root = treesitter.parser("cpp").parse(data).root_node
+        self.nodes = list(treesitter.walk(root))
+        self.aliases: dict[str, str] = adapters
+        for n in self.nodes:
+            self._index(n)
+        self.scope = CppValues(self.nodes)
+        self.scope.nodelet = b"nodelet" in data and b"Nodelet" in data
+        if root.has_error:
+            err = next((n for n in self.nodes if n.type == "ERROR" or n.is_missing), root)
+            self.out["notes"].append(Note(self.src(err), "C++ source has syntax errors; read what tree-sitter "
+                                                         "recovered", "ROS-PARSE"))
+
+    def src(self, n: Any) -> Src:
+        if self.vex_at is not None:  # an expression re-read out of place: located at its declaration
+            n = self.vex_at
+        return Src(self.shown, n.start_point[0] + 1, n.start_point[1] + 1)
+
+    def _index(self, n: Any) -> None:
+        t = n.type
+        if t == "function_declarator":
+            written = _T(n.child_by_field_name("declarator"))
+            params = n.child_by_field_name("parameters")
+            first = next((c for c in (params.children if params else [])
+                          if c.type in ("parameter_declaration", "optional_parameter_declaration")), None)
+            if first is not None and first.child_by_field_name("type") is not None:
+                ty = _T(first.child_by_field_name("type"))
+                _nss, cls = namespaces_of(n)
+                # by its name as written, with its class, and alone (the last a fallback)
+                for key in {written, "::".join(cls + [written]), written.split("::")[-1]}:
+                    self.out["callbacks"].setdefault(key, ty)
+        elif t == "alias_declaration":
+            self.aliases[_T(n.child_by_field_name("name"))] = _T(n.child_by_field_name("type"))
+        elif t == "type_definition":
+            for d in n.children_by_field_name("declarator"):
+                self.aliases[_T(d)] = _T(n.child_by_field_name("type"))
+        elif t == "using_declaration" and not any(c.type == "namespace" for c in n.children) and n.named_children:
+            full = _T(n.named_children[-1])
+            self.aliases[full.split("::")[-1]] = full
+        elif t == "preproc_include":
+            p = n.child_by_field_name("path")
+            if p is not None:
+                self.out["includes"].append(_T(p).strip('"<>'))
+
+    def msg(self, text: str | None) -> str | None:
+        t = message_type(text, self.aliases)
+        msgs = [ns for ns in self.scope.using_ns if ns.endswith(("::msg", "_msgs"))]
+        if t is None and text and "::" not in text and len(msgs) == 1:  # using namespace pkg::msg;
+            t = message_type(f"{msgs[0]}::{text.strip()}", self.aliases)
+        return t
+
+    # -- emitting
+    def emit(self, kind: str, name_node: Any, msg_type: str | None, at: Any, handle: symbols.Val,
+             cb: Any = None, name: symbols.Val = "unset", written: str | None = None) -> None:
+        v = self.scope.value(name_node) if name == "unset" else name
+        fn = self.scope.fn_of(at)
+        unit = fn.unit if fn is not None else None
+        if written is None:
+            written = _T(name_node) if name_node is not None else emit.short(str(symbols.text(v) or "?"))
+        ep, note = emit.make(kind, v, handle, msg_type, self.src(at), unit, fn.key if fn else None, written,
+                             self.src(name_node) if name_node is not None else self.src(at), cb)
+        if note is not None:
+            self.out["notes"].append(note)
+        if ep is None:
+            return
+        if ep.pending is None and ep.msg_type is None:
+            self.out["notes"].append(emit.type_note(ep))
+        self.out["endpoints"].append(ep)
+        if fn is not None and fn.in_class:
+            self.out["classes"].setdefault(fn.unit, {"nodes": [], "endpoints": []})["endpoints"].append(ep)
+
+    def specs(self, specs: list[cpp_helpers.Spec], at: Any) -> None:
+        for kind, v, t, h in specs:
+            self.emit(kind, None, t, at, h, name=v)
+
+    def node(self, v: symbols.Val, at: Any, ns: symbols.Val = None, kind: str | None = None) -> None:
+        fn = self.scope.fn_of(at)
+        unit = fn.unit if fn is not None else None
+        t = symbols.text(v)
+        if t is not None and symbols.is_concrete(v) and v[0] != "node" and names.node_name_problem(t) is None:
+            self.out["nodes"].append((t, self.src(at)))
+            if fn is not None and fn.in_class:
+                self.out["classes"].setdefault(fn.unit, {"nodes": [], "endpoints": []})["nodes"].append(
+                    (t, self.src(at)))
+        self.out["node_names"].append((v, self.src(at), unit, fn.key if fn else None, ns, kind))
+
+    def record(self, kind: str, callee: str, args: list[Any], at: Any) -> None:
+        fn = self.scope.fn_of(at)
+        vals = [self.scope.value(a) for a in args]
+        self.out["calls"].append((kind, callee, vals, fn.key if fn else None, fn.unit if fn else None,
+                                  self.src(at)))
+
+    # -- constructions
+    def construct(self, type_text: str, args: list[Any], at: Any) -> None:
+        head, targs = split_template(type_text.replace("typename", "").strip())
+        base = head.split("::")[-1]
+        if base in _NODE_TYPES and ("rclcpp" in head or head == base) and args:
+            self.node(self.scope.value(args[0]), at, self.scope.value(args[1]) if len(args) > 1 else None,
+                      "lifecycle" if base == "LifecycleNode" else None)
+            return
+        if base in _ACTIONLIB and targs and "actionlib" in head + type_text:
+            self.actionlib(_ACTIONLIB[base], targs[0], args, at)
+            return
+        specs = cpp_helpers.constructed(type_text, args, self.scope.value, self.ros2, self.aliases)
+        if specs is not None:
+            self.specs(specs, at)
+            return
+        if head and not head.startswith(_LIBRARY):  # with its template arguments (a template's types)
+            self.record("ctor", type_text.replace("typename", "").strip() if targs else head, args, at)
+
+    def actionlib(self, kind: str, ty: str, args: list[Any], at: Any) -> None:
+        if not args:
+            return
+        first_handle = len(args) >= 2 and self.scope.is_handle(args[0])
+        name_arg = args[1] if first_handle else args[0]
+        h = self.scope.value(args[0]) if first_handle else None
+        self.emit(kind, name_arg, action_type_in(self.aliases.get(ty, ty), self.scope.using_ns), at, h)
+
+    # -- the walk
+    def run(self) -> dict[str, Any]:
+        for n in self.nodes:
+            t = n.type
+            if t == "field_initializer":
+                self.initializer(n)
+            elif t == "new_expression":
+                a = n.child_by_field_name("arguments")
+                self.construct(_T(n.child_by_field_name("type")), list(a.named_children) if a is not None else [], n)
+            elif t == "declaration":
+                self.declaration(n)
+            elif t == "field_declaration":
+                self.member(n)
+            elif t in ("class_specifier", "struct_specifier"):
+                self.bases(n)
+            elif t == "call_expression":
+                self.call(n)
+        s = self.scope
+        # how many trailing parameters have a default (read or not): which overload a call picks
+        self.out["optional"] = {f.key: sum(d is not None for d in f.defaults)
+                                for f in list(s.decls.values()) + list(s.fns.values())}
+        self.out["fns"] = {f.key: (f.unit, f.params, f.ptypes, [s.value(d) for d in f.defaults])
+                           for f in list(s.decls.values()) + list(s.fns.values())}
+        self.out["returns"] = self.returns()
+        self.out["fn_tparams"] = {s.fns[n.id].key: _tparams(n.parent) for n in self.nodes
+                                  if n.type == "function_definition" and n.id in s.fns and n.parent is not None
+                                  and n.parent.type == "template_declaration"}
+        self.out["aliases"] = self.aliases
+        self.out["units"] = {c: {"bases": i["bases"], "members": i["members"], "tparams": i.get("tparams", [])}
+                             for c, i in s.classes.items()}
+        self.out["fields"] = s.field_values()
+        self.out["consts"] = {k: v for k, v in ((k, s._one([s.value(x) if not isinstance(x, tuple) else x
+                                                             for x in vs])) for k, vs in s.consts.items())
+                              if v is not None}
+        self.out["ros2"], self.out["using_ns"] = self.ros2, s.using_ns
+        return self.out
+
+    def rclcpp_like(self, full: str, args: list[Any], n: Any) -> bool:
+        """Whether qualified call ``full(args)`` may be rclcpp's (a create/advertise
+        call): a factory given the node first, rclcpp's or roscpp's own name, or a
+        node class's method named through its class (``rclcpp::Node::create_publisher``,
+        the caller's own class or a base of it)."""
+        if not full.split("::")[-1].startswith("create_") or full.startswith(("rclcpp", "ros::")):
+            return True
+        if len(args) >= 2 and (self.scope.is_handle(args[0]) or self.generic_node(args[0])):
+            return True
+        qual = full.rsplit("::", 1)[0].split("::")[-1].split("<")[0]
+        owner = self.scope.fn_of(n)
+        bases = self.scope.classes.get(owner.unit, {}).get("bases", []) if owner is not None else []
+        return "Node" in qual or (owner is not None and qual == owner.unit.split("::")[-1]) or any(
+            b.split("<")[0].split("::")[-1] == qual for b in bases)
+
+    def generic_node(self, n: Any) -> bool:
+        """Whether expression ``n`` is declared with a template parameter of its
+        function or class (``template<typename NodeT> C(const NodeT & parent)``):
+        given first to a stack's ``ns::create_subscription<T>(parent, topic, ...)``,
+        it stands for the node of any kind the template is made with (issue 65)."""
+        t = self.scope.type_of(n) if n.type == "identifier" else None
+        if not t:
+            return False
+        base = t.replace("const", "").replace("&", "").replace("*", "").strip()
+        p = n.parent
+        while p is not None:
+            if p.type == "template_declaration":
+                ps = p.child_by_field_name("parameters")
+                if base in _tparams(p):
+                    return True
+            p = p.parent
+        return False
+
+    def returns(self) -> dict[str, list[tuple[int, int, list[symbols.Val], list[symbols.Val], list[bool]]]]:
+        """Per function key, one ``(parameters, defaulted ones, default values,
+        values returned, per parameter: whether it may take a string literal)``
+        per definition (overloads apart) that returns a value
+        the linker may read: a ``("ret", ...)`` call of it is read from these
+        (a ``declare_parameter`` wrapper; issue 65).  A lambda's ``return`` is not
+        its enclosing function's."""
+        s, got = self.scope, {}  # type: ignore[var-annotated]
+        self.nodes_by_id = {n.id: n for n in self.nodes if n.type == "function_definition"}
+        for n in self.nodes:
+            if n.type != "return_statement" or not n.named_children:
+                continue
+            p = n.parent
+            while p is not None and p.type not in ("function_definition", "lambda_expression"):
+                p = p.parent
+            f = s.fns.get(p.id) if p is not None and p.type == "function_definition" else None
+            if f is not None:
+                got.setdefault(p.id, (f, []))[1].append(s.value(n.named_children[0]))
+        out: dict[str, list[tuple[int, int, list[symbols.Val], list[symbols.Val], list[bool]]]] = {}
+        for f, vals in got.values():
+            if any(v is not None for v in vals):
+                tps = set(_tparams(self.nodes_by_id[f.nid].parent)) if self.nodes_by_id[f.nid].parent is not None \
+                    and self.nodes_by_id[f.nid].parent.type == "template_declaration" else set()
+                out.setdefault(f.key, []).append((len(f.params), sum(d is not None for d in f.defaults),
+                                                  [s.value(d) for d in f.defaults], vals,
+                                                  [_takes_string(t, tps) for t in f.ptypes]))
+        return out
+
+    def initializer(self, n: Any) -> None:
+        head = n.named_children[0] if n.named_children else None
+        args = next((c for c in n.children if c.type in ("argument_list", "initializer_list")), None)
+        if head is None or args is None:
+            return
+        h = _T(head)
+        kind = node_base(h, self.ros2)
+        if kind is not None and args.named_children:
+            a = args.named_children
+            self.node(self.scope.value(a[0]), n, self.scope.value(a[1]) if len(a) > 1 and
+                      self.scope.value(a[1]) is not None and self.scope.value(a[1])[0] == "str" else None,
+                      "lifecycle" if kind == "lifecycle" else None)
+            if "::" in h and "rclcpp" not in h:  # a workspace base (pkg_util::LifecycleNode): the linker runs it too
+                self.record("member", h, list(args.named_children), n)
+            return
+        self.record("member", h, list(args.named_children), n)
+
+    def declaration(self, n: Any) -> None:
+        ty = _T(n.child_by_field_name("type"))
+        base = base_name(ty)
+        if not ty or base in ("auto", "NodeHandle") or n.child_by_field_name("type").type == "primitive_type":
+            return
+        for d in n.children_by_field_name("declarator"):
+            if d.type == "init_declarator":
+                v = d.child_by_field_name("value")
+                if v is not None and v.type in ("argument_list", "initializer_list"):
+                    self.construct(ty, list(v.named_children), n)
+            elif d.type == "identifier":
+                self.construct(ty, [], n)
+            elif d.type == "function_declarator" and self.scope.fn_of(n) is not None:
+                self.vexing(ty, d, n)
+
+    def vexing(self, ty: str, d: Any, n: Any) -> None:
+        """``Sensor s(nh, name());`` in a function body, which the grammar reads as a
+        function declaration (C++'s "most vexing parse"): its parentheses re-read
+        as call arguments, evaluated in the enclosing function."""
+        params = d.child_by_field_name("parameters")
+        if params is None:
+            return
+        tree = treesitter.parser("cpp").parse(b"void f_(){g_" + params.text + b";}").root_node
+        call = next((x for x in treesitter.walk(tree) if x.type == "call_expression"), None)
+        a = call.child_by_field_name("arguments") if call is not None else None
+        if a is None:
+            return
+        self.scope.override, self.vex_at = self.scope.fn_of(n), n
+        try:
+            self.construct(ty, list(a.named_children), n)
+        finally:
+            self.scope.override, self.vex_at = None, None
+
+    def call(self, n: Any) -> None:
+        fn = n.child_by_field_name("function")
+        a = n.child_by_field_name("arguments")
+        args = list(a.named_children) if a is not None else []
+        if fn is None:
+            return
+        full, last, targs = callee_parts(fn)
+        recv = fn.child_by_field_name("argument") if fn.type == "field_expression" else None
+        s = self.scope
+        if full == "ros::init" and len(args) >= 3:
+            self.node(s.value(args[2]), n)
+            return
+        if last in ("make_shared", "make_unique", "allocate_shared") and targs and recv is None:
+            self.construct(targs[0], args, n)
+            return
+        if full.endswith("Node::make_shared") and args:
+            self.node(s.value(args[0]), n, s.value(args[1]) if len(args) > 1 else None,
+                      "lifecycle" if "LifecycleNode" in full else None)
+            return
+        if full.endswith("Options::create") or (last == "init" and recv is not None and targs):
+            return  # options: read where subscribe(ops) / advertise(ops) uses them
+        specs = cpp_helpers.free(full, targs, args, s.value, self.aliases) if recv is None else None
+        if specs is None and recv is not None:
+            rt = s.type_of(recv)
+            if rt is not None:
+                specs = cpp_helpers.method(rt, last, args, targs, s.value, s.value(recv), self.aliases)
+            elif not targs and self.helper_form(last, args) and self.deferred_method(recv, last, args, n) \
+                    and last != "init":  # obj.init(...) may also be a method of the program's own class
+                return
+        if specs is not None:
+            self.specs(specs, n)
+            return
+        if last in ("create_server", "create_client") and "rclcpp_action" in full:
+            self.action2(last, targs, args, n)
+            return
+        if full in ("ros::service::call",) and len(args) >= 2:
+            self.emit("service_clients", args[0], service_type(s.type_of(args[1])), n, None)
+            return
+        kind = _CALLS.get(last)
+        if kind is None or not args:
+            if not full.startswith(_LIBRARY):
+                self.record("call", full, args, n)
+                if targs:  # a function template's types, read in its body by the linker
+                    owner = s.fn_of(n)
+                    self.out.setdefault("call_targs", []).append(
+                        (full, owner.unit if owner else None, owner.key if owner else None, len(args), targs))
+            return
+        if last == "create_server":
+            return
+        if recv is not None and last.startswith("create_") and s.is_handle(args[0]):
+            # rclcpp's node methods never take a node first: a user's method of the same name
+            # (bus.create_publisher(node, "t")), followed by the linker into its body (issue 65)
+            self.record("call", full, args, n)
+            owner = s.fn_of(n)
+            self.out.setdefault("user_creates", []).append(
+                (full, owner.unit if owner else None, owner.key if owner else None, self.src(n)))
+            return
+        if recv is None and "::" in full and not self.rclcpp_like(full, args, n):
+            # ns::create_subscription<T>(topic, ...): no node is given and ns is no rclcpp class:
+            # a workspace's function, followed by the linker into its body, else a note (issue 65)
+            self.record("call", full, args, n)
+            owner = s.fn_of(n)
+            self.out.setdefault("user_creates", []).append(
+                (full, owner.unit if owner else None, owner.key if owner else None, self.src(n),
+                 "is a function of another namespace than rclcpp's, given no node"))
+            return
+        handle = s.value(recv) if recv is not None else None
+        if recv is None and last.startswith("create_") and len(args) >= 2 and (
+                s.is_handle(args[0]) or self.generic_node(args[0])):
+            # a stack's factory, qualified or not: ns::create_service<T>(node, name, ...), read at its call
+            handle, args = s.value(args[0]), args[1:]
+        if last in ("advertise", "subscribe") and len(args) >= 2 and s.is_handle(args[0]):
+            # advertise(nh, topic, n) / subscribe(nh, topic, n) of an object given the handle
+            # (topic_tools::ShapeShifter, a message_filters subscriber of a class this file does not know)
+            ta = targs[0] if targs else None
+            self.emit(kind, args[1], self.msg(ta) if ta else None, n, s.value(args[0]))
+            return
+        if len(args) == 1 and last in ("subscribe", "advertise", "advertiseService") and "::" in full and recv is None:
+            return  # a static method of some class (T::subscribe(rate)), not a node handle's
+        if len(args) == 1 and last in ("subscribe", "advertise", "advertiseService"):
+            ops = s.value(args[0])
+            if ops is not None and ops[0] == "ops":
+                t = self.msg(ops[3]) if ops[1] in ("pub", "sub") else service_type(self.aliases.get(ops[3], ops[3]))
+                ocb = callback_name(ops[4] or "") or None
+                if t is None and ocb:
+                    ct = self.out["callbacks"].get(ocb)
+                    t = self.msg(ct) if ops[1] in ("pub", "sub") else service_type(ct)
+                self.emit(ops[1], None, t, n, handle, ocb if t is None else None, name=ops[2],
+                          written=ops[5] if len(ops) > 5 else None)
+            else:
+                self.out["notes"].append(Note(self.src(n), f"{last}({_T(args[0])[:60]}): its options are not read "
+                                                           f"statically"))
+            return
+        if last in ("create_generic_publisher", "create_generic_subscription"):
+            gt = s.value(args[1]) if len(args) > 1 else None
+            self.emit(kind, args[0], canon_type(symbols.text(gt)) if gt and gt[0] == "str" else None, n, handle)
+            return
+        ta = targs[0] if targs else None
+        cb: Any = None
+        if kind in ("pub", "sub"):
+            msg_type = self.msg(ta) if ta else None
+            if msg_type is None and kind == "sub" and last == "subscribe" and len(args) >= 3:
+                cb = callback_name(_T(args[2]))
+                msg_type = self.msg(self.out["callbacks"].get(cb))
+        else:
+            msg_type = service_type(self.aliases.get(ta, ta) if ta else None)
+            if msg_type is None and last == "advertiseService" and len(args) >= 2:
+                cb = callback_name(_T(args[1]))
+                msg_type = service_type(self.out["callbacks"].get(cb))
+        if msg_type is None and cb is None and ta:
+            cb = ("type", ta)  # an alias of another file (a header's using/typedef): read by the linker
+        self.emit(kind, args[0], msg_type, n, handle, cb if msg_type is None else None)
+
+    def action2(self, last: str, targs: list[str], args: list[Any], n: Any) -> None:
+        kind = "action_servers" if last == "create_server" else "action_clients"
+        k = 4 if len(args) >= 5 and "interface" in _T(args[0]) else 1
+        if len(args) <= k:
+            return
+        t = action_type(self.aliases.get(targs[0], targs[0])) if targs else None
+        self.emit(kind, args[k], t, n, self.scope.value(args[0]) if k == 1 else None,
+                  ("type", targs[0]) if t is None and targs else None)
+
+
+def _takes_string(ptype: str, tparams: set[str]) -> bool:
+    """Whether a parameter declared ``ptype`` may be given a string literal: a
+    string or character type, ``auto``, or a template parameter of its function
+    (``const std::string &``, ``T``); not ``const ParameterDescriptor &``,
+    ``bool``, ``rclcpp::Logger`` (how a call's overload is told apart)."""
+    base = ptype.replace("const", "").replace("&", "").replace("*", "").strip()
+    return "string" in base.lower() or "char" in base or base in ("auto", "") or base in tparams
+
+
+def _tparams(decl: Any) -> list[str]:
+    """The type parameters' names of a ``template<...>`` declaration."""
+    ps = decl.child_by_field_name("parameters")
+    return [_T(x.child_by_field_name("name") or (x.named_children[-1] if x.named_children else x))
+            for x in (ps.named_children if ps is not None else []) if "type" in x.type]
+
+
+def scan_cpp(data: bytes, shown: str) -> dict[str, Any]:
+    """The record of one C++ file: ``{"nodes": [(name, Src)], "endpoints": [Endpoint],
+    "notes": [Note], "classes": {qualified class: {"nodes", "endpoints"}},
+    "components": [(qualified class, Src)]}`` and, for the linker (:mod:`link`),
+    ``fns``, ``units``, ``calls``, ``fields``, ``consts``, ``node_names``,
+    ``member_decls``, ``member_calls``, ``includes``, ``callbacks``, ``ros2``.
+
+    tree-sitter recovers from syntax errors, so a broken file still yields
+    what it can; its ERROR regions are reported as one located warning."""
+    return _File(data, shown).run()

@@ -1,0 +1,45 @@
+"""The topics and message types present in a recorded run: a ROS 1 ``.bag``
+or a ROS 2 bag (directory or ``.mcap``), through ``rosbags``' AnyReader."""
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+from rclverify.ros.extract.model import Note, Src, canon_type
+
+
+def bag_topics(path: Path, shown: str) -> tuple[dict[str, Any] | None, list[Note]]:
+    """``{"path", "topics": [{"name", "type", "count"}]}`` or a located error note.
+    Only regular files are opened (:func:`rclverify.traces.guard.check_trace_path`):
+    a bag that is, or whose reader would open, a FIFO, device or socket is an
+    error note; another such entry of a bag directory is skipped with a
+    warning note."""
+    from rosbags.highlevel import AnyReader
+
+    from rclverify.traces.events import TraceError
+    from rclverify.traces.guard import check_trace_path
+    try:
+        skipped = check_trace_path(path)
+    except TraceError as exc:
+        return None, [Note(Src(shown), _entry_message(str(exc), path, "error"), "ROS-PARSE", "error")]
+    warnings = [Note(Src(shown), _entry_message(w, path, "warning"), "ROS-PARSE", "warning") for w in skipped]
+    try:
+        with AnyReader([path]) as reader:
+            topics = [{"name": c.topic if c.topic.startswith("/") else "/" + c.topic,
+                       "type": canon_type(c.msgtype), "count": int(c.msgcount)}
+                      for c in reader.connections]
+    except Exception as exc:  # rosbags raises its own reader errors on bad files
+        return None, [Note(Src(shown), f"cannot read bag: {' '.join(str(exc).split())[:300]}", "ROS-PARSE", "error")]
+    merged: dict[tuple[str, str], int] = {}
+    for t in topics:
+        merged[(t["name"], t["type"])] = merged.get((t["name"], t["type"]), 0) + t["count"]
+    return {"path": shown, "topics": [{"name": n, "type": ty, "count": c}
+                                      for (n, ty), c in sorted(merged.items())]}, warnings
+
+
+def _entry_message(text: str, path: Path, severity: str) -> str:
+    """``"<entry>: <reason>"`` from the guard's ``<path>/<entry>: <severity>: <reason>``
+    (the note is located at the bag; the entry is named inside it)."""
+    where, _, reason = text.partition(f": {severity}: ")
+    entry = where[len(str(path)):].lstrip("/")
+    return f"{entry}: {reason}" if entry else reason

@@ -1,0 +1,344 @@
+"""``rclverify ros scan``: one computation graph from ROS 1 and ROS 2
+workspaces, launch files, node sources and bags (docs/ros.md).
+
+Nodes come from the launch files given (``launch``); without any, each
+node source that names its node (``rospy.init_node('n')``,
+``ros::init(.., "n")``, ``Node("n")`` ...) is one node in the root
+namespace (programs naming the same node are kept apart, each a node
+``/name@package.executable``: :func:`apart_name`; a Python file's node
+classes are one node each).  A node's topics are its sources' publishers and subscribers,
+resolved in the node's namespace (ROS name rules, :mod:`names`) and then
+remapped by the launch file's ``remap`` elements (the last matching remap wins).
+"""
+from __future__ import annotations
+
+from rclverify.ros.extract import safefs
+
+import dataclasses
+import functools
+import os
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Sequence
+
+from rclverify.ros.extract import names
+from rclverify.ros.extract import namespaces
+from rclverify.ros.graph.assemble import Assembly
+from rclverify.ros.extract.cache import ParseCache
+from rclverify.ros.extract.executables import Targets, targets
+from rclverify.ros.extract.interfaces import TypeTable
+from rclverify.ros.extract.launch import El, Interpreter, read_xml, read_yaml
+from rclverify.ros.extract.launch_ros2 import read_python
+from rclverify.ros.extract.link import UNBUILT
+from rclverify.ros.extract.model import SERVICE_ROLES, Endpoint, Graph, GraphEdge, GraphNode, Note, Src
+from rclverify.ros.extract.param_yaml import PackageParams, expand_each
+from rclverify.ros.extract.packages import Package, find_manifests, read_package
+from rclverify.ros.extract.sources_cpp import scan_cpp
+from rclverify.ros.extract.sources_py import scan_python
+
+_CPP = {".cpp", ".cc", ".cxx", ".hpp", ".h", ".hh"}
+_SKIP_DIRS = {"build", "devel", "install", "log", "test", "tests", "launch", "msg", "srv", "action", "__pycache__"}
+_NOT_SCRIPTS = {"CMakeLists", "Makefile", "LICENSE", "COPYING", "AUTHORS", "CHANGELOG", "README", "CONTRIBUTING",
+                "Doxyfile", "Dockerfile", "COLCON_IGNORE", "CATKIN_IGNORE", "AMENT_IGNORE", "PKG-INFO"}
+_SCRIPT_DIRS = ("scripts", "nodes", "bin")
+MAX_SOURCE_BYTES = 2_000_000
+
+
+@dataclass
+class ScanResult:
+    """The graph plus what the scan used: packages, the type table, and
+    each file's parse results (``sources[shown] = {nodes, endpoints, notes}``)."""
+
+    graph: Graph
+    packages: dict[str, Package]
+    table: TypeTable
+    sources: dict[str, dict[str, Any]] = field(default_factory=dict)
+    cache_hits: int = 0
+    cache_misses: int = 0
+
+
+class Shower:
+    """Paths as shown in locations: relative to ``base`` when inside it."""
+
+    def __init__(self, base: Path | None) -> None:
+        self.base = os.path.realpath(base or Path.cwd())
+        self._memo: dict[str, str] = {}
+
+    def __call__(self, p: Path) -> str:
+        key = str(p)
+        shown = self._memo.get(key)
+        if shown is None:
+            real = os.path.realpath(key)
+            inside = real == self.base or real.startswith(self.base.rstrip(os.sep) + os.sep)
+            shown = Path(os.path.relpath(real, self.base)).as_posix() if inside else key
+            self._memo[key] = shown
+        return shown
+
+
+def _source_files(root: Path, skipped: list[str] | None = None) -> tuple[list[Path], list[Path], list[Path]]:
+    """``(Python files, C++ files, files without an extension)`` of a package; the last
+    are Python programs when their first line is a Python ``#!`` (or a build file
+    installs them as one)."""
+    py, cpp, bare = [], [], []
+    for dirpath, dirnames, filenames in os.walk(root):
+        dirnames[:] = sorted(d for d in safefs.keep_names(dirpath, dirnames, skipped)
+                             if d not in _SKIP_DIRS and not d.startswith("."))
+        for f in sorted(safefs.keep_names(dirpath, filenames, skipped)):
+            p = Path(dirpath) / f
+            if f.endswith(".py") and f != "setup.py" and not f.endswith(".launch.py") and f != "__init__.py":
+                py.append(p)
+            elif p.suffix in _CPP:
+                cpp.append(p)
+            elif not p.suffix and not f.startswith(".") and f not in _NOT_SCRIPTS:
+                bare.append(p)
+    return py, cpp, bare
+
+
+def _python_shebang(data: bytes) -> bool:
+    """Whether a file's first line is a ``#!`` naming a Python interpreter."""
+    return data.startswith(b"#!") and b"python" in data.split(b"\n", 1)[0]
+
+
+def _load_launch(path: Path, shown: str) -> tuple[El | None, list[Note]]:
+    n = path.name
+    if n.endswith(".py"):
+        return read_python(path, shown)
+    if n.endswith((".yaml", ".yml")):
+        return read_yaml(path, shown)
+    return read_xml(path, shown)
+
+
+def scan(paths: Sequence[Path], launch: Sequence[Path] = (), launch_args: dict[str, str] | None = None,
+         bags: Sequence[Path] = (), cache_path: Path | None = None, base: Path | None = None,
+         standard: bool = True) -> ScanResult:
+    """Scan workspaces ``paths`` (directories holding packages) into a graph.
+
+    ``launch``: entry launch files (with ``launch_args``); ``bags``: recorded
+    runs; ``cache_path``: the per-file parse cache (``None``: no cache);
+    ``base``: paths in locations are shown relative to it (default: the
+    current directory). Never raises on bad input: unreadable files become
+    located notes (``ROS-PARSE`` errors) in ``graph.notes``.
+    """
+    from rclverify.ros.extract.interfaces import DEBIAN_SHARE
+    # Reads are confined to the workspace (``base``, else the scanned paths
+    # and entry launch files as given): links leaving it are skipped (docs/ros.md).
+    tops = [base] if base is not None else [*paths, *(Path(lf).parent for lf in launch)]
+    with safefs.confined([*tops, DEBIAN_SHARE]):
+        return _scan(paths, launch, launch_args, bags, cache_path, base, standard)
+
+
+def _scan(paths: Sequence[Path], launch: Sequence[Path], launch_args: dict[str, str] | None,
+          bags: Sequence[Path], cache_path: Path | None, base: Path | None, standard: bool) -> ScanResult:
+    show = Shower(base)
+    cache = ParseCache(cache_path) if cache_path is not None else None
+    g = Graph()
+    table = TypeTable()
+    pkgs: dict[str, Package] = {}
+    tops = []
+    for p in paths:
+        if safefs.inside(p):
+            tops.append(Path(p))
+        else:
+            g.notes.append(Note(Src(show(Path(p))), "workspace path resolves outside the workspace "
+                                                    "(symlink): not scanned", "ROS-PARSE"))
+    skipped: list[str] = []
+    for m in find_manifests(tops, skipped):
+        shown = show(m)
+        try:
+            g.files[shown] = ParseCache.digest(safefs.read_bytes(m))
+        except OSError:
+            pass
+        try:
+            sha_m = g.files.get(shown) or ParseCache.digest(safefs.read_bytes(m))
+        except OSError:
+            sha_m = ""
+        pkg, notes = cache.get(f"pkg:{shown}", sha_m, lambda: read_package(m, shown)) if cache and sha_m \
+            else read_package(m, shown)
+        g.notes.extend(notes)
+        if pkg is None:
+            continue
+        # the cache is keyed by workspace-relative path and content: the
+        # directory is this tree's, never the one the entry was made in
+        pkg = dataclasses.replace(pkg, root=m.parent, manifest=m)
+        if pkg.name in pkgs:
+            g.notes.append(Note(Src(shown), f"package '{pkg.name}' also at {show(pkgs[pkg.name].manifest)}; "
+                                            f"this one is ignored", "ROS-MANIFEST"))
+            continue
+        pkgs[pkg.name] = pkg
+        g.packages[pkg.name] = pkg.to_json(shown)
+    for name in sorted(pkgs):
+        table.add_package_dir(pkgs[name].root, name, show, "workspace", cache, g.files)
+    # Debian's ros-*-msgs packages are ROS 1 (Noetic) definitions: used unless
+    # every scanned package is a ROS 2 one, whose standard types come from
+    # rosbags' ROS 2 store instead (docs/ros.md).
+    if standard and (not pkgs or any(p.ros == 1 for p in pkgs.values())):
+        table.add_debian_standard(cache)
+    elif standard:  # rosbags' ROS 2 store has messages only: services of message-less packages (std_srvs)
+        table.add_debian_standard(cache, services_only=True)
+    for tname, fname, missing in table.unknown_refs():
+        info = table.types[tname]
+        g.notes.append(Note(Src(info.file or tname, info.lines.get(fname, 1)),
+                            f"field '{fname}' of {tname} has type {missing}, which no scanned package "
+                            f"or standard package defines", "ROS-TYPE"))
+    g.notes.extend(table.notes)
+
+    res = ScanResult(g, pkgs, table)
+    records: dict[str, dict[str, dict[str, Any]]] = {}
+    tgts: dict[str, Targets] = {}
+    for name in sorted(pkgs):
+        root = pkgs[name].root
+        tgts[name] = targets(root, name)
+        installed = {p for paths in tgts[name].programs.values() for p in paths}
+        py, cpp, bare = _source_files(root, skipped)
+        recs = records[name] = {}
+        for f in py + cpp + bare:
+            quiet = f in bare and f not in installed and f.parent.name not in _SCRIPT_DIRS
+            try:
+                data = safefs.read_bytes(f)
+            except OSError as exc:
+                if not quiet:
+                    sev = "warning" if isinstance(exc, safefs.Refused) else "error"
+                    g.notes.append(Note(Src(show(f)), f"cannot read: {exc}", "ROS-PARSE", sev))
+                continue
+            if f in bare and not _python_shebang(data) and (f not in installed or data.startswith(b"#!")):
+                continue  # not a Python program (a shell script, a data file)
+            if len(data) > MAX_SOURCE_BYTES:
+                g.notes.append(Note(Src(show(f)), "source file larger than 2 MB: not scanned", "ROS-PARSE"))
+                continue
+            shown = show(f)
+            sha = ParseCache.digest(data)
+            is_py = f not in cpp
+            fn = functools.partial(_parse, data, shown, is_py)
+            r = cache.get(f"{'py' if is_py else 'cpp'}:{shown}", sha, fn) if cache else fn()
+            recs[shown] = r
+            if r["nodes"] or r["endpoints"] or r["notes"] or r.get("node_names"):
+                g.files[shown] = sha
+                res.sources[shown] = r
+    for bad in sorted({safefs.escaped(show(Path(b))) for b in skipped}):
+        g.notes.append(Note(Src(bad), "name is not valid UTF-8: skipped", "ROS-PARSE"))
+    asm = Assembly(pkgs, records, tgts, show, lambda t: table.get(t) is not None)
+    launch_params: dict[str, tuple[str, Src]] = {}
+    pfiles = PackageParams({} if launch else {p: pkgs[p].root for p in pkgs}, show)
+    g.notes.extend(pfiles.notes)
+    by_ros_name: dict[str, list[str]] = {}  # a ROS node name -> the graph nodes of the programs taking it
+
+    def add_node(full: str, ns: str, pkg: str | None, exe: str | None, files: list[str], declared: Src,
+                 eps: list[Endpoint], remaps: list[tuple[str, str, Src]], origin: str,
+                 params: dict[str, tuple[str, Src]] | None = None, lifecycle: bool = False) -> None:
+        node = GraphNode(full, ns, pkg, exe, files, declared, origin=origin, lifecycle=lifecycle)
+        key = full
+        if origin == "source":
+            # no launch file starts them: each program taking a name is a node of its
+            # own, kept apart by its executable (docs/ros.md, "Programs without launch files")
+            keys = by_ros_name.setdefault(full, [])
+            same = next((k for k in keys if g.nodes[k].declared_at == declared), None)
+            if same is not None:  # one code named twice (an executable and its component): one node
+                node, key = g.nodes[same], same
+                node.lifecycle = node.lifecycle or lifecycle
+                node.sources.extend(f for f in files if f not in node.sources)
+            elif keys:
+                if keys == [full]:  # the first program taking the name is kept apart too
+                    first = g.nodes.pop(full)
+                    first.name = keys[0] = apart_name(full, first.package, first.executable, first.declared_at,
+                                                      g.nodes)
+                    g.nodes[first.name] = first
+                key = node.name = apart_name(full, pkg, exe, declared, g.nodes)
+                g.notes.append(Note(declared, f"node {full} is also named at {g.nodes[keys[0]].declared_at}; "
+                                              f"no launch file starts these programs together: kept apart as "
+                                              f"{key} (and {', '.join(keys)})", "ROS-LAUNCH"))
+                keys.append(key)
+            else:
+                keys.append(full)
+        elif full in g.nodes:
+            g.notes.append(Note(declared, f"node {full} is started twice (first at {g.nodes[full].declared_at}); "
+                                          f"ROS keeps only the last one", "ROS-LAUNCH"))
+        mine: dict[str, Any] = {names.resolve(k, ns, full): v for k, v in (params or {}).items()}
+        if origin == "source":  # no launch file: the package's parameter files (param_yaml)
+            from_files, said = pfiles.for_node(pkg, full)
+            g.notes.extend(said)
+            mine = {**from_files, **mine}
+            more, more_files, said = asm.plugin_endpoints(full, mine)  # pluginlib plugins it loads
+            g.notes.extend(said)
+            eps = eps + more
+            node.sources.extend(f for f in more_files if f not in node.sources)
+        eps = expand_each(eps, lambda a: (mine.get(names.resolve(a, ns, full)) or (None,))[0], g.notes)
+        for e in eps:
+            written, pname, set_at = e.topic, None, None
+            if e.param is not None:
+                pname = names.resolve(e.param, ns, full)
+                got = mine.get(pname) or launch_params.get(pname)
+                if got is not None and isinstance(got[0], str):
+                    written, set_at = e.affix[0] + got[0] + e.affix[1], got[1]
+                elif e.unread is not None:
+                    g.notes.append(e.unread)
+                    continue
+                elif not e.topic:
+                    g.notes.append(Note(e.src, f"name of {e.kind} comes from parameter {pname}, which has no "
+                                               f"default in the code and no value in the launch files: "
+                                               f"not resolved statically"))
+                    continue
+            topic, at = namespaces.resolve(written, e.handle, ns, full, remaps)
+            edge = GraphEdge(topic, e.msg_type, e.src, at, namespaces.shown(written, e.handle), pname, set_at)
+            lst = node.edges_of(e.kind)
+            # every call site keeps its own edge (the same name created twice is two edges)
+            if not any(x.topic == edge.topic and x.msg_type == edge.msg_type and x.src == edge.src for x in lst):
+                lst.append(edge)
+        g.nodes[key] = node
+
+    if launch:
+        interp = Interpreter(lambda p: pkgs[p].root.resolve() if p in pkgs else None,
+                             lambda p: _load_launch(p, show(p)), show)
+        for lf in launch:
+            interp.run(Path(lf), dict(launch_args or {}))
+        for f in interp.files:
+            try:
+                g.files[show(f)] = ParseCache.digest(safefs.read_bytes(f))
+            except OSError:
+                pass
+        g.notes.extend(interp.notes)
+        launch_params.update(interp.params)
+        for ln in interp.nodes:
+            asm.launch_node(ln, add_node, g)
+    else:
+        asm.source_nodes(add_node, g)
+        asm.controller_nodes(add_node, pfiles.entries, g)  # ros2_control controllers (issue 65)
+    g.notes.extend(asm.unloaded_plugins())
+    for shown, r in sorted(res.sources.items()):
+        g.notes.extend(r["notes"])
+    g.notes = list(dict.fromkeys(g.notes))  # a note given by several programs (a shared header) once
+    made = {e.src for n in g.nodes.values() for r in ("pub", "sub") + SERVICE_ROLES for e in n.edges_of(r)}
+    g.notes = [n for n in g.notes if not (n.message.endswith(UNBUILT) and n.src in made)]  # another program makes it
+    for b in bags:
+        from rclverify.ros.graph.bag import bag_topics
+        recorded, notes = bag_topics(Path(b), show(Path(b)))
+        g.notes.extend(notes)
+        if recorded is not None:
+            g.bags.append(recorded)
+    used = {e.msg_type for n in g.nodes.values() for e in n.publishes + n.subscribes if e.msg_type}
+    used |= {t["type"] for b in g.bags for t in b["topics"] if t["type"]}
+    used |= {k for k, v in table.types.items() if v.origin == "workspace"}
+    g.types = {k: v.to_json() for k, v in table.closure(sorted(used)).items()}
+    if cache is not None:
+        cache.save()
+        res.cache_hits, res.cache_misses = cache.hits, cache.misses
+    return res
+
+
+def apart_name(full: str, pkg: str | None, exe: str | None, declared: Src | None, taken: dict[str, Any]) -> str:
+    """The graph name of one of several programs that take node name ``full`` with no
+    launch file starting them: ``/talker@demo_nodes_cpp.talker`` (``full@package.executable``;
+    the file's stem for a loose file; characters other than letters, digits, ``_``
+    and ``.`` as ``_``; ``.2``, ``.3`` ... appended while ``taken`` has it).  The
+    ``@`` makes it no ROS name, so it is never a running node's (docs/ros.md)."""
+    what = exe or (Path(declared.file).stem if declared is not None else "program")
+    tail = "".join(c if c.isalnum() or c in "_." else "_" for c in f"{pkg or 'loose'}.{what}")
+    out, k = f"{full}@{tail}", 1
+    while out in taken:
+        k += 1
+        out = f"{full}@{tail}.{k}"
+    return out
+
+
+def _parse(data: bytes, shown: str, is_py: bool) -> dict[str, Any]:
+    """The record of one source file (:func:`scan_python` or :func:`scan_cpp`)."""
+    return scan_python(data.decode("utf-8", errors="replace"), shown) if is_py else scan_cpp(data, shown)

@@ -1,0 +1,3 @@
+"""ROS layer d: contracts grounded in the computation graph (``ground``,
+``ground_services``, the lifecycle management interface).
+"""

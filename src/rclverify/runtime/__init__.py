@@ -1,0 +1,8 @@
+"""Layer 10, runtime: live monitoring as a product.
+
+The monitors' engine (``backends/monitors``) judging a running robot: the
+ROS 1 transport (``ros1``, ``ros1_interfaces``, ``service_proxy``,
+``live``), ROS 2 over DDS (``dds/``), enforcement (``enforce``), the
+WebSocket oracle (``oracle``) and the checking worker.  Imports
+``backends`` and below.
+"""

@@ -1,0 +1,141 @@
+"""A live ROS 2 run recorded as a ROS 2 bag (``--record BAG``), in either of
+rosbag2's storage formats: SQLite 3 (``.db3``, the default before Iron) or
+MCAP (the default since Iron), written by rosbags (``rosbag2`` format
+version 8, which ``ros2 bag`` reads from Iron on and rosbags reads in any
+version).
+
+Each message of a contract topic is stored as it came off the wire (its CDR
+bytes, encapsulation header included: what rosbag2 stores), under its ROS
+name, with the time the monitor received it, the same time the live engine
+gives a message without a header stamp; the message definition comes from
+the workspace's ``.msg`` files and rosbags' store (the types the monitor
+decoded with).  So ``rclverify monitor BAG`` checks exactly the messages the
+live run checked, at the same times, and gives the same verdicts
+(tests/test_monitor_live_dds.py).
+"""
+from __future__ import annotations
+
+import queue
+import shutil
+import threading
+from pathlib import Path
+from typing import Any, Mapping, Sequence
+
+STORAGES = ("sqlite3", "mcap")
+
+
+class BagError(Exception):
+    """The bag cannot be written (it exists, a type is unknown); ``str`` says why."""
+
+
+def storage_of(path: Path, storage: str | None) -> str:
+    """The storage format: ``storage`` when given, else ``mcap`` for a path
+    ending in ``.mcap``, else ``sqlite3``."""
+    if storage:
+        return storage
+    return "mcap" if Path(path).suffix == ".mcap" else "sqlite3"
+
+
+class BagRecorder:
+    """Write raw messages of ``topics`` (contract topic without ``/`` ->
+    ``pkg/msg/T``) to a new ROS 2 bag directory ``path``.  Raises
+    :class:`BagError` when the bag cannot be created.
+
+    Threads: rosbags' writer is opened, written and closed in one thread of
+    its own (``rclverify-bag``; SQLite allows a connection only in the thread
+    that made it), fed through a queue: :meth:`write` may be called from any
+    thread and never waits for the disk; :meth:`close` waits until every
+    queued message is written and the bag is finished."""
+
+    def __init__(self, path: Path, storage: str, topics: Mapping[str, str], msg_dirs: Sequence[Path],
+                 open_timeout_s: float = 30.0) -> None:
+        from rclverify.traces.bag import typestore
+        from rclverify.traces.events import TraceError
+        self.path = Path(path)
+        if self.path.suffix == ".mcap":  # a bag is a directory: name it without the suffix
+            self.path = self.path.with_suffix("")
+        if self.path.exists():
+            raise BagError(f"{self.path}: error: exists; a recording goes to a new bag directory")
+        try:
+            self._store = typestore(list(msg_dirs))
+        except TraceError as exc:
+            raise BagError(str(exc)) from None
+        self.storage, self.topics = storage, {t.strip("/"): ty for t, ty in topics.items()}
+        self.count = self.failed = 0
+        self.error = ""
+        self._queue: queue.SimpleQueue[tuple[str, int, bytes] | None] = queue.SimpleQueue()
+        self._opened = threading.Event()
+        self._thread = threading.Thread(target=self._run, name="rclverify-bag", daemon=True)
+        self._thread.start()
+        if not self._opened.wait(open_timeout_s):
+            raise BagError(f"{self.path}: error: cannot record: the bag was not opened within {open_timeout_s:g} s")
+        if self.error:
+            self._thread.join(open_timeout_s)
+            shutil.rmtree(self.path, ignore_errors=True)  # new (checked above): no half-made bag is left behind
+            raise BagError(f"{self.path}: error: cannot record: {self.error}")
+
+    def _open(self) -> tuple[Any, dict[str, Any]]:
+        from rosbags.rosbag2 import StoragePlugin, Writer
+        writer = Writer(self.path, version=8,
+                        storage_plugin=StoragePlugin.MCAP if self.storage == "mcap" else StoragePlugin.SQLITE3)
+        writer.open()
+        connections: dict[str, Any] = {}
+        for topic, msg_type in self.topics.items():
+            pkg, _, name = msg_type.replace("/msg/", "/").partition("/")
+            try:
+                connections[topic] = writer.add_connection("/" + topic, f"{pkg}/msg/{name}", typestore=self._store)
+            except Exception as exc:  # rosbags: a type its store cannot describe
+                writer.close()
+                wide = " (rosbags has no wide string: a wstring cannot be stored)" if "wstring" in str(exc) else ""
+                raise RuntimeError(f"topic /{topic} ({msg_type}): {exc}{wide}") from None
+        return writer, connections
+
+    def _run(self) -> None:
+        try:
+            writer, connections = self._open()
+        except Exception as exc:  # noqa: BLE001 - said by the constructor, in the caller's thread
+            self.error = str(exc) or type(exc).__name__
+            self._opened.set()
+            return
+        self._opened.set()
+        try:
+            while True:
+                item = self._queue.get()
+                if item is None:
+                    break
+                topic, time_ns, raw = item
+                try:
+                    writer.write(connections[topic], time_ns, raw)
+                    self.count += 1
+                except Exception as exc:  # noqa: BLE001 - one message lost, said in close()'s record
+                    self.failed += 1
+                    self.error = f"{type(exc).__name__}: {exc}"
+        finally:
+            writer.close()
+
+    def write(self, topic: str, time_ns: int, raw: bytes) -> None:
+        """Queue one message of ``topic`` received at ``time_ns`` (ns since the
+        epoch); a topic not recorded, or data that are not bytes, is ignored
+        (counted in ``failed`` for the latter: nothing malformed reaches the bag)."""
+        if topic not in self.topics:
+            return
+        if not isinstance(raw, (bytes, bytearray, memoryview)) or not isinstance(time_ns, int) or time_ns < 0:
+            self.failed += 1
+            return
+        self._queue.put((topic, time_ns, bytes(raw)))
+
+    def close(self, timeout_s: float = 60.0) -> dict[str, Any]:
+        """Write what is queued, finish the bag (idempotent); returns what the evidence says of it
+        (``failed``: messages not written, ``error``: the last writer error)."""
+        if self._thread.is_alive():
+            self._queue.put(None)
+            self._thread.join(timeout_s)
+        out: dict[str, Any] = {"path": str(self.path), "messages": self.count,
+                               "topics": sorted("/" + t for t in self.topics)}
+        if self.failed or self._thread.is_alive():
+            out["failed"] = self.failed
+            out["error"] = self.error or f"the bag was not finished within {timeout_s:g} s"
+        return out
+
+
+__all__ = ["BagError", "BagRecorder", "STORAGES", "storage_of"]

@@ -1,0 +1,267 @@
+"""``rclverify monitor --live --ros2``: the live monitor as a DDS participant.
+
+Everything that decides a verdict, writes the log or the evidence is the
+ROS 1 monitor's (:class:`~.live.LiveRun` around the one engine,
+:class:`~.worker.EngineWorker` as its only thread); this module moves
+messages in and verdicts out over DDS (:mod:`rclverify.ros.live.dds`):
+
+* joins domain ``ROS_DOMAIN_ID`` with Cyclone's ``CYCLONEDDS_URI``;
+* reads every topic the monitored contracts name (``rt/<topic>``, the
+  struct made from the contract's type, :mod:`.dds_types`) with a reader
+  that follows its publishers' QoS (:mod:`.dds_bus`), and every linked
+  service and action (:mod:`.dds_services`, checked call by call by
+  :mod:`.dds_calls`);
+* publishes each verdict as ``std_msgs/msg/String`` JSON on
+  ``rt/rclverify/verdict`` (``ros2 topic echo /rclverify/verdict``) and each
+  node's latest on ``rt/rclverify/<Node>/last_verdict``, reliable and
+  transient-local, depth 1 (ROS 2's latching);
+* with ``enforce``, republishes the guarded topics (:mod:`.dds_enforce`);
+  with ``record``, writes the run to a ROS 2 bag (:mod:`.dds_bag`).
+
+Threads: Cyclone's own (C, no GIL), the bus thread (takes raw samples,
+queues them), the engine thread (decodes, checks, logs, publishes, runs
+the timer), and the caller's (status lines, the stop).  The evidence record
+is the ROS 1 one (``live.stop_and_record``) with ``calls`` (per node the
+call-by-call verdicts' status), ``deadlines``, ``qos`` (per topic the
+reader's QoS and what it heard), ``warnings``, ``enforce`` and ``bag``.
+"""
+from __future__ import annotations
+
+import json
+import math
+import time as _time
+from importlib.metadata import PackageNotFoundError, version
+from pathlib import Path
+from typing import Any, Callable, Mapping
+
+from rclverify.records.store import atomic_write_text
+from rclverify.lang.types import Checked, CheckedNode
+from rclverify.ros.live.dds import DdsUnavailable, domain_id, make_participant, topic_name, type_hash_user_data, write_raw
+from rclverify.ros.live.dds_qos import writer_profile
+from rclverify.backends.monitors.summary import verdict_status
+from rclverify.runtime.dds.bag import BagRecorder
+from rclverify.backends.monitors.dds_calls import CallBook
+from rclverify.runtime.dds.services import CallTaps
+from rclverify.runtime.dds.types import DdsTypeError, TypeBook, to_fields
+from rclverify.runtime.dds.wire import WriterIds
+from rclverify.runtime.live import VERDICT_LOG_TOPIC, LiveRun, dumps, stop_and_record
+from rclverify.runtime.ros1 import contract_topics
+from rclverify.runtime.worker import EngineWorker
+
+
+class _Sink:
+    """What the engine thread feeds: the run's engine, and the call book's clock."""
+
+    def __init__(self, live: LiveRun, book: CallBook | None, taps: CallTaps | None, window: float) -> None:
+        self.live, self.book, self.taps, self.window = live, book, taps, window
+
+    def push(self, topic: str, fields: Mapping[str, Any], received: float) -> None:
+        self.live.push(topic, fields, received)
+
+    def tick(self, now: float) -> None:
+        self.live.tick(now)
+        if self.book is not None and self.taps is not None:
+            self.taps.tick(now, self.window)  # the book's clock as far behind as the topic engine's, or more
+
+
+def _status(live: LiveRun, calls: Mapping[tuple[str, str], int]) -> str:
+    """The topic engine's status line, then the calls' verdicts per node."""
+    line = live.status_line()
+    per: dict[str, list[str]] = {}
+    for (node, verdict), n in sorted(dict(calls).items()):  # copied at once: the engine thread adds to it
+        per.setdefault(node, []).append(f"{n} {verdict}")
+    return line + ("" if not per else " | calls: " + "; ".join(f"{n} {', '.join(v)}" for n, v in per.items()))
+
+
+def _version() -> str:
+    try:
+        return f"cyclonedds {version('cyclonedds')}"
+    except PackageNotFoundError:
+        return "cyclonedds (version unknown)"
+
+
+def run_dds(run_factory: Callable[..., LiveRun], checked: Checked, nodes: list[CheckedNode],
+            type_dirs: list[Path], *, verdict_topic: str, last_prefix: str, duration: float | None, tick_s: float,
+            status_s: float, evidence: Path | None, stop: Any, out: Callable[[str], None],
+            enforce: Mapping[str, str] | None = None, record: tuple[Path, str] | None = None,
+            msg_dirs: list[Path] | None = None, reorder_window: float = 0.0, **_ignored: Any) -> dict[str, Any]:
+    """Monitor the ROS 2 system on the DDS domain until ``stop`` is set or
+    ``duration`` s passed; returns the evidence record (written to
+    ``evidence`` too).  ``type_dirs``: directories of ``<pkg>/msg|srv|action``
+    (the mapping's message directories and ``--interfaces``); ``enforce``:
+    guarded contract topic -> private ROS name (``run_factory`` makes an
+    :class:`~.dds_enforce.EnforcingRun` then); ``record``: ``(bag path,
+    storage)``.  Raises :class:`~rclverify.ros.live.dds.DdsUnavailable` (the
+    binding, the domain, a type that cannot be made, a bag that cannot be
+    created: one message)."""
+    from rclverify.runtime.dds.bag import BagError
+    try:
+        types = TypeBook(type_dirs)
+        string = types.message("std_msgs/String")
+    except DdsTypeError as exc:
+        raise DdsUnavailable(str(exc)) from None
+    topics = contract_topics(checked, nodes)  # "/topic" -> "pkg/Type"
+    where = {t.field.strip("/"): f"{t.loc.file}:{t.loc.line}:{t.loc.col}" for n in reversed(nodes)
+             for t in reversed(n.node.topics)}  # the first mention of each topic
+    structs: dict[str, Any] = {}
+    for t, typ in topics.items():
+        try:
+            structs[t.strip("/")] = types.message(typ)
+        except DdsTypeError as exc:
+            raise DdsUnavailable(f"{where.get(t.strip('/'), t)}: error: topic {t} ({typ}): {exc}") from None
+    links = [(n, lk) for n in nodes for lk in n.node.links]
+    for _n, lk in links:  # every linked type made now: a missing one is one located message, before joining
+        try:
+            types.service(lk.ros_type) if lk.kind == "service" else types.action(lk.ros_type)
+        except DdsTypeError as exc:
+            raise DdsUnavailable(f"{lk.loc.file}:{lk.loc.line}:{lk.loc.col}: error: {lk.kind} {lk.name} "
+                                 f"({lk.ros_type}): {exc}") from None
+    enforce = dict(enforce or {})
+    recorder = None
+    if record is not None:
+        try:
+            recorder = BagRecorder(record[0], record[1], {t.strip("/"): ty for t, ty in topics.items()},
+                                   msg_dirs if msg_dirs is not None else type_dirs)
+        except BagError as exc:
+            raise DdsUnavailable(str(exc)) from None
+    dp = make_participant()
+    warnings: list[str] = []
+    decode_errors: dict[str, int] = {}
+
+    def warn(text: str) -> None:
+        warnings.append(text)
+        out(text)
+
+    from rclverify.runtime.dds.bus import Bus
+    from rclverify.runtime.dds.trust import VERDICT_KEY, downgrade
+    worker_box: list[EngineWorker] = []
+    republish: dict[str, Any] = {}
+
+    def on_reader(tap: Any, publishers: list[Any]) -> None:
+        """A guarded topic's real name is published as soon as its private one is
+        heard, with the QoS the node's publisher offers (so subscribers match it
+        before the first message is released)."""
+        if tap.key in enforce and tap.key not in republish:
+            republish[tap.key] = bus.writer(topic_name(tap.key), structs[tap.key], publishers[0].qos)
+    writers = WriterIds()  # a service sample's writer tells its wire form (dds_wire.py)
+    bus = Bus(dp, lambda tap, raw, info, rns: worker_box[0].offer(tap.key, (
+        raw, info.source_timestamp, rns, writers.of(tap.reader, info) if tap.key.startswith("call:") else None),
+        rns / 1e9), warn, on_reader=on_reader,
+              type_hash=types.type_hash)
+    user = type_hash_user_data("std_msgs/msg/String")
+    pub = bus.writer(topic_name(verdict_topic), string, writer_profile(depth=1000), user)
+    latched = writer_profile(transient_local=True, depth=1)
+    lasts = {n.name: bus.writer(topic_name(f"{last_prefix}/{n.name}/last_verdict"), string, latched, user)
+             for n in nodes}
+    def send(text: str) -> None:
+        pub.write(string(data=text))
+
+    def release(topic: str, raw: bytes) -> None:
+        write_raw(republish[topic], raw)  # made when the private topic's reader was (on_reader)
+    extra = {"release": release} if enforce else {}
+    def send_last(node: str, text: str) -> None:
+        lasts[node].write(string(data=text))
+    live = run_factory(publish=send, publish_last=send_last, **extra)
+    book = calls = None
+    call_counts: dict[tuple[str, str], int] = {}
+    if links:
+        def on_call_verdict(v: Any) -> None:
+            key = (v.node, v.verdict)
+            call_counts[key] = call_counts.get(key, 0) + 1
+            d = {**v.to_json(), "call": True}
+            live.note({"topic": VERDICT_LOG_TOPIC, "time": v.decided_at, "verdict": d})
+            send(dumps(d))
+
+        def on_deadline(v: Any) -> None:
+            t = book.now if book is not None and math.isfinite(book.now) else v.trigger_stamp
+            live.note({"topic": VERDICT_LOG_TOPIC, "time": t, "kind": "deadline", "verdict": v.to_json()})
+            send(dumps({"kind": "deadline", **v.to_json()}))
+        book = CallBook(checked, links, live.engine.rules, live.engine.horizon, on_call_verdict, on_deadline,
+                        live.note)
+        calls = CallTaps(book, types, links)
+    for t, struct in structs.items():
+        bus.tap(t, topic_name(enforce.get(t, t)), struct, where.get(t, t))
+    for t in enforce:  # only the gate may write a guarded topic, only the monitor the verdict topic (dds_trust.py)
+        bus.watch_writers(topic_name(t), t, where.get(t, t), "guarded topic")
+    bus.watch_writers(topic_name(verdict_topic), VERDICT_KEY, "--verdict-topic", "verdict topic")
+    if calls is not None:
+        calls.attach(bus, warn)
+
+    def decode(key: str, payload: Any) -> Mapping[str, Any] | None:
+        raw, source_ns, received_ns = payload[:3]
+        try:
+            if calls is not None and key.startswith("call:"):
+                calls.handle(key, raw, source_ns / 1e9, received_ns / 1e9, payload[3])
+                return None
+            fields: Mapping[str, Any] = to_fields(structs[key].deserialize(raw))
+        except Exception:  # bytes that are not the contract's type: counted, never a crash
+            decode_errors[key] = decode_errors.get(key, 0) + 1
+            return None
+        if recorder is not None:
+            recorder.write(key, received_ns, raw)
+        if key in enforce:
+            live.stash(fields, raw)  # type: ignore[attr-defined]
+        return fields
+
+    worker = EngineWorker(_Sink(live, book, calls, reorder_window), decode, _time.time, tick_s=tick_s)
+    worker_box.append(worker.start())
+    bus.start()
+    out(f"monitoring {len(structs)} topic(s) and {len(calls.specs) if calls else 0} service/action topic(s) for "
+        f"{len(nodes)} node(s) on DDS domain {domain_id()}; verdicts on {verdict_topic}")
+    t0 = _time.monotonic()
+    next_status = t0 + status_s
+    try:
+        while not stop.is_set():
+            if duration is not None and _time.monotonic() - t0 >= duration:
+                break
+            stop.wait(min(0.1, tick_s * 5))
+            if worker.error is not None or bus.error is not None:
+                break  # a dead thread: stop and say so, never monitor on silently
+            if status_s > 0 and _time.monotonic() >= next_status:
+                out(_status(live, call_counts))
+                next_status += status_s
+    finally:
+        bus_error = ""
+        try:
+            bus.stop()
+        except Exception as exc:  # noqa: BLE001 - said in the record
+            bus_error = f"{type(exc).__name__}: {exc}"
+        try:
+            worker.stop()
+        except Exception:  # noqa: BLE001 - stop_and_record stops it again and records the error
+            pass
+        summary = calls.finish() if calls is not None else None  # while the log is open
+        record_ = stop_and_record(worker, live, None, out)
+        if bus_error:
+            record_["bus_error"] = bus_error
+            for n in record_["nodes"]:
+                n["status"], n["explanation"] = "error", f"the DDS reader thread stopped: {bus_error}"
+        record_.update(middleware=f"DDS domain {domain_id()} ({_version()})", warnings=warnings,
+                       decode_errors=decode_errors, qos={t.key: t.to_json() for t in bus.taps})
+        if summary is not None and book is not None:
+            record_["calls"] = {"counts": summary["counts"], "nodes": [],
+                                "samples": calls.counts if calls is not None else {}}
+            for name, res in book.results.items():
+                status, explanation = verdict_status(res, "the live calls")
+                record_["calls"]["nodes"].append({"node": name, "status": status, "explanation": explanation,
+                                                  **res.to_json()})
+            record_["deadlines"] = {"results": summary["deadlines"], "false": summary["false"]}
+        if enforce:
+            record_["enforce"] = live.gate_counts  # type: ignore[attr-defined]
+        bypass = {k: sorted(v) for k, v in bus.bypass.items() if v}
+        if bypass:
+            record_["bypass"] = bypass
+        downgrade(record_["nodes"], {n.name: [t.field.strip("/") for t in n.node.topics] for n in nodes}, bypass,
+                  {t.key: t.reader_changes for t in bus.taps})
+        if recorder is not None:
+            record_["bag"] = recorder.close()
+        record_["not_judged"] = live.not_judged(record_)  # silence is never green (judged.py)
+        if evidence is not None:
+            atomic_write_text(evidence, json.dumps(record_, indent=2, sort_keys=True) + "\n")
+        out(_status(live, call_counts))
+        bus.close()
+        dp.__del__()
+    return record_
+
+
+__all__ = ["run_dds"]

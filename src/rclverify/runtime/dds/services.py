@@ -1,0 +1,417 @@
+"""Services and actions heard on the DDS bus, paired and fed to the
+:class:`~.dds_calls.CallBook`.
+
+For every link a monitored contract declares (``services(...)``,
+``actions(...)``), :class:`CallTaps` asks the bus (:mod:`.dds_bus`) for:
+
+* a service ``/s`` of type ``pkg/T``: ``rq/sRequest`` and ``rr/sReply``
+  (``pkg::srv::dds_::T_Request_`` / ``T_Response_``) and its introspection
+  events ``rt/s/_service_event`` (:mod:`.dds_introspection`);
+* an action ``/a``: ``rq``/``rr`` of ``/a/_action/send_goal``,
+  ``/a/_action/get_result`` and ``/a/_action/cancel_goal``, and
+  ``rt/a/_action/feedback`` and ``rt/a/_action/status``.
+
+The request and reply readers are of the wire form ``RMW_IMPLEMENTATION``
+names (:mod:`.dds_wire`); a sample whose writer is of the other vendor is
+counted, not decoded:
+
+* **with the request header** (rmw_cyclonedds): a request opens its call
+  under its identity (the client's writer handle and the sequence number),
+  the reply with the same identity answers it;
+* **without it** (rmw_fastrtps): the service's introspection events pair
+  request and reply exactly when the server (or every client) publishes
+  them; else the order pairs them where it is certain
+  (:mod:`.dds_order`), and says which calls it cannot pair;
+* **an action**: a goal opens its call under its ``goal_id``, the feedback
+  messages and the get-result reply carrying that goal id answer it (the
+  get-result request tells which goal its reply is about: by the header's
+  identity, or by the order), a refused goal (``accepted`` false) closes it
+  unjudged; status changes, cancel requests and the goals a cancel reply
+  names (goal ids in both: no pairing needed) are logged.
+
+Samples are taken in the order of their DDS source timestamps: each waits
+:data:`SETTLE_S` seconds after its stamp (so that a request taken after its
+reply, the two travelling on different topics, still comes first), and the
+call book's clock runs that far behind.  An answer whose request has not been
+heard waits up to :data:`EARLY_S` seconds for it before it counts as an
+answer without a call.
+"""
+from __future__ import annotations
+
+import heapq
+import os
+from typing import Any, Iterable
+
+from rclverify.lang import ast
+from rclverify.lang.types import CheckedNode
+from rclverify.ros.live.dds import ACTION_INFIX, reply_topic, request_topic, topic_name
+from rclverify.runtime.dds.bus import NAME_GRACE_S
+from rclverify.backends.monitors.dds_calls import CallBook
+from rclverify.runtime.dds.introspection import EVENT_SUFFIX, SIDES, event_key, event_side, event_struct
+from rclverify.runtime.dds.order import OrderPairer, Pending
+from rclverify.runtime.dds.shadow import REPLY_OF, Shadows
+from rclverify.runtime.dds.types import TypeBook, request_id, to_fields
+from rclverify.runtime.dds.wire import framed_rmw, has_header, vendor
+
+#: seconds an answer waits for its request (or goal) to be heard
+EARLY_S = 2.0
+#: seconds a sample waits after its source stamp, so that samples are taken in the stamps' order
+SETTLE_S = 0.3
+#: seconds after its receipt a sample is taken whatever its stamp says (a writer whose clock runs ahead)
+LATE_S = 1.0
+#: action_msgs/msg/GoalStatus values (ROS 2 design "Actions")
+GOAL_STATUS = {0: "unknown", 1: "accepted", 2: "executing", 3: "canceling", 4: "succeeded", 5: "canceled",
+               6: "aborted"}
+
+
+def _cancel_types(t: TypeBook) -> tuple[type, type, type, type]:
+    """The plain and the framed request and reply of ``action_msgs/srv/CancelGoal``
+    (ROS 2 design "Actions": the request a ``GoalInfo``, goal id and stamp;
+    the reply a return code and the ``GoalInfo`` of each goal now canceling),
+    defined here when the interface files do not (rosbags' store has no
+    services)."""
+    info = (2, "action_msgs/msg/GoalInfo")
+    req, rep = "action_msgs/srv/CancelGoal_Request", "action_msgs/srv/CancelGoal_Response"
+    t._synth(req, [("goal_info", info)])
+    t._synth(rep, [("return_code", (1, ("int8", 0))), ("goals_canceling", (4, (info, 0)))])
+    return t.struct(req), t.struct(rep), t.struct(req, header=True), t.struct(rep, header=True)
+
+
+def _where(link: ast.Link) -> str:
+    return f"{link.loc.file}:{link.loc.line}:{link.loc.col}"
+
+
+class CallTaps:
+    """The taps of every monitored link and the decoding of their samples
+    (module docstring).  Raises :class:`~.dds_types.DdsTypeError` (with the
+    link's location) for a link type the interface files do not define."""
+
+    def __init__(self, book: CallBook, types: TypeBook, links: Iterable[tuple[CheckedNode, ast.Link]],
+                 framed: bool | None = None) -> None:
+        from rclverify.runtime.dds.types import DdsTypeError
+        self.book, self.types = book, types
+        #: the services' samples carry rmw_cyclonedds' request header (default: by RMW_IMPLEMENTATION)
+        self.framed = framed_rmw() if framed is None else framed
+        #: tap key -> (link, the struct read, the header struct or None, part)
+        self.specs: dict[str, tuple[str, Any, Any, str]] = {}
+        self.plan: list[tuple[str, str, Any, str]] = []  # (tap key, dds topic, struct, where)
+        seen: set[str] = set()
+        for _node, lk in links:
+            name = "/" + lk.name.strip("/")
+            if name in seen:
+                continue
+            seen.add(name)
+            try:
+                self._plan(name, lk)
+            except DdsTypeError as exc:
+                raise DdsTypeError(f"{_where(lk)}: error: {lk.kind} {name} ({lk.ros_type}): {exc}") from None
+        self.taps: dict[str, Any] = {}  # tap key -> the bus's Tap (attach)
+        self._node_of: Any = lambda guid: None  # a writer's ROS node (the bus's discovery, attach)
+        self._disc: Any = None
+        self._warn: Any = None
+        self._warned: set[bytes] = set()
+        self._seen: dict[bytes, float] = {}  # when a writer of the other form was first seen
+        self._said: set[str] = set()
+        self._checked = float("-inf")
+        self.shadows: Shadows | None = None  # reply writers that keep services visible to clients (attach)
+        self._goal_of: dict[tuple[int, int], str] = {}  # send-goal/get-result request id -> goal id
+        self._status: dict[str, int] = {}
+        self._early: dict[tuple[Any, ...], list[tuple[str, dict[str, Any], float, bool, float, str]]] = {}
+        self._queue: list[tuple[float, int, float, str, bytes, bytes | None]] = []
+        self._n = 0
+        self._pairers: dict[str, OrderPairer] = {}
+        self._sides: dict[str, str | None] = {}  # per service, the introspection side last used
+        self._asked: dict[bytes, int] = {}  # requests heard per writer without identity
+        self.last = float("-inf")  # the stamp of the last sample taken
+        #: samples taken after a later-stamped one (``late``), of a writer no longer known or of the other
+        #: wire form (:mod:`.dds_wire`), events without contents, request/reply samples left to the
+        #: introspection events, samples that did not decode
+        self.counts = {"late": 0, "unknown_writer": 0, "other_form": 0, "no_contents": 0, "introspected": 0,
+                       "undecodable": 0}
+
+    def _plan(self, name: str, lk: ast.Link) -> None:
+        t = self.types
+        if lk.kind == "service":
+            req, rep = t.service(lk.ros_type)
+            pkg, _, rest = lk.ros_type.replace("/srv/", "/").partition("/")
+            self._add(name, "request", request_topic(name), t.struct(f"{pkg}/srv/{rest}_Request"), req, lk)
+            self._add(name, "reply", reply_topic(name), t.struct(f"{pkg}/srv/{rest}_Response"), rep, lk)
+            self._add(name, "event", topic_name(name + EVENT_SUFFIX), event_struct(t, lk.ros_type), None, lk)
+            return
+        a = t.action(lk.ros_type)
+        pkg, _, rest = lk.ros_type.replace("/action/", "/").partition("/")
+        plain = f"{pkg}/action/{rest}"
+        base = name + ACTION_INFIX
+        for svc, part, (hreq, hrep) in (("send_goal", "goal", a.send_goal), ("get_result", "result", a.get_result)):
+            kind = "SendGoal" if svc == "send_goal" else "GetResult"
+            self._add(name, f"{part}_request", request_topic(base + svc), t.struct(f"{plain}_{kind}_Request"), hreq,
+                      lk)
+            self._add(name, f"{part}_reply", reply_topic(base + svc), t.struct(f"{plain}_{kind}_Response"), hrep, lk)
+        self._add(name, "feedback", topic_name(base + "feedback"), a.feedback, None, lk)
+        self._add(name, "status", topic_name(base + "status"), a.status, None, lk)
+        cq, cr, hq, hr = _cancel_types(t)
+        self._add(name, "cancel_request", request_topic(base + "cancel_goal"), cq, hq, lk)
+        self._add(name, "cancel_reply", reply_topic(base + "cancel_goal"), cr, hr, lk)
+
+    def _add(self, name: str, part: str, dds_topic: str, plain: Any, header: Any, lk: ast.Link) -> None:
+        key = f"call:{name}:{part}"
+        self.specs[key] = (name, header if self.framed and header is not None else plain, header, part)
+        self.plan.append((key, dds_topic, header if self.framed and header is not None else plain, _where(lk)))
+
+    def attach(self, bus: Any, warn: Any = None) -> None:
+        """Ask ``bus`` (a :class:`~.dds_bus.Bus`, before it starts) for every topic of the plan;
+        ``warn(line)`` is told of each writer of the other wire form (:meth:`check_forms`); the
+        request readers get their shadow reply writers (:mod:`.dds_shadow`)."""
+        for key, dds_topic, struct, where in self.plan:
+            self.taps[key] = bus.tap(key, dds_topic, struct, where)
+        self._node_of = bus.discovery.node_of
+        self._disc, self._warn = bus.discovery, warn
+        self.shadows = Shadows(bus, [(self.taps[k], self.taps[k.rsplit(":", 1)[0] + ":" + REPLY_OF[part]])
+                                     for k, (_n, _s, _h, part) in self.specs.items() if part in REPLY_OF])
+
+    def check_forms(self, now: float) -> None:
+        """Warn once about each writer discovery shows on a request or reply
+        topic whose vendor writes the other wire form (:mod:`.dds_wire`): the
+        monitor's reader cannot take its samples (they do not have its
+        layout), so its calls would otherwise go unheard in silence.  A writer
+        is named by its node once ``ros_discovery_info`` tells it, or after
+        :data:`~.dds_bus.NAME_GRACE_S` seconds by its participant."""
+        if self._disc is None or self._warn is None:
+            return
+        for key, (name, _struct, header, _part) in self.specs.items():
+            if header is None:
+                continue
+            try:
+                pubs = self._disc.publishers(self.taps[key].dds_topic)
+            except RuntimeError:  # discovery changed under us (the DDS thread): next time
+                return
+            for e in pubs:
+                if has_header(e.guid) == self.framed or e.guid in self._warned:
+                    continue
+                first = self._seen.setdefault(e.guid, now)
+                if self._node_of(e.guid) is None and now - first < NAME_GRACE_S:
+                    continue
+                self._warned.add(e.guid)
+                mine, theirs = ("with", "without") if self.framed else ("without", "with")
+                line = (f"{self.taps[key].where}: warning: {name}: {self._disc.who(e)} is {vendor(e.guid)}, whose "
+                        f"service samples come {theirs} rmw_cyclonedds' request header; the monitor reads them {mine} "
+                        f"it (RMW_IMPLEMENTATION={os.environ.get('RMW_IMPLEMENTATION', '')!r}): its calls are not "
+                        "heard (set RMW_IMPLEMENTATION to the robot's middleware)")
+                if line not in self._said:  # a participant's request and reply writers, before its nodes are known
+                    self._said.add(line)
+                    self._warn(line)
+
+    # -- samples (engine thread) -------------------------------------------------------------
+    def handle(self, key: str, raw: bytes, stamp: float, now: float, writer: bytes | None = None) -> None:
+        """One sample of tap ``key`` (serialized, source stamp ``stamp``, received
+        ``now``, written by ``writer``: its GUID), taken at a later :meth:`tick`."""
+        self._n += 1
+        heapq.heappush(self._queue, (stamp, self._n, now, key, raw, writer))
+
+    def tick(self, now: float, window: float = 0.0) -> None:
+        """Take the samples whose time has come, in their stamps' order; answers
+        that waited :data:`EARLY_S` s for their call count as answers without
+        one; the book's clock moves to ``now - max(window, SETTLE_S)``."""
+        self._take(lambda stamp, got: stamp <= now - SETTLE_S or got <= now - LATE_S)
+        if now - self._checked >= 0.5:
+            self._checked = now
+            self.check_forms(now)
+            if self.shadows is not None:
+                self.shadows.update()
+        for key in [k for k, xs in self._early.items() if now - xs[0][4] > EARLY_S]:
+            for part, fields, stamp, final, _t, name in self._early.pop(key):
+                self.book.answer(key, part, fields, stamp, final, name)
+        self.book.tick(now - max(window, SETTLE_S))
+
+    def finish(self) -> dict[str, Any]:
+        """Take every sample still waiting, then finish the book (its summary)."""
+        self._take(lambda stamp, got: True)
+        return self.book.finish()
+
+    def _take(self, due: Any) -> None:
+        while self._queue and due(self._queue[0][0], self._queue[0][2]):
+            stamp, _n, got, key, raw, writer = heapq.heappop(self._queue)
+            if stamp < self.last - 1e-9:
+                self.counts["late"] += 1
+            self.last = max(self.last, stamp)
+            try:
+                self._decode(key, raw, stamp, got, writer)
+            except Exception:  # noqa: BLE001 - bytes that are not the link's type: counted, never a crash
+                self.counts["undecodable"] += 1
+
+    def _decode(self, key: str, raw: bytes, stamp: float, now: float, writer: bytes | None) -> None:
+        name, struct, header, part = self.specs[key]
+        framed = header is not None and self.framed
+        if header is not None:
+            if writer is None:
+                self.counts["unknown_writer"] += 1
+                return
+            if has_header(writer) != framed:
+                self.counts["other_form"] += 1
+                return  # a writer of the other middleware: its bytes are not this reader's layout
+        s = struct.deserialize(raw)
+        if part == "event":
+            self._event(name, s, stamp, now)
+        elif part in ("request", "reply"):
+            if self._side(name, stamp) is not None:
+                self.counts["introspected"] += 1
+                return  # the introspection events pair this service's calls (and would count them again)
+            if part == "request":
+                self._request(name, s, stamp, framed, writer)
+            elif framed:
+                self._answer(request_id(s), "response", to_fields(s), stamp, True, name, now)
+            else:
+                self._ordered_reply(name, s, stamp, writer)
+        else:
+            self._action(name, part, s, stamp, now, framed, writer)
+
+    # -- services ------------------------------------------------------------------------------
+    def _request(self, name: str, s: Any, stamp: float, framed: bool, writer: bytes | None) -> None:
+        if framed:
+            guid, seq = request_id(s)
+            self._open(name, (guid, seq), f"{name.strip('/')} call {guid:016x}:{seq}", to_fields(s), stamp)
+            return
+        assert writer is not None
+        k = self._asked[writer] = self._asked.get(writer, 0) + 1
+        key, label = ("w", writer.hex(), k), f"{name.strip('/')} call {writer.hex()}#{k}"
+        self._open(name, key, label, to_fields(s), stamp)
+        self._pairer(name).request(Pending(key, stamp, label))
+
+    def _ordered_reply(self, name: str, s: Any, stamp: float, writer: bytes | None) -> None:
+        out = self._pairer(name).reply(stamp, writer)
+        if out.answers is not None:
+            self.book.answer(out.answers.key, "response", to_fields(s), stamp, True, name)
+        elif out.orphan:
+            self.book.answer(("w", "", 0), "response", to_fields(s), stamp, True, name)
+        for p in out.undecided:
+            self.book.unpaired(p.key, stamp, out.reason)
+
+    def _pairer(self, name: str) -> OrderPairer:
+        p = self._pairers.get(name)
+        if p is None:
+            p = self._pairers[name] = OrderPairer(name)
+        return p
+
+    def _side(self, name: str, stamp: float) -> str | None:
+        """Which side's introspection events pair the calls of service ``name``
+        (:func:`event_side`) at the sample stamped ``stamp``.  When that changes
+        (an event writer discovered after calls began, or gone), the calls the
+        other source opened can no longer be answered by it: they are unpaired."""
+        ev, rep, req = (self.taps.get(f"call:{name}:{p}") for p in ("event", "reply", "request"))
+        side = None if ev is None or rep is None or req is None else \
+            event_side(ev.heard, rep.heard, req.heard, self._node_of)
+        if self._sides.setdefault(name, side) == side:
+            return side
+        was, self._sides[name] = self._sides[name], side
+        why = (f"{name}'s introspection events {'began' if was is None else 'changed or stopped'} while this call "
+               "was open: its answer may come through the other source, and the two cannot be matched")
+        keys = [k for k, c in self.book.calls.items() if c.name == name.strip("/") and k and k[0] in ("ev", "w")]
+        for k in keys:
+            self.book.unpaired(k, stamp, why)
+        self._pairers.pop(name, None)
+        return side
+
+    def _event(self, name: str, s: Any, stamp: float, now: float) -> None:
+        side = self._side(name, stamp)
+        if side is None:
+            return
+        asked, told = SIDES[side]
+        gid, seq = event_key(s)
+        key = ("ev", gid, seq)
+        kind = int(s.info.event_type)
+        if kind == asked:
+            if not s.request:
+                self.counts["no_contents"] += 1
+                return  # introspection without CONTENTS: nothing to judge (docs/ros2.md)
+            self._open(name, key, f"{name.strip('/')} call {gid}:{seq}", to_fields(s.request[0]), stamp)
+        elif kind == told and s.response:
+            self._answer(key, "response", to_fields(s.response[0]), stamp, True, name, now)
+
+    # -- actions -------------------------------------------------------------------------------
+    def _action(self, name: str, part: str, s: Any, stamp: float, now: float, framed: bool,
+                writer: bytes | None) -> None:
+        if part == "goal_request":
+            gid = bytes(s.goal_id.uuid).hex()
+            self._ask(name, "send_goal", s, gid, stamp, framed)
+            self._open(name, (gid,), f"{name.strip('/')} goal {gid}", to_fields(s.goal), stamp, "goal")
+        elif part == "result_request":
+            self._ask(name, "get_result", s, bytes(s.goal_id.uuid).hex(), stamp, framed)
+        elif part == "goal_reply":
+            self._goal_reply(name, s, stamp, framed, writer)
+        elif part == "result_reply":
+            gid, undecided, why = self._told(name, "get_result", s, stamp, framed, writer)
+            for g in undecided:
+                self.book.unpaired((g,), stamp, f"its result cannot be told apart: {why}", "result")
+            if gid:
+                self._answer((gid,), "result", to_fields(s.result), stamp, True, name, now)
+                self._note_status(name, gid, int(s.status), stamp)
+        elif part == "feedback":
+            self._answer((bytes(s.goal_id.uuid).hex(),), "feedback", to_fields(s.feedback), stamp, False, name, now)
+        elif part == "status":
+            for st in s.status_list:
+                self._note_status(name, bytes(st.goal_info.goal_id.uuid).hex(), int(st.status), stamp)
+        elif part == "cancel_request":  # a zero goal id (and stamp) asks to cancel every goal (before it)
+            self.book.note({"link": name.strip("/"), "part": "cancel", "time": stamp,
+                            "key": [bytes(s.goal_info.goal_id.uuid).hex()]})
+        elif part == "cancel_reply":  # the goals the server accepted to cancel: their ids, no pairing needed
+            self.book.note({"link": name.strip("/"), "part": "canceling", "time": stamp, "return_code":
+                            int(s.return_code), "key": [bytes(g.goal_id.uuid).hex() for g in s.goals_canceling]})
+
+    def _ask(self, name: str, svc: str, s: Any, gid: str, stamp: float, framed: bool) -> None:
+        """A send-goal or get-result request about goal ``gid``: remember which goal its reply is about."""
+        if framed:
+            self._goal_of[request_id(s)] = gid
+            while len(self._goal_of) > 10_000:
+                self._goal_of.pop(next(iter(self._goal_of)))
+        else:
+            self._pairer(f"{name}/_action/{svc}").request(Pending((gid,), stamp, f"goal {gid}"))
+
+    def _told(self, name: str, svc: str, s: Any, stamp: float, framed: bool,
+              writer: bytes | None) -> tuple[str, list[str], str]:
+        """The goal a send-goal or get-result reply is about (``""``: unknown), the
+        goals it leaves undecided and why."""
+        if framed:
+            return self._goal_of.pop(request_id(s), ""), [], ""
+        pairer = self._pairer(f"{name}/_action/{svc}")
+        out = pairer.reply(stamp, writer)
+        return (str(out.answers.key[0]) if out.answers else "", [str(p.key[0]) for p in out.undecided],
+                out.reason)
+
+    def _goal_reply(self, name: str, s: Any, stamp: float, framed: bool, writer: bytes | None) -> None:
+        pool = [str(p.key[0]) for p in self._pairers[f"{name}/_action/send_goal"].pool] \
+            if f"{name}/_action/send_goal" in self._pairers else []
+        gid, undecided, why = self._told(name, "send_goal", s, stamp, framed, writer)
+        if s.accepted:
+            return
+        if gid:
+            self.book.reject((gid,), stamp)
+            return
+        for g in dict.fromkeys(undecided + pool):  # one of them was refused: none can be judged
+            self.book.unpaired((g,), stamp, f"a goal was refused and which one cannot be told: "
+                               f"{why or 'its request is one of several unanswered'}", "result")
+
+    # -- the book --------------------------------------------------------------------------------
+    def _open(self, name: str, key: tuple[Any, ...], label: str, fields: dict[str, Any], stamp: float,
+              part: str = "request") -> None:
+        self.book.open(name, key, label, fields, stamp, part)
+        for apart, afields, astamp, final, _t, aname in self._early.pop(key, ()):
+            self.book.answer(key, apart, afields, astamp, final, aname)
+
+    def _answer(self, key: tuple[Any, ...], part: str, fields: dict[str, Any], stamp: float, final: bool,
+                name: str, now: float) -> None:
+        if key in self.book.calls:
+            self.book.answer(key, part, fields, stamp, final, name)
+        else:
+            self._early.setdefault(key, []).append((part, fields, stamp, final, now, name))
+
+    def _note_status(self, name: str, gid: str, status: int, stamp: float) -> None:
+        if self._status.get(gid) == status:
+            return
+        self._status[gid] = status
+        while len(self._status) > 10_000:
+            self._status.pop(next(iter(self._status)))
+        self.book.note({"link": name.strip("/"), "part": "status", "time": stamp, "key": [gid],
+                        "status": GOAL_STATUS.get(status, str(status))})
+
+
+__all__ = ["CallTaps", "EARLY_S", "GOAL_STATUS", "LATE_S", "SETTLE_S"]

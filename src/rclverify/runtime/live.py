@@ -1,0 +1,451 @@
+"""A live monitoring run, independent of the middleware.
+
+:class:`LiveRun` is what ``rclverify monitor --live`` runs around the
+:class:`~.online.OnlineEngine`; the ROS 1 runner (:func:`run_ros1`) and the
+ROS 2 layer (:mod:`.ros2`) only move messages in and verdicts out.  It
+
+* writes every released message and every verdict as JSON lines in
+  ROSMonitoring's log format (``topic``, ``time``, the fields flattened;
+  verdicts on the topic :data:`VERDICT_LOG_TOPIC`, which no contract names,
+  so ``rclverify monitor LOG`` re-checks the messages and skips them);
+* hands each verdict, as JSON text, to ``publish`` (node, guarantee,
+  verdict, time, the first violation's values ...), and each node's latest
+  verdict to ``publish_last`` (a latched topic) at every timer tick where
+  it changed;
+* keeps a one-line status per node (:meth:`status_line`);
+* runs each node's timed guarantees (``triggered by ... within ...``)
+  and periodic outputs through the offline check's monitors, fed the very
+  lines it writes to the log (:mod:`.logchecks`); each deadline verdict is
+  a log line (topic :data:`VERDICT_LOG_TOPIC`, ``kind: "deadline"``,
+  ``time`` the clock that decided it) and is published (``{"kind":
+  "deadline", ...}``);
+* counts what it heard of every item of the contracts (:mod:`.judged`);
+* on :meth:`stop` writes a monitoring evidence record shaped like the
+  offline one (events, verdict counts, first violation, the log's sha256,
+  the deadlines as ``topic_deadlines``, the periods as ``periods``).
+
+docs/monitors.md ("Live monitoring") gives the decisions.
+"""
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+import threading
+import time as _time
+from datetime import datetime, timezone
+from pathlib import Path
+from typing import IO, Any, Callable, Iterable, Mapping
+
+from rclverify.records.store import atomic_write_text
+from rclverify.lang.types import Checked, CheckedNode
+from rclverify.traces.events import Event
+from rclverify.traces.mapping import TopicRule
+from rclverify.backends.monitors.summary import monitoring_details, summary_line, tool_versions, verdict_status
+from rclverify.backends.monitors.check import NodeResult, Verdict
+from rclverify.backends.monitors.deadlines import DeadlineVerdict
+from rclverify.backends.monitors.judged import Heard, count_call_line, explain, not_judged
+from rclverify.runtime.logchecks import LogChecks
+from rclverify.backends.monitors.online import OnlineEngine
+from rclverify.runtime.worker import EngineWorker
+
+VERDICT_LOG_TOPIC = "rclverify/verdict"
+
+
+def _json_safe(v: Any) -> Any:
+    if isinstance(v, float) and not math.isfinite(v):
+        return repr(v)  # JSON has no NaN; the reader would refuse the line
+    if isinstance(v, dict):
+        return {str(k): _json_safe(x) for k, x in v.items()}
+    if isinstance(v, (list, tuple)):
+        return [_json_safe(x) for x in v]
+    return v
+
+
+def dumps(obj: Any) -> str:
+    """Compact JSON; a NaN or an infinity (no JSON number) is written as its
+    string (``"nan"``), so every line stays readable by the log reader."""
+    try:
+        return json.dumps(obj, allow_nan=False, separators=(", ", ": "))
+    except ValueError:
+        return json.dumps(_json_safe(obj), separators=(", ", ": "))
+
+
+class LiveRun:
+    """One live run: engine, log, verdict sinks, status and evidence.
+
+    ``log`` is the JSON-lines file to write (created, truncated);
+    ``publish(text)`` / ``publish_last(node, text)`` the verdict sinks (JSON text);
+    ``horizon``, ``reorder_window`` and ``silence_s`` in seconds.  Thread
+    safe: :meth:`push` and :meth:`tick` may come from different threads.
+    """
+
+    def __init__(self, checked: Checked, nodes: Iterable[CheckedNode], rules: Mapping[str, TopicRule],
+                 horizon: float, log: Path, *, reorder_window: float = 0.05, silence_s: float = 0.0,
+                 publish: Callable[[str], None] | None = None,
+                 publish_last: Callable[[str, str], None] | None = None) -> None:
+        self.log_path = log
+        log.parent.mkdir(parents=True, exist_ok=True)
+        self._log: IO[str] = log.open("w", encoding="utf-8")
+        self.publish, self.publish_last = publish, publish_last
+        self.lock = threading.Lock()
+        self.started = datetime.now(timezone.utc).isoformat(timespec="seconds")
+        self.silences: list[dict[str, Any]] = []
+        self.verdicts = 0
+        nodes = list(nodes)
+        self.nodes = nodes
+        self.engine = OnlineEngine(checked, nodes, rules, horizon, reorder_window, silence_s,
+                                   on_verdict=self._verdict, on_silence=self._silence, on_event=self._event)
+        #: the offline check's deadline and period monitors, fed the log's lines (logchecks.py)
+        self.checks = LogChecks(checked, nodes, rules, horizon, self._deadline)
+        #: link part ("estop/request") -> its call events heard (paired), and answers heard without their call
+        self.calls_heard: dict[str, int] = {}
+        self.orphans: dict[str, int] = {}
+        self.results: list[NodeResult] | None = None
+        self._last: dict[str, str] = {}  # node -> latest verdict not yet published as its last verdict
+
+    # -- engine callbacks (called under the lock) ----------------------------------
+    def _event(self, ev: Event) -> None:
+        self._log.write(dumps({"topic": ev.topic, "time": ev.time, **{k: v for k, v in ev.fields.items()
+                                                                       if k not in ("topic", "time")}}) + "\n")
+        self.checks.event(ev)  # after its log line: a verdict it decides comes after it, as offline
+
+    def _deadline(self, v: DeadlineVerdict, t: float) -> None:
+        line = {"topic": VERDICT_LOG_TOPIC, "time": t, "kind": "deadline", "verdict": v.to_json()}
+        self._log.write(dumps(line) + "\n")
+        self.checks.line(line, deadline=True)
+        if self.publish is not None:
+            self.publish(dumps({"kind": "deadline", **v.to_json()}))
+
+    def _verdict(self, v: Verdict) -> None:
+        self.verdicts += 1
+        text = dumps(v.to_json())  # serialised once: the log line and the published message
+        self._log.write(f'{{"topic": "{VERDICT_LOG_TOPIC}", "time": {v.decided_at!r}, "verdict": {text}}}\n')
+        if self.checks.active:
+            self.checks.line({"topic": VERDICT_LOG_TOPIC, "time": v.decided_at})
+        if self.publish is not None:
+            self.publish(text)
+        self._last[v.node] = text
+
+    def _silence(self, topic: str, seconds: float, silent: bool) -> None:
+        note = {"topic": topic, "silent": silent, "for_s": round(seconds, 3),
+                "time": self.engine.monitors[0].now if self.engine.monitors else 0.0}
+        if silent:
+            self.silences.append(note)
+        if self.publish is not None:
+            self.publish(dumps({"node": "", "verdict": "silent" if silent else "resumed", "topic": topic,
+                                "silent_for_s": round(seconds, 3), "time": note["time"]}))
+
+    # -- input ---------------------------------------------------------------------
+    def push(self, topic: str, fields: Mapping[str, Any], received: float) -> None:
+        """One message from the middleware (receipt time in seconds)."""
+        with self.lock:
+            if self.results is None:
+                self.engine.push(topic, fields, received)
+
+    def tick(self, now: float) -> None:
+        """The timer (see :meth:`OnlineEngine.tick`)."""
+        with self.lock:
+            if self.results is None:
+                self.engine.tick(now)
+                self.checks.advance(now - self.engine.reorder_window)  # the monitors' clock, as the engine's
+                self._flush_last()
+                self._log.flush()
+
+    def note(self, obj: Mapping[str, Any]) -> None:
+        """One more line of the log (the service proxy's events and deadline
+        verdicts, :mod:`.service_proxy`); dropped once the run stopped."""
+        with self.lock:
+            if self.results is None:
+                self._log.write(dumps(dict(obj)) + "\n")
+                self.checks.line(obj)
+                self._heard_call(obj)
+
+    def _heard_call(self, obj: Mapping[str, Any]) -> None:
+        """Count a call event of the log (the ROS 1 proxy's ``kind: "event"``
+        lines, the DDS call book's ``kind: "call"`` ones) for :mod:`.judged`."""
+        if obj.get("kind") == "event" and isinstance(obj.get("topic"), str):
+            key = str(obj["topic"]).strip("/")
+            self.calls_heard[key] = self.calls_heard.get(key, 0) + 1
+        else:
+            count_call_line(obj, self.calls_heard, self.orphans)
+
+    def _flush_last(self) -> None:
+        """Publish each node's latest verdict (latched), once per timer tick
+        rather than at every event: the topic holds the last one either way."""
+        if self.publish_last is not None:
+            for node, text in self._last.items():
+                self.publish_last(node, text)
+        self._last.clear()
+
+    def status_line(self) -> str:
+        """``Node: 3 satisfied, 1 violated; 4 answer(s) counted, 95 % bound 0.75 per answer | Node2: ...``
+        (a live per-node status: the counts so far, docs/statistics.md)."""
+        with self.lock:
+            parts = [summary_line(m.result) + running_bound(m.result) for m in self.engine.monitors]
+            parts += self.checks.status()
+        silent = [t for t, s in self.engine.topics.items() if s.silent]
+        return " | ".join(parts) + (f" | silent: {', '.join(sorted(silent))}" if silent else "")
+
+    # -- stop ------------------------------------------------------------------------
+    def stop(self, evidence: Path | None = None) -> dict[str, Any]:
+        """Finish the run (obligations still within their horizon are ``open``),
+        close the log and write the evidence record (atomically) when
+        ``evidence`` is given; returns the record."""
+        with self.lock:
+            if self.results is None:
+                self.results = self.engine.finish()
+                self.checks.finish()  # currently_false deadlines: logged
+                self._flush_last()
+                self._log.close()
+        sha = hashlib.sha256(self.log_path.read_bytes()).hexdigest()
+        versions = tool_versions()
+        horizon = self.engine.horizon
+        nodes = []
+        observed = (datetime.now(timezone.utc) - datetime.fromisoformat(self.started)).total_seconds()
+        for res in self.results:
+            status, explanation = verdict_status(res, self.log_path.name)
+            nodes.append({"node": res.node, "status": status, "explanation": explanation,
+                          **monitoring_details(res, self.log_path.name, self.engine.released, sha, versions,
+                                               horizon), "statistics": live_counts(res, sha, observed)})
+        record = {"kind": "monitoring", "mode": "live", "log": self.log_path.name, "sha256": sha,
+                  "started": self.started,
+                  "stopped": datetime.now(timezone.utc).isoformat(timespec="seconds"),
+                  "events": self.engine.released, "late_events": self.engine.late,
+                  "max_late_s": round(self.engine.max_late_s, 6),
+                  "reorder_window_s": self.engine.reorder_window, "verdicts": self.verdicts,
+                  "silent_topics": self.silences, "nodes": nodes, **self.checks.record(self.log_path.name)}
+        if evidence is not None:
+            atomic_write_text(evidence, json.dumps(record, indent=2, sort_keys=True) + "\n")
+        return record
+
+    def not_judged(self, record: Mapping[str, Any]) -> list[dict[str, str]]:
+        """The items of the monitored contracts this run did not judge
+        (:func:`~.judged.not_judged`), from what it heard and the finished
+        ``record`` (its ``nodes``, ``calls``, ``deadlines``,
+        ``topic_deadlines``, ``decode_errors``, ``warnings``, ``qos``); each
+        ``pending`` node of ``record["nodes"]`` gets the reason added to its
+        explanation."""
+        heard = Heard({**{t: s.received for t, s in self.engine.topics.items()}, **self.calls_heard},
+                      dict(self.orphans), dict(record.get("decode_errors") or {}), list(record.get("warnings") or ()),
+                      {k: int(v.get("publishers_heard", 0)) for k, v in record["qos"].items()}
+                      if isinstance(record.get("qos"), dict) else None)
+        statuses: dict[str, list[tuple[str, str]]] = {}
+        for n in [*record["nodes"], *record.get("calls", {}).get("nodes", [])]:
+            statuses.setdefault(n["node"], []).append((n["status"], n["explanation"]))
+        counts: dict[str, dict[str, int]] = {}
+        results = [e["deadlines"] for e in record.get("topic_deadlines", [])]
+        for r in results + list(record.get("deadlines", {}).get("results", [])):
+            total = counts.setdefault(r["node"], {})
+            for v, k in r["counts"].items():
+                total[v] = total.get(v, 0) + k
+        items = not_judged(self.nodes, heard, statuses, counts, "during the live run")
+        for entry in record["nodes"]:  # a pending node says why itself
+            explain(entry, items)
+        return items
+
+
+def running_bound(res: NodeResult) -> str:
+    """``; 40 answer(s) counted, 95 % bound 0.0722 per answer``: the one-sided
+    Clopper-Pearson bound on the probability that an answer violates the
+    contract, from the counts so far (undecided answers count as
+    violations; docs/statistics.md); ``""`` before the first answer."""
+    c = res.counts
+    n = c.get("satisfied", 0) + c.get("violated", 0) + c.get("inconclusive", 0)
+    if not n:
+        return ""
+    from rclverify.records.statistics import upper_bound
+    return f"; {n} answer(s) counted, 95 % bound {upper_bound(n - c.get('satisfied', 0), n, 0.95):.3g} per answer"
+
+
+def live_counts(res: NodeResult, sha: str, seconds: float) -> dict[str, Any]:
+    """What a live run counted of one node, as a run's evidence counts it
+    (:func:`.runset.run_counts`): the log's content sha256 (its identity: the
+    same log named twice in a plan is one run), judged answers, violations,
+    undecided answers (inconclusive and still open) and the wall-clock seconds
+    observed; ``recorded`` is ``live``."""
+    c = res.counts
+    return {"recorded": "live", "sha256": sha, "answers": c.get("satisfied", 0) + c.get("violated", 0),
+            "violations": c.get("violated", 0), "inconclusive": c.get("inconclusive", 0) + c.get("open", 0),
+            "seconds": round(seconds, 3)}
+
+
+def _no_delay(pub: Any) -> None:
+    """Turn Nagle's algorithm off on the verdict publisher's subscriber
+    connections (TCP_NODELAY), whether or not the subscriber asked for it:
+    with it on, a verdict written while the previous one is not yet
+    acknowledged waits for the subscriber's delayed ACK, up to 40 ms on
+    Linux (docs/monitors.md, "Live monitoring", "Threads").  Reaches rospy's publisher
+    connections (``impl.connections``, each with its ``socket``); a rospy
+    without them is left as it is."""
+    import socket
+    for c in list(getattr(getattr(pub, "impl", None), "connections", None) or ()):
+        sock = getattr(c, "socket", None)
+        if sock is not None:  # idempotent, one system call per connection every 0.1 s
+            try:
+                sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+            except (OSError, AttributeError):
+                pass
+
+
+def run_ros1(run_factory: Callable[..., LiveRun], checked: Checked, nodes: list[CheckedNode],
+             msg_dirs: list[Path], *, verdict_topic: str, last_prefix: str, node_name: str,
+             duration: float | None, tick_s: float, status_s: float, evidence: Path | None,
+             stop: threading.Event, out: Callable[[str], None],
+             proxy: Callable[[Any, LiveRun, Callable[[str], None]], Any] | None = None) -> dict[str, Any]:
+    """Run live monitoring on a ROS 1 master (``ROS_MASTER_URI``) until ``stop``
+    is set or ``duration`` seconds passed; returns the evidence record.
+
+    Subscribes with ``rospy.AnyMsg`` to every topic the contracts name and
+    decodes each message with the class of its connection's type
+    (:func:`~.ros1.message_class`); publishes every verdict as
+    ``std_msgs/String`` JSON on ``verdict_topic`` and each node's latest on
+    ``<last_prefix>/<node>/last_verdict`` (latched).  Raises
+    :class:`~.ros1.RosUnavailable` when rospy or a message class is missing.
+
+    ``proxy(rospy, live, publish)``, when given, starts the service proxy
+    and action subscriptions in this process (:mod:`.service_proxy`,
+    ``--forward``/``--interfaces``) and returns its run (``tick(now)``,
+    ``close()``): its events and deadline verdicts go to the same log and
+    verdict topic, its summary to the record's ``deadlines``.
+    """
+    from rclverify.ros.live.master_rpc import MASTER_TIMEOUT_S
+    from rclverify.runtime.ros1 import (REGISTER_TIMEOUT_S, SHUTDOWN_TIMEOUT_S, RosUnavailable, bound_master_calls, check_master,
+                       contract_topics, finish_within, flatten, import_rospy, message_class, run_bounded)
+    rospy = import_rospy()
+    from std_msgs.msg import String
+    topics = contract_topics(checked, nodes)
+    classes = {t: message_class(typ, msg_dirs) for t, typ in topics.items()}  # fail early, located
+    by_type = {c._type: c for c in classes.values()}  # type: ignore[attr-defined]
+    import rosgraph
+    uri = rosgraph.get_master_uri()
+    # every call to the master is bounded and the registration waits in short
+    # steps, so a master that hangs neither holds the monitor nor makes it deaf
+    # to SIGTERM/SIGINT (ros1.py, "A master is an external peer")
+    bound_master_calls(rospy, uri, MASTER_TIMEOUT_S)
+    until = _time.monotonic() + REGISTER_TIMEOUT_S
+
+    def register_node() -> tuple[Any, dict[str, Any]]:
+        check_master(uri, "/" + node_name, MASTER_TIMEOUT_S)
+        rospy.init_node(node_name, anonymous=False, disable_signals=True)
+        # synchronous: the engine thread writes each verdict to the subscribers'
+        # sockets itself; rospy's queued publisher hands every message to a writer
+        # thread and then yields the GIL (time.sleep(0)), which cost the engine
+        # thread a GIL hand-over per verdict (docs/monitors.md, "Live monitoring", "Threads")
+        import warnings
+        with warnings.catch_warnings():  # rospy warns about queue_size=None; here it is the choice made above
+            warnings.simplefilter("ignore", SyntaxWarning)
+            pub = rospy.Publisher(verdict_topic, String, queue_size=None)
+        return pub, {n.name: rospy.Publisher(f"{last_prefix}/{n.name}/last_verdict", String, queue_size=1,
+                                             latch=True) for n in nodes}
+
+    try:
+        pub, lasts = run_bounded(stop, REGISTER_TIMEOUT_S, f"registering with the master at {uri}", register_node)
+    except RosUnavailable:
+        finish_within(lambda: rospy.signal_shutdown("monitor not started"), SHUTDOWN_TIMEOUT_S)
+        raise
+    live = run_factory(publish=lambda text: pub.publish(String(text)),
+                       publish_last=lambda n, text: lasts[n].publish(String(text)))
+    decode_errors: dict[str, int] = {}
+
+    def decode(topic: str, raw: Any) -> Mapping[str, Any] | None:
+        typ = raw._connection_header.get("type", "") if getattr(raw, "_connection_header", None) else ""
+        cls = by_type.get(typ, classes[topic])
+        try:
+            msg = cls().deserialize(raw._buff)
+        except Exception:  # a publisher of another type on a contract topic: counted, never a crash
+            decode_errors[topic] = decode_errors.get(topic, 0) + 1
+            return None
+        return flatten(msg)  # type: ignore[no-any-return]
+
+    # the callbacks only stamp and queue; one worker thread decodes, checks,
+    # publishes and runs the timer (worker.py: why)
+    worker = EngineWorker(live, decode, rospy.get_time, tick_s=tick_s).start()
+    subs: list[Any] = []
+
+    def register_topics() -> Any:
+        calls = proxy(rospy, live, lambda text: pub.publish(String(text))) if proxy is not None else None
+        for t in topics:
+            subs.append(rospy.Subscriber(t, rospy.AnyMsg, lambda raw, t=t: worker.offer(t, raw, rospy.get_time()),
+                                         queue_size=10000, tcp_nodelay=True))
+        return calls
+
+    def unsubscribe() -> None:
+        for s in list(subs):
+            s.unregister()
+
+    try:
+        calls = run_bounded(stop, max(until - _time.monotonic(), 0.1),
+                            f"subscribing at the master at {uri}", register_topics)
+    except RosUnavailable:
+        finish_within(unsubscribe, SHUTDOWN_TIMEOUT_S)
+        stop_and_record(worker, live, None, lambda _line: None)
+        finish_within(lambda: rospy.signal_shutdown("monitor not started"), SHUTDOWN_TIMEOUT_S)
+        raise
+    out(f"monitoring {len(topics)} topic(s) for {len(nodes)} node(s); verdicts on {verdict_topic}")
+    t0 = _time.monotonic()
+    next_status = t0 + status_s
+    try:
+        while not stop.is_set() and not rospy.is_shutdown():
+            if duration is not None and _time.monotonic() - t0 >= duration:
+                break
+            stop.wait(min(0.1, tick_s * 5))
+            if calls is not None:
+                calls.tick(rospy.get_time())  # an unanswered call is false once its deadline expired
+            if worker.error is not None:
+                break  # the engine thread died: stop and say so, never monitor on silently
+            _no_delay(pub)
+            if status_s > 0 and _time.monotonic() >= next_status:
+                out(live.status_line())
+                next_status += status_s
+    finally:
+        # unregistering asks the master: bounded, so a master that hangs now cannot hold the exit
+        if not finish_within(unsubscribe, SHUTDOWN_TIMEOUT_S):
+            out(f"rclverify monitor --live: warning: the master at {uri} did not confirm the unsubscriptions "
+                f"within {SHUTDOWN_TIMEOUT_S:g} s")
+        deadlines = calls.close() if calls is not None else None  # before the log closes
+        record = stop_and_record(worker, live, evidence, out)
+        if deadlines is not None:
+            record["deadlines"] = {"results": deadlines["results"], "false": deadlines["false"]}
+        record["decode_errors"] = decode_errors
+        record["not_judged"] = live.not_judged(record)  # silence is never green (judged.py)
+        if evidence is not None:
+            atomic_write_text(evidence, json.dumps(record, indent=2, sort_keys=True) + "\n")
+        out(live.status_line())
+        finish_within(lambda: rospy.signal_shutdown("monitor stopped"), SHUTDOWN_TIMEOUT_S)
+    return record
+
+
+def stop_and_record(worker: EngineWorker, live: LiveRun, evidence: Any, out: Callable[[str], None]) -> dict[str, Any]:
+    """Stop ``worker`` (it checks what is still queued), then ``live``, and
+    return the monitoring evidence record with the worker's figures: the
+    longest queue, the messages dropped and the engine's CPU per message
+    (µs).  Verdicts that miss dropped messages prove nothing, so a node that
+    would be discharged or pending is ``inconclusive``; an engine that died
+    makes every node ``error``.  Shared by the ROS 1 and ROS 2 layers; the
+    caller writes the record."""
+    engine_error = ""
+    try:
+        worker.stop()
+    except Exception as exc:  # noqa: BLE001 - a bug in the engine: reported in the evidence, the log kept
+        engine_error = f"{type(exc).__name__}: {exc}"
+        out(f"rclverify monitor --live: error: the verdict engine stopped: {engine_error}")
+    record = live.stop(evidence)
+    if engine_error:
+        record["engine_error"] = engine_error
+        for n in record["nodes"]:
+            n["status"] = "error"
+            n["explanation"] = f"the verdict engine stopped during the run ({engine_error}); verdicts are partial"
+    record["backlog_max"] = worker.backlog_max
+    record["dropped_messages"] = worker.dropped
+    if worker.dropped:
+        for n in record["nodes"]:
+            if n["status"] in ("discharged", "pending"):
+                n["status"] = "inconclusive"
+                n["explanation"] = (f"{worker.dropped} message(s) were dropped because the monitor fell "
+                                    f"{worker.max_queue} messages behind; the verdicts do not cover them")
+    record["engine_cpu_us_per_message"] = round(worker.cpu_s / max(worker.handled, 1) * 1e6, 1)
+    return record
+
+
+__all__ = ["LiveRun", "VERDICT_LOG_TOPIC", "run_ros1", "stop_and_record"]

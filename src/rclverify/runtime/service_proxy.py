@@ -1,0 +1,260 @@
+"""The live ROS 1 monitor of services and actions (issue 33).
+
+``python3 -m rclverify.runtime.service_proxy --contracts FILE ...
+--forward /estop=/estop_real --log run.jsonl`` starts a rospy node that
+
+* serves each service a monitored contract links with ``serves(...)``
+  under its own name (``/estop``) and forwards every call to the real
+  server (``--forward /estop=/estop_real``): the proxy sees the request and
+  the response, stamps them with its ROS clock when it receives the request
+  and when the server's answer comes back (ROSMonitoring 2.0's scheme), and
+  feeds them to the deadline monitors as ``estop/request`` and
+  ``estop/response`` events;
+* subscribes to each linked action's actionlib topics ``<a>/goal``,
+  ``<a>/feedback`` and ``<a>/result``, whose header stamps are the clock;
+* advances the monitors' clock every ``--tick`` seconds
+  (``rospy.Time.now()``: wall time, or ``/clock`` under ``use_sim_time``),
+  so an unanswered call is ``false`` as soon as its deadline expires.
+
+Every event and verdict is one JSON line of ``--log`` (``{"kind": "event"|
+"verdict"|"summary", ...}``); on SIGINT/SIGTERM or after ``--duration``
+seconds the obligations still within their deadline are ``currently_false``,
+a ``summary`` line closes the log and the exit code is 1 when a verdict was
+``false``, else 0 (2 for a usage error, with one line on standard error).
+Classes come from the workspace's ``.srv``/``.action`` files
+(:mod:`.ros1_interfaces`).
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import signal
+import sys
+import tempfile
+import threading
+import time
+from pathlib import Path
+from typing import Any, Callable, Mapping, Sequence
+
+from rclverify.lang.errors import RclError
+from rclverify.lang.typecheck import load
+from rclverify.traces.events import Event
+from rclverify.backends.monitors.deadlines import DeadlineMonitor, DeadlineVerdict
+from rclverify.runtime.ros1 import RosUnavailable, flatten, import_rospy
+from rclverify.runtime.ros1_interfaces import action_classes, service_class
+
+
+class ProxyRun:
+    """The monitors and the log of one live run (thread-safe).
+
+    ``log``: the JSON-lines file to write (this module's own command); or
+    ``write(obj)``, a sink for each line's object (``rclverify monitor
+    --live``: the live monitor's log) and ``publish(text)`` for each
+    deadline verdict as JSON text (its verdict topic); ``forward(topic,
+    fields, stamp)`` receives every observed message too (``rclverify
+    monitor --live``: the live engine, whose node monitors then check each
+    call's response against the server's guarantees and the client's
+    assumption, issue 40)."""
+
+    def __init__(self, monitors: list[DeadlineMonitor], log: Path | None = None, *,
+                 write: Callable[[dict[str, Any]], None] | None = None,
+                 publish: Callable[[str], None] | None = None,
+                 forward: Callable[[str, dict[str, Any], float], None] | None = None) -> None:
+        self.monitors, self.lock, self.index, self.false = monitors, threading.Lock(), 0, 0
+        for m in monitors:
+            m.on_verdict = self._verdict
+        self.fh = log.open("w", encoding="utf-8") if log is not None else None
+        self.sink, self.publish, self.forward = write, publish, forward
+
+    def _write(self, obj: dict[str, Any]) -> None:
+        if self.sink is not None:
+            self.sink(obj)
+        if self.fh is not None:
+            self.fh.write(json.dumps(obj, sort_keys=True) + "\n")
+            self.fh.flush()
+
+    def _verdict(self, v: DeadlineVerdict) -> None:
+        self.false += v.verdict == "false" and not v.update
+        self._write({"kind": "verdict", **v.to_json()})
+        if self.publish is not None:
+            self.publish(json.dumps({"kind": "deadline", **v.to_json()}, sort_keys=True))
+
+    def event(self, topic: str, fields: dict[str, Any], stamp: float) -> None:
+        """One observed message; ``stamp`` (s) is set as its header stamp when it has none."""
+        if "header" not in fields:
+            secs = int(stamp)
+            fields = {**fields, "header": {"stamp": {"secs": secs, "nsecs": int(round((stamp - secs) * 1e9))}}}
+        with self.lock:
+            ev = Event(self.index, stamp, topic, fields, f"live:{self.index + 1}")
+            self.index += 1
+            self._write({"kind": "event", "index": ev.index, "topic": topic, "time": stamp, "fields": fields})
+            for m in self.monitors:
+                m.feed(ev)
+            if self.forward is not None:
+                self.forward(topic, fields, stamp)
+
+    def tick(self, now: float) -> None:
+        with self.lock:
+            for m in self.monitors:
+                m.advance(now)
+
+    def close(self) -> dict[str, Any]:
+        with self.lock:
+            results = [m.finish().to_json() for m in self.monitors]
+            summary = {"kind": "summary", "results": results, "false": self.false}
+            self._write(summary)
+            if self.fh is not None:
+                self.fh.close()
+        return summary
+
+
+def _parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(prog="python3 -m rclverify.runtime.service_proxy",
+                                description="monitor ROS 1 services (through a proxy) and actions live")
+    p.add_argument("--contracts", nargs="+", required=True, help="RCL files of the system")
+    p.add_argument("--interfaces", action="append", default=[], help="directory of <pkg>/srv and <pkg>/action files")
+    p.add_argument("--forward", action="append", default=[], metavar="SVC=REAL",
+                   help="serve SVC and forward each call to REAL (one per monitored service)")
+    p.add_argument("--log", default="services_live.jsonl", help="JSON-lines log of events and verdicts")
+    p.add_argument("--duration", type=float, default=0.0, help="stop after this many seconds (0: until SIGTERM)")
+    p.add_argument("--tick", type=float, default=0.05, help="seconds between clock advances")
+    return p
+
+
+class ProxyUsage(ValueError):
+    """A live run that cannot start as asked (a served service without ``--forward``)."""
+
+
+def deadline_nodes(checked: Any) -> list[Any]:
+    """The checked nodes with a guarantee that has a deadline: what the proxy monitors."""
+    return [n for n in checked.nodes.values() if any(c.deadline is not None for c in n.node.guarantees)]
+
+
+def start_proxy(rospy: Any, checked: Any, forwards: Mapping[str, str], dirs: Sequence[Path], run: ProxyRun,
+                now: Callable[[], float]) -> list[Any]:
+    """Serve each monitored service (``forwards``: ``/svc`` -> the real
+    server's name) and subscribe to each linked action's actionlib topics,
+    feeding ``run``; ``rospy.init_node`` must have run.  Returns the rospy
+    handles (keep them for the run).  Raises :class:`ProxyUsage` for a
+    served service without a forward and :class:`~.ros1.RosUnavailable` when
+    a class cannot be made from the interface files."""
+    nodes = deadline_nodes(checked)
+    services = {lk.name: lk for n in nodes for lk in n.node.links if lk.kind == "service" and lk.role == "serves"}
+    actions = {lk.name: lk for n in nodes for lk in n.node.links if lk.kind == "action"}
+    missing = [s for s in services if "/" + s.lstrip("/") not in forwards]
+    if missing:
+        raise ProxyUsage(f"say where {', '.join(missing)} is served: --forward /{missing[0].lstrip('/')}=/REAL")
+    svc_classes = {s: service_class(lk.ros_type, list(dirs)) for s, lk in services.items()}
+    gen = Path(tempfile.mkdtemp(prefix="rclverify-actions-"))
+    act_classes = {a: action_classes(lk.ros_type, list(dirs), gen) for a, lk in actions.items()}
+    keep: list[Any] = []
+    for name, cls in svc_classes.items():
+        real = forwards["/" + name.lstrip("/")]
+
+        rospy.wait_for_service(real, timeout=30)
+        # one persistent connection to the real server: a call's stamps do not include connecting anew
+        conn = {"proxy": rospy.ServiceProxy(real, cls, persistent=True)}
+
+        def handle(req: Any, name: str = name, cls: Any = cls, real: str = real, conn: dict[str, Any] = conn) -> Any:
+            run.event(f"{name}/request", flatten(req), now())
+            try:
+                resp = conn["proxy"](req)
+            except rospy.ServiceException:  # the server restarted: connect again once; a second failure reaches the caller
+                conn["proxy"] = rospy.ServiceProxy(real, cls, persistent=True)
+                resp = conn["proxy"](req)
+            run.event(f"{name}/response", flatten(resp), now())
+            return resp
+        keep.append(rospy.Service("/" + name.lstrip("/"), cls, handle))
+    for name, classes in act_classes.items():
+        for part, cls in classes.items():
+            topic = f"{name.lstrip('/')}/{part}"
+            keep.append(rospy.Subscriber("/" + topic, cls,
+                                         lambda msg, topic=topic: run.event(topic, flatten(msg), now())))
+    return keep
+
+
+def proxy_factory(checked: Any, nodes: Sequence[Any], forward: Sequence[str],
+                  dirs: Sequence[Path]) -> Callable[[Any, Any, Callable[[str], None]], ProxyRun] | None:
+    """The ``proxy`` argument of :func:`.live.run_ros1` for ``rclverify
+    monitor --live --forward SVC=REAL --interfaces DIR``: ``None`` when
+    neither option is given; else a function that starts the proxy for the
+    selected ``nodes`` with a deadline, writing to the live run's log
+    (``LiveRun.note``) and publishing each deadline verdict on its verdict
+    topic.  Raises :class:`ProxyUsage` for a malformed ``--forward``."""
+    if not forward and not dirs:
+        return None
+    forwards = parse_forwards(forward)
+    timed = {n.name for n in deadline_nodes(checked)}
+
+    def start(rospy: Any, live: Any, publish: Callable[[str], None]) -> ProxyRun:
+        rules = getattr(live.engine, "rules", {})  # the mapping's rules (and tolerance) of the live run
+        run = ProxyRun([DeadlineMonitor(checked, n, rules) for n in nodes if n.name in timed], write=live.note,
+                       publish=publish, forward=live.push)
+        run.handles = start_proxy(rospy, checked, forwards, dirs, run,  # type: ignore[attr-defined]
+                                  lambda: rospy.Time.now().to_sec())
+        return run
+    return start
+
+
+def parse_forwards(items: Sequence[str]) -> dict[str, str]:
+    """``["/estop=/estop_real"]`` -> ``{"/estop": "/estop_real"}``; raises
+    :class:`ProxyUsage` for an item without ``=``."""
+    out = {}
+    for f in items:
+        if "=" not in f:
+            raise ProxyUsage(f"--forward {f}: write SVC=REAL, e.g. --forward /estop=/estop_real")
+        a, b = f.split("=", 1)
+        out["/" + a.strip().lstrip("/")] = b.strip()
+    return out
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Run the proxy (module docstring); returns the exit code."""
+    args = _parser().parse_args(argv)
+    try:
+        checked = load(args.contracts)
+    except RclError as exc:
+        print(str(exc), file=sys.stderr)
+        return 2
+    dirs = [Path(d) for d in args.interfaces]
+    try:
+        forwards = parse_forwards(args.forward)
+        rospy = import_rospy()
+    except (ProxyUsage, RosUnavailable) as exc:
+        print(f"service_proxy: error: {exc}", file=sys.stderr)
+        return 2
+    from rclverify.ros.live.master_rpc import MASTER_TIMEOUT_S
+    from rclverify.runtime.ros1 import REGISTER_TIMEOUT_S, bound_master_calls, check_master, finish_within, run_bounded
+    import rosgraph
+    uri = rosgraph.get_master_uri()
+    stop = threading.Event()
+    for sig in (signal.SIGINT, signal.SIGTERM):
+        signal.signal(sig, lambda *_: stop.set())
+    run = ProxyRun([DeadlineMonitor(checked, n, {}) for n in deadline_nodes(checked)], Path(args.log))
+    now = lambda: rospy.Time.now().to_sec()  # noqa: E731  (the one clock of the proxy)
+    bound_master_calls(rospy, uri, MASTER_TIMEOUT_S)  # a master that hangs holds nothing (ros1.py)
+
+    def register() -> Any:
+        check_master(uri, "/rclverify_service_monitor", MASTER_TIMEOUT_S)
+        rospy.init_node("rclverify_service_monitor", anonymous=True, disable_signals=True)
+        return start_proxy(rospy, checked, forwards, dirs, run, now)
+
+    try:
+        keep = run_bounded(stop, REGISTER_TIMEOUT_S, f"registering with the master at {uri}", register)  # noqa: F841
+    except (ProxyUsage, RosUnavailable) as exc:
+        print(f"service_proxy: error: {exc}", file=sys.stderr)
+        run.close()
+        finish_within(lambda: rospy.signal_shutdown("usage"))
+        return 2
+    print("service_proxy: ready", flush=True)
+    end = time.monotonic() + args.duration if args.duration > 0 else float("inf")
+    while not stop.is_set() and time.monotonic() < end:
+        stop.wait(args.tick)
+        run.tick(now())
+    summary = run.close()
+    finish_within(lambda: rospy.signal_shutdown("done"))
+    return 1 if summary["false"] else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,138 @@
+"""Expressions of direct evaluation compiled once into nested closures
+(per AST node, I/O node and number semantics) that do what
+:meth:`rclverify.semantics.evaluator.Evaluator.interpret` does, node for node:
+the tree walk and the name resolution that does not depend on bound
+variables done once, membership, set and tuple literals and quantifiers
+handed back to the evaluator.
+
+Part of the direct evaluator (:mod:`rclverify.semantics.evaluate`, whose module
+docstring states the semantics).
+"""
+from __future__ import annotations
+
+from typing import Any, Callable, Mapping
+
+from rclverify.lang import ast
+from rclverify.lang.types import CheckedNode
+from rclverify.semantics.values import Term
+from rclverify.semantics.eval_values import _CMP, _LIT, Undecided, arithmetic
+
+
+#: Compiled expressions kept (per AST node and I/O node); cleared when full.
+COMPILED_SIZE = 10_000
+_Fn = Callable[[Any, Mapping[str, Any]], Any]  # (the evaluator, bound variables) -> value
+_COMPILED: dict[tuple[int, int, int], tuple[Any, Any, Any, _Fn]] = {}
+
+
+def _compile(e: Any, env: Any, node: CheckedNode, mode: str | None = None) -> _Fn:
+    """``e`` as a closure ``fn(evaluator, bound) -> value`` doing exactly what
+    :meth:`Evaluator.interpret` does for it (same order of evaluation, same
+    values, same exceptions), with the tree walk and the name resolution
+    that does not depend on the bound variables done once.  Membership,
+    set/tuple literals and quantifiers are handed to the evaluator.  With a
+    ``mode`` (an evaluator of other number semantics) literals, arithmetic
+    and comparisons call the evaluator's :meth:`~Evaluator.literal`,
+    :meth:`~Evaluator.arith` and :meth:`~Evaluator.compare`."""
+    if isinstance(e, ast.Var):
+        return _compile_var(e, env, node, mode)
+    if mode is not None:
+        if isinstance(e, ast.NumLit):
+            return lambda ev, b: ev.literal(e)
+        if isinstance(e, ast.Compare):
+            parts = tuple(_compile(o, env, node, mode) for o in e.operands)
+            ops = e.ops
+
+            def compare_in_mode(ev: Any, b: Mapping[str, Any]) -> Any:
+                vals = [o(ev, b) for o in parts]
+                return all(ev.compare(e, b, op, x, y) for op, x, y in zip(ops, vals, vals[1:]))
+            return compare_in_mode
+    if isinstance(e, ast.NumLit):
+        lit = _LIT.get(e.text)
+        if lit is None:
+            v = e.value
+            lit = _LIT[e.text] = int(v) if v.denominator == 1 else v
+        value = lit
+        return lambda ev, b: value
+    if isinstance(e, ast.BoolLit):
+        truth = e.value
+        return lambda ev, b: truth
+    if isinstance(e, ast.Apply):
+        args = tuple(_compile(a, env, node, mode) for a in e.args)
+        func = e.func
+        fname, qualified = func.name, func.qualified
+        ctor = func.prefix is None and fname in env.ctors
+        fvar = _compile_var(func, env, node, mode)
+
+        def apply(ev: Any, b: Mapping[str, Any]) -> Any:
+            vals = tuple([a(ev, b) for a in args])
+            if ctor and fname not in b:
+                return Term(fname, vals)
+            f = fvar(ev, b)
+            if not callable(f):
+                raise Undecided(f"{qualified} is not a function value")
+            return f(*vals)
+        return apply
+    if isinstance(e, ast.Unary):
+        operand = _compile(e.operand, env, node, mode)
+        if e.op == "not":
+            return lambda ev, b: not operand(ev, b)
+        return lambda ev, b: -operand(ev, b)
+    if isinstance(e, ast.Binary):
+        return _compile_binary(e, env, node, mode)
+    if isinstance(e, ast.Compare):
+        operands = tuple(_compile(o, env, node) for o in e.operands)
+        cmps = tuple(_CMP[op] for op in e.ops)
+        if len(cmps) == 1:
+            first, second = operands
+            cmp = cmps[0]
+            return lambda ev, b: bool(cmp(first(ev, b), second(ev, b)))  # all() of one comparison
+
+        def compare(ev: Any, b: Mapping[str, Any]) -> Any:
+            vals = [o(ev, b) for o in operands]
+            return all(c(x, y) for c, x, y in zip(cmps, vals, vals[1:]))
+        return compare
+    return lambda ev, b: ev.interpret(e, b)
+
+
+def _compile_var(v: ast.Var, env: Any, node: CheckedNode, mode: str | None = None) -> _Fn:
+    """:meth:`Evaluator.var` for ``v``: a bound variable first, then (fixed by
+    the context) an enumeration value, a constant, a constructor, else the
+    I/O value (:meth:`Evaluator.io`)."""
+    if v.prefix is not None:
+        key = v.qualified
+    else:
+        key = ("in." + v.name) if v.name in node.inputs else ("out." + v.name)
+
+    def io(ev: Any, b: Mapping[str, Any]) -> Any:
+        value = ev.values.get(key)
+        if value is None:
+            raise Undecided(f"no value for {key}")
+        return value
+    if v.prefix is not None:
+        return io
+    name = v.name
+    if name in env.enum_values:
+        return lambda ev, b: b.get(name, name)
+    if name in env.constants:
+        const = _compile(env.constants[name][1], env, node, mode)
+        return lambda ev, b: b[name] if name in b else const(ev, {})
+    if name in env.ctors:
+        return lambda ev, b: b[name] if name in b else Term(name, ())
+    return lambda ev, b: b[name] if name in b else io(ev, b)
+
+
+def _compile_binary(e: ast.Binary, env: Any, node: CheckedNode, mode: str | None = None) -> _Fn:
+    """:meth:`Evaluator.binary` for ``e``."""
+    op = e.op
+    left, right = _compile(e.left, env, node, mode), _compile(e.right, env, node, mode)
+    if op == "and":
+        return lambda ev, b: bool(left(ev, b)) and bool(right(ev, b))
+    if op == "or":
+        return lambda ev, b: bool(left(ev, b)) or bool(right(ev, b))
+    if op == "->":
+        return lambda ev, b: (not left(ev, b)) or bool(right(ev, b))
+    if op == "<=>":
+        return lambda ev, b: bool(left(ev, b)) == bool(right(ev, b))
+    if mode is not None:
+        return lambda ev, b: ev.arith(op, left(ev, b), right(ev, b))
+    return lambda ev, b: arithmetic(op, left(ev, b), right(ev, b))

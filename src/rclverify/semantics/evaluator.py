@@ -1,0 +1,185 @@
+"""The direct evaluator's context (:class:`Evaluator`): one node, its
+values, name resolution, expressions (compiled closures, or the tree walk
+they follow) and the semantics of numbers (exact here; the float-faithful
+semantics of recorded runs, :mod:`rclverify.semantics.floatsem`, override
+:meth:`Evaluator.literal`, :meth:`Evaluator.arith` and
+:meth:`Evaluator.compare`).  Quantifiers are
+:class:`rclverify.semantics.eval_quant.QuantifierEvaluation`'s.
+
+Part of the direct evaluator (:mod:`rclverify.semantics.evaluate`, whose module
+docstring states the semantics).
+"""
+from __future__ import annotations
+
+from typing import Any, Mapping
+
+from rclverify.lang import ast
+from rclverify.lang import types as T
+from rclverify.lang.types import Checked, CheckedNode
+from rclverify.semantics.values import Term, conforms
+from rclverify.semantics.eval_closures import COMPILED_SIZE, _COMPILED, _compile
+from rclverify.semantics.eval_quant import QuantifierEvaluation
+from rclverify.semantics.eval_values import _CMP, _LIT, Undecided, _numbers, arithmetic
+
+
+class Evaluator(QuantifierEvaluation):
+    """One evaluation context: the node, its values and the candidate numbers.
+
+    ``compiled`` (class attribute, True): evaluate through the compiled
+    closures; False walks the tree (:meth:`interpret`) everywhere, the
+    reference the tests compare the closures with."""
+
+    compiled = True
+    #: ``None``: exact arithmetic (the compiled closures of this class); a
+    #: subclass with other number semantics names them here (its expressions
+    #: are compiled apart, calling :meth:`literal`, :meth:`arith` and
+    #: :meth:`compare`)
+    mode: str | None = None
+
+    def __init__(self, checked: Checked, node: CheckedNode, values: Mapping[str, Any]) -> None:
+        self.env = checked.env
+        self.node = node
+        self.values = values
+        self._numbers: set[Any] | None = None
+        self._slots: dict[int, tuple[list[tuple[str, ...]], list[list[tuple[Any, ...]]]]] = {}
+        self.uncacheable = False  # set when a quantifier's candidates depend on outer bound values
+        self.io_names = frozenset(node.inputs) | frozenset(node.outputs)
+
+    def numbers(self) -> set[Any]:
+        if self._numbers is None:
+            found: set[Any] = set()
+            for v in self.values.values():
+                _numbers(v, found)
+            self._numbers = found
+        return self._numbers
+
+    # -- names ---------------------------------------------------------------
+    def io(self, v: ast.Var) -> Any:
+        if v.prefix is not None:
+            key = v.qualified
+        elif v.name in self.node.inputs:
+            key = "in." + v.name
+        else:
+            key = "out." + v.name
+        value = self.values.get(key)
+        if value is None:  # absent, or not observed yet: nothing to evaluate on
+            raise Undecided(f"no value for {key}")
+        return value
+
+    def var(self, v: ast.Var, bound: Mapping[str, Any]) -> Any:
+        if v.prefix is None and v.name in bound:
+            return bound[v.name]
+        if v.prefix is None and v.name in self.env.enum_values:
+            return v.name
+        if v.prefix is None and v.name in self.env.constants:
+            return self.eval(self.env.constants[v.name][1], {})
+        if v.prefix is None and v.name in self.env.ctors:
+            return Term(v.name, ())
+        return self.io(v)
+
+    # -- expressions -----------------------------------------------------------
+    def eval(self, e: ast.Expr, b: Mapping[str, Any]) -> Any:
+        """The value of ``e`` under bound variables ``b``: the expression is
+        compiled once (per AST node and I/O node) into nested closures that
+        do what :meth:`interpret` does, node for node (:func:`_compile`)."""
+        if not self.compiled:
+            return self.interpret(e, b)
+        mode = self.mode
+        key: tuple[Any, ...] = (id(e), id(self.node), id(self.env)) if mode is None else \
+            (id(e), id(self.node), id(self.env), mode)
+        hit = _COMPILED.get(key)
+        if hit is None or hit[0] is not e or hit[1] is not self.node or hit[2] is not self.env:
+            if len(_COMPILED) >= COMPILED_SIZE:
+                _COMPILED.clear()
+            hit = _COMPILED[key] = (e, self.node, self.env, _compile(e, self.env, self.node, mode))
+        return hit[3](self, b)
+
+    def interpret(self, e: ast.Expr, b: Mapping[str, Any]) -> Any:
+        """The value of ``e`` under ``b`` by walking the tree (the reference the
+        compiled closures follow; what they delegate membership, set and
+        tuple literals and quantifiers to)."""
+        if isinstance(e, ast.BoolLit):
+            return e.value
+        if isinstance(e, ast.NumLit):
+            return self.literal(e)
+        if isinstance(e, ast.Var):
+            return self.var(e, b)
+        if isinstance(e, ast.Apply):
+            args = tuple(self.eval(a, b) for a in e.args)
+            if e.func.prefix is None and e.func.name in self.env.ctors and e.func.name not in b:
+                return Term(e.func.name, args)
+            f = self.var(e.func, b)
+            if not callable(f):
+                raise Undecided(f"{e.func.qualified} is not a function value")
+            return f(*args)
+        if isinstance(e, ast.Unary):
+            x = self.eval(e.operand, b)
+            return (not x) if e.op == "not" else -x
+        if isinstance(e, ast.Binary):
+            return self.binary(e, b)
+        if isinstance(e, ast.Compare):
+            vals = [self.eval(o, b) for o in e.operands]
+            return all(self.compare(e, b, op, x, y) for op, x, y in zip(e.ops, vals, vals[1:]))
+        if isinstance(e, ast.Member):
+            x = self.eval(e.elem, b)
+            carrier = self.carrier(e.collection, b)
+            if carrier is not None:  # `x in NATURAL`, `(x, y) in REAL.REAL`
+                inside = conforms(x, carrier) is None
+                return (not inside) if e.negated else inside
+            coll = self.collection(e.collection, b)
+            return (x not in coll) if e.negated else (x in coll)
+        if isinstance(e, ast.SetLit):
+            return frozenset(self.eval(i, b) for i in e.items)
+        if isinstance(e, (ast.TupleLit, ast.SeqLit)):
+            return tuple(self.eval(i, b) for i in e.items)
+        if isinstance(e, ast.Quant):
+            return self.quant(e, b)
+        raise Undecided(f"cannot evaluate {type(e).__name__}")
+
+    def carrier(self, e: Any, b: Mapping[str, Any]) -> T.Type | None:
+        """The type a built-in term on the right of ``in`` stands for
+        (``NATURAL``, or the product ``REAL.REAL``), else ``None``."""
+        if not isinstance(e, ast.Var) or e.prefix is not None or e.name in b:
+            return None
+        if e.name in T.BASE_NAMES:
+            return T.Scalar(e.name)
+        return T.qualified_base(e.name)
+
+    def collection(self, e: Any, b: Mapping[str, Any]) -> Any:
+        if isinstance(e, ast.SetLit):
+            return {self.eval(i, b) for i in e.items}
+        v = self.eval(e, b)
+        if isinstance(v, (frozenset, tuple, set)):
+            return v
+        raise Undecided("membership in a value that is not a set")
+
+    def binary(self, e: ast.Binary, b: Mapping[str, Any]) -> Any:
+        op = e.op
+        if op == "and":
+            return bool(self.eval(e.left, b)) and bool(self.eval(e.right, b))
+        if op == "or":
+            return bool(self.eval(e.left, b)) or bool(self.eval(e.right, b))
+        if op == "->":
+            return (not self.eval(e.left, b)) or bool(self.eval(e.right, b))
+        if op == "<=>":
+            return bool(self.eval(e.left, b)) == bool(self.eval(e.right, b))
+        return self.arith(op, self.eval(e.left, b), self.eval(e.right, b))
+
+    # -- the semantics of numbers: exact here (REAL as rationals); the
+    # float-faithful semantics of recorded runs (semantics/floatsem.py) override
+    # these three and set ``mode``, under which expressions are compiled apart
+    def literal(self, e: ast.NumLit) -> Any:
+        """The value of a numeric literal: its exact rational (an ``int`` when whole)."""
+        lit = _LIT.get(e.text)
+        if lit is None:
+            v = e.value
+            lit = _LIT[e.text] = int(v) if v.denominator == 1 else v
+        return lit
+
+    def arith(self, op: str, x: Any, y: Any) -> Any:
+        """``x op y`` (:func:`arithmetic`: exact)."""
+        return arithmetic(op, x, y)
+
+    def compare(self, e: ast.Compare, b: Mapping[str, Any], op: str, x: Any, y: Any) -> bool:
+        """One comparison ``x op y`` of ``e`` under bound variables ``b`` (exact)."""
+        return _CMP[op](x, y)

@@ -1,0 +1,435 @@
+"""Float-faithful judgement of an RCL formula on values a running node published.
+
+RCL speaks of reals; a ROS node computes in IEEE-754 double arithmetic and
+publishes doubles.  Judged as exact rationals, a node that computes
+``1000 * 1.2`` and publishes ``1200.0`` violates ``out.d == 1000 * in.r``
+(``1.2`` as a double is 1.1999999999999999555...): a false alarm on a correct
+node.  A recorded value is therefore judged by what the node could have
+computed (docs/monitors.md, "Numbers on the wire"):
+
+* **exact**: the formula on the values as exact rationals, literals as the
+  decimals they spell (:func:`rclverify.semantics.evaluate.evaluate`, then Z3 on
+  the concrete values where that cannot decide; the semantics of the rest
+  of the tool, shared/DESIGN.md);
+* **double**: the same formula evaluated in IEEE-754 binary64 arithmetic as
+  the node computes it: every non-integer literal rounded to the nearest
+  double, every ``+ - * /`` rounded (Python's ``float`` operations are
+  binary64, round-to-nearest-even), left to right as written, comparisons
+  on the doubles.  Integers stay exact (an ``INTEGER`` is an integer on the
+  node too).  The recorded values themselves are never rounded or moved:
+  ``out.x <= 30`` is false of a published 30.000000000000004 in every
+  semantics but a declared tolerance;
+* **tolerance** (only when one is declared, :class:`Tolerance`): exact
+  arithmetic, and a comparison that reads a recorded value treats numbers
+  within the tolerance as equal: ``a == b`` iff ``|a - b| <= tol``,
+  ``a <= b`` iff ``a < b`` or equal so, ``a < b`` iff ``a < b`` and not
+  equal so, ``!=`` the negation of ``==`` (one consistent logic, so ``not``
+  flips nothing it should not).  Comparisons among bound variables and
+  literals alone stay exact.
+
+:func:`judge` answers *holds* when the formula holds in one of these
+(each evaluated as a whole: no mixing of semantics inside one formula,
+which could make ``a and not a`` hold), names the one that decided, and
+answers *false* only when it is false in every one that applies: a real
+violation is caught in all of them.  When exact arithmetic says false and a
+float semantics cannot decide, the answer is undecided with the reason,
+never false: that would be the false alarm this module removes.
+
+Soundness of the float semantics' quantifiers: the exact evaluator's
+shortcuts (candidate values from equalities, pins, preimages) rest on exact
+equality, which rounding and tolerance break (``x + 1 == out.y`` has many
+double solutions).  Under double and tolerance a quantifier is therefore
+enumerated over a finite domain only: ``BOOL``, an enumeration, a finite
+set, an ``INTEGER``/``NATURAL`` variable bounded by literal guards
+(``k <= 12 -> ...``), or a numeric variable the body never mentions; any
+other quantifier is undecided there, except, under double, a ``REAL``/``INTEGER``/``NATURAL``
+variable whose body changes truth only at finitely many points computable from the values
+(table keys, the terms it is compared with): it is decided exactly at those candidate points
+and one point in each gap (:mod:`rclverify.semantics.candidates`, :mod:`rclverify.semantics.candidate_points`; a ``REAL`` ranges over the
+doubles there).  A formula whose evaluation cannot
+differ between exact and double (no rounding arithmetic, every literal a
+double) is not evaluated again (:func:`float_sensitive`).
+
+One function (:func:`judge`) decides, for the monitors of recorded and live
+runs (``backends/monitors``: ``check.py``, ``deadlines.py``, and through them
+``online.py``, the ROS 1/2 live monitors and the oracle), and for the
+guarantee checks of the property tests (``backends/property_tests/harness.py``:
+a Python implementation computes in doubles too).
+"""
+from __future__ import annotations
+
+import itertools
+import math
+import struct
+from dataclasses import dataclass
+from fractions import Fraction
+from typing import Any, Mapping
+
+import z3
+
+from rclverify.lang import ast
+from rclverify.lang import types as T
+from rclverify.lang.types import Checked, CheckedNode
+from rclverify.semantics.candidate_points import quantify
+from rclverify.semantics.concrete import check_concrete
+from rclverify.semantics.encode import EncodingError
+from rclverify.semantics.eval_shapes import MAX_RANGE, _integer_range, _unused
+from rclverify.semantics.evaluate import Evaluator, Undecided, evaluate, why_undecided
+from rclverify.semantics.floatsens import float_sensitive
+
+#: The semantics a verdict may be decided in, in the order they are tried.
+SEMANTICS = ("exact", "double", "tolerance")
+
+_CMP = {"==": lambda a, b: a == b, "!=": lambda a, b: a != b, "<": lambda a, b: a < b,
+        "<=": lambda a, b: a <= b, ">": lambda a, b: a > b, ">=": lambda a, b: a >= b}
+#: The most assignments a quantifier is enumerated over under double or tolerance.
+MAX_ENUMERATION = 100_000
+
+
+class ToleranceError(ValueError):
+    """A malformed tolerance declaration; ``key`` is the key at fault (``()`` for the whole value)."""
+
+    def __init__(self, message: str, *key: str) -> None:
+        super().__init__(message)
+        self.key = key
+
+
+@dataclass(frozen=True)
+class Tolerance:
+    """Numbers closer than this are one value to the comparisons of a recorded run.
+
+    ``abs`` (in the variable's unit), ``rel`` (a fraction of the larger
+    magnitude) and ``ulps`` (units in the last place of the doubles nearest
+    the two values): two numbers are close when any bound that is set holds.
+    Declared in the mapping file or the plan's ``monitors`` entry
+    (``tolerance: {abs: 1.0e-9, rel: 1.0e-9, ulps: 4}``)."""
+
+    abs: Fraction = Fraction(0)
+    rel: Fraction = Fraction(0)
+    ulps: int = 0
+
+    def close(self, x: Any, y: Any) -> bool:
+        """Whether numbers ``x`` and ``y`` are within the tolerance (exact rational arithmetic)."""
+        a, b = Fraction(x), Fraction(y)
+        d = abs(a - b)
+        if d <= self.abs or d <= self.rel * max(abs(a), abs(b)):
+            return True
+        return bool(self.ulps) and ulp_distance(float(a), float(b)) <= self.ulps
+
+    def text(self) -> str:
+        """``abs 1e-09, rel 1e-09, ulps 4`` (the bounds that are set)."""
+        parts = [f"{k} {_num_text(v)}" for k, v in (("abs", self.abs), ("rel", self.rel), ("ulps", self.ulps)) if v]
+        return ", ".join(parts) or "none"
+
+    def to_json(self) -> dict[str, Any]:
+        return {"abs": float(self.abs), "rel": float(self.rel), "ulps": self.ulps}
+
+    def __bool__(self) -> bool:
+        return bool(self.abs or self.rel or self.ulps)
+
+
+def _num_text(v: Any) -> str:
+    return str(v) if isinstance(v, int) else repr(float(v))
+
+
+def ulp_distance(a: float, b: float) -> int:
+    """How many steps from double ``a`` to double ``b`` (0 when they compare
+    equal, so ``-0.0`` and ``0.0`` are 0 apart; a NaN is infinitely far)."""
+    if a == b:
+        return 0
+    if math.isnan(a) or math.isnan(b):
+        return 1 << 64
+
+    def ordered(x: float) -> int:
+        i: int = struct.unpack("<q", struct.pack("<d", x))[0]
+        return i if i >= 0 else -(i & 0x7FFFFFFFFFFFFFFF)
+    return abs(ordered(a) - ordered(b))
+
+
+def parse_tolerance(raw: Any) -> Tolerance | None:
+    """A :class:`Tolerance` from a mapping file's or plan entry's ``tolerance``
+    (``None``: none declared).  Each bound is a finite number >= 0 (a YAML
+    string such as ``1e-9``, which YAML 1.1 reads as text, is read as the
+    number it spells); ``ulps`` an integer.  Raises :class:`ToleranceError`
+    naming the key."""
+    if raw is None:
+        return None
+    if not isinstance(raw, Mapping):
+        raise ToleranceError(f"tolerance must map abs, rel or ulps to a number, not {raw!r}")
+    unknown = sorted(str(k) for k in raw if k not in ("abs", "rel", "ulps"))
+    if unknown:
+        raise ToleranceError(f"tolerance: unknown key {unknown[0]!r} (expected abs, rel, ulps)", unknown[0])
+    out: dict[str, Any] = {}
+    for key in ("abs", "rel", "ulps"):
+        if key not in raw:
+            continue
+        v = raw[key]
+        if isinstance(v, str):
+            try:
+                v = float(v)
+            except ValueError:
+                pass
+        if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v) or v < 0:
+            raise ToleranceError(f"tolerance: {key} must be a finite number >= 0, not {raw[key]!r}", key)
+        if key == "ulps":
+            if float(v) != int(v):
+                raise ToleranceError(f"tolerance: ulps must be a whole number, not {raw[key]!r}", key)
+            out[key] = int(v)
+        else:
+            out[key] = Fraction(v)
+    return Tolerance(**out)
+
+
+@dataclass(frozen=True)
+class Judgement:
+    """The truth of a formula on recorded values and the semantics that decided it.
+
+    ``truth`` True/False, ``None`` undecided (``reason`` says why; a reason
+    starting ``no value for`` means an I/O value is missing).
+    ``semantics``: for True the one semantics it holds in (``exact``,
+    ``double`` or ``tolerance``), for False every semantics that was applied
+    and agreed (``exact``, ``exact, double``, ``exact, double, tolerance``),
+    ``""`` when undecided."""
+
+    truth: bool | None
+    semantics: str = ""
+    reason: str = ""
+
+
+def judge(formula: ast.Expr, checked: Checked, node: CheckedNode, values: Mapping[str, Any],
+          tolerance: Tolerance | None = None) -> Judgement:
+    """Does ``formula`` (an RCL formula of ``node``) hold of the recorded
+    ``values`` (qualified names ``in.r``/``out.d`` -> values of
+    :mod:`rclverify.semantics.values`) in exact arithmetic, in the node's double
+    arithmetic, or within ``tolerance`` (module docstring)?  Never raises for
+    a value or formula it cannot handle: the judgement is then undecided
+    with the reason.  Exact is tried first (direct evaluation, Z3 on the
+    concrete values where that cannot decide); double and tolerance only when
+    exact does not hold and they could answer otherwise."""
+    v = evaluate(formula, checked, node, values)
+    reason = ""
+    if v is None:
+        reason = why_undecided(formula, checked, node, values)
+        if "no value for" in reason:  # an I/O value is missing: no semantics can decide
+            return Judgement(None, "", reason)
+        try:
+            v, reason = check_concrete(formula, checked, node, values)
+        except (ValueError, TypeError, KeyError, EncodingError, z3.Z3Exception) as exc:  # a value Z3 cannot take
+            v, reason = None, f"{reason}; Z3 on concrete values failed: {exc}"
+    if v is True:
+        return Judgement(True, "exact")
+    tried = ["exact"]
+    open_: list[str] = []
+    if float_sensitive(formula, checked, node):
+        d, why = _run(_Double(checked, node, values), formula)
+        if d is True:
+            return Judgement(True, "double", "false in exact arithmetic, true in IEEE-754 double arithmetic "
+                                             "(as the node computes)")
+        tried.append("double")
+        if d is None:
+            open_.append(f"in double arithmetic: {why}")
+    if tolerance and float_sensitive(formula, checked, node, tolerant=True):
+        ev = _Tolerant(checked, node, values)
+        ev.tolerance = tolerance
+        t, why = _run(ev, formula)
+        if t is True:
+            return Judgement(True, "tolerance", f"false in exact and double arithmetic, true within the declared "
+                                                f"tolerance ({tolerance.text()})")
+        tried.append("tolerance")
+        if t is None:
+            open_.append(f"within the tolerance: {why}")
+    if v is False and not open_:
+        return Judgement(False, ", ".join(tried), reason)
+    if v is False:
+        return Judgement(None, "", "false in exact arithmetic, undecided " + "; ".join(open_))
+    return Judgement(None, "", reason)
+
+
+def holds_in(semantics: str, formula: ast.Expr, checked: Checked, node: CheckedNode, values: Mapping[str, Any],
+             tolerance: Tolerance | None = None) -> bool | None:
+    """Does ``formula`` hold of ``values`` in the one arithmetic ``semantics``
+    (``exact``, ``double``, ``tolerance``), ``None`` when undecided there?
+    The monitor judges every guarantee of one message in one arithmetic
+    (issue 47, docs/monitors.md "Numbers on the wire"): a message whose
+    guarantees hold only in different arithmetics holds in none."""
+    if semantics == "exact":
+        j = judge(formula, checked, node, values)
+        return j.truth if j.semantics.startswith("exact") or j.truth is not True else False
+    if semantics == "double":
+        return _run(_Double(checked, node, values), formula)[0]
+    ev = _Tolerant(checked, node, values)
+    ev.tolerance = tolerance or Tolerance()
+    return _run(ev, formula)[0]
+
+
+def _run(ev: Evaluator, formula: ast.Expr) -> tuple[bool | None, str]:
+    try:
+        return bool(ev.eval(formula, {})), ""
+    except Undecided as exc:
+        return None, str(exc)
+    except (TypeError, ZeroDivisionError, OverflowError, ValueError) as exc:
+        return None, f"a value has the wrong form for the formula: {exc}"
+
+
+def _double(x: Any) -> Any:
+    """A number as the node holds it: a rational as the nearest double; an
+    ``int`` (an integer stays exact) and a ``float`` unchanged."""
+    return float(x) if type(x) is Fraction else x
+
+
+#: a literal's text -> its value in the double reading (parsed once)
+_DOUBLE_LITERALS: dict[str, Any] = {}
+
+
+class _Double(Evaluator):
+    """The formula in IEEE-754 binary64 arithmetic (module docstring)."""
+
+    mode = "double"
+
+    def literal(self, e: ast.NumLit) -> Any:
+        hit = _DOUBLE_LITERALS.get(e.text)
+        if hit is None:
+            v = e.value
+            hit = _DOUBLE_LITERALS[e.text] = int(v) if v.denominator == 1 else float(v)
+        return hit
+
+    def arith(self, op: str, x: Any, y: Any) -> Any:
+        x, y = _double(x), _double(y)
+        if op == "+":
+            return x + y
+        if op == "-":
+            return x - y
+        if op == "*":
+            return x * y
+        if y == 0:
+            raise Undecided("division by zero")
+        return x / y
+
+    def compare(self, e: ast.Compare, b: Mapping[str, Any], op: str, x: Any, y: Any) -> bool:
+        return bool(_CMP[op](_double(x), _double(y)))
+
+    def quant(self, e: ast.Quant, b: Mapping[str, Any]) -> bool:
+        got = quantify(self, e, b, _finite_domain, MAX_ENUMERATION)
+        return _enumerate(self, e, b) if got is None else got
+
+
+class _Tolerant(Evaluator):
+    """The formula in exact arithmetic with comparisons of recorded values up
+    to a tolerance (module docstring)."""
+
+    mode = "tolerance"
+    tolerance: Tolerance = Tolerance()
+
+    def compare(self, e: ast.Compare, b: Mapping[str, Any], op: str, x: Any, y: Any) -> bool:
+        if not (_number(x) and _number(y)) or not _reads_io(e, b, self.io_names):
+            return bool(_CMP[op](x, y))
+        close = self.tolerance.close(x, y)
+        if op == "==":
+            return close
+        if op == "!=":
+            return not close
+        if op == "<=":
+            return x <= y or close
+        if op == ">=":
+            return x >= y or close
+        if op == "<":
+            return x < y and not close
+        return x > y and not close  # ">"
+
+    def quant(self, e: ast.Quant, b: Mapping[str, Any]) -> bool:
+        return _enumerate(self, e, b)
+
+
+def _number(v: Any) -> bool:
+    return not isinstance(v, bool) and isinstance(v, (int, float, Fraction))
+
+
+_IO_READS: dict[int, tuple[ast.Compare, bool, frozenset[str]]] = {}
+
+
+def _reads_io(e: ast.Compare, b: Mapping[str, Any], io: frozenset[str]) -> bool:
+    """Does comparison ``e`` read a recorded value: an ``in.``/``out.``
+    variable, or a bare I/O name not bound by a quantifier (``b``)?"""
+    hit = _IO_READS.get(id(e))
+    if hit is None or hit[0] is not e:
+        names: set[str] = set()
+        prefixed = _io_names(e.operands, names)
+        if len(_IO_READS) >= 10_000:
+            _IO_READS.clear()
+        hit = _IO_READS[id(e)] = (e, prefixed, frozenset(names))
+    return hit[1] or any(n in io and n not in b for n in hit[2])
+
+
+def _io_names(e: Any, bare: set[str]) -> bool:
+    """Collect the bare names under ``e``; True when it reads a prefixed I/O variable."""
+    if isinstance(e, ast.Var):
+        if e.prefix is not None:
+            return True
+        bare.add(e.name)
+        return False
+    if isinstance(e, tuple):
+        return any([_io_names(x, bare) for x in e])
+    if isinstance(e, ast.Loc) or not hasattr(e, "__dataclass_fields__"):
+        return False
+    return any([_io_names(getattr(e, f), bare) for f in e.__dataclass_fields__])
+
+
+def _enumerate(ev: Evaluator, e: ast.Quant, b: Mapping[str, Any]) -> bool:
+    """Quantifier ``e`` by enumerating finite domains only (module docstring)."""
+    names: list[str] = []
+    doms: list[list[Any]] = []
+    size = 1
+    for bd in e.bindings:
+        for n in bd.names:
+            dom = _finite_domain(ev, e, bd, n, b)
+            names.append(n)
+            doms.append(dom)
+            size *= max(len(dom), 1)
+            if size > MAX_ENUMERATION:
+                raise Undecided(f"quantifier over more than {MAX_ENUMERATION} values")
+    count = 0
+    for combo in itertools.product(*doms):
+        cur = dict(b)
+        cur.update(zip(names, combo))
+        holds = bool(ev.eval(e.body, cur))
+        if e.kind == "forall":
+            if not holds:
+                return False
+        elif e.kind == "exists":
+            if holds:
+                return True
+        elif holds:
+            count += 1
+            if count > 1:
+                return False
+    return e.kind == "forall" or (e.kind == "exists_unique" and count == 1)
+
+
+def _finite_domain(ev: Evaluator, e: ast.Quant, bd: ast.Binding, name: str, b: Mapping[str, Any]) -> list[Any]:
+    dom = bd.domain
+    if isinstance(dom, ast.TEnum):
+        return list(dom.values)
+    typ: Any = None
+    if isinstance(dom, ast.TBase):
+        typ = T.Scalar(dom.name) if dom.name in ("REAL", "INTEGER", "NATURAL", "BOOL") else None
+    elif isinstance(dom, ast.TName):
+        typ = ev.env.types.get(dom.name)
+    elif isinstance(dom, (ast.SetLit, ast.Var)):
+        return list(ev.collection(dom, b))
+    if isinstance(typ, T.EnumT):
+        return list(typ.values)
+    if isinstance(typ, T.Scalar):
+        if typ.name == "BOOL":
+            return [False, True]
+        if e.kind in ("forall", "exists") and _unused(e, name, bd):
+            return [0]  # the body does not read it: one value of the (non-empty) domain stands for all
+        bounded = _integer_range(e.body, name, typ.name, e.kind)
+        if bounded is not None and len(bounded) <= MAX_RANGE:
+            return bounded
+        raise Undecided(f"{name} ranges over {typ.name} without a literal bound: not enumerable "
+                        f"outside exact arithmetic")
+    raise Undecided(f"quantifier over {type(dom).__name__} is not finite")
+
+
+__all__ = ["Judgement", "SEMANTICS", "Tolerance", "ToleranceError", "float_sensitive", "holds_in", "judge", "parse_tolerance",
+           "ulp_distance"]

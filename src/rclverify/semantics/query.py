@@ -1,0 +1,392 @@
+"""Validity and satisfiability queries with Z3, and their explanations.
+
+Every query:
+
+* runs with a per-query budget, given in milliseconds and enforced as Z3
+  resource steps (:data:`STEPS_PER_MS`), so the answer does not depend on
+  the machine's load;
+* maps Z3's answer to the tool's verdicts without ever upgrading an
+  ``unknown``: validity -> ``proved`` (negation unsat) / ``refuted`` (sat,
+  with a model) / ``inconclusive`` (unknown or timeout); satisfiability ->
+  ``sat`` (with a model) / ``unsat`` (with an unsat core of the labelled
+  formulas) / ``inconclusive``;
+* keeps its SMT-LIB2 text so a second solver can re-check it
+  (shared/DESIGN.md, "Calculus").
+
+Models are rendered in RCL terms by :func:`render_model`.
+"""
+from __future__ import annotations
+
+import time
+from contextlib import ExitStack, contextmanager
+from dataclasses import dataclass, field
+from functools import cached_property
+from typing import Callable, Iterator, Sequence
+
+import z3
+
+from rclverify.semantics.encode import Encoder, term_to_rcl, value_to_rcl
+from rclverify.semantics.functable import finite_table
+from rclverify.semantics.retry import (DEFAULT, TABLES, attempts, bounded_solver, load_canonical, reasons_text, retry_order,
+                    strategy_solver, variants)
+
+DEFAULT_TIMEOUT_MS = 10_000
+
+
+@dataclass(frozen=True)
+class QueryResult:
+    """Outcome of one query.
+
+    ``status``    ``proved``/``refuted``/``inconclusive`` for validity,
+                  ``sat``/``unsat``/``inconclusive`` for satisfiability;
+    ``model``     RCL name -> RCL value text (refuted or sat), else ``None``;
+    ``core``      labels of the formulas in an unsat core (unsat), else ``None``;
+    ``script``    makes the query's SMT-LIB2 script (read it as ``smt2``);
+    ``reason``    Z3's reason for ``unknown`` ('' otherwise);
+    ``duration_s`` wall time in seconds;
+    ``strategy``  the retry of :mod:`.retry` that answered ('' when the
+                  first attempt did, or when every attempt was unknown).
+    """
+
+    status: str
+    script: Callable[[], str] = field(repr=False, compare=False)
+    duration_s: float
+    model: dict[str, str] | None = None
+    core: list[str] | None = None
+    reason: str = ""
+    strategy: str = ""
+
+    @cached_property
+    def smt2(self) -> str:
+        """The query as an SMT-LIB2 script, written when first asked for:
+        most health queries find nothing and their text is never kept."""
+        return self.script()
+
+
+#: Z3 resource steps per millisecond of a query's budget: a ``timeout_ms``
+#: budget is enforced as Z3's ``rlimit`` of ``timeout_ms * STEPS_PER_MS``
+#: steps (Z3 does some 2,000 steps per millisecond on the heavy quantified
+#: queries of the case study on one idle core, up to 4,000 on light ones,
+#: which finish well inside their budget), so an answer does not
+#: depend on the machine's load: a serial run, ``doit -n 2`` and a busy CI
+#: machine decide the same queries.
+STEPS_PER_MS = 2_000
+#: The wall-clock safety net, a multiple of the budget.
+SAFETY_FACTOR = 10
+
+
+def steps(budget_ms: float) -> int:
+    """The Z3 resource limit of a budget of ``budget_ms`` milliseconds
+    (:data:`STEPS_PER_MS`), at least one step (Z3 reads 0 as no limit)."""
+    return max(1, int(budget_ms * STEPS_PER_MS))
+
+
+def budgeted_solver(timeout_ms: float, ctx: z3.Context | None = None) -> z3.Solver:
+    """A solver in ``ctx`` (default: the process's main context) whose
+    budget is ``timeout_ms`` milliseconds' worth of Z3 resource steps
+    (:func:`steps`), with a wall-clock safety net :data:`SAFETY_FACTOR`
+    times longer (at least a millisecond)."""
+    s = z3.Solver(ctx=ctx)
+    s.set("rlimit", steps(timeout_ms))
+    s.set("timeout", max(1, int(timeout_ms * SAFETY_FACTOR)))
+    return s
+
+
+class _Session:
+    """The shared solver of one :func:`solver_session` block and the query
+    budget its parameters are set to (set again only when a query asks for
+    another: setting a parameter of a solver in use costs about as much as
+    a small query)."""
+
+    def __init__(self) -> None:
+        self.solver = z3.SimpleSolver()
+        self.solver.set("unsat_core", True)
+        self.budget_ms: int | None = None
+
+    def scope(self, timeout_ms: int) -> z3.Solver:
+        if self.budget_ms != timeout_ms:
+            self.solver.set("rlimit", int(timeout_ms) * STEPS_PER_MS)
+            self.solver.set("timeout", int(timeout_ms) * SAFETY_FACTOR)
+            self.budget_ms = timeout_ms
+        self.solver.push()
+        return self.solver
+
+
+#: The :func:`solver_session` blocks under way, innermost last.
+_SESSIONS: list[_Session] = []
+
+
+@contextmanager
+def solver_session() -> Iterator[None]:
+    """Within the block, every query of this module (and every
+    :func:`query_solver`) runs in one shared incremental Z3 solver, each in
+    its own ``push``/``pop`` scope, instead of a fresh solver each.
+
+    A fresh ``z3.Solver()`` costs about 1.5 ms of set-up and tear-down,
+    more than most queries of a contract take to solve; a scope of an
+    incremental solver costs about 0.25 ms (docs/scale.md, sixth round).
+    The solver is Z3's incremental SMT core (``z3.SimpleSolver``, the
+    engine ``z3.Solver()`` itself switches to once a scope is pushed) with
+    unsat cores enabled.  A popped scope leaves no assertion behind, so
+    each query is decided on its own formulas; but a model, a core (and, on
+    a query near its budget, whether Z3 gives up: the retries of
+    :mod:`.retry`, in fresh solvers, then take over) may depend on the
+    queries the solver answered before in the same block, so a block must
+    always ask the same queries in the same order:
+    each covers one unit of work whose queries follow from its inputs alone
+    (one node's calculus, one node's health checks, one Hoare triple),
+    never queries whose order depends on scheduling.  Blocks nest (the
+    innermost is used).  The retries of :mod:`.retry` keep their own fresh
+    solvers.  Usable as a decorator (``@solver_session()``).
+    """
+    _SESSIONS.append(_Session())
+    try:
+        yield
+    finally:
+        _SESSIONS.pop()
+
+
+@contextmanager
+def query_solver(timeout_ms: int, *, cores: bool = False) -> Iterator[z3.Solver]:
+    """A solver for one query, budgeted like :func:`budgeted_solver`: a new
+    scope of the innermost :func:`solver_session` (popped when the block
+    ends), or a fresh solver outside any session.  ``cores``: the query
+    needs unsat cores (always on in a session's solver, since Z3 takes that
+    option only before the first assertion)."""
+    if not _SESSIONS:
+        fresh = budgeted_solver(timeout_ms)
+        if cores:
+            fresh.set("unsat_core", True)
+        yield fresh
+        return
+    s = _SESSIONS[-1].scope(timeout_ms)
+    try:
+        yield s
+    finally:
+        s.pop()
+
+
+def smt2_script(formulas: Sequence[z3.BoolRef], comment: str) -> Callable[[], str]:
+    """A function making the SMT-LIB2 script of ``formulas`` (headed by
+    ``comment`` as SMT-LIB comments) when called: most queries' text is
+    never kept, and printing it costs more than many queries."""
+    return lambda: _script(formulas, comment)
+
+
+def _script(formulas: Sequence[z3.BoolRef], comment: str) -> str:
+    header = "".join(f"; {line}\n" for line in comment.splitlines())
+    return header + smtlib_benchmark(formulas)
+
+
+def smtlib_benchmark(formulas: Sequence[z3.BoolRef], ctx: z3.Context | None = None) -> str:
+    """``formulas`` as an SMT-LIB2 script, printed by the Z3 call
+    ``z3.Solver.to_smt2()`` makes (``Z3_benchmark_to_smtlib_string``)
+    without making a solver: a fresh solver costs about a millisecond, and
+    the text of every health query is kept.  The same script as a solver's,
+    up to which shared subterms the printer names with ``let`` (it decides
+    by reference counts, which a solver holding the formulas raises).
+    :func:`.retry.canonical_smt2`, whose text is parsed back and solved,
+    keeps printing through a solver.  ``ctx`` is the formulas' context
+    (default: the first formula's, else the main context)."""
+    c = ctx if ctx is not None else formulas[0].ctx if formulas else z3.main_ctx()
+    *init, last = list(formulas) or [z3.BoolVal(True, c)]
+    v = (z3.Ast * len(init))(*[f.as_ast() for f in init])
+    return str(z3.Z3_benchmark_to_smtlib_string(c.ref(), "benchmark generated from python API", "", "unknown", "",
+                                                len(init), v, last.as_ast()))
+
+
+def prove(goal: z3.BoolRef, hypotheses: Sequence[z3.BoolRef], enc: Encoder | None = None, *,
+          timeout_ms: int = DEFAULT_TIMEOUT_MS, comment: str = "", deterministic: bool = False,
+          first_ms: float | None = None, likely_sat: Callable[[], bool] | None = None,
+          counterexample: Callable[[], dict[str, str] | None] | None = None) -> QueryResult:
+    """Is ``hypotheses => goal`` valid?  Checks ``hypotheses and not goal``.
+
+    ``enc`` (when given) renders a refuting model in RCL terms and adds its
+    typing axioms to the hypotheses.  ``deterministic``: run the first
+    attempt too in a fresh Z3 context bounded by a resource limit
+    (:func:`.retry.bounded_solver`) instead of ``timeout_ms``, so the answer
+    does not depend on load or history: the query is loaded from its
+    canonical SMT-LIB2 text (:func:`.retry.load_canonical`), so not even
+    the calling process's Z3 term ids reach the solver; the model is read
+    back through ``enc``'s symbol names, which the text keeps.  Never raises
+    on solver trouble: an unknown answer is ``inconclusive`` with Z3's reason.
+
+    ``first_ms`` (decide first with what decides, issue 44): the first
+    attempt gets only this budget (milliseconds' worth of resource steps);
+    a query it decides gets the answer the whole budget would give (a
+    resource-bounded search with a smaller bound is a prefix of the same
+    search).  Undecided, the strategies follow in the laddered order of
+    :func:`.retry.retry_order` (finite instantiation first, then the
+    default with its whole budget, then MBQI), each with its whole budget;
+    ``likely_sat`` (called only then, e.g. "a finite-table witness of the
+    refutation exists") puts the model-building MBQI first.  Not used
+    inside a :func:`solver_session` unless ``deterministic`` (a session's
+    first attempt is part of its history).
+
+    ``counterexample`` (with ``first_ms``; called only when the first
+    attempt did not decide): a more specific search for a refuting model,
+    e.g. one in which every function-typed input is a finite table
+    (:func:`rclverify.calculus.health.witness.finite_witness`).  Its model (RCL name
+    -> value text) must satisfy the hypotheses and the negated goal, so the
+    query is ``refuted`` with that model (strategy :data:`.retry.TABLES`)
+    without the retries; ``None`` leaves the query to the ladder, in the
+    order ``likely_sat`` gives (not asked again when it is the same search).
+    """
+    hyps = list(hypotheses) + (enc.axioms() if enc else [])
+    formulas = hyps + [z3.Not(goal)]
+    script = smt2_script(formulas, comment or "validity query: unsat means the goal follows from the hypotheses")
+    ladder = first_ms is not None and (deterministic or not _SESSIONS)
+    t0 = time.perf_counter()
+
+    def answered(s: z3.Solver, r: z3.CheckSatResult, strategy: str = "") -> QueryResult | None:
+        dt = round(time.perf_counter() - t0, 4)
+        if r == z3.unsat:
+            return QueryResult("proved", script, dt, strategy=strategy)
+        if r == z3.sat:
+            return QueryResult("refuted", script, dt, model=render_model(s.model(), enc), strategy=strategy)
+        return None
+
+    def default(budget_ms: float | None) -> z3.Solver:
+        """The first attempt's solver with the query in it (``None``: its whole budget)."""
+        if deterministic:
+            s = bounded_solver() if budget_ms is None else bounded_solver(rlimit=steps(budget_ms))
+            load_canonical(s, formulas)
+        else:
+            s = budgeted_solver(budget_ms if budget_ms is not None else timeout_ms)
+            s.add(*formulas)
+        return s
+
+    with ExitStack() as scope:
+        if ladder or deterministic:
+            s = default(first_ms if ladder else None)
+        else:
+            s = scope.enter_context(query_solver(timeout_ms))
+            s.add(*formulas)
+        got = answered(s, s.check())
+        if got is not None:
+            return got
+        reasons = {DEFAULT: s.reason_unknown()}
+        if ladder and counterexample is not None:
+            model = counterexample()
+            if model is not None:
+                return QueryResult("refuted", script, round(time.perf_counter() - t0, 4), model=model,
+                                   strategy=TABLES)
+        models_first = bool(ladder and likely_sat is not None and likely_sat())
+        for name in retry_order(formulas, ladder=ladder, models_first=models_first):
+            if name == DEFAULT:
+                s2 = default(None)
+            else:
+                s2, rewrite = strategy_solver(name)
+                load_canonical(s2, [rewrite(f) for f in formulas])
+            got = answered(s2, s2.check(), "" if name == DEFAULT else name)
+            if got is not None:
+                return got
+            reasons[name] = s2.reason_unknown()
+        return QueryResult("inconclusive", script, round(time.perf_counter() - t0, 4), reason=reasons_text(reasons))
+
+
+def satisfiable(labelled: Sequence[tuple[str, z3.BoolRef]], enc: Encoder | None = None, *,
+                timeout_ms: int = DEFAULT_TIMEOUT_MS, comment: str = "", retry: bool = True) -> QueryResult:
+    """Can all the labelled formulas hold together?
+
+    ``retry``: on ``unknown``, try the strategies of :mod:`.retry` (off for
+    the many small per-instance queries whose caller has its own fallback).
+
+    On ``unsat`` the result's ``core`` lists the labels of an unsat core
+    (the encoder's typing axioms are unlabelled background).
+    """
+    background = enc.axioms() if enc else []
+    with query_solver(timeout_ms, cores=True) as s:
+        s.add(*background)
+        trackers = {}
+        for k, (label, f) in enumerate(labelled):
+            b = z3.Bool(f"__label_{k}")
+            trackers[str(b)] = label
+            s.assert_and_track(f, b)
+        t0 = time.perf_counter()
+        r = s.check()
+        dt = round(time.perf_counter() - t0, 4)
+        script = smt2_script(background + [f for _, f in labelled], comment or "satisfiability query")
+        if r == z3.sat:
+            return QueryResult("sat", script, dt, model=render_model(s.model(), enc))
+        if r == z3.unsat:
+            core = sorted({trackers[str(c)] for c in s.unsat_core() if str(c) in trackers},
+                          key=[lbl for lbl, _ in labelled].index)
+            return QueryResult("unsat", script, dt, core=core)
+        reasons = [f"default: {s.reason_unknown()}"]
+        labels = [lbl for lbl, _ in labelled]
+        for name0, s0, rewrite in attempts(background + [f for _, f in labelled], timeout_ms) if retry else []:
+            for name, s2 in variants(name0, s0):
+                # loaded untracked from canonical text (tracking changes Z3's search)
+                load_canonical(s2, [rewrite(g) for g in background + [f for _, f in labelled]])
+                r = s2.check()
+                dt = round(time.perf_counter() - t0, 4)
+                if r == z3.sat:
+                    return QueryResult("sat", script, dt, model=render_model(s2.model(), enc), strategy=name)
+                if r == z3.unsat:
+                    tracked = _retry_core(background, labelled, rewrite)
+                    core = tracked if tracked is not None else labels
+                    return QueryResult("unsat", script, round(time.perf_counter() - t0, 4), core=core, strategy=name)
+                reasons.append(f"{name}: {s2.reason_unknown()}")
+        return QueryResult("inconclusive", script, dt, reason="; ".join(reasons) if len(reasons) > 1 else s.reason_unknown())
+
+
+def _retry_core(background: Sequence[z3.BoolRef], labelled: Sequence[tuple[str, z3.BoolRef]],
+                rewrite: Callable[[z3.BoolRef], z3.BoolRef]) -> list[str] | None:
+    """Labels of an unsat core of a query a retry found unsat: the formulas
+    tracked as ``label -> formula`` and checked under the labels, in a fresh
+    bounded context; ``None`` when that check is not ``unsat`` (the caller
+    then names every label, which is a core too)."""
+    s = bounded_solver()
+    s.set("smt.ematching", False)
+    s.set("unsat_core", True)
+    load_canonical(s, [rewrite(f) for f in background]
+                   + [z3.Implies(z3.Bool(f"__label_{k}", f.ctx), rewrite(f)) for k, (_, f) in enumerate(labelled)])
+    if s.check(*[z3.Bool(f"__label_{k}", s.ctx) for k in range(len(labelled))]) != z3.unsat:
+        return None
+    found = {str(c) for c in s.unsat_core()}
+    return [lbl for k, (lbl, _) in enumerate(labelled) if f"__label_{k}" in found]
+
+
+def render_model(model: z3.ModelRef, enc: Encoder | None) -> dict[str, str]:
+    """The free symbols of ``enc`` (or every declaration of ``model``) in RCL terms.
+
+    Constants map to their value (``green``, ``move(0.5, 1)``); functions to a
+    finite table ``{(0, 0) -> 3, else -> 0}``.  Names are the RCL names of the
+    symbols (``Agent.in.wayP``).
+    """
+    out: dict[str, str] = {}
+    decls = {d.name(): d for d in model.decls()}
+    names = ({n: s.display for n, s in enc.symbols.items()} if enc else {n: n for n in decls})
+    for z3name, display in sorted(names.items(), key=lambda kv: kv[1]):
+        d = decls.get(z3name)
+        if d is None:
+            continue
+        if d.arity() == 0:
+            out[display] = value_to_rcl(model.eval(d(), model_completion=True))
+            continue
+        interp = model[d]
+        if not isinstance(interp, z3.FuncInterp):
+            out[display] = str(interp)
+            continue
+        rows = []
+        for k in range(interp.num_entries()):
+            e = interp.entry(k)
+            args = ", ".join(value_to_rcl(e.arg_value(j)) for j in range(e.num_args()))
+            rows.append(f"({args}) -> {value_to_rcl(e.value())}")
+        else_v = interp.else_value()
+        params = [z3.Const(f"p{j + 1}", d.domain(j)) for j in range(d.arity())]
+        if else_v is None:
+            rows.append("else -> ?")
+        elif z3.is_app(else_v) and else_v.num_args() == 0 or z3.is_rational_value(else_v) or z3.is_int_value(else_v):
+            rows.append(f"else -> {value_to_rcl(else_v)}")
+        else:
+            table = finite_table(model, d, else_v, value_to_rcl)
+            if table is not None:  # an exact table: the points that differ, then the value elsewhere
+                rows = [f"({args}) -> {v}" for args, v in table[0]] + [f"else -> {table[1]}"]
+            else:
+                # Var(j) of a function interpretation stands for argument j (first to last)
+                body = z3.substitute_vars(else_v, *params) if params else else_v
+                rows.append(f"({', '.join(map(str, params))}) -> {term_to_rcl(body)}")
+        out[display] = "{" + ", ".join(rows) + "}"
+    return out

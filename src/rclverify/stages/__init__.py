@@ -1,0 +1,9 @@
+"""Layer 12, stages: the workspace on disk and the stages whose sealed
+records the report reads.
+
+``workspace`` (the loaded plan and contracts, artifact paths, snapshots,
+what makes a result stale), ``requirements`` (requirements decided from
+the composed contracts), ``deadlines`` (end-to-end deadlines), and
+``crosscheck/`` (every discharging query decided again by cvc5).  Imports
+``diagnosis`` and below.
+"""

@@ -1,0 +1,125 @@
+"""``rclverify bundle --recheck ARCHIVE``: every stored query decided again
+from the bundle alone, by both solvers (issue 50; docs/second-solver.md).
+
+Nothing of a workspace is read and no contract is parsed: the archive's
+sealed records name the items that discharge something
+(:func:`.items.discharging_items`), the second-solver record
+(``artifacts/crosscheck/index.json``) names each item's query and its
+sha256, and each query's SMT-LIB2 text is in the archive.  For each item:
+
+* the query in the archive must be the one that was decided (its sha256
+  is the record's): an edited query is named;
+* Z3 (from the text, a fresh solver, the query budget) must give the
+  answer the record's verdict rests on, and cvc5 the answer it recorded:
+  an opposite answer is named;
+* an item that the second-solver record does not list is named, and so
+  is a sealed record whose seal does not hold (an edited verdict).
+
+A ``unknown`` from either solver is reported (the verdict could not be
+re-established within the budget here) but is not a contradiction.
+"""
+from __future__ import annotations
+
+import hashlib
+import tempfile
+from dataclasses import dataclass
+from pathlib import Path
+
+from rclverify.records.sealed import check_text, is_sealed_path
+from rclverify.stages.crosscheck.cvc5_decide import Session, decide, version
+from rclverify.stages.crosscheck.items import discharging_items
+from rclverify.stages.crosscheck.stage import INDEX
+
+#: Z3's budget per query in the re-check, in resource steps (as the query module's 10 s budget).
+Z3_RLIMIT = 20_000_000
+
+
+@dataclass(frozen=True)
+class Recheck:
+    """The outcome: ``checked`` items re-decided, ``problems`` (sentences
+    naming an item: rc 1), ``notes`` (an answer not re-established)."""
+
+    checked: int
+    problems: list[str]
+    notes: list[str]
+
+
+def z3_answer(text: str, every: bool = False) -> str:
+    """Z3's answer (``sat``/``unsat``/``unknown``/``error``) to the last
+    query of the SMT-LIB2 script ``text`` (queries are joined by
+    ``(reset)``), from the text alone in a fresh context; with ``every``,
+    to each ``(push 1)`` ... ``(pop 1)`` scope of it (a Hoare triple's
+    conditions): ``unsat`` when all are, else the first other answer."""
+    if every:
+        import re
+        blocks = re.findall(r"\(push 1\)\n(.*?)\(pop 1\)", text, flags=re.S) or text.split("\n(reset)\n")
+        answers = [z3_answer(b) for b in blocks]
+        return next((a for a in answers if a != "unsat"), "unsat" if answers else "error")
+    import z3
+    last = text.split("\n(reset)\n")[-1]
+    ctx = z3.Context()
+    s = z3.Solver(ctx=ctx)
+    s.set("rlimit", Z3_RLIMIT)
+    try:
+        s.from_string(last)
+        return str(s.check())
+    except z3.Z3Exception:
+        return "error"
+
+
+def recheck_members(members: dict[str, bytes]) -> Recheck:
+    """Re-decide the items of an archive's ``members`` (name -> bytes, as
+    :func:`rclverify.report.bundle.archive.verify_bundle` keeps them)."""
+    problems: list[str] = []
+    notes: list[str] = []
+    raw = members.get(INDEX)
+    if raw is None:
+        return Recheck(0, [f"{INDEX}: not in the bundle: no second-solver record to re-check against"], [])
+    index, why = check_text(raw.decode("utf-8", "replace"), "second-solver record")
+    if why or index is None:
+        return Recheck(0, [f"{INDEX}: {why or 'unreadable'}"], [])
+    rows = {(str(r.get("kind")), str(r.get("id"))): r for r in index.get("items", []) if isinstance(r, dict)}
+    for name in sorted(members):  # a verdict edited in a sealed record: its seal no longer holds
+        if is_sealed_path(name):
+            _, bad = check_text(members[name].decode("utf-8", "replace"), "record")
+            if bad:
+                problems.append(f"{name}: {bad}")
+    with tempfile.TemporaryDirectory() as tmp:  # the records only, to read them as the stage does
+        root = Path(tmp)
+        for name, data in members.items():
+            if name.startswith("artifacts/") and name.endswith(".json"):
+                p = root / name
+                p.parent.mkdir(parents=True, exist_ok=True)
+                p.write_bytes(data)
+        nodes = sorted(p.stem for p in (root / "artifacts/calculus").glob("*.json"))
+        items = discharging_items(root, nodes)
+    has_cvc5 = bool(version())
+    session = Session() if has_cvc5 else None
+    for it in items:
+        label = f"{it.kind} {it.id}"
+        row = rows.get((it.kind, it.id))
+        if row is None:
+            problems.append(f"{label}: recorded {it.verdict} but not in {INDEX}: never decided by the second solver")
+            continue
+        data = members.get(it.smt2)
+        if data is None:
+            problems.append(f"{label}: its query {it.smt2} is not in the bundle")
+            continue
+        if hashlib.sha256(data).hexdigest() != row.get("sha256") or row.get("smt2") != it.smt2:
+            problems.append(f"{label}: its query {it.smt2} was edited after it was decided "
+                            f"(sha256 differs from {INDEX})")
+            continue
+        text = data.decode("utf-8", "replace")
+        z = z3_answer(text, it.every)
+        if z != it.expects:
+            (notes if z in ("unknown", "error") else problems).append(
+                f"{label}: recorded {it.verdict} (Z3 {it.expects}); Z3 now answers {z} on {it.smt2}")
+        recorded = (row.get("cvc5") or {}).get("answer")
+        if has_cvc5 and recorded in ("sat", "unsat"):
+            c = decide(text, it.smt2, proofs=recorded == "unsat", every=it.every, session=session)
+            if c.answer != recorded:
+                (notes if c.answer in ("unknown", "error") else problems).append(
+                    f"{label}: cvc5 recorded {recorded}, now answers {c.answer} on {it.smt2}")
+    if not has_cvc5:
+        notes.append("cvc5 is not installed: the second solver's answers were not re-decided (pip install cvc5)")
+    return Recheck(len(items), problems, notes)

@@ -1,0 +1,178 @@
+"""The ``requirements`` stage: check every requirement, write its record.
+
+Writes ``artifacts/requirements/<ID>.json`` (the record of
+:func:`.check.check_requirement` plus its ``fingerprint`` and ``inputs``,
+the sha256 of each contract snapshot of its cone and of the system model),
+``artifacts/requirements/<ID>.smt2`` (the query), ``<ID>.consistency.smt2``
+and ``<ID>.vacuity.smt2`` (a proved requirement's side queries, when Z3
+decided them) and
+``artifacts/requirements/index.json`` (``{"records": {id: sha256 of the
+record}}``, in requirement order: the report tasks depend on it).  Records
+and index are sealed (:mod:`rclverify.records.sealed`); a record whose seal
+does not hold is checked again, never reused.  A requirement whose
+fingerprint (its statements, the contract snapshots of its cone, the system
+model) equals the recorded one is not checked again, so editing one
+contract re-checks only the requirements whose cone contains that node.
+Records of requirements no longer in the plan are removed.
+"""
+from __future__ import annotations
+
+import hashlib
+import json
+import re
+from typing import TYPE_CHECKING, Any
+
+from rclverify.records.sealed import read_sealed, write_sealed
+from rclverify.records.store import atomic_write_text, dumps
+
+if TYPE_CHECKING:
+    from rclverify.stages.workspace import Workspace
+
+DIR = "artifacts/requirements"
+INDEX = f"{DIR}/index.json"
+_SAFE = re.compile(r"[^A-Za-z0-9_.-]+")
+
+
+#: The side queries of a proved requirement whose scripts are kept beside its record
+#: (``artifacts/requirements/<ID>.<side>.smt2``, ``<side>_smt2`` in the record).
+SIDE_QUERIES = ("consistency", "vacuity")
+
+
+def record_path(req_id: str) -> str:
+    """Workspace-relative path of a requirement's record."""
+    return f"{DIR}/{_SAFE.sub('_', req_id)}.json"
+
+
+def _read(path: Any) -> dict[str, Any] | None:
+    """The sealed record at ``path``; ``None`` when absent or not intact."""
+    rec, problem = read_sealed(path)
+    return None if problem else rec
+
+
+def stage_requirements(ws: "Workspace", *, force: bool = False) -> list[tuple[dict[str, Any], bool]]:
+    """Check the requirements of ``ws`` (module docstring).  Returns
+    ``(record, checked_now)`` per requirement, in plan order (the plan's,
+    then the Doorstop items').  Raises ``RclError`` for contracts or a plan
+    that do not check."""
+    from rclverify.model.plan.load import all_requirements
+    import z3
+
+    from rclverify.semantics.world import fresh
+    from rclverify.core.cache import code_stamp
+    from rclverify.calculus.requirements.check import check_requirement, cone_of, fingerprint, state_text, statement_formals
+    from rclverify.backends.monitors.temporal_evidence import fingerprint_text, requirement_traces, trace_hashes, trace_rows
+    code = f"{code_stamp()} z3 {z3.get_version_string()}"
+    checked, model, plan = ws.checked, ws.model, ws.plan
+    model_text = (ws.root / ws.MODEL).read_text(encoding="utf-8") if (ws.root / ws.MODEL).is_file() else \
+        json.dumps(model.to_json(), sort_keys=True)
+    model_hash = hashlib.sha256(dumps(model.to_json()).encode("utf-8")).hexdigest()  # as the report takes it
+    snaps: dict[str, str] = {}
+
+    def snap(n: str) -> str:
+        if n not in snaps:
+            p = ws.root / ws.snapshot(n)
+            snaps[n] = p.read_text(encoding="utf-8") if p.is_file() else ""
+        return snaps[n]
+    out: list[tuple[dict[str, Any], bool]] = []
+    index: dict[str, str] = {}
+    keep = set()
+    for req in all_requirements(plan):
+        formals = statement_formals(req, checked, plan)
+        formal = formals[0] if formals else None
+        cone = cone_of(formals, model) if formal is not None else []
+        # a temporal requirement also reads the state declarations of its cone (plan.states)
+        traces = requirement_traces(req, checked, plan)  # recorded runs checked against it (docs/plan.md)
+        th = trace_hashes(ws.root, traces)
+        fp = fingerprint(req, [snap(n) for n in cone] + [state_text(plan, cone)] + ([fingerprint_text(ws.root, traces)] if traces else []),
+                         model_text if formal is not None else "", code)
+        rel = record_path(req.id)
+        keep.add(rel.rsplit("/", 1)[1])
+        old = None if force else _read(ws.root / rel)
+        if old is not None and old.get("fingerprint") == fp:
+            rec, now = old, False
+        else:
+            fresh()  # each check in the same Z3 state whatever ran before it (semantics/world.py)
+            rec = check_requirement(req, checked, model, plan)
+            smt2 = rec.pop("smt2", None)
+            if smt2 is not None:
+                rec["smt2"] = rel[:-5] + ".smt2"
+                atomic_write_text(ws.root / rec["smt2"], smt2)
+                keep.add(rec["smt2"].rsplit("/", 1)[1])
+            for side in SIDE_QUERIES:  # the consistency and vacuity queries, for the second solver
+                text = rec.pop(f"{side}_smt2", None)
+                if text is not None:
+                    rec[f"{side}_smt2"] = rel[:-5] + f".{side}.smt2"
+                    atomic_write_text(ws.root / rec[f"{side}_smt2"], text)
+            rec["fingerprint"] = fp
+            rec["inputs"] = input_hashes(ws, cone, snap, model_hash) if formal is not None else {}
+            if traces:
+                rec["traces"] = trace_rows(req, checked, plan, ws.root)
+                rec["inputs"].update(th)
+            write_sealed(ws.root / rel, rec)
+            now = True
+        for key in ("smt2", *(f"{side}_smt2" for side in SIDE_QUERIES)):
+            if rec.get(key):
+                keep.add(rec[key].rsplit("/", 1)[1])
+        index[req.id] = hashlib.sha256((ws.root / rel).read_bytes()).hexdigest()
+        out.append((rec, now))
+    write_sealed(ws.root / INDEX, {"records": index})
+    keep.add("index.json")
+    for old_file in (ws.root / DIR).glob("*"):
+        if old_file.is_file() and old_file.name not in keep:
+            old_file.unlink()
+    return out
+
+
+def input_hashes(ws: "Workspace", cone: list[str], snap: Any, model_hash: str) -> dict[str, str]:
+    """``{artifacts/contracts/<Node>.json: sha256, artifacts/system/model.json: sha256}``
+    of the snapshots of ``cone`` (``snap(node)`` gives a snapshot's text) and
+    the model a record is made from: the hashes the report compares with the
+    current ones (:func:`read_records`)."""
+    from rclverify.model.plan.state import state_key, state_sha256
+    out = {ws.snapshot(n): hashlib.sha256(snap(n).encode("utf-8")).hexdigest() for n in cone}
+    out.update({state_key(n): state_sha256(ws.plan.states, n) for n in cone})  # a state: edit is stale too
+    out[ws.MODEL] = model_hash
+    return out
+
+
+def read_records(ws: "Workspace", current: dict[str, str] | None = None) -> dict[str, dict[str, Any]]:
+    """The records named by ``index.json`` (``{}`` before the stage ran), by
+    requirement id, as the report may show them:
+
+    * a record (or the index) whose seal does not hold is replaced by
+      ``{"verdict": "error", "reason": why, ...}`` (keeping the statements it
+      claims to be about, so that :func:`rclverify.report.build.current_record`
+      matches it): never the verdict it claims;
+    * with ``current`` (path -> sha256 of the contract snapshots and model
+      the current contracts and plan give,
+      :func:`rclverify.stages.workspace.current_snapshot_hashes`), a record made
+      from other inputs (a hash differs, or it records none) is replaced by
+      ``{"verdict": "stale", "recorded_verdict": ..., ...}``.
+    """
+    index, problem = read_sealed(ws.root / INDEX, "requirement index")
+    if index is None:
+        return {}
+    ids = index.get("records") if isinstance(index.get("records"), dict) else {}
+    out: dict[str, dict[str, Any]] = {}
+    for rid in ids:
+        rec, why = read_sealed(ws.root / record_path(rid), "requirement record")
+        if rec is None and not why:
+            continue
+        keep = {k: rec.get(k) for k in ("id", "formal", "assuming", "ranking", "invariant", "source",
+                                           "origin", "text")} if rec else {}
+        if why or problem:
+            out[rid] = {**keep, "verdict": "error", "reason": f"{record_path(rid)}: {why or problem}"}
+            continue
+        assert rec is not None
+        made = rec.get("inputs")
+        if current is not None and isinstance(made, dict):  # a recorded run's sha256 now (trace:<path>)
+            from rclverify.backends.monitors.temporal_evidence import trace_hashes
+            current = {**current, **trace_hashes(ws.root, [(p[6:], None) for p in made
+                                                           if p.startswith("trace:") and p not in current])}
+        if current is not None and rec.get("verdict") != "informal" and (
+                not isinstance(made, dict) or any(current.get(p) != h for p, h in made.items())):
+            out[rid] = {**keep, "verdict": "stale", "recorded_verdict": rec.get("verdict"),
+                        "reason": f"{record_path(rid)} was made from another text of the contracts or plan"}
+            continue
+        out[rid] = rec
+    return out
