@@ -210,7 +210,7 @@ def test_published_files_take_the_umask_mode(tmp_path: Path) -> None:
 HOLD = """
 import sys
 from pathlib import Path
-from rclverify import runlock
+from rclverify.core import runlock
 runlock.acquire(Path(sys.argv[1]))
 print("held", flush=True)
 sys.stdin.read()

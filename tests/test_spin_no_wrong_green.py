@@ -288,7 +288,7 @@ def _procs() -> list[tuple[int, str, int, int]]:
 RUN_ONE = """
 import sys
 from pathlib import Path
-from rclverify import pipeline
+from rclverify.app import pipeline
 from rclverify.lang.errors import RclError
 ws = pipeline.Workspace(Path(sys.argv[1]))
 try:
