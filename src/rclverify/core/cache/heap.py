@@ -45,6 +45,7 @@ import gc
 import os
 from contextlib import contextmanager
 from typing import Iterator
+import atexit
 
 _WORKER: list[int] = []
 _RUN: list[bool] = []
@@ -100,8 +101,8 @@ def keep_freed_memory() -> bool:
         return _MALLOPT[0]
     ok = False
     try:
-        import ctypes
-        import ctypes.util
+        import ctypes  # deferred: optional or conditional (inside a block)
+        import ctypes.util  # deferred: optional or conditional (inside a block)
         name = ctypes.util.find_library("c")
         libc = ctypes.CDLL(name) if name else None
         mallopt = getattr(libc, "mallopt", None)
@@ -124,7 +125,7 @@ def release_after_run() -> None:
 def freeze_inherited() -> None:
     """In a process forked by ``doit -n`` (a ``multiprocessing`` child),
     freeze the heap it inherited, once per process; nothing elsewhere."""
-    import multiprocessing
+    import multiprocessing  # deferred: start-up (this module loads at every `rclverify`/doit start; the import does not)
     pid = os.getpid()
     if _WORKER == [pid] or multiprocessing.parent_process() is None:
         return
@@ -142,6 +143,5 @@ def freeze_at_exit() -> None:
     operating system at exit either way."""
     if _EXIT:
         return
-    import atexit
     atexit.register(gc.freeze)
     _EXIT.append(True)

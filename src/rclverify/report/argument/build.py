@@ -42,6 +42,9 @@ from rclverify.report.argument.deadlines import own_check, with_deadline
 from rclverify.report.argument.statistics import with_statistics
 from rclverify.report.argument.model import Argument, Element, propagate
 from rclverify.report.textfmt import natural_key
+from rclverify.report.argument.defeaters import add_defeaters
+from rclverify.report.argument.accepted import add_accepted_risks
+from rclverify.report.argument.claim_points import add_claim_points
 
 _FINDING_AS = {"ok": "discharged", "problem": "failed", "inconclusive": "inconclusive", "stale": "stale"}
 _ID_BAD = re.compile(r"[^A-Za-z0-9_.\-]+")
@@ -316,11 +319,8 @@ def build_argument(report: Mapping[str, Any]) -> Argument:
     ids = ", ".join(str(r["id"]) for r in reqs) or "no requirement listed"
     b.els = {top: Element(top, "goal", f"The system {meta['workspace']} meets its requirements ({ids})",
                           supported_by=(s_reqs, s_contracts), in_context_of=top_ctx), **b.els}
-    from rclverify.report.argument.defeaters import add_defeaters  # counter-evidence as the dialectic extension's defeaters (issue 50)
     add_defeaters(b.els, report, ident)
-    from rclverify.report.argument.accepted import add_accepted_risks  # warnings acknowledged in the plan, as accepted risks (issue 64)
     add_accepted_risks(b.els, report, ident, top)
-    from rclverify.report.argument.claim_points import add_claim_points  # where confidence is argued (issue 50)
     add_claim_points(b.els, report, ident)
     return propagate(Argument(top, b.els))
 
