@@ -32,6 +32,14 @@ Usage::
     python3 bench/system_scale.py                          # N = 1000, local, then 1 and 2 workers
     python3 bench/system_scale.py --sizes 200 --workers 2 -n 2
     python3 bench/system_scale.py --smoke                  # N = 12, local: a few seconds (CI)
+    python3 bench/system_scale.py --sizes 200 --workers 0,2 --isolated   # workers as on other machines
+
+``--isolated`` starts the workers with ``RCLVERIFY_CLUSTER_ISOLATED=1``,
+each in its own working folder: they do not read the workspace's folder, so
+the sources travel to them once and each job's artifacts with it, as on
+machines that share no file system (docs/scale.md, "Workers that do not
+share the file system"); the ``copy MB`` column is the size of their
+copies when the run ends.
 
 The figures are printed, not asserted (the issue's aims: cold within 3
 minutes and 2 GiB on 2 cores, a no-op re-run within 2 s).
@@ -143,14 +151,20 @@ class Cluster:
     """A local Dask cluster of ``workers`` single-threaded worker processes on
     127.0.0.1 (none: the jobs run in the doit processes)."""
 
-    def __init__(self, workers: int) -> None:
+    def __init__(self, workers: int, isolated: bool = False, folder: Path | None = None) -> None:
         self.workers, self.cluster, self.client = workers, None, None
+        self.isolated, self.folder = isolated, folder
 
     def __enter__(self) -> "Cluster":
         if self.workers:
             import distributed
+            if self.isolated:  # the worker processes inherit it: they never run a job in the workspace's folder
+                os.environ["RCLVERIFY_CLUSTER_ISOLATED"] = "1"
+            extra = {"local_directory": str(self.folder)} if self.folder is not None else {}
             self.cluster = distributed.LocalCluster(n_workers=self.workers, threads_per_worker=1, processes=True,
-                                                    dashboard_address=None, host="127.0.0.1", protocol="tcp://")
+                                                    dashboard_address=None, host="127.0.0.1", protocol="tcp://",
+                                                    **extra)
+            os.environ.pop("RCLVERIFY_CLUSTER_ISOLATED", None)
             self.client = distributed.Client(self.cluster)
             os.environ["RCLVERIFY_CLUSTER"] = self.cluster.scheduler_address
         return self
@@ -165,6 +179,12 @@ class Cluster:
             u = resource.getrusage(resource.RUSAGE_SELF)
             return u.ru_utime + u.ru_stime
         return sum(self.client.run(used).values())
+
+    def working_folders_mb(self) -> float:
+        """The size of the workers' working folders (megabytes): the copies of the workspace they run in."""
+        if self.folder is None or not self.folder.exists():
+            return 0.0
+        return sum(p.stat().st_size for p in self.folder.rglob("*") if p.is_file()) / 1e6
 
     def __exit__(self, *exc: object) -> None:
         os.environ.pop("RCLVERIFY_CLUSTER", None)
@@ -184,6 +204,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     ap.add_argument("--hoare", type=int, default=1, metavar="EVERY")
     ap.add_argument("--property-tests", type=int, default=10, metavar="EVERY")
     ap.add_argument("--keep", help="write the workspaces under this directory and keep them")
+    ap.add_argument("--isolated", action="store_true", help="workers in their own working folders that never read "
+                                                            "the workspace's folder (as on other machines)")
     ap.add_argument("--smoke", action="store_true", help="N = 12, local, no property tests (CI; the cluster "
                                                          "path is tests/test_cluster.py's)")
     args = ap.parse_args(argv)
@@ -196,7 +218,7 @@ def main(argv: Sequence[str] | None = None) -> int:
           f"node, deadlines every {args.deadlines}th, hoare every {args.hoare}th, property tests every "
           f"{args.property_tests}th")
     header = (f"{'nodes':>6} {'svc':>4} {'ddl':>4} {'mode':>9} {'cold s':>7} {'(cpu)':>7} {'wrk cpu':>7} {'MB':>5} "
-              f"{'no-op s':>7} {'ran':>3}  verdicts")
+              f"{'no-op s':>7} {'ran':>3} {'copy MB':>7}  verdicts")
     print(header)
     print("-" * len(header))
     try:
@@ -208,17 +230,20 @@ def main(argv: Sequence[str] | None = None) -> int:
                     shutil.rmtree(root)
                 counts = generate(root, n, services=args.services, deadlines=args.deadlines, hoare=args.hoare,
                                   property_tests=args.property_tests)
-                with Cluster(w) as cl:
+                folder = base / f"n{n}-w{w}-workers" if w and args.isolated else None
+                with Cluster(w, args.isolated, folder) as cl:
                     cold = doit_verify(root, args.jobs)
                     wcpu = cl.cpu()
+                    copies_mb = cl.working_folders_mb()
                     if cold.rc != 0:
                         print(f"{n:>6}  cold run failed (exit {cold.rc}):\n{cold.output[-3000:]}")
                         return 1
                     noop = doit_verify(root, args.jobs)
                 got = verdicts(root)
-                mode = "local" if not w else f"{w} worker" + ("s" if w > 1 else "")
+                mode = "local" if not w else f"{w} worker" + ("s" if w > 1 else "") + (" (iso)" if args.isolated else "")
                 print(f"{n:>6} {counts['services']:>4} {counts['deadlines']:>4} {mode:>9} {cold.seconds:>7.1f} "
-                      f"{cold.cpu:>7.1f} {wcpu:>7.1f} {cold.peak_mb:>5.0f} {noop.seconds:>7.2f} {len(noop.ran):>3}  "
+                      f"{cold.cpu:>7.1f} {wcpu:>7.1f} {cold.peak_mb:>5.0f} {noop.seconds:>7.2f} {len(noop.ran):>3} "
+                      f"{copies_mb:>7.1f}  "
                       f"{json.dumps(got)}", flush=True)
                 if seen is not None and got != seen:
                     print(f"{n:>6}  the verdicts differ from the local run's: {seen}")
@@ -231,7 +256,7 @@ def main(argv: Sequence[str] | None = None) -> int:
             shutil.rmtree(base, ignore_errors=True)
     print("cold/no-op: wall-clock seconds of one `doit verify`; (cpu): CPU seconds of doit and its children; "
           "wrk cpu: the Dask workers' own CPU seconds; MB: peak RSS of the largest doit process; ran: tasks the "
-          "no-op run executed (0 expected).")
+          "no-op run executed (0 expected); copy MB: the workers' copies of the workspace (--isolated).")
     return 0
 
 

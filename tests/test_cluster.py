@@ -124,3 +124,72 @@ def test_unreachable_cluster_fails_the_job_with_one_message(tmp_path: Path) -> N
     assert "cannot reach the Dask scheduler at tcp://127.0.0.1:9" in r.stdout + r.stderr
     assert "Traceback" not in r.stdout + r.stderr
     assert not list((ws / "artifacts" / "evidence").glob("*.json"))
+
+
+def _artifact_files(ws: Path) -> dict[str, list[str]]:
+    """Every artifact but the evidence records, caches and locks: path -> its lines, timing lines aside."""
+    art = ws / "artifacts"
+    skip = ("evidence/", "cache/")
+    return {p.relative_to(art).as_posix(): _without_timing_lines(p.read_text(errors="replace"))
+            for p in sorted(art.rglob("*"))
+            if p.is_file() and not p.relative_to(art).as_posix().startswith(skip) and not p.name.endswith(".lock")}
+
+
+def test_workers_that_cannot_see_the_workspace_run_in_their_own_copy(tmp_path: Path,
+                                                                    monkeypatch: pytest.MonkeyPatch) -> None:
+    """Workers in their own processes and working folders, told not to read the submitting machine's
+    paths (as on other machines): the workspace's sources go to them, the jobs run in their copy, and
+    the evidence and every artifact the jobs wrote equal a local run's."""
+    local = _workspace(tmp_path / "local")
+    r = _verify(local)
+    assert r.returncode == 0, r.stdout + r.stderr
+    remote = tmp_path / "remote"
+    shutil.copytree(local, remote, ignore=shutil.ignore_patterns("artifacts", "reports", ".doit.db*", ".doit.sqlite*"))
+    folder = tmp_path / "worker-folder"
+    monkeypatch.setenv("RCLVERIFY_CLUSTER_ISOLATED", "1")  # the worker processes inherit it
+    with distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=True, dashboard_address=None,
+                                  protocol="tcp://", host="127.0.0.1", local_directory=str(folder)) as cluster:
+        r = _verify(remote, "--cluster", cluster.scheduler_address)
+        assert r.returncode == 0, r.stdout + r.stderr
+        # (Dask removes a worker's folder when the worker closes)
+        copies = list(folder.rglob("rclverify-workspaces/*/contracts/plan.yaml"))
+        assert len(copies) == 1  # the sources went once, and the jobs ran there
+        copy = copies[0].parents[1]
+        assert (copy / "artifacts" / "obligations" / "N1.json").is_file()
+        assert not list(copy.glob("artifacts/evidence/*.json"))  # the records came back as JSON only
+    assert _evidence(remote) == _evidence(local)
+    assert _artifact_files(remote) == _artifact_files(local)
+
+
+def test_a_worker_runs_in_place_only_where_the_sources_are_the_same(tmp_path: Path,
+                                                                     monkeypatch: pytest.MonkeyPatch) -> None:
+    """A folder at the workspace's path whose backend input differs (a stale copy on a worker's
+    machine) is not used: its evidence would be of other files."""
+    from rclverify.app import cluster, cluster_files
+    ws = _workspace(tmp_path / "ws")
+    key = cluster_files.digest(ws)
+    assert cluster._in_place(str(ws), "contracts/plan.yaml", key)
+    (ws / "backends" / "hoare" / "clamp.imp").write_text(CLAMP.replace("y := 0", "y := 1"))
+    assert not cluster._in_place(str(ws), "contracts/plan.yaml", key)
+    (ws / "backends" / "hoare" / "clamp.imp").write_text(CLAMP)
+    assert cluster._in_place(str(ws), "contracts/plan.yaml", key)
+    monkeypatch.setenv("RCLVERIFY_CLUSTER_ISOLATED", "1")
+    assert not cluster._in_place(str(ws), "contracts/plan.yaml", key)
+    # artifacts and reports are not sources: a run's outputs leave the digest alone
+    (ws / "artifacts").mkdir()
+    (ws / "artifacts" / "x.json").write_text("{}")
+    assert cluster_files.digest(ws) == key
+
+
+def test_shipped_files_are_checked_and_stay_in_the_worker_folder(tmp_path: Path) -> None:
+    from rclverify.app import cluster_files
+    ws = _workspace(tmp_path / "ws")
+    name, blob = cluster_files.digest(ws), cluster_files.archive(ws)
+    with pytest.raises(cluster_files.ShippingError, match="damaged"):
+        cluster_files.materialise(tmp_path / "w1", name, blob.replace(b"y := x", b"y := 7"))
+    assert not list((tmp_path / "w1" / "rclverify-workspaces").iterdir())  # nothing half-made left
+    copy = cluster_files.materialise(tmp_path / "w1", name, blob)
+    assert (copy / "backends" / "hoare" / "clamp.imp").read_text() == CLAMP
+    with pytest.raises(cluster_files.ShippingError, match="leave"):
+        cluster_files.place(copy, {"../escape.txt": b"x"})
+    assert not (tmp_path / "w1" / "rclverify-workspaces" / "escape.txt").exists()

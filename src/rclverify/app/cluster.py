@@ -14,14 +14,17 @@ the workspace's evidence store (``artifacts/evidence/<id>.json``, atomically).
 The record is therefore byte for byte the one a local run writes, except the
 timing fields ``started`` and ``duration_s``.
 
-Requirement: the workers see the workspace at the same absolute path as the
-local process (a shared file system, or a cluster on this machine), since a
-job reads the contracts, the plan and the backend inputs, hashes them into
-the evidence and renders the backend's artifacts next to them.
+A worker that sees the workspace at the same absolute path as the local
+process (a shared file system, or a cluster on this machine), with the same
+plan and contracts, runs the job in place.  A worker that does not (another
+machine, or a worker started with ``RCLVERIFY_CLUSTER_ISOLATED=1``) answers
+that it needs the files; the local process then sends the workspace's
+sources once per run and each job's share of ``artifacts/`` with the job,
+the worker runs it in a copy in its own working folder, and the files the
+job wrote come back with the record (:mod:`rclverify.app.cluster_files`).
 """
 from __future__ import annotations
 
-import hashlib
 import json
 import os
 import warnings
@@ -33,11 +36,17 @@ from rclverify.records.store import EvidenceStore
 
 #: Environment variable read by the ``evidence`` tasks of ``doit verify``.
 CLUSTER_ENV = "RCLVERIFY_CLUSTER"
+#: Set on a worker whose file system is not the submitting machine's: never run a job in place.
+ISOLATED_ENV = "RCLVERIFY_CLUSTER_ISOLATED"
+#: The answer of a worker that cannot see the workspace.
+NEEDS_FILES = "rclverify-needs-files"
 #: Seconds to wait for the scheduler before the job fails.
 CONNECT_TIMEOUT_S = 30
 
 _CLIENTS: dict[str, Any] = {}
 _WORKER_WORKSPACES: dict[tuple[str, str, str], Any] = {}
+#: Per (address, workspace root): the scattered sources (digest, future) once the cluster asked for files.
+_SHIPPED: dict[tuple[str, str], tuple[str, Any]] = {}
 
 
 class ClusterError(Exception):
@@ -50,28 +59,71 @@ def address() -> str | None:
     return value or None
 
 
-def workspace_key(root: Path, plan_file: str, contracts: tuple[str, ...]) -> str:
-    """sha256 over the plan and contract files: a worker reloads its cached
-    workspace when it differs (a long-lived worker outlives a contract edit)."""
-    h = hashlib.sha256()
-    for rel in (plan_file, *contracts):
-        h.update(rel.encode() + b"\0")
-        try:
-            h.update(hashlib.sha256((root / rel).read_bytes()).digest())
-        except OSError:
-            h.update(b"-")
-    return h.hexdigest()
+def _in_place(root: str, plan_file: str, key: str) -> bool:
+    """Can this worker run the job in the submitting process's own folder?"""
+    if os.environ.get(ISOLATED_ENV, "").strip() not in ("", "0"):
+        return False
+    if (root, plan_file, key) in _WORKER_WORKSPACES:
+        return True
+    path = Path(root)
+    if not (path / plan_file).is_file():
+        return False
+    from rclverify.app import cluster_files
+    try:
+        return cluster_files.digest(path) == key
+    except cluster_files.ShippingError:
+        return False
 
 
-def remote_run(root: str, plan_file: str, key: str, node: str, obligation_id: str) -> str:
+def _working_folder() -> Path:
+    """The worker's own working folder (Dask's ``local_directory``), else the temporary folder."""
+    try:
+        from dask.distributed import get_worker
+        return Path(get_worker().local_directory)
+    except (ImportError, ValueError):
+        import tempfile
+        return Path(tempfile.gettempdir())
+
+
+def remote_run(root: str, plan_file: str, key: str, node: str, obligation_id: str,
+               shipped: tuple[str, bytes, dict[str, bytes]] | None = None) -> str:
     """The job a worker runs: the backend of one exported obligation.
 
-    Returns the evidence record as JSON text; writes no evidence (the
-    submitting process does).  The workspace is loaded once per worker and
-    ``key`` (see :func:`workspace_key`).
+    ``key`` is the sha256 of the workspace's sources
+    (:func:`rclverify.app.cluster_files.digest`).  Without ``shipped``, runs
+    in the workspace at ``root`` when this worker sees the same sources
+    there, else returns :data:`NEEDS_FILES`.  With ``shipped`` (the
+    sources' digest and archive, the node's artifact files), runs in the
+    worker's copy (:mod:`rclverify.app.cluster_files`).
+
+    Returns JSON text: ``{"evidence": record, "files": {path: base64}}``
+    (the files the job wrote under ``artifacts/``; none when run in place),
+    or :data:`NEEDS_FILES`.  Writes no evidence (the submitting process does).
+    The workspace is loaded once per worker and sources' digest.
     """
-    from rclverify.core.cache import workspace as wscache
+    import base64
+
+    from rclverify.app import cluster_files
+    files: dict[str, str] = {}
+    if shipped is None:
+        if not _in_place(root, plan_file, key):
+            return NEEDS_FILES
+        where = Path(root)
+    else:
+        name, blob, own = shipped
+        where = cluster_files.materialise(_working_folder(), name, blob)
+        cluster_files.place(where, own)
+    before = cluster_files.listing(where) if shipped is not None else {}
+    ev = _run_here(str(where), plan_file, key, node, obligation_id)
+    if shipped is not None:
+        files = {rel: base64.b64encode(data).decode() for rel, data in cluster_files.changed_files(where, before).items()}
+    return json.dumps({"evidence": ev.to_json(), "files": files})
+
+
+def _run_here(root: str, plan_file: str, key: str, node: str, obligation_id: str) -> Evidence:
+    """One obligation's backend run in the workspace at ``root`` (loaded once per worker and ``key``)."""
     from rclverify.backends import get_backend
+    from rclverify.core.cache import workspace as wscache
     from rclverify.records.records import Obligation
     from rclverify.records.store import read_json
     from rclverify.semantics.world import fresh as fresh_z3
@@ -89,8 +141,7 @@ def remote_run(root: str, plan_file: str, key: str, node: str, obligation_id: st
         # its examples, and Hypothesis takes that for a strategy using `random` (ours do not: a local run
         # never warns); the warning would print the whole workspace's repr in the worker's log
         warnings.filterwarnings("ignore", message="Do not use the `random` module inside strategies")
-        ev = get_backend(o.backend).run(o, ws.target(node, int(o.data.get("entry", 0))))
-    return json.dumps(ev.to_json())
+        return get_backend(o.backend).run(o, ws.target(node, int(o.data.get("entry", 0))))
 
 
 def _client(addr: str) -> Any:
@@ -105,24 +156,69 @@ def _client(addr: str) -> Any:
     return client
 
 
+def _shipment(addr: str, client: Any, ws: Any, node: str) -> tuple[str, Any, dict[str, bytes]]:
+    """The job's ``shipped`` argument: the sources scattered once per (address, workspace), the node's files."""
+    from rclverify.app import cluster_files
+    root = ws.root.resolve()
+    have = _SHIPPED.get((addr, str(root)))
+    if have is None:
+        have = (_sources_digest(root), client.scatter(cluster_files.archive(root), hash=False))
+        _SHIPPED[(addr, str(root))] = have
+    return have[0], have[1], cluster_files.node_files(root, node)
+
+
+_DIGESTS: dict[str, str] = {}
+
+
+def _sources_digest(root: Path) -> str:
+    """The sources' digest, taken once per process (a doit run's processes see one version of the sources)."""
+    key = str(root)
+    if key not in _DIGESTS:
+        from rclverify.app import cluster_files
+        _DIGESTS[key] = cluster_files.digest(root)
+    return _DIGESTS[key]
+
+
 def run_on_cluster(addr: str, ws: Any, node: str, obligation_id: str) -> Evidence:
     """Run one obligation's backend job on the cluster at ``addr`` and store
-    the returned evidence record in ``ws``'s evidence store.
+    the returned evidence record in ``ws``'s evidence store, and the files
+    the job wrote (when it ran in a worker's copy) in ``ws``'s artifacts.
 
-    ``ws`` is the local :class:`~rclverify.app.pipeline.Workspace`.  Raises
-    :class:`ClusterError` when the scheduler cannot be reached or the job
-    raised on the worker.
+    ``ws`` is the local :class:`~rclverify.stages.workspace.Workspace`.  Raises
+    :class:`ClusterError` when the scheduler cannot be reached, the
+    workspace cannot be sent, or the job raised on the worker.
     """
+    import base64
+
+    from rclverify.app import cluster_files
+    from rclverify.core.atomic import atomic_write_bytes
     root = str(ws.root.resolve())
-    key = workspace_key(ws.root, ws.plan_file, tuple(ws.plan.contracts))
     client = _client(addr)
-    future = client.submit(remote_run, root, ws.plan_file, key, node, obligation_id, pure=False,
-                           key=f"rclverify-run-{obligation_id}-{os.urandom(4).hex()}")
+    text = None
     try:
-        text = future.result()
+        key = _sources_digest(ws.root.resolve())
+        for attempt in range(2):
+            shipped = None
+            if attempt or (addr, root) in _SHIPPED:
+                shipped = _shipment(addr, client, ws, node)
+            future = client.submit(remote_run, root, ws.plan_file, key, node, obligation_id, shipped, pure=False,
+                                   key=f"rclverify-run-{obligation_id}-{os.urandom(4).hex()}")
+            text = future.result()
+            if text != NEEDS_FILES:
+                break
+    except cluster_files.ShippingError as exc:
+        raise ClusterError(str(exc)) from None
     except Exception as exc:  # the job's own exception, re-raised by dask
         raise ClusterError(f"the job for {obligation_id} failed on the cluster at {addr}: "
                            f"{type(exc).__name__}: {exc}") from None
-    ev = Evidence.from_json(json.loads(text))
+    if text is None or text == NEEDS_FILES:
+        raise ClusterError(f"the job for {obligation_id} found no workspace on the cluster at {addr}")
+    answer = json.loads(text)
+    for rel, data in sorted(answer["files"].items()):
+        target = ws.root / rel
+        if not target.resolve().is_relative_to(ws.root.resolve()):
+            raise ClusterError(f"the job for {obligation_id} sent back a file outside the workspace: {rel}")
+        atomic_write_bytes(target, base64.b64decode(data))
+    ev = Evidence.from_json(answer["evidence"])
     EvidenceStore(ws.root).put(ev)
     return ev
