@@ -113,10 +113,10 @@ def remote_run(root: str, plan_file: str, key: str, node: str, obligation_id: st
         name, blob, own = shipped
         where = cluster_files.materialise(_working_folder(), name, blob)
         cluster_files.place(where, own)
-    before = cluster_files.listing(where) if shipped is not None else {}
+    before = cluster_files.listing(where, node) if shipped is not None else {}
     ev = _run_here(str(where), plan_file, key, node, obligation_id)
     if shipped is not None:
-        files = {rel: base64.b64encode(data).decode() for rel, data in cluster_files.changed_files(where, before).items()}
+        files = {rel: base64.b64encode(data).decode() for rel, data in cluster_files.changed_files(where, node, before).items()}
     return json.dumps({"evidence": ev.to_json(), "files": files})
 
 

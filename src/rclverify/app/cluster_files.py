@@ -17,8 +17,8 @@ not, the job runs in a copy in the worker's own working folder:
 * :func:`node_files` gives the job's own share of ``artifacts/``: the node's
   obligations, its contract snapshot and every backend's folder for the node
   (``artifacts/<backend>/<node>/``), sent with the job;
-* :func:`changed_files` lists what the job wrote under ``artifacts/`` (the
-  evidence folder aside: the record itself comes back as JSON), and the
+* :func:`changed_files` lists what the job wrote in its node's folders
+  under ``artifacts/`` (the record itself comes back as JSON), and the
   submitting process writes those files into its workspace, atomically.
 
 The evidence record names files by their workspace-relative paths and hashes
@@ -168,19 +168,24 @@ def place(root: Path, files: dict[str, bytes]) -> None:
         atomic_write_bytes(target, data)
 
 
-def listing(root: Path) -> dict[str, tuple[int, int]]:
-    """Every file under ``root/artifacts`` but the evidence records: relative path -> (size, mtime in ns)."""
+def listing(root: Path, node: str) -> dict[str, tuple[int, int]]:
+    """Every file a job of ``node`` may write: under ``root/artifacts/<folder>/<node>/``
+    (the backends write nowhere else; the evidence record comes back as JSON):
+    relative path -> (size, mtime in ns)."""
     art = root / "artifacts"
     out = {}
     if art.is_dir():
-        for p in art.rglob("*"):
-            rel = p.relative_to(root).as_posix()
-            if p.is_file() and not rel.startswith("artifacts/evidence/") and not rel.startswith("artifacts/cache/"):
-                st = p.stat()
-                out[rel] = (st.st_size, st.st_mtime_ns)
+        for folder in art.iterdir():
+            d = folder / node
+            if folder.name in ("evidence", "cache") or not d.is_dir():
+                continue
+            for p in d.rglob("*"):
+                if p.is_file():
+                    st = p.stat()
+                    out[p.relative_to(root).as_posix()] = (st.st_size, st.st_mtime_ns)
     return out
 
 
-def changed_files(root: Path, before: dict[str, tuple[int, int]]) -> dict[str, bytes]:
-    """The files under ``root/artifacts`` written since ``before`` (:func:`listing`): path -> bytes."""
-    return {rel: (root / rel).read_bytes() for rel, stamp in listing(root).items() if before.get(rel) != stamp}
+def changed_files(root: Path, node: str, before: dict[str, tuple[int, int]]) -> dict[str, bytes]:
+    """The files of ``node``'s folders written since ``before`` (:func:`listing`): path -> bytes."""
+    return {rel: (root / rel).read_bytes() for rel, stamp in listing(root, node).items() if before.get(rel) != stamp}
