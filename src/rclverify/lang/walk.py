@@ -9,41 +9,44 @@ domains that are types are not (see :func:`rclverify.lang.printer.is_type`).
 """
 from __future__ import annotations
 
-from typing import Iterator, Union
+from typing import Any, Callable, Iterable, Iterator, Union
 
 from rclverify.lang import ast
 from rclverify.lang.printer import is_type
 
 
+def _quant_children(e: ast.Quant) -> Iterator[ast.Expr]:
+    for b in e.bindings:
+        if not is_type(b.domain):
+            yield b.domain  # type: ignore[misc]
+    yield e.body
+
+
+def _tuple_quant_children(e: ast.TupleQuant) -> Iterator[ast.Expr]:
+    if not is_type(e.domain):
+        yield e.domain  # type: ignore[misc]
+    yield e.body
+
+
+_NONE: tuple[ast.Expr, ...] = ()
+#: expression class -> its direct subexpressions (one look-up per node, no chain of tests)
+_CHILDREN: dict[type, Callable[[Any], Iterable[ast.Expr]]] = {
+    ast.Var: lambda e: _NONE, ast.BoolLit: lambda e: _NONE, ast.NumLit: lambda e: _NONE,
+    ast.StrLit: lambda e: _NONE,
+    ast.Apply: lambda e: (e.func, *e.args), ast.Unary: lambda e: (e.operand,),
+    ast.Binary: lambda e: (e.left, e.right), ast.Compare: lambda e: e.operands,
+    ast.Member: lambda e: (e.elem, e.collection), ast.SetLit: lambda e: e.items,
+    ast.SeqLit: lambda e: e.items, ast.TupleLit: lambda e: e.items, ast.Quant: _quant_children,
+    ast.SeqRange: lambda e: (e.lo, e.hi), ast.TupleQuant: _tuple_quant_children,
+}
+
+
 def children(e: ast.Expr) -> Iterator[ast.Expr]:
-    """The direct subexpressions of ``e`` (an applied function's name included)."""
-    if isinstance(e, ast.Apply):
-        yield e.func
-        yield from e.args
-    elif isinstance(e, ast.Unary):
-        yield e.operand
-    elif isinstance(e, ast.Binary):
-        yield e.left
-        yield e.right
-    elif isinstance(e, ast.Compare):
-        yield from e.operands
-    elif isinstance(e, ast.Member):
-        yield e.elem
-        yield e.collection
-    elif isinstance(e, (ast.SetLit, ast.SeqLit, ast.TupleLit)):
-        yield from e.items
-    elif isinstance(e, ast.Quant):
-        for b in e.bindings:
-            if not is_type(b.domain):
-                yield b.domain  # type: ignore[misc]
-        yield e.body
-    elif isinstance(e, ast.SeqRange):
-        yield e.lo
-        yield e.hi
-    elif isinstance(e, ast.TupleQuant):
-        if not is_type(e.domain):
-            yield e.domain  # type: ignore[misc]
-        yield e.body
+    """The direct subexpressions of ``e`` (an applied function's name included);
+    none for a value that is not an expression."""
+    of = _CHILDREN.get(type(e))
+    if of is not None:
+        yield from of(e)
 
 
 def subexpressions(e: ast.Expr) -> Iterator[ast.Expr]:
