@@ -15,7 +15,8 @@ from typing import Any, Callable, Mapping
 from rclverify.lang import ast
 from rclverify.lang.types import CheckedNode
 from rclverify.semantics.values import Term
-from rclverify.semantics.eval_values import _CMP, _LIT, Undecided, arithmetic
+from rclverify.semantics.eval_values import _CMP, _LIT, Undecided
+from rclverify.semantics.operators import OPERATORS, UNARY, Operator
 
 
 #: Compiled expressions kept (per AST node and I/O node); cleared when full.
@@ -74,9 +75,8 @@ def _compile(e: Any, env: Any, node: CheckedNode, mode: str | None = None) -> _F
         return apply
     if isinstance(e, ast.Unary):
         operand = _compile(e.operand, env, node, mode)
-        if e.op == "not":
-            return lambda ev, b: not operand(ev, b)
-        return lambda ev, b: -operand(ev, b)
+        meaning = UNARY[e.op].exact
+        return lambda ev, b: meaning(operand(ev, b))
     if isinstance(e, ast.Binary):
         return _compile_binary(e, env, node, mode)
     if isinstance(e, ast.Compare):
@@ -125,14 +125,24 @@ def _compile_binary(e: ast.Binary, env: Any, node: CheckedNode, mode: str | None
     """:meth:`Evaluator.binary` for ``e``."""
     op = e.op
     left, right = _compile(e.left, env, node, mode), _compile(e.right, env, node, mode)
-    if op == "and":
-        return lambda ev, b: bool(left(ev, b)) and bool(right(ev, b))
-    if op == "or":
-        return lambda ev, b: bool(left(ev, b)) or bool(right(ev, b))
-    if op == "->":
-        return lambda ev, b: (not left(ev, b)) or bool(right(ev, b))
-    if op == "<=>":
-        return lambda ev, b: bool(left(ev, b)) == bool(right(ev, b))
+    entry = OPERATORS[op]
+    if entry.kind == "connective":
+        return _connective(entry, left, right)
     if mode is not None:
         return lambda ev, b: ev.arith(op, left(ev, b), right(ev, b))
-    return lambda ev, b: arithmetic(op, left(ev, b), right(ev, b))
+    meaning = entry.exact
+    return lambda ev, b: meaning(left(ev, b), right(ev, b))
+
+
+def _connective(entry: Operator, left: _Fn, right: _Fn) -> _Fn:
+    """A connective's closure from its entry in the semantics table: the left
+    operand's truth first; when it is the entry's ``decisive`` truth, its
+    ``decided`` value, else the truth table on both (which, for a connective
+    that short-circuits, is the right operand's truth: then taken as is)."""
+    truth, decisive, decided = entry.exact, entry.decisive, entry.decided
+    if decisive is None:
+        return lambda ev, b: truth(bool(left(ev, b)), bool(right(ev, b)))
+    other = not decisive
+    if truth(other, True) is True and truth(other, False) is False:
+        return lambda ev, b: decided if bool(left(ev, b)) is decisive else bool(right(ev, b))
+    return lambda ev, b: decided if bool(left(ev, b)) is decisive else truth(other, bool(right(ev, b)))

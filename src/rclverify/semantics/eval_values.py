@@ -8,21 +8,16 @@ docstring states the semantics); values follow :mod:`rclverify.semantics.values`
 """
 from __future__ import annotations
 
-import math
 from fractions import Fraction
 from typing import Any, Callable, Mapping
 
+from rclverify.semantics.operators import COMPARISONS, OPERATORS
+from rclverify.semantics.operators import Undecided as Undecided  # re-exported: its home before the semantics table
 from rclverify.semantics.values import FiniteFunction, Term
 
 
-class Undecided(Exception):
-    """The formula cannot be decided by direct evaluation (reason in ``str``)."""
-
-
-_CMP: Mapping[str, Callable[[Any, Any], bool]] = {
-    "==": lambda a, b: a == b, "!=": lambda a, b: a != b, "<": lambda a, b: a < b,
-    "<=": lambda a, b: a <= b, ">": lambda a, b: a > b, ">=": lambda a, b: a >= b,
-}
+#: comparison symbol -> its exact meaning (the semantics table's entry)
+_CMP: Mapping[str, Callable[[Any, Any], bool]] = {s: OPERATORS[s].exact for s in COMPARISONS}
 _INFINITE = ("REAL", "INTEGER", "NATURAL")
 _LIT: dict[str, Any] = {}
 
@@ -47,23 +42,11 @@ def _numbers(v: Any, out: set[Any]) -> None:
 
 
 def arithmetic(op: str, x: Any, y: Any) -> Any:
-    """``x op y`` for ``op`` in ``+ - * /`` on RCL numbers.  REAL is exact
-    (DESIGN.md: REAL -> Z3 Real): a float operand is taken as the rational
-    it denotes, so no rounding and no overflow to inf.  Raises
-    :class:`Undecided` for a division by zero (RCL leaves it unspecified)."""
-    if type(x) is float:
-        x = Fraction(x)
-    if type(y) is float:
-        y = Fraction(y)
-    if op == "+":
-        return x + y
-    if op == "-":
-        return x - y
-    if op == "*":
-        return x * y
-    if y == 0:
-        raise Undecided("division by zero")
-    return Fraction(x) / Fraction(y)
+    """``x op y`` for ``op`` in ``+ - * /`` on RCL numbers: the exact meaning of
+    the semantics table (:data:`rclverify.semantics.operators.OPERATORS`: a
+    float operand is the rational it denotes, no rounding, no overflow).
+    Raises :class:`Undecided` for a division by zero (RCL leaves it unspecified)."""
+    return OPERATORS[op].exact(x, y)
 
 
 class _NoDomain:

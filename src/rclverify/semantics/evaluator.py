@@ -20,6 +20,7 @@ from rclverify.semantics.values import Term, conforms
 from rclverify.semantics.eval_closures import COMPILED_SIZE, _COMPILED, _compile
 from rclverify.semantics.eval_quant import QuantifierEvaluation
 from rclverify.semantics.eval_values import _CMP, _LIT, Undecided, _numbers, arithmetic
+from rclverify.semantics.operators import OPERATORS, UNARY
 
 
 class Evaluator(QuantifierEvaluation):
@@ -113,8 +114,7 @@ class Evaluator(QuantifierEvaluation):
                 raise Undecided(f"{e.func.qualified} is not a function value")
             return f(*args)
         if isinstance(e, ast.Unary):
-            x = self.eval(e.operand, b)
-            return (not x) if e.op == "not" else -x
+            return UNARY[e.op].exact(self.eval(e.operand, b))
         if isinstance(e, ast.Binary):
             return self.binary(e, b)
         if isinstance(e, ast.Compare):
@@ -154,16 +154,15 @@ class Evaluator(QuantifierEvaluation):
         raise Undecided("membership in a value that is not a set")
 
     def binary(self, e: ast.Binary, b: Mapping[str, Any]) -> Any:
-        op = e.op
-        if op == "and":
-            return bool(self.eval(e.left, b)) and bool(self.eval(e.right, b))
-        if op == "or":
-            return bool(self.eval(e.left, b)) or bool(self.eval(e.right, b))
-        if op == "->":
-            return (not self.eval(e.left, b)) or bool(self.eval(e.right, b))
-        if op == "<=>":
-            return bool(self.eval(e.left, b)) == bool(self.eval(e.right, b))
-        return self.arith(op, self.eval(e.left, b), self.eval(e.right, b))
+        """A connective (short-circuit left to right) or arithmetic (:meth:`arith`),
+        as the operator's entry in the semantics table states it."""
+        entry = OPERATORS[e.op]
+        if entry.kind == "connective":
+            left = bool(self.eval(e.left, b))
+            if left is entry.decisive:
+                return entry.decided
+            return entry.exact(left, bool(self.eval(e.right, b)))
+        return self.arith(e.op, self.eval(e.left, b), self.eval(e.right, b))
 
     # -- the semantics of numbers: exact here (REAL as rationals); the
     # float-faithful semantics of recorded runs (semantics/floatsem.py) override

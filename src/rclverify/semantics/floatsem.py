@@ -76,12 +76,13 @@ from rclverify.semantics.encode import EncodingError
 from rclverify.semantics.eval_shapes import MAX_RANGE, _integer_range, _unused
 from rclverify.semantics.evaluate import Evaluator, Undecided, evaluate, why_undecided
 from rclverify.semantics.floatsens import float_sensitive
+from rclverify.semantics.operators import COMPARISONS, OPERATORS
 
 #: The semantics a verdict may be decided in, in the order they are tried.
 SEMANTICS = ("exact", "double", "tolerance")
 
-_CMP = {"==": lambda a, b: a == b, "!=": lambda a, b: a != b, "<": lambda a, b: a < b,
-        "<=": lambda a, b: a <= b, ">": lambda a, b: a > b, ">=": lambda a, b: a >= b}
+#: comparison symbol -> its exact meaning (the semantics table's entry)
+_CMP = {s: OPERATORS[s].exact for s in COMPARISONS}
 #: The most assignments a quantifier is enumerated over under double or tolerance.
 MAX_ENUMERATION = 100_000
 
@@ -271,12 +272,6 @@ def _run(ev: Evaluator, formula: ast.Expr) -> tuple[bool | None, str]:
         return None, f"a value has the wrong form for the formula: {exc}"
 
 
-def _double(x: Any) -> Any:
-    """A number as the node holds it: a rational as the nearest double; an
-    ``int`` (an integer stays exact) and a ``float`` unchanged."""
-    return float(x) if type(x) is Fraction else x
-
-
 #: a literal's text -> its value in the double reading (parsed once)
 _DOUBLE_LITERALS: dict[str, Any] = {}
 
@@ -294,19 +289,14 @@ class _Double(Evaluator):
         return hit
 
     def arith(self, op: str, x: Any, y: Any) -> Any:
-        x, y = _double(x), _double(y)
-        if op == "+":
-            return x + y
-        if op == "-":
-            return x - y
-        if op == "*":
-            return x * y
-        if y == 0:
-            raise Undecided("division by zero")
-        return x / y
+        """``x op y`` in binary64 (the double meaning of the semantics table)."""
+        result = OPERATORS[op].double(x, y)
+        return result
 
     def compare(self, e: ast.Compare, b: Mapping[str, Any], op: str, x: Any, y: Any) -> bool:
-        return bool(_CMP[op](_double(x), _double(y)))
+        """``x op y`` on the doubles (the double meaning of the semantics table)."""
+        truth: bool = OPERATORS[op].double(x, y)
+        return truth
 
     def quant(self, e: ast.Quant, b: Mapping[str, Any]) -> bool:
         got = quantify(self, e, b, _finite_domain, MAX_ENUMERATION)

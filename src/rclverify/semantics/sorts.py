@@ -18,6 +18,7 @@ from typing import Any, cast
 import z3
 
 from rclverify.lang.types import DataT, EmptyT, EnumT, Scalar, SeqT, SetT, TupleT, Type
+from rclverify.semantics.operators import OPERATORS
 from rclverify.semantics.world import on_fresh
 
 _SORTS: dict[Type, Any] = {}
@@ -174,10 +175,6 @@ def widen(x: z3.ExprRef, s: z3.SortRef) -> z3.ExprRef:
     return x
 
 
-_ARITH = {"<": "__lt__", "<=": "__le__", ">": "__gt__", ">=": "__ge__", "+": "__add__", "-": "__sub__",
-          "*": "__mul__"}
-
-
 def apply_operator(op: str, a: Any, b: Any) -> Any:
     """``a op b`` in Z3 for a binary connective, comparison or arithmetic operator
     of RCL (or the Hoare language): ``and or -> <=> == != < <= > >= + - * /``.
@@ -185,21 +182,18 @@ def apply_operator(op: str, a: Any, b: Any) -> Any:
     Numeric operands are widened as :func:`coerce` does; ``/`` is real
     division.  The left operand's method is called explicitly so that
     ``k >= 0`` stays ``k >= 0`` (Python would otherwise prefer the numeral's
-    reflected method and build ``0 <= k``).  Raises ``KeyError`` for an
-    unknown operator.
+    reflected method and build ``0 <= k``).  The Z3 function or method is
+    the operator's entry in the semantics table
+    (:data:`rclverify.semantics.operators.OPERATORS`).  Raises ``KeyError``
+    for an unknown operator.
     """
-    if op == "and":
-        return z3.And(a, b)
-    if op == "or":
-        return z3.Or(a, b)
-    if op == "->":
-        return z3.Implies(a, b)
+    entry = OPERATORS[op]
+    if entry.kind == "connective" and entry.decisive is not None:  # and, or, ->
+        return getattr(z3, cast(str, entry.z3))(a, b)
     if op == "/":
-        return widen(a, z3.RealSort()) / widen(b, z3.RealSort())
-    if op in ("<=>", "=="):
+        a, b = widen(a, z3.RealSort()), widen(b, z3.RealSort())
+    else:
         a, b = coerce(a, b)
-        return z3.ExprRef.__eq__(a, b)
-    a, b = coerce(a, b)
-    if op == "!=":
-        return z3.ExprRef.__ne__(a, b)
-    return getattr(z3.ArithRef, _ARITH[op])(a, b)
+    if entry.z3 in ("__eq__", "__ne__"):  # also <=> on truth values
+        return getattr(z3.ExprRef, entry.z3)(a, b)
+    return getattr(z3.ArithRef, cast(str, entry.z3))(a, b)

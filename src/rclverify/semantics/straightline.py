@@ -21,10 +21,11 @@ expression in which
   would meet it, and a formula that holds whatever an absent output is
   (``in.command == inspect(i) -> ...`` for a ``move``) still holds;
 * numbers are exact: literals are the evaluator's values (an ``int`` when
-  whole, else a ``Fraction``), ``+ - * /`` go through
-  :func:`rclverify.semantics.eval_values.arithmetic` (a float is the rational it
-  denotes), and comparisons are Python's, exact between ``int``, ``float``
-  and ``Fraction``;
+  whole, else a ``Fraction``), ``+ - * /`` call the exact meaning of their
+  entry in the semantics table (:mod:`rclverify.semantics.operators`: a float
+  is the rational it denotes), and comparisons and connectives are the
+  Python text of their entries (comparisons exact between ``int``,
+  ``float`` and ``Fraction``);
 * names resolve as :meth:`~rclverify.semantics.evaluator.Evaluator.var`
   resolves them (an enumeration value, a named constant's expression, an
   argument-less constructor, else the node's input, else its output).
@@ -44,7 +45,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from fractions import Fraction
-from typing import Any, Callable, Mapping
+from typing import Any, Callable, Mapping, cast
 
 import jinja2
 
@@ -52,7 +53,8 @@ from rclverify.lang import ast
 from rclverify.lang.printer import expr_to_rcl
 from rclverify.lang.types import Checked, CheckedNode
 from rclverify.semantics.values import Term
-from rclverify.semantics.eval_values import Undecided, arithmetic
+from rclverify.semantics.eval_values import Undecided
+from rclverify.semantics.operators import OPERATORS, UNARY
 
 #: Compiled formulas kept (per formula, node and environment); cleared when full.
 CACHE_SIZE = 10_000
@@ -133,15 +135,11 @@ def _call(args: tuple[Any, ...], f: Any, what: str) -> Any:
     return f(*args)
 
 
-_COMPARE: Mapping[str, Callable[[Any, Any], bool]] = {
-    "==": lambda a, b: a == b, "!=": lambda a, b: a != b, "<": lambda a, b: a < b,
-    "<=": lambda a, b: a <= b, ">": lambda a, b: a > b, ">=": lambda a, b: a >= b}
-
-
 def _chain(ops: tuple[str, ...], vals: tuple[Any, ...]) -> bool:
     """A chained comparison ``a < b <= c``: every operand evaluated first, then
-    the comparisons left to right (the evaluator's order)."""
-    return all(_COMPARE[op](x, y) for op, x, y in zip(ops, vals, vals[1:]))
+    the comparisons left to right (the evaluator's order), each the exact
+    meaning of the semantics table."""
+    return all(OPERATORS[op].exact(x, y) for op, x, y in zip(ops, vals, vals[1:]))
 
 
 #: Nodes whose generated expression is already a ``bool``.
@@ -155,8 +153,9 @@ class _Gen:
     def __init__(self, env: Any, node: CheckedNode) -> None:
         self.env, self.node = env, node
         self.loads: dict[str, str] = {}  # I/O key -> local name
-        self.ns: dict[str, Any] = {"_missing": _missing, "_call": _call, "_chain": _chain, "_arith": arithmetic,
-                                   "_Term": Term}
+        self.ns: dict[str, Any] = {"_missing": _missing, "_call": _call, "_chain": _chain, "_Term": Term}
+        #: operator symbol -> the name its exact meaning is bound to (the semantics table's entry)
+        self.meanings: dict[str, str] = {}
         self.expanding: set[str] = set()  # named constants being expanded (a cycle is not compiled)
 
     def function(self, formula: ast.Expr) -> Straight:
@@ -200,13 +199,13 @@ class _Gen:
                 return f"_Term({f.name!r}, ({args}))"
             return f"_call(({args}), {self.var(f)}, {f.qualified!r})"
         if isinstance(e, ast.Unary):
-            return f"(not {self.expr(e.operand)})" if e.op == "not" else f"(-{self.expr(e.operand)})"
+            return cast(str, UNARY[e.op].python).format(x=self.expr(e.operand))
         if isinstance(e, ast.Binary):
             return self.binary(e)
         if isinstance(e, ast.Compare):
             vals = [self.expr(o) for o in e.operands]
             if len(e.ops) == 1:
-                return f"({vals[0]} {e.ops[0]} {vals[1]})"
+                return cast(str, OPERATORS[e.ops[0]].python).format(l=vals[0], r=vals[1])
             return f"_chain({tuple(e.ops)!r}, ({', '.join(vals)},))"
         if isinstance(e, ast.Member) and isinstance(e.collection, ast.SetLit):
             elem = self.expr(e.elem)
@@ -220,7 +219,11 @@ class _Gen:
         raise _Unsupported(f"a {type(e).__name__}")
 
     def binary(self, e: ast.Binary) -> str:
+        """A connective as the Python text of its entry in the semantics table
+        (a chain of ``and``/``or`` flattened), arithmetic as a call of the
+        entry's exact meaning."""
         op = e.op
+        entry = OPERATORS[op]
         if op in ("and", "or"):
             parts = []
             stack: list[Any] = [e.right, e.left]
@@ -231,11 +234,13 @@ class _Gen:
                 else:
                     parts.append(self.truth(cur))
             return "(" + f" {op} ".join(parts) + ")"
-        if op == "->":
-            return f"((not {self.expr(e.left)}) or {self.truth(e.right)})"
-        if op == "<=>":
-            return f"({self.truth(e.left)} == {self.truth(e.right)})"
-        return f"_arith({op!r}, {self.expr(e.left)}, {self.expr(e.right)})"
+        if entry.kind == "connective":  # the left operand of -> is negated by the text itself
+            left = self.expr(e.left) if op == "->" else self.truth(e.left)
+            return cast(str, entry.python).format(l=left, r=self.truth(e.right))
+        name = self.meanings.get(op)
+        if name is None:
+            name = self.meanings[op] = self.const(entry.exact)
+        return f"{name}({self.expr(e.left)}, {self.expr(e.right)})"
 
     def var(self, v: ast.Var) -> str:
         """:meth:`Evaluator.var` for ``v`` (no variable is bound here)."""

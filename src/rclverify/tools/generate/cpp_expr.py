@@ -33,8 +33,11 @@ answers *undecided* (the monitor's ``inconclusive``), never a guess.
 """
 from __future__ import annotations
 
+from typing import cast
+
 from rclverify.lang import ast
 from rclverify.lang.types import Checked, CheckedNode, DataT, EnumT, FuncT, Scalar, Type
+from rclverify.semantics.operators import OPERATORS, UNARY
 from rclverify.tools.generate.cpp_common import CPP_SCALARS, Untranslatable, enum_const
 from rclverify.tools.generate.cpp_quant import quantifier
 from rclverify.tools.generate.cpp_values import kind_of, table_type, term_struct
@@ -85,11 +88,12 @@ class CppTranslator:
             return self.var(e)
         if isinstance(e, ast.Unary):
             code, kind = self.expr(e.operand)
+            text = cast(str, UNARY[e.op].cpp)
             if e.op == "not":
-                return f"(!{self._bool(code, kind)})", "bool"
+                return text.format(x=self._bool(code, kind)), "bool"
             if kind not in ("int", "double"):
                 raise Untranslatable(f"unary minus on {kind}")
-            return f"(-{code})", kind
+            return text.format(x=code), kind
         if isinstance(e, ast.Binary):
             return self.binary(e)
         if isinstance(e, ast.Compare):
@@ -171,17 +175,18 @@ class CppTranslator:
         raise Untranslatable(f"an argument of kind {kind} where {t} is declared")
 
     def binary(self, e: ast.Binary) -> tuple[str, str]:
+        """A connective or arithmetic as the C++ text of its entry in the semantics
+        table; ``/`` (no 1:1 text: a zero divisor is undecided) as ``rclverify_rt::div``."""
         (lc, lk), (rc, rk) = self.expr(e.left), self.expr(e.right)
-        if e.op in ("and", "or", "->", "<=>"):
-            lb, rb = self._bool(lc, lk), self._bool(rc, rk)
-            op = {"and": "&&", "or": "||", "<=>": "=="}.get(e.op)
-            return (f"(!{lb} || {rb})" if e.op == "->" else f"({lb} {op} {rb})"), "bool"
+        entry = OPERATORS[e.op]
+        if entry.kind == "connective":
+            return cast(str, entry.cpp).format(l=self._bool(lc, lk), r=self._bool(rc, rk)), "bool"
         if lk not in ("int", "double") or rk not in ("int", "double"):
             raise Untranslatable(f"arithmetic on {lk}, {rk}")
-        if e.op == "/":
+        if entry.cpp is None:  # "/": the runtime's division
             return f"rclverify_rt::div({lc}, {rc})", "double"
         kind = "int" if lk == rk == "int" else "double"
-        return f"({lc} {e.op} {rc})", kind
+        return entry.cpp.format(l=lc, r=rc), kind
 
     def compare(self, e: ast.Compare) -> tuple[str, str]:
         parts = [self.expr(x) for x in e.operands]
@@ -190,15 +195,16 @@ class CppTranslator:
         for k, op in enumerate(e.ops):
             (lc, lk), (rc, rk) = parts[k], parts[k + 1]
             numeric = lk in ("int", "double") and rk in ("int", "double")
+            text = cast(str, OPERATORS[op].cpp)
             if not numeric and (lk != rk or op not in ("==", "!=")):
                 raise Untranslatable(f"comparison {op} of {lk} and {rk}")
             if numeric and self.mode == "tolerance" and (reads[k] or reads[k + 1]):
                 out.append(f"rclverify_rt::tol_cmp(rclverify_rt::Cmp::{_CMP_NAMES[op]}, "
                            f"static_cast<double>({lc}), static_cast<double>({rc}), kTolerance)")
             elif numeric and lk != rk:  # int against double: compared as doubles
-                out.append(f"(static_cast<double>({lc}) {op} static_cast<double>({rc}))")
+                out.append(text.format(l=f"static_cast<double>({lc})", r=f"static_cast<double>({rc})"))
             else:
-                out.append(f"({lc} {op} {rc})")
+                out.append(text.format(l=lc, r=rc))
         return (out[0] if len(out) == 1 else "(" + " && ".join(out) + ")"), "bool"
 
     def member(self, e: ast.Member) -> tuple[str, str]:

@@ -1,0 +1,189 @@
+"""The semantics table: one entry per RCL operator giving its meaning.
+
+RCL's operators (docs/rcl-language.md; the connectives and arithmetic of
+the paper's EBNF, shared/reference lines 499-555) are ``not``, unary ``-``,
+``and or -> <=>``, ``== != < <= > >=`` and ``+ - * /``.  Each has ONE
+:class:`Operator` entry in :data:`OPERATORS` (binary) or :data:`UNARY`;
+every evaluator and compiler reads its operator's meaning from that entry
+instead of restating it:
+
+* :attr:`Operator.exact` is the reference meaning on Python values
+  (:mod:`rclverify.semantics.values`): REAL is exact (DESIGN.md: REAL -> Z3
+  Real), so a float operand is taken as the rational it denotes, integers
+  never overflow, and a division by zero raises :class:`Undecided` (RCL
+  leaves it unspecified: the formula is not decided, never guessed).  The
+  direct evaluator, its compiled closures and the straight-line code call it.
+* :attr:`Operator.double` is the IEEE-754 binary64 reading a ROS node
+  computes in (:mod:`rclverify.semantics.floatsem`): ``+ - * /`` on
+  doubles, division by zero undecided as above, a NaN compares false.
+* For the connectives, :attr:`Operator.decisive` and :attr:`Operator.decided`
+  state the short circuit (left to right: a left operand whose truth is
+  ``decisive`` gives ``decided`` without the right one being evaluated),
+  :attr:`Operator.exact` the truth table on ``bool`` values.
+* The text fields give the operator in the languages code is generated
+  in, where it maps one to one: :attr:`Operator.python` and :attr:`Operator.cpp`
+  (format strings over ``{l}`` and ``{r}``; ``None`` where the generator
+  must call a helper, e.g. exact arithmetic in Python, division in C++),
+  :attr:`Operator.z3` (the ``z3.ArithRef`` method, or the Z3 function of a
+  connective), :attr:`Operator.numpy` (the numpy ufunc's name for the
+  column evaluation of recorded runs), :attr:`Operator.smtlib`.
+* :attr:`Operator.identity` is the neutral element (``and`` TRUE, ``+`` 0, ...)
+  when there is one; :attr:`Operator.converse` and :attr:`Operator.negation`
+  relate the comparisons (``a < b`` is ``b > a`` and ``not (a >= b)``).
+
+``tests/test_operators.py`` checks each entry against the reference
+evaluator, the double reading against Python's floats and the text fields
+by compiling them.
+"""
+from __future__ import annotations
+
+import math
+import operator
+from dataclasses import dataclass
+from fractions import Fraction
+from typing import Any, Callable, Literal, Mapping
+
+Kind = Literal["connective", "comparison", "arithmetic", "negation"]
+
+
+class Undecided(Exception):
+    """The formula cannot be decided by direct evaluation (reason in ``str``):
+    a division by zero, a value missing or of the wrong form."""
+
+
+@dataclass(frozen=True)
+class Operator:
+    """One RCL operator's meaning (module docstring).
+
+    ``symbol`` is its RCL spelling, ``name`` the field's word for it,
+    ``arity`` 1 or 2; the callables take Python values and return one."""
+
+    symbol: str
+    name: str
+    kind: Kind
+    arity: int
+    exact: Callable[..., Any]
+    double: Callable[..., Any]
+    python: str | None = None
+    cpp: str | None = None
+    z3: str | None = None
+    numpy: str | None = None
+    smtlib: str | None = None
+    identity: Any = None
+    decisive: bool | None = None
+    decided: bool | None = None
+    converse: str | None = None
+    negation: str | None = None
+    #: what a zero divisor does: ``"undecided"`` (both readings) or ``""`` (cannot happen)
+    zero_divisor: str = ""
+
+
+def _exact_number(x: Any) -> Any:
+    """A float as the rational it denotes (ints and Fractions unchanged)."""
+    return Fraction(x) if type(x) is float else x
+
+
+def _double_number(x: Any) -> Any:
+    """A number as the double a ROS node holds (ints stay ints, as in C++ and Python)."""
+    return float(x) if type(x) is Fraction else x
+
+
+def _exact_arith(raw: Callable[[Any, Any], Any]) -> Callable[[Any, Any], Any]:
+    def meaning(x: Any, y: Any) -> Any:
+        return raw(_exact_number(x), _exact_number(y))
+    return meaning
+
+
+def _exact_div(x: Any, y: Any) -> Any:
+    if y == 0:
+        raise Undecided("division by zero")
+    return Fraction(_exact_number(x)) / Fraction(_exact_number(y))
+
+
+def _double_arith(raw: Callable[[Any, Any], Any]) -> Callable[[Any, Any], Any]:
+    def meaning(x: Any, y: Any) -> Any:
+        return raw(_double_number(x), _double_number(y))
+    return meaning
+
+
+def _double_div(x: Any, y: Any) -> Any:
+    x, y = _double_number(x), _double_number(y)
+    if y == 0:
+        raise Undecided("division by zero")
+    return x / y
+
+
+def _double_cmp(raw: Callable[[Any, Any], bool]) -> Callable[[Any, Any], bool]:
+    def meaning(x: Any, y: Any) -> bool:
+        return bool(raw(_double_number(x), _double_number(y)))
+    return meaning
+
+
+def _connective(symbol: str, name: str, truth: Callable[[bool, bool], bool], *, python: str, cpp: str,
+                z3: str, smtlib: str, identity: bool | None, decisive: bool | None,
+                decided: bool | None) -> Operator:
+    return Operator(symbol, name, "connective", 2, truth, truth, python=python, cpp=cpp, z3=z3, smtlib=smtlib,
+                    identity=identity, decisive=decisive, decided=decided)
+
+
+def _comparison(symbol: str, name: str, raw: Callable[[Any, Any], bool], *, z3: str, numpy: str,
+                smtlib: str | None, converse: str, negation: str) -> Operator:
+    return Operator(symbol, name, "comparison", 2, raw, _double_cmp(raw), python=f"({{l}} {symbol} {{r}})",
+                    cpp=f"({{l}} {symbol} {{r}})", z3=z3, numpy=numpy, smtlib=smtlib, converse=converse,
+                    negation=negation)
+
+
+_ENTRIES = (
+    _connective("and", "conjunction", lambda a, b: a and b, python="({l} and {r})", cpp="({l} && {r})",
+                z3="And", smtlib="and", identity=True, decisive=False, decided=False),
+    _connective("or", "disjunction", lambda a, b: a or b, python="({l} or {r})", cpp="({l} || {r})",
+                z3="Or", smtlib="or", identity=False, decisive=True, decided=True),
+    _connective("->", "implication", lambda a, b: (not a) or b, python="((not {l}) or {r})",
+                cpp="(!{l} || {r})", z3="Implies", smtlib="=>", identity=None, decisive=False, decided=True),
+    _connective("<=>", "equivalence", lambda a, b: a == b, python="({l} == {r})", cpp="({l} == {r})",
+                z3="__eq__", smtlib="=", identity=True, decisive=None, decided=None),
+    _comparison("==", "equality", operator.eq, z3="__eq__", numpy="equal", smtlib="=", converse="==",
+                negation="!="),
+    _comparison("!=", "disequality", operator.ne, z3="__ne__", numpy="not_equal", smtlib=None, converse="!=",
+                negation="=="),
+    _comparison("<", "less than", operator.lt, z3="__lt__", numpy="less", smtlib="<", converse=">",
+                negation=">="),
+    _comparison("<=", "at most", operator.le, z3="__le__", numpy="less_equal", smtlib="<=", converse=">=",
+                negation=">"),
+    _comparison(">", "greater than", operator.gt, z3="__gt__", numpy="greater", smtlib=">", converse="<",
+                negation="<="),
+    _comparison(">=", "at least", operator.ge, z3="__ge__", numpy="greater_equal", smtlib=">=", converse="<=",
+                negation="<"),
+    Operator("+", "addition", "arithmetic", 2, _exact_arith(operator.add), _double_arith(operator.add),
+             cpp="({l} + {r})", z3="__add__", numpy="add", smtlib="+", identity=0),
+    Operator("-", "subtraction", "arithmetic", 2, _exact_arith(operator.sub), _double_arith(operator.sub),
+             cpp="({l} - {r})", z3="__sub__", numpy="subtract", smtlib="-"),
+    Operator("*", "multiplication", "arithmetic", 2, _exact_arith(operator.mul), _double_arith(operator.mul),
+             cpp="({l} * {r})", z3="__mul__", numpy="multiply", smtlib="*", identity=1),
+    Operator("/", "division", "arithmetic", 2, _exact_div, _double_div, cpp=None, z3="__truediv__",
+             numpy="true_divide", smtlib="/", zero_divisor="undecided"),
+)
+
+#: binary operator symbol -> its entry
+OPERATORS: Mapping[str, Operator] = {o.symbol: o for o in _ENTRIES}
+
+#: unary operator symbol -> its entry (``not`` on truth values, ``-`` on numbers: exact in both readings)
+UNARY: Mapping[str, Operator] = {
+    "not": Operator("not", "negation", "negation", 1, operator.not_, operator.not_, python="(not {x})",
+                    cpp="(!{x})", z3="Not", numpy="logical_not", smtlib="not"),
+    "-": Operator("-", "unary minus", "arithmetic", 1, operator.neg, operator.neg, python="(-{x})",
+                  cpp="(-{x})", z3="__neg__", numpy="negative", smtlib="-"),
+}
+
+CONNECTIVES = frozenset(s for s, o in OPERATORS.items() if o.kind == "connective")
+COMPARISONS = frozenset(s for s, o in OPERATORS.items() if o.kind == "comparison")
+ARITHMETIC = frozenset(s for s, o in OPERATORS.items() if o.kind == "arithmetic")
+
+
+def is_nan(x: Any) -> bool:
+    """Whether ``x`` is a float NaN (no RCL number: the exact reading rejects it,
+    :func:`rclverify.semantics.values.exact`; the double reading compares it false)."""
+    return type(x) is float and math.isnan(x)
+
+
+__all__ = ["ARITHMETIC", "COMPARISONS", "CONNECTIVES", "OPERATORS", "Operator", "UNARY", "Undecided", "is_nan"]
