@@ -20,6 +20,7 @@ from dataclasses import dataclass
 from fractions import Fraction
 from typing import Any, Mapping
 
+from rclverify.semantics.operators import OPERATORS, UNARY, Undecided
 from rclverify.backends.hoare.lang import Assign, Binary, BoolConst, If, Name, Num, Old, Program, Skip, Unary, While
 
 #: Most statements executed in one run (a loop that runs longer names nothing).
@@ -60,11 +61,6 @@ def _value(v: Any) -> Any:
     raise _CannotRun(f"value {v!r}")
 
 
-_ARITH = {"+": lambda a, b: a + b, "-": lambda a, b: a - b, "*": lambda a, b: a * b}
-_COMPARE = {"==": lambda a, b: a == b, "!=": lambda a, b: a != b, "<": lambda a, b: a < b,
-            "<=": lambda a, b: a <= b, ">": lambda a, b: a > b, ">=": lambda a, b: a >= b}
-
-
 def _eval(e: Any, env: Mapping[str, Any], start: Mapping[str, Any]) -> Any:
     if isinstance(e, Num):
         return _number(e.text)
@@ -76,19 +72,14 @@ def _eval(e: Any, env: Mapping[str, Any], start: Mapping[str, Any]) -> Any:
             raise _CannotRun(f"{e.name} has no value")
         return table[e.name]
     if isinstance(e, Unary):
-        x = _eval(e.operand, env, start)
-        return (not x) if e.op == "not" else -x
-    if isinstance(e, Binary):
-        a = _eval(e.left, env, start)
-        if e.op in ("and", "or", "->"):  # as the logic reads them: both sides defined
-            b = _eval(e.right, env, start)
-            return (a and b) if e.op == "and" else (a or b) if e.op == "or" else ((not a) or b)
+        return UNARY[e.op].exact(_eval(e.operand, env, start))
+    if isinstance(e, Binary):  # the exact meaning of the semantics table; connectives as the logic
+        a = _eval(e.left, env, start)  # reads them: both sides defined
         b = _eval(e.right, env, start)
-        if e.op == "/":
-            if b == 0:
-                raise _CannotRun("division by zero")
-            return a / b
-        return _ARITH[e.op](a, b) if e.op in _ARITH else _COMPARE[e.op](a, b)
+        try:
+            return OPERATORS[e.op].exact(a, b)
+        except Undecided as exc:  # a zero divisor
+            raise _CannotRun(str(exc)) from None
     raise _CannotRun(f"{type(e).__name__} cannot be evaluated")  # an extern function applied
 
 

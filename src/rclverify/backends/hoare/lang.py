@@ -43,6 +43,8 @@ from rclverify.lang import ast as rast
 from rclverify.lang.ast import Loc
 from rclverify.lang.parser import describe_terminal, lark_cache_file
 from rclverify.lang.errors import RclError, error
+from rclverify.semantics.operators import COMPARISONS as OPERATORS_COMPARISONS
+from rclverify.semantics.operators import CONNECTIVES as OPERATORS_CONNECTIVES
 
 NOLOC = Loc()
 
@@ -103,8 +105,9 @@ class Call:
 
 UnOp = Literal["not", "-"]
 BinOp = Literal["->", "or", "and", "==", "!=", "<", "<=", ">", ">=", "+", "-", "*", "/"]
-COMPARISONS: frozenset[str] = frozenset({"==", "!=", "<", "<=", ">", ">="})
-CONNECTIVES: frozenset[str] = frozenset({"->", "or", "and"})
+#: the comparisons and connectives of the language: RCL's (the semantics table), without ``<=>``
+COMPARISONS: frozenset[str] = OPERATORS_COMPARISONS
+CONNECTIVES: frozenset[str] = OPERATORS_CONNECTIVES - {"<=>"}
 
 
 @dataclass(frozen=True)
