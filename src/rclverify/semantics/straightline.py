@@ -51,6 +51,7 @@ import jinja2
 
 from rclverify.lang import ast
 from rclverify.lang.printer import expr_to_rcl
+from rclverify.lang.visit import Visitor
 from rclverify.lang.types import Checked, CheckedNode
 from rclverify.semantics.values import Term
 from rclverify.semantics.eval_values import Undecided
@@ -146,7 +147,7 @@ def _chain(ops: tuple[str, ...], vals: tuple[Any, ...]) -> bool:
 _BOOLEAN = (ast.Compare, ast.BoolLit, ast.Member)
 
 
-class _Gen:
+class _Gen(Visitor[str]):
     """The code generator of one formula: the expression text, the I/O loads
     and the objects the code refers to by name (its namespace)."""
 
@@ -185,38 +186,55 @@ class _Gen:
 
     # -- values -----------------------------------------------------------------------
     def expr(self, e: Any) -> str:
-        if isinstance(e, ast.BoolLit):
-            return "True" if e.value else "False"
-        if isinstance(e, ast.NumLit):
-            v = e.value
-            return repr(int(v)) if v.denominator == 1 else self.const(Fraction(v))
-        if isinstance(e, ast.Var):
-            return self.var(e)
-        if isinstance(e, ast.Apply):
-            args = "".join(f"{self.expr(a)}, " for a in e.args)
-            f = e.func
-            if f.prefix is None and f.name in self.env.ctors:
-                return f"_Term({f.name!r}, ({args}))"
-            return f"_call(({args}), {self.var(f)}, {f.qualified!r})"
-        if isinstance(e, ast.Unary):
-            return cast(str, UNARY[e.op].python).format(x=self.expr(e.operand))
-        if isinstance(e, ast.Binary):
-            return self.binary(e)
-        if isinstance(e, ast.Compare):
-            vals = [self.expr(o) for o in e.operands]
-            if len(e.ops) == 1:
-                return cast(str, OPERATORS[e.ops[0]].python).format(l=vals[0], r=vals[1])
-            return f"_chain({tuple(e.ops)!r}, ({', '.join(vals)},))"
-        if isinstance(e, ast.Member) and isinstance(e.collection, ast.SetLit):
-            elem = self.expr(e.elem)
-            items = "".join(f"{self.expr(i)}, " for i in e.collection.items)
-            coll = f"{{{items}}}" if items else "set()"
-            return f"({elem} {'not in' if e.negated else 'in'} {coll})"
-        if isinstance(e, ast.Member):
-            raise _Unsupported("membership in a type or a set-valued term")
-        if isinstance(e, (ast.Quant, ast.TupleQuant)):
-            raise _Unsupported(f"a quantifier ({e.kind})")
+        """``e`` as a Python expression: the method ``visit_<Class>`` of its
+        class; a construct without one raises :class:`_Unsupported`."""
+        return self.visit(e)
+
+    def generic_visit(self, e: Any) -> str:
         raise _Unsupported(f"a {type(e).__name__}")
+
+    def visit_BoolLit(self, e: ast.BoolLit) -> str:
+        return "True" if e.value else "False"
+
+    def visit_NumLit(self, e: ast.NumLit) -> str:
+        v = e.value
+        return repr(int(v)) if v.denominator == 1 else self.const(Fraction(v))
+
+    def visit_Var(self, e: ast.Var) -> str:
+        return self.var(e)
+
+    def visit_Apply(self, e: ast.Apply) -> str:
+        args = "".join(f"{self.expr(a)}, " for a in e.args)
+        f = e.func
+        if f.prefix is None and f.name in self.env.ctors:
+            return f"_Term({f.name!r}, ({args}))"
+        return f"_call(({args}), {self.var(f)}, {f.qualified!r})"
+
+    def visit_Unary(self, e: ast.Unary) -> str:
+        return cast(str, UNARY[e.op].python).format(x=self.expr(e.operand))
+
+    def visit_Binary(self, e: ast.Binary) -> str:
+        return self.binary(e)
+
+    def visit_Compare(self, e: ast.Compare) -> str:
+        vals = [self.expr(o) for o in e.operands]
+        if len(e.ops) == 1:
+            return cast(str, OPERATORS[e.ops[0]].python).format(l=vals[0], r=vals[1])
+        return f"_chain({tuple(e.ops)!r}, ({', '.join(vals)},))"
+
+    def visit_Member(self, e: ast.Member) -> str:
+        if not isinstance(e.collection, ast.SetLit):
+            raise _Unsupported("membership in a type or a set-valued term")
+        elem = self.expr(e.elem)
+        items = "".join(f"{self.expr(i)}, " for i in e.collection.items)
+        coll = f"{{{items}}}" if items else "set()"
+        return f"({elem} {'not in' if e.negated else 'in'} {coll})"
+
+    def visit_Quant(self, e: ast.Quant) -> str:
+        raise _Unsupported(f"a quantifier ({e.kind})")
+
+    def visit_TupleQuant(self, e: ast.TupleQuant) -> str:
+        raise _Unsupported(f"a quantifier ({e.kind})")
 
     def binary(self, e: ast.Binary) -> str:
         """A connective as the Python text of its entry in the semantics table

@@ -10,13 +10,14 @@ encoding (:mod:`rclverify.semantics.encode`, whose module docstring states it).
 """
 from __future__ import annotations
 
-from typing import Any, Callable, Mapping, cast
+from typing import Any, Mapping, cast
 
 import z3
 
 from rclverify.lang import ast
 from rclverify.lang.printer import FLAT_CHAINS, chain_operands, is_type
 from rclverify.lang.typecheck import domain_type
+from rclverify.lang.visit import Visitor
 from rclverify.lang.types import BOOL, NATURAL, CheckedNode, EmptyT, FuncT, Scalar, TupleT, Type, qualified_base
 from rclverify.semantics.sorts import _join_sort, _tuple_fields, apply_operator, coerce, sort_of, tuple_sort, widen
 from rclverify.semantics.symbols import EncodingError, smt_symbol
@@ -26,7 +27,7 @@ def _is_empty_literal(x: ast.Expr) -> bool:
     return isinstance(x, (ast.SetLit, ast.SeqLit)) and not x.items
 
 
-class _Ctx:
+class _Ctx(Visitor[Any]):
     def __init__(self, enc: Any, node: CheckedNode, symbols: dict[str, Any]) -> None:
         self.e, self.node, self.symbols = enc, node, symbols
         self.var_types: dict[int, Type] = {}  # RCL type of each bound variable made here, by Z3 id
@@ -60,25 +61,26 @@ class _Ctx:
 
     # -- expressions ---------------------------------------------------------------------
     def enc(self, x: ast.Expr, bound: Mapping[str, z3.ExprRef]) -> Any:
-        m: Callable[..., Any] = getattr(self, "e_" + type(x).__name__)
-        return m(x, bound)
+        """The Z3 term of ``x`` under the bound variables ``bound``: the method
+        ``visit_<Class>`` of ``x``'s class (:class:`rclverify.lang.visit.Visitor`)."""
+        return self.visit(x, bound)
 
-    def e_BoolLit(self, x: ast.BoolLit, b: Mapping[str, Any]) -> Any:
+    def visit_BoolLit(self, x: ast.BoolLit, b: Mapping[str, Any]) -> Any:
         return z3.BoolVal(x.value)
 
-    def e_NumLit(self, x: ast.NumLit, b: Mapping[str, Any]) -> Any:
+    def visit_NumLit(self, x: ast.NumLit, b: Mapping[str, Any]) -> Any:
         v = x.value
         if x.is_integral:
             return z3.IntVal(int(v))
         return z3.RealVal(f"{v.numerator}/{v.denominator}")
 
-    def e_Var(self, x: ast.Var, b: Mapping[str, Any]) -> Any:
+    def visit_Var(self, x: ast.Var, b: Mapping[str, Any]) -> Any:
         r = self.var(x, b)
         if isinstance(r, z3.FuncDeclRef) and r.arity() > 0:
             raise EncodingError(x.loc, f"{x.qualified} is a function; comparing whole functions is not supported, apply it")
         return r() if isinstance(r, z3.FuncDeclRef) else r
 
-    def e_Apply(self, x: ast.Apply, b: Mapping[str, Any]) -> Any:
+    def visit_Apply(self, x: ast.Apply, b: Mapping[str, Any]) -> Any:
         f = x.func
         args = [self.enc(a, b) for a in x.args]
         is_value = f.prefix is not None or f.name in b or f.name in self.node.inputs or f.name in self.node.outputs
@@ -92,11 +94,11 @@ class _Ctx:
             return z3.Select(fn, *[widen(a, fn.sort().domain_n(k)) for k, a in enumerate(args)])
         raise EncodingError(x.loc, f"{f.qualified} cannot be applied")
 
-    def e_Unary(self, x: ast.Unary, b: Mapping[str, Any]) -> Any:
+    def visit_Unary(self, x: ast.Unary, b: Mapping[str, Any]) -> Any:
         v = self.enc(x.operand, b)
         return z3.Not(v) if x.op == "not" else -v
 
-    def e_Binary(self, x: ast.Binary, b: Mapping[str, Any]) -> Any:
+    def visit_Binary(self, x: ast.Binary, b: Mapping[str, Any]) -> Any:
         if x.op in FLAT_CHAINS:
             # One n-ary And/Or over the whole chain, opened iteratively, so a
             # chain of any length or shape (also one built by a program,
@@ -105,10 +107,10 @@ class _Ctx:
             return z3.And(*parts) if x.op == "and" else z3.Or(*parts)
         return apply_operator(x.op, self.enc(x.left, b), self.enc(x.right, b))
 
-    def e_StrLit(self, x: ast.StrLit, b: Mapping[str, Any]) -> Any:
+    def visit_StrLit(self, x: ast.StrLit, b: Mapping[str, Any]) -> Any:
         return z3.StringVal(x.value)
 
-    def e_SeqRange(self, x: ast.SeqRange, b: Mapping[str, Any]) -> Any:
+    def visit_SeqRange(self, x: ast.SeqRange, b: Mapping[str, Any]) -> Any:
         lo, hi = x.lo, x.hi
         if isinstance(lo, ast.NumLit) and isinstance(hi, ast.NumLit) and lo.is_integral and hi.is_integral:
             a, z = int(lo.value), int(hi.value)
@@ -122,7 +124,7 @@ class _Ctx:
         raise EncodingError(x.loc, "a range with non-literal bounds is only supported on the right of 'in' "
                                    "by backend z3")
 
-    def e_TupleQuant(self, x: ast.TupleQuant, b: Mapping[str, Any]) -> Any:
+    def visit_TupleQuant(self, x: ast.TupleQuant, b: Mapping[str, Any]) -> Any:
         """``Q((u, v) in S | body)``: one bound variable per component, and
         the tuple they form must be an element of ``S`` (no guard when ``S``
         is a tuple type)."""
@@ -161,7 +163,7 @@ class _Ctx:
             return None
         return ast.Var(d.name, None, d.loc) if isinstance(d, ast.TName) else cast(ast.Expr, d)
 
-    def e_Compare(self, x: ast.Compare, b: Mapping[str, Any]) -> Any:
+    def visit_Compare(self, x: ast.Compare, b: Mapping[str, Any]) -> Any:
         vals = [None if _is_empty_literal(o) else self.enc(o, b) for o in x.operands]
         for k, o in enumerate(x.operands):
             if vals[k] is None:
@@ -211,7 +213,7 @@ class _Ctx:
             return z3.And(integral, elem >= 0) if base == "NATURAL" else integral
         return z3.BoolVal(True)
 
-    def e_Member(self, x: ast.Member, b: Mapping[str, Any]) -> Any:
+    def visit_Member(self, x: ast.Member, b: Mapping[str, Any]) -> Any:
         r = self.member(self.enc(x.elem, b), x.collection, b)
         return z3.Not(r) if x.negated else r
 
@@ -226,14 +228,14 @@ class _Ctx:
             elem = _join_sort(elem, i.sort())
         return [widen(i, elem) for i in items]
 
-    def e_SetLit(self, x: ast.SetLit, b: Mapping[str, Any]) -> Any:
+    def visit_SetLit(self, x: ast.SetLit, b: Mapping[str, Any]) -> Any:
         items = self._items(x, b, "set")
         s = z3.EmptySet(items[0].sort())
         for i in items:
             s = z3.SetAdd(s, i)
         return s
 
-    def e_SeqLit(self, x: ast.SeqLit, b: Mapping[str, Any]) -> Any:
+    def visit_SeqLit(self, x: ast.SeqLit, b: Mapping[str, Any]) -> Any:
         units = [z3.Unit(i) for i in self._items(x, b, "sequence")]
         return units[0] if len(units) == 1 else z3.Concat(*units)
 
@@ -254,11 +256,11 @@ class _Ctx:
                 return z3.EmptySet(like.domain())
         raise EncodingError(x.loc, f"an empty literal compared with a value of Z3 sort {like}")
 
-    def e_TupleLit(self, x: ast.TupleLit, b: Mapping[str, Any]) -> Any:
+    def visit_TupleLit(self, x: ast.TupleLit, b: Mapping[str, Any]) -> Any:
         items = [self.enc(i, b) for i in x.items]
         return cast(z3.DatatypeSortRef, tuple_sort([i.sort() for i in items])).constructor(0)(*items)
 
-    def e_Quant(self, x: ast.Quant, b: Mapping[str, Any]) -> Any:
+    def visit_Quant(self, x: ast.Quant, b: Mapping[str, Any]) -> Any:
         inner = dict(b)
         xs: list[z3.ExprRef] = []
         guards: list[Any] = []

@@ -33,10 +33,11 @@ answers *undecided* (the monitor's ``inconclusive``), never a guess.
 """
 from __future__ import annotations
 
-from typing import cast
+from typing import Any, cast
 
 from rclverify.lang import ast
 from rclverify.lang.types import Checked, CheckedNode, DataT, EnumT, FuncT, Scalar, Type
+from rclverify.lang.visit import Visitor
 from rclverify.semantics.operators import OPERATORS, UNARY
 from rclverify.tools.generate.cpp_common import CPP_SCALARS, Untranslatable, enum_const
 from rclverify.tools.generate.cpp_quant import quantifier
@@ -56,7 +57,7 @@ def cpp_type(t: Type) -> str | None:
     return None
 
 
-class CppTranslator:
+class CppTranslator(Visitor[tuple[str, str]]):
     """Translates the formulas of one node; ``mode`` is ``double`` or ``tolerance``.
 
     ``translate(formula)`` returns a C++ expression of type ``bool`` reading ``in``
@@ -78,40 +79,54 @@ class CppTranslator:
 
     # -- expressions: (code, kind) with kind bool / int / double / enum:<Name> ------------
     def expr(self, e: ast.Expr) -> tuple[str, str]:
-        if isinstance(e, ast.BoolLit):
-            return ("true" if e.value else "false"), "bool"
-        if isinstance(e, ast.NumLit):
-            if e.is_integral:
-                return f"std::int64_t{{{int(e.value)}}}", "int"
-            return f"double{{{e.text}}}", "double"
-        if isinstance(e, ast.Var):
-            return self.var(e)
-        if isinstance(e, ast.Unary):
-            code, kind = self.expr(e.operand)
-            text = cast(str, UNARY[e.op].cpp)
-            if e.op == "not":
-                return text.format(x=self._bool(code, kind)), "bool"
-            if kind not in ("int", "double"):
-                raise Untranslatable(f"unary minus on {kind}")
-            return text.format(x=code), kind
-        if isinstance(e, ast.Binary):
-            return self.binary(e)
-        if isinstance(e, ast.Compare):
-            return self.compare(e)
-        if isinstance(e, ast.Member):
-            return self.member(e)
-        if isinstance(e, ast.Quant):
-            return quantifier(self, e)
-        if isinstance(e, ast.Apply):
-            return self.apply(e)
+        """``e`` as ``(code, kind)``: the method ``visit_<Class>`` of its class;
+        a construct without one raises :class:`Untranslatable` naming it."""
+        return self.visit(e)
+
+    def generic_visit(self, e: Any) -> tuple[str, str]:
         raise Untranslatable(_CONSTRUCTS.get(type(e).__name__, type(e).__name__))
+
+    def visit_BoolLit(self, e: ast.BoolLit) -> tuple[str, str]:
+        return ("true" if e.value else "false"), "bool"
+
+    def visit_NumLit(self, e: ast.NumLit) -> tuple[str, str]:
+        if e.is_integral:
+            return f"std::int64_t{{{int(e.value)}}}", "int"
+        return f"double{{{e.text}}}", "double"
+
+    def visit_Var(self, e: ast.Var) -> tuple[str, str]:
+        return self.var(e)
+
+    def visit_Unary(self, e: ast.Unary) -> tuple[str, str]:
+        code, kind = self.expr(e.operand)
+        text = cast(str, UNARY[e.op].cpp)
+        if e.op == "not":
+            return text.format(x=self._bool(code, kind)), "bool"
+        if kind not in ("int", "double"):
+            raise Untranslatable(f"unary minus on {kind}")
+        return text.format(x=code), kind
+
+    def visit_Binary(self, e: ast.Binary) -> tuple[str, str]:
+        return self.binary(e)
+
+    def visit_Compare(self, e: ast.Compare) -> tuple[str, str]:
+        return self.compare(e)
+
+    def visit_Member(self, e: ast.Member) -> tuple[str, str]:
+        return self.member(e)
+
+    def visit_Quant(self, e: ast.Quant) -> tuple[str, str]:
+        return quantifier(self, e)
+
+    def visit_Apply(self, e: ast.Apply) -> tuple[str, str]:
+        return self.apply(e)
 
     def var(self, v: ast.Var) -> tuple[str, str]:
         if v.prefix is None and v.name in self.bound:  # a quantified variable first, as rclverify resolves names
             return self.bound[v.name]
         if v.prefix is None and v.name in self.env.enum_values:
-            t = self.env.enum_values[v.name]
-            return enum_const(t, v.name), f"enum:{t.name}"
+            et = self.env.enum_values[v.name]
+            return enum_const(et, v.name), f"enum:{et.name}"
         if v.prefix is None and v.name in self.env.constants:
             code, kind = self.expr(self.env.constants[v.name][1])
             return f"({code})", kind
@@ -156,12 +171,13 @@ class CppTranslator:
         code, kind = self.var(f)
         if kind != "table":
             raise Untranslatable(f"an application of {f.qualified}")
-        t = (self.node.inputs if (f.prefix == "in" or (f.prefix is None and f.name in self.node.inputs))
-             else self.node.outputs)[f.name]
-        rk = kind_of(t.result)
+        ft = (self.node.inputs if (f.prefix == "in" or (f.prefix is None and f.name in self.node.inputs))
+              else self.node.outputs)[f.name]
+        assert isinstance(ft, FuncT)  # its kind is "table"
+        rk = kind_of(ft.result)
         if rk is None:
-            raise Untranslatable(f"a function result of type {t.result}")
-        args = [self._arg(a, at) for a, at in zip(e.args, t.args)]
+            raise Untranslatable(f"a function result of type {ft.result}")
+        args = [self._arg(a, at) for a, at in zip(e.args, ft.args)]
         return f"{code}({', '.join(args)})", rk
 
     def _arg(self, a: ast.Expr, t: Type) -> str:
