@@ -16,6 +16,7 @@ from typing import Any, Mapping
 from rclverify.lang import ast
 from rclverify.lang import types as T
 from rclverify.lang.types import Checked, CheckedNode
+from rclverify.lang.visit import Visitor
 from rclverify.semantics.values import Term, conforms
 from rclverify.semantics.eval_closures import COMPILED_SIZE, _COMPILED, _compile
 from rclverify.semantics.eval_quant import QuantifierEvaluation
@@ -23,7 +24,7 @@ from rclverify.semantics.eval_values import _CMP, _LIT, Undecided, _numbers, ari
 from rclverify.semantics.operators import OPERATORS, UNARY
 
 
-class Evaluator(QuantifierEvaluation):
+class Evaluator(QuantifierEvaluation, Visitor[Any]):
     """One evaluation context: the node, its values and the candidate numbers.
 
     ``compiled`` (class attribute, True): evaluate through the compiled
@@ -98,43 +99,60 @@ class Evaluator(QuantifierEvaluation):
     def interpret(self, e: ast.Expr, b: Mapping[str, Any]) -> Any:
         """The value of ``e`` under ``b`` by walking the tree (the reference the
         compiled closures follow; what they delegate membership, set and
-        tuple literals and quantifiers to)."""
-        if isinstance(e, ast.BoolLit):
-            return e.value
-        if isinstance(e, ast.NumLit):
-            return self.literal(e)
-        if isinstance(e, ast.Var):
-            return self.var(e, b)
-        if isinstance(e, ast.Apply):
-            args = tuple(self.eval(a, b) for a in e.args)
-            if e.func.prefix is None and e.func.name in self.env.ctors and e.func.name not in b:
-                return Term(e.func.name, args)
-            f = self.var(e.func, b)
-            if not callable(f):
-                raise Undecided(f"{e.func.qualified} is not a function value")
-            return f(*args)
-        if isinstance(e, ast.Unary):
-            return UNARY[e.op].exact(self.eval(e.operand, b))
-        if isinstance(e, ast.Binary):
-            return self.binary(e, b)
-        if isinstance(e, ast.Compare):
-            vals = [self.eval(o, b) for o in e.operands]
-            return all(self.compare(e, b, op, x, y) for op, x, y in zip(e.ops, vals, vals[1:]))
-        if isinstance(e, ast.Member):
-            x = self.eval(e.elem, b)
-            carrier = self.carrier(e.collection, b)
-            if carrier is not None:  # `x in NATURAL`, `(x, y) in REAL.REAL`
-                inside = conforms(x, carrier) is None
-                return (not inside) if e.negated else inside
-            coll = self.collection(e.collection, b)
-            return (x not in coll) if e.negated else (x in coll)
-        if isinstance(e, ast.SetLit):
-            return frozenset(self.eval(i, b) for i in e.items)
-        if isinstance(e, (ast.TupleLit, ast.SeqLit)):
-            return tuple(self.eval(i, b) for i in e.items)
-        if isinstance(e, ast.Quant):
-            return self.quant(e, b)
+        tuple literals and quantifiers to): the method ``visit_<Class>`` of
+        ``e``'s class (:class:`rclverify.lang.visit.Visitor`)."""
+        return self.visit(e, b)
+
+    def generic_visit(self, e: Any, b: Mapping[str, Any]) -> Any:
         raise Undecided(f"cannot evaluate {type(e).__name__}")
+
+    def visit_BoolLit(self, e: ast.BoolLit, b: Mapping[str, Any]) -> Any:
+        return e.value
+
+    def visit_NumLit(self, e: ast.NumLit, b: Mapping[str, Any]) -> Any:
+        return self.literal(e)
+
+    def visit_Var(self, e: ast.Var, b: Mapping[str, Any]) -> Any:
+        return self.var(e, b)
+
+    def visit_Apply(self, e: ast.Apply, b: Mapping[str, Any]) -> Any:
+        args = tuple(self.eval(a, b) for a in e.args)
+        if e.func.prefix is None and e.func.name in self.env.ctors and e.func.name not in b:
+            return Term(e.func.name, args)
+        f = self.var(e.func, b)
+        if not callable(f):
+            raise Undecided(f"{e.func.qualified} is not a function value")
+        return f(*args)
+
+    def visit_Unary(self, e: ast.Unary, b: Mapping[str, Any]) -> Any:
+        return UNARY[e.op].exact(self.eval(e.operand, b))
+
+    def visit_Binary(self, e: ast.Binary, b: Mapping[str, Any]) -> Any:
+        return self.binary(e, b)
+
+    def visit_Compare(self, e: ast.Compare, b: Mapping[str, Any]) -> Any:
+        vals = [self.eval(o, b) for o in e.operands]
+        return all(self.compare(e, b, op, x, y) for op, x, y in zip(e.ops, vals, vals[1:]))
+
+    def visit_Member(self, e: ast.Member, b: Mapping[str, Any]) -> Any:
+        x = self.eval(e.elem, b)
+        carrier = self.carrier(e.collection, b)
+        if carrier is not None:  # `x in NATURAL`, `(x, y) in REAL.REAL`
+            inside = conforms(x, carrier) is None
+            return (not inside) if e.negated else inside
+        coll = self.collection(e.collection, b)
+        return (x not in coll) if e.negated else (x in coll)
+
+    def visit_SetLit(self, e: ast.SetLit, b: Mapping[str, Any]) -> Any:
+        return frozenset(self.eval(i, b) for i in e.items)
+
+    def visit_TupleLit(self, e: ast.TupleLit, b: Mapping[str, Any]) -> Any:
+        return tuple(self.eval(i, b) for i in e.items)
+
+    visit_SeqLit = visit_TupleLit
+
+    def visit_Quant(self, e: ast.Quant, b: Mapping[str, Any]) -> Any:
+        return self.quant(e, b)
 
     def carrier(self, e: Any, b: Mapping[str, Any]) -> T.Type | None:
         """The type a built-in term on the right of ``in`` stands for

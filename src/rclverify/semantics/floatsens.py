@@ -18,6 +18,8 @@ from typing import Any, Mapping
 from rclverify.lang import ast
 from rclverify.lang import types as T
 from rclverify.lang.types import Checked, CheckedNode
+from rclverify.lang.visit import Visitor, children
+from rclverify.semantics.operators import OPERATORS
 
 _SENSITIVE: dict[tuple[int, int, bool], tuple[Any, bool]] = {}
 
@@ -33,41 +35,57 @@ def float_sensitive(formula: ast.Expr, checked: Checked, node: CheckedNode, tole
     hit = _SENSITIVE.get(key)
     if hit is not None and hit[0] is formula:
         return hit[1]
-    out = _sensitive(formula, checked.env, node, {}, tolerant, set())
+    out = _Sensitive(checked.env, node, tolerant).visit(formula, {})
     if len(_SENSITIVE) >= 10_000:
         _SENSITIVE.clear()
     _SENSITIVE[key] = (formula, out)
     return out
 
 
-def _sensitive(e: Any, env: Any, node: CheckedNode, scope: Mapping[str, Any], tolerant: bool, seen: set[str]) -> bool:
-    if isinstance(e, ast.NumLit):
+class _Sensitive(Visitor[bool]):
+    """:func:`float_sensitive` node by node: a literal that is no double, an
+    arithmetic operation that may round, a tolerant comparison of possibly
+    non-integer numbers, a named constant's expression (once); any other
+    node is sensitive when one of its children is."""
+
+    def __init__(self, env: Any, node: CheckedNode, tolerant: bool) -> None:
+        self.env, self.node, self.tolerant = env, node, tolerant
+        self.seen: set[str] = set()
+
+    def generic_visit(self, e: Any, scope: Mapping[str, Any]) -> bool:
+        return any(self.visit(c, scope) for c in children(e))
+
+    def visit_NumLit(self, e: ast.NumLit, scope: Mapping[str, Any]) -> bool:
         v = e.value
         return v.denominator != 1 and Fraction(float(v)) != v
-    if isinstance(e, ast.Var):
-        if e.prefix is None and e.name not in scope and e.name in env.constants and e.name not in seen:
-            seen.add(e.name)
-            return _sensitive(env.constants[e.name][1], env, node, {}, tolerant, seen)
+
+    def visit_Var(self, e: ast.Var, scope: Mapping[str, Any]) -> bool:
+        env = self.env
+        if e.prefix is None and e.name not in scope and e.name in env.constants and e.name not in self.seen:
+            self.seen.add(e.name)
+            return self.visit(env.constants[e.name][1], {})
         return False
-    if isinstance(e, ast.Binary) and e.op in ("+", "-", "*", "/"):
-        if e.op == "/" or _fractional(e.left, env, node, scope) or _fractional(e.right, env, node, scope):
+
+    def visit_Binary(self, e: ast.Binary, scope: Mapping[str, Any]) -> bool:
+        if OPERATORS[e.op].kind == "arithmetic" and (
+                e.op == "/" or _fractional(e.left, self.env, self.node, scope)
+                or _fractional(e.right, self.env, self.node, scope)):
             return True
-    if isinstance(e, ast.Compare) and tolerant and any(_fractional(o, env, node, scope) for o in e.operands):
-        return True
-    if isinstance(e, ast.Quant):
+        return self.generic_visit(e, scope)
+
+    def visit_Compare(self, e: ast.Compare, scope: Mapping[str, Any]) -> bool:
+        if self.tolerant and any(_fractional(o, self.env, self.node, scope) for o in e.operands):
+            return True
+        return self.generic_visit(e, scope)
+
+    def visit_Quant(self, e: ast.Quant, scope: Mapping[str, Any]) -> bool:
         inner = dict(scope)
         for bd in e.bindings:
-            if not isinstance(bd.domain, (ast.TBase, ast.TName, ast.TEnum)) and \
-                    _sensitive(bd.domain, env, node, scope, tolerant, seen):
+            if not isinstance(bd.domain, (ast.TBase, ast.TName, ast.TEnum)) and self.visit(bd.domain, scope):
                 return True
             for n in bd.names:
                 inner[n] = bd.domain
-        return _sensitive(e.body, env, node, inner, tolerant, seen)
-    if isinstance(e, tuple):
-        return any(_sensitive(x, env, node, scope, tolerant, seen) for x in e)
-    if isinstance(e, ast.Loc) or not hasattr(e, "__dataclass_fields__"):
-        return False
-    return any(_sensitive(getattr(e, f), env, node, scope, tolerant, seen) for f in e.__dataclass_fields__)
+        return self.visit(e.body, inner)
 
 
 def _integral_type(t: Any) -> bool:
