@@ -101,11 +101,10 @@ class Visitor(Generic[T]):
         """The result of this visitor's method for ``node``'s class.
 
         Raises :class:`UnknownNode` when ``node`` is not an RCL node."""
-        try:
-            method = self._dispatch[type(node)]
-        except KeyError:
+        method = self._dispatch.get(type(node))
+        if method is None:
             raise UnknownNode(f"{type(self).__name__} cannot visit a {type(node).__name__}: "
-                              f"not a node of the RCL syntax") from None
+                              f"not a node of the RCL syntax")
         result: T = method(self, node, *args)
         return result
 

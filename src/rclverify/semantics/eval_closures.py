@@ -143,6 +143,14 @@ def _connective(entry: Operator, left: _Fn, right: _Fn) -> _Fn:
     if decisive is None:
         return lambda ev, b: truth(bool(left(ev, b)), bool(right(ev, b)))
     other = not decisive
-    if truth(other, True) is True and truth(other, False) is False:
-        return lambda ev, b: decided if bool(left(ev, b)) is decisive else bool(right(ev, b))
-    return lambda ev, b: decided if bool(left(ev, b)) is decisive else truth(other, bool(right(ev, b)))
+    if not (truth(other, True) is True and truth(other, False) is False):
+        return lambda ev, b: decided if bool(left(ev, b)) is decisive else truth(other, bool(right(ev, b)))
+    # the right operand's truth when the left one does not decide: Python's own
+    # short circuit for the three (decisive, decided) pairs, the same values
+    if decisive is False and decided is False:  # and
+        return lambda ev, b: bool(left(ev, b)) and bool(right(ev, b))
+    if decisive is True and decided is True:  # or
+        return lambda ev, b: bool(left(ev, b)) or bool(right(ev, b))
+    if decisive is False and decided is True:  # ->
+        return lambda ev, b: (not left(ev, b)) or bool(right(ev, b))
+    return lambda ev, b: decided if bool(left(ev, b)) is decisive else bool(right(ev, b))

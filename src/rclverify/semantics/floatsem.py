@@ -63,7 +63,7 @@ import math
 import struct
 from dataclasses import dataclass
 from fractions import Fraction
-from typing import Any, Mapping
+from typing import Any, Callable, Mapping
 
 import z3
 
@@ -83,6 +83,8 @@ SEMANTICS = ("exact", "double", "tolerance")
 
 #: comparison symbol -> its exact meaning (the semantics table's entry)
 _CMP = {s: OPERATORS[s].exact for s in COMPARISONS}
+#: operator symbol -> its double meaning (the semantics table's entry)
+_DOUBLE: Mapping[str, Callable[[Any, Any], Any]] = {s: o.double for s, o in OPERATORS.items()}
 #: The most assignments a quantifier is enumerated over under double or tolerance.
 MAX_ENUMERATION = 100_000
 
@@ -290,12 +292,11 @@ class _Double(Evaluator):
 
     def arith(self, op: str, x: Any, y: Any) -> Any:
         """``x op y`` in binary64 (the double meaning of the semantics table)."""
-        result = OPERATORS[op].double(x, y)
-        return result
+        return _DOUBLE[op](x, y)
 
     def compare(self, e: ast.Compare, b: Mapping[str, Any], op: str, x: Any, y: Any) -> bool:
         """``x op y`` on the doubles (the double meaning of the semantics table)."""
-        truth: bool = OPERATORS[op].double(x, y)
+        truth: bool = _DOUBLE[op](x, y)
         return truth
 
     def quant(self, e: ast.Quant, b: Mapping[str, Any]) -> bool:

@@ -89,8 +89,8 @@ def _double_number(x: Any) -> Any:
 
 
 def _exact_arith(raw: Callable[[Any, Any], Any]) -> Callable[[Any, Any], Any]:
-    def meaning(x: Any, y: Any) -> Any:
-        return raw(_exact_number(x), _exact_number(y))
+    def meaning(x: Any, y: Any) -> Any:  # _exact_number inlined: on the evaluator's hot path
+        return raw(Fraction(x) if type(x) is float else x, Fraction(y) if type(y) is float else y)
     return meaning
 
 
@@ -101,8 +101,8 @@ def _exact_div(x: Any, y: Any) -> Any:
 
 
 def _double_arith(raw: Callable[[Any, Any], Any]) -> Callable[[Any, Any], Any]:
-    def meaning(x: Any, y: Any) -> Any:
-        return raw(_double_number(x), _double_number(y))
+    def meaning(x: Any, y: Any) -> Any:  # _double_number inlined
+        return raw(float(x) if type(x) is Fraction else x, float(y) if type(y) is Fraction else y)
     return meaning
 
 
@@ -114,8 +114,8 @@ def _double_div(x: Any, y: Any) -> Any:
 
 
 def _double_cmp(raw: Callable[[Any, Any], bool]) -> Callable[[Any, Any], bool]:
-    def meaning(x: Any, y: Any) -> bool:
-        return bool(raw(_double_number(x), _double_number(y)))
+    def meaning(x: Any, y: Any) -> bool:  # _double_number inlined
+        return bool(raw(float(x) if type(x) is Fraction else x, float(y) if type(y) is Fraction else y))
     return meaning
 
 
