@@ -50,6 +50,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from rclverify.lang import ast
+from rclverify.lang.visit import Visitor
 
 class NotInFragment(Exception):
     """The body reads the variable in a way candidate points cannot decide (the reason)."""
@@ -100,10 +101,11 @@ def analyse(body: ast.Expr, name: str, numeric: str, inner: frozenset[str], env:
     _PLANS[key] = (body, result)
     if isinstance(result, NotInFragment):
         raise result
-    return result
+    sources: tuple[Source, ...] = result
+    return sources
 
 
-class _Scan:
+class _Scan(Visitor[None]):
     """One variable's occurrences: ``pc(e)`` checks ``e`` is piecewise constant in it."""
 
     def __init__(self, name: str, numeric: str, env: Any, out: list[Source]) -> None:
@@ -122,9 +124,10 @@ class _Scan:
             return 0
         if self.numeric == "REAL" or not isinstance(e, ast.Binary) or e.op not in ("+", "-"):
             return None
-        if e.op == "+" and _int_lit(e.left) is not None:
+        lit = _int_lit(e.left) if e.op == "+" else None
+        if lit is not None:
             s = self.ident(e.right, inner)
-            return None if s is None else s + _int_lit(e.left)
+            return None if s is None else s + lit
         c = _int_lit(e.right)
         s = self.ident(e.left, inner)
         if c is None or s is None:
@@ -148,62 +151,67 @@ class _Scan:
         return not (e.func.prefix is None and e.func.name in self.env.ctors)
 
     def pc(self, e: Any, inner: frozenset[str]) -> None:
-        """Check ``e`` is piecewise constant in ``v``, collecting breakpoint sources."""
-        if not self.mentions(e, inner):
-            return
-        if isinstance(e, ast.Apply):
-            if not self._table(e):
-                raise NotInFragment(f"{self.v} in a constructor term not compared with == or !=")
-            if not (isinstance(e.func, ast.Var) and (e.func.prefix is not None or e.func.name not in inner)):
-                raise NotInFragment(f"{self.v} is an argument of a function bound inside its scope")
-            for k, a in enumerate(e.args):
-                if self.ident(a, inner) == 0:
-                    self.out.append(Source("keys", e.func, k))
-                elif self.ident(a, inner) is not None:
-                    raise NotInFragment(f"{self.v} in arithmetic as a function argument")
-                else:
-                    self.pc(a, inner)
-            return
-        if isinstance(e, ast.Compare):
-            for k, op in enumerate(e.ops):
-                self.pair(e.operands[k], op, e.operands[k + 1], inner)
-            return
-        if isinstance(e, ast.Unary):
-            if self.ident(e.operand, inner) is not None:
-                raise NotInFragment(f"{self.v} under unary {e.op}")
-            self.pc(e.operand, inner)
-            return
-        if isinstance(e, ast.Binary):
-            if self.ident(e, inner) is not None or self.ident(e.left, inner) is not None \
-                    or self.ident(e.right, inner) is not None:
-                raise NotInFragment(f"{self.v} in arithmetic that is not compared directly")
-            self.pc(e.left, inner)
-            self.pc(e.right, inner)
-            return
-        if isinstance(e, ast.Member):
-            if self.ident(e.elem, inner) == 0 and (isinstance(e.collection, ast.SetLit) or (
-                    isinstance(e.collection, ast.Var) and e.collection.prefix is not None)):
-                self.valued(e.collection, inner, "elems")
-                return
-            if self.ident(e.elem, inner) is not None:
-                raise NotInFragment(f"{self.v} tested for membership")
-            self.pc(e.elem, inner)
-            if isinstance(e.collection, ast.SetLit):
-                for item in e.collection.items:
-                    if self.ident(item, inner) is not None:
-                        raise NotInFragment(f"{self.v} as a set element")
-                    self.pc(item, inner)
-                return
-            raise NotInFragment(f"{self.v} in a membership test")
-        if isinstance(e, ast.Quant):
-            now = inner
-            for bd in e.bindings:
-                if self.mentions(bd.domain, now):
-                    raise NotInFragment(f"{self.v} in a quantifier's domain")
-                now = now | frozenset(bd.names)
-            self.pc(e.body, now)
-            return
+        """Check ``e`` is piecewise constant in ``v``, collecting breakpoint sources:
+        the method ``visit_<Class>`` of ``e``'s class; any other construct that
+        mentions ``v`` is outside the fragment (:meth:`generic_visit`)."""
+        if self.mentions(e, inner):
+            self.visit(e, inner)
+
+    def generic_visit(self, e: Any, inner: frozenset[str]) -> None:
         raise NotInFragment(f"{self.v} in {type(e).__name__}")
+
+    def visit_Apply(self, e: ast.Apply, inner: frozenset[str]) -> None:
+        if not self._table(e):
+            raise NotInFragment(f"{self.v} in a constructor term not compared with == or !=")
+        if not (isinstance(e.func, ast.Var) and (e.func.prefix is not None or e.func.name not in inner)):
+            raise NotInFragment(f"{self.v} is an argument of a function bound inside its scope")
+        for k, a in enumerate(e.args):
+            if self.ident(a, inner) == 0:
+                self.out.append(Source("keys", e.func, k))
+            elif self.ident(a, inner) is not None:
+                raise NotInFragment(f"{self.v} in arithmetic as a function argument")
+            else:
+                self.pc(a, inner)
+
+    def visit_Compare(self, e: ast.Compare, inner: frozenset[str]) -> None:
+        for k, op in enumerate(e.ops):
+            self.pair(e.operands[k], op, e.operands[k + 1], inner)
+
+    def visit_Unary(self, e: ast.Unary, inner: frozenset[str]) -> None:
+        if self.ident(e.operand, inner) is not None:
+            raise NotInFragment(f"{self.v} under unary {e.op}")
+        self.pc(e.operand, inner)
+
+    def visit_Binary(self, e: ast.Binary, inner: frozenset[str]) -> None:
+        if self.ident(e, inner) is not None or self.ident(e.left, inner) is not None \
+                or self.ident(e.right, inner) is not None:
+            raise NotInFragment(f"{self.v} in arithmetic that is not compared directly")
+        self.pc(e.left, inner)
+        self.pc(e.right, inner)
+
+    def visit_Member(self, e: ast.Member, inner: frozenset[str]) -> None:
+        if self.ident(e.elem, inner) == 0 and (isinstance(e.collection, ast.SetLit) or (
+                isinstance(e.collection, ast.Var) and e.collection.prefix is not None)):
+            self.valued(e.collection, inner, "elems")
+            return
+        if self.ident(e.elem, inner) is not None:
+            raise NotInFragment(f"{self.v} tested for membership")
+        self.pc(e.elem, inner)
+        if isinstance(e.collection, ast.SetLit):
+            for item in e.collection.items:
+                if self.ident(item, inner) is not None:
+                    raise NotInFragment(f"{self.v} as a set element")
+                self.pc(item, inner)
+            return
+        raise NotInFragment(f"{self.v} in a membership test")
+
+    def visit_Quant(self, e: ast.Quant, inner: frozenset[str]) -> None:
+        now = inner
+        for bd in e.bindings:
+            if self.mentions(bd.domain, now):
+                raise NotInFragment(f"{self.v} in a quantifier's domain")
+            now = now | frozenset(bd.names)
+        self.pc(e.body, now)
 
     def pair(self, left: Any, op: str, right: Any, inner: frozenset[str]) -> None:
         for a, b in ((left, right), (right, left)):
