@@ -154,3 +154,20 @@ def test_evaluator_closures_and_straight_line_read_the_table(op: str) -> None:
         assert evaluate(formula, checked, node, values) is expect
         if expect is not None:
             assert straight.fn(values) is expect
+
+
+def test_the_formula_core_keeps_no_copy_of_the_table() -> None:
+    """No module of the formula core states a comparison's or an arithmetic
+    operator's meaning again as a lambda (they read the table)."""
+    import re
+    from pathlib import Path
+
+    import rclverify
+
+    root = Path(rclverify.__file__).parent
+    files = [*(root / "semantics").glob("*.py"), *(root / "backends" / "hoare").glob("*.py"),
+             *(root / "backends" / "model_checking" / "ajpf").glob("*.py"), root / "tools" / "generate" / "cpp_expr.py"]
+    copy = re.compile(r"lambda (\w+), (\w+): \(?\1 (==|!=|<=|>=|<|>|\+|-|\*|/) \2")
+    found = [f"{f.name}: {m.group(0)}" for f in files if f.name != "operators.py"
+             for m in copy.finditer(f.read_text(encoding="utf-8"))]
+    assert len(files) > 30 and found == []
