@@ -18,24 +18,25 @@ from typing import Any, Iterable, cast
 
 from rclverify.lang import ast
 from rclverify.semantics.eval_values import _INFINITE
+from rclverify.semantics.operators import OPERATORS
+
+#: the order comparisons (their converse is the semantics table's)
+_ORDER = frozenset({"<", "<=", ">", ">="})
+
+
+#: node class -> the subexpressions the shape analyses look into: an applied
+#: function's arguments (not its name), a quantifier's body (not its domains)
+_CHILDREN: dict[type, Any] = {
+    ast.Apply: lambda e: e.args, ast.Unary: lambda e: (e.operand,), ast.Binary: lambda e: (e.left, e.right),
+    ast.Compare: lambda e: e.operands, ast.Member: lambda e: (e.elem, e.collection),
+    ast.SetLit: lambda e: e.items, ast.TupleLit: lambda e: e.items, ast.SeqLit: lambda e: e.items,
+    ast.Quant: lambda e: (e.body,),
+}
 
 
 def _children(e: Any) -> Iterable[Any]:
-    if isinstance(e, ast.Apply):
-        return e.args
-    if isinstance(e, ast.Unary):
-        return (e.operand,)
-    if isinstance(e, ast.Binary):
-        return (e.left, e.right)
-    if isinstance(e, ast.Compare):
-        return e.operands
-    if isinstance(e, ast.Member):
-        return (e.elem, e.collection)
-    if isinstance(e, (ast.SetLit, ast.TupleLit, ast.SeqLit)):
-        return e.items
-    if isinstance(e, ast.Quant):
-        return (e.body,)
-    return ()
+    of = _CHILDREN.get(type(e))
+    return () if of is None else cast(Iterable[Any], of(e))
 
 
 def _shift(e: Any, name: str) -> Fraction | None:
@@ -215,10 +216,9 @@ def _bound_of(e: Any, name: str) -> tuple[str, Fraction] | None:
 
     def is_name(x: Any) -> bool:
         return isinstance(x, ast.Var) and x.prefix is None and x.name == name
-    flip = {"<": ">", "<=": ">=", ">": "<", ">=": "<="}
     rel: str = op
-    if is_name(c) and lit(a) is not None and op in flip:
-        rel, a, c = flip[op], c, a
+    if is_name(c) and lit(a) is not None and op in _ORDER:  # c op name: name (op's converse) c
+        rel, a, c = str(OPERATORS[op].converse), c, a
     k = lit(c)
     if not is_name(a) or k is None:
         return None
