@@ -40,8 +40,9 @@ from rclverify.semantics.encode import Encoder
 from rclverify.model.plan.errors import PlanError
 from rclverify.lang import ast
 from rclverify.lang.errors import RclError, error
-from rclverify.lang.printer import binding_to_rcl, expr_to_rcl
+from rclverify.lang.printer import binding_to_rcl, expr_to_rcl, is_type
 from rclverify.lang.typecheck import domain_type
+from rclverify.lang.visit import Visitor, children
 from rclverify.lang.types import NATURAL, CheckedNode, FuncT, Type, assignable
 from rclverify.backends.base import NodeTarget
 from rclverify.backends.hoare import lang
@@ -216,59 +217,51 @@ def _conjuncts(e: ast.Expr) -> list[ast.Expr]:
     return [e]
 
 
-def io_names(e: ast.Expr, node: CheckedNode, bound: frozenset[str] = frozenset()) -> list[str]:
-    """Qualified I/O names (``in.r``, ``out.inspected``) occurring in ``e``, in order."""
-    out: list[str] = []
+class _IoNames(Visitor[None]):
+    """The qualified I/O names of a formula in order of first occurrence
+    (:func:`io_names`): a name bound by an enclosing quantifier is not one;
+    ranges and tuple quantifiers are not looked into."""
 
-    def add(v: ast.Var, scope: frozenset[str]) -> None:
+    def __init__(self, node: CheckedNode) -> None:
+        self.node = node
+        self.out: list[str] = []
+
+    def generic_visit(self, x: Any, scope: frozenset[str]) -> None:
+        for c in children(x):
+            self.visit(c, scope)
+
+    def visit_Var(self, v: ast.Var, scope: frozenset[str]) -> None:
         if v.prefix is None and v.name in scope:
             return
         if v.prefix is not None:
             q = v.qualified
-        elif v.name in node.inputs:
+        elif v.name in self.node.inputs:
             q = f"in.{v.name}"
-        elif v.name in node.outputs:
+        elif v.name in self.node.outputs:
             q = f"out.{v.name}"
         else:
             return
-        if q not in out:
-            out.append(q)
+        if q not in self.out:
+            self.out.append(q)
 
-    def go(x: Any, scope: frozenset[str]) -> None:
-        if isinstance(x, ast.Var):
-            add(x, scope)
-        elif isinstance(x, ast.Apply):
-            add(x.func, scope)
-            for a in x.args:
-                go(a, scope)
-        elif isinstance(x, ast.Quant):
-            inner = scope | frozenset(x.variables)
-            for b in x.bindings:
-                if not _is_type_domain(b.domain):
-                    go(b.domain, scope)
-            go(x.body, inner)
-        elif isinstance(x, ast.Unary):
-            go(x.operand, scope)
-        elif isinstance(x, ast.Binary):
-            go(x.left, scope)
-            go(x.right, scope)
-        elif isinstance(x, ast.Compare):
-            for o in x.operands:
-                go(o, scope)
-        elif isinstance(x, ast.Member):
-            go(x.elem, scope)
-            go(x.collection, scope)
-        elif isinstance(x, (ast.SetLit, ast.SeqLit, ast.TupleLit)):
-            for i in x.items:
-                go(i, scope)
+    def visit_Quant(self, x: ast.Quant, scope: frozenset[str]) -> None:
+        for b in x.bindings:
+            if not is_type(b.domain):
+                self.visit(b.domain, scope)
+        self.visit(x.body, scope | frozenset(x.variables))
 
-    go(e, bound)
-    return out
+    def visit_SeqRange(self, x: ast.SeqRange, scope: frozenset[str]) -> None:
+        return None
+
+    def visit_TupleQuant(self, x: ast.TupleQuant, scope: frozenset[str]) -> None:
+        return None
 
 
-def _is_type_domain(d: Any) -> bool:
-    return isinstance(d, (ast.TBase, ast.TName, ast.TEnum, ast.TConstructors, ast.TFunc, ast.TEmpty, ast.TSet,
-                          ast.TSeq, ast.TTuple))
+def io_names(e: ast.Expr, node: CheckedNode, bound: frozenset[str] = frozenset()) -> list[str]:
+    """Qualified I/O names (``in.r``, ``out.inspected``) occurring in ``e``, in order."""
+    names = _IoNames(node)
+    names.visit(e, bound)
+    return names.out
 
 
 def conjuncts(node: CheckedNode, covered: set[str] | frozenset[str]) -> list[Conjunct]:
@@ -425,7 +418,7 @@ def encode_triple(c: Conjunct, cfg: HoareConfig, m: ProgramModel, enc: Encoder, 
                 fixed[nm] = v
                 if t == NATURAL:
                     background.append(v >= 0)
-        if not _is_type_domain(b.domain):
+        if not is_type(b.domain):
             for nm in b.names:
                 member = ast.Member(ast.Var(nm), b.domain)  # type: ignore[arg-type]
                 pre_guards.append(_encode(enc, member, node, {}, pre_b))
