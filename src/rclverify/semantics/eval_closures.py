@@ -14,6 +14,7 @@ from typing import Any, Callable, Mapping
 
 from rclverify.lang import ast
 from rclverify.lang.types import CheckedNode
+from rclverify.lang.visit import Visitor
 from rclverify.semantics.values import Term
 from rclverify.semantics.eval_values import _CMP, _LIT, Undecided
 from rclverify.semantics.operators import OPERATORS, UNARY, Operator
@@ -34,35 +35,42 @@ def _compile(e: Any, env: Any, node: CheckedNode, mode: str | None = None) -> _F
     ``mode`` (an evaluator of other number semantics) literals, arithmetic
     and comparisons call the evaluator's :meth:`~Evaluator.literal`,
     :meth:`~Evaluator.arith` and :meth:`~Evaluator.compare`."""
-    if isinstance(e, ast.Var):
-        return _compile_var(e, env, node, mode)
-    if mode is not None:
-        if isinstance(e, ast.NumLit):
-            return lambda ev, b: ev.literal(e)
-        if isinstance(e, ast.Compare):
-            parts = tuple(_compile(o, env, node, mode) for o in e.operands)
-            ops = e.ops
+    return _Compiler(env, node, mode).visit(e)
 
-            def compare_in_mode(ev: Any, b: Mapping[str, Any]) -> Any:
-                vals = [o(ev, b) for o in parts]
-                return all(ev.compare(e, b, op, x, y) for op, x, y in zip(ops, vals, vals[1:]))
-            return compare_in_mode
-    if isinstance(e, ast.NumLit):
+
+class _Compiler(Visitor[_Fn]):
+    """:func:`_compile`, one method per node class (:mod:`rclverify.lang.visit`);
+    a class without one is handed to the evaluator's tree walk."""
+
+    def __init__(self, env: Any, node: CheckedNode, mode: str | None) -> None:
+        self.env, self.node, self.mode = env, node, mode
+
+    def generic_visit(self, e: Any) -> _Fn:
+        return lambda ev, b: ev.interpret(e, b)
+
+    def visit_Var(self, e: ast.Var) -> _Fn:
+        return _compile_var(e, self.env, self.node, self.mode)
+
+    def visit_NumLit(self, e: ast.NumLit) -> _Fn:
+        if self.mode is not None:
+            return lambda ev, b: ev.literal(e)
         lit = _LIT.get(e.text)
         if lit is None:
             v = e.value
             lit = _LIT[e.text] = int(v) if v.denominator == 1 else v
         value = lit
         return lambda ev, b: value
-    if isinstance(e, ast.BoolLit):
+
+    def visit_BoolLit(self, e: ast.BoolLit) -> _Fn:
         truth = e.value
         return lambda ev, b: truth
-    if isinstance(e, ast.Apply):
-        args = tuple(_compile(a, env, node, mode) for a in e.args)
+
+    def visit_Apply(self, e: ast.Apply) -> _Fn:
+        args = tuple(self.visit(a) for a in e.args)
         func = e.func
         fname, qualified = func.name, func.qualified
-        ctor = func.prefix is None and fname in env.ctors
-        fvar = _compile_var(func, env, node, mode)
+        ctor = func.prefix is None and fname in self.env.ctors
+        fvar = _compile_var(func, self.env, self.node, self.mode)
 
         def apply(ev: Any, b: Mapping[str, Any]) -> Any:
             vals = tuple([a(ev, b) for a in args])
@@ -73,14 +81,25 @@ def _compile(e: Any, env: Any, node: CheckedNode, mode: str | None = None) -> _F
                 raise Undecided(f"{qualified} is not a function value")
             return f(*vals)
         return apply
-    if isinstance(e, ast.Unary):
-        operand = _compile(e.operand, env, node, mode)
+
+    def visit_Unary(self, e: ast.Unary) -> _Fn:
+        operand = self.visit(e.operand)
         meaning = UNARY[e.op].exact
         return lambda ev, b: meaning(operand(ev, b))
-    if isinstance(e, ast.Binary):
-        return _compile_binary(e, env, node, mode)
-    if isinstance(e, ast.Compare):
-        operands = tuple(_compile(o, env, node) for o in e.operands)
+
+    def visit_Binary(self, e: ast.Binary) -> _Fn:
+        return _compile_binary(e, self.env, self.node, self.mode)
+
+    def visit_Compare(self, e: ast.Compare) -> _Fn:
+        if self.mode is not None:
+            parts = tuple(self.visit(o) for o in e.operands)
+            ops = e.ops
+
+            def compare_in_mode(ev: Any, b: Mapping[str, Any]) -> Any:
+                vals = [o(ev, b) for o in parts]
+                return all(ev.compare(e, b, op, x, y) for op, x, y in zip(ops, vals, vals[1:]))
+            return compare_in_mode
+        operands = tuple(self.visit(o) for o in e.operands)
         cmps = tuple(_CMP[op] for op in e.ops)
         if len(cmps) == 1:
             first, second = operands
@@ -91,7 +110,6 @@ def _compile(e: Any, env: Any, node: CheckedNode, mode: str | None = None) -> _F
             vals = [o(ev, b) for o in operands]
             return all(c(x, y) for c, x, y in zip(cmps, vals, vals[1:]))
         return compare
-    return lambda ev, b: ev.interpret(e, b)
 
 
 def _compile_var(v: ast.Var, env: Any, node: CheckedNode, mode: str | None = None) -> _Fn:
