@@ -34,11 +34,10 @@ from __future__ import annotations
 
 import re
 from dataclasses import dataclass
-from typing import Iterator
 
 from rclverify.backends.model_checking.ajpf.psl_ast import (  # re-exported: one namespace, psl.Term, psl.parse
     Sym, Num, Wild, Compound, Term, MODALITIES, Modal, Percept, Const, Not, And, Or, Implies, Always,
-    Eventually, Until, Release, Formula, TRUE, FALSE, MAX_NESTING, depth, PslSyntaxError)
+    Eventually, Until, Release, Formula, TRUE, FALSE, MAX_NESTING, depth, PslSyntaxError, propositions)
 
 
 # ---------------------------------------------------------------------------
@@ -476,27 +475,6 @@ def _not_level(f: Formula) -> bool:
 def _operand(f: Formula) -> str:
     text = to_text(f)
     return f"({text})" if isinstance(f, (And, Or, Implies, Until, Release)) else text
-
-
-# ---------------------------------------------------------------------------
-# Traversal
-# ---------------------------------------------------------------------------
-
-
-def propositions(f: Formula) -> Iterator[Formula]:
-    """Every proposition (``Modal``, ``Percept``) in ``f``, left to right."""
-    if isinstance(f, (Modal, Percept)):
-        yield f
-    elif isinstance(f, Const):
-        return
-    elif isinstance(f, (Not, Always, Eventually)):
-        yield from propositions(f.operand)
-    elif isinstance(f, (And, Or)):
-        for p in f.parts:
-            yield from propositions(p)
-    else:
-        yield from propositions(f.left)
-        yield from propositions(f.right)
 
 
 __all__ = ["And", "Always", "Compound", "Const", "Eventually", "FALSE", "Formula", "Implies", "MAX_NESTING",

@@ -6,7 +6,7 @@ PSL's own, not copies of RCL's: docs/semantics.md, "One formula core".
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Union
+from typing import Iterator, Union
 
 # ---------------------------------------------------------------------------
 # Terms
@@ -154,3 +154,24 @@ class PslSyntaxError(ValueError):
         super().__init__(f"column {col}: {message}")
         self.message = message
         self.col = col
+
+
+# ---------------------------------------------------------------------------
+# Traversal
+# ---------------------------------------------------------------------------
+
+
+def propositions(f: Formula) -> Iterator[Formula]:
+    """Every proposition (``Modal``, ``Percept``) in ``f``, left to right."""
+    if isinstance(f, (Modal, Percept)):
+        yield f
+    elif isinstance(f, Const):
+        return
+    elif isinstance(f, (Not, Always, Eventually)):
+        yield from propositions(f.operand)
+    elif isinstance(f, (And, Or)):
+        for p in f.parts:
+            yield from propositions(p)
+    else:
+        yield from propositions(f.left)
+        yield from propositions(f.right)
