@@ -36,9 +36,11 @@ from typing import Any, Iterator, Mapping, Sequence
 import numpy as np
 
 from rclverify.traces.bag import bag_event, open_bag, read_bag, typestore
+from rclverify.traces.bag_raw import RawMessages, from_items, raw_blocks
 from rclverify.traces.events import Event, TraceError
 
 FLOAT64, STRING = "std_msgs/msg/Float64", "std_msgs/msg/String"
+_WIDE = 256  # a String message longer than this (bytes) is decoded on its own
 _LE = b"\x00\x01"  # CDR little-endian encapsulation (the two bytes rosbags reads; the options after it are not)
 
 
@@ -85,27 +87,24 @@ def _blocks(path: Path, reader: Any, rows: int) -> Iterator[BagBlock | list[Even
     decoder = copy.copy(reader)
     memo: dict[bytes, Any] = {}
     try:
-        messages = reader.messages()
+        source = raw_blocks(reader, rows)  # rosbags' order without its generators (bag_raw.py), when it applies
+        if source is None:
+            source = _items(reader, rows)
         while True:
-            got: list[tuple[Any, int, bytes]] = []
-            error: TraceError | None = None
             try:
-                got.extend(islice(messages, rows))  # what was read stays in the list if the reader raises
-            except Exception as exc:  # noqa: BLE001 - read_bag's located error, after the messages before it
-                error = TraceError(f"{path}: message {index + len(got)}: error: cannot read the bag "
-                                   f"(truncated?): {exc}")
-            if got:
-                block, bad = BagBlock.make(path, decoder, got, index, memo)
-                if bad is not None:  # the events before a message that cannot be decoded, then its error
-                    if block:
-                        yield block
-                    raise bad
-                yield block
-                index += len(got)
-            if error is not None:
-                raise error
-            if len(got) < rows:
+                got = next(source)
+            except StopIteration:
                 return
+            except Exception as exc:  # noqa: BLE001 - read_bag's located error, after the messages before it
+                raise TraceError(f"{path}: message {index}: error: cannot read the bag "
+                                 f"(truncated?): {exc}") from None
+            block, bad = BagBlock.make(path, decoder, got, index, memo)
+            if bad is not None:  # the events before a message that cannot be decoded, then its error
+                if block:
+                    yield block
+                raise bad
+            yield block
+            index += len(got)
     finally:
         try:
             reader.close()
@@ -113,72 +112,112 @@ def _blocks(path: Path, reader: Any, rows: int) -> Iterator[BagBlock | list[Even
             pass
 
 
+def _items(reader: Any, rows: int) -> Iterator[RawMessages]:
+    """``AnyReader.messages()`` in blocks of at most ``rows``; what it raises, after the block before it."""
+    messages = reader.messages()
+    while True:
+        got: list[tuple[Any, int, bytes]] = []
+        try:
+            got.extend(islice(messages, rows))  # what was read stays in the list if the reader raises
+        except Exception:
+            if got:
+                yield from_items(got)
+            raise
+        if got:
+            yield from_items(got)
+        if len(got) < rows:
+            return
+
+
 class BagBlock:
     """Messages ``index ..`` of a bag as columns (module docstring): ``topics``, ``times``
     (float64 s, the recording's stamps), :meth:`values`, :meth:`typed`, ``block[i]`` (events)."""
 
-    __slots__ = ("path", "reader", "items", "index", "topics", "times", "_made", "_floats", "_is_float",
+    __slots__ = ("path", "reader", "raw", "index", "topics", "times", "_made", "_floats", "_is_float",
                  "_strs", "_is_str")
 
-    def __init__(self, path: Path, reader: Any, items: list[tuple[Any, int, bytes]], index: int) -> None:
-        self.path, self.reader, self.items, self.index = path, reader, items, index
+    def __init__(self, path: Path, reader: Any, raw: RawMessages, index: int) -> None:
+        self.path, self.reader, self.raw, self.index = path, reader, raw, index
         self._made: dict[int, Event] = {}
-        self.topics: list[str] = []
-        self.times = np.zeros(0)
-        n = len(items)
+        n = len(raw)
+        names = np.array([c.topic.lstrip("/") for c in raw.conns] or [""], dtype=object)
+        self.topics: list[str] = names[raw.code].tolist()
+        self.times = raw.stamps / 1e9  # as stamp / 1e9, per message
         self._floats = np.zeros(n, dtype=np.float64)
         self._is_float = np.zeros(n, dtype=bool)
         self._is_str = np.zeros(n, dtype=bool)
         self._strs = np.zeros(n, dtype="<U1")
 
     @classmethod
-    def make(cls, path: Path, reader: Any, items: list[tuple[Any, int, bytes]], index: int,
+    def make(cls, path: Path, reader: Any, raw: RawMessages, index: int,
              memo: dict[bytes, Any]) -> tuple[BagBlock | list[Event], TraceError | None]:
-        """The block of ``items`` (messages ``index ..``), or the events before a message
-        that cannot be decoded and its error (module docstring); ``memo``: String bytes
+        """The block of the messages ``raw`` (messages ``index ..``), or the events before a
+        message that cannot be decoded and its error (module docstring); ``memo``: String bytes
         already decoded (a run's statuses repeat), kept across the blocks."""
-        block = cls(path, reader, items, index)
-        n = len(items)
-        conns, stamps, raws = zip(*items)
-        ids = list(map(id, conns))
-        first = dict(zip(ids, conns))  # a rosbags Connection is not hashable: by identity
-        kind = {i: {FLOAT64: 1, STRING: 2}.get(c.msgtype, 0) for i, c in first.items()}
-        names = {i: c.topic.lstrip("/") for i, c in first.items()}
-        block.topics = list(map(names.__getitem__, ids))
-        block.times = np.fromiter(stamps, np.int64, n) / 1e9  # as stamp / 1e9, per message
-        code = np.fromiter(map(kind.__getitem__, ids), np.int8, n)
+        block = cls(path, reader, raw, index)
+        kinds = np.array([{FLOAT64: 1, STRING: 2}.get(c.msgtype, 0) for c in raw.conns] or [0], dtype=np.int8)
+        code = kinds[raw.code]
+        u = np.frombuffer(raw.buf, np.uint8)
         at = np.flatnonzero(code == 1)
         if len(at):
-            picked = [raws[i] for i in at.tolist()]
-            whole = np.fromiter(map(len, picked), np.int64, len(picked)) == 12
-            at = at[whole]
-            cells = np.frombuffer(b"".join([r for r, w in zip(picked, whole.tolist()) if w]), dtype=np.uint8)
-            cells = cells.reshape(-1, 12)
+            at = at[raw.stop[at] - raw.start[at] == 12]
+            cells = u[raw.start[at][:, None] + np.arange(12)]
             ok = (cells[:, 0] == 0) & (cells[:, 1] == 1)
             block._floats[at[ok]] = cells[ok, 4:12].copy().view("<f8").reshape(-1)
             block._is_float[at[ok]] = True
         at = np.flatnonzero(code == 2)
         if len(at):
-            picked = [raws[i] for i in at.tolist()]
-            texts = list(map(memo.get, picked))
-            for j, (raw, t) in enumerate(zip(picked, texts)):
-                if t is None:
-                    t = texts[j] = _string(raw)
-                    if len(memo) < 4096:
-                        memo[raw] = t
-            good = np.array([t is not False for t in texts], dtype=bool)
-            block._is_str[at[good]] = True
-            block._strs = np.zeros(n, dtype=np.array([t for t in texts if t is not False] or [""]).dtype)
-            block._strs[at[good]] = [t for t in texts if t is not False]
+            block._decode_strings(at, memo)
         for i in np.flatnonzero(~(block._is_float | block._is_str)).tolist():
             try:  # any other message: decoded now, in order, as the stream decodes it
-                block._made[i] = bag_event(reader, path, index + i, *items[i])
+                block._made[i] = bag_event(reader, path, index + i, *raw.item(i))
             except TraceError as exc:
                 return [block[j] for j in range(i)], exc
         return block, None
 
+    def _decode_strings(self, at: np.ndarray, memo: dict[bytes, Any]) -> None:
+        """The ``data`` of the String messages at ``at``: each distinct message's bytes
+        decoded once (:func:`_string`; ``memo`` across blocks), the rest by numpy."""
+        raw = self.raw
+        start, size = raw.start[at], raw.stop[at] - raw.start[at]
+        width = int(size.max())
+        if width > _WIDE:  # long texts: one at a time
+            picked = [raw.buf[a:b] for a, b in zip(start.tolist(), raw.stop[at].tolist())]
+            first, inverse = np.arange(len(at)), np.arange(len(at))
+        else:  # the messages as rows of ``width`` bytes (zeros after each one's end), its size in front
+            buf = raw.buf if int((start + width).max()) <= len(raw.buf) else raw.buf + bytes(width)
+            u = np.frombuffer(buf, np.uint8)
+            cells = np.lib.stride_tricks.as_strided(u, shape=(len(u) - width + 1, width), strides=(1, 1))[start]
+            cells[np.arange(width) >= size[:, None]] = 0
+            key = np.empty((len(at), width + 8), dtype=np.uint8)
+            key[:, :8] = size.astype("<u8").view(np.uint8).reshape(-1, 8)
+            key[:, 8:] = cells
+            _, first, inverse = np.unique(key.view(np.dtype((np.void, width + 8))).reshape(-1), return_index=True,
+                                          return_inverse=True)
+            picked = [cells[j, :n].tobytes() for j, n in zip(first.tolist(), size[first].tolist())]
+        texts = list(map(memo.get, picked))
+        for j, (one, t) in enumerate(zip(picked, texts)):
+            if t is None:
+                t = texts[j] = _string(one)
+                if len(memo) < 4096:
+                    memo[one] = t
+        good = np.array([t is not False for t in texts], dtype=bool)[inverse.reshape(-1)]
+        self._is_str[at[good]] = True
+        self._strs = np.zeros(len(raw), dtype=np.array([t or "" for t in texts]).dtype)
+        self._strs[at] = np.array([t or "" for t in texts])[inverse.reshape(-1)]
+
+    def topic_counts(self) -> dict[str, int]:
+        """Messages per topic (leading ``/`` removed) in this block."""
+        counts = np.bincount(self.raw.code, minlength=len(self.raw.conns)).tolist()
+        out: dict[str, int] = {}
+        for c, n in zip(self.raw.conns, counts):
+            if n:
+                name = c.topic.lstrip("/")
+                out[name] = out.get(name, 0) + n
+        return out
+
     def __len__(self) -> int:
-        return len(self.items)
+        return len(self.raw)
 
     def values(self, rows: np.ndarray, key: str) -> list[Any]:
         """The value of ``key`` in the messages at ``rows`` (``None`` where a message has none)."""
@@ -212,13 +251,13 @@ class BagBlock:
 
     def __getitem__(self, i: Any) -> Any:
         if isinstance(i, slice):
-            return [self[j] for j in range(*i.indices(len(self.items)))]
+            return [self[j] for j in range(*i.indices(len(self.raw)))]
         i = int(i)
         if i < 0:
-            i += len(self.items)
+            i += len(self.raw)
         ev = self._made.get(i)
         if ev is None:
-            ev = self._made[i] = bag_event(self.reader, self.path, self.index + i, *self.items[i])
+            ev = self._made[i] = bag_event(self.reader, self.path, self.index + i, *self.raw.item(i))
         return ev
 
 

@@ -86,8 +86,9 @@ class Counted:
     def _counted(self, blocks: Iterator[Any]) -> Iterator[Any]:
         heard = self.heard
         for block in blocks:
+            counts = getattr(block, "topic_counts", None)  # a bag block counts its connections' codes
             topics = [ev.topic for ev in block] if isinstance(block, list) else block.topics
-            for key, n in Counter(topics).items():
+            for key, n in (counts() if counts is not None else Counter(topics)).items():
                 key = key.strip("/")
                 heard[key] = heard.get(key, 0) + n
             yield block
