@@ -39,6 +39,8 @@ samples (made from ``--seed``), the monitoring loop timed in CPU seconds:
   takes them (traces/jsonl_blocks.py) and the ``data`` values of every
   row, in a process of its own after a warm-up on ten samples, without
   judging anything: the part of the command no monitor can skip (issue 67);
+  the same for the two bags (traces/bag_blocks.py, after a warm-up reading
+  the whole bag once, which also warms the file cache);
 * **RTAMT** 0.4.10 (``pip install rtamt==0.4.10``): the discrete-time STL
   specification of the same property, updated sample by sample
   (robustness >= 0 is satisfied; statuses as 0, 1, 2);
@@ -66,8 +68,8 @@ untimed run of the engine, so collecting them costs the timing nothing).
 A peer that is not installed is skipped with the reason: the peers are
 optional bench dependencies (``pip install '.[bench]'``), never rclverify's.
 
-``--repeat K`` runs the command on the log, its start-up, the reading of
-the log and the columns path K times each and keeps each one's least CPU
+``--repeat K`` runs the command on the log and on the bags, its start-up,
+the reading of the log and of the bags and the columns path K times each and keeps each one's least CPU
 (the run the machine's other load disturbed least; the ratios between them
 are taken from those).
 
@@ -268,22 +270,27 @@ def child(args: argparse.Namespace) -> int:
 
 
 def _read_log(log: Path) -> float:
-    """CPU seconds to read the log at ``log`` as the batch path does (its blocks, a block's
-    ``data`` at every row), after the same on the log's first ten samples (the imports, outside)."""
+    """CPU seconds to read the log (or, a directory, the bag) at ``log`` as the batch path does
+    (its blocks, a block's ``data`` at every row), after the same on the log's first ten samples
+    (a bag: on the whole bag; the imports, outside)."""
     import numpy as np
+    from rclverify.traces.bag_blocks import BagTrace
     from rclverify.traces.jsonl_blocks import JsonlLog
 
     def read(path: Path) -> int:
         rows = 0
-        for block in JsonlLog(path).blocks(["data"], 16384) or ():
+        for block in (BagTrace(path) if path.is_dir() else JsonlLog(path)).blocks(["data"], 16384) or ():
             rows += len(block)
             if not isinstance(block, list):
                 block.values(np.arange(len(block)), "data")
         return rows
     with tempfile.TemporaryDirectory() as tmp:
         head = Path(tmp) / "head.jsonl"
-        with log.open("rb") as f:
-            head.write_bytes(b"".join(f.readline() for _ in range(20)))
+        if log.is_dir():
+            head = log
+        else:
+            with log.open("rb") as f:
+                head.write_bytes(b"".join(f.readline() for _ in range(20)))
         read(head)
     t0 = time.process_time()
     read(log)
@@ -379,7 +386,7 @@ def main() -> int:
     ap.add_argument("--smoke", action="store_true", help="2,000 samples (CI)")
     ap.add_argument("--no-bags", action="store_true", help="leave out the command on the sqlite3 and MCAP bags")
     ap.add_argument("--repeat", type=int, default=1, metavar="K",
-                    help="run the command on the log, its start-up, the reading and the columns path K times; keep "
+                    help="run the command on the log and the bags, its start-up, the readings and the columns path K times; keep "
                          "each one's least CPU")
     ap.add_argument("--child", choices=("rclverify", "batch", "columns", "read", "rtamt", "reelay", "mstlo"),
                     help=argparse.SUPPRESS)
@@ -423,7 +430,10 @@ def _measure(args: argparse.Namespace) -> tuple[dict[str, dict[str, Any]], dict[
             if label == "new" and not args.no_bags:  # the same samples in ROS 2 bags
                 _bags(ws, args)
                 for storage in ("sqlite3", "mcap"):
-                    rows[f"rclverify monitor, {storage}"] = _run_command(ws, src, f"run_{storage}")
+                    rows[f"rclverify monitor, {storage}"] = _best(args.repeat, lambda s=storage: _run_command(
+                        ws, src, f"run_{s}"))
+                    rows[f"reading the {storage} bag"] = _best(args.repeat, lambda s=storage: _run_child(
+                        "read", args, None, src, ws / f"run_{s}"))
             if label == "new":  # the command's start-up: the same command on a log of ten samples
                 tiny = argparse.Namespace(**{**vars(args), "samples": 10})
                 (base / "tiny").mkdir()
@@ -476,10 +486,12 @@ def _print(rows: dict[str, dict[str, Any]], verdicts: dict[str, bytes], args: ar
               f"{cmd['cpu'] / cols['cpu']:.2f}, {(cmd['cpu'] - start) / cols['cpu']:.2f} without the start-up "
               f"(aim: at most 1.2); printed: {cmd['out']}")
         said.add(cmd["out"].split(": ", 1)[-1])
-    if "reading the log (new)" in rows:
-        read = rows["reading the log (new)"]["cpu"]
-        print(f"reading the log alone (blocks and values, nothing judged): {read:.2f} CPU s, {read / cols['cpu']:.2f}x "
-              "the batch path on columns")
+    for name, what in (("reading the log (new)", "the log"), ("reading the sqlite3 bag", "the sqlite3 bag"),
+                       ("reading the mcap bag", "the MCAP bag")):
+        if name in rows:
+            read = rows[name]["cpu"]
+            print(f"reading {what} alone (blocks and values, nothing judged): {read:.2f} CPU s, "
+                  f"{read / cols['cpu']:.2f}x the batch path on columns")
     if len(said) != 1:  # the log and the two bags hold the same samples: the same counts
         raise SystemExit(f"the command's counts differ between the log and the bags: {sorted(said)}")
     wrong = [k for k, v in verdicts.items() if v != verdicts["new"]]
