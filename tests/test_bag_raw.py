@@ -172,3 +172,35 @@ def test_a_damaged_mcap_gives_rosbags_messages_and_error(bags: dict[str, Path], 
                 events.append(ev)
         assert str(exc.value) == str(ref.value)
         assert repr(got) == repr(events)
+
+
+@pytest.mark.parametrize("storage", ["sqlite3", "mcap"])
+def test_many_and_long_strings_are_decoded_as_read_bag(tmp_path: Path, storage: str) -> None:
+    """More distinct String messages than a block compares (traces/bag_blocks.py), texts longer
+    than it gathers, texts of 7, 8 and 9 bytes (a 64-bit word's edge): read_bag's values."""
+    from collections import Counter
+
+    import numpy as np
+    from rosbags.rosbag2 import StoragePlugin, Writer
+    rnd = random.Random(3)
+    store = typestore([])
+    path = tmp_path / storage
+    with Writer(path, version=9, storage_plugin=StoragePlugin.MCAP if storage == "mcap" else
+                StoragePlugin.SQLITE3) as w:
+        conn = w.add_connection("/status", "std_msgs/msg/String", typestore=store)
+        for i in range(600):
+            text = rnd.choice([f"v{rnd.randrange(150)}", "x" * rnd.randrange(6, 11)] +
+                              (["y" * rnd.randrange(60, 90)] if i >= 400 else []))  # long ones in the last blocks
+            raw = text.encode() + b"\x00"
+            w.write(conn, 1000 + i, b"\x00\x01\x00\x00" + struct.pack("<I", len(raw)) + raw)
+    want = list(read_bag(path))
+    got, typed = [], 0
+    for b in BagTrace(path).blocks(["data"], 256) or []:
+        rows = np.arange(len(b))
+        got += b.values(rows, "data")
+        assert b.topic_counts() == dict(Counter(b.topics))
+        ok, col = b.typed(rows, "data", "enum", {"v7": 0, "xxxxxxxx": 1})
+        typed += int(ok.sum())
+        assert col[ok].tolist() == [{"v7": 0, "xxxxxxxx": 1}[v] for v, g in zip(b.values(rows, "data"), ok) if g]
+    assert got == [e.fields["data"] for e in want]
+    assert typed == sum(e.fields["data"] in ("v7", "xxxxxxxx") for e in want) > 0

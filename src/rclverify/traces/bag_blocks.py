@@ -40,7 +40,9 @@ from rclverify.traces.bag_raw import RawMessages, from_items, raw_blocks
 from rclverify.traces.events import Event, TraceError
 
 FLOAT64, STRING = "std_msgs/msg/Float64", "std_msgs/msg/String"
-_WIDE = 256  # a String message longer than this (bytes) is decoded on its own
+_WIDE = 64  # a String message longer than this (bytes) is decoded on its own
+_DISTINCT = 64  # distinct String messages a block finds by comparison (the others: one at a time)
+_MASKS = np.array([(1 << (8 * k)) - 1 for k in range(9)], dtype=np.uint64)  # the low k bytes of a word
 _LE = b"\x00\x01"  # CDR little-endian encapsulation (the two bytes rosbags reads; the options after it are not)
 
 
@@ -161,7 +163,7 @@ class BagBlock:
         at = np.flatnonzero(code == 1)
         if len(at):
             at = at[raw.stop[at] - raw.start[at] == 12]
-            cells = u[raw.start[at][:, None] + np.arange(12)]
+            cells = np.lib.stride_tricks.as_strided(u, shape=(max(len(u) - 11, 0), 12), strides=(1, 1))[raw.start[at]]
             ok = (cells[:, 0] == 0) & (cells[:, 1] == 1)
             block._floats[at[ok]] = cells[ok, 4:12].copy().view("<f8").reshape(-1)
             block._is_float[at[ok]] = True
@@ -177,34 +179,43 @@ class BagBlock:
 
     def _decode_strings(self, at: np.ndarray, memo: dict[bytes, Any]) -> None:
         """The ``data`` of the String messages at ``at``: each distinct message's bytes
-        decoded once (:func:`_string`; ``memo`` across blocks), the rest by numpy."""
+        decoded once (:func:`_string`; ``memo`` across blocks), found by comparing the
+        messages as 64-bit words (the bytes after a message's end zeroed)."""
         raw = self.raw
         start, size = raw.start[at], raw.stop[at] - raw.start[at]
-        width = int(size.max())
-        if width > _WIDE:  # long texts: one at a time
-            picked = [raw.buf[a:b] for a, b in zip(start.tolist(), raw.stop[at].tolist())]
-            first, inverse = np.arange(len(at)), np.arange(len(at))
-        else:  # the messages as rows of ``width`` bytes (zeros after each one's end), its size in front
+        width = -(-int(size.max()) // 8) * 8
+        which = np.full(len(at), -1, dtype=np.int64)
+        picked: list[bytes] = []
+        if width <= _WIDE:
             buf = raw.buf if int((start + width).max()) <= len(raw.buf) else raw.buf + bytes(width)
             u = np.frombuffer(buf, np.uint8)
-            cells = np.lib.stride_tricks.as_strided(u, shape=(len(u) - width + 1, width), strides=(1, 1))[start]
-            cells[np.arange(width) >= size[:, None]] = 0
-            key = np.empty((len(at), width + 8), dtype=np.uint8)
-            key[:, :8] = size.astype("<u8").view(np.uint8).reshape(-1, 8)
-            key[:, 8:] = cells
-            _, first, inverse = np.unique(key.view(np.dtype((np.void, width + 8))).reshape(-1), return_index=True,
-                                          return_inverse=True)
-            picked = [cells[j, :n].tobytes() for j, n in zip(first.tolist(), size[first].tolist())]
+            words = np.lib.stride_tricks.as_strided(u, shape=(len(u) - width + 1, width), strides=(1, 1))[start]
+            words = words.view("<u8")
+            for j in range(width // 8):  # keep each message's own bytes only
+                words[:, j] &= _MASKS[np.clip(size - 8 * j, 0, 8)]
+            left = np.arange(len(at))
+            while len(left) and len(picked) < _DISTINCT:
+                i = int(left[0])
+                same = size[left] == size[i]
+                for j in range(width // 8):
+                    same &= words[left, j] == words[i, j]
+                which[left[same]] = len(picked)
+                picked.append(words[i].tobytes()[:int(size[i])])
+                left = left[~same]
+        for i in np.flatnonzero(which < 0).tolist():  # long or too many distinct texts: one at a time
+            which[i] = len(picked)
+            picked.append(raw.buf[int(start[i]):int(start[i] + size[i])])
         texts = list(map(memo.get, picked))
         for j, (one, t) in enumerate(zip(picked, texts)):
             if t is None:
                 t = texts[j] = _string(one)
                 if len(memo) < 4096:
                     memo[one] = t
-        good = np.array([t is not False for t in texts], dtype=bool)[inverse.reshape(-1)]
+        good = np.array([t is not False for t in texts], dtype=bool)[which]
         self._is_str[at[good]] = True
-        self._strs = np.zeros(len(raw), dtype=np.array([t or "" for t in texts]).dtype)
-        self._strs[at] = np.array([t or "" for t in texts])[inverse.reshape(-1)]
+        values = np.array([t or "" for t in texts])
+        self._strs = np.zeros(len(raw), dtype=values.dtype)
+        self._strs[at] = values[which]
 
     def topic_counts(self) -> dict[str, int]:
         """Messages per topic (leading ``/`` removed) in this block."""

@@ -46,11 +46,13 @@ from __future__ import annotations
 
 from importlib.metadata import version
 from itertools import islice
+from operator import itemgetter
 from typing import Any, Iterator, Sequence
 
 import numpy as np
 
 _EMPTY = np.zeros(0, dtype=np.int64)
+_FIRST, _SECOND, _THIRD = itemgetter(0), itemgetter(1), itemgetter(2)
 
 
 class RawMessages:
@@ -83,17 +85,19 @@ def from_items(items: Sequence[tuple[Any, int, bytes]]) -> RawMessages:
     """``rosbags``' message tuples as :class:`RawMessages` (connections by identity: not hashable)."""
     if not items:
         return RawMessages([], _EMPTY, _EMPTY, b"", _EMPTY, _EMPTY)
-    conns, stamps, raws = zip(*items)
+    n = len(items)
+    conns = list(map(_FIRST, items))
     index: dict[int, int] = {}
     order: list[Any] = []
     for c in conns:
         if id(c) not in index:
             index[id(c)] = len(order)
             order.append(c)
-    code = np.fromiter(map(index.__getitem__, map(id, conns)), np.int64, len(conns))
-    lens = np.fromiter(map(len, raws), np.int64, len(raws))
+    code = np.fromiter(map(index.__getitem__, map(id, conns)), np.int64, n)
+    raws = list(map(_THIRD, items))
+    lens = np.fromiter(map(len, raws), np.int64, n)
     stop = np.cumsum(lens)
-    return RawMessages(order, code, np.fromiter(stamps, np.int64, len(stamps)), b"".join(raws), stop - lens, stop)
+    return RawMessages(order, code, np.fromiter(map(_SECOND, items), np.int64, n), b"".join(raws), stop - lens, stop)
 
 
 def raw_blocks(reader: Any, rows: int) -> Iterator[RawMessages] | None:
@@ -191,12 +195,13 @@ def _sqlite3(storage: Any, connmap: dict[int, Any], rows: int) -> Iterator[RawMe
             got.extend(islice(cur, rows))
         except Exception as exc:  # noqa: BLE001 - the rows before it first, as rosbags' generator gives them
             error = exc
-        if got:
-            cids, stamps, raws = zip(*got)
-            lens = np.fromiter(map(len, raws), np.int64, len(raws))
+        if got:  # (``zip(*got)`` would call 3 x len(got) iterators)
+            n = len(got)
+            raws = list(map(_THIRD, got))
+            lens = np.fromiter(map(len, raws), np.int64, n)
             stop = np.cumsum(lens)
-            yield RawMessages(order, np.fromiter(map(code.__getitem__, cids), np.int64, len(cids)),
-                              np.fromiter(stamps, np.int64, len(stamps)), b"".join(raws), stop - lens, stop)
+            yield RawMessages(order, np.fromiter(map(code.__getitem__, map(_FIRST, got)), np.int64, n),
+                              np.fromiter(map(_SECOND, got), np.int64, n), b"".join(raws), stop - lens, stop)
         if error is not None:
             raise error
         if len(got) < rows:

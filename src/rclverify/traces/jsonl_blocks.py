@@ -53,6 +53,7 @@ as a ``bytes`` object unless a row's event is asked for.
 """
 from __future__ import annotations
 
+from collections import Counter
 from operator import attrgetter
 from pathlib import Path
 from typing import Any, Iterator, Sequence, Union
@@ -283,6 +284,14 @@ class LogBlock:
 
     def __len__(self) -> int:
         return len(self.structs)
+
+    def topic_counts(self) -> dict[str, int]:
+        """Rows per topic (as ``topics`` names them): a count per distinct topic (a log has a few)."""
+        topics = self.topics
+        distinct = set(topics)
+        if len(distinct) > 16:
+            return dict(Counter(topics))
+        return {t: topics.count(t) for t in distinct}
 
     def values(self, rows: np.ndarray, key: str) -> list[Any]:
         """The value of ``key`` in the messages at ``rows`` (``None`` where a message
