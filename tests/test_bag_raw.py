@@ -113,6 +113,8 @@ def test_raw_blocks_are_rosbags_messages_in_its_order(bags: dict[str, Path], mon
         assert want[1] is None and len(want[0]) > 600
         for rows in (5, 16384):
             assert _raw(bags[name], rows) == want, (name, rows)
+        one = next(bags[name].glob("*.mcap" if "sqlite3" not in name else "*.db3"))  # the storage file named alone
+        assert _raw(one, 64) == _stream(one) != ([], None)
         if name.startswith("mcap"):
             reader = open_bag(bags[name], typestore([]))
             chunks += len(reader.readers[0].storage.storages[0].chunks)
