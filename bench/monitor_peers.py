@@ -39,8 +39,9 @@ samples (made from ``--seed``), the monitoring loop timed in CPU seconds:
   takes them (traces/jsonl_blocks.py) and the ``data`` values of every
   row, in a process of its own after a warm-up on ten samples, without
   judging anything: the part of the command no monitor can skip (issue 67);
-  the same for the two bags (traces/bag_blocks.py, after a warm-up reading
-  the whole bag once, which also warms the file cache);
+  the same for the two bags (traces/bag_blocks.py, a block's float column
+  as the batch path takes it, after a warm-up reading the whole bag once,
+  which also warms the file cache);
 * **RTAMT** 0.4.10 (``pip install rtamt==0.4.10``): the discrete-time STL
   specification of the same property, updated sample by sample
   (robustness >= 0 is satisfied; statuses as 0, 1, 2);
@@ -281,8 +282,10 @@ def _read_log(log: Path) -> float:
         rows = 0
         for block in (BagTrace(path) if path.is_dir() else JsonlLog(path)).blocks(["data"], 16384) or ():
             rows += len(block)
-            if not isinstance(block, list):
-                block.values(np.arange(len(block)), "data")
+            if not isinstance(block, list):  # the column as the batch path takes it (rows.py: typed, else values)
+                at = np.arange(len(block))
+                if getattr(block, "typed", None) is None or block.typed(at, "data", "real", {}) is None:
+                    block.values(at, "data")
         return rows
     with tempfile.TemporaryDirectory() as tmp:
         head = Path(tmp) / "head.jsonl"
