@@ -268,8 +268,18 @@ class BagBlock:
             i += len(self.raw)
         ev = self._made.get(i)
         if ev is None:
-            ev = self._made[i] = bag_event(self.reader, self.path, self.index + i, *self.raw.item(i))
+            ev = self._made[i] = self._event(i)
         return ev
+
+    def _event(self, i: int) -> Event:
+        """Row ``i``'s event: :func:`~.bag.bag_event`'s, made from the decoded ``data``
+        where the row was decoded here (the one field of either type; no header)."""
+        if not (self._is_float[i] or self._is_str[i]):
+            return bag_event(self.reader, self.path, self.index + i, *self.raw.item(i))
+        conn, stamp = self.raw.conns[int(self.raw.code[i])], int(self.raw.stamps[i])
+        value = float(self._floats[i]) if self._is_float[i] else str(self._strs[i])
+        return Event(self.index + i, stamp / 1e9, conn.topic.lstrip("/"), {"data": value},
+                     f"{self.path.name}: message {self.index + i}")
 
 
 def _string(raw: bytes) -> str | bool:
