@@ -6,8 +6,10 @@ dict of its fields and an :class:`~.events.Event`; the offline batch path
 time and one field.  :class:`BagTrace` is what
 :func:`~rclverify.traces.read_trace` returns for a bag: iterated, it gives
 :func:`~.bag.read_bag`'s events; :meth:`BagTrace.blocks` gives the same
-messages, in the same order (``rosbags``' own reader gives both their order
-and their bytes), as :class:`BagBlock`\\ s of at most ``rows`` messages.
+messages, in the same order and with the same bytes (``AnyReader.messages()``'s:
+read as raw columns by :mod:`.bag_raw` where it reproduces that order, else
+taken from ``rosbags``' reader itself), as :class:`BagBlock`\\ s of at most
+``rows`` messages.
 
 A block decodes the ``data`` field of the two message types a batch-path
 topic most often carries straight from their CDR bytes, for all the block's
@@ -16,13 +18,16 @@ exactly 12 bytes: the double at offset 4) and ``std_msgs/msg/String``
 (little-endian CDR: the length ``L`` at offset 4, then ``L - 1`` bytes of
 UTF-8 and the terminating zero, nothing after).  Those are the bytes
 ``rosbags`` decodes to the same value (a ``float``; a ``str``, strictly
-UTF-8), so the column holds what the event would.  Every other message (of
+UTF-8), so the column holds what the event would (a block's String
+messages are compared as 64-bit words, each distinct one decoded once).
+Every other message (of
 another type, big-endian, padded, not valid) is decoded at once by
 :func:`~.bag.bag_event`, as :func:`~.bag.read_bag` decodes it; one it
 cannot decode ends the block: the events before it are given as a list,
 then its located :class:`~.events.TraceError` is raised, as the stream
 raises it.  A message's event is made on demand by the same
-:func:`~.bag.bag_event`.  A ROS 1 bag, or a workspace whose own ``.msg``
+:func:`~.bag.bag_event` (a message decoded here: from its decoded ``data``,
+the one field of either type, as :func:`~.bag.bag_event` makes it).  A ROS 1 bag, or a workspace whose own ``.msg``
 files redefine either type, is not read in blocks (``blocks`` gives
 ``None``: the caller reads events).
 """
