@@ -28,6 +28,7 @@ from typing import TYPE_CHECKING, Any, Callable, Mapping, Sequence, cast
 
 from rclverify.records.store import dumps
 from rclverify.lang.errors import RclError
+from rclverify.stages.cone_digests import cone_digests
 
 if TYPE_CHECKING:
     from rclverify.backends.base import NodeTarget
@@ -282,59 +283,6 @@ def node_snapshots(ws: Workspace, texts: Any) -> dict[str, dict[str, Any]]:
             "plan_locations": dict(sorted(plan_locs.get(name, {}).items())),
         }
     return out
-
-
-def _merkle(model: Any, leaf: Mapping[str, str]) -> dict[str, str]:
-    """``{node: sha256}`` over the strongly connected components of
-    ``model``, producers first: a component's digest is the sha256 of its
-    members' ``leaf`` values and of the sorted digests of the components
-    feeding it.  It changes whenever the leaf of any node of the upstream
-    cone changes.  O(nodes + links)."""
-    comp: dict[str, tuple[str, ...]] = {n: (n,) for n in model.nodes}
-    for loop in model.loops:
-        for n in loop:
-            comp[n] = tuple(loop)
-    feeds: dict[tuple[str, ...], set[tuple[str, ...]]] = {}
-    for c in set(comp.values()):
-        feeds[c] = {comp[p] for m in c for p in model.producers(m)} - {c}
-    digest: dict[tuple[str, ...], str] = {}
-    for root in dict.fromkeys(comp[n] for n in model.nodes):  # iterative post-order over the component DAG
-        if root in digest:
-            continue
-        stack = [(root, iter(sorted(feeds[root])))]
-        while stack:
-            c, it = stack[-1]
-            for f in it:
-                if f not in digest:
-                    stack.append((f, iter(sorted(feeds[f]))))
-                    break
-            else:
-                stack.pop()
-                if c not in digest:
-                    h = hashlib.sha256()
-                    for m in c:
-                        h.update(f"{m} {leaf[m]}\n".encode())
-                    h.update(b"--\n")
-                    for d in sorted(digest[f] for f in feeds[c]):
-                        h.update(d.encode() + b"\n")
-                    digest[c] = h.hexdigest()
-    return {n: digest[comp[n]] for n in model.nodes}
-
-
-def cone_digests(model: Any, snapshot_sha: Mapping[str, str], env_sha: Mapping[str, str]) -> dict[str, str]:
-    """``{node: text}``: for every node of ``model`` (a
-    :class:`~rclverify.model.system.model.SystemModel`) the text of its cone
-    digest file (:meth:`Workspace.cone`), two lines: ``env <sha256>``, a
-    digest of the environment conjuncts of the assumptions of its upstream
-    cone (``env_sha``: node -> sha256 of their text; the derived property
-    reads them), and ``cone <sha256>``, a digest of the snapshots of its
-    whole upstream cone (``snapshot_sha``: node -> sha256 of its snapshot;
-    side conditions in context read them, docs/calculus.md).  Merkle hashes
-    over the cone's strongly connected components (:func:`_merkle`): one
-    file per node, not N*N/2 snapshots along a chain.  Which line a node's
-    ``compose`` stage depends on is :mod:`rclverify.app.conetask`'s business."""
-    env, full = _merkle(model, env_sha), _merkle(model, snapshot_sha)
-    return {n: f"env {env[n]}\ncone {full[n]}\n" for n in model.nodes}
 
 
 def environment_sha(ws: Workspace) -> dict[str, str]:
