@@ -273,13 +273,14 @@ def _claim_points_obey_v09(data: dict[str, Any]) -> list[tuple[str, str]]:
 
 
 def test_assurance_claim_points_mark_where_confidence_is_argued() -> None:
-    from rclverify.report.confidence_rows import annotate
+    from rclverify.report.assemble import with_confidence
+    from rclverify.report.confidence_rows import confidence_part
     rep = _report()
     rep["evidence"][0]["status"] = "failed"  # counter-evidence: a defeater of Sensor guarantee 1
     rep["obligations"][0]["status"] = "failed"
     rep["nodes"][0]["guarantees"][0]["obligations"] = ["Sensor.g1.hoare"]
     rep["nodes"][0]["guarantees"][1]["obligations"] = ["Sensor.g2.review"]
-    annotate(rep, [("Sensor", "Planner")])
+    rep = with_confidence(rep, confidence_part(rep, [("Sensor", "Planner")]))
     data = yaml.safe_load(to_gsn_yaml(build_argument(rep), "mini"))
     points = dict(_claim_points_obey_v09(data))
     # each requirement goal has one (these requirements are argued by the calculus: no confidence of their own)

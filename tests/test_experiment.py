@@ -14,7 +14,7 @@ from rclverify.backends.experiment.plot import render_svg
 from rclverify.records.store import EvidenceStore
 from rclverify.app.pipeline import Workspace, stage_check, stage_export, stage_run
 from rclverify.lang.parser import parse_formula
-from rclverify.report.build import _evidence_extras
+from rclverify.report.evidence_rows import evidence_extras as _evidence_extras
 from rclverify.app.tasks import act_check
 
 from _evidence_ws import copy_workspace, plan_line, replace_in_plan

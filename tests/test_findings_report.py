@@ -4,7 +4,8 @@ from __future__ import annotations
 import random
 
 from rclverify.records.records import SEVERITY, worst
-from rclverify.report.build import CONE_NAMES, ConeEvidence, _headline
+from rclverify.report.cones import CONE_NAMES, ConeEvidence
+from rclverify.report.summary_rows import headline as _headline
 from rclverify.model.system.model import Link, SystemModel
 
 

@@ -13,7 +13,7 @@ import pytest
 
 from rclverify.report.argument.model import Argument, Element, propagate
 from rclverify.cli.commands import main
-from rclverify.report.culprits import mark_culprits
+from rclverify.report.culprits import marked_nodes
 
 from _grip_ws import make
 
@@ -58,15 +58,16 @@ def test_no_culprit_reads_discharged(report: dict[str, Any]) -> None:
     assert goal["status"] == "failed" and goal.get("defeated") is True
 
 
-def test_mark_culprits_raises_only_what_a_row_names() -> None:
+def test_marked_nodes_raises_only_what_a_row_names() -> None:
     rep: dict[str, Any] = {
         "nodes": [{"name": "A", "status": "discharged", "guarantees": [{"index": 1, "status": "discharged"},
                                                                       {"index": 2, "status": "discharged"}]},
                   {"name": "B", "status": "discharged", "guarantees": [{"index": 1, "status": "discharged"}]}],
         "problems": [{"status": "problem", "sentence": "s", "culprits": [{"id": "guarantee:A:2"}]},
                      {"status": "inconclusive", "sentence": "t", "culprits": [{"id": "assumption:B:1"}]}]}
-    mark_culprits(rep)
-    a, b = rep["nodes"]
+    given = json.dumps(rep, sort_keys=True)
+    a, b = marked_nodes(rep["nodes"], rep["problems"])
+    assert json.dumps(rep, sort_keys=True) == given  # new rows: the report's own rows are left as they were
     assert a["status"] == "failed" and a["guarantees"][1]["status"] == "failed"
     assert a["guarantees"][0]["status"] == "discharged" and "culprit_of" not in a["guarantees"][0]
     assert b["status"] == "discharged"  # an assumption is where the victim is, not a culprit node

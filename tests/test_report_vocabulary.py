@@ -47,7 +47,8 @@ def test_the_stages_use_the_vocabulary() -> None:
     from rclverify.model.plan.expected import VERDICTS as EXPECTED
     from rclverify.lang.errors import Severity as LintSeverity
     from rclverify.report import severity
-    from rclverify.report.build import _DERIVATION, _FINDING_AS
+    from rclverify.report.cones import DERIVATION as _DERIVATION
+    from rclverify.report.contract_rows import FINDING_AS as _FINDING_AS
     from rclverify.report.deadlines import STATUS_OF
     from rclverify.calculus.requirements import rollup
     assert rollup.VERDICTS == statuses.REQUIREMENT_VERDICTS

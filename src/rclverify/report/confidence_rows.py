@@ -1,7 +1,8 @@
 """Evidence strength and confidence on the report's rows (issue 50).
 
-Annotates the report model :func:`rclverify.report.build.build_report`
-makes, in place:
+What :func:`confidence_part` gives the rows of the report
+:func:`rclverify.report.build.build_report` makes (report/assemble.py puts
+it in):
 
 * every evidence row and side condition gets ``strength``
   (:mod:`rclverify.report.argument.strength`);
@@ -15,7 +16,7 @@ The rules and their sources: :mod:`rclverify.report.argument.confidence`, docs/c
 """
 from __future__ import annotations
 
-from typing import Any
+from typing import Any, Mapping, TypedDict
 
 from rclverify.report.argument.confidence import Premise, derived_claims, guarantee_premise, node_claims, requirement_claim
 from rclverify.report.argument.strength import DOUBT, KINDS, evidence_strength, side_condition_strength
@@ -36,36 +37,55 @@ def limit_sentence(req_id: str, p: Premise) -> str:
     return f"{req_id} rests on {_WORDS.get(p.kind, p.kind)} for {p.label} (doubt {p.doubt:g})"
 
 
-def annotate(report: dict[str, Any], links: list[tuple[str, str]], required: dict[str, str] | None = None) -> bool:
-    """Add strength and confidence to ``report`` (module docstring).
-    ``links``: ``(producer node, consumer node)`` of the system model;
-    ``required``: requirement id -> the least strength the plan asks of the
-    guarantees its proof uses.  Returns ``False`` when a requirement falls
-    short of its required strength (then ``--strict`` fails; each shortfall
-    is a problem of ``summary.problems`` and the requirement's
-    ``strength_shortfall``)."""
-    ok = True
-    required = required or {}
+class ConfidencePart(TypedDict):
+    """What the confidence pass adds to the report's rows (module docstring),
+    by row: ``evidence``/``side_conditions``: one ``strength`` per row, in
+    the report's order; ``guarantees``: node -> one ``strength`` per
+    guarantee; ``nodes``/``derived``/``requirements``: name or id -> the
+    keys the row gains (``confidence``, ``limited_by``; a requirement also
+    ``required_strength`` and ``strength_shortfall``); ``problems``: one
+    sentence per requirement short of its required strength; ``confidence``:
+    the least confidence of the formal requirements (``None``: none);
+    ``ok``: no requirement is short of its required strength."""
+    evidence: list[dict[str, Any]]
+    side_conditions: list[dict[str, Any]]
+    guarantees: dict[str, list[dict[str, Any]]]
+    nodes: dict[str, dict[str, Any]]
+    derived: dict[str, dict[str, Any]]
+    requirements: dict[str, dict[str, Any]]
+    problems: list[str]
+    confidence: float | None
+    ok: bool
+
+
+def confidence_part(report: Mapping[str, Any], links: list[tuple[str, str]],
+                    required: dict[str, str] | None = None) -> ConfidencePart:
+    """The strength and confidence of ``report``'s rows (module docstring),
+    as a part: the report is read, not changed (report/assemble.py puts the
+    part in).  ``links``: ``(producer node, consumer node)`` of the system
+    model; ``required``: requirement id -> the least strength the plan asks
+    of the guarantees its proof uses; a requirement short of it makes
+    ``ok`` false (then ``--strict`` fails) and is one of ``problems``."""
+    part: ConfidencePart = {"evidence": [], "side_conditions": [], "guarantees": {}, "nodes": {}, "derived": {},
+                            "requirements": {}, "problems": [], "confidence": None, "ok": True}
     by_ob: dict[str, list[dict[str, Any]]] = {}
     for e in report.get("evidence", []):
-        e["strength"] = evidence_strength(e)
-        by_ob.setdefault(str(e.get("obligation")), []).append(e["strength"])
+        part["evidence"].append(evidence_strength(e))
+        by_ob.setdefault(str(e.get("obligation")), []).append(part["evidence"][-1])
     status = {str(o.get("id")): str(o.get("status")) for o in report.get("obligations", [])}
-    for sc in report.get("side_conditions", []):
-        sc["strength"] = side_condition_strength(sc)
-    own: dict[str, list[Premise]] = {}
-    guarantee: dict[tuple[str, int], Premise] = {}
     sc_premises: dict[str, list[Premise]] = {}
     for sc in report.get("side_conditions", []):
+        part["side_conditions"].append(side_condition_strength(sc))
         sc_premises.setdefault(str(sc.get("node")), []).append(
-            Premise(f"side condition {sc['id']}", "proof", sc["strength"]["doubt"]))
+            Premise(f"side condition {sc['id']}", "proof", part["side_conditions"][-1]["doubt"]))
+    own: dict[str, list[Premise]] = {}
+    guarantee: dict[tuple[str, int], Premise] = {}
     for n in report.get("nodes", []):
-        name = n["name"]
-        ps: list[Premise] = []
+        name, ps = n["name"], []
         for g in n.get("guarantees", []):
             p = guarantee_premise(f"{name} guarantee {g['index']}", _legs(g.get("obligations", []), by_ob, status))
             guarantee[(name, int(g["index"]))] = p
-            g["strength"] = {"kind": p.kind, "doubt": p.doubt}
+            part["guarantees"].setdefault(name, []).append({"kind": p.kind, "doubt": p.doubt})
             ps.append(p)
         own[name] = ps + sc_premises.get(name, [])
     producers: dict[str, set[str]] = {n: set() for n in own}
@@ -73,48 +93,49 @@ def annotate(report: dict[str, Any], links: list[tuple[str, str]], required: dic
         if b in producers and a in own:
             producers[b].add(a)
     claims = node_claims(own)
-    for n in report.get("nodes", []):  # one pass: a search per node was quadratic in the system's size
-        _put(n, claims[n["name"]])
+    part["nodes"] = {n["name"]: _put(claims[n["name"]]) for n in report.get("nodes", [])}
     derived = derived_claims(own, producers)
-    for d in report.get("derived_properties", []):
-        if d.get("node") in derived:
-            _put(d, derived[d["node"]])
-    lows: list[float] = []
-    for rq in report.get("requirements", []):
-        check = rq.get("check") or {}
-        if not check.get("formal"):
-            continue
-        two = (check.get("solvers") or {}).get("agreement") == "two solvers"
-        proof = Premise(f"the proof of {rq['id']}", "proof", DOUBT["proof2" if two else "proof"])
-        used: list[Premise] = []
-        rests: list[Premise] = []  # the guarantees the proof used
-        for p in check.get("used") or []:
-            if p.get("kind") == "guarantee" and (p.get("node"), p.get("index")) in guarantee:
-                rests.append(guarantee[(p["node"], p["index"])])
-                used.append(rests[-1])
-                used.extend(sc_premises.get(p["node"], []))
-            else:
-                used.append(Premise(str(p.get("label", p.get("kind"))), "assumed", DOUBT["assumed"]))
-        c = requirement_claim(rq.get("verdict") in _PROVED, proof, used)
-        need = required.get(str(rq["id"]))
-        if need in KINDS:
-            short = [g for g in rests if g.doubt >= 1.0 or g.kind not in KINDS or KINDS.index(g.kind) > KINDS.index(need)]
-            rq["required_strength"] = need
-            rq["strength_shortfall"] = [f"{g.label} ({g.kind if g.doubt < 1.0 else 'nothing discharged'})" for g in short]
-            if short:
-                ok = False
-                report.setdefault("summary", {}).setdefault("problems", []).append(
-                    f"Requirement {rq['id']} requires {need} evidence; " + ", ".join(
-                        f"{g.label} rests on {g.kind if g.doubt < 1.0 else 'no discharged'} evidence" for g in short))
-        _put(rq, c)
-        if rq.get("verdict") not in _PROVED:
-            rq["limited_by"]["sentence"] = f"{rq['id']} is {rq.get('verdict')}: no confidence rests on it"
-        elif c.limits is not None:
-            rq["limited_by"]["sentence"] = limit_sentence(rq["id"], c.limits)
-        lows.append(c.confidence)
+    part["derived"] = {d["node"]: _put(derived[d["node"]]) for d in report.get("derived_properties", [])
+                       if d.get("node") in derived}
+    lows = [_requirement(rq, guarantee, sc_premises, (required or {}).get(str(rq["id"])), part)
+            for rq in report.get("requirements", []) if (rq.get("check") or {}).get("formal")]
     if lows:
-        report.setdefault("summary", {})["confidence"] = min(lows)
-    return ok
+        part["confidence"] = min(lows)
+    return part
+
+
+def _requirement(rq: Mapping[str, Any], guarantee: Mapping[tuple[str, int], Premise],
+                 sc_premises: Mapping[str, list[Premise]], need: str | None, part: ConfidencePart) -> float:
+    """Put a formal requirement's confidence (C5) and its shortfall of ``need`` into ``part``; its confidence."""
+    check = rq.get("check") or {}
+    two = (check.get("solvers") or {}).get("agreement") == "two solvers"
+    proof = Premise(f"the proof of {rq['id']}", "proof", DOUBT["proof2" if two else "proof"])
+    used: list[Premise] = []
+    rests: list[Premise] = []  # the guarantees the proof used
+    for p in check.get("used") or []:
+        if p.get("kind") == "guarantee" and (p.get("node"), p.get("index")) in guarantee:
+            rests.append(guarantee[(p["node"], p["index"])])
+            used.append(rests[-1])
+            used.extend(sc_premises.get(p["node"], []))
+        else:
+            used.append(Premise(str(p.get("label", p.get("kind"))), "assumed", DOUBT["assumed"]))
+    c = requirement_claim(rq.get("verdict") in _PROVED, proof, used)
+    row: dict[str, Any] = {}
+    if need in KINDS:
+        short = [g for g in rests if g.doubt >= 1.0 or g.kind not in KINDS or KINDS.index(g.kind) > KINDS.index(need)]
+        row["required_strength"] = need
+        row["strength_shortfall"] = [f"{g.label} ({g.kind if g.doubt < 1.0 else 'nothing discharged'})" for g in short]
+        if short:
+            part["ok"] = False
+            part["problems"].append(f"Requirement {rq['id']} requires {need} evidence; " + ", ".join(
+                f"{g.label} rests on {g.kind if g.doubt < 1.0 else 'no discharged'} evidence" for g in short))
+    row.update(_put(c))
+    if rq.get("verdict") not in _PROVED:
+        row["limited_by"]["sentence"] = f"{rq['id']} is {rq.get('verdict')}: no confidence rests on it"
+    elif c.limits is not None:
+        row["limited_by"]["sentence"] = limit_sentence(rq["id"], c.limits)
+    part["requirements"][str(rq["id"])] = row
+    return float(c.confidence)
 
 
 #: Obligation statuses that are counter-evidence: the guarantee is defeated (docs/confidence.md, C0).
@@ -138,7 +159,8 @@ def _legs(obligations: list[str], by_ob: dict[str, list[dict[str, Any]]],
     return [(ps[0][0], min(1.0, sum(d for _, d in ps))) for ps in legs.values()]
 
 
-def _put(row: dict[str, Any], c: Any) -> None:
-    row["confidence"] = c.confidence
-    row["limited_by"] = None if c.limits is None else {"label": c.limits.label, "kind": c.limits.kind,
-                                                       "doubt": c.limits.doubt}
+def _put(c: Any) -> dict[str, Any]:
+    """A claim's ``confidence`` and ``limited_by`` (the premise with the largest doubt) as row keys."""
+    return {"confidence": c.confidence,
+            "limited_by": None if c.limits is None else {"label": c.limits.label, "kind": c.limits.kind,
+                                                         "doubt": c.limits.doubt}}

@@ -6,7 +6,7 @@ culprit are where the repair goes; the dashboard of the HTML report and the term
 """
 from __future__ import annotations
 
-from typing import Any, Iterable, Mapping
+from typing import Any, Iterable, Iterator, Mapping, Sequence
 
 from rclverify.records.records import SEVERITY, worst
 
@@ -40,19 +40,9 @@ def _status(word: Any) -> str | None:
     return s if s in SEVERITY else None
 
 
-def mark_culprits(report: dict[str, Any]) -> None:
-    """Give every node and guarantee a problem blames the status of that
-    problem (issue 64: a culprit never reads "discharged"; its own evidence
-    may all hold, the problem it causes does not).  For each row of
-    ``report["problems"]`` (:func:`rclverify.report.problems.group_problems`)
-    and each culprit ``guarantee:Node:k`` or ``contract:Node`` of it (or a
-    program line with its ``node``), the
-    node's ``status`` (and the guarantee's) becomes the worse of its own and
-    the row's, and ``culprit_of`` lists ``{"status", "sentence"}`` of the rows
-    that name it.  Changes ``report`` in place; a row without culprits, or
-    naming a node the report does not have, changes nothing."""
-    nodes = {str(n["name"]): n for n in report.get("nodes") or ()}
-    for g in report.get("problems") or ():
+def _blamed(problems: Iterable[Mapping[str, Any]]) -> Iterator[tuple[str, str, str, dict[str, str]]]:
+    """``(kind, node, guarantee index or '', {"status", "sentence"})`` for each culprit a problem row blames."""
+    for g in problems:
         st = _status(g.get("status"))
         if st is None or st == "discharged" or str((g.get("key") or [""])[0]).startswith("unverified:"):
             continue  # an unverified guarantee's row: the guarantee reads "unverified" already
@@ -61,16 +51,39 @@ def mark_culprits(report: dict[str, Any]) -> None:
             name, _, k = rest.partition(":")
             if kind == "line":  # a line of a node's code: the node, no guarantee (problems.py)
                 kind, name = "contract", str(c.get("node") or "")
-            n = nodes.get(name)
-            if kind not in ("guarantee", "contract") or n is None:
-                continue
-            targets = [n] + [x for x in n.get("guarantees") or () if kind == "guarantee" and str(x.get("index")) == k]
-            for t in targets:
-                t["status"] = worst([str(t.get("status") or "discharged"), st])
-                seen = t.setdefault("culprit_of", [])
-                row = {"status": st, "sentence": str(g.get("sentence", ""))}
-                if row not in seen:
-                    seen.append(row)
+            if kind in ("guarantee", "contract"):
+                yield kind, name, k, {"status": st, "sentence": str(g.get("sentence", ""))}
 
 
-__all__ = ["culprit_nodes", "mark_culprits"]
+def _marked(row: Mapping[str, Any], blame: Mapping[str, str]) -> dict[str, Any]:
+    """``row`` (a node or guarantee) with the status of the problem ``blame`` and the problem in ``culprit_of``."""
+    seen = list(row.get("culprit_of") or [])
+    if blame not in seen:
+        seen.append(dict(blame))
+    return {**row, "status": worst([str(row.get("status") or "discharged"), blame["status"]]), "culprit_of": seen}
+
+
+def marked_nodes(nodes: Sequence[Mapping[str, Any]], problems: Iterable[Mapping[str, Any]]) -> list[dict[str, Any]]:
+    """``nodes`` (the report's node rows) with every node and guarantee a
+    problem blames given the status of that problem (issue 64: a culprit
+    never reads "discharged"; its own evidence may all hold, the problem it
+    causes does not).  For each row of ``problems``
+    (:func:`rclverify.report.problems.group_problems`) and each culprit
+    ``guarantee:Node:k`` or ``contract:Node`` of it (or a program line with
+    its ``node``), the node's ``status`` (and the guarantee's) becomes the
+    worse of its own and the row's, and ``culprit_of`` lists ``{"status",
+    "sentence"}`` of the rows that name it.  New rows: ``nodes`` is left as
+    it is; a row without culprits, or naming a node not in ``nodes``,
+    changes nothing."""
+    out = {str(n["name"]): dict(n) for n in nodes}
+    for kind, name, k, blame in _blamed(problems):
+        n = out.get(name)
+        if n is None:
+            continue
+        out[name] = n = _marked(n, blame)
+        if kind == "guarantee":
+            n["guarantees"] = [_marked(x, blame) if str(x.get("index")) == k else x for x in n.get("guarantees") or ()]
+    return list(out.values())
+
+
+__all__ = ["culprit_nodes", "marked_nodes"]

@@ -149,41 +149,47 @@ def _monitor_verdicts(ws: Workspace, ob_rows: Sequence[Mapping[str, Any]],
     return out
 
 
-def fold_into(requirements: list[dict[str, Any]], rows: Sequence[Mapping[str, Any]]) -> None:
-    """Roll each deadline row into its requirement row (module docstring):
-    sets the requirement's ``deadline`` (the row) and, unless the deadline is
-    proved, its ``verdict``, ``status`` and ``note``."""
+def fold_into(requirements: Sequence[Mapping[str, Any]], rows: Sequence[Mapping[str, Any]]) -> list[dict[str, Any]]:
+    """``requirements`` with each deadline row of ``rows`` rolled into its
+    requirement row (module docstring): a new row with the requirement's
+    ``deadline`` (the row), ``without_deadline`` (its own verdict, status
+    and note) and, unless the deadline is proved from discharged evidence,
+    its ``verdict``, ``status`` and ``note``.  The rows given are left as
+    they are; a requirement without a deadline is returned as it is."""
     by_req = {str(r["requirement"]): r for r in rows}
-    for rq in requirements:
-        row = by_req.get(str(rq["id"]))
-        if row is None:
-            continue
-        rq["deadline"] = row
-        # the requirement as its own check left it: its own argument is built from it (report/argument/deadlines.py)
-        rq["without_deadline"] = {k: rq.get(k) for k in ("verdict", "status", "note")}
-        v, st = row["verdict"], row["status"]
-        if v == "proved":
-            if st != "discharged":  # the chain's evidence is outstanding: not met yet
-                if rq.get("verdict") == "met":
-                    rq["verdict"] = "proved, evidence outstanding"
-                rq["status"] = worst([str(rq.get("status", "pending")), st])
-                open_steps = [f"{c['node']} guarantee {c['guarantee']} ({c['status']})"
-                              for c in row.get("chain", []) if c.get("status") != "discharged"]
-                rq["note"] = (f"end-to-end deadline proved, evidence of its chain {st}"
-                              + (f": {', '.join(open_steps)}" if open_steps else "")
-                              + (f"; without the deadline: {rq['note']}" if rq.get("note") else ""))
-            continue
-        said = f"end-to-end deadline {row['within']} along {' -> '.join(row['path'])} {v}: {row['reason']}"
-        old = rq.get("verdict")
-        note = str(rq.get("note") or "")
-        if v == "refuted" and old != "error":
-            rq["verdict"] = "refuted"
-        elif v in ("stale", "error") and old not in _WORSE:
-            rq["verdict"] = v
-        elif v in ("inconclusive", "pending") and old not in _WORSE and old != "stale":
-            rq["verdict"] = "inconclusive"
-        rq["status"] = worst([str(rq.get("status", "pending")), st])
-        rq["note"] = said + (f"; {note}" if note and old != "informal" else "")
+    return [_with_deadline(rq, by_req[str(rq["id"])]) if str(rq["id"]) in by_req else dict(rq)
+            for rq in requirements]
+
+
+def _with_deadline(own: Mapping[str, Any], row: Mapping[str, Any]) -> dict[str, Any]:
+    """The requirement row ``own`` with the deadline ``row`` rolled in (:func:`fold_into`)."""
+    rq = {**own, "deadline": row,
+          # the requirement as its own check left it: its own argument is built from it (report/argument/deadlines.py)
+          "without_deadline": {k: own.get(k) for k in ("verdict", "status", "note")}}
+    v, st = row["verdict"], row["status"]
+    if v == "proved":
+        if st != "discharged":  # the chain's evidence is outstanding: not met yet
+            if rq.get("verdict") == "met":
+                rq["verdict"] = "proved, evidence outstanding"
+            rq["status"] = worst([str(rq.get("status", "pending")), st])
+            open_steps = [f"{c['node']} guarantee {c['guarantee']} ({c['status']})"
+                          for c in row.get("chain", []) if c.get("status") != "discharged"]
+            rq["note"] = (f"end-to-end deadline proved, evidence of its chain {st}"
+                          + (f": {', '.join(open_steps)}" if open_steps else "")
+                          + (f"; without the deadline: {rq['note']}" if rq.get("note") else ""))
+        return rq
+    said = f"end-to-end deadline {row['within']} along {' -> '.join(row['path'])} {v}: {row['reason']}"
+    old = rq.get("verdict")
+    note = str(rq.get("note") or "")
+    if v == "refuted" and old != "error":
+        rq["verdict"] = "refuted"
+    elif v in ("stale", "error") and old not in _WORSE:
+        rq["verdict"] = v
+    elif v in ("inconclusive", "pending") and old not in _WORSE and old != "stale":
+        rq["verdict"] = "inconclusive"
+    rq["status"] = worst([str(rq.get("status", "pending")), st])
+    rq["note"] = said + (f"; {note}" if note and old != "informal" else "")
+    return rq
 
 
 def strict_ok(rows: Sequence[Mapping[str, Any]]) -> bool:

@@ -2,7 +2,7 @@
 
 * :func:`compact` - an evidence record's ``details["statistics"]`` as the
   report row carries it (the run set's list of runs left in the record);
-* :func:`annotate_statistics` - the report's ``statistics`` table: the
+* :func:`statistics_part` - the report's ``statistics`` table: the
   monitored runs grouped by node, environment tag and origin (each run
   counted once, by its content digest; never a bound across two tags),
   with the one-sided 95 % Clopper-Pearson bound on the probability that a
@@ -16,7 +16,7 @@
 """
 from __future__ import annotations
 
-from typing import Any, Mapping
+from typing import Any, Mapping, TypedDict
 
 from rclverify.records.statistics import count_runs, decide, upper_bound
 from rclverify.model.plan.model import Plan
@@ -112,38 +112,54 @@ def requirement_statistics(req: Mapping[str, Any], target: Any, where: Mapping[s
     return out
 
 
-def annotate_statistics(report: dict[str, Any], plan: Plan, targets: Mapping[str, Any]) -> list[dict[str, Any]]:
-    """The report's ``statistics`` table (module docstring); sets
-    ``statistics.group`` on each per-run evidence row and ``statistics`` on
-    each requirement with recorded runs.  ``targets``: requirement id -> its
+class StatisticsPart(TypedDict):
+    """The statistics pass's part: the report's ``statistics`` table;
+    ``groups``: index of a per-run evidence row -> its ``statistics.group``;
+    ``requirements``: requirement id -> its ``statistics`` rows."""
+    table: list[dict[str, Any]]
+    groups: dict[int, dict[str, Any]]
+    requirements: dict[str, list[dict[str, Any]]]
+
+
+def _per_run(e: Mapping[str, Any]) -> bool:
+    """``e`` (an evidence row) is a believed monitored run of a run set (not a target's decision)."""
+    s = e.get("statistics")
+    return isinstance(s, dict) and "decision" not in s and e.get("backend") == "monitors" and "sha256" in s \
+        and e.get("status") not in _UNBELIEVED
+
+
+def _group_key(e: Mapping[str, Any]) -> tuple[str, str, str]:
+    s = e["statistics"]
+    return _node(str(e.get("obligation"))), str(s.get("environment", UNSTATED)), str(s.get("origin", "operation"))
+
+
+def statistics_part(report: Mapping[str, Any], plan: Plan, targets: Mapping[str, Any]) -> StatisticsPart:
+    """The report's ``statistics`` table (module docstring), each per-run
+    evidence row's group bound and each requirement's runs, as a part: the
+    report is read, not changed (report/assemble.py puts the part in).
+    ``targets``: requirement id -> its
     :class:`~rclverify.records.statistics.Target` (or ``None``)."""
     groups: dict[tuple[str, str, str], list[Mapping[str, Any]]] = {}
-    table: list[dict[str, Any]] = []
+    decisions: list[dict[str, Any]] = []
     for e in report.get("evidence", []):
-        s = e.get("statistics")
-        if not isinstance(s, dict):
-            continue
-        if "decision" in s:
-            table.append(_target_row(e))
-        elif e.get("backend") == "monitors" and "sha256" in s and e.get("status") not in _UNBELIEVED:
-            key = (_node(str(e.get("obligation"))), str(s.get("environment", UNSTATED)), str(s.get("origin", "operation")))
-            groups.setdefault(key, []).append(s)
+        if isinstance(e.get("statistics"), dict) and "decision" in e["statistics"]:
+            decisions.append(_target_row(e))
+        elif _per_run(e):
+            groups.setdefault(_group_key(e), []).append(e["statistics"])
     by_key = {key: _group_row(*key, rows) for key, rows in groups.items()}
-    for e in report.get("evidence", []):
-        s = e.get("statistics")
-        if isinstance(s, dict) and "decision" not in s and e.get("backend") == "monitors" and "sha256" in s \
-                and e.get("status") not in _UNBELIEVED:
-            g = by_key[(_node(str(e.get("obligation"))), str(s.get("environment", UNSTATED)),
-                        str(s.get("origin", "operation")))]
-            s["group"] = {"runs": g["counts"]["runs"], "bound": g["bound"], "level": LEVEL}
-    table = [by_key[k] for k in sorted(by_key)] + table
+    part: StatisticsPart = {"table": [by_key[k] for k in sorted(by_key)] + decisions, "groups": {},
+                            "requirements": {}}
+    for i, e in enumerate(report.get("evidence", [])):
+        if _per_run(e):
+            g = by_key[_group_key(e)]
+            part["groups"][i] = {"runs": g["counts"]["runs"], "bound": g["bound"], "level": LEVEL}
     where = _trace_environments(plan)
     for rq in report.get("requirements", []):
         rows = requirement_statistics(rq, targets.get(str(rq.get("id"))), where)
         if rows:
-            rq["statistics"] = rows
-            table.extend({"requirement": rq["id"], "kind": "requirement", **r} for r in rows)
-    return table
+            part["requirements"][str(rq["id"])] = rows
+            part["table"].extend({"requirement": rq["id"], "kind": "requirement", **r} for r in rows)
+    return part
 
 
-__all__ = ["LEVEL", "annotate_statistics", "compact", "requirement_statistics"]
+__all__ = ["LEVEL", "StatisticsPart", "statistics_part", "compact", "requirement_statistics"]

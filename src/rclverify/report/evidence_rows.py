@@ -1,0 +1,127 @@
+"""The obligations' and evidence records' rows of the report: the first pass of report/build.py.
+
+Each obligation's status is its evidence's *current* status: ``stale`` when
+an input's sha256 changed since the evidence was produced, ``pending`` when
+there is no record, ``error`` when the record (or the node's obligation
+list) was altered outside rclverify (records/store.py), and a proof the
+second solver does not confirm is downgraded (stages/crosscheck/apply.py).
+The pass returns its part (:class:`EvidencePart`) and changes nothing it
+was given.
+"""
+from __future__ import annotations
+
+from typing import Any, Mapping, Sequence, TypedDict
+
+from rclverify.records.records import Obligation
+from rclverify.records.report_schema import EvidenceRow, ObligationRow, PendingRow
+from rclverify.records.store import EvidenceStore
+from rclverify.report.statistics import compact as compact_statistics
+from rclverify.stages.crosscheck.apply import SecondSolver
+from rclverify.stages.workspace import Workspace
+
+
+class EvidencePart(TypedDict):
+    """What the evidence pass gives the report and the later passes.
+
+    ``obligations``/``evidence``/``pending``: the report's rows;
+    ``status``: obligation id -> its current status; ``declared``: node ->
+    ``(record status, declaration rows)`` per record that judged the node's
+    declarations (issue 64); ``altered``: one problem sentence per record
+    that cannot be read as rclverify wrote it; ``inputs``: obligation id ->
+    the input sha256s its evidence was made from (``None``: no record)."""
+    obligations: list[ObligationRow]
+    evidence: list[EvidenceRow]
+    pending: list[PendingRow]
+    status: dict[str, str]
+    declared: dict[str, list[tuple[str, Any]]]
+    altered: list[str]
+    inputs: dict[str, Any]
+
+
+def evidence_extras(ws: Workspace, details: Any) -> dict[str, Any]:
+    """Rows a backend asks the report to show (``details.figures_table``: the
+    experiment figures, the review record) and the inline SVG of its plot
+    (``details.plot``, an SVG artifact the backend drew with matplotlib)."""
+    out: dict[str, Any] = {}
+    rows = details.get("figures_table") if isinstance(details, dict) else None
+    if rows:
+        out["figures"] = [[str(a), str(b)] for a, b in rows]
+    plot = details.get("plot") if isinstance(details, dict) else None
+    if isinstance(plot, str) and plot.endswith(".svg"):
+        try:
+            text = ws.path(plot).read_text(encoding="utf-8")
+            out["plot_svg"] = text[text.index("<svg"):]
+        except (OSError, ValueError):
+            pass
+    return out
+
+
+def _explanation(ev: Any, status: str, altered: str, solvers: Mapping[str, Any] | None) -> str:
+    """The record's explanation, prefixed with why the report does not show its recorded status."""
+    expl = str(ev.explanation)
+    if altered:
+        expl = f"{altered[0].upper()}{altered[1:]}. The record's own text follows, not to be believed: " + expl
+    if solvers is not None and status != ev.status:
+        expl = f"Not discharged: {solvers['why']} (second solver). Z3 alone: " + expl
+    if status == "stale" and ev.status != "stale":
+        expl = f"STALE: an input changed since this evidence was produced (recorded status {ev.status}). " + expl
+    return expl
+
+
+def evidence_row(ws: Workspace, ev: Any, status: str, altered: str, solvers: dict[str, Any] | None) -> EvidenceRow:
+    """The report's row of the evidence record ``ev`` shown with ``status``
+    (``altered``: why the record is not believed, '' when it is;
+    ``solvers``: the second solver's agreement, ``None`` without one)."""
+    row: dict[str, Any] = {
+        "obligation": ev.obligation, "backend": ev.backend, "kind": ev.kind, "status": status,
+        "tool": ev.tool, "tool_version": ev.tool_version, "started": ev.started,
+        "duration_s": ev.duration_s, "explanation": _explanation(ev, status, altered, solvers),
+        "counterexample": ev.counterexample, "artifacts": list(ev.artifacts), "log_excerpt": ev.log[-2000:],
+        **evidence_extras(ws, ev.details)}
+    d = ev.details
+    if solvers is not None:
+        row["solvers"] = solvers
+    if isinstance(d.get("examples"), dict):  # property tests: example counts and seed
+        row["examples"] = {**d["examples"], "seed": d.get("seed"), "replay": d.get("replay", ""),
+                           "facts": d.get("facts", []), "coverage": d.get("coverage") or {}}
+    if isinstance(d, dict) and d.get("monitoring"):
+        row["monitoring"] = d["monitoring"]
+    if isinstance(d, dict) and isinstance(d.get("statistics"), dict):  # runs counted (issue 68)
+        row["statistics"] = compact_statistics(d["statistics"])
+    return row  # type: ignore[return-value]  # the keys of EvidenceRow, built as a dict for the optional ones
+
+
+def evidence_part(ws: Workspace, obligations: Sequence[Obligation], altered_lists: Mapping[str, str],
+                  hashes: dict[str, str], second: SecondSolver) -> EvidencePart:
+    """The rows of ``obligations`` and of their evidence records (module
+    docstring).  ``altered_lists``: placeholder obligation id -> why its
+    node's obligation list is not believed; ``hashes``: the current input
+    sha256s (stages/workspace.py), a memo the store adds the sha256s of
+    the records' other inputs to (records/store.py: taken once per file,
+    the files do not change while the report is built); ``second``: the
+    second solver's verdicts."""
+    store = EvidenceStore(ws.root)
+    part: EvidencePart = {"obligations": [], "evidence": [], "pending": [], "status": {}, "declared": {},
+                          "altered": [], "inputs": {}}
+    for o in obligations:
+        ev, altered = (None, altered_lists[o.id]) if o.id in altered_lists else store.read(o.id)
+        part["inputs"][o.id] = dict(ev.input_hashes) if ev is not None else None
+        status = "error" if altered else (store.current_status(ev, hashes) if ev else "pending")
+        status, solvers = second.evidence(o.id, o.backend, status)
+        part["status"][o.id] = status
+        part["obligations"].append({"id": o.id, "node": o.node, "guarantee": o.guarantee, "backend": o.backend,
+                                    "kind": o.kind, "instance": o.instance, "statement": o.statement,  # type: ignore[typeddict-item]
+                                    "source": str(o.source), "artifact": o.artifact, "status": status})  # type: ignore[typeddict-item]
+        if ev is None:
+            if altered:
+                part["altered"].append(f"Evidence {o.id} is error: {altered}")
+            else:
+                part["pending"].append({"obligation": o.id, "backend": o.backend,
+                                        "reason": "no evidence record yet: run `doit verify`"})
+            continue
+        if isinstance(ev.details.get("declarations"), list):  # a node's declarations judged (issue 64)
+            part["declared"].setdefault(o.node, []).append((status, ev.details["declarations"]))
+        part["evidence"].append(evidence_row(ws, ev, status, altered, solvers))
+        if status == "pending":
+            part["pending"].append({"obligation": o.id, "backend": o.backend, "reason": ev.explanation})
+    return part
