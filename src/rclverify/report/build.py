@@ -156,7 +156,8 @@ def build_report(ws: Workspace) -> Report:
     from rclverify.report.confidence_rows import confidence_part
     from rclverify.report.culprits import marked_nodes
     from rclverify.report.problems import group_problems
-    from rclverify.report.render import anchor, problem_items
+    from rclverify.report.templating import anchor
+    from rclverify.report.view import problem_items
     from rclverify.report.severity import blocking
     from rclverify.report.statistics import statistics_part
     inp = read_inputs(ws)

@@ -12,7 +12,7 @@ worst first); the global ``latex_frame(sources)``
 from __future__ import annotations
 
 from collections import Counter
-from typing import Any, Iterable
+from typing import Any, Callable, Iterable, cast
 
 import jinja2
 
@@ -33,7 +33,8 @@ def _tally(env: jinja2.Environment, statuses: Iterable[Any]) -> list[tuple[str, 
     """``[(status, how many)]`` of ``statuses``, worst first (the ``rank``
     global), then by word."""
     counts = Counter(str(s) for s in statuses)
-    return sorted(counts.items(), key=lambda kv: (-env.globals["rank"](kv[0]), kv[0]))
+    rank = cast(Callable[[str], int], env.globals["rank"])
+    return sorted(counts.items(), key=lambda kv: (-rank(kv[0]), kv[0]))
 
 
 def register(env: jinja2.Environment) -> None:

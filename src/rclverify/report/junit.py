@@ -52,7 +52,7 @@ from typing import Any, Mapping
 
 from rclverify.report.fragments import FragmentCache
 from rclverify.report.sarif import split_location
-from rclverify.report.render import model_text
+from rclverify.report.templating import model_text
 from rclverify.records.report_schema import Report
 
 

@@ -35,7 +35,7 @@ from dataclasses import dataclass
 from typing import Any, Mapping, Sequence
 
 from rclverify.records.store import dumps
-from rclverify.report.render import model_text
+from rclverify.report.templating import model_text
 from rclverify.records.report_schema import Report
 
 #: The SARIF version written and the schema it validates against.

@@ -70,9 +70,9 @@ class Element:
     acp: tuple[tuple[str, tuple[str, ...]], ...] = ()
 
     def to_json(self) -> dict[str, Any]:
-        out = {"id": self.id, "type": self.type, "text": self.text, "status": self.status,
-               "supported_by": list(self.supported_by), "in_context_of": list(self.in_context_of),
-               "undeveloped": self.undeveloped, "ref": self.ref, "url": self.url}
+        out: dict[str, Any] = {"id": self.id, "type": self.type, "text": self.text, "status": self.status,
+                               "supported_by": list(self.supported_by), "in_context_of": list(self.in_context_of),
+                               "undeveloped": self.undeveloped, "ref": self.ref, "url": self.url}
         if self.challenges or self.defeated:
             out.update(challenges=list(self.challenges), defeated=self.defeated)
         if self.acp:

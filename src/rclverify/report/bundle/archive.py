@@ -134,9 +134,9 @@ def _each_member(path: Path, problems: list[str]) -> Iterator[tuple[str, int, An
                     problems.append(f"{m.name}: unsafe, repeated, not a normalized member name or not a regular file")
                     continue
                 seen.add(m.name)
-                fh = tar.extractfile(m)
-                yield m.name, m.size, fh if fh is not None else io.BytesIO(b"")
-                tar.members = []  # tarfile keeps every header it read: not needed here
+                member = tar.extractfile(m)
+                yield m.name, m.size, member if member is not None else io.BytesIO(b"")
+                setattr(tar, "members", [])  # tarfile keeps every header it read (a private list): not needed here
 
 
 _ARCHIVE_ERRORS = (OSError, tarfile.TarError, zipfile.BadZipFile, EOFError, zlib.error)

@@ -1,0 +1,374 @@
+"""The report's view model: the lookups, lists and tables the templates lay out, a pure function of the
+report dict.
+
+What needs attention comes first: problems (worse than pending) and
+outstanding items (pending), worst first (:func:`_attention`); the
+dashboard's matrix of nodes against techniques (:func:`dashboard`); the
+traceability rows requirement -> guarantee -> obligation -> evidence
+(the paper's five steps); each node's section.  Nothing here verifies.
+"""
+from __future__ import annotations
+
+import re
+from collections import defaultdict
+from typing import Any, Callable, Mapping, Sequence, TypeVar
+
+from rclverify.records.records import SEVERITY
+from rclverify.report.culprits import culprit_nodes
+from rclverify.report.problems import group_problems
+from rclverify.report.templating import COUNT_ORDER, anchor, rank
+from rclverify.report.textfmt import natural_key, natural_sorted, natural_within
+
+_T = TypeVar("_T")
+
+#: Top-level keys every report dict carries.
+REPORT_KEYS: tuple[str, ...] = (
+    "meta", "summary", "system", "requirements", "nodes", "side_conditions",
+    "derived_properties", "findings", "obligations", "evidence",
+    "environment_assumptions", "pending", "lint",
+)
+
+
+def validate(report: Mapping[str, Any]) -> None:
+    """Check the top-level shape of ``report``.
+
+    Raises ``ValueError`` naming every missing top-level key (the templates
+    themselves raise ``jinja2.UndefinedError`` for a missing inner key).
+    """
+    missing = [k for k in REPORT_KEYS if k not in report]
+    if missing:
+        raise ValueError("report dict lacks key(s): " + ", ".join(missing))
+
+
+def _by(items: Sequence[Mapping[str, Any]], key: str) -> dict[str, list[Mapping[str, Any]]]:
+    out: dict[str, list[Mapping[str, Any]]] = defaultdict(list)
+    for it in items:
+        out[str(it[key])].append(it)
+    return out
+
+
+def _attention(report: Mapping[str, Any], ev_anchor: Sequence[str]) -> tuple[list[dict[str, Any]], list[dict[str, Any]]]:
+    """Items needing attention: (problems, outstanding).
+
+    Problems are everything worse than pending (failed, error, stale,
+    inconclusive evidence; refuted or undecided side conditions; contract
+    health problems; derived properties that do not hold; lint errors);
+    outstanding are the pending items with their reason.  Each item is
+    ``{"status", "kind", "ref", "anchor", "where", "message", "formula"}``
+    (``formula`` is RCL text to show as code, or ''); both lists
+    are sorted worst first, then by kind and reference.
+    """
+    items: list[dict[str, Any]] = []
+
+    def add(status: str, kind: str, ref: str, anchor_id: str, where: str, message: str,
+            formula: str = "") -> None:
+        items.append({"status": status, "kind": kind, "ref": ref, "anchor": anchor_id,
+                      "where": where, "message": message, "formula": formula})
+
+    reasons: dict[str, list[str]] = defaultdict(list)
+    for p in report["pending"]:
+        reasons[str(p["obligation"])].append(str(p["reason"]))
+    evidenced: set[str] = set()
+    for ev, aid in zip(report["evidence"], ev_anchor):
+        ob = str(ev["obligation"])
+        evidenced.add(ob)
+        if rank(ev["status"]) == 0:
+            continue
+        msg = str(ev["explanation"])
+        if ev["status"] == "pending" and reasons.get(ob):
+            msg = " ".join(dict.fromkeys([*reasons[ob], msg] if msg else reasons[ob]))
+        add(ev["status"], "evidence", ob, aid, f"{ev['backend']} ({ev['kind']})", msg)
+    for p in report["pending"]:
+        ob = str(p["obligation"])
+        if ob not in evidenced:
+            add("pending", "obligation", ob, anchor("ob", ob), str(p["backend"]), str(p["reason"]))
+            evidenced.add(ob)
+    for o in report["obligations"]:
+        if o["id"] not in evidenced and rank(o["status"]) > 0:
+            add(o["status"], "obligation", o["id"], anchor("ob", o["id"]), str(o["backend"]),
+                "No evidence record for this obligation.")
+    for u in report.get("unverified") or ():  # a guarantee no obligation covers (report/unverified.py)
+        add(str(u["status"]), "guarantee", str(u["id"]), anchor("g", u["node"], u["guarantee"]), str(u["source"]),
+            f"Unverified: {u['reason']}.")
+    for sc in report["side_conditions"]:
+        if rank(sc["status"]) > 0:
+            add(sc["status"], "side condition", sc["id"], anchor("sc", sc["id"]),
+                f"{sc['node']}, {sc['rule']}, {sc['source']}",
+                str(sc["explanation"]) or "Assumption conjunct not established:", str(sc["conjunct"]))
+    for f in report["findings"]:
+        if rank(f["status"]) > 0 and not f.get("acknowledged"):  # an accepted risk is listed with its reason
+            where = str(f["node"]) + (f", guarantee {f['guarantee']}" if f["guarantee"] is not None else "")
+            msg = str(f["message"]) + (f" {f['explanation']}" if f["explanation"] else "")
+            add(f["status"], f"contract health: {f['check']}", f["id"], anchor("finding", f["id"]), where, msg)
+    for d in report["derived_properties"]:
+        if rank(d["status"]) > SEVERITY["pending"]:
+            add(d["status"], "derived property", d["node"], anchor("derived", d["node"]),
+                ", ".join(d["rules"]), f"Derived property {d.get('derivation', 'not established')} "
+                "(a side condition of its cone is not discharged):", str(d["property"]))
+    for a in report.get("acknowledgements") or ():  # a stale or refused acknowledgement (model/plan/acknowledged.py)
+        if a.get("status") != "ok":
+            add(str(a["status"]), "acknowledgement", str(a["warning"]), "acknowledged", str(a["at"]), str(a["message"]))
+    for k, lint in enumerate(report["lint"]):
+        if str(lint["severity"]).lower() == "error":
+            add("error", "lint", str(lint["location"]), anchor("lint", k + 1), str(lint["location"]),
+                str(lint["message"]))
+
+    kind_order = {"evidence": 0, "obligation": 1, "guarantee": 1, "side condition": 2, "derived property": 4, "lint": 5}
+    items.sort(key=lambda it: (-rank(it["status"]), kind_order.get(it["kind"], 3), it["kind"], natural_key(it["ref"])))
+    problems = [it for it in items if rank(it["status"]) > SEVERITY["pending"]]
+    outstanding = [it for it in items if rank(it["status"]) <= SEVERITY["pending"]]
+    return problems, outstanding
+
+
+_NUMBERS = re.compile(r"\d+")
+
+
+def group_items(items: Sequence[dict[str, Any]]) -> list[dict[str, Any]]:
+    """Attention items grouped when they say the same thing: equal status,
+    kind and backend (``where``), and a message that is equal once its
+    numbers are left out (39 AJPF instances pending for one reason are one
+    group).  Each group is ``{"status", "kind", "where", "message" (the
+    first item's), "items" (in order)}``; groups keep the order of their
+    first items."""
+    groups: dict[tuple[str, str, str, str], dict[str, Any]] = {}
+    for it in items:
+        key = (it["status"], it["kind"], it["where"], _NUMBERS.sub("#", it["message"]))
+        g = groups.get(key)
+        if g is None:
+            g = groups[key] = {"status": it["status"], "kind": it["kind"], "where": it["where"],
+                               "message": it["message"], "items": []}
+        g["items"].append(it)
+    return list(groups.values())
+
+
+def evidence_anchors(report: Mapping[str, Any]) -> list[str]:
+    """One fragment id per evidence record of ``report``, in order:
+    ``ev-<obligation>``, then ``ev-<obligation>-2`` ... for further records
+    of the same obligation."""
+    seen: dict[str, int] = defaultdict(int)
+    out = []
+    for ev in report["evidence"]:
+        ob = str(ev["obligation"])
+        seen[ob] += 1
+        out.append(anchor("ev", ob) if seen[ob] == 1 else anchor("ev", ob, seen[ob]))
+    return out
+
+
+def problem_items(report: Mapping[str, Any]) -> list[dict[str, Any]]:
+    """The attention items of ``report`` that are problems (worse than
+    pending), worst first (see :func:`_attention`)."""
+    return _attention(report, evidence_anchors(report))[0]
+
+
+def problem_groups(report: Mapping[str, Any]) -> list[dict[str, Any]]:
+    """The report's problems grouped by root cause
+    (:func:`rclverify.report.problems.group_problems`): the report dict's
+    ``problems`` when it has them, else computed from ``report``."""
+    if report.get("problems") is not None:
+        return list(report["problems"])
+    return group_problems(report, problem_items(report), anchor)
+
+
+#: The techniques of the dashboard's columns, in order: contract health, the
+#: calculus' side conditions, then the backends (docs/reading-the-report.md).
+#: A backend outside this list gets a column after them when it has evidence.
+TECHNIQUES: tuple[str, ...] = ("health", "side conditions", "hoare", "dafny", "ajpf", "property_tests",
+                               "monitors", "experiment", "review")
+
+
+#: A contract health status as the evidence status the dashboard ranks it by.
+#: A warning stays ``warning`` (ranked with pending): it changes no node's
+#: status (report/build.py) but it is no pass either; it fails ``--strict``
+#: as in every other output (report/severity.py).
+_HEALTH_AS: Mapping[str, str] = {"ok": "discharged", "problem": "failed", "unknown": "inconclusive"}
+
+
+def dashboard(report: Mapping[str, Any], evidence_of: Mapping[str, Sequence[tuple[str, Any]]],
+              groups: Sequence[Mapping[str, Any]] | None = None) -> dict[str, Any]:
+    """The dashboard's matrix of nodes (rows) against techniques (columns).
+
+    Each cell is the WORST status of the node's items of that technique
+    (evidence severity: failed > error > stale > inconclusive > pending >
+    discharged, :data:`rclverify.records.records.SEVERITY`): for a backend,
+    the statuses of the node's obligations of that backend (an obligation's
+    status is that of its evidence, pending when it has none); for
+    ``no evidence`` (only when there is one), the node's guarantees no
+    obligation covers (``unverified``); for
+    ``health``, the node's contract health checks (ok counts as
+    discharged, a problem as failed, unknown as inconclusive); for ``side
+    conditions``, the side conditions the node's assumptions give rise to.
+    A cell is ``None`` when the node has no item of that technique, else
+    ``{"status", "worst" (how many items have it), "total", "counts"
+    ([(status, n)] worst first), "anchor"}``: ``anchor`` is the fragment id
+    of the first item with the worst status (its first evidence record,
+    else its obligation row; the health finding; the side condition).
+    Returns ``{"columns": [technique], "rows": [{"node", "status",
+    "cells": [cell], "culprit" (a problem's culprit is its guarantee or
+    contract, :func:`culprit_nodes`)}]}``."""
+    items: dict[tuple[str, str], list[tuple[str, str]]] = defaultdict(list)
+    for o in report["obligations"]:
+        evs = evidence_of.get(str(o["id"]), [])
+        items[(str(o["node"]), str(o["backend"]))].append(
+            (str(o["status"]), evs[0][0] if evs else anchor("ob", o["id"])))
+    for f in report["findings"]:
+        items[(str(f["node"]), "health")].append((_HEALTH_AS.get(str(f["status"]), str(f["status"])),
+                                                  anchor("finding", f["id"])))
+    for sc in report["side_conditions"]:
+        items[(str(sc["node"]), "side conditions")].append((str(sc["status"]), anchor("sc", sc["id"])))
+    for u in report.get("unverified") or ():  # no obligation at all: a column of its own, after the techniques
+        items[(str(u["node"]), "no evidence")].append((str(u["status"]), anchor("g", u["node"], u["guarantee"])))
+    culprits = culprit_nodes(groups if groups is not None else report.get("problems") or ())
+    extra = sorted({b for _, b in items} - set(TECHNIQUES) - {"no evidence"})
+    extra += ["no evidence"] if any(b == "no evidence" for _, b in items) else []
+    columns = [*TECHNIQUES, *extra]
+    rows = []
+    for n in report["nodes"]:
+        name = str(n["name"])
+        cells: list[dict[str, Any] | None] = []
+        for col in columns:
+            got = items.get((name, col))
+            if not got:
+                cells.append(None)
+                continue
+            worst_rank = max(rank(st) for st, _ in got)
+            first = next((st, a) for st, a in got if rank(st) == worst_rank)
+            tally: dict[str, int] = defaultdict(int)
+            for st, _ in got:
+                tally[st] += 1
+            counts = sorted(tally.items(), key=lambda kv: (-rank(kv[0]), kv[0]))
+            cells.append({"status": first[0], "worst": tally[first[0]], "total": len(got), "counts": counts,
+                          "anchor": first[1]})
+        rows.append({"node": name, "status": n["status"], "cells": cells, "culprit": name in culprits})
+    return {"columns": columns, "rows": rows}
+
+
+
+
+def _trace(report: Mapping[str, Any], obligation: Mapping[str, Mapping[str, Any]],
+           evidence_of: Mapping[str, list[tuple[str, Mapping[str, Any]]]]) -> list[dict[str, Any]]:
+    """The traceability rows: per requirement, its supporting guarantees with
+    each obligation's status and evidence (``rowspan``: rows it spans)."""
+    trace = []
+    for req in report["requirements"]:
+        rows = []
+        for sup in req["support"]:
+            obs = []
+            for oid in sup["obligations"]:
+                o = obligation.get(str(oid))
+                obs.append({
+                    "id": oid,
+                    "known": o is not None,
+                    "status": o["status"] if o is not None else "pending",
+                    "backend": o["backend"] if o is not None else "",
+                    "evidence": evidence_of.get(str(oid), []),
+                })
+            rows.append({"support": sup, "obligations": obs})
+        trace.append({"req": req, "rows": rows, "rowspan": max(1, len(rows))})
+    return trace
+
+
+def _sections(report: Mapping[str, Any], obligation: Mapping[str, Mapping[str, Any]]) -> list[dict[str, Any]]:
+    """Per node (then per name only the calculus knows): the node, its derived
+    property, side conditions, findings and ``ob_status`` (the status of each
+    obligation its guarantees list)."""
+    derived = _by(report["derived_properties"], "node")
+    sides = _by(natural_sorted(report["side_conditions"], key=lambda sc: sc["id"]), "node")
+    findings = _by(natural_sorted(report["findings"], key=lambda f: f["id"]), "node")
+    sections: list[dict[str, Any]] = []
+    named = [str(n["name"]) for n in report["nodes"]]
+    for n in report["nodes"]:
+        name = str(n["name"])
+        sections.append({"name": name, "node": n, "derived": derived.get(name, []),
+                         "side": sides.get(name, []), "findings": findings.get(name, [])})
+    for name in sorted((set(derived) | set(sides)) - set(named)):
+        sections.append({"name": name, "node": None, "derived": derived.get(name, []),
+                         "side": sides.get(name, []), "findings": findings.get(name, [])})
+    for sec in sections:
+        ids = [str(oid) for g in (sec["node"] or {}).get("guarantees", []) for oid in g["obligations"]]
+        sec["ob_status"] = {oid: obligation[oid]["status"] for oid in ids if oid in obligation}
+    return sections
+
+
+def _pending_groups(report: Mapping[str, Any]) -> list[dict[str, Any]]:
+    """The pending rows grouped by backend and reason (the same reason, numbers aside: one row)."""
+    groups: dict[tuple[str, str], dict[str, Any]] = {}
+    for p in natural_sorted(report["pending"], key=lambda p: p["obligation"]):
+        key = (str(p["backend"]), _NUMBERS.sub("#", str(p["reason"])))
+        groups.setdefault(key, {"backend": p["backend"], "reason": p["reason"], "items": []})["items"].append(p)
+    return list(groups.values())
+
+
+def _table_runs(report: Mapping[str, Any], ev_anchor: Sequence[str], obligation: Mapping[str, Mapping[str, Any]],
+                evidence_of: Mapping[str, list[tuple[str, Mapping[str, Any]]]]) -> dict[str, Any]:
+    """``finding_runs``, ``obligation_runs`` and ``evidence_runs`` of :func:`view`."""
+    def node_of_evidence(item: Mapping[str, Any]) -> str:
+        o = obligation.get(str(item["record"]["obligation"]))
+        return str(o["node"]) if o is not None else ""
+
+    return {
+        "finding_runs": runs(natural_within(report["findings"], lambda f: str(f["node"]), lambda f: f["id"]),
+                             lambda f: str(f["node"])),
+        "obligation_runs": runs([{"obligation": o, "evidence": [aid for aid, _ in evidence_of.get(str(o["id"]), [])]}
+                                 for o in natural_within(report["obligations"], lambda o: str(o["node"]),
+                                                         lambda o: o["id"])], lambda row: str(row["obligation"]["node"])),
+        "evidence_runs": runs(natural_within([{"anchor": aid, "record": ev} for aid, ev in zip(ev_anchor, report["evidence"])],
+                                             node_of_evidence, lambda it: it["record"]["obligation"]), node_of_evidence),
+    }
+
+
+def view(report: Mapping[str, Any]) -> dict[str, Any]:
+    """Derived lookups the templates need (pure function of ``report``).
+
+    Keys: ``dashboard`` (:func:`dashboard`), ``problem_groups`` (the
+    problems grouped by root cause, :func:`problem_groups`), ``diagnosis``
+    (diagnosis id -> record), ``counts`` (``[(status, n)]`` worst first), ``problems`` and
+    ``outstanding`` (see :func:`_attention`), ``unmet_requirements``,
+    ``ev_anchor`` (one fragment id per evidence record, in order),
+    ``evidence_of`` (obligation id -> ``[(anchor, record)]``), ``obligation``
+    (id -> obligation), ``trace`` (requirement rows with ``rowspan`` and the
+    evidence of each supporting obligation), ``sections`` (per node: the node,
+    its rule instances/derived property, side conditions, findings and
+    ``ob_status``, the status of each obligation its guarantees list),
+    ``finding_runs``, ``obligation_runs`` (rows ``{"obligation", "evidence":
+    [anchor]}``) and ``evidence_runs`` (``{"anchor", "record"}``): the rows of
+    the health table, the obligations table and the evidence records, in
+    report order, cut into runs of one node each (:func:`runs`).
+    """
+    validate(report)
+    ev_anchor = evidence_anchors(report)
+    evidence_of: dict[str, list[tuple[str, Mapping[str, Any]]]] = defaultdict(list)
+    for aid, ev in zip(ev_anchor, report["evidence"]):
+        evidence_of[str(ev["obligation"])].append((aid, ev))
+    obligation = {str(o["id"]): o for o in report["obligations"]}
+    counts_in = report["summary"]["counts"]
+    counts = [(s, counts_in[s]) for s in COUNT_ORDER if s in counts_in]
+    counts += [(s, counts_in[s]) for s in sorted(counts_in) if s not in SEVERITY]
+    problems, outstanding = _attention(report, ev_anchor)
+    groups = (list(report["problems"]) if report.get("problems") is not None
+              else group_problems(report, problems, anchor))
+    return {
+        "dashboard": dashboard(report, evidence_of, groups), "problem_groups": groups,
+        "diagnosis": {str(d["id"]): d for d in report.get("diagnoses") or []},
+        "counts": counts, "problems": problems, "outstanding": outstanding,
+        "outstanding_groups": group_items(outstanding), "pending_groups": _pending_groups(report),
+        "unmet_requirements": [r for r in report["requirements"] if rank(r["status"]) > 0],
+        "ev_anchor": ev_anchor, "evidence_of": evidence_of, "obligation": obligation,
+        "trace": _trace(report, obligation, evidence_of), "sections": _sections(report, obligation),
+        "lint_errors": sum(1 for x in report["lint"] if str(x["severity"]).lower() == "error"),
+        **_table_runs(report, ev_anchor, obligation, evidence_of),
+    }
+
+
+def runs(items: Sequence[_T], key: Callable[[_T], str]) -> list[list[_T]]:
+    """``items`` cut into runs of consecutive items with equal ``key``, in
+    order (the report lists rows node by node, so a run is usually one
+    node's rows: the unit a report piece is rendered and kept by)."""
+    out: list[list[_T]] = []
+    last: object = object()
+    for it in items:
+        k = key(it)
+        if not out or k != last:
+            out.append([])
+            last = k
+        out[-1].append(it)
+    return out
