@@ -157,88 +157,120 @@ def build_argument(report: Mapping[str, Any]) -> Argument:
     Raises ``KeyError`` for a missing report key and
     :class:`.model.ArgumentError` if the result were malformed.
     """
-    b = _Builder()
-    meta = report["meta"]
-    reqs = report["requirements"]
-    ev_of = {str(e["obligation"]): e for e in report["evidence"]}
-    obligations = sorted(report["obligations"], key=lambda o: natural_key(o["id"]))  # p1 < p2 < p10
-    obligations_of: dict[str, list[Mapping[str, Any]]] = {}  # by node, still sorted by id
-    for o in obligations:
-        obligations_of.setdefault(str(o["node"]), []).append(o)
-    sides: dict[str, list[Mapping[str, Any]]] = {}
-    for sc in report["side_conditions"]:
-        sides.setdefault(str(sc["node"]), []).append(sc)
-    findings: dict[str, list[Mapping[str, Any]]] = {}
-    for f in report["findings"]:
-        findings.setdefault(str(f["node"]), []).append(f)
-    env: dict[str, list[Mapping[str, Any]]] = {}
-    for a in report["environment_assumptions"]:
-        env.setdefault(str(a["node"]), []).append(a)
+    g = _Goals(report)
+    top, top_ctx = ident("G", "system"), g.top_context()
+    g.loop_assumptions()
+    g.j_calc = g.b.add(Element(ident("J", "calculus"), "justification", CALCULUS))
+    if any(sc.get("verdict") == "discharged in context" for sc in report["side_conditions"]):
+        g.b.add(Element(g.j_context, "justification", IN_CONTEXT))
+    contract_goals = [g.contract_goal(n) for n in report["nodes"]]
+    req_goals = [g.requirement_goal(r) for r in report["requirements"]]
+    b = g.b
+    s_reqs = b.add(Element(ident("S", "requirements"), "strategy", "Argument over each requirement of the plan",
+                           supported_by=tuple(req_goals), undeveloped=not req_goals))
+    s_contracts = b.add(Element(ident("S", "contracts"), "strategy",
+                                "Argument over the node contracts: every node meets its contract (the premises of rules R1-R4)",
+                                supported_by=tuple(contract_goals), in_context_of=(g.a_persist, *g.loop_ids.values())))
+    ids = ", ".join(str(r["id"]) for r in report["requirements"]) or "no requirement listed"
+    b.els = {top: Element(top, "goal", f"The system {report['meta']['workspace']} meets its requirements ({ids})",
+                          supported_by=(s_reqs, s_contracts), in_context_of=top_ctx), **b.els}
+    add_defeaters(b.els, report, ident)
+    add_accepted_risks(b.els, report, ident, top)
+    add_claim_points(b.els, report, ident)
+    return propagate(Argument(top, b.els))
 
-    top = ident("G", "system")
-    c_plan = b.add(Element(ident("C", "plan"), "context",
-                           f"Verification plan {meta['plan']} and contracts {', '.join(map(str, meta['contracts']))} "
-                           f"of {meta['workspace']}", url=str(meta["plan"])))
-    a_persist = b.add(Element(ident("A", "persist"), "assumption", PERSIST))
-    grounding = report.get("grounding")
-    top_ctx: tuple[str, ...] = (c_plan,)
-    if grounding:  # docs/ros.md: which software version the contracts were grounded in
+
+def _by_node(rows: Any) -> dict[str, list[Mapping[str, Any]]]:
+    out: dict[str, list[Mapping[str, Any]]] = {}
+    for r in rows:
+        out.setdefault(str(r["node"]), []).append(r)
+    return out
+
+
+class _Goals:
+    """The elements of one argument, added in a fixed order (the element
+    order is the output's): the report's rows by node, and the ids of the
+    context elements the goals refer to."""
+
+    def __init__(self, report: Mapping[str, Any]) -> None:
+        self.report, self.b = report, _Builder()
+        self.ev_of = {str(e["obligation"]): e for e in report["evidence"]}
+        # by node, still sorted by id: p1 < p2 < p10
+        self.obligations_of = _by_node(sorted(report["obligations"], key=lambda o: natural_key(o["id"])))
+        self.sides, self.findings = _by_node(report["side_conditions"]), _by_node(report["findings"])
+        self.env = _by_node(report["environment_assumptions"])
+        self.loop_ids: dict[str, str] = {}  # R4's assumption text -> its element (one per loop)
+        self.loop_of: dict[str, str] = {}
+        self.guarantee_goal: dict[tuple[str, int], str] = {}
+        self.a_persist = self.j_calc = ""
+        self.j_context = ident("J", "context")
+
+    def top_context(self) -> tuple[str, ...]:
+        """The plan's context, the persistence assumption and the grounding's context (docs/ros.md:
+        which software version the contracts were grounded in)."""
+        b, meta = self.b, self.report["meta"]
+        c_plan = b.add(Element(ident("C", "plan"), "context",
+                               f"Verification plan {meta['plan']} and contracts {', '.join(map(str, meta['contracts']))} "
+                               f"of {meta['workspace']}", url=str(meta["plan"])))
+        self.a_persist = b.add(Element(ident("A", "persist"), "assumption", PERSIST))
+        grounding = self.report.get("grounding")
+        if not grounding:
+            return (c_plan,)
         ctx = grounding["context"]
         digest = hashlib.sha256("".join(f"{f['path']}\0{f['sha256']}\n" for f in ctx["files"]).encode()).hexdigest()
-        top_ctx += (b.add(Element(ident("C", "ros"), "context", _clip(
+        return (c_plan, b.add(Element(ident("C", "ros"), "context", _clip(
             "Contracts grounded in the ROS software: "
             + ", ".join(f"{p['name']} {p['version']}" for p in ctx["packages"])
             + f"; {len(ctx['files'])} scanned files (sha256 of their sha256 list {digest[:16]}, each in "
               f"artifacts/ros/graph.json); {grounding['counts']['error']} grounding error(s), "
-              f"{grounding['counts']['warning']} warning(s)"), url="artifacts/ros/graph.json")),)
-    loop_ids: dict[str, str] = {}  # R4's assumption text -> its element (one per loop)
-    loop_of: dict[str, str] = {}
-    for d in report["derived_properties"]:
-        text = d.get("loop_assumption")
-        if text:
-            if text not in loop_ids:
-                loop_ids[text] = b.add(Element(ident("A", "loop", len(loop_ids) + 1), "assumption", str(text)))
-            loop_of[str(d["node"])] = loop_ids[text]
-    loops = list(loop_ids.values())
-    j_calc = b.add(Element(ident("J", "calculus"), "justification", CALCULUS))
-    j_context = ident("J", "context")
-    if any(sc.get("verdict") == "discharged in context" for sc in report["side_conditions"]):
-        b.add(Element(j_context, "justification", IN_CONTEXT))
+              f"{grounding['counts']['warning']} warning(s)"), url="artifacts/ros/graph.json")))
 
-    def evidence_goals(node: str, k: int) -> list[str]:
+    def loop_assumptions(self) -> None:
+        """One assumption element per loop of rule R4 (its derived properties' loop assumption)."""
+        for d in self.report["derived_properties"]:
+            text = d.get("loop_assumption")
+            if text:
+                if text not in self.loop_ids:
+                    self.loop_ids[text] = self.b.add(Element(ident("A", "loop", len(self.loop_ids) + 1), "assumption",
+                                                             str(text)))
+                self.loop_of[str(d["node"])] = self.loop_ids[text]
+
+    def _evidence(self, o: Mapping[str, Any]) -> str:
+        """The solution of obligation ``o`` (its evidence record), or an undeveloped goal without one."""
+        oid = str(o["id"])
+        ev = self.ev_of.get(oid)
+        if ev is None:
+            return self.b.add(Element(ident("G", "ob", oid), "goal",
+                                      f"Obligation {oid} ({o['backend']}) is discharged: no evidence record yet",
+                                      undeveloped=True, ref=oid))
+        tool = f"{ev['tool']} {ev['tool_version']}".strip()
+        return self.b.add(Element(
+            ident("Sn", "ev", oid), "solution",
+            _clip(f"{ev['kind']} evidence ({ev['backend']}, {tool}) for {oid}: {ev['status']}"
+                  + (f" [strength: {ev['strength']['kind']}; {ev['strength']['detail']}]" if ev.get("strength") else "")
+                  + f". {ev['explanation']}"),
+            status=str(ev["status"]), ref=oid, url=f"artifacts/evidence/{oid}.json"))
+
+    def evidence_goals(self, node: str, k: int) -> list[str]:
         """Solutions and undeveloped goals under guarantee ``k`` of ``node``."""
-        kids: list[str] = []
-        mine = [o for o in obligations_of.get(node, []) if o["node"] == node and int(o["guarantee"]) in (k, 0)]
-        for o in mine:
-            oid = str(o["id"])
-            ev = ev_of.get(oid)
-            if ev is None:
-                kids.append(b.add(Element(ident("G", "ob", oid), "goal",
-                                          f"Obligation {oid} ({o['backend']}) is discharged: no evidence record yet",
-                                          undeveloped=True, ref=oid)))
-                continue
-            tool = f"{ev['tool']} {ev['tool_version']}".strip()
-            kids.append(b.add(Element(
-                ident("Sn", "ev", oid), "solution",
-                _clip(f"{ev['kind']} evidence ({ev['backend']}, {tool}) for {oid}: {ev['status']}"
-                      + (f" [strength: {ev['strength']['kind']}; {ev['strength']['detail']}]" if ev.get("strength") else "")
-                      + f". {ev['explanation']}"),
-                status=str(ev["status"]), ref=oid, url=f"artifacts/evidence/{oid}.json")))
+        mine = [o for o in self.obligations_of.get(node, []) if o["node"] == node and int(o["guarantee"]) in (k, 0)]
+        kids = [self._evidence(o) for o in mine]
         if not mine:
-            kids.append(b.add(Element(ident("G", node, f"g{k}", "evidence"), "goal",
-                                      f"Evidence that {node} guarantee {k} holds: no obligation was exported for it",
-                                      undeveloped=True, ref=f"{node}.g{k}", status="unverified")))
-        for f in findings.get(node, []):
+            kids.append(self.b.add(Element(ident("G", node, f"g{k}", "evidence"), "goal",
+                                           f"Evidence that {node} guarantee {k} holds: no obligation was exported for it",
+                                           undeveloped=True, ref=f"{node}.g{k}", status="unverified")))
+        for f in self.findings.get(node, []):
             if f["guarantee"] in (None, k):
-                kids.append(b.add(Element(
+                kids.append(self.b.add(Element(
                     ident("Sn", "health", f["id"]), "solution",
                     _clip(f"Contract health check {f['check']} (Z3): {f['status']}. {f['message']}"),
                     status=_FINDING_AS.get(str(f["status"]), "error"), ref=str(f["id"]),
                     url=str(f.get("smt2") or ""))))
         return kids
 
-    def side_goal(sc: Mapping[str, Any]) -> str:
-        sid = str(sc["id"])
+    def side_goal(self, sc: Mapping[str, Any]) -> str:
+        """The goal of side condition ``sc`` with its Z3 query as solution (in context: the weaker claim)."""
+        b, sid = self.b, str(sc["id"])
         verdict = str(sc.get("verdict") or sc["status"])
         sn = b.add(Element(ident("Sn", "sc", sid), "solution",
                            _clip(f"Z3 query {sc['smt2']}: {verdict}"
@@ -253,76 +285,60 @@ def build_argument(report: Mapping[str, Any]) -> Argument:
                                        f"{sc['conjunct']} of {sc['node']}'s assumption follows, in context, from the "
                                        f"guarantees of its upstream cone ({', '.join(used) or 'none'}), each under its "
                                        "own node's assumption, and the cone's environment assumptions and facts"),
-                                 supported_by=(sn,), in_context_of=(j_context,), ref=sid))
+                                 supported_by=(sn,), in_context_of=(self.j_context,), ref=sid))
         return b.add(Element(ident("G", "sc", sid), "goal",
                              _clip(f"Side condition {sid} ({sc['rule']}, {sc['source']}): the conjunct "
                                    f"{sc['conjunct']} of {sc['node']}'s assumption follows from its producers' guarantees"),
                              supported_by=(sn,), ref=sid))
 
-    guarantee_goal: dict[tuple[str, int], str] = {}
-    contract_goals: list[str] = []
-    for n in report["nodes"]:
-        name = str(n["name"])
+    def contract_goal(self, n: Mapping[str, Any]) -> str:
+        """The goal that node ``n`` meets its contract: its guarantees' goals and its side conditions'."""
+        b, name = self.b, str(n["name"])
         g_ids = []
         for g in n["guarantees"]:
             k = int(g["index"])
             gid = b.add(Element(ident("G", name, f"g{k}"), "goal",
                                 _clip(f"{name} guarantee {k} holds ({g['source']}): {g['text']}"),
-                                supported_by=tuple(evidence_goals(name, k)), ref=f"{name}.g{k}"))
-            guarantee_goal[(name, k)] = gid
+                                supported_by=tuple(self.evidence_goals(name, k)), ref=f"{name}.g{k}"))
+            self.guarantee_goal[(name, k)] = gid
             g_ids.append(gid)
-        sc_ids = [side_goal(sc) for sc in sides.get(name, [])]
+        sc_ids = [self.side_goal(sc) for sc in self.sides.get(name, [])]
         c_node = b.add(Element(ident("C", name), "context", f"Contract of {name} ({n['source']})", ref=name))
         ctx = [c_node] + [b.add(Element(ident("A", "env", name, i), "assumption",
                                         _clip(f"Environment assumption of {name} ({a['source']}): {a['text']}"), ref=name))
-                          for i, a in enumerate(env.get(name, []), 1)]
-        contract_goals.append(b.add(Element(
+                          for i, a in enumerate(self.env.get(name, []), 1)]
+        return b.add(Element(
             ident("G", name), "goal",
             f"{name} meets its contract in the composed system: for every input satisfying its assumption, "
             f"eventually an output satisfying its guarantees (paper lines 462-495)",
-            supported_by=tuple(g_ids + sc_ids), in_context_of=tuple(ctx), ref=name)))
+            supported_by=tuple(g_ids + sc_ids), in_context_of=tuple(ctx), ref=name))
 
-    req_goals = []
-    for r in reqs:
-        rid = str(r["id"])
+    def requirement_goal(self, r: Mapping[str, Any]) -> str:
+        """The goal of requirement ``r``: Z3's entailment when it was checked, else the calculus over its support."""
+        b, rid = self.b, str(r["id"])
         if "verdict" in r:  # checked by Z3 (docs/requirements.md): entailment, or undeveloped
-            gid = _requirement_goal(b, own_check(r), guarantee_goal, sides, j_calc)
-            req_goals.append(with_statistics(b.els, with_deadline(b.els, gid, r, guarantee_goal), r))  # its deadline
-            # (rule D3) and its recorded runs' bounds and targets (statistics.py, issue 68)
-            continue
+            gid = _requirement_goal(b, own_check(r), self.guarantee_goal, self.sides, self.j_calc)
+            # its deadline (rule D3) and its recorded runs' bounds and targets (statistics.py, issue 68)
+            return with_statistics(b.els, with_deadline(b.els, gid, r, self.guarantee_goal), r)
         kids: list[str] = []
         nodes_used: list[str] = []
         for s in r["support"]:
-            kids.append(guarantee_goal[(str(s["node"]), int(s["guarantee"]))])
+            kids.append(self.guarantee_goal[(str(s["node"]), int(s["guarantee"]))])
             if s["node"] not in nodes_used:
                 nodes_used.append(str(s["node"]))
         for name in nodes_used:
-            kids += [ident("G", "sc", sc["id"]) for sc in sides.get(name, [])]
-        ctx = [a_persist] + sorted({loop_of[x] for x in nodes_used if x in loop_of}) + [j_calc]
+            kids += [ident("G", "sc", sc["id"]) for sc in self.sides.get(name, [])]
+        ctx = [self.a_persist] + sorted({self.loop_of[x] for x in nodes_used if x in self.loop_of}) + [self.j_calc]
         strategy = b.add(Element(
             ident("S", rid), "strategy",
             f"Argument over the composition calculus: {rid} follows from the guarantees of "
             f"{', '.join(nodes_used) or 'no node'} once the side conditions of their assumptions are discharged",
             supported_by=tuple(dict.fromkeys(kids)), in_context_of=tuple(ctx), ref=rid))
         if kids:
-            req_goals.append(b.add(Element(ident("G", rid), "goal", _clip(f"{rid}: {r['text']}"),
-                                           supported_by=(strategy,), ref=rid)))
-        else:  # no supporting guarantee listed: nothing argues for it
-            del b.els[strategy]
-            req_goals.append(b.add(Element(ident("G", rid), "goal", _clip(f"{rid}: {r['text']} (no supporting guarantee listed)"),
-                                           undeveloped=True, ref=rid)))
-    s_reqs = b.add(Element(ident("S", "requirements"), "strategy", "Argument over each requirement of the plan",
-                           supported_by=tuple(req_goals), undeveloped=not req_goals))
-    s_contracts = b.add(Element(ident("S", "contracts"), "strategy",
-                                "Argument over the node contracts: every node meets its contract (the premises of rules R1-R4)",
-                                supported_by=tuple(contract_goals), in_context_of=(a_persist, *loops)))
-    ids = ", ".join(str(r["id"]) for r in reqs) or "no requirement listed"
-    b.els = {top: Element(top, "goal", f"The system {meta['workspace']} meets its requirements ({ids})",
-                          supported_by=(s_reqs, s_contracts), in_context_of=top_ctx), **b.els}
-    add_defeaters(b.els, report, ident)
-    add_accepted_risks(b.els, report, ident, top)
-    add_claim_points(b.els, report, ident)
-    return propagate(Argument(top, b.els))
+            return b.add(Element(ident("G", rid), "goal", _clip(f"{rid}: {r['text']}"), supported_by=(strategy,), ref=rid))
+        del b.els[strategy]  # no supporting guarantee listed: nothing argues for it
+        return b.add(Element(ident("G", rid), "goal", _clip(f"{rid}: {r['text']} (no supporting guarantee listed)"),
+                             undeveloped=True, ref=rid))
 
 
 def _temporal_what(c: Mapping[str, Any]) -> str:
