@@ -138,7 +138,7 @@ def graph() -> nx.DiGraph:
 def test_the_graph_is_read_from_the_source(graph: nx.DiGraph) -> None:
     """Known imports of both kinds are found: module level and inside a function."""
     assert graph.has_edge("rclverify.semantics.decide", "rclverify.semantics.evaluate")  # module level, relative
-    assert graph.has_edge("rclverify.cli.commands", "rclverify.app.pipeline")  # inside a function
+    assert graph.has_edge("rclverify.cli.verify", "rclverify.app.pipeline")  # inside a function
     assert graph.has_edge("rclverify.calculus.health.checks", "rclverify.calculus.health.finding")
     assert len(graph) > 60 and graph.number_of_edges() > 300
 

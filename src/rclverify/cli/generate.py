@@ -31,7 +31,7 @@ def add_parsers(sub: Any) -> None:
 
 def cmd_ros2(args: argparse.Namespace) -> int:
     """Check the workspace's contracts and write the tree; prints what changed and the logic files to read."""
-    from rclverify.app.pipeline import Workspace
+    from rclverify.stages.workspace import Workspace
     from rclverify.backends.monitors.config import ConfigError
     from rclverify.tools.generate.writer import GenerateError, write_tree
     ws = Path(args.workspace)
