@@ -5,6 +5,7 @@ tier); tests/test_report_schema.py validates the reports of a run.
 """
 from __future__ import annotations
 
+import types
 import typing
 from typing import Any
 
@@ -64,25 +65,156 @@ def test_the_stages_use_the_vocabulary() -> None:
     assert set(EXPECTED) <= set(statuses.RECORD_STATUSES)
 
 
-#: Each row TypedDict and where the schema describes it.
-_ROWS: tuple[tuple[Any, tuple[str, ...]], ...] = (
-    (st.Meta, ("meta",)), (st.Summary, ("summary",)),
-    (st.NodeRow, ("nodes", "items")), (st.GuaranteeRow, ("nodes", "items", "guarantees", "items")),
-    (st.RequirementRow, ("requirements", "items")), (st.SupportRow, ("requirements", "items", "support", "items")),
-    (st.SideConditionRow, ("side_conditions", "items")), (st.DerivedPropertyRow, ("derived_properties", "items")),
-    (st.FindingRow, ("findings", "items")), (st.ObligationRow, ("obligations", "items")),
-    (st.EvidenceRow, ("evidence", "items")), (st.PendingRow, ("pending", "items")), (st.LintRow, ("lint", "items")),
-    (st.AcknowledgementRow, ("acknowledgements", "items")), (st.UnverifiedRow, ("unverified", "items")),
-    (st.ProblemRow, ("problems", "items")),
-)
+def _resolve(sub: Any) -> Any:
+    """``sub`` with a ``$ref`` to ``$defs`` followed."""
+    while isinstance(sub, dict) and "$ref" in sub:
+        sub = SCHEMA["$defs"][sub["$ref"].rsplit("/", 1)[1]]
+    return sub
+
+
+def _json_types(sub: Any) -> set[str] | None:
+    """The JSON types the schema ``sub`` allows (``None``: any)."""
+    sub = _resolve(sub)
+    if not isinstance(sub, dict) or sub == {}:
+        return None
+    if "anyOf" in sub:
+        parts = [_json_types(x) for x in sub["anyOf"]]
+        return None if any(p is None for p in parts) else set().union(*parts)  # type: ignore[arg-type]
+    if "enum" in sub:
+        return {"null" if w is None else "string" for w in sub["enum"]}
+    t = sub.get("type")
+    return None if t is None else {t} if isinstance(t, str) else set(t)
+
+
+def _py_types(ann: Any) -> set[str] | None:
+    """The JSON types a value of the annotation ``ann`` is written as (``None``: any)."""
+    origin = typing.get_origin(ann)
+    if ann is Any:
+        return None
+    if origin in (typing.Union, types.UnionType):
+        parts = [_py_types(a) for a in typing.get_args(ann)]
+        return None if any(p is None for p in parts) else set().union(*parts)  # type: ignore[arg-type]
+    if origin is typing.Literal:
+        return {"string"}
+    if origin is list or origin is tuple:
+        return {"array"}
+    if origin is dict or typing.is_typeddict(ann):
+        return {"object"}
+    return {str: {"string"}, int: {"integer"}, float: {"number"}, bool: {"boolean"}, type(None): {"null"}}[ann]
+
+
+def _typeddicts_in(ann: Any) -> list[Any]:
+    """The TypedDicts ``ann`` holds directly, as itself, a list's item or a member of a union."""
+    if typing.is_typeddict(ann):
+        return [ann]
+    return [t for a in typing.get_args(ann) for t in _typeddicts_in(a)]
+
+
+def _object_of(sub: Any, array: bool) -> Any:
+    """The object schema of a key's value (its items' for a list; the object branch of a union)."""
+    sub = _resolve(sub)
+    if array:
+        sub = _resolve(sub["items"])
+    for x in sub.get("anyOf", ()):
+        if _resolve(x).get("type") == "object":
+            return _resolve(x)
+    return sub
+
+
+def _disagreements(td: Any, sub: Any, where: str) -> list[str]:
+    """Where the TypedDict ``td`` and the object schema ``sub`` say different things: a key one has and the
+    other lacks, a key required in one and optional in the other, a value of another JSON type; then the
+    same for every TypedDict inside, so a key added to either at any depth is found."""
+    hints = typing.get_type_hints(td)
+    props = sub.get("properties", {})
+    out = [f"{where}.{k}: only in the TypedDict" for k in hints if k not in props]
+    out += [f"{where}.{k}: only in the schema" for k in props if k not in hints]
+    required = set(sub.get("required", ()))
+    out += [f"{where}.{k}: required in one only" for k in hints if k in props and (k in required) != (k in td.__required_keys__)]
+    for k, ann in hints.items():
+        if k not in props:
+            continue
+        have, want = _py_types(ann), _json_types(props[k])
+        if have is not None and want is not None and not have <= want | ({"number"} if "integer" in have else set()):
+            out.append(f"{where}.{k}: {sorted(have)} in the TypedDict, {sorted(want)} in the schema")
+        array = typing.get_origin(ann) is list or any(typing.get_origin(a) is list for a in typing.get_args(ann))
+        for inner in _typeddicts_in(ann):
+            out += _disagreements(inner, _object_of(props[k], array), f"{where}.{k}")
+    return out
 
 
 def test_the_typeddicts_are_the_schema() -> None:
     assert list(st.REPORT_KEYS) == list(SCHEMA["properties"]) == SCHEMA["required"]
-    for td, path in _ROWS:
-        sub: Any = SCHEMA["properties"]
-        for step in path:
-            sub = sub[step] if step in sub else sub["properties"][step]
-        keys = set(typing.get_type_hints(td))
-        assert set(sub["required"]) == set(td.__required_keys__), td.__name__
-        assert keys == set(sub["properties"]), (td.__name__, set(sub["properties"]) ^ keys)
+    assert _disagreements(st.Report, SCHEMA, "report") == []
+    # every row type is reached from Report (none is left out of the walk)
+    reached = {t for k, ann in typing.get_type_hints(st.Report).items() for t in _reached(ann)}
+    assert {getattr(st, n) for n in dir(st) if typing.is_typeddict(getattr(st, n))} == reached | {st.Report}
+
+
+def _reached(ann: Any) -> set[Any]:
+    out = set()
+    for t in _typeddicts_in(ann):
+        out |= {t} | {x for a in typing.get_type_hints(t).values() for x in _reached(a)}
+    return out
+
+
+def test_a_key_in_one_and_not_the_other_is_found() -> None:
+    """The check above fails for a key added to the schema only, to the TypedDict only, made optional
+    in one only, or given another type, at any depth."""
+    import copy
+    global SCHEMA
+    kept = SCHEMA
+    try:
+        for change, want in (
+                (lambda s: s["$defs"]["strength"]["properties"].update(colour={"type": "string", "description": "x"}),
+                 "report.evidence.strength.colour: only in the schema"),
+                (lambda s: s["properties"]["nodes"]["items"]["required"].remove("latex"),
+                 "report.nodes.latex: required in one only"),
+                (lambda s: s["properties"]["obligations"]["items"]["properties"]["guarantee"].update(type="string"),
+                 "report.obligations.guarantee: ['integer'] in the TypedDict, ['string'] in the schema"),
+                (lambda s: s["properties"]["requirements"]["items"]["properties"].pop("strength_shortfall"),
+                 "report.requirements.strength_shortfall: only in the TypedDict")):
+            SCHEMA = copy.deepcopy(kept)
+            change(SCHEMA)
+            assert want in _disagreements(st.Report, SCHEMA, "report"), want
+    finally:
+        SCHEMA = kept
+    assert {k: v for k, v in typing.get_type_hints(st.Strength).items()} and \
+        st.RequirementRow.__optional_keys__ >= {"required_strength", "strength_shortfall"}
+
+
+def test_a_status_that_does_not_follow_from_its_verdict_is_found() -> None:
+    """records/statuses.py, "Verdict and status": each kind of row that carries both, right and wrong."""
+    good = {
+        "requirements": [{"id": "R1", "verdict": "met", "status": "discharged"},
+                         {"id": "R2", "verdict": "proved, evidence outstanding", "status": "pending"},
+                         {"id": "R3", "verdict": "refuted", "status": "failed",
+                          "without_deadline": {"verdict": "met", "status": "discharged"}},
+                         {"id": "R4", "verdict": "inconclusive", "status": "stale"}],
+        "side_conditions": [{"id": "s1", "verdict": "discharged in context", "status": "discharged"},
+                            {"id": "s2", "verdict": "stale", "status": "stale"}],
+        "deadlines": [{"requirement": "R1", "verdict": "proved", "status": "pending", "evidence_status": "pending"},
+                      {"requirement": "R3", "verdict": "refuted", "status": "failed"}],
+        "derived_properties": [{"node": "A", "status": "discharged", "derivation": "derived"},
+                               {"node": "B", "status": "stale", "derivation": "undecided"}],
+    }
+    assert statuses.contradictions(good) == []
+    bad = {
+        "requirements": [{"id": "R1", "verdict": "proved, evidence outstanding", "status": "discharged"},
+                         {"id": "R2", "verdict": "met", "status": "pending"},
+                         {"id": "R3", "verdict": "refuted", "status": "inconclusive"},
+                         {"id": "R4", "verdict": "refuted", "status": "failed",
+                          "without_deadline": {"verdict": "proved vacuously", "status": "pending"}}],
+        "side_conditions": [{"id": "s1", "verdict": "discharged", "status": "stale"},
+                            {"id": "s2", "verdict": "failed", "status": "discharged"}],
+        "deadlines": [{"requirement": "R1", "verdict": "proved", "status": "discharged", "evidence_status": "pending"},
+                      {"requirement": "R3", "verdict": "inconclusive", "status": "pending"}],
+        "derived_properties": [{"node": "A", "status": "failed", "derivation": "derived"}],
+    }
+    found = statuses.contradictions(bad)
+    assert [f.split(" ", 1)[0] for f in found] == [
+        "requirements[0]", "requirements[1]", "requirements[2]", "requirements[3]", "side_conditions[0]",
+        "side_conditions[1]", "deadlines[0]", "deadlines[1]", "derived_properties[0]"], found
+    assert found[0] == "requirements[0] (R1): verdict 'proved, evidence outstanding', status 'discharged'"
+    assert set(statuses.REQUIREMENT_FLOOR) == set(statuses.REQUIREMENT_VERDICTS)
+    assert set(statuses.DEADLINE_STATUS) | {"proved"} == set(statuses.DEADLINE_VERDICTS)

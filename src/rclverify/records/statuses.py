@@ -40,9 +40,30 @@ outstanding), ``stale`` (an input changed since the evidence was made),
 ``error`` (the tool broke, or a record was altered outside rclverify),
 ``inconclusive`` (the tool could not decide: unknown, a time limit),
 ``unverified`` (nothing was planned to establish a guarantee; never a
-record's own status).  A requirement's ``verdict`` says what the Z3 check of its formal
-statement found; its ``status`` is an evidence status (only ``met`` is
-``discharged``; calculus/requirements/rollup.py).
+record's own status).
+
+Verdict and status, one rule.  A ``verdict`` (and a derived property's
+``derivation``) is what one check decided, in that check's own words: Z3
+on a requirement (calculus/requirements/rollup.py), on a side condition,
+on an end-to-end deadline (rule D3).  A ``status`` is always an evidence
+status: the roll-up the report shows, ranks by and rolls up further
+(:data:`SEVERITY`).  A row that carries both derives its status from its
+verdict and from the statuses of what it rests on, never the other way,
+as :data:`VERDICT_STATUS` says per kind of row; :func:`contradictions`
+finds a row that breaks it:
+
+* requirement (and its ``without_deadline``): ``discharged`` exactly when
+  the verdict is ``met``; otherwise no better than the verdict's floor in
+  :data:`REQUIREMENT_FLOOR` (refuted, proved from an inconsistency or
+  vacuously: ``failed``; ``proved, evidence outstanding``: the evidence's
+  own status, never ``discharged``);
+* side condition: ``discharged`` for ``discharged`` and ``discharged in
+  context``; otherwise the verdict's word itself;
+* deadline: for ``proved``, the status of the chain's evidence; otherwise
+  :data:`DEADLINE_STATUS` of the verdict;
+* derived property: the ``derivation`` says its ``status`` (``derived``
+  for ``discharged``, ``not derived`` for ``failed``, else ``undecided``);
+  its ``evidence_status`` is the roll-up of the node contracts it rests on.
 
 This module imports nothing of the package: it sits in the evidence
 records layer, below every stage that writes a status.
@@ -100,6 +121,64 @@ AGREEMENTS: tuple[Agreement, ...] = get_args(Agreement)
 EvidenceKind = Literal["proof", "model checking", "testing", "experiment", "review", "monitoring"]
 #: The kinds of evidence an obligation asks for and a record gives (obligations' and evidence rows' ``kind``).
 EVIDENCE_KINDS: tuple[EvidenceKind, ...] = get_args(EvidenceKind)
+
+#: The least bad status a requirement of each verdict may show (module docstring, "Verdict and status").
+REQUIREMENT_FLOOR: Mapping[str, EvidenceStatus] = MappingProxyType({
+    "met": "discharged", "proved, evidence outstanding": "pending", "proved from an inconsistency": "failed",
+    "proved vacuously": "failed", "refuted": "failed", "inconclusive": "pending", "informal": "pending",
+    "stale": "stale", "error": "error"})
+#: A deadline verdict other than ``proved`` as the status its row shows (report/deadlines.py).
+DEADLINE_STATUS: Mapping[str, EvidenceStatus] = MappingProxyType({
+    "refuted": "failed", "inconclusive": "inconclusive", "pending": "pending", "stale": "stale", "error": "error"})
+#: A derived property's derivation status (the worst side condition of its cone) as its ``derivation``
+#: (any other status: ``undecided``).
+DERIVATION_OF: Mapping[str, Derivation] = MappingProxyType({"discharged": "derived", "failed": "not derived"})
+#: Which rows carry both a verdict and a status, and the rule that ties them (module docstring).
+VERDICT_STATUS: Mapping[str, str] = MappingProxyType({
+    "requirements": "discharged exactly when met; otherwise no better than REQUIREMENT_FLOOR[verdict]",
+    "side_conditions": "discharged for discharged and discharged in context; otherwise the verdict",
+    "deadlines": "proved: the chain's evidence status; otherwise DEADLINE_STATUS[verdict]",
+    "derived_properties": "derivation: derived for discharged, not derived for failed, else undecided"})
+
+
+def _requirement_breaks(row: Mapping[str, object]) -> bool:
+    verdict, status = str(row.get("verdict")), str(row.get("status"))
+    if (status == "discharged") != (verdict == "met"):
+        return True
+    floor = REQUIREMENT_FLOOR.get(verdict)
+    return floor is None or SEVERITY.get(status, len(SEVERITY)) < SEVERITY[floor]
+
+
+def _breaks(kind: str, row: Mapping[str, object]) -> bool:
+    """Does ``row`` (a row of the report's list ``kind``) break the rule of :data:`VERDICT_STATUS`?"""
+    verdict, status = row.get("verdict"), row.get("status")
+    if kind == "requirements":
+        without = row.get("without_deadline")
+        return _requirement_breaks(row) or (isinstance(without, Mapping) and _requirement_breaks(without))
+    if kind == "side_conditions":
+        proved = verdict in ("discharged", "discharged in context")
+        return status != ("discharged" if proved else verdict)
+    if kind == "deadlines":
+        return status != (row.get("evidence_status") if verdict == "proved" else DEADLINE_STATUS.get(str(verdict)))
+    derivation = DERIVATION_OF.get(str(status), "undecided")
+    return row.get("derivation") != derivation
+
+
+def contradictions(report: Mapping[str, object]) -> list[str]:
+    """``kind[i] (id): verdict ... status ...`` for every row of ``report``
+    (a report dict, docs/assurance.schema.json) whose status does not follow
+    from its verdict by the rule of :data:`VERDICT_STATUS`; empty when every
+    row follows it.  Reads the report only."""
+    out = []
+    for kind in VERDICT_STATUS:
+        rows = report.get(kind)
+        for i, row in enumerate(rows if isinstance(rows, list) else ()):
+            if isinstance(row, Mapping) and _breaks(kind, row):
+                name = row.get("id", row.get("requirement", row.get("node")))
+                out.append(f"{kind}[{i}] ({name}): verdict {row.get('verdict', row.get('derivation'))!r}, "
+                           f"status {row.get('status')!r}")
+    return out
+
 
 #: Every set by the name the schema's ``$defs`` give it (docs/assurance.schema.json).
 VOCABULARY: Mapping[str, tuple[str, ...]] = MappingProxyType({

@@ -15,10 +15,11 @@ from typing import Iterable, Mapping, Sequence
 
 from rclverify.model.system.model import names_of
 from rclverify.records.records import SEVERITY, worst
-from rclverify.records.statuses import Derivation
+from rclverify.records.statuses import DERIVATION_OF
 
-#: A cone's worst side-condition status as the derived property's ``derivation`` (any other: ``undecided``).
-DERIVATION: dict[str, Derivation] = {"discharged": "derived", "failed": "not derived"}
+#: A cone's worst side-condition status as the derived property's ``derivation`` (any other: ``undecided``;
+#: records/statuses.py, "Verdict and status").
+DERIVATION = DERIVATION_OF
 #: Most node names a derived property's note lists per status ("3 pending node contracts: A, B, C");
 #: the rest are counted.  A property at the end of a 1000-node chain rests on 999 contracts: its
 #: note named them all, a quadratic amount of report text nobody reads (the cone itself is the

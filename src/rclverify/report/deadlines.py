@@ -41,11 +41,11 @@ import xml.etree.ElementTree as ET
 from typing import Any, Callable, Mapping, Sequence
 
 from rclverify.records.records import worst
+from rclverify.records.statuses import DEADLINE_STATUS
 from rclverify.stages.workspace import Workspace
 
 #: A deadline verdict as an evidence status (the report's badges and roll-up).
-STATUS_OF = {"proved": "discharged", "refuted": "failed", "inconclusive": "inconclusive", "pending": "pending",
-             "stale": "stale", "error": "error"}
+STATUS_OF = {"proved": "discharged", **DEADLINE_STATUS}  # records/statuses.py, "Verdict and status"
 #: Requirement verdicts a deadline that is not proved never improves.
 _WORSE = ("refuted", "proved from an inconsistency", "proved vacuously", "error")
 
