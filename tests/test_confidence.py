@@ -10,6 +10,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from _report_schema import check_report
 from rclverify.report.argument.confidence import Premise, claim, cones, derived_claims, requirement_claim
 from rclverify.report.argument.strength import BACKEND_KIND, KINDS, evidence_strength, one_sided_bound
 from rclverify.cli.commands import main
@@ -109,6 +110,7 @@ def test_strength_and_confidence_in_every_format(ws: Path) -> None:
     assert req["REQ1"]["verdict"] == "met" and 0.99 < req["REQ1"]["confidence"] < 1
     assert req["REQ1"]["limited_by"]["sentence"].startswith("REQ1 rests on a proof for Actuator guarantee 1")
     assert req["REQ1"]["strength_shortfall"] == []
+    check_report(r, "required strength")  # the keys a required strength adds are in the published schema
     assert r["summary"]["confidence"] == min(q["confidence"] for q in r["requirements"])
     sarif = json.loads((ws / "reports/assurance.sarif").read_text())
     assert sarif and "strength" in (ws / "reports/assurance.junit.xml").read_text()
@@ -146,6 +148,7 @@ def test_a_required_strength_the_evidence_lacks_fails_strict(ws: Path, tmp_path:
     r = json.loads((root / "reports/assurance.json").read_text())
     req = next(q for q in r["requirements"] if q["id"] == "REQ1")
     assert req["confidence"] == 0.0 and req["strength_shortfall"] == ["Actuator guarantee 1 (nothing discharged)"]
+    check_report(r, "strength short")
     assert any(p.startswith("Requirement REQ1 requires proof evidence") for p in r["summary"]["problems"])
 
 

@@ -17,8 +17,101 @@ a report that lacks a part.
 # annotations (with string annotations every key would count as required).
 from typing import Any, Mapping, NotRequired, TypedDict, cast
 
-from rclverify.records.statuses import (AcknowledgementStatus, Derivation, EvidenceKind, EvidenceStatus, HealthStatus,
-                                 LintSeverity, RequirementVerdict, SideConditionVerdict, EVIDENCE_STATUSES)
+from rclverify.records.statuses import (AcknowledgementStatus, Agreement, DeadlineVerdict, Derivation, EvidenceKind,
+                                        EvidenceStatus, HealthStatus, LintSeverity, RequirementVerdict,
+                                        SideConditionVerdict, EVIDENCE_STATUSES)
+
+
+class Solvers(TypedDict):
+    """The second solver's agreement on a verdict (``$defs/solvers``; docs/second-solver.md)."""
+    agreement: Agreement
+    why: str
+    cvc5: dict[str, Any] | None
+    proof: NotRequired[str]
+    smt2: NotRequired[str]
+
+
+class Strength(TypedDict):
+    """How strong a piece of evidence is (``$defs/strength``; docs/confidence.md); ``doubt`` 0 to 1."""
+    kind: str
+    doubt: float
+    detail: NotRequired[str]
+    solvers: NotRequired[int]
+
+
+class LimitedBy(TypedDict):
+    """The premise with the largest doubt behind a confidence (``$defs/limited_by``)."""
+    label: str
+    kind: str
+    doubt: float
+    sentence: NotRequired[str]
+
+
+class CulpritOf(TypedDict):
+    """A problem row an item is the culprit of (``$defs/culprit_of``, issue 64)."""
+    sentence: str
+    status: EvidenceStatus
+
+
+class SystemView(TypedDict):
+    """The system model as the report draws it (``system``; model/system/model.py ``view``)."""
+    nodes: list[dict[str, Any]]
+    connections: list[dict[str, Any]]
+    environment_inputs: list[dict[str, Any]]
+    loops: list[list[str]]
+    loop_components: list[list[str]]
+
+
+class EnvironmentAssumptionRow(TypedDict):
+    """An environment conjunct of a node's assumption (``environment_assumptions[]``)."""
+    node: str
+    text: str
+    source: str
+
+
+class ExpectedVerdictRow(TypedDict):
+    """An expectation of the plan against the obligation it names (``expected_verdicts[]``; report/expected.py)."""
+    node: str
+    backend: str
+    source: str
+    guarantee: int | None
+    instance: str | None
+    expected: str | None
+    actual: EvidenceStatus | None
+    obligation: str | None
+    reason: str
+    outcome: str
+
+
+class DeadlineRow(TypedDict):
+    """An end-to-end deadline decided by rule D3 (``deadlines[]``, ``$defs/deadline``; report/deadlines.py)."""
+    requirement: str
+    path: list[str]
+    within: str
+    source: str
+    verdict: DeadlineVerdict
+    status: NotRequired[EvidenceStatus]
+    evidence_status: NotRequired[EvidenceStatus]
+    reason: NotRequired[str]
+    chain: NotRequired[list[dict[str, Any]]]
+    total: NotRequired[str | None]
+    stamps: NotRequired[list[Any]]
+    smt2: NotRequired[str]
+    solvers: NotRequired[Solvers | None]
+
+
+class DiagnosisRow(TypedDict):
+    """One problem explained, with its repairs checked by Z3 (``diagnoses[]``; docs/diagnosis.md)."""
+    id: str
+    kind: str
+    status: str
+    node: str
+    guarantee: int | None
+    sentence: str
+    culprits: list[Any]
+    counterexample: list[Any]
+    related: list[Any]
+    repairs: list[dict[str, Any]]
 
 
 class Meta(TypedDict):
@@ -59,8 +152,8 @@ class GuaranteeRow(TypedDict):
     source: str
     status: EvidenceStatus
     obligations: list[str]
-    strength: NotRequired[dict[str, Any]]
-    culprit_of: NotRequired[list[dict[str, Any]]]
+    strength: NotRequired[Strength]
+    culprit_of: NotRequired[list[CulpritOf]]
 
 
 class NodeRow(TypedDict):
@@ -74,8 +167,8 @@ class NodeRow(TypedDict):
     guarantees: list[GuaranteeRow]
     latex: str
     confidence: NotRequired[float]
-    limited_by: NotRequired[dict[str, Any] | None]
-    culprit_of: NotRequired[list[dict[str, Any]]]
+    limited_by: NotRequired[LimitedBy | None]
+    culprit_of: NotRequired[list[CulpritOf]]
 
 
 class SupportRow(TypedDict):
@@ -97,11 +190,13 @@ class RequirementRow(TypedDict):
     note: str
     support: list[SupportRow]
     check: dict[str, Any]
-    deadline: NotRequired[dict[str, Any]]
+    deadline: NotRequired[DeadlineRow]
     without_deadline: NotRequired[dict[str, Any]]
     statistics: NotRequired[list[dict[str, Any]]]
     confidence: NotRequired[float]
-    limited_by: NotRequired[dict[str, Any] | None]
+    limited_by: NotRequired[LimitedBy | None]
+    required_strength: NotRequired[str]
+    strength_shortfall: NotRequired[list[str]]
 
 
 class SideConditionRow(TypedDict):
@@ -122,8 +217,8 @@ class SideConditionRow(TypedDict):
     links: list[str]
     context: dict[str, Any] | None
     scale_mismatch: NotRequired[list[dict[str, Any]]]
-    solvers: NotRequired[dict[str, Any]]
-    strength: NotRequired[dict[str, Any]]
+    solvers: NotRequired[Solvers]
+    strength: NotRequired[Strength]
 
 
 class DerivedPropertyRow(TypedDict):
@@ -139,7 +234,7 @@ class DerivedPropertyRow(TypedDict):
     evidence_note: str
     loop_assumption: str | None
     confidence: NotRequired[float]
-    limited_by: NotRequired[dict[str, Any] | None]
+    limited_by: NotRequired[LimitedBy | None]
 
 
 class FindingRow(TypedDict):
@@ -158,7 +253,7 @@ class FindingRow(TypedDict):
     model: NotRequired[dict[str, Any] | None]
     witness: NotRequired[dict[str, Any]]
     witness_smt2: NotRequired[str]
-    solvers: NotRequired[dict[str, Any]]
+    solvers: NotRequired[Solvers]
     flagged: NotRequired[str]
     sha256: NotRequired[str]
     acknowledged: NotRequired[dict[str, str]]
@@ -194,11 +289,11 @@ class EvidenceRow(TypedDict):
     log_excerpt: str
     figures: NotRequired[list[list[str]]]
     plot_svg: NotRequired[str]
-    solvers: NotRequired[dict[str, Any]]
+    solvers: NotRequired[Solvers]
     examples: NotRequired[dict[str, Any]]
     monitoring: NotRequired[dict[str, Any]]
     statistics: NotRequired[dict[str, Any]]
-    strength: NotRequired[dict[str, Any]]
+    strength: NotRequired[Strength]
 
 
 class PendingRow(TypedDict):
@@ -256,7 +351,7 @@ class Report(TypedDict):
     """``reports/assurance.json`` (docs/assurance.schema.json)."""
     meta: Meta
     summary: Summary
-    system: dict[str, Any]
+    system: SystemView
     requirements: list[RequirementRow]
     nodes: list[NodeRow]
     side_conditions: list[SideConditionRow]
@@ -264,16 +359,16 @@ class Report(TypedDict):
     findings: list[FindingRow]
     obligations: list[ObligationRow]
     evidence: list[EvidenceRow]
-    environment_assumptions: list[dict[str, str]]
+    environment_assumptions: list[EnvironmentAssumptionRow]
     pending: list[PendingRow]
     lint: list[LintRow]
-    expected_verdicts: list[dict[str, Any]]
+    expected_verdicts: list[ExpectedVerdictRow]
     grounding: dict[str, Any] | None
     unverified: list[UnverifiedRow]
-    deadlines: list[dict[str, Any]]
+    deadlines: list[DeadlineRow]
     acknowledgements: list[AcknowledgementRow]
     statistics: list[dict[str, Any]]
-    diagnoses: list[dict[str, Any]]
+    diagnoses: list[DiagnosisRow]
     problems: list[ProblemRow]
 
 

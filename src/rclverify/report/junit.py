@@ -135,7 +135,7 @@ def junit_tree(report: Report) -> ET.Element:
     return root
 
 
-def _requirements_suite(report: Mapping[str, Any]) -> tuple[ET.Element, dict[str, int], float] | None:
+def _requirements_suite(report: Report) -> tuple[ET.Element, dict[str, int], float] | None:
     """The ``requirements`` ``<testsuite>`` (module docstring), its counts and
     time; ``None`` when the report has no requirements."""
     reqs = report.get("requirements") or []
@@ -155,9 +155,10 @@ def _requirements_suite(report: Mapping[str, Any]) -> tuple[ET.Element, dict[str
         prevent = "; ".join(f"{p['label']}: {p['text']} ({p['source']})" for p in c.get("failed_to_prevent") or [])
         counts["tests"] += 1
         time += secs
-        if r.get("confidence") is not None and r.get("limited_by"):
+        limited = r.get("limited_by")
+        if r.get("confidence") is not None and limited:
             _properties(props, str(r["id"]), {"confidence": f"{r['confidence']:.6g}",
-                                              "limited_by": r["limited_by"].get("sentence", "")})
+                                              "limited_by": limited.get("sentence", "")})
         bumped = _outcome(case, str(r["status"]), f"{r['verdict']}: {r['note']}",
                           _lines(f"requirement {r['id']}: {r['text']}",
                                  f"formal: {c['formal']}" if c.get("formal") else "",
@@ -173,7 +174,7 @@ def _requirements_suite(report: Mapping[str, Any]) -> tuple[ET.Element, dict[str
     return suite, counts, time
 
 
-def _lint_suite(report: Mapping[str, Any]) -> tuple[ET.Element, dict[str, int], float] | None:
+def _lint_suite(report: Report) -> tuple[ET.Element, dict[str, int], float] | None:
     """The ``lint`` ``<testsuite>``: one ``<testcase>`` per lint diagnostic
     (``classname`` ``lint``, name its code and location, at its location), a
     ``<failure>`` of type ``warning`` or ``error`` (its one severity,
@@ -199,7 +200,7 @@ def _lint_suite(report: Mapping[str, Any]) -> tuple[ET.Element, dict[str, int], 
     return suite, counts, 0.0
 
 
-def _suite_data(report: Mapping[str, Any]) -> list[tuple[Mapping[str, Any], dict[str, Any]]]:
+def _suite_data(report: Report) -> list[tuple[Mapping[str, Any], dict[str, Any]]]:
     """Per node of ``report``, in order: the node and exactly what its
     ``<testsuite>`` is made from (its obligations, side conditions and
     findings, the evidence records and pending reasons of its obligations)."""
@@ -213,7 +214,7 @@ def _suite_data(report: Mapping[str, Any]) -> list[tuple[Mapping[str, Any], dict
             by_node.setdefault(item["node"], {}).setdefault(kind, []).append(item)
     for u in report.get("unverified") or ():
         by_node.setdefault(u["node"], {}).setdefault("unverified", []).append(u)
-    out = []
+    out: list[tuple[Mapping[str, Any], dict[str, Any]]] = []
     for node in report["nodes"]:
         items = by_node.get(str(node["name"]), {})
         ids = [str(o["id"]) for o in items.get("obligations", ())]

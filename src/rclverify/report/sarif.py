@@ -190,10 +190,10 @@ def _result(rule: str, level: str, text: str, where: str, key: str, props: Mappi
             "partialFingerprints": {"rclverifyItem/v1": key}, "properties": dict(props)}
 
 
-def _obligation_results(report: Mapping[str, Any]) -> list[dict[str, Any]]:
+def _obligation_results(report: Report) -> list[dict[str, Any]]:
     evidence: dict[str, Mapping[str, Any]] = {}
-    for ev in report["evidence"]:
-        evidence[str(ev["obligation"])] = ev
+    for row in report["evidence"]:
+        evidence[str(row["obligation"])] = row
     reasons: dict[str, str] = {}
     for p in report["pending"]:
         reasons.setdefault(str(p["obligation"]), str(p["reason"]))
@@ -231,7 +231,7 @@ def _obligation_results(report: Mapping[str, Any]) -> list[dict[str, Any]]:
     return out
 
 
-def _unverified_results(report: Mapping[str, Any]) -> list[dict[str, Any]]:
+def _unverified_results(report: Report) -> list[dict[str, Any]]:
     """One result per guarantee no obligation covers, at the guarantee (report/unverified.py)."""
     rule = RULES["RCL-GUARANTEE-UNVERIFIED"]
     return [_result(rule.id, _level("guarantee", "unverified"), f"Guarantee {u['guarantee']} of {u['node']} is unverified: {u['reason']}. "
@@ -240,7 +240,7 @@ def _unverified_results(report: Mapping[str, Any]) -> list[dict[str, Any]]:
             for u in report.get("unverified") or ()]
 
 
-def _side_condition_results(report: Mapping[str, Any]) -> list[dict[str, Any]]:
+def _side_condition_results(report: Report) -> list[dict[str, Any]]:
     out = []
     for sc in report["side_conditions"]:
         status = str(sc["status"])
@@ -271,7 +271,7 @@ def _side_condition_results(report: Mapping[str, Any]) -> list[dict[str, Any]]:
     return out
 
 
-def _requirement_results(report: Mapping[str, Any]) -> list[dict[str, Any]]:
+def _requirement_results(report: Report) -> list[dict[str, Any]]:
     """One result per requirement that is not met, at its formal statement
     (the plan, or the Doorstop item's file); a refuted one carries the
     counterexample node by node and the guarantees that did not prevent it."""
@@ -298,7 +298,7 @@ def _requirement_results(report: Mapping[str, Any]) -> list[dict[str, Any]]:
     return out
 
 
-def _finding_location(report: Mapping[str, Any], f: Mapping[str, Any]) -> str:
+def _finding_location(report: Report, f: Mapping[str, Any]) -> str:
     for n in report["nodes"]:
         if n["name"] == f["node"]:
             for g in n["guarantees"]:
@@ -308,7 +308,7 @@ def _finding_location(report: Mapping[str, Any], f: Mapping[str, Any]) -> str:
     return ""
 
 
-def _finding_results(report: Mapping[str, Any]) -> list[dict[str, Any]]:
+def _finding_results(report: Report) -> list[dict[str, Any]]:
     out = []
     for f in report["findings"]:
         if f["status"] == "ok":
@@ -320,7 +320,7 @@ def _finding_results(report: Mapping[str, Any]) -> list[dict[str, Any]]:
         if f.get("explanation"):
             words.append(str(f["explanation"]))
         if f.get("core"):
-            words.append("Unsat core: " + "; ".join(str(c) for c in f["core"]) + ".")
+            words.append("Unsat core: " + "; ".join(str(c) for c in f.get("core") or ()) + ".")
         if f.get("model"):
             words.append(f"Counterexample: {model_text(f['model'])}.")
         props = {"finding": f["id"], "node": f["node"], "check": f["check"], "status": f["status"]}
@@ -343,7 +343,7 @@ def _suppressed(res: dict[str, Any], row: Mapping[str, Any]) -> dict[str, Any]:
     return res
 
 
-def _acknowledgement_results(report: Mapping[str, Any]) -> list[dict[str, Any]]:
+def _acknowledgement_results(report: Report) -> list[dict[str, Any]]:
     """Stale or refused plan acknowledgements, at their plan entry."""
     return [_result("RCL-ACK-STALE", _level("acknowledgement", str(a["status"])),
                     f"Acknowledgement of {a['warning']} is {a['status']}: {a['message']}", str(a["at"]),
@@ -351,7 +351,7 @@ def _acknowledgement_results(report: Mapping[str, Any]) -> list[dict[str, Any]]:
             for a in report.get("acknowledgements") or () if a.get("status") != "ok"]
 
 
-def _lint_results(report: Mapping[str, Any]) -> tuple[list[dict[str, Any]], list[Rule]]:
+def _lint_results(report: Report) -> tuple[list[dict[str, Any]], list[Rule]]:
     out: list[dict[str, Any]] = []
     rules: dict[str, Rule] = {}
     for k, d in enumerate(report["lint"]):
@@ -364,7 +364,7 @@ def _lint_results(report: Mapping[str, Any]) -> tuple[list[dict[str, Any]], list
     return out, sorted(rules.values(), key=lambda r: r.id)
 
 
-def _grounding_results(report: Mapping[str, Any]) -> tuple[list[dict[str, Any]], list[Rule]]:
+def _grounding_results(report: Report) -> tuple[list[dict[str, Any]], list[Rule]]:
     """Grounding findings (docs/ros.md): located at the RCL line, with the
     software line it contradicts as a related location."""
     g = report.get("grounding")
@@ -391,22 +391,22 @@ def _grounding_results(report: Mapping[str, Any]) -> tuple[list[dict[str, Any]],
     return out, rules
 
 
-def _attach_diagnoses(report: Mapping[str, Any], results: Sequence[dict[str, Any]]) -> None:
+def _attach_diagnoses(report: Report, results: Sequence[dict[str, Any]]) -> None:
     """Give each result its diagnosis (``properties.diagnosis``: the
     sentence naming the culprit) and its repairs as SARIF ``fix`` objects
     (§3.55; each repair was checked by Z3 before it entered the report,
     docs/diagnosis.md).  A report without ``diagnoses`` is left as it is."""
     from rclverify.diagnosis.edits import sarif_fix
     by_key: dict[str, Mapping[str, Any]] = {}
-    for d in report.get("diagnoses", []):
-        if d.get("kind") == "unit":  # a unit mismatch: the lint error at the producer (diagnosis/units.py)
-            by_key[f"unit:{d.get('lint')}"] = d
+    for dg in report.get("diagnoses", []):
+        if dg.get("kind") == "unit":  # a unit mismatch: the lint error at the producer (diagnosis/units.py)
+            by_key[f"unit:{dg.get('lint')}"] = dg
             continue
-        if d.get("kind") == "deadline":
-            by_key[f"deadline:{d.get('requirement')}"] = d
+        if dg.get("kind") == "deadline":
+            by_key[f"deadline:{dg.get('requirement')}"] = dg
             continue
         for prefix in ("health", "side-condition", "obligation", "requirement"):
-            by_key[f"{prefix}:{d['id']}"] = d
+            by_key[f"{prefix}:{dg['id']}"] = dg
     for res in results:
         fp = res["partialFingerprints"]["rclverifyItem/v1"]
         d = by_key.get(fp) or (by_key.get("unit:" + fp[5:].split(":E-unit-")[0]) if ":E-unit-" in fp else None)

@@ -28,7 +28,7 @@ from typing import TYPE_CHECKING, Any, Callable, Mapping, Sequence, cast
 
 from rclverify.records.store import dumps
 from rclverify.lang.errors import RclError
-from rclverify.stages.cone_digests import cone_digests
+from rclverify.stages.cone_digests import cone_digests as cone_digests  # also where app/pipeline.py finds it
 
 if TYPE_CHECKING:
     from rclverify.backends.base import NodeTarget

@@ -38,6 +38,7 @@ import hashlib
 import re
 from typing import Any, Mapping
 
+from rclverify.records.report_schema import Report
 from rclverify.report.argument.deadlines import own_check, with_deadline
 from rclverify.report.argument.statistics import with_statistics
 from rclverify.report.argument.model import Argument, Element, propagate
@@ -147,7 +148,7 @@ class _Builder:
         return e.id
 
 
-def build_argument(report: Mapping[str, Any]) -> Argument:
+def build_argument(report: Report) -> Argument:
     """The goal structure of ``report`` (a report dict, see
     :data:`rclverify.report.render.REPORT_KEYS`), statuses propagated.
 
@@ -192,7 +193,7 @@ class _Goals:
     order is the output's): the report's rows by node, and the ids of the
     context elements the goals refer to."""
 
-    def __init__(self, report: Mapping[str, Any]) -> None:
+    def __init__(self, report: Report) -> None:
         self.report, self.b = report, _Builder()
         self.ev_of = {str(e["obligation"]): e for e in report["evidence"]}
         # by node, still sorted by id: p1 < p2 < p10
