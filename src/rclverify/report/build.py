@@ -25,19 +25,30 @@ import z3
 
 from rclverify import __version__
 from rclverify.diagnosis.build import diagnose
+from rclverify.model.plan.load import all_requirements
 from rclverify.model.system.model import cycles_kept
 from rclverify.records.records import Obligation, worst
 from rclverify.records.report_schema import Report
 from rclverify.report import assemble
+from rclverify.report.confidence_rows import confidence_part
 from rclverify.report.contract_rows import GuaranteeStatuses, contract_records, derived_rows, involved_model, node_part
 from rclverify.report.contract_texts import ContractTexts
+from rclverify.report.culprits import marked_nodes
+from rclverify.report.deadlines import deadline_rows, fold_into, strict_ok as deadlines_ok
 from rclverify.report.evidence_rows import evidence_part
 from rclverify.report.expected import expected_rows
 from rclverify.report.finding_rows import acknowledged_rows, finding_rows, grounding_row, lint_rows
+from rclverify.report.problems import group_problems
 from rclverify.report.records import inputs_sha256, node_obligations
 from rclverify.report.requirement_rows import requirement_rows
+from rclverify.report.severity import blocking
+from rclverify.report.statistics import statistics_part
 from rclverify.report.summary_rows import grounding_problems, headline, problem_sentences, status_counts, strict_gate
+from rclverify.report.templating import anchor
+from rclverify.report.unverified import unverified_guarantees
+from rclverify.report.view import problem_items
 from rclverify.stages.crosscheck.apply import SecondSolver, load as load_second_solver
+from rclverify.stages.requirements import read_records
 from rclverify.stages.workspace import Workspace, current_snapshot_hashes, stale_stages
 
 
@@ -89,9 +100,6 @@ class Facts(NamedTuple):
 
 def _rows(ws: Workspace, inp: Inputs) -> tuple[dict[str, Any], Facts]:
     """The report's rows, pass by pass (the module docstring), and the :class:`Facts` the summary needs."""
-    from rclverify.report.deadlines import deadline_rows, fold_into, strict_ok as deadlines_ok
-    from rclverify.report.unverified import unverified_guarantees
-    from rclverify.stages.requirements import read_records
     names = list(ws.checked.nodes)
     ev = evidence_part(ws, inp.obligations, inp.altered, inp.hashes, inp.second)
     comps, health = contract_records(ws, names, inp.stale, inp.second)
@@ -152,14 +160,6 @@ def build_report(ws: Workspace) -> Report:
     diagnosis per problem with repairs checked by Z3 (docs/diagnosis.md),
     the problems grouped by root cause (report/problems.py) and the
     culprit nodes marked (report/culprits.py, issue 64)."""
-    from rclverify.model.plan.load import all_requirements
-    from rclverify.report.confidence_rows import confidence_part
-    from rclverify.report.culprits import marked_nodes
-    from rclverify.report.problems import group_problems
-    from rclverify.report.templating import anchor
-    from rclverify.report.view import problem_items
-    from rclverify.report.severity import blocking
-    from rclverify.report.statistics import statistics_part
     inp = read_inputs(ws)
     report = _first_report(ws, inp, *_rows(ws, inp))
     plan = ws.plan

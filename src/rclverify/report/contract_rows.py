@@ -21,6 +21,7 @@ from rclverify.diagnosis.text import natural_sorted  # p1 < p2 < p10
 from rclverify.records.records import Obligation, worst
 from rclverify.records.report_schema import DerivedPropertyRow, GuaranteeRow, NodeRow, SideConditionRow
 from rclverify.records.statuses import EvidenceStatus, HealthStatus
+from rclverify.report.cex_cone import side_condition_view
 from rclverify.report.cones import DERIVATION, ConeEvidence
 from rclverify.report.contract_texts import ContractTexts
 from rclverify.report.records import node_records
@@ -84,7 +85,6 @@ def involved_model(sc: Mapping[str, Any]) -> SideConditionRow:
     cut to the nodes its conjunct involves (:func:`.cex_cone.side_condition_view`:
     the consumer, the producers of its links and, decided in context, the
     nodes whose assumption the counterexample violates)."""
-    from rclverify.report.cex_cone import side_condition_view
     return side_condition_view(sc)  # type: ignore[return-value]  # a calculus row as the schema gives it
 
 

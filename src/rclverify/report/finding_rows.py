@@ -8,6 +8,8 @@ from __future__ import annotations
 
 from typing import Any, Mapping, Sequence
 
+from rclverify.calculus.scale import scale_findings
+from rclverify.model.plan.acknowledged import apply_acknowledgements
 from rclverify.records.report_schema import AcknowledgementRow, FindingRow, LintRow
 from rclverify.report.records import diagnostics as read_diagnostics, grounding as read_grounding
 from rclverify.stages.workspace import Workspace
@@ -17,7 +19,6 @@ def finding_rows(nodes: Sequence[str], health: Mapping[str, Sequence[Mapping[str
                  side_conditions: Sequence[Mapping[str, Any]]) -> list[dict[str, Any]]:
     """The health findings of ``nodes`` in their order, then the side
     conditions whose ranges lie a power of ten apart (a warning, calculus/scale.py)."""
-    from rclverify.calculus.scale import scale_findings
     return [dict(f) for n in nodes for f in health[n]] + list(scale_findings(list(side_conditions)))
 
 
@@ -33,7 +34,6 @@ def acknowledged_rows(ws: Workspace, findings: Sequence[Mapping[str, Any]], lint
     marked with what each warning flags (``flagged``, ``sha256``) and the
     plan's answer to it (``acknowledged``), and one row per acknowledgement
     of the plan with its status (model/plan/acknowledged.py; docs/plan.md)."""
-    from rclverify.model.plan.acknowledged import apply_acknowledgements
     f_rows, l_rows = [dict(f) for f in findings], [dict(x) for x in lint]
     acks = apply_acknowledgements(ws.plan.acknowledged, f_rows, l_rows, ws.checked)
     return f_rows, l_rows, acks  # type: ignore[return-value]  # rows of the schema's shape, built as dicts

@@ -11,8 +11,11 @@ from __future__ import annotations
 
 from typing import Any, Callable, Mapping, cast
 
+from rclverify.calculus.requirements.rollup import declaration_evidence, declaration_statuses, roll_up
+from rclverify.model.plan.load import all_requirements
 from rclverify.records.records import worst
 from rclverify.records.report_schema import RequirementRow, SupportRow
+from rclverify.report.cex_cone import with_trace_view  # a temporal trace cut to what matters (issue 48)
 from rclverify.report.contract_rows import GuaranteeStatuses
 from rclverify.report.contract_texts import ContractTexts
 from rclverify.stages.workspace import Workspace
@@ -52,8 +55,6 @@ def requirement_check(record: Mapping[str, Any] | None, traced_status: str, g_st
     proved, evidence outstanding / proved from an inconsistency / refuted /
     inconclusive / informal), ``status`` (only ``met`` is ``discharged``),
     ``note`` and the check's details (:mod:`rclverify.calculus.requirements.rollup`)."""
-    from rclverify.calculus.requirements.rollup import declaration_evidence, roll_up
-    from rclverify.report.cex_cone import with_trace_view  # a temporal trace cut to what matters (issue 48)
     verdict, status, note = roll_up(record, g_status, sc_status, traced_status, d_status)
     details = dict(with_trace_view({k: (record or {}).get(k) for k in _CHECK_FIELDS}))
     details["declarations"] = declaration_evidence(record, d_status)  # the declarations it used, with their evidence (issue 64)
@@ -67,8 +68,6 @@ def requirement_rows(ws: Workspace, texts: ContractTexts, checks: Mapping[str, A
     check's fields (:func:`requirement_check`).  ``checks``: requirement id
     -> its check record (sealed, stale and second solver applied);
     ``declared``: node -> the records that judged its declarations."""
-    from rclverify.calculus.requirements.rollup import declaration_statuses
-    from rclverify.model.plan.load import all_requirements
     rows: list[RequirementRow] = []
     for r in all_requirements(ws.plan):
         support: list[SupportRow] = []
