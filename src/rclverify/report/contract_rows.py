@@ -85,7 +85,7 @@ def involved_model(sc: Mapping[str, Any]) -> SideConditionRow:
     cut to the nodes its conjunct involves (:func:`.cex_cone.side_condition_view`:
     the consumer, the producers of its links and, decided in context, the
     nodes whose assumption the counterexample violates)."""
-    return side_condition_view(sc)  # type: ignore[return-value]  # a calculus row as the schema gives it
+    return cast(SideConditionRow, side_condition_view(sc))  # a calculus record's row, the schema's shape
 
 
 class GuaranteeStatuses:

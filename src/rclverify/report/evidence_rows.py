@@ -10,7 +10,7 @@ was given.
 """
 from __future__ import annotations
 
-from typing import Any, Mapping, Sequence, TypedDict
+from typing import Any, Mapping, Sequence, TypedDict, cast
 
 from rclverify.records.records import Obligation
 from rclverify.records.report_schema import EvidenceRow, ObligationRow, PendingRow
@@ -88,7 +88,7 @@ def evidence_row(ws: Workspace, ev: Any, status: str, altered: str, solvers: dic
         row["monitoring"] = d["monitoring"]
     if isinstance(d, dict) and isinstance(d.get("statistics"), dict):  # runs counted (issue 68)
         row["statistics"] = compact_statistics(d["statistics"])
-    return row  # type: ignore[return-value]  # the keys of EvidenceRow, built as a dict for the optional ones
+    return cast(EvidenceRow, row)  # built as a dict for the optional keys
 
 
 def evidence_part(ws: Workspace, obligations: Sequence[Obligation], altered_lists: Mapping[str, str],
@@ -109,9 +109,10 @@ def evidence_part(ws: Workspace, obligations: Sequence[Obligation], altered_list
         status = "error" if altered else (store.current_status(ev, hashes) if ev else "pending")
         status, solvers = second.evidence(o.id, o.backend, status)
         part["status"][o.id] = status
-        part["obligations"].append({"id": o.id, "node": o.node, "guarantee": o.guarantee, "backend": o.backend,
-                                    "kind": o.kind, "instance": o.instance, "statement": o.statement,  # type: ignore[typeddict-item]
-                                    "source": str(o.source), "artifact": o.artifact, "status": status})  # type: ignore[typeddict-item]
+        part["obligations"].append(cast(ObligationRow, {
+            "id": o.id, "node": o.node, "guarantee": o.guarantee, "backend": o.backend, "kind": o.kind,
+            "instance": o.instance, "statement": o.statement, "source": str(o.source), "artifact": o.artifact,
+            "status": status}))  # the record's words: the vocabulary's (records/statuses.py)
         if ev is None:
             if altered:
                 part["altered"].append(f"Evidence {o.id} is error: {altered}")

@@ -6,7 +6,7 @@ acknowledgement pass marks copies of the findings and lint rows).
 """
 from __future__ import annotations
 
-from typing import Any, Mapping, Sequence
+from typing import Any, Mapping, Sequence, cast
 
 from rclverify.calculus.scale import scale_findings
 from rclverify.model.plan.acknowledged import apply_acknowledgements
@@ -36,7 +36,7 @@ def acknowledged_rows(ws: Workspace, findings: Sequence[Mapping[str, Any]], lint
     of the plan with its status (model/plan/acknowledged.py; docs/plan.md)."""
     f_rows, l_rows = [dict(f) for f in findings], [dict(x) for x in lint]
     acks = apply_acknowledgements(ws.plan.acknowledged, f_rows, l_rows, ws.checked)
-    return f_rows, l_rows, acks  # type: ignore[return-value]  # rows of the schema's shape, built as dicts
+    return cast(list[FindingRow], f_rows), cast(list[LintRow], l_rows), cast(list[AcknowledgementRow], acks)
 
 
 def grounding_row(ws: Workspace) -> dict[str, Any] | None:
