@@ -1,8 +1,12 @@
 """Layer 16, cli: the ``rclverify`` command, parsing and printing only.
 
 ``commands`` (the commands' table and the entry point), one module per
-command group (``monitor``, ``ros``, ``requirements``, ``generate``,
-``lsp``).  Imports every layer below.
+command group: ``contracts`` (check, latex, fmt), ``calculus`` (graph,
+compose, health, export, quotient, refines), ``requirements`` (with
+deadlines), ``verify`` (with report), ``explain`` (with status),
+``workspace`` (init, cache, review), ``bundle``, ``runs`` (monitor and
+oracle's parsers; ``monitor`` runs them), ``ros``, ``generate``, ``lsp``;
+``common`` holds what they share.  Imports every layer below.
 """
 from __future__ import annotations
 
