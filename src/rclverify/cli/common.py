@@ -13,9 +13,12 @@ import argparse
 import sys
 from contextlib import contextmanager
 from pathlib import Path
-from typing import Any, Callable, Iterator
+from typing import TYPE_CHECKING, Any, Callable, Iterator
 
 from rclverify.lang.errors import RclError
+
+if TYPE_CHECKING:
+    from rclverify.stages.workspace import Workspace
 
 #: ``add(name, fn, help, workspace=False)``: a subcommand's parser (:func:`rclverify.cli.commands.main`).
 AddCommand = Callable[..., argparse.ArgumentParser]
@@ -51,7 +54,7 @@ def emit(text: str, output: str | None) -> int:
     return 0
 
 
-def workspace_of(args: argparse.Namespace) -> Any:
+def workspace_of(args: argparse.Namespace) -> Workspace:
     """The :class:`~rclverify.stages.workspace.Workspace` of ``args.workspace`` and ``args.plan``."""
     from rclverify.stages.workspace import Workspace
     return Workspace(Path(args.workspace), args.plan)
