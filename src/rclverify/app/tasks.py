@@ -385,7 +385,8 @@ def _inputs(config: Any, root: Path, seen: dict[str, tuple[str, ...]]) -> list[s
 
     ``seen`` memoises the files of each path string across calls (the
     entries of many nodes name the same program or directory: one stat or
-    directory walk per distinct string)."""
+    directory walk per distinct string; one import walk per Python file,
+    which entries name with different callables, ``file.py:n0``)."""
     out: set[str] = set()
 
     def files(v: str) -> tuple[str, ...]:
@@ -396,7 +397,10 @@ def _inputs(config: Any, root: Path, seen: dict[str, tuple[str, ...]]) -> list[s
                 # a Python implementation (`file.py:callable`): the file and every workspace module it imports,
                 # so that a changed helper exports the obligations, and their inputs, again (issue 63, row 2)
                 from rclverify.backends.property_tests.closure import import_closure
-                seen[v] = tuple(import_closure(root, py)[0])
+                k = "\0" + py  # the closure is the file's, whatever callable follows the colon (one walk per file)
+                if k not in seen:
+                    seen[k] = tuple(import_closure(root, py)[0])
+                seen[v] = seen[k]
             elif not p.exists():
                 seen[v] = ()
             elif p.is_dir():

@@ -81,19 +81,25 @@ def claim(premises: Iterable[Premise]) -> Claim:
 
 def cones(producers: Mapping[str, Iterable[str]]) -> dict[str, frozenset[str]]:
     """C4's cones: for every node of ``producers`` (node -> its producer
-    nodes), the least fixpoint ``cone(n) = {n} + cone(p)``, by iterating
-    until no cone grows (loops included)."""
-    nodes = set(producers) | {p for ps in producers.values() for p in ps}
-    cone = {n: {n} for n in nodes}
-    changed = True
-    while changed:
-        changed = False
-        for n in nodes:
-            for p in producers.get(n, ()):
-                if not cone[p] <= cone[n]:
-                    cone[n] |= cone[p]
-                    changed = True
-    return {n: frozenset(c) for n, c in cone.items()}
+    nodes), the least fixpoint ``cone(n) = {n} + cone(p)`` (loops
+    included): the nodes with a path to ``n``, and ``n``.  Computed once
+    per strongly connected component (networkx's condensation: a loop's
+    nodes share one cone), producers' components first, each cone the
+    union of its component's nodes and its producer components' cones.
+    Iterating the fixpoint over the nodes until no cone grew took 2.8 s of
+    a report of 1000 nodes (docs/scale.md, issue 67)."""
+    import networkx as nx
+    g = nx.DiGraph()
+    g.add_nodes_from(set(producers) | {p for ps in producers.values() for p in ps})
+    g.add_edges_from((p, n) for n, ps in producers.items() for p in ps)
+    dag = nx.condensation(g)
+    acc: dict[int, frozenset[str]] = {}
+    for c in nx.topological_sort(dag):
+        members = set(dag.nodes[c]["members"])
+        for q in dag.predecessors(c):
+            members |= acc[q]
+        acc[c] = frozenset(members)
+    return {n: acc[c] for n, c in dag.graph["mapping"].items()}
 
 
 def node_claims(own: Mapping[str, Sequence[Premise]]) -> dict[str, Claim]:
