@@ -251,7 +251,7 @@ def test_the_stage_split_over_two_processes_writes_what_the_serial_stage_writes(
     proof files as deciding every script in this process, from an index that
     holds nothing to re-use."""
     import shutil
-    from rclverify.crosscheck import stage
+    from rclverify.stages.crosscheck import stage
     nodes = sorted(p.stem for p in (ws / "artifacts/calculus").glob("*.json"))
     out = {}
     real = stage._decide_block

@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import hashlib
 import os
+import threading
 from pathlib import Path
 from typing import Any, Iterable
 
@@ -157,18 +158,18 @@ def _decide_scripts(todo: list[tuple[str, str, bool]], split_min: int) -> list[D
     this process, or, for ``split_min`` scripts or more on a machine that
     gives this process two CPUs and can fork, the second half in a forked
     child beside the first half here (cvc5's Python API holds the GIL, so a
-    thread would not run beside it), unless this process runs other threads.  Each half has its own shared solver
+    thread would not run beside it), unless this process runs other
+    threads.  Each half has its own shared solver
     (:class:`~.cvc5_decide.Session`), whose answers and proofs equal a fresh
     solver's, so the decisions are those of the serial path."""
-    import threading
     half = len(todo) // 2
     # a process with other threads (the live progress line of a serial run on a terminal) is not forked:
-    # a lock one of them holds would stay held in the child (cache/workspace.py forks under the same rule)
+    # a lock one of them holds would stay held in the child (core/cache/workspace.py forks under the same rule)
     if (len(todo) < max(2, split_min) or len(_cpus()) < 2 or not hasattr(os, "fork")
             or threading.active_count() > 1):
         return _decide_block(todo)
-    import multiprocessing
-    from concurrent.futures import ProcessPoolExecutor
+    import multiprocessing  # deferred: optional or conditional (inside a block)
+    from concurrent.futures import ProcessPoolExecutor  # deferred: optional or conditional (inside a block)
     with ProcessPoolExecutor(1, mp_context=multiprocessing.get_context("fork")) as pool:
         second = pool.submit(_in_child, todo[half:])
         first = _decide_block(todo[:half])
