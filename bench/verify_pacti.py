@@ -8,7 +8,9 @@ holds in context (``x_i <= 50 + i``) and none locally; the requirement
 400):
 
 * **rclverify verify** in a fresh workspace, in a child process: CPU
-  seconds (user + system of it and its children), of which ``cvc5 s`` the
+  seconds (user + system of it and its children) and wall-clock seconds
+  (``wall s``; on two CPUs the second solver's stage uses both, issue 67),
+  of which ``cvc5 s`` the
   second solver's own (the seconds cvc5 took per item, issue 50), the side conditions
   discharged locally / in context / otherwise, those in context proved from
   the producers' cone summaries (calculus/summary.py), and SYS's verdict;
@@ -18,7 +20,9 @@ holds in context (``x_i <= 50 + i``) and none locally; the requirement
   composed with ``N0``, ``N1``, ... (bench/compose_pacti.py), CPU seconds,
   and whether it composes the whole chain (the same verdict).
 
-Then the growth per doubling of each column.  ``--src OLD_SRC`` runs
+``ratio`` is verify's CPU over Pacti's, ``wall/p`` its wall clock over
+Pacti's CPU seconds (Pacti runs on one core).  Then the growth per
+doubling of each column.  ``--src OLD_SRC`` runs
 ``rclverify verify`` from another source tree as well (a ``git worktree``
 of the old code), ``--repeat K`` takes the median of K runs.
 
@@ -108,8 +112,10 @@ def whatif(root: Path, off: str) -> float:
 def verify(root: Path, src: Path) -> dict[str, Any]:
     """``rclverify verify`` of ``root`` with the source tree ``src``: CPU and the verdicts."""
     env = dict(os.environ, PYTHONPATH=str(src))
+    t0 = time.perf_counter()
     p = subprocess.run([sys.executable, "-c", PROBE, sys.executable, "-m", "rclverify.cli.commands", "verify", "-w", str(root)],
                        capture_output=True, text=True, env=env)
+    wall = time.perf_counter() - t0
     probe = json.loads(p.stdout)
     rep = json.loads((root / "reports" / "assurance.json").read_text(encoding="utf-8"))
     scs = rep["side_conditions"]
@@ -122,7 +128,7 @@ def verify(root: Path, src: Path) -> dict[str, Any]:
         cvc5 = sum(float((r.get("cvc5") or {}).get("duration_s") or 0) for r in cross.get("items", []))
     except (OSError, ValueError):
         cvc5 = 0.0
-    return {"cpu": probe["cpu"], "rc": probe["rc"], "local": local, "context": context, "other": len(scs) - local - context,
+    return {"cpu": probe["cpu"], "wall": wall, "rc": probe["rc"], "local": local, "context": context, "other": len(scs) - local - context,
             "summaries": summaries, "SYS": str(sys_req.get("verdict") or sys_req.get("status")), "cvc5": cvc5}
 
 
@@ -156,11 +162,11 @@ def main(argv: list[str] | None = None) -> int:
     pc = _pacti()
     sizes = [5] if args.smoke else [int(x) for x in args.sizes.split(",")]
     print(f"CPU seconds, medians of {args.repeat}; {os.cpu_count()} CPU(s); chain with every x_i <= {BOUND}")
-    head = f"{'N':>5} {'verify s':>9} {'cvc5 s':>7} {'local':>5} {'ctx':>5} {'summ':>5} {'SYS':>8}"
+    head = f"{'N':>5} {'verify s':>9} {'wall s':>7} {'cvc5 s':>7} {'local':>5} {'ctx':>5} {'summ':>5} {'SYS':>8}"
     head += f" {'old s':>8}" if args.src else ""
     head += f" {'calc s':>7}" + (f" {'calc full':>9}" if args.full else "")
     head += f" {'no ctx':>7} {'no ctx,cvc5':>11}" if args.floor else ""
-    head += f" {'pacti s':>8} {'ratio':>6}"
+    head += f" {'pacti s':>8} {'ratio':>6} {'wall/p':>6}"
     print(head)
     ok, rows = True, []
     for n in sizes:
@@ -183,15 +189,17 @@ def main(argv: list[str] | None = None) -> int:
         r = runs[0]
         ok = ok and r["rc"] == 0 and r["other"] == 0 and r["context"] == n - 1 and r["SYS"].startswith("proved")
         row = {"n": n, "verify": statistics.median(x["cpu"] for x in runs), "calc": statistics.median(calc),
+               "wall": statistics.median(x["wall"] for x in runs),
                "old": statistics.median(old) if old else None, "full": statistics.median(full) if full else None,
                "pacti": statistics.median(pac) if pac else None,
                "noctx": statistics.median(noctx) if noctx else None, "bare": statistics.median(bare) if bare else None}
         rows.append(row)
-        line = f"{n:5} {row['verify']:9.2f} {r['cvc5']:7.2f} {r['local']:5} {r['context']:5} {r['summaries']:5} {r['SYS'].split(',')[0]:>8}"
+        line = f"{n:5} {row['verify']:9.2f} {row['wall']:7.2f} {r['cvc5']:7.2f} {r['local']:5} {r['context']:5} {r['summaries']:5} {r['SYS'].split(',')[0]:>8}"
         line += f" {row['old']:8.2f}" if args.src else ""
         line += f" {row['calc']:7.2f}" + (f" {row['full']:9.2f}" if args.full else "")
         line += f" {row['noctx']:7.2f} {row['bare']:11.2f}" if args.floor else ""
-        line += (f" {row['pacti']:8.2f} {row['verify'] / row['pacti']:6.2f}" if row["pacti"] else "  (Pacti not installed)")
+        line += (f" {row['pacti']:8.2f} {row['verify'] / row['pacti']:6.2f} {row['wall'] / row['pacti']:6.2f}"
+                 if row["pacti"] else "  (Pacti not installed)")
         print(line, flush=True)
     for a, b in zip(rows, rows[1:]):
         growth = {k: b[k] / a[k] for k in ("verify", "old", "calc", "full", "noctx", "bare", "pacti")

@@ -218,3 +218,14 @@ def test_upstream_masks_are_the_upstream_cones_also_through_loops() -> None:
             cone = [m for m in model.nodes if m in seen]
             assert [m for i, m in enumerate(model.nodes) if masks[n] >> i & 1] == cone
             assert model.upstream(n) == cone
+
+
+def test_the_task_definitions_name_the_stage_records_the_stages_write() -> None:
+    """app/tasks.py names the deadlines' and the second solver's records as
+    text, so that defining the tasks (every doit run, the no-op included)
+    imports neither stage (issue 67: the deadline stage's import loaded Z3):
+    the same paths."""
+    from rclverify.app import tasks
+    from rclverify.stages.crosscheck.stage import INDEX as crosscheck
+    from rclverify.stages.deadlines import INDEX as deadlines
+    assert (tasks.DEADLINES_INDEX, tasks.CROSSCHECK_INDEX) == (deadlines, crosscheck)

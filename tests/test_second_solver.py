@@ -242,3 +242,32 @@ def test_a_shared_session_answers_and_proves_as_fresh_solvers_do(ws: Path) -> No
         every = r["kind"] == "hoare" or (r["kind"] == "health" and r["z3"] == "unsat")
         got, fresh = decide(text, every=every, session=s), decide(text, every=every)
         assert (got.answer, got.proof) == (fresh.answer, fresh.proof) == (r["cvc5"]["answer"], got.proof)
+
+
+def test_the_stage_split_over_two_processes_writes_what_the_serial_stage_writes(
+        ws: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """The stage decides the second half of many scripts in a forked process
+    (issue 67): the same index (but the wall-clock durations) and the same
+    proof files as deciding every script in this process, from an index that
+    holds nothing to re-use."""
+    import shutil
+    from rclverify.stages.crosscheck import stage
+    nodes = sorted(p.stem for p in (ws / "artifacts/calculus").glob("*.json"))
+    out = {}
+    real = stage._decide_block
+    monkeypatch.setattr(stage, "_cpus", lambda: {0, 1})
+    for mode, split_min in (("serial", 10 ** 9), ("split", 1)):
+        root = tmp_path / mode
+        shutil.copytree(ws, root)
+        shutil.rmtree(root / "artifacts/crosscheck")
+        forked: list[int] = []
+        monkeypatch.setattr(stage, "_decide_block", lambda todo: forked.append(len(todo)) or real(todo))
+        index = stage_crosscheck(root, nodes, split_min=split_min)
+        # here: every script, or the first half (the child decides the rest in its copy of the process)
+        assert forked == [len(index["items"]) if mode == "serial" else len(index["items"]) // 2], forked
+        for r in index["items"]:
+            r["cvc5"]["duration_s"] = 0
+        proofs = {p.name: p.read_text() for p in (root / "artifacts/crosscheck/proofs").iterdir()}
+        out[mode] = (index, proofs)
+    assert out["split"] == out["serial"] and out["serial"][1]
+    assert out["serial"][0]["counts"] == {"two solvers": len(out["serial"][0]["items"])}

@@ -101,13 +101,13 @@ def keep_freed_memory() -> bool:
         return _MALLOPT[0]
     ok = False
     try:
-        import ctypes  # deferred: optional or conditional (inside a block)
-        import ctypes.util  # deferred: optional or conditional (inside a block)
-        name = ctypes.util.find_library("c")
-        libc = ctypes.CDLL(name) if name else None
-        mallopt = getattr(libc, "mallopt", None)
-        if mallopt is not None and "glibc" in (os.confstr("CS_GNU_LIBC_VERSION") or "").lower():
-            ok = bool(mallopt(_M_MMAP_THRESHOLD, _MMAP)) and bool(mallopt(_M_TRIM_THRESHOLD, _TRIM))
+        if "glibc" in (os.confstr("CS_GNU_LIBC_VERSION") or "").lower():
+            import ctypes  # deferred: optional or conditional (inside a block)
+            # the process's own symbols, glibc's among them: `ctypes.util.find_library("c")` runs
+            # `ldconfig -p` in a child process (10 ms of every doit run)
+            mallopt = getattr(ctypes.CDLL(None), "mallopt", None)
+            if mallopt is not None:
+                ok = bool(mallopt(_M_MMAP_THRESHOLD, _MMAP)) and bool(mallopt(_M_TRIM_THRESHOLD, _TRIM))
     except (OSError, ValueError, AttributeError):
         ok = False
     _MALLOPT[:] = [ok]

@@ -16,6 +16,8 @@ index when all three are the same: an incremental run equals a clean one.
 from __future__ import annotations
 
 import hashlib
+import os
+import threading
 from pathlib import Path
 from typing import Any, Iterable
 
@@ -71,20 +73,30 @@ def confirm_proof(text: str) -> tuple[str, str]:
     return agreement("unsat", decide(text).row() if version() else None)
 
 
-def stage_crosscheck(root: Path, nodes: Iterable[str]) -> dict[str, Any]:
+#: Scripts to decide from which the stage splits them between two processes (below that, a second
+#: process's start and its own cvc5 solver cost more than it saves).
+SPLIT_MIN = 200
+
+
+def stage_crosscheck(root: Path, nodes: Iterable[str], *, split_min: int = SPLIT_MIN) -> dict[str, Any]:
     """Decide every discharging item of the workspace at ``root`` again
     with cvc5 and write the stage's record (module docstring); returns the
-    index written.  Raises ``OSError`` when a file cannot be written; a
+    index written.  When ``split_min`` or more scripts are not in the last
+    index and the process may run on two CPUs, the second half of them is
+    decided in a forked process beside the first (:func:`_decide_scripts`;
+    every answer and proof is that of a fresh solver, so the index is the
+    same either way).  Raises ``OSError`` when a file cannot be written; a
     script that cannot be read gives the row ``error``."""
     ver = version()
     old, why = read_sealed(root / INDEX, "second-solver record")
     cache = {r["key"]: r["cvc5"] for r in (old or {}).get("items", []) if not why and isinstance(r, dict)
              and isinstance(r.get("cvc5"), dict) and isinstance(r.get("key"), str)}
-    rows: list[dict[str, Any]] = []
     keep: set[str] = set()
-    session = Session() if ver else None
-    for it in discharging_items(root, nodes):
-        rows.append(_row(root, it, ver, cache, keep, session))
+    pending = [_lookup(root, it, ver, cache) for it in discharging_items(root, nodes)]
+    todo = [(text, it.smt2, it.every) for it, row, text, d in pending if ver and d is None and text is not None]
+    decided = iter(_decide_scripts(todo, split_min))
+    rows = [_finish(root, it, row, next(decided) if ver and d is None and text is not None else d, keep)
+            for it, row, text, d in pending]
     index = {"solver": {"name": "cvc5", "version": ver, "rlimit": RLIMIT} if ver else None,
              "counts": _counts(rows), "items": rows}
     write_sealed(root / INDEX, index)
@@ -95,8 +107,12 @@ def stage_crosscheck(root: Path, nodes: Iterable[str]) -> dict[str, Any]:
     return index
 
 
-def _row(root: Path, it: Item, ver: str, cache: dict[str, dict[str, Any]], keep: set[str],
-         session: Session | None = None) -> dict[str, Any]:
+def _lookup(root: Path, it: Item, ver: str, cache: dict[str, dict[str, Any]]
+            ) -> tuple[Item, dict[str, Any], str | None, dict[str, Any] | Decision | None]:
+    """``(item, row, script text, decision)`` of ``it``: the decision kept in
+    the last index under the script's key (``None`` when cvc5 must decide it,
+    or when the script cannot be read: then ``text`` is ``None`` and the row
+    is complete)."""
     row: dict[str, Any] = {"kind": it.kind, "id": it.id, "smt2": it.smt2, "verdict": it.verdict,
                            "z3": it.expects}
     try:
@@ -104,18 +120,26 @@ def _row(root: Path, it: Item, ver: str, cache: dict[str, dict[str, Any]], keep:
     except (OSError, UnicodeDecodeError) as exc:
         row.update(sha256="", key="", cvc5=None, agreement="disagree",
                    why=f"{it.smt2} cannot be read ({exc.__class__.__name__}): the verdict has no query")
-        return row
+        return it, row, None, None
     sha = hashlib.sha256(text.encode("utf-8")).hexdigest()
     key = f"{sha}:{ver}:{RLIMIT}" + (":every" if it.every else "")
     row.update(sha256=sha, key=key)
-    proof_rel = f"{DIR}/proofs/{sha}.proof"
     d = cache.get(key) if ver else None
-    if d is not None and d.get("proof") and not (root / proof_rel).is_file():
+    if d is not None and d.get("proof") and not (root / f"{DIR}/proofs/{sha}.proof").is_file():
         d = None  # its proof is gone: decide again
-    if d is None and ver:
-        dec: Decision = decide(text, it.smt2, every=it.every, session=session)
-        d = dec.row()
+    return it, row, text, d
+
+
+def _finish(root: Path, it: Item, row: dict[str, Any], d: dict[str, Any] | Decision | None,
+            keep: set[str]) -> dict[str, Any]:
+    """The row of ``it`` with cvc5's decision ``d`` (kept, or just made: its
+    proof is written then) and the agreement."""
+    if "agreement" in row:  # the script could not be read
+        return row
+    if isinstance(d, Decision):
+        dec, d = d, d.row()
         if dec.proof:
+            proof_rel = f"{DIR}/proofs/{row['sha256']}.proof"
             atomic_write_text(root / proof_rel, dec.proof)
             d["proof"] = proof_rel
     if d is not None and d.get("proof"):
@@ -127,6 +151,45 @@ def _row(root: Path, it: Item, ver: str, cache: dict[str, dict[str, Any]], keep:
         row["why"] += (" on the witness query: the output terms written out answer every admissible input, which"
                        " implies the contract is realizable")
     return row
+
+
+def _decide_scripts(todo: list[tuple[str, str, bool]], split_min: int) -> list[Decision]:
+    """cvc5's decision of each ``(text, name, every)`` script, in order: in
+    this process, or, for ``split_min`` scripts or more on a machine that
+    gives this process two CPUs and can fork, the second half in a forked
+    child beside the first half here (cvc5's Python API holds the GIL, so a
+    thread would not run beside it), unless this process runs other
+    threads.  Each half has its own shared solver
+    (:class:`~.cvc5_decide.Session`), whose answers and proofs equal a fresh
+    solver's, so the decisions are those of the serial path."""
+    half = len(todo) // 2
+    # a process with other threads (the live progress line of a serial run on a terminal) is not forked:
+    # a lock one of them holds would stay held in the child (core/cache/workspace.py forks under the same rule)
+    if (len(todo) < max(2, split_min) or len(_cpus()) < 2 or not hasattr(os, "fork")
+            or threading.active_count() > 1):
+        return _decide_block(todo)
+    import multiprocessing  # deferred: optional or conditional (inside a block)
+    from concurrent.futures import ProcessPoolExecutor  # deferred: optional or conditional (inside a block)
+    with ProcessPoolExecutor(1, mp_context=multiprocessing.get_context("fork")) as pool:
+        second = pool.submit(_in_child, todo[half:])
+        first = _decide_block(todo[:half])
+        return first + second.result()
+
+
+def _cpus() -> set[int]:
+    getter = getattr(os, "sched_getaffinity", None)
+    return set(getter(0)) if getter is not None else set(range(os.cpu_count() or 1))
+
+
+def _in_child(todo: list[tuple[str, str, bool]]) -> list[Decision]:
+    """:func:`_decide_block` in the forked child (named here, not passed: the pool pickles what it runs)."""
+    return _decide_block(todo)
+
+
+def _decide_block(todo: list[tuple[str, str, bool]]) -> list[Decision]:
+    """The decisions of ``todo`` (:func:`_decide_scripts`) in one session of this process."""
+    session = Session()
+    return [decide(text, name, every=every, session=session) for text, name, every in todo]
 
 
 def _counts(rows: list[dict[str, Any]]) -> dict[str, int]:
