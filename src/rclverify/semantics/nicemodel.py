@@ -32,8 +32,6 @@ from fractions import Fraction
 from typing import Any, Mapping, Sequence
 
 import z3
-from rclverify.semantics.query import steps
-from rclverify.semantics.query import render_model
 
 #: Decimal places a value may have and still count as short.
 SHORT_DIGITS = 3
@@ -91,6 +89,7 @@ def candidates(v: Fraction) -> list[Fraction]:
 
 
 def _solver(ctx: z3.Context) -> z3.Solver:
+    from rclverify.semantics.query import steps
     s = z3.Solver(ctx=ctx)
     s.set("rlimit", steps(BUDGET_MS))
     s.set("timeout", BUDGET_MS * 10)
@@ -136,6 +135,7 @@ def nicer_model(formulas: Sequence[z3.BoolRef], enc: Any, model: Mapping[str, st
     ``assumptions`` labelled formulas to keep when they can hold.  Returns a
     :class:`Nicer`; never raises on solver trouble (the caller's model is
     kept)."""
+    from rclverify.semantics.query import render_model
     keep = Nicer(dict(model))
     if not formulas:
         return keep
