@@ -38,8 +38,6 @@ import itertools
 from typing import Union
 
 from rclverify.lang import ast
-from rclverify.lang.errors import RclError
-from rclverify.lang.parser import parse_formula
 
 #: Precedence level of each binary operator (higher binds tighter).
 BINARY_LEVEL: dict[str, int] = {
@@ -163,6 +161,8 @@ MINIMAL_CHAIN_MAX = 12
 
 def _reads_back(text: str, e: ast.Expr) -> bool:
     """Whether ``text`` parses to ``e`` (AST equality ignores parentheses and locations)."""
+    from rclverify.lang.errors import RclError
+    from rclverify.lang.parser import parse_formula
     try:
         return parse_formula(text) == e
     except (RclError, RecursionError):

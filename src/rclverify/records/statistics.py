@@ -28,7 +28,6 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from typing import Any, Iterable, Mapping, Protocol
-from scipy.stats import beta
 
 #: What a target counts: a whole run with any violation, or one judged answer.
 PER = ("run", "answer")
@@ -48,6 +47,7 @@ def upper_bound(k: int, n: int, level: float) -> float:
         return 1.0
     if k == 0:  # closed form, exact in floating point where beta.ppf rounds
         return 1.0 - math.pow(1.0 - level, 1.0 / n)
+    from scipy.stats import beta  # here, not at import: scipy.stats costs every plan load 0.3 s (issue 67)
     return float(beta.ppf(level, k + 1, n - k))
 
 
@@ -58,6 +58,7 @@ def lower_bound(k: int, n: int, level: float) -> float:
         return 0.0
     if k >= n:
         return math.pow(1.0 - level, 1.0 / n)
+    from scipy.stats import beta
     return float(beta.ppf(1.0 - level, k, n - k + 1))
 
 

@@ -10,14 +10,14 @@ import textwrap
 from typing import Mapping
 
 from rclverify.backends.experiment.figures import BASE, Figures, Quantity
-import matplotlib
-import matplotlib.pyplot as plt
 
 
 def render_svg(fig: Figures, constants: Mapping[str, Quantity], title: str) -> str:
     """The SVG text: per-trial values (or, for a summary, best/mean +- std/worst)
     with a horizontal line for every constant of the measured dimension."""
+    import matplotlib
     matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
     unit = BASE.get(fig.dim, "")
     with matplotlib.rc_context({"svg.hashsalt": "rclverify", "svg.fonttype": "none", "font.size": 9}):
         f, ax = plt.subplots(figsize=(6.4, 3.6))

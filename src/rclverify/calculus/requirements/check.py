@@ -61,10 +61,6 @@ from rclverify.lang.printer import expr_to_rcl
 from rclverify.lang.types import Checked, CheckedNode
 from rclverify.lang.walk import subexpressions
 from rclverify.model.system.model import SystemModel
-from rclverify.model.plan.ranking import parse_hints
-from rclverify.model.plan.state import state_types
-from rclverify.model.plan.temporal import operands, parse_temporal
-from rclverify.lang.walk import free_names
 
 NEGATED = "negated requirement"
 #: The first attempt's budget of the consistency and vacuity queries, which
@@ -109,6 +105,9 @@ def statement_formals(req: Requirement, checked: Checked, plan: Plan) -> list[An
     each with ``nodes``; ``[]`` for an informal requirement."""
     if req.formal is None:
         return []
+    from rclverify.model.plan.ranking import parse_hints
+    from rclverify.model.plan.state import state_types
+    from rclverify.model.plan.temporal import operands, parse_temporal
     stypes = state_types(plan.states, checked)
     t = parse_temporal(req.formal, checked, f"{req.id} formal", stypes)
     hints = [h for h in parse_hints(req.ranking, req.invariant, t, checked, req.id, stypes) if h is not None]
@@ -147,6 +146,7 @@ def fingerprint(req: Requirement, cone_snapshots: Sequence[str], model_json: str
 
 def _io_symbols(e: ast.Expr, cn: CheckedNode, enc: Encoder) -> set[str]:
     """The Z3 symbol names of the I/O variables formula ``e`` of ``cn`` mentions (bound names excluded)."""
+    from rclverify.lang.walk import free_names
     free = free_names(e)
     out = set()
     for v in subexpressions(e):
@@ -193,7 +193,7 @@ def check_requirement(req: Requirement, checked: Checked, model: SystemModel, pl
         "traced": [{"node": s.node, "guarantee": k} for s in req.support for k in s.guarantees],
     }
     if req.formal is not None and plan is not None:
-        from rclverify.calculus.requirements.temporal_check import check_temporal, is_temporal  # deferred: optional or conditional (inside a block)
+        from rclverify.calculus.requirements.temporal_check import check_temporal, is_temporal
         if is_temporal(req, checked, plan):  # over the composed system's runs (calculus/requirements/temporal_check.py)
             return check_temporal(req, checked, model, plan, base)
     formal, assuming = formals_of(req, checked)
@@ -274,7 +274,7 @@ def check_requirement(req: Requirement, checked: Checked, model: SystemModel, pl
         mentioned = {enc.symbol_name(n, p, v) for f in (formal,) for n, p, v in f.mentions}
         hit = [lbl for lbl, syms in g_symbols.items() if syms & mentioned]
         first = [l for l in hit if l in traced] or hit
-        from rclverify.calculus.requirements.readable import readable_counterexample  # within the assumptions, short values (issue 48); deferred: optional or conditional (inside a block)
+        from rclverify.calculus.requirements.readable import readable_counterexample  # within the assumptions, short values (issue 48)
         shown, note = readable_counterexample(labelled, r.model or {}, cone, checked, model, enc)
         out.update(verdict="refuted", counterexample=_counterexample(shown, cone, checked, enc),
                    failed_to_prevent=[by_label[l] for l in first], **note)

@@ -48,7 +48,6 @@ from typing import Any, Callable, Mapping, Sequence
 
 from rclverify.records.records import worst
 from rclverify.records.statuses import REQUIREMENT_VERDICTS
-from rclverify.calculus.requirements.declared_proof import initial_support, node_of, progress_labels
 
 MET = "met"
 OUTSTANDING = "proved, evidence outstanding"
@@ -98,6 +97,7 @@ def declaration_statuses(records: Mapping[str, Sequence[tuple[str, Sequence[Mapp
     ``initially`` on the other ``initially`` clauses Z3 shows entail it;
     without it, ``progress`` is the worst of its declarations.  No row at
     all: ``("pending", "declared, not verified")``."""
+    from rclverify.calculus.requirements.declared_proof import initial_support, node_of, progress_labels
 
     def status(node: str, kind: str, index: int) -> tuple[str, str]:
         per: dict[str, list[str]] = {}

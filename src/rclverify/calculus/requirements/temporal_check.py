@@ -64,8 +64,6 @@ from rclverify.calculus.requirements.lasso_confirm import confirm_lasso
 from rclverify.calculus.requirements.initial_needed import initially_not_needed
 from rclverify.calculus.requirements.progress_gap import EVEN_SO, explain_idle, stuck_in_loop, stuck_words
 from rclverify.calculus.requirements.transition import ComposedSystem, build_system, variable_types
-from rclverify.semantics.encode import Encoder
-from rclverify.lang.types import FuncT
 
 #: The bound of BMC for an unbounded ``eventually`` and of k-induction's k.
 DEFAULT_BOUND = 10
@@ -173,7 +171,7 @@ def _decide(t: Temporal, sys: ComposedSystem, pred: Callable[[Formal], Callable[
     if kind == "always":
         return prove_always(ts, pred(t.args[0]), max_k=bound, timeout_ms=timeout_ms, hint=hint)
     if kind == "response":  # always (P -> eventually[<= N] Q) / always (P -> next Q): calculus/requirements/response.py
-        from rclverify.calculus.requirements.response import check_response, check_unbounded_response  # deferred: optional or conditional (inside a block)
+        from rclverify.calculus.requirements.response import check_response, check_unbounded_response
         p, r = t.args[0].args  # type: ignore[union-attr]
         if r.op == "eventually" and r.bound is None:  # type: ignore[union-attr]
             return check_unbounded_response(ts, got(p), got(r.args[0]), max_k=bound,  # type: ignore[arg-type, union-attr]
@@ -228,6 +226,7 @@ def check_temporal(req: Requirement, checked: Checked, model: SystemModel, plan:
     ``base`` the fields :func:`.check.check_requirement` fills for every
     requirement.  Raises :class:`RclError` for a statement that does not
     check; never raises on solver trouble."""
+    from rclverify.semantics.encode import Encoder
     t0 = time.perf_counter()
     t = statement(req, checked, plan)
     shape(t, req.formal.loc if req.formal else req.loc)
@@ -289,6 +288,7 @@ def check_temporal(req: Requirement, checked: Checked, model: SystemModel, plan:
         ranking = (lambda s: enc.term(rank.expr, rank.scope, sys.statement_symbols(s))) if rank is not None else None
         inv_pred = raw(inv) if inv is not None else None
         missing: dict[str, Any] = {}
+        from rclverify.lang.types import FuncT
         v = decide(t, sys, pred, bound=bound, timeout_ms=timeout_ms, tables=tables, ranking=ranking,
                    invariant=inv_pred, checked=checked, gaps=missing,
                    tables_first=any(isinstance(ty, FuncT) for ty in types.values()), reach=reach,

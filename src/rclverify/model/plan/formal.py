@@ -31,8 +31,6 @@ from typing import Any, Mapping
 from rclverify.lang import ast
 from rclverify.lang.errors import RclError, error
 from rclverify.lang.types import BOOL, Checked, CheckedNode, Type
-from rclverify.lang.parser import parse_formula
-from rclverify.lang.typecheck import infer
 
 #: ``Node.in.x`` / ``Node.out.y`` (primes allowed, as in RCL names).
 QUALIFIED = re.compile(r"(?<![A-Za-z0-9_.'])([A-Za-z_][A-Za-z0-9_]*)\.(in|out|state)\.([A-Za-z_][A-Za-z0-9_]*'*)")
@@ -129,6 +127,8 @@ def read_expr(src: Source, checked: Checked, what: str = "requirement",
     a formula but of any type: returns ``(expr, scope, mentions, type)``
     with the fields of :class:`Formal` and the inferred type.  Raises
     :class:`RclError` with located diagnostics (as :func:`parse_formal`)."""
+    from rclverify.lang.parser import parse_formula
+    from rclverify.lang.typecheck import infer
     diags = []
     names: dict[str, str] = {}  # placeholder -> Node.in.x
     mentions: dict[tuple[str, str, str], None] = {}

@@ -35,7 +35,6 @@ from pathlib import Path
 from typing import Any, Callable, Sequence
 
 from rclverify.lang.errors import RclError
-from rclverify.model.plan.load import load_plan, read_plan_data, resolve
 
 
 @dataclass
@@ -83,6 +82,7 @@ def group_files(files: Sequence[str], workspace: str = ".", plan_rel: str = "con
     if found is None:
         return Scopes([Scope(files)])
     root, rel = found
+    from rclverify.model.plan.load import read_plan_data
     shown = str(root / rel)
     try:
         data, _ = read_plan_data(root, rel)
@@ -124,6 +124,7 @@ def plan_diagnostics(files: Sequence[str], checked: object, workspace: str = "."
     if found is None:
         return [], ""
     root, rel = found
+    from rclverify.model.plan.load import load_plan, read_plan_data, resolve
     try:
         data, _ = read_plan_data(root, rel)
     except RclError:

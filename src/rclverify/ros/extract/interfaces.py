@@ -24,8 +24,6 @@ from typing import Any, Iterable
 
 from rclverify.ros.extract.cache import ParseCache
 from rclverify.ros.extract.model import Note, Src
-from rclverify.ros.extract.cmake import expand
-from rosbags.typesys import get_types_from_idl, get_types_from_msg
 
 DEBIAN_SHARE = Path("/usr/share")
 BASE_TYPES = {"bool", "byte", "char", "int8", "uint8", "int16", "uint16", "int32", "uint32", "int64",
@@ -95,6 +93,7 @@ def generated_interfaces(root: Path, pkg: str) -> list[Path]:
     file is absent or unreadable.  Source: rosidl_cmake's
     ``rosidl_generate_interfaces`` (its arguments after the target are
     interface files relative to the package, up to the first keyword)."""
+    from rclverify.ros.extract.cmake import expand
     try:
         text = safefs.read_bytes(root / "CMakeLists.txt").decode("utf-8", errors="replace")
     except OSError:
@@ -116,6 +115,7 @@ def generated_interfaces(root: Path, pkg: str) -> list[Path]:
 
 
 def _parse_one(kind: str, text: str, name: str) -> dict[str, Any]:
+    from rosbags.typesys import get_types_from_idl, get_types_from_msg
     if kind == "idl":
         return dict(get_types_from_idl(text))
     if kind == "msg":
@@ -222,7 +222,7 @@ class TypeTable:
 
     def _fallback(self, name: str) -> TypeInfo | None:
         if self._store is None:
-            from rosbags.typesys import Stores, get_typestore  # deferred: optional or conditional (inside a block)
+            from rosbags.typesys import Stores, get_typestore
             self._store = get_typestore(Stores.ROS2_HUMBLE)
         fd = self._store.fielddefs.get(name)
         if fd is None:

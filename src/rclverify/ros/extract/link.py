@@ -41,7 +41,6 @@ from rclverify.ros.extract.link_returns import Returns
 from rclverify.ros.extract.link_values import MAX_DEPTH, MAX_VALUES, Values
 from rclverify.ros.extract.programs import PackageCode, Program
 from rclverify.ros.extract.unit_names import canonical
-from rclverify.ros.extract.sources_py import _typed
 
 __all__ = ["Linked", "Linker", "MAX_DEPTH", "MAX_VALUES"]
 _IDENT = re.compile(r"[A-Za-z_][\w:]*")
@@ -442,6 +441,7 @@ class Linker(LinkMembers, Values, Returns):
 
 def _py_typed(v: Any, kind: str) -> str | None:
     """The ROS type a Python value names (``("ext", "std_srvs.srv.Trigger")``) for role ``kind``."""
+    from rclverify.ros.extract.sources_py import _typed
     return _typed(v[1], kind) if v is not None and v[0] == "ext" and isinstance(v[1], str) else None
 
 

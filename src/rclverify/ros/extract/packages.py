@@ -15,7 +15,6 @@ from pathlib import Path
 
 from rclverify.ros.extract.model import Note, Src
 from rclverify.ros.extract.xmlsrc import parse_xml
-from catkin_pkg.package import InvalidPackage, parse_package_string
 
 _SKIP_DIRS = {"build", "devel", "install", "log", ".git", "__pycache__"}
 _IGNORE_FILES = ("CATKIN_IGNORE", "COLCON_IGNORE", "AMENT_IGNORE")
@@ -64,6 +63,7 @@ def find_manifests(paths: list[Path], skipped: list[str] | None = None) -> list[
 
 def read_package(manifest: Path, shown: str) -> tuple[Package | None, list[Note]]:
     """The package ``manifest`` describes, or ``None`` and a located error."""
+    from catkin_pkg.package import InvalidPackage, parse_package_string
     root, note = parse_xml(manifest, shown)
     if note is not None:
         return None, [note]

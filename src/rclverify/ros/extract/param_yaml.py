@@ -36,9 +36,6 @@ from typing import Any, Callable, Union
 
 from rclverify.ros.extract import names, safefs
 from rclverify.ros.extract.model import Endpoint, Note, Src
-import yaml
-from rclverify.model.plan.errors import PlanError
-from rclverify.model.plan.yamlguard import compose_guarded
 
 Value = Union[str, tuple[str, ...]]  # a string, or a string array
 DIRS = ("config", "params", "param")  # where packages keep their parameter files
@@ -49,7 +46,10 @@ def read_file(text: str, shown: str) -> tuple[list[tuple[str, str, Value, Src]],
     """``([(node pattern, "~key", value, where), ...], notes)`` of one parameter file's
     text.  Never raises: malformed YAML, or YAML over the limits of
     :mod:`rclverify.model.plan.yamlguard`, is one ``ROS-PARSE`` warning."""
+    import yaml
 
+    from rclverify.model.plan.errors import PlanError
+    from rclverify.model.plan.yamlguard import compose_guarded
     try:
         root = compose_guarded(text, shown)
     except yaml.YAMLError as exc:
@@ -65,6 +65,7 @@ def read_file(text: str, shown: str) -> tuple[list[tuple[str, str, Value, Src]],
 
 
 def _nodes(m: Any, prefix: str, shown: str, out: list[tuple[str, str, Value, Src]]) -> None:
+    import yaml
     for k, v in m.value:
         if not isinstance(k, yaml.ScalarNode) or not isinstance(v, yaml.MappingNode):
             continue
@@ -76,6 +77,7 @@ def _nodes(m: Any, prefix: str, shown: str, out: list[tuple[str, str, Value, Src
 
 
 def _params(m: Any, key: str, node: str, shown: str, out: list[tuple[str, str, Value, Src]]) -> None:
+    import yaml
     for k, v in m.value:
         if not isinstance(k, yaml.ScalarNode):
             continue

@@ -8,12 +8,12 @@ from typing import Any
 
 from rclverify.ros.extract import safefs
 from rclverify.ros.extract.model import Note, Src
-from lxml import etree
 
 
 def parse_xml(path: Path, shown: str) -> tuple[Any | None, Note | None]:
     """The root element of ``path``, or ``(None, note)`` with a located
     ``ROS-PARSE`` error when the file is not well-formed XML or unreadable."""
+    from lxml import etree
     parser = etree.XMLParser(resolve_entities=False, no_network=True, huge_tree=False, remove_comments=True)
     try:
         data = safefs.read_bytes(path)

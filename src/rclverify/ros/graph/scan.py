@@ -35,7 +35,6 @@ from rclverify.ros.extract.param_yaml import PackageParams, expand_each
 from rclverify.ros.extract.packages import Package, find_manifests, read_package
 from rclverify.ros.extract.sources_cpp import scan_cpp
 from rclverify.ros.extract.sources_py import scan_python
-from rclverify.ros.extract.interfaces import DEBIAN_SHARE
 
 _CPP = {".cpp", ".cc", ".cxx", ".hpp", ".h", ".hh"}
 _SKIP_DIRS = {"build", "devel", "install", "log", "test", "tests", "launch", "msg", "srv", "action", "__pycache__"}
@@ -120,6 +119,7 @@ def scan(paths: Sequence[Path], launch: Sequence[Path] = (), launch_args: dict[s
     current directory). Never raises on bad input: unreadable files become
     located notes (``ROS-PARSE`` errors) in ``graph.notes``.
     """
+    from rclverify.ros.extract.interfaces import DEBIAN_SHARE
     # Reads are confined to the workspace (``base``, else the scanned paths
     # and entry launch files as given): links leaving it are skipped (docs/ros.md).
     tops = [base] if base is not None else [*paths, *(Path(lf).parent for lf in launch)]
@@ -309,7 +309,7 @@ def _scan(paths: Sequence[Path], launch: Sequence[Path], launch_args: dict[str, 
     made = {e.src for n in g.nodes.values() for r in ("pub", "sub") + SERVICE_ROLES for e in n.edges_of(r)}
     g.notes = [n for n in g.notes if not (n.message.endswith(UNBUILT) and n.src in made)]  # another program makes it
     for b in bags:
-        from rclverify.ros.graph.bag import bag_topics  # deferred: optional or conditional (inside a block)
+        from rclverify.ros.graph.bag import bag_topics
         recorded, notes = bag_topics(Path(b), show(Path(b)))
         g.notes.extend(notes)
         if recorded is not None:

@@ -30,7 +30,6 @@ from rclverify.ros.extract import names
 from rclverify.ros.extract.interfaces import TypeTable
 from rclverify.ros.extract.model import Graph, GraphEdge, GraphNode, Src, canon_type, short_type
 from rclverify.ros.ground.lifecycle import implicit
-from rclverify.ros.live.master import fold_actions
 
 #: rule id -> (severity, description), merged into ``ground.RULES`` (SARIF rules)
 RULES: dict[str, tuple[str, str]] = {}
@@ -53,6 +52,7 @@ def folded(g: Graph) -> Graph:
     """``g`` with actions written on their raw actionlib topics folded into action
     servers/clients (:func:`rclverify.ros.live.master.fold_actions`); ``g`` itself when
     it has none (no copy), else a copy (``g`` is left as it is)."""
+    from rclverify.ros.live.master import fold_actions
     if not any(e.topic.endswith("/goal") and (e.msg_type or "").endswith("ActionGoal")
                for n in g.nodes.values() for e in n.publishes + n.subscribes):
         return g

@@ -45,16 +45,6 @@ import os
 import struct
 from dataclasses import dataclass, field
 from typing import Any, Iterable, Mapping
-from cyclonedds.core import DDSException
-from cyclonedds.domain import Domain
-from cyclonedds.domain import DomainParticipant
-from cyclonedds.idl import make_idl_struct
-from cyclonedds.idl import types as T
-from cyclonedds._clayer import ddspy_take
-from cyclonedds.core import InstanceState, SampleState, ViewState
-from cyclonedds._clayer import ddspy_write, ddspy_write_ts
-from rosbags.typesys import Stores, get_typestore
-from rclverify.ros.live.type_hash import rihs01
 
 #: The highest ROS_DOMAIN_ID usable on Linux (ROS 2 documentation, "The ROS_DOMAIN_ID").
 MAX_DOMAIN_ID = 232
@@ -74,8 +64,8 @@ class DdsUnavailable(Exception):
 def import_cyclonedds() -> Any:
     """The ``cyclonedds`` package; raises :class:`DdsUnavailable` with the remedy."""
     try:
-        import cyclonedds  # deferred: optional or conditional (inside a block)
-        import cyclonedds.domain  # noqa: F401  (loads the C library: fails here when it cannot); deferred: optional or conditional (inside a block)
+        import cyclonedds
+        import cyclonedds.domain  # noqa: F401  (loads the C library: fails here when it cannot)
         return cyclonedds
     except ImportError as exc:
         raise DdsUnavailable(f"the cyclonedds Python binding is not installed ({exc}); pip install "
@@ -119,6 +109,8 @@ def configure_domain(d: int) -> None:
     """Create domain ``d`` with the user's configuration (``CYCLONEDDS_URI``: files and XML fragments, comma
     separated, as Cyclone reads it) followed by :data:`COMPATIBILITY`; a domain this process already has
     (made here or by the caller) is left as it is."""
+    from cyclonedds.core import DDSException
+    from cyclonedds.domain import Domain
     if d in _domains:
         return
     user = os.environ.get("CYCLONEDDS_URI", "").strip().strip(",")
@@ -134,6 +126,8 @@ def make_participant(domain: int | None = None) -> Any:
     by ``CYCLONEDDS_URI`` and :data:`COMPATIBILITY`.  Raises :class:`DdsUnavailable`
     when Cyclone refuses (a configuration file that does not parse, no usable interface)."""
     import_cyclonedds()
+    from cyclonedds.core import DDSException
+    from cyclonedds.domain import DomainParticipant
     d = domain_id() if domain is None else domain
     try:
         configure_domain(d)
@@ -342,6 +336,8 @@ def discovery_struct() -> Any:
     flag on its sequence and array elements) is ignored by the participant
     (:data:`COMPATIBILITY`).  The samples are read raw, in either layout."""
     import_cyclonedds()
+    from cyclonedds.idl import make_idl_struct
+    from cyclonedds.idl import types as T
     gid16: Any = T.array[T.uint8, 16]  # type: ignore[misc]
     gid = make_idl_struct("Gid_", "rmw_dds_common::msg::dds_::Gid_", {"data": gid16})
     node = make_idl_struct("NodeEntitiesInfo_", "rmw_dds_common::msg::dds_::NodeEntitiesInfo_", {
@@ -357,9 +353,11 @@ def take_raw(reader: Any, n: int = 256) -> list[tuple[bytes, Any]]:
     """Up to ``n`` samples of ``reader`` as ``(serialized bytes, sample info)``
     (the bytes with their encapsulation header; samples without data, a
     writer gone, are skipped)."""
+    from cyclonedds._clayer import ddspy_take
+    from cyclonedds.core import InstanceState, SampleState, ViewState
     ret = ddspy_take(reader._ref, SampleState.Any | ViewState.Any | InstanceState.Any, n)
     if isinstance(ret, int):
-        from cyclonedds.core import DDSException  # deferred: optional or conditional (inside a block)
+        from cyclonedds.core import DDSException
         raise DDSException(ret, "take")
     return [(bytes(data), info) for data, info in ret if info.valid_data]
 
@@ -367,15 +365,17 @@ def take_raw(reader: Any, n: int = 256) -> list[tuple[bytes, Any]]:
 def write_raw(writer: Any, data: bytes, timestamp_ns: int | None = None) -> None:
     """Write serialized bytes (encapsulation header included) as one sample,
     with ``timestamp_ns`` as its source timestamp when given."""
+    from cyclonedds._clayer import ddspy_write, ddspy_write_ts
     data = data.ljust((len(data) + 3) & ~3, b"\0")
     ret = ddspy_write(writer._ref, data) if timestamp_ns is None else ddspy_write_ts(writer._ref, data, timestamp_ns)
     if ret < 0:
-        from cyclonedds.core import DDSException  # deferred: optional or conditional (inside a block)
+        from cyclonedds.core import DDSException
         raise DDSException(ret, "write")
 
 
 @functools.lru_cache(maxsize=1)
 def _humble() -> Any:
+    from rosbags.typesys import Stores, get_typestore
     return get_typestore(Stores.ROS2_HUMBLE)
 
 
@@ -384,6 +384,7 @@ def type_hash_user_data(ros_type_name: str, store: Any = None) -> bytes:
     newer announce it (the REP-2011 type hash, :func:`.type_hash.rihs01`, over
     the definitions of rosbags' type ``store``, ROS 2 Humble's by default);
     empty when the store does not know the type."""
+    from rclverify.ros.live.type_hash import rihs01
     if store is None:
         store = _humble()
     defs = store.fielddefs

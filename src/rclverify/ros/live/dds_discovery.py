@@ -21,10 +21,6 @@ from typing import Any
 
 from rclverify.ros.live.dds import DISCOVERY_TOPIC, NodeInfo, decode_participant_info, discovery_struct, take_raw
 from rclverify.ros.live.dds_qos import QosProfile, from_dds, to_dds
-from cyclonedds.builtin import BuiltinDataReader, BuiltinTopicDcpsParticipant, BuiltinTopicDcpsPublication, BuiltinTopicDcpsSubscription
-from cyclonedds.sub import DataReader
-from cyclonedds.topic import Topic
-from cyclonedds.core import InstanceState, ReadCondition, SampleState, ViewState
 
 ALIVE = 16  # DDS_ALIVE_INSTANCE_STATE
 
@@ -63,6 +59,10 @@ class Discovery:
     bad_info: int = 0
 
     def __post_init__(self) -> None:
+        from cyclonedds.builtin import (BuiltinDataReader, BuiltinTopicDcpsParticipant,
+                                        BuiltinTopicDcpsPublication, BuiltinTopicDcpsSubscription)
+        from cyclonedds.sub import DataReader
+        from cyclonedds.topic import Topic
         self.own.add(self.dp.guid.bytes)
         self._pubs = BuiltinDataReader(self.dp, BuiltinTopicDcpsPublication)
         self._subs = BuiltinDataReader(self.dp, BuiltinTopicDcpsSubscription)
@@ -73,6 +73,7 @@ class Discovery:
 
     def conditions(self) -> list[Any]:
         """Read conditions that trigger when discovery has news (for a wait set)."""
+        from cyclonedds.core import InstanceState, ReadCondition, SampleState, ViewState
         mask = SampleState.Any | ViewState.Any | InstanceState.Any
         return [ReadCondition(r, mask) for r in (self._pubs, self._subs, self._info, self._parts)]
 

@@ -25,7 +25,6 @@ from __future__ import annotations
 from dataclasses import dataclass, field, replace
 from fnmatch import fnmatchcase
 from typing import Any, Iterable
-from cyclonedds.core import Policy, Qos
 
 INFINITE_NS = 0x7FFFFFFFFFFFFFFF
 DURABILITY = ("volatile", "transient_local", "transient", "persistent")
@@ -121,6 +120,7 @@ def from_dds(qos: Any) -> QosProfile:
 
 def to_dds(q: QosProfile, user_data: bytes = b"") -> Any:
     """A cyclonedds ``Qos`` with these policies (and ``user_data`` when given)."""
+    from cyclonedds.core import Policy, Qos
     pol: list[Any] = [
         Policy.Reliability.Reliable(max_blocking_time=100_000_000) if q.reliable else Policy.Reliability.BestEffort,
         {"volatile": Policy.Durability.Volatile, "transient_local": Policy.Durability.TransientLocal,

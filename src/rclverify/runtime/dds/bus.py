@@ -48,11 +48,6 @@ from rclverify.ros.live.dds import take_raw
 from rclverify.ros.live.dds_discovery import Discovery
 from rclverify.ros.live.dds_qos import QosProfile, from_dds, mismatches, reader_for, to_dds
 from rclverify.runtime.dds.layout import OTHER, PENDING, LayoutJudge
-from cyclonedds.core import WaitSet
-from cyclonedds.pub import DataWriter
-from cyclonedds.topic import Topic
-from cyclonedds.core import InstanceState, ReadCondition, SampleState, ViewState
-from cyclonedds.sub import DataReader
 
 #: Seconds a warning about a publication waits for ros_discovery_info to name its node (a ROS 2 node
 #: announces itself after its endpoints are discovered); past it, the participant's id is named.
@@ -96,6 +91,7 @@ class Bus:
                  warn: Callable[[str], None], period_s: float = 0.05,
                  on_reader: Callable[[Tap, list[Any]], None] | None = None,
                  type_hash: Callable[[type], str | None] | None = None) -> None:
+        from cyclonedds.core import WaitSet
         self.dp, self.on_sample, self.warn, self.period_s = dp, on_sample, warn, period_s
         self.on_reader = on_reader
         self.layouts = LayoutJudge(dp, type_hash or (lambda struct: None))
@@ -133,6 +129,8 @@ class Bus:
 
     def writer(self, dds_topic: str, struct: type, qos: QosProfile, user_data: bytes = b"") -> Any:
         """A writer of the monitor on ``dds_topic``."""
+        from cyclonedds.pub import DataWriter
+        from cyclonedds.topic import Topic
         return DataWriter(self.dp, Topic(self.dp, dds_topic, struct), qos=to_dds(qos, user_data))
 
     def start(self) -> Bus:
@@ -180,6 +178,9 @@ class Bus:
 
     def _update(self) -> None:
         """Make or remake each tap's reader for the publishers discovered now; warn."""
+        from cyclonedds.core import InstanceState, ReadCondition, SampleState, ViewState
+        from cyclonedds.sub import DataReader
+        from cyclonedds.topic import Topic
         disc = self.discovery
         self._pending = False
         for t in self.taps:

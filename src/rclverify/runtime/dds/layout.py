@@ -31,8 +31,6 @@ from __future__ import annotations
 import time
 import typing
 from typing import Any, Callable
-from rclverify.ros.live.dds import announced_type_hash
-from cyclonedds.dynamic import get_types_for_typeid
 
 SAME, OTHER, PENDING = "same", "other", "pending"
 #: seconds a type identifier may stay unresolved (type lookup under way); past it, Cyclone's own
@@ -119,6 +117,7 @@ class LayoutJudge:
         """``(SAME | OTHER | PENDING, reason)`` for a publisher announcing
         ``type_id`` (``None``: none) and ``user_data``; ``reason`` names the
         field that differs, or the hashes."""
+        from rclverify.ros.live.dds import announced_type_hash
         if type_id is not None:
             return self._by_type_object(struct, type_id)
         theirs = announced_type_hash(user_data)
@@ -148,6 +147,7 @@ class LayoutJudge:
         resolved within the timeout)."""
         if type_id in self._shapes:
             return self._shapes[type_id]
+        from cyclonedds.dynamic import get_types_for_typeid
         try:
             cls, _deps = get_types_for_typeid(self.dp, type_id, int(self.timeout_s * 1e9))
         except Exception:  # noqa: BLE001 - not resolved yet (type lookup under way), or a kind the binding lacks

@@ -47,9 +47,6 @@ from rclverify.runtime.dds.wire import WriterIds
 from rclverify.runtime.live import VERDICT_LOG_TOPIC, LiveRun, dumps, stop_and_record
 from rclverify.runtime.ros1 import contract_topics
 from rclverify.runtime.worker import EngineWorker
-from rclverify.runtime.dds.bag import BagError
-from rclverify.runtime.dds.bus import Bus
-from rclverify.runtime.dds.trust import VERDICT_KEY, downgrade
 
 
 class _Sink:
@@ -97,6 +94,7 @@ def run_dds(run_factory: Callable[..., LiveRun], checked: Checked, nodes: list[C
     storage)``.  Raises :class:`~rclverify.ros.live.dds.DdsUnavailable` (the
     binding, the domain, a type that cannot be made, a bag that cannot be
     created: one message)."""
+    from rclverify.runtime.dds.bag import BagError
     try:
         types = TypeBook(type_dirs)
         string = types.message("std_msgs/String")
@@ -134,6 +132,8 @@ def run_dds(run_factory: Callable[..., LiveRun], checked: Checked, nodes: list[C
         warnings.append(text)
         out(text)
 
+    from rclverify.runtime.dds.bus import Bus
+    from rclverify.runtime.dds.trust import VERDICT_KEY, downgrade
     worker_box: list[EngineWorker] = []
     republish: dict[str, Any] = {}
 

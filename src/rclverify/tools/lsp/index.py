@@ -25,7 +25,6 @@ from typing import Any, Iterator
 from rclverify.lang import ast
 from rclverify.tools.lsp.diagnostics import Analysis
 from rclverify.tools.lsp.lines import normalize, split_lines
-import bisect
 
 _WORD = re.compile(r"(?<![\w.])(?:in|out|state)\.[A-Za-z_]\w*'*|[A-Za-z_]\w*(?:\.(?:in|out|state)\.[A-Za-z_]\w*'*)?'*")
 _COMMENTS = re.compile(r"//[^\n]*|/\*.*?(?:\*/|\Z)", re.S)
@@ -181,6 +180,7 @@ def occurrences(text: str, name: str, yaml: bool = False) -> Iterator[tuple[int,
     starts = [0]
     for line in split_lines(text):
         starts.append(starts[-1] + len(line) + 1)
+    import bisect
     for m in pattern.finditer(text):
         if any(a <= m.start() < b for a, b in spans):
             continue
