@@ -47,7 +47,7 @@ from typing import Any, Callable, Collection
 import z3
 
 from rclverify.model.plan.formal import Formal, parse_formal
-from rclverify.model.plan.load import Plan, Requirement
+from rclverify.model.plan.model import Plan, Requirement
 from rclverify.model.plan.ranking import parse_hints
 from rclverify.model.plan.state import state_types
 from rclverify.model.plan.temporal import Temporal, operands, parse_temporal, shape
