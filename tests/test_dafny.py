@@ -14,9 +14,11 @@ import pytest
 
 from rclverify.backends.base import NodeTarget
 from rclverify.backends.dafny import DafnyBackend
-from rclverify.backends.dafny.runner import find_dafny, parse_output, scan_implementation
+from rclverify.backends.dafny.implementation import scan_implementation
+from rclverify.backends.dafny.runner import find_dafny, parse_output
 from rclverify.backends.dafny.stubgen import clause_lines
-from rclverify.backends.dafny.translate import Translator, real_literal
+from rclverify.backends.dafny.text import real_literal
+from rclverify.backends.dafny.translate import Translator
 from rclverify.calculus.refinement import check_refinement, merge_envs, refines_main
 from rclverify.model.plan.errors import PlanError
 from rclverify.lang.parser import parse_formula

@@ -22,7 +22,8 @@ from rclverify.lang import ast
 from rclverify.lang.errors import RclError
 from rclverify.lang.latex import to_latex
 from rclverify.lang.lint import lint
-from rclverify.lang.parser import NESTING_LIMIT, parse_file, parse_text
+from rclverify.lang.nesting import NESTING_LIMIT
+from rclverify.lang.parser import parse_file, parse_text
 from rclverify.lang.printer import to_rcl
 from rclverify.lang.typecheck import check
 from rclverify.lang.types import INTEGER, NATURAL, STRING, EnumT, SeqT, TupleT

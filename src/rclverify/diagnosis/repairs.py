@@ -225,22 +225,7 @@ def guard_repair(ws: Any, node: str, culprit: int, victims: Sequence[tuple[int, 
         return None
     premise = body.left
     used = free_names(gs[culprit - 1].formula.body if isinstance(gs[culprit - 1].formula, ast.Quant) else body)
-    atoms: list[str] = []
-    for j, g in enumerate(gs, 1):
-        if j == culprit:
-            continue
-        jb, jbody = _peel(g.formula)
-        if not (isinstance(jbody, ast.Binary) and jbody.op == "->"):
-            continue
-        for a in conjuncts(jbody.left):
-            mentioned = free_names(a) & set(jb)
-            if mentioned and mentioned <= set(bound):
-                text = expr_to_rcl(a)
-                if text not in atoms:
-                    atoms.append(text)
-    # atoms on the variables the guarantee binds and never uses first (the lint's hint)
-    unused = {v for v in bound if v not in used}
-    atoms.sort(key=lambda t: not any(re.search(rf"(?<![\w']){re.escape(v)}(?![\w'])", t) for v in unused))
+    atoms = _premise_atoms(gs, culprit, bound, used)
     numeric = _numeric_vars(ws, cn, gs[culprit - 1].formula)
     ranged_why = dict(range_guards(premise, list(numeric), [f.expr for f in ws.plan.facts.get(node, ())]))
     ranged, equiv = _weakest_first(ws, node, list(ranged_why), numeric)
@@ -255,29 +240,9 @@ def guard_repair(ws: Any, node: str, culprit: int, victims: Sequence[tuple[int, 
         candidates += [(" and ".join(combo), "atoms") for combo in itertools.combinations(atoms, size)]
     for guard, how in candidates[:MAX_CANDIDATES]:
         edit = Edit(rel, loc.line, loc.col, loc.end_line, loc.end_col, f"{guard} and ({old})")
-        system = recheck.edited_system(ws, edit)
-        if system is None:
+        after = _guarded_health(ws, node, edit, victims)
+        if after is None:
             continue
-        checked, _ = system
-        fired = {}
-        for k, at in victims:
-            fired[f"{node}.g{k}.non-vacuous"] = recheck.premise_fires(ws, checked, node, k, at)
-            if fired[f"{node}.g{k}.non-vacuous"] != "sat":
-                break
-        if any(v != "sat" for v in fired.values()):
-            continue
-        # a premise query holds the assumption, every guarantee and the facts: a victim's witness is one of
-        # consistency too, which is asked only when there is no victim
-        if not victims and recheck.consistent(ws, checked, node) != "sat":
-            continue
-        # the checks just answered are not asked again
-        known = {**{k: "ok" for k in fired}, f"{node}.contract-consistent": "ok"}
-        after = recheck.health(ws, checked, node, {k: at for k, at in victims if at is not None}, known=known)
-        checks = [{"check": f"{node}.contract-consistent", "status": "consistent (Z3: sat, witness found)"}]
-        checks += [{"check": f"{node}.g{k}.non-vacuous" + (f" at {at}" if at is not None else ""),
-                    "status": "can fire (Z3: sat, witness found)"} for k, at in victims]
-        fired_text = ", ".join(f"guarantee {k}" + (f" (at the instance {at} where it was vacuous)" if at is not None else "")
-                               for k, at in victims)
         if how == "range":
             same = equiv.get(guard, [])
             why = (f"restricts {_and_text([f'`{v}`' for v in numeric])}: it {ranged_why[guard]}"
@@ -285,17 +250,74 @@ def guard_repair(ws: Any, node: str, culprit: int, victims: Sequence[tuple[int, 
                    + "; no weaker range restriction passed")
         else:
             why = f"no guard of fewer atoms among the {len(atoms)} candidate atoms passed"
-        summary = (f"Guard guarantee {culprit} of {node} with `{guard}`: Z3 found witnesses that the guarded "
-                   f"contract is consistent" + (f" and that {fired_text} can fire" if victims else "")
-                   + f"; the guard {why}.")
-        # compared with the stage's own statuses: the checks asked again (not the replacement check)
-        return _record("guard", summary, edit, source, checks,
-                       recheck.changes({k: v for k, v in before.items() if k in after or ".g" in k}, after),
-                       proves=(f"{fired_text} can fire and {node}'s contract is consistent (witnesses found)"
-                               if victims else f"{node}'s contract is consistent (a witness found)"),
-                       not_shown=(f"that guarantee {culprit} still says what {node} is meant to do where the guard "
-                                  f"is false; {node}'s evidence must then establish the guarded guarantee"))
+        return _guard_record(node, culprit, victims, guard, why, edit, source, before, after)
     return None
+
+
+def _premise_atoms(gs: Sequence[Any], culprit: int, bound: Sequence[str], used: set[str]) -> list[str]:
+    """The atoms of the node's other guarantees' premises that mention only
+    variables guarantee ``culprit`` binds (``bound``), those on a variable it
+    binds and never uses (``used``: the ones it does) first (the lint's hint)."""
+    atoms: list[str] = []
+    for j, g in enumerate(gs, 1):
+        if j == culprit:
+            continue
+        jb, jbody = _peel(g.formula)
+        if not (isinstance(jbody, ast.Binary) and jbody.op == "->"):
+            continue
+        for a in conjuncts(jbody.left):
+            mentioned = free_names(a) & set(jb)
+            if mentioned and mentioned <= set(bound):
+                text = expr_to_rcl(a)
+                if text not in atoms:
+                    atoms.append(text)
+    unused = {v for v in bound if v not in used}
+    atoms.sort(key=lambda t: not any(re.search(rf"(?<![\w']){re.escape(v)}(?![\w'])", t) for v in unused))
+    return atoms
+
+
+def _guarded_health(ws: Any, node: str, edit: Edit, victims: Sequence[tuple[int, int | None]]) -> dict[str, str] | None:
+    """The node's health after ``edit`` (:func:`recheck.health`) when Z3
+    found that every victim can fire (or, with none, that the contract is
+    consistent), else ``None``."""
+    system = recheck.edited_system(ws, edit)
+    if system is None:
+        return None
+    checked, _ = system
+    fired = {}
+    for k, at in victims:
+        fired[f"{node}.g{k}.non-vacuous"] = recheck.premise_fires(ws, checked, node, k, at)
+        if fired[f"{node}.g{k}.non-vacuous"] != "sat":
+            break
+    if any(v != "sat" for v in fired.values()):
+        return None
+    # a premise query holds the assumption, every guarantee and the facts: a victim's witness is one of
+    # consistency too, which is asked only when there is no victim
+    if not victims and recheck.consistent(ws, checked, node) != "sat":
+        return None
+    # the checks just answered are not asked again
+    known = {**{k: "ok" for k in fired}, f"{node}.contract-consistent": "ok"}
+    return recheck.health(ws, checked, node, {k: at for k, at in victims if at is not None}, known=known)
+
+
+def _guard_record(node: str, culprit: int, victims: Sequence[tuple[int, int | None]], guard: str, why: str,
+                  edit: Edit, source: str, before: Mapping[str, str], after: dict[str, str]) -> dict[str, Any]:
+    """The repair record of the guard Z3 accepted (``why``: why this one)."""
+    checks = [{"check": f"{node}.contract-consistent", "status": "consistent (Z3: sat, witness found)"}]
+    checks += [{"check": f"{node}.g{k}.non-vacuous" + (f" at {at}" if at is not None else ""),
+                "status": "can fire (Z3: sat, witness found)"} for k, at in victims]
+    fired_text = ", ".join(f"guarantee {k}" + (f" (at the instance {at} where it was vacuous)" if at is not None else "")
+                           for k, at in victims)
+    summary = (f"Guard guarantee {culprit} of {node} with `{guard}`: Z3 found witnesses that the guarded "
+               f"contract is consistent" + (f" and that {fired_text} can fire" if victims else "")
+               + f"; the guard {why}.")
+    # compared with the stage's own statuses: the checks asked again (not the replacement check)
+    return _record("guard", summary, edit, source, checks,
+                   recheck.changes({k: v for k, v in before.items() if k in after or ".g" in k}, after),
+                   proves=(f"{fired_text} can fire and {node}'s contract is consistent (witnesses found)"
+                           if victims else f"{node}'s contract is consistent (a witness found)"),
+                   not_shown=(f"that guarantee {culprit} still says what {node} is meant to do where the guard "
+                              f"is false; {node}'s evidence must then establish the guarded guarantee"))
 
 
 def _and_text(xs: Sequence[str]) -> str:

@@ -46,43 +46,8 @@ def requirement_record(ws: Any, report: Mapping[str, Any], q: Mapping[str, Any],
     if causes:  # refuted only because a side condition fails: that problem's row, its culprit (issue 64)
         return _consequence_record(report, q, check, causes, guarantee_source)
 
-    def find() -> list[dict[str, Any]]:
-        rows = []
-        for f in blame.requirement_culprits(ws, str(q["id"]), cone):
-            source = recheck.source_text(ws, f["edit"].file)
-            text, src = guarantee_source(report, f["node"], f["guarantee"])
-            what = f"guarantee {f['guarantee']} of {f['node']}"
-            if f["how"] == "bound":
-                summary = (f"Tighten the bound of {what} ({src}): {f['old']} becomes {f['new']}; Z3 proves "
-                           f"{q['id']} from consistent premises. {f['node']}'s evidence must then establish it.")
-            elif f["how"] == "threshold":
-                summary = (f"Make the threshold of {what} ({src}) {'include' if f['inclusive'] else 'exclude'} "
-                           f"{f['threshold']} itself: `{f['old']}` becomes `{f['new']}`, as {q['id']} states it "
-                           "(an off-by-one at the threshold); Z3 "
-                           f"proves {q['id']} from consistent premises. {f['node']}'s implementation and evidence "
-                           "must then decide the threshold value itself the same way.")
-            else:
-                summary = (f"Strengthen {what} ({src}) by `{f['new']}`; Z3 proves {q['id']} from consistent premises. "
-                           f"{f['node']}'s evidence must then establish it.")
-            rows.append({"node": f["node"], "guarantee": f["guarantee"], "how": f["how"], "old": f["old"],
-                         "new": f["new"], "text": text, "source": src,
-                         "repair": _repair(_KIND[f["how"]],
-                                           summary, f["edit"], source,
-                                           [{"check": str(q["id"]), "status": "proved (Z3: unsat)"},
-                                            {"check": f"{f['node']} implementable",
-                                             "status": "yes: every input its assumption allows has an answer "
-                                                       "(Z3: proved)" if f.get("implementable") == "proved"
-                                                       else "not decided (Z3 could not say in its budget)"}],
-                                           blame.cost(ws, report, f["node"], f["edit"]),
-                                           proves=f"{q['id']} follows from the edited contracts, from consistent "
-                                                  "premises",
-                                           not_shown=(f"that {f['node']} can meet the stronger guarantee: its "
-                                                      "evidence must establish it" if f["how"] != "threshold" else
-                                                      f"that the threshold {q['id']} states is the right one for "
-                                                      f"the robot, and that {f['node']} meets it: its evidence "
-                                                      "must establish it"))})
-        return rows
-    found = cache.get(["requirement", q["id"], check.get("formal"), cone], find) or []
+    found = cache.get(["requirement", q["id"], check.get("formal"), cone],
+                      lambda: _culprit_rows(ws, report, q, cone, guarantee_source)) or []
     cul = [{"what": f"guarantee {f['guarantee']} of {f['node']}: `{f['text']}`", "source": f["source"],
             "text": f["text"]} for f in found]
     mentioned = {str(r["node"]) for r in check.get("counterexample") or []
@@ -93,20 +58,7 @@ def requirement_record(ws: Any, report: Mapping[str, Any], q: Mapping[str, Any],
              for r in check.get("counterexample") or [] if not involved or str(r["node"]) in involved
              for v, x in r["values"].items()]
     cex = ", ".join(f"{r['node']}.{r['variable']} = {r['value']}" for r in table)
-    if found:
-        f = found[0]
-        how = (f"its bound {f['old']} lets the counterexample through; with {f['new']} Z3 proves {q['id']}"
-               if f["how"] == "bound" else
-               f"its threshold `{f['old']}` has the other strictness than {q['id']}'s (an off-by-one at the "
-               f"threshold); with `{f['new']}` Z3 proves {q['id']}" if f["how"] == "threshold" else
-               f"strengthened by `{f['new']}` it lets Z3 prove {q['id']}")
-        sentence = (f"Requirement {q['id']} (`{check.get('formal')}`, {check.get('source')}) is refuted because of "
-                    f"guarantee {f['guarantee']} of {f['node']} ({f['source']}) `{f['text']}`: {how}"
-                    + (f". Z3's counterexample: {cex}" if cex else "") + ".")
-    else:
-        sentence = (f"Requirement {q['id']} (`{check.get('formal')}`, {check.get('source')}) is refuted: the guarantees "
-                    "of its cone allow a counterexample, and no single strengthening Z3 tried proves it"
-                    + (f". Z3's counterexample: {cex}" if cex else "") + ".")
+    sentence = _refuted(q, check, found[0] if found else None, cex)
     through = _passes_through(ws, report, q, cone)
     if through:  # the counterexample runs through another node's refuted side condition: say so (issue 64)
         sentence += " Its counterexample passes through " + "; ".join(
@@ -116,6 +68,65 @@ def requirement_record(ws: Any, report: Mapping[str, Any], q: Mapping[str, Any],
             "sentence": sentence, "culprits": cul, "counterexample": table,
             "repairs": [f["repair"] for f in found], "guarantee": None,
             "passes_through": [str(sc["id"]) for sc in through]}
+
+
+def _culprit_rows(ws: Any, report: Mapping[str, Any], q: Mapping[str, Any], cone: list[str],
+                  guarantee_source: Callable[[Mapping[str, Any], str, int], tuple[str, str]]) -> list[dict[str, Any]]:
+    """One row per guarantee whose strengthening Z3 showed proves ``q``
+    (:func:`blame.requirement_culprits`), with that strengthening as a repair."""
+    rows = []
+    for f in blame.requirement_culprits(ws, str(q["id"]), cone):
+        source = recheck.source_text(ws, f["edit"].file)
+        text, src = guarantee_source(report, f["node"], f["guarantee"])
+        checks = [{"check": str(q["id"]), "status": "proved (Z3: unsat)"},
+                  {"check": f"{f['node']} implementable",
+                   "status": "yes: every input its assumption allows has an answer (Z3: proved)"
+                   if f.get("implementable") == "proved" else "not decided (Z3 could not say in its budget)"}]
+        not_shown = (f"that {f['node']} can meet the stronger guarantee: its evidence must establish it"
+                     if f["how"] != "threshold" else
+                     f"that the threshold {q['id']} states is the right one for the robot, and that {f['node']} "
+                     "meets it: its evidence must establish it")
+        rows.append({"node": f["node"], "guarantee": f["guarantee"], "how": f["how"], "old": f["old"],
+                     "new": f["new"], "text": text, "source": src,
+                     "repair": _repair(_KIND[f["how"]], _summary(f, q, src), f["edit"], source, checks,
+                                       blame.cost(ws, report, f["node"], f["edit"]),
+                                       proves=f"{q['id']} follows from the edited contracts, from consistent "
+                                              "premises",
+                                       not_shown=not_shown)})
+    return rows
+
+
+def _summary(f: Mapping[str, Any], q: Mapping[str, Any], src: str) -> str:
+    """The repair's one-paragraph summary for culprit ``f`` (``src`` its guarantee's location)."""
+    what = f"guarantee {f['guarantee']} of {f['node']}"
+    if f["how"] == "bound":
+        return (f"Tighten the bound of {what} ({src}): {f['old']} becomes {f['new']}; Z3 proves "
+                f"{q['id']} from consistent premises. {f['node']}'s evidence must then establish it.")
+    if f["how"] == "threshold":
+        return (f"Make the threshold of {what} ({src}) {'include' if f['inclusive'] else 'exclude'} "
+                f"{f['threshold']} itself: `{f['old']}` becomes `{f['new']}`, as {q['id']} states it "
+                "(an off-by-one at the threshold); Z3 "
+                f"proves {q['id']} from consistent premises. {f['node']}'s implementation and evidence "
+                "must then decide the threshold value itself the same way.")
+    return (f"Strengthen {what} ({src}) by `{f['new']}`; Z3 proves {q['id']} from consistent premises. "
+            f"{f['node']}'s evidence must then establish it.")
+
+
+def _refuted(q: Mapping[str, Any], check: Mapping[str, Any], f: Mapping[str, Any] | None, cex: str) -> str:
+    """The record's sentence: why ``q`` is refuted, naming the first culprit
+    ``f`` (``None``: no single strengthening proves it) and the counterexample."""
+    if f is not None:
+        how = (f"its bound {f['old']} lets the counterexample through; with {f['new']} Z3 proves {q['id']}"
+               if f["how"] == "bound" else
+               f"its threshold `{f['old']}` has the other strictness than {q['id']}'s (an off-by-one at the "
+               f"threshold); with `{f['new']}` Z3 proves {q['id']}" if f["how"] == "threshold" else
+               f"strengthened by `{f['new']}` it lets Z3 prove {q['id']}")
+        return (f"Requirement {q['id']} (`{check.get('formal')}`, {check.get('source')}) is refuted because of "
+                f"guarantee {f['guarantee']} of {f['node']} ({f['source']}) `{f['text']}`: {how}"
+                + (f". Z3's counterexample: {cex}" if cex else "") + ".")
+    return (f"Requirement {q['id']} (`{check.get('formal')}`, {check.get('source')}) is refuted: the guarantees "
+            "of its cone allow a counterexample, and no single strengthening Z3 tried proves it"
+            + (f". Z3's counterexample: {cex}" if cex else "") + ".")
 
 
 def _causes(ws: Any, report: Mapping[str, Any], q: Mapping[str, Any], cone: list[str],

@@ -310,13 +310,12 @@ def run_ros1(run_factory: Callable[..., LiveRun], checked: Checked, nodes: list[
     verdict topic, its summary to the record's ``deadlines``.
     """
     from rclverify.ros.live.master_rpc import MASTER_TIMEOUT_S
-    from rclverify.runtime.ros1 import (REGISTER_TIMEOUT_S, SHUTDOWN_TIMEOUT_S, RosUnavailable, bound_master_calls, check_master,
-                       contract_topics, finish_within, flatten, import_rospy, message_class, run_bounded)
+    from rclverify.runtime.ros1 import (REGISTER_TIMEOUT_S, SHUTDOWN_TIMEOUT_S, bound_master_calls, contract_topics,
+                                        finish_within, import_rospy, message_class)
     rospy = import_rospy()
     from std_msgs.msg import String
     topics = contract_topics(checked, nodes)
     classes = {t: message_class(typ, msg_dirs) for t, typ in topics.items()}  # fail early, located
-    by_type = {c._type: c for c in classes.values()}  # type: ignore[attr-defined]
     import rosgraph
     uri = rosgraph.get_master_uri()
     # every call to the master is bounded and the registration waits in short
@@ -324,80 +323,22 @@ def run_ros1(run_factory: Callable[..., LiveRun], checked: Checked, nodes: list[
     # to SIGTERM/SIGINT (ros1.py, "A master is an external peer")
     bound_master_calls(rospy, uri, MASTER_TIMEOUT_S)
     until = _time.monotonic() + REGISTER_TIMEOUT_S
-
-    def register_node() -> tuple[Any, dict[str, Any]]:
-        check_master(uri, "/" + node_name, MASTER_TIMEOUT_S)
-        rospy.init_node(node_name, anonymous=False, disable_signals=True)
-        # synchronous: the engine thread writes each verdict to the subscribers'
-        # sockets itself; rospy's queued publisher hands every message to a writer
-        # thread and then yields the GIL (time.sleep(0)), which cost the engine
-        # thread a GIL hand-over per verdict (docs/monitors.md, "Live monitoring", "Threads")
-        import warnings
-        with warnings.catch_warnings():  # rospy warns about queue_size=None; here it is the choice made above
-            warnings.simplefilter("ignore", SyntaxWarning)
-            pub = rospy.Publisher(verdict_topic, String, queue_size=None)
-        return pub, {n.name: rospy.Publisher(f"{last_prefix}/{n.name}/last_verdict", String, queue_size=1,
-                                             latch=True) for n in nodes}
-
-    try:
-        pub, lasts = run_bounded(stop, REGISTER_TIMEOUT_S, f"registering with the master at {uri}", register_node)
-    except RosUnavailable:
-        finish_within(lambda: rospy.signal_shutdown("monitor not started"), SHUTDOWN_TIMEOUT_S)
-        raise
+    pub, lasts = _register(rospy, String, stop, uri, node_name, verdict_topic, last_prefix, nodes)
     live = run_factory(publish=lambda text: pub.publish(String(text)),
                        publish_last=lambda n, text: lasts[n].publish(String(text)))
     decode_errors: dict[str, int] = {}
-
-    def decode(topic: str, raw: Any) -> Mapping[str, Any] | None:
-        typ = raw._connection_header.get("type", "") if getattr(raw, "_connection_header", None) else ""
-        cls = by_type.get(typ, classes[topic])
-        try:
-            msg = cls().deserialize(raw._buff)
-        except Exception:  # a publisher of another type on a contract topic: counted, never a crash
-            decode_errors[topic] = decode_errors.get(topic, 0) + 1
-            return None
-        return flatten(msg)  # type: ignore[no-any-return]
-
     # the callbacks only stamp and queue; one worker thread decodes, checks,
     # publishes and runs the timer (worker.py: why)
-    worker = EngineWorker(live, decode, rospy.get_time, tick_s=tick_s).start()
+    worker = EngineWorker(live, _decoder(classes, decode_errors), rospy.get_time, tick_s=tick_s).start()
     subs: list[Any] = []
-
-    def register_topics() -> Any:
-        calls = proxy(rospy, live, lambda text: pub.publish(String(text))) if proxy is not None else None
-        for t in topics:
-            subs.append(rospy.Subscriber(t, rospy.AnyMsg, lambda raw, t=t: worker.offer(t, raw, rospy.get_time()),
-                                         queue_size=10000, tcp_nodelay=True))
-        return calls
 
     def unsubscribe() -> None:
         for s in list(subs):
             s.unregister()
-
-    try:
-        calls = run_bounded(stop, max(until - _time.monotonic(), 0.1),
-                            f"subscribing at the master at {uri}", register_topics)
-    except RosUnavailable:
-        finish_within(unsubscribe, SHUTDOWN_TIMEOUT_S)
-        stop_and_record(worker, live, None, lambda _line: None)
-        finish_within(lambda: rospy.signal_shutdown("monitor not started"), SHUTDOWN_TIMEOUT_S)
-        raise
+    calls = _subscribe(rospy, String, stop, until, uri, topics, pub, live, worker, subs, unsubscribe, proxy)
     out(f"monitoring {len(topics)} topic(s) for {len(nodes)} node(s); verdicts on {verdict_topic}")
-    t0 = _time.monotonic()
-    next_status = t0 + status_s
     try:
-        while not stop.is_set() and not rospy.is_shutdown():
-            if duration is not None and _time.monotonic() - t0 >= duration:
-                break
-            stop.wait(min(0.1, tick_s * 5))
-            if calls is not None:
-                calls.tick(rospy.get_time())  # an unanswered call is false once its deadline expired
-            if worker.error is not None:
-                break  # the engine thread died: stop and say so, never monitor on silently
-            _no_delay(pub)
-            if status_s > 0 and _time.monotonic() >= next_status:
-                out(live.status_line())
-                next_status += status_s
+        _watch(rospy, stop, duration, tick_s, status_s, calls, worker, pub, live, out)
     finally:
         # unregistering asks the master: bounded, so a master that hangs now cannot hold the exit
         if not finish_within(unsubscribe, SHUTDOWN_TIMEOUT_S):
@@ -414,6 +355,104 @@ def run_ros1(run_factory: Callable[..., LiveRun], checked: Checked, nodes: list[
         out(live.status_line())
         finish_within(lambda: rospy.signal_shutdown("monitor stopped"), SHUTDOWN_TIMEOUT_S)
     return record
+
+
+def _register(rospy: Any, string: Any, stop: threading.Event, uri: str, node_name: str, verdict_topic: str,
+              last_prefix: str, nodes: list[CheckedNode]) -> tuple[Any, dict[str, Any]]:
+    """The monitor's node registered with the master at ``uri`` and its
+    publishers ``(verdict, {node: last verdict, latched})``; within
+    ``REGISTER_TIMEOUT_S`` and ``stop``, else rospy is shut down and
+    :class:`~.ros1.RosUnavailable` raised."""
+    from rclverify.ros.live.master_rpc import MASTER_TIMEOUT_S
+    from rclverify.runtime.ros1 import (REGISTER_TIMEOUT_S, SHUTDOWN_TIMEOUT_S, RosUnavailable, check_master,
+                                        finish_within, run_bounded)
+
+    def register_node() -> tuple[Any, dict[str, Any]]:
+        check_master(uri, "/" + node_name, MASTER_TIMEOUT_S)
+        rospy.init_node(node_name, anonymous=False, disable_signals=True)
+        # synchronous: the engine thread writes each verdict to the subscribers'
+        # sockets itself; rospy's queued publisher hands every message to a writer
+        # thread and then yields the GIL (time.sleep(0)), which cost the engine
+        # thread a GIL hand-over per verdict (docs/monitors.md, "Live monitoring", "Threads")
+        import warnings
+        with warnings.catch_warnings():  # rospy warns about queue_size=None; here it is the choice made above
+            warnings.simplefilter("ignore", SyntaxWarning)
+            pub = rospy.Publisher(verdict_topic, string, queue_size=None)
+        return pub, {n.name: rospy.Publisher(f"{last_prefix}/{n.name}/last_verdict", string, queue_size=1,
+                                             latch=True) for n in nodes}
+
+    try:
+        return run_bounded(stop, REGISTER_TIMEOUT_S, f"registering with the master at {uri}",  # type: ignore[no-any-return]
+                           register_node)
+    except RosUnavailable:
+        finish_within(lambda: rospy.signal_shutdown("monitor not started"), SHUTDOWN_TIMEOUT_S)
+        raise
+
+
+def _decoder(classes: Mapping[str, Any], decode_errors: dict[str, int]) -> Callable[[str, Any], Mapping[str, Any] | None]:
+    """The engine thread's decoding of a ``rospy.AnyMsg``: with the class of
+    its connection's type, else the contract's; undecodable bytes are counted
+    per topic in ``decode_errors``."""
+    from rclverify.runtime.ros1 import flatten
+    by_type = {c._type: c for c in classes.values()}
+
+    def decode(topic: str, raw: Any) -> Mapping[str, Any] | None:
+        typ = raw._connection_header.get("type", "") if getattr(raw, "_connection_header", None) else ""
+        cls = by_type.get(typ, classes[topic])
+        try:
+            msg = cls().deserialize(raw._buff)
+        except Exception:  # a publisher of another type on a contract topic: counted, never a crash
+            decode_errors[topic] = decode_errors.get(topic, 0) + 1
+            return None
+        return flatten(msg)  # type: ignore[no-any-return]
+    return decode
+
+
+def _subscribe(rospy: Any, string: Any, stop: threading.Event, until: float, uri: str, topics: Mapping[str, str],
+               pub: Any, live: LiveRun, worker: EngineWorker, subs: list[Any], unsubscribe: Callable[[], None],
+               proxy: Callable[[Any, LiveRun, Callable[[str], None]], Any] | None) -> Any:
+    """Subscribe to every contract topic (into ``subs``) and start the
+    ``proxy``; returns the proxy's run or ``None``.  By the registration's
+    deadline ``until`` (monotonic s), else everything started is stopped and
+    :class:`~.ros1.RosUnavailable` raised."""
+    from rclverify.runtime.ros1 import SHUTDOWN_TIMEOUT_S, RosUnavailable, finish_within, run_bounded
+
+    def register_topics() -> Any:
+        calls = proxy(rospy, live, lambda text: pub.publish(string(text))) if proxy is not None else None
+        for t in topics:
+            subs.append(rospy.Subscriber(t, rospy.AnyMsg, lambda raw, t=t: worker.offer(t, raw, rospy.get_time()),
+                                         queue_size=10000, tcp_nodelay=True))
+        return calls
+
+    try:
+        return run_bounded(stop, max(until - _time.monotonic(), 0.1), f"subscribing at the master at {uri}",
+                           register_topics)
+    except RosUnavailable:
+        finish_within(unsubscribe, SHUTDOWN_TIMEOUT_S)
+        stop_and_record(worker, live, None, lambda _line: None)
+        finish_within(lambda: rospy.signal_shutdown("monitor not started"), SHUTDOWN_TIMEOUT_S)
+        raise
+
+
+def _watch(rospy: Any, stop: threading.Event, duration: float | None, tick_s: float, status_s: float, calls: Any,
+           worker: EngineWorker, pub: Any, live: LiveRun, out: Callable[[str], None]) -> None:
+    """Until ``stop``, rospy's shutdown, ``duration`` s or the engine
+    thread's death: the proxy's clock, the verdict publisher's sockets
+    (:func:`_no_delay`) and a status line every ``status_s`` s."""
+    t0 = _time.monotonic()
+    next_status = t0 + status_s
+    while not stop.is_set() and not rospy.is_shutdown():
+        if duration is not None and _time.monotonic() - t0 >= duration:
+            break
+        stop.wait(min(0.1, tick_s * 5))
+        if calls is not None:
+            calls.tick(rospy.get_time())  # an unanswered call is false once its deadline expired
+        if worker.error is not None:
+            break  # the engine thread died: stop and say so, never monitor on silently
+        _no_delay(pub)
+        if status_s > 0 and _time.monotonic() >= next_status:
+            out(live.status_line())
+            next_status += status_s
 
 
 def stop_and_record(worker: EngineWorker, live: LiveRun, evidence: Any, out: Callable[[str], None]) -> dict[str, Any]:

@@ -268,70 +268,12 @@ async def serve(checked: Checked, nodes: list[CheckedNode], rules: Mapping[str, 
     run and its queues are freed when it closes.
     Raises ``OSError`` when the port cannot be bound."""
     from websockets.asyncio.server import serve as ws_serve
-    from websockets.exceptions import ConnectionClosed
 
     lim = limits or OracleLimits()
     st = stats if stats is not None else OracleStats()
 
     async def handler(ws: Any) -> None:
-        run = OracleRun(checked, nodes, rules, horizon)
-        inbox: list[Any] = []
-        held = [0]  # bytes in inbox
-        wake, space = asyncio.Event(), asyncio.Event()
-        closed = False
-
-        async def read() -> None:
-            # websockets hands over every message already received without
-            # suspending, so `inbox` fills with everything that arrived in one
-            # read from the socket before write() runs; a full inbox stops the
-            # reading until the replies went out (websockets then stops reading
-            # the socket: the client's sends wait)
-            nonlocal closed
-            try:
-                async for message in ws:
-                    inbox.append(message)
-                    held[0] += len(message)
-                    st.peak_inbox = max(st.peak_inbox, len(inbox))
-                    wake.set()
-                    while len(inbox) >= lim.inbox or held[0] >= lim.inbox_bytes:
-                        space.clear()
-                        await space.wait()
-            except ConnectionClosed:
-                pass
-            finally:
-                closed = True
-                wake.set()
-
-        st.connections += 1
-        reader = asyncio.create_task(read())
-        try:
-            while True:
-                if not await _woken(wake, ws, lim.stall_s):  # replies unread for stall_s: drop it
-                    st.dropped += 1
-                    ws.transport.abort()
-                    return
-                wake.clear()
-                if inbox:
-                    batch = inbox[:]
-                    del inbox[:]
-                    held[0] = 0
-                    replies = [encode(_answer(run, m)) for m in batch]
-                    st.answered += len(batch)
-                    space.set()
-                    try:
-                        await asyncio.wait_for(_send_batch(ws, replies), lim.stall_s)
-                    except asyncio.TimeoutError:  # the client does not read its replies: drop it
-                        st.dropped += 1
-                        ws.transport.abort()
-                        return
-                elif closed:
-                    return
-        except ConnectionClosed:
-            return
-        finally:
-            reader.cancel()
-            inbox.clear()
-            st.connections -= 1
+        await _Connection(ws, OracleRun(checked, nodes, rules, horizon), lim, st).serve()
 
     async with ws_serve(handler, host, port, ping_interval=None, max_size=2**22):
         if ready is not None:
@@ -340,6 +282,80 @@ async def serve(checked: Checked, nodes: list[CheckedNode], rules: Mapping[str, 
             await asyncio.Future()
         else:
             await stop.wait()
+
+
+class _Connection:
+    """One client's connection: its run, the inbox of messages read and not
+    yet answered (bounded by ``lim``), and the counts it adds to ``st``."""
+
+    def __init__(self, ws: Any, run: OracleRun, lim: OracleLimits, st: OracleStats) -> None:
+        self.ws, self.run, self.lim, self.st = ws, run, lim, st
+        self.inbox: list[Any] = []
+        self.held = 0  # bytes in inbox
+        self.wake, self.space = asyncio.Event(), asyncio.Event()
+        self.closed = False
+
+    async def read(self) -> None:
+        """Read messages into the inbox until the client closes."""
+        from websockets.exceptions import ConnectionClosed
+        # websockets hands over every message already received without
+        # suspending, so the inbox fills with everything that arrived in one
+        # read from the socket before the replies are written; a full inbox stops the
+        # reading until the replies went out (websockets then stops reading
+        # the socket: the client's sends wait)
+        lim, st, inbox = self.lim, self.st, self.inbox
+        try:
+            async for message in self.ws:
+                inbox.append(message)
+                self.held += len(message)
+                st.peak_inbox = max(st.peak_inbox, len(inbox))
+                self.wake.set()
+                while len(inbox) >= lim.inbox or self.held >= lim.inbox_bytes:
+                    self.space.clear()
+                    await self.space.wait()
+        except ConnectionClosed:
+            pass
+        finally:
+            self.closed = True
+            self.wake.set()
+
+    def drop(self) -> None:
+        """The client does not read its replies: its connection is dropped."""
+        self.st.dropped += 1
+        self.ws.transport.abort()
+
+    async def serve(self) -> None:
+        """Answer the inbox batch by batch until the client closes or is dropped."""
+        from websockets.exceptions import ConnectionClosed
+        st, lim = self.st, self.lim
+        st.connections += 1
+        reader = asyncio.create_task(self.read())
+        try:
+            while True:
+                if not await _woken(self.wake, self.ws, lim.stall_s):  # replies unread for stall_s: drop it
+                    self.drop()
+                    return
+                self.wake.clear()
+                if self.inbox:
+                    batch = self.inbox[:]
+                    del self.inbox[:]
+                    self.held = 0
+                    replies = [encode(_answer(self.run, m)) for m in batch]
+                    st.answered += len(batch)
+                    self.space.set()
+                    try:
+                        await asyncio.wait_for(_send_batch(self.ws, replies), lim.stall_s)
+                    except asyncio.TimeoutError:  # the client does not read its replies: drop it
+                        self.drop()
+                        return
+                elif self.closed:
+                    return
+        except ConnectionClosed:
+            return
+        finally:
+            reader.cancel()
+            self.inbox.clear()
+            st.connections -= 1
 
 
 __all__ = ["MAX_EVENT_DEPTH", "ORACLE_VERDICTS", "OracleLimits", "OracleRun", "OracleStats", "json_depth", "serve"]

@@ -49,7 +49,7 @@ from rclverify.records.store import atomic_write_text
 from rclverify.lang.errors import RclError
 from rclverify.lang.printer import expr_to_rcl
 from rclverify.backends.base import NodeTarget, Stopwatch, make_evidence
-from rclverify.backends.dafny import runner
+from rclverify.backends.dafny import implementation, runner
 from rclverify.backends.dafny.stubgen import ClauseRef, Stub, build_stub, clause_lines, snake
 
 DEFAULT_TIME_LIMIT_S = 60
@@ -189,7 +189,7 @@ class DafnyBackend:
             text = impl_path.read_text(encoding="utf-8")
         except (OSError, UnicodeDecodeError) as exc:
             return ev("error", f"cannot read {cfg.implementation}: {exc}", tool.version)
-        scan = runner.scan_implementation(text, stub.module, stub.method)
+        scan = implementation.scan_implementation(text, stub.module, stub.method)
         scan_details = {"refining_modules": [{"module": m, "line": ln} for m, ln in scan.refining],
                         "unsound_constructs": [{"line": ln, "construct": c} for ln, c in scan.unsound]}
         if not scan.refining:
@@ -244,7 +244,7 @@ def _clause_of(msg: runner.Message, clauses: Mapping[int, ClauseRef], stub_rel: 
 
 
 def _judge(res: runner.RunOutput, out: runner.Output, clauses: Mapping[int, ClauseRef], stub_rel: str,
-           cfg: _Config, scan: runner.ImplementationScan, tool: runner.DafnyTool, n_guarantees: int,
+           cfg: _Config, scan: implementation.ImplementationScan, tool: runner.DafnyTool, n_guarantees: int,
            target: NodeTarget) -> tuple[str, str, dict[str, Any]]:
     """Status, explanation and details of one Dafny run."""
     errors: list[dict[str, Any]] = []

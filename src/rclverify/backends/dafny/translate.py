@@ -39,7 +39,6 @@ from __future__ import annotations
 
 import re
 from dataclasses import dataclass, field
-from fractions import Fraction
 from typing import Any, Mapping, cast
 
 from rclverify.model.plan.errors import PlanError
@@ -66,7 +65,7 @@ from rclverify.lang.types import (
     numeric_join,
     qualified_base,
 )
-from rclverify.semantics.values import decimal_text
+from rclverify.backends.dafny.text import dafny_string, real_literal, strip_parens, value_join, wrap
 from rclverify.backends.dafny.types import dafny_ident, dafny_type
 
 _BASE_NAMES = {"REAL": REAL, "INTEGER": INTEGER, "NATURAL": NATURAL, "BOOL": BOOL}
@@ -76,19 +75,6 @@ _LOGIC = {"and": "&&", "or": "||", "->": "==>", "<=>": "<==>"}
 _EXPANSION_LIMIT = 64
 #: Most items a literal range `<a upto b>` is spelled out to.
 _RANGE_LIMIT = 1000
-
-
-def real_literal(value: Fraction) -> str:
-    """Exact Dafny ``real`` literal text of ``value`` (``120.0``, ``0.125``, ``-2.5``).
-
-    Values whose decimal expansion does not terminate are written as a
-    quotient ``(1.0 / 3.0)``.
-    """
-    text = decimal_text(value)
-    if text is None:
-        v = abs(value)
-        return f"({'-' if value < 0 else ''}{v.numerator}.0 / {v.denominator}.0)"
-    return text if "." in text else text + ".0"
 
 
 @dataclass
@@ -125,7 +111,7 @@ class Translator:
         text, t = self.tr(e, {})
         if t != BOOL:
             raise self._err(e.loc, f"expected a formula, found a term of type {t}")
-        return _strip(text)
+        return strip_parens(text)
 
     def term(self, e: ast.Expr) -> tuple[str, Type]:
         """Dafny text and RCL type of the term ``e``."""
@@ -166,7 +152,7 @@ class Translator:
             return f"({text} as real)"
         if isinstance(src, TupleT) and isinstance(dst, TupleT) and src != dst and len(src.elems) == len(dst.elems):
             # component by component: `(1, 2)` where `(real, real)` is expected
-            return "(" + ", ".join(Translator.conv(f"{_wrap(text)}.{k}", a, b)
+            return "(" + ", ".join(Translator.conv(f"{wrap(text)}.{k}", a, b)
                                    for k, (a, b) in enumerate(zip(src.elems, dst.elems))) + ")"
         return text
 
@@ -204,15 +190,15 @@ class Translator:
         if isinstance(e, ast.Unary):
             s, t = self.tr(e.operand, scope)
             if e.op == "not":
-                return f"!{_wrap(s)}", BOOL
-            return f"(-{_wrap(s)})", (REAL if t == REAL else INTEGER)
+                return f"!{wrap(s)}", BOOL
+            return f"(-{wrap(s)})", (REAL if t == REAL else INTEGER)
         if isinstance(e, ast.Binary):
             return self.binary(e, scope)
         if isinstance(e, ast.Compare):
             return self.compare(e, scope)
         if isinstance(e, ast.Member):
             s = self.member(self.tr(e.elem, scope), e.collection, scope)
-            return (f"!{_wrap(s)}" if e.negated else s), BOOL
+            return (f"!{wrap(s)}" if e.negated else s), BOOL
         if isinstance(e, (ast.SetLit, ast.SeqLit)):
             texts, t = self._join([self.tr(i, scope) for i in e.items])
             if isinstance(e, ast.SetLit):
@@ -343,7 +329,7 @@ class Translator:
         vals = [self.tr(o, scope) for o in e.operands]
         parts = []
         for op, (a, at), (b, bt) in zip(e.ops, vals, vals[1:]):
-            j = _value_join(at, bt)
+            j = value_join(at, bt)
             if j is not None:
                 a, b = self.conv(a, at, j), self.conv(b, bt, j)
             parts.append(f"({a} {op} {b})")
@@ -414,7 +400,7 @@ class Translator:
             assert isinstance(coll, (ast.SetLit, ast.SeqLit))
             texts, t = self._join([self.tr(i, scope) for i in coll.items])
             for nm in bd.names:
-                choices.append([(nm, _wrap(x), t) for x in texts])
+                choices.append([(nm, wrap(x), t) for x in texts])
         total = 1
         for c in choices:
             total *= len(c)
@@ -491,56 +477,3 @@ class Translator:
         ycore = " && ".join(yguards + [ybody])
         unique = f"(forall {', '.join(ydecls)} :: ({ycore}) ==> ({' && '.join(eqs)}))"
         return f"(exists {binders} :: {core} && {unique})"
-
-
-def dafny_string(value: str, loc: ast.Loc) -> str:
-    """A Dafny string literal for ``value``: ``"`` and ``\\`` escaped,
-    other characters outside printable ASCII as ``\\u`` and four hex
-    digits (``\\u00e9``).  Raises
-    :class:`PlanError` (located) for characters beyond U+FFFF, which Dafny 2
-    string literals cannot spell."""
-    out = []
-    for ch in value:
-        if ch in ('"', "\\"):
-            out.append("\\" + ch)
-        elif " " <= ch <= "~":
-            out.append(ch)
-        elif ord(ch) <= 0xFFFF:
-            out.append(f"\\u{ord(ch):04x}")
-        else:
-            raise PlanError([error(loc, f"the string literal holds {ch!r}, beyond U+FFFF, which a Dafny string "
-                                        "literal cannot spell", "E-dafny")])
-    return '"' + "".join(out) + '"'
-
-
-def _value_join(a: Type, b: Type) -> Type | None:
-    """The type both sides of ``==`` widen to: the numeric join, taken
-    component by component for tuples; ``None`` when no widening applies."""
-    if isinstance(a, TupleT) and isinstance(b, TupleT) and len(a.elems) == len(b.elems):
-        parts = [x if x == y else _value_join(x, y) for x, y in zip(a.elems, b.elems)]
-        return None if any(p is None for p in parts) else TupleT(tuple(p for p in parts if p is not None))
-    return numeric_join(a, b)
-
-
-def _wrap(s: str) -> str:
-    """Parenthesise ``s`` unless it is already atomic or parenthesised as a whole."""
-    if re.fullmatch(r"[A-Za-z0-9_'.]+", s) or _balanced_parens(s):
-        return s
-    return f"({s})"
-
-
-def _balanced_parens(s: str) -> bool:
-    if not (s.startswith("(") and s.endswith(")")):
-        return False
-    depth = 0
-    for k, ch in enumerate(s):
-        depth += ch == "("
-        depth -= ch == ")"
-        if depth == 0 and k < len(s) - 1:
-            return False
-    return True
-
-
-def _strip(s: str) -> str:
-    """Drop one pair of parentheses enclosing the whole of ``s``."""
-    return s[1:-1] if _balanced_parens(s) else s

@@ -33,7 +33,7 @@ import shutil
 import time
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, Mapping
+from typing import TYPE_CHECKING, Any, Callable, Mapping
 
 from rclverify.records.records import Evidence, Obligation, SourceRef, make_obligation_id
 from rclverify.records.store import atomic_write_text
@@ -257,6 +257,78 @@ def _vacuity_claims(claims: list[Claim]) -> list[Claim]:
     return out
 
 
+#: How :func:`check_graph` words its evidence: ``(status, why, **make_evidence keywords)``.
+_Say = Callable[..., Evidence]
+
+
+def _not_run(graph: StateGraph, mine: Claim, percepts: tuple[psl.Term, ...], details: dict[str, Any]) -> str | None:
+    """Why SPIN is not run on ``graph`` for the claim ``mine`` (the evidence is
+    inconclusive): the exploration was cut, or the claim names an identifier
+    value; ``None`` when it is run."""
+    if not graph.complete:
+        details["spin_verdict"] = "not run"
+        details["bounded"] = True
+        return (f"the exploration was cut ({graph.cut}), so the graph is not the program's whole state space and "
+                "SPIN was not run on it (bounded: raise the bound named to decide)")
+    named = named_identifiers(mine.formula, percepts)
+    if named:
+        details["spin_verdict"] = "not run"
+        return (f"the property names an identifier value ({', '.join(named)}); an identifier is any fresh value "
+                "(docs/model-checking.md, Identifiers), so the property has no meaning: write '_' at the "
+                "identifier's place")
+    return None
+
+
+def _violated(evidence: _Say, target: NodeTarget, graph: StateGraph, mine: Claim, res: spin.CheckResult,
+              trail_path: Path, arts: list[str], details: dict[str, Any]) -> Evidence:
+    """SPIN's violation of ``mine`` mapped back to a lasso of ``graph``, its
+    steps written to ``trail_path``: failed evidence with the counterexample."""
+    props = Propositions([mine.formula])
+    try:
+        cex = counterexample(graph, read_replay(res.trail), props)
+    except ValueError as exc:
+        return evidence("error", f"SPIN's trail does not map back to the graph: {exc}", log=res.output + res.trail)
+    details["lasso"] = cex
+    atomic_write_text(trail_path, "\n".join(cex["trace"]) + "\n")
+    arts.append(target.rel(trail_path))
+    # the counterexample as AJPF's results give it (a summary and the path, one line per step);
+    # the steps as data are details["lasso"]
+    return evidence("failed", f"property violated; counterexample: {summary(cex)}", log=res.output,
+                    artifacts=tuple(arts), counterexample={"lasso": summary(cex), "trace": cex["trace"]})
+
+
+def _holds(evidence: _Say, graph: StateGraph, graph_key: str, pml: PromelaModel, mine: Claim,
+           run: Callable[[str], spin.CheckResult], res: spin.CheckResult, arts: list[str],
+           details: dict[str, Any]) -> Evidence:
+    """The claim holds on every path: discharged unless an antecedent never
+    holds (vacuous) or whether it ever holds was not decided (inconclusive)."""
+    memo = _MEMO.setdefault(graph_key, {})
+    memo.update({a: ks for a, ks in pml.truth.items() if a not in memo})  # the model's own truth table
+    vac = check_vacuity(graph, mine.formula, memo)
+    vacuous = list(vac.vacuous)
+    undecided = []
+    aux = [c for c in _vacuity_claims([mine])]
+    for a, c in zip(vac.pending, aux):
+        r = run(c.name)
+        if r.verdict == "holds":
+            vacuous.append(f"the antecedent {a.text} holds on no path" + ("" if a.temporal_context else
+                                                                          " from the initial state"))
+        elif r.verdict != "violated":
+            undecided.append(f"whether the antecedent {a.text} ever holds: {r.reason or r.verdict}")
+    details["antecedents"] = [{"antecedent": t, "holds_in_state": k} for t, k in vac.witnessed]
+    if vacuous:
+        details["vacuous"] = vacuous
+        return evidence("inconclusive", "the property holds on every path (pan: errors: 0, full search), but "
+                                        "vacuously: " + "; ".join(vacuous) + " -- it says nothing about what the "
+                                        "agent does (vacuous)", log=res.output, artifacts=tuple(arts))
+    if undecided:
+        return evidence("inconclusive", "the property holds on every path (pan: errors: 0, full search), but its "
+                                        "vacuity was not decided: " + "; ".join(undecided),
+                        log=res.output, artifacts=tuple(arts))
+    return evidence("discharged", "the property holds on every path (pan: errors: 0, full search), and every "
+                                  "antecedent holds in some state (not vacuous)", log=res.output, artifacts=tuple(arts))
+
+
 def check_graph(obligation: Obligation, target: NodeTarget, graph: StateGraph, claims: list[Claim], claim: str, *,
                 tools: spin.Tools, graph_key: str, bounds: tuple[int, int], claims_key: str | None = None,
                 explore_s: float = 0.0, timeout_s: float = spin.DEFAULT_TIMEOUT_S, clock: Stopwatch | None = None,
@@ -293,18 +365,9 @@ def check_graph(obligation: Obligation, target: NodeTarget, graph: StateGraph, c
         return make_evidence(target, obligation, status, tool=TOOL, tool_version=tools.version, clock=clock,
                              details=details, explanation=f"{what}: {why}", **kw)
 
-    if not graph.complete:
-        details["spin_verdict"] = "not run"
-        details["bounded"] = True
-        return evidence("inconclusive", f"the exploration was cut ({graph.cut}), so the graph is not the program's "
-                                        "whole state space and SPIN was not run on it (bounded: raise the bound "
-                                        "named to decide)")
-    named = named_identifiers(mine.formula, percepts)
-    if named:
-        details["spin_verdict"] = "not run"
-        return evidence("inconclusive", f"the property names an identifier value ({', '.join(named)}); an "
-                                        "identifier is any fresh value (docs/model-checking.md, Identifiers), so "
-                                        "the property has no meaning: write '_' at the identifier's place")
+    refused = _not_run(graph, mine, percepts, details)
+    if refused is not None:
+        return evidence("inconclusive", refused)
     mkey = hashlib.sha256((graph_key + claims_key).encode()).hexdigest()
     where = _where(target, graph)
     t0 = time.perf_counter()
@@ -333,48 +396,12 @@ def check_graph(obligation: Obligation, target: NodeTarget, graph: StateGraph, c
                     "propositions": dict(pml.props)})
     arts = [target.rel(spin_dir / "model.pml")]
     if res.verdict == "violated":
-        props = Propositions([mine.formula])
-        try:
-            cex = counterexample(graph, read_replay(res.trail), props)
-        except ValueError as exc:
-            return evidence("error", f"SPIN's trail does not map back to the graph: {exc}", log=res.output + res.trail)
-        details["lasso"] = cex
-        trail_path = spin_dir / f"{claim}.trail.txt"
-        atomic_write_text(trail_path, "\n".join(cex["trace"]) + "\n")
-        arts.append(target.rel(trail_path))
-        # the counterexample as AJPF's results give it (a summary and the path, one line per step);
-        # the steps as data are details["lasso"]
-        return evidence("failed", f"property violated; counterexample: {summary(cex)}", log=res.output,
-                        artifacts=tuple(arts), counterexample={"lasso": summary(cex), "trace": cex["trace"]})
+        return _violated(evidence, target, graph, mine, res, spin_dir / f"{claim}.trail.txt", arts, details)
     if res.verdict == "incomplete":
         return evidence("inconclusive", f"SPIN's search was cut: {res.reason}", log=res.output, artifacts=tuple(arts))
     if res.verdict != "holds":
         return evidence("error", f"SPIN failed: {res.reason}", log=res.output, artifacts=tuple(arts))
-    memo = _MEMO.setdefault(graph_key, {})
-    memo.update({a: ks for a, ks in pml.truth.items() if a not in memo})  # the model's own truth table
-    vac = check_vacuity(graph, mine.formula, memo)
-    vacuous = list(vac.vacuous)
-    undecided = []
-    aux = [c for c in _vacuity_claims([mine])]
-    for a, c in zip(vac.pending, aux):
-        r = run(c.name)
-        if r.verdict == "holds":
-            vacuous.append(f"the antecedent {a.text} holds on no path" + ("" if a.temporal_context else
-                                                                          " from the initial state"))
-        elif r.verdict != "violated":
-            undecided.append(f"whether the antecedent {a.text} ever holds: {r.reason or r.verdict}")
-    details["antecedents"] = [{"antecedent": t, "holds_in_state": k} for t, k in vac.witnessed]
-    if vacuous:
-        details["vacuous"] = vacuous
-        return evidence("inconclusive", "the property holds on every path (pan: errors: 0, full search), but "
-                                        "vacuously: " + "; ".join(vacuous) + " -- it says nothing about what the "
-                                        "agent does (vacuous)", log=res.output, artifacts=tuple(arts))
-    if undecided:
-        return evidence("inconclusive", "the property holds on every path (pan: errors: 0, full search), but its "
-                                        "vacuity was not decided: " + "; ".join(undecided),
-                        log=res.output, artifacts=tuple(arts))
-    return evidence("discharged", "the property holds on every path (pan: errors: 0, full search), and every "
-                                  "antecedent holds in some state (not vacuous)", log=res.output, artifacts=tuple(arts))
+    return _holds(evidence, graph, graph_key, pml, mine, run, res, arts, details)
 
 
 def clear_caches() -> None:

@@ -35,19 +35,19 @@ from __future__ import annotations
 from collections import deque
 from typing import Any, Callable, Mapping
 
-from rclverify.semantics.floatsem import Judgement, Tolerance, holds_in, judge
+from rclverify.semantics.floatsem import Judgement, Tolerance
 from rclverify.semantics.judges import FormulaJudge
 from rclverify.lang.printer import expr_to_rcl
 from rclverify.lang.types import Checked, CheckedNode
 from rclverify.traces.events import Event
 from rclverify.traces.mapping import MappingError, TopicRule, initial_value, rule_for, value_mapper
 from rclverify.traces.questions import Question, QuestionStream
-from rclverify.semantics.values import render
 from rclverify.backends.monitors.closing import Closing
+from rclverify.backends.monitors.judging import Judging
 from rclverify.backends.monitors.late import Late
 from rclverify.backends.monitors.needs_answer import answer_decides
 from rclverify.backends.monitors.outcome import Outcome, combine, skew_reason
-from rclverify.backends.monitors.verdicts import WEAK as _WEAK, LINK_TOPICS, NodeResult, Verdict, in_all, names, reads
+from rclverify.backends.monitors.verdicts import LINK_TOPICS, NodeResult, Verdict, in_all, names, reads
 
 _NO_RULE = TopicRule()  # the rule of a topic the mapping does not name
 _NEVER = float("inf")
@@ -57,11 +57,7 @@ _EMPTY: Mapping[str, Any] = {}
 _SATISFIED = {sem: Outcome("satisfied", semantics=sem) for sem in ("exact", "double", "tolerance")}
 
 
-def _always(k: int) -> bool:
-    return True
-
-
-class NodeMonitor(Closing, Late):
+class NodeMonitor(Judging, Closing, Late):
     """Streams events through one node's contract; :meth:`finish` gives the result.
 
     ``rules`` maps topic names to :class:`TopicRule` (its ``tolerance`` and
@@ -84,26 +80,7 @@ class NodeMonitor(Closing, Late):
         self.on_verdict = on_verdict
         self.now = float("-inf")
         self.result = NodeResult(node.name)
-        self.topics: dict[str, list[tuple[str, Any, bool]]] = {}
-        for t in node.node.topics:
-            if t.match is None:
-                continue
-            typ = node.io_type(t.match)
-            if typ is None:
-                continue
-            is_input = t.match.prefix == "in" or (t.match.prefix is None and t.match.name in node.inputs)
-            key = ("in." if is_input else "out.") + t.match.name
-            self.topics.setdefault(t.field.lstrip("/"), []).append((key, typ, is_input))
-        parts: dict[tuple[str, str], str] = {}  # (topic, key) -> the actionlib part that maps to the variable
-        for lk in node.node.links:
-            for suffix, v in zip(LINK_TOPICS.get(lk.kind, ()), lk.parts):
-                typ = node.io_type(v)
-                if typ is None or v.prefix not in ("in", "out"):
-                    continue
-                topic, key = f"{lk.name.lstrip('/')}/{suffix}", f"{v.prefix}.{v.name}"
-                self.topics.setdefault(topic, []).append((key, typ, v.prefix == "in"))
-                if lk.kind == "action":
-                    parts[(topic, key)] = suffix
+        self.topics, parts = node_topics(node)
         self.has_inputs = any(i for vs in self.topics.values() for _, _, i in vs)
         self._feeds = {topic: [(key, value_mapper(typ, rule_for(rules, topic, key, _NO_RULE)), parts.get((topic, key), ""))
                                for key, typ, _ in vs] for topic, vs in self.topics.items()}
@@ -115,6 +92,14 @@ class NodeMonitor(Closing, Late):
         for topic, vs in self.topics.items():
             for key, typ, _ in vs:
                 self.values[key] = initial_value(typ, rule_for(rules, topic, key, _NO_RULE))
+        self._read_contract(node)
+        self._sort_guarantees(rules)
+        self._start_stream(rules, horizon)
+        self._make_judges(checked, node)
+
+    def _read_contract(self, node: CheckedNode) -> None:
+        """The contract's formulas, triggers and texts, and the variables it
+        reads: those an input question needs and those no topic carries."""
         self.assumption = tuple(c.formula for c in node.node.assumes)
         self.guarantees = tuple(c.formula for c in node.node.guarantees)
         #: guarantee k -> ``in.x`` for ``triggered by in.x``: it answers the messages of that input only
@@ -131,6 +116,10 @@ class NodeMonitor(Closing, Late):
         #: variables the contract reads that no topic or link part carries: no run gives them a value
         self.unbound = sorted(f"{p}.{v}" for p, names_ in (("in", node.inputs), ("out", node.outputs))
                               for v in names_ if f"{p}.{v}" not in self.values and (v in needed or f"{p}.{v}" in needed))
+
+    def _sort_guarantees(self, rules: Mapping[str, TopicRule]) -> None:
+        """Which variables each formula reads, which guarantees are asked of a
+        question and which judged alone, and per topic those a message on it touches."""
         outputs = sorted(k for k in self.values if k.startswith("out."))
         event_outs = {key for topic, vs in self.topics.items() for key, _, inp in vs
                       if not inp and not rules.get(topic, _NO_RULE).state}
@@ -160,6 +149,9 @@ class NodeMonitor(Closing, Late):
                         for topic, (asked, alone) in self._touch.items()}
         #: the guarantees an answered question must see decided (they read an output)
         self._need = [k for k in self._asked if gouts[k]]
+
+    def _start_stream(self, rules: Mapping[str, TopicRule], horizon: float) -> None:
+        """The questions' stream and what the engine remembers of the run."""
         skew = getattr(rules, "skew", None) or 0.0
         self.stream = QuestionStream(skew if self.has_inputs else 0.0, horizon)
         #: outputs judged at once, for a question within the skew after them that gets no answer of its own
@@ -179,6 +171,10 @@ class NodeMonitor(Closing, Late):
         #: newer question within its horizon, which owes what it lacks, or was closed when its horizon passed)
         self._open: Question | None = None
         self._due = _NEVER
+
+    def _make_judges(self, checked: Checked, node: CheckedNode) -> None:
+        """One compiled judge per formula, the evaluation cache, and whether a
+        question's guarantees are evaluated when it comes."""
         self._cache: dict[tuple[Any, tuple[Any, ...]], Judgement] = {}
         self._assumed = [(("A", j), f) for j, f in enumerate(self.assumption)]
         self._guaranteed = dict(enumerate(self.guarantees, 1))
@@ -190,40 +186,6 @@ class NodeMonitor(Closing, Late):
         self._ask_at_question = any(not self._reads_out[k] for k in self._asked) or not (
             self.has_inputs and not self._state_outs and not self._trigger
             and answer_decides(checked, node, self.guarantees))
-
-    # -- evaluation --------------------------------------------------------------
-    def _judge(self, k: Any, values: Mapping[str, Any]) -> Judgement:
-        """The judgement of guarantee ``k`` (``("A", j)``: assumption ``j``) on
-        ``values``: the compiled code where it decides alone, else
-        :func:`~rclverify.semantics.floatsem.judge`, remembered per (formula,
-        values of the variables it reads)."""
-        hit = self._judges[k].quick(values)
-        if hit is not None:
-            return hit
-        ck = (k, tuple([values.get(d) for d in self._deps[k]]))
-        hit = self._cache.get(ck)
-        if hit is not None:
-            return hit
-        formula = self._guaranteed[k] if isinstance(k, int) else self.assumption[k[1]]
-        j = judge(formula, self.checked, self.node, values, self.tolerance)
-        if self.cache_size:
-            if len(self._cache) >= self.cache_size:
-                self._cache.clear()
-            self._cache[ck] = j
-        return j
-
-    def _rendered(self, values: Mapping[str, Any]) -> dict[str, str]:
-        out = {}
-        for k, v in sorted(values.items()):
-            if v is None:
-                continue
-            hit = self._renders.get(id(v))
-            if hit is None or hit[0] is not v:
-                if len(self._renders) >= 256:
-                    self._renders.clear()
-                hit = self._renders[id(v)] = (v, render(v))
-            out[k] = hit[1]
-        return out
 
     def _verdict(self, verdict: str, ev: Event, guarantee: int = 0, values: Mapping[str, str] | None = None,
                  reason: str = "", semantics: str = "", question: str = "") -> None:
@@ -237,12 +199,6 @@ class NodeMonitor(Closing, Late):
             self.on_verdict(Verdict(self.node.name, verdict, ev.index, ev.time, ev.where, ev.topic,
                                     max(self.now, ev.time), guarantee, dict(values or {}), reason, semantics,
                                     question))
-
-    def _note_inexact(self, ev: Event, judged: Judgement, what: str, values: Mapping[str, Any]) -> None:
-        if self.result.first_inexact is None:
-            self.result.first_inexact = {"event": ev.index, "time": ev.time, "where": ev.where,
-                                         "semantics": judged.semantics, "formula": what,
-                                         "values": self._rendered(values), "reason": judged.reason}
 
     # -- streaming ---------------------------------------------------------------
     def feed(self, ev: Event) -> None:
@@ -359,10 +315,6 @@ class NodeMonitor(Closing, Late):
         if self._ask_at_question:
             self._at_question(q)
 
-    def _owes(self, q: Question, k: int) -> bool:
-        trig = self._trigger.get(k)
-        return trig is None or trig in q.triggers
-
     def _output(self, ev: Event, changed: list[str]) -> None:
         values = self.values
         asked, alone = self._touch[ev.topic]
@@ -443,93 +395,6 @@ class NodeMonitor(Closing, Late):
             # judged now: an input heard later but stamped before it may still be its question (late.py)
             self._released.append((ev, stamped, {k: outs[k] for k in self._topic_io[ev.topic][1] if k in outs}, state))
 
-    def _alone_outcome(self, ev: Event, ks: list[int]) -> Outcome:
-        """The guarantees over outputs only that ``ev`` touches, on the outputs as they stand."""
-        if not ks:
-            return Outcome("none")
-        values = {k: v for k, v in self.values.items() if v is not None}
-        return self._outcome(ks, values, lambda k: True, None, ev)
-
-    def _outcome(self, ks: list[int], values: Mapping[str, Any], owed: Callable[[int], bool],
-                 q: Question | None, ev: Event, weakest: str = "exact") -> Outcome:
-        """Guarantees ``ks`` (those ``owed``) judged on ``values``: the first
-        false one, else undecided, else satisfied, else ``none``."""
-        decided, undecided = False, None
-        held: list[tuple[int, str]] = []
-        if q is not None and ev.time > q.due and not self._at_due(ev.time, q.due):
-            q = None  # judged against it, but past its horizon: no part of its answer
-        first_inexact = None
-        for k in ks:
-            if not owed(k):
-                continue
-            if q is not None and k in self._trigger:
-                q.mark("answered_triggers", self._trigger[k])
-            judged = self._judge(k, values)
-            if judged.truth is False:
-                if q is not None:
-                    q.waiting.pop(k, None)
-                    q.decided.add(k)
-                return Outcome("violated", k, judged.semantics, values=dict(values))
-            if judged.truth is None:
-                if judged.reason.startswith("no value for out."):  # waits for that output
-                    if q is not None:
-                        q.waiting[k] = (ev, judged.reason, {x: v for x, v in values.items() if x.startswith("out.")})
-                    continue
-                undecided = undecided or (k, judged.reason)
-                continue
-            if q is not None:
-                q.waiting.pop(k, None)
-                q.decided.add(k)
-            decided = True
-            held.append((k, judged.semantics))
-            if judged.semantics != "exact":
-                first_inexact = first_inexact or (k, judged)
-                if _WEAK.get(judged.semantics, 0) > _WEAK[weakest]:
-                    weakest = judged.semantics
-        if undecided is not None:
-            k, why = undecided
-            return Outcome("inconclusive", k, reason=f"guarantee {k}: {why}" + self._unbound_note(why))
-        if decided and weakest != "exact":  # one arithmetic per message for the whole contract
-            for k, sem in held:
-                if _WEAK.get(sem, 0) < _WEAK[weakest] and holds_in(weakest, self._guaranteed[k], self.checked,
-                                                                  self.node, values, self.tolerance) is False:
-                    other = next(j for j, s2 in held if s2 == weakest)
-                    return Outcome("violated", k, weakest, values=dict(values),
-                                   reason=f"guarantee {other} holds only in {weakest} arithmetic and guarantee {k} "
-                                          f"is false in it: no one arithmetic makes the node's guarantees hold on "
-                                          f"the message")
-        if decided:
-            if first_inexact is not None:
-                k, judged = first_inexact
-                self._note_inexact(ev, judged, f"guarantee {k} ({self._texts[k]})", values)
-            return Outcome("satisfied", semantics=weakest)
-        return Outcome("none")
-
-    def _question_outcome(self, q: Question | None, ev: Event, ks: list[int], outs: Mapping[str, Any],
-                          state: Mapping[str, Any], keep: bool = True) -> Outcome:
-        """Output ``ev`` judged against question ``q``; ``keep``: it is the
-        question ``ev`` answered (not another reading within the skew), whose
-        decided and waiting guarantees it updates."""
-        if q is None:
-            return Outcome("unasked")
-        if not q.owed:
-            return Outcome("none")
-        if not state and outs is q.answer and q.view is not None:
-            values = q.view  # inputs and answer, kept by _output: no copy
-        else:
-            values = dict(q.inputs)
-            if state:
-                values.update(state)
-            values.update(outs)
-        return self._outcome(ks, values, self._owes_fn(q), q if keep else None, ev,
-                             q.info)
-
-    def _owes_fn(self, q: Question) -> Callable[[int], bool]:
-        """Which guarantees ``q`` is owed (all of them when none has a trigger)."""
-        if not self._trigger:
-            return _always
-        return lambda k: self._owes(q, k)
-
     def _decide(self, ev: Event, q: Question | None, others: list[Question], alone: Outcome,
                 outs: Mapping[str, Any], first: Outcome | None = None, state: Mapping[str, Any] | None = None) -> None:
         """One output message's verdict: its output-only guarantees (``alone``)
@@ -582,4 +447,33 @@ class NodeMonitor(Closing, Late):
         return self.result
 
 
-__all__ = ["NodeMonitor"]
+def node_topics(node: CheckedNode) -> tuple[dict[str, list[tuple[str, Any, bool]]], dict[tuple[str, str], str]]:
+    """The topics that carry ``node``'s variables: topic (no leading ``/``) ->
+    ``[(key, type, is_input)]`` with ``key`` ``in.x``/``out.x``, from its
+    ``topics(...)`` and the parts of its service and action links
+    (:data:`LINK_TOPICS`); and ``(topic, key)`` -> the actionlib part of the
+    message that maps to the variable."""
+    topics: dict[str, list[tuple[str, Any, bool]]] = {}
+    for t in node.node.topics:
+        if t.match is None:
+            continue
+        typ = node.io_type(t.match)
+        if typ is None:
+            continue
+        is_input = t.match.prefix == "in" or (t.match.prefix is None and t.match.name in node.inputs)
+        key = ("in." if is_input else "out.") + t.match.name
+        topics.setdefault(t.field.lstrip("/"), []).append((key, typ, is_input))
+    parts: dict[tuple[str, str], str] = {}
+    for lk in node.node.links:
+        for suffix, v in zip(LINK_TOPICS.get(lk.kind, ()), lk.parts):
+            typ = node.io_type(v)
+            if typ is None or v.prefix not in ("in", "out"):
+                continue
+            topic, key = f"{lk.name.lstrip('/')}/{suffix}", f"{v.prefix}.{v.name}"
+            topics.setdefault(topic, []).append((key, typ, v.prefix == "in"))
+            if lk.kind == "action":
+                parts[(topic, key)] = suffix
+    return topics, parts
+
+
+__all__ = ["NodeMonitor", "node_topics"]

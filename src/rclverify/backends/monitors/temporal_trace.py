@@ -56,28 +56,23 @@ from __future__ import annotations
 import math
 
 from dataclasses import dataclass, field
-from fractions import Fraction
 from typing import Any, Iterable, Mapping
 
 import z3
 
-from rclverify.semantics.concrete import finite_interpretation, to_z3
 from rclverify.semantics.floatsem import judge
-from rclverify.semantics.encode import EncodingError, Encoder
+from rclverify.semantics.encode import EncodingError
 from rclverify.model.plan.formal import Formal
-from rclverify.model.plan.state import StateFormula, StateVar, parse_state_formula, state_type
+from rclverify.model.plan.state import StateVar, state_type
 from rclverify.model.plan.temporal import Temporal, shape
 from rclverify.backends.monitors.response_trace import ResponseTracker
-from rclverify.lang.types import Checked, EnumT, FuncT, Scalar, Type
+from rclverify.backends.monitors.trace_states import TraceStates
+from rclverify.lang.types import Checked
 from rclverify.traces.events import Event
-from rclverify.traces.mapping import MappingError, TopicRule, initial_value, map_value, rule_for
-from rclverify.semantics.values import FiniteFunction, render
+from rclverify.traces.mapping import TopicRule
+from rclverify.semantics.values import render
 
 VERDICTS = ("true", "false", "currently_false", "inconclusive")
-#: :func:`solve_value`'s answer when a value the formula reads is not observed yet.
-MISSING = object()
-#: Z3's budget per state update (ms).
-TIMEOUT_MS = 2_000
 
 
 @dataclass
@@ -102,206 +97,6 @@ class TraceVerdict:
         return {"verdict": self.verdict, "steps": self.steps, "reason": self.reason, "step": self.step,
                 "time": self.time, "where": self.where, "witness": self.witness}
 
-
-def _from_z3(v: z3.ExprRef, t: Type) -> Any:
-    """A Z3 model value as a value of :mod:`rclverify.semantics.values` (None if not a literal)."""
-    if isinstance(t, Scalar):
-        if t.name == "BOOL":
-            return True if z3.is_true(v) else False if z3.is_false(v) else None
-        if z3.is_int_value(v):
-            return v.as_long()
-        if z3.is_rational_value(v):
-            f = Fraction(v.numerator_as_long(), v.denominator_as_long())
-            return int(f) if f.denominator == 1 and t.name != "REAL" else f
-        return None
-    if isinstance(t, EnumT):
-        return str(v) if z3.is_const(v) and v.num_args() == 0 else None
-    return None
-
-
-def _numbers(v: Any, out: set[Any]) -> None:
-    """Every number in a value (table keys and results, constructor arguments)."""
-    if isinstance(v, bool):
-        return
-    if isinstance(v, (int, float, Fraction)):
-        out.add(v)
-    elif isinstance(v, FiniteFunction):
-        for k, r in v.table.items():
-            _numbers(k, out)
-            _numbers(r, out)
-    elif isinstance(v, (tuple, list, frozenset, set)):
-        for x in v:
-            _numbers(x, out)
-    elif hasattr(v, "args") and isinstance(getattr(v, "args"), tuple):
-        _numbers(v.args, out)
-
-
-def _function_value(m: z3.ModelRef, decl: z3.FuncDeclRef, t: FuncT, values: Mapping[str, Any],
-                    enc: Encoder) -> FiniteFunction | None:
-    """A candidate finite table for function ``decl`` in model ``m``: its
-    value at every point built from the numbers of ``values`` and at one
-    point beyond them (the default).  The caller checks it is the only
-    solution, so a wrong candidate is never used.  Unary functions over
-    numbers only (else ``None``)."""
-    if len(t.args) != 1 or not isinstance(t.args[0], Scalar) or t.args[0].name == "BOOL":
-        return None
-    a = t.args[0]
-    nums: set[Any] = set()
-    _numbers(list(values.values()), nums)
-    pts = {x if a.name == "REAL" else int(x) for x in nums if a.name == "REAL" or Fraction(x).denominator == 1}
-    pts = {x for x in pts if a.name != "NATURAL" or x >= 0}
-    beyond = max(pts, default=0) + 1
-    at = lambda x: _from_z3(m.eval(decl(to_z3(x, a, enc)), model_completion=True), t.result)  # noqa: E731
-    default = at(beyond)
-    if default is None:
-        return None
-    table = {}
-    for x in sorted(pts):
-        r = at(x)
-        if r is None:
-            return None
-        if r != default:
-            table[(x,)] = r
-    return FiniteFunction(table, default, 1)
-
-
-def solve_value(sf: StateFormula, checked: Checked, target: str, values: Mapping[str, Any]) -> Any:
-    """The one value of ``target`` (``"state.v"`` for ``init``, ``"next.v"``
-    for ``next``) that makes ``sf`` true with every other variable at its
-    value in ``values`` (keyed ``"in.x"``, ``"out.y"``, ``"state.v"``).
-    Returns :data:`MISSING` when a value it reads is not observed yet,
-    ``None`` when Z3 cannot decide, or the
-    formula does not define exactly one value (docs/plan.md, "state": a
-    ``next`` must be a definition).  Never raises."""
-    enc = Encoder(checked.env)
-    try:
-        phi = enc.formula(sf.expr, sf.scope)
-        consts, funcs, goal = [], [], None
-        for sym in enc.symbols.values():
-            name = sym.z3name.split(".", 1)[1]  # "<Node>.in.state.v" -> "in.state.v"
-            bare = name[3:] if name.startswith(("in.state.", "in.next.")) else name
-            if bare == target:
-                goal = sym
-                continue
-            v = values.get(bare)
-            if v is None:
-                return MISSING
-            t = sym.type
-            if isinstance(t, FuncT):
-                if not isinstance(v, FiniteFunction):
-                    return None
-                funcs.append((sym.decl, finite_interpretation(v, t, enc)))
-            else:
-                consts.append((sym.decl, to_z3(v, t, enc)))
-        if goal is None:
-            return None
-        if consts:
-            phi = z3.substitute(phi, *consts)
-        if funcs:
-            phi = z3.substitute_funs(phi, *funcs)
-        s = z3.Solver()
-        s.set("timeout", TIMEOUT_MS)
-        s.add(phi)
-        if s.check() != z3.sat:
-            return None
-        m = s.model()
-        t = goal.type
-        if isinstance(t, FuncT):
-            value = _function_value(m, goal.decl, t, values, enc)
-            if value is None:
-                return None
-            xs = [z3.FreshConst(d) for d in [goal.decl.domain(k) for k in range(goal.decl.arity())]]
-            body = finite_interpretation(value, t, enc)
-            differs = z3.And(goal.decl(*xs) != z3.substitute_vars(body, *reversed(xs)),
-                             *[x >= 0 for x, a in zip(xs, t.args) if isinstance(a, Scalar) and a.name == "NATURAL"])
-        else:
-            value = _from_z3(m.eval(goal.decl, model_completion=True), t)
-            if value is None:
-                return None
-            differs = goal.decl != to_z3(value, t, enc)
-        s.add(differs)  # unique: no other value satisfies the formula
-        return value if s.check() == z3.unsat else None
-    except (EncodingError, ValueError, TypeError, KeyError, z3.Z3Exception):
-        return None
-
-
-class TraceStates:
-    """The states of the steps of a trace for the nodes ``nodes`` (module
-    docstring): :meth:`feed` one event, ``values`` the state (keyed as the
-    statement's scope reads them: ``"in.Node.in.x"``, ``"out.Node.out.y"``,
-    ``"in.Node.state.v"``)."""
-
-    def __init__(self, checked: Checked, nodes: Iterable[str], states: tuple[StateVar, ...],
-                 rules: Mapping[str, TopicRule]) -> None:
-        self.checked, self.rules = checked, rules
-        self.nodes = list(nodes)
-        self.topics: dict[str, list[tuple[str, str, Type]]] = {}  # topic -> [(node, "in.x", type)]
-        self.io: dict[str, dict[str, Any]] = {n: {} for n in self.nodes}
-        for n in self.nodes:
-            cn = checked.nodes[n]
-            for t in cn.node.topics:
-                typ = cn.io_type(t.match) if t.match is not None else None
-                if typ is None:
-                    continue
-                inp = t.match.prefix == "in" or (t.match.prefix is None and t.match.name in cn.inputs)
-                key = ("in." if inp else "out.") + t.match.name
-                topic = t.field.lstrip("/")
-                self.topics.setdefault(topic, []).append((n, key, typ))
-                self.io[n][key] = initial_value(typ, rule_for(rules, topic, key))
-        self.vars = [sv for sv in states if sv.node in self.nodes]
-        self.formulas = {(sv.node, sv.name): (parse_state_formula(sv, "init", checked, states),
-                                              parse_state_formula(sv, "next", checked, states)) for sv in self.vars}
-        self.state: dict[tuple[str, str], Any] = {}
-        self.steps = 0
-        self.problem = ""
-        #: scope keys (``"in.Node.in.x"``) whose last message could not be read (a string for a REAL, NaN, a
-        #: bool): no value, and what reads them is undecided, never judged on the value before (issue 63, row 5)
-        self.unreadable: dict[str, str] = {}
-
-    def _node_values(self, n: str) -> dict[str, Any]:
-        out = {k: v for k, v in self.io[n].items() if v is not None}
-        out.update({f"state.{v}": x for (m, v), x in self.state.items() if m == n and x is not None})
-        return out
-
-    def feed(self, ev: Event) -> bool:
-        """Apply one event; returns whether it is a step (on a topic of the nodes)."""
-        vs = self.topics.get(ev.topic.lstrip("/"))
-        if not vs:
-            return False
-        before = {n: self._node_values(n) for n in {sv.node for sv in self.vars}} if self.steps else {}
-        for n, key, typ in vs:
-            p, _, name = key.partition(".")
-            try:
-                self.io[n][key] = map_value(typ, ev.fields, rule_for(self.rules, ev.topic, key), self.io[n].get(key))
-                self.unreadable.pop(f"{p}.{n}.{p}.{name}", None)
-            except MappingError as exc:
-                self.io[n][key] = None
-                self.unreadable[f"{p}.{n}.{p}.{name}"] = f"{ev.where}: {n}.{key}: {exc}"
-                self.problem = self.problem or f"{ev.where}: {n}.{key}: {exc}"
-        for sv in self.vars:
-            init, nxt = self.formulas[(sv.node, sv.name)]
-            if self.steps == 0:
-                v = solve_value(init, self.checked, f"state.{sv.name}", {})
-            else:  # the node has not produced what next reads yet: no step of the node, the state is kept
-                v = solve_value(nxt, self.checked, f"next.{sv.name}", before[sv.node])
-                if v is MISSING:
-                    continue
-            self.state[(sv.node, sv.name)] = None if v is MISSING else v
-        self.steps += 1
-        return True
-
-    def values(self) -> dict[str, Any]:
-        """The state of the current step, keyed for a statement's scope."""
-        out: dict[str, Any] = {}
-        for n in self.nodes:
-            for k, v in self.io[n].items():
-                if v is not None:
-                    p, _, name = k.partition(".")
-                    out[f"{p}.{n}.{p}.{name}"] = v
-        for (n, v), x in self.state.items():
-            if x is not None:
-                out[f"in.{n}.state.{v}"] = x
-        return out
 
 
 def _truth(f: Formal, checked: Checked, values: Mapping[str, Any], tolerance: Any = None,
@@ -337,6 +132,147 @@ def _shown(f: Formal, values: Mapping[str, Any]) -> dict[str, str]:
     return {k.partition(".")[2]: render(v) for k, v in sorted(values.items()) if k.partition(".")[2] in names}
 
 
+@dataclass
+class _Run:
+    """One statement's check on one trace, step by step: the operands
+    ``ops``, the state of the run so far (the trace states ``st``, the step
+    ``i`` and its event ``last``, the values ``vals`` at it) and the first
+    undecided operand's witness (``undecided``)."""
+
+    kind: str
+    ops: list[Formal]
+    bound: int | None
+    checked: Checked
+    st: TraceStates
+    tol: Any
+    tracker: ResponseTracker | None = None
+    sems: dict[int, str] = field(default_factory=dict)
+    undecided: dict[str, Any] | None = None
+    i: int = -1
+    last: Event | None = None
+    vals: Mapping[str, Any] = field(default_factory=dict)
+
+    def decide(self, f: Formal, unpublished: bool | None) -> bool | None:
+        """``f``'s truth at this step: undecided when a value it reads was unreadable in its last message,
+        ``unpublished`` when one was never published, else judged."""
+        if any(f"{p}.{n}.{p}.{v}" in self.st.unreadable for n, p, v in f.mentions):
+            return None
+        return _truth(f, self.checked, self.vals, self.tol, self.sems) if _published(f, self.vals) else unpublished
+
+    def wit(self, f: Formal, holds: bool | None) -> dict[str, Any]:
+        """The witness of operand ``f`` at this step."""
+        ev = self.last
+        assert ev is not None
+        out = {"step": self.i, "time": ev.time, "where": ev.where, "operand": f.expr and _text(f),
+               "holds": holds, "values": _shown(f, self.vals)}
+        bad = [self.st.unreadable[k] for n, p, v in f.mentions if (k := f"{p}.{n}.{p}.{v}") in self.st.unreadable]
+        if bad:
+            out["unreadable"] = bad
+        if holds and self.sems.get(id(f), "exact") != "exact":  # held only in double arithmetic or the tolerance
+            out["semantics"] = self.sems[id(f)]
+        return out
+
+    def at(self, verdict: str, why: str, w: list[dict[str, Any]]) -> TraceVerdict:
+        """The verdict decided at this step."""
+        ev = self.last
+        assert ev is not None
+        return TraceVerdict(verdict, self.i + 1, why, self.i, ev.time, ev.where, w)
+
+    def note(self, f: Formal, h: bool | None) -> None:
+        """Remember ``f`` as the first undecided operand when ``h`` is undecided and none was before."""
+        if h is None and self.undecided is None:
+            self.undecided = self.wit(f, None)
+
+    def where(self) -> str:
+        ev = self.last
+        assert ev is not None
+        return f"{ev.where}, t = {ev.time} s"
+
+
+def _step_always(r: _Run) -> TraceVerdict | None:
+    """``always F`` and ``always next F``: false at the first step where F is false."""
+    if r.kind == "always next" and r.i == 0:
+        return None
+    f = r.ops[0]
+    h = r.decide(f, True)  # a value it reads never published: not evaluated (docs/semantics.md)
+    if h is False:
+        return r.at("false", f"{_text(f)} is false at step {r.i} ({r.where()})", [r.wit(f, False)])
+    r.note(f, h)
+    return None
+
+
+def _step_response(r: _Run) -> TraceVerdict | None:
+    """The response pattern (response_trace.py): false when a trigger goes unanswered in time."""
+    assert r.tracker is not None
+    said = r.tracker.step(r.i, r.decide(r.ops[0], False), r.decide(r.ops[1], False))
+    if said is not None and said[0] == "false":
+        return r.at("false", f"{_text(r.ops[0])} held at step {said[1]} and {_text(r.ops[1])} did not hold in "
+                             f"time, by step {r.i} ({r.where()})", [r.wit(r.ops[1], False)])
+    if said is not None and r.undecided is None:
+        r.undecided = r.wit(r.ops[said[1]], None)
+    return None
+
+
+def _step_next(r: _Run) -> TraceVerdict | None:
+    """``next F``: decided at step 1."""
+    if r.i != 1:
+        return None
+    h = r.decide(r.ops[0], False)
+    v = {True: "true", False: "false", None: "inconclusive"}[h]
+    return r.at(v, f"{_text(r.ops[0])} is {v if h is not None else 'undecided'} at step 1", [r.wit(r.ops[0], h)])
+
+
+def _step_eventually(r: _Run) -> TraceVerdict | None:
+    """``eventually[<= N] F``: true at the first step where F holds (reached only on published values)."""
+    f = r.ops[0]
+    h = r.decide(f, False)
+    if h is True:
+        return r.at("true", f"{_text(f)} holds at step {r.i} ({r.where()})", [r.wit(f, True)])
+    r.note(f, h)
+    if r.bound is not None and r.i >= r.bound:
+        if r.undecided is not None:
+            return r.at("inconclusive", f"not met within {r.bound} steps, but undecided at step "
+                                        f"{r.undecided['step']}", [r.undecided])
+        return r.at("false", f"{_text(f)} does not hold at any step 0..{r.bound}: the bound passed "
+                             f"at step {r.i} ({r.where()})", [r.wit(f, False)])
+    return None
+
+
+def _step_until(r: _Run) -> TraceVerdict | None:
+    """``F until G``: true when G holds with F at every step before, false when F fails first."""
+    f_op, g_op = r.ops[0], r.ops[1]
+    g = r.decide(g_op, False)
+    if g is True and r.undecided is None:
+        return r.at("true", f"{_text(g_op)} holds at step {r.i}, {_text(f_op)} at every step before",
+                    [r.wit(g_op, True)])
+    r.note(g_op, g)
+    if g is not True:
+        f = r.decide(f_op, True)
+        if f is False and r.undecided is None:
+            return r.at("false", f"{_text(f_op)} is false at step {r.i} before {_text(g_op)} held",
+                        [r.wit(f_op, False)])
+        r.note(f_op, f)
+    return None
+
+
+#: What each decided shape (model/plan/temporal.py, ``shape``) checks at one step.
+_STEPS = {"always": _step_always, "always next": _step_always, "response": _step_response, "next": _step_next,
+          "eventually": _step_eventually, "until": _step_until}
+
+
+def _operands(t: Temporal, kind: str) -> tuple[list[Formal], ResponseTracker | None]:
+    """The state formulas statement ``t`` of shape ``kind`` reads, and the
+    response pattern's tracker."""
+    if kind == "always next":
+        return [t.args[0].args[0]], None  # type: ignore[union-attr, list-item]
+    if kind == "response":  # always (P -> eventually[<= N] Q) / always (P -> next Q)
+        trig, resp = t.args[0].args  # type: ignore[union-attr]
+        tracker = ResponseTracker((math.inf if resp.bound is None else resp.bound)  # type: ignore[union-attr]
+                                  if resp.op == "eventually" else None)  # type: ignore[union-attr]
+        return [trig, resp.args[0]], tracker  # type: ignore[list-item, union-attr]
+    return list(t.args), None  # type: ignore[arg-type]
+
+
 def check_temporal_trace(t: Temporal, checked: Checked, states: tuple[StateVar, ...], events: Iterable[Event],
                          rules: Mapping[str, TopicRule]) -> TraceVerdict:
     """The verdict of statement ``t`` on the recorded run ``events`` (module
@@ -345,110 +281,41 @@ def check_temporal_trace(t: Temporal, checked: Checked, states: tuple[StateVar, 
     shape that is not decided and whatever the event source raises
     (:class:`~rclverify.traces.TraceError`)."""
     kind = shape(t, None)
-    tracker: ResponseTracker | None = None
-    if kind == "always next":
-        ops: list[Formal] = [t.args[0].args[0]]  # type: ignore[union-attr]
-    elif kind == "response":  # always (P -> eventually[<= N] Q) / always (P -> next Q)
-        trig, resp = t.args[0].args  # type: ignore[union-attr]
-        ops = [trig, resp.args[0]]  # type: ignore[list-item, union-attr]
-        tracker = ResponseTracker((math.inf if resp.bound is None else resp.bound)  # type: ignore[union-attr]
-                                  if resp.op == "eventually" else None)  # type: ignore[union-attr]
-    else:
-        ops = list(t.args)  # type: ignore[arg-type]
+    ops, tracker = _operands(t, kind)
     nodes = list(dict.fromkeys(n for f in ops for n in f.nodes))
     for sv in states:
         state_type(sv, checked)
     st = TraceStates(checked, nodes, states, rules)
-    tol = getattr(rules, "tolerance", None)  # the mapping's tolerance of recorded numbers
-    sems: dict[int, str] = {}
-    undecided: dict[str, Any] | None = None
-    i = -1
-    last: Event | None = None
-    def decide(f: Formal, unpublished: bool | None) -> bool | None:
-        """``f``'s truth at this step: undecided when a value it reads was unreadable in its last message,
-        ``unpublished`` when one was never published, else judged."""
-        if any(f"{p}.{n}.{p}.{v}" in st.unreadable for n, p, v in f.mentions):
-            return None
-        return _truth(f, checked, vals, tol, sems) if _published(f, vals) else unpublished
-
+    # the mapping's tolerance of recorded numbers
+    r = _Run(kind, ops, t.bound, checked, st, getattr(rules, "tolerance", None), tracker)
+    step = _STEPS[kind]
     for ev in events:
         if not st.feed(ev):
             continue
-        i, last = i + 1, ev
-        vals = st.values()
+        r.i, r.last = r.i + 1, ev
+        r.vals = st.values()
+        verdict = step(r)
+        if verdict is not None:
+            return verdict
+    return _at_end(r, nodes)
 
-        def wit(f: Formal, holds: bool | None) -> dict[str, Any]:
-            out = {"step": i, "time": ev.time, "where": ev.where, "operand": f.expr and _text(f),
-                   "holds": holds, "values": _shown(f, vals)}
-            bad = [st.unreadable[k] for n, p, v in f.mentions if (k := f"{p}.{n}.{p}.{v}") in st.unreadable]
-            if bad:
-                out["unreadable"] = bad
-            if holds and sems.get(id(f), "exact") != "exact":  # held only in double arithmetic or the tolerance
-                out["semantics"] = sems[id(f)]
-            return out
 
-        def at(verdict: str, why: str, w: list[dict[str, Any]]) -> TraceVerdict:
-            return TraceVerdict(verdict, i + 1, why, i, ev.time, ev.where, w)
-        if kind in ("always", "always next"):
-            if kind == "always next" and i == 0:
-                continue
-            h = decide(ops[0], True)  # a value it reads never published: not evaluated (docs/semantics.md)
-            if h is False:
-                return at("false", f"{_text(ops[0])} is false at step {i} ({ev.where}, t = {ev.time} s)",
-                          [wit(ops[0], False)])
-            if h is None and undecided is None:
-                undecided = wit(ops[0], None)
-        elif tracker is not None:  # the response pattern (response_trace.py)
-            said = tracker.step(i, decide(ops[0], False), decide(ops[1], False))
-            if said is not None and said[0] == "false":
-                return at("false", f"{_text(ops[0])} held at step {said[1]} and {_text(ops[1])} did not hold in "
-                                   f"time, by step {i} ({ev.where}, t = {ev.time} s)", [wit(ops[1], False)])
-            if said is not None and undecided is None:
-                undecided = wit(ops[said[1]], None)
-        elif kind == "next":
-            if i == 1:
-                h = decide(ops[0], False)
-                v = {True: "true", False: "false", None: "inconclusive"}[h]
-                return at(v, f"{_text(ops[0])} is {v if h is not None else 'undecided'} at step 1", [wit(ops[0], h)])
-        elif kind == "eventually":  # reached only on published values
-            h = decide(ops[0], False)
-            if h is True:
-                return at("true", f"{_text(ops[0])} holds at step {i} ({ev.where}, t = {ev.time} s)",
-                          [wit(ops[0], True)])
-            if h is None and undecided is None:
-                undecided = wit(ops[0], None)
-            if t.bound is not None and i >= t.bound:
-                if undecided is not None:
-                    return at("inconclusive", f"not met within {t.bound} steps, but undecided at step "
-                                              f"{undecided['step']}", [undecided])
-                return at("false", f"{_text(ops[0])} does not hold at any step 0..{t.bound}: the bound passed "
-                                   f"at step {i} ({ev.where}, t = {ev.time} s)", [wit(ops[0], False)])
-        else:  # until
-            g = decide(ops[1], False)
-            if g is True and undecided is None:
-                return at("true", f"{_text(ops[1])} holds at step {i}, {_text(ops[0])} at every step before",
-                          [wit(ops[1], True)])
-            if g is None and undecided is None:
-                undecided = wit(ops[1], None)
-            if g is not True:
-                f = decide(ops[0], True)
-                if f is False and undecided is None:
-                    return at("false", f"{_text(ops[0])} is false at step {i} before {_text(ops[1])} held",
-                              [wit(ops[0], False)])
-                if f is None and undecided is None:
-                    undecided = wit(ops[0], None)
-    n = i + 1
-    end = {"step": i if n else None, "time": last.time if last else None, "where": last.where if last else ""}
+def _at_end(r: _Run, nodes: list[str]) -> TraceVerdict:
+    """The verdict when the trace ended undecided (module table)."""
+    ops, tracker, undecided, last = r.ops, r.tracker, r.undecided, r.last
+    n = r.i + 1
+    end: dict[str, Any] = {"step": r.i if n else None, "time": last.time if last else None,
+                           "where": last.where if last else ""}
     if n == 0:
         return TraceVerdict("inconclusive", 0, "the trace has no message on the topics of "
                                                f"{', '.join(nodes)}: nothing was checked")
-    if undecided is not None and kind != "eventually":
+    if undecided is not None and r.kind != "eventually":
         why = (f"a value it reads could not be read ({undecided['unreadable'][0]}), and the value before never "
                "stands in" if undecided.get("unreadable") else "a value it reads is not observed or not decidable there")
         return TraceVerdict("inconclusive", n, f"an operand is undecided at step {undecided['step']} "
                                                f"({undecided['where']}): {why}", undecided["step"], undecided["time"],
                             undecided["where"], [undecided])
-    if kind in ("always", "always next"):
+    if r.kind in ("always", "always next"):
         return TraceVerdict("true", n, f"{_text(ops[0])} holds at every step of this trace ({n} steps): "
                                        "evidence for the requirement, not a proof", **end)
     if tracker is not None and tracker.pending is None:
@@ -459,7 +326,7 @@ def check_temporal_trace(t: Temporal, checked: Checked, states: tuple[StateVar, 
         return TraceVerdict("currently_false", n, f"{_text(ops[0])} held at step {tracker.pending} and {_text(ops[1])} has "
                                                   f"not held since when the trace ended after {n} steps (a longer run "
                                                   "may still answer it in time): inconclusive", **end)
-    if kind == "next":
+    if r.kind == "next":
         return TraceVerdict("inconclusive", n, "the trace ended before step 1", **end)
     also = (f"; undecided at some steps, the first {undecided['step']} ({undecided['where']})"
             if undecided is not None else "")
@@ -473,4 +340,4 @@ def _text(f: Formal) -> str:
     return expr_to_rcl(f.expr)
 
 
-__all__ = ["TraceStates", "TraceVerdict", "VERDICTS", "check_temporal_trace", "solve_value"]
+__all__ = ["TraceVerdict", "VERDICTS", "check_temporal_trace"]

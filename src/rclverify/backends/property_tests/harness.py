@@ -22,13 +22,9 @@ hold on its inputs and its outputs violate the conjunct.
 """
 from __future__ import annotations
 
-import importlib.util
 import inspect
-import os
-import sys
 from contextlib import contextmanager
 from dataclasses import dataclass, field
-from fractions import Fraction
 from pathlib import Path
 from typing import Any, Callable, Iterator, Mapping
 
@@ -50,108 +46,12 @@ from rclverify.backends.property_tests.seeding import Seeder, split_facts
 from rclverify.backends.property_tests.coverage import Coverage
 from rclverify.backends.property_tests.constants import boundary_constants, constant_values
 from rclverify.backends.property_tests.strategies import assumption_bounds, conjuncts, input_space
+from rclverify.backends.property_tests.config import Config, ConfigError, load_implementation, read_config
 
-DEFAULT_MAX_EXAMPLES = 200
-DEFAULT_SEED = 20260
-DEFAULT_STEPS = 4
-#: Wall-clock limit of one guarantee's run when the entry gives no ``timeout_s`` (seconds).
-DEFAULT_TIMEOUT_S = 600.0
-
-
-class ConfigError(Exception):
-    """A plan entry the harness cannot use; ``path`` is the key path inside the entry."""
-
-    def __init__(self, message: str, *path: Any) -> None:
-        super().__init__(message)
-        self.path = path
-
-
-@dataclass(frozen=True)
-class Config:
-    """A plan entry ``{backend: property_tests, implementation: file.py:callable, ...}``."""
-
-    implementation: str
-    file: str
-    attr: str
-    max_examples: int = DEFAULT_MAX_EXAMPLES
-    seed: int = DEFAULT_SEED
-    deadline_ms: int | None = None
-    steps: int = DEFAULT_STEPS
-    bounds: Mapping[str, tuple[Fraction | None, Fraction | None]] = field(default_factory=dict)
-    #: Wall-clock limit of one guarantee's run, in seconds (``timeout_s``; :mod:`..timelimit`).
-    timeout_s: float = 600.0
-
-
-def _positive(raw: Mapping[str, Any], key: str, default: int) -> int:
-    v = raw.get(key, default)
-    if isinstance(v, bool) or not isinstance(v, int) or v < 1:
-        raise ConfigError(f"{key} must be a positive integer", key)
-    return v
-
-
-def read_config(raw: Mapping[str, Any], node: CheckedNode, root: Path) -> Config:
-    """Validate a plan entry.  Raises :class:`ConfigError` (with the key path)."""
-    impl = raw.get("implementation")
-    if not isinstance(impl, str) or ":" not in impl:
-        raise ConfigError("implementation must be '<file.py>:<callable>' (workspace-relative)", "implementation")
-    file, _, attr = impl.rpartition(":")
-    if not (root / file).is_file():
-        raise ConfigError(f"implementation file {file!r} does not exist", "implementation")
-    seed = raw.get("seed", DEFAULT_SEED)
-    if isinstance(seed, bool) or not isinstance(seed, int):
-        raise ConfigError("seed must be an integer", "seed")
-    deadline = raw.get("deadline_ms")
-    if deadline is not None and (isinstance(deadline, bool) or not isinstance(deadline, int) or deadline < 1):
-        raise ConfigError("deadline_ms must be a positive integer (milliseconds)", "deadline_ms")
-    bounds: dict[str, tuple[Fraction | None, Fraction | None]] = {}
-    raw_bounds = raw.get("bounds") or {}
-    if not isinstance(raw_bounds, Mapping):
-        raise ConfigError("bounds must map in.<input> to [lo, hi]", "bounds")
-    for k, v in raw_bounds.items():
-        name = str(k).removeprefix("in.")
-        if name not in node.inputs:
-            raise ConfigError(f"{k!r} is not an input of {node.name} ({', '.join(node.inputs)})", "bounds", k)
-        if (not isinstance(v, list) or len(v) != 2
-                or any(x is not None and (isinstance(x, bool) or not isinstance(x, (int, float))) for x in v)):
-            raise ConfigError(f"bounds of {k} must be [lo, hi] (numbers or null)", "bounds", k)
-        bounds[name] = (None if v[0] is None else Fraction(v[0]), None if v[1] is None else Fraction(v[1]))
-    timeout = raw.get("timeout_s", DEFAULT_TIMEOUT_S)
-    if isinstance(timeout, bool) or not isinstance(timeout, (int, float)) or not 0 < timeout <= 86400:
-        raise ConfigError("timeout_s must be a number of seconds, above 0 and at most 86400", "timeout_s")
-    return Config(impl, file, attr, _positive(raw, "max_examples", DEFAULT_MAX_EXAMPLES), seed, deadline,
-                  _positive(raw, "steps", DEFAULT_STEPS), bounds, float(timeout))
-
-
-def load_implementation(root: Path, cfg: Config) -> Any:
-    """Import the implementation's file afresh, with every workspace module of
-    its import closure (:mod:`.closure`) that this process imported before,
-    and return the named callable or class.
-
-    Raises :class:`ConfigError` when the file does not import or lacks the name.
-    """
-    path = (root / cfg.file).resolve()
-    from rclverify.backends.property_tests.closure import import_closure
-    closure = {(root / f).resolve() for f in import_closure(root, cfg.file)[0]}
-    names = {p.name for p in closure}
-    for name, mod in list(sys.modules.items()):  # the workspace modules it imports, afresh too (a long-lived process)
-        where = getattr(mod, "__file__", None)
-        # the file name first: resolving every loaded module's path cost seconds per run
-        if where and os.path.basename(where) in names and Path(where).resolve() in closure:
-            del sys.modules[name]
-    modname = f"rclverify_impl_{abs(hash(str(path)))}"
-    spec = importlib.util.spec_from_file_location(modname, path)
-    if spec is None or spec.loader is None:
-        raise ConfigError(f"cannot import {cfg.file}", "implementation")
-    module = importlib.util.module_from_spec(spec)
-    sys.modules[modname] = module
-    try:
-        spec.loader.exec_module(module)
-    except Exception as exc:  # the user's file: any error is theirs
-        raise ConfigError(f"importing {cfg.file} failed: {type(exc).__name__}: {exc}", "implementation") from None
-    obj = getattr(module, cfg.attr, None)
-    if obj is None or not callable(obj):
-        raise ConfigError(f"{cfg.file} has no callable {cfg.attr!r}", "implementation")
-    return obj
+# The plan entry's reading lives in .config; its names stay importable from here (the backend, replay, the tests
+# and the benchmark import them with the run).
+__all__ = ["Config", "ConfigError", "Counts", "GuaranteeRun", "Outcome", "load_implementation", "read_config",
+           "run_guarantee", "versions"]
 
 
 @dataclass

@@ -55,12 +55,16 @@ from rclverify.semantics.encode import Encoder
 from rclverify.calculus.health.witness import finite_witness, has_tables, points_for
 from rclverify.semantics.query import DEFAULT_TIMEOUT_MS, QueryResult, satisfiable, solver_session
 from rclverify.model.plan.formal import Formal, parse_formal
-from rclverify.model.plan.load import Plan, Requirement
+from rclverify.model.plan.model import Plan, Requirement
 from rclverify.lang import ast
 from rclverify.lang.printer import expr_to_rcl
 from rclverify.lang.types import Checked, CheckedNode
 from rclverify.lang.walk import subexpressions
 from rclverify.model.system.model import SystemModel
+from rclverify.model.plan.ranking import parse_hints
+from rclverify.model.plan.state import state_types
+from rclverify.model.plan.temporal import operands, parse_temporal
+from rclverify.lang.walk import free_names
 
 NEGATED = "negated requirement"
 #: The first attempt's budget of the consistency and vacuity queries, which
@@ -105,9 +109,6 @@ def statement_formals(req: Requirement, checked: Checked, plan: Plan) -> list[An
     each with ``nodes``; ``[]`` for an informal requirement."""
     if req.formal is None:
         return []
-    from rclverify.model.plan.ranking import parse_hints
-    from rclverify.model.plan.state import state_types
-    from rclverify.model.plan.temporal import operands, parse_temporal
     stypes = state_types(plan.states, checked)
     t = parse_temporal(req.formal, checked, f"{req.id} formal", stypes)
     hints = [h for h in parse_hints(req.ranking, req.invariant, t, checked, req.id, stypes) if h is not None]
@@ -146,7 +147,6 @@ def fingerprint(req: Requirement, cone_snapshots: Sequence[str], model_json: str
 
 def _io_symbols(e: ast.Expr, cn: CheckedNode, enc: Encoder) -> set[str]:
     """The Z3 symbol names of the I/O variables formula ``e`` of ``cn`` mentions (bound names excluded)."""
-    from rclverify.lang.walk import free_names
     free = free_names(e)
     out = set()
     for v in subexpressions(e):
@@ -193,7 +193,7 @@ def check_requirement(req: Requirement, checked: Checked, model: SystemModel, pl
         "traced": [{"node": s.node, "guarantee": k} for s in req.support for k in s.guarantees],
     }
     if req.formal is not None and plan is not None:
-        from rclverify.calculus.requirements.temporal_check import check_temporal, is_temporal
+        from rclverify.calculus.requirements.temporal_check import check_temporal, is_temporal  # deferred: optional or conditional (inside a block)
         if is_temporal(req, checked, plan):  # over the composed system's runs (calculus/requirements/temporal_check.py)
             return check_temporal(req, checked, model, plan, base)
     formal, assuming = formals_of(req, checked)
@@ -201,86 +201,117 @@ def check_requirement(req: Requirement, checked: Checked, model: SystemModel, pl
         return {**base, "verdict": "informal", "cone": [], "used": [], "traced_not_needed": [],
                 "explanation": "No formal statement: the requirement is traced to guarantees, never checked, never met."}
     cone = cone_of([formal, *assuming], model)
-    enc = Encoder(checked.env, model.alias())
-    premises: list[dict[str, Any]] = []
-    labelled: list[tuple[str, z3.BoolRef]] = []
-
-    def add(label: str, kind: str, node: str | None, index: int, e: ast.Expr, f: z3.BoolRef, text: str | None = None) -> None:
-        premises.append({"label": label, "kind": kind, "node": node, "index": index,
-                         "text": text if text is not None else expr_to_rcl(e), "source": _where(e.loc)})
-        labelled.append((label, f))
-
-    g_symbols: dict[str, set[str]] = {}
-    for n in cone:
-        cn = checked.nodes[n]
-        for k, g in enumerate(cn.node.guarantees, 1):
-            label = f"{n} guarantee {k}"
-            add(label, "guarantee", n, k, g.formula, enc.formula(g.formula, cn))
-            g_symbols[label] = _io_symbols(g.formula, cn, enc)
-        for k, c in enumerate(split_assumption(checked, model, n)[1], 1):
-            add(f"{n} environment assumption {k}", "environment assumption", n, k, c, enc.formula(c, cn))
-        for k, fact in enumerate(plan.facts.get(n, ()), 1):
-            add(f"{n} environment fact {k}", "environment fact", n, k, fact.expr, enc.formula(fact.expr, cn))
+    q = _Query(Encoder(checked.env, model.alias()))
+    q.cone_premises(cone, checked, model, plan)
     # the statements' variables are named Node.in.x in their pseudo node (model/plan/formal.py); the encoder looks
     # an input/output up as "<in|out>.<name>", here "in.Node.in.x", and takes the node's own symbol
+    enc = q.enc
     symbols = {f"{p}.{n}.{p}.{v}": enc.io_symbol(checked.nodes[n], p, v)
                for f in (formal, *assuming) for n, p, v in f.mentions}
     for k, a in enumerate(assuming, 1):
-        add(f"assuming {k}", "assuming", None, k, a.expr, enc.formula(a.expr, a.scope, symbols))
+        q.add(f"assuming {k}", "assuming", None, k, a.expr, enc.formula(a.expr, a.scope, symbols))
     goal = enc.formula(formal.expr, formal.scope, symbols)
-    labelled.append((NEGATED, z3.Not(goal)))
+    q.labelled.append((NEGATED, z3.Not(goal)))
     head = (f"rclverify requirement {req.id}: {base['formal']}\nsource {base['source']}; "
             "unsat means the requirement follows from the premises")
-    r = satisfiable(labelled, enc, timeout_ms=timeout_ms, comment=head)
-    out: dict[str, Any] = {**base, "cone": cone, "premises": len(premises), "smt2": r.smt2,
+    r = satisfiable(q.labelled, enc, timeout_ms=timeout_ms, comment=head)
+    out: dict[str, Any] = {**base, "cone": cone, "premises": len(q.premises), "smt2": r.smt2,
                            "duration_s": r.duration_s}
-    by_label = {p["label"]: p for p in premises}
     traced = [f"{t['node']} guarantee {t['guarantee']}" for t in base["traced"]]
     if r.status == "unsat":
-        core = [c for c in (r.core or []) if c != NEGATED]
-        used = [by_label[c] for c in core]
-        out.update(verdict="proved", used=used,
-                   traced_not_needed=[by_label.get(t, {"label": t, "kind": "guarantee"}) for t in traced if t not in core])
-        if NEGATED not in (r.core or []):
-            out.update(consistency="inconsistent", inconsistent_core=used, consistency_duration_s=0.0)
-        else:
-            r2 = _model_query([(lbl, f) for lbl, f in labelled if lbl in core], enc, model_ms, _points(plan, cone),
-                              f"rclverify requirement {req.id}: are the premises its proof used consistent?")
-            out["consistency_duration_s"] = r2.duration_s
-            if r2.status in ("sat", "unsat"):  # decided: a second solver re-decides it (docs/second-solver.md)
-                out["consistency_smt2"] = r2.smt2
-            if r2.status == "unsat":
-                out.update(consistency="inconsistent", inconsistent_core=[by_label[c] for c in (r2.core or [])])
-            elif r2.status == "sat":
-                out.update(consistency="consistent")
-            else:
-                out.update(consistency="undecided", consistency_reason=r2.reason)
+        _proved(out, r, q, traced, req.id, model_ms, _points(plan, cone))
         premise = _premise(formal.expr)
         if out["consistency"] == "consistent" and premise is not None:
-            r3 = _model_query([(lbl, f) for lbl, f in labelled if lbl != NEGATED]
-                              + [("requirement premise", enc.formula(premise, formal.scope, symbols))], enc,
-                              model_ms, _points(plan, cone),
-                              f"rclverify requirement {req.id}: can its premise hold with every premise of the cone?")
-            out["vacuity_duration_s"] = r3.duration_s
-            if r3.status in ("sat", "unsat"):
-                out["vacuity_smt2"] = r3.smt2
-            if r3.status == "unsat":
-                out.update(vacuity="vacuous", vacuity_core=[by_label[c] for c in (r3.core or []) if c in by_label])
-            else:
-                out["vacuity"] = {"sat": "non-vacuous", "inconclusive": "undecided"}.get(r3.status, "undecided")
+            _vacuity(out, q, enc.formula(premise, formal.scope, symbols), req.id, model_ms, _points(plan, cone))
         return out
     out.update(used=[], traced_not_needed=[])
     if r.status == "sat":
         mentioned = {enc.symbol_name(n, p, v) for f in (formal,) for n, p, v in f.mentions}
-        hit = [lbl for lbl, syms in g_symbols.items() if syms & mentioned]
+        hit = [lbl for lbl, syms in q.g_symbols.items() if syms & mentioned]
         first = [l for l in hit if l in traced] or hit
-        from rclverify.calculus.requirements.readable import readable_counterexample  # within the assumptions, short values (issue 48)
-        shown, note = readable_counterexample(labelled, r.model or {}, cone, checked, model, enc)
+        from rclverify.calculus.requirements.readable import readable_counterexample  # within the assumptions, short values (issue 48); deferred: optional or conditional (inside a block)
+        shown, note = readable_counterexample(q.labelled, r.model or {}, cone, checked, model, enc)
         out.update(verdict="refuted", counterexample=_counterexample(shown, cone, checked, enc),
-                   failed_to_prevent=[by_label[l] for l in first], **note)
+                   failed_to_prevent=[q.by_label[l] for l in first], **note)
         return out
     out.update(verdict="inconclusive", reason=r.reason or "unknown")
     return out
+
+
+class _Query:
+    """The premises of one requirement's query: each listed for the record
+    (``premises``, ``by_label``) and labelled for Z3's unsat core
+    (``labelled``); ``g_symbols`` the inputs and outputs each guarantee reads."""
+
+    def __init__(self, enc: Encoder) -> None:
+        self.enc = enc
+        self.premises: list[dict[str, Any]] = []
+        self.by_label: dict[str, dict[str, Any]] = {}
+        self.labelled: list[tuple[str, z3.BoolRef]] = []
+        self.g_symbols: dict[str, set[str]] = {}
+
+    def add(self, label: str, kind: str, node: str | None, index: int, e: ast.Expr, f: z3.BoolRef,
+            text: str | None = None) -> None:
+        row = {"label": label, "kind": kind, "node": node, "index": index,
+               "text": text if text is not None else expr_to_rcl(e), "source": _where(e.loc)}
+        self.premises.append(row)
+        self.by_label[label] = row
+        self.labelled.append((label, f))
+
+    def cone_premises(self, cone: Sequence[str], checked: Checked, model: SystemModel, plan: Plan) -> None:
+        """The guarantees, environment assumptions and environment facts of the cone's nodes."""
+        enc = self.enc
+        for n in cone:
+            cn = checked.nodes[n]
+            for k, g in enumerate(cn.node.guarantees, 1):
+                label = f"{n} guarantee {k}"
+                self.add(label, "guarantee", n, k, g.formula, enc.formula(g.formula, cn))
+                self.g_symbols[label] = _io_symbols(g.formula, cn, enc)
+            for k, c in enumerate(split_assumption(checked, model, n)[1], 1):
+                self.add(f"{n} environment assumption {k}", "environment assumption", n, k, c, enc.formula(c, cn))
+            for k, fact in enumerate(plan.facts.get(n, ()), 1):
+                self.add(f"{n} environment fact {k}", "environment fact", n, k, fact.expr,
+                         enc.formula(fact.expr, cn))
+
+
+def _proved(out: dict[str, Any], r: QueryResult, q: _Query, traced: list[str], rid: str, model_ms: int,
+            points: int) -> None:
+    """A proved requirement's record: the premises its proof used (the unsat
+    core), the traced guarantees it did not need, and whether the used
+    premises are consistent (Z3 looks for a model of them)."""
+    by_label = q.by_label
+    core = [c for c in (r.core or []) if c != NEGATED]
+    used = [by_label[c] for c in core]
+    out.update(verdict="proved", used=used,
+               traced_not_needed=[by_label.get(t, {"label": t, "kind": "guarantee"}) for t in traced if t not in core])
+    if NEGATED not in (r.core or []):
+        out.update(consistency="inconsistent", inconsistent_core=used, consistency_duration_s=0.0)
+        return
+    r2 = _model_query([(lbl, f) for lbl, f in q.labelled if lbl in core], q.enc, model_ms, points,
+                      f"rclverify requirement {rid}: are the premises its proof used consistent?")
+    out["consistency_duration_s"] = r2.duration_s
+    if r2.status in ("sat", "unsat"):  # decided: a second solver re-decides it (docs/second-solver.md)
+        out["consistency_smt2"] = r2.smt2
+    if r2.status == "unsat":
+        out.update(consistency="inconsistent", inconsistent_core=[by_label[c] for c in (r2.core or [])])
+    elif r2.status == "sat":
+        out.update(consistency="consistent")
+    else:
+        out.update(consistency="undecided", consistency_reason=r2.reason)
+
+
+def _vacuity(out: dict[str, Any], q: _Query, premise: z3.BoolRef, rid: str, model_ms: int, points: int) -> None:
+    """A proved implication's vacuity: can its premise hold with every premise of the cone?"""
+    r3 = _model_query([(lbl, f) for lbl, f in q.labelled if lbl != NEGATED] + [("requirement premise", premise)],
+                      q.enc, model_ms, points,
+                      f"rclverify requirement {rid}: can its premise hold with every premise of the cone?")
+    out["vacuity_duration_s"] = r3.duration_s
+    if r3.status in ("sat", "unsat"):
+        out["vacuity_smt2"] = r3.smt2
+    if r3.status == "unsat":
+        out.update(vacuity="vacuous", vacuity_core=[q.by_label[c] for c in (r3.core or []) if c in q.by_label])
+    else:
+        out["vacuity"] = {"sat": "non-vacuous", "inconclusive": "undecided"}.get(r3.status, "undecided")
 
 
 def _points(plan: Plan, cone: Sequence[str]) -> int:

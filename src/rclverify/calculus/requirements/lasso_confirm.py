@@ -113,77 +113,125 @@ def _node_values(state: Mapping[str, Any], node: str) -> dict[str, Any]:
 def _confirm(trace: Sequence[Mapping[str, Any]], loop: int, cone: Sequence[str], variables: Mapping[str, tuple[str, str, str]],
              types: Mapping[str, Type], checked: Checked, model: SystemModel, plan: Plan,
              goal: Formal, assuming: Sequence[Formal], fair: Sequence[str], pub: Publication) -> None:
-    if not trace or not 0 <= loop < len(trace) - 1:
-        raise _Unconfirmed("the trace is not a lasso")
-    if dict(trace[-1]) != dict(trace[loop]):
-        raise _Unconfirmed(f"the last state differs from the loop state {loop}")
-    for n in fair:
-        ring = trace[loop:-1]
-        accepted = [st.get(f"{n}.accepts", True) is True and all(st.get(f) is True for f in pub.fed.get(n, ()))
-                    for st in ring]
-        if any(accepted) and not any(st[f"{n}.answers"] is True for st in ring):
-            raise _Unconfirmed(f"{n} accepts its input in the loop but never answers there (its progress)")
-    states = [sv for sv in plan.states if sv.node in cone]
-    parsed = {sv: (parse_state_formula(sv, "init", checked, plan.states),
-                   parse_state_formula(sv, "next", checked, plan.states)) for sv in states}
-    split = {n: split_assumption(checked, model, n) for n in cone}
-    facts = {n: [f.expr for f in plan.facts.get(n, ())] for n in cone}
-    links = [(f"{c}.in.{v}", p) for (c, _, v), p in model.alias().items() if c in cone and p in variables]
+    c = _Lasso(trace, loop, cone, variables, types, checked, model, plan, goal, assuming, fair, pub)
+    c.shape()
+    c.prepare()
     for i, st in enumerate(trace):
-        for name in variables:
-            if name not in st:
-                raise _Unconfirmed(f"step {i}: no value for {name}")
-            bad = conforms(st[name], types[name])
-            if bad:
-                raise _Unconfirmed(f"step {i}: {name}: {bad}")
-        for n in cone:
-            cn, vals = checked.nodes[n], _node_values(st, n)
-            internal, env = split[n]
-            for k, e in enumerate([*env, *facts[n]], 1):
-                if not _holds(e, checked, cn, vals, f"step {i}: {n} environment assumption/fact {expr_to_rcl(e)}"):
-                    raise _Unconfirmed(f"step {i}: {n}'s environment assumption or fact {k} does not hold")
-            accepts = all(_holds(a, checked, cn, vals, f"step {i}: {n} assumption") for a in internal)
-            ready = all(st.get(f) is True for f in pub.fed.get(n, ()))
-            if f"{n}.accepts" in variables and st[f"{n}.accepts"] is not accepts:
-                raise _Unconfirmed(f"step {i}: {n}.accepts is {st[f'{n}.accepts']} but its assumption "
-                                   f"{'holds' if accepts else 'fails'}")
-            answers = st[f"{n}.answers"] if f"{n}.answers" in variables else accepts
-            if answers and not accepts:
-                raise _Unconfirmed(f"step {i}: {n} answers although its assumption fails")
-            if answers:
-                for k, g in enumerate(cn.node.guarantees, 1):
-                    if not _holds(g.formula, checked, cn, vals, f"step {i}: {n} guarantee {k}"):
-                        raise _Unconfirmed(f"step {i}: {n}'s guarantee {k} does not hold")
-            if f"{n}.answers" in variables:
-                _check_waiting(n, cn, trace, i, accepts and ready, answers)
-            if i == 0 and f"{n}.answers" in variables and not answers:
-                for k, ini in enumerate(cn.node.initially, 1):
-                    if not _holds(ini.formula, checked, cn, vals, f"step 0: {n} initially {k}"):
-                        raise _Unconfirmed(f"step 0: {n} does not answer and its initially {k} does not hold")
-        # the statement's pseudo node names Node.out.y an output, every other variable an input (model/plan/formal.py)
-        pseudo = {f"{'out' if variables[name][1] == 'out' else 'in'}.{name}": v
-                  for name, v in st.items() if name in variables}
-        for k, a in enumerate(assuming, 1):
-            if all(st.get(f) is True for f in pub.flags_of(a.mentions)) and \
-                    not _holds(a.expr, checked, a.scope, pseudo, f"step {i}: assuming {k}"):
-                raise _Unconfirmed(f"step {i}: the requirement's assuming {k} does not hold")
-        published = all(st.get(f) is True for f in pub.flags_of(goal.mentions))
-        if published and _holds(goal.expr, checked, goal.scope, pseudo, f"step {i}: the goal"):
-            raise _Unconfirmed(f"step {i}: the goal holds")
+        c.state(i, st)
     bad_flag = confirm_flags(trace, pub, lambda st, n: st.get(f"{n}.answers") is True)
     if bad_flag:
         raise _Unconfirmed(bad_flag)
-    for sv in states:
-        vals = {f"in.state.{o.name}": trace[0][f"{o.node}.state.{o.name}"] for o in states if o.node == sv.node}
-        f = parsed[sv][0]
-        if not _holds(f.expr, checked, f.scope, vals, f"{sv.node}.state.{sv.name} init"):
-            raise _Unconfirmed(f"step 0: {sv.node}.state.{sv.name} does not satisfy its init")
+    c.initial_states()
     for i in range(len(trace) - 1):
-        s, t = trace[i], trace[i + 1]
-        for c, p in links:
+        c.step(i, trace[i], trace[i + 1])
+
+
+class _Lasso:
+    """The checks of one lasso, in the order :func:`_confirm` runs them; each
+    failure raises :class:`_Unconfirmed` with its reason."""
+
+    def __init__(self, trace: Sequence[Mapping[str, Any]], loop: int, cone: Sequence[str],
+                 variables: Mapping[str, tuple[str, str, str]], types: Mapping[str, Type], checked: Checked,
+                 model: SystemModel, plan: Plan, goal: Formal, assuming: Sequence[Formal], fair: Sequence[str],
+                 pub: Publication) -> None:
+        self.trace, self.loop, self.cone, self.variables, self.types = trace, loop, cone, variables, types
+        self.checked, self.model, self.plan, self.goal, self.assuming = checked, model, plan, goal, assuming
+        self.fair, self.pub = fair, pub
+
+    def shape(self) -> None:
+        """A lasso whose last state is its loop state, every fair node answering in the loop where it accepts."""
+        trace, loop, pub = self.trace, self.loop, self.pub
+        if not trace or not 0 <= loop < len(trace) - 1:
+            raise _Unconfirmed("the trace is not a lasso")
+        if dict(trace[-1]) != dict(trace[loop]):
+            raise _Unconfirmed(f"the last state differs from the loop state {loop}")
+        for n in self.fair:
+            ring = trace[loop:-1]
+            accepted = [st.get(f"{n}.accepts", True) is True and all(st.get(f) is True for f in pub.fed.get(n, ()))
+                        for st in ring]
+            if any(accepted) and not any(st[f"{n}.answers"] is True for st in ring):
+                raise _Unconfirmed(f"{n} accepts its input in the loop but never answers there (its progress)")
+
+    def prepare(self) -> None:
+        """The cone's state declarations parsed, its assumptions split, its facts and links."""
+        checked, plan, cone, model = self.checked, self.plan, self.cone, self.model
+        self.states = [sv for sv in plan.states if sv.node in cone]
+        self.parsed = {sv: (parse_state_formula(sv, "init", checked, plan.states),
+                            parse_state_formula(sv, "next", checked, plan.states)) for sv in self.states}
+        self.split = {n: split_assumption(checked, model, n) for n in cone}
+        self.facts = {n: [f.expr for f in plan.facts.get(n, ())] for n in cone}
+        self.links = [(f"{c}.in.{v}", p) for (c, _, v), p in model.alias().items()
+                      if c in cone and p in self.variables]
+
+    def state(self, i: int, st: Mapping[str, Any]) -> None:
+        """State ``i``: every variable typed, every node's contract kept, the
+        requirement's assumptions holding and its goal not reached."""
+        checked, variables, pub = self.checked, self.variables, self.pub
+        for name in variables:
+            if name not in st:
+                raise _Unconfirmed(f"step {i}: no value for {name}")
+            bad = conforms(st[name], self.types[name])
+            if bad:
+                raise _Unconfirmed(f"step {i}: {name}: {bad}")
+        for n in self.cone:
+            self.node_at(i, st, n)
+        # the statement's pseudo node names Node.out.y an output, every other variable an input (model/plan/formal.py)
+        pseudo = {f"{'out' if variables[name][1] == 'out' else 'in'}.{name}": v
+                  for name, v in st.items() if name in variables}
+        for k, a in enumerate(self.assuming, 1):
+            if all(st.get(f) is True for f in pub.flags_of(a.mentions)) and \
+                    not _holds(a.expr, checked, a.scope, pseudo, f"step {i}: assuming {k}"):
+                raise _Unconfirmed(f"step {i}: the requirement's assuming {k} does not hold")
+        goal = self.goal
+        published = all(st.get(f) is True for f in pub.flags_of(goal.mentions))
+        if published and _holds(goal.expr, checked, goal.scope, pseudo, f"step {i}: the goal"):
+            raise _Unconfirmed(f"step {i}: the goal holds")
+
+    def node_at(self, i: int, st: Mapping[str, Any], n: str) -> None:
+        """Node ``n`` at state ``i``: its environment, its accepting and
+        answering, its guarantees when it answers, its waiting, its initial values."""
+        checked, variables = self.checked, self.variables
+        cn, vals = checked.nodes[n], _node_values(st, n)
+        internal, env = self.split[n]
+        for k, e in enumerate([*env, *self.facts[n]], 1):
+            if not _holds(e, checked, cn, vals, f"step {i}: {n} environment assumption/fact {expr_to_rcl(e)}"):
+                raise _Unconfirmed(f"step {i}: {n}'s environment assumption or fact {k} does not hold")
+        accepts = all(_holds(a, checked, cn, vals, f"step {i}: {n} assumption") for a in internal)
+        ready = all(st.get(f) is True for f in self.pub.fed.get(n, ()))
+        if f"{n}.accepts" in variables and st[f"{n}.accepts"] is not accepts:
+            raise _Unconfirmed(f"step {i}: {n}.accepts is {st[f'{n}.accepts']} but its assumption "
+                               f"{'holds' if accepts else 'fails'}")
+        answers = st[f"{n}.answers"] if f"{n}.answers" in variables else accepts
+        if answers and not accepts:
+            raise _Unconfirmed(f"step {i}: {n} answers although its assumption fails")
+        if answers:
+            for k, g in enumerate(cn.node.guarantees, 1):
+                if not _holds(g.formula, checked, cn, vals, f"step {i}: {n} guarantee {k}"):
+                    raise _Unconfirmed(f"step {i}: {n}'s guarantee {k} does not hold")
+        if f"{n}.answers" in variables:
+            _check_waiting(n, cn, self.trace, i, accepts and ready, answers)
+        if i == 0 and f"{n}.answers" in variables and not answers:
+            for k, ini in enumerate(cn.node.initially, 1):
+                if not _holds(ini.formula, checked, cn, vals, f"step 0: {n} initially {k}"):
+                    raise _Unconfirmed(f"step 0: {n} does not answer and its initially {k} does not hold")
+
+    def initial_states(self) -> None:
+        """Every declared state variable satisfies its ``init`` at step 0."""
+        states, trace = self.states, self.trace
+        for sv in states:
+            vals = {f"in.state.{o.name}": trace[0][f"{o.node}.state.{o.name}"] for o in states if o.node == sv.node}
+            f = self.parsed[sv][0]
+            if not _holds(f.expr, self.checked, f.scope, vals, f"{sv.node}.state.{sv.name} init"):
+                raise _Unconfirmed(f"step 0: {sv.node}.state.{sv.name} does not satisfy its init")
+
+    def step(self, i: int, s: Mapping[str, Any], t: Mapping[str, Any]) -> None:
+        """The step from state ``i`` to ``i + 1``: links carry values, a node
+        that does not answer keeps its outputs, state variables follow their ``next``."""
+        checked, variables, states = self.checked, self.variables, self.states
+        for c, p in self.links:
             if t[c] != s[p]:
                 raise _Unconfirmed(f"step {i + 1}: {c} is not the value {p} had at step {i}")
-        for n in cone:
+        for n in self.cone:
             cn = checked.nodes[n]
             if f"{n}.answers" in variables and t[f"{n}.answers"] is not True:
                 for v in cn.outputs:
@@ -196,6 +244,6 @@ def _confirm(trace: Sequence[Mapping[str, Any]], loop: int, cone: Sequence[str],
                 if o.node == sv.node:
                     vals[f"in.state.{o.name}"] = s[f"{o.node}.state.{o.name}"]
                     vals[f"in.next.{o.name}"] = t[f"{o.node}.state.{o.name}"]
-            f = parsed[sv][1]
+            f = self.parsed[sv][1]
             if not _holds(f.expr, checked, f.scope, vals, f"step {i}: {sv.node}.state.{sv.name} next"):
                 raise _Unconfirmed(f"step {i + 1}: {sv.node}.state.{sv.name} is not the value its next gives")

@@ -47,7 +47,7 @@ from typing import Any, Callable, Collection
 import z3
 
 from rclverify.model.plan.formal import Formal, parse_formal
-from rclverify.model.plan.load import Plan, Requirement
+from rclverify.model.plan.model import Plan, Requirement
 from rclverify.model.plan.ranking import parse_hints
 from rclverify.model.plan.state import state_types
 from rclverify.model.plan.temporal import Temporal, operands, parse_temporal, shape
@@ -64,6 +64,8 @@ from rclverify.calculus.requirements.lasso_confirm import confirm_lasso
 from rclverify.calculus.requirements.initial_needed import initially_not_needed
 from rclverify.calculus.requirements.progress_gap import EVEN_SO, explain_idle, stuck_in_loop, stuck_words
 from rclverify.calculus.requirements.transition import ComposedSystem, build_system, variable_types
+from rclverify.semantics.encode import Encoder
+from rclverify.lang.types import FuncT
 
 #: The bound of BMC for an unbounded ``eventually`` and of k-induction's k.
 DEFAULT_BOUND = 10
@@ -171,7 +173,7 @@ def _decide(t: Temporal, sys: ComposedSystem, pred: Callable[[Formal], Callable[
     if kind == "always":
         return prove_always(ts, pred(t.args[0]), max_k=bound, timeout_ms=timeout_ms, hint=hint)
     if kind == "response":  # always (P -> eventually[<= N] Q) / always (P -> next Q): calculus/requirements/response.py
-        from rclverify.calculus.requirements.response import check_response, check_unbounded_response
+        from rclverify.calculus.requirements.response import check_response, check_unbounded_response  # deferred: optional or conditional (inside a block)
         p, r = t.args[0].args  # type: ignore[union-attr]
         if r.op == "eventually" and r.bound is None:  # type: ignore[union-attr]
             return check_unbounded_response(ts, got(p), got(r.args[0]), max_k=bound,  # type: ignore[arg-type, union-attr]
@@ -226,7 +228,6 @@ def check_temporal(req: Requirement, checked: Checked, model: SystemModel, plan:
     ``base`` the fields :func:`.check.check_requirement` fills for every
     requirement.  Raises :class:`RclError` for a statement that does not
     check; never raises on solver trouble."""
-    from rclverify.semantics.encode import Encoder
     t0 = time.perf_counter()
     t = statement(req, checked, plan)
     shape(t, req.formal.loc if req.formal else req.loc)
@@ -236,65 +237,8 @@ def check_temporal(req: Requirement, checked: Checked, model: SystemModel, plan:
     hints = [h for h in (rank, inv) if h is not None]
     want = {u for f in (*ops, *assuming, *hints) for n in f.nodes for u in (model.upstream(n) or [n])}
     cone = [n for n in model.nodes if n in want]  # as requirements/check.cone_of
-
-    def solve(without: Collection[str] = ()) -> tuple[ComposedSystem, TemporalVerdict, dict[str, Any]]:
-        """The system of the cone (the nodes of ``without`` built with no ``initially``) and its verdict."""
-        sys = build_system(cone, checked, model, plan, without_initially=without)
-        enc = Encoder(checked.env)
-
-        def raw(f: Formal) -> Callable[[Any], Any]:
-            return lambda s: enc.formula(f.expr, f.scope, sys.statement_symbols(s))
-
-        def pred(f: Formal) -> Callable[[Any], Any]:  # must hold: only where its values are published
-            return lambda s: z3.Implies(sys.pub.defined(f.mentions, s), raw(f)(s))
-
-        def reach(f: Formal) -> Callable[[Any], Any]:  # must be reached: on published values
-            return lambda s: z3.And(sys.pub.defined(f.mentions, s), raw(f)(s))
-        if assuming:  # the requirement's own assumptions hold in every state
-            holds = [pred(a) for a in assuming]
-            ts = sys.ts
-            sys.ts = TransitionSystem(ts.sorts, lambda s: z3.And(ts.init(s), *[h(s) for h in holds]),
-                                      lambda s, u: z3.And(ts.trans(s, u), *[h(s) for h in holds], *[h(u) for h in holds]),
-                                      ts.fairness)
-            for k, a in enumerate(assuming, 1):
-                sys.premises.append({"label": f"assuming {k}", "kind": "assuming", "node": None, "index": k,
-                                     "text": base["assuming"][k - 1], "source": base["source"]})
-        types = variable_types(sys, checked, plan)
-        points = max([points_for(plan.instances.get(n)) for n in cone] or [points_for(None)])
-
-        def tables(goal: Formal, v: TemporalVerdict, ts: TransitionSystem) -> TemporalVerdict:
-            """The finite-table lasso search over ``ts``, confirmed on the trace (:mod:`.lasso`)."""
-            if any(isinstance(ty, EmptyT) for ty in types.values()):
-                return v
-            try:
-                found = find_table_lasso(ts, reach(goal), types, bound=bound, points=points)
-            except (ValueError, z3.Z3Exception) as exc:
-                found = f"the finite-table search failed ({exc})"
-            if isinstance(found, str):
-                return TemporalVerdict(v.status, v.method, k=v.k, bound=v.bound, trace=v.trace, loop=v.loop,
-                                       detail=f"{v.detail}; {found}")
-            why = confirm_lasso(found.values, found.loop, cone, sys.variables, types, checked, model, plan, goal, assuming,
-                                [f.label for f in ts.fairness], sys.pub)
-            if why is not None:
-                return TemporalVerdict(v.status, v.method, k=v.k, bound=v.bound, trace=v.trace, loop=v.loop,
-                                       detail=f"{v.detail}; a lasso with {points}-point tables was found but not "
-                                              f"confirmed on its values ({why})")
-            n = len(found.values) - 1
-            return TemporalVerdict("refuted", "lasso", bound=n, loop=found.loop,
-                                   trace=[{k: render(x) for k, x in st.items()} for st in found.values],
-                                   detail=f"a run whose step {n} returns to step {found.loop} and never reaches it "
-                                          f"(found with every function a {points}-point table, confirmed on the "
-                                          f"trace's values)")
-        ranking = (lambda s: enc.term(rank.expr, rank.scope, sys.statement_symbols(s))) if rank is not None else None
-        inv_pred = raw(inv) if inv is not None else None
-        missing: dict[str, Any] = {}
-        from rclverify.lang.types import FuncT
-        v = decide(t, sys, pred, bound=bound, timeout_ms=timeout_ms, tables=tables, ranking=ranking,
-                   invariant=inv_pred, checked=checked, gaps=missing,
-                   tables_first=any(isinstance(ty, FuncT) for ty in types.values()), reach=reach,
-                   hint_text=" ".join(req.invariant.text.split()) if req.invariant is not None else "")
-        return sys, v, missing
-    sys, v, missing = solve()
+    ctx = _Question(req, checked, model, plan, base, t, assuming, rank, inv, cone, bound, timeout_ms)
+    sys, v, missing = ctx.solve()
     lasso = v.status == "refuted" and "lasso" in v.method.split(" + ")
     gaps = missing.get("missing_progress", []) if lasso else []
     stuck = missing.get("missing_initially", []) if lasso else []
@@ -303,26 +247,7 @@ def check_temporal(req: Requirement, checked: Checked, model: SystemModel, plan:
                                         "ranking": base.get("ranking"), "invariant": base.get("invariant"),
                                         "missing_progress": gaps, "missing_initially": stuck}}
     if v.status in ("proved", "met"):
-        a, b = sys.ts.state(0), sys.ts.state(1)
-        s = z3.Solver()
-        s.set("timeout", timeout_ms)
-        s.add(sys.ts.init(a), sys.ts.trans(a, b))
-        r = s.check()
-        used = sys.premises
-        out.update(verdict="proved", used=used)
-        # an initial value no output meets forces its node to answer at step 0: it removes runs, as a contradiction
-        bad, why = sys.initial_values_unsatisfiable(timeout_ms)
-        if bad:  # the initial values no output meets: the precise core (they alone may leave no run)
-            out.update(consistency="inconsistent", inconsistent_core=bad)
-        elif r == z3.unsat:
-            out.update(consistency="inconsistent", inconsistent_core=used)
-        elif r == z3.sat and not why:
-            out.update(consistency="consistent")
-            spare = initially_not_needed(sys.premises, lambda nodes: solve(nodes)[1].status in ("proved", "met"))
-            out.update(used=[p for p in used if not (p["kind"] == "initial value" and p["node"] in spare)],
-                       traced_not_needed=[p for p in used if p["kind"] == "initial value" and p["node"] in spare])
-        else:
-            out.update(consistency="undecided", consistency_reason=s.reason_unknown() if r != z3.sat else why)
+        _proved(out, sys, ctx)
     elif v.status == "refuted":
         mentioned = {n for f in ops for n in f.nodes}
         # a run that stops, or a lasso resting on a node that never answers, is not let through by a guarantee
@@ -332,3 +257,119 @@ def check_temporal(req: Requirement, checked: Checked, model: SystemModel, plan:
         out.update(verdict="inconclusive", reason=v.detail or "undecided")
     out["duration_s"] = round(time.perf_counter() - t0, 4)
     return out
+
+
+def _proved(out: dict[str, Any], sys: ComposedSystem, ctx: _Question) -> None:
+    """A proved (or met) statement's record: its premises used, whether
+    they are consistent (a first step exists, the initial values can be
+    met), and the ``initially`` declarations the proof does not need."""
+    a, b = sys.ts.state(0), sys.ts.state(1)
+    s = z3.Solver()
+    s.set("timeout", ctx.timeout_ms)
+    s.add(sys.ts.init(a), sys.ts.trans(a, b))
+    r = s.check()
+    used = sys.premises
+    out.update(verdict="proved", used=used)
+    # an initial value no output meets forces its node to answer at step 0: it removes runs, as a contradiction
+    bad, why = sys.initial_values_unsatisfiable(ctx.timeout_ms)
+    if bad:  # the initial values no output meets: the precise core (they alone may leave no run)
+        out.update(consistency="inconsistent", inconsistent_core=bad)
+    elif r == z3.unsat:
+        out.update(consistency="inconsistent", inconsistent_core=used)
+    elif r == z3.sat and not why:
+        out.update(consistency="consistent")
+        spare = initially_not_needed(sys.premises, lambda nodes: ctx.solve(nodes)[1].status in ("proved", "met"))
+        out.update(used=[p for p in used if not (p["kind"] == "initial value" and p["node"] in spare)],
+                   traced_not_needed=[p for p in used if p["kind"] == "initial value" and p["node"] in spare])
+    else:
+        out.update(consistency="undecided", consistency_reason=s.reason_unknown() if r != z3.sat else why)
+
+
+class _Question:
+    """One temporal statement asked of its cone: what every system built to
+    decide it shares (:meth:`solve` builds one, with some nodes' ``initially``
+    left out to ask whether the proof needs them)."""
+
+    def __init__(self, req: Requirement, checked: Checked, model: SystemModel, plan: Plan, base: dict[str, Any],
+                 t: Any, assuming: list[Formal], rank: Any, inv: Formal | None, cone: list[str],
+                 bound: int, timeout_ms: int) -> None:
+        self.req, self.checked, self.model, self.plan, self.base = req, checked, model, plan, base
+        self.t, self.assuming, self.rank, self.inv, self.cone = t, assuming, rank, inv, cone
+        self.bound, self.timeout_ms = bound, timeout_ms
+
+    def solve(self, without: Collection[str] = ()) -> tuple[ComposedSystem, TemporalVerdict, dict[str, Any]]:
+        """The system of the cone (the nodes of ``without`` built with no ``initially``) and its verdict."""
+        return _System(self, without).decide()
+
+
+class _System:
+    """One system of a question's cone and the predicates over its states."""
+
+    def __init__(self, q: _Question, without: Collection[str]) -> None:
+        self.q = q
+        self.sys = build_system(q.cone, q.checked, q.model, q.plan, without_initially=without)
+        self.enc = Encoder(q.checked.env)
+        if q.assuming:  # the requirement's own assumptions hold in every state
+            self.assume()
+        self.types = variable_types(self.sys, q.checked, q.plan)
+        self.points = max([points_for(q.plan.instances.get(n)) for n in q.cone] or [points_for(None)])
+
+    def raw(self, f: Formal) -> Callable[[Any], Any]:
+        enc, sys = self.enc, self.sys
+        return lambda s: enc.formula(f.expr, f.scope, sys.statement_symbols(s))
+
+    def pred(self, f: Formal) -> Callable[[Any], Any]:  # must hold: only where its values are published
+        raw = self.raw(f)
+        return lambda s: z3.Implies(self.sys.pub.defined(f.mentions, s), raw(s))
+
+    def reach(self, f: Formal) -> Callable[[Any], Any]:  # must be reached: on published values
+        raw = self.raw(f)
+        return lambda s: z3.And(self.sys.pub.defined(f.mentions, s), raw(s))
+
+    def assume(self) -> None:
+        """The requirement's ``assuming`` formulas hold in every state of the system."""
+        sys, q = self.sys, self.q
+        holds = [self.pred(a) for a in q.assuming]
+        ts = sys.ts
+        sys.ts = TransitionSystem(ts.sorts, lambda s: z3.And(ts.init(s), *[h(s) for h in holds]),
+                                  lambda s, u: z3.And(ts.trans(s, u), *[h(s) for h in holds], *[h(u) for h in holds]),
+                                  ts.fairness)
+        for k, a in enumerate(q.assuming, 1):
+            sys.premises.append({"label": f"assuming {k}", "kind": "assuming", "node": None, "index": k,
+                                 "text": q.base["assuming"][k - 1], "source": q.base["source"]})
+
+    def tables(self, goal: Formal, v: TemporalVerdict, ts: TransitionSystem) -> TemporalVerdict:
+        """The finite-table lasso search over ``ts``, confirmed on the trace (:mod:`.lasso`)."""
+        q, types, points = self.q, self.types, self.points
+        if any(isinstance(ty, EmptyT) for ty in types.values()):
+            return v
+        try:
+            found = find_table_lasso(ts, self.reach(goal), types, bound=q.bound, points=points)
+        except (ValueError, z3.Z3Exception) as exc:
+            found = f"the finite-table search failed ({exc})"
+        if isinstance(found, str):
+            return TemporalVerdict(v.status, v.method, k=v.k, bound=v.bound, trace=v.trace, loop=v.loop,
+                                   detail=f"{v.detail}; {found}")
+        why = confirm_lasso(found.values, found.loop, q.cone, self.sys.variables, types, q.checked, q.model, q.plan,
+                            goal, q.assuming, [f.label for f in ts.fairness], self.sys.pub)
+        if why is not None:
+            return TemporalVerdict(v.status, v.method, k=v.k, bound=v.bound, trace=v.trace, loop=v.loop,
+                                   detail=f"{v.detail}; a lasso with {points}-point tables was found but not "
+                                          f"confirmed on its values ({why})")
+        n = len(found.values) - 1
+        return TemporalVerdict("refuted", "lasso", bound=n, loop=found.loop,
+                               trace=[{k: render(x) for k, x in st.items()} for st in found.values],
+                               detail=f"a run whose step {n} returns to step {found.loop} and never reaches it "
+                                      f"(found with every function a {points}-point table, confirmed on the "
+                                      f"trace's values)")
+
+    def decide(self) -> tuple[ComposedSystem, TemporalVerdict, dict[str, Any]]:
+        q, sys, enc, rank = self.q, self.sys, self.enc, self.q.rank
+        ranking = (lambda s: enc.term(rank.expr, rank.scope, sys.statement_symbols(s))) if rank is not None else None
+        inv_pred = self.raw(q.inv) if q.inv is not None else None
+        missing: dict[str, Any] = {}
+        v = decide(q.t, sys, self.pred, bound=q.bound, timeout_ms=q.timeout_ms, tables=self.tables, ranking=ranking,
+                   invariant=inv_pred, checked=q.checked, gaps=missing,
+                   tables_first=any(isinstance(ty, FuncT) for ty in self.types.values()), reach=self.reach,
+                   hint_text=" ".join(q.req.invariant.text.split()) if q.req.invariant is not None else "")
+        return sys, v, missing

@@ -193,183 +193,230 @@ def build_system(cone: Sequence[str], checked: Checked, model: SystemModel, plan
     Raises :class:`~rclverify.lang.errors.RclError` for a state declaration
     that does not check (the plan's ``resolve`` reports those first).
     """
-    enc = Encoder(checked.env)
-    sorts: dict[str, z3.SortRef] = {}
-    types: dict[str, Type] = {}
-    variables: dict[str, tuple[str, str, str]] = {}
-    premises: list[dict[str, Any]] = []
-    for n in cone:
-        cn = checked.nodes[n]
-        for p, table in (("in", cn.inputs), ("out", cn.outputs)):
-            for v, t in table.items():
-                if isinstance(t, EmptyT):  # no value to hold (the encoder refuses any formula using it)
-                    continue
-                name = f"{n}.{p}.{v}"
-                sorts[name], types[name], variables[name] = _sort(t), t, (n, p, v)
-    states = [sv for sv in plan.states if sv.node in cone]
-    for sv in states:
-        name = f"{sv.node}.state.{sv.name}"
-        t = state_type(sv, checked)
-        sorts[name], types[name], variables[name] = _sort(t), t, (sv.node, "state", sv.name)
+    return _Builder(cone, checked, model, plan, without_initially).build()
 
-    def where(e: Any) -> str:
-        return f"{e.loc.file}:{e.loc.line}:{e.loc.col}"
 
-    guarantees, internal, env, facts = {}, {}, {}, {}
-    for n in cone:
-        cn = checked.nodes[n]
-        guarantees[n] = [g.formula for g in cn.node.guarantees]
-        internal[n], env[n] = split_assumption(checked, model, n)
-        facts[n] = [f.expr for f in plan.facts.get(n, ())]
-        for k, g in enumerate(guarantees[n], 1):
-            premises.append({"label": f"{n} guarantee {k}", "kind": "guarantee", "node": n, "index": k,
-                             "text": expr_to_rcl(g), "source": where(g)})
-        for k, a in enumerate(internal[n], 1):
-            premises.append({"label": f"{n} assumption {k}", "kind": "internal assumption", "node": n, "index": k,
-                             "text": expr_to_rcl(a), "source": where(a)})
-        for k, a in enumerate(env[n], 1):
-            premises.append({"label": f"{n} environment assumption {k}", "kind": "environment assumption", "node": n,
-                             "index": k, "text": expr_to_rcl(a), "source": where(a)})
-        for k, f in enumerate(plan.facts.get(n, ()), 1):
-            premises.append({"label": f"{n} environment fact {k}", "kind": "environment fact", "node": n,
-                             "index": k, "text": f.text, "source": where(f.expr)})
-    # answering (module docstring): which nodes answer, accept, count their waiting
-    bounds = {n: step_bound(checked.nodes[n].node) for n in cone}
-    initially = {n: [c.formula for c in checked.nodes[n].node.initially] if n not in without_initially else []
-                 for n in cone}
-    answering = [n for n in cone if any(f"{n}.out.{v}" in sorts for v in checked.nodes[n].outputs)]
-    for n in answering:
-        node = checked.nodes[n].node
-        sorts[f"{n}.answers"], types[f"{n}.answers"], variables[f"{n}.answers"] = z3.BoolSort(), BOOL, (n, "run", "answers")
-        if internal[n]:
-            sorts[f"{n}.accepts"], types[f"{n}.accepts"], variables[f"{n}.accepts"] = z3.BoolSort(), BOOL, (n, "run", "accepts")
-        if bounds[n]:
-            sorts[f"{n}.waiting"], types[f"{n}.waiting"], variables[f"{n}.waiting"] = z3.IntSort(), INTEGER, (n, "run", "waiting")
-        for k, c in enumerate(node.initially if n not in without_initially else (), 1):
-            premises.append({"label": f"{n} initially {k}", "kind": "initial value", "node": n, "index": k,
-                             "text": expr_to_rcl(c.formula), "source": where(c)})
-        if fair(node):
-            premises.append({"label": f"{n} progress", "kind": "progress", "node": n, "index": 0,
-                             "text": progress_words(node),
-                             "source": where(node.progress[0] if node.progress else
-                                             next(p for p in node.periodic if p.unit in STEP_WORDS))})
-    parsed = {}
-    for sv in states:
-        parsed[sv] = (parse_state_formula(sv, "init", checked, plan.states),
-                      parse_state_formula(sv, "next", checked, plan.states))
-        for which, src in (("init", sv.init), ("next", sv.next)):
-            premises.append({"label": f"{sv.node}.state.{sv.name} {which}", "kind": "state declaration",
-                             "node": sv.node, "index": 0, "text": " ".join(src.text.split()),
-                             "source": f"{src.file}:{src.loc.line}:{src.loc.col}"})
+def _where(e: Any) -> str:
+    return f"{e.loc.file}:{e.loc.line}:{e.loc.col}"
 
-    alias = model.alias()
-    links = [(f"{c}.in.{v}", producer) for (c, p, v), producer in alias.items()
-             if c in cone and producer in sorts]
-    reads = {n: {v for f in [*internal[n], *env[n], *guarantees[n]] for p, v in free_io(f)
-                 if p in ("in", None) and v in checked.nodes[n].inputs} for n in cone}
-    pub = publication(answering, links, reads, [n for n in answering if initially[n]])
-    for name, var in pub.variables():
-        sorts[name], types[name], variables[name] = z3.BoolSort(), BOOL, var
 
-    def node_symbols(n: str, s: State) -> dict[str, Any]:
-        cn = checked.nodes[n]
+class _Builder:
+    """The composed system of one cone, built step by step
+    (:func:`build_system`): the variables (inputs and outputs, declared
+    states, the answering nodes' run variables, publication), the premises
+    listed for the report, then the encodings of a valid state, the initial
+    states and a step."""
+
+    def __init__(self, cone: Sequence[str], checked: Checked, model: SystemModel, plan: Plan,
+                 without_initially: Collection[str]) -> None:
+        self.cone, self.checked, self.model, self.plan = cone, checked, model, plan
+        self.without_initially = without_initially
+        self.enc = Encoder(checked.env)
+        self.sorts: dict[str, z3.SortRef] = {}
+        self.types: dict[str, Type] = {}
+        self.variables: dict[str, tuple[str, str, str]] = {}
+        self.premises: list[dict[str, Any]] = []
+        # what valid/trans encode is a function of the states' terms: encoded once per state (pair).  The
+        # cache keeps the terms it is keyed by alive, so their ids cannot be reused for other terms.
+        self.memo: dict[tuple[int, ...], tuple[list[z3.ExprRef], z3.BoolRef]] = {}
+
+    def add(self, name: str, sort: z3.SortRef, t: Type, var: tuple[str, str, str]) -> None:
+        self.sorts[name], self.types[name], self.variables[name] = sort, t, var
+
+    def premise(self, label: str, kind: str, node: str, index: int, text: str, source: str) -> None:
+        self.premises.append({"label": label, "kind": kind, "node": node, "index": index, "text": text,
+                              "source": source})
+
+    def build(self) -> ComposedSystem:
+        checked, cone = self.checked, self.cone
+        self.io_and_state_variables()
+        self.contract_premises()
+        self.run_variables()
+        self.state_premises()
+        alias = self.model.alias()
+        self.links = [(f"{c}.in.{v}", producer) for (c, p, v), producer in alias.items()
+                      if c in cone and producer in self.sorts]
+        reads = {n: {v for f in [*self.internal[n], *self.env[n], *self.guarantees[n]] for p, v in free_io(f)
+                     if p in ("in", None) and v in checked.nodes[n].inputs} for n in cone}
+        self.pub = publication(self.answering, self.links, reads, [n for n in self.answering if self.initially[n]])
+        for name, var in self.pub.variables():
+            self.add(name, z3.BoolSort(), BOOL, var)
+        declared = tuple(self.progress_of(n) for n in self.answering if fair(checked.nodes[n].node))
+        everyone = tuple(self.progress_of(n) for n in self.answering)
+        return ComposedSystem(TransitionSystem(self.sorts, self.init, self.trans, declared), list(cone),
+                              self.variables, self.premises, everyone, self.links, self.bounds,
+                              {n: self.initial_of(n) for n in self.answering if self.initially[n]}, self.pub)
+
+    # -- the variables and the premises ------------------------------------------------
+    def io_and_state_variables(self) -> None:
+        """Each node's inputs and outputs (but of the empty type), then the declared state variables."""
+        for n in self.cone:
+            cn = self.checked.nodes[n]
+            for p, table in (("in", cn.inputs), ("out", cn.outputs)):
+                for v, t in table.items():
+                    if isinstance(t, EmptyT):  # no value to hold (the encoder refuses any formula using it)
+                        continue
+                    self.add(f"{n}.{p}.{v}", _sort(t), t, (n, p, v))
+        self.states = [sv for sv in self.plan.states if sv.node in self.cone]
+        for sv in self.states:
+            t = state_type(sv, self.checked)
+            self.add(f"{sv.node}.state.{sv.name}", _sort(t), t, (sv.node, "state", sv.name))
+
+    def contract_premises(self) -> None:
+        """Each node's guarantees, assumptions (internal and environment) and environment facts."""
+        self.guarantees: dict[str, list[Any]] = {}
+        self.internal: dict[str, list[Any]] = {}
+        self.env: dict[str, list[Any]] = {}
+        self.facts: dict[str, list[Any]] = {}
+        for n in self.cone:
+            cn = self.checked.nodes[n]
+            self.guarantees[n] = [g.formula for g in cn.node.guarantees]
+            self.internal[n], self.env[n] = split_assumption(self.checked, self.model, n)
+            self.facts[n] = [f.expr for f in self.plan.facts.get(n, ())]
+            for k, g in enumerate(self.guarantees[n], 1):
+                self.premise(f"{n} guarantee {k}", "guarantee", n, k, expr_to_rcl(g), _where(g))
+            for k, a in enumerate(self.internal[n], 1):
+                self.premise(f"{n} assumption {k}", "internal assumption", n, k, expr_to_rcl(a), _where(a))
+            for k, a in enumerate(self.env[n], 1):
+                self.premise(f"{n} environment assumption {k}", "environment assumption", n, k, expr_to_rcl(a),
+                             _where(a))
+            for k, f in enumerate(self.plan.facts.get(n, ()), 1):
+                self.premise(f"{n} environment fact {k}", "environment fact", n, k, f.text, _where(f.expr))
+
+    def run_variables(self) -> None:
+        """Answering (module docstring): which nodes answer, accept, count their waiting; their
+        ``initially`` and ``progress`` premises."""
+        checked, cone, wo = self.checked, self.cone, self.without_initially
+        self.bounds = {n: step_bound(checked.nodes[n].node) for n in cone}
+        self.initially = {n: [c.formula for c in checked.nodes[n].node.initially] if n not in wo else []
+                          for n in cone}
+        self.answering = [n for n in cone if any(f"{n}.out.{v}" in self.sorts for v in checked.nodes[n].outputs)]
+        for n in self.answering:
+            node = checked.nodes[n].node
+            self.add(f"{n}.answers", z3.BoolSort(), BOOL, (n, "run", "answers"))
+            if self.internal[n]:
+                self.add(f"{n}.accepts", z3.BoolSort(), BOOL, (n, "run", "accepts"))
+            if self.bounds[n]:
+                self.add(f"{n}.waiting", z3.IntSort(), INTEGER, (n, "run", "waiting"))
+            for k, c in enumerate(node.initially if n not in wo else (), 1):
+                self.premise(f"{n} initially {k}", "initial value", n, k, expr_to_rcl(c.formula), _where(c))
+            if fair(node):
+                self.premise(f"{n} progress", "progress", n, 0, progress_words(node),
+                             _where(node.progress[0] if node.progress else
+                                    next(p for p in node.periodic if p.unit in STEP_WORDS)))
+
+    def state_premises(self) -> None:
+        """The declared state variables' ``init`` and ``next`` formulas, parsed."""
+        self.parsed = {}
+        for sv in self.states:
+            self.parsed[sv] = (parse_state_formula(sv, "init", self.checked, self.plan.states),
+                               parse_state_formula(sv, "next", self.checked, self.plan.states))
+            for which, src in (("init", sv.init), ("next", sv.next)):
+                self.premise(f"{sv.node}.state.{sv.name} {which}", "state declaration", sv.node, 0,
+                             " ".join(src.text.split()), f"{src.file}:{src.loc.line}:{src.loc.col}")
+
+    # -- the encodings ----------------------------------------------------------------------
+    def node_symbols(self, n: str, s: State) -> dict[str, Any]:
+        cn = self.checked.nodes[n]
         return {**{f"in.{v}": s[f"{n}.in.{v}"] for v in cn.inputs if f"{n}.in.{v}" in s},
                 **{f"out.{v}": s[f"{n}.out.{v}"] for v in cn.outputs if f"{n}.out.{v}" in s}}
 
-    def holds(n: str, e: Any, s: State) -> z3.BoolRef:
-        return enc.formula(e, checked.nodes[n], node_symbols(n, s))
+    def holds(self, n: str, e: Any, s: State) -> z3.BoolRef:
+        return self.enc.formula(e, self.checked.nodes[n], self.node_symbols(n, s))
 
-    def assumed(n: str, s: State) -> z3.BoolRef:
-        return z3.And(*[holds(n, a, s) for a in internal[n]]) if internal[n] else z3.BoolVal(True)
+    def assumed(self, n: str, s: State) -> z3.BoolRef:
+        return z3.And(*[self.holds(n, a, s) for a in self.internal[n]]) if self.internal[n] else z3.BoolVal(True)
 
-    # what valid/trans encode is a function of the states' terms: encoded once per state (pair).  The
-    # cache keeps the terms it is keyed by alive, so their ids cannot be reused for other terms.
-    memo: dict[tuple[int, ...], tuple[list[z3.ExprRef], z3.BoolRef]] = {}
-
-    def cached(tag: int, states_: tuple[State, ...], make: Any) -> z3.BoolRef:
-        terms = [st[name] for st in states_ for name in sorts]
+    def cached(self, tag: int, states_: tuple[State, ...], make: Any) -> z3.BoolRef:
+        terms = [st[name] for st in states_ for name in self.sorts]
         key = (tag, *[x.get_id() for x in terms])
-        hit = memo.get(key)
+        hit = self.memo.get(key)
         if hit is None:
-            hit = memo[key] = (terms, make())
+            hit = self.memo[key] = (terms, make())
         return hit[1]
 
-    def valid(s: State) -> z3.BoolRef:
-        return cached(0, (s,), lambda: _valid(s))
+    def valid(self, s: State) -> z3.BoolRef:
+        return self.cached(0, (s,), lambda: self._valid(s))
 
-    def accepted(n: str, s: State) -> z3.BoolRef:
+    def accepted(self, n: str, s: State) -> z3.BoolRef:
         """The node's assumption holds on ``s``'s input (its ``accepts`` variable, TRUE without one)."""
         return s[f"{n}.accepts"] if f"{n}.accepts" in s else z3.BoolVal(True)
 
-    def enabled(n: str, s: State) -> z3.BoolRef:
+    def enabled(self, n: str, s: State) -> z3.BoolRef:
         """The node has a question it owes an answer: every input it reads published, its assumption holding."""
-        return z3.And(accepted(n, s), pub.ready(n, s))
+        return z3.And(self.accepted(n, s), self.pub.ready(n, s))
 
+    @staticmethod
     def answers_in(n: str, s: State) -> z3.BoolRef:
         return s[f"{n}.answers"]
 
-    def _valid(s: State) -> z3.BoolRef:
-        parts = [c for c in (_typing(s[name], types[name]) for name in sorts) if c is not None]
-        for n in cone:
-            parts += [holds(n, a, s) for a in env[n]] + [holds(n, f, s) for f in facts[n]]
+    def _valid(self, s: State) -> z3.BoolRef:
+        holds, types = self.holds, self.types
+        parts = [c for c in (_typing(s[name], types[name]) for name in self.sorts) if c is not None]
+        for n in self.cone:
+            parts += [holds(n, a, s) for a in self.env[n]] + [holds(n, f, s) for f in self.facts[n]]
             if f"{n}.accepts" in s:
-                parts.append(s[f"{n}.accepts"] == assumed(n, s))
-            promise = z3.And(*[holds(n, g, s) for g in guarantees[n]]) if guarantees[n] else z3.BoolVal(True)
+                parts.append(s[f"{n}.accepts"] == self.assumed(n, s))
+            guarantees = self.guarantees[n]
+            promise = z3.And(*[holds(n, g, s) for g in guarantees]) if guarantees else z3.BoolVal(True)
             if f"{n}.answers" not in s:  # no output to answer with: its guarantee holds where its assumption does
-                if guarantees[n]:
-                    parts.append(z3.Implies(assumed(n, s), promise))
+                if guarantees:
+                    parts.append(z3.Implies(self.assumed(n, s), promise))
                 continue
             answers = s[f"{n}.answers"]
-            parts.append(z3.Implies(answers, z3.And(enabled(n, s), promise)))
-            k = bounds[n]
+            parts.append(z3.Implies(answers, z3.And(self.enabled(n, s), promise)))
+            k = self.bounds[n]
             if k == 0:
-                parts.append(z3.Implies(enabled(n, s), answers))
+                parts.append(z3.Implies(self.enabled(n, s), answers))
             elif k:
                 w = s[f"{n}.waiting"]
-                parts.append(z3.If(z3.Or(answers, z3.Not(enabled(n, s))), w == 0, z3.And(w >= 1, w <= k)))
+                parts.append(z3.If(z3.Or(answers, z3.Not(self.enabled(n, s))), w == 0, z3.And(w >= 1, w <= k)))
         return z3.And(*parts)
 
-    def state_syms(sv: Any, s: State, t: State | None) -> dict[str, Any]:
-        out = node_symbols(sv.node, s) if t is not None else {}
-        for o in states:
+    def state_syms(self, sv: Any, s: State, t: State | None) -> dict[str, Any]:
+        out = self.node_symbols(sv.node, s) if t is not None else {}
+        for o in self.states:
             if o.node == sv.node:
                 out[f"in.state.{o.name}"] = s[f"{o.node}.state.{o.name}"]
                 if t is not None:
                     out[f"in.next.{o.name}"] = t[f"{o.node}.state.{o.name}"]
         return out
 
-    def init(s: State) -> z3.BoolRef:
-        parts = [valid(s), pub.init(s, answers_in),
-                 *[enc.formula(parsed[sv][0].expr, parsed[sv][0].scope, state_syms(sv, s, None)) for sv in states]]
-        for n in answering:
-            if initially[n]:
-                parts.append(z3.Implies(z3.Not(s[f"{n}.answers"]), z3.And(*[holds(n, f, s) for f in initially[n]])))
-            if bounds[n]:
+    def init(self, s: State) -> z3.BoolRef:
+        enc, parsed = self.enc, self.parsed
+        parts = [self.valid(s), self.pub.init(s, self.answers_in),
+                 *[enc.formula(parsed[sv][0].expr, parsed[sv][0].scope, self.state_syms(sv, s, None))
+                   for sv in self.states]]
+        for n in self.answering:
+            if self.initially[n]:
+                parts.append(z3.Implies(z3.Not(s[f"{n}.answers"]),
+                                        z3.And(*[self.holds(n, f, s) for f in self.initially[n]])))
+            if self.bounds[n]:
                 parts.append(s[f"{n}.waiting"] <= 1)
         return z3.And(*parts)
 
-    def trans(s: State, t: State) -> z3.BoolRef:
-        return cached(1, (s, t), lambda: _trans(s, t))
+    def trans(self, s: State, t: State) -> z3.BoolRef:
+        return self.cached(1, (s, t), lambda: self._trans(s, t))
 
-    def _trans(s: State, t: State) -> z3.BoolRef:
-        parts = [valid(s), valid(t), pub.trans(s, t, answers_in)] + [t[c] == s[p] for c, p in links]
-        for n in answering:
-            outs = [t[f"{n}.out.{v}"] == s[f"{n}.out.{v}"] for v in checked.nodes[n].outputs if f"{n}.out.{v}" in s]
+    def _trans(self, s: State, t: State) -> z3.BoolRef:
+        parts = [self.valid(s), self.valid(t), self.pub.trans(s, t, self.answers_in)] + [
+            t[c] == s[p] for c, p in self.links]
+        for n in self.answering:
+            outs = [t[f"{n}.out.{v}"] == s[f"{n}.out.{v}"] for v in self.checked.nodes[n].outputs
+                    if f"{n}.out.{v}" in s]
             parts.append(z3.Implies(z3.Not(t[f"{n}.answers"]), z3.And(*outs)))
-            if bounds[n]:
-                parts.append(z3.Implies(z3.And(z3.Not(t[f"{n}.answers"]), enabled(n, t)),
+            if self.bounds[n]:
+                parts.append(z3.Implies(z3.And(z3.Not(t[f"{n}.answers"]), self.enabled(n, t)),
                                         t[f"{n}.waiting"] == s[f"{n}.waiting"] + 1))
-        parts += [enc.formula(parsed[sv][1].expr, parsed[sv][1].scope, state_syms(sv, s, t)) for sv in states]
+        parts += [self.enc.formula(self.parsed[sv][1].expr, self.parsed[sv][1].scope, self.state_syms(sv, s, t))
+                  for sv in self.states]
         return z3.And(*parts)
 
-    def initial_of(n: str) -> Any:
-        outs = [f"{n}.out.{v}" for v in checked.nodes[n].outputs if f"{n}.out.{v}" in sorts]
+    def initial_of(self, n: str) -> Any:
+        outs = [f"{n}.out.{v}" for v in self.checked.nodes[n].outputs if f"{n}.out.{v}" in self.sorts]
+        types, holds, initially = self.types, self.holds, self.initially
         return lambda s: z3.And(*[c for c in (_typing(s[o], types[o]) for o in outs) if c is not None],
                                 *[holds(n, f, s) for f in initially[n]])
 
-    def progress_of(n: str) -> Fairness:
-        return Fairness(n, lambda s: enabled(n, s), lambda s: s[f"{n}.answers"])
-    declared = tuple(progress_of(n) for n in answering if fair(checked.nodes[n].node))
-    everyone = tuple(progress_of(n) for n in answering)
-    return ComposedSystem(TransitionSystem(sorts, init, trans, declared), list(cone), variables, premises, everyone,
-                          links, bounds, {n: initial_of(n) for n in answering if initially[n]}, pub)
+    def progress_of(self, n: str) -> Fairness:
+        return Fairness(n, lambda s: self.enabled(n, s), lambda s: s[f"{n}.answers"])

@@ -13,7 +13,7 @@ from __future__ import annotations
 import json
 from importlib import resources
 from pathlib import Path
-from typing import Any, Mapping
+from typing import Any, Mapping, Sequence
 
 import yaml
 
@@ -267,70 +267,24 @@ def resolve(plan: Plan, checked: Checked) -> None:
     :func:`rclverify.backends.entry_checks.check_entries`, which the caller
     runs after this (``Workspace.checked``).
     """
-    from rclverify.lang.typecheck import infer
-    diags: list[Diagnostic] = []
-    nodes = checked.nodes
-
-    def bad(l: ast.Loc, msg: str) -> None:
-        diags.extend(plan_error(l.file, l.line, l.col, msg).diagnostics)
-
-    def node_ok(name: str, l: ast.Loc) -> bool:
-        if name in nodes:
-            return True
-        bad(l, f"no node named {name!r} in the contracts; nodes are: {', '.join(nodes)}")
-        return False
-
+    refs = _References(checked)
+    diags = refs.diags
     try:
         reqs = all_requirements(plan)
     except PlanError as exc:
         diags.extend(exc.diagnostics)
         reqs = plan.requirements
-    for r in reqs:
-        for s in r.support:
-            if node_ok(s.node, s.loc):
-                n = len(nodes[s.node].node.guarantees)
-                for g in s.guarantees:
-                    if not 1 <= g <= n:
-                        bad(s.loc, f"{r.id}: node {s.node} has {n} guarantee(s); there is no guarantee {g}")
+    refs.support(reqs)
     diags.extend(check_formal(reqs, checked, plan.states))
     from rclverify.model.plan.state import check_states
     diags.extend(check_states(plan.states, checked))
     for d in plan.deadlines:
         for n in d.path:
-            if not node_ok(n, d.loc):
+            if not refs.node_ok(n, d.loc):
                 break
-    for c in plan.connections:
-        if node_ok(c.from_node, c.loc) and node_ok(c.to_node, c.loc):
-            ot = nodes[c.from_node].outputs.get(c.from_var)
-            it = nodes[c.to_node].inputs.get(c.to_var)
-            if ot is None:
-                bad(c.loc, f"{c.from_node} has no output {c.from_var!r}")
-            if it is None:
-                bad(c.loc, f"{c.to_node} has no input {c.to_var!r}")
-            if ot is not None and it is not None and ot != it:
-                bad(c.loc, f"connection joins {c.from_node}.{c.from_var} : {ot} to {c.to_node}.{c.to_var} : {it}")
-    for node, facts in plan.facts.items():
-        for f in facts:
-            if not node_ok(node, f.loc):
-                break
-            try:
-                t = infer(f.expr, nodes[node], checked.env)
-            except RclError as exc:
-                diags.extend(exc.diagnostics)
-                continue
-            if t != BOOL:
-                bad(f.loc, f"an environment fact must be a formula, found {t}")
-    from rclverify.model.plan.entries import BACKEND_NAMES, unknown_key_messages
-    for node, entries in plan.evidence.items():
-        if entries:
-            node_ok(node, entries[0].loc)
-        for e in entries:
-            if e.backend not in BACKEND_NAMES:
-                bl = plan.locs.get(("nodes", node, "evidence", e.index, "backend"), e.loc)
-                bad(bl, f"unknown backend {e.backend!r}; known backends: {', '.join(BACKEND_NAMES)}")
-            for key, msg in unknown_key_messages(e.backend, e.config):
-                path = ("nodes", node, "evidence", e.index, key)
-                bad(plan.locs.get(path + (KEY,), plan.locs.get(path, e.loc)), msg)
+    refs.connections(plan)
+    refs.facts(plan)
+    refs.entries(plan)
     diags.extend(check_targets(plan, checked))  # statistical targets, environment tags, run origins (docs/statistics.md)
     # The backends' own check-time validation (experiment data and criteria,
     # review records, trace mappings) is run by the layer above both
@@ -341,3 +295,74 @@ def resolve(plan: Plan, checked: Checked) -> None:
     diags.extend(check_expected(plan, checked))
     if diags:
         raise PlanError(diags)
+
+
+class _References:
+    """The plan's references into the contracts checked one kind at a time
+    (:func:`resolve`), each problem a located diagnostic in ``diags``."""
+
+    def __init__(self, checked: Checked) -> None:
+        self.checked, self.nodes = checked, checked.nodes
+        self.diags: list[Diagnostic] = []
+
+    def bad(self, l: ast.Loc, msg: str) -> None:
+        self.diags.extend(plan_error(l.file, l.line, l.col, msg).diagnostics)
+
+    def node_ok(self, name: str, l: ast.Loc) -> bool:
+        if name in self.nodes:
+            return True
+        self.bad(l, f"no node named {name!r} in the contracts; nodes are: {', '.join(self.nodes)}")
+        return False
+
+    def support(self, reqs: Sequence[Requirement]) -> None:
+        """A requirement's ``support``: its nodes exist, its guarantee indices are in range."""
+        for r in reqs:
+            for s in r.support:
+                if self.node_ok(s.node, s.loc):
+                    n = len(self.nodes[s.node].node.guarantees)
+                    for g in s.guarantees:
+                        if not 1 <= g <= n:
+                            self.bad(s.loc, f"{r.id}: node {s.node} has {n} guarantee(s); there is no guarantee {g}")
+
+    def connections(self, plan: Plan) -> None:
+        """A connection joins an output and an input of equal type."""
+        nodes, bad = self.nodes, self.bad
+        for c in plan.connections:
+            if self.node_ok(c.from_node, c.loc) and self.node_ok(c.to_node, c.loc):
+                ot = nodes[c.from_node].outputs.get(c.from_var)
+                it = nodes[c.to_node].inputs.get(c.to_var)
+                if ot is None:
+                    bad(c.loc, f"{c.from_node} has no output {c.from_var!r}")
+                if it is None:
+                    bad(c.loc, f"{c.to_node} has no input {c.to_var!r}")
+                if ot is not None and it is not None and ot != it:
+                    bad(c.loc, f"connection joins {c.from_node}.{c.from_var} : {ot} to {c.to_node}.{c.to_var} : {it}")
+
+    def facts(self, plan: Plan) -> None:
+        """An environment fact is a well-typed formula of its node."""
+        from rclverify.lang.typecheck import infer
+        for node, facts in plan.facts.items():
+            for f in facts:
+                if not self.node_ok(node, f.loc):
+                    break
+                try:
+                    t = infer(f.expr, self.nodes[node], self.checked.env)
+                except RclError as exc:
+                    self.diags.extend(exc.diagnostics)
+                    continue
+                if t != BOOL:
+                    self.bad(f.loc, f"an environment fact must be a formula, found {t}")
+
+    def entries(self, plan: Plan) -> None:
+        """An evidence entry names a registered backend and only its keys."""
+        from rclverify.model.plan.entries import BACKEND_NAMES, unknown_key_messages
+        for node, entries in plan.evidence.items():
+            if entries:
+                self.node_ok(node, entries[0].loc)
+            for e in entries:
+                if e.backend not in BACKEND_NAMES:
+                    bl = plan.locs.get(("nodes", node, "evidence", e.index, "backend"), e.loc)
+                    self.bad(bl, f"unknown backend {e.backend!r}; known backends: {', '.join(BACKEND_NAMES)}")
+                for key, msg in unknown_key_messages(e.backend, e.config):
+                    path = ("nodes", node, "evidence", e.index, key)
+                    self.bad(plan.locs.get(path + (KEY,), plan.locs.get(path, e.loc)), msg)

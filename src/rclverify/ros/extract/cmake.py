@@ -100,7 +100,8 @@ def _items(args: list[str], env: dict[str, str]) -> list[str]:
         start, stop, step = (0, n[0], 1) if len(n) == 1 else (n[0], n[1], n[2] if len(n) > 2 else 1)
         return [str(i) for i in range(start, stop + 1, step or 1)][:MAX_ITEMS] if step > 0 else []
     if args[:1] == ["IN"]:
-        out, mode = [], None
+        out: list[str] = []
+        mode = None
         for a in args[1:]:
             if a in ("LISTS", "ITEMS", "ZIP_LISTS"):
                 mode = a
@@ -112,10 +113,11 @@ def _items(args: list[str], env: dict[str, str]) -> list[str]:
     return args[:MAX_ITEMS]
 
 
-def _block(seq: list[tuple[str, list[str], int]], i: int, opener: str, closer: str) -> tuple[list, int]:
+def _block(seq: list[tuple[str, list[str], int]], i: int, opener: str, closer: str) -> tuple[list[_Cmd], int]:
     """The commands between ``seq[i]`` (an ``opener``) and its matching ``closer``, and
     the index of that closer (``len(seq)`` when missing)."""
-    body, depth, j = [], 1, i + 1
+    body: list[_Cmd] = []
+    depth, j = 1, i + 1
     while j < len(seq):
         if seq[j][0] == opener:
             depth += 1
@@ -128,6 +130,9 @@ def _block(seq: list[tuple[str, list[str], int]], i: int, opener: str, closer: s
     return body, j
 
 
+_Cmd = tuple[str, list[str], int]
+
+
 def expand(text: str, pkg: str, glob: Callable[[str, bool], list[str]] | None = None) -> list[tuple[str, list[str], int]]:
     """The commands ``text`` runs, with variables substituted, ``foreach`` loops
     unrolled and calls of the file's own ``function``/``macro`` definitions
@@ -135,37 +140,45 @@ def expand(text: str, pkg: str, glob: Callable[[str, bool], list[str]] | None = 
     the top-level call.  Arguments holding ``;`` lists are split, as CMake does
     for unquoted ones.  ``glob(pattern, recurse)`` lists the package files a
     ``file(GLOB ...)`` pattern matches (relative paths); without it globs are empty."""
-    cmds = commands_of(text)
-    defs: dict[str, tuple[list[str], list[tuple[str, list[str], int]]]] = {}
-    top: list[tuple[str, list[str], int]] = []
+    defs, top = _definitions(commands_of(text))
+    runner = _Runner(defs, glob)
+    runner.run(top, {"PROJECT_NAME": pkg, "CMAKE_CURRENT_SOURCE_DIR": ".", "PROJECT_SOURCE_DIR": "."}, 0, None)
+    return runner.out
+
+
+def _definitions(cmds: list[_Cmd]) -> tuple[dict[str, tuple[list[str], list[_Cmd]]], list[_Cmd]]:
+    """The file's ``function``/``macro`` definitions (name lower-cased ->
+    (parameters, body)) and its other top-level commands."""
+    defs: dict[str, tuple[list[str], list[_Cmd]]] = {}
+    top: list[_Cmd] = []
     i = 0
     while i < len(cmds):
         name, args, line = cmds[i]
         if name in ("function", "macro") and args:
-            end = "endfunction" if name == "function" else "endmacro"
-            body, depth, i = [], 1, i + 1
-            while i < len(cmds) and depth:
-                if cmds[i][0] == name:
-                    depth += 1
-                elif cmds[i][0] == end:
-                    depth -= 1
-                    if not depth:
-                        break
-                body.append(cmds[i])
-                i += 1
+            body, i = _block(cmds, i, name, "endfunction" if name == "function" else "endmacro")
             defs[args[0].lower()] = (args[1:], body)
         else:
             top.append(cmds[i])
         i += 1
-    out: list[tuple[str, list[str], int]] = []
-    env = {"PROJECT_NAME": pkg, "CMAKE_CURRENT_SOURCE_DIR": ".", "PROJECT_SOURCE_DIR": "."}
+    return defs, top
 
-    def run(seq: list[tuple[str, list[str], int]], env: dict[str, str], depth: int, at: int | None) -> None:
+
+class _Runner:
+    """Runs commands into ``out`` (bounded by :data:`MAX_COMMANDS` and :data:`MAX_DEPTH`)."""
+
+    def __init__(self, defs: dict[str, tuple[list[str], list[_Cmd]]],
+                 glob: Callable[[str, bool], list[str]] | None) -> None:
+        self.defs, self.glob = defs, glob
+        self.out: list[_Cmd] = []
+
+    def run(self, seq: list[_Cmd], env: dict[str, str], depth: int, at: int | None) -> None:
+        """Run ``seq`` in ``env`` at nesting ``depth``; ``at`` the line of the
+        top-level call every produced command keeps (``None``: its own)."""
         i = 0
         while i < len(seq):
             name, raw, line = seq[i]
             i += 1
-            if len(out) >= MAX_COMMANDS:
+            if len(self.out) >= MAX_COMMANDS:
                 return
             args = [x for a in raw for x in _subst(a, env).split(";") if x != ""]
             where = at if at is not None else line
@@ -175,15 +188,10 @@ def expand(text: str, pkg: str, glob: Callable[[str, bool], list[str]] | None = 
                 if args and depth < MAX_DEPTH:
                     for item in _items(args[1:], env):
                         env[args[0]] = item
-                        run(body, env, depth + 1, where)
+                        self.run(body, env, depth + 1, where)
                 continue
             if name == "file" and len(args) >= 2 and args[0] in ("GLOB", "GLOB_RECURSE"):
-                pats = [a for a in args[2:] if a not in ("LIST_DIRECTORIES", "CONFIGURE_DEPENDS", "true", "false")]
-                if "RELATIVE" in pats:
-                    k = pats.index("RELATIVE")
-                    pats = pats[:k] + pats[k + 2:]
-                found = [f for p in pats for f in (glob(p, args[0] == "GLOB_RECURSE") if glob else [])]
-                env[args[1]] = ";".join(sorted(set(found)))
+                self.file_glob(args, env)
                 continue
             if name == "set" and args:
                 env[args[0]] = ";".join(a for a in args[1:] if a != "PARENT_SCOPE")
@@ -191,37 +199,53 @@ def expand(text: str, pkg: str, glob: Callable[[str, bool], list[str]] | None = 
                 env["PROJECT_NAME"] = args[0]
             elif name == "cmake_parse_arguments" and len(args) >= 4:
                 _parse_arguments(raw, env)
-            elif name in defs and depth < MAX_DEPTH:
-                params, body = defs[name]
-                inner = dict(env)
-                for k, p in enumerate(params):
-                    inner[p] = args[k] if k < len(args) else ""
-                inner["ARGV"] = ";".join(args)
-                inner["ARGN"] = ";".join(args[len(params):])
-                inner["ARGC"] = str(len(args))
-                for k, a in enumerate(args):
-                    inner[f"ARGV{k}"] = a
-                run(body, inner, depth + 1, where)
+            elif name in self.defs and depth < MAX_DEPTH:
+                self.call(name, args, env, depth, where)
             else:
-                out.append((name, args, where))
+                self.out.append((name, args, where))
 
-    def _parse_arguments(raw: list[str], env: dict[str, str]) -> None:
-        prefix, opts, one, multi = (_subst(x, env) for x in raw[:4])
-        rest = [x for a in raw[4:] for x in _subst(a, env).split(";") if x != ""]
-        o, s, m = opts.split(";"), one.split(";"), multi.split(";")
-        for k in o + s + m:
-            if k:
-                env[f"{prefix}_{k}"] = ""
-        cur = None
-        for tok in rest:
-            if tok in o:
-                env[f"{prefix}_{tok}"], cur = "TRUE", None
-            elif tok in s or tok in m:
-                cur = tok
-            elif cur is not None:
-                key = f"{prefix}_{cur}"
-                env[key] = f"{env[key]};{tok}" if env.get(key) and cur in m else tok
-                if cur in s:
-                    cur = None
-    run(top, env, 0, None)
-    return out
+    def file_glob(self, args: list[str], env: dict[str, str]) -> None:
+        """``file(GLOB|GLOB_RECURSE var [RELATIVE dir] patterns...)``: ``var`` the files found."""
+        pats = [a for a in args[2:] if a not in ("LIST_DIRECTORIES", "CONFIGURE_DEPENDS", "true", "false")]
+        if "RELATIVE" in pats:
+            k = pats.index("RELATIVE")
+            pats = pats[:k] + pats[k + 2:]
+        glob = self.glob
+        found = [f for p in pats for f in (glob(p, args[0] == "GLOB_RECURSE") if glob else [])]
+        env[args[1]] = ";".join(sorted(set(found)))
+
+    def call(self, name: str, args: list[str], env: dict[str, str], depth: int, where: int) -> None:
+        """A call of the file's own function or macro: its body run with its
+        parameters, ``ARGV``, ``ARGN``, ``ARGC`` and ``ARGVn`` set."""
+        params, body = self.defs[name]
+        inner = dict(env)
+        for k, p in enumerate(params):
+            inner[p] = args[k] if k < len(args) else ""
+        inner["ARGV"] = ";".join(args)
+        inner["ARGN"] = ";".join(args[len(params):])
+        inner["ARGC"] = str(len(args))
+        for k, a in enumerate(args):
+            inner[f"ARGV{k}"] = a
+        self.run(body, inner, depth + 1, where)
+
+
+def _parse_arguments(raw: list[str], env: dict[str, str]) -> None:
+    """``cmake_parse_arguments(PREFIX options one-value multi-value args...)``:
+    ``PREFIX_KEY`` set in ``env`` (cmake-commands(7))."""
+    prefix, opts, one, multi = (_subst(x, env) for x in raw[:4])
+    rest = [x for a in raw[4:] for x in _subst(a, env).split(";") if x != ""]
+    o, s, m = opts.split(";"), one.split(";"), multi.split(";")
+    for k in o + s + m:
+        if k:
+            env[f"{prefix}_{k}"] = ""
+    cur = None
+    for tok in rest:
+        if tok in o:
+            env[f"{prefix}_{tok}"], cur = "TRUE", None
+        elif tok in s or tok in m:
+            cur = tok
+        elif cur is not None:
+            key = f"{prefix}_{cur}"
+            env[key] = f"{env[key]};{tok}" if env.get(key) and cur in m else tok
+            if cur in s:
+                cur = None

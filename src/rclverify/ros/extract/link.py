@@ -78,12 +78,28 @@ class Linker(LinkMembers, Values, Returns):
         self.aliases: dict[str, str] = {}
         self.calls: list[tuple[Any, ...]] = []
         self.using_ns = sorted({ns for r in self.recs.values() for ns in r.get("using_ns", [])})
-        entry_units: set[str] = set()
         self.optional: dict[str, int] = {k: n for r in self.recs.values() for k, n in r.get("optional", {}).items()}
         self.returns: dict[str, list[Any]] = {}
         self.reading: set[tuple[str, int]] = set()
         self.fn_tparams: dict[str, list[str]] = {}
         self.call_targs: list[tuple[str, str | None, str | None, int, list[str]]] = []
+        entry_units = self._merge_records(prog)
+        self.py = bool(self.recs) and all(r.get("lang") == "py" for r in self.recs.values())
+        self.classes = [] if self.py else sorted(self.units)
+        self.entry = prog.units if prog.units is not None else entry_units
+        self.sites: dict[str, list[tuple[list[Any], dict[str, Any], str | None]]] = {}
+        # what runs what: "U:class" (constructed: all its methods run) and "F:function" (called)
+        self.edges: dict[str, set[str]] = {}
+        self._link_calls(prog)
+        self.reach = self._reach({f"U:{u}" for u in self.entry})
+        self._memo: dict[str, list[dict[int, Any]]] = {}
+        self._stack: set[str] = set()
+        self.pins: dict[str, int] = {}
+
+    def _merge_records(self, prog: Program) -> set[str]:
+        """The program's files' records merged (a header read by several
+        files counted once); returns the units its entry files define."""
+        entry_units: set[str] = set()
         for r in self.recs.values():  # a header read by several files: its definitions once
             self.fn_tparams.update(r.get("fn_tparams", {}))
             self.call_targs += [tuple(c) for c in r.get("call_targs", []) if tuple(c) not in self.call_targs]
@@ -116,12 +132,12 @@ class Linker(LinkMembers, Values, Returns):
                 self.calls.append(tuple(c) + (({},) if len(c) == 6 else ()))
             if r.get("lang") == "py":
                 entry_units.add(f"{f}::<module>")  # a module's code runs when it is imported
-        self.py = bool(self.recs) and all(r.get("lang") == "py" for r in self.recs.values())
-        self.classes = [] if self.py else sorted(self.units)
-        self.entry = prog.units if prog.units is not None else entry_units
-        self.sites: dict[str, list[tuple[list[Any], dict[str, Any], str | None]]] = {}
-        # what runs what: "U:class" (constructed: all its methods run) and "F:function" (called)
-        self.edges: dict[str, set[str]] = {}
+        return entry_units
+
+    def _link_calls(self, prog: Program) -> None:
+        """What runs what (:attr:`edges`) and the call sites of each function
+        (:attr:`sites`): a class's methods, the calls read, a plugin's entry
+        points, the classes a class holds or derives from."""
         overloaded = {k.split("#")[0] for k in self.fns if "#" in k}  # constructors run only where called
         for k, (unit, *_rest) in self.fns.items():
             if (unit in self.units or unit == k) and "#" not in k and k not in overloaded:
@@ -152,10 +168,6 @@ class Linker(LinkMembers, Values, Returns):
                     m = self.match(ident, u) if not ident.startswith(("std::", "ros::", "rclcpp::")) else None
                     if m is not None and m != u:
                         self._edge(f"U:{u}", f"U:{m}")
-        self.reach = self._reach({f"U:{u}" for u in self.entry})
-        self._memo: dict[str, list[dict[int, Any]]] = {}
-        self._stack: set[str] = set()
-        self.pins: dict[str, int] = {}
 
     # -- program structure
     def match(self, name: str, caller: str | None) -> str | None:

@@ -146,83 +146,121 @@ def _class_named(code: PackageCode, cls: str) -> str:
 
 def programs(code: PackageCode, t: Targets) -> list[Program]:
     """Every program of the package (see the module docstring)."""
-    show = code.show
-    listed = {show(p) for srcs in list(t.executables.values()) + list(t.libraries.values()) for p in srcs}
+    f = _Finder(code, t)
+    f.executables()
+    f.plugins()
+    f.pluginlib()
+    f.scripts()
+    f.loose()
+    return f.out
 
-    def linked(target: str, seen: set[str]) -> list[str]:
+
+class _Finder:
+    """The package's programs found kind by kind (:func:`programs`): ``out``
+    the programs so far, ``held`` the files one of them takes in."""
+
+    def __init__(self, code: PackageCode, t: Targets) -> None:
+        self.code, self.t, self.show = code, t, code.show
+        show = code.show
+        self.listed = {show(p) for srcs in list(t.executables.values()) + list(t.libraries.values()) for p in srcs}
+        self.out: list[Program] = []
+        self.held: set[str] = set()
+
+    def linked(self, target: str, seen: set[str]) -> list[str]:
+        """The sources of the libraries ``target`` links, transitively."""
+        t, show = self.t, self.show
         out = []
         for lib in t.links.get(target, []):
             if lib in t.libraries and lib not in seen:
                 seen.add(lib)
-                out += [show(p) for p in t.libraries[lib]] + linked(lib, seen)
+                out += [show(p) for p in t.libraries[lib]] + self.linked(lib, seen)
         return out
 
-    out: list[Program] = []
-    held: set[str] = set()
-    for exe, srcs in sorted(t.executables.items()):
-        own = [show(p) for p in srcs]
-        files = _closure(code, own + linked(exe, {exe}), listed)
-        comp = t.components.get(exe)
-        out.append(Program(code.name, exe, own, files, {comp[0]} if comp else None))
-        held.update(files)
-    lookups = {c: k for k, (c, _lib) in t.nodelets.items()}
-    plugins = dict(t.plugins)
-    for f, r in sorted(code.records.items()):  # nodelets registered in code, with no plugin description read
-        for cls, lookup, _at in r.get("nodelets", []):
-            if _class_named(code, cls) not in {_class_named(code, c) for c in plugins}:
-                lib = next((n for n, ps in sorted(t.libraries.items()) if f in {show(p) for p in ps}), None)
-                plugins[cls] = lib or f"file:{f}"
-                lookups.setdefault(cls, lookup or cls)
-    for cls, target in sorted(plugins.items()):
-        lib_srcs = [show(p) for p in t.libraries.get(target, []) + t.executables.get(target, [])] or \
-            ([target[5:]] if target.startswith("file:") else [])
-        files = _closure(code, lib_srcs + linked(target, {target}),
-                         listed if not target.startswith("file:") else set())
-        exes: list[str | None] = [e for e, (c, _l) in t.components.items() if c == cls]
-        for comp_exe in exes or [None]:
-            if comp_exe is not None and comp_exe in t.executables:
-                continue
-            out.append(Program(code.name, comp_exe, lib_srcs, files, {_class_named(code, cls)},
-                               nodelet=lookups.get(cls)))
-        held.update(files)
-    for pc in t.pluginlib:  # ROS 2 pluginlib classes: run from their class, loaded by a node (plugins)
-        cls = _class_named(code, pc.type)
-        srcs = [show(p) for p in t.libraries.get(pc.library or "", [])] or sorted(
-            f for f, r in code.records.items() if r.get("lang") != "py" and cls in r.get("units", {}))
-        if srcs and any(cls in r.get("units", {}) for r in code.records.values() if r.get("lang") != "py"):
-            target = pc.library if pc.library in t.libraries else None
-            files = _closure(code, srcs + (linked(target, {target}) if target else []),
-                             listed if target else set())
-            out.append(Program(code.name, None, srcs, files, {cls}, plugin=pc.type))
-            held.update(f for f in files if not code.records.get(f, {}).get("node_names"))
-    scripts: dict[str, list[str]] = {}
-    for exe, paths in t.programs.items():
-        scripts.setdefault(show(paths[0]), []).append(exe)
-    for f, names in sorted(scripts.items()):
-        files = _closure(code, [f], listed)
-        out.append(Program(code.name, names[0], [f], files, None, names[1:]))
-        held.update(files[1:])
-    entries = {p.entry[0] for p in out if p.entry and p.exe is not None and code.records.get(p.entry[0], {})
-               .get("lang") == "py"}
+    def executables(self) -> None:
+        """One program per built executable (a component's executable runs its class)."""
+        code, t, show = self.code, self.t, self.show
+        for exe, srcs in sorted(t.executables.items()):
+            own = [show(p) for p in srcs]
+            files = _closure(code, own + self.linked(exe, {exe}), self.listed)
+            comp = t.components.get(exe)
+            self.out.append(Program(code.name, exe, own, files, {comp[0]} if comp else None))
+            self.held.update(files)
 
-    def content(f: str) -> bool:
-        r = code.records[f]
-        return bool(r.get("nodes") or r.get("node_names") or r.get("endpoints"))
+    def plugins(self) -> None:
+        """Nodelets and components: one program per class (and per executable
+        of a component that has no executable target of its own); nodelets
+        registered in code with no plugin description read count too."""
+        code, t, show = self.code, self.t, self.show
+        lookups = {c: k for k, (c, _lib) in t.nodelets.items()}
+        plugins = dict(t.plugins)
+        for f, r in sorted(code.records.items()):  # nodelets registered in code, with no plugin description read
+            for cls, lookup, _at in r.get("nodelets", []):
+                if _class_named(code, cls) not in {_class_named(code, c) for c in plugins}:
+                    lib = next((n for n, ps in sorted(t.libraries.items()) if f in {show(p) for p in ps}), None)
+                    plugins[cls] = lib or f"file:{f}"
+                    lookups.setdefault(cls, lookup or cls)
+        for cls, target in sorted(plugins.items()):
+            lib_srcs = [show(p) for p in t.libraries.get(target, []) + t.executables.get(target, [])] or \
+                ([target[5:]] if target.startswith("file:") else [])
+            files = _closure(code, lib_srcs + self.linked(target, {target}),
+                             self.listed if not target.startswith("file:") else set())
+            exes: list[str | None] = [e for e, (c, _l) in t.components.items() if c == cls]
+            for comp_exe in exes or [None]:
+                if comp_exe is not None and comp_exe in t.executables:
+                    continue
+                self.out.append(Program(code.name, comp_exe, lib_srcs, files, {_class_named(code, cls)},
+                                        nodelet=lookups.get(cls)))
+            self.held.update(files)
 
-    loose = [f for f in sorted(code.records) if f not in entries and content(f)]
-    py = [f for f in loose if code.records[f].get("lang") == "py"]
-    cpp = [f for f in loose if code.records[f].get("lang") != "py"]
-    # files naming a node first, so the modules and headers they take in are theirs
-    for f in sorted(py + cpp, key=lambda f: (not code.records[f].get("node_names"),
-                                              "." + f.rsplit(".", 1)[-1] in _HEADER, f)):
-        if f in held and not (f in py and code.records[f].get("node_names")):
-            continue  # a module or header a program takes in (a script naming a node also runs alone)
-        files = _closure(code, [f], listed)
-        name = f.rsplit("/", 1)[-1]
-        if f in py:
-            stem = name.rsplit(".", 1)[0]
-            out.append(Program(code.name, name, [f], files, None, [stem] if stem != name else []))
-        else:
-            out.append(Program(code.name, None, [f], files))
-        held.update(files)
-    return out
+    def pluginlib(self) -> None:
+        """ROS 2 pluginlib classes: run from their class, loaded by a node (plugins)."""
+        code, t, show = self.code, self.t, self.show
+        for pc in t.pluginlib:
+            cls = _class_named(code, pc.type)
+            srcs = [show(p) for p in t.libraries.get(pc.library or "", [])] or sorted(
+                f for f, r in code.records.items() if r.get("lang") != "py" and cls in r.get("units", {}))
+            if srcs and any(cls in r.get("units", {}) for r in code.records.values() if r.get("lang") != "py"):
+                target = pc.library if pc.library in t.libraries else None
+                files = _closure(code, srcs + (self.linked(target, {target}) if target else []),
+                                 self.listed if target else set())
+                self.out.append(Program(code.name, None, srcs, files, {cls}, plugin=pc.type))
+                self.held.update(f for f in files if not code.records.get(f, {}).get("node_names"))
+
+    def scripts(self) -> None:
+        """One program per installed script (its other installed names as aliases)."""
+        code = self.code
+        scripts: dict[str, list[str]] = {}
+        for exe, paths in self.t.programs.items():
+            scripts.setdefault(self.show(paths[0]), []).append(exe)
+        for f, names in sorted(scripts.items()):
+            files = _closure(code, [f], self.listed)
+            self.out.append(Program(code.name, names[0], [f], files, None, names[1:]))
+            self.held.update(files[1:])
+
+    def loose(self) -> None:
+        """Files no build target names that name a node or make endpoints:
+        a program each, unless another program takes them in."""
+        code, held = self.code, self.held
+        entries = {p.entry[0] for p in self.out if p.entry and p.exe is not None
+                   and code.records.get(p.entry[0], {}).get("lang") == "py"}
+
+        def content(f: str) -> bool:
+            r = code.records[f]
+            return bool(r.get("nodes") or r.get("node_names") or r.get("endpoints"))
+
+        loose = [f for f in sorted(code.records) if f not in entries and content(f)]
+        py = [f for f in loose if code.records[f].get("lang") == "py"]
+        cpp = [f for f in loose if code.records[f].get("lang") != "py"]
+        # files naming a node first, so the modules and headers they take in are theirs
+        for f in sorted(py + cpp, key=lambda f: (not code.records[f].get("node_names"),
+                                                  "." + f.rsplit(".", 1)[-1] in _HEADER, f)):
+            if f in held and not (f in py and code.records[f].get("node_names")):
+                continue  # a module or header a program takes in (a script naming a node also runs alone)
+            files = _closure(code, [f], self.listed)
+            name = f.rsplit("/", 1)[-1]
+            if f in py:
+                stem = name.rsplit(".", 1)[0]
+                self.out.append(Program(code.name, name, [f], files, None, [stem] if stem != name else []))
+            else:
+                self.out.append(Program(code.name, None, [f], files))
+            held.update(files)

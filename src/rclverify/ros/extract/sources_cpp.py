@@ -37,28 +37,24 @@ from typing import Any
 
 from rclverify.ros.extract import cpp_helpers, emit, names, symbols, treesitter
 from rclverify.ros.extract.cpp_bases import node_base
+from rclverify.ros.extract.cpp_calls import LIBRARY, CallReader
 from rclverify.ros.extract.cpp_members import MemberReader
 from rclverify.ros.extract.cpp_prep import REGISTER, prepare
 from rclverify.ros.extract.nodelets import registered
-from rclverify.ros.extract.cpp_scope import base_name, callee_parts, namespaces_of
+from rclverify.ros.extract.cpp_scope import base_name, namespaces_of
 from rclverify.ros.extract.cpp_values import CppValues
-from rclverify.ros.extract.cpp_types import adapted, action_type, action_type_in, callback_name, message_type, service_type, split_template
-from rclverify.ros.extract.model import Note, Src, canon_type
+from rclverify.ros.extract.cpp_types import adapted, action_type, action_type_in, message_type, service_type, split_template
+from rclverify.ros.extract.model import Note, Src
 
 __all__ = ["scan_cpp", "action_type", "service_type"]
 
-_CALLS = {"advertise": "pub", "subscribe": "sub", "create_publisher": "pub", "create_subscription": "sub",
-          "advertiseService": "service_servers", "serviceClient": "service_clients",
-          "create_service": "service_servers", "create_client": "service_clients",
-          "create_generic_publisher": "pub", "create_generic_subscription": "sub"}
 _ACTIONLIB = {"SimpleActionServer": "action_servers", "ActionServer": "action_servers",
               "SimpleActionClient": "action_clients", "ActionClient": "action_clients"}
 _NODE_TYPES = {"Node", "LifecycleNode"}
-_LIBRARY = ("std::", "ros::", "rclcpp::", "boost::", "RCLCPP_", "ROS_", "tf2::", "Eigen::", "rcutils_", "rcl_")
 _T = treesitter.text
 
 
-class _File(MemberReader):
+class _File(CallReader, MemberReader):
     def __init__(self, data: bytes, shown: str) -> None:
         self.shown = shown
         self.vex_at: Any = None
@@ -178,7 +174,7 @@ class _File(MemberReader):
         if specs is not None:
             self.specs(specs, at)
             return
-        if head and not head.startswith(_LIBRARY):  # with its template arguments (a template's types)
+        if head and not head.startswith(LIBRARY):  # with its template arguments (a template's types)
             self.record("ctor", type_text.replace("typename", "").strip() if targs else head, args, at)
 
     def actionlib(self, kind: str, ty: str, args: list[Any], at: Any) -> None:
@@ -336,128 +332,6 @@ class _File(MemberReader):
             self.construct(ty, list(a.named_children), n)
         finally:
             self.scope.override, self.vex_at = None, None
-
-    def call(self, n: Any) -> None:
-        fn = n.child_by_field_name("function")
-        a = n.child_by_field_name("arguments")
-        args = list(a.named_children) if a is not None else []
-        if fn is None:
-            return
-        full, last, targs = callee_parts(fn)
-        recv = fn.child_by_field_name("argument") if fn.type == "field_expression" else None
-        s = self.scope
-        if full == "ros::init" and len(args) >= 3:
-            self.node(s.value(args[2]), n)
-            return
-        if last in ("make_shared", "make_unique", "allocate_shared") and targs and recv is None:
-            self.construct(targs[0], args, n)
-            return
-        if full.endswith("Node::make_shared") and args:
-            self.node(s.value(args[0]), n, s.value(args[1]) if len(args) > 1 else None,
-                      "lifecycle" if "LifecycleNode" in full else None)
-            return
-        if full.endswith("Options::create") or (last == "init" and recv is not None and targs):
-            return  # options: read where subscribe(ops) / advertise(ops) uses them
-        specs = cpp_helpers.free(full, targs, args, s.value, self.aliases) if recv is None else None
-        if specs is None and recv is not None:
-            rt = s.type_of(recv)
-            if rt is not None:
-                specs = cpp_helpers.method(rt, last, args, targs, s.value, s.value(recv), self.aliases)
-            elif not targs and self.helper_form(last, args) and self.deferred_method(recv, last, args, n) \
-                    and last != "init":  # obj.init(...) may also be a method of the program's own class
-                return
-        if specs is not None:
-            self.specs(specs, n)
-            return
-        if last in ("create_server", "create_client") and "rclcpp_action" in full:
-            self.action2(last, targs, args, n)
-            return
-        if full in ("ros::service::call",) and len(args) >= 2:
-            self.emit("service_clients", args[0], service_type(s.type_of(args[1])), n, None)
-            return
-        kind = _CALLS.get(last)
-        if kind is None or not args:
-            if not full.startswith(_LIBRARY):
-                self.record("call", full, args, n)
-                if targs:  # a function template's types, read in its body by the linker
-                    owner = s.fn_of(n)
-                    self.out.setdefault("call_targs", []).append(
-                        (full, owner.unit if owner else None, owner.key if owner else None, len(args), targs))
-            return
-        if last == "create_server":
-            return
-        if recv is not None and last.startswith("create_") and s.is_handle(args[0]):
-            # rclcpp's node methods never take a node first: a user's method of the same name
-            # (bus.create_publisher(node, "t")), followed by the linker into its body (issue 65)
-            self.record("call", full, args, n)
-            owner = s.fn_of(n)
-            self.out.setdefault("user_creates", []).append(
-                (full, owner.unit if owner else None, owner.key if owner else None, self.src(n)))
-            return
-        if recv is None and "::" in full and not self.rclcpp_like(full, args, n):
-            # ns::create_subscription<T>(topic, ...): no node is given and ns is no rclcpp class:
-            # a workspace's function, followed by the linker into its body, else a note (issue 65)
-            self.record("call", full, args, n)
-            owner = s.fn_of(n)
-            self.out.setdefault("user_creates", []).append(
-                (full, owner.unit if owner else None, owner.key if owner else None, self.src(n),
-                 "is a function of another namespace than rclcpp's, given no node"))
-            return
-        handle = s.value(recv) if recv is not None else None
-        if recv is None and last.startswith("create_") and len(args) >= 2 and (
-                s.is_handle(args[0]) or self.generic_node(args[0])):
-            # a stack's factory, qualified or not: ns::create_service<T>(node, name, ...), read at its call
-            handle, args = s.value(args[0]), args[1:]
-        if last in ("advertise", "subscribe") and len(args) >= 2 and s.is_handle(args[0]):
-            # advertise(nh, topic, n) / subscribe(nh, topic, n) of an object given the handle
-            # (topic_tools::ShapeShifter, a message_filters subscriber of a class this file does not know)
-            ta = targs[0] if targs else None
-            self.emit(kind, args[1], self.msg(ta) if ta else None, n, s.value(args[0]))
-            return
-        if len(args) == 1 and last in ("subscribe", "advertise", "advertiseService") and "::" in full and recv is None:
-            return  # a static method of some class (T::subscribe(rate)), not a node handle's
-        if len(args) == 1 and last in ("subscribe", "advertise", "advertiseService"):
-            ops = s.value(args[0])
-            if ops is not None and ops[0] == "ops":
-                t = self.msg(ops[3]) if ops[1] in ("pub", "sub") else service_type(self.aliases.get(ops[3], ops[3]))
-                ocb = callback_name(ops[4] or "") or None
-                if t is None and ocb:
-                    ct = self.out["callbacks"].get(ocb)
-                    t = self.msg(ct) if ops[1] in ("pub", "sub") else service_type(ct)
-                self.emit(ops[1], None, t, n, handle, ocb if t is None else None, name=ops[2],
-                          written=ops[5] if len(ops) > 5 else None)
-            else:
-                self.out["notes"].append(Note(self.src(n), f"{last}({_T(args[0])[:60]}): its options are not read "
-                                                           f"statically"))
-            return
-        if last in ("create_generic_publisher", "create_generic_subscription"):
-            gt = s.value(args[1]) if len(args) > 1 else None
-            self.emit(kind, args[0], canon_type(symbols.text(gt)) if gt and gt[0] == "str" else None, n, handle)
-            return
-        ta = targs[0] if targs else None
-        cb: Any = None
-        if kind in ("pub", "sub"):
-            msg_type = self.msg(ta) if ta else None
-            if msg_type is None and kind == "sub" and last == "subscribe" and len(args) >= 3:
-                cb = callback_name(_T(args[2]))
-                msg_type = self.msg(self.out["callbacks"].get(cb))
-        else:
-            msg_type = service_type(self.aliases.get(ta, ta) if ta else None)
-            if msg_type is None and last == "advertiseService" and len(args) >= 2:
-                cb = callback_name(_T(args[1]))
-                msg_type = service_type(self.out["callbacks"].get(cb))
-        if msg_type is None and cb is None and ta:
-            cb = ("type", ta)  # an alias of another file (a header's using/typedef): read by the linker
-        self.emit(kind, args[0], msg_type, n, handle, cb if msg_type is None else None)
-
-    def action2(self, last: str, targs: list[str], args: list[Any], n: Any) -> None:
-        kind = "action_servers" if last == "create_server" else "action_clients"
-        k = 4 if len(args) >= 5 and "interface" in _T(args[0]) else 1
-        if len(args) <= k:
-            return
-        t = action_type(self.aliases.get(targs[0], targs[0])) if targs else None
-        self.emit(kind, args[k], t, n, self.scope.value(args[0]) if k == 1 else None,
-                  ("type", targs[0]) if t is None and targs else None)
 
 
 def _takes_string(ptype: str, tparams: set[str]) -> bool:

@@ -44,8 +44,9 @@ from typing import Any
 from rclverify.ros.extract import emit, names, py_helpers, symbols
 from rclverify.ros.extract.cpp_types import action_type, service_type
 from rclverify.ros.extract.model import Endpoint, Note, Src, canon_type
-from rclverify.ros.extract.pyconst import DISCOVERY, PyScope
-from rclverify.ros.extract.pyrecords import PyCall, PyModule, PyVal, percent
+from rclverify.ros.extract.pyconst import PyScope
+from rclverify.ros.extract.pyrecords import PyCall, PyModule, PyVal
+from rclverify.ros.extract.sources_py_ast import ast_module
 
 
 # (role, index and keyword of the name, index and keyword of the type), by callee
@@ -68,124 +69,6 @@ _METHODS = {"create_publisher": ("pub", 1, "topic", 0, "msg_type"),
             "create_client": ("service_clients", 1, "srv_name", 0, "srv_type")}
 _WHAT = emit.WHAT
 _short = emit.short
-
-
-def _dotted(e: ast.AST) -> str | None:
-    if isinstance(e, ast.Name):
-        return e.id
-    if isinstance(e, ast.Attribute):
-        base = _dotted(e.value)
-        return f"{base}.{e.attr}" if base else None
-    return None
-
-
-def _ast_module(tree: ast.AST, shown: str) -> PyModule:
-    mod = PyModule()
-    made: dict[int, PyCall] = {}
-
-    def loc(e: ast.AST) -> Src:
-        return Src(shown, getattr(e, "lineno", 1), getattr(e, "col_offset", 0) + 1)
-
-    def call(c: ast.Call) -> PyCall:
-        if id(c) not in made:
-            f = c.func
-            func = _dotted(f) or ""
-            if isinstance(f, ast.Attribute) and isinstance(f.value, ast.Call) and _dotted(f.value.func) == "super":
-                func = f"super().{f.attr}"
-            elif not func and isinstance(f, ast.Attribute):
-                func = f".{f.attr}"
-            made[id(c)] = PyCall(func, [val(a) for a in c.args],
-                                 {k.arg: val(k.value) for k in c.keywords if k.arg}, loc(c))
-        return made[id(c)]
-
-    def val(e: ast.AST) -> PyVal:
-        if isinstance(e, ast.Constant) and isinstance(e.value, str):
-            return PyVal("str", e.value, loc(e))
-        d = _dotted(e)
-        if d is not None:
-            return PyVal("name", d, loc(e))
-        if isinstance(e, ast.BinOp) and isinstance(e.op, ast.Add):
-            return PyVal("cat", ast.unparse(e), loc(e), parts=[val(e.left), val(e.right)])
-        if isinstance(e, ast.BinOp) and isinstance(e.op, ast.Mod) and isinstance(e.left, ast.Constant) \
-                and isinstance(e.left.value, str):  # '/%s/pose' % name
-            args = e.right.elts if isinstance(e.right, ast.Tuple) else [e.right]
-            return percent(e.left.value, [val(a) for a in args], ast.unparse(e), loc(e))
-        if isinstance(e, ast.JoinedStr):
-            parts = [val(x.value) if isinstance(x, ast.FormattedValue) and x.conversion == -1 and x.format_spec is None
-                     else val(x) if isinstance(x, ast.Constant) else PyVal("other", ast.unparse(x), loc(e))
-                     for x in e.values]
-            return PyVal("cat", ast.unparse(e), loc(e), parts=parts)
-        chain, x = [], e  # a call and the attributes/calls on its result: get_parameter('t').value
-        while isinstance(x, (ast.Call, ast.Attribute)):
-            if isinstance(x, ast.Call):
-                chain.append(call(x))
-                x = x.func
-            else:
-                x = x.value
-        if isinstance(e, ast.Call):
-            return PyVal("call", ast.unparse(e), loc(e), call(e), chain)
-        return PyVal("other", ast.unparse(e), loc(e), None, chain if isinstance(e, ast.Attribute) else [])
-
-    def scopes(body: list[ast.stmt], prefix: str, in_class: bool) -> None:
-        for st in body:
-            if isinstance(st, ast.ClassDef):
-                scopes(st.body, f"{prefix}{st.name}.", True)
-            elif isinstance(st, (ast.FunctionDef, ast.AsyncFunctionDef)):
-                a = st.args
-                pos = a.posonlyargs + a.args
-                static = any(_dotted(d) == "staticmethod" for d in st.decorator_list)
-                names = [x.arg for x in pos] + [x.arg for x in a.kwonlyargs]
-                defaults: list[PyVal | None] = [None] * (len(pos) - len(a.defaults)) + [val(d) for d in a.defaults]
-                defaults += [val(d) if d is not None else None for d in a.kw_defaults]
-                if in_class and not static and names:
-                    names, defaults = names[1:], defaults[1:]
-                mod.functions.append((f"{prefix}{st.name}", st.lineno, getattr(st, "end_lineno", None) or st.lineno,
-                                      names, defaults))
-                scopes(st.body, f"{prefix}{st.name}.<locals>.", False)
-            else:
-                for fld in ("body", "orelse", "finalbody", "handlers"):
-                    inner = getattr(st, fld, None)
-                    if isinstance(inner, list):
-                        scopes([x for x in inner if isinstance(x, ast.stmt)] +
-                               [y for h in inner if isinstance(h, ast.ExceptHandler) for y in h.body], prefix, in_class)
-
-    for n in ast.walk(tree):
-        if isinstance(n, ast.ImportFrom) and (n.module or n.level):
-            for a in n.names:  # a relative import names the package's own module (``from . import names``)
-                if a.name == "*":
-                    if n.module:
-                        mod.star.append(n.module)
-                else:
-                    mod.bind_import(a.asname or a.name, f"{n.module}.{a.name}" if n.module else a.name, n.lineno)
-        elif isinstance(n, ast.Import):
-            for a in n.names:
-                mod.bind_import(a.asname or a.name.split(".")[0], a.name if a.asname else a.name.split(".")[0],
-                                n.lineno)
-        elif isinstance(n, ast.Call):
-            mod.calls.append(call(n))
-        elif isinstance(n, ast.Return) and n.value is not None:
-            mod.returns.append((n.lineno, val(n.value)))
-        elif isinstance(n, ast.ClassDef):
-            mod.classes.append((n.name, n.lineno, getattr(n, "end_lineno", None) or n.lineno))
-            mod.bases[n.name] = [d for d in (_dotted(b) for b in n.bases) if d]
-        elif isinstance(n, ast.For) and isinstance(n.iter, ast.Call) and \
-                (_dotted(n.iter.func) or "").rsplit(".", 1)[-1] in DISCOVERY:
-            # for name, types in node.get_topic_names_and_types(): names found at run time (pyconst)
-            for t in (n.target.elts if isinstance(n.target, ast.Tuple) else [n.target]):
-                if isinstance(t, ast.Name):
-                    mod.assigns.append((t.id, val(n.iter)))
-        elif isinstance(n, (ast.Assign, ast.AnnAssign)) and n.value is not None:
-            for t in (n.targets if isinstance(n, ast.Assign) else [n.target]):
-                d = _dotted(t)
-                if d is not None:
-                    mod.assigns.append((d, val(n.value)))
-                elif isinstance(t, ast.Tuple) and t.elts and isinstance(t.elts[0], ast.Name) and isinstance(
-                        n.value, ast.Call) and (_dotted(n.value.func) or "").endswith(".parse_known_args"):
-                    mod.assigns.append((t.elts[0].id, val(n.value)))  # args, rest = p.parse_known_args()
-    if isinstance(tree, ast.Module):
-        scopes(tree.body, "", False)
-    mod.calls.sort(key=lambda c: (c.src.line, c.src.col))  # source order, as the tolerant reader gives
-    return mod
 
 
 def scan_python(text: str, shown: str) -> dict[str, Any]:
@@ -213,7 +96,7 @@ def scan_python(text: str, shown: str) -> dict[str, Any]:
                                                            f"reader (tree-sitter-python); {unread}", "ROS-PARSE"))
         return out
     try:
-        return extract(_ast_module(tree, shown), shown)
+        return extract(ast_module(tree, shown), shown)
     except RecursionError:
         return {"nodes": [], "endpoints": [], "notes": [Note(Src(shown), "Python source nested too deeply to read",
                                                              "ROS-PARSE", "error")]}
@@ -223,18 +106,31 @@ def extract(mod: PyModule, shown: str) -> dict[str, Any]:
     """The record of a file from its :class:`PyModule` (either reader): nodes,
     endpoints, notes, ``owners`` and, for the linker (:mod:`link`), ``fns``,
     ``units``, ``calls``, ``fields``, ``consts``, ``node_names``, ``imports``."""
-    sc = PyScope(mod, shown)
-    ros2 = any(o.split(".")[0] == "rclpy" for o in mod.imports.values())
-    out: dict[str, Any] = {"nodes": [], "endpoints": [], "notes": [], "lang": "py", "calls": [], "node_names": [],
-                           "member_decls": [], "member_calls": [], "includes": [], "callbacks": {}, "ros2": ros2}
-    said: set[str] = set()
+    x = _Extractor(mod, shown)
+    for c in mod.calls:
+        x.call(c)
+    return x.finish()
 
-    def type_of(v: Any, kind: str) -> tuple[str | None, Any]:
+
+class _Extractor:
+    """One file's record built call by call (:func:`extract`)."""
+
+    def __init__(self, mod: PyModule, shown: str) -> None:
+        self.mod, self.shown = mod, shown
+        self.sc = PyScope(mod, shown)
+        self.ros2 = any(o.split(".")[0] == "rclpy" for o in mod.imports.values())
+        self.out: dict[str, Any] = {"nodes": [], "endpoints": [], "notes": [], "lang": "py", "calls": [],
+                                    "node_names": [], "member_decls": [], "member_calls": [], "includes": [],
+                                    "callbacks": {}, "ros2": self.ros2}
+        self.said: set[str] = set()
+
+    def type_of(self, v: Any, kind: str) -> tuple[str | None, Any]:
         """(type, candidates for the linker)."""
+        mod, sc, out = self.mod, self.sc, self.out
         if isinstance(v, str) or v is None:
             return v, None
         if v.kind == "call" and v.call is not None and v.call.func.split(".")[-1] == "numpy_msg" and v.call.args:
-            return type_of(v.call.args[0], kind)
+            return self.type_of(v.call.args[0], kind)
         if v.kind != "name":
             return None, None
         pv = sc.value(v)
@@ -242,8 +138,8 @@ def extract(mod: PyModule, shown: str) -> dict[str, Any]:
             return None, ("argtype", pv[1], pv[2])
         head = v.text.split(".")[0]
         chosen = {o for o, _ln in mod.import_lines.get(head, [])}
-        if len(chosen) > 1 and head not in said:
-            said.add(head)
+        if len(chosen) > 1 and head not in self.said:
+            self.said.add(head)
             lines = sorted(ln for _o, ln in mod.import_lines[head])
             out["notes"].append(Note(v.src, f"'{head}' is imported {len(lines)} times (lines "
                                             f"{', '.join(map(str, lines))}), chosen at run time: read as "
@@ -257,7 +153,9 @@ def extract(mod: PyModule, shown: str) -> dict[str, Any]:
             return None, (("cands", tuple(cands)) if cands else None)
         return _typed(sc.full(v.text), kind), None
 
-    def add(kind: str, name: Any, type_v: Any, c: PyCall, handle: Any = None) -> None:
+    def add(self, kind: str, name: Any, type_v: Any, c: PyCall, handle: Any = None) -> None:
+        """The endpoint of role ``kind`` named by ``name`` with type ``type_v``, made at call ``c``."""
+        sc, out = self.sc, self.out
         if isinstance(name, tuple) and name and name[0] == "under":
             nv = sc.value(name[1]) if name[1] is not None else None
             val, written, nsrc = symbols.cat([nv, symbols.lit("/" + name[2])]) if nv is not None else None, \
@@ -266,7 +164,7 @@ def extract(mod: PyModule, shown: str) -> dict[str, Any]:
             val, written, nsrc = sc.value(name), name.text, name.src
         else:
             val, written, nsrc = name, symbols.text(name) or "?", c.src
-        t, cands = type_of(type_v, kind)
+        t, cands = self.type_of(type_v, kind)
         unit = sc.unit_at(c.src.line)
         ep, note = emit.make(kind, val, handle, t, c.src, unit, sc.fn_key(c.src.line), written, nsrc, cands)
         if note is not None:
@@ -278,32 +176,15 @@ def extract(mod: PyModule, shown: str) -> dict[str, Any]:
                                                  f"'{ep.topic or ep.param}' not resolved statically"))
         out["endpoints"].append(ep)
 
-    for c in mod.calls:
+    def call(self, c: PyCall) -> None:
+        """One call: a node's name, an endpoint's constructor or method, a
+        library helper, or a call of the package's own code (for the linker)."""
+        sc = self.sc
         f = sc.full(c.func) if c.func else ""
         last = c.func.rsplit(".", 1)[-1]
         if f in ("rospy.init_node", "rclpy.create_node", "rclpy.node.Node") or c.func == "super().__init__":
-            v = c.args[0] if c.args else c.kwargs.get("name") or c.kwargs.get("node_name")
-            if v is None:
-                continue
-            val = sc.value(v)
-            if c.func == "super().__init__" and v.kind != "str" and not _node_class(mod, sc.class_at(c.src.line)):
-                continue
-            unit = sc.unit_at(c.src.line)
-            if val is not None and val[0] == "str" and names.node_name_problem(val[1]) is not None:
-                out["notes"].append(Note(v.src, f"node name {names.node_name_problem(val[1])}: not resolved "
-                                                f"statically; its endpoints are not in the graph"))
-                continue
-            if val is not None and val[0] == "str":
-                out["nodes"].append((val[1], c.src))
-            elif symbols.is_concrete(val):
-                if c.func != "super().__init__":
-                    out["notes"].append(Note(v.src, "node name is not a string literal: not resolved statically"))
-                continue
-            life = "lifecycle" if _node_class(mod, sc.class_at(c.src.line), lifecycle=sc.full) else None
-            ns = c.kwargs.get("namespace")  # rclpy: keyword-only (Node, create_node); rospy has none
-            nsv = (sc.value(ns) or ("runtime", "computed at run time")) if ns else None
-            out["node_names"].append((val, c.src, unit, sc.fn_key(c.src.line), nsv, life))
-            continue
+            self.node_name(c)
+            return
         spec = _CTORS.get(f)
         if spec is None and "actionlib" in f and last in _CTORS:
             spec = _CTORS[last]
@@ -312,33 +193,68 @@ def extract(mod: PyModule, shown: str) -> dict[str, Any]:
         if spec is None and "." in c.func and last in _METHODS and not f.startswith(("rospy.", "os.")):
             spec = _METHODS[last]
         if spec is None:
-            helped = py_helpers.helper(f, c, ros2) if f and "." in f else None
-            for m in mod.star if helped is None and f and "." not in f and f not in mod.imports else ():
-                helped = helped or py_helpers.helper(f"{m}.{f}", c, ros2)  # from interactive_markers... import *
-            if helped is not None:
-                for kind, name, typ in helped:
-                    add(kind, name, typ, c)
-                continue
-            callee = sc.callee(c)
-            if callee is not None:
-                out["calls"].append(("call", callee, [sc.value(a) for a in c.args], sc.fn_key(c.src.line),
-                                     sc.unit_at(c.src.line), c.src, {k: sc.value(v) for k, v in c.kwargs.items()}))
-            continue
+            self.other_call(c, f)
+            return
         kind, ni, nk, ti, tk = spec
         name_v = c.kwargs.get(nk) or (c.args[ni] if len(c.args) > ni else None)
         type_v = c.kwargs.get(tk) or (c.args[ti] if len(c.args) > ti else None)
         if name_v is not None:
-            add(kind, name_v, type_v, c)
-    out["owners"] = owners(mod.classes, out["nodes"], out["endpoints"])
-    out["fns"] = {f"{shown}::{q}": (sc.unit_at(a), params, [], [sc.value(d) for d in defaults])
-                  for q, a, _b, params, defaults in mod.functions}
-    out["units"] = {f"{shown}::{q}": {"bases": mod.bases.get(q.split(".")[-1], []), "members": {}}
-                    for q, _a, _b in sc.cls}
-    out["fields"] = sc.fields()
-    out["consts"] = sc.consts()
-    out["returns"] = sc.returns()
-    out["imports"] = sorted(set(mod.imports.values()) | set(mod.star))
-    return out
+            self.add(kind, name_v, type_v, c)
+
+    def node_name(self, c: PyCall) -> None:
+        """``rospy.init_node(n)``, ``rclpy.create_node(n)``, ``Node(n)``, ``super().__init__(n)``."""
+        mod, sc, out = self.mod, self.sc, self.out
+        v = c.args[0] if c.args else c.kwargs.get("name") or c.kwargs.get("node_name")
+        if v is None:
+            return
+        val = sc.value(v)
+        if c.func == "super().__init__" and v.kind != "str" and not _node_class(mod, sc.class_at(c.src.line)):
+            return
+        unit = sc.unit_at(c.src.line)
+        if val is not None and val[0] == "str" and names.node_name_problem(val[1]) is not None:
+            out["notes"].append(Note(v.src, f"node name {names.node_name_problem(val[1])}: not resolved "
+                                            f"statically; its endpoints are not in the graph"))
+            return
+        if val is not None and val[0] == "str":
+            out["nodes"].append((val[1], c.src))
+        elif symbols.is_concrete(val):
+            if c.func != "super().__init__":
+                out["notes"].append(Note(v.src, "node name is not a string literal: not resolved statically"))
+            return
+        life = "lifecycle" if _node_class(mod, sc.class_at(c.src.line), lifecycle=sc.full) else None
+        ns = c.kwargs.get("namespace")  # rclpy: keyword-only (Node, create_node); rospy has none
+        nsv = (sc.value(ns) or ("runtime", "computed at run time")) if ns else None
+        out["node_names"].append((val, c.src, unit, sc.fn_key(c.src.line), nsv, life))
+
+    def other_call(self, c: PyCall, f: str) -> None:
+        """A call that makes no endpoint itself: a library helper's endpoints
+        (:mod:`py_helpers`), else a call of the package's own code."""
+        mod, sc = self.mod, self.sc
+        helped = py_helpers.helper(f, c, self.ros2) if f and "." in f else None
+        for m in mod.star if helped is None and f and "." not in f and f not in mod.imports else ():
+            helped = helped or py_helpers.helper(f"{m}.{f}", c, self.ros2)  # from interactive_markers... import *
+        if helped is not None:
+            for kind, name, typ in helped:
+                self.add(kind, name, typ, c)
+            return
+        callee = sc.callee(c)
+        if callee is not None:
+            self.out["calls"].append(("call", callee, [sc.value(a) for a in c.args], sc.fn_key(c.src.line),
+                                      sc.unit_at(c.src.line), c.src, {k: sc.value(v) for k, v in c.kwargs.items()}))
+
+    def finish(self) -> dict[str, Any]:
+        """The record with what the linker reads of the file."""
+        mod, sc, out, shown = self.mod, self.sc, self.out, self.shown
+        out["owners"] = owners(mod.classes, out["nodes"], out["endpoints"])
+        out["fns"] = {f"{shown}::{q}": (sc.unit_at(a), params, [], [sc.value(d) for d in defaults])
+                      for q, a, _b, params, defaults in mod.functions}
+        out["units"] = {f"{shown}::{q}": {"bases": mod.bases.get(q.split(".")[-1], []), "members": {}}
+                        for q, _a, _b in sc.cls}
+        out["fields"] = sc.fields()
+        out["consts"] = sc.consts()
+        out["returns"] = sc.returns()
+        out["imports"] = sorted(set(mod.imports.values()) | set(mod.star))
+        return out
 
 
 def _typed(dotted: str, kind: str) -> str | None:

@@ -35,6 +35,7 @@ from rclverify.ros.extract.param_yaml import PackageParams, expand_each
 from rclverify.ros.extract.packages import Package, find_manifests, read_package
 from rclverify.ros.extract.sources_cpp import scan_cpp
 from rclverify.ros.extract.sources_py import scan_python
+from rclverify.ros.extract.interfaces import DEBIAN_SHARE
 
 _CPP = {".cpp", ".cc", ".cxx", ".hpp", ".h", ".hh"}
 _SKIP_DIRS = {"build", "devel", "install", "log", "test", "tests", "launch", "msg", "srv", "action", "__pycache__"}
@@ -119,7 +120,6 @@ def scan(paths: Sequence[Path], launch: Sequence[Path] = (), launch_args: dict[s
     current directory). Never raises on bad input: unreadable files become
     located notes (``ROS-PARSE`` errors) in ``graph.notes``.
     """
-    from rclverify.ros.extract.interfaces import DEBIAN_SHARE
     # Reads are confined to the workspace (``base``, else the scanned paths
     # and entry launch files as given): links leaving it are skipped (docs/ros.md).
     tops = [base] if base is not None else [*paths, *(Path(lf).parent for lf in launch)]
@@ -129,199 +129,254 @@ def scan(paths: Sequence[Path], launch: Sequence[Path] = (), launch_args: dict[s
 
 def _scan(paths: Sequence[Path], launch: Sequence[Path], launch_args: dict[str, str] | None,
           bags: Sequence[Path], cache_path: Path | None, base: Path | None, standard: bool) -> ScanResult:
-    show = Shower(base)
-    cache = ParseCache(cache_path) if cache_path is not None else None
-    g = Graph()
-    table = TypeTable()
-    pkgs: dict[str, Package] = {}
-    tops = []
-    for p in paths:
-        if safefs.inside(p):
-            tops.append(Path(p))
-        else:
-            g.notes.append(Note(Src(show(Path(p))), "workspace path resolves outside the workspace "
-                                                    "(symlink): not scanned", "ROS-PARSE"))
-    skipped: list[str] = []
-    for m in find_manifests(tops, skipped):
-        shown = show(m)
-        try:
-            g.files[shown] = ParseCache.digest(safefs.read_bytes(m))
-        except OSError:
-            pass
-        try:
-            sha_m = g.files.get(shown) or ParseCache.digest(safefs.read_bytes(m))
-        except OSError:
-            sha_m = ""
-        pkg, notes = cache.get(f"pkg:{shown}", sha_m, lambda: read_package(m, shown)) if cache and sha_m \
-            else read_package(m, shown)
-        g.notes.extend(notes)
-        if pkg is None:
-            continue
-        # the cache is keyed by workspace-relative path and content: the
-        # directory is this tree's, never the one the entry was made in
-        pkg = dataclasses.replace(pkg, root=m.parent, manifest=m)
-        if pkg.name in pkgs:
-            g.notes.append(Note(Src(shown), f"package '{pkg.name}' also at {show(pkgs[pkg.name].manifest)}; "
-                                            f"this one is ignored", "ROS-MANIFEST"))
-            continue
-        pkgs[pkg.name] = pkg
-        g.packages[pkg.name] = pkg.to_json(shown)
-    for name in sorted(pkgs):
-        table.add_package_dir(pkgs[name].root, name, show, "workspace", cache, g.files)
-    # Debian's ros-*-msgs packages are ROS 1 (Noetic) definitions: used unless
-    # every scanned package is a ROS 2 one, whose standard types come from
-    # rosbags' ROS 2 store instead (docs/ros.md).
-    if standard and (not pkgs or any(p.ros == 1 for p in pkgs.values())):
-        table.add_debian_standard(cache)
-    elif standard:  # rosbags' ROS 2 store has messages only: services of message-less packages (std_srvs)
-        table.add_debian_standard(cache, services_only=True)
-    for tname, fname, missing in table.unknown_refs():
-        info = table.types[tname]
-        g.notes.append(Note(Src(info.file or tname, info.lines.get(fname, 1)),
-                            f"field '{fname}' of {tname} has type {missing}, which no scanned package "
-                            f"or standard package defines", "ROS-TYPE"))
-    g.notes.extend(table.notes)
+    sc = _Scan(Shower(base), ParseCache(cache_path) if cache_path is not None else None)
+    sc.read_packages(paths)
+    sc.read_types(standard)
+    sc.read_sources()
+    sc.assemble(launch, launch_args)
+    sc.finish(bags)
+    return sc.res
 
-    res = ScanResult(g, pkgs, table)
-    records: dict[str, dict[str, dict[str, Any]]] = {}
-    tgts: dict[str, Targets] = {}
-    for name in sorted(pkgs):
-        root = pkgs[name].root
-        tgts[name] = targets(root, name)
-        installed = {p for paths in tgts[name].programs.values() for p in paths}
-        py, cpp, bare = _source_files(root, skipped)
-        recs = records[name] = {}
-        for f in py + cpp + bare:
-            quiet = f in bare and f not in installed and f.parent.name not in _SCRIPT_DIRS
+
+class _Scan:
+    """One scan's state, step by step (:func:`scan`): the packages and their
+    manifests, the type table, each source file's record, then the nodes
+    assembled from the launch files (or, without them, from the programs),
+    the recorded runs and the types the graph uses."""
+
+    def __init__(self, show: Shower, cache: ParseCache | None) -> None:
+        self.show, self.cache = show, cache
+        self.g = Graph()
+        self.table = TypeTable()
+        self.pkgs: dict[str, Package] = {}
+        self.skipped: list[str] = []
+        self.res = ScanResult(self.g, self.pkgs, self.table)
+        self.records: dict[str, dict[str, dict[str, Any]]] = {}
+        self.tgts: dict[str, Targets] = {}
+        self.launch_params: dict[str, tuple[str, Src]] = {}
+        self.by_ros_name: dict[str, list[str]] = {}  # a ROS node name -> the graph nodes of the programs taking it
+
+    def read_packages(self, paths: Sequence[Path]) -> None:
+        """The packages under ``paths`` (one per name; a second is a note)."""
+        g, show, cache, pkgs = self.g, self.show, self.cache, self.pkgs
+        tops = []
+        for p in paths:
+            if safefs.inside(p):
+                tops.append(Path(p))
+            else:
+                g.notes.append(Note(Src(show(Path(p))), "workspace path resolves outside the workspace "
+                                                        "(symlink): not scanned", "ROS-PARSE"))
+        for m in find_manifests(tops, self.skipped):
+            shown = show(m)
             try:
-                data = safefs.read_bytes(f)
-            except OSError as exc:
-                if not quiet:
-                    sev = "warning" if isinstance(exc, safefs.Refused) else "error"
-                    g.notes.append(Note(Src(show(f)), f"cannot read: {exc}", "ROS-PARSE", sev))
+                g.files[shown] = ParseCache.digest(safefs.read_bytes(m))
+            except OSError:
+                pass
+            try:
+                sha_m = g.files.get(shown) or ParseCache.digest(safefs.read_bytes(m))
+            except OSError:
+                sha_m = ""
+            pkg, notes = cache.get(f"pkg:{shown}", sha_m, lambda: read_package(m, shown)) if cache and sha_m \
+                else read_package(m, shown)
+            g.notes.extend(notes)
+            if pkg is None:
                 continue
-            if f in bare and not _python_shebang(data) and (f not in installed or data.startswith(b"#!")):
-                continue  # not a Python program (a shell script, a data file)
-            if len(data) > MAX_SOURCE_BYTES:
-                g.notes.append(Note(Src(show(f)), "source file larger than 2 MB: not scanned", "ROS-PARSE"))
+            # the cache is keyed by workspace-relative path and content: the
+            # directory is this tree's, never the one the entry was made in
+            pkg = dataclasses.replace(pkg, root=m.parent, manifest=m)
+            if pkg.name in pkgs:
+                g.notes.append(Note(Src(shown), f"package '{pkg.name}' also at {show(pkgs[pkg.name].manifest)}; "
+                                                f"this one is ignored", "ROS-MANIFEST"))
                 continue
-            shown = show(f)
-            sha = ParseCache.digest(data)
-            is_py = f not in cpp
-            fn = functools.partial(_parse, data, shown, is_py)
-            r = cache.get(f"{'py' if is_py else 'cpp'}:{shown}", sha, fn) if cache else fn()
-            recs[shown] = r
-            if r["nodes"] or r["endpoints"] or r["notes"] or r.get("node_names"):
-                g.files[shown] = sha
-                res.sources[shown] = r
-    for bad in sorted({safefs.escaped(show(Path(b))) for b in skipped}):
-        g.notes.append(Note(Src(bad), "name is not valid UTF-8: skipped", "ROS-PARSE"))
-    asm = Assembly(pkgs, records, tgts, show, lambda t: table.get(t) is not None)
-    launch_params: dict[str, tuple[str, Src]] = {}
-    pfiles = PackageParams({} if launch else {p: pkgs[p].root for p in pkgs}, show)
-    g.notes.extend(pfiles.notes)
-    by_ros_name: dict[str, list[str]] = {}  # a ROS node name -> the graph nodes of the programs taking it
+            pkgs[pkg.name] = pkg
+            g.packages[pkg.name] = pkg.to_json(shown)
 
-    def add_node(full: str, ns: str, pkg: str | None, exe: str | None, files: list[str], declared: Src,
+    def read_types(self, standard: bool) -> None:
+        """The message, service and action types of the packages and, with
+        ``standard``, of the standard packages; a field of an unknown type is a note."""
+        g, table, pkgs, cache = self.g, self.table, self.pkgs, self.cache
+        for name in sorted(pkgs):
+            table.add_package_dir(pkgs[name].root, name, self.show, "workspace", cache, g.files)
+        # Debian's ros-*-msgs packages are ROS 1 (Noetic) definitions: used unless
+        # every scanned package is a ROS 2 one, whose standard types come from
+        # rosbags' ROS 2 store instead (docs/ros.md).
+        if standard and (not pkgs or any(p.ros == 1 for p in pkgs.values())):
+            table.add_debian_standard(cache)
+        elif standard:  # rosbags' ROS 2 store has messages only: services of message-less packages (std_srvs)
+            table.add_debian_standard(cache, services_only=True)
+        for tname, fname, missing in table.unknown_refs():
+            info = table.types[tname]
+            g.notes.append(Note(Src(info.file or tname, info.lines.get(fname, 1)),
+                                f"field '{fname}' of {tname} has type {missing}, which no scanned package "
+                                f"or standard package defines", "ROS-TYPE"))
+        g.notes.extend(table.notes)
+
+    def read_sources(self) -> None:
+        """Each package's build targets and the record of each of its source
+        files (Python, C++, and extensionless Python programs)."""
+        g, show, cache = self.g, self.show, self.cache
+        for name in sorted(self.pkgs):
+            root = self.pkgs[name].root
+            self.tgts[name] = targets(root, name)
+            installed = {p for paths in self.tgts[name].programs.values() for p in paths}
+            py, cpp, bare = _source_files(root, self.skipped)
+            recs = self.records[name] = {}
+            for f in py + cpp + bare:
+                quiet = f in bare and f not in installed and f.parent.name not in _SCRIPT_DIRS
+                try:
+                    data = safefs.read_bytes(f)
+                except OSError as exc:
+                    if not quiet:
+                        sev = "warning" if isinstance(exc, safefs.Refused) else "error"
+                        g.notes.append(Note(Src(show(f)), f"cannot read: {exc}", "ROS-PARSE", sev))
+                    continue
+                if f in bare and not _python_shebang(data) and (f not in installed or data.startswith(b"#!")):
+                    continue  # not a Python program (a shell script, a data file)
+                if len(data) > MAX_SOURCE_BYTES:
+                    g.notes.append(Note(Src(show(f)), "source file larger than 2 MB: not scanned", "ROS-PARSE"))
+                    continue
+                shown = show(f)
+                sha = ParseCache.digest(data)
+                is_py = f not in cpp
+                fn = functools.partial(_parse, data, shown, is_py)
+                r = cache.get(f"{'py' if is_py else 'cpp'}:{shown}", sha, fn) if cache else fn()
+                recs[shown] = r
+                if r["nodes"] or r["endpoints"] or r["notes"] or r.get("node_names"):
+                    g.files[shown] = sha
+                    self.res.sources[shown] = r
+        for bad in sorted({safefs.escaped(show(Path(b))) for b in self.skipped}):
+            g.notes.append(Note(Src(bad), "name is not valid UTF-8: skipped", "ROS-PARSE"))
+
+    def assemble(self, launch: Sequence[Path], launch_args: dict[str, str] | None) -> None:
+        """The graph's nodes: those the entry launch files start, else the
+        programs of the packages and the ros2_control controllers."""
+        g, show, pkgs = self.g, self.show, self.pkgs
+        table = self.table
+        self.asm = Assembly(pkgs, self.records, self.tgts, show, lambda t: table.get(t) is not None)
+        self.pfiles = PackageParams({} if launch else {p: pkgs[p].root for p in pkgs}, show)
+        g.notes.extend(self.pfiles.notes)
+        if launch:
+            interp = Interpreter(lambda p: pkgs[p].root.resolve() if p in pkgs else None,
+                                 lambda p: _load_launch(p, show(p)), show)
+            for lf in launch:
+                interp.run(Path(lf), dict(launch_args or {}))
+            for f in interp.files:
+                try:
+                    g.files[show(f)] = ParseCache.digest(safefs.read_bytes(f))
+                except OSError:
+                    pass
+            g.notes.extend(interp.notes)
+            self.launch_params.update(interp.params)
+            for ln in interp.nodes:
+                self.asm.launch_node(ln, self.add_node, g)
+        else:
+            self.asm.source_nodes(self.add_node, g)
+            self.asm.controller_nodes(self.add_node, self.pfiles.entries, g)  # ros2_control controllers (issue 65)
+        g.notes.extend(self.asm.unloaded_plugins())
+
+    def add_node(self, full: str, ns: str, pkg: str | None, exe: str | None, files: list[str], declared: Src,
                  eps: list[Endpoint], remaps: list[tuple[str, str, Src]], origin: str,
                  params: dict[str, tuple[str, Src]] | None = None, lifecycle: bool = False) -> None:
+        """Add the node ``full`` (in namespace ``ns``) with its endpoints
+        ``eps`` resolved against its parameters and ``remaps``: the callback
+        :class:`~rclverify.ros.graph.assemble.Assembly` calls per node."""
+        g = self.g
         node = GraphNode(full, ns, pkg, exe, files, declared, origin=origin, lifecycle=lifecycle)
         key = full
         if origin == "source":
-            # no launch file starts them: each program taking a name is a node of its
-            # own, kept apart by its executable (docs/ros.md, "Programs without launch files")
-            keys = by_ros_name.setdefault(full, [])
-            same = next((k for k in keys if g.nodes[k].declared_at == declared), None)
-            if same is not None:  # one code named twice (an executable and its component): one node
-                node, key = g.nodes[same], same
-                node.lifecycle = node.lifecycle or lifecycle
-                node.sources.extend(f for f in files if f not in node.sources)
-            elif keys:
-                if keys == [full]:  # the first program taking the name is kept apart too
-                    first = g.nodes.pop(full)
-                    first.name = keys[0] = apart_name(full, first.package, first.executable, first.declared_at,
-                                                      g.nodes)
-                    g.nodes[first.name] = first
-                key = node.name = apart_name(full, pkg, exe, declared, g.nodes)
-                g.notes.append(Note(declared, f"node {full} is also named at {g.nodes[keys[0]].declared_at}; "
-                                              f"no launch file starts these programs together: kept apart as "
-                                              f"{key} (and {', '.join(keys)})", "ROS-LAUNCH"))
-                keys.append(key)
-            else:
-                keys.append(full)
+            node, key = self._source_key(node, full, pkg, exe, files, declared, lifecycle)
         elif full in g.nodes:
             g.notes.append(Note(declared, f"node {full} is started twice (first at {g.nodes[full].declared_at}); "
                                           f"ROS keeps only the last one", "ROS-LAUNCH"))
         mine: dict[str, Any] = {names.resolve(k, ns, full): v for k, v in (params or {}).items()}
         if origin == "source":  # no launch file: the package's parameter files (param_yaml)
-            from_files, said = pfiles.for_node(pkg, full)
+            from_files, said = self.pfiles.for_node(pkg, full)
             g.notes.extend(said)
             mine = {**from_files, **mine}
-            more, more_files, said = asm.plugin_endpoints(full, mine)  # pluginlib plugins it loads
+            more, more_files, said = self.asm.plugin_endpoints(full, mine)  # pluginlib plugins it loads
             g.notes.extend(said)
             eps = eps + more
             node.sources.extend(f for f in more_files if f not in node.sources)
         eps = expand_each(eps, lambda a: (mine.get(names.resolve(a, ns, full)) or (None,))[0], g.notes)
         for e in eps:
-            written, pname, set_at = e.topic, None, None
-            if e.param is not None:
-                pname = names.resolve(e.param, ns, full)
-                got = mine.get(pname) or launch_params.get(pname)
-                if got is not None and isinstance(got[0], str):
-                    written, set_at = e.affix[0] + got[0] + e.affix[1], got[1]
-                elif e.unread is not None:
-                    g.notes.append(e.unread)
-                    continue
-                elif not e.topic:
-                    g.notes.append(Note(e.src, f"name of {e.kind} comes from parameter {pname}, which has no "
-                                               f"default in the code and no value in the launch files: "
-                                               f"not resolved statically"))
-                    continue
-            topic, at = namespaces.resolve(written, e.handle, ns, full, remaps)
-            edge = GraphEdge(topic, e.msg_type, e.src, at, namespaces.shown(written, e.handle), pname, set_at)
-            lst = node.edges_of(e.kind)
-            # every call site keeps its own edge (the same name created twice is two edges)
-            if not any(x.topic == edge.topic and x.msg_type == edge.msg_type and x.src == edge.src for x in lst):
-                lst.append(edge)
+            self._add_edge(node, e, mine, ns, full, remaps)
         g.nodes[key] = node
 
-    if launch:
-        interp = Interpreter(lambda p: pkgs[p].root.resolve() if p in pkgs else None,
-                             lambda p: _load_launch(p, show(p)), show)
-        for lf in launch:
-            interp.run(Path(lf), dict(launch_args or {}))
-        for f in interp.files:
-            try:
-                g.files[show(f)] = ParseCache.digest(safefs.read_bytes(f))
-            except OSError:
-                pass
-        g.notes.extend(interp.notes)
-        launch_params.update(interp.params)
-        for ln in interp.nodes:
-            asm.launch_node(ln, add_node, g)
-    else:
-        asm.source_nodes(add_node, g)
-        asm.controller_nodes(add_node, pfiles.entries, g)  # ros2_control controllers (issue 65)
-    g.notes.extend(asm.unloaded_plugins())
-    for shown, r in sorted(res.sources.items()):
-        g.notes.extend(r["notes"])
-    g.notes = list(dict.fromkeys(g.notes))  # a note given by several programs (a shared header) once
-    made = {e.src for n in g.nodes.values() for r in ("pub", "sub") + SERVICE_ROLES for e in n.edges_of(r)}
-    g.notes = [n for n in g.notes if not (n.message.endswith(UNBUILT) and n.src in made)]  # another program makes it
-    for b in bags:
-        from rclverify.ros.graph.bag import bag_topics
-        recorded, notes = bag_topics(Path(b), show(Path(b)))
-        g.notes.extend(notes)
-        if recorded is not None:
-            g.bags.append(recorded)
-    used = {e.msg_type for n in g.nodes.values() for e in n.publishes + n.subscribes if e.msg_type}
-    used |= {t["type"] for b in g.bags for t in b["topics"] if t["type"]}
-    used |= {k for k, v in table.types.items() if v.origin == "workspace"}
-    g.types = {k: v.to_json() for k, v in table.closure(sorted(used)).items()}
-    if cache is not None:
-        cache.save()
-        res.cache_hits, res.cache_misses = cache.hits, cache.misses
-    return res
+    def _source_key(self, node: GraphNode, full: str, pkg: str | None, exe: str | None, files: list[str],
+                    declared: Src, lifecycle: bool) -> tuple[GraphNode, str]:
+        """A node no launch file starts: each program taking a name is a node
+        of its own, kept apart by its executable (docs/ros.md, "Programs
+        without launch files"); returns the node to fill and its graph key."""
+        g = self.g
+        key = full
+        keys = self.by_ros_name.setdefault(full, [])
+        same = next((k for k in keys if g.nodes[k].declared_at == declared), None)
+        if same is not None:  # one code named twice (an executable and its component): one node
+            node, key = g.nodes[same], same
+            node.lifecycle = node.lifecycle or lifecycle
+            node.sources.extend(f for f in files if f not in node.sources)
+        elif keys:
+            if keys == [full]:  # the first program taking the name is kept apart too
+                first = g.nodes.pop(full)
+                first.name = keys[0] = apart_name(full, first.package, first.executable, first.declared_at,
+                                                  g.nodes)
+                g.nodes[first.name] = first
+            key = node.name = apart_name(full, pkg, exe, declared, g.nodes)
+            g.notes.append(Note(declared, f"node {full} is also named at {g.nodes[keys[0]].declared_at}; "
+                                          f"no launch file starts these programs together: kept apart as "
+                                          f"{key} (and {', '.join(keys)})", "ROS-LAUNCH"))
+            keys.append(key)
+        else:
+            keys.append(full)
+        return node, key
+
+    def _add_edge(self, node: GraphNode, e: Endpoint, mine: dict[str, Any], ns: str, full: str,
+                  remaps: list[tuple[str, str, Src]]) -> None:
+        """The edge of endpoint ``e``, its name taken from a parameter where
+        the code reads it from one (``mine``: the node's parameters)."""
+        written, pname, set_at = e.topic, None, None
+        if e.param is not None:
+            pname = names.resolve(e.param, ns, full)
+            got = mine.get(pname) or self.launch_params.get(pname)
+            if got is not None and isinstance(got[0], str):
+                written, set_at = e.affix[0] + got[0] + e.affix[1], got[1]
+            elif e.unread is not None:
+                self.g.notes.append(e.unread)
+                return
+            elif not e.topic:
+                self.g.notes.append(Note(e.src, f"name of {e.kind} comes from parameter {pname}, which has no "
+                                                f"default in the code and no value in the launch files: "
+                                                f"not resolved statically"))
+                return
+        topic, at = namespaces.resolve(written, e.handle, ns, full, remaps)
+        edge = GraphEdge(topic, e.msg_type, e.src, at, namespaces.shown(written, e.handle), pname, set_at)
+        lst = node.edges_of(e.kind)
+        # every call site keeps its own edge (the same name created twice is two edges)
+        if not any(x.topic == edge.topic and x.msg_type == edge.msg_type and x.src == edge.src for x in lst):
+            lst.append(edge)
+
+    def finish(self, bags: Sequence[Path]) -> None:
+        """The notes once each, the recorded runs' topics, the types the
+        graph uses, and the parse cache saved."""
+        g, res = self.g, self.res
+        for shown, r in sorted(res.sources.items()):
+            g.notes.extend(r["notes"])
+        g.notes = list(dict.fromkeys(g.notes))  # a note given by several programs (a shared header) once
+        made = {e.src for n in g.nodes.values() for r in ("pub", "sub") + SERVICE_ROLES for e in n.edges_of(r)}
+        g.notes = [n for n in g.notes if not (n.message.endswith(UNBUILT) and n.src in made)]  # another program makes it
+        for b in bags:
+            from rclverify.ros.graph.bag import bag_topics  # deferred: optional or conditional (inside a block)
+            recorded, notes = bag_topics(Path(b), self.show(Path(b)))
+            g.notes.extend(notes)
+            if recorded is not None:
+                g.bags.append(recorded)
+        used = {e.msg_type for n in g.nodes.values() for e in n.publishes + n.subscribes if e.msg_type}
+        used |= {t["type"] for b in g.bags for t in b["topics"] if t["type"]}
+        used |= {k for k, v in self.table.types.items() if v.origin == "workspace"}
+        g.types = {k: v.to_json() for k, v in self.table.closure(sorted(used)).items()}
+        if self.cache is not None:
+            self.cache.save()
+            res.cache_hits, res.cache_misses = self.cache.hits, self.cache.misses
 
 
 def apart_name(full: str, pkg: str | None, exe: str | None, declared: Src | None, taken: dict[str, Any]) -> str:

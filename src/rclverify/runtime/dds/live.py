@@ -47,6 +47,9 @@ from rclverify.runtime.dds.wire import WriterIds
 from rclverify.runtime.live import VERDICT_LOG_TOPIC, LiveRun, dumps, stop_and_record
 from rclverify.runtime.ros1 import contract_topics
 from rclverify.runtime.worker import EngineWorker
+from rclverify.runtime.dds.bag import BagError
+from rclverify.runtime.dds.bus import Bus
+from rclverify.runtime.dds.trust import VERDICT_KEY, downgrade
 
 
 class _Sink:
@@ -94,133 +97,171 @@ def run_dds(run_factory: Callable[..., LiveRun], checked: Checked, nodes: list[C
     storage)``.  Raises :class:`~rclverify.ros.live.dds.DdsUnavailable` (the
     binding, the domain, a type that cannot be made, a bag that cannot be
     created: one message)."""
-    from rclverify.runtime.dds.bag import BagError
+    run = _DdsRun(checked, nodes, type_dirs, dict(enforce or {}), out)
+    run.open_recorder(record, msg_dirs)
+    dp = make_participant()
+    run.join(dp, run_factory, verdict_topic, last_prefix)
+    worker = EngineWorker(_Sink(run.live, run.book, run.calls, reorder_window), run.decode, _time.time,
+                          tick_s=tick_s)
+    run.worker_box.append(worker.start())
+    run.bus.start()
+    out(f"monitoring {len(run.structs)} topic(s) and {len(run.calls.specs) if run.calls else 0} service/action "
+        f"topic(s) for {len(nodes)} node(s) on DDS domain {domain_id()}; verdicts on {verdict_topic}")
     try:
-        types = TypeBook(type_dirs)
-        string = types.message("std_msgs/String")
-    except DdsTypeError as exc:
-        raise DdsUnavailable(str(exc)) from None
-    topics = contract_topics(checked, nodes)  # "/topic" -> "pkg/Type"
-    where = {t.field.strip("/"): f"{t.loc.file}:{t.loc.line}:{t.loc.col}" for n in reversed(nodes)
-             for t in reversed(n.node.topics)}  # the first mention of each topic
-    structs: dict[str, Any] = {}
-    for t, typ in topics.items():
+        run.wait(worker, stop, duration, tick_s, status_s)
+    finally:
+        record_ = run.finish(worker, evidence)
+        run.bus.close()
+        dp.__del__()
+    return record_
+
+
+class _DdsRun:
+    """One live run on DDS, step by step (:func:`run_dds`): the types made
+    before joining, the bus and its writers, the call book, the engine
+    thread's decoding, and the evidence record at the end."""
+
+    def __init__(self, checked: Checked, nodes: list[CheckedNode], type_dirs: list[Path],
+                 enforce: dict[str, str], out: Callable[[str], None]) -> None:
+        self.checked, self.nodes, self.type_dirs, self.enforce, self.out = checked, nodes, type_dirs, enforce, out
         try:
-            structs[t.strip("/")] = types.message(typ)
+            self.types = TypeBook(type_dirs)
+            self.string = self.types.message("std_msgs/String")
         except DdsTypeError as exc:
-            raise DdsUnavailable(f"{where.get(t.strip('/'), t)}: error: topic {t} ({typ}): {exc}") from None
-    links = [(n, lk) for n in nodes for lk in n.node.links]
-    for _n, lk in links:  # every linked type made now: a missing one is one located message, before joining
+            raise DdsUnavailable(str(exc)) from None
+        self.topics = contract_topics(checked, nodes)  # "/topic" -> "pkg/Type"
+        self.where = {t.field.strip("/"): f"{t.loc.file}:{t.loc.line}:{t.loc.col}" for n in reversed(nodes)
+                      for t in reversed(n.node.topics)}  # the first mention of each topic
+        self.structs: dict[str, Any] = {}
+        for t, typ in self.topics.items():
+            try:
+                self.structs[t.strip("/")] = self.types.message(typ)
+            except DdsTypeError as exc:
+                raise DdsUnavailable(f"{self.where.get(t.strip('/'), t)}: error: topic {t} ({typ}): {exc}") from None
+        self.links = [(n, lk) for n in nodes for lk in n.node.links]
+        for _n, lk in self.links:  # every linked type made now: a missing one is one located message, before joining
+            try:
+                self.types.service(lk.ros_type) if lk.kind == "service" else self.types.action(lk.ros_type)
+            except DdsTypeError as exc:
+                raise DdsUnavailable(f"{lk.loc.file}:{lk.loc.line}:{lk.loc.col}: error: {lk.kind} {lk.name} "
+                                     f"({lk.ros_type}): {exc}") from None
+        self.recorder: BagRecorder | None = None
+        self.warnings: list[str] = []
+        self.decode_errors: dict[str, int] = {}
+        self.worker_box: list[EngineWorker] = []
+        self.republish: dict[str, Any] = {}
+        self.book: CallBook | None = None
+        self.calls: CallTaps | None = None
+        self.call_counts: dict[tuple[str, str], int] = {}
+
+    def open_recorder(self, record: tuple[Path, str] | None, msg_dirs: list[Path] | None) -> None:
+        """The bag the run is written to, when ``record`` names one."""
+        if record is None:
+            return
         try:
-            types.service(lk.ros_type) if lk.kind == "service" else types.action(lk.ros_type)
-        except DdsTypeError as exc:
-            raise DdsUnavailable(f"{lk.loc.file}:{lk.loc.line}:{lk.loc.col}: error: {lk.kind} {lk.name} "
-                                 f"({lk.ros_type}): {exc}") from None
-    enforce = dict(enforce or {})
-    recorder = None
-    if record is not None:
-        try:
-            recorder = BagRecorder(record[0], record[1], {t.strip("/"): ty for t, ty in topics.items()},
-                                   msg_dirs if msg_dirs is not None else type_dirs)
+            self.recorder = BagRecorder(record[0], record[1], {t.strip("/"): ty for t, ty in self.topics.items()},
+                                        msg_dirs if msg_dirs is not None else self.type_dirs)
         except BagError as exc:
             raise DdsUnavailable(str(exc)) from None
-    dp = make_participant()
-    warnings: list[str] = []
-    decode_errors: dict[str, int] = {}
 
-    def warn(text: str) -> None:
-        warnings.append(text)
-        out(text)
+    def warn(self, text: str) -> None:
+        self.warnings.append(text)
+        self.out(text)
 
-    from rclverify.runtime.dds.bus import Bus
-    from rclverify.runtime.dds.trust import VERDICT_KEY, downgrade
-    worker_box: list[EngineWorker] = []
-    republish: dict[str, Any] = {}
-
-    def on_reader(tap: Any, publishers: list[Any]) -> None:
+    def on_reader(self, tap: Any, publishers: list[Any]) -> None:
         """A guarded topic's real name is published as soon as its private one is
         heard, with the QoS the node's publisher offers (so subscribers match it
         before the first message is released)."""
-        if tap.key in enforce and tap.key not in republish:
-            republish[tap.key] = bus.writer(topic_name(tap.key), structs[tap.key], publishers[0].qos)
-    writers = WriterIds()  # a service sample's writer tells its wire form (dds_wire.py)
-    bus = Bus(dp, lambda tap, raw, info, rns: worker_box[0].offer(tap.key, (
-        raw, info.source_timestamp, rns, writers.of(tap.reader, info) if tap.key.startswith("call:") else None),
-        rns / 1e9), warn, on_reader=on_reader,
-              type_hash=types.type_hash)
-    user = type_hash_user_data("std_msgs/msg/String")
-    pub = bus.writer(topic_name(verdict_topic), string, writer_profile(depth=1000), user)
-    latched = writer_profile(transient_local=True, depth=1)
-    lasts = {n.name: bus.writer(topic_name(f"{last_prefix}/{n.name}/last_verdict"), string, latched, user)
-             for n in nodes}
-    def send(text: str) -> None:
-        pub.write(string(data=text))
+        if tap.key in self.enforce and tap.key not in self.republish:
+            self.republish[tap.key] = self.bus.writer(topic_name(tap.key), self.structs[tap.key], publishers[0].qos)
 
-    def release(topic: str, raw: bytes) -> None:
-        write_raw(republish[topic], raw)  # made when the private topic's reader was (on_reader)
-    extra = {"release": release} if enforce else {}
-    def send_last(node: str, text: str) -> None:
-        lasts[node].write(string(data=text))
-    live = run_factory(publish=send, publish_last=send_last, **extra)
-    book = calls = None
-    call_counts: dict[tuple[str, str], int] = {}
-    if links:
-        def on_call_verdict(v: Any) -> None:
-            key = (v.node, v.verdict)
-            call_counts[key] = call_counts.get(key, 0) + 1
-            d = {**v.to_json(), "call": True}
-            live.note({"topic": VERDICT_LOG_TOPIC, "time": v.decided_at, "verdict": d})
-            send(dumps(d))
+    def join(self, dp: Any, run_factory: Callable[..., LiveRun], verdict_topic: str, last_prefix: str) -> None:
+        """The bus on participant ``dp``, the verdict writers, the run, the
+        call book, and a tap on every contract topic and linked call."""
+        string, enforce = self.string, self.enforce
+        writers = WriterIds()  # a service sample's writer tells its wire form (dds_wire.py)
+        self.bus = bus = Bus(dp, lambda tap, raw, info, rns: self.worker_box[0].offer(tap.key, (
+            raw, info.source_timestamp, rns, writers.of(tap.reader, info) if tap.key.startswith("call:") else None),
+            rns / 1e9), self.warn, on_reader=self.on_reader, type_hash=self.types.type_hash)
+        user = type_hash_user_data("std_msgs/msg/String")
+        self.pub = bus.writer(topic_name(verdict_topic), string, writer_profile(depth=1000), user)
+        latched = writer_profile(transient_local=True, depth=1)
+        lasts = {n.name: bus.writer(topic_name(f"{last_prefix}/{n.name}/last_verdict"), string, latched, user)
+                 for n in self.nodes}
 
-        def on_deadline(v: Any) -> None:
-            t = book.now if book is not None and math.isfinite(book.now) else v.trigger_stamp
-            live.note({"topic": VERDICT_LOG_TOPIC, "time": t, "kind": "deadline", "verdict": v.to_json()})
-            send(dumps({"kind": "deadline", **v.to_json()}))
-        book = CallBook(checked, links, live.engine.rules, live.engine.horizon, on_call_verdict, on_deadline,
-                        live.note)
-        calls = CallTaps(book, types, links)
-    for t, struct in structs.items():
-        bus.tap(t, topic_name(enforce.get(t, t)), struct, where.get(t, t))
-    for t in enforce:  # only the gate may write a guarded topic, only the monitor the verdict topic (dds_trust.py)
-        bus.watch_writers(topic_name(t), t, where.get(t, t), "guarded topic")
-    bus.watch_writers(topic_name(verdict_topic), VERDICT_KEY, "--verdict-topic", "verdict topic")
-    if calls is not None:
-        calls.attach(bus, warn)
+        def release(topic: str, raw: bytes) -> None:
+            write_raw(self.republish[topic], raw)  # made when the private topic's reader was (on_reader)
+        extra = {"release": release} if enforce else {}
 
-    def decode(key: str, payload: Any) -> Mapping[str, Any] | None:
+        def send_last(node: str, text: str) -> None:
+            lasts[node].write(string(data=text))
+        self.live = run_factory(publish=self.send, publish_last=send_last, **extra)
+        if self.links:
+            self.book = CallBook(self.checked, self.links, self.live.engine.rules, self.live.engine.horizon,
+                                 self.on_call_verdict, self.on_deadline, self.live.note)
+            self.calls = CallTaps(self.book, self.types, self.links)
+        for t, struct in self.structs.items():
+            bus.tap(t, topic_name(enforce.get(t, t)), struct, self.where.get(t, t))
+        for t in enforce:  # only the gate may write a guarded topic, only the monitor the verdict topic (dds_trust.py)
+            bus.watch_writers(topic_name(t), t, self.where.get(t, t), "guarded topic")
+        bus.watch_writers(topic_name(verdict_topic), VERDICT_KEY, "--verdict-topic", "verdict topic")
+        if self.calls is not None:
+            self.calls.attach(bus, self.warn)
+
+    def send(self, text: str) -> None:
+        self.pub.write(self.string(data=text))
+
+    def on_call_verdict(self, v: Any) -> None:
+        key = (v.node, v.verdict)
+        self.call_counts[key] = self.call_counts.get(key, 0) + 1
+        d = {**v.to_json(), "call": True}
+        self.live.note({"topic": VERDICT_LOG_TOPIC, "time": v.decided_at, "verdict": d})
+        self.send(dumps(d))
+
+    def on_deadline(self, v: Any) -> None:
+        book = self.book
+        t = book.now if book is not None and math.isfinite(book.now) else v.trigger_stamp
+        self.live.note({"topic": VERDICT_LOG_TOPIC, "time": t, "kind": "deadline", "verdict": v.to_json()})
+        self.send(dumps({"kind": "deadline", **v.to_json()}))
+
+    def decode(self, key: str, payload: Any) -> Mapping[str, Any] | None:
+        """One sample's fields (engine thread); a call sample goes to the call
+        taps, bytes that are not the contract's type are counted."""
         raw, source_ns, received_ns = payload[:3]
+        calls = self.calls
         try:
             if calls is not None and key.startswith("call:"):
                 calls.handle(key, raw, source_ns / 1e9, received_ns / 1e9, payload[3])
                 return None
-            fields: Mapping[str, Any] = to_fields(structs[key].deserialize(raw))
+            fields: Mapping[str, Any] = to_fields(self.structs[key].deserialize(raw))
         except Exception:  # bytes that are not the contract's type: counted, never a crash
-            decode_errors[key] = decode_errors.get(key, 0) + 1
+            self.decode_errors[key] = self.decode_errors.get(key, 0) + 1
             return None
-        if recorder is not None:
-            recorder.write(key, received_ns, raw)
-        if key in enforce:
-            live.stash(fields, raw)  # type: ignore[attr-defined]
+        if self.recorder is not None:
+            self.recorder.write(key, received_ns, raw)
+        if key in self.enforce:
+            self.live.stash(fields, raw)  # type: ignore[attr-defined]
         return fields
 
-    worker = EngineWorker(_Sink(live, book, calls, reorder_window), decode, _time.time, tick_s=tick_s)
-    worker_box.append(worker.start())
-    bus.start()
-    out(f"monitoring {len(structs)} topic(s) and {len(calls.specs) if calls else 0} service/action topic(s) for "
-        f"{len(nodes)} node(s) on DDS domain {domain_id()}; verdicts on {verdict_topic}")
-    t0 = _time.monotonic()
-    next_status = t0 + status_s
-    try:
+    def wait(self, worker: EngineWorker, stop: Any, duration: float | None, tick_s: float, status_s: float) -> None:
+        """Until ``stop`` is set, ``duration`` s passed or a thread died,
+        with a status line every ``status_s`` s."""
+        t0 = _time.monotonic()
+        next_status = t0 + status_s
         while not stop.is_set():
             if duration is not None and _time.monotonic() - t0 >= duration:
                 break
             stop.wait(min(0.1, tick_s * 5))
-            if worker.error is not None or bus.error is not None:
+            if worker.error is not None or self.bus.error is not None:
                 break  # a dead thread: stop and say so, never monitor on silently
             if status_s > 0 and _time.monotonic() >= next_status:
-                out(_status(live, call_counts))
+                self.out(_status(self.live, self.call_counts))
                 next_status += status_s
-    finally:
+
+    def finish(self, worker: EngineWorker, evidence: Path | None) -> dict[str, Any]:
+        """Stop the threads and make the evidence record (module docstring),
+        written to ``evidence`` when given."""
+        bus, live, calls, book = self.bus, self.live, self.calls, self.book
         bus_error = ""
         try:
             bus.stop()
@@ -231,37 +272,40 @@ def run_dds(run_factory: Callable[..., LiveRun], checked: Checked, nodes: list[C
         except Exception:  # noqa: BLE001 - stop_and_record stops it again and records the error
             pass
         summary = calls.finish() if calls is not None else None  # while the log is open
-        record_ = stop_and_record(worker, live, None, out)
+        record_ = stop_and_record(worker, live, None, self.out)
         if bus_error:
             record_["bus_error"] = bus_error
             for n in record_["nodes"]:
                 n["status"], n["explanation"] = "error", f"the DDS reader thread stopped: {bus_error}"
-        record_.update(middleware=f"DDS domain {domain_id()} ({_version()})", warnings=warnings,
-                       decode_errors=decode_errors, qos={t.key: t.to_json() for t in bus.taps})
+        record_.update(middleware=f"DDS domain {domain_id()} ({_version()})", warnings=self.warnings,
+                       decode_errors=self.decode_errors, qos={t.key: t.to_json() for t in bus.taps})
         if summary is not None and book is not None:
-            record_["calls"] = {"counts": summary["counts"], "nodes": [],
-                                "samples": calls.counts if calls is not None else {}}
-            for name, res in book.results.items():
-                status, explanation = verdict_status(res, "the live calls")
-                record_["calls"]["nodes"].append({"node": name, "status": status, "explanation": explanation,
-                                                  **res.to_json()})
+            record_["calls"] = _calls_record(summary, book, calls)
             record_["deadlines"] = {"results": summary["deadlines"], "false": summary["false"]}
-        if enforce:
+        if self.enforce:
             record_["enforce"] = live.gate_counts  # type: ignore[attr-defined]
         bypass = {k: sorted(v) for k, v in bus.bypass.items() if v}
         if bypass:
             record_["bypass"] = bypass
-        downgrade(record_["nodes"], {n.name: [t.field.strip("/") for t in n.node.topics] for n in nodes}, bypass,
-                  {t.key: t.reader_changes for t in bus.taps})
-        if recorder is not None:
-            record_["bag"] = recorder.close()
+        downgrade(record_["nodes"], {n.name: [t.field.strip("/") for t in n.node.topics] for n in self.nodes},
+                  bypass, {t.key: t.reader_changes for t in bus.taps})
+        if self.recorder is not None:
+            record_["bag"] = self.recorder.close()
         record_["not_judged"] = live.not_judged(record_)  # silence is never green (judged.py)
         if evidence is not None:
             atomic_write_text(evidence, json.dumps(record_, indent=2, sort_keys=True) + "\n")
-        out(_status(live, call_counts))
-        bus.close()
-        dp.__del__()
-    return record_
+        self.out(_status(live, self.call_counts))
+        return record_
+
+
+def _calls_record(summary: Mapping[str, Any], book: CallBook, calls: CallTaps | None) -> dict[str, Any]:
+    """The record's ``calls``: the counts of the call-by-call verdicts, each
+    node's status over its calls, and the samples heard per call topic."""
+    out: dict[str, Any] = {"counts": summary["counts"], "nodes": [], "samples": calls.counts if calls is not None else {}}
+    for name, res in book.results.items():
+        status, explanation = verdict_status(res, "the live calls")
+        out["nodes"].append({"node": name, "status": status, "explanation": explanation, **res.to_json()})
+    return out
 
 
 __all__ = ["run_dds"]

@@ -1,0 +1,162 @@
+"""How the verdict engine (:mod:`.engine`) judges guarantees on values.
+
+One formula's judgement is the compiled code where it decides alone, else
+:func:`rclverify.semantics.floatsem.judge` (exact, double, tolerance),
+remembered per (formula, values of the variables it reads).  A set of
+guarantees judged on one reading gives one :class:`.outcome.Outcome`: the
+first false one, else undecided, else satisfied in the weakest arithmetic
+any of them needed (one arithmetic for the whole contract per message),
+else ``none``; a guarantee that reads an output not yet published waits for
+it (docs/semantics.md).
+"""
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, Any, Callable, Mapping
+
+from rclverify.semantics.floatsem import Judgement, holds_in, judge
+from rclverify.semantics.values import render
+from rclverify.traces.events import Event
+from rclverify.traces.questions import Question
+from rclverify.backends.monitors.outcome import Outcome
+from rclverify.backends.monitors.verdicts import WEAK as _WEAK
+
+
+def _always(k: int) -> bool:
+    return True
+
+
+class Judging:
+    """The judging part of :class:`~.engine.NodeMonitor` (module docstring)."""
+
+    if TYPE_CHECKING:  # the engine's state and helpers the mixin reads, declared for the type checker only
+        def __getattr__(self, name: str) -> Any: ...
+
+    def _judge(self, k: Any, values: Mapping[str, Any]) -> Judgement:
+        """The judgement of guarantee ``k`` (``("A", j)``: assumption ``j``) on
+        ``values``: the compiled code where it decides alone, else
+        :func:`~rclverify.semantics.floatsem.judge`, remembered per (formula,
+        values of the variables it reads)."""
+        hit: Judgement | None = self._judges[k].quick(values)
+        if hit is not None:
+            return hit
+        ck = (k, tuple([values.get(d) for d in self._deps[k]]))
+        hit = self._cache.get(ck)
+        if hit is not None:
+            return hit
+        formula = self._guaranteed[k] if isinstance(k, int) else self.assumption[k[1]]
+        j = judge(formula, self.checked, self.node, values, self.tolerance)
+        if self.cache_size:
+            if len(self._cache) >= self.cache_size:
+                self._cache.clear()
+            self._cache[ck] = j
+        return j
+
+    def _rendered(self, values: Mapping[str, Any]) -> dict[str, str]:
+        out = {}
+        for k, v in sorted(values.items()):
+            if v is None:
+                continue
+            hit = self._renders.get(id(v))
+            if hit is None or hit[0] is not v:
+                if len(self._renders) >= 256:
+                    self._renders.clear()
+                hit = self._renders[id(v)] = (v, render(v))
+            out[k] = hit[1]
+        return out
+
+    def _note_inexact(self, ev: Event, judged: Judgement, what: str, values: Mapping[str, Any]) -> None:
+        if self.result.first_inexact is None:
+            self.result.first_inexact = {"event": ev.index, "time": ev.time, "where": ev.where,
+                                         "semantics": judged.semantics, "formula": what,
+                                         "values": self._rendered(values), "reason": judged.reason}
+
+    def _owes(self, q: Question, k: int) -> bool:
+        trig = self._trigger.get(k)
+        return trig is None or trig in q.triggers
+
+    def _alone_outcome(self, ev: Event, ks: list[int]) -> Outcome:
+        """The guarantees over outputs only that ``ev`` touches, on the outputs as they stand."""
+        if not ks:
+            return Outcome("none")
+        values = {k: v for k, v in self.values.items() if v is not None}
+        return self._outcome(ks, values, lambda k: True, None, ev)
+
+    def _outcome(self, ks: list[int], values: Mapping[str, Any], owed: Callable[[int], bool],
+                 q: Question | None, ev: Event, weakest: str = "exact") -> Outcome:
+        """Guarantees ``ks`` (those ``owed``) judged on ``values``: the first
+        false one, else undecided, else satisfied, else ``none``."""
+        decided, undecided = False, None
+        held: list[tuple[int, str]] = []
+        if q is not None and ev.time > q.due and not self._at_due(ev.time, q.due):
+            q = None  # judged against it, but past its horizon: no part of its answer
+        first_inexact = None
+        for k in ks:
+            if not owed(k):
+                continue
+            if q is not None and k in self._trigger:
+                q.mark("answered_triggers", self._trigger[k])
+            judged = self._judge(k, values)
+            if judged.truth is False:
+                if q is not None:
+                    q.waiting.pop(k, None)
+                    q.decided.add(k)
+                return Outcome("violated", k, judged.semantics, values=dict(values))
+            if judged.truth is None:
+                if judged.reason.startswith("no value for out."):  # waits for that output
+                    if q is not None:
+                        q.waiting[k] = (ev, judged.reason, {x: v for x, v in values.items() if x.startswith("out.")})
+                    continue
+                undecided = undecided or (k, judged.reason)
+                continue
+            if q is not None:
+                q.waiting.pop(k, None)
+                q.decided.add(k)
+            decided = True
+            held.append((k, judged.semantics))
+            if judged.semantics != "exact":
+                first_inexact = first_inexact or (k, judged)
+                if _WEAK.get(judged.semantics, 0) > _WEAK[weakest]:
+                    weakest = judged.semantics
+        if undecided is not None:
+            k, why = undecided
+            return Outcome("inconclusive", k, reason=f"guarantee {k}: {why}" + self._unbound_note(why))
+        if decided and weakest != "exact":  # one arithmetic per message for the whole contract
+            for k, sem in held:
+                if _WEAK.get(sem, 0) < _WEAK[weakest] and holds_in(weakest, self._guaranteed[k], self.checked,
+                                                                  self.node, values, self.tolerance) is False:
+                    other = next(j for j, s2 in held if s2 == weakest)
+                    return Outcome("violated", k, weakest, values=dict(values),
+                                   reason=f"guarantee {other} holds only in {weakest} arithmetic and guarantee {k} "
+                                          f"is false in it: no one arithmetic makes the node's guarantees hold on "
+                                          f"the message")
+        if decided:
+            if first_inexact is not None:
+                k, judged = first_inexact
+                self._note_inexact(ev, judged, f"guarantee {k} ({self._texts[k]})", values)
+            return Outcome("satisfied", semantics=weakest)
+        return Outcome("none")
+
+    def _question_outcome(self, q: Question | None, ev: Event, ks: list[int], outs: Mapping[str, Any],
+                          state: Mapping[str, Any], keep: bool = True) -> Outcome:
+        """Output ``ev`` judged against question ``q``; ``keep``: it is the
+        question ``ev`` answered (not another reading within the skew), whose
+        decided and waiting guarantees it updates."""
+        if q is None:
+            return Outcome("unasked")
+        if not q.owed:
+            return Outcome("none")
+        if not state and outs is q.answer and q.view is not None:
+            values = q.view  # inputs and answer, kept by _output: no copy
+        else:
+            values = dict(q.inputs)
+            if state:
+                values.update(state)
+            values.update(outs)
+        return self._outcome(ks, values, self._owes_fn(q), q if keep else None, ev,
+                             q.info)
+
+    def _owes_fn(self, q: Question) -> Callable[[int], bool]:
+        """Which guarantees ``q`` is owed (all of them when none has a trigger)."""
+        if not self._trigger:
+            return _always
+        return lambda k: self._owes(q, k)

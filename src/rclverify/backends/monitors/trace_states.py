@@ -1,0 +1,237 @@
+"""The states of the steps of a recorded run, for a temporal requirement
+checked on it (:mod:`.temporal_trace`, whose docstring defines a step).
+
+The inputs and outputs of the nodes a statement reads are mapped from the
+messages on their topics (:mod:`rclverify.traces.mapping`); a declared state
+variable (the plan's ``state:``, :mod:`rclverify.model.plan.state`) takes the
+value its ``init`` (step 0) or ``next`` (from step i's values) defines,
+found by Z3 on the concrete values (:func:`solve_value`) and used only when
+the formula defines exactly one value.
+"""
+from __future__ import annotations
+
+from fractions import Fraction
+from typing import Any, Iterable, Mapping
+
+import z3
+
+from rclverify.semantics.concrete import finite_interpretation, to_z3
+from rclverify.semantics.encode import EncodingError, Encoder
+from rclverify.model.plan.state import StateFormula, StateVar, parse_state_formula
+from rclverify.lang.types import Checked, EnumT, FuncT, Scalar, Type
+from rclverify.traces.events import Event
+from rclverify.traces.mapping import MappingError, TopicRule, initial_value, map_value, rule_for
+from rclverify.semantics.values import FiniteFunction
+
+#: :func:`solve_value`'s answer when a value the formula reads is not observed yet.
+MISSING = object()
+#: Z3's budget per state update (ms).
+TIMEOUT_MS = 2_000
+
+
+def _from_z3(v: z3.ExprRef, t: Type) -> Any:
+    """A Z3 model value as a value of :mod:`rclverify.semantics.values` (None if not a literal)."""
+    if isinstance(t, Scalar):
+        if t.name == "BOOL":
+            return True if z3.is_true(v) else False if z3.is_false(v) else None
+        if z3.is_int_value(v):
+            return v.as_long()
+        if z3.is_rational_value(v):
+            f = Fraction(v.numerator_as_long(), v.denominator_as_long())
+            return int(f) if f.denominator == 1 and t.name != "REAL" else f
+        return None
+    if isinstance(t, EnumT):
+        return str(v) if z3.is_const(v) and v.num_args() == 0 else None
+    return None
+
+
+def _numbers(v: Any, out: set[Any]) -> None:
+    """Every number in a value (table keys and results, constructor arguments)."""
+    if isinstance(v, bool):
+        return
+    if isinstance(v, (int, float, Fraction)):
+        out.add(v)
+    elif isinstance(v, FiniteFunction):
+        for k, r in v.table.items():
+            _numbers(k, out)
+            _numbers(r, out)
+    elif isinstance(v, (tuple, list, frozenset, set)):
+        for x in v:
+            _numbers(x, out)
+    elif hasattr(v, "args") and isinstance(getattr(v, "args"), tuple):
+        _numbers(v.args, out)
+
+
+def _function_value(m: z3.ModelRef, decl: z3.FuncDeclRef, t: FuncT, values: Mapping[str, Any],
+                    enc: Encoder) -> FiniteFunction | None:
+    """A candidate finite table for function ``decl`` in model ``m``: its
+    value at every point built from the numbers of ``values`` and at one
+    point beyond them (the default).  The caller checks it is the only
+    solution, so a wrong candidate is never used.  Unary functions over
+    numbers only (else ``None``)."""
+    if len(t.args) != 1 or not isinstance(t.args[0], Scalar) or t.args[0].name == "BOOL":
+        return None
+    a = t.args[0]
+    nums: set[Any] = set()
+    _numbers(list(values.values()), nums)
+    pts = {x if a.name == "REAL" else int(x) for x in nums if a.name == "REAL" or Fraction(x).denominator == 1}
+    pts = {x for x in pts if a.name != "NATURAL" or x >= 0}
+    beyond = max(pts, default=0) + 1
+
+    def at(x: Any) -> Any:
+        return _from_z3(m.eval(decl(to_z3(x, a, enc)), model_completion=True), t.result)
+
+    default = at(beyond)
+    if default is None:
+        return None
+    table = {}
+    for x in sorted(pts):
+        r = at(x)
+        if r is None:
+            return None
+        if r != default:
+            table[(x,)] = r
+    return FiniteFunction(table, default, 1)
+
+
+def solve_value(sf: StateFormula, checked: Checked, target: str, values: Mapping[str, Any]) -> Any:
+    """The one value of ``target`` (``"state.v"`` for ``init``, ``"next.v"``
+    for ``next``) that makes ``sf`` true with every other variable at its
+    value in ``values`` (keyed ``"in.x"``, ``"out.y"``, ``"state.v"``).
+    Returns :data:`MISSING` when a value it reads is not observed yet,
+    ``None`` when Z3 cannot decide, or the
+    formula does not define exactly one value (docs/plan.md, "state": a
+    ``next`` must be a definition).  Never raises."""
+    enc = Encoder(checked.env)
+    try:
+        phi = enc.formula(sf.expr, sf.scope)
+        consts, funcs, goal = [], [], None
+        for sym in enc.symbols.values():
+            name = sym.z3name.split(".", 1)[1]  # "<Node>.in.state.v" -> "in.state.v"
+            bare = name[3:] if name.startswith(("in.state.", "in.next.")) else name
+            if bare == target:
+                goal = sym
+                continue
+            v = values.get(bare)
+            if v is None:
+                return MISSING
+            t = sym.type
+            if isinstance(t, FuncT):
+                if not isinstance(v, FiniteFunction):
+                    return None
+                funcs.append((sym.decl, finite_interpretation(v, t, enc)))
+            else:
+                consts.append((sym.decl, to_z3(v, t, enc)))
+        if goal is None:
+            return None
+        if consts:
+            phi = z3.substitute(phi, *consts)
+        if funcs:
+            phi = z3.substitute_funs(phi, *funcs)
+        s = z3.Solver()
+        s.set("timeout", TIMEOUT_MS)
+        s.add(phi)
+        if s.check() != z3.sat:
+            return None
+        m = s.model()
+        t = goal.type
+        if isinstance(t, FuncT):
+            value = _function_value(m, goal.decl, t, values, enc)
+            if value is None:
+                return None
+            xs = [z3.FreshConst(d) for d in [goal.decl.domain(k) for k in range(goal.decl.arity())]]
+            body = finite_interpretation(value, t, enc)
+            differs = z3.And(goal.decl(*xs) != z3.substitute_vars(body, *reversed(xs)),
+                             *[x >= 0 for x, a in zip(xs, t.args) if isinstance(a, Scalar) and a.name == "NATURAL"])
+        else:
+            value = _from_z3(m.eval(goal.decl, model_completion=True), t)
+            if value is None:
+                return None
+            differs = goal.decl != to_z3(value, t, enc)
+        s.add(differs)  # unique: no other value satisfies the formula
+        return value if s.check() == z3.unsat else None
+    except (EncodingError, ValueError, TypeError, KeyError, z3.Z3Exception):
+        return None
+
+
+class TraceStates:
+    """The states of the steps of a trace for the nodes ``nodes`` (module
+    docstring): :meth:`feed` one event, ``values`` the state (keyed as the
+    statement's scope reads them: ``"in.Node.in.x"``, ``"out.Node.out.y"``,
+    ``"in.Node.state.v"``)."""
+
+    def __init__(self, checked: Checked, nodes: Iterable[str], states: tuple[StateVar, ...],
+                 rules: Mapping[str, TopicRule]) -> None:
+        self.checked, self.rules = checked, rules
+        self.nodes = list(nodes)
+        self.topics: dict[str, list[tuple[str, str, Type]]] = {}  # topic -> [(node, "in.x", type)]
+        self.io: dict[str, dict[str, Any]] = {n: {} for n in self.nodes}
+        for n in self.nodes:
+            cn = checked.nodes[n]
+            for t in cn.node.topics:
+                typ = cn.io_type(t.match) if t.match is not None else None
+                if typ is None or t.match is None:
+                    continue
+                inp = t.match.prefix == "in" or (t.match.prefix is None and t.match.name in cn.inputs)
+                key = ("in." if inp else "out.") + t.match.name
+                topic = t.field.lstrip("/")
+                self.topics.setdefault(topic, []).append((n, key, typ))
+                self.io[n][key] = initial_value(typ, rule_for(rules, topic, key))
+        self.vars = [sv for sv in states if sv.node in self.nodes]
+        self.formulas = {(sv.node, sv.name): (parse_state_formula(sv, "init", checked, states),
+                                              parse_state_formula(sv, "next", checked, states)) for sv in self.vars}
+        self.state: dict[tuple[str, str], Any] = {}
+        self.steps = 0
+        self.problem = ""
+        #: scope keys (``"in.Node.in.x"``) whose last message could not be read (a string for a REAL, NaN, a
+        #: bool): no value, and what reads them is undecided, never judged on the value before (issue 63, row 5)
+        self.unreadable: dict[str, str] = {}
+
+    def _node_values(self, n: str) -> dict[str, Any]:
+        out = {k: v for k, v in self.io[n].items() if v is not None}
+        out.update({f"state.{v}": x for (m, v), x in self.state.items() if m == n and x is not None})
+        return out
+
+    def feed(self, ev: Event) -> bool:
+        """Apply one event; returns whether it is a step (on a topic of the nodes)."""
+        vs = self.topics.get(ev.topic.lstrip("/"))
+        if not vs:
+            return False
+        before = {n: self._node_values(n) for n in {sv.node for sv in self.vars}} if self.steps else {}
+        for n, key, typ in vs:
+            p, _, name = key.partition(".")
+            try:
+                self.io[n][key] = map_value(typ, ev.fields, rule_for(self.rules, ev.topic, key), self.io[n].get(key))
+                self.unreadable.pop(f"{p}.{n}.{p}.{name}", None)
+            except MappingError as exc:
+                self.io[n][key] = None
+                self.unreadable[f"{p}.{n}.{p}.{name}"] = f"{ev.where}: {n}.{key}: {exc}"
+                self.problem = self.problem or f"{ev.where}: {n}.{key}: {exc}"
+        for sv in self.vars:
+            init, nxt = self.formulas[(sv.node, sv.name)]
+            if self.steps == 0:
+                v = solve_value(init, self.checked, f"state.{sv.name}", {})
+            else:  # the node has not produced what next reads yet: no step of the node, the state is kept
+                v = solve_value(nxt, self.checked, f"next.{sv.name}", before[sv.node])
+                if v is MISSING:
+                    continue
+            self.state[(sv.node, sv.name)] = None if v is MISSING else v
+        self.steps += 1
+        return True
+
+    def values(self) -> dict[str, Any]:
+        """The state of the current step, keyed for a statement's scope."""
+        out: dict[str, Any] = {}
+        for n in self.nodes:
+            for k, v in self.io[n].items():
+                if v is not None:
+                    p, _, name = k.partition(".")
+                    out[f"{p}.{n}.{p}.{name}"] = v
+        for (n, v), x in self.state.items():
+            if x is not None:
+                out[f"in.{n}.state.{v}"] = x
+        return out
+
+
+
+__all__ = ["MISSING", "TIMEOUT_MS", "TraceStates", "solve_value"]

@@ -1,0 +1,486 @@
+"""The AST builder of the RCL parser: a lark transformer that makes the
+immutable AST (:mod:`rclverify.lang.ast`) while the LALR(1) automaton of
+``rcl.lark`` reduces, so no parse tree is ever built.
+
+It also holds the limits a literal is checked against as it is read
+(:func:`numeral_problem`, ``E-number``), the balanced tree an ``and``/``or``
+chain becomes (:func:`balanced`, shared with the printer) and string
+unquoting.  :mod:`rclverify.lang.parser` drives it; the grammar follows the
+paper's EBNF table and appendix A (see ``rcl.lark``).
+"""
+from __future__ import annotations
+
+import dataclasses
+import re
+from typing import Any, Callable, cast
+
+from lark import Token, Transformer
+
+from rclverify.lang import ast
+from rclverify.lang.errors import RclError, error
+
+# Terminals whose text is data; every other token (keywords, punctuation) is
+# syntax, kept in the children only for its position.  "QUANT" is the
+# quantifier-kind token the transformer itself makes.
+_VALUE_TERMINALS = frozenset({"NAME", "IO_NAME", "NUMBER", "ROS_TYPE", "CMP_OP", "BASE_TYPE", "EXISTS_BANG",
+                              "QUANT", "STRING_LIT", "QUALIFIED_BASE", "UNIT"})
+
+
+class _Spanned:
+    """An intermediate value with the location of the text it came from."""
+
+    __slots__ = ("value", "loc")
+
+    def __init__(self, value: Any, loc: ast.Loc) -> None:
+        self.value, self.loc = value, loc
+
+
+def _is_syntax(x: Any) -> bool:
+    return isinstance(x, Token) and x.type not in _VALUE_TERMINALS
+
+
+def _vals(c: list[Any]) -> list[Any]:
+    """The data children of a rule (syntax tokens dropped, placeholders kept)."""
+    return [x for x in c if not (isinstance(x, Token) and x.type not in _VALUE_TERMINALS)]  # _is_syntax, inlined
+
+
+class ToAst(Transformer[Token, Any]):
+    """Builds the immutable AST while the LALR parser reduces.
+
+    Children arrive with all tokens kept; a node's location runs from the
+    start of its first child to the end of its last one.  ``file``, ``dline``
+    and ``dcol`` (set by the parser for each run) offset locations for a
+    formula embedded in another file (first line shifted by ``dcol``)."""
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.reset("<string>", 0, 0)
+
+    def reset(self, file: str, dline: int, dcol: int) -> None:
+        """Prepare for one parse of ``file`` (offsets as in :func:`parse_formula`)."""
+        self.file, self.dline, self.dcol = file, dline, dcol
+        self.units_seen = False  # a UNIT token was read (Spec.has_units)
+        # id(node) -> (node, span with the parentheses) for parenthesised
+        # expressions: a parent spans its operand's parentheses, while the
+        # operand's own location is the text inside them.  The node is held
+        # so that its id stays unique for the whole parse.
+        self.wrapped: dict[int, tuple[Any, ast.Loc]] = {}
+
+    # -- locations -------------------------------------------------------
+    def _start(self, x: Any) -> tuple[int, int]:
+        if isinstance(x, Token):
+            line = x.line or 0
+            return line + self.dline, (x.column or 0) + (self.dcol if line == 1 else 0)
+        loc = self.wrapped[id(x)][1] if id(x) in self.wrapped else x.loc
+        return loc.line, loc.col
+
+    def _end(self, x: Any) -> tuple[int, int]:
+        if isinstance(x, Token):
+            end_line = x.end_line or 0
+            return end_line + self.dline, (x.end_column or 0) + (self.dcol if end_line == 1 else 0)
+        loc = self.wrapped[id(x)][1] if id(x) in self.wrapped else x.loc
+        return loc.end_line, loc.end_col
+
+    def _span(self, c: list[Any]) -> ast.Loc:
+        first, last = c[0], c[-1]  # usually positioned; else skip placeholders
+        if first is None or not (isinstance(first, Token) or hasattr(first, "loc")):
+            first = next((x for x in c if isinstance(x, Token) or hasattr(x, "loc")), None)
+            if first is None:
+                return ast.Loc(self.file)
+        if last is None or not (isinstance(last, Token) or hasattr(last, "loc")):
+            last = next(x for x in reversed(c) if isinstance(x, Token) or hasattr(x, "loc"))
+        # _start/_end inlined: this runs once per AST node (hot in parsing).
+        wrapped = self.wrapped
+        if isinstance(first, Token):
+            sl = first.line or 0
+            sc = (first.column or 0) + (self.dcol if sl == 1 else 0)
+            sl += self.dline
+        else:
+            w = wrapped.get(id(first)) if wrapped else None
+            loc = w[1] if w is not None else first.loc
+            sl, sc = loc.line, loc.col
+        if isinstance(last, Token):
+            el = last.end_line or 0
+            ec = (last.end_column or 0) + (self.dcol if el == 1 else 0)
+            el += self.dline
+        else:
+            w = wrapped.get(id(last)) if wrapped else None
+            loc = w[1] if w is not None else last.loc
+            el, ec = loc.end_line, loc.end_col
+        return ast.Loc(self.file, sl, sc, el, ec)
+
+    # -- top level -----------------------------------------------------------
+    def start(self, c: list[Any]) -> ast.Spec:
+        ctx = tuple(i for i in c if isinstance(i, ast.Context))
+        nodes = tuple(i for i in c if isinstance(i, ast.Node))
+        return ast.Spec(ctx, nodes, file=self.file, has_units=self.units_seen)
+
+    def context_clause(self, c: list[Any]) -> ast.Context:
+        return ast.Context(tuple(_vals(c)), self._span(c))
+
+    def type_decl(self, c: list[Any]) -> ast.TypeDecl:
+        v = _vals(c)
+        return ast.TypeDecl(str(v[0]), v[1], self._span(c))
+
+    def const_decl(self, c: list[Any]) -> ast.ConstDecl:
+        v = _vals(c)
+        if len(v) == 4:  # NAME type [UNIT] expr
+            return ast.ConstDecl(str(v[0]), v[3], v[1], self._span(c), self._unit(v[2]))
+        return ast.ConstDecl(str(v[0]), v[1], None, self._span(c))
+
+    def _unit(self, tok: Token | None) -> ast.UnitAnn | None:
+        """The :class:`~rclverify.lang.ast.UnitAnn` of a ``UNIT`` token
+        (``None`` for an absent one): its text without the brackets, as
+        :func:`~rclverify.lang.units.normal_text` writes it (a blank between
+        two symbols is a product, ``[m s]`` is ``m*s``, never ``ms``),
+        located at the opening bracket."""
+        if tok is None:
+            return None
+        self.units_seen = True
+        from rclverify.lang.units import normal_text
+        return ast.UnitAnn(normal_text(str(tok)[1:-1]), self._span([tok]))
+
+    def node_clause(self, c: list[Any]) -> ast.Node:
+        v = _vals(c)
+        name, inputs, outputs = str(v[0]), v[1], v[2]
+        rest = v[3:]
+        topics: tuple[ast.Topic, ...] = ()
+        if rest and rest[0][0] == "topics":
+            topics = rest[0][1]
+            rest = rest[1:]
+        links = tuple(lk for kind, group in rest if kind == "links" for lk in group)
+        assumes = tuple(cl for kind, cl in rest if kind == "assume")
+        guarantees = tuple(cl for kind, cl in rest if kind == "guarantee")
+        return ast.Node(name, inputs, outputs, topics, assumes, guarantees, self._span(c), links,
+                        tuple(cl for kind, cl in rest if kind == "initially"),
+                        tuple(p for kind, p in rest if kind == "progress"),
+                        tuple(p for kind, p in rest if kind == "periodic"))
+
+    def inputs(self, c: list[Any]) -> tuple[ast.IOVar, ...]:
+        return tuple(x for x in _vals(c) if x is not None)
+
+    outputs = inputs
+
+    def io_var(self, c: list[Any]) -> ast.IOVar:
+        v = _vals(c)
+        return ast.IOVar(str(v[0]), v[1], self._span(c), self._unit(v[2]))
+
+    def topics(self, c: list[Any]) -> tuple[str, tuple[ast.Topic, ...]]:
+        return ("topics", tuple(x for x in _vals(c) if x is not None))
+
+    def topic(self, c: list[Any]) -> ast.Topic:
+        v = _vals(c)
+        match = v[2].value if v[2] is not None else None
+        return ast.Topic(str(v[0]), str(v[1]), match, self._span(c))
+
+    def topic_match(self, c: list[Any]) -> _Spanned:
+        return _Spanned(_vals(c)[0], self._span(c))
+
+    def assume(self, c: list[Any]) -> tuple[str, ast.Clause]:
+        return ("assume", ast.Clause(_vals(c)[0], self._span(c)))
+
+    def guarantee(self, c: list[Any]) -> tuple[str, ast.Clause]:
+        v = _vals(c)
+        trigger = v[1].value if len(v) > 1 and v[1] is not None else None
+        deadline = v[2] if len(v) > 2 else None
+        return ("guarantee", ast.Clause(v[0], self._span([x for x in c if x is not None]), trigger, deadline))
+
+    def initially(self, c: list[Any]) -> tuple[str, ast.Clause]:
+        return ("initially", ast.Clause(_vals(c)[0], self._span(c)))
+
+    def progress(self, c: list[Any]) -> tuple[str, ast.Progress]:
+        kind = _vals(c)[0]
+        return ("progress", ast.Progress(kind[0], kind[1], self._span(c)))
+
+    def progress_eventually(self, c: list[Any]) -> tuple[str | None, str | None]:
+        return (None, None)
+
+    def progress_within(self, c: list[Any]) -> tuple[str | None, str | None]:
+        v = _vals(c)
+        return (str(v[0]), str(v[1]) if v[1] is not None else None)
+
+    def periodic(self, c: list[Any]) -> tuple[str, ast.Periodic]:
+        v = _vals(c)
+        return ("periodic", ast.Periodic(v[0], str(v[1]), str(v[2]) if v[2] is not None else None,
+                                         self._span(c)))
+
+    def trigger(self, c: list[Any]) -> _Spanned:
+        return _Spanned(_vals(c)[0], self._span(c))
+
+    def deadline(self, c: list[Any]) -> ast.Deadline:
+        v = _vals(c)
+        unit = str(v[1]) if v[1] is not None else None
+        return ast.Deadline(str(v[0]), unit, self._span([x for x in c if x is not None]))
+
+    def services(self, c: list[Any]) -> tuple[str, tuple[ast.Link, ...]]:
+        return ("links", tuple(x for x in _vals(c) if x is not None))
+
+    actions = services
+
+    def serves(self, c: list[Any]) -> str:
+        return "serves"
+
+    def calls(self, c: list[Any]) -> str:
+        return "calls"
+
+    def _link(self, kind: str, c: list[Any]) -> ast.Link:
+        v = _vals(c)
+        return ast.Link(kind, str(v[0]), str(v[1]), v[2], tuple(v[3:]), self._span(c))
+
+    def service_link(self, c: list[Any]) -> ast.Link:
+        return self._link("service", c)
+
+    def action_link(self, c: list[Any]) -> ast.Link:
+        return self._link("action", c)
+
+    # -- types ---------------------------------------------------------------
+    def base_name(self, c: list[Token]) -> Token:
+        return c[0]  # the BASE_TYPE token: its text and its position
+
+    def base_type(self, c: list[Any]) -> ast.TBase:
+        return ast.TBase(str(c[0]), self._span(c))  # type: ignore[arg-type]
+
+    def named_type(self, c: list[Any]) -> ast.TName:
+        return ast.TName(str(c[0]), self._span(c))
+
+    def empty_type(self, c: list[Any]) -> ast.TEmpty:
+        return ast.TEmpty(self._span(c))
+
+    def alt(self, c: list[Any]) -> ast.Constructor:
+        v = _vals(c)
+        return ast.Constructor(str(v[0]), tuple(t for t in v[1:] if t is not None), self._span(c))
+
+    def alt_type(self, c: list[Any]) -> ast.TypeExpr:
+        alts: list[ast.Constructor] = _vals(c)
+        if all(not a.args for a in alts):
+            return ast.TEnum(tuple(a.name for a in alts), self._span(c))
+        return ast.TConstructors(tuple(alts), self._span(c))
+
+    def func_type(self, c: list[Any]) -> ast.TFunc:
+        arrow = next(k for k, x in enumerate(c) if isinstance(x, Token) and x.value == "-->")
+        args, res = _vals(c[:arrow]), _vals(c[arrow + 1:])
+        result = res[0] if len(res) == 1 else ast.TTuple(tuple(res), self._span(c[arrow + 1:]))
+        return ast.TFunc(tuple(args), result, self._span(c))
+
+    def set_type(self, c: list[Any]) -> ast.TSet:
+        return ast.TSet(_vals(c)[0], self._span(c))
+
+    def seq_type(self, c: list[Any]) -> ast.TSeq:
+        return ast.TSeq(_vals(c)[0], self._span(c))
+
+    def tuple_type(self, c: list[Any]) -> ast.TTuple:
+        return ast.TTuple(tuple(_vals(c)), self._span(c))
+
+    def type_atom(self, c: list[Any]) -> Any:
+        t = c[1]  # "(" type ")": the type itself, spanning its parentheses for its parent
+        self.wrapped[id(t)] = (t, self._span(c))
+        return t
+
+    # -- expressions -----------------------------------------------------------
+    def _bin(self, op: ast.BinaryOp, c: list[Any]) -> ast.Binary:
+        return ast.Binary(op, c[0], c[2], self._span(c))
+
+    def iff(self, c: list[Any]) -> ast.Binary:
+        return self._bin("<=>", c)
+
+    def implies(self, c: list[Any]) -> ast.Binary:
+        return self._bin("->", c)
+
+    def disj(self, c: list[Any]) -> ast.Binary:
+        return self._chain("or", c)
+
+    def conj(self, c: list[Any]) -> ast.Binary:
+        return self._chain("and", c)
+
+    def _chain(self, op: ast.BinaryOp, c: list[Any]) -> ast.Binary:
+        """A flat ``a op b op c ...`` chain as a balanced tree (see
+        :func:`balanced`): depth log2(n), so every recursive consumer copes
+        with chains of any length."""
+        if len(c) == 3:
+            return ast.Binary(op, c[0], c[2], self._span(c))
+        return balanced(op, c[0::2], lambda a, b: self._span([a, b]))  # type: ignore[no-any-return]
+
+    def add(self, c: list[Any]) -> ast.Binary:
+        return self._bin("+", c)
+
+    def sub(self, c: list[Any]) -> ast.Binary:
+        return self._bin("-", c)
+
+    def mul(self, c: list[Any]) -> ast.Binary:
+        return self._bin("*", c)
+
+    def div(self, c: list[Any]) -> ast.Binary:
+        return self._bin("/", c)
+
+    def neg(self, c: list[Any]) -> ast.Unary:
+        return ast.Unary("not", c[1], self._span(c))
+
+    def minus(self, c: list[Any]) -> ast.Unary:
+        return ast.Unary("-", c[1], self._span(c))
+
+    def compare(self, c: list[Any]) -> ast.Compare:
+        ops = cast("tuple[ast.CompareOp, ...]", tuple(str(t) for t in c[1::2]))
+        return ast.Compare(ops, tuple(c[0::2]), self._span(c))
+
+    def member(self, c: list[Any]) -> ast.Member:
+        return ast.Member(c[0], c[2], False, self._span(c))
+
+    def not_member(self, c: list[Any]) -> ast.Member:
+        return ast.Member(c[0], c[2], True, self._span(c))
+
+    def number(self, c: list[Any]) -> ast.NumLit:
+        text, loc = str(c[0]), self._span([c[0]])
+        problem = numeral_problem(text)
+        if problem:
+            raise RclError([error(loc, problem, "E-number")])
+        unit = c[1] if len(c) > 1 else None
+        if unit is not None:
+            return ast.NumLit(text, self._span(c), self._unit(unit))
+        return ast.NumLit(text, loc)
+
+    def true(self, c: list[Any]) -> ast.BoolLit:
+        return ast.BoolLit(True, self._span(c))
+
+    def false(self, c: list[Any]) -> ast.BoolLit:
+        return ast.BoolLit(False, self._span(c))
+
+    def io_name(self, c: list[Any]) -> ast.Var:
+        prefix, name = str(c[0]).split(".", 1)
+        return ast.Var(name, prefix, self._span(c))  # type: ignore[arg-type]
+
+    def plain_name(self, c: list[Any]) -> ast.Var:
+        return ast.Var(str(c[0]), None, self._span(c))
+
+    base_type_name = plain_name
+    qualified_base = plain_name
+
+    def apply(self, c: list[Any]) -> ast.Apply:
+        v = _vals(c)
+        return ast.Apply(v[0], tuple(a for a in v[1:] if a is not None), self._span(c))
+
+    def _kind(self, kind: str, c: list[Token]) -> Token:
+        return Token.new_borrow_pos("QUANT", kind, c[0])
+
+    def forall(self, c: list[Token]) -> Token:
+        return self._kind("forall", c)
+
+    def exists(self, c: list[Token]) -> Token:
+        return self._kind("exists", c)
+
+    def exists_unique(self, c: list[Token]) -> Token:
+        return self._kind("exists_unique", c)
+
+    def quant(self, c: list[Any]) -> ast.Quant:
+        v = _vals(c)
+        return ast.Quant(str(v[0]), v[1], v[2], self._span(c))  # type: ignore[arg-type]
+
+    def bindings(self, c: list[Any]) -> tuple[ast.Binding, ...]:
+        return tuple(_vals(c))
+
+    def binding(self, c: list[Any]) -> ast.Binding:
+        v = _vals(c)
+        names = tuple(str(n) for n in v[:-1])
+        locs = tuple(self._span([n]) for n in v[:-1])
+        domain = v[-1]
+        if isinstance(domain, ast.Var) and domain.prefix is None:
+            domain = ast.TName(domain.name, domain.loc)
+        return ast.Binding(names, domain, self._span(c), locs)
+
+    def bound_name(self, c: list[Token]) -> Token:
+        return c[0]  # the NAME token: its text and its position
+
+    def set_lit(self, c: list[Any]) -> ast.SetLit:
+        return ast.SetLit(tuple(x for x in _vals(c) if x is not None), self._span(c))
+
+    def seq_lit(self, c: list[Any]) -> ast.SeqLit:
+        return ast.SeqLit(tuple(x for x in _vals(c) if x is not None), self._span(c))
+
+    def seq_range(self, c: list[Any]) -> ast.SeqRange:
+        v = _vals(c)
+        return ast.SeqRange(v[0], v[1], self._span(c))
+
+    def string(self, c: list[Any]) -> ast.StrLit:
+        return ast.StrLit(_unquote(str(c[0])), self._span(c))
+
+    def tuple_binder(self, c: list[Any]) -> list[Token]:
+        return [t for t in _vals(c)]
+
+    def tuple_quant(self, c: list[Any]) -> ast.TupleQuant:
+        v = _vals(c)
+        kind, names, domain, body = v[0], v[1], v[2], v[3]
+        if isinstance(domain, ast.Var) and domain.prefix is None:
+            domain = ast.TName(domain.name, domain.loc)
+        return ast.TupleQuant(str(kind), tuple(str(n) for n in names), domain, body,  # type: ignore[arg-type]
+                              self._span(c), tuple(self._span([n]) for n in names))
+
+    def tuple_lit(self, c: list[Any]) -> ast.TupleLit:
+        return ast.TupleLit(tuple(_vals(c)), self._span(c))
+
+    def paren(self, c: list[Any]) -> Any:
+        e = c[1]
+        if isinstance(e, ast.Binary):
+            e = dataclasses.replace(e, parenthesised=True)
+        self.wrapped[id(e)] = (e, self._span(c))
+        return e
+
+
+#: Most digits a numeral may have (before and after its point) and largest
+#: magnitude of its exponent.  A literal within both limits has an exact value
+#: of at most 2,001 digits, so every stage (Fraction arithmetic, Z3, printing
+#: the value in JSON or text: Python refuses to print integers above 4,300
+#: digits) handles it; a longer one is a located ``E-number`` error at parse
+#: time (docs/rcl-language.md, "Robustness limits").
+NUMERAL_DIGITS_LIMIT = 1000
+NUMERAL_EXPONENT_LIMIT = 1000
+
+
+def numeral_problem(text: str) -> str | None:
+    """Why the numeral ``text`` (the ``NUMBER`` terminal of ``rcl.lark``:
+    digits, an optional fraction, an optional exponent) is refused, or
+    ``None`` when it is within :data:`NUMERAL_DIGITS_LIMIT` digits and its
+    exponent within :data:`NUMERAL_EXPONENT_LIMIT` in magnitude."""
+    mantissa, _, exponent = text.lower().partition("e")
+    digits = len(mantissa) - ("." in mantissa)
+    if digits > NUMERAL_DIGITS_LIMIT:
+        return f"numeral too long: {digits} digits (limit {NUMERAL_DIGITS_LIMIT})"
+    exp_digits = exponent.lstrip("+-").lstrip("0")
+    if len(exp_digits) > 4 or (exp_digits and int(exp_digits) > NUMERAL_EXPONENT_LIMIT):
+        return f"numeral's exponent too large (limit {NUMERAL_EXPONENT_LIMIT} in magnitude)"
+    return None
+
+
+#: Deepest nesting of expressions and types the parser accepts (AST depth;
+#: parentheses alone do not count, a balanced ``and``/``or`` chain of n
+#: operands counts log2(n)).  Deeper input is a located ``E-depth`` error
+#: instead of a ``RecursionError`` in a later stage (docs/rcl-language.md).
+NESTING_LIMIT = 200
+
+
+def balanced(op: ast.BinaryOp, operands: list[Any], span: Callable[[Any, Any], ast.Loc]) -> Any:
+    """The balanced tree of ``op`` over ``operands`` (n >= 1): the first
+    ceil(n/2) operands form the left subtree, the rest the right one, so two
+    and three operands give the left-nested tree a left-associative grammar
+    gives.  ``span(first, last)`` is the location of a subtree.  Also used by
+    the printer's round-trip check (printer.py); iterative (no recursion)."""
+    if len(operands) == 1:
+        return operands[0]
+    # Build bottom-up over (lo, hi) ranges with an explicit post-order stack.
+    result: dict[tuple[int, int], Any] = {}
+    stack: list[tuple[int, int, bool]] = [(0, len(operands), False)]
+    while stack:
+        lo, hi, ready = stack.pop()
+        if hi - lo == 1:
+            result[(lo, hi)] = operands[lo]
+            continue
+        mid = lo + (hi - lo + 1) // 2
+        if not ready:
+            stack += [(lo, hi, True), (mid, hi, False), (lo, mid, False)]
+            continue
+        left, right = result.pop((lo, mid)), result.pop((mid, hi))
+        result[(lo, hi)] = ast.Binary(op, left, right, span(operands[lo], operands[hi - 1]))
+    return result[(0, len(operands))]
+
+
+def _unquote(text: str) -> str:
+    """The value of a ``STRING_LIT`` token: quotes removed, ``\\x`` -> ``x``."""
+    return re.sub(r"\\(.)", r"\1", text[1:-1])
