@@ -33,6 +33,11 @@ from typing import Any
 
 from rclverify.records.records import Evidence
 from rclverify.records.store import EvidenceStore
+from rclverify.records.records import Obligation
+from rclverify.records.store import read_json
+from rclverify.semantics.world import fresh as fresh_z3
+from rclverify.stages.workspace import Workspace
+from rclverify.core.atomic import atomic_write_bytes
 
 #: Environment variable read by the ``evidence`` tasks of ``doit verify``.
 CLUSTER_ENV = "RCLVERIFY_CLUSTER"
@@ -68,7 +73,7 @@ def _in_place(root: str, plan_file: str, key: str) -> bool:
     path = Path(root)
     if not (path / plan_file).is_file():
         return False
-    from rclverify.app import cluster_files
+    from rclverify.app import cluster_files  # deferred: start-up (loads rclverify.app.cluster_files, io and more only when called)
     try:
         return cluster_files.digest(path) == key
     except cluster_files.ShippingError:
@@ -78,10 +83,10 @@ def _in_place(root: str, plan_file: str, key: str) -> bool:
 def _working_folder() -> Path:
     """The worker's own working folder (Dask's ``local_directory``), else the temporary folder."""
     try:
-        from dask.distributed import get_worker
+        from dask.distributed import get_worker  # deferred: optional or conditional (inside a block)
         return Path(get_worker().local_directory)
     except (ImportError, ValueError):
-        import tempfile
+        import tempfile  # deferred: optional or conditional (inside a block)
         return Path(tempfile.gettempdir())
 
 
@@ -101,9 +106,9 @@ def remote_run(root: str, plan_file: str, key: str, node: str, obligation_id: st
     or :data:`NEEDS_FILES`.  Writes no evidence (the submitting process does).
     The workspace is loaded once per worker and sources' digest.
     """
-    import base64
+    import base64  # deferred: start-up (loads base64 only when called)
 
-    from rclverify.app import cluster_files
+    from rclverify.app import cluster_files  # deferred: start-up (loads rclverify.app.cluster_files, io and more only when called)
     files: dict[str, str] = {}
     if shipped is None:
         if not _in_place(root, plan_file, key):
@@ -122,12 +127,8 @@ def remote_run(root: str, plan_file: str, key: str, node: str, obligation_id: st
 
 def _run_here(root: str, plan_file: str, key: str, node: str, obligation_id: str) -> Evidence:
     """One obligation's backend run in the workspace at ``root`` (loaded once per worker and ``key``)."""
-    from rclverify.backends import get_backend
-    from rclverify.core.cache import workspace as wscache
-    from rclverify.records.records import Obligation
-    from rclverify.records.store import read_json
-    from rclverify.semantics.world import fresh as fresh_z3
-    from rclverify.stages.workspace import Workspace
+    from rclverify.backends import get_backend  # deferred: start-up (loads rclverify.backends, importlib only when called)
+    from rclverify.core.cache import workspace as wscache  # deferred: start-up (loads rclverify.core.cache, fractions and more only when called)
     ws = _WORKER_WORKSPACES.get((root, plan_file, key))
     if ws is None:
         ws = Workspace(Path(root), plan_file)
@@ -147,7 +148,7 @@ def _run_here(root: str, plan_file: str, key: str, node: str, obligation_id: str
 def _client(addr: str) -> Any:
     client = _CLIENTS.get(addr)
     if client is None:
-        from dask.distributed import Client
+        from dask.distributed import Client  # deferred: optional or conditional (inside a block)
         try:
             client = Client(addr, timeout=CONNECT_TIMEOUT_S, set_as_default=False)  # type: ignore[no-untyped-call]
         except (OSError, TimeoutError, ValueError) as exc:
@@ -158,7 +159,7 @@ def _client(addr: str) -> Any:
 
 def _shipment(addr: str, client: Any, ws: Any, node: str) -> tuple[str, Any, dict[str, bytes]]:
     """The job's ``shipped`` argument: the sources scattered once per (address, workspace), the node's files."""
-    from rclverify.app import cluster_files
+    from rclverify.app import cluster_files  # deferred: start-up (loads rclverify.app.cluster_files, io and more only when called)
     root = ws.root.resolve()
     have = _SHIPPED.get((addr, str(root)))
     if have is None:
@@ -174,7 +175,7 @@ def _sources_digest(root: Path) -> str:
     """The sources' digest, taken once per process (a doit run's processes see one version of the sources)."""
     key = str(root)
     if key not in _DIGESTS:
-        from rclverify.app import cluster_files
+        from rclverify.app import cluster_files  # deferred: optional or conditional (inside a block)
         _DIGESTS[key] = cluster_files.digest(root)
     return _DIGESTS[key]
 
@@ -188,10 +189,9 @@ def run_on_cluster(addr: str, ws: Any, node: str, obligation_id: str) -> Evidenc
     :class:`ClusterError` when the scheduler cannot be reached, the
     workspace cannot be sent, or the job raised on the worker.
     """
-    import base64
+    import base64  # deferred: start-up (loads base64 only when called)
 
-    from rclverify.app import cluster_files
-    from rclverify.core.atomic import atomic_write_bytes
+    from rclverify.app import cluster_files  # deferred: start-up (loads rclverify.app.cluster_files, io and more only when called)
     root = str(ws.root.resolve())
     client = _client(addr)
     text = None

@@ -33,6 +33,7 @@ import io
 import os
 import tarfile
 from pathlib import Path
+from rclverify.core.atomic import atomic_write_bytes
 
 #: Folders of a workspace never sent: written by runs, or not part of the inputs.
 SKIPPED_TOP = frozenset({"artifacts", "reports"})
@@ -143,13 +144,13 @@ def materialise(base: Path, name: str, blob: bytes) -> Path:
     with tarfile.open(fileobj=io.BytesIO(blob), mode="r:") as tar:
         tar.extractall(tmp, filter="data")
     if digest(tmp) != name:
-        import shutil
+        import shutil  # deferred: optional or conditional (inside a block)
         shutil.rmtree(tmp, ignore_errors=True)
         raise ShippingError("the workspace's sources arrived damaged (their sha256 differs)")
     try:
         os.replace(tmp, root)
     except OSError:  # another job of this worker unpacked it first
-        import shutil
+        import shutil  # deferred: optional or conditional (inside a block)
         shutil.rmtree(tmp, ignore_errors=True)
     return root
 
@@ -157,7 +158,6 @@ def materialise(base: Path, name: str, blob: bytes) -> Path:
 def place(root: Path, files: dict[str, bytes]) -> None:
     """Write ``files`` (relative path -> bytes) under ``root``, atomically,
     skipping a file that already holds those bytes."""
-    from rclverify.core.atomic import atomic_write_bytes
     for rel, data in files.items():
         target = _safe_member(root, rel)
         try:

@@ -53,7 +53,7 @@ class ConeUnchanged:
             return ""
 
     def _used_cone(self) -> bool:
-        from rclverify.records.sealed import read_sealed
+        from rclverify.records.sealed import read_sealed  # deferred: start-up (loads rclverify.core, rclverify.core.atomic and more only when called)
         rec, altered = read_sealed(Path(self.provenance))
         if altered or not isinstance(rec, dict) or not isinstance(rec.get("compose"), dict):
             return True

@@ -40,8 +40,8 @@ def save_finished() -> int:
     Never raises: a state that cannot be written now is written by doit at
     the end of the run, as before."""
     try:
-        from doit.dependency import SqliteDB
-        from doit.globals import Globals
+        from doit.dependency import SqliteDB  # deferred: optional or conditional (inside a block)
+        from doit.globals import Globals  # deferred: optional or conditional (inside a block)
     except ImportError:  # pragma: no cover - doit is a dependency
         return 0
     manager = getattr(Globals, "dep_manager", None)

@@ -38,6 +38,7 @@ from rclverify.lang.errors import RclError, error
 from rclverify.stages.workspace import (PLAN, REPORT_PARTS, TaskIndex, Workspace, cone_digests, current_model_hash,  # noqa: F401
                         current_snapshot_hashes, environment_sha, node_snapshots, read_artifact, record_provenance, stage_inputs, stale_stages,
                         write_check_index)
+from rclverify.records.sealed import read_sealed
 
 if TYPE_CHECKING:
     from rclverify.calculus.health.checks import Finding
@@ -53,15 +54,15 @@ def stage_check(ws: Workspace) -> dict[str, Any]:
 
     Returns the diagnostics JSON (lint warnings).  Raises RclError/PlanError.
     """
-    from rclverify.report.contract_texts import ContractTexts
+    from rclverify.report.contract_texts import ContractTexts  # deferred: start-up (loads rclverify.core.cache, rclverify.lang.ast and more only when called)
     checked, model = ws.checked, ws.model
     texts = ContractTexts(ws)  # each file's lint and each node's RCL text, kept by the file's sha256
     warnings = [w for s in checked.specs for w in texts.lint(s)]
     # units across connections: a missing unit (warning), a mismatch (an error row at the producer's end, the run
     # going on: issue 48)
-    from rclverify.model.system.units import producer_diagnostics
+    from rclverify.model.system.units import producer_diagnostics  # deferred: start-up (loads rclverify.lang.ast, rclverify.lang.printer and more only when called)
     warnings += [d.to_json() for d in producer_diagnostics(checked, model.links)]
-    from rclverify.model.system.services import unserved
+    from rclverify.model.system.services import unserved  # deferred: start-up (loads rclverify.lang.ast, rclverify.lang.types and more only when called)
     warnings += [d.to_json() for d in unserved(checked)]  # a call no node answers (W-unserved)
     write_sealed(ws.path(ws.DIAGNOSTICS), {"warnings": warnings})
     hashes: dict[str, str] = {}
@@ -100,7 +101,7 @@ def stage_graph(ws: Workspace) -> str:
     only ``doit graph`` and ``rclverify graph`` need it, and finding the
     model's loops for it took a fifth of the check stage of a 1000-node
     system.  Raises ``RclError`` for contracts or a plan that do not check."""
-    from rclverify.report.diagram import system_dot
+    from rclverify.report.diagram import system_dot  # deferred: start-up (loads jinja2, rclverify.core.cache and more only when called)
     dot = system_dot(ws.model.view({}))
     atomic_write_text(ws.path(ws.DOT), dot)
     return dot
@@ -109,7 +110,7 @@ def stage_graph(ws: Workspace) -> str:
 def stage_compose(ws: Workspace, node: str) -> dict[str, Any]:
     """Apply the calculus to ``node``; writes its JSON and one .smt2 per side condition."""
     fresh_z3()  # the same Z3 state whatever ran before in this process (semantics/world.py)
-    from rclverify.calculus.compose import compose_node, composition_json
+    from rclverify.calculus.compose import compose_node, composition_json  # deferred: start-up (loads lark, yaml and more only when called)
     comp = compose_node(ws.checked, ws.model, node, facts=plan_facts(ws))
     paths = []
     for sc in comp.side_conditions:
@@ -135,7 +136,7 @@ def plan_facts(ws: Workspace) -> dict[str, list[Any]]:
 def stage_health(ws: Workspace, node: str) -> list[dict[str, Any]]:
     """Run the contract health checks of ``node``; writes its findings JSON."""
     fresh_z3()  # the same Z3 state whatever ran before in this process (semantics/world.py)
-    from rclverify.calculus.health.checks import check_node
+    from rclverify.calculus.health.checks import check_node  # deferred: start-up (loads lark, yaml and more only when called)
     facts = [(f.expr, f.loc) for f in ws.plan.facts.get(node, ())]
     checked = check_node(ws.checked, node, facts, ws.plan.instances.get(node))
     if node in ws.plan.replacements:
@@ -163,13 +164,13 @@ def replacement_finding(ws: Workspace, node: str) -> Finding:
     in the replacement file) when it cannot be read, does not check, lacks the
     node, or has a different interface.
     """
-    from rclverify.calculus.refinement import check_refinement, merge_envs, split_spec
-    from rclverify.calculus.health.checks import refinement_finding
-    from rclverify.lang.parser import parse_text
-    from rclverify.lang.typecheck import check
+    from rclverify.calculus.refinement import check_refinement, merge_envs, split_spec  # deferred: start-up (loads lark, yaml and more only when called)
+    from rclverify.calculus.health.checks import refinement_finding  # deferred: start-up (loads lark, yaml and more only when called)
+    from rclverify.lang.parser import parse_text  # deferred: start-up (loads lark, rclverify.core.cache and more only when called)
+    from rclverify.lang.typecheck import check  # deferred: start-up (loads lark, rclverify.core.cache and more only when called)
     spec, loc = ws.plan.replacements[node]
     rel, name = split_spec(spec)
-    from rclverify.lang.source import decode_text
+    from rclverify.lang.source import decode_text  # deferred: start-up (loads rclverify.lang.ast, rclverify.lang.source and more only when called)
     try:
         text = decode_text((ws.root / rel).read_bytes(), rel)
     except OSError as exc:
@@ -188,7 +189,7 @@ def replacement_finding(ws: Workspace, node: str) -> Finding:
 def stage_export(ws: Workspace, node: str) -> list[dict[str, Any]]:
     """Export ``node``'s obligations for every evidence entry of the plan."""
     fresh_z3()  # the same Z3 state whatever ran before in this process (semantics/world.py)
-    from rclverify.backends import get_backend
+    from rclverify.backends import get_backend  # deferred: start-up (loads rclverify.backends, importlib only when called)
     obligations = []
     shared = set(ws.plan.contracts) | {ws.plan.file}
     snapshot = ws.snapshot(node)
@@ -197,7 +198,7 @@ def stage_export(ws: Workspace, node: str) -> list[dict[str, Any]]:
         backend = get_backend(entry.backend)
         for o in backend.export(ws.target(node, entry.index)):
             if o.id in first_entry and first_entry[o.id] is not entry:
-                from rclverify.model.plan.errors import plan_error
+                from rclverify.model.plan.errors import plan_error  # deferred: optional or conditional (inside a block)
                 here = ws.plan.locs.get(("nodes", node, "evidence", entry.index, "backend"), entry.loc)
                 there = first_entry[o.id]
                 raise plan_error(here.file, here.line, here.col,
@@ -223,7 +224,7 @@ def stage_export(ws: Workspace, node: str) -> list[dict[str, Any]]:
 
 def ast_loc(rel: str) -> Any:
     """Line 1, column 1 of the workspace file ``rel`` (a located error about a whole record)."""
-    from rclverify.lang.ast import Loc
+    from rclverify.lang.ast import Loc  # deferred: start-up (loads rclverify.lang.ast, fractions only when called)
     return Loc(rel, 1, 1)
 
 
@@ -233,8 +234,7 @@ def stage_run(ws: Workspace, node: str, obligation_id: str) -> Evidence:
     Raises ``RclError`` when the obligation's record was altered outside
     rclverify (its seal does not hold): the backend is never run on it."""
     fresh_z3()  # the same Z3 state whatever ran before in this process (semantics/world.py)
-    from rclverify.backends import get_backend
-    from rclverify.records.sealed import read_sealed
+    from rclverify.backends import get_backend  # deferred: start-up (loads rclverify.backends, importlib only when called)
     rel = ws.obligation(node, obligation_id)
     raw, altered = read_sealed(ws.path(rel), "obligation record")
     if altered or raw is None:  # never run a backend on an obligation rclverify did not export
@@ -247,14 +247,14 @@ def stage_run(ws: Workspace, node: str, obligation_id: str) -> Evidence:
 
 def stage_requirements(ws: Workspace, *, force: bool = False) -> list[tuple[dict[str, Any], bool]]:
     """Check every requirement with Z3; see :mod:`rclverify.stages.requirements`."""
-    from rclverify.stages.requirements import stage_requirements as run
+    from rclverify.stages.requirements import stage_requirements as run  # deferred: start-up (loads rclverify.stages.requirements only when called)
     return run(ws, force=force)
 
 
 def stage_deadlines(ws: Workspace) -> list[dict[str, Any]]:
     """Decide every end-to-end deadline with Z3 (rule D3); see
     :mod:`rclverify.stages.deadlines`.  Returns the records written."""
-    from rclverify.stages.deadlines import stage_deadlines as run
+    from rclverify.stages.deadlines import stage_deadlines as run  # deferred: start-up (loads yaml, z3 and more only when called)
     return run(ws)[1]
 
 
@@ -270,12 +270,12 @@ def stage_report(ws: Workspace, parts: Sequence[str] = tuple(REPORT_PARTS),
     the paths written; raises ``RclError`` for contracts or a plan that do
     not check, ``KeyError`` for an unknown part and ``OSError`` when a file
     cannot be written."""
-    from rclverify.report import layoutcache
-    from rclverify.report.build import build_report
-    from rclverify.report.fragments import FragmentCache
-    from rclverify.report.parts import FRAGMENTS, write_part
-    from rclverify.core.cache.keys import user_cache_dir
-    from rclverify.report.render import use_bytecode_cache
+    from rclverify.report import layoutcache  # deferred: start-up (loads rclverify.core.cache, rclverify.report and more only when called)
+    from rclverify.report.build import build_report  # deferred: start-up (loads jinja2, lark and more only when called)
+    from rclverify.report.fragments import FragmentCache  # deferred: start-up (loads rclverify.core.cache, rclverify.report and more only when called)
+    from rclverify.report.parts import FRAGMENTS, write_part  # deferred: start-up (loads jinja2, markupsafe and more only when called)
+    from rclverify.core.cache.keys import user_cache_dir  # deferred: start-up (loads rclverify.core.cache and more only when called)
+    from rclverify.report.render import use_bytecode_cache  # deferred: start-up (loads jinja2, markupsafe and more only when called)
     if report is None:
         report = build_report(ws)
     layoutcache.use_directory(ws.path("artifacts/cache/layout"))
@@ -287,7 +287,7 @@ def stage_report(ws: Workspace, parts: Sequence[str] = tuple(REPORT_PARTS),
         paths += write_part(report, out, part, fragments)
         fragments.save()
         if part == "html":  # with assurance.json: what verify prints
-            from rclverify.report.summary import summary_data
+            from rclverify.report.summary import summary_data  # deferred: optional or conditional (inside a block)
             write_sealed(ws.path(ws.SUMMARY), summary_data(report))
     # the one fragment cache of the single report task of earlier versions (38 MB at 1000 nodes)
     ws.path("artifacts/cache/report-fragments.pickle").unlink(missing_ok=True)

@@ -126,12 +126,12 @@ class ProgressReporter(ConsoleReporter):  # type: ignore[misc]
         """Remember doit's task table (it grows when delayed tasks are created),
         and freeze doit's task objects for the run with the workspace
         (:func:`rclverify.core.cache.heap.freeze_for_run`)."""
-        from rclverify.core.cache.heap import freeze_for_run
+        from rclverify.core.cache.heap import freeze_for_run  # deferred: start-up (loads rclverify.core, rclverify.core.cache and more only when called)
         freeze_for_run()
         self.tasks = tasks
         if self.live_mode:
-            from rich.console import Console
-            from rich.live import Live
+            from rich.console import Console  # deferred: optional or conditional (inside a block)
+            from rich.live import Live  # deferred: optional or conditional (inside a block)
             console = Console(file=sys.stdout, force_terminal=True)
             self.live = Live(self._line(), console=console, transient=True, refresh_per_second=4,
                              redirect_stdout=True, redirect_stderr=True, get_renderable=self._line)
@@ -186,14 +186,14 @@ class ProgressReporter(ConsoleReporter):  # type: ignore[misc]
             self.live = None
         super().complete_run()
         if self.verify_root is not None:  # nothing had to run: the last run's status all the same
-            from rclverify.lang.errors import RclError
-            from rclverify.report.summary import print_last_run
+            from rclverify.lang.errors import RclError  # deferred: optional or conditional (inside a block)
+            from rclverify.report.summary import print_last_run  # deferred: optional or conditional (inside a block)
             try:
                 print_last_run(Path(self.verify_root))
             except RclError as exc:  # no report to show, or one of another shape: its one located line
                 self.write("".join(f"{d}\n" for d in exc.diagnostics))
-        from rclverify.core.cache.heap import freeze_at_exit, release_after_run
-        from rclverify.core.runlock import release
+        from rclverify.core.cache.heap import freeze_at_exit, release_after_run  # deferred: start-up (loads rclverify.core, rclverify.core.cache and more only when called)
+        from rclverify.core.runlock import release  # deferred: start-up (loads rclverify.core, rclverify.core.runlock only when called)
         release()  # the workspace's run lock (rclverify.core.runlock): the next run may start
         release_after_run()
         freeze_at_exit()
@@ -207,7 +207,7 @@ class ProgressReporter(ConsoleReporter):  # type: ignore[misc]
             names, running = [], []
         total = sum(1 for name in names if name.startswith("evidence:"))
         obligations = f"{len(self.done)}/{total}" if total else "0/?"
-        from rich.text import Text
+        from rich.text import Text  # deferred: start-up (loads rich and more only when called)
         line = Text()
         line.append(f"{self.stage:<9}", style="bold cyan")
         line.append(f" {obligations} obligations")

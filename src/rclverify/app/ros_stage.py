@@ -18,6 +18,9 @@ from pathlib import Path, PurePosixPath
 from typing import Any
 
 from rclverify.lang import ast
+from rclverify.model.plan.errors import plan_error
+from rclverify.ros.extract import names
+from rclverify.ros.graph.inputs import input_files
 
 GRAPH = "artifacts/ros/graph.json"
 GROUNDING = "artifacts/ros/grounding.json"
@@ -31,7 +34,6 @@ def _paths(ws: Any, key: str, missing: list[Any] | None = None) -> list[Path]:
     """The existing paths of ``ros.<key>``.  A path that leaves the workspace is
     a plan error (raised); one that does not exist is appended to ``missing``
     as ``(loc, message)``: a grounding error, which never stops the pipeline."""
-    from rclverify.model.plan.errors import plan_error
     ros = ws.plan.ros
     vals = ros.get(key, []) or []
     out = []
@@ -51,7 +53,7 @@ def _paths(ws: Any, key: str, missing: list[Any] | None = None) -> list[Path]:
 
 
 def _fields(ws: Any) -> dict[str, list[str]]:
-    import yaml
+    import yaml  # deferred: start-up (loads yaml only when called)
     ros = ws.plan.ros
     out: dict[str, list[str]] = {}
     mapping = ros.get("mapping") or (DEFAULT_MAPPING if (ws.root / DEFAULT_MAPPING).is_file() else None)
@@ -75,9 +77,9 @@ def has_ros(ws: Any) -> bool:
 def stage_ground(ws: Any) -> dict[str, Any]:
     """Scan, ground, write both artifacts; returns the grounding dict
     (``findings``, ``counts``, ``context`` for the GSN argument)."""
-    from rclverify.records.store import atomic_write_text
-    from rclverify.ros.graph.scan import scan
-    from rclverify.ros.ground.ground import ground
+    from rclverify.records.store import atomic_write_text  # deferred: start-up (loads rclverify.core, rclverify.core.atomic and more only when called)
+    from rclverify.ros.graph.scan import scan  # deferred: start-up (loads rclverify.core, rclverify.core.atomic and more only when called)
+    from rclverify.ros.ground.ground import ground  # deferred: start-up (loads rclverify.core, rclverify.core.atomic and more only when called)
     ros = ws.plan.ros
     missing: list[Any] = []
     wss = _paths(ws, "workspaces", missing)
@@ -86,7 +88,7 @@ def stage_ground(ws: Any) -> dict[str, Any]:
     args = {str(k): (str(v).lower() if isinstance(v, bool) else str(v)) for k, v in (ros.get("args") or {}).items()}
     res = scan(wss, launch, args, bags, ws.root / CACHE, base=ws.root)
     plan_loc = ws.plan.locs.get(("ros",), ast.Loc(ws.plan.file, 1, 1))
-    from rclverify.ros.ground.ground import Finding
+    from rclverify.ros.ground.ground import Finding  # deferred: start-up (loads rclverify.core, rclverify.core.atomic and more only when called)
     findings = [Finding("ROS-SCAN", "error", msg, loc, None) for loc, msg in missing]
     findings += ground(res, ws.checked, ws.plan.file, ros, _fields(ws), plan_loc)
     g = res.graph
@@ -104,10 +106,9 @@ def stage_ground(ws: Any) -> dict[str, Any]:
             "launch": [str(p.relative_to(ws.root)) for p in launch],
         },
     }
-    from rclverify.report.diagram import dot_to_svg
-    from rclverify.ros.graph.draw import grounding_dot
-    from rclverify.ros.ground.ground import match_nodes
-    from rclverify.ros.extract import names
+    from rclverify.report.diagram import dot_to_svg  # deferred: start-up (loads jinja2, rclverify.core and more only when called)
+    from rclverify.ros.graph.draw import grounding_dot  # deferred: start-up (loads jinja2, rclverify.ros and more only when called)
+    from rclverify.ros.ground.ground import match_nodes  # deferred: start-up (loads rclverify.core, rclverify.core.atomic and more only when called)
     ignore = {names.normalise(n) for n in ros.get("ignore", []) or []}
     pairs = match_nodes(ws.checked.nodes, {k: v for k, v in g.nodes.items() if k not in ignore},
                         dict(ros.get("nodes", {}) or {}))
@@ -119,9 +120,8 @@ def stage_ground(ws: Any) -> dict[str, Any]:
     if svg is not None:
         atomic_write_text(ws.path(SVG), svg)
     atomic_write_text(ws.path(GRAPH), json.dumps(graph_json, indent=2) + "\n")
-    from rclverify.records.records import hash_inputs
-    from rclverify.records.sealed import write_sealed
-    from rclverify.ros.graph.inputs import input_files
+    from rclverify.records.records import hash_inputs  # deferred: start-up (loads rclverify.records, rclverify.records.records and more only when called)
+    from rclverify.records.sealed import write_sealed  # deferred: start-up (loads rclverify.core, rclverify.core.atomic and more only when called)
     data["inputs"] = hash_inputs(ws.root, input_files(ws))
     write_sealed(ws.path(GROUNDING), data)  # sealed: the report reads it (records/sealed.py)
     return data
@@ -132,8 +132,8 @@ def run_check(root: Path, plan: str, strict: bool, json_out: str | None) -> int:
     any grounding error is found (or the plan/contract cannot be read), else 0.
     ``strict`` is kept for older command lines and changes nothing: an error is
     never a pass (issue 65: 26 errors with exit 0 was a wrong green)."""
-    from rclverify.records.store import atomic_write_text
-    from rclverify.stages.workspace import Workspace
+    from rclverify.records.store import atomic_write_text  # deferred: start-up (loads rclverify.core, rclverify.core.atomic and more only when called)
+    from rclverify.stages.workspace import Workspace  # deferred: start-up (loads rclverify.core, rclverify.core.atomic and more only when called)
     ws = Workspace(root, plan)
     if not has_ros(ws):
         print(f"{ws.plan.file}:1:1: error: the plan has no ros: section (docs/ros.md)", file=sys.stderr)

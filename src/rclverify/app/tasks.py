@@ -66,6 +66,12 @@ from rclverify.app.pipeline import REPORT_PARTS, TaskIndex, Workspace
 from rclverify.model.plan.entries import TOOL_KEYS
 from rclverify.lang.errors import RclError
 from rclverify.stages.workspace import check_input_files
+import sys
+from rclverify.app.pipeline import stage_check, stage_graph, stage_run, stage_report, stage_requirements, stage_deadlines
+from rclverify.records.store import atomic_write_text, EvidenceStore
+from rclverify.app import pipeline
+from rclverify import __version__
+from rclverify.records.sealed import TargetsSealed, obligation_list
 
 if TYPE_CHECKING:
     from rclverify.records.report_schema import Report
@@ -119,12 +125,11 @@ def _io_fail(exc: OSError, root: str, place: str = "artifacts/") -> TaskFailed:
     """A fault of the machine (read-only directory, full disk) as one plain line
     (:mod:`rclverify.core.faults`; ``place``: where the action writes, for an
     error without a file name): the writes are atomic, nothing recorded changed."""
-    from rclverify.core.faults import describe_os_error
+    from rclverify.core.faults import describe_os_error  # deferred: start-up (loads rclverify.core.faults only when called)
     return TaskFailed(describe_os_error(exc, Path(root), place=place))
 
 
 def act_check(root: str, plan_file: str = "contracts/plan.yaml") -> Any:
-    from rclverify.app.pipeline import stage_check
     try:
         out = stage_check(_ws(root, plan_file))
     except RclError as exc:
@@ -137,9 +142,7 @@ def act_check(root: str, plan_file: str = "contracts/plan.yaml") -> Any:
 
 
 def act_graph(root: str) -> Any:
-    from rclverify.records.store import atomic_write_text
-    from rclverify.app.pipeline import stage_graph
-    from rclverify.report.diagram import dot_to_svg
+    from rclverify.report.diagram import dot_to_svg  # deferred: start-up (loads jinja2, rclverify.report and more only when called)
     try:
         dot = stage_graph(_ws(root))
         svg = dot_to_svg(dot)
@@ -178,7 +181,6 @@ def act_node(root: str, node: str, deps: dict[str, list[str]], changed: list[str
 
     ``changed`` is filled by doit (the task's file dependencies that changed
     since its last successful run)."""
-    from rclverify.app import pipeline
     stages = stages_to_run(deps, changed)
     try:
         for stage in stages:
@@ -192,8 +194,7 @@ def act_node(root: str, node: str, deps: dict[str, list[str]], changed: list[str
 
 
 def act_run(root: str, node: str, obligation_id: str) -> Any:
-    from rclverify.app import cluster
-    from rclverify.app.pipeline import stage_run
+    from rclverify.app import cluster  # deferred: start-up (loads rclverify.app.cluster only when called)
     addr = cluster.address()  # RCLVERIFY_CLUSTER: the backend job runs on that Dask cluster
     try:
         if addr is None:
@@ -221,7 +222,6 @@ def act_report(root: str, part: str) -> Any:
     that runs both (``doit`` without ``-n``) builds the report dict once:
     it is kept for the workspace object of this run (:func:`_ws`), which
     a later run (a new :func:`build_tasks`) replaces."""
-    from rclverify.app.pipeline import stage_report
     try:
         ws = _ws(root)
         kept = _REPORTS.get(root)
@@ -240,7 +240,6 @@ def act_report(root: str, part: str) -> Any:
 
 def act_requirements(root: str) -> Any:
     """Check the requirements whose inputs changed (:mod:`rclverify.stages.requirements`)."""
-    from rclverify.app.pipeline import stage_requirements
     try:
         rows = stage_requirements(_ws(root))
     except RclError as exc:
@@ -253,7 +252,6 @@ def act_requirements(root: str) -> Any:
 
 def act_deadlines(root: str) -> Any:
     """Decide the end-to-end deadlines (rule D3, :mod:`rclverify.stages.deadlines`)."""
-    from rclverify.app.pipeline import stage_deadlines
     try:
         records = stage_deadlines(_ws(root))
     except RclError as exc:
@@ -266,7 +264,7 @@ def act_deadlines(root: str) -> Any:
 
 def act_crosscheck(root: str, nodes: list[str]) -> Any:
     """Decide every discharging query again with cvc5 (:mod:`rclverify.stages.crosscheck.stage`, issue 50)."""
-    from rclverify.stages.crosscheck.stage import stage_crosscheck
+    from rclverify.stages.crosscheck.stage import stage_crosscheck  # deferred: start-up (loads rclverify.stages.crosscheck, rclverify.stages.requirements and more only when called)
     try:
         index = stage_crosscheck(Path(root), nodes)
     except OSError as exc:
@@ -280,7 +278,7 @@ def act_crosscheck(root: str, nodes: list[str]) -> Any:
 def act_ground(root: str) -> Any:
     """The grounding stage (docs/ros.md): scan the plan's ``ros:`` section,
     hold the contracts against it; findings go to the report, never to a verdict."""
-    from rclverify.app.ros_stage import stage_ground
+    from rclverify.app.ros_stage import stage_ground  # deferred: start-up (loads rclverify.app.ros_stage, rclverify.lang.ast only when called)
     try:
         data = stage_ground(_ws(root))
     except RclError as exc:
@@ -318,9 +316,8 @@ def act_verify(root: str, strict: bool) -> Any:
     """The ``verify`` task: print the run's status, problems and summary table
     (:func:`rclverify.report.summary.print_last_run`); with ``strict``, fail
     unless every item holds."""
-    from rclverify.app.progress import PlainFailure
-    from rclverify.lang.errors import RclError
-    from rclverify.report.summary import print_last_run, strict_sentence
+    from rclverify.app.progress import PlainFailure  # deferred: start-up (loads doit, rclverify.app.doitstate and more only when called)
+    from rclverify.report.summary import print_last_run, strict_sentence  # deferred: start-up (loads rclverify.report, rclverify.report.summary only when called)
     try:
         data = print_last_run(Path(root))
     except RclError as exc:  # the last run's summary is missing or of another shape: one located line
@@ -360,7 +357,6 @@ class RecordIntact:
             return False
         if values.get("_record_stat") == now["_record_stat"]:
             return True
-        from rclverify.records.store import EvidenceStore
         root, _, name = target.rpartition("/artifacts/evidence/")
         try:
             ev, problem = EvidenceStore(Path(root)).read(name[:-len(".json")])
@@ -400,7 +396,7 @@ def _inputs(config: Any, root: Path, seen: dict[str, tuple[str, ...]]) -> list[s
             if py.endswith(".py") and (root / py).is_file():
                 # a Python implementation (`file.py:callable`): the file and every workspace module it imports,
                 # so that a changed helper exports the obligations, and their inputs, again (issue 63, row 2)
-                from rclverify.backends.property_tests.closure import import_closure
+                from rclverify.backends.property_tests.closure import import_closure  # deferred: optional or conditional (inside a block)
                 k = "\0" + py  # the closure is the file's, whatever callable follows the colon (one walk per file)
                 if k not in seen:
                     seen[k] = tuple(import_closure(root, py)[0])
@@ -431,7 +427,7 @@ def _inputs(config: Any, root: Path, seen: dict[str, tuple[str, ...]]) -> list[s
 def _z3_version() -> str:
     """The installed z3-solver's version (from its metadata: importing Z3 costs a no-op run
     a fifth of a second).  Every verdict comes from Z3, so another version makes them again."""
-    from importlib.metadata import PackageNotFoundError, version
+    from importlib.metadata import PackageNotFoundError, version  # deferred: start-up (loads importlib only when called)
     try:
         return version("z3-solver")
     except PackageNotFoundError:
@@ -439,7 +435,6 @@ def _z3_version() -> str:
 
 
 def _tool_fingerprint() -> dict[str, Any]:
-    from rclverify import __version__
     return {"rclverify": __version__, "dafny": shutil.which("dafny"), "mcapl": os.environ.get("MCAPL_HOME") or os.environ.get("AJPF_HOME"),
             "dot": shutil.which("dot"), "spin": shutil.which("spin")}
 
@@ -458,7 +453,7 @@ def doit_config(dep_file: str = DEP_FILE) -> dict[str, Any]:
     per task with ``ast.literal_eval``, about 0.3 CPU s of a 1000-node no-op
     run when it had 5000 tasks (docs/scale.md).  A workspace that switches store runs
     every task once, as doit knows no earlier state in the new file."""
-    from rclverify.app.progress import ProgressReporter
+    from rclverify.app.progress import ProgressReporter  # deferred: start-up (loads doit, rclverify.app.doitstate and more only when called)
     return {"default_tasks": ["verify"], "verbosity": 2, "dep_file": dep_file, "backend": "sqlite3",
             "reporter": ProgressReporter}
 
@@ -483,7 +478,7 @@ def _use_linear_implicit_task_dep() -> None:
     doit's own has the signature it replaces (``pyproject.toml`` pins the
     doit versions it was checked against; ``tests/test_tasks_doit.py``
     compares the two)."""
-    from doit.control import TaskControl
+    from doit.control import TaskControl  # deferred: start-up (loads doit only when called)
     current = TaskControl.add_implicit_task_dep
     if current is _linear_implicit_task_dep:
         return
@@ -505,9 +500,8 @@ def _guard_dep_writes() -> None:
     a task fails) once per process; what the run wrote is complete (every
     write is atomic), only doit's record of it is lost, so its tasks run
     again next time.  ``SystemExit`` passes through doit's own handler."""
-    import sqlite3
-    import sys
-    from doit.dependency import SqliteDB
+    import sqlite3  # deferred: start-up (loads sqlite3 only when called)
+    from doit.dependency import SqliteDB  # deferred: start-up (loads doit only when called)
 
     def guard(method: Callable[..., Any]) -> Callable[..., Any]:
         def guarded(self: Any, *args: Any) -> Any:
@@ -543,9 +537,8 @@ def build_tasks(root: str | Path, plan_file: str = "contracts/plan.yaml", *,
     cyclic garbage collection and then frozen for the run
     (:mod:`rclverify.core.cache.heap`; the progress reporter gives it back to the
     collector when doit completes the run)."""
-    import sys
-    from rclverify.core import runlock
-    from rclverify.core.faults import describe_os_error
+    from rclverify.core import runlock  # deferred: start-up (loads rclverify.core.runlock only when called)
+    from rclverify.core.faults import describe_os_error  # deferred: start-up (loads rclverify.core.faults only when called)
     rootp = Path(root)
     if not rootp.is_dir():
         print(f"{root}: error: no such workspace directory", file=sys.stderr)
@@ -605,7 +598,6 @@ def _build_tasks(root: str | Path, plan_file: str) -> dict[str, Callable[[], Any
     # a missing plan or contract makes `check` run, and fail with the located message, every time.
     named = [str(rootp / plan_file)] + contract_deps
     check_deps = [d for d in named if os.path.isfile(d)]
-    from rclverify.records.sealed import TargetsSealed  # a sealed record altered outside rclverify is made again
     sealed = TargetsSealed()
     check_extra: dict[str, Any] = {"uptodate": [False] if len(check_deps) < len(named) or not ok else [code, sealed]}
 
@@ -623,7 +615,7 @@ def _build_tasks(root: str | Path, plan_file: str) -> dict[str, Callable[[], Any
 
     def task_node() -> Iterator[dict[str, Any]]:
         """One task per node: its calculus, health checks and exported obligations."""
-        from rclverify.app.conetask import ConeUnchanged
+        from rclverify.app.conetask import ConeUnchanged  # deferred: start-up (loads rclverify.app.conetask only when called)
         assert index is not None  # registered only when ok, i.e. the model was built
         model_json, seen = at(ws.MODEL), dict[str, tuple[str, ...]]()
         yield {"basename": "node", "name": None,
@@ -649,10 +641,10 @@ def _build_tasks(root: str | Path, plan_file: str) -> dict[str, Callable[[], Any
         the evidence and report tasks: doit orders tasks by where their creators are defined, and the
         report parts must run in their usual order after it (their fragment caches, report/fragments.py)."""
         assert index is not None
-        from rclverify.stages.requirements import INDEX
+        from rclverify.stages.requirements import INDEX  # deferred: start-up (loads rclverify.stages.requirements only when called)
         extra: list[str] = []
         if index.requirement_dirs:
-            from rclverify.model.plan.doorstop import doorstop_files
+            from rclverify.model.plan.doorstop import doorstop_files  # deferred: optional or conditional (inside a block)
             for d in index.requirement_dirs:
                 extra += [str(rootp / f) for f in doorstop_files(rootp, d)]
         for configs in index.entries.values():  # recorded runs checked against temporal requirements (docs/plan.md)
@@ -688,7 +680,6 @@ def _build_tasks(root: str | Path, plan_file: str) -> dict[str, Callable[[], Any
         return exported_memo[0]
 
     def read_exported() -> list[tuple[str, dict[str, Any]]]:
-        from rclverify.records.sealed import obligation_list
         out: list[tuple[str, dict[str, Any]]] = []
         for n in nodes:
             records, _ = obligation_list(at(ws.obligations(n)))  # sealed: an altered list is made again first

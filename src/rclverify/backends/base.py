@@ -30,6 +30,7 @@ from rclverify.model.plan.errors import PlanError, plan_error
 from rclverify.model.plan.load import KEY
 from rclverify.lang import ast
 from rclverify.lang.types import Checked, CheckedNode
+from rclverify.backends.timing_scope import scope
 
 
 @dataclass(frozen=True)
@@ -156,7 +157,6 @@ def make_evidence(
     For a timed guarantee a backend that does not check time says so in the
     explanation and ``details["timing"]`` (:mod:`.timing_scope`).
     """
-    from rclverify.backends.timing_scope import scope
     explanation, details = scope(obligation.backend, target.node, obligation.guarantee, explanation, details or {})
     return Evidence(
         obligation=obligation.id, backend=obligation.backend, kind=obligation.kind, status=status,

@@ -24,6 +24,7 @@ from rclverify.model.plan.load import KEY, Plan
 from rclverify.lang import ast
 from rclverify.lang.errors import Diagnostic
 from rclverify.lang.types import Checked
+import json
 
 
 def check_entries(plan: Plan, checked: Checked) -> list[Diagnostic]:
@@ -50,10 +51,10 @@ def check_entries(plan: Plan, checked: Checked) -> list[Diagnostic]:
                 return plan.locs.get(full, _e.loc)
             try:
                 if e.backend == "experiment":
-                    from rclverify.backends.experiment.config import read_config
+                    from rclverify.backends.experiment.config import read_config  # deferred: optional or conditional (inside a block)
                     read_config(plan.root, e.config, len(checked.nodes[node].node.guarantees), loc)
                 elif e.backend == "review":
-                    from rclverify.backends.review.backend import read_record
+                    from rclverify.backends.review.backend import read_record  # deferred: optional or conditional (inside a block)
                     read_record(plan.root, e.config, loc)
                 else:
                     _check_monitors(plan, e.config, loc, checked)
@@ -88,7 +89,6 @@ def _no_repeated_entry(plan: Plan, node: str, entries: Any) -> list[Diagnostic]:
     obligations, which doit refuses as duplicated task names.  (Entries that
     differ but still name their obligations alike are caught when the
     obligations are exported, :func:`rclverify.app.pipeline.stage_export`.)"""
-    import json
     seen: dict[str, ast.Loc] = {}
     out = []
     for e in entries:
@@ -111,8 +111,8 @@ def _shared_topics(plan: Plan, config: Any, checked: Checked, node: str) -> list
     """Located errors of ``node``'s variables that share a topic and would
     read one field (:mod:`.monitors.shared_topics`), under the entry's
     mapping file's rules (none when it does not exist yet)."""
-    from rclverify.backends.monitors.config import DEFAULT_MAPPING, ConfigError, load_mapping
-    from rclverify.backends.monitors.shared_topics import shared_topic_errors
+    from rclverify.backends.monitors.config import DEFAULT_MAPPING, ConfigError, load_mapping  # deferred: start-up (loads lark, z3 and more only when called)
+    from rclverify.backends.monitors.shared_topics import shared_topic_errors  # deferred: start-up (loads rclverify.backends.monitors, rclverify.semantics and more only when called)
     rel = config.get("mapping")
     rules: Any = {}
     if isinstance(rel, (str, type(None))) and (plan.root / (rel or DEFAULT_MAPPING)).is_file():
@@ -130,8 +130,8 @@ def _check_monitors(plan: Plan, config: Any, loc: Any, checked: Checked | None =
     :mod:`.monitors.fieldpaths`) and the entry's ``tolerance``.  A missing
     mapping or trace is left to the export stage (a workspace may record its
     traces after writing the plan).  Raises :class:`PlanError`."""
-    from rclverify.semantics.floatsem import ToleranceError, parse_tolerance
-    from rclverify.backends.monitors.config import DEFAULT_MAPPING, ConfigError, load_mapping
+    from rclverify.semantics.floatsem import ToleranceError, parse_tolerance  # deferred: start-up (loads lark, z3 and more only when called)
+    from rclverify.backends.monitors.config import DEFAULT_MAPPING, ConfigError, load_mapping  # deferred: start-up (loads lark, z3 and more only when called)
     rel = config.get("mapping")
     if not isinstance(rel, (str, type(None))) or not (plan.root / (rel or DEFAULT_MAPPING)).is_file():
         try:
@@ -148,7 +148,7 @@ def _check_monitors(plan: Plan, config: Any, loc: Any, checked: Checked | None =
         l = loc(*exc.path)
         raise plan_error(l.file, l.line, l.col, str(exc)) from None
     if checked is not None and cfg.mapping:
-        from rclverify.backends.monitors.fieldpaths import check_field_paths
+        from rclverify.backends.monitors.fieldpaths import check_field_paths  # deferred: optional or conditional (inside a block)
         diags = check_field_paths(plan.root, cfg.mapping, cfg.msg_dirs, checked)
         if diags:
             raise PlanError(diags)

@@ -25,6 +25,7 @@ from rclverify.lang.timing import seconds
 from rclverify.lang.types import Checked
 from rclverify.lang.walk import subexpressions
 from rclverify.model.system.model import SystemModel
+from rclverify.model.system.services import unserved_parts
 
 #: Verdicts of an end-to-end deadline, as the requirements' statuses.
 PROVED, REFUTED, INCONCLUSIVE = "proved", "refuted", "inconclusive"
@@ -113,7 +114,6 @@ def chains(checked: Checked, model: SystemModel, path: Sequence[str]) -> tuple[l
     triggered by it never fires), and a chain whose last hop answers with
     such a request ends nowhere.  When only such chains exist, the reason
     names the call."""
-    from rclverify.model.system.services import unserved_parts
     dead = unserved_parts(checked)
     found, why = _chains(checked, model, path, dead)
     if found or not dead:

@@ -54,6 +54,11 @@ from rclverify.model.system.model import SystemModel
 from rclverify.calculus.compose import compose_node, split_assumption
 from rclverify.calculus.context import opened_links
 from rclverify.calculus.linear import clauses_under, eliminate, to_rcl
+from rclverify.model.plan.load import all_requirements
+from rclverify.lang.walk import subexpressions
+from rclverify.semantics import world
+from rclverify.lang.typecheck import check
+from rclverify.model.system.model import build
 
 ARITH = (BOOL, INTEGER, NATURAL, REAL)
 
@@ -153,9 +158,8 @@ def targets(sysm: _System) -> tuple[list[Target], list[str]]:
         for k, c in enumerate(internal, 1):
             out.append(Target("side condition", f"{d}.sc{k}", expr_to_rcl(c), prem,
                               enc.formula(c, checked.nodes[d]), d, c))
-    from rclverify.model.plan.load import all_requirements
-    from rclverify.calculus.requirements.check import cone_of, formals_of
-    from rclverify.calculus.requirements.temporal_check import is_temporal
+    from rclverify.calculus.requirements.check import cone_of, formals_of  # deferred: start-up (loads rclverify.calculus.health, rclverify.calculus.requirements and more only when called)
+    from rclverify.calculus.requirements.temporal_check import is_temporal  # deferred: start-up (loads rclverify.calculus.health, rclverify.calculus.requirements and more only when called)
     for req in all_requirements(plan):
         if req.formal is None:
             continue
@@ -304,7 +308,7 @@ def render(q: Quotient, target_texts: Mapping[str, str] | None = None) -> str:
     """The command's output: RCL comment lines saying what the contract
     serves, how it was computed and re-checked, then the node block
     (jinja2 template ``calculus/templates/quotient.rcl.j2``)."""
-    import jinja2
+    import jinja2  # deferred: start-up (loads jinja2 only when called)
     env = jinja2.Environment(loader=jinja2.PackageLoader("rclverify.calculus", "templates"), autoescape=False,
                              keep_trailing_newline=True, trim_blocks=True, lstrip_blocks=True)
     texts = target_texts or {}
@@ -357,7 +361,6 @@ def _approximate(sysm: _System, tgts: Sequence[Target]) -> str:
 
 
 def _vars(e: ast.Expr) -> list[ast.Var]:
-    from rclverify.lang.walk import subexpressions
     return [v for v in subexpressions(e) if isinstance(v, ast.Var)]
 
 
@@ -393,10 +396,7 @@ def _recheck(checked: Checked, plan: Any, node: str, block: str,
              tgts: Sequence[Target]) -> list[tuple[str, str, str]]:
     """Every target's verdict with ``block`` in place of ``node`` (module
     docstring): ``(id, verdict, the SMT-LIB2 script it was decided from)``."""
-    from rclverify.semantics import world
-    from rclverify.lang.typecheck import check
-    from rclverify.calculus.requirements.check import check_requirement
-    from rclverify.model.system.model import build
+    from rclverify.calculus.requirements.check import check_requirement  # deferred: start-up (loads rclverify.calculus.health, rclverify.calculus.requirements and more only when called)
     file = checked.nodes[node].node.loc.file
     [new] = parse_text(block, file).nodes
     specs = [ast.Spec(s.contexts, tuple(new if x.name == node else x for x in s.nodes), s.file) for s in checked.specs]
@@ -415,7 +415,6 @@ def _recheck(checked: Checked, plan: Any, node: str, block: str,
     for t in tgts:
         if t.kind == "side condition":
             out.append((t.id, *verdicts.get(t.id, ("absent", ""))))
-    from rclverify.model.plan.load import all_requirements
     reqs = {r.id: r for r in all_requirements(plan)}
     for t in tgts:
         if t.kind == "requirement":
@@ -436,7 +435,6 @@ def _compare(cn: Any, a_text: str, g_text: str, checked: Checked, model: SystemM
     n = cn.node
     if not n.assumes and not n.guarantees:
         return []
-    from rclverify.semantics import world
     world.fresh()
     enc = Encoder(checked.env, model.alias())
     a_new, g_new = enc.formula(parse_formula(a_text), cn), enc.formula(parse_formula(g_text), cn)

@@ -63,6 +63,7 @@ from rclverify.semantics.query import query_solver
 from rclverify.model.system.model import SystemModel
 from rclverify.calculus.context import NEGATED, ContextResult, _multi_path, _node_premises
 from rclverify.calculus.smttext import SORTS, quote, to_smt
+from rclverify.semantics.retry import has_quantifier
 
 #: Budget of each quantifier elimination and each check of a summary (milliseconds).
 QE_MS = 2_000
@@ -237,7 +238,6 @@ def _eliminate(ctx: z3.Context, decls: str, bodies: Sequence[str], hidden: Seque
         xs = _bound(ctx, fs, bodies, hidden, sorts)
         if xs:
             body = z3.Exists(xs, body)
-    from rclverify.semantics.retry import has_quantifier
     for qe in ("qe2", "qe"):  # model-based projection first: a clean conjunction, and faster (docs/calculus.md)
         g = z3.Goal(ctx=ctx)
         g.add(body)

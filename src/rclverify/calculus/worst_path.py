@@ -24,6 +24,7 @@ from typing import Any, Sequence
 from rclverify.lang.types import Checked
 from rclverify.model.system.model import SystemModel
 from rclverify.calculus.deadlines import INCONCLUSIVE, PROVED, REFUTED, _show, chains, decide
+import itertools
 
 #: The largest number of paths from A to B examined.
 MAX_PATHS = 200
@@ -31,7 +32,7 @@ MAX_PATHS = 200
 
 def _graph(model: SystemModel) -> Any:
     """The links of ``model`` as a networkx ``DiGraph`` over its nodes."""
-    import networkx as nx
+    import networkx as nx  # deferred: start-up (loads networkx only when called)
     g = nx.DiGraph()
     g.add_nodes_from(model.nodes)
     g.add_edges_from((lk.from_node, lk.to_node) for lk in model.links)
@@ -40,7 +41,7 @@ def _graph(model: SystemModel) -> Any:
 
 def _between(g: Any, first: str, last: str) -> set[str]:
     """The nodes of ``g`` reachable from ``first`` that reach ``last`` (both included)."""
-    import networkx as nx
+    import networkx as nx  # deferred: start-up (loads networkx only when called)
     return (nx.descendants(g, first) | {first}) & (nx.ancestors(g, last) | {last})
 
 
@@ -52,9 +53,8 @@ def other_paths(model: SystemModel, path: Sequence[str]) -> tuple[list[tuple[str
     nodes: the same paths in the same order, without walking the rest of
     the system (a 1000-node system with loops downstream of the deadline
     took minutes to enumerate before)."""
-    import itertools
 
-    import networkx as nx
+    import networkx as nx  # deferred: start-up (loads networkx only when called)
     g = _graph(model)
     if path[0] not in g or path[-1] not in g or len(path) < 2:
         return [], False

@@ -15,5 +15,5 @@ def main(argv: list[str] | None = None) -> int:
     """The ``rclverify`` command's entry point (pyproject's ``rclverify.cli:main``):
     :func:`rclverify.cli.commands.main`, imported when called so that
     importing a command group does not load every command."""
-    from rclverify.cli.commands import main as run
+    from rclverify.cli.commands import main as run  # deferred: start-up (loads rclverify.cli.bundle, rclverify.cli.calculus and more only when called)
     return run(argv)

@@ -12,11 +12,11 @@ from rclverify.cli.common import AddCommand, no_wait_option, run_lock, workspace
 
 def cmd_bundle(args: argparse.Namespace) -> int:
     """Write the assessor's bundle, or (``--verify FILE``) check one against its manifest."""
-    from rclverify.report.bundle.archive import verify_bundle, write_bundle
-    from rclverify.report.bundle.manifest import BundleError
+    from rclverify.report.bundle.archive import verify_bundle, write_bundle  # deferred: start-up (loads yaml, z3 and more only when called)
+    from rclverify.report.bundle.manifest import BundleError  # deferred: start-up (loads yaml, z3 and more only when called)
     if args.recheck:
         return _bundle_recheck(args.recheck)
-    from rclverify.report.bundle import signature
+    from rclverify.report.bundle import signature  # deferred: start-up (loads cryptography, yaml and more only when called)
     if args.keygen:
         try:
             public = signature.write_key_pair(Path(args.keygen))
@@ -66,15 +66,15 @@ def cmd_bundle(args: argparse.Namespace) -> int:
 def _report_out_of_date(ws: Any) -> list[str]:
     """Why the written report no longer says what the recorded artifacts say
     (:func:`rclverify.report.bundle.fresh.report_out_of_date`)."""
-    from rclverify.report.bundle.fresh import report_out_of_date
+    from rclverify.report.bundle.fresh import report_out_of_date  # deferred: start-up (every command module loads when rclverify starts: cli/common.py)
     return report_out_of_date(ws)
 
 
 def _bundle_recheck(archive: str) -> int:
     """``bundle --recheck``: re-decide every stored query of ``archive`` with both solvers (docs/second-solver.md)."""
-    from rclverify.report.bundle.archive import scan_members
-    from rclverify.report.bundle.manifest import BundleError
-    from rclverify.stages.crosscheck.recheck import recheck_members
+    from rclverify.report.bundle.archive import scan_members  # deferred: start-up (loads yaml, z3 and more only when called)
+    from rclverify.report.bundle.manifest import BundleError  # deferred: start-up (loads yaml, z3 and more only when called)
+    from rclverify.stages.crosscheck.recheck import recheck_members  # deferred: start-up (loads rclverify.core, rclverify.core.atomic and more only when called)
     records: dict[str, bytes] = {}
     try:  # streamed under --verify's limits and member-name rules; only the records kept (issue 63, row 8)
         scan_members(Path(archive), None, records)

@@ -11,8 +11,8 @@ from rclverify.cli.common import AddCommand, emit, workspace_of
 
 def cmd_graph(args: argparse.Namespace) -> int:
     """Write the system model as DOT (``-o FILE``, default under artifacts/) and as SVG when Graphviz is there."""
-    from rclverify.app.pipeline import stage_check, stage_graph
-    from rclverify.report.diagram import dot_to_svg
+    from rclverify.app.pipeline import stage_check, stage_graph  # deferred: start-up (loads rclverify.app, rclverify.app.pipeline and more only when called)
+    from rclverify.report.diagram import dot_to_svg  # deferred: start-up (loads jinja2, rclverify.core and more only when called)
     ws = workspace_of(args)
     stage_check(ws)
     dot = stage_graph(ws)
@@ -32,7 +32,7 @@ def cmd_graph(args: argparse.Namespace) -> int:
 
 def cmd_compose(args: argparse.Namespace) -> int:
     """Apply the calculus to every node and print its rules, side conditions (a counterexample for one not discharged), instances and derived property; exit 1 when a side condition is not discharged."""
-    from rclverify.app.pipeline import stage_check, stage_compose
+    from rclverify.app.pipeline import stage_check, stage_compose  # deferred: start-up (loads rclverify.app, rclverify.app.pipeline and more only when called)
     ws = workspace_of(args)
     stage_check(ws)
     bad = 0
@@ -56,8 +56,8 @@ def cmd_compose(args: argparse.Namespace) -> int:
                 for h in sc.get("hypotheses", []):
                     print(f"      producer: {h}")
             if sc["model"]:
-                from rclverify.diagnosis.table import counterexample_table
-                from rclverify.diagnosis.text import table_lines
+                from rclverify.diagnosis.table import counterexample_table  # deferred: optional or conditional (inside a block)
+                from rclverify.diagnosis.text import table_lines  # deferred: optional or conditional (inside a block)
                 print("      counterexample:")
                 print("\n".join(table_lines(counterexample_table(sc["model"], n), "        ")))
             bad += sc["status"] != "discharged"
@@ -71,7 +71,7 @@ def cmd_compose(args: argparse.Namespace) -> int:
 
 def cmd_health(args: argparse.Namespace) -> int:
     """Run the contract health checks of ``args.nodes`` (default: every node) and print each finding; exit 1 on a problem, 2 for an unknown node."""
-    from rclverify.app.pipeline import stage_check, stage_health
+    from rclverify.app.pipeline import stage_check, stage_health  # deferred: start-up (loads rclverify.app, rclverify.app.pipeline and more only when called)
     ws = workspace_of(args)
     stage_check(ws)
     problems = 0
@@ -89,7 +89,7 @@ def cmd_health(args: argparse.Namespace) -> int:
 
 def cmd_export(args: argparse.Namespace) -> int:
     """Export every node's obligations to the plan's backends and print each one."""
-    from rclverify.app.pipeline import stage_check, stage_export
+    from rclverify.app.pipeline import stage_check, stage_export  # deferred: start-up (loads rclverify.app, rclverify.app.pipeline and more only when called)
     ws = workspace_of(args)
     stage_check(ws)
     for n in ws.node_names():
@@ -102,9 +102,9 @@ def cmd_quotient(args: argparse.Namespace) -> int:
     """Print (or write, ``-o FILE``) the weakest contract of ``args.node``
     (:mod:`rclverify.calculus.quotient`); a contract that cannot be given is
     one ``error:`` line, exit 1."""
-    from rclverify.calculus.quotient import QuotientError, quotient, render
-    from rclverify.stages.crosscheck.stage import confirm_proof  # each proved re-check confirmed by cvc5 (docs/second-solver.md)
-    from rclverify.stages.workspace import Workspace
+    from rclverify.calculus.quotient import QuotientError, quotient, render  # deferred: start-up (loads lark, yaml and more only when called)
+    from rclverify.stages.crosscheck.stage import confirm_proof  # each proved re-check confirmed by cvc5 (docs/second-solver.md); deferred: start-up (loads rclverify.core, rclverify.core.atomic and more only when called)
+    from rclverify.stages.workspace import Workspace  # deferred: start-up (loads rclverify.core, rclverify.core.atomic and more only when called)
     ws = Workspace(Path(args.workspace), args.plan, interface_only=(args.node,))
     try:
         q = quotient(ws.checked, ws.model, ws.plan, args.node, confirm=confirm_proof)
@@ -116,8 +116,8 @@ def cmd_quotient(args: argparse.Namespace) -> int:
 
 def cmd_refines(args: argparse.Namespace) -> int:
     """May the replacement contract replace the original? Z3, each proved side confirmed by cvc5; the exit code of :func:`rclverify.calculus.refinement.refines_main`."""
-    from rclverify.calculus.refinement import refines_main
-    from rclverify.stages.crosscheck.stage import confirm_proof  # each proved side confirmed by cvc5 (docs/second-solver.md)
+    from rclverify.calculus.refinement import refines_main  # deferred: start-up (loads lark, yaml and more only when called)
+    from rclverify.stages.crosscheck.stage import confirm_proof  # each proved side confirmed by cvc5 (docs/second-solver.md); deferred: start-up (loads rclverify.core, rclverify.core.atomic and more only when called)
     return refines_main(args.original, args.replacement, assumes=getattr(args, "assume", None) or (),
                         confirm=confirm_proof)
 

@@ -43,17 +43,17 @@ from rclverify.lang.errors import RclError
 
 
 def _ros(sub: Any) -> None:
-    from rclverify.cli.ros import add_parsers
+    from rclverify.cli.ros import add_parsers  # deferred: start-up (loads rclverify.cli.ros only when called)
     add_parsers(sub)
 
 
 def _generate(sub: Any) -> None:
-    from rclverify.cli.generate import add_parsers
+    from rclverify.cli.generate import add_parsers  # deferred: start-up (loads rclverify.cli.generate only when called)
     add_parsers(sub)
 
 
 def _lsp(sub: Any) -> None:
-    from rclverify.cli.lsp import add_parsers
+    from rclverify.cli.lsp import add_parsers  # deferred: start-up (loads rclverify.cli.lsp only when called)
     add_parsers(sub)
 
 
@@ -93,7 +93,7 @@ def _reader_left() -> int:
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``rclverify`` console script; returns the exit code."""
     p = argparse.ArgumentParser(prog="rclverify", description="Compositional verification from RCL contracts.")
-    from rclverify import __version__
+    from rclverify import __version__  # deferred: start-up (every command module loads when rclverify starts: cli/common.py)
     p.add_argument("--version", action="version", version=f"rclverify {__version__}")
     sub = p.add_subparsers(dest="command", required=True)
 
@@ -117,7 +117,7 @@ def main(argv: Sequence[str] | None = None) -> int:
 
 def _run(args: argparse.Namespace) -> int:
     """Run the command ``args`` chose; every fault of the user or the machine is one plain line."""
-    from rclverify.core.runlock import RunInProgress
+    from rclverify.core.runlock import RunInProgress  # deferred: start-up (loads rclverify.core, rclverify.core.runlock only when called)
     try:
         code = int(args.fn(args))
         if not sys.stdout.closed:  # the language server closes its stdout at `exit`
@@ -133,7 +133,7 @@ def _run(args: argparse.Namespace) -> int:
     except KeyboardInterrupt:
         return 130
     except OSError as exc:  # a fault of the machine (read-only directory, full disk): one plain line
-        from rclverify.core.faults import describe_os_error
+        from rclverify.core.faults import describe_os_error  # deferred: optional or conditional (inside a block)
         root = getattr(args, "workspace", None)
         print(describe_os_error(exc, Path(root).resolve() if root else None), file=sys.stderr)
         return 1

@@ -49,21 +49,21 @@ def emit(text: str, output: str | None) -> int:
     if output is None:
         print(text, end="")
         return 0
-    from rclverify.lang.output import write_atomic
+    from rclverify.lang.output import write_atomic  # deferred: start-up (loads rclverify.lang.ast, rclverify.lang.output and more only when called)
     write_atomic(Path(output), text)
     return 0
 
 
 def workspace_of(args: argparse.Namespace) -> Workspace:
     """The :class:`~rclverify.stages.workspace.Workspace` of ``args.workspace`` and ``args.plan``."""
-    from rclverify.stages.workspace import Workspace
+    from rclverify.stages.workspace import Workspace  # deferred: start-up (loads rclverify.core, rclverify.core.atomic and more only when called)
     return Workspace(Path(args.workspace), args.plan)
 
 
 def io_error(path: Path, message: str) -> Any:
     """A located ``E-io`` diagnostic at line 1 of ``path``."""
-    from rclverify.lang.ast import Loc
-    from rclverify.lang.errors import error
+    from rclverify.lang.ast import Loc  # deferred: start-up (loads rclverify.lang.ast, fractions only when called)
+    from rclverify.lang.errors import error  # deferred: start-up (every command module loads when rclverify starts: cli/common.py)
     return error(Loc(str(path), 1, 1), message, "E-io")
 
 
@@ -76,7 +76,7 @@ def run_lock(args: argparse.Namespace) -> Iterator[None]:
     make it exit 1 instead (:class:`~rclverify.core.runlock.RunInProgress`,
     printed by :func:`main`).  Released at the end of the block; a lock this
     process already held stays held."""
-    from rclverify.core import runlock
+    from rclverify.core import runlock  # deferred: start-up (every command module loads when rclverify starts: cli/common.py)
     root = Path(args.workspace)
     took = False
     # no workspace or no plan: the command fails with its own located error, and no

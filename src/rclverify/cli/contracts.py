@@ -15,16 +15,16 @@ def cmd_check(args: argparse.Namespace) -> int:
     :func:`rclverify.model.plan.scopes.group_files` (the plan's system together,
     a replacement contract in its own scope; docs/rcl-language.md).  Every
     scope is checked; exit 1 when one has an error."""
-    from rclverify.model.plan.scopes import group_files, plan_diagnostics
-    from rclverify.lang.filewarn import file_warnings
-    from rclverify.lang.lint import lint
-    from rclverify.lang.parser import parse_files
-    from rclverify.lang.typecheck import check
-    from rclverify.model.system.services import unserved
+    from rclverify.model.plan.scopes import group_files, plan_diagnostics  # deferred: start-up (every command module loads when rclverify starts: cli/common.py)
+    from rclverify.lang.filewarn import file_warnings  # deferred: start-up (loads rclverify.lang.ast, rclverify.lang.filewarn and more only when called)
+    from rclverify.lang.lint import lint  # deferred: start-up (loads rclverify.lang.ast, rclverify.lang.lint and more only when called)
+    from rclverify.lang.parser import parse_files  # deferred: start-up (loads lark, rclverify.core and more only when called)
+    from rclverify.lang.typecheck import check  # deferred: start-up (loads lark, rclverify.core and more only when called)
+    from rclverify.model.system.services import unserved  # deferred: start-up (loads rclverify.lang.ast, rclverify.lang.types and more only when called)
     grouped = group_files(args.files, args.workspace, args.plan)
     for note in grouped.notes:
         print(note, file=sys.stderr)
-    from rclverify.lang.errors import Diagnostic
+    from rclverify.lang.errors import Diagnostic  # deferred: start-up (every command module loads when rclverify starts: cli/common.py)
     errors: list[Diagnostic] = []
     warnings: list[Diagnostic] = []
     for scope in grouped.scopes:
@@ -37,12 +37,12 @@ def cmd_check(args: argparse.Namespace) -> int:
             errors += exc.diagnostics
             continue
         warnings += [d for s in specs for d in file_warnings(s)] + [d for s in specs for d in lint(s)]
-        from rclverify.model.system.model import unit_diagnostics  # units at both ends of each connection (docs/rcl-language.md)
+        from rclverify.model.system.model import unit_diagnostics  # units at both ends of each connection (docs/rcl-language.md); deferred: optional or conditional (inside a block)
         for d in unit_diagnostics(checked):
             (errors if d.severity == "error" else warnings).append(d)
         if scope.why == "the plan's system" or (grouped.plan and len(grouped.scopes) == 1):
             # the plan's statements (formal:, deadline:, ...) against the system they name (docs/requirements.md)
-            from rclverify.backends.entry_checks import check_entries  # the evidence entries too (docs/plan.md)
+            from rclverify.backends.entry_checks import check_entries  # the evidence entries too (docs/plan.md); deferred: optional or conditional (inside a block)
             found, note = plan_diagnostics(scope.files, checked, args.workspace, args.plan, check_entries)
             errors += [cast(Diagnostic, d) for d in found if getattr(d, "severity", "error") == "error"]
             if note:
@@ -60,9 +60,9 @@ def cmd_check(args: argparse.Namespace) -> int:
 
 def cmd_latex(args: argparse.Namespace) -> int:
     """Print (or write, ``-o FILE``) the contracts of ``args.file`` as LaTeX, type-checked first."""
-    from rclverify.lang.latex import to_latex
-    from rclverify.lang.parser import parse_file
-    from rclverify.lang.typecheck import check
+    from rclverify.lang.latex import to_latex  # deferred: start-up (loads jinja2, rclverify.lang.ast and more only when called)
+    from rclverify.lang.parser import parse_file  # deferred: start-up (loads lark, rclverify.core and more only when called)
+    from rclverify.lang.typecheck import check  # deferred: start-up (loads lark, rclverify.core and more only when called)
     spec = parse_file(args.file)
     check([spec])
     return emit(to_latex(spec), args.output)
@@ -70,8 +70,8 @@ def cmd_latex(args: argparse.Namespace) -> int:
 
 def cmd_fmt(args: argparse.Namespace) -> int:
     """Print (or write, ``-o FILE``) the contracts of ``args.file`` in canonical RCL."""
-    from rclverify.lang.parser import parse_file
-    from rclverify.lang.printer import to_rcl
+    from rclverify.lang.parser import parse_file  # deferred: start-up (loads lark, rclverify.core and more only when called)
+    from rclverify.lang.printer import to_rcl  # deferred: start-up (loads rclverify.lang.ast, rclverify.lang.printer and more only when called)
     return emit(to_rcl(parse_file(args.file)), args.output)
 
 

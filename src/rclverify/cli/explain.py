@@ -15,7 +15,7 @@ def cmd_status(args: argparse.Namespace) -> int:
     ``artifacts/report/summary.json`` (the JSON report when there is none);
     runs nothing.  Exit 0; 1 (one located line) when neither is there or the
     file read is of another shape (:mod:`rclverify.report.lastrun`)."""
-    from rclverify.report.summary import print_last_run
+    from rclverify.report.summary import print_last_run  # deferred: start-up (loads rclverify.records, rclverify.records.records and more only when called)
     print_last_run(Path(args.workspace))
     return 0
 
@@ -27,8 +27,8 @@ def cmd_explain(args: argparse.Namespace) -> int:
     diagnosis, problem number, SARIF rule, ROS or lint code, argument
     element).  Exit 0; 1 (one located line, with the closest ids) for an
     unknown id or a report of another shape."""
-    from rclverify.report.explain import explain, id_kinds, near_ids
-    from rclverify.report.lastrun import located, read_report
+    from rclverify.report.explain import explain, id_kinds, near_ids  # deferred: start-up (loads rclverify.diagnosis, rclverify.diagnosis.table and more only when called)
+    from rclverify.report.lastrun import located, read_report  # deferred: start-up (loads rclverify.lang.ast, rclverify.report and more only when called)
     root = Path(args.workspace)
     report = read_report(root)
     extra = []
@@ -44,7 +44,7 @@ def cmd_explain(args: argparse.Namespace) -> int:
         raise located(root / "reports/assurance.json", f"not an rclverify report: cannot read it ({exc!r}); "
                       "run `rclverify verify` (or `doit verify`) to write it again") from None
     if lines is None:  # an unverified guarantee, a derived property: a finding with no record of its own
-        from rclverify.diagnosis.text import finding_lines
+        from rclverify.diagnosis.text import finding_lines  # deferred: optional or conditional (inside a block)
         lines = finding_lines(report, args.id) or None
     if lines is not None:
         print("\n".join(lines))

@@ -31,9 +31,9 @@ def add_parsers(sub: Any) -> None:
 
 def cmd_ros2(args: argparse.Namespace) -> int:
     """Check the workspace's contracts and write the tree; prints what changed and the logic files to read."""
-    from rclverify.stages.workspace import Workspace
-    from rclverify.backends.monitors.config import ConfigError
-    from rclverify.tools.generate.writer import GenerateError, write_tree
+    from rclverify.stages.workspace import Workspace  # deferred: start-up (loads rclverify.core, rclverify.core.atomic and more only when called)
+    from rclverify.backends.monitors.config import ConfigError  # deferred: start-up (loads lark, yaml and more only when called)
+    from rclverify.tools.generate.writer import GenerateError, write_tree  # deferred: start-up (loads jinja2, lark and more only when called)
     ws = Path(args.workspace)
     checked = Workspace(ws, args.plan).checked  # raises RclError, printed located by main
     system = args.system or ws.resolve().name
@@ -61,8 +61,8 @@ def monitor_rules(ws: Path, plan: str) -> tuple[Any, Any]:
     first ``monitors`` evidence entry of the plan naming a ``mapping`` (its ``tolerance``
     overriding the file's; not the ``rclverify_mapping.yaml`` this command writes), else the default mapping file (``backends/monitors/mapping.yaml``,
     absent: no rules).  Raises ``ConfigError`` (located) for a malformed mapping file."""
-    from rclverify.backends.monitors.config import load_mapping
-    from rclverify.model.plan.load import load_plan
+    from rclverify.backends.monitors.config import load_mapping  # deferred: start-up (loads lark, yaml and more only when called)
+    from rclverify.model.plan.load import load_plan  # deferred: start-up (loads yaml, rclverify.lang and more only when called)
     rel, tol = None, None
     p = load_plan(ws, plan)
     for e in (e for es in p.evidence.values() for e in es if e.backend == "monitors"):

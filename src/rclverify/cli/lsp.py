@@ -31,5 +31,5 @@ def cmd_lsp(args: argparse.Namespace) -> int:
     if args.workspace and not Path(args.workspace).is_dir():
         print(f"{args.workspace}: error: no such workspace directory", file=sys.stderr)
         return 2
-    from rclverify.tools.lsp.server import serve
+    from rclverify.tools.lsp.server import serve  # deferred: start-up (loads lsprotocol, pygls and more only when called)
     return serve(Path(args.workspace) if args.workspace else None, args.plan)

@@ -58,7 +58,7 @@ def monitor_command(args: argparse.Namespace, checked: Checked) -> int:
     except ConfigError as exc:
         print(f"{exc}" if exc.located else f"{args.mapping or 'rclverify monitor'}: error: {exc}", file=sys.stderr)
         return 2
-    from rclverify.backends.monitors.shared_topics import shared_topic_errors  # two variables on one topic read distinct fields (issue 64)
+    from rclverify.backends.monitors.shared_topics import shared_topic_errors  # two variables on one topic read distinct fields (issue 64); deferred: start-up (every command module loads when rclverify starts: cli/common.py)
     shared = [d for n in checked.nodes for d in shared_topic_errors(checked, n, cfg.rules, cfg.mapping or
                                                                    "backends/monitors/mapping.yaml")]
     if shared:
@@ -212,15 +212,15 @@ def live_command(args: argparse.Namespace, checked: Any, cfg: Any, root: Path) -
     status 1 when a contract was violated (a topic, a call, a deadline), 0
     otherwise, 2 when ROS 1, the DDS domain or a message type is unavailable
     (one message on stderr)."""
-    import signal
-    import threading
-    from functools import partial
+    import signal  # deferred: start-up (loads signal only when called)
+    import threading  # deferred: start-up (every command module loads when rclverify starts: cli/common.py)
+    from functools import partial  # deferred: start-up (every command module loads when rclverify starts: cli/common.py)
 
-    import os
+    import os  # deferred: start-up (every command module loads when rclverify starts: cli/common.py)
 
-    from rclverify.runtime.live import LiveRun, run_ros1
-    from rclverify.runtime.ros1 import RosUnavailable
-    from rclverify.ros.live.dds import DdsUnavailable
+    from rclverify.runtime.live import LiveRun, run_ros1  # deferred: start-up (loads rclverify.records, rclverify.records.records and more only when called)
+    from rclverify.runtime.ros1 import RosUnavailable  # deferred: start-up (every command module loads when rclverify starts: cli/common.py)
+    from rclverify.ros.live.dds import DdsUnavailable  # deferred: start-up (every command module loads when rclverify starts: cli/common.py)
     if args.traces:
         print("rclverify monitor: error: --live takes no TRACE (it monitors the running system)", file=sys.stderr)
         return 2
@@ -241,7 +241,7 @@ def live_command(args: argparse.Namespace, checked: Any, cfg: Any, root: Path) -
     run_class: Any = LiveRun
     extra: dict[str, Any] = {}
     if enforce_items:
-        from rclverify.runtime.enforce import EnforceUsage, EnforcingRun, fail_open, parse_enforce
+        from rclverify.runtime.enforce import EnforceUsage, EnforcingRun, fail_open, parse_enforce  # deferred: optional or conditional (inside a block)
         try:
             extra["guarded"] = parse_enforce(enforce_items)
             extra["open_topics"] = fail_open(enforce_items)
@@ -263,12 +263,12 @@ def live_command(args: argparse.Namespace, checked: Any, cfg: Any, root: Path) -
         verdict_topic=args.verdict_topic, last_prefix=args.verdict_topic.rsplit("/", 1)[0] or "/rclverify",
         node_name="rclverify_monitor", duration=args.duration, tick_s=0.02, status_s=args.status, stop=stop,
         evidence=Path(args.evidence) if args.evidence else None, out=lambda line: print(line, flush=True))
-    from rclverify.runtime.service_proxy import ProxyUsage, proxy_factory
+    from rclverify.runtime.service_proxy import ProxyUsage, proxy_factory  # deferred: start-up (loads rclverify.runtime, rclverify.runtime.ros1 and more only when called)
     interfaces = [root / d for d in getattr(args, "interfaces", [])]
     try:
         if ros == "2":
-            from rclverify.runtime.dds.bag import storage_of
-            from rclverify.runtime.dds.live import run_dds
+            from rclverify.runtime.dds.bag import storage_of  # deferred: optional or conditional (inside a block)
+            from rclverify.runtime.dds.live import run_dds  # deferred: optional or conditional (inside a block)
             msg_dirs = [root / d for d in cfg.msg_dirs]
             rec = (Path(record), storage_of(Path(record), getattr(args, "record_storage", None))) if record else None
             record_ = run_dds(factory, checked, nodes, msg_dirs + interfaces, **common,
@@ -314,10 +314,10 @@ def oracle_command(args: argparse.Namespace, checked: Checked) -> int:
     the pipeline) as a ROSMonitoring oracle (WebSocket, :mod:`.oracle`) until
     SIGINT/SIGTERM.  Exit 2 for a port that cannot be bound or a configuration
     that cannot be read."""
-    import asyncio
-    import signal
+    import asyncio  # deferred: start-up (loads asyncio only when called)
+    import signal  # deferred: start-up (loads signal only when called)
 
-    from rclverify.runtime.oracle import serve
+    from rclverify.runtime.oracle import serve  # deferred: start-up (loads rclverify.runtime, rclverify.runtime.oracle and more only when called)
     root = Path(args.workspace)
     try:
         cfg = load_mapping(root, args.mapping, args.horizon)

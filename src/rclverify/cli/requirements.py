@@ -22,8 +22,8 @@ def show_requirements(ws: "Workspace", out: TextIO) -> int:
     the artifacts recorded so far), the premises a proof used and, for a
     refuted one, the counterexample node by node.  Returns the exit code:
     1 when one is refuted, proved from an inconsistency or inconclusive."""
-    from rclverify.report.build import build_report
-    from rclverify.report.explain import requirement_lines
+    from rclverify.report.build import build_report  # deferred: start-up (loads jinja2, lark and more only when called)
+    from rclverify.report.explain import requirement_lines  # deferred: start-up (loads rclverify.diagnosis, rclverify.diagnosis.table and more only when called)
     report = build_report(ws)
     bad = 0
     for r in report["requirements"]:
@@ -36,7 +36,7 @@ def cmd_requirements(args: argparse.Namespace) -> int:
     """Check the requirements (only those whose inputs changed, unless
     ``--force``) and print each with its status; exit 1 when one is refuted,
     proved from an inconsistency or inconclusive."""
-    from rclverify.app.pipeline import stage_check, stage_requirements
+    from rclverify.app.pipeline import stage_check, stage_requirements  # deferred: start-up (loads rclverify.app, rclverify.app.pipeline and more only when called)
     ws = workspace_of(args)
     stage_check(ws)
     stage_requirements(ws, force=args.force)
@@ -48,9 +48,9 @@ def cmd_deadlines(args: argparse.Namespace) -> int:
     calculus/deadlines.py), write ``artifacts/deadlines/index.json`` (the
     stage's sealed record, stages/deadlines.py) and print
     each result; exit 1 when one is refuted or inconclusive."""
-    from rclverify.stages.deadlines import stage_deadlines
-    from rclverify.calculus.deadlines import PROVED, show
-    from rclverify.app.pipeline import stage_check
+    from rclverify.stages.deadlines import stage_deadlines  # deferred: start-up (loads yaml, z3 and more only when called)
+    from rclverify.calculus.deadlines import PROVED, show  # deferred: start-up (loads yaml, z3 and more only when called)
+    from rclverify.app.pipeline import stage_check  # deferred: start-up (loads rclverify.app, rclverify.app.pipeline and more only when called)
     ws = workspace_of(args)
     stage_check(ws)  # the snapshots the record's inputs name
     results, records = stage_deadlines(ws)

@@ -58,7 +58,7 @@ def add_parsers(sub: Any) -> None:
 
 def _seconds(text: str) -> float:
     """A time limit in seconds: a finite number > 0 (argparse type; a usage error otherwise)."""
-    import math
+    import math  # deferred: start-up (every command module loads when rclverify starts: cli/common.py)
     try:
         x = float(text)
     except ValueError:
@@ -90,7 +90,7 @@ def _scan_args(args: argparse.Namespace, bags: list[str], cache: Path | None,
     """The scan of ``args.paths``/``args.launch``/``args.arg`` (and ``bags``) shared by
     ``ros scan`` and ``ros diff``: ``graph.scan``'s result, or ``None`` after one
     usage message on standard error (a path that does not exist, a bad ``--arg``)."""
-    from rclverify.ros.graph.scan import scan
+    from rclverify.ros.graph.scan import scan  # deferred: start-up (loads rclverify.core, rclverify.core.atomic and more only when called)
     for p in list(args.paths) + list(args.launch) + bags + list(also_exist or ()):
         if not Path(p).exists():
             print(f"{p}: error: no such file or directory", file=sys.stderr)
@@ -104,8 +104,8 @@ def _scan_args(args: argparse.Namespace, bags: list[str], cache: Path | None,
 
 
 def cmd_scan(args: argparse.Namespace) -> int:
-    from rclverify.records.store import atomic_write_text
-    from rclverify.ros.live.master import MasterError, read_master
+    from rclverify.records.store import atomic_write_text  # deferred: start-up (loads rclverify.core, rclverify.core.atomic and more only when called)
+    from rclverify.ros.live.master import MasterError, read_master  # deferred: start-up (loads rclverify.ros, rclverify.ros.extract and more only when called)
     res = _scan_args(args, list(args.bag), Path(args.cache) / "ros-scan.pickle" if args.cache else None)
     if res is None:
         return 2
@@ -137,10 +137,10 @@ def cmd_diff(args: argparse.Namespace) -> int:
     """``rclverify ros diff``: print the missing and extra lists (docs/ros.md,
     "Expected against observed"); exit 0 equal, 1 they differ (or the master or
     the DDS domain cannot be read, or a scanned file cannot be), 2 usage."""
-    from rclverify.records.store import atomic_write_text
-    from rclverify.ros.graph.bag import bag_topics
-    from rclverify.ros.live.diff import diff_bag, diff_master, render_text
-    from rclverify.ros.live.master import MasterError, read_master
+    from rclverify.records.store import atomic_write_text  # deferred: start-up (loads rclverify.core, rclverify.core.atomic and more only when called)
+    from rclverify.ros.graph.bag import bag_topics  # deferred: start-up (every command module loads when rclverify starts: cli/common.py)
+    from rclverify.ros.live.diff import diff_bag, diff_master, render_text  # deferred: start-up (loads rclverify.ros, rclverify.ros.extract and more only when called)
+    from rclverify.ros.live.master import MasterError, read_master  # deferred: start-up (loads rclverify.ros, rclverify.ros.extract and more only when called)
     if sum((args.master is not None, args.bag is not None, bool(getattr(args, "ros2", False)))) != 1:
         print("error: ros diff needs exactly one running side: --master URI, --ros2 or --bag BAG", file=sys.stderr)
         return 2
@@ -162,8 +162,8 @@ def cmd_diff(args: argparse.Namespace) -> int:
             print(f"{args.master}: {n.severity}: {n.message}", file=sys.stderr)
         result = diff_master(res.graph, running, args.master)
     elif getattr(args, "ros2", False):
-        from rclverify.ros.live.dds import DdsUnavailable
-        from rclverify.ros.live.diff_dds import diff_dds, qos_conflicts, read_dds_graph
+        from rclverify.ros.live.dds import DdsUnavailable  # deferred: optional or conditional (inside a block)
+        from rclverify.ros.live.diff_dds import diff_dds, qos_conflicts, read_dds_graph  # deferred: optional or conditional (inside a block)
         try:
             running, disc, source, dp = read_dds_graph(max(0.0, args.wait))
         except DdsUnavailable as exc:
@@ -197,8 +197,8 @@ def cmd_diff(args: argparse.Namespace) -> int:
 
 def init_from_ros(args: argparse.Namespace) -> int:
     """``rclverify init DIR --from-ros PATH [--launch FILE]``."""
-    from rclverify.ros.graph.scan import scan
-    from rclverify.tools.scaffold.skeleton import write_from_ros
+    from rclverify.ros.graph.scan import scan  # deferred: start-up (loads rclverify.core, rclverify.core.atomic and more only when called)
+    from rclverify.tools.scaffold.skeleton import write_from_ros  # deferred: start-up (loads jinja2, rclverify.core and more only when called)
     root = Path(args.dir)
     if root.exists() and (not root.is_dir() or any(root.iterdir())):
         print(f"{args.dir}: error: exists and is not an empty directory; rclverify init writes only into a new "
@@ -228,5 +228,5 @@ def init_from_ros(args: argparse.Namespace) -> int:
 
 
 def cmd_check(args: argparse.Namespace) -> int:
-    from rclverify.app.ros_stage import run_check
+    from rclverify.app.ros_stage import run_check  # deferred: start-up (loads rclverify.app, rclverify.app.ros_stage and more only when called)
     return run_check(Path(args.workspace), args.plan, args.strict, args.json)

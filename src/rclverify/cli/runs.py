@@ -10,16 +10,16 @@ from rclverify.cli.common import AddCommand, seconds
 
 def cmd_monitor(args: argparse.Namespace) -> int:
     """Judge recorded runs, or the running system (``--live``), against every node's contract (:func:`rclverify.cli.monitor.monitor_command`)."""
-    from rclverify.cli.monitor import monitor_command
-    from rclverify.stages.workspace import Workspace
+    from rclverify.cli.monitor import monitor_command  # deferred: start-up (loads jinja2, lark and more only when called)
+    from rclverify.stages.workspace import Workspace  # deferred: start-up (loads rclverify.core, rclverify.core.atomic and more only when called)
     checked = Workspace(Path(args.workspace), args.plan).checked  # raises RclError, printed located by main
     return monitor_command(args, checked)
 
 
 def cmd_oracle(args: argparse.Namespace) -> int:
     """Serve the contracts as a ROSMonitoring oracle over WebSocket (:func:`rclverify.cli.monitor.oracle_command`)."""
-    from rclverify.cli.monitor import oracle_command
-    from rclverify.stages.workspace import Workspace
+    from rclverify.cli.monitor import oracle_command  # deferred: start-up (loads jinja2, lark and more only when called)
+    from rclverify.stages.workspace import Workspace  # deferred: start-up (loads rclverify.core, rclverify.core.atomic and more only when called)
     checked = Workspace(Path(args.workspace), args.plan).checked  # raises RclError, printed located by main
     return oracle_command(args, checked)
 

@@ -12,7 +12,7 @@ from rclverify.cli.common import AddCommand, no_wait_option, run_lock, workspace
 
 def cmd_report(args: argparse.Namespace) -> int:
     """Rebuild reports/ from the artifacts (waiting for a run in progress unless ``--no-wait``); print the files and the headline."""
-    from rclverify.app.pipeline import stage_report
+    from rclverify.app.pipeline import stage_report  # deferred: start-up (loads rclverify.app, rclverify.app.pipeline and more only when called)
     with run_lock(args):
         report, paths = stage_report(workspace_of(args))
     for p in paths:
@@ -23,7 +23,7 @@ def cmd_report(args: argparse.Namespace) -> int:
 
 def cmd_verify(args: argparse.Namespace) -> int:
     """Run the whole pipeline through doit in ``args.workspace`` (``--strict``: exit 1 unless everything holds; ``-n``: parallel processes; ``--cluster``: backend jobs on Dask); doit's exit code."""
-    from rclverify.app.tasks import DEP_FILE, build_tasks, doit_config
+    from rclverify.app.tasks import DEP_FILE, build_tasks, doit_config  # deferred: start-up (loads doit, rclverify.app and more only when called)
     if not Path(args.workspace).is_dir():  # before doit opens its state file there (a sqlite3 traceback)
         print(f"{args.workspace}: error: no such workspace directory", file=sys.stderr)
         return 1
@@ -45,17 +45,17 @@ def cmd_verify(args: argparse.Namespace) -> int:
     except SystemExit as exc:
         return int(exc.code) if isinstance(exc.code, int) else 1
     finally:  # the run lock, also when doit ended before completing the run (in-process callers go on)
-        from rclverify.core.runlock import release
+        from rclverify.core.runlock import release  # deferred: optional or conditional (inside a block)
         release(Path(args.workspace))
 
 
 def run_doit(module: object, argv: list[str], cluster: str | None) -> int:
     """Run doit's ``argv`` on the tasks of ``module``, with the Dask scheduler ``cluster`` named to the evidence tasks when given; doit's exit code."""
-    from doit.cmd_base import ModuleTaskLoader
-    from doit.doit_cmd import DoitMain
+    from doit.cmd_base import ModuleTaskLoader  # deferred: start-up (loads doit and more only when called)
+    from doit.doit_cmd import DoitMain  # deferred: start-up (loads doit and more only when called)
     if not cluster:
         return int(DoitMain(ModuleTaskLoader(module)).run(argv))
-    from rclverify.app.cluster import CLUSTER_ENV  # read by the evidence tasks, also in doit's worker processes
+    from rclverify.app.cluster import CLUSTER_ENV  # read by the evidence tasks, also in doit's worker processes; deferred: start-up (loads rclverify.app, rclverify.app.cluster and more only when called)
     before = os.environ.get(CLUSTER_ENV)
     os.environ[CLUSTER_ENV] = cluster
     try:

@@ -13,9 +13,9 @@ from rclverify.lang.errors import RclError
 def cmd_init(args: argparse.Namespace) -> int:
     """Write a new workspace in ``args.dir`` that verifies at once (``--from-ros``: one contract skeleton per node of a ROS workspace, docs/ros.md); print the files written."""
     if getattr(args, "from_ros", None):
-        from rclverify.cli.ros import init_from_ros
+        from rclverify.cli.ros import init_from_ros  # deferred: optional or conditional (inside a block)
         return init_from_ros(args)
-    from rclverify.tools.scaffold import InitError, init_workspace
+    from rclverify.tools.scaffold import InitError, init_workspace  # deferred: start-up (loads jinja2, rclverify.core and more only when called)
     names = [n.strip() for n in args.nodes.split(",")] if args.nodes is not None else None
     try:
         written = init_workspace(Path(args.dir), names)
@@ -37,9 +37,9 @@ def cmd_cache(args: argparse.Namespace) -> int:
     this rclverify code wrote it), or delete it all with ``--clear`` (always
     safe: every entry is a pure speed-up).  Exit 0; 1 (located) for a
     missing workspace."""
-    import shutil
+    import shutil  # deferred: start-up (loads shutil only when called)
 
-    from rclverify.core.cache import CACHE_DIR, kept_files
+    from rclverify.core.cache import CACHE_DIR, kept_files  # deferred: start-up (loads rclverify.core, rclverify.core.atomic and more only when called)
     root = Path(args.workspace)
     if not root.is_dir():
         raise RclError([io_error(root, "no such workspace directory")])
@@ -60,9 +60,9 @@ def cmd_cache(args: argparse.Namespace) -> int:
 
 def cmd_review(args: argparse.Namespace) -> int:
     """Write (``-o FILE``) or print the review record to fill in for ``args.node`` (a checklist from its guarantees, the reviewed files with their sha256); exit 2 for an unknown node."""
-    from rclverify.backends.review.blank import blank_record
-    from rclverify.records.store import atomic_write_text
-    from rclverify.stages.workspace import Workspace
+    from rclverify.backends.review.blank import blank_record  # deferred: start-up (loads jinja2, yaml and more only when called)
+    from rclverify.records.store import atomic_write_text  # deferred: start-up (loads rclverify.core, rclverify.core.atomic and more only when called)
+    from rclverify.stages.workspace import Workspace  # deferred: start-up (loads rclverify.core, rclverify.core.atomic and more only when called)
     root = Path(args.workspace)
     out_rel = ""
     if args.output:  # the record this command writes may be the one the plan names and misses (issue 48)

@@ -43,6 +43,9 @@ from rclverify.diagnosis import realize, recheck
 from rclverify.diagnosis.bounds import FLIP, bound_literals, thresholds, value
 from rclverify.diagnosis.edits import Edit
 from rclverify.diagnosis.repairs import link_pairs, _numbers, _peel, _rename
+from rclverify.model.plan.load import all_requirements
+from rclverify.calculus.requirements.check import check_requirement, formals_of
+from rclverify.lang.walk import subexpressions
 
 #: Most edited systems checked per problem (each costs a parse, a type check and a Z3 query).
 MAX_TRIALS = 24
@@ -126,14 +129,12 @@ def proved_with(ws: Any, req_id: str, edit: Edit) -> bool:
     non-vacuously, once ``edit`` is made (the pipeline's own requirement
     check on an edited copy; nothing is written)?  ``False`` when the edited
     text does not check or the requirement is not in the plan."""
-    from rclverify.model.plan.load import all_requirements
     req = next((r for r in all_requirements(ws.plan) if r.id == req_id), None)
     system = recheck.edited_system(ws, edit)
     return req is not None and system is not None and _proved(req, system, ws.plan)
 
 
 def _proved(req: Any, system: Any, plan: Any) -> bool:
-    from rclverify.calculus.requirements.check import check_requirement
     world.fresh()
     rec = check_requirement(req, system[0], system[1], plan, timeout_ms=5000, model_ms=2000)
     return rec.get("verdict") == "proved" and rec.get("consistency") == "consistent" \
@@ -178,8 +179,6 @@ def requirement_culprits(ws: Any, req_id: str, cone: Sequence[str]) -> list[dict
     "edit": Edit, "how": "bound" | "threshold" | "conclusion", "old", "new"}`` with the
     strengthening Z3 checked and ``"implementable"`` (``proved`` or
     ``inconclusive``).  ``[]`` when no single strengthening proves it."""
-    from rclverify.model.plan.load import all_requirements
-    from rclverify.calculus.requirements.check import formals_of
     req = next((r for r in all_requirements(ws.plan) if r.id == req_id), None)
     if req is None:
         return []
@@ -245,7 +244,6 @@ def requirement_culprits(ws: Any, req_id: str, cone: Sequence[str]) -> list[dict
 def _summands(e: Any) -> list[ast.NumLit]:
     """The integer literals under ``e`` that are a direct operand of ``+``
     or ``-`` (an index offset: ``1`` in ``out.joint == in.index + 1``)."""
-    from rclverify.lang.walk import subexpressions
     out: list[ast.NumLit] = []
     for x in subexpressions(e):
         if isinstance(x, ast.Binary) and x.op in ("+", "-"):
@@ -264,7 +262,6 @@ def temporal_culprits(ws: Any, req_id: str, cone: Sequence[str]) -> list[dict[st
     and the edited node stays implementable.  Each ``{"node", "guarantee",
     "edit", "how": "threshold" | "offset", "old", "new", "implementable"}``;
     ``[]`` when no such edit does it within :data:`TEMPORAL_TRIALS`."""
-    from rclverify.model.plan.load import all_requirements
     req = next((r for r in all_requirements(ws.plan) if r.id == req_id), None)
     if req is None or req.formal is None:
         return []

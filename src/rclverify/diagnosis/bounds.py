@@ -112,5 +112,5 @@ def power_of_ten(a: Fraction, b: Fraction) -> int | None:
 def number_text(x: Fraction) -> str | None:
     """``x`` as an exact RCL numeric literal (an integer or a finite decimal:
     ``3/2`` -> ``1.5``), ``None`` when it has no finite decimal."""
-    from rclverify.semantics.values import decimal_text
+    from rclverify.semantics.values import decimal_text  # deferred: start-up (loads rclverify.lang.types, rclverify.lang.units and more only when called)
     return decimal_text(x)

@@ -45,6 +45,7 @@ from rclverify.diagnosis.requirement import requirement_record
 from rclverify.diagnosis.sidecond import side_condition_repairs
 from rclverify.diagnosis.culprits import culprits, parse_core, plan_facts
 from rclverify.diagnosis.table import counterexample_table
+from rclverify.diagnosis.units import unit_records
 
 CACHE = "artifacts/cache/diagnosis.pickle"
 #: Taken while diagnosing (:func:`_one_at_a_time`); beside the run lock, not a kept result.
@@ -111,7 +112,7 @@ def _one_at_a_time(ws: Any) -> Iterator[None]:
     lock cannot be taken (no ``fcntl``, a read-only workspace) the block
     runs unlocked: the lock only saves work."""
     try:
-        import fcntl
+        import fcntl  # deferred: optional or conditional (inside a block)
         path = ws.path(LOCK)
         path.parent.mkdir(parents=True, exist_ok=True)
         fd = os.open(path, os.O_RDWR | os.O_CREAT, 0o644)
@@ -162,7 +163,6 @@ def _diagnose(ws: Any, report: Mapping[str, Any]) -> list[dict[str, Any]]:
         return found
 
     # a unit mismatch on a connection first: it explains the side condition and the runs that follow from it
-    from rclverify.diagnosis.units import unit_records
     out += unit_records(ws, report, cache.get)
     for f in report["findings"]:
         if f["status"] != "problem":
@@ -309,7 +309,7 @@ def _generated_handler(ws: Any, node: str, monitoring: Mapping[str, Any]) -> Any
     """The handler of ``node``'s generated logic.py that published the first
     violating message (:func:`rclverify.diagnosis.handlers.violating_handler`),
     ``None`` for a node without generated code or a run it cannot place."""
-    from rclverify.diagnosis.handlers import violating_handler
+    from rclverify.diagnosis.handlers import violating_handler  # deferred: start-up (loads rclverify.diagnosis.handlers, ast only when called)
     entries = [{"backend": x.backend, **dict(x.config)} for x in ws.plan.evidence.get(node, ())]
     return violating_handler(ws.root, node, entries, monitoring)
 
@@ -319,8 +319,8 @@ def _breaking_assignments(ws: Any, program: str, cex: Mapping[str, Any], data: M
     """The last assignments to the outputs ``conj`` reads in the program's
     run on the counterexample (:func:`rclverify.backends.hoare.culprit_assign.breaking_assignments`);
     ``[]`` when the program no longer reads or the run cannot be made."""
-    from rclverify.backends.hoare import lang
-    from rclverify.backends.hoare.culprit_assign import breaking_assignments
+    from rclverify.backends.hoare import lang  # deferred: start-up (loads jinja2, z3 and more only when called)
+    from rclverify.backends.hoare.culprit_assign import breaking_assignments  # deferred: start-up (loads jinja2, z3 and more only when called)
     outs = {k: str(v) for k, v in (data.get("binding") or {}).items()
             if k.startswith("out.") and re.search(rf"(?<![\w.]){re.escape(k)}(?!\w)", conj)}
     try:
@@ -331,7 +331,7 @@ def _breaking_assignments(ws: Any, program: str, cex: Mapping[str, Any], data: M
 
 
 def _obligation_record(ws: Any, node: str, oid: str) -> Mapping[str, Any]:
-    from rclverify.records.sealed import obligation_list
+    from rclverify.records.sealed import obligation_list  # deferred: start-up (loads rclverify.records, rclverify.records.records and more only when called)
     records, _ = obligation_list(ws.path(ws.obligations(node)))  # [] when altered outside rclverify
     for o in records or []:
         if isinstance(o, dict) and o.get("id") == oid:
@@ -393,8 +393,8 @@ def _evidence(ws: Any, report: Mapping[str, Any], e: Mapping[str, Any], o: Mappi
 
 
 def _hoare(ws: Any, report: Mapping[str, Any], e: Mapping[str, Any], o: Mapping[str, Any], cache: _Cache) -> dict[str, Any]:
-    from rclverify.backends.hoare import lang
-    from rclverify.backends.hoare.culprit_lines import compared_constants
+    from rclverify.backends.hoare import lang  # deferred: start-up (loads jinja2, z3 and more only when called)
+    from rclverify.backends.hoare.culprit_lines import compared_constants  # deferred: start-up (loads jinja2, z3 and more only when called)
     node, k = o["node"], o["guarantee"]
     rec = _obligation_record(ws, node, e["obligation"])
     data = rec.get("data", {})

@@ -18,6 +18,7 @@ from rclverify.diagnosis import recheck
 from rclverify.diagnosis.bounds import bound_literals
 from rclverify.diagnosis.edits import Edit
 from rclverify.diagnosis.repairs import MAX_CANDIDATES, _record
+from rclverify.lang.ast import Loc
 
 _ORDERING = ("<", "<=", ">", ">=")
 
@@ -54,7 +55,7 @@ def hoare_repair(ws: Any, node: str, guarantee: int, program: str,
     ``guarantee`` of ``node``) under which every triple of the plan entry of
     ``program`` is discharged, fewest changes first; ``None`` when none
     passes.  ``before`` maps the entry's obligation ids to their statuses."""
-    from rclverify.backends.hoare import lang
+    from rclverify.backends.hoare import lang  # deferred: start-up (loads jinja2, z3 and more only when called)
     idx = next((i for i, e in enumerate(ws.plan.evidence.get(node, ()))
                 if e.backend == "hoare" and e.config.get("program") == program), None)
     if idx is None:
@@ -109,7 +110,6 @@ def hoare_repair(ws: Any, node: str, guarantee: int, program: str,
 
 class _At:
     def __init__(self, text: str, line: int, col: int, end_line: int, end_col: int) -> None:
-        from rclverify.lang.ast import Loc
         self.text = text
         self.loc = Loc("", line, col, end_line, end_col)
 

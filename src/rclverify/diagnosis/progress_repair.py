@@ -29,6 +29,8 @@ from rclverify.semantics import world
 from rclverify.diagnosis import recheck
 from rclverify.diagnosis.edits import Edit
 from rclverify.diagnosis.repairs import _record
+from rclverify.model.plan.load import all_requirements
+from rclverify.calculus.requirements.check import check_requirement
 
 #: The step bounds tried, weakest first (a larger K is a weaker claim).
 BOUNDS = (3, 1, 0)
@@ -73,8 +75,6 @@ def progress_repairs(ws: Any, q: Mapping[str, Any], temporal: Mapping[str, Any])
     proves ``q`` on the edited contracts.  ``[]`` when none does, when the
     requirement or a node cannot be found, or the edited text does not
     check."""
-    from rclverify.model.plan.load import all_requirements
-    from rclverify.calculus.requirements.check import check_requirement
     req = next((r for r in all_requirements(ws.plan) if r.id == q["id"]), None)
     if req is None:
         return []

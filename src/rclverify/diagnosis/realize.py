@@ -34,6 +34,7 @@ from rclverify.semantics.encode import Encoder, EncodingError
 from rclverify.lang import ast
 from rclverify.lang.types import Checked, FuncT
 from rclverify.lang.walk import subexpressions
+from rclverify.semantics.query import prove
 
 #: Budget of each query (milliseconds).
 TIMEOUT_MS = 3000
@@ -49,7 +50,6 @@ def implementable(ws: Any, checked: Checked, node: str) -> tuple[str, dict[str, 
     input the assumption allows and no output answers, or
     ``("inconclusive", {})`` (a function-typed output, Z3 undecided, an
     encoding error)."""
-    from rclverify.semantics.query import prove
     world.fresh()
     cn = checked.nodes[node]
     if any(isinstance(t, FuncT) for t in cn.outputs.values()):

@@ -74,8 +74,8 @@ def health(ws: Any, checked: Checked, node: str, instances: Mapping[int, int] | 
     check is not asked again.  ``known``: statuses of checks the caller has
     just asked Z3 on the same ``checked`` (``{"Agent.g1.non-vacuous":
     "ok"}``), taken as they are instead of being asked twice."""
-    from rclverify.calculus.health.checks import INSTANCE_TIMEOUT_MS
-    from rclverify.calculus.health.shape import shape_findings
+    from rclverify.calculus.health.checks import INSTANCE_TIMEOUT_MS  # deferred: start-up (loads rclverify.calculus.compose, rclverify.calculus.context and more only when called)
+    from rclverify.calculus.health.shape import shape_findings  # deferred: start-up (loads rclverify.calculus.compose, rclverify.calculus.context and more only when called)
     as_status = {"sat": "ok", "unsat": "problem"}
     known = known or {}
     h = _health(ws, checked, node)
@@ -96,7 +96,7 @@ def health(ws: Any, checked: Checked, node: str, instances: Mapping[int, int] | 
 
 
 def _health(ws: Any, checked: Checked, node: str) -> Any:
-    from rclverify.calculus.health.checks import _NodeHealth, INSTANCE_TIMEOUT_MS
+    from rclverify.calculus.health.checks import _NodeHealth, INSTANCE_TIMEOUT_MS  # deferred: start-up (loads rclverify.calculus.compose, rclverify.calculus.context and more only when called)
     world.fresh()
     facts = [(f.expr, f.loc) for f in ws.plan.facts.get(node, ())]
     return _NodeHealth(checked, checked.nodes[node], facts, None, INSTANCE_TIMEOUT_MS)
@@ -124,7 +124,7 @@ def premise_fires(ws: Any, checked: Checked, node: str, k: int, at: int | None =
     shape :func:`finite_witness` looks for (asked first), or for the query
     of the health check ``non-vacuous``; else that query's ``unsat`` or
     ``inconclusive``."""
-    from rclverify.calculus.health.checks import INSTANCE_TIMEOUT_MS
+    from rclverify.calculus.health.checks import INSTANCE_TIMEOUT_MS  # deferred: start-up (loads rclverify.calculus.compose, rclverify.calculus.context and more only when called)
     h = _health(ws, checked, node)
     var = h.natural_vars(k)
     prem = h.premise(k, {var[0]: at} if at is not None and var else None)
@@ -143,7 +143,7 @@ def consistent(ws: Any, checked: Checked, node: str) -> str:
     """Can the assumption, every guarantee and the facts of ``node`` hold
     together?  ``sat`` (a witness: the general query or :func:`finite_witness`),
     ``unsat`` or ``inconclusive``."""
-    from rclverify.calculus.health.checks import INSTANCE_TIMEOUT_MS
+    from rclverify.calculus.health.checks import INSTANCE_TIMEOUT_MS  # deferred: start-up (loads rclverify.calculus.compose, rclverify.calculus.context and more only when called)
     h = _health(ws, checked, node)
     if finite_witness(h, [], _points(ws, node)) == "sat":  # first, as in premise_fires
         return "sat"
@@ -155,7 +155,7 @@ def side_conditions(checked: Checked, model: SystemModel, node: str, ws: Any = N
     """``{side condition id: status}`` of ``node`` in the edited system (a fresh Z3 world), with the
     plan's environment facts of ``ws`` (the workspace) as the stage has them: a side condition that
     fails locally is checked in context with them (docs/calculus.md)."""
-    from rclverify.calculus.compose import compose_node
+    from rclverify.calculus.compose import compose_node  # deferred: start-up (loads rclverify.calculus.compose, rclverify.calculus.context and more only when called)
     world.fresh()
     facts = {n: [f.expr for f in fs] for n, fs in ws.plan.facts.items()} if ws is not None else None
     return {sc.id: sc.status for sc in compose_node(checked, model, node, facts=facts).side_conditions}
@@ -166,8 +166,8 @@ def hoare_statuses(ws: Any, node: str, index: int, program: str, new_text: str) 
     ``index`` of ``node`` with its program replaced by ``new_text`` (written to
     a temporary copy of the program's path; the workspace is not touched).
     A pending triple is ``pending``; a triple Z3 cannot decide ``inconclusive``."""
-    from rclverify.backends.hoare.backend import prepare
-    from rclverify.backends.hoare.solve import check_all
+    from rclverify.backends.hoare.backend import prepare  # deferred: start-up (loads jinja2, z3 and more only when called)
+    from rclverify.backends.hoare.solve import check_all  # deferred: start-up (loads jinja2, z3 and more only when called)
     world.fresh()
     tmp = Path(tempfile.mkdtemp(prefix="rclverify-repair-"))
     try:

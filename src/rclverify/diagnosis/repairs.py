@@ -41,6 +41,11 @@ from rclverify.lang.walk import free_names, subexpressions
 from rclverify.semantics import world
 from rclverify.diagnosis import recheck
 from rclverify.diagnosis.edits import Edit
+from rclverify.semantics.encode import Encoder
+from rclverify.semantics.query import prove
+from rclverify.lang.parser import parse_formula
+from rclverify.lang.typecheck import domain_type
+from rclverify.lang.types import Scalar
 
 #: Most candidates tried per problem (each costs Z3 queries).
 MAX_CANDIDATES = 12
@@ -162,10 +167,7 @@ def _weakest_first(ws: Any, node: str, guards: list[str], var_types: Mapping[str
     strictly weaker than, one without quantifiers comes first (Z3 decides
     the checks of the guarded contract more easily; of two equivalent
     guards either is the weakest)."""
-    from rclverify.calculus.health.checks import INSTANCE_TIMEOUT_MS
-    from rclverify.semantics.encode import Encoder
-    from rclverify.semantics.query import prove
-    from rclverify.lang.parser import parse_formula
+    from rclverify.calculus.health.checks import INSTANCE_TIMEOUT_MS  # deferred: start-up (loads rclverify.calculus.health, rclverify.calculus.refine_timing and more only when called)
     if len(guards) < 2:
         return guards, {g: [] for g in guards}
     checked = ws.checked
@@ -327,8 +329,6 @@ def _and_text(xs: Sequence[str]) -> str:
 def _numeric_vars(ws: Any, cn: Any, formula: ast.Expr) -> dict[str, str]:
     """``{name: "NATURAL" | "INTEGER"}`` of the outer ``forall``'s bound
     variables of those types, in binding order."""
-    from rclverify.lang.typecheck import domain_type
-    from rclverify.lang.types import Scalar
     out: dict[str, str] = {}
     e = formula
     while isinstance(e, ast.Quant) and e.kind == "forall":

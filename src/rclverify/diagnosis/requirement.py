@@ -14,6 +14,9 @@ from rclverify.diagnosis import blame, recheck
 from rclverify.diagnosis.liveness import liveness_culprits
 from rclverify.diagnosis.progress_repair import progress_repairs
 from rclverify.diagnosis.repairs import _record as _repair
+from fractions import Fraction
+from rclverify.lang.printer import expr_to_rcl
+from rclverify.calculus.compose import conjuncts
 
 #: The repair kind of each way a culprit was found (:func:`blame.requirement_culprits`).
 _KIND = {"bound": "tighten-bound", "threshold": "move-threshold", "conclusion": "strengthen-guarantee"}
@@ -160,7 +163,6 @@ def _causes(ws: Any, report: Mapping[str, Any], q: Mapping[str, Any], cone: list
 def _cex_value(text: Any) -> Any:
     """A counterexample's value text as a value of :mod:`rclverify.semantics.values`
     (a number or a boolean); ``None`` for anything else."""
-    from fractions import Fraction
     t = str(text).strip()
     if t in ("true", "false", "TRUE", "FALSE"):
         return t.lower() == "true"
@@ -177,9 +179,7 @@ def _passes_through(ws: Any, report: Mapping[str, Any], q: Mapping[str, Any],
     monitors' evaluator, :func:`rclverify.semantics.decide.decide`): the
     counterexample passes through them.  A value that does not read, or a
     conjunct the evaluator cannot decide, counts as not passing."""
-    from rclverify.semantics.decide import decide
-    from rclverify.lang.printer import expr_to_rcl
-    from rclverify.calculus.compose import conjuncts
+    from rclverify.semantics.decide import decide  # deferred: start-up (loads rclverify.semantics.concrete, rclverify.semantics.decide and more only when called)
     rows = {str(r["node"]): r.get("values") or {} for r in (q.get("check") or {}).get("counterexample") or []}
     out = []
     for sc in report.get("side_conditions") or ():

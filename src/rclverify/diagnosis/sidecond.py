@@ -57,6 +57,9 @@ from rclverify.diagnosis import realize, recheck
 from rclverify.diagnosis.bounds import coefficient_literals, number_text, power_of_ten, value
 from rclverify.diagnosis.edits import Edit
 from rclverify.diagnosis.repairs import MAX_CANDIDATES, _and_text, link_pairs, _record, _rename
+from rclverify.model.plan.errors import PlanError
+from rclverify.model.plan.load import all_requirements
+from rclverify.diagnosis.units import declared_unit, literal_si, literal_in
 
 _UPPER = {"<=": True, "<": True, ">=": False, ">": False}
 _MIRROR = {"<=": ">=", "<": ">", ">=": "<=", ">": "<"}
@@ -155,8 +158,6 @@ def _stems_from(ws: Any, sc: Mapping[str, Any], pairs: Sequence[tuple[str, str, 
     stems from: a formal statement that reads the linked value
     (``Gripper.in.force`` or ``Supervisor.out.force``) or names a constant
     the assumption's bound is written with."""
-    from rclverify.model.plan.errors import PlanError
-    from rclverify.model.plan.load import all_requirements
     try:
         reqs = all_requirements(ws.plan)
     except PlanError:  # a Doorstop tree that cannot be read: reported elsewhere; the plan's own requirements
@@ -285,7 +286,6 @@ def _inplace(ws: Any, p: str, ov: str, target: ast.Expr) -> tuple[Edit, int, str
     (:func:`.units.literal_si`); ``B`` is written in ``N``'s unit, or as the
     consumer's named constant (issue 64: a unit on the bound no longer
     suppresses the safe repair)."""
-    from rclverify.diagnosis.units import declared_unit, literal_si, literal_in
     consts = ws.checked.env.constants
     mine = next(((v, _normal(target, pre, v.name, consts)) for pre in ("in", None) for v in subexpressions(target)
                  if isinstance(v, ast.Var) and v.prefix == pre and v.name not in consts

@@ -11,7 +11,6 @@ SENTENCE = 600
 
 
 def _natural_key(text: str) -> list[Any]:
-    import re
     return [int(t) if t.isdigit() else t for t in re.split(r"(\d+)", text)]
 
 

@@ -29,6 +29,11 @@ from rclverify.model.system.units import Mismatch, mismatches
 from rclverify.diagnosis import recheck
 from rclverify.diagnosis.edits import Edit
 from rclverify.diagnosis.repairs import link_pairs, _record
+from rclverify.lang.printer import level, expr_to_rcl
+from rclverify.lang import ast
+from rclverify.lang.units import UnitError, parse_unit
+from fractions import Fraction
+from rclverify.diagnosis.bounds import number_text
 
 
 def _loc(loc: Any) -> str:
@@ -153,7 +158,6 @@ def conversion_repair(ws: Any, m: Mismatch) -> list[dict[str, Any]]:
     old = edit0.deleted(source)
     op, lit = _number(m.writer_unit, m.reader_unit)
     unit = f"{_wrap(m.reader_unit.text or str(m.reader_unit)[1:-1])}/{_wrap(m.writer_unit.text or str(m.writer_unit)[1:-1])}"
-    from rclverify.lang.printer import level
     body = old if level(rhs) >= 8 else f"({old})"
     edit = Edit(loc.file, loc.line, loc.col, loc.end_line, loc.end_col, f"{body} {op} {lit} [{unit}]")
     after = recheck.edited_system(ws, edit)
@@ -172,7 +176,6 @@ def conversion_repair(ws: Any, m: Mismatch) -> list[dict[str, Any]]:
     fixed = [k for k, v in now.items() if v == "discharged" and before.get(k) != "discharged"]
     still = [k for k, v in now.items() if v != "discharged"]
     words = factor_name(m.writer_unit, m.reader_unit)  # how many of the reader's units make one of the writer's
-    from rclverify.lang.printer import expr_to_rcl
     side = expr_to_rcl(lhs if rhs is not lhs else eq.operands[1])
     summary = (f"Convert in {p}: write `{side} == {body} {op} {lit} [{unit}]` so that {p} publishes {m.reader_unit}, "
                f"the unit {c} reads ({m.writer_unit} to {m.reader_unit}: multiply by {words})")
@@ -192,7 +195,6 @@ def conversion_repair(ws: Any, m: Mismatch) -> list[dict[str, Any]]:
 def declared_unit(decls: Any, name: str) -> Any:
     """The ``UnitAnn`` declared for the input or output ``name`` among
     ``decls`` (``IOVar``s, or a mapping of name to one), ``None`` when none is."""
-    from rclverify.lang import ast
     items = decls.values() if isinstance(decls, Mapping) else decls
     for v in items:
         if isinstance(v, ast.IOVar) and v.name == name:
@@ -201,7 +203,6 @@ def declared_unit(decls: Any, name: str) -> Any:
 
 
 def _unit_of(ann: Any) -> Unit | None:
-    from rclverify.lang.units import UnitError, parse_unit
     if ann is None:
         return None
     try:
@@ -219,8 +220,6 @@ def literal_si(lit: Any, constants: Mapping[str, Any], declared: Any) -> tuple[A
     constant defined by a numeral likewise.  Dimensions are ``None`` for a
     number with no unit at all.  ``None`` when the value or unit cannot be
     read (an affine or pi-scaled unit, a constant not defined by a numeral)."""
-    from fractions import Fraction
-    from rclverify.lang import ast
     if isinstance(lit, ast.Var) and lit.name in constants:
         lit = constants[lit.name][1]
     if not isinstance(lit, ast.NumLit):
@@ -238,7 +237,6 @@ def literal_in(si: Any, like: Any, declared: Any) -> str | None:
     literal ``like``: with ``like``'s unit written after it when it has one
     (``40 [N]``), else bare in ``declared``'s unit; ``None`` when that is no
     finite decimal."""
-    from rclverify.diagnosis.bounds import number_text
     ann = like.unit if like.unit is not None else declared
     u = _unit_of(ann)
     if ann is not None and u is None:

@@ -137,7 +137,7 @@ class ToAst(Transformer[Token, Any]):
         if tok is None:
             return None
         self.units_seen = True
-        from rclverify.lang.units import normal_text
+        from rclverify.lang.units import normal_text  # deferred: start-up (loads rclverify.lang.units, difflib only when called)
         return ast.UnitAnn(normal_text(str(tok)[1:-1]), self._span([tok]))
 
     def node_clause(self, c: list[Any]) -> ast.Node:

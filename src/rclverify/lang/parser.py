@@ -41,6 +41,7 @@ from rclverify.lang.builder import ToAst
 from rclverify.lang.errors import Diagnostic, RclError, error
 from rclverify.lang.nesting import check_nesting
 from rclverify.lang.syntax_errors import syntax_error
+from rclverify.lang.source import decode_text
 
 _FRIENDLY = {
     "NAME": "a name", "IO_NAME": "an in./out. name", "NUMBER": "a number", "ROS_TYPE": "a ROS type",
@@ -151,7 +152,6 @@ def ast_from_tree(tree: Any, file: str = "<string>") -> Any:
 
 def parse_file(path: str | Path) -> ast.Spec:
     """Read and parse an RCL file.  A missing/unreadable file is an RclError."""
-    from rclverify.lang.source import decode_text
     p = Path(path)
     try:
         data = p.read_bytes()

@@ -38,6 +38,7 @@ import itertools
 from typing import Union
 
 from rclverify.lang import ast
+from rclverify.lang.errors import RclError
 
 #: Precedence level of each binary operator (higher binds tighter).
 BINARY_LEVEL: dict[str, int] = {
@@ -161,8 +162,7 @@ MINIMAL_CHAIN_MAX = 12
 
 def _reads_back(text: str, e: ast.Expr) -> bool:
     """Whether ``text`` parses to ``e`` (AST equality ignores parentheses and locations)."""
-    from rclverify.lang.errors import RclError
-    from rclverify.lang.parser import parse_formula
+    from rclverify.lang.parser import parse_formula  # deferred: start-up (loads lark, rclverify.core and more only when called)
     try:
         return parse_formula(text) == e
     except (RclError, RecursionError):

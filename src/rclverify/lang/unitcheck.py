@@ -42,6 +42,8 @@ from rclverify.lang import ast
 from rclverify.lang.printer import expr_to_rcl
 from rclverify.lang.types import CheckedNode, Scalar, Type, is_numeric
 from rclverify.lang.units import Unit, UnitError, best_name, describe, dimension_name, factor_text, parse_unit
+from rclverify.lang.printer import level, is_type
+from rclverify.lang.units import ratio
 
 Report = Callable[[ast.Loc, str, str], None]
 
@@ -281,8 +283,6 @@ def _conversion(a: Q, b: Q) -> str:
     one side that is the factor becomes the factor with its unit
     (``out.d == 1000 * in.r`` -> ``1000 [mm/m] * in.r``); otherwise the
     factor with its unit multiplies the other side (``1000 [mm/m] * in.r``)."""
-    from rclverify.lang.printer import level
-    from rclverify.lang.units import ratio
     assert a.unit is not None and b.unit is not None
     for x, y in ((b, a), (a, b)):
         e = x.expr
@@ -329,5 +329,4 @@ def _decimal(f: Fraction) -> str:
 
 
 def _is_type(d: object) -> bool:
-    from rclverify.lang.printer import is_type
     return is_type(d)

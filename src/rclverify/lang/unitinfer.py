@@ -43,6 +43,7 @@ from rclverify.lang.printer import expr_to_rcl
 from rclverify.lang.types import Checked
 from rclverify.lang.unitconv import convert_by, named
 from rclverify.lang.units import Unit
+from rclverify.lang.walk import subexpressions
 
 #: ``(node, "in" | "out", variable)``.
 Key = tuple[str, str, str]
@@ -162,7 +163,7 @@ class _Terms:
         if isinstance(e, ast.NumLit):
             if e.unit is None:
                 return ("number", _num(e))
-            from rclverify.lang.units import UnitError, parse_unit
+            from rclverify.lang.units import UnitError, parse_unit  # deferred: optional or conditional (inside a block)
             try:
                 return ("units", frozenset({(parse_unit(e.unit.text), Fraction(1))}))
             except UnitError:
@@ -340,7 +341,6 @@ def certain(got: Inferred | None, u: Unit) -> bool:
 
 def _reads(e: ast.Expr, checked: Checked, node: str) -> tuple[Key, ...]:
     """The inputs and outputs of ``node`` the term ``e`` reads."""
-    from rclverify.lang.walk import subexpressions
     cn = checked.nodes[node]
     out: list[Key] = []
     for v in subexpressions(e):

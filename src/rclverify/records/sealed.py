@@ -148,7 +148,7 @@ def _companions(path: str) -> list[str]:
         records = (index or {}).get("records")
         if problem or not isinstance(records, dict):
             return []
-        import re
+        import re  # deferred: optional or conditional (inside a block)
         return [f"{head}/artifacts/requirements/{re.sub(r'[^A-Za-z0-9_.-]+', '_', str(rid))}.json" for rid in records]
     return []
 

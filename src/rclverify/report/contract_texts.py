@@ -24,6 +24,7 @@ from typing import TYPE_CHECKING, Any
 
 from rclverify.core.cache import Shelf
 from rclverify.lang import ast
+from rclverify.lang.printer import expr_to_rcl, to_rcl, type_to_rcl, unit_to_rcl
 
 if TYPE_CHECKING:
     from rclverify.stages.workspace import Workspace
@@ -37,8 +38,7 @@ def node_texts(node: ast.Node) -> dict[str, Any]:
     no preamble, its real file name), "inputs"/"outputs": [[name, type as RCL with its unit, ``REAL [m]``],
     ...], "assumptions"/"guarantees": [[formula as RCL, "file:line:col"],
     ...]}`` (lists, in declaration order)."""
-    from rclverify.lang.latex import node_latex
-    from rclverify.lang.printer import expr_to_rcl, to_rcl, type_to_rcl, unit_to_rcl
+    from rclverify.lang.latex import node_latex  # deferred: start-up (loads jinja2, rclverify.lang.latex and more only when called)
     return {
         "rcl": to_rcl(ast.Spec((), (node,))), "latex": node_latex(node),
         "inputs": [[v.name, type_to_rcl(v.type) + unit_to_rcl(v.unit)] for v in node.inputs],
@@ -50,7 +50,7 @@ def node_texts(node: ast.Node) -> dict[str, Any]:
 
 def lint_json(spec: ast.Spec) -> list[dict[str, Any]]:
     """The lint warnings of one parsed file (:func:`rclverify.lang.lint.lint`) as JSON."""
-    from rclverify.lang.lint import lint
+    from rclverify.lang.lint import lint  # deferred: start-up (loads rclverify.lang.errors, rclverify.lang.lint and more only when called)
     return [d.to_json() for d in lint(spec)]
 
 

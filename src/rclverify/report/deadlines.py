@@ -43,6 +43,7 @@ from typing import Any, Callable, Mapping, Sequence
 from rclverify.records.records import worst
 from rclverify.records.statuses import DEADLINE_STATUS
 from rclverify.stages.workspace import Workspace
+from rclverify.records.store import EvidenceStore
 
 #: A deadline verdict as an evidence status (the report's badges and roll-up).
 STATUS_OF = {"proved": "discharged", **DEADLINE_STATUS}  # records/statuses.py, "Verdict and status"
@@ -52,7 +53,7 @@ _WORSE = ("refuted", "proved from an inconsistency", "proved vacuously", "error"
 
 def _spec_of(rec: Mapping[str, Any], spec: Any) -> bool:
     """Whether the record ``rec`` was decided for the plan's ``spec`` (same path and bound)."""
-    from fractions import Fraction
+    from fractions import Fraction  # deferred: start-up (loads fractions only when called)
     try:
         within = Fraction(str(rec.get("within_s")))
     except (ValueError, ZeroDivisionError):
@@ -70,8 +71,8 @@ def deadline_rows(ws: Workspace, current: Mapping[str, str], g_status: Callable[
     ``second``: the second solver's verdicts (:class:`rclverify.stages.crosscheck.apply.SecondSolver`),
     which make a proved deadline they do not agree on inconclusive.
     Returns ``[]`` for a plan without deadlines."""
-    from rclverify.stages.deadlines import INDEX, read_deadlines
-    from rclverify.calculus.deadlines import show_seconds as _show
+    from rclverify.stages.deadlines import INDEX, read_deadlines  # deferred: start-up (loads yaml, z3 and more only when called)
+    from rclverify.calculus.deadlines import show_seconds as _show  # deferred: start-up (loads yaml, z3 and more only when called)
     specs = list(ws.plan.deadlines)
     if not specs:
         return []
@@ -134,7 +135,6 @@ def _monitor_verdicts(ws: Workspace, ob_rows: Sequence[Mapping[str, Any]],
     """node -> the deadline verdicts of its monitors' evidence records
     (``details["deadlines"]``, backends/monitors/deadlines.py):
     ``[{"obligation", "status", "counts", "first_false"}]``."""
-    from rclverify.records.store import EvidenceStore
     store = EvidenceStore(ws.root)
     out: dict[str, list[dict[str, Any]]] = {}
     for o in ob_rows:
@@ -242,7 +242,7 @@ def sarif_results(report: Mapping[str, Any], result: Callable[..., dict[str, Any
     for r in report.get("deadlines") or ():
         if r["verdict"] == "proved":
             continue
-        from rclverify.report.severity import of
+        from rclverify.report.severity import of  # deferred: optional or conditional (inside a block)
         rule = "RCL-DEADLINE-REFUTED" if r["verdict"] == "refuted" else "RCL-DEADLINE-INCONCLUSIVE"
         level = of("deadline", str(r["verdict"])) or "note"  # one severity in every output (report/severity.py)
         words = [f"End-to-end deadline of {r['requirement']} ({r['within']} along {' -> '.join(r['path'])}) is "
@@ -260,7 +260,7 @@ def sarif_results(report: Mapping[str, Any], result: Callable[..., dict[str, Any
 
 def float_text(fraction: Any) -> str:
     """An exact fraction of seconds as text (``"1/4"``) in decimal (``0.25``)."""
-    from fractions import Fraction
+    from fractions import Fraction  # deferred: start-up (loads fractions only when called)
     try:
         return f"{float(Fraction(str(fraction))):g}"
     except (ValueError, ZeroDivisionError):

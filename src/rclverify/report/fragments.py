@@ -36,7 +36,7 @@ KIND = "report-fragments"
 
 
 def _versions() -> tuple[str, ...]:
-    import jinja2
+    import jinja2  # deferred: start-up (loads jinja2 only when called)
     return (f"jinja2 {jinja2.__version__}",)
 
 

@@ -54,6 +54,7 @@ from rclverify.report.fragments import FragmentCache
 from rclverify.report.sarif import split_location
 from rclverify.report.templating import model_text
 from rclverify.records.report_schema import Report
+from rclverify.report.severity import junit_outcome
 
 
 def _case(suite: ET.Element, classname: str, name: str, where: str, seconds: Any) -> ET.Element:
@@ -68,7 +69,6 @@ def _outcome(case: ET.Element, status: str, summary: str, detail: str, kind: str
     """Attach the child element for an item of ``kind`` with ``status`` (its
     one severity, :func:`.severity.junit_outcome`); return the counter it
     bumps (``failures``, ``errors``, ``skipped``) or '' for a pass."""
-    from rclverify.report.severity import junit_outcome
     if status == "acknowledged":  # a warning accepted in the plan with a reason (model/plan/acknowledged.py)
         ET.SubElement(case, "skipped", {"message": f"acknowledged warning: {summary}"}).text = detail or None
         return "skipped"
@@ -121,7 +121,7 @@ def junit_tree(report: Report) -> ET.Element:
         for k, v in counts.items():
             totals[k] += v
         total_time += time
-    from rclverify.report.deadlines import junit_suite
+    from rclverify.report.deadlines import junit_suite  # deferred: start-up (loads rclverify.lang.errors, rclverify.report.deadlines and more only when called)
     for req in (_requirements_suite(report), junit_suite(report, _case, _outcome), _lint_suite(report)):
         if req is None:
             continue
@@ -323,7 +323,7 @@ def render_junit(report: Report, fragments: FragmentCache | None = None) -> str:
         for k, v in piece["counts"].items():
             totals[k] += v
         total_time += piece["time"]
-    from rclverify.report.deadlines import junit_suite
+    from rclverify.report.deadlines import junit_suite  # deferred: start-up (loads rclverify.lang.errors, rclverify.report.deadlines and more only when called)
     for req in (_requirements_suite(report), junit_suite(report, _case, _outcome), _lint_suite(report)):
         if req is None:
             continue

@@ -18,6 +18,8 @@ from typing import Any, Iterable, Mapping
 from rclverify.records.records import Obligation, SourceRef
 from rclverify.records.sealed import obligation_list, read_sealed
 from rclverify.stages.workspace import Workspace
+from rclverify.records.store import dumps
+from rclverify.stages.workspace import check_inputs
 
 
 def _error_side_conditions(node: str, body: dict[str, Any] | None, why: str) -> dict[str, Any]:
@@ -95,8 +97,8 @@ def grounding(ws: Workspace, rel: str) -> dict[str, Any] | None:
                 "context": {"packages": [], "files": []}, "drawing": {"dot": "", "svg": None},
                 "graph": {"nodes": []}, "matched": {}}
     if body is not None:
-        from rclverify.records.records import hash_inputs
-        from rclverify.ros.graph.inputs import input_files
+        from rclverify.records.records import hash_inputs  # deferred: optional or conditional (inside a block)
+        from rclverify.ros.graph.inputs import input_files  # deferred: optional or conditional (inside a block)
         made = body.get("inputs")
         now = input_files(ws)
         if not isinstance(made, dict) or set(made) != set(now) or hash_inputs(ws.root, now) != made:
@@ -118,8 +120,6 @@ def inputs_sha256(ws: Workspace, made_from: Mapping[str, str], evidence_inputs: 
     run and a clean one give the same value.  The bundle compares it with
     the value of a report built now (docs/argument.md): a report written
     before the evidence was produced again is not packed."""
-    from rclverify.records.store import dumps
-    from rclverify.stages.workspace import check_inputs
     body = {"files": check_inputs(ws), "made_from": dict(made_from), "evidence": dict(evidence_inputs),
             "requirements": {k: [v.get("verdict"), v.get("fingerprint"), v.get("inputs")] for k, v in checks.items()}}
     return hashlib.sha256(dumps(body).encode("utf-8")).hexdigest()

@@ -74,14 +74,14 @@ def _argument(report: Report, rendering: diagram.Rendering | None,
     """The assurance argument's view for the templates (GSN goal structure
     built from ``report``, see :mod:`rclverify.report.argument`); ``rendering`` of
     the system diagram, when given, stands in for its layout too."""
-    from rclverify.report.argument.export import argument_view
+    from rclverify.report.argument.export import argument_view  # deferred: start-up (loads rclverify.report.argument, textwrap and more only when called)
     return argument_view(report, rendering, fragments)
 
 
 @last_call  # the HTML report's layout and page both show it
 def _system_dot(report: Report) -> str:
     """The system diagram with the problems' culprit nodes and the failing connections marked (issue 48)."""
-    from rclverify.diagnosis.repairs import link_pairs
+    from rclverify.diagnosis.repairs import link_pairs  # deferred: start-up (loads lark, yaml and more only when called)
     failing = {(p, c) for sc in report.get("side_conditions") or () if sc.get("status") in ("failed", "inconclusive", "error")
                for p, _, c, _ in link_pairs(sc)}
     culprits = culprit_nodes(problem_groups(report))
@@ -171,9 +171,9 @@ def render_files(report: Report, out_dir: Path, names: Sequence[str] = REPORT_FI
     ``ValueError``/``TypeError``/``jinja2.UndefinedError`` for a malformed
     report and ``OSError`` when ``out_dir`` cannot be written.
     """
-    from concurrent.futures import Future, ThreadPoolExecutor
+    from concurrent.futures import Future, ThreadPoolExecutor  # deferred: start-up (loads concurrent and more only when called)
 
-    from rclverify.report.argument.export import argument_layout
+    from rclverify.report.argument.export import argument_layout  # deferred: start-up (loads rclverify.report.argument, textwrap and more only when called)
     texts = {}
     # The two Graphviz layouts (seconds each on a large system) run as subprocesses beside the
     # other rendering; a thread only waits for its `dot`, so the GIL is not in the way.

@@ -37,6 +37,8 @@ from typing import Any, Mapping, Sequence
 from rclverify.records.store import dumps
 from rclverify.report.templating import model_text
 from rclverify.records.report_schema import Report
+from rclverify.report.severity import of
+from rclverify.diagnosis.edits import sarif_fix
 
 #: The SARIF version written and the schema it validates against.
 SARIF_VERSION = "2.1.0"
@@ -154,7 +156,6 @@ _OBLIGATION_RULE = {"failed": "RCL-OBL-FAILED", "error": "RCL-OBL-ERROR", "stale
 
 def _level(kind: str, status: str) -> str:
     """The SARIF level of an item: its one severity (:mod:`.severity`)."""
-    from rclverify.report.severity import of
     return of(kind, status) or "note"
 
 
@@ -288,7 +289,7 @@ def _requirement_results(report: Report) -> list[dict[str, Any]]:
                 f"{row['node']}: " + ", ".join(f"{k} = {v}" for k, v in row["values"].items())
                 for row in c["counterexample"]) + ".")
         if c.get("temporal"):  # a temporal requirement: its method, bound and trace step by step
-            from rclverify.report.temporal import temporal_words
+            from rclverify.report.temporal import temporal_words  # deferred: optional or conditional (inside a block)
             words.append(temporal_words(c["temporal"]))
         for p in c.get("failed_to_prevent") or []:
             words.append(f"Not prevented by {p['label']} ({p['text']}, {p['source']}).")
@@ -370,7 +371,7 @@ def _grounding_results(report: Report) -> tuple[list[dict[str, Any]], list[Rule]
     g = report.get("grounding")
     if not g:
         return [], []
-    from rclverify.ros.ground.ground import RULES as ROS_RULES
+    from rclverify.ros.ground.ground import RULES as ROS_RULES  # deferred: start-up (loads rclverify.core.cache, rclverify.ros and more only when called)
     rules = [Rule(code, "Ros" + "".join(w.capitalize() for w in code.split("-")[1:]),
                   "error" if sev == "error" else "warning", text) for code, (sev, text) in ROS_RULES.items()]
     out = []
@@ -396,7 +397,6 @@ def _attach_diagnoses(report: Report, results: Sequence[dict[str, Any]]) -> None
     sentence naming the culprit) and its repairs as SARIF ``fix`` objects
     (§3.55; each repair was checked by Z3 before it entered the report,
     docs/diagnosis.md).  A report without ``diagnoses`` is left as it is."""
-    from rclverify.diagnosis.edits import sarif_fix
     by_key: dict[str, Mapping[str, Any]] = {}
     for dg in report.get("diagnoses", []):
         if dg.get("kind") == "unit":  # a unit mismatch: the lint error at the producer (diagnosis/units.py)
@@ -462,7 +462,7 @@ def sarif_log(report: Report) -> dict[str, Any]:
     """
     lint, lint_rules = _lint_results(report)
     ground, ground_rules = _grounding_results(report)
-    from rclverify.report.deadlines import SARIF_RULES, sarif_results
+    from rclverify.report.deadlines import SARIF_RULES, sarif_results  # deferred: start-up (loads rclverify.lang.errors, rclverify.report.deadlines and more only when called)
     results = (_obligation_results(report) + _unverified_results(report) + _side_condition_results(report) + _finding_results(report) + lint + ground
                + _requirement_results(report) + sarif_results(report, _result) + _acknowledgement_results(report))
     _attach_diagnoses(report, results)

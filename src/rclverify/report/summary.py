@@ -41,7 +41,7 @@ def node_rows(report: Mapping[str, Any]) -> list[dict[str, Any]]:
         return out
     obligations, sides, findings = (by_node(report[k]) for k in ("obligations", "side_conditions", "findings"))
     unverified = by_node(list(report.get("unverified") or ()))
-    from rclverify.report.culprits import culprit_nodes
+    from rclverify.report.culprits import culprit_nodes  # deferred: start-up (loads rclverify.report.culprits only when called)
     blamed = culprit_nodes(report.get("problems") or ())
     rows = []
     for k, n in enumerate(report["nodes"]):
@@ -139,7 +139,7 @@ def group_sentence(group: Mapping[str, Any]) -> str:
     """The first sentence of a problem group, whole: the report's row
     (report/problems.py) cuts it to a length; the terminal cuts it only at
     a clause boundary (:func:`rclverify.diagnosis.text.clause_cut`)."""
-    from rclverify.diagnosis.text import whole_first_sentence
+    from rclverify.diagnosis.text import whole_first_sentence  # deferred: start-up (loads rclverify.diagnosis, rclverify.diagnosis.text only when called)
     short = str(group.get("sentence", ""))
     stem = short[:-4] if short.endswith(" ...") else None
     for m in group.get("members", []):
@@ -210,7 +210,7 @@ def strict_reasons(report: Mapping[str, Any]) -> list[str]:
     if rq:
         out.append(f"{len(rq)} formal requirement{'s are' if len(rq) != 1 else ' is'} not met ("
                    + ", ".join(rq[:4]) + (", ..." if len(rq) > 4 else "") + ")")
-    from rclverify.report.deadlines import strict_reason
+    from rclverify.report.deadlines import strict_reason  # deferred: start-up (loads rclverify.core, rclverify.core.atomic and more only when called)
     out += strict_reason(report)  # end-to-end deadlines not proved
     g = _grounding(report.get("grounding"))
     if g and g["error"]:
@@ -232,7 +232,7 @@ def status_text(data: Mapping[str, Any]) -> list[str]:
     (:func:`rclverify.diagnosis.text.status_lines`), with the ROS grounding
     errors: counted on the overall line and listed one a line (they change
     no verdict, docs/ros.md, but fail ``--strict``)."""
-    from rclverify.diagnosis.text import status_lines
+    from rclverify.diagnosis.text import status_lines  # deferred: start-up (loads rclverify.diagnosis, rclverify.diagnosis.text only when called)
     g = data.get("grounding") or {}
     errors = int(g.get("error", 0) or 0)
     if errors:  # listed below one a line, not as the report's one summary problem
@@ -251,9 +251,9 @@ def status_text(data: Mapping[str, Any]) -> list[str]:
 def summary_table(report: Mapping[str, Any], colour: bool, rows: list[dict[str, Any]] | None = None) -> Table:
     """The summary table of ``report`` (at most :data:`MAX_ROWS` node rows +
     total); ``rows`` are its :func:`node_rows` when already made."""
-    from rich import box
-    from rich.markup import escape
-    from rich.table import Table
+    from rich import box  # deferred: start-up (loads rich only when called)
+    from rich.markup import escape  # deferred: start-up (loads rich and more only when called)
+    from rich.table import Table  # deferred: start-up (loads rich and more only when called)
     rows = node_rows(report) if rows is None else rows
     shown, rest = rows[:MAX_ROWS], rows[MAX_ROWS:]
     if rest:
@@ -293,7 +293,7 @@ def print_summary(report: Mapping[str, Any], report_path: str, file: IO[str] | N
     (default: the current ``sys.stdout``).  ``terminal`` (default
     :func:`is_terminal`) selects colours and box drawing; otherwise plain
     ASCII, at most 120 columns wide.  ``rows`` as for :func:`summary_table`."""
-    from rich.console import Console
+    from rich.console import Console  # deferred: start-up (loads rich and more only when called)
     tty = is_terminal() if terminal is None else terminal
     console = Console(file=file or sys.stdout, force_terminal=tty, no_color=not tty, highlight=False,
                       width=None if tty else 120, soft_wrap=False)
@@ -333,9 +333,9 @@ def read_summary(root: Path) -> dict[str, Any]:
     ``reports/assurance.json``.  Raises
     :class:`~rclverify.lang.errors.RclError` (one located line) as
     :func:`rclverify.report.lastrun.read_checked` does."""
-    from rclverify.stages.workspace import Workspace
-    from rclverify.report.lastrun import SUMMARY_SHAPE, SUMMARY_SOURCE_SHAPE, located, read_checked
-    from rclverify.records.sealed import read_sealed
+    from rclverify.stages.workspace import Workspace  # deferred: start-up (loads rclverify.core, rclverify.core.atomic and more only when called)
+    from rclverify.report.lastrun import SUMMARY_SHAPE, SUMMARY_SOURCE_SHAPE, located, read_checked  # deferred: start-up (loads rclverify.lang, rclverify.lang.ast and more only when called)
+    from rclverify.records.sealed import read_sealed  # deferred: start-up (loads rclverify.core, rclverify.core.atomic and more only when called)
     path = root / Workspace.SUMMARY
     if path.exists():
         # sealed: a summary altered outside rclverify is said so and never shown (docs/integrity.md)

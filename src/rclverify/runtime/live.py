@@ -48,6 +48,9 @@ from rclverify.backends.monitors.judged import Heard, count_call_line, explain, 
 from rclverify.runtime.logchecks import LogChecks
 from rclverify.backends.monitors.online import OnlineEngine
 from rclverify.runtime.worker import EngineWorker
+import warnings
+from rclverify.records.statistics import upper_bound
+from rclverify.runtime.ros1 import REGISTER_TIMEOUT_S, SHUTDOWN_TIMEOUT_S, bound_master_calls, contract_topics, finish_within, import_rospy, message_class, RosUnavailable, check_master, run_bounded, flatten
 
 VERDICT_LOG_TOPIC = "rclverify/verdict"
 
@@ -254,7 +257,6 @@ def running_bound(res: NodeResult) -> str:
     n = c.get("satisfied", 0) + c.get("violated", 0) + c.get("inconclusive", 0)
     if not n:
         return ""
-    from rclverify.records.statistics import upper_bound
     return f"; {n} answer(s) counted, 95 % bound {upper_bound(n - c.get('satisfied', 0), n, 0.95):.3g} per answer"
 
 
@@ -278,7 +280,7 @@ def _no_delay(pub: Any) -> None:
     Linux (docs/monitors.md, "Live monitoring", "Threads").  Reaches rospy's publisher
     connections (``impl.connections``, each with its ``socket``); a rospy
     without them is left as it is."""
-    import socket
+    import socket  # deferred: start-up (loads socket only when called)
     for c in list(getattr(getattr(pub, "impl", None), "connections", None) or ()):
         sock = getattr(c, "socket", None)
         if sock is not None:  # idempotent, one system call per connection every 0.1 s
@@ -309,14 +311,12 @@ def run_ros1(run_factory: Callable[..., LiveRun], checked: Checked, nodes: list[
     ``close()``): its events and deadline verdicts go to the same log and
     verdict topic, its summary to the record's ``deadlines``.
     """
-    from rclverify.ros.live.master_rpc import MASTER_TIMEOUT_S
-    from rclverify.runtime.ros1 import (REGISTER_TIMEOUT_S, SHUTDOWN_TIMEOUT_S, bound_master_calls, contract_topics,
-                                        finish_within, import_rospy, message_class)
+    from rclverify.ros.live.master_rpc import MASTER_TIMEOUT_S  # deferred: start-up (loads rclverify.ros, rclverify.ros.live and more only when called)
     rospy = import_rospy()
-    from std_msgs.msg import String
+    from std_msgs.msg import String  # deferred: start-up (loads std_msgs and more only when called)
     topics = contract_topics(checked, nodes)
     classes = {t: message_class(typ, msg_dirs) for t, typ in topics.items()}  # fail early, located
-    import rosgraph
+    import rosgraph  # deferred: start-up (loads rosgraph only when called)
     uri = rosgraph.get_master_uri()
     # every call to the master is bounded and the registration waits in short
     # steps, so a master that hangs neither holds the monitor nor makes it deaf
@@ -363,9 +363,7 @@ def _register(rospy: Any, string: Any, stop: threading.Event, uri: str, node_nam
     publishers ``(verdict, {node: last verdict, latched})``; within
     ``REGISTER_TIMEOUT_S`` and ``stop``, else rospy is shut down and
     :class:`~.ros1.RosUnavailable` raised."""
-    from rclverify.ros.live.master_rpc import MASTER_TIMEOUT_S
-    from rclverify.runtime.ros1 import (REGISTER_TIMEOUT_S, SHUTDOWN_TIMEOUT_S, RosUnavailable, check_master,
-                                        finish_within, run_bounded)
+    from rclverify.ros.live.master_rpc import MASTER_TIMEOUT_S  # deferred: start-up (loads rclverify.ros, rclverify.ros.live and more only when called)
 
     def register_node() -> tuple[Any, dict[str, Any]]:
         check_master(uri, "/" + node_name, MASTER_TIMEOUT_S)
@@ -374,7 +372,6 @@ def _register(rospy: Any, string: Any, stop: threading.Event, uri: str, node_nam
         # sockets itself; rospy's queued publisher hands every message to a writer
         # thread and then yields the GIL (time.sleep(0)), which cost the engine
         # thread a GIL hand-over per verdict (docs/monitors.md, "Live monitoring", "Threads")
-        import warnings
         with warnings.catch_warnings():  # rospy warns about queue_size=None; here it is the choice made above
             warnings.simplefilter("ignore", SyntaxWarning)
             pub = rospy.Publisher(verdict_topic, string, queue_size=None)
@@ -393,7 +390,6 @@ def _decoder(classes: Mapping[str, Any], decode_errors: dict[str, int]) -> Calla
     """The engine thread's decoding of a ``rospy.AnyMsg``: with the class of
     its connection's type, else the contract's; undecodable bytes are counted
     per topic in ``decode_errors``."""
-    from rclverify.runtime.ros1 import flatten
     by_type = {c._type: c for c in classes.values()}
 
     def decode(topic: str, raw: Any) -> Mapping[str, Any] | None:
@@ -415,7 +411,6 @@ def _subscribe(rospy: Any, string: Any, stop: threading.Event, until: float, uri
     ``proxy``; returns the proxy's run or ``None``.  By the registration's
     deadline ``until`` (monotonic s), else everything started is stopped and
     :class:`~.ros1.RosUnavailable` raised."""
-    from rclverify.runtime.ros1 import SHUTDOWN_TIMEOUT_S, RosUnavailable, finish_within, run_bounded
 
     def register_topics() -> Any:
         calls = proxy(rospy, live, lambda text: pub.publish(string(text))) if proxy is not None else None

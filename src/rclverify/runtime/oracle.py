@@ -210,9 +210,9 @@ def _unread(transport: Any) -> int:
     n = int(transport.get_write_buffer_size())
     sock = transport.get_extra_info("socket")
     try:
-        import fcntl
-        import struct
-        import termios
+        import fcntl  # deferred: optional or conditional (inside a block)
+        import struct  # deferred: optional or conditional (inside a block)
+        import termios  # deferred: optional or conditional (inside a block)
         if sock is not None:
             n += struct.unpack("i", fcntl.ioctl(sock.fileno(), termios.TIOCOUTQ, b"\0\0\0\0"))[0]
     except (ImportError, AttributeError, OSError, ValueError):  # no such query here: the buffer alone
@@ -267,7 +267,7 @@ async def serve(checked: Checked, nodes: list[CheckedNode], rules: Mapping[str, 
     server counts into ``stats`` (:class:`OracleStats`).  A connection's
     run and its queues are freed when it closes.
     Raises ``OSError`` when the port cannot be bound."""
-    from websockets.asyncio.server import serve as ws_serve
+    from websockets.asyncio.server import serve as ws_serve  # deferred: start-up (loads websockets and more only when called)
 
     lim = limits or OracleLimits()
     st = stats if stats is not None else OracleStats()
@@ -297,7 +297,7 @@ class _Connection:
 
     async def read(self) -> None:
         """Read messages into the inbox until the client closes."""
-        from websockets.exceptions import ConnectionClosed
+        from websockets.exceptions import ConnectionClosed  # deferred: start-up (loads websockets and more only when called)
         # websockets hands over every message already received without
         # suspending, so the inbox fills with everything that arrived in one
         # read from the socket before the replies are written; a full inbox stops the
@@ -326,7 +326,7 @@ class _Connection:
 
     async def serve(self) -> None:
         """Answer the inbox batch by batch until the client closes or is dropped."""
-        from websockets.exceptions import ConnectionClosed
+        from websockets.exceptions import ConnectionClosed  # deferred: start-up (loads websockets and more only when called)
         st, lim = self.st, self.lim
         st.connections += 1
         reader = asyncio.create_task(self.read())

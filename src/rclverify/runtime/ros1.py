@@ -46,6 +46,8 @@ import time
 import types
 from pathlib import Path
 from typing import Any, Callable, Iterable, Mapping, Sequence
+import os
+import xmlrpc.client
 
 DEBIAN_DIST_PACKAGES = "/usr/lib/python3/dist-packages"
 #: Seconds the live monitor may take to register with the master (node, publishers, subscribers, services).
@@ -66,7 +68,7 @@ class RosStopped(RosUnavailable):
 def check_master(uri: str, caller: str, timeout: float) -> None:
     """Ask the master at ``uri`` for its pid within ``timeout`` seconds;
     :class:`RosUnavailable` naming it and why when it does not answer."""
-    from rclverify.ros.live.master_rpc import MasterError, call
+    from rclverify.ros.live.master_rpc import MasterError, call  # deferred: start-up (loads rclverify.ros, rclverify.ros.live and more only when called)
     try:
         call(uri, "getPid", caller, timeout=timeout)
     except MasterError as exc:
@@ -79,7 +81,7 @@ def bound_master_calls(rospy: Any, uri: str, timeout: float) -> bool:
     so that no call of rospy's to the master waits for ever.  Returns
     whether this rospy has the cache (an older or newer one is left as it
     is; the registration is still bounded by :func:`run_bounded`)."""
-    from rclverify.ros.live.master_rpc import TimeoutTransport
+    from rclverify.ros.live.master_rpc import TimeoutTransport  # deferred: start-up (loads rclverify.ros, rclverify.ros.live and more only when called)
     core = getattr(rospy, "core", None)
     cache = getattr(core, "_xmlrpc_cache", None)
     locked = getattr(core, "_LockedServerProxy", None)
@@ -93,7 +95,7 @@ def run_bounded(stop: threading.Event, limit: float, what: str, fn: Callable[[],
     """``fn()`` in a daemon thread (:func:`~...ros.master_rpc.in_thread`):
     its value (or its exception); :class:`RosStopped` as soon as ``stop`` is
     set (a signal); :class:`RosUnavailable` once ``limit`` seconds passed."""
-    from rclverify.ros.live.master_rpc import in_thread
+    from rclverify.ros.live.master_rpc import in_thread  # deferred: start-up (loads rclverify.ros, rclverify.ros.live and more only when called)
     state, got = in_thread(fn, limit, "rclverify-ros1-register", stop)
     if state == "stopped":
         raise RosStopped(f"stopped by a signal while {what}; nothing was monitored")
@@ -109,7 +111,7 @@ def finish_within(fn: Callable[[], Any], limit: float = SHUTDOWN_TIMEOUT_S) -> b
     master) in a daemon thread, waited for at most ``limit`` seconds, so a
     master that hangs cannot hold the exit.  Returns whether it finished
     (its exception, if any, is dropped: the run is ending)."""
-    from rclverify.ros.live.master_rpc import in_thread
+    from rclverify.ros.live.master_rpc import in_thread  # deferred: start-up (loads rclverify.ros, rclverify.ros.live and more only when called)
     return in_thread(fn, limit, "rclverify-ros1-shutdown")[0] != "timeout"
 
 
@@ -136,9 +138,9 @@ _GENERATED: dict[str, type] = {}
 
 
 def _generate(pkg: str, name: str, path: Path, msg_dirs: Sequence[Path]) -> type:
-    import genmsg
-    import genmsg.msg_loader
-    import genpy.generator
+    import genmsg  # deferred: start-up (loads genmsg only when called)
+    import genmsg.msg_loader  # deferred: start-up (loads genmsg and more only when called)
+    import genpy.generator  # deferred: start-up (loads genpy and more only when called)
     ctx = genmsg.MsgContext.create_default()
     search: dict[str, list[str]] = {}
     for d in msg_dirs:
@@ -177,7 +179,7 @@ def message_class(msg_type: str, msg_dirs: Sequence[Path] = ()) -> type:
             _GENERATED[key] = _generate(pkg, name, f, msg_dirs)
             return _GENERATED[key]
     import_rospy()
-    import roslib.message
+    import roslib.message  # deferred: start-up (loads roslib and more only when called)
     cls = roslib.message.get_message_class(key)
     if cls is None:
         raise RosUnavailable(f"message type {key} is neither installed nor defined under "
@@ -217,7 +219,7 @@ def contract_topics(checked: Any, nodes: Iterable[Any]) -> dict[str, str]:
 
 def free_port() -> int:
     """A TCP port free on 127.0.0.1 now (for a master started right after)."""
-    import socket
+    import socket  # deferred: start-up (loads socket only when called)
     with socket.socket() as s:
         s.bind(("127.0.0.1", 0))
         return int(s.getsockname()[1])
@@ -237,11 +239,8 @@ class LocalMaster:
         self.proc: Any = None
 
     def __enter__(self) -> dict[str, str]:
-        import os
-        import shutil
-        import subprocess
-        import time
-        import xmlrpc.client
+        import shutil  # deferred: start-up (loads shutil only when called)
+        import subprocess  # deferred: start-up (loads subprocess only when called)
         exe = shutil.which("rosmaster")
         if exe is None:
             raise RosUnavailable("rosmaster is not installed (Debian: apt-get install ros-core)")
@@ -264,8 +263,7 @@ class LocalMaster:
                 time.sleep(0.1)
 
     def __exit__(self, *exc: Any) -> None:
-        import os
-        import signal
+        import signal  # deferred: start-up (loads signal only when called)
         if self.proc is not None and self.proc.poll() is None:
             os.killpg(self.proc.pid, signal.SIGTERM)
             try:

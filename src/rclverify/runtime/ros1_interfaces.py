@@ -21,6 +21,8 @@ from pathlib import Path
 from typing import Any, Sequence
 
 from rclverify.runtime.ros1 import RosUnavailable, import_rospy
+import sys
+from rclverify.runtime.ros1 import message_class
 
 _CACHE: dict[str, Any] = {}
 
@@ -55,9 +57,9 @@ def service_class(srv_type: str, dirs: Sequence[Path]) -> Any:
         raise RosUnavailable(f"service type {srv_type}: no {pkg}/srv/{name}.srv under "
                              f"{', '.join(map(str, dirs)) or 'the workspace'}")
     import_rospy()
-    import genmsg
-    import genmsg.msg_loader
-    import genpy.generator
+    import genmsg  # deferred: start-up (loads genmsg only when called)
+    import genmsg.msg_loader  # deferred: start-up (loads genmsg and more only when called)
+    import genpy.generator  # deferred: start-up (loads genpy and more only when called)
     ctx = genmsg.MsgContext.create_default()
     search = _search(dirs)
     try:
@@ -109,8 +111,6 @@ def action_classes(action_type: str, dirs: Sequence[Path], out_dir: Path) -> dic
     msg_dir.mkdir(parents=True, exist_ok=True)
     for n, t in texts.items():
         (msg_dir / f"{n}.msg").write_text(t + "\n", encoding="utf-8")
-    import sys
-    from rclverify.runtime.ros1 import message_class
     search = [Path(out_dir), *map(Path, dirs)]
     # genpy's code of MoveActionGoal imports `pkg.msg` for MoveGoal: give it that module, made of the
     # classes generated first (the package is not installed; Debian's packages come first on sys.path)

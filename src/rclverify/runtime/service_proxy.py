@@ -42,6 +42,7 @@ from rclverify.traces.events import Event
 from rclverify.backends.monitors.deadlines import DeadlineMonitor, DeadlineVerdict
 from rclverify.runtime.ros1 import RosUnavailable, flatten, import_rospy
 from rclverify.runtime.ros1_interfaces import action_classes, service_class
+from rclverify.runtime.ros1 import REGISTER_TIMEOUT_S, bound_master_calls, check_master, finish_within, run_bounded
 
 
 class ProxyRun:
@@ -223,9 +224,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     except (ProxyUsage, RosUnavailable) as exc:
         print(f"service_proxy: error: {exc}", file=sys.stderr)
         return 2
-    from rclverify.ros.live.master_rpc import MASTER_TIMEOUT_S
-    from rclverify.runtime.ros1 import REGISTER_TIMEOUT_S, bound_master_calls, check_master, finish_within, run_bounded
-    import rosgraph
+    from rclverify.ros.live.master_rpc import MASTER_TIMEOUT_S  # deferred: start-up (loads rclverify.ros, rclverify.ros.live and more only when called)
+    import rosgraph  # deferred: start-up (loads rosgraph only when called)
     uri = rosgraph.get_master_uri()
     stop = threading.Event()
     for sig in (signal.SIGINT, signal.SIGTERM):

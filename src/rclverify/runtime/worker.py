@@ -37,6 +37,7 @@ import threading
 import time as _time
 from collections.abc import Callable, Mapping
 from typing import Any, Protocol
+from rclverify.core.cache.heap import freeze_for_live
 
 
 class Sink(Protocol):
@@ -79,7 +80,6 @@ class EngineWorker:
 
     def start(self) -> EngineWorker:
         """Start the worker thread, the loaded heap frozen first (:func:`~rclverify.core.cache.heap.freeze_for_live`)."""
-        from rclverify.core.cache.heap import freeze_for_live
         freeze_for_live()
         self._thread.start()
         return self

@@ -89,7 +89,7 @@ def candidates(v: Fraction) -> list[Fraction]:
 
 
 def _solver(ctx: z3.Context) -> z3.Solver:
-    from rclverify.semantics.query import steps
+    from rclverify.semantics.query import steps  # deferred: start-up (loads lark, rclverify.core and more only when called)
     s = z3.Solver(ctx=ctx)
     s.set("rlimit", steps(BUDGET_MS))
     s.set("timeout", BUDGET_MS * 10)
@@ -135,7 +135,7 @@ def nicer_model(formulas: Sequence[z3.BoolRef], enc: Any, model: Mapping[str, st
     ``assumptions`` labelled formulas to keep when they can hold.  Returns a
     :class:`Nicer`; never raises on solver trouble (the caller's model is
     kept)."""
-    from rclverify.semantics.query import render_model
+    from rclverify.semantics.query import render_model  # deferred: start-up (loads lark, rclverify.core and more only when called)
     keep = Nicer(dict(model))
     if not formulas:
         return keep

@@ -26,6 +26,7 @@ from typing import TYPE_CHECKING, Any, Mapping
 from rclverify.records.sealed import read_sealed, write_sealed
 from rclverify.records.store import atomic_write_text, dumps
 from rclverify.calculus.deadlines import DeadlineResult, decide_plan
+from rclverify.calculus.worst_path import nodes_between, with_worst_path
 
 if TYPE_CHECKING:
     from rclverify.stages.workspace import Workspace
@@ -47,7 +48,6 @@ def stage_deadlines(ws: "Workspace") -> tuple[list[DeadlineResult], list[dict[st
     Returns ``(results, records)`` in plan order.  Raises ``RclError`` for
     contracts or a plan that do not check, ``OSError`` when a file cannot
     be written."""
-    from rclverify.calculus.worst_path import nodes_between, with_worst_path  # the slowest other path may refute a deadline (issue 48)
     results = [with_worst_path(r, ws.checked, ws.model) for r in decide_plan(ws.plan, ws.checked, ws.model)]
     model_hash = hashlib.sha256(dumps(ws.model.to_json()).encode("utf-8")).hexdigest()  # as the report takes it
     records: list[dict[str, Any]] = []

@@ -54,13 +54,13 @@ def stage_requirements(ws: "Workspace", *, force: bool = False) -> list[tuple[di
     ``(record, checked_now)`` per requirement, in plan order (the plan's,
     then the Doorstop items').  Raises ``RclError`` for contracts or a plan
     that do not check."""
-    from rclverify.model.plan.load import all_requirements
-    import z3
+    from rclverify.model.plan.load import all_requirements  # deferred: start-up (loads yaml, rclverify.lang and more only when called)
+    import z3  # deferred: start-up (loads z3 only when called)
 
-    from rclverify.semantics.world import fresh
-    from rclverify.core.cache import code_stamp
-    from rclverify.calculus.requirements.check import check_requirement, cone_of, fingerprint, state_text, statement_formals
-    from rclverify.backends.monitors.temporal_evidence import fingerprint_text, requirement_traces, trace_hashes, trace_rows
+    from rclverify.semantics.world import fresh  # deferred: start-up (loads rclverify.semantics, rclverify.semantics.world only when called)
+    from rclverify.core.cache import code_stamp  # deferred: start-up (loads rclverify.core.cache, fractions and more only when called)
+    from rclverify.calculus.requirements.check import check_requirement, cone_of, fingerprint, state_text, statement_formals  # deferred: start-up (loads lark, yaml and more only when called)
+    from rclverify.backends.monitors.temporal_evidence import fingerprint_text, requirement_traces, trace_hashes, trace_rows  # deferred: start-up (loads jinja2, lark and more only when called)
     code = f"{code_stamp()} z3 {z3.get_version_string()}"
     checked, model, plan = ws.checked, ws.model, ws.plan
     model_text = (ws.root / ws.MODEL).read_text(encoding="utf-8") if (ws.root / ws.MODEL).is_file() else \
@@ -128,7 +128,7 @@ def input_hashes(ws: "Workspace", cone: list[str], snap: Any, model_hash: str) -
     of the snapshots of ``cone`` (``snap(node)`` gives a snapshot's text) and
     the model a record is made from: the hashes the report compares with the
     current ones (:func:`read_records`)."""
-    from rclverify.model.plan.state import state_key, state_sha256
+    from rclverify.model.plan.state import state_key, state_sha256  # deferred: start-up (loads rclverify.lang, rclverify.lang.ast and more only when called)
     out = {ws.snapshot(n): hashlib.sha256(snap(n).encode("utf-8")).hexdigest() for n in cone}
     out.update({state_key(n): state_sha256(ws.plan.states, n) for n in cone})  # a state: edit is stale too
     out[ws.MODEL] = model_hash
@@ -166,7 +166,7 @@ def read_records(ws: "Workspace", current: dict[str, str] | None = None) -> dict
         assert rec is not None
         made = rec.get("inputs")
         if current is not None and isinstance(made, dict):  # a recorded run's sha256 now (trace:<path>)
-            from rclverify.backends.monitors.temporal_evidence import trace_hashes
+            from rclverify.backends.monitors.temporal_evidence import trace_hashes  # deferred: optional or conditional (inside a block)
             current = {**current, **trace_hashes(ws.root, [(p[6:], None) for p in made
                                                            if p.startswith("trace:") and p not in current])}
         if current is not None and rec.get("verdict") != "informal" and (

@@ -29,6 +29,8 @@ from typing import TYPE_CHECKING, Any, Callable, Mapping, Sequence, cast
 from rclverify.records.store import dumps
 from rclverify.lang.errors import RclError
 from rclverify.stages.cone_digests import cone_digests as cone_digests  # also where app/pipeline.py finds it
+from rclverify.records.store import atomic_write_text, sealed_dumps, SEAL, seal_of
+from rclverify.records.records import hash_inputs
 
 if TYPE_CHECKING:
     from rclverify.backends.base import NodeTarget
@@ -112,13 +114,13 @@ class Workspace:
         cached = self.__dict__.get("plan")
         if cached is not None:
             return cast("Plan", cached)
-        from rclverify.model.plan.load import load_plan
+        from rclverify.model.plan.load import load_plan  # deferred: start-up (loads yaml, rclverify.lang.ast and more only when called)
         return load_plan(self.root, self.plan_file)
 
     @cached_property
     def index(self) -> TaskIndex:
         """The :class:`TaskIndex` of the loaded workspace (raises like :attr:`model`)."""
-        from rclverify.calculus.worst_path import nodes_between
+        from rclverify.calculus.worst_path import nodes_between  # deferred: start-up (loads yaml, z3 and more only when called)
         plan, model = self.plan, self.model
         return TaskIndex(
             nodes=tuple(self.checked.nodes), producers={n: tuple(model.producers(n)) for n in self.checked.nodes},
@@ -132,10 +134,10 @@ class Workspace:
     @cached_property
     def checked(self) -> Checked:
         self._run_deferred()
-        from rclverify.model.plan.load import resolve
-        from rclverify.lang.parser import parse_text
-        from rclverify.lang.source import read_text as read_source
-        from rclverify.lang.typecheck import check
+        from rclverify.model.plan.load import resolve  # deferred: start-up (loads yaml, rclverify.lang.ast and more only when called)
+        from rclverify.lang.parser import parse_text  # deferred: start-up (loads lark, rclverify.core.cache and more only when called)
+        from rclverify.lang.source import read_text as read_source  # deferred: start-up (loads rclverify.lang.ast, rclverify.lang.source and more only when called)
+        from rclverify.lang.typecheck import check  # deferred: start-up (loads lark, rclverify.core.cache and more only when called)
         plan = self.plan
         specs = []
         diags: list[Diagnostic] = []
@@ -159,7 +161,7 @@ class Workspace:
         if diags:
             raise RclError(diags)
         c = check(specs, self.interface_only)
-        from rclverify.model.plan.errors import PlanError
+        from rclverify.model.plan.errors import PlanError  # deferred: start-up (loads rclverify.lang.ast, rclverify.model and more only when called)
         try:
             resolve(self.plan, c)
         except PlanError as exc:
@@ -173,13 +175,13 @@ class Workspace:
         """The backends' check-time validation of the plan's entries (experiment
         data, review records, trace mappings): run here, above both the plan and
         the backends, so that no plan module imports backend code."""
-        from rclverify.backends.entry_checks import check_entries
+        from rclverify.backends.entry_checks import check_entries  # deferred: start-up (loads yaml, rclverify.backends and more only when called)
         diags = check_entries(self.plan, c)
         return [d for d in diags if not any(f"review record {r!r} does not exist" in d.message for r in self.missing_ok)]
 
     @cached_property
     def model(self) -> SystemModel:
-        from rclverify.model.system.model import build
+        from rclverify.model.system.model import build  # deferred: start-up (loads yaml, rclverify.lang.ast and more only when called)
         return build(self.checked, self.plan.connections)
 
     def node_names(self) -> list[str]:
@@ -233,7 +235,7 @@ class Workspace:
     SUMMARY = "artifacts/report/summary.json"
 
     def target(self, node: str, index: int) -> NodeTarget:
-        from rclverify.backends.base import NodeTarget
+        from rclverify.backends.base import NodeTarget  # deferred: start-up (loads yaml, rclverify.backends and more only when called)
         entry = self.plan.evidence[node][index]
         return NodeTarget(
             root=self.root.resolve(), checked=self.checked, node=self.checked.nodes[node], config=entry.config,
@@ -259,8 +261,8 @@ def node_snapshots(ws: Workspace, texts: Any) -> dict[str, dict[str, Any]]:
     is the run's :class:`~rclverify.report.contract_texts.ContractTexts` (the caller's: it
     sits above this module).
     Raises RclError/PlanError for contracts or a plan that do not check."""
-    from rclverify.lang import ast
-    from rclverify.lang.printer import to_rcl
+    from rclverify.lang import ast  # deferred: start-up (loads rclverify.lang.ast, fractions only when called)
+    from rclverify.lang.printer import to_rcl  # deferred: start-up (loads rclverify.lang.ast, rclverify.lang.printer and more only when called)
     checked, plan = ws.checked, ws.plan
     context_text = to_rcl(ast.Spec(tuple(c for s in checked.specs for c in s.contexts), ()))
     plan_locs: dict[str, dict[str, str]] = {}  # node -> {value path under nodes.<node>: "line:col"}
@@ -287,7 +289,7 @@ def node_snapshots(ws: Workspace, texts: Any) -> dict[str, dict[str, Any]]:
 
 def environment_sha(ws: Workspace) -> dict[str, str]:
     """``{node: sha256 of the text of the environment conjuncts of its assumption}``."""
-    from rclverify.calculus.compose import environment_texts
+    from rclverify.calculus.compose import environment_texts  # deferred: start-up (loads lark, yaml and more only when called)
     return {n: hashlib.sha256("\n".join(environment_texts(ws.checked, ws.model, n)).encode("utf-8")).hexdigest()
             for n in ws.checked.nodes}
 
@@ -310,7 +312,7 @@ def check_input_files(ws: Workspace) -> list[str]:
 
 def check_inputs(ws: Workspace) -> dict[str, str]:
     """``{file: sha256}`` of each of :func:`check_input_files`."""
-    from rclverify.core.cache import file_digest
+    from rclverify.core.cache import file_digest  # deferred: start-up (loads rclverify.core.cache, fractions and more only when called)
     return {f: file_digest(ws.path(f)) for f in check_input_files(ws)}
 
 
@@ -320,8 +322,7 @@ def write_check_index(ws: Workspace, hashes: dict[str, str]) -> None:
     and the sha256 of each file they were made from (:func:`check_inputs`),
     sealed as evidence records are, in :attr:`Workspace.CHECK_INDEX`.
     Raises ``OSError``."""
-    from rclverify.core.cache import code_stamp
-    from rclverify.records.store import atomic_write_text, sealed_dumps
+    from rclverify.core.cache import code_stamp  # deferred: start-up (loads rclverify.core.cache, fractions and more only when called)
     body = {"code": code_stamp(), "inputs": check_inputs(ws), "hashes": hashes}
     atomic_write_text(ws.path(ws.CHECK_INDEX), sealed_dumps(body))
 
@@ -341,8 +342,7 @@ def current_snapshot_hashes(ws: Workspace, texts: Any) -> dict[str, str]:
     (snapshots and model are pure functions of those files and the code)
     and are returned without making every snapshot again (0.45 s of each
     report task at 1000 nodes).  Raises like :func:`node_snapshots`."""
-    from rclverify.core.cache import code_stamp
-    from rclverify.records.store import SEAL, seal_of
+    from rclverify.core.cache import code_stamp  # deferred: start-up (loads rclverify.core.cache, fractions and more only when called)
     kept = read_artifact(ws, ws.CHECK_INDEX, None)
     if (isinstance(kept, dict) and kept.get("code") == code_stamp() and isinstance(kept.get("hashes"), dict)
             and kept.get(SEAL) == seal_of(kept) and kept.get("inputs") == check_inputs(ws)):
@@ -357,7 +357,7 @@ def state_hashes(ws: Workspace) -> dict[str, str]:
     plan's ``state:`` (:func:`rclverify.model.plan.state.state_sha256`): a
     requirement record holds those of its cone's nodes, so a ``state:`` edit
     shows it stale in ``rclverify report`` before the requirements stage ran."""
-    from rclverify.model.plan.state import state_key, state_sha256
+    from rclverify.model.plan.state import state_key, state_sha256  # deferred: start-up (loads rclverify.lang.ast, rclverify.lang.types and more only when called)
     return {state_key(n): state_sha256(ws.plan.states, n) for n in ws.checked.nodes}
 
 
@@ -369,8 +369,7 @@ def record_provenance(ws: Workspace, node: str, stage: str, inputs: Sequence[str
     or health findings of a contract edited since are shown ``stale``, never
     with the status of the old text (``rclverify report`` runs no stage).
     Raises ``OSError`` when the file cannot be written."""
-    from rclverify.records.records import hash_inputs
-    from rclverify.records.sealed import read_sealed, write_sealed
+    from rclverify.records.sealed import read_sealed, write_sealed  # deferred: start-up (loads rclverify.records.sealed only when called)
     rel = ws.provenance(node)
     current, problem = read_sealed(ws.path(rel))
     if problem or current is None:  # an altered record is not kept: the other stage then reads as stale
@@ -404,8 +403,7 @@ def stale_stages(ws: Workspace, current: dict[str, str]) -> dict[str, set[str]]:
     -> sha256; :func:`current_snapshot_hashes` plus :func:`current_model_hash`;
     other files are hashed here and added to it), or nothing was recorded.
     Nodes with no artifacts yet are left out."""
-    from rclverify.records.records import hash_inputs
-    from rclverify.records.sealed import read_sealed
+    from rclverify.records.sealed import read_sealed  # deferred: start-up (loads rclverify.records.sealed only when called)
     out: dict[str, set[str]] = {}
     for n in ws.checked.nodes:
         rec, altered = read_sealed(ws.path(ws.provenance(n)))

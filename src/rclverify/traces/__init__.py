@@ -15,6 +15,7 @@ from pathlib import Path
 from typing import Callable, Iterator, Sequence
 
 from rclverify.traces.events import Event, TraceError
+from rclverify.traces.guard import LOG_SUFFIXES, check_trace_path
 
 
 def read_trace(path: Path, msg_dirs: Sequence[Path] = (), *, streams: bool = False,
@@ -31,14 +32,13 @@ def read_trace(path: Path, msg_dirs: Sequence[Path] = (), *, streams: bool = Fal
     ``on_warning``.  Raises :class:`TraceError` (located) for a trace it
     cannot read, or one that could block the reader (a FIFO, a device).
     """
-    from rclverify.traces.guard import LOG_SUFFIXES, check_trace_path
     for w in check_trace_path(path, streams):
         if on_warning is not None:
             on_warning(w)
     if not path.is_dir() and path.suffix in LOG_SUFFIXES:
-        from rclverify.traces.jsonl_blocks import JsonlLog
+        from rclverify.traces.jsonl_blocks import JsonlLog  # deferred: optional or conditional (inside a block)
         return JsonlLog(path)  # its events, as read_jsonl reads them, or its blocks for the batch path
-    from rclverify.traces.bag_blocks import BagTrace
+    from rclverify.traces.bag_blocks import BagTrace  # deferred: start-up (loads numpy, rclverify.traces.bag and more only when called)
     return BagTrace(path, msg_dirs)  # read_bag's events, or its blocks for the batch path (a ROS 2 bag)
 
 

@@ -17,7 +17,7 @@ def custom_types(msg_dirs: Sequence[Path]) -> dict[str, Any]:
 
     Raises :class:`TraceError` (naming the file) for a definition rosbags rejects.
     """
-    from rosbags.typesys import get_types_from_msg
+    from rosbags.typesys import get_types_from_msg  # deferred: start-up (loads rosbags and more only when called)
     types: dict[str, Any] = {}
     for d in msg_dirs:
         for f in sorted(d.rglob("*.msg")):
@@ -41,7 +41,7 @@ def typestore(msg_dirs: Sequence[Path]) -> Any:
     (``TypesysError``), which made every bag of such a workspace unreadable.
     Raises :class:`TraceError` as :func:`custom_types` does.
     """
-    from rosbags.typesys import Stores, get_typestore
+    from rosbags.typesys import Stores, get_typestore  # deferred: start-up (loads rosbags and more only when called)
     store = get_typestore(Stores.ROS2_HUMBLE)
     own = custom_types(msg_dirs)
     if any(store.fielddefs.get(name, fields) != fields for name, fields in own.items()):
@@ -106,7 +106,7 @@ def read_bag(path: Path, msg_dirs: Sequence[Path] = ()) -> Iterator[Event]:
 
 def open_bag(path: Path, store: Any) -> Any:
     """An opened ``rosbags`` reader of the bag at ``path``; raises :class:`TraceError` as :func:`read_bag`."""
-    from rosbags.highlevel import AnyReader
+    from rosbags.highlevel import AnyReader  # deferred: start-up (loads rosbags and more only when called)
     try:
         reader = AnyReader([path], default_typestore=store)
         reader.open()

@@ -75,7 +75,7 @@ class BagTrace:
         if self._events is not None:
             return None
         store = typestore(self.msg_dirs)
-        from rosbags.typesys import Stores, get_typestore
+        from rosbags.typesys import Stores, get_typestore  # deferred: start-up (loads rosbags and more only when called)
         standard = get_typestore(Stores.ROS2_HUMBLE).fielddefs
         if any(store.fielddefs.get(t) != standard[t] for t in (FLOAT64, STRING)):
             return None  # the workspace redefines one: its layout is not the one decoded here

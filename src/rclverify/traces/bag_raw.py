@@ -105,9 +105,9 @@ def raw_blocks(reader: Any, rows: int) -> Iterator[RawMessages] | None:
     in ``AnyReader.messages()``'s order (module docstring), or ``None`` when that order is
     not reproduced here.  Raises what ``rosbags`` raises, after the blocks before it."""
     try:
-        from rosbags.rosbag2.reader import DirectoryReader
-        from rosbags.rosbag2.storage_mcap import McapReader
-        from rosbags.rosbag2.storage_sqlite3 import Sqlite3Reader
+        from rosbags.rosbag2.reader import DirectoryReader  # deferred: optional or conditional (inside a block)
+        from rosbags.rosbag2.storage_mcap import McapReader  # deferred: optional or conditional (inside a block)
+        from rosbags.rosbag2.storage_sqlite3 import Sqlite3Reader  # deferred: optional or conditional (inside a block)
         if not version("rosbags").startswith("0.11."):
             return None
     except Exception:  # noqa: BLE001 - another rosbags: its own reader
@@ -224,7 +224,7 @@ def _mcap_chunks(storage: Any, connmap: dict[int, Any]) -> list[Any] | None:
 
 def _mcap_chunk(storage: Any, chunk: Any, connmap: dict[int, Any]) -> RawMessages:
     """One chunk's messages, sorted stably by stamp (module docstring); raises rosbags' error."""
-    from rosbags.rosbag2.storage_mcap import msgsrc
+    from rosbags.rosbag2.storage_mcap import msgsrc  # deferred: start-up (loads rosbags and more only when called)
     got = None
     try:
         got = _mcap_fast(storage, chunk, connmap)
@@ -244,7 +244,7 @@ def _gather(u: np.ndarray, at: np.ndarray, width: int) -> np.ndarray:
 
 def _mcap_fast(storage: Any, chunk: Any, connmap: dict[int, Any]) -> RawMessages | None:
     """The chunk read through its message index, or ``None`` when the index does not check out."""
-    from rosbags.rosbag2.storage_mcap import decompress, deserialize_uint32, read_exact
+    from rosbags.rosbag2.storage_mcap import decompress, deserialize_uint32, read_exact  # deferred: start-up (loads rosbags and more only when called)
     bio = storage.bio
     bio.seek(chunk.chunk_start_offset + 9 + 24)
     crc = deserialize_uint32(read_exact(bio, 4))[0]

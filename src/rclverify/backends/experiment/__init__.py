@@ -18,6 +18,6 @@ def __getattr__(name: str) -> Any:
     """``ExperimentBackend`` loaded on first use (PEP 562): ``rclverify check``
     enters the package only for :mod:`.config` (the plan entry's checks)."""
     if name == "ExperimentBackend":
-        from rclverify.backends.experiment.backend import ExperimentBackend
+        from rclverify.backends.experiment.backend import ExperimentBackend  # deferred: optional or conditional (inside a block)
         return ExperimentBackend
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

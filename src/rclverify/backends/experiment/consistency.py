@@ -25,11 +25,11 @@ from fractions import Fraction
 from typing import Any
 
 from rclverify.backends.experiment.figures import Figures
+from rclverify.backends.experiment.figures import BASE, UNITS
 
 
 def _display_unit(text: str, dim: str) -> tuple[str, Fraction]:
     """The unit ``text`` is written in (``"21.4 cm"`` -> cm), else the base unit."""
-    from rclverify.backends.experiment.figures import BASE, UNITS
     word = text.split()[-1] if len(text.split()) == 2 else ""
     if word in UNITS and UNITS[word][0] == dim:
         return word, UNITS[word][1]

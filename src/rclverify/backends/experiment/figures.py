@@ -28,6 +28,7 @@ from fractions import Fraction
 from typing import Any, Mapping
 
 from rclverify.model.plan.yamlguard import safe_load_guarded
+import yaml
 
 #: unit -> (dimension, factor to the base unit).  Base units: m, s.
 UNITS: Mapping[str, tuple[str, Fraction]] = {
@@ -108,7 +109,6 @@ class Figures:
 
 def load_summary(text: str, file: str) -> Figures:
     """Read a summary-statistics YAML text.  Raises :class:`DataError`."""
-    import yaml
     try:
         data = safe_load_guarded(text, file)
     except yaml.YAMLError as exc:

@@ -15,9 +15,9 @@ from rclverify.backends.experiment.figures import BASE, Figures, Quantity
 def render_svg(fig: Figures, constants: Mapping[str, Quantity], title: str) -> str:
     """The SVG text: per-trial values (or, for a summary, best/mean +- std/worst)
     with a horizontal line for every constant of the measured dimension."""
-    import matplotlib
+    import matplotlib  # deferred: start-up (loads matplotlib only when called)
     matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    import matplotlib.pyplot as plt  # deferred: start-up (loads matplotlib and more only when called)
     unit = BASE.get(fig.dim, "")
     with matplotlib.rc_context({"svg.hashsalt": "rclverify", "svg.fonttype": "none", "font.size": 9}):
         f, ax = plt.subplots(figsize=(6.4, 3.6))

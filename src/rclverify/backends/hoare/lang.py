@@ -46,6 +46,7 @@ from rclverify.lang.errors import RclError, error
 from rclverify.backends.hoare.nodes import (  # re-exported: the language's syntax, one namespace
     NOLOC, Num, BoolConst, Name, Old, Call, UnOp, BinOp, COMPARISONS, CONNECTIVES, Unary, Binary, Expr, Assign,
     If, While, Skip, Stmt, VarDecl, ExternDecl, Program)
+from rclverify.lang.source import decode_text
 
 
 # --------------------------------------------------------------------------
@@ -306,7 +307,6 @@ def parse_program_file(path: str | Path, display: str | None = None) -> Program:
     path); defaults to ``str(path)``.  An unreadable file is an
     :class:`RclError` (code ``E-io``) located at line 1.
     """
-    from rclverify.lang.source import decode_text  # UTF-8 rules of every input (a BOM accepted, UTF-16/32 named)
     name = display if display is not None else str(path)
     try:
         data = Path(path).read_bytes()

@@ -94,7 +94,7 @@ def read_spin_config(target: NodeTarget) -> SpinConfig:
     env = None
     if "environment" in cfg:
         try:
-            from rclverify.backends.model_checking.environment import environment_from_plan  # stage one
+            from rclverify.backends.model_checking.environment import environment_from_plan  # stage one; deferred: optional or conditional (inside a block)
         except ImportError:  # an installation without stage one: its evidence says so (run_spin)
             environment_from_plan = None
         if environment_from_plan is not None:
@@ -178,7 +178,7 @@ def _graph(target: NodeTarget, model: str, cfg: SpinConfig, time_limit_s: float,
     key = hashlib.sha256(text + json.dumps([model, cfg.environment_raw, cfg.max_states, cfg.max_depth,
                                             time_limit_s, avoid], sort_keys=True, default=str).encode()).hexdigest()
     if key not in _GRAPHS:
-        from rclverify.backends.model_checking.explore import explore  # stage one
+        from rclverify.backends.model_checking.explore import explore  # stage one; deferred: optional or conditional (inside a block)
         assert cfg.environment is not None  # run_spin checked it
         t0 = time.perf_counter()
         graph: StateGraph | RclError

@@ -133,7 +133,7 @@ class MonitorsBackend:
                                 c.get("tolerance"))
         except ConfigError as exc:
             if exc.located:  # an error inside the mapping file: located there
-                from rclverify.model.plan.errors import plan_error
+                from rclverify.model.plan.errors import plan_error  # deferred: optional or conditional (inside a block)
                 raise plan_error(*exc.located) from None
             if exc.path:
                 raise target.config_error(str(exc), *exc.path) from None

@@ -36,6 +36,10 @@ from rclverify.semantics.floatsem import Tolerance, ToleranceError, parse_tolera
 from rclverify.traces.mapping import RuleError, TopicRule, load_rules
 from rclverify.model.plan.yamlguard import read_yaml_text, safe_load_guarded
 from rclverify.backends.monitors.skew import DEFAULT_SKEW_S, parse_skew
+from rclverify.model.plan.errors import PlanError, plan_error
+from rclverify.model.plan.yamlguard import load_located
+from rclverify.model.plan.paths import escape_reason
+from rclverify.lang.errors import Diagnostic
 
 DEFAULT_MAPPING = "backends/monitors/mapping.yaml"
 DEFAULT_HORIZON = 5.0
@@ -168,8 +172,6 @@ def load_mapping(root: Path, rel: str | None, horizon: Any = None, traces: Any =
 def _at(path: Path, rel: str, keys: tuple[Any, ...]) -> str:
     """``line:col`` of the value at ``keys`` in the mapping file (``1:1``
     when it cannot be found)."""
-    from rclverify.model.plan.errors import PlanError
-    from rclverify.model.plan.yamlguard import load_located
     try:
         _, locs = load_located(read_yaml_text(path, rel), rel)
     except (PlanError, yaml.YAMLError):
@@ -185,10 +187,6 @@ def _check_msg_dirs(root: Path, rel: str, path: Path, dirs: list[str]) -> None:
     :mod:`rclverify.model.plan.paths`): the ``.msg`` files are inputs of the
     evidence and belong in the assessor's bundle.  Raises ``PlanError``
     located at the directory in the mapping file."""
-    from rclverify.model.plan.errors import PlanError, plan_error
-    from rclverify.model.plan.paths import escape_reason
-    from rclverify.model.plan.yamlguard import load_located
-    from rclverify.lang.errors import Diagnostic
     bad = [(i, d, why) for i, d in enumerate(dirs) for why in [escape_reason(root, d)] if why is not None]
     if not bad:
         return

@@ -41,6 +41,8 @@ from rclverify.traces import TraceError, read_trace
 from rclverify.backends.monitors.backend import trace_sha256
 from rclverify.backends.monitors.config import ConfigError, load_mapping
 from rclverify.backends.monitors.temporal_trace import check_temporal_trace
+import hashlib
+import json
 
 STATUS = {"false": "failed", "true": "discharged", "currently_false": "inconclusive", "inconclusive": "inconclusive"}
 
@@ -87,8 +89,6 @@ def trace_hashes(root: Path, traces: list[tuple[str, str | None]]) -> dict[str, 
 def fingerprint_text(root: Path, traces: list[tuple[str, str | None]]) -> str:
     """What a requirement's fingerprint adds for its recorded runs: each
     trace's sha256 and its mapping file's (the mapping decides the values)."""
-    import hashlib
-    import json
     out = []
     for tr, mapping in traces:
         m = root / mapping if mapping else None

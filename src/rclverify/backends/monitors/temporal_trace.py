@@ -71,6 +71,7 @@ from rclverify.lang.types import Checked
 from rclverify.traces.events import Event
 from rclverify.traces.mapping import TopicRule
 from rclverify.semantics.values import render
+from rclverify.lang.printer import expr_to_rcl
 
 VERDICTS = ("true", "false", "currently_false", "inconclusive")
 
@@ -336,7 +337,6 @@ def _at_end(r: _Run, nodes: list[str]) -> TraceVerdict:
 
 
 def _text(f: Formal) -> str:
-    from rclverify.lang.printer import expr_to_rcl
     return expr_to_rcl(f.expr)
 
 

@@ -17,6 +17,6 @@ def __getattr__(name: str) -> Any:
     implementation's import closure), which must not pay for importing
     Hypothesis (about 0.3 s of a no-op run's 0.46 s)."""
     if name == "PropertyTestsBackend":
-        from rclverify.backends.property_tests.backend import PropertyTestsBackend
+        from rclverify.backends.property_tests.backend import PropertyTestsBackend  # deferred: optional or conditional (inside a block)
         return PropertyTestsBackend
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

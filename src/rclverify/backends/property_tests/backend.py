@@ -36,6 +36,7 @@ from rclverify.backends.property_tests.closure import import_closure, outside_ve
 from rclverify.backends.property_tests.declared import declaration_rows, has_declarations
 from rclverify.backends.property_tests.seeding import split_facts
 from rclverify.backends.property_tests.harness import Config, ConfigError, Outcome, load_implementation, read_config, run_guarantee, versions
+import inspect
 
 NAME = "property_tests"
 KIND = "testing"
@@ -89,7 +90,6 @@ def render_tests(target: NodeTarget, cfg: Config, stateful: bool) -> str:
 
 
 def _is_class(target: NodeTarget, cfg: Config) -> bool:
-    import inspect
     try:
         return inspect.isclass(load_implementation(target.root, cfg))
     except ConfigError as exc:

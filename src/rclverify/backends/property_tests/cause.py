@@ -27,6 +27,8 @@ import os
 import sys
 from types import FrameType
 from typing import Any, Callable, Mapping, Sequence
+import dis
+import linecache
 
 
 def implementation_file(impl: Any) -> str | None:
@@ -92,7 +94,6 @@ def _stores(code: Any) -> dict[int, str]:
     that stores a local variable (:mod:`dis`): which line assigned a local
     is then known exactly, even when the new value is the same object as
     the old one (a small int)."""
-    import dis
     return {i.offset: str(i.argval) for i in dis.get_instructions(code)
             if i.opname in ("STORE_FAST", "STORE_NAME", "STORE_DEREF", "STORE_GLOBAL")}
 
@@ -103,8 +104,7 @@ def _returned_names(file: str, line: int) -> set[str]:
     candidate only when the return reads it); empty when the line is not a
     whole ``return`` statement (one spread over lines: every local is a
     candidate)."""
-    import ast
-    import linecache
+    import ast  # deferred: start-up (loads ast only when called)
     text = linecache.getline(file, line).strip()
     try:
         tree = ast.parse(text)

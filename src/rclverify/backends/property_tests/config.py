@@ -98,7 +98,7 @@ def load_implementation(root: Path, cfg: Config) -> Any:
     Raises :class:`ConfigError` when the file does not import or lacks the name.
     """
     path = (root / cfg.file).resolve()
-    from rclverify.backends.property_tests.closure import import_closure
+    from rclverify.backends.property_tests.closure import import_closure  # deferred: start-up (loads rclverify.backends.property_tests, ast only when called)
     closure = {(root / f).resolve() for f in import_closure(root, cfg.file)[0]}
     names = {p.name for p in closure}
     for name, mod in list(sys.modules.items()):  # the workspace modules it imports, afresh too (a long-lived process)

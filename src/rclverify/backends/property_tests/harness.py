@@ -317,7 +317,7 @@ class GuaranteeRun:
                 test()
         except _Violation:
             assert self.last_failure is not None
-            from rclverify.backends.property_tests.readable import readable_failure  # the boundary value first, the implementation's line (issue 48)
+            from rclverify.backends.property_tests.readable import readable_failure  # the boundary value first, the implementation's line (issue 48); deferred: optional or conditional (inside a block)
             moved = readable_failure(self, _Violation)
             unconfirmed = self._unconfirmed()
             if unconfirmed is not None:
@@ -374,8 +374,8 @@ def _no_local_constants() -> Iterator[None]:
     source is saved too.  A Hypothesis without this pool is left as it is.
     """
     try:
-        from hypothesis.internal.conjecture import providers
-        from hypothesis.internal.constants_ast import Constants
+        from hypothesis.internal.conjecture import providers  # deferred: optional or conditional (inside a block)
+        from hypothesis.internal.constants_ast import Constants  # deferred: optional or conditional (inside a block)
         get = providers._get_local_constants
         cache = providers.CONSTANTS_CACHE.cache
     except (ImportError, AttributeError):

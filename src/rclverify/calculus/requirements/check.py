@@ -229,7 +229,7 @@ def check_requirement(req: Requirement, checked: Checked, model: SystemModel, pl
         mentioned = {enc.symbol_name(n, p, v) for f in (formal,) for n, p, v in f.mentions}
         hit = [lbl for lbl, syms in q.g_symbols.items() if syms & mentioned]
         first = [l for l in hit if l in traced] or hit
-        from rclverify.calculus.requirements.readable import readable_counterexample  # within the assumptions, short values (issue 48); deferred: optional or conditional (inside a block)
+        from rclverify.calculus.requirements.readable import readable_counterexample  # within the assumptions, short values (issue 48); deferred: optional or conditional (inside a block); deferred: optional or conditional (inside a block)
         shown, note = readable_counterexample(q.labelled, r.model or {}, cone, checked, model, enc)
         out.update(verdict="refuted", counterexample=_counterexample(shown, cone, checked, enc),
                    failed_to_prevent=[q.by_label[l] for l in first], **note)

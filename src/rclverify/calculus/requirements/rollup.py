@@ -97,7 +97,7 @@ def declaration_statuses(records: Mapping[str, Sequence[tuple[str, Sequence[Mapp
     ``initially`` on the other ``initially`` clauses Z3 shows entail it;
     without it, ``progress`` is the worst of its declarations.  No row at
     all: ``("pending", "declared, not verified")``."""
-    from rclverify.calculus.requirements.declared_proof import initial_support, node_of, progress_labels
+    from rclverify.calculus.requirements.declared_proof import initial_support, node_of, progress_labels  # deferred: start-up (loads lark, z3 and more only when called)
 
     def status(node: str, kind: str, index: int) -> tuple[str, str]:
         per: dict[str, list[str]] = {}

@@ -53,7 +53,7 @@ def _fraction(*args: Any) -> Fraction:
 
 def _nodetype() -> Any:
     try:
-        from rosbags.interfaces import Nodetype
+        from rosbags.interfaces import Nodetype  # deferred: optional or conditional (inside a block)
     except ImportError:
         return None
     return Nodetype
@@ -61,7 +61,7 @@ def _nodetype() -> Any:
 
 def _markup() -> Any:
     try:
-        from markupsafe import Markup
+        from markupsafe import Markup  # deferred: optional or conditional (inside a block)
     except ImportError:  # pragma: no cover - a dependency of jinja2
         return None
     return Markup

@@ -37,6 +37,7 @@ from typing import Any, BinaryIO
 from rclverify.core.cache.keys import file_digest, salt
 from rclverify.core.cache.safeload import load
 from rclverify.core.cache.store import open_stream, write_stream
+from rclverify.core.cache.heap import no_collection
 
 CACHE = "artifacts/cache/workspace.pickle"
 KIND = "workspace"
@@ -107,7 +108,6 @@ def restore(ws: Any) -> bool:
 
 
 def _load_large(fh: Any) -> Any:
-    from rclverify.core.cache.heap import no_collection
     with no_collection():  # the loaded objects are all live: collecting during the load only costs time
         return load(fh)
 

@@ -29,6 +29,8 @@ from typing import Any, Iterable, Mapping, MutableMapping
 
 from rclverify.lang import ast
 from rclverify.lang.types import Checked
+from rclverify.model.plan.errors import plan_error
+from rclverify.lang.printer import to_rcl, expr_to_rcl
 
 #: ``<Node>.g<k>[.c<j>].<check>`` or ``<Node>.<check>``: a health finding's id (calculus/health/finding.py).
 _HEALTH_ID = re.compile(r"^(?P<node>[A-Za-z_][A-Za-z0-9_]*)(?:\.g(?P<k>\d+)(?:\.c(?P<j>\d+))?)?\.(?P<check>[A-Za-z0-9_-]+)$")
@@ -74,7 +76,6 @@ def read_acknowledgements(data: Mapping[str, Any], locs: Mapping[Any, ast.Loc], 
     at the entry, for an entry that gives neither or both of ``text`` and
     ``sha256``, or whose reason is no sentence (fewer than three words of
     letters: ``reason: "..."`` says nothing a reviewer can weigh)."""
-    from rclverify.model.plan.errors import plan_error
     out = []
     for i, a in enumerate(data.get("acknowledged") or ()):
         at = locs.get(("acknowledged", i), ast.Loc(plan_rel, 1, 1))
@@ -99,7 +100,6 @@ def _within(loc: ast.Loc, line: int, col: int) -> bool:
 
 
 def _node_text(node: ast.Node) -> str:
-    from rclverify.lang.printer import to_rcl
     return to_rcl(ast.Spec((), (node,)))
 
 
@@ -107,7 +107,6 @@ def lint_flagged(row: Mapping[str, Any], checked: Checked, source: str = "") -> 
     """The flagged text of a lint row (``file``/``line``/``col`` or
     ``location``): the clause or constant whose span holds the location,
     else the node's whole contract, else the source line ``source`` gives."""
-    from rclverify.lang.printer import expr_to_rcl
     file, line, col = _where(row)
     for spec in checked.specs:
         if spec.file != file:
@@ -146,7 +145,6 @@ def health_flagged(finding: Mapping[str, Any], checked: Checked) -> str:
     ``k`` (``<Node>.g<k>.c<j>.<check>``), guarantee ``k``
     (``<Node>.g<k>.<check>``), the node's contract (``<Node>.<check>``), or
     the finding's message when its id names no node of ``checked``."""
-    from rclverify.lang.printer import expr_to_rcl
     m = _HEALTH_ID.match(str(finding.get("id", "")))
     cn = checked.nodes.get(m["node"]) if m else None
     if m is None or cn is None:

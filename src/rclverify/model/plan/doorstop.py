@@ -34,6 +34,7 @@ from typing import Any
 from rclverify.lang import ast
 from rclverify.model.plan.errors import PlanError, plan_error
 from rclverify.model.plan.formal import Source
+from rclverify.model.plan.paths import escape_reason
 
 
 def _documents(folder: Path) -> list[Path]:
@@ -71,7 +72,6 @@ def _item_file(root: Path, path: Path, loc: ast.Loc) -> str:
     file resolves outside the workspace, e.g. through a symbolic link: every
     file a requirement rests on must be in the workspace, so that the
     assessor's bundle holds it (:mod:`.paths`)."""
-    from rclverify.model.plan.paths import escape_reason
     rel = path
     for a, b in ((path, root), (path.absolute(), root.absolute())):
         try:
@@ -95,7 +95,7 @@ def read_requirements(root: Path, folder: str, loc: ast.Loc) -> tuple[Any, ...]:
     folder holds no document or Doorstop cannot read it, and located in an
     item's file when an attribute has the wrong shape.
     """
-    from rclverify.model.plan.model import Requirement, Support
+    from rclverify.model.plan.model import Requirement, Support  # deferred: start-up (loads rclverify.model.plan, hashlib and more only when called)
     base = root / folder
     if not base.is_dir():
         raise plan_error(loc.file, loc.line, loc.col, f"requirements_from: {folder!r} is not a folder", "E-io")
@@ -104,7 +104,7 @@ def read_requirements(root: Path, folder: str, loc: ast.Loc) -> tuple[Any, ...]:
         raise plan_error(loc.file, loc.line, loc.col, f"requirements_from: no Doorstop document (a folder with a "
                                                       f".doorstop.yml) under {folder!r}", "E-io")
     try:
-        from doorstop.core.document import Document
+        from doorstop.core.document import Document  # deferred: optional or conditional (inside a block)
     except ImportError:  # pragma: no cover - a dependency of rclverify
         raise plan_error(loc.file, loc.line, loc.col, "requirements_from: the 'doorstop' package is not installed "
                                                       "(pip install doorstop)", "E-io") from None

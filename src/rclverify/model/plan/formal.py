@@ -127,8 +127,8 @@ def read_expr(src: Source, checked: Checked, what: str = "requirement",
     a formula but of any type: returns ``(expr, scope, mentions, type)``
     with the fields of :class:`Formal` and the inferred type.  Raises
     :class:`RclError` with located diagnostics (as :func:`parse_formal`)."""
-    from rclverify.lang.parser import parse_formula
-    from rclverify.lang.typecheck import infer
+    from rclverify.lang.parser import parse_formula  # deferred: start-up (loads lark, rclverify.core and more only when called)
+    from rclverify.lang.typecheck import infer  # deferred: start-up (loads lark, rclverify.core and more only when called)
     diags = []
     names: dict[str, str] = {}  # placeholder -> Node.in.x
     mentions: dict[tuple[str, str, str], None] = {}

@@ -27,6 +27,15 @@ from rclverify.model.plan.yamlguard import KEY, Blocks, compose_guarded, read_ya
 
 # The plan's values live in model/plan/model.py (below this loader and what it calls); re-exported here.
 from rclverify.model.plan.model import Connection, DeadlineSpec, EvidenceEntry, Fact, Path_, Plan, Requirement, Support  # noqa: E402,F401
+from rclverify.model.plan.paths import check_plan_paths
+from rclverify.model.plan.state import read_state, state_types, check_states
+from rclverify.model.plan.acknowledged import read_acknowledgements
+from rclverify.lang.timing import UNITS, parse_duration
+from rclverify.model.plan.formal import parse_formal
+from rclverify.model.plan.ranking import parse_hints
+from rclverify.model.plan.temporal import Temporal, parse_temporal, shape
+from rclverify.model.plan.expected import check_expected
+from rclverify.model.plan.entries import BACKEND_NAMES, unknown_key_messages
 
 __all__ = ["KEY", "Plan", "load_plan", "read_plan_data", "resolve"]
 
@@ -70,7 +79,7 @@ def _read_plan_source(root: Path, plan_rel: str) -> tuple[dict[str, Any], dict[P
         raise plan_error(plan_rel, line, col, f"invalid YAML: {getattr(exc, 'problem', exc)}", "E-yaml") from None
     if not isinstance(data, dict):
         raise plan_error(plan_rel, 1, 1, "the verification plan must be a mapping with a 'contracts' list")
-    import jsonschema  # here, not at module level: a doit run that reuses the cached workspace never validates
+    import jsonschema  # here, not at module level: a doit run that reuses the cached workspace never validates; deferred: start-up (loads jsonschema only when called)
     errors = sorted(jsonschema.Draft202012Validator(_schema()).iter_errors(data), key=lambda e: list(map(str, e.absolute_path)))
     if errors:
         diags: list[Diagnostic] = []
@@ -96,13 +105,12 @@ def load_plan(root: Path, plan_rel: str = "contracts/plan.yaml") -> Plan:
     Raises :class:`PlanError`.  Call :func:`resolve` once the contracts are
     checked to validate the references into them.
     """
-    from rclverify.lang.parser import parse_formula  # here: a run that reuses the cached workspace loads no plan
+    from rclverify.lang.parser import parse_formula  # here: a run that reuses the cached workspace loads no plan; deferred: start-up (loads lark, rclverify.core and more only when called)
     data, locs, blocks = _read_plan_source(root, plan_rel)
 
     def loc(*path: Any) -> ast.Loc:
         return locs.get(tuple(path), ast.Loc(plan_rel, 1, 1))
 
-    from rclverify.model.plan.paths import check_plan_paths
     check_plan_paths(root, plan_rel, data, locs)
     contracts = tuple(data["contracts"])
     for i, c in enumerate(contracts):
@@ -164,9 +172,7 @@ def load_plan(root: Path, plan_rel: str = "contracts/plan.yaml") -> Plan:
             replacements[node] = (spec["replacement"], loc("nodes", node, "replacement"))
     rfrom = tuple((str(v), loc("requirements_from", k)) for k, v in (data.get("requirements_from") or {}).items())
     deadlines = _deadlines(data, loc, plan_rel)
-    from rclverify.model.plan.state import read_state
     states = read_state(data, locs, blocks, plan_rel)
-    from rclverify.model.plan.acknowledged import read_acknowledgements
     return Plan(plan_rel, root, contracts, tuple(reqs), tuple(conns), facts, instances, evidence, replacements, locs,
                 str(data.get("name", "")), dict(data.get("ros") or {}), rfrom, deadlines, states,
                 read_acknowledgements(data, locs, plan_rel))
@@ -175,7 +181,6 @@ def load_plan(root: Path, plan_rel: str = "contracts/plan.yaml") -> Plan:
 def _deadlines(data: Mapping[str, Any], loc: Any, plan_rel: str) -> tuple[DeadlineSpec, ...]:
     """The requirements' ``deadline:`` entries (rule D3); a duration without
     a unit is a located plan error."""
-    from rclverify.lang.timing import UNITS, parse_duration
     out = []
     for i, r in enumerate(data.get("requirements", [])):
         d = r.get("deadline")
@@ -210,7 +215,7 @@ def all_requirements(plan: Plan) -> tuple[Requirement, ...]:
     cannot be read."""
     out = list(plan.requirements)
     if plan.requirements_from:
-        from rclverify.model.plan.doorstop import read_requirements
+        from rclverify.model.plan.doorstop import read_requirements  # deferred: optional or conditional (inside a block)
         for folder, l in plan.requirements_from:
             out.extend(read_requirements(plan.root, folder, l))
     return tuple(out)
@@ -221,10 +226,6 @@ def check_formal(reqs: tuple[Requirement, ...], checked: Checked, states: tuple[
     statements (:func:`.temporal.parse_temporal`: unknown node or variable, an
     input written as an output, a type error, a temporal operator's bound;
     ``states`` the plan's declared state variables, :mod:`.state`)."""
-    from rclverify.model.plan.formal import parse_formal
-    from rclverify.model.plan.ranking import parse_hints
-    from rclverify.model.plan.state import state_types
-    from rclverify.model.plan.temporal import Temporal, parse_temporal, shape
     stypes = state_types(tuple(states), checked)
     diags: list[Diagnostic] = []
     seen: dict[str, Requirement] = {}
@@ -276,7 +277,6 @@ def resolve(plan: Plan, checked: Checked) -> None:
         reqs = plan.requirements
     refs.support(reqs)
     diags.extend(check_formal(reqs, checked, plan.states))
-    from rclverify.model.plan.state import check_states
     diags.extend(check_states(plan.states, checked))
     for d in plan.deadlines:
         for n in d.path:
@@ -291,7 +291,6 @@ def resolve(plan: Plan, checked: Checked) -> None:
     # (rclverify.app.pipeline.Workspace.checked calls backends.entry_checks), so
     # the plan imports no backend code.
     # expected verdicts: a malformed entry is an error here, not a report row
-    from rclverify.model.plan.expected import check_expected
     diags.extend(check_expected(plan, checked))
     if diags:
         raise PlanError(diags)
@@ -340,7 +339,7 @@ class _References:
 
     def facts(self, plan: Plan) -> None:
         """An environment fact is a well-typed formula of its node."""
-        from rclverify.lang.typecheck import infer
+        from rclverify.lang.typecheck import infer  # deferred: start-up (loads lark, rclverify.core and more only when called)
         for node, facts in plan.facts.items():
             for f in facts:
                 if not self.node_ok(node, f.loc):
@@ -355,7 +354,6 @@ class _References:
 
     def entries(self, plan: Plan) -> None:
         """An evidence entry names a registered backend and only its keys."""
-        from rclverify.model.plan.entries import BACKEND_NAMES, unknown_key_messages
         for node, entries in plan.evidence.items():
             if entries:
                 self.node_ok(node, entries[0].loc)

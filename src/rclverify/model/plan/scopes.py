@@ -82,7 +82,7 @@ def group_files(files: Sequence[str], workspace: str = ".", plan_rel: str = "con
     if found is None:
         return Scopes([Scope(files)])
     root, rel = found
-    from rclverify.model.plan.load import read_plan_data
+    from rclverify.model.plan.load import read_plan_data  # deferred: start-up (loads yaml, rclverify.lang.ast and more only when called)
     shown = str(root / rel)
     try:
         data, _ = read_plan_data(root, rel)
@@ -124,7 +124,7 @@ def plan_diagnostics(files: Sequence[str], checked: object, workspace: str = "."
     if found is None:
         return [], ""
     root, rel = found
-    from rclverify.model.plan.load import load_plan, read_plan_data, resolve
+    from rclverify.model.plan.load import load_plan, read_plan_data, resolve  # deferred: start-up (loads yaml, rclverify.lang.ast and more only when called)
     try:
         data, _ = read_plan_data(root, rel)
     except RclError:

@@ -42,6 +42,7 @@ from rclverify.lang import ast
 from rclverify.lang.errors import Diagnostic, RclError, error
 from rclverify.lang.types import BOOL, INTEGER, NATURAL, REAL, STRING, Checked, CheckedNode, Type
 from rclverify.model.plan.formal import Source, _loc_at, _rename
+import json
 
 #: ``state.v`` / ``next.v`` in a declaration's formulas.
 STATE_REF = re.compile(r"(?<![A-Za-z0-9_.'])(state|next)\.([A-Za-z_][A-Za-z0-9_]*)")
@@ -123,8 +124,8 @@ def parse_state_formula(sv: StateVar, which: str, checked: Checked, states: tupl
     also ``next.v`` and the node's ``in.x``/``out.y``.  Raises
     :class:`RclError` with located diagnostics (``E-name``, ``E-type``).
     """
-    from rclverify.lang.parser import parse_formula
-    from rclverify.lang.typecheck import infer
+    from rclverify.lang.parser import parse_formula  # deferred: start-up (loads lark, rclverify.core and more only when called)
+    from rclverify.lang.typecheck import infer  # deferred: start-up (loads lark, rclverify.core and more only when called)
     src = sv.init if which == "init" else sv.next
     what = f"state {sv.node}.{sv.name} {which}"
     cn = checked.nodes.get(sv.node)
@@ -194,7 +195,6 @@ def state_key(node: str) -> str:
 def state_sha256(states: tuple[StateVar, ...], node: str) -> str:
     """sha256 of ``node``'s state declarations (type, init, next; none: the
     empty list), so that a ``state:`` edit makes the records that read them stale."""
-    import hashlib
-    import json
+    import hashlib  # deferred: start-up (loads hashlib only when called)
     text = json.dumps([[s.name, s.type_name, s.init.text, s.next.text] for s in states if s.node == node])
     return hashlib.sha256(text.encode("utf-8")).hexdigest()

@@ -28,6 +28,7 @@ from typing import Any, Mapping
 from rclverify.lang.errors import RclError, error
 from rclverify.lang.types import Checked, Type
 from rclverify.model.plan.formal import Formal, Source, _loc_at, parse_formal
+import difflib
 
 _PREFIX = re.compile(r"\s*(always|eventually|next|previous)\b")
 _BOUND = re.compile(r"\s*\[\s*<=\s*([^\]]*)\]")
@@ -172,7 +173,6 @@ def _misspelled(src: Source, start: int, end: int, checked: Checked, what: str) 
     """A located error naming the first word of ``src.text[start:end]``
     that is no name of the system and reads like a misspelled temporal
     operator (``eventualy``: did you mean ``eventually``?), or ``None``."""
-    import difflib
     known = set(checked.env.constants) | set(checked.env.enum_values) | set(checked.env.ctors) | _RCL_WORDS
     segment = src.text[start:end]
     first = start + len(segment) - len(segment.lstrip())

@@ -57,6 +57,7 @@ import yaml
 from rclverify.lang import ast
 from rclverify.lang.errors import RclError
 from rclverify.model.plan.errors import PlanError, plan_error
+from rclverify.lang.source import decode_text
 
 Path_ = tuple[Any, ...]
 #: Marker in a location path: ``path + (key, KEY)`` is where the key itself is written.
@@ -257,7 +258,6 @@ def read_yaml_text(path: Path, file: str) -> str:
     Raises ``PlanError``: over :data:`MAX_YAML_BYTES` (``E-yaml-limit``), not
     readable (``E-io``), not UTF-8 (``E-encoding``, naming the encoding a
     byte-order mark shows; :mod:`rclverify.lang.source`)."""
-    from rclverify.lang.source import decode_text
     check_size(path, file)
     try:
         data = path.read_bytes()

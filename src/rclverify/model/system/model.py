@@ -31,6 +31,7 @@ from rclverify.lang.errors import RclError, error
 from rclverify.lang.types import Checked, EmptyT
 from rclverify.model.system.services import peers as service_peers, side_conditions as service_conditions
 from rclverify.model.system.units import connection_diagnostics
+from rclverify.model.system.cycles import elementary_cycles
 
 
 @dataclass(frozen=True)
@@ -214,7 +215,6 @@ class SystemModel:
 
     @cached_property
     def _cycles(self) -> tuple[tuple[str, ...], ...]:
-        from rclverify.model.system.cycles import elementary_cycles
         order = {n: k for k, n in enumerate(self.nodes)}
         out = []
         for c in elementary_cycles(self.nodes, [(l.from_node, l.to_node) for l in self.links]):
@@ -381,7 +381,7 @@ def cycles_kept(model: SystemModel, path: Path) -> list[list[str]]:
     edit seldom changes a connection (docs/scale.md).  A missing, damaged
     or foreign file is recomputed and replaced atomically; raises nothing
     for an unwritable cache (the cycles are returned anyway)."""
-    from rclverify.core.cache import Shelf
+    from rclverify.core.cache import Shelf  # deferred: start-up (loads rclverify.core, rclverify.core.atomic and more only when called)
     shelf = Shelf(path, "system-cycles")
     k = shelf.key("cycles", json.dumps([list(model.nodes), [l.to_json() for l in model.links]], sort_keys=True))
     cycles: list[list[str]] = [list(c) for c in shelf.get_or_make(k, model.cycles)]

@@ -25,6 +25,8 @@ from typing import Any, Iterator, Mapping
 from rclverify.records.store import atomic_write_bytes, dumps
 from rclverify.model.plan.load import Plan
 from rclverify.report.bundle.manifest import MANIFEST, BundleError, build_manifest, collect, tool_versions
+from rclverify.records.sealed import is_sealed_path, check_text
+from rclverify.records.store import SEAL
 
 _ZIP_TIME = (1980, 1, 1, 0, 0, 0)
 
@@ -83,7 +85,7 @@ def write_bundle(root: Path, plan: Plan, out: Path, tools: Mapping[str, str] | N
     manifest = build_manifest(root, plan, files, missing, contents, tools if tools is not None else tool_versions())
     members = {MANIFEST: dumps(manifest).encode("utf-8")}
     if key is not None:
-        from rclverify.report.bundle.signature import SIGNATURE, sign
+        from rclverify.report.bundle.signature import SIGNATURE, sign  # deferred: optional or conditional (inside a block)
         members[SIGNATURE] = sign(members[MANIFEST], key)
     members.update(contents)
     out.parent.mkdir(parents=True, exist_ok=True)
@@ -182,7 +184,6 @@ def must_be_sealed(name: str) -> bool:
     """Whether member ``name`` is a record rclverify always writes sealed:
     an evidence record (``artifacts/evidence/<id>.json``) or one of
     :func:`rclverify.records.sealed.is_sealed_path`."""
-    from rclverify.records.sealed import is_sealed_path
     return (name.startswith("artifacts/evidence/") and name.count("/") == 2 and name.endswith(".json")) \
         or is_sealed_path(name)
 
@@ -275,8 +276,6 @@ def seal_problem(name: str, data: bytes | None) -> str:
     has none though rclverify always seals it (:func:`must_be_sealed`), or
     it cannot be read.  A JSON file with no seal that rclverify does not
     seal (a tool's own output) is not a record: ``""``."""
-    from rclverify.records.sealed import check_text
-    from rclverify.records.store import SEAL
     if data is None:
         return f"{name}: larger than {MAX_RECORD_BYTES} bytes: its seal was not checked" if must_be_sealed(name) else ""
     try:
@@ -309,7 +308,7 @@ def verify_bundle(path: Path, kept: dict[str, bytes] | None = None, key: Any = N
     manifest has ``signed`` set to the key's fingerprint, ``None`` when no
     key was given.
     """
-    from rclverify.report.bundle.signature import SIGNATURE, check, fingerprint
+    from rclverify.report.bundle.signature import SIGNATURE, check, fingerprint  # deferred: start-up (loads cryptography, rclverify.report.bundle and more only when called)
     seals: list[str] = []
     signature: dict[str, bytes] = {}
     manifest_bytes, members = scan_members(path, seals, kept, signature)

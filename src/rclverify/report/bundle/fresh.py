@@ -28,7 +28,7 @@ def report_out_of_date(ws: Any) -> list[str]:
     what the recorded artifacts say, one sentence each (empty when it does,
     when there is no report yet, or when the workspace does not check: the
     bundle then packs what there is)."""
-    from rclverify.report.build import build_report
+    from rclverify.report.build import build_report  # deferred: start-up (loads jinja2, lark and more only when called)
     try:
         written = json.loads(ws.path("reports/assurance.json").read_text(encoding="utf-8"))
         was = {o["id"]: o["status"] for o in written["obligations"]}

@@ -39,6 +39,7 @@ import z3
 from rclverify import __version__
 from rclverify.model.plan.load import Plan
 from rclverify.model.plan.paths import TOOL_KEYS, escape_reason, looks_like_path
+from rclverify.model.plan.entries import declared_paths
 
 #: Format tag of the manifest.
 FORMAT = "rclverify-bundle/1"
@@ -90,7 +91,7 @@ def _named(plan: Plan) -> set[str]:
     out = {plan.file, *plan.contracts}
     out.update(spec.rpartition(":")[0] for spec, _ in plan.replacements.values())
     if plan.requirements_from:  # Doorstop trees: their items are requirements (with each .doorstop.yml)
-        from rclverify.model.plan.doorstop import doorstop_files
+        from rclverify.model.plan.doorstop import doorstop_files  # deferred: optional or conditional (inside a block)
         for folder, _ in plan.requirements_from:
             out.update(doorstop_files(plan.root, folder) or [folder])
 
@@ -104,7 +105,6 @@ def _named(plan: Plan) -> set[str]:
         elif isinstance(v, list):
             for x in v:
                 walk(x)
-    from rclverify.model.plan.entries import declared_paths
     for entries in plan.evidence.values():
         for e in entries:
             # the backend's declared path keys, a "<file>:<callable>" value by its file part (model/plan/entries.py),
@@ -176,7 +176,7 @@ def collect(root: Path, plan: Plan) -> tuple[list[str], list[str]]:
 
 
 def _dafny_version() -> str:
-    from rclverify.backends.dafny.runner import detect, find_dafny
+    from rclverify.backends.dafny.runner import detect, find_dafny  # deferred: start-up (loads rclverify.backends, rclverify.backends.bounded and more only when called)
     exe = find_dafny()
     if exe is None:
         return "not installed"
@@ -199,9 +199,9 @@ def tool_versions() -> dict[str, str]:
     """Versions of the tools the evidence depends on: rclverify, Z3, Dafny
     (found and identified like the Dafny backend does), Hypothesis, Python,
     Graphviz and doit.  A tool that is absent is ``"not installed"``."""
-    import doit
+    import doit  # deferred: start-up (loads doit only when called)
     try:
-        import hypothesis
+        import hypothesis  # deferred: optional or conditional (inside a block)
         hyp = str(hypothesis.__version__)
     except ImportError:
         hyp = "not installed"

@@ -24,6 +24,7 @@ from rclverify.ros.extract import cpp_helpers, treesitter
 from rclverify.ros.extract.cpp_scope import namespaces_of
 from rclverify.ros.extract.cpp_types import split_template
 from rclverify.ros.extract.model import Src
+from rclverify.ros.extract.cpp_params import string_value
 
 _ACTIONLIB = {"SimpleActionServer", "ActionServer", "SimpleActionClient", "ActionClient"}
 _T = treesitter.text
@@ -89,7 +90,6 @@ class MemberReader:
         only (never of a node handle's): ``advertise(name, n)``, the camera forms,
         message_filters' ``subscribe(h, name, ...)``, ``on_parameter_event(cb)``,
         a realtime publisher's ``init(h, name, n)``."""
-        from rclverify.ros.extract.cpp_params import string_value
         if method in ("advertiseCamera", "subscribeCamera", "on_parameter_event"):
             return True
         if method == "init":  # realtime_tools' pub.init(nh, "topic", 1)

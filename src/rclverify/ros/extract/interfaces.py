@@ -24,6 +24,7 @@ from typing import Any, Iterable
 
 from rclverify.ros.extract.cache import ParseCache
 from rclverify.ros.extract.model import Note, Src
+from rclverify.ros.extract.cmake import expand
 
 DEBIAN_SHARE = Path("/usr/share")
 BASE_TYPES = {"bool", "byte", "char", "int8", "uint8", "int16", "uint16", "int32", "uint32", "int64",
@@ -93,7 +94,6 @@ def generated_interfaces(root: Path, pkg: str) -> list[Path]:
     file is absent or unreadable.  Source: rosidl_cmake's
     ``rosidl_generate_interfaces`` (its arguments after the target are
     interface files relative to the package, up to the first keyword)."""
-    from rclverify.ros.extract.cmake import expand
     try:
         text = safefs.read_bytes(root / "CMakeLists.txt").decode("utf-8", errors="replace")
     except OSError:
@@ -115,7 +115,7 @@ def generated_interfaces(root: Path, pkg: str) -> list[Path]:
 
 
 def _parse_one(kind: str, text: str, name: str) -> dict[str, Any]:
-    from rosbags.typesys import get_types_from_idl, get_types_from_msg
+    from rosbags.typesys import get_types_from_idl, get_types_from_msg  # deferred: start-up (loads rosbags and more only when called)
     if kind == "idl":
         return dict(get_types_from_idl(text))
     if kind == "msg":
@@ -222,7 +222,7 @@ class TypeTable:
 
     def _fallback(self, name: str) -> TypeInfo | None:
         if self._store is None:
-            from rosbags.typesys import Stores, get_typestore
+            from rosbags.typesys import Stores, get_typestore  # deferred: optional or conditional (inside a block)
             self._store = get_typestore(Stores.ROS2_HUMBLE)
         fd = self._store.fielddefs.get(name)
         if fd is None:

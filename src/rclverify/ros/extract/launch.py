@@ -34,6 +34,7 @@ from typing import Any, Callable
 from rclverify.ros.extract import safefs
 from rclverify.ros.extract import names
 from rclverify.ros.extract.model import Note, Src
+from rclverify.ros.extract.xmlsrc import line_of, parse_xml
 
 
 @dataclass
@@ -302,14 +303,12 @@ class Interpreter:
 # -- readers ------------------------------------------------------------
 
 def _from_xml(e: Any, shown: str) -> El:
-    from rclverify.ros.extract.xmlsrc import line_of
     kids = [_from_xml(c, shown) for c in e if isinstance(c.tag, str)]
     return El(str(e.tag), {str(k): str(v) for k, v in e.attrib.items()}, kids, Src(shown, line_of(e)))
 
 
 def read_xml(path: Path, shown: str) -> tuple[El | None, list[Note]]:
     """A ROS 1 or ROS 2 XML launch file as an element tree (root ``launch``)."""
-    from rclverify.ros.extract.xmlsrc import parse_xml
     root, note = parse_xml(path, shown)
     if root is None:
         return None, [note] if note else []
@@ -347,7 +346,7 @@ def read_yaml(path: Path, shown: str) -> tuple[El | None, list[Note]]:
     """A ROS 2 YAML launch file (``launch: [ {node: {...}}, ...]``) as an element tree.
 
     Lines: each top-level action is located at its own line."""
-    import yaml
+    import yaml  # deferred: start-up (loads yaml only when called)
 
     class _L(yaml.SafeLoader):
         pass
@@ -361,8 +360,8 @@ def read_yaml(path: Path, shown: str) -> tuple[El | None, list[Note]]:
         text = safefs.read_text(path)
         if len(text) > 5_000_000:
             return None, [Note(Src(shown), "launch file too large", "ROS-PARSE", "error")]
-        from rclverify.model.plan.errors import PlanError
-        from rclverify.model.plan.yamlguard import compose_guarded
+        from rclverify.model.plan.errors import PlanError  # deferred: optional or conditional (inside a block)
+        from rclverify.model.plan.yamlguard import compose_guarded  # deferred: optional or conditional (inside a block)
         try:
             compose_guarded(text, shown)  # alias bombs, cycles and depth refused before expansion
         except PlanError as exc:

@@ -453,7 +453,7 @@ class Linker(LinkMembers, Values, Returns):
 
 def _py_typed(v: Any, kind: str) -> str | None:
     """The ROS type a Python value names (``("ext", "std_srvs.srv.Trigger")``) for role ``kind``."""
-    from rclverify.ros.extract.sources_py import _typed
+    from rclverify.ros.extract.sources_py import _typed  # deferred: start-up (loads rclverify.ros.extract and more only when called)
     return _typed(v[1], kind) if v is not None and v[0] == "ext" and isinstance(v[1], str) else None
 
 

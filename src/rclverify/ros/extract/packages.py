@@ -63,7 +63,7 @@ def find_manifests(paths: list[Path], skipped: list[str] | None = None) -> list[
 
 def read_package(manifest: Path, shown: str) -> tuple[Package | None, list[Note]]:
     """The package ``manifest`` describes, or ``None`` and a located error."""
-    from catkin_pkg.package import InvalidPackage, parse_package_string
+    from catkin_pkg.package import InvalidPackage, parse_package_string  # deferred: start-up (loads catkin_pkg and more only when called)
     root, note = parse_xml(manifest, shown)
     if note is not None:
         return None, [note]

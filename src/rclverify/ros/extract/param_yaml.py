@@ -46,10 +46,10 @@ def read_file(text: str, shown: str) -> tuple[list[tuple[str, str, Value, Src]],
     """``([(node pattern, "~key", value, where), ...], notes)`` of one parameter file's
     text.  Never raises: malformed YAML, or YAML over the limits of
     :mod:`rclverify.model.plan.yamlguard`, is one ``ROS-PARSE`` warning."""
-    import yaml
+    import yaml  # deferred: start-up (loads yaml only when called)
 
-    from rclverify.model.plan.errors import PlanError
-    from rclverify.model.plan.yamlguard import compose_guarded
+    from rclverify.model.plan.errors import PlanError  # deferred: start-up (loads rclverify.lang, rclverify.lang.ast and more only when called)
+    from rclverify.model.plan.yamlguard import compose_guarded  # deferred: start-up (loads yaml, rclverify.lang and more only when called)
     try:
         root = compose_guarded(text, shown)
     except yaml.YAMLError as exc:
@@ -65,7 +65,7 @@ def read_file(text: str, shown: str) -> tuple[list[tuple[str, str, Value, Src]],
 
 
 def _nodes(m: Any, prefix: str, shown: str, out: list[tuple[str, str, Value, Src]]) -> None:
-    import yaml
+    import yaml  # deferred: start-up (loads yaml only when called)
     for k, v in m.value:
         if not isinstance(k, yaml.ScalarNode) or not isinstance(v, yaml.MappingNode):
             continue
@@ -77,7 +77,7 @@ def _nodes(m: Any, prefix: str, shown: str, out: list[tuple[str, str, Value, Src
 
 
 def _params(m: Any, key: str, node: str, shown: str, out: list[tuple[str, str, Value, Src]]) -> None:
-    import yaml
+    import yaml  # deferred: start-up (loads yaml only when called)
     for k, v in m.value:
         if not isinstance(k, yaml.ScalarNode):
             continue

@@ -49,6 +49,7 @@ from typing import Any, Iterable
 from rclverify.ros.extract import safefs
 from rclverify.ros.extract.model import Endpoint, Note, Src
 from rclverify.ros.extract.xmlsrc import line_of, parse_xml
+from rclverify.ros.extract.cmake import expand
 
 MAX_PLUGIN_FILES = 16  # plugin description files read per package
 _CLASSY = re.compile(r"^(?:[A-Za-z_]\w*::)+[A-Za-z_]\w*$|^[A-Za-z_]\w*/[A-Za-z_]\w*$")
@@ -116,7 +117,6 @@ def cmake_described(root: Path) -> list[tuple[str, str, int]]:
     ``pluginlib_export_plugin_description_file(base_pkg file.xml)`` (pluginlib's
     ament CMake macro, the ROS 2 way that ros2_control controllers use instead
     of a ``package.xml`` export); ``[]`` when the file cannot be read."""
-    from rclverify.ros.extract.cmake import expand
     try:
         cmds = expand(safefs.read_text(root / "CMakeLists.txt"), root.name)
     except (OSError, UnicodeDecodeError):

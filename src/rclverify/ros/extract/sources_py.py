@@ -79,7 +79,7 @@ def scan_python(text: str, shown: str) -> dict[str, Any]:
     try:
         tree = ast.parse(text, filename=shown)
     except (SyntaxError, ValueError, RecursionError, MemoryError) as exc:
-        from rclverify.ros.extract.sources_py_tolerant import tolerant_module
+        from rclverify.ros.extract.sources_py_tolerant import tolerant_module  # deferred: optional or conditional (inside a block)
         line = getattr(exc, "lineno", None) or 1
         col = getattr(exc, "offset", None) or 1
         try:

@@ -14,11 +14,11 @@ def parser(language: str) -> Any:
     ``KeyError`` for another language."""
     p = _PARSERS.get(language)
     if p is None:
-        from tree_sitter import Language, Parser
+        from tree_sitter import Language, Parser  # deferred: optional or conditional (inside a block)
         if language == "cpp":
-            import tree_sitter_cpp as grammar
+            import tree_sitter_cpp as grammar  # deferred: optional or conditional (inside a block)
         elif language == "python":
-            import tree_sitter_python as grammar  # type: ignore[no-redef]
+            import tree_sitter_python as grammar  # type: ignore[no-redef]; deferred: optional or conditional (inside a block)
         else:
             raise KeyError(language)
         p = _PARSERS[language] = Parser(Language(grammar.language()))

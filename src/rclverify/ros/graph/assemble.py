@@ -91,7 +91,7 @@ class Assembly:
         prog = next((x for x in self.progs.get(pk, []) if x.units == {cls}), None)
         if prog is None:
             files = sorted({h[2] for h in hits if h[1] == cls})
-            from rclverify.ros.extract.programs import _closure
+            from rclverify.ros.extract.programs import _closure  # deferred: optional or conditional (inside a block)
             prog = Program(pk, None, files, _closure(self.codes[pk], files, set()), {cls})
             added = cross_package.extend(prog, self.codes)
             if added:

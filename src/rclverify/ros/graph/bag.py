@@ -6,6 +6,8 @@ from pathlib import Path
 from typing import Any
 
 from rclverify.ros.extract.model import Note, Src, canon_type
+from rclverify.traces.events import TraceError
+from rclverify.traces.guard import check_trace_path
 
 
 def bag_topics(path: Path, shown: str) -> tuple[dict[str, Any] | None, list[Note]]:
@@ -14,10 +16,8 @@ def bag_topics(path: Path, shown: str) -> tuple[dict[str, Any] | None, list[Note
     a bag that is, or whose reader would open, a FIFO, device or socket is an
     error note; another such entry of a bag directory is skipped with a
     warning note."""
-    from rosbags.highlevel import AnyReader
+    from rosbags.highlevel import AnyReader  # deferred: start-up (loads rosbags and more only when called)
 
-    from rclverify.traces.events import TraceError
-    from rclverify.traces.guard import check_trace_path
     try:
         skipped = check_trace_path(path)
     except TraceError as exc:

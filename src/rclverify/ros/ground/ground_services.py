@@ -52,7 +52,7 @@ def folded(g: Graph) -> Graph:
     """``g`` with actions written on their raw actionlib topics folded into action
     servers/clients (:func:`rclverify.ros.live.master.fold_actions`); ``g`` itself when
     it has none (no copy), else a copy (``g`` is left as it is)."""
-    from rclverify.ros.live.master import fold_actions
+    from rclverify.ros.live.master import fold_actions  # deferred: start-up (loads rclverify.ros.live, http and more only when called)
     if not any(e.topic.endswith("/goal") and (e.msg_type or "").endswith("ActionGoal")
                for n in g.nodes.values() for e in n.publishes + n.subscribes):
         return g

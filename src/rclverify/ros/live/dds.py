@@ -64,8 +64,8 @@ class DdsUnavailable(Exception):
 def import_cyclonedds() -> Any:
     """The ``cyclonedds`` package; raises :class:`DdsUnavailable` with the remedy."""
     try:
-        import cyclonedds
-        import cyclonedds.domain  # noqa: F401  (loads the C library: fails here when it cannot)
+        import cyclonedds  # deferred: optional or conditional (inside a block)
+        import cyclonedds.domain  # noqa: F401  (loads the C library: fails here when it cannot); deferred: optional or conditional (inside a block)
         return cyclonedds
     except ImportError as exc:
         raise DdsUnavailable(f"the cyclonedds Python binding is not installed ({exc}); pip install "
@@ -109,8 +109,8 @@ def configure_domain(d: int) -> None:
     """Create domain ``d`` with the user's configuration (``CYCLONEDDS_URI``: files and XML fragments, comma
     separated, as Cyclone reads it) followed by :data:`COMPATIBILITY`; a domain this process already has
     (made here or by the caller) is left as it is."""
-    from cyclonedds.core import DDSException
-    from cyclonedds.domain import Domain
+    from cyclonedds.core import DDSException  # deferred: start-up (loads cyclonedds and more only when called)
+    from cyclonedds.domain import Domain  # deferred: start-up (loads cyclonedds and more only when called)
     if d in _domains:
         return
     user = os.environ.get("CYCLONEDDS_URI", "").strip().strip(",")
@@ -126,8 +126,8 @@ def make_participant(domain: int | None = None) -> Any:
     by ``CYCLONEDDS_URI`` and :data:`COMPATIBILITY`.  Raises :class:`DdsUnavailable`
     when Cyclone refuses (a configuration file that does not parse, no usable interface)."""
     import_cyclonedds()
-    from cyclonedds.core import DDSException
-    from cyclonedds.domain import DomainParticipant
+    from cyclonedds.core import DDSException  # deferred: start-up (loads cyclonedds and more only when called)
+    from cyclonedds.domain import DomainParticipant  # deferred: start-up (loads cyclonedds and more only when called)
     d = domain_id() if domain is None else domain
     try:
         configure_domain(d)
@@ -336,8 +336,8 @@ def discovery_struct() -> Any:
     flag on its sequence and array elements) is ignored by the participant
     (:data:`COMPATIBILITY`).  The samples are read raw, in either layout."""
     import_cyclonedds()
-    from cyclonedds.idl import make_idl_struct
-    from cyclonedds.idl import types as T
+    from cyclonedds.idl import make_idl_struct  # deferred: start-up (loads cyclonedds and more only when called)
+    from cyclonedds.idl import types as T  # deferred: start-up (loads cyclonedds and more only when called)
     gid16: Any = T.array[T.uint8, 16]  # type: ignore[misc]
     gid = make_idl_struct("Gid_", "rmw_dds_common::msg::dds_::Gid_", {"data": gid16})
     node = make_idl_struct("NodeEntitiesInfo_", "rmw_dds_common::msg::dds_::NodeEntitiesInfo_", {
@@ -353,11 +353,11 @@ def take_raw(reader: Any, n: int = 256) -> list[tuple[bytes, Any]]:
     """Up to ``n`` samples of ``reader`` as ``(serialized bytes, sample info)``
     (the bytes with their encapsulation header; samples without data, a
     writer gone, are skipped)."""
-    from cyclonedds._clayer import ddspy_take
-    from cyclonedds.core import InstanceState, SampleState, ViewState
+    from cyclonedds._clayer import ddspy_take  # deferred: start-up (loads cyclonedds and more only when called)
+    from cyclonedds.core import InstanceState, SampleState, ViewState  # deferred: start-up (loads cyclonedds and more only when called)
     ret = ddspy_take(reader._ref, SampleState.Any | ViewState.Any | InstanceState.Any, n)
     if isinstance(ret, int):
-        from cyclonedds.core import DDSException
+        from cyclonedds.core import DDSException  # deferred: optional or conditional (inside a block)
         raise DDSException(ret, "take")
     return [(bytes(data), info) for data, info in ret if info.valid_data]
 
@@ -365,17 +365,17 @@ def take_raw(reader: Any, n: int = 256) -> list[tuple[bytes, Any]]:
 def write_raw(writer: Any, data: bytes, timestamp_ns: int | None = None) -> None:
     """Write serialized bytes (encapsulation header included) as one sample,
     with ``timestamp_ns`` as its source timestamp when given."""
-    from cyclonedds._clayer import ddspy_write, ddspy_write_ts
+    from cyclonedds._clayer import ddspy_write, ddspy_write_ts  # deferred: start-up (loads cyclonedds and more only when called)
     data = data.ljust((len(data) + 3) & ~3, b"\0")
     ret = ddspy_write(writer._ref, data) if timestamp_ns is None else ddspy_write_ts(writer._ref, data, timestamp_ns)
     if ret < 0:
-        from cyclonedds.core import DDSException
+        from cyclonedds.core import DDSException  # deferred: optional or conditional (inside a block)
         raise DDSException(ret, "write")
 
 
 @functools.lru_cache(maxsize=1)
 def _humble() -> Any:
-    from rosbags.typesys import Stores, get_typestore
+    from rosbags.typesys import Stores, get_typestore  # deferred: start-up (loads rosbags and more only when called)
     return get_typestore(Stores.ROS2_HUMBLE)
 
 
@@ -384,7 +384,7 @@ def type_hash_user_data(ros_type_name: str, store: Any = None) -> bytes:
     newer announce it (the REP-2011 type hash, :func:`.type_hash.rihs01`, over
     the definitions of rosbags' type ``store``, ROS 2 Humble's by default);
     empty when the store does not know the type."""
-    from rclverify.ros.live.type_hash import rihs01
+    from rclverify.ros.live.type_hash import rihs01  # deferred: start-up (loads rclverify.ros.live, hashlib only when called)
     if store is None:
         store = _humble()
     defs = store.fielddefs

@@ -60,9 +60,9 @@ class Discovery:
 
     def __post_init__(self) -> None:
         from cyclonedds.builtin import (BuiltinDataReader, BuiltinTopicDcpsParticipant,
-                                        BuiltinTopicDcpsPublication, BuiltinTopicDcpsSubscription)
-        from cyclonedds.sub import DataReader
-        from cyclonedds.topic import Topic
+                                        BuiltinTopicDcpsPublication, BuiltinTopicDcpsSubscription)  # deferred: start-up (loads cyclonedds and more only when called)
+        from cyclonedds.sub import DataReader  # deferred: start-up (loads cyclonedds and more only when called)
+        from cyclonedds.topic import Topic  # deferred: start-up (loads cyclonedds and more only when called)
         self.own.add(self.dp.guid.bytes)
         self._pubs = BuiltinDataReader(self.dp, BuiltinTopicDcpsPublication)
         self._subs = BuiltinDataReader(self.dp, BuiltinTopicDcpsSubscription)
@@ -73,7 +73,7 @@ class Discovery:
 
     def conditions(self) -> list[Any]:
         """Read conditions that trigger when discovery has news (for a wait set)."""
-        from cyclonedds.core import InstanceState, ReadCondition, SampleState, ViewState
+        from cyclonedds.core import InstanceState, ReadCondition, SampleState, ViewState  # deferred: start-up (loads cyclonedds and more only when called)
         mask = SampleState.Any | ViewState.Any | InstanceState.Any
         return [ReadCondition(r, mask) for r in (self._pubs, self._subs, self._info, self._parts)]
 

@@ -120,7 +120,7 @@ def from_dds(qos: Any) -> QosProfile:
 
 def to_dds(q: QosProfile, user_data: bytes = b"") -> Any:
     """A cyclonedds ``Qos`` with these policies (and ``user_data`` when given)."""
-    from cyclonedds.core import Policy, Qos
+    from cyclonedds.core import Policy, Qos  # deferred: start-up (loads cyclonedds and more only when called)
     pol: list[Any] = [
         Policy.Reliability.Reliable(max_blocking_time=100_000_000) if q.reliable else Policy.Reliability.BestEffort,
         {"volatile": Policy.Durability.Volatile, "transient_local": Policy.Durability.TransientLocal,

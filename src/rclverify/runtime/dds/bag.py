@@ -20,6 +20,8 @@ import shutil
 import threading
 from pathlib import Path
 from typing import Any, Mapping, Sequence
+from rclverify.traces.bag import typestore
+from rclverify.traces.events import TraceError
 
 STORAGES = ("sqlite3", "mcap")
 
@@ -49,8 +51,6 @@ class BagRecorder:
 
     def __init__(self, path: Path, storage: str, topics: Mapping[str, str], msg_dirs: Sequence[Path],
                  open_timeout_s: float = 30.0) -> None:
-        from rclverify.traces.bag import typestore
-        from rclverify.traces.events import TraceError
         self.path = Path(path)
         if self.path.suffix == ".mcap":  # a bag is a directory: name it without the suffix
             self.path = self.path.with_suffix("")
@@ -75,7 +75,7 @@ class BagRecorder:
             raise BagError(f"{self.path}: error: cannot record: {self.error}")
 
     def _open(self) -> tuple[Any, dict[str, Any]]:
-        from rosbags.rosbag2 import StoragePlugin, Writer
+        from rosbags.rosbag2 import StoragePlugin, Writer  # deferred: start-up (loads rosbags and more only when called)
         writer = Writer(self.path, version=8,
                         storage_plugin=StoragePlugin.MCAP if self.storage == "mcap" else StoragePlugin.SQLITE3)
         writer.open()

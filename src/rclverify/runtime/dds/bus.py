@@ -91,7 +91,7 @@ class Bus:
                  warn: Callable[[str], None], period_s: float = 0.05,
                  on_reader: Callable[[Tap, list[Any]], None] | None = None,
                  type_hash: Callable[[type], str | None] | None = None) -> None:
-        from cyclonedds.core import WaitSet
+        from cyclonedds.core import WaitSet  # deferred: start-up (loads cyclonedds and more only when called)
         self.dp, self.on_sample, self.warn, self.period_s = dp, on_sample, warn, period_s
         self.on_reader = on_reader
         self.layouts = LayoutJudge(dp, type_hash or (lambda struct: None))
@@ -129,8 +129,8 @@ class Bus:
 
     def writer(self, dds_topic: str, struct: type, qos: QosProfile, user_data: bytes = b"") -> Any:
         """A writer of the monitor on ``dds_topic``."""
-        from cyclonedds.pub import DataWriter
-        from cyclonedds.topic import Topic
+        from cyclonedds.pub import DataWriter  # deferred: start-up (loads cyclonedds and more only when called)
+        from cyclonedds.topic import Topic  # deferred: start-up (loads cyclonedds and more only when called)
         return DataWriter(self.dp, Topic(self.dp, dds_topic, struct), qos=to_dds(qos, user_data))
 
     def start(self) -> Bus:
@@ -178,9 +178,9 @@ class Bus:
 
     def _update(self) -> None:
         """Make or remake each tap's reader for the publishers discovered now; warn."""
-        from cyclonedds.core import InstanceState, ReadCondition, SampleState, ViewState
-        from cyclonedds.sub import DataReader
-        from cyclonedds.topic import Topic
+        from cyclonedds.core import InstanceState, ReadCondition, SampleState, ViewState  # deferred: start-up (loads cyclonedds and more only when called)
+        from cyclonedds.sub import DataReader  # deferred: start-up (loads cyclonedds and more only when called)
+        from cyclonedds.topic import Topic  # deferred: start-up (loads cyclonedds and more only when called)
         disc = self.discovery
         self._pending = False
         for t in self.taps:

@@ -117,7 +117,7 @@ class LayoutJudge:
         """``(SAME | OTHER | PENDING, reason)`` for a publisher announcing
         ``type_id`` (``None``: none) and ``user_data``; ``reason`` names the
         field that differs, or the hashes."""
-        from rclverify.ros.live.dds import announced_type_hash
+        from rclverify.ros.live.dds import announced_type_hash  # deferred: start-up (loads rclverify.ros, rclverify.ros.live and more only when called)
         if type_id is not None:
             return self._by_type_object(struct, type_id)
         theirs = announced_type_hash(user_data)
@@ -147,7 +147,7 @@ class LayoutJudge:
         resolved within the timeout)."""
         if type_id in self._shapes:
             return self._shapes[type_id]
-        from cyclonedds.dynamic import get_types_for_typeid
+        from cyclonedds.dynamic import get_types_for_typeid  # deferred: start-up (loads cyclonedds and more only when called)
         try:
             cls, _deps = get_types_for_typeid(self.dp, type_id, int(self.timeout_s * 1e9))
         except Exception:  # noqa: BLE001 - not resolved yet (type lookup under way), or a kind the binding lacks

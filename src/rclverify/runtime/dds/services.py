@@ -52,6 +52,7 @@ from rclverify.runtime.dds.order import OrderPairer, Pending
 from rclverify.runtime.dds.shadow import REPLY_OF, Shadows
 from rclverify.runtime.dds.types import TypeBook, request_id, to_fields
 from rclverify.runtime.dds.wire import framed_rmw, has_header, vendor
+from rclverify.runtime.dds.types import DdsTypeError
 
 #: seconds an answer waits for its request (or goal) to be heard
 EARLY_S = 2.0
@@ -88,7 +89,6 @@ class CallTaps:
 
     def __init__(self, book: CallBook, types: TypeBook, links: Iterable[tuple[CheckedNode, ast.Link]],
                  framed: bool | None = None) -> None:
-        from rclverify.runtime.dds.types import DdsTypeError
         self.book, self.types = book, types
         #: the services' samples carry rmw_cyclonedds' request header (default: by RMW_IMPLEMENTATION)
         self.framed = framed_rmw() if framed is None else framed

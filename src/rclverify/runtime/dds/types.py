@@ -44,6 +44,9 @@ from typing import Any, Mapping, Sequence
 
 from rclverify.ros.live.dds import dds_type, import_cyclonedds
 from rclverify.ros.extract.interfaces import TypeTable
+from rclverify.ros.extract.interfaces import TypeInfo
+from rclverify.ros.live.dds import ros_type
+from rclverify.ros.live.type_hash import UnknownType, rihs01
 
 #: rmw_cyclonedds' request header, as the first members of a service part's struct
 HEADER_FIELDS = ("client_guid_", "sequence_number_")
@@ -130,7 +133,7 @@ class TypeBook:
         return info
 
     def _field_type(self, desc: Any, owner: str, fname: str) -> tuple[Any, type | None]:
-        from cyclonedds.idl import types as T
+        from cyclonedds.idl import types as T  # deferred: start-up (loads cyclonedds and more only when called)
         kind, detail = int(desc[0]), desc[1]
         if kind == 1:
             base, bound = detail
@@ -157,8 +160,8 @@ class TypeBook:
         hit = self._structs.get(key)
         if hit is not None:
             return hit
-        from cyclonedds.idl import make_idl_struct
-        from cyclonedds.idl import types as T
+        from cyclonedds.idl import make_idl_struct  # deferred: start-up (loads cyclonedds and more only when called)
+        from cyclonedds.idl import types as T  # deferred: start-up (loads cyclonedds and more only when called)
         info = self._info(name, used_by)
         fields: dict[str, Any] = {}
         nested: dict[str, type] = {}
@@ -191,7 +194,6 @@ class TypeBook:
                 self.struct(f"{pkg}/srv/{rest}_Response", header=True))
 
     def _synth(self, name: str, fields: list[tuple[str, Any]]) -> None:
-        from rclverify.ros.extract.interfaces import TypeInfo
         if self.table.get(name) is None:
             self.table.types[name] = TypeInfo([], fields, "rclverify")
 
@@ -221,8 +223,6 @@ class TypeBook:
         of message struct ``cls`` from the definitions this book reads: what a
         ROS 2 publisher of the same definition announces.  ``None`` for a
         service part or request-header struct."""
-        from rclverify.ros.live.dds import ros_type
-        from rclverify.ros.live.type_hash import UnknownType, rihs01
         name = ros_type(getattr(cls, "__idl_typename__", ""))
         if name is None or "/msg/" not in name:
             return None

@@ -15,6 +15,9 @@ from typing import Any, Mapping
 
 from rclverify.stages.crosscheck.items import witness_query
 from rclverify.stages.crosscheck.stage import DOWNGRADES
+import hashlib
+from rclverify.stages.crosscheck.stage import read_crosscheck
+from rclverify.stages.crosscheck.items import SIDE_ANSWERS
 
 _STAGE_MISSING = "the second-solver stage has not decided it (run `doit verify`)"
 _NO_QUERY = ("no single SMT-LIB2 query is kept for this verdict (a temporal proof by BMC, k-induction or a "
@@ -87,7 +90,6 @@ class SecondSolver:
             "recorded_verdict": "proved", "reason": f"second solver: {s['why']}"})
         if rec is None or rec.get("verdict") != "proved":
             return rec
-        from rclverify.stages.crosscheck.items import SIDE_ANSWERS
         for side, answers in SIDE_ANSWERS.items():
             if rec.get(side) not in answers or not rec.get(f"{side}_smt2"):
                 continue
@@ -129,9 +131,7 @@ def load(root: Any) -> SecondSolver:
     decided (its ``sha256``; a stage re-wrote it since, the second-solver
     stage not yet) is marked ``other_text``: its agreement is not carried
     over to a query cvc5 never saw, whichever way it went."""
-    import hashlib
 
-    from rclverify.stages.crosscheck.stage import read_crosscheck
     rows, problem = read_crosscheck(root)
     for key, r in list(rows.items()):
         rel = r.get("smt2")

@@ -73,7 +73,7 @@ class Decision:
 def version() -> str:
     """cvc5's version string, '' when the package is not installed."""
     try:
-        import cvc5
+        import cvc5  # deferred: optional or conditional (inside a block)
     except ImportError:
         return ""
     return str(getattr(cvc5, "__version__", "")) or "unknown"
@@ -144,7 +144,7 @@ class Session:
                 and text.count("(push") == text.count("(pop"))
 
     def _fresh(self) -> Any:
-        import cvc5
+        import cvc5  # deferred: start-up (loads cvc5 only when called)
         tm = cvc5.TermManager()
         s = cvc5.Solver(tm)
         for k, v in (("incremental", "true"), ("rlimit-per", str(int(self.rlimit))), ("tlimit-per", str(WALL_MS)),
@@ -191,7 +191,7 @@ def _decide_one(text: str, name: str = "query.smt2", *, rlimit: int = RLIMIT, pr
     script (``error`` with cvc5's message).  Raises ``ImportError`` when
     cvc5 is missing.
     """
-    import cvc5
+    import cvc5  # deferred: start-up (loads cvc5 only when called)
     t0 = time.perf_counter()
     ver = version()
     tm = cvc5.TermManager()
@@ -236,7 +236,7 @@ def _run(s: Any, sm: Any, script: str, name: str, proofs: bool) -> tuple[list[st
     proof of each ``unsat`` in CPC text, taken at once (a later ``pop`` or
     ``reset`` discards it).  Raises :class:`_ScriptError` with cvc5's error
     output, and whatever cvc5's API raises for a script it rejects."""
-    import cvc5
+    import cvc5  # deferred: start-up (loads cvc5 only when called)
     parser = cvc5.InputParser(s, sm)
     parser.setStringInput(cvc5.InputLanguage.SMT_LIB_2_6, script, name)
     answers: list[str] = []

@@ -37,6 +37,8 @@ from typing import Any, Iterable
 
 from rclverify.records.sealed import read_sealed
 from rclverify.stages.requirements import record_path
+from rclverify.records.sealed import obligation_list
+from rclverify.records.store import EvidenceStore
 
 #: Health checks whose ``ok`` is an ``unsat`` answer (a proof); every other
 #: check's ``ok`` is a satisfiable answer with Z3's witness.
@@ -130,8 +132,6 @@ def _path(p: Any) -> bool:
 def _hoare_items(root: Any, nodes: Iterable[str]) -> list[Item]:
     """A discharged Hoare obligation's verification conditions (its ``.smt2``
     artifact: one ``push``/``pop`` scope per condition, all ``unsat``)."""
-    from rclverify.records.sealed import obligation_list
-    from rclverify.records.store import EvidenceStore
     store = EvidenceStore(root)
     out: list[Item] = []
     for n in nodes:

@@ -51,11 +51,11 @@ def z3_answer(text: str, every: bool = False) -> str:
     to each ``(push 1)`` ... ``(pop 1)`` scope of it (a Hoare triple's
     conditions): ``unsat`` when all are, else the first other answer."""
     if every:
-        import re
+        import re  # deferred: optional or conditional (inside a block)
         blocks = re.findall(r"\(push 1\)\n(.*?)\(pop 1\)", text, flags=re.S) or text.split("\n(reset)\n")
         answers = [z3_answer(b) for b in blocks]
         return next((a for a in answers if a != "unsat"), "unsat" if answers else "error")
-    import z3
+    import z3  # deferred: start-up (loads z3 only when called)
     last = text.split("\n(reset)\n")[-1]
     ctx = z3.Context()
     s = z3.Solver(ctx=ctx)

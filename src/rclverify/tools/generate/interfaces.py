@@ -88,7 +88,7 @@ def _unit(node: CheckedNode, prefix: str, var: str) -> str:
     u = node.unit_of(prefix, var)
     parts = [str(u)] if u is not None else []
     if prefix == "in":
-        from rclverify.backends.property_tests.strategies import assumption_bounds
+        from rclverify.backends.property_tests.strategies import assumption_bounds  # deferred: optional or conditional (inside a block)
         bd = assumption_bounds(node).get(var)
         if bd is not None and (bd.lo is not None or bd.hi is not None):
             lo = f"{bd.lo} {'<' if bd.lo_strict else '<='} " if bd.lo is not None else ""

@@ -31,6 +31,8 @@ from rclverify.lang.errors import Diagnostic, RclError, error
 from rclverify.lang.types import Checked, DataT, EnumT
 from rclverify.tools.generate import names
 from rclverify.tools.generate.typemap import STANDARD_PACKAGES
+from rclverify.tools.generate.cpp_common import enum_const
+from rclverify.tools.generate.cpp_values import term_struct
 
 _MSG = re.compile(r"^[A-Z][A-Za-z0-9]*$")
 _PKG = re.compile(r"^(?!.*__)(?!.*_$)[a-z][a-z0-9_]*$")
@@ -118,8 +120,6 @@ def _context(checked: Checked, diags: list[Diagnostic]) -> None:
     """The names the context's enumerations and constructor sets give, in the interfaces (rosidl
     constants) and in every node's C++ header (one namespace)."""
     locs = {d.name: d.loc for sp in checked.specs for c in sp.contexts for d in c.decls}
-    from rclverify.tools.generate.cpp_common import enum_const
-    from rclverify.tools.generate.cpp_values import term_struct
     consts = _Scope("the rosidl constant", diags)
     cpp = _Scope("the C++ name", diags)
     for own in _HEADER_NAMES:

@@ -17,6 +17,8 @@ from typing import Any, Mapping
 
 from rclverify.tools.generate.nodes import NodePackage
 from rclverify.tools.generate.wiring import wires
+from rclverify.traces.mapping import rule_for
+from rclverify.ros.extract.model import canon_type
 
 #: property test examples per generated node
 MAX_EXAMPLES = 100
@@ -46,7 +48,6 @@ def mapped_topics(nodes: list[NodePackage], rules: Mapping[str, Any] | None
     (:func:`_field_named`); else ``omitted`` lists ``{"topic", "type",
     "var", "why"}`` for the variable, and the mapping file says so in a
     comment, naming the entry to write (issue 64)."""
-    from rclverify.traces.mapping import rule_for
     per: dict[str, dict[str, str]] = {}
     omitted: list[dict[str, str]] = []
     for np in nodes:
@@ -88,8 +89,7 @@ def _field_named(ros_type: str, var: str) -> str:
     that name holding one value (``range`` of ``sensor_msgs/Range``, ``x`` of
     ``geometry_msgs/Point``), else ``""``: a field named as the variable is
     the one a reader takes it to carry; any other choice is a guess."""
-    from rclverify.ros.extract.interfaces import BASE_TYPES, TypeTable, field_path
-    from rclverify.ros.extract.model import canon_type
+    from rclverify.ros.extract.interfaces import BASE_TYPES, TypeTable, field_path  # deferred: start-up (loads rclverify.core, rclverify.core.atomic and more only when called)
     typ = canon_type(ros_type)
     if not typ:
         return ""

@@ -37,6 +37,7 @@ from rclverify.semantics.floatsens import float_sensitive
 from rclverify.lang import ast
 from rclverify.lang import types as T
 from rclverify.lang.types import Checked, CheckedNode
+from rclverify.lang.printer import expr_to_rcl
 
 #: a note every undecided reason of an uncarried part ends with
 NOT_CARRIED = "not judged by the carried contract layer (rclverify's monitor judges it)"
@@ -142,7 +143,6 @@ class _Tree:
 
 def _what(e: Any) -> str:
     """A short text of ``e`` for a reason."""
-    from rclverify.lang.printer import expr_to_rcl
     try:
         return expr_to_rcl(e)
     except Exception:  # noqa: BLE001 - only a label; the node type is named anyway

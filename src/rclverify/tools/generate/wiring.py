@@ -20,6 +20,7 @@ from typing import Any, Mapping
 from rclverify.tools.generate.interfaces import is_standard
 from rclverify.tools.generate.nodes import NodePackage
 from rclverify.tools.generate.names import field_name
+from rclverify.traces.mapping import rule_for
 
 #: std_msgs messages holding one value in field ``data``
 STD_DATA = frozenset({"Bool", "Byte", "Char", "Float32", "Float64", "Int8", "Int16", "Int32", "Int64", "UInt8",
@@ -61,7 +62,6 @@ def _path(ros_type: str, var: str, topic: str, rules: Mapping[str, Any]) -> str:
         return field_name(var.split(".", 1)[1])
     if pkg == "std_msgs" and cls in STD_DATA:
         return "data"
-    from rclverify.traces.mapping import rule_for  # a topic's rule, or its variable's own (several variables on one topic)
     fields = list(rule_for(rules, topic.lstrip("/"), var).fields) if rules else []
     return fields[0] if len(fields) == 1 else ""
 

@@ -33,6 +33,8 @@ from rclverify.tools.lsp.lastrun import LastRun
 from rclverify.tools.lsp.lines import eol_of, for_parser, split_lines, with_eol
 from rclverify.tools.lsp.rpc import Failed
 from rclverify.tools.lsp.workspace import LspWorkspace, Outside
+from rclverify.lang.printer import context_to_rcl, node_to_rcl
+from rclverify.tools.lsp.diagnostics import MAX_CHARS
 
 _COMMENT = re.compile(r"//|/\*")
 
@@ -112,9 +114,7 @@ def format_edits(rel: str, text: str) -> list[lsp.TextEdit]:
     (LSP ``RequestFailed``) with the located syntax error when ``text``
     does not parse, or when it is longer than
     :data:`.diagnostics.MAX_CHARS` (it is not parsed as you type either)."""
-    from rclverify.lang.parser import parse_text
-    from rclverify.lang.printer import context_to_rcl, node_to_rcl
-    from rclverify.tools.lsp.diagnostics import MAX_CHARS
+    from rclverify.lang.parser import parse_text  # deferred: start-up (loads lark, rclverify.core and more only when called)
     if len(text) > MAX_CHARS:
         raise Failed(f"{rel}: not formatted in the editor: {len(text)} characters, over the limit of {MAX_CHARS} "
                      f"(run `rclverify fmt {rel}`)")

@@ -47,7 +47,7 @@ class MessageTypes:
 
     def table(self) -> Any:
         if self._table is None:
-            from rclverify.ros.extract.interfaces import TypeTable
+            from rclverify.ros.extract.interfaces import TypeTable  # deferred: optional or conditional (inside a block)
             t = TypeTable()
             for msg in sorted(self._msg_files(self.root, 0)):
                 pkg = msg.parent.parent.name
@@ -82,7 +82,7 @@ class MessageTypes:
             return []
         if info is None:
             return []
-        from rclverify.ros.extract.interfaces import describe
+        from rclverify.ros.extract.interfaces import describe  # deferred: start-up (loads rclverify.core, rclverify.core.atomic and more only when called)
         return [(n, describe(d)["type"] + (describe(d)["array"] or "")) for n, d in info.fields]
 
 
@@ -99,7 +99,7 @@ def completions(a: Analysis | None, rel: str, text: str, line: int, char16: int,
     before = here[:code_point_col(here, char16)]
     K = lsp.CompletionItemKind
     if _UNIT.search(before):
-        from rclverify.lang.units import SYMBOLS
+        from rclverify.lang.units import SYMBOLS  # deferred: optional or conditional (inside a block)
         return [_item(name, K.Unit, sym.name) for name, sym in SYMBOLS.items()]  # Symbol.name: what the unit is
     node = node_at(a, rel, line + 1) if a is not None else None
     m = _IO.search(before)
@@ -107,7 +107,7 @@ def completions(a: Analysis | None, rel: str, text: str, line: int, char16: int,
         if node is None:
             return []
         vs = node.inputs if m.group(1) == "in" else node.outputs
-        from rclverify.lang.printer import type_to_rcl
+        from rclverify.lang.printer import type_to_rcl  # deferred: optional or conditional (inside a block)
         return [_item(v.name, K.Variable, type_to_rcl(v.type)) for v in vs]
     m = _TOPIC.search(before)
     if m and messages is not None and "topics" in "\n".join(lines[max(0, line - 20):line + 1]):
@@ -120,7 +120,7 @@ def completions(a: Analysis | None, rel: str, text: str, line: int, char16: int,
             items.append(_item(name, kind, what))
         items += [_item(n, K.Module, "node") for n in all_nodes(a)]
         if node is not None:
-            from rclverify.lang.printer import type_to_rcl
+            from rclverify.lang.printer import type_to_rcl  # deferred: optional or conditional (inside a block)
             items += [_item(f"in.{v.name}", K.Variable, type_to_rcl(v.type)) for v in node.inputs]
             items += [_item(f"out.{v.name}", K.Variable, type_to_rcl(v.type)) for v in node.outputs]
     return items

@@ -26,6 +26,8 @@ from rclverify.lang import ast
 from rclverify.lang.errors import Diagnostic, RclError, error
 from rclverify.tools.lsp.lines import for_parser
 from rclverify.tools.lsp.workspace import LspWorkspace
+from rclverify.lang.filewarn import file_warnings
+from rclverify.lang.lint import lint
 
 #: The longest text (characters) analysed as you type: some 40 times the
 #: 160-node file of bench/lsp_latency.py.
@@ -75,30 +77,28 @@ def analyse(ws: LspWorkspace, rel: str, open_docs: Mapping[str, str]) -> Analysi
             a.add([error(ast.Loc(f, 1, 1), f"file too large to check as you type ({len(a.texts[f])} characters, "
                          f"limit {MAX_CHARS}); run `rclverify check {f}`", "E-lsp-size")])
             continue
-        from rclverify.lang.parser import parse_text
+        from rclverify.lang.parser import parse_text  # deferred: optional or conditional (inside a block)
         try:
             a.specs[f] = parse_text(a.texts[f], f)
         except RclError as exc:
             a.add(exc.diagnostics)
     if len(a.specs) < len(files):
         return a
-    from rclverify.lang.typecheck import check
+    from rclverify.lang.typecheck import check  # deferred: start-up (loads lark, rclverify.core and more only when called)
     specs = [a.specs[f] for f in files]
     try:
         a.checked = check(specs)
     except RclError as exc:
         a.add(exc.diagnostics)
         return a
-    from rclverify.lang.filewarn import file_warnings
-    from rclverify.lang.lint import lint
-    from rclverify.model.system.services import unserved
+    from rclverify.model.system.services import unserved  # deferred: start-up (loads rclverify.lang.types, rclverify.lang.units and more only when called)
     for s in specs:
         a.add(file_warnings(s))
         a.add(lint(s))
     connections: tuple[Any, ...] = ()
     if files == ws.contracts():
         connections = _plan(ws, a)
-    from rclverify.model.system.model import build, unit_diagnostics
+    from rclverify.model.system.model import build, unit_diagnostics  # deferred: start-up (loads yaml, rclverify.lang.printer and more only when called)
     try:
         a.add(unit_diagnostics(a.checked, connections))
         a.model = build(a.checked, connections)
@@ -112,7 +112,7 @@ def _plan(ws: LspWorkspace, a: Analysis) -> tuple[Any, ...]:
     """The plan read from disk and resolved against ``a.checked`` (its
     errors filed under the plan); its connections, ``()`` when it does not
     load."""
-    from rclverify.model.plan.load import load_plan, resolve
+    from rclverify.model.plan.load import load_plan, resolve  # deferred: start-up (loads yaml, rclverify.lang.types and more only when called)
     try:
         plan = load_plan(ws.root, ws.plan)
     except RclError as exc:

@@ -25,6 +25,7 @@ from lsprotocol import types as lsp
 from rclverify.lang import ast
 from rclverify.tools.lsp.diagnostics import Analysis
 from rclverify.tools.lsp.index import Symbol, all_nodes, declarations
+from rclverify.lang.printer import node_to_rcl, type_to_rcl
 
 _ENV = jinja2.Environment(loader=jinja2.PackageLoader("rclverify.tools.lsp", "templates"), autoescape=False,
                           keep_trailing_newline=False, undefined=jinja2.StrictUndefined)
@@ -40,7 +41,6 @@ def _report_node(report: Mapping[str, Any] | None, name: str) -> Mapping[str, An
 def hover_text(a: Analysis, sym: Symbol, report: Mapping[str, Any] | None) -> str | None:
     """The Markdown hover of ``sym`` in the analysis ``a`` with the last
     ``report`` (``None``: no last run); ``None`` when there is nothing to say."""
-    from rclverify.lang.printer import node_to_rcl, type_to_rcl
     nodes = all_nodes(a)
     t = _ENV.get_template("hover.md.j2")
     if sym.kind == "node" and sym.name in nodes:
@@ -70,7 +70,7 @@ def hover_text(a: Analysis, sym: Symbol, report: Mapping[str, Any] | None) -> st
         n = nodes[sym.node]
         if not 1 <= sym.index <= len(n.guarantees):
             return None
-        from rclverify.lang.printer import expr_to_rcl
+        from rclverify.lang.printer import expr_to_rcl  # deferred: optional or conditional (inside a block)
         g: Mapping[str, Any] = next((x for x in _report_node(report, sym.node).get("guarantees") or ()
                                      if x.get("index") == sym.index), {})
         obligations = [o for o in (report or {}).get("obligations", ())
@@ -96,7 +96,7 @@ def hover_text(a: Analysis, sym: Symbol, report: Mapping[str, Any] | None) -> st
         if isinstance(d, ast.TypeDecl):
             text = f"{d.name} : {type_to_rcl(d.type)} ;"
         else:
-            from rclverify.lang.printer import context_to_rcl
+            from rclverify.lang.printer import context_to_rcl  # deferred: optional or conditional (inside a block)
             text = context_to_rcl(ast.Context((d,))).split("\n")[1].strip()
         return t.render(kind="decl", what=what, name=sym.name, declaration=text)
     return None

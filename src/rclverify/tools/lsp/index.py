@@ -180,7 +180,7 @@ def occurrences(text: str, name: str, yaml: bool = False) -> Iterator[tuple[int,
     starts = [0]
     for line in split_lines(text):
         starts.append(starts[-1] + len(line) + 1)
-    import bisect
+    import bisect  # deferred: start-up (loads bisect only when called)
     for m in pattern.finditer(text):
         if any(a <= m.start() < b for a, b in spans):
             continue

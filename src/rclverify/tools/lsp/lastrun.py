@@ -81,7 +81,7 @@ class LastRun:
         is not of the report's shape."""
         stamp = _stamp(self.root / REPORT)
         if stamp != self._report[0]:
-            from rclverify.report.lastrun import read_report
+            from rclverify.report.lastrun import read_report  # deferred: optional or conditional (inside a block)
             try:
                 rep: dict[str, Any] | None = read_report(self.root)
             except RclError:

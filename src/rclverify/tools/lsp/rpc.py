@@ -77,7 +77,7 @@ def invalid_params_message(method: str, exc: BaseException | None) -> str:
     params did not fit their type (``exc``: the converter's error)."""
     why: list[str] = []
     try:
-        import cattrs
+        import cattrs  # deferred: optional or conditional (inside a block)
         for e in cattrs.transform_error(exc) if exc is not None else ():
             what, _, where = e.partition(" @ ")
             why.append(f"{_field(where)}: {what}")

@@ -45,6 +45,13 @@ from rclverify.tools.lsp.lastrun import LastRun
 from rclverify.tools.lsp.lines import split_lines
 from rclverify.tools.lsp.rpc import RclProtocol, Refused, guarded, log_one_line, one_line
 from rclverify.tools.lsp.workspace import PLAN, LspWorkspace, Outside
+from rclverify.tools.lsp.actions import format_edits, quick_fixes
+from rclverify.tools.lsp.index import symbol_at
+from rclverify.tools.lsp.navigate import definition, references
+from rclverify.tools.lsp.complete import MessageTypes, completions
+from pygls.exceptions import FeatureRequestError
+from rclverify.lang.ast import Loc
+from rclverify.lang.errors import error
 
 #: Seconds a check of the text as you type may take before it is abandoned.
 TIME_LIMIT = 5.0
@@ -73,7 +80,6 @@ class RclServer(LanguageServer):
         apply, e.g. ``didChange`` of a document never opened): one line in
         the editor's log (``window/logMessage``), not a pop-up; a request's
         fault is in its answer (:mod:`.rpc`)."""
-        from pygls.exceptions import FeatureRequestError
         if source is FeatureRequestError:
             return
         self.window_log_message(lsp.LogMessageParams(
@@ -134,8 +140,6 @@ class RclServer(LanguageServer):
         first = key[0]
         loop = asyncio.get_running_loop()
         fut = loop.run_in_executor(self.thread_pool, analyse, self.ws, first, texts)
-        from rclverify.lang.ast import Loc
-        from rclverify.lang.errors import error
         try:
             a = await asyncio.wait_for(asyncio.shield(fut), TIME_LIMIT)
         except asyncio.TimeoutError:
@@ -288,7 +292,6 @@ def text_of(ls: RclServer, uri: str) -> tuple[str, str]:
 @SERVER.feature(lsp.TEXT_DOCUMENT_FORMATTING)
 @guarded(lsp.TEXT_DOCUMENT_FORMATTING)
 def _formatting(ls: RclServer, params: lsp.DocumentFormattingParams) -> list[lsp.TextEdit] | None:
-    from rclverify.tools.lsp.actions import format_edits
     rel, text = text_of(ls, params.text_document.uri)
     return format_edits(rel, text)
 
@@ -297,14 +300,12 @@ def _formatting(ls: RclServer, params: lsp.DocumentFormattingParams) -> list[lsp
                 lsp.CodeActionOptions(code_action_kinds=[lsp.CodeActionKind.QuickFix]))
 @guarded(lsp.TEXT_DOCUMENT_CODE_ACTION)
 def _code_action(ls: RclServer, params: lsp.CodeActionParams) -> list[lsp.CodeAction]:
-    from rclverify.tools.lsp.actions import quick_fixes
     rel, _text = text_of(ls, params.text_document.uri)
     return quick_fixes(ls.ws, ls.open_texts(), rel, params, ls.last)
 
 
 def _symbol(ls: RclServer, uri: str, pos: lsp.Position) -> tuple[Any, Any] | None:
     """``(analysis, symbol)`` at ``pos`` of ``uri``, ``None`` when nothing known stands there."""
-    from rclverify.tools.lsp.index import symbol_at
     rel, text = text_of(ls, uri)
     a = ls.analysis(rel) or ls.analysis(rel, good=False)
     if a is None:
@@ -316,7 +317,7 @@ def _symbol(ls: RclServer, uri: str, pos: lsp.Position) -> tuple[Any, Any] | Non
 @SERVER.feature(lsp.TEXT_DOCUMENT_HOVER)
 @guarded(lsp.TEXT_DOCUMENT_HOVER)
 def _hover(ls: RclServer, params: lsp.HoverParams) -> lsp.Hover | None:
-    from rclverify.tools.lsp.hover import hover
+    from rclverify.tools.lsp.hover import hover  # deferred: start-up (loads jinja2, rclverify.tools.lsp and more only when called)
     found = _symbol(ls, params.text_document.uri, params.position)
     return hover(found[0], found[1], ls.last.report()) if found else None
 
@@ -324,7 +325,6 @@ def _hover(ls: RclServer, params: lsp.HoverParams) -> lsp.Hover | None:
 @SERVER.feature(lsp.TEXT_DOCUMENT_DEFINITION)
 @guarded(lsp.TEXT_DOCUMENT_DEFINITION)
 def _definition(ls: RclServer, params: lsp.DefinitionParams) -> list[lsp.Location] | None:
-    from rclverify.tools.lsp.navigate import definition
     found = _symbol(ls, params.text_document.uri, params.position)
     return definition(ls.ws, found[0], ls.open_texts(), found[1]) or None if found else None
 
@@ -332,7 +332,6 @@ def _definition(ls: RclServer, params: lsp.DefinitionParams) -> list[lsp.Locatio
 @SERVER.feature(lsp.TEXT_DOCUMENT_REFERENCES)
 @guarded(lsp.TEXT_DOCUMENT_REFERENCES)
 def _references(ls: RclServer, params: lsp.ReferenceParams) -> list[lsp.Location] | None:
-    from rclverify.tools.lsp.navigate import references
     found = _symbol(ls, params.text_document.uri, params.position)
     if not found:
         return None
@@ -342,7 +341,6 @@ def _references(ls: RclServer, params: lsp.ReferenceParams) -> list[lsp.Location
 @SERVER.feature(lsp.TEXT_DOCUMENT_COMPLETION, lsp.CompletionOptions(trigger_characters=[".", "[", " "]))
 @guarded(lsp.TEXT_DOCUMENT_COMPLETION)
 def _completion(ls: RclServer, params: lsp.CompletionParams) -> lsp.CompletionList:
-    from rclverify.tools.lsp.complete import MessageTypes, completions
     rel, text = text_of(ls, params.text_document.uri)
     if ls.messages is None or ls.messages.root != ls.ws.root:
         ls.messages = MessageTypes(ls.ws.root)

@@ -26,6 +26,7 @@ from urllib.parse import quote, unquote, urlparse
 
 from rclverify.lang.errors import RclError
 from rclverify.lang.source import decode_text
+from rclverify.lang.source import read_text
 
 #: The plan, relative to the root (the default of every command).
 PLAN = "contracts/plan.yaml"
@@ -102,7 +103,7 @@ class LspWorkspace:
         except OSError:
             return ()
         if self._plan_cache is None or self._plan_cache[0] != stamp:
-            from rclverify.model.plan.load import read_plan_data
+            from rclverify.model.plan.load import read_plan_data  # deferred: optional or conditional (inside a block)
             try:
                 data, _ = read_plan_data(self.root, self.plan)
                 files = tuple(str(c) for c in data.get("contracts") or [] if isinstance(c, str))
@@ -122,7 +123,6 @@ class LspWorkspace:
         :class:`RclError` (``E-io``, ``E-encoding``) located in ``rel``."""
         if rel in open_docs:
             return open_docs[rel]
-        from rclverify.lang.source import read_text
         return read_text(self.root / rel, rel)
 
     def disk_text(self, rel: str) -> str | None:

@@ -37,6 +37,7 @@ from rclverify.ros.graph.scan import ScanResult
 from rclverify.ros.extract.interfaces import TypeTable, elem_type
 from rclverify.ros.extract.model import LIBRARY_TOPICS, GraphEdge, GraphNode, library_of, short_type
 from rclverify.tools.scaffold.safecopy import copy_package
+from rclverify.tools.scaffold import EMPTY_DIRS, _env as scaffold_env
 
 _ENV = jinja2.Environment(loader=jinja2.PackageLoader("rclverify.tools.scaffold", "templates"), autoescape=False,
                           undefined=jinja2.StrictUndefined, trim_blocks=True, lstrip_blocks=True,
@@ -326,7 +327,6 @@ def write_from_ros(root: Path, res: ScanResult, scanned: list[Path], launch: lis
     ``ros/`` (a copy of each scanned package directory) and empty ``backends``,
     ``artifacts``, ``reports``.  Returns the paths written.  Raises ``OSError``.
     ``library``: library endpoints become inputs and outputs too (:func:`build_skeletons`)."""
-    from rclverify.tools.scaffold import EMPTY_DIRS, _env as scaffold_env
     nodes, fields, external, context = build_skeletons(res, library)
     for n in nodes:
         for line in n.apart:

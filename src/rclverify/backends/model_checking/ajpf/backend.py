@@ -139,7 +139,7 @@ def read_config(target: NodeTarget) -> AjpfConfig:
     if not isinstance(log_info, list) or not all(isinstance(x, str) and _JAVA_CLASS.match(x) for x in log_info):
         raise target.config_error("'log_info' must be a list of logger (class) names", "log_info")
     rows = _rows(cfg.get("mapping", []), target, agent, domains)
-    from rclverify.backends.model_checking.backend import read_spin_config  # lazily: model_checking imports ajpf.psl
+    from rclverify.backends.model_checking.backend import read_spin_config  # lazily: model_checking imports ajpf.psl; deferred: start-up (loads rclverify.backends.model_checking, rclverify.lang.source and more only when called)
     return AjpfConfig(agent, model, domains, rows, env_class, home, float(timeout), results.rstrip("/"),
                       tuple(log_info), read_spin_config(target))
 
@@ -278,7 +278,7 @@ class AjpfBackend:
             for u in inst.unmapped:
                 if u not in per_guarantee.setdefault(g, []):
                     per_guarantee[g].append(u)
-        from rclverify.backends.model_checking.backend import extra_obligations
+        from rclverify.backends.model_checking.backend import extra_obligations  # deferred: start-up (loads rclverify.backends.model_checking, rclverify.lang.source and more only when called)
         return [self._obligation(target, cfg, g, clause, inst, numbers, psl_rel, ail_rel, per_guarantee.get(g, []),
                                  coverage.get((g, inst.label), []))
                 for g, clause, inst in planned] + extra_obligations(target, cfg.spin, cfg.agent, cfg.model)
@@ -349,7 +349,7 @@ class AjpfBackend:
                 explanation=("no AJPF property: " + "; ".join(data.get("unmapped", []))
                              + " -- add mapping rows for these atoms to the plan"),
                 details={"unmapped": list(data.get("unmapped", []))})
-        from rclverify.backends.model_checking.backend import chosen_checker, run_spin, spin_timeout
+        from rclverify.backends.model_checking.backend import chosen_checker, run_spin, spin_timeout  # deferred: start-up (loads rclverify.backends.model_checking, rclverify.lang.source and more only when called)
         if chosen_checker(target.config) == "spin":
             return run_spin(obligation, target, str(target.config["model"]), spin_timeout(target.config))
         if "log" not in data:  # a property of the plan's `properties` files
