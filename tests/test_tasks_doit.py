@@ -1,4 +1,4 @@
-"""rclverify's replacement of doit's implicit-dependency scan (app/tasks.py) adds
+"""rclverify's replacement of doit's implicit-dependency scan (app/doit_patches.py) adds
 the same task dependencies in the same order as doit's own."""
 from __future__ import annotations
 
@@ -7,13 +7,13 @@ from types import SimpleNamespace
 
 from doit.control import TaskControl
 
-from rclverify.app import tasks
+from rclverify.app import doit_patches, tasks
 
 
 def test_the_linear_scan_adds_what_doits_own_adds() -> None:
-    tasks._use_linear_implicit_task_dep()
-    doits = tasks.DOIT_IMPLICIT_TASK_DEP[0]
-    assert doits is not tasks._linear_implicit_task_dep
+    doit_patches.use_linear_implicit_task_dep()
+    doits = doit_patches.DOIT_IMPLICIT_TASK_DEP[0]
+    assert doits is not doit_patches.linear_implicit_task_dep
     rnd = random.Random(7)
     for _ in range(200):
         targets = {f"f{k}": f"t{rnd.randrange(8)}" for k in range(rnd.randrange(30))}
@@ -21,10 +21,10 @@ def test_the_linear_scan_adds_what_doits_own_adds() -> None:
         start = [f"t{rnd.randrange(8)}" for _ in range(rnd.randrange(3))]
         a, b = SimpleNamespace(task_dep=list(start)), SimpleNamespace(task_dep=list(start))
         doits(targets, a, deps)
-        tasks._linear_implicit_task_dep(targets, b, deps)
+        doit_patches.linear_implicit_task_dep(targets, b, deps)
         assert a.task_dep == b.task_dep
 
 
 def test_build_tasks_installs_it(tmp_path) -> None:
     tasks.build_tasks(tmp_path)  # an empty directory: no plan, only check and verify are defined
-    assert TaskControl.add_implicit_task_dep is tasks._linear_implicit_task_dep
+    assert TaskControl.add_implicit_task_dep is doit_patches.linear_implicit_task_dep

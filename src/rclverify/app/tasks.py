@@ -72,6 +72,7 @@ from rclverify.records.store import atomic_write_text, EvidenceStore
 from rclverify.app import pipeline
 from rclverify import __version__
 from rclverify.records.sealed import TargetsSealed, obligation_list
+from rclverify.app.doit_patches import guard_dep_writes, use_linear_implicit_task_dep
 
 if TYPE_CHECKING:
     from rclverify.records.report_schema import Report
@@ -458,68 +459,6 @@ def doit_config(dep_file: str = DEP_FILE) -> dict[str, Any]:
             "reporter": ProgressReporter}
 
 
-def _linear_implicit_task_dep(targets: dict[str, str], task: Any, deps_list: Sequence[str]) -> None:
-    """doit's ``TaskControl.add_implicit_task_dep`` with a set for the
-    membership test: the same task dependencies in the same order.  doit's
-    own tests ``name not in task.task_dep`` on a list, which is quadratic
-    for a task whose file dependencies are the targets of thousands of
-    tasks (each report task of a 1000-node system: 5,000 file dependencies
-    from 3,000 tasks, a seventh of a second per task per run)."""
-    have = set(task.task_dep)
-    for dep in deps_list:
-        name = targets.get(dep)
-        if name is not None and name not in have:
-            task.task_dep.append(name)
-            have.add(name)
-
-
-def _use_linear_implicit_task_dep() -> None:
-    """Install :func:`_linear_implicit_task_dep` in doit (idempotent), when
-    doit's own has the signature it replaces (``pyproject.toml`` pins the
-    doit versions it was checked against; ``tests/test_tasks_doit.py``
-    compares the two)."""
-    from doit.control import TaskControl  # deferred: start-up (loads doit only when called)
-    current = TaskControl.add_implicit_task_dep
-    if current is _linear_implicit_task_dep:
-        return
-    if list(inspect.signature(current).parameters) == ["targets", "task", "deps_list"]:
-        DOIT_IMPLICIT_TASK_DEP.append(current)
-        TaskControl.add_implicit_task_dep = staticmethod(_linear_implicit_task_dep)
-
-
-#: doit's own implicit-dependency scan, once replaced (for the test that compares the two).
-DOIT_IMPLICIT_TASK_DEP: list[Callable[..., None]] = []
-
-
-def _guard_dep_writes() -> None:
-    """Make a full disk (or a read-only workspace) while doit writes its task
-    state end the run with one plain line and exit code 1, instead of doit's
-    traceback (``sqlite3.OperationalError: database or disk is full``, exit
-    3).  Wraps the writing methods of ``doit.dependency.SqliteDB`` (the store
-    :func:`doit_config` selects: ``dump`` at the end of a run, ``remove`` when
-    a task fails) once per process; what the run wrote is complete (every
-    write is atomic), only doit's record of it is lost, so its tasks run
-    again next time.  ``SystemExit`` passes through doit's own handler."""
-    import sqlite3  # deferred: start-up (loads sqlite3 only when called)
-    from doit.dependency import SqliteDB  # deferred: start-up (loads doit only when called)
-
-    def guard(method: Callable[..., Any]) -> Callable[..., Any]:
-        def guarded(self: Any, *args: Any) -> Any:
-            try:
-                return method(self, *args)
-            except (sqlite3.Error, OSError) as exc:
-                print(f"error: cannot save doit's task state in {os.path.basename(self.name)}: {exc} (free some "
-                      "space or make the workspace writable, and run again); what this run wrote is complete, and "
-                      "its tasks run again next time", file=sys.stderr)
-                raise SystemExit(1) from None
-        guarded._rclverify_guarded = True  # type: ignore[attr-defined]
-        return guarded
-    for name in ("dump", "remove"):
-        method = getattr(SqliteDB, name)
-        if not getattr(method, "_rclverify_guarded", False):
-            setattr(SqliteDB, name, guard(method))
-
-
 def build_tasks(root: str | Path, plan_file: str = "contracts/plan.yaml", *,
                 wait: bool | None = None) -> dict[str, Callable[[], Any]]:
     """The ``task_*`` functions for a dodo.py of the workspace at ``root``.
@@ -558,8 +497,8 @@ def build_tasks(root: str | Path, plan_file: str = "contracts/plan.yaml", *,
 
 
 def _build_tasks(root: str | Path, plan_file: str) -> dict[str, Callable[[], Any]]:
-    _use_linear_implicit_task_dep()
-    _guard_dep_writes()
+    use_linear_implicit_task_dep()
+    guard_dep_writes()
     rootp = Path(root).resolve()
     r = str(rootp)
     ws = Workspace(rootp, plan_file)
