@@ -49,7 +49,6 @@ the records are stored locally as in a local run.
 """
 from __future__ import annotations
 
-import glob
 import inspect
 import os
 import shutil
@@ -63,16 +62,16 @@ from doit.tools import config_changed
 from rclverify.core.cache import code_stamp, heap
 from rclverify.core.cache import workspace as wscache
 from rclverify.app.pipeline import REPORT_PARTS, TaskIndex, Workspace
-from rclverify.model.plan.entries import TOOL_KEYS
 from rclverify.lang.errors import RclError
 from rclverify.stages.workspace import check_input_files
 import sys
 from rclverify.app.pipeline import stage_check, stage_graph, stage_run, stage_report, stage_requirements, stage_deadlines
-from rclverify.records.store import atomic_write_text, EvidenceStore
+from rclverify.records.store import atomic_write_text
 from rclverify.app import pipeline
-from rclverify import __version__
 from rclverify.records.sealed import TargetsSealed, obligation_list
 from rclverify.app.doit_patches import guard_dep_writes, use_linear_implicit_task_dep
+from rclverify.app.task_checks import (RecordIntact, entry_inputs, ros_fingerprint, strict_uptodate, tool_fingerprint,
+                                       z3_version)
 
 if TYPE_CHECKING:
     from rclverify.records.report_schema import Report
@@ -289,30 +288,6 @@ def act_ground(root: str) -> Any:
     return None
 
 
-def ros_fingerprint(root: Path, ros: Mapping[str, Any]) -> list[tuple[str, int, int]]:
-    """(path, size, mtime_ns) of every file under the ``ros:`` section's paths:
-    the grounding task runs again when one changes (the scan's own cache then
-    re-parses only the changed files)."""
-    out: list[tuple[str, int, int]] = []
-    for key in ("workspaces", "launch", "bags"):
-        for rel in ros.get(key, []) or []:
-            top = root / str(rel)
-            files = [top] if top.is_file() else sorted(p for p in top.rglob("*") if p.is_file()) if top.is_dir() else []
-            for p in files:
-                try:
-                    st = p.stat()
-                except OSError:
-                    continue
-                out.append((str(p.relative_to(root)), st.st_size, st.st_mtime_ns))
-    for key in ("mapping",):
-        if ros.get(key):
-            p = root / str(ros[key])
-            if p.is_file():
-                st = p.stat()
-                out.append((str(ros[key]), st.st_size, st.st_mtime_ns))
-    return out
-
-
 def act_verify(root: str, strict: bool) -> Any:
     """The ``verify`` task: print the run's status, problems and summary table
     (:func:`rclverify.report.summary.print_last_run`); with ``strict``, fail
@@ -328,116 +303,8 @@ def act_verify(root: str, strict: bool) -> Any:
     return None
 
 
-class RecordIntact:
-    """doit ``uptodate`` check of an evidence task: its record is as rclverify
-    wrote it.  A record changed by anything else (a hand edit of its status)
-    makes the task run again, so ``doit verify`` produces the evidence anew
-    instead of believing it (the report of a run that does not re-run it,
-    ``rclverify report``, shows it as ``error``: evidence altered).
-
-    Cheap on a no-op run: after the task ran, the record's size and
-    modification time are saved with doit's task values; while they are the
-    same the record is not read.  Otherwise its seal is checked
-    (:meth:`rclverify.records.store.EvidenceStore.read`)."""
-
-    __signature__ = inspect.Signature([inspect.Parameter("task", inspect.Parameter.POSITIONAL_OR_KEYWORD),
-                                       inspect.Parameter("values", inspect.Parameter.POSITIONAL_OR_KEYWORD)])
-
-    def __call__(self, task: Any, values: Mapping[str, Any]) -> bool:
-        target = task.targets[0]
-
-        def stat() -> dict[str, Any]:
-            try:
-                st = os.stat(target)
-            except OSError:
-                return {}
-            return {"_record_stat": [st.st_mtime_ns, st.st_size]}
-        task.value_savers.append(stat)
-        now = stat()
-        if not now:
-            return False
-        if values.get("_record_stat") == now["_record_stat"]:
-            return True
-        root, _, name = target.rpartition("/artifacts/evidence/")
-        try:
-            ev, problem = EvidenceStore(Path(root)).read(name[:-len(".json")])
-        except Exception as exc:  # noqa: BLE001 - whatever the file holds, the task produces it again
-            ev, problem = None, f"evidence record unreadable ({exc.__class__.__name__}): altered outside rclverify"
-        if problem:
-            print(f"{os.path.relpath(target, root)}: {problem}: producing it again")
-            return False
-        return ev is not None
-
-
-def strict_uptodate(task: Any, values: Any) -> bool:
-    """``verify`` is up to date unless ``--strict`` asks for the check again."""
-    return not bool(task.options.get("strict"))
-
-
-def _inputs(config: Any, root: Path, seen: dict[str, tuple[str, ...]]) -> list[str]:
-    """Workspace files named in a plan evidence entry (strings that are existing paths).
-
-    The values of tool keys (``dafny: PATH``, ``mcapl_home``, ``options``:
-    :data:`rclverify.model.plan.entries.TOOL_KEYS`) name installed tools, not
-    workspace files, and are never file dependencies (an absolute tool path
-    joined to the workspace root was a dependency on a file that does not
-    exist, a doit DependencyError); nor is any absolute path (the plan check
-    refuses those everywhere else).
-
-    ``seen`` memoises the files of each path string across calls (the
-    entries of many nodes name the same program or directory: one stat or
-    directory walk per distinct string; one import walk per Python file,
-    which entries name with different callables, ``file.py:n0``)."""
-    out: set[str] = set()
-
-    def files(v: str) -> tuple[str, ...]:
-        if v not in seen:
-            p = root / v
-            py = v.rsplit(":", 1)[0] if ":" in v else v
-            if py.endswith(".py") and (root / py).is_file():
-                # a Python implementation (`file.py:callable`): the file and every workspace module it imports,
-                # so that a changed helper exports the obligations, and their inputs, again (issue 63, row 2)
-                from rclverify.backends.property_tests.closure import import_closure  # deferred: optional or conditional (inside a block)
-                k = "\0" + py  # the closure is the file's, whatever callable follows the colon (one walk per file)
-                if k not in seen:
-                    seen[k] = tuple(import_closure(root, py)[0])
-                seen[v] = seen[k]
-            elif not p.exists():
-                seen[v] = ()
-            elif p.is_dir():
-                seen[v] = tuple(os.path.relpath(f, root) for f in glob.glob(str(p / "**" / "*"), recursive=True)
-                                if os.path.isfile(f))
-            else:
-                seen[v] = (v,)
-        return seen[v]
-
-    def walk(v: Any) -> None:
-        if isinstance(v, str) and "/" in v and not os.path.isabs(v):
-            out.update(files(v))
-        elif isinstance(v, dict):
-            for k, x in v.items():
-                if k not in TOOL_KEYS:
-                    walk(x)
-        elif isinstance(v, list):
-            for x in v:
-                walk(x)
-    walk(dict(config))
-    return sorted(out)
-
-
-def _z3_version() -> str:
-    """The installed z3-solver's version (from its metadata: importing Z3 costs a no-op run
-    a fifth of a second).  Every verdict comes from Z3, so another version makes them again."""
-    from importlib.metadata import PackageNotFoundError, version  # deferred: start-up (loads importlib only when called)
-    try:
-        return version("z3-solver")
-    except PackageNotFoundError:
-        return "-"
-
-
-def _tool_fingerprint() -> dict[str, Any]:
-    return {"rclverify": __version__, "dafny": shutil.which("dafny"), "mcapl": os.environ.get("MCAPL_HOME") or os.environ.get("AJPF_HOME"),
-            "dot": shutil.which("dot"), "spin": shutil.which("spin")}
+#: The name older callers import (tests, ``from rclverify.app.tasks import _inputs``): :func:`entry_inputs`.
+_inputs = entry_inputs
 
 
 #: Where doit keeps the state of each task (its file_dep signatures), relative to the workspace.
@@ -529,7 +396,7 @@ def _build_tasks(root: str | Path, plan_file: str) -> dict[str, Callable[[], Any
     snap = {n: at(ws.snapshot(n)) for n in nodes}
     # Every task that makes a result depends on the rclverify code that makes it: another version
     # (an upgrade, a changed module) makes every result again, as a clean run would.
-    code_version = {"rclverify": code_stamp(), "z3": _z3_version()}
+    code_version = {"rclverify": code_stamp(), "z3": z3_version()}
     code = config_changed(code_version)
     code.__signature__ = inspect.signature(code)  # answered at once by doit (see task_evidence)
 
@@ -565,7 +432,7 @@ def _build_tasks(root: str | Path, plan_file: str) -> dict[str, Callable[[], Any
             deps = {
                 "compose": [snap[n], *(snap[p] for p in index.producers[n]), model_json],
                 "health": [snap[n]] + ([str(rootp / repl)] if repl and (rootp / repl).is_file() else []),
-                "export": [snap[n]] + [at(f) for config in index.entries.get(n, ()) for f in _inputs(config, rootp, seen)],
+                "export": [snap[n]] + [at(f) for config in index.entries.get(n, ()) for f in entry_inputs(config, rootp, seen)],
             }
             # the upstream cone: a file the check writes, read by an uptodate check (app/conetask.py), not a
             # file_dep: only a composition that read the cone runs again when the cone changes
@@ -635,7 +502,7 @@ def _build_tasks(root: str | Path, plan_file: str) -> dict[str, Callable[[], Any
         # `__signature__` (PEP 362) answers it at once.
         # One config_changed per task: doit saves every config_changed of a task under one key, so a
         # second one would overwrite the first's value and the task would never be up to date.
-        tools_unchanged = config_changed({**_tool_fingerprint(), **code_version})
+        tools_unchanged = config_changed({**tool_fingerprint(), **code_version})
         tools_unchanged.__signature__ = inspect.signature(tools_unchanged)
         record_intact = RecordIntact()
         input_file: dict[str, str | None] = {}  # input -> its absolute path when it is a file (one stat per input)

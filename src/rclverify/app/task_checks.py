@@ -1,0 +1,162 @@
+"""What decides whether a ``doit verify`` task runs again: its ``uptodate`` checks and the files it depends on.
+
+Used by :mod:`rclverify.app.task_table` when it defines the tasks: the
+files a plan evidence entry names (:func:`entry_inputs`), the files of the
+plan's ``ros:`` section (:func:`ros_fingerprint`), the versions of the code
+and tools that make the results (:func:`z3_version`,
+:func:`tool_fingerprint`), and the ``uptodate`` checks of an evidence
+record (:class:`RecordIntact`) and of ``verify --strict``
+(:func:`strict_uptodate`).  doit's ``uptodate`` protocol: a callable given
+the task and its saved values, answering whether the task is up to date.
+"""
+from __future__ import annotations
+
+import glob
+import inspect
+import os
+import shutil
+from pathlib import Path
+from typing import Any, Mapping
+
+from rclverify import __version__
+from rclverify.model.plan.entries import TOOL_KEYS
+from rclverify.records.store import EvidenceStore
+
+
+def ros_fingerprint(root: Path, ros: Mapping[str, Any]) -> list[tuple[str, int, int]]:
+    """(path, size, mtime_ns) of every file under the ``ros:`` section's paths:
+    the grounding task runs again when one changes (the scan's own cache then
+    re-parses only the changed files)."""
+    out: list[tuple[str, int, int]] = []
+    for key in ("workspaces", "launch", "bags"):
+        for rel in ros.get(key, []) or []:
+            top = root / str(rel)
+            files = [top] if top.is_file() else sorted(p for p in top.rglob("*") if p.is_file()) if top.is_dir() else []
+            for p in files:
+                try:
+                    st = p.stat()
+                except OSError:
+                    continue
+                out.append((str(p.relative_to(root)), st.st_size, st.st_mtime_ns))
+    for key in ("mapping",):
+        if ros.get(key):
+            p = root / str(ros[key])
+            if p.is_file():
+                st = p.stat()
+                out.append((str(ros[key]), st.st_size, st.st_mtime_ns))
+    return out
+
+
+class RecordIntact:
+    """doit ``uptodate`` check of an evidence task: its record is as rclverify
+    wrote it.  A record changed by anything else (a hand edit of its status)
+    makes the task run again, so ``doit verify`` produces the evidence anew
+    instead of believing it (the report of a run that does not re-run it,
+    ``rclverify report``, shows it as ``error``: evidence altered).
+
+    Cheap on a no-op run: after the task ran, the record's size and
+    modification time are saved with doit's task values; while they are the
+    same the record is not read.  Otherwise its seal is checked
+    (:meth:`rclverify.records.store.EvidenceStore.read`)."""
+
+    __signature__ = inspect.Signature([inspect.Parameter("task", inspect.Parameter.POSITIONAL_OR_KEYWORD),
+                                       inspect.Parameter("values", inspect.Parameter.POSITIONAL_OR_KEYWORD)])
+
+    def __call__(self, task: Any, values: Mapping[str, Any]) -> bool:
+        target = task.targets[0]
+
+        def stat() -> dict[str, Any]:
+            try:
+                st = os.stat(target)
+            except OSError:
+                return {}
+            return {"_record_stat": [st.st_mtime_ns, st.st_size]}
+        task.value_savers.append(stat)
+        now = stat()
+        if not now:
+            return False
+        if values.get("_record_stat") == now["_record_stat"]:
+            return True
+        root, _, name = target.rpartition("/artifacts/evidence/")
+        try:
+            ev, problem = EvidenceStore(Path(root)).read(name[:-len(".json")])
+        except Exception as exc:  # noqa: BLE001 - whatever the file holds, the task produces it again
+            ev, problem = None, f"evidence record unreadable ({exc.__class__.__name__}): altered outside rclverify"
+        if problem:
+            print(f"{os.path.relpath(target, root)}: {problem}: producing it again")
+            return False
+        return ev is not None
+
+
+def strict_uptodate(task: Any, values: Any) -> bool:
+    """``verify`` is up to date unless ``--strict`` asks for the check again."""
+    return not bool(task.options.get("strict"))
+
+
+def entry_inputs(config: Any, root: Path, seen: dict[str, tuple[str, ...]]) -> list[str]:
+    """Workspace files named in a plan evidence entry (strings that are existing paths).
+
+    The values of tool keys (``dafny: PATH``, ``mcapl_home``, ``options``:
+    :data:`rclverify.model.plan.entries.TOOL_KEYS`) name installed tools, not
+    workspace files, and are never file dependencies (an absolute tool path
+    joined to the workspace root was a dependency on a file that does not
+    exist, a doit DependencyError); nor is any absolute path (the plan check
+    refuses those everywhere else).
+
+    ``seen`` memoises the files of each path string across calls (the
+    entries of many nodes name the same program or directory: one stat or
+    directory walk per distinct string; one import walk per Python file,
+    which entries name with different callables, ``file.py:n0``)."""
+    out: set[str] = set()
+
+    def files(v: str) -> tuple[str, ...]:
+        if v not in seen:
+            p = root / v
+            py = v.rsplit(":", 1)[0] if ":" in v else v
+            if py.endswith(".py") and (root / py).is_file():
+                # a Python implementation (`file.py:callable`): the file and every workspace module it imports,
+                # so that a changed helper exports the obligations, and their inputs, again (issue 63, row 2)
+                from rclverify.backends.property_tests.closure import import_closure  # deferred: optional or conditional (inside a block)
+                k = "\0" + py  # the closure is the file's, whatever callable follows the colon (one walk per file)
+                if k not in seen:
+                    seen[k] = tuple(import_closure(root, py)[0])
+                seen[v] = seen[k]
+            elif not p.exists():
+                seen[v] = ()
+            elif p.is_dir():
+                seen[v] = tuple(os.path.relpath(f, root) for f in glob.glob(str(p / "**" / "*"), recursive=True)
+                                if os.path.isfile(f))
+            else:
+                seen[v] = (v,)
+        return seen[v]
+
+    def walk(v: Any) -> None:
+        if isinstance(v, str) and "/" in v and not os.path.isabs(v):
+            out.update(files(v))
+        elif isinstance(v, dict):
+            for k, x in v.items():
+                if k not in TOOL_KEYS:
+                    walk(x)
+        elif isinstance(v, list):
+            for x in v:
+                walk(x)
+    walk(dict(config))
+    return sorted(out)
+
+
+def z3_version() -> str:
+    """The installed z3-solver's version (from its metadata: importing Z3 costs a no-op run
+    a fifth of a second).  Every verdict comes from Z3, so another version makes them again."""
+    from importlib.metadata import PackageNotFoundError, version  # deferred: start-up (loads importlib only when called)
+    try:
+        return version("z3-solver")
+    except PackageNotFoundError:
+        return "-"
+
+
+def tool_fingerprint() -> dict[str, Any]:
+    """The tools the backends run, as found now: rclverify's version and the paths of ``dafny``, MCAPL
+    (``MCAPL_HOME`` or ``AJPF_HOME``), ``dot`` and ``spin`` (``None`` when absent); another value makes every
+    evidence record again (the evidence tasks' ``config_changed``)."""
+    return {"rclverify": __version__, "dafny": shutil.which("dafny"), "mcapl": os.environ.get("MCAPL_HOME") or os.environ.get("AJPF_HOME"),
+            "dot": shutil.which("dot"), "spin": shutil.which("spin")}
