@@ -53,10 +53,9 @@ import inspect
 import os
 import shutil
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, Callable, Iterator, Mapping, Sequence, TypeVar, cast
+from typing import Any, Callable, Iterator, TypeVar, cast
 
 from doit import create_after as _create_after
-from doit.exceptions import TaskFailed
 from doit.tools import config_changed
 
 from rclverify.core.cache import code_stamp, heap
@@ -65,16 +64,16 @@ from rclverify.app.pipeline import REPORT_PARTS, TaskIndex, Workspace
 from rclverify.lang.errors import RclError
 from rclverify.stages.workspace import check_input_files
 import sys
-from rclverify.app.pipeline import stage_check, stage_graph, stage_run, stage_report, stage_requirements, stage_deadlines
-from rclverify.records.store import atomic_write_text
-from rclverify.app import pipeline
 from rclverify.records.sealed import TargetsSealed, obligation_list
 from rclverify.app.doit_patches import guard_dep_writes, use_linear_implicit_task_dep
+from rclverify.app.task_actions import (NODE_STAGES, WORKSPACES, act_check, act_crosscheck, act_deadlines, act_graph,
+                                        act_ground, act_node, act_report, act_requirements, act_run, act_verify,
+                                        stages_to_run)
 from rclverify.app.task_checks import (RecordIntact, entry_inputs, ros_fingerprint, strict_uptodate, tool_fingerprint,
                                        z3_version)
 
-if TYPE_CHECKING:
-    from rclverify.records.report_schema import Report
+__all__ = ["build_tasks", "doit_config", "DEP_FILE", "REPORTS", "DEADLINES_INDEX", "CROSSCHECK_INDEX", "NODE_STAGES",
+           "stages_to_run", "act_check", "act_report", "act_verify"]
 
 _F = TypeVar("_F", bound=Callable[..., Any])
 
@@ -89,218 +88,6 @@ REPORTS = ["reports/assurance.html", "reports/assurance.md", "reports/assurance.
 #: named here so that defining the tasks imports neither stage (tests/test_scale.py holds them equal).
 DEADLINES_INDEX = "artifacts/deadlines/index.json"
 CROSSCHECK_INDEX = "artifacts/crosscheck/index.json"
-
-
-_WORKSPACES: dict[str, Workspace] = {}
-
-
-def _ws(root: str, plan_file: str | None = None) -> Workspace:
-    """The workspace at ``root``, loaded once per doit run: every action would
-    otherwise parse and check the contracts again.
-
-    :func:`build_tasks` (called at the start of every run, also by
-    ``rclverify verify``) puts the workspace it loaded here, so the actions of
-    a run see the contracts and plan as they were when the run started -- the
-    state its ``check`` task snapshots and every later task depends on.  A
-    contract edited while a run is under way is therefore picked up by the
-    next run, whose ``check`` sees the changed file.  Without a seeded entry
-    (a worker process that did not inherit it) the workspace is loaded here,
-    with ``plan_file`` (the ``check`` task passes the run's plan file; the
-    default plan otherwise).
-    """
-    heap.freeze_inherited()  # a doit -n worker: its inherited heap stays live (rclverify.core.cache.heap)
-    ws = _WORKSPACES.get(root)
-    if ws is None or (plan_file is not None and ws.plan_file != plan_file):
-        ws = Workspace(Path(root), plan_file or "contracts/plan.yaml")
-        ws.model  # load now: raises RclError for bad input and then caches nothing
-        _WORKSPACES[root] = ws
-    return ws
-
-
-def _fail(exc: RclError) -> TaskFailed:
-    return TaskFailed("\n".join(str(d) for d in exc.diagnostics))
-
-
-def _io_fail(exc: OSError, root: str, place: str = "artifacts/") -> TaskFailed:
-    """A fault of the machine (read-only directory, full disk) as one plain line
-    (:mod:`rclverify.core.faults`; ``place``: where the action writes, for an
-    error without a file name): the writes are atomic, nothing recorded changed."""
-    from rclverify.core.faults import describe_os_error  # deferred: start-up (loads rclverify.core.faults only when called)
-    return TaskFailed(describe_os_error(exc, Path(root), place=place))
-
-
-def act_check(root: str, plan_file: str = "contracts/plan.yaml") -> Any:
-    try:
-        out = stage_check(_ws(root, plan_file))
-    except RclError as exc:
-        return _fail(exc)
-    except OSError as exc:
-        return _io_fail(exc, root)
-    for w in out["warnings"]:
-        print(f"{w['file']}:{w['line']}:{w['col']}: warning: {w['message']}")
-    return None
-
-
-def act_graph(root: str) -> Any:
-    from rclverify.report.diagram import dot_to_svg  # deferred: start-up (loads jinja2, rclverify.report and more only when called)
-    try:
-        dot = stage_graph(_ws(root))
-        svg = dot_to_svg(dot)
-        if svg is None:
-            print(f"graphviz 'dot' not found: {Workspace.DOT} written, model.svg not drawn")
-            return None
-        atomic_write_text(Path(root) / "artifacts/system/model.svg", svg)
-    except RclError as exc:
-        return _fail(exc)
-    except OSError as exc:
-        return _io_fail(exc, root)
-    return None
-
-
-#: The stages of a ``node:<Node>`` task, in the order they run.
-NODE_STAGES = ("compose", "health", "export")
-
-
-def stages_to_run(deps: Mapping[str, Sequence[str]], changed: Sequence[str]) -> list[str]:
-    """The stages of a node task whose own file dependencies are among
-    ``changed`` (doit's ``dep_changed``), in :data:`NODE_STAGES` order.
-
-    ``deps`` maps each stage to its file dependencies.  An empty ``changed``
-    means doit gave no reason by file (a forced run, ``doit -a``, a changed
-    ``uptodate`` check): every stage runs.  A missing target makes doit list
-    every dependency as changed, so every stage runs then too.
-    """
-    if not changed:
-        return list(NODE_STAGES)
-    hit = set(changed)
-    return [stage for stage in NODE_STAGES if hit.intersection(deps[stage])]
-
-
-def act_node(root: str, node: str, deps: dict[str, list[str]], changed: list[str]) -> Any:
-    """Run the stages of ``node`` whose inputs changed (:func:`stages_to_run`).
-
-    ``changed`` is filled by doit (the task's file dependencies that changed
-    since its last successful run)."""
-    stages = stages_to_run(deps, changed)
-    try:
-        for stage in stages:
-            getattr(pipeline, f"stage_{stage}")(_ws(root), node)
-    except RclError as exc:
-        return _fail(exc)
-    except OSError as exc:
-        return _io_fail(exc, root)
-    print(f"{node}: {', '.join(stages)}")
-    return None
-
-
-def act_run(root: str, node: str, obligation_id: str) -> Any:
-    from rclverify.app import cluster  # deferred: start-up (loads rclverify.app.cluster only when called)
-    addr = cluster.address()  # RCLVERIFY_CLUSTER: the backend job runs on that Dask cluster
-    try:
-        if addr is None:
-            ev = stage_run(_ws(root), node, obligation_id)
-        else:
-            ev = cluster.run_on_cluster(addr, _ws(root), node, obligation_id)
-    except RclError as exc:
-        return _fail(exc)
-    except cluster.ClusterError as exc:
-        return TaskFailed(f"error: {exc}")
-    except OSError as exc:
-        return _io_fail(exc, root, "artifacts/evidence/")
-    print(f"{ev.obligation}: {ev.status}")
-    return None
-
-
-#: The report dict built by the first report part of a run, for the other parts the same process
-#: runs (a serial run): keyed by workspace root, valid for the workspace object of that run.
-_REPORTS: dict[str, tuple[Workspace, Report]] = {}
-
-
-def act_report(root: str, part: str) -> Any:
-    """Write one part of the report (:mod:`rclverify.report.parts`).  The
-    parts run after every backend, from the same artifacts, so a process
-    that runs both (``doit`` without ``-n``) builds the report dict once:
-    it is kept for the workspace object of this run (:func:`_ws`), which
-    a later run (a new :func:`build_tasks`) replaces."""
-    try:
-        ws = _ws(root)
-        kept = _REPORTS.get(root)
-        report, _ = stage_report(ws, (part,), kept[1] if kept is not None and kept[0] is ws else None)
-    except RclError as exc:
-        return _fail(exc)
-    except OSError as exc:
-        return _io_fail(exc, root, "reports/")
-    _REPORTS[root] = (ws, report)
-    if part == "html":
-        print(f"report: reports/assurance.html  ({report['summary']['headline']})")
-    else:
-        print("report: reports/assurance.md, reports/argument.{json,gsn.yaml,dot}")
-    return None
-
-
-def act_requirements(root: str) -> Any:
-    """Check the requirements whose inputs changed (:mod:`rclverify.stages.requirements`)."""
-    try:
-        rows = stage_requirements(_ws(root))
-    except RclError as exc:
-        return _fail(exc)
-    again = [rec["id"] for rec, now in rows if now]
-    print(f"requirements: {len(again)} of {len(rows)} checked" + (f" ({', '.join(again[:10])}"
-                                                                  + (", ..." if len(again) > 10 else "") + ")" if again else ""))
-    return None
-
-
-def act_deadlines(root: str) -> Any:
-    """Decide the end-to-end deadlines (rule D3, :mod:`rclverify.stages.deadlines`)."""
-    try:
-        records = stage_deadlines(_ws(root))
-    except RclError as exc:
-        return _fail(exc)
-    except OSError as exc:
-        return _io_fail(exc, root)
-    print("deadlines: " + ", ".join(f"{r['requirement']} {r['status']}" for r in records))
-    return None
-
-
-def act_crosscheck(root: str, nodes: list[str]) -> Any:
-    """Decide every discharging query again with cvc5 (:mod:`rclverify.stages.crosscheck.stage`, issue 50)."""
-    from rclverify.stages.crosscheck.stage import stage_crosscheck  # deferred: start-up (loads rclverify.stages.crosscheck, rclverify.stages.requirements and more only when called)
-    try:
-        index = stage_crosscheck(Path(root), nodes)
-    except OSError as exc:
-        return _io_fail(exc, root)
-    counts = index.get("counts", {})
-    print("second solver: " + (", ".join(f"{v} {k}" for k, v in counts.items()) or "nothing to re-decide")
-          + ("" if index.get("solver") else " (cvc5 is not installed)"))
-    return None
-
-
-def act_ground(root: str) -> Any:
-    """The grounding stage (docs/ros.md): scan the plan's ``ros:`` section,
-    hold the contracts against it; findings go to the report, never to a verdict."""
-    from rclverify.app.ros_stage import stage_ground  # deferred: start-up (loads rclverify.app.ros_stage, rclverify.lang.ast only when called)
-    try:
-        data = stage_ground(_ws(root))
-    except RclError as exc:
-        return _fail(exc)
-    c = data["counts"]
-    print(f"grounding: {c['error']} error(s), {c['warning']} warning(s) (rclverify ros check lists them)")
-    return None
-
-
-def act_verify(root: str, strict: bool) -> Any:
-    """The ``verify`` task: print the run's status, problems and summary table
-    (:func:`rclverify.report.summary.print_last_run`); with ``strict``, fail
-    unless every item holds."""
-    from rclverify.app.progress import PlainFailure  # deferred: start-up (loads doit, rclverify.app.doitstate and more only when called)
-    from rclverify.report.summary import print_last_run, strict_sentence  # deferred: start-up (loads rclverify.report, rclverify.report.summary only when called)
-    try:
-        data = print_last_run(Path(root))
-    except RclError as exc:  # the last run's summary is missing or of another shape: one located line
-        return PlainFailure("\n".join(str(d) for d in exc.diagnostics))
-    if strict and not data["meta"]["strict_ok"]:
-        return PlainFailure(strict_sentence(data))  # one sentence naming why (issue 30)
-    return None
 
 
 #: The name older callers import (tests, ``from rclverify.app.tasks import _inputs``): :func:`entry_inputs`.
@@ -378,11 +165,11 @@ def _build_tasks(root: str | Path, plan_file: str) -> dict[str, Callable[[], Any
     ok = index is not None
     nodes = list(index.nodes) if index is not None else []
     if ok:
-        _WORKSPACES[r] = ws
+        WORKSPACES[r] = ws
         if not restored:
             wscache.save_in_background(ws)
     else:
-        _WORKSPACES.pop(r, None)
+        WORKSPACES.pop(r, None)
     try:
         contract_deps = [f"{r}/{c}" for c in (index.contracts if index is not None else ws.plan.contracts)]
     except RclError:
