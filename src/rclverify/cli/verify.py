@@ -40,7 +40,7 @@ def cmd_verify(args: argparse.Namespace) -> int:
     argv = ["verify"] + (["--strict"] if args.strict else [])
     if args.jobs > 1:
         argv = ["-n", str(args.jobs)] + argv
-    try:  # SystemExit: a fault while doit saves its state, already reported in one line (tasks._guard_dep_writes)
+    try:  # SystemExit: a fault while doit saves its state, already reported in one line (doit_patches.guard_dep_writes)
         return run_doit(module, argv, args.cluster)
     except SystemExit as exc:
         return int(exc.code) if isinstance(exc.code, int) else 1
