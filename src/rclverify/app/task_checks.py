@@ -89,8 +89,9 @@ class RecordIntact:
 
 
 def strict_uptodate(task: Any, values: Any) -> bool:
-    """``verify`` is up to date unless ``--strict`` asks for the check again."""
-    return not bool(task.options.get("strict"))
+    """``verify`` is up to date unless ``--strict`` asks for the check again.  ``doit list --status``
+    asks without parsing the task's options (``task.options`` is ``None``): no ``--strict`` then."""
+    return not bool((task.options or {}).get("strict"))
 
 
 def entry_inputs(config: Any, root: Path, seen: dict[str, tuple[str, ...]]) -> list[str]:
