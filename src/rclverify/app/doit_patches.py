@@ -72,6 +72,8 @@ def guard_dep_writes() -> None:
         guarded._rclverify_guarded = True  # type: ignore[attr-defined]
         return guarded
     for name in ("dump", "remove"):
-        method = getattr(SqliteDB, name)
+        method = getattr(SqliteDB, name, None)
+        if method is None:  # another doit: leave its store as it is (docs/decisions.md, "Where rclverify reaches into doit")
+            continue
         if not getattr(method, "_rclverify_guarded", False):
             setattr(SqliteDB, name, guard(method))
