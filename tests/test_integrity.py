@@ -27,6 +27,7 @@ from pathlib import Path
 import pytest
 
 import _incremental as inc
+from _restore import restored
 
 
 @pytest.fixture(scope="module")
@@ -45,6 +46,8 @@ def verified(clean_run: tuple[Path, subprocess.CompletedProcess[str]]) -> Path:
 
 
 def _copy(verified: Path, tmp_path: Path) -> Path:
+    """A copy of the verified workspace, for a test that runs no stage in it (a run in a copy re-runs
+    every task: doit's state names the files by absolute path)."""
     ws = tmp_path / "ws"
     shutil.copytree(verified, ws, symlinks=True)
     return ws
@@ -65,7 +68,12 @@ def _rclverify(ws: Path, *args: str) -> subprocess.CompletedProcess[str]:
 
 
 def test_a_plan_edit_re_renders_the_report(verified: Path, tmp_path: Path) -> None:
-    ws = _copy(verified, tmp_path)
+    # in place (an incremental run, as a user's), the workspace put back afterwards
+    with restored(verified, tmp_path / "before") as ws:
+        _a_plan_edit_re_renders_the_report(ws)
+
+
+def _a_plan_edit_re_renders_the_report(ws: Path) -> None:
     inc.edit_requirement_text(ws, 7)
     inc.edit_requirement_tracing(ws, 2)  # REQ2 -> Localisation guarantee 1
     inc.edit_plan_name(ws, 9)
@@ -87,9 +95,11 @@ def test_a_contract_edit_that_changes_no_snapshot_re_renders_the_report(verified
     (``meta.inputs_sha256``), so it is rendered again, and the bundle takes
     it (found by bench/incremental_equivalence.py: the report kept the old
     sha256, `doit verify` called it up to date and the bundle refused it)."""
-    ws = _copy(verified, tmp_path)
-    proc = inc.verify(ws)  # in this directory first: doit's state names the workspace's files
-    assert proc.returncode == 0, proc.stdout + proc.stderr
+    with restored(verified, tmp_path / "before") as ws:
+        _a_contract_edit_that_changes_no_snapshot(ws, tmp_path)
+
+
+def _a_contract_edit_that_changes_no_snapshot(ws: Path, tmp_path: Path) -> None:
     snapshots = {p.name: p.read_bytes() for p in (ws / "artifacts/contracts").glob("*.json")}
     rcl = ws / "contracts/remote_inspection.rcl"
     rcl.write_text(rcl.read_text(encoding="utf-8") + "// a closing comment\n", encoding="utf-8")
@@ -102,7 +112,11 @@ def test_a_contract_edit_that_changes_no_snapshot_re_renders_the_report(verified
 
 
 def test_report_shows_evidence_of_an_edited_contract_as_stale(verified: Path, tmp_path: Path) -> None:
-    ws = _copy(verified, tmp_path)
+    with restored(verified, tmp_path / "before") as ws:
+        _evidence_of_an_edited_contract_is_stale(ws)
+
+
+def _evidence_of_an_edited_contract_is_stale(ws: Path) -> None:
     before = {o["id"]: o["status"] for o in _report(ws)["obligations"]}
     assert before["RadiationSensor.g1.hoare.radiation_sensor.c4"] == "discharged"
     rcl = ws / "contracts/remote_inspection.rcl"
@@ -148,7 +162,11 @@ def test_a_check_index_that_does_not_match_its_seal_is_not_believed(verified: Pa
 
 
 def test_a_hand_edited_evidence_record_is_not_believed(verified: Path, tmp_path: Path) -> None:
-    ws = _copy(verified, tmp_path)
+    with restored(verified, tmp_path / "before") as ws:
+        _a_hand_edited_evidence_record_is_not_believed(ws)
+
+
+def _a_hand_edited_evidence_record_is_not_believed(ws: Path) -> None:
     record = ws / "artifacts/evidence/Navigation.g1.experiment.e0.json"
     data = json.loads(record.read_text(encoding="utf-8"))
     assert data["status"] == "failed"

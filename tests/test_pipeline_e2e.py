@@ -1,17 +1,16 @@
 """End to end: `doit verify` on a copy of the bundled workspace (the paper's case study)."""
 from __future__ import annotations
 
-import contextlib
 import json
 import re
 import shutil
 import subprocess
 import sys
 from pathlib import Path
-from typing import Iterator
 
 import pytest
 
+from _restore import restored
 from rclverify.records.store import dumps
 from rclverify.app.pipeline import Workspace
 from rclverify.report.build import build_report
@@ -319,25 +318,11 @@ def test_strict_mode_fails_on_open_evidence(workspace: Path) -> None:
     assert "--strict" in r.stdout + r.stderr
 
 
-@contextlib.contextmanager
-def _restored(workspace: Path, keep: Path) -> Iterator[None]:
-    """Run the block on ``workspace``, then put back the whole workspace as it was before (inputs, artifacts,
-    reports and doit's state, with their modification times): the module's later tests see the verified
-    case study again without a third ``doit verify`` that undoes the edit (it would re-run what the edit's
-    own run ran, about a third of the case study)."""
-    shutil.copytree(workspace, keep, symlinks=True)
-    try:
-        yield
-    finally:
-        shutil.rmtree(workspace)
-        shutil.copytree(keep, workspace, symlinks=True)
-
-
 def test_bad_rcl_gives_located_error_and_keeps_evidence(workspace: Path, tmp_path: Path) -> None:
     rcl = workspace / "contracts" / "remote_inspection.rcl"
     before = {p.name: p.read_bytes() for p in (workspace / "artifacts" / "evidence").glob("*.json")}
     original = rcl.read_text()
-    with _restored(workspace, tmp_path / "before"):
+    with restored(workspace, tmp_path / "before"):
         rcl.write_text(original.replace("assume( 0 <= in.r )", "assume( 0 <= in.rr )"))
         r = _doit(workspace, "verify")
         out = r.stdout + r.stderr
@@ -353,7 +338,7 @@ def test_staleness_follows_the_inputs_of_each_obligation(workspace: Path, tmp_pa
     plan = workspace / "contracts" / "plan.yaml"
     program = workspace / "backends" / "hoare" / "radiation_sensor.imp"
     plan_text, program_text = plan.read_text(), program.read_text()
-    with _restored(workspace, tmp_path / "before"):
+    with restored(workspace, tmp_path / "before"):
         # a change that concerns no node's evidence keeps every record fresh
         plan.write_text(plan_text.replace("Each waypoint only needs", "Each waypoint needs"))
         assert _doit(workspace, "verify").returncode == 0
@@ -400,7 +385,7 @@ def test_side_conditions_are_written_for_a_second_solver(report: dict, workspace
 def test_editing_one_contract_reruns_that_node_its_consumers_and_the_report(workspace: Path, tmp_path: Path) -> None:
     rcl = workspace / "contracts" / "remote_inspection.rcl"
     original = rcl.read_text()
-    with _restored(workspace, tmp_path / "before"):
+    with restored(workspace, tmp_path / "before"):
         rcl.write_text(original.replace("and (250 <= in.r -> out.radiationStatus == red)",
                                         "and (251 <= in.r -> out.radiationStatus == red)"))
         r = _doit(workspace, "verify")
