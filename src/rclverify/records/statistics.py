@@ -58,7 +58,7 @@ def lower_bound(k: int, n: int, level: float) -> float:
         return 0.0
     if k >= n:
         return math.pow(1.0 - level, 1.0 / n)
-    from scipy.stats import beta
+    from scipy.stats import beta  # deferred: start-up (loads scipy only when called)
     return float(beta.ppf(1.0 - level, k, n - k + 1))
 
 
