@@ -56,9 +56,11 @@ class UnknownNode(TypeError):
     """:meth:`Visitor.visit` was given a value that is not an RCL node (the message names its class)."""
 
 
-class MissingVisit(NotImplementedError):
+class MissingVisit(LookupError):
     """A visitor met a node class it has no ``visit_<Class>`` method for and
-    does not combine children's results (the message names both)."""
+    does not combine children's results (the message names both): a
+    construct the visitor was never taught, an error in the visitor, never
+    a silent default."""
 
 
 def _is_node(value: Any) -> bool:
