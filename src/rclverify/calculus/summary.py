@@ -320,6 +320,52 @@ def decide(checked: Checked, model: SystemModel, node: str, conjunct: ast.Expr,
     query over the summaries), or ``None``: decide over the whole cone
     (module docstring).  Never raises on solver trouble."""
     facts = facts or {}
+    q = _summary_query(checked, model, node, conjunct, environment, facts)
+    if q is None:
+        return None
+    t0 = time.perf_counter()
+    core = _solve(q, timeout_ms)
+    if core is None:
+        return None
+    dt = round(time.perf_counter() - t0, 4)
+    used = _core_premises(checked, model, node, environment, facts, q, core)
+    node_of = {u[0]: model.nodes[u[2][0]] for u in used}
+    nodes = tuple(dict.fromkeys(node_of[u[0]] for u in used if " guarantee " in u[0]))
+    joins = _multi_path(model, node, model.upstream(node), set()) if q.joined or nodes else set()
+    header = "".join(f"; {line}\n" for line in comment.splitlines())
+    script = (header + f"; premises: the summaries of the cones of {', '.join(q.top)} (each proved implied by its "
+              "cone by Z3 when made: calculus/summary.py) and the consumer's environment assumptions and facts\n"
+              + q.decls + "".join(f"; {label}\n(assert {b})\n" for label, b in q.premises)
+              + "".join(f"(assert {a})\n" for a in q.axioms) + f"; {NEGATED}\n(assert (not {q.goal}))\n(check-sat)\n")
+    return ContextResult("proved", script, dt, used=tuple(f"{u[0]}: {u[1]}" for u in used), used_nodes=nodes,
+                         joins=tuple(n for n in nodes if n in joins), summaries=tuple(q.top))
+
+
+@dataclass(frozen=True)
+class _Query:
+    """The query of :func:`decide` as SMT-LIB text: ``top`` the maximal
+    producers, ``joined`` whether the node has several producers,
+    ``decls`` the declarations, ``premises`` ``(label, formula)`` (the
+    summaries first, then the node's own premises), ``own`` label to
+    ``(RCL text, index among the node's premises)``, ``axioms`` the
+    naturals' bounds, ``goal`` the conjunct."""
+
+    top: list[str]
+    joined: bool
+    decls: str
+    premises: list[tuple[str, str]]
+    own: dict[str, tuple[str, int]]
+    axioms: list[str]
+    goal: str
+
+
+def _summary_query(checked: Checked, model: SystemModel, node: str, conjunct: ast.Expr,
+                   environment: Callable[[str], Sequence[ast.Expr]],
+                   facts: Mapping[str, Sequence[ast.Expr]]) -> _Query | None:
+    """The query of :func:`decide` over the summaries of ``node``'s
+    maximal producers (arguments as there), or ``None`` when no summary
+    query applies (a loop, no producers, a missing summary, a formula or
+    sort outside the fragment)."""
     if model.loop_of(node):
         return None
     producers = model.producers(node)
@@ -344,46 +390,50 @@ def decide(checked: Checked, model: SystemModel, node: str, conjunct: ast.Expr,
         sorts[name] = SORTS[t]
     premises = [(f"{p} summary", sm.formula) for p, sm in zip(top, sums)]  # type: ignore[union-attr]
     premises += [(label, t or "true") for label, _, _, _, t in d.items]
-    axioms = _naturals(checked, node, symbol)
     decls = "".join(f"(declare-fun {quote(n)} () {s})\n" for n, s in sorted(sorts.items()))
-    t0 = time.perf_counter()
-    lits = "".join(f"(declare-fun |l!{k}| () Bool)\n" for k in range(len(premises) + 1))
-    text = (decls + lits + "".join(f"(assert (=> |l!{k}| {b}))\n" for k, (_, b) in enumerate(premises))
-            + "".join(f"(assert {a})\n" for a in axioms) + f"(assert (=> |l!{len(premises)}| (not {goal})))\n")
+    own = {label: (text_, k) for k, (label, text_, _, _, _) in enumerate(d.items)}
+    return _Query(top, len(producers) > 1, decls, premises, own, _naturals(checked, node, symbol), goal)
+
+
+def _solve(q: _Query, timeout_ms: int) -> set[str] | None:
+    """The unsat core (literal names ``l!k``) of ``q``'s premises and the
+    negated goal, or ``None`` unless the query is unsat with the goal
+    needed and the premises alone satisfiable (``timeout_ms`` per check)."""
+    n = len(q.premises)
+    lits = "".join(f"(declare-fun |l!{k}| () Bool)\n" for k in range(n + 1))
+    text = (q.decls + lits + "".join(f"(assert (=> |l!{k}| {b}))\n" for k, (_, b) in enumerate(q.premises))
+            + "".join(f"(assert {a})\n" for a in q.axioms) + f"(assert (=> |l!{n}| (not {q.goal})))\n")
     try:
         # a scope of the caller's solver session (one node's calculus, semantics/query.py): its queries follow
         # from the stage's inputs alone, in a fixed order, so a failure then decided over the whole cone
         # gets the same model in every run; a fresh Z3 context here cost as much as the query (docs/scale.md)
         with query_solver(timeout_ms, cores=True) as s:
             s.add(z3.parse_smt2_string(text))
-            lit = [z3.Bool(f"l!{k}") for k in range(len(premises) + 1)]
+            lit = [z3.Bool(f"l!{k}") for k in range(n + 1)]
             if s.check(*lit) != z3.unsat:
                 return None  # a counterexample or unknown: the full cone decides (and traces the counterexample)
             core = {str(c) for c in s.unsat_core()}
-            if f"l!{len(premises)}" not in core or s.check(*lit[:-1]) != z3.sat:
+            if f"l!{n}" not in core or s.check(*lit[:-1]) != z3.sat:
                 return None  # premises that may contradict each other: the full cone says what they prove
     except z3.Z3Exception:
         return None
-    dt = round(time.perf_counter() - t0, 4)
+    return core
+
+
+def _core_premises(checked: Checked, model: SystemModel, node: str,
+                   environment: Callable[[str], Sequence[ast.Expr]], facts: Mapping[str, Sequence[ast.Expr]],
+                   q: _Query, core: set[str]) -> list[tuple[str, str, tuple[int, int]]]:
+    """The cone's premises ``core`` rests on, each ``(label, RCL text,
+    (node index, premise index))`` in cone order: a summary in the core
+    stands for the premises its own proof used."""
     index = {n: i for i, n in enumerate(model.nodes)}
-    own = {label: (text_, k) for k, (label, text_, _, _, _) in enumerate(d.items)}
     out: dict[str, tuple[str, str, tuple[int, int]]] = {}
-    for k, (label, _) in enumerate(premises):
+    for k, (label, _) in enumerate(q.premises):
         if f"l!{k}" not in core:
             continue
         if label.endswith(" summary"):
             for u in summary_of(checked, model, label[:-len(" summary")], environment, facts).used:  # type: ignore[union-attr]
                 out[u[0]] = u
         else:
-            out[label] = (label, own[label][0], (index[node], own[label][1]))
-    used = sorted(out.values(), key=lambda u: u[2])
-    node_of = {u[0]: model.nodes[u[2][0]] for u in used}
-    nodes = tuple(dict.fromkeys(node_of[u[0]] for u in used if " guarantee " in u[0]))
-    joins = _multi_path(model, node, model.upstream(node), set()) if len(producers) > 1 or nodes else set()
-    header = "".join(f"; {line}\n" for line in comment.splitlines())
-    script = (header + f"; premises: the summaries of the cones of {', '.join(top)} (each proved implied by its cone "
-              "by Z3 when made: calculus/summary.py) and the consumer's environment assumptions and facts\n"
-              + decls + "".join(f"; {label}\n(assert {b})\n" for label, b in premises)
-              + "".join(f"(assert {a})\n" for a in axioms) + f"; {NEGATED}\n(assert (not {goal}))\n(check-sat)\n")
-    return ContextResult("proved", script, dt, used=tuple(f"{u[0]}: {u[1]}" for u in used), used_nodes=nodes,
-                         joins=tuple(n for n in nodes if n in joins), summaries=tuple(top))
+            out[label] = (label, q.own[label][0], (index[node], q.own[label][1]))
+    return sorted(out.values(), key=lambda u: u[2])
