@@ -244,35 +244,8 @@ def quotient(checked: Checked, model: SystemModel, plan: Any, node: str,
     if not tgts:
         raise QuotientError(f"nothing downstream of {node} assumes anything of it and no formal requirement's cone "
                             "holds it: any contract serves (assume( TRUE ) with a guarantee of your choice)")
-    enc = sysm.enc
-    ins = {v: enc.io_symbol(cn, "in", v) for v in cn.inputs if cn.inputs[v] in ARITH}
-    outs = {v: enc.io_symbol(cn, "out", v) for v in cn.outputs if cn.outputs[v] in ARITH}
-    names = {str(s): f"in.{v}" for v, s in ins.items()} | {str(s): f"out.{v}" for v, s in outs.items()}
-    a_text = g_text = None
-    how = ""
     try:
-        if len(ins) < len(cn.inputs) or len(outs) < len(cn.outputs):
-            raise _Beyond("an input or output of the node is not a number or a Boolean")
-        up = [m for m in model.upstream(node)]
-        p_up = sysm.cone_premises(up, node, enc)
-        keep = set(names)
-        inputs = {str(x) for x in ins.values()}
-        hidden = [c for n, c in sorted(_constants(p_up).items()) if n not in inputs]  # outputs too: A is over i
-        a = eliminate(z3.Exists(hidden, _conj(p_up)) if hidden else _conj(p_up))
-        parts = []
-        for t in tgts:
-            body = z3.Implies(_conj(list(t.premises)), t.goal)
-            hid = [c for n, c in sorted(_constants([body]).items()) if n not in keep]
-            parts.append(z3.ForAll(hid, body) if hid else body)
-        g = eliminate(_conj(parts))
-        if a is None or g is None:
-            raise _Beyond("Z3's quantifier elimination left a quantifier")
-        _no_answer(sysm, a, g, list(outs.values()), names)
-        a = clauses_under(a)
-        g = clauses_under(g, [a])
-        a_text, g_text = to_rcl(a, names), to_rcl(g, names)
-        if a_text is None or g_text is None:
-            raise _Beyond("the eliminated formula is not linear arithmetic RCL can print")
+        a_text, g_text = _exact(sysm, model, node, tgts)
         how = ("exact: the weakest contract (linear arithmetic; Z3's quantifier elimination, the guarantee "
                "simplified where the assumption holds)")
     except _Beyond as why:
@@ -280,16 +253,7 @@ def quotient(checked: Checked, model: SystemModel, plan: Any, node: str,
         how = (f"a sound approximation, not the weakest contract ({why}): assumption TRUE; guarantee: what the "
                "direct consumers assume of its outputs")
     block = _node_block(cn.node, a_text, g_text)
-    decided = _recheck(checked, plan, node, block, tgts)
-    said: list[tuple[str, str, str]] = []
-    recheck: list[tuple[str, str]] = []
-    for i, v, script in decided:
-        if confirm is not None and v in PROVED and script:
-            agreement, why = confirm(script)
-            said.append((i, agreement, why))
-            if agreement in NOT_CONFIRMED:
-                v = f"inconclusive (second solver: {why})"
-        recheck.append((i, v))
+    recheck, said = _confirmed(_recheck(checked, plan, node, block, tgts), confirm)
     bad = [f"{i} {v}" for i, v in recheck if v not in PROVED]
     if bad:
         raise QuotientError(f"the contract computed for {node} ({how}) does not re-check"
@@ -302,6 +266,60 @@ def quotient(checked: Checked, model: SystemModel, plan: Any, node: str,
     return Quotient(node, a_text, g_text, how.startswith("exact"), how,
                     tuple(f"{t.kind} {t.id}: {t.text}" for t in tgts), tuple(recheck), tuple(notes), block,
                     tuple(said))
+
+
+def _exact(sysm: _System, model: SystemModel, node: str, tgts: Sequence[Target]) -> tuple[str, str]:
+    """The weakest contract of ``node`` as RCL text ``(assumption,
+    guarantee)``: the upstream premises with all but the node's inputs
+    eliminated, and the targets under them with all but the node's inputs
+    and outputs eliminated (Z3's ``qe``), simplified and printed.  Raises
+    :class:`_Beyond` when anything leaves linear arithmetic."""
+    enc = sysm.enc
+    cn = sysm.checked.nodes[node]
+    ins = {v: enc.io_symbol(cn, "in", v) for v in cn.inputs if cn.inputs[v] in ARITH}
+    outs = {v: enc.io_symbol(cn, "out", v) for v in cn.outputs if cn.outputs[v] in ARITH}
+    names = {str(s): f"in.{v}" for v, s in ins.items()} | {str(s): f"out.{v}" for v, s in outs.items()}
+    if len(ins) < len(cn.inputs) or len(outs) < len(cn.outputs):
+        raise _Beyond("an input or output of the node is not a number or a Boolean")
+    up = [m for m in model.upstream(node)]
+    p_up = sysm.cone_premises(up, node, enc)
+    keep = set(names)
+    inputs = {str(x) for x in ins.values()}
+    hidden = [c for n, c in sorted(_constants(p_up).items()) if n not in inputs]  # outputs too: A is over i
+    a = eliminate(z3.Exists(hidden, _conj(p_up)) if hidden else _conj(p_up))
+    parts = []
+    for t in tgts:
+        body = z3.Implies(_conj(list(t.premises)), t.goal)
+        hid = [c for n, c in sorted(_constants([body]).items()) if n not in keep]
+        parts.append(z3.ForAll(hid, body) if hid else body)
+    g = eliminate(_conj(parts))
+    if a is None or g is None:
+        raise _Beyond("Z3's quantifier elimination left a quantifier")
+    _no_answer(sysm, a, g, list(outs.values()), names)
+    a = clauses_under(a)
+    g = clauses_under(g, [a])
+    a_text, g_text = to_rcl(a, names), to_rcl(g, names)
+    if a_text is None or g_text is None:
+        raise _Beyond("the eliminated formula is not linear arithmetic RCL can print")
+    return a_text, g_text
+
+
+def _confirmed(decided: Sequence[tuple[str, str, str]], confirm: Callable[[str], tuple[str, str]] | None
+               ) -> tuple[list[tuple[str, str]], list[tuple[str, str, str]]]:
+    """The re-check's ``(id, verdict)`` pairs and the second solver's
+    ``(id, agreement, why)`` sayings: a proved verdict ``confirm`` does not
+    confirm becomes inconclusive (``decided``: ``(id, verdict, SMT-LIB2
+    script)`` from :func:`_recheck`)."""
+    said: list[tuple[str, str, str]] = []
+    recheck: list[tuple[str, str]] = []
+    for i, v, script in decided:
+        if confirm is not None and v in PROVED and script:
+            agreement, why = confirm(script)
+            said.append((i, agreement, why))
+            if agreement in NOT_CONFIRMED:
+                v = f"inconclusive (second solver: {why})"
+        recheck.append((i, v))
+    return recheck, said
 
 
 def render(q: Quotient, target_texts: Mapping[str, str] | None = None) -> str:
