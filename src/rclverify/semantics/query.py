@@ -236,53 +236,77 @@ def prove(goal: z3.BoolRef, hypotheses: Sequence[z3.BoolRef], enc: Encoder | Non
     formulas = hyps + [z3.Not(goal)]
     script = smt2_script(formulas, comment or "validity query: unsat means the goal follows from the hypotheses")
     ladder = first_ms is not None and (deterministic or not _SESSIONS)
-    t0 = time.perf_counter()
-
-    def answered(s: z3.Solver, r: z3.CheckSatResult, strategy: str = "") -> QueryResult | None:
-        dt = round(time.perf_counter() - t0, 4)
-        if r == z3.unsat:
-            return QueryResult("proved", script, dt, strategy=strategy)
-        if r == z3.sat:
-            return QueryResult("refuted", script, dt, model=render_model(s.model(), enc), strategy=strategy)
-        return None
-
-    def default(budget_ms: float | None) -> z3.Solver:
-        """The first attempt's solver with the query in it (``None``: its whole budget)."""
-        if deterministic:
-            s = bounded_solver() if budget_ms is None else bounded_solver(rlimit=steps(budget_ms))
-            load_canonical(s, formulas)
-        else:
-            s = budgeted_solver(budget_ms if budget_ms is not None else timeout_ms)
-            s.add(*formulas)
-        return s
-
+    q = _Validity(formulas, script, enc, deterministic, timeout_ms)
     with ExitStack() as scope:
         if ladder or deterministic:
-            s = default(first_ms if ladder else None)
+            s = q.default(first_ms if ladder else None)
         else:
             s = scope.enter_context(query_solver(timeout_ms))
             s.add(*formulas)
-        got = answered(s, s.check())
+        got = q.answered(s, s.check())
         if got is not None:
             return got
         reasons = {DEFAULT: s.reason_unknown()}
         if ladder and counterexample is not None:
             model = counterexample()
             if model is not None:
-                return QueryResult("refuted", script, round(time.perf_counter() - t0, 4), model=model,
-                                   strategy=TABLES)
+                return QueryResult("refuted", script, q.elapsed(), model=model, strategy=TABLES)
         models_first = bool(ladder and likely_sat is not None and likely_sat())
-        for name in retry_order(formulas, ladder=ladder, models_first=models_first):
+        return q.retries(ladder, models_first, reasons)
+
+
+class _Validity:
+    """The attempts of one :func:`prove` query: its ``formulas``
+    (hypotheses and the negated goal), the maker of their SMT-LIB2
+    ``script`` (:func:`smt2_script`), the
+    encoder that renders a model, and the clock started when it was made."""
+
+    def __init__(self, formulas: list[z3.BoolRef], script: Callable[[], str], enc: Encoder | None, deterministic: bool,
+                 timeout_ms: int) -> None:
+        self.formulas, self.script, self.enc = formulas, script, enc
+        self.deterministic, self.timeout_ms = deterministic, timeout_ms
+        self.t0 = time.perf_counter()
+
+    def elapsed(self) -> float:
+        """Seconds since the query was made, rounded to 0.1 ms."""
+        return round(time.perf_counter() - self.t0, 4)
+
+    def answered(self, s: z3.Solver, r: z3.CheckSatResult, strategy: str = "") -> QueryResult | None:
+        """The result for answer ``r`` of solver ``s`` (``strategy`` the
+        retry that gave it), or ``None`` when ``r`` is unknown."""
+        if r == z3.unsat:
+            return QueryResult("proved", self.script, self.elapsed(), strategy=strategy)
+        if r == z3.sat:
+            return QueryResult("refuted", self.script, self.elapsed(), model=render_model(s.model(), self.enc),
+                               strategy=strategy)
+        return None
+
+    def default(self, budget_ms: float | None) -> z3.Solver:
+        """The first attempt's solver with the query in it (``None``: its whole budget)."""
+        if self.deterministic:
+            s = bounded_solver() if budget_ms is None else bounded_solver(rlimit=steps(budget_ms))
+            load_canonical(s, self.formulas)
+        else:
+            s = budgeted_solver(budget_ms if budget_ms is not None else self.timeout_ms)
+            s.add(*self.formulas)
+        return s
+
+    def retries(self, ladder: bool, models_first: bool, reasons: dict[str, str]) -> QueryResult:
+        """The strategies of :func:`.retry.retry_order` in turn after an
+        undecided first attempt (``reasons``: strategy -> Z3's reason
+        unknown, grown here); ``inconclusive`` with every reason when none
+        decides."""
+        for name in retry_order(self.formulas, ladder=ladder, models_first=models_first):
             if name == DEFAULT:
-                s2 = default(None)
+                s2 = self.default(None)
             else:
                 s2, rewrite = strategy_solver(name)
-                load_canonical(s2, [rewrite(f) for f in formulas])
-            got = answered(s2, s2.check(), "" if name == DEFAULT else name)
+                load_canonical(s2, [rewrite(f) for f in self.formulas])
+            got = self.answered(s2, s2.check(), "" if name == DEFAULT else name)
             if got is not None:
                 return got
             reasons[name] = s2.reason_unknown()
-        return QueryResult("inconclusive", script, round(time.perf_counter() - t0, 4), reason=reasons_text(reasons))
+        return QueryResult("inconclusive", self.script, self.elapsed(), reason=reasons_text(reasons))
 
 
 def satisfiable(labelled: Sequence[tuple[str, z3.BoolRef]], enc: Encoder | None = None, *,
