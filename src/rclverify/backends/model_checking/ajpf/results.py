@@ -118,63 +118,26 @@ def parse_log(text: str) -> AjpfResult:
     Never raises for odd input: an empty or foreign text gives verdict
     ``unfinished`` with empty fields.
     """
-    sections: list[tuple[str, list[str]]] = [("", [])]
-    for line in text.splitlines():
-        m = _SECTION.match(line)
-        if m:
-            sections.append((m.group(1), []))
-        else:
-            sections[-1][1].append(line)
-
     prop_name = psl_file = ail_file = None
     m = _SUT.search(text)
     if m:
         args = re.findall(r'"([^"]*)"', m.group(1))
         if len(args) >= 3:
             ail_file, psl_file, prop_name = args[0], args[1], args[2]
-
     results_lines: list[str] | None = None
     error_sections: list[list[str]] = []
     stats: list[str] = []
-    for title, lines in sections:
+    for title, lines in _sections(text):
         if title == "results":
             results_lines = lines
         elif re.match(r"^error\s+\d+$", title):
             error_sections.append(lines)
         elif title == "statistics":
             stats = lines
-
-    errors: list[str] = []
-    no_errors = False
-    if results_lines is not None:
-        for line in results_lines:
-            s = line.strip()
-            if s == "no errors detected":
-                no_errors = True
-            elif _ERROR_LINE.match(s):
-                errors.append(s)
-
-    path: list[tuple[int, int, int]] = []
-    listener_error = False
-    for lines in error_sections:
-        body = "\n".join(lines)
-        if "MCAPLListener" in body or "Accepting Path" in body:
-            listener_error = True
-            path = [(int(a), int(b), int(c)) for a, b, c in _PATH_STEP.findall(body)]
-            break
-    if any("MCAPLListener" in e for e in errors):
-        listener_error = True
-
-    constraints = None
-    elapsed = None
-    for line in stats:
-        cm = re.search(r"constraints=(\d+)", line)
-        if cm:
-            constraints = int(cm.group(1))
-        em = re.match(r"\s*elapsed time:\s*(\S+)", line)
-        if em:
-            elapsed = em.group(1)
-
+    errors, no_errors = _results(results_lines)
+    path, listener_error = _accepting_path(error_sections)
+    listener_error = listener_error or any("MCAPLListener" in e for e in errors)
+    constraints, elapsed = _statistics(stats)
     if listener_error:
         verdict = "violated"
     elif errors:
@@ -183,8 +146,74 @@ def parse_log(text: str) -> AjpfResult:
         verdict = "verified" if not constraints else "incomplete-search"
     else:
         verdict = "unfinished"
-
     info, arrivals = _info_lines(text)
+    mv = re.search(r"MCAPL Framework\s+(\S+)", text)
+    jv = re.search(r"JavaPathfinder core system v(\S+)", text)
+    return AjpfResult(
+        verdict=verdict, property_name=prop_name, psl_file=psl_file, ail_file=ail_file,
+        accepting_path=tuple(path), trace=tuple(_trace(path, arrivals)), errors=tuple(errors),
+        constraints=constraints, elapsed=elapsed, mcapl_version=mv.group(1) if mv else "",
+        jpf_version=jv.group(1) if jv else "", info=tuple(info),
+    )
+
+
+def _sections(text: str) -> list[tuple[str, list[str]]]:
+    """The log's sections as ``(title, lines)``; the text before the first
+    rule of ``=`` is the section titled ``""``."""
+    sections: list[tuple[str, list[str]]] = [("", [])]
+    for line in text.splitlines():
+        m = _SECTION.match(line)
+        if m:
+            sections.append((m.group(1), []))
+        else:
+            sections[-1][1].append(line)
+    return sections
+
+
+def _results(lines: list[str] | None) -> tuple[list[str], bool]:
+    """The ``error #k`` lines of the results section ``lines`` and whether
+    it says ``no errors detected`` (``None``: no results section)."""
+    errors: list[str] = []
+    no_errors = False
+    for line in lines or ():
+        s = line.strip()
+        if s == "no errors detected":
+            no_errors = True
+        elif _ERROR_LINE.match(s):
+            errors.append(s)
+    return errors, no_errors
+
+
+def _accepting_path(error_sections: list[list[str]]) -> tuple[list[tuple[int, int, int]], bool]:
+    """The accepting path of the first error section from
+    ``ajpf.MCAPLListener`` as ``(model state, automaton state, until
+    count)`` triples, and whether there is such a section."""
+    for lines in error_sections:
+        body = "\n".join(lines)
+        if "MCAPLListener" in body or "Accepting Path" in body:
+            return [(int(a), int(b), int(c)) for a, b, c in _PATH_STEP.findall(body)], True
+    return [], False
+
+
+def _statistics(lines: list[str]) -> tuple[int | None, str | None]:
+    """JPF's count of search constraints hit and its elapsed time text
+    (``hh:mm:ss``) from the statistics section ``lines`` (``None`` where absent)."""
+    constraints = None
+    elapsed = None
+    for line in lines:
+        cm = re.search(r"constraints=(\d+)", line)
+        if cm:
+            constraints = int(cm.group(1))
+        em = re.match(r"\s*elapsed time:\s*(\S+)", line)
+        if em:
+            elapsed = em.group(1)
+    return constraints, elapsed
+
+
+def _trace(path: list[tuple[int, int, int]], arrivals: dict[int, list[str]]) -> list[str]:
+    """One text per model state of ``path``, with the actions logged on the
+    way into it (``arrivals``, from :func:`_info_lines`); a state seen
+    before is marked ``(again)``."""
     trace = []
     seen: set[int] = set()
     for ms, _, _ in path:
@@ -194,15 +223,7 @@ def parse_log(text: str) -> AjpfResult:
         seen.add(ms)
         acts = arrivals.get(ms, [])
         trace.append(f"state {ms}" + (": " + "; ".join(acts) if acts else ""))
-
-    mv = re.search(r"MCAPL Framework\s+(\S+)", text)
-    jv = re.search(r"JavaPathfinder core system v(\S+)", text)
-    return AjpfResult(
-        verdict=verdict, property_name=prop_name, psl_file=psl_file, ail_file=ail_file,
-        accepting_path=tuple(path), trace=tuple(trace), errors=tuple(errors), constraints=constraints,
-        elapsed=elapsed, mcapl_version=mv.group(1) if mv else "", jpf_version=jv.group(1) if jv else "",
-        info=tuple(info),
-    )
+    return trace
 
 
 def _info_lines(text: str) -> tuple[list[str], dict[int, list[str]]]:
