@@ -61,7 +61,12 @@ import z3
 
 from rclverify.semantics.encode import Encoder
 from rclverify.semantics.nicemodel import nicer_model
-from rclverify.calculus.context import ConeContext, ContextResult
+from rclverify.calculus.context import ConeContext
+from rclverify.calculus.side_condition import (IN_CONTEXT as IN_CONTEXT, STATUS as STATUS,
+                                               VARIANT_AS_WRITTEN as VARIANT_AS_WRITTEN,
+                                               VARIANT_IN_CONTEXT as VARIANT_IN_CONTEXT,
+                                               VARIANT_WITH_ASSUMPTIONS as VARIANT_WITH_ASSUMPTIONS, ConeView,
+                                               SideCondition as SideCondition, explain_local, in_context)
 from rclverify.calculus.summary import decide as decide_by_summaries
 from rclverify.semantics.query import DEFAULT_TIMEOUT_MS, prove, solver_session
 from rclverify.lang import ast
@@ -71,7 +76,6 @@ from rclverify.lang.types import Checked
 from rclverify.model.system.model import SystemModel
 from rclverify.calculus.scale import probable_mismatches
 
-STATUS = {"proved": "discharged", "refuted": "failed", "inconclusive": "inconclusive"}
 
 R4_ASSUMPTION = (
     "Rule R4 (paper lines 717-768) is applied because {loop} form a loop. It rests on an extra assumption the "
@@ -111,40 +115,6 @@ def contract_text(exprs: Sequence[ast.Expr]) -> str:
 
 
 @dataclass(frozen=True)
-class SideCondition:
-    id: str
-    node: str
-    rule: str
-    conjunct: str
-    source: str
-    hypotheses: tuple[str, ...]
-    status: str
-    duration_s: float
-    smt2: str
-    model: dict[str, str] | None = None
-    explanation: str = ""
-    variant: str = ""
-    links: tuple[str, ...] = ()
-    #: ``discharged`` (locally), ``discharged in context``, ``failed`` or ``inconclusive`` (module docstring)
-    verdict: str = ""
-    #: how the in-context check went (``None`` when the side condition was discharged locally): ``cone``
-    #: (its size), ``used`` (premises of the proof), ``used_nodes``, ``opened`` (links opened, rule R4),
-    #: ``violated`` (nodes whose assumption the counterexample violates), ``joins``, ``local`` (the
-    #: local verdict: ``status``, ``variant``, ``model``)
-    context: dict[str, Any] | None = None
-    #: probable scale mismatches behind a side condition that is not discharged (:mod:`.scale`)
-    scale: tuple[dict[str, Any], ...] = ()
-
-    def to_json(self, smt2_path: str) -> dict[str, Any]:
-        return {"id": self.id, "node": self.node, "rule": self.rule, "conjunct": self.conjunct,
-                "source": self.source, "hypotheses": list(self.hypotheses), "status": self.status,
-                "duration_s": self.duration_s, "smt2": smt2_path, "model": self.model,
-                "explanation": self.explanation, "variant": self.variant, "links": list(self.links),
-                "verdict": self.verdict or self.status, "context": self.context,
-                **({"scale_mismatch": list(self.scale)} if self.scale else {})}
-
-
-@dataclass(frozen=True)
 class NodeComposition:
     """Everything the calculus says about one node (JSON via :meth:`to_json`)."""
 
@@ -159,15 +129,6 @@ class NodeComposition:
     loop_assumption: str | None = None
     cone_environment: tuple[tuple[str, str], ...] = ()
     guarantee: str = ""
-
-
-VARIANT_AS_WRITTEN = "as written"
-VARIANT_WITH_ASSUMPTIONS = "with producers' assumptions"
-VARIANT_IN_CONTEXT = "in context"
-#: How many premises of an in-context proof its explanation names (all are its hypotheses).
-NAMED = 8
-#: The verdict of a side condition discharged against its upstream cone.
-IN_CONTEXT = "discharged in context"
 
 
 def branch_siblings(model: SystemModel, node: str) -> list[str]:
@@ -275,191 +236,139 @@ def compose_node(checked: Checked, model: SystemModel, node: str, *,
     solver session
     (:func:`~rclverify.semantics.query.solver_session`), asked in a fixed order.
     """
-    cn = checked.nodes[node]
-    producers = model.producers(node)
-    rules = _rules(model, node)
     internal, env = split_assumption(checked, model, node)
-    enc = Encoder(checked.env, model.alias())
-    hyps, hyp_text = [], []
-    prod_assumptions, prod_a_text = [], []
-    for p in producers:
-        pn = checked.nodes[p]
-        for k, g in enumerate(pn.node.guarantees, 1):
-            hyps.append(enc.formula(g.formula, pn))
-            hyp_text.append(f"{p} guarantee {k}: {expr_to_rcl(g.formula)}")
-        for k, a in enumerate(pn.node.assumes, 1):
-            if isinstance(a.formula, ast.BoolLit) and a.formula.value:
-                continue
-            prod_assumptions.append(enc.formula(a.formula, pn))
-            prod_a_text.append(f"{p} assumption {k}: {expr_to_rcl(a.formula)}")
-    rule = instance_rule(model, node) or "R1"
-    who = ", ".join(producers)
-    scs = []
-    cone_ctx: ConeContext | None = None
-    for k, c in enumerate(internal, 1):
-        goal = enc.formula(c, cn)
-        links = _links_of(model, cn, node, c)
-        head = (f"rclverify side condition {node}.sc{k} ({rule}): guarantees of {who} "
-                f"entail {expr_to_rcl(c)}\nsource {_loc(c.loc)}; unsat means discharged")
-        r = prove(goal, hyps, enc, timeout_ms=timeout_ms, comment=head + "\nvariant: " + VARIANT_AS_WRITTEN)
-        variant, used_text = VARIANT_AS_WRITTEN, tuple(hyp_text)
-        first = r
-        if r.status != "proved" and prod_assumptions:
-            r = prove(goal, hyps + prod_assumptions, enc, timeout_ms=timeout_ms,
-                      comment=head + "\nvariant: " + VARIANT_WITH_ASSUMPTIONS)
-            variant, used_text = VARIANT_WITH_ASSUMPTIONS, tuple(hyp_text) + tuple(prod_a_text)
-        status = STATUS[r.status]
-        link_text = "; ".join(links) or "no link"
-        if status == "discharged" and variant == VARIANT_AS_WRITTEN:
-            expl = (f"Discharged as written: Z3 proved that the guarantees of {who} entail this conjunct of "
-                    f"{node}'s assumption.")
-        elif status == "discharged":
-            expl = (f"Discharged with the producers' assumptions: the guarantees of {who} alone do not entail "
-                    f"this conjunct of {node}'s assumption ({first.status}), but together with the assumptions "
-                    f"of {who} they do. {node} only reads outputs produced while those assumptions held, so the "
-                    "link is sound; the environment must meet the producers' assumptions.")
-        elif status == "failed":
-            feeders = sorted({x.split(".", 1)[0] for x in links}, key=producers.index) or producers
-            expl = (f"{' and '.join(feeders)} and {node} are not correctly linked on {link_text}: Z3 found values "
-                    f"satisfying every guarantee{' and assumption' if prod_assumptions else ''} of {who} that "
-                    f"violate this conjunct of {node}'s assumption (model below). What "
-                    f"{' and '.join(feeders)} guarantee{'s' if len(feeders) == 1 else ''} about "
-                    f"{'these outputs' if len(links) > 1 else 'this output'} is weaker than what {node} assumes.")
-        else:
-            expl = (f"Z3 could not decide the side condition (reason given by Z3: {r.reason or 'unknown'}); "
-                    "it is not proved.")
-            if first.status == "refuted":
-                expl += (" As written it is refuted, but that model violates the producers' assumptions, so it "
-                         "is not shown.")
-        if r.strategy:
-            expl += f" Z3's default strategy gave up; answered with {r.strategy}."
-        duration = round(first.duration_s + (r.duration_s if r is not first else 0.0), 4)
-        shown = r.model  # integers and short decimals where Z3 finds them, re-checked (semantics/nicemodel.py)
-        if status == "failed" and r.model:
-            asked = hyps + (prod_assumptions if variant == VARIANT_WITH_ASSUMPTIONS else [])
-            shown = nicer_model([*asked, z3.Not(goal)], enc, r.model).model
-        sc = SideCondition(f"{node}.sc{k}", node, rule, expr_to_rcl(c), _loc(c.loc), used_text,
-                           status, duration, r.smt2, shown, expl, variant, tuple(links), status)
-        if status != "discharged":  # context before blame (docs/calculus.md)
-            env_of = lambda m: environment_conjuncts(checked, model, m)  # noqa: E731
-            comment = head + "\nvariant: " + VARIANT_IN_CONTEXT
-            cr = (decide_by_summaries(checked, model, node, c, env_of, facts, comment + " (the summaries of the "
-                                      "producers' cones)", timeout_ms) if summaries else None)
-            if cr is not None:  # proved from the producers' summaries: the cone is not read (calculus/summary.py)
-                sc = in_context(sc, cr, ConeView(tuple(model.upstream(node)), ()), who)
-            else:
-                if cone_ctx is None:
-                    cone_ctx = ConeContext(checked, model, node, env_of, facts)
-                cr = cone_ctx.decide(c, comment + " (the upstream cone; each guarantee under its node's assumption)",
-                                     timeout_ms)
-                read_from = {x.split(".", 1)[0] for x in links}
-                keep: set[str] = ({node}.union(*(model.upstream(p) for p in read_from)) if read_from
-                                  else set(cone_ctx.cone))
-                sc = in_context(sc, cr, cone_ctx, who, keep)
-        if sc.status != "discharged":  # neither locally nor in context: a power of ten between the ranges?
-            scale = tuple(probable_mismatches(checked, model.links_into(node), enc, node, c))
-            if scale:
-                sc = dataclasses.replace(sc, scale=scale, explanation=sc.explanation + "".join(
-                    f" {m['message'][0].upper()}{m['message'][1:]}." for m in scale))
-        scs.append(sc)
+    steps = _NodeCalculus(checked, model, node, facts, timeout_ms, summaries)
+    scs = [steps.side_condition(k, c) for k, c in enumerate(internal, 1)]
+    cn, producers, rule = steps.cn, steps.producers, steps.rule
     env_assumptions = tuple({"node": node, "text": expr_to_rcl(c), "source": _loc(c.loc)} for c in env)
     g_text = contract_text([g.formula for g in cn.node.guarantees])
     a_text = contract_text([a.formula for a in cn.node.assumes])
-    instances = []
-    if producers:
-        premises = []
-        prem_a = []
-        siblings = branch_siblings(model, node) if rule == "R2" else []
-        for p in producers:
-            pn = checked.nodes[p]
-            pa = contract_text([a.formula for a in pn.node.assumes])
-            premises.append(f"{p}: ({pa}) => <> ({contract_text([g.formula for g in pn.node.guarantees])})")
-            prem_a.append(pa)
-        premises.append(f"{node}: ({a_text}) => <> ({g_text})")
-        for sib in siblings:
-            premises.append(f"{sib} (the other reader of the branch; its own side condition is checked at {sib})")
-        premises.append("side condition: " + " and ".join(f"G_{p}" for p in producers) + f" => A_{node}"
-                        + ("" if scs else " (no conjunct of the assumption ranges over produced inputs)"))
-        instances.append({"rule": rule, "premises": premises,
-                          "conclusion": " and ".join(f"({a})" for a in prem_a) + f" => <> G_{node}",
-                          "shape": _shape(rule, producers, node, siblings)})
+    instances = _instances(checked, model, node, rule, a_text, g_text, bool(scs))
     cone = model.upstream(node)
     cone_env = tuple((m, t) for m in cone for t in _environment_texts(checked, model, m))
     derived = ("(" + " and ".join(t for _, t in cone_env) + ")" if cone_env else "TRUE") + f" => <> G_{node}"
     loop = model.loop_of(node)
-    return NodeComposition(node, rules, tuple(producers), tuple(scs), env_assumptions, tuple(instances), derived,
-                           tuple(cone), R4_ASSUMPTION.format(loop="{" + ", ".join(loop) + "}") if loop else None,
-                           cone_env, g_text)
+    return NodeComposition(node, _rules(model, node), tuple(producers), tuple(scs), env_assumptions,
+                           tuple(instances), derived, tuple(cone),
+                           R4_ASSUMPTION.format(loop="{" + ", ".join(loop) + "}") if loop else None, cone_env, g_text)
 
 
-@dataclass(frozen=True)
-class ConeView:
-    """What :func:`in_context` reads of a cone: its nodes and the links its
-    loops are opened at (a :class:`.ConeContext` has both)."""
+class _NodeCalculus:
+    """The steps of :func:`compose_node` for one node, and the state they
+    share: the node's producers, their guarantees and assumptions encoded
+    once, and the node's upstream cone, read only when a side condition
+    first needs it."""
 
-    cone: tuple[str, ...]
-    cut: tuple[str, ...]
+    def __init__(self, checked: Checked, model: SystemModel, node: str,
+                 facts: Mapping[str, Sequence[ast.Expr]] | None, timeout_ms: int, summaries: bool) -> None:
+        self.checked, self.model, self.node, self.facts = checked, model, node, facts
+        self.timeout_ms, self.summaries = timeout_ms, summaries
+        self.cn = checked.nodes[node]
+        self.producers = model.producers(node)
+        self.enc = Encoder(checked.env, model.alias())
+        self.hyps: list[z3.BoolRef] = []
+        self.hyp_text: list[str] = []
+        self.prod_assumptions: list[z3.BoolRef] = []
+        self.prod_a_text: list[str] = []
+        for p in self.producers:
+            pn = checked.nodes[p]
+            for k, g in enumerate(pn.node.guarantees, 1):
+                self.hyps.append(self.enc.formula(g.formula, pn))
+                self.hyp_text.append(f"{p} guarantee {k}: {expr_to_rcl(g.formula)}")
+            for k, a in enumerate(pn.node.assumes, 1):
+                if isinstance(a.formula, ast.BoolLit) and a.formula.value:
+                    continue
+                self.prod_assumptions.append(self.enc.formula(a.formula, pn))
+                self.prod_a_text.append(f"{p} assumption {k}: {expr_to_rcl(a.formula)}")
+        self.rule = instance_rule(model, node) or "R1"
+        self.who = ", ".join(self.producers)
+        self.cone_ctx: ConeContext | None = None
+
+    def side_condition(self, k: int, c: ast.Expr) -> SideCondition:
+        """The ``k``-th side condition (internal conjunct ``c``), decided
+        locally, then in context unless discharged, with the probable scale
+        mismatches of one still not discharged."""
+        links = _links_of(self.model, self.cn, self.node, c)
+        head = (f"rclverify side condition {self.node}.sc{k} ({self.rule}): guarantees of {self.who} "
+                f"entail {expr_to_rcl(c)}\nsource {_loc(c.loc)}; unsat means discharged")
+        sc = self._local(k, c, head, links)
+        if sc.status != "discharged":  # context before blame (docs/calculus.md)
+            sc = self._in_context(sc, c, head, links)
+        if sc.status != "discharged":  # neither locally nor in context: a power of ten between the ranges?
+            scale = tuple(probable_mismatches(self.checked, self.model.links_into(self.node), self.enc, self.node, c))
+            if scale:
+                sc = dataclasses.replace(sc, scale=scale, explanation=sc.explanation + "".join(
+                    f" {m['message'][0].upper()}{m['message'][1:]}." for m in scale))
+        return sc
+
+    def _local(self, k: int, c: ast.Expr, head: str, links: list[str]) -> SideCondition:
+        """The side condition decided from the producers' guarantees as
+        written, then with their assumptions (module docstring)."""
+        goal = self.enc.formula(c, self.cn)
+        r = prove(goal, self.hyps, self.enc, timeout_ms=self.timeout_ms,
+                  comment=head + "\nvariant: " + VARIANT_AS_WRITTEN)
+        variant, used_text = VARIANT_AS_WRITTEN, tuple(self.hyp_text)
+        first = r
+        if r.status != "proved" and self.prod_assumptions:
+            r = prove(goal, self.hyps + self.prod_assumptions, self.enc, timeout_ms=self.timeout_ms,
+                      comment=head + "\nvariant: " + VARIANT_WITH_ASSUMPTIONS)
+            variant, used_text = VARIANT_WITH_ASSUMPTIONS, tuple(self.hyp_text) + tuple(self.prod_a_text)
+        status = STATUS[r.status]
+        expl = explain_local(self.node, self.who, self.producers, links, bool(self.prod_assumptions), variant,
+                             first, r)
+        duration = round(first.duration_s + (r.duration_s if r is not first else 0.0), 4)
+        shown = r.model  # integers and short decimals where Z3 finds them, re-checked (semantics/nicemodel.py)
+        if status == "failed" and r.model:
+            asked = self.hyps + (self.prod_assumptions if variant == VARIANT_WITH_ASSUMPTIONS else [])
+            shown = nicer_model([*asked, z3.Not(goal)], self.enc, r.model).model
+        return SideCondition(f"{self.node}.sc{k}", self.node, self.rule, expr_to_rcl(c), _loc(c.loc), used_text,
+                             status, duration, r.smt2, shown, expl, variant, tuple(links), status)
+
+    def _in_context(self, sc: SideCondition, c: ast.Expr, head: str, links: list[str]) -> SideCondition:
+        """``sc`` decided again in context: from the summaries of the
+        producers' cones when they prove it, else over the whole upstream
+        cone (:mod:`.summary`, :mod:`.context`)."""
+        checked, model, node = self.checked, self.model, self.node
+        env_of = lambda m: environment_conjuncts(checked, model, m)  # noqa: E731
+        comment = head + "\nvariant: " + VARIANT_IN_CONTEXT
+        cr = (decide_by_summaries(checked, model, node, c, env_of, self.facts, comment + " (the summaries of the "
+                                  "producers' cones)", self.timeout_ms) if self.summaries else None)
+        if cr is not None:  # proved from the producers' summaries: the cone is not read (calculus/summary.py)
+            return in_context(sc, cr, ConeView(tuple(model.upstream(node)), ()), self.who)
+        if self.cone_ctx is None:
+            self.cone_ctx = ConeContext(checked, model, node, env_of, self.facts)
+        cr = self.cone_ctx.decide(c, comment + " (the upstream cone; each guarantee under its node's assumption)",
+                                  self.timeout_ms)
+        read_from = {x.split(".", 1)[0] for x in links}
+        keep: set[str] = ({node}.union(*(model.upstream(p) for p in read_from)) if read_from
+                          else set(self.cone_ctx.cone))
+        return in_context(sc, cr, self.cone_ctx, self.who, keep)
 
 
-def in_context(sc: SideCondition, cr: ContextResult, ctx: ConeContext | ConeView, who: str,
-               keep: set[str] | None = None) -> SideCondition:
-    """``sc`` (decided locally, not discharged) with the verdict of its
-    in-context check ``cr`` over the cone ``ctx`` (:mod:`.context`): the
-    status, verdict, hypotheses, model, explanation, SMT-LIB2 text (the local
-    query, ``(reset)``, the in-context query) and the ``context`` record.
-    A counterexample shows the nodes of ``keep`` (the consumer and the cones
-    of the producers of the inputs the conjunct reads: the values traced
-    back to their sources, not a sibling branch feeding another input)."""
-    node = sc.node
-    local = {"status": sc.status, "variant": sc.variant, "model": sc.model}
-    size = len(ctx.cone)
-    record: dict[str, Any] = {"cone": size, "used": [u.split(":", 1)[0] for u in cr.used],
-                              "used_nodes": list(cr.used_nodes),
-                              "opened": list(ctx.cut), "violated": list(cr.violated), "joins": list(cr.joins),
-                              "local": local, **({"summaries": list(cr.summaries)} if cr.summaries else {})}
-    opened = ("; the loop of its cone is opened at " + ", ".join(ctx.cut) + " (rule R4, paper lines 717-768: "
-              "the value read there is taken as arbitrary, so no guarantee is used to discharge its own premise)"
-              if ctx.cut else "")
-    cone_words = (f"the upstream cone of {node} ({size} node{'s' if size != 1 else ''}: every guarantee under its "
-                  f"own node's assumption, the environment assumptions and facts{opened})")
-    local_words = (f"The guarantees of {who} alone do not entail this conjunct of {node}'s assumption "
-                   f"({'refuted' if sc.status == 'failed' else 'undecided'} locally, {sc.variant})")
-    smt2 = sc.smt2 + "\n(reset)\n" + cr.smt2
-    duration = round(sc.duration_s + cr.duration_s, 4)
-    strategy = f" Z3's default strategy gave up on the in-context query; answered with {cr.strategy}." if cr.strategy else ""
-    if cr.status == "proved":
-        labels = [u.split(":", 1)[0] for u in cr.used]
-        named = ", ".join(labels[:NAMED]) + (f" and {len(labels) - NAMED} more premises (all listed as its hypotheses)"
-                                              if len(labels) > NAMED else "") if labels else "no premise"
-        expl = (f"Discharged in context. {local_words}, but {cone_words} does: Z3 proved it from {named}. Sound for "
-                f"the composed system as long as the environment assumptions of the cone hold.")
-        if cr.summaries:
-            expl += (f" The proof read the summaries of the cones of {', '.join(cr.summaries)} (what each cone "
-                     "establishes about the values read outside it, built producer by producer and each proved "
-                     "implied by its cone) instead of the cone itself; the premises named are those they rest on.")
-        if cr.joins:
-            expl += (f" The proof reads {', '.join(cr.joins)} along more than one path; like the requirement checks "
-                     "it rests on R3's simplifying assumption that the outputs a join reads persist and are available "
-                     "together (paper line 660).")
-        return SideCondition(sc.id, node, sc.rule, sc.conjunct, sc.source, tuple(cr.used), "discharged", duration,
-                             smt2, None, expl + strategy, VARIANT_IN_CONTEXT, sc.links, IN_CONTEXT, record)
-    if cr.status == "refuted":
-        expl = (f"{sc.explanation} Checked in context too: with {cone_words}, Z3 still finds values violating it "
-                "(the counterexample below, traced back through the cone to its sources).")
-        if cr.violated:
-            expl += (f" In it the assumption of {', '.join(cr.violated)} does not hold, so "
-                     f"{'its guarantees promise' if len(cr.violated) == 1 else 'their guarantees promise'} nothing "
-                     "there: the side conditions upstream are the first to repair.")
-        if ctx.cut:
-            expl += " The value on an opened link is arbitrary, so the counterexample may use one the loop never produces."
-        shown = ({k: v for k, v in cr.model.items() if k.split(".", 1)[0] in keep}
-                 if cr.model is not None and keep is not None else cr.model)
-        return SideCondition(sc.id, node, sc.rule, sc.conjunct, sc.source, sc.hypotheses, "failed", duration,
-                             smt2, shown, expl + strategy, VARIANT_IN_CONTEXT, sc.links, "failed", record)
-    expl = (f"{local_words}; checked in context, with {cone_words}, Z3 could not decide it ({cr.reason or 'unknown'}). "
-            "It is not proved, and no counterexample of the whole cone is known.")
-    return SideCondition(sc.id, node, sc.rule, sc.conjunct, sc.source, sc.hypotheses, "inconclusive", duration,
-                         smt2, None, expl + strategy, VARIANT_IN_CONTEXT, sc.links, "inconclusive", record)
+def _instances(checked: Checked, model: SystemModel, node: str, rule: str, a_text: str, g_text: str,
+               any_side_condition: bool) -> list[dict[str, Any]]:
+    """The rule instance of ``node`` (none without producers): its rule,
+    premises (each producer's contract, the node's, a branch's other
+    readers, the side condition), conclusion and graph shape."""
+    producers = model.producers(node)
+    if not producers:
+        return []
+    premises = []
+    prem_a = []
+    siblings = branch_siblings(model, node) if rule == "R2" else []
+    for p in producers:
+        pn = checked.nodes[p]
+        pa = contract_text([a.formula for a in pn.node.assumes])
+        premises.append(f"{p}: ({pa}) => <> ({contract_text([g.formula for g in pn.node.guarantees])})")
+        prem_a.append(pa)
+    premises.append(f"{node}: ({a_text}) => <> ({g_text})")
+    for sib in siblings:
+        premises.append(f"{sib} (the other reader of the branch; its own side condition is checked at {sib})")
+    premises.append("side condition: " + " and ".join(f"G_{p}" for p in producers) + f" => A_{node}"
+                    + ("" if any_side_condition else " (no conjunct of the assumption ranges over produced inputs)"))
+    return [{"rule": rule, "premises": premises,
+             "conclusion": " and ".join(f"({a})" for a in prem_a) + f" => <> G_{node}",
+             "shape": _shape(rule, producers, node, siblings)}]
 
 
 def _shape(rule: str, producers: Sequence[str], node: str, siblings: Sequence[str]) -> str:
