@@ -44,10 +44,8 @@ violates: their guarantees promise nothing there), ``inconclusive``.
 """
 from __future__ import annotations
 
-import re
 import time
 from dataclasses import dataclass
-from fractions import Fraction
 from typing import Any, Callable, Mapping, Sequence
 
 import z3
@@ -56,11 +54,11 @@ from rclverify.semantics.encode import Encoder
 from rclverify.semantics.nicemodel import nicer_model
 from rclverify.semantics.query import query_solver, render_model, satisfiable, smt2_script, smtlib_benchmark
 from rclverify.lang import ast
-from rclverify.lang.printer import expr_to_rcl
 from rclverify.lang.types import Checked
 from rclverify.model.system.model import Link, SystemModel
-from rclverify.semantics.values import decimal_text
-from rclverify.calculus.smttext import SORTS, quote, to_smt
+from rclverify.calculus.smttext import quote
+from rclverify.calculus.premises import node_premises
+from rclverify.calculus.cone_script import declare, merge, read_model, sort_of_symbol
 
 NEGATED = "negated side condition"
 #: Budget of the query that checks the premises of an in-context proof can hold together (milliseconds).
@@ -167,71 +165,6 @@ def _multi_path(model: SystemModel, node: str, cone: Sequence[str], cut: set[tup
     return {v for v, k in paths.items() if k > 1}
 
 
-@dataclass(frozen=True)
-class _NodePremises:
-    """What one node of a cone contributes, as data (no Z3 object), kept
-    per process by :func:`_node_premises`.  ``items``: ``(label, RCL text,
-    kind, index, SMT-LIB text or None)`` with kind ``guarantee``,
-    ``environment`` or ``fact``; ``assumption``: the SMT-LIB text of the
-    node's assumption (``None``: none or ``TRUE``); ``smt``: every formula
-    of the node is in :mod:`.smttext`'s fragment; ``symbols``: ``{symbol
-    name: (prefix, var)}`` of the I/O the texts mention."""
-
-    items: tuple[tuple[str, str, str, int, str | None], ...]
-    assumption: str | None
-    smt: bool
-    symbols: tuple[tuple[str, str, str], ...]
-
-
-_PREMISES: dict[str, Any] = {"key": None, "nodes": {}}
-
-
-def _node_premises(checked: Checked, model: SystemModel, m: str, consumer: bool,
-                   environment: Sequence[ast.Expr], facts: Sequence[ast.Expr],
-                   symbol: Mapping[tuple[str, str], str]) -> _NodePremises:
-    """Node ``m``'s premises (``consumer``: ``m`` is the node whose side
-    condition is decided: its own guarantees are no premise), remembered
-    for the last (checked, model) pair by everything they depend on (the
-    node, its role, its facts' text, the symbols of its I/O): along a chain
-    each node is in the cone of every node after it."""
-    if _PREMISES["key"] is None or _PREMISES["key"][0] is not checked or _PREMISES["key"][1] is not model:
-        _PREMISES["key"], _PREMISES["nodes"] = (checked, model), {}
-    fact_texts = tuple(expr_to_rcl(f) for f in facts)
-    key = (m, consumer, fact_texts, tuple(sorted(symbol.items())))
-    cache: dict[Any, _NodePremises] = _PREMISES["nodes"]
-    hit = cache.get(key)
-    if hit is not None:
-        return hit
-    cn = checked.nodes[m]
-    used: dict[str, str] = {}
-    items: list[tuple[str, str, str, int, str | None]] = []
-    assumption: str | None = None
-    smt = True
-    if not consumer:
-        parts = [a.formula for a in cn.node.assumes if not (isinstance(a.formula, ast.BoolLit) and a.formula.value)]
-        texts = [to_smt(a, cn, symbol, used) for a in parts]
-        smt = smt and all(t is not None for t in texts)
-        if parts and smt:
-            assumption = texts[0] if len(texts) == 1 else "(and " + " ".join(t or "" for t in texts) + ")"
-        for k, g in enumerate(cn.node.guarantees, 1):
-            t = to_smt(g.formula, cn, symbol, used)
-            smt = smt and t is not None
-            items.append((f"{m} guarantee {k}", expr_to_rcl(g.formula) + (" (under its assumption)" if parts else ""),
-                          "guarantee", k, t))
-    for k, c in enumerate(environment, 1):
-        t = to_smt(c, cn, symbol, used)
-        smt = smt and t is not None
-        items.append((f"{m} environment assumption {k}", expr_to_rcl(c), "environment", k, t))
-    for k, (f, ftext) in enumerate(zip(facts, fact_texts), 1):
-        t = to_smt(f, cn, symbol, used)
-        smt = smt and t is not None
-        items.append((f"{m} environment fact {k}", ftext, "fact", k, t))
-    names = {name: pv for pv, name in symbol.items()}
-    out = _NodePremises(tuple(items), assumption, smt, tuple((n, *names[n]) for n in sorted(used)))
-    cache[key] = out
-    return out
-
-
 class ConeContext:
     """The upstream cone of one consumer as labelled Z3 premises, built once
     per node (its side conditions share it) and only when one of them fails
@@ -276,7 +209,7 @@ class ConeContext:
             cn = checked.nodes[m]
             symbol = {(p, v): enc.symbol_name(m, p, v) for p, table in (("in", cn.inputs), ("out", cn.outputs))
                       for v in table}
-            described.append((m, _node_premises(checked, model, m, m == node, environment(m),
+            described.append((m, node_premises(checked, model, m, m == node, environment(m),
                                                 (facts or {}).get(m, ()), symbol)))
         for m, d in described:
             for label, text, _, _, _ in d.items:
@@ -293,7 +226,7 @@ class ConeContext:
             if fast and d.smt:
                 for name, p, v in d.symbols:
                     enc.io_symbol(checked.nodes[m], p, v)  # the encoder knows every symbol: models, NATURAL axioms
-                    decls[name] = _sort_of_symbol(checked.nodes[m], p, v)
+                    decls[name] = sort_of_symbol(checked.nodes[m], p, v)
                 flag = None
                 if d.assumption is not None:
                     flag = f"A!{m}"
@@ -303,7 +236,7 @@ class ConeContext:
                     body = f"(=> {quote(flag)} {t})" if kind == "guarantee" and flag else t
                     lines.append(f"(assert (=> {quote(f'l!{k + j}')} {body}))")
             k += n_items
-        parsed = iter(z3.parse_smt2_string(_declare(decls, self.flags.values(), len(self.labels)) + "\n".join(lines))
+        parsed = iter(z3.parse_smt2_string(declare(decls, self.flags.values(), len(self.labels)) + "\n".join(lines))
                       if lines else [])
         k = 0
         for m, d in described:
@@ -323,11 +256,11 @@ class ConeContext:
                     self.literals.append(lit)
             k += len(d.items)
         if self.all_text:
-            self.script_text = _declare(decls, self.flags.values(), len(self.labels)) + "\n".join(lines)
+            self.script_text = declare(decls, self.flags.values(), len(self.labels)) + "\n".join(lines)
 
     def _encode(self, cn: Any, m: str, consumer: bool, environment: Sequence[ast.Expr],
                 facts: Sequence[ast.Expr]) -> list[z3.BoolRef]:
-        """The node's premises (in :class:`_NodePremises` order) through the
+        """The node's premises (in :class:`.NodePremises` order) through the
         encoder; its assumption becomes the definition of ``A!m``."""
         enc, out = self.enc, []
         if not consumer:
@@ -376,7 +309,7 @@ class ConeContext:
                     dt = round(dt + time.perf_counter() - t1, 4)
             elif r == z3.sat:
                 m = s.model()
-                read = _read_model(m.sexpr()) if self.all_text else None
+                read = read_model(m.sexpr()) if self.all_text else None
                 if read is not None:  # the fragment: values read from the model's text, not one object each
                     values, flags = read
                     shown = {sym.display: values[name] for name, sym in sorted(self.enc.symbols.items(),
@@ -419,7 +352,7 @@ class ConeContext:
                 body = self.script_text + "\n" + "\n".join(f"(assert {quote(f'l!{k}')})"
                                                               for k in range(len(literals) - 1))
                 # the goal, the axioms and the goal's literal: Z3's printing of those few formulas (with declarations)
-                return header + _merge(body, goal_and_axioms)
+                return header + merge(body, goal_and_axioms)
             return text
         return smt2_script(list(background) + list(tracked) + list(literals), comment)
 
@@ -456,83 +389,3 @@ class ConeContext:
         nodes = tuple(dict.fromkeys(self.node_of[c] for c in used if " guarantee " in c))
         return ContextResult("proved", script(), dt, used=text, used_nodes=nodes,
                              joins=tuple(n for n in nodes if n in self.joins), strategy=strategy)
-
-
-def _sort_of_symbol(cn: Any, prefix: str, var: str) -> str:
-    t = (cn.inputs if prefix == "in" else cn.outputs)[var]
-    return SORTS[t]
-
-
-def _declare(symbols: Mapping[str, str], flags: Any, n_literals: int) -> str:
-    """SMT-LIB declarations of the cone's I/O symbols, the assumption flags
-    ``A!m`` and the premise literals ``l!k``."""
-    out = [f"(declare-fun {quote(n)} () {sort})" for n, sort in symbols.items()]
-    out += [f"(declare-fun {quote(f)} () Bool)" for f in flags]
-    out += [f"(declare-fun {quote(f'l!{k}')} () Bool)" for k in range(n_literals)]
-    return "\n".join(out) + "\n"
-
-
-def _merge(body: str, benchmark: str) -> str:
-    """One script: ``body`` (declarations and assertions) and the
-    ``benchmark`` Z3 printed for the goal and axioms, whose declarations of
-    symbols ``body`` already declares are dropped."""
-    declared = {line.split()[1].strip("|") for line in body.splitlines() if line.startswith("(declare-fun ")}
-    kept = [line for line in benchmark.splitlines()
-            if not ((line.startswith("(declare-fun ") or line.startswith("(declare-const "))
-                    and line.split()[1].strip("|") in declared)]
-    return body + "\n" + "\n".join(kept) + "\n"
-
-
-_DEFINE = re.compile(r"\(define-fun (\|[^|]*\||\S+) \(\) (Real|Int|Bool)\s+(.*?)\)\s*(?=\(define-fun |$)", re.S)
-
-
-def _number(text: str) -> str | None:
-    """An SMT-LIB numeral of a model (``5``, ``101.0``, ``(- 5.0)``, ``(/ 1.0 3.0)``,
-    ``(- (/ 1.0 2.0))``) as :func:`rclverify.semantics.encode.value_to_rcl` writes it; ``None`` otherwise."""
-    t = " ".join(text.split())
-    sign = 1
-    if t.startswith("(- ") and t.endswith(")"):
-        sign, t = -1, t[3:-1].strip()
-    try:
-        if t.startswith("(/ ") and t.endswith(")"):
-            num, den = t[3:-1].split()
-            fr = Fraction(num) / Fraction(den)
-        else:
-            fr = Fraction(t)
-    except (ValueError, ZeroDivisionError):
-        return None
-    fr *= sign
-    if fr.denominator == 1:
-        return str(fr.numerator)
-    dec = float(fr)
-    if Fraction(dec) == fr:
-        return repr(dec)
-    return decimal_text(fr) or f"{fr.numerator}/{fr.denominator}"
-
-
-def _read_model(text: str) -> tuple[dict[str, str], dict[str, bool]] | None:
-    """``({symbol: RCL value}, {A!m flag: value})`` from a model of the
-    fragment printed by Z3 (``define-fun`` of Real, Int and Bool constants);
-    ``None`` when the text holds anything else (the caller renders the
-    model object instead)."""
-    values: dict[str, str] = {}
-    flags: dict[str, bool] = {}
-    found = _DEFINE.findall(text)
-    if text.count("(define-fun ") != len(found):
-        return None
-    for name, sort, value in found:
-        name = name.strip("|")
-        v = " ".join(value.split())
-        if sort == "Bool":
-            if v not in ("true", "false"):
-                return None
-            if name.startswith("A!"):
-                flags[name] = v == "true"
-            elif not name.startswith("l!"):
-                values[name] = "TRUE" if v == "true" else "FALSE"
-            continue
-        num = _number(v)
-        if num is None:
-            return None
-        values[name] = num
-    return values, flags

@@ -61,7 +61,8 @@ from rclverify.lang.printer import expr_to_rcl
 from rclverify.lang.types import NATURAL, Checked
 from rclverify.semantics.query import query_solver
 from rclverify.model.system.model import SystemModel
-from rclverify.calculus.context import NEGATED, ContextResult, _multi_path, _node_premises
+from rclverify.calculus.context import NEGATED, ContextResult, _multi_path
+from rclverify.calculus.premises import node_premises
 from rclverify.calculus.smttext import SORTS, quote, to_smt
 from rclverify.semantics.retry import has_quantifier
 
@@ -170,7 +171,7 @@ def _build(checked: Checked, model: SystemModel, m: str, environment: Callable[[
     if top is None or any(memo.get(p) is None for p in producers):
         return None
     symbol = _symbols(checked, model, m)
-    d = _node_premises(checked, model, m, False, environment(m), facts.get(m, ()), symbol)
+    d = node_premises(checked, model, m, False, environment(m), facts.get(m, ()), symbol)
     if not d.smt:
         return None
     index = {n: i for i, n in enumerate(model.nodes)}
@@ -376,7 +377,7 @@ def _summary_query(checked: Checked, model: SystemModel, node: str, conjunct: as
     if any(s is None for s in sums):
         return None
     symbol = _symbols(checked, model, node)
-    d = _node_premises(checked, model, node, True, environment(node), facts.get(node, ()), symbol)
+    d = node_premises(checked, model, node, True, environment(node), facts.get(node, ()), symbol)
     used_syms: dict[str, str] = {}
     goal = to_smt(conjunct, checked.nodes[node], symbol, used_syms)
     if not d.smt or goal is None:
