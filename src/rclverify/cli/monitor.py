@@ -21,19 +21,18 @@ import argparse
 import json
 import sys
 from pathlib import Path
-from typing import Any, Iterable, Iterator
+from typing import Any
 
 from rclverify.lang.errors import RclError
 from rclverify.lang.types import Checked
-from rclverify.traces import TraceError, read_trace
+from rclverify.traces import TraceError
 from rclverify.backends.monitors.summary import monitoring_details, summary_line, tool_versions, verdict_status
-from rclverify.backends.monitors.check import check_trace
-from rclverify.backends.monitors.deadlines import DeadlineMonitor, deadline_status, has_deadlines
+from rclverify.backends.monitors.deadlines import deadline_status
 from rclverify.backends.monitors.config import ConfigError, load_mapping
-from rclverify.backends.monitors.judged import Counted, Heard, explain, not_judged, strict_line
-from rclverify.backends.monitors.log_calls import LogCalls
-from rclverify.backends.monitors.declarations import DeclarationMonitor, add_periods, declaration_status, has_declarations
-from rclverify.backends.monitors.periods import PeriodMonitor, has_periods, period_status
+from rclverify.backends.monitors.judged import explain, strict_line
+from rclverify.backends.monitors.declarations import declaration_status
+from rclverify.backends.monitors.periods import period_status
+from rclverify.backends.monitors.recorded import RecordedRun, check_recorded
 
 
 
@@ -76,38 +75,9 @@ def monitor_command(args: argparse.Namespace, checked: Checked) -> int:
     violated = False
     unjudged: list[dict[str, str]] = []
     report: list[dict[str, Any]] = []
-    timed = [n for n in nodes if has_deadlines(n)]
     for trace in args.traces:
-        path = Path(trace)
-        # one pass over the run feeds both checks (a log named here may be a stream, read once)
-        dmons = [DeadlineMonitor(checked, n, cfg.rules, horizon=cfg.horizon, tolerance=cfg.tolerance) for n in timed]
-        pmons = [PeriodMonitor(n) for n in nodes if has_periods(n)]
-        decl = [DeclarationMonitor(checked, n, cfg.rules, tolerance=cfg.tolerance) for n in nodes
-                if has_declarations(n)]
-        calls = LogCalls(checked, nodes, cfg.rules, cfg.horizon, trace)  # a live log's calls (log_calls.py)
-        heard: dict[str, int] = {}
-
-        def tap(events: Iterable[Any]) -> Iterator[Any]:
-            for ev in events:
-                for m in dmons:
-                    m.feed(ev)
-                for p in pmons:
-                    p.feed(ev)
-                for dm in decl:
-                    dm.feed(ev)
-                yield ev
         try:
-            run = read_trace(path, [root / d for d in cfg.msg_dirs], streams=True,
-                             on_warning=lambda w: print(w, file=sys.stderr))
-            source = tap(run) if dmons or pmons or decl else run  # untapped, a log keeps its columnar reading (batch path)
-            source = calls.tap(source) if calls.active else source  # only nodes with links: never the batch path
-            events, results = check_trace(checked, nodes, Counted(source, heard), cfg.rules, cfg.horizon,
-                                          tolerance=cfg.tolerance)
-            dres = [m.finish() for m in dmons]
-            pres = [p.finish() for p in pmons]
-            decl_res = [add_periods(dm.finish(), dm.node, next((p for p in pres if p.node == dm.node.name), None))
-                        for dm in decl]
-            summary = calls.finish()
+            run = check_recorded(checked, nodes, cfg, root, trace, lambda w: print(w, file=sys.stderr))
         except TraceError as exc:
             _emit(report, args.json)
             print(str(exc), file=sys.stderr)
@@ -116,59 +86,59 @@ def monitor_command(args: argparse.Namespace, checked: Checked) -> int:
             _emit(report, args.json)
             print(f"{trace}: error: the trace could not be checked: {type(exc).__name__}: {exc}", file=sys.stderr)
             return 2
-        statuses = {res.node: [verdict_status(res, trace)] for res in results}
-        centries, dentries = calls.entries(), calls.deadline_entries()
-        for c in centries:
-            statuses.setdefault(c["node"], []).append((c["status"], c["explanation"]))
-        dcounts = {d.node: dict(d.counts) for d in dres}
-        for r in calls.deadlines():  # the topic and the call deadlines summed, as the live run does
-            total = dcounts.setdefault(r.node, {})
-            for v, k in r.counts.items():
-                total[v] = total.get(v, 0) + k
-        items = not_judged(nodes, Heard({**heard, **calls.messages}, dict(calls.orphans)), statuses, dcounts,
-                           f"in {trace}")
-        unjudged += items
-        for res in results:
-            status, explanation = verdict_status(res, trace)
-            violated = violated or status == "failed"
-            entry = {"node": res.node, "status": status, "explanation": explanation,
-                     **monitoring_details(res, trace, events, "", tool_versions(), cfg.horizon, cfg.tolerance)}
-            entry.pop("sha256")
-            entry["evaluation"] = dict(res.evaluation)  # debug: which formulas ran as compiled code
-            entry["not_judged"] = [i for i in items if i["node"] == res.node]
-            explain(entry, items)
-            report.append(entry)
-            if not args.json:
-                print(f"{trace}: {summary_line(res)}")
-                print(f"  {status}: {entry['explanation']}")
-        for d in dres:
-            status, explanation = deadline_status(d, trace)
-            violated = violated or status == "failed"
-            report.append({"node": d.node, "status": status, "explanation": explanation, "trace": trace,
-                           "deadlines": d.to_json()})
-            if not args.json:
-                print(f"{trace}: {d.node} deadlines: " + (", ".join(f"{n} {v}" for v, n in d.counts.items() if n)
-                                                            or "no trigger event")
-                      + ("; no verdict: " + ", ".join(f"{n} {v}" for v, n in d.unaccepted.items() if n)
-                         if any(d.unaccepted.values()) else ""))
-                print(f"  {status}: {explanation}")
-        # periods, then the declarations (initially, progress, periods: declarations.py, issue 64): one row each
-        judged: list[tuple[str, Any, Any, Any]] = [("periods", pr, period_status(pr, trace), pr.to_json())
-                                                   for pr in pres]
-        judged += [("declarations", dr, declaration_status(dr, trace), dr.rows()) for dr in decl_res]
-        for label, res_, (status, explanation), part in judged:
-            violated = violated or status == "failed"
-            report.append({"node": res_.node, "status": status, "explanation": explanation, "trace": trace,
-                           label: part})
-            if not args.json:
-                print(f"{trace}: {res_.node} {label}: {status}: {explanation}")
-        if summary is not None:
-            violated = _report_calls(report, centries + dentries, summary, calls.missed(), trace,
-                                     args.json) or violated
-        if not args.json:
-            _print_not_judged(items, f"{trace}: ")
+        unjudged += run.not_judged
+        violated = _report_run(report, run, trace, cfg, args.json) or violated
     _emit(report, args.json)
     return 1 if violated else _strict(args, unjudged)
+
+
+def _report_run(report: list[dict[str, Any]], run: RecordedRun, trace: str, cfg: Any, as_json: bool) -> bool:
+    """Add the verdicts of the recorded run ``run`` (at path ``trace``) to
+    ``report`` and print them unless ``as_json``: per node its messages,
+    deadlines, periods and declarations, then a live log's calls and what
+    the run did not judge; returns whether a verdict failed."""
+    violated = False
+    items = run.not_judged
+    for res in run.results:
+        status, explanation = verdict_status(res, trace)
+        violated = violated or status == "failed"
+        entry = {"node": res.node, "status": status, "explanation": explanation,
+                 **monitoring_details(res, trace, run.events, "", tool_versions(), cfg.horizon, cfg.tolerance)}
+        entry.pop("sha256")
+        entry["evaluation"] = dict(res.evaluation)  # debug: which formulas ran as compiled code
+        entry["not_judged"] = [i for i in items if i["node"] == res.node]
+        explain(entry, items)
+        report.append(entry)
+        if not as_json:
+            print(f"{trace}: {summary_line(res)}")
+            print(f"  {status}: {entry['explanation']}")
+    for d in run.deadlines:
+        status, explanation = deadline_status(d, trace)
+        violated = violated or status == "failed"
+        report.append({"node": d.node, "status": status, "explanation": explanation, "trace": trace,
+                       "deadlines": d.to_json()})
+        if not as_json:
+            print(f"{trace}: {d.node} deadlines: " + (", ".join(f"{n} {v}" for v, n in d.counts.items() if n)
+                                                        or "no trigger event")
+                  + ("; no verdict: " + ", ".join(f"{n} {v}" for v, n in d.unaccepted.items() if n)
+                     if any(d.unaccepted.values()) else ""))
+            print(f"  {status}: {explanation}")
+    # periods, then the declarations (initially, progress, periods: declarations.py, issue 64): one row each
+    judged: list[tuple[str, Any, Any, Any]] = [("periods", pr, period_status(pr, trace), pr.to_json())
+                                               for pr in run.periods]
+    judged += [("declarations", dr, declaration_status(dr, trace), dr.rows()) for dr in run.declarations]
+    for label, res_, (status, explanation), part in judged:
+        violated = violated or status == "failed"
+        report.append({"node": res_.node, "status": status, "explanation": explanation, "trace": trace,
+                       label: part})
+        if not as_json:
+            print(f"{trace}: {res_.node} {label}: {status}: {explanation}")
+    if run.calls is not None:
+        violated = _report_calls(report, run.call_entries + run.deadline_entries, run.calls, run.missed, trace,
+                                 as_json) or violated
+    if not as_json:
+        _print_not_judged(items, f"{trace}: ")
+    return violated
 
 
 def _report_calls(report: list[dict[str, Any]], entries: list[dict[str, Any]], summary: dict[str, Any],
@@ -230,30 +200,17 @@ def live_command(args: argparse.Namespace, checked: Any, cfg: Any, root: Path) -
     log = Path(args.log)
     ros = args.ros or os.environ.get("ROS_VERSION", "1")  # ROS's setup scripts set ROS_VERSION
     enforce_items, record = getattr(args, "enforce", []), getattr(args, "record", None)
-    if ros != "2" and (enforce_items or record):
-        print("rclverify monitor --live: error: --enforce and --record need ROS 2 (--ros2)", file=sys.stderr)
-        return 2
-    if ros == "2" and getattr(args, "forward", []):
-        print("rclverify monitor --live --ros2: error: --forward is for ROS 1's service proxy; over DDS the "
-              "monitor reads every call on the bus (name the .srv/.action directories with --interfaces)",
-              file=sys.stderr)
+    usage = _live_usage(args, ros, bool(enforce_items or record))
+    if usage:
+        print(usage, file=sys.stderr)
         return 2
     run_class: Any = LiveRun
     extra: dict[str, Any] = {}
     if enforce_items:
-        from rclverify.runtime.enforce import EnforceUsage, EnforcingRun, fail_open, parse_enforce  # deferred: optional or conditional (inside a block)
-        try:
-            extra["guarded"] = parse_enforce(enforce_items)
-            extra["open_topics"] = fail_open(enforce_items)
-        except EnforceUsage as exc:
-            print(f"rclverify monitor --live: error: {exc}", file=sys.stderr)
+        enforcing = _enforcing(enforce_items, nodes, extra)
+        if enforcing is None:
             return 2
-        unknown = sorted(set(extra["guarded"]) - {t.field.strip("/") for n in nodes for t in n.node.topics})
-        if unknown:
-            print(f"rclverify monitor --live: error: --enforce /{unknown[0]}: no monitored contract names this "
-                  f"topic", file=sys.stderr)
-            return 2
-        run_class = EnforcingRun
+        run_class = enforcing
     factory = partial(run_class, checked, nodes, cfg.rules, cfg.horizon, log,
                       reorder_window=args.reorder_window, silence_s=args.silence, **extra)
     stop = threading.Event()
@@ -281,6 +238,45 @@ def live_command(args: argparse.Namespace, checked: Any, cfg: Any, root: Path) -
         text = str(exc)
         print(text if ": error: " in text else f"rclverify monitor --live: error: {text}", file=sys.stderr)
         return 2
+    _print_live(log, record_)
+    return _live_exit(args, record_)
+
+
+def _live_usage(args: argparse.Namespace, ros: str, ros2_only: bool) -> str | None:
+    """The error line for options the ROS version ``ros`` does not take
+    (``ros2_only``: ``--enforce`` or ``--record`` given), or ``None``."""
+    if ros != "2" and ros2_only:
+        return "rclverify monitor --live: error: --enforce and --record need ROS 2 (--ros2)"
+    if ros == "2" and getattr(args, "forward", []):
+        return ("rclverify monitor --live --ros2: error: --forward is for ROS 1's service proxy; over DDS the "
+                "monitor reads every call on the bus (name the .srv/.action directories with --interfaces)")
+    return None
+
+
+def _enforcing(items: list[str], nodes: list[Any], extra: dict[str, Any]) -> Any:
+    """The enforcing run class for ``--enforce`` ``items``, its guarded and
+    fail-open topics put in ``extra``; ``None`` after printing one error
+    line for an item that does not parse or names a topic no monitored
+    contract names."""
+    from rclverify.runtime.enforce import EnforceUsage, EnforcingRun, fail_open, parse_enforce  # deferred: optional or conditional (inside a block)
+    try:
+        extra["guarded"] = parse_enforce(items)
+        extra["open_topics"] = fail_open(items)
+    except EnforceUsage as exc:
+        print(f"rclverify monitor --live: error: {exc}", file=sys.stderr)
+        return None
+    unknown = sorted(set(extra["guarded"]) - {t.field.strip("/") for n in nodes for t in n.node.topics})
+    if unknown:
+        print(f"rclverify monitor --live: error: --enforce /{unknown[0]}: no monitored contract names this "
+              f"topic", file=sys.stderr)
+        return None
+    return EnforcingRun
+
+
+def _print_live(log: Path, record_: dict[str, Any]) -> None:
+    """The lines a stopped live run prints: its log, then per node its
+    calls, deadlines, periods and declarations, enforcement, the recording
+    and what it did not judge (``record_``: the run's evidence record)."""
     print(f"{log}: {record_['events']} event(s), {record_['verdicts']} verdict(s); sha256 {record_['sha256']}")
     for n in record_.get("calls", {}).get("nodes", []):
         print(f"calls: {n['node']}: {n['status']}: {n['explanation']}")
@@ -299,6 +295,11 @@ def live_command(args: argparse.Namespace, checked: Any, cfg: Any, root: Path) -
     if "bag" in record_:
         print(f"recorded {record_['bag']['messages']} message(s) to {record_['bag']['path']}")
     _print_not_judged(record_.get("not_judged", []), "")
+
+
+def _live_exit(args: argparse.Namespace, record_: dict[str, Any]) -> int:
+    """The exit code of a stopped live run: 1 when a message, call,
+    deadline, period or declaration failed, else :func:`_strict`'s."""
     late = bool(record_.get("deadlines", {}).get("false"))
     late = late or any(d["status"] == "failed" for d in record_.get("topic_deadlines", []) + record_.get("periods", [])
                        + record_.get("declarations", []))

@@ -1,0 +1,97 @@
+"""One recorded run checked against the selected nodes' contracts: the
+message monitors, the deadline, period and declaration monitors, and a
+live ROS 2 log's calls, all fed by one pass over the run (a log may be a
+stream, read once), and the items the run did not judge (:mod:`.judged`:
+silence is never green).
+
+``rclverify monitor TRACE...`` (:mod:`rclverify.cli.monitor`) prints what
+:func:`check_recorded` returns; nothing here prints.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, Callable, Iterable, Iterator, Sequence
+
+from rclverify.lang.types import Checked, CheckedNode
+from rclverify.traces import read_trace
+from rclverify.backends.monitors.check import check_trace
+from rclverify.backends.monitors.deadlines import DeadlineMonitor, DeadlineResult, has_deadlines
+from rclverify.backends.monitors.declarations import (DeclarationMonitor, DeclarationResult, add_periods,
+                                                      has_declarations)
+from rclverify.backends.monitors.judged import Counted, Heard, not_judged
+from rclverify.backends.monitors.log_calls import LogCalls
+from rclverify.backends.monitors.periods import PeriodMonitor, PeriodResult, has_periods
+from rclverify.backends.monitors.summary import verdict_status
+from rclverify.backends.monitors.verdicts import NodeResult
+
+
+@dataclass
+class RecordedRun:
+    """What one recorded run says.  ``events``: events read; ``results``
+    one :class:`.NodeResult` per node; ``deadlines``, ``periods``,
+    ``declarations``: the results of those monitors (nodes that declare
+    them); ``calls``: a live ROS 2 log's call summary (``None``: no call
+    lines), with its per-node call ``call_entries`` and
+    ``deadline_entries`` and ``missed`` ``(missed, judged)`` call
+    deadlines; ``not_judged``: the items the run did not judge."""
+
+    events: int
+    results: list[NodeResult]
+    deadlines: list[DeadlineResult]
+    periods: list[PeriodResult]
+    declarations: list[DeclarationResult]
+    calls: dict[str, Any] | None
+    call_entries: list[dict[str, Any]]
+    deadline_entries: list[dict[str, Any]]
+    missed: tuple[int, int]
+    not_judged: list[dict[str, str]]
+
+
+def check_recorded(checked: Checked, nodes: Sequence[CheckedNode], cfg: Any, root: Path, trace: str,
+                   on_warning: Callable[[str], None]) -> RecordedRun:
+    """Check the run at path ``trace`` against ``nodes`` under the monitor
+    configuration ``cfg`` (:func:`.config.load_mapping`; its message
+    directories relative to the workspace ``root``); ``on_warning`` gets
+    the reader's warnings.  Raises :class:`rclverify.traces.TraceError` for
+    a run that cannot be read, and whatever a malformed run makes the
+    readers raise (the caller reports either, located)."""
+    dmons = [DeadlineMonitor(checked, n, cfg.rules, horizon=cfg.horizon, tolerance=cfg.tolerance)
+             for n in nodes if has_deadlines(n)]
+    pmons = [PeriodMonitor(n) for n in nodes if has_periods(n)]
+    decl = [DeclarationMonitor(checked, n, cfg.rules, tolerance=cfg.tolerance) for n in nodes if has_declarations(n)]
+    calls = LogCalls(checked, nodes, cfg.rules, cfg.horizon, trace)  # a live log's calls (log_calls.py)
+    heard: dict[str, int] = {}
+
+    def tap(events: Iterable[Any]) -> Iterator[Any]:
+        for ev in events:
+            for m in dmons:
+                m.feed(ev)
+            for p in pmons:
+                p.feed(ev)
+            for dm in decl:
+                dm.feed(ev)
+            yield ev
+    run = read_trace(Path(trace), [root / d for d in cfg.msg_dirs], streams=True, on_warning=on_warning)
+    source = tap(run) if dmons or pmons or decl else run  # untapped, a log keeps its columnar reading (batch path)
+    source = calls.tap(source) if calls.active else source  # only nodes with links: never the batch path
+    events, results = check_trace(checked, nodes, Counted(source, heard), cfg.rules, cfg.horizon,
+                                  tolerance=cfg.tolerance)
+    dres = [m.finish() for m in dmons]
+    pres = [p.finish() for p in pmons]
+    decl_res = [add_periods(dm.finish(), dm.node, next((p for p in pres if p.node == dm.node.name), None))
+                for dm in decl]
+    summary = calls.finish()
+    statuses = {res.node: [verdict_status(res, trace)] for res in results}
+    centries, dentries = calls.entries(), calls.deadline_entries()
+    for c in centries:
+        statuses.setdefault(c["node"], []).append((c["status"], c["explanation"]))
+    dcounts = {d.node: dict(d.counts) for d in dres}
+    for r in calls.deadlines():  # the topic and the call deadlines summed, as the live run does
+        total = dcounts.setdefault(r.node, {})
+        for v, k in r.counts.items():
+            total[v] = total.get(v, 0) + k
+    items = not_judged(nodes, Heard({**heard, **calls.messages}, dict(calls.orphans)), statuses, dcounts,
+                       f"in {trace}")
+    return RecordedRun(events, results, dres, pres, decl_res, summary, centries, dentries,
+                       calls.missed() if summary is not None else (0, 0), items)
