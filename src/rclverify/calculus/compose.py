@@ -236,10 +236,48 @@ def compose_node(checked: Checked, model: SystemModel, node: str, *,
     solver session
     (:func:`~rclverify.semantics.query.solver_session`), asked in a fixed order.
     """
+    cn = checked.nodes[node]
+    producers = model.producers(node)
+    rules = _rules(model, node)
     internal, env = split_assumption(checked, model, node)
-    steps = _NodeCalculus(checked, model, node, facts, timeout_ms, summaries)
-    scs = [steps.side_condition(k, c) for k, c in enumerate(internal, 1)]
-    cn, producers, rule = steps.cn, steps.producers, steps.rule
+    enc = Encoder(checked.env, model.alias())
+    hyps, hyp_text, prod_assumptions, prod_a_text = _producer_premises(checked, producers, enc)
+    rule = instance_rule(model, node) or "R1"
+    who = ", ".join(producers)
+    scs = []
+    cone_ctx: ConeContext | None = None
+    # one loop, not a step per method: Z3 numbers a new term with the id of a freed one and the `let` names of
+    # every recorded script follow those ids, so the answers below live exactly as long as they always did
+    for k, c in enumerate(internal, 1):
+        goal = enc.formula(c, cn)
+        links = _links_of(model, cn, node, c)
+        head = (f"rclverify side condition {node}.sc{k} ({rule}): guarantees of {who} "
+                f"entail {expr_to_rcl(c)}\nsource {_loc(c.loc)}; unsat means discharged")
+        r = prove(goal, hyps, enc, timeout_ms=timeout_ms, comment=head + "\nvariant: " + VARIANT_AS_WRITTEN)
+        variant, used_text = VARIANT_AS_WRITTEN, tuple(hyp_text)
+        first = r
+        if r.status != "proved" and prod_assumptions:
+            r = prove(goal, hyps + prod_assumptions, enc, timeout_ms=timeout_ms,
+                      comment=head + "\nvariant: " + VARIANT_WITH_ASSUMPTIONS)
+            variant, used_text = VARIANT_WITH_ASSUMPTIONS, tuple(hyp_text) + tuple(prod_a_text)
+        status = STATUS[r.status]
+        expl = explain_local(node, who, producers, links, bool(prod_assumptions), variant, first, r)
+        duration = round(first.duration_s + (r.duration_s if r is not first else 0.0), 4)
+        shown = r.model  # integers and short decimals where Z3 finds them, re-checked (semantics/nicemodel.py)
+        if status == "failed" and r.model:
+            asked = hyps + (prod_assumptions if variant == VARIANT_WITH_ASSUMPTIONS else [])
+            shown = nicer_model([*asked, z3.Not(goal)], enc, r.model).model
+        sc = SideCondition(f"{node}.sc{k}", node, rule, expr_to_rcl(c), _loc(c.loc), used_text,
+                           status, duration, r.smt2, shown, expl, variant, tuple(links), status)
+        if status != "discharged":  # context before blame (docs/calculus.md)
+            sc, cone_ctx = _in_context_step(checked, model, node, c, sc, cone_ctx, head, links,
+                                            facts, timeout_ms, summaries)
+        if sc.status != "discharged":  # neither locally nor in context: a power of ten between the ranges?
+            scale = tuple(probable_mismatches(checked, model.links_into(node), enc, node, c))
+            if scale:
+                sc = dataclasses.replace(sc, scale=scale, explanation=sc.explanation + "".join(
+                    f" {m['message'][0].upper()}{m['message'][1:]}." for m in scale))
+        scs.append(sc)
     env_assumptions = tuple({"node": node, "text": expr_to_rcl(c), "source": _loc(c.loc)} for c in env)
     g_text = contract_text([g.formula for g in cn.node.guarantees])
     a_text = contract_text([a.formula for a in cn.node.assumes])
@@ -248,101 +286,56 @@ def compose_node(checked: Checked, model: SystemModel, node: str, *,
     cone_env = tuple((m, t) for m in cone for t in _environment_texts(checked, model, m))
     derived = ("(" + " and ".join(t for _, t in cone_env) + ")" if cone_env else "TRUE") + f" => <> G_{node}"
     loop = model.loop_of(node)
-    return NodeComposition(node, _rules(model, node), tuple(producers), tuple(scs), env_assumptions,
+    return NodeComposition(node, rules, tuple(producers), tuple(scs), env_assumptions,
                            tuple(instances), derived, tuple(cone),
                            R4_ASSUMPTION.format(loop="{" + ", ".join(loop) + "}") if loop else None, cone_env, g_text)
 
 
-class _NodeCalculus:
-    """The steps of :func:`compose_node` for one node, and the state they
-    share: the node's producers, their guarantees and assumptions encoded
-    once, and the node's upstream cone, read only when a side condition
-    first needs it."""
+def _producer_premises(checked: Checked, producers: Sequence[str], enc: Encoder
+                       ) -> tuple[list[z3.BoolRef], list[str], list[z3.BoolRef], list[str]]:
+    """The producers' guarantees and their assumptions (``TRUE`` left
+    out), each encoded by ``enc`` and as ``"P guarantee k: RCL text"``
+    (``"P assumption k: ..."``): ``(guarantees, their texts, assumptions,
+    their texts)``, in producer order."""
+    hyps, hyp_text = [], []
+    prod_assumptions, prod_a_text = [], []
+    for p in producers:
+        pn = checked.nodes[p]
+        for k, g in enumerate(pn.node.guarantees, 1):
+            hyps.append(enc.formula(g.formula, pn))
+            hyp_text.append(f"{p} guarantee {k}: {expr_to_rcl(g.formula)}")
+        for k, a in enumerate(pn.node.assumes, 1):
+            if isinstance(a.formula, ast.BoolLit) and a.formula.value:
+                continue
+            prod_assumptions.append(enc.formula(a.formula, pn))
+            prod_a_text.append(f"{p} assumption {k}: {expr_to_rcl(a.formula)}")
+    return hyps, hyp_text, prod_assumptions, prod_a_text
 
-    def __init__(self, checked: Checked, model: SystemModel, node: str,
-                 facts: Mapping[str, Sequence[ast.Expr]] | None, timeout_ms: int, summaries: bool) -> None:
-        self.checked, self.model, self.node, self.facts = checked, model, node, facts
-        self.timeout_ms, self.summaries = timeout_ms, summaries
-        self.cn = checked.nodes[node]
-        self.producers = model.producers(node)
-        self.enc = Encoder(checked.env, model.alias())
-        self.hyps: list[z3.BoolRef] = []
-        self.hyp_text: list[str] = []
-        self.prod_assumptions: list[z3.BoolRef] = []
-        self.prod_a_text: list[str] = []
-        for p in self.producers:
-            pn = checked.nodes[p]
-            for k, g in enumerate(pn.node.guarantees, 1):
-                self.hyps.append(self.enc.formula(g.formula, pn))
-                self.hyp_text.append(f"{p} guarantee {k}: {expr_to_rcl(g.formula)}")
-            for k, a in enumerate(pn.node.assumes, 1):
-                if isinstance(a.formula, ast.BoolLit) and a.formula.value:
-                    continue
-                self.prod_assumptions.append(self.enc.formula(a.formula, pn))
-                self.prod_a_text.append(f"{p} assumption {k}: {expr_to_rcl(a.formula)}")
-        self.rule = instance_rule(model, node) or "R1"
-        self.who = ", ".join(self.producers)
-        self.cone_ctx: ConeContext | None = None
 
-    def side_condition(self, k: int, c: ast.Expr) -> SideCondition:
-        """The ``k``-th side condition (internal conjunct ``c``), decided
-        locally, then in context unless discharged, with the probable scale
-        mismatches of one still not discharged."""
-        links = _links_of(self.model, self.cn, self.node, c)
-        head = (f"rclverify side condition {self.node}.sc{k} ({self.rule}): guarantees of {self.who} "
-                f"entail {expr_to_rcl(c)}\nsource {_loc(c.loc)}; unsat means discharged")
-        sc = self._local(k, c, head, links)
-        if sc.status != "discharged":  # context before blame (docs/calculus.md)
-            sc = self._in_context(sc, c, head, links)
-        if sc.status != "discharged":  # neither locally nor in context: a power of ten between the ranges?
-            scale = tuple(probable_mismatches(self.checked, self.model.links_into(self.node), self.enc, self.node, c))
-            if scale:
-                sc = dataclasses.replace(sc, scale=scale, explanation=sc.explanation + "".join(
-                    f" {m['message'][0].upper()}{m['message'][1:]}." for m in scale))
-        return sc
-
-    def _local(self, k: int, c: ast.Expr, head: str, links: list[str]) -> SideCondition:
-        """The side condition decided from the producers' guarantees as
-        written, then with their assumptions (module docstring)."""
-        goal = self.enc.formula(c, self.cn)
-        r = prove(goal, self.hyps, self.enc, timeout_ms=self.timeout_ms,
-                  comment=head + "\nvariant: " + VARIANT_AS_WRITTEN)
-        variant, used_text = VARIANT_AS_WRITTEN, tuple(self.hyp_text)
-        first = r
-        if r.status != "proved" and self.prod_assumptions:
-            r = prove(goal, self.hyps + self.prod_assumptions, self.enc, timeout_ms=self.timeout_ms,
-                      comment=head + "\nvariant: " + VARIANT_WITH_ASSUMPTIONS)
-            variant, used_text = VARIANT_WITH_ASSUMPTIONS, tuple(self.hyp_text) + tuple(self.prod_a_text)
-        status = STATUS[r.status]
-        expl = explain_local(self.node, self.who, self.producers, links, bool(self.prod_assumptions), variant,
-                             first, r)
-        duration = round(first.duration_s + (r.duration_s if r is not first else 0.0), 4)
-        shown = r.model  # integers and short decimals where Z3 finds them, re-checked (semantics/nicemodel.py)
-        if status == "failed" and r.model:
-            asked = self.hyps + (self.prod_assumptions if variant == VARIANT_WITH_ASSUMPTIONS else [])
-            shown = nicer_model([*asked, z3.Not(goal)], self.enc, r.model).model
-        return SideCondition(f"{self.node}.sc{k}", self.node, self.rule, expr_to_rcl(c), _loc(c.loc), used_text,
-                             status, duration, r.smt2, shown, expl, variant, tuple(links), status)
-
-    def _in_context(self, sc: SideCondition, c: ast.Expr, head: str, links: list[str]) -> SideCondition:
-        """``sc`` decided again in context: from the summaries of the
-        producers' cones when they prove it, else over the whole upstream
-        cone (:mod:`.summary`, :mod:`.context`)."""
-        checked, model, node = self.checked, self.model, self.node
-        env_of = lambda m: environment_conjuncts(checked, model, m)  # noqa: E731
-        comment = head + "\nvariant: " + VARIANT_IN_CONTEXT
-        cr = (decide_by_summaries(checked, model, node, c, env_of, self.facts, comment + " (the summaries of the "
-                                  "producers' cones)", self.timeout_ms) if self.summaries else None)
-        if cr is not None:  # proved from the producers' summaries: the cone is not read (calculus/summary.py)
-            return in_context(sc, cr, ConeView(tuple(model.upstream(node)), ()), self.who)
-        if self.cone_ctx is None:
-            self.cone_ctx = ConeContext(checked, model, node, env_of, self.facts)
-        cr = self.cone_ctx.decide(c, comment + " (the upstream cone; each guarantee under its node's assumption)",
-                                  self.timeout_ms)
-        read_from = {x.split(".", 1)[0] for x in links}
-        keep: set[str] = ({node}.union(*(model.upstream(p) for p in read_from)) if read_from
-                          else set(self.cone_ctx.cone))
-        return in_context(sc, cr, self.cone_ctx, self.who, keep)
+def _in_context_step(checked: Checked, model: SystemModel, node: str, c: ast.Expr, sc: SideCondition,
+                     cone_ctx: ConeContext | None, head: str, links: list[str],
+                     facts: Mapping[str, Sequence[ast.Expr]] | None, timeout_ms: int,
+                     summaries: bool) -> tuple[SideCondition, ConeContext | None]:
+    """``sc`` (conjunct ``c``, not discharged locally) decided again in
+    context: from the summaries of the producers' cones when they prove it
+    (``summaries``), else over the whole upstream cone ``cone_ctx`` (made
+    here the first time a side condition of ``node`` needs it); returns the
+    side condition and the cone (:mod:`.summary`, :mod:`.context`)."""
+    who = ", ".join(model.producers(node))
+    env_of = lambda m: environment_conjuncts(checked, model, m)  # noqa: E731
+    comment = head + "\nvariant: " + VARIANT_IN_CONTEXT
+    cr = (decide_by_summaries(checked, model, node, c, env_of, facts, comment + " (the summaries of the "
+                              "producers' cones)", timeout_ms) if summaries else None)
+    if cr is not None:  # proved from the producers' summaries: the cone is not read (calculus/summary.py)
+        return in_context(sc, cr, ConeView(tuple(model.upstream(node)), ()), who), cone_ctx
+    if cone_ctx is None:
+        cone_ctx = ConeContext(checked, model, node, env_of, facts)
+    cr = cone_ctx.decide(c, comment + " (the upstream cone; each guarantee under its node's assumption)",
+                         timeout_ms)
+    read_from = {x.split(".", 1)[0] for x in links}
+    keep: set[str] = ({node}.union(*(model.upstream(p) for p in read_from)) if read_from
+                      else set(cone_ctx.cone))
+    return in_context(sc, cr, cone_ctx, who, keep), cone_ctx
 
 
 def _instances(checked: Checked, model: SystemModel, node: str, rule: str, a_text: str, g_text: str,
