@@ -252,7 +252,19 @@ def prove(goal: z3.BoolRef, hypotheses: Sequence[z3.BoolRef], enc: Encoder | Non
             if model is not None:
                 return QueryResult("refuted", script, q.elapsed(), model=model, strategy=TABLES)
         models_first = bool(ladder and likely_sat is not None and likely_sat())
-        return q.retries(ladder, models_first, reasons)
+        # the retries inline, not a method: the last solver lives as long as it always did (Z3 reuses the ids
+        # of freed terms, and the `let` names of later scripts follow them)
+        for name in retry_order(formulas, ladder=ladder, models_first=models_first):
+            if name == DEFAULT:
+                s2 = q.default(None)
+            else:
+                s2, rewrite = strategy_solver(name)
+                load_canonical(s2, [rewrite(f) for f in formulas])
+            got = q.answered(s2, s2.check(), "" if name == DEFAULT else name)
+            if got is not None:
+                return got
+            reasons[name] = s2.reason_unknown()
+        return QueryResult("inconclusive", script, q.elapsed(), reason=reasons_text(reasons))
 
 
 class _Validity:
@@ -290,23 +302,6 @@ class _Validity:
             s = budgeted_solver(budget_ms if budget_ms is not None else self.timeout_ms)
             s.add(*self.formulas)
         return s
-
-    def retries(self, ladder: bool, models_first: bool, reasons: dict[str, str]) -> QueryResult:
-        """The strategies of :func:`.retry.retry_order` in turn after an
-        undecided first attempt (``reasons``: strategy -> Z3's reason
-        unknown, grown here); ``inconclusive`` with every reason when none
-        decides."""
-        for name in retry_order(self.formulas, ladder=ladder, models_first=models_first):
-            if name == DEFAULT:
-                s2 = self.default(None)
-            else:
-                s2, rewrite = strategy_solver(name)
-                load_canonical(s2, [rewrite(f) for f in self.formulas])
-            got = self.answered(s2, s2.check(), "" if name == DEFAULT else name)
-            if got is not None:
-                return got
-            reasons[name] = s2.reason_unknown()
-        return QueryResult("inconclusive", self.script, self.elapsed(), reason=reasons_text(reasons))
 
 
 def satisfiable(labelled: Sequence[tuple[str, z3.BoolRef]], enc: Encoder | None = None, *,
