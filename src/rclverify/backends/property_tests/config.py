@@ -90,6 +90,22 @@ def read_config(raw: Mapping[str, Any], node: CheckedNode, root: Path) -> Config
                   _positive(raw, "steps", DEFAULT_STEPS), bounds, float(timeout))
 
 
+def _forget_bytecode(files: set[Path]) -> None:
+    """Remove the cached bytecode of the workspace's own files before they are imported.
+
+    Python trusts a ``__pycache__`` file whose recorded source modification
+    time (whole seconds) and size match the source: an implementation edited
+    within the second it was last imported, to a text of the same length (a
+    ``-`` made a ``+``), would run its old code, and its evidence would be of
+    a file it does not hash.  With no bytecode left, and none written while
+    the workspace's files import, the source itself is always what runs."""
+    for f in files:
+        try:
+            os.unlink(importlib.util.cache_from_source(str(f)))
+        except (OSError, NotImplementedError, ValueError):
+            pass
+
+
 def load_implementation(root: Path, cfg: Config) -> Any:
     """Import the implementation's file afresh, with every workspace module of
     its import closure (:mod:`.closure`) that this process imported before,
@@ -112,10 +128,15 @@ def load_implementation(root: Path, cfg: Config) -> Any:
         raise ConfigError(f"cannot import {cfg.file}", "implementation")
     module = importlib.util.module_from_spec(spec)
     sys.modules[modname] = module
+    _forget_bytecode(closure | {path})
+    dont_write = sys.dont_write_bytecode
+    sys.dont_write_bytecode = True
     try:
         spec.loader.exec_module(module)
     except Exception as exc:  # the user's file: any error is theirs
         raise ConfigError(f"importing {cfg.file} failed: {type(exc).__name__}: {exc}", "implementation") from None
+    finally:
+        sys.dont_write_bytecode = dont_write
     obj = getattr(module, cfg.attr, None)
     if obj is None or not callable(obj):
         raise ConfigError(f"{cfg.file} has no callable {cfg.attr!r}", "implementation")
