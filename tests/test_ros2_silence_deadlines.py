@@ -97,7 +97,9 @@ until = time.monotonic() + 20
 while time.monotonic() < until and (r.get_subscription_count() < 2 or out.get_subscription_count() < 2):
     ex.spin_once(timeout_sec=0.05)
 print("matched", r.get_subscription_count(), out.get_subscription_count(), flush=True)
-time.sleep(0.3)
+# the writer has matched the monitors' readers; their own side of the match can lag under load, and a
+# volatile reader misses what was written before it matched (a full suite once heard nothing on /r)
+time.sleep(1.0)
 for k in range(10):
     r.publish(Float64(data=float(k)))
     until = time.monotonic() + 3
