@@ -26,7 +26,7 @@ import hashlib
 
 import dataclasses
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, Sequence
+from typing import TYPE_CHECKING, Any, Sequence, cast
 
 from rclverify.records.records import Evidence, Obligation
 from rclverify.records.sealed import write_sealed
@@ -43,12 +43,14 @@ from rclverify.records.sealed import read_sealed
 if TYPE_CHECKING:
     from rclverify.calculus.health.checks import Finding
     from rclverify.records.report_schema import Report
+    from rclverify.records.stage_records import (CheckRecord, CompositionRecord, DeadlineRecord, HealthFinding,
+                                                 ObligationRecord, RequirementRecord)
 
 # The parser, type checker, calculus, health checks, lint and backends are
 # imported where a stage uses them: a doit run that reuses the cached
 # workspace and runs no such stage (a no-op) never needs them (docs/scale.md).
 
-def stage_check(ws: Workspace) -> dict[str, Any]:
+def stage_check(ws: Workspace) -> CheckRecord:
     """Parse, type-check, resolve the plan, lint; write snapshots (:func:`node_snapshots`)
     and the system model.
 
@@ -82,7 +84,7 @@ def stage_check(ws: Workspace) -> dict[str, Any]:
     atomic_write_text(ws.path(ws.MODEL), text)
     hashes[ws.MODEL] = hashlib.sha256(text.encode("utf-8")).hexdigest()
     write_check_index(ws, hashes)  # the report then needs not make every snapshot again
-    return {"warnings": warnings}
+    return cast("CheckRecord", {"warnings": warnings})
 
 
 def _write_if_changed(path: Path, text: str) -> None:
@@ -107,7 +109,7 @@ def stage_graph(ws: Workspace) -> str:
     return dot
 
 
-def stage_compose(ws: Workspace, node: str) -> dict[str, Any]:
+def stage_compose(ws: Workspace, node: str) -> CompositionRecord:
     """Apply the calculus to ``node``; writes its JSON and one .smt2 per side condition."""
     fresh_z3()  # the same Z3 state whatever ran before in this process (semantics/world.py)
     from rclverify.calculus.compose import compose_node, composition_json  # deferred: start-up (loads lark, yaml and more only when called)
@@ -123,7 +125,7 @@ def stage_compose(ws: Workspace, node: str) -> dict[str, Any]:
     # condition was decided in context (the doit task re-runs on any change of the cone: derived property)
     record_provenance(ws, node, "compose", stage_inputs(ws, node, "compose",
                                                         any(sc.context for sc in comp.side_conditions)))
-    return out
+    return cast("CompositionRecord", out)
 
 
 def plan_facts(ws: Workspace) -> dict[str, list[Any]]:
@@ -133,7 +135,7 @@ def plan_facts(ws: Workspace) -> dict[str, list[Any]]:
     return {n: [f.expr for f in fs] for n, fs in ws.plan.facts.items()}
 
 
-def stage_health(ws: Workspace, node: str) -> list[dict[str, Any]]:
+def stage_health(ws: Workspace, node: str) -> list[HealthFinding]:
     """Run the contract health checks of ``node``; writes its findings JSON."""
     fresh_z3()  # the same Z3 state whatever ran before in this process (semantics/world.py)
     from rclverify.calculus.health.checks import check_node  # deferred: start-up (loads lark, yaml and more only when called)
@@ -153,7 +155,7 @@ def stage_health(ws: Workspace, node: str) -> list[dict[str, Any]]:
         findings.append(j)
     write_sealed(ws.path(ws.health(node)), {"node": node, "findings": findings})
     record_provenance(ws, node, "health", stage_inputs(ws, node, "health"))
-    return findings
+    return cast("list[HealthFinding]", findings)
 
 
 def replacement_finding(ws: Workspace, node: str) -> Finding:
@@ -186,7 +188,7 @@ def replacement_finding(ws: Workspace, node: str) -> Finding:
                                                            instances=ws.plan.instances.get(node)))
 
 
-def stage_export(ws: Workspace, node: str) -> list[dict[str, Any]]:
+def stage_export(ws: Workspace, node: str) -> list[ObligationRecord]:
     """Export ``node``'s obligations for every evidence entry of the plan."""
     fresh_z3()  # the same Z3 state whatever ran before in this process (semantics/world.py)
     from rclverify.backends import get_backend  # deferred: start-up (loads rclverify.backends, importlib only when called)
@@ -219,7 +221,7 @@ def stage_export(ws: Workspace, node: str) -> list[dict[str, Any]]:
     for old in ws.path(f"artifacts/obligations/{node}").glob("*.json"):
         if old.name not in keep:
             old.unlink()
-    return [o.to_json() for o in obligations]
+    return cast("list[ObligationRecord]", [o.to_json() for o in obligations])
 
 
 def ast_loc(rel: str) -> Any:
@@ -245,17 +247,17 @@ def stage_run(ws: Workspace, node: str, obligation_id: str) -> Evidence:
     return ev
 
 
-def stage_requirements(ws: Workspace, *, force: bool = False) -> list[tuple[dict[str, Any], bool]]:
+def stage_requirements(ws: Workspace, *, force: bool = False) -> list[tuple[RequirementRecord, bool]]:
     """Check every requirement with Z3; see :mod:`rclverify.stages.requirements`."""
     from rclverify.stages.requirements import stage_requirements as run  # deferred: start-up (loads rclverify.stages.requirements only when called)
-    return run(ws, force=force)
+    return cast("list[tuple[RequirementRecord, bool]]", run(ws, force=force))
 
 
-def stage_deadlines(ws: Workspace) -> list[dict[str, Any]]:
+def stage_deadlines(ws: Workspace) -> list[DeadlineRecord]:
     """Decide every end-to-end deadline with Z3 (rule D3); see
     :mod:`rclverify.stages.deadlines`.  Returns the records written."""
     from rclverify.stages.deadlines import stage_deadlines as run  # deferred: start-up (loads yaml, z3 and more only when called)
-    return run(ws)[1]
+    return cast("list[DeadlineRecord]", run(ws)[1])
 
 
 def stage_report(ws: Workspace, parts: Sequence[str] = tuple(REPORT_PARTS),

@@ -15,9 +15,10 @@ from __future__ import annotations
 import json
 import sys
 from pathlib import Path, PurePosixPath
-from typing import Any
+from typing import Any, cast
 
 from rclverify.lang import ast
+from rclverify.records.stage_records import GroundingRecord
 from rclverify.model.plan.errors import plan_error
 from rclverify.ros.extract import names
 from rclverify.ros.graph.inputs import input_files
@@ -74,7 +75,7 @@ def has_ros(ws: Any) -> bool:
     return bool(ws.plan.ros)
 
 
-def stage_ground(ws: Any) -> dict[str, Any]:
+def stage_ground(ws: Any) -> GroundingRecord:
     """Scan, ground, write both artifacts; returns the grounding dict
     (``findings``, ``counts``, ``context`` for the GSN argument)."""
     from rclverify.records.store import atomic_write_text  # deferred: start-up (loads rclverify.core, rclverify.core.atomic and more only when called)
@@ -124,7 +125,7 @@ def stage_ground(ws: Any) -> dict[str, Any]:
     from rclverify.records.sealed import write_sealed  # deferred: start-up (loads rclverify.core, rclverify.core.atomic and more only when called)
     data["inputs"] = hash_inputs(ws.root, input_files(ws))
     write_sealed(ws.path(GROUNDING), data)  # sealed: the report reads it (records/sealed.py)
-    return data
+    return cast(GroundingRecord, data)
 
 
 def run_check(root: Path, plan: str, strict: bool, json_out: str | None) -> int:

@@ -1,7 +1,8 @@
 """Layer 2, records: the formats every stage writes and the report reads.
 
 Obligations and evidence records (``records``), their atomic store
-(``store``), sealed stage records (``sealed``), published artifacts,
+(``store``), sealed stage records (``sealed``) and their types
+(``stage_records``), published artifacts,
 run-based statistics, the one status vocabulary (``statuses``) and the
 assurance report's schema as types (``report_schema``).  Imports ``core``.
 """

@@ -19,9 +19,10 @@ import hashlib
 import os
 import threading
 from pathlib import Path
-from typing import Any, Iterable
+from typing import Any, Iterable, cast
 
 from rclverify.records.sealed import read_sealed, write_sealed
+from rclverify.records.stage_records import CrosscheckRecord
 from rclverify.records.store import atomic_write_text
 from rclverify.stages.crosscheck.cvc5_decide import RLIMIT, Decision, Session, decide, version
 from rclverify.stages.crosscheck.items import WITNESS, Item, discharging_items
@@ -78,7 +79,7 @@ def confirm_proof(text: str) -> tuple[str, str]:
 SPLIT_MIN = 200
 
 
-def stage_crosscheck(root: Path, nodes: Iterable[str], *, split_min: int = SPLIT_MIN) -> dict[str, Any]:
+def stage_crosscheck(root: Path, nodes: Iterable[str], *, split_min: int = SPLIT_MIN) -> CrosscheckRecord:
     """Decide every discharging item of the workspace at ``root`` again
     with cvc5 and write the stage's record (module docstring); returns the
     index written.  When ``split_min`` or more scripts are not in the last
@@ -104,7 +105,7 @@ def stage_crosscheck(root: Path, nodes: Iterable[str], *, split_min: int = SPLIT
     for f in proofs.glob("*.proof") if proofs.is_dir() else []:
         if f.name not in keep:
             f.unlink()
-    return index
+    return cast(CrosscheckRecord, index)
 
 
 def _lookup(root: Path, it: Item, ver: str, cache: dict[str, dict[str, Any]]
