@@ -95,7 +95,7 @@ PIPELINE = frozenset({
     "test_units_inferred", "test_deadline_monitors", "test_monitor_floats", "test_acknowledged",
     "test_blame_line", "test_deadline_timing_measured", "test_example_fleet_trials", "test_mapping_hygiene",
     "test_one_row_per_cause", "test_repairs_units", "test_report_hygiene", "test_report_schema",
-    "test_example_safety_stop", "test_init",
+    "test_example_safety_stop", "test_init", "test_stage_records",
 })
 
 #: The ``slow`` tier: every module measured above two CPU seconds, and the pipeline runs.
