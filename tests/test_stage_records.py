@@ -79,6 +79,21 @@ def _check(value: Any, tp: Any, where: str) -> None:
     assert problems == [], "\n".join(problems)
 
 
+# Two requirements more, so that the records of the informal and the refuted branches are walked too.
+EXTRA = """\
+  - id: EXTRA-INFORMAL
+    text: The rover is pleasant to work with.
+    supported_by:
+      - {node: Agent, guarantees: [1]}
+  - id: EXTRA-REFUTED
+    text: With the radiation red, the agent commands the inspection of waypoint 0 (REQ3 says it leaves).
+    formal: >-
+      Agent.in.radiationStatus == red -> Agent.out.command == inspect(0)
+    supported_by:
+      - {node: Agent, guarantees: [1]}
+"""
+
+
 @pytest.fixture(scope="module")
 def run(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, dict[str, Any]]:
     """The case study's stages run once on a copy: ``(root, {stage: what it returned})``."""
@@ -89,6 +104,10 @@ def run(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, dict[str, Any]]
     root = tmp_path_factory.mktemp("rover")
     for d in ("contracts", "backends", "ros"):
         shutil.copytree(ROOT / d, root / d, ignore=shutil.ignore_patterns("__pycache__"))
+    plan = root / "contracts" / "plan.yaml"
+    text = plan.read_text(encoding="utf-8")
+    assert text.count("\nrequirements:\n") == 1
+    plan.write_text(text.replace("\nrequirements:\n", "\nrequirements:\n" + EXTRA, 1), encoding="utf-8")
     ws = Workspace(root)
     out: dict[str, Any] = {"check": pipeline.stage_check(ws)}
     nodes = list(ws.checked.nodes)
@@ -112,6 +131,9 @@ def test_the_returned_records_are_their_types(run: tuple[Path, dict[str, Any]]) 
     _, out = run
     assert len(out["compose"]) == 4 and all(out["export"].values()) and out["requirements"]
     assert out["crosscheck"]["items"] and out["ground"]["findings"] is not None
+    verdicts = {r["id"]: r["verdict"] for r in out["requirements"]}
+    assert verdicts["EXTRA-INFORMAL"] == "informal" and verdicts["EXTRA-REFUTED"] == "refuted"
+    assert any(r["id"] == "EXTRA-REFUTED" and r.get("counterexample") for r in out["requirements"])
     _check(out["check"], sr.CheckRecord, "check")
     for n in out["compose"]:
         _check(out["compose"][n], sr.CompositionRecord, f"compose[{n}]")
