@@ -65,12 +65,12 @@ class SideCondition(TypedDict):
     status: str
     duration_s: float
     smt2: str
-    model: dict[str, Any] | None
+    model: dict[str, str] | None
     explanation: str
     variant: str
     links: list[str]
     verdict: str
-    context: Any
+    context: dict[str, Any] | None
     scale_mismatch: NotRequired[list[dict[str, Any]]]
 
 
