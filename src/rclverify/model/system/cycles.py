@@ -20,10 +20,12 @@ from typing import Hashable, Iterable, Sequence, TypeVar
 N = TypeVar("N", bound=Hashable)
 
 
-def _components(nodes: Sequence[N], succ: dict[N, list[N]]) -> list[list[N]]:
+def strongly_connected_components(nodes: Sequence[N], succ: dict[N, list[N]]) -> list[list[N]]:
     """The strongly connected components of the graph restricted to
-    ``nodes`` (Tarjan's algorithm, iteratively), each in the order of
-    ``nodes``."""
+    ``nodes`` (``succ``: node -> its successors; every node of ``nodes`` a
+    key), by Tarjan's algorithm, iteratively; each component's nodes in the
+    order of ``nodes``.  A component comes after every component it reaches
+    (Tarjan completes a component only then)."""
     inside = set(nodes)
     index: dict[N, int] = {}
     low: dict[N, int] = {}
@@ -128,12 +130,12 @@ def elementary_cycles(nodes: Sequence[N], edges: Iterable[tuple[N, N]]) -> list[
             out.append([a])
         else:
             succ[a].append(b)
-    todo = [c for c in _components(list(nodes), succ) if len(c) > 1]
+    todo = [c for c in strongly_connected_components(list(nodes), succ) if len(c) > 1]
     while todo:
         comp = todo.pop()
         s, rest = comp[0], comp[1:]
         out += _circuits_through(s, set(comp), succ)
-        todo += [c for c in _components(rest, succ) if len(c) > 1]
+        todo += [c for c in strongly_connected_components(rest, succ) if len(c) > 1]
     return out
 
 

@@ -37,6 +37,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Iterable, Mapping, Sequence
 
+from rclverify.model.system.cycles import strongly_connected_components
+
 
 @dataclass(frozen=True)
 class Premise:
@@ -83,58 +85,26 @@ def cones(producers: Mapping[str, Iterable[str]]) -> dict[str, frozenset[str]]:
     """C4's cones: for every node of ``producers`` (node -> its producer
     nodes), the least fixpoint ``cone(n) = {n} + cone(p)`` (loops
     included): the nodes with a path to ``n``, and ``n``.  Computed once
-    per strongly connected component (Tarjan's algorithm, which completes
-    a component only after every component it reads from: a loop's nodes
-    share one cone), each cone the union of its component's nodes and its
+    per strongly connected component (:func:`rclverify.model.system.cycles.strongly_connected_components`,
+    which gives a component after every component it reads from: a loop's
+    nodes share one cone), each cone the union of its component's nodes and its
     producer components' cones.  Iterating the fixpoint over the nodes
     until no cone grew took 1.4 CPU s of each report task at 1000 nodes
     (docs/scale.md, issue 67); networkx's condensation does the same in
     0.1 s, plus 0.1 s to import it in every report process."""
     nodes = sorted(set(producers) | {p for ps in producers.values() for p in ps})
     preds = {n: list(producers.get(n, ())) for n in nodes}
-    index: dict[str, int] = {}
-    low: dict[str, int] = {}
-    stack: list[str] = []
-    on_stack: set[str] = set()
     cone: dict[str, frozenset[str]] = {}
-    for root in nodes:
-        if root in index:
-            continue
-        index[root] = low[root] = len(index)
-        stack.append(root)
-        on_stack.add(root)
-        work = [(root, iter(preds[root]))]
-        while work:
-            v, edges = work[-1]
-            for w in edges:
-                if w not in index:
-                    index[w] = low[w] = len(index)
-                    stack.append(w)
-                    on_stack.add(w)
-                    work.append((w, iter(preds[w])))
-                    break
-                if w in on_stack:
-                    low[v] = min(low[v], index[w])
-            else:
-                work.pop()
-                if work:
-                    low[work[-1][0]] = min(low[work[-1][0]], low[v])
-                if low[v] == index[v]:  # v roots a component: every component it reads from is done
-                    members = set()
-                    while True:
-                        w = stack.pop()
-                        on_stack.discard(w)
-                        members.add(w)
-                        if w == v:
-                            break
-                    acc = set(members)
-                    for m in members:
-                        for q in preds[m]:
-                            if q not in members:
-                                acc |= cone[q]
-                    whole = frozenset(acc)
-                    for m in members:
-                        cone[m] = whole
+    for members in strongly_connected_components(nodes, preds):  # each after every component it reads from
+        inside = set(members)
+        acc = set(inside)
+        for m in members:
+            for q in preds[m]:
+                if q not in inside:
+                    acc |= cone[q]
+        whole = frozenset(acc)
+        for m in members:
+            cone[m] = whole
     return cone
 
 
