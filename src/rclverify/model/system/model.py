@@ -24,14 +24,14 @@ from dataclasses import dataclass
 from functools import cached_property
 from pathlib import Path
 from types import MappingProxyType
-from typing import Any, Iterable, Iterator, Mapping, Sequence
+from typing import Any, Iterable, Mapping, Sequence
 
 from rclverify.model.plan.load import Connection
 from rclverify.lang.errors import RclError, error
 from rclverify.lang.types import Checked, EmptyT
 from rclverify.model.system.services import peers as service_peers, side_conditions as service_conditions
 from rclverify.model.system.units import connection_diagnostics
-from rclverify.model.system.cycles import elementary_cycles
+from rclverify.model.system.cycles import elementary_cycles, strongly_connected_components
 
 
 @dataclass(frozen=True)
@@ -321,55 +321,13 @@ def _by_topic(checked: Checked, node: str, var: str) -> list[tuple[str, str]]:
 
 
 def _loops(nodes: Sequence[str], links: Iterable[Link]) -> tuple[tuple[str, ...], ...]:
-    """Strongly connected components with a cycle (Tarjan), sorted."""
+    """Strongly connected components with a cycle (:func:`.cycles.strongly_connected_components`:
+    Tarjan's), each and all sorted."""
     succ: dict[str, set[str]] = {n: set() for n in nodes}
     for l in links:
         succ[l.from_node].add(l.to_node)
-    index: dict[str, int] = {}
-    low: dict[str, int] = {}
-    stack: list[str] = []
-    on: set[str] = set()
-    out: list[tuple[str, ...]] = []
-
-    def visit(root: str) -> None:
-        # Tarjan's algorithm with an explicit stack of (node, its remaining
-        # successors): a chain of a thousand nodes would exceed Python's
-        # recursion limit with the recursive formulation.
-        index[root] = low[root] = len(index)
-        stack.append(root)
-        on.add(root)
-        work: list[tuple[str, Iterator[str]]] = [(root, iter(sorted(succ[root])))]
-        while work:
-            v, successors = work[-1]
-            for w in successors:
-                if w not in index:
-                    index[w] = low[w] = len(index)
-                    stack.append(w)
-                    on.add(w)
-                    work.append((w, iter(sorted(succ[w]))))
-                    break
-                if w in on:
-                    low[v] = min(low[v], index[w])
-            else:
-                work.pop()
-                if work:
-                    parent = work[-1][0]
-                    low[parent] = min(low[parent], low[v])
-                if low[v] == index[v]:
-                    comp = []
-                    while True:
-                        w = stack.pop()
-                        on.discard(w)
-                        comp.append(w)
-                        if w == v:
-                            break
-                    if len(comp) > 1 or v in succ[v]:
-                        out.append(tuple(sorted(comp)))
-
-    for n in nodes:
-        if n not in index:
-            visit(n)
-    return tuple(sorted(out))
+    comps = strongly_connected_components(list(nodes), {n: sorted(ws) for n, ws in succ.items()})
+    return tuple(sorted(tuple(sorted(c)) for c in comps if len(c) > 1 or c[0] in succ[c[0]]))
 
 
 def cycles_kept(model: SystemModel, path: Path) -> list[list[str]]:
