@@ -99,10 +99,12 @@ def _forget_bytecode(files: set[Path]) -> None:
     ``-`` made a ``+``), would run its old code, and its evidence would be of
     a file it does not hash.  With no bytecode left, and none written while
     the workspace's files import, the source itself is always what runs."""
+    if sys.implementation.cache_tag is None:  # an interpreter that caches no bytecode
+        return
     for f in files:
         try:
             os.unlink(importlib.util.cache_from_source(str(f)))
-        except (OSError, NotImplementedError, ValueError):
+        except (OSError, ValueError):  # none cached, or a name Python would not cache
             pass
 
 
