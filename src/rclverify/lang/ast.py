@@ -7,6 +7,10 @@ original (the round-trip property of the printer).
 Source of the syntax: the EBNF table and the listings of the paper
 (shared/reference, lines 499-555, 1131-1171 and appendix A, 1890-1983).
 
+Long module: the flat list of the syntax's node classes, one small frozen
+dataclass each; split, it would only gain a module that re-exports them all
+(the visitor's table, ``lang/visit.py``, names every class).
+
 Shapes
 ------
 * A :class:`Spec` is one RCL file: a tuple of :class:`Context` clauses and a
