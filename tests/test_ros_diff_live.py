@@ -45,12 +45,16 @@ def _ros1() -> None:
 
 
 def _settled(uri: str, deadline: float) -> None:
-    """Wait until the master shows what the fixture started (bounded)."""
+    """Wait until the master shows what the fixture started (bounded): every node, and each
+    one's registrations the tests read (a node shows on the master, by its ``/rosout``, before
+    it registers its service)."""
     while True:
         try:
             g = read_master(uri, service_types=False)
             nodes = set(g.nodes)
-            if {"/sensor", "/planner"} <= nodes and any(n.startswith("/base") for n in nodes) \
+            if {"/sensor", "/planner"} <= nodes \
+                    and any(n.startswith("/base") and any(e.topic == "/estop" for e in g.nodes[n].service_servers)
+                            for n in nodes) \
                     and any(n.startswith("/mover") and g.nodes[n].action_servers for n in nodes) \
                     and any(e.topic == "/sensor_debug" for e in g.nodes["/sensor"].publishes) \
                     and any(e.topic == "/range" for e in g.nodes["/planner"].subscribes):
