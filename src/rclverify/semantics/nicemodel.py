@@ -24,6 +24,11 @@ every shown constant pinned to its new value must be satisfiable in a fresh
 solver; otherwise (or on any ``unknown``) the caller's model is returned
 unchanged, so a shown counterexample is always one.  A model already within
 the assumptions and already short is returned as it was (the same text).
+
+Only the budget of steps decides (issue 67): when the wall-clock safety net
+of any of these queries fires (:mod:`.wallclock`: a loaded machine), the
+caller's model, the one the deterministic query found, is returned
+unchanged, never the intermediate model a loop cut short had reached.
 """
 from __future__ import annotations
 
@@ -32,6 +37,9 @@ from fractions import Fraction
 from typing import Any, Mapping, Sequence
 
 import z3
+
+from rclverify.semantics import wallclock
+from rclverify.semantics.wallclock import check, limit
 
 #: Decimal places a value may have and still count as short.
 SHORT_DIGITS = 3
@@ -61,7 +69,7 @@ class Nicer:
 
 def short(v: Fraction) -> bool:
     """Is ``v`` an integer or a decimal of at most :data:`SHORT_DIGITS` places?"""
-    return (v * 10 ** SHORT_DIGITS).denominator == 1
+    return bool((v * 10 ** SHORT_DIGITS).denominator == 1)
 
 
 def parse_number(text: str) -> Fraction | None:
@@ -89,10 +97,7 @@ def candidates(v: Fraction) -> list[Fraction]:
 
 
 def _solver(ctx: z3.Context) -> z3.Solver:
-    from rclverify.semantics.query import steps  # deferred: start-up (loads lark, rclverify.core and more only when called)
-    s = z3.Solver(ctx=ctx)
-    s.set("rlimit", steps(BUDGET_MS))
-    s.set("timeout", BUDGET_MS * 10)
+    s: z3.Solver = limit(z3.Solver(ctx=ctx), BUDGET_MS)
     return s
 
 
@@ -134,11 +139,20 @@ def nicer_model(formulas: Sequence[z3.BoolRef], enc: Any, model: Mapping[str, st
     model (RCL name -> value text, :func:`rclverify.semantics.query.render_model`);
     ``assumptions`` labelled formulas to keep when they can hold.  Returns a
     :class:`Nicer`; never raises on solver trouble (the caller's model is
-    kept)."""
-    from rclverify.semantics.query import render_model  # deferred: start-up (loads lark, rclverify.core and more only when called)
+    kept), and keeps the caller's model when the wall-clock safety net cut
+    any query (module docstring)."""
     keep = Nicer(dict(model))
     if not formulas:
         return keep
+    with wallclock.watch() as w:
+        nice = _nicer(formulas, enc, model, assumptions, keep)
+    return keep if w.cut else nice
+
+
+def _nicer(formulas: Sequence[z3.BoolRef], enc: Any, model: Mapping[str, str],
+           assumptions: Sequence[tuple[str, z3.BoolRef]], keep: Nicer) -> Nicer:
+    """:func:`nicer_model`'s search, whatever the wall clock did."""
+    from rclverify.semantics.query import render_model  # deferred: start-up (loads lark, rclverify.core and more only when called)
     consts = _constants(enc, model)
     ctx = formulas[0].ctx
     base = list(formulas) + list(enc.axioms())
@@ -162,7 +176,7 @@ def nicer_model(formulas: Sequence[z3.BoolRef], enc: Any, model: Mapping[str, st
         s.add(*base, *kept)
         s.push()
         s.add(*(pins if as_is or not kept else []))  # from the caller's values when they are a model of s
-        if s.check() != z3.sat:
+        if check(s) != z3.sat:
             return Nicer(dict(model), False, within, outside)
         m = s.model()
         s.pop()
@@ -179,7 +193,7 @@ def nicer_model(formulas: Sequence[z3.BoolRef], enc: Any, model: Mapping[str, st
 def _check(formulas: Sequence[z3.BoolRef], ctx: z3.Context) -> z3.CheckSatResult:
     s = _solver(ctx)
     s.add(*formulas)
-    return s.check()
+    return check(s)
 
 
 def _all_short(consts: Mapping[str, z3.ExprRef], model: Mapping[str, str]) -> bool:
@@ -216,7 +230,7 @@ def _round(s: z3.Solver, consts: Mapping[str, z3.ExprRef], m: z3.ModelRef) -> z3
             asked += 1
             s.push()
             s.add(c == z3.RealVal(cand, c.ctx))
-            if s.check() == z3.sat:
+            if check(s) == z3.sat:
                 m = s.model()  # the pin stays (no pop): later constants keep it
                 break
             s.pop()
@@ -233,7 +247,7 @@ def _recheck(formulas: Sequence[z3.BoolRef], consts: Mapping[str, z3.ExprRef], m
     if len(pins) < len([n for n in consts if n in model]):
         return False  # a value that does not read back (an algebraic number): not checked, not shown
     s.add(*pins)
-    return s.check() == z3.sat
+    return bool(check(s) == z3.sat)
 
 
 def _core(base: Sequence[z3.BoolRef], assumptions: Sequence[tuple[str, z3.BoolRef]], ctx: z3.Context) -> list[str]:
@@ -245,7 +259,7 @@ def _core(base: Sequence[z3.BoolRef], assumptions: Sequence[tuple[str, z3.BoolRe
         b = z3.Bool(f"__nice_{k}", ctx)
         marks[str(b)] = label
         s.add(z3.Implies(b, f))
-    if s.check(*[z3.Bool(f"__nice_{k}", ctx) for k in range(len(assumptions))]) == z3.unsat:
+    if check(s, *[z3.Bool(f"__nice_{k}", ctx) for k in range(len(assumptions))]) == z3.unsat:
         found = {str(c) for c in s.unsat_core()}
         got = [lbl for k, (lbl, _) in enumerate(assumptions) if f"__nice_{k}" in found]
         if got:

@@ -4,7 +4,10 @@ Every query:
 
 * runs with a per-query budget, given in milliseconds and enforced as Z3
   resource steps (:data:`STEPS_PER_MS`), so the answer does not depend on
-  the machine's load;
+  the machine's load; its wall-clock safety net (:mod:`.wallclock`), when
+  it fires first, gives ``inconclusive`` with the reason "took longer than
+  N s", and no retry is asked in its place (a retry's model would differ
+  from the one the budget finds: issue 67);
 * maps Z3's answer to the tool's verdicts without ever upgrading an
   ``unknown``: validity -> ``proved`` (negation unsat) / ``refuted`` (sat,
   with a model) / ``inconclusive`` (unknown or timeout); satisfiability ->
@@ -29,6 +32,8 @@ from rclverify.semantics.encode import Encoder, term_to_rcl, value_to_rcl
 from rclverify.semantics.functable import finite_table
 from rclverify.semantics.retry import (DEFAULT, TABLES, attempts, bounded_solver, load_canonical, reasons_text, retry_order,
                     strategy_solver, variants)
+from rclverify.semantics import wallclock
+from rclverify.semantics.wallclock import STEPS_PER_MS as STEPS_PER_MS, check, cut_reason, steps as steps
 
 DEFAULT_TIMEOUT_MS = 10_000
 
@@ -63,32 +68,19 @@ class QueryResult:
         return self.script()
 
 
-#: Z3 resource steps per millisecond of a query's budget: a ``timeout_ms``
-#: budget is enforced as Z3's ``rlimit`` of ``timeout_ms * STEPS_PER_MS``
-#: steps (Z3 does some 2,000 steps per millisecond on the heavy quantified
-#: queries of the case study on one idle core, up to 4,000 on light ones,
-#: which finish well inside their budget), so an answer does not
-#: depend on the machine's load: a serial run, ``doit -n 2`` and a busy CI
-#: machine decide the same queries.
-STEPS_PER_MS = 2_000
-#: The wall-clock safety net, a multiple of the budget.
-SAFETY_FACTOR = 10
-
-
-def steps(budget_ms: float) -> int:
-    """The Z3 resource limit of a budget of ``budget_ms`` milliseconds
-    (:data:`STEPS_PER_MS`), at least one step (Z3 reads 0 as no limit)."""
-    return max(1, int(budget_ms * STEPS_PER_MS))
+# STEPS_PER_MS and steps() (a budget in milliseconds' worth of Z3 resource
+# steps) and SAFETY_FACTOR (the wall-clock safety net, a multiple of the
+# budget) live in rclverify.semantics.wallclock, which also tells the net's
+# firing apart (issue 67); STEPS_PER_MS and steps are re-exported here.
 
 
 def budgeted_solver(timeout_ms: float, ctx: z3.Context | None = None) -> z3.Solver:
     """A solver in ``ctx`` (default: the process's main context) whose
     budget is ``timeout_ms`` milliseconds' worth of Z3 resource steps
-    (:func:`steps`), with a wall-clock safety net :data:`SAFETY_FACTOR`
-    times longer (at least a millisecond)."""
-    s = z3.Solver(ctx=ctx)
-    s.set("rlimit", steps(timeout_ms))
-    s.set("timeout", max(1, int(timeout_ms * SAFETY_FACTOR)))
+    (:func:`steps`), with a wall-clock safety net
+    :data:`.wallclock.SAFETY_FACTOR` times longer (at least a millisecond),
+    registered so that :func:`.wallclock.check` tells its firing apart."""
+    s: z3.Solver = wallclock.limit(z3.Solver(ctx=ctx), timeout_ms)
     return s
 
 
@@ -105,8 +97,7 @@ class _Session:
 
     def scope(self, timeout_ms: int) -> z3.Solver:
         if self.budget_ms != timeout_ms:
-            self.solver.set("rlimit", int(timeout_ms) * STEPS_PER_MS)
-            self.solver.set("timeout", int(timeout_ms) * SAFETY_FACTOR)
+            wallclock.limit(self.solver, timeout_ms)
             self.budget_ms = timeout_ms
         self.solver.push()
         return self.solver
@@ -243,9 +234,12 @@ def prove(goal: z3.BoolRef, hypotheses: Sequence[z3.BoolRef], enc: Encoder | Non
         else:
             s = scope.enter_context(query_solver(timeout_ms))
             s.add(*formulas)
-        got = q.answered(s, s.check())
+        seen = wallclock.cuts()
+        got = q.answered(s, check(s))
         if got is not None:
             return got
+        if wallclock.cuts() != seen:  # the clock, not the budget: no retry may answer in its place
+            return QueryResult("inconclusive", script, q.elapsed(), reason=cut_reason())
         reasons = {DEFAULT: s.reason_unknown()}
         if ladder and counterexample is not None:
             model = counterexample()
@@ -260,9 +254,11 @@ def prove(goal: z3.BoolRef, hypotheses: Sequence[z3.BoolRef], enc: Encoder | Non
             else:
                 s2, rewrite = strategy_solver(name)
                 load_canonical(s2, [rewrite(f) for f in formulas])
-            got = q.answered(s2, s2.check(), "" if name == DEFAULT else name)
+            got = q.answered(s2, check(s2), "" if name == DEFAULT else name)
             if got is not None:
                 return got
+            if wallclock.cuts() != seen:
+                return QueryResult("inconclusive", script, q.elapsed(), reason=cut_reason())
             reasons[name] = s2.reason_unknown()
         return QueryResult("inconclusive", script, q.elapsed(), reason=reasons_text(reasons))
 
@@ -323,9 +319,12 @@ def satisfiable(labelled: Sequence[tuple[str, z3.BoolRef]], enc: Encoder | None 
             trackers[str(b)] = label
             s.assert_and_track(f, b)
         t0 = time.perf_counter()
-        r = s.check()
+        seen = wallclock.cuts()
+        r = check(s)
         dt = round(time.perf_counter() - t0, 4)
         script = smt2_script(background + [f for _, f in labelled], comment or "satisfiability query")
+        if wallclock.cuts() != seen:  # the clock, not the budget: no retry may answer in its place
+            return QueryResult("inconclusive", script, dt, reason=cut_reason())
         if r == z3.sat:
             return QueryResult("sat", script, dt, model=render_model(s.model(), enc))
         if r == z3.unsat:
@@ -338,8 +337,10 @@ def satisfiable(labelled: Sequence[tuple[str, z3.BoolRef]], enc: Encoder | None 
             for name, s2 in variants(name0, s0):
                 # loaded untracked from canonical text (tracking changes Z3's search)
                 load_canonical(s2, [rewrite(g) for g in background + [f for _, f in labelled]])
-                r = s2.check()
+                r = check(s2)
                 dt = round(time.perf_counter() - t0, 4)
+                if wallclock.cuts() != seen:
+                    return QueryResult("inconclusive", script, dt, reason=cut_reason())
                 if r == z3.sat:
                     return QueryResult("sat", script, dt, model=render_model(s2.model(), enc), strategy=name)
                 if r == z3.unsat:
@@ -361,7 +362,7 @@ def _retry_core(background: Sequence[z3.BoolRef], labelled: Sequence[tuple[str, 
     s.set("unsat_core", True)
     load_canonical(s, [rewrite(f) for f in background]
                    + [z3.Implies(z3.Bool(f"__label_{k}", f.ctx), rewrite(f)) for k, (_, f) in enumerate(labelled)])
-    if s.check(*[z3.Bool(f"__label_{k}", s.ctx) for k in range(len(labelled))]) != z3.unsat:
+    if check(s, *[z3.Bool(f"__label_{k}", s.ctx) for k in range(len(labelled))]) != z3.unsat:
         return None
     found = {str(c) for c in s.unsat_core()}
     return [lbl for k, (lbl, _) in enumerate(labelled) if f"__label_{k}" in found]

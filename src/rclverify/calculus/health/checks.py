@@ -32,6 +32,7 @@ from typing import Any, Callable, Sequence
 import z3
 
 from rclverify.calculus.refinement import RefinementResult
+from rclverify.semantics import wallclock
 from rclverify.semantics.encode import Encoder
 from rclverify.semantics.query import QueryResult, satisfiable, smt2_script, solver_session
 from rclverify.lang import ast
@@ -163,7 +164,34 @@ def check_node(checked: Checked, node: str, facts: Sequence[tuple[ast.Expr, ast.
     conjuncts); returns its findings
     in order.  The queries share one solver session
     (:func:`~rclverify.semantics.query.solver_session`): they depend on the
-    node's contract, facts and instances alone, and run in a fixed order."""
+    node's contract, facts and instances alone, and run in a fixed order.
+
+    When the wall-clock safety net cut a query (:mod:`rclverify.semantics.wallclock`:
+    a loaded machine), the findings of that check and of every later one
+    are ``inconclusive`` ("took longer than N s", :func:`_cut_short`): the
+    cut changed the path (the next instance of a scan, another subset of
+    guarantees) and the state of the shared solver, so their models and
+    cores could differ from what the budget alone decides (issue 67)."""
+    with wallclock.watch() as w:
+        cuts: list[int] = []
+        out = _check_node(checked, node, facts, instances, timeout_ms, lambda k: cuts.append(k) if w.cut else None)
+    return out[:cuts[0]] + [_cut_short(f) for f in out[cuts[0]:]] if cuts else out
+
+
+def _cut_short(f: Finding) -> Finding:
+    """``f`` as an ``inconclusive`` finding of the same check: decided
+    after the wall-clock safety net cut a query (:func:`check_node`)."""
+    if f.status == "inconclusive" and "wall-clock" in f.explanation:
+        return f
+    return Finding(f.id, f.node, f.check, f.guarantee, "inconclusive",
+                   f"This check of {f.node} was not decided here.",
+                   f"A health query of {f.node} {wallclock.cut_reason()}.", duration_s=f.duration_s)
+
+
+def _check_node(checked: Checked, node: str, facts: Sequence[tuple[ast.Expr, ast.Loc]],
+                instances: tuple[int, int] | None, timeout_ms: int, done: Callable[[int], None]) -> list[Finding]:
+    """:func:`check_node`'s checks, whatever the wall clock did; ``done(k)``
+    is called after each check with the index of its first finding."""
     h = _NodeHealth(checked, checked.nodes[node], facts, instances, timeout_ms)
     out: list[Finding] = []
     n = node
@@ -183,6 +211,7 @@ def check_node(checked: Checked, node: str, facts: Sequence[tuple[ast.Expr, ast.
                            f"Z3 could not decide whether the assumption of {n} can hold.", r.reason, duration_s=r.duration_s))
 
     out[mark] = _noted(replace(out[mark], smt2=r.smt2), r)
+    done(mark)
     comment = f"health {n}: can the assumption, every guarantee and the environment facts hold together?"
     tables = _table_witness(h, comment)
     r = tables or h.sat([], comment=comment)
@@ -204,12 +233,18 @@ def check_node(checked: Checked, node: str, facts: Sequence[tuple[ast.Expr, ast.
                            "timeout; no conclusion is drawn.", duration_s=r.duration_s))
 
     out[mark] = _noted(replace(out[mark], smt2=r.smt2), r)
+    done(mark)
     for k in range(1, len(checked.nodes[node].node.guarantees) + 1):
         f = _non_vacuity(h, n, k)
         if f is not None:  # only implications have a premise that can be vacuous
             out.append(f)
+        done(len(out) - 1 if f is not None else len(out))
+    mark = len(out)
     out += realizability_findings(checked, node, facts, instances)
+    done(mark)
+    mark = len(out)
     out += shape_findings(checked, node)
+    done(mark)
     return out
 
 

@@ -60,7 +60,8 @@ from typing import Sequence
 import z3
 
 from rclverify.semantics.encode import Encoder
-from rclverify.semantics.query import STEPS_PER_MS, SAFETY_FACTOR, render_model, satisfiable, smt2_script
+from rclverify.semantics import wallclock
+from rclverify.semantics.query import render_model, satisfiable, smt2_script
 from rclverify.lang import ast
 from rclverify.semantics.natural import natural_typing
 from rclverify.lang.types import Checked, FuncT
@@ -164,12 +165,10 @@ class _Query:
         """``(sat|unsat|unknown, input model)`` of ``f`` asked of Z3's
         quantifier elimination then its SMT solver, within the query's budget
         (resource steps, as :func:`rclverify.semantics.query.budgeted_solver`)."""
-        s = z3.Then("qe", "smt").solver()
-        s.set("rlimit", REALIZABLE_TIMEOUT_MS * STEPS_PER_MS)
-        s.set("timeout", REALIZABLE_TIMEOUT_MS * SAFETY_FACTOR)
+        s = wallclock.limit(z3.Then("qe", "smt").solver(), REALIZABLE_TIMEOUT_MS)
         s.add(*self.enc.axioms(), f)
         try:
-            r = s.check()
+            r = wallclock.check(s)
         except z3.Z3Exception:  # a tactic that refuses the query: undecided here, the general query follows
             return "unknown", None
         if r == z3.sat:
@@ -183,7 +182,26 @@ def realizability_findings(checked: Checked, node: str, facts: Sequence[tuple[as
     is not realizable, ``ok`` when Z3 proves it is; ``[]`` when not decided
     or not checked (module docstring).  ``facts``: the plan's
     environment facts of the node with their locations; ``instances``: its
-    ``instances`` range (the tables' size).  Never raises on solver trouble."""
+    ``instances`` range (the tables' size).  Never raises on solver trouble.
+
+    When the wall-clock safety net cut any of its queries
+    (:mod:`rclverify.semantics.wallclock`: a loaded machine), the finding is
+    ``inconclusive`` ("took longer than N s"), never the model of the path
+    the cut led to: the search for the conflicting guarantees moves on to
+    the next subset when one is undecided, so a cut would show another
+    input and other guarantees than the budget finds (issue 67)."""
+    with wallclock.watch() as w:
+        found = _realizability(checked, node, facts, instances)
+    if not w.cut:
+        return found
+    return [Finding(f"{node}.realizable", node, "realizable", None, "inconclusive",
+                    f"Whether the contract of {node} can be implemented was not decided here.",
+                    f"A realizability query {wallclock.cut_reason()}.")]
+
+
+def _realizability(checked: Checked, node: str, facts: Sequence[tuple[ast.Expr, ast.Loc]],
+                   instances: tuple[int, int] | None) -> list[Finding]:
+    """:func:`realizability_findings`, whatever the wall clock did."""
     cn = checked.nodes[node]
     n = cn.node
     if not n.guarantees or not n.outputs:

@@ -53,6 +53,7 @@ import z3
 
 from rclverify.semantics.modeltext import value_to_rcl
 from rclverify.semantics.query import budgeted_solver
+from rclverify.semantics.wallclock import check
 from rclverify.semantics.retry import has_quantifier
 
 #: Synthesis/verification rounds per template.
@@ -152,7 +153,7 @@ def _cegis(params: Sequence[z3.ExprRef], terms: Sequence[_Term], given: Sequence
     answered = z3.substitute(body, *[(o, _expr(t)) for o, t in zip(outs, terms)])
     synth = budgeted_solver(CHECK_MS)
     for _ in range(ROUNDS):
-        if synth.check() != z3.sat:
+        if check(synth) != z3.sat:
             return None
         m = synth.model()
         values = {p.get_id(): m.eval(p, model_completion=True) for p in params}
@@ -160,7 +161,7 @@ def _cegis(params: Sequence[z3.ExprRef], terms: Sequence[_Term], given: Sequence
         query = [*given, z3.Not(z3.substitute(body, *zip(outs, ws)))]
         v = budgeted_solver(CHECK_MS)
         v.add(*query)
-        r = v.check()
+        r = check(v)
         if r == z3.unsat:
             return values, query
         if r != z3.sat:
@@ -173,7 +174,7 @@ def _cegis(params: Sequence[z3.ExprRef], terms: Sequence[_Term], given: Sequence
 
 def _name(x: z3.ExprRef, names: dict[str, str]) -> str:
     n = x.decl().name()
-    return names.get(n, n)
+    return str(names.get(n, n))
 
 
 def _text(t: _Term, values: dict[int, z3.ExprRef], names: dict[str, str]) -> str:

@@ -33,7 +33,8 @@ from typing import Any, Iterator, Sequence
 import z3
 
 from rclverify.semantics.encode import value_to_rcl
-from rclverify.semantics.query import SAFETY_FACTOR, budgeted_solver, render_model, steps
+from rclverify.semantics.query import budgeted_solver, render_model
+from rclverify.semantics.wallclock import check, limit
 from rclverify.semantics.retry import load_canonical
 
 #: Points of each function table (at least the plan's instances: see :func:`points_for`).
@@ -165,18 +166,18 @@ def finite_witness(enc: Any, formulas: Sequence[z3.BoolRef], points: int,
             load_canonical(s, all_formulas)
         else:
             s.add(*all_formulas)
-        if s.check() == z3.sat and _confirmed(s.assertions(), s.model()):
+        if check(s) == z3.sat and _confirmed(s.assertions(), s.model()):
             m = s.model()
             return Witness("sat", _render(m, enc, tables, points),
                            None if deterministic else _found(m, enc, ctx, tables, points))
     if deterministic:
         s = budgeted_solver(budget_ms, z3.Context())
         load_canonical(s, all_formulas)
-        if s.check() != z3.sat:
+        if check(s) != z3.sat:
             return Witness("inconclusive")
     else:
         s = budgeted_solver(budget_ms, ctx)
-        if s.check(*all_formulas) != z3.sat:
+        if check(s, *all_formulas) != z3.sat:
             return Witness("inconclusive")
         return Witness("sat", _render(s.model(), enc, tables, points), _found(s.model(), enc, ctx, tables, points))
     return Witness("sat", _render(s.model(), enc, tables, points))
@@ -185,9 +186,7 @@ def finite_witness(enc: Any, formulas: Sequence[z3.BoolRef], points: int,
 def _tactic_solver(budget_ms: int, ctx: z3.Context) -> z3.Solver:
     """A solver of the tactics :data:`SIMPLIFIED` in ``ctx``, budgeted as
     :func:`rclverify.semantics.query.budgeted_solver` budgets one."""
-    s = z3.Then(*SIMPLIFIED, ctx=ctx).solver()
-    s.set("rlimit", steps(budget_ms))
-    s.set("timeout", max(1, int(budget_ms * SAFETY_FACTOR)))
+    s: z3.Solver = limit(z3.Then(*SIMPLIFIED, ctx=ctx).solver(), budget_ms)
     return s
 
 
@@ -205,7 +204,7 @@ def _confirmed(formulas: Sequence[z3.BoolRef], model: z3.ModelRef) -> bool:
     subs = [(c, model.eval(c, model_completion=True)) for c in consts.values()]
     fixed = [z3.substitute(f, *subs) for f in formulas] if subs else list(formulas)
     s = budgeted_solver(EXTEND_TIMEOUT_MS, model.ctx)
-    return bool(s.check(*fixed) == z3.sat)
+    return bool(check(s, *fixed) == z3.sat)
 
 
 def _found(model: z3.ModelRef, enc: Any, ctx: z3.Context, tables: dict[str, tuple[str, z3.FuncDeclRef]],
@@ -287,7 +286,7 @@ def extend(w: Witness, enc: Any, formulas: Sequence[z3.BoolRef], budget_ms: int 
     if _fixed_left(new, f):
         return Witness("inconclusive")
     s = budgeted_solver(budget_ms, f.ctx)
-    if s.check(*new) != z3.sat:
+    if check(s, *new) != z3.sat:
         return Witness("inconclusive")
     added = render_model(s.model(), enc)
     return Witness("sat", {**w.model, **{k: v for k, v in added.items() if k not in w.model}})
