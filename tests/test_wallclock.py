@@ -1,0 +1,126 @@
+"""The wall-clock safety net never decides what is recorded (issue 67;
+docs/decisions.md, "Results never depend on the wall clock").
+
+The net is made tiny (:data:`rclverify.semantics.wallclock.SAFETY_FACTOR`,
+read when a solver is made) so that it fires before the budget of steps on
+queries of a few hundred milliseconds, as it does on a loaded machine;
+each result is then either the one an ample net gives or marked as cut
+short ("took longer than N s"), never another model shown as the answer.
+"""
+from __future__ import annotations
+
+from typing import Any
+
+import pytest
+import z3
+
+from rclverify.calculus.health.realizable import realizability_findings
+from rclverify.lang.parser import parse_text
+from rclverify.lang.typecheck import check
+from rclverify.semantics import query, wallclock, world
+from rclverify.semantics.nicemodel import nicer_model
+
+#: Nets of 0.04 times the budget: 80 ms for a 2,000 ms budget, 12 ms for the
+#: readable model's 300 ms (Z3 does not always honour a net of 1-2 ms: its
+#: timer can fire before the search starts and be forgotten).
+TINY = 0.04
+
+
+def _refutable() -> tuple[z3.BoolRef, list[z3.BoolRef]]:
+    """A validity query, made in a fresh Z3 world, that Z3's default
+    strategy refutes in some 1.4 million steps (0.3 s of an idle core:
+    five sums of cubes and a quantifier over 1,000 instances), well within
+    a 2,000 ms budget (4 million steps); a net of 80 ms cuts it."""
+    world.fresh()
+    f = z3.Function("f", z3.IntSort(), z3.IntSort())
+    x, y, k = z3.Ints("x y k")
+    hyps = [z3.ForAll([k], z3.Implies(z3.And(k >= 0, k <= 1000), f(k) * f(k) >= x + k)), x > 7, y == f(3) + f(5)]
+    for i in range(5):
+        u, v = z3.Ints(f"u{i} v{i}")
+        hyps += [u * u * u + v * v * v == 32832, u > 4, v > u]
+    return y < 30, hyps
+
+
+def _cut(r: Any) -> bool:
+    return bool(r.status == "inconclusive" and "wall-clock" in r.reason)
+
+
+def test_check_counts_the_nets_cut_and_not_the_budgets(monkeypatch: pytest.MonkeyPatch) -> None:
+    goal, hyps = _refutable()
+    before = wallclock.cuts()
+    s = wallclock.limit(z3.Solver(), 200, rlimit=1)  # the budget (one step) stops it, long before a 2 s net
+    s.add(*hyps, z3.Not(goal))
+    assert wallclock.check(s) == z3.unknown and wallclock.cuts() == before
+    monkeypatch.setattr(wallclock, "SAFETY_FACTOR", TINY)
+    s = wallclock.limit(z3.Solver(), 2000)  # 4,000,000 steps, an 80 ms net: the net stops it
+    s.add(*hyps, z3.Not(goal))
+    with wallclock.watch() as w:
+        assert wallclock.check(s) == z3.unknown
+    assert w.cut and wallclock.cuts() == before + 1 and "longer than 0.08 s" in wallclock.cut_reason()
+
+
+def test_a_cut_query_is_inconclusive_not_a_retrys_other_model(monkeypatch: pytest.MonkeyPatch) -> None:
+    goal, hyps = _refutable()
+    ample = query.prove(goal, hyps, timeout_ms=2000)
+    assert ample.status == "refuted" and ample.strategy == "" and ample.model is not None
+    monkeypatch.setattr(wallclock, "SAFETY_FACTOR", TINY)
+    with wallclock.watch() as w:
+        cut = query.prove(goal, hyps, timeout_ms=2000)
+    assert w.cut  # the net fired (today's code then asked the retries, whose models differ)
+    assert _cut(cut) and cut.model is None and "took longer than 0.08 s" in cut.reason
+
+
+def test_a_cut_satisfiability_query_is_inconclusive(monkeypatch: pytest.MonkeyPatch) -> None:
+    goal, hyps = _refutable()
+    labelled = [(f"h{k}", h) for k, h in enumerate(hyps)] + [("goal", z3.Not(goal))]
+    assert query.satisfiable(labelled, timeout_ms=2000).status == "sat"
+    monkeypatch.setattr(wallclock, "SAFETY_FACTOR", TINY)
+    assert _cut(query.satisfiable(labelled, timeout_ms=2000))
+
+
+def test_a_readable_model_cut_short_is_the_first_model(monkeypatch: pytest.MonkeyPatch) -> None:
+    from rclverify.semantics.encode import Encoder
+    world.fresh()
+    checked = check([parse_text("node N { inputs( a : REAL, b : REAL ) outputs( c : REAL ) "
+                                "guarantee( out.c >= in.a ) }", "n.rcl")])
+    enc = Encoder(checked.env)
+    cn = checked.nodes["N"]
+    a, b = enc.io_symbol(cn, "in", "a"), enc.io_symbol(cn, "in", "b")
+    cubes = []  # two sums of cubes: each of the loop's queries takes some 50 ms of an idle core
+    for i in range(2):
+        u, v = z3.Ints(f"u{i} v{i}")
+        cubes += [u * u * u + v * v * v == 32832, u > 4, v > u]
+    formulas = [*cubes, 3 * a > b, b * 7 > 2, a < 100]
+    first = {"N.in.a": "1/3", "N.in.b": "3/7"}  # the caller's model, its values not short
+    ample = nicer_model(formulas, enc, first)
+    assert ample.changed and ample.model != first  # rounded to short values
+    monkeypatch.setattr(wallclock, "SAFETY_FACTOR", TINY)
+    with wallclock.watch() as w:
+        cut = nicer_model(formulas, enc, first)
+    assert w.cut and cut.model == first and not cut.changed  # today's code showed the loop's last model
+
+
+#: Not realizable (on with x > 10: y == x breaks y <= 10); its assumption a
+#: sum of cubes, so that its queries take some 0.3 s of an idle core.
+CLAMP = """
+node C {
+  inputs( x : INTEGER, on : BOOL, u : INTEGER, v : INTEGER )
+  outputs( y : INTEGER )
+  assume( 0 <= in.x and in.u * in.u * in.u + in.v * in.v * in.v == 32832 and 4 < in.u and in.u < in.v )
+  guarantee( in.on -> out.y == in.x )
+  guarantee( out.y <= 10 )
+}
+"""
+
+
+def test_a_cut_health_finding_is_inconclusive_never_another_model(monkeypatch: pytest.MonkeyPatch) -> None:
+    checked = check([parse_text(CLAMP, "c.rcl")])
+    world.fresh()
+    [ample] = realizability_findings(checked, "C")
+    assert ample.status == "problem" and ample.model is not None and int(ample.model["C.in.x"]) > 10
+    monkeypatch.setattr(wallclock, "SAFETY_FACTOR", TINY)
+    world.fresh()
+    with wallclock.watch() as w:
+        [cut] = realizability_findings(checked, "C")
+    assert w.cut and cut.status == "inconclusive" and cut.model is None and cut.core is None
+    assert cut.id == ample.id and "took longer than" in cut.explanation
