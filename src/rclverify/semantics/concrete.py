@@ -24,6 +24,7 @@ from rclverify.lang import ast
 from rclverify.lang.types import Checked, CheckedNode, DataT, EnumT, FuncT, Scalar, SeqT, SetT, TupleT, Type
 from rclverify.semantics.values import FiniteFunction, Term, exact
 from rclverify.semantics.encode import Encoder, sort_of, widen
+from rclverify.semantics import wallclock
 from rclverify.semantics.retry import SAFETY_TIMEOUT_MS
 from rclverify.semantics.world import on_fresh
 
@@ -144,7 +145,8 @@ def check_concrete(formula: ast.Expr, checked: Checked, node: CheckedNode, value
     ``(False, "")`` when it is violated, ``(None, reason)`` when Z3 answers
     unknown (``reason`` is Z3's, e.g. ``"max. resource limit exceeded"``)
     within the resource budget ``rlimit`` (Z3 steps; ``timeout_ms``
-    milliseconds of wall-clock time are only a safety net).  Raises ``KeyError`` for a name that is not an I/O
+    milliseconds of wall-clock time are only a safety net: when it fires,
+    ``reason`` says "took longer than N s", :mod:`.wallclock`).  Raises ``KeyError`` for a name that is not an I/O
     variable of ``node``, :class:`ConcreteValueError` for a value of the
     wrong shape, :class:`~rclverify.semantics.encode.EncodingError` for a formula
     Z3 cannot express.
@@ -179,14 +181,15 @@ def check_concrete(formula: ast.Expr, checked: Checked, node: CheckedNode, value
         return False, ""
     s = z3.Solver()
     s.set("rlimit", int(rlimit))
-    s.set("timeout", int(timeout_ms))
+    wallclock.note_limit(s, timeout_ms)  # a safety net: its firing is told apart (issue 67)
     s.add(z3.Not(phi))
-    r = s.check()
+    seen = wallclock.cuts()
+    r = wallclock.check(s)
     if r == z3.unsat:
         return True, ""
     if r == z3.sat:
         return False, ""
-    return None, s.reason_unknown() or "unknown"
+    return None, wallclock.cut_reason() if wallclock.cuts() != seen else s.reason_unknown() or "unknown"
 
 
 def false_whatever_the_rest(formula: ast.Expr, checked: Checked, node: CheckedNode, values: Mapping[str, Any], *,
@@ -221,9 +224,9 @@ def false_whatever_the_rest(formula: ast.Expr, checked: Checked, node: CheckedNo
         body = z3.substitute_funs(body, *funcs)
     s = z3.Solver()
     s.set("rlimit", int(rlimit))
-    s.set("timeout", int(timeout_ms))
+    wallclock.note_limit(s, timeout_ms)
     s.add(body)
-    return s.check() == z3.unsat
+    return bool(wallclock.check(s) == z3.unsat)
 
 
 __all__ = ["ConcreteValueError", "check_concrete", "false_whatever_the_rest", "finite_interpretation", "to_z3"]

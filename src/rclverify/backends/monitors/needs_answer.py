@@ -39,6 +39,7 @@ from typing import Any, Iterable, Mapping
 import z3
 
 from rclverify.semantics.encode import Encoder
+from rclverify.semantics.query import budgeted_solver
 from rclverify.lang import ast
 from rclverify.lang.types import BOOL, INTEGER, NATURAL, REAL, Checked, CheckedNode, EnumT
 
@@ -98,8 +99,7 @@ def _decides(checked: Checked, node: CheckedNode, formulas: list[ast.Expr]) -> b
         typed = z3.And(*enc.axioms()) if enc.axioms() else z3.BoolVal(True)
         for g in encoded:
             for goal in (g, z3.Not(g)):
-                s = z3.Solver()
-                s.set("timeout", QUERY_MS)
+                s = budgeted_solver(QUERY_MS)  # resource steps decide, not the clock (issue 67)
                 s.add(z3.ForAll(outs, z3.Implies(typed, goal)) if outs else goal)
                 if s.check() != z3.unsat:  # a value of the inputs decides it (or Z3 cannot say)
                     return False
