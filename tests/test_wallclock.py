@@ -26,6 +26,12 @@ from rclverify.semantics.nicemodel import nicer_model
 TINY = 0.04
 
 
+def tiny(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Every net :data:`TINY` times its budget, the floor of 1 s removed."""
+    monkeypatch.setattr(wallclock, "MIN_WALL_MS", 0)
+    monkeypatch.setattr(wallclock, "SAFETY_FACTOR", TINY)
+
+
 def _refutable() -> tuple[z3.BoolRef, list[z3.BoolRef]]:
     """A validity query, made in a fresh Z3 world, that Z3's default
     strategy refutes in some 1.4 million steps (0.3 s of an idle core:
@@ -51,7 +57,7 @@ def test_check_counts_the_nets_cut_and_not_the_budgets(monkeypatch: pytest.Monke
     s = wallclock.limit(z3.Solver(), 200, rlimit=1)  # the budget (one step) stops it, long before a 2 s net
     s.add(*hyps, z3.Not(goal))
     assert wallclock.check(s) == z3.unknown and wallclock.cuts() == before
-    monkeypatch.setattr(wallclock, "SAFETY_FACTOR", TINY)
+    tiny(monkeypatch)
     s = wallclock.limit(z3.Solver(), 2000)  # 4,000,000 steps, an 80 ms net: the net stops it
     s.add(*hyps, z3.Not(goal))
     with wallclock.watch() as w:
@@ -63,7 +69,7 @@ def test_a_cut_query_is_inconclusive_not_a_retrys_other_model(monkeypatch: pytes
     goal, hyps = _refutable()
     ample = query.prove(goal, hyps, timeout_ms=2000)
     assert ample.status == "refuted" and ample.strategy == "" and ample.model is not None
-    monkeypatch.setattr(wallclock, "SAFETY_FACTOR", TINY)
+    tiny(monkeypatch)
     with wallclock.watch() as w:
         cut = query.prove(goal, hyps, timeout_ms=2000)
     assert w.cut  # the net fired (today's code then asked the retries, whose models differ)
@@ -74,7 +80,7 @@ def test_a_cut_satisfiability_query_is_inconclusive(monkeypatch: pytest.MonkeyPa
     goal, hyps = _refutable()
     labelled = [(f"h{k}", h) for k, h in enumerate(hyps)] + [("goal", z3.Not(goal))]
     assert query.satisfiable(labelled, timeout_ms=2000).status == "sat"
-    monkeypatch.setattr(wallclock, "SAFETY_FACTOR", TINY)
+    tiny(monkeypatch)
     assert _cut(query.satisfiable(labelled, timeout_ms=2000))
 
 
@@ -94,7 +100,7 @@ def test_a_readable_model_cut_short_is_the_first_model(monkeypatch: pytest.Monke
     first = {"N.in.a": "1/3", "N.in.b": "3/7"}  # the caller's model, its values not short
     ample = nicer_model(formulas, enc, first)
     assert ample.changed and ample.model != first  # rounded to short values
-    monkeypatch.setattr(wallclock, "SAFETY_FACTOR", TINY)
+    tiny(monkeypatch)
     with wallclock.watch() as w:
         cut = nicer_model(formulas, enc, first)
     assert w.cut and cut.model == first and not cut.changed  # today's code showed the loop's last model
@@ -118,7 +124,7 @@ def test_a_cut_health_finding_is_inconclusive_never_another_model(monkeypatch: p
     world.fresh()
     [ample] = realizability_findings(checked, "C")
     assert ample.status == "problem" and ample.model is not None and int(ample.model["C.in.x"]) > 10
-    monkeypatch.setattr(wallclock, "SAFETY_FACTOR", TINY)
+    tiny(monkeypatch)
     world.fresh()
     with wallclock.watch() as w:
         [cut] = realizability_findings(checked, "C")

@@ -46,6 +46,9 @@ import z3
 STEPS_PER_MS = 2_000
 #: The wall-clock safety net, a multiple of a budget's time on an idle core.
 SAFETY_FACTOR = 10
+#: The shortest net (ms): a smaller one fires on the cost of starting a check
+#: (a first look of a few steps takes a millisecond), not on the search.
+MIN_WALL_MS = 1_000
 
 _LIMITS: "weakref.WeakKeyDictionary[Any, int]" = weakref.WeakKeyDictionary()
 
@@ -65,10 +68,11 @@ def steps(budget_ms: float) -> int:
 
 
 def wall_ms(budget_ms: float) -> int:
-    """The wall-clock limit (ms, at least 1) of a budget of ``budget_ms``
-    milliseconds' worth of resource steps: :data:`SAFETY_FACTOR` times it,
-    read when called (so a test can make it tiny)."""
-    return max(1, int(budget_ms * SAFETY_FACTOR))
+    """The wall-clock limit (ms) of a budget of ``budget_ms`` milliseconds'
+    worth of resource steps: :data:`SAFETY_FACTOR` times it, at least
+    :data:`MIN_WALL_MS` (and 1), both read when called (so a test can make
+    the net tiny)."""
+    return max(1, MIN_WALL_MS, int(budget_ms * SAFETY_FACTOR))
 
 
 def note_limit(s: Any, timeout_ms: int) -> Any:
@@ -133,4 +137,4 @@ def watch() -> Iterator[Watch]:
     yield Watch(_TALLY.cuts)
 
 
-__all__ = ["SAFETY_FACTOR", "STEPS_PER_MS", "steps", "Watch", "check", "cut_reason", "cuts", "limit", "note_limit", "wall_ms", "watch"]
+__all__ = ["MIN_WALL_MS", "SAFETY_FACTOR", "STEPS_PER_MS", "steps", "Watch", "check", "cut_reason", "cuts", "limit", "note_limit", "wall_ms", "watch"]
